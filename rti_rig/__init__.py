@@ -1,0 +1,1 @@
+"""rti_rig package."""
