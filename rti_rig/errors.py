@@ -1,0 +1,58 @@
+"""Error hierarchy.
+
+Every error a user can meet says *where* (file and line, config key, device, LED or step) and
+*what to do*. Callers catch :class:`RtiRigError` at the CLI edge and print it without a traceback.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class RtiRigError(Exception):
+    """Base class of every error rti-rig raises on purpose."""
+
+
+class ConfigError(RtiRigError):
+    """A rig config is unreadable or invalid; names the file and the key."""
+
+    def __init__(self, path: Path | str, key: str | None, message: str) -> None:
+        self.path = str(path)
+        self.key = key
+        self.message = message
+        where = f"{self.path}: key '{key}'" if key else self.path
+        super().__init__(f"{where}: {message}")
+
+
+class LpFormatError(RtiRigError):
+    """An `.lp` light-position file breaks the format; names the file and line."""
+
+    def __init__(self, path: Path | str, line: int | None, message: str) -> None:
+        self.path = str(path)
+        self.line = line
+        self.message = message
+        where = f"{self.path}, line {line}" if line is not None else self.path
+        super().__init__(f"{where}: {message}")
+
+
+class ScheduleError(RtiRigError):
+    """A light schedule cannot run on this rig (found before anything moves)."""
+
+
+class DeviceError(RtiRigError):
+    """A device failed or answered wrongly; names the device and the command."""
+
+    def __init__(self, device: str, message: str, command: str | None = None) -> None:
+        self.device = device
+        self.command = command
+        self.message = message
+        cmd = f" during '{command}'" if command else ""
+        super().__init__(f"{device}{cmd}: {message}")
+
+
+class CaptureError(DeviceError):
+    """The camera did not deliver a usable frame."""
+
+
+class SessionError(RtiRigError):
+    """The session folder cannot be written or read as asked (never overwrites captures)."""

@@ -1,0 +1,72 @@
+"""The coordinate frame shared by the whole project, and conversions within it.
+
+Object-centred, right-handed: x to the right of the image, y to the top of the image (image rows
+run the other way), z towards the camera. A light direction is the unit vector from the object to
+the light. Azimuth is measured from +x towards +y; elevation from the object plane (0° grazing,
+90° on the camera axis). This is the frame of `.lp` files, relight and DiLiGenT.
+
+Conversions use ``atan2`` on both angles so that they stay accurate at the zenith (where the
+azimuth is undefined and is reported as 0) and at the horizon (where ``asin(z)`` loses precision).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+#: Below this horizontal length a direction is treated as the zenith (or nadir): azimuth 0.
+ZENITH_EPS = 1e-12
+
+
+def normalize(vectors: ArrayLike) -> NDArray[np.float64]:
+    """Unit vectors along ``vectors`` (..., 3); raises on zero or non-finite input."""
+    v = np.asarray(vectors, dtype=np.float64)
+    if v.shape[-1] != 3:
+        raise ValueError(f"expected vectors of length 3, got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError("direction contains NaN or infinity")
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    if np.any(n < 1e-12):
+        raise ValueError("zero-length direction has no orientation")
+    return v / n
+
+
+def direction_from_az_el(azimuth_deg: ArrayLike, elevation_deg: ArrayLike) -> NDArray[np.float64]:
+    """Unit direction(s) for azimuth and elevation in degrees; shape (..., 3)."""
+    az = np.radians(np.asarray(azimuth_deg, dtype=np.float64))
+    el = np.radians(np.asarray(elevation_deg, dtype=np.float64))
+    az, el = np.broadcast_arrays(az, el)
+    ce = np.cos(el)
+    return np.stack([ce * np.cos(az), ce * np.sin(az), np.sin(el)], axis=-1)
+
+
+def az_el_from_direction(
+    direction: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Azimuth in [0, 360) and elevation in [-90, 90] degrees of direction(s) (..., 3).
+
+    The input need not be unit length. At the zenith the azimuth is undefined; 0 is returned.
+    """
+    v = normalize(direction)
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    h = np.hypot(x, y)
+    el = np.degrees(np.arctan2(z, h))
+    az = np.where(h < ZENITH_EPS, 0.0, np.degrees(np.arctan2(y, x)) % 360.0)
+    # ``% 360`` can return 360.0 for tiny negative angles through rounding.
+    az = np.where(az >= 360.0, 0.0, az)
+    return az, el
+
+
+def angle_between_deg(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """Angle in degrees between direction(s) ``a`` and ``b``, accurate for tiny angles."""
+    ua, ub = normalize(a), normalize(b)
+    cross = np.linalg.norm(np.cross(ua, ub), axis=-1)
+    dot = np.sum(ua * ub, axis=-1)
+    return np.degrees(np.arctan2(cross, dot))
+
+
+def pixel_to_frame_xy(rows: ArrayLike, cols: ArrayLike, height: int, width: int) -> NDArray:
+    """Frame (x, y) of pixel centres, origin at the image centre, y up (rows run down)."""
+    r = np.asarray(rows, dtype=np.float64)
+    c = np.asarray(cols, dtype=np.float64)
+    return np.stack([c - (width - 1) / 2.0, (height - 1) / 2.0 - r], axis=-1)

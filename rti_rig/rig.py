@@ -1,0 +1,116 @@
+"""Rig capability interfaces: what the controller may ask of a light source and a camera.
+
+Capabilities, not classes: a dome is a *discrete* light source (fire LED *i*), an arm is a
+*continuous* light carrier (move the lamp to a direction). Real drivers and simulated devices
+implement the same protocols, so the controller never knows which it is talking to.
+
+Every device has a documented **safe state** that the controller restores in ``finally``, after
+success, cancellation or any error:
+
+* discrete light source: all LEDs off;
+* light carrier: lamp off, motion stopped, then parked (parking may be refused by policy);
+* camera: no exposure in progress, device released by ``close``.
+
+Devices open their transport in ``connect()`` (never in ``__init__``) and release it in
+``close()``; ``close`` must be safe to call twice and after a failed ``connect``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One captured image as linear data.
+
+    ``pixels`` is linear (proportional to scene radiance, black level removed), ``uint16``,
+    shape (H, W) or (H, W, 3); ``white_level`` is the code value at which the sensor saturates.
+    """
+
+    pixels: NDArray[np.uint16]
+    exposure_s: float
+    gain: float
+    white_level: int
+    timestamp_s: float
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def saturated_fraction(self) -> float:
+        """Fraction of pixels (any channel) at or above the white level."""
+        px = self.pixels if self.pixels.ndim == 2 else self.pixels.max(axis=-1)
+        return float(np.mean(px >= self.white_level))
+
+    @property
+    def black_fraction(self) -> float:
+        """Fraction of pixels (all channels) at zero: underexposed or in full shadow."""
+        px = self.pixels if self.pixels.ndim == 2 else self.pixels.max(axis=-1)
+        return float(np.mean(px == 0))
+
+
+@runtime_checkable
+class DiscreteLightSource(Protocol):
+    """A set of fixed, calibrated lights fired one at a time (an LED dome).
+
+    Safe state: all lights off.
+    """
+
+    name: str
+
+    def connect(self) -> None: ...
+
+    def close(self) -> None: ...
+
+    def light_count(self) -> int: ...
+
+    def light(self, index: int, intensity: float = 1.0) -> None:
+        """Turn on light ``index`` (0-based) alone; any other light goes off."""
+        ...
+
+    def all_off(self) -> None: ...
+
+
+@runtime_checkable
+class LightCarrier(Protocol):
+    """A lamp moved to arbitrary directions (a servo arm). Safe state: lamp off, stopped, parked."""
+
+    name: str
+
+    def connect(self) -> None: ...
+
+    def close(self) -> None: ...
+
+    def unreachable_reason(self, direction: NDArray[np.float64]) -> str | None:
+        """``None`` if ``direction`` can be reached safely, else why not (limits, keep-out)."""
+        ...
+
+    def move_to(self, direction: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Move and wait until in position; return the direction actually reached."""
+        ...
+
+    def lamp(self, on: bool) -> None: ...
+
+    def stop(self) -> None: ...
+
+    def park(self) -> None: ...
+
+
+@runtime_checkable
+class Camera(Protocol):
+    """A camera that captures one linear frame at a fixed exposure.
+
+    Safe state: idle and released (``close``). Nothing automatic: exposure, gain and white
+    balance stay as set.
+    """
+
+    name: str
+
+    def connect(self) -> None: ...
+
+    def close(self) -> None: ...
+
+    def capture(self, exposure_s: float) -> Frame: ...
