@@ -1,0 +1,44 @@
+"""Write one benchmark's figures into its own section of ``docs/benchmarks.md``.
+
+Each benchmark owns a section delimited by HTML comment markers, so benchmarks can be rerun
+independently without clobbering each other's figures.
+"""
+
+from __future__ import annotations
+
+import platform
+import re
+from datetime import UTC, datetime
+from pathlib import Path
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "benchmarks.md"
+HEADER = (
+    "# Benchmarks\n\n"
+    "Figures written by the scripts in `benchmarks/`; each section names the command that "
+    "measured it. Rerun a script to refresh its section.\n"
+)
+
+
+def machine_line() -> str:
+    """One line describing where and when the figures were measured."""
+    import os
+
+    cores = os.cpu_count()
+    when = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
+    py = platform.python_version()
+    return f"Measured {when} on {platform.machine()}, {cores} cores, Python {py}."
+
+
+def write_section(name: str, markdown: str, path: Path = DOCS) -> Path:
+    """Replace (or append) the section ``name`` of the benchmarks document with ``markdown``."""
+    begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
+    block = f"{begin}\n{markdown.rstrip()}\n{end}"
+    text = path.read_text(encoding="utf-8") if path.exists() else HEADER
+    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.DOTALL)
+    if pattern.search(text):
+        text = pattern.sub(lambda _m: block, text)
+    else:
+        text = text.rstrip() + "\n\n" + block + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text if text.endswith("\n") else text + "\n", encoding="utf-8")
+    return path
