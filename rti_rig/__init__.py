@@ -1,1 +1,3 @@
-"""rti_rig package."""
+"""rti-rig: controller for Reflectance Transformation Imaging rigs."""
+
+__version__ = "0.1.0"

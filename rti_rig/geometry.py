@@ -70,3 +70,26 @@ def pixel_to_frame_xy(rows: ArrayLike, cols: ArrayLike, height: int, width: int)
     r = np.asarray(rows, dtype=np.float64)
     c = np.asarray(cols, dtype=np.float64)
     return np.stack([c - (width - 1) / 2.0, (height - 1) / 2.0 - r], axis=-1)
+
+
+def fibonacci_cap(
+    n: int, min_elevation_deg: float = 0.0, max_elevation_deg: float = 90.0
+) -> NDArray[np.float64]:
+    """``n`` directions spread evenly (equal solid angle) over an elevation band of the hemisphere.
+
+    Heights are stratified uniformly in z (z is uniform on the sphere for equal areas) and
+    azimuths advance by the golden angle, which gives near-uniform coverage for any ``n`` without
+    the clustering of rings near the zenith.
+    """
+    if n <= 0:
+        raise ValueError(f"need at least one direction, got {n}")
+    if not 0.0 <= min_elevation_deg < max_elevation_deg <= 90.0:
+        raise ValueError(
+            f"elevation band [{min_elevation_deg}, {max_elevation_deg}] is not within [0, 90]"
+        )
+    z0, z1 = np.sin(np.radians([min_elevation_deg, max_elevation_deg]))
+    i = np.arange(n)
+    z = z0 + (z1 - z0) * (i + 0.5) / n
+    az = i * np.pi * (3.0 - np.sqrt(5.0))
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    return np.stack([r * np.cos(az), r * np.sin(az), z], axis=-1)

@@ -1,0 +1,86 @@
+"""Homogeneous light layouts: the baseline every smarter plan must beat.
+
+For a dome, "homogeneous" means choosing ``n`` of its LEDs that cover the hemisphere (above an
+optional elevation floor) as evenly as possible, without repeats: ideal equal-area directions are
+matched one-to-one to LEDs by minimum total angle (an optimal assignment, not greedy snapping,
+which can pick the same LED twice or leave gaps). For an arm, the ideal directions are used
+directly within its reachable band.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+from rti_rig.errors import ScheduleError
+from rti_rig.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.schedule import LightSchedule
+
+
+def select_uniform_leds(
+    dome: DomeGeometry, n: int, min_elevation_deg: float = 0.0
+) -> NDArray[np.intp]:
+    """Indices (ascending) of ``n`` LEDs spread evenly above ``min_elevation_deg``."""
+    if n <= 0:
+        raise ScheduleError(f"--lights must be at least 1, got {n}")
+    _, el = az_el_from_direction(dome.directions)
+    candidates = np.flatnonzero(el >= min_elevation_deg - 1e-9)
+    if n > len(candidates):
+        floor = f" at or above {min_elevation_deg:g}° elevation" if min_elevation_deg > 0 else ""
+        raise ScheduleError(
+            f"asked for {n} lights but the dome has only {len(candidates)} LEDs{floor}; "
+            f"use --lights {len(candidates)} or fewer"
+        )
+    if n == len(candidates):
+        return np.sort(candidates)
+    lo = max(min_elevation_deg, float(el[candidates].min()))
+    hi = float(el[candidates].max())
+    ideal = fibonacci_cap(n, lo, hi) if hi > lo else fibonacci_cap(n, 0.0, 90.0)
+    cost = angle_between_deg(ideal[:, None, :], dome.directions[candidates][None, :, :])
+    _, cols = linear_sum_assignment(cost)
+    return np.sort(candidates[cols])
+
+
+def order_nearest_neighbour(
+    directions: NDArray[np.float64], start: NDArray[np.float64]
+) -> NDArray[np.intp]:
+    """Greedy nearest-neighbour tour by angle, from ``start``: short moves for an arm."""
+    remaining = list(range(len(directions)))
+    order = []
+    here = np.asarray(start, dtype=np.float64)
+    while remaining:
+        ang = angle_between_deg(directions[remaining], here)
+        k = remaining.pop(int(np.argmin(ang)))
+        order.append(k)
+        here = directions[k]
+    return np.asarray(order, dtype=np.intp)
+
+
+def plan_uniform(
+    geometry: DomeGeometry | ArmGeometry, n: int, min_elevation_deg: float = 0.0
+) -> LightSchedule:
+    """A homogeneous schedule of ``n`` lights, ordered for the rig."""
+    provenance = {"n": n, "min_elevation_deg": min_elevation_deg}
+    if isinstance(geometry, DomeGeometry):
+        leds = select_uniform_leds(geometry, n, min_elevation_deg)
+        return LightSchedule.from_directions(
+            geometry.directions[leds],
+            leds=[int(i) for i in leds],
+            labels=[geometry.names[i] for i in leds],
+            method="uniform",
+            provenance=provenance,
+        )
+    if n <= 0:
+        raise ScheduleError(f"--lights must be at least 1, got {n}")
+    lo = max(min_elevation_deg, geometry.min_elevation_deg)
+    hi = min(geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
+    if lo >= hi:
+        raise ScheduleError(
+            f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
+            f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
+        )
+    dirs = fibonacci_cap(n, lo, hi)
+    order = order_nearest_neighbour(dirs, geometry.park_direction)
+    return LightSchedule.from_directions(dirs[order], method="uniform", provenance=provenance)

@@ -1,0 +1,1 @@
+"""Rig configs shipped with rti-rig (TOML), importable so installed copies can find them."""

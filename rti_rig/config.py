@@ -1,0 +1,283 @@
+"""Rig configuration: one TOML file per rig, validated before anything is built.
+
+A bad config is reported with the file, the dotted key and what is wrong, e.g.
+``rig.toml: key 'dome.rings[2].count': Input should be greater than 0 (got -4)``.
+The config describes *what* the rig is (light layout, camera, timing, limits) and which backend
+drives it; building devices from it happens in :mod:`rti_rig.compose` (the composition root).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from rti_rig.errors import ConfigError, LpFormatError
+from rti_rig.geometry import direction_from_az_el, fibonacci_cap
+from rti_rig.lp_format import read_lp
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Ring(_Strict):
+    """One ring of LEDs at a fixed elevation, evenly spaced in azimuth."""
+
+    elevation_deg: float = Field(ge=0, le=90)
+    count: int = Field(gt=0, le=1000)
+    azimuth_offset_deg: float = 0.0
+
+
+class DomeConfig(_Strict):
+    """Where a dome's LEDs are: rings, an even (Fibonacci) spread, or a calibrated `.lp` file."""
+
+    layout: Literal["rings", "fibonacci", "lp"] = "rings"
+    rings: list[Ring] = Field(default_factory=list)
+    count: int | None = Field(default=None, gt=0, le=1000)
+    min_elevation_deg: float = Field(default=10.0, ge=0, lt=90)
+    lp_file: str | None = None
+    default_lights: int | None = Field(default=None, gt=0, le=1000)
+
+    @model_validator(mode="after")
+    def _layout_has_its_keys(self) -> DomeConfig:
+        if self.layout == "rings" and not self.rings:
+            raise ValueError("layout 'rings' needs at least one [[dome.rings]] table")
+        if self.layout == "fibonacci" and self.count is None:
+            raise ValueError("layout 'fibonacci' needs key 'count' (number of LEDs)")
+        if self.layout == "lp" and not self.lp_file:
+            raise ValueError("layout 'lp' needs key 'lp_file' (path relative to the config)")
+        return self
+
+
+class ArmConfig(_Strict):
+    """Reach, safety limits and motion of an arm that carries one lamp."""
+
+    min_elevation_deg: float = Field(default=5.0, ge=0, lt=90)
+    max_elevation_deg: float = Field(default=80.0, gt=0, le=90)
+    keep_out_half_angle_deg: float = Field(default=8.0, ge=0, lt=90)
+    speed_deg_s: float = Field(default=90.0, gt=0)
+    acceleration_deg_s2: float = Field(default=180.0, gt=0)
+    resolution_deg: float = Field(default=360.0 / 4096, gt=0)
+    park_azimuth_deg: float = 0.0
+    park_elevation_deg: float = 45.0
+    default_lights: int = Field(default=24, gt=0, le=1000)
+
+    @model_validator(mode="after")
+    def _limits_consistent(self) -> ArmConfig:
+        if self.max_elevation_deg <= self.min_elevation_deg:
+            raise ValueError("max_elevation_deg must be above min_elevation_deg")
+        if self.max_elevation_deg > 90.0 - self.keep_out_half_angle_deg + 1e-9:
+            raise ValueError(
+                "max_elevation_deg reaches into the keep-out cone around the camera: "
+                f"keep it at most {90.0 - self.keep_out_half_angle_deg:g}"
+            )
+        return self
+
+
+class CameraConfig(_Strict):
+    """The camera's fixed settings for a session."""
+
+    width: int = Field(default=512, gt=0, le=20000)
+    height: int = Field(default=512, gt=0, le=20000)
+    exposure_s: float = Field(default=0.05, gt=0)
+    gain: float = Field(default=1.0, gt=0)
+    min_exposure_s: float = Field(default=1e-4, gt=0)
+    max_exposure_s: float = Field(default=30.0, gt=0)
+
+    @model_validator(mode="after")
+    def _exposure_in_range(self) -> CameraConfig:
+        if not self.min_exposure_s <= self.exposure_s <= self.max_exposure_s:
+            raise ValueError(
+                f"exposure_s {self.exposure_s} is outside "
+                f"[{self.min_exposure_s}, {self.max_exposure_s}]"
+            )
+        return self
+
+
+class TimingConfig(_Strict):
+    """How long the real rig takes for each part of a step (seconds)."""
+
+    light_switch_s: float = Field(default=0.02, ge=0)
+    settle_s: float = Field(default=0.1, ge=0)
+    readout_s: float = Field(default=0.3, ge=0)
+    transfer_s: float = Field(default=0.7, ge=0)
+
+
+class SceneConfig(_Strict):
+    """What the simulated camera looks at (simulated backend only)."""
+
+    name: str = "relief"
+    seed: int = 0
+    noise: bool = True
+
+
+class RigConfig(_Strict):
+    """A whole rig: what it is, how it is driven, its camera and its timing."""
+
+    name: str = Field(min_length=1)
+    kind: Literal["dome", "arm"]
+    backend: Literal["simulated"] = "simulated"
+    description: str = ""
+    dome: DomeConfig | None = None
+    arm: ArmConfig | None = None
+    camera: CameraConfig = CameraConfig()
+    timing: TimingConfig = TimingConfig()
+    scene: SceneConfig = SceneConfig()
+
+    @model_validator(mode="after")
+    def _kind_has_its_table(self) -> RigConfig:
+        if self.kind == "dome" and self.dome is None:
+            raise ValueError("kind 'dome' needs a [dome] table")
+        if self.kind == "arm" and self.arm is None:
+            raise ValueError("kind 'arm' needs an [arm] table")
+        return self
+
+
+class LoadedRig(BaseModel):
+    """A validated config together with where it came from (for errors and the manifest)."""
+
+    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True)
+
+    config: RigConfig
+    path: str
+    sha256: str
+    raw: dict[str, Any]
+
+    @property
+    def folder(self) -> Path:
+        return Path(self.path).parent
+
+
+def _key_of(loc: tuple[Any, ...]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
+    """Validate parsed TOML; the first problem becomes a :class:`ConfigError`."""
+    try:
+        return RigConfig.model_validate(data)
+    except ValidationError as exc:
+        problems = []
+        for err in exc.errors():
+            key = _key_of(err["loc"]) or None
+            msg = err["msg"].removeprefix("Value error, ")
+            if err["type"] == "extra_forbidden":
+                msg = "unknown key (check its spelling and the table it is in)"
+            elif err["type"] != "value_error" and "input" in err and err["type"] != "missing":
+                msg += f" (got {err['input']!r})"
+            problems.append((key, msg))
+        key, msg = problems[0]
+        if len(problems) > 1:
+            rest = "; ".join(f"'{k}': {m}" if k else m for k, m in problems[1:])
+            msg += f" — and also {rest}"
+        raise ConfigError(path, key, msg) from None
+
+
+def load_rig_config(path: Path | str) -> LoadedRig:
+    """Read and validate a rig config TOML file."""
+    path = Path(path)
+    try:
+        raw_bytes = path.read_bytes()
+    except OSError as exc:
+        raise ConfigError(path, None, f"cannot read the file: {exc.strerror or exc}") from None
+    try:
+        data = tomllib.loads(raw_bytes.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ConfigError(path, None, f"not valid TOML: {exc}") from None
+    config = parse_rig_config(data, str(path))
+    loaded = LoadedRig(
+        config=config,
+        path=str(path.resolve()),
+        sha256=hashlib.sha256(raw_bytes).hexdigest(),
+        raw=data,
+    )
+    if config.kind == "dome":
+        dome_led_directions(loaded)  # fail now, not when the session starts
+    return loaded
+
+
+def default_config_path() -> Path:
+    """The embedded simulated dome config shipped with the package."""
+    return Path(str(resources.files("rig_configs").joinpath("simulated_dome.toml")))
+
+
+def _ring_directions(rings: list[Ring]) -> NDArray[np.float64]:
+    dirs = []
+    for ring in rings:
+        az = ring.azimuth_offset_deg + 360.0 * np.arange(ring.count) / ring.count
+        dirs.append(direction_from_az_el(az, np.full(ring.count, ring.elevation_deg)))
+    return np.concatenate(dirs, axis=0)
+
+
+def dome_led_directions(rig: LoadedRig) -> tuple[NDArray[np.float64], list[str]]:
+    """The dome's calibrated LED directions (N, 3) and their names, in LED index order."""
+    dome = rig.config.dome
+    if dome is None:
+        raise ConfigError(rig.path, "kind", "this rig is not a dome")
+    if dome.layout == "rings":
+        dirs = _ring_directions(dome.rings)
+    elif dome.layout == "fibonacci":
+        assert dome.count is not None
+        dirs = fibonacci_cap(dome.count, dome.min_elevation_deg)
+    else:
+        assert dome.lp_file is not None
+        lp_path = (rig.folder / dome.lp_file).resolve()
+        if not lp_path.exists():
+            raise ConfigError(
+                rig.path,
+                "dome.lp_file",
+                f"file {lp_path} does not exist (paths are relative to the config file's folder)",
+            )
+        try:
+            entries = read_lp(lp_path)
+        except LpFormatError as exc:
+            raise ConfigError(rig.path, "dome.lp_file", str(exc)) from None
+        dirs = np.array([e.direction for e in entries])
+        names = [e.name for e in entries]
+        _check_hemisphere(rig, dirs)
+        return dirs, names
+    if len(dirs) > 1000:
+        raise ConfigError(rig.path, "dome", f"{len(dirs)} LEDs: at most 1000 are supported")
+    _check_hemisphere(rig, dirs)
+    return dirs, [f"led_{i:03d}" for i in range(len(dirs))]
+
+
+def _check_hemisphere(rig: LoadedRig, dirs: NDArray[np.float64]) -> None:
+    below = np.flatnonzero(dirs[:, 2] < -1e-9)
+    if below.size:
+        raise ConfigError(
+            rig.path,
+            "dome",
+            f"LED(s) {below.tolist()} point below the object plane (z < 0): check the layout",
+        )
+
+
+def rig_geometry(rig: LoadedRig) -> DomeGeometry | ArmGeometry:
+    """Where this rig can put light, for the planner and for validation."""
+    cfg = rig.config
+    if cfg.kind == "dome":
+        dirs, names = dome_led_directions(rig)
+        return DomeGeometry(dirs, tuple(names))
+    arm = cfg.arm
+    assert arm is not None
+    return ArmGeometry(
+        min_elevation_deg=arm.min_elevation_deg,
+        max_elevation_deg=arm.max_elevation_deg,
+        keep_out_half_angle_deg=arm.keep_out_half_angle_deg,
+        park_azimuth_deg=arm.park_azimuth_deg,
+        park_elevation_deg=arm.park_elevation_deg,
+    )

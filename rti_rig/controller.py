@@ -1,0 +1,201 @@
+"""The controller: validate a schedule against the rig, run it step by step, always tear down.
+
+Policy lives here, not in drivers: nothing moves until the whole schedule has been checked;
+between steps the run can be cancelled; lights go off after every capture; and whatever happens
+(success, cancel, device error, Ctrl-C) the ``finally`` block puts every device in its safe state
+and writes the session's `.lp` and manifest from the images already on disk.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import StrEnum
+
+from rti_rig.assembly import Rig
+from rti_rig.errors import ScheduleError
+from rti_rig.lp_format import MAX_LIGHTS
+from rti_rig.schedule import LightSchedule, LightStep
+from rti_rig.session import SessionFolder, StepRecord
+
+
+class FinishReason(StrEnum):
+    COMPLETED = "completed"
+    CANCELLED = "cancelled"
+    ERROR = "error"
+    INTERRUPTED = "interrupted"
+
+
+class CancelToken:
+    """Set from another thread or a signal handler; checked between steps."""
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+
+    def cancel(self) -> None:
+        self._event.set()
+
+    @property
+    def cancelled(self) -> bool:
+        return self._event.is_set()
+
+
+@dataclass(frozen=True)
+class StepStarted:
+    index: int
+    total: int
+    step: LightStep
+
+
+@dataclass(frozen=True)
+class StepCompleted:
+    index: int
+    total: int
+    record: StepRecord
+
+
+@dataclass(frozen=True)
+class SessionResult:
+    finish_reason: FinishReason
+    records: tuple[StepRecord, ...]
+    rig_time_s: float
+    wall_time_s: float
+    error: str | None
+    teardown_failures: tuple[str, ...]
+
+
+Event = StepStarted | StepCompleted
+
+
+def step_exposure(rig: Rig, step: LightStep) -> float:
+    return step.exposure_s if step.exposure_s is not None else rig.camera_config.exposure_s
+
+
+def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
+    """Raise :class:`ScheduleError` listing every step the rig cannot run, before anything moves."""
+    if len(schedule) == 0:
+        raise ScheduleError("the schedule has no steps")
+    if len(schedule) > MAX_LIGHTS:
+        raise ScheduleError(
+            f"{len(schedule)} steps: `.lp` readers accept at most {MAX_LIGHTS} images per session"
+        )
+    cam = rig.camera_config
+    problems = []
+    for i, step in enumerate(schedule.steps):
+        reason = rig.lighting.problem(step)
+        exp = step_exposure(rig, step)
+        if reason is None and not cam.min_exposure_s <= exp <= cam.max_exposure_s:
+            reason = f"exposure {exp} s outside [{cam.min_exposure_s}, {cam.max_exposure_s}] s"
+        if reason:
+            label = f" ({step.label})" if step.label else ""
+            problems.append(f"step {i + 1}{label}: {reason}")
+    if problems:
+        shown = "\n  ".join(problems[:10])
+        more = f"\n  ... and {len(problems) - 10} more" if len(problems) > 10 else ""
+        raise ScheduleError(
+            f"the schedule cannot run on rig '{rig.name}' "
+            f"({len(problems)} problem(s)); nothing has moved:\n  {shown}{more}"
+        )
+
+
+def run_session(
+    rig: Rig,
+    schedule: LightSchedule,
+    folder: SessionFolder,
+    *,
+    cancel: CancelToken | None = None,
+    on_event: Callable[[Event], None] | None = None,
+) -> SessionResult:
+    """Run ``schedule`` on ``rig`` into ``folder``; see the module docstring for the guarantees."""
+    validate_schedule(rig, schedule)
+    if folder.total_steps != len(schedule):
+        raise ScheduleError("session folder was sized for another schedule")
+    cancel = cancel or CancelToken()
+    emit = on_event or (lambda _e: None)
+    clock = rig.clock
+    folder.begin(
+        {
+            "rig": {
+                "name": rig.name,
+                "kind": rig.loaded.config.kind,
+                "backend": rig.loaded.config.backend,
+                "config_path": rig.loaded.path,
+                "config_sha256": rig.loaded.sha256,
+                "config": rig.loaded.raw,
+            },
+            "schedule": schedule.to_dict(),
+        }
+    )
+    records: list[StepRecord] = []
+    reason = FinishReason.ERROR
+    error: str | None = None
+    teardown: list[str] = []
+    rig_t0, wall_t0 = clock.now(), time.perf_counter()
+    total = len(schedule)
+    try:
+        rig.lighting.connect()
+        rig.camera.connect()
+        rig.lighting.off()
+        for i, step in enumerate(schedule.steps):
+            if cancel.cancelled:
+                reason = FinishReason.CANCELLED
+                break
+            emit(StepStarted(i, total, step))
+            t_start = clock.now()
+            actual = rig.lighting.set(step)
+            t_lit = clock.now()
+            clock.sleep(rig.timing.settle_s)
+            t_settled = clock.now()
+            frame = rig.camera.capture(step_exposure(rig, step))
+            t_captured = clock.now()
+            rig.lighting.off()
+            record = folder.write_step(
+                i,
+                frame,
+                {
+                    "planned_direction": step.direction,
+                    "actual_direction": actual.direction,
+                    "led": actual.led,
+                    "rig_start_s": t_start - rig_t0,
+                    "light_s": t_lit - t_start,
+                    "settle_s": t_settled - t_lit,
+                    "capture_s": t_captured - t_settled,
+                },
+            )
+            records.append(record)
+            emit(StepCompleted(i, total, record))
+        else:
+            reason = FinishReason.COMPLETED
+    except KeyboardInterrupt:
+        reason, error = FinishReason.INTERRUPTED, "interrupted by the user (Ctrl-C)"
+        raise
+    except Exception as exc:
+        reason, error = FinishReason.ERROR, f"{type(exc).__name__}: {exc}"
+        raise
+    finally:
+        teardown += rig.lighting.safe()
+        for label, close in (
+            ("camera close", rig.camera.close),
+            ("light close", rig.lighting.close),
+        ):
+            try:
+                close()
+            except Exception as exc:  # keep tearing down whatever fails
+                teardown.append(f"{label}: {exc}")
+        rig_time = clock.now() - rig_t0
+        wall_time = time.perf_counter() - wall_t0
+        folder.finish(
+            records,
+            runner={
+                "state": "finished",
+                "finish_reason": str(reason),
+                "error": error,
+                "teardown_failures": teardown,
+                "steps_planned": total,
+                "steps_done": len(records),
+            },
+            timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
+        )
+    return SessionResult(reason, tuple(records), rig_time, wall_time, error, tuple(teardown))

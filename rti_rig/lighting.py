@@ -1,0 +1,139 @@
+"""Lighting policy over the two kinds of light source.
+
+The controller speaks one small vocabulary — check a step, light it, turn it off, go safe — and
+these adapters translate it for a dome (discrete LEDs) or an arm (a lamp moved to a direction).
+They also say what *actually* ran: the calibrated direction of the LED fired, or the direction the
+arm reached, which is what the session's `.lp` records.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from rti_rig.errors import DeviceError
+from rti_rig.geometry import angle_between_deg
+from rti_rig.rig import DiscreteLightSource, LightCarrier
+from rti_rig.rig_geometry import DomeGeometry
+from rti_rig.schedule import LightStep
+
+#: A dome step's direction must match its LED's calibrated direction this closely (degrees).
+LED_MATCH_TOLERANCE_DEG = 0.5
+
+
+@dataclass(frozen=True)
+class ActualLight:
+    """The light that really lit an image."""
+
+    direction: tuple[float, float, float]
+    led: int | None = None
+
+
+class Lighting(Protocol):
+    name: str
+
+    def connect(self) -> None: ...
+
+    def close(self) -> None: ...
+
+    def problem(self, step: LightStep) -> str | None: ...
+
+    def set(self, step: LightStep) -> ActualLight: ...
+
+    def off(self) -> None: ...
+
+    def safe(self) -> list[str]: ...
+
+
+class DomeLighting:
+    """A dome: each step names an LED whose calibrated direction is the recorded one."""
+
+    def __init__(self, source: DiscreteLightSource, geometry: DomeGeometry) -> None:
+        self.source = source
+        self.geometry = geometry
+        self.name = source.name
+
+    def connect(self) -> None:
+        self.source.connect()
+        if self.source.light_count() != self.geometry.count:
+            raise DeviceError(
+                self.name,
+                f"reports {self.source.light_count()} LEDs but the rig config describes "
+                f"{self.geometry.count}: fix the config's LED layout",
+                "connect",
+            )
+
+    def close(self) -> None:
+        self.source.close()
+
+    def problem(self, step: LightStep) -> str | None:
+        if step.led is None:
+            return "a dome step must name an LED (snap the plan to the dome's LEDs)"
+        if not 0 <= step.led < self.geometry.count:
+            return f"LED {step.led} does not exist: this dome has LEDs 0..{self.geometry.count - 1}"
+        off = float(angle_between_deg(step.direction, self.geometry.directions[step.led]))
+        if off > LED_MATCH_TOLERANCE_DEG:
+            return (
+                f"planned direction is {off:.2f}° from LED {step.led}'s calibrated direction: "
+                "the plan was made for another dome layout"
+            )
+        return None
+
+    def set(self, step: LightStep) -> ActualLight:
+        assert step.led is not None
+        self.source.light(step.led, step.intensity)
+        d = self.geometry.directions[step.led]
+        return ActualLight((float(d[0]), float(d[1]), float(d[2])), step.led)
+
+    def off(self) -> None:
+        self.source.all_off()
+
+    def safe(self) -> list[str]:
+        return _attempt([("all LEDs off", self.source.all_off)])
+
+
+class ArmLighting:
+    """An arm: move, then lamp on; the reached direction is the recorded one."""
+
+    def __init__(self, carrier: LightCarrier) -> None:
+        self.carrier = carrier
+        self.name = carrier.name
+
+    def connect(self) -> None:
+        self.carrier.connect()
+
+    def close(self) -> None:
+        self.carrier.close()
+
+    def problem(self, step: LightStep) -> str | None:
+        return self.carrier.unreachable_reason(np.asarray(step.direction))
+
+    def set(self, step: LightStep) -> ActualLight:
+        reached = self.carrier.move_to(np.asarray(step.direction))
+        self.carrier.lamp(True)
+        return ActualLight((float(reached[0]), float(reached[1]), float(reached[2])))
+
+    def off(self) -> None:
+        self.carrier.lamp(False)
+
+    def safe(self) -> list[str]:
+        return _attempt(
+            [
+                ("lamp off", lambda: self.carrier.lamp(False)),
+                ("stop", self.carrier.stop),
+                ("park", self.carrier.park),
+            ]
+        )
+
+
+def _attempt(actions: list[tuple[str, object]]) -> list[str]:
+    """Run every teardown action even if some fail; return the failures as text."""
+    failures = []
+    for label, action in actions:
+        try:
+            action()  # type: ignore[operator]
+        except Exception as exc:  # teardown must go on whatever one device does
+            failures.append(f"{label}: {exc}")
+    return failures

@@ -1,0 +1,193 @@
+"""Reading and writing `.lp` light-position files.
+
+The writer emits the one profile every known reader accepts (see DESIGN.md): a count line (at
+most 1000), then ``name x y z`` with one space, LF endings, unit vectors in fixed point as
+``0.xxxxxx`` / ``-0.xxxxxx`` (RTIBuilder finds numbers with the regex ``-?0\\.[0-9]+``, so ``1``,
+``1.0`` and exponents are never written; components are clamped to ±0.999999).
+
+The reader is tolerant of what real files contain (tabs, CRLF, trailing blanks, blank lines, a
+missing count line, non-unit vectors, which are renormalised) and precise about what it rejects:
+every error names the file, the line and the reason.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath, PureWindowsPath
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.errors import LpFormatError
+
+#: relight refuses files with more lights than this.
+MAX_LIGHTS = 1000
+#: relight rejects directions shorter than this; so do we.
+MIN_NORM = 1e-4
+_CLAMP = 0.999999
+_NAME_OK = re.compile(r"^[^\s]+$")
+
+
+@dataclass(frozen=True)
+class LpEntry:
+    """One line of an `.lp` file: an image name and the unit direction to its light."""
+
+    name: str
+    direction: tuple[float, float, float]
+
+
+def format_component(value: float) -> str:
+    """A direction component in the safe fixed-point form ``0.xxxxxx`` or ``-0.xxxxxx``."""
+    if not math.isfinite(value):
+        raise ValueError(f"cannot write non-finite component {value!r}")
+    v = min(max(value, -_CLAMP), _CLAMP)
+    text = f"{v:.6f}"
+    return "0.000000" if text == "-0.000000" else text
+
+
+def format_lp(entries: Sequence[LpEntry]) -> str:
+    """The text of an `.lp` file for ``entries``, in the safe profile."""
+    if not entries:
+        raise ValueError("an .lp file needs at least one light")
+    if len(entries) > MAX_LIGHTS:
+        raise ValueError(
+            f"{len(entries)} lights: readers such as relight accept at most {MAX_LIGHTS}"
+        )
+    lines = [str(len(entries))]
+    for e in entries:
+        if not _NAME_OK.match(e.name):
+            raise ValueError(f"image name {e.name!r} is empty or contains whitespace")
+        d = np.asarray(e.direction, dtype=np.float64)
+        n = float(np.linalg.norm(d))
+        if not math.isfinite(n) or n < MIN_NORM:
+            raise ValueError(f"direction of {e.name} is zero or not finite: {e.direction}")
+        d = d / n
+        lines.append(f"{e.name} " + " ".join(format_component(float(c)) for c in d))
+    return "\n".join(lines) + "\n"
+
+
+def write_lp(path: Path, entries: Sequence[LpEntry]) -> Path:
+    """Write ``entries`` to ``path`` atomically (temporary file, then rename)."""
+    path = Path(path)
+    text = format_lp(entries)
+    tmp = path.with_name(f".{path.name}.tmp")
+    with open(tmp, "w", encoding="ascii", newline="\n") as fh:
+        fh.write(text)
+    tmp.replace(path)
+    return path
+
+
+def _check_name(name: str, source: str, lineno: int) -> None:
+    """Reject names that would resolve outside the `.lp` file's own folder."""
+    for pure in (PurePosixPath(name), PureWindowsPath(name)):
+        if pure.is_absolute() or pure.drive or pure.anchor:
+            raise LpFormatError(
+                source,
+                lineno,
+                f"image name {name!r} is an absolute path; names must be relative to the .lp "
+                "file's folder (rewrite the name as a bare file name)",
+            )
+        if ".." in pure.parts:
+            raise LpFormatError(
+                source,
+                lineno,
+                f"image name {name!r} climbs out of the .lp file's folder with '..'; "
+                "move the .lp next to the images and use bare file names",
+            )
+
+
+def _parse_float(token: str, source: str, lineno: int, axis: str) -> float:
+    try:
+        value = float(token)
+    except ValueError:
+        hint = " (use '.' as the decimal separator)" if "," in token else ""
+        raise LpFormatError(
+            source, lineno, f"{axis} component {token!r} is not a number{hint}"
+        ) from None
+    if not math.isfinite(value):
+        raise LpFormatError(source, lineno, f"{axis} component {token!r} is not finite")
+    return value
+
+
+def parse_lp(text: str, source: str = "<lp>") -> list[LpEntry]:
+    """Parse `.lp` text; ``source`` names the file in errors."""
+    lines = text.splitlines()  # handles LF, CRLF and CR
+    numbered = [(i + 1, ln.strip()) for i, ln in enumerate(lines)]
+    content = [(n, ln) for n, ln in numbered if ln]
+    if not content:
+        raise LpFormatError(source, None, "the file is empty; expected a count line and lights")
+
+    declared: int | None = None
+    first_no, first = content[0]
+    first_tokens = first.split()
+    if len(first_tokens) == 1:
+        try:
+            declared = int(first_tokens[0])
+        except ValueError:
+            raise LpFormatError(
+                source, first_no, f"count line {first!r} is not a whole number"
+            ) from None
+        if declared <= 0:
+            raise LpFormatError(source, first_no, f"count {declared} must be positive")
+        content = content[1:]
+
+    entries: list[LpEntry] = []
+    seen: dict[str, int] = {}
+    for lineno, line in content:
+        tokens = line.split()
+        if len(tokens) < 4:
+            raise LpFormatError(
+                source,
+                lineno,
+                f"expected 'name x y z', found {len(tokens)} field(s): {line!r}",
+            )
+        # Like relight: the last three fields are the vector, the rest is the name.
+        name = " ".join(tokens[:-3])
+        x, y, z = (
+            _parse_float(t, source, lineno, axis)
+            for t, axis in zip(tokens[-3:], "xyz", strict=True)
+        )
+        norm = math.sqrt(x * x + y * y + z * z)
+        if norm < MIN_NORM:
+            raise LpFormatError(
+                source, lineno, f"direction ({x}, {y}, {z}) is (nearly) zero: it has no orientation"
+            )
+        _check_name(name, source, lineno)
+        if name in seen:
+            raise LpFormatError(
+                source, lineno, f"image name {name!r} already used on line {seen[name]}"
+            )
+        seen[name] = lineno
+        entries.append(LpEntry(name, (x / norm, y / norm, z / norm)))
+
+    if declared is not None and declared != len(entries):
+        raise LpFormatError(
+            source,
+            first_no,
+            f"count line says {declared} lights but the file lists {len(entries)}",
+        )
+    if not entries:
+        raise LpFormatError(source, None, "no light lines after the count line")
+    return entries
+
+
+def read_lp(path: Path | str) -> list[LpEntry]:
+    """Read an `.lp` file tolerantly; errors name the file and line."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise LpFormatError(path, None, f"cannot read: {exc.strerror or exc}") from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")
+    return parse_lp(text, str(path))
+
+
+def directions_of(entries: Iterable[LpEntry]) -> NDArray[np.float64]:
+    """The (N, 3) array of the entries' unit directions."""
+    return np.array([e.direction for e in entries], dtype=np.float64).reshape(-1, 3)

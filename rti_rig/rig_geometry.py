@@ -1,0 +1,75 @@
+"""Where a rig can put light, as plain data the planner can use without any hardware.
+
+A dome offers a finite set of calibrated LED directions; an arm offers a continuous band of
+elevations minus a keep-out cone around the camera. Both come from the rig config.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
+
+
+@dataclass(frozen=True, eq=False)
+class DomeGeometry:
+    """A dome: LED ``i`` lights from ``directions[i]`` and is called ``names[i]``."""
+
+    directions: NDArray[np.float64]
+    names: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        d = np.asarray(self.directions, dtype=np.float64).reshape(-1, 3)
+        d.setflags(write=False)
+        object.__setattr__(self, "directions", d)
+        object.__setattr__(self, "names", tuple(self.names))
+        if len(self.names) != len(d):
+            raise ValueError("one name per LED is needed")
+
+    @property
+    def count(self) -> int:
+        return len(self.directions)
+
+    def nearest_led(self, direction: ArrayLike) -> tuple[int, float]:
+        """Index of the LED closest to ``direction`` and the angle to it in degrees."""
+        ang = angle_between_deg(self.directions, np.asarray(direction, dtype=np.float64))
+        i = int(np.argmin(ang))
+        return i, float(ang[i])
+
+
+@dataclass(frozen=True)
+class ArmGeometry:
+    """An arm's reachable band of light directions and its parking pose."""
+
+    min_elevation_deg: float
+    max_elevation_deg: float
+    keep_out_half_angle_deg: float
+    park_azimuth_deg: float
+    park_elevation_deg: float
+
+    @property
+    def park_direction(self) -> NDArray[np.float64]:
+        return direction_from_az_el(self.park_azimuth_deg, self.park_elevation_deg)
+
+    def unreachable_reason(self, direction: ArrayLike) -> str | None:
+        """``None`` when the arm may go to ``direction``, else the limit it would break."""
+        d = np.asarray(direction, dtype=np.float64)
+        _, el = az_el_from_direction(d)
+        el = float(el)
+        off_axis = float(angle_between_deg(d, (0.0, 0.0, 1.0)))
+        if off_axis < self.keep_out_half_angle_deg:
+            return (
+                f"direction is {off_axis:.2f}° from the camera axis, inside the "
+                f"{self.keep_out_half_angle_deg:g}° keep-out cone"
+            )
+        if el < self.min_elevation_deg - 1e-9:
+            return f"elevation {el:.2f}° is below the arm's minimum {self.min_elevation_deg:g}°"
+        if el > self.max_elevation_deg + 1e-9:
+            return f"elevation {el:.2f}° is above the arm's maximum {self.max_elevation_deg:g}°"
+        return None
+
+
+RigGeometry = DomeGeometry | ArmGeometry

@@ -1,0 +1,165 @@
+"""Simulated light sources: a dome and an arm that keep a shared light state and model time.
+
+They implement the rig protocols, so the controller drives them exactly as it drives hardware.
+The simulated camera renders from the shared :class:`LightState`, i.e. from what the light source
+actually did, not from what the schedule asked for.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.clock import Clock
+from rti_rig.errors import DeviceError
+from rti_rig.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+
+
+@dataclass
+class LightState:
+    """What is lit right now: a direction and a relative intensity, or nothing."""
+
+    direction: NDArray[np.float64] | None = None
+    intensity: float = 0.0
+
+
+class SimulatedDome:
+    """An LED dome with calibrated directions; lighting an LED takes ``switch_s``."""
+
+    def __init__(
+        self, geometry: DomeGeometry, state: LightState, clock: Clock, switch_s: float = 0.02
+    ) -> None:
+        self.name = "simulated dome"
+        self._geometry = geometry
+        self._state = state
+        self._clock = clock
+        self._switch_s = switch_s
+        self._connected = False
+        self.lit: int | None = None
+        self.history: list[tuple[float, int | None]] = []
+
+    def connect(self) -> None:
+        self._connected = True
+
+    def close(self) -> None:
+        self._connected = False
+
+    def light_count(self) -> int:
+        return self._geometry.count
+
+    def _require(self, command: str) -> None:
+        if not self._connected:
+            raise DeviceError(self.name, "not connected; call connect() first", command)
+
+    def light(self, index: int, intensity: float = 1.0) -> None:
+        self._require(f"light {index}")
+        if not 0 <= index < self._geometry.count:
+            raise DeviceError(
+                self.name, f"LED {index} does not exist (0..{self._geometry.count - 1})", "light"
+            )
+        self._clock.sleep(self._switch_s)
+        self.lit = index
+        self._state.direction = self._geometry.directions[index].copy()
+        self._state.intensity = intensity
+        self.history.append((self._clock.now(), index))
+
+    def all_off(self) -> None:
+        # Safe state must be reachable even when not connected (teardown after a failed connect).
+        self.lit = None
+        self._state.direction = None
+        self._state.intensity = 0.0
+        self.history.append((self._clock.now(), None))
+
+
+def trapezoid_move_s(distance: float, speed: float, acceleration: float) -> float:
+    """Time of a rest-to-rest move under a trapezoidal (or triangular) velocity profile."""
+    d = abs(distance)
+    if d == 0.0:
+        return 0.0
+    if d >= speed * speed / acceleration:
+        return d / speed + speed / acceleration
+    return 2.0 * float(np.sqrt(d / acceleration))
+
+
+class SimulatedArm:
+    """A two-axis arm (azimuth, elevation) with quantised joints and trapezoidal moves.
+
+    The azimuth joint turns within [-180°, 180°) without wrapping (a cable forbids endless
+    rotation), so a move from 170° to -170° goes the long way round, as on real rigs.
+    """
+
+    def __init__(
+        self,
+        geometry: ArmGeometry,
+        state: LightState,
+        clock: Clock,
+        speed_deg_s: float,
+        acceleration_deg_s2: float,
+        resolution_deg: float,
+        switch_s: float = 0.02,
+    ) -> None:
+        self.name = "simulated arm"
+        self._geometry = geometry
+        self._state = state
+        self._clock = clock
+        self._speed = speed_deg_s
+        self._accel = acceleration_deg_s2
+        self._res = resolution_deg
+        self._switch_s = switch_s
+        self._connected = False
+        self.joints_deg = (geometry.park_azimuth_deg, geometry.park_elevation_deg)
+        self.lamp_on = False
+        self.moves: list[tuple[float, float]] = []
+
+    def connect(self) -> None:
+        self._connected = True
+
+    def close(self) -> None:
+        self._connected = False
+
+    def unreachable_reason(self, direction: NDArray[np.float64]) -> str | None:
+        return self._geometry.unreachable_reason(direction)
+
+    def _direction(self) -> NDArray[np.float64]:
+        return direction_from_az_el(*self.joints_deg)
+
+    def _move_joints(self, az: float, el: float) -> None:
+        az = round(az / self._res) * self._res
+        el = round(el / self._res) * self._res
+        t = max(
+            trapezoid_move_s(az - self.joints_deg[0], self._speed, self._accel),
+            trapezoid_move_s(el - self.joints_deg[1], self._speed, self._accel),
+        )
+        self._clock.sleep(t)
+        self.joints_deg = (az, el)
+        self.moves.append(self.joints_deg)
+        if self.lamp_on:
+            self._state.direction = self._direction()
+
+    def move_to(self, direction: NDArray[np.float64]) -> NDArray[np.float64]:
+        if not self._connected:
+            raise DeviceError(self.name, "not connected; call connect() first", "move_to")
+        reason = self.unreachable_reason(direction)
+        if reason:
+            raise DeviceError(self.name, f"refused: {reason}", "move_to")
+        az, el = az_el_from_direction(direction)
+        az = float(az)
+        az = az - 360.0 if az >= 180.0 else az
+        self._move_joints(az, float(el))
+        return self._direction()
+
+    def lamp(self, on: bool) -> None:
+        self._clock.sleep(self._switch_s)
+        self.lamp_on = on
+        self._state.direction = self._direction() if on else None
+        self._state.intensity = 1.0 if on else 0.0
+
+    def stop(self) -> None:
+        """Motion is modelled as complete when ``move_to`` returns, so stopping is immediate."""
+
+    def park(self) -> None:
+        self.lamp(False)
+        self._move_joints(self._geometry.park_azimuth_deg, self._geometry.park_elevation_deg)

@@ -1,0 +1,165 @@
+"""The command line, end to end: the README's dry run, plans, exports and clear errors."""
+
+from __future__ import annotations
+
+import re
+import shlex
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import REPO, SMALL_DOME, write_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.geometry import az_el_from_direction
+from rti_rig.image_files import read_linear_tiff
+from rti_rig.lp_format import read_lp
+
+runner = CliRunner()
+
+
+def readme_commands() -> list[str]:
+    """The shell commands in the README's first code block (the two set-up commands)."""
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    block = re.search(r"```(?:sh|bash|console)?\n(.*?)```", text, re.DOTALL)
+    assert block, "README must open with a code block holding the set-up commands"
+    return [ln.strip() for ln in block.group(1).splitlines() if ln.strip() and ln[0] != "#"]
+
+
+def readme_run_args() -> list[str]:
+    """The arguments the README's first command passes to `rti-rig run`."""
+    first = readme_commands()[0]
+    part = first[first.index("rti-rig run") :]
+    return shlex.split(part.split("&&")[0])[1:]
+
+
+def brightest_azimuth_deg(lum: np.ndarray) -> float:
+    """Azimuth (frame of DESIGN.md) of the centroid of the brightest 2 % of pixels."""
+    h, w = lum.shape
+    top = lum >= np.quantile(lum, 0.98)
+    rows, cols = np.nonzero(top)
+    x = cols.mean() - (w - 1) / 2
+    y = (h - 1) / 2 - rows.mean()
+    return float(np.degrees(np.arctan2(y, x)) % 360)
+
+
+def test_readme_first_command_dry_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    args = readme_run_args()
+    assert args[0] == "run" and args[1] == "rig_configs/simulated_dome.toml"
+    out = tmp_path / "session"
+    args[args.index("--out") + 1] = str(out)
+    monkeypatch.chdir(REPO)
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "Session time on the real rig" in result.output
+
+    entries = read_lp(out / "lights.lp")
+    lines = (out / "lights.lp").read_text().splitlines()
+    assert int(lines[0]) == len(lines) - 1 == len(entries)
+    jpgs = sorted(p.name for p in out.glob("*.jpg"))
+    assert [e.name for e in entries] == jpgs  # names match files, in name order
+    assert len(jpgs) == 48
+
+    # The brightest region moves with the light's azimuth (low rings: strong modelling).
+    # Brightness is taken relative to the mean over all lights, so that albedo cancels.
+    lum = np.stack(
+        [
+            read_linear_tiff(out / "linear" / e.name.replace(".jpg", ".tif")).mean(axis=-1)
+            for e in entries
+        ]
+    )
+    relative = lum / (lum.mean(axis=0) + 1.0)
+    checked = 0
+    for e, rel in zip(entries, relative, strict=True):
+        az, el = az_el_from_direction(e.direction)
+        if el > 30:
+            continue
+        got = brightest_azimuth_deg(rel)
+        diff = (got - float(az) + 180) % 360 - 180
+        assert abs(diff) < 25, (e.name, float(az), got)
+        checked += 1
+    assert checked == 24
+
+
+def test_plan_then_run_then_export(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    plan = tmp_path / "plan.lp"
+    r = runner.invoke(app, ["plan", "--rig", str(cfg), "--lights", "5", "--out", str(plan)])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(plan)) == 5
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--plan", str(plan)])
+    assert r.exit_code == 0, r.output
+    exported = tmp_path / "e.lp"
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(exported)])
+    assert r.exit_code == 0, r.output
+    assert exported.read_text() == (out / "lights.lp").read_text()
+    np.testing.assert_allclose(
+        [e.direction for e in read_lp(exported)], [e.direction for e in read_lp(plan)], atol=2e-6
+    )
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(exported)])
+    assert r.exit_code == 2 and "exists" in r.output
+    lin = tmp_path / "lin.lp"
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(lin), "--linear"])
+    assert r.exit_code == 0
+    assert read_lp(lin)[0].name == "linear/image_001.tif"
+
+
+def test_plan_on_bare_lp_keeps_original_names(tmp_path: Path) -> None:
+    src = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    plan = tmp_path / "p.lp"
+    r = runner.invoke(app, ["plan", "--rig", str(src), "--lights", "9", "--out", str(plan)])
+    assert r.exit_code == 0, r.output
+    chosen = read_lp(plan)
+    originals = {e.name: e.direction for e in read_lp(src)}
+    assert len(chosen) == 9 and len({e.name for e in chosen}) == 9
+    for e in chosen:
+        np.testing.assert_allclose(e.direction, originals[e.name], atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["run", "{cfg}", "--out", "{tmp}/s", "--lights", "99"], "only 12 LEDs"),
+        (["run", "{tmp}/missing.toml", "--out", "{tmp}/s"], "cannot read the file"),
+        (["run", "{cfg}", "--out", "{tmp}/s", "--plan", "{tmp}/bad.lp"], "bad.lp, line 2"),
+        (["export-lp", "{tmp}", "--out", "{tmp}/x.lp"], "not an rti-rig session folder"),
+        (["plan", "--rig", "{cfg}", "--method", "magic", "--out", "{tmp}/p.lp"], "not available"),
+    ],
+)
+def test_errors_are_one_clear_line(tmp_path: Path, args: list[str], fragment: str) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    (tmp_path / "bad.lp").write_text("1\nimage_001.jpg 0 0 zero\n")
+    argv = [a.format(cfg=cfg, tmp=tmp_path) for a in args]
+    r = runner.invoke(app, argv)
+    assert r.exit_code == 2, r.output
+    assert fragment in " ".join(r.output.split())
+    assert "Traceback" not in r.output
+
+
+def test_plan_from_another_dome_is_refused(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    plan = tmp_path / "p.lp"
+    plan.write_text("1\nimage_001.jpg 0.3 0.3 0.905539\n")
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--plan", str(plan)])
+    assert r.exit_code == 2
+    assert "no LED of this dome within" in " ".join(r.output.split())
+    assert not (tmp_path / "s").exists()
+
+
+def test_help_explains_commands() -> None:
+    r = runner.invoke(app, ["--help"])
+    assert r.exit_code == 0
+    for word in ("run", "plan", "export-lp", "relight"):
+        assert word in r.output
+    r = runner.invoke(app, ["run", "--help"])
+    assert "--lights" in r.output and "--plan" in r.output and "--out" in r.output
+
+
+def test_ci_runs_the_readme_test_command() -> None:
+    commands = readme_commands()
+    assert len(commands) >= 2 and "pytest" in commands[1]
+    ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
+    assert commands[1] in ci
+    assert commands[0].replace(" || exit 1", "") in ci

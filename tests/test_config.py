@@ -1,0 +1,102 @@
+"""Rig configs: shipped ones load; bad ones name the file, the key and what is wrong."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import SMALL_DOME, write_config
+
+from rti_rig.config import default_config_path, load_rig_config, rig_geometry
+from rti_rig.errors import ConfigError
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+
+
+def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> None:
+    dome = load_rig_config(dome_config_path)
+    g = rig_geometry(dome)
+    assert isinstance(g, DomeGeometry) and g.count == 48
+    assert np.all(g.directions[:, 2] > 0)
+    arm = rig_geometry(load_rig_config(arm_config_path))
+    assert isinstance(arm, ArmGeometry)
+    assert default_config_path().name == "simulated_dome.toml"
+    assert default_config_path().exists()
+
+
+@pytest.mark.parametrize(
+    ("edit", "key", "fragment"),
+    [
+        (("count = 8", "count = -8"), "dome.rings[0].count", "greater than 0"),
+        (("count = 8", "cuont = 8"), "dome.rings[0].count", "'dome.rings[0].cuont': unknown key"),
+        (('kind = "dome"', 'kind = "cupola"'), "kind", "'dome' or 'arm'"),
+        (('backend = "simulated"', 'backend = "usb"'), "backend", "simulated"),
+        (("exposure_s = 0.05", "exposure_s = 100.0"), "camera", "outside"),
+        (("width = 64", 'width = "wide"'), "camera.width", "integer"),
+        (('layout = "rings"', 'layout = "lp"'), "dome", "needs key 'lp_file'"),
+    ],
+)
+def test_bad_values_name_file_and_key(
+    tmp_path: Path, edit: tuple[str, str], key: str, fragment: str
+) -> None:
+    old, new = edit
+    assert old in SMALL_DOME
+    path = write_config(tmp_path, SMALL_DOME.replace(old, new, 1))
+    with pytest.raises(ConfigError) as info:
+        load_rig_config(path)
+    assert info.value.key == key
+    assert fragment in info.value.message
+    assert str(path) in str(info.value)
+
+
+def test_missing_table_and_bad_toml(tmp_path: Path) -> None:
+    no_dome = SMALL_DOME.split("[dome]")[0]
+    with pytest.raises(ConfigError, match=r"needs a \[dome\] table"):
+        load_rig_config(write_config(tmp_path, no_dome))
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        load_rig_config(write_config(tmp_path, "name = \n", "broken.toml"))
+    with pytest.raises(ConfigError, match="cannot read"):
+        load_rig_config(tmp_path / "nope.toml")
+
+
+def test_lp_layout_resolves_relative_to_config(tmp_path: Path) -> None:
+    (tmp_path / "domes").mkdir()
+    (tmp_path / "domes" / "my.lp").write_text("2\nled_1.jpg 0 0.6 0.8\nled_2.jpg 0.6 0 0.8\n")
+    text = SMALL_DOME.replace('layout = "rings"', 'layout = "lp"\nlp_file = "domes/my.lp"')
+    text = text.split("rings = [")[0] + "\n[camera]" + text.split("[camera]")[1]
+    g = rig_geometry(load_rig_config(write_config(tmp_path, text)))
+    assert isinstance(g, DomeGeometry)
+    assert g.names == ("led_1.jpg", "led_2.jpg")
+
+
+def test_lp_layout_errors_name_the_lp_line(tmp_path: Path) -> None:
+    (tmp_path / "bad.lp").write_text("2\nled_1.jpg 0 0.6 0.8\nled_2.jpg 0 0 zero\n")
+    text = SMALL_DOME.replace('layout = "rings"', 'layout = "lp"\nlp_file = "bad.lp"')
+    text = text.split("rings = [")[0] + "\n[camera]" + text.split("[camera]")[1]
+    with pytest.raises(ConfigError) as info:
+        load_rig_config(write_config(tmp_path, text))
+    assert info.value.key == "dome.lp_file"
+    assert "bad.lp, line 3" in str(info.value)
+    missing = text.replace("bad.lp", "gone.lp")
+    with pytest.raises(ConfigError, match="does not exist"):
+        load_rig_config(write_config(tmp_path, missing, "m.toml"))
+
+
+def test_arm_limits_checked(tmp_path: Path) -> None:
+    text = """
+name = "a"
+kind = "arm"
+[arm]
+max_elevation_deg = 88.0
+keep_out_half_angle_deg = 10.0
+"""
+    with pytest.raises(ConfigError, match="keep-out cone"):
+        load_rig_config(write_config(tmp_path, text))
+
+
+def test_led_below_plane_rejected(tmp_path: Path) -> None:
+    (tmp_path / "low.lp").write_text("1\nled_1.jpg 0 0.6 -0.8\n")
+    text = SMALL_DOME.replace('layout = "rings"', 'layout = "lp"\nlp_file = "low.lp"')
+    text = text.split("rings = [")[0] + "\n[camera]" + text.split("[camera]")[1]
+    with pytest.raises(ConfigError, match="below the object plane"):
+        load_rig_config(write_config(tmp_path, text))

@@ -1,0 +1,237 @@
+"""The controller: validate first, record what ran, keep every image, always go safe."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import SMALL_DOME, write_config
+
+from planner.uniform import plan_uniform
+from rti_rig.assembly import Rig
+from rti_rig.compose import build_rig
+from rti_rig.config import load_rig_config
+from rti_rig.controller import (
+    CancelToken,
+    FinishReason,
+    StepCompleted,
+    run_session,
+)
+from rti_rig.errors import CaptureError, DeviceError, ScheduleError, SessionError
+from rti_rig.lp_format import read_lp
+from rti_rig.schedule import LightSchedule, LightStep
+from rti_rig.session import SessionFolder
+
+
+def small_rig(tmp_path: Path) -> Rig:
+    return build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+
+
+class FailingCamera:
+    """Wraps a camera and raises at capture number ``at`` (0-based)."""
+
+    def __init__(self, inner, at: int, exc: BaseException) -> None:  # type: ignore[no-untyped-def]
+        self.inner, self.at, self.exc, self.n = inner, at, exc, 0
+        self.name = "failing camera"
+        self.closed = False
+
+    def connect(self) -> None:
+        self.inner.connect()
+
+    def close(self) -> None:
+        self.closed = True
+        self.inner.close()
+
+    def capture(self, exposure_s: float):  # type: ignore[no-untyped-def]
+        if self.n == self.at:
+            raise self.exc
+        self.n += 1
+        return self.inner.capture(exposure_s)
+
+
+def manifest(folder: Path) -> dict:
+    return json.loads((folder / "manifest.json").read_text())
+
+
+def assert_images_intact(folder: Path, count: int) -> None:
+    jpgs = sorted(folder.glob("image_*.jpg"))
+    tifs = sorted((folder / "linear").glob("image_*.tif"))
+    assert len(jpgs) == count and len(tifs) == count
+    entries = read_lp(folder / "lights.lp") if count else []
+    assert [e.name for e in entries] == [p.name for p in jpgs]
+    steps = manifest(folder)["steps"]
+    assert len(steps) == count
+    import hashlib
+
+    for s in steps:
+        for name, digest in s["sha256"].items():
+            assert hashlib.sha256((folder / name).read_bytes()).hexdigest() == digest
+    assert not list(folder.rglob(".*partial"))
+
+
+def test_complete_session_records_what_ran(tmp_path: Path) -> None:
+    rig = small_rig(tmp_path)
+    schedule = plan_uniform(rig.geometry, 12)
+    out = tmp_path / "s"
+    result = run_session(rig, schedule, SessionFolder.create(out, len(schedule)))
+    assert result.finish_reason is FinishReason.COMPLETED
+    assert_images_intact(out, 12)
+    m = manifest(out)
+    assert m["runner"]["finish_reason"] == "completed"
+    assert m["rig"]["config"]["name"] == "small"
+    assert m["schedule"]["method"] == "uniform"
+    assert set(m["software"]) >= {"rti_rig", "python", "numpy"}
+    t = rig.loaded.config.timing
+    per_step = t.light_switch_s + t.settle_s + 0.05 + t.readout_s + t.transfer_s
+    assert result.rig_time_s == pytest.approx(12 * per_step, rel=1e-9)
+    assert m["timing"]["rig_time_s"] == pytest.approx(result.rig_time_s)
+    lp = read_lp(out / "lights.lp")
+    leds = [s["led"] for s in m["steps"]]
+    np.testing.assert_allclose([e.direction for e in lp], rig.geometry.directions[leds], atol=1e-6)
+    assert rig.lighting.source.lit is None  # type: ignore[attr-defined]
+
+
+def test_cancel_between_steps_keeps_images_and_turns_lights_off(tmp_path: Path) -> None:
+    rig = small_rig(tmp_path)
+    schedule = plan_uniform(rig.geometry, 12)
+    cancel = CancelToken()
+
+    def on_event(e) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(e, StepCompleted) and e.index == 2:
+            cancel.cancel()
+
+    out = tmp_path / "s"
+    result = run_session(
+        rig, schedule, SessionFolder.create(out, 12), cancel=cancel, on_event=on_event
+    )
+    assert result.finish_reason is FinishReason.CANCELLED
+    assert len(result.records) == 3
+    assert_images_intact(out, 3)
+    assert manifest(out)["runner"]["finish_reason"] == "cancelled"
+    dome = rig.lighting.source  # type: ignore[attr-defined]
+    assert dome.lit is None and dome.history[-1][1] is None
+
+
+@pytest.mark.parametrize(
+    ("exc", "reason"),
+    [
+        (CaptureError("cam", "camera busy", "capture"), "error"),
+        (KeyboardInterrupt(), "interrupted"),
+    ],
+)
+def test_failing_capture_keeps_images_and_lights_off(
+    tmp_path: Path, exc: BaseException, reason: str
+) -> None:
+    rig = small_rig(tmp_path)
+    rig.camera = FailingCamera(rig.camera, 4, exc)
+    schedule = plan_uniform(rig.geometry, 12)
+    out = tmp_path / "s"
+    with pytest.raises(type(exc)):
+        run_session(rig, schedule, SessionFolder.create(out, 12))
+    assert_images_intact(out, 4)
+    m = manifest(out)
+    assert m["runner"]["finish_reason"] == reason
+    assert m["runner"]["steps_done"] == 4
+    assert rig.lighting.source.lit is None  # type: ignore[attr-defined]
+    assert rig.camera.closed  # type: ignore[attr-defined]
+
+
+def test_failing_light_and_failing_teardown_are_reported(tmp_path: Path) -> None:
+    rig = small_rig(tmp_path)
+    dome = rig.lighting.source  # type: ignore[attr-defined]
+    real_light, real_off = dome.light, dome.all_off
+    calls = {"n": 0}
+
+    def light(index: int, intensity: float = 1.0) -> None:
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise DeviceError("dome", f"no ack for LED {index}", f"light {index}")
+        real_light(index, intensity)
+
+    def all_off() -> None:
+        real_off()
+        if calls["n"] >= 3:
+            raise DeviceError("dome", "port gone", "all off")
+
+    dome.light, dome.all_off = light, all_off
+    out = tmp_path / "s"
+    with pytest.raises(DeviceError, match="no ack for LED"):
+        run_session(rig, plan_uniform(rig.geometry, 6), SessionFolder.create(out, 6))
+    assert_images_intact(out, 2)
+    runner = manifest(out)["runner"]
+    assert "no ack for LED" in runner["error"]
+    assert any("port gone" in f for f in runner["teardown_failures"])
+
+
+def test_validation_happens_before_anything_moves(tmp_path: Path) -> None:
+    rig = small_rig(tmp_path)
+    good = plan_uniform(rig.geometry, 3)
+    bad = LightSchedule((*good.steps, LightStep(direction=(0, 0, 1), led=40)))
+    out = tmp_path / "s"
+    folder = SessionFolder.create(out, len(bad))
+    with pytest.raises(ScheduleError) as info:
+        run_session(rig, bad, folder)
+    assert "step 4" in str(info.value) and "LED 40 does not exist" in str(info.value)
+    assert rig.lighting.source.history == []  # type: ignore[attr-defined]
+    assert not list(out.glob("image_*"))
+    mismatched = LightSchedule((LightStep(direction=(0, 0, 1), led=0),))
+    with pytest.raises(ScheduleError, match="another dome layout"):
+        run_session(rig, mismatched, SessionFolder.create(tmp_path / "t", 1))
+
+
+def test_never_writes_into_a_non_empty_folder(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    out.mkdir()
+    (out / "keep.jpg").write_bytes(b"precious")
+    with pytest.raises(SessionError, match="not empty"):
+        SessionFolder.create(out, 3)
+    assert (out / "keep.jpg").read_bytes() == b"precious"
+
+
+def test_image_write_refuses_to_overwrite(tmp_path: Path) -> None:
+    rig = small_rig(tmp_path)
+    folder = SessionFolder.create(tmp_path / "s", 2)
+    (folder.root / "image_001.jpg").write_bytes(b"earlier capture")
+    rig.camera.connect()
+    frame = rig.camera.capture(0.05)
+    fields = {
+        "planned_direction": (0.0, 0.0, 1.0),
+        "actual_direction": (0.0, 0.0, 1.0),
+        "led": None,
+        "rig_start_s": 0.0,
+        "light_s": 0.0,
+        "settle_s": 0.0,
+        "capture_s": 0.0,
+    }
+    with pytest.raises(SessionError, match="refusing to overwrite"):
+        folder.write_step(0, frame, fields)
+    assert (folder.root / "image_001.jpg").read_bytes() == b"earlier capture"
+
+
+def test_arm_session_records_reached_directions_and_parks(
+    tmp_path: Path, arm_config_path: Path
+) -> None:
+    text = (
+        arm_config_path.read_text()
+        .replace("width = 512", "width = 48")
+        .replace("height = 512", "height = 48")
+    )
+    rig = build_rig(load_rig_config(write_config(tmp_path, text)))
+    schedule = plan_uniform(rig.geometry, 10)
+    out = tmp_path / "s"
+    result = run_session(rig, schedule, SessionFolder.create(out, 10))
+    assert result.finish_reason is FinishReason.COMPLETED
+    arm = rig.lighting.carrier  # type: ignore[attr-defined]
+    assert not arm.lamp_on
+    assert arm.joints_deg == pytest.approx((0.0, 45.0), abs=0.1)
+    steps = manifest(out)["steps"]
+    for s in steps:
+        angle = np.degrees(
+            np.arccos(np.clip(np.dot(s["planned_direction"], s["actual_direction"]), -1, 1))
+        )
+        assert 0.0 <= angle < 0.1  # quantised to servo ticks, never far off
+    zenith = LightSchedule((LightStep(direction=(0, 0, 1)),))
+    with pytest.raises(ScheduleError, match="keep-out cone"):
+        run_session(rig, zenith, SessionFolder.create(tmp_path / "z", 1))

@@ -1,0 +1,122 @@
+"""`.lp` files: the writer's profile, exact round trips, tolerant reading, precise rejection."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from rti_rig.errors import LpFormatError
+from rti_rig.lp_format import LpEntry, format_lp, parse_lp, read_lp, write_lp
+
+DATA = Path(__file__).parent / "data"
+# The profile of DESIGN.md: count line, then 'name x y z' with fixed-point 0.xxxxxx values.
+PROFILE_LINE = re.compile(r"^[^\s]+( -?0\.\d{6}){3}$")
+
+unit = (
+    st.tuples(*[st.floats(-1, 1, allow_nan=False)] * 3)
+    .filter(lambda v: np.linalg.norm(v) > 1e-3)
+    .map(lambda v: tuple(np.asarray(v) / np.linalg.norm(v)))
+)
+
+
+@given(st.lists(unit, min_size=1, max_size=40))
+def test_round_trip_exact_to_1e6(dirs: list[tuple[float, float, float]]) -> None:
+    entries = [LpEntry(f"image_{i + 1:03d}.jpg", d) for i, d in enumerate(dirs)]
+    back = parse_lp(format_lp(entries))
+    assert [e.name for e in back] == [e.name for e in entries]
+    got = np.array([e.direction for e in back])
+    np.testing.assert_allclose(got, np.array(dirs), atol=1e-6, rtol=0)
+
+
+@given(st.lists(unit, min_size=1, max_size=40))
+def test_written_lines_match_profile(dirs: list[tuple[float, float, float]]) -> None:
+    text = format_lp([LpEntry(f"img_{i:04d}.jpg", d) for i, d in enumerate(dirs)])
+    lines = text.split("\n")
+    assert lines[0] == str(len(dirs))
+    assert lines[-1] == ""  # LF-terminated, no CR anywhere
+    assert "\r" not in text
+    for line in lines[1:-1]:
+        assert PROFILE_LINE.match(line), line
+
+
+def test_axis_directions_never_write_one() -> None:
+    text = format_lp([LpEntry("a_1.jpg", (0, 0, 1)), LpEntry("a_2.jpg", (-1, 0, 0))])
+    assert "a_1.jpg 0.000000 0.000000 0.999999" in text
+    assert "a_2.jpg -0.999999 0.000000 0.000000" in text
+    values = [tok for line in text.splitlines()[1:] for tok in line.split()[1:]]
+    assert len(values) == 6
+    assert all(re.fullmatch(r"-?0\.\d{6}", v) for v in values), values
+
+
+def test_real_dome_file_reads() -> None:
+    entries = read_lp(DATA / "neuralrti" / "dirs.lp")
+    assert len(entries) == 72
+    assert entries[0].name == "image01.jpg"
+    np.testing.assert_allclose(
+        entries[0].direction, (0.205158607891401, -0.237020612397229, 0.949595268999854), atol=1e-12
+    )
+    d = np.array([e.direction for e in entries])
+    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-12)
+    assert np.all(d[:, 2] > 0)
+
+
+def test_tolerant_reading() -> None:
+    text = "2  \r\na_1.jpg\t0.6 0.0 0.8 \r\n\r\na_2.jpg  0 0 2\t\r\n\r\n"
+    entries = parse_lp(text)
+    assert [e.name for e in entries] == ["a_1.jpg", "a_2.jpg"]
+    np.testing.assert_allclose(entries[1].direction, (0, 0, 1))  # renormalised
+    no_count = parse_lp("x_1.jpg 0 0.6 0.8\nx_2.jpg 0.6 0 0.8\n")
+    assert len(no_count) == 2
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "fragment"),
+    [
+        ("3\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n", 1, "count line says 3 lights but the file lists 2"),
+        ("2\na_1.jpg 0 0 1\na_2.jpg 0 x 1\n", 3, "y component 'x' is not a number"),
+        ("1\na_1.jpg 0,5 0 1\n", 2, "decimal separator"),
+        ("1\na_1.jpg 0 0 0\n", 2, "nearly) zero"),
+        ("1\n../a_1.jpg 0 0 1\n", 2, "climbs out"),
+        ("1\nsub/../../a_1.jpg 0 0 1\n", 2, "climbs out"),
+        ("1\n/etc/a_1.jpg 0 0 1\n", 2, "absolute path"),
+        ("1\nC:\\data\\a_1.jpg 0 0 1\n", 2, "absolute path"),
+        ("2\na_1.jpg 0 0 1\na_1.jpg 0 1 0\n", 3, "already used on line 2"),
+        ("1\na_1.jpg 0 0 nan\n", 2, "not finite"),
+        ("1\na_1.jpg 0 1\n", 2, "expected 'name x y z'"),
+        ("two\na_1.jpg 0 0 1\n", 1, "not a whole number"),
+        ("0\n", 1, "must be positive"),
+    ],
+)
+def test_malformed_files_name_line_and_reason(text: str, line: int, fragment: str) -> None:
+    with pytest.raises(LpFormatError) as info:
+        parse_lp(text, "plan.lp")
+    assert info.value.line == line
+    assert fragment in str(info.value)
+    assert str(info.value).startswith(f"plan.lp, line {line}: ")
+
+
+def test_empty_and_missing(tmp_path: Path) -> None:
+    with pytest.raises(LpFormatError, match="empty"):
+        parse_lp("\n \n")
+    with pytest.raises(LpFormatError, match="cannot read"):
+        read_lp(tmp_path / "missing.lp")
+
+
+def test_write_is_atomic_and_complete(tmp_path: Path) -> None:
+    p = write_lp(tmp_path / "x.lp", [LpEntry("a_1.jpg", (0.6, 0, 0.8))])
+    assert p.read_text() == "1\na_1.jpg 0.600000 0.000000 0.800000\n"
+    assert not list(tmp_path.glob(".*tmp"))
+
+
+def test_writer_refuses_bad_entries() -> None:
+    with pytest.raises(ValueError, match="whitespace"):
+        format_lp([LpEntry("a b.jpg", (0, 0, 1))])
+    with pytest.raises(ValueError, match="at least one"):
+        format_lp([])
+    with pytest.raises(ValueError, match="at most 1000"):
+        format_lp([LpEntry(f"a_{i}.jpg", (0, 0, 1)) for i in range(1001)])
