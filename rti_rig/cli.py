@@ -31,11 +31,6 @@ app = typer.Typer(
 err = Console(stderr=True)
 out = Console()
 
-RigArg = Annotated[
-    Path,
-    typer.Argument(help="Rig config TOML (see rig_configs/), e.g. rig_configs/simulated_dome.toml"),
-]
-
 
 def _fail(exc: RtiRigError) -> typer.Exit:
     err.print(f"[bold red]error:[/] {exc}", highlight=False, markup=True, soft_wrap=True)
@@ -55,10 +50,16 @@ def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
 
 @app.command()
 def run(
-    rig_config: RigArg,
+    rig_config: Annotated[
+        Path | None,
+        typer.Argument(
+            help="Rig config TOML (see rig_configs/), e.g. rig_configs/simulated_dome.toml. "
+            "Optional with --resume (the session's own config is used)."
+        ),
+    ] = None,
     out_dir: Annotated[
-        Path, typer.Option("--out", help="New or empty folder to write the session into.")
-    ],
+        Path | None, typer.Option("--out", help="New or empty folder to write the session into.")
+    ] = None,
     lights: Annotated[
         int | None,
         typer.Option(
@@ -75,45 +76,117 @@ def run(
         float,
         typer.Option("--min-elevation-deg", help="Elevation floor of the homogeneous layout."),
     ] = 0.0,
+    resume: Annotated[
+        Path | None,
+        typer.Option(
+            "--resume",
+            help="Continue an interrupted session folder: verify what is on disk and capture "
+            "only the steps not yet done.",
+        ),
+    ] = None,
 ) -> None:
-    """Run a capture session (a dry run when the config's backend is 'simulated')."""
+    """Run a capture session (a dry run when the config's backend is 'simulated').
+
+    Ctrl-C once stops after the current image; Ctrl-C twice or SIGTERM stops at once (lights
+    off, arm parked); SIGUSR1 pauses or resumes between images. An interrupted session can be
+    continued with --resume.
+    """
     from planner.from_lp import schedule_from_lp
     from planner.uniform import plan_uniform
     from rti_rig.compose import build_rig
     from rti_rig.config import load_rig_config, rig_geometry
-    from rti_rig.controller import CancelToken, FinishReason, StepCompleted, run_session
+    from rti_rig.controller import validate_schedule
     from rti_rig.lp_format import read_lp
-    from rti_rig.session import LP_NAME, SessionFolder
+    from rti_rig.schedule import LightSchedule
+    from rti_rig.session import SessionFolder
 
     try:
-        loaded = load_rig_config(rig_config)
-        geometry = rig_geometry(loaded)
-        if plan is not None:
-            if lights is not None:
-                raise typer.BadParameter("give either --plan or --lights, not both")
-            schedule = schedule_from_lp(read_lp(plan), geometry, str(plan))
+        if resume is not None:
+            if out_dir is not None or plan is not None or lights is not None:
+                raise RtiRigError(
+                    "--resume continues a session as planned: drop --out, --plan, --lights"
+                )
+            folder = SessionFolder.reopen(resume)
+            manifest = folder.manifest
+            config_path = rig_config or Path(manifest["rig"]["config_path"])
+            loaded = load_rig_config(config_path)
+            if loaded.sha256 != manifest["rig"].get("config_sha256"):
+                err.print(
+                    f"[yellow]note:[/] {config_path} has changed since the session began; "
+                    "the remaining steps are checked against it before anything moves."
+                )
+            schedule = LightSchedule.from_dict(manifest["schedule"])
+            out_dir = resume
+            rig = build_rig(loaded)
+            validate_schedule(rig, schedule)
+            done = len(folder.done)
+            out.print(
+                f"Resuming {resume}: {done} of {len(schedule)} images verified on disk"
+                + (
+                    f", {len(folder.resume.recovered)} unverified file(s) moved to recovered/"
+                    if folder.resume and folder.resume.recovered
+                    else ""
+                )
+            )
         else:
-            n = lights if lights is not None else _default_lights(loaded, geometry)
-            schedule = plan_uniform(geometry, n, min_elevation_deg)
-        rig = build_rig(loaded)
-        from rti_rig.controller import validate_schedule
-
-        validate_schedule(rig, schedule)
-        folder = SessionFolder.create(out_dir, len(schedule))
+            if rig_config is None or out_dir is None:
+                raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
+            loaded = load_rig_config(rig_config)
+            geometry = rig_geometry(loaded)
+            if plan is not None:
+                if lights is not None:
+                    raise RtiRigError("give either --plan or --lights, not both")
+                schedule = schedule_from_lp(read_lp(plan), geometry, str(plan))
+            else:
+                n = lights if lights is not None else _default_lights(loaded, geometry)
+                schedule = plan_uniform(geometry, n, min_elevation_deg)
+            rig = build_rig(loaded)
+            validate_schedule(rig, schedule)
+            folder = SessionFolder.create(out_dir, len(schedule))
     except RtiRigError as exc:
         raise _fail(exc) from None
+    _execute(rig, schedule, folder, out_dir)
+
+
+def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-untyped-def]
+    """Run with a progress bar and signal handling; print what happened and how to go on."""
+    from rti_rig.controller import (
+        CancelToken,
+        EmergencyStop,
+        FinishReason,
+        Paused,
+        StepCompleted,
+        run_session,
+    )
+    from rti_rig.session import LP_NAME
 
     cancel = CancelToken()
 
     def on_sigint(signum, frame):  # type: ignore[no-untyped-def]
         if cancel.cancelled:
-            raise KeyboardInterrupt
+            raise EmergencyStop("second Ctrl-C")
         cancel.cancel()
         err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")
 
-    previous = signal.signal(signal.SIGINT, on_sigint)
-    dry = " (dry run)" if loaded.config.backend == "simulated" else ""
-    out.print(f"Rig [bold]{loaded.config.name}[/]{dry}: {len(schedule)} lights → {out_dir}")
+    def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]
+        raise EmergencyStop("SIGTERM")
+
+    def on_sigusr1(signum, frame):  # type: ignore[no-untyped-def]
+        if cancel.paused:
+            cancel.resume()
+            err.print("[green]Resuming.[/]")
+        else:
+            cancel.pause()
+            err.print("[yellow]Pausing after this image (lights off); SIGUSR1 again resumes.[/]")
+
+    handlers = {signal.SIGINT: on_sigint, signal.SIGTERM: on_sigterm}
+    if hasattr(signal, "SIGUSR1"):
+        handlers[signal.SIGUSR1] = on_sigusr1
+    previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
+    dry = " (dry run)" if rig.loaded.config.backend == "simulated" else ""
+    todo = len(schedule) - len(folder.done)
+    out.print(f"Rig [bold]{rig.name}[/]{dry}: {todo} of {len(schedule)} lights → {out_dir}")
+    resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
     try:
         with Progress(
             TextColumn("[progress.description]{task.description}"),
@@ -122,28 +195,38 @@ def run(
             TimeElapsedColumn(),
             console=out,
         ) as progress:
-            task = progress.add_task("capturing", total=len(schedule))
+            task = progress.add_task("capturing", total=len(schedule), completed=len(folder.done))
 
             def on_event(event):  # type: ignore[no-untyped-def]
                 if isinstance(event, StepCompleted):
-                    progress.update(task, completed=event.index + 1)
+                    progress.advance(task)
+                elif isinstance(event, Paused):
+                    progress.update(task, description="paused")
 
             result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event)
+    except EmergencyStop as exc:
+        err.print(f"[red]Emergency stop ({exc}):[/] lights off, devices safe; images kept.")
+        err.print(resume_hint)
+        raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:
-        err.print(f"Images already captured are kept in {out_dir}; lights are off.")
+        err.print(f"Images already captured are kept in {out_dir}; lights are off. {resume_hint}")
         raise _fail(exc) from None
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, h in previous.items():
+            signal.signal(sig, h)
 
+    total_done = len(folder.done) + len(result.records)
     out.print(
-        f"{len(result.records)} image(s) written; {LP_NAME} lists the lights that fired.\n"
+        f"{total_done} image(s) in the session; {LP_NAME} lists the lights that fired.\n"
         f"Session time on the real rig: {result.rig_time_s:.1f} s"
         + (f" (simulated in {result.wall_time_s:.1f} s)" if dry else "")
     )
     for failure in result.teardown_failures:
         err.print(f"[red]teardown problem:[/] {failure}")
     if result.finish_reason is FinishReason.CANCELLED:
-        err.print("[yellow]Session cancelled; the images captured so far are kept.[/]")
+        err.print(
+            f"[yellow]Session cancelled; the images captured so far are kept.[/] {resume_hint}"
+        )
         raise typer.Exit(code=130)
 
 

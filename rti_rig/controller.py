@@ -18,7 +18,12 @@ from rti_rig.assembly import Rig
 from rti_rig.errors import ScheduleError
 from rti_rig.lp_format import MAX_LIGHTS
 from rti_rig.schedule import LightSchedule, LightStep
-from rti_rig.session import SessionFolder, StepRecord
+from rti_rig.session import (
+    SessionFolder,
+    StepRecord,
+    check_free_space,
+    estimated_bytes_per_image,
+)
 
 
 class FinishReason(StrEnum):
@@ -26,20 +31,57 @@ class FinishReason(StrEnum):
     CANCELLED = "cancelled"
     ERROR = "error"
     INTERRUPTED = "interrupted"
+    EMERGENCY_STOP = "emergency-stop"
+
+
+class EmergencyStop(BaseException):
+    """Raised (e.g. from a SIGTERM handler) to abandon the current step at once.
+
+    A BaseException so that no ``except Exception`` in a driver swallows it; the controller's
+    ``finally`` still puts every device in its safe state.
+    """
 
 
 class CancelToken:
-    """Set from another thread or a signal handler; checked between steps."""
+    """Run control set from another thread or a signal handler, acted on between steps.
+
+    ``cancel`` ends the session after the current step; ``pause`` holds the run between steps,
+    with the lights off, until ``resume`` (or ``cancel``).
+    """
 
     def __init__(self) -> None:
-        self._event = threading.Event()
+        self._cancel = threading.Event()
+        self._running = threading.Event()
+        self._running.set()
 
     def cancel(self) -> None:
-        self._event.set()
+        self._cancel.set()
+        self._running.set()
+
+    def pause(self) -> None:
+        self._running.clear()
+
+    def resume(self) -> None:
+        self._running.set()
 
     @property
     def cancelled(self) -> bool:
-        return self._event.is_set()
+        return self._cancel.is_set()
+
+    @property
+    def paused(self) -> bool:
+        return not self._running.is_set()
+
+    def wait_while_paused(self, poll_s: float = 0.2) -> None:
+        """Block (in real time: a pause waits for a person) until resumed or cancelled."""
+        while not self._running.wait(poll_s):
+            pass
+
+
+@dataclass(frozen=True)
+class Paused:
+    index: int
+    total: int
 
 
 @dataclass(frozen=True)
@@ -66,7 +108,7 @@ class SessionResult:
     teardown_failures: tuple[str, ...]
 
 
-Event = StepStarted | StepCompleted
+Event = StepStarted | StepCompleted | Paused
 
 
 def step_exposure(rig: Rig, step: LightStep) -> float:
@@ -112,6 +154,10 @@ def run_session(
     validate_schedule(rig, schedule)
     if folder.total_steps != len(schedule):
         raise ScheduleError("session folder was sized for another schedule")
+    done = folder.done
+    todo = [i for i in range(len(schedule)) if i not in done]
+    cam = rig.camera_config
+    check_free_space(folder.root, len(todo), estimated_bytes_per_image(cam.width, cam.height))
     cancel = cancel or CancelToken()
     emit = on_event or (lambda _e: None)
     clock = rig.clock
@@ -138,7 +184,11 @@ def run_session(
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()
-        for i, step in enumerate(schedule.steps):
+        for i in todo:
+            step = schedule.steps[i]
+            if cancel.paused:
+                emit(Paused(i, total))
+                cancel.wait_while_paused()
             if cancel.cancelled:
                 reason = FinishReason.CANCELLED
                 break
@@ -171,6 +221,9 @@ def run_session(
     except KeyboardInterrupt:
         reason, error = FinishReason.INTERRUPTED, "interrupted by the user (Ctrl-C)"
         raise
+    except EmergencyStop as exc:
+        reason, error = FinishReason.EMERGENCY_STOP, f"emergency stop: {exc}"
+        raise
     except Exception as exc:
         reason, error = FinishReason.ERROR, f"{type(exc).__name__}: {exc}"
         raise
@@ -194,7 +247,7 @@ def run_session(
                 "error": error,
                 "teardown_failures": teardown,
                 "steps_planned": total,
-                "steps_done": len(records),
+                "steps_done_this_run": len(records),
             },
             timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
         )

@@ -16,10 +16,13 @@ writes refuse existing files.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import platform
+import shutil
 import sys
+import time
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -93,14 +96,35 @@ def _write_json_atomic(path: Path, data: dict[str, Any]) -> None:
     os.replace(tmp, path)
 
 
+def estimated_bytes_per_image(width: int, height: int, channels: int = 3) -> int:
+    """A generous upper bound for one step's files: uncompressed 16-bit TIFF plus a JPEG."""
+    pixels = width * height * channels
+    return 2 * pixels + pixels // 2 + 16_384
+
+
+def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
+    """Refuse to start when the disk cannot hold the images still to be captured."""
+    probe = Path(root)
+    while not probe.exists():
+        probe = probe.parent
+    free = shutil.disk_usage(probe).free
+    need = steps * bytes_per_image + 8 * 1024 * 1024
+    if free < need:
+        raise SessionError(
+            f"not enough free disk space for {steps} image(s) under {probe}: need about "
+            f"{need / 1e6:.0f} MB, {free / 1e6:.0f} MB free; free space or choose another --out"
+        )
+
+
 class SessionFolder:
-    """Writes one session; created empty, filled step by step, finished once."""
+    """Writes one session: created empty (or reopened to resume), filled step by step."""
 
     def __init__(self, root: Path, total_steps: int) -> None:
         self.root = Path(root)
         self.total_steps = total_steps
         self.names = image_names(total_steps)
         self.manifest: dict[str, Any] = {}
+        self.resume: ResumeState | None = None
 
     @classmethod
     def create(cls, root: Path, total_steps: int) -> SessionFolder:
@@ -110,7 +134,7 @@ class SessionFolder:
         if root.exists() and any(root.iterdir()):
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "
-                "choose a new --out folder"
+                "choose a new --out folder, or continue an interrupted session with --resume"
             )
         try:
             (root / LINEAR_DIR).mkdir(parents=True, exist_ok=True)
@@ -118,22 +142,57 @@ class SessionFolder:
             raise SessionError(f"cannot create {root}: {exc.strerror or exc}") from None
         return cls(root, total_steps)
 
+    @classmethod
+    def reopen(cls, root: Path) -> SessionFolder:
+        """Open an interrupted session to capture the steps it has not done yet.
+
+        What is on disk is verified against the journal's checksums first; see
+        :func:`prepare_resume`.
+        """
+        state = prepare_resume(Path(root))
+        folder = cls(Path(root), len(state.manifest["schedule"]["steps"]))
+        folder.manifest = state.manifest
+        folder.resume = state
+        return folder
+
+    @property
+    def done(self) -> dict[int, StepRecord]:
+        return dict(self.resume.done) if self.resume else {}
+
     def begin(self, header: dict[str, Any]) -> None:
         """Record what is about to run, before anything moves."""
-        self.manifest = {
-            "format": FORMAT,
-            "software": software_versions(),
-            "started_at": _now_iso(),
-            **header,
-            "runner": {"state": "running", "finish_reason": None},
-            "steps": [],
-        }
+        run = {"started_at": _now_iso(), "software": software_versions()}
+        if self.resume is not None:
+            if header["schedule"] != self.manifest["schedule"]:
+                raise SessionError(
+                    f"{self.root}: the schedule to resume differs from the one the session began "
+                    "with; a resumed session must run the same steps"
+                )
+            runs = self.manifest.setdefault("runs", [])
+            for old in runs:
+                old.setdefault("finish_reason", "crashed")
+            run["resumed_with_steps_done"] = len(self.resume.done)
+            run["recovered_files"] = self.resume.recovered
+            runs.append(run)
+            self.manifest["runner"] = {"state": "running", "finish_reason": None}
+        else:
+            self.manifest = {
+                "format": FORMAT,
+                "software": run["software"],
+                "started_at": run["started_at"],
+                **header,
+                "runner": {"state": "running", "finish_reason": None},
+                "runs": [run],
+                "steps": [],
+            }
         _write_json_atomic(self.root / MANIFEST, self.manifest)
 
     def write_step(self, index: int, frame: Frame, record_fields: dict[str, Any]) -> StepRecord:
-        """Write one captured frame (linear TIFF + sRGB JPEG) and journal it."""
-        import time
+        """Write one captured frame (linear TIFF, then sRGB JPEG), then journal it.
 
+        The journal line is the commit point: a step is done only once its line is on disk, and
+        its checksums prove the files are the ones written.
+        """
         t0 = time.perf_counter()
         base = self.names[index]
         jpg, tif = f"{base}.jpg", f"{LINEAR_DIR}/{base}.tif"
@@ -159,22 +218,124 @@ class SessionFolder:
     def finish(
         self, records: list[StepRecord], runner: dict[str, Any], timing: dict[str, Any]
     ) -> None:
-        """Write the `.lp` from what actually ran, then the final manifest."""
-        if records:
+        """Write the `.lp` from what actually ran (all runs, in step order), then the manifest."""
+        every = {r.index: r for r in self.done.values()}
+        every.update({r.index: r for r in records})
+        ordered = [every[i] for i in sorted(every)]
+        if ordered:
             write_lp(
                 self.root / LP_NAME,
-                [LpEntry(r.image, r.actual_direction) for r in records],
+                [LpEntry(r.image, r.actual_direction) for r in ordered],
             )
+        run = self.manifest["runs"][-1]
+        run.update({"finished_at": _now_iso(), "finish_reason": runner["finish_reason"], **timing})
+        runs = self.manifest["runs"]
         self.manifest.update(
             {
-                "finished_at": _now_iso(),
-                "runner": runner,
-                "timing": timing,
-                "lp_file": LP_NAME if records else None,
-                "steps": [asdict(r) for r in records],
+                "finished_at": run["finished_at"],
+                "runner": {**runner, "steps_done": len(ordered)},
+                "timing": {
+                    "rig_time_s": sum(r.get("rig_time_s", 0.0) for r in runs),
+                    "wall_time_s": sum(r.get("wall_time_s", 0.0) for r in runs),
+                    "runs": len(runs),
+                },
+                "lp_file": LP_NAME if ordered else None,
+                "steps": [asdict(r) for r in ordered],
             }
         )
         _write_json_atomic(self.root / MANIFEST, self.manifest)
+
+
+@dataclass
+class ResumeState:
+    """What an interrupted session folder holds, verified."""
+
+    manifest: dict[str, Any]
+    done: dict[int, StepRecord]
+    recovered: list[str]
+
+
+def read_journal(root: Path) -> list[dict[str, Any]]:
+    """Journal lines; a torn last line (the process died while appending) is ignored."""
+    path = Path(root) / JOURNAL
+    if not path.exists():
+        return []
+    lines = path.read_text(encoding="utf-8").split("\n")
+    out = []
+    for i, line in enumerate(lines):
+        if not line.strip():
+            continue
+        try:
+            out.append(json.loads(line))
+        except json.JSONDecodeError:
+            if i == len(lines) - 1:  # no newline after it: torn by a crash, never committed
+                break
+            raise SessionError(
+                f"{path}, line {i + 1}: not valid JSON, so it cannot be known which images are "
+                "complete; restore the journal from a backup or start a new session (nothing "
+                "in this folder has been changed)"
+            ) from None
+    return out
+
+
+def _sha256(path: Path) -> str | None:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except FileNotFoundError:
+        return None
+
+
+def prepare_resume(root: Path) -> ResumeState:
+    """Verify an interrupted session and set aside anything that is not a committed step.
+
+    A step counts as done when its journal line exists and every file it names is on disk with
+    the journaled checksum. Image files that no committed step accounts for (a write cut short
+    between the TIFF and the JPEG, a checksum mismatch) are *moved* to ``recovered/``, never
+    deleted; half-written temporary files are removed (they never were an image).
+    """
+    manifest = read_manifest(root)
+    total = len(manifest.get("schedule", {}).get("steps", []))
+    if total == 0:
+        raise SessionError(f"{root}: the manifest holds no schedule, so there is nothing to resume")
+    runner = manifest.get("runner", {})
+    if runner.get("finish_reason") == "completed":
+        raise SessionError(f"{root}: this session already completed all {total} steps")
+    names = image_names(total)
+    fields = set(StepRecord.__dataclass_fields__)
+    done: dict[int, StepRecord] = {}
+    for entry in read_journal(root):
+        idx = entry.get("index")
+        if (
+            not isinstance(idx, int)
+            or not 0 <= idx < total
+            or entry.get("image") != f"{names[idx]}.jpg"
+        ):
+            raise SessionError(
+                f"{root}: journal entry {entry.get('image')!r} does not fit the schedule"
+            )
+        ok = all(_sha256(root / name) == digest for name, digest in entry["sha256"].items())
+        if ok:
+            rec = {k: v for k, v in entry.items() if k in fields}
+            for key in ("planned_direction", "actual_direction"):
+                rec[key] = tuple(rec[key])
+            done[idx] = StepRecord(**rec)
+        else:
+            done.pop(idx, None)
+    keep = {name for rec in done.values() for name in rec.sha256}
+    recovered: list[str] = []
+    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
+    for path in sorted([*root.glob("image_*"), *(root / LINEAR_DIR).glob("image_*")]):
+        rel = path.relative_to(root).as_posix()
+        if rel in keep:
+            continue
+        dest = root / "recovered" / stamp / rel
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        os.replace(path, dest)
+        recovered.append(dest.relative_to(root).as_posix())
+    for partial in [*root.glob(".*.partial"), *(root / LINEAR_DIR).glob(".*.partial")]:
+        partial.unlink()
+    (root / LINEAR_DIR).mkdir(exist_ok=True)
+    return ResumeState(manifest=manifest, done=done, recovered=recovered)
 
 
 def read_manifest(root: Path) -> dict[str, Any]:

@@ -61,6 +61,21 @@ class SimulatedCamera:
     def close(self) -> None:
         self._connected = False
 
+    def _noise_key(self, exposure_s: float) -> list[int]:
+        """Noise depends on the scene seed and what is lit, not on how many frames came before.
+
+        A session that is interrupted and resumed therefore yields bit-identical images to an
+        uninterrupted one, which is what lets the tests compare the two folders file by file.
+        """
+        d = self._state.direction
+        light = [0, 0, 0] if d is None else [round(c * 1e6) + 2_000_000 for c in d]
+        return [
+            self._seed,
+            *light,
+            round(self._state.intensity * 1e6),
+            round(exposure_s * 1e9),
+        ]
+
     def capture(self, exposure_s: float) -> Frame:
         if not self._connected:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
@@ -69,7 +84,7 @@ class SimulatedCamera:
         t0 = self._clock.now()
         radiance = self._render(self._state.direction, self._state.intensity) + self._ambient
         electrons = radiance * (self._e_per_radiance_s * exposure_s)
-        rng = np.random.default_rng([self._seed, self._count])
+        rng = np.random.default_rng(self._noise_key(exposure_s))
         self._count += 1
         if self._noise:
             electrons = rng.poisson(np.clip(electrons, 0.0, None)).astype(np.float64)

@@ -1,0 +1,214 @@
+"""Never lose an image: kill a session at every stage of a step, resume, and compare the folder
+with an uninterrupted run of the same plan, file by file."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from conftest import REPO, SMALL_DOME, write_config
+from typer.testing import CliRunner
+
+from planner.uniform import plan_uniform
+from rti_rig.cli import app
+from rti_rig.compose import build_rig
+from rti_rig.config import load_rig_config
+from rti_rig.controller import CancelToken, FinishReason, Paused, StepCompleted, run_session
+from rti_rig.errors import SessionError
+from rti_rig.session import SessionFolder
+
+runner = CliRunner()
+LIGHTS = 8
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    """The command's output with rich's line wrapping undone."""
+    return " ".join(result.output.split())
+
+
+def digests(folder: Path) -> dict[str, str]:
+    """SHA-256 of every image file and the .lp (what a user would compare)."""
+    files = [*folder.glob("image_*.jpg"), *(folder / "linear").glob("*.tif"), folder / "lights.lp"]
+    return {
+        p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest() for p in files
+    }
+
+
+def steps_of(folder: Path) -> list[tuple]:
+    m = json.loads((folder / "manifest.json").read_text())
+    return [(s["index"], s["image"], s["led"], tuple(s["actual_direction"])) for s in m["steps"]]
+
+
+@pytest.fixture
+def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    base = tmp_path_factory.mktemp("ref")
+    cfg = write_config(base, SMALL_DOME)
+    out = base / "uninterrupted"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 0, r.output
+    return cfg, out
+
+
+def child(stage: str, k: int, cfg: Path, out: Path) -> subprocess.Popen:
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    return subprocess.Popen(
+        [
+            sys.executable,
+            str(REPO / "tests" / "session_child.py"),
+            stage,
+            str(k),
+            str(cfg),
+            str(out),
+            str(LIGHTS),
+        ],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+
+
+@pytest.mark.parametrize(
+    ("stage", "recovered"),
+    [
+        ("before_light", 0),
+        ("after_light", 0),
+        ("during_capture", 0),
+        ("during_write", 0),  # half a TIFF in a temporary file: never an image, removed
+        ("between_files", 1),  # a complete TIFF without its JPEG or journal line: set aside
+        ("before_journal", 2),  # both files complete but never committed: set aside
+    ],
+)
+def test_sigkill_at_every_stage_then_resume(
+    tmp_path: Path, reference: tuple[Path, Path], stage: str, recovered: int
+) -> None:
+    cfg, ref = reference
+    out = tmp_path / "s"
+    proc = child(stage, 3, cfg, out)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    assert len(list(out.glob("image_*.jpg"))) <= 3 + (stage == "before_journal")
+
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "3 of 8 images verified" in said(r)
+    assert digests(out) == digests(ref)
+    assert steps_of(out) == steps_of(ref)
+    moved = [p for p in (out / "recovered").rglob("*") if p.is_file()] if recovered else []
+    assert len(moved) == recovered
+    assert not list(out.rglob(".*.partial"))
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["runner"]["finish_reason"] == "completed"
+    assert [run.get("finish_reason") for run in m["runs"]] == ["crashed", "completed"]
+
+
+def test_sigterm_is_an_emergency_stop_that_can_be_resumed(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    cfg, ref = reference
+    out = tmp_path / "s"
+    proc = child("slow", 0, cfg, out)
+    deadline = time.monotonic() + 60
+    journal = out / "journal.jsonl"
+    while time.monotonic() < deadline:
+        if journal.exists() and journal.read_text().count("\n") >= 2:
+            break
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 143, stderr.decode()
+    assert b"Emergency stop" in stderr
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["runner"]["finish_reason"] == "emergency-stop"
+    assert m["runner"]["teardown_failures"] == []
+    assert 2 <= len(m["steps"]) < LIGHTS
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref)
+
+
+def test_cancelled_session_resumes_and_corrupt_files_are_recaptured(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    cfg, ref = reference
+    rig = build_rig(load_rig_config(cfg))
+    schedule = plan_uniform(rig.geometry, LIGHTS)
+    cancel = CancelToken()
+
+    def stop_after_four(e) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(e, StepCompleted) and e.index == 3:
+            cancel.cancel()
+
+    out = tmp_path / "s"
+    res = run_session(
+        rig, schedule, SessionFolder.create(out, LIGHTS), cancel=cancel, on_event=stop_after_four
+    )
+    assert res.finish_reason is FinishReason.CANCELLED
+    damaged = out / "image_002.jpg"
+    data = bytearray(damaged.read_bytes())
+    data[100] ^= 0xFF
+    damaged.write_bytes(bytes(data))
+    with open(out / "journal.jsonl", "a") as fh:
+        fh.write('{"index": 4, "image": "image_0')  # torn by a crash: never committed
+
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "3 of 8 images verified" in said(r)
+    assert digests(out) == digests(ref)
+    kept = list((out / "recovered").rglob("image_002.jpg"))
+    assert len(kept) == 1 and kept[0].read_bytes() == bytes(data)  # set aside, never deleted
+
+
+def test_resume_refuses_what_it_cannot_do(tmp_path: Path, reference: tuple[Path, Path]) -> None:
+    _, ref = reference
+    r = runner.invoke(app, ["run", "--resume", str(ref)])
+    assert r.exit_code == 2 and "already completed" in said(r)
+    r = runner.invoke(app, ["run", "--resume", str(tmp_path)])
+    assert r.exit_code == 2 and "not an rti-rig session folder" in " ".join(r.output.split())
+    r = runner.invoke(app, ["run", "--resume", str(ref), "--lights", "3"])
+    assert r.exit_code == 2 and "drop --out" in said(r)
+
+
+def test_free_disk_is_checked_before_anything_moves(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import shutil
+
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=1_000_000))
+    out = tmp_path / "s"
+    with pytest.raises(SessionError, match="not enough free disk space for 8 image"):
+        run_session(rig, plan_uniform(rig.geometry, LIGHTS), SessionFolder.create(out, LIGHTS))
+    assert rig.lighting.source.history == []  # type: ignore[attr-defined]
+
+
+def test_pause_holds_between_steps_with_lights_off(tmp_path: Path) -> None:
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    dome = rig.lighting.source  # type: ignore[attr-defined]
+    control = CancelToken()
+    seen: list[tuple[int, int | None, int]] = []
+    out = tmp_path / "s"
+
+    def on_event(e) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(e, StepCompleted) and e.index == 1:
+            control.pause()
+        elif isinstance(e, Paused):
+            seen.append((e.index, dome.lit, len(list(out.glob("image_*.jpg")))))
+            control.resume()
+
+    res = run_session(
+        rig,
+        plan_uniform(rig.geometry, 4),
+        SessionFolder.create(out, 4),
+        cancel=control,
+        on_event=on_event,
+    )
+    assert res.finish_reason is FinishReason.COMPLETED
+    assert seen == [(2, None, 2)]
