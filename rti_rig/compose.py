@@ -56,7 +56,9 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
                 acceleration_deg_s2=cfg.arm.acceleration_deg_s2,
                 resolution_deg=cfg.arm.resolution_deg,
                 switch_s=cfg.timing.light_switch_s,
-            )
+            ),
+            park_after_session=cfg.arm.park_after_session,
+            park_on_emergency=cfg.arm.park_on_emergency_stop,
         )
     camera = SimulatedCamera(
         render,

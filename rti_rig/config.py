@@ -69,6 +69,8 @@ class ArmConfig(_Strict):
     park_azimuth_deg: float = 0.0
     park_elevation_deg: float = 45.0
     default_lights: int = Field(default=24, gt=0, le=1000)
+    park_after_session: bool = True
+    park_on_emergency_stop: bool = False
 
     @model_validator(mode="after")
     def _limits_consistent(self) -> ArmConfig:

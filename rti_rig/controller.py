@@ -228,7 +228,7 @@ def run_session(
         reason, error = FinishReason.ERROR, f"{type(exc).__name__}: {exc}"
         raise
     finally:
-        teardown += rig.lighting.safe()
+        teardown += rig.lighting.safe(emergency=reason is FinishReason.EMERGENCY_STOP)
         for label, close in (
             ("camera close", rig.camera.close),
             ("light close", rig.lighting.close),

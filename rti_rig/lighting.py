@@ -44,7 +44,7 @@ class Lighting(Protocol):
 
     def off(self) -> None: ...
 
-    def safe(self) -> list[str]: ...
+    def safe(self, emergency: bool = False) -> list[str]: ...
 
 
 class DomeLighting:
@@ -90,16 +90,30 @@ class DomeLighting:
     def off(self) -> None:
         self.source.all_off()
 
-    def safe(self) -> list[str]:
+    def safe(self, emergency: bool = False) -> list[str]:
         return _attempt([("all LEDs off", self.source.all_off)])
 
 
 class ArmLighting:
-    """An arm: move, then lamp on; the reached direction is the recorded one."""
+    """An arm: move, then lamp on; the reached direction is the recorded one.
 
-    def __init__(self, carrier: LightCarrier) -> None:
+    Going safe always switches the lamp off and stops motion. Parking is a *move*, so it follows
+    policy: after a session (completed, cancelled or failed) the arm parks unless
+    ``park_after_session`` is off; after an emergency stop it stays where it stopped unless
+    ``park_on_emergency`` is on, because moving a just-stopped arm near an object is what an
+    emergency stop is meant to prevent.
+    """
+
+    def __init__(
+        self,
+        carrier: LightCarrier,
+        park_after_session: bool = True,
+        park_on_emergency: bool = False,
+    ) -> None:
         self.carrier = carrier
         self.name = carrier.name
+        self.park_after_session = park_after_session
+        self.park_on_emergency = park_on_emergency
 
     def connect(self) -> None:
         self.carrier.connect()
@@ -118,14 +132,14 @@ class ArmLighting:
     def off(self) -> None:
         self.carrier.lamp(False)
 
-    def safe(self) -> list[str]:
-        return _attempt(
-            [
-                ("lamp off", lambda: self.carrier.lamp(False)),
-                ("stop", self.carrier.stop),
-                ("park", self.carrier.park),
-            ]
-        )
+    def safe(self, emergency: bool = False) -> list[str]:
+        actions: list[tuple[str, object]] = [
+            ("lamp off", lambda: self.carrier.lamp(False)),
+            ("stop", self.carrier.stop),
+        ]
+        if self.park_on_emergency if emergency else self.park_after_session:
+            actions.append(("park", self.carrier.park))
+        return _attempt(actions)
 
 
 def _attempt(actions: list[tuple[str, object]]) -> list[str]:

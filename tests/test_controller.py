@@ -235,3 +235,29 @@ def test_arm_session_records_reached_directions_and_parks(
     zenith = LightSchedule((LightStep(direction=(0, 0, 1)),))
     with pytest.raises(ScheduleError, match="keep-out cone"):
         run_session(rig, zenith, SessionFolder.create(tmp_path / "z", 1))
+
+
+@pytest.mark.parametrize("park_on_emergency", [False, True])
+def test_arm_emergency_stop_follows_parking_policy(
+    tmp_path: Path, arm_config_path: Path, park_on_emergency: bool
+) -> None:
+    from rti_rig.controller import EmergencyStop
+
+    text = arm_config_path.read_text().replace("width = 512", "width = 32")
+    text = text.replace("height = 512", "height = 32")
+    text = text.replace(
+        "default_lights = 24",
+        f"default_lights = 24\npark_on_emergency_stop = {str(park_on_emergency).lower()}",
+    )
+    rig = build_rig(load_rig_config(write_config(tmp_path, text)))
+    rig.camera = FailingCamera(rig.camera, 3, EmergencyStop("SIGTERM"))
+    out = tmp_path / "s"
+    with pytest.raises(EmergencyStop):
+        run_session(rig, plan_uniform(rig.geometry, 8), SessionFolder.create(out, 8))
+    arm = rig.lighting.carrier  # type: ignore[attr-defined]
+    assert not arm.lamp_on
+    parked = arm.joints_deg == pytest.approx((0.0, 45.0), abs=0.1)
+    assert parked is park_on_emergency
+    m = manifest(out)
+    assert m["runner"]["finish_reason"] == "emergency-stop"
+    assert_images_intact(out, 3)

@@ -61,11 +61,15 @@ def child(stage: str, k: int, cfg: Path, out: Path) -> subprocess.Popen:
     return subprocess.Popen(
         [
             sys.executable,
-            str(REPO / "tests" / "session_child.py"),
+            "-m",
+            "simulator.kill_hooks",
             stage,
             str(k),
+            "run",
             str(cfg),
+            "--out",
             str(out),
+            "--lights",
             str(LIGHTS),
         ],
         env=env,
@@ -212,3 +216,24 @@ def test_pause_holds_between_steps_with_lights_off(tmp_path: Path) -> None:
     )
     assert res.finish_reason is FinishReason.COMPLETED
     assert seen == [(2, None, 2)]
+
+
+def test_wrong_light_oracle_catches_a_swapped_record(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """The campaign's oracle must see a mislabelled image (else 'wrong lights: 0' means nothing)."""
+    import shutil
+
+    from simulator.verify import wrong_light_steps
+
+    cfg, ref = reference
+    assert wrong_light_steps(cfg, ref) == []
+    bad = tmp_path / "bad"
+    shutil.copytree(ref, bad)
+    m = json.loads((bad / "manifest.json").read_text())
+    m["steps"][2]["actual_direction"], m["steps"][5]["actual_direction"] = (
+        m["steps"][5]["actual_direction"],
+        m["steps"][2]["actual_direction"],
+    )
+    (bad / "manifest.json").write_text(json.dumps(m))
+    assert wrong_light_steps(cfg, bad) == [2, 5]

@@ -1,0 +1,93 @@
+"""In-process fault injection around simulated devices, for tests and the fault campaign.
+
+Wrappers raise the errors real devices raise (a camera that times out, a light source whose reply
+never comes) at a chosen call. Byte-level faults (garbled serial replies, servo hardware errors)
+belong to the device emulators; these model what reaches the controller.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rti_rig.errors import CaptureError, DeviceError
+from rti_rig.rig import Frame
+
+
+@dataclass
+class FaultPlan:
+    """Raise ``kind`` at the ``at``-th call (0-based) of the wrapped operation."""
+
+    kind: str
+    at: int
+    fired: list[str] = field(default_factory=list)
+
+
+class FaultyCamera:
+    """A camera that fails once, as a camera that stops answering would."""
+
+    def __init__(self, inner, plan: FaultPlan) -> None:  # type: ignore[no-untyped-def]
+        self.inner, self.plan, self.calls = inner, plan, 0
+        self.name = inner.name
+
+    def connect(self) -> None:
+        self.inner.connect()
+
+    def close(self) -> None:
+        self.inner.close()
+
+    def capture(self, exposure_s: float) -> Frame:
+        n, self.calls = self.calls, self.calls + 1
+        if n == self.plan.at:
+            self.plan.fired.append(self.plan.kind)
+            raise CaptureError(self.name, f"injected fault: {self.plan.kind}", "capture")
+        return self.inner.capture(exposure_s)
+
+
+class FaultyLightSource:
+    """A dome whose `light` command fails once (no acknowledgement, port gone)."""
+
+    def __init__(self, inner, plan: FaultPlan) -> None:  # type: ignore[no-untyped-def]
+        self.inner, self.plan, self.calls = inner, plan, 0
+        self.name = inner.name
+
+    def connect(self) -> None:
+        self.inner.connect()
+
+    def close(self) -> None:
+        self.inner.close()
+
+    def light_count(self) -> int:
+        return self.inner.light_count()
+
+    def light(self, index: int, intensity: float = 1.0) -> None:
+        n, self.calls = self.calls, self.calls + 1
+        if n == self.plan.at:
+            self.plan.fired.append(self.plan.kind)
+            raise DeviceError(self.name, f"injected fault: {self.plan.kind}", f"light {index}")
+        self.inner.light(index, intensity)
+
+    def all_off(self) -> None:
+        self.inner.all_off()
+
+    def __getattr__(self, name: str):  # type: ignore[no-untyped-def]
+        return getattr(self.inner, name)
+
+
+class FaultyCarrier:
+    """An arm whose `move_to` fails once (a servo error surfacing mid-move)."""
+
+    def __init__(self, inner, plan: FaultPlan) -> None:  # type: ignore[no-untyped-def]
+        self.inner, self.plan, self.calls = inner, plan, 0
+        self.name = inner.name
+
+    def __getattr__(self, name: str):  # type: ignore[no-untyped-def]
+        return getattr(self.inner, name)
+
+    def move_to(self, direction: np.ndarray) -> np.ndarray:
+        n, self.calls = self.calls, self.calls + 1
+        if n == self.plan.at:
+            self.plan.fired.append(self.plan.kind)
+            raise DeviceError(self.name, f"injected fault: {self.plan.kind}", "move_to")
+        return self.inner.move_to(direction)

@@ -1,0 +1,112 @@
+"""Make a dry-run session die (SIGKILL) at a chosen stage of a chosen step.
+
+This is how the resume tests and the fault campaign reproduce the worst interruption there is:
+no ``finally``, no flush, a half-written file. Run as a module it installs the hooks and then
+runs the ``rti-rig`` command line with the remaining arguments::
+
+    python -m simulator.kill_hooks STAGE K run RIG.toml --out DIR --lights 8
+
+Stages: ``before_light``, ``after_light``, ``during_capture``, ``during_write`` (half a TIFF in
+its temporary file), ``between_files`` (TIFF renamed, JPEG not written), ``before_journal`` (both
+files complete, journal line not written), and ``slow`` (no kill: each capture takes 50 ms of
+real time so that another process can signal the run).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import time
+from pathlib import Path
+
+STAGES = (
+    "before_light",
+    "after_light",
+    "during_capture",
+    "during_write",
+    "between_files",
+    "before_journal",
+    "slow",
+)
+
+
+def install(stage: str, k: int) -> None:
+    """Patch the simulated devices and the session writer so the process dies at step ``k``."""
+    import rti_rig.image_files as image_files
+    import rti_rig.session as session
+    import simulator.sim_camera as sim_camera
+    import simulator.sim_lights as sim_lights
+
+    if stage not in STAGES:
+        raise SystemExit(f"unknown stage {stage!r}; choose from {', '.join(STAGES)}")
+    counts = {"light": 0, "capture": 0, "write": 0, "journal": 0}
+
+    def die() -> None:
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    real_light = sim_lights.SimulatedDome.light
+    real_move = sim_lights.SimulatedArm.move_to
+    real_capture = sim_camera.SimulatedCamera.capture
+    real_write = image_files._atomic_write
+    real_asdict = session.asdict
+
+    def lit(call, *args):  # type: ignore[no-untyped-def]
+        if stage == "before_light" and counts["light"] == k:
+            die()
+        result = call(*args)
+        if stage == "after_light" and counts["light"] == k:
+            die()
+        counts["light"] += 1
+        return result
+
+    def light(self, index, intensity=1.0):  # type: ignore[no-untyped-def]
+        return lit(real_light, self, index, intensity)
+
+    def move_to(self, direction):  # type: ignore[no-untyped-def]
+        return lit(real_move, self, direction)
+
+    def capture(self, exposure_s):  # type: ignore[no-untyped-def]
+        if stage == "slow":
+            time.sleep(0.05)
+        frame = real_capture(self, exposure_s)
+        if stage == "during_capture" and counts["capture"] == k:
+            die()
+        counts["capture"] += 1
+        return frame
+
+    def atomic_write(path: Path, data: bytes) -> str:
+        n = counts["write"]
+        counts["write"] += 1
+        if stage == "during_write" and n == 2 * k:
+            with open(path.with_name(f".{path.name}.partial"), "wb") as fh:
+                fh.write(data[: len(data) // 2])
+            die()
+        if stage == "between_files" and n == 2 * k + 1:
+            die()
+        return real_write(path, data)
+
+    def asdict(obj):  # type: ignore[no-untyped-def]
+        if stage == "before_journal" and isinstance(obj, session.StepRecord):
+            if counts["journal"] == k:
+                die()
+            counts["journal"] += 1
+        return real_asdict(obj)
+
+    sim_lights.SimulatedDome.light = light  # type: ignore[method-assign]
+    sim_lights.SimulatedArm.move_to = move_to  # type: ignore[method-assign]
+    sim_camera.SimulatedCamera.capture = capture  # type: ignore[method-assign]
+    image_files._atomic_write = atomic_write
+    session.asdict = asdict  # type: ignore[assignment]
+
+
+def main(argv: list[str]) -> None:
+    from rti_rig.cli import app
+
+    stage, k, *cli_args = argv
+    install(stage, int(k))
+    app(cli_args)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
