@@ -8,9 +8,11 @@ and writes the session's `.lp` and manifest from the images already on disk.
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from enum import StrEnum
 
@@ -142,6 +144,26 @@ def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
         )
 
 
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """Hold SIGINT/SIGTERM while devices are put in their safe state.
+
+    An emergency-stop handler raising in the middle of teardown could leave a light on; the
+    signals are delivered (and acted on) as soon as teardown is done.
+    """
+    deferrable = hasattr(signal, "pthread_sigmask") and (
+        threading.current_thread() is threading.main_thread()
+    )
+    held = {signal.SIGINT, signal.SIGTERM}
+    if deferrable:
+        signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        if deferrable:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
+
+
 def run_session(
     rig: Rig,
     schedule: LightSchedule,
@@ -228,27 +250,28 @@ def run_session(
         reason, error = FinishReason.ERROR, f"{type(exc).__name__}: {exc}"
         raise
     finally:
-        teardown += rig.lighting.safe(emergency=reason is FinishReason.EMERGENCY_STOP)
-        for label, close in (
-            ("camera close", rig.camera.close),
-            ("light close", rig.lighting.close),
-        ):
-            try:
-                close()
-            except Exception as exc:  # keep tearing down whatever fails
-                teardown.append(f"{label}: {exc}")
-        rig_time = clock.now() - rig_t0
-        wall_time = time.perf_counter() - wall_t0
-        folder.finish(
-            records,
-            runner={
-                "state": "finished",
-                "finish_reason": str(reason),
-                "error": error,
-                "teardown_failures": teardown,
-                "steps_planned": total,
-                "steps_done_this_run": len(records),
-            },
-            timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
-        )
+        with _signals_deferred():
+            teardown += rig.lighting.safe(emergency=reason is FinishReason.EMERGENCY_STOP)
+            for label, close in (
+                ("camera close", rig.camera.close),
+                ("light close", rig.lighting.close),
+            ):
+                try:
+                    close()
+                except Exception as exc:  # keep tearing down whatever fails
+                    teardown.append(f"{label}: {exc}")
+            rig_time = clock.now() - rig_t0
+            wall_time = time.perf_counter() - wall_t0
+            folder.finish(
+                records,
+                runner={
+                    "state": "finished",
+                    "finish_reason": str(reason),
+                    "error": error,
+                    "teardown_failures": teardown,
+                    "steps_planned": total,
+                    "steps_done_this_run": len(records),
+                },
+                timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
+            )
     return SessionResult(reason, tuple(records), rig_time, wall_time, error, tuple(teardown))

@@ -34,7 +34,9 @@ class LightStep:
     intensity: float = 1.0
 
     def __post_init__(self) -> None:
-        d = normalize(self.direction)
+        d = np.asarray(self.direction, dtype=np.float64)
+        if abs(float(np.linalg.norm(d)) - 1.0) > 1e-12 or not np.all(np.isfinite(d)):
+            d = normalize(d)  # idempotent for unit input, so a saved schedule reloads bit-exact
         object.__setattr__(self, "direction", (float(d[0]), float(d[1]), float(d[2])))
         if self.led is not None and self.led < 0:
             raise ValueError(f"LED index must be >= 0, got {self.led}")

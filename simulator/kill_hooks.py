@@ -8,8 +8,8 @@ runs the ``rti-rig`` command line with the remaining arguments::
 
 Stages: ``before_light``, ``after_light``, ``during_capture``, ``during_write`` (half a TIFF in
 its temporary file), ``between_files`` (TIFF renamed, JPEG not written), ``before_journal`` (both
-files complete, journal line not written), and ``slow`` (no kill: each capture takes 50 ms of
-real time so that another process can signal the run).
+files complete, journal line not written), and ``stall`` (no kill: capture K blocks for up to
+60 s of real time, so that another process can signal the run at a known step).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ STAGES = (
     "during_write",
     "between_files",
     "before_journal",
-    "slow",
+    "stall",
 )
 
 
@@ -67,8 +67,10 @@ def install(stage: str, k: int) -> None:
         return lit(real_move, self, direction)
 
     def capture(self, exposure_s):  # type: ignore[no-untyped-def]
-        if stage == "slow":
-            time.sleep(0.05)
+        if stage == "stall" and counts["capture"] == k:
+            deadline = time.monotonic() + 60.0
+            while time.monotonic() < deadline:  # a signal handler's exception ends this
+                time.sleep(0.05)
         frame = real_capture(self, exposure_s)
         if stage == "during_capture" and counts["capture"] == k:
             die()
