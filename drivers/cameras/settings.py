@@ -197,4 +197,8 @@ class FolderWatchSettings(_Strict):
         "ExposureTime; None = do not check",
     )
     gain: float = Field(0.0, description="recorded in the frame when the file has no ISO")
+    eight_bit_response: Literal["refuse", "linear", "srgb"] = Field(
+        "refuse", description="8-bit files (JPEG, PNG) are gamma-encoded: refuse them, or "
+        "linearise with the inverse sRGB curve, or take them as linear"
+    )
     decode: RawDecodeSettings = RawDecodeSettings()
