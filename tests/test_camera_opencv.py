@@ -114,7 +114,7 @@ class FakeV4l2:
     def _frame(self):
         return np.full((4, 6), int(self.props[cv2.CAP_PROP_EXPOSURE]), np.uint16)
 
-    def isOpened(self):  # noqa: N802 - OpenCV's name
+    def isOpened(self):
         return self.opened
 
     def set(self, prop, value):
