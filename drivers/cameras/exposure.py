@@ -151,15 +151,19 @@ def meter_exposure(
     start_exposure_s: float,
     candidates_s: Sequence[float] | None = None,
     step_down: float = 4.0,
+    backoff: float = 0.9,
 ) -> ExposureChoice:
     """Short test series at the current light: preview, predict, verify with a real shot.
 
     The caller turns on the brightest planned light first. A preview that saturates too much is
-    retaken ``step_down`` times shorter; a prediction that fails verification becomes the next
-    preview. At most ``rule.max_attempts`` shots are taken.
+    retaken ``step_down`` times shorter; a predicted exposure that fails verification is
+    shortened by ``backoff`` (or to the next shorter candidate) towards the preview's. At most
+    ``rule.max_attempts`` shots are taken; if none verifies, the longest good shot is chosen.
     """
     if step_down <= 1:
         raise ValueError("step_down must exceed 1")
+    if not 0 < backoff < 1:
+        raise ValueError("backoff must lie in (0, 1)")
     series: list[Frame] = []
     frame = _shot(camera, start_exposure_s, series)
     while True:
@@ -172,12 +176,15 @@ def meter_exposure(
         choice = choose_exposure(frame, rule, candidates_s)
         if np.isclose(choice.exposure_s, frame.exposure_s, rtol=1e-9):
             return _measured(choice, frame, series)
-        if len(series) >= rule.max_attempts:
-            break
-        check = _shot(camera, choice.exposure_s, series)
-        if check.saturated_fraction <= rule.max_saturated_fraction:
-            return _measured(choice, check, series)
-        break  # prediction failed verification: fall back to what was measured
+        # Verify with a real shot. Noise can push a few more pixels over white than the preview
+        # predicted; back off towards the (good) preview exposure until one verifies.
+        target = choice.exposure_s
+        while len(series) < rule.max_attempts and target > frame.exposure_s:
+            check = _shot(camera, target, series)
+            if check.saturated_fraction <= rule.max_saturated_fraction:
+                return _measured(choice, check, series)
+            target = _backoff(target, frame.exposure_s, backoff, candidates_s)
+        break
     return choose_from_series(series, rule)
 
 
@@ -196,6 +203,15 @@ def _shorter(target: float, rule: ExposureRule, candidates_s: Sequence[float] | 
     if ok:
         return max(ok)
     return min(c for c in candidates_s if c >= rule.min_exposure_s)
+
+
+def _backoff(
+    target: float, floor: float, factor: float, candidates_s: Sequence[float] | None
+) -> float:
+    if candidates_s is None:
+        return max(target * factor, floor)
+    shorter = [c for c in candidates_s if floor <= c < target]
+    return max(shorter) if shorter else floor
 
 
 def _measured(choice: ExposureChoice, frame: Frame, series: list[Frame]) -> ExposureChoice:

@@ -61,7 +61,7 @@ class ExposureRule(_Strict):
     )
     min_exposure_s: float = Field(1e-5, gt=0.0)
     max_exposure_s: float = Field(30.0, gt=0.0)
-    max_attempts: int = Field(4, ge=1, description="test shots before giving up")
+    max_attempts: int = Field(6, ge=1, description="test shots before giving up")
 
     @model_validator(mode="after")
     def _ordered(self) -> ExposureRule:
