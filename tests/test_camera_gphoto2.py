@@ -111,6 +111,12 @@ def make_module(body: Body) -> types.SimpleNamespace:
             body.fail("autodetect")
             return list(body.detected)
 
+        def set_port_info(self, info):
+            body.calls.append(f"port {info}")
+
+        def set_abilities(self, abilities):
+            body.calls.append(f"model {abilities}")
+
         def init(self):
             body.fail("init")
             if not body.detected:
@@ -164,8 +170,23 @@ def make_module(body: Body) -> types.SimpleNamespace:
             body.deleted.append(name)
             body.storage.pop(name, None)
 
+    class PortInfoList(list):
+        def load(self):
+            self.extend(addr for _, addr in body.detected)
+
+        def lookup_path(self, path):
+            return self.index(path)
+
+    class CameraAbilitiesList(list):
+        def load(self):
+            self.extend(name for name, _ in body.detected)
+
+        def lookup_model(self, model):
+            return self.index(model)
+
     return types.SimpleNamespace(
         GPhoto2Error=FakeGPhoto2Error, Camera=FakeCamera, GP_CAPTURE_IMAGE=0,
+        PortInfoList=PortInfoList, CameraAbilitiesList=CameraAbilitiesList,
         GP_FILE_TYPE_NORMAL=1, GP_EVENT_TIMEOUT=1, GP_EVENT_FILE_ADDED=2,
         GP_EVENT_CAPTURE_COMPLETE=4,
     )
@@ -281,6 +302,14 @@ def test_several_cameras_need_a_port(tmp_path):
         camera(body, tmp_path).connect()
     with pytest.raises(DeviceError, match="no camera on port usb:002,001"):
         camera(body, tmp_path, port="usb:002,001").connect()
+
+
+def test_port_chooses_one_of_several_cameras(tmp_path):
+    body = Body(detected=[("Nikon D750", "usb:001,004"), ("Canon EOS 600D", "usb:001,005")])
+    with camera(body, tmp_path, port="usb:001,005") as cam:
+        assert cam.camera_model == "Canon EOS 600D"
+        cam.capture(1 / 60)
+    assert "port usb:001,005" in body.calls and "model Canon EOS 600D" in body.calls
 
 
 def test_value_not_offered_and_value_not_latched(tmp_path):

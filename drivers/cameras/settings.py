@@ -8,9 +8,16 @@ automatic mode. Every model therefore forbids extra keys and is frozen once vali
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    TypeAdapter,
+    field_validator,
+    model_validator,
+)
 
 CfaPattern = Literal["RGGB", "BGGR", "GRBG", "GBRG"]
 
@@ -202,3 +209,21 @@ class FolderWatchSettings(_Strict):
         "linearise with the inverse sRGB curve, or take them as linear"
     )
     decode: RawDecodeSettings = RawDecodeSettings()
+
+
+CameraSettings = Annotated[
+    OpenCvCameraSettings | Gphoto2CameraSettings | FolderWatchSettings,
+    Field(discriminator="kind"),
+]
+"""Any real camera's settings, told apart by ``kind`` (``[camera] kind = "gphoto2"``)."""
+
+CAMERA_SETTINGS_ADAPTER: TypeAdapter[CameraSettings] = TypeAdapter(CameraSettings)
+
+
+def parse_camera_settings(data: dict[str, object]) -> CameraSettings:
+    """Validate a rig config's ``[camera]`` table into the right backend's settings.
+
+    Raises pydantic's ``ValidationError`` (the config loader turns it into a ConfigError that
+    names the file and key).
+    """
+    return CAMERA_SETTINGS_ADAPTER.validate_python(data)
