@@ -58,6 +58,7 @@ class Body:
     deleted: list[str] = field(default_factory=list)
     exits: int = 0
     shots: int = 0
+    announce_first: bool = False  # also send FILE_ADDED for the file capture() returned
 
     def fail(self, op: str) -> None:
         self.calls.append(op)
@@ -153,7 +154,7 @@ def make_module(body: Body) -> types.SimpleNamespace:
             for n, data in names:
                 body.storage[n] = data
             first, *rest = names
-            for n, _ in rest:
+            for n, _ in names if body.announce_first else rest:
                 body.events.append((2, Path("/", n)))
             body.events.append((4, None))
             return Path("/", first[0])
@@ -244,6 +245,15 @@ def test_raw_plus_jpeg_collects_the_second_file_from_events(tmp_path):
     assert (tmp_path / "cap0001_IMG_0001.JPG").read_bytes().startswith(b"\xff\xd8")
     assert f.metadata["source_file"].endswith("IMG_0001.DNG")
     assert sorted(body.deleted) == ["IMG_0001.DNG", "IMG_0001.JPG"]
+
+
+def test_file_announced_twice_is_downloaded_once(tmp_path):
+    body = Body(announce_first=True)
+    with camera(body, tmp_path, image_format="RAW + Large Fine JPEG") as cam:
+        f = cam.capture(1 / 60)
+    assert f.metadata["camera_files"] == ["/IMG_0001.DNG", "/IMG_0001.JPG"]
+    assert body.calls.count("file_get") == 1  # the JPEG is not kept by default
+    assert f.metadata["jpeg_file"] is None
 
 
 def test_jpeg_only_camera_is_an_error_naming_the_setting(tmp_path):

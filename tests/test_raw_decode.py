@@ -41,6 +41,18 @@ def test_mosaic_mode_is_bit_exact_from_file(tmp_path):
     assert frame.saturated_fraction == 0.0
 
 
+def test_per_channel_black_levels_are_removed_per_photosite():
+    mosaic = random_mosaic(4)
+    blacks = (500, 510, 520, 530)  # R, G (row 0), G (row 1), B
+    f = decode_raw(dng_bytes(mosaic, black_level=blacks, white_level=WHITE))
+    per_site = np.tile(np.array(blacks).reshape(2, 2), (24, 32))
+    np.testing.assert_array_equal(
+        f.pixels, np.clip(mosaic.astype(np.int64) - per_site, 0, WHITE - 530)
+    )
+    assert f.white_level == WHITE - 530
+    assert sorted(f.metadata["raw_black_level"]) == sorted(blacks)
+
+
 def test_bytes_and_file_decode_identically(tmp_path):
     mosaic = random_mosaic(3)
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)

@@ -39,6 +39,7 @@ TAG_FNUMBER = 33437
 TAG_ISO = 34855
 TAG_DNG_VERSION = 50706
 TAG_UNIQUE_MODEL = 50708
+TAG_BLACK_REPEAT = 50713
 TAG_BLACK_LEVEL = 50714
 TAG_WHITE_LEVEL = 50717
 TAG_AS_SHOT_NEUTRAL = 50728
@@ -52,7 +53,7 @@ def _rational(value: float, max_den: int = 1_000_000) -> tuple[int, int]:
 def dng_bytes(
     mosaic: NDArray[np.uint16],
     cfa_pattern: str = "RGGB",
-    black_level: int = 0,
+    black_level: int | tuple[int, int, int, int] = 0,
     white_level: int = 65535,
     exposure_s: float | None = None,
     iso: int | None = None,
@@ -64,6 +65,8 @@ def dng_bytes(
     """Encode a Bayer mosaic (uint16, H×W, even sizes) as an uncompressed DNG and return bytes.
 
     ``mosaic`` holds raw code values *including* the black offset, as a sensor delivers them.
+    ``black_level`` is one value, or four for the 2×2 positions row by row (written with
+    BlackLevelRepeatDim, as cameras with per-channel black levels do).
     """
     arr = np.asarray(mosaic)
     if arr.dtype != np.uint16 or arr.ndim != 2:
@@ -77,9 +80,10 @@ def dng_bytes(
         )
     if cfa_pattern not in CFA_CODES:
         raise ValueError(f"cfa_pattern must be one of {sorted(CFA_CODES)}, got {cfa_pattern!r}")
-    if not 0 <= black_level < white_level <= 65535:
-        raise ValueError(f"need 0 <= black_level < white_level <= 65535, got {black_level}, "
-                         f"{white_level}")
+    blacks = (black_level,) if isinstance(black_level, int) else tuple(black_level)
+    if len(blacks) not in (1, 4) or not all(0 <= b < white_level <= 65535 for b in blacks):
+        raise ValueError(f"need 0 <= black_level < white_level <= 65535 (one or four black "
+                         f"levels), got {black_level}, {white_level}")
     tags: list[tuple[int, str, int, object, bool]] = [
         (TAG_DNG_VERSION, "B", 4, (1, 4, 0, 0), True),
         (TAG_UNIQUE_MODEL, "s", 0, f"{make} {model}", True),
@@ -87,9 +91,11 @@ def dng_bytes(
         (TAG_MODEL, "s", 0, model, True),
         (TAG_CFA_REPEAT, "H", 2, (2, 2), True),
         (TAG_CFA_PATTERN, "B", 4, CFA_CODES[cfa_pattern], True),
-        (TAG_BLACK_LEVEL, "H", 1, int(black_level), True),
+        (TAG_BLACK_LEVEL, "H", len(blacks), blacks if len(blacks) > 1 else blacks[0], True),
         (TAG_WHITE_LEVEL, "H", 1, int(white_level), True),
     ]
+    if len(blacks) == 4:
+        tags.append((TAG_BLACK_REPEAT, "H", 2, (2, 2), True))
     if exposure_s is not None:
         if exposure_s <= 0:
             raise ValueError(f"exposure_s must be positive, got {exposure_s}")

@@ -322,7 +322,7 @@ class Gphoto2Camera:
             "iso": s.iso,
             "aperture": s.aperture,
             "gain_unit": "iso",
-            "camera_files": [f"{f}/{n}" for f, n in files],
+            "camera_files": [f"{f.rstrip('/')}/{n}" for f, n in files],
             "jpeg_file": jpeg[0] if jpeg else None,
         })
         return Frame(pixels=decoded.pixels, exposure_s=secs, gain=float(iso),
@@ -337,7 +337,9 @@ class Gphoto2Camera:
         while budget_ms > 0:
             event, data = self._call("wait_for_event", lambda: self._cam.wait_for_event(wait_ms))
             if event == gp.GP_EVENT_FILE_ADDED:
-                more.append((str(data.folder), str(data.name)))
+                item = (str(data.folder), str(data.name))
+                if item not in files and item not in more:  # some bodies re-announce the first
+                    more.append(item)
             elif event == gp.GP_EVENT_TIMEOUT:
                 budget_ms -= wait_ms
                 if any(is_raw_file(Path(n)) for _, n in files + more):

@@ -137,20 +137,34 @@ def decode_raw(
     name, handle = _source(source)
     try:
         with rawpy.imread(handle) as raw:
-            raw_vis = np.array(raw.raw_image_visible, dtype=np.int64)  # copy out of LibRaw
-            colors = np.array(raw.raw_colors_visible)
+            raw_vis = np.array(raw.raw_image_visible)  # uint16 copy out of LibRaw memory
             black_pc = np.asarray(raw.black_level_per_channel, dtype=np.int64)
             white = int(raw.white_level)
             pattern = _pattern_name(raw)
             other = raw.other
             if raw_vis.ndim != 2:
                 raise CaptureError(DECODER, f"{name}: not a single-plane CFA RAW", "decode")
-            black = black_pc[colors]
-            span = white - black
-            saturated = raw_vis >= black + np.floor(settings.saturation_level * span)
+            white_level = int(white - black_pc.max())
+            if white_level <= 0:
+                raise CaptureError(DECODER, f"{name}: white level {white} is not above the "
+                                   f"black levels {black_pc.tolist()}", "decode")
+            # Uniform black (the usual case) stays scalar: uint16 arithmetic, no index arrays.
+            black: int | NDArray[np.int64] = (
+                int(black_pc[0]) if np.all(black_pc == black_pc[0])
+                else black_pc[np.array(raw.raw_colors_visible)]
+            )
+            threshold = (
+                int(black + np.floor(settings.saturation_level * (white - black)))
+                if isinstance(black, int)
+                else black + np.floor(settings.saturation_level * (white - black))
+            )
+            saturated = raw_vis >= threshold
             if settings.mode == "mosaic":
-                white_level = int(white - black_pc.max())
-                pixels = np.clip(raw_vis - black, 0, white_level).astype(np.uint16)
+                if isinstance(black, int):
+                    pixels = np.clip(raw_vis, black, black + white_level) - np.uint16(black)
+                else:
+                    pixels = np.clip(raw_vis.astype(np.int64) - black, 0, white_level)
+                pixels = pixels.astype(np.uint16, copy=False)
                 pixels[saturated] = white_level
             else:
                 rgb = raw.postprocess(**_postprocess_params(settings))
@@ -169,8 +183,6 @@ def decode_raw(
             "is it a complete RAW/DNG download?",
             "decode",
         ) from exc
-    if white_level <= 0:
-        raise CaptureError(DECODER, f"{name}: white level {white} not above black {black_pc}")
     iso = float(other.iso_speed) or _iso_from_tiff(source)
     exposure = float(other.shutter_speed)
     if timestamp_s is None:
