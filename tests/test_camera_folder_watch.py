@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import time
 
 import numpy as np
@@ -74,6 +75,7 @@ def test_file_that_appears_later_is_decoded_and_existing_files_ignored(tmp_path)
     assert np.mean(f.pixels) / f.white_level == pytest.approx(0.3, abs=1e-3)
     assert f.exposure_s == pytest.approx(0.5) and f.gain == 100.0
     assert f.metadata["exposure_source"] == "file"
+    json.dumps(f.metadata)  # goes into the session manifest as is
     assert 1.0 <= clock.now() <= 1.5  # picked up within a poll or two of appearing
     with pytest.raises(CaptureError, match="within"):
         cam.capture(0.5)  # each file is used once

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import types
 from dataclasses import dataclass, field
@@ -220,6 +221,7 @@ def test_connect_applies_settings_and_capture_downloads_and_decodes_raw(tmp_path
     assert f.metadata["source_file"] == str(src) and src.exists()
     assert body.deleted == ["IMG_0001.DNG"]
     assert f.metadata["shutter_label"] == "1/125"
+    json.dumps(f.metadata)  # goes into the session manifest as is
     cam.close()
     cam.close()
     assert body.exits == 1

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from collections import deque
 
 import cv2
@@ -38,6 +39,7 @@ def test_image_sequence_16bit_frames_come_back_unchanged_after_draining(tmp_path
     assert f.exposure_s == 0.02 and f.timestamp_s == 5.0
     assert f.metadata["exposure_applied"] is False
     assert f.metadata["stream_index"] == 2 and f.metadata["bit_depth"] == 16
+    json.dumps(f.metadata)  # goes into the session manifest as is
     assert np.all(cam.capture(0.02).pixels == 6000)
     with pytest.raises(CaptureError, match="stream ended while draining"):
         cam.capture(0.02)

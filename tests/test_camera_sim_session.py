@@ -6,6 +6,8 @@ stereo on the decoded frames recovers the sphere's normals.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
 from drivers.cameras.exposure import meter_exposure
@@ -100,7 +102,8 @@ def test_session_raw_like_frames_recover_normals(tmp_path):
         dome.close()
         cam.close()
     assert dome.on is None
-    manifest = {"exposure": choice.to_manifest()}
+    manifest = {"exposure": choice.to_manifest(), "frames": [f.metadata for f in frames]}
+    json.dumps(manifest)
     assert manifest["exposure"]["exposure_s"] == choice.exposure_s
     files = sorted(raw_dir.glob("cap*.dng"))
     assert len(files) == len(choice.test_exposures_s) + len(dirs)
