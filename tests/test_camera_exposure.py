@@ -124,3 +124,22 @@ def test_meter_exposure_with_camera_shutter_list(tmp_path):
     choice = meter_exposure(cam, ExposureRule(max_saturated_fraction=0.01), 1 / 4, shutters)
     # brightest 1% of the ramp is above 9.9: 1/15 s puts it at 0.66 of full scale, 1/8 s clips
     assert choice.satisfied and choice.exposure_s == 1 / 15
+
+
+def test_meter_exposure_validates_its_arguments():
+    cam = RawRoundTripCamera("sim", lambda t: np.full((32, 32, 3), t))
+    cam.connect()
+    with pytest.raises(ValueError, match="not one of the camera's exposures"):
+        meter_exposure(cam, ExposureRule(), 0.1, [1 / 60, 1 / 30])
+    with pytest.raises(ValueError, match="backoff"):
+        meter_exposure(cam, ExposureRule(), 0.1, backoff=1.5)
+
+
+def test_meter_exposure_gives_up_when_even_the_shortest_shot_saturates():
+    cam = RawRoundTripCamera("sim", lambda t: np.full((32, 32, 3), 1000.0 * t))
+    cam.connect()
+    rule = ExposureRule(max_saturated_fraction=0.01, min_exposure_s=1e-3, max_attempts=10)
+    choice = meter_exposure(cam, rule, 0.1)
+    assert not choice.satisfied
+    assert choice.exposure_s == pytest.approx(1e-3)
+    assert choice.test_exposures_s == pytest.approx((1e-3, 1.5625e-3, 6.25e-3, 0.025, 0.1))

@@ -164,6 +164,11 @@ def meter_exposure(
         raise ValueError("step_down must exceed 1")
     if not 0 < backoff < 1:
         raise ValueError("backoff must lie in (0, 1)")
+    if candidates_s is not None and not any(
+        np.isclose(start_exposure_s, c, rtol=1e-9) for c in candidates_s
+    ):
+        raise ValueError(f"start exposure {start_exposure_s:g} s is not one of the camera's "
+                         "exposures (candidates_s)")
     series: list[Frame] = []
     frame = _shot(camera, start_exposure_s, series)
     while True:
