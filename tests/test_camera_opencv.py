@@ -202,6 +202,15 @@ def test_without_draining_the_frame_is_stale():
     assert np.all(f.pixels == 156)
 
 
+def test_v4l2_size_is_set_before_the_pixel_format():
+    fake = FakeV4l2()
+    with v4l2_camera(fake, width=320, height=240) as cam:
+        assert cam.connection_info["fourcc"] == "Y16 "
+    order = [p for p, _ in fake.log]
+    assert order.index(cv2.CAP_PROP_FRAME_HEIGHT) < order.index(cv2.CAP_PROP_FOURCC)
+    assert fake.props[cv2.CAP_PROP_FRAME_WIDTH] == 320
+
+
 def test_v4l2_refused_manual_exposure_fails_at_connect_and_releases():
     fake = FakeV4l2(manual_latches=False)
     cam = v4l2_camera(fake)

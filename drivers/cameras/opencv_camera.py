@@ -140,6 +140,11 @@ class OpenCvCamera:
     def _configure(self, cap: VideoCaptureLike) -> None:
         s = self.settings
         info: dict[str, Any] = {"backend": "v4l2", "controls": True}
+        # Size first: a size change renegotiates the format, which could drop the fourcc.
+        if s.width is not None:
+            self._set_verified(cap, cv2.CAP_PROP_FRAME_WIDTH, s.width, "width")
+        if s.height is not None:
+            self._set_verified(cap, cv2.CAP_PROP_FRAME_HEIGHT, s.height, "height")
         if s.fourcc is not None:
             cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter_fourcc(*s.fourcc))
             got = fourcc_to_str(cap.get(cv2.CAP_PROP_FOURCC))
@@ -154,10 +159,6 @@ class OpenCvCamera:
             info["fourcc"] = got
             if got in RAW_GREY_FOURCCS:
                 self._set_verified(cap, cv2.CAP_PROP_CONVERT_RGB, 0, "convert_rgb")
-        if s.width is not None:
-            self._set_verified(cap, cv2.CAP_PROP_FRAME_WIDTH, s.width, "width")
-        if s.height is not None:
-            self._set_verified(cap, cv2.CAP_PROP_FRAME_HEIGHT, s.height, "height")
         info["buffer_size_set"] = bool(cap.set(cv2.CAP_PROP_BUFFERSIZE, s.buffer_size))
         if s.toggle_auto_exposure:
             cap.set(cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_auto)
@@ -173,6 +174,10 @@ class OpenCvCamera:
                                "wb_temperature", tol=50)
         if s.gain is not None:
             self._set_verified(cap, cv2.CAP_PROP_GAIN, s.gain, "gain")
+        if "fourcc" in info and fourcc_to_str(cap.get(cv2.CAP_PROP_FOURCC)) != info["fourcc"]:
+            raise DeviceError(self.name, f"pixel format changed from {info['fourcc']!r} while "
+                              "configuring; set fourcc, width and height the camera supports "
+                              "together (`v4l2-ctl --list-formats-ext`)", "verify fourcc")
         self.connection_info = info
 
     # -- capture ---------------------------------------------------------------------------
