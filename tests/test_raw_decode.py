@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic, write_dng
 from drivers.cameras.raw_decode import average_frames, decode_raw, exposure_stats, subtract_dark
@@ -198,3 +200,22 @@ def test_linear_to_mosaic_clips_and_quantises():
     np.testing.assert_array_equal(m, [[100, 600], [1100, 1100]])
     with pytest.raises(ValueError, match="NaN"):
         linear_to_mosaic(np.array([[np.nan, 0.0]]))
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    h=st.integers(11, 40).map(lambda v: 2 * v),
+    w=st.integers(11, 40).map(lambda v: 2 * v),
+    black=st.integers(0, 4000),
+    span=st.integers(100, 60000),
+    pattern=st.sampled_from(["RGGB", "BGGR", "GRBG", "GBRG"]),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_any_dng_round_trips_bit_exactly(h, w, black, span, pattern, seed):
+    white = min(black + span, 65535)
+    rng = np.random.default_rng(seed)
+    mosaic = rng.integers(black, white, (h, w), endpoint=False).astype(np.uint16)
+    f = decode_raw(dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white))
+    np.testing.assert_array_equal(f.pixels, mosaic.astype(np.int64) - black)
+    assert f.white_level == white - black
+    assert f.metadata["cfa_pattern"] == pattern
