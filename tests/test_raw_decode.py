@@ -68,7 +68,7 @@ def test_bytes_and_file_decode_identically(tmp_path):
 @pytest.mark.parametrize("mode", ["half", "demosaic"])
 def test_postprocess_modes_are_linear_and_never_rescaled(mode):
     # The brightest patch is 0.9 of white: LibRaw's default adjust_maximum_thr=0.75 would
-    # rescale it to 1.0 (hardware-notes §6.1); the decode must keep it at 0.9.
+    # rescale it to 1.0 (LibRaw's adjust_maximum_thr); the decode must keep it at 0.9.
     levels = [0.01, 0.1, 0.25, 0.5, 0.75, 0.9]
     frame = decode_raw(dng_bytes(patch_mosaic(levels), black_level=BLACK, white_level=WHITE),
                        RawDecodeSettings(mode=mode))

@@ -4,8 +4,8 @@ Why: tests and the simulated camera need RAW files that go through exactly the s
 decode path as a real camera's, without shipping camera files. A DNG is a TIFF whose IFD0 carries
 a few extra tags; LibRaw needs DNGVersion, CFARepeatPatternDim and CFAPattern, and reads
 BlackLevel/WhiteLevel and ExposureTime from IFD0. (ISO is only read by LibRaw from an EXIF IFD,
-so ``raw_decode`` reads the ISOSpeedRatings tag written here with tifffile.) Verified recipe:
-/work/shared/reference/hardware-notes.md §6.2.
+so ``raw_decode`` reads the ISOSpeedRatings tag written here with tifffile.) Without
+BlackLevel/WhiteLevel LibRaw assumes 0 and 65535; images under 22×22 pixels are refused.
 """
 
 from __future__ import annotations

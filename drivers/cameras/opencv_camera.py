@@ -5,7 +5,7 @@ did not latch (auto exposure still on, exposure clamped). A capture is only trus
 camera reports the exposure that was asked for. Why drain: V4L2 queues several buffers, so the
 next frame read after changing exposure was usually exposed *before* the change.
 
-Facts used (hardware-notes §7, from OpenCV's cap_v4l.cpp): ``CAP_PROP_AUTO_EXPOSURE`` maps to the
+Facts used (from OpenCV's modules/videoio/src/cap_v4l.cpp): ``CAP_PROP_AUTO_EXPOSURE`` maps to the
 V4L2 menu (1 = manual, 3 = aperture-priority auto) unless OPENCV_VIDEOIO_V4L_RANGE_NORMALIZED is
 set; ``CAP_PROP_EXPOSURE`` is V4L2 exposure_absolute in 100 µs units; a Y16 stream comes back as
 CV_16UC1 only with ``CAP_PROP_CONVERT_RGB = 0``. OpenCV maps no auto-gain control: if the camera

@@ -2,7 +2,8 @@
 
 Why a module of its own: every camera path that yields RAW (gphoto2 downloads, watched folders,
 the simulated camera's DNGs) must produce *the same* linear data, so they all call
-:func:`decode_raw`. The settings that matter for radiometry (hardware-notes §6.1, verified):
+:func:`decode_raw`. The settings that matter for radiometry (checked against rawpy 0.28 /
+LibRaw 0.22 with synthetic DNGs in tests/test_raw_decode.py):
 gamma (1, 1), ``no_auto_bright``, 16-bit output, ``adjust_maximum_thr=0`` (the default 0.75
 rescales to the data maximum and breaks linearity), a fixed white balance, no rotation.
 """
