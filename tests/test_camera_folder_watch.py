@@ -77,6 +77,7 @@ def test_file_that_appears_later_is_decoded_and_existing_files_ignored(tmp_path)
     assert f.metadata["exposure_source"] == "file"
     json.dumps(f.metadata)  # goes into the session manifest as is
     assert 1.0 <= clock.now() <= 1.5  # picked up within a poll or two of appearing
+    assert f.timestamp_s == 0.0 and f.metadata["capture_finished_s"] == clock.now()
     with pytest.raises(CaptureError, match="within"):
         cam.capture(0.5)  # each file is used once
 

@@ -273,6 +273,8 @@ def test_busy_is_retried_on_the_injected_clock(tmp_path):
     assert body.shots == 1 and cam.retries_used == 2
     assert clock.now() == pytest.approx(1.0)  # two waits of 0.5 s, none real
     assert f.timestamp_s == pytest.approx(0.0)
+    assert f.metadata["capture_started_s"] == 0.0
+    assert f.metadata["capture_finished_s"] == pytest.approx(1.0)
 
 
 def test_busy_forever_gives_up_with_a_clear_error(tmp_path):

@@ -125,17 +125,16 @@ class FolderWatchCamera:
         """Fire the trigger (if any), wait for the file, decode it to a linear frame."""
         if self._seen is None:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
+        started = self._clock.now()
         if self._trigger is not None:
             self._trigger(exposure_s)
         path = self.wait_for_file()
-        frame = self._decode(path, exposure_s)
-        return frame
+        return self._decode(path, exposure_s, started)
 
-    def _decode(self, path: Path, exposure_s: float) -> Frame:
+    def _decode(self, path: Path, exposure_s: float, started: float) -> Frame:
         s = self.settings
-        now = self._clock.now()
         if is_raw_file(path):
-            decoded = decode_raw(path, s.decode, timestamp_s=now)
+            decoded = decode_raw(path, s.decode, timestamp_s=started)
             pixels, white = decoded.pixels, decoded.white_level
             file_exposure = decoded.exposure_s or None
             gain = decoded.gain or s.gain
@@ -167,6 +166,8 @@ class FolderWatchCamera:
                     "check exposure",
                 )
         metadata.update({"camera": self.name, "exposure_requested_s": exposure_s,
-                         "exposure_source": "file" if file_exposure else "requested"})
+                         "exposure_source": "file" if file_exposure else "requested",
+                         "capture_started_s": started,
+                         "capture_finished_s": self._clock.now()})
         return Frame(pixels=pixels, exposure_s=file_exposure or exposure_s, gain=float(gain),
-                     white_level=white, timestamp_s=now, metadata=metadata)
+                     white_level=white, timestamp_s=started, metadata=metadata)

@@ -324,6 +324,8 @@ class Gphoto2Camera:
             "gain_unit": "iso",
             "camera_files": [f"{f.rstrip('/')}/{n}" for f, n in files],
             "jpeg_file": jpeg[0] if jpeg else None,
+            "capture_started_s": t_capture,
+            "capture_finished_s": self._clock.now(),
         })
         return Frame(pixels=decoded.pixels, exposure_s=secs, gain=float(iso),
                      white_level=decoded.white_level, timestamp_s=t_capture, metadata=metadata)

@@ -221,6 +221,7 @@ class OpenCvCamera:
                 f"[{s.min_exposure_s:g}, {s.max_exposure_s:g}] s",
                 "capture",
             )
+        started = self._clock.now()
         if s.backend == "v4l2":
             actual, units = self._apply_exposure(cap, exposure_s)
             gain = float(cap.get(cv2.CAP_PROP_GAIN))
@@ -253,8 +254,10 @@ class OpenCvCamera:
             "gain_unit": "v4l2" if applied else "configured",
             "drained_frames": s.drain_frames,
             "stream_index": self._frames_read - 1,
+            "capture_started_s": started,
+            "capture_finished_s": self._clock.now(),
         }
         metadata.update(self.connection_info)
         metadata.update(exposure_stats(pixels, white, 0.001))
         return Frame(pixels=pixels, exposure_s=actual, gain=gain, white_level=white,
-                     timestamp_s=self._clock.now(), metadata=metadata)
+                     timestamp_s=started, metadata=metadata)

@@ -96,7 +96,8 @@ class RawRoundTripCamera:
                               self._black, self._white, self._iso, path, self._clock.now())
         metadata = dict(frame.metadata)
         metadata.update({"camera": self.name, "exposure_requested_s": exposure_s,
-                         "gain_unit": "iso"})
+                         "gain_unit": "iso", "capture_started_s": frame.timestamp_s,
+                         "capture_finished_s": self._clock.now()})
         # The DNG stores exposure as a float32 rational; the requested value is exact.
         return Frame(pixels=frame.pixels, exposure_s=exposure_s, gain=float(self._iso),
                      white_level=frame.white_level, timestamp_s=frame.timestamp_s,
