@@ -1,0 +1,365 @@
+"""DSLR and mirrorless cameras through python-gphoto2, one camera session kept open.
+
+Why one session: each gphoto2 CLI run spends about a second initialising the camera
+(libgphoto2 #309), and an RTI session takes 50-100 shots. Why retries: bodies report "busy"
+(-110) while still writing the previous file to SDRAM or card; that is transient, anything else
+is not. Why the module is injected: python-gphoto2 is an optional dependency (LGPL, bundled
+libgphoto2) and tests run against a fake module; ``import gphoto2`` happens in ``connect``.
+
+API used (python-gphoto2 2.x): ``Camera.autodetect()``, ``Camera().init()/exit()``,
+``get_config()/set_config()``, widget ``get_child_by_name/get_value/set_value/count_choices/
+get_choice``, ``capture(GP_CAPTURE_IMAGE)``, ``wait_for_event(ms)``, ``file_get(...).save()``,
+``file_delete``; errors are ``GPhoto2Error`` with ``.code``.
+
+Safe state: no capture in progress, ``exit()`` called on the camera (``close``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+from drivers.cameras.folder_watch import is_raw_file
+from drivers.cameras.raw_decode import decode_raw
+from drivers.cameras.settings import Gphoto2CameraSettings
+from rti_rig.clock import Clock, SystemClock
+from rti_rig.errors import CaptureError, DeviceError
+from rti_rig.rig import Frame
+
+T = TypeVar("T")
+
+GP_ERROR_HINTS = {
+    -7: "USB I/O error: check the cable and the camera's power saving",
+    -52: "USB device not found: is the camera on and connected?",
+    -53: "the USB device is claimed by another program (on desktops gvfs-gphoto2-volume-monitor "
+    "or a file manager mounted it): stop that program or unmount the camera",
+    -105: "no camera model detected: is it on, connected, and in PC/PTP mode?",
+    -110: "camera busy: still writing the previous file? raise busy_retries or retry_delay_s",
+}
+NO_CAMERA_HELP = (
+    "gphoto2 found no camera: check the USB cable, that the camera is switched on and in PC/PTP "
+    "mode, and that no other program (gvfs-gphoto2-volume-monitor, a gphoto2 shell, the vendor "
+    "utility) holds it; `gphoto2 --auto-detect` should list it"
+)
+
+
+def load_gphoto2() -> Any:
+    """Import python-gphoto2 lazily, with an error that says how to install it."""
+    try:
+        import gphoto2
+    except ImportError as exc:
+        raise DeviceError(
+            "gphoto2",
+            "python-gphoto2 is not installed: pip install gphoto2 (binary wheels bundle "
+            "libgphoto2 on Linux and macOS)",
+            "import",
+        ) from exc
+    return gphoto2
+
+
+_SECONDS = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(?:s|sec|\"|'')?\s*$", re.IGNORECASE)
+_FRACTION = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*/\s*(\d+(?:\.\d+)?)\s*(?:s|sec)?\s*$", re.IGNORECASE)
+
+
+def parse_shutter(label: str) -> float | None:
+    """Seconds for a camera shutter label ('1/125', '0.3', '2.5s', '30"'); None for bulb/auto."""
+    m = _FRACTION.match(label)
+    if m:
+        den = float(m.group(2))
+        return float(m.group(1)) / den if den else None
+    m = _SECONDS.match(label)
+    if m:
+        v = float(m.group(1))
+        return v if v > 0 else None
+    return None
+
+
+def nearest_shutter(
+    exposure_s: float, shutters: list[tuple[float, str]]
+) -> tuple[float, str, float]:
+    """(seconds, label, relative error) of the offered shutter speed nearest in stops (pure)."""
+    if not shutters:
+        raise ValueError("the camera offers no shutter speeds")
+    secs, label = min(shutters, key=lambda s: abs(math.log(s[0] / exposure_s)))
+    return secs, label, abs(secs - exposure_s) / exposure_s
+
+
+class Gphoto2Camera:
+    """Implements the ``Camera`` protocol on a tethered stills camera."""
+
+    def __init__(
+        self,
+        settings: Gphoto2CameraSettings,
+        output_dir: Path | None = None,
+        clock: Clock | None = None,
+        gp_module: Any = None,
+    ) -> None:
+        self.settings = settings
+        self.name = settings.name
+        self.output_dir = output_dir
+        self._clock = clock or SystemClock()
+        self._gp = gp_module
+        self._cam: Any = None
+        self._shutters: list[tuple[float, str]] = []
+        self._shutter_label: str | None = None
+        self._count = 0
+        self.retries_used = 0
+        self.camera_model: str | None = None
+
+    # -- error handling --------------------------------------------------------------------
+    def _call(self, command: str, fn: Callable[[], T], error: type[DeviceError] = CaptureError
+              ) -> T:
+        """Run one gphoto2 call, retrying the transient (busy) codes with the injected clock."""
+        gp = self._gp
+        s = self.settings
+        for attempt in range(s.busy_retries + 1):
+            try:
+                return fn()
+            except gp.GPhoto2Error as exc:
+                code = getattr(exc, "code", None)
+                if code in s.retry_codes and attempt < s.busy_retries:
+                    self.retries_used += 1
+                    self._clock.sleep(s.retry_delay_s)
+                    continue
+                hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
+                tries = f" after {attempt + 1} attempts" if attempt else ""
+                raise error(self.name, f"gphoto2 error {code} ({exc}){tries}: {hint}",
+                            command) from exc
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    # -- lifecycle -------------------------------------------------------------------------
+    def connect(self) -> None:
+        """Find the camera, open one session, apply ISO/aperture/format/target, read shutters."""
+        if self._cam is not None:
+            return
+        if self._gp is None:
+            self._gp = load_gphoto2()
+        gp = self._gp
+        detected = [(str(n), str(a)) for n, a in
+                    self._call("autodetect", lambda: list(gp.Camera.autodetect()), DeviceError)]
+        if not detected:
+            raise DeviceError(self.name, NO_CAMERA_HELP, "connect")
+        port = self.settings.port
+        if port is not None:
+            match = [d for d in detected if d[1] == port]
+            if not match:
+                raise DeviceError(self.name, f"no camera on port {port}; found {detected}",
+                                  "connect")
+            model = match[0][0]
+        elif len(detected) > 1:
+            raise DeviceError(self.name, f"several cameras found {detected}: set 'port' to "
+                              "choose one", "connect")
+        else:
+            model, port = detected[0]
+        cam = gp.Camera()
+        if self.settings.port is not None:
+            ports = gp.PortInfoList()
+            ports.load()
+            abilities = gp.CameraAbilitiesList()
+            abilities.load()
+            cam.set_port_info(ports[ports.lookup_path(port)])
+            cam.set_abilities(abilities[abilities.lookup_model(model)])
+        self._call("init", cam.init, DeviceError)
+        self._cam = cam
+        self.camera_model = model
+        try:
+            self._configure()
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """End the camera session. Safe twice and after a failed connect."""
+        cam, self._cam = self._cam, None
+        self._shutter_label = None
+        if cam is not None:
+            # the camera may already be gone; there is nothing else to release
+            with contextlib.suppress(Exception):
+                cam.exit()
+
+    def __enter__(self) -> Gphoto2Camera:
+        self.connect()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- configuration ---------------------------------------------------------------------
+    def _widget(self, config: Any, name: str, key: str) -> Any:
+        gp = self._gp
+        try:
+            return config.get_child_by_name(name)
+        except gp.GPhoto2Error as exc:
+            raise DeviceError(
+                self.name,
+                f"camera has no setting '{name}': set '{key}' to this camera's name for it "
+                "(list them with `gphoto2 --list-config`)",
+                f"get {name}",
+            ) from exc
+
+    @staticmethod
+    def _choices(widget: Any) -> list[str]:
+        try:
+            return [str(widget.get_choice(i)) for i in range(widget.count_choices())]
+        except Exception:  # text widgets have no choices
+            return []
+
+    def _set_config_values(self, values: dict[str, tuple[str, str]]) -> None:
+        """Set {config name: (value, settings key)}, then read back and verify each."""
+        if not values:
+            return
+        cam = self._cam
+        config = self._call("get_config", cam.get_config, DeviceError)
+        for name, (value, key) in values.items():
+            widget = self._widget(config, name, key)
+            choices = self._choices(widget)
+            if choices and value not in choices:
+                raise DeviceError(self.name, f"'{value}' is not offered for {name} (settings "
+                                  f"key '{key}'); the camera offers {choices}", f"set {name}")
+            widget.set_value(value)
+        self._call("set_config", lambda: cam.set_config(config), DeviceError)
+        check = self._call("get_config", cam.get_config, DeviceError)
+        for name, (value, key) in values.items():
+            got = str(self._widget(check, name, key).get_value())
+            if got != value:
+                raise DeviceError(
+                    self.name,
+                    f"{name} set to '{value}' but the camera reports '{got}': put the camera in "
+                    "manual (M) mode with auto-ISO off",
+                    f"set {name}",
+                )
+
+    def _configure(self) -> None:
+        s = self.settings
+        wanted: dict[str, tuple[str, str]] = {}
+        if s.capture_target is not None:
+            wanted["capturetarget"] = (s.capture_target, "capture_target")
+        if s.image_format is not None:
+            wanted[s.image_format_config] = (s.image_format, "image_format")
+        if s.iso is not None:
+            wanted[s.iso_config] = (s.iso, "iso")
+        if s.aperture is not None:
+            wanted[s.aperture_config] = (s.aperture, "aperture")
+        self._set_config_values(wanted)
+        config = self._call("get_config", self._cam.get_config, DeviceError)
+        widget = self._widget(config, s.shutter_config, "shutter_config")
+        shutters = []
+        for label in self._choices(widget):
+            secs = parse_shutter(label)
+            if secs is not None:
+                shutters.append((secs, label))
+        if not shutters:
+            raise DeviceError(self.name, f"'{s.shutter_config}' offers no timed shutter speeds: "
+                              "is the camera in manual (M) mode?", "read shutter speeds")
+        self._shutters = sorted(shutters)
+
+    def available_exposures_s(self) -> list[float]:
+        """Shutter speeds the camera offers, in seconds (for ``exposure.choose_exposure``)."""
+        return [secs for secs, _ in self._shutters]
+
+    # -- capture ---------------------------------------------------------------------------
+    def capture(self, exposure_s: float) -> Frame:
+        """Set the shutter, fire, download the RAW (and JPEG), decode it to linear data."""
+        if self._cam is None:
+            raise CaptureError(self.name, "camera is not connected; call connect() first",
+                               "capture")
+        if self.output_dir is None:
+            raise CaptureError(self.name, "no output_dir set for downloaded files", "capture")
+        s = self.settings
+        gp = self._gp
+        cam = self._cam
+        secs, label, err = nearest_shutter(exposure_s, self._shutters)
+        if err > s.shutter_tolerance:
+            raise CaptureError(
+                self.name,
+                f"exposure {exposure_s:g} s is not offered (nearest '{label}' = {secs:g} s); "
+                "choose one of available_exposures_s()",
+                "set shutter",
+            )
+        if label != self._shutter_label:
+            self._set_config_values({s.shutter_config: (label, "shutter_config")})
+            self._shutter_label = label
+        t_capture = self._clock.now()
+        path = self._call("capture", lambda: cam.capture(gp.GP_CAPTURE_IMAGE))
+        files = [(str(path.folder), str(path.name))]
+        files.extend(self._more_files(files))
+        self._count += 1
+        raw_files = [f for f in files if is_raw_file(Path(f[1]))]
+        if not raw_files:
+            self._delete(files)
+            raise CaptureError(
+                self.name,
+                f"camera delivered {[n for _, n in files]} but no RAW file: set image_format to "
+                "the camera's RAW (or RAW+JPEG) value",
+                "capture",
+            )
+        self.output_dir.mkdir(parents=True, exist_ok=True)
+        saved: dict[str, Path] = {}
+        for folder, name in files:
+            if not is_raw_file(Path(name)) and not s.keep_jpeg:
+                continue
+            target = self.output_dir / f"cap{self._count:04d}_{name}"
+            camera_file = self._call(
+                "download", lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL)
+            )
+            camera_file.save(str(target))
+            saved[name] = target
+        self._delete(files)
+        raw_path = saved[raw_files[0][1]]
+        decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
+        jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
+        iso = _number(s.iso) or decoded.gain
+        metadata = dict(decoded.metadata)
+        metadata.update({
+            "camera": self.name,
+            "camera_model": self.camera_model,
+            "shutter_label": label,
+            "exposure_requested_s": exposure_s,
+            "iso": s.iso,
+            "aperture": s.aperture,
+            "gain_unit": "iso",
+            "camera_files": [f"{f.rstrip('/')}/{n}" for f, n in files],
+            "jpeg_file": jpeg[0] if jpeg else None,
+            "capture_started_s": t_capture,
+            "capture_finished_s": self._clock.now(),
+        })
+        return Frame(pixels=decoded.pixels, exposure_s=secs, gain=float(iso),
+                     white_level=decoded.white_level, timestamp_s=t_capture, metadata=metadata)
+
+    def _more_files(self, files: list[tuple[str, str]]) -> list[tuple[str, str]]:
+        """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet."""
+        gp = self._gp
+        wait_ms = 200
+        budget_ms = self.settings.event_timeout_s * 1000
+        more: list[tuple[str, str]] = []
+        while budget_ms > 0:
+            event, data = self._call("wait_for_event", lambda: self._cam.wait_for_event(wait_ms))
+            if event == gp.GP_EVENT_FILE_ADDED:
+                item = (str(data.folder), str(data.name))
+                if item not in files and item not in more:  # some bodies re-announce the first
+                    more.append(item)
+            elif event == gp.GP_EVENT_TIMEOUT:
+                budget_ms -= wait_ms
+                if any(is_raw_file(Path(n)) for _, n in files + more):
+                    break
+        return more
+
+    def _delete(self, files: list[tuple[str, str]]) -> None:
+        if not self.settings.delete_from_camera:
+            return
+        gp = self._gp
+        for folder, name in files:
+            # files in camera RAM may vanish once downloaded
+            with contextlib.suppress(gp.GPhoto2Error):
+                self._cam.file_delete(folder, name)
+
+
+def _number(text: str | None) -> float:
+    try:
+        return float(text) if text is not None else 0.0
+    except ValueError:
+        return 0.0

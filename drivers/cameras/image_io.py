@@ -1,0 +1,70 @@
+"""Non-RAW pixels (UVC frames, 16-bit TIFF/PNG) to linear uint16 data.
+
+Why: the RAW path has LibRaw; everything else arrives as 8- or 16-bit arrays from OpenCV or
+tifffile and needs one honest conversion. 16-bit data is taken as linear (Y16 sensors, linear
+TIFFs). 8-bit data is gamma-encoded on nearly every camera, so it is only accepted through an
+explicit response curve: ``"srgb"`` (inverse sRGB) or ``"linear"`` (the user asserts it is).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+import cv2
+import numpy as np
+import tifffile
+from numpy.typing import NDArray
+
+from rti_rig.errors import CaptureError
+
+Response = Literal["linear", "srgb"]
+
+
+def _srgb_to_linear_lut() -> NDArray[np.uint16]:
+    v = np.arange(256, dtype=np.float64) / 255.0
+    lin = np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+    return np.rint(lin * 65535).astype(np.uint16)
+
+
+_SRGB_LUT = _srgb_to_linear_lut()
+
+
+def to_linear_uint16(
+    image: NDArray, response: Response, black_level: int = 0, white_level: int = 65535
+) -> tuple[NDArray[np.uint16], int]:
+    """Return ``(pixels, white_level)``: linear uint16, RGB order for colour input (pure).
+
+    OpenCV delivers colour as BGR; it is reordered to RGB to match rawpy's output.
+    """
+    img = np.asarray(image)
+    if img.ndim == 3 and img.shape[2] == 1:
+        img = img[..., 0]
+    if img.ndim == 3 and img.shape[2] == 4:
+        img = img[..., :3]
+    if img.ndim == 3 and img.shape[2] == 3:
+        img = img[..., ::-1]
+    elif img.ndim != 2:
+        raise ValueError(f"expected an H×W or H×W×3 image, got shape {img.shape}")
+    if img.dtype == np.uint16:
+        wl = white_level - black_level
+        if wl <= 0:
+            raise ValueError(f"white_level {white_level} must exceed black_level {black_level}")
+        px = np.clip(img.astype(np.int64) - black_level, 0, wl).astype(np.uint16)
+        return np.ascontiguousarray(px), wl
+    if img.dtype == np.uint8:
+        if response == "srgb":
+            return np.ascontiguousarray(_SRGB_LUT[img]), 65535
+        return np.ascontiguousarray(img.astype(np.uint16) * 257), 65535
+    raise ValueError(f"unsupported pixel type {img.dtype}; expected uint8 or uint16")
+
+
+def read_image_file(path: Path, device: str) -> NDArray:
+    """Read a non-RAW image file unchanged (bit depth and channels kept)."""
+    suffix = path.suffix.lower()
+    if suffix in (".tif", ".tiff"):
+        return tifffile.imread(path)
+    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise CaptureError(device, f"cannot read image file {path}", "read")
+    return img

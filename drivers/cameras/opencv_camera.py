@@ -1,0 +1,263 @@
+"""UVC cameras through OpenCV's V4L2 backend, with every automatic control off and verified.
+
+Why verify by reading back: ``VideoCapture.set`` returns True on many drivers even when the value
+did not latch (auto exposure still on, exposure clamped). A capture is only trusted after the
+camera reports the exposure that was asked for. Why drain: V4L2 queues several buffers, so the
+next frame read after changing exposure was usually exposed *before* the change.
+
+Facts used (from OpenCV's modules/videoio/src/cap_v4l.cpp): ``CAP_PROP_AUTO_EXPOSURE`` maps to the
+V4L2 menu (1 = manual, 3 = aperture-priority auto) unless OPENCV_VIDEOIO_V4L_RANGE_NORMALIZED is
+set; ``CAP_PROP_EXPOSURE`` is V4L2 exposure_absolute in 100 µs units; a Y16 stream comes back as
+CV_16UC1 only with ``CAP_PROP_CONVERT_RGB = 0``. OpenCV maps no auto-gain control: if the camera
+has one, turn it off with ``v4l2-ctl -c gain_automatic=0`` (or ``autogain``) and set ``gain``.
+
+Safe state: idle and released (``close``). ``backend = "images"`` reads an image sequence for
+dry runs and tests through the same read/drain/convert path, without camera controls.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, Protocol
+
+import cv2
+import numpy as np
+
+from drivers.cameras.image_io import to_linear_uint16
+from drivers.cameras.raw_decode import exposure_stats
+from drivers.cameras.settings import OpenCvCameraSettings
+from rti_rig.clock import Clock, SystemClock
+from rti_rig.errors import CaptureError, DeviceError
+from rti_rig.rig import Frame
+
+RAW_GREY_FOURCCS = {"Y16 ", "Y10 ", "Y12 "}
+
+
+class VideoCaptureLike(Protocol):
+    """The slice of ``cv2.VideoCapture`` this driver uses (a fake implements it in tests)."""
+
+    def isOpened(self) -> bool: ...
+
+    def set(self, prop: int, value: float) -> bool: ...
+
+    def get(self, prop: int) -> float: ...
+
+    def grab(self) -> bool: ...
+
+    def read(self) -> tuple[bool, Any]: ...
+
+    def release(self) -> None: ...
+
+
+CaptureFactory = Callable[[int | str, int], VideoCaptureLike]
+
+
+def fourcc_to_str(code: float) -> str:
+    """Decode OpenCV's numeric FOURCC property into its four characters."""
+    c = int(code)
+    return "".join(chr((c >> (8 * i)) & 0xFF) for i in range(4))
+
+
+class OpenCvCamera:
+    """A UVC camera (``backend = "v4l2"``) or an image sequence (``"images"``)."""
+
+    def __init__(
+        self,
+        settings: OpenCvCameraSettings,
+        clock: Clock | None = None,
+        capture_factory: CaptureFactory | None = None,
+    ) -> None:
+        self.settings = settings
+        self.name = settings.name
+        self._clock = clock or SystemClock()
+        self._factory: CaptureFactory = capture_factory or cv2.VideoCapture
+        self._cap: VideoCaptureLike | None = None
+        self._frames_read = 0
+        self.connection_info: dict[str, Any] = {}
+
+    # -- lifecycle -------------------------------------------------------------------------
+    def connect(self) -> None:
+        """Open the device and put it in manual mode; raises DeviceError naming what failed."""
+        if self._cap is not None:
+            return
+        s = self.settings
+        if s.backend == "images":
+            if not isinstance(s.device, str):
+                raise DeviceError(self.name, "backend 'images' needs device = a file pattern such "
+                                  "as 'frames/f_%03d.png'", "connect")
+            api = cv2.CAP_IMAGES
+        else:
+            api = cv2.CAP_V4L2
+        cap = self._factory(s.device, api)
+        if not cap.isOpened():
+            cap.release()
+            where = f"/dev/video{s.device}" if isinstance(s.device, int) else s.device
+            hint = (
+                "check that the device exists (v4l2-ctl --list-devices), that you may read it "
+                "(group 'video') and that no other program holds it"
+                if s.backend == "v4l2"
+                else "check the file pattern and that the first file exists"
+            )
+            raise DeviceError(self.name, f"cannot open {where} ({s.backend}): {hint}", "connect")
+        self._cap = cap
+        self._frames_read = 0
+        try:
+            if s.backend == "v4l2":
+                self._configure(cap)
+            else:
+                self.connection_info = {"backend": "images", "controls": False}
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Release the device. Safe twice and after a failed connect."""
+        cap, self._cap = self._cap, None
+        if cap is not None:
+            cap.release()
+
+    def __enter__(self) -> OpenCvCamera:
+        self.connect()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- configuration ---------------------------------------------------------------------
+    def _set_verified(self, cap: VideoCaptureLike, prop: int, value: float, what: str,
+                      tol: float = 0.5) -> float:
+        accepted = cap.set(prop, value)
+        got = cap.get(prop)
+        if not accepted or abs(got - value) > tol:
+            raise DeviceError(
+                self.name,
+                f"camera did not accept {what} = {value:g} (set returned {accepted}, reads back "
+                f"{got:g}); check `v4l2-ctl -d {self.settings.device} --list-ctrls`",
+                f"set {what}",
+            )
+        return got
+
+    def _configure(self, cap: VideoCaptureLike) -> None:
+        s = self.settings
+        info: dict[str, Any] = {"backend": "v4l2", "controls": True}
+        # Size first: a size change renegotiates the format, which could drop the fourcc.
+        if s.width is not None:
+            self._set_verified(cap, cv2.CAP_PROP_FRAME_WIDTH, s.width, "width")
+        if s.height is not None:
+            self._set_verified(cap, cv2.CAP_PROP_FRAME_HEIGHT, s.height, "height")
+        if s.fourcc is not None:
+            cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter_fourcc(*s.fourcc))
+            got = fourcc_to_str(cap.get(cv2.CAP_PROP_FOURCC))
+            if got != s.fourcc and s.require_fourcc:
+                raise DeviceError(
+                    self.name,
+                    f"camera refused pixel format {s.fourcc!r} (delivers {got!r}); it may not "
+                    "offer 16-bit frames: list formats with `v4l2-ctl --list-formats-ext`, or set "
+                    "fourcc = null and require_fourcc = false to accept 8-bit gamma-encoded frames",
+                    "set fourcc",
+                )
+            info["fourcc"] = got
+            if got in RAW_GREY_FOURCCS:
+                self._set_verified(cap, cv2.CAP_PROP_CONVERT_RGB, 0, "convert_rgb")
+        info["buffer_size_set"] = bool(cap.set(cv2.CAP_PROP_BUFFERSIZE, s.buffer_size))
+        if s.toggle_auto_exposure:
+            cap.set(cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_auto)
+        self._set_verified(cap, cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_manual,
+                           "auto_exposure (manual)")
+        # Mono sensors have no white balance control: absent is fine, stuck on is not.
+        if not cap.set(cv2.CAP_PROP_AUTO_WB, 0) and cap.get(cv2.CAP_PROP_AUTO_WB) == 1:
+            raise DeviceError(self.name, "camera refused to turn auto white balance off",
+                              "set auto_wb")
+        info["auto_wb"] = cap.get(cv2.CAP_PROP_AUTO_WB)
+        if s.wb_temperature_k is not None:
+            self._set_verified(cap, cv2.CAP_PROP_WB_TEMPERATURE, s.wb_temperature_k,
+                               "wb_temperature", tol=50)
+        if s.gain is not None:
+            self._set_verified(cap, cv2.CAP_PROP_GAIN, s.gain, "gain")
+        if "fourcc" in info and fourcc_to_str(cap.get(cv2.CAP_PROP_FOURCC)) != info["fourcc"]:
+            raise DeviceError(self.name, f"pixel format changed from {info['fourcc']!r} while "
+                              "configuring; set fourcc, width and height the camera supports "
+                              "together (`v4l2-ctl --list-formats-ext`)", "verify fourcc")
+        self.connection_info = info
+
+    # -- capture ---------------------------------------------------------------------------
+    def _require_open(self) -> VideoCaptureLike:
+        if self._cap is None:
+            raise CaptureError(self.name, "camera is not connected; call connect() first",
+                               "capture")
+        return self._cap
+
+    def _apply_exposure(self, cap: VideoCaptureLike, exposure_s: float) -> tuple[float, float]:
+        """Set the exposure, verify it reads back; returns (actual_s, units)."""
+        s = self.settings
+        units = max(1, round(exposure_s / s.exposure_unit_s))
+        actual = units * s.exposure_unit_s
+        if abs(actual - exposure_s) > s.exposure_tolerance * exposure_s:
+            raise CaptureError(
+                self.name,
+                f"exposure {exposure_s:g} s is not a whole number of {s.exposure_unit_s:g} s "
+                f"units (nearest {actual:g} s); choose a representable exposure",
+                "set exposure",
+            )
+        accepted = cap.set(cv2.CAP_PROP_EXPOSURE, units)
+        got = cap.get(cv2.CAP_PROP_EXPOSURE)
+        if not accepted or abs(got - units) > max(0.5, s.exposure_tolerance * units):
+            raise CaptureError(
+                self.name,
+                f"exposure set to {units} units ({actual:g} s) but the camera reads back {got:g} "
+                f"(set returned {accepted}): auto exposure may be on or the value out of range",
+                "set exposure",
+            )
+        return got * s.exposure_unit_s, float(units)
+
+    def capture(self, exposure_s: float) -> Frame:
+        """Set ``exposure_s``, drain queued frames, read one fresh frame as linear data."""
+        s = self.settings
+        cap = self._require_open()
+        if not s.min_exposure_s <= exposure_s <= s.max_exposure_s:
+            raise CaptureError(
+                self.name,
+                f"exposure {exposure_s:g} s outside the configured range "
+                f"[{s.min_exposure_s:g}, {s.max_exposure_s:g}] s",
+                "capture",
+            )
+        started = self._clock.now()
+        if s.backend == "v4l2":
+            actual, units = self._apply_exposure(cap, exposure_s)
+            gain = float(cap.get(cv2.CAP_PROP_GAIN))
+            applied = True
+        else:
+            actual, units, applied = exposure_s, exposure_s / s.exposure_unit_s, False
+            gain = float(s.gain or 0.0)
+        for i in range(s.drain_frames):
+            if not cap.grab():
+                raise CaptureError(self.name, f"stream ended while draining frame {i + 1} of "
+                                   f"{s.drain_frames}", "drain")
+        self._frames_read += s.drain_frames
+        ok, image = cap.read()
+        if not ok or image is None:
+            raise CaptureError(self.name, "no frame delivered (stream ended or device lost)",
+                               "read")
+        self._frames_read += 1
+        image = np.asarray(image)
+        pixels, white = to_linear_uint16(image, s.response, s.black_level, s.white_level)
+        metadata: dict[str, Any] = {
+            "camera": self.name,
+            "backend": s.backend,
+            "device": s.device,
+            "source_file": None,
+            "bit_depth": 16 if image.dtype == np.uint16 else 8,
+            "response": s.response if image.dtype == np.uint8 else "linear",
+            "exposure_requested_s": exposure_s,
+            "exposure_units": units,
+            "exposure_applied": applied,
+            "gain_unit": "v4l2" if applied else "configured",
+            "drained_frames": s.drain_frames,
+            "stream_index": self._frames_read - 1,
+            "capture_started_s": started,
+            "capture_finished_s": self._clock.now(),
+        }
+        metadata.update(self.connection_info)
+        metadata.update(exposure_stats(pixels, white, 0.001))
+        return Frame(pixels=pixels, exposure_s=actual, gain=gain, white_level=white,
+                     timestamp_s=started, metadata=metadata)

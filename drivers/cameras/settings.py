@@ -1,0 +1,229 @@
+"""Camera settings: one pydantic model per backend, plus the RAW-decode and exposure rules.
+
+Why models and not loose dicts: the rig TOML is written by hand, and a misspelt key
+(``exposure_unti_s``) must fail loudly at load time instead of silently leaving the camera in an
+automatic mode. Every model therefore forbids extra keys and is frozen once validated.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    TypeAdapter,
+    field_validator,
+    model_validator,
+)
+
+CfaPattern = Literal["RGGB", "BGGR", "GRBG", "GBRG"]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class RawDecodeSettings(_Strict):
+    """How a RAW file becomes linear data (see ``raw_decode.decode_raw``).
+
+    ``mode``:
+      * ``"mosaic"`` – the sensor values themselves, black removed, no demosaic, no white balance:
+        the most transparent route, bit-exact with the file (shape H×W, one colour per photosite).
+      * ``"half"`` – LibRaw 2×2 super-pixels (no interpolation), RGB at half resolution.
+      * ``"demosaic"`` – LibRaw bilinear demosaic, RGB at full resolution.
+    The last two run ``postprocess`` with gamma 1, no auto-bright, ``adjust_maximum_thr=0`` (so
+    LibRaw never rescales to the data maximum), no rotation and a *fixed* white balance.
+    """
+
+    mode: Literal["mosaic", "half", "demosaic"] = "mosaic"
+    white_balance: Literal["unity", "camera"] | tuple[float, float, float, float] = "unity"
+    output_color: Literal["raw", "srgb"] = "raw"
+    saturation_level: float = Field(
+        1.0,
+        gt=0.0,
+        le=1.0,
+        description="fraction of (white - black) at which a raw value counts as saturated; "
+        "some sensors clip a little below their nominal white level",
+    )
+    underexposed_level: float = Field(
+        0.001,
+        ge=0.0,
+        lt=1.0,
+        description="pixels at or below this fraction of white count as underexposed",
+    )
+
+
+class ExposureRule(_Strict):
+    """The rule that fixes a session's exposure (see ``exposure.choose_exposure``)."""
+
+    max_saturated_fraction: float = Field(0.001, ge=0.0, lt=1.0)
+    headroom: float = Field(
+        1.0,
+        ge=1.0,
+        description="predict as if the scene were this much brighter (margin for lights "
+        "brighter than the metered one)",
+    )
+    min_exposure_s: float = Field(1e-5, gt=0.0)
+    max_exposure_s: float = Field(30.0, gt=0.0)
+    max_attempts: int = Field(6, ge=1, description="test shots before giving up")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> ExposureRule:
+        if self.min_exposure_s > self.max_exposure_s:
+            raise ValueError("min_exposure_s must not exceed max_exposure_s")
+        return self
+
+
+class OpenCvCameraSettings(_Strict):
+    """A UVC camera through OpenCV's V4L2 backend (or an image sequence for dry runs and tests).
+
+    ``backend = "images"`` opens ``device`` as an OpenCV image-sequence pattern
+    (``frames/f_%03d.png``); no camera controls exist there, so exposure is recorded as requested
+    but cannot be applied (``metadata["exposure_applied"] = False``).
+    """
+
+    kind: Literal["opencv"] = "opencv"
+    name: str = "uvc-camera"
+    backend: Literal["v4l2", "images"] = "v4l2"
+    device: int | str = 0
+    width: int | None = Field(None, gt=0)
+    height: int | None = Field(None, gt=0)
+    fourcc: str | None = Field(
+        "Y16 ", description="pixel format to request; 'Y16 ' gives 16-bit grey frames; None keeps "
+        "the camera default (usually 8-bit YUYV/MJPEG, gamma-encoded)"
+    )
+    require_fourcc: bool = Field(
+        True, description="fail at connect if the camera refuses the requested fourcc"
+    )
+    exposure_unit_s: float = Field(
+        100e-6, gt=0.0, description="seconds per CAP_PROP_EXPOSURE unit (V4L2 absolute: 100 µs)"
+    )
+    auto_exposure_manual: float = Field(
+        1.0, description="CAP_PROP_AUTO_EXPOSURE value meaning manual (V4L2 menu: 1)"
+    )
+    auto_exposure_auto: float = Field(
+        3.0, description="value meaning auto (aperture priority: 3), written first as a toggle"
+    )
+    toggle_auto_exposure: bool = Field(
+        True, description="write auto then manual: some UVC drivers only latch manual that way"
+    )
+    gain: float | None = Field(None, description="CAP_PROP_GAIN to set and verify; None = leave")
+    wb_temperature_k: int | None = Field(None, gt=0)
+    buffer_size: int = Field(1, ge=1, description="CAP_PROP_BUFFERSIZE requested at connect")
+    drain_frames: int = Field(
+        4,
+        ge=0,
+        description="frames grabbed and discarded before each capture so the returned frame "
+        "was exposed after the exposure was set (V4L2 queues several buffers)",
+    )
+    exposure_tolerance: float = Field(
+        0.02, ge=0.0, description="relative mismatch allowed between set and read-back exposure"
+    )
+    min_exposure_s: float = Field(100e-6, gt=0.0)
+    max_exposure_s: float = Field(2.0, gt=0.0)
+    response: Literal["linear", "srgb"] = Field(
+        "linear",
+        description="how 8-bit frames map to linear data: 'linear' (scale only) or 'srgb' "
+        "(inverse sRGB curve). 16-bit frames are always taken as linear.",
+    )
+    black_level: int = Field(0, ge=0, description="code value subtracted from 16-bit frames")
+    white_level: int = Field(65535, gt=0, le=65535, description="saturation code of 16-bit frames")
+
+    @field_validator("fourcc")
+    @classmethod
+    def _four_chars(cls, v: str | None) -> str | None:
+        if v is not None and len(v) != 4:
+            raise ValueError(f"fourcc must be exactly 4 characters (pad with spaces), got {v!r}")
+        return v
+
+
+class Gphoto2CameraSettings(_Strict):
+    """A DSLR or mirrorless camera through python-gphoto2 (one session kept open).
+
+    Config names differ between makers (Nikon: ``f-number``, Canon: ``aperture``); the defaults
+    are the common ones and each can be overridden. Values are the camera's own strings
+    (``iso = "100"``, ``aperture = "8"``); the shutter is chosen from the camera's list to match
+    the requested ``exposure_s``.
+    """
+
+    kind: Literal["gphoto2"] = "gphoto2"
+    name: str = "dslr"
+    port: str | None = Field(None, description="e.g. 'usb:001,004'; None = the only camera found")
+    iso: str | None = "100"
+    aperture: str | None = None
+    image_format: str | None = Field(
+        None, description="camera's own value for RAW (or RAW+JPEG), e.g. 'RAW' or 'NEF (Raw)'"
+    )
+    keep_jpeg: bool = Field(False, description="download a JPEG delivered with the RAW")
+    capture_target: str | None = Field(
+        "Internal RAM", description="camera's own capturetarget value; None = leave"
+    )
+    shutter_config: str = "shutterspeed"
+    iso_config: str = "iso"
+    aperture_config: str = "aperture"
+    image_format_config: str = "imageformat"
+    shutter_tolerance: float = Field(
+        0.06, ge=0.0, description="relative mismatch allowed between requested exposure and the "
+        "nearest shutter speed the camera offers (1/3 stop is 0.26)"
+    )
+    busy_retries: int = Field(5, ge=0)
+    retry_delay_s: float = Field(0.5, ge=0.0)
+    retry_codes: tuple[int, ...] = Field(
+        (-110,), description="GPhoto2Error codes retried: -110 = camera busy / not ready"
+    )
+    event_timeout_s: float = Field(
+        5.0, gt=0.0, description="how long to wait for the remaining files of a RAW+JPEG shot"
+    )
+    delete_from_camera: bool = Field(
+        True, description="delete each file on the camera after it is downloaded"
+    )
+    decode: RawDecodeSettings = RawDecodeSettings()
+
+
+class FolderWatchSettings(_Strict):
+    """A camera fired by someone else (the dome's shutter line, a vendor program).
+
+    The driver waits for the next file matching ``patterns`` to appear in ``folder`` and be
+    complete (size unchanged over ``stable_polls`` polls), with a timeout.
+    """
+
+    kind: Literal["folder_watch"] = "folder_watch"
+    name: str = "folder-camera"
+    folder: Path
+    patterns: tuple[str, ...] = ("*.dng", "*.DNG")
+    timeout_s: float = Field(10.0, gt=0.0)
+    poll_interval_s: float = Field(0.05, gt=0.0)
+    stable_polls: int = Field(2, ge=1)
+    exposure_tolerance: float | None = Field(
+        0.06,
+        ge=0.0,
+        description="relative mismatch allowed between requested exposure and the file's "
+        "ExposureTime; None = do not check",
+    )
+    gain: float = Field(0.0, description="recorded in the frame when the file has no ISO")
+    eight_bit_response: Literal["refuse", "linear", "srgb"] = Field(
+        "refuse", description="8-bit files (JPEG, PNG) are gamma-encoded: refuse them, or "
+        "linearise with the inverse sRGB curve, or take them as linear"
+    )
+    decode: RawDecodeSettings = RawDecodeSettings()
+
+
+CameraSettings = Annotated[
+    OpenCvCameraSettings | Gphoto2CameraSettings | FolderWatchSettings,
+    Field(discriminator="kind"),
+]
+"""Any real camera's settings, told apart by ``kind`` (``[camera] kind = "gphoto2"``)."""
+
+CAMERA_SETTINGS_ADAPTER: TypeAdapter[CameraSettings] = TypeAdapter(CameraSettings)
+
+
+def parse_camera_settings(data: dict[str, object]) -> CameraSettings:
+    """Validate a rig config's ``[camera]`` table into the right backend's settings.
+
+    Raises pydantic's ``ValidationError`` (the config loader turns it into a ConfigError that
+    names the file and key).
+    """
+    return CAMERA_SETTINGS_ADAPTER.validate_python(data)

@@ -1,0 +1,140 @@
+"""Folder-watch backend: waits for the next file on an injected clock, with a timeout."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import numpy as np
+import pytest
+import tifffile
+
+from drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+from drivers.cameras.folder_watch import FolderWatchCamera
+from drivers.cameras.settings import FolderWatchSettings
+from rti_rig.clock import SystemClock, VirtualClock
+from rti_rig.errors import CaptureError, DeviceError
+from rti_rig.rig import Camera
+
+
+class ScriptedClock(VirtualClock):
+    """Virtual time; runs ``actions[t]`` once virtual time reaches ``t`` (a file appearing...)."""
+
+    def __init__(self, actions):
+        super().__init__()
+        self.actions = sorted(actions.items())
+
+    def sleep(self, seconds):
+        super().sleep(seconds)
+        while self.actions and self.actions[0][0] <= self.now():
+            self.actions.pop(0)[1]()
+
+
+def dng(path, level=0.3, exposure_s=0.5):
+    mosaic = linear_to_mosaic(np.full((32, 32), level), "RGGB", 256, 4095)
+    return write_dng(path, mosaic, black_level=256, white_level=4095, exposure_s=exposure_s,
+                     iso=100)
+
+
+def watch(tmp_path, clock, **kw):
+    return FolderWatchCamera(FolderWatchSettings(folder=tmp_path, **kw), clock=clock)
+
+
+def test_timeout_without_real_waiting(tmp_path):
+    clock = VirtualClock()
+    cam = watch(tmp_path, clock, timeout_s=10.0, poll_interval_s=0.5)
+    assert isinstance(cam, Camera)
+    cam.connect()
+    t0 = time.monotonic()
+    with pytest.raises(CaptureError, match=r"no new file matching .* within 10 s"):
+        cam.capture(0.5)
+    assert time.monotonic() - t0 < 1.0
+    assert clock.now() == pytest.approx(10.0)
+
+
+def test_timeout_on_the_system_clock_is_bounded(tmp_path):
+    cam = watch(tmp_path, SystemClock(), timeout_s=0.2, poll_interval_s=0.02)
+    cam.connect()
+    t0 = time.monotonic()
+    with pytest.raises(CaptureError, match=r"within 0\.2 s"):
+        cam.capture(0.5)
+    assert 0.19 <= time.monotonic() - t0 < 1.0
+
+
+def test_file_that_appears_later_is_decoded_and_existing_files_ignored(tmp_path):
+    dng(tmp_path / "old.dng", level=0.9)  # present before connect: not ours
+    clock = ScriptedClock({1.0: lambda: dng(tmp_path / "IMG_0002.dng", level=0.3)})
+    triggered: list[float] = []
+    cam = FolderWatchCamera(FolderWatchSettings(folder=tmp_path, timeout_s=5.0,
+                                                poll_interval_s=0.25),
+                            clock=clock, trigger=triggered.append)
+    cam.connect()
+    f = cam.capture(0.5)
+    assert triggered == [0.5]
+    assert f.metadata["source_file"] == str(tmp_path / "IMG_0002.dng")
+    assert np.mean(f.pixels) / f.white_level == pytest.approx(0.3, abs=1e-3)
+    assert f.exposure_s == pytest.approx(0.5) and f.gain == 100.0
+    assert f.metadata["exposure_source"] == "file"
+    json.dumps(f.metadata)  # goes into the session manifest as is
+    assert 1.0 <= clock.now() <= 1.5  # picked up within a poll or two of appearing
+    assert f.timestamp_s == 0.0 and f.metadata["capture_finished_s"] == clock.now()
+    with pytest.raises(CaptureError, match="within"):
+        cam.capture(0.5)  # each file is used once
+
+
+def test_file_still_growing_is_not_taken(tmp_path):
+    target = tmp_path / "IMG.dng"
+    data = dng(tmp_path / "full.bin").read_bytes()
+    (tmp_path / "full.bin").unlink()
+    # binary-exact times (multiples of 1/8 s) so virtual time never drifts past an action
+    clock = ScriptedClock({
+        0.25: lambda: target.write_bytes(data[:100]),
+        0.5: lambda: target.write_bytes(data[:2000]),
+        0.75: lambda: target.write_bytes(data),
+    })
+    cam = watch(tmp_path, clock, timeout_s=5.0, poll_interval_s=0.125, stable_polls=3)
+    cam.connect()
+    f = cam.capture(0.5)
+    assert f.pixels.shape == (32, 32)
+    assert clock.now() == 1.0  # seen at 0.75, 0.875, 1.0: three equal sizes
+
+
+def test_growing_file_at_timeout_is_reported(tmp_path):
+    target = tmp_path / "IMG.dng"
+    grow = {0.125 * i: (lambda i=i: target.write_bytes(b"x" * (i * 10))) for i in range(1, 40)}
+    cam = watch(tmp_path, ScriptedClock(grow), timeout_s=2.0, poll_interval_s=0.125)
+    cam.connect()
+    with pytest.raises(CaptureError, match="still being written"):
+        cam.capture(0.5)
+
+
+def test_exposure_mismatch_is_refused(tmp_path):
+    clock = ScriptedClock({0.1: lambda: dng(tmp_path / "a.dng", exposure_s=1 / 30)})
+    cam = watch(tmp_path, clock)
+    cam.connect()
+    with pytest.raises(CaptureError, match="manual"):
+        cam.capture(0.5)
+
+
+def test_16bit_tiff_accepted_8bit_refused(tmp_path):
+    def tif16():
+        tifffile.imwrite(tmp_path / "a.tif", np.full((4, 4), 30000, np.uint16))
+
+    def tif8():
+        tifffile.imwrite(tmp_path / "b.tif", np.full((4, 4), 200, np.uint8))
+
+    clock = ScriptedClock({0.1: tif16, 0.5: tif8})
+    cam = watch(tmp_path, clock, patterns=("*.tif",))
+    cam.connect()
+    f = cam.capture(0.5)
+    assert np.all(f.pixels == 30000) and f.exposure_s == 0.5
+    assert f.metadata["exposure_source"] == "requested"
+    with pytest.raises(CaptureError, match="8-bit"):
+        cam.capture(0.5)
+
+
+def test_missing_folder_and_not_connected(tmp_path):
+    with pytest.raises(DeviceError, match="does not exist"):
+        watch(tmp_path / "nope", VirtualClock()).connect()
+    with pytest.raises(CaptureError, match="not connected"):
+        watch(tmp_path, VirtualClock()).capture(0.5)

@@ -1,0 +1,221 @@
+"""RAW decoding: DNGs written by the test itself, read back as linear data (no camera files)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic, write_dng
+from drivers.cameras.raw_decode import average_frames, decode_raw, exposure_stats, subtract_dark
+from drivers.cameras.settings import RawDecodeSettings
+from rti_rig.errors import CaptureError
+
+BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
+
+
+def random_mosaic(seed: int = 0, shape: tuple[int, int] = (48, 64)) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return rng.integers(BLACK, WHITE, shape, endpoint=False).astype(np.uint16)
+
+
+def patch_mosaic(levels: list[float], width: int = 8, height: int = 32) -> np.ndarray:
+    """Vertical stripes, each a uniform fraction of full scale (above black)."""
+    cols = [np.full((height, width), lv) for lv in levels]
+    return linear_to_mosaic(np.hstack(cols), "RGGB", BLACK, WHITE)
+
+
+def test_mosaic_mode_is_bit_exact_from_file(tmp_path):
+    mosaic = random_mosaic()
+    path = write_dng(tmp_path / "r.dng", mosaic, black_level=BLACK, white_level=WHITE,
+                     exposure_s=1 / 125, iso=200)
+    frame = decode_raw(path)
+    assert frame.pixels.dtype == np.uint16
+    assert frame.pixels.shape == mosaic.shape
+    np.testing.assert_array_equal(frame.pixels, mosaic.astype(np.int64) - BLACK)
+    assert frame.white_level == WHITE - BLACK
+    assert frame.exposure_s == pytest.approx(1 / 125, rel=1e-6)
+    assert frame.gain == 200.0
+    assert frame.metadata["cfa_pattern"] == "RGGB"
+    assert frame.metadata["source_file"] == str(path)
+    assert frame.metadata["raw_black_level"] == [BLACK] * 4
+    assert frame.saturated_fraction == 0.0
+
+
+def test_per_channel_black_levels_are_removed_per_photosite():
+    mosaic = random_mosaic(4)
+    blacks = (500, 510, 520, 530)  # R, G (row 0), G (row 1), B
+    f = decode_raw(dng_bytes(mosaic, black_level=blacks, white_level=WHITE))
+    per_site = np.tile(np.array(blacks).reshape(2, 2), (24, 32))
+    np.testing.assert_array_equal(
+        f.pixels, np.clip(mosaic.astype(np.int64) - per_site, 0, WHITE - 530)
+    )
+    assert f.white_level == WHITE - 530
+    assert sorted(f.metadata["raw_black_level"]) == sorted(blacks)
+
+
+def test_bytes_and_file_decode_identically(tmp_path):
+    mosaic = random_mosaic(3)
+    data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
+    (tmp_path / "a.dng").write_bytes(data)
+    a = decode_raw(data)
+    b = decode_raw(tmp_path / "a.dng")
+    np.testing.assert_array_equal(a.pixels, b.pixels)
+    assert a.metadata["source_file"] is None
+
+
+@pytest.mark.parametrize("mode", ["half", "demosaic"])
+def test_postprocess_modes_are_linear_and_never_rescaled(mode):
+    # The brightest patch is 0.9 of white: LibRaw's default adjust_maximum_thr=0.75 would
+    # rescale it to 1.0 (LibRaw's adjust_maximum_thr); the decode must keep it at 0.9.
+    levels = [0.01, 0.1, 0.25, 0.5, 0.75, 0.9]
+    frame = decode_raw(dng_bytes(patch_mosaic(levels), black_level=BLACK, white_level=WHITE),
+                       RawDecodeSettings(mode=mode))
+    assert frame.white_level == 65535
+    assert frame.pixels.ndim == 3 and frame.pixels.shape[2] == 3
+    step = 4 if mode == "half" else 8
+    for i, lv in enumerate(levels):
+        centre = frame.pixels[frame.pixels.shape[0] // 2, i * step + step // 2] / 65535
+        np.testing.assert_allclose(centre, lv, atol=2e-4)
+
+
+def test_unity_white_balance_keeps_channel_ratios_camera_wb_changes_them():
+    mosaic = patch_mosaic([0.4, 0.4, 0.4])
+    data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE,
+                     as_shot_neutral=(0.5, 1.0, 0.8))
+    unity = decode_raw(data, RawDecodeSettings(mode="half"))
+    cam = decode_raw(data, RawDecodeSettings(mode="half", white_balance="camera"))
+    px = unity.pixels[8, 2].astype(float)
+    assert px[0] == pytest.approx(px[1], rel=1e-3) == pytest.approx(px[2], rel=1e-3)
+    cpx = cam.pixels[8, 2].astype(float)
+    assert cpx[0] / cpx[1] == pytest.approx(2.0, rel=0.02)  # 1 / 0.5 for red
+    assert cpx[2] / cpx[1] == pytest.approx(1.25, rel=0.02)  # 1 / 0.8 for blue
+
+
+@pytest.mark.parametrize("pattern", ["RGGB", "BGGR", "GRBG", "GBRG"])
+def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
+    h, w = 24, 24
+    rgb = np.zeros((h, w, 3))
+    rgb[..., 0], rgb[..., 1], rgb[..., 2] = 0.2, 0.5, 0.8
+    frame = decode_raw(dng_bytes(linear_to_mosaic(rgb, pattern, BLACK, WHITE),
+                                 cfa_pattern=pattern, black_level=BLACK, white_level=WHITE),
+                       RawDecodeSettings(mode="half"))
+    assert frame.metadata["cfa_pattern"] == pattern
+    np.testing.assert_allclose(frame.pixels[5, 5] / 65535, [0.2, 0.5, 0.8], atol=2e-4)
+
+
+def test_saturation_detected_on_raw_and_pinned_through_processing():
+    mosaic = patch_mosaic([0.3, 1.5], width=16)  # second stripe clips at the white level
+    data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
+    m = decode_raw(data)
+    assert m.saturated_fraction == pytest.approx(0.5)
+    assert m.metadata["saturated_fraction"] == pytest.approx(0.5)
+    h = decode_raw(data, RawDecodeSettings(mode="half"))
+    assert np.all(h.pixels[:, 8:] == 65535)
+    assert np.all(h.pixels[:, :8] < 65535)
+    d = decode_raw(data, RawDecodeSettings(mode="demosaic"))
+    assert d.saturated_fraction >= 0.5  # the 3×3 dilation marks the border pixels too
+
+
+def test_saturation_level_below_nominal_white():
+    mosaic = patch_mosaic([0.3, 0.97], width=16)
+    data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
+    assert decode_raw(data).saturated_fraction == 0.0
+    f = decode_raw(data, RawDecodeSettings(saturation_level=0.95))
+    assert f.saturated_fraction == pytest.approx(0.5)
+    assert np.all(f.pixels[:, 16:] == f.white_level)
+
+
+def test_underexposure_fraction():
+    mosaic = patch_mosaic([0.0, 0.0005, 0.5, 0.5])
+    f = decode_raw(dng_bytes(mosaic, black_level=BLACK, white_level=WHITE))
+    assert f.metadata["underexposed_fraction"] == pytest.approx(0.5)
+    assert exposure_stats(f.pixels, f.white_level, 0.0)["underexposed_fraction"] == 0.25
+
+
+def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
+    rng = np.random.default_rng(7)
+    scene = np.hstack([np.full((32, 16), 0.4), np.full((32, 16), 2.0)])
+    dark_lin = rng.uniform(0.0, 0.01, size=scene.shape)
+    light = linear_to_mosaic(scene + dark_lin, "RGGB", BLACK, WHITE)
+    dark = linear_to_mosaic(dark_lin, "RGGB", BLACK, WHITE)
+    write_dng(tmp_path / "dark.dng", dark, black_level=BLACK, white_level=WHITE,
+              exposure_s=0.5)
+    dark_frame = decode_raw(tmp_path / "dark.dng")
+    img = decode_raw(dng_bytes(light, black_level=BLACK, white_level=WHITE, exposure_s=0.5),
+                     dark=dark_frame)
+    assert img.metadata["dark_subtracted"] is True
+    assert img.metadata["dark_file"] == str(tmp_path / "dark.dng")
+    expected = light[:, :16].astype(np.int64) - dark[:, :16].astype(np.int64)
+    np.testing.assert_array_equal(img.pixels[:, :16], expected)
+    assert np.all(img.pixels[:, 16:] == img.white_level)
+    assert img.saturated_fraction == pytest.approx(0.5)
+
+
+def test_dark_with_other_exposure_or_shape_is_refused():
+    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE,
+                             exposure_s=0.5))
+    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE,
+                             exposure_s=0.25))
+    with pytest.raises(CaptureError, match="exposure"):
+        subtract_dark(a, b)
+    c = decode_raw(dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE))
+    with pytest.raises(CaptureError, match="shape"):
+        subtract_dark(a, c)
+
+
+def test_average_frames_is_a_rounded_mean():
+    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE))
+    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE))
+    m = average_frames([a, b])
+    want = np.rint((a.pixels.astype(float) + b.pixels) / 2).astype(np.uint16)
+    np.testing.assert_array_equal(m.pixels, want)
+
+
+def test_unreadable_and_missing_files_name_the_file(tmp_path):
+    bad = tmp_path / "broken.dng"
+    bad.write_bytes(b"not a raw file at all" * 10)
+    with pytest.raises(CaptureError, match=r"broken\.dng"):
+        decode_raw(bad)
+    with pytest.raises(CaptureError, match="not found"):
+        decode_raw(tmp_path / "missing.dng")
+
+
+def test_dng_writer_validates_its_input():
+    with pytest.raises(ValueError, match="at least 22"):
+        dng_bytes(np.zeros((20, 20), np.uint16))
+    with pytest.raises(ValueError, match="uint16"):
+        dng_bytes(np.zeros((32, 32), np.float32))
+    with pytest.raises(ValueError, match="even"):
+        dng_bytes(np.zeros((33, 32), np.uint16))
+    with pytest.raises(ValueError, match="black_level"):
+        dng_bytes(np.zeros((32, 32), np.uint16), black_level=5000, white_level=4000)
+    with pytest.raises(ValueError, match="cfa_pattern"):
+        linear_to_mosaic(np.zeros((4, 4, 3)), "RGBW")
+
+
+def test_linear_to_mosaic_clips_and_quantises():
+    m = linear_to_mosaic(np.array([[0.0, 0.5], [1.0, 7.0]]), "RGGB", 100, 1100)
+    np.testing.assert_array_equal(m, [[100, 600], [1100, 1100]])
+    with pytest.raises(ValueError, match="NaN"):
+        linear_to_mosaic(np.array([[np.nan, 0.0]]))
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    h=st.integers(11, 40).map(lambda v: 2 * v),
+    w=st.integers(11, 40).map(lambda v: 2 * v),
+    black=st.integers(0, 4000),
+    span=st.integers(100, 60000),
+    pattern=st.sampled_from(["RGGB", "BGGR", "GRBG", "GBRG"]),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_any_dng_round_trips_bit_exactly(h, w, black, span, pattern, seed):
+    white = min(black + span, 65535)
+    rng = np.random.default_rng(seed)
+    mosaic = rng.integers(black, white, (h, w), endpoint=False).astype(np.uint16)
+    f = decode_raw(dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white))
+    np.testing.assert_array_equal(f.pixels, mosaic.astype(np.int64) - black)
+    assert f.white_level == white - black
+    assert f.metadata["cfa_pattern"] == pattern
