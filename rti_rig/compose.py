@@ -69,5 +69,6 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
         transfer_s=cfg.timing.transfer_s,
         noise=cfg.scene.noise,
         seed=cfg.scene.seed,
+        raw=cfg.scene.raw,
     )
     return Rig(loaded=loaded, geometry=geometry, lighting=lighting, camera=camera, clock=clock)

@@ -119,6 +119,7 @@ class SceneConfig(_Strict):
     name: str = "relief"
     seed: int = 0
     noise: bool = True
+    raw: bool = False  # deliver frames through a DNG and the rawpy decode path, as a DSLR would
 
 
 class RigConfig(_Strict):

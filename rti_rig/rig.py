@@ -30,6 +30,8 @@ class Frame:
 
     ``pixels`` is linear (proportional to scene radiance, black level removed), ``uint16``,
     shape (H, W) or (H, W, 3); ``white_level`` is the code value at which the sensor saturates.
+    ``gain`` is in the camera's own unit (ISO for still cameras, the V4L2 gain value for UVC
+    cameras, 1.0 for the simulated sensor); ``metadata["gain_unit"]`` says which where known.
     """
 
     pixels: NDArray[np.uint16]

@@ -38,6 +38,7 @@ class SimulatedCamera:
         ambient: float = 0.0,
         noise: bool = True,
         seed: int = 0,
+        raw: bool = False,
     ) -> None:
         self.name = "simulated camera"
         self._render = render
@@ -52,6 +53,7 @@ class SimulatedCamera:
         self._ambient = ambient
         self._noise = noise
         self._seed = seed
+        self._raw = raw
         self._count = 0
         self._connected = False
 
@@ -90,9 +92,11 @@ class SimulatedCamera:
             electrons = rng.poisson(np.clip(electrons, 0.0, None)).astype(np.float64)
             electrons += rng.normal(0.0, self._read_noise, electrons.shape)
         electrons = np.clip(electrons, 0.0, self._full_well)
+        self._clock.sleep(exposure_s + self._readout_s + self._transfer_s)
+        if self._raw:
+            return self._through_raw(electrons / self._full_well, exposure_s, t0)
         white = 65535
         pixels = np.round(electrons * (white / self._full_well)).astype(np.uint16)
-        self._clock.sleep(exposure_s + self._readout_s + self._transfer_s)
         return Frame(
             pixels=pixels,
             exposure_s=exposure_s,
@@ -101,3 +105,14 @@ class SimulatedCamera:
             timestamp_s=t0,
             metadata={"source": "simulated", "capture_index": self._count - 1},
         )
+
+    def _through_raw(self, linear: NDArray[np.float64], exposure_s: float, t0: float) -> Frame:
+        """Deliver the frame as a DSLR would: Bayer mosaic → DNG → the real rawpy decode path."""
+        from drivers.cameras.raw_roundtrip import encode_decode
+        from drivers.cameras.settings import RawDecodeSettings
+
+        frame = encode_decode(
+            linear, exposure_s, RawDecodeSettings(mode="demosaic"), timestamp_s=t0
+        )
+        meta = {**frame.metadata, "source": "simulated-raw"}
+        return Frame(frame.pixels, exposure_s, frame.gain, frame.white_level, t0, meta)

@@ -29,8 +29,13 @@ def test_prediction_scales_linearly_and_keeps_saturated_pixels():
     assert predicted_saturated_fraction(f, 0.01) == 0.0
     assert predicted_saturated_fraction(f, 0.02) == pytest.approx(0.5)  # 500..999
     assert predicted_saturated_fraction(f, 0.02, headroom=2.0) == pytest.approx(0.75)
-    sat = Frame(pixels=np.array([[1000, 10]], np.uint16), exposure_s=1.0, gain=0.0,
-                white_level=1000, timestamp_s=0.0)
+    sat = Frame(
+        pixels=np.array([[1000, 10]], np.uint16),
+        exposure_s=1.0,
+        gain=0.0,
+        white_level=1000,
+        timestamp_s=0.0,
+    )
     assert predicted_saturated_fraction(sat, 0.001) == 0.5  # unknown true value: stays clipped
 
 
@@ -58,14 +63,24 @@ def test_continuous_choice_sits_on_the_limit():
 
 
 def test_continuous_choice_is_clamped_to_the_rule_range():
-    dark = Frame(pixels=np.zeros((4, 4), np.uint16), exposure_s=0.01, gain=0.0,
-                 white_level=1000, timestamp_s=0.0)
+    dark = Frame(
+        pixels=np.zeros((4, 4), np.uint16),
+        exposure_s=0.01,
+        gain=0.0,
+        white_level=1000,
+        timestamp_s=0.0,
+    )
     assert choose_exposure(dark, ExposureRule(max_exposure_s=2.0)).exposure_s == 2.0
 
 
 def test_unsatisfiable_cases_say_what_to_do():
-    sat = Frame(pixels=np.full((4, 4), 1000, np.uint16), exposure_s=0.01, gain=0.0,
-                white_level=1000, timestamp_s=0.0)
+    sat = Frame(
+        pixels=np.full((4, 4), 1000, np.uint16),
+        exposure_s=0.01,
+        gain=0.0,
+        white_level=1000,
+        timestamp_s=0.0,
+    )
     c = choose_exposure(sat, ExposureRule(), [0.001, 0.01])
     assert not c.satisfied and "shorter preview" in c.reason and c.exposure_s == 0.001
     bright = ramp_frame(exposure_s=0.01)
@@ -79,8 +94,9 @@ def test_choose_from_series_uses_measurements():
     def shot(t, frac):
         px = np.zeros(100, np.uint16)
         px[: int(frac * 100)] = 1000
-        return Frame(pixels=px.reshape(10, 10), exposure_s=t, gain=0.0, white_level=1000,
-                     timestamp_s=0.0)
+        return Frame(
+            pixels=px.reshape(10, 10), exposure_s=t, gain=0.0, white_level=1000, timestamp_s=0.0
+        )
 
     rule = ExposureRule(max_saturated_fraction=0.05)
     c = choose_from_series([shot(0.1, 0.2), shot(0.05, 0.04), shot(0.02, 0.0)], rule)

@@ -32,8 +32,9 @@ class ScriptedClock(VirtualClock):
 
 def dng(path, level=0.3, exposure_s=0.5):
     mosaic = linear_to_mosaic(np.full((32, 32), level), "RGGB", 256, 4095)
-    return write_dng(path, mosaic, black_level=256, white_level=4095, exposure_s=exposure_s,
-                     iso=100)
+    return write_dng(
+        path, mosaic, black_level=256, white_level=4095, exposure_s=exposure_s, iso=100
+    )
 
 
 def watch(tmp_path, clock, **kw):
@@ -65,9 +66,11 @@ def test_file_that_appears_later_is_decoded_and_existing_files_ignored(tmp_path)
     dng(tmp_path / "old.dng", level=0.9)  # present before connect: not ours
     clock = ScriptedClock({1.0: lambda: dng(tmp_path / "IMG_0002.dng", level=0.3)})
     triggered: list[float] = []
-    cam = FolderWatchCamera(FolderWatchSettings(folder=tmp_path, timeout_s=5.0,
-                                                poll_interval_s=0.25),
-                            clock=clock, trigger=triggered.append)
+    cam = FolderWatchCamera(
+        FolderWatchSettings(folder=tmp_path, timeout_s=5.0, poll_interval_s=0.25),
+        clock=clock,
+        trigger=triggered.append,
+    )
     cam.connect()
     f = cam.capture(0.5)
     assert triggered == [0.5]
@@ -87,11 +90,13 @@ def test_file_still_growing_is_not_taken(tmp_path):
     data = dng(tmp_path / "full.bin").read_bytes()
     (tmp_path / "full.bin").unlink()
     # binary-exact times (multiples of 1/8 s) so virtual time never drifts past an action
-    clock = ScriptedClock({
-        0.25: lambda: target.write_bytes(data[:100]),
-        0.5: lambda: target.write_bytes(data[:2000]),
-        0.75: lambda: target.write_bytes(data),
-    })
+    clock = ScriptedClock(
+        {
+            0.25: lambda: target.write_bytes(data[:100]),
+            0.5: lambda: target.write_bytes(data[:2000]),
+            0.75: lambda: target.write_bytes(data),
+        }
+    )
     cam = watch(tmp_path, clock, timeout_s=5.0, poll_interval_s=0.125, stable_polls=3)
     cam.connect()
     f = cam.capture(0.5)

@@ -22,8 +22,7 @@ from rti_rig.clock import VirtualClock
 from rti_rig.errors import CaptureError, DeviceError
 from rti_rig.rig import Camera
 
-SHUTTERS = ["bulb", "30", "2", "1", "0.5", "1/4", "1/8", "1/15", "1/30", "1/60", "1/125",
-            "1/250"]
+SHUTTERS = ["bulb", "30", "2", "1", "0.5", "1/4", "1/8", "1/15", "1/30", "1/60", "1/125", "1/250"]
 BLACK, WHITE = 512, 16383
 
 
@@ -40,17 +39,24 @@ class Body:
     detected: list[tuple[str, str]] = field(
         default_factory=lambda: [("Canon EOS 600D", "usb:001,004")]
     )
-    config: dict[str, str] = field(default_factory=lambda: {
-        "capturetarget": "Memory card", "imageformat": "Large Fine JPEG", "iso": "Auto",
-        "aperture": "5.6", "shutterspeed": "1/60",
-    })
-    choices: dict[str, list[str]] = field(default_factory=lambda: {
-        "capturetarget": ["Internal RAM", "Memory card"],
-        "imageformat": ["Large Fine JPEG", "RAW", "RAW + Large Fine JPEG"],
-        "iso": ["Auto", "100", "200", "400"],
-        "aperture": ["4", "5.6", "8"],
-        "shutterspeed": SHUTTERS,
-    })
+    config: dict[str, str] = field(
+        default_factory=lambda: {
+            "capturetarget": "Memory card",
+            "imageformat": "Large Fine JPEG",
+            "iso": "Auto",
+            "aperture": "5.6",
+            "shutterspeed": "1/60",
+        }
+    )
+    choices: dict[str, list[str]] = field(
+        default_factory=lambda: {
+            "capturetarget": ["Internal RAM", "Memory card"],
+            "imageformat": ["Large Fine JPEG", "RAW", "RAW + Large Fine JPEG"],
+            "iso": ["Auto", "100", "200", "400"],
+            "aperture": ["4", "5.6", "8"],
+            "shutterspeed": SHUTTERS,
+        }
+    )
     read_only: set[str] = field(default_factory=set)
     failures: dict[str, list[int]] = field(default_factory=dict)  # op -> codes to raise first
     calls: list[str] = field(default_factory=list)
@@ -144,8 +150,13 @@ def make_module(body: Body) -> types.SimpleNamespace:
             # a grey card of reflectance 0.25 at 1/60 s, linear in exposure time
             level = 0.25 * secs * 60
             mosaic = linear_to_mosaic(np.full((32, 48), level), "RGGB", BLACK, WHITE)
-            raw = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE, exposure_s=secs,
-                            iso=int(body.config["iso"]) if body.config["iso"].isdigit() else None)
+            raw = dng_bytes(
+                mosaic,
+                black_level=BLACK,
+                white_level=WHITE,
+                exposure_s=secs,
+                iso=int(body.config["iso"]) if body.config["iso"].isdigit() else None,
+            )
             fmt = body.config["imageformat"]
             names = []
             if "RAW" in fmt:
@@ -187,9 +198,14 @@ def make_module(body: Body) -> types.SimpleNamespace:
             return self.index(model)
 
     return types.SimpleNamespace(
-        GPhoto2Error=FakeGPhoto2Error, Camera=FakeCamera, GP_CAPTURE_IMAGE=0,
-        PortInfoList=PortInfoList, CameraAbilitiesList=CameraAbilitiesList,
-        GP_FILE_TYPE_NORMAL=1, GP_EVENT_TIMEOUT=1, GP_EVENT_FILE_ADDED=2,
+        GPhoto2Error=FakeGPhoto2Error,
+        Camera=FakeCamera,
+        GP_CAPTURE_IMAGE=0,
+        PortInfoList=PortInfoList,
+        CameraAbilitiesList=CameraAbilitiesList,
+        GP_FILE_TYPE_NORMAL=1,
+        GP_EVENT_TIMEOUT=1,
+        GP_EVENT_FILE_ADDED=2,
         GP_EVENT_CAPTURE_COMPLETE=4,
     )
 
@@ -197,8 +213,9 @@ def make_module(body: Body) -> types.SimpleNamespace:
 def camera(body, tmp_path, clock=None, **kw):
     kw.setdefault("image_format", "RAW")
     settings = Gphoto2CameraSettings(**kw)
-    return Gphoto2Camera(settings, output_dir=tmp_path, clock=clock or VirtualClock(),
-                         gp_module=make_module(body))
+    return Gphoto2Camera(
+        settings, output_dir=tmp_path, clock=clock or VirtualClock(), gp_module=make_module(body)
+    )
 
 
 def test_connect_applies_settings_and_capture_downloads_and_decodes_raw(tmp_path):
@@ -260,8 +277,10 @@ def test_file_announced_twice_is_downloaded_once(tmp_path):
 
 def test_jpeg_only_camera_is_an_error_naming_the_setting(tmp_path):
     body = Body()
-    with camera(body, tmp_path, image_format=None) as cam, \
-            pytest.raises(CaptureError, match="no RAW file"):
+    with (
+        camera(body, tmp_path, image_format=None) as cam,
+        pytest.raises(CaptureError, match="no RAW file"),
+    ):
         cam.capture(1 / 60)
 
 
@@ -279,8 +298,10 @@ def test_busy_is_retried_on_the_injected_clock(tmp_path):
 
 def test_busy_forever_gives_up_with_a_clear_error(tmp_path):
     body = Body(failures={"capture": [-110] * 10})
-    with camera(body, tmp_path, busy_retries=3) as cam, \
-            pytest.raises(CaptureError, match=r"-110.*after 4 attempts.*busy"):
+    with (
+        camera(body, tmp_path, busy_retries=3) as cam,
+        pytest.raises(CaptureError, match=r"-110.*after 4 attempts.*busy"),
+    ):
         cam.capture(1 / 60)
 
 
@@ -346,10 +367,19 @@ def test_unknown_config_name_points_to_list_config(tmp_path):
         camera(Body(), tmp_path, aperture="8", aperture_config="f-number").connect()
 
 
-@pytest.mark.parametrize(("label", "secs"), [
-    ("1/125", 1 / 125), ("0.3", 0.3), ("2.5s", 2.5), ('30"', 30.0), ("1/4000s", 1 / 4000),
-    ("bulb", None), ("Auto", None), ("0", None),
-])
+@pytest.mark.parametrize(
+    ("label", "secs"),
+    [
+        ("1/125", 1 / 125),
+        ("0.3", 0.3),
+        ("2.5s", 2.5),
+        ('30"', 30.0),
+        ("1/4000s", 1 / 4000),
+        ("bulb", None),
+        ("Auto", None),
+        ("0", None),
+    ],
+)
 def test_parse_shutter(label, secs):
     got = parse_shutter(label)
     assert got == (pytest.approx(secs) if secs is not None else None)

@@ -23,8 +23,9 @@ def write_sequence(folder, values, dtype=np.uint16, shape=(6, 8)):
 
 
 def images_camera(pattern, **kw):
-    return OpenCvCamera(OpenCvCameraSettings(backend="images", device=pattern, **kw),
-                        clock=VirtualClock(5.0))
+    return OpenCvCamera(
+        OpenCvCameraSettings(backend="images", device=pattern, **kw), clock=VirtualClock(5.0)
+    )
 
 
 def test_image_sequence_16bit_frames_come_back_unchanged_after_draining(tmp_path):
@@ -91,8 +92,15 @@ def test_images_backend_errors(tmp_path):
 class FakeV4l2:
     """A UVC camera as OpenCV's V4L2 backend presents it, with a queue of stale buffers."""
 
-    def __init__(self, formats=("YUYV", "Y16 "), manual_latches=True, exposure_latches=True,
-                 has_awb=False, opened=True, buffers=4):
+    def __init__(
+        self,
+        formats=("YUYV", "Y16 "),
+        manual_latches=True,
+        exposure_latches=True,
+        has_awb=False,
+        opened=True,
+        buffers=4,
+    ):
         self.formats = formats
         self.manual_latches = manual_latches
         self.exposure_latches = exposure_latches

@@ -28,8 +28,11 @@ def test_kind_selects_the_backend_and_builds_the_driver(tmp_path):
     cases = [
         ({"kind": "opencv", "device": 2}, OpenCvCameraSettings, OpenCvCamera),
         ({"kind": "gphoto2", "iso": "200"}, Gphoto2CameraSettings, Gphoto2Camera),
-        ({"kind": "folder_watch", "folder": str(tmp_path), "patterns": ["*.NEF"]},
-         FolderWatchSettings, FolderWatchCamera),
+        (
+            {"kind": "folder_watch", "folder": str(tmp_path), "patterns": ["*.NEF"]},
+            FolderWatchSettings,
+            FolderWatchCamera,
+        ),
     ]
     for data, settings_type, driver_type in cases:
         settings = parse_camera_settings(data)
@@ -39,13 +42,16 @@ def test_kind_selects_the_backend_and_builds_the_driver(tmp_path):
     assert parse_camera_settings(cases[2][0]).patterns == ("*.NEF",)
 
 
-@pytest.mark.parametrize("data", [
-    {"kind": "opencv", "exposure_unti_s": 1e-4},
-    {"kind": "gphoto2", "decode": {"mode": "mosaic", "gamma": 2.2}},
-    {"kind": "folder_watch"},  # folder is required
-    {"kind": "webcam"},
-    {"kind": "gphoto2", "decode": {"white_balance": "auto"}},  # nothing automatic
-])
+@pytest.mark.parametrize(
+    "data",
+    [
+        {"kind": "opencv", "exposure_unti_s": 1e-4},
+        {"kind": "gphoto2", "decode": {"mode": "mosaic", "gamma": 2.2}},
+        {"kind": "folder_watch"},  # folder is required
+        {"kind": "webcam"},
+        {"kind": "gphoto2", "decode": {"white_balance": "auto"}},  # nothing automatic
+    ],
+)
 def test_invalid_camera_tables_are_rejected(data):
     with pytest.raises(ValidationError):
         parse_camera_settings(data)

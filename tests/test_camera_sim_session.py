@@ -81,8 +81,13 @@ def test_session_raw_like_frames_recover_normals(tmp_path):
         return signal + rng.normal(0.0, 2e-4, signal.shape)  # read noise
 
     raw_dir = tmp_path / "raw"
-    cam = RawRoundTripCamera("sim-camera", render, RawDecodeSettings(mode="mosaic"),
-                             output_dir=raw_dir, clock=VirtualClock())
+    cam = RawRoundTripCamera(
+        "sim-camera",
+        render,
+        RawDecodeSettings(mode="mosaic"),
+        output_dir=raw_dir,
+        clock=VirtualClock(),
+    )
     assert isinstance(cam, Camera) and isinstance(dome, DiscreteLightSource)
     cam.connect()
     dome.connect()

@@ -261,3 +261,21 @@ def test_arm_emergency_stop_follows_parking_policy(
     m = manifest(out)
     assert m["runner"]["finish_reason"] == "emergency-stop"
     assert_images_intact(out, 3)
+
+
+def test_simulated_dslr_frames_go_through_the_raw_decode_path(tmp_path: Path) -> None:
+    """scene.raw = true: every frame is a DNG decoded by rawpy, and the session still works."""
+    text = SMALL_DOME.replace("seed = 3", "seed = 3\nraw = true")
+    rig = build_rig(load_rig_config(write_config(tmp_path, text)))
+    rig.camera.connect()
+    rig.lighting.connect()
+    rig.lighting.set(plan_uniform(rig.geometry, 1).steps[0])
+    frame = rig.camera.capture(0.05)
+    assert frame.metadata["source"] == "simulated-raw"
+    assert frame.pixels.shape == (64, 64, 3) and frame.pixels.dtype == np.uint16
+    assert "underexposed_fraction" in frame.metadata  # measured by the rawpy decode path
+    out = tmp_path / "s"
+    rig2 = build_rig(load_rig_config(write_config(tmp_path, text, "raw.toml")))
+    result = run_session(rig2, plan_uniform(rig2.geometry, 6), SessionFolder.create(out, 6))
+    assert result.finish_reason is FinishReason.COMPLETED
+    assert_images_intact(out, 6)

@@ -28,8 +28,14 @@ def patch_mosaic(levels: list[float], width: int = 8, height: int = 32) -> np.nd
 
 def test_mosaic_mode_is_bit_exact_from_file(tmp_path):
     mosaic = random_mosaic()
-    path = write_dng(tmp_path / "r.dng", mosaic, black_level=BLACK, white_level=WHITE,
-                     exposure_s=1 / 125, iso=200)
+    path = write_dng(
+        tmp_path / "r.dng",
+        mosaic,
+        black_level=BLACK,
+        white_level=WHITE,
+        exposure_s=1 / 125,
+        iso=200,
+    )
     frame = decode_raw(path)
     assert frame.pixels.dtype == np.uint16
     assert frame.pixels.shape == mosaic.shape
@@ -70,8 +76,10 @@ def test_postprocess_modes_are_linear_and_never_rescaled(mode):
     # The brightest patch is 0.9 of white: LibRaw's default adjust_maximum_thr=0.75 would
     # rescale it to 1.0 (LibRaw's adjust_maximum_thr); the decode must keep it at 0.9.
     levels = [0.01, 0.1, 0.25, 0.5, 0.75, 0.9]
-    frame = decode_raw(dng_bytes(patch_mosaic(levels), black_level=BLACK, white_level=WHITE),
-                       RawDecodeSettings(mode=mode))
+    frame = decode_raw(
+        dng_bytes(patch_mosaic(levels), black_level=BLACK, white_level=WHITE),
+        RawDecodeSettings(mode=mode),
+    )
     assert frame.white_level == 65535
     assert frame.pixels.ndim == 3 and frame.pixels.shape[2] == 3
     step = 4 if mode == "half" else 8
@@ -82,8 +90,7 @@ def test_postprocess_modes_are_linear_and_never_rescaled(mode):
 
 def test_unity_white_balance_keeps_channel_ratios_camera_wb_changes_them():
     mosaic = patch_mosaic([0.4, 0.4, 0.4])
-    data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE,
-                     as_shot_neutral=(0.5, 1.0, 0.8))
+    data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE, as_shot_neutral=(0.5, 1.0, 0.8))
     unity = decode_raw(data, RawDecodeSettings(mode="half"))
     cam = decode_raw(data, RawDecodeSettings(mode="half", white_balance="camera"))
     px = unity.pixels[8, 2].astype(float)
@@ -98,9 +105,15 @@ def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
     h, w = 24, 24
     rgb = np.zeros((h, w, 3))
     rgb[..., 0], rgb[..., 1], rgb[..., 2] = 0.2, 0.5, 0.8
-    frame = decode_raw(dng_bytes(linear_to_mosaic(rgb, pattern, BLACK, WHITE),
-                                 cfa_pattern=pattern, black_level=BLACK, white_level=WHITE),
-                       RawDecodeSettings(mode="half"))
+    frame = decode_raw(
+        dng_bytes(
+            linear_to_mosaic(rgb, pattern, BLACK, WHITE),
+            cfa_pattern=pattern,
+            black_level=BLACK,
+            white_level=WHITE,
+        ),
+        RawDecodeSettings(mode="half"),
+    )
     assert frame.metadata["cfa_pattern"] == pattern
     np.testing.assert_allclose(frame.pixels[5, 5] / 65535, [0.2, 0.5, 0.8], atol=2e-4)
 
@@ -140,11 +153,11 @@ def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
     dark_lin = rng.uniform(0.0, 0.01, size=scene.shape)
     light = linear_to_mosaic(scene + dark_lin, "RGGB", BLACK, WHITE)
     dark = linear_to_mosaic(dark_lin, "RGGB", BLACK, WHITE)
-    write_dng(tmp_path / "dark.dng", dark, black_level=BLACK, white_level=WHITE,
-              exposure_s=0.5)
+    write_dng(tmp_path / "dark.dng", dark, black_level=BLACK, white_level=WHITE, exposure_s=0.5)
     dark_frame = decode_raw(tmp_path / "dark.dng")
-    img = decode_raw(dng_bytes(light, black_level=BLACK, white_level=WHITE, exposure_s=0.5),
-                     dark=dark_frame)
+    img = decode_raw(
+        dng_bytes(light, black_level=BLACK, white_level=WHITE, exposure_s=0.5), dark=dark_frame
+    )
     assert img.metadata["dark_subtracted"] is True
     assert img.metadata["dark_file"] == str(tmp_path / "dark.dng")
     expected = light[:, :16].astype(np.int64) - dark[:, :16].astype(np.int64)
@@ -154,10 +167,12 @@ def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
 
 
 def test_dark_with_other_exposure_or_shape_is_refused():
-    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE,
-                             exposure_s=0.5))
-    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE,
-                             exposure_s=0.25))
+    a = decode_raw(
+        dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE, exposure_s=0.5)
+    )
+    b = decode_raw(
+        dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE, exposure_s=0.25)
+    )
     with pytest.raises(CaptureError, match="exposure"):
         subtract_dark(a, b)
     c = decode_raw(dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE))

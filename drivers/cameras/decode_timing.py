@@ -34,8 +34,9 @@ def measure(shape: tuple[int, int], repeats: int) -> dict[str, float]:
     """Median seconds for dng_bytes and each decode mode on a random 14-bit mosaic."""
     rng = np.random.default_rng(0)
     mosaic = rng.integers(512, 16383, shape).astype(np.uint16)
-    out = {"write": _median_s(lambda: dng_bytes(mosaic, black_level=512, white_level=16383),
-                              repeats)}
+    out = {
+        "write": _median_s(lambda: dng_bytes(mosaic, black_level=512, white_level=16383), repeats)
+    }
     data = dng_bytes(mosaic, black_level=512, white_level=16383)
     for mode in MODES:
         settings = RawDecodeSettings(mode=mode)
@@ -50,8 +51,10 @@ def main() -> None:
     args = parser.parse_args()
     import rawpy
 
-    print(f"{platform.machine()}, Python {platform.python_version()}, rawpy {rawpy.__version__}"
-          f", LibRaw {'.'.join(map(str, rawpy.libraw_version))}; median of {args.repeats}")
+    print(
+        f"{platform.machine()}, Python {platform.python_version()}, rawpy {rawpy.__version__}"
+        f", LibRaw {'.'.join(map(str, rawpy.libraw_version))}; median of {args.repeats}"
+    )
     print("| size | dng_bytes | mosaic | half | demosaic | demosaic / mosaic |")
     print("|---|---|---|---|---|---|")
     for size in args.sizes:

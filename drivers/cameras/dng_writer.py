@@ -82,8 +82,10 @@ def dng_bytes(
         raise ValueError(f"cfa_pattern must be one of {sorted(CFA_CODES)}, got {cfa_pattern!r}")
     blacks = (black_level,) if isinstance(black_level, int) else tuple(black_level)
     if len(blacks) not in (1, 4) or not all(0 <= b < white_level <= 65535 for b in blacks):
-        raise ValueError(f"need 0 <= black_level < white_level <= 65535 (one or four black "
-                         f"levels), got {black_level}, {white_level}")
+        raise ValueError(
+            f"need 0 <= black_level < white_level <= 65535 (one or four black "
+            f"levels), got {black_level}, {white_level}"
+        )
     tags: list[tuple[int, str, int, object, bool]] = [
         (TAG_DNG_VERSION, "B", 4, (1, 4, 0, 0), True),
         (TAG_UNIQUE_MODEL, "s", 0, f"{make} {model}", True),
@@ -110,9 +112,7 @@ def dng_bytes(
             flat.extend(_rational(v, 10_000))
         tags.append((TAG_AS_SHOT_NEUTRAL, "2I", 3, tuple(flat), True))
     buf = io.BytesIO()
-    tifffile.imwrite(
-        buf, arr, photometric=tifffile.PHOTOMETRIC.CFA, extratags=tags, metadata=None
-    )
+    tifffile.imwrite(buf, arr, photometric=tifffile.PHOTOMETRIC.CFA, extratags=tags, metadata=None)
     return buf.getvalue()
 
 

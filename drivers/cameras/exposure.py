@@ -109,8 +109,9 @@ def choose_exposure(
             f"longest exposure predicted to saturate {p:.4%} of pixels "
             f"(limit {rule.max_saturated_fraction:.4%}) from a {preview.exposure_s:g} s preview"
         )
-        return ExposureChoice(t, True, p, "preview-prediction", reason, rule,
-                              test_exposures_s=(preview.exposure_s,))
+        return ExposureChoice(
+            t, True, p, "preview-prediction", reason, rule, test_exposures_s=(preview.exposure_s,)
+        )
     t, p = min(predictions)
     if preview.saturated_fraction > rule.max_saturated_fraction:
         reason = (
@@ -122,8 +123,9 @@ def choose_exposure(
             f"even {t:g} s is predicted to saturate {p:.4%} of pixels: dim the light, close "
             "the aperture or lower the gain"
         )
-    return ExposureChoice(t, False, p, "preview-prediction", reason, rule,
-                          test_exposures_s=(preview.exposure_s,))
+    return ExposureChoice(
+        t, False, p, "preview-prediction", reason, rule, test_exposures_s=(preview.exposure_s,)
+    )
 
 
 def choose_from_series(series: Sequence[Frame], rule: ExposureRule) -> ExposureChoice:
@@ -135,14 +137,28 @@ def choose_from_series(series: Sequence[Frame], rule: ExposureRule) -> ExposureC
     ok = [(t, s) for t, s in measured if s <= rule.max_saturated_fraction]
     if ok:
         t, s = max(ok)
-        return ExposureChoice(t, True, s, "test-series",
-                              f"longest test shot within the limit ({s:.4%} saturated)", rule, s,
-                              tested)
+        return ExposureChoice(
+            t,
+            True,
+            s,
+            "test-series",
+            f"longest test shot within the limit ({s:.4%} saturated)",
+            rule,
+            s,
+            tested,
+        )
     t, s = measured[0]
-    return ExposureChoice(t, False, s, "test-series",
-                          f"every test shot saturates more than "
-                          f"{rule.max_saturated_fraction:.4%} (shortest: {s:.4%} at {t:g} s)",
-                          rule, s, tested)
+    return ExposureChoice(
+        t,
+        False,
+        s,
+        "test-series",
+        f"every test shot saturates more than "
+        f"{rule.max_saturated_fraction:.4%} (shortest: {s:.4%} at {t:g} s)",
+        rule,
+        s,
+        tested,
+    )
 
 
 def meter_exposure(
@@ -167,8 +183,10 @@ def meter_exposure(
     if candidates_s is not None and not any(
         np.isclose(start_exposure_s, c, rtol=1e-9) for c in candidates_s
     ):
-        raise ValueError(f"start exposure {start_exposure_s:g} s is not one of the camera's "
-                         "exposures (candidates_s)")
+        raise ValueError(
+            f"start exposure {start_exposure_s:g} s is not one of the camera's "
+            "exposures (candidates_s)"
+        )
     series: list[Frame] = []
     frame = _shot(camera, start_exposure_s, series)
     while True:

@@ -26,8 +26,26 @@ from rti_rig.errors import CaptureError, DeviceError
 from rti_rig.rig import Frame
 
 RAW_SUFFIXES = {
-    ".dng", ".cr2", ".cr3", ".crw", ".nef", ".nrw", ".arw", ".srf", ".sr2", ".orf", ".rw2",
-    ".raf", ".pef", ".srw", ".3fr", ".iiq", ".erf", ".kdc", ".mos", ".x3f",
+    ".dng",
+    ".cr2",
+    ".cr3",
+    ".crw",
+    ".nef",
+    ".nrw",
+    ".arw",
+    ".srf",
+    ".sr2",
+    ".orf",
+    ".rw2",
+    ".raf",
+    ".pef",
+    ".srw",
+    ".3fr",
+    ".iiq",
+    ".erf",
+    ".kdc",
+    ".mos",
+    ".x3f",
 }
 
 
@@ -54,8 +72,12 @@ class FolderWatchCamera:
     def connect(self) -> None:
         folder = self.settings.folder
         if not folder.is_dir():
-            raise DeviceError(self.name, f"watched folder {folder} does not exist or is not a "
-                              "folder; create it or fix 'folder' in the rig config", "connect")
+            raise DeviceError(
+                self.name,
+                f"watched folder {folder} does not exist or is not a "
+                "folder; create it or fix 'folder' in the rig config",
+                "connect",
+            )
         self._seen = {p.name for p in self._matching()}
 
     def close(self) -> None:
@@ -165,9 +187,20 @@ class FolderWatchCamera:
                     "asked: set the camera to manual at the session exposure",
                     "check exposure",
                 )
-        metadata.update({"camera": self.name, "exposure_requested_s": exposure_s,
-                         "exposure_source": "file" if file_exposure else "requested",
-                         "capture_started_s": started,
-                         "capture_finished_s": self._clock.now()})
-        return Frame(pixels=pixels, exposure_s=file_exposure or exposure_s, gain=float(gain),
-                     white_level=white, timestamp_s=started, metadata=metadata)
+        metadata.update(
+            {
+                "camera": self.name,
+                "exposure_requested_s": exposure_s,
+                "exposure_source": "file" if file_exposure else "requested",
+                "capture_started_s": started,
+                "capture_finished_s": self._clock.now(),
+            }
+        )
+        return Frame(
+            pixels=pixels,
+            exposure_s=file_exposure or exposure_s,
+            gain=float(gain),
+            white_level=white,
+            timestamp_s=started,
+            metadata=metadata,
+        )

@@ -111,8 +111,9 @@ class Gphoto2Camera:
         self.camera_model: str | None = None
 
     # -- error handling --------------------------------------------------------------------
-    def _call(self, command: str, fn: Callable[[], T], error: type[DeviceError] = CaptureError
-              ) -> T:
+    def _call(
+        self, command: str, fn: Callable[[], T], error: type[DeviceError] = CaptureError
+    ) -> T:
         """Run one gphoto2 call, retrying the transient (busy) codes with the injected clock."""
         gp = self._gp
         s = self.settings
@@ -127,8 +128,9 @@ class Gphoto2Camera:
                     continue
                 hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
                 tries = f" after {attempt + 1} attempts" if attempt else ""
-                raise error(self.name, f"gphoto2 error {code} ({exc}){tries}: {hint}",
-                            command) from exc
+                raise error(
+                    self.name, f"gphoto2 error {code} ({exc}){tries}: {hint}", command
+                ) from exc
         raise AssertionError("unreachable")  # pragma: no cover
 
     # -- lifecycle -------------------------------------------------------------------------
@@ -139,20 +141,24 @@ class Gphoto2Camera:
         if self._gp is None:
             self._gp = load_gphoto2()
         gp = self._gp
-        detected = [(str(n), str(a)) for n, a in
-                    self._call("autodetect", lambda: list(gp.Camera.autodetect()), DeviceError)]
+        detected = [
+            (str(n), str(a))
+            for n, a in self._call("autodetect", lambda: list(gp.Camera.autodetect()), DeviceError)
+        ]
         if not detected:
             raise DeviceError(self.name, NO_CAMERA_HELP, "connect")
         port = self.settings.port
         if port is not None:
             match = [d for d in detected if d[1] == port]
             if not match:
-                raise DeviceError(self.name, f"no camera on port {port}; found {detected}",
-                                  "connect")
+                raise DeviceError(
+                    self.name, f"no camera on port {port}; found {detected}", "connect"
+                )
             model = match[0][0]
         elif len(detected) > 1:
-            raise DeviceError(self.name, f"several cameras found {detected}: set 'port' to "
-                              "choose one", "connect")
+            raise DeviceError(
+                self.name, f"several cameras found {detected}: set 'port' to choose one", "connect"
+            )
         else:
             model, port = detected[0]
         cam = gp.Camera()
@@ -218,8 +224,12 @@ class Gphoto2Camera:
             widget = self._widget(config, name, key)
             choices = self._choices(widget)
             if choices and value not in choices:
-                raise DeviceError(self.name, f"'{value}' is not offered for {name} (settings "
-                                  f"key '{key}'); the camera offers {choices}", f"set {name}")
+                raise DeviceError(
+                    self.name,
+                    f"'{value}' is not offered for {name} (settings "
+                    f"key '{key}'); the camera offers {choices}",
+                    f"set {name}",
+                )
             widget.set_value(value)
         self._call("set_config", lambda: cam.set_config(config), DeviceError)
         check = self._call("get_config", cam.get_config, DeviceError)
@@ -253,8 +263,12 @@ class Gphoto2Camera:
             if secs is not None:
                 shutters.append((secs, label))
         if not shutters:
-            raise DeviceError(self.name, f"'{s.shutter_config}' offers no timed shutter speeds: "
-                              "is the camera in manual (M) mode?", "read shutter speeds")
+            raise DeviceError(
+                self.name,
+                f"'{s.shutter_config}' offers no timed shutter speeds: "
+                "is the camera in manual (M) mode?",
+                "read shutter speeds",
+            )
         self._shutters = sorted(shutters)
 
     def available_exposures_s(self) -> list[float]:
@@ -265,8 +279,9 @@ class Gphoto2Camera:
     def capture(self, exposure_s: float) -> Frame:
         """Set the shutter, fire, download the RAW (and JPEG), decode it to linear data."""
         if self._cam is None:
-            raise CaptureError(self.name, "camera is not connected; call connect() first",
-                               "capture")
+            raise CaptureError(
+                self.name, "camera is not connected; call connect() first", "capture"
+            )
         if self.output_dir is None:
             raise CaptureError(self.name, "no output_dir set for downloaded files", "capture")
         s = self.settings
@@ -314,21 +329,29 @@ class Gphoto2Camera:
         jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
         iso = _number(s.iso) or decoded.gain
         metadata = dict(decoded.metadata)
-        metadata.update({
-            "camera": self.name,
-            "camera_model": self.camera_model,
-            "shutter_label": label,
-            "exposure_requested_s": exposure_s,
-            "iso": s.iso,
-            "aperture": s.aperture,
-            "gain_unit": "iso",
-            "camera_files": [f"{f.rstrip('/')}/{n}" for f, n in files],
-            "jpeg_file": jpeg[0] if jpeg else None,
-            "capture_started_s": t_capture,
-            "capture_finished_s": self._clock.now(),
-        })
-        return Frame(pixels=decoded.pixels, exposure_s=secs, gain=float(iso),
-                     white_level=decoded.white_level, timestamp_s=t_capture, metadata=metadata)
+        metadata.update(
+            {
+                "camera": self.name,
+                "camera_model": self.camera_model,
+                "shutter_label": label,
+                "exposure_requested_s": exposure_s,
+                "iso": s.iso,
+                "aperture": s.aperture,
+                "gain_unit": "iso",
+                "camera_files": [f"{f.rstrip('/')}/{n}" for f, n in files],
+                "jpeg_file": jpeg[0] if jpeg else None,
+                "capture_started_s": t_capture,
+                "capture_finished_s": self._clock.now(),
+            }
+        )
+        return Frame(
+            pixels=decoded.pixels,
+            exposure_s=secs,
+            gain=float(iso),
+            white_level=decoded.white_level,
+            timestamp_s=t_capture,
+            metadata=metadata,
+        )
 
     def _more_files(self, files: list[tuple[str, str]]) -> list[tuple[str, str]]:
         """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet."""

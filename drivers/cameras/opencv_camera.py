@@ -83,8 +83,11 @@ class OpenCvCamera:
         s = self.settings
         if s.backend == "images":
             if not isinstance(s.device, str):
-                raise DeviceError(self.name, "backend 'images' needs device = a file pattern such "
-                                  "as 'frames/f_%03d.png'", "connect")
+                raise DeviceError(
+                    self.name,
+                    "backend 'images' needs device = a file pattern such as 'frames/f_%03d.png'",
+                    "connect",
+                )
             api = cv2.CAP_IMAGES
         else:
             api = cv2.CAP_V4L2
@@ -124,8 +127,9 @@ class OpenCvCamera:
         self.close()
 
     # -- configuration ---------------------------------------------------------------------
-    def _set_verified(self, cap: VideoCaptureLike, prop: int, value: float, what: str,
-                      tol: float = 0.5) -> float:
+    def _set_verified(
+        self, cap: VideoCaptureLike, prop: int, value: float, what: str, tol: float = 0.5
+    ) -> float:
         accepted = cap.set(prop, value)
         got = cap.get(prop)
         if not accepted or abs(got - value) > tol:
@@ -162,29 +166,37 @@ class OpenCvCamera:
         info["buffer_size_set"] = bool(cap.set(cv2.CAP_PROP_BUFFERSIZE, s.buffer_size))
         if s.toggle_auto_exposure:
             cap.set(cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_auto)
-        self._set_verified(cap, cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_manual,
-                           "auto_exposure (manual)")
+        self._set_verified(
+            cap, cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_manual, "auto_exposure (manual)"
+        )
         # Mono sensors have no white balance control: absent is fine, stuck on is not.
         if not cap.set(cv2.CAP_PROP_AUTO_WB, 0) and cap.get(cv2.CAP_PROP_AUTO_WB) == 1:
-            raise DeviceError(self.name, "camera refused to turn auto white balance off",
-                              "set auto_wb")
+            raise DeviceError(
+                self.name, "camera refused to turn auto white balance off", "set auto_wb"
+            )
         info["auto_wb"] = cap.get(cv2.CAP_PROP_AUTO_WB)
         if s.wb_temperature_k is not None:
-            self._set_verified(cap, cv2.CAP_PROP_WB_TEMPERATURE, s.wb_temperature_k,
-                               "wb_temperature", tol=50)
+            self._set_verified(
+                cap, cv2.CAP_PROP_WB_TEMPERATURE, s.wb_temperature_k, "wb_temperature", tol=50
+            )
         if s.gain is not None:
             self._set_verified(cap, cv2.CAP_PROP_GAIN, s.gain, "gain")
         if "fourcc" in info and fourcc_to_str(cap.get(cv2.CAP_PROP_FOURCC)) != info["fourcc"]:
-            raise DeviceError(self.name, f"pixel format changed from {info['fourcc']!r} while "
-                              "configuring; set fourcc, width and height the camera supports "
-                              "together (`v4l2-ctl --list-formats-ext`)", "verify fourcc")
+            raise DeviceError(
+                self.name,
+                f"pixel format changed from {info['fourcc']!r} while "
+                "configuring; set fourcc, width and height the camera supports "
+                "together (`v4l2-ctl --list-formats-ext`)",
+                "verify fourcc",
+            )
         self.connection_info = info
 
     # -- capture ---------------------------------------------------------------------------
     def _require_open(self) -> VideoCaptureLike:
         if self._cap is None:
-            raise CaptureError(self.name, "camera is not connected; call connect() first",
-                               "capture")
+            raise CaptureError(
+                self.name, "camera is not connected; call connect() first", "capture"
+            )
         return self._cap
 
     def _apply_exposure(self, cap: VideoCaptureLike, exposure_s: float) -> tuple[float, float]:
@@ -231,13 +243,17 @@ class OpenCvCamera:
             gain = float(s.gain or 0.0)
         for i in range(s.drain_frames):
             if not cap.grab():
-                raise CaptureError(self.name, f"stream ended while draining frame {i + 1} of "
-                                   f"{s.drain_frames}", "drain")
+                raise CaptureError(
+                    self.name,
+                    f"stream ended while draining frame {i + 1} of {s.drain_frames}",
+                    "drain",
+                )
         self._frames_read += s.drain_frames
         ok, image = cap.read()
         if not ok or image is None:
-            raise CaptureError(self.name, "no frame delivered (stream ended or device lost)",
-                               "read")
+            raise CaptureError(
+                self.name, "no frame delivered (stream ended or device lost)", "read"
+            )
         self._frames_read += 1
         image = np.asarray(image)
         pixels, white = to_linear_uint16(image, s.response, s.black_level, s.white_level)
@@ -259,5 +275,11 @@ class OpenCvCamera:
         }
         metadata.update(self.connection_info)
         metadata.update(exposure_stats(pixels, white, 0.001))
-        return Frame(pixels=pixels, exposure_s=actual, gain=gain, white_level=white,
-                     timestamp_s=started, metadata=metadata)
+        return Frame(
+            pixels=pixels,
+            exposure_s=actual,
+            gain=gain,
+            white_level=white,
+            timestamp_s=started,
+            metadata=metadata,
+        )

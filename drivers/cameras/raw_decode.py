@@ -147,11 +147,16 @@ def decode_raw(
                 raise CaptureError(DECODER, f"{name}: not a single-plane CFA RAW", "decode")
             white_level = int(white - black_pc.max())
             if white_level <= 0:
-                raise CaptureError(DECODER, f"{name}: white level {white} is not above the "
-                                   f"black levels {black_pc.tolist()}", "decode")
+                raise CaptureError(
+                    DECODER,
+                    f"{name}: white level {white} is not above the "
+                    f"black levels {black_pc.tolist()}",
+                    "decode",
+                )
             # Uniform black (the usual case) stays scalar: uint16 arithmetic, no index arrays.
             black: int | NDArray[np.int64] = (
-                int(black_pc[0]) if np.all(black_pc == black_pc[0])
+                int(black_pc[0])
+                if np.all(black_pc == black_pc[0])
                 else black_pc[np.array(raw.raw_colors_visible)]
             )
             threshold = (

@@ -35,8 +35,14 @@ def encode_decode(
 ) -> Frame:
     """Linear data → Bayer mosaic → DNG (bytes, or ``path`` if given) → ``decode_raw`` → Frame."""
     mosaic = linear_to_mosaic(linear, cfa_pattern, black_level, white_level)
-    data = dng_bytes(mosaic, cfa_pattern=cfa_pattern, black_level=black_level,
-                     white_level=white_level, exposure_s=exposure_s, iso=iso)
+    data = dng_bytes(
+        mosaic,
+        cfa_pattern=cfa_pattern,
+        black_level=black_level,
+        white_level=white_level,
+        exposure_s=exposure_s,
+        iso=iso,
+    )
     if path is not None:
         path.write_bytes(data)
         return decode_raw(path, decode, timestamp_s=timestamp_s)
@@ -82,23 +88,43 @@ class RawRoundTripCamera:
 
     def capture(self, exposure_s: float) -> Frame:
         if not self._connected:
-            raise CaptureError(self.name, "camera is not connected; call connect() first",
-                               "capture")
+            raise CaptureError(
+                self.name, "camera is not connected; call connect() first", "capture"
+            )
         if exposure_s <= 0:
-            raise CaptureError(self.name, f"exposure must be positive, got {exposure_s}",
-                               "capture")
+            raise CaptureError(self.name, f"exposure must be positive, got {exposure_s}", "capture")
         self._count += 1
         path = None
         if self.output_dir is not None:
             self.output_dir.mkdir(parents=True, exist_ok=True)
             path = self.output_dir / f"cap{self._count:04d}.dng"
-        frame = encode_decode(self._render(exposure_s), exposure_s, self._decode, self._cfa,
-                              self._black, self._white, self._iso, path, self._clock.now())
+        frame = encode_decode(
+            self._render(exposure_s),
+            exposure_s,
+            self._decode,
+            self._cfa,
+            self._black,
+            self._white,
+            self._iso,
+            path,
+            self._clock.now(),
+        )
         metadata = dict(frame.metadata)
-        metadata.update({"camera": self.name, "exposure_requested_s": exposure_s,
-                         "gain_unit": "iso", "capture_started_s": frame.timestamp_s,
-                         "capture_finished_s": self._clock.now()})
+        metadata.update(
+            {
+                "camera": self.name,
+                "exposure_requested_s": exposure_s,
+                "gain_unit": "iso",
+                "capture_started_s": frame.timestamp_s,
+                "capture_finished_s": self._clock.now(),
+            }
+        )
         # The DNG stores exposure as a float32 rational; the requested value is exact.
-        return Frame(pixels=frame.pixels, exposure_s=exposure_s, gain=float(self._iso),
-                     white_level=frame.white_level, timestamp_s=frame.timestamp_s,
-                     metadata=metadata)
+        return Frame(
+            pixels=frame.pixels,
+            exposure_s=exposure_s,
+            gain=float(self._iso),
+            white_level=frame.white_level,
+            timestamp_s=frame.timestamp_s,
+            metadata=metadata,
+        )

@@ -92,8 +92,9 @@ class OpenCvCameraSettings(_Strict):
     width: int | None = Field(None, gt=0)
     height: int | None = Field(None, gt=0)
     fourcc: str | None = Field(
-        "Y16 ", description="pixel format to request; 'Y16 ' gives 16-bit grey frames; None keeps "
-        "the camera default (usually 8-bit YUYV/MJPEG, gamma-encoded)"
+        "Y16 ",
+        description="pixel format to request; 'Y16 ' gives 16-bit grey frames; None keeps "
+        "the camera default (usually 8-bit YUYV/MJPEG, gamma-encoded)",
     )
     require_fourcc: bool = Field(
         True, description="fail at connect if the camera refuses the requested fourcc"
@@ -166,8 +167,10 @@ class Gphoto2CameraSettings(_Strict):
     aperture_config: str = "aperture"
     image_format_config: str = "imageformat"
     shutter_tolerance: float = Field(
-        0.06, ge=0.0, description="relative mismatch allowed between requested exposure and the "
-        "nearest shutter speed the camera offers (1/3 stop is 0.26)"
+        0.06,
+        ge=0.0,
+        description="relative mismatch allowed between requested exposure and the "
+        "nearest shutter speed the camera offers (1/3 stop is 0.26)",
     )
     busy_retries: int = Field(5, ge=0)
     retry_delay_s: float = Field(0.5, ge=0.0)
@@ -205,8 +208,9 @@ class FolderWatchSettings(_Strict):
     )
     gain: float = Field(0.0, description="recorded in the frame when the file has no ISO")
     eight_bit_response: Literal["refuse", "linear", "srgb"] = Field(
-        "refuse", description="8-bit files (JPEG, PNG) are gamma-encoded: refuse them, or "
-        "linearise with the inverse sRGB curve, or take them as linear"
+        "refuse",
+        description="8-bit files (JPEG, PNG) are gamma-encoded: refuse them, or "
+        "linearise with the inverse sRGB curve, or take them as linear",
     )
     decode: RawDecodeSettings = RawDecodeSettings()
 
