@@ -11,8 +11,9 @@ of rows. Attached shadows and highlights bias it (notes §2: 15.4° mean on DiLi
 
 1. **shadows**: observations below ``dark_threshold`` (default :data:`DARK_FRACTION` of the
    stack's reference level, the 99th percentile of a pixel sample);
-2. **saturated** observations at or above ``saturation`` (default: none for float input, the
-   top code value for integer input, 1.0 for :func:`stack_from_frames`);
+2. **saturated** observations at or above ``saturation`` (default: the stack's saturation
+   level — none for float input, the top code value for integer input, 1.0 for
+   :func:`stack_from_frames`; pass ``float("inf")`` to disable);
 3. **highlights**: observations brighter than the current Lambertian fit by more than
    ``max(highlight_k * sigma, highlight_floor)``, with ``sigma = 1.4826 * median |residual|``
    over the pixel's used observations (a robust noise scale), refitting after each of up to
@@ -195,9 +196,9 @@ def fit_photometric_stereo(
     *,
     dark_threshold: float | None = None,
     saturation: float | None = None,
-    highlight_k: float = 3.0,
+    highlight_k: float = 2.0,
     highlight_floor: float | None = None,
-    max_passes: int = 3,
+    max_passes: int = 10,
     cond_limit: float = COND_LIMIT,
 ) -> PSResult:
     """Normals and albedo of linear ``images`` (N, H, W[, C]) under unit ``lights`` (N, 3).
@@ -219,8 +220,8 @@ def fit_photometric_stereo(
             raise ReconstructionError(f"mask has shape {inside_all.shape}, images are {(h, wd)}")
     ref = stack.reference_level()
     dark = float(dark_threshold) if dark_threshold is not None else DARK_FRACTION * ref
-    if saturation is None and np.issubdtype(stack.dtype, np.integer):
-        saturation = float(np.iinfo(stack.dtype).max * stack.scale)
+    if saturation is None:
+        saturation = stack.saturation_level
     floor = HIGHLIGHT_FLOOR_FRACTION * ref if highlight_floor is None else float(highlight_floor)
     eps_b = DARK_PIXEL_FRACTION * ref
 

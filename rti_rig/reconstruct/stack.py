@@ -30,16 +30,24 @@ UNIT_TOLERANCE = 0.05
 class ImageStack:
     """Read-only view of N linear images, read a band of rows at a time as float32.
 
+    ``saturation_level`` (in scaled units) marks clipped observations; integer images default
+    to their top code value, float images to None (unknown).
+
     ``grey`` is True when the images have no channel axis; fitted outputs then have none either.
     """
 
-    def __init__(self, images: Any, scale: float | None = None) -> None:
+    def __init__(
+        self, images: Any, scale: float | None = None, saturation_level: float | None = None
+    ) -> None:
         if isinstance(images, ImageStack):
             self._frames: Sequence[Any] | None = images._frames
             self._array = images._array
             self.n, self.height, self.width = images.n, images.height, images.width
             self.channels, self.grey = images.channels, images.grey
             self.dtype, self.scale = images.dtype, images.scale if scale is None else scale
+            self.saturation_level = (
+                images.saturation_level if saturation_level is None else saturation_level
+            )
             return
         if isinstance(images, np.ndarray):
             if images.ndim not in (3, 4):
@@ -79,6 +87,10 @@ class ImageStack:
         if scale is None:
             scale = 1.0 / np.iinfo(dtype).max if np.issubdtype(dtype, np.integer) else 1.0
         self.scale = float(scale)
+        if saturation_level is None and np.issubdtype(dtype, np.integer):
+            saturation_level = float(np.iinfo(dtype).max) * self.scale
+        #: Scaled value at or above which an observation is saturated (None: unknown).
+        self.saturation_level = saturation_level
         if self.height < 1 or self.width < 1 or self.channels < 1:
             raise ReconstructionError(f"images are empty: shape {shape}")
 
@@ -135,10 +147,10 @@ class ImageStack:
         return level if level > 0 else 1.0
 
 
-def stack_from_frames(frames: Sequence[Any]) -> tuple[ImageStack, float]:
-    """Stack of captured :class:`rti_rig.rig.Frame` objects, kept as uint16, and its saturation.
+def stack_from_frames(frames: Sequence[Any]) -> ImageStack:
+    """Stack of captured :class:`rti_rig.rig.Frame` objects, kept as uint16 (no float copy).
 
-    Values are scaled by 1 / white level, so the returned saturation level is 1.0.
+    Values are scaled by 1 / white level, so the stack's saturation level is 1.0.
     """
     if not frames:
         raise ReconstructionError("no frames to reconstruct from")
@@ -148,7 +160,7 @@ def stack_from_frames(frames: Sequence[Any]) -> tuple[ImageStack, float]:
     white = levels.pop()
     if white <= 0:
         raise ReconstructionError(f"frame white level must be positive, got {white}")
-    return ImageStack([f.pixels for f in frames], scale=1.0 / white), 1.0
+    return ImageStack([f.pixels for f in frames], scale=1.0 / white, saturation_level=1.0)
 
 
 def validate_lights(lights: ArrayLike, n_images: int | None = None) -> NDArray[np.float64]:
