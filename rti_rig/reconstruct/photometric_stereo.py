@@ -232,7 +232,8 @@ def fit_photometric_stereo(
     valid = np.zeros((h, wd), dtype=bool)
     used = np.zeros((h, wd), dtype=np.int16)
     w32 = w_ls.astype(np.float32)
-    rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 3)
+    # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
+    rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
         band = stack.rows(sl)  # (N, r, W, C)
         r = band.shape[1]

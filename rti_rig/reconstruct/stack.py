@@ -137,7 +137,7 @@ class ImageStack:
         flat = (rows[:, None] * self.width + cols[None, :]).ravel()
         return values, flat
 
-    def reference_level(self, max_pixels: int = 65536) -> float:
+    def reference_level(self, max_pixels: int = 10_000) -> float:
         """A robust "bright" level of the stack: the 99th percentile of a pixel sample.
 
         Thresholds (dark, highlight floor) are fractions of it, so they follow the exposure.
