@@ -140,21 +140,25 @@ def _sym3_inverse_and_cond(
 def _solve_weighted(
     g: NDArray[np.float32], w: NDArray[np.bool_], lights: NDArray[np.float64], cond_limit: float
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Per-pixel least squares on the used observations ``w``: b (P, 3) and solvable (P,)."""
+    """Least squares per pixel on its used observations.
+
+    ``g`` and ``w`` are pixel-major (P, N) so that gathering a subset of pixels is contiguous.
+    Returns b (P, 3) and solvable (P,): at least 3 observations and a light subset whose
+    condition number is within ``cond_limit``.
+    """
     ll = (lights[:, :, None] * lights[:, None, :]).reshape(-1, 9)
     wf = w.astype(np.float64)
-    m = wf.T @ ll  # (P, 9)
-    rhs = (wf * g).T @ lights  # (P, 3)
+    m = wf @ ll  # (P, 9)
+    rhs = (wf * g) @ lights  # (P, 3)
     inv, ratio = _sym3_inverse_and_cond(m)
-    ok = (w.sum(axis=0) >= 3) & (ratio <= cond_limit**2)
-    inv3 = inv.reshape(-1, 3, 3)
-    b = np.einsum("pij,pj->pi", inv3, rhs)
+    ok = (w.sum(axis=1) >= 3) & (ratio <= cond_limit**2)
+    b = np.einsum("pij,pj->pi", inv.reshape(-1, 3, 3), rhs)
     b[~ok] = 0.0
     return b, ok
 
 
 def _robust_band(
-    g: NDArray[np.float32],
+    g_nm: NDArray[np.float32],
     inside: NDArray[np.bool_],
     lights: NDArray[np.float64],
     dark: float,
@@ -164,27 +168,38 @@ def _robust_band(
     max_passes: int,
     cond_limit: float,
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
-    """Robust fit of one band: b (P, 3), used observations (N, P), solvable pixels (P,)."""
-    w = (g > dark) & inside[None, :]
+    """Robust fit of one band ``g_nm`` (N, P): b (P, 3), used observations (N, P), solvable."""
+    g = np.ascontiguousarray(g_nm.T)  # (P, N)
+    w = (g > dark) & inside[:, None]
     if saturation is not None:
         w &= g < saturation
     b, ok = _solve_weighted(g, w, lights, cond_limit)
-    n_obs = g.shape[0]
+    n_obs = g.shape[1]
+    # Only pixels that dropped an observation in the last pass are refitted: most converge in
+    # one or two passes, so later passes touch few pixels.
+    active = np.flatnonzero(ok)
     for _ in range(max_passes):
-        resid = g - (lights @ b.T)  # (N, P)
-        absr = np.where(w, np.abs(resid), np.inf)
-        absr.sort(axis=0)
-        count = w.sum(axis=0)
+        if active.size == 0:
+            break
+        ga, wa = g[active], w[active]
+        resid = ga - b[active] @ lights.T  # (A, N)
+        absr = np.where(wa, np.abs(resid), np.inf)
+        absr.sort(axis=1)
+        count = wa.sum(axis=1)
         mid = np.clip((count - 1) // 2, 0, n_obs - 1)
-        med = np.take_along_axis(absr, mid[None, :], axis=0)[0]
+        med = np.take_along_axis(absr, mid[:, None], axis=1)[:, 0]
         med = np.where(count > 0, med, 0.0)
         thr = np.maximum(highlight_k * 1.4826 * med, highlight_floor)
-        drop = w & (resid > thr[None, :]) & ok[None, :]
-        if not drop.any():
+        drop = wa & (resid > thr[:, None])
+        changed = drop.any(axis=1)
+        if not changed.any():
             break
-        w &= ~drop
-        b, ok = _solve_weighted(g, w, lights, cond_limit)
-    return b, w, ok
+        active = active[changed]
+        wa = wa[changed] & ~drop[changed]
+        w[active] = wa
+        b[active], ok[active] = _solve_weighted(g[active], wa, lights, cond_limit)
+        active = active[ok[active]]
+    return b, w.T, ok
 
 
 def fit_photometric_stereo(
