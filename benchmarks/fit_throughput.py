@@ -6,7 +6,7 @@ on top, measured in the same run on the same machine. Figures: median wall time 
 throughput in pixels × lights per second, the ratio to the matrix product, and the peak traced
 memory of one fit compared with the float32 stack it never builds.
 
-Run: ``python -m benchmarks.fit_throughput`` (defaults: 1024 × 1024 grey pixels, 48 lights,
+Run: ``python -m benchmarks.fit_throughput`` (defaults: 512 × 512 grey pixels, 48 lights,
 5 repeats); ``--size``, ``--lights``, ``--repeats``, ``--tile-rows`` change the shape.
 """
 
@@ -105,7 +105,7 @@ def run(size: int, n_lights: int, repeats: int, tile_rows: int | None) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=int, default=1024, help="image side in pixels")
+    parser.add_argument("--size", type=int, default=512, help="image side in pixels")
     parser.add_argument("--lights", type=int, default=48, help="number of lights N")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument(

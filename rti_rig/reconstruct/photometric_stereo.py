@@ -202,6 +202,72 @@ def _robust_band(
     return b, w.T, ok
 
 
+def _unit_normals(
+    b: NDArray[np.float64], ok: NDArray[np.bool_], eps_b: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+    """Normals (P, 3) with z >= 0, |b| and validity; invalid pixels get (0, 0, 1)."""
+    b[:, 2] = np.maximum(b[:, 2], 0.0)  # a normal facing away from the camera is unseen
+    norm = np.linalg.norm(b, axis=1)
+    ok = ok & (norm > eps_b)
+    n = np.where(ok[:, None], b / np.where(norm > 0, norm, 1.0)[:, None], [0.0, 0.0, 1.0])
+    return n, norm, ok
+
+
+def _albedo_residual_used(
+    b: NDArray[np.float64],
+    w: NDArray[np.bool_],
+    ok: NDArray[np.bool_],
+    g: NDArray[np.float32],
+    flat: NDArray[np.float32],
+    lights: NDArray[np.float64],
+    eps_b: float,
+) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray[np.bool_]]:
+    """Normals, per-channel albedo, RMS residual and counts over each pixel's used lights."""
+    n, norm, ok = _unit_normals(b, ok, eps_b)
+    wf = w & ok[None, :]
+    s = lights @ n.T  # (N, P)
+    shade = s * wf
+    den = np.sum(shade * shade, axis=0)
+    alb = np.einsum("np,npc->pc", shade, flat) / np.where(den > 0, den, 1.0)[:, None]
+    count = wf.sum(axis=0)
+    res = np.where(wf, g - norm[None, :] * s, 0.0)
+    rms = np.sqrt(np.sum(res * res, axis=0) / np.maximum(count, 1))
+    return n, alb, rms, count, ok
+
+
+def _albedo_residual_all(
+    w32: NDArray[np.float32],
+    inside: NDArray[np.bool_],
+    g: NDArray[np.float32],
+    flat: NDArray[np.float32],
+    lights: NDArray[np.float64],
+    gram: NDArray[np.float64],
+    eps_b: float,
+) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
+    """Least squares over all lights without (N, P) temporaries: matrix products only.
+
+    With every light used, ``sum_k s_k I_k = n . (L^T I)`` and ``sum_k s_k^2 = n^T (L^T L) n``,
+    so albedo and residual need three (3 × N) @ (N × P) products and one sum of squares.
+    """
+    b = (w32 @ g).T.astype(np.float64)
+    n, norm, ok = _unit_normals(b, inside.copy(), eps_b)
+    ss = np.einsum("pi,ij,pj->p", n, gram, n)
+    ss = np.where(ss > 0, ss, 1.0)
+    lt32 = lights.T.astype(np.float32)
+    channels = flat.shape[2]
+    alb = np.empty((g.shape[1], channels))
+    for c in range(channels):
+        proj = (lt32 @ np.ascontiguousarray(flat[..., c])).T.astype(np.float64)  # (P, 3)
+        alb[:, c] = np.sum(n * proj, axis=1) / ss
+    # float64 here: the residual is a small difference of large sums
+    g64 = g.astype(np.float64)
+    ltg = (lights.T @ g64).T
+    g2 = np.einsum("np,np->p", g64, g64)
+    sse = g2 - 2.0 * norm * np.sum(n * ltg, axis=1) + norm * norm * ss
+    rms = np.sqrt(np.maximum(sse, 0.0) / g.shape[0])
+    return n, alb, rms, ok
+
+
 def fit_photometric_stereo(
     images: Any,
     lights: ArrayLike,
@@ -247,6 +313,7 @@ def fit_photometric_stereo(
     valid = np.zeros((h, wd), dtype=bool)
     used = np.zeros((h, wd), dtype=np.int16)
     w32 = w_ls.astype(np.float32)
+    gram = lt.T @ lt
     # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
@@ -259,22 +326,10 @@ def fit_photometric_stereo(
             b, w, ok = _robust_band(
                 g, inside, lt, dark, saturation, highlight_k, floor, max_passes, cond_limit
             )
+            n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
         else:
-            b = (w32 @ g).T.astype(np.float64)
-            w = np.broadcast_to(inside[None, :], g.shape)
-            ok = inside.copy()
-        b[:, 2] = np.maximum(b[:, 2], 0.0)  # a normal facing away from the camera is unseen
-        norm = np.linalg.norm(b, axis=1)
-        ok &= inside & (norm > eps_b)
-        n = np.where(ok[:, None], b / np.where(norm > 0, norm, 1.0)[:, None], [0.0, 0.0, 1.0])
-        wf = w & ok[None, :]
-        shade = (lt @ n.T) * wf  # (N, P), zero where unused
-        den = np.sum(shade * shade, axis=0)
-        den = np.where(den > 0, den, 1.0)
-        alb = np.einsum("np,npc->pc", shade, flat) / den[:, None]
-        count = wf.sum(axis=0)
-        res = g - norm[None, :] * (lt @ n.T)
-        rms = np.sqrt(np.sum(np.where(wf, res * res, 0.0), axis=0) / np.maximum(count, 1))
+            n, alb, rms, ok = _albedo_residual_all(w32, inside, g, flat, lt, gram, eps_b)
+            count = np.full(ok.shape, stack.n)
         normals[sl] = n.reshape(r, wd, 3)
         albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
         residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)
