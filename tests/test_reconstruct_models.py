@@ -160,3 +160,14 @@ def test_relight_validates_direction() -> None:
         model.relight([0.0, 0.6, -0.8])
     with pytest.raises(ReconstructionError, match="unit vectors"):
         model.relight([0.0, 0.0, 2.0])
+
+
+@pytest.mark.parametrize("model", ["hsh1", "ptm", "hsh2", "hsh3"])
+def test_lights_on_one_ring_are_ill_conditioned_for_every_basis(model: str) -> None:
+    ring = direction_from_az_el(np.arange(24) * 15.0, np.full(24, 45.0))
+    images = np.ones((24, 3, 3), dtype=np.float32)
+    with pytest.raises(ReconstructionError, match=f"ill-conditioned for {model}"):
+        fit_model(model, images, ring, ill_conditioned="refuse")
+    fitted = fit_model(model, images, ring)
+    assert fitted.report.regularised
+    np.testing.assert_allclose(fitted.relight(ring[3]), 1.0, rtol=1e-3)

@@ -90,3 +90,17 @@ def test_robust_photometric_stereo_peak_memory_is_bounded_by_the_band() -> None:
     reference_sample = 2 * n * 10_000 * 4  # the 99th-percentile sample behind the thresholds
     assert peak < outputs + 40 * band_values + reference_sample + 500_000
     assert peak < n * h * w * 4 * 0.75
+
+
+def test_coefficients_can_stream_into_a_memmap(tmp_path) -> None:
+    normals, _ = sphere_normals(20, 16)
+    lights = fibonacci_lights(30)
+    images = render(normals, np.full((20, 16, 3), 0.4), lights)
+    out = np.lib.format.open_memmap(tmp_path / "hsh3.npy", "w+", np.float32, (16, 20, 16, 3))
+    model = fit_model("hsh3", images, lights, tile_rows=5, out=out)
+    assert model.coefficients is out
+    out.flush()
+    reread = np.load(tmp_path / "hsh3.npy")
+    np.testing.assert_allclose(reread, fit_model("hsh3", images, lights).coefficients, atol=1e-6)
+    with pytest.raises(ReconstructionError, match="out has shape"):
+        fit_model("ptm", images, lights, out=np.zeros((6, 20, 16), np.float32))

@@ -49,8 +49,12 @@ def fit_hsh(
     tile_rows: int | None = None,
     ill_conditioned: IllConditioned = "regularise",
     cond_limit: float = COND_LIMIT,
+    out: NDArray[Any] | None = None,
 ) -> HSHModel:
-    """Fit HSH of ``order`` (1, 2, 3) to linear ``images``; needs N >= 4, 9, 16 lights."""
+    """Fit HSH of ``order`` (1, 2, 3) to linear ``images``; needs N >= 4, 9, 16 lights.
+
+    ``out``: optional array (e.g. a memmap) for the coefficients, see ``fit_coefficients``.
+    """
     if order not in (1, 2, 3):
         raise ReconstructionError(
             f"HSH order must be 1, 2 or 3 (4, 9, 16 coefficients), got {order}"
@@ -59,6 +63,6 @@ def fit_hsh(
     lt = validate_lights(lights, stack.n)
     coef, report = fit_coefficients(
         stack, hsh_basis(lt, order), f"hsh{order}", tile_rows=tile_rows,
-        ill_conditioned=ill_conditioned, cond_limit=cond_limit,
+        ill_conditioned=ill_conditioned, cond_limit=cond_limit, out=out,
     )
     return HSHModel(coef, report, order)

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.bases import design_matrix
+from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.solve import COND_LIMIT, FitReport, IllConditioned, solve_matrix
 from rti_rig.reconstruct.stack import ImageStack, as_direction, validate_lights
 from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
@@ -77,12 +78,15 @@ def fit_coefficients(
     tile_rows: int | None = None,
     ill_conditioned: IllConditioned = "regularise",
     cond_limit: float = COND_LIMIT,
-) -> tuple[NDArray[np.float32], FitReport]:
+    out: NDArray[Any] | None = None,
+) -> tuple[NDArray[Any], FitReport]:
     """Fit ``design`` to every pixel of ``images``, a band of rows at a time.
 
     Returns coefficients (p, H, W) or (p, H, W, C) float32 and the fit report. The float32
     working set is one band (see :mod:`rti_rig.reconstruct.tiling`); the solve matrix is
-    computed once in float64 and applied in float32.
+    computed once in float64 and applied in float32. ``out`` (same shape) receives the
+    coefficients instead of a new array: a ``numpy.memmap`` keeps a 24-megapixel HSH3 fit
+    (4.6 GB of float32 colour coefficients) out of memory.
     """
     stack = ImageStack(images)
     if design.shape[0] != stack.n:
@@ -91,13 +95,15 @@ def fit_coefficients(
     w32 = w.astype(np.float32)
     p = w.shape[0]
     rows = tile_rows or rows_for_budget(stack.n, stack.width, stack.channels)
-    coef = np.empty((p, stack.height, stack.width, stack.channels), dtype=np.float32)
+    shape = (p, stack.height, stack.width) + (() if stack.grey else (stack.channels,))
+    if out is not None and out.shape != shape:
+        raise ReconstructionError(f"out has shape {out.shape}, the coefficients need {shape}")
+    coef = np.empty(shape, dtype=np.float32) if out is None else out
     for sl in row_tiles(stack.height, rows):
         band = stack.rows(sl)  # (N, r, W, C)
         r = band.shape[1]
-        coef[:, sl] = (w32 @ band.reshape(stack.n, -1)).reshape(p, r, stack.width, stack.channels)
-    if stack.grey:
-        coef = coef[..., 0]
+        tile = (w32 @ band.reshape(stack.n, -1)).reshape(p, r, stack.width, stack.channels)
+        coef[:, sl] = tile[..., 0] if stack.grey else tile
     return coef, report
 
 
@@ -107,6 +113,7 @@ def fit_lambert(
     *,
     tile_rows: int | None = None,
     ill_conditioned: IllConditioned = "refuse",
+    out: NDArray[Any] | None = None,
 ) -> LambertModel:
     """Least-squares Lambertian model (no shadow handling): the lowest-order relighting model.
 
@@ -117,6 +124,6 @@ def fit_lambert(
     lt = validate_lights(lights, stack.n)
     coef, report = fit_coefficients(
         stack, LambertModel.design(lt), "lambert", tile_rows=tile_rows,
-        ill_conditioned=ill_conditioned,
+        ill_conditioned=ill_conditioned, out=out,
     )
     return LambertModel(coef, report)

@@ -56,12 +56,16 @@ def fit_ptm(
     tile_rows: int | None = None,
     ill_conditioned: IllConditioned = "regularise",
     cond_limit: float = COND_LIMIT,
+    out: NDArray[Any] | None = None,
 ) -> PTMModel:
-    """Fit a PTM to linear ``images`` (N, H, W[, C]) lit from unit ``lights`` (N, 3); N >= 6."""
+    """Fit a PTM to linear ``images`` (N, H, W[, C]) lit from unit ``lights`` (N, 3); N >= 6.
+
+    ``out``: optional array (e.g. a memmap) for the coefficients, see ``fit_coefficients``.
+    """
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
     coef, report = fit_coefficients(
         stack, PTMModel.design(lt), "ptm", tile_rows=tile_rows,
-        ill_conditioned=ill_conditioned, cond_limit=cond_limit,
+        ill_conditioned=ill_conditioned, cond_limit=cond_limit, out=out,
     )
     return PTMModel(coef, report)
