@@ -6,13 +6,18 @@ on top, measured in the same run on the same machine. Figures: median wall time 
 throughput in pixels × lights per second, the ratio to the matrix product, and the peak traced
 memory of one fit compared with the float32 stack it never builds.
 
-Run: ``python -m benchmarks.fit_throughput`` (defaults: 512 × 512 grey pixels, 48 lights,
-5 repeats); ``--size``, ``--lights``, ``--repeats``, ``--tile-rows`` change the shape.
+Run: ``OPENBLAS_NUM_THREADS=1 python -m benchmarks.fit_throughput`` (one BLAS thread: on a
+shared machine, threaded BLAS on tall-skinny products loses more to contention than it gains;
+defaults: 512 × 512 grey pixels, 48 lights, 5 repeats); ``--size``, ``--lights``,
+``--repeats``, ``--tile-rows`` change the shape. It also writes a small accuracy table
+(``--accuracy-size``, 0 to skip): angular error and held-out relighting PSNR/SSIM of each
+model on a synthetic sphere with highlights.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import time
 import tracemalloc
@@ -21,7 +26,8 @@ from collections.abc import Callable
 import numpy as np
 
 from benchmarks.report import machine_line, write_section
-from rti_rig.reconstruct import N_COEFFICIENTS, fit_model
+from rti_rig.metrics import angular_error_deg, relight_psnr, relight_ssim
+from rti_rig.reconstruct import N_COEFFICIENTS, fit_model, select_model
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
 MODELS = ("ps", "ps-robust", "lambert", "hsh1", "ptm", "hsh2", "hsh3")
@@ -71,10 +77,13 @@ def run(size: int, n_lights: int, repeats: int, tile_rows: int | None) -> str:
             f"  fit(uint16 frames) {t_u16 * 1e3:8.1f} ms  ratio {t_fit / t_mm:6.1f}x"
             f"  peak {peak / 1e6:7.1f} MB"
         )
+    threads = os.environ.get("OPENBLAS_NUM_THREADS")
     cmd = (
         f"python -m benchmarks.fit_throughput --size {size} --lights {n_lights} "
         f"--repeats {repeats}"
     )
+    if threads:
+        cmd = f"OPENBLAS_NUM_THREADS={threads} {cmd}"
     if tile_rows:
         cmd += f" --tile-rows {tile_rows}"
     lines = [
@@ -103,11 +112,58 @@ def run(size: int, n_lights: int, repeats: int, tile_rows: int | None) -> str:
     return "\n".join(lines)
 
 
+def accuracy(size: int, n_lights: int) -> str:
+    """Accuracy on the same kind of scene: what the throughput buys (held-out lights)."""
+    lights = fibonacci_lights(n_lights)
+    normals, inside = sphere_normals(size, size)
+    test = np.arange(n_lights) % 4 == 0
+    lines = [
+        "## Reconstruction accuracy on the synthetic sphere",
+        "",
+        f"{machine_line()} Command: `python -m benchmarks.fit_throughput --accuracy-size {size} "
+        f"--lights {n_lights}` (written with the throughput section).",
+        "",
+        f"{size} × {size} sphere, albedo 0.6, Blinn–Phong highlight of weight 0.8 at the given "
+        f"shininess, noise σ = 0.003; {int((~test).sum())} Fibonacci lights fit, every 4th of "
+        f"{n_lights} held out. Angular error over the sphere's valid pixels (valid fraction "
+        "given); relighting PSNR (data range 1) and SSIM are means over held-out lights.",
+        "",
+        "| shininess | model | mean angle (°) | median (°) | valid | relight PSNR (dB) | "
+        "relight SSIM |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    choices = []
+    for shininess in (10.0, 40.0, 100.0):
+        images = render(normals, 0.6, lights, specular=0.8, shininess=shininess)
+        images += np.random.default_rng(2).normal(0, 0.003, images.shape).astype(np.float32)
+        fit_im, fit_l, held_im, held_l = images[~test], lights[~test], images[test], lights[test]
+        for name in MODELS:
+            model = fit_model(name, fit_im, fit_l)
+            angle = median = valid = "—"
+            if name.startswith("ps"):
+                ok = inside & model.valid
+                stats = angular_error_deg(model.normals, normals, ok)
+                angle, median = f"{stats.mean:.2f}", f"{stats.median:.2f}"
+                valid = f"{ok.sum() / inside.sum():.3f}"
+            elif name == "ptm":
+                stats = angular_error_deg(model.normals(), normals, inside)
+                angle, median = f"{stats.mean:.2f}", f"{stats.median:.2f}"
+            lines.append(
+                f"| {shininess:g} | {name} | {angle} | {median} | {valid} | "
+                f"{relight_psnr(model, held_im, held_l):.2f} | "
+                f"{relight_ssim(model, held_im, held_l):.4f} |"
+            )
+        choice = select_model(fit_im, fit_l)
+        choices.append(f"- shininess {shininess:g}: `select_model` chose **{choice.model}**.")
+    return "\n".join([*lines, "", *choices])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", type=int, default=512, help="image side in pixels")
     parser.add_argument("--lights", type=int, default=48, help="number of lights N")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--accuracy-size", type=int, default=128, help="0 skips accuracy")
     parser.add_argument(
         "--tile-rows", type=int, default=None, help="rows per band (default: 256 MB budget)"
     )
@@ -115,6 +171,10 @@ def main() -> None:
     markdown = run(args.size, args.lights, args.repeats, args.tile_rows)
     path = write_section("fit_throughput", markdown)
     print(f"written to {path}")
+    if args.accuracy_size:
+        table = accuracy(args.accuracy_size, args.lights)
+        print(table)
+        write_section("reconstruction_accuracy", table)
 
 
 if __name__ == "__main__":

@@ -147,9 +147,8 @@ def _solve_weighted(
     condition number is within ``cond_limit``.
     """
     ll = (lights[:, :, None] * lights[:, None, :]).reshape(-1, 9)
-    wf = w.astype(np.float64)
-    m = wf @ ll  # (P, 9)
-    rhs = (wf * g) @ lights  # (P, 3)
+    m = w.astype(np.float64) @ ll  # (P, 9), float64: near-singular subsets must be detected
+    rhs = (np.where(w, g, np.float32(0.0)) @ lights.astype(np.float32)).astype(np.float64)
     inv, ratio = _sym3_inverse_and_cond(m)
     ok = (w.sum(axis=1) >= 3) & (ratio <= cond_limit**2)
     b = np.einsum("pij,pj->pi", inv.reshape(-1, 3, 3), rhs)
@@ -182,8 +181,8 @@ def _robust_band(
         if active.size == 0:
             break
         ga, wa = g[active], w[active]
-        resid = ga - b[active] @ lights.T  # (A, N)
-        absr = np.where(wa, np.abs(resid), np.inf)
+        resid = ga - (b[active] @ lights.T).astype(np.float32)  # (A, N)
+        absr = np.where(wa, np.abs(resid), np.float32(np.inf))
         absr.sort(axis=1)
         count = wa.sum(axis=1)
         mid = np.clip((count - 1) // 2, 0, n_obs - 1)
