@@ -207,3 +207,74 @@ def relight_ssim(
 ) -> float:
     """Mean over held-out lights of relighting SSIM; ``images`` were not used to fit."""
     return float(np.mean(relight_ssim_per_light(model, images, lights, data_range, mask)))
+
+
+@dataclass(frozen=True)
+class ReconstructionScores:
+    """Every metric that applies to one fitted model; None where it does not apply.
+
+    ``valid_fraction`` is the share of the compared pixels where the model gave a normal
+    (photometric stereo marks some invalid); angular and normal-map scores are over those.
+    """
+
+    model: str
+    n_coefficients: int
+    angular: AngularErrorStats | None
+    normal_psnr: float | None
+    normal_ssim: float | None
+    valid_fraction: float | None
+    relight_psnr: float | None
+    relight_ssim: float | None
+
+
+def model_normals(model: Any) -> tuple[NDArray[np.float32], NDArray[np.bool_] | None] | None:
+    """Normals a model provides and its validity mask: PS result, Lambert, PTM; else None."""
+    normals = getattr(model, "normals", None)
+    if normals is None:
+        return None
+    if callable(normals):
+        return normals(), None
+    return normals, getattr(model, "valid", None)
+
+
+def score_reconstruction(
+    model: Any,
+    *,
+    true_normals: ArrayLike | None = None,
+    mask: ArrayLike | None = None,
+    held_images: Any = None,
+    held_lights: ArrayLike | None = None,
+    data_range: float = 1.0,
+) -> ReconstructionScores:
+    """Score a fitted model against ground-truth normals and/or held-out images.
+
+    The entry point for speed/accuracy comparisons: one call per (plan, model). Normal metrics
+    are computed where ``true_normals`` is given and the model has normals (HSH has none);
+    relighting metrics where held-out images and their lights are given.
+    """
+    angular = n_psnr = n_ssim = valid_fraction = None
+    got = model_normals(model)
+    if true_normals is not None and got is not None:
+        est, valid = got
+        truth = np.asarray(true_normals, dtype=np.float64)
+        region = _mask(mask, truth.shape[:2])
+        usable = region if valid is None else region & valid
+        valid_fraction = float(usable.sum() / region.sum())
+        if usable.any():
+            angular = angular_error_deg(est, truth, usable)
+            n_psnr = normal_map_psnr(est, truth, usable)
+            n_ssim = normal_map_ssim(est, truth, usable)
+    r_psnr = r_ssim = None
+    if held_images is not None and held_lights is not None:
+        r_psnr = relight_psnr(model, held_images, held_lights, data_range, mask)
+        r_ssim = relight_ssim(model, held_images, held_lights, data_range, mask)
+    return ReconstructionScores(
+        model=str(model.name),
+        n_coefficients=int(model.n_coefficients),
+        angular=angular,
+        normal_psnr=n_psnr,
+        normal_ssim=n_ssim,
+        valid_fraction=valid_fraction,
+        relight_psnr=r_psnr,
+        relight_ssim=r_ssim,
+    )

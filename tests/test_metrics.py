@@ -130,3 +130,33 @@ def test_relighting_metrics_on_held_out_lights() -> None:
     assert 0.5 < relight_ssim(hsh, images[test], lights[test]) < relight_ssim(
         ps, images[test], lights[test]
     )
+
+
+def test_score_reconstruction_applies_each_metric_where_it_can() -> None:
+    from rti_rig.metrics import score_reconstruction
+    from rti_rig.reconstruct import fit_model
+
+    normals, inside = sphere_normals(40, 40)
+    lights = fibonacci_lights(40)
+    images = render(normals, 0.7, lights)
+    train, test = np.arange(40) % 4 != 0, np.arange(40) % 4 == 0
+    scores = {}
+    for name in ("ps-robust", "lambert", "ptm", "hsh2"):
+        model = fit_model(name, images[train], lights[train])
+        scores[name] = score_reconstruction(
+            model, true_normals=normals, mask=inside,
+            held_images=images[test], held_lights=lights[test],
+        )
+    ps = scores["ps-robust"]
+    assert ps.model == "lambert-ps-robust" and ps.n_coefficients == 3
+    assert ps.angular is not None and ps.angular.mean < 0.1
+    assert ps.valid_fraction is not None and ps.valid_fraction > 0.99
+    assert ps.normal_psnr is not None and ps.normal_psnr > 50
+    # the unshadowed least-squares Lambert fit is biased by attached shadows
+    assert scores["lambert"].angular.mean > 5 * ps.angular.mean
+    assert scores["hsh2"].angular is None and scores["hsh2"].normal_psnr is None
+    assert scores["hsh2"].relight_psnr > scores["lambert"].relight_psnr
+    assert ps.relight_psnr == pytest.approx(
+        relight_psnr(fit_photometric_stereo(images[train], lights[train], robust=True),
+                     images[test], lights[test], 1.0, inside)
+    )

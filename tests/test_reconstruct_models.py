@@ -171,3 +171,20 @@ def test_lights_on_one_ring_are_ill_conditioned_for_every_basis(model: str) -> N
     fitted = fit_model(model, images, ring)
     assert fitted.report.regularised
     np.testing.assert_allclose(fitted.relight(ring[3]), 1.0, rtol=1e-3)
+
+
+def test_lambert_model_normals_match_photometric_stereo_without_shadows() -> None:
+    from rti_rig.reconstruct import fit_photometric_stereo
+
+    rng = np.random.default_rng(3)
+    normals = rng.normal(size=(6, 5, 3)) * [0.2, 0.2, 0.0] + [0.0, 0.0, 1.0]
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    lights = direction_from_az_el(np.arange(9) * 40.0, np.full(9, 75.0))
+    images = np.einsum("hwk,nk->nhw", normals, lights).astype(np.float32) * 0.5
+    images[:, 0, 0] = 0.0
+    model = fit_lambert(images, lights)
+    got = model.normals()
+    np.testing.assert_allclose(got[1:], normals[1:], atol=1e-5)
+    np.testing.assert_array_equal(got[0, 0], [0.0, 0.0, 1.0])
+    ps = fit_photometric_stereo(images, lights)
+    np.testing.assert_allclose(got[ps.valid], ps.normals[ps.valid], atol=1e-5)

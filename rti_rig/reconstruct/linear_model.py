@@ -69,6 +69,19 @@ class LambertModel(LinearBasisModel):
 
     model_name: ClassVar[str] = "lambert"
 
+    def normals(self) -> NDArray[np.float32]:
+        """Unit normals (H, W, 3) with z >= 0 from ``b = albedo × normal`` (channels averaged);
+        all-dark pixels get the view axis (0, 0, 1)."""
+        b = self.coefficients.astype(np.float64)
+        if b.ndim == 4:
+            b = b.mean(axis=-1)
+        b = np.moveaxis(b, 0, -1)
+        b[..., 2] = np.maximum(b[..., 2], 0.0)
+        norm = np.linalg.norm(b, axis=-1, keepdims=True)
+        flat = np.broadcast_to(np.array([0.0, 0.0, 1.0]), b.shape)
+        out = np.where(norm > 0, b / np.where(norm > 0, norm, 1.0), flat)
+        return out.astype(np.float32)
+
 
 def fit_coefficients(
     images: Any,
