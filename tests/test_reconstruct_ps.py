@@ -186,3 +186,19 @@ def test_tiled_equals_untiled(robust: bool) -> None:
     np.testing.assert_array_equal(whole.used_lights, tiled.used_lights)
     np.testing.assert_allclose(whole.normals, tiled.normals, atol=1e-6)
     np.testing.assert_allclose(whole.albedo, tiled.albedo, atol=1e-6)
+
+
+def test_pixel_whose_lit_lights_are_coplanar_is_invalid() -> None:
+    """Globally fine lights, but for this normal only the four lights in the xz plane are lit."""
+    lights = direction_from_az_el([0.0, 0.0, 0.0, 180.0, 90.0], [30.0, 60.0, 90.0, 45.0, 10.0])
+    normals = np.empty((2, 2, 3))
+    normals[...] = direction_from_az_el(270.0, 60.0)  # shadows the az-90 light
+    normals[0, 0] = [0.0, 0.0, 1.0]  # sees all five
+    images = render(normals, 0.5, lights)
+    res = fit_photometric_stereo(images, lights, robust=True)
+    assert res.valid[0, 0]
+    assert res.valid.sum() == 1
+    assert res.used_lights[0, 0] == 5
+    ls = fit_photometric_stereo(images, lights)
+    assert ls.valid.all()  # least squares uses the shadowed zero and returns a biased normal
+    assert angular_error_deg(ls.normals, normals, ~np.eye(2, dtype=bool)).mean > 1.0
