@@ -83,8 +83,7 @@ def run(size: int, n_lights: int, repeats: int, tile_rows: int | None) -> str:
         )
     threads = os.environ.get("OPENBLAS_NUM_THREADS")
     cmd = (
-        f"python -m benchmarks.fit_throughput --size {size} --lights {n_lights} "
-        f"--repeats {repeats}"
+        f"python -m benchmarks.fit_throughput --size {size} --lights {n_lights} --repeats {repeats}"
     )
     if threads:
         cmd = f"OPENBLAS_NUM_THREADS={threads} {cmd}"
@@ -97,7 +96,7 @@ def run(size: int, n_lights: int, repeats: int, tile_rows: int | None) -> str:
         "",
         f"Shape: {size} × {size} grey pixels, {n_lights} lights (Fibonacci hemisphere), "
         f"synthetic sphere with highlights and noise; median of {repeats} runs after a warm-up. "
-        "\"matmul\" is a float32 `(p × N) @ (N × pixels)` product, the same shape as the fit, "
+        '"matmul" is a float32 `(p × N) @ (N × pixels)` product, the same shape as the fit, '
         "timed in the same run. Throughput is pixels × lights per second. Peak memory is the "
         f"tracemalloc peak of one fit from uint16 frames in bands of {PEAK_TILE_ROWS} rows "
         f"(outputs included); the float32 stack would be {stack_bytes / 1e6:.0f} MB. Timings "

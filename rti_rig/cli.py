@@ -311,5 +311,35 @@ def export_lp(
     out.print(f"{len(entries)} lights → {out_file}")
 
 
+bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy trade.")
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command("tradeoff")
+def bench_tradeoff(
+    out_dir: Annotated[
+        Path, typer.Option("--out", help="Folder for results.csv, the plots and summary.md.")
+    ] = Path("docs/tradeoff"),
+    quick: Annotated[
+        bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
+    ] = False,
+) -> None:
+    """Error against number of lights and session time, for every planner, on simulated scenes."""
+    import time
+
+    from rti_rig.bench_tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
+
+    settings = TradeoffSettings.quick() if quick else TradeoffSettings()
+    t0 = time.perf_counter()
+    rows = run_tradeoff(settings, progress=lambda msg: out.print(msg, highlight=False))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_csv(rows, out_dir / "results.csv")
+    plot(rows, out_dir)
+    command = "rti-rig bench tradeoff" + (" --quick" if quick else "") + f" --out {out_dir}"
+    text = summarise(rows, settings, time.perf_counter() - t0, command)
+    (out_dir / "summary.md").write_text(text, encoding="utf-8")
+    out.print(text, highlight=False)
+
+
 def main() -> None:
     app()

@@ -127,8 +127,10 @@ def test_relighting_metrics_on_held_out_lights() -> None:
     assert relight_psnr(ps, images[test], lights[test]) > relight_psnr(
         hsh, images[test], lights[test]
     )
-    assert 0.5 < relight_ssim(hsh, images[test], lights[test]) < relight_ssim(
-        ps, images[test], lights[test]
+    assert (
+        0.5
+        < relight_ssim(hsh, images[test], lights[test])
+        < relight_ssim(ps, images[test], lights[test])
     )
 
 
@@ -144,8 +146,11 @@ def test_score_reconstruction_applies_each_metric_where_it_can() -> None:
     for name in ("ps-robust", "lambert", "ptm", "hsh2"):
         model = fit_model(name, images[train], lights[train])
         scores[name] = score_reconstruction(
-            model, true_normals=normals, mask=inside,
-            held_images=images[test], held_lights=lights[test],
+            model,
+            true_normals=normals,
+            mask=inside,
+            held_images=images[test],
+            held_lights=lights[test],
         )
     ps = scores["ps-robust"]
     assert ps.model == "lambert-ps-robust" and ps.n_coefficients == 3
@@ -157,6 +162,11 @@ def test_score_reconstruction_applies_each_metric_where_it_can() -> None:
     assert scores["hsh2"].angular is None and scores["hsh2"].normal_psnr is None
     assert scores["hsh2"].relight_psnr > scores["lambert"].relight_psnr
     assert ps.relight_psnr == pytest.approx(
-        relight_psnr(fit_photometric_stereo(images[train], lights[train], robust=True),
-                     images[test], lights[test], 1.0, inside)
+        relight_psnr(
+            fit_photometric_stereo(images[train], lights[train], robust=True),
+            images[test],
+            lights[test],
+            1.0,
+            inside,
+        )
     )

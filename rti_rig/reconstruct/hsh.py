@@ -62,7 +62,12 @@ def fit_hsh(
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
     coef, report = fit_coefficients(
-        stack, hsh_basis(lt, order), f"hsh{order}", tile_rows=tile_rows,
-        ill_conditioned=ill_conditioned, cond_limit=cond_limit, out=out,
+        stack,
+        hsh_basis(lt, order),
+        f"hsh{order}",
+        tile_rows=tile_rows,
+        ill_conditioned=ill_conditioned,
+        cond_limit=cond_limit,
+        out=out,
     )
     return HSHModel(coef, report, order)

@@ -136,7 +136,11 @@ def fit_lambert(
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
     coef, report = fit_coefficients(
-        stack, LambertModel.design(lt), "lambert", tile_rows=tile_rows,
-        ill_conditioned=ill_conditioned, out=out,
+        stack,
+        LambertModel.design(lt),
+        "lambert",
+        tile_rows=tile_rows,
+        ill_conditioned=ill_conditioned,
+        out=out,
     )
     return LambertModel(coef, report)

@@ -1,4 +1,4 @@
-""""Model only what the scene requires": the lowest-order model that predicts unseen lights.
+""" "Model only what the scene requires": the lowest-order model that predicts unseen lights.
 
 Each candidate linear model is fitted on some lights and asked to predict the images of the
 others (k-fold over lights, or one explicit held-out set). The error is the RMS difference

@@ -65,7 +65,12 @@ def fit_ptm(
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
     coef, report = fit_coefficients(
-        stack, PTMModel.design(lt), "ptm", tile_rows=tile_rows,
-        ill_conditioned=ill_conditioned, cond_limit=cond_limit, out=out,
+        stack,
+        PTMModel.design(lt),
+        "ptm",
+        tile_rows=tile_rows,
+        ill_conditioned=ill_conditioned,
+        cond_limit=cond_limit,
+        out=out,
     )
     return PTMModel(coef, report)

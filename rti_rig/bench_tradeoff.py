@@ -1,0 +1,430 @@
+"""The speed/accuracy benchmark: how much each light (and each minute) buys, per planner.
+
+The paper's protocol on the simulator: for each scene, a dense homogeneous acquisition is the
+ground truth (true normals, plus noise-free images under held-out lights for relighting). A
+dense virtual dome offers the candidate lights. Each planner chooses N of them from one preview
+shot; the chosen images (rendered with shadows, specular and sensor noise) are fitted, and the
+result is scored against the ground truth:
+
+* normals: robust photometric stereo → mean angular error over *every* pixel (a pixel the fit
+  cannot solve counts with the default normal, so a plan that leaves pixels unsolved is not
+  flattered);
+* relighting: the model chosen from the acquired images alone ("model only what the scene
+  requires", by held-out error) → PSNR and SSIM on held-out ground-truth lights.
+
+Each plan is also timed as a session on the simulated dome (constant time per light) and on the
+simulated arm (move time depends on the order and the distances), so error can be read against
+session time. This module composes simulator, planner and reconstruction, so it sits beside the
+composition root and is only imported by the CLI.
+"""
+
+from __future__ import annotations
+
+import csv
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.clock import VirtualClock
+from rti_rig.geometry import fibonacci_cap
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+
+FULL_COUNTS = (3, 4, 5, 6, 8, 10, 12, 16, 20, 30, 50, 100)
+QUICK_COUNTS = (3, 6, 12, 30)
+FLOORS_DEG = (0.0, 10.0, 20.0, 30.0, 40.0)
+
+
+@dataclass(frozen=True)
+class TradeoffSettings:
+    """What the benchmark runs; ``quick()`` is a smaller version for CI-sized machines."""
+
+    scenes: tuple[str, ...] = ("painting", "coin", "tilted", "industrial", "tablet")
+    size_px: int = 96
+    counts: tuple[int, ...] = FULL_COUNTS
+    ground_truth_lights: int = 500
+    held_out_lights: int = 40
+    candidates: int = 240
+    preview_light_az_el_deg: tuple[float, float] = (45.0, 50.0)
+    floors_deg: tuple[float, ...] = FLOORS_DEG
+    seed: int = 0
+    methods: tuple[tuple[str, str], ...] = (
+        ("uniform", "normals"),
+        ("kmeans", "normals"),
+        ("optimal", "normals"),
+        ("optimal", "relight"),
+    )
+
+    @classmethod
+    def quick(cls) -> TradeoffSettings:
+        return cls(
+            scenes=("painting", "coin", "tilted", "industrial"),
+            size_px=48,
+            counts=QUICK_COUNTS,
+            ground_truth_lights=150,
+            held_out_lights=20,
+            candidates=120,
+        )
+
+
+@dataclass
+class Row:
+    """One (scene, plan, N) result."""
+
+    scene: str
+    method: str
+    objective: str
+    n: int
+    floor_deg: float
+    normal_mean_deg: float
+    normal_median_deg: float
+    normal_valid_fraction: float
+    relight_model: str
+    relight_psnr_db: float
+    relight_ssim: float
+    dome_time_s: float
+    arm_time_s: float
+    plan_s: float
+
+
+@dataclass
+class SceneData:
+    """Everything rendered once per scene and shared by every plan."""
+
+    name: str
+    normals: NDArray[np.float64]
+    candidate_dirs: NDArray[np.float64]
+    candidate_images: NDArray[np.float32]  # (M, H, W, 3) noisy, in units of the white level
+    held_dirs: NDArray[np.float64]
+    held_images: NDArray[np.float32]  # noise-free, same units
+    preview: NDArray[np.float32]
+    passes: tuple[str, ...] = field(default_factory=tuple)
+
+
+def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
+    """Render the candidate lights (with noise) and the held-out reference (noise-free)."""
+    from simulator.camera_model import CameraModel
+    from simulator.ground_truth import homogeneous_directions
+    from simulator.light_transport import DirectionalLight, render_radiance
+    from simulator.scenes import make_scene
+
+    scene = make_scene(name, s.size_px, s.size_px, seed=s.seed)
+    camera = CameraModel()
+    # Exposure: a white Lambertian patch facing the light at 80 % of white (as a user meters).
+    exposure = camera.exposure_for(1.0, 0.8)
+    white = float(camera.white_level)
+    rng = np.random.default_rng(s.seed)
+
+    def shoot(direction: NDArray[np.float64], noisy: bool) -> NDArray[np.float32]:
+        radiance = render_radiance(scene, DirectionalLight(tuple(direction)))
+        if not noisy:
+            scale = camera.expected_electrons(radiance, exposure) * camera.dn_per_electron
+            return np.clip(scale / white, 0.0, 1.0).astype(np.float32)
+        pixels, wl = camera.expose(radiance, exposure, rng)
+        return (pixels.astype(np.float32) / wl).astype(np.float32)
+
+    cand = fibonacci_cap(s.candidates, 3.0, 87.0)
+    # Held-out reference lights: a dense homogeneous set, offset from the candidates.
+    gt = homogeneous_directions(s.ground_truth_lights)
+    pick = np.random.default_rng(s.seed + 1).choice(len(gt), s.held_out_lights, replace=False)
+    held = gt[np.sort(pick)]
+    az, el = np.radians(s.preview_light_az_el_deg)
+    preview_dir = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    return SceneData(
+        name=name,
+        normals=np.asarray(scene.normals, dtype=np.float64),
+        candidate_dirs=cand,
+        candidate_images=np.stack([shoot(d, True) for d in cand]),
+        held_dirs=held,
+        held_images=np.stack([shoot(d, False) for d in held]),
+        preview=shoot(preview_dir, True),
+        passes=tuple(sorted(scene.passes)),
+    )
+
+
+def score_plan(
+    data: SceneData, chosen: NDArray[np.intp]
+) -> tuple[float, float, float, str, float, float]:
+    """Normal error (robust PS, every pixel) and relighting quality of one plan."""
+    from rti_rig.metrics import angular_error_deg, relight_psnr, relight_ssim
+    from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo, select_model
+
+    images = data.candidate_images[chosen]
+    lights = data.candidate_dirs[chosen]
+    h, w = data.normals.shape[:2]
+    everywhere = np.ones((h, w), dtype=bool)
+    try:
+        ps = fit_photometric_stereo(images, lights, robust=True)
+        normals = np.where(ps.valid[..., None], ps.normals, np.array([0.0, 0.0, 1.0]))
+        err = angular_error_deg(normals, data.normals, everywhere)
+        mean, median, valid = err.mean, err.median, float(ps.valid.mean())
+    except ReconstructionError:
+        flat = np.broadcast_to(np.array([0.0, 0.0, 1.0]), data.normals.shape)
+        err = angular_error_deg(flat, data.normals, everywhere)
+        mean, median, valid = err.mean, err.median, 0.0
+    try:
+        choice = select_model(images, lights, holdout=min(5, max(1, len(chosen) // 4)))
+        model = choice.fit(images, lights)
+        psnr = relight_psnr(model, data.held_images, data.held_dirs, 1.0)
+        ssim = relight_ssim(model, data.held_images, data.held_dirs, 1.0)
+        name = choice.model
+    except ReconstructionError:
+        name, psnr, ssim = "none", float("nan"), float("nan")
+    return float(mean), float(median), valid, name, float(psnr), float(ssim)
+
+
+def session_times(
+    directions: NDArray[np.float64],
+    per_light_s: float,
+    arm: ArmGeometry,
+    speed: float,
+    accel: float,
+) -> tuple[float, float]:
+    """Session time of a plan on the simulated dome and on the simulated arm (seconds).
+
+    The dome takes the same time for every light. The arm visits the lights in the order it
+    would execute them (greedy nearest neighbour from the park pose; move-time-optimal ordering
+    is the arm planner's job) and pays each move under its trapezoidal velocity profile.
+    Lights the arm cannot reach (inside its keep-out cone) are clamped to its band for timing.
+    """
+    from planner.uniform import order_nearest_neighbour
+    from simulator.sim_lights import LightState, SimulatedArm
+
+    dome_s = len(directions) * per_light_s
+    clock = VirtualClock()
+    carrier = SimulatedArm(arm, LightState(), clock, speed, accel, 360.0 / 4096, 0.02)
+    carrier.connect()
+    reachable = np.array([_clamp_to_band(d, arm) for d in directions])
+    for i in order_nearest_neighbour(reachable, arm.park_direction):
+        carrier.move_to(reachable[i])
+        clock.sleep(per_light_s)
+    carrier.park()
+    return dome_s, clock.now()
+
+
+def _clamp_to_band(d: NDArray[np.float64], arm: ArmGeometry) -> NDArray[np.float64]:
+    from rti_rig.geometry import az_el_from_direction, direction_from_az_el
+
+    az, el = az_el_from_direction(d)
+    top = min(arm.max_elevation_deg, 90.0 - arm.keep_out_half_angle_deg - 1e-6)
+    el = float(np.clip(el, arm.min_elevation_deg, top))
+    return direction_from_az_el(float(az), el)
+
+
+def run_tradeoff(s: TradeoffSettings, progress: Callable[[str], None] = print) -> list[Row]:
+    """Run the whole benchmark; returns one row per (scene, method, objective, floor, N)."""
+    rows: list[Row] = []
+    for scene in s.scenes:
+        t0 = time.perf_counter()
+        data = render_scene_data(scene, s)
+        progress(f"{scene}: rendered in {time.perf_counter() - t0:.1f} s")
+        rows += run_scene(data, s, progress)
+    return rows
+
+
+#: The simulated rigs every plan is timed on.
+BENCH_ARM = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
+PER_LIGHT_S = 0.02 + 0.1 + 0.05 + 0.3 + 0.7  # LED switch, settle, exposure, readout, transfer
+
+
+def run_scene(
+    data: SceneData, s: TradeoffSettings, progress: Callable[[str], None] = print
+) -> list[Row]:
+    """Every plan for one rendered scene."""
+    from planner.make_plan import make_plan
+
+    from planner.uniform import select_uniform_leds
+
+    dome = DomeGeometry(data.candidate_dirs, tuple(f"c{i:03d}" for i in range(s.candidates)))
+    rows: list[Row] = []
+
+    def add(
+        method: str, objective: str, n: int, floor: float, chosen: Iterable[int], plan_s: float
+    ) -> None:
+        idx = np.asarray(list(chosen), dtype=np.intp)
+        scores = score_plan(data, idx)
+        dome_s, arm_s = session_times(data.candidate_dirs[idx], PER_LIGHT_S, BENCH_ARM, 60.0, 120.0)
+        rows.append(Row(data.name, method, objective, n, floor, *scores, dome_s, arm_s, plan_s))
+
+    for n in s.counts:
+        if n > s.candidates:
+            continue
+        for floor in s.floors_deg:
+            t = time.perf_counter()
+            chosen = select_uniform_leds(dome, n, floor)
+            add("uniform", "-", n, floor, chosen, time.perf_counter() - t)
+        for method, objective in s.methods:
+            if method == "uniform":
+                continue
+            t = time.perf_counter()
+            sched = make_plan(
+                data.preview, dome, n, method, objective, preview_light=s.preview_light_az_el_deg
+            )
+            leds = [int(step.led) for step in sched.steps if step.led is not None]
+            add(method, objective, n, 0.0, leds, time.perf_counter() - t)
+        progress(f"{data.name}: N={n} done")
+    return rows
+
+
+def best_floor(rows: Iterable[Row], scene: str) -> float:
+    """The uniform elevation floor with the lowest mean normal error over N (hindsight)."""
+    by_floor: dict[float, list[float]] = {}
+    for r in rows:
+        if r.scene == scene and r.method == "uniform":
+            by_floor.setdefault(r.floor_deg, []).append(r.normal_mean_deg)
+    return min(by_floor, key=lambda f: float(np.mean(by_floor[f])))
+
+
+def write_csv(rows: list[Row], path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(asdict(rows[0])))
+        writer.writeheader()
+        for r in rows:
+            writer.writerow(asdict(r))
+    return path
+
+
+def _series(rows: list[Row], scene: str) -> dict[str, list[Row]]:
+    """Rows per plotted series: naive uniform, uniform at the scene's best floor, planners."""
+    floor = best_floor(rows, scene)
+    out: dict[str, list[Row]] = {}
+    for r in rows:
+        if r.scene != scene:
+            continue
+        if r.method == "uniform":
+            if r.floor_deg == 0.0:
+                out.setdefault("uniform", []).append(r)
+            if r.floor_deg == floor:
+                out.setdefault(f"uniform, floor {floor:g}°", []).append(r)
+        else:
+            out.setdefault(f"{r.method} ({r.objective})", []).append(r)
+    return out
+
+
+def plot(rows: list[Row], out_dir: Path) -> list[Path]:
+    """Error against N and against session time, one figure per metric."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scenes = sorted({r.scene for r in rows}, key=[r.scene for r in rows].index)
+    paths = []
+    for metric, label in (
+        ("normal_mean_deg", "mean normal error (°)"),
+        ("relight_psnr_db", "relighting PSNR (dB)"),
+    ):
+        for x_key, x_label, name in (
+            ("n", "number of lights", "n"),
+            ("dome_time_s", "session time on the dome (s)", "dome_time"),
+            ("arm_time_s", "session time on the arm (s)", "arm_time"),
+        ):
+            fig, axes = plt.subplots(
+                1, len(scenes), figsize=(4.2 * len(scenes), 3.6), squeeze=False
+            )
+            for ax, scene in zip(axes[0], scenes, strict=True):
+                for series, rs in _series(rows, scene).items():
+                    rs = sorted(rs, key=lambda r: r.n)
+                    ax.plot(
+                        [getattr(r, x_key) for r in rs],
+                        [getattr(r, metric) for r in rs],
+                        marker="o",
+                        ms=3,
+                        label=series,
+                    )
+                ax.set_xscale("log")
+                ax.set_title(scene)
+                ax.set_xlabel(x_label)
+                ax.grid(alpha=0.3)
+            axes[0][0].set_ylabel(label)
+            axes[0][-1].legend(fontsize=7)
+            fig.tight_layout()
+            path = out_dir / f"{metric.split('_')[0]}_vs_{name}.png"
+            fig.savefig(path, dpi=90)
+            plt.close(fig)
+            paths.append(path)
+    return paths
+
+
+def summarise(rows: list[Row], s: TradeoffSettings, seconds: float, command: str) -> str:
+    """The markdown summary: tables per scene and plain statements of who wins where."""
+    lines = [
+        "# Speed/accuracy trade-off",
+        "",
+        f"Measured with `{command}` in {seconds:.0f} s. Scenes {', '.join(s.scenes)} at "
+        f"{s.size_px}×{s.size_px} px; candidates: {s.candidates} homogeneous dome positions "
+        f"(3°–87°); relighting reference: {s.held_out_lights} held-out lights of a "
+        f"{s.ground_truth_lights}-light homogeneous acquisition; preview lit from az/el "
+        f"{s.preview_light_az_el_deg[0]:g}°/{s.preview_light_az_el_deg[1]:g}°. Normal error is "
+        "the mean over all pixels of robust photometric stereo (unsolved pixels count); "
+        "relighting uses the model chosen from the acquired images by held-out error.",
+        "",
+    ]
+    verdicts: list[str] = []
+    for scene in dict.fromkeys(r.scene for r in rows):
+        series = _series(rows, scene)
+        lines += [f"## {scene}", "", "Mean normal error (°) / relighting PSNR (dB):", ""]
+        names = list(series)
+        lines.append("| N | " + " | ".join(names) + " |")
+        lines.append("|---" * (len(names) + 1) + "|")
+        counts = sorted({r.n for r in rows if r.scene == scene})
+        for n in counts:
+            cells = []
+            for name in names:
+                r = next((r for r in series[name] if r.n == n), None)
+                cells.append(
+                    "–" if r is None else f"{r.normal_mean_deg:.2f} / {r.relight_psnr_db:.1f}"
+                )
+            lines.append(f"| {n} | " + " | ".join(cells) + " |")
+        lines.append("")
+        verdicts += _verdicts(scene, series, counts)
+    lines += ["## What the numbers say", "", *verdicts, ""]
+    return "\n".join(lines)
+
+
+def _verdicts(scene: str, series: dict[str, list[Row]], counts: list[int]) -> list[str]:
+    def at(name: str, n: int) -> Row | None:
+        return next((r for r in series.get(name, []) if r.n == n), None)
+
+    floor_name = next((k for k in series if k.startswith("uniform, floor")), "uniform")
+    out = []
+    km = [
+        n
+        for n in counts
+        if (a := at("kmeans (normals)", n))
+        and (b := at("uniform", n))
+        and a.normal_mean_deg < b.normal_mean_deg
+    ]
+    out.append(
+        f"- **{scene}**: k-means (the paper's method) beats naive uniform on normals at "
+        f"N = {', '.join(map(str, km)) or 'no N'}"
+        f"{' and loses elsewhere' if len(km) < len(counts) else ''}."
+    )
+    for objective, key, better in (
+        ("normals", "normal_mean_deg", lambda a, b: a < b),
+        ("relight", "relight_psnr_db", lambda a, b: a > b),
+    ):
+        name = f"optimal ({objective})"
+        worse = []
+        gains = []
+        for n in counts:
+            a, b = at(name, n), at(floor_name, n)
+            if a is None or b is None:
+                continue
+            va, vb = getattr(a, key), getattr(b, key)
+            if not better(va, vb) and not np.isclose(va, vb, rtol=1e-3):
+                worse.append(n)
+            if n <= 10:
+                gains.append(vb - va if key == "normal_mean_deg" else va - vb)
+        unit = "°" if key == "normal_mean_deg" else " dB"
+        out.append(
+            f"  - optimal/{objective} vs {floor_name} on {key}: "
+            + (f"worse at N = {', '.join(map(str, worse))}" if worse else "never worse")
+            + (f"; mean gain at N ≤ 10: {np.mean(gains):+.2f}{unit}" if gains else "")
+            + "."
+        )
+    return out
