@@ -132,6 +132,7 @@ class DomeFirmware:
     faults: FaultPlan = field(default_factory=FaultPlan)
     clock: Clock = field(default_factory=SystemClock)
     boot_delay_s: float = 0.0
+    banner_on_boot: bool = True
 
     def __post_init__(self) -> None:
         self.dead_leds = frozenset(self.dead_leds)
@@ -155,7 +156,10 @@ class DomeFirmware:
         """(index, level) of the LED really emitting light now, or None."""
         with self._lock:
             self._expire_watchdog()
-            return None if self._lit is None else (self._lit.index, self._lit.level)
+            lit = self._lit
+            if lit is None or lit.index in self.dead_leds:
+                return None  # a dead LED the firmware believes lit gives no light
+            return (lit.index, lit.level)
 
     def lit_indices(self) -> list[int]:
         """LEDs really emitting light (0 or 1 of them: the firmware lights one at a time)."""
@@ -172,6 +176,8 @@ class DomeFirmware:
             self._rx.clear()
             self.powered = True
             self.history.append(FirmwareEvent(now, "boot"))
+            if not self.banner_on_boot:
+                return []
             return [Output(now + self.boot_delay_s, self.codec.encode_banner(self.identity))]
 
     def on_port_opened(self) -> list[Output]:
@@ -262,7 +268,6 @@ class DomeFirmware:
                 self.history.append(FirmwareEvent(now, "dead", cmd.index, cmd.level))
                 if self.reports_dead_leds:
                     return Nak(seq, ERR_LED_FAULT, f"LED {cmd.index} open circuit")
-                return Ack(seq, cmd)
             until = None if not cmd.max_on_ms else now + cmd.max_on_ms / 1000.0
             self._lit = _LitLed(cmd.index, cmd.level, now, until)
             self.history.append(FirmwareEvent(now, "lit", cmd.index, cmd.level))

@@ -153,7 +153,14 @@ class _Server:
             os.write(self.master, data)
 
     def _unplug(self, down_s: float) -> None:
-        """Close the pty (the host sees EIO), then offer a new one after ``down_s``."""
+        """Close the pty (the host sees EIO), then offer a new one after ``down_s``.
+
+        With ``down_s <= 0`` the new pty is behind the symlink before the old one closes, so a
+        host that reconnects as soon as it notices the drop finds the device back at once.
+        """
+        if down_s <= 0:
+            self.new_pty()
+            return
         with contextlib.suppress(FileNotFoundError):
             self.link_path.unlink()
         os.close(self.master)

@@ -2,8 +2,8 @@
 
 Specified in ``docs/protocols/led-dome.md``. One command per line, one reply per command::
 
-    host:  7 L 12 200 5000*1C\\n        light LED 12 at level 200, firmware watchdog 5000 ms
-    dome:  OK 7 L 12 200 5000*0E\\n     done, echoing what it executed
+    host:  7 L 12 200 5000*4F\\n        light LED 12 at level 200, firmware watchdog 5000 ms
+    dome:  OK 7 L 12 200 5000*6B\\n     done, echoing what it executed
 
 Why each part: the sequence number lets the host recognise a late reply to an earlier command
 instead of taking it for the current one; the echo lets it check the firmware lit the LED it
@@ -77,10 +77,9 @@ class DefaultCodec:
             if star < 0 or len(line) - star != 3:
                 return None, consumed, "missing checksum"
             body, digits = line[:star], line[star + 1 :]
-            try:
-                expected = int(digits.decode("ascii"), 16)
-            except (UnicodeDecodeError, ValueError):
-                return None, consumed, "unreadable checksum"
+            if any(d not in b"0123456789ABCDEF" for d in digits):
+                return None, consumed, "unreadable checksum (two upper-case hex digits)"
+            expected = int(digits.decode("ascii"), 16)
             if xor_checksum(body) != expected:
                 return None, consumed, "checksum mismatch"
             line = body

@@ -159,8 +159,13 @@ ERROR_CODES: dict[int, str] = {
     ERR_BAD_CHECKSUM: "bad checksum: the command arrived garbled",
 }
 
-#: Error codes that say the command never ran because its bytes were damaged: resending helps.
-TRANSIENT_ERROR_CODES = frozenset({ERR_BAD_CHECKSUM, ERR_UNKNOWN_COMMAND})
+#: Error codes that mean the command did not arrive as sent, so resending it may help. The host
+#: validates verbs, LED indices and levels before sending, so when the firmware still finds one
+#: unknown or out of range, the bytes were damaged on the way (profiles without a checksum only
+#: notice it this way). A dead LED or a thermal cut-out is definitive.
+TRANSIENT_ERROR_CODES = frozenset(
+    {ERR_BAD_CHECKSUM, ERR_UNKNOWN_COMMAND, ERR_BAD_ARGUMENT, ERR_LED_OUT_OF_RANGE}
+)
 
 
 def error_text(code: int) -> str:
