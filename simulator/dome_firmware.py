@@ -144,6 +144,7 @@ class DomeFirmware:
         self.powered = False
         self.unplugged_until: float | None = None
         self._disconnect_pending: float | None = None
+        self._booting_until = 0.0
 
     @property
     def identity(self) -> DomeIdentity:
@@ -175,6 +176,7 @@ class DomeFirmware:
             self._switch_off(now, "boot")
             self._rx.clear()
             self.powered = True
+            self._booting_until = now + self.boot_delay_s
             self.history.append(FirmwareEvent(now, "boot"))
             if not self.banner_on_boot:
                 return []
@@ -195,6 +197,10 @@ class DomeFirmware:
         out: list[Output] = []
         with self._lock:
             if not self.powered:
+                return out
+            if self.clock.now() < self._booting_until:
+                # the bootloader runs: bytes sent before the banner are lost, as on an Arduino
+                self.history.append(FirmwareEvent(self.clock.now(), "lost while booting"))
                 return out
             self._rx.extend(data)
             while self._rx and self.powered:

@@ -17,6 +17,17 @@ import serial
 
 from rti_rig.clock import Clock, SystemClock
 
+try:  # pyserial lets termios.error (not an OSError) escape from tcdrain/tcsetattr on POSIX
+    import termios
+
+    _PORT_ERRORS: tuple[type[BaseException], ...] = (
+        serial.SerialException,
+        OSError,
+        termios.error,
+    )
+except ImportError:  # pragma: no cover - Windows
+    _PORT_ERRORS = (serial.SerialException, OSError)
+
 
 class TransportError(Exception):
     """The port is gone (unplugged, closed under us) or cannot be opened."""
@@ -69,7 +80,7 @@ class SerialTransport:
                 timeout=0,
                 write_timeout=self.write_timeout_s,
             )
-        except (serial.SerialException, OSError, ValueError) as exc:
+        except (*_PORT_ERRORS, ValueError) as exc:
             raise TransportError(f"cannot open serial port {self.port}: {exc}") from exc
         self._timeout = 0
 
@@ -78,7 +89,7 @@ class SerialTransport:
         if ser is not None:
             try:
                 ser.close()
-            except (serial.SerialException, OSError):
+            except _PORT_ERRORS:
                 pass  # already gone: closing is best effort by design
 
     def write(self, data: bytes) -> None:
@@ -86,7 +97,7 @@ class SerialTransport:
         try:
             ser.write(data)
             ser.flush()
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise TransportError(f"write to {self.port} failed: {exc}") from exc
 
     def read(self, timeout_s: float) -> bytes:
@@ -101,7 +112,7 @@ class SerialTransport:
                 return b""
             waiting = ser.in_waiting
             return first + (ser.read(waiting) if waiting else b"")
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise TransportError(f"read from {self.port} failed: {exc}") from exc
 
     def _require(self) -> serial.SerialBase:
