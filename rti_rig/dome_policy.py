@@ -228,7 +228,7 @@ class _Lit:
 
 
 class DomePolicy:
-    """An LED dome as a :class:`DiscreteLightSource`, with retries, reconnection and a thermal guard.
+    """An LED dome as a :class:`DiscreteLightSource`: retries, reconnection, thermal guard.
 
     ``link`` is the driver (connected by :meth:`connect`, never in ``__init__``); ``clock``
     measures on-times and paces back-offs and cool-downs; ``directions`` (N, 3) are the dome's
@@ -273,8 +273,9 @@ class DomePolicy:
             raise DeviceError(self.name, problem, "handshake")
         self.info = info
         self._lit = None
-        log.info("%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version,
-                 info.led_count)
+        log.info(
+            "%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version, info.led_count
+        )
         self._run(self.link.all_off, "all off")  # start from the safe state
 
     def close(self) -> None:
@@ -335,7 +336,7 @@ class DomePolicy:
                     )
 
         try:
-            self._run(fire, command, led=index)
+            self._run(fire, command)
         except DomeLinkError as exc:
             self._fail_safe()
             if exc.fault is LinkFault.REJECTED:
@@ -376,7 +377,8 @@ class DomePolicy:
         """PWM level for ``intensity`` on LED ``index`` after its intensity correction."""
         if not (math.isfinite(intensity) and 0.0 < intensity <= 1.0):
             raise DeviceError(
-                self.name, f"intensity {intensity} for LED {index} is outside (0, 1]",
+                self.name,
+                f"intensity {intensity} for LED {index} is outside (0, 1]",
                 f"light LED {index}",
             )
         corr = self.settings.intensity_correction
@@ -384,7 +386,8 @@ class DomePolicy:
         level = round(intensity * factor * self.link.max_level)
         if level > self.link.max_level:
             raise DomeLedError(
-                self.name, index,
+                self.name,
+                index,
                 f"LED {index} cannot give intensity {intensity}: with its correction "
                 f"{factor:g} it would need level {level} > {self.link.max_level}; lower the "
                 "intensity or renormalise the correction list so its largest factor is 1",
@@ -400,7 +403,6 @@ class DomePolicy:
         command: str,
         *,
         idempotent: bool = True,
-        led: int | None = None,
     ) -> T:
         """Run one exchange with bounded retries, reconnection and the lost-light check."""
         attempt = 0
@@ -410,11 +412,18 @@ class DomePolicy:
                 return op()
             except DomeLinkError as exc:
                 fault = exc.fault
-                log.warning("%s: %s failed (%s, attempt %d): %s", self.name, command, fault,
-                            attempt + 1, exc.message)
+                log.warning(
+                    "%s: %s failed (%s, attempt %d): %s",
+                    self.name,
+                    command,
+                    fault,
+                    attempt + 1,
+                    exc.message,
+                )
                 if fault in (LinkFault.RESET, LinkFault.DISCONNECTED) and self._lit is not None:
                     lost = self._lit
                     self._lit = None
+                    self.guard.record(lost.index, lost.since, self.clock.now())
                     self._recover(exc, command)
                     what = "rebooted" if fault is LinkFault.RESET else "dropped off the USB bus"
                     raise DomeLedError(
@@ -452,8 +461,9 @@ class DomePolicy:
             except DomeLinkError as again:
                 if again.fault is LinkFault.DISCONNECTED:
                     self._reconnect(command)
-                    return
-                raise
+                else:  # the resend that follows is bounded by the retry count anyway
+                    log.warning("%s: handshake after a reset failed: %s", self.name, again)
+                return
             problem = self._check_identity(info)
             if problem:
                 raise DeviceError(self.name, f"after a board reset: {problem}", command)
@@ -495,12 +505,16 @@ class DomePolicy:
         if self.info is not None and n != self.info.led_count:
             return f"the firmware now reports {n} LEDs, not {self.info.led_count}"
         if s.expected_led_count is not None and n != s.expected_led_count:
-            return f"the firmware reports {n} LEDs but the rig config expects {s.expected_led_count}"
+            return (
+                f"the firmware reports {n} LEDs but the rig config expects {s.expected_led_count}"
+            )
         if self.directions is not None and len(self.directions) != n:
             return f"the firmware reports {n} LEDs but the dome's .lp has {len(self.directions)}"
         if s.intensity_correction is not None and len(s.intensity_correction) != n:
-            return (f"intensity_correction has {len(s.intensity_correction)} factors but the "
-                    f"firmware reports {n} LEDs")
+            return (
+                f"intensity_correction has {len(s.intensity_correction)} factors but the "
+                f"firmware reports {n} LEDs"
+            )
         return None
 
     def _check_on_time(self, command: str) -> None:
@@ -514,10 +528,14 @@ class DomePolicy:
             self.guard.record(lit.index, lit.since, self.clock.now())
             self._lit = None
             self._fail_safe()
-            cut = (" the firmware watchdog switched it off, so the image taken under it may be "
-                   "dark;" if self.link.has_watchdog else "")
+            cut = (
+                " the firmware watchdog switched it off, so the image taken under it may be dark;"
+                if self.link.has_watchdog
+                else ""
+            )
             raise DomeLedError(
-                self.name, lit.index,
+                self.name,
+                lit.index,
                 f"LED {lit.index} stayed on {on_s:.3f} s, beyond max_on_s = {limit:g} s;{cut} "
                 "raise max_on_s or shorten settle and exposure",
                 command,
@@ -541,7 +559,8 @@ class DomePolicy:
             raise DeviceError(self.name, f"LED index {index!r} is not an integer")
         if not 0 <= index < count:
             raise DeviceError(
-                self.name, f"LED {index} does not exist: this dome has LEDs 0..{count - 1}",
+                self.name,
+                f"LED {index} does not exist: this dome has LEDs 0..{count - 1}",
                 f"light LED {index}",
             )
 
@@ -583,17 +602,24 @@ class SelfTestReport:
         return self.aborted is None and not self.failed and len(self.checks) == self.led_count
 
     def lines(self) -> list[str]:
-        fw = (f"{self.firmware.firmware_id} {self.firmware.version}" if self.firmware
-              else "unknown firmware")
+        fw = (
+            f"{self.firmware.firmware_id} {self.firmware.version}"
+            if self.firmware
+            else "unknown firmware"
+        )
         out = [f"{self.name}: {fw}, {self.led_count} LEDs"]
         passed = sum(c.ok for c in self.checks)
-        out.append(f"LEDs stepped: {len(self.checks)}, passed: {passed}, "
-                   f"failed: {len(self.failed)} in {self.elapsed_s:.2f} s")
+        out.append(
+            f"LEDs stepped: {len(self.checks)}, passed: {passed}, "
+            f"failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
+        )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
         if self.stats is not None:
             s = self.stats
-            out.append(f"recovery: {s.retries} retries, {s.reconnects} reconnects, "
-                       f"{s.rehandshakes} re-handshakes")
+            out.append(
+                f"recovery: {s.retries} retries, {s.reconnects} reconnects, "
+                f"{s.rehandshakes} re-handshakes"
+            )
         if self.aborted:
             out.append(f"ABORTED: {self.aborted}")
         out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))

@@ -31,7 +31,6 @@ from drivers.led_dome.messages import (
     Ack,
     AllOff,
     BadRequest,
-    Banner,
     Command,
     DomeIdentity,
     Hello,
@@ -217,8 +216,10 @@ class DomeFirmware:
                 kinds = {f.kind for f in faults}
                 if FaultKind.GARBLE_COMMAND in kinds:
                     reparsed, _ = self.codec.decode_command(garble(raw))
-                    parsed = reparsed if reparsed is not None else BadRequest(
-                        raw, None, ERR_BAD_ARGUMENT, "garbled beyond framing"
+                    parsed = (
+                        reparsed
+                        if reparsed is not None
+                        else BadRequest(raw, None, ERR_BAD_ARGUMENT, "garbled beyond framing")
                     )
                 out += self._handle(parsed, faults)
             return out

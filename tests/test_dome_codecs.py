@@ -242,7 +242,7 @@ def test_binary_firmware_side_skips_noise_and_checks_the_packet():
     pkt[4] ^= 0x41
     parsed, used = codec.decode_command(bytes(pkt))
     assert isinstance(parsed, BadRequest) and parsed.code == 6 and used == 7
-    with pytest.raises(ValueError, match="1..127"):
+    with pytest.raises(ValueError, match=r"1\.\.127"):
         codec.encode_command(128, AllOff())
 
 

@@ -6,6 +6,8 @@ Every check compares with the emulator's truth (``firmware.lit``: the LED really
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -41,7 +43,13 @@ OFF_AFTER_1 = 6
 
 
 def make(
-    profile="default", faults=(), *, dead=(), reports_dead=True, leds=N_LEDS, banner=True,
+    profile="default",
+    faults=(),
+    *,
+    dead=(),
+    reports_dead=True,
+    leds=N_LEDS,
+    banner=True,
     **settings,
 ):
     clock = VirtualClock()
@@ -150,7 +158,7 @@ def test_reset_or_drop_while_lit_stops_naming_the_led(profile, kind, at):
 @pytest.mark.parametrize("profile", PROFILES)
 def test_persistent_silence_gives_up_naming_led_and_command_and_goes_dark(profile):
     faults = [Fault(n, FaultKind.DROP_REPLY) for n in (LIGHT_1, LIGHT_1 + 1, LIGHT_1 + 2)]
-    dome, fw, clock = make(profile, faults, retries=2)
+    dome, fw, _clock = make(profile, faults, retries=2)
     dome.connect()
     dome.light(0, 1.0)
     dome.all_off()
@@ -177,7 +185,7 @@ def test_dead_led_reported_by_the_firmware_stops_naming_it(profile):
 def test_silent_dead_led_is_dark_in_the_truth_so_the_camera_sees_it():
     """A firmware without current sensing cannot report it: the emulator's truth shows the dark
     LED so the simulated camera renders a black frame for the controller to catch."""
-    dome, fw, clock = make("default", dead=[2], reports_dead=False)
+    dome, fw, _clock = make("default", dead=[2], reports_dead=False)
     dome.connect()
     dome.light(2, 1.0)
     assert fw.lit is None
@@ -185,7 +193,7 @@ def test_silent_dead_led_is_dark_in_the_truth_so_the_camera_sees_it():
 
 
 def test_disconnect_that_does_not_come_back_gives_up():
-    dome, fw, clock = make(
+    dome, fw, _clock = make(
         "default", [Fault(LIGHT_1, FaultKind.DISCONNECT, delay_s=1000.0)], reconnect_attempts=3
     )
     dome.connect()
@@ -198,7 +206,7 @@ def test_disconnect_that_does_not_come_back_gives_up():
 
 
 def test_shutter_is_never_resent():
-    dome, fw, clock = make("default", [Fault(3, FaultKind.DROP_REPLY)])
+    dome, fw, _clock = make("default", [Fault(3, FaultKind.DROP_REPLY)])
     dome.connect()
     with pytest.raises(DomeLinkError, match="not resent"):
         dome.shutter(40)
@@ -206,7 +214,7 @@ def test_shutter_is_never_resent():
 
 
 def test_shutter_pulse_is_sent_once():
-    dome, fw, clock = make("framed")
+    dome, fw, _clock = make("framed")
     dome.connect()
     dome.shutter()
     assert [(e.what, e.level) for e in fw.history if e.what == "shutter"] == [("shutter", 50)]
@@ -214,7 +222,7 @@ def test_shutter_pulse_is_sent_once():
 
 def test_late_reply_is_dropped_not_taken_for_the_next_command():
     """A reply delayed past the timeout must not acknowledge the resent command by accident."""
-    dome, fw, clock = make("default", [Fault(LIGHT_1, FaultKind.DELAY_REPLY, delay_s=0.7)])
+    dome, fw, _clock = make("default", [Fault(LIGHT_1, FaultKind.DELAY_REPLY, delay_s=0.7)])
     dome.connect()
     dome.light(0, 1.0)
     dome.all_off()
@@ -296,7 +304,9 @@ def test_policy_waits_for_an_led_to_cool_and_the_duty_holds_in_the_truth():
         dome.all_off()
     assert dome.stats.thermal_wait_s > 0
     events = [(e.time_s, e.what) for e in fw.history if e.what in ("lit", "off")]
-    spans = [(t0, t1) for (t0, a), (t1, b) in zip(events, events[1:]) if a == "lit" and b == "off"]
+    spans = [
+        (t0, t1) for (t0, a), (t1, b) in itertools.pairwise(events) if a == "lit" and b == "off"
+    ]
     assert len(spans) == 6
     for _, end in spans:  # duty over every window ending at an LED switch-off
         on = sum(max(0.0, min(e, end) - max(s, end - 20.0)) for s, e in spans)
@@ -317,7 +327,7 @@ def test_overrun_of_max_on_time_is_an_error_and_the_watchdog_cut_the_led():
 
 def test_intensity_correction_maps_to_levels():
     corr = [1.0, 0.5, 0.25, 1.0, 1.0, 1.0]
-    dome, fw, clock = make("default", intensity_correction=corr)
+    dome, fw, _clock = make("default", intensity_correction=corr)
     dome.connect()
     dome.light(1, 1.0)
     assert fw.lit == (1, 128)
@@ -329,7 +339,7 @@ def test_intensity_correction_maps_to_levels():
 
 
 def test_correction_list_of_the_wrong_length_fails_at_connect():
-    dome, fw, clock = make("default", intensity_correction=[1.0] * 5)
+    dome, _fw, _clock = make("default", intensity_correction=[1.0] * 5)
     with pytest.raises(DeviceError, match="intensity_correction has 5 factors but the firmware"):
         dome.connect()
 
@@ -344,22 +354,22 @@ def test_directions_from_the_lp_must_match_the_led_count():
     assert dome.direction_of(3).tolist() == [0.0, 0.0, 1.0]
     fw2 = firmware_for(s, clock=clock, led_count=5)
     dome2 = build_dome(s, clock, transport=InProcessDomeTransport(fw2), directions=dirs)
-    with pytest.raises(DeviceError, match="reports 5 LEDs but the dome's .lp has 4"):
+    with pytest.raises(DeviceError, match=r"reports 5 LEDs but the dome's \.lp has 4"):
         dome2.connect()
 
 
 def test_out_of_range_index_is_refused_before_any_byte():
-    dome, fw, clock = make("default")
+    dome, fw, _clock = make("default")
     dome.connect()
     before = fw.commands_received
-    with pytest.raises(DeviceError, match="LED 6 does not exist: this dome has LEDs 0..5"):
+    with pytest.raises(DeviceError, match=r"LED 6 does not exist: this dome has LEDs 0\.\.5"):
         dome.light(6)
     assert fw.commands_received == before
 
 
 def test_no_banner_board_still_handshakes_after_the_ready_timeout():
     """A board without auto-reset sends no banner: wait at most ready_timeout_s, then ask."""
-    dome, fw, clock = make("default", ready_timeout_s=1.5, banner=False)
+    dome, _fw, clock = make("default", ready_timeout_s=1.5, banner=False)
     dome.connect()
     assert clock.now() == pytest.approx(1.5)
     assert dome.info.led_count == N_LEDS
@@ -367,7 +377,7 @@ def test_no_banner_board_still_handshakes_after_the_ready_timeout():
 
 
 def test_wait_for_banner_instead_of_a_fixed_sleep():
-    dome, fw, clock = make("default", ready_timeout_s=3.0)
+    dome, _fw, clock = make("default", ready_timeout_s=3.0)
     dome.connect()
     assert clock.now() == pytest.approx(0.2)  # the boot delay, not the 3 s timeout
     assert dome.link.banners_seen == 1
@@ -386,7 +396,7 @@ def test_self_test_passes_on_a_healthy_dome():
 
 
 def test_self_test_lists_a_dead_led_and_continues():
-    dome, fw, clock = make("default", dead=[1, 4])
+    dome, _fw, clock = make("default", dead=[1, 4])
     report = self_test(dome, clock)
     assert not report.ok
     assert [c.index for c in report.failed] == [1, 4]

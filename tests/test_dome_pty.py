@@ -12,8 +12,8 @@ import pytest
 
 from drivers.led_dome import DomeSerialSettings, build_dome
 from rti_rig.clock import SystemClock, VirtualClock
-from rti_rig.errors import DeviceError
 from rti_rig.dome_policy import DomeLedError, DomeLinkError, self_test
+from rti_rig.errors import DeviceError
 from simulator.dome_firmware import (
     Fault,
     FaultKind,
@@ -31,8 +31,12 @@ OFF_AFTER_1 = 6
 
 
 def settings(profile, **kw):
-    base = {"port": "set-later", "reply_timeout_s": 0.15, "ready_timeout_s": 0.5,
-            "reconnect_backoff_s": 0.0}
+    base = {
+        "port": "set-later",
+        "reply_timeout_s": 0.15,
+        "ready_timeout_s": 0.5,
+        "reconnect_backoff_s": 0.0,
+    }
     base.update(kw)
     return DomeSerialSettings(profile=profile, **base)
 
@@ -144,13 +148,13 @@ def test_unplugged_for_good_gives_up_naming_the_command():
         dome.connect()
         dome.light(0, 1.0)
         dome.all_off()
-        with pytest.raises(DomeLinkError, match="light LED 1.*did not come back"):
+        with pytest.raises(DomeLinkError, match=r"light LED 1.*did not come back"):
             dome.light(1, 1.0)
         assert fw.lit is None
 
 
 def test_self_test_over_pty_reports_the_dead_led():
-    fw, pty, s = run_on_pty("framed", dead=[3])
+    _fw, pty, s = run_on_pty("framed", dead=[3])
     with pty as link:
         clock = VirtualClock()
         dome = build_dome(s.model_copy(update={"port": link.port}), clock)

@@ -36,13 +36,15 @@ class DomeCodec(Protocol):
         """Parse one reply from the front of ``buf``: (reply, bytes consumed).
 
         ``(None, n)`` means more bytes are needed after dropping ``n`` bytes of filler
-        (whitespace between frames; usually ``n == 0``). ``pending`` is the command awaiting an answer
-        (binary replies have a length that depends on it).
+        (whitespace between frames; usually ``n == 0``). ``pending`` is the command awaiting
+        an answer (binary replies have a length that depends on it).
         """
         ...
 
     # firmware side
-    def decode_command(self, buf: bytes) -> tuple[tuple[int | None, Command] | BadRequest | None, int]:
+    def decode_command(
+        self, buf: bytes
+    ) -> tuple[tuple[int | None, Command] | BadRequest | None, int]:
         """Parse one command from the front of ``buf``: ((seq, command) | BadRequest, consumed)."""
         ...
 

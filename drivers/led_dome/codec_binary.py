@@ -172,7 +172,9 @@ class BinaryCodec:
                 major, _, minor = echo.version.partition(".")
                 code = _firmware_code(echo.firmware_id)
                 n = echo.led_count
-                body = bytes([seq, int(major), int(minor.split(".")[0] or 0), n >> 8, n & 0xFF, code])
+                body = bytes(
+                    [seq, int(major), int(minor.split(".")[0] or 0), n >> 8, n & 0xFF, code]
+                )
                 return body + bytes([xor_checksum(body)])
             if isinstance(echo, LitState):
                 idx = NO_LED if echo.index is None else echo.index + self.index_base
@@ -200,5 +202,3 @@ def _identity(chunk: bytes) -> DomeIdentity:
         version=f"{chunk[1]}.{chunk[2]}",
         led_count=(chunk[3] << 8) | chunk[4],
     )
-
-

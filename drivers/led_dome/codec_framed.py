@@ -229,9 +229,11 @@ class FramedCodec:
 
     def encode_reply(self, reply: Reply, cmd: Command | None) -> bytes:
         s = self.spec
-        seq_field = [str(reply.seq or 0)] if self.has_sequence and not isinstance(
-            reply, Banner | Garbled
-        ) else []
+        seq_field = (
+            [str(reply.seq or 0)]
+            if self.has_sequence and not isinstance(reply, Banner | Garbled)
+            else []
+        )
         if isinstance(reply, Ack):
             echo = reply.echo
             if isinstance(echo, DomeIdentity):

@@ -97,8 +97,9 @@ class LedDomeDriver:
     def hello(self) -> DomeInfo:
         echo = self._exchange(Hello()).echo
         if not isinstance(echo, DomeIdentity):
-            raise self._error("handshake reply carries no identity", "handshake",
-                              LinkFault.GARBLED, True)
+            raise self._error(
+                "handshake reply carries no identity", "handshake", LinkFault.GARBLED, True
+            )
         return DomeInfo(echo.firmware_id, echo.version, echo.led_count)
 
     def light(self, index: int, level: int, max_on_ms: int | None = None) -> None:
@@ -120,8 +121,9 @@ class LedDomeDriver:
     def query(self) -> tuple[int | None, int]:
         echo = self._exchange(Query()).echo
         if not isinstance(echo, LitState):
-            raise self._error("query reply carries no state", "query lit LED",
-                              LinkFault.GARBLED, True)
+            raise self._error(
+                "query reply carries no state", "query lit LED", LinkFault.GARBLED, True
+            )
         return echo.index, echo.level
 
     # ------------------------------------------------------------------ exchange
@@ -153,28 +155,35 @@ class LedDomeDriver:
                 if remaining <= 0:
                     raise self._error(
                         f"no reply within {self.reply_timeout_s:g} s (lost or late)",
-                        name, LinkFault.TIMEOUT, True,
+                        name,
+                        LinkFault.TIMEOUT,
+                        True,
                     )
                 self._feed(self.transport.read(remaining))
                 continue
             if isinstance(reply, Banner):
                 self._saw_banner(reply)
-                raise self._error("the board rebooted (boot banner) before answering", name,
-                                  LinkFault.RESET, True)
+                raise self._error(
+                    "the board rebooted (boot banner) before answering", name, LinkFault.RESET, True
+                )
             if isinstance(reply, Garbled):
-                raise self._error(f"garbled reply ({reply.reason}): {reply.raw!r}", name,
-                                  LinkFault.GARBLED, True)
+                raise self._error(
+                    f"garbled reply ({reply.reason}): {reply.raw!r}", name, LinkFault.GARBLED, True
+                )
             if self.codec.has_sequence and reply.seq is not None and reply.seq != seq:
-                traffic_log.debug("%s: dropped a late reply to command %s", self.device,
-                                  reply.seq)
+                traffic_log.debug("%s: dropped a late reply to command %s", self.device, reply.seq)
                 continue
             if isinstance(reply, Nak):
                 if reply.code not in ERROR_CODES:
-                    raise self._error(f"unknown error code {reply.code}", name,
-                                      LinkFault.GARBLED, True)
+                    raise self._error(
+                        f"unknown error code {reply.code}", name, LinkFault.GARBLED, True
+                    )
                 raise self._error(
                     f"firmware error {reply.code}: {error_text(reply.code)}",
-                    name, LinkFault.REJECTED, reply.code in TRANSIENT_ERROR_CODES, reply.code,
+                    name,
+                    LinkFault.REJECTED,
+                    reply.code in TRANSIENT_ERROR_CODES,
+                    reply.code,
                 )
             self._check_echo(cmd, reply, name)
             return reply
@@ -183,8 +192,7 @@ class LedDomeDriver:
         echo = ack.echo
         if echo is None:
             if isinstance(cmd, Hello | Query):
-                raise self._error("reply without the expected data", name, LinkFault.GARBLED,
-                                  True)
+                raise self._error("reply without the expected data", name, LinkFault.GARBLED, True)
             return
         ok = True
         if isinstance(cmd, Light):
@@ -199,8 +207,10 @@ class LedDomeDriver:
             ok = isinstance(echo, LitState)
         if not ok:
             raise self._error(
-                f"the firmware acknowledged {_describe_echo(echo)} instead", name,
-                LinkFault.MISMATCH, True,
+                f"the firmware acknowledged {_describe_echo(echo)} instead",
+                name,
+                LinkFault.MISMATCH,
+                True,
             )
 
     def _drain_stale(self, name: str) -> None:
@@ -213,8 +223,12 @@ class LedDomeDriver:
             if isinstance(reply, Banner):
                 self._saw_banner(reply)
                 self._rx.clear()
-                raise self._error("the board rebooted since the last command (boot banner)",
-                                  name, LinkFault.RESET, True)
+                raise self._error(
+                    "the board rebooted since the last command (boot banner)",
+                    name,
+                    LinkFault.RESET,
+                    True,
+                )
             traffic_log.debug("%s: dropped stale input %r", self.device, reply)
 
     def _wait_for_banner(self) -> None:
@@ -231,15 +245,19 @@ class LedDomeDriver:
                 continue
             remaining = deadline - clock.now()
             if remaining <= 0:
-                traffic_log.debug("%s: no ready banner within %g s; handshaking anyway",
-                                  self.device, self.ready_timeout_s)
+                traffic_log.debug(
+                    "%s: no ready banner within %g s; handshaking anyway",
+                    self.device,
+                    self.ready_timeout_s,
+                )
                 return
             try:
                 self._feed(self.transport.read(remaining))
             except TransportError as exc:
                 self._open = False
-                raise self._error(f"port lost: {exc}", "wait for ready banner",
-                                  LinkFault.DISCONNECTED, True) from exc
+                raise self._error(
+                    f"port lost: {exc}", "wait for ready banner", LinkFault.DISCONNECTED, True
+                ) from exc
 
     # ------------------------------------------------------------------ helpers
 
@@ -265,7 +283,11 @@ class LedDomeDriver:
             self.banner = banner.identity
 
     def _error(
-        self, message: str, command: str, fault: LinkFault, retryable: bool,
+        self,
+        message: str,
+        command: str,
+        fault: LinkFault,
+        retryable: bool,
         code: int | None = None,
     ) -> DomeLinkError:
         return DomeLinkError(self.device, message, command, fault, retryable=retryable, code=code)

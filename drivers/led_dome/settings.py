@@ -154,12 +154,12 @@ class DomeSerialSettings(_Strict):
         if self.profile == "binary" and self.max_level > 255:
             raise ValueError("the binary profile carries the level in one byte: max_level ≤ 255")
         n = self.expected_led_count
-        if n is not None and self.intensity_correction is not None:
-            if len(self.intensity_correction) != n:
-                raise ValueError(
-                    f"intensity_correction has {len(self.intensity_correction)} factors for "
-                    f"expected_led_count = {n}"
-                )
+        corr = self.intensity_correction
+        if n is not None and corr is not None and len(corr) != n:
+            raise ValueError(
+                f"intensity_correction has {len(self.intensity_correction)} factors for "
+                f"expected_led_count = {n}"
+            )
         return self
 
     def check_led_count(self, count: int) -> str | None:

@@ -11,6 +11,7 @@ reply deadlines on ``transport.clock`` so the two never disagree.
 
 from __future__ import annotations
 
+import contextlib
 from typing import Protocol
 
 import serial
@@ -87,10 +88,8 @@ class SerialTransport:
     def close(self) -> None:
         ser, self._ser = self._ser, None
         if ser is not None:
-            try:
+            with contextlib.suppress(*_PORT_ERRORS):  # already gone: closing is best effort
                 ser.close()
-            except _PORT_ERRORS:
-                pass  # already gone: closing is best effort by design
 
     def write(self, data: bytes) -> None:
         ser = self._require()
