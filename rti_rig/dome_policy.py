@@ -344,9 +344,13 @@ class DomePolicy:
                     self.name, index, f"LED {index} refused: {exc.message}", command
                 ) from exc
             raise
-        previous, self._lit = self._lit, _Lit(index, level, self.clock.now())
-        if previous is not None and previous.index != index:
-            self.guard.record(previous.index, previous.since, self._lit.since)
+        since = self.clock.now()
+        previous = self._lit
+        if previous is not None and previous.index == index:
+            since = previous.since  # lit again without a pause: the on-time keeps counting
+        elif previous is not None:
+            self.guard.record(previous.index, previous.since, since)
+        self._lit = _Lit(index, level, since)
 
     def all_off(self) -> None:
         """Every LED off (the safe state); reports an LED that overran its on-time."""

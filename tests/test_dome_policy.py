@@ -411,3 +411,37 @@ def test_self_test_reports_an_unreachable_dome():
     report = self_test(dome, clock)
     assert report.aborted and "no handshake" in report.aborted
     assert not report.ok
+
+
+def test_relighting_the_same_led_keeps_counting_its_on_time():
+    dome, fw, clock = make("framed", thermal={"max_on_s": 2.0, "max_duty": 0.5})
+    dome.connect()
+    dome.light(0, 1.0)
+    clock.sleep(1.5)
+    dome.light(0, 0.5)  # no all-off in between: the LED never cooled
+    clock.sleep(1.0)
+    with pytest.raises(DomeLedError, match=r"LED 0 stayed on 2\.500 s"):
+        dome.all_off()
+
+
+def test_settings_from_a_rig_toml_table():
+    import tomllib
+
+    table = tomllib.loads(
+        """
+        [dome.serial]
+        port = "/dev/serial/by-id/usb-Arduino_Mega_2560-if00"
+        profile = "framed"
+        reply_timeout_s = 0.5
+        [dome.serial.framed]
+        index_base = 1
+        line_ending = "\\n"
+        [dome.serial.thermal]
+        max_on_s = 8.0
+        max_duty = 0.3
+        duty_window_s = 60.0
+        """
+    )
+    s = DomeSerialSettings.model_validate(table["dome"]["serial"])
+    assert s.framed.index_base == 1 and s.thermal.max_duty == 0.3
+    assert s.framed.line_ending == "\n"
