@@ -414,7 +414,7 @@ def test_self_test_reports_an_unreachable_dome():
 
 
 def test_relighting_the_same_led_keeps_counting_its_on_time():
-    dome, fw, clock = make("framed", thermal={"max_on_s": 2.0, "max_duty": 0.5})
+    dome, _fw, clock = make("framed", thermal={"max_on_s": 2.0, "max_duty": 0.5})
     dome.connect()
     dome.light(0, 1.0)
     clock.sleep(1.5)
