@@ -445,3 +445,14 @@ def test_settings_from_a_rig_toml_table():
     s = DomeSerialSettings.model_validate(table["dome"]["serial"])
     assert s.framed.index_base == 1 and s.thermal.max_duty == 0.3
     assert s.framed.line_ending == "\n"
+
+
+@pytest.mark.parametrize("at", [LIGHT_1, OFF_AFTER_1])
+@pytest.mark.parametrize("kind", [FaultKind.DELAY_REPLY, FaultKind.DROP_REPLY])
+def test_framed_without_sequence_numbers_relies_on_echoes(at, kind):
+    """Nab-style firmware: no sequence field, so late replies are told apart by their echo."""
+    dome, fw, clock = make(
+        "framed", [Fault(at, kind, delay_s=0.7)], framed={"sequence": False, "index_base": 1}
+    )
+    session(dome, fw, clock)
+    assert dome.stats.retries >= 1
