@@ -439,11 +439,19 @@ class DomePolicy:
                         command,
                     ) from exc
                 if not exc.retryable or not idempotent or attempt >= self.settings.retries:
-                    tries = f"after {attempt + 1} attempt{'s' if attempt else ''}"
-                    hint = "" if idempotent else " (not resent: it is not idempotent)"
+                    if not idempotent and exc.retryable:
+                        why = " (not resent: it is not idempotent)"
+                    elif exc.retryable:
+                        why = f"; gave up after {attempt + 1} attempt{'s' if attempt else ''}"
+                    else:
+                        why = (
+                            f" (after {attempt} resend{'s' if attempt > 1 else ''})"
+                            if attempt
+                            else ""
+                        )
                     raise DomeLinkError(
                         self.name,
-                        f"{exc.message}; gave up {tries}{hint}",
+                        f"{exc.message}{why}",
                         command,
                         fault,
                         retryable=False,

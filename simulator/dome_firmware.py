@@ -376,3 +376,53 @@ def emulated_dome_on_pty(firmware: DomeFirmware) -> Iterator[PtyLink]:
         raise ValueError("a firmware served on a pty needs a SystemClock (replies are real-time)")
     with serve_on_pty(firmware, "dome") as link:
         yield link
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Serve an emulated dome on a pty until interrupted: ``python -m simulator.dome_firmware``.
+
+    Prints the port path, so that a rig config (or ``rti-rig check``) can be pointed at it for a
+    dry run through the real driver and real pyserial.
+    """
+    import argparse
+    import time
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("--profile", choices=["default", "framed", "binary"], default="default")
+    parser.add_argument("--leds", type=int, default=48)
+    parser.add_argument("--dead", type=int, nargs="*", default=[], help="dead LED indices")
+    parser.add_argument("--boot-delay-s", type=float, default=0.5)
+    parser.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="K:KIND",
+        help=f"fault KIND at the K-th command; kinds: {', '.join(k.value for k in FaultKind)}",
+    )
+    parser.add_argument("--seconds", type=float, default=None, help="stop after this long")
+    args = parser.parse_args(argv)
+    faults = []
+    for spec in args.fault:
+        at, _, kind = spec.partition(":")
+        faults.append(Fault(int(at), FaultKind(kind)))
+    settings = DomeSerialSettings(port="pty", profile=args.profile)
+    firmware = firmware_for(
+        settings,
+        led_count=args.leds,
+        dead_leds=frozenset(args.dead),
+        boot_delay_s=args.boot_delay_s,
+        faults=FaultPlan(tuple(faults)),
+    )
+    with emulated_dome_on_pty(firmware) as link:
+        print(f"emulated {args.profile} dome with {args.leds} LEDs on {link.port}", flush=True)
+        deadline = None if args.seconds is None else time.monotonic() + args.seconds
+        try:
+            while link.alive and (deadline is None or time.monotonic() < deadline):
+                time.sleep(0.1)
+        except KeyboardInterrupt:
+            pass
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
