@@ -171,3 +171,25 @@ def test_wrong_port_is_a_clear_error():
     with pytest.raises(DeviceError, match=r"no handshake.*cannot open serial port /nonexistent"):
         dome.connect()
     dome.close()
+
+
+def test_the_port_is_locked_against_a_second_program():
+    fw, pty, s = run_on_pty("default")
+    with pty as link:
+        port_settings = s.model_copy(update={"port": link.port})
+        first = build_dome(port_settings, VirtualClock())
+        first.connect()
+        second = build_dome(port_settings, VirtualClock())
+        with pytest.raises(DeviceError, match=r"cannot open serial port.*lock"):
+            second.connect()
+        first.light(1)
+        assert fw.lit == (1, 255)
+        first.close()
+
+
+def test_loop_url_transport_opens_without_a_lock():
+    """``serial_for_url`` URLs work too (here nothing answers: a clear handshake timeout)."""
+    s = settings("default", port="loop://", ready_timeout_s=0.05, reply_timeout_s=0.05)
+    dome = build_dome(s, VirtualClock())
+    with pytest.raises(DeviceError, match="no handshake"):
+        dome.connect()

@@ -12,6 +12,7 @@ reply deadlines on ``transport.clock`` so the two never disagree.
 from __future__ import annotations
 
 import contextlib
+import os
 from typing import Protocol
 
 import serial
@@ -74,12 +75,16 @@ class SerialTransport:
     def open(self) -> None:
         if self._ser is not None:
             return
+        # A second program on the same port would interleave its bytes with ours: lock it
+        # (POSIX device paths only; URL handlers such as loop:// have nothing to lock).
+        lock = {"exclusive": True} if "://" not in self.port and os.name == "posix" else {}
         try:
             self._ser = serial.serial_for_url(
                 self.port,
                 baudrate=self.baudrate,
                 timeout=0,
                 write_timeout=self.write_timeout_s,
+                **lock,
             )
         except (*_PORT_ERRORS, ValueError) as exc:
             raise TransportError(f"cannot open serial port {self.port}: {exc}") from exc
