@@ -8,6 +8,7 @@ wait for a CPU), so each fault costs well under a second.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -193,3 +194,38 @@ def test_loop_url_transport_opens_without_a_lock():
     dome = build_dome(s, VirtualClock())
     with pytest.raises(DeviceError, match="no handshake"):
         dome.connect()
+
+
+def test_dry_run_against_the_emulator_in_another_process():
+    """``python -m simulator.dome_firmware`` serves a dome that any program can open by path."""
+    import subprocess
+
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "simulator.dome_firmware",
+            "--leds",
+            "6",
+            "--dead",
+            "2",
+            "--boot-delay-s",
+            "0.02",
+            "--seconds",
+            "20",
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=Path(__file__).resolve().parent.parent,
+    )
+    try:
+        line = proc.stdout.readline()
+        assert line.startswith("emulated default dome with 6 LEDs on "), line
+        port = line.split()[-1]
+        clock = VirtualClock()
+        report = self_test(build_dome(settings("default", port=port), clock), clock)
+        assert [c.index for c in report.failed] == [2]
+        assert len(report.checks) == 6 and report.firmware.firmware_id == "RTIDOME-EMU"
+    finally:
+        proc.terminate()
+        proc.wait(timeout=5)
