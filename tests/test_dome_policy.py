@@ -456,3 +456,11 @@ def test_framed_without_sequence_numbers_relies_on_echoes(at, kind):
     )
     session(dome, fw, clock)
     assert dome.stats.retries >= 1
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+@pytest.mark.parametrize("kind", [FaultKind.RESET, FaultKind.RESET_AFTER_REPLY])
+def test_a_second_reboot_while_connecting_is_absorbed(profile, kind):
+    dome, fw, clock = make(profile, [Fault(1, kind)])
+    session(dome, fw, clock)
+    assert [e.what for e in fw.history].count("boot") == 2

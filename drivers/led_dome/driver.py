@@ -85,7 +85,14 @@ class LedDomeDriver:
         self._open = True
         self._rx.clear()
         self._wait_for_banner()
-        return self.hello()
+        try:
+            return self.hello()
+        except DomeLinkError as exc:
+            # Some USB-serial bridges toggle DTR twice on open, so the board can reboot once
+            # more right after its first banner: one more handshake, after the new banner.
+            if exc.fault is not LinkFault.RESET:
+                raise
+            return self.hello()
 
     def close(self) -> None:
         self._open = False
