@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -604,6 +605,11 @@ class SelfTestReport:
     elapsed_s: float = 0.0
     stats: DomeStats | None = None
     aborted: str | None = None
+    #: LEDs the test meant to step through (all of them unless a subset was asked for).
+    planned: int = 0
+    #: Wall-clock seconds each successful ``light`` call took (the command's round trip over
+    #: the real link, whatever clock the rig uses): a measured ``light_switch_s``.
+    light_latency_s: list[float] = field(default_factory=list)
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -611,7 +617,17 @@ class SelfTestReport:
 
     @property
     def ok(self) -> bool:
-        return self.aborted is None and not self.failed and len(self.checks) == self.led_count
+        return (
+            self.aborted is None
+            and not self.failed
+            and self.planned > 0
+            and len(self.checks) == self.planned
+        )
+
+    @property
+    def median_light_latency_s(self) -> float | None:
+        lat = self.light_latency_s
+        return float(np.median(lat)) if lat else None
 
     def lines(self) -> list[str]:
         fw = (
@@ -626,6 +642,12 @@ class SelfTestReport:
             f"failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
         )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
+        if self.light_latency_s:
+            lat = np.asarray(self.light_latency_s) * 1000
+            out.append(
+                f"light command round trip: median {np.median(lat):.2f} ms, "
+                f"max {lat.max():.2f} ms (wall clock)"
+            )
         if self.stats is not None:
             s = self.stats
             out.append(
@@ -659,9 +681,13 @@ def self_test(
         if isinstance(source, DomePolicy):
             report.firmware = source.info
             report.stats = source.stats
-        for i in range(report.led_count) if leds is None else leds:
+        order = list(range(report.led_count)) if leds is None else list(leds)
+        report.planned = len(order)
+        for i in order:
             try:
+                t0 = time.perf_counter()
                 source.light(i, intensity)
+                report.light_latency_s.append(time.perf_counter() - t0)
                 clock.sleep(settle_s)
                 if isinstance(source, DomePolicy):
                     lit, _ = source.lit_state()

@@ -464,3 +464,12 @@ def test_a_second_reboot_while_connecting_is_absorbed(profile, kind):
     dome, fw, clock = make(profile, [Fault(1, kind)])
     session(dome, fw, clock)
     assert [e.what for e in fw.history].count("boot") == 2
+
+
+def test_self_test_on_a_subset_of_leds():
+    dome, fw, clock = make("default")
+    report = self_test(dome, clock, leds=[0, 5])
+    assert report.ok and report.planned == 2
+    assert [c.index for c in report.checks] == [0, 5]
+    assert len(report.light_latency_s) == 2 and report.median_light_latency_s > 0
+    assert [e.index for e in fw.history if e.what == "lit"] == [0, 5]
