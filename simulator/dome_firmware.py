@@ -132,6 +132,9 @@ class DomeFirmware:
     clock: Clock = field(default_factory=SystemClock)
     boot_delay_s: float = 0.0
     banner_on_boot: bool = True
+    #: Serial line speed: replies take the time their bytes (and the command's) need on the
+    #: wire, 10 bits a byte, as a UART would; a pty alone has no line speed. None: instant.
+    baudrate: int | None = None
 
     def __post_init__(self) -> None:
         self.dead_leds = frozenset(self.dead_leds)
@@ -148,6 +151,10 @@ class DomeFirmware:
     @property
     def identity(self) -> DomeIdentity:
         return DomeIdentity(self.firmware_id, self.version, self.led_count)
+
+    def wire_s(self, n_bytes: int) -> float:
+        """Seconds ``n_bytes`` take on the serial line (8N1: 10 bits a byte)."""
+        return 0.0 if not self.baudrate else n_bytes * 10.0 / self.baudrate
 
     # ------------------------------------------------------------------ truth
 
@@ -179,7 +186,8 @@ class DomeFirmware:
             self.history.append(FirmwareEvent(now, "boot"))
             if not self.banner_on_boot:
                 return []
-            return [Output(now + self.boot_delay_s, self.codec.encode_banner(self.identity))]
+            banner = self.codec.encode_banner(self.identity)
+            return [Output(now + self.boot_delay_s + self.wire_s(len(banner)), banner)]
 
     def on_port_opened(self) -> list[Output]:
         """Opening the port toggles DTR, which resets an Arduino: reboot."""
@@ -221,13 +229,16 @@ class DomeFirmware:
                         if reparsed is not None
                         else BadRequest(raw, None, ERR_BAD_ARGUMENT, "garbled beyond framing")
                     )
-                out += self._handle(parsed, faults)
+                out += self._handle(parsed, faults, len(raw))
             return out
 
     # ------------------------------------------------------------------ internals
 
     def _handle(
-        self, parsed: tuple[int | None, Command] | BadRequest, faults: Iterable[Fault]
+        self,
+        parsed: tuple[int | None, Command] | BadRequest,
+        faults: Iterable[Fault],
+        command_len: int,
     ) -> list[Output]:
         now = self.clock.now()
         by_kind = {f.kind: f for f in faults}
@@ -249,17 +260,19 @@ class DomeFirmware:
             seq, cmd = parsed
             reply_msg = self._execute(seq, cmd, now)
         data = self.codec.encode_reply(reply_msg, cmd)
+        sent = now + self.wire_s(command_len + len(data))
         if FaultKind.DROP_REPLY in by_kind:
             out: list[Output] = []
         elif FaultKind.GARBLE_REPLY in by_kind:
-            out = [Output(now, garble(data))]
+            out = [Output(sent, garble(data))]
         elif FaultKind.DELAY_REPLY in by_kind:
-            out = [Output(now + by_kind[FaultKind.DELAY_REPLY].delay_s, data)]
+            out = [Output(sent + by_kind[FaultKind.DELAY_REPLY].delay_s, data)]
         else:
-            out = [Output(now, data)]
+            out = [Output(sent, data)]
         if FaultKind.RESET_AFTER_REPLY in by_kind:
             self.history.append(FirmwareEvent(now, "reset"))
-            out += self.boot()
+            # the reset follows the acknowledgement on the wire, whatever the boot delay
+            out += [Output(max(o.due_s, sent + 1e-6), o.data) for o in self.boot()]
         return out
 
     def _execute(self, seq: int | None, cmd: Command, now: float) -> Ack | Nak:
@@ -363,6 +376,7 @@ class InProcessDomeTransport:
 
 def firmware_for(settings: DomeSerialSettings, **kwargs: object) -> DomeFirmware:
     """A firmware emulator speaking the profile of ``settings`` (same codec as the driver)."""
+    kwargs.setdefault("baudrate", settings.baudrate)
     return DomeFirmware(make_codec(settings), max_level=settings.max_level, **kwargs)  # type: ignore[arg-type]
 
 
