@@ -277,6 +277,12 @@ class DomePolicy:
         log.info(
             "%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version, info.led_count
         )
+        if not self.link.echoes_light and not self.settings.confirm_with_query:
+            log.warning(
+                "%s: this profile's light acknowledgement does not say which LED was lit; set "
+                "confirm_with_query = true to have the firmware confirm every LED",
+                self.name,
+            )
         self._run(self.link.all_off, "all off")  # start from the safe state
 
     def close(self) -> None:

@@ -49,15 +49,6 @@ class Query:
 
 Command = Hello | Light | AllOff | Shutter | Query
 
-#: Commands whose effect does not depend on how many times they run: safe to resend when the
-#: reply was lost. A shutter pulse is not: resending it may take a second picture.
-IDEMPOTENT = (Hello, Light, AllOff, Query)
-
-
-def is_idempotent(cmd: Command) -> bool:
-    return isinstance(cmd, IDEMPOTENT)
-
-
 def describe(cmd: Command) -> str:
     """Short human name of a command, used in error messages and logs."""
     if isinstance(cmd, Light):
