@@ -73,6 +73,11 @@ def test_each_profile_builds_its_codec():
         ),
         ({"port": "x", "profile": "binary", "max_level": 1023}, "", "max_level ≤ 255"),
         (
+            {"port": "x", "profile": "framed", "framed": {"codes": {"light": "L,1"}}},
+            "framed",
+            "command code light = 'L,1' contains the separator character",
+        ),
+        (
             {"port": "x", "expected_led_count": 3, "intensity_correction": [1, 1]},
             "",
             "2 factors for expected_led_count = 3",

@@ -68,6 +68,13 @@ class FramedOptions(_Strict):
                 )
         if len(set(marks.values())) != 3:
             raise ValueError(f"start, end and separator must differ, got {marks}")
+        for verb, code in self.codes.model_dump().items():
+            clash = [k for k, v in marks.items() if v in code]
+            if clash:
+                raise ValueError(
+                    f"command code {verb} = {code!r} contains the {clash[0]} character; "
+                    "it would break the frame"
+                )
         words = [self.ok_word, self.err_word, self.ready_word]
         if len(set(words)) != 3 or not all(w.isascii() and w.isalnum() for w in words):
             raise ValueError(f"ok_word, err_word, ready_word must be distinct ASCII words: {words}")
