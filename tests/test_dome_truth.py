@@ -35,17 +35,22 @@ fault_plans = st.lists(
 )
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    profile=st.sampled_from(["default", "framed", "binary"]),
+    profile=st.sampled_from(["default", "framed", "framed-noseq", "binary"]),
     faults=fault_plans,
     dead=st.sets(st.integers(0, N_LEDS - 1), max_size=2),
     confirm=st.booleans(),
 )
 def test_no_capture_is_recorded_under_a_wrong_light(profile, faults, dead, confirm):
     clock = VirtualClock()
+    extra = {"framed": {"sequence": False, "index_base": 1}} if profile == "framed-noseq" else {}
     s = DomeSerialSettings(
-        port="emulated", profile=profile, reply_timeout_s=0.5, confirm_with_query=confirm
+        port="emulated",
+        profile=profile.removesuffix("-noseq"),
+        reply_timeout_s=0.5,
+        confirm_with_query=confirm,
+        **extra,
     )
     fw = firmware_for(
         s,
