@@ -286,3 +286,18 @@ def test_a_single_flipped_bit_never_yields_a_different_valid_command(cmd, seq, p
         raw[i] ^= 1 << bit
         parsed, _ = codec.decode_command(bytes(raw))
         assert not isinstance(parsed, tuple), (codec.profile, bytes(raw), parsed)
+
+
+@pytest.mark.parametrize("codec", [DefaultCodec(), BinaryCodec()], ids=["default", "binary"])
+def test_every_single_bit_flip_of_sample_commands_is_refused(codec):
+    samples = [Hello(), AllOff(), Query(), Shutter(50), Light(0, 1), Light(47, 255)]
+    if isinstance(codec, DefaultCodec):
+        samples.append(Light(12, 200, 5000))
+    for cmd in samples:
+        raw = codec.encode_command(9, cmd)
+        for i in range(len(raw)):
+            for bit in range(8):
+                bad = bytearray(raw)
+                bad[i] ^= 1 << bit
+                parsed, _ = codec.decode_command(bytes(bad))
+                assert not isinstance(parsed, tuple), (cmd, i, bit, bytes(bad), parsed)
