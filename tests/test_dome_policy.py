@@ -486,3 +486,13 @@ def test_replies_take_their_time_on_the_serial_line():
     assert t1 - t0 == pytest.approx((19 + 22) * 10 / 9600)
     dome.all_off()
     assert clock.now() - t1 == pytest.approx((7 + 10) * 10 / 9600)  # "4 X*4C\n" + "OK 4 X*68\n"
+
+
+def test_profile_without_intensity_refuses_a_dimmed_light_clearly():
+    dome, fw, _clock = make("framed", framed={"send_level": False})
+    dome.connect()
+    dome.light(2, 1.0)
+    assert fw.lit == (2, 255)
+    with pytest.raises(DomeLedError, match=r"send_level = false\): only full intensity 1\.0"):
+        dome.light(3, 0.5)
+    assert fw.lit is None

@@ -110,12 +110,18 @@ class LedDomeDriver:
         return DomeInfo(echo.firmware_id, echo.version, echo.led_count)
 
     def light(self, index: int, level: int, max_on_ms: int | None = None) -> None:
+        name = describe(Light(index, level))
         if not 0 <= level <= self.max_level:
-            raise ValueError(f"level {level} outside 0..{self.max_level}")
+            raise self._error(
+                f"level {level} outside 0..{self.max_level}", name, LinkFault.REJECTED, False
+            )
         if not self.codec.has_level and level != self.max_level:
-            raise ValueError(
+            raise self._error(
                 f"the {self.codec.profile} profile is configured without intensity "
-                f"(send_level = false): only full level {self.max_level} is possible"
+                f"(send_level = false): only full intensity 1.0 is possible",
+                name,
+                LinkFault.REJECTED,
+                False,
             )
         self._exchange(Light(index, level, max_on_ms if self.codec.has_watchdog else None))
 
