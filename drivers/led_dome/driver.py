@@ -1,0 +1,312 @@
+"""The LED dome driver: one command, one acknowledged reply, nothing guessed.
+
+The driver translates verbs into a profile's bytes over an injected transport and reports
+exactly what went wrong (timeout, garbled reply, wrong echo, reboot banner, lost port, firmware
+error) as a :class:`rti_rig.dome_policy.DomeLinkError`. It never retries: deciding what is safe
+to resend is the rig policy's job (``rti_rig.dome_policy.DomePolicy``).
+
+Stale input is handled here, because only the codec-aware layer can recognise it: before each
+command, bytes already waiting are read and classified (a late reply to an earlier command is
+dropped, a boot banner means the board reset); while waiting, replies carrying another sequence
+number are dropped as late.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from drivers.led_dome.codec_base import DomeCodec
+from drivers.led_dome.messages import (
+    ERROR_CODES,
+    TRANSIENT_ERROR_CODES,
+    Ack,
+    AllOff,
+    Banner,
+    Command,
+    DomeIdentity,
+    Garbled,
+    Hello,
+    Light,
+    LitState,
+    Nak,
+    Query,
+    Reply,
+    Shutter,
+    describe,
+    error_text,
+)
+from drivers.led_dome.transport import Transport, TransportError
+from rti_rig.dome_policy import DomeInfo, DomeLinkError, LinkFault
+
+#: Every byte to and from the dome goes through this logger (DEBUG, hex).
+traffic_log = logging.getLogger("rti_rig.dome.traffic")
+
+
+class LedDomeDriver:
+    """Implements :class:`rti_rig.dome_policy.DomeLink` for one protocol profile."""
+
+    def __init__(
+        self,
+        transport: Transport,
+        codec: DomeCodec,
+        *,
+        device: str = "dome",
+        reply_timeout_s: float = 0.5,
+        ready_timeout_s: float = 3.0,
+        max_level: int = 255,
+    ) -> None:
+        if reply_timeout_s <= 0:
+            raise ValueError(f"reply_timeout_s must be > 0, got {reply_timeout_s}")
+        self.transport = transport
+        self.codec = codec
+        self.device = f"{device} ({transport.name}, {codec.profile} profile)"
+        self.reply_timeout_s = reply_timeout_s
+        self.ready_timeout_s = ready_timeout_s
+        self.max_level = max_level
+        self.has_watchdog = codec.has_watchdog
+        self.echoes_light = codec.profile != "binary"
+        self._rx = bytearray()
+        self._seq = 0
+        self._open = False
+        #: Identity from the last boot banner (``None`` if the board sent none or a bare one).
+        self.banner: DomeIdentity | None = None
+        #: Boot banners seen since connect (initial one included).
+        self.banners_seen = 0
+
+    # ------------------------------------------------------------------ lifecycle
+
+    def connect(self) -> DomeInfo:
+        """Open the port, wait for the ready banner (bounded), then handshake."""
+        self.close()
+        try:
+            self.transport.open()
+        except TransportError as exc:
+            raise self._error(str(exc), "open port", LinkFault.DISCONNECTED, True) from exc
+        self._open = True
+        self._rx.clear()
+        self._wait_for_banner()
+        try:
+            return self.hello()
+        except DomeLinkError as exc:
+            # Some USB-serial bridges toggle DTR twice on open, so the board can reboot once
+            # more right after its first banner: one more handshake, after the new banner.
+            if exc.fault is not LinkFault.RESET:
+                raise
+            return self.hello()
+
+    def close(self) -> None:
+        self._open = False
+        self._rx.clear()
+        self.transport.close()
+
+    # ------------------------------------------------------------------ verbs
+
+    def hello(self) -> DomeInfo:
+        echo = self._exchange(Hello()).echo
+        if not isinstance(echo, DomeIdentity):
+            raise self._error(
+                "handshake reply carries no identity", "handshake", LinkFault.GARBLED, True
+            )
+        return DomeInfo(echo.firmware_id, echo.version, echo.led_count)
+
+    def light(self, index: int, level: int, max_on_ms: int | None = None) -> None:
+        name = describe(Light(index, level))
+        if not 0 <= level <= self.max_level:
+            raise self._error(
+                f"level {level} outside 0..{self.max_level}", name, LinkFault.REJECTED, False
+            )
+        if not self.codec.has_level and level != self.max_level:
+            raise self._error(
+                f"the {self.codec.profile} profile is configured without intensity "
+                f"(send_level = false): only full intensity 1.0 is possible",
+                name,
+                LinkFault.REJECTED,
+                False,
+            )
+        self._exchange(Light(index, level, max_on_ms if self.codec.has_watchdog else None))
+
+    def all_off(self) -> None:
+        self._exchange(AllOff())
+
+    def shutter(self, pulse_ms: int) -> None:
+        self._exchange(Shutter(pulse_ms))
+
+    def query(self) -> tuple[int | None, int]:
+        echo = self._exchange(Query()).echo
+        if not isinstance(echo, LitState):
+            raise self._error(
+                "query reply carries no state", "query lit LED", LinkFault.GARBLED, True
+            )
+        return echo.index, echo.level
+
+    # ------------------------------------------------------------------ exchange
+
+    def _exchange(self, cmd: Command) -> Ack:
+        name = describe(cmd)
+        if not self._open:
+            raise self._error("port not open (connect first)", name, LinkFault.DISCONNECTED, True)
+        try:
+            self._drain_stale(name)
+            self._seq = self.codec.next_seq(self._seq)
+            seq = self._seq
+            data = self.codec.encode_command(seq, cmd)
+            traffic_log.debug("%s >> %s", self.device, data.hex(" "))
+            self.transport.write(data)
+            return self._await_reply(seq, cmd, name)
+        except TransportError as exc:
+            self._open = False
+            self.transport.close()
+            raise self._error(f"port lost: {exc}", name, LinkFault.DISCONNECTED, True) from exc
+
+    def _await_reply(self, seq: int, cmd: Command, name: str) -> Ack:
+        clock = self.transport.clock
+        deadline = clock.now() + self.reply_timeout_s
+        while True:
+            reply = self._next_reply(cmd)
+            if reply is None:
+                remaining = deadline - clock.now()
+                if remaining <= 0:
+                    raise self._error(
+                        f"no reply within {self.reply_timeout_s:g} s (lost or late)",
+                        name,
+                        LinkFault.TIMEOUT,
+                        True,
+                    )
+                self._feed(self.transport.read(remaining))
+                continue
+            if isinstance(reply, Banner):
+                self._saw_banner(reply)
+                raise self._error(
+                    "the board rebooted (boot banner) before answering", name, LinkFault.RESET, True
+                )
+            if isinstance(reply, Garbled):
+                raise self._error(
+                    f"garbled reply ({reply.reason}): {reply.raw!r}", name, LinkFault.GARBLED, True
+                )
+            if self.codec.has_sequence and reply.seq is not None and reply.seq != seq:
+                traffic_log.debug("%s: dropped a late reply to command %s", self.device, reply.seq)
+                continue
+            if isinstance(reply, Nak):
+                if reply.code not in ERROR_CODES:
+                    raise self._error(
+                        f"unknown error code {reply.code}", name, LinkFault.GARBLED, True
+                    )
+                raise self._error(
+                    f"firmware error {reply.code}: {error_text(reply.code)}",
+                    name,
+                    LinkFault.REJECTED,
+                    reply.code in TRANSIENT_ERROR_CODES,
+                    reply.code,
+                )
+            self._check_echo(cmd, reply, name)
+            return reply
+
+    def _check_echo(self, cmd: Command, ack: Ack, name: str) -> None:
+        echo = ack.echo
+        if echo is None:
+            if isinstance(cmd, Hello | Query):
+                raise self._error("reply without the expected data", name, LinkFault.GARBLED, True)
+            return
+        ok = True
+        if isinstance(cmd, Light):
+            ok = isinstance(echo, Light) and (echo.index, echo.level) == (cmd.index, cmd.level)
+        elif isinstance(cmd, AllOff):
+            ok = isinstance(echo, AllOff)
+        elif isinstance(cmd, Shutter):
+            ok = isinstance(echo, Shutter) and echo.pulse_ms == cmd.pulse_ms
+        elif isinstance(cmd, Hello):
+            ok = isinstance(echo, DomeIdentity)
+        elif isinstance(cmd, Query):
+            ok = isinstance(echo, LitState)
+        if not ok:
+            raise self._error(
+                f"the firmware acknowledged {_describe_echo(echo)} instead",
+                name,
+                LinkFault.MISMATCH,
+                True,
+            )
+
+    def _drain_stale(self, name: str) -> None:
+        """Classify whatever arrived since the last exchange; a banner means a reset."""
+        self._feed(self.transport.read(0.0))
+        while True:
+            reply = self._next_reply(None)
+            if reply is None:
+                return
+            if isinstance(reply, Banner):
+                self._saw_banner(reply)
+                self._rx.clear()
+                raise self._error(
+                    "the board rebooted since the last command (boot banner)",
+                    name,
+                    LinkFault.RESET,
+                    True,
+                )
+            traffic_log.debug("%s: dropped stale input %r", self.device, reply)
+
+    def _wait_for_banner(self) -> None:
+        """Wait (bounded) for the ready banner; boards without auto-reset send none."""
+        clock = self.transport.clock
+        deadline = clock.now() + self.ready_timeout_s
+        while True:
+            reply = self._next_reply(None)
+            if isinstance(reply, Banner):
+                self._saw_banner(reply)
+                return
+            if reply is not None:
+                traffic_log.debug("%s: ignored before the banner: %r", self.device, reply)
+                continue
+            remaining = deadline - clock.now()
+            if remaining <= 0:
+                traffic_log.debug(
+                    "%s: no ready banner within %g s; handshaking anyway",
+                    self.device,
+                    self.ready_timeout_s,
+                )
+                return
+            try:
+                self._feed(self.transport.read(remaining))
+            except TransportError as exc:
+                self._open = False
+                raise self._error(
+                    f"port lost: {exc}", "wait for ready banner", LinkFault.DISCONNECTED, True
+                ) from exc
+
+    # ------------------------------------------------------------------ helpers
+
+    def _feed(self, data: bytes) -> None:
+        if data:
+            traffic_log.debug("%s << %s", self.device, data.hex(" "))
+            self._rx.extend(data)
+
+    def _next_reply(self, pending: Command | None) -> Reply | None:
+        while self._rx:
+            reply, consumed = self.codec.decode_reply(bytes(self._rx), pending)
+            if consumed:
+                del self._rx[:consumed]
+            if reply is not None:
+                return reply
+            if not consumed:
+                return None
+        return None
+
+    def _saw_banner(self, banner: Banner) -> None:
+        self.banners_seen += 1
+        if banner.identity is not None:
+            self.banner = banner.identity
+
+    def _error(
+        self,
+        message: str,
+        command: str,
+        fault: LinkFault,
+        retryable: bool,
+        code: int | None = None,
+    ) -> DomeLinkError:
+        return DomeLinkError(self.device, message, command, fault, retryable=retryable, code=code)
+
+
+def _describe_echo(echo: object) -> str:
+    if isinstance(echo, Light | AllOff | Shutter | Hello | Query):
+        return describe(echo)
+    return repr(echo)

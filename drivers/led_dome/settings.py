@@ -1,0 +1,179 @@
+"""The ``[dome]`` serial settings of a rig config, validated before any port is opened.
+
+Every field a user can get wrong is checked here with a message that says what is allowed, so
+that the rig config loader can report ``rig.toml: key 'dome.framed.codes.light': ...`` before
+the session starts.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class DefaultProfileOptions(_Strict):
+    """Options of the ``default`` line protocol (``docs/protocols/led-dome.md``)."""
+
+    checksum: bool = Field(True, description="append and check the '*HH' XOR checksum")
+
+
+class FramedCodes(_Strict):
+    """The command code sent as the first field of each frame."""
+
+    hello: str = "9"
+    light: str = "3"
+    all_off: str = "0"
+    shutter: str = "6"
+    query: str = "8"
+
+    @model_validator(mode="after")
+    def _distinct(self) -> FramedCodes:
+        codes = [self.hello, self.light, self.all_off, self.shutter, self.query]
+        if len(set(codes)) != len(codes):
+            raise ValueError(f"command codes must differ from each other, got {codes}")
+        for code in codes:
+            if not code or not code.isascii() or not code.isprintable():
+                raise ValueError(f"command code {code!r} must be printable ASCII, not empty")
+        return self
+
+
+class FramedOptions(_Strict):
+    """Options of the ``framed`` ``<cmd,arg>`` profile (markers, codes, numbering, words)."""
+
+    start: str = "<"
+    end: str = ">"
+    separator: str = ","
+    line_ending: Literal["", "\n", "\r\n"] = ""
+    codes: FramedCodes = FramedCodes()
+    index_base: Literal[0, 1] = 0
+    send_level: bool = True
+    sequence: bool = True
+    ok_word: str = "OK"
+    err_word: str = "ERR"
+    ready_word: str = "READY"
+
+    @model_validator(mode="after")
+    def _markers(self) -> FramedOptions:
+        marks = {"start": self.start, "end": self.end, "separator": self.separator}
+        for key, value in marks.items():
+            if len(value) != 1 or not value.isascii() or value.isalnum() or value.isspace():
+                raise ValueError(
+                    f"{key} must be one printable ASCII punctuation character, got {value!r}"
+                )
+        if len(set(marks.values())) != 3:
+            raise ValueError(f"start, end and separator must differ, got {marks}")
+        for verb, code in self.codes.model_dump().items():
+            clash = [k for k, v in marks.items() if v in code]
+            if clash:
+                raise ValueError(
+                    f"command code {verb} = {code!r} contains the {clash[0]} character; "
+                    "it would break the frame"
+                )
+        words = [self.ok_word, self.err_word, self.ready_word]
+        if len(set(words)) != 3 or not all(w.isascii() and w.isalnum() for w in words):
+            raise ValueError(f"ok_word, err_word, ready_word must be distinct ASCII words: {words}")
+        return self
+
+
+class BinaryOptions(_Strict):
+    """Options of the ``binary`` profile (7-byte commands, one-byte sequence ack)."""
+
+    start_byte: int = Field(0xA5, ge=0, le=0xFE, description="first byte of each command")
+    index_base: Literal[0, 1] = 0
+
+
+class ThermalSettings(_Strict):
+    """Per-LED protection: longest continuous on-time, highest duty over a sliding window."""
+
+    max_on_s: float = Field(10.0, gt=0, le=3600)
+    max_duty: float = Field(0.5, gt=0, le=1)
+    duty_window_s: float = Field(60.0, gt=0, le=86400)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> ThermalSettings:
+        if self.max_on_s > self.max_duty * self.duty_window_s:
+            raise ValueError(
+                f"max_on_s ({self.max_on_s} s) is longer than max_duty × duty_window_s "
+                f"({self.max_duty * self.duty_window_s:g} s): a single lighting would break the "
+                "duty limit; lower max_on_s or widen the window"
+            )
+        return self
+
+
+Profile = Literal["default", "framed", "binary"]
+
+
+class DomeSerialSettings(_Strict):
+    """How to reach an LED dome over a serial port, and the policy that keeps it safe."""
+
+    port: str = Field(..., min_length=1, description="e.g. /dev/ttyACM0, COM3, loop://")
+    baudrate: int = Field(115200, gt=0, le=4_000_000)
+    profile: Profile = "default"
+    default: DefaultProfileOptions | None = None
+    framed: FramedOptions | None = None
+    binary: BinaryOptions | None = None
+    reply_timeout_s: float = Field(0.5, gt=0, le=30)
+    ready_timeout_s: float = Field(3.0, ge=0, le=60)
+    retries: int = Field(2, ge=0, le=10)
+    retry_backoff_s: float = Field(0.05, ge=0, le=10)
+    reconnect_attempts: int = Field(3, ge=0, le=20)
+    reconnect_backoff_s: float = Field(1.0, ge=0, le=60)
+    max_level: int = Field(255, ge=1, le=65535)
+    shutter_pulse_ms: int = Field(50, ge=1, le=10_000)
+    confirm_with_query: bool = Field(
+        False, description="after lighting, ask the firmware which LED is lit (binary: no echo)"
+    )
+    expected_led_count: int | None = Field(None, ge=1, le=1000)
+    thermal: ThermalSettings = ThermalSettings()
+    intensity_correction: list[float] | None = Field(
+        None, description="per-LED factor (0, 1] applied to the requested intensity"
+    )
+
+    @field_validator("intensity_correction")
+    @classmethod
+    def _factors(cls, value: list[float] | None) -> list[float] | None:
+        if value is None:
+            return value
+        if not value:
+            raise ValueError("intensity_correction is empty; omit it or give one factor per LED")
+        for i, f in enumerate(value):
+            if not math.isfinite(f) or not 0 < f <= 1:
+                raise ValueError(
+                    f"factor for LED {i} is {f}; factors must be in (0, 1] (divide the list by "
+                    "its largest value)"
+                )
+        return value
+
+    @model_validator(mode="after")
+    def _profile_options(self) -> DomeSerialSettings:
+        for other in ("default", "framed", "binary"):
+            if other != self.profile and getattr(self, other) is not None:
+                raise ValueError(
+                    f"options for the '{other}' profile are given but profile = "
+                    f"'{self.profile}'; remove [dome.{other}] or set profile = '{other}'"
+                )
+        if self.profile == "binary" and self.max_level > 255:
+            raise ValueError("the binary profile carries the level in one byte: max_level ≤ 255")
+        n = self.expected_led_count
+        corr = self.intensity_correction
+        if n is not None and corr is not None and len(corr) != n:
+            raise ValueError(
+                f"intensity_correction has {len(self.intensity_correction)} factors for "
+                f"expected_led_count = {n}"
+            )
+        return self
+
+    def check_led_count(self, count: int) -> str | None:
+        """Why ``count`` LEDs (e.g. from the dome's ``.lp``) do not fit these settings, or None."""
+        if self.expected_led_count is not None and self.expected_led_count != count:
+            return f"expected_led_count = {self.expected_led_count} but {count} LEDs given"
+        corr = self.intensity_correction
+        if corr is not None and len(corr) != count:
+            return f"intensity_correction has {len(corr)} factors for {count} LEDs"
+        return None

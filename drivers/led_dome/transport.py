@@ -1,0 +1,125 @@
+"""Byte transports for the dome driver: the real serial port, or anything that behaves like it.
+
+The driver never touches pyserial directly; it is handed a :class:`Transport`, so the same driver
+runs on a USB serial port, on the emulator over a pseudo-terminal (still real pyserial), or on
+the emulator in-process (``simulator.dome_firmware.InProcessDomeTransport``).
+
+A transport carries the clock its reads wait on: real ports wait in real time whatever clock the
+rig uses, while the in-process emulator waits on the simulation's clock. The driver measures its
+reply deadlines on ``transport.clock`` so the two never disagree.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from typing import Protocol
+
+import serial
+
+from rti_rig.clock import Clock, SystemClock
+
+try:  # pyserial lets termios.error (not an OSError) escape from tcdrain/tcsetattr on POSIX
+    import termios
+
+    _PORT_ERRORS: tuple[type[BaseException], ...] = (
+        serial.SerialException,
+        OSError,
+        termios.error,
+    )
+except ImportError:  # pragma: no cover - Windows
+    _PORT_ERRORS = (serial.SerialException, OSError)
+
+
+class TransportError(Exception):
+    """The port is gone (unplugged, closed under us) or cannot be opened."""
+
+
+class Transport(Protocol):
+    """A byte pipe to the board. Opened by :meth:`open`, never in the constructor."""
+
+    #: Human name of the endpoint (port path), used in error messages.
+    name: str
+    #: The clock :meth:`read` waits on.
+    clock: Clock
+
+    def open(self) -> None: ...
+
+    def close(self) -> None:
+        """Release the port; safe twice."""
+        ...
+
+    def write(self, data: bytes) -> None: ...
+
+    def read(self, timeout_s: float) -> bytes:
+        """Bytes available now, waiting up to ``timeout_s`` for the first; ``b""`` on timeout."""
+        ...
+
+
+class SerialTransport:
+    """A pyserial port (``serial_for_url``, so ``loop://`` and ``socket://`` work too).
+
+    Opening the port toggles DTR, which resets most Arduino boards: the driver then waits for the
+    board's ready banner rather than sleeping a fixed time.
+    """
+
+    def __init__(self, port: str, baudrate: int = 115200, write_timeout_s: float = 1.0) -> None:
+        self.name = port
+        self.port = port
+        self.baudrate = baudrate
+        self.write_timeout_s = write_timeout_s
+        self.clock: Clock = SystemClock()
+        self._ser: serial.SerialBase | None = None
+        self._timeout: float | None = None
+
+    def open(self) -> None:
+        if self._ser is not None:
+            return
+        # A second program on the same port would interleave its bytes with ours: lock it
+        # (POSIX device paths only; URL handlers such as loop:// have nothing to lock).
+        lock = {"exclusive": True} if "://" not in self.port and os.name == "posix" else {}
+        try:
+            self._ser = serial.serial_for_url(
+                self.port,
+                baudrate=self.baudrate,
+                timeout=0,
+                write_timeout=self.write_timeout_s,
+                **lock,
+            )
+        except (*_PORT_ERRORS, ValueError) as exc:
+            raise TransportError(f"cannot open serial port {self.port}: {exc}") from exc
+        self._timeout = 0
+
+    def close(self) -> None:
+        ser, self._ser = self._ser, None
+        if ser is not None:
+            with contextlib.suppress(*_PORT_ERRORS):  # already gone: closing is best effort
+                ser.close()
+
+    def write(self, data: bytes) -> None:
+        ser = self._require()
+        try:
+            ser.write(data)
+            ser.flush()
+        except _PORT_ERRORS as exc:
+            raise TransportError(f"write to {self.port} failed: {exc}") from exc
+
+    def read(self, timeout_s: float) -> bytes:
+        ser = self._require()
+        timeout = max(0.0, round(timeout_s, 4))
+        try:
+            if timeout != self._timeout:
+                ser.timeout = timeout
+                self._timeout = timeout
+            first = ser.read(1)
+            if not first:
+                return b""
+            waiting = ser.in_waiting
+            return first + (ser.read(waiting) if waiting else b"")
+        except _PORT_ERRORS as exc:
+            raise TransportError(f"read from {self.port} failed: {exc}") from exc
+
+    def _require(self) -> serial.SerialBase:
+        if self._ser is None:
+            raise TransportError(f"serial port {self.port} is not open")
+        return self._ser

@@ -1,0 +1,716 @@
+"""Rig-layer policy for an LED dome: what to do when the bytes go wrong, and how to spare the LEDs.
+
+Policy above, bytes below. A dome driver (``drivers/led_dome``) only turns verbs into bytes and
+reports precisely what went wrong as a :class:`DomeLinkError`. This module decides what that
+means for an acquisition, and implements :class:`rti_rig.rig.DiscreteLightSource`:
+
+* idempotent commands (light one LED, all off, handshake, query) are resent a bounded number of
+  times after a timeout, a garbled or mismatched reply; a shutter pulse never is;
+* a USB drop is answered by a bounded number of reconnections, a board reset by a new handshake;
+* if the board reset or dropped while an LED was meant to be lit, the light that the last image
+  was taken under is unknown: that is an error naming the LED and the command, never a silent
+  recovery, so that no image is recorded under a wrong (or no) light;
+* per-LED intensity correction maps a requested intensity to a PWM level;
+* a thermal guard bounds each LED's continuous on-time (also sent to the firmware's watchdog when
+  the profile can carry it) and its duty cycle over a sliding window, waiting on the injected
+  clock for an LED to cool rather than overdriving it;
+* LED index ↔ direction comes from the dome's calibrated ``.lp`` (passed in as directions).
+
+The rig core must not import ``drivers``: the driver is reached through the :class:`DomeLink`
+protocol below and builds its errors from :class:`DomeLinkError`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import Protocol, TypeVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.clock import Clock
+from rti_rig.errors import DeviceError
+from rti_rig.rig import DiscreteLightSource
+
+log = logging.getLogger("rti_rig.dome")
+
+T = TypeVar("T")
+
+
+# ----------------------------------------------------------------------------- link interface
+
+
+class LinkFault(StrEnum):
+    """What went wrong on the link, as the driver saw it."""
+
+    TIMEOUT = "timeout"  # no reply in time (dropped or late)
+    GARBLED = "garbled"  # bytes that are not a valid reply
+    MISMATCH = "mismatch"  # the echo says the firmware did something else
+    RESET = "reset"  # an unexpected boot banner: the board rebooted
+    DISCONNECTED = "disconnected"  # the port went away (USB drop) or is not open
+    REJECTED = "rejected"  # the firmware answered ERR
+
+
+class DomeLinkError(DeviceError):
+    """A failed exchange with the dome. ``retryable``: resending the same command may succeed."""
+
+    def __init__(
+        self,
+        device: str,
+        message: str,
+        command: str | None,
+        fault: LinkFault,
+        *,
+        retryable: bool,
+        code: int | None = None,
+    ) -> None:
+        super().__init__(device, message, command)
+        self.fault = fault
+        self.retryable = retryable
+        self.code = code
+
+
+@dataclass(frozen=True)
+class DomeInfo:
+    """What the handshake told about the board."""
+
+    firmware_id: str
+    version: str
+    led_count: int
+
+
+class DomeLink(Protocol):
+    """The verbs of a dome driver (one exchange each; errors are :class:`DomeLinkError`)."""
+
+    device: str
+    #: The light command carries the firmware watchdog time (max on-time).
+    has_watchdog: bool
+    #: The light acknowledgement echoes the LED index and level that were executed.
+    echoes_light: bool
+    #: Highest PWM level the firmware takes.
+    max_level: int
+
+    def connect(self) -> DomeInfo:
+        """Open the port, wait for the ready banner, handshake."""
+        ...
+
+    def close(self) -> None: ...
+
+    def hello(self) -> DomeInfo: ...
+
+    def light(self, index: int, level: int, max_on_ms: int | None) -> None: ...
+
+    def all_off(self) -> None: ...
+
+    def shutter(self, pulse_ms: int) -> None: ...
+
+    def query(self) -> tuple[int | None, int]:
+        """(index lit or None, level) as the firmware sees it."""
+        ...
+
+
+class DomeLedError(DeviceError):
+    """An error about one LED (dead, thermal limit, unknown light during a capture)."""
+
+    def __init__(self, device: str, led: int, message: str, command: str | None) -> None:
+        super().__init__(device, message, command)
+        self.led = led
+
+
+# ----------------------------------------------------------------------------- thermal guard
+
+
+@dataclass(frozen=True)
+class ThermalLimits:
+    """Per LED: longest continuous on-time, and highest duty over a sliding window."""
+
+    max_on_s: float
+    max_duty: float
+    duty_window_s: float
+
+    def __post_init__(self) -> None:
+        if not (self.max_on_s > 0 and 0 < self.max_duty <= 1 and self.duty_window_s > 0):
+            raise ValueError(f"invalid thermal limits {self}")
+        if self.max_on_s > self.max_duty * self.duty_window_s:
+            raise ValueError(
+                f"max_on_s {self.max_on_s} s exceeds max_duty × duty_window_s "
+                f"({self.max_duty * self.duty_window_s:g} s): one lighting would break the duty"
+            )
+
+
+class ThermalGuard:
+    """On-time bookkeeping per LED, and when an LED may next be lit.
+
+    Pure bookkeeping on times given by the caller (no clock inside), so it is tested directly.
+    The start time returned by :meth:`earliest_start` assumes the next lighting lasts the full
+    ``max_on_s`` (which the watchdog or the on-time check enforce), so the duty over any window
+    ending at the end of that lighting stays within ``max_duty``.
+    """
+
+    def __init__(self, limits: ThermalLimits) -> None:
+        self.limits = limits
+        self._intervals: dict[int, list[tuple[float, float]]] = {}
+
+    def record(self, index: int, start: float, end: float) -> None:
+        if end < start:
+            raise ValueError(f"LED {index}: interval ends ({end}) before it starts ({start})")
+        spans = self._intervals.setdefault(index, [])
+        spans.append((start, end))
+        horizon = end - 2 * self.limits.duty_window_s
+        while spans and spans[0][1] < horizon:
+            spans.pop(0)
+
+    def on_time(self, index: int, window_start: float, window_end: float) -> float:
+        total = 0.0
+        for s, e in self._intervals.get(index, ()):
+            total += max(0.0, min(e, window_end) - max(s, window_start))
+        return total
+
+    def earliest_start(self, index: int, now: float) -> float:
+        """Earliest time ≥ ``now`` at which ``index`` may be lit for up to ``max_on_s``."""
+        lim = self.limits
+        budget = lim.max_duty * lim.duty_window_s - lim.max_on_s
+
+        def fits(t: float) -> bool:
+            return self.on_time(index, t - lim.duty_window_s, t) <= budget + 1e-9
+
+        if fits(now):
+            return now
+        lo, hi = now, now + lim.duty_window_s
+        for _ in range(60):  # on_time falls monotonically as t moves on: bisect
+            mid = (lo + hi) / 2
+            if fits(mid):
+                hi = mid
+            else:
+                lo = mid
+        return hi
+
+
+# ----------------------------------------------------------------------------- policy
+
+
+@dataclass
+class DomeStats:
+    """What the policy had to do to keep the dome on track (for reports and tests)."""
+
+    commands: int = 0
+    retries: int = 0
+    reconnects: int = 0
+    rehandshakes: int = 0
+    thermal_wait_s: float = 0.0
+    recovered: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class DomePolicySettings:
+    """The policy knobs (the driver settings carry the same values from the rig config)."""
+
+    retries: int = 2
+    retry_backoff_s: float = 0.05
+    reconnect_attempts: int = 3
+    reconnect_backoff_s: float = 1.0
+    thermal: ThermalLimits = ThermalLimits(max_on_s=10.0, max_duty=0.5, duty_window_s=60.0)
+    intensity_correction: tuple[float, ...] | None = None
+    confirm_with_query: bool = False
+    expected_led_count: int | None = None
+    shutter_pulse_ms: int = 50
+
+
+@dataclass(frozen=True)
+class _Lit:
+    index: int
+    level: int
+    since: float
+
+
+class DomePolicy:
+    """An LED dome as a :class:`DiscreteLightSource`: retries, reconnection, thermal guard.
+
+    ``link`` is the driver (connected by :meth:`connect`, never in ``__init__``); ``clock``
+    measures on-times and paces back-offs and cool-downs; ``directions`` (N, 3) are the dome's
+    calibrated LED directions in LED index order, from its ``.lp``.
+    """
+
+    def __init__(
+        self,
+        link: DomeLink,
+        clock: Clock,
+        settings: DomePolicySettings | None = None,
+        *,
+        directions: NDArray[np.float64] | None = None,
+        name: str = "dome",
+    ) -> None:
+        self.name = name
+        self.link = link
+        self.clock = clock
+        self.settings = settings or DomePolicySettings()
+        self.directions = None if directions is None else np.asarray(directions, dtype=float)
+        self.guard = ThermalGuard(self.settings.thermal)
+        self.stats = DomeStats()
+        self.info: DomeInfo | None = None
+        self._lit: _Lit | None = None
+
+    # ------------------------------------------------------------------ lifecycle
+
+    def connect(self) -> None:
+        try:
+            info = self.link.connect()
+        except DomeLinkError as exc:
+            self._quiet_close()
+            raise DeviceError(
+                self.name,
+                f"no handshake with the dome ({exc.message}); check the port, the baud rate and "
+                "the protocol profile in the rig config, and that the board is powered",
+                exc.command,
+            ) from exc
+        problem = self._check_identity(info)
+        if problem:
+            self._quiet_close()
+            raise DeviceError(self.name, problem, "handshake")
+        self.info = info
+        self._lit = None
+        log.info(
+            "%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version, info.led_count
+        )
+        if not self.link.echoes_light and not self.settings.confirm_with_query:
+            log.warning(
+                "%s: this profile's light acknowledgement does not say which LED was lit; set "
+                "confirm_with_query = true to have the firmware confirm every LED",
+                self.name,
+            )
+        self._run(self.link.all_off, "all off")  # start from the safe state
+
+    def close(self) -> None:
+        """All off (best effort), then release the port. Safe twice and after a failed connect."""
+        if self.info is not None:
+            try:
+                self.all_off()
+            except DeviceError as exc:
+                log.warning("%s: could not switch all off while closing: %s", self.name, exc)
+        self.info = None
+        self._lit = None
+        self._quiet_close()
+
+    def light_count(self) -> int:
+        if self.info is not None:
+            return self.info.led_count
+        if self.directions is not None:
+            return len(self.directions)
+        raise DeviceError(self.name, "LED count unknown before connect(); connect first")
+
+    def direction_of(self, index: int) -> NDArray[np.float64]:
+        """Calibrated direction of LED ``index`` (from the dome's ``.lp``)."""
+        if self.directions is None:
+            raise DeviceError(self.name, "no calibrated LED directions were given (.lp file)")
+        self._check_index(index, len(self.directions))
+        return self.directions[index].copy()
+
+    # ------------------------------------------------------------------ verbs
+
+    def light(self, index: int, intensity: float = 1.0) -> None:
+        """Light ``index`` alone at ``intensity`` (0, 1], corrected per LED."""
+        info = self._require_connected(f"light LED {index}")
+        self._check_index(index, info.led_count)
+        level = self.level_for(index, intensity)
+        command = f"light LED {index} at level {level}"
+        self._check_on_time(command)
+        now = self.clock.now()
+        start = self.guard.earliest_start(index, now)
+        if start > now:
+            log.info("%s: LED %d cools for %.3f s (duty limit)", self.name, index, start - now)
+            self.clock.sleep(start - now)
+            self.stats.thermal_wait_s += start - now
+        max_on_ms = math.ceil(self.settings.thermal.max_on_s * 1000)
+        watchdog = max_on_ms if self.link.has_watchdog else None
+
+        def fire() -> None:
+            self.link.light(index, level, watchdog)
+            if self.settings.confirm_with_query:
+                lit, got = self.link.query()
+                if lit != index or got != level:
+                    raise DomeLinkError(
+                        self.link.device,
+                        f"the firmware reports LED {lit} at level {got} lit, not LED {index} at "
+                        f"level {level}",
+                        command,
+                        LinkFault.MISMATCH,
+                        retryable=True,
+                    )
+
+        try:
+            self._run(fire, command)
+        except DomeLinkError as exc:
+            self._fail_safe()
+            if exc.fault is LinkFault.REJECTED:
+                raise DomeLedError(
+                    self.name, index, f"LED {index} refused: {exc.message}", command
+                ) from exc
+            raise
+        since = self.clock.now()
+        previous = self._lit
+        if previous is not None and previous.index == index:
+            since = previous.since  # lit again without a pause: the on-time keeps counting
+        elif previous is not None:
+            self.guard.record(previous.index, previous.since, since)
+        self._lit = _Lit(index, level, since)
+
+    def all_off(self) -> None:
+        """Every LED off (the safe state); reports an LED that overran its on-time."""
+        if self.info is None:
+            return
+        try:
+            self._run(self.link.all_off, "all off")
+        except DomeLinkError:
+            self._lit = None
+            raise
+        self._check_on_time("all off")
+        if self._lit is not None:
+            self.guard.record(self._lit.index, self._lit.since, self.clock.now())
+        self._lit = None
+
+    def shutter(self, pulse_ms: int | None = None) -> None:
+        """Pulse the camera release line. Never resent: a resend could take a second picture."""
+        self._require_connected("shutter")
+        ms = self.settings.shutter_pulse_ms if pulse_ms is None else int(pulse_ms)
+        self._run(lambda: self.link.shutter(ms), f"shutter pulse {ms} ms", idempotent=False)
+
+    def lit_state(self) -> tuple[int | None, int]:
+        """What the firmware itself says is lit (index or None, level)."""
+        self._require_connected("query")
+        return self._run(self.link.query, "query lit LED")
+
+    def level_for(self, index: int, intensity: float) -> int:
+        """PWM level for ``intensity`` on LED ``index`` after its intensity correction."""
+        if not (math.isfinite(intensity) and 0.0 < intensity <= 1.0):
+            raise DeviceError(
+                self.name,
+                f"intensity {intensity} for LED {index} is outside (0, 1]",
+                f"light LED {index}",
+            )
+        corr = self.settings.intensity_correction
+        factor = 1.0 if corr is None else corr[index]
+        level = round(intensity * factor * self.link.max_level)
+        if level > self.link.max_level:
+            raise DomeLedError(
+                self.name,
+                index,
+                f"LED {index} cannot give intensity {intensity}: with its correction "
+                f"{factor:g} it would need level {level} > {self.link.max_level}; lower the "
+                "intensity or renormalise the correction list so its largest factor is 1",
+                f"light LED {index}",
+            )
+        return max(level, 1)
+
+    # ------------------------------------------------------------------ internals
+
+    def _run(
+        self,
+        op: Callable[[], T],
+        command: str,
+        *,
+        idempotent: bool = True,
+    ) -> T:
+        """Run one exchange with bounded retries, reconnection and the lost-light check."""
+        attempt = 0
+        while True:
+            self.stats.commands += 1
+            try:
+                return op()
+            except DomeLinkError as exc:
+                fault = exc.fault
+                log.warning(
+                    "%s: %s failed (%s, attempt %d): %s",
+                    self.name,
+                    command,
+                    fault,
+                    attempt + 1,
+                    exc.message,
+                )
+                if fault in (LinkFault.RESET, LinkFault.DISCONNECTED) and self._lit is not None:
+                    lost = self._lit
+                    self._lit = None
+                    self.guard.record(lost.index, lost.since, self.clock.now())
+                    self._recover(exc, command)
+                    what = "rebooted" if fault is LinkFault.RESET else "dropped off the USB bus"
+                    raise DomeLedError(
+                        self.name,
+                        lost.index,
+                        f"the board {what} while LED {lost.index} was meant to be lit (found "
+                        f"during '{command}'): the image taken under LED {lost.index} may have "
+                        "had no light; the dome is off again, repeat that capture",
+                        command,
+                    ) from exc
+                if not exc.retryable or not idempotent or attempt >= self.settings.retries:
+                    if not idempotent and exc.retryable:
+                        why = " (not resent: it is not idempotent)"
+                    elif exc.retryable:
+                        why = f"; gave up after {attempt + 1} attempt{'s' if attempt else ''}"
+                    else:
+                        why = (
+                            f" (after {attempt} resend{'s' if attempt > 1 else ''})"
+                            if attempt
+                            else ""
+                        )
+                    raise DomeLinkError(
+                        self.name,
+                        f"{exc.message}{why}",
+                        command,
+                        fault,
+                        retryable=False,
+                        code=exc.code,
+                    ) from exc
+                attempt += 1
+                self.stats.retries += 1
+                self._recover(exc, command)
+                self.stats.recovered.append(f"{command}: {fault}")
+
+    def _recover(self, exc: DomeLinkError, command: str) -> None:
+        """Bring the link back after ``exc`` so that the command can be sent again."""
+        if exc.fault is LinkFault.DISCONNECTED:
+            self._reconnect(command)
+        elif exc.fault is LinkFault.RESET:
+            self.stats.rehandshakes += 1
+            try:
+                info = self.link.hello()
+            except DomeLinkError as again:
+                if again.fault is LinkFault.DISCONNECTED:
+                    self._reconnect(command)
+                else:  # the resend that follows is bounded by the retry count anyway
+                    log.warning("%s: handshake after a reset failed: %s", self.name, again)
+                return
+            problem = self._check_identity(info)
+            if problem:
+                raise DeviceError(self.name, f"after a board reset: {problem}", command)
+        else:
+            self.clock.sleep(self.settings.retry_backoff_s)
+
+    def _reconnect(self, command: str) -> None:
+        self._quiet_close()
+        last = "no attempt made"
+        for attempt in range(self.settings.reconnect_attempts):
+            self.clock.sleep(self.settings.reconnect_backoff_s * (2**attempt))
+            try:
+                info = self.link.connect()
+            except DomeLinkError as exc:
+                last = exc.message
+                self._quiet_close()
+                continue
+            problem = self._check_identity(info)
+            if problem:
+                self._quiet_close()
+                raise DeviceError(self.name, f"after reconnecting: {problem}", command)
+            self.stats.reconnects += 1
+            return
+        raise DomeLinkError(
+            self.name,
+            f"the dome dropped off and did not come back after "
+            f"{self.settings.reconnect_attempts} reconnection attempts ({last}); check the USB "
+            "cable and the dome's power",
+            command,
+            LinkFault.DISCONNECTED,
+            retryable=False,
+        )
+
+    def _check_identity(self, info: DomeInfo) -> str | None:
+        s = self.settings
+        n = info.led_count
+        if n < 1:
+            return f"the firmware reports {n} LEDs"
+        if self.info is not None and n != self.info.led_count:
+            return f"the firmware now reports {n} LEDs, not {self.info.led_count}"
+        if s.expected_led_count is not None and n != s.expected_led_count:
+            return (
+                f"the firmware reports {n} LEDs but the rig config expects {s.expected_led_count}"
+            )
+        if self.directions is not None and len(self.directions) != n:
+            return f"the firmware reports {n} LEDs but the dome's .lp has {len(self.directions)}"
+        if s.intensity_correction is not None and len(s.intensity_correction) != n:
+            return (
+                f"intensity_correction has {len(s.intensity_correction)} factors but the "
+                f"firmware reports {n} LEDs"
+            )
+        return None
+
+    def _check_on_time(self, command: str) -> None:
+        """An LED on longer than max_on_s was cut by the watchdog (or overheated): say so."""
+        lit = self._lit
+        if lit is None:
+            return
+        on_s = self.clock.now() - lit.since
+        limit = self.settings.thermal.max_on_s
+        if on_s > limit + 1e-9:
+            self.guard.record(lit.index, lit.since, self.clock.now())
+            self._lit = None
+            self._fail_safe()
+            cut = (
+                " the firmware watchdog switched it off, so the image taken under it may be dark;"
+                if self.link.has_watchdog
+                else ""
+            )
+            raise DomeLedError(
+                self.name,
+                lit.index,
+                f"LED {lit.index} stayed on {on_s:.3f} s, beyond max_on_s = {limit:g} s;{cut} "
+                "raise max_on_s or shorten settle and exposure",
+                command,
+            )
+
+    def _fail_safe(self) -> None:
+        """Try to reach the safe state after an error, without masking that error."""
+        try:
+            self.link.all_off()
+        except DeviceError as exc:
+            log.warning("%s: all off after an error failed too: %s", self.name, exc)
+        self._lit = None
+
+    def _require_connected(self, command: str) -> DomeInfo:
+        if self.info is None:
+            raise DeviceError(self.name, "not connected; call connect() first", command)
+        return self.info
+
+    def _check_index(self, index: int, count: int) -> None:
+        if isinstance(index, bool) or not isinstance(index, int | np.integer):
+            raise DeviceError(self.name, f"LED index {index!r} is not an integer")
+        if not 0 <= index < count:
+            raise DeviceError(
+                self.name,
+                f"LED {index} does not exist: this dome has LEDs 0..{count - 1}",
+                f"light LED {index}",
+            )
+
+    def _quiet_close(self) -> None:
+        try:
+            self.link.close()
+        except Exception as exc:  # closing must never mask the error that led here
+            log.warning("%s: error while closing the port: %s", self.name, exc)
+
+
+# ----------------------------------------------------------------------------- self test
+
+
+@dataclass(frozen=True)
+class LedCheck:
+    index: int
+    ok: bool
+    message: str = ""
+
+
+@dataclass
+class SelfTestReport:
+    """What ``rti-rig check`` prints: identity, per-LED results, what recovery was needed."""
+
+    name: str
+    firmware: DomeInfo | None
+    led_count: int
+    checks: list[LedCheck] = field(default_factory=list)
+    elapsed_s: float = 0.0
+    stats: DomeStats | None = None
+    aborted: str | None = None
+    #: LEDs the test meant to step through (all of them unless a subset was asked for).
+    planned: int = 0
+    #: Wall-clock seconds each successful ``light`` call took (the command's round trip over
+    #: the real link, whatever clock the rig uses): a measured ``light_switch_s``.
+    light_latency_s: list[float] = field(default_factory=list)
+
+    @property
+    def failed(self) -> list[LedCheck]:
+        return [c for c in self.checks if not c.ok]
+
+    @property
+    def ok(self) -> bool:
+        return (
+            self.aborted is None
+            and not self.failed
+            and self.planned > 0
+            and len(self.checks) == self.planned
+        )
+
+    @property
+    def median_light_latency_s(self) -> float | None:
+        lat = self.light_latency_s
+        return float(np.median(lat)) if lat else None
+
+    def lines(self) -> list[str]:
+        fw = (
+            f"{self.firmware.firmware_id} {self.firmware.version}"
+            if self.firmware
+            else "unknown firmware"
+        )
+        out = [f"{self.name}: {fw}, {self.led_count} LEDs"]
+        passed = sum(c.ok for c in self.checks)
+        out.append(
+            f"LEDs stepped: {len(self.checks)}, passed: {passed}, "
+            f"failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
+        )
+        out += [f"  LED {c.index}: {c.message}" for c in self.failed]
+        if self.light_latency_s:
+            lat = np.asarray(self.light_latency_s) * 1000
+            out.append(
+                f"light command round trip: median {np.median(lat):.2f} ms, "
+                f"max {lat.max():.2f} ms (wall clock)"
+            )
+        if self.stats is not None:
+            s = self.stats
+            out.append(
+                f"recovery: {s.retries} retries, {s.reconnects} reconnects, "
+                f"{s.rehandshakes} re-handshakes"
+            )
+        if self.aborted:
+            out.append(f"ABORTED: {self.aborted}")
+        out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
+        return out
+
+
+def self_test(
+    source: DiscreteLightSource,
+    clock: Clock,
+    *,
+    intensity: float = 0.2,
+    settle_s: float = 0.05,
+    leds: Sequence[int] | None = None,
+) -> SelfTestReport:
+    """Handshake, then light each LED in turn (confirming with the firmware when it can).
+
+    Connects and closes ``source`` itself. An error about one LED is recorded and the test moves
+    on; any other error aborts the walk (the dome is switched off in every case).
+    """
+    started = clock.now()
+    report = SelfTestReport(name=source.name, firmware=None, led_count=0)
+    try:
+        source.connect()
+        report.led_count = source.light_count()
+        if isinstance(source, DomePolicy):
+            report.firmware = source.info
+            report.stats = source.stats
+        order = list(range(report.led_count)) if leds is None else list(leds)
+        report.planned = len(order)
+        for i in order:
+            try:
+                t0 = time.perf_counter()
+                source.light(i, intensity)
+                report.light_latency_s.append(time.perf_counter() - t0)
+                clock.sleep(settle_s)
+                if isinstance(source, DomePolicy):
+                    lit, _ = source.lit_state()
+                    if lit != i:
+                        report.checks.append(LedCheck(i, False, f"firmware reports LED {lit} lit"))
+                        source.all_off()
+                        continue
+                source.all_off()
+                report.checks.append(LedCheck(i, True))
+            except DomeLedError as exc:
+                report.checks.append(LedCheck(i, False, str(exc)))
+    except DeviceError as exc:
+        report.aborted = str(exc)
+    finally:
+        try:
+            source.close()
+        except DeviceError as exc:
+            report.aborted = report.aborted or str(exc)
+        report.elapsed_s = clock.now() - started
+    return report

@@ -1,0 +1,442 @@
+"""An LED dome firmware emulator that speaks the drivers' bytes, with deterministic faults.
+
+The emulator decodes commands and encodes replies with the very codec of the configured profile
+(``drivers.led_dome``), so the real driver runs unchanged against it: in-process through
+:class:`InProcessDomeTransport` on a virtual clock, or over a pseudo-terminal through real
+pyserial (``simulator.pty_link.emulated_dome_on_pty``).
+
+It keeps the **truth**: :attr:`DomeFirmware.lit` is the LED that really emits light (after dead
+LEDs, the watchdog, resets and dropped commands), so a simulated camera can render what the
+firmware does, not what the host asked for, and tests can check that no image is ever recorded
+under a wrong light.
+
+Faults come from a :class:`FaultPlan` keyed by the number of the command received (1-based,
+counted over the emulator's whole life, garbled commands included), so a test can say "drop the
+reply to the 5th command" and get the same run every time.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+from drivers.led_dome.codec_base import DomeCodec
+from drivers.led_dome.messages import (
+    ERR_BAD_ARGUMENT,
+    ERR_LED_FAULT,
+    ERR_LED_OUT_OF_RANGE,
+    Ack,
+    AllOff,
+    BadRequest,
+    Command,
+    DomeIdentity,
+    Hello,
+    Light,
+    LitState,
+    Nak,
+    Query,
+    Shutter,
+)
+from drivers.led_dome.profiles import make_codec
+from drivers.led_dome.settings import DomeSerialSettings
+from drivers.led_dome.transport import TransportError
+from rti_rig.clock import Clock, SystemClock
+from simulator.pty_link import PtyLink, serve_on_pty
+
+
+class FaultKind(StrEnum):
+    DROP_REPLY = "drop_reply"  # executed, reply never sent
+    GARBLE_REPLY = "garble_reply"  # executed, one reply byte damaged
+    GARBLE_COMMAND = "garble_command"  # one command byte damaged on the way in
+    DELAY_REPLY = "delay_reply"  # executed, reply sent after ``delay_s``
+    DISCONNECT = "disconnect"  # USB drop as the command arrives: not executed, board unpowered
+    RESET = "reset"  # brown-out reset as the command arrives: not executed, banner
+    RESET_AFTER_REPLY = "reset_after_reply"  # executed and acknowledged, then a reset
+
+
+@dataclass(frozen=True)
+class Fault:
+    """Fault ``kind`` at the ``at_command``-th command received (1-based)."""
+
+    at_command: int
+    kind: FaultKind
+    delay_s: float = 1.0  # DELAY_REPLY: reply delay; DISCONNECT: time the device stays away
+
+
+@dataclass(frozen=True)
+class FaultPlan:
+    faults: tuple[Fault, ...] = ()
+
+    @classmethod
+    def of(cls, *faults: tuple[int, FaultKind] | Fault) -> FaultPlan:
+        return cls(tuple(f if isinstance(f, Fault) else Fault(f[0], f[1]) for f in faults))
+
+    def at(self, n: int) -> list[Fault]:
+        return [f for f in self.faults if f.at_command == n]
+
+
+@dataclass(frozen=True)
+class Output:
+    """Bytes the board sends at time ``due_s`` (on the emulator's clock)."""
+
+    due_s: float
+    data: bytes
+
+
+@dataclass
+class _LitLed:
+    index: int
+    level: int
+    since: float
+    until: float | None  # watchdog deadline
+
+
+@dataclass
+class FirmwareEvent:
+    """One entry of the truth log."""
+
+    time_s: float
+    what: str  # "boot", "lit", "off", "watchdog", "shutter", "reset", "unplugged", "dead"
+    index: int | None = None
+    level: int | None = None
+
+
+def garble(data: bytes) -> bytes:
+    """Damage one byte in the middle of ``data`` (deterministic, keeps a trailing newline)."""
+    if not data:
+        return data
+    body_len = len(data) - 1 if data.endswith(b"\n") and len(data) > 1 else len(data)
+    i = body_len // 2
+    return data[:i] + bytes([data[i] ^ 0x41]) + data[i + 1 :]
+
+
+@dataclass
+class DomeFirmware:
+    """The board: LEDs, a watchdog, a boot banner, and the faults of its plan.
+
+    ``reports_dead_leds``: the board senses LED current and answers an error for a dead LED;
+    otherwise it acknowledges and the LED stays dark (only the image can tell).
+    """
+
+    codec: DomeCodec
+    led_count: int = 48
+    firmware_id: str = "RTIDOME-EMU"
+    version: str = "1.0.0"
+    max_level: int = 255
+    dead_leds: frozenset[int] = frozenset()
+    reports_dead_leds: bool = True
+    faults: FaultPlan = field(default_factory=FaultPlan)
+    clock: Clock = field(default_factory=SystemClock)
+    boot_delay_s: float = 0.0
+    banner_on_boot: bool = True
+    #: Serial line speed: replies take the time their bytes (and the command's) need on the
+    #: wire, 10 bits a byte, as a UART would; a pty alone has no line speed. None: instant.
+    baudrate: int | None = None
+
+    def __post_init__(self) -> None:
+        self.dead_leds = frozenset(self.dead_leds)
+        self._lock = threading.RLock()
+        self._rx = bytearray()
+        self._lit: _LitLed | None = None
+        self.commands_received = 0
+        self.history: list[FirmwareEvent] = []
+        self.powered = False
+        self.unplugged_until: float | None = None
+        self._disconnect_pending: float | None = None
+        self._booting_until = 0.0
+
+    @property
+    def identity(self) -> DomeIdentity:
+        return DomeIdentity(self.firmware_id, self.version, self.led_count)
+
+    def wire_s(self, n_bytes: int) -> float:
+        """Seconds ``n_bytes`` take on the serial line (8N1: 10 bits a byte)."""
+        return 0.0 if not self.baudrate else n_bytes * 10.0 / self.baudrate
+
+    # ------------------------------------------------------------------ truth
+
+    @property
+    def lit(self) -> tuple[int, int] | None:
+        """(index, level) of the LED really emitting light now, or None."""
+        with self._lock:
+            self._expire_watchdog()
+            lit = self._lit
+            if lit is None or lit.index in self.dead_leds:
+                return None  # a dead LED the firmware believes lit gives no light
+            return (lit.index, lit.level)
+
+    def lit_indices(self) -> list[int]:
+        """LEDs really emitting light (0 or 1 of them: the firmware lights one at a time)."""
+        state = self.lit
+        return [] if state is None else [state[0]]
+
+    # ------------------------------------------------------------------ lifecycle
+
+    def boot(self) -> list[Output]:
+        """Power-on or reset: everything off, banner after the boot delay."""
+        with self._lock:
+            now = self.clock.now()
+            self._switch_off(now, "boot")
+            self._rx.clear()
+            self.powered = True
+            self._booting_until = now + self.boot_delay_s
+            self.history.append(FirmwareEvent(now, "boot"))
+            if not self.banner_on_boot:
+                return []
+            banner = self.codec.encode_banner(self.identity)
+            return [Output(now + self.boot_delay_s + self.wire_s(len(banner)), banner)]
+
+    def on_port_opened(self) -> list[Output]:
+        """Opening the port toggles DTR, which resets an Arduino: reboot."""
+        return self.boot()
+
+    def take_disconnect(self) -> float | None:
+        """Seconds the device stays away, once, after a DISCONNECT fault fired; else None."""
+        with self._lock:
+            down, self._disconnect_pending = self._disconnect_pending, None
+            return down
+
+    def receive(self, data: bytes) -> list[Output]:
+        """Bytes from the host; returns what the board sends back, with due times."""
+        out: list[Output] = []
+        with self._lock:
+            if not self.powered:
+                return out
+            if self.clock.now() < self._booting_until:
+                # the bootloader runs: bytes sent before the banner are lost, as on an Arduino
+                self.history.append(FirmwareEvent(self.clock.now(), "lost while booting"))
+                return out
+            self._rx.extend(data)
+            while self._rx and self.powered:
+                parsed, consumed = self.codec.decode_command(bytes(self._rx))
+                if parsed is None:
+                    if consumed:
+                        del self._rx[:consumed]
+                        continue
+                    break
+                raw = bytes(self._rx[:consumed])
+                del self._rx[:consumed]
+                self.commands_received += 1
+                faults = self.faults.at(self.commands_received)
+                kinds = {f.kind for f in faults}
+                if FaultKind.GARBLE_COMMAND in kinds:
+                    reparsed, _ = self.codec.decode_command(garble(raw))
+                    parsed = (
+                        reparsed
+                        if reparsed is not None
+                        else BadRequest(raw, None, ERR_BAD_ARGUMENT, "garbled beyond framing")
+                    )
+                out += self._handle(parsed, faults, len(raw))
+            return out
+
+    # ------------------------------------------------------------------ internals
+
+    def _handle(
+        self,
+        parsed: tuple[int | None, Command] | BadRequest,
+        faults: Iterable[Fault],
+        command_len: int,
+    ) -> list[Output]:
+        now = self.clock.now()
+        by_kind = {f.kind: f for f in faults}
+        if FaultKind.DISCONNECT in by_kind:
+            self._switch_off(now, "unplugged")
+            self.history.append(FirmwareEvent(now, "unplugged"))
+            self.powered = False
+            down = by_kind[FaultKind.DISCONNECT].delay_s
+            self.unplugged_until = now + down
+            self._disconnect_pending = down
+            return []
+        if FaultKind.RESET in by_kind:
+            self.history.append(FirmwareEvent(now, "reset"))
+            return self.boot()
+        if isinstance(parsed, BadRequest):
+            reply_msg: Ack | Nak = Nak(parsed.seq, parsed.code, parsed.reason)
+            cmd: Command | None = None
+        else:
+            seq, cmd = parsed
+            reply_msg = self._execute(seq, cmd, now)
+        data = self.codec.encode_reply(reply_msg, cmd)
+        sent = now + self.wire_s(command_len + len(data))
+        if FaultKind.DROP_REPLY in by_kind:
+            out: list[Output] = []
+        elif FaultKind.GARBLE_REPLY in by_kind:
+            out = [Output(sent, garble(data))]
+        elif FaultKind.DELAY_REPLY in by_kind:
+            out = [Output(sent + by_kind[FaultKind.DELAY_REPLY].delay_s, data)]
+        else:
+            out = [Output(sent, data)]
+        if FaultKind.RESET_AFTER_REPLY in by_kind:
+            self.history.append(FirmwareEvent(now, "reset"))
+            # the reset follows the acknowledgement on the wire, whatever the boot delay
+            out += [Output(max(o.due_s, sent + 1e-6), o.data) for o in self.boot()]
+        return out
+
+    def _execute(self, seq: int | None, cmd: Command, now: float) -> Ack | Nak:
+        if isinstance(cmd, Hello):
+            return Ack(seq, self.identity)
+        if isinstance(cmd, Light):
+            if not 0 <= cmd.index < self.led_count:
+                return Nak(seq, ERR_LED_OUT_OF_RANGE, f"LED {cmd.index} of {self.led_count}")
+            if not 0 <= cmd.level <= self.max_level:
+                return Nak(seq, ERR_BAD_ARGUMENT, f"level {cmd.level}")
+            self._switch_off(now, "off")
+            if cmd.index in self.dead_leds:
+                self.history.append(FirmwareEvent(now, "dead", cmd.index, cmd.level))
+                if self.reports_dead_leds:
+                    return Nak(seq, ERR_LED_FAULT, f"LED {cmd.index} open circuit")
+            until = None if not cmd.max_on_ms else now + cmd.max_on_ms / 1000.0
+            self._lit = _LitLed(cmd.index, cmd.level, now, until)
+            self.history.append(FirmwareEvent(now, "lit", cmd.index, cmd.level))
+            return Ack(seq, cmd)
+        if isinstance(cmd, AllOff):
+            self._switch_off(now, "off")
+            return Ack(seq, cmd)
+        if isinstance(cmd, Shutter):
+            self.history.append(FirmwareEvent(now, "shutter", level=cmd.pulse_ms))
+            return Ack(seq, cmd)
+        if isinstance(cmd, Query):
+            self._expire_watchdog()
+            lit = self._lit
+            return Ack(seq, LitState(None, 0) if lit is None else LitState(lit.index, lit.level))
+        raise TypeError(f"unhandled command {cmd!r}")
+
+    def _expire_watchdog(self) -> None:
+        lit = self._lit
+        if lit is not None and lit.until is not None and self.clock.now() >= lit.until:
+            self.history.append(FirmwareEvent(lit.until, "watchdog", lit.index))
+            self._lit = None
+
+    def _switch_off(self, now: float, why: str) -> None:
+        self._expire_watchdog()
+        if self._lit is not None:
+            self.history.append(FirmwareEvent(now, why, self._lit.index))
+        self._lit = None
+
+
+class InProcessDomeTransport:
+    """A :class:`drivers.led_dome.transport.Transport` wired straight to a :class:`DomeFirmware`.
+
+    Reads wait on the firmware's (virtual) clock: a reply due later than the read's timeout is not
+    seen, exactly like a late reply on a real port, but no test ever really sleeps.
+    """
+
+    def __init__(self, firmware: DomeFirmware, name: str = "in-process dome") -> None:
+        self.firmware = firmware
+        self.clock = firmware.clock
+        self.name = name
+        self._queue: list[Output] = []
+        self._open = False
+        self.opens = 0
+
+    def open(self) -> None:
+        fw = self.firmware
+        now = self.clock.now()
+        if fw.unplugged_until is not None and now < fw.unplugged_until:
+            raise TransportError(f"{self.name}: no such device (unplugged)")
+        self._open = True
+        self.opens += 1
+        self._queue = list(fw.on_port_opened())
+
+    def close(self) -> None:
+        self._open = False
+        self._queue.clear()
+
+    def write(self, data: bytes) -> None:
+        self._check()
+        self._queue += self.firmware.receive(data)
+        self._queue.sort(key=lambda o: o.due_s)
+
+    def read(self, timeout_s: float) -> bytes:
+        self._check()
+        now = self.clock.now()
+        if not any(o.due_s <= now for o in self._queue):
+            upcoming = [o.due_s for o in self._queue if o.due_s <= now + timeout_s]
+            wait = (min(upcoming) - now) if upcoming else timeout_s
+            if wait > 0:
+                self.clock.sleep(wait)
+            self._check()
+            now = self.clock.now()
+        ready = [o for o in self._queue if o.due_s <= now]
+        self._queue = [o for o in self._queue if o.due_s > now]
+        return b"".join(o.data for o in ready)
+
+    def _check(self) -> None:
+        if not self._open:
+            raise TransportError(f"{self.name} is not open")
+        down = self.firmware.take_disconnect()
+        if down is not None or not self.firmware.powered:
+            self._open = False
+            self._queue.clear()
+            raise TransportError(f"{self.name}: device disconnected")
+
+
+def firmware_for(settings: DomeSerialSettings, **kwargs: object) -> DomeFirmware:
+    """A firmware emulator speaking the profile of ``settings`` (same codec as the driver)."""
+    kwargs.setdefault("baudrate", settings.baudrate)
+    return DomeFirmware(make_codec(settings), max_level=settings.max_level, **kwargs)  # type: ignore[arg-type]
+
+
+@contextlib.contextmanager
+def emulated_dome_on_pty(firmware: DomeFirmware) -> Iterator[PtyLink]:
+    """Serve ``firmware`` on a pseudo-terminal; ``link.port`` is the path for pyserial.
+
+    The firmware must run on a :class:`SystemClock`: the pty thread times replies in real time.
+    """
+    if not isinstance(firmware.clock, SystemClock):
+        raise ValueError("a firmware served on a pty needs a SystemClock (replies are real-time)")
+    with serve_on_pty(firmware, "dome") as link:
+        yield link
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Serve an emulated dome on a pty until interrupted: ``python -m simulator.dome_firmware``.
+
+    Prints the port path, so that a rig config (or ``rti-rig check``) can be pointed at it for a
+    dry run through the real driver and real pyserial.
+    """
+    import argparse
+    import time
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("--profile", choices=["default", "framed", "binary"], default="default")
+    parser.add_argument("--leds", type=int, default=48)
+    parser.add_argument("--dead", type=int, nargs="*", default=[], help="dead LED indices")
+    parser.add_argument("--boot-delay-s", type=float, default=0.5)
+    parser.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="K:KIND",
+        help=f"fault KIND at the K-th command; kinds: {', '.join(k.value for k in FaultKind)}",
+    )
+    parser.add_argument("--seconds", type=float, default=None, help="stop after this long")
+    args = parser.parse_args(argv)
+    faults = []
+    for spec in args.fault:
+        at, _, kind = spec.partition(":")
+        faults.append(Fault(int(at), FaultKind(kind)))
+    settings = DomeSerialSettings(port="pty", profile=args.profile)
+    firmware = firmware_for(
+        settings,
+        led_count=args.leds,
+        dead_leds=frozenset(args.dead),
+        boot_delay_s=args.boot_delay_s,
+        faults=FaultPlan(tuple(faults)),
+    )
+    with emulated_dome_on_pty(firmware) as link:
+        print(f"emulated {args.profile} dome with {args.leds} LEDs on {link.port}", flush=True)
+        deadline = None if args.seconds is None else time.monotonic() + args.seconds
+        try:
+            while link.alive and (deadline is None or time.monotonic() < deadline):
+                time.sleep(0.1)
+        except KeyboardInterrupt:
+            pass
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,194 @@
+"""Serve a byte-level device emulator on a pseudo-terminal, so real pyserial talks to it.
+
+A thread owns the master side of an ``os.openpty()`` pair; the host opens the slave through a
+stable symlink (like ``/dev/serial/by-id/...``) with ordinary pyserial. The helper emulates what
+matters about a USB serial board:
+
+* **auto-reset on open**: when the slave gets opened (the master stops reporting a hang-up), the
+  device's ``on_port_opened()`` runs, so an Arduino-like board reboots and sends its banner;
+* **USB drop**: when the device asks for it (``take_disconnect()``), the pty is torn down (the
+  host's next read or write fails as on a real unplug) and a fresh one appears behind the same
+  symlink after the requested time, so the host can reconnect by path;
+* **timed replies**: outputs carry due times, so late replies really arrive late.
+
+Shutdown is bounded: the thread polls with a short timeout and is joined with a timeout.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import select
+import tempfile
+import threading
+import time
+import tty
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+
+class TimedOutput(Protocol):
+    due_s: float
+    data: bytes
+
+
+class PtyDevice(Protocol):
+    """A device emulator whose outputs are timed on ``time.monotonic`` (a ``SystemClock``)."""
+
+    def on_port_opened(self) -> list[TimedOutput]: ...
+
+    def receive(self, data: bytes) -> list[TimedOutput]: ...
+
+    def take_disconnect(self) -> float | None: ...
+
+
+@dataclass
+class PtyLink:
+    """A running pty server: open ``port`` with pyserial; ``stop()`` to end (also on exit)."""
+
+    port: str
+    device: PtyDevice
+    _stop: threading.Event
+    _thread: threading.Thread
+    errors: list[BaseException]
+
+    @property
+    def alive(self) -> bool:
+        return self._thread.is_alive()
+
+    def stop(self, timeout_s: float = 2.0) -> None:
+        self._stop.set()
+        self._thread.join(timeout_s)
+        if self._thread.is_alive():
+            raise RuntimeError(f"pty server for {self.port} did not stop within {timeout_s} s")
+
+
+class _Server:
+    def __init__(self, device: PtyDevice, link_path: Path, stop: threading.Event) -> None:
+        self.device = device
+        self.link_path = link_path
+        self.stop = stop
+        self.master = -1
+        self.opened = False
+        self.pending: list[TimedOutput] = []
+        self.errors: list[BaseException] = []
+
+    def new_pty(self) -> None:
+        master, slave = os.openpty()
+        tty.setraw(slave)
+        target = os.ttyname(slave)
+        os.close(slave)  # keep no slave fd: a hang-up on the master then means "nobody opened it"
+        tmp = self.link_path.with_suffix(".new")
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        tmp.symlink_to(target)
+        tmp.replace(self.link_path)
+        old, self.master = self.master, master
+        self.opened = False
+        self.pending.clear()
+        if old >= 0:
+            os.close(old)
+
+    def run(self) -> None:
+        try:
+            self._loop()
+        except BaseException as exc:  # reported to the test through PtyLink.errors
+            self.errors.append(exc)
+        finally:
+            if self.master >= 0:
+                os.close(self.master)
+                self.master = -1
+
+    def _loop(self) -> None:
+        poller = select.poll()
+        registered = -1
+        while not self.stop.is_set():
+            if registered != self.master:
+                if registered >= 0:
+                    with contextlib.suppress(KeyError, ValueError):
+                        poller.unregister(registered)
+                poller.register(self.master, select.POLLIN)
+                registered = self.master
+            events = poller.poll(self._poll_ms())
+            hup = any(ev & select.POLLHUP for _, ev in events)
+            if hup:
+                if self.opened:
+                    self.opened = False
+                    self.pending.clear()  # nobody listens: output is lost, as on a real board
+                time.sleep(0.002)
+            elif not self.opened:
+                self.opened = True
+                self.pending += self.device.on_port_opened()
+            if any(ev & select.POLLIN for _, ev in events) and not hup:
+                try:
+                    data = os.read(self.master, 4096)
+                except OSError:
+                    data = b""
+                if data:
+                    self.pending += self.device.receive(data)
+            down = self.device.take_disconnect()
+            if down is not None:
+                self._unplug(down)
+                continue
+            self._flush_due()
+
+    def _poll_ms(self) -> int:
+        if not self.pending:
+            return 10
+        wait = min(o.due_s for o in self.pending) - time.monotonic()
+        return max(0, min(10, int(wait * 1000) + 1))
+
+    def _flush_due(self) -> None:
+        if not self.pending or not self.opened:
+            return
+        now = time.monotonic()
+        due = sorted((o for o in self.pending if o.due_s <= now), key=lambda o: o.due_s)
+        if not due:
+            return
+        self.pending = [o for o in self.pending if o.due_s > now]
+        data = b"".join(o.data for o in due)
+        with contextlib.suppress(OSError):
+            os.write(self.master, data)
+
+    def _unplug(self, down_s: float) -> None:
+        """Close the pty (the host sees EIO), then offer a new one after ``down_s``.
+
+        With ``down_s <= 0`` the new pty is behind the symlink before the old one closes, so a
+        host that reconnects as soon as it notices the drop finds the device back at once.
+        """
+        if down_s <= 0:
+            self.new_pty()
+            return
+        with contextlib.suppress(FileNotFoundError):
+            self.link_path.unlink()
+        os.close(self.master)
+        self.master = -1
+        self.pending.clear()
+        self.stop.wait(max(0.0, down_s))
+        if not self.stop.is_set():
+            self.new_pty()
+
+
+@contextlib.contextmanager
+def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
+    """Serve ``device`` on a pty; yields a :class:`PtyLink` whose ``port`` pyserial can open."""
+    folder = Path(tempfile.mkdtemp(prefix="rti-rig-pty-"))
+    link_path = folder / f"tty-{name}"
+    stop = threading.Event()
+    server = _Server(device, link_path, stop)
+    server.new_pty()
+    thread = threading.Thread(target=server.run, name=f"pty-{name}", daemon=True)
+    link = PtyLink(str(link_path), device, stop, thread, server.errors)
+    thread.start()
+    try:
+        yield link
+    finally:
+        stop.set()
+        thread.join(2.0)
+        for p in (link_path, link_path.with_suffix(".new")):
+            with contextlib.suppress(FileNotFoundError):
+                p.unlink()
+        with contextlib.suppress(OSError):
+            folder.rmdir()

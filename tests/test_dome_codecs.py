@@ -1,0 +1,303 @@
+"""Byte-exact codec tests: scripted exchanges for every dome protocol profile, both sides."""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from drivers.led_dome.codec_binary import BinaryCodec
+from drivers.led_dome.codec_default import DefaultCodec
+from drivers.led_dome.codec_framed import FramedCodec, FramedSpec
+from drivers.led_dome.messages import (
+    Ack,
+    AllOff,
+    BadRequest,
+    Banner,
+    DomeIdentity,
+    Garbled,
+    Hello,
+    Light,
+    LitState,
+    Nak,
+    Query,
+    Shutter,
+)
+from drivers.led_dome.profiles import make_codec
+from drivers.led_dome.settings import DomeSerialSettings
+
+IDENT = DomeIdentity("RTIDOME", "1.2.0", 48)
+
+# (seq, command, command bytes, reply, reply bytes): each row is one scripted exchange.
+DEFAULT_SCRIPT = [
+    (1, Hello(), b"1 ID*1C\n", Ack(1, IDENT), b"OK 1 ID RTIDOME 1.2.0 48*6B\n"),
+    (
+        7,
+        Light(12, 200, 5000),
+        b"7 L 12 200 5000*4F\n",
+        Ack(7, Light(12, 200, 5000)),
+        b"OK 7 L 12 200 5000*6B\n",
+    ),
+    (8, AllOff(), b"8 X*40\n", Ack(8, AllOff()), b"OK 8 X*64\n"),
+    (9, Shutter(50), b"9 S 50*6F\n", Ack(9, Shutter(50)), b"OK 9 S 50*4B\n"),
+    (10, Query(), b"10 Q*70\n", Ack(10, LitState(12, 200)), b"OK 10 Q 12 200*65\n"),
+    (10, Query(), b"10 Q*70\n", Ack(10, LitState(None, 0)), b"OK 10 Q -1 0*78\n"),
+    (
+        11,
+        Light(99, 255),
+        b"11 L 99 255*5E\n",
+        Nak(11, 3, "LED 99 of 48"),
+        b"ERR 11 3 LED_99_of_48*41\n",
+    ),
+]
+
+FRAMED_SCRIPT = [
+    (1, Hello(), b"<9,1>", Ack(1, IDENT), b"<OK,1,9,RTIDOME,1.2.0,48>"),
+    (7, Light(12, 200), b"<3,7,12,200>", Ack(7, Light(12, 200)), b"<OK,7,3,12,200>"),
+    (8, AllOff(), b"<0,8>", Ack(8, AllOff()), b"<OK,8,0>"),
+    (9, Shutter(50), b"<6,9,50>", Ack(9, Shutter(50)), b"<OK,9,6,50>"),
+    (10, Query(), b"<8,10>", Ack(10, LitState(12, 200)), b"<OK,10,8,12,200>"),
+    (10, Query(), b"<8,10>", Ack(10, LitState(None, 0)), b"<OK,10,8,-1,0>"),
+    (11, Light(3, 10), b"<3,11,3,10>", Nak(11, 4, "LED fault"), b"<ERR,11,4,LED fault>"),
+]
+
+BINARY_SCRIPT = [
+    (
+        1,
+        Hello(),
+        bytes.fromhex("a5 01 01 00 00 00 a5"),
+        Ack(1, DomeIdentity("binary-0x2A", "1.2", 48)),
+        bytes.fromhex("01 01 02 00 30 2a 18"),
+    ),
+    (7, Light(12, 200), bytes.fromhex("a5 02 07 00 0c c8 64"), Ack(7), bytes.fromhex("07")),
+    (8, AllOff(), bytes.fromhex("a5 03 08 00 00 00 ae"), Ack(8), bytes.fromhex("08")),
+    (9, Shutter(50), bytes.fromhex("a5 04 09 00 32 00 9a"), Ack(9), bytes.fromhex("09")),
+    (
+        10,
+        Query(),
+        bytes.fromhex("a5 05 0a 00 00 00 aa"),
+        Ack(10, LitState(12, 200)),
+        bytes.fromhex("0a 00 0c c8 ce"),
+    ),
+    (
+        10,
+        Query(),
+        bytes.fromhex("a5 05 0a 00 00 00 aa"),
+        Ack(10, LitState(None, 0)),
+        bytes.fromhex("0a ff ff 00 0a"),
+    ),
+    (11, Light(3, 10), bytes.fromhex("a5 02 0b 00 03 0a a5"), Nak(None, 4), bytes.fromhex("84")),
+]
+
+CASES = [
+    ("default", DefaultCodec(), DEFAULT_SCRIPT),
+    ("framed", FramedCodec(), FRAMED_SCRIPT),
+    ("binary", BinaryCodec(), BINARY_SCRIPT),
+]
+PARAMS = [
+    pytest.param(codec, row, id=f"{name}-{i}")
+    for name, codec, script in CASES
+    for i, row in enumerate(script)
+]
+
+
+@pytest.mark.parametrize(("codec", "row"), PARAMS)
+def test_host_encodes_command_bytes_exactly(codec, row):
+    seq, cmd, cmd_bytes, _, _ = row
+    assert codec.encode_command(seq, cmd) == cmd_bytes
+
+
+@pytest.mark.parametrize(("codec", "row"), PARAMS)
+def test_firmware_decodes_the_command_bytes(codec, row):
+    seq, cmd, cmd_bytes, _, _ = row
+    parsed, used = codec.decode_command(cmd_bytes + b"<rest")
+    assert used == len(cmd_bytes)
+    assert parsed == (seq, cmd)
+
+
+@pytest.mark.parametrize(("codec", "row"), PARAMS)
+def test_firmware_encodes_reply_bytes_exactly(codec, row):
+    _, cmd, _, reply, reply_bytes = row
+    assert codec.encode_reply(reply, cmd) == reply_bytes
+
+
+@pytest.mark.parametrize(("codec", "row"), PARAMS)
+def test_host_decodes_the_reply_bytes(codec, row):
+    _, cmd, _, reply, reply_bytes = row
+    assert codec.decode_reply(reply_bytes, cmd) == (reply, len(reply_bytes))
+    # byte by byte, a partial reply asks for more and consumes nothing
+    for cut in range(len(reply_bytes)):
+        got, used = codec.decode_reply(reply_bytes[:cut], cmd)
+        assert got is None and used == 0, cut
+
+
+def test_banners_of_each_profile():
+    assert DefaultCodec().encode_banner(IDENT) == b"READY RTIDOME 1.2.0 48*18\n"
+    assert FramedCodec().encode_banner(IDENT) == b"<READY,RTIDOME,1.2.0,48>"
+    assert BinaryCodec().encode_banner(IDENT) == b"\xffRDY"
+    for codec in (DefaultCodec(), FramedCodec(), BinaryCodec()):
+        raw = codec.encode_banner(IDENT)
+        got, used = codec.decode_reply(raw, None)
+        assert isinstance(got, Banner) and used == len(raw)
+
+
+def test_default_checksum_catches_a_flipped_byte_both_ways():
+    codec = DefaultCodec()
+    reply = bytearray(b"OK 7 L 12 200 5000*6B\n")
+    reply[7] ^= 0x01  # '1' -> '0': "L 02" would otherwise parse as LED 2
+    got, used = codec.decode_reply(bytes(reply), Light(12, 200))
+    assert isinstance(got, Garbled) and "checksum" in got.reason and used == len(reply)
+    cmd = bytearray(b"7 L 12 200 5000*4F\n")
+    cmd[4] ^= 0x01
+    parsed, _ = codec.decode_command(bytes(cmd))
+    assert isinstance(parsed, BadRequest) and parsed.code == 6 and parsed.seq is None
+    assert codec.encode_reply(Nak(None, 6, "checksum mismatch"), None) == (
+        b"ERR 0 6 checksum_mismatch*35\n"
+    )
+
+
+def test_default_without_checksum_and_with_crlf():
+    codec = DefaultCodec(checksum=False)
+    assert codec.encode_command(3, Light(1, 2)) == b"3 L 1 2\n"
+    assert codec.decode_reply(b"OK 3 L 1 2\r\n", None) == (Ack(3, Light(1, 2)), 12)
+
+
+def test_default_rejects_noise_and_unknown_verbs():
+    codec = DefaultCodec(checksum=False)
+    got, used = codec.decode_reply(b"HELLO THERE\n", None)
+    assert isinstance(got, Garbled) and used == 12
+    got, used = codec.decode_reply(b"x" * 300, None)
+    assert isinstance(got, Garbled) and used == 300
+    parsed, _ = codec.decode_command(b"4 Z 1\n")
+    assert isinstance(parsed, BadRequest) and parsed.code == 1 and parsed.seq == 4
+    parsed, _ = codec.decode_command(b"4 L -1 2\n")
+    assert isinstance(parsed, BadRequest) and parsed.code == 2
+
+
+def test_framed_profile_adapts_to_a_legacy_firmware_without_python():
+    """A Nab-style firmware: 1-based LEDs, no level, no sequence, CR LF after each frame."""
+    settings = DomeSerialSettings.model_validate(
+        {
+            "port": "x",
+            "profile": "framed",
+            "framed": {
+                "index_base": 1,
+                "send_level": False,
+                "sequence": False,
+                "line_ending": "\r\n",
+                "codes": {"hello": "H", "light": "3", "all_off": "0", "shutter": "6"},
+                "start": "[",
+                "end": "]",
+            },
+        }
+    )
+    codec = make_codec(settings)
+    assert codec.encode_command(5, Light(0, 255)) == b"[3,1]\r\n"
+    assert codec.encode_command(6, AllOff()) == b"[0]\r\n"
+    assert codec.encode_command(7, Hello()) == b"[H]\r\n"
+    assert codec.decode_reply(b"[OK,3,1]\r\n", Light(0, 255)) == (Ack(None, Light(0, 255)), 8)
+    assert codec.decode_command(b"[3,48]\r\n") == ((None, Light(47, 255)), 6)
+    got, _ = codec.decode_reply(b"[ERR,4,dead]", None)
+    assert got == Nak(None, 4, "dead")
+
+
+def test_framed_reports_bytes_outside_frames_and_skips_whitespace():
+    codec = FramedCodec()
+    got, used = codec.decode_reply(b"boot text<OK,1,0>", AllOff())
+    assert isinstance(got, Garbled) and used == len(b"boot text")
+    assert codec.decode_reply(b"\r\n<OK,1,0>", AllOff()) == (Ack(1, AllOff()), 10)
+    got, used = codec.decode_reply(b"<OK,1,0", AllOff())
+    assert got is None and used == 0
+    got, _ = codec.decode_reply(b"<OK,1,7>", None)  # 7 is no command code
+    assert isinstance(got, Garbled)
+
+
+def test_framed_spec_with_other_words():
+    codec = FramedCodec(FramedSpec(ok_word="ACK", err_word="NAK", ready_word="BOOT"))
+    assert codec.encode_reply(Ack(2, AllOff()), AllOff()) == b"<ACK,2,0>"
+    assert codec.decode_reply(b"<BOOT>", None) == (Banner(None), 6)
+
+
+def test_binary_acks_and_errors_are_told_apart():
+    codec = BinaryCodec()
+    assert codec.decode_reply(b"\x05", AllOff()) == (Ack(5), 1)
+    assert codec.decode_reply(b"\x86", AllOff()) == (Nak(None, 6), 1)
+    for byte in (0x00, 0xC0, 0xFE):
+        got, used = codec.decode_reply(bytes([byte]), AllOff())
+        assert isinstance(got, Garbled) and used == 1
+    got, _ = codec.decode_reply(b"\xffRDX", None)
+    assert isinstance(got, Garbled)
+    bad = bytearray(bytes.fromhex("0a 00 0c c8 ce"))
+    bad[2] ^= 1
+    got, _ = codec.decode_reply(bytes(bad), Query())
+    assert isinstance(got, Garbled)
+
+
+def test_binary_firmware_side_skips_noise_and_checks_the_packet():
+    codec = BinaryCodec()
+    assert codec.decode_command(b"\x00\x13") == (None, 2)
+    assert codec.decode_command(b"\x00\xa5\x02") == (None, 1)
+    assert codec.decode_command(b"\xa5\x02\x07") == (None, 0)
+    pkt = bytearray(codec.encode_command(7, Light(12, 200)))
+    pkt[4] ^= 0x41
+    parsed, used = codec.decode_command(bytes(pkt))
+    assert isinstance(parsed, BadRequest) and parsed.code == 6 and used == 7
+    with pytest.raises(ValueError, match=r"1\.\.127"):
+        codec.encode_command(128, AllOff())
+
+
+def test_binary_index_base_one():
+    codec = BinaryCodec(index_base=1)
+    assert codec.encode_command(7, Light(0, 9))[3:5] == b"\x00\x01"
+    assert codec.decode_command(codec.encode_command(7, Light(0, 9)))[0] == (7, Light(0, 9))
+    reply = codec.encode_reply(Ack(3, LitState(4, 9)), Query())
+    assert reply[1:3] == b"\x00\x05"
+    assert codec.decode_reply(reply, Query())[0] == Ack(3, LitState(4, 9))
+
+
+commands = st.one_of(
+    st.just(Hello()),
+    st.just(AllOff()),
+    st.just(Query()),
+    st.builds(Shutter, st.integers(0, 5000)),
+    st.builds(Light, st.integers(0, 999), st.integers(0, 255)),
+)
+
+
+@given(cmd=commands, seq=st.integers(1, 127))
+def test_every_profile_round_trips_commands_and_echoes(cmd, seq):
+    for codec in (DefaultCodec(), FramedCodec(), BinaryCodec()):
+        assert codec.decode_command(codec.encode_command(seq, cmd)) == (
+            (seq, cmd),
+            len(codec.encode_command(seq, cmd)),
+        )
+        if not isinstance(cmd, Hello | Query):
+            ack = Ack(seq, None if isinstance(codec, BinaryCodec) else cmd)
+            raw = codec.encode_reply(ack, cmd)
+            assert codec.decode_reply(raw, cmd) == (ack, len(raw))
+
+
+@given(cmd=commands, seq=st.integers(1, 127), pos=st.integers(0, 100), bit=st.integers(0, 7))
+def test_a_single_flipped_bit_never_yields_a_different_valid_command(cmd, seq, pos, bit):
+    """Checksummed profiles: damage is refused, never executed as another command."""
+    for codec in (DefaultCodec(), BinaryCodec()):
+        raw = bytearray(codec.encode_command(seq, cmd))
+        i = pos % (len(raw) - 1 if raw.endswith(b"\n") else len(raw))
+        raw[i] ^= 1 << bit
+        parsed, _ = codec.decode_command(bytes(raw))
+        assert not isinstance(parsed, tuple), (codec.profile, bytes(raw), parsed)
+
+
+@pytest.mark.parametrize("codec", [DefaultCodec(), BinaryCodec()], ids=["default", "binary"])
+def test_every_single_bit_flip_of_sample_commands_is_refused(codec):
+    samples = [Hello(), AllOff(), Query(), Shutter(50), Light(0, 1), Light(47, 255)]
+    if isinstance(codec, DefaultCodec):
+        samples.append(Light(12, 200, 5000))
+    for cmd in samples:
+        raw = codec.encode_command(9, cmd)
+        for i in range(len(raw)):
+            for bit in range(8):
+                bad = bytearray(raw)
+                bad[i] ^= 1 << bit
+                parsed, _ = codec.decode_command(bytes(bad))
+                assert not isinstance(parsed, tuple), (cmd, i, bit, bytes(bad), parsed)

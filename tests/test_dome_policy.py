@@ -1,0 +1,498 @@
+"""Rig policy over the in-process firmware emulator: faults, thermal guard, correction, self-test.
+
+Every check compares with the emulator's truth (``firmware.lit``: the LED really emitting), so
+"recovered" means the right LED is physically lit, not merely that no exception was raised.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from drivers.led_dome import DomeSerialSettings, build_dome
+from drivers.led_dome.codec_default import DefaultCodec
+from drivers.led_dome.driver import LedDomeDriver
+from rti_rig.clock import VirtualClock
+from rti_rig.dome_policy import (
+    DomeLedError,
+    DomeLinkError,
+    DomePolicy,
+    LinkFault,
+    ThermalGuard,
+    ThermalLimits,
+    self_test,
+)
+from rti_rig.errors import DeviceError
+from rti_rig.rig import DiscreteLightSource
+from simulator.dome_firmware import (
+    Fault,
+    FaultKind,
+    FaultPlan,
+    InProcessDomeTransport,
+    firmware_for,
+)
+
+PROFILES = ["default", "framed", "binary"]
+N_LEDS = 6
+# Commands 1 and 2 are the connect handshake and the initial all-off; light(i) is command
+# 3 + 2i and the all-off after it 4 + 2i.
+LIGHT_1 = 5
+OFF_AFTER_1 = 6
+
+
+def make(
+    profile="default",
+    faults=(),
+    *,
+    dead=(),
+    reports_dead=True,
+    leds=N_LEDS,
+    banner=True,
+    **settings,
+):
+    clock = VirtualClock()
+    s = DomeSerialSettings(port="emulated", profile=profile, **settings)
+    fw = firmware_for(
+        s,
+        clock=clock,
+        led_count=leds,
+        boot_delay_s=0.2,
+        dead_leds=frozenset(dead),
+        reports_dead_leds=reports_dead,
+        faults=FaultPlan(tuple(faults)),
+        banner_on_boot=banner,
+    )
+    dome = build_dome(s, clock, transport=InProcessDomeTransport(fw))
+    return dome, fw, clock
+
+
+def session(dome, fw, clock, leds=range(N_LEDS)):
+    """The controller's loop: light, check the truth while 'capturing', all off."""
+    dome.connect()
+    for i in leds:
+        dome.light(i, 1.0)
+        assert fw.lit == (i, 255), f"LED {i} asked, firmware has {fw.lit}"
+        clock.sleep(0.5)  # settle + exposure
+        assert fw.lit == (i, 255), f"LED {i} went out during the capture"
+        dome.all_off()
+        assert fw.lit is None
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+def test_full_session_each_profile(profile):
+    dome, fw, clock = make(profile)
+    assert isinstance(dome, DiscreteLightSource)
+    session(dome, fw, clock)
+    assert dome.stats.retries == 0
+    assert dome.light_count() == N_LEDS
+    lit = [e.index for e in fw.history if e.what == "lit"]
+    assert lit == list(range(N_LEDS))
+    dome.close()
+    dome.close()  # safe twice
+    assert fw.lit is None
+
+
+RECOVERABLE = [
+    FaultKind.DROP_REPLY,
+    FaultKind.GARBLE_REPLY,
+    FaultKind.GARBLE_COMMAND,
+    FaultKind.DELAY_REPLY,
+    FaultKind.DISCONNECT,
+    FaultKind.RESET,
+]
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+@pytest.mark.parametrize("kind", RECOVERABLE)
+def test_fault_while_lighting_recovers_with_the_right_led(profile, kind):
+    dome, fw, clock = make(profile, [Fault(LIGHT_1, kind, delay_s=1.0)])
+    session(dome, fw, clock)
+    assert dome.stats.retries == 1, dome.stats
+    if kind is FaultKind.DISCONNECT:
+        assert dome.stats.reconnects == 1
+    if kind is FaultKind.RESET:
+        assert dome.stats.rehandshakes == 1
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+@pytest.mark.parametrize(
+    "kind", [FaultKind.DROP_REPLY, FaultKind.GARBLE_REPLY, FaultKind.DELAY_REPLY]
+)
+def test_fault_while_switching_off_recovers(profile, kind):
+    dome, fw, clock = make(profile, [Fault(OFF_AFTER_1, kind)])
+    session(dome, fw, clock)
+    assert dome.stats.retries == 1
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+@pytest.mark.parametrize(
+    ("kind", "at"),
+    [
+        (FaultKind.RESET_AFTER_REPLY, LIGHT_1),  # reset during the capture under LED 1
+        (FaultKind.RESET, OFF_AFTER_1),
+        (FaultKind.DISCONNECT, OFF_AFTER_1),
+    ],
+)
+def test_reset_or_drop_while_lit_stops_naming_the_led(profile, kind, at):
+    dome, fw, clock = make(profile, [Fault(at, kind, delay_s=0.1)])
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    dome.light(1, 1.0)
+    clock.sleep(0.5)
+    if kind is FaultKind.RESET_AFTER_REPLY:
+        assert fw.lit is None  # the truth: the capture under LED 1 had no light
+    with pytest.raises(DomeLedError) as info:
+        dome.all_off()
+    err = info.value
+    assert err.led == 1 and err.command == "all off"
+    assert "LED 1" in str(err) and "all off" in str(err)
+    assert fw.lit is None
+    # the dome is usable again afterwards (the acquisition may repeat that capture)
+    dome.light(1, 1.0)
+    assert fw.lit == (1, 255)
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+def test_persistent_silence_gives_up_naming_led_and_command_and_goes_dark(profile):
+    faults = [Fault(n, FaultKind.DROP_REPLY) for n in (LIGHT_1, LIGHT_1 + 1, LIGHT_1 + 2)]
+    dome, fw, _clock = make(profile, faults, retries=2)
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    with pytest.raises(DomeLinkError) as info:
+        dome.light(1, 1.0)
+    msg = str(info.value)
+    assert "light LED 1" in msg and "gave up after 3 attempts" in msg
+    assert info.value.fault is LinkFault.TIMEOUT
+    assert fw.lit is None  # the policy switched the dome off after giving up
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+def test_dead_led_reported_by_the_firmware_stops_naming_it(profile):
+    dome, fw, clock = make(profile, dead=[3])
+    with pytest.raises(DomeLedError) as info:
+        session(dome, fw, clock)
+    assert info.value.led == 3
+    assert "LED 3" in str(info.value) and "LED fault" in str(info.value)
+    assert "light LED 3" in str(info.value)
+    assert fw.lit is None
+    assert dome.stats.retries == 0  # a dead LED is not a transient fault
+
+
+def test_silent_dead_led_is_dark_in_the_truth_so_the_camera_sees_it():
+    """A firmware without current sensing cannot report it: the emulator's truth shows the dark
+    LED so the simulated camera renders a black frame for the controller to catch."""
+    dome, fw, _clock = make("default", dead=[2], reports_dead=False)
+    dome.connect()
+    dome.light(2, 1.0)
+    assert fw.lit is None
+    assert dome.lit_state() == (2, 255)  # the firmware believes it is lit
+
+
+def test_disconnect_that_does_not_come_back_gives_up():
+    dome, fw, _clock = make(
+        "default", [Fault(LIGHT_1, FaultKind.DISCONNECT, delay_s=1000.0)], reconnect_attempts=3
+    )
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    with pytest.raises(DomeLinkError, match="did not come back after 3 reconnection") as info:
+        dome.light(1, 1.0)
+    assert "light LED 1" in str(info.value)
+    assert fw.lit is None
+
+
+def test_shutter_is_never_resent():
+    dome, fw, _clock = make("default", [Fault(3, FaultKind.DROP_REPLY)])
+    dome.connect()
+    with pytest.raises(DomeLinkError, match="not resent"):
+        dome.shutter(40)
+    assert [e.what for e in fw.history].count("shutter") == 1
+
+
+def test_shutter_pulse_is_sent_once():
+    dome, fw, _clock = make("framed")
+    dome.connect()
+    dome.shutter()
+    assert [(e.what, e.level) for e in fw.history if e.what == "shutter"] == [("shutter", 50)]
+
+
+def test_late_reply_is_dropped_not_taken_for_the_next_command():
+    """A reply delayed past the timeout must not acknowledge the resent command by accident."""
+    dome, fw, _clock = make("default", [Fault(LIGHT_1, FaultKind.DELAY_REPLY, delay_s=0.7)])
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    dome.light(1, 1.0)
+    assert fw.lit == (1, 255)
+    dome.all_off()
+    assert fw.lit is None
+    dome.light(2, 1.0)
+    assert fw.lit == (2, 255)
+
+
+class ScriptedTransport:
+    """Replays a scripted exchange and fails the test on any unexpected write."""
+
+    def __init__(self, script):
+        self.script = list(script)
+        self.clock = VirtualClock()
+        self.name = "scripted"
+        self.pending = b""
+
+    def open(self):
+        self.pending = b"READY RTIDOME 1.2.0 4*20\n"
+
+    def close(self):
+        pass
+
+    def write(self, data):
+        expected, reply = self.script.pop(0)
+        assert data == expected
+        self.pending += reply
+
+    def read(self, timeout_s):
+        data, self.pending = self.pending, b""
+        if not data:
+            self.clock.sleep(timeout_s)
+        return data
+
+
+def test_wrong_echo_is_caught_and_the_light_resent():
+    transport = ScriptedTransport(
+        [
+            (b"1 ID*1C\n", b"OK 1 ID RTIDOME 1.2.0 4*53\n"),
+            (b"2 X*4A\n", b"OK 2 X*6E\n"),
+            (b"3 L 2 255 10000*4E\n", b"OK 3 L 1 255 10000*69\n"),  # lit LED 1, not 2
+            (b"4 L 2 255 10000*49\n", b"OK 4 L 2 255 10000*6D\n"),
+        ]
+    )
+    dome = DomePolicy(LedDomeDriver(transport, DefaultCodec()), VirtualClock())
+    dome.connect()
+    dome.light(2, 1.0)
+    assert dome.stats.retries == 1
+    assert dome.stats.recovered == ["light LED 2 at level 255: mismatch"]
+    assert transport.script == []
+
+
+# ----------------------------------------------------------------------------- thermal
+
+
+def test_thermal_guard_earliest_start_is_exact():
+    guard = ThermalGuard(ThermalLimits(max_on_s=2.0, max_duty=0.5, duty_window_s=10.0))
+    guard.record(0, 0.0, 2.0)
+    guard.record(0, 3.0, 5.0)
+    assert guard.on_time(0, -5.0, 5.0) == pytest.approx(4.0)
+    # budget = 0.5 * 10 - 2 = 3 s: the first interval must leave the window by 1 s -> t = 11
+    assert guard.earliest_start(0, 5.0) == pytest.approx(11.0, abs=1e-6)
+    assert guard.earliest_start(1, 5.0) == 5.0  # another LED is cold
+    with pytest.raises(ValueError, match="would break the duty"):
+        ThermalLimits(max_on_s=6.0, max_duty=0.5, duty_window_s=10.0)
+
+
+def test_policy_waits_for_an_led_to_cool_and_the_duty_holds_in_the_truth():
+    dome, fw, clock = make(
+        "default", thermal={"max_on_s": 1.0, "max_duty": 0.2, "duty_window_s": 20.0}
+    )
+    dome.connect()
+    for _ in range(6):
+        dome.light(4, 1.0)
+        clock.sleep(0.9)
+        dome.all_off()
+    assert dome.stats.thermal_wait_s > 0
+    events = [(e.time_s, e.what) for e in fw.history if e.what in ("lit", "off")]
+    spans = [
+        (t0, t1) for (t0, a), (t1, b) in itertools.pairwise(events) if a == "lit" and b == "off"
+    ]
+    assert len(spans) == 6
+    for _, end in spans:  # duty over every window ending at an LED switch-off
+        on = sum(max(0.0, min(e, end) - max(s, end - 20.0)) for s, e in spans)
+        assert on <= 0.2 * 20.0 + 1e-6
+
+
+def test_overrun_of_max_on_time_is_an_error_and_the_watchdog_cut_the_led():
+    dome, fw, clock = make("default", thermal={"max_on_s": 2.0, "max_duty": 0.5})
+    dome.connect()
+    dome.light(5, 1.0)
+    clock.sleep(3.0)  # a capture that took too long
+    assert fw.lit is None  # the firmware watchdog switched it off at 2 s
+    assert any(e.what == "watchdog" and e.index == 5 for e in fw.history)
+    with pytest.raises(DomeLedError, match=r"LED 5 stayed on 3\.00\d s, beyond max_on_s = 2") as e:
+        dome.all_off()
+    assert e.value.led == 5 and "watchdog" in str(e.value)
+
+
+def test_intensity_correction_maps_to_levels():
+    corr = [1.0, 0.5, 0.25, 1.0, 1.0, 1.0]
+    dome, fw, _clock = make("default", intensity_correction=corr)
+    dome.connect()
+    dome.light(1, 1.0)
+    assert fw.lit == (1, 128)
+    dome.light(2, 0.5)
+    assert fw.lit == (2, 32)
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(DeviceError, match="outside"):
+            dome.light(0, bad)
+
+
+def test_correction_list_of_the_wrong_length_fails_at_connect():
+    dome, _fw, _clock = make("default", intensity_correction=[1.0] * 5)
+    with pytest.raises(DeviceError, match="intensity_correction has 5 factors but the firmware"):
+        dome.connect()
+
+
+def test_directions_from_the_lp_must_match_the_led_count():
+    clock = VirtualClock()
+    s = DomeSerialSettings(port="emulated")
+    fw = firmware_for(s, clock=clock, led_count=4)
+    dirs = np.array([[0.0, 0.0, 1.0]] * 4)
+    dome = build_dome(s, clock, transport=InProcessDomeTransport(fw), directions=dirs)
+    dome.connect()
+    assert dome.direction_of(3).tolist() == [0.0, 0.0, 1.0]
+    fw2 = firmware_for(s, clock=clock, led_count=5)
+    dome2 = build_dome(s, clock, transport=InProcessDomeTransport(fw2), directions=dirs)
+    with pytest.raises(DeviceError, match=r"reports 5 LEDs but the dome's \.lp has 4"):
+        dome2.connect()
+
+
+def test_out_of_range_index_is_refused_before_any_byte():
+    dome, fw, _clock = make("default")
+    dome.connect()
+    before = fw.commands_received
+    with pytest.raises(DeviceError, match=r"LED 6 does not exist: this dome has LEDs 0\.\.5"):
+        dome.light(6)
+    assert fw.commands_received == before
+
+
+def test_no_banner_board_still_handshakes_after_the_ready_timeout():
+    """A board without auto-reset sends no banner: wait at most ready_timeout_s, then ask."""
+    dome, _fw, clock = make("default", ready_timeout_s=1.5, banner=False)
+    dome.connect()
+    assert clock.now() == pytest.approx(1.5, abs=0.01)  # + the handshake on a 115200 bd line
+    assert dome.info.led_count == N_LEDS
+    assert dome.link.banners_seen == 0
+
+
+def test_wait_for_banner_instead_of_a_fixed_sleep():
+    dome, _fw, clock = make("default", ready_timeout_s=3.0)
+    dome.connect()
+    assert clock.now() == pytest.approx(0.2, abs=0.01)  # the boot delay, not the 3 s timeout
+    assert dome.link.banners_seen == 1
+
+
+# ----------------------------------------------------------------------------- self test
+
+
+def test_self_test_passes_on_a_healthy_dome():
+    dome, fw, clock = make("binary", confirm_with_query=True)
+    report = self_test(dome, clock)
+    assert report.ok, report.lines()
+    assert len(report.checks) == N_LEDS
+    assert report.lines()[-1] == "RESULT: PASS"
+    assert fw.lit is None
+
+
+def test_self_test_lists_a_dead_led_and_continues():
+    dome, _fw, clock = make("default", dead=[1, 4])
+    report = self_test(dome, clock)
+    assert not report.ok
+    assert [c.index for c in report.failed] == [1, 4]
+    assert len(report.checks) == N_LEDS
+    assert any("LED 4" in line for line in report.lines())
+    assert report.lines()[-1] == "RESULT: FAIL"
+
+
+def test_self_test_reports_an_unreachable_dome():
+    dome, fw, clock = make("default", [Fault(1, FaultKind.DROP_REPLY)] * 1, retries=0)
+    fw.faults = FaultPlan(tuple(Fault(n, FaultKind.DROP_REPLY) for n in range(1, 10)))
+    report = self_test(dome, clock)
+    assert report.aborted and "no handshake" in report.aborted
+    assert not report.ok
+
+
+def test_relighting_the_same_led_keeps_counting_its_on_time():
+    dome, _fw, clock = make("framed", thermal={"max_on_s": 2.0, "max_duty": 0.5})
+    dome.connect()
+    dome.light(0, 1.0)
+    clock.sleep(1.5)
+    dome.light(0, 0.5)  # no all-off in between: the LED never cooled
+    clock.sleep(1.0)
+    with pytest.raises(DomeLedError, match=r"LED 0 stayed on 2\.50\d s"):
+        dome.all_off()
+
+
+def test_settings_from_a_rig_toml_table():
+    import tomllib
+
+    table = tomllib.loads(
+        """
+        [dome.serial]
+        port = "/dev/serial/by-id/usb-Arduino_Mega_2560-if00"
+        profile = "framed"
+        reply_timeout_s = 0.5
+        [dome.serial.framed]
+        index_base = 1
+        line_ending = "\\n"
+        [dome.serial.thermal]
+        max_on_s = 8.0
+        max_duty = 0.3
+        duty_window_s = 60.0
+        """
+    )
+    s = DomeSerialSettings.model_validate(table["dome"]["serial"])
+    assert s.framed.index_base == 1 and s.thermal.max_duty == 0.3
+    assert s.framed.line_ending == "\n"
+
+
+@pytest.mark.parametrize("at", [LIGHT_1, OFF_AFTER_1])
+@pytest.mark.parametrize("kind", [FaultKind.DELAY_REPLY, FaultKind.DROP_REPLY])
+def test_framed_without_sequence_numbers_relies_on_echoes(at, kind):
+    """Nab-style firmware: no sequence field, so late replies are told apart by their echo."""
+    dome, fw, clock = make(
+        "framed", [Fault(at, kind, delay_s=0.7)], framed={"sequence": False, "index_base": 1}
+    )
+    session(dome, fw, clock)
+    assert dome.stats.retries >= 1
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+@pytest.mark.parametrize("kind", [FaultKind.RESET, FaultKind.RESET_AFTER_REPLY])
+def test_a_second_reboot_while_connecting_is_absorbed(profile, kind):
+    dome, fw, clock = make(profile, [Fault(1, kind)])
+    session(dome, fw, clock)
+    assert [e.what for e in fw.history].count("boot") == 2
+
+
+def test_self_test_on_a_subset_of_leds():
+    dome, fw, clock = make("default")
+    report = self_test(dome, clock, leds=[0, 5])
+    assert report.ok and report.planned == 2
+    assert [c.index for c in report.checks] == [0, 5]
+    assert len(report.light_latency_s) == 2 and report.median_light_latency_s > 0
+    assert [e.index for e in fw.history if e.what == "lit"] == [0, 5]
+
+
+def test_replies_take_their_time_on_the_serial_line():
+    """At 9600 baud a light and an all-off cost what their bytes need on the wire."""
+    dome, _fw, clock = make("default", baudrate=9600)
+    dome.connect()
+    t0 = clock.now()
+    dome.light(1, 1.0)
+    t1 = clock.now()
+    # "3 L 1 255 10000*XX\n" (19 bytes) + "OK 3 L 1 255 10000*XX\n" (22 bytes), 10 bits each
+    assert t1 - t0 == pytest.approx((19 + 22) * 10 / 9600)
+    dome.all_off()
+    assert clock.now() - t1 == pytest.approx((7 + 10) * 10 / 9600)  # "4 X*4C\n" + "OK 4 X*68\n"
+
+
+def test_profile_without_intensity_refuses_a_dimmed_light_clearly():
+    dome, fw, _clock = make("framed", framed={"send_level": False})
+    dome.connect()
+    dome.light(2, 1.0)
+    assert fw.lit == (2, 255)
+    with pytest.raises(DomeLedError, match=r"send_level = false\): only full intensity 1\.0"):
+        dome.light(3, 0.5)
+    assert fw.lit is None
