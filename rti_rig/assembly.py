@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import contextlib
+from dataclasses import dataclass, field
 
 from rti_rig.clock import Clock
 from rti_rig.config import CameraConfig, LoadedRig, TimingConfig
@@ -20,6 +21,18 @@ class Rig:
     lighting: Lighting
     camera: Camera
     clock: Clock
+    #: Things the rig holds open besides its devices (an emulator's pseudo-terminal…).
+    resources: contextlib.ExitStack = field(default_factory=contextlib.ExitStack)
+
+    def close(self) -> None:
+        """Release what ``build_rig`` opened; the controller has already made devices safe."""
+        self.resources.close()
+
+    def __enter__(self) -> Rig:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     @property
     def name(self) -> str:

@@ -100,6 +100,7 @@ def run(
     from rti_rig.schedule import LightSchedule
     from rti_rig.session import SessionFolder
 
+    rig = None
     try:
         if resume is not None:
             if out_dir is not None or plan is not None or lights is not None:
@@ -144,8 +145,11 @@ def run(
             validate_schedule(rig, schedule)
             folder = SessionFolder.create(out_dir, len(schedule))
     except RtiRigError as exc:
+        if rig is not None:
+            rig.close()
         raise _fail(exc) from None
-    _execute(rig, schedule, folder, out_dir)
+    with rig:
+        _execute(rig, schedule, folder, out_dir)
 
 
 def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-untyped-def]
@@ -183,7 +187,7 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
     if hasattr(signal, "SIGUSR1"):
         handlers[signal.SIGUSR1] = on_sigusr1
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
-    dry = " (dry run)" if rig.loaded.config.backend == "simulated" else ""
+    dry = " (dry run)" if rig.loaded.config.backend != "hardware" else ""
     todo = len(schedule) - len(folder.done)
     out.print(f"Rig [bold]{rig.name}[/]{dry}: {todo} of {len(schedule)} lights → {out_dir}")
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
@@ -309,6 +313,34 @@ def export_lp(
     except RtiRigError as exc:
         raise _fail(exc) from None
     out.print(f"{len(entries)} lights → {out_file}")
+
+
+@app.command()
+def check(
+    rig_config: Annotated[Path, typer.Argument(help="Rig config TOML to check.")],
+    intensity: Annotated[
+        float, typer.Option("--intensity", help="LED intensity for the walk (0-1).")
+    ] = 0.2,
+) -> None:
+    """Self-test a dome: handshake, then light each LED in turn and report what answered."""
+    from rti_rig.compose import build_rig
+    from rti_rig.config import load_rig_config
+    from rti_rig.dome_policy import self_test
+    from rti_rig.lighting import DomeLighting
+
+    try:
+        loaded = load_rig_config(rig_config)
+        rig = build_rig(loaded)
+    except RtiRigError as exc:
+        raise _fail(exc) from None
+    with rig:
+        if not isinstance(rig.lighting, DomeLighting):
+            raise _fail(RtiRigError(f"{rig_config}: 'check' walks a dome's LEDs; this is an arm"))
+        report = self_test(rig.lighting.source, rig.clock, intensity=intensity)
+    for line in report.lines():
+        out.print(line, highlight=False)
+    if not report.ok:
+        raise typer.Exit(code=1)
 
 
 bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy trade.")

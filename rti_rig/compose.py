@@ -6,8 +6,10 @@ This is the one place in the core that imports ``simulator`` (and, as backends a
 
 from __future__ import annotations
 
+import contextlib
+
 from rti_rig.assembly import Rig
-from rti_rig.clock import Clock, VirtualClock
+from rti_rig.clock import Clock, SystemClock, VirtualClock
 from rti_rig.config import LoadedRig, rig_geometry
 from rti_rig.errors import ConfigError
 from rti_rig.lighting import ArmLighting, DomeLighting
@@ -15,16 +17,21 @@ from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
 
 
 def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
-    """Build the rig a config describes. Simulated rigs get a virtual clock by default."""
+    """Build the rig a config describes.
+
+    Simulated and emulated rigs run on a virtual clock (a dry run reports the real rig's time
+    without waiting for it); hardware runs on the system clock. Use the rig as a context manager
+    (or call ``close``) to release emulators and ports afterwards.
+    """
     cfg = loaded.config
-    if cfg.backend != "simulated":
-        raise ConfigError(loaded.path, "backend", f"backend {cfg.backend!r} is not available")
+    if cfg.backend == "hardware":
+        return _build_hardware(loaded, clock or SystemClock())
     return _build_simulated(loaded, clock or VirtualClock())
 
 
-def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
+def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[no-untyped-def]
+    """A camera that renders the scene under whatever light ``state`` says is really on."""
     from simulator.sim_camera import SimulatedCamera
-    from simulator.sim_lights import LightState, SimulatedArm, SimulatedDome
     from simulator.sim_scene import lambert_radiance, relief_scene
 
     cfg = loaded.config
@@ -33,14 +40,108 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
             loaded.path, "scene.name", f"unknown scene {cfg.scene.name!r}; available: 'relief'"
         )
     scene = relief_scene(cfg.camera.height, cfg.camera.width, cfg.scene.seed)
-    state = LightState()
 
     def render(direction, intensity):  # type: ignore[no-untyped-def]
         if direction is None:
             return scene.albedo * 0.0
         return lambert_radiance(scene, direction, intensity)
 
+    return SimulatedCamera(
+        render,
+        state,
+        clock,
+        reference_exposure_s=cfg.camera.exposure_s,
+        readout_s=cfg.timing.readout_s,
+        transfer_s=cfg.timing.transfer_s,
+        noise=cfg.scene.noise,
+        seed=cfg.scene.seed,
+        raw=cfg.scene.raw,
+    )
+
+
+class _FirmwareLight:
+    """The light state the emulated dome firmware really produces, for the simulated camera."""
+
+    def __init__(self, firmware, geometry: DomeGeometry, max_level: int) -> None:  # type: ignore[no-untyped-def]
+        self._fw, self._geometry, self._max = firmware, geometry, max_level
+
+    @property
+    def direction(self):  # type: ignore[no-untyped-def]
+        lit = self._fw.lit
+        return None if lit is None else self._geometry.directions[lit[0]]
+
+    @property
+    def intensity(self) -> float:
+        lit = self._fw.lit
+        return 0.0 if lit is None else lit[1] / self._max
+
+
+def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock) -> Rig:
+    """The real dome driver over real pyserial, talking to the firmware emulator on a pty."""
+    from drivers.led_dome import build_dome
+    from simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+
+    cfg = loaded.config
+    assert cfg.dome is not None and cfg.dome.serial is not None
+    serial = cfg.dome.serial
+    firmware = firmware_for(
+        serial,
+        led_count=geometry.count,
+        dead_leds=frozenset(cfg.emulator.dead_leds),
+        reports_dead_leds=cfg.emulator.reports_dead_leds,
+        clock=SystemClock(),
+    )
+    stack = contextlib.ExitStack()
+    link = stack.enter_context(emulated_dome_on_pty(firmware))
+    try:
+        dome = build_dome(
+            serial.model_copy(update={"port": link.port}),
+            clock,
+            directions=geometry.directions,
+            name=f"dome on {link.port} (emulated)",
+        )
+        camera = _simulated_camera(
+            loaded, _FirmwareLight(firmware, geometry, serial.max_level), clock
+        )
+    except BaseException:
+        stack.close()
+        raise
+    rig = Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock, stack)
+    rig.emulator = firmware  # type: ignore[attr-defined]  # for tests and the fault campaign
+    return rig
+
+
+def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
+    """Real devices: the dome over its serial port, the camera from [camera.device]."""
+    from drivers.cameras.factory import build_camera
+    from drivers.led_dome import build_dome
+    from rti_rig.config import camera_device_settings
+
+    cfg = loaded.config
     geometry = rig_geometry(loaded)
+    if not isinstance(geometry, DomeGeometry):
+        raise ConfigError(
+            loaded.path,
+            "backend",
+            "a hardware arm is driven with backend 'hardware' once the "
+            "Dynamixel driver is configured under [arm.dynamixel]",
+        )
+    assert cfg.dome is not None and cfg.dome.serial is not None
+    dome = build_dome(cfg.dome.serial, clock, directions=geometry.directions, name="dome")
+    camera = build_camera(camera_device_settings(loaded), clock=clock)
+    return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
+
+
+def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
+    from simulator.sim_lights import LightState, SimulatedArm, SimulatedDome
+
+    cfg = loaded.config
+    geometry = rig_geometry(loaded)
+    if cfg.backend == "emulated" and isinstance(geometry, DomeGeometry):
+        return _build_emulated_dome(loaded, geometry, clock)
+    if cfg.backend == "emulated":
+        raise ConfigError(loaded.path, "backend", "an emulated arm needs [arm.dynamixel]")
+    state = LightState()
     if isinstance(geometry, DomeGeometry):
         lighting = DomeLighting(
             SimulatedDome(geometry, state, clock, cfg.timing.light_switch_s), geometry
@@ -60,15 +161,5 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
             park_after_session=cfg.arm.park_after_session,
             park_on_emergency=cfg.arm.park_on_emergency_stop,
         )
-    camera = SimulatedCamera(
-        render,
-        state,
-        clock,
-        reference_exposure_s=cfg.camera.exposure_s,
-        readout_s=cfg.timing.readout_s,
-        transfer_s=cfg.timing.transfer_s,
-        noise=cfg.scene.noise,
-        seed=cfg.scene.seed,
-        raw=cfg.scene.raw,
-    )
+    camera = _simulated_camera(loaded, state, clock)
     return Rig(loaded=loaded, geometry=geometry, lighting=lighting, camera=camera, clock=clock)

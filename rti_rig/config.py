@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.errors import ConfigError, LpFormatError
 from rti_rig.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.lp_format import read_lp
@@ -45,6 +46,7 @@ class DomeConfig(_Strict):
     min_elevation_deg: float = Field(default=10.0, ge=0, lt=90)
     lp_file: str | None = None
     default_lights: int | None = Field(default=None, gt=0, le=1000)
+    serial: DomeSerialSettings | None = None
 
     @model_validator(mode="after")
     def _layout_has_its_keys(self) -> DomeConfig:
@@ -85,7 +87,11 @@ class ArmConfig(_Strict):
 
 
 class CameraConfig(_Strict):
-    """The camera's fixed settings for a session."""
+    """The camera's fixed settings for a session.
+
+    ``device`` is the real camera's driver table (``kind = "opencv" | "gphoto2" |
+    "folder_watch"``, see docs/cameras.md); a simulated or emulated rig renders its images.
+    """
 
     width: int = Field(default=512, gt=0, le=20000)
     height: int = Field(default=512, gt=0, le=20000)
@@ -93,6 +99,7 @@ class CameraConfig(_Strict):
     gain: float = Field(default=1.0, gt=0)
     min_exposure_s: float = Field(default=1e-4, gt=0)
     max_exposure_s: float = Field(default=30.0, gt=0)
+    device: dict[str, Any] | None = None
 
     @model_validator(mode="after")
     def _exposure_in_range(self) -> CameraConfig:
@@ -122,18 +129,31 @@ class SceneConfig(_Strict):
     raw: bool = False  # deliver frames through a DNG and the rawpy decode path, as a DSLR would
 
 
+class EmulatorConfig(_Strict):
+    """Faults of the emulated devices in an ``emulated`` dry run (to rehearse failures)."""
+
+    dead_leds: list[int] = Field(default_factory=list)
+    reports_dead_leds: bool = True
+
+
 class RigConfig(_Strict):
-    """A whole rig: what it is, how it is driven, its camera and its timing."""
+    """A whole rig: what it is, how it is driven, its camera and its timing.
+
+    ``backend``: ``simulated`` (simulated devices, virtual time), ``emulated`` (the real
+    drivers, pyserial or dynamixel-sdk, talking to device emulators on pseudo-terminals; the
+    camera renders what the emulated devices really did) or ``hardware``.
+    """
 
     name: str = Field(min_length=1)
     kind: Literal["dome", "arm"]
-    backend: Literal["simulated"] = "simulated"
+    backend: Literal["simulated", "emulated", "hardware"] = "simulated"
     description: str = ""
     dome: DomeConfig | None = None
     arm: ArmConfig | None = None
     camera: CameraConfig = CameraConfig()
     timing: TimingConfig = TimingConfig()
     scene: SceneConfig = SceneConfig()
+    emulator: EmulatorConfig = EmulatorConfig()
 
     @model_validator(mode="after")
     def _kind_has_its_table(self) -> RigConfig:
@@ -141,6 +161,16 @@ class RigConfig(_Strict):
             raise ValueError("kind 'dome' needs a [dome] table")
         if self.kind == "arm" and self.arm is None:
             raise ValueError("kind 'arm' needs an [arm] table")
+        if self.backend != "simulated" and self.kind == "dome" and self.dome.serial is None:  # type: ignore[union-attr]
+            raise ValueError(
+                f"backend '{self.backend}' drives the dome over serial: add a [dome.serial] "
+                "table (port, profile; see docs/protocols/led-dome.md)"
+            )
+        if self.backend == "hardware" and self.camera.device is None:
+            raise ValueError(
+                "backend 'hardware' needs a [camera.device] table naming the camera driver "
+                "(kind = 'opencv', 'gphoto2' or 'folder_watch'; see docs/cameras.md)"
+            )
         return self
 
 
@@ -209,8 +239,29 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         raw=data,
     )
     if config.kind == "dome":
-        dome_led_directions(loaded)  # fail now, not when the session starts
+        dirs, _ = dome_led_directions(loaded)  # fail now, not when the session starts
+        serial = config.dome.serial if config.dome else None
+        if serial is not None and (problem := serial.check_led_count(len(dirs))):
+            raise ConfigError(path, "dome.serial.expected_led_count", problem)
+    if config.camera.device is not None:
+        camera_device_settings(loaded)
     return loaded
+
+
+def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
+    """The validated driver settings of the rig's real camera (``[camera.device]``)."""
+    from drivers.cameras.settings import parse_camera_settings
+
+    try:
+        return parse_camera_settings(rig.config.camera.device or {})
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        loc = [p for p in err["loc"] if not (isinstance(p, str) and p in _CAMERA_KINDS)]
+        key = _key_of(("camera", "device", *loc))
+        raise ConfigError(rig.path, key, err["msg"].removeprefix("Value error, ")) from None
+
+
+_CAMERA_KINDS = ("opencv", "gphoto2", "folder_watch")
 
 
 def default_config_path() -> Path:
