@@ -36,6 +36,15 @@ from simulator.verify import wrong_light_steps
 
 REPO = Path(__file__).resolve().parent.parent
 IN_PROCESS = ("camera-failure", "light-failure")
+SERIAL = (
+    "serial-drop-reply",
+    "serial-garble-reply",
+    "serial-garble-command",
+    "serial-delay-reply",
+    "serial-disconnect",
+    "serial-reset",
+    "serial-reset-after-reply",
+)
 KILLS = (
     "sigkill-before-light",
     "sigkill-during-capture",
@@ -46,14 +55,22 @@ KILLS = (
 SIZE = 48
 
 
-def make_config(folder: Path, kind: str, seed: int) -> Path:
-    src = REPO / "rig_configs" / ("simulated_dome.toml" if kind == "dome" else "simulated_arm.toml")
-    text = (
-        src.read_text()
-        .replace("width = 512", f"width = {SIZE}")
-        .replace("height = 512", f"height = {SIZE}")
-        .replace("seed = 0", f"seed = {seed}")
-    )
+def make_config(folder: Path, kind: str, seed: int, fault: tuple[int, str] | None = None) -> Path:
+    """A small copy of a shipped config; ``kind`` dome, arm or emulated (with a serial fault)."""
+    name = {"dome": "simulated_dome", "arm": "simulated_arm", "emulated": "emulated_dome"}[kind]
+    src = REPO / "rig_configs" / f"{name}.toml"
+    text = src.read_text()
+    for big in ("512", "256"):
+        text = text.replace(f"width = {big}", f"width = {SIZE}")
+        text = text.replace(f"height = {big}", f"height = {SIZE}")
+    text = text.replace("seed = 0", f"seed = {seed}")
+    text = text.replace('lp_file = "', f'lp_file = "{src.parent}/')
+    if fault is not None:
+        at, fault_kind = fault
+        text += (
+            f'\n[emulator]\nfaults = [{{ at_command = {at}, kind = "{fault_kind}", '
+            "delay_s = 0.8 }]\n"
+        )
     path = folder / f"{kind}.toml"
     path.write_text(text)
     return path
@@ -78,18 +95,15 @@ def committed_files(root: Path) -> dict[str, str]:
     return out
 
 
-def run_in_process(
-    cfg: Path,
-    out: Path,
-    schedule: LightSchedule | None,
-    n: int,
-    fault: FaultPlan | None,
-    resume: bool,
-) -> None:
+def run_in_process(cfg: Path, out: Path, n: int, fault: FaultPlan | None, resume: bool) -> None:
+    """One run (new or resumed) in this process, with an optional injected device fault."""
+    with build_rig(load_rig_config(cfg)) as rig:
+        _run(rig, out, n, fault, resume)
+
+
+def _run(rig, out: Path, n: int, fault: FaultPlan | None, resume: bool) -> None:  # type: ignore[no-untyped-def]
     from planner.uniform import plan_uniform
 
-    loaded = load_rig_config(cfg)
-    rig = build_rig(loaded)
     if fault is not None:
         if fault.kind == "camera-failure":
             rig.camera = FaultyCamera(rig.camera, fault)
@@ -138,15 +152,29 @@ def campaign(sessions: int, seed: int) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         tmpdir = Path(tmp)
         for i in range(sessions):
-            kind = "dome" if rng.random() < 0.6 else "arm"
-            cfg = make_config(tmpdir, f"{kind}", int(rng.integers(0, 1000)))
             n = int(rng.integers(6, 17))
             out = tmpdir / f"session_{i:04d}"
-            fault_kind = str(rng.choice(IN_PROCESS + KILLS))
+            fault_kind = str(rng.choice(IN_PROCESS + KILLS + SERIAL))
             k = int(rng.integers(0, n))
             faults[fault_kind] += 1
-            if fault_kind in IN_PROCESS:
-                run_in_process(cfg, out, None, n, FaultPlan(fault_kind, k), resume=False)
+            seed_i = int(rng.integers(0, 1000))
+            if fault_kind in SERIAL:
+                # hello is command 1; each step then sends 'light' and 'all off'.
+                command = 2 + 2 * k + int(rng.integers(0, 2))
+                kind_name = fault_kind.removeprefix("serial-").replace("-", "_")
+                cfg = make_config(tmpdir, "emulated", seed_i, (command, kind_name))
+                run_in_process(cfg, out, n, None, resume=False)
+                first = read_manifest(out)["runner"].get("finish_reason")
+                stats["serial_faults_recovered_in_session"] += int(first == "completed")
+                stats["serial_faults_stopped_with_error"] += int(first == "error")
+                cfg = make_config(tmpdir, "emulated", seed_i)  # the fault was a one-off
+            else:
+                kind = "dome" if rng.random() < 0.6 else "arm"
+                cfg = make_config(tmpdir, kind, seed_i)
+            if fault_kind in SERIAL:
+                pass  # already run above, against the faulty emulated firmware
+            elif fault_kind in IN_PROCESS:
+                run_in_process(cfg, out, n, FaultPlan(fault_kind, k), resume=False)
             else:
                 stage = fault_kind.removeprefix("sigkill-").replace("-", "_")
                 code = run_killed(cfg, out, n, stage, k)
@@ -167,7 +195,7 @@ def campaign(sessions: int, seed: int) -> dict:
                 if rng.random() < 0.3:
                     again = FaultPlan(str(rng.choice(IN_PROCESS)), int(rng.integers(0, n)))
                     faults[again.kind] += 1
-                run_in_process(cfg, out, None, n, again, resume=True)
+                run_in_process(cfg, out, n, again, resume=True)
             stats["sessions"] += 1
             stats["resumes"] += resumes
             m = read_manifest(out)
@@ -208,6 +236,14 @@ def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
             "**wrong-light images recorded** (image better explained by another light)",
             "wrong_light_images",
         ),
+        (
+            "serial faults recovered inside the session (retry, reconnect)",
+            "serial_faults_recovered_in_session",
+        ),
+        (
+            "serial faults that stopped the session with an error (then resumed)",
+            "serial_faults_stopped_with_error",
+        ),
         ("sessions abandoned after 10 resumes", "sessions_abandoned"),
         ("SIGKILL faults that failed to kill", "kills_that_did_not_kill"),
     ]
@@ -217,7 +253,8 @@ def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
 
 Measured with `python -m benchmarks.fault_campaign --sessions {sessions} --seed {seed}`
 ({seconds:.0f} s). Each session runs a homogeneous plan of 6–16 lights on the simulated dome (60 %)
-or arm (40 %) at {SIZE}×{SIZE} pixels, with a fault at a random step; it is then resumed with
+or arm (40 %), or for serial faults on the emulated dome, at {SIZE}×{SIZE} pixels, with a
+fault at a random step; it is then resumed with
 `--resume` semantics until complete, and 30 % of resumes get a further in-process fault.
 
 | figure | value |
@@ -232,13 +269,14 @@ or arm (40 %) at {SIZE}×{SIZE} pixels, with a fault at a random step; it is the
 
 - `camera-failure`: the camera raises a capture error (no frame) at the step.
 - `light-failure`: the dome's `light` command or the arm's move fails at the step.
+- `serial-*`: a byte-level fault of the emulated dome firmware, met by the real driver over
+  real pyserial on a pseudo-terminal: a reply dropped, garbled or late, a garbled command, a
+  USB disconnect, a board reset before or after acknowledging.
 - `sigkill-*`: the process is killed with SIGKILL (no cleanup at all) before the light, after
   the capture, half-way through writing the TIFF, between the TIFF and the JPEG, or after both
   files but before the journal line.
 
-Not yet in this campaign: byte-level faults of the device emulators (serial timeouts and garbage,
-USB disconnects, servo hardware errors), which arrive with the serial dome and Dynamixel
-emulators.
+Not yet in this campaign: servo hardware errors of the emulated Dynamixel arm.
 """
 
 

@@ -79,7 +79,13 @@ class _FirmwareLight:
 def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock) -> Rig:
     """The real dome driver over real pyserial, talking to the firmware emulator on a pty."""
     from drivers.led_dome import build_dome
-    from simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+    from simulator.dome_firmware import (
+        Fault,
+        FaultKind,
+        FaultPlan,
+        emulated_dome_on_pty,
+        firmware_for,
+    )
 
     cfg = loaded.config
     assert cfg.dome is not None and cfg.dome.serial is not None
@@ -89,6 +95,9 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
         led_count=geometry.count,
         dead_leds=frozenset(cfg.emulator.dead_leds),
         reports_dead_leds=cfg.emulator.reports_dead_leds,
+        faults=FaultPlan(
+            tuple(Fault(f.at_command, FaultKind(f.kind), f.delay_s) for f in cfg.emulator.faults)
+        ),
         clock=SystemClock(),
     )
     stack = contextlib.ExitStack()

@@ -129,11 +129,28 @@ class SceneConfig(_Strict):
     raw: bool = False  # deliver frames through a DNG and the rawpy decode path, as a DSLR would
 
 
+class EmulatorFault(_Strict):
+    """One byte-level fault of the emulated dome firmware, at its n-th command (1-based)."""
+
+    at_command: int = Field(gt=0)
+    kind: Literal[
+        "drop_reply",
+        "garble_reply",
+        "garble_command",
+        "delay_reply",
+        "disconnect",
+        "reset",
+        "reset_after_reply",
+    ]
+    delay_s: float = Field(default=1.0, ge=0, le=60)
+
+
 class EmulatorConfig(_Strict):
     """Faults of the emulated devices in an ``emulated`` dry run (to rehearse failures)."""
 
     dead_leds: list[int] = Field(default_factory=list)
     reports_dead_leds: bool = True
+    faults: list[EmulatorFault] = Field(default_factory=list)
 
 
 class RigConfig(_Strict):

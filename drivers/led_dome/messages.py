@@ -49,6 +49,7 @@ class Query:
 
 Command = Hello | Light | AllOff | Shutter | Query
 
+
 def describe(cmd: Command) -> str:
     """Short human name of a command, used in error messages and logs."""
     if isinstance(cmd, Light):
