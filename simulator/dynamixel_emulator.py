@@ -25,6 +25,7 @@ import math
 import os
 import select
 import threading
+import time
 import tty
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -483,11 +484,18 @@ class PtyServoServer:
     (e.g. /dev/pts/5) to give to ``dynamixel_sdk.PortHandler``.
 
     A slave fd stays open for the server's lifetime (otherwise reads fail with EIO whenever the
-    SDK closes its port); ``stop()`` joins the thread within a bounded time."""
+    SDK closes its port); ``stop()`` joins the thread within a bounded time.
 
-    def __init__(self, emulator: DynamixelBusEmulator, poll_s: float = 0.02) -> None:
+    ``reply_delay_s`` models the servos' Return Delay Time (default 250 x 2 us = 0.5 ms) in
+    real time: replies then arrive *after* the SDK has returned from a command it did not wait
+    for, which is what makes the unread-status pitfall bite on real hardware."""
+
+    def __init__(
+        self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, reply_delay_s: float = 0.0005
+    ) -> None:
         self.emulator = emulator
         self.poll_s = poll_s
+        self.reply_delay_s = reply_delay_s
         self.device_path: str | None = None
         self._fds: tuple[int, int] | None = None
         self._stop = threading.Event()
@@ -516,6 +524,8 @@ class PtyServoServer:
                 continue
             reply = self.emulator.receive(data)
             if reply:
+                if self.reply_delay_s > 0:
+                    time.sleep(self.reply_delay_s)  # emulator thread only; tests never sleep
                 os.write(master, reply)
 
     def stop(self, timeout_s: float = 1.0) -> None:

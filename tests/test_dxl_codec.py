@@ -19,9 +19,11 @@ def h(text: str) -> bytes:
 # (built by our codec, expected bytes from the e-manual, protocol2.md examples)
 EMANUAL = [
     (p2.ping(1), "FF FF FD 00 01 03 00 01 19 4E"),
-    (p2.status_packet(1, 0, bytes([0x06, 0x04, 0x26])), "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"),
+    (p2.status_packet(1, 0, bytes([0x06, 0x04, 0x26])),
+     "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"),
     (p2.ping(p2.BROADCAST_ID), "FF FF FD 00 FE 03 00 01 31 42"),
-    (p2.status_packet(2, 0, bytes([0x06, 0x04, 0x26])), "FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D"),
+    (p2.status_packet(2, 0, bytes([0x06, 0x04, 0x26])),
+     "FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D"),
     (p2.read(1, 132, 4), "FF FF FD 00 01 07 00 02 84 00 04 00 1D 15"),
     (p2.status_packet(1, 0, p2.u32(166)), "FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0"),
     (p2.write(1, 116, p2.u32(512)), "FF FF FD 00 01 09 00 03 74 00 00 02 00 00 CA 89"),

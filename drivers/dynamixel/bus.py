@@ -29,6 +29,13 @@ from drivers.dynamixel.faults import (
 
 log = logging.getLogger("rti_rig.dynamixel.traffic")
 
+#: SDK communication result codes by name, for error messages (COMM_RX_TIMEOUT, ...).
+COMM_NAMES = {getattr(sdk, n): n for n in dir(sdk) if n.startswith("COMM_")}
+
+
+def comm_text(ph: Any, result: int) -> str:
+    return f"{COMM_NAMES.get(result, result)}: {ph.getTxRxResult(result)}"
+
 
 class DxlBus:
     """Checked Protocol 2.0 commands over an SDK port (a ``PortHandler`` or a stand-in)."""
@@ -63,7 +70,7 @@ class DxlBus:
         if result != sdk.COMM_SUCCESS:
             raise CommunicationError(
                 self.device,
-                f"{self.ph.getTxRxResult(result)} (check power, cabling, id and baud rate)",
+                f"{comm_text(self.ph, result)} (check power, cabling, id and baud rate)",
                 command,
                 dxl_id,
             )
@@ -124,7 +131,7 @@ class DxlBus:
         log.debug("%s: id %d write-no-wait %s = %d (%d)", self.device, dxl_id, reg.name, value,
                   result)
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, self.ph.getTxRxResult(result),
+            raise CommunicationError(self.device, comm_text(self.ph, result),
                                      f"write {reg.name}", dxl_id)
         self.drain_reply()
 
@@ -142,7 +149,7 @@ class DxlBus:
         result = group.txPacket()
         log.debug("%s: sync write %s %s (%d)", self.device, reg.name, dict(values), result)
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, self.ph.getTxRxResult(result),
+            raise CommunicationError(self.device, comm_text(self.ph, result),
                                      f"sync write {reg.name} {dict(values)}")
 
     def broadcast_write(self, reg: ct.Register, value: int) -> None:
@@ -152,14 +159,14 @@ class DxlBus:
         result = self.ph.writeTxOnly(self.port, p2.BROADCAST_ID, reg.address, reg.size, data)
         log.debug("%s: broadcast write %s = %d (%d)", self.device, reg.name, value, result)
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, self.ph.getTxRxResult(result),
+            raise CommunicationError(self.device, comm_text(self.ph, result),
                                      f"broadcast write {reg.name}")
 
     def action(self) -> None:
         """Action to the broadcast id: unicast Action leaves a stale reply (SDK pitfall)."""
         result = self.ph.action(self.port, p2.BROADCAST_ID)
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, self.ph.getTxRxResult(result), "action")
+            raise CommunicationError(self.device, comm_text(self.ph, result), "action")
 
     def reboot(self, dxl_id: int) -> None:
         result, error = self.ph.reboot(self.port, dxl_id)
