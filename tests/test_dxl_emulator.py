@@ -82,8 +82,11 @@ def test_write_no_wait_drains_the_reply_over_pty(pty_bus) -> None:
     raw_bad = 0
     for i in range(10):
         ph.write1ByteTxOnly(port, 1, ct.LED.address, i % 2)
-        value, result, _ = ph.read4ByteTxRx(port, 1, ct.PRESENT_POSITION.address)
-        raw_bad += (result, value) != (sdk.COMM_SUCCESS, 2048)
+        try:
+            value, result, _ = ph.read4ByteTxRx(port, 1, ct.PRESENT_POSITION.address)
+            raw_bad += (result, value) != (sdk.COMM_SUCCESS, 2048)
+        except IndexError:  # the SDK itself trips over the empty stale status
+            raw_bad += 1
         bus.drain_reply()  # resynchronise before the next round
     assert raw_bad >= 5, "the emulator no longer reproduces the unread-status pitfall"
     for i in range(20):
