@@ -76,42 +76,40 @@ def _nearest_neighbour(cost: NDArray[np.float64], first: int) -> list[int]:
     return order
 
 
-def _two_opt(order: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
-    """One pass of 2-opt on the open path (node 0 fixed first; the end is free).
+def _two_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
+    """One pass of 2-opt on an open path of matrix nodes (``nodes[0]`` is the fixed start).
 
-    Deltas are exact for asymmetric costs: the reversed segment's inner edges are summed both
-    ways with prefix sums."""
-    nodes = [0, *[i + 1 for i in order]]
+    Deltas are exact for asymmetric costs (the reversed segment's inner edges are summed both
+    ways with prefix sums) and evaluated for all segment ends at once with numpy."""
     improved = False
     m = len(nodes)
     i = 1
     while i < m - 1:
-        arr = np.array(nodes)
+        arr = np.asarray(nodes)
         fwd = np.concatenate([[0.0], np.cumsum(cost[arr[:-1], arr[1:]])])
         bwd = np.concatenate([[0.0], np.cumsum(cost[arr[1:], arr[:-1]])])
-        changed = False
-        for k in range(i + 1, m):
-            a, b, c = nodes[i - 1], nodes[i], nodes[k]
-            inner = (bwd[k] - bwd[i]) - (fwd[k] - fwd[i])
-            delta = cost[a, c] - cost[a, b] + inner
-            if k + 1 < m:
-                d = nodes[k + 1]
-                delta += cost[b, d] - cost[c, d]
-            if delta < -1e-12:
-                nodes = nodes[:i] + nodes[i:k + 1][::-1] + nodes[k + 1:]
-                improved = changed = True
-                break
-        if not changed:
+        a, b = arr[i - 1], arr[i]
+        ks = np.arange(i + 1, m)
+        c = arr[ks]
+        delta = cost[a, c] - cost[a, b] + (bwd[ks] - bwd[i]) - (fwd[ks] - fwd[i])
+        has_d = ks + 1 < m
+        d = arr[np.minimum(ks + 1, m - 1)]
+        delta = delta + np.where(has_d, cost[b, d] - cost[c, d], 0.0)
+        best = int(np.argmin(delta))
+        if delta[best] < -1e-12:
+            k = int(ks[best])
+            nodes = nodes[:i] + nodes[i:k + 1][::-1] + nodes[k + 1:]
+            improved = True
+        else:
             i += 1
-    return [x - 1 for x in nodes[1:]], improved
+    return nodes, improved
 
 
-def _or_opt(order: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
+def _or_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
     """One pass of Or-opt: move a segment of 1-3 stops elsewhere, forwards or reversed.
 
-    Exact deltas: edges removed and added around the segment, plus the change of its inner
-    edges when it is reversed."""
-    nodes = [0, *[i + 1 for i in order]]
+    Exact deltas (edges removed and added, plus the inner edges' change when reversed), with
+    all insertion points evaluated at once."""
     improved = False
     for seg in (1, 2, 3):
         i = 1
@@ -123,42 +121,61 @@ def _or_opt(order: list[int], cost: NDArray[np.float64]) -> tuple[list[int], boo
             bridged = cost[p, q] if q is not None else 0.0
             inner_f = sum(cost[s[t], s[t + 1]] for t in range(seg - 1))
             inner_b = sum(cost[s[t + 1], s[t]] for t in range(seg - 1))
-            rest = nodes[:i] + nodes[i + seg:]
+            rest = np.asarray(nodes[:i] + nodes[i + seg:])
+            x = rest  # insert after rest[pos-1] = x, before y (None at the end)
+            y = np.append(rest[1:], -1)
+            has_y = y >= 0
+            y_safe = np.where(has_y, y, 0)
+            opened = np.where(has_y, cost[x, y_safe], 0.0)
             best_delta, best_move = -1e-12, None
-            for pos in range(1, len(rest) + 1):  # insert between rest[pos-1] and rest[pos]
-                x = rest[pos - 1]
-                y = rest[pos] if pos < len(rest) else None
-                if x == p:
-                    continue
-                opened = cost[x, y] if y is not None else 0.0
-                for rev, piece, inner in ((False, s, inner_f), (True, s[::-1], inner_b)):
-                    added = cost[x, piece[0]] + (cost[piece[-1], y] if y is not None else 0.0)
-                    delta = (bridged - removed) + (added - opened) + (inner - inner_f)
-                    if delta < best_delta:
-                        best_delta, best_move = delta, (pos, rev)
+            for rev, first, last, inner in ((False, s[0], s[-1], inner_f),
+                                            (True, s[-1], s[0], inner_b)):
+                added = cost[x, first] + np.where(has_y, cost[last, y_safe], 0.0)
+                delta = (bridged - removed) + (added - opened) + (inner - inner_f)
+                delta[i - 1] = np.inf  # that is where the segment came from
+                j = int(np.argmin(delta))
+                if delta[j] < best_delta:
+                    best_delta, best_move = float(delta[j]), (j + 1, rev)
             if best_move is not None:
                 pos, rev = best_move
                 piece = s[::-1] if rev else s
-                nodes = rest[:pos] + piece + rest[pos:]
+                rest_l = rest.tolist()
+                nodes = rest_l[:pos] + piece + rest_l[pos:]
                 improved = True
             else:
                 i += 1
-    return [x - 1 for x in nodes[1:]], improved
+    return nodes, improved
 
 
-def improve(order: list[int], cost: NDArray[np.float64], max_rounds: int = 50) -> list[int]:
-    """2-opt and Or-opt until neither helps (or ``max_rounds``)."""
+def _local_search(nodes: list[int], cost: NDArray[np.float64], max_rounds: int = 100) -> list[int]:
     for _ in range(max_rounds):
-        order, a = _two_opt(order, cost)
-        order, b = _or_opt(order, cost)
+        nodes, a = _two_opt(nodes, cost)
+        nodes, b = _or_opt(nodes, cost)
         if not (a or b):
             break
-    return order
+    return nodes
 
 
-def heuristic_order(cost: NDArray[np.float64], seeds: int = 4) -> list[int]:
-    """Nearest neighbour from the ``seeds`` stops nearest the start, each locally improved."""
+def improve(order: list[int], cost: NDArray[np.float64]) -> list[int]:
+    """2-opt and Or-opt until neither helps; stops as 0-based indices."""
+    return [x - 1 for x in _local_search([0, *[i + 1 for i in order]], cost)[1:]]
+
+
+def _double_bridge(nodes: list[int], rng: np.random.Generator) -> list[int]:
+    """Classic ILS kick: cut the path (after the fixed start) in four and swap the middle two."""
+    n = len(nodes) - 1
+    a, b, c = sorted(int(v) for v in rng.choice(np.arange(1, n + 1), size=3, replace=False))
+    return nodes[:a] + nodes[b:c] + nodes[a:b] + nodes[c:]
+
+
+def heuristic_order(
+    cost: NDArray[np.float64], seeds: int = 4, kicks: int | None = None, seed: int = 0
+) -> list[int]:
+    """Nearest neighbour from the ``seeds`` stops nearest the start, 2-opt + Or-opt, then
+    iterated local search (double-bridge kicks, keep if better). Deterministic for a seed."""
     n = cost.shape[0] - 1
+    if n == 0:
+        return []
     firsts = list(np.argsort(cost[0, 1:])[:max(1, min(seeds, n))])
     best, best_t = None, np.inf
     for f in firsts:
@@ -166,7 +183,18 @@ def heuristic_order(cost: NDArray[np.float64], seeds: int = 4) -> list[int]:
         t = path_time_s(cand, cost)
         if t < best_t:
             best, best_t = cand, t
-    return best or []
+    assert best is not None
+    if n < 8:
+        return best
+    rng = np.random.default_rng(seed)
+    nodes = [0, *[i + 1 for i in best]]
+    kicks = max(20, 2000 // n) if kicks is None else kicks
+    for _ in range(kicks):
+        cand = _local_search(_double_bridge(nodes, rng), cost)
+        t = path_time_s([x - 1 for x in cand[1:]], cost)
+        if t < best_t - 1e-12:
+            nodes, best_t = cand, t
+    return [x - 1 for x in nodes[1:]]
 
 
 def order_from_matrix(cost: NDArray[np.float64]) -> list[int]:
