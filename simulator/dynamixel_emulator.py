@@ -27,7 +27,7 @@ import select
 import threading
 import time
 import tty
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -562,3 +562,48 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
                                     operating_mode=int(joint.mode),
                                     present_ticks=ticks if at_park else 2048))
     return DynamixelBusEmulator(servos, clock)
+
+
+@contextlib.contextmanager
+def emulated_arm_port(
+    settings: Any, clock: Clock, transport: str = "pty"
+) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
+    """``(port, emulator)`` for a dry run of ``DynamixelArm`` against emulated servos.
+
+    ``transport="pty"``: a real ``dynamixel_sdk.PortHandler`` on a pseudo-terminal served by a
+    thread (the real SDK and pyserial run unchanged); ``"inprocess"``: an :class:`InProcessPort`
+    (no thread, no pty; fastest). The server is stopped on exit."""
+    emulator = emulator_for_arm(settings, clock)
+    if transport == "inprocess":
+        yield InProcessPort(emulator), emulator
+        return
+    if transport != "pty":
+        raise ValueError(f"transport must be 'pty' or 'inprocess', not {transport!r}")
+    import dynamixel_sdk
+
+    server = PtyServoServer(emulator)
+    path = server.start()
+    try:
+        yield dynamixel_sdk.PortHandler(path), emulator
+    finally:
+        server.stop()
+
+
+def main() -> None:  # pragma: no cover - manual tool
+    """Serve two XL430s (ids 1, 2) on a pty until Ctrl-C, in real time (SystemClock)."""
+    from rti_rig.clock import SystemClock
+
+    clock = SystemClock()
+    emulator = DynamixelBusEmulator(
+        [EmulatedServo(1, 1060, clock), EmulatedServo(2, 1060, clock)], clock)
+    with PtyServoServer(emulator) as server:
+        print(f"emulated XL430 ids 1, 2 on {server.device_path}; Ctrl-C to stop", flush=True)
+        try:
+            while True:
+                time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

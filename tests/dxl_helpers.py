@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from drivers.dynamixel.settings import ArmSettings
 
 
@@ -22,3 +24,13 @@ def arm_settings(**overrides) -> ArmSettings:
         else:
             base[key] = value
     return ArmSettings(**base)
+
+
+@pytest.fixture
+def wide_sdk_timeouts(monkeypatch):
+    """Widen the SDK's reply timeout from ~34 ms to ~200 ms for pty tests: the machine is
+    shared and the emulator thread competes with the SDK's busy-wait for the GIL. Only a
+    missing reply ever waits this long, and the pty tests expect none."""
+    import dynamixel_sdk.port_handler as port_handler
+
+    monkeypatch.setattr(port_handler, "LATENCY_TIMER", 100)

@@ -21,7 +21,10 @@ from rti_rig.clock import VirtualClock
 from rti_rig.geometry import angle_between_deg, direction_from_az_el
 from rti_rig.rig import LightCarrier
 from simulator.dynamixel_emulator import InProcessPort, PtyServoServer, emulator_for_arm
-from tests.dxl_helpers import arm_settings
+from tests.dxl_helpers import (
+    arm_settings,
+    wide_sdk_timeouts,  # noqa: F401  (fixture)
+)
 
 
 def make_arm(**overrides):
@@ -158,6 +161,7 @@ def test_settings_errors_name_the_problem() -> None:
         arm_settings(azimuth=dict(model_number=12))
 
 
+@pytest.mark.usefixtures("wide_sdk_timeouts")
 def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
     settings = arm_settings(azimuth=dict(operating_mode="extended_position",
                                          min_deg=-360.0, max_deg=360.0))
@@ -174,3 +178,20 @@ def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
         assert angle_between_deg(d, direction_from_az_el(az, 30)) < 0.2
     assert clock.now() > 1.0  # emulator time passed; the wall clock did not wait for it
     assert np.isfinite(clock.now())
+
+
+@pytest.mark.usefixtures("wide_sdk_timeouts")
+@pytest.mark.parametrize("transport", ["pty", "inprocess"])
+def test_emulated_arm_port_dry_run(transport: str) -> None:
+    from simulator.dynamixel_emulator import emulated_arm_port
+
+    settings = arm_settings()
+    clock = VirtualClock()
+    with emulated_arm_port(settings, clock, transport) as (port, emu):
+        arm = DynamixelArm(settings, port, clock)
+        with arm:
+            reached = arm.move_to(direction_from_az_el(45, 45))
+            ticks = emu.joint_positions()
+            lamp_now = arm.kin.direction_of_ticks(ticks[1], ticks[2])
+            assert angle_between_deg(lamp_now, reached) < 0.01
+        assert not port.is_open

@@ -15,6 +15,7 @@ from simulator.dynamixel_emulator import (
     InProcessPort,
     PtyServoServer,
 )
+from tests.dxl_helpers import wide_sdk_timeouts  # noqa: F401  (fixture)
 
 
 def two_servos(clock: VirtualClock, mode: int = 3) -> DynamixelBusEmulator:
@@ -26,7 +27,7 @@ def two_servos(clock: VirtualClock, mode: int = 3) -> DynamixelBusEmulator:
 
 
 @pytest.fixture
-def pty_bus():
+def pty_bus(wide_sdk_timeouts):  # noqa: F811
     clock = VirtualClock()
     emu = two_servos(clock)
     server = PtyServoServer(emu)
