@@ -98,3 +98,23 @@ def move_time_matrix(
     out += settings.settle_time_s
     np.fill_diagonal(out, 0.0)
     return out
+
+
+def sequence_time_s(
+    directions: ArrayLike, settings: Any, start: ArrayLike | None = None
+) -> float:
+    """Total move time of visiting ``directions`` in the given order from ``start`` (park if
+    None), choosing each multi-turn azimuth nearest the previous one, as the driver does.
+
+    Unlike the pairwise matrix this is exact for multi-turn ranges too; use it to report the
+    time of a final order."""
+    if start is None:
+        pose = (settings.park_azimuth_deg, settings.park_elevation_deg)
+    else:
+        pose = joint_pose(start, settings, settings.park_azimuth_deg)
+    total = 0.0
+    for d in np.asarray(directions, dtype=np.float64).reshape(-1, 3):
+        nxt = joint_pose(d, settings, pose[0])
+        total += pose_move_time_s(pose, nxt, settings)
+        pose = nxt
+    return total

@@ -235,6 +235,10 @@ class EmulatedServo:
                 return p2.ERR_RESULT_FAIL  # after a shutdown only a reboot re-enables torque
             if not on:
                 self._freeze()
+            elif not self.torque_on:
+                # the firmware makes the present position the goal when torque comes on
+                self._freeze()
+                self._set(ct.GOAL_POSITION, round(self.position()))
         mode_before = self.get(ct.OPERATING_MODE)
         self.table[address:end] = data
         if self.get(ct.OPERATING_MODE) != mode_before:

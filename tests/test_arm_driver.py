@@ -195,3 +195,50 @@ def test_emulated_arm_port_dry_run(transport: str) -> None:
             lamp_now = arm.kin.direction_of_ticks(ticks[1], ticks[2])
             assert angle_between_deg(lamp_now, reached) < 0.01
         assert not port.is_open
+
+
+def test_reboot_after_fault_then_home() -> None:
+    arm, emu, _ = make_arm()
+    arm.connect()
+    emu.servos[1].inject_hardware_error(ct.HardwareFault.ELECTRICAL_SHOCK)
+    with pytest.raises(HardwareFaultError, match="electrical shock"):
+        arm.move_to(direction_from_az_el(90, 30))
+    arm.reboot()
+    assert emu.servos[1].hardware_error == 0 and emu.servos[1].torque_on
+    arm.move_to(direction_from_az_el(90, 30))
+    arm.home()
+    park = arm.kin.ticks_of_pose(0.0, 10.0)
+    assert tuple(round(v) for v in emu.joint_positions().values()) == park
+    arm.close()
+
+
+def test_settings_from_a_rig_toml_table() -> None:
+    import tomllib
+
+    from drivers.dynamixel.settings import ArmSettings
+
+    text = """
+    [arm]
+    port = "/dev/ttyUSB0"
+    baudrate = 1000000
+    keep_out_half_angle_deg = 12.0
+    park_azimuth_deg = 0.0
+    park_elevation_deg = 15.0
+    [arm.azimuth]
+    servo_id = 1
+    model_number = 1020
+    operating_mode = "extended_position"
+    zero_offset_ticks = 2048
+    min_deg = -360.0
+    max_deg = 360.0
+    [arm.elevation]
+    servo_id = 2
+    model_number = 1020
+    zero_offset_ticks = 1024
+    direction = -1
+    min_deg = 0.0
+    max_deg = 85.0
+    """
+    s = ArmSettings.model_validate(tomllib.loads(text)["arm"])
+    assert s.azimuth.mode == ct.OperatingMode.EXTENDED_POSITION
+    assert s.elevation.tick_limits == (57, 1024)  # direction -1: 85 deg is below the zero

@@ -83,3 +83,18 @@ def test_order_for_arm_beats_plan_order_and_is_a_permutation() -> None:
         cost = move_time_matrix(dirs, s)
         assert path_time_s(order, cost) < path_time_s(list(range(n)), cost)
     assert order_from_matrix(np.zeros((1, 1))) == []
+
+
+def test_sequence_time_follows_multi_turn_choices() -> None:
+    from planner.arm_motion import sequence_time_s
+
+    s = arm_settings(azimuth=dict(operating_mode="extended_position", min_deg=-360.0,
+                                  max_deg=360.0), settle_time_s=0.0)
+    dirs = direction_from_az_el(np.array([170.0, -170.0]), np.array([10.0, 10.0]))
+    # from park (az 0, el 10): 170 deg, then -170 is joint 190 deg: 20 deg the short way
+    az = s.azimuth
+    t = lambda d: joint_move_time_s(d, az.joint_velocity_deg_s, az.joint_acceleration_deg_s2)  # noqa: E731
+    assert sequence_time_s(dirs, s) == pytest.approx(t(170.0) + t(20.0))
+    # the pairwise matrix fixes each stop's azimuth nearest the start: 340 deg apart
+    m = move_time_matrix(dirs, s)
+    assert m[1, 2] == pytest.approx(t(340.0))

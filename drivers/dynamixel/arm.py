@@ -79,6 +79,7 @@ class DynamixelArm:
             raise
         self._connected = True
         self._lamp_on = False
+        self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is
 
     def _check_servo(self, joint) -> None:
         sid, dev = joint.servo_id, self.name
