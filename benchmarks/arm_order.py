@@ -28,6 +28,10 @@ from simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
 
 SIZES = (8, 12, 25, 50, 100)
 TRIALS = 7
+#: Kicks of the long reference runs for N > 12 (the default ordering uses max(20, 2000 // N)).
+REF_KICKS = 300
+#: Sizes above EXACT_MAX where the exact DP is still cheap: checks the heuristic itself.
+HEURISTIC_CHECK_SIZES = (14, 16)
 
 
 def bench_settings() -> ArmSettings:
@@ -87,22 +91,34 @@ def main() -> int:
             if n <= EXACT_MAX:
                 exact.append(path_time_s(held_karp(cost), cost))
                 heur.append(path_time_s(heuristic_order(cost), cost))
+            else:  # reference: best of long iterated-local-search runs (not a proof)
+                exact.append(min(path_time_s(heuristic_order(cost, kicks=REF_KICKS, seed=k),
+                                             cost) for k in range(1, 3)))
         med = statistics.median
         ratio_plan = med(p / o for p, o in zip(plan, ordered, strict=True))
         ratio_sweep = med(s / o for s, o in zip(sweep, ordered, strict=True))
-        if exact:
-            gaps = [o / e - 1 for o, e in zip(ordered, exact, strict=True)]
+        gaps = [o / e - 1 for o, e in zip(ordered, exact, strict=True)]
+        if n <= EXACT_MAX:
             hgaps = [h / e - 1 for h, e in zip(heur, exact, strict=True)]
             worst_gap = max(worst_gap, max(gaps))
             vs_opt = f"{100 * max(gaps):.2f} % (exact DP)"
             heur_txt = f"{100 * med(hgaps):.2f} % / {100 * max(hgaps):.2f} %"
         else:
-            vs_opt = "optimum unknown (heuristic)"
-            heur_txt = "—"
+            vs_opt = f"{100 * max(gaps):.2f} % vs best found (optimum unknown)"
+            heur_txt = "(is the ordering)"
         rows.append(f"| {n} | {med(plan):.1f} | {med(sweep):.1f} | {med(ordered):.1f} | "
                     f"{ratio_plan:.2f}x | {ratio_sweep:.2f}x | {vs_opt} | {heur_txt} | "
                     f"{1000 * med(wall):.1f} |")
         print(rows[-1], flush=True)
+    heur_rows = []
+    for n in HEURISTIC_CHECK_SIZES:
+        hg = []
+        for _ in range(TRIALS):
+            cost = move_time_matrix(light_set(n, rng), settings)
+            hg.append(path_time_s(heuristic_order(cost), cost)
+                      / path_time_s(held_karp(cost), cost) - 1)
+        heur_rows.append(f"| {n} | {100 * statistics.median(hg):.2f} % | {100 * max(hg):.2f} % |")
+        print(heur_rows[-1], flush=True)
     # model vs emulator execution through the real driver + SDK (in-process port)
     for n in (12, 50):
         dirs = light_set(n, rng)
@@ -129,7 +145,15 @@ def main() -> int:
         "",
         f"Worst gap to the exact optimum where it is known (N ≤ {EXACT_MAX}): "
         f"{100 * worst_gap:.2f} % (target ≤ 3 %). The heuristic column shows what the "
-        "heuristic alone would give on the same sets.",
+        "heuristic alone would give on the same sets. For N > 12 the optimum is unknown; the "
+        f"reference is the best of two longer heuristic runs ({REF_KICKS} kicks, other seeds).",
+        "",
+        "The heuristic alone against the exact optimum, where Held–Karp is still cheap "
+        f"({TRIALS} random sets each):",
+        "",
+        "| N | heuristic above optimum (median) | (worst) |",
+        "|---|---|---|",
+        *heur_rows,
         "",
         "Model check: the ordered schedule executed by `DynamixelArm` through the real "
         "`dynamixel_sdk` against the emulated servos (virtual clock, 5 ms polling), settle time "
