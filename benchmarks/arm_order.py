@@ -134,8 +134,9 @@ def main() -> int:
         f"Median total move time in seconds over {TRIALS} random light sets per N (XL430 arm, "
         "20 rpm / 2000 rev/min² profiles, 0.05 s settle per move; model of "
         "`planner.arm_motion`). *Plan* = planner output order, *sweep* = sorted by azimuth, "
-        "*ordered* = `order_for_arm` (exact Held–Karp for N ≤ 12, NN + 2-opt + Or-opt "
-        "beyond). Ratios are medians of per-set ratios.",
+        "*ordered* = `order_for_arm` (exact Held–Karp for N ≤ 12; beyond, nearest neighbour + "
+        "2-opt + Or-opt + iterated local search with double-bridge kicks"
+        "). Ratios are medians of per-set ratios.",
         "",
         "| N | plan (s) | sweep (s) | ordered (s) | plan/ordered | sweep/ordered | "
         "ordered above optimum (worst) | heuristic above optimum (median / worst) | "

@@ -15,6 +15,7 @@ from drivers.dynamixel.faults import UnreachableError
 from drivers.dynamixel.kinematics import ArmKinematics
 from drivers.dynamixel.settings import ArmSettings
 from rti_rig.clock import VirtualClock
+from rti_rig.geometry import direction_from_az_el
 from simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
 
 DPT = 360.0 / 4096.0
@@ -67,16 +68,27 @@ def independent_check(cfg: ArmSettings, servo_id: int, ticks: int) -> str | None
     return None
 
 
-directions = st.lists(
-    st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-0.3, 1)).filter(
-        lambda v: math.hypot(*v) > 0.1),
-    min_size=1, max_size=8,
-)
+def schedules(cfg: ArmSettings):
+    """Directions mostly around the reachable box, spilling past its edges (limits, cone,
+    below the horizon), plus arbitrary directions."""
+    el_top = 90.0 - cfg.keep_out_half_angle_deg
+    az_lo, az_hi = cfg.azimuth.min_deg, cfg.azimuth.max_deg
+    el_lo = cfg.elevation.min_deg
+    near = st.tuples(st.floats(-0.1, 1.1), st.floats(-0.15, 1.15)).map(
+        lambda f: tuple(direction_from_az_el(az_lo + f[0] * (az_hi - az_lo),
+                                             min(89.9, el_lo + f[1] * (el_top - el_lo)))))
+    cone_edge = st.tuples(st.floats(0.0, 1.0), st.floats(-2.0, 4.0)).map(
+        lambda f: tuple(direction_from_az_el(az_lo + f[0] * (az_hi - az_lo),
+                                             min(89.9, el_top + f[1]))))
+    anywhere = st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-0.3, 1)).filter(
+        lambda v: math.hypot(*v) > 0.1)
+    return st.lists(st.one_of(near, near, cone_edge, anywhere), min_size=1, max_size=8)
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(cfg=arm_configs(), schedule=directions)
-def test_no_unsafe_goal_ever_reaches_the_bus(cfg: ArmSettings, schedule) -> None:
+@given(cfg=arm_configs(), data=st.data())
+def test_no_unsafe_goal_ever_reaches_the_bus(cfg: ArmSettings, data) -> None:
+    schedule = data.draw(schedules(cfg))
     clock = VirtualClock()
     emu = emulator_for_arm(cfg, clock)
     arm = DynamixelArm(cfg, InProcessPort(emu), clock)
@@ -108,3 +120,22 @@ def test_gate_refuses_any_unsafe_tick_pair(cfg: ArmSettings, az: int, el_offset:
     gate_ok = ArmKinematics(cfg).ticks_reason(az, el) is None
     independent_ok = independent_check(cfg, 1, az) is None and independent_check(cfg, 2, el) is None
     assert gate_ok == independent_ok
+
+
+def test_direction_on_a_degree_limit_is_reachable_from_either_side() -> None:
+    """Regression (found by the property test): a pose on a degree limit lies up to one tick
+    outside the inward-rounded tick limits; it must be clamped, not refused."""
+    cfg = ArmSettings(
+        port="emulated",
+        azimuth=dict(servo_id=1, model_number=1060, zero_offset_ticks=0, min_deg=-1.0,
+                     max_deg=359.0, operating_mode="extended_position"),
+        elevation=dict(servo_id=2, model_number=1020, zero_offset_ticks=2048, min_deg=0.0,
+                       max_deg=30.0),
+        keep_out_half_angle_deg=0.0, park_azimuth_deg=179.0, park_elevation_deg=1.0,
+    )
+    kin = ArmKinematics(cfg)
+    d = direction_from_az_el(-1.0, 0.0)
+    for ref in (0.0, 179.0, 179.03, 358.0):
+        pose, reason = kin.solve(d, ref)
+        assert reason is None and pose is not None
+        assert kin.ticks_reason(*kin.ticks_of_pose(*pose)) is None

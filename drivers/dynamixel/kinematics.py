@@ -75,17 +75,19 @@ class ArmKinematics:
         return None
 
     def ticks_of_pose(self, azimuth_deg: float, elevation_deg: float) -> tuple[int, int]:
-        """Rounded goal ticks of a joint pose; values within half a tick of a limit are clamped
-        onto it (the limits are rounded inwards, so the clamp never leaves the safe range)."""
+        """Rounded goal ticks of a joint pose. The tick limits are the degree limits rounded
+        inwards, so a pose on a degree limit can lie up to one tick outside them; such values
+        are clamped onto the limit (which is inside the safe range). Anything further out is
+        left alone for the gate to refuse."""
         out = []
         for joint, deg in ((self.settings.azimuth, azimuth_deg),
                            (self.settings.elevation, elevation_deg)):
             raw = joint_to_ticks(joint, deg)
             lo, hi = joint.tick_limits
             t = round(raw)
-            if lo - 0.5 <= raw < lo:
+            if lo - 1.0 <= raw and t < lo:
                 t = lo
-            elif hi < raw <= hi + 0.5:
+            elif raw <= hi + 1.0 and t > hi:
                 t = hi
             out.append(int(t))
         return out[0], out[1]
