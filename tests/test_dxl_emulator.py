@@ -152,3 +152,42 @@ def test_status_errors_are_named() -> None:
     with pytest.raises(ServoStatusError, match="access error") as info:
         bus.write(1, ct.MODEL_NUMBER, 5)
     assert info.value.error == 7 and "Model Number" in str(info.value)
+
+
+def test_bulk_read_write_reg_write_action_in_process() -> None:
+    clock = VirtualClock()
+    emu = two_servos(clock)
+    port = InProcessPort(emu)
+    port.openPort()
+    ph = sdk.PacketHandler(2.0)
+    bw = sdk.GroupBulkWrite(port, ph)
+    bw.addParam(1, ct.LED.address, 1, [1])
+    bw.addParam(2, ct.PROFILE_VELOCITY.address, 4, [50, 0, 0, 0])
+    assert bw.txPacket() == sdk.COMM_SUCCESS
+    br = sdk.GroupBulkRead(port, ph)
+    br.addParam(1, ct.LED.address, 1)
+    br.addParam(2, ct.PROFILE_VELOCITY.address, 4)
+    assert br.txRxPacket() == sdk.COMM_SUCCESS
+    assert br.getData(1, ct.LED.address, 1) == 1
+    assert br.getData(2, ct.PROFILE_VELOCITY.address, 4) == 50
+    # Reg Write is held until a (broadcast) Action
+    assert ph.regWriteTxRx(port, 1, ct.LED.address, 1, [0]) == (sdk.COMM_SUCCESS, 0)
+    assert ph.read1ByteTxRx(port, 1, ct.REGISTERED_INSTRUCTION.address)[0] == 1
+    assert ph.read1ByteTxRx(port, 1, ct.LED.address)[0] == 1
+    DxlBus(port, "arm", ph).action()
+    assert ph.read1ByteTxRx(port, 1, ct.LED.address)[0] == 0
+
+
+def test_emulator_accepts_properly_stuffed_packets() -> None:
+    """Other clients stuff FF FF FD in bodies (the e-manual rule); both forms must work."""
+    from drivers.dynamixel import protocol2 as p2
+
+    clock = VirtualClock()
+    emu = two_servos(clock, mode=4)
+    emu.receive(p2.write(1, ct.TORQUE_ENABLE.address, b"\x01"))
+    reply = emu.receive(p2.write(1, ct.GOAL_POSITION.address, p2.u32(-131073)))
+    assert p2.decode(reply).error == 0
+    assert emu.goal_log[-1] == (1, -131073)
+    raw = emu.receive(p2.read(1, ct.GOAL_POSITION.address, 4))
+    status = p2.decode(raw)
+    assert p2.to_signed(int.from_bytes(status.params, "little"), 4) == -131073
