@@ -242,3 +242,24 @@ def test_settings_from_a_rig_toml_table() -> None:
     s = ArmSettings.model_validate(tomllib.loads(text)["arm"])
     assert s.azimuth.mode == ct.OperatingMode.EXTENDED_POSITION
     assert s.elevation.tick_limits == (57, 1024)  # direction -1: 85 deg is below the zero
+
+
+def test_the_documented_rig_config_validates_and_dry_runs() -> None:
+    """The TOML in docs/protocols/dynamixel-arm.md is the proposed simulated_arm.toml."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    from drivers.dynamixel.settings import ArmSettings
+
+    doc = Path(__file__).resolve().parent.parent / "docs" / "protocols" / "dynamixel-arm.md"
+    block = re.search(r"```toml\n(.*?)```", doc.read_text(encoding="utf-8"), re.DOTALL)
+    assert block is not None
+    table = tomllib.loads(block.group(1))["arm"]
+    assert (table.pop("backend"), table.pop("transport")) == ("emulated", "pty")
+    settings = ArmSettings.model_validate(table)
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    with DynamixelArm(settings, InProcessPort(emu), clock) as arm:
+        arm.move_to(direction_from_az_el(-90, 45))
+    assert clock.now() > 0.5
