@@ -21,7 +21,7 @@ from rti_rig.clock import VirtualClock
 from rti_rig.geometry import angle_between_deg, direction_from_az_el
 from rti_rig.rig import LightCarrier
 from simulator.dynamixel_emulator import InProcessPort, PtyServoServer, emulator_for_arm
-from tests.dxl_helpers import (
+from tests.test_dxl_support import (
     arm_settings,
     wide_sdk_timeouts,  # noqa: F401  (fixture)
 )

@@ -20,7 +20,7 @@ from planner.arm_order import (
     path_time_s,
 )
 from rti_rig.geometry import direction_from_az_el
-from tests.dxl_helpers import arm_settings
+from tests.test_dxl_support import arm_settings
 
 
 def test_trapezoid_and_triangle() -> None:

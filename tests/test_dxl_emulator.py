@@ -15,7 +15,7 @@ from simulator.dynamixel_emulator import (
     InProcessPort,
     PtyServoServer,
 )
-from tests.dxl_helpers import wide_sdk_timeouts  # noqa: F401  (fixture)
+from tests.test_dxl_support import wide_sdk_timeouts  # noqa: F401  (fixture)
 
 
 def two_servos(clock: VirtualClock, mode: int = 3) -> DynamixelBusEmulator:

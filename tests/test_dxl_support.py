@@ -1,4 +1,4 @@
-"""Shared fixtures-as-functions for the Dynamixel arm tests (not a test module)."""
+"""Shared helpers for the Dynamixel arm tests (imported by the others), and their tests."""
 
 from __future__ import annotations
 
@@ -34,3 +34,15 @@ def wide_sdk_timeouts(monkeypatch):
     import dynamixel_sdk.port_handler as port_handler
 
     monkeypatch.setattr(port_handler, "LATENCY_TIMER", 100)
+
+
+def test_default_test_arm_is_valid_and_overridable() -> None:
+    s = arm_settings(azimuth=dict(servo_id=7))
+    assert s.servo_ids == (7, 2)
+    assert s.azimuth.tick_limits == (114, 3982)  # 2048 -+ 170 deg / 0.0879 deg, rounded in
+
+
+def test_wide_sdk_timeouts_fixture(wide_sdk_timeouts) -> None:
+    import dynamixel_sdk.port_handler as port_handler
+
+    assert port_handler.LATENCY_TIMER == 100
