@@ -293,8 +293,8 @@ class DynamixelArm:
             if self.clock.now() - start > s.move_timeout_s:
                 try:
                     self.stop()
-                finally:
-                    pass
+                except Exception as exc:  # report the timeout, not the failed stop
+                    log.error("%s: stop after timeout failed: %s", self.name, exc)
                 raise MoveTimeoutError(
                     self.name,
                     f"not in position after {s.move_timeout_s} s: goal {goal}, present "
