@@ -81,15 +81,19 @@ def stop_poses(
 
 
 def move_time_matrix(
-    directions: ArrayLike, settings: Any, start: ArrayLike | None = None
+    directions: ArrayLike, settings: Any, start: ArrayLike | None = None, cyclic: bool = False
 ) -> NDArray[np.float64]:
     """(N+1)x(N+1) move times; index 0 is the start pose, i+1 is ``directions[i]``.
 
-    Vectorised: each joint's trapezoid over all pairs at once."""
+    ``cyclic=True`` measures azimuth the short way round (|d| <= 180 deg), an optimistic
+    model for multi-turn ranges where the arm can usually unwind either way; check a final
+    order with :func:`sequence_time_s`. Vectorised: each joint's trapezoid over all pairs."""
     poses = np.array(stop_poses(directions, settings, start))
     out = np.zeros((len(poses), len(poses)))
     for col, joint in ((0, settings.azimuth), (1, settings.elevation)):
         d = np.abs(poses[:, col][:, None] - poses[:, col][None, :])
+        if cyclic and col == 0:
+            d = np.minimum(d % 360.0, 360.0 - d % 360.0)
         v, acc = joint.joint_velocity_deg_s, joint.joint_acceleration_deg_s2
         tri = 2.0 * np.sqrt(d / acc)
         trap = d / v + v / acc

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from planner.arm_motion import move_time_matrix
+from planner.arm_motion import move_time_matrix, sequence_time_s
 
 #: Largest stop count solved exactly.
 EXACT_MAX = 12
@@ -207,5 +207,16 @@ def order_from_matrix(cost: NDArray[np.float64]) -> list[int]:
 
 def order_for_arm(directions: ArrayLike, start: ArrayLike | None, settings: Any) -> list[int]:
     """Permutation of ``range(len(directions))`` minimising total move time from ``start``
-    (the lamp's current direction; ``None`` = the park pose)."""
-    return order_from_matrix(move_time_matrix(directions, settings, start))
+    (the lamp's current direction; ``None`` = the park pose).
+
+    When the azimuth joint spans more than a turn (multi-turn), the move time depends on the
+    path, so two orders are computed (azimuth fixed near the start, and azimuth the short way
+    round) and the one whose driver-faithful :func:`sequence_time_s` is lower is returned."""
+    dirs = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    order = order_from_matrix(move_time_matrix(dirs, settings, start))
+    if settings.azimuth.max_deg - settings.azimuth.min_deg <= 360.0 or len(dirs) < 2:
+        return order
+    other = order_from_matrix(move_time_matrix(dirs, settings, start, cyclic=True))
+    t_fixed = sequence_time_s(dirs[order], settings, start)
+    t_cyclic = sequence_time_s(dirs[other], settings, start)
+    return other if t_cyclic < t_fixed else order

@@ -98,3 +98,21 @@ def test_sequence_time_follows_multi_turn_choices() -> None:
     # the pairwise matrix fixes each stop's azimuth nearest the start: 340 deg apart
     m = move_time_matrix(dirs, s)
     assert m[1, 2] == pytest.approx(t(340.0))
+
+
+def test_multi_turn_ordering_uses_the_short_way_when_it_helps() -> None:
+    from planner.arm_motion import sequence_time_s
+
+    s = arm_settings(azimuth=dict(operating_mode="extended_position", min_deg=-540.0,
+                                  max_deg=540.0))
+    rng = np.random.default_rng(3)
+    az = rng.uniform(-180, 180, 20)
+    dirs = direction_from_az_el(az, rng.uniform(5, 70, 20))
+    order = order_for_arm(dirs, None, s)
+    assert sorted(order) == list(range(20))
+    fixed = order_from_matrix(move_time_matrix(dirs, s))
+    cyclic = order_from_matrix(move_time_matrix(dirs, s, cyclic=True))
+    t = sequence_time_s(dirs[order], s)
+    best = min(sequence_time_s(dirs[fixed], s), sequence_time_s(dirs[cyclic], s))
+    assert t == pytest.approx(best)
+    assert t < sequence_time_s(dirs, s)
