@@ -4,7 +4,10 @@ This is an open travelling-salesman path from the arm's start pose through every
 the move-time model of :mod:`planner.arm_motion` as the distance. Exact Held-Karp dynamic
 programming up to :data:`EXACT_MAX` stops (2^12 * 12 states, vectorised with numpy: a few ms);
 beyond that nearest-neighbour construction from several seeds, improved by 2-opt and Or-opt
-(segments of 1-3 stops moved, possibly reversed) until no move helps.
+(segments of 1-3 stops moved, possibly reversed) until no move helps, then iterated local
+search (double-bridge kicks, kept when they shorten the path; deterministic seed). The
+benchmark (``python -m benchmarks.arm_order``) measures the heuristic against the exact
+optimum at N = 14 and 16: median 0 %, worst 1.97 % above.
 
 The order does not change *what* is imaged, only when: the session still writes its ``.lp``
 from what ran, in the order it ran.
