@@ -5,3 +5,32 @@ addresses, units, fault bits), :mod:`settings` (validated arm config), :mod:`kin
 (direction <-> joint ticks, reachability), :mod:`faults` (named errors), :mod:`bus` (the one
 place that talks to the official ``dynamixel_sdk``) and :mod:`arm` (the ``LightCarrier``).
 """
+
+from drivers.dynamixel.arm import DynamixelArm
+from drivers.dynamixel.faults import (
+    CommunicationError,
+    ConfigMismatchError,
+    DynamixelError,
+    HardwareFaultError,
+    MoveTimeoutError,
+    SafetyViolation,
+    ServoStatusError,
+    UnreachableError,
+)
+from drivers.dynamixel.kinematics import ArmKinematics
+from drivers.dynamixel.settings import ArmSettings, JointSettings
+
+__all__ = [
+    "ArmKinematics",
+    "ArmSettings",
+    "CommunicationError",
+    "ConfigMismatchError",
+    "DynamixelArm",
+    "DynamixelError",
+    "HardwareFaultError",
+    "JointSettings",
+    "MoveTimeoutError",
+    "SafetyViolation",
+    "ServoStatusError",
+    "UnreachableError",
+]
