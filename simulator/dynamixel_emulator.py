@@ -236,7 +236,8 @@ class EmulatedServo:
             if not on:
                 self._freeze()
             elif not self.torque_on:
-                # the firmware makes the present position the goal when torque comes on
+                # modelled: torque-on holds the present position (goal := present). Not
+                # verified against the e-manual; the driver writes goal := present first anyway
                 self._freeze()
                 self._set(ct.GOAL_POSITION, round(self.position()))
         mode_before = self.get(ct.OPERATING_MODE)

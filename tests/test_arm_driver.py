@@ -107,6 +107,12 @@ def test_arm_outside_limits_at_power_up_is_refused() -> None:
     with pytest.raises(SafetyViolation, match="move the arm by hand"):
         arm.connect()
     assert not emu.servos[1].torque_on
+    arm, emu, _ = make_arm()
+    in_cone = arm.kin.ticks_of_pose(0.0, 80.0)[1]  # cone starts at 75 deg
+    emu.servos[2]._profile.start = emu.servos[2]._profile.goal = float(in_cone)
+    with pytest.raises(SafetyViolation, match="keep-out cone"):
+        arm.connect()
+    assert not emu.servos[2].torque_on and emu.goal_log == []
 
 
 def test_fault_during_move_is_named_and_teardown_still_runs() -> None:

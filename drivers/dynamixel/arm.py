@@ -72,6 +72,9 @@ class DynamixelArm:
             for joint in self.settings.joints:
                 self._bus.write(joint.servo_id, ct.PROFILE_ACCELERATION, joint.acceleration_units)
                 self._bus.write(joint.servo_id, ct.PROFILE_VELOCITY, joint.velocity_units)
+            # Goal := present before torque on, so no stale goal can make the arm jump
+            # (whatever the firmware does with Goal Position on torque-on).
+            self._send_goal(self.joint_ticks(), "connect")
             for joint in self.settings.joints:
                 self._bus.write(joint.servo_id, ct.TORQUE_ENABLE, 1)
         except BaseException:
@@ -144,7 +147,8 @@ class DynamixelArm:
                                       f"wrote {(lo, hi)}", "connect", sid)
 
     def _check_in_limits(self) -> None:
-        """Homing check: refuse to move an arm that powers up outside its safe range."""
+        """Homing check: refuse to move an arm that powers up outside its safe range or inside
+        the keep-out cone (absolute encoders: the reading is the pose, no search needed)."""
         ticks = self.joint_ticks()
         for joint, t in zip(self.settings.joints, ticks, strict=True):
             lo, hi = joint.tick_limits
@@ -156,6 +160,10 @@ class DynamixelArm:
                     "connect",
                     joint.servo_id,
                 )
+        reason = self.kin.ticks_reason(*ticks)
+        if reason:
+            raise SafetyViolation(self.name, f"the arm is not in a safe pose ({reason}); move it "
+                                  "by hand out of the keep-out cone (torque is off)", "connect")
 
     def close(self) -> None:
         """Restore the safe state (lamp off, stopped, parked; torque policy) and release the port.
