@@ -76,6 +76,9 @@ def test_unreachable_directions_never_reach_the_bus() -> None:
         assert arm.unreachable_reason(d) is not None
         with pytest.raises(UnreachableError):
             arm.move_to(d)
+    for bad in ([0.0, 0.0, 0.0], [np.nan, 0.0, 1.0], [1.0, 2.0]):
+        with pytest.raises(UnreachableError):
+            arm.move_to(bad)
     assert len(emu.goal_log) == before
     with pytest.raises(SafetyViolation, match="keep-out"):
         arm._send_goal(arm.kin.ticks_of_pose(0.0, 89.0), "test")

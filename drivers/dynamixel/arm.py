@@ -201,7 +201,10 @@ class DynamixelArm:
 
     def move_to(self, direction: ArrayLike) -> NDArray[np.float64]:
         """Move the lamp to ``direction``; wait until in position; return the direction reached."""
-        d = as_direction(direction)
+        try:
+            d = as_direction(direction)
+        except ValueError as exc:
+            raise UnreachableError(self.name, direction, f"not a 3-vector: {exc}") from exc
         current_az = None
         if self._goal is not None:
             current_az = self.kin.pose_of_ticks(*self._goal)[0]
