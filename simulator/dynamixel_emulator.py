@@ -569,6 +569,16 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
     return DynamixelBusEmulator(servos, clock)
 
 
+def lamp_direction(emulator: DynamixelBusEmulator, settings: Any) -> Any:
+    """Unit direction of the lamp *now* (emulator time), from the servos' present positions:
+    what a simulated camera should render, wherever the arm really is (even mid-move)."""
+    from drivers.dynamixel.kinematics import ArmKinematics
+
+    pos = emulator.joint_positions()
+    return ArmKinematics(settings).direction_of_ticks(
+        pos[settings.azimuth.servo_id], pos[settings.elevation.servo_id])
+
+
 @contextlib.contextmanager
 def emulated_arm_port(
     settings: Any, clock: Clock, transport: str = "pty"

@@ -200,9 +200,17 @@ def test_emulated_arm_port_dry_run(transport: str) -> None:
         arm = DynamixelArm(settings, port, clock)
         with arm:
             reached = arm.move_to(direction_from_az_el(45, 45))
-            ticks = emu.joint_positions()
-            lamp_now = arm.kin.direction_of_ticks(ticks[1], ticks[2])
-            assert angle_between_deg(lamp_now, reached) < 0.01
+            from simulator.dynamixel_emulator import lamp_direction
+
+            assert angle_between_deg(lamp_direction(emu, settings), reached) < 0.01
+            # mid-move the lamp is between start and goal
+            start = lamp_direction(emu, settings)
+            goal = direction_from_az_el(-45, 30)
+            arm._send_goal(arm.kin.ticks_of_pose(-45.0, 30.0), "test")
+            arm.joint_ticks()  # a round trip: the pty server has taken the (unanswered) goal
+            clock.sleep(0.3)
+            mid = lamp_direction(emu, settings)
+            assert angle_between_deg(mid, start) > 1.0 and angle_between_deg(mid, goal) > 1.0
         assert not port.is_open
 
 
