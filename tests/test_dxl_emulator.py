@@ -27,10 +27,11 @@ def two_servos(clock: VirtualClock, mode: int = 3) -> DynamixelBusEmulator:
 
 
 @pytest.fixture
-def pty_bus(wide_sdk_timeouts):  # noqa: F811
+def pty_bus(wide_sdk_timeouts, request):  # noqa: F811
     clock = VirtualClock()
     emu = two_servos(clock)
-    server = PtyServoServer(emu)
+    # a longer reply delay makes the unread-status pitfall reproducible on a loaded machine
+    server = PtyServoServer(emu, reply_delay_s=getattr(request, "param", 0.0005))
     path = server.start()
     port = sdk.PortHandler(path)
     assert port.openPort() and port.setBaudRate(57600)
@@ -73,6 +74,7 @@ def test_motion_follows_profile_in_emulator_time(pty_bus) -> None:
     assert ph.read4ByteTxRx(port, 1, 132)[0] == 3072
 
 
+@pytest.mark.parametrize("pty_bus", [0.005], indirect=True)
 def test_write_no_wait_drains_the_reply_over_pty(pty_bus) -> None:
     """Unicast TxOnly leaves a status the SDK never reads; the bus drains it.
 
