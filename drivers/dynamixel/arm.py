@@ -1,0 +1,316 @@
+"""The servo-arm light carrier: policy for two Dynamixel X-series joints.
+
+Safe state (``rti_rig.rig.LightCarrier``): lamp off, motion stopped, parked. ``close`` restores
+it as far as the hardware allows, then applies the torque policy ("hold": servos keep holding
+the park pose, so the arm cannot fall; "release_on_close": torque off after parking).
+
+The lamp is **tracked in software** by default (the lamp's own switch is outside the servo
+bus); with ``lamp = "servo_led"`` the state is also mirrored on the LED register (65) of
+``lamp_servo_id``, which is where a lamp driven from a servo board output would be wired.
+
+Every goal goes through :meth:`DynamixelArm._send_goal`, which runs the tick-level safety gate
+(:meth:`ArmKinematics.ticks_reason`) before anything reaches the bus.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from drivers.dynamixel import control_table as ct
+from drivers.dynamixel import protocol2 as p2
+from drivers.dynamixel.bus import DxlBus
+from drivers.dynamixel.faults import (
+    ConfigMismatchError,
+    DynamixelError,
+    HardwareFaultError,
+    MoveTimeoutError,
+    SafetyViolation,
+    UnreachableError,
+)
+from drivers.dynamixel.kinematics import ArmKinematics, as_direction, clamp_ticks
+from drivers.dynamixel.settings import ArmSettings
+from rti_rig.clock import Clock
+
+log = logging.getLogger("rti_rig.dynamixel.arm")
+
+
+class DynamixelArm:
+    """Two-axis light arm (azimuth + elevation) on Dynamixel Protocol 2.0 servos.
+
+    ``port`` is a ``dynamixel_sdk.PortHandler`` (a real device or an emulator's pty path) or an
+    in-process stand-in with the same methods; it is opened by :meth:`connect`, never here.
+    """
+
+    def __init__(
+        self,
+        settings: ArmSettings,
+        port: Any,
+        clock: Clock,
+        packet_handler: Any | None = None,
+    ) -> None:
+        self.settings = settings
+        self.name = settings.name
+        self.clock = clock
+        self.kin = ArmKinematics(settings)
+        self._bus = DxlBus(port, settings.name, packet_handler)
+        self._connected = False
+        self._lamp_on = False
+        self._goal: tuple[int, int] | None = None
+
+    # -- lifecycle --------------------------------------------------------------------------
+    def connect(self) -> None:
+        """Open the port, check the servos against the config, set profiles, torque on."""
+        self._bus.open(self.settings.baudrate)
+        try:
+            for joint in self.settings.joints:
+                self._check_servo(joint)
+            self._check_in_limits()
+            for joint in self.settings.joints:
+                self._bus.write(joint.servo_id, ct.PROFILE_ACCELERATION, joint.acceleration_units)
+                self._bus.write(joint.servo_id, ct.PROFILE_VELOCITY, joint.velocity_units)
+            # Goal := present before torque on, so no stale goal can make the arm jump
+            # (whatever the firmware does with Goal Position on torque-on).
+            self._send_goal(self.joint_ticks(), "connect")
+            for joint in self.settings.joints:
+                self._bus.write(joint.servo_id, ct.TORQUE_ENABLE, 1)
+        except BaseException:
+            self._bus.close()
+            raise
+        self._connected = True
+        self._lamp_on = False
+        self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is
+
+    def _check_servo(self, joint) -> None:
+        sid, dev = joint.servo_id, self.name
+        model = self._bus.ping(sid)
+        if model != joint.model_number:
+            raise ConfigMismatchError(
+                dev,
+                f"model number {model} ({ct.MODEL_NAMES.get(model, 'unknown')}) but the config "
+                f"expects {joint.model_number} ({ct.MODEL_NAMES[joint.model_number]}); fix "
+                "model_number or the servo id",
+                "connect",
+                sid,
+            )
+        status = self._bus.read(sid, ct.HARDWARE_ERROR_STATUS, check_alert=False)
+        if status:
+            raise HardwareFaultError(dev, sid, status, "connect")
+        mode = self._bus.read(sid, ct.OPERATING_MODE)
+        if mode != joint.mode:
+            raise ConfigMismatchError(
+                dev,
+                f"operating mode {mode} but the config expects {int(joint.mode)} "
+                f"({joint.operating_mode}); set it with Dynamixel Wizard (torque off)",
+                "connect",
+                sid,
+            )
+        drive = self._bus.read(sid, ct.DRIVE_MODE)
+        if drive & 0x05:
+            raise ConfigMismatchError(
+                dev,
+                f"drive mode 0x{drive:02X} has the reverse or time-based bit set; the driver "
+                "expects 0 (set 'direction' in the config instead)",
+                "connect",
+                sid,
+            )
+        if joint.mode == ct.OperatingMode.POSITION:
+            self._check_position_limits(joint)
+
+    def _check_position_limits(self, joint) -> None:
+        """Servo-side limits equal to the config's, so the servo refuses what the config does."""
+        sid = joint.servo_id
+        lo, hi = joint.tick_limits
+        have = (self._bus.read(sid, ct.MIN_POSITION_LIMIT),
+                self._bus.read(sid, ct.MAX_POSITION_LIMIT))
+        if have == (lo, hi):
+            return
+        if not self.settings.sync_position_limits:
+            raise ConfigMismatchError(
+                self.name,
+                f"Min/Max Position Limit are {have[0]}..{have[1]} but the config gives {lo}..{hi};"
+                " set sync_position_limits = true or write them with Dynamixel Wizard",
+                "connect",
+                sid,
+            )
+        log.info("%s: servo %d position limits %s -> %s", self.name, sid, have, (lo, hi))
+        self._bus.write(sid, ct.TORQUE_ENABLE, 0)  # EEPROM is writable only with torque off
+        self._bus.write(sid, ct.MIN_POSITION_LIMIT, lo)
+        self._bus.write(sid, ct.MAX_POSITION_LIMIT, hi)
+        again = (self._bus.read(sid, ct.MIN_POSITION_LIMIT),
+                 self._bus.read(sid, ct.MAX_POSITION_LIMIT))
+        if again != (lo, hi):
+            raise ConfigMismatchError(self.name, f"position limits read back as {again}, "
+                                      f"wrote {(lo, hi)}", "connect", sid)
+
+    def _check_in_limits(self) -> None:
+        """Homing check: refuse to move an arm that powers up outside its safe range or inside
+        the keep-out cone (absolute encoders: the reading is the pose, no search needed)."""
+        ticks = self.joint_ticks()
+        for joint, t in zip(self.settings.joints, ticks, strict=True):
+            lo, hi = joint.tick_limits
+            if not lo <= t <= hi:
+                raise SafetyViolation(
+                    self.name,
+                    f"present position {t} is outside the configured range {lo}..{hi}; move the "
+                    "arm by hand into its range (torque is off) or fix zero_offset_ticks",
+                    "connect",
+                    joint.servo_id,
+                )
+        reason = self.kin.ticks_reason(*ticks)
+        if reason:
+            raise SafetyViolation(self.name, f"the arm is not in a safe pose ({reason}); move it "
+                                  "by hand out of the keep-out cone (torque is off)", "connect")
+
+    def close(self) -> None:
+        """Restore the safe state (lamp off, stopped, parked; torque policy) and release the port.
+
+        Safe to call twice and after a failed ``connect``. Errors during teardown are logged and
+        the first one is re-raised after the port has been closed."""
+        if not self._connected:
+            self._bus.close()
+            return
+        first: BaseException | None = None
+        steps = [lambda: self.lamp(False), self.stop, self.park]
+        if self.settings.torque_policy == "release_on_close":
+            steps.append(lambda: self._bus.broadcast_write(ct.TORQUE_ENABLE, 0))
+        for step in steps:
+            try:
+                step()
+            except Exception as exc:  # keep tearing down
+                log.error("%s: teardown step failed: %s", self.name, exc)
+                first = first or exc
+        self._connected = False
+        self._bus.close()
+        if first is not None:
+            raise first
+
+    def __enter__(self) -> DynamixelArm:
+        self.connect()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- capability -------------------------------------------------------------------------
+    def unreachable_reason(self, direction: NDArray[np.float64]) -> str | None:
+        return self.kin.unreachable_reason(direction)
+
+    def move_to(self, direction: ArrayLike) -> NDArray[np.float64]:
+        """Move the lamp to ``direction``; wait until in position; return the direction reached."""
+        try:
+            d = as_direction(direction)
+        except ValueError as exc:
+            raise UnreachableError(self.name, direction, f"not a 3-vector: {exc}") from exc
+        current_az = None
+        if self._goal is not None:
+            current_az = self.kin.pose_of_ticks(*self._goal)[0]
+        pose, reason = self.kin.solve(d, current_az)
+        if pose is None:
+            raise UnreachableError(self.name, np.round(d, 6).tolist(), reason or "unknown")
+        return self._move_ticks(self.kin.ticks_of_pose(*pose), f"move_to {np.round(d, 4)}")
+
+    def park(self) -> None:
+        s = self.settings
+        self._move_ticks(self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg), "park")
+
+    def home(self) -> None:
+        """Check the arm is inside its limits (absolute encoders: no search needed) and park."""
+        self._require_connected("home")
+        self._check_in_limits()
+        self.park()
+
+    def lamp(self, on: bool) -> None:
+        if self.settings.lamp == "servo_led" and self._connected:
+            self._bus.write(int(self.settings.lamp_servo_id), ct.LED, 1 if on else 0)
+        self._lamp_on = bool(on)
+
+    @property
+    def lamp_is_on(self) -> bool:
+        return self._lamp_on
+
+    def stop(self) -> None:
+        """Stop motion by making the present position the goal (torque stays on: no falling)."""
+        if not self._connected:
+            return
+        ticks = self.joint_ticks()
+        goal = tuple(clamp_ticks(j, t) for j, t in zip(self.settings.joints, ticks, strict=True))
+        self._send_goal(goal, "stop")  # type: ignore[arg-type]
+
+    def emergency_stop(self) -> None:
+        """Torque off on every servo now (one broadcast packet, no reply to wait for).
+
+        Use when the bus may be unreliable or the arm is hitting something: the arm goes limp
+        and may drop under gravity, which is why ``stop`` (hold) is the normal safe stop."""
+        self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
+        self._lamp_on = False
+
+    def reboot(self) -> None:
+        """Reboot both servos (clears a hardware fault) and reconnect-style re-check them."""
+        for joint in self.settings.joints:
+            self._bus.reboot(joint.servo_id)
+        self._connected = False
+        self._bus.close()
+        self.connect()
+
+    # -- internals --------------------------------------------------------------------------
+    def _require_connected(self, command: str) -> None:
+        if not self._connected:
+            raise DynamixelError(self.name, "not connected; call connect() first", command)
+
+    def joint_ticks(self) -> tuple[int, int]:
+        """Present Position of (azimuth, elevation), signed."""
+        return tuple(self._bus.read(j.servo_id, ct.PRESENT_POSITION)  # type: ignore[return-value]
+                     for j in self.settings.joints)
+
+    def reached_direction(self) -> NDArray[np.float64]:
+        return self.kin.direction_of_ticks(*self.joint_ticks())
+
+    def _send_goal(self, goal: tuple[int, int], command: str) -> None:
+        reason = self.kin.ticks_reason(*goal)
+        if reason:
+            raise SafetyViolation(self.name, f"refused before sending: {reason}", command)
+        ids = self.settings.servo_ids
+        self._bus.sync_write(ct.GOAL_POSITION, dict(zip(ids, goal, strict=True)))
+        self._goal = goal
+
+    def _move_ticks(self, goal: tuple[int, int], command: str) -> NDArray[np.float64]:
+        self._require_connected(command)
+        self._send_goal(goal, command)
+        return self._wait_in_position(goal, command)
+
+    def _wait_in_position(self, goal: tuple[int, int], command: str) -> NDArray[np.float64]:
+        s = self.settings
+        start = self.clock.now()
+        while True:
+            present, moving = [], False
+            for joint in s.joints:
+                data, error = self._bus.read_block(
+                    joint.servo_id, ct.STATUS_BLOCK_START, ct.STATUS_BLOCK_LENGTH)
+                if error & p2.ERR_ALERT:
+                    status = self._bus.read(joint.servo_id, ct.HARDWARE_ERROR_STATUS,
+                                            check_alert=False)
+                    raise HardwareFaultError(self.name, joint.servo_id, status, command)
+                moving = moving or data[0] != 0
+                off = ct.PRESENT_POSITION.address - ct.STATUS_BLOCK_START
+                present.append(p2.to_signed(int.from_bytes(data[off:off + 4], "little"), 4))
+            close = all(abs(p - g) <= s.in_position_tolerance_ticks
+                        for p, g in zip(present, goal, strict=True))
+            if close and not moving:
+                return self.kin.direction_of_ticks(*present)
+            if self.clock.now() - start > s.move_timeout_s:
+                try:
+                    self.stop()
+                except Exception as exc:  # report the timeout, not the failed stop
+                    log.error("%s: stop after timeout failed: %s", self.name, exc)
+                raise MoveTimeoutError(
+                    self.name,
+                    f"not in position after {s.move_timeout_s} s: goal {goal}, present "
+                    f"{tuple(present)} ticks (tolerance {s.in_position_tolerance_ticks}); check "
+                    "for an obstruction, the load, or raise move_timeout_s",
+                    command,
+                )
+            self.clock.sleep(s.poll_interval_s)

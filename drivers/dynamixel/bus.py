@@ -1,0 +1,174 @@
+"""The one place that talks to the official ``dynamixel_sdk``: checks every result, converts
+signed values, and logs every command (the traffic choke point).
+
+Known SDK behaviours handled here:
+
+* 4-byte reads come back unsigned -> :meth:`DxlBus.read` converts signed registers.
+* A unicast Action or ``*TxOnly`` leaves the servo's status reply unread, and it corrupts the
+  next read -> the arm never sends those; :meth:`DxlBus.write_no_wait` (the only TxOnly here)
+  drains the reply, and :meth:`DxlBus.action` always broadcasts (no reply at all).
+* Instruction packets go out without byte stuffing -> harmless for servos (they parse by
+  length); the emulator parses by length too.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+from typing import Any
+
+import dynamixel_sdk as sdk
+
+from drivers.dynamixel import control_table as ct
+from drivers.dynamixel import protocol2 as p2
+from drivers.dynamixel.faults import (
+    CommunicationError,
+    HardwareFaultError,
+    ServoStatusError,
+)
+
+log = logging.getLogger("rti_rig.dynamixel.traffic")
+
+#: SDK communication result codes by name, for error messages (COMM_RX_TIMEOUT, ...).
+COMM_NAMES = {getattr(sdk, n): n for n in dir(sdk) if n.startswith("COMM_")}
+
+
+def comm_text(ph: Any, result: int) -> str:
+    return f"{COMM_NAMES.get(result, result)}: {ph.getTxRxResult(result)}"
+
+
+class DxlBus:
+    """Checked Protocol 2.0 commands over an SDK port (a ``PortHandler`` or a stand-in)."""
+
+    def __init__(self, port: Any, device: str, packet_handler: Any | None = None) -> None:
+        self.port = port
+        self.device = device
+        self.ph = packet_handler or sdk.PacketHandler(2.0)
+
+    # -- port -------------------------------------------------------------------------------
+    def open(self, baudrate: int) -> None:
+        log.debug("%s: open %s at %d baud", self.device, self.port.getPortName(), baudrate)
+        try:
+            ok = self.port.openPort() and self.port.setBaudRate(baudrate)
+        except Exception as exc:  # pyserial raises SerialException/OSError
+            raise CommunicationError(
+                self.device, f"cannot open port {self.port.getPortName()!r}: {exc}", "open"
+            ) from exc
+        if not ok:
+            raise CommunicationError(
+                self.device,
+                f"port {self.port.getPortName()!r} refused baud rate {baudrate}",
+                "open",
+            )
+
+    def close(self) -> None:
+        if getattr(self.port, "is_open", False):
+            self.port.closePort()
+
+    # -- checks -----------------------------------------------------------------------------
+    def _check(self, result: int, error: int, dxl_id: int, command: str, alert: bool = True):
+        if result != sdk.COMM_SUCCESS:
+            raise CommunicationError(
+                self.device,
+                f"{comm_text(self.ph, result)} (check power, cabling, id and baud rate)",
+                command,
+                dxl_id,
+            )
+        if error & 0x7F:
+            raise ServoStatusError(
+                self.device, dxl_id, error, command, f"servo answered {p2.describe_error(error)}"
+            )
+        if alert and error & p2.ERR_ALERT:
+            status = self.read(dxl_id, ct.HARDWARE_ERROR_STATUS, check_alert=False)
+            raise HardwareFaultError(self.device, dxl_id, status, command)
+
+    # -- commands ---------------------------------------------------------------------------
+    def ping(self, dxl_id: int) -> int:
+        """Model number of servo ``dxl_id`` (raises if it does not answer)."""
+        model, result, error = self.ph.ping(self.port, dxl_id)
+        log.debug("%s: ping %d -> model %s (%d, %d)", self.device, dxl_id, model, result, error)
+        self._check(result, error, dxl_id, "ping", alert=False)
+        return int(model)
+
+    def read(self, dxl_id: int, reg: ct.Register, check_alert: bool = True) -> int:
+        command = f"read {reg.name}"
+        fn = {1: self.ph.read1ByteTxRx, 2: self.ph.read2ByteTxRx, 4: self.ph.read4ByteTxRx}
+        value, result, error = fn[reg.size](self.port, dxl_id, reg.address)
+        log.debug("%s: id %d %s -> %s (%d, %d)", self.device, dxl_id, command, value, result,
+                  error)
+        self._check(result, error, dxl_id, command, alert=check_alert)
+        return p2.to_signed(value, reg.size) if reg.signed else int(value)
+
+    def read_block(self, dxl_id: int, address: int, length: int) -> tuple[bytes, int]:
+        """Raw bytes of ``length`` registers from ``address`` and the status ERR byte.
+
+        Hardware alerts are *not* raised here; the caller decides (it may want the data)."""
+        data, result, error = self.ph.readTxRx(self.port, dxl_id, address, length)
+        log.debug("%s: id %d read %d+%d -> %s (%d, %d)", self.device, dxl_id, address, length,
+                  bytes(data or b"").hex(), result, error)
+        self._check(result, error, dxl_id, f"read {address}+{length}", alert=False)
+        if len(data) != length:
+            raise CommunicationError(self.device, f"short reply: {len(data)} of {length} bytes",
+                                     f"read {address}+{length}", dxl_id)
+        return bytes(data), int(error)
+
+    def write(self, dxl_id: int, reg: ct.Register, value: int) -> None:
+        command = f"write {reg.name} = {value}"
+        raw = value & ((1 << (8 * reg.size)) - 1)
+        fn = {1: self.ph.write1ByteTxRx, 2: self.ph.write2ByteTxRx, 4: self.ph.write4ByteTxRx}
+        result, error = fn[reg.size](self.port, dxl_id, reg.address, raw)
+        log.debug("%s: id %d %s (%d, %d)", self.device, dxl_id, command, result, error)
+        self._check(result, error, dxl_id, command)
+
+    def write_no_wait(self, dxl_id: int, reg: ct.Register, value: int) -> None:
+        """Unicast write without waiting for success, *then drain the reply* it provokes.
+
+        Without the drain, the status the servo sends back is read as the answer to the next
+        command (SDK pitfall; ROBOTIS PR #646)."""
+        raw = value & ((1 << (8 * reg.size)) - 1)
+        data = list(raw.to_bytes(reg.size, "little"))
+        result = self.ph.writeTxOnly(self.port, dxl_id, reg.address, reg.size, data)
+        log.debug("%s: id %d write-no-wait %s = %d (%d)", self.device, dxl_id, reg.name, value,
+                  result)
+        if result != sdk.COMM_SUCCESS:
+            raise CommunicationError(self.device, comm_text(self.ph, result),
+                                     f"write {reg.name}", dxl_id)
+        self.drain_reply()
+
+    def drain_reply(self) -> None:
+        """Read and discard one pending status packet, if any (bounded by the SDK timeout)."""
+        self.port.setPacketTimeout(11)
+        self.ph.rxPacket(self.port, False)
+
+    def sync_write(self, reg: ct.Register, values: Mapping[int, int]) -> None:
+        """Same register on several servos in one broadcast packet (no reply to wait for)."""
+        group = sdk.GroupSyncWrite(self.port, self.ph, reg.address, reg.size)
+        for dxl_id, value in values.items():
+            raw = int(value) & ((1 << (8 * reg.size)) - 1)
+            group.addParam(dxl_id, list(raw.to_bytes(reg.size, "little")))
+        result = group.txPacket()
+        log.debug("%s: sync write %s %s (%d)", self.device, reg.name, dict(values), result)
+        if result != sdk.COMM_SUCCESS:
+            raise CommunicationError(self.device, comm_text(self.ph, result),
+                                     f"sync write {reg.name} {dict(values)}")
+
+    def broadcast_write(self, reg: ct.Register, value: int) -> None:
+        """Write to every servo at once; broadcast writes get no status, so none is left over."""
+        raw = value & ((1 << (8 * reg.size)) - 1)
+        data = list(raw.to_bytes(reg.size, "little"))
+        result = self.ph.writeTxOnly(self.port, p2.BROADCAST_ID, reg.address, reg.size, data)
+        log.debug("%s: broadcast write %s = %d (%d)", self.device, reg.name, value, result)
+        if result != sdk.COMM_SUCCESS:
+            raise CommunicationError(self.device, comm_text(self.ph, result),
+                                     f"broadcast write {reg.name}")
+
+    def action(self) -> None:
+        """Action to the broadcast id: unicast Action leaves a stale reply (SDK pitfall)."""
+        result = self.ph.action(self.port, p2.BROADCAST_ID)
+        if result != sdk.COMM_SUCCESS:
+            raise CommunicationError(self.device, comm_text(self.ph, result), "action")
+
+    def reboot(self, dxl_id: int) -> None:
+        result, error = self.ph.reboot(self.port, dxl_id)
+        log.debug("%s: reboot %d (%d, %d)", self.device, dxl_id, result, error)
+        self._check(result, error, dxl_id, "reboot", alert=False)

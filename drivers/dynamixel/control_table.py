@@ -1,0 +1,144 @@
+"""X-series control table (XL430-W250, XM430-W350/W210 and kin): addresses, sizes and units.
+
+Sources: ROBOTIS e-manual pages for XL430-W250 and XM430-W350 (see
+docs/protocols/dynamixel-arm.md). Only the registers the arm driver and the emulator use are
+named here; the emulator keeps the whole table as bytes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import IntEnum
+
+
+@dataclass(frozen=True)
+class Register:
+    """One control-table item."""
+
+    name: str
+    address: int
+    size: int
+    eeprom: bool = False
+    writable: bool = True
+    signed: bool = False
+
+
+MODEL_NUMBER = Register("Model Number", 0, 2, eeprom=True, writable=False)
+FIRMWARE_VERSION = Register("Firmware Version", 6, 1, eeprom=True, writable=False)
+ID = Register("ID", 7, 1, eeprom=True)
+BAUD_RATE = Register("Baud Rate", 8, 1, eeprom=True)
+RETURN_DELAY_TIME = Register("Return Delay Time", 9, 1, eeprom=True)
+DRIVE_MODE = Register("Drive Mode", 10, 1, eeprom=True)
+OPERATING_MODE = Register("Operating Mode", 11, 1, eeprom=True)
+HOMING_OFFSET = Register("Homing Offset", 20, 4, eeprom=True, signed=True)
+MOVING_THRESHOLD = Register("Moving Threshold", 24, 4, eeprom=True)
+TEMPERATURE_LIMIT = Register("Temperature Limit", 31, 1, eeprom=True)
+MAX_VOLTAGE_LIMIT = Register("Max Voltage Limit", 32, 2, eeprom=True)
+MIN_VOLTAGE_LIMIT = Register("Min Voltage Limit", 34, 2, eeprom=True)
+VELOCITY_LIMIT = Register("Velocity Limit", 44, 4, eeprom=True)
+MAX_POSITION_LIMIT = Register("Max Position Limit", 48, 4, eeprom=True)
+MIN_POSITION_LIMIT = Register("Min Position Limit", 52, 4, eeprom=True)
+SHUTDOWN = Register("Shutdown", 63, 1, eeprom=True)
+TORQUE_ENABLE = Register("Torque Enable", 64, 1)
+LED = Register("LED", 65, 1)
+STATUS_RETURN_LEVEL = Register("Status Return Level", 68, 1)
+REGISTERED_INSTRUCTION = Register("Registered Instruction", 69, 1, writable=False)
+HARDWARE_ERROR_STATUS = Register("Hardware Error Status", 70, 1, writable=False)
+GOAL_VELOCITY = Register("Goal Velocity", 104, 4, signed=True)
+PROFILE_ACCELERATION = Register("Profile Acceleration", 108, 4)
+PROFILE_VELOCITY = Register("Profile Velocity", 112, 4)
+GOAL_POSITION = Register("Goal Position", 116, 4, signed=True)
+REALTIME_TICK = Register("Realtime Tick", 120, 2, writable=False)
+MOVING = Register("Moving", 122, 1, writable=False)
+MOVING_STATUS = Register("Moving Status", 123, 1, writable=False)
+PRESENT_VELOCITY = Register("Present Velocity", 128, 4, writable=False, signed=True)
+PRESENT_POSITION = Register("Present Position", 132, 4, writable=False, signed=True)
+PRESENT_INPUT_VOLTAGE = Register("Present Input Voltage", 144, 2, writable=False)
+PRESENT_TEMPERATURE = Register("Present Temperature", 146, 1, writable=False)
+
+#: The block the driver polls while waiting: Moving .. Present Position (122..135).
+STATUS_BLOCK_START = MOVING.address
+STATUS_BLOCK_LENGTH = PRESENT_POSITION.address + 4 - MOVING.address
+
+#: Size of the emulated table (indirect data 29-56 ends at 661).
+TABLE_SIZE = 662
+EEPROM_END = 64  # addresses below this are EEPROM: writable only with torque off
+
+
+class OperatingMode(IntEnum):
+    """Operating Mode (address 11) values the arm can use."""
+
+    POSITION = 3  # one turn, 0..4095, Min/Max Position Limit enforced by the servo
+    EXTENDED_POSITION = 4  # multi-turn, +-256 rev, position limits NOT enforced by the servo
+
+
+#: Model numbers of X-series servos (Model Number, address 0).
+MODEL_NAMES = {
+    1060: "XL430-W250",
+    1090: "2XL430-W250",
+    1020: "XM430-W350",
+    1030: "XM430-W210",
+    1000: "XH430-W350",
+    1120: "XM540-W270",
+    1200: "XL330-M288",
+}
+
+TICKS_PER_REV = 4096
+DEG_PER_TICK = 360.0 / TICKS_PER_REV
+MAX_TICK = TICKS_PER_REV - 1
+#: Extended position mode covers +-256 revolutions.
+EXTENDED_TICK_LIMIT = 256 * TICKS_PER_REV - 1
+#: Profile Velocity unit: 0.229 rev/min.
+RPM_PER_VELOCITY_UNIT = 0.229
+#: Profile Acceleration unit: 214.577 rev/min^2.
+REV_MIN2_PER_ACCEL_UNIT = 214.577
+#: Largest register values accepted (velocity-based profile; e-manual ranges).
+MAX_PROFILE_VELOCITY_UNITS = 32767
+MAX_PROFILE_ACCELERATION_UNITS = 32767
+
+
+def velocity_units_to_deg_s(units: int) -> float:
+    """Profile Velocity register value to servo-shaft degrees per second."""
+    return units * RPM_PER_VELOCITY_UNIT * 360.0 / 60.0
+
+
+def acceleration_units_to_deg_s2(units: int) -> float:
+    """Profile Acceleration register value to servo-shaft degrees per second squared."""
+    return units * REV_MIN2_PER_ACCEL_UNIT * 360.0 / 3600.0
+
+
+class HardwareFault(IntEnum):
+    """Bits of Hardware Error Status (address 70)."""
+
+    INPUT_VOLTAGE = 0x01
+    OVERHEATING = 0x04
+    MOTOR_ENCODER = 0x08
+    ELECTRICAL_SHOCK = 0x10
+    OVERLOAD = 0x20
+
+
+FAULT_ADVICE = {
+    HardwareFault.INPUT_VOLTAGE: "check the power supply voltage against the servo's limits",
+    HardwareFault.OVERHEATING: "let the servo cool down and reduce its load or duty cycle",
+    HardwareFault.MOTOR_ENCODER: "the encoder failed; check the servo, then reboot it",
+    HardwareFault.ELECTRICAL_SHOCK: "check wiring and power; then reboot the servo",
+    HardwareFault.OVERLOAD: "the arm is blocked or overloaded; clear the obstruction, then reboot",
+}
+
+
+def decode_hardware_error(status: int) -> list[HardwareFault]:
+    """Named faults set in a Hardware Error Status byte, in bit order."""
+    return [f for f in HardwareFault if status & f.value]
+
+
+#: Baud Rate register codes (X-series, Protocol 2.0).
+BAUD_CODES = {
+    0: 9600,
+    1: 57600,
+    2: 115200,
+    3: 1_000_000,
+    4: 2_000_000,
+    5: 3_000_000,
+    6: 4_000_000,
+    7: 4_500_000,
+}

@@ -1,0 +1,71 @@
+"""Named errors of the Dynamixel arm: every one says which servo, which command, what to do."""
+
+from __future__ import annotations
+
+from drivers.dynamixel import control_table as ct
+from rti_rig.errors import DeviceError, ScheduleError
+
+
+class DynamixelError(DeviceError):
+    """Base class of the arm's device errors; ``servo_id`` is None for bus-wide failures."""
+
+    def __init__(
+        self, device: str, message: str, command: str | None = None, servo_id: int | None = None
+    ) -> None:
+        self.servo_id = servo_id
+        where = f"servo {servo_id}: " if servo_id is not None else ""
+        super().__init__(device, where + message, command)
+
+
+class CommunicationError(DynamixelError):
+    """No reply, or a corrupted reply (timeout, CRC): cabling, power, id or baud rate."""
+
+
+class ServoStatusError(DynamixelError):
+    """The servo answered with an error number (data limit, access error, ...)."""
+
+    def __init__(self, device: str, servo_id: int, error: int, command: str, detail: str) -> None:
+        self.error = error
+        super().__init__(device, detail, command, servo_id)
+
+
+class HardwareFaultError(DynamixelError):
+    """Hardware Error Status has bits set: the servo has shut its torque off."""
+
+    def __init__(self, device: str, servo_id: int, status: int, command: str | None) -> None:
+        self.status = status
+        self.faults = ct.decode_hardware_error(status)
+        names = ", ".join(f.name.lower().replace("_", " ") for f in self.faults) or "unknown"
+        advice = "; ".join(ct.FAULT_ADVICE[f] for f in self.faults)
+        super().__init__(
+            device,
+            f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}. "
+            "Torque stays off until the servo is rebooted.",
+            command,
+            servo_id,
+        )
+
+    @property
+    def fault_names(self) -> list[str]:
+        """Lower-case names, e.g. ['overload', 'overheating']."""
+        return [f.name.lower() for f in self.faults]
+
+
+class ConfigMismatchError(DynamixelError):
+    """The servos on the bus differ from the arm config (model, mode, limits)."""
+
+
+class MoveTimeoutError(DynamixelError):
+    """A move did not finish in position within ``move_timeout_s``."""
+
+
+class SafetyViolation(DynamixelError):
+    """A command was refused before reaching the bus (limits or keep-out cone)."""
+
+
+class UnreachableError(ScheduleError):
+    """A light direction the arm cannot or must not reach."""
+
+    def __init__(self, device: str, direction: object, reason: str) -> None:
+        self.reason = reason
+        super().__init__(f"{device}: direction {direction} is unreachable: {reason}")

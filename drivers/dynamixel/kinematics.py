@@ -1,0 +1,158 @@
+"""Light direction <-> joint angles <-> servo ticks, and the safety gate. Pure functions.
+
+Why a *tick-level* gate: the reachability test on directions is a convenience for planners;
+what protects the camera is :meth:`ArmKinematics.ticks_reason`, which checks the integers that
+will actually be written to Goal Position (after rounding and multi-turn choice). The driver
+calls it on every goal it sends, so a bug upstream cannot put a bad command on the bus.
+
+Why endpoints suffice: each X-series joint follows a monotone (trapezoidal) profile to its goal,
+so between two safe poses every intermediate joint value lies between the endpoint values. Joint
+limits are intervals and the keep-out cone around +z is ``elevation > 90 - half_angle``; with
+elevation confined to -90..90 both are convex in joint space, so a path between two safe poses
+stays safe.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from drivers.dynamixel import control_table as ct
+from drivers.dynamixel.settings import ArmSettings, JointSettings
+from rti_rig.geometry import az_el_from_direction, direction_from_az_el
+
+#: Slack when comparing joint angles to limits, for floating-point round trips.
+EPS_DEG = 1e-9
+
+
+def joint_to_ticks(joint: JointSettings, joint_deg: float) -> float:
+    """Unrounded servo ticks of a joint angle."""
+    return joint.zero_offset_ticks + joint_deg * joint.ticks_per_joint_deg
+
+
+def ticks_to_joint(joint: JointSettings, ticks: float) -> float:
+    """Joint angle in degrees of a servo reading."""
+    return (ticks - joint.zero_offset_ticks) / joint.ticks_per_joint_deg
+
+
+class ArmKinematics:
+    """Kinematics and reachability of one configured arm."""
+
+    def __init__(self, settings: ArmSettings) -> None:
+        self.settings = settings
+
+    # -- joint level ------------------------------------------------------------------------
+    def pose_reason(self, azimuth_deg: float, elevation_deg: float) -> str | None:
+        """Why a joint pose is unsafe, or None."""
+        s = self.settings
+        az, el = s.azimuth, s.elevation
+        if not az.min_deg - EPS_DEG <= azimuth_deg <= az.max_deg + EPS_DEG:
+            return f"azimuth joint {azimuth_deg:.3f} deg outside {az.min_deg}..{az.max_deg}"
+        if not el.min_deg - EPS_DEG <= elevation_deg <= el.max_deg + EPS_DEG:
+            return f"elevation {elevation_deg:.3f} deg outside {el.min_deg}..{el.max_deg}"
+        limit = 90.0 - s.keep_out_half_angle_deg
+        if elevation_deg > limit + EPS_DEG:
+            return (f"elevation {elevation_deg:.3f} deg is inside the "
+                    f"{s.keep_out_half_angle_deg} deg keep-out cone around the camera "
+                    f"(max {limit:.3f})")
+        return None
+
+    def ticks_reason(self, azimuth_ticks: int, elevation_ticks: int) -> str | None:
+        """THE safety gate: why these Goal Position values must not be sent, or None."""
+        s = self.settings
+        for name, joint, t in (("azimuth", s.azimuth, azimuth_ticks),
+                               ("elevation", s.elevation, elevation_ticks)):
+            lo, hi = joint.tick_limits
+            if not lo <= t <= hi:
+                return f"{name} servo {joint.servo_id} goal {t} ticks outside limits {lo}..{hi}"
+        el_deg = ticks_to_joint(s.elevation, elevation_ticks)
+        limit = 90.0 - s.keep_out_half_angle_deg
+        if el_deg > limit + EPS_DEG:
+            return (f"elevation goal {elevation_ticks} ticks = {el_deg:.3f} deg enters the "
+                    f"keep-out cone (max {limit:.3f} deg)")
+        return None
+
+    def ticks_of_pose(self, azimuth_deg: float, elevation_deg: float) -> tuple[int, int]:
+        """Rounded goal ticks of a joint pose. The tick limits are the degree limits rounded
+        inwards, so a pose on a degree limit can lie up to one tick outside them; such values
+        are clamped onto the limit (which is inside the safe range). Anything further out is
+        left alone for the gate to refuse."""
+        out = []
+        for joint, deg in ((self.settings.azimuth, azimuth_deg),
+                           (self.settings.elevation, elevation_deg)):
+            raw = joint_to_ticks(joint, deg)
+            lo, hi = joint.tick_limits
+            t = round(raw)
+            if lo - 1.0 <= raw and t < lo:
+                t = lo
+            elif raw <= hi + 1.0 and t > hi:
+                t = hi
+            out.append(int(t))
+        return out[0], out[1]
+
+    def pose_of_ticks(self, azimuth_ticks: float, elevation_ticks: float) -> tuple[float, float]:
+        return (ticks_to_joint(self.settings.azimuth, azimuth_ticks),
+                ticks_to_joint(self.settings.elevation, elevation_ticks))
+
+    def direction_of_ticks(self, azimuth_ticks: float, elevation_ticks: float) -> NDArray:
+        """Unit light direction of a servo reading."""
+        az, el = self.pose_of_ticks(azimuth_ticks, elevation_ticks)
+        return direction_from_az_el(az, el)
+
+    # -- direction level --------------------------------------------------------------------
+    def azimuth_candidates(self, azimuth_deg: float) -> list[float]:
+        """Joint azimuths (azimuth + k*360) inside the azimuth joint limits."""
+        j = self.settings.azimuth
+        k0 = math.floor((j.min_deg - azimuth_deg) / 360.0)
+        k1 = math.ceil((j.max_deg - azimuth_deg) / 360.0)
+        return [azimuth_deg + 360.0 * k for k in range(k0, k1 + 1)
+                if j.min_deg - EPS_DEG <= azimuth_deg + 360.0 * k <= j.max_deg + EPS_DEG]
+
+    def solve(
+        self, direction: ArrayLike, current_azimuth_deg: float | None = None
+    ) -> tuple[tuple[float, float] | None, str | None]:
+        """Joint pose for ``direction`` nearest the current azimuth, or (None, reason).
+
+        Multi-turn: any azimuth + k*360 inside the joint limits will do, and the one closest
+        to where the arm is now is taken (shortest move). The pose is checked on the rounded
+        ticks with :meth:`ticks_reason`, exactly as the driver will check it.
+        """
+        try:
+            az, el = az_el_from_direction(direction)
+        except ValueError as exc:
+            return None, str(exc)
+        az, el = float(az), float(el)
+        ref = self.settings.park_azimuth_deg if current_azimuth_deg is None else current_azimuth_deg
+        candidates = self.azimuth_candidates(az)
+        if not candidates:
+            j = self.settings.azimuth
+            return None, (f"azimuth {az:.3f} deg is outside the joint limits "
+                           f"{j.min_deg}..{j.max_deg}")
+        joint_az = min(candidates, key=lambda a: abs(a - ref))
+        reason = self.pose_reason(joint_az, el)
+        if reason:
+            return None, reason
+        reason = self.ticks_reason(*self.ticks_of_pose(joint_az, el))
+        if reason:
+            return None, reason
+        return (joint_az, el), None
+
+    def unreachable_reason(self, direction: ArrayLike) -> str | None:
+        return self.solve(direction)[1]
+
+
+def clamp_ticks(joint: JointSettings, ticks: int) -> int:
+    """Ticks clamped into the joint's safe tick range."""
+    lo, hi = joint.tick_limits
+    return int(min(max(ticks, lo), hi))
+
+
+def wrap_ticks(ticks: int) -> int:
+    """One-turn reading of a multi-turn position (0..4095)."""
+    return int(ticks) % ct.TICKS_PER_REV
+
+
+def as_direction(direction: ArrayLike) -> NDArray[np.float64]:
+    return np.asarray(direction, dtype=np.float64).reshape(3)

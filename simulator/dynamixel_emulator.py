@@ -1,0 +1,624 @@
+"""Dynamixel Protocol 2.0 X-series servos, emulated byte for byte, so that the official
+``dynamixel_sdk`` runs unchanged against them (over a pty or an in-process port).
+
+What is modelled: the control table as bytes (EEPROM locked while torque is on, read-only
+registers, position limits in position mode, Operating Mode changes resetting the profile),
+Ping/Read/Write/Reg Write/Action/Reboot/Clear/Sync Read/Sync Write/Bulk Read/Bulk Write,
+Status Return Level, the Alert bit, motion under Profile Velocity/Acceleration (trapezoid in
+*emulator time* read from an injected clock, so a dry run with a ``VirtualClock`` never waits)
+and fault injection: hardware errors (shutdown: torque off, motion frozen), corrupted CRC on
+replies, and silent (disconnected) servos.
+
+Deliberate simplifications: a new goal during a move restarts the profile from the present
+position at zero velocity (the firmware blends); no load, current or temperature dynamics;
+Return Delay Time is not waited.
+
+Like a real servo, a unicast Action and unicast writes *are* answered; the SDK does not read
+those replies (a pitfall the driver handles). Instruction packets are parsed by length, because
+the SDK sends them unstuffed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import select
+import threading
+import time
+import tty
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from drivers.dynamixel import control_table as ct
+from drivers.dynamixel import protocol2 as p2
+from rti_rig.clock import Clock
+
+#: Read-only address ranges [start, end) of the X-series table.
+READ_ONLY = ((0, 7), (69, 71), (120, 148))
+DEFAULT_FIRMWARE = 46
+
+
+def _ticks_per_s(velocity_units: int) -> float:
+    return velocity_units * ct.RPM_PER_VELOCITY_UNIT / 60.0 * ct.TICKS_PER_REV
+
+
+def _ticks_per_s2(acceleration_units: int) -> float:
+    return acceleration_units * ct.REV_MIN2_PER_ACCEL_UNIT / 3600.0 * ct.TICKS_PER_REV
+
+
+@dataclass
+class _Profile:
+    """A trapezoidal (or triangular) move from ``start`` to ``goal`` beginning at ``t0``."""
+
+    start: float
+    goal: float
+    t0: float
+    v: float
+    a: float
+
+    def __post_init__(self) -> None:
+        d = abs(self.goal - self.start)
+        if math.isinf(self.a):
+            self.ta, self.vp = 0.0, self.v
+            self.total = d / self.v if self.v > 0 else 0.0
+        elif d < self.v * self.v / self.a:  # never reaches the profile velocity
+            self.ta = math.sqrt(d / self.a)
+            self.vp = self.a * self.ta
+            self.total = 2.0 * self.ta
+        else:
+            self.ta, self.vp = self.v / self.a, self.v
+            self.total = d / self.v + self.ta
+
+    def position(self, t: float) -> float:
+        s = t - self.t0
+        d = abs(self.goal - self.start)
+        sign = 1.0 if self.goal >= self.start else -1.0
+        if s <= 0:
+            return self.start
+        if s >= self.total:
+            return self.goal
+        if s < self.ta:
+            x = 0.5 * self.a * s * s
+        elif s <= self.total - self.ta:
+            x = 0.5 * self.vp * self.ta + self.vp * (s - self.ta)
+        else:
+            r = self.total - s
+            x = d - (0.5 * self.a * r * r if not math.isinf(self.a) else 0.0)
+        return self.start + sign * min(x, d)
+
+    def velocity(self, t: float) -> float:
+        s = t - self.t0
+        if s <= 0 or s >= self.total:
+            return 0.0
+        sign = 1.0 if self.goal >= self.start else -1.0
+        if s < self.ta:
+            return sign * self.a * s
+        if s <= self.total - self.ta:
+            return sign * self.vp
+        return sign * self.a * (self.total - s)
+
+    def moving(self, t: float) -> bool:
+        return t - self.t0 < self.total
+
+
+class EmulatedServo:
+    """One X-series servo: a control table and a motion profile."""
+
+    def __init__(
+        self,
+        dxl_id: int,
+        model_number: int,
+        clock: Clock,
+        *,
+        operating_mode: int = ct.OperatingMode.POSITION,
+        present_ticks: int = 2048,
+        min_position: int = 0,
+        max_position: int = ct.MAX_TICK,
+        firmware: int = DEFAULT_FIRMWARE,
+    ) -> None:
+        self.clock = clock
+        self.table = bytearray(ct.TABLE_SIZE)
+        self._set(ct.MODEL_NUMBER, model_number)
+        self._set(ct.FIRMWARE_VERSION, firmware)
+        self._set(ct.ID, dxl_id)
+        self._set(ct.BAUD_RATE, 1)
+        self._set(ct.RETURN_DELAY_TIME, 250)
+        self._set(ct.OPERATING_MODE, int(operating_mode))
+        self._set(ct.MOVING_THRESHOLD, 10)
+        self._set(ct.TEMPERATURE_LIMIT, 72)
+        self._set(ct.VELOCITY_LIMIT, 265)
+        self._set(ct.MAX_POSITION_LIMIT, max_position)
+        self._set(ct.MIN_POSITION_LIMIT, min_position)
+        self._set(ct.SHUTDOWN, 0x34)
+        self._set(ct.STATUS_RETURN_LEVEL, 2)
+        self._set(ct.PRESENT_INPUT_VOLTAGE, 120)
+        self._set(ct.PRESENT_TEMPERATURE, 30)
+        self._set(ct.GOAL_POSITION, present_ticks)
+        self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
+        self._registered: tuple[int, bytes] | None = None
+
+    # -- table helpers ----------------------------------------------------------------------
+    def _set(self, reg: ct.Register, value: int) -> None:
+        raw = int(value) & ((1 << (8 * reg.size)) - 1)
+        self.table[reg.address:reg.address + reg.size] = raw.to_bytes(reg.size, "little")
+
+    def get(self, reg: ct.Register) -> int:
+        raw = int.from_bytes(self.table[reg.address:reg.address + reg.size], "little")
+        return p2.to_signed(raw, reg.size) if reg.signed else raw
+
+    @property
+    def dxl_id(self) -> int:
+        return self.table[ct.ID.address]
+
+    @property
+    def torque_on(self) -> bool:
+        return self.table[ct.TORQUE_ENABLE.address] == 1
+
+    @property
+    def hardware_error(self) -> int:
+        return self.table[ct.HARDWARE_ERROR_STATUS.address]
+
+    def position(self, now: float | None = None) -> float:
+        """Present position in ticks (float) at emulator time ``now``."""
+        return self._profile.position(self.clock.now() if now is None else now)
+
+    def is_moving(self, now: float | None = None) -> bool:
+        return self._profile.moving(self.clock.now() if now is None else now)
+
+    def _refresh(self) -> None:
+        now = self.clock.now()
+        moving = self._profile.moving(now)
+        self._set(ct.PRESENT_POSITION, round(self._profile.position(now)))
+        units = self._profile.velocity(now) / (ct.RPM_PER_VELOCITY_UNIT / 60 * ct.TICKS_PER_REV)
+        self._set(ct.PRESENT_VELOCITY, round(units))
+        self._set(ct.MOVING, 1 if moving else 0)
+        self._set(ct.MOVING_STATUS, 0x02 if moving else 0x01)
+        self._set(ct.REALTIME_TICK, int(now * 1000) % 32768)
+
+    def _freeze(self) -> None:
+        now = self.clock.now()
+        p = self._profile.position(now)
+        self._profile = _Profile(p, p, now, 1.0, 1.0)
+
+    # -- faults -----------------------------------------------------------------------------
+    def inject_hardware_error(self, bits: int) -> None:
+        """Set Hardware Error Status bits: torque off, motion frozen, Alert in every status."""
+        self._freeze()
+        self.table[ct.HARDWARE_ERROR_STATUS.address] |= bits & 0xFF
+        self.table[ct.TORQUE_ENABLE.address] = 0
+
+    def reboot(self) -> None:
+        self._freeze()
+        self.table[ct.HARDWARE_ERROR_STATUS.address] = 0
+        self.table[ct.TORQUE_ENABLE.address] = 0
+        self.table[ct.LED.address] = 0
+
+    # -- instructions -----------------------------------------------------------------------
+    def status_error(self, number: int = 0) -> int:
+        return number | (p2.ERR_ALERT if self.hardware_error else 0)
+
+    def read(self, address: int, length: int) -> tuple[int, bytes]:
+        if length < 0 or address + length > ct.TABLE_SIZE:
+            return p2.ERR_DATA_LENGTH, b""
+        self._refresh()
+        return 0, bytes(self.table[address:address + length])
+
+    def write(self, address: int, data: bytes) -> int:
+        """Apply a Write; returns the error number (0 = ok)."""
+        end = address + len(data)
+        if not data or end > ct.TABLE_SIZE:
+            return p2.ERR_DATA_LENGTH
+        for lo, hi in READ_ONLY:
+            if address < hi and end > lo:
+                return p2.ERR_ACCESS
+        if address < ct.EEPROM_END and self.torque_on:
+            return p2.ERR_ACCESS
+        goal = ct.GOAL_POSITION
+        if address <= goal.address < end:
+            if (address, len(data)) != (goal.address, goal.size):
+                return p2.ERR_DATA_LENGTH
+            value = p2.to_signed(int.from_bytes(data, "little"), 4)
+            if self.get(ct.OPERATING_MODE) == ct.OperatingMode.POSITION:
+                lo, hi = self.get(ct.MIN_POSITION_LIMIT), self.get(ct.MAX_POSITION_LIMIT)
+            else:
+                lo, hi = -ct.EXTENDED_TICK_LIMIT, ct.EXTENDED_TICK_LIMIT
+            if not lo <= value <= hi:
+                return p2.ERR_DATA_LIMIT
+            self.table[address:end] = data
+            self._start_move(value)
+            return 0
+        if address <= ct.TORQUE_ENABLE.address < end:
+            on = data[ct.TORQUE_ENABLE.address - address]
+            if on and self.hardware_error:
+                return p2.ERR_RESULT_FAIL  # after a shutdown only a reboot re-enables torque
+            if not on:
+                self._freeze()
+            elif not self.torque_on:
+                # modelled: torque-on holds the present position (goal := present). Not
+                # verified against the e-manual; the driver writes goal := present first anyway
+                self._freeze()
+                self._set(ct.GOAL_POSITION, round(self.position()))
+        mode_before = self.get(ct.OPERATING_MODE)
+        self.table[address:end] = data
+        if self.get(ct.OPERATING_MODE) != mode_before:
+            self._set(ct.PROFILE_VELOCITY, 0)
+            self._set(ct.PROFILE_ACCELERATION, 0)
+        return 0
+
+    def _start_move(self, goal: int) -> None:
+        if not self.torque_on or self.hardware_error:
+            return
+        now = self.clock.now()
+        v_units = self.get(ct.PROFILE_VELOCITY) or self.get(ct.VELOCITY_LIMIT) or 1
+        a_units = self.get(ct.PROFILE_ACCELERATION)
+        a = _ticks_per_s2(a_units) if a_units else math.inf
+        self._profile = _Profile(self._profile.position(now), float(goal), now,
+                                 _ticks_per_s(v_units), a)
+
+    def reg_write(self, address: int, data: bytes) -> int:
+        self._registered = (address, bytes(data))
+        self.table[ct.REGISTERED_INSTRUCTION.address] = 1
+        return 0
+
+    def action(self) -> int:
+        if self._registered is None:
+            return p2.ERR_INSTRUCTION
+        address, data = self._registered
+        self._registered = None
+        self.table[ct.REGISTERED_INSTRUCTION.address] = 0
+        return self.write(address, data)
+
+    def clear_multi_turn(self) -> int:
+        if self.is_moving():
+            return p2.ERR_RESULT_FAIL
+        p = round(self.position()) % ct.TICKS_PER_REV
+        self._profile = _Profile(p, p, self.clock.now(), 1.0, 1.0)
+        self._set(ct.GOAL_POSITION, p)
+        return 0
+
+
+class DynamixelBusEmulator:
+    """Several servos on one bus: bytes in, status bytes out (thread-safe).
+
+    Fault injection: ``silent_ids`` never answer nor act (a disconnected servo);
+    ``corrupt_next_replies`` damages the CRC of that many upcoming status packets.
+    ``goal_log`` records every Goal Position value that reached the bus, accepted or not.
+    """
+
+    def __init__(self, servos: Iterable[EmulatedServo], clock: Clock) -> None:
+        self.servos = {s.dxl_id: s for s in servos}
+        self.clock = clock
+        self.silent_ids: set[int] = set()
+        self.corrupt_next_replies = 0
+        self.goal_log: list[tuple[int, int]] = []
+        self.instructions: list[p2.Packet] = []
+        self._parser = p2.PacketParser()
+        self._lock = threading.RLock()
+
+    # -- accessors for the simulated rig ----------------------------------------------------
+    def joint_positions(self) -> dict[int, float]:
+        """Present position (ticks, float) of every servo at the clock's current time."""
+        with self._lock:
+            return {i: s.position() for i, s in self.servos.items()}
+
+    def inject_hardware_error(self, dxl_id: int, fault: int) -> None:
+        with self._lock:
+            self.servos[dxl_id].inject_hardware_error(int(fault))
+
+    # -- bytes ------------------------------------------------------------------------------
+    def receive(self, data: bytes) -> bytes:
+        """Feed instruction bytes; return the status bytes the servos send back."""
+        with self._lock:
+            self._parser.feed(bytes(data))
+            out = bytearray()
+            for item in self._parser.packets():
+                if isinstance(item, p2.CrcMismatch):
+                    dxl_id = item.raw[4]
+                    if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                        out += self._reply(dxl_id, p2.ERR_CRC)
+                    continue
+                self.instructions.append(item)
+                out += self._handle(item)
+            return bytes(out)
+
+    def _reply(self, dxl_id: int, number: int = 0, params: bytes = b"") -> bytes:
+        servo = self.servos[dxl_id]
+        packet = p2.status_packet(dxl_id, servo.status_error(number), params)
+        if self.corrupt_next_replies > 0:
+            self.corrupt_next_replies -= 1
+            packet = packet[:-1] + bytes([packet[-1] ^ 0xFF])
+        return packet
+
+    def _answers(self, servo: EmulatedServo, instruction: int) -> bool:
+        level = servo.get(ct.STATUS_RETURN_LEVEL)
+        if instruction == p2.INST_PING:
+            return True
+        if instruction in (p2.INST_READ, p2.INST_SYNC_READ, p2.INST_BULK_READ):
+            return level >= 1
+        return level >= 2
+
+    def _targets(self, pkt: p2.Packet) -> list[EmulatedServo]:
+        if pkt.dxl_id == p2.BROADCAST_ID:
+            ids = sorted(self.servos)
+        else:
+            ids = [pkt.dxl_id] if pkt.dxl_id in self.servos else []
+        return [self.servos[i] for i in ids if i not in self.silent_ids]
+
+    def _log_goal(self, dxl_id: int, address: int, data: bytes) -> None:
+        g = ct.GOAL_POSITION.address
+        if address <= g and address + len(data) >= g + 4:
+            raw = int.from_bytes(data[g - address:g - address + 4], "little")
+            self.goal_log.append((dxl_id, p2.to_signed(raw, 4)))
+
+    def _handle(self, pkt: p2.Packet) -> bytes:
+        inst, prm = pkt.instruction, pkt.params
+        unicast = pkt.dxl_id != p2.BROADCAST_ID
+        out = bytearray()
+        if inst == p2.INST_SYNC_WRITE:
+            address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
+            for i in range(4, len(prm), length + 1):
+                dxl_id, data = prm[i], prm[i + 1:i + 1 + length]
+                self._log_goal(dxl_id, address, data)
+                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                    self.servos[dxl_id].write(address, data)
+            return b""
+        if inst == p2.INST_BULK_WRITE:
+            i = 0
+            while i + 5 <= len(prm):
+                dxl_id = prm[i]
+                address = int.from_bytes(prm[i + 1:i + 3], "little")
+                length = int.from_bytes(prm[i + 3:i + 5], "little")
+                data = prm[i + 5:i + 5 + length]
+                self._log_goal(dxl_id, address, data)
+                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                    self.servos[dxl_id].write(address, data)
+                i += 5 + length
+            return b""
+        if inst == p2.INST_SYNC_READ:
+            address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
+            for dxl_id in prm[4:]:
+                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                    err, data = self.servos[dxl_id].read(address, length)
+                    out += self._reply(dxl_id, err, data)
+            return bytes(out)
+        if inst == p2.INST_BULK_READ:
+            for i in range(0, len(prm) - 4, 5):
+                dxl_id = prm[i]
+                address = int.from_bytes(prm[i + 1:i + 3], "little")
+                length = int.from_bytes(prm[i + 3:i + 5], "little")
+                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                    err, data = self.servos[dxl_id].read(address, length)
+                    out += self._reply(dxl_id, err, data)
+            return bytes(out)
+        for servo in self._targets(pkt):
+            err, params = self._execute(servo, inst, prm)
+            if inst == p2.INST_PING or (unicast and self._answers(servo, inst)):
+                out += self._reply(servo.dxl_id, err, params)
+        return bytes(out)
+
+    def _execute(self, servo: EmulatedServo, inst: int, prm: bytes) -> tuple[int, bytes]:
+        if inst == p2.INST_PING:
+            model = servo.get(ct.MODEL_NUMBER)
+            return 0, p2.u16(model) + bytes([servo.get(ct.FIRMWARE_VERSION)])
+        if inst == p2.INST_READ and len(prm) == 4:
+            address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
+            return servo.read(address, length)
+        if inst in (p2.INST_WRITE, p2.INST_REG_WRITE) and len(prm) >= 3:
+            address = int.from_bytes(prm[0:2], "little")
+            if inst == p2.INST_WRITE:
+                self._log_goal(servo.dxl_id, address, prm[2:])
+                return servo.write(address, prm[2:]), b""
+            return servo.reg_write(address, prm[2:]), b""
+        if inst == p2.INST_ACTION:
+            if servo._registered is not None:
+                self._log_goal(servo.dxl_id, *servo._registered)
+            return servo.action(), b""
+        if inst == p2.INST_REBOOT:
+            servo.reboot()
+            return 0, b""
+        if inst == p2.INST_CLEAR and prm == bytes([0x01, 0x44, 0x58, 0x4C, 0x22]):
+            return servo.clear_multi_turn(), b""
+        return p2.ERR_INSTRUCTION, b""
+
+
+class InProcessPort:
+    """A stand-in for ``dynamixel_sdk.PortHandler`` wired straight to an emulator.
+
+    Replies are produced synchronously on write, so "no more bytes" means "timed out": silence
+    costs no wall time (unlike a pty, where the SDK busy-waits its ~34 ms timeout)."""
+
+    def __init__(self, emulator: DynamixelBusEmulator, name: str = "inprocess") -> None:
+        self.emulator = emulator
+        self.port_name = name
+        self.is_open = False
+        self.is_using = False
+        self.baudrate = 1_000_000
+        self._rx = bytearray()
+        self.tx_log: list[bytes] = []
+
+    def openPort(self) -> bool:
+        self.is_open = True
+        return True
+
+    def closePort(self) -> None:
+        self.is_open = False
+
+    def clearPort(self) -> None:
+        self._rx.clear()
+
+    def setBaudRate(self, baudrate: int) -> bool:
+        self.baudrate = baudrate
+        return True
+
+    def getBaudRate(self) -> int:
+        return self.baudrate
+
+    def getPortName(self) -> str:
+        return self.port_name
+
+    def getBytesAvailable(self) -> int:
+        return len(self._rx)
+
+    def readPort(self, length: int) -> bytes:
+        out = bytes(self._rx[:length])
+        del self._rx[:length]
+        return out
+
+    def writePort(self, packet: Any) -> int:
+        if not self.is_open:
+            raise OSError(f"{self.port_name}: port is not open")
+        data = bytes(packet)
+        self.tx_log.append(data)
+        self._rx += self.emulator.receive(data)
+        return len(data)
+
+    def setPacketTimeout(self, packet_length: int) -> None:
+        pass
+
+    def setPacketTimeoutMillis(self, msec: float) -> None:
+        pass
+
+    def isPacketTimeout(self) -> bool:
+        return not self._rx
+
+
+class PtyServoServer:
+    """Serve an emulator on a pseudo-terminal; ``start()`` returns the device path
+    (e.g. /dev/pts/5) to give to ``dynamixel_sdk.PortHandler``.
+
+    A slave fd stays open for the server's lifetime (otherwise reads fail with EIO whenever the
+    SDK closes its port); ``stop()`` joins the thread within a bounded time.
+
+    ``reply_delay_s`` models the servos' Return Delay Time (default 250 x 2 us = 0.5 ms) in
+    real time: replies then arrive *after* the SDK has returned from a command it did not wait
+    for, which is what makes the unread-status pitfall bite on real hardware."""
+
+    def __init__(
+        self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, reply_delay_s: float = 0.0005
+    ) -> None:
+        self.emulator = emulator
+        self.poll_s = poll_s
+        self.reply_delay_s = reply_delay_s
+        self.device_path: str | None = None
+        self._fds: tuple[int, int] | None = None
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self) -> str:
+        master, slave = os.openpty()
+        tty.setraw(slave)
+        self._fds = (master, slave)
+        self.device_path = os.ttyname(slave)
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._serve, name="dxl-emulator", daemon=True)
+        self._thread.start()
+        return self.device_path
+
+    def _serve(self) -> None:
+        assert self._fds is not None
+        master = self._fds[0]
+        while not self._stop.is_set():
+            ready, _, _ = select.select([master], [], [], self.poll_s)
+            if not ready:
+                continue
+            try:
+                data = os.read(master, 4096)
+            except OSError:
+                continue
+            reply = self.emulator.receive(data)
+            if reply:
+                if self.reply_delay_s > 0:
+                    time.sleep(self.reply_delay_s)  # emulator thread only; tests never sleep
+                os.write(master, reply)
+
+    def stop(self, timeout_s: float = 1.0) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout_s)
+            self._thread = None
+        if self._fds is not None:
+            for fd in self._fds:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+            self._fds = None
+
+    def __enter__(self) -> PtyServoServer:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> DynamixelBusEmulator:
+    """Servos matching an ``ArmSettings`` (ids, models, modes), resting at the park pose.
+
+    Their Min/Max Position Limit are left at the factory 0..4095, so the driver's connect-time
+    check has something to synchronise, as on a fresh servo."""
+    from drivers.dynamixel.kinematics import ArmKinematics  # the emulator speaks their geometry
+
+    kin = ArmKinematics(settings)
+    park = kin.ticks_of_pose(settings.park_azimuth_deg, settings.park_elevation_deg)
+    servos = []
+    for joint, ticks in zip(settings.joints, park, strict=True):
+        servos.append(EmulatedServo(joint.servo_id, joint.model_number, clock,
+                                    operating_mode=int(joint.mode),
+                                    present_ticks=ticks if at_park else 2048))
+    return DynamixelBusEmulator(servos, clock)
+
+
+def lamp_direction(emulator: DynamixelBusEmulator, settings: Any) -> Any:
+    """Unit direction of the lamp *now* (emulator time), from the servos' present positions:
+    what a simulated camera should render, wherever the arm really is (even mid-move)."""
+    from drivers.dynamixel.kinematics import ArmKinematics
+
+    pos = emulator.joint_positions()
+    return ArmKinematics(settings).direction_of_ticks(
+        pos[settings.azimuth.servo_id], pos[settings.elevation.servo_id])
+
+
+@contextlib.contextmanager
+def emulated_arm_port(
+    settings: Any, clock: Clock, transport: str = "pty"
+) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
+    """``(port, emulator)`` for a dry run of ``DynamixelArm`` against emulated servos.
+
+    ``transport="pty"``: a real ``dynamixel_sdk.PortHandler`` on a pseudo-terminal served by a
+    thread (the real SDK and pyserial run unchanged); ``"inprocess"``: an :class:`InProcessPort`
+    (no thread, no pty; fastest). The server is stopped on exit."""
+    emulator = emulator_for_arm(settings, clock)
+    if transport == "inprocess":
+        yield InProcessPort(emulator), emulator
+        return
+    if transport != "pty":
+        raise ValueError(f"transport must be 'pty' or 'inprocess', not {transport!r}")
+    import dynamixel_sdk
+
+    server = PtyServoServer(emulator)
+    path = server.start()
+    try:
+        yield dynamixel_sdk.PortHandler(path), emulator
+    finally:
+        server.stop()
+
+
+def main() -> None:  # pragma: no cover - manual tool
+    """Serve two XL430s (ids 1, 2) on a pty until Ctrl-C, in real time (SystemClock)."""
+    from rti_rig.clock import SystemClock
+
+    clock = SystemClock()
+    emulator = DynamixelBusEmulator(
+        [EmulatedServo(1, 1060, clock), EmulatedServo(2, 1060, clock)], clock)
+    with PtyServoServer(emulator) as server:
+        print(f"emulated XL430 ids 1, 2 on {server.device_path}; Ctrl-C to stop", flush=True)
+        try:
+            while True:
+                time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

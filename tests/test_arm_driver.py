@@ -1,0 +1,282 @@
+"""The arm driver over the real dynamixel_sdk against emulated servos."""
+
+from __future__ import annotations
+
+import dynamixel_sdk as sdk
+import numpy as np
+import pytest
+from pydantic import ValidationError
+
+from drivers.dynamixel import control_table as ct
+from drivers.dynamixel.arm import DynamixelArm
+from drivers.dynamixel.faults import (
+    ConfigMismatchError,
+    HardwareFaultError,
+    MoveTimeoutError,
+    SafetyViolation,
+    UnreachableError,
+)
+from planner.arm_motion import move_time_s
+from rti_rig.clock import VirtualClock
+from rti_rig.geometry import angle_between_deg, direction_from_az_el
+from rti_rig.rig import LightCarrier
+from simulator.dynamixel_emulator import InProcessPort, PtyServoServer, emulator_for_arm
+from tests.test_dxl_support import (
+    arm_settings,
+    wide_sdk_timeouts,  # noqa: F401  (fixture)
+)
+
+
+def make_arm(**overrides):
+    settings = arm_settings(**overrides)
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    return DynamixelArm(settings, InProcessPort(emu), clock), emu, clock
+
+
+def test_is_a_light_carrier_and_moves_where_asked() -> None:
+    arm, emu, _clock = make_arm()
+    assert isinstance(arm, LightCarrier)
+    arm.connect()
+    # connect synchronised the servo-side position limits with the config
+    assert emu.servos[1].get(ct.MIN_POSITION_LIMIT) == arm.settings.azimuth.tick_limits[0]
+    assert emu.servos[2].get(ct.MAX_POSITION_LIMIT) == arm.settings.elevation.tick_limits[1]
+    for az, el in [(30, 40), (-120, 20), (160, 70), (0, 5)]:
+        target = direction_from_az_el(az, el)
+        reached = arm.move_to(target)
+        assert angle_between_deg(reached, target) < 0.2  # a tick is 0.088 deg
+        ticks = emu.joint_positions()
+        assert angle_between_deg(arm.kin.direction_of_ticks(ticks[1], ticks[2]), target) < 0.2
+    arm.close()
+    assert emu.servos[1].get(ct.TORQUE_ENABLE) == 1  # "hold" policy: parked and holding
+    park = arm.kin.ticks_of_pose(0.0, 10.0)
+    assert tuple(round(v) for v in emu.joint_positions().values()) == park
+    arm.close()  # twice is fine
+
+
+def test_move_time_matches_the_motion_model() -> None:
+    arm, _emu, clock = make_arm(settle_time_s=0.0, poll_interval_s=0.005)
+    arm.connect()
+    a, b = direction_from_az_el(-100, 10), direction_from_az_el(120, 60)
+    arm.move_to(a)
+    t0 = clock.now()
+    arm.move_to(b)
+    measured = clock.now() - t0
+    model = move_time_s(a, b, arm.settings)
+    assert model > 1.0
+    assert abs(measured - model) <= 0.02 + 0.01 * model  # polling granularity + rounding
+
+
+def test_unreachable_directions_never_reach_the_bus() -> None:
+    arm, emu, _clock = make_arm()
+    arm.connect()
+    before = len(emu.goal_log)
+    for az, el in [(10, 80), (0, 90), (175, 30), (20, -5)]:
+        d = direction_from_az_el(az, el)
+        assert arm.unreachable_reason(d) is not None
+        with pytest.raises(UnreachableError):
+            arm.move_to(d)
+    for bad in ([0.0, 0.0, 0.0], [np.nan, 0.0, 1.0], [1.0, 2.0]):
+        with pytest.raises(UnreachableError):
+            arm.move_to(bad)
+    assert len(emu.goal_log) == before
+    with pytest.raises(SafetyViolation, match="keep-out"):
+        arm._send_goal(arm.kin.ticks_of_pose(0.0, 89.0), "test")
+    assert len(emu.goal_log) == before
+
+
+def test_connect_checks_model_mode_and_limits() -> None:
+    arm, emu, _ = make_arm()
+    emu.servos[2].table[0:2] = (1020).to_bytes(2, "little")
+    with pytest.raises(ConfigMismatchError, match="model number 1020"):
+        arm.connect()
+    arm.close()
+    arm, emu, _ = make_arm()
+    emu.servos[1].table[ct.OPERATING_MODE.address] = 4
+    with pytest.raises(ConfigMismatchError, match="operating mode 4"):
+        arm.connect()
+    arm, emu, _ = make_arm(sync_position_limits=False)
+    with pytest.raises(ConfigMismatchError, match="Position Limit"):
+        arm.connect()
+    arm, emu, _ = make_arm()
+    emu.servos[2].inject_hardware_error(ct.HardwareFault.OVERHEATING)
+    with pytest.raises(HardwareFaultError, match="overheating"):
+        arm.connect()
+
+
+def test_arm_outside_limits_at_power_up_is_refused() -> None:
+    arm, emu, _ = make_arm()
+    emu.servos[1]._profile.start = emu.servos[1]._profile.goal = 4090.0  # beyond +170 deg
+    with pytest.raises(SafetyViolation, match="move the arm by hand"):
+        arm.connect()
+    assert not emu.servos[1].torque_on
+    arm, emu, _ = make_arm()
+    in_cone = arm.kin.ticks_of_pose(0.0, 80.0)[1]  # cone starts at 75 deg
+    emu.servos[2]._profile.start = emu.servos[2]._profile.goal = float(in_cone)
+    with pytest.raises(SafetyViolation, match="keep-out cone"):
+        arm.connect()
+    assert not emu.servos[2].torque_on and emu.goal_log == []
+
+
+def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
+    arm, emu, clock = make_arm()
+    arm.connect()
+    arm.lamp(True)
+    real_sleep = clock.sleep
+
+    def sleep_then_overload(s: float) -> None:
+        real_sleep(s)
+        if clock.now() > 0.3:
+            emu.servos[1].inject_hardware_error(ct.HardwareFault.OVERLOAD)
+
+    clock.sleep = sleep_then_overload  # type: ignore[method-assign]
+    with pytest.raises(HardwareFaultError) as info:
+        arm.move_to(direction_from_az_el(150, 30))
+    assert info.value.fault_names == ["overload"] and info.value.servo_id == 1
+    with pytest.raises(HardwareFaultError):
+        arm.close()  # parking a faulted servo fails, loudly, but the port is released
+    assert not arm.lamp_is_on
+
+
+def test_stalled_move_times_out_and_stops() -> None:
+    arm, emu, clock = make_arm(move_timeout_s=1.0)
+    arm.connect()
+    emu.servos[2].table[ct.TORQUE_ENABLE.address] = 0  # stalls: goal accepted, no motion
+    with pytest.raises(MoveTimeoutError, match="not in position"):
+        arm.move_to(direction_from_az_el(0, 60))
+    assert clock.now() < 2.0
+
+
+def test_emergency_stop_and_lamp_on_servo_led() -> None:
+    arm, emu, _ = make_arm(lamp="servo_led", lamp_servo_id=2)
+    arm.connect()
+    arm.lamp(True)
+    assert emu.servos[2].get(ct.LED) == 1
+    arm.emergency_stop()
+    assert not emu.servos[1].torque_on and not emu.servos[2].torque_on
+    assert not arm.lamp_is_on
+
+
+def test_settings_errors_name_the_problem() -> None:
+    with pytest.raises(ValidationError, match="keep-out cone"):
+        arm_settings(park_elevation_deg=80.0)
+    with pytest.raises(ValidationError, match=r"outside 0\.\.4095"):
+        arm_settings(azimuth=dict(min_deg=-200.0))
+    with pytest.raises(ValidationError, match="share servo_id"):
+        arm_settings(elevation=dict(servo_id=1))
+    with pytest.raises(ValidationError, match="extra"):
+        arm_settings(speed=3)
+    with pytest.raises(ValidationError, match="not a supported"):
+        arm_settings(azimuth=dict(model_number=12))
+
+
+@pytest.mark.usefixtures("wide_sdk_timeouts")
+def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
+    settings = arm_settings(azimuth=dict(operating_mode="extended_position",
+                                         min_deg=-360.0, max_deg=360.0))
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    with PtyServoServer(emu) as server:
+        arm = DynamixelArm(settings, sdk.PortHandler(server.device_path), clock)
+        with arm:
+            reached = [arm.move_to(direction_from_az_el(az, 30)) for az in (170, -170, 10)]
+        # multi-turn: 170 -> -170 deg goes the short way, through 180 (joint 190 deg)
+        az_ticks = [g for i, g in emu.goal_log if i == 1]
+        assert max(az_ticks) > arm.kin.ticks_of_pose(180.0, 30.0)[0]
+    for az, d in zip((170, -170, 10), reached, strict=True):
+        assert angle_between_deg(d, direction_from_az_el(az, 30)) < 0.2
+    assert clock.now() > 1.0  # emulator time passed; the wall clock did not wait for it
+    assert np.isfinite(clock.now())
+
+
+@pytest.mark.usefixtures("wide_sdk_timeouts")
+@pytest.mark.parametrize("transport", ["pty", "inprocess"])
+def test_emulated_arm_port_dry_run(transport: str) -> None:
+    from simulator.dynamixel_emulator import emulated_arm_port
+
+    settings = arm_settings()
+    clock = VirtualClock()
+    with emulated_arm_port(settings, clock, transport) as (port, emu):
+        arm = DynamixelArm(settings, port, clock)
+        with arm:
+            reached = arm.move_to(direction_from_az_el(45, 45))
+            from simulator.dynamixel_emulator import lamp_direction
+
+            assert angle_between_deg(lamp_direction(emu, settings), reached) < 0.01
+            # mid-move the lamp is between start and goal
+            start = lamp_direction(emu, settings)
+            goal = direction_from_az_el(-45, 30)
+            arm._send_goal(arm.kin.ticks_of_pose(-45.0, 30.0), "test")
+            arm.joint_ticks()  # a round trip: the pty server has taken the (unanswered) goal
+            clock.sleep(0.3)
+            mid = lamp_direction(emu, settings)
+            assert angle_between_deg(mid, start) > 1.0 and angle_between_deg(mid, goal) > 1.0
+        assert not port.is_open
+
+
+def test_reboot_after_fault_then_home() -> None:
+    arm, emu, _ = make_arm()
+    arm.connect()
+    emu.servos[1].inject_hardware_error(ct.HardwareFault.ELECTRICAL_SHOCK)
+    with pytest.raises(HardwareFaultError, match="electrical shock"):
+        arm.move_to(direction_from_az_el(90, 30))
+    arm.reboot()
+    assert emu.servos[1].hardware_error == 0 and emu.servos[1].torque_on
+    arm.move_to(direction_from_az_el(90, 30))
+    arm.home()
+    park = arm.kin.ticks_of_pose(0.0, 10.0)
+    assert tuple(round(v) for v in emu.joint_positions().values()) == park
+    arm.close()
+
+
+def test_settings_from_a_rig_toml_table() -> None:
+    import tomllib
+
+    from drivers.dynamixel.settings import ArmSettings
+
+    text = """
+    [arm]
+    port = "/dev/ttyUSB0"
+    baudrate = 1000000
+    keep_out_half_angle_deg = 12.0
+    park_azimuth_deg = 0.0
+    park_elevation_deg = 15.0
+    [arm.azimuth]
+    servo_id = 1
+    model_number = 1020
+    operating_mode = "extended_position"
+    zero_offset_ticks = 2048
+    min_deg = -360.0
+    max_deg = 360.0
+    [arm.elevation]
+    servo_id = 2
+    model_number = 1020
+    zero_offset_ticks = 1024
+    direction = -1
+    min_deg = 0.0
+    max_deg = 85.0
+    """
+    s = ArmSettings.model_validate(tomllib.loads(text)["arm"])
+    assert s.azimuth.mode == ct.OperatingMode.EXTENDED_POSITION
+    assert s.elevation.tick_limits == (57, 1024)  # direction -1: 85 deg is below the zero
+
+
+def test_the_documented_rig_config_validates_and_dry_runs() -> None:
+    """The TOML in docs/protocols/dynamixel-arm.md is the proposed simulated_arm.toml."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    from drivers.dynamixel.settings import ArmSettings
+
+    doc = Path(__file__).resolve().parent.parent / "docs" / "protocols" / "dynamixel-arm.md"
+    block = re.search(r"```toml\n(.*?)```", doc.read_text(encoding="utf-8"), re.DOTALL)
+    assert block is not None
+    table = tomllib.loads(block.group(1))["arm"]
+    assert (table.pop("backend"), table.pop("transport")) == ("emulated", "pty")
+    settings = ArmSettings.model_validate(table)
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    with DynamixelArm(settings, InProcessPort(emu), clock) as arm:
+        arm.move_to(direction_from_az_el(-90, 45))
+    assert clock.now() > 0.5

@@ -1,0 +1,118 @@
+"""Motion-time model and move ordering."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from planner.arm_motion import joint_move_time_s, move_time_matrix, move_time_s
+from planner.arm_order import (
+    EXACT_MAX,
+    held_karp,
+    heuristic_order,
+    order_for_arm,
+    order_from_matrix,
+    path_time_s,
+)
+from rti_rig.geometry import direction_from_az_el
+from tests.test_dxl_support import arm_settings
+
+
+def test_trapezoid_and_triangle() -> None:
+    # 90 deg at 45 deg/s, 90 deg/s^2: accel 0.5 s over 11.25 deg, cruise, decel -> 2.5 s
+    assert joint_move_time_s(90.0, 45.0, 90.0) == pytest.approx(2.5)
+    # too short to reach cruise: triangle 2*sqrt(d/a)
+    assert joint_move_time_s(10.0, 45.0, 90.0) == pytest.approx(2 * math.sqrt(10 / 90))
+    assert joint_move_time_s(0.0, 45.0, 90.0) == 0.0
+    # continuous at the switch-over distance v^2/a
+    d = 45.0**2 / 90.0
+    assert joint_move_time_s(d - 1e-9, 45, 90) == pytest.approx(joint_move_time_s(d, 45, 90))
+
+
+def test_slower_joint_sets_the_pace_and_matrix_agrees() -> None:
+    s = arm_settings(settle_time_s=0.1, elevation=dict(profile_velocity_rpm=5.0))
+    a, b = direction_from_az_el(0, 10), direction_from_az_el(5, 60)
+    el = s.elevation
+    t_el = joint_move_time_s(50.0, el.joint_velocity_deg_s, el.joint_acceleration_deg_s2)
+    assert move_time_s(a, b, s) == pytest.approx(t_el + 0.1)
+    dirs = direction_from_az_el(np.array([10, -100, 150]), np.array([20, 50, 5]))
+    m = move_time_matrix(dirs, s, start=a)
+    for i in range(3):
+        assert m[0, i + 1] == pytest.approx(move_time_s(a, dirs[i], s))
+        for j in range(3):
+            if i != j:
+                assert m[i + 1, j + 1] == pytest.approx(move_time_s(dirs[i], dirs[j], s))
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(1, 7), st.integers(0, 2**32 - 1))
+def test_held_karp_equals_brute_force(n: int, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    cost = rng.uniform(0.1, 5.0, size=(n + 1, n + 1))  # asymmetric on purpose
+    best = min(path_time_s(list(p), cost) for p in itertools.permutations(range(n)))
+    order = held_karp(cost)
+    assert sorted(order) == list(range(n))
+    assert path_time_s(order, cost) == pytest.approx(best)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_heuristic_is_within_3_percent_of_optimal(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    s = arm_settings()
+    n = 12
+    dirs = direction_from_az_el(rng.uniform(-170, 170, n), rng.uniform(0, 75, n))
+    cost = move_time_matrix(dirs, s)
+    exact = path_time_s(held_karp(cost), cost)
+    heur = path_time_s(heuristic_order(cost), cost)
+    assert exact <= heur + 1e-9
+    assert heur <= 1.03 * exact
+
+
+def test_order_for_arm_beats_plan_order_and_is_a_permutation() -> None:
+    rng = np.random.default_rng(7)
+    s = arm_settings()
+    for n in (5, EXACT_MAX, 40):
+        dirs = direction_from_az_el(rng.uniform(-170, 170, n), rng.uniform(0, 75, n))
+        order = order_for_arm(dirs, None, s)
+        assert sorted(order) == list(range(n))
+        cost = move_time_matrix(dirs, s)
+        assert path_time_s(order, cost) < path_time_s(list(range(n)), cost)
+    assert order_from_matrix(np.zeros((1, 1))) == []
+
+
+def test_sequence_time_follows_multi_turn_choices() -> None:
+    from planner.arm_motion import sequence_time_s
+
+    s = arm_settings(azimuth=dict(operating_mode="extended_position", min_deg=-360.0,
+                                  max_deg=360.0), settle_time_s=0.0)
+    dirs = direction_from_az_el(np.array([170.0, -170.0]), np.array([10.0, 10.0]))
+    # from park (az 0, el 10): 170 deg, then -170 is joint 190 deg: 20 deg the short way
+    az = s.azimuth
+    t = lambda d: joint_move_time_s(d, az.joint_velocity_deg_s, az.joint_acceleration_deg_s2)  # noqa: E731
+    assert sequence_time_s(dirs, s) == pytest.approx(t(170.0) + t(20.0))
+    # the pairwise matrix fixes each stop's azimuth nearest the start: 340 deg apart
+    m = move_time_matrix(dirs, s)
+    assert m[1, 2] == pytest.approx(t(340.0))
+
+
+def test_multi_turn_ordering_uses_the_short_way_when_it_helps() -> None:
+    from planner.arm_motion import sequence_time_s
+
+    s = arm_settings(azimuth=dict(operating_mode="extended_position", min_deg=-540.0,
+                                  max_deg=540.0))
+    rng = np.random.default_rng(3)
+    az = rng.uniform(-180, 180, 20)
+    dirs = direction_from_az_el(az, rng.uniform(5, 70, 20))
+    order = order_for_arm(dirs, None, s)
+    assert sorted(order) == list(range(20))
+    fixed = order_from_matrix(move_time_matrix(dirs, s))
+    cyclic = order_from_matrix(move_time_matrix(dirs, s, cyclic=True))
+    t = sequence_time_s(dirs[order], s)
+    best = min(sequence_time_s(dirs[fixed], s), sequence_time_s(dirs[cyclic], s))
+    assert t == pytest.approx(best)
+    assert t < sequence_time_s(dirs, s)
