@@ -37,10 +37,12 @@ HEURISTIC_CHECK_SIZES = (14, 16)
 def bench_settings() -> ArmSettings:
     return ArmSettings(
         port="emulated",
-        azimuth=dict(servo_id=1, model_number=1060, zero_offset_ticks=2048,
-                     min_deg=-170.0, max_deg=170.0),
-        elevation=dict(servo_id=2, model_number=1060, zero_offset_ticks=1024,
-                       min_deg=0.0, max_deg=90.0),
+        azimuth=dict(
+            servo_id=1, model_number=1060, zero_offset_ticks=2048, min_deg=-170.0, max_deg=170.0
+        ),
+        elevation=dict(
+            servo_id=2, model_number=1060, zero_offset_ticks=1024, min_deg=0.0, max_deg=90.0
+        ),
         keep_out_half_angle_deg=15.0,
         settle_time_s=0.05,
     )
@@ -61,8 +63,9 @@ def sweep_order(dirs: np.ndarray) -> list[int]:
 def executed_time_s(settings: ArmSettings, dirs: np.ndarray, order: list[int]) -> float:
     clock = VirtualClock()
     emu = emulator_for_arm(settings, clock)
-    arm = DynamixelArm(settings.model_copy(update={"poll_interval_s": 0.005}),
-                       InProcessPort(emu), clock)
+    arm = DynamixelArm(
+        settings.model_copy(update={"poll_interval_s": 0.005}), InProcessPort(emu), clock
+    )
     arm.connect()
     t0 = clock.now()
     for i in order:
@@ -92,8 +95,12 @@ def main() -> int:
                 exact.append(path_time_s(held_karp(cost), cost))
                 heur.append(path_time_s(heuristic_order(cost), cost))
             else:  # reference: best of long iterated-local-search runs (not a proof)
-                exact.append(min(path_time_s(heuristic_order(cost, kicks=REF_KICKS, seed=k),
-                                             cost) for k in range(1, 3)))
+                exact.append(
+                    min(
+                        path_time_s(heuristic_order(cost, kicks=REF_KICKS, seed=k), cost)
+                        for k in range(1, 3)
+                    )
+                )
         med = statistics.median
         ratio_plan = med(p / o for p, o in zip(plan, ordered, strict=True))
         ratio_sweep = med(s / o for s, o in zip(sweep, ordered, strict=True))
@@ -106,17 +113,20 @@ def main() -> int:
         else:
             vs_opt = f"{100 * max(gaps):.2f} % vs best found (optimum unknown)"
             heur_txt = "(is the ordering)"
-        rows.append(f"| {n} | {med(plan):.1f} | {med(sweep):.1f} | {med(ordered):.1f} | "
-                    f"{ratio_plan:.2f}x | {ratio_sweep:.2f}x | {vs_opt} | {heur_txt} | "
-                    f"{1000 * med(wall):.1f} |")
+        rows.append(
+            f"| {n} | {med(plan):.1f} | {med(sweep):.1f} | {med(ordered):.1f} | "
+            f"{ratio_plan:.2f}x | {ratio_sweep:.2f}x | {vs_opt} | {heur_txt} | "
+            f"{1000 * med(wall):.1f} |"
+        )
         print(rows[-1], flush=True)
     heur_rows = []
     for n in HEURISTIC_CHECK_SIZES:
         hg = []
         for _ in range(TRIALS):
             cost = move_time_matrix(light_set(n, rng), settings)
-            hg.append(path_time_s(heuristic_order(cost), cost)
-                      / path_time_s(held_karp(cost), cost) - 1)
+            hg.append(
+                path_time_s(heuristic_order(cost), cost) / path_time_s(held_karp(cost), cost) - 1
+            )
         heur_rows.append(f"| {n} | {100 * statistics.median(hg):.2f} % | {100 * max(hg):.2f} % |")
         print(heur_rows[-1], flush=True)
     # model vs emulator execution through the real driver + SDK (in-process port)
@@ -127,44 +137,46 @@ def main() -> int:
         run = executed_time_s(settings, dirs, order)
         checks.append(f"| {n} | {model:.2f} | {run:.2f} | {100 * (run / model - 1):+.2f} % |")
         print(checks[-1], flush=True)
-    md = "\n".join([
-        "## Arm move order (`python -m benchmarks.arm_order`)",
-        "",
-        machine_line(),
-        f"Median total move time in seconds over {TRIALS} random light sets per N (XL430 arm, "
-        "20 rpm / 2000 rev/min² profiles, 0.05 s settle per move; model of "
-        "`planner.arm_motion`). *Plan* = planner output order, *sweep* = sorted by azimuth, "
-        "*ordered* = `order_for_arm` (exact Held–Karp for N ≤ 12; beyond, nearest neighbour + "
-        "2-opt + Or-opt + iterated local search with double-bridge kicks"
-        "). Ratios are medians of per-set ratios.",
-        "",
-        "| N | plan (s) | sweep (s) | ordered (s) | plan/ordered | sweep/ordered | "
-        "ordered above optimum (worst) | heuristic above optimum (median / worst) | "
-        "ordering time (ms) |",
-        "|---|---|---|---|---|---|---|---|---|",
-        *rows,
-        "",
-        f"Worst gap to the exact optimum where it is known (N ≤ {EXACT_MAX}): "
-        f"{100 * worst_gap:.2f} % (target ≤ 3 %). The heuristic column shows what the "
-        "heuristic alone would give on the same sets. For N > 12 the optimum is unknown; the "
-        f"reference is the best of two longer heuristic runs ({REF_KICKS} kicks, other seeds).",
-        "",
-        "The heuristic alone against the exact optimum, where Held–Karp is still cheap "
-        f"({TRIALS} random sets each):",
-        "",
-        "| N | heuristic above optimum (median) | (worst) |",
-        "|---|---|---|",
-        *heur_rows,
-        "",
-        "Model check: the ordered schedule executed by `DynamixelArm` through the real "
-        "`dynamixel_sdk` against the emulated servos (virtual clock, 5 ms polling), settle time "
-        "excluded. The emulator integrates the same trapezoid, so this checks the driver loop "
-        "and the kinematics, not the physics.",
-        "",
-        "| N | model (s) | executed in emulator (s) | difference |",
-        "|---|---|---|---|",
-        *checks,
-    ])
+    md = "\n".join(
+        [
+            "## Arm move order (`python -m benchmarks.arm_order`)",
+            "",
+            machine_line(),
+            f"Median total move time in seconds over {TRIALS} random light sets per N (XL430 arm, "
+            "20 rpm / 2000 rev/min² profiles, 0.05 s settle per move; model of "
+            "`planner.arm_motion`). *Plan* = planner output order, *sweep* = sorted by azimuth, "
+            "*ordered* = `order_for_arm` (exact Held–Karp for N ≤ 12; beyond, nearest neighbour + "
+            "2-opt + Or-opt + iterated local search with double-bridge kicks"
+            "). Ratios are medians of per-set ratios.",
+            "",
+            "| N | plan (s) | sweep (s) | ordered (s) | plan/ordered | sweep/ordered | "
+            "ordered above optimum (worst) | heuristic above optimum (median / worst) | "
+            "ordering time (ms) |",
+            "|---|---|---|---|---|---|---|---|---|",
+            *rows,
+            "",
+            f"Worst gap to the exact optimum where it is known (N ≤ {EXACT_MAX}): "
+            f"{100 * worst_gap:.2f} % (target ≤ 3 %). The heuristic column shows what the "
+            "heuristic alone would give on the same sets. For N > 12 the optimum is unknown; the "
+            f"reference is the best of two longer heuristic runs ({REF_KICKS} kicks, other seeds).",
+            "",
+            "The heuristic alone against the exact optimum, where Held–Karp is still cheap "
+            f"({TRIALS} random sets each):",
+            "",
+            "| N | heuristic above optimum (median) | (worst) |",
+            "|---|---|---|",
+            *heur_rows,
+            "",
+            "Model check: the ordered schedule executed by `DynamixelArm` through the real "
+            "`dynamixel_sdk` against the emulated servos (virtual clock, 5 ms polling), "
+            "settle time excluded. The emulator integrates the same trapezoid, so this checks "
+            "the driver loop and the kinematics, not the physics.",
+            "",
+            "| N | model (s) | executed in emulator (s) | difference |",
+            "|---|---|---|---|",
+            *checks,
+        ]
+    )
     write_section("arm_order", md)
     return 0
 

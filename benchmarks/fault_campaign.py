@@ -57,7 +57,7 @@ SIZE = 48
 
 def make_config(folder: Path, kind: str, seed: int, fault: tuple[int, str] | None = None) -> Path:
     """A small copy of a shipped config; ``kind`` dome, arm or emulated (with a serial fault)."""
-    name = {"dome": "simulated_dome", "arm": "simulated_arm", "emulated": "emulated_dome"}[kind]
+    name = {"dome": "simulated_dome", "arm": "virtual_arm", "emulated": "emulated_dome"}[kind]
     src = REPO / "rig_configs" / f"{name}.toml"
     text = src.read_text()
     for big in ("512", "256"):

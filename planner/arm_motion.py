@@ -44,8 +44,11 @@ def joint_pose(direction: ArrayLike, settings: Any, ref_azimuth_deg: float) -> t
     j = settings.azimuth
     k0 = math.floor((j.min_deg - az) / 360.0)
     k1 = math.ceil((j.max_deg - az) / 360.0)
-    cands = [az + 360.0 * k for k in range(k0, k1 + 1)
-             if j.min_deg - 1e-9 <= az + 360.0 * k <= j.max_deg + 1e-9]
+    cands = [
+        az + 360.0 * k
+        for k in range(k0, k1 + 1)
+        if j.min_deg - 1e-9 <= az + 360.0 * k <= j.max_deg + 1e-9
+    ]
     if not cands:
         raise ValueError(f"azimuth {az:.3f} deg outside the joint limits {j.min_deg}..{j.max_deg}")
     return min(cands, key=lambda a: abs(a - ref_azimuth_deg)), el
@@ -104,9 +107,7 @@ def move_time_matrix(
     return out
 
 
-def sequence_time_s(
-    directions: ArrayLike, settings: Any, start: ArrayLike | None = None
-) -> float:
+def sequence_time_s(directions: ArrayLike, settings: Any, start: ArrayLike | None = None) -> float:
     """Total move time of visiting ``directions`` in the given order from ``start`` (park if
     None), choosing each multi-turn azimuth nearest the previous one, as the driver does.
 

@@ -101,7 +101,7 @@ def _two_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bo
         best = int(np.argmin(delta))
         if delta[best] < -1e-12:
             k = int(ks[best])
-            nodes = nodes[:i] + nodes[i:k + 1][::-1] + nodes[k + 1:]
+            nodes = nodes[:i] + nodes[i : k + 1][::-1] + nodes[k + 1 :]
             improved = True
         else:
             i += 1
@@ -117,22 +117,24 @@ def _or_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], boo
     for seg in (1, 2, 3):
         i = 1
         while i + seg <= len(nodes):
-            s = nodes[i:i + seg]
+            s = nodes[i : i + seg]
             p = nodes[i - 1]
             q = nodes[i + seg] if i + seg < len(nodes) else None
             removed = cost[p, s[0]] + (cost[s[-1], q] if q is not None else 0.0)
             bridged = cost[p, q] if q is not None else 0.0
             inner_f = sum(cost[s[t], s[t + 1]] for t in range(seg - 1))
             inner_b = sum(cost[s[t + 1], s[t]] for t in range(seg - 1))
-            rest = np.asarray(nodes[:i] + nodes[i + seg:])
+            rest = np.asarray(nodes[:i] + nodes[i + seg :])
             x = rest  # insert after rest[pos-1] = x, before y (None at the end)
             y = np.append(rest[1:], -1)
             has_y = y >= 0
             y_safe = np.where(has_y, y, 0)
             opened = np.where(has_y, cost[x, y_safe], 0.0)
             best_delta, best_move = -1e-12, None
-            for rev, first, last, inner in ((False, s[0], s[-1], inner_f),
-                                            (True, s[-1], s[0], inner_b)):
+            for rev, first, last, inner in (
+                (False, s[0], s[-1], inner_f),
+                (True, s[-1], s[0], inner_b),
+            ):
                 added = cost[x, first] + np.where(has_y, cost[last, y_safe], 0.0)
                 delta = (bridged - removed) + (added - opened) + (inner - inner_f)
                 delta[i - 1] = np.inf  # that is where the segment came from
@@ -179,7 +181,7 @@ def heuristic_order(
     n = cost.shape[0] - 1
     if n == 0:
         return []
-    firsts = list(np.argsort(cost[0, 1:])[:max(1, min(seeds, n))])
+    firsts = list(np.argsort(cost[0, 1:])[: max(1, min(seeds, n))])
     best, best_t = None, np.inf
     for f in firsts:
         cand = improve(_nearest_neighbour(cost, int(f)), cost)

@@ -9,6 +9,8 @@ directly within its reachable band.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
@@ -58,10 +60,21 @@ def order_nearest_neighbour(
     return np.asarray(order, dtype=np.intp)
 
 
+#: Orders an arm's stops: (directions (n, 3), start direction) -> visiting order.
+ArmOrder = Callable[[NDArray[np.float64], NDArray[np.float64]], Sequence[int]]
+
+
 def plan_uniform(
-    geometry: DomeGeometry | ArmGeometry, n: int, min_elevation_deg: float = 0.0
+    geometry: DomeGeometry | ArmGeometry,
+    n: int,
+    min_elevation_deg: float = 0.0,
+    arm_order: ArmOrder | None = None,
 ) -> LightSchedule:
-    """A homogeneous schedule of ``n`` lights, ordered for the rig."""
+    """A homogeneous schedule of ``n`` lights, ordered for the rig.
+
+    Dome steps go in LED order. Arm steps go in ``arm_order`` (the move-time-optimal order of
+    :mod:`planner.arm_order` when the arm's servos are known), else nearest neighbour by angle.
+    """
     provenance = {"n": n, "min_elevation_deg": min_elevation_deg}
     if isinstance(geometry, DomeGeometry):
         leds = select_uniform_leds(geometry, n, min_elevation_deg)
@@ -81,6 +94,8 @@ def plan_uniform(
             f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
             f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
         )
-    dirs = fibonacci_cap(n, lo, hi)
-    order = order_nearest_neighbour(dirs, geometry.park_direction)
+    dirs = np.array([geometry.clamp_azimuth(d) for d in fibonacci_cap(n, lo, hi)])
+    start = geometry.park_direction
+    order = (arm_order or order_nearest_neighbour)(dirs, start)
+    order = np.asarray(order, dtype=np.intp)
     return LightSchedule.from_directions(dirs[order], method="uniform", provenance=provenance)

@@ -93,7 +93,7 @@ def run(
     """
     from planner.from_lp import schedule_from_lp
     from planner.uniform import plan_uniform
-    from rti_rig.compose import build_rig
+    from rti_rig.compose import arm_order_for, build_rig
     from rti_rig.config import load_rig_config, rig_geometry
     from rti_rig.controller import validate_schedule
     from rti_rig.lp_format import read_lp
@@ -140,7 +140,7 @@ def run(
                 schedule = schedule_from_lp(read_lp(plan), geometry, str(plan))
             else:
                 n = lights if lights is not None else _default_lights(loaded, geometry)
-                schedule = plan_uniform(geometry, n, min_elevation_deg)
+                schedule = plan_uniform(geometry, n, min_elevation_deg, arm_order_for(loaded))
             rig = build_rig(loaded)
             validate_schedule(rig, schedule)
             folder = SessionFolder.create(out_dir, len(schedule))

@@ -120,25 +120,80 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
     return rig
 
 
+class _ArmLamp:
+    """Where the emulated servos really hold the lamp (even mid-move), if it is on."""
+
+    def __init__(self, arm, emulator, settings) -> None:  # type: ignore[no-untyped-def]
+        self._arm, self._emulator, self._settings = arm, emulator, settings
+
+    @property
+    def direction(self):  # type: ignore[no-untyped-def]
+        from simulator.dynamixel_emulator import lamp_direction
+
+        if not self._arm.lamp_is_on:
+            return None
+        return lamp_direction(self._emulator, self._settings)
+
+    @property
+    def intensity(self) -> float:
+        return 1.0 if self._arm.lamp_is_on else 0.0
+
+
+def _arm_lighting(loaded: LoadedRig, carrier) -> ArmLighting:  # type: ignore[no-untyped-def]
+    arm = loaded.config.arm
+    assert arm is not None
+    return ArmLighting(
+        carrier,
+        park_after_session=arm.park_after_session,
+        park_on_emergency=arm.park_on_emergency_stop,
+    )
+
+
+def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) -> Rig:
+    """The real Dynamixel driver and SDK against emulated servos (pty or in-process)."""
+    from drivers.dynamixel.arm import DynamixelArm
+    from simulator.dynamixel_emulator import emulated_arm_port
+
+    arm_cfg = loaded.config.arm
+    assert arm_cfg is not None and arm_cfg.dynamixel is not None
+    settings = arm_cfg.dynamixel
+    stack = contextlib.ExitStack()
+    port, emulator = stack.enter_context(
+        emulated_arm_port(settings, clock, transport=arm_cfg.transport)
+    )
+    try:
+        arm = DynamixelArm(settings, port, clock)
+        camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)
+    except BaseException:
+        stack.close()
+        raise
+    rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock, stack)
+    rig.emulator = emulator  # type: ignore[attr-defined]  # for tests and the fault campaign
+    return rig
+
+
 def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
-    """Real devices: the dome over its serial port, the camera from [camera.device]."""
+    """Real devices: the dome or arm on its port, the camera from [camera.device]."""
     from drivers.cameras.factory import build_camera
-    from drivers.led_dome import build_dome
     from rti_rig.config import camera_device_settings
 
     cfg = loaded.config
     geometry = rig_geometry(loaded)
-    if not isinstance(geometry, DomeGeometry):
-        raise ConfigError(
-            loaded.path,
-            "backend",
-            "a hardware arm is driven with backend 'hardware' once the "
-            "Dynamixel driver is configured under [arm.dynamixel]",
-        )
-    assert cfg.dome is not None and cfg.dome.serial is not None
-    dome = build_dome(cfg.dome.serial, clock, directions=geometry.directions, name="dome")
     camera = build_camera(camera_device_settings(loaded), clock=clock)
-    return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
+    if isinstance(geometry, DomeGeometry):
+        from drivers.led_dome import build_dome
+
+        assert cfg.dome is not None and cfg.dome.serial is not None
+        dome = build_dome(cfg.dome.serial, clock, directions=geometry.directions, name="dome")
+        return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
+    import dynamixel_sdk
+
+    from drivers.dynamixel.arm import DynamixelArm
+
+    assert cfg.arm is not None and cfg.arm.dynamixel is not None
+    settings = cfg.arm.dynamixel
+    arm = DynamixelArm(settings, dynamixel_sdk.PortHandler(settings.port), clock)
+    return Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock)
 
 
 def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
@@ -149,7 +204,8 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
     if cfg.backend == "emulated" and isinstance(geometry, DomeGeometry):
         return _build_emulated_dome(loaded, geometry, clock)
     if cfg.backend == "emulated":
-        raise ConfigError(loaded.path, "backend", "an emulated arm needs [arm.dynamixel]")
+        assert isinstance(geometry, ArmGeometry)
+        return _build_emulated_arm(loaded, geometry, clock)
     state = LightState()
     if isinstance(geometry, DomeGeometry):
         lighting = DomeLighting(
@@ -157,7 +213,8 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
         )
     else:
         assert isinstance(geometry, ArmGeometry) and cfg.arm is not None
-        lighting = ArmLighting(
+        lighting = _arm_lighting(
+            loaded,
             SimulatedArm(
                 geometry,
                 state,
@@ -167,8 +224,17 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
                 resolution_deg=cfg.arm.resolution_deg,
                 switch_s=cfg.timing.light_switch_s,
             ),
-            park_after_session=cfg.arm.park_after_session,
-            park_on_emergency=cfg.arm.park_on_emergency_stop,
         )
     camera = _simulated_camera(loaded, state, clock)
     return Rig(loaded=loaded, geometry=geometry, lighting=lighting, camera=camera, clock=clock)
+
+
+def arm_order_for(loaded: LoadedRig):  # type: ignore[no-untyped-def]
+    """The move-time-optimal stop order for an arm whose servos are configured, else None."""
+    arm = loaded.config.arm
+    if arm is None or arm.dynamixel is None:
+        return None
+    from planner.arm_order import order_for_arm
+
+    settings = arm.dynamixel
+    return lambda directions, start: order_for_arm(directions, start, settings)

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from drivers.dynamixel.settings import ArmSettings
 from drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.errors import ConfigError, LpFormatError
 from rti_rig.geometry import direction_from_az_el, fibonacci_cap
@@ -60,7 +61,12 @@ class DomeConfig(_Strict):
 
 
 class ArmConfig(_Strict):
-    """Reach, safety limits and motion of an arm that carries one lamp."""
+    """Reach, safety limits and motion of an arm that carries one lamp.
+
+    A simulated arm uses the limits and motion below. An emulated or hardware arm is described
+    by its servos under ``[arm.dynamixel]`` (docs/protocols/dynamixel-arm.md): its reach,
+    keep-out cone and parking pose then come from there.
+    """
 
     min_elevation_deg: float = Field(default=5.0, ge=0, lt=90)
     max_elevation_deg: float = Field(default=80.0, gt=0, le=90)
@@ -73,6 +79,9 @@ class ArmConfig(_Strict):
     default_lights: int = Field(default=24, gt=0, le=1000)
     park_after_session: bool = True
     park_on_emergency_stop: bool = False
+    dynamixel: ArmSettings | None = None
+    #: emulated backend: "pty" runs the real SDK and pyserial on a pseudo-terminal.
+    transport: Literal["pty", "inprocess"] = "pty"
 
     @model_validator(mode="after")
     def _limits_consistent(self) -> ArmConfig:
@@ -182,6 +191,11 @@ class RigConfig(_Strict):
             raise ValueError(
                 f"backend '{self.backend}' drives the dome over serial: add a [dome.serial] "
                 "table (port, profile; see docs/protocols/led-dome.md)"
+            )
+        if self.backend != "simulated" and self.kind == "arm" and self.arm.dynamixel is None:  # type: ignore[union-attr]
+            raise ValueError(
+                f"backend '{self.backend}' drives the arm's servos: add an [arm.dynamixel] "
+                "table (see docs/protocols/dynamixel-arm.md)"
             )
         if self.backend == "hardware" and self.camera.device is None:
             raise ValueError(
@@ -345,6 +359,17 @@ def rig_geometry(rig: LoadedRig) -> DomeGeometry | ArmGeometry:
         return DomeGeometry(dirs, tuple(names))
     arm = cfg.arm
     assert arm is not None
+    if arm.dynamixel is not None and cfg.backend != "simulated":
+        dxl = arm.dynamixel
+        return ArmGeometry(
+            min_elevation_deg=max(0.0, dxl.elevation.min_deg),
+            max_elevation_deg=min(dxl.elevation.max_deg, 90.0 - dxl.keep_out_half_angle_deg),
+            keep_out_half_angle_deg=dxl.keep_out_half_angle_deg,
+            park_azimuth_deg=dxl.park_azimuth_deg,
+            park_elevation_deg=dxl.park_elevation_deg,
+            min_azimuth_deg=max(-180.0, dxl.azimuth.min_deg),
+            max_azimuth_deg=min(180.0, dxl.azimuth.max_deg),
+        )
     return ArmGeometry(
         min_elevation_deg=arm.min_elevation_deg,
         max_elevation_deg=arm.max_elevation_deg,

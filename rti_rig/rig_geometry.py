@@ -49,6 +49,9 @@ class ArmGeometry:
     keep_out_half_angle_deg: float
     park_azimuth_deg: float
     park_elevation_deg: float
+    #: Azimuth range of the arm's base joint, in (-180, 180] terms (a cable stops a full turn).
+    min_azimuth_deg: float = -180.0
+    max_azimuth_deg: float = 180.0
 
     @property
     def park_direction(self) -> NDArray[np.float64]:
@@ -69,7 +72,21 @@ class ArmGeometry:
             return f"elevation {el:.2f}° is below the arm's minimum {self.min_elevation_deg:g}°"
         if el > self.max_elevation_deg + 1e-9:
             return f"elevation {el:.2f}° is above the arm's maximum {self.max_elevation_deg:g}°"
+        az = float(az_el_from_direction(d)[0])
+        az = az - 360.0 if az > 180.0 else az
+        if not self.min_azimuth_deg - 1e-9 <= az <= self.max_azimuth_deg + 1e-9:
+            return (
+                f"azimuth {az:.2f}° is outside the arm's range "
+                f"[{self.min_azimuth_deg:g}°, {self.max_azimuth_deg:g}°]"
+            )
         return None
+
+    def clamp_azimuth(self, direction: ArrayLike) -> NDArray[np.float64]:
+        """``direction`` with its azimuth moved to the nearest end of the arm's range if outside."""
+        az, el = az_el_from_direction(np.asarray(direction, dtype=np.float64))
+        a = float(az) - 360.0 if float(az) > 180.0 else float(az)
+        a = min(max(a, self.min_azimuth_deg), self.max_azimuth_deg)
+        return direction_from_az_el(a, float(el))
 
 
 RigGeometry = DomeGeometry | ArmGeometry

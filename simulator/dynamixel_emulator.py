@@ -142,10 +142,10 @@ class EmulatedServo:
     # -- table helpers ----------------------------------------------------------------------
     def _set(self, reg: ct.Register, value: int) -> None:
         raw = int(value) & ((1 << (8 * reg.size)) - 1)
-        self.table[reg.address:reg.address + reg.size] = raw.to_bytes(reg.size, "little")
+        self.table[reg.address : reg.address + reg.size] = raw.to_bytes(reg.size, "little")
 
     def get(self, reg: ct.Register) -> int:
-        raw = int.from_bytes(self.table[reg.address:reg.address + reg.size], "little")
+        raw = int.from_bytes(self.table[reg.address : reg.address + reg.size], "little")
         return p2.to_signed(raw, reg.size) if reg.signed else raw
 
     @property
@@ -203,7 +203,7 @@ class EmulatedServo:
         if length < 0 or address + length > ct.TABLE_SIZE:
             return p2.ERR_DATA_LENGTH, b""
         self._refresh()
-        return 0, bytes(self.table[address:address + length])
+        return 0, bytes(self.table[address : address + length])
 
     def write(self, address: int, data: bytes) -> int:
         """Apply a Write; returns the error number (0 = ok)."""
@@ -254,8 +254,9 @@ class EmulatedServo:
         v_units = self.get(ct.PROFILE_VELOCITY) or self.get(ct.VELOCITY_LIMIT) or 1
         a_units = self.get(ct.PROFILE_ACCELERATION)
         a = _ticks_per_s2(a_units) if a_units else math.inf
-        self._profile = _Profile(self._profile.position(now), float(goal), now,
-                                 _ticks_per_s(v_units), a)
+        self._profile = _Profile(
+            self._profile.position(now), float(goal), now, _ticks_per_s(v_units), a
+        )
 
     def reg_write(self, address: int, data: bytes) -> int:
         self._registered = (address, bytes(data))
@@ -349,7 +350,7 @@ class DynamixelBusEmulator:
     def _log_goal(self, dxl_id: int, address: int, data: bytes) -> None:
         g = ct.GOAL_POSITION.address
         if address <= g and address + len(data) >= g + 4:
-            raw = int.from_bytes(data[g - address:g - address + 4], "little")
+            raw = int.from_bytes(data[g - address : g - address + 4], "little")
             self.goal_log.append((dxl_id, p2.to_signed(raw, 4)))
 
     def _handle(self, pkt: p2.Packet) -> bytes:
@@ -359,7 +360,7 @@ class DynamixelBusEmulator:
         if inst == p2.INST_SYNC_WRITE:
             address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
             for i in range(4, len(prm), length + 1):
-                dxl_id, data = prm[i], prm[i + 1:i + 1 + length]
+                dxl_id, data = prm[i], prm[i + 1 : i + 1 + length]
                 self._log_goal(dxl_id, address, data)
                 if dxl_id in self.servos and dxl_id not in self.silent_ids:
                     self.servos[dxl_id].write(address, data)
@@ -368,9 +369,9 @@ class DynamixelBusEmulator:
             i = 0
             while i + 5 <= len(prm):
                 dxl_id = prm[i]
-                address = int.from_bytes(prm[i + 1:i + 3], "little")
-                length = int.from_bytes(prm[i + 3:i + 5], "little")
-                data = prm[i + 5:i + 5 + length]
+                address = int.from_bytes(prm[i + 1 : i + 3], "little")
+                length = int.from_bytes(prm[i + 3 : i + 5], "little")
+                data = prm[i + 5 : i + 5 + length]
                 self._log_goal(dxl_id, address, data)
                 if dxl_id in self.servos and dxl_id not in self.silent_ids:
                     self.servos[dxl_id].write(address, data)
@@ -386,8 +387,8 @@ class DynamixelBusEmulator:
         if inst == p2.INST_BULK_READ:
             for i in range(0, len(prm) - 4, 5):
                 dxl_id = prm[i]
-                address = int.from_bytes(prm[i + 1:i + 3], "little")
-                length = int.from_bytes(prm[i + 3:i + 5], "little")
+                address = int.from_bytes(prm[i + 1 : i + 3], "little")
+                length = int.from_bytes(prm[i + 3 : i + 5], "little")
                 if dxl_id in self.servos and dxl_id not in self.silent_ids:
                     err, data = self.servos[dxl_id].read(address, length)
                     out += self._reply(dxl_id, err, data)
@@ -563,9 +564,15 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
     park = kin.ticks_of_pose(settings.park_azimuth_deg, settings.park_elevation_deg)
     servos = []
     for joint, ticks in zip(settings.joints, park, strict=True):
-        servos.append(EmulatedServo(joint.servo_id, joint.model_number, clock,
-                                    operating_mode=int(joint.mode),
-                                    present_ticks=ticks if at_park else 2048))
+        servos.append(
+            EmulatedServo(
+                joint.servo_id,
+                joint.model_number,
+                clock,
+                operating_mode=int(joint.mode),
+                present_ticks=ticks if at_park else 2048,
+            )
+        )
     return DynamixelBusEmulator(servos, clock)
 
 
@@ -576,7 +583,8 @@ def lamp_direction(emulator: DynamixelBusEmulator, settings: Any) -> Any:
 
     pos = emulator.joint_positions()
     return ArmKinematics(settings).direction_of_ticks(
-        pos[settings.azimuth.servo_id], pos[settings.elevation.servo_id])
+        pos[settings.azimuth.servo_id], pos[settings.elevation.servo_id]
+    )
 
 
 @contextlib.contextmanager
@@ -610,7 +618,8 @@ def main() -> None:  # pragma: no cover - manual tool
 
     clock = SystemClock()
     emulator = DynamixelBusEmulator(
-        [EmulatedServo(1, 1060, clock), EmulatedServo(2, 1060, clock)], clock)
+        [EmulatedServo(1, 1060, clock), EmulatedServo(2, 1060, clock)], clock
+    )
     with PtyServoServer(emulator) as server:
         print(f"emulated XL430 ids 1, 2 on {server.device_path}; Ctrl-C to stop", flush=True)
         try:

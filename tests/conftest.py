@@ -17,7 +17,7 @@ def dome_config_path() -> Path:
 
 @pytest.fixture
 def arm_config_path() -> Path:
-    return CONFIGS / "simulated_arm.toml"
+    return CONFIGS / "virtual_arm.toml"
 
 
 def write_config(tmp_path: Path, text: str, name: str = "rig.toml") -> Path:

@@ -172,8 +172,9 @@ def test_settings_errors_name_the_problem() -> None:
 
 @pytest.mark.usefixtures("wide_sdk_timeouts")
 def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
-    settings = arm_settings(azimuth=dict(operating_mode="extended_position",
-                                         min_deg=-360.0, max_deg=360.0))
+    settings = arm_settings(
+        azimuth=dict(operating_mode="extended_position", min_deg=-360.0, max_deg=360.0)
+    )
     clock = VirtualClock()
     emu = emulator_for_arm(settings, clock)
     with PtyServoServer(emu) as server:

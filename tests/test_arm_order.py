@@ -88,8 +88,10 @@ def test_order_for_arm_beats_plan_order_and_is_a_permutation() -> None:
 def test_sequence_time_follows_multi_turn_choices() -> None:
     from planner.arm_motion import sequence_time_s
 
-    s = arm_settings(azimuth=dict(operating_mode="extended_position", min_deg=-360.0,
-                                  max_deg=360.0), settle_time_s=0.0)
+    s = arm_settings(
+        azimuth=dict(operating_mode="extended_position", min_deg=-360.0, max_deg=360.0),
+        settle_time_s=0.0,
+    )
     dirs = direction_from_az_el(np.array([170.0, -170.0]), np.array([10.0, 10.0]))
     # from park (az 0, el 10): 170 deg, then -170 is joint 190 deg: 20 deg the short way
     az = s.azimuth
@@ -103,8 +105,9 @@ def test_sequence_time_follows_multi_turn_choices() -> None:
 def test_multi_turn_ordering_uses_the_short_way_when_it_helps() -> None:
     from planner.arm_motion import sequence_time_s
 
-    s = arm_settings(azimuth=dict(operating_mode="extended_position", min_deg=-540.0,
-                                  max_deg=540.0))
+    s = arm_settings(
+        azimuth=dict(operating_mode="extended_position", min_deg=-540.0, max_deg=540.0)
+    )
     rng = np.random.default_rng(3)
     az = rng.uniform(-180, 180, 20)
     dirs = direction_from_az_el(az, rng.uniform(5, 70, 20))

@@ -45,11 +45,26 @@ def arm_configs(draw) -> ArmSettings:
     profile = dict(profile_velocity_rpm=50.0, profile_acceleration_rev_min2=5000.0)
     return ArmSettings(
         port="emulated",
-        azimuth=dict(servo_id=1, model_number=1060, zero_offset_ticks=az_zero,
-                     direction=az_dir, gear_ratio=gear, min_deg=az_min, max_deg=az_max,
-                     operating_mode="extended_position" if extended else "position", **profile),
-        elevation=dict(servo_id=2, model_number=1020, zero_offset_ticks=2048,
-                       direction=el_dir, min_deg=el_min, max_deg=el_max, **profile),
+        azimuth=dict(
+            servo_id=1,
+            model_number=1060,
+            zero_offset_ticks=az_zero,
+            direction=az_dir,
+            gear_ratio=gear,
+            min_deg=az_min,
+            max_deg=az_max,
+            operating_mode="extended_position" if extended else "position",
+            **profile,
+        ),
+        elevation=dict(
+            servo_id=2,
+            model_number=1020,
+            zero_offset_ticks=2048,
+            direction=el_dir,
+            min_deg=el_min,
+            max_deg=el_max,
+            **profile,
+        ),
         keep_out_half_angle_deg=keep_out,
         park_azimuth_deg=az_min + az_span / 2,
         park_elevation_deg=park_el,
@@ -75,13 +90,20 @@ def schedules(cfg: ArmSettings):
     az_lo, az_hi = cfg.azimuth.min_deg, cfg.azimuth.max_deg
     el_lo = cfg.elevation.min_deg
     near = st.tuples(st.floats(-0.1, 1.1), st.floats(-0.15, 1.15)).map(
-        lambda f: tuple(direction_from_az_el(az_lo + f[0] * (az_hi - az_lo),
-                                             min(89.9, el_lo + f[1] * (el_top - el_lo)))))
+        lambda f: tuple(
+            direction_from_az_el(
+                az_lo + f[0] * (az_hi - az_lo), min(89.9, el_lo + f[1] * (el_top - el_lo))
+            )
+        )
+    )
     cone_edge = st.tuples(st.floats(0.0, 1.0), st.floats(-2.0, 4.0)).map(
-        lambda f: tuple(direction_from_az_el(az_lo + f[0] * (az_hi - az_lo),
-                                             min(89.9, el_top + f[1]))))
+        lambda f: tuple(
+            direction_from_az_el(az_lo + f[0] * (az_hi - az_lo), min(89.9, el_top + f[1]))
+        )
+    )
     anywhere = st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-0.3, 1)).filter(
-        lambda v: math.hypot(*v) > 0.1)
+        lambda v: math.hypot(*v) > 0.1
+    )
     return st.lists(st.one_of(near, near, cone_edge, anywhere), min_size=1, max_size=8)
 
 
@@ -127,11 +149,20 @@ def test_direction_on_a_degree_limit_is_reachable_from_either_side() -> None:
     outside the inward-rounded tick limits; it must be clamped, not refused."""
     cfg = ArmSettings(
         port="emulated",
-        azimuth=dict(servo_id=1, model_number=1060, zero_offset_ticks=0, min_deg=-1.0,
-                     max_deg=359.0, operating_mode="extended_position"),
-        elevation=dict(servo_id=2, model_number=1020, zero_offset_ticks=2048, min_deg=0.0,
-                       max_deg=30.0),
-        keep_out_half_angle_deg=0.0, park_azimuth_deg=179.0, park_elevation_deg=1.0,
+        azimuth=dict(
+            servo_id=1,
+            model_number=1060,
+            zero_offset_ticks=0,
+            min_deg=-1.0,
+            max_deg=359.0,
+            operating_mode="extended_position",
+        ),
+        elevation=dict(
+            servo_id=2, model_number=1020, zero_offset_ticks=2048, min_deg=0.0, max_deg=30.0
+        ),
+        keep_out_half_angle_deg=0.0,
+        park_azimuth_deg=179.0,
+        park_elevation_deg=1.0,
     )
     kin = ArmKinematics(cfg)
     d = direction_from_az_el(-1.0, 0.0)

@@ -19,33 +19,50 @@ def h(text: str) -> bytes:
 # (built by our codec, expected bytes from the e-manual, protocol2.md examples)
 EMANUAL = [
     (p2.ping(1), "FF FF FD 00 01 03 00 01 19 4E"),
-    (p2.status_packet(1, 0, bytes([0x06, 0x04, 0x26])),
-     "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D"),
+    (
+        p2.status_packet(1, 0, bytes([0x06, 0x04, 0x26])),
+        "FF FF FD 00 01 07 00 55 00 06 04 26 65 5D",
+    ),
     (p2.ping(p2.BROADCAST_ID), "FF FF FD 00 FE 03 00 01 31 42"),
-    (p2.status_packet(2, 0, bytes([0x06, 0x04, 0x26])),
-     "FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D"),
+    (
+        p2.status_packet(2, 0, bytes([0x06, 0x04, 0x26])),
+        "FF FF FD 00 02 07 00 55 00 06 04 26 6F 6D",
+    ),
     (p2.read(1, 132, 4), "FF FF FD 00 01 07 00 02 84 00 04 00 1D 15"),
     (p2.status_packet(1, 0, p2.u32(166)), "FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0"),
     (p2.write(1, 116, p2.u32(512)), "FF FF FD 00 01 09 00 03 74 00 00 02 00 00 CA 89"),
     (p2.status_packet(1), "FF FF FD 00 01 04 00 55 00 A1 0C"),
-    (p2.instruction_packet(1, p2.INST_REG_WRITE, p2.u16(104) + p2.u32(200)),
-     "FF FF FD 00 01 09 00 04 68 00 C8 00 00 00 AE 8E"),
+    (
+        p2.instruction_packet(1, p2.INST_REG_WRITE, p2.u16(104) + p2.u32(200)),
+        "FF FF FD 00 01 09 00 04 68 00 C8 00 00 00 AE 8E",
+    ),
     (p2.instruction_packet(1, p2.INST_ACTION), "FF FF FD 00 01 03 00 05 02 CE"),
     (p2.instruction_packet(1, p2.INST_FACTORY_RESET, b"\x01"), "FF FF FD 00 01 04 00 06 01 A1 E6"),
     (p2.instruction_packet(1, p2.INST_REBOOT), "FF FF FD 00 01 03 00 08 2F 4E"),
-    (p2.instruction_packet(1, p2.INST_CLEAR, h("01 44 58 4C 22")),
-     "FF FF FD 00 01 08 00 10 01 44 58 4C 22 B1 DC"),
+    (
+        p2.instruction_packet(1, p2.INST_CLEAR, h("01 44 58 4C 22")),
+        "FF FF FD 00 01 08 00 10 01 44 58 4C 22 B1 DC",
+    ),
     (p2.sync_read(132, 4, [1, 2]), "FF FF FD 00 FE 09 00 82 84 00 04 00 01 02 CE FA"),
     (p2.status_packet(2, 0, p2.u32(2079)), "FF FF FD 00 02 08 00 55 00 1F 08 00 00 BA BE"),
-    (p2.sync_write(116, 4, {1: p2.u32(150), 2: p2.u32(170)}),
-     "FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87"),
-    (p2.instruction_packet(p2.BROADCAST_ID, p2.INST_BULK_READ, h("01 90 00 02 00 02 92 00 01 00")),
-     "FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05"),
+    (
+        p2.sync_write(116, 4, {1: p2.u32(150), 2: p2.u32(170)}),
+        "FF FF FD 00 FE 11 00 83 74 00 04 00 01 96 00 00 00 02 AA 00 00 00 82 87",
+    ),
+    (
+        p2.instruction_packet(
+            p2.BROADCAST_ID, p2.INST_BULK_READ, h("01 90 00 02 00 02 92 00 01 00")
+        ),
+        "FF FF FD 00 FE 0D 00 92 01 90 00 02 00 02 92 00 01 00 1A 05",
+    ),
     (p2.status_packet(1, 0, p2.u16(119)), "FF FF FD 00 01 06 00 55 00 77 00 C3 69"),
     (p2.status_packet(2, 0, bytes([36])), "FF FF FD 00 02 05 00 55 00 24 8B A9"),
-    (p2.instruction_packet(p2.BROADCAST_ID, p2.INST_BULK_WRITE,
-                           h("01 20 00 02 00 A0 00 02 1F 00 01 00 50")),
-     "FF FF FD 00 FE 10 00 93 01 20 00 02 00 A0 00 02 1F 00 01 00 50 B7 68"),
+    (
+        p2.instruction_packet(
+            p2.BROADCAST_ID, p2.INST_BULK_WRITE, h("01 20 00 02 00 A0 00 02 1F 00 01 00 50")
+        ),
+        "FF FF FD 00 FE 10 00 93 01 20 00 02 00 A0 00 02 1F 00 01 00 50 B7 68",
+    ),
 ]
 
 
@@ -101,7 +118,7 @@ def test_parser_takes_unstuffed_sdk_packets_by_length(dxl_id: int, params: bytes
     raw = p2.instruction_packet(dxl_id, p2.INST_WRITE, params, stuffed=False)
     parser = p2.PacketParser()
     for i in range(len(raw)):  # byte by byte, as a serial port delivers them
-        parser.feed(raw[i:i + 1])
+        parser.feed(raw[i : i + 1])
     packets = parser.packets()
     assert len(packets) == 1 and isinstance(packets[0], p2.Packet)
     assert packets[0].dxl_id == dxl_id
@@ -116,8 +133,9 @@ def test_signed_conversion() -> None:
 
 def test_sdk_emits_the_emanual_ping_and_unstuffed_writes() -> None:
     """The bytes the real SDK puts on the wire, captured by the in-process port."""
-    emu = DynamixelBusEmulator([EmulatedServo(1, 1030, VirtualClock(), operating_mode=4)],
-                               VirtualClock())
+    emu = DynamixelBusEmulator(
+        [EmulatedServo(1, 1030, VirtualClock(), operating_mode=4)], VirtualClock()
+    )
     port = InProcessPort(emu)
     port.openPort()
     ph = sdk.PacketHandler(2.0)

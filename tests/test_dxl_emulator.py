@@ -20,8 +20,10 @@ from tests.test_dxl_support import wide_sdk_timeouts  # noqa: F401  (fixture)
 
 def two_servos(clock: VirtualClock, mode: int = 3) -> DynamixelBusEmulator:
     return DynamixelBusEmulator(
-        [EmulatedServo(1, 1060, clock, operating_mode=mode),
-         EmulatedServo(2, 1020, clock, operating_mode=mode, present_ticks=1000)],
+        [
+            EmulatedServo(1, 1060, clock, operating_mode=mode),
+            EmulatedServo(2, 1020, clock, operating_mode=mode, present_ticks=1000),
+        ],
         clock,
     )
 
@@ -113,10 +115,13 @@ def test_extended_position_reads_are_signed() -> None:
 
 @pytest.mark.parametrize(
     ("fault", "name"),
-    [(ct.HardwareFault.OVERLOAD, "overload"), (ct.HardwareFault.OVERHEATING, "overheating"),
-     (ct.HardwareFault.INPUT_VOLTAGE, "input_voltage"),
-     (ct.HardwareFault.MOTOR_ENCODER, "motor_encoder"),
-     (ct.HardwareFault.ELECTRICAL_SHOCK, "electrical_shock")],
+    [
+        (ct.HardwareFault.OVERLOAD, "overload"),
+        (ct.HardwareFault.OVERHEATING, "overheating"),
+        (ct.HardwareFault.INPUT_VOLTAGE, "input_voltage"),
+        (ct.HardwareFault.MOTOR_ENCODER, "motor_encoder"),
+        (ct.HardwareFault.ELECTRICAL_SHOCK, "electrical_shock"),
+    ],
 )
 def test_injected_hardware_error_surfaces_by_name(fault, name) -> None:
     clock = VirtualClock()

@@ -11,10 +11,12 @@ def arm_settings(**overrides) -> ArmSettings:
     """A plausible XL430 arm: azimuth +-170 deg, elevation 0..90, 15 deg keep-out cone."""
     base = dict(
         port="emulated",
-        azimuth=dict(servo_id=1, model_number=1060, zero_offset_ticks=2048,
-                     min_deg=-170.0, max_deg=170.0),
-        elevation=dict(servo_id=2, model_number=1060, zero_offset_ticks=1024,
-                       min_deg=0.0, max_deg=90.0),
+        azimuth=dict(
+            servo_id=1, model_number=1060, zero_offset_ticks=2048, min_deg=-170.0, max_deg=170.0
+        ),
+        elevation=dict(
+            servo_id=2, model_number=1060, zero_offset_ticks=1024, min_deg=0.0, max_deg=90.0
+        ),
         keep_out_half_angle_deg=15.0,
         move_timeout_s=20.0,
     )

@@ -124,8 +124,10 @@ class DynamixelArm:
         """Servo-side limits equal to the config's, so the servo refuses what the config does."""
         sid = joint.servo_id
         lo, hi = joint.tick_limits
-        have = (self._bus.read(sid, ct.MIN_POSITION_LIMIT),
-                self._bus.read(sid, ct.MAX_POSITION_LIMIT))
+        have = (
+            self._bus.read(sid, ct.MIN_POSITION_LIMIT),
+            self._bus.read(sid, ct.MAX_POSITION_LIMIT),
+        )
         if have == (lo, hi):
             return
         if not self.settings.sync_position_limits:
@@ -140,11 +142,14 @@ class DynamixelArm:
         self._bus.write(sid, ct.TORQUE_ENABLE, 0)  # EEPROM is writable only with torque off
         self._bus.write(sid, ct.MIN_POSITION_LIMIT, lo)
         self._bus.write(sid, ct.MAX_POSITION_LIMIT, hi)
-        again = (self._bus.read(sid, ct.MIN_POSITION_LIMIT),
-                 self._bus.read(sid, ct.MAX_POSITION_LIMIT))
+        again = (
+            self._bus.read(sid, ct.MIN_POSITION_LIMIT),
+            self._bus.read(sid, ct.MAX_POSITION_LIMIT),
+        )
         if again != (lo, hi):
-            raise ConfigMismatchError(self.name, f"position limits read back as {again}, "
-                                      f"wrote {(lo, hi)}", "connect", sid)
+            raise ConfigMismatchError(
+                self.name, f"position limits read back as {again}, wrote {(lo, hi)}", "connect", sid
+            )
 
     def _check_in_limits(self) -> None:
         """Homing check: refuse to move an arm that powers up outside its safe range or inside
@@ -162,8 +167,12 @@ class DynamixelArm:
                 )
         reason = self.kin.ticks_reason(*ticks)
         if reason:
-            raise SafetyViolation(self.name, f"the arm is not in a safe pose ({reason}); move it "
-                                  "by hand out of the keep-out cone (torque is off)", "connect")
+            raise SafetyViolation(
+                self.name,
+                f"the arm is not in a safe pose ({reason}); move it "
+                "by hand out of the keep-out cone (torque is off)",
+                "connect",
+            )
 
     def close(self) -> None:
         """Restore the safe state (lamp off, stopped, parked; torque policy) and release the port.
@@ -263,8 +272,10 @@ class DynamixelArm:
 
     def joint_ticks(self) -> tuple[int, int]:
         """Present Position of (azimuth, elevation), signed."""
-        return tuple(self._bus.read(j.servo_id, ct.PRESENT_POSITION)  # type: ignore[return-value]
-                     for j in self.settings.joints)
+        return tuple(
+            self._bus.read(j.servo_id, ct.PRESENT_POSITION)  # type: ignore[return-value]
+            for j in self.settings.joints
+        )
 
     def reached_direction(self) -> NDArray[np.float64]:
         return self.kin.direction_of_ticks(*self.joint_ticks())
@@ -289,16 +300,20 @@ class DynamixelArm:
             present, moving = [], False
             for joint in s.joints:
                 data, error = self._bus.read_block(
-                    joint.servo_id, ct.STATUS_BLOCK_START, ct.STATUS_BLOCK_LENGTH)
+                    joint.servo_id, ct.STATUS_BLOCK_START, ct.STATUS_BLOCK_LENGTH
+                )
                 if error & p2.ERR_ALERT:
-                    status = self._bus.read(joint.servo_id, ct.HARDWARE_ERROR_STATUS,
-                                            check_alert=False)
+                    status = self._bus.read(
+                        joint.servo_id, ct.HARDWARE_ERROR_STATUS, check_alert=False
+                    )
                     raise HardwareFaultError(self.name, joint.servo_id, status, command)
                 moving = moving or data[0] != 0
                 off = ct.PRESENT_POSITION.address - ct.STATUS_BLOCK_START
-                present.append(p2.to_signed(int.from_bytes(data[off:off + 4], "little"), 4))
-            close = all(abs(p - g) <= s.in_position_tolerance_ticks
-                        for p, g in zip(present, goal, strict=True))
+                present.append(p2.to_signed(int.from_bytes(data[off : off + 4], "little"), 4))
+            close = all(
+                abs(p - g) <= s.in_position_tolerance_ticks
+                for p, g in zip(present, goal, strict=True)
+            )
             if close and not moving:
                 return self.kin.direction_of_ticks(*present)
             if self.clock.now() - start > s.move_timeout_s:

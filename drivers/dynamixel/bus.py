@@ -94,8 +94,7 @@ class DxlBus:
         command = f"read {reg.name}"
         fn = {1: self.ph.read1ByteTxRx, 2: self.ph.read2ByteTxRx, 4: self.ph.read4ByteTxRx}
         value, result, error = fn[reg.size](self.port, dxl_id, reg.address)
-        log.debug("%s: id %d %s -> %s (%d, %d)", self.device, dxl_id, command, value, result,
-                  error)
+        log.debug("%s: id %d %s -> %s (%d, %d)", self.device, dxl_id, command, value, result, error)
         self._check(result, error, dxl_id, command, alert=check_alert)
         return p2.to_signed(value, reg.size) if reg.signed else int(value)
 
@@ -104,12 +103,24 @@ class DxlBus:
 
         Hardware alerts are *not* raised here; the caller decides (it may want the data)."""
         data, result, error = self.ph.readTxRx(self.port, dxl_id, address, length)
-        log.debug("%s: id %d read %d+%d -> %s (%d, %d)", self.device, dxl_id, address, length,
-                  bytes(data or b"").hex(), result, error)
+        log.debug(
+            "%s: id %d read %d+%d -> %s (%d, %d)",
+            self.device,
+            dxl_id,
+            address,
+            length,
+            bytes(data or b"").hex(),
+            result,
+            error,
+        )
         self._check(result, error, dxl_id, f"read {address}+{length}", alert=False)
         if len(data) != length:
-            raise CommunicationError(self.device, f"short reply: {len(data)} of {length} bytes",
-                                     f"read {address}+{length}", dxl_id)
+            raise CommunicationError(
+                self.device,
+                f"short reply: {len(data)} of {length} bytes",
+                f"read {address}+{length}",
+                dxl_id,
+            )
         return bytes(data), int(error)
 
     def write(self, dxl_id: int, reg: ct.Register, value: int) -> None:
@@ -128,11 +139,13 @@ class DxlBus:
         raw = value & ((1 << (8 * reg.size)) - 1)
         data = list(raw.to_bytes(reg.size, "little"))
         result = self.ph.writeTxOnly(self.port, dxl_id, reg.address, reg.size, data)
-        log.debug("%s: id %d write-no-wait %s = %d (%d)", self.device, dxl_id, reg.name, value,
-                  result)
+        log.debug(
+            "%s: id %d write-no-wait %s = %d (%d)", self.device, dxl_id, reg.name, value, result
+        )
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, comm_text(self.ph, result),
-                                     f"write {reg.name}", dxl_id)
+            raise CommunicationError(
+                self.device, comm_text(self.ph, result), f"write {reg.name}", dxl_id
+            )
         self.drain_reply()
 
     def drain_reply(self) -> None:
@@ -149,8 +162,9 @@ class DxlBus:
         result = group.txPacket()
         log.debug("%s: sync write %s %s (%d)", self.device, reg.name, dict(values), result)
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, comm_text(self.ph, result),
-                                     f"sync write {reg.name} {dict(values)}")
+            raise CommunicationError(
+                self.device, comm_text(self.ph, result), f"sync write {reg.name} {dict(values)}"
+            )
 
     def broadcast_write(self, reg: ct.Register, value: int) -> None:
         """Write to every servo at once; broadcast writes get no status, so none is left over."""
@@ -159,8 +173,9 @@ class DxlBus:
         result = self.ph.writeTxOnly(self.port, p2.BROADCAST_ID, reg.address, reg.size, data)
         log.debug("%s: broadcast write %s = %d (%d)", self.device, reg.name, value, result)
         if result != sdk.COMM_SUCCESS:
-            raise CommunicationError(self.device, comm_text(self.ph, result),
-                                     f"broadcast write {reg.name}")
+            raise CommunicationError(
+                self.device, comm_text(self.ph, result), f"broadcast write {reg.name}"
+            )
 
     def action(self) -> None:
         """Action to the broadcast id: unicast Action leaves a stale reply (SDK pitfall)."""

@@ -54,24 +54,30 @@ class ArmKinematics:
             return f"elevation {elevation_deg:.3f} deg outside {el.min_deg}..{el.max_deg}"
         limit = 90.0 - s.keep_out_half_angle_deg
         if elevation_deg > limit + EPS_DEG:
-            return (f"elevation {elevation_deg:.3f} deg is inside the "
-                    f"{s.keep_out_half_angle_deg} deg keep-out cone around the camera "
-                    f"(max {limit:.3f})")
+            return (
+                f"elevation {elevation_deg:.3f} deg is inside the "
+                f"{s.keep_out_half_angle_deg} deg keep-out cone around the camera "
+                f"(max {limit:.3f})"
+            )
         return None
 
     def ticks_reason(self, azimuth_ticks: int, elevation_ticks: int) -> str | None:
         """THE safety gate: why these Goal Position values must not be sent, or None."""
         s = self.settings
-        for name, joint, t in (("azimuth", s.azimuth, azimuth_ticks),
-                               ("elevation", s.elevation, elevation_ticks)):
+        for name, joint, t in (
+            ("azimuth", s.azimuth, azimuth_ticks),
+            ("elevation", s.elevation, elevation_ticks),
+        ):
             lo, hi = joint.tick_limits
             if not lo <= t <= hi:
                 return f"{name} servo {joint.servo_id} goal {t} ticks outside limits {lo}..{hi}"
         el_deg = ticks_to_joint(s.elevation, elevation_ticks)
         limit = 90.0 - s.keep_out_half_angle_deg
         if el_deg > limit + EPS_DEG:
-            return (f"elevation goal {elevation_ticks} ticks = {el_deg:.3f} deg enters the "
-                    f"keep-out cone (max {limit:.3f} deg)")
+            return (
+                f"elevation goal {elevation_ticks} ticks = {el_deg:.3f} deg enters the "
+                f"keep-out cone (max {limit:.3f} deg)"
+            )
         return None
 
     def ticks_of_pose(self, azimuth_deg: float, elevation_deg: float) -> tuple[int, int]:
@@ -80,8 +86,10 @@ class ArmKinematics:
         are clamped onto the limit (which is inside the safe range). Anything further out is
         left alone for the gate to refuse."""
         out = []
-        for joint, deg in ((self.settings.azimuth, azimuth_deg),
-                           (self.settings.elevation, elevation_deg)):
+        for joint, deg in (
+            (self.settings.azimuth, azimuth_deg),
+            (self.settings.elevation, elevation_deg),
+        ):
             raw = joint_to_ticks(joint, deg)
             lo, hi = joint.tick_limits
             t = round(raw)
@@ -93,8 +101,10 @@ class ArmKinematics:
         return out[0], out[1]
 
     def pose_of_ticks(self, azimuth_ticks: float, elevation_ticks: float) -> tuple[float, float]:
-        return (ticks_to_joint(self.settings.azimuth, azimuth_ticks),
-                ticks_to_joint(self.settings.elevation, elevation_ticks))
+        return (
+            ticks_to_joint(self.settings.azimuth, azimuth_ticks),
+            ticks_to_joint(self.settings.elevation, elevation_ticks),
+        )
 
     def direction_of_ticks(self, azimuth_ticks: float, elevation_ticks: float) -> NDArray:
         """Unit light direction of a servo reading."""
@@ -107,8 +117,11 @@ class ArmKinematics:
         j = self.settings.azimuth
         k0 = math.floor((j.min_deg - azimuth_deg) / 360.0)
         k1 = math.ceil((j.max_deg - azimuth_deg) / 360.0)
-        return [azimuth_deg + 360.0 * k for k in range(k0, k1 + 1)
-                if j.min_deg - EPS_DEG <= azimuth_deg + 360.0 * k <= j.max_deg + EPS_DEG]
+        return [
+            azimuth_deg + 360.0 * k
+            for k in range(k0, k1 + 1)
+            if j.min_deg - EPS_DEG <= azimuth_deg + 360.0 * k <= j.max_deg + EPS_DEG
+        ]
 
     def solve(
         self, direction: ArrayLike, current_azimuth_deg: float | None = None
@@ -128,8 +141,9 @@ class ArmKinematics:
         candidates = self.azimuth_candidates(az)
         if not candidates:
             j = self.settings.azimuth
-            return None, (f"azimuth {az:.3f} deg is outside the joint limits "
-                           f"{j.min_deg}..{j.max_deg}")
+            return None, (
+                f"azimuth {az:.3f} deg is outside the joint limits {j.min_deg}..{j.max_deg}"
+            )
         joint_az = min(candidates, key=lambda a: abs(a - ref))
         reason = self.pose_reason(joint_az, el)
         if reason:

@@ -57,8 +57,11 @@ class JointSettings(BaseModel):
         if not self.min_deg < self.max_deg:
             raise ValueError(f"min_deg ({self.min_deg}) must be below max_deg ({self.max_deg})")
         lo, hi = self.tick_limits
-        bound = (0, ct.MAX_TICK) if self.mode == ct.OperatingMode.POSITION else (
-            -ct.EXTENDED_TICK_LIMIT, ct.EXTENDED_TICK_LIMIT)
+        bound = (
+            (0, ct.MAX_TICK)
+            if self.mode == ct.OperatingMode.POSITION
+            else (-ct.EXTENDED_TICK_LIMIT, ct.EXTENDED_TICK_LIMIT)
+        )
         if lo < bound[0] or hi > bound[1]:
             raise ValueError(
                 f"joint range {self.min_deg}..{self.max_deg} deg maps to servo ticks {lo}..{hi}, "
@@ -67,8 +70,11 @@ class JointSettings(BaseModel):
             )
         for name, units, top in (
             ("profile_velocity_rpm", self.velocity_units, ct.MAX_PROFILE_VELOCITY_UNITS),
-            ("profile_acceleration_rev_min2", self.acceleration_units,
-             ct.MAX_PROFILE_ACCELERATION_UNITS),
+            (
+                "profile_acceleration_rev_min2",
+                self.acceleration_units,
+                ct.MAX_PROFILE_ACCELERATION_UNITS,
+            ),
         ):
             if not 1 <= units <= top:
                 raise ValueError(f"{name} gives register value {units}, outside 1..{top}")
@@ -148,8 +154,10 @@ class ArmSettings(BaseModel):
     @classmethod
     def _baud(cls, v: int) -> int:
         if v not in SDK_BAUDRATES:
-            raise ValueError(f"baudrate {v} is not accepted by dynamixel_sdk; use one of "
-                             f"{', '.join(map(str, SDK_BAUDRATES))}")
+            raise ValueError(
+                f"baudrate {v} is not accepted by dynamixel_sdk; use one of "
+                f"{', '.join(map(str, SDK_BAUDRATES))}"
+            )
         return v
 
     @model_validator(mode="after")
@@ -164,15 +172,18 @@ class ArmSettings(BaseModel):
         if self.keep_out_half_angle_deg + self.elevation.min_deg >= 90.0:
             raise ValueError("keep-out cone covers the whole elevation range: nothing is reachable")
         if self.lamp == "servo_led" and self.lamp_servo_id not in (
-            self.azimuth.servo_id, self.elevation.servo_id
+            self.azimuth.servo_id,
+            self.elevation.servo_id,
         ):
             raise ValueError("lamp = 'servo_led' needs lamp_servo_id set to one of the arm's ids")
         from drivers.dynamixel.kinematics import ArmKinematics  # local: avoid import cycle
 
         reason = ArmKinematics(self).pose_reason(self.park_azimuth_deg, self.park_elevation_deg)
         if reason:
-            raise ValueError(f"park pose (azimuth {self.park_azimuth_deg}, elevation "
-                             f"{self.park_elevation_deg}) is not safe: {reason}")
+            raise ValueError(
+                f"park pose (azimuth {self.park_azimuth_deg}, elevation "
+                f"{self.park_elevation_deg}) is not safe: {reason}"
+            )
         return self
 
     @property
