@@ -31,11 +31,18 @@ from rti_rig.errors import RtiRigError
 from rti_rig.rig_geometry import DomeGeometry
 from rti_rig.schedule import LightSchedule
 from rti_rig.session import SessionFolder, read_manifest
-from simulator.faults import FaultPlan, FaultyCamera, FaultyCarrier, FaultyLightSource
+from simulator.faults import (
+    FaultPlan,
+    FaultyCamera,
+    FaultyCarrier,
+    FaultyLightSource,
+    ServoFaultCarrier,
+)
 from simulator.verify import wrong_light_steps
 
 REPO = Path(__file__).resolve().parent.parent
 IN_PROCESS = ("camera-failure", "light-failure")
+SERVO = ("servo-overload", "servo-overheating", "servo-corrupt-crc", "servo-silence")
 SERIAL = (
     "serial-drop-reply",
     "serial-garble-reply",
@@ -57,13 +64,19 @@ SIZE = 48
 
 def make_config(folder: Path, kind: str, seed: int, fault: tuple[int, str] | None = None) -> Path:
     """A small copy of a shipped config; ``kind`` dome, arm or emulated (with a serial fault)."""
-    name = {"dome": "simulated_dome", "arm": "virtual_arm", "emulated": "emulated_dome"}[kind]
+    name = {
+        "dome": "simulated_dome",
+        "arm": "virtual_arm",
+        "emulated": "emulated_dome",
+        "servo": "simulated_arm",
+    }[kind]
     src = REPO / "rig_configs" / f"{name}.toml"
     text = src.read_text()
     for big in ("512", "256"):
         text = text.replace(f"width = {big}", f"width = {SIZE}")
         text = text.replace(f"height = {big}", f"height = {SIZE}")
     text = text.replace("seed = 0", f"seed = {seed}")
+    text = text.replace('transport = "pty"', 'transport = "inprocess"')
     text = text.replace('lp_file = "', f'lp_file = "{src.parent}/')
     if fault is not None:
         at, fault_kind = fault
@@ -105,7 +118,12 @@ def _run(rig, out: Path, n: int, fault: FaultPlan | None, resume: bool) -> None:
     from planner.uniform import plan_uniform
 
     if fault is not None:
-        if fault.kind == "camera-failure":
+        if fault.kind in SERVO:
+            servo_id = rig.loaded.config.arm.dynamixel.elevation.servo_id
+            rig.lighting.carrier = ServoFaultCarrier(  # type: ignore[attr-defined]
+                rig.lighting.carrier, rig.emulator, fault, servo_id
+            )
+        elif fault.kind == "camera-failure":
             rig.camera = FaultyCamera(rig.camera, fault)
         elif isinstance(rig.geometry, DomeGeometry):
             rig.lighting.source = FaultyLightSource(rig.lighting.source, fault)  # type: ignore[attr-defined]
@@ -154,7 +172,7 @@ def campaign(sessions: int, seed: int) -> dict:
         for i in range(sessions):
             n = int(rng.integers(6, 17))
             out = tmpdir / f"session_{i:04d}"
-            fault_kind = str(rng.choice(IN_PROCESS + KILLS + SERIAL))
+            fault_kind = str(rng.choice(IN_PROCESS + KILLS + SERIAL + SERVO))
             k = int(rng.integers(0, n))
             faults[fault_kind] += 1
             seed_i = int(rng.integers(0, 1000))
@@ -171,7 +189,12 @@ def campaign(sessions: int, seed: int) -> dict:
             else:
                 kind = "dome" if rng.random() < 0.6 else "arm"
                 cfg = make_config(tmpdir, kind, seed_i)
-            if fault_kind in SERIAL:
+            if fault_kind in SERVO:
+                cfg = make_config(tmpdir, "servo", seed_i)
+                run_in_process(cfg, out, n, FaultPlan(fault_kind, k), resume=False)
+                first = read_manifest(out)["runner"].get("finish_reason")
+                stats["servo_faults_stopped_with_error"] += int(first == "error")
+            elif fault_kind in SERIAL:
                 pass  # already run above, against the faulty emulated firmware
             elif fault_kind in IN_PROCESS:
                 run_in_process(cfg, out, n, FaultPlan(fault_kind, k), resume=False)
@@ -244,6 +267,10 @@ def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
             "serial faults that stopped the session with an error (then resumed)",
             "serial_faults_stopped_with_error",
         ),
+        (
+            "servo faults that stopped the session with a named error (then resumed)",
+            "servo_faults_stopped_with_error",
+        ),
         ("sessions abandoned after 10 resumes", "sessions_abandoned"),
         ("SIGKILL faults that failed to kill", "kills_that_did_not_kill"),
     ]
@@ -276,7 +303,9 @@ fault at a random step; it is then resumed with
   the capture, half-way through writing the TIFF, between the TIFF and the JPEG, or after both
   files but before the journal line.
 
-Not yet in this campaign: servo hardware errors of the emulated Dynamixel arm.
+- `servo-*`: the emulated Dynamixel servos (real SDK, in-process port) report overload or
+  overheating in their Hardware Error Status, corrupt their status packets' CRC, or fall silent,
+  just as a move is commanded.
 """
 
 

@@ -91,3 +91,39 @@ class FaultyCarrier:
             self.plan.fired.append(self.plan.kind)
             raise DeviceError(self.name, f"injected fault: {self.plan.kind}", "move_to")
         return self.inner.move_to(direction)
+
+
+class ServoFaultCarrier:
+    """An emulated Dynamixel arm whose servos fail at the ``at``-th move (byte level).
+
+    The fault is injected into the servo emulator just before the move is commanded, so the
+    real driver meets it in the bytes it reads back: a Hardware Error Status bit (overload,
+    overheating), corrupted CRCs, or a servo that stops answering.
+    """
+
+    def __init__(self, inner, emulator, plan: FaultPlan, servo_id: int) -> None:  # type: ignore[no-untyped-def]
+        self.inner, self.emulator, self.plan, self.calls = inner, emulator, plan, 0
+        self.servo_id = servo_id
+        self.name = inner.name
+
+    def __getattr__(self, name: str):  # type: ignore[no-untyped-def]
+        return getattr(self.inner, name)
+
+    def move_to(self, direction: np.ndarray) -> np.ndarray:
+        from drivers.dynamixel.control_table import HardwareFault
+
+        n, self.calls = self.calls, self.calls + 1
+        if n == self.plan.at:
+            self.plan.fired.append(self.plan.kind)
+            kind = self.plan.kind
+            if kind == "servo-overload":
+                self.emulator.inject_hardware_error(self.servo_id, HardwareFault.OVERLOAD)
+            elif kind == "servo-overheating":
+                self.emulator.inject_hardware_error(self.servo_id, HardwareFault.OVERHEATING)
+            elif kind == "servo-corrupt-crc":
+                self.emulator.corrupt_next_replies = 3
+            elif kind == "servo-silence":
+                self.emulator.silent_ids.add(self.servo_id)
+            else:
+                raise ValueError(f"unknown servo fault {kind!r}")
+        return self.inner.move_to(direction)
