@@ -1,0 +1,122 @@
+"""Per-pixel linear relighting models and their streamed fit.
+
+Every model here stores coefficients (p, H, W) or (p, H, W, C) — the layout of the input
+images with the coefficient axis first — and relights with one weighted sum of coefficient
+planes. Relit values are clamped at 0: radiance is never negative, and an unclamped low-order
+fit undershoots in shadow.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rti_rig.reconstruct.bases import design_matrix
+from rti_rig.reconstruct.solve import COND_LIMIT, FitReport, IllConditioned, solve_matrix
+from rti_rig.reconstruct.stack import ImageStack, as_direction, validate_lights
+from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
+
+
+@runtime_checkable
+class RelightModel(Protocol):
+    """Anything that renders the object under a new light: fitted models, PS results."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def n_coefficients(self) -> int: ...
+
+    def relight(self, direction: ArrayLike) -> NDArray[np.float32]:
+        """Image (H, W) or (H, W, C) under the unit light ``direction`` (DESIGN.md frame)."""
+        ...
+
+
+@dataclass(frozen=True)
+class LinearBasisModel:
+    """Coefficients of a linear basis in light direction, per pixel, and how they were fitted."""
+
+    coefficients: NDArray[np.float32]
+    report: FitReport
+    model_name: ClassVar[str] = "linear"
+
+    @property
+    def name(self) -> str:
+        return self.model_name
+
+    @property
+    def n_coefficients(self) -> int:
+        return int(self.coefficients.shape[0])
+
+    @classmethod
+    def design(cls, lights: ArrayLike) -> NDArray[np.float64]:
+        """Design matrix (N, p) of this model for unit ``lights`` (N, 3)."""
+        return design_matrix(cls.model_name, lights)
+
+    def relight(self, direction: ArrayLike) -> NDArray[np.float32]:
+        weights = self.design(as_direction(direction)[None, :])[0].astype(np.float32)
+        img = np.tensordot(weights, self.coefficients, axes=(0, 0))
+        return np.maximum(img, np.float32(0.0))
+
+
+@dataclass(frozen=True)
+class LambertModel(LinearBasisModel):
+    """Unclamped Lambertian fit: coefficients are albedo × normal (3, H, W[, C])."""
+
+    model_name: ClassVar[str] = "lambert"
+
+
+def fit_coefficients(
+    images: Any,
+    design: NDArray[np.float64],
+    model: str,
+    *,
+    tile_rows: int | None = None,
+    ill_conditioned: IllConditioned = "regularise",
+    cond_limit: float = COND_LIMIT,
+) -> tuple[NDArray[np.float32], FitReport]:
+    """Fit ``design`` to every pixel of ``images``, a band of rows at a time.
+
+    Returns coefficients (p, H, W) or (p, H, W, C) float32 and the fit report. The float32
+    working set is one band (see :mod:`rti_rig.reconstruct.tiling`); the solve matrix is
+    computed once in float64 and applied in float32.
+    """
+    stack = ImageStack(images)
+    if design.shape[0] != stack.n:
+        raise ValueError(f"design has {design.shape[0]} rows for {stack.n} images")
+    w, report = solve_matrix(design, model, ill_conditioned, cond_limit)
+    w32 = w.astype(np.float32)
+    p = w.shape[0]
+    rows = tile_rows or rows_for_budget(stack.n, stack.width, stack.channels)
+    coef = np.empty((p, stack.height, stack.width, stack.channels), dtype=np.float32)
+    for sl in row_tiles(stack.height, rows):
+        band = stack.rows(sl)  # (N, r, W, C)
+        r = band.shape[1]
+        coef[:, sl] = (w32 @ band.reshape(stack.n, -1)).reshape(p, r, stack.width, stack.channels)
+    if stack.grey:
+        coef = coef[..., 0]
+    return coef, report
+
+
+def fit_lambert(
+    images: Any,
+    lights: ArrayLike,
+    *,
+    tile_rows: int | None = None,
+    ill_conditioned: IllConditioned = "refuse",
+) -> LambertModel:
+    """Least-squares Lambertian model (no shadow handling): the lowest-order relighting model.
+
+    Refuses ill-conditioned (near-coplanar) light sets by default: its coefficients are read as
+    normals, and a regularised normal is biased towards the well-lit plane.
+    """
+    stack = ImageStack(images)
+    lt = validate_lights(lights, stack.n)
+    coef, report = fit_coefficients(
+        stack, LambertModel.design(lt), "lambert", tile_rows=tile_rows,
+        ill_conditioned=ill_conditioned,
+    )
+    return LambertModel(coef, report)

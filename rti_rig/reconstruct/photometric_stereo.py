@@ -1,0 +1,278 @@
+"""Lambertian photometric stereo (Woodham 1980): normals and albedo from N >= 3 lights.
+
+Model: ``I_k = rho * max(0, l_k . n)``. Per pixel, ``b = rho n`` solves the least-squares
+system ``L b = I`` over the observations used; ``n = b / |b|``, ``rho = |b|`` (grey), per-channel
+albedo by least squares on the fitted shading.
+
+*Least squares* (``robust=False``) uses every light: one matrix product with ``pinv(L)`` per band
+of rows. Attached shadows and highlights bias it (notes §2: 15.4° mean on DiLiGenT).
+
+*Robust* (``robust=True``) discards, per pixel,
+
+1. **shadows**: observations below ``dark_threshold`` (default :data:`DARK_FRACTION` of the
+   stack's reference level, the 99th percentile of a pixel sample);
+2. **saturated** observations at or above ``saturation`` (default: the stack's saturation
+   level — none for float input, the top code value for integer input, 1.0 for
+   :func:`stack_from_frames`; pass ``float("inf")`` to disable);
+3. **highlights**: observations brighter than the current Lambertian fit by more than
+   ``max(highlight_k * sigma, highlight_floor)``, with ``sigma = 1.4826 * median |residual|``
+   over the pixel's used observations (a robust noise scale), refitting after each of up to
+   ``max_passes`` passes. Only positive residuals are outliers: specular lobes add light.
+
+A pixel keeps at least 3 observations whose lights are not ill-conditioned (condition
+number of its light subset <= ``cond_limit``), else it is marked invalid (``valid`` False,
+normal (0, 0, 1), albedo 0) — never silently guessed. Pixels outside ``mask`` and all-dark
+pixels are invalid too. The full light set must itself be well-conditioned, or the fit is refused:
+a regularised normal would be biased towards the plane of the lights.
+
+Per-pixel systems are solved in closed form (3 × 3 adjugate, closed-form symmetric eigenvalues),
+vectorised over the band: no Python loop over pixels.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rti_rig.reconstruct.errors import ReconstructionError
+from rti_rig.reconstruct.solve import COND_LIMIT, solve_matrix
+from rti_rig.reconstruct.stack import ImageStack, as_direction, validate_lights
+from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
+
+#: Default shadow threshold as a fraction of the stack's reference level.
+DARK_FRACTION = 0.02
+#: Default floor of the highlight test as a fraction of the reference level (so that a perfect
+#: fit with rounding-level residuals drops nothing).
+HIGHLIGHT_FLOOR_FRACTION = 0.01
+#: Pixels with |b| at or below this fraction of the reference level are "all dark": invalid.
+DARK_PIXEL_FRACTION = 1e-6
+
+
+@dataclass(frozen=True)
+class PSResult:
+    """Normals, albedo and the evidence of a photometric-stereo fit.
+
+    ``normals`` (H, W, 3) float32 unit vectors with z >= 0 (DESIGN.md frame), ``albedo`` (H, W)
+    or (H, W, C), ``residual`` RMS grey residual over the used observations, ``valid`` (H, W),
+    ``used_lights`` (H, W) count of observations used per pixel.
+    """
+
+    normals: NDArray[np.float32]
+    albedo: NDArray[np.float32]
+    residual: NDArray[np.float32]
+    valid: NDArray[np.bool_]
+    used_lights: NDArray[np.int16]
+    condition_number: float
+    robust: bool
+    dark_threshold: float
+    saturation: float | None
+
+    @property
+    def name(self) -> str:
+        return "lambert-ps-robust" if self.robust else "lambert-ps"
+
+    @property
+    def n_coefficients(self) -> int:
+        return 3
+
+    def relight(self, direction: ArrayLike) -> NDArray[np.float32]:
+        """Lambertian rendering ``albedo * max(0, n . l)``; invalid pixels render black."""
+        d = as_direction(direction).astype(np.float32)
+        shade = np.maximum(self.normals @ d, np.float32(0.0)) * self.valid
+        return (self.albedo * (shade if self.albedo.ndim == 2 else shade[..., None])).astype(
+            np.float32
+        )
+
+    def summary(self) -> dict[str, float]:
+        """Headline numbers for reports: valid fraction, mean used lights, median residual."""
+        v = self.valid
+        return {
+            "valid_fraction": float(v.mean()),
+            "mean_used_lights": float(self.used_lights[v].mean()) if v.any() else 0.0,
+            "median_residual": float(np.median(self.residual[v])) if v.any() else float("nan"),
+            "condition_number": self.condition_number,
+        }
+
+
+def _sym3_inverse_and_cond(
+    m: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Inverse and eigenvalue ratio of symmetric PSD 3 × 3 matrices packed as (P, 9).
+
+    Closed forms (adjugate; trigonometric eigenvalues) are ~20× faster than batched LAPACK
+    for millions of 3 × 3 systems. Singular matrices get ratio inf and a zero inverse.
+    """
+    a, b, c = m[:, 0], m[:, 1], m[:, 2]
+    d, e, f = m[:, 4], m[:, 5], m[:, 8]
+    # symmetric: [[a b c] [b d e] [c e f]]
+    co_a = d * f - e * e
+    co_b = c * e - b * f
+    co_c = b * e - c * d
+    det = a * co_a + b * co_b + c * co_c
+    co_d = a * f - c * c
+    co_e = b * c - a * e
+    co_f = a * d - b * b
+    # eigenvalues (Smith 1961)
+    q = (a + d + f) / 3.0
+    p1 = b * b + c * c + e * e
+    p2 = (a - q) ** 2 + (d - q) ** 2 + (f - q) ** 2 + 2.0 * p1
+    p = np.sqrt(np.maximum(p2, 0.0) / 6.0)
+    ps = np.where(p > 0, p, 1.0)
+    ba, bd, bf = (a - q) / ps, (d - q) / ps, (f - q) / ps
+    bb, bc, be = b / ps, c / ps, e / ps
+    r = (ba * (bd * bf - be * be) - bb * (bb * bf - be * bc) + bc * (bb * be - bd * bc)) / 2.0
+    phi = np.arccos(np.clip(r, -1.0, 1.0)) / 3.0
+    e1 = q + 2.0 * p * np.cos(phi)
+    e3 = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
+    e3 = np.where(p > 0, e3, q)
+    e1 = np.where(p > 0, e1, q)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(e3 > e1 * 1e-14, e1 / e3, np.inf)
+    ok = np.isfinite(ratio) & (np.abs(det) > 0)
+    inv_det = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    inv = np.stack([co_a, co_b, co_c, co_b, co_d, co_e, co_c, co_e, co_f], axis=1)
+    return inv * inv_det[:, None], ratio
+
+
+def _solve_weighted(
+    g: NDArray[np.float32], w: NDArray[np.bool_], lights: NDArray[np.float64], cond_limit: float
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Per-pixel least squares on the used observations ``w``: b (P, 3) and solvable (P,)."""
+    ll = (lights[:, :, None] * lights[:, None, :]).reshape(-1, 9)
+    wf = w.astype(np.float64)
+    m = wf.T @ ll  # (P, 9)
+    rhs = (wf * g).T @ lights  # (P, 3)
+    inv, ratio = _sym3_inverse_and_cond(m)
+    ok = (w.sum(axis=0) >= 3) & (ratio <= cond_limit**2)
+    inv3 = inv.reshape(-1, 3, 3)
+    b = np.einsum("pij,pj->pi", inv3, rhs)
+    b[~ok] = 0.0
+    return b, ok
+
+
+def _robust_band(
+    g: NDArray[np.float32],
+    inside: NDArray[np.bool_],
+    lights: NDArray[np.float64],
+    dark: float,
+    saturation: float | None,
+    highlight_k: float,
+    highlight_floor: float,
+    max_passes: int,
+    cond_limit: float,
+) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
+    """Robust fit of one band: b (P, 3), used observations (N, P), solvable pixels (P,)."""
+    w = (g > dark) & inside[None, :]
+    if saturation is not None:
+        w &= g < saturation
+    b, ok = _solve_weighted(g, w, lights, cond_limit)
+    n_obs = g.shape[0]
+    for _ in range(max_passes):
+        resid = g - (lights @ b.T)  # (N, P)
+        absr = np.where(w, np.abs(resid), np.inf)
+        absr.sort(axis=0)
+        count = w.sum(axis=0)
+        mid = np.clip((count - 1) // 2, 0, n_obs - 1)
+        med = np.take_along_axis(absr, mid[None, :], axis=0)[0]
+        med = np.where(count > 0, med, 0.0)
+        thr = np.maximum(highlight_k * 1.4826 * med, highlight_floor)
+        drop = w & (resid > thr[None, :]) & ok[None, :]
+        if not drop.any():
+            break
+        w &= ~drop
+        b, ok = _solve_weighted(g, w, lights, cond_limit)
+    return b, w, ok
+
+
+def fit_photometric_stereo(
+    images: Any,
+    lights: ArrayLike,
+    robust: bool = False,
+    mask: ArrayLike | None = None,
+    tile_rows: int | None = None,
+    *,
+    dark_threshold: float | None = None,
+    saturation: float | None = None,
+    highlight_k: float = 2.0,
+    highlight_floor: float | None = None,
+    max_passes: int = 10,
+    cond_limit: float = COND_LIMIT,
+) -> PSResult:
+    """Normals and albedo of linear ``images`` (N, H, W[, C]) under unit ``lights`` (N, 3).
+
+    See the module docstring for the robust rules. Raises :class:`ReconstructionError` for
+    fewer than 3 lights or an ill-conditioned (near-coplanar) light set.
+    """
+    stack = ImageStack(images)
+    lt = validate_lights(lights, stack.n)
+    w_ls, report = solve_matrix(
+        lt, "photometric stereo", "refuse", cond_limit, normalise_columns=False
+    )
+    h, wd = stack.height, stack.width
+    if mask is None:
+        inside_all = np.ones((h, wd), dtype=bool)
+    else:
+        inside_all = np.asarray(mask, dtype=bool)
+        if inside_all.shape != (h, wd):
+            raise ReconstructionError(f"mask has shape {inside_all.shape}, images are {(h, wd)}")
+    ref = stack.reference_level()
+    dark = float(dark_threshold) if dark_threshold is not None else DARK_FRACTION * ref
+    if saturation is None:
+        saturation = stack.saturation_level
+    floor = HIGHLIGHT_FLOOR_FRACTION * ref if highlight_floor is None else float(highlight_floor)
+    eps_b = DARK_PIXEL_FRACTION * ref
+
+    normals = np.zeros((h, wd, 3), dtype=np.float32)
+    normals[..., 2] = 1.0
+    albedo = np.zeros((h, wd, stack.channels), dtype=np.float32)
+    residual = np.zeros((h, wd), dtype=np.float32)
+    valid = np.zeros((h, wd), dtype=bool)
+    used = np.zeros((h, wd), dtype=np.int16)
+    w32 = w_ls.astype(np.float32)
+    # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
+    rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
+    for sl in row_tiles(h, rows):
+        band = stack.rows(sl)  # (N, r, W, C)
+        r = band.shape[1]
+        flat = band.reshape(stack.n, r * wd, stack.channels)
+        g = flat.mean(axis=2) if stack.channels > 1 else flat[..., 0]
+        inside = inside_all[sl].ravel()
+        if robust:
+            b, w, ok = _robust_band(
+                g, inside, lt, dark, saturation, highlight_k, floor, max_passes, cond_limit
+            )
+        else:
+            b = (w32 @ g).T.astype(np.float64)
+            w = np.broadcast_to(inside[None, :], g.shape)
+            ok = inside.copy()
+        b[:, 2] = np.maximum(b[:, 2], 0.0)  # a normal facing away from the camera is unseen
+        norm = np.linalg.norm(b, axis=1)
+        ok &= inside & (norm > eps_b)
+        n = np.where(ok[:, None], b / np.where(norm > 0, norm, 1.0)[:, None], [0.0, 0.0, 1.0])
+        wf = w & ok[None, :]
+        shade = (lt @ n.T) * wf  # (N, P), zero where unused
+        den = np.sum(shade * shade, axis=0)
+        den = np.where(den > 0, den, 1.0)
+        alb = np.einsum("np,npc->pc", shade, flat) / den[:, None]
+        count = wf.sum(axis=0)
+        res = g - norm[None, :] * (lt @ n.T)
+        rms = np.sqrt(np.sum(np.where(wf, res * res, 0.0), axis=0) / np.maximum(count, 1))
+        normals[sl] = n.reshape(r, wd, 3)
+        albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
+        residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)
+        valid[sl] = ok.reshape(r, wd)
+        used[sl] = np.where(ok, count, 0).reshape(r, wd)
+    return PSResult(
+        normals=normals,
+        albedo=albedo[..., 0] if stack.grey else albedo,
+        residual=residual,
+        valid=valid,
+        used_lights=used,
+        condition_number=report.condition_number,
+        robust=robust,
+        dark_threshold=dark,
+        saturation=saturation,
+    )

@@ -1,0 +1,200 @@
+"""Images and lights as the fitting code sees them, checked once at the edge.
+
+Images arrive as one array (N, H, W) or (N, H, W, C) — possibly a ``numpy.memmap`` — or as a
+sequence of N arrays (H, W) / (H, W, C), e.g. the ``uint16`` pixels of captured frames. Nothing
+here converts the whole stack: :meth:`ImageStack.rows` converts one band of rows to float32 on
+demand, so a stack larger than memory can be fitted from a memmap or from frames kept as
+``uint16``.
+
+Integer images are scaled to [0, 1] by ``scale`` (default 1 / the dtype's maximum, or
+1 / white level via :func:`stack_from_frames`); float images are taken as linear values as given.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rti_rig.reconstruct.errors import ReconstructionError
+
+#: A light may dip this far below the horizon (z) through calibration noise; it is clipped to 0.
+HORIZON_TOLERANCE = 1e-6
+#: Light vectors whose length differs from 1 by more than this are rejected, not renormalised:
+#: such a file holds positions or a wrong unit, and silently fixing it would hide that.
+UNIT_TOLERANCE = 0.05
+
+
+class ImageStack:
+    """Read-only view of N linear images, read a band of rows at a time as float32.
+
+    ``saturation_level`` (in scaled units) marks clipped observations; integer images default
+    to their top code value, float images to None (unknown).
+
+    ``grey`` is True when the images have no channel axis; fitted outputs then have none either.
+    """
+
+    def __init__(
+        self, images: Any, scale: float | None = None, saturation_level: float | None = None
+    ) -> None:
+        if isinstance(images, ImageStack):
+            self._frames: Sequence[Any] | None = images._frames
+            self._array = images._array
+            self.n, self.height, self.width = images.n, images.height, images.width
+            self.channels, self.grey = images.channels, images.grey
+            self.dtype, self.scale = images.dtype, images.scale if scale is None else scale
+            self.saturation_level = (
+                images.saturation_level if saturation_level is None else saturation_level
+            )
+            return
+        if isinstance(images, np.ndarray):
+            if images.ndim not in (3, 4):
+                raise ReconstructionError(
+                    f"images must have shape (N, H, W) or (N, H, W, C), got {images.shape}"
+                )
+            self._array: NDArray[Any] | None = images
+            self._frames = None
+            shape = images.shape[1:]
+            dtype = images.dtype
+        elif isinstance(images, Sequence) and len(images) > 0:
+            arrays = [np.asarray(im) for im in images]
+            shape = arrays[0].shape
+            for i, a in enumerate(arrays):
+                if a.shape != shape:
+                    raise ReconstructionError(
+                        f"image {i} has shape {a.shape}, image 0 has {shape}: all must match"
+                    )
+                if a.dtype != arrays[0].dtype:
+                    raise ReconstructionError(
+                        f"image {i} has dtype {a.dtype}, image 0 has {arrays[0].dtype}"
+                    )
+            if len(shape) not in (2, 3):
+                raise ReconstructionError(f"each image must be (H, W) or (H, W, C), got {shape}")
+            self._array = None
+            self._frames = arrays
+            dtype = arrays[0].dtype
+        else:
+            raise ReconstructionError("images must be an array (N, H, W[, C]) or a list of images")
+        if not (np.issubdtype(dtype, np.floating) or np.issubdtype(dtype, np.integer)):
+            raise ReconstructionError(f"images must be numeric, got dtype {dtype}")
+        self.n = len(images)
+        self.height, self.width = int(shape[0]), int(shape[1])
+        self.grey = len(shape) == 2
+        self.channels = 1 if self.grey else int(shape[2])
+        self.dtype = np.dtype(dtype)
+        if scale is None:
+            scale = 1.0 / np.iinfo(dtype).max if np.issubdtype(dtype, np.integer) else 1.0
+        self.scale = float(scale)
+        if saturation_level is None and np.issubdtype(dtype, np.integer):
+            saturation_level = float(np.iinfo(dtype).max) * self.scale
+        #: Scaled value at or above which an observation is saturated (None: unknown).
+        self.saturation_level = saturation_level
+        if self.height < 1 or self.width < 1 or self.channels < 1:
+            raise ReconstructionError(f"images are empty: shape {shape}")
+
+    def rows(self, sl: slice, indices: ArrayLike | None = None) -> NDArray[np.float32]:
+        """Band of rows ``sl`` of images ``indices`` (default all) as float32 (n, r, W, C)."""
+        idx = np.arange(self.n) if indices is None else np.asarray(indices)
+        if self._array is not None:
+            band = np.asarray(self._array[idx, sl])
+        else:
+            assert self._frames is not None
+            band = np.stack([np.asarray(self._frames[i][sl]) for i in idx])
+        out = band.astype(np.float32, copy=True)
+        if self.scale != 1.0:
+            out *= np.float32(self.scale)
+        if out.ndim == 3:
+            out = out[..., None]
+        if not np.all(np.isfinite(out)):
+            bad = int(np.argwhere(~np.isfinite(out))[0][0])
+            raise ReconstructionError(
+                f"image {int(idx[bad])} holds NaN or infinity in rows {sl.start}:{sl.stop}; "
+                "fitting needs finite linear values"
+            )
+        return out
+
+    def pixel_sample(self, max_pixels: int) -> tuple[NDArray[np.float32], NDArray[np.intp]]:
+        """A regular grid of at most ``max_pixels`` pixels: values (N, P, C) and flat indices.
+
+        A strided grid rather than a random draw, so that the sample (and a model choice made
+        on it) is reproducible and touches every part of the image.
+        """
+        total = self.height * self.width
+        step = max(1, int(np.ceil(np.sqrt(total / max(1, max_pixels)))))
+        rows = np.arange(step // 2, self.height, step)
+        cols = np.arange(step // 2, self.width, step)
+        if rows.size == 0:
+            rows = np.array([self.height // 2])
+        if cols.size == 0:
+            cols = np.array([self.width // 2])
+        parts = []
+        for r in rows:
+            band = self.rows(slice(int(r), int(r) + 1))  # (N, 1, W, C)
+            parts.append(band[:, 0, cols, :])
+        values = np.concatenate(parts, axis=1)
+        flat = (rows[:, None] * self.width + cols[None, :]).ravel()
+        return values, flat
+
+    def reference_level(self, max_pixels: int = 10_000) -> float:
+        """A robust "bright" level of the stack: the 99th percentile of a pixel sample.
+
+        Thresholds (dark, highlight floor) are fractions of it, so they follow the exposure.
+        """
+        values, _ = self.pixel_sample(max_pixels)
+        level = float(np.percentile(values, 99.0))
+        return level if level > 0 else 1.0
+
+
+def stack_from_frames(frames: Sequence[Any]) -> ImageStack:
+    """Stack of captured :class:`rti_rig.rig.Frame` objects, kept as uint16 (no float copy).
+
+    Values are scaled by 1 / white level, so the stack's saturation level is 1.0.
+    """
+    if not frames:
+        raise ReconstructionError("no frames to reconstruct from")
+    levels = {int(f.white_level) for f in frames}
+    if len(levels) != 1:
+        raise ReconstructionError(f"frames have different white levels {sorted(levels)}")
+    white = levels.pop()
+    if white <= 0:
+        raise ReconstructionError(f"frame white level must be positive, got {white}")
+    return ImageStack([f.pixels for f in frames], scale=1.0 / white, saturation_level=1.0)
+
+
+def validate_lights(lights: ArrayLike, n_images: int | None = None) -> NDArray[np.float64]:
+    """Unit light directions (N, 3) on the upper hemisphere, checked and renormalised.
+
+    Rejects a wrong shape, a count that disagrees with the images, NaN, zero or far-from-unit
+    vectors, and lights below the object plane, naming the light.
+    """
+    arr = np.asarray(lights, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ReconstructionError(f"lights must have shape (N, 3), got {arr.shape}")
+    if n_images is not None and arr.shape[0] != n_images:
+        raise ReconstructionError(
+            f"{arr.shape[0]} light directions for {n_images} images: they must pair one to one"
+        )
+    for i, v in enumerate(arr):
+        if not np.all(np.isfinite(v)):
+            raise ReconstructionError(f"light {i} is not finite: {v.tolist()}")
+        norm = float(np.linalg.norm(v))
+        if abs(norm - 1.0) > UNIT_TOLERANCE:
+            raise ReconstructionError(
+                f"light {i} has length {norm:.4f}; light directions must be unit vectors "
+                "(object to light, DESIGN.md frame)"
+            )
+        if v[2] / norm < -HORIZON_TOLERANCE:
+            raise ReconstructionError(
+                f"light {i} = {v.tolist()} is below the object plane (z < 0); RTI lights must be "
+                "on the upper hemisphere"
+            )
+    out = arr / np.linalg.norm(arr, axis=1, keepdims=True)
+    out[:, 2] = np.clip(out[:, 2], 0.0, 1.0)
+    return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+def as_direction(direction: ArrayLike) -> NDArray[np.float64]:
+    """One light direction (3,) validated like a light of a fit."""
+    return validate_lights(np.asarray(direction, dtype=np.float64).reshape(1, 3))[0]

@@ -1,0 +1,62 @@
+"""Small synthetic scenes with known answers, for tests and the fit-throughput benchmark.
+
+Not the project's simulator (that lives in ``simulator/``): just closed-form normals and a
+Lambertian-plus-Blinn–Phong shader, enough to know what a fit must return.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+def fibonacci_lights(n: int, min_elevation_deg: float = 10.0) -> NDArray[np.float64]:
+    """``n`` unit lights spread evenly over the hemisphere above ``min_elevation_deg``."""
+    i = np.arange(n) + 0.5
+    zmin = np.sin(np.radians(min_elevation_deg))
+    z = 1.0 - (1.0 - zmin) * i / n
+    r = np.sqrt(1.0 - z * z)
+    phi = i * np.pi * (3.0 - np.sqrt(5.0))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def sphere_normals(height: int, width: int, radius_fraction: float = 0.45) -> tuple[
+    NDArray[np.float64], NDArray[np.bool_]
+]:
+    """Normals (H, W, 3) of a sphere seen from +z (DESIGN.md frame, y up) and its mask.
+
+    Outside the sphere the normal is (0, 0, 1), a flat background.
+    """
+    rows, cols = np.mgrid[0:height, 0:width].astype(np.float64)
+    rad = radius_fraction * min(height, width)
+    x = (cols - (width - 1) / 2.0) / rad
+    y = ((height - 1) / 2.0 - rows) / rad
+    rr = x * x + y * y
+    inside = rr < 0.98
+    z = np.sqrt(np.clip(1.0 - rr, 0.0, 1.0))
+    n = np.stack([np.where(inside, x, 0.0), np.where(inside, y, 0.0), np.where(inside, z, 1.0)], -1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True), inside
+
+
+def render(
+    normals: NDArray[np.float64],
+    albedo: NDArray[np.float64] | float,
+    lights: NDArray[np.float64],
+    specular: float = 0.0,
+    shininess: float = 50.0,
+) -> NDArray[np.float32]:
+    """Images (N, H, W) or (N, H, W, C) if ``albedo`` has a channel axis.
+
+    ``rho * max(0, n.l) + specular * max(0, n.h)^shininess`` (Blinn–Phong, viewer on +z,
+    highlight white), with attached shadows and no cast shadows.
+    """
+    shade = np.maximum(np.einsum("hwk,nk->nhw", normals, lights), 0.0)
+    alb = np.asarray(albedo, dtype=np.float64)
+    img = shade[..., None] * alb if alb.ndim == 3 else shade * alb
+    if specular > 0:
+        half = lights + np.array([0.0, 0.0, 1.0])
+        half /= np.linalg.norm(half, axis=1, keepdims=True)
+        spec = np.maximum(np.einsum("hwk,nk->nhw", normals, half), 0.0) ** shininess
+        spec *= shade > 0
+        img = img + specular * (spec[..., None] if alb.ndim == 3 else spec)
+    return img.astype(np.float32)

@@ -1,0 +1,188 @@
+"""Photometric stereo on synthetic scenes with known normals and albedo."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rti_rig.geometry import direction_from_az_el
+from rti_rig.metrics import angular_error_deg
+from rti_rig.reconstruct import (
+    ReconstructionError,
+    fit_photometric_stereo,
+    stack_from_frames,
+)
+from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
+from rti_rig.rig import Frame
+
+
+def _gentle_normals(h: int = 24, w: int = 20, max_tilt_deg: float = 25.0) -> np.ndarray:
+    """Normals tilted at most ``max_tilt_deg``: lit by every light above 70° elevation."""
+    rng = np.random.default_rng(1)
+    tilt = np.radians(rng.uniform(0, max_tilt_deg, (h, w)))
+    az = rng.uniform(0, 2 * np.pi, (h, w))
+    return np.stack([np.sin(tilt) * np.cos(az), np.sin(tilt) * np.sin(az), np.cos(tilt)], -1)
+
+
+def _high_lights(n: int) -> np.ndarray:
+    return direction_from_az_el(np.arange(n) * 360.0 / n + 7.0, np.full(n, 70.0))
+
+
+def test_least_squares_is_exact_without_shadows() -> None:
+    n_true = _gentle_normals()
+    albedo = np.random.default_rng(2).uniform(0.2, 0.9, n_true.shape[:2])
+    lights = _high_lights(8)
+    res = fit_photometric_stereo(render(n_true, albedo, lights), lights)
+    assert res.valid.all()
+    assert angular_error_deg(res.normals, n_true).p90 < 0.01
+    np.testing.assert_allclose(res.albedo, albedo, rtol=1e-4)
+    assert np.all(res.used_lights == 8)
+    assert res.residual.max() < 1e-5
+
+
+def test_exactly_three_lights_recover_normals() -> None:
+    n_true = _gentle_normals()
+    lights = direction_from_az_el([0.0, 120.0, 240.0], [54.74, 54.74, 54.74])
+    images = render(n_true, 0.5, lights)
+    for robust in (False, True):
+        res = fit_photometric_stereo(images, lights, robust=robust)
+        assert res.valid.all()
+        assert angular_error_deg(res.normals, n_true).mean < 0.01
+        assert np.all(res.used_lights == 3)
+
+
+def test_robust_discards_attached_shadows_where_least_squares_is_biased() -> None:
+    n_true, inside = sphere_normals(64, 64)
+    lights = fibonacci_lights(40)
+    images = render(n_true, 0.7, lights)
+    ls = fit_photometric_stereo(images, lights)
+    rb = fit_photometric_stereo(images, lights, robust=True)
+    assert angular_error_deg(ls.normals, n_true, inside).mean > 3.0
+    err = angular_error_deg(rb.normals, n_true, inside & rb.valid)
+    assert err.p90 < 0.05
+    assert rb.valid[inside].mean() > 0.99
+    assert rb.used_lights[inside].min() < 40  # shadowed observations really were dropped
+
+
+def test_robust_discards_highlights_under_noise() -> None:
+    n_true, inside = sphere_normals(64, 64)
+    lights = fibonacci_lights(48)
+    images = render(n_true, 0.6, lights, specular=1.5, shininess=40.0)
+    images += np.random.default_rng(3).normal(0, 0.004, images.shape).astype(np.float32)
+    ls = angular_error_deg(fit_photometric_stereo(images, lights).normals, n_true, inside)
+    res = fit_photometric_stereo(images, lights, robust=True)
+    rb = angular_error_deg(res.normals, n_true, inside & res.valid)
+    assert ls.mean > 5.0
+    assert rb.mean < 1.0
+    assert rb.mean < ls.mean / 4
+
+
+def test_pixel_with_fewer_than_three_lit_lights_is_invalid() -> None:
+    n_true = np.zeros((4, 4, 3))
+    n_true[...] = direction_from_az_el(45.0, 10.0)  # tilted 80° towards +x+y: 2 lights lit
+    n_true[0, 0] = [0.0, 0.0, 1.0]
+    lights = direction_from_az_el([0.0, 90.0, 180.0, 270.0], [30.0] * 4)
+    images = render(n_true, 0.8, lights)
+    res = fit_photometric_stereo(images, lights, robust=True)
+    assert res.valid[0, 0]
+    assert not res.valid[1:, :].any() and not res.valid[0, 1:].any()
+    assert np.all(res.used_lights[~res.valid] == 0)
+    assert np.all(res.albedo[~res.valid] == 0)
+
+
+def test_all_dark_pixels_are_invalid_without_nan() -> None:
+    n_true = _gentle_normals(10, 10)
+    lights = _high_lights(6)
+    images = render(n_true, 0.5, lights)
+    images[:, 2:5, 3:6] = 0.0
+    for robust in (False, True):
+        res = fit_photometric_stereo(images, lights, robust=robust)
+        assert not res.valid[2:5, 3:6].any()
+        assert res.valid.sum() == 100 - 9
+        for arr in (res.normals, res.albedo, res.residual):
+            assert np.all(np.isfinite(arr))
+        np.testing.assert_array_equal(res.normals[2:5, 3:6], np.broadcast_to([0, 0, 1], (3, 3, 3)))
+        assert np.all(res.relight([0.0, 0.0, 1.0])[2:5, 3:6] == 0)
+
+
+def test_coplanar_lights_are_refused() -> None:
+    lights = direction_from_az_el([0.0, 0.0, 0.0, 180.0, 180.0], [20.0, 50.0, 80.0, 40.0, 70.0])
+    images = np.ones((5, 4, 4), dtype=np.float32)
+    with pytest.raises(ReconstructionError, match="ill-conditioned"):
+        fit_photometric_stereo(images, lights)
+
+
+def test_too_few_lights_are_refused() -> None:
+    lights = direction_from_az_el([0.0, 90.0], [45.0, 45.0])
+    with pytest.raises(ReconstructionError, match="at least 3"):
+        fit_photometric_stereo(np.ones((2, 3, 3), dtype=np.float32), lights)
+
+
+def test_images_and_lights_must_pair() -> None:
+    with pytest.raises(ReconstructionError, match="pair one to one"):
+        fit_photometric_stereo(np.ones((4, 3, 3), dtype=np.float32), _high_lights(5))
+    bad = _high_lights(4)
+    bad[2] = [0.6, 0.0, -0.8]
+    with pytest.raises(ReconstructionError, match="light 2"):
+        fit_photometric_stereo(np.ones((4, 3, 3), dtype=np.float32), bad)
+
+
+def test_mask_excludes_pixels() -> None:
+    n_true = _gentle_normals(8, 8)
+    lights = _high_lights(6)
+    mask = np.zeros((8, 8), dtype=bool)
+    mask[2:6, 2:6] = True
+    res = fit_photometric_stereo(render(n_true, 0.5, lights), lights, mask=mask)
+    np.testing.assert_array_equal(res.valid, mask)
+
+
+def test_colour_albedo_per_channel_and_relight() -> None:
+    n_true = _gentle_normals(12, 10)
+    albedo = np.broadcast_to(np.array([0.8, 0.5, 0.2]), (12, 10, 3))
+    lights = _high_lights(7)
+    images = render(n_true, albedo, lights)
+    res = fit_photometric_stereo(images, lights, robust=True)
+    assert res.albedo.shape == (12, 10, 3)
+    np.testing.assert_allclose(res.albedo, albedo, rtol=1e-4)
+    new = direction_from_az_el(33.0, 75.0)
+    expected = render(n_true, albedo, new[None, :])[0]
+    np.testing.assert_allclose(res.relight(new), expected, atol=1e-5)
+
+
+def test_normals_unit_with_non_negative_z() -> None:
+    rng = np.random.default_rng(5)
+    images = rng.uniform(0, 1, (10, 16, 16)).astype(np.float32)  # arbitrary, non-Lambertian
+    res = fit_photometric_stereo(images, fibonacci_lights(10), robust=True)
+    assert np.all(res.normals[..., 2] >= 0)
+    np.testing.assert_allclose(np.linalg.norm(res.normals, axis=-1), 1.0, atol=1e-5)
+
+
+def test_saturated_frames_are_discarded() -> None:
+    n_true, inside = sphere_normals(40, 40)
+    lights = fibonacci_lights(30)
+    images = render(n_true, 1.4, lights)  # over-exposed: brightly lit observations clip
+    white = 4000
+    pixels = np.clip(np.round(images * white), 0, white).astype(np.uint16)
+    assert (pixels == white).mean() > 0.05
+    frames = [Frame(p, 0.01, 1.0, white, 0.0) for p in pixels]
+    stack = stack_from_frames(frames)
+    res = fit_photometric_stereo(stack, lights, robust=True)
+    assert res.saturation == 1.0
+    good = angular_error_deg(res.normals, n_true, inside & res.valid)
+    blind = fit_photometric_stereo(stack, lights, robust=True, saturation=float("inf"))
+    bad = angular_error_deg(blind.normals, n_true, inside & blind.valid)
+    assert good.mean < 0.2
+    assert bad.mean > 3 * good.mean
+
+
+@pytest.mark.parametrize("robust", [False, True])
+def test_tiled_equals_untiled(robust: bool) -> None:
+    n_true, _ = sphere_normals(37, 29)
+    lights = fibonacci_lights(20)
+    images = render(n_true, 0.6, lights, specular=0.8)
+    whole = fit_photometric_stereo(images, lights, robust=robust, tile_rows=1000)
+    tiled = fit_photometric_stereo(images, lights, robust=robust, tile_rows=4)
+    np.testing.assert_array_equal(whole.valid, tiled.valid)
+    np.testing.assert_array_equal(whole.used_lights, tiled.used_lights)
+    np.testing.assert_allclose(whole.normals, tiled.normals, atol=1e-6)
+    np.testing.assert_allclose(whole.albedo, tiled.albedo, atol=1e-6)
