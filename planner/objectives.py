@@ -1,0 +1,335 @@
+"""What a light layout is worth for a given surface: the planner's two objectives.
+
+Everything here is evaluated over a *sample of the preview's normals* and a finite set of
+*candidate lights* (a dome's LEDs; a dense reachable set for an arm), so a layout is a set of
+candidate indices and its cost a number that can be compared and optimised.
+
+* ``normals`` — surface inspection and normal maps. The Cramér–Rao bound of the per-pixel
+  Lambertian least-squares fit (algorithms notes, section 3): ``E[θ²] = (σ/ρ)² tr(P M⁻¹ P)``
+  with ``M = Σ_k w_k l_k l_kᵀ`` over the lights that really reach the pixel and
+  ``P = I - n nᵀ``. The weights ``w_k`` remove attached shadows (soft, near-grazing light is
+  unreliable), cast shadows (marched over the preview's relief) and, when the preview shows
+  highlights, lights whose mirror direction points at the camera.
+* ``relight`` — interactive relighting with a linear basis (PTM or HSH). The expected
+  relighting error on held-out directions is bias² (how badly the basis, fitted on the chosen
+  lights, reproduces the surface's shadowed, possibly glossy reflectance) plus variance
+  (``σ² · mean_t a_tᵀ (AᵀA)⁻¹ a_t``, the noise propagation of the fit).
+
+The reflectance model (Lambert + shadows + an optional highlight lobe) is simple on purpose:
+it has to rank layouts, not render images.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+from rti_rig.errors import ScheduleError
+from rti_rig.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
+from rti_rig.reconstruct.bases import N_COEFFICIENTS, design_matrix
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+
+Objective = Literal["normals", "relight"]
+OBJECTIVES: tuple[str, ...] = ("normals", "relight")
+
+#: Image noise relative to albedo assumed by the bounds (≈ 34 dB): it sets the balance
+#: between the variance and bias terms of the relighting objective.
+NOISE_REL = 0.02
+
+#: Below this n·l a light is treated as (softly) shadowed: grazing light carries little signal
+#: and is where shadow boundaries, foreshortening and inter-reflections spoil the model.
+GRAZING_COS = 0.15
+
+#: Cap of the per-pixel squared angular error (rad²): an unobservable normal is "90° wrong".
+MAX_ERR2 = (np.pi / 2) ** 2
+
+#: Dense candidate count for an arm's continuous reachable band.
+ARM_CANDIDATES = 160
+
+#: Held-out directions for the relighting objective.
+HELD_OUT = 160
+
+#: Relighting models considered, with the light count each needs to be well determined
+#: (≥ 1.5× its coefficients, algorithms notes section 3: below that the fit over-fits).
+MODEL_MIN_LIGHTS = {"lambert": 3, "hsh1": 6, "ptm": 9, "hsh2": 14, "hsh3": 24}
+
+
+@dataclass(frozen=True, eq=False)
+class Candidates:
+    """Light directions the rig can use; ``leds[i]``/``names[i]`` when it is a dome."""
+
+    directions: NDArray[np.float64]
+    leds: NDArray[np.intp] | None
+    names: tuple[str, ...] | None
+
+    def __len__(self) -> int:
+        return len(self.directions)
+
+
+def candidates_for(
+    geometry: DomeGeometry | ArmGeometry,
+    min_elevation_deg: float = 0.0,
+    extra: NDArray[np.float64] | None = None,
+) -> Candidates:
+    """The rig's usable lights above the elevation floor (a dome's LEDs; an arm's dense band).
+
+    ``extra`` adds directions (e.g. a homogeneous layout) to an arm's set, so that a layout
+    computed elsewhere is exactly representable.
+    """
+    if isinstance(geometry, DomeGeometry):
+        _, el = az_el_from_direction(geometry.directions)
+        idx = np.flatnonzero(el >= min_elevation_deg - 1e-9)
+        if len(idx) == 0:
+            raise ScheduleError(
+                f"the dome has no LED at or above {min_elevation_deg:g}° elevation; "
+                "lower --min-elevation"
+            )
+        return Candidates(
+            geometry.directions[idx], idx.astype(np.intp), tuple(geometry.names[i] for i in idx)
+        )
+    lo = max(min_elevation_deg, geometry.min_elevation_deg)
+    hi = min(geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
+    if lo >= hi:
+        raise ScheduleError(
+            f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
+            f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
+        )
+    dense = fibonacci_cap(ARM_CANDIDATES, lo, hi)
+    if extra is not None and len(extra):
+        dense = np.concatenate([np.asarray(extra, dtype=np.float64).reshape(-1, 3), dense])
+    ok = [geometry.unreachable_reason(d) is None for d in dense]
+    return Candidates(dense[np.asarray(ok, dtype=bool)], None, None)
+
+
+def snap_unique(targets: NDArray[np.float64], candidates: Candidates) -> NDArray[np.intp]:
+    """Candidate indices for ``targets`` (one each, no repeats), minimising the total angle."""
+    if len(targets) > len(candidates):
+        raise ScheduleError(
+            f"asked for {len(targets)} lights but only {len(candidates)} are available"
+        )
+    cost = angle_between_deg(targets[:, None, :], candidates.directions[None, :, :])
+    rows, cols = linear_sum_assignment(cost)
+    out = np.empty(len(targets), dtype=np.intp)
+    out[rows] = cols
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceSample:
+    """What the planner knows of the surface: sampled normals, their weights, shadow maps.
+
+    ``lit_candidates[p, k]`` / ``lit_held_out[p, t]`` are 1 where light k / t reaches pixel p
+    without a cast shadow (from the preview's relief) and 0 where it is blocked;
+    ``specular`` (0..1) is the strength of the highlight lobe suggested by the preview.
+    """
+
+    normals: NDArray[np.float64]
+    weights: NDArray[np.float64]
+    lit_candidates: NDArray[np.float64]
+    held_out: NDArray[np.float64]
+    lit_held_out: NDArray[np.float64]
+    specular: float = 0.0
+
+
+def cast_shadow_visibility(
+    height_px: NDArray[np.float64],
+    rows: NDArray[np.intp],
+    cols: NDArray[np.intp],
+    directions: NDArray[np.float64],
+    max_steps: int = 32,
+) -> NDArray[np.float64]:
+    """1 where a light from ``directions[k]`` reaches pixel (rows[p], cols[p]), else 0.
+
+    Marches from each pixel towards the light over the relief (height in pixel units) and
+    reports a cast shadow when the terrain rises above the ray. Nearest-pixel lookups and a
+    bounded march: this ranks layouts, it does not render.
+    """
+    h, w = height_px.shape
+    d = np.asarray(directions, dtype=np.float64)
+    horiz = np.hypot(d[:, 0], d[:, 1])
+    step_x = np.where(horiz > 1e-9, d[:, 0] / np.maximum(horiz, 1e-9), 0.0)
+    step_y = np.where(horiz > 1e-9, d[:, 1] / np.maximum(horiz, 1e-9), 0.0)
+    rise = d[:, 2] / np.maximum(horiz, 1e-9)  # height gained per pixel travelled
+    t = np.arange(1, max_steps + 1, dtype=np.float64)
+    h0 = height_px[rows, cols]
+    vis = np.ones((len(rows), len(d)))
+    for k in range(len(d)):
+        if horiz[k] < 1e-6:
+            continue
+        cc = np.rint(cols[:, None] + t[None, :] * step_x[k]).astype(np.intp)
+        rr = np.rint(rows[:, None] - t[None, :] * step_y[k]).astype(np.intp)
+        inside = (cc >= 0) & (cc < w) & (rr >= 0) & (rr < h)
+        hh = height_px[np.clip(rr, 0, h - 1), np.clip(cc, 0, w - 1)]
+        ray = h0[:, None] + t[None, :] * rise[k]
+        vis[:, k] = ~np.any(inside & (hh > ray + 0.5), axis=1)
+    return vis
+
+
+def _attached(normals: NDArray, directions: NDArray) -> NDArray[np.float64]:
+    """Soft attached-shadow weight: 0 facing away, ramping to 1 past :data:`GRAZING_COS`."""
+    return np.clip((normals @ directions.T) / GRAZING_COS, 0.0, 1.0)
+
+
+def _highlight(normals: NDArray, directions: NDArray, width_deg: float) -> NDArray:
+    """Strength of a mirror highlight seen by the camera (+z) for each normal and light."""
+    half = directions + np.array([0.0, 0.0, 1.0])
+    half = half / np.linalg.norm(half, axis=-1, keepdims=True)
+    cos = np.clip(normals @ half.T, -1.0, 1.0)
+    return np.exp(-((np.degrees(np.arccos(cos)) / width_deg) ** 2))
+
+
+def light_weights(sample: SurfaceSample, directions: NDArray[np.float64]) -> NDArray:
+    """Per-pixel, per-light usefulness for the normal fit (P, K) — see module notes."""
+    w = _attached(sample.normals, directions) * sample.lit_candidates
+    if sample.specular > 0:
+        w = w * (1.0 - sample.specular * _highlight(sample.normals, directions, 15.0))
+    return w
+
+
+def reflectance(
+    sample: SurfaceSample, directions: NDArray[np.float64], lit: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Modelled radiance (P, K) per unit albedo: shadowed Lambert plus a highlight lobe."""
+    cos = np.clip(sample.normals @ directions.T, 0.0, None)
+    f = cos * lit
+    if sample.specular > 0:
+        f = f + sample.specular * _highlight(sample.normals, directions, 10.0) * lit * (cos > 0)
+    return f
+
+
+class NormalsObjective:
+    """Expected RMS normal error (degrees) of the Lambertian fit over the sample (see module)."""
+
+    name = "normals"
+
+    #: Index pairs of the 6 distinct entries of a symmetric 3×3 (xx, xy, xz, yy, yz, zz).
+    PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+
+    def __init__(self, sample: SurfaceSample, candidates: Candidates) -> None:
+        self.sample = sample
+        w = light_weights(sample, candidates.directions)  # (P, K)
+        d = candidates.directions
+        # information contributed by candidate k at pixel p, as the 6 distinct entries of
+        # w_pk l_k l_kᵀ: shape (6, K, P), contiguous per entry for fast batched swaps
+        self.outer = np.ascontiguousarray(
+            np.stack([w.T * (d[:, i] * d[:, j])[:, None] for i, j in self.PAIRS])
+        )
+        self.n = sample.normals
+        self.wts = sample.weights / sample.weights.sum()
+
+    def _per_pixel(self, m: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Squared angular error (rad²) from information entries ``m`` (6, ..., P)."""
+        # closed-form adjugate of the symmetric 3×3 (batched np.linalg.inv is ~20× slower):
+        # tr(P M⁻¹ P) = tr(M⁻¹) - nᵀ M⁻¹ n with P = I - n nᵀ
+        a, b, c, d, e, f = m[0] + 1e-9, m[1], m[2], m[3] + 1e-9, m[4], m[5] + 1e-9
+        c00, c11, c22 = d * f - e * e, a * f - c * c, a * d - b * b
+        c01, c02, c12 = c * e - b * f, b * e - c * d, b * c - a * e
+        det = a * c00 + b * c01 + c * c02
+        x, y, z = self.n[:, 0], self.n[:, 1], self.n[:, 2]
+        quad = (
+            c00 * x * x + c11 * y * y + c22 * z * z
+            + 2 * (c01 * x * y + c02 * x * z + c12 * y * z)
+        )
+        ok = det > 1e-12
+        tr = (c00 + c11 + c22 - quad) / np.where(ok, det, 1.0)
+        return np.clip(np.where(ok, NOISE_REL**2 * tr, MAX_ERR2), 0.0, MAX_ERR2)
+
+    def cost(self, chosen: NDArray[np.intp]) -> float:
+        m = self.outer[:, chosen].sum(axis=1)  # (6, P)
+        return float(np.degrees(np.sqrt(self._per_pixel(m) @ self.wts)))
+
+    def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
+        """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch."""
+        base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
+        err2 = self._per_pixel(base[:, None, :] + self.outer)  # (K, P)
+        return np.degrees(np.sqrt(err2 @ self.wts))
+
+    def describe(self, value: float) -> str:
+        return f"expected RMS normal error {value:.2f}° at {100 * NOISE_REL:g}% noise"
+
+
+def models_for(n: int) -> list[str]:
+    """Relighting bases that ``n`` lights can determine (see :data:`MODEL_MIN_LIGHTS`)."""
+    ok = [m for m, k in MODEL_MIN_LIGHTS.items() if n >= k and m != "lambert"]
+    return ok or ["lambert"]
+
+
+class RelightObjective:
+    """Expected relighting MSE (per unit albedo) on held-out directions, for a basis.
+
+    For coefficients ``c`` fitted on the chosen lights the held-out bias is
+    ``mean_t (a_tᵀ c - f_t)² = cᵀ G c - 2 cᵀ h + k`` with ``G = A_Tᵀ A_T / T``,
+    ``h = A_Tᵀ f / T`` and ``k = mean f_t²``, so no held-out image is ever rendered.
+    """
+
+    name = "relight"
+
+    def __init__(self, sample: SurfaceSample, candidates: Candidates, model: str) -> None:
+        if model not in N_COEFFICIENTS:
+            raise ValueError(f"unknown relighting model '{model}'")
+        self.model = model
+        self.sample = sample
+        self.a_cand = design_matrix(model, candidates.directions)  # (K, p)
+        a_test = design_matrix(model, sample.held_out)  # (T, p)
+        f_test = reflectance(sample, sample.held_out, sample.lit_held_out)  # (P, T)
+        t = len(a_test)
+        self.gram = a_test.T @ a_test / t  # (p, p)
+        self.h = f_test @ a_test / t  # (P, p)
+        self.k = np.mean(f_test * f_test, axis=1)  # (P,)
+        self.f_cand = reflectance(sample, candidates.directions, sample.lit_candidates)  # (P, K)
+        self.wts = sample.weights / sample.weights.sum()
+
+    def _costs(self, a: NDArray[np.float64], f: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Costs of batched layouts: design ``a`` (B, N, p), reflectance ``f`` (B, P, N)."""
+        p = a.shape[-1]
+        ata = np.swapaxes(a, 1, 2) @ a + 1e-8 * np.eye(p)
+        inv = np.linalg.inv(ata)  # (B, p, p)
+        coef = f @ (a @ inv)  # (B, P, p)
+        bias2 = np.sum(coef * (coef @ self.gram - 2 * self.h[None]), axis=-1) + self.k[None]
+        var = NOISE_REL**2 * np.einsum("ij,bji->b", self.gram, inv)
+        return np.clip(bias2, 0.0, None) @ self.wts + var
+
+    def cost(self, chosen: NDArray[np.intp]) -> float:
+        a = self.a_cand[chosen][None]
+        f = self.f_cand[:, chosen][None]
+        return float(self._costs(a, f)[0])
+
+    def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
+        k = len(self.a_cand)
+        a = np.repeat(self.a_cand[chosen][None], k, axis=0)
+        a[:, position] = self.a_cand
+        f = np.repeat(self.f_cand[:, chosen][None], k, axis=0)
+        f[:, :, position] = self.f_cand.T
+        out = np.full(k, np.inf)
+        for lo in range(0, k, 64):  # bounded memory on large arm candidate sets
+            sl = slice(lo, min(k, lo + 64))
+            with np.errstate(all="ignore"):
+                out[sl] = self._costs(a[sl], f[sl])
+        return np.where(np.isfinite(out), out, np.inf)
+
+    def describe(self, value: float) -> str:
+        psnr = -10 * np.log10(max(value, 1e-12))
+        return f"expected relighting error {psnr:.1f} dB PSNR ({self.model.upper()})"
+
+
+def make_objective(
+    objective: str, sample: SurfaceSample, candidates: Candidates, n: int, start: NDArray[np.intp]
+) -> NormalsObjective | RelightObjective:
+    """The objective to optimise; for ``relight`` the basis that ``start`` fits best is chosen."""
+    if objective == "normals":
+        return NormalsObjective(sample, candidates)
+    if objective == "relight":
+        best: RelightObjective | None = None
+        best_cost = float("inf")
+        for model in models_for(n):
+            obj = RelightObjective(sample, candidates, model)
+            c = obj.cost(start)
+            if c < best_cost:
+                best, best_cost = obj, c
+        assert best is not None
+        return best
+    raise ScheduleError(f"unknown objective '{objective}'; use one of {', '.join(OBJECTIVES)}")
