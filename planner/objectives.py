@@ -40,6 +40,10 @@ OBJECTIVES: tuple[str, ...] = ("normals", "relight")
 #: between the variance and bias terms of the relighting objective.
 NOISE_REL = 0.02
 
+#: Assumed RMS deviation of real reflectance from Lambert, relative to albedo, for the model
+#: bias term of the normals objective (chosen a priori, not fitted to any benchmark).
+BIAS_REL = 0.05
+
 #: Below this n·l a light is treated as (softly) shadowed: grazing light carries little signal
 #: and is where shadow boundaries, foreshortening and inter-reflections spoil the model.
 GRAZING_COS = 0.15
@@ -202,14 +206,30 @@ def reflectance(
 
 
 class NormalsObjective:
-    """Expected RMS normal error (degrees) of the Lambertian fit over the sample (see module)."""
+    """Expected RMS normal error (degrees) of the Lambertian fit over the sample.
+
+    Two parts, per sampled normal ``n`` (unit albedo):
+
+    * variance — the Cramér–Rao bound ``σ² tr(P M⁻¹ P)`` with ``M = Σ w_k l_k l_kᵀ`` (module
+      notes);
+    * model bias — real surfaces are not Lambertian, and a sparse set of lights fits a
+      Lambertian normal that differs from the one the dense dome would give. The deviation
+      from Lambert is unknown from one preview, so it is modelled as a random smooth function
+      of the light direction, ``g(l) = Σ β_j h_j(l)`` over the 9 order-2 hemispherical
+      harmonics with independent ``β_j ~ N(0, τ²)``; the fitted ``b`` then moves by
+      ``(G_S - G_all) β`` with ``G = M⁻¹ Σ w_k l_k h_kᵀ``, whose expected squared tangential
+      size is ``τ² ‖P (G_S - G_all)‖²_F``. This favours layouts whose Lambertian fit agrees
+      with the fit on every usable light (the reference an RTI user compares against).
+    """
 
     name = "normals"
 
     #: Index pairs of the 6 distinct entries of a symmetric 3×3 (xx, xy, xz, yy, yz, zz).
     PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
-    def __init__(self, sample: SurfaceSample, candidates: Candidates) -> None:
+    def __init__(
+        self, sample: SurfaceSample, candidates: Candidates, bias_rel: float = BIAS_REL
+    ) -> None:
         self.sample = sample
         w = light_weights(sample, candidates.directions)  # (P, K)
         d = candidates.directions
@@ -220,32 +240,69 @@ class NormalsObjective:
         )
         self.n = sample.normals
         self.wts = sample.weights / sample.weights.sum()
+        self.tau2 = (bias_rel * np.sqrt(2 * np.pi / 9)) ** 2  # RMS deviation = bias_rel
+        if self.tau2 > 0:
+            hsh = design_matrix("hsh2", d)  # (K, 9)
+            # cross term w_pk l_k h_kᵀ as (3, K, P, 9)
+            self.cross = np.ascontiguousarray(
+                d.T[:, :, None, None] * w.T[None, :, :, None] * hsh[None, :, None, :]
+            )
+            all_m = self.outer.sum(axis=1)  # (6, P)
+            self.g_all = self._solve(all_m[:, None], self.cross.sum(axis=1)[:, None])[:, 0]
 
-    def _per_pixel(self, m: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Squared angular error (rad²) from information entries ``m`` (6, ..., P)."""
-        # closed-form adjugate of the symmetric 3×3 (batched np.linalg.inv is ~20× slower):
-        # tr(P M⁻¹ P) = tr(M⁻¹) - nᵀ M⁻¹ n with P = I - n nᵀ
+    @staticmethod
+    def _adjugate(m: NDArray[np.float64]) -> tuple[tuple[NDArray, ...], NDArray]:
         a, b, c, d, e, f = m[0] + 1e-9, m[1], m[2], m[3] + 1e-9, m[4], m[5] + 1e-9
         c00, c11, c22 = d * f - e * e, a * f - c * c, a * d - b * b
         c01, c02, c12 = c * e - b * f, b * e - c * d, b * c - a * e
         det = a * c00 + b * c01 + c * c02
+        return (c00, c01, c02, c11, c12, c22), det
+
+    def _solve(self, m: NDArray, r: NDArray) -> NDArray[np.float64]:
+        """``M⁻¹ R`` for entries ``m`` (6, B, P) and ``r`` (3, B, P, 9) → (3, B, P, 9)."""
+        (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
+        inv_det = np.where(det > 1e-12, 1.0 / np.where(det > 1e-12, det, 1.0), 0.0)
+        rows = ((c00, c01, c02), (c01, c11, c12), (c02, c12, c22))
+        return np.stack(
+            [
+                (row[0][..., None] * r[0] + row[1][..., None] * r[1] + row[2][..., None] * r[2])
+                * inv_det[..., None]
+                for row in rows
+            ]
+        )
+
+    def _per_pixel(self, m: NDArray[np.float64], r: NDArray | None = None) -> NDArray:
+        """Squared angular error (rad²) from information entries ``m`` (6, B, P)."""
+        # closed-form adjugate of the symmetric 3×3 (batched np.linalg.inv is ~20× slower):
+        # tr(P M⁻¹ P) = tr(M⁻¹) - nᵀ M⁻¹ n with P = I - n nᵀ
+        (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
         x, y, z = self.n[:, 0], self.n[:, 1], self.n[:, 2]
         quad = (
             c00 * x * x + c11 * y * y + c22 * z * z
             + 2 * (c01 * x * y + c02 * x * z + c12 * y * z)
         )
         ok = det > 1e-12
-        tr = (c00 + c11 + c22 - quad) / np.where(ok, det, 1.0)
-        return np.clip(np.where(ok, NOISE_REL**2 * tr, MAX_ERR2), 0.0, MAX_ERR2)
+        err2 = NOISE_REL**2 * (c00 + c11 + c22 - quad) / np.where(ok, det, 1.0)
+        if r is not None and self.tau2 > 0:
+            delta = self._solve(m, r) - self.g_all[:, None]  # (3, B, P, 9)
+            along = x[:, None] * delta[0] + y[:, None] * delta[1] + z[:, None] * delta[2]
+            tang = np.sum(delta * delta, axis=(0, -1)) - np.sum(along * along, axis=-1)
+            err2 = err2 + self.tau2 * tang
+        return np.clip(np.where(ok, err2, MAX_ERR2), 0.0, MAX_ERR2)
 
     def cost(self, chosen: NDArray[np.intp]) -> float:
-        m = self.outer[:, chosen].sum(axis=1)  # (6, P)
-        return float(np.degrees(np.sqrt(self._per_pixel(m) @ self.wts)))
+        m = self.outer[:, chosen].sum(axis=1)[:, None]  # (6, 1, P)
+        r = self.cross[:, chosen].sum(axis=1)[:, None] if self.tau2 > 0 else None
+        return float(np.degrees(np.sqrt(self._per_pixel(m, r)[0] @ self.wts)))
 
     def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
         """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch."""
         base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
-        err2 = self._per_pixel(base[:, None, :] + self.outer)  # (K, P)
+        r = None
+        if self.tau2 > 0:
+            rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
+            r = rb[:, None] + self.cross  # (3, K, P, 9)
+        err2 = self._per_pixel(base[:, None, :] + self.outer, r)  # (K, P)
         return np.degrees(np.sqrt(err2 @ self.wts))
 
     def describe(self, value: float) -> str:
