@@ -111,13 +111,23 @@ def fit_relief_scale(
         idx = np.random.default_rng(seed).choice(y.size, FIT_PIXELS, replace=False)
         p, q, y = p[idx], q[idx], y[idx]
     lx, ly, lz = (float(v) for v in light)
+
+    def evaluate(scales: NDArray) -> tuple[NDArray, NDArray, NDArray, int]:
+        s = scales[:, None]
+        shade = (-s * p * lx - s * q * ly + lz) / np.sqrt(1 + s * s * (p * p + q * q))
+        shade = np.clip(shade, 0, None)
+        ss = np.sum(shade * shade, axis=1)
+        rho = np.where(ss > 0, np.sum(shade * y, axis=1) / np.where(ss > 0, ss, 1.0), 0.0)
+        sse = np.sum((y - rho[:, None] * shade) ** 2, axis=1)
+        # exact ties (a zenith light cannot tell convex from concave) go to the convex reading
+        return shade, rho, sse, int(np.argmin(sse + 1e-9 * float(sse.max()) * (scales < 0)))
+
     scales = np.concatenate([SCALE_GRID, -SCALE_GRID[1:]])
-    s = scales[:, None]
-    shade = np.clip((-s * p * lx - s * q * ly + lz) / np.sqrt(1 + s * s * (p * p + q * q)), 0, None)
-    ss = np.sum(shade * shade, axis=1)
-    rho = np.where(ss > 0, np.sum(shade * y, axis=1) / np.where(ss > 0, ss, 1.0), 0.0)
-    sse = np.sum((y - rho[:, None] * shade) ** 2, axis=1)
-    best = int(np.argmin(sse - 1e-9 * np.abs(scales)))  # ties → smallest, convex first
+    shade, rho, sse, best = evaluate(scales)
+    if scales[best] != 0.0:  # refine between the neighbouring grid values
+        ratio = float(SCALE_GRID[2] / SCALE_GRID[1])
+        scales = scales[best] * np.geomspace(1 / ratio, ratio, 21)
+        shade, rho, sse, best = evaluate(scales)
     sst = float(np.sum((y - y.mean()) ** 2))
     explained = 1.0 - float(sse[best]) / sst if sst > 0 else 0.0
     resid = y - rho[best] * shade[best]
