@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from planner.objectives import Candidates, snap_unique
 
 #: Normals fed to k-means (a random subset; clustering needs the distribution, not every pixel).
-KMEANS_PIXELS = 10000
+KMEANS_PIXELS = 5000
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,7 @@ class KMeansResult:
 
 
 #: Restarts of k-means from different random initial centroids; the lowest inertia wins.
-KMEANS_RESTARTS = 4
+KMEANS_RESTARTS = 3
 
 #: Lloyd iterations per restart (it converges well before on normal maps).
 KMEANS_ITERATIONS = 60

@@ -68,7 +68,7 @@ DEFAULT_OBJECTIVE = "normals"
 START_FLOORS_DEG = (10.0, 20.0, 30.0, 40.0)
 
 #: Pixels sampled for the objectives.
-SAMPLE_PIXELS = 384
+SAMPLE_PIXELS = 256
 
 #: A preview with more than this fraction of clipped pixels carries no shading to read.
 MAX_SATURATED_FRACTION = 0.95

@@ -45,7 +45,7 @@ NOISE_REL = 0.02
 BIAS_REL = 0.05
 
 #: Sampled normals used for the bias term (it varies smoothly with the normal).
-BIAS_PIXELS = 192
+BIAS_PIXELS = 128
 
 #: Below this n·l a light is treated as (softly) shadowed: grazing light carries little signal
 #: and is where shadow boundaries, foreshortening and inter-reflections spoil the model.

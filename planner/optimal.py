@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from planner.objectives import NormalsObjective, RelightObjective
 
 #: At most this many sweeps over the chosen lights (a bound on run time; rarely reached).
-MAX_PASSES = 6
+MAX_PASSES = 4
 
 
 @dataclass(frozen=True)
