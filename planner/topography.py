@@ -79,6 +79,23 @@ def linear_luminance(preview: NDArray) -> NDArray[np.float64]:
     return lin
 
 
+def read_preview(path: Path) -> NDArray:
+    """The preview image file as an array in RGB order, keeping its type (the CLI's edge).
+
+    8-bit files (JPEG, PNG) are taken as sRGB; 16-bit files (TIFF, PNG) as linear data, which
+    is what ``rti-rig run`` writes for fitting (DESIGN.md "Linear data").
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ScheduleError(f"{p}: preview image not found")
+    img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ScheduleError(f"{p}: cannot read this file as an image (JPEG, PNG or TIFF)")
+    if img.ndim == 3 and img.shape[2] >= 3:
+        img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2RGB)
+    return img
+
+
 def downsample(image: NDArray[np.float64], max_side: int = PLANNING_SIDE_PX) -> NDArray:
     """Area-averaged copy with the long side at most ``max_side`` (tiny images are kept)."""
     h, w = image.shape[:2]

@@ -130,3 +130,23 @@ def test_cast_shadow_from_a_wall() -> None:
     high_east = direction_from_az_el(0, 80)
     vis = cast_shadow_visibility(height, rows, cols, np.stack([east, west, high_east]))
     assert vis.tolist() == [[0.0, 1.0, 1.0]]
+
+
+def test_read_preview_keeps_type_and_rgb_order(tmp_path) -> None:
+    import cv2
+
+    from planner.topography import read_preview
+
+    rgb = np.zeros((4, 5, 3), np.uint8)
+    rgb[..., 0] = 200  # red
+    cv2.imwrite(str(tmp_path / "p.png"), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    got = read_preview(tmp_path / "p.png")
+    assert got.dtype == np.uint8 and got.shape == (4, 5, 3) and got[0, 0, 0] == 200
+    deep = np.full((3, 3), 40000, np.uint16)
+    cv2.imwrite(str(tmp_path / "d.tif"), deep)
+    assert read_preview(tmp_path / "d.tif").dtype == np.uint16
+    with pytest.raises(ScheduleError, match="not found"):
+        read_preview(tmp_path / "none.jpg")
+    (tmp_path / "bad.jpg").write_bytes(b"xx")
+    with pytest.raises(ScheduleError, match="cannot read"):
+        read_preview(tmp_path / "bad.jpg")
