@@ -88,6 +88,8 @@ class SurfaceEstimate:
     fit: ReliefFit
     relief_source: str
     nonfinite_repaired: int
+    #: normals of the fitted relief before the trust shrinkage (what the paper's k-means sees)
+    fitted_normals: NDArray[np.float64] | None = None
 
 
 @dataclass
@@ -192,7 +194,8 @@ def estimate_surface(
     # albedo (a painting) must not be read as steep relief (see docs/planner.md)
     relief = fit.scale * relief_trust(fit) * height
     return SurfaceEstimate(
-        image, light, light_source, relief, normals_from_height(relief), fit, source, bad
+        image, light, light_source, relief, normals_from_height(relief), fit, source, bad,
+        normals_from_height(fit.scale * height),
     )
 
 
@@ -375,7 +378,9 @@ def _plan(
         held_out = fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)
         sample = sample_surface(surface, candidates, held_out, seed=seed)
         if method == "kmeans":
-            chosen, km = plan_kmeans(surface.normals, n, candidates, seed)
+            # the paper clusters the depth gradient's normals as they come: no shrinkage
+            raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
+            chosen, km = plan_kmeans(raw, n, candidates, seed)
             report.kmeans_distinct_normals = km.distinct_normals
             if km.distinct_normals < n:
                 report.notes.append(

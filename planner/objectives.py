@@ -338,11 +338,20 @@ class RelightObjective:
     For coefficients ``c`` fitted on the chosen lights the held-out bias is
     ``mean_t (a_tᵀ c - f_t)² = cᵀ G c - 2 cᵀ h + k`` with ``G = A_Tᵀ A_T / T``,
     ``h = A_Tᵀ f / T`` and ``k = mean f_t²``, so no held-out image is ever rendered.
+
+    As for normals, real reflectance deviates from the model in ways one preview cannot show;
+    the deviation is modelled as a random smooth function (order-3 hemispherical harmonics,
+    RMS :data:`BIAS_REL` of albedo) and its expected held-out error after the basis is fitted on
+    the chosen lights is added: ``τ² ‖A_T (A_SᵀA_S)⁻¹ A_Sᵀ H_S - H_T‖²_F / T``. It rewards
+    layouts whose fit generalises over the whole hemisphere.
     """
 
     name = "relight"
 
-    def __init__(self, sample: SurfaceSample, candidates: Candidates, model: str) -> None:
+    def __init__(
+        self, sample: SurfaceSample, candidates: Candidates, model: str,
+        bias_rel: float = BIAS_REL,
+    ) -> None:
         if model not in N_COEFFICIENTS:
             raise ValueError(f"unknown relighting model '{model}'")
         self.model = model
@@ -356,21 +365,31 @@ class RelightObjective:
         self.k = np.mean(f_test * f_test, axis=1)  # (P,)
         self.f_cand = reflectance(sample, candidates.directions, sample.lit_candidates)  # (P, K)
         self.wts = sample.weights / sample.weights.sum()
+        self.a_test = a_test
+        self.dev_cand = design_matrix("hsh3", candidates.directions)  # (K, 16)
+        self.dev_test = design_matrix("hsh3", sample.held_out)  # (T, 16)
+        self.tau2 = bias_rel**2 * 2 * np.pi / 16  # RMS deviation over the hemisphere = bias_rel
 
-    def _costs(self, a: NDArray[np.float64], f: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Costs of batched layouts: design ``a`` (B, N, p), reflectance ``f`` (B, P, N)."""
+    def _costs(
+        self, a: NDArray[np.float64], f: NDArray[np.float64], dev: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Costs of batched layouts: design ``a`` (B, N, p), reflectance ``f`` (B, P, N),
+        deviation basis ``dev`` (B, N, 16) at the chosen lights."""
         p = a.shape[-1]
         ata = np.swapaxes(a, 1, 2) @ a + 1e-8 * np.eye(p)
         inv = np.linalg.inv(ata)  # (B, p, p)
-        coef = f @ (a @ inv)  # (B, P, p)
+        fit = a @ inv  # (B, N, p)
+        coef = f @ fit  # (B, P, p)
         bias2 = np.sum(coef * (coef @ self.gram - 2 * self.h[None]), axis=-1) + self.k[None]
         var = NOISE_REL**2 * np.einsum("ij,bji->b", self.gram, inv)
-        return np.clip(bias2, 0.0, None) @ self.wts + var
+        miss = self.a_test @ (np.swapaxes(fit, 1, 2) @ dev) - self.dev_test  # (B, T, 16)
+        unmodelled = self.tau2 * np.mean(np.sum(miss * miss, axis=-1), axis=-1)
+        return np.clip(bias2, 0.0, None) @ self.wts + var + unmodelled
 
     def cost(self, chosen: NDArray[np.intp]) -> float:
         a = self.a_cand[chosen][None]
         f = self.f_cand[:, chosen][None]
-        return float(self._costs(a, f)[0])
+        return float(self._costs(a, f, self.dev_cand[chosen][None])[0])
 
     def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
         k = len(self.a_cand)
@@ -378,11 +397,13 @@ class RelightObjective:
         a[:, position] = self.a_cand
         f = np.repeat(self.f_cand[:, chosen][None], k, axis=0)
         f[:, :, position] = self.f_cand.T
+        dev = np.repeat(self.dev_cand[chosen][None], k, axis=0)
+        dev[:, position] = self.dev_cand
         out = np.full(k, np.inf)
         for lo in range(0, k, 64):  # bounded memory on large arm candidate sets
             sl = slice(lo, min(k, lo + 64))
             with np.errstate(all="ignore"):
-                out[sl] = self._costs(a[sl], f[sl])
+                out[sl] = self._costs(a[sl], f[sl], dev[sl])
         return np.where(np.isfinite(out), out, np.inf)
 
     def describe(self, value: float) -> str:

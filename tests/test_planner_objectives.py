@@ -95,9 +95,21 @@ def test_relight_variance_anchor() -> None:
         np.array([[0.0, 0.0, 1.0]]), np.ones(1), np.zeros((1, 36)),
         fibonacci_cap(2000, 5.0, 90.0), np.zeros((1, 2000)),
     )  # fully shadowed pixel: reflectance 0 everywhere, so the cost is variance only
-    obj = RelightObjective(sample, cands, "ptm")
+    obj = RelightObjective(sample, cands, "ptm", bias_rel=0.0)
     var = obj.cost(np.arange(36))
     assert var == pytest.approx(6 * NOISE_REL**2 / 36, rel=0.5)
+
+
+def test_unmodelled_reflectance_term_favours_spread_lights() -> None:
+    cands = Candidates(fibonacci_cap(60, 5.0, 90.0), None, None)
+    sample = make_sample(fibonacci_cap(20, 50.0, 90.0), cands)
+    with_term = RelightObjective(sample, cands, "ptm")
+    without = RelightObjective(sample, cands, "ptm", bias_rel=0.0)
+    spread = np.linspace(0, 59, 12).round().astype(int)
+    clumped = np.argsort(-cands.directions[:, 2])[:12]  # the 12 highest lights
+    extra_spread = with_term.cost(spread) - without.cost(spread)
+    extra_clumped = with_term.cost(clumped) - without.cost(clumped)
+    assert 0 < extra_spread < extra_clumped
 
 
 def test_models_for_light_counts() -> None:
