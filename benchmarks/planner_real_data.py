@@ -19,8 +19,10 @@ Subset normals use robust photometric stereo (shadows and highlights discarded p
 it refuses an ill-conditioned subset (lights nearly coplanar) plain least squares with a
 pseudo-inverse is used and the row is marked ``*``.
 
-Rows "uniform, tuned floor" and "hindsight" use the reference to choose — they are bars, not
-plans: the first is the best homogeneous layout over floors 0–40° (what a dome owner could tune
+Row "flat prior (no preview)" is the `optimal` planner given a uniform grey preview: what its
+model alone does, with no information about the object. Rows "uniform, tuned floor" and
+"hindsight" use the reference to choose — they are bars, not plans:
+the first is the best homogeneous layout over floors 0–40° (what a dome owner could tune
 once), the second a greedy + exchange selection on the actual normal error (an upper bound for
 any planner on this object).
 
@@ -174,6 +176,12 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
         _, best_f, best_leds = min(tuned, key=lambda t: t[0])
         fixed[f"uniform, tuned floor ({best_f:g}°, hindsight)"] = best_leds
         fixed["hindsight (normals, oracle)"] = hindsight(n, images, dirs, ref, mask)
+        # the planner's model without any information from a preview: a uniform grey image
+        grey = np.full((64, 64), 120, dtype=np.uint8)
+        flat_plan, _ = plan_with_report(grey, dome, n, "optimal", "normals", (0.0, 50.0))
+        fixed["optimal, normals, flat prior (no preview)"] = np.array(
+            [s.led for s in flat_plan.steps]
+        )
         scores = {k: evaluate(v, images, dirs, ref, mask, model) for k, v in fixed.items()}
         bar_err = min(scores[k][0] for k in list(scores)[:2])
         bar_psnr = max(scores[k][1] for k in list(scores)[:2])
