@@ -355,8 +355,16 @@ def _plan(
             f"--method {method} plans from a preview shot; give one, or use --method uniform"
         )
     chosen = starts[0][1]
+    surface: SurfaceEstimate | None = None
     if preview is not None:
-        surface = estimate_surface(preview, preview_light, depth_model, depth_spec)
+        try:
+            surface = estimate_surface(preview, preview_light, depth_model, depth_spec)
+        except ScheduleError as exc:
+            if method != "uniform":
+                raise
+            # the homogeneous layout does not need the preview: report, do not fail
+            report.notes.append(f"preview not evaluated: {exc}")
+    if surface is not None:
         az, el = az_el_from_direction(surface.light)
         report.preview_shape = tuple(np.asarray(preview).shape)
         report.planning_shape = tuple(surface.image.shape)

@@ -207,3 +207,9 @@ def test_report_is_serialisable_and_readable() -> None:
     import json
 
     json.dumps(sched.to_dict())
+
+
+def test_uniform_does_not_fail_on_a_useless_preview() -> None:
+    sched, rep = plan_with_report(np.zeros((20, 20), np.uint8), DOME, 6, "uniform")
+    assert [s.led for s in sched.steps] == [s.led for s in plan_uniform(DOME, 6).steps]
+    assert any("preview not evaluated" in note and "black" in note for note in rep.notes)
