@@ -1,0 +1,442 @@
+"""One entry point from a preview shot to an ordered light schedule: :func:`make_plan`.
+
+Pipeline (each step a pure function in its own module):
+
+1. :func:`planner.topography.planning_image` — downsample early, linearise, reduce to luminance;
+2. the preview's light: ``preview_light`` (azimuth, elevation in degrees, frame of DESIGN.md) or
+   :func:`planner.topography.estimate_light`;
+3. a relief: the user's ONNX depth model (:func:`planner.topography.depth_from_onnx`) or the
+   weight-free :func:`planner.topography.shape_from_shading`;
+4. its scale from the preview's shading and then normals (:mod:`planner.normals`);
+5. the method: ``uniform`` (homogeneous, no preview needed), ``kmeans`` (the paper's) or
+   ``optimal`` (exchange search on an objective, :mod:`planner.optimal`);
+6. the rig's constraints (usable LEDs without repeats / reachable arm band) and its order
+   (ascending LED index on a dome; shortest moves from the park pose on an arm).
+
+The default objective is ``normals``: see docs/planner.md for the real-dome evidence behind it.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from threadpoolctl import threadpool_limits
+
+from planner.kmeans_method import plan_kmeans
+from planner.normals import (
+    ReliefFit,
+    fit_relief_scale,
+    normals_from_height,
+    sanitize_height,
+)
+from planner.objectives import (
+    HELD_OUT,
+    OBJECTIVES,
+    Candidates,
+    SurfaceSample,
+    candidates_for,
+    cast_shadow_visibility,
+    make_objective,
+)
+from planner.optimal import exchange_search
+from planner.topography import (
+    DepthModelSpec,
+    depth_from_onnx,
+    estimate_light,
+    given_light,
+    planning_image,
+    shape_from_shading,
+)
+from planner.uniform import order_nearest_neighbour, select_uniform_leds
+from rti_rig.errors import ScheduleError
+from rti_rig.geometry import az_el_from_direction, fibonacci_cap
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.schedule import LightSchedule
+
+METHODS: tuple[str, ...] = ("uniform", "kmeans", "optimal")
+
+#: The objective used when none is asked for (evidence in docs/planner.md).
+DEFAULT_OBJECTIVE = "normals"
+
+#: Extra elevation floors tried for the homogeneous starting layouts of ``optimal``.
+START_FLOORS_DEG = (10.0, 20.0, 30.0, 40.0)
+
+#: Pixels sampled for the objectives.
+SAMPLE_PIXELS = 256
+
+#: A preview with more than this fraction of clipped pixels carries no shading to read.
+MAX_SATURATED_FRACTION = 0.95
+
+ArmOrder = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.intp]]
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceEstimate:
+    """What one preview says about the surface, at planning resolution."""
+
+    image: NDArray[np.float64]
+    light: NDArray[np.float64]
+    light_source: str
+    relief_px: NDArray[np.float64]
+    normals: NDArray[np.float64]
+    fit: ReliefFit
+    relief_source: str
+    nonfinite_repaired: int
+    #: normals of the fitted relief before the trust shrinkage (what the paper's k-means sees)
+    fitted_normals: NDArray[np.float64] | None = None
+
+
+@dataclass
+class PlanReport:
+    """Evidence behind a plan, for the CLI to print and the session to keep."""
+
+    method: str
+    objective: str
+    n: int
+    rig: str
+    candidates: int
+    min_elevation_deg: float
+    preview_shape: tuple[int, ...] | None = None
+    planning_shape: tuple[int, ...] | None = None
+    preview_light_az_el_deg: tuple[float, float] | None = None
+    preview_light_source: str | None = None
+    relief_source: str | None = None
+    relief_scale: float | None = None
+    shading_explained_r2: float | None = None
+    rms_tilt_deg: float | None = None
+    p90_tilt_deg: float | None = None
+    highlight_hint: float | None = None
+    nonfinite_relief_repaired: int = 0
+    model: str | None = None
+    expected: dict[str, float] = field(default_factory=dict)
+    expected_meaning: str | None = None
+    start_layout: str | None = None
+    swaps: int | None = None
+    kmeans_distinct_normals: int | None = None
+    notes: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
+
+    def lines(self) -> list[str]:
+        """Human-readable summary, one fact per line."""
+        out = [f"method {self.method}, objective {self.objective}, {self.n} lights on {self.rig}"]
+        if self.preview_light_az_el_deg is not None:
+            az, el = self.preview_light_az_el_deg
+            out.append(f"preview light az {az:.1f}°, el {el:.1f}° ({self.preview_light_source})")
+        if self.relief_source:
+            out.append(
+                f"relief from {self.relief_source}: RMS tilt {self.rms_tilt_deg:.1f}°, "
+                f"90th percentile {self.p90_tilt_deg:.1f}°, shading explained "
+                f"R²={self.shading_explained_r2:.2f}"
+            )
+        if self.model:
+            out.append(f"relighting model assumed: {self.model}")
+        if self.expected and self.expected_meaning:
+            parts = ", ".join(f"{k} {v:.4g}" for k, v in self.expected.items())
+            out.append(f"{self.expected_meaning}: {parts}")
+        out.extend(self.notes)
+        out.append(f"planned in {self.seconds:.2f} s")
+        return out
+
+
+def relief_trust(fit: ReliefFit) -> float:
+    """How far to believe the fitted relief: the R² of the preview's shading fit, in [0, 1].
+
+    The relief's slopes are multiplied by it (shrinkage towards the flat surface, the prior of
+    RTI targets). On the real painted icon of the benchmark the unshrunk shape-from-shading
+    relief (R² ≈ 0.1) misled the planner into worse layouts than assuming a flat surface.
+    """
+    return float(np.clip(fit.explained, 0.0, 1.0))
+
+
+def estimate_surface(
+    preview: NDArray,
+    preview_light: tuple[float, float] | None = None,
+    depth_model: Path | None = None,
+    depth_spec: DepthModelSpec | None = None,
+) -> SurfaceEstimate:
+    """Steps 1–4 of the pipeline (see module docstring)."""
+    image = planning_image(preview)
+    peak = float(image.max()) if image.size else 0.0
+    if not peak > 1e-6:
+        raise ScheduleError(
+            "the preview is black: no light reached the sensor, so it says nothing about the "
+            "surface; retake it with a longer exposure or use --method uniform"
+        )
+    if float(np.mean(image >= 0.995)) > MAX_SATURATED_FRACTION:
+        raise ScheduleError(
+            "the preview is saturated almost everywhere, so its shading is lost; retake it "
+            "with a shorter exposure or use --method uniform"
+        )
+    if preview_light is not None:
+        light, light_source, albedo = given_light(preview_light), "given", None
+    else:
+        est = estimate_light(image)
+        light, light_source, albedo = est.direction, "estimated (Zheng-Chellappa)", None
+    if depth_model is not None:
+        raw = depth_from_onnx(preview, Path(depth_model), depth_spec, out_shape=image.shape)
+        source = f"depth model {Path(depth_model).name}"
+        height, bad = sanitize_height(raw, source)
+    else:
+        height, bad = shape_from_shading(image, light, albedo), 0
+        source = "shape from shading"
+    fit = fit_relief_scale(height, image, light)
+    # shrink the relief by the share of the preview it explains: a preview that is mostly
+    # albedo (a painting) must not be read as steep relief (see docs/planner.md)
+    relief = fit.scale * relief_trust(fit) * height
+    return SurfaceEstimate(
+        image, light, light_source, relief, normals_from_height(relief), fit, source, bad,
+        normals_from_height(fit.scale * height),
+    )
+
+
+def sample_surface(
+    surface: SurfaceEstimate,
+    candidates: Candidates,
+    held_out: NDArray[np.float64],
+    n_pixels: int = SAMPLE_PIXELS,
+    seed: int = 0,
+) -> SurfaceSample:
+    """A seeded pixel sample with cast-shadow maps for the candidates and held-out lights."""
+    h, w = surface.image.shape
+    rng = np.random.default_rng(seed)
+    count = min(n_pixels, h * w)
+    flat = rng.choice(h * w, count, replace=False)
+    rows, cols = np.divmod(flat, w)
+    normals = surface.normals.reshape(-1, 3)[flat]
+    lit_c = cast_shadow_visibility(surface.relief_px, rows, cols, candidates.directions)
+    lit_t = cast_shadow_visibility(surface.relief_px, rows, cols, held_out)
+    specular = float(np.clip(10.0 * (surface.fit.bright_outliers - 0.005), 0.0, 0.8))
+    return SurfaceSample(normals, np.ones(count), lit_c, held_out, lit_t, specular)
+
+
+def _tilt_stats(normals: NDArray[np.float64]) -> tuple[float, float]:
+    tilt = np.degrees(np.arccos(np.clip(normals[..., 2], -1.0, 1.0))).ravel()
+    return float(np.sqrt(np.mean(tilt**2))), float(np.percentile(tilt, 90))
+
+
+def _uniform_layouts(
+    geometry: DomeGeometry | ArmGeometry, n: int, floors: list[float]
+) -> tuple[list[tuple[str, NDArray[np.float64], NDArray[np.intp] | None]], str | None]:
+    """Homogeneous layouts (label, directions, dome LEDs) for each feasible floor."""
+    out: list[tuple[str, NDArray[np.float64], NDArray[np.intp] | None]] = []
+    first_error: str | None = None
+    for f in floors:
+        try:
+            if isinstance(geometry, DomeGeometry):
+                leds = select_uniform_leds(geometry, n, f)
+                out.append((f"uniform ≥{f:g}°", geometry.directions[leds], leds))
+            else:
+                lo = max(f, geometry.min_elevation_deg)
+                hi = min(geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
+                if lo >= hi:
+                    raise ScheduleError(
+                        f"elevation floor {f:g}° leaves no reachable band "
+                        f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
+                    )
+                out.append((f"uniform ≥{f:g}°", fibonacci_cap(n, lo, hi), None))
+        except ScheduleError as exc:
+            first_error = first_error or str(exc)
+    return out, first_error
+
+
+def _to_candidate_indices(
+    layout: tuple[str, NDArray[np.float64], NDArray[np.intp] | None],
+    candidates: Candidates,
+    offset: int,
+) -> NDArray[np.intp]:
+    _, dirs, leds = layout
+    if leds is not None and candidates.leds is not None:
+        where = {int(led): i for i, led in enumerate(candidates.leds)}
+        return np.array([where[int(i)] for i in leds], dtype=np.intp)
+    return np.arange(offset, offset + len(dirs), dtype=np.intp)
+
+
+def _schedule(
+    geometry: DomeGeometry | ArmGeometry,
+    candidates: Candidates,
+    chosen: NDArray[np.intp],
+    method: str,
+    provenance: dict[str, Any],
+    arm_order: ArmOrder | None,
+) -> LightSchedule:
+    dirs = candidates.directions[chosen]
+    if isinstance(geometry, DomeGeometry):
+        assert candidates.leds is not None
+        leds = candidates.leds[chosen]
+        order = np.argsort(leds, kind="stable")
+        return LightSchedule.from_directions(
+            dirs[order],
+            leds=[int(i) for i in leds[order]],
+            labels=[geometry.names[int(i)] for i in leds[order]],
+            method=method,
+            provenance=provenance,
+        )
+    orderer = arm_order or order_nearest_neighbour
+    order = np.asarray(orderer(dirs, geometry.park_direction), dtype=np.intp)
+    return LightSchedule.from_directions(dirs[order], method=method, provenance=provenance)
+
+
+def plan_with_report(
+    preview: NDArray | None,
+    geometry: DomeGeometry | ArmGeometry,
+    n: int,
+    method: str = "optimal",
+    objective: str = DEFAULT_OBJECTIVE,
+    preview_light: tuple[float, float] | None = None,
+    depth_model: Path | None = None,
+    min_elevation_deg: float = 0.0,
+    *,
+    depth_spec: DepthModelSpec | None = None,
+    arm_order: ArmOrder | None = None,
+    seed: int = 0,
+) -> tuple[LightSchedule, PlanReport]:
+    """The schedule and the evidence behind it; see :func:`make_plan`.
+
+    BLAS is held to one thread while planning: every matrix here is small (3 to 16 columns),
+    and a threaded BLAS on a busy machine made such products 40× slower, not faster.
+    """
+    with threadpool_limits(limits=1):
+        return _plan(
+            preview, geometry, n, method, objective, preview_light, depth_model,
+            min_elevation_deg, depth_spec, arm_order, seed,
+        )
+
+
+def _plan(
+    preview: NDArray | None,
+    geometry: DomeGeometry | ArmGeometry,
+    n: int,
+    method: str,
+    objective: str,
+    preview_light: tuple[float, float] | None,
+    depth_model: Path | None,
+    min_elevation_deg: float,
+    depth_spec: DepthModelSpec | None,
+    arm_order: ArmOrder | None,
+    seed: int,
+) -> tuple[LightSchedule, PlanReport]:
+    t0 = time.perf_counter()
+    if method not in METHODS:
+        raise ScheduleError(f"unknown method '{method}'; use one of {', '.join(METHODS)}")
+    if objective not in OBJECTIVES:
+        raise ScheduleError(f"unknown objective '{objective}'; use one of {', '.join(OBJECTIVES)}")
+    if n < 1:
+        raise ScheduleError(f"--lights must be at least 1, got {n}")
+    floors = [min_elevation_deg] + [f for f in START_FLOORS_DEG if f > min_elevation_deg]
+    uniforms, uniform_error = _uniform_layouts(geometry, n, floors)
+    if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
+        # the user's own floor must work; the extra floors are optional starting points
+        raise ScheduleError(uniform_error or "no homogeneous layout fits this rig")
+    extra = (
+        np.concatenate([u[1] for u in uniforms]) if isinstance(geometry, ArmGeometry) else None
+    )
+    candidates = candidates_for(geometry, min_elevation_deg, extra)
+    starts: list[tuple[str, NDArray[np.intp]]] = []
+    offset = 0
+    for u in uniforms:
+        starts.append((u[0], _to_candidate_indices(u, candidates, offset)))
+        offset += len(u[1])
+    rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
+    report = PlanReport(method, objective, n, rig, len(candidates), min_elevation_deg)
+    prov: dict[str, Any] = {"n": n, "min_elevation_deg": min_elevation_deg, "objective": objective}
+
+    if method != "uniform" and preview is None:
+        raise ScheduleError(
+            f"--method {method} plans from a preview shot; give one, or use --method uniform"
+        )
+    chosen = starts[0][1]
+    surface: SurfaceEstimate | None = None
+    if preview is not None:
+        try:
+            surface = estimate_surface(preview, preview_light, depth_model, depth_spec)
+        except ScheduleError as exc:
+            if method != "uniform":
+                raise
+            # the homogeneous layout does not need the preview: report, do not fail
+            report.notes.append(f"preview not evaluated: {exc}")
+    if surface is not None:
+        az, el = az_el_from_direction(surface.light)
+        report.preview_shape = tuple(np.asarray(preview).shape)
+        report.planning_shape = tuple(surface.image.shape)
+        report.preview_light_az_el_deg = (float(az), float(el))
+        report.preview_light_source = surface.light_source
+        report.relief_source = surface.relief_source
+        report.relief_scale = surface.fit.scale * relief_trust(surface.fit)
+        report.shading_explained_r2 = surface.fit.explained
+        report.rms_tilt_deg, report.p90_tilt_deg = _tilt_stats(surface.normals)
+        report.highlight_hint = surface.fit.bright_outliers
+        report.nonfinite_relief_repaired = surface.nonfinite_repaired
+        if surface.nonfinite_repaired:
+            report.notes.append(
+                f"{surface.nonfinite_repaired} NaN/infinite relief values were replaced by the "
+                "median"
+            )
+        _, cel = az_el_from_direction(candidates.directions)
+        lo, hi = float(cel.min()), float(cel.max())
+        held_out = fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)
+        sample = sample_surface(surface, candidates, held_out, seed=seed)
+        if method == "kmeans":
+            # the paper clusters the depth gradient's normals as they come: no shrinkage
+            raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
+            chosen, km = plan_kmeans(raw, n, candidates, seed)
+            report.kmeans_distinct_normals = km.distinct_normals
+            if km.distinct_normals < n:
+                report.notes.append(
+                    f"only {km.distinct_normals} distinct normals for {n} clusters: the "
+                    "remaining lights sit on the usable positions nearest the cluster centres"
+                )
+            starts.append(("kmeans", chosen))
+        obj = make_objective(objective, sample, candidates, n, starts[0][1])
+        report.model = getattr(obj, "model", "lambert (photometric stereo)")
+        report.expected_meaning = (
+            "expected RMS normal error (degrees)"
+            if objective == "normals"
+            else f"expected relighting MSE per unit albedo ({report.model})"
+        )
+        if method == "optimal":
+            res = exchange_search(obj, starts)
+            chosen = res.chosen
+            report.start_layout, report.swaps = res.start_label, res.swaps
+            report.expected.update(res.start_costs)
+            report.expected["optimal"] = res.cost
+        else:
+            report.expected[starts[0][0]] = obj.cost(starts[0][1])
+            if method == "kmeans":
+                report.expected["kmeans"] = obj.cost(chosen)
+    report.seconds = time.perf_counter() - t0
+    prov["report"] = report.to_dict()
+    schedule = _schedule(geometry, candidates, chosen, method, prov, arm_order)
+    return schedule, report
+
+
+def make_plan(
+    preview: NDArray | None,
+    geometry: DomeGeometry | ArmGeometry,
+    n: int,
+    method: str = "optimal",
+    objective: str = DEFAULT_OBJECTIVE,
+    preview_light: tuple[float, float] | None = None,
+    depth_model: Path | None = None,
+    min_elevation_deg: float = 0.0,
+) -> LightSchedule:
+    """An ordered schedule of ``n`` lights for ``geometry`` planned from one preview.
+
+    ``preview`` is an image (H, W) or (H, W, 3): uint8 is sRGB, uint16 and float are linear
+    (see :mod:`planner.topography`). It may be ``None`` only for ``method="uniform"``. Dome
+    steps carry LED indices and the dome's LED names as labels, in ascending LED order; arm
+    steps are ordered for short moves from the park pose. The evidence is in
+    ``schedule.provenance["report"]`` (or use :func:`plan_with_report`).
+    """
+    return plan_with_report(
+        preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg
+    )[0]

@@ -1,0 +1,430 @@
+"""What a light layout is worth for a given surface: the planner's two objectives.
+
+Everything here is evaluated over a *sample of the preview's normals* and a finite set of
+*candidate lights* (a dome's LEDs; a dense reachable set for an arm), so a layout is a set of
+candidate indices and its cost a number that can be compared and optimised.
+
+* ``normals`` — surface inspection and normal maps. The Cramér–Rao bound of the per-pixel
+  Lambertian least-squares fit (algorithms notes, section 3): ``E[θ²] = (σ/ρ)² tr(P M⁻¹ P)``
+  with ``M = Σ_k w_k l_k l_kᵀ`` over the lights that really reach the pixel and
+  ``P = I - n nᵀ``. The weights ``w_k`` remove attached shadows (soft, near-grazing light is
+  unreliable), cast shadows (marched over the preview's relief) and, when the preview shows
+  highlights, lights whose mirror direction points at the camera.
+* ``relight`` — interactive relighting with a linear basis (PTM or HSH). The expected
+  relighting error on held-out directions is bias² (how badly the basis, fitted on the chosen
+  lights, reproduces the surface's shadowed, possibly glossy reflectance) plus variance
+  (``σ² · mean_t a_tᵀ (AᵀA)⁻¹ a_t``, the noise propagation of the fit).
+
+The reflectance model (Lambert + shadows + an optional highlight lobe) is simple on purpose:
+it has to rank layouts, not render images.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+from rti_rig.errors import ScheduleError
+from rti_rig.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
+from rti_rig.reconstruct.bases import N_COEFFICIENTS, design_matrix
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+
+Objective = Literal["normals", "relight"]
+OBJECTIVES: tuple[str, ...] = ("normals", "relight")
+
+#: Image noise relative to albedo assumed by the bounds (≈ 34 dB): it sets the balance
+#: between the variance and bias terms of the relighting objective.
+NOISE_REL = 0.02
+
+#: Assumed RMS deviation of real reflectance from Lambert, relative to albedo, for the model
+#: bias term of the normals objective (chosen a priori, not fitted to any benchmark).
+BIAS_REL = 0.05
+
+#: Sampled normals used for the bias term (it varies smoothly with the normal).
+BIAS_PIXELS = 128
+
+#: Below this n·l a light is treated as (softly) shadowed: grazing light carries little signal
+#: and is where shadow boundaries, foreshortening and inter-reflections spoil the model.
+GRAZING_COS = 0.15
+
+#: Cap of the per-pixel squared angular error (rad²): an unobservable normal is "90° wrong".
+MAX_ERR2 = (np.pi / 2) ** 2
+
+#: Dense candidate count for an arm's continuous reachable band.
+ARM_CANDIDATES = 120
+
+#: Held-out directions for the relighting objective.
+HELD_OUT = 160
+
+#: Relighting models considered, with the light count each needs to be well determined
+#: (≥ 1.5× its coefficients, algorithms notes section 3: below that the fit over-fits).
+MODEL_MIN_LIGHTS = {"lambert": 3, "hsh1": 6, "ptm": 9, "hsh2": 14, "hsh3": 24}
+
+
+@dataclass(frozen=True, eq=False)
+class Candidates:
+    """Light directions the rig can use; ``leds[i]``/``names[i]`` when it is a dome."""
+
+    directions: NDArray[np.float64]
+    leds: NDArray[np.intp] | None
+    names: tuple[str, ...] | None
+
+    def __len__(self) -> int:
+        return len(self.directions)
+
+
+def candidates_for(
+    geometry: DomeGeometry | ArmGeometry,
+    min_elevation_deg: float = 0.0,
+    extra: NDArray[np.float64] | None = None,
+) -> Candidates:
+    """The rig's usable lights above the elevation floor (a dome's LEDs; an arm's dense band).
+
+    ``extra`` adds directions (e.g. a homogeneous layout) to an arm's set, so that a layout
+    computed elsewhere is exactly representable.
+    """
+    if isinstance(geometry, DomeGeometry):
+        _, el = az_el_from_direction(geometry.directions)
+        idx = np.flatnonzero(el >= min_elevation_deg - 1e-9)
+        if len(idx) == 0:
+            raise ScheduleError(
+                f"the dome has no LED at or above {min_elevation_deg:g}° elevation; "
+                "lower --min-elevation"
+            )
+        return Candidates(
+            geometry.directions[idx], idx.astype(np.intp), tuple(geometry.names[i] for i in idx)
+        )
+    lo = max(min_elevation_deg, geometry.min_elevation_deg)
+    hi = min(geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
+    if lo >= hi:
+        raise ScheduleError(
+            f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
+            f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
+        )
+    dense = fibonacci_cap(ARM_CANDIDATES, lo, hi)
+    if extra is not None and len(extra):
+        dense = np.concatenate([np.asarray(extra, dtype=np.float64).reshape(-1, 3), dense])
+    ok = [geometry.unreachable_reason(d) is None for d in dense]
+    return Candidates(dense[np.asarray(ok, dtype=bool)], None, None)
+
+
+def snap_unique(targets: NDArray[np.float64], candidates: Candidates) -> NDArray[np.intp]:
+    """Candidate indices for ``targets`` (one each, no repeats), minimising the total angle."""
+    if len(targets) > len(candidates):
+        raise ScheduleError(
+            f"asked for {len(targets)} lights but only {len(candidates)} are available"
+        )
+    cost = angle_between_deg(targets[:, None, :], candidates.directions[None, :, :])
+    rows, cols = linear_sum_assignment(cost)
+    out = np.empty(len(targets), dtype=np.intp)
+    out[rows] = cols
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceSample:
+    """What the planner knows of the surface: sampled normals, their weights, shadow maps.
+
+    ``lit_candidates[p, k]`` / ``lit_held_out[p, t]`` are 1 where light k / t reaches pixel p
+    without a cast shadow (from the preview's relief) and 0 where it is blocked;
+    ``specular`` (0..1) is the strength of the highlight lobe suggested by the preview.
+    """
+
+    normals: NDArray[np.float64]
+    weights: NDArray[np.float64]
+    lit_candidates: NDArray[np.float64]
+    held_out: NDArray[np.float64]
+    lit_held_out: NDArray[np.float64]
+    specular: float = 0.0
+
+
+def cast_shadow_visibility(
+    height_px: NDArray[np.float64],
+    rows: NDArray[np.intp],
+    cols: NDArray[np.intp],
+    directions: NDArray[np.float64],
+    max_steps: int = 32,
+) -> NDArray[np.float64]:
+    """1 where a light from ``directions[k]`` reaches pixel (rows[p], cols[p]), else 0.
+
+    Marches from each pixel towards the light over the relief (height in pixel units) and
+    reports a cast shadow when the terrain rises above the ray. Nearest-pixel lookups and a
+    bounded march: this ranks layouts, it does not render.
+    """
+    h, w = height_px.shape
+    d = np.asarray(directions, dtype=np.float64)
+    horiz = np.hypot(d[:, 0], d[:, 1])
+    step_x = np.where(horiz > 1e-9, d[:, 0] / np.maximum(horiz, 1e-9), 0.0)
+    step_y = np.where(horiz > 1e-9, d[:, 1] / np.maximum(horiz, 1e-9), 0.0)
+    rise = d[:, 2] / np.maximum(horiz, 1e-9)  # height gained per pixel travelled
+    t = np.arange(1, max_steps + 1, dtype=np.float64)
+    h0 = height_px[rows, cols]
+    vis = np.ones((len(rows), len(d)))
+    for k in range(len(d)):
+        if horiz[k] < 1e-6:
+            continue
+        cc = np.rint(cols[:, None] + t[None, :] * step_x[k]).astype(np.intp)
+        rr = np.rint(rows[:, None] - t[None, :] * step_y[k]).astype(np.intp)
+        inside = (cc >= 0) & (cc < w) & (rr >= 0) & (rr < h)
+        hh = height_px[np.clip(rr, 0, h - 1), np.clip(cc, 0, w - 1)]
+        ray = h0[:, None] + t[None, :] * rise[k]
+        vis[:, k] = ~np.any(inside & (hh > ray + 0.5), axis=1)
+    return vis
+
+
+def _attached(normals: NDArray, directions: NDArray) -> NDArray[np.float64]:
+    """Soft attached-shadow weight: 0 facing away, ramping to 1 past :data:`GRAZING_COS`."""
+    return np.clip((normals @ directions.T) / GRAZING_COS, 0.0, 1.0)
+
+
+def _highlight(normals: NDArray, directions: NDArray, width_deg: float) -> NDArray:
+    """Strength of a mirror highlight seen by the camera (+z) for each normal and light."""
+    half = directions + np.array([0.0, 0.0, 1.0])
+    half = half / np.linalg.norm(half, axis=-1, keepdims=True)
+    cos = np.clip(normals @ half.T, -1.0, 1.0)
+    return np.exp(-((np.degrees(np.arccos(cos)) / width_deg) ** 2))
+
+
+def light_weights(sample: SurfaceSample, directions: NDArray[np.float64]) -> NDArray:
+    """Per-pixel, per-light usefulness for the normal fit (P, K) — see module notes."""
+    w = _attached(sample.normals, directions) * sample.lit_candidates
+    if sample.specular > 0:
+        w = w * (1.0 - sample.specular * _highlight(sample.normals, directions, 15.0))
+    return w
+
+
+def reflectance(
+    sample: SurfaceSample, directions: NDArray[np.float64], lit: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Modelled radiance (P, K) per unit albedo: shadowed Lambert plus a highlight lobe."""
+    cos = np.clip(sample.normals @ directions.T, 0.0, None)
+    f = cos * lit
+    if sample.specular > 0:
+        f = f + sample.specular * _highlight(sample.normals, directions, 10.0) * lit * (cos > 0)
+    return f
+
+
+class NormalsObjective:
+    """Expected RMS normal error (degrees) of the Lambertian fit over the sample.
+
+    Two parts, per sampled normal ``n`` (unit albedo):
+
+    * variance — the Cramér–Rao bound ``σ² tr(P M⁻¹ P)`` with ``M = Σ w_k l_k l_kᵀ`` (module
+      notes);
+    * model bias — real surfaces are not Lambertian, and a sparse set of lights fits a
+      Lambertian normal that differs from the one the dense dome would give. The deviation
+      from Lambert is unknown from one preview, so it is modelled as a random smooth function
+      of the light direction, ``g(l) = Σ β_j h_j(l)`` over the 9 order-2 hemispherical
+      harmonics with independent ``β_j ~ N(0, τ²)``; the fitted ``b`` then moves by
+      ``(G_S - G_all) β`` with ``G = M⁻¹ Σ w_k l_k h_kᵀ``, whose expected squared tangential
+      size is ``τ² ‖P (G_S - G_all)‖²_F``. This favours layouts whose Lambertian fit agrees
+      with the fit on every usable light (the reference an RTI user compares against).
+    """
+
+    name = "normals"
+
+    #: Index pairs of the 6 distinct entries of a symmetric 3×3 (xx, xy, xz, yy, yz, zz).
+    PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+
+    def __init__(
+        self, sample: SurfaceSample, candidates: Candidates, bias_rel: float = BIAS_REL
+    ) -> None:
+        self.sample = sample
+        w = light_weights(sample, candidates.directions)  # (P, K)
+        d = candidates.directions
+        # information contributed by candidate k at pixel p, as the 6 distinct entries of
+        # w_pk l_k l_kᵀ: shape (6, K, P), contiguous per entry for fast batched swaps
+        self.outer = np.ascontiguousarray(
+            np.stack([w.T * (d[:, i] * d[:, j])[:, None] for i, j in self.PAIRS])
+        )
+        self.n = sample.normals
+        self.wts = sample.weights / sample.weights.sum()
+        self.tau2 = (bias_rel * np.sqrt(2 * np.pi / 9)) ** 2  # RMS deviation = bias_rel
+        # the bias term is smooth over normals: a sub-sample of the (random) pixels suffices
+        self.n_bias = min(len(self.n), BIAS_PIXELS)
+        wb = self.wts[: self.n_bias]
+        self.wts_bias = wb / wb.sum()
+        if self.tau2 > 0:
+            hsh = design_matrix("hsh2", d)  # (K, 9)
+            wsub = w[: self.n_bias]
+            # cross term w_pk l_k h_kᵀ as (3, K, P_bias, 9)
+            self.cross = np.ascontiguousarray(
+                d.T[:, :, None, None] * wsub.T[None, :, :, None] * hsh[None, :, None, :]
+            )
+            all_m = self.outer[..., : self.n_bias].sum(axis=1)  # (6, P_bias)
+            self.g_all = self._solve(all_m[:, None], self.cross.sum(axis=1)[:, None])[:, 0]
+
+    @staticmethod
+    def _adjugate(m: NDArray[np.float64]) -> tuple[tuple[NDArray, ...], NDArray]:
+        a, b, c, d, e, f = m[0] + 1e-9, m[1], m[2], m[3] + 1e-9, m[4], m[5] + 1e-9
+        c00, c11, c22 = d * f - e * e, a * f - c * c, a * d - b * b
+        c01, c02, c12 = c * e - b * f, b * e - c * d, b * c - a * e
+        det = a * c00 + b * c01 + c * c02
+        return (c00, c01, c02, c11, c12, c22), det
+
+    def _solve(self, m: NDArray, r: NDArray) -> NDArray[np.float64]:
+        """``M⁻¹ R`` for entries ``m`` (6, B, P) and ``r`` (3, B, P, 9) → (3, B, P, 9)."""
+        (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
+        inv_det = np.where(det > 1e-12, 1.0 / np.where(det > 1e-12, det, 1.0), 0.0)
+        rows = ((c00, c01, c02), (c01, c11, c12), (c02, c12, c22))
+        return np.stack(
+            [
+                (row[0][..., None] * r[0] + row[1][..., None] * r[1] + row[2][..., None] * r[2])
+                * inv_det[..., None]
+                for row in rows
+            ]
+        )
+
+    def _variance(self, m: NDArray[np.float64]) -> NDArray:
+        """Squared angular error (rad²) of noise from information entries ``m`` (6, B, P)."""
+        # closed-form adjugate of the symmetric 3×3 (batched np.linalg.inv is ~20× slower):
+        # tr(P M⁻¹ P) = tr(M⁻¹) - nᵀ M⁻¹ n with P = I - n nᵀ
+        (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
+        x, y, z = self.n[:, 0], self.n[:, 1], self.n[:, 2]
+        quad = (
+            c00 * x * x + c11 * y * y + c22 * z * z
+            + 2 * (c01 * x * y + c02 * x * z + c12 * y * z)
+        )
+        ok = det > 1e-12
+        err2 = NOISE_REL**2 * (c00 + c11 + c22 - quad) / np.where(ok, det, 1.0)
+        return np.clip(np.where(ok, err2, MAX_ERR2), 0.0, MAX_ERR2)
+
+    def _bias(self, m: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray:
+        """Expected squared tangential bias (rad²) on the first pixels, (B, P_bias)."""
+        nb = self.n[: self.n_bias]
+        delta = self._solve(m, r) - self.g_all[:, None]  # (3, B, P_bias, 9)
+        along = nb[:, 0, None] * delta[0] + nb[:, 1, None] * delta[1] + nb[:, 2, None] * delta[2]
+        tang = np.sum(delta * delta, axis=(0, -1)) - np.sum(along * along, axis=-1)
+        return np.clip(self.tau2 * tang, 0.0, MAX_ERR2)
+
+    def _total(self, m: NDArray[np.float64], r: NDArray | None) -> NDArray[np.float64]:
+        """RMS error in degrees for batched information ``m`` (6, B, P) and cross terms ``r``."""
+        err2 = self._variance(m) @ self.wts
+        if r is not None:
+            err2 = err2 + self._bias(m[..., : self.n_bias], r) @ self.wts_bias
+        return np.degrees(np.sqrt(err2))
+
+    def cost(self, chosen: NDArray[np.intp]) -> float:
+        m = self.outer[:, chosen].sum(axis=1)[:, None]  # (6, 1, P)
+        r = self.cross[:, chosen].sum(axis=1)[:, None] if self.tau2 > 0 else None
+        return float(self._total(m, r)[0])
+
+    def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
+        """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch."""
+        base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
+        r = None
+        if self.tau2 > 0:
+            rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
+            r = rb[:, None] + self.cross  # (3, K, P_bias, 9)
+        return self._total(base[:, None, :] + self.outer, r)
+
+    def describe(self, value: float) -> str:
+        return f"expected RMS normal error {value:.2f}° at {100 * NOISE_REL:g}% noise"
+
+
+def models_for(n: int) -> list[str]:
+    """Relighting bases that ``n`` lights can determine (see :data:`MODEL_MIN_LIGHTS`)."""
+    ok = [m for m, k in MODEL_MIN_LIGHTS.items() if n >= k and m != "lambert"]
+    return ok or ["lambert"]
+
+
+class RelightObjective:
+    """Expected relighting MSE (per unit albedo) on held-out directions, for a basis.
+
+    For coefficients ``c`` fitted on the chosen lights the held-out bias is
+    ``mean_t (a_tᵀ c - f_t)² = cᵀ G c - 2 cᵀ h + k`` with ``G = A_Tᵀ A_T / T``,
+    ``h = A_Tᵀ f / T`` and ``k = mean f_t²``, so no held-out image is ever rendered.
+
+    As for normals, real reflectance deviates from the model in ways one preview cannot show;
+    the deviation is modelled as a random smooth function (order-3 hemispherical harmonics,
+    RMS :data:`BIAS_REL` of albedo) and its expected held-out error after the basis is fitted on
+    the chosen lights is added: ``τ² ‖A_T (A_SᵀA_S)⁻¹ A_Sᵀ H_S - H_T‖²_F / T``. It rewards
+    layouts whose fit generalises over the whole hemisphere.
+    """
+
+    name = "relight"
+
+    def __init__(
+        self, sample: SurfaceSample, candidates: Candidates, model: str,
+        bias_rel: float = BIAS_REL,
+    ) -> None:
+        if model not in N_COEFFICIENTS:
+            raise ValueError(f"unknown relighting model '{model}'")
+        self.model = model
+        self.sample = sample
+        self.a_cand = design_matrix(model, candidates.directions)  # (K, p)
+        a_test = design_matrix(model, sample.held_out)  # (T, p)
+        f_test = reflectance(sample, sample.held_out, sample.lit_held_out)  # (P, T)
+        t = len(a_test)
+        self.gram = a_test.T @ a_test / t  # (p, p)
+        self.h = f_test @ a_test / t  # (P, p)
+        self.k = np.mean(f_test * f_test, axis=1)  # (P,)
+        self.f_cand = reflectance(sample, candidates.directions, sample.lit_candidates)  # (P, K)
+        self.wts = sample.weights / sample.weights.sum()
+        self.a_test = a_test
+        self.dev_cand = design_matrix("hsh3", candidates.directions)  # (K, 16)
+        self.dev_test = design_matrix("hsh3", sample.held_out)  # (T, 16)
+        self.tau2 = bias_rel**2 * 2 * np.pi / 16  # RMS deviation over the hemisphere = bias_rel
+
+    def _costs(
+        self, a: NDArray[np.float64], f: NDArray[np.float64], dev: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Costs of batched layouts: design ``a`` (B, N, p), reflectance ``f`` (B, P, N),
+        deviation basis ``dev`` (B, N, 16) at the chosen lights."""
+        p = a.shape[-1]
+        ata = np.swapaxes(a, 1, 2) @ a + 1e-8 * np.eye(p)
+        inv = np.linalg.inv(ata)  # (B, p, p)
+        fit = a @ inv  # (B, N, p)
+        coef = f @ fit  # (B, P, p)
+        bias2 = np.sum(coef * (coef @ self.gram - 2 * self.h[None]), axis=-1) + self.k[None]
+        var = NOISE_REL**2 * np.einsum("ij,bji->b", self.gram, inv)
+        miss = self.a_test @ (np.swapaxes(fit, 1, 2) @ dev) - self.dev_test  # (B, T, 16)
+        unmodelled = self.tau2 * np.mean(np.sum(miss * miss, axis=-1), axis=-1)
+        return np.clip(bias2, 0.0, None) @ self.wts + var + unmodelled
+
+    def cost(self, chosen: NDArray[np.intp]) -> float:
+        a = self.a_cand[chosen][None]
+        f = self.f_cand[:, chosen][None]
+        return float(self._costs(a, f, self.dev_cand[chosen][None])[0])
+
+    def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
+        k = len(self.a_cand)
+        a = np.repeat(self.a_cand[chosen][None], k, axis=0)
+        a[:, position] = self.a_cand
+        f = np.repeat(self.f_cand[:, chosen][None], k, axis=0)
+        f[:, :, position] = self.f_cand.T
+        dev = np.repeat(self.dev_cand[chosen][None], k, axis=0)
+        dev[:, position] = self.dev_cand
+        out = np.full(k, np.inf)
+        for lo in range(0, k, 64):  # bounded memory on large arm candidate sets
+            sl = slice(lo, min(k, lo + 64))
+            with np.errstate(all="ignore"):
+                out[sl] = self._costs(a[sl], f[sl], dev[sl])
+        return np.where(np.isfinite(out), out, np.inf)
+
+    def describe(self, value: float) -> str:
+        psnr = -10 * np.log10(max(value, 1e-12))
+        return f"expected relighting error {psnr:.1f} dB PSNR ({self.model.upper()})"
+
+
+def make_objective(
+    objective: str, sample: SurfaceSample, candidates: Candidates, n: int, start: NDArray[np.intp]
+) -> NormalsObjective | RelightObjective:
+    """The objective to optimise; for ``relight`` the basis that ``start`` fits best is chosen."""
+    if objective == "normals":
+        return NormalsObjective(sample, candidates)
+    if objective == "relight":
+        best: RelightObjective | None = None
+        best_cost = float("inf")
+        for model in models_for(n):
+            obj = RelightObjective(sample, candidates, model)
+            c = obj.cost(start)
+            if c < best_cost:
+                best, best_cost = obj, c
+        assert best is not None
+        return best
+    raise ScheduleError(f"unknown objective '{objective}'; use one of {', '.join(OBJECTIVES)}")

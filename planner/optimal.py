@@ -1,0 +1,76 @@
+"""The "optimal" method: exchange search over the rig's lights for the chosen objective.
+
+Design of experiments, not clustering: the lights that minimise the expected reconstruction
+error over the preview's normals (:mod:`planner.objectives`: Cramér–Rao bound of the Lambertian
+fit with attached/cast shadows and highlights removed, or relighting bias² + variance for the
+basis the light count supports). The search is a Fedorov-style exchange: start from the best of
+several layouts that need no preview (homogeneous layouts with different elevation floors, plus
+the k-means layout when given), then sweep over the chosen lights, replacing each by the
+unused candidate that lowers the cost most (if any does), until a sweep changes nothing.
+
+Because the starting set includes the homogeneous layout the user would otherwise get and only
+improving swaps are accepted, the result is never worse than that layout *on the objective
+being optimised* — which is a statement about the model, not about the real surface; the
+real-data benchmark (docs/planner.md) is where that is checked.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planner.objectives import NormalsObjective, RelightObjective
+
+#: At most this many sweeps over the chosen lights (a bound on run time; rarely reached).
+MAX_PASSES = 4
+
+
+@dataclass(frozen=True)
+class ExchangeResult:
+    """The chosen candidate indices, their cost, the start's cost and the accepted swaps."""
+
+    chosen: NDArray[np.intp]
+    cost: float
+    start_cost: float
+    start_label: str
+    swaps: int
+    start_costs: dict[str, float] = field(default_factory=dict)
+
+
+def exchange_search(
+    objective: NormalsObjective | RelightObjective,
+    starts: Sequence[tuple[str, NDArray[np.intp]]],
+    max_passes: int | None = None,
+) -> ExchangeResult:
+    """Exchange search from the cheapest of ``starts`` (label, candidate indices).
+
+    Sweeps over the chosen lights; at each, the best replacement among the unused candidates is
+    taken if it lowers the cost. Stops after a sweep without a change (a local optimum for
+    single swaps) or :data:`MAX_PASSES` sweeps.
+    """
+    if not starts:
+        raise ValueError("exchange search needs at least one starting layout")
+    costs = {label: objective.cost(np.asarray(s, dtype=np.intp)) for label, s in starts}
+    label, first = min(starts, key=lambda ls: costs[ls[0]])
+    chosen = np.asarray(first, dtype=np.intp).copy()
+    cost = costs[label]
+    n = len(chosen)
+    limit = max_passes if max_passes is not None else MAX_PASSES
+    swaps = 0
+    for _ in range(limit):
+        changed = False
+        for pos in range(n):
+            trial = objective.swap_costs(chosen, pos)
+            trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
+            k = int(np.argmin(trial))
+            if float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):
+                chosen[pos] = k
+                cost = objective.cost(chosen)
+                swaps += 1
+                changed = True
+        if not changed:
+            break
+    return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)
