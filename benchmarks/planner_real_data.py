@@ -95,7 +95,11 @@ def relight_model(images: np.ndarray, lights: np.ndarray, model: str):
 
 
 def evaluate(
-    leds: np.ndarray, images: np.ndarray, dirs: np.ndarray, ref: np.ndarray, mask: np.ndarray,
+    leds: np.ndarray,
+    images: np.ndarray,
+    dirs: np.ndarray,
+    ref: np.ndarray,
+    mask: np.ndarray,
     model: str,
 ) -> tuple[float, float, bool]:
     leds = np.asarray(sorted(int(i) for i in leds))
@@ -161,8 +165,10 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
     band = np.flatnonzero((el >= 40.0) & (el <= 62.0))
     band = band[np.argsort(el[band])]
     previews = band[np.linspace(0, len(band) - 1, n_previews).round().astype(int)]
-    print(f"reference: robust PS on 72 lights, {int(mask.sum())} masked pixels; previews "
-          + ", ".join(f"{dome.names[p]} (el {el[p]:.0f}°)" for p in previews))
+    print(
+        f"reference: robust PS on 72 lights, {int(mask.sum())} masked pixels; previews "
+        + ", ".join(f"{dome.names[p]} (el {el[p]:.0f}°)" for p in previews)
+    )
 
     table: list[str] = []
     wins: dict[str, list[int]] = {}
@@ -186,8 +192,10 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
         bar_err = min(scores[k][0] for k in list(scores)[:2])
         bar_psnr = max(scores[k][1] for k in list(scores)[:2])
         for label, (err, psnr, fb) in scores.items():
-            table.append(f"| {n} | {label}{' *' if fb else ''} | {err:.2f} | — | {psnr:.2f} "
-                         f"| — | {model.upper()} | — |")
+            table.append(
+                f"| {n} | {label}{' *' if fb else ''} | {err:.2f} | — | {psnr:.2f} "
+                f"| — | {model.upper()} | — |"
+            )
             print(f"N={n:2d} {label:40s} normal error {err:6.2f}°  relight {psnr:6.2f} dB")
         for label, method, objective, given in PLANNED:
             errs, psnrs, secs, fbs = [], [], [], 0
@@ -210,10 +218,12 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
                 f"({w_err}/{len(e)}) | {np.median(q):.2f} | {q.min():.2f}–{q.max():.2f} "
                 f"({w_psnr}/{len(q)}) | {model.upper()} | {np.median(secs):.2f} |"
             )
-            print(f"N={n:2d} {label:40s} normal error median {np.median(e):6.2f}° "
-                  f"[{e.min():.2f}, {e.max():.2f}] beats bar {w_err}/{len(e)}; relight "
-                  f"{np.median(q):6.2f} dB [{q.min():.2f}, {q.max():.2f}] beats bar "
-                  f"{w_psnr}/{len(q)}")
+            print(
+                f"N={n:2d} {label:40s} normal error median {np.median(e):6.2f}° "
+                f"[{e.min():.2f}, {e.max():.2f}] beats bar {w_err}/{len(e)}; relight "
+                f"{np.median(q):6.2f} dB [{q.min():.2f}, {q.max():.2f}] beats bar "
+                f"{w_psnr}/{len(q)}"
+            )
             sys.stdout.flush()
 
     lines = [

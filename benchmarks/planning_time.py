@@ -55,8 +55,10 @@ def main() -> str:
     for rig_name, geometry in (("72-LED dome", dome), ("arm", arm)):
         for n in (9, 18):
             for method, objective in (
-                ("uniform", "normals"), ("kmeans", "normals"),
-                ("optimal", "normals"), ("optimal", "relight"),
+                ("uniform", "normals"),
+                ("kmeans", "normals"),
+                ("optimal", "normals"),
+                ("optimal", "relight"),
             ):
                 med = median_s(
                     lambda g=geometry, n=n, m=method, o=objective: plan_with_report(
@@ -67,7 +69,8 @@ def main() -> str:
                 print(f"{rig_name:12s} N={n:2d} {method:8s} {objective:8s} median {med:.3f} s")
     print(f"downsample + linearise 24 MP: median {prep:.3f} s")
     lines = [
-        "Command: `python -m benchmarks.planning_time`. " + machine_line()
+        "Command: `python -m benchmarks.planning_time`. "
+        + machine_line()
         + f" os.cpu_count() = {os.cpu_count()}; median of {REPEATS} runs each.",
         "",
         "Planning from a 6000×4000 uint8 sRGB preview with the weight-free path (shape from "

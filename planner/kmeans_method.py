@@ -46,41 +46,25 @@ KMEANS_RESTARTS = 3
 KMEANS_ITERATIONS = 60
 
 
-def lloyd_kmeans(
-    points: NDArray[np.float64], k: int, rng: np.random.Generator
+def sklearn_kmeans(
+    points: NDArray[np.float64], k: int, seed: int
 ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    """Plain k-means as the paper describes it: random initial centroids, assign, re-average.
+    """k-means with scikit-learn, as the paper uses it: Lloyd's algorithm, restarts.
 
-    Written out in numpy rather than calling scikit-learn: for 3-D points and k ≤ a few hundred
-    it is the same algorithm and several times faster than sklearn's threaded version here.
-    Empty clusters are re-seeded at the point farthest from its centroid.
+    Random initial centroids (``init="random"``, the paper's description) with
+    ``KMEANS_RESTARTS`` restarts; the lowest inertia wins. Callers hold BLAS/OpenMP to one thread
+    (``threadpool_limits``): on a busy 2-core machine threads only cost here.
     """
-    best: tuple[float, NDArray[np.float64], NDArray[np.intp]] | None = None
-    sq = np.sum(points * points, axis=1)
-    for _ in range(KMEANS_RESTARTS):
-        centres = points[rng.choice(len(points), k, replace=False)].copy()
-        labels = np.zeros(len(points), dtype=np.intp)
-        for it in range(KMEANS_ITERATIONS):
-            d2 = sq[:, None] - 2 * np.einsum("pi,ki->pk", points, centres)
-            d2 += np.sum(centres * centres, axis=1)[None]
-            new = np.argmin(d2, axis=1)
-            if it and np.array_equal(new, labels):
-                break
-            labels = new
-            counts = np.bincount(labels, minlength=k)
-            sums = np.stack(
-                [np.bincount(labels, weights=points[:, j], minlength=k) for j in range(3)], axis=1
-            )
-            empty = counts == 0
-            centres[~empty] = sums[~empty] / counts[~empty, None]
-            if np.any(empty):
-                far = np.argsort(-d2[np.arange(len(points)), labels])[: int(empty.sum())]
-                centres[empty] = points[far]
-        inertia = float(np.sum((points - centres[labels]) ** 2))
-        if best is None or inertia < best[0]:
-            best = (inertia, centres, labels)
-    assert best is not None
-    return best[1], best[2]
+    from sklearn.cluster import KMeans
+
+    km = KMeans(
+        n_clusters=k,
+        init="random",
+        n_init=KMEANS_RESTARTS,
+        max_iter=KMEANS_ITERATIONS,
+        random_state=seed,
+    ).fit(points)
+    return km.cluster_centers_.astype(np.float64), km.labels_.astype(np.intp)
 
 
 def cluster_normals(normals: NDArray[np.float64], k: int, seed: int = 0) -> KMeansResult:
@@ -93,11 +77,9 @@ def cluster_normals(normals: NDArray[np.float64], k: int, seed: int = 0) -> KMea
     kk = int(min(k, len(distinct)))
     if kk == len(distinct):
         centres = distinct
-        labels = np.argmin(
-            np.linalg.norm(pts[:, None, :] - distinct[None, :, :], axis=-1), axis=1
-        )
+        labels = np.argmin(np.linalg.norm(pts[:, None, :] - distinct[None, :, :], axis=-1), axis=1)
     else:
-        centres, labels = lloyd_kmeans(pts, kk, rng)
+        centres, labels = sklearn_kmeans(pts, kk, seed)
     shares = np.bincount(labels, minlength=kk) / len(pts)
     norm = np.linalg.norm(centres, axis=1, keepdims=True)
     centres = np.where(norm > 1e-9, centres / np.maximum(norm, 1e-9), [0.0, 0.0, 1.0])

@@ -194,7 +194,14 @@ def estimate_surface(
     # albedo (a painting) must not be read as steep relief (see docs/planner.md)
     relief = fit.scale * relief_trust(fit) * height
     return SurfaceEstimate(
-        image, light, light_source, relief, normals_from_height(relief), fit, source, bad,
+        image,
+        light,
+        light_source,
+        relief,
+        normals_from_height(relief),
+        fit,
+        source,
+        bad,
         normals_from_height(fit.scale * height),
     )
 
@@ -307,8 +314,17 @@ def plan_with_report(
     """
     with threadpool_limits(limits=1):
         return _plan(
-            preview, geometry, n, method, objective, preview_light, depth_model,
-            min_elevation_deg, depth_spec, arm_order, seed,
+            preview,
+            geometry,
+            n,
+            method,
+            objective,
+            preview_light,
+            depth_model,
+            min_elevation_deg,
+            depth_spec,
+            arm_order,
+            seed,
         )
 
 
@@ -337,9 +353,7 @@ def _plan(
     if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
         # the user's own floor must work; the extra floors are optional starting points
         raise ScheduleError(uniform_error or "no homogeneous layout fits this rig")
-    extra = (
-        np.concatenate([u[1] for u in uniforms]) if isinstance(geometry, ArmGeometry) else None
-    )
+    extra = np.concatenate([u[1] for u in uniforms]) if isinstance(geometry, ArmGeometry) else None
     candidates = candidates_for(geometry, min_elevation_deg, extra)
     starts: list[tuple[str, NDArray[np.intp]]] = []
     offset = 0

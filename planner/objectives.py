@@ -286,8 +286,7 @@ class NormalsObjective:
         (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
         x, y, z = self.n[:, 0], self.n[:, 1], self.n[:, 2]
         quad = (
-            c00 * x * x + c11 * y * y + c22 * z * z
-            + 2 * (c01 * x * y + c02 * x * z + c12 * y * z)
+            c00 * x * x + c11 * y * y + c22 * z * z + 2 * (c01 * x * y + c02 * x * z + c12 * y * z)
         )
         ok = det > 1e-12
         err2 = NOISE_REL**2 * (c00 + c11 + c22 - quad) / np.where(ok, det, 1.0)
@@ -349,7 +348,10 @@ class RelightObjective:
     name = "relight"
 
     def __init__(
-        self, sample: SurfaceSample, candidates: Candidates, model: str,
+        self,
+        sample: SurfaceSample,
+        candidates: Candidates,
+        model: str,
         bias_rel: float = BIAS_REL,
     ) -> None:
         if model not in N_COEFFICIENTS:

@@ -234,11 +234,30 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
         raise typer.Exit(code=130)
 
 
+def _parse_az_el(text: str | None) -> tuple[float, float] | None:
+    """``"AZ,EL"`` in degrees → a pair; a clear error otherwise."""
+    if text is None:
+        return None
+    parts = text.replace(" ", "").split(",")
+    try:
+        az, el = (float(p) for p in parts)
+    except ValueError:
+        raise RtiRigError(
+            f"--preview-light {text!r}: give azimuth and elevation in degrees as AZ,EL (e.g. 45,30)"
+        ) from None
+    if not 0.0 <= el <= 90.0:
+        raise RtiRigError(f"--preview-light elevation {el:g}° is outside 0..90°")
+    return az, el
+
+
 @app.command()
 def plan(
     preview: Annotated[
         Path | None,
-        typer.Argument(help="Preview image (not needed by the 'uniform' method)."),
+        typer.Argument(
+            help="One preview image of the object (JPEG/PNG = sRGB, 16-bit TIFF = linear). "
+            "Not needed by the 'uniform' method."
+        ),
     ] = None,
     rig: Annotated[
         Path,
@@ -248,7 +267,39 @@ def plan(
         ),
     ] = Path("rig_configs/simulated_dome.toml"),
     lights: Annotated[int, typer.Option("--lights", help="Number of lights to plan.")] = 12,
-    method: Annotated[str, typer.Option("--method", help="Planning method: uniform.")] = "uniform",
+    method: Annotated[
+        str | None,
+        typer.Option(
+            "--method",
+            help="uniform (homogeneous, no preview), kmeans (the paper's: k-means on the "
+            "preview's normals) or optimal (least expected error for the objective). "
+            "Default: optimal with a preview, uniform without.",
+        ),
+    ] = None,
+    objective: Annotated[
+        str | None,
+        typer.Option(
+            "--objective",
+            help="What the session is for: normals (surface inspection, normal maps; default) "
+            "or relight (interactive relighting with PTM/HSH).",
+        ),
+    ] = None,
+    preview_light: Annotated[
+        str | None,
+        typer.Option(
+            "--preview-light",
+            help="Azimuth,elevation of the preview's light in degrees (frame of the .lp files); "
+            "estimated from the image when omitted.",
+        ),
+    ] = None,
+    depth_model: Annotated[
+        Path | None,
+        typer.Option(
+            "--depth-model",
+            help="A monocular depth network (.onnx, MiDaS / Depth Anything / LeReS style) to "
+            "estimate the relief; without it, shape from shading is used.",
+        ),
+    ] = None,
     min_elevation_deg: Annotated[
         float, typer.Option("--min-elevation-deg", help="Lowest elevation allowed (degrees).")
     ] = 0.0,
@@ -259,26 +310,58 @@ def plan(
         bool, typer.Option("--force", help="Overwrite an existing plan file.")
     ] = False,
 ) -> None:
-    """Plan an ordered set of lights for a rig and write it as an .lp file."""
-    from planner.uniform import plan_uniform
+    """Plan an ordered set of lights from one preview shot and write it as an .lp file.
+
+    The plan's lights are the rig's own (a dome's LEDs, used once each; an arm's reachable
+    directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.
+    """
+    from planner.make_plan import DEFAULT_OBJECTIVE, METHODS, plan_with_report
+    from planner.objectives import OBJECTIVES
+    from planner.topography import read_preview
+    from rti_rig.compose import arm_order_for
     from rti_rig.config import load_rig_config, rig_geometry
     from rti_rig.lp_format import LpEntry, read_lp, write_lp
     from rti_rig.rig_geometry import DomeGeometry
     from rti_rig.session import image_names
 
-    if method != "uniform":
-        raise _fail(RtiRigError(f"--method {method!r} is not available; use 'uniform'"))
     try:
+        method = method or ("optimal" if preview is not None else "uniform")
+        if method not in METHODS:
+            raise RtiRigError(f"--method {method!r} is not known; choose {', '.join(METHODS)}")
+        objective = objective or DEFAULT_OBJECTIVE
+        if objective not in OBJECTIVES:
+            raise RtiRigError(
+                f"--objective {objective!r} is not known; choose {', '.join(OBJECTIVES)}"
+            )
+        if method != "uniform" and preview is None:
+            raise RtiRigError(f"--method {method} plans from a preview image: give PREVIEW")
+        if depth_model is not None and not depth_model.is_file():
+            raise RtiRigError(f"--depth-model {depth_model}: file not found")
+        az_el = _parse_az_el(preview_light)
+        arm_order = None
         if rig.suffix.lower() == ".lp":
             entries = read_lp(rig)
             geometry: object = DomeGeometry(
                 [e.direction for e in entries], tuple(e.name for e in entries)
             )
         else:
-            geometry = rig_geometry(load_rig_config(rig))
-        schedule = plan_uniform(geometry, lights, min_elevation_deg)  # type: ignore[arg-type]
+            loaded = load_rig_config(rig)
+            geometry = rig_geometry(loaded)
+            arm_order = arm_order_for(loaded)
         if out_file.exists() and not force:
             raise RtiRigError(f"{out_file} exists; use --force to replace it")
+        image = read_preview(preview) if preview is not None else None
+        schedule, report = plan_with_report(
+            image,
+            geometry,  # type: ignore[arg-type]
+            lights,
+            method,
+            objective,
+            preview_light=az_el,
+            depth_model=depth_model,
+            min_elevation_deg=min_elevation_deg,
+            arm_order=arm_order,
+        )
         if rig.suffix.lower() == ".lp":
             names = [s.label for s in schedule.steps]
         else:
@@ -288,7 +371,9 @@ def plan(
         )
     except RtiRigError as exc:
         raise _fail(exc) from None
-    out.print(f"Planned {len(schedule)} lights ({method}) → {out_file}")
+    for line in report.lines():
+        out.print(line, highlight=False)
+    out.print(f"Planned {len(schedule)} lights ({method}, {objective}) → {out_file}")
 
 
 @app.command("export-lp")

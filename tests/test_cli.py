@@ -125,7 +125,7 @@ def test_plan_on_bare_lp_keeps_original_names(tmp_path: Path) -> None:
         (["run", "{tmp}/missing.toml", "--out", "{tmp}/s"], "cannot read the file"),
         (["run", "{cfg}", "--out", "{tmp}/s", "--plan", "{tmp}/bad.lp"], "bad.lp, line 2"),
         (["export-lp", "{tmp}", "--out", "{tmp}/x.lp"], "not an rti-rig session folder"),
-        (["plan", "--rig", "{cfg}", "--method", "magic", "--out", "{tmp}/p.lp"], "not available"),
+        (["plan", "--rig", "{cfg}", "--method", "magic", "--out", "{tmp}/p.lp"], "is not known"),
     ],
 )
 def test_errors_are_one_clear_line(tmp_path: Path, args: list[str], fragment: str) -> None:
@@ -163,3 +163,103 @@ def test_ci_runs_the_readme_test_command() -> None:
     ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
     assert commands[1] in ci
     assert commands[0].replace(" || exit 1", "") in ci
+
+
+@pytest.mark.parametrize("method", ["optimal", "kmeans"])
+def test_plan_from_a_real_preview_on_a_bare_lp(tmp_path: Path, method: str) -> None:
+    """The issue's CLI contract on real data: a preview of the 72-LED dome, its own .lp."""
+    src = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    preview = REPO / "tests" / "data" / "neuralrti" / "image11_small.jpg"
+    plan = tmp_path / "p.lp"
+    az, el = az_el_from_direction(read_lp(src)[10].direction)
+    args = [
+        "plan",
+        str(preview),
+        "--rig",
+        str(src),
+        "--lights",
+        "9",
+        "--method",
+        method,
+        "--preview-light",
+        f"{float(az):.3f},{float(el):.3f}",
+        "--out",
+        str(plan),
+    ]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    chosen = read_lp(plan)
+    originals = {e.name: e.direction for e in read_lp(src)}
+    assert len(chosen) == 9 and len({e.name for e in chosen}) == 9
+    for e in chosen:
+        np.testing.assert_allclose(e.direction, originals[e.name], atol=1e-6)
+    assert f"method {method}" in r.output
+
+
+def test_preview_shot_then_plan_then_run(tmp_path: Path) -> None:
+    """The product's loop: one preview shot on the rig, a plan from it, the session."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    shot = tmp_path / "preview"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(shot), "--lights", "1"])
+    assert r.exit_code == 0, r.output
+    preview_light = read_lp(shot / "lights.lp")[0].direction
+    az, el = az_el_from_direction(preview_light)
+    plan = tmp_path / "plan.lp"
+    r = runner.invoke(
+        app,
+        [
+            "plan",
+            str(shot / "linear" / "image_001.tif"),
+            "--rig",
+            str(cfg),
+            "--lights",
+            "6",
+            "--preview-light",
+            f"{float(az)},{float(el)}",
+            "--out",
+            str(plan),
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--plan", str(plan)])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(out / "lights.lp")) == 6
+
+
+@pytest.mark.parametrize(
+    ("extra", "fragment"),
+    [
+        (["--preview-light", "north"], "give azimuth and elevation"),
+        (["--preview-light", "10,95"], "outside 0..90"),
+        (["--objective", "beauty"], "--objective 'beauty' is not known"),
+        (["--depth-model", "{tmp}/none.onnx"], "file not found"),
+    ],
+)
+def test_plan_option_errors(tmp_path: Path, extra: list[str], fragment: str) -> None:
+    preview = REPO / "tests" / "data" / "neuralrti" / "image11_small.jpg"
+    args = [
+        "plan",
+        str(preview),
+        "--rig",
+        str(REPO / "tests" / "data" / "neuralrti" / "dirs.lp"),
+        "--out",
+        str(tmp_path / "p.lp"),
+        *[a.format(tmp=tmp_path) for a in extra],
+    ]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 2, r.output
+    assert fragment in " ".join(r.output.split())
+    r = runner.invoke(
+        app,
+        [
+            "plan",
+            "--rig",
+            str(REPO / "tests" / "data" / "neuralrti" / "dirs.lp"),
+            "--method",
+            "kmeans",
+            "--out",
+            str(tmp_path / "q.lp"),
+        ],
+    )
+    assert r.exit_code == 2 and "give PREVIEW" in r.output

@@ -62,11 +62,14 @@ def test_every_method_on_a_dome(method: str, objective: str, n: int) -> None:
 
 
 @pytest.mark.parametrize("method", METHODS)
-@pytest.mark.parametrize(("n", "objective"), [(1, "normals"), (2, "relight"), (3, "normals"),
-                                              (7, "relight"), (7, "normals")])
+@pytest.mark.parametrize(
+    ("n", "objective"),
+    [(1, "normals"), (2, "relight"), (3, "normals"), (7, "relight"), (7, "normals")],
+)
 def test_every_method_on_an_arm(method: str, objective: str, n: int) -> None:
-    arm = make_plan(PREVIEW, ARM, n, method, objective, preview_light=(30.0, 50.0),
-                    min_elevation_deg=15.0)
+    arm = make_plan(
+        PREVIEW, ARM, n, method, objective, preview_light=(30.0, 50.0), min_elevation_deg=15.0
+    )
     check_arm(arm, n, 15.0)
     assert arm.method == method
 

@@ -76,7 +76,8 @@ def test_batched_swaps_equal_direct_costs(objective: str) -> None:
     normals = fibonacci_cap(25, 45.0, 90.0)
     sample = make_sample(normals, cands, specular=0.3)
     obj = (
-        NormalsObjective(sample, cands) if objective == "normals"
+        NormalsObjective(sample, cands)
+        if objective == "normals"
         else RelightObjective(sample, cands, "ptm")
     )
     chosen = rng.choice(30, 9, replace=False)
@@ -92,8 +93,11 @@ def test_relight_variance_anchor() -> None:
     with well spread lights the variance part is close to p σ² / N (algorithms notes §3)."""
     cands = Candidates(fibonacci_cap(36, 5.0, 90.0), None, None)
     sample = SurfaceSample(
-        np.array([[0.0, 0.0, 1.0]]), np.ones(1), np.zeros((1, 36)),
-        fibonacci_cap(2000, 5.0, 90.0), np.zeros((1, 2000)),
+        np.array([[0.0, 0.0, 1.0]]),
+        np.ones(1),
+        np.zeros((1, 36)),
+        fibonacci_cap(2000, 5.0, 90.0),
+        np.zeros((1, 2000)),
     )  # fully shadowed pixel: reflectance 0 everywhere, so the cost is variance only
     obj = RelightObjective(sample, cands, "ptm", bias_rel=0.0)
     var = obj.cost(np.arange(36))

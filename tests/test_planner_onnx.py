@@ -34,9 +34,7 @@ def build_model(path: Path, size: int, op: str = "mean", out_4d: bool = True) ->
         nodes.append(helper.make_node("Div", ["m", "z"], ["d"]))
         last = "d"
     if not out_4d:
-        nodes.append(
-            helper.make_node("Squeeze", [last, "ax"], ["sq"])
-        )
+        nodes.append(helper.make_node("Squeeze", [last, "ax"], ["sq"]))
         axes = helper.make_tensor("axes", TensorProto.INT64, [1], [1])
         nodes.insert(0, helper.make_node("Constant", [], ["ax"], value=axes))
         last = "sq"
