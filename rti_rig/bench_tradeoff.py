@@ -150,7 +150,13 @@ def score_plan(
 ) -> tuple[float, float, float, str, float, float]:
     """Normal error (robust PS, every pixel) and relighting quality of one plan."""
     from rti_rig.metrics import angular_error_deg, relight_psnr, relight_ssim
-    from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo, select_model
+    from rti_rig.reconstruct import (
+        N_COEFFICIENTS,
+        ReconstructionError,
+        fit_model,
+        fit_photometric_stereo,
+        select_model,
+    )
 
     images = data.candidate_images[chosen]
     lights = data.candidate_dirs[chosen]
@@ -165,14 +171,24 @@ def score_plan(
         flat = np.broadcast_to(np.array([0.0, 0.0, 1.0]), data.normals.shape)
         err = angular_error_deg(flat, data.normals, everywhere)
         mean, median, valid = err.mean, err.median, 0.0
+    model, name = None, "none"
     try:
-        choice = select_model(images, lights, holdout=min(5, max(1, len(chosen) // 4)))
-        model = choice.fit(images, lights)
+        choice = select_model(images, lights, holdout=min(5, len(chosen)))
+        model, name = choice.fit(images, lights), choice.model
+    except ReconstructionError:
+        # Too few lights to hold any out: the light count alone decides the model.
+        for candidate in ("ptm", "hsh1", "lambert"):
+            if N_COEFFICIENTS[candidate] <= len(chosen):
+                try:
+                    model, name = fit_model(candidate, images, lights), f"{candidate} (forced)"
+                    break
+                except ReconstructionError:
+                    continue
+    if model is None:
+        psnr = ssim = float("nan")
+    else:
         psnr = relight_psnr(model, data.held_images, data.held_dirs, 1.0)
         ssim = relight_ssim(model, data.held_images, data.held_dirs, 1.0)
-        name = choice.model
-    except ReconstructionError:
-        name, psnr, ssim = "none", float("nan"), float("nan")
     return float(mean), float(median), valid, name, float(psnr), float(ssim)
 
 
@@ -235,7 +251,6 @@ def run_scene(
 ) -> list[Row]:
     """Every plan for one rendered scene."""
     from planner.make_plan import make_plan
-
     from planner.uniform import select_uniform_leds
 
     dome = DomeGeometry(data.candidate_dirs, tuple(f"c{i:03d}" for i in range(s.candidates)))
@@ -399,11 +414,13 @@ def _verdicts(scene: str, series: dict[str, list[Row]], counts: list[int]) -> li
         and (b := at("uniform", n))
         and a.normal_mean_deg < b.normal_mean_deg
     ]
-    out.append(
-        f"- **{scene}**: k-means (the paper's method) beats naive uniform on normals at "
-        f"N = {', '.join(map(str, km)) or 'no N'}"
-        f"{' and loses elsewhere' if len(km) < len(counts) else ''}."
-    )
+    if not km:
+        verdict = "never beats naive uniform on normals"
+    elif len(km) == len(counts):
+        verdict = "beats naive uniform on normals at every N"
+    else:
+        verdict = f"beats naive uniform on normals only at N = {', '.join(map(str, km))}"
+    out.append(f"- **{scene}**: k-means (the paper's method) {verdict}.")
     for objective, key, better in (
         ("normals", "normal_mean_deg", lambda a, b: a < b),
         ("relight", "relight_psnr_db", lambda a, b: a > b),
