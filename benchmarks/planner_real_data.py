@@ -26,7 +26,7 @@ the first is the best homogeneous layout over floors 0–40° (what a dome owner
 once), the second a greedy + exchange selection on the actual normal error (an upper bound for
 any planner on this object).
 
-Run: ``python -m benchmarks.planner_real_data`` (reads /work/shared/data/neuralrti-example;
+Run: ``python -m benchmarks.planner_real_data`` (reads ../shared/data/neuralrti-example beside the repository;
 writes the results section of docs/planner.md).
 """
 
@@ -48,7 +48,8 @@ from rti_rig.metrics import angular_error_map, relight_psnr
 from rti_rig.reconstruct import ReconstructionError, fit_hsh, fit_photometric_stereo, fit_ptm
 from rti_rig.rig_geometry import DomeGeometry
 
-DATA = Path("/work/shared/data/neuralrti-example")
+#: The real acquisition, in the shared folder beside the repository (not needed by tests).
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "neuralrti-example"
 DOC = Path(__file__).resolve().parent.parent / "docs" / "planner.md"
 NS = (6, 9, 12, 18)
 FLOORS = (0.0, 10.0, 20.0, 30.0, 40.0)

@@ -176,14 +176,12 @@ def test_preview_lit_from_the_zenith(method: str) -> None:
     assert rep.rms_tilt_deg > 1.0  # the zenith path still recovers relief
 
 
-def test_24_megapixel_preview_plans_quickly() -> None:
+def test_24_megapixel_preview_is_planned_at_working_resolution() -> None:
+    """Speed is the benchmark's business (benchmarks/planning_time.py); this checks the path."""
     big = cv2.resize(PREVIEW, (6000, 4000), interpolation=cv2.INTER_LINEAR)
-    t0 = time.perf_counter()
     sched, rep = plan_with_report(big, DOME, 9, "optimal", preview_light=(30.0, 50.0))
-    elapsed = time.perf_counter() - t0
     check_dome(sched, DOME, 9)
     assert rep.planning_shape == (171, 256)
-    assert elapsed < 10.0  # generous bound for a shared machine; the benchmark measures it
 
 
 def test_real_preview_on_the_real_dome() -> None:
