@@ -26,8 +26,8 @@ the first is the best homogeneous layout over floors 0–40° (what a dome owner
 once), the second a greedy + exchange selection on the actual normal error (an upper bound for
 any planner on this object).
 
-Run: ``python -m benchmarks.planner_real_data`` (reads ../shared/data/neuralrti-example beside the repository;
-writes the results section of docs/planner.md).
+Run: ``python -m benchmarks.planner_real_data`` (reads ../shared/data/neuralrti-example beside
+the repository; writes the results section of docs/planner.md).
 """
 
 from __future__ import annotations

@@ -1,7 +1,8 @@
 """The paper's method: k-means on the preview's normals, one light per cluster centre.
 
 Reference: "one-shot planning of RTI light positions from surface topography"
-(`../shared/reference/000_cf791ba4d7403715.txt` beside the repository), section *Methodology* and its flowchart,
+(`../shared/reference/000_cf791ba4d7403715.txt` beside the repository), section *Methodology*
+and its flowchart,
 Figure 3: one image → monocular depth (LeReS) → normal map from the depth gradient → k-means with
 ``k`` = the number of lights → "the cluster centers ... correspond to where most of the pixels in
 the normal map image are pointing towards. This vector intersects with the imaginary hemisphere
