@@ -22,13 +22,22 @@ class FaultPlan:
     kind: str
     at: int
     fired: list[str] = field(default_factory=list)
+    calls: int = 0
+
+    def due(self) -> bool:
+        """Count one call of the wrapped operation; True (and recorded) when the fault is due."""
+        n, self.calls = self.calls, self.calls + 1
+        if n == self.at:
+            self.fired.append(self.kind)
+            return True
+        return False
 
 
 class FaultyCamera:
     """A camera that fails once, as a camera that stops answering would."""
 
     def __init__(self, inner, plan: FaultPlan) -> None:  # type: ignore[no-untyped-def]
-        self.inner, self.plan, self.calls = inner, plan, 0
+        self.inner, self.plan = inner, plan
         self.name = inner.name
 
     def connect(self) -> None:
@@ -38,9 +47,7 @@ class FaultyCamera:
         self.inner.close()
 
     def capture(self, exposure_s: float) -> Frame:
-        n, self.calls = self.calls, self.calls + 1
-        if n == self.plan.at:
-            self.plan.fired.append(self.plan.kind)
+        if self.plan.due():
             raise CaptureError(self.name, f"injected fault: {self.plan.kind}", "capture")
         return self.inner.capture(exposure_s)
 
@@ -49,7 +56,7 @@ class FaultyLightSource:
     """A dome whose `light` command fails once (no acknowledgement, port gone)."""
 
     def __init__(self, inner, plan: FaultPlan) -> None:  # type: ignore[no-untyped-def]
-        self.inner, self.plan, self.calls = inner, plan, 0
+        self.inner, self.plan = inner, plan
         self.name = inner.name
 
     def connect(self) -> None:
@@ -62,9 +69,7 @@ class FaultyLightSource:
         return self.inner.light_count()
 
     def light(self, index: int, intensity: float = 1.0) -> None:
-        n, self.calls = self.calls, self.calls + 1
-        if n == self.plan.at:
-            self.plan.fired.append(self.plan.kind)
+        if self.plan.due():
             raise DeviceError(self.name, f"injected fault: {self.plan.kind}", f"light {index}")
         self.inner.light(index, intensity)
 
@@ -79,16 +84,14 @@ class FaultyCarrier:
     """An arm whose `move_to` fails once (a servo error surfacing mid-move)."""
 
     def __init__(self, inner, plan: FaultPlan) -> None:  # type: ignore[no-untyped-def]
-        self.inner, self.plan, self.calls = inner, plan, 0
+        self.inner, self.plan = inner, plan
         self.name = inner.name
 
     def __getattr__(self, name: str):  # type: ignore[no-untyped-def]
         return getattr(self.inner, name)
 
     def move_to(self, direction: np.ndarray) -> np.ndarray:
-        n, self.calls = self.calls, self.calls + 1
-        if n == self.plan.at:
-            self.plan.fired.append(self.plan.kind)
+        if self.plan.due():
             raise DeviceError(self.name, f"injected fault: {self.plan.kind}", "move_to")
         return self.inner.move_to(direction)
 
@@ -102,7 +105,7 @@ class ServoFaultCarrier:
     """
 
     def __init__(self, inner, emulator, plan: FaultPlan, servo_id: int) -> None:  # type: ignore[no-untyped-def]
-        self.inner, self.emulator, self.plan, self.calls = inner, emulator, plan, 0
+        self.inner, self.emulator, self.plan = inner, emulator, plan
         self.servo_id = servo_id
         self.name = inner.name
 
@@ -112,9 +115,7 @@ class ServoFaultCarrier:
     def move_to(self, direction: np.ndarray) -> np.ndarray:
         from drivers.dynamixel.control_table import HardwareFault
 
-        n, self.calls = self.calls, self.calls + 1
-        if n == self.plan.at:
-            self.plan.fired.append(self.plan.kind)
+        if self.plan.due():
             kind = self.plan.kind
             if kind == "servo-overload":
                 self.emulator.inject_hardware_error(self.servo_id, HardwareFault.OVERLOAD)

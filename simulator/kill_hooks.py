@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -100,6 +101,29 @@ def install(stage: str, k: int) -> None:
     sim_camera.SimulatedCamera.capture = capture  # type: ignore[method-assign]
     image_files._atomic_write = atomic_write
     session.asdict = asdict  # type: ignore[assignment]
+
+
+def popen_session(
+    stage: str, k: int, config: Path | str, out: Path | str, lights: int
+) -> subprocess.Popen[bytes]:
+    """Start ``rti-rig run CONFIG --out OUT --lights LIGHTS`` in a child process that dies at
+    ``stage`` of step ``k`` (see the module docstring); stdout and stderr are piped."""
+    repo = Path(__file__).resolve().parent.parent
+    env = {**os.environ, "PYTHONPATH": str(repo)}
+    argv = [
+        sys.executable,
+        "-m",
+        "simulator.kill_hooks",
+        stage,
+        str(k),
+        "run",
+        str(config),
+        "--out",
+        str(out),
+        "--lights",
+        str(lights),
+    ]
+    return subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
 def main(argv: list[str]) -> None:

@@ -5,15 +5,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
-from conftest import REPO, SMALL_DOME, write_config
+from conftest import SMALL_DOME, write_config
 from typer.testing import CliRunner
 
 from planner.uniform import plan_uniform
@@ -23,6 +21,7 @@ from rti_rig.config import load_rig_config
 from rti_rig.controller import CancelToken, FinishReason, Paused, StepCompleted, run_session
 from rti_rig.errors import SessionError
 from rti_rig.session import SessionFolder
+from simulator.kill_hooks import popen_session
 
 runner = CliRunner()
 LIGHTS = 8
@@ -57,25 +56,7 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 
 def child(stage: str, k: int, cfg: Path, out: Path) -> subprocess.Popen:
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    return subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "simulator.kill_hooks",
-            stage,
-            str(k),
-            "run",
-            str(cfg),
-            "--out",
-            str(out),
-            "--lights",
-            str(LIGHTS),
-        ],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
+    return popen_session(stage, k, cfg, out, LIGHTS)
 
 
 @pytest.mark.parametrize(
@@ -248,27 +229,9 @@ def test_arm_session_killed_mid_move_resumes_identically(
     r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--lights", "11"])
     assert r.exit_code == 0, r.output
     out = tmp_path / "s"
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "simulator.kill_hooks",
-            "before_light",
-            "6",
-            "run",
-            str(cfg),
-            "--out",
-            str(out),
-            "--lights",
-            "11",
-        ],
-        env=env,
-        capture_output=True,
-        timeout=120,
-        check=False,
-    )
-    assert proc.returncode == -signal.SIGKILL, proc.stderr.decode()
+    proc = popen_session("before_light", 6, cfg, out, 11)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
     assert digests(out) == digests(ref)
