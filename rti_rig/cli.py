@@ -76,6 +76,18 @@ def run(
         float,
         typer.Option("--min-elevation-deg", help="Elevation floor of the homogeneous layout."),
     ] = 0.0,
+    auto_exposure: Annotated[
+        bool,
+        typer.Option(
+            "--auto-exposure",
+            help="Before starting, meter at the brightest planned light (a short test series) "
+            "and fix the exposure that keeps saturated pixels under --max-saturated.",
+        ),
+    ] = False,
+    max_saturated: Annotated[
+        float,
+        typer.Option("--max-saturated", help="Largest fraction of saturated pixels allowed."),
+    ] = 0.001,
     resume: Annotated[
         Path | None,
         typer.Option(
@@ -143,6 +155,8 @@ def run(
                 schedule = plan_uniform(geometry, n, min_elevation_deg, arm_order_for(loaded))
             rig = build_rig(loaded)
             validate_schedule(rig, schedule)
+            if auto_exposure:
+                schedule = _fix_exposure(rig, schedule, max_saturated)
             folder = SessionFolder.create(out_dir, len(schedule))
     except RtiRigError as exc:
         if rig is not None:
@@ -150,6 +164,32 @@ def run(
         raise _fail(exc) from None
     with rig:
         _execute(rig, schedule, folder, out_dir)
+
+
+def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyped-def]
+    """Meter the session's exposure with the camera driver layer's test series."""
+    from drivers.cameras.exposure import meter_exposure
+    from drivers.cameras.settings import ExposureRule
+    from rti_rig.exposure_policy import fix_session_exposure
+
+    cam = rig.camera_config
+    rule = ExposureRule(
+        max_saturated_fraction=max_saturated,
+        headroom=1.25,  # other planned lights may be a little brighter than the metered one
+        min_exposure_s=cam.min_exposure_s,
+        max_exposure_s=cam.max_exposure_s,
+    )
+
+    def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
+        shutter = getattr(camera, "available_exposures_s", None)
+        return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
+
+    fixed = fix_session_exposure(rig, schedule, meter)
+    chosen = fixed.provenance["exposure"]
+    out.print(
+        f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})", highlight=False
+    )
+    return fixed
 
 
 def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-untyped-def]

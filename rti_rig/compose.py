@@ -29,6 +29,11 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
     return _build_simulated(loaded, clock or VirtualClock())
 
 
+#: The simulated scenes are lit so that this exposure fills 3/4 of the sensor's well with a white
+#: surface facing the light: a config's exposure_s over- or under-exposes them as on a real rig.
+SIMULATED_SCENE_EXPOSURE_S = 0.05
+
+
 def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[no-untyped-def]
     """A camera that renders the scene under whatever light ``state`` says is really on."""
     from simulator.sim_camera import SimulatedCamera
@@ -50,7 +55,7 @@ def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[n
         render,
         state,
         clock,
-        reference_exposure_s=cfg.camera.exposure_s,
+        reference_exposure_s=SIMULATED_SCENE_EXPOSURE_S,
         readout_s=cfg.timing.readout_s,
         transfer_s=cfg.timing.transfer_s,
         noise=cfg.scene.noise,

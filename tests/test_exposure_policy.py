@@ -1,0 +1,72 @@
+"""A session's exposure is fixed from a test series at its brightest light, and recorded."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from conftest import SMALL_DOME, write_config
+from typer.testing import CliRunner
+
+from planner.uniform import plan_uniform
+from rti_rig.cli import app
+from rti_rig.compose import build_rig
+from rti_rig.config import load_rig_config
+from rti_rig.exposure_policy import brightest_step, fix_session_exposure
+
+runner = CliRunner()
+
+
+@pytest.mark.parametrize("exposure", ["0.05", "0.8"])  # sensible, and four stops too long
+def test_auto_exposure_keeps_the_session_under_the_saturation_limit(
+    tmp_path: Path, exposure: str
+) -> None:
+    cfg = write_config(
+        tmp_path, SMALL_DOME.replace("exposure_s = 0.05", f"exposure_s = {exposure}")
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(cfg),
+            "--out",
+            str(out),
+            "--lights",
+            "8",
+            "--auto-exposure",
+            "--max-saturated",
+            "0.002",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    m = json.loads((out / "manifest.json").read_text())
+    chosen = m["schedule"]["provenance"]["exposure"]
+    assert chosen["satisfied"] and chosen["measured_saturated_fraction"] <= 0.002
+    assert {s["exposure_s"] for s in m["steps"]} == {chosen["exposure_s"]}
+    assert max(s["saturated_fraction"] for s in m["steps"]) <= 0.002
+    if exposure == "0.8":
+        assert chosen["exposure_s"] < 0.8 and len(chosen["test_exposures_s"]) >= 2
+
+
+def test_metering_lights_the_brightest_step_and_switches_it_off(tmp_path: Path) -> None:
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    schedule = plan_uniform(rig.geometry, 6)
+    lit = []
+
+    class Choice:
+        exposure_s = 0.02
+
+        def to_manifest(self) -> dict:
+            return {"exposure_s": 0.02}
+
+    def meter(camera, start_s: float) -> Choice:  # type: ignore[no-untyped-def]
+        lit.append(rig.lighting.source.lit)  # type: ignore[attr-defined]
+        return Choice()
+
+    fixed = fix_session_exposure(rig, schedule, meter)
+    assert lit == [schedule.steps[brightest_step(schedule)].led]
+    assert rig.lighting.source.lit is None  # type: ignore[attr-defined]
+    assert all(s.exposure_s == 0.02 for s in fixed.steps)
+    assert fixed.provenance["exposure"]["metered_at_step"] == brightest_step(schedule) + 1
