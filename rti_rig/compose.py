@@ -11,7 +11,6 @@ import contextlib
 from rti_rig.assembly import Rig
 from rti_rig.clock import Clock, SystemClock, VirtualClock
 from rti_rig.config import LoadedRig, rig_geometry
-from rti_rig.errors import ConfigError
 from rti_rig.lighting import ArmLighting, DomeLighting
 from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
 
@@ -37,19 +36,16 @@ SIMULATED_SCENE_EXPOSURE_S = 0.05
 def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[no-untyped-def]
     """A camera that renders the scene under whatever light ``state`` says is really on."""
     from simulator.sim_camera import SimulatedCamera
-    from simulator.sim_scene import lambert_radiance, relief_scene
+    from simulator.sim_scene import renderer_for
 
     cfg = loaded.config
-    if cfg.scene.name != "relief":
-        raise ConfigError(
-            loaded.path, "scene.name", f"unknown scene {cfg.scene.name!r}; available: 'relief'"
-        )
-    scene = relief_scene(cfg.camera.height, cfg.camera.width, cfg.scene.seed)
-
-    def render(direction, intensity):  # type: ignore[no-untyped-def]
-        if direction is None:
-            return scene.albedo * 0.0
-        return lambert_radiance(scene, direction, intensity)
+    render = renderer_for(
+        cfg.scene.name,
+        cfg.camera.height,
+        cfg.camera.width,
+        cfg.scene.seed,
+        cfg.scene.light_distance_mm,
+    )
 
     return SimulatedCamera(
         render,

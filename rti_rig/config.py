@@ -130,11 +130,27 @@ class TimingConfig(_Strict):
 
 
 class SceneConfig(_Strict):
-    """What the simulated camera looks at (simulated backend only)."""
+    """What the simulated camera looks at (simulated and emulated backends).
+
+    ``name``: ``relief`` (a simple Lambertian test scene) or a scene of the library in
+    docs/simulator.md (painting, tablet, coin, tilted, industrial, flat).
+    """
+
+    @model_validator(mode="after")
+    def _known_scene(self) -> SceneConfig:
+        from simulator.scenes import SCENE_NAMES
+
+        if self.name not in ("relief", *SCENE_NAMES):
+            raise ValueError(
+                f"unknown scene {self.name!r}; choose relief, {', '.join(SCENE_NAMES)}"
+            )
+        return self
 
     name: str = "relief"
     seed: int = 0
     noise: bool = True
+    #: None: directional lights; else point lamps at this distance (dome radius, arm reach).
+    light_distance_mm: float | None = Field(default=None, gt=0)
     raw: bool = False  # deliver frames through a DNG and the rawpy decode path, as a DSLR would
 
 

@@ -63,3 +63,42 @@ def lambert_radiance(
     """Radiance of a Lambertian surface under a directional light (attached shadows only)."""
     cos = np.clip(scene.normals @ np.asarray(direction, dtype=np.float64), 0.0, None)
     return scene.albedo * (irradiance * cos)[..., None]
+
+
+def renderer_for(
+    name: str,
+    height_px: int,
+    width_px: int,
+    seed: int = 0,
+    light_distance_mm: float | None = None,
+):  # type: ignore[no-untyped-def]
+    """``render(direction | None, intensity) -> (H, W, 3)`` radiance for a named scene.
+
+    ``relief`` is this module's simple Lambertian scene; every other name is a scene of the
+    library (:mod:`simulator.scenes`), rendered with the passes it needs (cast shadows, GGX
+    specular) under a directional light, or a point lamp at ``light_distance_mm`` (the dome's
+    radius or the arm's reach) when given. The simulated camera and the wrong-light check both
+    render through this one function, so they cannot disagree about what a light looks like.
+    """
+    if name == "relief":
+        scene = relief_scene(height_px, width_px, seed)
+
+        def render_relief(direction, intensity):  # type: ignore[no-untyped-def]
+            if direction is None:
+                return np.zeros_like(scene.albedo)
+            return lambert_radiance(scene, direction, intensity)
+
+        return render_relief
+
+    from simulator.light_transport import light_at, render_radiance
+    from simulator.scenes import make_scene
+
+    library = make_scene(name, height_px, width_px, seed=seed)
+
+    def render(direction, intensity):  # type: ignore[no-untyped-def]
+        if direction is None or intensity <= 0:
+            return np.zeros(library.albedo.shape, dtype=np.float64)
+        light = light_at(direction, light_distance_mm, irradiance=float(intensity))
+        return render_radiance(library, light).astype(np.float64)
+
+    return render
