@@ -1,0 +1,68 @@
+"""The speed/accuracy benchmark runs end to end and its numbers mean what they say."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rti_rig.bench_tradeoff import (
+    PER_LIGHT_S,
+    TradeoffSettings,
+    plot,
+    render_scene_data,
+    run_scene,
+    score_plan,
+    summarise,
+    write_csv,
+)
+
+TINY = TradeoffSettings(
+    scenes=("painting",), size_px=24, counts=(3, 8), ground_truth_lights=60, held_out_lights=8,
+    candidates=40, floors_deg=(0.0, 20.0),
+)
+
+
+@pytest.fixture(scope="module")
+def rows():  # type: ignore[no-untyped-def]
+    data = render_scene_data("painting", TINY)
+    return run_scene(data, TINY, progress=lambda _m: None)
+
+
+def test_every_plan_is_scored_and_timed(rows) -> None:  # type: ignore[no-untyped-def]
+    kinds = {(r.method, r.objective, r.floor_deg) for r in rows}
+    assert ("kmeans", "normals", 0.0) in kinds and ("optimal", "relight", 0.0) in kinds
+    assert ("uniform", "-", 20.0) in kinds
+    for r in rows:
+        assert math.isfinite(r.normal_mean_deg) and 0 <= r.normal_mean_deg <= 180
+        assert r.dome_time_s == pytest.approx(r.n * PER_LIGHT_S)
+        assert r.arm_time_s > r.dome_time_s  # the arm also moves between lights
+        assert math.isfinite(r.relight_psnr_db)
+
+
+def test_more_lights_help_the_homogeneous_layout(rows) -> None:  # type: ignore[no-untyped-def]
+    uniform = {r.n: r for r in rows if r.method == "uniform" and r.floor_deg == 0.0}
+    assert uniform[8].normal_mean_deg < uniform[3].normal_mean_deg
+
+
+def test_scores_see_a_bad_plan() -> None:
+    """Three nearly coplanar lights must score far worse than three well-spread ones."""
+    data = render_scene_data("painting", TINY)
+    el = np.degrees(np.arcsin(data.candidate_dirs[:, 2]))
+    high = np.argsort(-el)[:3]  # three lights around the zenith: nearly coplanar
+    az = np.degrees(np.arctan2(data.candidate_dirs[:, 1], data.candidate_dirs[:, 0])) % 360
+    spread = [int(np.argmin(np.abs(el - 45) + np.abs(((az - a + 180) % 360) - 180) / 4))
+              for a in (0, 120, 240)]
+    bad, good = score_plan(data, high), score_plan(data, np.array(spread))
+    assert bad[0] > 3 * good[0]
+
+
+def test_outputs(rows, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    csv_path = write_csv(rows, tmp_path / "results.csv")
+    assert csv_path.read_text().count("\n") == len(rows) + 1
+    pngs = plot(rows, tmp_path)
+    assert len(pngs) == 6 and all(p.stat().st_size > 1000 for p in pngs)
+    text = summarise(rows, TINY, 1.0, "test")
+    assert "## painting" in text and "What the numbers say" in text
