@@ -252,6 +252,7 @@ def run_scene(
     """Every plan for one rendered scene."""
     from planner.make_plan import make_plan
     from planner.uniform import select_uniform_leds
+    from rti_rig.errors import ScheduleError
 
     dome = DomeGeometry(data.candidate_dirs, tuple(f"c{i:03d}" for i in range(s.candidates)))
     rows: list[Row] = []
@@ -269,7 +270,10 @@ def run_scene(
             continue
         for floor in s.floors_deg:
             t = time.perf_counter()
-            chosen = select_uniform_leds(dome, n, floor)
+            try:
+                chosen = select_uniform_leds(dome, n, floor)
+            except ScheduleError:  # fewer candidates above this floor than N: not a layout
+                continue
             add("uniform", "-", n, floor, chosen, time.perf_counter() - t)
         for method, objective in s.methods:
             if method == "uniform":
@@ -286,11 +290,13 @@ def run_scene(
 
 def best_floor(rows: Iterable[Row], scene: str) -> float:
     """The uniform elevation floor with the lowest mean normal error over N (hindsight)."""
-    by_floor: dict[float, list[float]] = {}
+    by_floor: dict[float, dict[int, float]] = {}
     for r in rows:
         if r.scene == scene and r.method == "uniform":
-            by_floor.setdefault(r.floor_deg, []).append(r.normal_mean_deg)
-    return min(by_floor, key=lambda f: float(np.mean(by_floor[f])))
+            by_floor.setdefault(r.floor_deg, {})[r.n] = r.normal_mean_deg
+    # Compare floors on the light counts every floor could do (a high floor has fewer LEDs).
+    common = set.intersection(*(set(v) for v in by_floor.values()))
+    return min(by_floor, key=lambda f: float(np.mean([by_floor[f][n] for n in common])))
 
 
 def write_csv(rows: list[Row], path: Path) -> Path:
