@@ -15,7 +15,8 @@ Pipeline per pixel and channel (EMVA 1288-style linear model):
 4. ADC                  DN = round(K·e) + black level, clipped to [0, 2^bits - 1];
                         K = gain · (2^bits - 1 - black) / full_well (at gain 1 the full well
                         just fills the ADC range)
-5. black subtraction    pixels = max(DN - black, 0), clipped at ``white_level`` (uint16)
+5. black subtraction    pixels = max(DN - black, 0), clipped at ``white_level`` (uint16);
+                        a full well reads exactly ``white_level``
 
 so, away from the clips, mean = K·Φ and variance = K²·(Φ + σ_r²) + 1/12 (quantisation).
 ``white_level`` = min(2^bits - 1 - black, round(K · full_well)): the code at which the pixel
@@ -112,6 +113,7 @@ class CameraModel:
         # Anything above a few wells saturates anyway; capping keeps Poisson in its valid range.
         phi = np.minimum(phi, 4.0 * self.full_well_e)
         electrons = rng.poisson(phi).astype(np.float64)
+        full = electrons >= self.full_well_e
         np.minimum(electrons, self.full_well_e, out=electrons)
         if self.read_noise_e > 0:
             electrons += rng.normal(0.0, self.read_noise_e, size=electrons.shape)
@@ -120,10 +122,11 @@ class CameraModel:
         dn -= self.black_level_dn
         white = self.white_level
         np.clip(dn, 0, white, out=dn)
+        dn[full] = white  # a full well reads white exactly, so saturation is detectable
         return dn.astype(np.uint16), white
 
     def exposure_for(self, radiance_level: float, fraction_of_white: float = 0.8) -> float:
-        """Exposure (s) that puts π·radiance ``radiance_level`` at ``fraction_of_white`` of white."""
+        """Exposure (s) putting π·radiance ``radiance_level`` at ``fraction_of_white`` of white."""
         if not (radiance_level > 0 and 0 < fraction_of_white <= 1):
             raise ValueError("radiance_level must be > 0 and fraction_of_white in (0, 1]")
         target_e = fraction_of_white * self.white_level / self.dn_per_electron

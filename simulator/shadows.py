@@ -134,7 +134,7 @@ def point_visibility(
     else:
         nc = min(max(fc, -0.5), cols - 0.5)
         nr = min(max(fr, -0.5), rows - 0.5)
-        rho_min = max(0.0, math.hypot(fc - nc, fr - nr) - 1.0)
+        rho_min = float(max(0, math.floor(math.hypot(fc - nc, fr - nr)) - 1))
     n_phi = max(2, math.ceil((phi1 - phi0) * rho_max) + 1)
     n_rho = max(2, math.ceil(rho_max - rho_min) + 1)
     phi = np.linspace(phi0, phi1, n_phi)
