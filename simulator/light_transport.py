@@ -164,7 +164,8 @@ def _geometry(
     return (lx, ly, lz), irradiance
 
 
-def _visibility(scene: Scene, prep: PreparedScene, light: Light) -> NDArray[np.float32]:
+def visibility(scene: Scene, prep: PreparedScene, light: Light) -> NDArray[np.float32]:
+    """Cast-shadow visibility (H, W) in [0, 1] of the scene from ``light``."""
     if isinstance(light, DirectionalLight):
         return directional_visibility(prep.height, light.direction)
     rows, cols = prep.shape
@@ -192,7 +193,7 @@ def render_radiance(
     np.maximum(cos_i, 0.0, out=cos_i)
     shade = cos_i * irradiance  # E·cos θ, W/m² on the surface
     if "shadows" in chosen:
-        shade *= _visibility(scene, prep, light)
+        shade *= visibility(scene, prep, light)
     out = prep.albedo * shade[..., None]
     if "specular" in chosen:
         out += specular_term(prep, (lx, ly, lz), cos_i) * (shade[..., None])
