@@ -15,7 +15,8 @@ Pipeline per pixel and channel (EMVA 1288-style linear model):
 4. ADC                  DN = round(K·e) + black level, clipped to [0, 2^bits - 1];
                         K = gain · (2^bits - 1 - black) / full_well (at gain 1 the full well
                         just fills the ADC range)
-5. black subtraction    pixels = max(DN - black, 0), clipped at ``white_level`` (uint16)
+5. black subtraction    pixels = max(DN - black, 0), clipped at ``white_level`` (uint16);
+                        a full well reads exactly ``white_level``
 
 so, away from the clips, mean = K·Φ and variance = K²·(Φ + σ_r²) + 1/12 (quantisation).
 ``white_level`` = min(2^bits - 1 - black, round(K · full_well)): the code at which the pixel
@@ -121,9 +122,7 @@ class CameraModel:
         dn -= self.black_level_dn
         white = self.white_level
         np.clip(dn, 0, white, out=dn)
-        # A full well reads as the white level: read noise must not pull saturated pixels
-        # below it, or saturation detection (>= white) would miss them.
-        dn[full] = white
+        dn[full] = white  # a full well reads white exactly, so saturation is detectable
         return dn.astype(np.uint16), white
 
     def exposure_for(self, radiance_level: float, fraction_of_white: float = 0.8) -> float:

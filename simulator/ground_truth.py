@@ -64,10 +64,7 @@ class GroundTruth:
 
 
 def iter_ground_truth(
-    scene: Scene,
-    directions: NDArray[np.float64],
-    *,
-    distance_mm: float | None = None,
+    scene: Scene, directions: NDArray[np.float64], *, distance_mm: float | None = None,
     passes: Iterable[str] | None = None,
 ) -> Iterator[tuple[Light, NDArray[np.float32]]]:
     """Yield (light, image) one light at a time: constant memory for large scenes."""
@@ -77,12 +74,8 @@ def iter_ground_truth(
 
 
 def render_ground_truth(
-    scene: Scene,
-    n_lights: int = 500,
-    *,
-    distance_mm: float | None = None,
-    min_elevation_deg: float = 0.0,
-    passes: Iterable[str] | None = None,
+    scene: Scene, n_lights: int = 500, *, distance_mm: float | None = None,
+    min_elevation_deg: float = 0.0, passes: Iterable[str] | None = None,
     max_bytes: int = DEFAULT_MAX_BYTES,
 ) -> GroundTruth:
     """Render the ``n_lights`` homogeneous acquisition of ``scene`` (noise-free radiance).

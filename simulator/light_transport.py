@@ -46,10 +46,8 @@ class DirectionalLight:
     def __post_init__(self) -> None:
         d = np.asarray(self.direction, dtype=np.float64).reshape(-1)
         if d.shape != (3,) or not np.all(np.isfinite(d)) or np.linalg.norm(d) < 1e-12:
-            raise ValueError(
-                f"DirectionalLight: direction must be a finite non-zero 3-vector, "
-                f"got {self.direction!r}"
-            )
+            raise ValueError(f"DirectionalLight: direction must be a finite non-zero 3-vector, "
+                             f"got {self.direction!r}")
         if not (math.isfinite(self.irradiance) and self.irradiance >= 0):
             raise ValueError(f"DirectionalLight: irradiance must be >= 0, got {self.irradiance}")
         object.__setattr__(self, "direction", tuple(float(x) for x in d / np.linalg.norm(d)))
@@ -66,9 +64,8 @@ class PointLight:
     def __post_init__(self) -> None:
         p = np.asarray(self.position_mm, dtype=np.float64).reshape(-1)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
-            raise ValueError(
-                f"PointLight: position_mm must be a finite 3-vector, got {self.position_mm!r}"
-            )
+            raise ValueError(f"PointLight: position_mm must be a finite 3-vector, "
+                             f"got {self.position_mm!r}")
         if not (math.isfinite(self.power) and self.power >= 0):
             raise ValueError(f"PointLight: power must be >= 0, got {self.power}")
         object.__setattr__(self, "position_mm", tuple(float(x) for x in p))
@@ -145,7 +142,9 @@ def resolve_passes(scene: Scene, passes: Iterable[str] | None) -> frozenset[str]
     return chosen
 
 
-def _geometry(prep: PreparedScene, light: Light) -> tuple[tuple, NDArray[np.float32] | np.float32]:
+def _geometry(
+    prep: PreparedScene, light: Light
+) -> tuple[tuple, NDArray[np.float32] | np.float32]:
     """Per-pixel (or constant) unit light direction components and irradiance."""
     f32 = np.float32
     if isinstance(light, DirectionalLight):
@@ -165,7 +164,8 @@ def _geometry(prep: PreparedScene, light: Light) -> tuple[tuple, NDArray[np.floa
     return (lx, ly, lz), irradiance
 
 
-def _visibility(scene: Scene, prep: PreparedScene, light: Light) -> NDArray[np.float32]:
+def visibility(scene: Scene, prep: PreparedScene, light: Light) -> NDArray[np.float32]:
+    """Cast-shadow visibility (H, W) in [0, 1] of the scene from ``light``."""
     if isinstance(light, DirectionalLight):
         return directional_visibility(prep.height, light.direction)
     rows, cols = prep.shape
@@ -193,7 +193,7 @@ def render_radiance(
     np.maximum(cos_i, 0.0, out=cos_i)
     shade = cos_i * irradiance  # E·cos θ, W/m² on the surface
     if "shadows" in chosen:
-        shade *= _visibility(scene, prep, light)
+        shade *= visibility(scene, prep, light)
     out = prep.albedo * shade[..., None]
     if "specular" in chosen:
         out += specular_term(prep, (lx, ly, lz), cos_i) * (shade[..., None])
