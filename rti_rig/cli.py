@@ -300,12 +300,13 @@ def plan(
         ),
     ] = None,
     rig: Annotated[
-        Path,
+        Path | None,
         typer.Option(
             "--rig",
-            help="Rig config TOML, or a bare .lp meaning 'a dome with exactly these lights'.",
+            help="Rig config TOML, or a bare .lp meaning 'a dome with exactly these lights' "
+            "(default: the simulated 48-LED dome shipped with rti-rig).",
         ),
-    ] = Path("rig_configs/simulated_dome.toml"),
+    ] = None,
     lights: Annotated[int, typer.Option("--lights", help="Number of lights to plan.")] = 12,
     method: Annotated[
         str | None,
@@ -364,6 +365,9 @@ def plan(
     from rti_rig.rig_geometry import DomeGeometry
     from rti_rig.session import image_names
 
+    from rti_rig.config import default_config_path
+
+    rig = rig or default_config_path()
     try:
         method = method or ("optimal" if preview is not None else "uniform")
         if method not in METHODS:
