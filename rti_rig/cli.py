@@ -360,12 +360,10 @@ def plan(
     from planner.objectives import OBJECTIVES
     from planner.topography import read_preview
     from rti_rig.compose import arm_order_for
-    from rti_rig.config import load_rig_config, rig_geometry
+    from rti_rig.config import default_config_path, load_rig_config, rig_geometry
     from rti_rig.lp_format import LpEntry, read_lp, write_lp
     from rti_rig.rig_geometry import DomeGeometry
     from rti_rig.session import image_names
-
-    from rti_rig.config import default_config_path
 
     rig = rig or default_config_path()
     try:
