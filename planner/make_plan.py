@@ -235,6 +235,10 @@ def sample_surface(
     )
 
 
+#: Below this many lights the exchange search is not run (see ``_plan``): 3 lights are exactly
+#: the unknowns of the Lambertian fit, with no redundancy left for a shadow or a highlight.
+MIN_LIGHTS_FOR_EXCHANGE = 4
+
 #: Global tilts the planner hedges against (degrees from the camera axis) and their share.
 TILT_PRIOR_DEG = 25.0
 TILT_PRIOR_AZIMUTHS = 6
@@ -461,7 +465,21 @@ def _plan(
             if objective == "normals"
             else f"expected relighting MSE per unit albedo ({report.model})"
         )
-        if method == "optimal":
+        if method == "optimal" and n <= MIN_LIGHTS_FOR_EXCHANGE - 1:
+            # With as many lights as unknowns, one shadowed or clipped light leaves a pixel
+            # unsolvable: a cliff the expected-error objective cannot see (simulated tilted
+            # scene, N = 3: 43° after exchanges, 1.2° homogeneous). Keep a homogeneous layout,
+            # the one the objective prefers among the elevation floors.
+            costs = {label: obj.cost(idx) for label, idx in starts}
+            best = min(costs, key=costs.__getitem__)
+            chosen = dict(starts)[best]
+            report.start_layout, report.swaps = best, 0
+            report.expected.update(costs)
+            report.notes.append(
+                f"{n} lights leave no redundancy: a homogeneous layout ({best}) is kept, "
+                "not optimised further"
+            )
+        elif method == "optimal":
             res = exchange_search(obj, starts)
             chosen = res.chosen
             report.start_layout, report.swaps = res.start_label, res.swaps

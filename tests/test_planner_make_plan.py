@@ -213,3 +213,16 @@ def test_uniform_does_not_fail_on_a_useless_preview() -> None:
     sched, rep = plan_with_report(np.zeros((20, 20), np.uint8), DOME, 6, "uniform")
     assert [s.led for s in sched.steps] == [s.led for s in plan_uniform(DOME, 6).steps]
     assert any("preview not evaluated" in note and "black" in note for note in rep.notes)
+
+
+def test_three_lights_keep_a_homogeneous_layout() -> None:
+    """N = 3 has no redundancy: the optimal method keeps the best homogeneous layout."""
+    from planner.uniform import select_uniform_leds
+
+    sched, rep = plan_with_report(PREVIEW, DOME, 3, "optimal", preview_light=(30.0, 50.0))
+    check_dome(sched, DOME, 3)
+    leds = sorted(s.led for s in sched.steps)
+    floors = [float(f) for f in (0, 10, 20, 30, 40)]
+    layouts = [sorted(select_uniform_leds(DOME, 3, f).tolist()) for f in floors]
+    assert leds in layouts
+    assert rep.swaps == 0 and any("no redundancy" in n for n in rep.notes)
