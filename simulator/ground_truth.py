@@ -9,17 +9,15 @@ special counts.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.geometry import fibonacci_cap
 from simulator.light_transport import Light, light_at, render_radiance
 from simulator.scenes import Scene, SceneError
-
-GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
 
 #: Refuse to hold a ground truth larger than this in memory; use ``iter_ground_truth`` instead.
 DEFAULT_MAX_BYTES = 2 * 1024**3
@@ -31,16 +29,12 @@ def homogeneous_directions(n: int, min_elevation_deg: float = 0.0) -> NDArray[np
     Fibonacci spiral: z_k = z_min + (1 - z_min)(k + ½)/n (equal solid angle per light),
     azimuth_k = k × golden angle. No light is exactly at the horizon or the zenith.
     """
-    if int(n) < 1:
-        raise ValueError(f"homogeneous_directions: n must be >= 1, got {n}")
     if not 0.0 <= min_elevation_deg < 90.0:
         raise ValueError(f"min_elevation_deg must be in [0, 90), got {min_elevation_deg}")
-    k = np.arange(int(n), dtype=np.float64)
-    z_min = math.sin(math.radians(min_elevation_deg))
-    z = z_min + (1.0 - z_min) * (k + 0.5) / n
-    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
-    az = k * GOLDEN_ANGLE
-    return np.stack([r * np.cos(az), r * np.sin(az), z], axis=-1)
+    try:
+        return fibonacci_cap(int(n), min_elevation_deg, 90.0)
+    except ValueError as exc:
+        raise ValueError(f"homogeneous_directions: {exc}") from None
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,7 +58,10 @@ class GroundTruth:
 
 
 def iter_ground_truth(
-    scene: Scene, directions: NDArray[np.float64], *, distance_mm: float | None = None,
+    scene: Scene,
+    directions: NDArray[np.float64],
+    *,
+    distance_mm: float | None = None,
     passes: Iterable[str] | None = None,
 ) -> Iterator[tuple[Light, NDArray[np.float32]]]:
     """Yield (light, image) one light at a time: constant memory for large scenes."""
@@ -74,8 +71,12 @@ def iter_ground_truth(
 
 
 def render_ground_truth(
-    scene: Scene, n_lights: int = 500, *, distance_mm: float | None = None,
-    min_elevation_deg: float = 0.0, passes: Iterable[str] | None = None,
+    scene: Scene,
+    n_lights: int = 500,
+    *,
+    distance_mm: float | None = None,
+    min_elevation_deg: float = 0.0,
+    passes: Iterable[str] | None = None,
     max_bytes: int = DEFAULT_MAX_BYTES,
 ) -> GroundTruth:
     """Render the ``n_lights`` homogeneous acquisition of ``scene`` (noise-free radiance).

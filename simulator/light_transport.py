@@ -46,8 +46,10 @@ class DirectionalLight:
     def __post_init__(self) -> None:
         d = np.asarray(self.direction, dtype=np.float64).reshape(-1)
         if d.shape != (3,) or not np.all(np.isfinite(d)) or np.linalg.norm(d) < 1e-12:
-            raise ValueError(f"DirectionalLight: direction must be a finite non-zero 3-vector, "
-                             f"got {self.direction!r}")
+            raise ValueError(
+                f"DirectionalLight: direction must be a finite non-zero 3-vector, "
+                f"got {self.direction!r}"
+            )
         if not (math.isfinite(self.irradiance) and self.irradiance >= 0):
             raise ValueError(f"DirectionalLight: irradiance must be >= 0, got {self.irradiance}")
         object.__setattr__(self, "direction", tuple(float(x) for x in d / np.linalg.norm(d)))
@@ -64,8 +66,9 @@ class PointLight:
     def __post_init__(self) -> None:
         p = np.asarray(self.position_mm, dtype=np.float64).reshape(-1)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
-            raise ValueError(f"PointLight: position_mm must be a finite 3-vector, "
-                             f"got {self.position_mm!r}")
+            raise ValueError(
+                f"PointLight: position_mm must be a finite 3-vector, got {self.position_mm!r}"
+            )
         if not (math.isfinite(self.power) and self.power >= 0):
             raise ValueError(f"PointLight: power must be >= 0, got {self.power}")
         object.__setattr__(self, "position_mm", tuple(float(x) for x in p))
@@ -142,9 +145,7 @@ def resolve_passes(scene: Scene, passes: Iterable[str] | None) -> frozenset[str]
     return chosen
 
 
-def _geometry(
-    prep: PreparedScene, light: Light
-) -> tuple[tuple, NDArray[np.float32] | np.float32]:
+def _geometry(prep: PreparedScene, light: Light) -> tuple[tuple, NDArray[np.float32] | np.float32]:
     """Per-pixel (or constant) unit light direction components and irradiance."""
     f32 = np.float32
     if isinstance(light, DirectionalLight):

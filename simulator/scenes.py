@@ -158,9 +158,7 @@ def _smoothstep(e0: float, e1: float, x: NDArray[np.float64]) -> NDArray[np.floa
     return t * t * (3 - 2 * t)
 
 
-def _value_noise(
-    rng: np.random.Generator, rows: int, cols: int, cells: int
-) -> NDArray[np.float64]:
+def _value_noise(rng: np.random.Generator, rows: int, cols: int, cells: int) -> NDArray[np.float64]:
     """Smooth random field in [-1, 1] with about ``cells`` features across the short side."""
     s = min(rows, cols)
     gr = max(2, math.ceil(cells * rows / s) + 2)
@@ -174,15 +172,29 @@ def _fill(shape: tuple[int, int], value: Iterable[float]) -> NDArray[np.float64]
 
 
 def _build(
-    name: str, seed: int, height: NDArray[np.float64], albedo: NDArray[np.float64],
-    specular: NDArray[np.float64], roughness: NDArray[np.float64], passes: Iterable[str],
-    material: str, description: str, pixel_size_mm: float,
+    name: str,
+    seed: int,
+    height: NDArray[np.float64],
+    albedo: NDArray[np.float64],
+    specular: NDArray[np.float64],
+    roughness: NDArray[np.float64],
+    passes: Iterable[str],
+    material: str,
+    description: str,
+    pixel_size_mm: float,
 ) -> Scene:
     return Scene(
-        name=name, seed=seed, height=height, normals=normals_from_height(height),
-        albedo=np.clip(albedo, 0.0, 1.0), specular_albedo=np.clip(specular, 0.0, 1.0),
-        roughness=np.clip(roughness, 0.02, 1.0), passes=frozenset(passes),
-        pixel_size_mm=pixel_size_mm, material=material, description=description,
+        name=name,
+        seed=seed,
+        height=height,
+        normals=normals_from_height(height),
+        albedo=np.clip(albedo, 0.0, 1.0),
+        specular_albedo=np.clip(specular, 0.0, 1.0),
+        roughness=np.clip(roughness, 0.02, 1.0),
+        passes=frozenset(passes),
+        pixel_size_mm=pixel_size_mm,
+        material=material,
+        description=description,
     )
 
 
@@ -200,8 +212,15 @@ def _painting(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     ground = np.array([0.82, 0.78, 0.68])
     albedo = _fill((rows, cols), ground)
     palette = np.array(
-        [[0.60, 0.12, 0.08], [0.10, 0.18, 0.45], [0.75, 0.60, 0.15], [0.15, 0.35, 0.15],
-         [0.85, 0.83, 0.80], [0.05, 0.05, 0.06], [0.55, 0.30, 0.15]]
+        [
+            [0.60, 0.12, 0.08],
+            [0.10, 0.18, 0.45],
+            [0.75, 0.60, 0.15],
+            [0.15, 0.35, 0.15],
+            [0.85, 0.83, 0.80],
+            [0.05, 0.05, 0.06],
+            [0.55, 0.30, 0.15],
+        ]
     )
     flow = rng.uniform(0, np.pi)  # strokes follow a dominant direction, as a painter's do
     for _ in range(220):
@@ -232,7 +251,13 @@ def _painting(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     spec = _fill((rows, cols), (0.04, 0.04, 0.04))  # varnish (n ≈ 1.5)
     rough = np.full((rows, cols), 0.35)  # varnish over rough paint: broad lobe
     return _build(
-        "painting", seed, height, albedo, spec, rough, {"shadows", "specular"},
+        "painting",
+        seed,
+        height,
+        albedo,
+        spec,
+        rough,
+        {"shadows", "specular"},
         "varnished oil paint on canvas",
         "Canvas weave plus impasto brush strokes (bristle grooves, piled ends) with varied "
         "pigments; a thin varnish gives a weak, broad highlight; strokes cast short shadows.",
@@ -282,7 +307,13 @@ def _tablet(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     albedo *= (1.0 - 0.25 * np.clip(impressions / depth, 0, 1))[..., None]  # dirt in the cuts
     zeros = np.zeros((rows, cols, 3))
     return _build(
-        "tablet", seed, height, albedo, zeros, np.ones((rows, cols)), {"shadows"},
+        "tablet",
+        seed,
+        height,
+        albedo,
+        zeros,
+        np.ones((rows, cols)),
+        {"shadows"},
         "matte fired clay",
         "Convex clay tablet with lines of sharp wedge impressions; matte (no specular pass); "
         "the wedges cast shadows under raking light.",
@@ -321,9 +352,10 @@ def _coin(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
             groove = np.clip(1 - dist / 0.0035, 0, None) * ring
             np.maximum(legend, groove, out=legend)
     height = on_coin * (thickness + rim + bust - 0.006 * s * legend)
-    cloth = _fill((rows, cols), (0.05, 0.06, 0.09)) * (
-        1 + 0.3 * _value_noise(rng, rows, cols, 80)
-    )[..., None]
+    cloth = (
+        _fill((rows, cols), (0.05, 0.06, 0.09))
+        * (1 + 0.3 * _value_noise(rng, rows, cols, 80))[..., None]
+    )
     metal_diffuse = np.array([0.04, 0.04, 0.035])
     oc = on_coin[..., None]
     albedo = cloth * (1 - oc) + metal_diffuse * oc
@@ -333,7 +365,13 @@ def _coin(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     rough = 0.25 + 0.05 * _value_noise(rng, rows, cols, 30)
     rough = rough * on_coin + 1.0 * (1 - on_coin)
     return _build(
-        "coin", seed, height, albedo, spec, rough, {"shadows", "specular"},
+        "coin",
+        seed,
+        height,
+        albedo,
+        spec,
+        rough,
+        {"shadows", "specular"},
         "polished silver (GGX, low roughness) on matte cloth",
         "Silver coin standing on cloth: a step at its edge, raised rim, relief portrait, "
         "engraved legend; glossy metal needs the specular pass, edges and rim cast shadows.",
@@ -359,8 +397,14 @@ def _tilted(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     tone = 0.72 + 0.08 * _value_noise(rng, rows, cols, 20) - 0.2 * _smoothstep(0.08, 0.0, veins)
     albedo = np.array([1.0, 0.97, 0.92]) * tone[..., None]
     return _build(
-        "tilted", seed, height, albedo, np.zeros((rows, cols, 3)), np.ones((rows, cols)),
-        {"shadows"}, "matte limestone",
+        "tilted",
+        seed,
+        height,
+        albedo,
+        np.zeros((rows, cols, 3)),
+        np.ones((rows, cols)),
+        {"shadows"},
+        "matte limestone",
         "Sculpted relief on a plane tilted 50°: normals far from the camera axis, large "
         "attached and cast shadows for lights on the far side; matte.",
         pixel_mm,
@@ -393,13 +437,20 @@ def _industrial(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
         depth = rng.uniform(0.08, 0.15) * r * s
         height -= depth * np.clip(1 - dist**2, 0, None) ** 2
         height += 0.1 * depth * np.exp(-(((dist - 1.1) / 0.12) ** 2))
-    albedo = _fill((rows, cols), (0.10, 0.10, 0.11)) * (
-        1 + 0.1 * _value_noise(rng, rows, cols, 10)
-    )[..., None]
+    albedo = (
+        _fill((rows, cols), (0.10, 0.10, 0.11))
+        * (1 + 0.1 * _value_noise(rng, rows, cols, 10))[..., None]
+    )
     spec = _fill((rows, cols), (0.56, 0.57, 0.58))  # steel F0
     rough = 0.3 + 0.05 * _value_noise(rng, rows, cols, 10)
     return _build(
-        "industrial", seed, height, albedo, spec, rough, {"shadows", "specular"},
+        "industrial",
+        seed,
+        height,
+        albedo,
+        spec,
+        rough,
+        {"shadows", "specular"},
         "brushed steel (GGX, medium roughness)",
         "Machined steel with a brushed finish, thin deep scratches and shallow dents: defects "
         "show in the highlight and in grazing-light shadows.",
@@ -410,8 +461,14 @@ def _industrial(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
 def _flat(rows: int, cols: int, seed: int, pixel_mm: float) -> Scene:
     """Flat matte plate of uniform albedo: every method must be exact here."""
     return _build(
-        "flat", seed, np.zeros((rows, cols)), _fill((rows, cols), (0.5, 0.5, 0.5)),
-        np.zeros((rows, cols, 3)), np.ones((rows, cols)), set(), "matte grey card",
+        "flat",
+        seed,
+        np.zeros((rows, cols)),
+        _fill((rows, cols), (0.5, 0.5, 0.5)),
+        np.zeros((rows, cols, 3)),
+        np.ones((rows, cols)),
+        set(),
+        "matte grey card",
         "Flat uniform Lambertian plate (degenerate case): no relief, so no shadows pass; "
         "matte, so no specular pass.",
         pixel_mm,
@@ -432,7 +489,10 @@ SCENE_NAMES: tuple[str, ...] = tuple(_BUILDERS)
 
 
 def make_scene(
-    name: str, height_px: int, width_px: int, seed: int = 0,
+    name: str,
+    height_px: int,
+    width_px: int,
+    seed: int = 0,
     pixel_size_mm: float = DEFAULT_PIXEL_SIZE_MM,
 ) -> Scene:
     """Build the named library scene at the given size; same (name, size, seed) → same scene."""
@@ -487,9 +547,15 @@ def _albedo_array(albedo: float | ArrayLike, shape: tuple[int, int]) -> NDArray[
 
 
 def scene_from_depth_file(
-    path: str | Path, *, scale_px: float = 1.0, relief_px: float | None = None,
-    is_depth: bool = False, albedo: float | ArrayLike = 0.6, pixel_size_mm: float = 0.05,
-    passes: Iterable[str] = ("shadows",), name: str | None = None,
+    path: str | Path,
+    *,
+    scale_px: float = 1.0,
+    relief_px: float | None = None,
+    is_depth: bool = False,
+    albedo: float | ArrayLike = 0.6,
+    pixel_size_mm: float = 0.05,
+    passes: Iterable[str] = ("shadows",),
+    name: str | None = None,
 ) -> Scene:
     """A matte scene from a height (or depth) map file: .npy, .tif/.tiff, or an image (.png…).
 
@@ -515,16 +581,28 @@ def scene_from_depth_file(
         h = h * float(scale_px)
     shape = (h.shape[0], h.shape[1])
     return Scene(
-        name=name or p.stem, seed=0, height=h, normals=normals_from_height(h),
-        albedo=_albedo_array(albedo, shape), specular_albedo=np.zeros((*shape, 3)),
-        roughness=np.ones(shape), passes=frozenset(passes), pixel_size_mm=pixel_size_mm,
-        material="matte (from depth file)", description=f"height field from {p.name}",
+        name=name or p.stem,
+        seed=0,
+        height=h,
+        normals=normals_from_height(h),
+        albedo=_albedo_array(albedo, shape),
+        specular_albedo=np.zeros((*shape, 3)),
+        roughness=np.ones(shape),
+        passes=frozenset(passes),
+        pixel_size_mm=pixel_size_mm,
+        material="matte (from depth file)",
+        description=f"height field from {p.name}",
     )
 
 
 def scene_from_normal_file(
-    path: str | Path, *, green_up: bool = True, albedo: float | ArrayLike = 0.6,
-    pixel_size_mm: float = 0.05, passes: Iterable[str] = (), name: str | None = None,
+    path: str | Path,
+    *,
+    green_up: bool = True,
+    albedo: float | ArrayLike = 0.6,
+    pixel_size_mm: float = 0.05,
+    passes: Iterable[str] = (),
+    name: str | None = None,
 ) -> Scene:
     """A matte scene from a normal map: .npy/.tif float in [-1, 1], or an 8/16-bit RGB image.
 
@@ -551,8 +629,15 @@ def scene_from_normal_file(
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
     shape = (n.shape[0], n.shape[1])
     return Scene(
-        name=name or p.stem, seed=0, height=height_from_normals(n), normals=n,
-        albedo=_albedo_array(albedo, shape), specular_albedo=np.zeros((*shape, 3)),
-        roughness=np.ones(shape), passes=frozenset(passes), pixel_size_mm=pixel_size_mm,
-        material="matte (from normal file)", description=f"normal map from {p.name}",
+        name=name or p.stem,
+        seed=0,
+        height=height_from_normals(n),
+        normals=n,
+        albedo=_albedo_array(albedo, shape),
+        specular_albedo=np.zeros((*shape, 3)),
+        roughness=np.ones(shape),
+        passes=frozenset(passes),
+        pixel_size_mm=pixel_size_mm,
+        material="matte (from normal file)",
+        description=f"normal map from {p.name}",
     )

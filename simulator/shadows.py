@@ -79,8 +79,11 @@ def directional_visibility(
     flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
     hs = cv2.warpAffine(h, fwd, (n_a, n_b), flags=flags, borderMode=cv2.BORDER_REPLICATE)
     inside = cv2.warpAffine(
-        np.ones(h.shape, np.uint8), fwd, (n_a, n_b),
-        flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_CONSTANT,
+        np.ones(h.shape, np.uint8),
+        fwd,
+        (n_a, n_b),
+        flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
+        borderMode=cv2.BORDER_CONSTANT,
         borderValue=0,
     )
     a = np.arange(n_a, dtype=np.float32) - np.float32(ea)
@@ -115,7 +118,10 @@ def _angular_range(fc: float, fr: float, cols: int, rows: int) -> tuple[float, f
 
 
 def point_visibility(
-    height: ArrayLike, light_col: float, light_row: float, light_z: float,
+    height: ArrayLike,
+    light_col: float,
+    light_row: float,
+    light_z: float,
     bias_px: float = BIAS_PX,
 ) -> NDArray[np.float32]:
     """Visibility of each pixel from a point light at image position (col, row), height z.

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.arm_motion import joint_move_time_s
 from rti_rig.clock import Clock
 from rti_rig.errors import DeviceError
 from rti_rig.geometry import az_el_from_direction, direction_from_az_el
@@ -74,16 +75,6 @@ class SimulatedDome:
         self.history.append((self._clock.now(), None))
 
 
-def trapezoid_move_s(distance: float, speed: float, acceleration: float) -> float:
-    """Time of a rest-to-rest move under a trapezoidal (or triangular) velocity profile."""
-    d = abs(distance)
-    if d == 0.0:
-        return 0.0
-    if d >= speed * speed / acceleration:
-        return d / speed + speed / acceleration
-    return 2.0 * float(np.sqrt(d / acceleration))
-
-
 class SimulatedArm:
     """A two-axis arm (azimuth, elevation) with quantised joints and trapezoidal moves.
 
@@ -130,8 +121,8 @@ class SimulatedArm:
         az = round(az / self._res) * self._res
         el = round(el / self._res) * self._res
         t = max(
-            trapezoid_move_s(az - self.joints_deg[0], self._speed, self._accel),
-            trapezoid_move_s(el - self.joints_deg[1], self._speed, self._accel),
+            joint_move_time_s(az - self.joints_deg[0], self._speed, self._accel),
+            joint_move_time_s(el - self.joints_deg[1], self._speed, self._accel),
         )
         self._clock.sleep(t)
         self.joints_deg = (az, el)

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from simulator.scenes import normals_from_height
+
 
 @dataclass(frozen=True, eq=False)
 class HeightFieldScene:
@@ -22,15 +24,6 @@ class HeightFieldScene:
     height: NDArray[np.float64]
     normals: NDArray[np.float64]
     albedo: NDArray[np.float64]
-
-
-def normals_from_height(height: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Unit normals of a height field with unit pixel pitch; y is up, so rows are flipped."""
-    dh_drow, dh_dcol = np.gradient(height)
-    dh_dx = dh_dcol
-    dh_dy = -dh_drow  # frame y runs towards row 0
-    n = np.stack([-dh_dx, -dh_dy, np.ones_like(height)], axis=-1)
-    return n / np.linalg.norm(n, axis=-1, keepdims=True)
 
 
 def relief_scene(height_px: int, width_px: int, seed: int = 0) -> HeightFieldScene:
