@@ -291,14 +291,7 @@ def _uniform_layouts(
                 leds = select_uniform_leds(geometry, n, f)
                 out.append((f"uniform ≥{f:g}°", geometry.directions[leds], leds))
             else:
-                lo = max(f, geometry.min_elevation_deg)
-                hi = min(geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
-                if lo >= hi:
-                    raise ScheduleError(
-                        f"elevation floor {f:g}° leaves no reachable band "
-                        f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
-                    )
-                out.append((f"uniform ≥{f:g}°", fibonacci_cap(n, lo, hi), None))
+                out.append((f"uniform ≥{f:g}°", geometry.homogeneous(n, f), None))
         except ScheduleError as exc:
             first_error = first_error or str(exc)
     return out, first_error

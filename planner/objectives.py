@@ -98,13 +98,7 @@ def candidates_for(
         return Candidates(
             geometry.directions[idx], idx.astype(np.intp), tuple(geometry.names[i] for i in idx)
         )
-    lo = max(min_elevation_deg, geometry.min_elevation_deg)
-    hi = min(geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
-    if lo >= hi:
-        raise ScheduleError(
-            f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
-            f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
-        )
+    lo, hi = geometry.elevation_band(min_elevation_deg)
     dense = fibonacci_cap(ARM_CANDIDATES, lo, hi)
     if extra is not None and len(extra):
         dense = np.concatenate([np.asarray(extra, dtype=np.float64).reshape(-1, 3), dense])

@@ -85,16 +85,7 @@ def plan_uniform(
             method="uniform",
             provenance=provenance,
         )
-    if n <= 0:
-        raise ScheduleError(f"--lights must be at least 1, got {n}")
-    lo = max(min_elevation_deg, geometry.min_elevation_deg)
-    hi = min(geometry.max_elevation_deg, 90.0 - geometry.keep_out_half_angle_deg)
-    if lo >= hi:
-        raise ScheduleError(
-            f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
-            f"(the arm reaches {geometry.min_elevation_deg:g}°..{hi:g}°)"
-        )
-    dirs = np.array([geometry.clamp_azimuth(d) for d in fibonacci_cap(n, lo, hi)])
+    dirs = geometry.homogeneous(n, min_elevation_deg)
     start = geometry.park_direction
     order = (arm_order or order_nearest_neighbour)(dirs, start)
     order = np.asarray(order, dtype=np.intp)

@@ -11,7 +11,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
+from rti_rig.errors import ScheduleError
+from rti_rig.geometry import (
+    angle_between_deg,
+    az_el_from_direction,
+    direction_from_az_el,
+    fibonacci_cap,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,6 +86,24 @@ class ArmGeometry:
                 f"[{self.min_azimuth_deg:g}°, {self.max_azimuth_deg:g}°]"
             )
         return None
+
+    def elevation_band(self, min_elevation_deg: float = 0.0) -> tuple[float, float]:
+        """The reachable elevations (degrees) at or above a floor; ScheduleError if none."""
+        lo = max(min_elevation_deg, self.min_elevation_deg)
+        hi = min(self.max_elevation_deg, 90.0 - self.keep_out_half_angle_deg)
+        if lo >= hi:
+            raise ScheduleError(
+                f"elevation floor {min_elevation_deg:g}° leaves no reachable band "
+                f"(the arm reaches {self.min_elevation_deg:g}°..{hi:g}°)"
+            )
+        return lo, hi
+
+    def homogeneous(self, n: int, min_elevation_deg: float = 0.0) -> NDArray[np.float64]:
+        """``n`` directions spread evenly over the reachable band, azimuths within range."""
+        if n <= 0:
+            raise ScheduleError(f"--lights must be at least 1, got {n}")
+        lo, hi = self.elevation_band(min_elevation_deg)
+        return np.array([self.clamp_azimuth(d) for d in fibonacci_cap(n, lo, hi)])
 
     def clamp_azimuth(self, direction: ArrayLike) -> NDArray[np.float64]:
         """``direction`` with its azimuth moved to the nearest end of the arm's range if outside."""
