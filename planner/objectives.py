@@ -236,6 +236,10 @@ class NormalsObjective:
             np.stack([w.T * (d[:, i] * d[:, j])[:, None] for i, j in self.PAIRS])
         )
         self.n = sample.normals
+        x, y, z = self.n.T
+        # entries of P = I - n nᵀ paired with adj(M): diagonal once, off-diagonal twice
+        proj = np.stack([1 - x * x, 1 - y * y, 1 - z * z, -2 * x * y, -2 * x * z, -2 * y * z])
+        self.projector = (proj, proj.astype(np.float32))
         self.wts = sample.weights / sample.weights.sum()
         self.tau2 = (bias_rel * np.sqrt(2 * np.pi / 9)) ** 2  # RMS deviation = bias_rel
         # the bias term is smooth over normals: a sub-sample of the (random) pixels suffices
@@ -251,6 +255,11 @@ class NormalsObjective:
             )
             all_m = self.outer[..., : self.n_bias].sum(axis=1)  # (6, P_bias)
             self.g_all = self._solve(all_m[:, None], self.cross.sum(axis=1)[:, None])[:, 0]
+        # single-precision copies for the batched swap scans, the planner's hot loop: they halve
+        # the memory traffic, and every accepted swap is re-scored in double precision
+        # (:func:`planner.optimal.exchange_search`), so rounding can only cost a missed swap
+        self.outer32 = self.outer.astype(np.float32)
+        self.cross32 = self.cross.astype(np.float32) if self.tau2 > 0 else None
 
     @staticmethod
     def _adjugate(m: NDArray[np.float64]) -> tuple[tuple[NDArray, ...], NDArray]:
@@ -276,15 +285,16 @@ class NormalsObjective:
     def _variance(self, m: NDArray[np.float64]) -> NDArray:
         """Squared angular error (rad²) of noise from information entries ``m`` (6, B, P)."""
         # closed-form adjugate of the symmetric 3×3 (batched np.linalg.inv is ~20× slower):
-        # tr(P M⁻¹ P) = tr(M⁻¹) - nᵀ M⁻¹ n with P = I - n nᵀ
+        # tr(P M⁻¹ P) = Σ_ij adj(M)_ij P_ij / det(M), P = I - n nᵀ (weights precomputed)
         (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
-        x, y, z = self.n[:, 0], self.n[:, 1], self.n[:, 2]
-        quad = (
-            c00 * x * x + c11 * y * y + c22 * z * z + 2 * (c01 * x * y + c02 * x * z + c12 * y * z)
-        )
+        q = self.projector[1 if m.dtype == np.float32 else 0]
+        num = c00 * q[0]
+        for c, qq in ((c11, q[1]), (c22, q[2]), (c01, q[3]), (c02, q[4]), (c12, q[5])):
+            num += c * qq
         ok = det > 1e-12
-        err2 = NOISE_REL**2 * (c00 + c11 + c22 - quad) / np.where(ok, det, 1.0)
-        return np.clip(np.where(ok, err2, MAX_ERR2), 0.0, MAX_ERR2)
+        num *= NOISE_REL**2
+        num /= np.where(ok, det, 1.0)
+        return np.clip(np.where(ok, num, MAX_ERR2), 0.0, MAX_ERR2)
 
     def _bias(self, m: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray:
         """Expected squared tangential bias (rad²) on the first pixels, (B, P_bias)."""
@@ -310,10 +320,10 @@ class NormalsObjective:
         """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch."""
         base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
         r = None
-        if self.tau2 > 0:
+        if self.cross32 is not None:
             rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
-            r = rb[:, None] + self.cross  # (3, K, P_bias, 9)
-        return self._total(base[:, None, :] + self.outer, r)
+            r = rb.astype(np.float32)[:, None] + self.cross32  # (3, K, P_bias, 9)
+        return self._total(base.astype(np.float32)[:, None, :] + self.outer32, r)
 
     def describe(self, value: float) -> str:
         return f"expected RMS normal error {value:.2f}° at {100 * NOISE_REL:g}% noise"

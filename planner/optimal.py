@@ -67,10 +67,16 @@ def exchange_search(
             trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
             k = int(np.argmin(trial))
             if float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):
+                # the scan may be approximate (single precision): accept on the exact cost
+                previous = int(chosen[pos])
                 chosen[pos] = k
-                cost = objective.cost(chosen)
-                swaps += 1
-                changed = True
+                exact = objective.cost(chosen)
+                if exact < cost - 1e-9 * max(abs(cost), 1e-12):
+                    cost = exact
+                    swaps += 1
+                    changed = True
+                else:
+                    chosen[pos] = previous
         if not changed:
             break
     return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)
