@@ -22,9 +22,15 @@ from rti_rig.schedule import LightSchedule
 
 
 def select_uniform_leds(
-    dome: DomeGeometry, n: int, min_elevation_deg: float = 0.0
+    dome: DomeGeometry, n: int, min_elevation_deg: float = 0.0, azimuth_offset_deg: float = 0.0
 ) -> NDArray[np.intp]:
-    """Indices (ascending) of ``n`` LEDs spread evenly above ``min_elevation_deg``."""
+    """Indices (ascending) of ``n`` LEDs spread evenly above ``min_elevation_deg``.
+
+    ``azimuth_offset_deg`` turns the ideal layout about the vertical before it is matched to
+    LEDs: every offset is an equally homogeneous layout, and the spread of their errors on a
+    real object is the luck a homogeneous layout's arbitrary orientation carries (the real-data
+    benchmark reports it).
+    """
     if n <= 0:
         raise ScheduleError(f"--lights must be at least 1, got {n}")
     _, el = az_el_from_direction(dome.directions)
@@ -40,6 +46,10 @@ def select_uniform_leds(
     lo = max(min_elevation_deg, float(el[candidates].min()))
     hi = float(el[candidates].max())
     ideal = fibonacci_cap(n, lo, hi) if hi > lo else fibonacci_cap(n, 0.0, 90.0)
+    if azimuth_offset_deg:
+        t = np.radians(azimuth_offset_deg)
+        c, s = np.cos(t), np.sin(t)
+        ideal = ideal @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
     cost = angle_between_deg(ideal[:, None, :], dome.directions[candidates][None, :, :])
     _, cols = linear_sum_assignment(cost)
     return np.sort(candidates[cols])

@@ -43,6 +43,27 @@ def test_uniform_spreads_better_than_first_n() -> None:
     assert worst_gap < 35.0
 
 
+def test_azimuth_offset_turns_the_layout() -> None:
+    """On a dome symmetric under a 90° turn, a 90° offset gives the turned LED set."""
+    az_el = [(a, 20.0) for a in range(0, 360, 15)] + [(a, 50.0) for a in range(0, 360, 30)]
+    az0, el0 = np.array(az_el, dtype=float).T
+    dirs = np.stack(
+        [
+            np.cos(np.radians(el0)) * np.cos(np.radians(az0)),
+            np.cos(np.radians(el0)) * np.sin(np.radians(az0)),
+            np.sin(np.radians(el0)),
+        ],
+        axis=1,
+    )
+    dome = DomeGeometry(dirs, tuple(str(i) for i in range(len(dirs))))
+    base = select_uniform_leds(dome, 7)
+    turned = select_uniform_leds(dome, 7, azimuth_offset_deg=90.0)
+    want = sorted(zip(np.round((az0[base] + 90.0) % 360.0, 6), el0[base]))
+    got = sorted(zip(np.round(az0[turned] % 360.0, 6), el0[turned]))
+    assert got == want
+    assert set(base.tolist()) != set(turned.tolist())
+
+
 @pytest.mark.parametrize("n", [1, 2, 3, 25])
 def test_arm_plans_are_reachable(n: int) -> None:
     sched = plan_uniform(ARM, n, 15.0)
