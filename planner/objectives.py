@@ -341,6 +341,11 @@ class RelightObjective:
     For coefficients ``c`` fitted on the chosen lights the held-out bias is
     ``mean_t (a_tᵀ c - f_t)² = cᵀ G c - 2 cᵀ h + k`` with ``G = A_Tᵀ A_T / T``,
     ``h = A_Tᵀ f / T`` and ``k = mean f_t²``, so no held-out image is ever rendered.
+    With ``c_p = Q f_p``, ``Q = (A_SᵀA_S)⁻¹ A_Sᵀ``, the weighted sum over pixels is
+    ``tr(G Q Φ_S Qᵀ) - 2 tr(Q Ψ_S) + Σ w k`` where ``Φ = Σ_p w_p f_p f_pᵀ`` and
+    ``Ψ = Σ_p w_p f_p h_pᵀ`` are summed over pixels once for every pair of candidates: a
+    layout's cost then never touches the pixels, which keeps the exchange search's swap scans
+    (hundreds of layouts per scan) independent of the sample size.
 
     As for normals, real reflectance deviates from the model in ways one preview cannot show;
     the deviation is modelled as a random smooth function (order-3 hemispherical harmonics,
@@ -366,50 +371,46 @@ class RelightObjective:
         a_test = design_matrix(model, sample.held_out)  # (T, p)
         f_test = reflectance(sample, sample.held_out, sample.lit_held_out)  # (P, T)
         t = len(a_test)
+        wts = sample.weights / sample.weights.sum()
         self.gram = a_test.T @ a_test / t  # (p, p)
-        self.h = f_test @ a_test / t  # (P, p)
-        self.k = np.mean(f_test * f_test, axis=1)  # (P,)
-        self.f_cand = reflectance(sample, candidates.directions, sample.lit_candidates)  # (P, K)
-        self.wts = sample.weights / sample.weights.sum()
+        h = f_test @ a_test / t  # (P, p)
+        self.k = float(np.mean(f_test * f_test, axis=1) @ wts)
+        f_cand = reflectance(sample, candidates.directions, sample.lit_candidates)  # (P, K)
+        wf = f_cand * wts[:, None]
+        self.phi = f_cand.T @ wf  # (K, K)
+        self.psi = wf.T @ h  # (K, p)
         self.a_test = a_test
         self.dev_cand = design_matrix("hsh3", candidates.directions)  # (K, 16)
         self.dev_test = design_matrix("hsh3", sample.held_out)  # (T, 16)
         self.tau2 = bias_rel**2 * 2 * np.pi / 16  # RMS deviation over the hemisphere = bias_rel
 
-    def _costs(
-        self, a: NDArray[np.float64], f: NDArray[np.float64], dev: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        """Costs of batched layouts: design ``a`` (B, N, p), reflectance ``f`` (B, P, N),
-        deviation basis ``dev`` (B, N, 16) at the chosen lights."""
+    def _costs(self, idx: NDArray[np.intp]) -> NDArray[np.float64]:
+        """Costs of the layouts ``idx`` (B, N) of candidate indices."""
+        a = self.a_cand[idx]  # (B, N, p)
         p = a.shape[-1]
         ata = np.swapaxes(a, 1, 2) @ a + 1e-8 * np.eye(p)
         inv = np.linalg.inv(ata)  # (B, p, p)
-        fit = a @ inv  # (B, N, p)
-        coef = f @ fit  # (B, P, p)
-        bias2 = np.sum(coef * (coef @ self.gram - 2 * self.h[None]), axis=-1) + self.k[None]
+        q = inv @ np.swapaxes(a, 1, 2)  # (B, p, N)
+        phi = self.phi[idx[:, :, None], idx[:, None, :]]  # (B, N, N)
+        psi = self.psi[idx]  # (B, N, p)
+        quad = np.einsum("ij,bjn,bnm,bim->b", self.gram, q, phi, q, optimize=True)
+        cross = np.einsum("bin,bni->b", q, psi)
+        bias2 = np.clip(quad - 2.0 * cross + self.k, 0.0, None)
         var = NOISE_REL**2 * np.einsum("ij,bji->b", self.gram, inv)
-        miss = self.a_test @ (np.swapaxes(fit, 1, 2) @ dev) - self.dev_test  # (B, T, 16)
+        dev = self.dev_cand[idx]  # (B, N, 16)
+        miss = self.a_test @ (q @ dev) - self.dev_test  # (B, T, 16)
         unmodelled = self.tau2 * np.mean(np.sum(miss * miss, axis=-1), axis=-1)
-        return np.clip(bias2, 0.0, None) @ self.wts + var + unmodelled
+        return bias2 + var + unmodelled
 
     def cost(self, chosen: NDArray[np.intp]) -> float:
-        a = self.a_cand[chosen][None]
-        f = self.f_cand[:, chosen][None]
-        return float(self._costs(a, f, self.dev_cand[chosen][None])[0])
+        return float(self._costs(np.asarray(chosen, dtype=np.intp)[None])[0])
 
     def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
         k = len(self.a_cand)
-        a = np.repeat(self.a_cand[chosen][None], k, axis=0)
-        a[:, position] = self.a_cand
-        f = np.repeat(self.f_cand[:, chosen][None], k, axis=0)
-        f[:, :, position] = self.f_cand.T
-        dev = np.repeat(self.dev_cand[chosen][None], k, axis=0)
-        dev[:, position] = self.dev_cand
-        out = np.full(k, np.inf)
-        for lo in range(0, k, 64):  # bounded memory on large arm candidate sets
-            sl = slice(lo, min(k, lo + 64))
-            with np.errstate(all="ignore"):
-                out[sl] = self._costs(a[sl], f[sl], dev[sl])
+        idx = np.repeat(np.asarray(chosen, dtype=np.intp)[None], k, axis=0)
+        idx[:, position] = np.arange(k)
+        with np.errstate(all="ignore"):
+            out = self._costs(idx)
         return np.where(np.isfinite(out), out, np.inf)
 
     def describe(self, value: float) -> str:

@@ -91,6 +91,40 @@ def test_batched_swaps_equal_direct_costs(objective: str) -> None:
         )
 
 
+def test_relight_cost_equals_a_per_pixel_held_out_evaluation() -> None:
+    """The pixel-summed Gram form equals fitting each pixel and scoring it on held-out lights."""
+    from planner.objectives import reflectance
+    from rti_rig.reconstruct.bases import design_matrix
+
+    rng = np.random.default_rng(3)
+    cands = candidates_for(DomeGeometry(fibonacci_cap(40, 5.0, 88.0), tuple(map(str, range(40)))))
+    normals = fibonacci_cap(30, 30.0, 90.0)
+    held = fibonacci_cap(50, 5.0, 90.0)
+    sample = SurfaceSample(
+        normals,
+        rng.uniform(0.5, 2.0, 30),
+        (rng.random((30, 40)) > 0.2).astype(float),  # some cast shadows
+        held,
+        (rng.random((30, 50)) > 0.2).astype(float),
+        0.3,
+    )
+    obj = RelightObjective(sample, cands, "ptm")
+    chosen = rng.choice(40, 10, replace=False)
+    a_s = design_matrix("ptm", cands.directions[chosen])
+    a_t = design_matrix("ptm", held)
+    f_s = reflectance(sample, cands.directions, sample.lit_candidates)[:, chosen]
+    f_t = reflectance(sample, held, sample.lit_held_out)
+    inv = np.linalg.inv(a_s.T @ a_s + 1e-8 * np.eye(6))
+    coef = f_s @ (a_s @ inv)  # (P, p): per-pixel least squares
+    per_pixel = np.mean((coef @ a_t.T - f_t) ** 2, axis=1)
+    w = sample.weights / sample.weights.sum()
+    var = NOISE_REL**2 * np.trace(a_t.T @ a_t / 50 @ inv)
+    dev_s, dev_t = design_matrix("hsh3", cands.directions[chosen]), design_matrix("hsh3", held)
+    miss = a_t @ (inv @ a_s.T @ dev_s) - dev_t
+    unmodelled = obj.tau2 * np.mean(np.sum(miss * miss, axis=1))
+    assert obj.cost(chosen) == pytest.approx(per_pixel @ w + var + unmodelled, rel=1e-9)
+
+
 def test_relight_variance_anchor() -> None:
     """No bias (reflectance in the basis span is impossible to get exactly, so use p/N bound):
     with well spread lights the variance part is close to p σ² / N (algorithms notes §3)."""
