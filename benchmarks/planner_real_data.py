@@ -305,7 +305,8 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
         f'Rows "{len(OFFSETS)} orientations": the homogeneous layout turned about the vertical in '
         f"{360 // len(OFFSETS)}° steps before it is matched to LEDs (every turn is an equally "
         "homogeneous layout), at the floor whose median over turns is lowest; median and range "
-        "over the turns. The layout `uniform` ships (no turn) ranks "
+        "over the turns. The layout `uniform` ships (floor 0°, no turn) ranks, among the turns "
+        "of the floor-0° layout, "
         + ", ".join(f"{shipped_rank[n]} of {len(OFFSETS)} at N = {n}" for n in NS)
         + " among them (1 = best). Against the median turn (what a homogeneous layout gives "
         "an object placed at an arbitrary orientation), previews on which the plan's normal "
