@@ -20,8 +20,13 @@ from rti_rig.bench_tradeoff import (
 )
 
 TINY = TradeoffSettings(
-    scenes=("painting",), size_px=24, counts=(3, 8), ground_truth_lights=60, held_out_lights=8,
-    candidates=40, floors_deg=(0.0, 20.0),
+    scenes=("painting",),
+    size_px=24,
+    counts=(3, 8),
+    ground_truth_lights=60,
+    held_out_lights=8,
+    candidates=40,
+    floors_deg=(0.0, 20.0),
 )
 
 
@@ -53,8 +58,10 @@ def test_scores_see_a_bad_plan() -> None:
     el = np.degrees(np.arcsin(data.candidate_dirs[:, 2]))
     high = np.argsort(-el)[:3]  # three lights around the zenith: nearly coplanar
     az = np.degrees(np.arctan2(data.candidate_dirs[:, 1], data.candidate_dirs[:, 0])) % 360
-    spread = [int(np.argmin(np.abs(el - 45) + np.abs(((az - a + 180) % 360) - 180) / 4))
-              for a in (0, 120, 240)]
+    spread = [
+        int(np.argmin(np.abs(el - 45) + np.abs(((az - a + 180) % 360) - 180) / 4))
+        for a in (0, 120, 240)
+    ]
     bad, good = score_plan(data, high), score_plan(data, np.array(spread))
     assert bad[0] > 3 * good[0]
 

@@ -58,8 +58,8 @@ def test_azimuth_offset_turns_the_layout() -> None:
     dome = DomeGeometry(dirs, tuple(str(i) for i in range(len(dirs))))
     base = select_uniform_leds(dome, 7)
     turned = select_uniform_leds(dome, 7, azimuth_offset_deg=90.0)
-    want = sorted(zip(np.round((az0[base] + 90.0) % 360.0, 6), el0[base]))
-    got = sorted(zip(np.round(az0[turned] % 360.0, 6), el0[turned]))
+    want = sorted(zip(np.round((az0[base] + 90.0) % 360.0, 6), el0[base], strict=True))
+    got = sorted(zip(np.round(az0[turned] % 360.0, 6), el0[turned], strict=True))
     assert got == want
     assert set(base.tolist()) != set(turned.tolist())
 

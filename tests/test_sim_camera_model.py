@@ -8,8 +8,14 @@ from simulator.camera_model import CameraModel, encode_jpeg, to_srgb8
 
 
 def test_noise_mean_and_variance_match_model():
-    cam = CameraModel(full_well_e=20000, read_noise_e=5.0, bit_depth=16, gain=2.0,
-                      black_level_dn=1024, electrons_per_unit_s=1e5)
+    cam = CameraModel(
+        full_well_e=20000,
+        read_noise_e=5.0,
+        bit_depth=16,
+        gain=2.0,
+        black_level_dn=1024,
+        electrons_per_unit_s=1e5,
+    )
     rad = np.full((400, 500), 0.3)
     px, white = cam.expose(rad, 0.1, np.random.default_rng(1))
     k = 2.0 * (65535 - 1024) / 20000

@@ -16,9 +16,14 @@ def _plane_scene(height, albedo=0.5, spec=0.0, rough=1.0, passes=()):
     h = np.asarray(height, dtype=np.float64)
     shape = h.shape
     return Scene(
-        name="test", seed=0, height=h, normals=normals_from_height(h),
-        albedo=np.full((*shape, 3), albedo), specular_albedo=np.full((*shape, 3), spec),
-        roughness=np.full(shape, rough), passes=frozenset(passes),
+        name="test",
+        seed=0,
+        height=h,
+        normals=normals_from_height(h),
+        albedo=np.full((*shape, 3), albedo),
+        specular_albedo=np.full((*shape, 3), spec),
+        roughness=np.full(shape, rough),
+        passes=frozenset(passes),
     )
 
 
