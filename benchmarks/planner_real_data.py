@@ -78,6 +78,14 @@ def load(data: Path) -> tuple[DomeGeometry, np.ndarray, list[np.ndarray]]:
     return DomeGeometry(dirs, names), lum.astype(np.float32), rgb8
 
 
+def reference(images: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Robust photometric stereo on every light, and the mask of well-lit object pixels."""
+    ref_fit = fit_photometric_stereo(images, dirs, robust=True)
+    alb = np.asarray(ref_fit.albedo).reshape(ref_fit.normals.shape[:2])
+    mask = ref_fit.valid & (alb > 0.1 * np.percentile(alb[ref_fit.valid], 99))
+    return ref_fit.normals, mask
+
+
 def ls_normals(images: np.ndarray, lights: np.ndarray) -> np.ndarray:
     b = np.tensordot(np.linalg.pinv(lights), images, axes=(1, 0))  # (3, H, W)
     b = np.moveaxis(b, 0, -1)
@@ -161,10 +169,7 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
     t0 = time.perf_counter()
     dome, images, rgb8 = load(data)
     dirs = dome.directions
-    ref_fit = fit_photometric_stereo(images, dirs, robust=True)
-    ref = ref_fit.normals
-    alb = np.asarray(ref_fit.albedo).reshape(ref.shape[:2])
-    mask = ref_fit.valid & (alb > 0.1 * np.percentile(alb[ref_fit.valid], 99))
+    ref, mask = reference(images, dirs)
     az, el = az_el_from_direction(dirs)
     band = np.flatnonzero((el >= 40.0) & (el <= 62.0))
     band = band[np.argsort(el[band])]
