@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import signal
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.console import Console
@@ -449,11 +449,15 @@ def check(
         float, typer.Option("--intensity", help="LED intensity for the walk (0-1).")
     ] = 0.2,
 ) -> None:
-    """Self-test a dome: handshake, then light each LED in turn and report what answered."""
+    """Self-test the rig's lights: a dome lights each LED in turn and reports what answered; an
+    arm visits poses spanning its band (checking where it really got to), flashes the lamp at
+    each and parks."""
+    from rti_rig.arm_check import arm_self_test
     from rti_rig.compose import build_rig
     from rti_rig.config import load_rig_config
     from rti_rig.dome_policy import self_test
-    from rti_rig.lighting import DomeLighting
+    from rti_rig.lighting import ArmLighting, DomeLighting
+    from rti_rig.rig_geometry import ArmGeometry
 
     try:
         loaded = load_rig_config(rig_config)
@@ -461,9 +465,13 @@ def check(
     except RtiRigError as exc:
         raise _fail(exc) from None
     with rig:
-        if not isinstance(rig.lighting, DomeLighting):
-            raise _fail(RtiRigError(f"{rig_config}: 'check' walks a dome's LEDs; this is an arm"))
-        report = self_test(rig.lighting.source, rig.clock, intensity=intensity)
+        report: Any
+        if isinstance(rig.lighting, DomeLighting):
+            report = self_test(rig.lighting.source, rig.clock, intensity=intensity)
+        elif isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
+            report = arm_self_test(rig.lighting.carrier, rig.geometry, rig.clock)
+        else:
+            raise _fail(RtiRigError(f"{rig_config}: no self-test for this kind of lighting"))
     for line in report.lines():
         out.print(line, highlight=False)
     if not report.ok:

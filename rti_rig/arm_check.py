@@ -1,0 +1,171 @@
+"""Self-test of a light-carrying arm: connect, visit a few poses that span its band, park.
+
+What a user wants to know before trusting an arm with an object under it: does every joint
+answer, does the arm reach where it is told (within ``tolerance_deg``) across its whole band —
+lowest and highest reachable elevations, both ends of its azimuth range — does the lamp switch,
+and how long does a move take. Every pose is checked against the arm's limits and keep-out cone
+*before* it is sent; the lamp is switched off and the arm stopped whatever happens, and it
+parks at the end unless the test was aborted by a device error (moving a faulty arm near an
+object is what the abort protects against; the same rule as an emergency stop).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.clock import Clock
+from rti_rig.errors import DeviceError
+from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
+from rti_rig.rig import LightCarrier
+from rti_rig.rig_geometry import ArmGeometry
+
+#: Largest angle between the asked and the reached direction that passes (degrees).
+TOLERANCE_DEG = 1.0
+
+
+@dataclass(frozen=True)
+class PoseCheck:
+    """One visited pose: asked and reached (azimuth, elevation), the error and the move time."""
+
+    label: str
+    asked_az_el: tuple[float, float]
+    reached_az_el: tuple[float, float] | None
+    error_deg: float | None
+    move_s: float | None
+    ok: bool
+    message: str = ""
+
+
+@dataclass
+class ArmSelfTestReport:
+    """What the arm self-test saw, for the CLI to print."""
+
+    name: str
+    tolerance_deg: float
+    checks: list[PoseCheck] = field(default_factory=list)
+    parked: bool = False
+    aborted: str | None = None
+    teardown_failures: list[str] = field(default_factory=list)
+    elapsed_s: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return (
+            self.aborted is None
+            and not self.teardown_failures
+            and bool(self.checks)
+            and all(c.ok for c in self.checks)
+            and self.parked
+        )
+
+    def lines(self) -> list[str]:
+        out = [
+            f"arm {self.name}: {len(self.checks)} poses, tolerance {self.tolerance_deg:g}°",
+            "  pose               asked az/el       reached az/el     error   move",
+        ]
+        for c in self.checks:
+            az, el = c.asked_az_el
+            if c.reached_az_el is None:
+                out.append(f"  {c.label:18s} {az:7.2f}°/{el:5.2f}°  FAIL {c.message}")
+                continue
+            raz, rel = c.reached_az_el
+            verdict = "ok" if c.ok else f"FAIL {c.message}"
+            out.append(
+                f"  {c.label:18s} {az:7.2f}°/{el:5.2f}° → {raz:7.2f}°/{rel:5.2f}°  "
+                f"{c.error_deg:.3f}°  {c.move_s:5.2f} s  {verdict}"
+            )
+        moves = [c.move_s for c in self.checks if c.move_s is not None]
+        if moves:
+            out.append(f"move time: median {np.median(moves):.2f} s, longest {max(moves):.2f} s")
+        if self.aborted:
+            out.append(f"ABORTED: {self.aborted} (lamp off and arm stopped; not parked)")
+        out.extend(f"teardown: {f}" for f in self.teardown_failures)
+        out.append("parked" if self.parked else "NOT parked")
+        out.append(f"elapsed {self.elapsed_s:.1f} s on the rig's clock")
+        out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
+        return out
+
+
+def self_test_poses(geometry: ArmGeometry) -> list[tuple[str, NDArray[np.float64]]]:
+    """Poses spanning the arm's band: both elevation extremes, the azimuth range's ends, middle.
+
+    Kept 0.5° inside every limit, so that a correct arm is never asked for a pose on the edge of
+    what its own limit checks accept.
+    """
+    lo, hi = geometry.elevation_band(0.0)
+    lo, hi = lo + 0.5, hi - 0.5
+    mid = 0.5 * (lo + hi)
+    az_lo = geometry.min_azimuth_deg + 0.5
+    az_hi = geometry.max_azimuth_deg - 0.5
+    if az_hi - az_lo >= 359.0:  # a full turn: four quarters
+        azimuths = [0.0, 90.0, 180.0, -90.0]
+    else:
+        azimuths = list(np.linspace(az_lo, az_hi, 4))
+    poses = [(f"low, az {a:.0f}°", direction_from_az_el(a, lo)) for a in azimuths[::2]]
+    poses += [(f"high, az {a:.0f}°", direction_from_az_el(a, hi)) for a in azimuths[1::2]]
+    poses += [(f"middle, az {a:.0f}°", direction_from_az_el(a, mid)) for a in azimuths]
+    return poses
+
+
+def _az_el(direction: NDArray[np.float64]) -> tuple[float, float]:
+    az, el = az_el_from_direction(np.asarray(direction, dtype=np.float64))
+    a = float(az) - 360.0 if float(az) > 180.0 else float(az)
+    return a, float(el)
+
+
+def arm_self_test(
+    carrier: LightCarrier,
+    geometry: ArmGeometry,
+    clock: Clock,
+    *,
+    tolerance_deg: float = TOLERANCE_DEG,
+    lamp_s: float = 0.05,
+) -> ArmSelfTestReport:
+    """Connect, visit :func:`self_test_poses` (lamp flashed at each), park, close; never raises for
+    a device error — the report says what failed."""
+    started = clock.now()
+    report = ArmSelfTestReport(carrier.name, tolerance_deg)
+    poses = self_test_poses(geometry)
+    # validate every pose before anything connects or moves
+    for label, d in poses:
+        reason = geometry.unreachable_reason(d) or carrier.unreachable_reason(d)
+        if reason:
+            report.aborted = f"pose '{label}' refused before moving: {reason}"
+            report.elapsed_s = clock.now() - started
+            return report
+    try:
+        carrier.connect()
+        for label, d in poses:
+            t0 = clock.now()
+            try:
+                reached = np.asarray(carrier.move_to(d), dtype=np.float64)
+            except DeviceError as exc:
+                report.checks.append(PoseCheck(label, _az_el(d), None, None, None, False, str(exc)))
+                raise
+            move_s = clock.now() - t0
+            err = float(angle_between_deg(reached, d))
+            carrier.lamp(True)
+            clock.sleep(lamp_s)
+            carrier.lamp(False)
+            ok = err <= tolerance_deg
+            msg = "" if ok else f"reached {err:.2f}° from the asked direction"
+            report.checks.append(PoseCheck(label, _az_el(d), _az_el(reached), err, move_s, ok, msg))
+        carrier.park()
+        report.parked = True
+    except DeviceError as exc:
+        report.aborted = str(exc)
+    finally:
+        for label, action in (("lamp off", lambda: carrier.lamp(False)), ("stop", carrier.stop)):
+            try:
+                action()
+            except Exception as exc:  # teardown goes on whatever one device does
+                report.teardown_failures.append(f"{label}: {exc}")
+        try:
+            carrier.close()
+        except DeviceError as exc:
+            report.teardown_failures.append(f"close: {exc}")
+        report.elapsed_s = clock.now() - started
+    return report

@@ -1,0 +1,130 @@
+"""Arm self-test (`rti-rig check` on an arm): poses span the band, errors are caught, teardown."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.arm_check import arm_self_test, self_test_poses
+from rti_rig.cli import app
+from rti_rig.clock import VirtualClock
+from rti_rig.errors import DeviceError
+from rti_rig.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.rig_geometry import ArmGeometry
+
+runner = CliRunner()
+ARM = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
+
+
+class FakeCarrier:
+    """A carrier that records what it was told; optional aim error, failure and refusal."""
+
+    name = "fake arm"
+
+    def __init__(
+        self, aim_error_deg: float = 0.0, fail_on_move: int | None = None, refuse: bool = False
+    ) -> None:
+        self.log: list[str] = []
+        self.aim_error_deg = aim_error_deg
+        self.fail_on_move = fail_on_move
+        self.refuse = refuse
+        self.moves = 0
+
+    def connect(self) -> None:
+        self.log.append("connect")
+
+    def close(self) -> None:
+        self.log.append("close")
+
+    def unreachable_reason(self, direction: np.ndarray) -> str | None:
+        return "the fake refuses everything" if self.refuse else None
+
+    def move_to(self, direction: np.ndarray) -> np.ndarray:
+        self.moves += 1
+        if self.fail_on_move == self.moves:
+            raise DeviceError(self.name, "servo 2 reports an overload error")
+        self.log.append("move")
+        az, el = az_el_from_direction(np.asarray(direction))
+        return direction_from_az_el(float(az), float(el) - self.aim_error_deg)
+
+    def lamp(self, on: bool) -> None:
+        self.log.append(f"lamp {'on' if on else 'off'}")
+
+    def stop(self) -> None:
+        self.log.append("stop")
+
+    def park(self) -> None:
+        self.log.append("park")
+
+
+@pytest.mark.parametrize(
+    "geometry",
+    [ARM, ArmGeometry(0.0, 75.0, 15.0, -170.0, 0.0, -170.0, 170.0)],
+    ids=["full turn", "limited azimuth"],
+)
+def test_poses_span_the_band_inside_every_limit(geometry: ArmGeometry) -> None:
+    poses = self_test_poses(geometry)
+    dirs = np.array([d for _, d in poses])
+    assert all(geometry.unreachable_reason(d) is None for d in dirs)
+    az, el = az_el_from_direction(dirs)
+    lo, hi = geometry.elevation_band()
+    assert el.min() == pytest.approx(lo + 0.5) and el.max() == pytest.approx(hi - 0.5)
+    az = np.where(az > 180.0, az - 360.0, az)
+    span = az.max() - az.min()
+    assert span >= min(180.0, geometry.max_azimuth_deg - geometry.min_azimuth_deg - 1.0) - 1e-6
+
+
+def test_a_good_arm_passes_flashes_the_lamp_and_parks() -> None:
+    carrier = FakeCarrier()
+    report = arm_self_test(carrier, ARM, VirtualClock())
+    assert report.ok, report.lines()
+    assert carrier.log.count("move") == len(self_test_poses(ARM))
+    assert carrier.log.count("lamp on") == carrier.log.count("move")
+    assert carrier.log[-4:] == ["park", "lamp off", "stop", "close"]
+    assert report.lines()[-1] == "RESULT: PASS"
+
+
+def test_an_arm_that_misses_its_target_fails_naming_the_error() -> None:
+    report = arm_self_test(FakeCarrier(aim_error_deg=2.0), ARM, VirtualClock())
+    assert not report.ok
+    assert all(not c.ok for c in report.checks)
+    text = "\n".join(report.lines())
+    assert "reached 2.00° from the asked direction" in text
+    assert text.endswith("RESULT: FAIL")
+
+
+def test_a_device_error_aborts_without_parking_but_makes_the_arm_safe() -> None:
+    carrier = FakeCarrier(fail_on_move=3)
+    report = arm_self_test(carrier, ARM, VirtualClock())
+    assert not report.ok
+    assert report.aborted and "overload" in report.aborted
+    assert "park" not in carrier.log
+    assert carrier.log[-3:] == ["lamp off", "stop", "close"]
+    assert len(report.checks) == 3 and not report.checks[-1].ok
+    assert "not parked" in "\n".join(report.lines())
+
+
+def test_a_refused_pose_stops_the_test_before_anything_connects() -> None:
+    carrier = FakeCarrier(refuse=True)
+    report = arm_self_test(carrier, ARM, VirtualClock())
+    assert not report.ok
+    assert "refused before moving" in (report.aborted or "")
+    assert carrier.log == []
+
+
+@pytest.mark.parametrize("config", ["virtual_arm.toml", "simulated_arm.toml"])
+def test_check_command_on_the_shipped_arm_configs(config: str) -> None:
+    """The pure simulated arm and the emulated Dynamixel arm (real SDK on a pty) both pass."""
+    r = runner.invoke(app, ["check", str(CONFIGS / config)])
+    assert r.exit_code == 0, r.output
+    assert "RESULT: PASS" in r.output
+    assert "8 poses" in r.output and "parked" in r.output
+
+
+def test_check_command_fails_on_a_missing_config(tmp_path: Path) -> None:
+    r = runner.invoke(app, ["check", str(tmp_path / "nope.toml")])
+    assert r.exit_code != 0
