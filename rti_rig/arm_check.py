@@ -17,7 +17,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.clock import Clock
-from rti_rig.errors import DeviceError
 from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.rig import LightCarrier
 from rti_rig.rig_geometry import ArmGeometry
@@ -45,6 +44,7 @@ class ArmSelfTestReport:
 
     name: str
     tolerance_deg: float
+    park_wanted: bool = True
     checks: list[PoseCheck] = field(default_factory=list)
     parked: bool = False
     aborted: str | None = None
@@ -58,7 +58,7 @@ class ArmSelfTestReport:
             and not self.teardown_failures
             and bool(self.checks)
             and all(c.ok for c in self.checks)
-            and self.parked
+            and self.parked == self.park_wanted
         )
 
     def lines(self) -> list[str]:
@@ -81,9 +81,12 @@ class ArmSelfTestReport:
         if moves:
             out.append(f"move time: median {np.median(moves):.2f} s, longest {max(moves):.2f} s")
         if self.aborted:
-            out.append(f"ABORTED: {self.aborted} (lamp off and arm stopped; not parked)")
-        out.extend(f"teardown: {f}" for f in self.teardown_failures)
-        out.append("parked" if self.parked else "NOT parked")
+            out.append(f"ABORTED: {self.aborted} (the arm is left where it stopped, not parked)")
+        out.extend(f"teardown FAILED: {f}" for f in self.teardown_failures)
+        if self.parked:
+            out.append("parked")
+        else:
+            out.append("NOT parked" + ("" if self.park_wanted else " (park_after_session is off)"))
         out.append(f"elapsed {self.elapsed_s:.1f} s on the rig's clock")
         out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
@@ -98,12 +101,8 @@ def self_test_poses(geometry: ArmGeometry) -> list[tuple[str, NDArray[np.float64
     lo, hi = geometry.elevation_band(0.0)
     lo, hi = lo + 0.5, hi - 0.5
     mid = 0.5 * (lo + hi)
-    az_lo = geometry.min_azimuth_deg + 0.5
-    az_hi = geometry.max_azimuth_deg - 0.5
-    if az_hi - az_lo >= 359.0:  # a full turn: four quarters
-        azimuths = [0.0, 90.0, 180.0, -90.0]
-    else:
-        azimuths = list(np.linspace(az_lo, az_hi, 4))
+    # both ends of the azimuth range (on a full turn: either side of the cable stop) and between
+    azimuths = list(np.linspace(geometry.min_azimuth_deg + 0.5, geometry.max_azimuth_deg - 0.5, 4))
     poses = [(f"low, az {a:.0f}°", direction_from_az_el(a, lo)) for a in azimuths[::2]]
     poses += [(f"high, az {a:.0f}°", direction_from_az_el(a, hi)) for a in azimuths[1::2]]
     poses += [(f"middle, az {a:.0f}°", direction_from_az_el(a, mid)) for a in azimuths]
@@ -123,11 +122,14 @@ def arm_self_test(
     *,
     tolerance_deg: float = TOLERANCE_DEG,
     lamp_s: float = 0.05,
+    park: bool = True,
 ) -> ArmSelfTestReport:
-    """Connect, visit :func:`self_test_poses` (lamp flashed at each), park, close; never raises for
-    a device error — the report says what failed."""
+    """Connect, visit :func:`self_test_poses` (lamp flashed at each), park (unless ``park`` is
+    off: the rig's ``park_after_session`` policy), close. An error of the arm or its driver
+    ends the walk and is reported, never raised; the lamp is switched off and the arm stopped in
+    every case, and it is not parked after an error."""
     started = clock.now()
-    report = ArmSelfTestReport(carrier.name, tolerance_deg)
+    report = ArmSelfTestReport(carrier.name, tolerance_deg, park_wanted=park)
     poses = self_test_poses(geometry)
     # validate every pose before anything connects or moves
     for label, d in poses:
@@ -142,30 +144,31 @@ def arm_self_test(
             t0 = clock.now()
             try:
                 reached = np.asarray(carrier.move_to(d), dtype=np.float64)
-            except DeviceError as exc:
+            except Exception as exc:
                 report.checks.append(PoseCheck(label, _az_el(d), None, None, None, False, str(exc)))
                 raise
             move_s = clock.now() - t0
             err = float(angle_between_deg(reached, d))
-            carrier.lamp(True)
-            clock.sleep(lamp_s)
-            carrier.lamp(False)
             ok = err <= tolerance_deg
             msg = "" if ok else f"reached {err:.2f}° from the asked direction"
             report.checks.append(PoseCheck(label, _az_el(d), _az_el(reached), err, move_s, ok, msg))
-        carrier.park()
-        report.parked = True
-    except DeviceError as exc:
-        report.aborted = str(exc)
+            carrier.lamp(True)
+            clock.sleep(lamp_s)
+            carrier.lamp(False)
+        if park:
+            carrier.park()
+            report.parked = True
+    except Exception as exc:  # a self-test reports what went wrong; teardown follows
+        report.aborted = f"{type(exc).__name__}: {exc}"
     finally:
-        for label, action in (("lamp off", lambda: carrier.lamp(False)), ("stop", carrier.stop)):
+        for label, action in (
+            ("lamp off", lambda: carrier.lamp(False)),
+            ("stop", carrier.stop),
+            ("close", carrier.close),
+        ):
             try:
                 action()
             except Exception as exc:  # teardown goes on whatever one device does
                 report.teardown_failures.append(f"{label}: {exc}")
-        try:
-            carrier.close()
-        except DeviceError as exc:
-            report.teardown_failures.append(f"close: {exc}")
         report.elapsed_s = clock.now() - started
     return report

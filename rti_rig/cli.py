@@ -469,7 +469,12 @@ def check(
         if isinstance(rig.lighting, DomeLighting):
             report = self_test(rig.lighting.source, rig.clock, intensity=intensity)
         elif isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
-            report = arm_self_test(rig.lighting.carrier, rig.geometry, rig.clock)
+            report = arm_self_test(
+                rig.lighting.carrier,
+                rig.geometry,
+                rig.clock,
+                park=rig.lighting.park_after_session,
+            )
         else:
             raise _fail(RtiRigError(f"{rig_config}: no self-test for this kind of lighting"))
     for line in report.lines():

@@ -78,7 +78,11 @@ class DiscreteLightSource(Protocol):
 
 @runtime_checkable
 class LightCarrier(Protocol):
-    """A lamp moved to arbitrary directions (a servo arm). Safe state: lamp off, stopped, parked."""
+    """A lamp moved to arbitrary directions (a servo arm).
+
+    Safe state: lamp off, stopped. ``close`` switches the lamp off and stops but never moves the
+    arm; parking is a move that the caller's policy decides (``ArmLighting.safe``).
+    """
 
     name: str
 

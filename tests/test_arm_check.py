@@ -108,6 +108,56 @@ def test_a_device_error_aborts_without_parking_but_makes_the_arm_safe() -> None:
     assert "not parked" in "\n".join(report.lines())
 
 
+def test_any_other_error_is_reported_too_and_the_arm_made_safe() -> None:
+    carrier = FakeCarrier()
+
+    def broken_lamp(on: bool) -> None:
+        carrier.log.append(f"lamp {'on' if on else 'off'}")
+        if on:
+            raise OSError("lamp relay driver not found")
+
+    carrier.lamp = broken_lamp  # type: ignore[method-assign]
+    report = arm_self_test(carrier, ARM, VirtualClock())
+    assert not report.ok
+    assert report.aborted == "OSError: lamp relay driver not found"
+    assert len(report.checks) == 1 and report.checks[0].ok  # the pose reached is still reported
+    assert "park" not in carrier.log and carrier.log[-2:] == ["stop", "close"]
+
+
+def test_park_after_session_off_is_respected() -> None:
+    carrier = FakeCarrier()
+    report = arm_self_test(carrier, ARM, VirtualClock(), park=False)
+    assert report.ok
+    assert "park" not in carrier.log
+    assert "NOT parked (park_after_session is off)" in report.lines()
+
+
+def test_the_real_driver_is_not_parked_after_an_error(tmp_path: Path) -> None:
+    """Emulated XL430s through the real SDK: a move that fails (an obstruction, say) leaves the
+    arm where it stopped — the driver's close must not park it behind the test's back."""
+    from rti_rig.compose import build_rig
+    from rti_rig.config import load_rig_config
+
+    with build_rig(load_rig_config(CONFIGS / "simulated_arm.toml")) as rig:
+        carrier = rig.lighting.carrier  # type: ignore[attr-defined]
+        emulator = rig.emulator  # type: ignore[attr-defined]
+        real_move, moves = carrier.move_to, []
+
+        def move_until_blocked(direction: np.ndarray) -> np.ndarray:
+            moves.append(direction)
+            if len(moves) == 3:
+                raise DeviceError(carrier.name, "not in position after 5 s: obstructed?")
+            return real_move(direction)
+
+        carrier.move_to = move_until_blocked
+        report = arm_self_test(carrier, rig.geometry, rig.clock)  # type: ignore[arg-type]
+        assert not report.ok and "obstructed" in (report.aborted or "")
+        ticks = tuple(round(v) for v in emulator.joint_positions().values())
+        park = carrier.kin.ticks_of_pose(0.0, 10.0)
+        assert max(abs(a - b) for a, b in zip(ticks, park, strict=True)) > 20
+        assert not carrier.lamp_is_on
+
+
 def test_a_refused_pose_stops_the_test_before_anything_connects() -> None:
     carrier = FakeCarrier(refuse=True)
     report = arm_self_test(carrier, ARM, VirtualClock())
@@ -122,7 +172,7 @@ def test_check_command_on_the_shipped_arm_configs(config: str) -> None:
     r = runner.invoke(app, ["check", str(CONFIGS / config)])
     assert r.exit_code == 0, r.output
     assert "RESULT: PASS" in r.output
-    assert "8 poses" in r.output and "parked" in r.output
+    assert "8 poses" in r.output and "\nparked\n" in r.output and "NOT parked" not in r.output
 
 
 def test_check_command_fails_on_a_missing_config(tmp_path: Path) -> None:

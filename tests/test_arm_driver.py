@@ -47,10 +47,12 @@ def test_is_a_light_carrier_and_moves_where_asked() -> None:
         assert angle_between_deg(reached, target) < 0.2  # a tick is 0.088 deg
         ticks = emu.joint_positions()
         assert angle_between_deg(arm.kin.direction_of_ticks(ticks[1], ticks[2]), target) < 0.2
+    held = tuple(round(v) for v in emu.joint_positions().values())
     arm.close()
-    assert emu.servos[1].get(ct.TORQUE_ENABLE) == 1  # "hold" policy: parked and holding
-    park = arm.kin.ticks_of_pose(0.0, 10.0)
-    assert tuple(round(v) for v in emu.joint_positions().values()) == park
+    # "hold" policy: torque stays on, and close never moves the arm (parking is policy's call)
+    assert emu.servos[1].get(ct.TORQUE_ENABLE) == 1
+    assert tuple(round(v) for v in emu.joint_positions().values()) == held
+    assert held != arm.kin.ticks_of_pose(0.0, 10.0)
     arm.close()  # twice is fine
 
 
@@ -134,7 +136,7 @@ def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
         arm.move_to(direction_from_az_el(150, 30))
     assert info.value.fault_names == ["overload"] and info.value.servo_id == 1
     with pytest.raises(HardwareFaultError):
-        arm.close()  # parking a faulted servo fails, loudly, but the port is released
+        arm.close()  # stopping a faulted servo fails, loudly, but the port is released
     assert not arm.lamp_is_on
 
 

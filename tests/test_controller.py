@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import SMALL_DOME, write_config
+from conftest import REPO, SMALL_DOME, write_config
 
 from planner.uniform import plan_uniform
 from rti_rig.assembly import Rig
@@ -261,6 +261,30 @@ def test_arm_emergency_stop_follows_parking_policy(
     m = manifest(out)
     assert m["runner"]["finish_reason"] == "emergency-stop"
     assert_images_intact(out, 3)
+
+
+@pytest.mark.parametrize("park_on_emergency", [False, True])
+def test_emulated_dynamixel_arm_stays_put_after_an_emergency_stop_unless_told(
+    tmp_path: Path, park_on_emergency: bool
+) -> None:
+    """The real driver's close must not park behind the policy's back (it once did)."""
+    from rti_rig.controller import EmergencyStop
+
+    text = (REPO / "rig_configs" / "simulated_arm.toml").read_text()
+    text = text.replace("width = 256", "width = 32").replace("height = 256", "height = 32")
+    text = text.replace(
+        "default_lights = 24",
+        f"default_lights = 24\npark_on_emergency_stop = {str(park_on_emergency).lower()}",
+    )
+    rig = build_rig(load_rig_config(write_config(tmp_path, text)))
+    rig.camera = FailingCamera(rig.camera, 3, EmergencyStop("SIGTERM"))
+    with rig, pytest.raises(EmergencyStop):
+        run_session(rig, plan_uniform(rig.geometry, 8), SessionFolder.create(tmp_path / "s", 8))
+    arm = rig.lighting.carrier  # type: ignore[attr-defined]
+    ticks = tuple(round(v) for v in rig.emulator.joint_positions().values())  # type: ignore[attr-defined]
+    park = arm.kin.ticks_of_pose(0.0, 10.0)
+    assert (max(abs(a - b) for a, b in zip(ticks, park, strict=True)) <= 2) is park_on_emergency
+    assert not arm.lamp_is_on
 
 
 def test_simulated_dslr_frames_go_through_the_raw_decode_path(tmp_path: Path) -> None:

@@ -175,15 +175,19 @@ class DynamixelArm:
             )
 
     def close(self) -> None:
-        """Restore the safe state (lamp off, stopped, parked; torque policy) and release the port.
+        """Lamp off, motion stopped (torque policy applied), port released — the arm is not moved.
 
-        Safe to call twice and after a failed ``connect``. Errors during teardown are logged and
-        the first one is re-raised after the port has been closed."""
+        Parking is a move, and whether to move is policy: after a session the rig parks the arm
+        first (``ArmLighting.safe``), after an emergency stop or a failed self-test it must not
+        (the arm may be stopped against an obstruction). So ``close`` never parks; call
+        ``park()`` before it when that is wanted. Safe to call twice and after a failed
+        ``connect``. Errors during teardown are logged and the first one is re-raised after the
+        port has been closed."""
         if not self._connected:
             self._bus.close()
             return
         first: BaseException | None = None
-        steps = [lambda: self.lamp(False), self.stop, self.park]
+        steps = [lambda: self.lamp(False), self.stop]
         if self.settings.torque_policy == "release_on_close":
             steps.append(lambda: self._bus.broadcast_write(ct.TORQUE_ENABLE, 0))
         for step in steps:
