@@ -316,10 +316,22 @@ class NormalsObjective:
         r = self.cross[:, chosen].sum(axis=1)[:, None] if self.tau2 > 0 else None
         return float(self._total(m, r)[0])
 
-    def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
-        """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch."""
+    def swap_costs(
+        self, chosen: NDArray[np.intp], position: int, exact: bool = False
+    ) -> NDArray[np.float64]:
+        """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch.
+
+        Single precision unless ``exact``: enough to rank swaps, except where a pixel is lit
+        by one or two lights (a near-singular 3×3 whose determinant float32 cannot resolve);
+        the exchange search re-scans exactly when a proposed swap is not confirmed.
+        """
         base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
         r = None
+        if exact:
+            if self.tau2 > 0:
+                rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
+                r = rb[:, None] + self.cross
+            return self._total(base[:, None, :] + self.outer, r)
         if self.cross32 is not None:
             rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
             r = rb.astype(np.float32)[:, None] + self.cross32  # (3, K, P_bias, 9)
@@ -405,7 +417,10 @@ class RelightObjective:
     def cost(self, chosen: NDArray[np.intp]) -> float:
         return float(self._costs(np.asarray(chosen, dtype=np.intp)[None])[0])
 
-    def swap_costs(self, chosen: NDArray[np.intp], position: int) -> NDArray[np.float64]:
+    def swap_costs(
+        self, chosen: NDArray[np.intp], position: int, exact: bool = False
+    ) -> NDArray[np.float64]:
+        """Cost of replacing ``chosen[position]`` by each candidate (always double precision)."""
         k = len(self.a_cand)
         idx = np.repeat(np.asarray(chosen, dtype=np.intp)[None], k, axis=0)
         idx[:, position] = np.arange(k)

@@ -63,11 +63,14 @@ def exchange_search(
     for _ in range(limit):
         changed = False
         for pos in range(n):
-            trial = objective.swap_costs(chosen, pos)
-            trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
-            k = int(np.argmin(trial))
-            if float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):
-                # the scan may be approximate (single precision): accept on the exact cost
+            for exact_scan in (False, True):
+                # the fast scan may be approximate (single precision): a swap is accepted on its
+                # exact cost, and a proposal that cost does not confirm earns an exact re-scan
+                trial = objective.swap_costs(chosen, pos, exact=exact_scan)
+                trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
+                k = int(np.argmin(trial))
+                if not float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):
+                    break  # no improving swap at this position
                 previous = int(chosen[pos])
                 chosen[pos] = k
                 exact = objective.cost(chosen)
@@ -75,8 +78,8 @@ def exchange_search(
                     cost = exact
                     swaps += 1
                     changed = True
-                else:
-                    chosen[pos] = previous
+                    break
+                chosen[pos] = previous
         if not changed:
             break
     return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)

@@ -179,7 +179,7 @@ def test_exchange_accepts_a_swap_only_on_its_exact_cost() -> None:
         def cost(self, chosen: np.ndarray) -> float:
             return float(np.sum(chosen))  # lower indices are better
 
-        def swap_costs(self, chosen: np.ndarray, position: int) -> np.ndarray:
+        def swap_costs(self, chosen: np.ndarray, position: int, exact: bool = False) -> np.ndarray:
             out = np.full(10, np.inf)
             out[9] = -1.0  # claims that index 9 (the worst) is a great replacement
             return out
@@ -188,6 +188,42 @@ def test_exchange_accepts_a_swap_only_on_its_exact_cost() -> None:
     assert res.chosen.tolist() == [0, 1, 2]
     assert res.swaps == 0
     assert res.cost == 3.0
+
+
+def test_a_rejected_fast_proposal_is_followed_by_an_exact_scan() -> None:
+    """The fast scan proposes a bad swap; the exact re-scan finds the real improvement."""
+
+    class FastScanWrong:
+        def cost(self, chosen: np.ndarray) -> float:
+            return float(np.sum(chosen))
+
+        def swap_costs(self, chosen: np.ndarray, position: int, exact: bool = False) -> np.ndarray:
+            if not exact:
+                out = np.full(10, np.inf)
+                out[9] = -1.0
+                return out
+            return np.array([float(np.sum(chosen) - chosen[position] + k) for k in range(10)])
+
+    res = exchange_search(FastScanWrong(), [("start", np.array([4, 5, 6]))])  # type: ignore[arg-type]
+    assert sorted(res.chosen.tolist()) == [0, 1, 2]
+    assert res.cost == 3.0
+
+
+def test_variance_matches_the_trace_formula_on_tilted_normals() -> None:
+    """Both precisions of the closed form equal σ² tr(P M⁻¹ P) computed with numpy."""
+    cands = Candidates(fibonacci_cap(40, 5.0, 88.0), None, None)
+    normals = np.array([direction_from_az_el(a, e) for a, e in [(20, 50), (200, 35), (300, 70)]])
+    obj = NormalsObjective(make_sample(normals, cands), cands, bias_rel=0.0)
+    chosen = np.array([0, 5, 11, 17, 23, 31, 38])
+    m = obj.outer[:, chosen].sum(axis=1)[:, None]  # (6, 1, P)
+    want = []
+    for p, n in enumerate(normals):
+        e = m[:, 0, p]
+        mm = np.array([[e[0], e[1], e[2]], [e[1], e[3], e[4]], [e[2], e[4], e[5]]])
+        proj = np.eye(3) - np.outer(n, n)
+        want.append(NOISE_REL**2 * np.trace(proj @ np.linalg.inv(mm) @ proj))
+    assert obj._variance(m)[0] == pytest.approx(want, rel=1e-8)
+    assert obj._variance(m.astype(np.float32))[0] == pytest.approx(want, rel=1e-4)
 
 
 def test_snap_unique_and_too_many() -> None:
