@@ -56,6 +56,18 @@ def test_is_a_light_carrier_and_moves_where_asked() -> None:
     arm.close()  # twice is fine
 
 
+def test_release_on_close_releases_torque_only_at_the_park_pose() -> None:
+    arm, emu, _clock = make_arm(torque_policy="release_on_close")
+    arm.connect()
+    arm.move_to(direction_from_az_el(40, 60))
+    arm.close()  # stopped mid-band: a limp arm could drop, so it keeps holding
+    assert emu.servos[1].get(ct.TORQUE_ENABLE) == 1 and emu.servos[2].get(ct.TORQUE_ENABLE) == 1
+    arm.connect()
+    arm.park()
+    arm.close()  # parked: released
+    assert emu.servos[1].get(ct.TORQUE_ENABLE) == 0 and emu.servos[2].get(ct.TORQUE_ENABLE) == 0
+
+
 def test_move_time_matches_the_motion_model() -> None:
     arm, _emu, clock = make_arm(settle_time_s=0.0, poll_interval_s=0.005)
     arm.connect()

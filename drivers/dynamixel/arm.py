@@ -1,8 +1,9 @@
 """The servo-arm light carrier: policy for two Dynamixel X-series joints.
 
-Safe state (``rti_rig.rig.LightCarrier``): lamp off, motion stopped, parked. ``close`` restores
-it as far as the hardware allows, then applies the torque policy ("hold": servos keep holding
-the park pose, so the arm cannot fall; "release_on_close": torque off after parking).
+Safe state (``rti_rig.rig.LightCarrier``): lamp off, motion stopped. ``close`` restores it as far
+as the hardware allows without moving the arm (parking is the caller's policy), then applies the
+torque policy ("hold": servos keep holding where they are, so the arm cannot fall;
+"release_on_close": torque off, but only if the arm is at the park pose).
 
 The lamp is **tracked in software** by default (the lamp's own switch is outside the servo
 bus); with ``lamp = "servo_led"`` the state is also mirrored on the LED register (65) of
@@ -189,7 +190,7 @@ class DynamixelArm:
         first: BaseException | None = None
         steps = [lambda: self.lamp(False), self.stop]
         if self.settings.torque_policy == "release_on_close":
-            steps.append(lambda: self._bus.broadcast_write(ct.TORQUE_ENABLE, 0))
+            steps.append(self._release_if_parked)
         for step in steps:
             try:
                 step()
@@ -200,6 +201,29 @@ class DynamixelArm:
         self._bus.close()
         if first is not None:
             raise first
+
+    #: How close (ticks, each joint) to the park pose counts as parked for releasing torque.
+    PARKED_TICKS = 8
+
+    def _release_if_parked(self) -> None:
+        """``release_on_close``: torque off only at the park pose, where the arm rests safely.
+
+        Anywhere else a limp arm can drop onto the object, so torque stays on (holding) and the
+        reason is logged: close never parks (see :meth:`close`)."""
+        s = self.settings
+        park = self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
+        present = self.joint_ticks()
+        if (
+            max(abs(int(a) - int(b)) for a, b in zip(present, park, strict=True))
+            <= self.PARKED_TICKS
+        ):
+            self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
+        else:
+            log.warning(
+                "%s: not at the park pose, so torque stays on (release_on_close releases only "
+                "when parked, where the arm cannot drop onto the object)",
+                self.name,
+            )
 
     def __enter__(self) -> DynamixelArm:
         self.connect()
