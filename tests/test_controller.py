@@ -272,6 +272,7 @@ def test_emulated_dynamixel_arm_stays_put_after_an_emergency_stop_unless_told(
 
     text = (REPO / "rig_configs" / "simulated_arm.toml").read_text()
     text = text.replace("width = 256", "width = 32").replace("height = 256", "height = 32")
+    text = text.replace('transport = "pty"', 'transport = "inprocess"')  # no real-time thread
     text = text.replace(
         "default_lights = 24",
         f"default_lights = 24\npark_on_emergency_stop = {str(park_on_emergency).lower()}",
