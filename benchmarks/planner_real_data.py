@@ -86,6 +86,14 @@ def reference(images: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndar
     return ref_fit.normals, mask
 
 
+def preview_leds(el: np.ndarray, n_previews: int = PREVIEWS) -> np.ndarray:
+    """LEDs whose images serve as previews: ``n_previews`` spread over 40–62° elevation (the
+    paper's protocol: "an acquisition from 45 to 60 degrees of elevation")."""
+    band = np.flatnonzero((el >= 40.0) & (el <= 62.0))
+    band = band[np.argsort(el[band])]
+    return band[np.linspace(0, len(band) - 1, n_previews).round().astype(int)]
+
+
 def ls_normals(images: np.ndarray, lights: np.ndarray) -> np.ndarray:
     b = np.tensordot(np.linalg.pinv(lights), images, axes=(1, 0))  # (3, H, W)
     b = np.moveaxis(b, 0, -1)
@@ -171,9 +179,7 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
     dirs = dome.directions
     ref, mask = reference(images, dirs)
     az, el = az_el_from_direction(dirs)
-    band = np.flatnonzero((el >= 40.0) & (el <= 62.0))
-    band = band[np.argsort(el[band])]
-    previews = band[np.linspace(0, len(band) - 1, n_previews).round().astype(int)]
+    previews = preview_leds(el, n_previews)
     print(
         f"reference: robust PS on 72 lights, {int(mask.sum())} masked pixels; previews "
         + ", ".join(f"{dome.names[p]} (el {el[p]:.0f}°)" for p in previews)

@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-from benchmarks.planner_real_data import DATA, DOC, NS, PREVIEWS, evaluate, load, reference
+from benchmarks.planner_real_data import DATA, DOC, NS, evaluate, load, preview_leds, reference
 from benchmarks.report import write_section
 from planner.make_plan import plan_with_report
 from planner.objectives import models_for
@@ -50,9 +50,7 @@ def main(seed: int = 0) -> str:
     dirs = dome.directions
     ref, mask = reference(images, dirs)
     az, el = az_el_from_direction(dirs)
-    band = np.flatnonzero((el >= 40.0) & (el <= 62.0))
-    band = band[np.argsort(el[band])]
-    previews = band[np.linspace(0, len(band) - 1, PREVIEWS).round().astype(int)]
+    previews = preview_leds(el)
     rng = np.random.default_rng(seed)
     rows: list[str] = []
     for n in NS:

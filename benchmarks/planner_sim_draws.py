@@ -22,25 +22,13 @@ from benchmarks.planner_real_data import DOC
 from benchmarks.report import write_section
 from planner.make_plan import plan_with_report
 from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import TradeoffSettings, render_scene_data
-from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
+from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
 from rti_rig.rig_geometry import DomeGeometry
 
 DRAWS = 8
 REMOVED = 24
 COUNTS = (6, 12, 20, 30)
 FLOORS = (0.0, 10.0, 20.0, 30.0)
-
-
-def normal_error(normals: np.ndarray, images: np.ndarray, lights: np.ndarray) -> float:
-    """Mean angle (°) of robust photometric stereo to the truth; unsolved pixels count as flat."""
-    try:
-        ps = fit_photometric_stereo(images, lights, robust=True)
-        est = np.where(ps.valid[..., None], ps.normals, np.array([0.0, 0.0, 1.0]))
-    except ReconstructionError:
-        est = np.broadcast_to(np.array([0.0, 0.0, 1.0]), normals.shape)
-    cos = np.clip(np.sum(est * normals, axis=-1), -1.0, 1.0)
-    return float(np.degrees(np.arccos(cos)).mean())
 
 
 def main(seed: int = 0) -> str:
@@ -60,14 +48,14 @@ def main(seed: int = 0) -> str:
                 for f in FLOORS:
                     idx = keep[select_uniform_leds(sub, n, f)]
                     err.setdefault((n, f"uniform {f:g}"), []).append(
-                        normal_error(data.normals, data.candidate_images[idx], cand[idx])
+                        normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
                     )
                 sched, _ = plan_with_report(
                     data.preview, sub, n, "optimal", "normals", settings.preview_light_az_el_deg
                 )
                 idx = keep[np.array([s.led for s in sched.steps])]
                 err.setdefault((n, "optimal"), []).append(
-                    normal_error(data.normals, data.candidate_images[idx], cand[idx])
+                    normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
                 )
         floor = min(
             FLOORS,

@@ -325,17 +325,15 @@ class NormalsObjective:
         by one or two lights (a near-singular 3×3 whose determinant float32 cannot resolve);
         the exchange search re-scans exactly when a proposed swap is not confirmed.
         """
+        dtype = np.float64 if exact else np.float32
+        outer = self.outer if exact else self.outer32
         base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
         r = None
-        if exact:
-            if self.tau2 > 0:
-                rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
-                r = rb[:, None] + self.cross
-            return self._total(base[:, None, :] + self.outer, r)
-        if self.cross32 is not None:
+        if self.tau2 > 0:
+            cross = self.cross if exact else self.cross32
             rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
-            r = rb.astype(np.float32)[:, None] + self.cross32  # (3, K, P_bias, 9)
-        return self._total(base.astype(np.float32)[:, None, :] + self.outer32, r)
+            r = rb.astype(dtype)[:, None] + cross  # (3, K, P_bias, 9)
+        return self._total(base.astype(dtype)[:, None, :] + outer, r)
 
     def describe(self, value: float) -> str:
         return f"expected RMS normal error {value:.2f}° at {100 * NOISE_REL:g}% noise"

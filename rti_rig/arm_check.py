@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from rti_rig.clock import Clock
 from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
+from rti_rig.lighting import attempt_all
 from rti_rig.rig import LightCarrier
 from rti_rig.rig_geometry import ArmGeometry
 
@@ -161,14 +162,12 @@ def arm_self_test(
     except Exception as exc:  # a self-test reports what went wrong; teardown follows
         report.aborted = f"{type(exc).__name__}: {exc}"
     finally:
-        for label, action in (
-            ("lamp off", lambda: carrier.lamp(False)),
-            ("stop", carrier.stop),
-            ("close", carrier.close),
-        ):
-            try:
-                action()
-            except Exception as exc:  # teardown goes on whatever one device does
-                report.teardown_failures.append(f"{label}: {exc}")
+        report.teardown_failures = attempt_all(
+            [
+                ("lamp off", lambda: carrier.lamp(False)),
+                ("stop", carrier.stop),
+                ("close", carrier.close),
+            ]
+        )
         report.elapsed_s = clock.now() - started
     return report

@@ -145,32 +145,35 @@ def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
     )
 
 
+def normal_error(
+    truth: NDArray[np.float64], images: NDArray, lights: NDArray[np.float64]
+) -> tuple[float, float, float]:
+    """Mean and median angle (°) of robust photometric stereo to ``truth`` over every pixel,
+    and the solved fraction; unsolved pixels (or a refused fit) count as facing the camera."""
+    from rti_rig.metrics import angular_error_deg
+    from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
+
+    everywhere = np.ones(truth.shape[:2], dtype=bool)
+    flat = np.array([0.0, 0.0, 1.0])
+    try:
+        ps = fit_photometric_stereo(images, lights, robust=True)
+        est, valid = np.where(ps.valid[..., None], ps.normals, flat), float(ps.valid.mean())
+    except ReconstructionError:
+        est, valid = np.broadcast_to(flat, truth.shape), 0.0
+    err = angular_error_deg(est, truth, everywhere)
+    return float(err.mean), float(err.median), valid
+
+
 def score_plan(
     data: SceneData, chosen: NDArray[np.intp]
 ) -> tuple[float, float, float, str, float, float]:
     """Normal error (robust PS, every pixel) and relighting quality of one plan."""
-    from rti_rig.metrics import angular_error_deg, relight_psnr, relight_ssim
-    from rti_rig.reconstruct import (
-        N_COEFFICIENTS,
-        ReconstructionError,
-        fit_model,
-        fit_photometric_stereo,
-        select_model,
-    )
+    from rti_rig.metrics import relight_psnr, relight_ssim
+    from rti_rig.reconstruct import N_COEFFICIENTS, ReconstructionError, fit_model, select_model
 
     images = data.candidate_images[chosen]
     lights = data.candidate_dirs[chosen]
-    h, w = data.normals.shape[:2]
-    everywhere = np.ones((h, w), dtype=bool)
-    try:
-        ps = fit_photometric_stereo(images, lights, robust=True)
-        normals = np.where(ps.valid[..., None], ps.normals, np.array([0.0, 0.0, 1.0]))
-        err = angular_error_deg(normals, data.normals, everywhere)
-        mean, median, valid = err.mean, err.median, float(ps.valid.mean())
-    except ReconstructionError:
-        flat = np.broadcast_to(np.array([0.0, 0.0, 1.0]), data.normals.shape)
-        err = angular_error_deg(flat, data.normals, everywhere)
-        mean, median, valid = err.mean, err.median, 0.0
+    mean, median, valid = normal_error(data.normals, images, lights)
     model, name = None, "none"
     try:
         choice = select_model(images, lights, holdout=min(5, len(chosen)))

@@ -91,7 +91,7 @@ class DomeLighting:
         self.source.all_off()
 
     def safe(self, emergency: bool = False) -> list[str]:
-        return _attempt([("all LEDs off", self.source.all_off)])
+        return attempt_all([("all LEDs off", self.source.all_off)])
 
 
 class ArmLighting:
@@ -139,10 +139,10 @@ class ArmLighting:
         ]
         if self.park_on_emergency if emergency else self.park_after_session:
             actions.append(("park", self.carrier.park))
-        return _attempt(actions)
+        return attempt_all(actions)
 
 
-def _attempt(actions: list[tuple[str, object]]) -> list[str]:
+def attempt_all(actions: list[tuple[str, object]]) -> list[str]:
     """Run every teardown action even if some fail; return the failures as text."""
     failures = []
     for label, action in actions:
