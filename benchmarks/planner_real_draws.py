@@ -16,11 +16,12 @@ spans 3.1–6.0° at 12 lights (``benchmarks.planner_real_data``). This benchmar
 
 The homogeneous floor is tuned with hindsight (the floor with the lowest mean error over the
 draws, per N). Reported per N: mean, median and 90th percentile of the normal error, mean
-relighting PSNR, and in how many draws the planner beat the tuned homogeneous layout of the
-same draw.
+relighting PSNR, in how many draws the planner beat the tuned homogeneous layout of the
+same draw, and how sure that is (:mod:`benchmarks.paired`: the mean paired difference with a
+95 % bootstrap interval and the sign test).
 
-Run: ``python -m benchmarks.planner_real_draws`` (reads ../shared/data/neuralrti-example beside
-the repository; writes its section of docs/planner.md).
+Run: ``python -m benchmarks.planner_real_draws [DRAWS]`` (reads
+../shared/data/neuralrti-example beside the repository; writes its section of docs/planner.md).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ import time
 
 import numpy as np
 
+from benchmarks.paired import compare
 from benchmarks.planner_real_data import DATA, DOC, NS, evaluate, load, preview_leds, reference
 from benchmarks.report import write_section
 from planner.make_plan import plan_with_report
@@ -38,13 +40,13 @@ from planner.uniform import select_uniform_leds
 from rti_rig.geometry import az_el_from_direction
 from rti_rig.rig_geometry import DomeGeometry
 
-DRAWS = 24
+DRAWS = 48
 REMOVED = 8
 FLOORS = (0.0, 10.0, 20.0, 30.0)
 OBJECTIVES = ("normals", "relight")
 
 
-def main(seed: int = 0) -> str:
+def main(seed: int = 0, draws: int = DRAWS) -> str:
     t0 = time.perf_counter()
     dome, images, rgb8 = load(DATA)
     dirs = dome.directions
@@ -65,7 +67,7 @@ def main(seed: int = 0) -> str:
             err.setdefault(label, []).append(e)
             psnr.setdefault(label, []).append(q)
 
-        for d in range(DRAWS):
+        for d in range(draws):
             keep = np.sort(rng.choice(len(dirs), len(dirs) - REMOVED, replace=False))
             sub = DomeGeometry(dirs[keep], tuple(dome.names[i] for i in keep))
             turn = float(rng.uniform(0.0, 360.0))
@@ -96,19 +98,20 @@ def main(seed: int = 0) -> str:
         ] + [(f"optimal, {o}", f"optimal {o}") for o in OBJECTIVES]
         for label, key in show:
             e = np.array(err[key])
-            wins = "—"
+            wins = paired = "—"
             if key.startswith("optimal"):
                 wins = " / ".join(
-                    f"{int(np.sum(e < bars[k]))}/{DRAWS}" for k in ("uniform", "turned")
+                    f"{int(np.sum(e < bars[k]))}/{draws}" for k in ("uniform", "turned")
                 )
+                paired = compare(e, bars["uniform"], seed).cell()
             rows.append(
                 f"| {n} | {label} | {e.mean():.2f} | {np.median(e):.2f} | "
-                f"{np.percentile(e, 90):.2f} | {np.mean(psnr[key]):.2f} | {wins} |"
+                f"{np.percentile(e, 90):.2f} | {np.mean(psnr[key]):.2f} | {wins} | {paired} |"
             )
             print(
                 f"N={n:2d} {label:45s} mean {e.mean():5.2f}° median {np.median(e):5.2f}° "
                 f"p90 {np.percentile(e, 90):5.2f}° relight {np.mean(psnr[key]):5.2f} dB "
-                f"wins {wins}"
+                f"wins {wins} {paired}"
             )
             sys.stdout.flush()
     md = "\n".join(
@@ -116,14 +119,18 @@ def main(seed: int = 0) -> str:
             "Command: `python -m benchmarks.planner_real_draws` "
             f"(total {time.perf_counter() - t0:.0f} s, seed {seed}).",
             "",
-            f"{DRAWS} paired draws per N; in each, {REMOVED} random LEDs of the 72 are out of "
+            f"{draws} paired draws per N; in each, {REMOVED} random LEDs of the 72 are out of "
             "service, the preview is one of the 8 previews in turn, and every strategy plans on "
             "the same remaining LEDs. Floors tuned with hindsight on the mean over draws. "
             '"wins": draws in which the plan\'s normal error is below the tuned homogeneous '
-            "layout's, as shipped / randomly turned.",
+            'layout\'s, as shipped / randomly turned. "vs shipped": mean paired difference '
+            "plan − tuned homogeneous as shipped with its 95 % bootstrap interval, wins, the "
+            "sign test's two-sided p, and the verdict (win or loss only when the interval "
+            "excludes 0 and the sign test agrees at p < 0.05; `benchmarks.paired`).",
             "",
-            "| N | strategy | mean normal error ° | median | 90th pct | mean relight dB | wins |",
-            "|---|---|---|---|---|---|---|",
+            "| N | strategy | mean normal error ° | median | 90th pct | mean relight dB | wins "
+            "| vs shipped |",
+            "|---|---|---|---|---|---|---|---|",
             *rows,
         ]
     )
@@ -132,4 +139,4 @@ def main(seed: int = 0) -> str:
 
 
 if __name__ == "__main__":
-    main()
+    main(draws=int(sys.argv[1]) if len(sys.argv) > 1 else DRAWS)

@@ -18,6 +18,7 @@ import time
 
 import numpy as np
 
+from benchmarks.paired import compare
 from benchmarks.planner_real_data import DOC
 from benchmarks.report import write_section
 from planner.make_plan import plan_with_report
@@ -65,7 +66,10 @@ def main(seed: int = 0) -> str:
         for n in COUNTS:
             bar = np.array(err[(n, f"uniform {floor:g}")])
             opt = np.array(err[(n, "optimal")])
-            cells.append(f"{bar.mean():.2f} → {opt.mean():.2f} ({int(np.sum(opt < bar))}/{DRAWS})")
+            verdict = compare(opt, bar, seed).verdict()
+            cells.append(
+                f"{bar.mean():.2f} → {opt.mean():.2f} ({int(np.sum(opt < bar))}/{DRAWS}, {verdict})"
+            )
         rows.append(f"| {scene} | {floor:g}° | " + " | ".join(cells) + " |")
         print(rows[-1])
         sys.stdout.flush()
@@ -76,7 +80,8 @@ def main(seed: int = 0) -> str:
             "",
             f"{DRAWS} paired draws per scene and N; in each, {REMOVED} of the 240 candidate lights "
             "are out of service. Cells: mean normal error (°) of the tuned homogeneous layout → "
-            "of `optimal`/`normals`, and (draws the plan won).",
+            "of `optimal`/`normals`, and (draws the plan won, verdict: win or loss when the 95 % "
+            "bootstrap interval of the mean paired difference excludes 0, else tie).",
             "",
             "| scene | tuned floor | " + " | ".join(f"N = {n}" for n in COUNTS) + " |",
             "|---|---|" + "---|" * len(COUNTS),

@@ -1,9 +1,10 @@
 """Where the planner loses on the simulator, and why: the error of each layout split by cause.
 
 ``benchmarks.planner_sim_draws`` shows the ``optimal`` planner losing to a tuned homogeneous
-layout on some simulated scenes at high light counts. This benchmark renders the same two layouts
-(the planner's and the tuned homogeneous one, on all 240 candidates) once per physical effect,
-so each loss can be traced to what the simulator renders and what the planner's model assumes:
+layout on some simulated scenes at high light counts. This benchmark takes two layouts on the
+same scenes (the planner's, from its own preview shot, and the homogeneous one with the floor
+that scores best; all 240 candidates, no draws) and renders them once per physical effect, so
+each loss can be traced to what the simulator renders and what the planner's model assumes:
 
 * ``noise``: pure Lambertian images (no cast shadow, no specular lobe) with sensor noise — the
   part of the error the planner's Cramér–Rao term models;
