@@ -12,7 +12,8 @@ spans 3.1–6.0° at 12 lights (``benchmarks.planner_real_data``). This benchmar
 * the preview is one of the 8 previews of ``benchmarks.planner_real_data`` (in turn);
 * every strategy plans on the same remaining LEDs: ``uniform`` at each floor as shipped
   (no turn), ``uniform`` turned by a random azimuth (an object placed at an arbitrary
-  orientation), and the ``optimal`` planner for each objective.
+  orientation), the ``optimal`` planner for each objective, and the same planner given a
+  uniform grey image instead of the preview (is the preview worth taking?).
 
 The homogeneous floor is tuned with hindsight (the floor with the lowest mean error over the
 draws, per N). Reported per N: mean, median and 90th percentile of the normal error, mean
@@ -41,6 +42,8 @@ from rti_rig.geometry import az_el_from_direction
 from rti_rig.rig_geometry import DomeGeometry
 
 DRAWS = 48
+#: What the planner sees when told nothing about the object: a uniform grey image.
+FLAT_PREVIEW = np.full((64, 64), 120, dtype=np.uint8)
 REMOVED = 8
 FLOORS = (0.0, 10.0, 20.0, 30.0)
 OBJECTIVES = ("normals", "relight")
@@ -55,6 +58,7 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
     previews = preview_leds(el)
     rng = np.random.default_rng(seed)
     rows: list[str] = []
+    worth: list[str] = []
     for n in NS:
         model = models_for(n)[-1]
         err: dict[str, list[float]] = {}
@@ -80,6 +84,9 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
                     rgb8[p], sub, n, "optimal", objective, (float(az[p]), float(el[p]))
                 )
                 score(f"optimal {objective}", keep[np.array([s.led for s in sched.steps])])
+            # the same planner told nothing about the object: is the preview worth taking?
+            sched, _ = plan_with_report(FLAT_PREVIEW, sub, n, "optimal", "normals", (0.0, 50.0))
+            score("optimal flat", keep[np.array([s.led for s in sched.steps])])
         tuned = {
             kind: min(FLOORS, key=lambda f, k=kind: float(np.mean(err[f"{k} {f:g}"])))
             for kind in ("uniform", "turned")
@@ -96,6 +103,11 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
             ),
             ("uniform, floor 0°, as shipped", "uniform 0"),
         ] + [(f"optimal, {o}", f"optimal {o}") for o in OBJECTIVES]
+        show.append(("optimal, normals, flat prior (no preview)", "optimal flat"))
+        worth.append(
+            f"| {n} | {np.mean(err['optimal flat']):.2f} | {np.mean(err['optimal normals']):.2f} "
+            f"| {compare(err['optimal normals'], err['optimal flat'], seed).cell()} |"
+        )
         for label, key in show:
             e = np.array(err[key])
             wins = paired = "—"
@@ -132,6 +144,15 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
             "| vs shipped |",
             "|---|---|---|---|---|---|---|---|",
             *rows,
+            "",
+            "Is the preview worth taking? `optimal`/`normals` planned from the draw's preview "
+            "against the same planner given a uniform grey image (a flat surface, no "
+            "information), same draws: mean normal error (°) and the paired comparison "
+            "(preview − flat prior).",
+            "",
+            "| N | flat prior | preview | preview − flat prior |",
+            "|---|---|---|---|",
+            *worth,
         ]
     )
     write_section("planner_real_draws", md, DOC)

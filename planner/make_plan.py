@@ -206,6 +206,34 @@ def estimate_surface(
     )
 
 
+#: Side (pixels) of the stand-in planning image when there is no preview.
+FLAT_SIDE_PX = 16
+
+
+def flat_surface() -> SurfaceEstimate:
+    """What the ``optimal`` planner assumes without a preview: a level, matte surface.
+
+    The model alone (shadows of the tilt hedge, noise propagation, the reflectance prior) then
+    chooses the lights. On the real dome and on the simulator's scenes this did as well as
+    planning from a preview (docs/planner.md), so a preview shot is optional for ``optimal``.
+    It is exactly what a uniform grey preview yields (tested): no relief, no highlight hint.
+    """
+    relief = np.zeros((FLAT_SIDE_PX, FLAT_SIDE_PX))
+    normals = normals_from_height(relief)
+    fit = ReliefFit(scale=0.0, albedo=0.0, explained=0.0, rms_slope_deg=0.0, bright_outliers=0.0)
+    return SurfaceEstimate(
+        np.full_like(relief, 0.5),
+        np.array([0.0, 0.0, 1.0]),
+        "none (no preview)",
+        relief,
+        normals,
+        fit,
+        "none (no preview: a level surface)",
+        0,
+        normals,
+    )
+
+
 def sample_surface(
     surface: SurfaceEstimate,
     candidates: Candidates,
@@ -405,13 +433,20 @@ def _plan(
     report = PlanReport(method, objective, n, rig, len(candidates), min_elevation_deg)
     prov: dict[str, Any] = {"n": n, "min_elevation_deg": min_elevation_deg, "objective": objective}
 
-    if method != "uniform" and preview is None:
+    if method == "kmeans" and preview is None:
         raise ScheduleError(
-            f"--method {method} plans from a preview shot; give one, or use --method uniform"
+            "--method kmeans clusters the preview's normals; give a preview shot, or use "
+            "--method optimal (which plans for a flat surface without one) or uniform"
         )
     chosen = starts[0][1]
     surface: SurfaceEstimate | None = None
-    if preview is not None:
+    if preview is None and method == "optimal":
+        surface = flat_surface()
+        report.notes.append(
+            "no preview: planned for a level, matte surface (the model alone; on the benchmarks "
+            "in docs/planner.md this did as well as planning from a preview)"
+        )
+    elif preview is not None:
         try:
             surface = estimate_surface(preview, preview_light, depth_model, depth_spec)
         except ScheduleError as exc:
@@ -420,11 +455,12 @@ def _plan(
             # the homogeneous layout does not need the preview: report, do not fail
             report.notes.append(f"preview not evaluated: {exc}")
     if surface is not None:
-        az, el = az_el_from_direction(surface.light)
-        report.preview_shape = tuple(np.asarray(preview).shape)
+        if preview is not None:
+            az, el = az_el_from_direction(surface.light)
+            report.preview_shape = tuple(np.asarray(preview).shape)
+            report.preview_light_az_el_deg = (float(az), float(el))
+            report.preview_light_source = surface.light_source
         report.planning_shape = tuple(surface.image.shape)
-        report.preview_light_az_el_deg = (float(az), float(el))
-        report.preview_light_source = surface.light_source
         report.relief_source = surface.relief_source
         report.relief_scale = surface.fit.scale * relief_trust(surface.fit)
         report.shading_explained_r2 = surface.fit.explained
@@ -501,7 +537,8 @@ def make_plan(
     """An ordered schedule of ``n`` lights for ``geometry`` planned from one preview.
 
     ``preview`` is an image (H, W) or (H, W, 3): uint8 is sRGB, uint16 and float are linear
-    (see :mod:`planner.topography`). It may be ``None`` only for ``method="uniform"``. Dome
+    (see :mod:`planner.topography`). It may be ``None`` for ``uniform`` (no preview needed) and
+    ``optimal`` (which then plans for a level, matte surface: :func:`flat_surface`). Dome
     steps carry LED indices and the dome's LED names as labels, in ascending LED order; arm
     steps are ordered for short moves from the park pose. The evidence is in
     ``schedule.provenance["report"]`` (or use :func:`plan_with_report`).

@@ -296,7 +296,7 @@ def plan(
         Path | None,
         typer.Argument(
             help="One preview image of the object (JPEG/PNG = sRGB, 16-bit TIFF = linear). "
-            "Not needed by the 'uniform' method."
+            "Needed by 'kmeans'; without it 'optimal' plans for a level, matte surface."
         ),
     ] = None,
     rig: Annotated[
@@ -375,8 +375,11 @@ def plan(
             raise RtiRigError(
                 f"--objective {objective!r} is not known; choose {', '.join(OBJECTIVES)}"
             )
-        if method != "uniform" and preview is None:
-            raise RtiRigError(f"--method {method} plans from a preview image: give PREVIEW")
+        if method == "kmeans" and preview is None:
+            raise RtiRigError(
+                "--method kmeans clusters the preview's normals: give PREVIEW (or use "
+                "--method optimal, which plans for a flat surface without one)"
+            )
         if depth_model is not None and not depth_model.is_file():
             raise RtiRigError(f"--depth-model {depth_model}: file not found")
         az_el = _parse_az_el(preview_light)

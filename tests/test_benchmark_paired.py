@@ -59,3 +59,31 @@ def test_a_mean_carried_by_a_few_draws_is_not_a_win() -> None:
     assert c.sign_p > 0.05
     assert c.verdict() == "tie (lower mean)"
     assert compare(bar, plan).verdict() == "tie (higher mean)"
+
+
+def test_more_wins_than_losses_is_not_enough_without_the_sign_test() -> None:
+    """22 small wins, 5 large ones and 21 small losses: the mean is sure, the sign test is not."""
+    bar = _bar(48)
+    diff = np.r_[np.full(22, -0.05), np.full(21, 0.05), np.full(5, -3.0)]
+    c = compare(bar + diff, bar)
+    assert c.wins > 48 - c.wins - c.ties and c.high < 0 and c.sign_p > 0.05
+    assert c.verdict() == "tie (lower mean)"
+
+
+def test_mean_and_sign_test_on_opposite_sides_is_a_tie() -> None:
+    """Loses 40 draws by a little, wins 8 by a lot: lower mean, but the typical draw is worse."""
+    bar = _bar(48)
+    diff = np.r_[np.full(40, 0.1), np.full(8, -4.0)]
+    c = compare(bar + diff, bar)
+    assert c.high < 0 and c.sign_p < 0.05
+    assert c.verdict() == "tie (lower mean)"
+    assert compare(bar - diff, bar).verdict() == "tie (higher mean)"
+
+
+def test_ties_do_not_count_for_the_sign_test() -> None:
+    """5 wins and 43 exact ties: 5 of 5 untied draws is not significant (p = 0.0625)."""
+    bar = _bar(48)
+    diff = np.r_[np.full(5, -1.0), np.zeros(43)]
+    c = compare(bar + diff, bar)
+    assert (c.wins, c.ties) == (5, 43) and c.sign_p == pytest.approx(0.0625)
+    assert c.verdict() == "tie (lower mean)"

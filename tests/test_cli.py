@@ -263,3 +263,17 @@ def test_plan_option_errors(tmp_path: Path, extra: list[str], fragment: str) -> 
         ],
     )
     assert r.exit_code == 2 and "give PREVIEW" in r.output
+
+
+def test_plan_optimal_without_a_preview(tmp_path: Path) -> None:
+    """`optimal` needs no preview: it plans for a level, matte surface and says so."""
+    rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    out = tmp_path / "flat.lp"
+    r = runner.invoke(
+        app, ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "9", "--out", str(out)]
+    )
+    assert r.exit_code == 0, r.output
+    assert "no preview" in r.output
+    names = {e.name for e in read_lp(rig)}
+    planned = read_lp(out)
+    assert len(planned) == 9 and {e.name for e in planned} <= names

@@ -77,8 +77,26 @@ def test_uniform_without_preview_matches_the_baseline() -> None:
     a = make_plan(None, DOME, 12, "uniform", min_elevation_deg=10.0)
     b = plan_uniform(DOME, 12, 10.0)
     assert [s.led for s in a.steps] == [s.led for s in b.steps]
-    with pytest.raises(ScheduleError, match="preview shot"):
-        make_plan(None, DOME, 12, "optimal")
+    with pytest.raises(ScheduleError, match="kmeans clusters the preview"):
+        make_plan(None, DOME, 12, "kmeans")
+
+
+@pytest.mark.parametrize("objective", ["normals", "relight"])
+@pytest.mark.parametrize(("n", "geometry"), [(6, DOME), (12, DOME), (9, ARM)])
+def test_optimal_without_preview_plans_for_a_level_matte_surface(
+    objective: str, n: int, geometry: DomeGeometry | ArmGeometry
+) -> None:
+    """No preview: exactly the plan of a uniform grey preview (no relief, no highlight), which
+    the draw benchmarks compare against the preview-planned layouts."""
+    sched, rep = plan_with_report(None, geometry, n, "optimal", objective)
+    grey = np.full((64, 64), 120, dtype=np.uint8)
+    same, _ = plan_with_report(grey, geometry, n, "optimal", objective, (0.0, 50.0))
+    assert [s.direction for s in sched.steps] == [s.direction for s in same.steps]
+    assert rep.preview_shape is None and rep.preview_light_az_el_deg is None
+    assert rep.relief_source and "no preview" in rep.relief_source
+    assert any("no preview" in note for note in rep.notes)
+    assert rep.expected["optimal"] <= rep.expected["uniform ≥0°"] + 1e-12
+    assert len(sched) == n and len({tuple(s.direction) for s in sched.steps}) == n
 
 
 @pytest.mark.parametrize("objective", ["normals", "relight"])
