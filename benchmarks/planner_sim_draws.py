@@ -35,6 +35,12 @@ FLOORS = (0.0, 10.0, 20.0, 30.0)
 FLAT_PREVIEW = np.full((64, 64), 120, dtype=np.uint8)
 
 
+def _table_head(*first: str) -> tuple[str, str]:
+    """Markdown header rows: the given columns, then one per light count."""
+    cols = [*first, *(f"N = {n}" for n in COUNTS)]
+    return "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)
+
+
 def _cell(bar: np.ndarray, plan: np.ndarray, seed: int) -> str:
     """ "bar mean → plan mean (draws the plan won, verdict)"."""
     verdict = compare(plan, bar, seed).verdict()
@@ -104,16 +110,14 @@ def main(seed: int = 0) -> str:
             "agrees at p < 0.05, so 7/8 is not yet a win; else tie, noting a surely lower or "
             "higher mean; `benchmarks.paired`).",
             "",
-            "| scene | tuned floor | " + " | ".join(f"N = {n}" for n in COUNTS) + " |",
-            "|---|---|" + "---|" * len(COUNTS),
+            *_table_head("scene", "tuned floor"),
             *rows,
             "",
             "Is the preview worth taking? The same draws, `optimal`/`normals` given a uniform "
             "grey image (a flat surface, no information) → given the scene's preview: mean "
             "normal error (°), (draws the preview won, verdict).",
             "",
-            "| scene | " + " | ".join(f"N = {n}" for n in COUNTS) + " |",
-            "|---|" + "---|" * len(COUNTS),
+            *_table_head("scene"),
             *worth,
         ]
     )
