@@ -47,9 +47,11 @@ class PairedComparison:
         return "tie"
 
     def cell(self) -> str:
+        losses = self.draws - self.wins - self.ties
         return (
-            f"{self.mean_diff:+.2f}° [{self.low:+.2f}, {self.high:+.2f}], "
-            f"{self.wins}/{self.draws}, p = {self.sign_p:.2g}: {self.verdict()}"
+            f"{self.mean_diff:+.2f}° [{self.low:+.2f}, {self.high:+.2f}], {self.wins} won, "
+            f"{losses} lost, {self.ties} tied of {self.draws}, p = {self.sign_p:.2g}: "
+            f"{self.verdict()}"
         )
 
 

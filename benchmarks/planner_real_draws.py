@@ -136,7 +136,8 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
             "the same remaining LEDs. Floors tuned with hindsight on the mean over draws. "
             '"wins": draws in which the plan\'s normal error is below the tuned homogeneous '
             'layout\'s, as shipped / randomly turned. "vs shipped": mean paired difference '
-            "plan − tuned homogeneous as shipped with its 95 % bootstrap interval, wins, the "
+            "plan − tuned homogeneous as shipped with its 95 % bootstrap interval, draws won, "
+            "lost and tied, the "
             "sign test's two-sided p, and the verdict (win or loss only when the interval "
             "excludes 0 and the sign test agrees at p < 0.05; `benchmarks.paired`).",
             "",

@@ -43,8 +43,9 @@ def _table_head(*first: str) -> tuple[str, str]:
 
 def _cell(bar: np.ndarray, plan: np.ndarray, seed: int) -> str:
     """ "bar mean → plan mean (draws the plan won, verdict)"."""
-    verdict = compare(plan, bar, seed).verdict()
-    return f"{bar.mean():.2f} → {plan.mean():.2f} ({int(np.sum(plan < bar))}/{len(bar)}, {verdict})"
+    c = compare(plan, bar, seed)
+    tied = f", {c.ties} tied" if c.ties else ""
+    return f"{bar.mean():.2f} → {plan.mean():.2f} ({c.wins}/{c.draws}{tied}, {c.verdict()})"
 
 
 def main(seed: int = 0) -> str:

@@ -36,6 +36,7 @@ from planner.normals import (
     sanitize_height,
 )
 from planner.objectives import (
+    BIAS_PIXELS,
     HELD_OUT,
     OBJECTIVES,
     Candidates,
@@ -132,7 +133,9 @@ class PlanReport:
         if self.preview_light_az_el_deg is not None:
             az, el = self.preview_light_az_el_deg
             out.append(f"preview light az {az:.1f}°, el {el:.1f}° ({self.preview_light_source})")
-        if self.relief_source:
+        if self.relief_source and self.shading_explained_r2 is None:
+            out.append(f"relief: {self.relief_source}")
+        elif self.relief_source:
             out.append(
                 f"relief from {self.relief_source}: RMS tilt {self.rms_tilt_deg:.1f}°, "
                 f"90th percentile {self.p90_tilt_deg:.1f}°, shading explained "
@@ -216,8 +219,12 @@ def flat_surface() -> SurfaceEstimate:
     The model alone (shadows of the tilt hedge, noise propagation, the reflectance prior) then
     chooses the lights. On the real dome and on the simulator's scenes this did as well as
     planning from a preview (docs/planner.md), so a preview shot is optional for ``optimal``.
-    It is exactly what a uniform grey preview yields (tested): no relief, no highlight hint.
+    It is exactly what a uniform grey preview of at least :data:`~planner.objectives.BIAS_PIXELS`
+    pixels yields (tested): no relief, no highlight hint.
     """
+    # the objective's model-bias term reads the first BIAS_PIXELS sampled rows, which must all
+    # be the level surface (not its tilted hedge copies) for the grey-preview equivalence
+    assert FLAT_SIDE_PX**2 >= BIAS_PIXELS
     relief = np.zeros((FLAT_SIDE_PX, FLAT_SIDE_PX))
     normals = normals_from_height(relief)
     fit = ReliefFit(scale=0.0, albedo=0.0, explained=0.0, rms_slope_deg=0.0, bright_outliers=0.0)
@@ -440,6 +447,12 @@ def _plan(
         )
     chosen = starts[0][1]
     surface: SurfaceEstimate | None = None
+    if preview is None and (preview_light is not None or depth_model is not None):
+        given = "--preview-light" if preview_light is not None else "--depth-model"
+        raise ScheduleError(
+            f"{given} describes a preview shot, but no preview was given: give the preview, "
+            f"or drop {given}"
+        )
     if preview is None and method == "optimal":
         surface = flat_surface()
         report.notes.append(
@@ -455,16 +468,17 @@ def _plan(
             # the homogeneous layout does not need the preview: report, do not fail
             report.notes.append(f"preview not evaluated: {exc}")
     if surface is not None:
-        if preview is not None:
-            az, el = az_el_from_direction(surface.light)
-            report.preview_shape = tuple(np.asarray(preview).shape)
-            report.preview_light_az_el_deg = (float(az), float(el))
-            report.preview_light_source = surface.light_source
-        report.planning_shape = tuple(surface.image.shape)
         report.relief_source = surface.relief_source
+        report.rms_tilt_deg, report.p90_tilt_deg = _tilt_stats(surface.normals)
+    if surface is not None and preview is not None:
+        # facts measured on the preview (none of them exist without one)
+        az, el = az_el_from_direction(surface.light)
+        report.preview_shape = tuple(np.asarray(preview).shape)
+        report.preview_light_az_el_deg = (float(az), float(el))
+        report.preview_light_source = surface.light_source
+        report.planning_shape = tuple(surface.image.shape)
         report.relief_scale = surface.fit.scale * relief_trust(surface.fit)
         report.shading_explained_r2 = surface.fit.explained
-        report.rms_tilt_deg, report.p90_tilt_deg = _tilt_stats(surface.normals)
         report.highlight_hint = surface.fit.bright_outliers
         report.nonfinite_relief_repaired = surface.nonfinite_repaired
         if surface.nonfinite_repaired:
@@ -472,6 +486,7 @@ def _plan(
                 f"{surface.nonfinite_repaired} NaN/infinite relief values were replaced by the "
                 "median"
             )
+    if surface is not None:
         _, cel = az_el_from_direction(candidates.directions)
         lo, hi = float(cel.min()), float(cel.max())
         held_out = fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)

@@ -34,7 +34,7 @@ def test_noise_around_zero_is_a_tie_even_with_more_wins() -> None:
     plan = bar + noise - noise.mean() - 0.05
     c = compare(plan, bar)
     assert c.verdict() == "tie" and c.low < 0 < c.high
-    assert "tie" in c.cell()
+    assert "tie" in c.cell() and f"{c.wins} won" in c.cell()
 
 
 def test_identical_strategies_tie_with_p_one() -> None:
@@ -86,4 +86,5 @@ def test_ties_do_not_count_for_the_sign_test() -> None:
     diff = np.r_[np.full(5, -1.0), np.zeros(43)]
     c = compare(bar + diff, bar)
     assert (c.wins, c.ties) == (5, 43) and c.sign_p == pytest.approx(0.0625)
+    assert "5 won, 0 lost, 43 tied of 48" in c.cell()
     assert c.verdict() == "tie (lower mean)"

@@ -277,3 +277,19 @@ def test_plan_optimal_without_a_preview(tmp_path: Path) -> None:
     names = {e.name for e in read_lp(rig)}
     planned = read_lp(out)
     assert len(planned) == 9 and {e.name for e in planned} <= names
+    r = runner.invoke(
+        app,
+        [
+            "plan",
+            "--rig",
+            str(rig),
+            "--method",
+            "optimal",
+            "--preview-light",
+            "30,50",
+            "--out",
+            str(tmp_path / "x.lp"),
+        ],
+    )
+    assert r.exit_code == 2 and "no preview was given" in " ".join(r.output.split())
+    assert not (tmp_path / "x.lp").exists()

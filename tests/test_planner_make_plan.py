@@ -93,6 +93,10 @@ def test_optimal_without_preview_plans_for_a_level_matte_surface(
     same, _ = plan_with_report(grey, geometry, n, "optimal", objective, (0.0, 50.0))
     assert [s.direction for s in sched.steps] == [s.direction for s in same.steps]
     assert rep.preview_shape is None and rep.preview_light_az_el_deg is None
+    # nothing measured on a preview is reported as if it had been
+    assert rep.shading_explained_r2 is None and rep.highlight_hint is None
+    assert rep.relief_scale is None and rep.planning_shape is None
+    assert not any("R²" in line or "preview light" in line for line in rep.lines())
     assert rep.relief_source and "no preview" in rep.relief_source
     assert any("no preview" in note for note in rep.notes)
     assert rep.expected["optimal"] <= rep.expected["uniform ≥0°"] + 1e-12
@@ -245,3 +249,12 @@ def test_three_lights_keep_a_homogeneous_layout() -> None:
         leds = sorted(s.led for s in sched.steps)
         assert leds == sorted(select_uniform_leds(DOME, 3, floor).tolist())
         assert rep.swaps == 0 and any("no redundancy" in n for n in rep.notes)
+
+
+def test_preview_options_without_a_preview_are_refused() -> None:
+    """--preview-light or --depth-model without the preview they describe is a user error,
+    not something to drop silently."""
+    for kwargs in ({"preview_light": (30.0, 50.0)}, {"depth_model": Path("midas.onnx")}):
+        for method in ("optimal", "uniform"):
+            with pytest.raises(ScheduleError, match="no preview was given"):
+                make_plan(None, DOME, 9, method, **kwargs)
