@@ -116,7 +116,7 @@ def main(seed: int = 0) -> str:
             "",
             "Is the preview worth taking? The same draws, `optimal`/`normals` given a uniform "
             "grey image (a flat surface, no information) → given the scene's preview: mean "
-            "normal error (°), (draws the preview won, verdict).",
+            "normal error (°), (draws the preview won, tied draws if any, verdict).",
             "",
             *_table_head("scene"),
             *worth,

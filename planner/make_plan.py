@@ -6,7 +6,8 @@ Pipeline (each step a pure function in its own module):
 2. the preview's light: ``preview_light`` (azimuth, elevation in degrees, frame of DESIGN.md) or
    :func:`planner.topography.estimate_light`;
 3. a relief: the user's ONNX depth model (:func:`planner.topography.depth_from_onnx`) or the
-   weight-free :func:`planner.topography.shape_from_shading`;
+   weight-free :func:`planner.topography.shape_from_shading` — or, with no preview at all, a
+   level, matte surface (:func:`flat_surface`; on the benchmarks it planned as well);
 4. its scale from the preview's shading and then normals (:mod:`planner.normals`);
 5. the method: ``uniform`` (homogeneous, no preview needed), ``kmeans`` (the paper's) or
    ``optimal`` (exchange search on an objective, :mod:`planner.optimal`);
@@ -173,12 +174,13 @@ def estimate_surface(
     if not peak > 1e-6:
         raise ScheduleError(
             "the preview is black: no light reached the sensor, so it says nothing about the "
-            "surface; retake it with a longer exposure or use --method uniform"
+            "surface; retake it with a longer exposure, or plan without a preview "
+            "(--method optimal or uniform)"
         )
     if float(np.mean(image >= 0.995)) > MAX_SATURATED_FRACTION:
         raise ScheduleError(
             "the preview is saturated almost everywhere, so its shading is lost; retake it "
-            "with a shorter exposure or use --method uniform"
+            "with a shorter exposure, or plan without a preview (--method optimal or uniform)"
         )
     if preview_light is not None:
         light, light_source, albedo = given_light(preview_light), "given", None
