@@ -37,7 +37,6 @@ from planner.normals import (
     sanitize_height,
 )
 from planner.objectives import (
-    BIAS_PIXELS,
     HELD_OUT,
     OBJECTIVES,
     Candidates,
@@ -221,12 +220,9 @@ def flat_surface() -> SurfaceEstimate:
     The model alone (shadows of the tilt hedge, noise propagation, the reflectance prior) then
     chooses the lights. On the real dome and on the simulator's scenes this did as well as
     planning from a preview (docs/planner.md), so a preview shot is optional for ``optimal``.
-    It is exactly what a uniform grey preview of at least :data:`~planner.objectives.BIAS_PIXELS`
-    pixels yields (tested): no relief, no highlight hint.
+    It is exactly what a uniform grey preview yields (tested, down to 1×1): no relief, no
+    highlight hint.
     """
-    # the objective's model-bias term reads the first BIAS_PIXELS sampled rows, which must all
-    # be the level surface (not its tilted hedge copies) for the grey-preview equivalence
-    assert FLAT_SIDE_PX**2 >= BIAS_PIXELS
     relief = np.zeros((FLAT_SIDE_PX, FLAT_SIDE_PX))
     normals = normals_from_height(relief)
     fit = ReliefFit(scale=0.0, albedo=0.0, explained=0.0, rms_slope_deg=0.0, bright_outliers=0.0)
@@ -269,6 +265,7 @@ def sample_surface(
         held_out,
         np.tile(lit_t, (copies, 1)),
         specular,
+        base_count=count,
     )
 
 

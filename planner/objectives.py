@@ -134,6 +134,9 @@ class SurfaceSample:
     held_out: NDArray[np.float64]
     lit_held_out: NDArray[np.float64]
     specular: float = 0.0
+    #: how many leading rows are the estimated surface itself (the rest: hedge copies of it,
+    #: :func:`planner.make_plan.hedge_global_tilt`); None means every row
+    base_count: int | None = None
 
 
 def cast_shadow_visibility(
@@ -243,7 +246,9 @@ class NormalsObjective:
         self.wts = sample.weights / sample.weights.sum()
         self.tau2 = (bias_rel * np.sqrt(2 * np.pi / 9)) ** 2  # RMS deviation = bias_rel
         # the bias term is smooth over normals: a sub-sample of the (random) pixels suffices
-        self.n_bias = min(len(self.n), BIAS_PIXELS)
+        # ... taken from the estimated surface itself, never from its tilted hedge copies
+        # (with fewer sampled pixels than BIAS_PIXELS they would otherwise slip in)
+        self.n_bias = min(sample.base_count or len(self.n), BIAS_PIXELS)
         wb = self.wts[: self.n_bias]
         self.wts_bias = wb / wb.sum()
         if self.tau2 > 0:
