@@ -19,9 +19,10 @@ Subset normals use robust photometric stereo (shadows and highlights discarded p
 it refuses an ill-conditioned subset (lights nearly coplanar) plain least squares with a
 pseudo-inverse is used and the row is marked ``*``.
 
-Row "flat prior (no preview)" is the `optimal` planner given a uniform grey preview: what its
-model alone does, with no information about the object. Rows "uniform, tuned floor" and
-"hindsight" use the reference to choose — they are bars, not plans:
+Row "flat prior (no preview)" is the `optimal` planner given no preview (it then plans for a
+level, matte surface, as for a uniform grey image): what its model alone does, with no
+information about the object. Rows "uniform, tuned floor" and "hindsight" use the reference
+to choose — they are bars, not plans:
 the first is the best homogeneous layout over floors 0–40° (what a dome owner could tune
 once), the second a greedy + exchange selection on the actual normal error (an upper bound for
 any planner on this object).
@@ -201,9 +202,8 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
         _, best_f, best_leds = min(tuned, key=lambda t: t[0])
         fixed[f"uniform, tuned floor ({best_f:g}°, hindsight)"] = best_leds
         fixed["hindsight (normals, oracle)"] = hindsight(n, images, dirs, ref, mask)
-        # the planner's model without any information from a preview: a uniform grey image
-        grey = np.full((64, 64), 120, dtype=np.uint8)
-        flat_plan, _ = plan_with_report(grey, dome, n, "optimal", "normals", (0.0, 50.0))
+        # the planner's model without any information from a preview (a level, matte surface)
+        flat_plan, _ = plan_with_report(None, dome, n, "optimal", "normals")
         fixed["optimal, normals, flat prior (no preview)"] = np.array(
             [s.led for s in flat_plan.steps]
         )

@@ -7,7 +7,7 @@ ones. Normal error is the mean over all pixels of robust photometric stereo agai
 true normals. The homogeneous floor is tuned with hindsight per scene (lowest mean over every N
 and draw). Reported: mean error per strategy and in how many draws the planner beat the tuned
 homogeneous layout of the same draw; and, to ask whether the preview is worth taking, the same
-planner given a uniform grey image instead of the preview.
+planner given no preview (it then plans for a level, matte surface).
 
 Run: ``python -m benchmarks.planner_sim_draws`` (writes its section of docs/planner.md).
 """
@@ -31,8 +31,6 @@ DRAWS = 8
 REMOVED = 24
 COUNTS = (6, 12, 20, 30)
 FLOORS = (0.0, 10.0, 20.0, 30.0)
-#: What the planner sees when told nothing about the object: a uniform grey image.
-FLAT_PREVIEW = np.full((64, 64), 120, dtype=np.uint8)
 
 
 def _table_head(*first: str) -> tuple[str, str]:
@@ -76,7 +74,7 @@ def main(seed: int = 0) -> str:
                     normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
                 )
                 # the same planner told nothing about the object: is the preview worth taking?
-                sched, _ = plan_with_report(FLAT_PREVIEW, sub, n, "optimal", "normals", (0.0, 50.0))
+                sched, _ = plan_with_report(None, sub, n, "optimal", "normals")
                 idx = keep[np.array([s.led for s in sched.steps])]
                 err.setdefault((n, "flat"), []).append(
                     normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
@@ -114,8 +112,8 @@ def main(seed: int = 0) -> str:
             *_table_head("scene", "tuned floor"),
             *rows,
             "",
-            "Is the preview worth taking? The same draws, `optimal`/`normals` given a uniform "
-            "grey image (a flat surface, no information) → given the scene's preview: mean "
+            "Is the preview worth taking? The same draws, `optimal`/`normals` given no "
+            "preview (a level, matte surface: no information) → given the scene's preview: mean "
             "normal error (°), (draws the preview won, tied draws if any, verdict).",
             "",
             *_table_head("scene"),

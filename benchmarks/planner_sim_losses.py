@@ -36,34 +36,18 @@ from benchmarks.report import write_section
 from planner.make_plan import estimate_surface, plan_with_report, sample_surface
 from planner.objectives import HELD_OUT, NormalsObjective, candidates_for
 from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
+from rti_rig.bench_tradeoff import (
+    TradeoffSettings,
+    normal_error,
+    render_scene_data,
+    scene_camera,
+)
 from rti_rig.geometry import az_el_from_direction, fibonacci_cap
 from rti_rig.rig_geometry import DomeGeometry
 
 COUNTS = (6, 12, 20, 30)
 FLOORS = (0.0, 10.0, 20.0, 30.0)
 NOISE_REPEATS = 3
-
-
-def _renderer(name: str, settings: TradeoffSettings):
-    from simulator.camera_model import CameraModel
-    from simulator.light_transport import DirectionalLight, render_radiance
-    from simulator.scenes import make_scene
-
-    scene = make_scene(name, settings.size_px, settings.size_px, seed=settings.seed)
-    camera = CameraModel()
-    exposure = camera.exposure_for(1.0, 0.8)
-    white = float(camera.white_level)
-
-    def shoot(d: NDArray, passes: frozenset[str], rng: np.random.Generator | None) -> NDArray:
-        radiance = render_radiance(scene, DirectionalLight(tuple(d)), passes)
-        if rng is None:
-            electrons = camera.expected_electrons(radiance, exposure) * camera.dn_per_electron
-            return np.clip(electrons / white, 0.0, 1.0).astype(np.float32)
-        pixels, wl = camera.expose(radiance, exposure, rng)
-        return (pixels.astype(np.float32) / wl).astype(np.float32)
-
-    return scene, shoot
 
 
 def _terms(obj: NormalsObjective, chosen: NDArray[np.intp]) -> tuple[float, float]:
@@ -85,7 +69,7 @@ def main() -> str:
     candidates = candidates_for(dome)
     rows: list[str] = []
     for name in settings.scenes:
-        scene, shoot = _renderer(name, settings)
+        scene, camera_shot = scene_camera(name, settings)
         truth = np.asarray(scene.normals, dtype=np.float64)
         # the very preview shot that benchmarks.planner_sim_draws plans from
         preview = render_scene_data(name, settings).preview
@@ -102,13 +86,15 @@ def main() -> str:
             variants.append(("specular", frozenset({"specular"}), False))
         variants.append(("all", frozenset(scene.passes), True))
 
-        def errors(idx: NDArray[np.intp], variants=variants, shoot=shoot, truth=truth) -> dict:
+        def errors(
+            idx: NDArray[np.intp], variants=variants, shoot=camera_shot, truth=truth
+        ) -> dict:
             out = {}
             for label, passes, noisy in variants:
                 vals = []
                 for rep in range(NOISE_REPEATS if noisy else 1):
                     rng = np.random.default_rng(100 + rep) if noisy else None
-                    imgs = np.stack([shoot(cand[i], passes, rng) for i in idx])
+                    imgs = np.stack([shoot(cand[i], rng, passes) for i in idx])
                     vals.append(normal_error(truth, imgs, cand[idx])[0])
                 out[label] = float(np.mean(vals))
             return out

@@ -25,6 +25,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -104,10 +105,15 @@ class SceneData:
     passes: tuple[str, ...] = field(default_factory=tuple)
 
 
-def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
-    """Render the candidate lights (with noise) and the held-out reference (noise-free)."""
+def scene_camera(
+    name: str, s: TradeoffSettings, passes: Iterable[str] | None = None
+) -> tuple[Any, Callable[..., NDArray[np.float32]]]:
+    """The benchmark's scene and a ``shoot(direction, rng)`` in units of the white level.
+
+    ``rng=None`` gives the noise-free image; ``passes`` overrides the scene's render passes
+    (``benchmarks.planner_sim_losses`` renders one physical effect at a time).
+    """
     from simulator.camera_model import CameraModel
-    from simulator.ground_truth import homogeneous_directions
     from simulator.light_transport import DirectionalLight, render_radiance
     from simulator.scenes import make_scene
 
@@ -116,15 +122,31 @@ def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
     # Exposure: a white Lambertian patch facing the light at 80 % of white (as a user meters).
     exposure = camera.exposure_for(1.0, 0.8)
     white = float(camera.white_level)
-    rng = np.random.default_rng(s.seed)
 
-    def shoot(direction: NDArray[np.float64], noisy: bool) -> NDArray[np.float32]:
-        radiance = render_radiance(scene, DirectionalLight(tuple(direction)))
-        if not noisy:
+    def shoot(
+        direction: NDArray[np.float64],
+        rng: np.random.Generator | None,
+        passes: Iterable[str] | None = passes,
+    ) -> NDArray[np.float32]:
+        radiance = render_radiance(scene, DirectionalLight(tuple(direction)), passes)
+        if rng is None:
             scale = camera.expected_electrons(radiance, exposure) * camera.dn_per_electron
             return np.clip(scale / white, 0.0, 1.0).astype(np.float32)
         pixels, wl = camera.expose(radiance, exposure, rng)
         return (pixels.astype(np.float32) / wl).astype(np.float32)
+
+    return scene, shoot
+
+
+def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
+    """Render the candidate lights (with noise) and the held-out reference (noise-free)."""
+    from simulator.ground_truth import homogeneous_directions
+
+    scene, camera_shot = scene_camera(name, s)
+    rng = np.random.default_rng(s.seed)
+
+    def shoot(direction: NDArray[np.float64], noisy: bool) -> NDArray[np.float32]:
+        return camera_shot(direction, rng if noisy else None)
 
     cand = fibonacci_cap(s.candidates, 3.0, 87.0)
     # Held-out reference lights: a dense homogeneous set, offset from the candidates.

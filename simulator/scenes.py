@@ -579,19 +579,15 @@ def scene_from_depth_file(
         h = (h - h.min()) * (relief_px / span if span > 0 else 0.0)
     else:
         h = h * float(scale_px)
-    shape = (h.shape[0], h.shape[1])
-    return Scene(
-        name=name or p.stem,
-        seed=0,
-        height=h,
-        normals=normals_from_height(h),
-        albedo=_albedo_array(albedo, shape),
-        specular_albedo=np.zeros((*shape, 3)),
-        roughness=np.ones(shape),
-        passes=frozenset(passes),
-        pixel_size_mm=pixel_size_mm,
-        material="matte (from depth file)",
-        description=f"height field from {p.name}",
+    return _matte_from_file(
+        name or p.stem,
+        h,
+        normals_from_height(h),
+        albedo,
+        pixel_size_mm,
+        passes,
+        "depth file",
+        f"height field from {p.name}",
     )
 
 
@@ -627,17 +623,40 @@ def scene_from_normal_file(
         n[..., 1] = -n[..., 1]
     n[..., 2] = np.maximum(n[..., 2], 1e-3)
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
-    shape = (n.shape[0], n.shape[1])
+    return _matte_from_file(
+        name or p.stem,
+        height_from_normals(n),
+        n,
+        albedo,
+        pixel_size_mm,
+        passes,
+        "normal file",
+        f"normal map from {p.name}",
+    )
+
+
+def _matte_from_file(
+    name: str,
+    height: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    albedo: float | ArrayLike,
+    pixel_size_mm: float,
+    passes: Iterable[str],
+    source: str,
+    description: str,
+) -> Scene:
+    """A matte scene (no specular lobe) from a height and its normals read from a file."""
+    shape = (height.shape[0], height.shape[1])
     return Scene(
-        name=name or p.stem,
+        name=name,
         seed=0,
-        height=height_from_normals(n),
-        normals=n,
+        height=height,
+        normals=normals,
         albedo=_albedo_array(albedo, shape),
         specular_albedo=np.zeros((*shape, 3)),
         roughness=np.ones(shape),
         passes=frozenset(passes),
         pixel_size_mm=pixel_size_mm,
-        material="matte (from normal file)",
-        description=f"normal map from {p.name}",
+        material=f"matte (from {source})",
+        description=description,
     )
