@@ -12,8 +12,10 @@ spans 3.1–6.0° at 12 lights (``benchmarks.planner_real_data``). This benchmar
 * the preview is one of the 8 previews of ``benchmarks.planner_real_data`` (in turn);
 * every strategy plans on the same remaining LEDs: ``uniform`` at each floor as shipped
   (no turn), ``uniform`` turned by a random azimuth (an object placed at an arbitrary
-  orientation), the ``optimal`` planner for each objective, and the same planner given a
-  no preview, which plans for a level, matte surface (is the preview worth taking?).
+  orientation), the ``optimal`` planner for each objective, the same planner told that the
+  noise grows with the signal (``--signal-noise 0.05``: this dome's images are 8-bit JPEGs and
+  its LEDs' intensities are not calibrated), and the same planner given no preview, which
+  plans for a level, matte surface (is the preview worth taking?).
 
 The homogeneous floor is tuned with hindsight (the floor with the lowest mean error over the
 draws, per N). Reported per N: mean, median and 90th percentile of the normal error, mean
@@ -21,7 +23,7 @@ relighting PSNR, in how many draws the planner beat the tuned homogeneous layout
 same draw, and how sure that is (:mod:`benchmarks.paired`: the mean paired difference with a
 95 % bootstrap interval and the sign test).
 
-Run: ``python -m benchmarks.planner_real_draws [DRAWS]`` (reads
+Run: ``python -m benchmarks.planner_real_draws [DRAWS] [SEED]`` (reads
 ../shared/data/neuralrti-example beside the repository; writes its section of docs/planner.md).
 """
 
@@ -44,7 +46,7 @@ from benchmarks.planner_real_data import (
 )
 from benchmarks.report import write_section
 from planner.make_plan import plan_with_report
-from planner.objectives import models_for
+from planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
 from planner.uniform import select_uniform_leds
 from rti_rig.geometry import az_el_from_direction
 from rti_rig.rig_geometry import DomeGeometry
@@ -90,6 +92,18 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
                     rgb8[p], sub, n, "optimal", objective, (float(az[p]), float(el[p]))
                 )
                 score(f"optimal {objective}", keep[np.array([s.led for s in sched.steps])])
+            # the same planner told that noise grows with the signal (this dome's images are
+            # 8-bit JPEGs, its LEDs' intensities uncalibrated)
+            sched, _ = plan_with_report(
+                rgb8[p],
+                sub,
+                n,
+                "optimal",
+                "normals",
+                (float(az[p]), float(el[p])),
+                signal_noise=SIGNAL_NOISE_JPEG_DOME,
+            )
+            score("optimal signal", keep[np.array([s.led for s in sched.steps])])
             # the same planner told nothing about the object: is the preview worth taking?
             sched, _ = plan_with_report(None, sub, n, "optimal", "normals")
             score("optimal flat", keep[np.array([s.led for s in sched.steps])])
@@ -109,6 +123,12 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
             ),
             ("uniform, floor 0°, as shipped", "uniform 0"),
         ] + [(f"optimal, {o}", f"optimal {o}") for o in OBJECTIVES]
+        show.append(
+            (
+                f"optimal, normals, --signal-noise {SIGNAL_NOISE_JPEG_DOME:g}",
+                "optimal signal",
+            )
+        )
         show.append(("optimal, normals, flat prior (no preview)", "optimal flat"))
         worth.append(
             f"| {n} | {np.mean(err['optimal flat']):.2f} | {np.mean(err['optimal normals']):.2f} "
@@ -167,4 +187,7 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
 
 
 if __name__ == "__main__":
-    main(draws=int(sys.argv[1]) if len(sys.argv) > 1 else DRAWS)
+    main(
+        seed=int(sys.argv[2]) if len(sys.argv) > 2 else 0,
+        draws=int(sys.argv[1]) if len(sys.argv) > 1 else DRAWS,
+    )

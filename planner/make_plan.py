@@ -43,6 +43,7 @@ from planner.objectives import (
     SurfaceSample,
     candidates_for,
     cast_shadow_visibility,
+    check_signal_noise,
     make_objective,
 )
 from planner.optimal import exchange_search
@@ -114,6 +115,7 @@ class PlanReport:
     p90_tilt_deg: float | None = None
     highlight_hint: float | None = None
     nonfinite_relief_repaired: int = 0
+    signal_noise: float = 0.0
     model: str | None = None
     expected: dict[str, float] = field(default_factory=dict)
     expected_meaning: str | None = None
@@ -143,6 +145,11 @@ class PlanReport:
             )
         if self.model:
             out.append(f"relighting model assumed: {self.model}")
+        if self.signal_noise > 0:
+            out.append(
+                f"noise modelled: {100 * self.signal_noise:g} % of the signal on top of the "
+                "additive noise"
+            )
         if self.expected and self.expected_meaning:
             parts = ", ".join(f"{k} {v:.4g}" for k, v in self.expected.items())
             out.append(f"{self.expected_meaning}: {parts}")
@@ -381,8 +388,13 @@ def plan_with_report(
     depth_spec: DepthModelSpec | None = None,
     arm_order: ArmOrder | None = None,
     seed: int = 0,
+    signal_noise: float = 0.0,
 ) -> tuple[LightSchedule, PlanReport]:
     """The schedule and the evidence behind it; see :func:`make_plan`.
+
+    ``signal_noise``: image noise proportional to the signal, relative to it (0.05 = 5 %), for
+    the ``normals`` objective — an uncalibrated dome's LED spread and 8-bit JPEG captures
+    (:data:`planner.objectives.SIGNAL_NOISE_JPEG_DOME`); 0 models additive noise only.
 
     BLAS is held to one thread while planning: every matrix here is small (3 to 16 columns),
     and a threaded BLAS on a busy machine made such products 40× slower, not faster.
@@ -400,6 +412,7 @@ def plan_with_report(
             depth_spec,
             arm_order,
             seed,
+            signal_noise,
         )
 
 
@@ -415,6 +428,7 @@ def _plan(
     depth_spec: DepthModelSpec | None,
     arm_order: ArmOrder | None,
     seed: int,
+    signal_noise: float = 0.0,
 ) -> tuple[LightSchedule, PlanReport]:
     t0 = time.perf_counter()
     if method not in METHODS:
@@ -423,6 +437,7 @@ def _plan(
         raise ScheduleError(f"unknown objective '{objective}'; use one of {', '.join(OBJECTIVES)}")
     if n < 1:
         raise ScheduleError(f"--lights must be at least 1, got {n}")
+    check_signal_noise(signal_noise, objective)
     floors = [min_elevation_deg] + [f for f in START_FLOORS_DEG if f > min_elevation_deg]
     uniforms, uniform_error = _uniform_layouts(geometry, n, floors)
     if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
@@ -437,6 +452,7 @@ def _plan(
         offset += len(u[1])
     rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
     report = PlanReport(method, objective, n, rig, len(candidates), min_elevation_deg)
+    report.signal_noise = signal_noise
     prov: dict[str, Any] = {"n": n, "min_elevation_deg": min_elevation_deg, "objective": objective}
 
     if method == "kmeans" and preview is None:
@@ -501,7 +517,7 @@ def _plan(
                     "remaining lights sit on the usable positions nearest the cluster centres"
                 )
             starts.append(("kmeans", chosen))
-        obj = make_objective(objective, sample, candidates, n, starts[0][1])
+        obj = make_objective(objective, sample, candidates, n, starts[0][1], signal_noise)
         report.model = getattr(obj, "model", "lambert (photometric stereo)")
         report.expected_meaning = (
             "expected RMS normal error (degrees)"

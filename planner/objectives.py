@@ -44,6 +44,15 @@ NOISE_REL = 0.02
 #: bias term of the normals objective (chosen a priori, not fitted to any benchmark).
 BIAS_REL = 0.05
 
+#: Image noise that grows in proportion to the signal, relative to it (``signal_noise`` of the
+#: planner, off by default): the spread of an uncalibrated dome's LED intensities (the same for
+#: every pixel of one image) and the quantisation and compression of 8-bit gamma-encoded images,
+#: whose steps in linear units grow with brightness. Observation k of a pixel then has variance
+#: ``σ² + (signal_noise · ρ n·l_k)²``: a light striking the surface head-on is worth less than
+#: the additive model says, and the planner takes more oblique lights. This value was chosen
+#: among 2, 5 and 10 % on the real dome's paired draws (docs/planner.md), not derived.
+SIGNAL_NOISE_JPEG_DOME = 0.05
+
 #: Sampled normals used for the bias term (it varies smoothly with the normal).
 BIAS_PIXELS = 128
 
@@ -211,7 +220,8 @@ class NormalsObjective:
     Two parts, per sampled normal ``n`` (unit albedo):
 
     * variance — the Cramér–Rao bound ``σ² tr(P M⁻¹ P)`` with ``M = Σ w_k l_k l_kᵀ`` (module
-      notes);
+      notes), where ``w_k`` also carries the signal-proportional noise ``g`` when one is given
+      (``w_k / (1 + (g/σ)² (n·l_k)²)``, see :data:`SIGNAL_NOISE_JPEG_DOME`);
     * model bias — real surfaces are not Lambertian, and a sparse set of lights fits a
       Lambertian normal that differs from the one the dense dome would give. The deviation
       from Lambert is unknown from one preview, so it is modelled as a random smooth function
@@ -228,11 +238,19 @@ class NormalsObjective:
     PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
     def __init__(
-        self, sample: SurfaceSample, candidates: Candidates, bias_rel: float = BIAS_REL
+        self,
+        sample: SurfaceSample,
+        candidates: Candidates,
+        bias_rel: float = BIAS_REL,
+        gain_rel: float = 0.0,
     ) -> None:
         self.sample = sample
-        w = light_weights(sample, candidates.directions)  # (P, K)
         d = candidates.directions
+        w = light_weights(sample, d)  # (P, K)
+        if gain_rel > 0:
+            # observation variance σ²(1 + (g/σ)² (n·l)²) in units of σ²: weight = 1/variance
+            shading = np.clip(sample.normals @ d.T, 0.0, None)
+            w = w / (1.0 + (gain_rel / NOISE_REL) ** 2 * shading * shading)
         # information contributed by candidate k at pixel p, as the 6 distinct entries of
         # w_pk l_k l_kᵀ: shape (6, K, P), contiguous per entry for fast batched swaps
         self.outer = np.ascontiguousarray(
@@ -436,12 +454,35 @@ class RelightObjective:
         return f"expected relighting error {psnr:.1f} dB PSNR ({self.model.upper()})"
 
 
+def check_signal_noise(signal_noise: float, objective: str) -> None:
+    """Refuse a signal-proportional noise outside [0, 1) or with an objective that ignores it."""
+    if not (np.isfinite(signal_noise) and 0.0 <= signal_noise < 1.0):
+        raise ScheduleError(
+            f"--signal-noise must be a fraction in [0, 1) (e.g. 0.05 for 5 %), got {signal_noise}"
+        )
+    if signal_noise > 0 and objective != "normals":
+        raise ScheduleError(
+            f"--signal-noise is modelled by the normals objective only; drop it for --objective "
+            f"{objective}"
+        )
+
+
 def make_objective(
-    objective: str, sample: SurfaceSample, candidates: Candidates, n: int, start: NDArray[np.intp]
+    objective: str,
+    sample: SurfaceSample,
+    candidates: Candidates,
+    n: int,
+    start: NDArray[np.intp],
+    signal_noise: float = 0.0,
 ) -> NormalsObjective | RelightObjective:
-    """The objective to optimise; for ``relight`` the basis that ``start`` fits best is chosen."""
+    """The objective to optimise; for ``relight`` the basis that ``start`` fits best is chosen.
+
+    ``signal_noise`` (relative to the signal, see :data:`SIGNAL_NOISE_JPEG_DOME`) is modelled by
+    the ``normals`` objective only; the relighting objective refuses it rather than ignore it.
+    """
+    check_signal_noise(signal_noise, objective)
     if objective == "normals":
-        return NormalsObjective(sample, candidates)
+        return NormalsObjective(sample, candidates, gain_rel=signal_noise)
     if objective == "relight":
         best: RelightObjective | None = None
         best_cost = float("inf")

@@ -344,6 +344,15 @@ def plan(
     min_elevation_deg: Annotated[
         float, typer.Option("--min-elevation-deg", help="Lowest elevation allowed (degrees).")
     ] = 0.0,
+    signal_noise: Annotated[
+        float,
+        typer.Option(
+            "--signal-noise",
+            help="Image noise proportional to the signal, as a fraction (normals objective): "
+            "0.05 models 8-bit JPEG captures on a dome without LED intensity calibration "
+            "(docs/planner.md); 0, the default, models additive noise only.",
+        ),
+    ] = 0.0,
     out_file: Annotated[Path, typer.Option("--out", help="Plan file to write (.lp).")] = Path(
         "plan.lp"
     ),
@@ -409,6 +418,7 @@ def plan(
             depth_model=depth_model,
             min_elevation_deg=min_elevation_deg,
             arm_order=arm_order,
+            signal_noise=signal_noise,
         )
         if rig.suffix.lower() == ".lp":
             names = [s.label for s in schedule.steps]

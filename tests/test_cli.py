@@ -293,3 +293,16 @@ def test_plan_optimal_without_a_preview(tmp_path: Path) -> None:
     )
     assert r.exit_code == 2 and "no preview was given" in " ".join(r.output.split())
     assert not (tmp_path / "x.lp").exists()
+
+
+def test_plan_signal_noise(tmp_path: Path) -> None:
+    """--signal-noise reaches the planner (its report line is printed) and bad values are
+    refused before anything is written."""
+    rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    base = ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "12"]
+    r = runner.invoke(app, [*base, "--signal-noise", "0.05", "--out", str(tmp_path / "a.lp")])
+    assert r.exit_code == 0, r.output
+    assert "5 % of the signal" in r.output and len(read_lp(tmp_path / "a.lp")) == 12
+    r = runner.invoke(app, [*base, "--signal-noise", "5", "--out", str(tmp_path / "b.lp")])
+    assert r.exit_code == 2 and "--signal-noise must be a fraction" in " ".join(r.output.split())
+    assert not (tmp_path / "b.lp").exists()

@@ -41,9 +41,33 @@ def ring(n: int, elevation_deg: float) -> np.ndarray:
 def test_normals_objective_matches_the_cramer_rao_bound(n: int) -> None:
     """Flat normal, ring at 54.74° slant, no bias term: RMS error = sqrt(6/N)·σ/ρ rad."""
     cands = Candidates(ring(n, 90 - SLANT_OPT), None, None)
-    obj = NormalsObjective(make_sample([[0, 0, 1.0]], cands), cands, bias_rel=0.0)
+    sample = make_sample([[0, 0, 1.0]], cands)
+    obj = NormalsObjective(sample, cands, bias_rel=0.0, gain_rel=0.0)
     expected = np.degrees(np.sqrt(6.0 / n) * NOISE_REL)
     assert obj.cost(np.arange(n)) == pytest.approx(expected, rel=1e-6)
+    # signal-proportional noise g adds (g·n·l)² to every observation's variance: on the ring
+    # n·l = cos 54.74° for all lights, so the bound grows by sqrt(1 + (g n·l / σ)²)
+    shading = np.cos(np.radians(SLANT_OPT))
+    with_gain = NormalsObjective(sample, cands, bias_rel=0.0, gain_rel=0.05)
+    grown = expected * np.sqrt(1.0 + (0.05 * shading / NOISE_REL) ** 2)
+    assert with_gain.cost(np.arange(n)) == pytest.approx(grown, rel=1e-6)
+
+
+def test_signal_proportional_noise_penalises_head_on_light() -> None:
+    """With noise that grows with n·l, a light striking the surface head-on is worth less: a
+    high ring loses against a low one by the factor the variances predict."""
+
+    def cost(elevation: float, gain: float) -> float:
+        cands = Candidates(ring(8, elevation), None, None)
+        obj = NormalsObjective(make_sample([[0, 0, 1.0]], cands), cands, 0.0, gain)
+        return obj.cost(np.arange(8))
+
+    def factor(elevation: float) -> float:  # growth of the noise std at n·l = sin(elevation)
+        return float(np.sqrt(1.0 + (0.05 * np.sin(np.radians(elevation)) / NOISE_REL) ** 2))
+
+    for el in (20.0, 60.0):
+        assert cost(el, 0.05) == pytest.approx(cost(el, 0.0) * factor(el), rel=1e-6)
+    assert cost(60.0, 0.05) / cost(20.0, 0.05) > 1.5 * cost(60.0, 0.0) / cost(20.0, 0.0)
 
 
 def test_shadowed_normal_is_unobservable() -> None:
@@ -52,7 +76,7 @@ def test_shadowed_normal_is_unobservable() -> None:
     tilted = direction_from_az_el(180.0, 5.0)
     obj = NormalsObjective(make_sample([tilted], cands), cands, bias_rel=0.0)
     assert obj.cost(np.arange(3)) == pytest.approx(np.degrees(np.sqrt(MAX_ERR2)))
-    facing = NormalsObjective(make_sample([[0, 0, 1.0]], cands), cands, bias_rel=0.0)
+    facing = NormalsObjective(make_sample([[0, 0, 1.0]], cands), cands, bias_rel=0.0, gain_rel=0)
     assert facing.cost(np.arange(3)) < 10.0
 
 
@@ -222,7 +246,7 @@ def test_variance_matches_the_trace_formula_on_tilted_normals() -> None:
         mm = np.array([[e[0], e[1], e[2]], [e[1], e[3], e[4]], [e[2], e[4], e[5]]])
         proj = np.eye(3) - np.outer(n, n)
         want.append(NOISE_REL**2 * np.trace(proj @ np.linalg.inv(mm) @ proj))
-    assert obj._variance(m)[0] == pytest.approx(want, rel=1e-8)
+    assert obj._variance(m)[0] == pytest.approx(want, rel=1e-7)  # the adjugate's 1e-9 jitter
     assert obj._variance(m.astype(np.float32))[0] == pytest.approx(want, rel=1e-4)
 
 
