@@ -452,7 +452,6 @@ def _plan(
         offset += len(u[1])
     rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
     report = PlanReport(method, objective, n, rig, len(candidates), min_elevation_deg)
-    report.signal_noise = signal_noise
     prov: dict[str, Any] = {"n": n, "min_elevation_deg": min_elevation_deg, "objective": objective}
 
     if method == "kmeans" and preview is None:
@@ -518,6 +517,12 @@ def _plan(
                 )
             starts.append(("kmeans", chosen))
         obj = make_objective(objective, sample, candidates, n, starts[0][1], signal_noise)
+        report.signal_noise = signal_noise
+        if signal_noise > 0 and method != "optimal":
+            report.notes.append(
+                f"--signal-noise changes only the expected errors reported here, not the "
+                f"lights {method} chooses"
+            )
         report.model = getattr(obj, "model", "lambert (photometric stereo)")
         report.expected_meaning = (
             "expected RMS normal error (degrees)"
@@ -563,6 +568,7 @@ def make_plan(
     preview_light: tuple[float, float] | None = None,
     depth_model: Path | None = None,
     min_elevation_deg: float = 0.0,
+    signal_noise: float = 0.0,
 ) -> LightSchedule:
     """An ordered schedule of ``n`` lights for ``geometry`` planned from one preview.
 
@@ -574,5 +580,13 @@ def make_plan(
     ``schedule.provenance["report"]`` (or use :func:`plan_with_report`).
     """
     return plan_with_report(
-        preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg
+        preview,
+        geometry,
+        n,
+        method,
+        objective,
+        preview_light,
+        depth_model,
+        min_elevation_deg,
+        signal_noise=signal_noise,
     )[0]

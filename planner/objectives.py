@@ -220,8 +220,10 @@ class NormalsObjective:
     Two parts, per sampled normal ``n`` (unit albedo):
 
     * variance — the Cramér–Rao bound ``σ² tr(P M⁻¹ P)`` with ``M = Σ w_k l_k l_kᵀ`` (module
-      notes), where ``w_k`` also carries the signal-proportional noise ``g`` when one is given
-      (``w_k / (1 + (g/σ)² (n·l_k)²)``, see :data:`SIGNAL_NOISE_JPEG_DOME`);
+      notes), where ``w_k`` also carries the signal-proportional noise ``s`` when one is given
+      (``w_k / (1 + (s/σ)² (n·l_k)²)``, see :data:`SIGNAL_NOISE_JPEG_DOME`: the information
+      of a fit that weights each observation by its noise; the reconstruction's robust fit
+      weights them equally, so this ranks layouts, it does not predict that fit's error);
     * model bias — real surfaces are not Lambertian, and a sparse set of lights fits a
       Lambertian normal that differs from the one the dense dome would give. The deviation
       from Lambert is unknown from one preview, so it is modelled as a random smooth function
@@ -245,6 +247,7 @@ class NormalsObjective:
         gain_rel: float = 0.0,
     ) -> None:
         self.sample = sample
+        self.gain_rel = gain_rel
         d = candidates.directions
         w = light_weights(sample, d)  # (P, K)
         if gain_rel > 0:
@@ -359,7 +362,8 @@ class NormalsObjective:
         return self._total(base.astype(dtype)[:, None, :] + outer, r)
 
     def describe(self, value: float) -> str:
-        return f"expected RMS normal error {value:.2f}° at {100 * NOISE_REL:g}% noise"
+        signal = f" + {100 * self.gain_rel:g}% of the signal" if self.gain_rel > 0 else ""
+        return f"expected RMS normal error {value:.2f}° at {100 * NOISE_REL:g}% noise{signal}"
 
 
 def models_for(n: int) -> list[str]:

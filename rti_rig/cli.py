@@ -369,7 +369,7 @@ def plan(
     directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.
     """
     from planner.make_plan import DEFAULT_OBJECTIVE, METHODS, plan_with_report
-    from planner.objectives import OBJECTIVES
+    from planner.objectives import OBJECTIVES, check_signal_noise
     from planner.topography import read_preview
     from rti_rig.compose import arm_order_for
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
@@ -387,6 +387,7 @@ def plan(
             raise RtiRigError(
                 f"--objective {objective!r} is not known; choose {', '.join(OBJECTIVES)}"
             )
+        check_signal_noise(signal_noise, objective)
         if method == "kmeans" and preview is None:
             raise RtiRigError(
                 "--method kmeans clusters the preview's normals: give PREVIEW (or use "

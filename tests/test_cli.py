@@ -306,3 +306,6 @@ def test_plan_signal_noise(tmp_path: Path) -> None:
     r = runner.invoke(app, [*base, "--signal-noise", "5", "--out", str(tmp_path / "b.lp")])
     assert r.exit_code == 2 and "--signal-noise must be a fraction" in " ".join(r.output.split())
     assert not (tmp_path / "b.lp").exists()
+    # checked before the rig and the output file: the option's own error, not "exists"
+    r = runner.invoke(app, [*base, "--signal-noise", "-1", "--out", str(tmp_path / "a.lp")])
+    assert r.exit_code == 2 and "--signal-noise must be a fraction" in " ".join(r.output.split())

@@ -293,3 +293,22 @@ def test_signal_noise_with_the_relight_objective_is_refused() -> None:
     """The relighting objective does not model it: refusing beats silently ignoring it."""
     with pytest.raises(ScheduleError, match="normals objective only"):
         plan_with_report(PREVIEW, DOME, 12, "optimal", "relight", (30.0, 50.0), signal_noise=0.05)
+
+
+def test_signal_noise_is_reported_only_where_it_was_modelled() -> None:
+    """Without a preview `uniform` builds no objective: the report must not claim the noise was
+    modelled. With a preview it is, but only in the expected errors: the report says so, and the
+    lights are the same; make_plan passes the option on like plan_with_report."""
+    _, rep = plan_with_report(None, DOME, 9, "uniform", signal_noise=0.05)
+    assert rep.signal_noise == 0 and not any("of the signal" in line for line in rep.lines())
+    plain, _ = plan_with_report(PREVIEW, DOME, 9, "uniform", preview_light=(30.0, 50.0))
+    noisy, rep = plan_with_report(
+        PREVIEW, DOME, 9, "uniform", preview_light=(30.0, 50.0), signal_noise=0.05
+    )
+    assert [s.led for s in noisy.steps] == [s.led for s in plain.steps]
+    assert rep.signal_noise == 0.05
+    assert any("not the lights uniform chooses" in line for line in rep.lines())
+    via_make = make_plan(None, REAL_DOME, 12, "optimal", signal_noise=0.05)
+    via_report, _ = plan_with_report(None, REAL_DOME, 12, "optimal", signal_noise=0.05)
+    assert [s.led for s in via_make.steps] == [s.led for s in via_report.steps]
+    assert via_make.provenance["report"]["signal_noise"] == 0.05

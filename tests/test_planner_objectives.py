@@ -246,7 +246,7 @@ def test_variance_matches_the_trace_formula_on_tilted_normals() -> None:
         mm = np.array([[e[0], e[1], e[2]], [e[1], e[3], e[4]], [e[2], e[4], e[5]]])
         proj = np.eye(3) - np.outer(n, n)
         want.append(NOISE_REL**2 * np.trace(proj @ np.linalg.inv(mm) @ proj))
-    assert obj._variance(m)[0] == pytest.approx(want, rel=1e-7)  # the adjugate's 1e-9 jitter
+    assert obj._variance(m)[0] == pytest.approx(want, rel=1e-8)
     assert obj._variance(m.astype(np.float32))[0] == pytest.approx(want, rel=1e-4)
 
 
