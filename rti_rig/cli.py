@@ -12,6 +12,7 @@ from typing import Annotated, Any
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from rti_rig.errors import RtiRigError
@@ -33,7 +34,8 @@ out = Console()
 
 
 def _fail(exc: RtiRigError) -> typer.Exit:
-    err.print(f"[bold red]error:[/] {exc}", highlight=False, markup=True, soft_wrap=True)
+    # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
+    err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
     return typer.Exit(code=2)
 
 
@@ -345,14 +347,15 @@ def plan(
         float, typer.Option("--min-elevation-deg", help="Lowest elevation allowed (degrees).")
     ] = 0.0,
     signal_noise: Annotated[
-        float,
+        float | None,
         typer.Option(
             "--signal-noise",
             help="Image noise proportional to the signal, as a fraction (normals objective): "
             "0.05 models 8-bit JPEG captures on a dome without LED intensity calibration "
-            "(docs/planner.md); 0, the default, models additive noise only.",
+            "(docs/planner.md); 0 models additive noise only. Default: the rig config's "
+            "[camera] signal_noise (0 if absent, and for a bare .lp).",
         ),
-    ] = 0.0,
+    ] = None,
     out_file: Annotated[Path, typer.Option("--out", help="Plan file to write (.lp).")] = Path(
         "plan.lp"
     ),
@@ -387,7 +390,8 @@ def plan(
             raise RtiRigError(
                 f"--objective {objective!r} is not known; choose {', '.join(OBJECTIVES)}"
             )
-        check_signal_noise(signal_noise, objective)
+        if signal_noise is not None:
+            check_signal_noise(signal_noise, objective)
         if method == "kmeans" and preview is None:
             raise RtiRigError(
                 "--method kmeans clusters the preview's normals: give PREVIEW (or use "
@@ -406,6 +410,14 @@ def plan(
             loaded = load_rig_config(rig)
             geometry = rig_geometry(loaded)
             arm_order = arm_order_for(loaded)
+            if signal_noise is None and loaded.config.camera.signal_noise > 0:
+                signal_noise = loaded.config.camera.signal_noise
+                if objective != "normals":
+                    raise RtiRigError(
+                        f"{rig}: [camera] signal_noise = {signal_noise:g} is modelled by the "
+                        f"normals objective only; give --signal-noise 0 to plan for "
+                        f"--objective {objective}"
+                    )
         if out_file.exists() and not force:
             raise RtiRigError(f"{out_file} exists; use --force to replace it")
         image = read_preview(preview) if preview is not None else None
@@ -419,7 +431,7 @@ def plan(
             depth_model=depth_model,
             min_elevation_deg=min_elevation_deg,
             arm_order=arm_order,
-            signal_noise=signal_noise,
+            signal_noise=signal_noise or 0.0,
         )
         if rig.suffix.lower() == ".lp":
             names = [s.label for s in schedule.steps]

@@ -100,6 +100,10 @@ class CameraConfig(_Strict):
 
     ``device`` is the real camera's driver table (``kind = "opencv" | "gphoto2" |
     "folder_watch"``, see docs/cameras.md); a simulated or emulated rig renders its images.
+    ``signal_noise``: noise in this rig's images that grows in proportion to the signal, as a
+    fraction, for the planner (``rti-rig plan`` uses it unless ``--signal-noise`` is given):
+    0.05 for 8-bit JPEGs on a dome whose LED intensities are not calibrated (docs/planner.md),
+    0 (the default) when the noise is additive and shot noise only, as on the simulated rigs.
     """
 
     width: int = Field(default=512, gt=0, le=20000)
@@ -109,6 +113,7 @@ class CameraConfig(_Strict):
     min_exposure_s: float = Field(default=1e-4, gt=0)
     max_exposure_s: float = Field(default=30.0, gt=0)
     device: dict[str, Any] | None = None
+    signal_noise: float = Field(default=0.0, ge=0.0, lt=1.0)
 
     @model_validator(mode="after")
     def _exposure_in_range(self) -> CameraConfig:

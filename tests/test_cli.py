@@ -309,3 +309,31 @@ def test_plan_signal_noise(tmp_path: Path) -> None:
     # checked before the rig and the output file: the option's own error, not "exists"
     r = runner.invoke(app, [*base, "--signal-noise", "-1", "--out", str(tmp_path / "a.lp")])
     assert r.exit_code == 2 and "--signal-noise must be a fraction" in " ".join(r.output.split())
+
+
+def _rig_with_signal_noise(tmp_path: Path, value: str) -> Path:
+    text = (REPO / "rig_configs" / "simulated_dome.toml").read_text()
+    rig = tmp_path / "jpeg_dome.toml"
+    rig.write_text(text.replace("[camera]\n", f"[camera]\nsignal_noise = {value}\n", 1))
+    return rig
+
+
+def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
+    """A rig declares its images' signal-proportional noise once ([camera] signal_noise); the
+    flag overrides it; an objective that cannot model it is refused, naming the file."""
+    rig = _rig_with_signal_noise(tmp_path, "0.05")
+    base = ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "12"]
+    r = runner.invoke(app, [*base, "--out", str(tmp_path / "a.lp")])
+    assert r.exit_code == 0, r.output
+    assert "5 % of the signal" in r.output
+    r = runner.invoke(app, [*base, "--signal-noise", "0", "--out", str(tmp_path / "b.lp")])
+    assert r.exit_code == 0, r.output
+    assert "of the signal" not in r.output
+    r = runner.invoke(app, [*base, "--objective", "relight", "--out", str(tmp_path / "c.lp")])
+    flat = " ".join(r.output.split())
+    assert r.exit_code == 2 and "jpeg_dome.toml" in flat and "[camera] signal_noise" in flat
+    assert not (tmp_path / "c.lp").exists()
+    bad = _rig_with_signal_noise(tmp_path, "1.5")
+    r = runner.invoke(app, ["plan", "--rig", str(bad), "--out", str(tmp_path / "d.lp")])
+    flat = " ".join(r.output.split())
+    assert r.exit_code == 2 and "signal_noise" in flat and "jpeg_dome.toml" in flat
