@@ -51,7 +51,7 @@ from planner.uniform import select_uniform_leds
 from rti_rig.geometry import az_el_from_direction
 from rti_rig.rig_geometry import DomeGeometry
 
-DRAWS = 48
+DRAWS = 144
 REMOVED = 8
 FLOORS = (0.0, 10.0, 20.0, 30.0)
 OBJECTIVES = ("normals", "relight")
