@@ -579,14 +579,5 @@ def make_plan(
     steps are ordered for short moves from the park pose. The evidence is in
     ``schedule.provenance["report"]`` (or use :func:`plan_with_report`).
     """
-    return plan_with_report(
-        preview,
-        geometry,
-        n,
-        method,
-        objective,
-        preview_light,
-        depth_model,
-        min_elevation_deg,
-        signal_noise=signal_noise,
-    )[0]
+    args = (preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg)
+    return plan_with_report(*args, signal_noise=signal_noise)[0]
