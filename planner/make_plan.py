@@ -518,7 +518,7 @@ def _plan(
             starts.append(("kmeans", chosen))
         obj = make_objective(objective, sample, candidates, n, starts[0][1], signal_noise)
         report.signal_noise = signal_noise
-        if signal_noise > 0 and method != "optimal":
+        if signal_noise > 0 and (method != "optimal" or n < MIN_LIGHTS_FOR_EXCHANGE):
             report.notes.append(
                 f"--signal-noise changes only the expected errors reported here, not the "
                 f"lights {method} chooses"

@@ -127,8 +127,8 @@ def run(
             loaded = load_rig_config(config_path)
             if loaded.sha256 != manifest["rig"].get("config_sha256"):
                 err.print(
-                    f"[yellow]note:[/] {config_path} has changed since the session began; "
-                    "the remaining steps are checked against it before anything moves."
+                    f"[yellow]note:[/] {escape(str(config_path))} has changed since the session "
+                    "began; the remaining steps are checked against it before anything moves."
                 )
             schedule = LightSchedule.from_dict(manifest["schedule"])
             out_dir = resume
@@ -231,7 +231,10 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
     dry = " (dry run)" if rig.loaded.config.backend != "hardware" else ""
     todo = len(schedule) - len(folder.done)
-    out.print(f"Rig [bold]{rig.name}[/]{dry}: {todo} of {len(schedule)} lights → {out_dir}")
+    out.print(
+        f"Rig [bold]{escape(rig.name)}[/]{dry}: {todo} of {len(schedule)} lights → "
+        f"{escape(str(out_dir))}"
+    )
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
     try:
         with Progress(
@@ -251,11 +254,16 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
 
             result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event)
     except EmergencyStop as exc:
-        err.print(f"[red]Emergency stop ({exc}):[/] lights off, devices safe; images kept.")
+        err.print(
+            f"[red]Emergency stop ({escape(str(exc))}):[/] lights off, devices safe; images kept."
+        )
         err.print(resume_hint)
         raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:
-        err.print(f"Images already captured are kept in {out_dir}; lights are off. {resume_hint}")
+        err.print(
+            f"Images already captured are kept in {out_dir}; lights are off. {resume_hint}",
+            markup=False,
+        )
         raise _fail(exc) from None
     finally:
         for sig, h in previous.items():
@@ -268,7 +276,7 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
         + (f" (simulated in {result.wall_time_s:.1f} s)" if dry else "")
     )
     for failure in result.teardown_failures:
-        err.print(f"[red]teardown problem:[/] {failure}")
+        err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
     if result.finish_reason is FinishReason.CANCELLED:
         err.print(
             f"[yellow]Session cancelled; the images captured so far are kept.[/] {resume_hint}"
@@ -443,7 +451,7 @@ def plan(
     except RtiRigError as exc:
         raise _fail(exc) from None
     for line in report.lines():
-        out.print(line, highlight=False)
+        out.print(line, highlight=False, markup=False)
     out.print(f"Planned {len(schedule)} lights ({method}, {objective}) → {out_file}")
 
 
