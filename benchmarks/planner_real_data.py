@@ -132,6 +132,21 @@ def evaluate(
     return err, psnr, fallback
 
 
+def planned_leds(
+    preview: np.ndarray | None,
+    geometry: DomeGeometry,
+    n: int,
+    light: tuple[float, float] | None,
+    signal_noise: float = 0.0,
+    objective: str = "normals",
+) -> np.ndarray:
+    """The ``optimal`` plan's LED indices into ``geometry`` (both draw benchmarks use it)."""
+    sched, _ = plan_with_report(
+        preview, geometry, n, "optimal", objective, light, signal_noise=signal_noise
+    )
+    return np.array([s.led for s in sched.steps])
+
+
 def hindsight(
     n: int, images: np.ndarray, dirs: np.ndarray, ref: np.ndarray, mask: np.ndarray, seed: int = 0
 ) -> np.ndarray:

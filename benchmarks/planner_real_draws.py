@@ -41,11 +41,11 @@ from benchmarks.planner_real_data import (
     NS,
     evaluate,
     load,
+    planned_leds,
     preview_leds,
     reference,
 )
 from benchmarks.report import write_section
-from planner.make_plan import plan_with_report
 from planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
 from planner.uniform import select_uniform_leds
 from rti_rig.geometry import az_el_from_direction
@@ -87,26 +87,16 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
                 score(f"uniform {f:g}", keep[select_uniform_leds(sub, n, f)])
                 score(f"turned {f:g}", keep[select_uniform_leds(sub, n, f, turn)])
             p = previews[d % len(previews)]
+            light = (float(az[p]), float(el[p]))
             for objective in OBJECTIVES:
-                sched, _ = plan_with_report(
-                    rgb8[p], sub, n, "optimal", objective, (float(az[p]), float(el[p]))
-                )
-                score(f"optimal {objective}", keep[np.array([s.led for s in sched.steps])])
+                chosen = planned_leds(rgb8[p], sub, n, light, objective=objective)
+                score(f"optimal {objective}", keep[chosen])
             # the same planner told that noise grows with the signal (this dome's images are
             # 8-bit JPEGs, its LEDs' intensities uncalibrated)
-            sched, _ = plan_with_report(
-                rgb8[p],
-                sub,
-                n,
-                "optimal",
-                "normals",
-                (float(az[p]), float(el[p])),
-                signal_noise=SIGNAL_NOISE_JPEG_DOME,
-            )
-            score("optimal signal", keep[np.array([s.led for s in sched.steps])])
+            noisy = planned_leds(rgb8[p], sub, n, light, SIGNAL_NOISE_JPEG_DOME)
+            score("optimal signal", keep[noisy])
             # the same planner told nothing about the object: is the preview worth taking?
-            sched, _ = plan_with_report(None, sub, n, "optimal", "normals")
-            score("optimal flat", keep[np.array([s.led for s in sched.steps])])
+            score("optimal flat", keep[planned_leds(None, sub, n, None)])
         tuned = {
             kind: min(FLOORS, key=lambda f, k=kind: float(np.mean(err[f"{k} {f:g}"])))
             for kind in ("uniform", "turned")

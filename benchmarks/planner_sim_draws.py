@@ -20,9 +20,8 @@ import time
 import numpy as np
 
 from benchmarks.paired import compare
-from benchmarks.planner_real_data import DOC
+from benchmarks.planner_real_data import DOC, planned_leds
 from benchmarks.report import write_section
-from planner.make_plan import plan_with_report
 from planner.objectives import SIGNAL_NOISE_JPEG_DOME
 from planner.uniform import select_uniform_leds
 from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
@@ -63,39 +62,19 @@ def main(seed: int = 0) -> str:
                 keep = np.sort(rng.choice(len(cand), len(cand) - REMOVED, replace=False))
                 sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
 
-                for f in FLOORS:
-                    idx = keep[select_uniform_leds(sub, n, f)]
-                    err.setdefault((n, f"uniform {f:g}"), []).append(
-                        normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-                    )
-                sched, _ = plan_with_report(
-                    data.preview, sub, n, "optimal", "normals", settings.preview_light_az_el_deg
-                )
-                idx = keep[np.array([s.led for s in sched.steps])]
-                err.setdefault((n, "optimal"), []).append(
-                    normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-                )
+                chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
+                light = settings.preview_light_az_el_deg
+                chosen["optimal"] = keep[planned_leds(data.preview, sub, n, light)]
                 # the same planner modelling noise that grows with the signal, as for the real
                 # dome's JPEGs (the simulated camera's is shot noise on a 14-bit raw)
-                sched, _ = plan_with_report(
-                    data.preview,
-                    sub,
-                    n,
-                    "optimal",
-                    "normals",
-                    settings.preview_light_az_el_deg,
-                    signal_noise=SIGNAL_NOISE_JPEG_DOME,
-                )
-                idx = keep[np.array([s.led for s in sched.steps])]
-                err.setdefault((n, "signal"), []).append(
-                    normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-                )
+                noisy = planned_leds(data.preview, sub, n, light, SIGNAL_NOISE_JPEG_DOME)
+                chosen["signal"] = keep[noisy]
                 # the same planner told nothing about the object: is the preview worth taking?
-                sched, _ = plan_with_report(None, sub, n, "optimal", "normals")
-                idx = keep[np.array([s.led for s in sched.steps])]
-                err.setdefault((n, "flat"), []).append(
-                    normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-                )
+                chosen["flat"] = keep[planned_leds(None, sub, n, None)]
+                for label, idx in chosen.items():
+                    err.setdefault((n, label), []).append(
+                        normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
+                    )
         floor = min(
             FLOORS,
             key=lambda f: float(np.mean([np.mean(err[(n, f"uniform {f:g}")]) for n in COUNTS])),

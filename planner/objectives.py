@@ -482,9 +482,9 @@ def make_objective(
     """The objective to optimise; for ``relight`` the basis that ``start`` fits best is chosen.
 
     ``signal_noise`` (relative to the signal, see :data:`SIGNAL_NOISE_JPEG_DOME`) is modelled by
-    the ``normals`` objective only; the relighting objective refuses it rather than ignore it.
+    the ``normals`` objective only; the planner refuses it with any other objective
+    (:func:`check_signal_noise`, called once before planning starts).
     """
-    check_signal_noise(signal_noise, objective)
     if objective == "normals":
         return NormalsObjective(sample, candidates, gain_rel=signal_noise)
     if objective == "relight":
