@@ -69,6 +69,9 @@ DEFAULT_OBJECTIVE = "normals"
 #: Extra elevation floors tried for the homogeneous starting layouts of ``optimal``.
 START_FLOORS_DEG = (10.0, 20.0, 30.0, 40.0)
 
+#: Below this many pixels on a side a preview cannot show relief (the report says so).
+TINY_PREVIEW_PX = 16
+
 #: Pixels sampled for the objectives.
 SAMPLE_PIXELS = 256
 
@@ -488,6 +491,12 @@ def _plan(
         # facts measured on the preview (none of them exist without one)
         az, el = az_el_from_direction(surface.light)
         report.preview_shape = tuple(np.asarray(preview).shape)
+        if min(report.preview_shape[:2]) < TINY_PREVIEW_PX:
+            report.notes.append(
+                f"the preview is only {report.preview_shape[1]}×{report.preview_shape[0]} px: "
+                "too small to show relief or the light's direction, so this plan is in effect "
+                "the one for a level, matte surface (give a real preview for more)"
+            )
         report.preview_light_az_el_deg = (float(az), float(el))
         report.preview_light_source = surface.light_source
         report.planning_shape = tuple(surface.image.shape)

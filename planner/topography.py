@@ -86,6 +86,8 @@ def read_preview(path: Path) -> NDArray:
     is what ``rti-rig run`` writes for fitting (DESIGN.md "Linear data").
     """
     p = Path(path)
+    if p.is_dir():
+        raise ScheduleError(f"{p} is a folder: give one preview image file")
     if not p.is_file():
         raise ScheduleError(f"{p}: preview image not found")
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)

@@ -39,6 +39,42 @@ def _fail(exc: RtiRigError) -> typer.Exit:
     return typer.Exit(code=2)
 
 
+def _check_output_file(out_file: Path, force: bool, inputs: dict[str, Path | None]) -> None:
+    """Refuse, before any work, an output the command could not write or should not replace.
+
+    ``inputs`` names the files the command reads (``{"PREVIEW": path, ...}``): replacing one of
+    them is refused even with ``--force``, as is replacing a file inside a session folder —
+    nothing already captured is ever overwritten.
+    """
+    from rti_rig.session import MANIFEST
+
+    if out_file.is_dir():
+        raise RtiRigError(f"--out {out_file} is a folder: give the name of the file to write")
+    parent = out_file.parent
+    if not parent.is_dir():
+        raise RtiRigError(f"--out {out_file}: folder {parent} does not exist; create it first")
+    if not out_file.exists():
+        return
+    for what, path in inputs.items():
+        if path is not None and path.exists() and out_file.resolve() == path.resolve():
+            raise RtiRigError(f"--out {out_file} is the {what} this command reads; choose another")
+    if (parent / MANIFEST).is_file():
+        raise RtiRigError(
+            f"--out {out_file} would replace a file of the session in {parent}; a session's "
+            "files are never overwritten: write the .lp elsewhere"
+        )
+    if not force:
+        raise RtiRigError(f"{out_file} exists; use --force to replace it")
+
+
+def _check_floor(min_elevation_deg: float) -> None:
+    """An elevation floor is an angle above the object plane, below the zenith."""
+    if not 0.0 <= min_elevation_deg < 90.0:
+        raise RtiRigError(
+            f"--min-elevation-deg {min_elevation_deg:g}: give an elevation in [0, 90) degrees"
+        )
+
+
 def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
     from rti_rig.rig_geometry import DomeGeometry
 
@@ -102,7 +138,8 @@ def run(
     """Run a capture session (a dry run when the config's backend is 'simulated').
 
     Ctrl-C once stops after the current image; Ctrl-C twice or SIGTERM stops at once (lights
-    off, arm parked); SIGUSR1 pauses or resumes between images. An interrupted session can be
+    off, arm stopped, and parked if the config says park_on_emergency_stop = true); SIGUSR1
+    pauses or resumes between images. An interrupted session can be
     continued with --resume.
     """
     from planner.from_lp import schedule_from_lp
@@ -116,6 +153,11 @@ def run(
 
     rig = None
     try:
+        if not 0.0 <= max_saturated < 1.0:
+            raise RtiRigError(
+                f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
+                "e.g. 0.001 for 0.1 %"
+            )
         if resume is not None:
             if out_dir is not None or plan is not None or lights is not None:
                 raise RtiRigError(
@@ -151,8 +193,11 @@ def run(
             if plan is not None:
                 if lights is not None:
                     raise RtiRigError("give either --plan or --lights, not both")
-                schedule = schedule_from_lp(read_lp(plan), geometry, str(plan))
+                schedule = schedule_from_lp(
+                    read_lp(plan, upper_hemisphere=True), geometry, str(plan)
+                )
             else:
+                _check_floor(min_elevation_deg)
                 n = lights if lights is not None else _default_lights(loaded, geometry)
                 schedule = plan_uniform(geometry, n, min_elevation_deg, arm_order_for(loaded))
             rig = build_rig(loaded)
@@ -305,7 +350,8 @@ def plan(
     preview: Annotated[
         Path | None,
         typer.Argument(
-            help="One preview image of the object (JPEG/PNG = sRGB, 16-bit TIFF = linear). "
+            help="One preview image of the object (8-bit JPEG/PNG/TIFF = sRGB, 16-bit "
+            "PNG/TIFF = linear, as 'rti-rig run' writes them). "
             "Needed by 'kmeans'; without it 'optimal' plans for a level, matte surface."
         ),
     ] = None,
@@ -384,7 +430,7 @@ def plan(
     from planner.topography import read_preview
     from rti_rig.compose import arm_order_for
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
-    from rti_rig.lp_format import LpEntry, read_lp, write_lp
+    from rti_rig.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
     from rti_rig.rig_geometry import DomeGeometry
     from rti_rig.session import image_names
 
@@ -407,10 +453,19 @@ def plan(
             )
         if depth_model is not None and not depth_model.is_file():
             raise RtiRigError(f"--depth-model {depth_model}: file not found")
+        _check_floor(min_elevation_deg)
+        if lights > MAX_LIGHTS:
+            raise RtiRigError(
+                f"--lights {lights}: at most {MAX_LIGHTS} lights (the most an .lp file may list "
+                "for readers such as relight)"
+            )
+        _check_output_file(
+            out_file, force, {"preview": preview, "rig file": rig, "depth model": depth_model}
+        )
         az_el = _parse_az_el(preview_light)
         arm_order = None
         if rig.suffix.lower() == ".lp":
-            entries = read_lp(rig)
+            entries = read_lp(rig, upper_hemisphere=True)
             geometry: object = DomeGeometry(
                 [e.direction for e in entries], tuple(e.name for e in entries)
             )
@@ -426,8 +481,6 @@ def plan(
                         f"normals objective only; give --signal-noise 0 to plan for "
                         f"--objective {objective}"
                     )
-        if out_file.exists() and not force:
-            raise RtiRigError(f"{out_file} exists; use --force to replace it")
         image = read_preview(preview) if preview is not None else None
         schedule, report = plan_with_report(
             image,
@@ -471,8 +524,7 @@ def export_lp(
 
     try:
         entries = session_lp_entries(session_dir, linear=linear)
-        if out_file.exists() and not force:
-            raise RtiRigError(f"{out_file} exists; use --force to replace it")
+        _check_output_file(out_file, force, {})
         write_lp(out_file, entries)
     except RtiRigError as exc:
         raise _fail(exc) from None
@@ -483,7 +535,7 @@ def export_lp(
 def check(
     rig_config: Annotated[Path, typer.Argument(help="Rig config TOML to check.")],
     intensity: Annotated[
-        float, typer.Option("--intensity", help="LED intensity for the walk (0-1).")
+        float, typer.Option("--intensity", help="LED drive level for the walk, in (0, 1].")
     ] = 0.2,
 ) -> None:
     """Self-test the rig's lights: a dome lights each LED in turn and reports what answered; an
@@ -497,6 +549,10 @@ def check(
     from rti_rig.rig_geometry import ArmGeometry
 
     try:
+        if not 0.0 < intensity <= 1.0:
+            raise RtiRigError(
+                f"--intensity {intensity:g}: give the LED drive level as a fraction in (0, 1]"
+            )
         loaded = load_rig_config(rig_config)
         rig = build_rig(loaded)
     except RtiRigError as exc:
@@ -552,3 +608,7 @@ def bench_tradeoff(
 
 def main() -> None:
     app()
+
+
+if __name__ == "__main__":
+    main()

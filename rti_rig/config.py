@@ -208,6 +208,22 @@ class RigConfig(_Strict):
             raise ValueError("kind 'dome' needs a [dome] table")
         if self.kind == "arm" and self.arm is None:
             raise ValueError("kind 'arm' needs an [arm] table")
+        devices = [
+            name
+            for name, present in (
+                ("[dome.serial]", self.dome is not None and self.dome.serial is not None),
+                ("[arm.dynamixel]", self.arm is not None and self.arm.dynamixel is not None),
+                ("[camera.device]", self.camera.device is not None),
+            )
+            if present
+        ]
+        if "backend" not in self.model_fields_set and devices:
+            # a missing line must not turn a hardware session into a simulated one unnoticed
+            raise ValueError(
+                f"backend is not set, but {' and '.join(devices)} describe real devices: "
+                "add backend = 'hardware' to drive them (or 'emulated' / 'simulated' for a "
+                "dry run)"
+            )
         if self.backend != "simulated" and self.kind == "dome" and self.dome.serial is None:  # type: ignore[union-attr]
             raise ValueError(
                 f"backend '{self.backend}' drives the dome over serial: add a [dome.serial] "
@@ -349,7 +365,7 @@ def dome_led_directions(rig: LoadedRig) -> tuple[NDArray[np.float64], list[str]]
                 f"file {lp_path} does not exist (paths are relative to the config file's folder)",
             )
         try:
-            entries = read_lp(lp_path)
+            entries = read_lp(lp_path, upper_hemisphere=True)
         except LpFormatError as exc:
             raise ConfigError(rig.path, "dome.lp_file", str(exc)) from None
         dirs = np.array([e.direction for e in entries])

@@ -112,8 +112,13 @@ def _parse_float(token: str, source: str, lineno: int, axis: str) -> float:
     return value
 
 
-def parse_lp(text: str, source: str = "<lp>") -> list[LpEntry]:
-    """Parse `.lp` text; ``source`` names the file in errors."""
+def parse_lp(text: str, source: str = "<lp>", upper_hemisphere: bool = False) -> list[LpEntry]:
+    """Parse `.lp` text; ``source`` names the file in errors.
+
+    ``upper_hemisphere`` refuses lights below the object plane (z < 0), naming the line: for a
+    rig's own lights or a plan to run, where such a light cannot be meant (a reader of other
+    tools' files leaves it off and lets the fit decide).
+    """
     lines = text.splitlines()  # handles LF, CRLF and CR
     numbered = [(i + 1, ln.strip()) for i, ln in enumerate(lines)]
     content = [(n, ln) for n, ln in numbered if ln]
@@ -155,6 +160,14 @@ def parse_lp(text: str, source: str = "<lp>") -> list[LpEntry]:
             raise LpFormatError(
                 source, lineno, f"direction ({x}, {y}, {z}) is (nearly) zero: it has no orientation"
             )
+        if upper_hemisphere and z / norm < -1e-9:
+            raise LpFormatError(
+                source,
+                lineno,
+                f"direction ({x}, {y}, {z}) points below the object plane (z < 0): a light "
+                "there cannot light the object; check the sign convention (DESIGN.md: z up, "
+                "towards the camera)",
+            )
         _check_name(name, source, lineno)
         if name in seen:
             raise LpFormatError(
@@ -174,8 +187,8 @@ def parse_lp(text: str, source: str = "<lp>") -> list[LpEntry]:
     return entries
 
 
-def read_lp(path: Path | str) -> list[LpEntry]:
-    """Read an `.lp` file tolerantly; errors name the file and line."""
+def read_lp(path: Path | str, upper_hemisphere: bool = False) -> list[LpEntry]:
+    """Read an `.lp` file tolerantly; errors name the file and line (see :func:`parse_lp`)."""
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -185,7 +198,7 @@ def read_lp(path: Path | str) -> list[LpEntry]:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         text = raw.decode("latin-1")
-    return parse_lp(text, str(path))
+    return parse_lp(text, str(path), upper_hemisphere)
 
 
 def directions_of(entries: Iterable[LpEntry]) -> NDArray[np.float64]:

@@ -341,6 +341,12 @@ def prepare_resume(root: Path) -> ResumeState:
 def read_manifest(root: Path) -> dict[str, Any]:
     """The manifest of a session folder, with a clear error if it is not one."""
     path = Path(root) / MANIFEST
+    if not Path(root).exists():
+        raise SessionError(f"{root} does not exist: give a session folder written by 'rti-rig run'")
+    if not Path(root).is_dir():
+        raise SessionError(
+            f"{root} is a file: give the session folder that holds it (the one with {MANIFEST})"
+        )
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:

@@ -125,17 +125,73 @@ def test_plan_on_bare_lp_keeps_original_names(tmp_path: Path) -> None:
         (["run", "{tmp}/missing.toml", "--out", "{tmp}/s"], "cannot read the file"),
         (["run", "{cfg}", "--out", "{tmp}/s", "--plan", "{tmp}/bad.lp"], "bad.lp, line 2"),
         (["export-lp", "{tmp}", "--out", "{tmp}/x.lp"], "not an rti-rig session folder"),
+        (["export-lp", "{tmp}/gone", "--out", "{tmp}/x.lp"], "gone does not exist"),
+        (["export-lp", "{cfg}", "--out", "{tmp}/x.lp"], "is a file: give the session folder"),
+        (["run", "{cfg}", "--out", "{tmp}/s", "--plan", "{tmp}/under.lp"], "under.lp, line 2"),
+        (["run", "{cfg}", "--out", "{tmp}/s", "--auto-exposure", "--max-saturated", "2"], "[0, 1)"),
+        (["run", "{cfg}", "--out", "{tmp}/s", "--min-elevation-deg", "95"], "in [0, 90)"),
+        (["check", "{cfg}", "--intensity", "1.5"], "--intensity 1.5: give the LED drive level"),
+        (["check", "{cfg}", "--intensity", "0"], "fraction in (0, 1]"),
+        (["plan", "--rig", "{cfg}", "--min-elevation-deg", "95", "--out", "{tmp}/p.lp"], "[0, 90)"),
+        (["plan", "--rig", "{cfg}", "--lights", "5000", "--out", "{tmp}/p.lp"], "at most 1000"),
+        (["plan", "--rig", "{tmp}/under.lp", "--out", "{tmp}/p.lp"], "below the object plane"),
+        (["plan", "{tmp}", "--rig", "{cfg}", "--out", "{tmp}/p.lp"], "is a folder: give one"),
         (["plan", "--rig", "{cfg}", "--method", "magic", "--out", "{tmp}/p.lp"], "is not known"),
     ],
 )
 def test_errors_are_one_clear_line(tmp_path: Path, args: list[str], fragment: str) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     (tmp_path / "bad.lp").write_text("1\nimage_001.jpg 0 0 zero\n")
+    (tmp_path / "under.lp").write_text("2\nimage_001.jpg 0.6 0 -0.8\nimage_002.jpg 0 0 1\n")
     argv = [a.format(cfg=cfg, tmp=tmp_path) for a in args]
     r = runner.invoke(app, argv)
     assert r.exit_code == 2, r.output
     assert fragment in " ".join(r.output.split())
     assert "Traceback" not in r.output
+    assert not (tmp_path / "s").exists() and not (tmp_path / "p.lp").exists()
+
+
+def test_outputs_are_checked_before_work_and_inputs_never_replaced(tmp_path: Path) -> None:
+    """A plan or .lp goes to a file in an existing folder; no input and no session file is
+    ever replaced, even with --force."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    preview = tmp_path / "preview.png"
+    preview.write_bytes((REPO / "tests" / "data" / "neuralrti" / "image11_small.jpg").read_bytes())
+    before = preview.read_bytes()
+
+    def plan(out: Path, *extra: str):  # type: ignore[no-untyped-def]
+        args = ["plan", str(preview), "--rig", str(cfg), "--lights", "4", "--out", str(out)]
+        return runner.invoke(app, [*args, *extra])
+
+    r = plan(tmp_path / "nowhere" / "p.lp")
+    assert r.exit_code == 2 and "folder" in r.output and "does not exist" in r.output
+    assert not (tmp_path / "nowhere").exists()
+    r = plan(tmp_path, "--force")
+    assert r.exit_code == 2 and "is a folder" in r.output
+    assert not list(tmp_path.glob(".*.tmp"))
+    r = plan(preview, "--force")
+    assert r.exit_code == 2 and "is the preview this command reads" in r.output
+    assert preview.read_bytes() == before
+    r = plan(cfg, "--force")
+    assert r.exit_code == 2 and "is the rig file" in r.output
+
+    session = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(session), "--lights", "4"])
+    assert r.exit_code == 0, r.output
+    own = (session / "lights.lp").read_text()
+    r = runner.invoke(
+        app, ["export-lp", str(session), "--out", str(session / "lights.lp"), "--linear", "--force"]
+    )
+    assert r.exit_code == 2 and "never overwritten" in " ".join(r.output.split())
+    assert (session / "lights.lp").read_text() == own
+    r = plan(session / "lights.lp", "--force")
+    assert r.exit_code == 2 and (session / "lights.lp").read_text() == own
+    # a new file beside the session's own is fine
+    r = runner.invoke(
+        app, ["export-lp", str(session), "--out", str(session / "linear.lp"), "--linear"]
+    )
+    assert r.exit_code == 0, r.output
+    assert read_lp(session / "linear.lp")[0].name == "linear/image_001.tif"
 
 
 def test_plan_from_another_dome_is_refused(tmp_path: Path) -> None:

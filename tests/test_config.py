@@ -100,3 +100,25 @@ def test_led_below_plane_rejected(tmp_path: Path) -> None:
     text = text.split("rings = [")[0] + "\n[camera]" + text.split("[camera]")[1]
     with pytest.raises(ConfigError, match="below the object plane"):
         load_rig_config(write_config(tmp_path, text))
+
+
+def test_missing_backend_with_device_tables_is_refused(tmp_path: Path) -> None:
+    """A hardware config that lost its backend line must not run as a dry run unnoticed."""
+    shipped = Path(__file__).parents[1] / "rig_configs" / "example_dome_48.toml"
+    text = shipped.read_text(encoding="utf-8")
+    assert 'backend = "hardware"\n' in text
+    (tmp_path / "example_dome_48.lp").write_text(
+        (shipped.parent / "example_dome_48.lp").read_text(encoding="utf-8")
+    )
+    path = write_config(tmp_path, text.replace('backend = "hardware"\n', ""), "no_backend.toml")
+    with pytest.raises(ConfigError) as info:
+        load_rig_config(path)
+    assert "backend is not set" in info.value.message
+    assert "[dome.serial] and [camera.device]" in info.value.message
+    assert str(path) in str(info.value)
+    # a config without device tables may still default to the simulated backend
+    assert 'backend = "simulated"' in SMALL_DOME
+    plain = SMALL_DOME.replace('backend = "simulated"\n', "")
+    assert load_rig_config(write_config(tmp_path, plain, "plain.toml")).config.backend == (
+        "simulated"
+    )

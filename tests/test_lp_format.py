@@ -120,3 +120,14 @@ def test_writer_refuses_bad_entries() -> None:
         format_lp([])
     with pytest.raises(ValueError, match="at most 1000"):
         format_lp([LpEntry(f"a_{i}.jpg", (0, 0, 1)) for i in range(1001)])
+
+
+def test_lights_below_the_object_plane_named_by_line_when_asked() -> None:
+    """A rig's lights or a plan to run cannot point below the object plane; other tools'
+    files are read as they are."""
+    text = "3\nimage_1.jpg 0 0 1\nimage_2.jpg 0.6 0 -0.8\nimage_3.jpg 0 0.6 0.8\n"
+    assert len(parse_lp(text, "mixed.lp")) == 3
+    with pytest.raises(LpFormatError, match=r"mixed\.lp, line 3: .*below the object plane"):
+        parse_lp(text, "mixed.lp", upper_hemisphere=True)
+    # the horizon itself is allowed
+    assert len(parse_lp("1\nimage_1.jpg 1 0 0\n", upper_hemisphere=True)) == 1

@@ -91,8 +91,10 @@ def test_optimal_without_preview_plans_for_a_level_matte_surface(
     sched, rep = plan_with_report(None, geometry, n, "optimal", objective)
     for side in (64, 8, 1):  # 8×8 and 1×1 sample fewer pixels than the model-bias term reads
         grey = np.full((side, side), 120, dtype=np.uint8)
-        same, _ = plan_with_report(grey, geometry, n, "optimal", objective, (0.0, 50.0))
+        same, srep = plan_with_report(grey, geometry, n, "optimal", objective, (0.0, 50.0))
         assert [s.direction for s in sched.steps] == [s.direction for s in same.steps], side
+        # a preview too small to show anything is said to be so
+        assert any("too small to show relief" in x for x in srep.notes) == (side < 16), side
     assert rep.preview_shape is None and rep.preview_light_az_el_deg is None
     # nothing measured on a preview is reported as if it had been
     assert rep.shading_explained_r2 is None and rep.highlight_hint is None
