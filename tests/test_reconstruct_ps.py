@@ -12,6 +12,7 @@ from rti_rig.reconstruct import (
     fit_photometric_stereo,
     stack_from_frames,
 )
+from rti_rig.reconstruct.photometric_stereo import SHADOW_K
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 from rti_rig.rig import Frame
 
@@ -202,3 +203,42 @@ def test_pixel_whose_lit_lights_are_coplanar_is_invalid() -> None:
     ls = fit_photometric_stereo(images, lights)
     assert ls.valid.all()  # least squares uses the shadowed zero and returns a biased normal
     assert angular_error_deg(ls.normals, normals, ~np.eye(2, dtype=bool)).mean > 1.0
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_robust_drops_partial_shadows_but_keeps_five(seed: int) -> None:
+    """A pixel on a cast shadow's edge (or under a weak LED) is darker than Lambert says yet
+    too bright to count as shadow: rule 4 drops it, where the fit without it is tilted."""
+    rng = np.random.default_rng(seed)
+    n_true = _gentle_normals(12, 10, 20.0)
+    lights = _high_lights(12)
+    images = render(n_true, 0.6, lights) + rng.normal(0, 0.002, (12, 12, 10)).astype(np.float32)
+    images[3] *= 0.55  # one light half-shadowed on every pixel
+    images[8, :6] *= 0.7  # another on half of them
+    on = fit_photometric_stereo(images, lights, robust=True, shadow_k=SHADOW_K)
+    off = fit_photometric_stereo(images, lights, robust=True)
+    assert angular_error_deg(off.normals, n_true).mean > 3.0
+    assert angular_error_deg(on.normals, n_true).p90 < 0.6
+    # both dark observations go where there are two, the one elsewhere; noise rarely costs more
+    assert on.used_lights[:6].max() == 10 and on.used_lights[6:].max() == 11
+    assert np.mean(on.used_lights[6:] == 11) > 0.7 and on.used_lights.min() >= 9
+    # never fewer than five observations: with six lights, at most one dark one goes
+    dark = images[:6].copy()
+    dark[[1, 4]] *= 0.3
+    six = fit_photometric_stereo(dark, lights[:6], robust=True, shadow_k=SHADOW_K)
+    assert six.used_lights.min() == 5 and six.valid.all()
+    five = fit_photometric_stereo(images[:5], lights[:5], robust=True, shadow_k=SHADOW_K)
+    assert np.all(five.used_lights == 5)
+
+
+def test_partial_shadow_rule_leaves_clean_noisy_data_alone() -> None:
+    """Under plain sensor noise the darkest residual rarely exceeds 3 robust sigmas."""
+    n_true = _gentle_normals(40, 40, 25.0)
+    lights = _high_lights(24)
+    images = render(n_true, 0.6, lights)
+    images += np.random.default_rng(5).normal(0, 0.003, images.shape).astype(np.float32)
+    res = fit_photometric_stereo(images, lights, robust=True, shadow_k=SHADOW_K)
+    off = fit_photometric_stereo(images, lights, robust=True)
+    assert np.mean(res.used_lights < off.used_lights) < 0.1
+    on_err = angular_error_deg(res.normals, n_true).mean
+    assert on_err < 1.05 * angular_error_deg(off.normals, n_true).mean

@@ -17,7 +17,14 @@ of rows. Attached shadows and highlights bias it (notes §2: 15.4° mean on DiLi
 3. **highlights**: observations brighter than the current Lambertian fit by more than
    ``max(highlight_k * sigma, highlight_floor)``, with ``sigma = 1.4826 * median |residual|``
    over the pixel's used observations (a robust noise scale), refitting after each of up to
-   ``max_passes`` passes. Only positive residuals are outliers: specular lobes add light.
+   ``max_passes`` passes. Only positive residuals count here: specular lobes add light.
+4. **partial shadows** (only when ``shadow_k`` is given, e.g. :data:`SHADOW_K`): then, one per
+   pass, the observation darkest against the fit if it is darker by more than
+   ``max(shadow_k * sigma, highlight_floor)``, while more than :data:`SHADOW_MIN_KEPT`
+   observations remain. A pixel on the edge of a cast shadow, or lit by a weak LED, is darker
+   than Lambert says yet too bright for rule 1; left in, it tilts the normal away from its
+   light. Only the darkest one per pass, because a remaining highlight's pull on the fit makes
+   every other observation look a little dark.
 
 A pixel keeps at least 3 observations whose lights are not ill-conditioned (condition
 number of its light subset <= ``cond_limit``), else it is marked invalid (``valid`` False,
@@ -49,6 +56,11 @@ DARK_FRACTION = 0.02
 HIGHLIGHT_FLOOR_FRACTION = 0.01
 #: Pixels with |b| at or below this fraction of the reference level are "all dark": invalid.
 DARK_PIXEL_FRACTION = 1e-6
+#: Threshold of the partial-shadow test in robust noise scales (rule 4), when it is asked for
+#: (``shadow_k=SHADOW_K``; off by default until every benchmark is re-measured with it).
+SHADOW_K = 3.0
+#: The partial-shadow test never leaves a pixel fewer observations than this.
+SHADOW_MIN_KEPT = 5
 
 
 @dataclass(frozen=True)
@@ -166,6 +178,7 @@ def _robust_band(
     highlight_floor: float,
     max_passes: int,
     cond_limit: float,
+    shadow_k: float | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
     """Robust fit of one band ``g_nm`` (N, P): b (P, 3), used observations (N, P), solvable."""
     g = np.ascontiguousarray(g_nm.T)  # (P, N)
@@ -173,7 +186,6 @@ def _robust_band(
     if saturation is not None:
         w &= g < saturation
     b, ok = _solve_weighted(g, w, lights, cond_limit)
-    n_obs = g.shape[1]
     # Only pixels that dropped an observation in the last pass are refitted: most converge in
     # one or two passes, so later passes touch few pixels.
     active = np.flatnonzero(ok)
@@ -182,13 +194,7 @@ def _robust_band(
             break
         ga, wa = g[active], w[active]
         resid = ga - (b[active] @ lights.T).astype(np.float32)  # (A, N)
-        absr = np.where(wa, np.abs(resid), np.float32(np.inf))
-        absr.sort(axis=1)
-        count = wa.sum(axis=1)
-        mid = np.clip((count - 1) // 2, 0, n_obs - 1)
-        med = np.take_along_axis(absr, mid[:, None], axis=1)[:, 0]
-        med = np.where(count > 0, med, 0.0)
-        thr = np.maximum(highlight_k * 1.4826 * med, highlight_floor)
+        thr = np.maximum(highlight_k * _robust_sigma(resid, wa), highlight_floor)
         drop = wa & (resid > thr[:, None])
         changed = drop.any(axis=1)
         if not changed.any():
@@ -198,7 +204,51 @@ def _robust_band(
         w[active] = wa
         b[active], ok[active] = _solve_weighted(g[active], wa, lights, cond_limit)
         active = active[ok[active]]
+    if shadow_k is not None:
+        _drop_partial_shadows(
+            g, w, b, ok, lights, shadow_k, highlight_floor, max_passes, cond_limit
+        )
     return b, w.T, ok
+
+
+def _robust_sigma(resid: NDArray, used: NDArray[np.bool_]) -> NDArray:
+    """1.4826 × the median |residual| over each row's used observations (0 if none)."""
+    absr = np.where(used, np.abs(resid), np.float32(np.inf))
+    absr.sort(axis=1)
+    count = used.sum(axis=1)
+    mid = np.clip((count - 1) // 2, 0, used.shape[1] - 1)
+    med = np.take_along_axis(absr, mid[:, None], axis=1)[:, 0]
+    return 1.4826 * np.where(count > 0, med, 0.0)
+
+
+def _drop_partial_shadows(
+    g: NDArray[np.float32],
+    w: NDArray[np.bool_],
+    b: NDArray[np.float64],
+    ok: NDArray[np.bool_],
+    lights: NDArray[np.float64],
+    shadow_k: float,
+    floor: float,
+    max_passes: int,
+    cond_limit: float,
+) -> None:
+    """Rule 4, in place on ``w`` (P, N), ``b`` and ``ok``: the darkest outlier per pass."""
+    active = np.flatnonzero(ok)
+    for _ in range(max_passes):
+        if active.size == 0:
+            break
+        wa = w[active]
+        resid = np.where(wa, g[active] - (b[active] @ lights.T).astype(np.float32), 0.0)
+        thr = np.maximum(shadow_k * _robust_sigma(resid, wa), floor)
+        worst = np.argmin(resid, axis=1)
+        low = resid[np.arange(active.size), worst]
+        drop = (low < -thr) & (wa.sum(axis=1) > SHADOW_MIN_KEPT)
+        if not drop.any():
+            break
+        active, worst = active[drop], worst[drop]
+        w[active, worst] = False
+        b[active], ok[active] = _solve_weighted(g[active], w[active], lights, cond_limit)
+        active = active[ok[active]]
 
 
 def _unit_normals(
@@ -280,6 +330,7 @@ def fit_photometric_stereo(
     highlight_floor: float | None = None,
     max_passes: int = 10,
     cond_limit: float = COND_LIMIT,
+    shadow_k: float | None = None,
 ) -> PSResult:
     """Normals and albedo of linear ``images`` (N, H, W[, C]) under unit ``lights`` (N, 3).
 
@@ -323,7 +374,16 @@ def fit_photometric_stereo(
         inside = inside_all[sl].ravel()
         if robust:
             b, w, ok = _robust_band(
-                g, inside, lt, dark, saturation, highlight_k, floor, max_passes, cond_limit
+                g,
+                inside,
+                lt,
+                dark,
+                saturation,
+                highlight_k,
+                floor,
+                max_passes,
+                cond_limit,
+                shadow_k,
             )
             n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
         else:
