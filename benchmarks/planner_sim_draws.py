@@ -168,8 +168,8 @@ def main(seed: int = 0) -> str:
             f"Against one floor for the rig ({rig:g}°) instead of one per scene: a homogeneous "
             "layout needs no preview, but its floor tuned per object needs the object's ground "
             "truth; a rig owner tunes one floor for the rig. Chosen with hindsight over the five "
-            "scenes: the floor whose error relative to each scene's best floor has the lowest "
-            "geometric mean over scenes and N. Same draws; cells as in the first table.",
+            "scenes: the floor whose mean error relative to the best floor's, at each scene "
+            "and N, has the lowest geometric mean. Same draws; cells as in the first table.",
             "",
             *_table_head("scene", "plan"),
             *rig_rows,

@@ -494,8 +494,9 @@ def _plan(
         if min(report.preview_shape[:2]) < TINY_PREVIEW_PX:
             report.notes.append(
                 f"the preview is only {report.preview_shape[1]}×{report.preview_shape[0]} px: "
-                "too small to show relief or the light's direction, so this plan is in effect "
-                "the one for a level, matte surface (give a real preview for more)"
+                "too small to show relief or the light's direction reliably, so this plan rests "
+                "on very little evidence (give a larger preview, or none for the plan of a "
+                "level, matte surface)"
             )
         report.preview_light_az_el_deg = (float(az), float(el))
         report.preview_light_source = surface.light_source

@@ -56,13 +56,14 @@ def _check_output_file(out_file: Path, force: bool, inputs: dict[str, Path | Non
     if not out_file.exists():
         return
     for what, path in inputs.items():
-        if path is not None and path.exists() and out_file.resolve() == path.resolve():
+        if path is not None and path.exists() and out_file.samefile(path):
             raise RtiRigError(f"--out {out_file} is the {what} this command reads; choose another")
-    if (parent / MANIFEST).is_file():
-        raise RtiRigError(
-            f"--out {out_file} would replace a file of the session in {parent}; a session's "
-            "files are never overwritten: write the .lp elsewhere"
-        )
+    for folder in out_file.resolve().parents:
+        if (folder / MANIFEST).is_file():
+            raise RtiRigError(
+                f"--out {out_file} would replace a file of the session in {folder}; a "
+                "session's files are never overwritten: write the .lp elsewhere"
+            )
     if not force:
         raise RtiRigError(f"{out_file} exists; use --force to replace it")
 
@@ -471,6 +472,11 @@ def plan(
             )
         else:
             loaded = load_rig_config(rig)
+            dome = loaded.config.dome
+            if dome is not None and dome.lp_file is not None:
+                # the dome's calibration is an input too
+                lp_file = loaded.folder / dome.lp_file
+                _check_output_file(out_file, force, {"rig's LED calibration (lp_file)": lp_file})
             geometry = rig_geometry(loaded)
             arm_order = arm_order_for(loaded)
             if signal_noise is None and loaded.config.camera.signal_noise > 0:

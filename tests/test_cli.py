@@ -393,3 +393,29 @@ def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
     r = runner.invoke(app, ["plan", "--rig", str(bad), "--out", str(tmp_path / "d.lp")])
     flat = " ".join(r.output.split())
     assert r.exit_code == 2 and "signal_noise" in flat and "jpeg_dome.toml" in flat
+
+
+def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
+    """Not even a captured image in a session's subfolder, nor the dome's LED calibration."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    session = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(session), "--lights", "4"])
+    assert r.exit_code == 0, r.output
+    tif = session / "linear" / "image_001.tif"
+    before = tif.read_bytes()
+    r = runner.invoke(app, ["export-lp", str(session), "--out", str(tif), "--force"])
+    assert r.exit_code == 2 and "never overwritten" in " ".join(r.output.split())
+    assert tif.read_bytes() == before
+
+    (tmp_path / "domes").mkdir()
+    lp = tmp_path / "domes" / "my.lp"
+    lp.write_text("3\nled_1.jpg 0 0.6 0.8\nled_2.jpg 0.6 0 0.8\nled_3.jpg 0 0 1\n")
+    text = SMALL_DOME.replace('layout = "rings"', 'layout = "lp"\nlp_file = "domes/my.lp"')
+    text = text.split("rings = [")[0] + "\n[camera]" + text.split("[camera]")[1]
+    lp_cfg = write_config(tmp_path, text, "lp_dome.toml")
+    calibration = lp.read_text()
+    r = runner.invoke(
+        app, ["plan", "--rig", str(lp_cfg), "--lights", "2", "--out", str(lp), "--force"]
+    )
+    assert r.exit_code == 2 and "LED calibration" in " ".join(r.output.split())
+    assert lp.read_text() == calibration

@@ -242,3 +242,30 @@ def test_partial_shadow_rule_leaves_clean_noisy_data_alone() -> None:
     assert np.mean(res.used_lights < off.used_lights) < 0.1
     on_err = angular_error_deg(res.normals, n_true).mean
     assert on_err < 1.05 * angular_error_deg(off.normals, n_true).mean
+
+
+def test_partial_shadow_rule_options_are_checked() -> None:
+    lights = _high_lights(8)
+    images = render(_gentle_normals(4, 4), 0.5, lights)
+    with pytest.raises(ReconstructionError, match="robust=True"):
+        fit_photometric_stereo(images, lights, shadow_k=SHADOW_K)
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ReconstructionError, match="positive"):
+            fit_photometric_stereo(images, lights, robust=True, shadow_k=bad)
+
+
+def test_partial_shadow_drop_that_leaves_a_pixel_unsolvable_is_undone() -> None:
+    """If the darkest observation is the only one off a plane of lights, dropping it would
+    leave an ill-conditioned subset: the pixel keeps its observation and its fit."""
+    from rti_rig.reconstruct.photometric_stereo import _drop_partial_shadows
+
+    in_plane = direction_from_az_el(np.array([0.0, 0.0, 0.0, 180.0, 180.0]), [20, 45, 80, 30, 60])
+    lights = np.vstack([in_plane, direction_from_az_el(90.0, 40.0)])
+    b = np.array([[0.0, 0.0, 0.6]])
+    g = (b @ lights.T).astype(np.float32)
+    g[0, 5] *= 0.2  # the only off-plane light reads dark against this (given) fit
+    w = np.ones_like(g, dtype=bool)
+    ok = np.array([True])
+    _drop_partial_shadows(g, w, b, ok, lights, SHADOW_K, 1e-4, 10, 100.0)
+    assert w.all() and ok.all()
+    np.testing.assert_allclose(b, [[0.0, 0.0, 0.6]])

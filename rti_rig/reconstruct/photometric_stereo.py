@@ -247,8 +247,12 @@ def _drop_partial_shadows(
             break
         active, worst = active[drop], worst[drop]
         w[active, worst] = False
-        b[active], ok[active] = _solve_weighted(g[active], w[active], lights, cond_limit)
-        active = active[ok[active]]
+        b_new, ok_new = _solve_weighted(g[active], w[active], lights, cond_limit)
+        # a drop that leaves the pixel unsolvable (ill-conditioned subset) is undone: the
+        # pixel keeps its earlier fit rather than turning invalid
+        w[active[~ok_new], worst[~ok_new]] = True
+        b[active[ok_new]] = b_new[ok_new]
+        active = active[ok_new]
 
 
 def _unit_normals(
@@ -337,6 +341,11 @@ def fit_photometric_stereo(
     See the module docstring for the robust rules. Raises :class:`ReconstructionError` for
     fewer than 3 lights or an ill-conditioned (near-coplanar) light set.
     """
+    if shadow_k is not None:
+        if not robust:
+            raise ReconstructionError("shadow_k is a rule of the robust fit: pass robust=True")
+        if not (np.isfinite(shadow_k) and shadow_k > 0):
+            raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
     w_ls, report = solve_matrix(
