@@ -460,23 +460,21 @@ def plan(
                 f"--lights {lights}: at most {MAX_LIGHTS} lights (the most an .lp file may list "
                 "for readers such as relight)"
             )
-        _check_output_file(
-            out_file, force, {"preview": preview, "rig file": rig, "depth model": depth_model}
-        )
         az_el = _parse_az_el(preview_light)
+        bare_lp = rig.suffix.lower() == ".lp"
+        loaded = None if bare_lp else load_rig_config(rig)
+        inputs = {"preview": preview, "rig file": rig, "depth model": depth_model}
+        if loaded is not None and loaded.config.dome is not None and loaded.config.dome.lp_file:
+            # the dome's LED calibration is an input too
+            inputs["rig's LED calibration (lp_file)"] = loaded.folder / loaded.config.dome.lp_file
+        _check_output_file(out_file, force, inputs)
         arm_order = None
-        if rig.suffix.lower() == ".lp":
+        if loaded is None:
             entries = read_lp(rig, upper_hemisphere=True)
             geometry: object = DomeGeometry(
                 [e.direction for e in entries], tuple(e.name for e in entries)
             )
         else:
-            loaded = load_rig_config(rig)
-            dome = loaded.config.dome
-            if dome is not None and dome.lp_file is not None:
-                # the dome's calibration is an input too
-                lp_file = loaded.folder / dome.lp_file
-                _check_output_file(out_file, force, {"rig's LED calibration (lp_file)": lp_file})
             geometry = rig_geometry(loaded)
             arm_order = arm_order_for(loaded)
             if signal_noise is None and loaded.config.camera.signal_noise > 0:
@@ -500,7 +498,7 @@ def plan(
             arm_order=arm_order,
             signal_noise=signal_noise or 0.0,
         )
-        if rig.suffix.lower() == ".lp":
+        if bare_lp:
             names = [s.label for s in schedule.steps]
         else:
             names = [f"{n}.jpg" for n in image_names(len(schedule))]

@@ -369,9 +369,7 @@ def dome_led_directions(rig: LoadedRig) -> tuple[NDArray[np.float64], list[str]]
         except LpFormatError as exc:
             raise ConfigError(rig.path, "dome.lp_file", str(exc)) from None
         dirs = np.array([e.direction for e in entries])
-        names = [e.name for e in entries]
-        _check_hemisphere(rig, dirs)
-        return dirs, names
+        return dirs, [e.name for e in entries]  # read_lp refused lights below the plane
     if len(dirs) > 1000:
         raise ConfigError(rig.path, "dome", f"{len(dirs)} LEDs: at most 1000 are supported")
     _check_hemisphere(rig, dirs)
