@@ -18,8 +18,8 @@ of rows. Attached shadows and highlights bias it (notes §2: 15.4° mean on DiLi
    ``max(highlight_k * sigma, highlight_floor)``, with ``sigma = 1.4826 * median |residual|``
    over the pixel's used observations (a robust noise scale), refitting after each of up to
    ``max_passes`` passes. Only positive residuals count here: specular lobes add light.
-4. **partial shadows** (only when ``shadow_k`` is given, e.g. :data:`SHADOW_K`): then, one per
-   pass, the observation darkest against the fit if it is darker by more than
+4. **partial shadows** (``shadow_k``, default :data:`SHADOW_K`; ``None`` turns the rule off):
+   then, one per pass, the observation darkest against the fit if it is darker by more than
    ``max(shadow_k * sigma, highlight_floor)``, while more than :data:`SHADOW_MIN_KEPT`
    observations remain. A pixel on the edge of a cast shadow, or lit by a weak LED, is darker
    than Lambert says yet too bright for rule 1; left in, it tilts the normal away from its
@@ -56,8 +56,8 @@ DARK_FRACTION = 0.02
 HIGHLIGHT_FLOOR_FRACTION = 0.01
 #: Pixels with |b| at or below this fraction of the reference level are "all dark": invalid.
 DARK_PIXEL_FRACTION = 1e-6
-#: Threshold of the partial-shadow test in robust noise scales (rule 4), when it is asked for
-#: (``shadow_k=SHADOW_K``; off by default until every benchmark is re-measured with it).
+#: Threshold of the partial-shadow test in robust noise scales (rule 4). On by default: it removes
+#: the simulated tablet's losses and costs nothing on the real dome (docs/planner.md).
 SHADOW_K = 3.0
 #: The partial-shadow test never leaves a pixel fewer observations than this.
 SHADOW_MIN_KEPT = 5
@@ -334,16 +334,15 @@ def fit_photometric_stereo(
     highlight_floor: float | None = None,
     max_passes: int = 10,
     cond_limit: float = COND_LIMIT,
-    shadow_k: float | None = None,
+    shadow_k: float | None = SHADOW_K,
 ) -> PSResult:
     """Normals and albedo of linear ``images`` (N, H, W[, C]) under unit ``lights`` (N, 3).
 
-    See the module docstring for the robust rules. Raises :class:`ReconstructionError` for
+    See the module docstring for the robust rules; ``shadow_k`` (rule 4) is read only by the
+    robust fit, since least squares discards nothing. Raises :class:`ReconstructionError` for
     fewer than 3 lights or an ill-conditioned (near-coplanar) light set.
     """
     if shadow_k is not None:
-        if not robust:
-            raise ReconstructionError("shadow_k is a rule of the robust fit: pass robust=True")
         if not (np.isfinite(shadow_k) and shadow_k > 0):
             raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
     stack = ImageStack(images)
