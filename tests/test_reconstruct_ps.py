@@ -249,7 +249,11 @@ def test_partial_shadow_rule_options_are_checked() -> None:
     images = render(_gentle_normals(4, 4), 0.5, lights)
     # least squares discards nothing: shadow_k is the robust fit's alone
     plain = fit_photometric_stereo(images, lights, shadow_k=None)
-    assert np.array_equal(fit_photometric_stereo(images, lights).normals, plain.normals)
+    default_ls = fit_photometric_stereo(images, lights)
+    assert np.array_equal(default_ls.normals, plain.normals)
+    assert default_ls.shadow_k is None  # the result records the rule it applied
+    assert fit_photometric_stereo(images, lights, robust=True).shadow_k == SHADOW_K
+    assert fit_photometric_stereo(images, lights, robust=True, shadow_k=None).shadow_k is None
     for bad in (0.0, -1.0, float("nan")):
         with pytest.raises(ReconstructionError, match="positive"):
             fit_photometric_stereo(images, lights, robust=True, shadow_k=bad)

@@ -81,6 +81,8 @@ class PSResult:
     robust: bool
     dark_threshold: float
     saturation: float | None
+    #: the partial-shadow threshold the fit applied (None: rule off, or least squares)
+    shadow_k: float | None = None
 
     @property
     def name(self) -> str:
@@ -342,9 +344,8 @@ def fit_photometric_stereo(
     robust fit, since least squares discards nothing. Raises :class:`ReconstructionError` for
     fewer than 3 lights or an ill-conditioned (near-coplanar) light set.
     """
-    if shadow_k is not None:
-        if not (np.isfinite(shadow_k) and shadow_k > 0):
-            raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
+    if shadow_k is not None and not (np.isfinite(shadow_k) and shadow_k > 0):
+        raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
     w_ls, report = solve_matrix(
@@ -412,4 +413,5 @@ def fit_photometric_stereo(
         robust=robust,
         dark_threshold=dark,
         saturation=saturation,
+        shadow_k=shadow_k if robust else None,
     )
