@@ -56,8 +56,9 @@ DARK_FRACTION = 0.02
 HIGHLIGHT_FLOOR_FRACTION = 0.01
 #: Pixels with |b| at or below this fraction of the reference level are "all dark": invalid.
 DARK_PIXEL_FRACTION = 1e-6
-#: Threshold of the partial-shadow test in robust noise scales (rule 4). On by default: it removes
-#: the simulated tablet's losses and costs nothing on the real dome (docs/planner.md).
+#: Threshold of the partial-shadow test in robust noise scales (rule 4). On by default: it turns
+#: the planner's losses on the simulated tablet into ties and moves the real dome's means by at
+#: most 0.1°, no verdict (docs/planner.md).
 SHADOW_K = 3.0
 #: The partial-shadow test never leaves a pixel fewer observations than this.
 SHADOW_MIN_KEPT = 5
