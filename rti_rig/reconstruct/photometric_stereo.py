@@ -181,7 +181,7 @@ def _robust_band(
     highlight_floor: float,
     max_passes: int,
     cond_limit: float,
-    shadow_k: float | None = None,
+    shadow_k: float | None,
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
     """Robust fit of one band ``g_nm`` (N, P): b (P, 3), used observations (N, P), solvable."""
     g = np.ascontiguousarray(g_nm.T)  # (P, N)
