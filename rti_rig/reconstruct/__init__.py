@@ -8,6 +8,7 @@ frame of DESIGN.md. See docs/reconstruction.md.
 from rti_rig.reconstruct.bases import N_COEFFICIENTS, design_matrix, hsh_basis, ptm_basis
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.hsh import HSHModel, fit_hsh
+from rti_rig.reconstruct.light_gains import LightGains, apply_light_gains, estimate_light_gains
 from rti_rig.reconstruct.linear_model import LambertModel, RelightModel, fit_lambert
 from rti_rig.reconstruct.model_select import CandidateEvidence, ModelChoice, select_model
 from rti_rig.reconstruct.photometric_stereo import PSResult, fit_photometric_stereo
@@ -26,12 +27,15 @@ __all__ = [
     "HSHModel",
     "ImageStack",
     "LambertModel",
+    "LightGains",
     "ModelChoice",
     "PSResult",
     "PTMModel",
     "ReconstructionError",
     "RelightModel",
+    "apply_light_gains",
     "design_matrix",
+    "estimate_light_gains",
     "fit_hsh",
     "fit_lambert",
     "fit_model",
