@@ -2,7 +2,7 @@
 
 Photometric stereo, PTM and HSH all assume every light of a session has the same strength.
 The LEDs of a real dome do not: on neuralrti-example (72 LEDs) images under some LEDs are
-20–37 % darker than the all-light fit predicts, consistently over the whole object, and a
+19–37 % darker than the all-light fit predicts, consistently over the whole object, and a
 light too dim tilts every normal it helps to fit. A layout's error then depends on which dim
 or bright LEDs it happens to take — the "lottery" of docs/planner.md.
 
@@ -84,9 +84,8 @@ def _normalise(gains: NDArray[np.float64], estimated: NDArray[np.bool_]) -> NDAr
 def _check_dead(gains: NDArray[np.float64], estimated: NDArray[np.bool_]) -> None:
     for k in np.flatnonzero(estimated & (gains < MIN_GAIN)):
         raise ReconstructionError(
-            f"light {k} is {1 / max(gains[k], 1e-12):.0f}× dimmer than the median light: a dead "
-            "LED or a black frame, not something to calibrate; check that light and drop its "
-            "image"
+            f"light {k} gives {gains[k]:.3f} of the median light's signal: a dead LED or a "
+            "black frame, not something to calibrate; check that light and drop its image"
         )
 
 
