@@ -57,21 +57,6 @@ class LightGains:
     last_step: float
 
 
-def _sample(images: Any, max_pixels: int, seed: int) -> tuple[NDArray[np.float32], bool]:
-    """A random sample of pixels as a (N, 1, P, C) float32 array, and whether input was grey."""
-    stack = ImageStack(images)
-    total = stack.height * stack.width
-    rng = np.random.default_rng(seed)
-    pick = np.sort(rng.choice(total, min(max_pixels, total), replace=False))
-    rows = pick // stack.width
-    out = np.empty((stack.n, len(pick), stack.channels), dtype=np.float32)
-    for r in np.unique(rows):
-        sel = rows == r
-        band = stack.rows(slice(int(r), int(r) + 1))  # (N, 1, W, C)
-        out[:, sel] = band[:, 0, pick[sel] % stack.width]
-    return out[:, None], stack.grey
-
-
 def _normalise(gains: NDArray[np.float64], estimated: NDArray[np.bool_]) -> NDArray[np.float64]:
     scale = (
         np.exp(np.median(np.log(np.maximum(gains[estimated], 1e-12)))) if estimated.any() else 1.0
@@ -92,39 +77,37 @@ def _check_dead(gains: NDArray[np.float64], estimated: NDArray[np.bool_]) -> Non
 def _target_channel(
     obs: NDArray[np.float32],
     shade: NDArray[np.float64],
+    usable: NDArray[np.bool_],
     passes: int,
     tolerance: float,
     min_pixels: int,
-) -> tuple[NDArray[np.float64], NDArray[np.bool_], int, int, float]:
-    """Gains of one channel of a level target: obs (N, 1, P) = gain × albedo × shade."""
-    n = len(shade)
-    seen = obs[:, 0].astype(np.float64)  # (N, P)
-    usable = shade > WELL_LIT_FRACTION * np.percentile(shade, 90)
-    per_light = np.where(usable[:, None], seen / np.where(usable, shade, 1.0)[:, None], np.nan)
-    gains = np.ones(n)
-    estimated = usable.copy()
+) -> tuple[NDArray[np.float64], int, int, float]:
+    """Gains of one channel of a level target: obs (N, P) = gain × albedo × shade."""
+    # each usable light's image over its shading: gain × albedo, to be factored
+    per_light = obs[usable].astype(np.float64) / shade[usable, None]  # (usable, P)
+    gains = np.ones(len(shade))
     step, done = np.inf, 0
-    bright = np.zeros(seen.shape[1], dtype=bool)
+    bright = np.zeros(obs.shape[1], dtype=bool)
     while done < passes:
         done += 1
-        albedo = np.nanmedian(per_light[estimated] / gains[estimated, None], axis=0)
+        albedo = np.median(per_light / gains[usable, None], axis=0)
         bright = albedo > 0.05 * np.percentile(albedo, 90)
         if int(bright.sum()) < min_pixels:
             raise ReconstructionError(
                 f"only {int(bright.sum())} sampled pixels of the target are lit (need "
                 f"{min_pixels}): the images are black, or the target does not fill the frame"
             )
-        update = np.ones(n)
-        update[estimated] = np.median(
-            per_light[estimated][:, bright] / (gains[estimated, None] * albedo[bright]), axis=1
+        update = np.ones(len(shade))
+        update[usable] = np.median(
+            per_light[:, bright] / (gains[usable, None] * albedo[bright]), axis=1
         )
-        new = _normalise(gains * update, estimated)
+        new = _normalise(gains * update, usable)
         step = float(np.max(np.abs(new / gains - 1.0)))
         gains = new
-        _check_dead(gains, estimated)
+        _check_dead(gains, usable)
         if step < tolerance:
             break
-    return gains, estimated, int(bright.sum()), done, step
+    return gains, int(bright.sum()), done, step
 
 
 def estimate_light_gains(
@@ -136,12 +119,12 @@ def estimate_light_gains(
     tolerance: float = 1e-4,
     min_pixels: int = MIN_PIXELS,
     max_pixels: int = 50_000,
-    seed: int = 0,
 ) -> LightGains:
     """Each light's gain from linear ``images`` (N, H, W[, C]) of a level matte target.
 
     ``target_normal`` is the card's normal in the frame of DESIGN.md (the zenith for a card
-    lying flat). Reads a random sample of ``max_pixels`` pixels. Raises
+    lying flat). Reads a regular grid of at most ``max_pixels`` pixels
+    (:meth:`ImageStack.pixel_sample`). Raises
     :class:`ReconstructionError` for fewer than 4 lights, images that do not pair with the
     lights, non-finite values, a card too dark to measure, or a light whose gain says its LED is
     dead.
@@ -155,7 +138,8 @@ def estimate_light_gains(
         raise ReconstructionError(
             f"need passes >= 1 and max_pixels >= min_pixels, got {passes}, {max_pixels}"
         )
-    sample, grey = _sample(images, max_pixels, seed)
+    stack = ImageStack(images)
+    sample, _ = stack.pixel_sample(max_pixels)  # (N, P, C)
     if sample.shape[0] != len(lt):
         raise ReconstructionError(
             f"{len(lt)} light directions for {sample.shape[0]} images: they must pair one to one"
@@ -163,17 +147,18 @@ def estimate_light_gains(
     if not np.all(np.isfinite(sample)):
         raise ReconstructionError("images hold NaN or infinity; gains need finite linear values")
     shade = np.maximum(lt @ as_direction(target_normal), 0.0)
+    usable = shade > WELL_LIT_FRACTION * np.percentile(shade, 90)
     results = [
-        _target_channel(sample[..., c], shade, passes, tolerance, min_pixels)
+        _target_channel(sample[..., c], shade, usable, passes, tolerance, min_pixels)
         for c in range(sample.shape[-1])
     ]
     gains = np.stack([r[0] for r in results], axis=1)
     return LightGains(
-        gains=gains[:, 0] if grey else gains,
-        estimated=np.logical_and.reduce([r[1] for r in results]),
-        pixels=min(r[2] for r in results),
-        passes=max(r[3] for r in results),
-        last_step=max(r[4] for r in results),
+        gains=gains[:, 0] if stack.grey else gains,
+        estimated=usable,
+        pixels=min(r[1] for r in results),
+        passes=max(r[2] for r in results),
+        last_step=max(r[3] for r in results),
     )
 
 
@@ -202,4 +187,4 @@ def apply_light_gains(images: ArrayLike, gains: ArrayLike) -> NDArray[np.float32
             f"gain of light {k} is {g[k].tolist()}: gains must be positive and finite"
         )
     scale = (1.0 / g).reshape((len(g), 1, 1) + ((g.shape[1],) if g.ndim == 2 else ()))
-    return (arr.astype(np.float32) * scale.astype(np.float32)).astype(np.float32)
+    return arr.astype(np.float32) * scale.astype(np.float32)
