@@ -399,6 +399,7 @@ def main(argv: list[str] | None = None) -> int:
     dry run through the real driver and real pyserial.
     """
     import argparse
+    import signal
     import time
 
     parser = argparse.ArgumentParser(description=main.__doc__)
@@ -427,6 +428,9 @@ def main(argv: list[str] | None = None) -> int:
         boot_delay_s=args.boot_delay_s,
         faults=FaultPlan(tuple(faults)),
     )
+    # SIGTERM (what a test harness or service manager sends) ends like Ctrl-C, so the pty's
+    # temporary folder is removed instead of left behind in /tmp.
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
     with emulated_dome_on_pty(firmware) as link:
         print(f"emulated {args.profile} dome with {args.leds} LEDs on {link.port}", flush=True)
         deadline = None if args.seconds is None else time.monotonic() + args.seconds

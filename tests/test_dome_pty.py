@@ -229,3 +229,6 @@ def test_dry_run_against_the_emulator_in_another_process():
     finally:
         proc.terminate()
         proc.wait(timeout=5)
+    # Terminated, it still removes the pty's temporary folder rather than leave it in /tmp.
+    assert proc.returncode == 0
+    assert not Path(port).parent.exists()
