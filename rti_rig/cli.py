@@ -6,6 +6,7 @@ Every user-facing failure is an :class:`~rti_rig.errors.RtiRigError` printed as 
 
 from __future__ import annotations
 
+import os
 import signal
 from pathlib import Path
 from typing import Annotated, Any
@@ -62,7 +63,7 @@ def _check_output_file(out_file: Path, force: bool, inputs: dict[str, Path | Non
         if (folder / MANIFEST).is_file():
             raise RtiRigError(
                 f"--out {out_file} would replace a file of the session in {folder}; a "
-                "session's files are never overwritten: write the .lp elsewhere"
+                "session's files are never overwritten: write it elsewhere"
             )
     if not force:
         raise RtiRigError(f"{out_file} exists; use --force to replace it")
@@ -533,6 +534,140 @@ def export_lp(
     except RtiRigError as exc:
         raise _fail(exc) from None
     out.print(f"{len(entries)} lights → {out_file}")
+
+
+def _parse_normal(text: str) -> tuple[float, float, float]:
+    """``"X,Y,Z"`` → a unit vector pointing up out of the card; a clear error otherwise."""
+    import math
+
+    try:
+        x, y, z = (float(p) for p in text.replace(" ", "").split(","))
+    except ValueError:
+        raise RtiRigError(
+            f"--card-normal {text!r}: give the card's normal as X,Y,Z (e.g. 0,0,1 for level)"
+        ) from None
+    norm = math.sqrt(x * x + y * y + z * z)
+    if not (math.isfinite(norm) and norm > 0 and z / norm > 0.5):
+        raise RtiRigError(
+            f"--card-normal {text!r}: the card must face the camera (z > 0, within 60° of the "
+            "zenith); give its normal as X,Y,Z"
+        )
+    return (x / norm, y / norm, z / norm)
+
+
+@app.command("calibrate-lights")
+def calibrate_lights(
+    card_session: Annotated[
+        Path,
+        typer.Argument(
+            help="A session of a level matte white card shot under every LED ('rti-rig run').",
+            show_default=False,
+        ),
+    ],
+    rig_config: Annotated[
+        Path, typer.Option("--rig", help="The dome's rig config (the one the card was shot on).")
+    ],
+    out_file: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            help="Calibration file to write (default: CARD_SESSION/light_calibration.toml).",
+        ),
+    ] = None,
+    card_normal: Annotated[
+        str, typer.Option("--card-normal", help="The card's normal as X,Y,Z if it is not level.")
+    ] = "0,0,1",
+    min_elevation_deg: Annotated[
+        float,
+        typer.Option(
+            "--min-elevation-deg",
+            help="LEDs lower than this above the card are not measured (grazing light on a "
+            "card is the most sensitive to its tilt and texture).",
+        ),
+    ] = 5.0,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Measure each LED's light from a card session and write the intensity correction that
+    evens the dome out (every LED dimmed to the weakest one's light), for [dome.serial]
+    intensity_correction_file in the rig config."""
+    import math
+
+    import numpy as np
+
+    from rti_rig.config import load_rig_config, rig_geometry
+    from rti_rig.light_calibration import calibrate_dome, calibration_toml, read_card_session
+
+    try:
+        normal = _parse_normal(card_normal)
+        loaded = load_rig_config(rig_config)
+        serial = loaded.config.dome.serial if loaded.config.dome else None
+        if serial is None:
+            raise RtiRigError(
+                f"{rig_config}: rig '{loaded.config.name}' has no [dome.serial]: only a serial "
+                "dome can dim its LEDs (the simulated backend's are exact)"
+            )
+        from drivers.led_dome.profiles import make_codec
+
+        if not make_codec(serial).has_level:
+            raise RtiRigError(
+                f"{rig_config}: the dome's '{serial.profile}' profile sends no PWM level "
+                "(send_level = false), so it cannot dim an LED; divide the gains out of the "
+                "images instead (rti_rig.reconstruct.apply_light_gains)"
+            )
+        geometry = rig_geometry(loaded)
+        card = read_card_session(card_session)
+        if card.rig_name != loaded.config.name:
+            raise RtiRigError(
+                f"{card_session} was shot on rig '{card.rig_name}', but {rig_config} is rig "
+                f"'{loaded.config.name}': calibrate a dome from its own card session"
+            )
+        target = out_file or card_session / "light_calibration.toml"
+        _check_output_file(target, force, {"RIG": rig_config})
+        cal = calibrate_dome(
+            card, geometry.count, card_normal=normal, min_elevation_deg=min_elevation_deg
+        )
+        target.write_text(
+            calibration_toml(cal, loaded.config.name, card_session.resolve(), geometry.names),
+            encoding="utf-8",
+        )
+    except RtiRigError as exc:
+        raise _fail(exc) from None
+    measured = np.flatnonzero(cal.measured)
+    elevation = np.degrees(np.arcsin(np.clip(geometry.directions[measured] @ normal, -1, 1)))
+    lowest = float(elevation.min())
+    weak, strong = int(np.argmin(cal.output)), int(np.argmax(cal.output))
+    names = geometry.names
+    out.print(
+        f"Card session {escape(str(card_session))}: {len(card.leds)} images of rig "
+        f"'{escape(loaded.config.name)}'; {len(measured)} of {geometry.count} LEDs measured "
+        f"(lowest {lowest:.1f}° above the card)."
+    )
+    out.print(
+        f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light from "
+        f"{cal.output[weak]:.2f} (LED {weak}, {escape(names[weak])}) to {cal.output[strong]:.2f} "
+        f"(LED {strong}, {escape(names[strong])}) of the median."
+    )
+    out.print(
+        f"Evened out, the dome gives {100 * cal.light_kept:.0f} % of its light on average "
+        f"({cal.stops_lost:.2f} stop(s) more exposure)."
+    )
+    if cal.output[weak] < 0.5:
+        err.print(
+            f"[yellow]warning:[/] LED {weak} gives only {cal.output[weak]:.2f} of the median "
+            "light; check it (a failing LED, a dirty diffuser) before evening the dome out to it."
+        )
+    tilt_pct = 100 * math.tan(math.radians(1.0)) / math.tan(math.radians(lowest))
+    out.print(
+        f"A card tilted by 1° would move the lowest LEDs' figures by up to {tilt_pct:.0f} %: "
+        "level it with care."
+    )
+    rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
+    out.print(f"Calibration → {escape(str(target))}")
+    out.print(
+        f"To use it, add under {escape('[dome.serial]')} in {escape(str(rig_config))}:  "
+        f'intensity_correction_file = "{escape(rel)}"\n'
+        "Then shoot the card again and calibrate that session: its spread is what is left."
+    )
 
 
 @app.command()

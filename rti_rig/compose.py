@@ -63,8 +63,9 @@ def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[n
 class _FirmwareLight:
     """The light state the emulated dome firmware really produces, for the simulated camera."""
 
-    def __init__(self, firmware, geometry: DomeGeometry, max_level: int) -> None:  # type: ignore[no-untyped-def]
+    def __init__(self, firmware, geometry: DomeGeometry, max_level: int, power) -> None:  # type: ignore[no-untyped-def]
         self._fw, self._geometry, self._max = firmware, geometry, max_level
+        self._power = power  # each emulated LED's output relative to nominal
 
     @property
     def direction(self):  # type: ignore[no-untyped-def]
@@ -74,7 +75,7 @@ class _FirmwareLight:
     @property
     def intensity(self) -> float:
         lit = self._fw.lit
-        return 0.0 if lit is None else lit[1] / self._max
+        return 0.0 if lit is None else lit[1] / self._max * float(self._power[lit[0]])
 
 
 def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock) -> Rig:
@@ -111,7 +112,14 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
             name=f"dome on {link.port} (emulated)",
         )
         camera = _simulated_camera(
-            loaded, _FirmwareLight(firmware, geometry, serial.max_level), clock
+            loaded,
+            _FirmwareLight(
+                firmware,
+                geometry,
+                serial.max_level,
+                cfg.emulator.led_powers(geometry.count, cfg.scene.seed),
+            ),
+            clock,
         )
     except BaseException:
         stack.close()

@@ -176,11 +176,42 @@ class EmulatorFault(_Strict):
 
 
 class EmulatorConfig(_Strict):
-    """Faults of the emulated devices in an ``emulated`` dry run (to rehearse failures)."""
+    """Faults and flaws of the emulated devices in an ``emulated`` dry run (to rehearse them).
+
+    ``led_power`` / ``led_power_spread`` make the emulated dome's LEDs uneven, as real domes'
+    are (one measured dome: 19–37 % darker to 18–23 % brighter than its median LED), so that a
+    light calibration (``rti-rig calibrate-lights``) can be rehearsed: either each LED's output
+    relative to nominal, in LED index order, or the RMS of the natural log of the output, drawn
+    per LED from ``scene.seed``.
+    """
 
     dead_leds: list[int] = Field(default_factory=list)
     reports_dead_leds: bool = True
     faults: list[EmulatorFault] = Field(default_factory=list)
+    led_power: list[float] | None = None
+    led_power_spread: float = Field(default=0.0, ge=0.0, le=1.0)
+
+    @model_validator(mode="after")
+    def _one_power_model(self) -> EmulatorConfig:
+        if self.led_power is not None:
+            if self.led_power_spread:
+                raise ValueError(
+                    "give either led_power (each LED's output) or led_power_spread, not both"
+                )
+            for i, p in enumerate(self.led_power):
+                if not (np.isfinite(p) and 0.05 <= p <= 5.0):
+                    raise ValueError(
+                        f"led_power[{i}] is {p}: an LED's output relative to nominal must be "
+                        "in [0.05, 5] (use dead_leds for an LED that gives no light)"
+                    )
+        return self
+
+    def led_powers(self, count: int, seed: int) -> NDArray[np.float64]:
+        """Each emulated LED's output relative to nominal (all 1 unless configured)."""
+        if self.led_power is not None:
+            return np.asarray(self.led_power, dtype=np.float64)
+        rng = np.random.default_rng([seed, 0x1ED])
+        return np.exp(self.led_power_spread * rng.standard_normal(count))
 
 
 class RigConfig(_Strict):
@@ -234,6 +265,15 @@ class RigConfig(_Strict):
                 f"backend '{self.backend}' drives the arm's servos: add an [arm.dynamixel] "
                 "table (see docs/protocols/dynamixel-arm.md)"
             )
+        emu = self.emulator
+        if (emu.led_power is not None or emu.led_power_spread) and (
+            self.backend != "emulated" or self.kind != "dome"
+        ):
+            raise ValueError(
+                "emulator.led_power / led_power_spread make an emulated dome's LEDs uneven: "
+                "they need kind = 'dome' and backend = 'emulated' (the real driver applies the "
+                "intensity correction that evens them out)"
+            )
         if self.backend == "hardware" and self.camera.device is None:
             raise ValueError(
                 "backend 'hardware' needs a [camera.device] table naming the camera driver "
@@ -250,7 +290,7 @@ class LoadedRig(BaseModel):
     config: RigConfig
     path: str
     sha256: str
-    raw: dict[str, Any]
+    raw: dict[str, Any]  # the parsed TOML (a correction file's values filled in)
 
     @property
     def folder(self) -> Path:
@@ -288,6 +328,69 @@ def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
         raise ConfigError(path, key, msg) from None
 
 
+#: Format tag of a light calibration file (``rti-rig calibrate-lights``).
+CALIBRATION_FORMAT = "rti-rig-light-calibration/1"
+
+
+def read_correction_file(path: Path, rig_name: str) -> list[float]:
+    """The ``intensity_correction`` list of a calibration file, checked against the rig.
+
+    Raises ``ValueError`` with what is wrong (the config loader names the file and key).
+    """
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path} is not valid TOML: {exc}") from None
+    if data.get("format") != CALIBRATION_FORMAT:
+        raise ValueError(
+            f"{path} is not an rti-rig light calibration (format {CALIBRATION_FORMAT!r})"
+        )
+    if data.get("rig") != rig_name:
+        raise ValueError(
+            f"{path} calibrates the dome '{data.get('rig')}', not '{rig_name}'; calibrate this "
+            "dome (rti-rig calibrate-lights)"
+        )
+    corr = data.get("intensity_correction")
+    if not isinstance(corr, list) or not all(isinstance(v, int | float) for v in corr):
+        raise ValueError(f"{path}: intensity_correction must be a list of numbers")
+    return [float(v) for v in corr]
+
+
+def _with_correction_file(
+    data: dict[str, Any], path: Path
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(to record, to validate): ``data`` with ``[dome.serial] intensity_correction_file``
+    read into ``intensity_correction``.
+
+    The record keeps the file's name beside its values, so a session's manifest says both what
+    was applied and where it came from; the settings model sees only the values.
+    """
+    dome = data.get("dome")
+    serial = dome.get("serial") if isinstance(dome, dict) else None
+    if not isinstance(serial, dict) or "intensity_correction_file" not in serial:
+        return data, data
+    key = "dome.serial.intensity_correction_file"
+    name = serial["intensity_correction_file"]
+    if "intensity_correction" in serial:
+        raise ConfigError(
+            path, key, "give intensity_correction or intensity_correction_file, not both"
+        )
+    if not isinstance(name, str) or not name:
+        raise ConfigError(path, key, "must be the path of a calibration file (a string)")
+    try:
+        values = read_correction_file((path.parent / name).resolve(), str(data.get("name")))
+    except ValueError as exc:
+        raise ConfigError(path, key, str(exc)) from None
+    recorded = {**serial, "intensity_correction": values}
+    settings = {k: v for k, v in recorded.items() if k != "intensity_correction_file"}
+    return (
+        {**data, "dome": {**dome, "serial": recorded}},  # type: ignore[dict-item]
+        {**data, "dome": {**dome, "serial": settings}},  # type: ignore[dict-item]
+    )
+
+
 def load_rig_config(path: Path | str) -> LoadedRig:
     """Read and validate a rig config TOML file."""
     path = Path(path)
@@ -299,7 +402,8 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         data = tomllib.loads(raw_bytes.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(path, None, f"not valid TOML: {exc}") from None
-    config = parse_rig_config(data, str(path))
+    data, settings = _with_correction_file(data, path)
+    config = parse_rig_config(settings, str(path))
     loaded = LoadedRig(
         config=config,
         path=str(path.resolve()),
@@ -310,7 +414,18 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         dirs, _ = dome_led_directions(loaded)  # fail now, not when the session starts
         serial = config.dome.serial if config.dome else None
         if serial is not None and (problem := serial.check_led_count(len(dirs))):
-            raise ConfigError(path, "dome.serial.expected_led_count", problem)
+            key = "dome.serial.expected_led_count"
+            if problem.startswith("intensity_correction"):
+                used_file = "intensity_correction_file" in data["dome"]["serial"]
+                key = "dome.serial.intensity_correction" + ("_file" if used_file else "")
+            raise ConfigError(path, key, problem)
+        power = config.emulator.led_power
+        if power is not None and len(power) != len(dirs):
+            raise ConfigError(
+                path,
+                "emulator.led_power",
+                f"{len(power)} values for {len(dirs)} LEDs: give one per LED, in LED order",
+            )
     if config.camera.device is not None:
         camera_device_settings(loaded)
     return loaded

@@ -19,7 +19,9 @@ def _gains(n: int, seed: int = 3, spread: float = 0.25) -> np.ndarray:
     return g / np.exp(np.median(np.log(g)))
 
 
-def _card(h: int = 60, w: int = 80, tilt: np.ndarray | None = None) -> np.ndarray:
+def _card(
+    h: int = 60, w: int = 80, tilt: np.ndarray | None = None, lights: np.ndarray = LIGHTS
+) -> np.ndarray:
     """A level card (normal ``tilt`` or the zenith) with uneven albedo: falloff and specks."""
     rng = np.random.default_rng(5)
     yy, xx = np.mgrid[0:h, 0:w]
@@ -28,7 +30,7 @@ def _card(h: int = 60, w: int = 80, tilt: np.ndarray | None = None) -> np.ndarra
     albedo[rng.random((h, w)) < 0.01] = 0.05  # dust
     n = np.zeros((h, w, 3))
     n[...] = [0.0, 0.0, 1.0] if tilt is None else tilt
-    return render(n, albedo, LIGHTS)
+    return render(n, albedo, lights)
 
 
 def test_recovers_known_gains_of_a_level_card() -> None:
@@ -79,6 +81,22 @@ def test_grazing_light_is_left_unestimated() -> None:
     res = estimate_light_gains(card, lights)
     assert not res.estimated[-1] and res.estimated[:-1].all()
     assert res.gains[-1] == 1.0
+
+
+def test_min_shading_lets_a_calibration_measure_low_lights() -> None:
+    el = np.radians(8.0)
+    lights = np.vstack([LIGHTS, [[np.cos(el), 0.0, np.sin(el)]]])
+    card = _card(lights=lights)
+    card[-1] *= 0.7  # the low LED is dim
+    assert not estimate_light_gains(card, lights).estimated[-1]  # the default skips it
+    res = estimate_light_gains(card, lights, min_shading=np.sin(np.radians(5.0)))
+    assert res.estimated.all()
+    ratio = res.gains[-1] / np.median(res.gains[:-1])
+    assert ratio == pytest.approx(0.7, rel=0.02)
+    with pytest.raises(ReconstructionError, match="min_shading must be in"):
+        estimate_light_gains(card, lights, min_shading=1.5)
+    with pytest.raises(ReconstructionError, match="need 4; is the card's normal right"):
+        estimate_light_gains(card, lights, min_shading=0.999)
 
 
 def test_dividing_gains_out_restores_photometric_stereo() -> None:

@@ -119,11 +119,16 @@ def estimate_light_gains(
     tolerance: float = 1e-4,
     min_pixels: int = MIN_PIXELS,
     max_pixels: int = 50_000,
+    min_shading: float | None = None,
 ) -> LightGains:
     """Each light's gain from linear ``images`` (N, H, W[, C]) of a level matte target.
 
     ``target_normal`` is the card's normal in the frame of DESIGN.md (the zenith for a card
-    lying flat). Reads a regular grid of at most ``max_pixels`` pixels
+    lying flat). A light is measured where its shading on the card (cosine of incidence) is at
+    least ``min_shading`` — by default :data:`WELL_LIT_FRACTION` of the best-placed lights'
+    (their 90th percentile); a calibration that must cover a dome's low ring passes the sine of
+    its lowest elevation instead, and accepts that a tilt of the card biases those gains most.
+    Reads a regular grid of at most ``max_pixels`` pixels
     (:meth:`ImageStack.pixel_sample`). Raises
     :class:`ReconstructionError` for fewer than 4 lights, images that do not pair with the
     lights, non-finite values, a card too dark to measure, or a light whose gain says its LED is
@@ -147,7 +152,16 @@ def estimate_light_gains(
     if not np.all(np.isfinite(sample)):
         raise ReconstructionError("images hold NaN or infinity; gains need finite linear values")
     shade = np.maximum(lt @ as_direction(target_normal), 0.0)
-    usable = shade > WELL_LIT_FRACTION * np.percentile(shade, 90)
+    if min_shading is None:
+        min_shading = WELL_LIT_FRACTION * float(np.percentile(shade, 90))
+    elif not 0.0 < min_shading < 1.0:
+        raise ReconstructionError(f"min_shading must be in (0, 1), got {min_shading}")
+    usable = shade >= min_shading
+    if int(usable.sum()) < 4:
+        raise ReconstructionError(
+            f"only {int(usable.sum())} lights light the card at shading >= {min_shading:.3f}: "
+            "need 4; is the card's normal right?"
+        )
     results = [
         _target_channel(sample[..., c], shade, usable, passes, tolerance, min_pixels)
         for c in range(sample.shape[-1])

@@ -1,0 +1,276 @@
+"""Evening out a dome's LEDs: a per-LED intensity correction measured from a card session.
+
+Why in the dome and not in the fit: relight, RTIBuilder and every PTM/HSH/photometric-stereo
+fitter read only the images and the ``.lp``, and assume all lights are equally strong. Real
+domes' LEDs are not (one measured dome: 19–37 % darker to 18–23 % brighter than its median LED,
+docs/reconstruction.md "Light gains"), and a dim light tilts every normal it helps to fit. The
+dome driver can dim each LED by a factor (``[dome.serial] intensity_correction``, PWM level ×
+factor), so a correction measured once makes every later session's images equal-light for
+every tool.
+
+The measurement: shoot a level matte white card under every LED (``rti-rig run``), then
+:func:`read_card_session` and :func:`calibrate_dome`. The card's images give each light's gain
+(:func:`rti_rig.reconstruct.estimate_light_gains`). An image is ∝ p · d where p is the LED's
+own output and d the drive it was given (the correction in force × the step's intensity, as the
+quantised PWM level it became), so p = gain / d, and the new correction p_min / p makes every
+LED give the weakest one's light. Evening out costs light (the exposure must grow by the mean
+factor's reciprocal), which is reported.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.config import CALIBRATION_FORMAT as FORMAT
+from rti_rig.errors import SessionError
+from rti_rig.image_files import read_linear_tiff
+from rti_rig.reconstruct import ReconstructionError, estimate_light_gains
+from rti_rig.session import read_manifest
+
+#: Card images are area-averaged to at most this many pixels on their long side: the gains are
+#: medians over the card, so full resolution only costs memory (72 × 24 MP would be 7 GB).
+WORK_SIZE = 512
+#: A card image with more saturated pixels than this is refused (its gain would be clipped).
+MAX_SATURATED = 0.01
+
+
+@dataclass(frozen=True)
+class CardSession:
+    """The card images of one dome session, each with the LED that lit it and how hard."""
+
+    root: Path
+    rig_name: str
+    images: NDArray[np.float32]  # (n, h, w) grey, linear, downsampled
+    directions: NDArray[np.float64]  # (n, 3) the directions that actually ran
+    leds: NDArray[np.intp]  # (n,) LED index of each image
+    drive: NDArray[np.float64]  # (n,) PWM level / max level each LED was driven at
+    image_names: tuple[str, ...]
+    correction: tuple[float, ...] | None  # the dome's intensity_correction when it was shot
+
+
+@dataclass(frozen=True)
+class LightCalibration:
+    """A dome's per-LED correction, and the evidence for it.
+
+    ``output`` each LED's light at full drive relative to the median measured LED (1 where not
+    measured); ``measured`` which LEDs the card session measured; ``correction`` the new factors
+    in (0, 1] (the weakest LED at 1); ``previous`` the factors the card was shot with;
+    ``shot_spread`` the RMS of the natural log of the measured lights' gains as shot (the
+    unevenness the card session itself had: after a good correction, a re-shot card shows the
+    residual here); ``light_kept`` the mean new factor (evening out dims the dome to this share).
+    """
+
+    output: NDArray[np.float64]
+    measured: NDArray[np.bool_]
+    correction: NDArray[np.float64]
+    previous: NDArray[np.float64]
+    shot_gains: NDArray[np.float64]  # (n,) the session's gains, median 1, per image
+    shot_estimated: NDArray[np.bool_]  # (n,)
+    shot_spread: float
+    light_kept: float
+
+    @property
+    def stops_lost(self) -> float:
+        """Exposure the evened-out dome needs beyond the uncorrected one, in stops."""
+        return float(-math.log2(self.light_kept))
+
+
+def _serial_table(manifest: dict[str, Any]) -> dict[str, Any]:
+    config = (manifest.get("rig") or {}).get("config") or {}
+    return (config.get("dome") or {}).get("serial") or {}
+
+
+def read_card_session(root: Path | str) -> CardSession:
+    """Load a finished dome session of a calibration card (its linear images, downsampled).
+
+    Raises :class:`SessionError` naming the session and image for what cannot calibrate: not a
+    dome session, a session shot without a serial dome (the simulated backend), an LED shot
+    twice, a missing image, or an image with too many saturated pixels.
+    """
+    root = Path(root)
+    manifest = read_manifest(root)
+    rig = manifest.get("rig") or {}
+    steps = manifest.get("steps") or []
+    if rig.get("kind") != "dome":
+        raise SessionError(
+            f"{root}: a session of the {rig.get('kind')!r} rig '{rig.get('name')}'; light "
+            "calibration is for domes (an arm carries one lamp, which every image shares)"
+        )
+    serial = _serial_table(manifest)
+    if not serial:
+        raise SessionError(
+            f"{root}: shot on rig '{rig.get('name')}' without a [dome.serial] table (backend "
+            f"{rig.get('backend')!r}): only a serial dome can dim its LEDs; shoot the card on "
+            "the hardware (or emulated) rig"
+        )
+    if len(steps) < 4:
+        raise SessionError(
+            f"{root}: {len(steps)} image(s); shoot the card under every LED of the dome "
+            "(rti-rig run RIG --out CARD_SESSION, with no --lights)"
+        )
+    planned = (manifest.get("schedule") or {}).get("steps") or []
+    correction = serial.get("intensity_correction")
+    max_level = int(serial.get("max_level", 255))
+    images, drive, leds, names = [], [], [], []
+    seen: dict[int, str] = {}
+    for s in steps:
+        led, name = s.get("led"), s["linear_image"]
+        if led is None:
+            raise SessionError(f"{root}: step {s['index'] + 1} ({name}) records no LED")
+        if led in seen:
+            raise SessionError(
+                f"{root}: LED {led} lit both {seen[led]} and {name}; a card session shoots each "
+                "LED once"
+            )
+        seen[led] = name
+        if s.get("saturated_fraction", 0.0) > MAX_SATURATED:
+            raise SessionError(
+                f"{root}/{name} (LED {led}): {100 * s['saturated_fraction']:.1f} % of its pixels "
+                "are saturated; shoot the card again with a shorter exposure (rti-rig run "
+                "--auto-exposure meters one)"
+            )
+        path = root / name
+        try:
+            pixels = read_linear_tiff(path)
+        except (OSError, ValueError) as exc:
+            raise SessionError(f"{path} (LED {led}) cannot be read: {exc}") from None
+        images.append(_work_image(pixels))
+        intensity = float(planned[s["index"]].get("intensity", 1.0)) if planned else 1.0
+        factor = 1.0 if correction is None else float(correction[led])
+        drive.append(max(round(intensity * factor * max_level), 1) / max_level)
+        leds.append(int(led))
+        names.append(name)
+    return CardSession(
+        root=root,
+        rig_name=str(rig.get("name")),
+        images=np.stack(images),
+        directions=np.array([s["actual_direction"] for s in steps], dtype=np.float64),
+        leds=np.array(leds, dtype=np.intp),
+        drive=np.array(drive),
+        image_names=tuple(names),
+        correction=None if correction is None else tuple(float(v) for v in correction),
+    )
+
+
+def _work_image(pixels: NDArray[Any]) -> NDArray[np.float32]:
+    """Grey linear float32, area-averaged so its long side is at most :data:`WORK_SIZE`."""
+    grey = pixels.astype(np.float32)
+    if grey.ndim == 3:
+        grey = grey.mean(axis=2)
+    h, w = grey.shape
+    scale = WORK_SIZE / max(h, w)
+    if scale < 1.0:
+        size = (max(1, round(w * scale)), max(1, round(h * scale)))
+        grey = cv2.resize(grey, size, interpolation=cv2.INTER_AREA)
+    return grey
+
+
+def calibrate_dome(
+    card: CardSession,
+    led_count: int,
+    *,
+    card_normal: Sequence[float] = (0.0, 0.0, 1.0),
+    min_elevation_deg: float = 5.0,
+) -> LightCalibration:
+    """The correction that evens out a dome of ``led_count`` LEDs, from its card session.
+
+    LEDs lower than ``min_elevation_deg`` above the card, or not in the session, are not
+    measured: they are assumed to give the median LED's light. Raises
+    :class:`ReconstructionError` (from the gain estimate) for a dead LED, a card too dark to
+    measure or images that do not pair with their lights, and :class:`SessionError` for an LED
+    index outside the dome.
+    """
+    if np.any(card.leds >= led_count):
+        bad = int(card.leds[card.leds >= led_count][0])
+        raise SessionError(
+            f"{card.root}: LED {bad} is outside a dome of {led_count} LEDs; was the card shot "
+            "on another rig?"
+        )
+    if not 0.0 < min_elevation_deg < 90.0:
+        raise ReconstructionError(f"min_elevation_deg must be in (0, 90), got {min_elevation_deg}")
+    gains = estimate_light_gains(
+        card.images,
+        card.directions,
+        target_normal=card_normal,
+        min_shading=math.sin(math.radians(min_elevation_deg)),
+    )
+    est = gains.estimated
+    power = gains.gains / card.drive  # each measured LED's own output, up to a common scale
+    power = power / np.exp(np.median(np.log(power[est])))
+    output = np.ones(led_count)
+    measured = np.zeros(led_count, dtype=bool)
+    output[card.leds[est]] = power[est]
+    measured[card.leds[est]] = True
+    correction = output.min() / output
+    previous = np.ones(led_count) if card.correction is None else np.array(card.correction)
+    if len(previous) != led_count:
+        raise SessionError(
+            f"{card.root}: shot with {len(previous)} correction factors, but the dome has "
+            f"{led_count} LEDs; was the card shot on another rig?"
+        )
+    log_gains = np.log(gains.gains[est])
+    return LightCalibration(
+        output=output,
+        measured=measured,
+        correction=correction,
+        previous=previous,
+        shot_gains=gains.gains,
+        shot_estimated=est,
+        shot_spread=float(np.sqrt(np.mean((log_gains - np.median(log_gains)) ** 2))),
+        light_kept=float(np.mean(correction)),
+    )
+
+
+def calibration_toml(
+    cal: LightCalibration, rig_name: str, session: Path, names: Sequence[str]
+) -> str:
+    """The calibration file: the correction list plus the evidence, as commented TOML.
+
+    ``names`` are the dome's LED names (from its config or ``.lp``), for the comments.
+    """
+    created = datetime.now(UTC).isoformat(timespec="seconds")
+    weakest = int(np.argmin(cal.output))
+
+    def listing(items: list[str]) -> str:
+        rows = (", ".join(items[i : i + 8]) for i in range(0, len(items), 8))
+        return "[\n" + "".join(f"  {r},\n" for r in rows) + "]"
+
+    def floats(values: NDArray[np.float64]) -> str:
+        return listing([f"{v:.4f}" for v in values])
+
+    lines = [
+        f"# Light calibration of dome '{rig_name}' from the card session {session}.",
+        "# Use it from the rig config, under [dome.serial]:",
+        '#   intensity_correction_file = "<path of this file, relative to the config>"',
+        "# then shoot the card again and calibrate that session: its spread is what is left.",
+        f"# Measured {int(cal.measured.sum())} of {len(cal.output)} LEDs; the unmeasured ones "
+        "are assumed to give the median LED's light.",
+        f"# Spread of the lights as shot (RMS of ln gain): {cal.shot_spread:.3f}; weakest LED "
+        f"{weakest} ({names[weakest]}) at {cal.output[weakest]:.3f} of the median.",
+        f"# Evened out, the dome gives {100 * cal.light_kept:.0f} % of its light on average "
+        f"({cal.stops_lost:.2f} stop(s) more exposure).",
+        f'format = "{FORMAT}"',
+        f"rig = {_toml_string(rig_name)}",
+        f"session = {_toml_string(str(session))}",
+        f'created = "{created}"',
+        f"measured = {listing(['true' if m else 'false' for m in cal.measured])}",
+        "# each LED's output at full drive relative to the median measured LED, LED order",
+        f"relative_output = {floats(cal.output)}",
+        "# PWM factor per LED, LED order (the dome driver multiplies each level by it)",
+        f"intensity_correction = {floats(cal.correction)}",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def _toml_string(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
