@@ -622,14 +622,20 @@ def calibrate_lights(
                 f"'{loaded.config.name}': calibrate a dome from its own card session"
             )
         target = out_file or card_session / "light_calibration.toml"
+        if out_file is None and target.exists():
+            raise RtiRigError(
+                f"{target} exists: this card session was calibrated already (its file is never "
+                "replaced); give --out to write the calibration elsewhere"
+            )
         _check_output_file(target, force, {"RIG": rig_config})
         cal = calibrate_dome(
             card, geometry.count, card_normal=normal, min_elevation_deg=min_elevation_deg
         )
-        target.write_text(
-            calibration_toml(cal, loaded.config.name, card_session.resolve(), geometry.names),
-            encoding="utf-8",
-        )
+        text = calibration_toml(cal, loaded.config.name, card_session.resolve(), geometry.names)
+        try:
+            target.write_text(text, encoding="utf-8")
+        except OSError as exc:
+            raise RtiRigError(f"cannot write {target}: {exc.strerror or exc}") from None
     except RtiRigError as exc:
         raise _fail(exc) from None
     measured = np.flatnonzero(cal.measured)
@@ -648,9 +654,16 @@ def calibrate_lights(
         f"(LED {strong}, {escape(names[strong])}) of the median."
     )
     out.print(
-        f"Evened out, the dome gives {100 * cal.light_kept:.0f} % of its light on average "
+        f"Evened out, every LED gives {cal.evened_light:.2f} of the median LED's light "
         f"({cal.stops_lost:.2f} stop(s) more exposure)."
     )
+    if not cal.measured.all():
+        skipped = ", ".join(names[i] for i in np.flatnonzero(~cal.measured))
+        err.print(
+            f"[yellow]note:[/] not measured (not in the session, or lower than "
+            f"{min_elevation_deg:g}° above the card), assumed to give the median light under "
+            f"the correction in force: {escape(skipped)}"
+        )
     if cal.output[weak] < 0.5:
         err.print(
             f"[yellow]warning:[/] LED {weak} gives only {cal.output[weak]:.2f} of the median "

@@ -9,6 +9,7 @@ drives it; building devices from it happens in :mod:`rti_rig.compose` (the compo
 from __future__ import annotations
 
 import hashlib
+import math
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -289,7 +290,7 @@ class LoadedRig(BaseModel):
 
     config: RigConfig
     path: str
-    sha256: str
+    sha256: str  # of the config file, and of its light calibration file if it names one
     raw: dict[str, Any]  # the parsed TOML (a correction file's values filled in)
 
     @property
@@ -353,24 +354,32 @@ def read_correction_file(path: Path, rig_name: str) -> list[float]:
             "dome (rti-rig calibrate-lights)"
         )
     corr = data.get("intensity_correction")
-    if not isinstance(corr, list) or not all(isinstance(v, int | float) for v in corr):
-        raise ValueError(f"{path}: intensity_correction must be a list of numbers")
+    if not isinstance(corr, list) or not corr:
+        raise ValueError(f"{path}: intensity_correction must be a list of factors, one per LED")
+    for i, v in enumerate(corr):
+        ok = isinstance(v, int | float) and not isinstance(v, bool)
+        if not (ok and math.isfinite(v) and 0 < v <= 1):
+            raise ValueError(
+                f"{path}: intensity_correction[{i}] is {v!r}; factors must be numbers in (0, 1] "
+                "(calibrate again with rti-rig calibrate-lights)"
+            )
     return [float(v) for v in corr]
 
 
 def _with_correction_file(
     data: dict[str, Any], path: Path
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(to record, to validate): ``data`` with ``[dome.serial] intensity_correction_file``
-    read into ``intensity_correction``.
+) -> tuple[dict[str, Any], dict[str, Any], bytes]:
+    """(to record, to validate, the file's bytes): ``data`` with ``[dome.serial]
+    intensity_correction_file`` read into ``intensity_correction``.
 
     The record keeps the file's name beside its values, so a session's manifest says both what
-    was applied and where it came from; the settings model sees only the values.
+    was applied and where it came from; the settings model sees only the values. The path is
+    relative to the config's real folder (as ``lp_file`` is).
     """
     dome = data.get("dome")
     serial = dome.get("serial") if isinstance(dome, dict) else None
     if not isinstance(serial, dict) or "intensity_correction_file" not in serial:
-        return data, data
+        return data, data, b""
     key = "dome.serial.intensity_correction_file"
     name = serial["intensity_correction_file"]
     if "intensity_correction" in serial:
@@ -379,8 +388,9 @@ def _with_correction_file(
         )
     if not isinstance(name, str) or not name:
         raise ConfigError(path, key, "must be the path of a calibration file (a string)")
+    file = (path.resolve().parent / name).resolve()
     try:
-        values = read_correction_file((path.parent / name).resolve(), str(data.get("name")))
+        values = read_correction_file(file, str(data.get("name")))
     except ValueError as exc:
         raise ConfigError(path, key, str(exc)) from None
     recorded = {**serial, "intensity_correction": values}
@@ -388,6 +398,7 @@ def _with_correction_file(
     return (
         {**data, "dome": {**dome, "serial": recorded}},  # type: ignore[dict-item]
         {**data, "dome": {**dome, "serial": settings}},  # type: ignore[dict-item]
+        file.read_bytes(),
     )
 
 
@@ -402,12 +413,13 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         data = tomllib.loads(raw_bytes.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(path, None, f"not valid TOML: {exc}") from None
-    data, settings = _with_correction_file(data, path)
+    data, settings, correction_bytes = _with_correction_file(data, path)
     config = parse_rig_config(settings, str(path))
     loaded = LoadedRig(
         config=config,
         path=str(path.resolve()),
-        sha256=hashlib.sha256(raw_bytes).hexdigest(),
+        # a new calibration file changes the rig as much as an edit of the config does
+        sha256=hashlib.sha256(raw_bytes + correction_bytes).hexdigest(),
         raw=data,
     )
     if config.kind == "dome":

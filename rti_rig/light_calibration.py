@@ -13,8 +13,8 @@ The measurement: shoot a level matte white card under every LED (``rti-rig run``
 (:func:`rti_rig.reconstruct.estimate_light_gains`). An image is ∝ p · d where p is the LED's
 own output and d the drive it was given (the correction in force × the step's intensity, as the
 quantised PWM level it became), so p = gain / d, and the new correction p_min / p makes every
-LED give the weakest one's light. Evening out costs light (the exposure must grow by the mean
-factor's reciprocal), which is reported.
+LED give the weakest one's light. Evening out costs light (an image needs p_median / p_min
+times the exposure it needed under the median LED), which is reported.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ class CardSession:
     images: NDArray[np.float32]  # (n, h, w) grey, linear, downsampled
     directions: NDArray[np.float64]  # (n, 3) the directions that actually ran
     leds: NDArray[np.intp]  # (n,) LED index of each image
-    drive: NDArray[np.float64]  # (n,) PWM level / max level each LED was driven at
+    drive: NDArray[np.float64]  # (n,) PWM level / max level × exposure / longest exposure
     image_names: tuple[str, ...]
     correction: tuple[float, ...] | None  # the dome's intensity_correction when it was shot
 
@@ -61,12 +61,13 @@ class CardSession:
 class LightCalibration:
     """A dome's per-LED correction, and the evidence for it.
 
-    ``output`` each LED's light at full drive relative to the median measured LED (1 where not
-    measured); ``measured`` which LEDs the card session measured; ``correction`` the new factors
-    in (0, 1] (the weakest LED at 1); ``previous`` the factors the card was shot with;
+    ``output`` each LED's light at full drive relative to the median measured LED (assumed
+    where not measured, see :func:`calibrate_dome`); ``measured`` which LEDs the card session
+    measured; ``correction`` the new factors in (0, 1] (the weakest LED at 1); ``previous``
+    the factors the card was shot with;
     ``shot_spread`` the RMS of the natural log of the measured lights' gains as shot (the
     unevenness the card session itself had: after a good correction, a re-shot card shows the
-    residual here); ``light_kept`` the mean new factor (evening out dims the dome to this share).
+    residual here).
     """
 
     output: NDArray[np.float64]
@@ -76,12 +77,16 @@ class LightCalibration:
     shot_gains: NDArray[np.float64]  # (n,) the session's gains, median 1, per image
     shot_estimated: NDArray[np.bool_]  # (n,)
     shot_spread: float
-    light_kept: float
+
+    @property
+    def evened_light(self) -> float:
+        """The light every LED gives once evened out, relative to the median LED's (≤ 1)."""
+        return float(self.output.min() / np.median(self.output[self.measured]))
 
     @property
     def stops_lost(self) -> float:
-        """Exposure the evened-out dome needs beyond the uncorrected one, in stops."""
-        return float(-math.log2(self.light_kept))
+        """Exposure an evened-out image needs beyond one lit by the median LED, in stops."""
+        return float(-math.log2(self.evened_light))
 
 
 def _serial_table(manifest: dict[str, Any]) -> dict[str, Any]:
@@ -93,12 +98,24 @@ def read_card_session(root: Path | str) -> CardSession:
     """Load a finished dome session of a calibration card (its linear images, downsampled).
 
     Raises :class:`SessionError` naming the session and image for what cannot calibrate: not a
-    dome session, a session shot without a serial dome (the simulated backend), an LED shot
-    twice, a missing image, or an image with too many saturated pixels.
+    dome session, a session shot without a serial dome (the simulated backend), one that did
+    not finish, or whose runs were shot with different configs or calibrations, an LED shot
+    twice or outside the dome, a missing image, an image with too many saturated pixels, or a
+    manifest that does not say what it should.
     """
     root = Path(root)
     manifest = read_manifest(root)
-    rig = manifest.get("rig") or {}
+    try:
+        return _read_card_session(root, manifest)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
+        raise SessionError(
+            f"{root}/manifest.json does not describe a card session rti-rig can read "
+            f"({type(exc).__name__}: {exc}); shoot the card again with 'rti-rig run'"
+        ) from None
+
+
+def _read_card_session(root: Path, manifest: dict[str, Any]) -> CardSession:
+    rig = manifest["rig"]
     steps = manifest.get("steps") or []
     if rig.get("kind") != "dome":
         raise SessionError(
@@ -112,27 +129,43 @@ def read_card_session(root: Path | str) -> CardSession:
             f"{rig.get('backend')!r}): only a serial dome can dim its LEDs; shoot the card on "
             "the hardware (or emulated) rig"
         )
+    planned = manifest["schedule"]["steps"]
+    finish = (manifest.get("runner") or {}).get("finish_reason")
+    if finish != "completed" or len(steps) != len(planned):
+        raise SessionError(
+            f"{root}: the card session did not finish ({finish or 'no finish recorded'}, "
+            f"{len(steps)} of {len(planned)} images): continue it with rti-rig run --resume "
+            f"{root}, or shoot the card again"
+        )
+    shot_with = {run.get("config_sha256") for run in manifest.get("runs") or []}
+    shot_with.discard(None)
+    if len(shot_with | {rig.get("config_sha256")}) > 1:
+        raise SessionError(
+            f"{root}: the card session was resumed with a changed rig config or light "
+            "calibration, so its images were not all shot with the same LED correction; shoot "
+            "the card again"
+        )
     if len(steps) < 4:
         raise SessionError(
             f"{root}: {len(steps)} image(s); shoot the card under every LED of the dome "
             "(rti-rig run RIG --out CARD_SESSION, with no --lights)"
         )
-    planned = (manifest.get("schedule") or {}).get("steps") or []
     correction = serial.get("intensity_correction")
     max_level = int(serial.get("max_level", 255))
+    exposures = np.array([float(s["exposure_s"]) for s in steps])
     images, drive, leds, names = [], [], [], []
     seen: dict[int, str] = {}
-    for s in steps:
-        led, name = s.get("led"), s["linear_image"]
-        if led is None:
-            raise SessionError(f"{root}: step {s['index'] + 1} ({name}) records no LED")
+    for s, exposure in zip(steps, exposures, strict=True):
+        led, name = s["led"], s["linear_image"]
+        if isinstance(led, bool) or not isinstance(led, int) or led < 0:
+            raise SessionError(f"{root}: step {s['index'] + 1} ({name}) records LED {led!r}")
         if led in seen:
             raise SessionError(
                 f"{root}: LED {led} lit both {seen[led]} and {name}; a card session shoots each "
                 "LED once"
             )
         seen[led] = name
-        if s.get("saturated_fraction", 0.0) > MAX_SATURATED:
+        if float(s.get("saturated_fraction") or 0.0) > MAX_SATURATED:
             raise SessionError(
                 f"{root}/{name} (LED {led}): {100 * s['saturated_fraction']:.1f} % of its pixels "
                 "are saturated; shoot the card again with a shorter exposure (rti-rig run "
@@ -144,10 +177,12 @@ def read_card_session(root: Path | str) -> CardSession:
         except (OSError, ValueError) as exc:
             raise SessionError(f"{path} (LED {led}) cannot be read: {exc}") from None
         images.append(_work_image(pixels))
-        intensity = float(planned[s["index"]].get("intensity", 1.0)) if planned else 1.0
-        factor = 1.0 if correction is None else float(correction[led])
-        drive.append(max(round(intensity * factor * max_level), 1) / max_level)
-        leds.append(int(led))
+        intensity = float(planned[s["index"]].get("intensity", 1.0))
+        factor = 1.0 if correction is None or led >= len(correction) else float(correction[led])
+        level = max(round(intensity * factor * max_level), 1) / max_level
+        # what reached the sensor is ∝ PWM level × exposure time
+        drive.append(level * exposure / exposures.max())
+        leds.append(led)
         names.append(name)
     return CardSession(
         root=root,
@@ -184,13 +219,15 @@ def calibrate_dome(
     """The correction that evens out a dome of ``led_count`` LEDs, from its card session.
 
     LEDs lower than ``min_elevation_deg`` above the card, or not in the session, are not
-    measured: they are assumed to give the median LED's light. Raises
+    measured: they are assumed to give, under the correction in force when the card was shot,
+    the median measured LED's light under it (so an earlier calibration of them is kept). Raises
     :class:`ReconstructionError` (from the gain estimate) for a dead LED, a card too dark to
     measure or images that do not pair with their lights, and :class:`SessionError` for an LED
     index outside the dome.
     """
-    if np.any(card.leds >= led_count):
-        bad = int(card.leds[card.leds >= led_count][0])
+    outside = (card.leds < 0) | (card.leds >= led_count)
+    if outside.any():
+        bad = int(card.leds[outside][0])
         raise SessionError(
             f"{card.root}: LED {bad} is outside a dome of {led_count} LEDs; was the card shot "
             "on another rig?"
@@ -203,20 +240,24 @@ def calibrate_dome(
         target_normal=card_normal,
         min_shading=math.sin(math.radians(min_elevation_deg)),
     )
-    est = gains.estimated
-    power = gains.gains / card.drive  # each measured LED's own output, up to a common scale
-    power = power / np.exp(np.median(np.log(power[est])))
-    output = np.ones(led_count)
-    measured = np.zeros(led_count, dtype=bool)
-    output[card.leds[est]] = power[est]
-    measured[card.leds[est]] = True
-    correction = output.min() / output
     previous = np.ones(led_count) if card.correction is None else np.array(card.correction)
     if len(previous) != led_count:
         raise SessionError(
             f"{card.root}: shot with {len(previous)} correction factors, but the dome has "
             f"{led_count} LEDs; was the card shot on another rig?"
         )
+    est = gains.estimated
+    power = gains.gains / card.drive  # each measured LED's own output, up to a common scale
+    power = power / np.exp(np.median(np.log(power[est])))
+    measured = np.zeros(led_count, dtype=bool)
+    measured[card.leds[est]] = True
+    output = np.empty(led_count)
+    output[card.leds[est]] = power[est]
+    # an LED not measured is assumed to give, under the correction in force, the median
+    # measured LED's light under it (with no correction: the median LED's light)
+    evened = float(np.median(output[measured] * previous[measured]))
+    output[~measured] = evened / previous[~measured]
+    correction = output.min() / output
     log_gains = np.log(gains.gains[est])
     return LightCalibration(
         output=output,
@@ -226,7 +267,6 @@ def calibrate_dome(
         shot_gains=gains.gains,
         shot_estimated=est,
         shot_spread=float(np.sqrt(np.mean((log_gains - np.median(log_gains)) ** 2))),
-        light_kept=float(np.mean(correction)),
     )
 
 
@@ -253,10 +293,10 @@ def calibration_toml(
         '#   intensity_correction_file = "<path of this file, relative to the config>"',
         "# then shoot the card again and calibrate that session: its spread is what is left.",
         f"# Measured {int(cal.measured.sum())} of {len(cal.output)} LEDs; the unmeasured ones "
-        "are assumed to give the median LED's light.",
+        "are assumed to give the median LED's light under the correction in force.",
         f"# Spread of the lights as shot (RMS of ln gain): {cal.shot_spread:.3f}; weakest LED "
         f"{weakest} ({names[weakest]}) at {cal.output[weakest]:.3f} of the median.",
-        f"# Evened out, the dome gives {100 * cal.light_kept:.0f} % of its light on average "
+        f"# Evened out, every LED gives {cal.evened_light:.3f} of the median LED's light "
         f"({cal.stops_lost:.2f} stop(s) more exposure).",
         f'format = "{FORMAT}"',
         f"rig = {_toml_string(rig_name)}",

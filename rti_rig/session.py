@@ -161,7 +161,12 @@ class SessionFolder:
 
     def begin(self, header: dict[str, Any]) -> None:
         """Record what is about to run, before anything moves."""
-        run = {"started_at": _now_iso(), "software": software_versions()}
+        run = {
+            "started_at": _now_iso(),
+            "software": software_versions(),
+            # which config (and light calibration) this run's images were shot with
+            "config_sha256": (header.get("rig") or {}).get("config_sha256"),
+        }
         if self.resume is not None:
             if header["schedule"] != self.manifest["schedule"]:
                 raise SessionError(

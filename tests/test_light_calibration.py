@@ -124,8 +124,18 @@ def test_unmeasured_leds_take_the_median_and_the_weakest_sets_the_level() -> Non
     assert cal.measured.tolist() == [True] * 5 + [False, False]
     np.testing.assert_allclose(cal.output, [1.0, 0.5, 1.25, 1.0, 0.8, 1.0, 1.0], rtol=1e-3)
     np.testing.assert_allclose(cal.correction, 0.5 / cal.output, rtol=1e-3)
-    assert cal.light_kept == pytest.approx(np.mean(0.5 / cal.output), rel=1e-6)
-    assert cal.stops_lost == pytest.approx(-np.log2(cal.light_kept))
+    assert cal.evened_light == pytest.approx(0.5, rel=1e-3)
+    assert cal.stops_lost == pytest.approx(1.0, rel=1e-3)
+
+
+def test_unmeasured_leds_keep_the_correction_in_force() -> None:
+    # LED 4 sits too low to measure; the correction in force had dimmed it to 0.5 (it is bright)
+    old = (1.0, 1.0, 1.0, 1.0, 0.5)
+    card = synthetic_card([0, 1, 2, 3, 4], [30, 40, 50, 60, 3], [1.0, 0.8, 1.25, 1.0, 2.0], old)
+    cal = calibrate_dome(card, 5)
+    assert cal.measured.tolist() == [True] * 4 + [False]
+    assert cal.output[4] == pytest.approx(2.0, rel=1e-3)  # median light / its old factor
+    assert cal.correction[4] == pytest.approx(0.8 / 2.0, rel=1e-3)  # still dimmed, not raised
 
 
 def test_a_correction_in_force_is_composed_not_replaced() -> None:
@@ -219,7 +229,7 @@ def test_cli_refusals_name_what_is_wrong(tmp_path: Path) -> None:
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
     assert r.exit_code == 0, r.output
     # the calibration file inside the session is written once, never replaced, even forced
-    assert "a session's files are never overwritten" in calibrate("--force")
+    assert "calibrated already (its file is never replaced)" in calibrate("--force")
     elsewhere = tmp_path / "cal.toml"
     assert (
         runner.invoke(
@@ -293,3 +303,66 @@ def test_the_shipped_rehearsal_config_runs_as_its_comments_say(tmp_path: Path) -
     shoot(cfg, tmp_path / "sessions" / "card2")
     assert calibrate_dome(read_card_session(card), 48).shot_spread > 0.1
     assert calibrate_dome(read_card_session(tmp_path / "sessions" / "card2"), 48).shot_spread < 0.01
+
+
+def test_resumed_unfinished_or_malformed_card_sessions_are_refused(tmp_path: Path) -> None:
+    cfg = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(cfg, card)
+    good = (card / "manifest.json").read_text()
+
+    def refused(change, match: str) -> None:  # type: ignore[no-untyped-def]
+        (card / "manifest.json").write_text(good)
+        edit_manifest(card, change)
+        with pytest.raises(SessionError, match=match):
+            read_card_session(card)
+
+    def cancelled(m):  # type: ignore[no-untyped-def]
+        m["runner"]["finish_reason"] = "cancelled"
+        m["steps"] = m["steps"][:20]
+
+    refused(cancelled, r"did not finish \(cancelled, 20 of 48 images\)")
+
+    def resumed_with_another_calibration(m):  # type: ignore[no-untyped-def]
+        m["runs"].append({**m["runs"][0], "config_sha256": "0" * 64})
+
+    refused(resumed_with_another_calibration, "resumed with a changed rig config or light")
+    refused(lambda m: m["steps"][3].update(led=-1), r"records LED -1")
+    refused(lambda m: m["steps"][3].pop("actual_direction"), "does not describe a card session")
+    refused(lambda m: m.update(rig=[]), "does not describe a card session")
+
+
+def test_a_step_shot_at_another_exposure_is_scaled_by_it(tmp_path: Path) -> None:
+    cfg = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(cfg, card)
+    before = calibrate_dome(read_card_session(card), 48).output
+    # the same image said to be shot at half the exposure: its LED must be twice as bright
+    edit_manifest(card, lambda m: m["steps"][12].update(exposure_s=0.025))
+    after = calibrate_dome(read_card_session(card), 48).output
+    assert after[12] / before[12] == pytest.approx(2.0, rel=0.01)
+    others = np.delete(np.arange(48), 12)
+    np.testing.assert_allclose(after[others], before[others], rtol=0.01)
+
+
+def test_the_calibration_file_counts_in_the_rig_fingerprint_and_follows_symlinks(
+    tmp_path: Path,
+) -> None:
+    head = 'format = "rti-rig-light-calibration/1"\nrig = "emulated-dome-48"\n'
+    cal = tmp_path / "rigs" / "cal.toml"
+    cal.parent.mkdir()
+    cal.write_text(head + f"intensity_correction = [{', '.join(['1.0'] * 48)}]\n")
+    cfg = card_rig(tmp_path / "rigs", 'intensity_correction_file = "cal.toml"\n')
+    first = load_rig_config(cfg).sha256
+    cal.write_text(head + f"intensity_correction = [{', '.join(['0.9'] * 48)}]\n")
+    assert load_rig_config(cfg).sha256 != first  # a resume then says the rig has changed
+    (tmp_path / "elsewhere").mkdir()
+    link = tmp_path / "elsewhere" / "rig.toml"
+    link.symlink_to(cfg)
+    assert load_rig_config(link).config.dome.serial.intensity_correction == [0.9] * 48  # type: ignore[union-attr]
+    for bad, fragment in [("0.0", "intensity_correction[0] is 0.0"), ("true", "is True")]:
+        cal.write_text(head + f"intensity_correction = [{bad}]\n")
+        with pytest.raises(ConfigError) as info:
+            load_rig_config(cfg)
+        assert info.value.key == "dome.serial.intensity_correction_file"
+        assert fragment in info.value.message
