@@ -615,12 +615,7 @@ def calibrate_lights(
                 "images instead (rti_rig.reconstruct.apply_light_gains)"
             )
         geometry = rig_geometry(loaded)
-        card = read_card_session(card_session)
-        if card.rig_name != loaded.config.name:
-            raise RtiRigError(
-                f"{card_session} was shot on rig '{card.rig_name}', but {rig_config} is rig "
-                f"'{loaded.config.name}': calibrate a dome from its own card session"
-            )
+        card = read_card_session(card_session, rig_name=loaded.config.name)
         target = out_file or card_session / "light_calibration.toml"
         if out_file is None and target.exists():
             raise RtiRigError(

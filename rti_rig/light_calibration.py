@@ -26,10 +26,10 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.topography import downsample
 from rti_rig.config import CALIBRATION_FORMAT as FORMAT
 from rti_rig.errors import SessionError
 from rti_rig.image_files import read_linear_tiff
@@ -53,7 +53,6 @@ class CardSession:
     directions: NDArray[np.float64]  # (n, 3) the directions that actually ran
     leds: NDArray[np.intp]  # (n,) LED index of each image
     drive: NDArray[np.float64]  # (n,) PWM level / max level × exposure / longest exposure
-    image_names: tuple[str, ...]
     correction: tuple[float, ...] | None  # the dome's intensity_correction when it was shot
 
 
@@ -74,8 +73,6 @@ class LightCalibration:
     measured: NDArray[np.bool_]
     correction: NDArray[np.float64]
     previous: NDArray[np.float64]
-    shot_gains: NDArray[np.float64]  # (n,) the session's gains, median 1, per image
-    shot_estimated: NDArray[np.bool_]  # (n,)
     shot_spread: float
 
     @property
@@ -94,19 +91,20 @@ def _serial_table(manifest: dict[str, Any]) -> dict[str, Any]:
     return (config.get("dome") or {}).get("serial") or {}
 
 
-def read_card_session(root: Path | str) -> CardSession:
+def read_card_session(root: Path | str, rig_name: str | None = None) -> CardSession:
     """Load a finished dome session of a calibration card (its linear images, downsampled).
 
     Raises :class:`SessionError` naming the session and image for what cannot calibrate: not a
     dome session, a session shot without a serial dome (the simulated backend), one that did
     not finish, or whose runs were shot with different configs or calibrations, an LED shot
     twice or outside the dome, a missing image, an image with too many saturated pixels, or a
-    manifest that does not say what it should.
+    manifest that does not say what it should. With ``rig_name``, a session shot on another
+    rig is refused before any image is read.
     """
     root = Path(root)
     manifest = read_manifest(root)
     try:
-        return _read_card_session(root, manifest)
+        return _read_card_session(root, manifest, rig_name)
     except (KeyError, IndexError, TypeError, ValueError, AttributeError) as exc:
         raise SessionError(
             f"{root}/manifest.json does not describe a card session rti-rig can read "
@@ -114,8 +112,13 @@ def read_card_session(root: Path | str) -> CardSession:
         ) from None
 
 
-def _read_card_session(root: Path, manifest: dict[str, Any]) -> CardSession:
+def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | None) -> CardSession:
     rig = manifest["rig"]
+    if rig_name is not None and rig.get("name") != rig_name:
+        raise SessionError(
+            f"{root} was shot on rig '{rig.get('name')}', not '{rig_name}': calibrate a dome "
+            "from its own card session"
+        )
     steps = manifest.get("steps") or []
     if rig.get("kind") != "dome":
         raise SessionError(
@@ -191,22 +194,14 @@ def _read_card_session(root: Path, manifest: dict[str, Any]) -> CardSession:
         directions=np.array([s["actual_direction"] for s in steps], dtype=np.float64),
         leds=np.array(leds, dtype=np.intp),
         drive=np.array(drive),
-        image_names=tuple(names),
         correction=None if correction is None else tuple(float(v) for v in correction),
     )
 
 
 def _work_image(pixels: NDArray[Any]) -> NDArray[np.float32]:
     """Grey linear float32, area-averaged so its long side is at most :data:`WORK_SIZE`."""
-    grey = pixels.astype(np.float32)
-    if grey.ndim == 3:
-        grey = grey.mean(axis=2)
-    h, w = grey.shape
-    scale = WORK_SIZE / max(h, w)
-    if scale < 1.0:
-        size = (max(1, round(w * scale)), max(1, round(h * scale)))
-        grey = cv2.resize(grey, size, interpolation=cv2.INTER_AREA)
-    return grey
+    small = downsample(pixels, WORK_SIZE)
+    return (small.mean(axis=2) if small.ndim == 3 else small).astype(np.float32)
 
 
 def calibrate_dome(
@@ -264,8 +259,6 @@ def calibrate_dome(
         measured=measured,
         correction=correction,
         previous=previous,
-        shot_gains=gains.gains,
-        shot_estimated=est,
         shot_spread=float(np.sqrt(np.mean((log_gains - np.median(log_gains)) ** 2))),
     )
 

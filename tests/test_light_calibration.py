@@ -111,7 +111,6 @@ def synthetic_card(
         directions=dirs,
         leds=np.array(leds),
         drive=drive,
-        image_names=tuple(f"linear/image_{i:03d}.tif" for i in range(len(leds))),
         correction=correction,
     )
 
@@ -219,7 +218,7 @@ def test_cli_refusals_name_what_is_wrong(tmp_path: Path) -> None:
         return said(r)
 
     other = write_config(tmp_path, cfg.read_text().replace("emulated-dome-48", "other"), "o.toml")
-    assert "was shot on rig 'emulated-dome-48', but" in calibrate(rig=other)
+    assert "was shot on rig 'emulated-dome-48', not 'other'" in calibrate(rig=other)
     assert "simulated backend" in calibrate(rig=CONFIGS / "simulated_dome.toml")
     no_level = cfg.read_text().replace('profile = "default"', 'profile = "framed"')
     no_level += "\n[dome.serial.framed]\nsend_level = false\n"
