@@ -9,7 +9,8 @@ and draw). Reported: mean error per strategy and in how many draws the planner b
 homogeneous layout of the same draw; to ask whether the preview is worth taking, the same
 planner given no preview (it then plans for a level, matte surface); and the planner against one
 floor tuned for the rig instead of per scene (what a rig owner without the object's ground
-truth can do).
+truth can do); and, for the ``relight`` objective, the relighting PSNR of the homogeneous
+layout (floor tuned on PSNR), the ``normals`` plan and the ``relight`` plan.
 
 Run: ``python -m benchmarks.planner_sim_draws`` (writes its section of docs/planner.md).
 """
