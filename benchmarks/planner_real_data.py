@@ -44,6 +44,7 @@ import numpy as np
 
 from planner.make_plan import plan_with_report
 from planner.objectives import models_for
+from planner.topography import REC709
 from planner.uniform import select_uniform_leds
 from rti_rig.geometry import az_el_from_direction
 from rti_rig.lp_format import read_lp
@@ -78,7 +79,7 @@ def load(data: Path) -> tuple[DomeGeometry, np.ndarray, list[np.ndarray]]:
     dirs = np.array([e.direction for e in entries])
     names = tuple(e.name for e in entries)
     rgb8 = [cv2.cvtColor(cv2.imread(str(data / n)), cv2.COLOR_BGR2RGB) for n in names]
-    lum = np.stack([srgb_to_linear(im / 255.0) @ [0.2126, 0.7152, 0.0722] for im in rgb8])
+    lum = np.stack([srgb_to_linear(im / 255.0) @ REC709 for im in rgb8])
     return DomeGeometry(dirs, names), lum.astype(np.float32), rgb8
 
 

@@ -26,6 +26,7 @@ from benchmarks.paired import compare
 from benchmarks.planner_real_data import DOC, planned_leds, relight_model
 from benchmarks.report import write_section
 from planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
+from planner.topography import REC709
 from planner.uniform import select_uniform_leds
 from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
 from rti_rig.metrics import relight_psnr
@@ -100,7 +101,7 @@ def scene_errors(scene: str, settings: TradeoffSettings, rng: np.random.Generato
     """
     data = render_scene_data(scene, settings)
     cand = data.candidate_dirs
-    lum = data.candidate_images @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
+    lum = data.candidate_images @ REC709.astype(np.float32)
     err: dict[tuple[int, str], list[float]] = {}
     psnr: dict[tuple[int, str], list[float]] = {}
     for n in COUNTS:
@@ -122,7 +123,7 @@ def scene_errors(scene: str, settings: TradeoffSettings, rng: np.random.Generato
                 err.setdefault((n, label), []).append(
                     normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
                 )
-                if label == "signal" or label == "flat":
+                if label in ("signal", "flat"):  # normal-error comparisons only
                     continue
                 rest = np.setdiff1d(np.arange(len(cand)), idx)
                 mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
