@@ -62,11 +62,15 @@ FLOORS = (0.0, 10.0, 20.0, 30.0, 40.0)
 #: homogeneous layout, so their spread is the luck of the layout's arbitrary orientation.
 OFFSETS = tuple(float(a) for a in range(0, 360, 30))
 PREVIEWS = 8
+#: (label, method, objective, preview light given, material declared)
 PLANNED = (
-    ("kmeans (paper)", "kmeans", "normals", True),
-    ("optimal, normals", "optimal", "normals", True),
-    ("optimal, relight", "optimal", "relight", True),
-    ("optimal, normals, light estimated", "optimal", "normals", False),
+    ("kmeans (paper)", "kmeans", "normals", True, "auto"),
+    ("optimal, normals", "optimal", "normals", True, "auto"),
+    ("optimal, relight", "optimal", "relight", True, "auto"),
+    ("optimal, normals, light estimated", "optimal", "normals", False, "auto"),
+    # the icon is gilded: what its owner would declare (planner.objectives.MATERIALS)
+    ("optimal, normals, declared glossy", "optimal", "normals", True, "glossy"),
+    ("optimal, relight, declared glossy", "optimal", "relight", True, "glossy"),
 )
 
 
@@ -143,10 +147,18 @@ def planned_leds(
     light: tuple[float, float] | None,
     signal_noise: float = 0.0,
     objective: str = "normals",
+    material: str = "auto",
 ) -> np.ndarray:
     """The ``optimal`` plan's LED indices into ``geometry`` (both draw benchmarks use it)."""
     sched, _ = plan_with_report(
-        preview, geometry, n, "optimal", objective, light, signal_noise=signal_noise
+        preview,
+        geometry,
+        n,
+        "optimal",
+        objective,
+        light,
+        signal_noise=signal_noise,
+        material=material,
     )
     return np.array([s.led for s in sched.steps])
 
@@ -297,12 +309,14 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
             f"shipped orientation (floor 0°) ranks {rank} of {len(OFFSETS)}"
         )
         shipped_rank[n] = rank
-        for label, method, objective, given in PLANNED:
+        for label, method, objective, given, material in PLANNED:
             errs, psnrs, secs, fbs, predicted = [], [], [], 0, []
             for p in previews:
                 light = (float(az[p]), float(el[p])) if given else None
                 ts = time.perf_counter()
-                sched, rep = plan_with_report(rgb8[p], dome, n, method, objective, light)
+                sched, rep = plan_with_report(
+                    rgb8[p], dome, n, method, objective, light, material=material
+                )
                 secs.append(time.perf_counter() - ts)
                 if rep.start_layout in rep.expected and "optimal" in rep.expected:
                     predicted.append(1.0 - rep.expected["optimal"] / rep.expected[rep.start_layout])

@@ -14,8 +14,10 @@ spans 3.1–6.0° at 12 lights (``benchmarks.planner_real_data``). This benchmar
   (no turn), ``uniform`` turned by a random azimuth (an object placed at an arbitrary
   orientation), the ``optimal`` planner for each objective, the same planner told that the
   noise grows with the signal (``--signal-noise 0.05``: this dome's images are 8-bit JPEGs and
-  its LEDs' intensities are not calibrated), and the same planner given no preview, which
-  plans for a level, matte surface (is the preview worth taking?).
+  its LEDs' intensities are not calibrated), the same planner told that the object is glossy
+  (``--material glossy``: the icon is gilded, which its owner knows and one preview does not
+  show), and the same planner given no preview, which plans for a level, matte surface (is
+  the preview worth taking?).
 
 The homogeneous floor is tuned with hindsight (the floor with the lowest mean error over the
 draws, per N). Reported per N: mean, median and 90th percentile of the normal error, mean
@@ -95,6 +97,9 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
             # 8-bit JPEGs, its LEDs' intensities uncalibrated)
             noisy = planned_leds(rgb8[p], sub, n, light, SIGNAL_NOISE_JPEG_DOME)
             score("optimal signal", keep[noisy])
+            # the same planner told what the icon's owner knows: it is gilded
+            glossy = planned_leds(rgb8[p], sub, n, light, material="glossy")
+            score("optimal glossy", keep[glossy])
             # the same planner told nothing about the object: is the preview worth taking?
             score("optimal flat", keep[planned_leds(None, sub, n, None)])
         tuned = {
@@ -119,6 +124,7 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
                 "optimal signal",
             )
         )
+        show.append(("optimal, normals, --material glossy", "optimal glossy"))
         show.append(("optimal, normals, flat prior (no preview)", "optimal flat"))
         worth.append(
             f"| {n} | {np.mean(err['optimal flat']):.2f} | {np.mean(err['optimal normals']):.2f} "

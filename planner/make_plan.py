@@ -37,12 +37,15 @@ from planner.normals import (
     sanitize_height,
 )
 from planner.objectives import (
+    GLOSSY_SPECULAR,
+    GLOSSY_WIDTH_DEG,
     HELD_OUT,
     OBJECTIVES,
     Candidates,
     SurfaceSample,
     candidates_for,
     cast_shadow_visibility,
+    check_material,
     check_signal_noise,
     make_objective,
 )
@@ -119,6 +122,7 @@ class PlanReport:
     highlight_hint: float | None = None
     nonfinite_relief_repaired: int = 0
     signal_noise: float = 0.0
+    material: str = "auto"
     model: str | None = None
     expected: dict[str, float] = field(default_factory=dict)
     expected_meaning: str | None = None
@@ -255,8 +259,14 @@ def sample_surface(
     held_out: NDArray[np.float64],
     n_pixels: int = SAMPLE_PIXELS,
     seed: int = 0,
+    material: str = "auto",
 ) -> SurfaceSample:
-    """A seeded pixel sample with cast-shadow maps for the candidates and held-out lights."""
+    """A seeded pixel sample with cast-shadow maps for the candidates and held-out lights.
+
+    ``material`` (:data:`planner.objectives.MATERIALS`) sets the highlight model: ``auto``
+    from the preview's bright outliers, ``matte`` none, ``glossy`` the declared lobe.
+    """
+    check_material(material)
     h, w = surface.image.shape
     rng = np.random.default_rng(seed)
     count = min(n_pixels, h * w)
@@ -265,7 +275,13 @@ def sample_surface(
     normals = surface.normals.reshape(-1, 3)[flat]
     lit_c = cast_shadow_visibility(surface.relief_px, rows, cols, candidates.directions)
     lit_t = cast_shadow_visibility(surface.relief_px, rows, cols, held_out)
-    specular = float(np.clip(10.0 * (surface.fit.bright_outliers - 0.005), 0.0, 0.8))
+    width = None
+    if material == "glossy":
+        specular, width = GLOSSY_SPECULAR, GLOSSY_WIDTH_DEG
+    elif material == "matte":
+        specular = 0.0
+    else:
+        specular = float(np.clip(10.0 * (surface.fit.bright_outliers - 0.005), 0.0, 0.8))
     normals, weights = hedge_global_tilt(normals)
     copies = len(normals) // count
     return SurfaceSample(
@@ -275,6 +291,7 @@ def sample_surface(
         held_out,
         np.tile(lit_t, (copies, 1)),
         specular,
+        highlight_width_deg=width,
         base_count=count,
     )
 
@@ -392,8 +409,14 @@ def plan_with_report(
     arm_order: ArmOrder | None = None,
     seed: int = 0,
     signal_noise: float = 0.0,
+    material: str = "auto",
 ) -> tuple[LightSchedule, PlanReport]:
     """The schedule and the evidence behind it; see :func:`make_plan`.
+
+    ``material``: what the user knows of the surface (:data:`planner.objectives.MATERIALS`):
+    ``auto`` (default) reads highlights from the preview, ``matte`` models none, ``glossy``
+    (polished metal, gilding, varnish) models a strong, broad highlight lobe even when the
+    preview does not show one — on a flat glossy object it never does (docs/planner.md).
 
     ``signal_noise``: image noise proportional to the signal, relative to it (0.05 = 5 %), for
     the ``normals`` objective — an uncalibrated dome's LED spread and 8-bit JPEG captures
@@ -416,6 +439,7 @@ def plan_with_report(
             arm_order,
             seed,
             signal_noise,
+            material,
         )
 
 
@@ -432,6 +456,7 @@ def _plan(
     arm_order: ArmOrder | None,
     seed: int,
     signal_noise: float = 0.0,
+    material: str = "auto",
 ) -> tuple[LightSchedule, PlanReport]:
     t0 = time.perf_counter()
     if method not in METHODS:
@@ -441,6 +466,7 @@ def _plan(
     if n < 1:
         raise ScheduleError(f"--lights must be at least 1, got {n}")
     check_signal_noise(signal_noise, objective)
+    check_material(material)
     floors = [min_elevation_deg] + [f for f in START_FLOORS_DEG if f > min_elevation_deg]
     uniforms, uniform_error = _uniform_layouts(geometry, n, floors)
     if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
@@ -454,7 +480,9 @@ def _plan(
         starts.append((u[0], _to_candidate_indices(u, candidates, offset)))
         offset += len(u[1])
     rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
-    report = PlanReport(method, objective, n, rig, len(candidates), min_elevation_deg)
+    report = PlanReport(
+        method, objective, n, rig, len(candidates), min_elevation_deg, material=material
+    )
     prov: dict[str, Any] = {"n": n, "min_elevation_deg": min_elevation_deg, "objective": objective}
 
     if method == "kmeans" and preview is None:
@@ -472,9 +500,10 @@ def _plan(
         )
     if preview is None and method == "optimal":
         surface = flat_surface()
+        kind = "glossy" if material == "glossy" else "matte"
         report.notes.append(
-            "no preview: planned for a level, matte surface (the model alone; on the benchmarks "
-            "in docs/planner.md this did as well as planning from a preview)"
+            f"no preview: planned for a level, {kind} surface (the model alone; on the "
+            "benchmarks in docs/planner.md this did as well as planning from a preview)"
         )
     elif preview is not None:
         try:
@@ -514,7 +543,7 @@ def _plan(
         _, cel = az_el_from_direction(candidates.directions)
         lo, hi = float(cel.min()), float(cel.max())
         held_out = fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)
-        sample = sample_surface(surface, candidates, held_out, seed=seed)
+        sample = sample_surface(surface, candidates, held_out, seed=seed, material=material)
         if method == "kmeans":
             # the paper clusters the depth gradient's normals as they come: no shrinkage
             raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
@@ -533,6 +562,20 @@ def _plan(
                 f"--signal-noise changes only the expected errors reported here, not the "
                 f"lights {method} chooses"
             )
+        if material == "glossy":
+            report.notes.append(
+                f"declared glossy: highlights modelled as a {GLOSSY_WIDTH_DEG:g}° lobe of "
+                f"strength {GLOSSY_SPECULAR:g} around the mirror direction, whatever the preview "
+                "shows"
+                + (
+                    ""
+                    if method == "optimal" and n >= MIN_LIGHTS_FOR_EXCHANGE
+                    else f" (it changes only the expected errors reported here, not the lights "
+                    f"{method} chooses)"
+                )
+            )
+        elif material == "matte":
+            report.notes.append("declared matte: no highlight modelled, whatever the preview shows")
         report.model = getattr(obj, "model", "lambert (photometric stereo)")
         report.expected_meaning = (
             "expected RMS normal error (degrees)"
@@ -563,6 +606,10 @@ def _plan(
             report.expected[starts[0][0]] = obj.cost(starts[0][1])
             if method == "kmeans":
                 report.expected["kmeans"] = obj.cost(chosen)
+    if surface is None and material != "auto":
+        report.notes.append(
+            f"--material {material} is not used: no surface was modelled ({method} needs none)"
+        )
     report.seconds = time.perf_counter() - t0
     prov["report"] = report.to_dict()
     schedule = _schedule(geometry, candidates, chosen, method, prov, arm_order)
@@ -579,6 +626,7 @@ def make_plan(
     depth_model: Path | None = None,
     min_elevation_deg: float = 0.0,
     signal_noise: float = 0.0,
+    material: str = "auto",
 ) -> LightSchedule:
     """An ordered schedule of ``n`` lights for ``geometry`` planned from one preview.
 
@@ -590,4 +638,4 @@ def make_plan(
     ``schedule.provenance["report"]`` (or use :func:`plan_with_report`).
     """
     args = (preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg)
-    return plan_with_report(*args, signal_noise=signal_noise)[0]
+    return plan_with_report(*args, signal_noise=signal_noise, material=material)[0]

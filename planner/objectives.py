@@ -53,6 +53,26 @@ BIAS_REL = 0.05
 #: among 2, 5 and 10 % on the real dome's paired draws (docs/planner.md), not derived.
 SIGNAL_NOISE_JPEG_DOME = 0.05
 
+#: What the user may declare about the object's surface (``material`` of the planner):
+#: ``auto`` reads the highlight strength from the preview's bright outliers (the default),
+#: ``matte`` models no highlight, ``glossy`` models a strong, broad one whatever the preview
+#: shows. One preview of a flat glossy object does not show its gloss (the gilded icon of
+#: docs/planner.md reads ≈ 0), but its owner knows it.
+MATERIALS: tuple[str, ...] = ("auto", "matte", "glossy")
+
+#: Highlight lobe widths (degrees between the half vector and the normal) the preview's hint
+#: is modelled with: the light weights of the normals objective and the reflectance of the
+#: relight objective.
+HIGHLIGHT_WEIGHT_WIDTH_DEG = 15.0
+HIGHLIGHT_MODEL_WIDTH_DEG = 10.0
+
+#: A declared glossy surface: the hint's ceiling strength on a 30° lobe. Chosen (among
+#: 0.5 on 25° and 0.8 on 30°) on the simulator's polished coin, then checked on the real
+#: gilded dome's paired draws, where both lowered the normal error at every N
+#: (docs/planner.md); not tuned on the real dome.
+GLOSSY_SPECULAR = 0.8
+GLOSSY_WIDTH_DEG = 30.0
+
 #: Sampled normals used for the bias term (it varies smoothly with the normal).
 BIAS_PIXELS = 128
 
@@ -143,6 +163,9 @@ class SurfaceSample:
     held_out: NDArray[np.float64]
     lit_held_out: NDArray[np.float64]
     specular: float = 0.0
+    #: highlight lobe width (degrees) for both the light weights and the modelled reflectance;
+    #: None keeps :data:`HIGHLIGHT_WEIGHT_WIDTH_DEG` / :data:`HIGHLIGHT_MODEL_WIDTH_DEG`
+    highlight_width_deg: float | None = None
     #: how many leading rows are the estimated surface itself (the rest: hedge copies of it,
     #: :func:`planner.make_plan.hedge_global_tilt`); None means every row
     base_count: int | None = None
@@ -199,7 +222,8 @@ def light_weights(sample: SurfaceSample, directions: NDArray[np.float64]) -> NDA
     """Per-pixel, per-light usefulness for the normal fit (P, K) — see module notes."""
     w = _attached(sample.normals, directions) * sample.lit_candidates
     if sample.specular > 0:
-        w = w * (1.0 - sample.specular * _highlight(sample.normals, directions, 15.0))
+        width = sample.highlight_width_deg or HIGHLIGHT_WEIGHT_WIDTH_DEG
+        w = w * (1.0 - sample.specular * _highlight(sample.normals, directions, width))
     return w
 
 
@@ -210,7 +234,8 @@ def reflectance(
     cos = np.clip(sample.normals @ directions.T, 0.0, None)
     f = cos * lit
     if sample.specular > 0:
-        f = f + sample.specular * _highlight(sample.normals, directions, 10.0) * lit * (cos > 0)
+        width = sample.highlight_width_deg or HIGHLIGHT_MODEL_WIDTH_DEG
+        f = f + sample.specular * _highlight(sample.normals, directions, width) * lit * (cos > 0)
     return f
 
 
@@ -468,6 +493,15 @@ def check_signal_noise(signal_noise: float, objective: str) -> None:
         raise ScheduleError(
             f"--signal-noise is modelled by the normals objective only; drop it for --objective "
             f"{objective}"
+        )
+
+
+def check_material(material: str) -> None:
+    """Refuse a surface declaration the planner does not model."""
+    if material not in MATERIALS:
+        raise ScheduleError(
+            f"--material {material!r} is not known; choose {', '.join(MATERIALS)} (glossy: "
+            "polished metal, gilding, varnish)"
         )
 
 

@@ -412,6 +412,15 @@ def plan(
             "[camera] signal_noise (0 if absent, and for a bare .lp).",
         ),
     ] = None,
+    material: Annotated[
+        str,
+        typer.Option(
+            "--material",
+            help="What you know of the surface: auto (highlights read from the preview; "
+            "default), matte, or glossy (polished metal, gilding, varnish: one preview of a "
+            "flat glossy object does not show its gloss; docs/planner.md).",
+        ),
+    ] = "auto",
     out_file: Annotated[Path, typer.Option("--out", help="Plan file to write (.lp).")] = Path(
         "plan.lp"
     ),
@@ -428,7 +437,7 @@ def plan(
     directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.
     """
     from planner.make_plan import DEFAULT_OBJECTIVE, METHODS, plan_with_report
-    from planner.objectives import OBJECTIVES, check_signal_noise
+    from planner.objectives import OBJECTIVES, check_material, check_signal_noise
     from planner.topography import read_preview
     from rti_rig.compose import arm_order_for
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
@@ -448,6 +457,7 @@ def plan(
             )
         if signal_noise is not None:
             check_signal_noise(signal_noise, objective)
+        check_material(material)
         if method == "kmeans" and preview is None:
             raise RtiRigError(
                 "--method kmeans clusters the preview's normals: give PREVIEW (or use "
@@ -498,6 +508,7 @@ def plan(
             min_elevation_deg=min_elevation_deg,
             arm_order=arm_order,
             signal_noise=signal_noise or 0.0,
+            material=material,
         )
         if bare_lp:
             names = [s.label for s in schedule.steps]
