@@ -66,10 +66,9 @@ MATERIALS: tuple[str, ...] = ("auto", "matte", "glossy")
 HIGHLIGHT_WEIGHT_WIDTH_DEG = 15.0
 HIGHLIGHT_MODEL_WIDTH_DEG = 10.0
 
-#: A declared glossy surface: the hint's ceiling strength on a 30° lobe. Chosen (among
-#: 0.5 on 25° and 0.8 on 30°) on the simulator's polished coin, then checked on the real
-#: gilded dome's paired draws, where both lowered the normal error at every N
-#: (docs/planner.md); not tuned on the real dome.
+#: A declared glossy surface: the hint's ceiling strength on a 30° lobe. Chosen between 0.5 on
+#: 25° and 0.8 on 30° on the simulator's polished coin and an ad hoc run of the real gilded
+#: dome's paired draws, where both lowered the normal error at every N (docs/planner.md).
 GLOSSY_SPECULAR = 0.8
 GLOSSY_WIDTH_DEG = 30.0
 
