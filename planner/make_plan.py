@@ -525,7 +525,7 @@ def _plan(
                 f"the preview is only {report.preview_shape[1]}×{report.preview_shape[0]} px: "
                 "too small to show relief or the light's direction reliably, so this plan rests "
                 "on very little evidence (give a larger preview, or none for the plan of a "
-                "level, matte surface)"
+                "level surface)"
             )
         report.preview_light_az_el_deg = (float(az), float(el))
         report.preview_light_source = surface.light_source
@@ -562,20 +562,20 @@ def _plan(
                 f"--signal-noise changes only the expected errors reported here, not the "
                 f"lights {method} chooses"
             )
-        if material == "glossy":
-            report.notes.append(
-                f"declared glossy: highlights modelled as a {GLOSSY_WIDTH_DEG:g}° lobe of "
-                f"strength {GLOSSY_SPECULAR:g} around the mirror direction, whatever the preview "
-                "shows"
-                + (
-                    ""
-                    if method == "optimal" and n >= MIN_LIGHTS_FOR_EXCHANGE
-                    else f" (it changes only the expected errors reported here, not the lights "
-                    f"{method} chooses)"
-                )
+        if material != "auto":
+            unused = (
+                ""
+                if method == "optimal" and n >= MIN_LIGHTS_FOR_EXCHANGE
+                else f" (it changes only the expected errors reported here, not the lights "
+                f"{method} chooses)"
             )
-        elif material == "matte":
-            report.notes.append("declared matte: no highlight modelled, whatever the preview shows")
+            what = (
+                f"highlights modelled as a {GLOSSY_WIDTH_DEG:g}° lobe of strength "
+                f"{GLOSSY_SPECULAR:g} around the mirror direction"
+                if material == "glossy"
+                else "no highlight modelled"
+            )
+            report.notes.append(f"declared {material}: {what}, whatever the preview shows{unused}")
         report.model = getattr(obj, "model", "lambert (photometric stereo)")
         report.expected_meaning = (
             "expected RMS normal error (degrees)"

@@ -153,7 +153,8 @@ class SurfaceSample:
 
     ``lit_candidates[p, k]`` / ``lit_held_out[p, t]`` are 1 where light k / t reaches pixel p
     without a cast shadow (from the preview's relief) and 0 where it is blocked;
-    ``specular`` (0..1) is the strength of the highlight lobe suggested by the preview.
+    ``specular`` (0..1) is the strength of the highlight lobe, from the preview's hint or the
+    user's declared material (``planner.make_plan.sample_surface``).
     """
 
     normals: NDArray[np.float64]

@@ -354,7 +354,8 @@ def plan(
         typer.Argument(
             help="One preview image of the object (8-bit JPEG/PNG/TIFF = sRGB, 16-bit "
             "PNG/TIFF = linear, as 'rti-rig run' writes them). "
-            "Needed by 'kmeans'; without it 'optimal' plans for a level, matte surface."
+            "Needed by 'kmeans'; without it 'optimal' plans for a level surface (matte unless "
+            "--material glossy)."
         ),
     ] = None,
     rig: Annotated[
@@ -430,8 +431,9 @@ def plan(
 ) -> None:
     """Plan an ordered set of lights from one preview shot and write it as an .lp file.
 
-    Without PREVIEW: `uniform` (the default then) or `optimal`, which plans for a level, matte
-    surface (on the benchmarks in docs/planner.md it did as well as with a preview).
+    Without PREVIEW: `uniform` (the default then) or `optimal`, which plans for a level surface,
+    matte unless `--material glossy` (on the benchmarks in docs/planner.md it did as well as
+    with a preview).
 
     The plan's lights are the rig's own (a dome's LEDs, used once each; an arm's reachable
     directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.

@@ -7,6 +7,7 @@ anyway, and the lights it then chooses keep away from the mirror direction.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,7 @@ from planner.objectives import (
     HIGHLIGHT_WEIGHT_WIDTH_DEG,
     candidates_for,
     light_weights,
+    reflectance,
 )
 from rti_rig.cli import app
 from rti_rig.errors import ScheduleError
@@ -59,6 +61,34 @@ def test_sample_models_the_declared_surface() -> None:
     assert w_glossy[1] > 0.5 * w_auto[1]  # a low light barely does
     # the lobe is broader than the one the preview's hint is modelled with
     assert GLOSSY_WIDTH_DEG > HIGHLIGHT_WEIGHT_WIDTH_DEG
+
+
+def test_declaration_overrides_the_preview_hint() -> None:
+    """A surface whose preview showed highlights: auto models them, matte removes them, glossy
+    replaces them by the declared lobe — in the reflectance the relight objective fits too,
+    where a 30° lobe still lights a 30°-elevation light's mirror path and the hint's 10° one
+    does not."""
+    flat = flat_surface()
+    shiny = dataclasses.replace(flat, fit=dataclasses.replace(flat.fit, bright_outliers=0.05))
+    d = np.stack([direction_from_az_el(0, 90), direction_from_az_el(0, 30)])
+    cands = candidates_for(DomeGeometry(d, ("zenith", "el30")))
+    held = fibonacci_cap(16, 3.0, 88.0)
+    smp = {m: sample_surface(shiny, cands, held, material=m) for m in ("auto", "matte", "glossy")}
+    assert smp["auto"].specular == pytest.approx(0.45)  # 10 × (0.05 − 0.005)
+    assert smp["matte"].specular == 0.0
+    assert smp["glossy"].specular == GLOSSY_SPECULAR
+    level = np.array([[0.0, 0.0, 1.0]])
+    lit = np.ones((1, 2))
+    f = {
+        m: reflectance(dataclasses.replace(smp[m], normals=level), d, lit)[0]
+        for m in ("auto", "matte", "glossy")
+    }
+    lambert = d[:, 2]
+    assert f["matte"] == pytest.approx(lambert)
+    assert f["auto"][0] == pytest.approx(lambert[0] + 0.45)  # the hint's lobe at the mirror
+    assert f["auto"][1] - lambert[1] < 0.01  # 30° off the mirror: outside a 10° lobe
+    assert f["glossy"][0] == pytest.approx(lambert[0] + GLOSSY_SPECULAR)
+    assert f["glossy"][1] - lambert[1] == pytest.approx(GLOSSY_SPECULAR * np.exp(-1.0), rel=1e-6)
 
 
 def test_declared_glossy_keeps_lights_off_the_mirror_direction() -> None:
@@ -130,3 +160,7 @@ def test_cli_material(tmp_path: Path) -> None:
     r = runner.invoke(app, [*base, "--material", "shiny", "--out", str(tmp_path / "b.lp")])
     assert r.exit_code == 2 and "--material 'shiny' is not known" in " ".join(r.output.split())
     assert not (tmp_path / "b.lp").exists()
+    # refused before the rig is read: its own error, not the missing rig's
+    missing = ["plan", "--rig", str(tmp_path / "nowhere.toml"), "--material", "shiny"]
+    r = runner.invoke(app, [*missing, "--out", str(tmp_path / "c.lp")])
+    assert r.exit_code == 2 and "--material 'shiny' is not known" in " ".join(r.output.split())
