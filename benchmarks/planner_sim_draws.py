@@ -29,12 +29,7 @@ from benchmarks.report import write_section
 from planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
 from planner.topography import REC709
 from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import (
-    TradeoffSettings,
-    normal_error,
-    render_scene_data,
-    scene_camera,
-)
+from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
 from rti_rig.metrics import relight_psnr
 from rti_rig.rig_geometry import DomeGeometry
 
@@ -99,7 +94,8 @@ def scene_floor(err: dict[tuple[int, str], list[float]]) -> float:
 
 
 def scene_errors(scene: str, settings: TradeoffSettings, rng: np.random.Generator):
-    """Normal error and relighting PSNR per (N, strategy) over the paired draws of one scene.
+    """Normal error and relighting PSNR per (N, strategy) over the paired draws of one scene,
+    and the scene's material.
 
     Relighting: the basis :func:`planner.objectives.models_for` allows at N (the richest, as
     in the real-dome benchmarks), fitted on the chosen lights' luminance and relit to every
@@ -137,7 +133,7 @@ def scene_errors(scene: str, settings: TradeoffSettings, rng: np.random.Generato
                 rest = np.setdiff1d(np.arange(len(cand)), idx)
                 mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
                 psnr.setdefault((n, label), []).append(relight_psnr(mdl, lum[rest], cand[rest]))
-    return err, psnr
+    return err, psnr, data.material
 
 
 def main(seed: int = 0) -> str:
@@ -146,8 +142,9 @@ def main(seed: int = 0) -> str:
     rng = np.random.default_rng(seed)
     errors = {}
     psnrs = {}
+    materials = {}
     for scene in settings.scenes:
-        errors[scene], psnrs[scene] = scene_errors(scene, settings, rng)
+        errors[scene], psnrs[scene], materials[scene] = scene_errors(scene, settings, rng)
         print(f"{scene}: done ({time.perf_counter() - t0:.0f} s)")
         sys.stdout.flush()
     rig = rig_floor(errors)
@@ -189,9 +186,8 @@ def main(seed: int = 0) -> str:
         rows.append(f"| {scene} | {floor:g}° | " + cells(f"uniform {floor:g}", "optimal") + " |")
         signal.append(f"| {scene} | {floor:g}° | " + cells(f"uniform {floor:g}", "signal") + " |")
         worth.append(f"| {scene} | " + cells("flat", "optimal") + " |")
-        material = scene_camera(scene, settings)[0].material
         glossy.append(
-            f"| {scene} ({material}) | tuned homogeneous ({floor:g}°) → declared glossy | "
+            f"| {scene} ({materials[scene]}) | tuned homogeneous ({floor:g}°) → declared glossy | "
             + cells(f"uniform {floor:g}", "glossy")
             + " |"
         )

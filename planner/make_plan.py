@@ -281,7 +281,9 @@ def sample_surface(
     elif material == "matte":
         specular = 0.0
     else:
-        specular = float(np.clip(10.0 * (surface.fit.bright_outliers - 0.005), 0.0, 0.8))
+        # the hint's ceiling is the declared glossy strength
+        hint = 10.0 * (surface.fit.bright_outliers - 0.005)
+        specular = float(np.clip(hint, 0.0, GLOSSY_SPECULAR))
     normals, weights = hedge_global_tilt(normals)
     copies = len(normals) // count
     return SurfaceSample(

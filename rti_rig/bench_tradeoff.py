@@ -103,6 +103,7 @@ class SceneData:
     held_images: NDArray[np.float32]  # noise-free, same units
     preview: NDArray[np.float32]
     passes: tuple[str, ...] = field(default_factory=tuple)
+    material: str = ""  # the scene's own description of its surface
 
 
 def scene_camera(
@@ -164,6 +165,7 @@ def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
         held_images=np.stack([shoot(d, False) for d in held]),
         preview=shoot(preview_dir, True),
         passes=tuple(sorted(scene.passes)),
+        material=scene.material,
     )
 
 
