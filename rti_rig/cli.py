@@ -444,7 +444,7 @@ def plan(
     from rti_rig.compose import arm_order_for
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
     from rti_rig.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
-    from rti_rig.rig_geometry import DomeGeometry
+    from rti_rig.rig_geometry import DomeGeometry, coincident_leds
     from rti_rig.session import image_names
 
     rig = rig or default_config_path()
@@ -484,6 +484,14 @@ def plan(
         arm_order = None
         if loaded is None:
             entries = read_lp(rig, upper_hemisphere=True)
+            pair = coincident_leds([e.direction for e in entries])
+            if pair is not None:
+                i, j = pair
+                raise RtiRigError(
+                    f"{rig}: lights {i + 1} ({entries[i].name}) and {j + 1} "
+                    f"({entries[j].name}) give the same direction; as --rig, an .lp means a "
+                    "dome with exactly these lights, each listed once (remove the repeats)"
+                )
             geometry: object = DomeGeometry(
                 [e.direction for e in entries], tuple(e.name for e in entries)
             )

@@ -22,9 +22,9 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from drivers.dynamixel.settings import ArmSettings
 from drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.errors import ConfigError, LpFormatError
-from rti_rig.geometry import direction_from_az_el, fibonacci_cap
+from rti_rig.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.lp_format import read_lp
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 
 
 class _Strict(BaseModel):
@@ -496,10 +496,31 @@ def dome_led_directions(rig: LoadedRig) -> tuple[NDArray[np.float64], list[str]]
         except LpFormatError as exc:
             raise ConfigError(rig.path, "dome.lp_file", str(exc)) from None
         dirs = np.array([e.direction for e in entries])
+        pair = coincident_leds(dirs)
+        if pair is not None:
+            i, j = pair
+            raise ConfigError(
+                rig.path,
+                "dome.lp_file",
+                f"{lp_path}: lights {i + 1} ({entries[i].name}) and {j + 1} ({entries[j].name}) "
+                "give the same direction; a dome's calibration lists each LED once (an "
+                "acquisition's .lp may repeat a light: remove the repeats)",
+            )
         return dirs, [e.name for e in entries]  # read_lp refused lights below the plane
     if len(dirs) > 1000:
         raise ConfigError(rig.path, "dome", f"{len(dirs)} LEDs: at most 1000 are supported")
     _check_hemisphere(rig, dirs)
+    pair = coincident_leds(dirs)
+    if pair is not None:
+        i, j = pair
+        az, el = az_el_from_direction(dirs[i])
+        raise ConfigError(
+            rig.path,
+            f"dome.{dome.layout}",
+            f"LEDs {i} and {j} both point at azimuth {float(az):.1f}°, elevation "
+            f"{float(el):.1f}°: two LEDs cannot share a direction (a ring at 90° elevation "
+            "holds one LED; rings at one elevation need different azimuth offsets)",
+        )
     return dirs, [f"led_{i:03d}" for i in range(len(dirs))]
 
 

@@ -19,6 +19,26 @@ from rti_rig.geometry import (
     fibonacci_cap,
 )
 
+#: Two LEDs closer than this (degrees) are one LED listed twice: a real LED is several tenths of a
+#: degree across as seen from the object, and `.lp` files resolve ~0.0001°.
+COINCIDENT_LED_DEG = 0.1
+
+
+def coincident_leds(directions: ArrayLike) -> tuple[int, int] | None:
+    """The first pair ``(i, j)``, ``i < j``, of LEDs sharing a direction, or ``None``.
+
+    Why it matters: the planner would treat such a pair as two lights and may choose both, a
+    plan cannot tell them apart when it is run, and two images of one direction add no
+    information. Callers name the file or key, since that is what the user has to fix.
+    """
+    d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    if len(d) < 2:
+        return None
+    d = d / np.linalg.norm(d, axis=1, keepdims=True)
+    close = np.triu(d @ d.T >= np.cos(np.radians(COINCIDENT_LED_DEG)), k=1)
+    pairs = np.argwhere(close)
+    return None if pairs.size == 0 else (int(pairs[0][0]), int(pairs[0][1]))
+
 
 @dataclass(frozen=True, eq=False)
 class DomeGeometry:
