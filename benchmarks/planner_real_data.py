@@ -46,7 +46,7 @@ from planner.make_plan import plan_with_report
 from planner.objectives import models_for
 from planner.topography import REC709
 from planner.uniform import select_uniform_leds
-from rti_rig.geometry import az_el_from_direction
+from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.lp_format import read_lp
 from rti_rig.metrics import angular_error_map, relight_psnr
 from rti_rig.reconstruct import ReconstructionError, fit_hsh, fit_photometric_stereo, fit_ptm
@@ -258,6 +258,7 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
     shipped_rank: dict[int, int] = {}
     typical_wins: dict[str, list[int]] = {}
     gain_rows: list[str] = []
+    light_off: dict[int, float] = {}  # preview → its estimated light's error (degrees)
     for n in NS:
         model = models_for(n)[-1]
         fixed: dict[str, np.ndarray] = {"uniform (floor 0°)": select_uniform_leds(dome, n, 0.0)}
@@ -318,6 +319,9 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
                     rgb8[p], dome, n, method, objective, light, material=material
                 )
                 secs.append(time.perf_counter() - ts)
+                if not given and rep.preview_light_az_el_deg is not None:
+                    guess = direction_from_az_el(*rep.preview_light_az_el_deg)
+                    light_off[p] = float(angle_between_deg(guess, dirs[p]))
                 if rep.start_layout in rep.expected and "optimal" in rep.expected:
                     predicted.append(1.0 - rep.expected["optimal"] / rep.expected[rep.start_layout])
                 leds = np.array([s.led for s in sched.steps])
@@ -360,7 +364,10 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
         + ", ".join(f"`{dome.names[p]}`" for p in previews)
         + "); each planned method is run once per preview. Reference = robust photometric "
         f"stereo on all 72 lights ({int(mask.sum())} masked pixels). Relighting PSNR: model "
-        "fitted on the N chosen lights, relit to the other 72 − N lights, linear luminance.",
+        "fitted on the N chosen lights, relit to the other 72 − N lights, linear luminance. "
+        'Row "light estimated": the preview\'s light estimated from the image is '
+        + ", ".join(f"{light_off[p]:.0f}°" for p in previews if p in light_off)
+        + " off the dome's recorded light (same preview order).",
         "",
         "Planned rows give the median over previews, the range, and in brackets on how many "
         "previews the plan beat *the better of the two homogeneous layouts* (naive and "

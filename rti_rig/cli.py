@@ -6,6 +6,7 @@ Every user-facing failure is an :class:`~rti_rig.errors.RtiRigError` printed as 
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 from pathlib import Path
@@ -331,8 +332,78 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
         raise typer.Exit(code=130)
 
 
-def _parse_az_el(text: str | None) -> tuple[float, float] | None:
-    """``"AZ,EL"`` in degrees → a pair; a clear error otherwise."""
+@app.command()
+def preview(
+    rig_config: Annotated[
+        Path, typer.Argument(help="Rig config TOML, e.g. rig_configs/simulated_dome.toml.")
+    ],
+    out_dir: Annotated[
+        Path, typer.Option("--out", help="New or empty folder to write the one-image session.")
+    ],
+    light: Annotated[
+        str | None,
+        typer.Option(
+            "--light",
+            help="Azimuth,elevation of the preview light in degrees (frame of the .lp files; "
+            "default 135,50: top left, in the paper's 45–60° band). A dome uses its nearest LED.",
+        ),
+    ] = None,
+    auto_exposure: Annotated[
+        bool,
+        typer.Option(
+            "--auto-exposure",
+            help="Meter first (a short test series) so the preview is not saturated.",
+        ),
+    ] = False,
+    max_saturated: Annotated[
+        float,
+        typer.Option("--max-saturated", help="Largest fraction of saturated pixels allowed."),
+    ] = 0.001,
+) -> None:
+    """Shoot the planner's preview: one image under one light, as a session of one image.
+
+    The session records the light that fired, so `rti-rig plan OUT_DIR --rig RIG ...` plans from
+    its linear image with that light (no --preview-light needed).
+    """
+    from planner.preview_shot import PREVIEW_AZ_EL_DEG, preview_schedule
+    from rti_rig.compose import build_rig
+    from rti_rig.config import load_rig_config, rig_geometry
+    from rti_rig.controller import validate_schedule
+    from rti_rig.session import SessionFolder
+
+    rig = None
+    try:
+        if not 0.0 <= max_saturated < 1.0:
+            raise RtiRigError(
+                f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
+                "e.g. 0.001 for 0.1 %"
+            )
+        az_el = _parse_az_el(light, "--light") or PREVIEW_AZ_EL_DEG
+        loaded = load_rig_config(rig_config)
+        schedule, notes = preview_schedule(rig_geometry(loaded), az_el)
+        rig = build_rig(loaded)
+        validate_schedule(rig, schedule)
+        if auto_exposure:
+            schedule = _fix_exposure(rig, schedule, max_saturated)
+        folder = SessionFolder.create(out_dir, len(schedule))
+    except RtiRigError as exc:
+        if rig is not None:
+            rig.close()
+        raise _fail(exc) from None
+    for note in notes:
+        err.print(f"[yellow]note:[/] {escape(note)}")
+    with rig:
+        _execute(rig, schedule, folder, out_dir)
+    out.print(
+        f"Plan from it: rti-rig plan {out_dir} --rig {rig_config} --lights N --out plan.lp",
+        highlight=False,
+        markup=False,
+        soft_wrap=True,
+    )
+
+
+def _parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[float, float] | None:
+    """``"AZ,EL"`` in degrees → a pair; a clear error naming ``option`` otherwise."""
     if text is None:
         return None
     parts = text.replace(" ", "").split(",")
@@ -340,10 +411,12 @@ def _parse_az_el(text: str | None) -> tuple[float, float] | None:
         az, el = (float(p) for p in parts)
     except ValueError:
         raise RtiRigError(
-            f"--preview-light {text!r}: give azimuth and elevation in degrees as AZ,EL (e.g. 45,30)"
+            f"{option} {text!r}: give azimuth and elevation in degrees as AZ,EL (e.g. 45,30)"
         ) from None
-    if not 0.0 <= el <= 90.0:
-        raise RtiRigError(f"--preview-light elevation {el:g}° is outside 0..90°")
+    if not (math.isfinite(az) and 0.0 <= el <= 90.0):
+        raise RtiRigError(
+            f"{option} {text!r}: the elevation is outside 0..90° or the azimuth is not finite"
+        )
     return az, el
 
 
@@ -353,7 +426,8 @@ def plan(
         Path | None,
         typer.Argument(
             help="One preview image of the object (8-bit JPEG/PNG/TIFF = sRGB, 16-bit "
-            "PNG/TIFF = linear, as 'rti-rig run' writes them). "
+            "PNG/TIFF = linear, as 'rti-rig run' writes them), or the session folder "
+            "'rti-rig preview' wrote. "
             "Needed by 'kmeans'; without it 'optimal' plans for a level surface (matte unless "
             "--material glossy)."
         ),
@@ -388,8 +462,9 @@ def plan(
         str | None,
         typer.Option(
             "--preview-light",
-            help="Azimuth,elevation of the preview's light in degrees (frame of the .lp files); "
-            "estimated from the image when omitted.",
+            help="Azimuth,elevation of the preview's light in degrees (frame of the .lp files). "
+            "When omitted: the light a preview session recorded, or the one an .lp beside the "
+            "image lists for it, else estimated from the image.",
         ),
     ] = None,
     depth_model: Annotated[
@@ -444,6 +519,7 @@ def plan(
     from rti_rig.compose import arm_order_for
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
     from rti_rig.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
+    from rti_rig.preview_source import resolve_preview
     from rti_rig.rig_geometry import DomeGeometry, coincident_leds
     from rti_rig.session import image_names
 
@@ -506,7 +582,12 @@ def plan(
                         f"normals objective only; give --signal-noise 0 to plan for "
                         f"--objective {objective}"
                     )
-        image = read_preview(preview) if preview is not None else None
+        image, light_note = None, None
+        if preview is not None:
+            source = resolve_preview(preview)
+            if az_el is None and source.light_az_el_deg is not None:
+                az_el, light_note = source.light_az_el_deg, source.light_source
+            image = read_preview(source.image)
         schedule, report = plan_with_report(
             image,
             geometry,  # type: ignore[arg-type]
@@ -520,6 +601,8 @@ def plan(
             signal_noise=signal_noise or 0.0,
             material=material,
         )
+        if light_note and report.preview_light_source == "given":
+            report.preview_light_source = light_note
         if bare_lp:
             names = [s.label for s in schedule.steps]
         else:

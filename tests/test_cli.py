@@ -256,27 +256,17 @@ def test_preview_shot_then_plan_then_run(tmp_path: Path) -> None:
     """The product's loop: one preview shot on the rig, a plan from it, the session."""
     cfg = write_config(tmp_path, SMALL_DOME)
     shot = tmp_path / "preview"
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(shot), "--lights", "1"])
+    r = runner.invoke(app, ["preview", str(cfg), "--out", str(shot)])
     assert r.exit_code == 0, r.output
-    preview_light = read_lp(shot / "lights.lp")[0].direction
-    az, el = az_el_from_direction(preview_light)
+    assert f"rti-rig plan {shot} --rig {cfg}" in r.output
+    az, el = az_el_from_direction(read_lp(shot / "lights.lp")[0].direction)
+    # the small dome's LED at the default preview light (135°, 50°)
+    assert (round(float(az)), round(float(el))) == (135, 50)
     plan = tmp_path / "plan.lp"
-    r = runner.invoke(
-        app,
-        [
-            "plan",
-            str(shot / "linear" / "image_001.tif"),
-            "--rig",
-            str(cfg),
-            "--lights",
-            "6",
-            "--preview-light",
-            f"{float(az)},{float(el)}",
-            "--out",
-            str(plan),
-        ],
-    )
+    args = ["plan", str(shot), "--rig", str(cfg), "--lights", "6", "--out", str(plan)]
+    r = runner.invoke(app, args)
     assert r.exit_code == 0, r.output
+    assert "az 135.0°, el 50.0° (recorded by the session preview)" in r.output
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--plan", str(plan)])
     assert r.exit_code == 0, r.output
