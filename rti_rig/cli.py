@@ -89,6 +89,37 @@ def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
     return cfg.arm.default_lights
 
 
+def _check_max_saturated(max_saturated: float) -> None:
+    if not 0.0 <= max_saturated < 1.0:
+        raise RtiRigError(
+            f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
+            "e.g. 0.001 for 0.1 %"
+        )
+
+
+def _open_new_session(  # type: ignore[no-untyped-def]
+    loaded, schedule, out_dir: Path, auto_exposure: bool, max_saturated: float
+):
+    """Build the rig, check the schedule before anything moves, meter if asked, make the folder.
+
+    The rig is closed (lights off, arm stopped) if any of it fails, whatever the exception.
+    """
+    from rti_rig.compose import build_rig
+    from rti_rig.controller import validate_schedule
+    from rti_rig.session import SessionFolder
+
+    rig = build_rig(loaded)
+    try:
+        validate_schedule(rig, schedule)
+        if auto_exposure:
+            schedule = _fix_exposure(rig, schedule, max_saturated)
+        folder = SessionFolder.create(out_dir, len(schedule))
+    except BaseException:
+        rig.close()
+        raise
+    return rig, schedule, folder
+
+
 @app.command()
 def run(
     rig_config: Annotated[
@@ -156,11 +187,7 @@ def run(
 
     rig = None
     try:
-        if not 0.0 <= max_saturated < 1.0:
-            raise RtiRigError(
-                f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
-                "e.g. 0.001 for 0.1 %"
-            )
+        _check_max_saturated(max_saturated)
         if resume is not None:
             if out_dir is not None or plan is not None or lights is not None:
                 raise RtiRigError(
@@ -203,11 +230,9 @@ def run(
                 _check_floor(min_elevation_deg)
                 n = lights if lights is not None else _default_lights(loaded, geometry)
                 schedule = plan_uniform(geometry, n, min_elevation_deg, arm_order_for(loaded))
-            rig = build_rig(loaded)
-            validate_schedule(rig, schedule)
-            if auto_exposure:
-                schedule = _fix_exposure(rig, schedule, max_saturated)
-            folder = SessionFolder.create(out_dir, len(schedule))
+            rig, schedule, folder = _open_new_session(
+                loaded, schedule, out_dir, auto_exposure, max_saturated
+            )
     except RtiRigError as exc:
         if rig is not None:
             rig.close()
@@ -366,29 +391,17 @@ def preview(
     its linear image with that light (no --preview-light needed).
     """
     from planner.preview_shot import PREVIEW_AZ_EL_DEG, preview_schedule
-    from rti_rig.compose import build_rig
     from rti_rig.config import load_rig_config, rig_geometry
-    from rti_rig.controller import validate_schedule
-    from rti_rig.session import SessionFolder
 
-    rig = None
     try:
-        if not 0.0 <= max_saturated < 1.0:
-            raise RtiRigError(
-                f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
-                "e.g. 0.001 for 0.1 %"
-            )
+        _check_max_saturated(max_saturated)
         az_el = _parse_az_el(light, "--light") or PREVIEW_AZ_EL_DEG
         loaded = load_rig_config(rig_config)
         schedule, notes = preview_schedule(rig_geometry(loaded), az_el)
-        rig = build_rig(loaded)
-        validate_schedule(rig, schedule)
-        if auto_exposure:
-            schedule = _fix_exposure(rig, schedule, max_saturated)
-        folder = SessionFolder.create(out_dir, len(schedule))
+        rig, schedule, folder = _open_new_session(
+            loaded, schedule, out_dir, auto_exposure, max_saturated
+        )
     except RtiRigError as exc:
-        if rig is not None:
-            rig.close()
         raise _fail(exc) from None
     for note in notes:
         err.print(f"[yellow]note:[/] {escape(note)}")
