@@ -404,7 +404,7 @@ def preview(
     except RtiRigError as exc:
         raise _fail(exc) from None
     for note in notes:
-        err.print(f"[yellow]note:[/] {escape(note)}")
+        err.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
     with rig:
         _execute(rig, schedule, folder, out_dir)
     out.print(

@@ -88,9 +88,10 @@ def resolve_preview(path: Path) -> PreviewSource:
                 f"{path} is a session of {len(entries)} images: give the one to plan from, e.g. "
                 f"{path / entries[0].name}"
             )
+        image = path / entries[0].name
         return PreviewSource(
-            path / entries[0].name,
-            _az_el(entries[0].direction),
+            image,
+            _lit_from_above(entries[0].direction, path / LP_NAME, image),
             f"recorded by the session {path.name}",
         )
     found = lights_listing(path) if path.is_file() else []
@@ -104,4 +105,20 @@ def resolve_preview(path: Path) -> PreviewSource:
                 f"{first_lp.name} and {lp.name} beside {path.name} give its light {off:.1f}° "
                 "apart: give the preview's light with --preview-light AZ,EL"
             )
-    return PreviewSource(path, _az_el(first), f"from {first_lp.name} beside the preview")
+    return PreviewSource(
+        path, _lit_from_above(first, first_lp, path), f"from {first_lp.name} beside the preview"
+    )
+
+
+def _lit_from_above(
+    direction: tuple[float, float, float], record: Path, image: Path
+) -> tuple[float, float]:
+    """The recorded light as (azimuth, elevation), refused if it cannot have lit the object."""
+    az_el = _az_el(direction)
+    if not az_el[1] > 0.0:
+        raise ScheduleError(
+            f"{record}: the light it lists for {image.name} is at {az_el[1]:.1f}° elevation, at "
+            "or below the object plane, so it cannot have lit the preview: fix the .lp, or give "
+            "the light with --preview-light AZ,EL"
+        )
+    return az_el

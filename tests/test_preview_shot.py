@@ -75,6 +75,12 @@ def test_light_comes_from_an_lp_beside_the_image(tmp_path: Path) -> None:
     # an unreadable .lp beside the image is not the user's input: skipped
     (tmp_path / "other.lp").write_text("1\nshot_07.jpg 0 0 zero\n")
     assert resolve_preview(img).light_source == "from acq.lp beside the preview"
+    # a recorded light below the object plane cannot have lit it: the .lp is named
+    (tmp_path / "other.lp").unlink()
+    (tmp_path / "copy.lp").unlink()
+    write_lp(tmp_path / "acq.lp", [LpEntry("shot_07.jpg", direction_from_az_el(200.0, -10.0))])
+    with pytest.raises(ScheduleError, match=r"acq.lp: the light it lists for shot_07.jpg"):
+        resolve_preview(img)
 
 
 def test_session_folders_as_previews(tmp_path: Path) -> None:
