@@ -297,6 +297,16 @@ def test_signal_noise_with_the_relight_objective_is_refused() -> None:
         plan_with_report(PREVIEW, DOME, 12, "optimal", "relight", (30.0, 50.0), signal_noise=0.05)
 
 
+def test_relight_plans_carry_the_evidence_against_them() -> None:
+    """The relight objective relit worse than the normals one on the real dome: a user who asks
+    for it is told so, and one who does not is not."""
+    _, rep = plan_with_report(PREVIEW, DOME, 12, "optimal", "relight", (30.0, 50.0))
+    assert any("--objective normals is the tested choice" in line for line in rep.lines())
+    for method, objective in (("optimal", "normals"), ("uniform", "relight")):
+        _, rep = plan_with_report(PREVIEW, DOME, 12, method, objective, (30.0, 50.0))
+        assert not any("tested choice" in line for line in rep.lines())
+
+
 def test_signal_noise_is_reported_only_where_it_was_modelled() -> None:
     """Without a preview `uniform` builds no objective: the report must not claim the noise was
     modelled. With a preview it is, but only in the expected errors: the report says so, and the
