@@ -364,10 +364,14 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
         + ", ".join(f"`{dome.names[p]}`" for p in previews)
         + "); each planned method is run once per preview. Reference = robust photometric "
         f"stereo on all 72 lights ({int(mask.sum())} masked pixels). Relighting PSNR: model "
-        "fitted on the N chosen lights, relit to the other 72 − N lights, linear luminance. "
-        'Row "light estimated": the preview\'s light estimated from the image is '
-        + ", ".join(f"{light_off[p]:.0f}°" for p in previews if p in light_off)
-        + " off the dome's recorded light (same preview order).",
+        "fitted on the N chosen lights, relit to the other 72 − N lights, linear luminance."
+        + (
+            ' Row "light estimated": the preview\'s light estimated from the image is '
+            + ", ".join(f"{light_off[p]:.0f}°" for p in previews if p in light_off)
+            + " off the dome's recorded light (same preview order)."
+            if light_off
+            else ""
+        ),
         "",
         "Planned rows give the median over previews, the range, and in brackets on how many "
         "previews the plan beat *the better of the two homogeneous layouts* (naive and "

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import shlex
 import signal
 from pathlib import Path
 from typing import Annotated, Any
@@ -97,20 +98,36 @@ def _check_max_saturated(max_saturated: float) -> None:
         )
 
 
-def _open_new_session(  # type: ignore[no-untyped-def]
-    loaded, schedule, out_dir: Path, auto_exposure: bool, max_saturated: float
-):
-    """Build the rig, check the schedule before anything moves, meter if asked, make the folder.
+def _checked_rig(loaded, schedule):  # type: ignore[no-untyped-def]
+    """The rig, opened, with ``schedule`` checked against it before anything moves.
 
-    The rig is closed (lights off, arm stopped) if any of it fails, whatever the exception.
+    The rig is closed (lights off, arm stopped) if the check fails, whatever the exception.
     """
     from rti_rig.compose import build_rig
     from rti_rig.controller import validate_schedule
-    from rti_rig.session import SessionFolder
 
     rig = build_rig(loaded)
     try:
         validate_schedule(rig, schedule)
+    except BaseException:
+        rig.close()
+        raise
+    return rig
+
+
+def _open_new_session(  # type: ignore[no-untyped-def]
+    loaded, schedule, out_dir: Path, auto_exposure: bool, max_saturated: float
+):
+    """Check the folder, open and check the rig, meter if asked, make the folder.
+
+    The folder is checked first, so nothing lights or moves for a session that could not be
+    written; the rig is closed if anything after opening it fails, whatever the exception.
+    """
+    from rti_rig.session import SessionFolder
+
+    SessionFolder.check_new(out_dir)
+    rig = _checked_rig(loaded, schedule)
+    try:
         if auto_exposure:
             schedule = _fix_exposure(rig, schedule, max_saturated)
         folder = SessionFolder.create(out_dir, len(schedule))
@@ -178,14 +195,12 @@ def run(
     """
     from planner.from_lp import schedule_from_lp
     from planner.uniform import plan_uniform
-    from rti_rig.compose import arm_order_for, build_rig
+    from rti_rig.compose import arm_order_for
     from rti_rig.config import load_rig_config, rig_geometry
-    from rti_rig.controller import validate_schedule
     from rti_rig.lp_format import read_lp
     from rti_rig.schedule import LightSchedule
     from rti_rig.session import SessionFolder
 
-    rig = None
     try:
         _check_max_saturated(max_saturated)
         if resume is not None:
@@ -204,8 +219,6 @@ def run(
                 )
             schedule = LightSchedule.from_dict(manifest["schedule"])
             out_dir = resume
-            rig = build_rig(loaded)
-            validate_schedule(rig, schedule)
             done = len(folder.done)
             out.print(
                 f"Resuming {resume}: {done} of {len(schedule)} images verified on disk"
@@ -215,6 +228,7 @@ def run(
                     else ""
                 )
             )
+            rig = _checked_rig(loaded, schedule)
         else:
             if rig_config is None or out_dir is None:
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
@@ -234,8 +248,6 @@ def run(
                 loaded, schedule, out_dir, auto_exposure, max_saturated
             )
     except RtiRigError as exc:
-        if rig is not None:
-            rig.close()
         raise _fail(exc) from None
     with rig:
         _execute(rig, schedule, folder, out_dir)
@@ -398,17 +410,18 @@ def preview(
         az_el = _parse_az_el(light, "--light") or PREVIEW_AZ_EL_DEG
         loaded = load_rig_config(rig_config)
         schedule, notes = preview_schedule(rig_geometry(loaded), az_el)
+        for note in notes:
+            err.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
         rig, schedule, folder = _open_new_session(
             loaded, schedule, out_dir, auto_exposure, max_saturated
         )
     except RtiRigError as exc:
         raise _fail(exc) from None
-    for note in notes:
-        err.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
     with rig:
         _execute(rig, schedule, folder, out_dir)
     out.print(
-        f"Plan from it: rti-rig plan {out_dir} --rig {rig_config} --lights N --out plan.lp",
+        f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
+        f"{shlex.quote(str(rig_config))} --lights N --out plan.lp",
         highlight=False,
         markup=False,
         soft_wrap=True,
@@ -426,10 +439,10 @@ def _parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[flo
         raise RtiRigError(
             f"{option} {text!r}: give azimuth and elevation in degrees as AZ,EL (e.g. 45,30)"
         ) from None
-    if not (math.isfinite(az) and 0.0 <= el <= 90.0):
-        raise RtiRigError(
-            f"{option} {text!r}: the elevation is outside 0..90° or the azimuth is not finite"
-        )
+    if not math.isfinite(az):
+        raise RtiRigError(f"{option} {text!r}: the azimuth {az:g} is not a finite angle")
+    if not 0.0 <= el <= 90.0:
+        raise RtiRigError(f"{option} {text!r}: the elevation {el:g}° is outside 0..90°")
     return az, el
 
 
@@ -476,8 +489,8 @@ def plan(
         typer.Option(
             "--preview-light",
             help="Azimuth,elevation of the preview's light in degrees (frame of the .lp files). "
-            "When omitted: the light a preview session recorded, or the one an .lp beside the "
-            "image lists for it, else estimated from the image.",
+            "When omitted: the light the preview's rti-rig session recorded, or the line of "
+            "the bare .lp given as --rig that lists the image, else estimated from the image.",
         ),
     ] = None,
     depth_model: Annotated[
@@ -597,7 +610,7 @@ def plan(
                     )
         image, light_note = None, None
         if preview is not None:
-            source = resolve_preview(preview)
+            source = resolve_preview(preview, rig if bare_lp else None)
             if az_el is None and source.light_az_el_deg is not None:
                 az_el, light_note = source.light_az_el_deg, source.light_source
             image = read_preview(source.image)

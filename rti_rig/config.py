@@ -512,16 +512,27 @@ def dome_led_directions(rig: LoadedRig) -> tuple[NDArray[np.float64], list[str]]
     _check_hemisphere(rig, dirs)
     pair = coincident_leds(dirs)
     if pair is not None:
-        i, j = pair
-        az, el = az_el_from_direction(dirs[i])
+        az, el = (float(v) for v in az_el_from_direction(dirs[pair[0]]))
         raise ConfigError(
             rig.path,
             f"dome.{dome.layout}",
-            f"LEDs {i} and {j} both point at azimuth {float(az):.1f}°, elevation "
-            f"{float(el):.1f}°: two LEDs cannot share a direction (a ring at 90° elevation "
-            "holds one LED; rings at one elevation need different azimuth offsets)",
+            f"{_led_name(dome, pair[0])} and {_led_name(dome, pair[1])} both point at azimuth "
+            f"{az:.1f}°, elevation {el:.1f}°: two LEDs cannot share a direction (a ring at 90° "
+            "elevation holds one LED; rings at one elevation need different azimuth offsets)",
         )
     return dirs, [f"led_{i:03d}" for i in range(len(dirs))]
+
+
+def _led_name(dome: DomeConfig, i: int) -> str:
+    """LED ``i`` as the user wrote it: ``LED i (rings[r], its k-th)`` for rings."""
+    if dome.layout != "rings":
+        return f"LED {i}"
+    k = i
+    for r, ring in enumerate(dome.rings):
+        if k < ring.count:
+            return f"LED {i} (rings[{r}], LED {k + 1} of {ring.count})"
+        k -= ring.count
+    return f"LED {i}"
 
 
 def _check_hemisphere(rig: LoadedRig, dirs: NDArray[np.float64]) -> None:

@@ -1,31 +1,35 @@
 """Where the planner's preview image and its light come from (the CLI's edge, file reads only).
 
 A preview shot on a rig is an image *and* the light that made it; the planner reads the light's
-direction far better than it can estimate it from the image. So when the user does not give
-``--preview-light``, the light is taken from what already records it:
+direction far better than it can estimate it from the image (on the real icon of
+docs/planner.md the estimate is 17–59° off). So when the user does not give
+``--preview-light``, the light is taken from what records it, and only from that:
 
 * an rti-rig session folder holding one image (``rti-rig preview`` writes one): its linear
-  image, and the direction that actually fired, from the manifest;
-* an image with an `.lp` beside it that lists it (an rti-rig session's ``lights.lp``, a dome's
-  acquisition ``.lp``; for a session's ``linear/`` TIFF, the session's ``lights.lp`` lists the
-  JPEG of the same number).
+  image, and the direction that actually fired, from the session's manifest;
+* an image of an rti-rig session (``image_007.jpg``, or ``linear/image_007.tif``): that step's
+  direction, from the manifest;
+* an image that the bare ``.lp`` given as ``--rig`` lists (a dome's acquisition ``.lp``): its
+  line there, the user having named that file.
 
-Two `.lp` files that disagree about the light are an error, not a guess.
+Any other ``.lp`` lying beside the image is *not* read: it may be a plan (whose names look like
+a session's) or belong to another acquisition. Two records that disagree are an error.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from rti_rig.errors import RtiRigError, ScheduleError
+from rti_rig.errors import ScheduleError
 from rti_rig.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.lp_format import read_lp
-from rti_rig.session import LINEAR_DIR, LP_NAME, MANIFEST, session_lp_entries
+from rti_rig.session import LINEAR_DIR, MANIFEST, read_manifest
 
-#: `.lp` files whose directions for one image differ by more than this (degrees) disagree.
+#: Two records of one preview's light more than this far apart (degrees) disagree.
 AGREE_DEG = 0.5
 
 
@@ -38,87 +42,89 @@ class PreviewSource:
     light_source: str | None = None
 
 
-def _az_el(direction: tuple[float, float, float]) -> tuple[float, float]:
-    az, el = az_el_from_direction(np.asarray(direction, dtype=np.float64))
-    return float(az), float(el)
+def _session_root(image: Path) -> Path | None:
+    """The rti-rig session folder ``image`` belongs to (its own folder, or the one above a
+    session's ``linear/`` folder), if any."""
+    folder = image.resolve().parent
+    roots = (folder, folder.parent) if folder.name == LINEAR_DIR else (folder,)
+    return next((r for r in roots if (r / MANIFEST).is_file()), None)
 
 
-def lights_listing(image: Path) -> list[tuple[Path, tuple[float, float, float]]]:
-    """``(lp file, direction)`` for every readable `.lp` beside ``image`` that lists it.
+def _finished_steps(root: Path) -> list[dict[str, Any]]:
+    """The steps a session recorded; an error saying what to do when it recorded none."""
+    steps = read_manifest(root).get("steps") or []
+    if not steps:
+        raise ScheduleError(
+            f"{root}: the session has no finished images, so its lights are not recorded yet; "
+            f"if it was interrupted, finish it with 'rti-rig run --resume {root}' (or shoot the "
+            "preview again), or give the light with --preview-light AZ,EL"
+        )
+    return steps
 
-    An entry lists the image when its name, relative to the `.lp`'s folder, is the image file;
-    a session's ``lights.lp`` also lists the ``linear/`` TIFF of the same number. `.lp` files
-    that cannot be read are skipped: the user did not name them.
-    """
+
+def _lit_from_above(direction: Any, record: str, image: Path) -> tuple[float, float]:
+    """The recorded light as (azimuth, elevation), refused if it cannot have lit the object."""
+    az, el = (float(v) for v in az_el_from_direction(np.asarray(direction, dtype=np.float64)))
+    if not el > 0.0:
+        raise ScheduleError(
+            f"{record}: the light it gives for {image.name} is at {el:.1f}° elevation, at or "
+            "below the object plane, so it cannot have lit the preview: give the light with "
+            "--preview-light AZ,EL"
+        )
+    return az, el
+
+
+def _records(image: Path, rig_lp: Path | None) -> list[tuple[str, str, Any]]:
+    """``(where, short name, direction)`` of every record of ``image``'s light (module notes)."""
     target = image.resolve()
-    folders = [image.parent]
-    if image.parent.name == LINEAR_DIR:
-        folders.append(image.parent.parent)
     found = []
-    for folder in folders:
-        for lp in sorted(folder.glob("*.lp")):
-            try:
-                entries = read_lp(lp)
-            except RtiRigError:
-                continue
-            for e in entries:
-                named = (lp.parent / e.name).resolve()
-                same_number = (
-                    folder != image.parent
-                    and lp.name == LP_NAME
-                    and Path(e.name).stem == image.stem
+    root = _session_root(image)
+    if root is not None:
+        for step in _finished_steps(root):
+            names = (step.get("image"), step.get("linear_image"))
+            if any(n and (root / n).resolve() == target for n in names):
+                found.append(
+                    (f"the session {root}", f"the session {root.name}", step["actual_direction"])
                 )
-                if named == target or same_number:
-                    found.append((lp, e.direction))
-                    break
+                break
+    if rig_lp is not None:
+        for e in read_lp(rig_lp):
+            if (rig_lp.parent / e.name).resolve() == target:
+                found.append((str(rig_lp), rig_lp.name, e.direction))
+                break
     return found
 
 
-def resolve_preview(path: Path) -> PreviewSource:
-    """The preview image behind ``path`` (a file or a one-image session) and its light."""
+def resolve_preview(path: Path, rig_lp: Path | None = None) -> PreviewSource:
+    """The preview image behind ``path`` (a file or a one-image session) and its light.
+
+    ``rig_lp`` is the bare ``.lp`` given as ``--rig``, if it was one.
+    """
     if path.is_dir():
         if not (path / MANIFEST).is_file():
             raise ScheduleError(
                 f"{path} is a folder: give one preview image file, or a session folder from "
                 "'rti-rig preview'"
             )
-        entries = session_lp_entries(path, linear=True)
-        if len(entries) != 1:
+        steps = _finished_steps(path)
+        if len(steps) != 1:
             raise ScheduleError(
-                f"{path} is a session of {len(entries)} images: give the one to plan from, e.g. "
-                f"{path / entries[0].name}"
+                f"{path} is a session of {len(steps)} images: give the one to plan from, e.g. "
+                f"{path / steps[0]['linear_image']}"
             )
-        image = path / entries[0].name
-        return PreviewSource(
-            image,
-            _lit_from_above(entries[0].direction, path / LP_NAME, image),
-            f"recorded by the session {path.name}",
-        )
-    found = lights_listing(path) if path.is_file() else []
+        image = path / steps[0]["linear_image"]
+        where = f"the session {path.resolve().name}"
+        light = _lit_from_above(steps[0]["actual_direction"], where, image)
+        return PreviewSource(image, light, f"recorded by {where}")
+    found = _records(path, rig_lp) if path.is_file() else []
     if not found:
         return PreviewSource(path)
-    first_lp, first = found[0]
-    for lp, d in found[1:]:
+    (first_where, short, first), *others = found
+    for where, _, d in others:
         off = float(angle_between_deg(np.asarray(first), np.asarray(d)))
         if off > AGREE_DEG:
             raise ScheduleError(
-                f"{first_lp.name} and {lp.name} beside {path.name} give its light {off:.1f}° "
-                "apart: give the preview's light with --preview-light AZ,EL"
+                f"{first_where} and {where} give the light of {path} {off:.1f}° apart: give "
+                "it with --preview-light AZ,EL"
             )
-    return PreviewSource(
-        path, _lit_from_above(first, first_lp, path), f"from {first_lp.name} beside the preview"
-    )
-
-
-def _lit_from_above(
-    direction: tuple[float, float, float], record: Path, image: Path
-) -> tuple[float, float]:
-    """The recorded light as (azimuth, elevation), refused if it cannot have lit the object."""
-    az_el = _az_el(direction)
-    if not az_el[1] > 0.0:
-        raise ScheduleError(
-            f"{record}: the light it lists for {image.name} is at {az_el[1]:.1f}° elevation, at "
-            "or below the object plane, so it cannot have lit the preview: fix the .lp, or give "
-            "the light with --preview-light AZ,EL"
-        )
-    return az_el
+    return PreviewSource(path, _lit_from_above(first, first_where, path), f"recorded by {short}")

@@ -126,16 +126,24 @@ class SessionFolder:
         self.manifest: dict[str, Any] = {}
         self.resume: ResumeState | None = None
 
-    @classmethod
-    def create(cls, root: Path, total_steps: int) -> SessionFolder:
+    @staticmethod
+    def check_new(root: Path) -> None:
+        """Refuse a folder a new session may not be written into (checked before the rig is
+        even opened, so nothing moves or lights for a session that cannot be kept)."""
         root = Path(root)
         if root.exists() and not root.is_dir():
             raise SessionError(f"{root} exists and is not a folder: choose another --out")
         if root.exists() and any(root.iterdir()):
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "
-                "choose a new --out folder, or continue an interrupted session with --resume"
+                "choose a new --out folder, or continue an interrupted session with "
+                f"'rti-rig run --resume {root}'"
             )
+
+    @classmethod
+    def create(cls, root: Path, total_steps: int) -> SessionFolder:
+        root = Path(root)
+        cls.check_new(root)
         try:
             (root / LINEAR_DIR).mkdir(parents=True, exist_ok=True)
         except OSError as exc:

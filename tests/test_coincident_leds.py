@@ -36,10 +36,13 @@ def test_coincident_leds_finds_the_first_pair_only_within_tolerance() -> None:
 @pytest.mark.parametrize(
     ("rings", "fragment"),
     [
-        ("{ elevation_deg = 90.0, count = 2 }", "LEDs 0 and 1 both point at azimuth"),
+        (
+            "{ elevation_deg = 90.0, count = 2 }",
+            "LED 0 (rings[0], LED 1 of 2) and LED 1 (rings[0], LED 2 of 2) both point",
+        ),
         (
             "{ elevation_deg = 40.0, count = 4 }, { elevation_deg = 40.0, count = 4 }",
-            "LEDs 0 and 4 both point",
+            "LED 0 (rings[0], LED 1 of 4) and LED 4 (rings[1], LED 1 of 4) both point",
         ),
     ],
 )

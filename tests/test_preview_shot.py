@@ -6,6 +6,7 @@ image, so a light that was recorded must reach it, and a wrong or ambiguous one 
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -56,31 +57,42 @@ def test_arm_preview_goes_where_asked_or_names_the_limit() -> None:
         preview_schedule(arm, (0.0, -5.0))
 
 
-def test_light_comes_from_an_lp_beside_the_image(tmp_path: Path) -> None:
+def test_light_comes_from_the_rig_lp_listing_the_image_and_no_other_lp(tmp_path: Path) -> None:
     img = tmp_path / "shot_07.jpg"
     shutil.copy(IMAGE, img)
-    assert resolve_preview(img).light_az_el_deg is None  # nothing records it: estimated
     d = direction_from_az_el(200.0, 45.0)
-    write_lp(tmp_path / "acq.lp", [LpEntry("shot_06.jpg", (0, 0, 1)), LpEntry("shot_07.jpg", d)])
-    src = resolve_preview(img)
+    dome = tmp_path / "acq.lp"
+    write_lp(dome, [LpEntry("shot_06.jpg", (0, 0, 1)), LpEntry("shot_07.jpg", d)])
+    # an .lp beside the image is not a record of its light unless the user named it (--rig)
+    assert resolve_preview(img).light_az_el_deg is None
+    src = resolve_preview(img, dome)
     assert src.image == img
     assert _az_el(direction_from_az_el(*src.light_az_el_deg)) == (200.0, 45.0)
-    assert src.light_source == "from acq.lp beside the preview"
-    # a second .lp agreeing is fine; one disagreeing is an error naming both
-    write_lp(tmp_path / "copy.lp", [LpEntry("shot_07.jpg", d)])
-    assert resolve_preview(img).light_az_el_deg is not None
-    write_lp(tmp_path / "other.lp", [LpEntry("shot_07.jpg", direction_from_az_el(200.0, 60.0))])
-    with pytest.raises(ScheduleError, match=r"acq.lp and other.lp .* 15.0° apart"):
-        resolve_preview(img)
-    # an unreadable .lp beside the image is not the user's input: skipped
-    (tmp_path / "other.lp").write_text("1\nshot_07.jpg 0 0 zero\n")
-    assert resolve_preview(img).light_source == "from acq.lp beside the preview"
-    # a recorded light below the object plane cannot have lit it: the .lp is named
-    (tmp_path / "other.lp").unlink()
-    (tmp_path / "copy.lp").unlink()
-    write_lp(tmp_path / "acq.lp", [LpEntry("shot_07.jpg", direction_from_az_el(200.0, -10.0))])
-    with pytest.raises(ScheduleError, match=r"acq.lp: the light it lists for shot_07.jpg"):
-        resolve_preview(img)
+    assert src.light_source == "recorded by acq.lp"
+    # a rig .lp that does not list the preview says nothing about it
+    other = tmp_path / "other.lp"
+    write_lp(other, [LpEntry("shot_08.jpg", d)])
+    assert resolve_preview(img, other).light_az_el_deg is None
+    # a light below the object plane cannot have lit it: the .lp is named
+    write_lp(dome, [LpEntry("shot_07.jpg", direction_from_az_el(200.0, -10.0))])
+    with pytest.raises(ScheduleError, match=r"acq.lp: the light it gives for shot_07.jpg"):
+        resolve_preview(img, dome)
+
+
+def test_a_plan_beside_the_preview_is_never_read_as_its_light(tmp_path: Path) -> None:
+    """A plan's entries are named like a session's images: planning twice from image_001.jpg
+    with --out plan.lp beside it must not take a planned light as the preview's."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    work = tmp_path / "work"
+    work.mkdir()
+    shutil.copy(IMAGE, work / "image_001.jpg")
+    plan = work / "plan.lp"
+    args = ["plan", str(work / "image_001.jpg"), "--rig", str(cfg), "--lights", "6"]
+    for _ in range(2):
+        r = runner.invoke(app, [*args, "--out", str(plan), "--force"])
+        assert r.exit_code == 0, r.output
+        assert "(estimated" in r.output and "recorded by" not in r.output
+    assert read_lp(plan)[0].name == "image_001.jpg"  # the trap was armed
 
 
 def test_session_folders_as_previews(tmp_path: Path) -> None:
@@ -90,17 +102,48 @@ def test_session_folders_as_previews(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     src = resolve_preview(one)
     assert src.image == one / "linear" / "image_001.tif"
+    assert src.light_source == "recorded by the session one"
     fired = read_lp(one / "lights.lp")[0].direction
     assert _az_el(direction_from_az_el(*src.light_az_el_deg)) == _az_el(fired)
-    # the session's linear TIFF, given directly, finds lights.lp by its number
-    linear = resolve_preview(one / "linear" / "image_001.tif")
-    assert linear.light_az_el_deg == pytest.approx(src.light_az_el_deg)
-    two = tmp_path / "two"
-    assert runner.invoke(app, ["run", str(cfg), "--out", str(two), "--lights", "2"]).exit_code == 0
-    with pytest.raises(ScheduleError, match="session of 2 images: give the one"):
-        resolve_preview(two)
     with pytest.raises(ScheduleError, match="is a folder"):
         resolve_preview(tmp_path)
+
+
+def test_images_of_a_session_take_their_step_s_light(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    many = tmp_path / "many"
+    assert runner.invoke(app, ["run", str(cfg), "--out", str(many), "--lights", "4"]).exit_code == 0
+    with pytest.raises(ScheduleError, match="session of 4 images: give the one"):
+        resolve_preview(many)
+    lights = read_lp(many / "lights.lp")
+    for name, k in (("image_003.jpg", 2), ("linear/image_004.tif", 3)):
+        src = resolve_preview(many / name)
+        got = _az_el(direction_from_az_el(*src.light_az_el_deg))
+        assert got == _az_el(lights[k].direction)
+        assert src.light_source == "recorded by the session many"
+    # a folder called linear that is no session's records nothing
+    stray = tmp_path / "stray" / "linear"
+    stray.mkdir(parents=True)
+    shutil.copy(many / "linear" / "image_004.tif", stray / "image_004.tif")
+    write_lp(stray.parent / "lights.lp", read_lp(many / "lights.lp"))
+    assert resolve_preview(stray / "image_004.tif").light_az_el_deg is None
+    # the session's record and the rig .lp disagreeing is an error naming both
+    dome = many / "dome.lp"
+    write_lp(dome, [LpEntry("image_003.jpg", direction_from_az_el(10.0, 80.0))])
+    with pytest.raises(ScheduleError, match=r"the session .*many and .*dome.lp give the light"):
+        resolve_preview(many / "image_003.jpg", dome)
+
+
+def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    shot = tmp_path / "shot"
+    assert runner.invoke(app, ["preview", str(cfg), "--out", str(shot)]).exit_code == 0
+    manifest = json.loads((shot / "manifest.json").read_text())
+    manifest["steps"] = []  # as a run killed before it finished leaves it
+    (shot / "manifest.json").write_text(json.dumps(manifest))
+    for target in (shot, shot / "linear" / "image_001.tif"):
+        with pytest.raises(ScheduleError, match=r"no finished images.*rti-rig run --resume"):
+            resolve_preview(target)
 
 
 def test_plan_uses_the_recorded_light_unless_one_is_given(tmp_path: Path) -> None:
@@ -121,12 +164,61 @@ def test_plan_uses_the_recorded_light_unless_one_is_given(tmp_path: Path) -> Non
     assert r.exit_code == 0 and "az 300.0°, el 25.0° (given)" in r.output
 
 
-def test_preview_refuses_before_anything_moves(tmp_path: Path) -> None:
+def test_preview_refuses_before_anything_moves(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Bad options and an --out that cannot be written are refused before the rig is opened:
+    no metering series, no LED, no arm move for a session that could not be kept."""
+    import rti_rig.compose
+
+    def no_rig(*_: object) -> None:
+        raise AssertionError("the rig was opened")
+
     cfg = write_config(tmp_path, SMALL_DOME)
     out = tmp_path / "p"
-    r = runner.invoke(app, ["preview", str(cfg), "--out", str(out), "--light", "north"])
-    assert r.exit_code == 2 and "--light 'north'" in r.output
-    assert not out.exists()
     (out / "x").mkdir(parents=True)
-    r = runner.invoke(app, ["preview", str(cfg), "--out", str(out)])
-    assert r.exit_code == 2 and "not empty" in r.output
+    monkeypatch.setattr(rti_rig.compose, "build_rig", no_rig)
+    for extra in (["--light", "north"], ["--light", "10,95"], ["--auto-exposure"], []):
+        r = runner.invoke(app, ["preview", str(cfg), "--out", str(out), *extra])
+        assert r.exit_code == 2, r.output
+        assert "Exposure fixed" not in r.output
+    assert (
+        "the elevation 95° is outside 0..90°"
+        in runner.invoke(app, ["preview", str(cfg), "--out", str(out), "--light", "10,95"]).output
+    )
+    assert "not empty" in r.output and f"rti-rig run --resume {out}" in r.output
+
+
+class _FakeRig:
+    closed = False
+
+    def close(self) -> None:
+        self.closed = True
+
+
+def test_the_rig_is_closed_whatever_interrupts_the_start(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C (or any exception) between opening the rig and the session's start still turns
+    the lights off and stops the arm: the rig is closed, and the interruption goes on."""
+    import rti_rig.cli as cli
+    import rti_rig.compose
+    import rti_rig.controller
+    from rti_rig.session import SessionFolder
+
+    rig = _FakeRig()
+    monkeypatch.setattr(rti_rig.compose, "build_rig", lambda loaded: rig)
+
+    def interrupted(*_: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(rti_rig.controller, "validate_schedule", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cli._checked_rig(None, None)
+    assert rig.closed
+    rig.closed = False
+    monkeypatch.setattr(rti_rig.controller, "validate_schedule", lambda r, s: None)
+    monkeypatch.setattr(SessionFolder, "create", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cli._open_new_session(None, [], tmp_path / "new", False, 0.001)
+    assert rig.closed
