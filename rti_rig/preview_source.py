@@ -95,10 +95,14 @@ def _records(image: Path, rig_lp: Path | None) -> list[tuple[str, str, Any]]:
     return found
 
 
-def resolve_preview(path: Path, rig_lp: Path | None = None) -> PreviewSource:
+def resolve_preview(
+    path: Path, rig_lp: Path | None = None, light_given: bool = False
+) -> PreviewSource:
     """The preview image behind ``path`` (a file or a one-image session) and its light.
 
-    ``rig_lp`` is the bare ``.lp`` given as ``--rig``, if it was one.
+    ``rig_lp`` is the bare ``.lp`` given as ``--rig``, if it was one. With ``light_given``
+    (``--preview-light``) no record of a file's light is read, so an unreadable or unfinished
+    one cannot stand in the way of the light the user gave.
     """
     if path.is_dir():
         if not (path / MANIFEST).is_file():
@@ -116,7 +120,7 @@ def resolve_preview(path: Path, rig_lp: Path | None = None) -> PreviewSource:
         where = f"the session {path.resolve().name}"
         light = _lit_from_above(steps[0]["actual_direction"], where, image)
         return PreviewSource(image, light, f"recorded by {where}")
-    found = _records(path, rig_lp) if path.is_file() else []
+    found = _records(path, rig_lp) if path.is_file() and not light_given else []
     if not found:
         return PreviewSource(path)
     (first_where, short, first), *others = found

@@ -144,6 +144,12 @@ def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
     for target in (shot, shot / "linear" / "image_001.tif"):
         with pytest.raises(ScheduleError, match=r"no finished images.*rti-rig run --resume"):
             resolve_preview(target)
+    # ... unless the user gives the light: then the image file is all plan needs
+    cfg_args = ["--rig", str(cfg), "--lights", "6", "--out", str(tmp_path / "p.lp")]
+    image = str(shot / "linear" / "image_001.tif")
+    r = runner.invoke(app, ["plan", image, "--preview-light", "135,50", *cfg_args])
+    assert r.exit_code == 0, r.output
+    assert "az 135.0°, el 50.0° (given)" in r.output
 
 
 def test_plan_uses_the_recorded_light_unless_one_is_given(tmp_path: Path) -> None:
