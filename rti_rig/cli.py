@@ -382,7 +382,8 @@ def preview(
         typer.Option(
             "--light",
             help="Azimuth,elevation of the preview light in degrees (frame of the .lp files; "
-            "default 135,50: top left, in the paper's 45–60° band). A dome uses its nearest LED.",
+            "default 135,50: top left, in the paper's 45–60° band). A dome uses its nearest LED "
+            "(by default the nearest in that band, if it has LEDs there).",
         ),
     ] = None,
     auto_exposure: Annotated[
@@ -402,12 +403,12 @@ def preview(
     The session records the light that fired, so `rti-rig plan OUT_DIR --rig RIG ...` plans from
     its linear image with that light (no --preview-light needed).
     """
-    from planner.preview_shot import PREVIEW_AZ_EL_DEG, preview_schedule
+    from planner.preview_shot import preview_schedule
     from rti_rig.config import load_rig_config, rig_geometry
 
     try:
         _check_max_saturated(max_saturated)
-        az_el = _parse_az_el(light, "--light") or PREVIEW_AZ_EL_DEG
+        az_el = _parse_az_el(light, "--light")
         loaded = load_rig_config(rig_config)
         schedule, notes = preview_schedule(rig_geometry(loaded), az_el)
         for note in notes:

@@ -46,6 +46,23 @@ def test_dome_preview_uses_the_nearest_led_and_says_how_far_it_is() -> None:
     assert schedule.provenance["wanted_az_el_deg"] == [135.0, 80.0]
 
 
+def test_default_dome_preview_stays_in_the_paper_s_band_when_it_can() -> None:
+    """By default a dome's preview LED is the nearest in 45–60° elevation, even when an LED
+    outside the band is nearer; asked for a direction, the dome gives its nearest LED."""
+    az = np.array([144.0, 157.5, 112.5, 0.0])
+    el = np.array([40.0, 55.0, 55.0, 20.0])
+    dome = DomeGeometry(direction_from_az_el(az, el), ("low", "right", "left", "far"))
+    schedule, notes = preview_schedule(dome)
+    assert schedule.steps[0].label in ("right", "left")
+    assert any("the nearest in the paper's 45–60° band" in n for n in notes)
+    schedule, _ = preview_schedule(dome, PREVIEW_AZ_EL_DEG)
+    assert schedule.steps[0].label == "low"
+    # a dome with no LED in the band falls back to its nearest LED
+    schedule, notes = preview_schedule(DomeGeometry(dome.directions[[0, 3]], ("low", "far")))
+    assert schedule.steps[0].label == "low"
+    assert any("the nearest, low" in n for n in notes)
+
+
 def test_arm_preview_goes_where_asked_or_names_the_limit() -> None:
     arm = ArmGeometry(0.0, 80.0, 15.0, 0.0, 30.0)
     schedule, notes = preview_schedule(arm)
