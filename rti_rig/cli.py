@@ -611,7 +611,8 @@ def plan(
                     )
         image, light_note = None, None
         if preview is not None:
-            source = resolve_preview(preview, rig if bare_lp else None, az_el is not None)
+            rig_lp = (rig, entries) if loaded is None else None
+            source = resolve_preview(preview, rig_lp, az_el is not None)
             if az_el is None and source.light_az_el_deg is not None:
                 az_el, light_note = source.light_az_el_deg, source.light_source
             image = read_preview(source.image)

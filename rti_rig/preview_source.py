@@ -18,6 +18,7 @@ a session's) or belong to another acquisition. Two records that disagree are an 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -26,8 +27,11 @@ import numpy as np
 
 from rti_rig.errors import ScheduleError
 from rti_rig.geometry import angle_between_deg, az_el_from_direction
-from rti_rig.lp_format import read_lp
+from rti_rig.lp_format import LpEntry
 from rti_rig.session import LINEAR_DIR, MANIFEST, read_manifest
+
+#: A bare `.lp` given as ``--rig``: its path and its entries.
+RigLp = tuple[Path, Sequence[LpEntry]]
 
 #: Two records of one preview's light more than this far apart (degrees) disagree.
 AGREE_DEG = 0.5
@@ -74,7 +78,7 @@ def _lit_from_above(direction: Any, record: str, image: Path) -> tuple[float, fl
     return az, el
 
 
-def _records(image: Path, rig_lp: Path | None) -> list[tuple[str, str, Any]]:
+def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any]]:
     """``(where, short name, direction)`` of every record of ``image``'s light (module notes)."""
     target = image.resolve()
     found = []
@@ -88,19 +92,21 @@ def _records(image: Path, rig_lp: Path | None) -> list[tuple[str, str, Any]]:
                 )
                 break
     if rig_lp is not None:
-        for e in read_lp(rig_lp):
-            if (rig_lp.parent / e.name).resolve() == target:
-                found.append((str(rig_lp), rig_lp.name, e.direction))
+        lp, entries = rig_lp
+        for e in entries:
+            if (lp.parent / e.name).resolve() == target:
+                found.append((str(lp), lp.name, e.direction))
                 break
     return found
 
 
 def resolve_preview(
-    path: Path, rig_lp: Path | None = None, light_given: bool = False
+    path: Path, rig_lp: RigLp | None = None, light_given: bool = False
 ) -> PreviewSource:
     """The preview image behind ``path`` (a file or a one-image session) and its light.
 
-    ``rig_lp`` is the bare ``.lp`` given as ``--rig``, if it was one. With ``light_given``
+    ``rig_lp`` is the bare ``.lp`` given as ``--rig`` with its entries (as the caller already
+    read them), if it was one. With ``light_given``
     (``--preview-light``) no record of a file's light is read, so an unreadable or unfinished
     one cannot stand in the way of the light the user gave.
     """

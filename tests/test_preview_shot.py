@@ -82,18 +82,18 @@ def test_light_comes_from_the_rig_lp_listing_the_image_and_no_other_lp(tmp_path:
     write_lp(dome, [LpEntry("shot_06.jpg", (0, 0, 1)), LpEntry("shot_07.jpg", d)])
     # an .lp beside the image is not a record of its light unless the user named it (--rig)
     assert resolve_preview(img).light_az_el_deg is None
-    src = resolve_preview(img, dome)
+    src = resolve_preview(img, (dome, read_lp(dome)))
     assert src.image == img
     assert _az_el(direction_from_az_el(*src.light_az_el_deg)) == (200.0, 45.0)
     assert src.light_source == "recorded by acq.lp"
     # a rig .lp that does not list the preview says nothing about it
     other = tmp_path / "other.lp"
     write_lp(other, [LpEntry("shot_08.jpg", d)])
-    assert resolve_preview(img, other).light_az_el_deg is None
+    assert resolve_preview(img, (other, read_lp(other))).light_az_el_deg is None
     # a light below the object plane cannot have lit it: the .lp is named
     write_lp(dome, [LpEntry("shot_07.jpg", direction_from_az_el(200.0, -10.0))])
     with pytest.raises(ScheduleError, match=r"acq.lp: the light it gives for shot_07.jpg"):
-        resolve_preview(img, dome)
+        resolve_preview(img, (dome, read_lp(dome)))
 
 
 def test_a_plan_beside_the_preview_is_never_read_as_its_light(tmp_path: Path) -> None:
@@ -148,7 +148,7 @@ def test_images_of_a_session_take_their_step_s_light(tmp_path: Path) -> None:
     dome = many / "dome.lp"
     write_lp(dome, [LpEntry("image_003.jpg", direction_from_az_el(10.0, 80.0))])
     with pytest.raises(ScheduleError, match=r"the session .*many and .*dome.lp give the light"):
-        resolve_preview(many / "image_003.jpg", dome)
+        resolve_preview(many / "image_003.jpg", (dome, read_lp(dome)))
 
 
 def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
