@@ -39,13 +39,13 @@ COUNTS = (6, 12, 20, 30)
 FLOORS = (0.0, 10.0, 20.0, 30.0)
 
 
-def _table_head(*first: str) -> tuple[str, str]:
+def table_head(*first: str) -> tuple[str, str]:
     """Markdown header rows: the given columns, then one per light count."""
     cols = [*first, *(f"N = {n}" for n in COUNTS)]
     return "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)
 
 
-def _cell(bar: np.ndarray, plan: np.ndarray, seed: int) -> str:
+def cell(bar: np.ndarray, plan: np.ndarray, seed: int) -> str:
     """ "bar mean → plan mean (draws the plan won, verdict)"."""
     c = compare(plan, bar, seed)
     tied = f", {c.ties} tied" if c.ties else ""
@@ -179,7 +179,7 @@ def main(seed: int = 0) -> str:
 
         def cells(bar_label: str, plan_label: str, err=err) -> str:
             return " | ".join(
-                _cell(np.array(err[(n, bar_label)]), np.array(err[(n, plan_label)]), seed)
+                cell(np.array(err[(n, bar_label)]), np.array(err[(n, plan_label)]), seed)
                 for n in COUNTS
             )
 
@@ -214,7 +214,7 @@ def main(seed: int = 0) -> str:
             "agrees at p < 0.05, so 7/8 is not yet a win; else tie, noting a surely lower or "
             "higher mean; `benchmarks.paired`).",
             "",
-            *_table_head("scene", "tuned floor"),
+            *table_head("scene", "tuned floor"),
             *rows,
             "",
             f"The same, with `--signal-noise {SIGNAL_NOISE_JPEG_DOME:g}` (noise proportional to "
@@ -222,7 +222,7 @@ def main(seed: int = 0) -> str:
             "read noise on a 14-bit raw, no LED spread): tuned homogeneous → `optimal`/`normals` "
             "with it.",
             "",
-            *_table_head("scene", "tuned floor"),
+            *table_head("scene", "tuned floor"),
             *signal,
             "",
             "Declared glossy (`--material glossy`: highlights modelled as a broad lobe whatever "
@@ -232,14 +232,14 @@ def main(seed: int = 0) -> str:
             "have a specular lobe; the tilted plane and the tablet are matte, where the "
             "declaration is wrong, which shows what a wrong one costs.",
             "",
-            *_table_head("scene", "comparison"),
+            *table_head("scene", "comparison"),
             *glossy,
             "",
             "Is the preview worth taking? The same draws, `optimal`/`normals` given no "
             "preview (a level, matte surface: no information) → given the scene's preview: mean "
             "normal error (°), (draws the preview won, tied draws if any, verdict).",
             "",
-            *_table_head("scene"),
+            *table_head("scene"),
             *worth,
             "",
             f"Against one floor for the rig ({rig:g}°) instead of one per scene: a homogeneous "
@@ -248,7 +248,7 @@ def main(seed: int = 0) -> str:
             "scenes: the floor whose mean error relative to the best floor's, at each scene "
             "and N, has the lowest geometric mean. Same draws; cells as in the first table.",
             "",
-            *_table_head("scene", "plan"),
+            *table_head("scene", "plan"),
             *rig_rows,
             "",
             "Relighting (the `relight` objective's purpose), same draws: mean relighting PSNR "
@@ -259,7 +259,7 @@ def main(seed: int = 0) -> str:
             "12, HSH2 at 20, HSH3 at 30), fitted on the chosen lights and relit to the other "
             f"{240 - 6}–{240 - 30} candidates.",
             "",
-            *_table_head("scene", "PSNR-tuned floor"),
+            *table_head("scene", "PSNR-tuned floor"),
             *relight_rows,
         ]
     )

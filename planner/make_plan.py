@@ -155,9 +155,9 @@ class PlanReport:
         if self.signal_noise > 0:
             out.append(
                 f"noise modelled: {100 * self.signal_noise:g} % of the signal on top of the "
-                "additive noise (it cost on the simulator's steeply tilted flat object and "
-                "brushed steel, raw or JPEG: give --signal-noise 0 for such objects; "
-                "docs/planner.md)"
+                "additive noise (it cost on the simulator's steeply tilted flat object, and on "
+                "brushed steel from 20 lights, raw or JPEG: give --signal-noise 0 for such "
+                "objects; docs/planner.md)"
             )
         if self.expected and self.expected_meaning:
             parts = ", ".join(f"{k} {v:.4g}" for k, v in self.expected.items())

@@ -112,7 +112,9 @@ def scene_camera(
     """The benchmark's scene and a ``shoot(direction, rng)`` in units of the white level.
 
     ``rng=None`` gives the noise-free image; ``passes`` overrides the scene's render passes
-    (``benchmarks.planner_sim_losses`` renders one physical effect at a time).
+    (``benchmarks.planner_sim_losses`` renders one physical effect at a time); ``irradiance``
+    scales the light before the camera exposes, so a brighter LED saturates as it would
+    (``benchmarks.planner_sim_jpeg``'s LED spread).
     """
     from simulator.camera_model import CameraModel
     from simulator.light_transport import DirectionalLight, render_radiance
@@ -128,8 +130,10 @@ def scene_camera(
         direction: NDArray[np.float64],
         rng: np.random.Generator | None,
         passes: Iterable[str] | None = passes,
+        irradiance: float = 1.0,
     ) -> NDArray[np.float32]:
-        radiance = render_radiance(scene, DirectionalLight(tuple(direction)), passes)
+        light = DirectionalLight(tuple(direction), irradiance)
+        radiance = render_radiance(scene, light, passes)
         if rng is None:
             scale = camera.expected_electrons(radiance, exposure) * camera.dn_per_electron
             return np.clip(scale / white, 0.0, 1.0).astype(np.float32)
