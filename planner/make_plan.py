@@ -621,9 +621,10 @@ def _plan(
             if n >= MANY_LIGHTS and objective == "normals":
                 report.notes.append(
                     f"evidence at {n} lights (docs/planner.md): from {MANY_LIGHTS} lights up the "
-                    "gain over a homogeneous layout is small and depends on the object (on the "
-                    "simulator it lost on brushed steel at 20 and 30 lights); when the object "
-                    "is brushed metal or unknown, --method uniform is the safe choice"
+                    "gain over a homogeneous layout is small and depends on the object (it won "
+                    "on the real gilded dome declared glossy, and lost on the simulator's "
+                    "brushed steel at 20 and 30 lights); when the object is brushed metal or "
+                    "unknown, --method uniform is the safe choice"
                 )
         else:
             report.expected[starts[0][0]] = obj.cost(starts[0][1])
