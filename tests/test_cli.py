@@ -374,7 +374,7 @@ def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
     flat = " ".join(r.output.split())
     assert "5 % of the signal" in flat
     # where the evidence says it costs, and how to turn the rig's setting off for one plan
-    assert "brushed steel" in flat and "give --signal-noise 0" in flat
+    assert "brushed steel from 12 lights" in flat and "give --signal-noise 0" in flat
     r = runner.invoke(app, [*base, "--signal-noise", "0", "--out", str(tmp_path / "b.lp")])
     assert r.exit_code == 0, r.output
     assert "of the signal" not in r.output
