@@ -11,7 +11,7 @@ import os
 import shlex
 import signal
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -19,6 +19,11 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from rti_rig.errors import RtiRigError
+
+if TYPE_CHECKING:
+    from planner.make_plan import PlanReport
+    from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+    from rti_rig.schedule import LightSchedule
 
 app = typer.Typer(
     help=(
@@ -42,29 +47,33 @@ def _fail(exc: RtiRigError) -> typer.Exit:
     return typer.Exit(code=2)
 
 
-def _check_output_file(out_file: Path, force: bool, inputs: dict[str, Path | None]) -> None:
+def _check_output_file(
+    out_file: Path, force: bool, inputs: dict[str, Path | None], option: str = "--out"
+) -> None:
     """Refuse, before any work, an output the command could not write or should not replace.
 
     ``inputs`` names the files the command reads (``{"PREVIEW": path, ...}``): replacing one of
     them is refused even with ``--force``, as is replacing a file inside a session folder —
-    nothing already captured is ever overwritten.
+    nothing already captured is ever overwritten. ``option`` is the flag that named the file.
     """
     from rti_rig.session import MANIFEST
 
     if out_file.is_dir():
-        raise RtiRigError(f"--out {out_file} is a folder: give the name of the file to write")
+        raise RtiRigError(f"{option} {out_file} is a folder: give the name of the file to write")
     parent = out_file.parent
     if not parent.is_dir():
-        raise RtiRigError(f"--out {out_file}: folder {parent} does not exist; create it first")
+        raise RtiRigError(f"{option} {out_file}: folder {parent} does not exist; create it first")
     if not out_file.exists():
         return
     for what, path in inputs.items():
         if path is not None and path.exists() and out_file.samefile(path):
-            raise RtiRigError(f"--out {out_file} is the {what} this command reads; choose another")
+            raise RtiRigError(
+                f"{option} {out_file} is the {what} this command reads; choose another"
+            )
     for folder in out_file.resolve().parents:
         if (folder / MANIFEST).is_file():
             raise RtiRigError(
-                f"--out {out_file} would replace a file of the session in {folder}; a "
+                f"{option} {out_file} would replace a file of the session in {folder}; a "
                 "session's files are never overwritten: write it elsewhere"
             )
     if not force:
@@ -527,8 +536,16 @@ def plan(
     out_file: Annotated[Path, typer.Option("--out", help="Plan file to write (.lp).")] = Path(
         "plan.lp"
     ),
+    figure: Annotated[
+        Path | None,
+        typer.Option(
+            "--figure",
+            help="Also draw the plan as a map (.png, .svg or .pdf): the lights seen from above, "
+            "numbered in firing order, on the dome's LEDs or the arm's reach.",
+        ),
+    ] = None,
     force: Annotated[
-        bool, typer.Option("--force", help="Overwrite an existing plan file.")
+        bool, typer.Option("--force", help="Overwrite an existing plan file (and --figure).")
     ] = False,
 ) -> None:
     """Plan an ordered set of lights from one preview shot and write it as an .lp file.
@@ -546,6 +563,7 @@ def plan(
     from rti_rig.compose import arm_order_for
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
     from rti_rig.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
+    from rti_rig.plan_figure import check_figure_path
     from rti_rig.preview_source import resolve_preview
     from rti_rig.rig_geometry import DomeGeometry, coincident_leds
     from rti_rig.session import image_names
@@ -584,6 +602,11 @@ def plan(
             # the dome's LED calibration is an input too
             inputs["rig's LED calibration (lp_file)"] = loaded.folder / loaded.config.dome.lp_file
         _check_output_file(out_file, force, inputs)
+        if figure is not None:
+            check_figure_path(figure)
+            _check_output_file(figure, force, inputs, "--figure")
+            if figure.resolve() == out_file.resolve():
+                raise RtiRigError(f"--figure {figure} is the --out plan file; choose another")
         arm_order = None
         if loaded is None:
             entries = read_lp(rig, upper_hemisphere=True)
@@ -638,11 +661,45 @@ def plan(
         write_lp(
             out_file, [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)]
         )
+        if figure is not None:
+            _write_plan_figure(figure, schedule, geometry, report, f"{method}/{objective}", rig)
     except RtiRigError as exc:
         raise _fail(exc) from None
     for line in report.lines():
         out.print(line, highlight=False, markup=False)
     out.print(f"Planned {len(schedule)} lights ({method}, {objective}) → {out_file}")
+    if figure is not None:
+        out.print(f"Map of the plan → {figure}")
+
+
+def _write_plan_figure(
+    path: Path,
+    schedule: LightSchedule,
+    geometry: DomeGeometry | ArmGeometry,
+    report: PlanReport,
+    how: str,
+    rig: Path,
+) -> None:
+    """Draw the plan's map (``plan --figure``); the .lp is already written, so a failure here
+    names the map file and leaves the plan in place."""
+    from rti_rig.geometry import direction_from_az_el
+    from rti_rig.plan_figure import expected_caption, layout_figure, write_layout_figure
+
+    light = report.preview_light_az_el_deg
+    caption = expected_caption(report.expected_meaning or "expected error", report.expected)
+    fig = layout_figure(
+        [s.direction for s in schedule.steps],
+        geometry,
+        None if light is None else direction_from_az_el(*light),
+        f"{len(schedule.steps)} lights · {how} · {rig.name}",
+        [caption] if caption else [],
+    )
+    try:
+        write_layout_figure(path, fig)
+    except OSError as exc:
+        raise RtiRigError(
+            f"--figure {path}: could not write the map ({exc}); the plan itself was written"
+        ) from None
 
 
 @app.command("export-lp")

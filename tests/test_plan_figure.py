@@ -1,0 +1,119 @@
+"""The map of a light plan (rti_rig.plan_figure, `rti-rig plan --figure`).
+
+A plan is checked on this map before the rig moves, so the map must put every light where the
+frame of DESIGN.md says it is (azimuth from +x towards +y, distance from the centre = 90° −
+elevation) and number the lights in the order they fire.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.errors import RtiRigError
+from rti_rig.geometry import direction_from_az_el, fibonacci_cap
+from rti_rig.plan_figure import (
+    check_figure_path,
+    expected_caption,
+    layout_figure,
+    polar_coordinates,
+    write_layout_figure,
+)
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+
+REPO = Path(__file__).resolve().parents[1]
+DOME = DomeGeometry(fibonacci_cap(40, 5.0, 85.0), tuple(f"led{i:02d}" for i in range(40)))
+runner = CliRunner()
+
+
+def _by_gid(fig, gid: str) -> list:
+    ax = fig.axes[0]
+    return [a for a in [*ax.collections, *ax.patches] if a.get_gid() == gid]
+
+
+def test_polar_coordinates_follow_the_design_frame() -> None:
+    t, r = polar_coordinates([direction_from_az_el(30.0, 60.0), direction_from_az_el(250.0, 5.0)])
+    np.testing.assert_allclose(np.degrees(t) % 360, [30.0, 250.0], atol=1e-9)
+    np.testing.assert_allclose(r, [30.0, 85.0], atol=1e-9)
+    t, r = polar_coordinates([0.0, 0.0, 1.0])  # the zenith sits at the centre
+    assert r[0] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_dome_map_places_every_led_and_numbers_the_plan_in_firing_order() -> None:
+    order = [7, 2, 31, 18, 25]
+    fig = layout_figure(DOME.directions[order], DOME, direction_from_az_el(135.0, 50.0), "t")
+    (cands,) = _by_gid(fig, "candidates")
+    t, r = polar_coordinates(DOME.directions)
+    np.testing.assert_allclose(cands.get_offsets(), np.column_stack([t, r]))
+    (chosen,) = _by_gid(fig, "chosen")
+    t, r = polar_coordinates(DOME.directions[order])
+    np.testing.assert_allclose(chosen.get_offsets(), np.column_stack([t, r]))
+    labels = [(a.get_text(), a.get_position()) for a in fig.axes[0].texts]
+    assert [text for text, _ in labels] == ["1", "2", "3", "4", "5"]
+    np.testing.assert_allclose([pos for _, pos in labels], np.column_stack([t, r]))
+    assert "preview light" in [h.get_label() for h in fig.axes[0].collections]
+    assert not _by_gid(fig, "reach")
+    # seen from above: azimuth 0° (+x) to the right of the centre, 90° (+y) above it
+    fig.canvas.draw()
+    centre, east, north = fig.axes[0].transData.transform(
+        [(0.0, 0.0), (0.0, 45.0), (np.pi / 2, 45.0)]
+    )
+    assert east[0] > centre[0] + 10 and abs(east[1] - centre[1]) < 1
+    assert north[1] > centre[1] + 10 and abs(north[0] - centre[0]) < 1
+
+
+def test_arm_map_shades_the_reach_and_hatches_the_keep_out_cone() -> None:
+    arm = ArmGeometry(5.0, 80.0, 12.0, 0.0, 45.0, -170.0, 170.0)
+    chosen = [direction_from_az_el(a, 30.0) for a in (0.0, 90.0, 180.0 - 15.0)]
+    fig = layout_figure(chosen, arm)
+    (reach,) = _by_gid(fig, "reach")
+    verts = reach.get_paths()[0].vertices
+    assert verts[:, 1].min() == pytest.approx(10.0) and verts[:, 1].max() == pytest.approx(85.0)
+    assert np.degrees(verts[:, 0]).min() == pytest.approx(-170.0)
+    (keep,) = _by_gid(fig, "keep_out")
+    assert np.max(keep.get_xy()[:, 1]) == pytest.approx(12.0)
+    assert not _by_gid(fig, "candidates")
+
+
+def test_caption_gives_the_plan_and_its_best_starting_layout() -> None:
+    text = expected_caption("err", {"uniform ≥0°": 1.4, "uniform ≥10°": 1.3, "optimal": 1.0})
+    assert text == "err: optimal 1, best starting layout (uniform ≥10°) 1.3"
+    assert expected_caption("err", {"uniform ≥0°": 1.4}) == "err: uniform ≥0° 1.4"
+    assert expected_caption("err", {}) == ""
+
+
+def test_map_file_types(tmp_path: Path) -> None:
+    with pytest.raises(RtiRigError, match=r"\.png, \.svg, \.pdf"):
+        check_figure_path(tmp_path / "map.jpg")
+    path = write_layout_figure(tmp_path / "map.svg", layout_figure(DOME.directions[:3], DOME))
+    assert path.read_text().lstrip().startswith("<?xml")
+
+
+def test_plan_cli_writes_the_map_and_never_overwrites_unasked(tmp_path: Path) -> None:
+    rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    base = ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "9"]
+    plan, fig = tmp_path / "p.lp", tmp_path / "p.png"
+    r = runner.invoke(app, [*base, "--out", str(plan), "--figure", str(fig)])
+    assert r.exit_code == 0, r.output
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and plan.is_file()
+    assert "Map of the plan" in r.output
+    # an existing map is kept unless --force; checked before anything is planned or written
+    before = fig.read_bytes()
+    r = runner.invoke(app, [*base, "--out", str(tmp_path / "q.lp"), "--figure", str(fig)])
+    assert r.exit_code == 2 and "exists" in r.output and fig.read_bytes() == before
+    assert not (tmp_path / "q.lp").exists()
+    r = runner.invoke(
+        app, [*base, "--out", str(tmp_path / "q.lp"), "--figure", str(fig), "--force"]
+    )
+    assert r.exit_code == 0, r.output
+    # a type the map cannot be written as, or the plan file itself: refused up front
+    for bad in (tmp_path / "m.jpg", tmp_path / "r.lp"):
+        out = tmp_path / "r.lp"
+        r = runner.invoke(app, [*base, "--out", str(out), "--figure", str(bad)])
+        flat = " ".join(r.output.split())
+        assert r.exit_code == 2 and "--figure" in flat, flat
+        assert not out.exists()
