@@ -77,7 +77,7 @@ def _check_output_file(
                 "session's files are never overwritten: write it elsewhere"
             )
     if not force:
-        raise RtiRigError(f"{out_file} exists; use --force to replace it")
+        raise RtiRigError(f"{option} {out_file} exists; use --force to replace it")
 
 
 def _check_floor(min_elevation_deg: float) -> None:
@@ -563,7 +563,6 @@ def plan(
     from rti_rig.compose import arm_order_for
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
     from rti_rig.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
-    from rti_rig.plan_figure import check_figure_path
     from rti_rig.preview_source import resolve_preview
     from rti_rig.rig_geometry import DomeGeometry, coincident_leds
     from rti_rig.session import image_names
@@ -603,6 +602,8 @@ def plan(
             inputs["rig's LED calibration (lp_file)"] = loaded.folder / loaded.config.dome.lp_file
         _check_output_file(out_file, force, inputs)
         if figure is not None:
+            from rti_rig.plan_figure import check_figure_path  # matplotlib only when asked
+
             check_figure_path(figure)
             _check_output_file(figure, force, inputs, "--figure")
             if figure.resolve() == out_file.resolve():
@@ -661,14 +662,18 @@ def plan(
         write_lp(
             out_file, [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)]
         )
-        if figure is not None:
-            _write_plan_figure(figure, schedule, geometry, report, f"{method}/{objective}", rig)
     except RtiRigError as exc:
         raise _fail(exc) from None
     for line in report.lines():
         out.print(line, highlight=False, markup=False)
     out.print(f"Planned {len(schedule)} lights ({method}, {objective}) → {out_file}")
     if figure is not None:
+        # after the report: a map that cannot be drawn must not hide a plan that was written
+        how = f"{method}/{objective}"
+        try:
+            _write_plan_figure(figure, schedule, geometry, report, how, rig)  # type: ignore[arg-type]
+        except RtiRigError as exc:
+            raise _fail(exc) from None
         out.print(f"Map of the plan → {figure}")
 
 
@@ -687,16 +692,16 @@ def _write_plan_figure(
 
     light = report.preview_light_az_el_deg
     caption = expected_caption(report.expected_meaning or "expected error", report.expected)
-    fig = layout_figure(
-        [s.direction for s in schedule.steps],
-        geometry,
-        None if light is None else direction_from_az_el(*light),
-        f"{len(schedule.steps)} lights · {how} · {rig.name}",
-        [caption] if caption else [],
-    )
     try:
+        fig = layout_figure(
+            [s.direction for s in schedule.steps],
+            geometry,
+            None if light is None else direction_from_az_el(*light),
+            f"{len(schedule.steps)} lights · {how} · {rig.name}",
+            [caption] if caption else [],
+        )
         write_layout_figure(path, fig)
-    except OSError as exc:
+    except (OSError, ValueError, RuntimeError) as exc:
         raise RtiRigError(
             f"--figure {path}: could not write the map ({exc}); the plan itself was written"
         ) from None

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 
@@ -31,6 +32,27 @@ def polar_coordinates(directions: ArrayLike) -> tuple[NDArray[np.float64], NDArr
     """(angle in radians = azimuth, radius = 90° − elevation) of unit light directions."""
     az, el = az_el_from_direction(np.asarray(directions, dtype=np.float64).reshape(-1, 3))
     return np.radians(np.atleast_1d(az)), 90.0 - np.atleast_1d(el)
+
+
+def _draw_arm_reach(ax: Axes, arm: ArmGeometry) -> None:
+    """Shade the band of directions the arm may reach and hatch its keep-out cone."""
+    theta = np.radians(np.linspace(arm.min_azimuth_deg, arm.max_azimuth_deg, 181, dtype=float))
+    inner, outer = 90.0 - arm.max_elevation_deg, 90.0 - arm.min_elevation_deg
+    ax.fill_between(
+        theta, inner, outer, color="tab:green", alpha=0.12, label="arm's reach", gid="reach"
+    )
+    keep = arm.keep_out_half_angle_deg
+    if keep > 0:
+        full = np.linspace(0.0, 2 * np.pi, 181)
+        ax.fill(
+            full,
+            np.full_like(full, keep),
+            facecolor="none",
+            edgecolor="tab:red",
+            hatch="//",
+            label="keep-out cone",
+            gid="keep_out",
+        )
 
 
 def layout_figure(
@@ -58,20 +80,7 @@ def layout_figure(
         t, r = polar_coordinates(geometry.directions)
         ax.scatter(t, r, s=14, c="0.7", label=f"dome LEDs ({len(t)})", zorder=2, gid="candidates")
     else:
-        theta = np.radians(
-            np.linspace(geometry.min_azimuth_deg, geometry.max_azimuth_deg, 181, dtype=float)
-        )
-        inner, outer = 90.0 - geometry.max_elevation_deg, 90.0 - geometry.min_elevation_deg
-        ax.fill_between(
-            theta, inner, outer, color="tab:green", alpha=0.12, label="arm's reach", gid="reach"
-        )
-        keep = geometry.keep_out_half_angle_deg
-        if keep > 0:
-            full = np.linspace(0.0, 2 * np.pi, 181)
-            ax.fill(
-                full, np.full_like(full, keep), facecolor="none", edgecolor="tab:red",
-                hatch="//", label="keep-out cone", gid="keep_out",
-            )  # fmt: skip
+        _draw_arm_reach(ax, geometry)
     t, r = polar_coordinates(chosen)
     ax.plot(t, r, color="tab:blue", alpha=0.35, lw=1, zorder=3)  # the firing order
     ax.scatter(t, r, s=150, c="tab:blue", edgecolors="white", zorder=4, gid="chosen")
@@ -79,18 +88,27 @@ def layout_figure(
         ax.text(ti, ri, str(i), color="white", fontsize=7, ha="center", va="center", zorder=5)
     if preview is not None:
         pt, pr = polar_coordinates(preview)
-        ax.scatter(pt, pr, s=220, marker="*", c="tab:orange", zorder=6, label="preview light")
+        ax.scatter(
+            pt,
+            pr,
+            s=220,
+            marker="*",
+            c="tab:orange",
+            zorder=6,
+            label="preview light",
+            gid="preview",
+        )
     ax.scatter([], [], s=60, c="tab:blue", label=f"planned lights ({len(t)}), in firing order")
     fig.legend(loc="outside lower center", ncol=2, fontsize=8, frameon=False)
     if title:
-        fig.suptitle(title, fontsize=10)
+        fig.suptitle(title, fontsize=10, parse_math=False)  # a file name may hold "$"
     notes = [
         "seen from above: azimuth 0° (+x) right, 90° (+y) up; "
         "rings at 60° and 30° elevation, rim 0°",
         *caption,
     ]
     wrapped = [w for note in notes for w in textwrap.wrap(note, 110)]
-    ax.set_title("\n".join(wrapped), fontsize=7, pad=22)
+    ax.set_title("\n".join(wrapped), fontsize=7, pad=22, parse_math=False)
     return fig
 
 

@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 from rti_rig.cli import app
 from rti_rig.errors import RtiRigError
 from rti_rig.geometry import direction_from_az_el, fibonacci_cap
+from rti_rig.lp_format import read_lp
 from rti_rig.plan_figure import (
     check_figure_path,
     expected_caption,
@@ -55,7 +56,8 @@ def test_dome_map_places_every_led_and_numbers_the_plan_in_firing_order() -> Non
     labels = [(a.get_text(), a.get_position()) for a in fig.axes[0].texts]
     assert [text for text, _ in labels] == ["1", "2", "3", "4", "5"]
     np.testing.assert_allclose([pos for _, pos in labels], np.column_stack([t, r]))
-    assert "preview light" in [h.get_label() for h in fig.axes[0].collections]
+    (star,) = _by_gid(fig, "preview")
+    np.testing.assert_allclose(star.get_offsets(), [[np.radians(135.0), 40.0]], atol=1e-9)
     assert not _by_gid(fig, "reach")
     # seen from above: azimuth 0° (+x) to the right of the centre, 90° (+y) above it
     fig.canvas.draw()
@@ -66,16 +68,40 @@ def test_dome_map_places_every_led_and_numbers_the_plan_in_firing_order() -> Non
     assert north[1] > centre[1] + 10 and abs(north[0] - centre[0]) < 1
 
 
-def test_arm_map_shades_the_reach_and_hatches_the_keep_out_cone() -> None:
-    arm = ArmGeometry(5.0, 80.0, 12.0, 0.0, 45.0, -170.0, 170.0)
-    chosen = [direction_from_az_el(a, 30.0) for a in (0.0, 90.0, 180.0 - 15.0)]
+@pytest.mark.parametrize(
+    ("arm", "azimuths", "radii", "keep"),
+    [
+        (
+            ArmGeometry(5.0, 80.0, 12.0, 0.0, 45.0, -170.0, 170.0),
+            (-170.0, 170.0),
+            (10.0, 85.0),
+            12.0,
+        ),
+        (ArmGeometry(0.0, 90.0, 0.0, 0.0, 45.0), (-180.0, 180.0), (0.0, 90.0), None),
+        (
+            ArmGeometry(10.0, 60.0, 5.0, 0.0, 45.0, -180.0, -100.0),
+            (-180.0, -100.0),
+            (30.0, 80.0),
+            5.0,
+        ),
+    ],
+)
+def test_arm_map_shades_the_reach_and_hatches_the_keep_out_cone(
+    arm: ArmGeometry, azimuths: tuple, radii: tuple, keep: float | None
+) -> None:
+    chosen = [direction_from_az_el(a, 30.0) for a in (0.0, 90.0, 165.0)]
     fig = layout_figure(chosen, arm)
     (reach,) = _by_gid(fig, "reach")
     verts = reach.get_paths()[0].vertices
-    assert verts[:, 1].min() == pytest.approx(10.0) and verts[:, 1].max() == pytest.approx(85.0)
-    assert np.degrees(verts[:, 0]).min() == pytest.approx(-170.0)
-    (keep,) = _by_gid(fig, "keep_out")
-    assert np.max(keep.get_xy()[:, 1]) == pytest.approx(12.0)
+    np.testing.assert_allclose([verts[:, 1].min(), verts[:, 1].max()], radii, atol=1e-9)
+    az = np.degrees(verts[:, 0])
+    np.testing.assert_allclose([az.min(), az.max()], azimuths, atol=1e-9)
+    cones = _by_gid(fig, "keep_out")
+    if keep is None:
+        assert not cones  # no keep-out cone: nothing hatched
+    else:
+        (cone,) = cones
+        np.testing.assert_allclose(cone.get_xy()[:, 1], keep)
     assert not _by_gid(fig, "candidates")
 
 
@@ -111,9 +137,61 @@ def test_plan_cli_writes_the_map_and_never_overwrites_unasked(tmp_path: Path) ->
     )
     assert r.exit_code == 0, r.output
     # a type the map cannot be written as, or the plan file itself: refused up front
-    for bad in (tmp_path / "m.jpg", tmp_path / "r.lp"):
-        out = tmp_path / "r.lp"
+    for out, bad, why in (
+        (tmp_path / "r.lp", tmp_path / "m.jpg", "give a file ending in"),
+        (tmp_path / "r.png", tmp_path / "r.png", "is the --out plan file"),
+    ):
         r = runner.invoke(app, [*base, "--out", str(out), "--figure", str(bad)])
         flat = " ".join(r.output.split())
-        assert r.exit_code == 2 and "--figure" in flat, flat
+        assert r.exit_code == 2 and why in flat, flat
         assert not out.exists()
+
+
+def test_plan_cli_map_shows_the_lights_of_the_plan_file_in_its_order(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The map drawn is of the plan written: the same lights, in the .lp's (firing) order, and
+    the preview light the plan used."""
+    import rti_rig.plan_figure as plan_figure
+
+    drawn = []
+    monkeypatch.setattr(plan_figure, "write_layout_figure", lambda path, fig: drawn.append(fig))
+    rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    preview = REPO / "tests" / "data" / "neuralrti" / "image11_small.jpg"
+    plan = tmp_path / "p.lp"
+    args = ["plan", str(preview), "--rig", str(rig), "--lights", "9", "--out", str(plan)]
+    r = runner.invoke(
+        app, [*args, "--preview-light", "120,40", "--figure", str(tmp_path / "p.png")]
+    )
+    assert r.exit_code == 0, r.output
+    (fig,) = drawn
+    (chosen,) = _by_gid(fig, "chosen")
+    t, rad = polar_coordinates([e.direction for e in read_lp(plan)])
+    np.testing.assert_allclose(chosen.get_offsets(), np.column_stack([t, rad]), atol=1e-3)
+    (star,) = _by_gid(fig, "preview")
+    np.testing.assert_allclose(star.get_offsets(), [[np.radians(120.0), 50.0]], atol=1e-6)
+
+
+def test_plan_cli_map_failure_keeps_the_plan_and_its_report(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import rti_rig.plan_figure as plan_figure
+
+    def fail(path: Path, fig: object) -> None:
+        raise OSError("disk full")
+
+    monkeypatch.setattr(plan_figure, "write_layout_figure", fail)
+    rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    plan = tmp_path / "p.lp"
+    args = ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "9", "--out", str(plan)]
+    r = runner.invoke(app, [*args, "--figure", str(tmp_path / "p.png")])
+    flat = " ".join(r.output.split())
+    assert r.exit_code == 2 and "disk full" in flat and "the plan itself was written" in flat
+    assert "Planned 9 lights" in flat and len(read_lp(plan)) == 9
+
+
+def test_title_with_dollar_signs_is_drawn_as_text(tmp_path: Path) -> None:
+    """A rig file's name goes into the title; matplotlib must not read it as a formula."""
+    fig = layout_figure(DOME.directions[:3], DOME, title=r"dome$\frac$.lp")
+    write_layout_figure(tmp_path / "m.png", fig)
+    assert (tmp_path / "m.png").stat().st_size > 0
