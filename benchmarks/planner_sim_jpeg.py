@@ -44,7 +44,7 @@ from benchmarks.planner_sim_draws import (
 from benchmarks.report import write_section
 from planner.objectives import SIGNAL_NOISE_JPEG_DOME
 from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data, scene_camera
+from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
 from rti_rig.rig_geometry import DomeGeometry
 from simulator.camera_model import encode_jpeg, to_srgb8
 
@@ -83,21 +83,6 @@ def led_factors(count: int, spread: float, seed: int) -> NDArray[np.float64]:
     return np.exp(np.random.default_rng(seed).normal(0.0, spread, count))
 
 
-def candidate_images(
-    scene: str, settings: TradeoffSettings, cand: NDArray[np.float64], factors: NDArray
-) -> NDArray[np.float32]:
-    """The candidates' noisy linear images with each light's irradiance scaled by its factor.
-
-    Shot in ``render_scene_data``'s order with its noise stream, so factors of 1 give exactly
-    its candidate images.
-    """
-    _, shoot = scene_camera(scene, settings)
-    rng = np.random.default_rng(settings.seed)
-    return np.stack(
-        [shoot(d, rng, irradiance=float(f)) for d, f in zip(cand, factors, strict=True)]
-    )
-
-
 def scene_errors(
     scene: str, settings: TradeoffSettings, rng: np.random.Generator
 ) -> dict[tuple[str, int, str], list[float]]:
@@ -110,7 +95,7 @@ def scene_errors(
         shot = (
             data.candidate_images
             if spread == 0
-            else candidate_images(scene, settings, cand, factors)
+            else render_scene_data(scene, settings, factors).candidate_images
         )
         images[label] = np.stack([jpeg_round_trip(im)[1] for im in shot])
     preview, _ = jpeg_round_trip(data.preview)

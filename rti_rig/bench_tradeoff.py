@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.clock import VirtualClock
 from rti_rig.geometry import fibonacci_cap
@@ -143,17 +143,30 @@ def scene_camera(
     return scene, shoot
 
 
-def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
-    """Render the candidate lights (with noise) and the held-out reference (noise-free)."""
+def render_scene_data(
+    name: str, s: TradeoffSettings, candidate_irradiance: ArrayLike | None = None
+) -> SceneData:
+    """Render the candidate lights (with noise) and the held-out reference (noise-free).
+
+    ``candidate_irradiance`` (one factor per candidate, default 1) scales each candidate light
+    before the camera exposes, as an uncalibrated LED would (``benchmarks.planner_sim_jpeg``);
+    the candidates are shot first, so their noise stream is the same whatever the factors.
+    """
     from simulator.ground_truth import homogeneous_directions
 
     scene, camera_shot = scene_camera(name, s)
     rng = np.random.default_rng(s.seed)
 
-    def shoot(direction: NDArray[np.float64], noisy: bool) -> NDArray[np.float32]:
-        return camera_shot(direction, rng if noisy else None)
+    def shoot(
+        direction: NDArray[np.float64], noisy: bool, irradiance: float = 1.0
+    ) -> NDArray[np.float32]:
+        return camera_shot(direction, rng if noisy else None, irradiance=irradiance)
 
     cand = fibonacci_cap(s.candidates, 3.0, 87.0)
+    factors = np.ones(len(cand)) if candidate_irradiance is None else candidate_irradiance
+    factors = np.asarray(factors, dtype=np.float64)
+    if factors.shape != (len(cand),):
+        raise ValueError(f"candidate_irradiance: one factor per candidate ({len(cand)}) needed")
     # Held-out reference lights: a dense homogeneous set, offset from the candidates.
     gt = homogeneous_directions(s.ground_truth_lights)
     pick = np.random.default_rng(s.seed + 1).choice(len(gt), s.held_out_lights, replace=False)
@@ -164,7 +177,9 @@ def render_scene_data(name: str, s: TradeoffSettings) -> SceneData:
         name=name,
         normals=np.asarray(scene.normals, dtype=np.float64),
         candidate_dirs=cand,
-        candidate_images=np.stack([shoot(d, True) for d in cand]),
+        candidate_images=np.stack(
+            [shoot(d, True, float(f)) for d, f in zip(cand, factors, strict=True)]
+        ),
         held_dirs=held,
         held_images=np.stack([shoot(d, False) for d in held]),
         preview=shoot(preview_dir, True),

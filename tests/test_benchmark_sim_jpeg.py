@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from benchmarks.planner_real_data import srgb_to_linear
-from benchmarks.planner_sim_jpeg import candidate_images, jpeg_round_trip, led_factors
+from benchmarks.planner_sim_jpeg import jpeg_round_trip, led_factors
 from rti_rig.bench_tradeoff import TradeoffSettings, render_scene_data
 from simulator.camera_model import to_srgb8
 
@@ -75,7 +75,7 @@ def test_led_factors_have_the_stated_spread_and_none_without_it() -> None:
     assert np.array_equal(f, led_factors(4000, 0.05, 3))  # one fixed draw: one simulated dome
 
 
-def test_candidate_images_scale_the_light_before_the_camera() -> None:
+def test_candidate_irradiance_scales_the_light_before_the_camera() -> None:
     """Factors of 1 give render_scene_data's own images; a brighter LED is brighter and
     saturates at white, as in a camera, instead of being a clipped image scaled afterwards."""
     s = TradeoffSettings(
@@ -83,11 +83,11 @@ def test_candidate_images_scale_the_light_before_the_camera() -> None:
     )
     data = render_scene_data("coin", s)
     cand = data.candidate_dirs
-    same = candidate_images("coin", s, cand, np.ones(len(cand)))
+    same = render_scene_data("coin", s, np.ones(len(cand))).candidate_images
     assert np.array_equal(same, data.candidate_images)
-    bright = candidate_images("coin", s, cand, np.full(len(cand), 3.0))
+    bright = render_scene_data("coin", s, np.full(len(cand), 3.0)).candidate_images
     assert bright.max() == 1.0 and np.mean(bright >= 1.0) > np.mean(same >= 1.0)
-    dark = candidate_images("coin", s, cand, np.full(len(cand), 0.5))
+    dark = render_scene_data("coin", s, np.full(len(cand), 0.5)).candidate_images
     lit = (same > 0.1) & (same < 0.9)
     assert abs(np.mean(dark[lit]) / np.mean(same[lit]) - 0.5) < 0.03
     # a saturated highlight dimmed by a factor below 1 reads below white, as a real LED would
