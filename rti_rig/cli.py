@@ -671,7 +671,15 @@ def plan(
         # after the report: a map that cannot be drawn must not hide a plan that was written
         how = f"{method}/{objective}"
         try:
-            _write_plan_figure(figure, schedule, geometry, report, how, rig)  # type: ignore[arg-type]
+            _write_plan_figure(
+                figure,
+                schedule,
+                geometry,  # type: ignore[arg-type]
+                report,
+                how,
+                rig,
+                min_elevation_deg,
+            )
         except RtiRigError as exc:
             raise _fail(exc) from None
         out.print(f"Map of the plan → {figure}")
@@ -684,6 +692,7 @@ def _write_plan_figure(
     report: PlanReport,
     how: str,
     rig: Path,
+    min_elevation_deg: float = 0.0,
 ) -> None:
     """Draw the plan's map (``plan --figure``); the .lp is already written, so a failure here
     names the map file and leaves the plan in place."""
@@ -699,6 +708,7 @@ def _write_plan_figure(
             None if light is None else direction_from_az_el(*light),
             f"{len(schedule.steps)} lights · {how} · {rig.name}",
             [caption] if caption else [],
+            min_elevation_deg,
         )
         write_layout_figure(path, fig)
     except (OSError, ValueError, RuntimeError) as exc:

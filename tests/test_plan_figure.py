@@ -33,7 +33,7 @@ runner = CliRunner()
 
 def _by_gid(fig, gid: str) -> list:
     ax = fig.axes[0]
-    return [a for a in [*ax.collections, *ax.patches] if a.get_gid() == gid]
+    return [a for a in [*ax.collections, *ax.patches, *ax.lines] if a.get_gid() == gid]
 
 
 def test_polar_coordinates_follow_the_design_frame() -> None:
@@ -58,6 +58,16 @@ def test_dome_map_places_every_led_and_numbers_the_plan_in_firing_order() -> Non
     np.testing.assert_allclose([pos for _, pos in labels], np.column_stack([t, r]))
     (star,) = _by_gid(fig, "preview")
     np.testing.assert_allclose(star.get_offsets(), [[np.radians(135.0), 40.0]], atol=1e-9)
+    assert not _by_gid(fig, "floor")  # no floor given: no ring
+
+
+def test_dome_map_draws_the_elevation_floor_as_a_full_ring() -> None:
+    fig = layout_figure(DOME.directions[[3, 9, 12]], DOME, None, "t", min_elevation_deg=20.0)
+    (ring,) = _by_gid(fig, "floor")
+    theta, radius = ring.get_data()
+    np.testing.assert_allclose(radius, 70.0)  # 90° − the floor's elevation
+    assert np.ptp(theta) == pytest.approx(2 * np.pi)
+    assert "20°" in ring.get_label()
     assert not _by_gid(fig, "reach")
     # seen from above: azimuth 0° (+x) to the right of the centre, 90° (+y) above it
     fig.canvas.draw()
@@ -161,13 +171,25 @@ def test_plan_cli_map_shows_the_lights_of_the_plan_file_in_its_order(
     plan = tmp_path / "p.lp"
     args = ["plan", str(preview), "--rig", str(rig), "--lights", "9", "--out", str(plan)]
     r = runner.invoke(
-        app, [*args, "--preview-light", "120,40", "--figure", str(tmp_path / "p.png")]
+        app,
+        [
+            *args,
+            "--preview-light",
+            "120,40",
+            "--min-elevation-deg",
+            "15",
+            "--figure",
+            str(tmp_path / "p.png"),
+        ],
     )
     assert r.exit_code == 0, r.output
     (fig,) = drawn
     (chosen,) = _by_gid(fig, "chosen")
     t, rad = polar_coordinates([e.direction for e in read_lp(plan)])
     np.testing.assert_allclose(chosen.get_offsets(), np.column_stack([t, rad]), atol=1e-3)
+    (ring,) = _by_gid(fig, "floor")  # the plan's floor, with every planned light inside it
+    np.testing.assert_allclose(ring.get_data()[1], 75.0)
+    assert rad.max() <= 75.0 + 1e-3
     (star,) = _by_gid(fig, "preview")
     np.testing.assert_allclose(star.get_offsets(), [[np.radians(120.0), 50.0]], atol=1e-6)
 
