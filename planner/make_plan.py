@@ -160,7 +160,7 @@ class PlanReport:
                 "docs/planner.md)"
             )
         if self.expected and self.expected_meaning:
-            parts = ", ".join(f"{k} {v:.4g}" for k, v in self.expected.items())
+            parts = ", ".join(f"{k} {v:#.4g}" for k, v in self.expected.items())
             out.append(f"{self.expected_meaning}: {parts}")
         out.extend(self.notes)
         out.append(f"planned in {self.seconds:.2f} s")

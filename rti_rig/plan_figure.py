@@ -136,8 +136,8 @@ def expected_caption(meaning: str, expected: dict[str, float]) -> str:
         others = {k: v for k, v in expected.items() if k != "optimal"}
         best = min(others, key=lambda k: others[k])
         mine = expected["optimal"]
-        return f"{meaning}: optimal {mine:.4g}, best starting layout ({best}) {others[best]:.4g}"
-    return f"{meaning}: " + ", ".join(f"{k} {v:.4g}" for k, v in expected.items())
+        return f"{meaning}: optimal {mine:#.4g}, best starting layout ({best}) {others[best]:#.4g}"
+    return f"{meaning}: " + ", ".join(f"{k} {v:#.4g}" for k, v in expected.items())
 
 
 def check_figure_path(path: Path) -> None:

@@ -117,8 +117,9 @@ def test_arm_map_shades_the_reach_and_hatches_the_keep_out_cone(
 
 def test_caption_gives_the_plan_and_its_best_starting_layout() -> None:
     text = expected_caption("err", {"uniform ≥0°": 1.4, "uniform ≥10°": 1.3, "optimal": 1.0})
-    assert text == "err: optimal 1, best starting layout (uniform ≥10°) 1.3"
-    assert expected_caption("err", {"uniform ≥0°": 1.4}) == "err: uniform ≥0° 1.4"
+    # four significant digits, kept: a plan's "1.000°" must not read as a rounded "1"
+    assert text == "err: optimal 1.000, best starting layout (uniform ≥10°) 1.300"
+    assert expected_caption("err", {"uniform ≥0°": 1.4}) == "err: uniform ≥0° 1.400"
     assert expected_caption("err", {}) == ""
 
 

@@ -229,6 +229,10 @@ def test_report_is_serialisable_and_readable() -> None:
     assert d["method"] == "optimal" and isinstance(d["expected"], dict)
     text = "\n".join(rep.lines())
     assert "expected RMS normal error" in text and "planned in" in text
+    # four significant digits, trailing zeros kept (a plan at 1.000° once printed "optimal 1"),
+    # and a relighting MSE keeps its small digits
+    rep.expected = {"uniform ≥0°": 1.325, "optimal": 1.0, "relit": 0.0012}
+    assert "uniform ≥0° 1.325, optimal 1.000, relit 0.001200" in "\n".join(rep.lines())
     import json
 
     json.dumps(sched.to_dict())
