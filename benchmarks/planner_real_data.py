@@ -163,14 +163,29 @@ def planned_leds(
     return np.array([s.led for s in sched.steps])
 
 
-def _exchange(n: int, dirs: np.ndarray, cost) -> np.ndarray:
-    """Greedy exchange from the homogeneous layout: up to two sweeps of single-LED swaps."""
-    sel = list(select_uniform_leds(DomeGeometry(dirs, tuple(map(str, range(len(dirs))))), n))
-    for _ in range(2):
+def hindsight_exchange(
+    n: int,
+    dirs: np.ndarray,
+    cost,
+    start: np.ndarray | None = None,
+    sweeps: int = 2,
+    stride: int = 1,
+) -> np.ndarray:
+    """Greedy exchange of single LEDs from ``start`` (default: the homogeneous layout, floor
+    0°) for up to ``sweeps`` sweeps; never worse than ``start`` on ``cost``.
+
+    ``stride`` > 1 tries every ``stride``-th LED in a sweep, offset by one each sweep (so a
+    slow cost still sees every LED over ``stride`` sweeps: ``benchmarks.planner_sim_oracle``).
+    """
+    if start is None:
+        start = select_uniform_leds(DomeGeometry(dirs, tuple(map(str, range(len(dirs))))), n)
+    sel = [int(k) for k in start]
+    quiet = 0  # consecutive sweeps without a swap: stop once every LED was tried since one
+    for sweep in range(sweeps):
         changed = False
         for pos in range(n):
             best, best_k = cost(sel), None
-            for k in range(len(dirs)):
+            for k in range(sweep % stride, len(dirs), stride):
                 if k in sel:
                     continue
                 trial = sel.copy()
@@ -181,7 +196,8 @@ def _exchange(n: int, dirs: np.ndarray, cost) -> np.ndarray:
             if best_k is not None:
                 sel[pos] = best_k
                 changed = True
-        if not changed:
+        quiet = 0 if changed else quiet + 1
+        if quiet >= stride:
             break
     return np.asarray(sel)
 
@@ -213,7 +229,7 @@ def hindsight(
         nb = b / np.maximum(np.linalg.norm(b, axis=1, keepdims=True), 1e-12)
         return float(np.degrees(np.arccos(np.clip(np.sum(nb * r, axis=1), -1, 1))).mean())
 
-    return _exchange(n, dirs, err)
+    return hindsight_exchange(n, dirs, err)
 
 
 def hindsight_relight(
@@ -237,7 +253,7 @@ def hindsight_relight(
         mse = np.mean((pred - obs[rest]) ** 2, axis=1)
         return float(np.mean(10.0 * np.log10(np.maximum(mse, 1e-12))))
 
-    return _exchange(n, dirs, neg_psnr)
+    return hindsight_exchange(n, dirs, neg_psnr)
 
 
 def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
