@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -110,6 +110,7 @@ class PlanReport:
     rig: str
     candidates: int
     min_elevation_deg: float
+    max_elevation_deg: float = 90.0
     preview_shape: tuple[int, ...] | None = None
     planning_shape: tuple[int, ...] | None = None
     preview_light_az_el_deg: tuple[float, float] | None = None
@@ -139,6 +140,11 @@ class PlanReport:
     def lines(self) -> list[str]:
         """Human-readable summary, one fact per line."""
         out = [f"method {self.method}, objective {self.objective}, {self.n} lights on {self.rig}"]
+        if self.max_elevation_deg < 90.0:
+            out.append(
+                f"lights between {self.min_elevation_deg:g}° and {self.max_elevation_deg:g}° "
+                "elevation (none near the camera axis)"
+            )
         if self.preview_light_az_el_deg is not None:
             az, el = self.preview_light_az_el_deg
             out.append(f"preview light az {az:.1f}°, el {el:.1f}° ({self.preview_light_source})")
@@ -350,16 +356,43 @@ def _tilt_stats(normals: NDArray[np.float64]) -> tuple[float, float]:
     return float(np.sqrt(np.mean(tilt**2))), float(np.percentile(tilt, 90))
 
 
+def check_elevation_band(min_elevation_deg: float, max_elevation_deg: float) -> None:
+    """Refuse an elevation band that is empty or leaves the hemisphere."""
+    if not 0.0 <= min_elevation_deg < 90.0:
+        raise ScheduleError(
+            f"--min-elevation-deg {min_elevation_deg:g}: give an elevation in [0, 90) degrees"
+        )
+    if not min_elevation_deg < max_elevation_deg <= 90.0:
+        raise ScheduleError(
+            f"--max-elevation-deg {max_elevation_deg:g}: give an elevation above the floor "
+            f"({min_elevation_deg:g}°) and at most 90°"
+        )
+
+
+def arm_below(arm: ArmGeometry, max_elevation_deg: float) -> ArmGeometry:
+    """The arm as planning sees it under an elevation ceiling: its band cut at the ceiling
+    (its reach, limits and park pose otherwise unchanged)."""
+    if max_elevation_deg >= arm.max_elevation_deg:
+        return arm
+    if max_elevation_deg <= arm.min_elevation_deg:
+        raise ScheduleError(
+            f"--max-elevation-deg {max_elevation_deg:g} is at or below the arm's lowest "
+            f"elevation ({arm.min_elevation_deg:g}°): no light is left; raise it"
+        )
+    return replace(arm, max_elevation_deg=max_elevation_deg)
+
+
 def _uniform_layouts(
-    geometry: DomeGeometry | ArmGeometry, n: int, floors: list[float]
+    geometry: DomeGeometry | ArmGeometry, n: int, floors: list[float], ceiling: float = 90.0
 ) -> tuple[list[tuple[str, NDArray[np.float64], NDArray[np.intp] | None]], str | None]:
-    """Homogeneous layouts (label, directions, dome LEDs) for each feasible floor."""
+    """Homogeneous layouts (label, directions, dome LEDs) for each feasible floor, below
+    ``ceiling`` (an arm is limited by :func:`arm_below` beforehand)."""
     out: list[tuple[str, NDArray[np.float64], NDArray[np.intp] | None]] = []
     first_error: str | None = None
     for f in floors:
         try:
             if isinstance(geometry, DomeGeometry):
-                leds = select_uniform_leds(geometry, n, f)
+                leds = select_uniform_leds(geometry, n, f, max_elevation_deg=ceiling)
                 out.append((f"uniform ≥{f:g}°", geometry.directions[leds], leds))
             else:
                 out.append((f"uniform ≥{f:g}°", geometry.homogeneous(n, f), None))
@@ -420,8 +453,13 @@ def plan_with_report(
     seed: int = 0,
     signal_noise: float = 0.0,
     material: str = "auto",
+    max_elevation_deg: float = 90.0,
 ) -> tuple[LightSchedule, PlanReport]:
     """The schedule and the evidence behind it; see :func:`make_plan`.
+
+    ``max_elevation_deg``: no light above this elevation (90 = none excluded): lights near
+    the camera axis put mirror highlights on a level glossy object (docs/planner.md, "An
+    elevation ceiling").
 
     ``material``: what the user knows of the surface (:data:`planner.objectives.MATERIALS`):
     ``auto`` (default) reads highlights from the preview, ``matte`` models none, ``glossy``
@@ -450,6 +488,7 @@ def plan_with_report(
             seed,
             signal_noise,
             material,
+            max_elevation_deg,
         )
 
 
@@ -467,6 +506,7 @@ def _plan(
     seed: int,
     signal_noise: float = 0.0,
     material: str = "auto",
+    max_elevation_deg: float = 90.0,
 ) -> tuple[LightSchedule, PlanReport]:
     t0 = time.perf_counter()
     if method not in METHODS:
@@ -477,13 +517,18 @@ def _plan(
         raise ScheduleError(f"--lights must be at least 1, got {n}")
     check_signal_noise(signal_noise, objective)
     check_material(material)
-    floors = [min_elevation_deg] + [f for f in START_FLOORS_DEG if f > min_elevation_deg]
-    uniforms, uniform_error = _uniform_layouts(geometry, n, floors)
+    check_elevation_band(min_elevation_deg, max_elevation_deg)
+    if isinstance(geometry, ArmGeometry):
+        geometry = arm_below(geometry, max_elevation_deg)
+    floors = [min_elevation_deg] + [
+        f for f in START_FLOORS_DEG if min_elevation_deg < f < max_elevation_deg
+    ]
+    uniforms, uniform_error = _uniform_layouts(geometry, n, floors, max_elevation_deg)
     if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
         # the user's own floor must work; the extra floors are optional starting points
         raise ScheduleError(uniform_error or "no homogeneous layout fits this rig")
     extra = np.concatenate([u[1] for u in uniforms]) if isinstance(geometry, ArmGeometry) else None
-    candidates = candidates_for(geometry, min_elevation_deg, extra)
+    candidates = candidates_for(geometry, min_elevation_deg, extra, max_elevation_deg)
     starts: list[tuple[str, NDArray[np.intp]]] = []
     offset = 0
     for u in uniforms:
@@ -491,9 +536,21 @@ def _plan(
         offset += len(u[1])
     rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
     report = PlanReport(
-        method, objective, n, rig, len(candidates), min_elevation_deg, material=material
+        method,
+        objective,
+        n,
+        rig,
+        len(candidates),
+        min_elevation_deg,
+        max_elevation_deg,
+        material=material,
     )
-    prov: dict[str, Any] = {"n": n, "min_elevation_deg": min_elevation_deg, "objective": objective}
+    prov: dict[str, Any] = {
+        "n": n,
+        "min_elevation_deg": min_elevation_deg,
+        "max_elevation_deg": max_elevation_deg,
+        "objective": objective,
+    }
 
     if method == "kmeans" and preview is None:
         raise ScheduleError(
@@ -651,6 +708,7 @@ def make_plan(
     min_elevation_deg: float = 0.0,
     signal_noise: float = 0.0,
     material: str = "auto",
+    max_elevation_deg: float = 90.0,
 ) -> LightSchedule:
     """An ordered schedule of ``n`` lights for ``geometry`` planned from one preview.
 
@@ -662,4 +720,6 @@ def make_plan(
     ``schedule.provenance["report"]`` (or use :func:`plan_with_report`).
     """
     args = (preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg)
-    return plan_with_report(*args, signal_noise=signal_noise, material=material)[0]
+    return plan_with_report(
+        *args, signal_noise=signal_noise, material=material, max_elevation_deg=max_elevation_deg
+    )[0]

@@ -109,19 +109,22 @@ def candidates_for(
     geometry: DomeGeometry | ArmGeometry,
     min_elevation_deg: float = 0.0,
     extra: NDArray[np.float64] | None = None,
+    max_elevation_deg: float = 90.0,
 ) -> Candidates:
-    """The rig's usable lights above the elevation floor (a dome's LEDs; an arm's dense band).
+    """The rig's usable lights between the elevation floor and ceiling (a dome's LEDs; an
+    arm's dense band — pass an arm already limited by :func:`planner.make_plan.arm_below`).
 
     ``extra`` adds directions (e.g. a homogeneous layout) to an arm's set, so that a layout
     computed elsewhere is exactly representable.
     """
     if isinstance(geometry, DomeGeometry):
         _, el = az_el_from_direction(geometry.directions)
-        idx = np.flatnonzero(el >= min_elevation_deg - 1e-9)
+        idx = np.flatnonzero((el >= min_elevation_deg - 1e-9) & (el <= max_elevation_deg + 1e-9))
         if len(idx) == 0:
             raise ScheduleError(
-                f"the dome has no LED at or above {min_elevation_deg:g}° elevation; "
-                "lower --min-elevation"
+                f"the dome has no LED between {min_elevation_deg:g}° and "
+                f"{max_elevation_deg:g}° elevation; widen --min-elevation-deg / "
+                "--max-elevation-deg"
             )
         return Candidates(
             geometry.directions[idx], idx.astype(np.intp), tuple(geometry.names[i] for i in idx)

@@ -21,10 +21,22 @@ from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.schedule import LightSchedule
 
 
+def band_text(min_elevation_deg: float, max_elevation_deg: float) -> str:
+    """ " at or above F° elevation" / " between F° and C° elevation" / "" for the full dome."""
+    if max_elevation_deg < 90.0:
+        return f" between {min_elevation_deg:g}° and {max_elevation_deg:g}° elevation"
+    return f" at or above {min_elevation_deg:g}° elevation" if min_elevation_deg > 0 else ""
+
+
 def select_uniform_leds(
-    dome: DomeGeometry, n: int, min_elevation_deg: float = 0.0, azimuth_offset_deg: float = 0.0
+    dome: DomeGeometry,
+    n: int,
+    min_elevation_deg: float = 0.0,
+    azimuth_offset_deg: float = 0.0,
+    max_elevation_deg: float = 90.0,
 ) -> NDArray[np.intp]:
-    """Indices (ascending) of ``n`` LEDs spread evenly above ``min_elevation_deg``.
+    """Indices (ascending) of ``n`` LEDs spread evenly between ``min_elevation_deg`` and
+    ``max_elevation_deg``.
 
     ``azimuth_offset_deg`` turns the ideal layout about the vertical before it is matched to
     LEDs: every offset is an equally homogeneous layout, and the spread of their errors on a
@@ -34,11 +46,11 @@ def select_uniform_leds(
     if n <= 0:
         raise ScheduleError(f"--lights must be at least 1, got {n}")
     _, el = az_el_from_direction(dome.directions)
-    candidates = np.flatnonzero(el >= min_elevation_deg - 1e-9)
+    candidates = np.flatnonzero((el >= min_elevation_deg - 1e-9) & (el <= max_elevation_deg + 1e-9))
     if n > len(candidates):
-        floor = f" at or above {min_elevation_deg:g}° elevation" if min_elevation_deg > 0 else ""
+        band = band_text(min_elevation_deg, max_elevation_deg)
         raise ScheduleError(
-            f"asked for {n} lights but the dome has only {len(candidates)} LEDs{floor}; "
+            f"asked for {n} lights but the dome has only {len(candidates)} LEDs{band}; "
             f"use --lights {len(candidates)} or fewer"
         )
     if n == len(candidates):

@@ -62,13 +62,15 @@ def layout_figure(
     title: str = "",
     caption: Sequence[str] = (),
     min_elevation_deg: float = 0.0,
+    max_elevation_deg: float = 90.0,
 ) -> Figure:
     """The map of ``chosen`` (N×3 directions, in firing order) on ``geometry``.
 
     A dome's LEDs are grey dots; an arm's reachable band is shaded and its keep-out cone
     hatched. The chosen lights are numbered 1…N; ``preview`` (the preview's light) is a star.
-    An elevation floor above 0° (``--min-elevation-deg``) is a dashed ring: the planner took
-    no light outside it, so LEDs there were excluded on purpose, not overlooked.
+    An elevation floor above 0° (``--min-elevation-deg``) and a ceiling below 90°
+    (``--max-elevation-deg``) are dashed rings: the planner took no light outside them, so LEDs
+    there were excluded on purpose, not overlooked.
     """
     fig = Figure(figsize=(6.4, 7.0), layout="constrained")
     ax = fig.add_subplot(projection="polar")
@@ -84,18 +86,22 @@ def layout_figure(
         ax.scatter(t, r, s=14, c="0.7", label=f"dome LEDs ({len(t)})", zorder=2, gid="candidates")
     else:
         _draw_arm_reach(ax, geometry)
-    if min_elevation_deg > 0:
-        ring = np.linspace(0.0, 2 * np.pi, 361)
-        ax.plot(
-            ring,
-            np.full_like(ring, 90.0 - min_elevation_deg),
-            color="tab:purple",
-            ls="--",
-            lw=1.2,
-            zorder=3,
-            label=f"elevation floor {min_elevation_deg:g}°",
-            gid="floor",
-        )
+    ring = np.linspace(0.0, 2 * np.pi, 361)
+    for limit, shown, label, gid in (
+        (min_elevation_deg, min_elevation_deg > 0, "elevation floor", "floor"),
+        (max_elevation_deg, max_elevation_deg < 90, "elevation ceiling", "ceiling"),
+    ):
+        if shown:
+            ax.plot(
+                ring,
+                np.full_like(ring, 90.0 - limit),
+                color="tab:purple",
+                ls="--" if gid == "floor" else ":",
+                lw=1.2,
+                zorder=3,
+                label=f"{label} {limit:g}°",
+                gid=gid,
+            )
     t, r = polar_coordinates(chosen)
     ax.plot(t, r, color="tab:blue", alpha=0.35, lw=1, zorder=3)  # the firing order
     ax.scatter(t, r, s=150, c="tab:blue", edgecolors="white", zorder=4, gid="chosen")

@@ -1,0 +1,150 @@
+"""An elevation ceiling for plans (``max_elevation_deg``, ``rti-rig plan --max-elevation-deg``).
+
+Lights near the camera axis put mirror highlights on a level glossy object; a ceiling keeps
+every planned light at or below it, for every method, on a dome and on an arm, and refuses a
+band that is empty before anything is planned.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from planner.make_plan import arm_below, check_elevation_band, make_plan, plan_with_report
+from planner.objectives import candidates_for
+from planner.uniform import select_uniform_leds
+from rti_rig.cli import app
+from rti_rig.errors import ScheduleError
+from rti_rig.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
+from rti_rig.lp_format import read_lp
+from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from simulator.sim_scene import lambert_radiance, relief_scene
+
+REPO = Path(__file__).resolve().parents[1]
+DOME = DomeGeometry(fibonacci_cap(60, 5.0, 88.0), tuple(f"led{i:02d}" for i in range(60)))
+ARM = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
+SCENE = relief_scene(64, 64, seed=3)
+PREVIEW = (np.clip(lambert_radiance(SCENE, direction_from_az_el(30, 50)), 0, 1) * 255).astype(
+    np.uint8
+)
+runner = CliRunner()
+
+
+def _elevations(sched) -> np.ndarray:
+    return np.array([s.elevation_deg for s in sched.steps])
+
+
+@pytest.mark.parametrize("method", ["uniform", "kmeans", "optimal"])
+@pytest.mark.parametrize("geometry", [DOME, ARM], ids=["dome", "arm"])
+def test_every_light_stays_between_floor_and_ceiling(method: str, geometry) -> None:
+    sched = make_plan(
+        PREVIEW,
+        geometry,
+        9,
+        method,
+        preview_light=(30.0, 50.0),
+        min_elevation_deg=10.0,
+        max_elevation_deg=55.0,
+    )
+    el = _elevations(sched)
+    assert len(el) == 9
+    assert el.min() >= 10.0 - 1e-6 and el.max() <= 55.0 + 1e-6
+    if isinstance(geometry, DomeGeometry):
+        assert len({s.led for s in sched.steps}) == 9
+    else:
+        for s in sched.steps:
+            assert ARM.unreachable_reason(np.array(s.direction)) is None
+
+
+def test_without_a_ceiling_the_planner_uses_the_high_lights() -> None:
+    """So the ceiling is what keeps them out (the tests above would pass vacuously if the
+    plans never went high)."""
+    sched = make_plan(None, DOME, 18, "uniform")
+    assert _elevations(sched).max() > 70.0
+
+
+def test_homogeneous_layout_spreads_over_the_band() -> None:
+    leds = select_uniform_leds(DOME, 12, 10.0, max_elevation_deg=60.0)
+    _, el = az_el_from_direction(DOME.directions[leds])
+    _, all_el = az_el_from_direction(DOME.directions)
+    band = all_el[(all_el >= 10.0) & (all_el <= 60.0)]
+    assert el.max() <= 60.0 + 1e-9 and el.min() >= 10.0 - 1e-9
+    assert el.max() > band.max() - 10.0 and el.min() < band.min() + 10.0  # the whole band
+
+
+def test_candidates_and_arm_are_cut_at_the_ceiling() -> None:
+    cands = candidates_for(DOME, 10.0, max_elevation_deg=40.0)
+    _, el = az_el_from_direction(cands.directions)
+    assert el.max() <= 40.0 + 1e-9 and el.min() >= 10.0 - 1e-9
+    assert arm_below(ARM, 50.0).max_elevation_deg == 50.0
+    assert arm_below(ARM, 85.0) is ARM  # above the arm's own limit: unchanged
+    with pytest.raises(ScheduleError, match="at or below the arm's lowest elevation"):
+        arm_below(ARM, 5.0)
+
+
+@pytest.mark.parametrize(
+    ("floor", "ceiling", "match"),
+    [
+        (30.0, 30.0, "above the floor"),
+        (30.0, 20.0, "above the floor"),
+        (0.0, 95.0, "at most 90"),
+        (-5.0, 60.0, r"\[0, 90\)"),
+    ],
+)
+def test_an_empty_or_impossible_band_is_refused(floor: float, ceiling: float, match: str) -> None:
+    with pytest.raises(ScheduleError, match=match):
+        check_elevation_band(floor, ceiling)
+    with pytest.raises(ScheduleError, match=match):
+        make_plan(None, DOME, 6, "optimal", min_elevation_deg=floor, max_elevation_deg=ceiling)
+
+
+def test_too_few_leds_in_the_band_names_the_band() -> None:
+    with pytest.raises(ScheduleError, match=r"between 10° and 20° elevation; use --lights"):
+        make_plan(None, DOME, 30, "uniform", min_elevation_deg=10.0, max_elevation_deg=20.0)
+
+
+def test_report_and_provenance_record_the_ceiling() -> None:
+    sched, report = plan_with_report(None, DOME, 6, "optimal", max_elevation_deg=60.0)
+    assert report.max_elevation_deg == 60.0
+    assert sched.provenance["max_elevation_deg"] == 60.0
+    assert any("between 0° and 60° elevation" in line for line in report.lines())
+    _, full = plan_with_report(None, DOME, 6, "optimal")
+    assert not any("elevation (none near" in line for line in full.lines())
+
+
+def test_plan_cli_keeps_the_plan_below_the_ceiling_and_draws_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import rti_rig.plan_figure as plan_figure
+
+    drawn = []
+    monkeypatch.setattr(plan_figure, "write_layout_figure", lambda path, fig: drawn.append(fig))
+    rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
+    plan = tmp_path / "p.lp"
+    args = ["plan", "--rig", str(rig), "--lights", "12", "--method", "optimal"]
+    r = runner.invoke(
+        app,
+        [
+            *args,
+            "--max-elevation-deg",
+            "60",
+            "--out",
+            str(plan),
+            "--figure",
+            str(tmp_path / "m.png"),
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    _, el = az_el_from_direction(np.array([e.direction for e in read_lp(plan)]))
+    assert len(el) == 12 and el.max() <= 60.0 + 1e-3
+    (fig,) = drawn
+    (ring,) = [a for a in fig.axes[0].lines if a.get_gid() == "ceiling"]
+    np.testing.assert_allclose(ring.get_data()[1], 30.0)  # 90° − 60°
+    r = runner.invoke(
+        app, [*args, "--min-elevation-deg", "40", "--max-elevation-deg", "30", "--out", str(plan)]
+    )
+    flat = " ".join(r.output.split())
+    assert r.exit_code == 2 and "--max-elevation-deg 30" in flat and "above the floor" in flat
