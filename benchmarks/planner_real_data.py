@@ -148,6 +148,7 @@ def planned_leds(
     signal_noise: float = 0.0,
     objective: str = "normals",
     material: str = "auto",
+    max_elevation_deg: float = 90.0,
 ) -> np.ndarray:
     """The ``optimal`` plan's LED indices into ``geometry`` (both draw benchmarks use it)."""
     sched, _ = plan_with_report(
@@ -159,6 +160,7 @@ def planned_leds(
         light,
         signal_noise=signal_noise,
         material=material,
+        max_elevation_deg=max_elevation_deg,
     )
     return np.array([s.led for s in sched.steps])
 

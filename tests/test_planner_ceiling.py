@@ -148,3 +148,50 @@ def test_plan_cli_keeps_the_plan_below_the_ceiling_and_draws_it(
     )
     flat = " ".join(r.output.split())
     assert r.exit_code == 2 and "--max-elevation-deg 30" in flat and "above the floor" in flat
+
+
+def test_ceiling_benchmark_strategies_and_hindsight_floor() -> None:
+    """benchmarks.planner_ceiling: every strategy is laid out on the draw's dome, the band
+    layouts under the ceiling, the planned ones with their ceiling; the bar's floor is the one
+    with the lowest mean."""
+    from benchmarks import planner_ceiling as bc
+
+    asked = []
+
+    def plan(g: DomeGeometry, k: int, material: str, ceiling: float) -> np.ndarray:
+        asked.append((material, ceiling))
+        return select_uniform_leds(g, k, max_elevation_deg=ceiling)
+
+    out = bc.strategies(DOME, 8, plan)
+    assert {f"uniform {f:g}" for f in bc.FLOORS} <= set(out)
+    assert sorted(asked) == sorted((m, c) for _, m, c in bc.PLANNED)
+    for f in bc.BAND_FLOORS:
+        _, el = az_el_from_direction(DOME.directions[out[f"band {f:g}"]])
+        assert el.max() <= bc.CEILING + 1e-9 and el.min() >= f - 1e-9
+    err = {(6, "uniform 0"): [3.0, 3.2], (6, "uniform 10"): [2.0, 2.4], (9, "uniform 0"): [1.0]}
+    err[(9, "uniform 10")] = [1.5]
+    assert bc.tuned(err, "uniform", (0.0, 10.0)) == "uniform 10"
+
+
+def test_ceiling_benchmark_bars_are_tuned_per_n_on_the_real_dome_and_once_on_the_simulator() -> (
+    None
+):
+    from benchmarks import planner_ceiling as bc
+
+    err = {}
+    for n, best in ((6, 0.0), (9, 20.0)):
+        for f in bc.FLOORS:
+            err[(n, f"uniform {f:g}")] = [1.0 if f == best else 2.0 + f / 100]
+        for f in bc.BAND_FLOORS:
+            err[(n, f"band {f:g}")] = [1.5 if f == 10.0 else 3.0]
+    per_n = dict(err)
+    names = bc.add_bars(per_n, [6, 9], per_n=True)
+    assert (
+        per_n[(6, "bar")] is err[(6, "uniform 0")] and per_n[(9, "bar")] is err[(9, "uniform 20")]
+    )
+    assert per_n[(9, "band")] is err[(9, "band 10")]
+    assert "per N (0/20°)" in names["bar"]
+    once = dict(err)
+    names = bc.add_bars(once, [6, 9], per_n=False)
+    # one floor for every N: floor 0° has the lowest mean over both (1.5 against 1.6 for 20°)
+    assert once[(9, "bar")] is err[(9, "uniform 0")] and names["bar"].endswith("floor (0°)")
