@@ -97,11 +97,16 @@ def tuned(
 
 
 def add_bars(
-    err: dict[tuple[int, str], list[float]], counts: Sequence[int], per_n: bool
+    err: dict[tuple[int, str], list[float]],
+    counts: Sequence[int],
+    per_n: bool,
+    *also: dict[tuple[int, str], list[float]],
 ) -> dict[str, str]:
     """Add the tuned homogeneous layouts to ``err`` as ``bar`` (floor of :data:`FLOORS`) and
     ``band`` (under the ceiling, floor of :data:`BAND_FLOORS`), tuned per N (as the real dome's
-    benchmarks do) or once over every N (as the simulator's do); return their display names."""
+    benchmarks do) or once over every N (as the simulator's do); ``also`` (e.g. the same
+    layouts' relighting PSNR) gets the same layouts under the same keys. Returns their display
+    names."""
     names = {}
     for key, prefix, floors, what in (
         ("bar", "uniform", FLOORS, "homogeneous"),
@@ -109,7 +114,8 @@ def add_bars(
     ):
         chosen = {n: tuned(err, prefix, floors, [n] if per_n else counts) for n in counts}
         for n in counts:
-            err[(n, key)] = err[(n, chosen[n])]
+            for table in (err, *also):
+                table[(n, key)] = table[(n, chosen[n])]
         shown = (
             "/".join(chosen[n].split()[-1] for n in counts)
             if per_n
@@ -181,14 +187,7 @@ def real_rows() -> tuple[list[str], list[str]]:
                 psnr.setdefault((n, label), []).append(q)
         print(f"real dome, N = {n}: done")
         sys.stdout.flush()
-    names = add_bars(err, NS, per_n=True)
-    for n in NS:  # the relighting PSNR of the very layouts the normal-error bars chose
-        for key in ("bar", "band"):
-            psnr[(n, key)] = next(
-                psnr[(m, k)]
-                for (m, k), v in err.items()
-                if m == n and k != key and v is err[(n, key)]
-            )
+    names = add_bars(err, NS, True, psnr)  # the relighting of the same layouts
     rows = _rows("real dome (icon)", err, names, NS)
     relit = [
         f"| {names.get(label, label)} | "

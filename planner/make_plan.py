@@ -369,6 +369,22 @@ def check_elevation_band(min_elevation_deg: float, max_elevation_deg: float) -> 
         )
 
 
+def _elevation_range(
+    geometry: DomeGeometry | ArmGeometry, min_elevation_deg: float
+) -> tuple[float, float]:
+    """The lowest and highest elevation the rig offers at or above the floor (degrees)."""
+    if isinstance(geometry, ArmGeometry):
+        return geometry.elevation_band(min_elevation_deg)
+    _, el = az_el_from_direction(geometry.directions)
+    above = el[el >= min_elevation_deg - 1e-9]
+    if len(above) == 0:
+        raise ScheduleError(
+            f"the dome has no LED at or above {min_elevation_deg:g}° elevation; lower "
+            "--min-elevation-deg"
+        )
+    return float(above.min()), float(above.max())
+
+
 def arm_below(arm: ArmGeometry, max_elevation_deg: float) -> ArmGeometry:
     """The arm as planning sees it under an elevation ceiling: its band cut at the ceiling
     (its reach, limits and park pose otherwise unchanged)."""
@@ -518,6 +534,15 @@ def _plan(
     check_signal_noise(signal_noise, objective)
     check_material(material)
     check_elevation_band(min_elevation_deg, max_elevation_deg)
+    # the relight objective scores relighting over the rig's whole range above the floor, the
+    # directions above a ceiling included (a user relights there too), so take it before the cut
+    relit_band, cut = (0.0, 90.0), False
+    if max_elevation_deg < 90.0:
+        try:
+            relit_band = _elevation_range(geometry, min_elevation_deg)
+            cut = relit_band[1] > max_elevation_deg
+        except ScheduleError:
+            pass  # nothing above the floor: the homogeneous layouts below say so
     if isinstance(geometry, ArmGeometry):
         geometry = arm_below(geometry, max_elevation_deg)
     floors = [min_elevation_deg] + [
@@ -542,7 +567,7 @@ def _plan(
         rig,
         len(candidates),
         min_elevation_deg,
-        max_elevation_deg,
+        max_elevation_deg if cut else 90.0,  # a ceiling above every light changes nothing
         material=material,
     )
     prov: dict[str, Any] = {
@@ -607,8 +632,11 @@ def _plan(
                 "median"
             )
     if surface is not None:
-        _, cel = az_el_from_direction(candidates.directions)
-        lo, hi = float(cel.min()), float(cel.max())
+        if cut:
+            lo, hi = relit_band
+        else:  # exactly the candidates' range, as before ceilings existed
+            _, cel = az_el_from_direction(candidates.directions)
+            lo, hi = float(cel.min()), float(cel.max())
         held_out = fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)
         sample = sample_surface(surface, candidates, held_out, seed=seed, material=material)
         if method == "kmeans":
@@ -616,6 +644,12 @@ def _plan(
             raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
             chosen, km = plan_kmeans(raw, n, candidates, seed)
             report.kmeans_distinct_normals = km.distinct_normals
+            if cut:
+                report.notes.append(
+                    f"kmeans puts each light at the usable position nearest its cluster centre: "
+                    f"under the {max_elevation_deg:g}° ceiling the clusters of a near-level "
+                    "surface all land on the ceiling's ring"
+                )
             if km.distinct_normals < n:
                 report.notes.append(
                     f"only {km.distinct_normals} distinct normals for {n} clusters: the "

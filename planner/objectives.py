@@ -112,7 +112,7 @@ def candidates_for(
     max_elevation_deg: float = 90.0,
 ) -> Candidates:
     """The rig's usable lights between the elevation floor and ceiling (a dome's LEDs; an
-    arm's dense band — pass an arm already limited by :func:`planner.make_plan.arm_below`).
+    arm's dense band).
 
     ``extra`` adds directions (e.g. a homogeneous layout) to an arm's set, so that a layout
     computed elsewhere is exactly representable.
@@ -130,6 +130,12 @@ def candidates_for(
             geometry.directions[idx], idx.astype(np.intp), tuple(geometry.names[i] for i in idx)
         )
     lo, hi = geometry.elevation_band(min_elevation_deg)
+    hi = min(hi, max_elevation_deg)
+    if hi <= lo:
+        raise ScheduleError(
+            f"--max-elevation-deg {max_elevation_deg:g} leaves the arm no band above "
+            f"{lo:g}°; raise it"
+        )
     dense = fibonacci_cap(ARM_CANDIDATES, lo, hi)
     if extra is not None and len(extra):
         dense = np.concatenate([np.asarray(extra, dtype=np.float64).reshape(-1, 3), dense])

@@ -49,9 +49,12 @@ def select_uniform_leds(
     candidates = np.flatnonzero((el >= min_elevation_deg - 1e-9) & (el <= max_elevation_deg + 1e-9))
     if n > len(candidates):
         band = band_text(min_elevation_deg, max_elevation_deg)
+        fewer = f"use --lights {len(candidates)} or fewer" if len(candidates) else ""
+        if max_elevation_deg < 90.0 or min_elevation_deg > 0:
+            widen = "widen --min-elevation-deg / --max-elevation-deg"
+            fewer = f"{fewer} or {widen}" if fewer else widen
         raise ScheduleError(
-            f"asked for {n} lights but the dome has only {len(candidates)} LEDs{band}; "
-            f"use --lights {len(candidates)} or fewer"
+            f"asked for {n} lights but the dome has only {len(candidates)} LEDs{band}; {fewer}"
         )
     if n == len(candidates):
         return np.sort(candidates)

@@ -58,7 +58,7 @@ def test_dome_map_places_every_led_and_numbers_the_plan_in_firing_order() -> Non
     np.testing.assert_allclose([pos for _, pos in labels], np.column_stack([t, r]))
     (star,) = _by_gid(fig, "preview")
     np.testing.assert_allclose(star.get_offsets(), [[np.radians(135.0), 40.0]], atol=1e-9)
-    assert not _by_gid(fig, "floor")  # no floor given: no ring
+    assert not _by_gid(fig, "floor") and not _by_gid(fig, "ceiling")  # none given: no ring
 
 
 def test_dome_map_draws_the_elevation_floor_as_a_full_ring() -> None:

@@ -79,6 +79,11 @@ def test_candidates_and_arm_are_cut_at_the_ceiling() -> None:
     cands = candidates_for(DOME, 10.0, max_elevation_deg=40.0)
     _, el = az_el_from_direction(cands.directions)
     assert el.max() <= 40.0 + 1e-9 and el.min() >= 10.0 - 1e-9
+    arm = candidates_for(ARM, 10.0, max_elevation_deg=40.0)  # the arm's band is cut too
+    _, el = az_el_from_direction(arm.directions)
+    assert el.max() <= 40.0 + 1e-9 and el.min() >= 10.0 - 1e-9
+    with pytest.raises(ScheduleError, match="leaves the arm no band"):
+        candidates_for(ARM, 10.0, max_elevation_deg=8.0)
     assert arm_below(ARM, 50.0).max_elevation_deg == 50.0
     assert arm_below(ARM, 85.0) is ARM  # above the arm's own limit: unchanged
     with pytest.raises(ScheduleError, match="at or below the arm's lowest elevation"):
@@ -101,9 +106,49 @@ def test_an_empty_or_impossible_band_is_refused(floor: float, ceiling: float, ma
         make_plan(None, DOME, 6, "optimal", min_elevation_deg=floor, max_elevation_deg=ceiling)
 
 
-def test_too_few_leds_in_the_band_names_the_band() -> None:
-    with pytest.raises(ScheduleError, match=r"between 10° and 20° elevation; use --lights"):
+def test_too_few_leds_in_the_band_names_the_band_and_how_to_widen_it() -> None:
+    with pytest.raises(ScheduleError, match=r"between 10° and 20° elevation; use --lights \d+ or"):
         make_plan(None, DOME, 30, "uniform", min_elevation_deg=10.0, max_elevation_deg=20.0)
+    with pytest.raises(ScheduleError, match="widen --min-elevation-deg / --max-elevation-deg") as e:
+        make_plan(None, DOME, 6, "optimal", max_elevation_deg=3.0)
+    assert "--lights 0" not in str(e.value)  # never advise planning no light
+
+
+def test_relight_objective_scores_relighting_above_the_ceiling_too(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A user relights from every direction, so the held-out directions the relight objective
+    scores reach above the ceiling the planned lights respect."""
+    import planner.objectives as objectives
+
+    seen = []
+    original = objectives.RelightObjective.__init__
+
+    def spy(self, sample, *args, **kwargs):
+        seen.append(sample.held_out)
+        original(self, sample, *args, **kwargs)
+
+    monkeypatch.setattr(objectives.RelightObjective, "__init__", spy)
+    sched = make_plan(PREVIEW, DOME, 9, "optimal", "relight", (30.0, 50.0), max_elevation_deg=50.0)
+    assert _elevations(sched).max() <= 50.0 + 1e-6
+    _, held_el = az_el_from_direction(seen[-1])
+    assert held_el.max() > 75.0
+
+
+def test_report_shows_the_ceiling_only_where_it_cuts() -> None:
+    """An arm that cannot reach 85° is not "kept below 85°" by a ceiling there."""
+    _, report = plan_with_report(None, ARM, 6, "optimal", max_elevation_deg=85.0)
+    assert report.max_elevation_deg == 90.0
+    assert not any("none near the camera axis" in line for line in report.lines())
+    _, report = plan_with_report(None, ARM, 6, "optimal", max_elevation_deg=50.0)
+    assert any("between 0° and 50° elevation" in line for line in report.lines())
+
+
+def test_kmeans_under_a_ceiling_says_where_its_lights_land() -> None:
+    _, report = plan_with_report(
+        PREVIEW, ARM, 9, "kmeans", preview_light=(30.0, 50.0), max_elevation_deg=40.0
+    )
+    assert any("land on the ceiling's ring" in note for note in report.notes)
 
 
 def test_report_and_provenance_record_the_ceiling() -> None:
@@ -185,7 +230,12 @@ def test_ceiling_benchmark_bars_are_tuned_per_n_on_the_real_dome_and_once_on_the
         for f in bc.BAND_FLOORS:
             err[(n, f"band {f:g}")] = [1.5 if f == 10.0 else 3.0]
     per_n = dict(err)
-    names = bc.add_bars(per_n, [6, 9], per_n=True)
+    psnr = {key: [20.0] for key in err}
+    names = bc.add_bars(per_n, [6, 9], True, psnr)
+    # the relighting shown for the bar is that of the very layouts the normal error chose
+    assert (
+        psnr[(6, "bar")] is psnr[(6, "uniform 0")] and psnr[(9, "bar")] is psnr[(9, "uniform 20")]
+    )
     assert (
         per_n[(6, "bar")] is err[(6, "uniform 0")] and per_n[(9, "bar")] is err[(9, "uniform 20")]
     )
