@@ -15,9 +15,9 @@ draws, 8 LEDs out of service, previews of 40–62° elevation) and
 run; :data:`SENSITIVITY` gives the planner at 50° and 70° too, to show how much hangs on it.
 The bar is the homogeneous layout with its floor tuned with hindsight, as everywhere.
 
-Run: ``python -m benchmarks.planner_ceiling`` (``sim`` or ``real`` for one part: about 10 and
-25 minutes; each writes its section of docs/planner.md). The real part needs
-``../shared/data/neuralrti-example``.
+Run: ``python -m benchmarks.planner_ceiling`` (``sim`` or ``real`` for one part: 18 and 20
+minutes when run side by side on 2 cores; each writes its section of docs/planner.md). The
+real part needs ``../shared/data/neuralrti-example``.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from benchmarks.planner_real_data import (
     preview_leds,
     reference,
 )
-from benchmarks.planner_sim_draws import COUNTS, DRAWS, REMOVED, cell
+from benchmarks.planner_sim_draws import COUNTS, DRAWS, REMOVED, cell, paired_draws
 from benchmarks.report import write_section
 from planner.objectives import models_for
 from planner.uniform import select_uniform_leds
@@ -134,23 +134,20 @@ def sim_rows() -> list[str]:
         light = settings.preview_light_az_el_deg
         rng = np.random.default_rng(SEED)
         err: dict[tuple[int, str], list[float]] = {}
-        for n in COUNTS:
-            for _ in range(DRAWS):
-                keep = np.sort(rng.choice(len(cand), len(cand) - REMOVED, replace=False))
-                sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
+        for n, keep, sub in paired_draws(cand, COUNTS, DRAWS, REMOVED, rng):
 
-                def plan(
-                    g: DomeGeometry, k: int, material: str, ceiling: float, data=data, light=light
-                ) -> NDArray:
-                    return planned_leds(
-                        data.preview, g, k, light, material=material, max_elevation_deg=ceiling
-                    )
+            def plan(
+                g: DomeGeometry, k: int, material: str, ceiling: float, data=data, light=light
+            ) -> NDArray:
+                return planned_leds(
+                    data.preview, g, k, light, material=material, max_elevation_deg=ceiling
+                )
 
-                for label, idx in strategies(sub, n, plan).items():
-                    sel = keep[idx]
-                    err.setdefault((n, label), []).append(
-                        normal_error(data.normals, data.candidate_images[sel], cand[sel])[0]
-                    )
+            for label, idx in strategies(sub, n, plan).items():
+                sel = keep[idx]
+                err.setdefault((n, label), []).append(
+                    normal_error(data.normals, data.candidate_images[sel], cand[sel])[0]
+                )
         rows.extend(_rows(scene, err, add_bars(err, COUNTS, per_n=False), COUNTS))
         print(f"{scene}: done")
         sys.stdout.flush()

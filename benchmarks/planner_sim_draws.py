@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
@@ -37,6 +38,18 @@ DRAWS = 8
 REMOVED = 24
 COUNTS = (6, 12, 20, 30)
 FLOORS = (0.0, 10.0, 20.0, 30.0)
+
+
+def paired_draws(
+    cand: np.ndarray, counts: Sequence[int], draws: int, removed: int, rng: np.random.Generator
+) -> Iterator[tuple[int, np.ndarray, DomeGeometry]]:
+    """The paired design: for each N, ``draws`` random subsets of the candidates with
+    ``removed`` of them out of service, as (N, kept candidate indices, the dome they form).
+    Every strategy plans on the same subset; ``keep`` maps its indices back to the candidates."""
+    for n in counts:
+        for _ in range(draws):
+            keep = np.sort(rng.choice(len(cand), len(cand) - removed, replace=False))
+            yield n, keep, DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
 
 
 def table_head(*first: str) -> tuple[str, str]:
@@ -106,33 +119,29 @@ def scene_errors(scene: str, settings: TradeoffSettings, rng: np.random.Generato
     lum = data.candidate_images @ REC709.astype(np.float32)
     err: dict[tuple[int, str], list[float]] = {}
     psnr: dict[tuple[int, str], list[float]] = {}
-    for n in COUNTS:
-        for _ in range(DRAWS):
-            keep = np.sort(rng.choice(len(cand), len(cand) - REMOVED, replace=False))
-            sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
-
-            chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
-            light = settings.preview_light_az_el_deg
-            chosen["optimal"] = keep[planned_leds(data.preview, sub, n, light)]
-            # the same planner modelling noise that grows with the signal, as for the real
-            # dome's JPEGs (the simulated camera's is shot noise on a 14-bit raw)
-            noisy = planned_leds(data.preview, sub, n, light, SIGNAL_NOISE_JPEG_DOME)
-            chosen["signal"] = keep[noisy]
-            # the same planner told that the object is glossy (right for the varnished painting,
-            # the coin and the industrial part; wrong for the matte tilted plane and tablet)
-            chosen["glossy"] = keep[planned_leds(data.preview, sub, n, light, material="glossy")]
-            # the same planner told nothing about the object: is the preview worth taking?
-            chosen["flat"] = keep[planned_leds(None, sub, n, None)]
-            chosen["relight"] = keep[planned_leds(data.preview, sub, n, light, objective="relight")]
-            for label, idx in chosen.items():
-                err.setdefault((n, label), []).append(
-                    normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-                )
-                if label in ("signal", "flat", "glossy"):  # normal-error comparisons only
-                    continue
-                rest = np.setdiff1d(np.arange(len(cand)), idx)
-                mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
-                psnr.setdefault((n, label), []).append(relight_psnr(mdl, lum[rest], cand[rest]))
+    for n, keep, sub in paired_draws(cand, COUNTS, DRAWS, REMOVED, rng):
+        chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
+        light = settings.preview_light_az_el_deg
+        chosen["optimal"] = keep[planned_leds(data.preview, sub, n, light)]
+        # the same planner modelling noise that grows with the signal, as for the real
+        # dome's JPEGs (the simulated camera's is shot noise on a 14-bit raw)
+        noisy = planned_leds(data.preview, sub, n, light, SIGNAL_NOISE_JPEG_DOME)
+        chosen["signal"] = keep[noisy]
+        # the same planner told that the object is glossy (right for the varnished painting,
+        # the coin and the industrial part; wrong for the matte tilted plane and tablet)
+        chosen["glossy"] = keep[planned_leds(data.preview, sub, n, light, material="glossy")]
+        # the same planner told nothing about the object: is the preview worth taking?
+        chosen["flat"] = keep[planned_leds(None, sub, n, None)]
+        chosen["relight"] = keep[planned_leds(data.preview, sub, n, light, objective="relight")]
+        for label, idx in chosen.items():
+            err.setdefault((n, label), []).append(
+                normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
+            )
+            if label in ("signal", "flat", "glossy"):  # normal-error comparisons only
+                continue
+            rest = np.setdiff1d(np.arange(len(cand)), idx)
+            mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
+            psnr.setdefault((n, label), []).append(relight_psnr(mdl, lum[rest], cand[rest]))
     return err, psnr, data.material
 
 

@@ -22,11 +22,18 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from benchmarks.planner_real_data import DOC, planned_leds
-from benchmarks.planner_sim_draws import COUNTS, DRAWS, FLOORS, REMOVED, cell, scene_floor
+from benchmarks.planner_sim_draws import (
+    COUNTS,
+    DRAWS,
+    FLOORS,
+    REMOVED,
+    cell,
+    paired_draws,
+    scene_floor,
+)
 from benchmarks.report import write_section
 from planner.uniform import select_uniform_leds
 from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
-from rti_rig.rig_geometry import DomeGeometry
 
 #: Scene seeds run here (seed 0 is the instance of ``benchmarks.planner_sim_draws``).
 INSTANCES = (1, 2)
@@ -46,17 +53,14 @@ def instance_errors(
     cand = data.candidate_dirs
     rng = np.random.default_rng(DRAW_SEED)
     err: dict[tuple[int, str], list[float]] = {}
-    for n in counts:
-        for _ in range(draws):
-            keep = np.sort(rng.choice(len(cand), len(cand) - removed, replace=False))
-            sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
-            chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
-            light = settings.preview_light_az_el_deg
-            chosen["optimal"] = keep[planned_leds(data.preview, sub, n, light)]
-            for label, idx in chosen.items():
-                err.setdefault((n, label), []).append(
-                    normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-                )
+    for n, keep, sub in paired_draws(cand, counts, draws, removed, rng):
+        chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
+        light = settings.preview_light_az_el_deg
+        chosen["optimal"] = keep[planned_leds(data.preview, sub, n, light)]
+        for label, idx in chosen.items():
+            err.setdefault((n, label), []).append(
+                normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
+            )
     return err
 
 

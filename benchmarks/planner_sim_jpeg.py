@@ -38,6 +38,7 @@ from benchmarks.planner_sim_draws import (
     FLOORS,
     REMOVED,
     cell,
+    paired_draws,
     scene_floor,
     table_head,
 )
@@ -45,7 +46,6 @@ from benchmarks.report import write_section
 from planner.objectives import SIGNAL_NOISE_JPEG_DOME
 from planner.uniform import select_uniform_leds
 from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
-from rti_rig.rig_geometry import DomeGeometry
 from simulator.camera_model import encode_jpeg, to_srgb8
 
 #: JPEG quality of the simulated 8-bit camera (the simulator's ``encode_jpeg`` default; the
@@ -101,17 +101,14 @@ def scene_errors(
     preview, _ = jpeg_round_trip(data.preview)
     light = settings.preview_light_az_el_deg
     err: dict[tuple[str, int, str], list[float]] = {}
-    for n in COUNTS:
-        for _ in range(DRAWS):
-            keep = np.sort(rng.choice(len(cand), len(cand) - REMOVED, replace=False))
-            sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
-            chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
-            chosen["optimal"] = keep[planned_leds(preview, sub, n, light)]
-            chosen["signal"] = keep[planned_leds(preview, sub, n, light, SIGNAL_NOISE_JPEG_DOME)]
-            for variant, imgs in images.items():
-                for label, idx in chosen.items():
-                    e = normal_error(data.normals, imgs[idx], cand[idx])[0]
-                    err.setdefault((variant, n, label), []).append(e)
+    for n, keep, sub in paired_draws(cand, COUNTS, DRAWS, REMOVED, rng):
+        chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
+        chosen["optimal"] = keep[planned_leds(preview, sub, n, light)]
+        chosen["signal"] = keep[planned_leds(preview, sub, n, light, SIGNAL_NOISE_JPEG_DOME)]
+        for variant, imgs in images.items():
+            for label, idx in chosen.items():
+                e = normal_error(data.normals, imgs[idx], cand[idx])[0]
+                err.setdefault((variant, n, label), []).append(e)
     return err
 
 

@@ -14,8 +14,8 @@ every layout is scored again on a second shot of the same lights with fresh sens
 (:data:`FRESH_NOISE_SEED`); the table gives both. The oracle is a near-bound, not a bound: a
 greedy search from one start.
 
-Run: ``python -m benchmarks.planner_sim_oracle`` (about 20 minutes on 2 cores; writes its
-section of docs/planner.md).
+Run: ``python -m benchmarks.planner_sim_oracle`` (53 minutes in the committed run, sharing 2
+cores with two other benchmarks; writes its section of docs/planner.md).
 """
 
 from __future__ import annotations

@@ -98,3 +98,19 @@ def test_instances_are_other_scenes_and_every_strategy_is_scored() -> None:
     labels = {label for _, label in err}
     assert labels == {"uniform 0", "uniform 10", "uniform 20", "uniform 30", "optimal"}
     assert all(len(v) == 2 and np.all(np.isfinite(v)) for v in err.values())
+
+
+def test_paired_draws_are_the_designs_draws() -> None:
+    """The draw benchmarks share this generator; it must give the subsets the explicit loop
+    gave (same generator calls, same order), so their committed tables stand."""
+    from benchmarks.planner_sim_draws import paired_draws
+
+    cand = fibonacci_cap(40, 3.0, 87.0)
+    got = list(paired_draws(cand, (6, 9), 3, 5, np.random.default_rng(7)))
+    rng = np.random.default_rng(7)
+    want = [(n, np.sort(rng.choice(40, 35, replace=False))) for n in (6, 9) for _ in range(3)]
+    assert [n for n, _, _ in got] == [n for n, _ in want]
+    for (_, keep, sub), (_, expected) in zip(got, want, strict=True):
+        np.testing.assert_array_equal(keep, expected)
+        np.testing.assert_array_equal(sub.directions, cand[keep])
+        assert sub.names == tuple(f"c{i:03d}" for i in keep)
