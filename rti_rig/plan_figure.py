@@ -69,8 +69,8 @@ def layout_figure(
     A dome's LEDs are grey dots; an arm's reachable band is shaded and its keep-out cone
     hatched. The chosen lights are numbered 1…N; ``preview`` (the preview's light) is a star.
     An elevation floor above 0° (``--min-elevation-deg``) and a ceiling below 90°
-    (``--max-elevation-deg``) are dashed rings: the planner took no light outside them, so LEDs
-    there were excluded on purpose, not overlooked.
+    (``--max-elevation-deg``) are dashed and dotted rings: the planner took no light outside
+    them, so LEDs there were excluded on purpose, not overlooked.
     """
     fig = Figure(figsize=(6.4, 7.0), layout="constrained")
     ax = fig.add_subplot(projection="polar")
