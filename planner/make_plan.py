@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -58,7 +58,7 @@ from planner.topography import (
     planning_image,
     shape_from_shading,
 )
-from planner.uniform import order_nearest_neighbour, select_uniform_leds
+from planner.uniform import arm_below, order_nearest_neighbour, select_uniform_leds
 from rti_rig.errors import ScheduleError
 from rti_rig.geometry import az_el_from_direction, fibonacci_cap
 from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
@@ -383,19 +383,6 @@ def _elevation_range(
             "--min-elevation-deg"
         )
     return float(above.min()), float(above.max())
-
-
-def arm_below(arm: ArmGeometry, max_elevation_deg: float) -> ArmGeometry:
-    """The arm as planning sees it under an elevation ceiling: its band cut at the ceiling
-    (its reach, limits and park pose otherwise unchanged)."""
-    if max_elevation_deg >= arm.max_elevation_deg:
-        return arm
-    if max_elevation_deg <= arm.min_elevation_deg:
-        raise ScheduleError(
-            f"--max-elevation-deg {max_elevation_deg:g} is at or below the arm's lowest "
-            f"elevation ({arm.min_elevation_deg:g}°): no light is left; raise it"
-        )
-    return replace(arm, max_elevation_deg=max_elevation_deg)
 
 
 def _uniform_layouts(

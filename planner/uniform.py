@@ -10,6 +10,7 @@ directly within its reachable band.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -70,6 +71,19 @@ def select_uniform_leds(
     return np.sort(candidates[cols])
 
 
+def arm_below(arm: ArmGeometry, max_elevation_deg: float) -> ArmGeometry:
+    """The arm as planning sees it under an elevation ceiling: its band cut at the ceiling
+    (its reach, limits and park pose otherwise unchanged)."""
+    if max_elevation_deg >= arm.max_elevation_deg:
+        return arm
+    if max_elevation_deg <= arm.min_elevation_deg:
+        raise ScheduleError(
+            f"--max-elevation-deg {max_elevation_deg:g} is at or below the arm's lowest "
+            f"elevation ({arm.min_elevation_deg:g}°): no light is left; raise it"
+        )
+    return replace(arm, max_elevation_deg=max_elevation_deg)
+
+
 def order_nearest_neighbour(
     directions: NDArray[np.float64], start: NDArray[np.float64]
 ) -> NDArray[np.intp]:
@@ -94,15 +108,23 @@ def plan_uniform(
     n: int,
     min_elevation_deg: float = 0.0,
     arm_order: ArmOrder | None = None,
+    max_elevation_deg: float = 90.0,
 ) -> LightSchedule:
-    """A homogeneous schedule of ``n`` lights, ordered for the rig.
+    """A homogeneous schedule of ``n`` lights between the elevation floor and ceiling, ordered
+    for the rig.
 
     Dome steps go in LED order. Arm steps go in ``arm_order`` (the move-time-optimal order of
     :mod:`planner.arm_order` when the arm's servos are known), else nearest neighbour by angle.
     """
-    provenance = {"n": n, "min_elevation_deg": min_elevation_deg}
+    provenance = {
+        "n": n,
+        "min_elevation_deg": min_elevation_deg,
+        "max_elevation_deg": max_elevation_deg,
+    }
     if isinstance(geometry, DomeGeometry):
-        leds = select_uniform_leds(geometry, n, min_elevation_deg)
+        leds = select_uniform_leds(
+            geometry, n, min_elevation_deg, max_elevation_deg=max_elevation_deg
+        )
         return LightSchedule.from_directions(
             geometry.directions[leds],
             leds=[int(i) for i in leds],
@@ -110,7 +132,7 @@ def plan_uniform(
             method="uniform",
             provenance=provenance,
         )
-    dirs = geometry.homogeneous(n, min_elevation_deg)
+    dirs = arm_below(geometry, max_elevation_deg).homogeneous(n, min_elevation_deg)
     start = geometry.park_direction
     order = (arm_order or order_nearest_neighbour)(dirs, start)
     order = np.asarray(order, dtype=np.intp)

@@ -174,6 +174,14 @@ def run(
         float,
         typer.Option("--min-elevation-deg", help="Elevation floor of the homogeneous layout."),
     ] = 0.0,
+    max_elevation_deg: Annotated[
+        float,
+        typer.Option(
+            "--max-elevation-deg",
+            help="Elevation ceiling of the homogeneous layout (90 = up to the zenith; 60 keeps "
+            "lights away from the camera axis, see 'plan --max-elevation-deg').",
+        ),
+    ] = 90.0,
     auto_exposure: Annotated[
         bool,
         typer.Option(
@@ -203,6 +211,7 @@ def run(
     continued with --resume.
     """
     from planner.from_lp import schedule_from_lp
+    from planner.make_plan import check_elevation_band
     from planner.uniform import plan_uniform
     from rti_rig.compose import arm_order_for
     from rti_rig.config import load_rig_config, rig_geometry
@@ -251,8 +260,11 @@ def run(
                 )
             else:
                 _check_floor(min_elevation_deg)
+                check_elevation_band(min_elevation_deg, max_elevation_deg)
                 n = lights if lights is not None else _default_lights(loaded, geometry)
-                schedule = plan_uniform(geometry, n, min_elevation_deg, arm_order_for(loaded))
+                schedule = plan_uniform(
+                    geometry, n, min_elevation_deg, arm_order_for(loaded), max_elevation_deg
+                )
             rig, schedule, folder = _open_new_session(
                 loaded, schedule, out_dir, auto_exposure, max_saturated
             )

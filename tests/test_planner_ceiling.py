@@ -245,3 +245,34 @@ def test_ceiling_benchmark_bars_are_tuned_per_n_on_the_real_dome_and_once_on_the
     names = bc.add_bars(once, [6, 9], per_n=False)
     # one floor for every N: floor 0° has the lowest mean over both (1.5 against 1.6 for 20°)
     assert once[(9, "bar")] is err[(9, "uniform 0")] and names["bar"].endswith("floor (0°)")
+
+
+@pytest.mark.parametrize("geometry", [DOME, ARM], ids=["dome", "arm"])
+def test_homogeneous_schedule_under_a_ceiling(geometry) -> None:
+    """plan_uniform (what 'rti-rig run --lights N' runs) keeps to the band too."""
+    from planner.uniform import plan_uniform
+
+    sched = plan_uniform(geometry, 10, 10.0, max_elevation_deg=45.0)
+    el = _elevations(sched)
+    assert len(el) == 10 and el.max() <= 45.0 + 1e-6 and el.min() >= 10.0 - 1e-6
+    assert sched.provenance["max_elevation_deg"] == 45.0
+
+
+def test_run_cli_runs_the_homogeneous_layout_under_the_ceiling(tmp_path: Path) -> None:
+    import json
+
+    cfg = REPO / "rig_configs" / "simulated_dome.toml"
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(out), "--lights", "8", "--max-elevation-deg", "50"]
+    )
+    assert r.exit_code == 0, r.output
+    _, el = az_el_from_direction(np.array([e.direction for e in read_lp(out / "lights.lp")]))
+    assert len(el) == 8 and el.max() <= 50.0 + 1e-3
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert "max_elevation_deg" in json.dumps(manifest)
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(tmp_path / "t"), "--max-elevation-deg", "0"]
+    )
+    assert r.exit_code == 2 and "above the floor" in " ".join(r.output.split())
+    assert not (tmp_path / "t").exists()  # refused before anything was created
