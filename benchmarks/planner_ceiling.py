@@ -39,7 +39,14 @@ from benchmarks.planner_real_data import (
     preview_leds,
     reference,
 )
-from benchmarks.planner_sim_draws import COUNTS, DRAWS, REMOVED, cell, paired_draws
+from benchmarks.planner_sim_draws import (
+    COUNTS,
+    DRAWS,
+    REMOVED,
+    cell,
+    paired_draws,
+    table_head,
+)
 from benchmarks.report import write_section
 from planner.objectives import models_for
 from planner.uniform import select_uniform_leds
@@ -252,8 +259,7 @@ def main(parts: Sequence[str] = ("sim", "real")) -> str:
                 f"{time.perf_counter() - t0:.0f} s, seed {SEED}). Simulator: {DRAWS} draws per "
                 f"N, {REMOVED} of 240 candidates out of service. {head}",
                 "",
-                "| scene | comparison | " + " | ".join(f"N = {n}" for n in COUNTS) + " |",
-                "|---|---|" + "---|" * len(COUNTS),
+                *table_head("scene", "comparison"),
                 *sim,
             ]
         )

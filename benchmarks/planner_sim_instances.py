@@ -30,6 +30,7 @@ from benchmarks.planner_sim_draws import (
     cell,
     paired_draws,
     scene_floor,
+    table_head,
 )
 from benchmarks.report import write_section
 from planner.uniform import select_uniform_leds
@@ -92,8 +93,7 @@ def main(instances: Iterable[int] = INSTANCES, scenes: Iterable[str] | None = No
             "seed 1 and 2 (the table above is seed 0). Cells: tuned homogeneous mean → "
             "`optimal` mean (°), draws the planner won, verdict (bootstrap and sign test).",
             "",
-            "| scene | instance | tuned floor | " + " | ".join(f"N = {n}" for n in COUNTS) + " |",
-            "|---|---|---|" + "---|" * len(COUNTS),
+            *table_head("scene", "instance", "tuned floor"),
             *rows,
         ]
     )

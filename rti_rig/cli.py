@@ -80,14 +80,6 @@ def _check_output_file(
         raise RtiRigError(f"{option} {out_file} exists; use --force to replace it")
 
 
-def _check_floor(min_elevation_deg: float) -> None:
-    """An elevation floor is an angle above the object plane, below the zenith."""
-    if not 0.0 <= min_elevation_deg < 90.0:
-        raise RtiRigError(
-            f"--min-elevation-deg {min_elevation_deg:g}: give an elevation in [0, 90) degrees"
-        )
-
-
 def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
     from rti_rig.rig_geometry import DomeGeometry
 
@@ -259,7 +251,6 @@ def run(
                     read_lp(plan, upper_hemisphere=True), geometry, str(plan)
                 )
             else:
-                _check_floor(min_elevation_deg)
                 check_elevation_band(min_elevation_deg, max_elevation_deg)
                 n = lights if lights is not None else _default_lights(loaded, geometry)
                 schedule = plan_uniform(
@@ -614,7 +605,6 @@ def plan(
             )
         if depth_model is not None and not depth_model.is_file():
             raise RtiRigError(f"--depth-model {depth_model}: file not found")
-        _check_floor(min_elevation_deg)
         check_elevation_band(min_elevation_deg, max_elevation_deg)
         if lights > MAX_LIGHTS:
             raise RtiRigError(
