@@ -27,6 +27,11 @@ from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
 #: File types the map can be written as (by the file name's suffix).
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
 
+#: Marker areas (points²) of a planned light and of the preview's light, which is drawn under
+#: it and larger, so that a planned light at the preview's position keeps its number visible.
+LIGHT_SIZE = 150
+PREVIEW_STAR_SIZE = 520
+
 
 def polar_coordinates(directions: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(angle in radians = azimuth, radius = 90° − elevation) of unit light directions."""
@@ -79,7 +84,7 @@ def layout_figure(
     ax.set_rlim(0.0, 90.0)
     ax.set_rticks([30, 60, 90])
     ax.set_yticklabels(["60°", "30°", ""])  # elevations: the rim is 0°, the centre 90°
-    ax.set_rlabel_position(112.5)
+    ax.set_rlabel_position(292.5)  # away from the default preview light's side (135°)
     ax.grid(True, alpha=0.4)
     if isinstance(geometry, DomeGeometry):
         t, r = polar_coordinates(geometry.directions)
@@ -104,21 +109,24 @@ def layout_figure(
             )
     t, r = polar_coordinates(chosen)
     ax.plot(t, r, color="tab:blue", alpha=0.35, lw=1, zorder=3)  # the firing order
-    ax.scatter(t, r, s=150, c="tab:blue", edgecolors="white", zorder=4, gid="chosen")
+    ax.scatter(t, r, s=LIGHT_SIZE, c="tab:blue", edgecolors="white", zorder=4, gid="chosen")
     for i, (ti, ri) in enumerate(zip(t, r, strict=True), start=1):
         ax.text(ti, ri, str(i), color="white", fontsize=7, ha="center", va="center", zorder=5)
     if preview is not None:
+        # under the planned lights and larger than them: the default plans often fire the
+        # preview's own LED again, and that light's number must stay readable (its star's
+        # points show around it)
         pt, pr = polar_coordinates(preview)
         ax.scatter(
             pt,
             pr,
-            s=220,
+            s=PREVIEW_STAR_SIZE,
             marker="*",
             c="tab:orange",
-            zorder=6,
-            label="preview light",
+            zorder=3.5,
             gid="preview",
         )
+        ax.scatter([], [], s=220, marker="*", c="tab:orange", label="preview light")
     ax.scatter([], [], s=60, c="tab:blue", label=f"planned lights ({len(t)}), in firing order")
     fig.legend(loc="outside lower center", ncol=2, fontsize=8, frameon=False)
     if title:

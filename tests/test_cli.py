@@ -412,3 +412,28 @@ def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
     )
     assert r.exit_code == 2 and "LED calibration" in " ".join(r.output.split())
     assert lp.read_text() == calibration
+
+
+def test_plan_orders_an_arm_by_move_time_with_its_servo_settings(tmp_path: Path) -> None:
+    """``rti-rig plan`` on an arm with ``[arm.dynamixel]`` fires its stops in the move-time
+    order of ``planner.arm_order`` (the issue's "move-time order for arms"), which here is
+    faster than the nearest-neighbour fallback."""
+    from planner.arm_motion import sequence_time_s
+    from planner.arm_order import order_for_arm
+    from planner.uniform import order_nearest_neighbour
+    from rti_rig.config import load_rig_config, rig_geometry
+
+    rig = REPO / "rig_configs" / "simulated_arm.toml"
+    plan = tmp_path / "plan.lp"
+    args = ["plan", "--rig", str(rig), "--lights", "12", "--method", "optimal"]
+    r = runner.invoke(app, [*args, "--out", str(plan)])
+    assert r.exit_code == 0, r.output
+    loaded = load_rig_config(rig)
+    settings = loaded.config.arm.dynamixel
+    park = rig_geometry(loaded).park_direction
+    dirs = np.array([e.direction for e in read_lp(plan)])
+    planned = sequence_time_s(dirs, settings, park)
+    best = sequence_time_s(dirs[order_for_arm(dirs, park, settings)], settings, park)
+    nearest = sequence_time_s(dirs[order_nearest_neighbour(dirs, park)], settings, park)
+    assert planned == pytest.approx(best, rel=1e-3)
+    assert planned < nearest * 0.99

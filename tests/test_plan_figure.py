@@ -218,3 +218,16 @@ def test_title_with_dollar_signs_is_drawn_as_text(tmp_path: Path) -> None:
     fig = layout_figure(DOME.directions[:3], DOME, title=r"dome$\frac$.lp")
     write_layout_figure(tmp_path / "m.png", fig)
     assert (tmp_path / "m.png").stat().st_size > 0
+
+
+def test_a_planned_light_at_the_preview_light_keeps_its_number_visible() -> None:
+    """The preview's LED is often planned again: its star is drawn under that light's disc and
+    number, and large enough for its points to show around the disc."""
+    preview = DOME.directions[7]
+    fig = layout_figure(DOME.directions[[2, 7, 31]], DOME, preview, "t")
+    (star,) = _by_gid(fig, "preview")
+    (chosen,) = _by_gid(fig, "chosen")
+    numbers = fig.axes[0].texts
+    assert star.get_zorder() < chosen.get_zorder()
+    assert all(star.get_zorder() < t.get_zorder() for t in numbers)
+    assert star.get_sizes()[0] > 2 * chosen.get_sizes()[0]
