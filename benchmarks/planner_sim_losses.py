@@ -33,8 +33,9 @@ from numpy.typing import NDArray
 
 from benchmarks.planner_real_data import DOC
 from benchmarks.report import write_section
-from planner.make_plan import estimate_surface, plan_with_report, sample_surface
+from planner.make_plan import plan_with_report
 from planner.objectives import HELD_OUT, NormalsObjective, candidates_for
+from planner.surface_estimate import estimate_surface, sample_surface
 from planner.uniform import select_uniform_leds
 from rti_rig.bench_tradeoff import (
     TradeoffSettings,

@@ -2,26 +2,23 @@
 
 Pipeline (each step a pure function in its own module):
 
-1. :func:`planner.topography.planning_image` — downsample early, linearise, reduce to luminance;
-2. the preview's light: ``preview_light`` (azimuth, elevation in degrees, frame of DESIGN.md) or
-   :func:`planner.topography.estimate_light`;
-3. a relief: the user's ONNX depth model (:func:`planner.topography.depth_from_onnx`) or the
-   weight-free :func:`planner.topography.shape_from_shading` — or, with no preview at all, a
-   level, matte surface (:func:`flat_surface`; on the benchmarks it planned as well);
-4. its scale from the preview's shading and then normals (:mod:`planner.normals`);
-5. the method: ``uniform`` (homogeneous, no preview needed), ``kmeans`` (the paper's) or
+1. the surface (:mod:`planner.surface_estimate`): the preview reduced to a planning image, its
+   light (given or estimated), a relief (an ONNX depth model or shape from shading) scaled by
+   the preview's shading, and normals — or, with no preview at all, a level, matte surface
+   (:func:`planner.surface_estimate.flat_surface`; on the benchmarks it planned as well);
+2. the method: ``uniform`` (homogeneous, no preview needed), ``kmeans`` (the paper's) or
    ``optimal`` (exchange search on an objective, :mod:`planner.optimal`);
-6. the rig's constraints (usable LEDs without repeats / reachable arm band) and its order
+3. the rig's constraints (usable LEDs without repeats / reachable arm band) and its order
    (ascending LED index on a dome; shortest moves from the park pose on an arm).
 
-The default objective is ``normals``: see docs/planner.md for the real-dome evidence behind it.
+The evidence behind a plan is a :class:`planner.plan_report.PlanReport`. The default objective
+is ``normals``: see docs/planner.md for the real-dome evidence behind it.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -30,34 +27,30 @@ from numpy.typing import NDArray
 from threadpoolctl import threadpool_limits
 
 from planner.kmeans_method import plan_kmeans
-from planner.normals import (
-    ReliefFit,
-    fit_relief_scale,
-    normals_from_height,
-    sanitize_height,
-)
 from planner.objectives import (
     GLOSSY_SPECULAR,
     GLOSSY_WIDTH_DEG,
     HELD_OUT,
     OBJECTIVES,
     Candidates,
-    SurfaceSample,
+    NormalsObjective,
+    RelightObjective,
     candidates_for,
-    cast_shadow_visibility,
     check_material,
     check_signal_noise,
     make_objective,
 )
 from planner.optimal import exchange_search
-from planner.topography import (
-    DepthModelSpec,
-    depth_from_onnx,
-    estimate_light,
-    given_light,
-    planning_image,
-    shape_from_shading,
+from planner.plan_report import PlanReport
+from planner.surface_estimate import (
+    SurfaceEstimate,
+    estimate_surface,
+    flat_surface,
+    relief_trust,
+    sample_surface,
+    tilt_stats,
 )
+from planner.topography import DepthModelSpec
 from planner.uniform import arm_below, order_nearest_neighbour, select_uniform_leds
 from rti_rig.errors import ScheduleError
 from rti_rig.geometry import az_el_from_direction, fibonacci_cap
@@ -75,238 +68,9 @@ START_FLOORS_DEG = (10.0, 20.0, 30.0, 40.0)
 #: Below this many pixels on a side a preview cannot show relief (the report says so).
 TINY_PREVIEW_PX = 16
 
-#: Pixels sampled for the objectives.
-SAMPLE_PIXELS = 256
-
-#: A preview with more than this fraction of clipped pixels carries no shading to read.
-MAX_SATURATED_FRACTION = 0.95
-
 ArmOrder = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.intp]]
 
-
-@dataclass(frozen=True, eq=False)
-class SurfaceEstimate:
-    """What one preview says about the surface, at planning resolution."""
-
-    image: NDArray[np.float64]
-    light: NDArray[np.float64]
-    light_source: str
-    relief_px: NDArray[np.float64]
-    normals: NDArray[np.float64]
-    fit: ReliefFit
-    relief_source: str
-    nonfinite_repaired: int
-    #: normals of the fitted relief before the trust shrinkage (what the paper's k-means sees)
-    fitted_normals: NDArray[np.float64] | None = None
-
-
-@dataclass
-class PlanReport:
-    """Evidence behind a plan, for the CLI to print and the session to keep."""
-
-    method: str
-    objective: str
-    n: int
-    rig: str
-    candidates: int
-    min_elevation_deg: float
-    max_elevation_deg: float = 90.0
-    preview_shape: tuple[int, ...] | None = None
-    planning_shape: tuple[int, ...] | None = None
-    preview_light_az_el_deg: tuple[float, float] | None = None
-    preview_light_source: str | None = None
-    relief_source: str | None = None
-    relief_scale: float | None = None
-    shading_explained_r2: float | None = None
-    rms_tilt_deg: float | None = None
-    p90_tilt_deg: float | None = None
-    highlight_hint: float | None = None
-    nonfinite_relief_repaired: int = 0
-    signal_noise: float = 0.0
-    material: str = "auto"
-    model: str | None = None
-    expected: dict[str, float] = field(default_factory=dict)
-    expected_meaning: str | None = None
-    start_layout: str | None = None
-    swaps: int | None = None
-    kmeans_distinct_normals: int | None = None
-    notes: list[str] = field(default_factory=list)
-    seconds: float = 0.0
-
-    def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
-
-    def lines(self) -> list[str]:
-        """Human-readable summary, one fact per line."""
-        out = [f"method {self.method}, objective {self.objective}, {self.n} lights on {self.rig}"]
-        if self.max_elevation_deg < 90.0:
-            out.append(
-                f"lights between {self.min_elevation_deg:g}° and {self.max_elevation_deg:g}° "
-                "elevation (none near the camera axis)"
-            )
-        if self.preview_light_az_el_deg is not None:
-            az, el = self.preview_light_az_el_deg
-            out.append(f"preview light az {az:.1f}°, el {el:.1f}° ({self.preview_light_source})")
-        if self.relief_source and self.shading_explained_r2 is None:
-            out.append(f"relief: {self.relief_source}")
-        elif self.relief_source:
-            out.append(
-                f"relief from {self.relief_source}: RMS tilt {self.rms_tilt_deg:.1f}°, "
-                f"90th percentile {self.p90_tilt_deg:.1f}°, shading explained "
-                f"R²={self.shading_explained_r2:.2f}"
-            )
-        if self.model:
-            out.append(f"relighting model assumed: {self.model}")
-        if self.signal_noise > 0:
-            out.append(
-                f"noise modelled: {100 * self.signal_noise:g} % of the signal on top of the "
-                "additive noise (in the tests it cost accuracy on a steeply tilted flat object, "
-                "and on brushed steel from 12 lights: give --signal-noise 0 for such objects; "
-                "docs/planner.md)"
-            )
-        if self.expected and self.expected_meaning:
-            parts = ", ".join(f"{k} {v:#.4g}" for k, v in self.expected.items())
-            out.append(f"{self.expected_meaning}: {parts}")
-        out.extend(self.notes)
-        out.append(f"planned in {self.seconds:.2f} s")
-        return out
-
-
-def relief_trust(fit: ReliefFit) -> float:
-    """How far to believe the fitted relief: the R² of the preview's shading fit, in [0, 1].
-
-    The relief's slopes are multiplied by it (shrinkage towards the flat surface, the prior of
-    RTI targets). On the real painted icon of the benchmark the unshrunk shape-from-shading
-    relief (R² ≈ 0.1) misled the planner into worse layouts than assuming a flat surface.
-    """
-    return float(np.clip(fit.explained, 0.0, 1.0))
-
-
-def estimate_surface(
-    preview: NDArray,
-    preview_light: tuple[float, float] | None = None,
-    depth_model: Path | None = None,
-    depth_spec: DepthModelSpec | None = None,
-) -> SurfaceEstimate:
-    """Steps 1–4 of the pipeline (see module docstring)."""
-    image = planning_image(preview)
-    peak = float(image.max()) if image.size else 0.0
-    if not peak > 1e-6:
-        raise ScheduleError(
-            "the preview is black: no light reached the sensor, so it says nothing about the "
-            "surface; retake it with a longer exposure, or plan without a preview "
-            "(--method optimal or uniform)"
-        )
-    if float(np.mean(image >= 0.995)) > MAX_SATURATED_FRACTION:
-        raise ScheduleError(
-            "the preview is saturated almost everywhere, so its shading is lost; retake it "
-            "with a shorter exposure, or plan without a preview (--method optimal or uniform)"
-        )
-    if preview_light is not None:
-        light, light_source, albedo = given_light(preview_light), "given", None
-    else:
-        est = estimate_light(image)
-        light, light_source, albedo = est.direction, "estimated (Zheng-Chellappa)", None
-    if depth_model is not None:
-        raw = depth_from_onnx(preview, Path(depth_model), depth_spec, out_shape=image.shape)
-        source = f"depth model {Path(depth_model).name}"
-        height, bad = sanitize_height(raw, source)
-    else:
-        height, bad = shape_from_shading(image, light, albedo), 0
-        source = "shape from shading"
-    fit = fit_relief_scale(height, image, light)
-    # shrink the relief by the share of the preview it explains: a preview that is mostly
-    # albedo (a painting) must not be read as steep relief (see docs/planner.md)
-    relief = fit.scale * relief_trust(fit) * height
-    return SurfaceEstimate(
-        image,
-        light,
-        light_source,
-        relief,
-        normals_from_height(relief),
-        fit,
-        source,
-        bad,
-        normals_from_height(fit.scale * height),
-    )
-
-
-#: Side (pixels) of the stand-in planning image when there is no preview.
-FLAT_SIDE_PX = 16
-
-
-def flat_surface() -> SurfaceEstimate:
-    """What the ``optimal`` planner assumes without a preview: a level, matte surface.
-
-    The model alone (shadows of the tilt hedge, noise propagation, the reflectance prior) then
-    chooses the lights. On the real dome and on the simulator's scenes this did as well as
-    planning from a preview (docs/planner.md), so a preview shot is optional for ``optimal``.
-    It is exactly what a uniform grey preview yields (tested, down to 1×1): no relief, no
-    highlight hint.
-    """
-    relief = np.zeros((FLAT_SIDE_PX, FLAT_SIDE_PX))
-    normals = normals_from_height(relief)
-    fit = ReliefFit(scale=0.0, albedo=0.0, explained=0.0, rms_slope_deg=0.0, bright_outliers=0.0)
-    return SurfaceEstimate(
-        np.full_like(relief, 0.5),
-        np.array([0.0, 0.0, 1.0]),
-        "none (no preview)",
-        relief,
-        normals,
-        fit,
-        "none (no preview: a level surface)",
-        0,
-        normals,
-    )
-
-
-def sample_surface(
-    surface: SurfaceEstimate,
-    candidates: Candidates,
-    held_out: NDArray[np.float64],
-    n_pixels: int = SAMPLE_PIXELS,
-    seed: int = 0,
-    material: str = "auto",
-) -> SurfaceSample:
-    """A seeded pixel sample with cast-shadow maps for the candidates and held-out lights.
-
-    ``material`` (:data:`planner.objectives.MATERIALS`) sets the highlight model: ``auto``
-    from the preview's bright outliers, ``matte`` none, ``glossy`` the declared lobe.
-    """
-    check_material(material)
-    h, w = surface.image.shape
-    rng = np.random.default_rng(seed)
-    count = min(n_pixels, h * w)
-    flat = rng.choice(h * w, count, replace=False)
-    rows, cols = np.divmod(flat, w)
-    normals = surface.normals.reshape(-1, 3)[flat]
-    lit_c = cast_shadow_visibility(surface.relief_px, rows, cols, candidates.directions)
-    lit_t = cast_shadow_visibility(surface.relief_px, rows, cols, held_out)
-    width = None
-    if material == "glossy":
-        specular, width = GLOSSY_SPECULAR, GLOSSY_WIDTH_DEG
-    elif material == "matte":
-        specular = 0.0
-    else:
-        # the hint's ceiling is the declared glossy strength
-        hint = 10.0 * (surface.fit.bright_outliers - 0.005)
-        specular = float(np.clip(hint, 0.0, GLOSSY_SPECULAR))
-    normals, weights = hedge_global_tilt(normals)
-    copies = len(normals) // count
-    return SurfaceSample(
-        normals,
-        weights,
-        np.tile(lit_c, (copies, 1)),
-        held_out,
-        np.tile(lit_t, (copies, 1)),
-        specular,
-        highlight_width_deg=width,
-        base_count=count,
-    )
-
-
-#: Below this many lights the exchange search is not run (see ``_plan``): 3 lights are exactly
+#: Below this many lights the exchange search is not run (see ``_run_method``): 3 lights are exactly
 #: the unknowns of the Lambertian fit, with no redundancy left for a shadow or a highlight.
 MIN_LIGHTS_FOR_EXCHANGE = 4
 
@@ -315,45 +79,6 @@ MIN_LIGHTS_FOR_EXCHANGE = 4
 #: by default, wins at both declared glossy; simulator: losses on brushed steel at 20 and 30
 #: against a 10° floor), so the report says so.
 MANY_LIGHTS = 12
-
-#: Global tilts the planner hedges against (degrees from the camera axis) and their share.
-TILT_PRIOR_DEG = 25.0
-TILT_PRIOR_AZIMUTHS = 6
-TILT_PRIOR_SHARE = 0.3
-
-
-def hedge_global_tilt(
-    normals: NDArray[np.float64],
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The sampled normals plus copies under plausible global tilts, and their weights.
-
-    One image cannot show a global tilt: a tilted plane shades uniformly, exactly like a level
-    plane of another albedo, so shape from shading (and a relative-depth network) returns it
-    level. Planning for the level surface alone puts low lights where a tilted object would
-    leave them in attached shadow, and three such lights leave every pixel unsolvable (on the
-    simulated 50°-tilted scene at N = 3: 49.9° mean error without the hedge, 2.5° with it). So
-    ``1 - TILT_PRIOR_SHARE`` of the weight stays on the estimate and the rest is spread over
-    copies tilted by ``TILT_PRIOR_DEG`` towards ``TILT_PRIOR_AZIMUTHS`` azimuths. The constants
-    were chosen on the simulator's quick trade-off scenes (share 0.3 and 25° had the smallest
-    worst-case ratio to uniform of the variants tried); they are not tuned on real data.
-    """
-    n = len(normals)
-    out = [normals]
-    weights = [np.full(n, 1.0 - TILT_PRIOR_SHARE)]
-    t = np.radians(TILT_PRIOR_DEG)
-    for k in range(TILT_PRIOR_AZIMUTHS):
-        phi = 2.0 * np.pi * k / TILT_PRIOR_AZIMUTHS
-        axis = np.array([-np.sin(phi), np.cos(phi), 0.0])  # tilts +z towards azimuth phi
-        kx = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-        rot = np.eye(3) + np.sin(t) * kx + (1 - np.cos(t)) * (kx @ kx)
-        out.append(normals @ rot.T)
-        weights.append(np.full(n, TILT_PRIOR_SHARE / TILT_PRIOR_AZIMUTHS))
-    return np.concatenate(out), np.concatenate(weights)
-
-
-def _tilt_stats(normals: NDArray[np.float64]) -> tuple[float, float]:
-    tilt = np.degrees(np.arccos(np.clip(normals[..., 2], -1.0, 1.0))).ravel()
-    return float(np.sqrt(np.mean(tilt**2))), float(np.percentile(tilt, 90))
 
 
 def check_elevation_band(min_elevation_deg: float, max_elevation_deg: float) -> None:
@@ -512,40 +237,13 @@ def _plan(
     max_elevation_deg: float = 90.0,
 ) -> tuple[LightSchedule, PlanReport]:
     t0 = time.perf_counter()
-    if method not in METHODS:
-        raise ScheduleError(f"unknown method '{method}'; use one of {', '.join(METHODS)}")
-    if objective not in OBJECTIVES:
-        raise ScheduleError(f"unknown objective '{objective}'; use one of {', '.join(OBJECTIVES)}")
-    if n < 1:
-        raise ScheduleError(f"--lights must be at least 1, got {n}")
-    check_signal_noise(signal_noise, objective)
-    check_material(material)
-    check_elevation_band(min_elevation_deg, max_elevation_deg)
-    # the relight objective scores relighting over the rig's whole range above the floor, the
-    # directions above a ceiling included (a user relights there too), so take it before the cut
-    relit_band, cut = (0.0, 90.0), False
-    if max_elevation_deg < 90.0:
-        try:
-            relit_band = _elevation_range(geometry, min_elevation_deg)
-            cut = relit_band[1] > max_elevation_deg
-        except ScheduleError:
-            pass  # nothing above the floor: the homogeneous layouts below say so
+    _check_request(
+        n, method, objective, signal_noise, material, min_elevation_deg, max_elevation_deg
+    )
+    relit_band, cut = _relit_band(geometry, min_elevation_deg, max_elevation_deg)
     if isinstance(geometry, ArmGeometry):
         geometry = arm_below(geometry, max_elevation_deg)
-    floors = [min_elevation_deg] + [
-        f for f in START_FLOORS_DEG if min_elevation_deg < f < max_elevation_deg
-    ]
-    uniforms, uniform_error = _uniform_layouts(geometry, n, floors, max_elevation_deg)
-    if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
-        # the user's own floor must work; the extra floors are optional starting points
-        raise ScheduleError(uniform_error or "no homogeneous layout fits this rig")
-    extra = np.concatenate([u[1] for u in uniforms]) if isinstance(geometry, ArmGeometry) else None
-    candidates = candidates_for(geometry, min_elevation_deg, extra, max_elevation_deg)
-    starts: list[tuple[str, NDArray[np.intp]]] = []
-    offset = 0
-    for u in uniforms:
-        starts.append((u[0], _to_candidate_indices(u, candidates, offset)))
-        offset += len(u[1])
+    candidates, starts = _candidates_and_starts(geometry, n, min_elevation_deg, max_elevation_deg)
     rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
     report = PlanReport(
         method,
@@ -564,12 +262,108 @@ def _plan(
         "objective": objective,
     }
 
+    chosen = starts[0][1]
+    surface = _surface_for(
+        preview, method, material, preview_light, depth_model, depth_spec, report
+    )
+    if surface is not None:
+        held_out = _held_out_lights(candidates, relit_band, cut)
+        sample = sample_surface(surface, candidates, held_out, seed=seed, material=material)
+        if method == "kmeans":
+            chosen = _run_kmeans(surface, n, candidates, seed, cut, max_elevation_deg, report)
+            starts.append(("kmeans", chosen))
+        obj = make_objective(objective, sample, candidates, n, starts[0][1], signal_noise)
+        report.signal_noise = signal_noise
+        _note_assumptions(report, method, objective, n, signal_noise, material)
+        chosen = _run_method(obj, method, objective, n, material, starts, chosen, report)
+    if surface is None and material != "auto":
+        report.notes.append(
+            f"--material {material} is not used: no surface was modelled ({method} needs none)"
+        )
+    report.seconds = time.perf_counter() - t0
+    prov["report"] = report.to_dict()
+    schedule = _schedule(geometry, candidates, chosen, method, prov, arm_order)
+    return schedule, report
+
+
+def _check_request(
+    n: int,
+    method: str,
+    objective: str,
+    signal_noise: float,
+    material: str,
+    min_elevation_deg: float,
+    max_elevation_deg: float,
+) -> None:
+    """Refuse an unknown method, objective or material, a light count below 1, a signal noise
+    the objective does not model and an empty elevation band."""
+    if method not in METHODS:
+        raise ScheduleError(f"unknown method '{method}'; use one of {', '.join(METHODS)}")
+    if objective not in OBJECTIVES:
+        raise ScheduleError(f"unknown objective '{objective}'; use one of {', '.join(OBJECTIVES)}")
+    if n < 1:
+        raise ScheduleError(f"--lights must be at least 1, got {n}")
+    check_signal_noise(signal_noise, objective)
+    check_material(material)
+    check_elevation_band(min_elevation_deg, max_elevation_deg)
+
+
+def _relit_band(
+    geometry: DomeGeometry | ArmGeometry, min_elevation_deg: float, max_elevation_deg: float
+) -> tuple[tuple[float, float], bool]:
+    """The elevations (degrees) the relight objective scores, and whether the ceiling cuts the
+    rig's range above the floor."""
+    # the relight objective scores relighting over the rig's whole range above the floor, the
+    # directions above a ceiling included (a user relights there too), so take it before the cut
+    relit_band, cut = (0.0, 90.0), False
+    if max_elevation_deg < 90.0:
+        try:
+            relit_band = _elevation_range(geometry, min_elevation_deg)
+            cut = relit_band[1] > max_elevation_deg
+        except ScheduleError:
+            pass  # nothing above the floor: the homogeneous layouts below say so
+    return relit_band, cut
+
+
+def _candidates_and_starts(
+    geometry: DomeGeometry | ArmGeometry, n: int, min_elevation_deg: float, max_elevation_deg: float
+) -> tuple[Candidates, list[tuple[str, NDArray[np.intp]]]]:
+    """The usable light positions and the homogeneous starting layouts (label, candidate
+    indices), the one at the user's floor first (an arm is limited by :func:`arm_below`
+    beforehand)."""
+    floors = [min_elevation_deg] + [
+        f for f in START_FLOORS_DEG if min_elevation_deg < f < max_elevation_deg
+    ]
+    uniforms, uniform_error = _uniform_layouts(geometry, n, floors, max_elevation_deg)
+    if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
+        # the user's own floor must work; the extra floors are optional starting points
+        raise ScheduleError(uniform_error or "no homogeneous layout fits this rig")
+    extra = np.concatenate([u[1] for u in uniforms]) if isinstance(geometry, ArmGeometry) else None
+    candidates = candidates_for(geometry, min_elevation_deg, extra, max_elevation_deg)
+    starts: list[tuple[str, NDArray[np.intp]]] = []
+    offset = 0
+    for u in uniforms:
+        starts.append((u[0], _to_candidate_indices(u, candidates, offset)))
+        offset += len(u[1])
+    return candidates, starts
+
+
+def _surface_for(
+    preview: NDArray | None,
+    method: str,
+    material: str,
+    preview_light: tuple[float, float] | None,
+    depth_model: Path | None,
+    depth_spec: DepthModelSpec | None,
+    report: PlanReport,
+) -> SurfaceEstimate | None:
+    """The surface to plan for: estimated from the preview, assumed level without one (for
+    ``optimal``), or None when the method needs none; its facts go into ``report``."""
     if method == "kmeans" and preview is None:
         raise ScheduleError(
             "--method kmeans clusters the preview's normals; give a preview shot, or use "
             "--method optimal (which plans for a flat surface without one) or uniform"
         )
-    chosen = starts[0][1]
     surface: SurfaceEstimate | None = None
     if preview is None and (preview_light is not None or depth_model is not None):
         given = "--preview-light" if preview_light is not None else "--depth-model"
@@ -594,128 +388,164 @@ def _plan(
             report.notes.append(f"preview not evaluated: {exc}")
     if surface is not None:
         report.relief_source = surface.relief_source
-        report.rms_tilt_deg, report.p90_tilt_deg = _tilt_stats(surface.normals)
+        report.rms_tilt_deg, report.p90_tilt_deg = tilt_stats(surface.normals)
     if surface is not None and preview is not None:
-        # facts measured on the preview (none of them exist without one)
-        az, el = az_el_from_direction(surface.light)
-        report.preview_shape = tuple(np.asarray(preview).shape)
-        if min(report.preview_shape[:2]) < TINY_PREVIEW_PX:
-            report.notes.append(
-                f"the preview is only {report.preview_shape[1]}×{report.preview_shape[0]} px: "
-                "too small to show relief or the light's direction reliably, so this plan rests "
-                "on very little evidence (give a larger preview, or none for the plan of a "
-                "level surface)"
-            )
-        report.preview_light_az_el_deg = (float(az), float(el))
-        report.preview_light_source = surface.light_source
-        report.planning_shape = tuple(surface.image.shape)
-        report.relief_scale = surface.fit.scale * relief_trust(surface.fit)
-        report.shading_explained_r2 = surface.fit.explained
-        report.highlight_hint = surface.fit.bright_outliers
-        report.nonfinite_relief_repaired = surface.nonfinite_repaired
-        if surface.nonfinite_repaired:
-            report.notes.append(
-                f"{surface.nonfinite_repaired} NaN/infinite relief values were replaced by the "
-                "median"
-            )
-    if surface is not None:
-        if cut:
-            lo, hi = relit_band
-        else:  # exactly the candidates' range, as before ceilings existed
-            _, cel = az_el_from_direction(candidates.directions)
-            lo, hi = float(cel.min()), float(cel.max())
-        held_out = fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)
-        sample = sample_surface(surface, candidates, held_out, seed=seed, material=material)
-        if method == "kmeans":
-            # the paper clusters the depth gradient's normals as they come: no shrinkage
-            raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
-            chosen, km = plan_kmeans(raw, n, candidates, seed)
-            report.kmeans_distinct_normals = km.distinct_normals
-            if cut:
-                report.notes.append(
-                    f"kmeans puts each light at the usable position nearest its cluster centre: "
-                    f"under the {max_elevation_deg:g}° ceiling the clusters of a near-level "
-                    "surface all land on the ceiling's ring"
-                )
-            if km.distinct_normals < n:
-                report.notes.append(
-                    f"only {km.distinct_normals} distinct normals for {n} clusters: the "
-                    "remaining lights sit on the usable positions nearest the cluster centres"
-                )
-            starts.append(("kmeans", chosen))
-        obj = make_objective(objective, sample, candidates, n, starts[0][1], signal_noise)
-        report.signal_noise = signal_noise
-        if signal_noise > 0 and (method != "optimal" or n < MIN_LIGHTS_FOR_EXCHANGE):
-            report.notes.append(
-                f"--signal-noise changes only the expected errors reported here, not the "
-                f"lights {method} chooses"
-            )
-        if material != "auto":
-            unused = (
-                ""
-                if method == "optimal" and n >= MIN_LIGHTS_FOR_EXCHANGE
-                else f" (it changes only the expected errors reported here, not the lights "
-                f"{method} chooses)"
-            )
-            what = (
-                f"highlights modelled as a {GLOSSY_WIDTH_DEG:g}° lobe of strength "
-                f"{GLOSSY_SPECULAR:g} around the mirror direction"
-                if material == "glossy"
-                else "no highlight modelled"
-            )
-            report.notes.append(f"declared {material}: {what}, whatever the preview shows{unused}")
-        if objective == "relight" and method == "optimal":
-            report.notes.append(
-                "evidence: on the real dome of docs/planner.md the normals objective's layouts "
-                "relit better than this objective's at 6, 9, 12 and 18 lights (mean PSNR over "
-                "144 draws; median over 8 previews with --material glossy too); for "
-                "relighting, --objective normals is the tested choice"
-            )
-        report.model = getattr(obj, "model", "lambert (photometric stereo)")
-        report.expected_meaning = (
-            "expected RMS normal error (degrees)"
-            if objective == "normals"
-            else f"expected relighting MSE per unit albedo ({report.model})"
-        )
-        if method == "optimal" and n <= MIN_LIGHTS_FOR_EXCHANGE - 1:
-            # With as many lights as unknowns, one shadowed or clipped light leaves a pixel
-            # unsolvable: a cliff the expected-error objective cannot see. On the simulated
-            # scenes, exchanges at N = 3 collapsed on the tilted one (43° against 1.2°), and
-            # choosing among elevation floors by the objective picked near-coplanar high
-            # lights (painting 14.6° against 3.7°). So three lights stay homogeneous at the
-            # user's floor: the preview-free choice, never worse than itself.
-            label, chosen = starts[0]
-            report.start_layout, report.swaps = label, 0
-            report.expected[label] = obj.cost(chosen)
-            report.notes.append(
-                f"{n} lights leave no redundancy for a shadow or a highlight: the homogeneous "
-                f"layout ({label}) is kept"
-            )
-        elif method == "optimal":
-            res = exchange_search(obj, starts)
-            chosen = res.chosen
-            report.start_layout, report.swaps = res.start_label, res.swaps
-            report.expected.update(res.start_costs)
-            report.expected["optimal"] = res.cost
-            if n >= MANY_LIGHTS and objective == "normals" and res.swaps > 0:
-                glossy = "" if material == "glossy" else "; for gilding, --material glossy helped"
-                report.notes.append(
-                    f"from {MANY_LIGHTS} lights the planner gained little over an even layout in "
-                    "the tests (docs/planner.md): for brushed metal at 20 lights or more, "
-                    f"--method uniform --min-elevation-deg 10 did better{glossy}"
-                )
-        else:
-            report.expected[starts[0][0]] = obj.cost(starts[0][1])
-            if method == "kmeans":
-                report.expected["kmeans"] = obj.cost(chosen)
-    if surface is None and material != "auto":
+        _report_preview_facts(preview, surface, report)
+    return surface
+
+
+def _report_preview_facts(preview: NDArray, surface: SurfaceEstimate, report: PlanReport) -> None:
+    """Facts measured on the preview (none of them exist without one)."""
+    az, el = az_el_from_direction(surface.light)
+    report.preview_shape = tuple(np.asarray(preview).shape)
+    if min(report.preview_shape[:2]) < TINY_PREVIEW_PX:
         report.notes.append(
-            f"--material {material} is not used: no surface was modelled ({method} needs none)"
+            f"the preview is only {report.preview_shape[1]}×{report.preview_shape[0]} px: "
+            "too small to show relief or the light's direction reliably, so this plan rests "
+            "on very little evidence (give a larger preview, or none for the plan of a "
+            "level surface)"
         )
-    report.seconds = time.perf_counter() - t0
-    prov["report"] = report.to_dict()
-    schedule = _schedule(geometry, candidates, chosen, method, prov, arm_order)
-    return schedule, report
+    report.preview_light_az_el_deg = (float(az), float(el))
+    report.preview_light_source = surface.light_source
+    report.planning_shape = tuple(surface.image.shape)
+    report.relief_scale = surface.fit.scale * relief_trust(surface.fit)
+    report.shading_explained_r2 = surface.fit.explained
+    report.highlight_hint = surface.fit.bright_outliers
+    report.nonfinite_relief_repaired = surface.nonfinite_repaired
+    if surface.nonfinite_repaired:
+        report.notes.append(
+            f"{surface.nonfinite_repaired} NaN/infinite relief values were replaced by the median"
+        )
+
+
+def _held_out_lights(
+    candidates: Candidates, relit_band: tuple[float, float], cut: bool
+) -> NDArray[np.float64]:
+    """The held-out lights the objectives score a layout on: over the relit band under a
+    ceiling that cuts the rig's range, otherwise over the candidates' range."""
+    if cut:
+        lo, hi = relit_band
+    else:  # exactly the candidates' range, as before ceilings existed
+        _, cel = az_el_from_direction(candidates.directions)
+        lo, hi = float(cel.min()), float(cel.max())
+    return fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)
+
+
+def _run_kmeans(
+    surface: SurfaceEstimate,
+    n: int,
+    candidates: Candidates,
+    seed: int,
+    cut: bool,
+    max_elevation_deg: float,
+    report: PlanReport,
+) -> NDArray[np.intp]:
+    """The paper's method: the usable positions nearest the preview's normal clusters."""
+    # the paper clusters the depth gradient's normals as they come: no shrinkage
+    raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
+    chosen, km = plan_kmeans(raw, n, candidates, seed)
+    report.kmeans_distinct_normals = km.distinct_normals
+    if cut:
+        report.notes.append(
+            f"kmeans puts each light at the usable position nearest its cluster centre: "
+            f"under the {max_elevation_deg:g}° ceiling the clusters of a near-level "
+            "surface all land on the ceiling's ring"
+        )
+    if km.distinct_normals < n:
+        report.notes.append(
+            f"only {km.distinct_normals} distinct normals for {n} clusters: the "
+            "remaining lights sit on the usable positions nearest the cluster centres"
+        )
+    return chosen
+
+
+def _note_assumptions(
+    report: PlanReport,
+    method: str,
+    objective: str,
+    n: int,
+    signal_noise: float,
+    material: str,
+) -> None:
+    """Notes on the declared signal noise and material and on the objective's evidence."""
+    if signal_noise > 0 and (method != "optimal" or n < MIN_LIGHTS_FOR_EXCHANGE):
+        report.notes.append(
+            f"--signal-noise changes only the expected errors reported here, not the "
+            f"lights {method} chooses"
+        )
+    if material != "auto":
+        unused = (
+            ""
+            if method == "optimal" and n >= MIN_LIGHTS_FOR_EXCHANGE
+            else f" (it changes only the expected errors reported here, not the lights "
+            f"{method} chooses)"
+        )
+        what = (
+            f"highlights modelled as a {GLOSSY_WIDTH_DEG:g}° lobe of strength "
+            f"{GLOSSY_SPECULAR:g} around the mirror direction"
+            if material == "glossy"
+            else "no highlight modelled"
+        )
+        report.notes.append(f"declared {material}: {what}, whatever the preview shows{unused}")
+    if objective == "relight" and method == "optimal":
+        report.notes.append(
+            "evidence: on the real dome of docs/planner.md the normals objective's layouts "
+            "relit better than this objective's at 6, 9, 12 and 18 lights (mean PSNR over "
+            "144 draws; median over 8 previews with --material glossy too); for "
+            "relighting, --objective normals is the tested choice"
+        )
+
+
+def _run_method(
+    obj: NormalsObjective | RelightObjective,
+    method: str,
+    objective: str,
+    n: int,
+    material: str,
+    starts: list[tuple[str, NDArray[np.intp]]],
+    chosen: NDArray[np.intp],
+    report: PlanReport,
+) -> NDArray[np.intp]:
+    """The lights ``method`` chooses (``chosen`` unless it is ``optimal``), with the expected
+    errors of the layouts it compared recorded in ``report``."""
+    report.model = getattr(obj, "model", "lambert (photometric stereo)")
+    report.expected_meaning = (
+        "expected RMS normal error (degrees)"
+        if objective == "normals"
+        else f"expected relighting MSE per unit albedo ({report.model})"
+    )
+    if method == "optimal" and n <= MIN_LIGHTS_FOR_EXCHANGE - 1:
+        # With as many lights as unknowns, one shadowed or clipped light leaves a pixel
+        # unsolvable: a cliff the expected-error objective cannot see. On the simulated
+        # scenes, exchanges at N = 3 collapsed on the tilted one (43° against 1.2°), and
+        # choosing among elevation floors by the objective picked near-coplanar high
+        # lights (painting 14.6° against 3.7°). So three lights stay homogeneous at the
+        # user's floor: the preview-free choice, never worse than itself.
+        label, chosen = starts[0]
+        report.start_layout, report.swaps = label, 0
+        report.expected[label] = obj.cost(chosen)
+        report.notes.append(
+            f"{n} lights leave no redundancy for a shadow or a highlight: the homogeneous "
+            f"layout ({label}) is kept"
+        )
+    elif method == "optimal":
+        res = exchange_search(obj, starts)
+        chosen = res.chosen
+        report.start_layout, report.swaps = res.start_label, res.swaps
+        report.expected.update(res.start_costs)
+        report.expected["optimal"] = res.cost
+        if n >= MANY_LIGHTS and objective == "normals" and res.swaps > 0:
+            glossy = "" if material == "glossy" else "; for gilding, --material glossy helped"
+            report.notes.append(
+                f"from {MANY_LIGHTS} lights the planner gained little over an even layout in "
+                "the tests (docs/planner.md): for brushed metal at 20 lights or more, "
+                f"--method uniform --min-elevation-deg 10 did better{glossy}"
+            )
+    else:
+        report.expected[starts[0][0]] = obj.cost(starts[0][1])
+        if method == "kmeans":
+            report.expected["kmeans"] = obj.cost(chosen)
+    return chosen
 
 
 def make_plan(
@@ -735,10 +565,11 @@ def make_plan(
 
     ``preview`` is an image (H, W) or (H, W, 3): uint8 is sRGB, uint16 and float are linear
     (see :mod:`planner.topography`). It may be ``None`` for ``uniform`` (no preview needed) and
-    ``optimal`` (which then plans for a level, matte surface: :func:`flat_surface`). Dome
-    steps carry LED indices and the dome's LED names as labels, in ascending LED order; arm
-    steps are ordered for short moves from the park pose. The evidence is in
-    ``schedule.provenance["report"]`` (or use :func:`plan_with_report`).
+    ``optimal`` (which then plans for a level, matte surface:
+    :func:`planner.surface_estimate.flat_surface`). Dome steps carry LED indices and the dome's
+    LED names as labels, in ascending LED order; arm steps are ordered for short moves from the
+    park pose. The evidence is in ``schedule.provenance["report"]`` (or use
+    :func:`plan_with_report`).
     """
     args = (preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg)
     return plan_with_report(

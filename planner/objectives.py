@@ -163,7 +163,7 @@ class SurfaceSample:
     ``lit_candidates[p, k]`` / ``lit_held_out[p, t]`` are 1 where light k / t reaches pixel p
     without a cast shadow (from the preview's relief) and 0 where it is blocked;
     ``specular`` (0..1) is the strength of the highlight lobe, from the preview's hint or the
-    user's declared material (``planner.make_plan.sample_surface``).
+    user's declared material (``planner.surface_estimate.sample_surface``).
     """
 
     normals: NDArray[np.float64]
@@ -176,7 +176,7 @@ class SurfaceSample:
     #: None keeps :data:`HIGHLIGHT_WEIGHT_WIDTH_DEG` / :data:`HIGHLIGHT_MODEL_WIDTH_DEG`
     highlight_width_deg: float | None = None
     #: how many leading rows are the estimated surface itself (the rest: hedge copies of it,
-    #: :func:`planner.make_plan.hedge_global_tilt`); None means every row
+    #: :func:`planner.surface_estimate.hedge_global_tilt`); None means every row
     base_count: int | None = None
 
 

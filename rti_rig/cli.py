@@ -21,7 +21,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rti_rig.errors import RtiRigError
 
 if TYPE_CHECKING:
-    from planner.make_plan import PlanReport
+    from planner.plan_report import PlanReport
     from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
     from rti_rig.schedule import LightSchedule
 

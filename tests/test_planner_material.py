@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from planner.make_plan import estimate_surface, flat_surface, plan_with_report, sample_surface
+from planner.make_plan import plan_with_report
 from planner.objectives import (
     GLOSSY_SPECULAR,
     GLOSSY_WIDTH_DEG,
@@ -23,6 +23,7 @@ from planner.objectives import (
     light_weights,
     reflectance,
 )
+from planner.surface_estimate import estimate_surface, flat_surface, sample_surface
 from rti_rig.cli import app
 from rti_rig.errors import ScheduleError
 from rti_rig.geometry import direction_from_az_el, fibonacci_cap

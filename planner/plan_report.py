@@ -1,0 +1,80 @@
+"""The evidence behind a plan (:class:`PlanReport`): what the planner measured, assumed and
+expects, for the CLI to print and the session to keep beside the schedule."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+
+@dataclass
+class PlanReport:
+    """Evidence behind a plan, for the CLI to print and the session to keep."""
+
+    method: str
+    objective: str
+    n: int
+    rig: str
+    candidates: int
+    min_elevation_deg: float
+    max_elevation_deg: float = 90.0
+    preview_shape: tuple[int, ...] | None = None
+    planning_shape: tuple[int, ...] | None = None
+    preview_light_az_el_deg: tuple[float, float] | None = None
+    preview_light_source: str | None = None
+    relief_source: str | None = None
+    relief_scale: float | None = None
+    shading_explained_r2: float | None = None
+    rms_tilt_deg: float | None = None
+    p90_tilt_deg: float | None = None
+    highlight_hint: float | None = None
+    nonfinite_relief_repaired: int = 0
+    signal_noise: float = 0.0
+    material: str = "auto"
+    model: str | None = None
+    expected: dict[str, float] = field(default_factory=dict)
+    expected_meaning: str | None = None
+    start_layout: str | None = None
+    swaps: int | None = None
+    kmeans_distinct_normals: int | None = None
+    notes: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
+
+    def lines(self) -> list[str]:
+        """Human-readable summary, one fact per line."""
+        out = [f"method {self.method}, objective {self.objective}, {self.n} lights on {self.rig}"]
+        if self.max_elevation_deg < 90.0:
+            out.append(
+                f"lights between {self.min_elevation_deg:g}° and {self.max_elevation_deg:g}° "
+                "elevation (none near the camera axis)"
+            )
+        if self.preview_light_az_el_deg is not None:
+            az, el = self.preview_light_az_el_deg
+            out.append(f"preview light az {az:.1f}°, el {el:.1f}° ({self.preview_light_source})")
+        if self.relief_source and self.shading_explained_r2 is None:
+            out.append(f"relief: {self.relief_source}")
+        elif self.relief_source:
+            out.append(
+                f"relief from {self.relief_source}: RMS tilt {self.rms_tilt_deg:.1f}°, "
+                f"90th percentile {self.p90_tilt_deg:.1f}°, shading explained "
+                f"R²={self.shading_explained_r2:.2f}"
+            )
+        if self.model:
+            out.append(f"relighting model assumed: {self.model}")
+        if self.signal_noise > 0:
+            out.append(
+                f"noise modelled: {100 * self.signal_noise:g} % of the signal on top of the "
+                "additive noise (in the tests it cost accuracy on a steeply tilted flat object, "
+                "and on brushed steel from 12 lights: give --signal-noise 0 for such objects; "
+                "docs/planner.md)"
+            )
+        if self.expected and self.expected_meaning:
+            parts = ", ".join(f"{k} {v:#.4g}" for k, v in self.expected.items())
+            out.append(f"{self.expected_meaning}: {parts}")
+        out.extend(self.notes)
+        out.append(f"planned in {self.seconds:.2f} s")
+        return out
