@@ -16,12 +16,15 @@ run; :data:`SENSITIVITY` gives the planner at 50° and 70° too, to show how muc
 The bar is the homogeneous layout with its floor tuned with hindsight, as everywhere.
 
 Run: ``python -m benchmarks.planner_ceiling`` (``sim`` or ``real`` for one part: 18 and 20
-minutes when run side by side on 2 cores; each writes its section of docs/planner.md). The
-real part needs ``../shared/data/neuralrti-example``.
+minutes when run side by side on 2 cores; each writes its section of docs/planner.md).
+``--seed K`` (K ≠ 0) draws fresh subsets and only prints its tables: the checks of the
+committed ones that docs/planner.md quotes. The real part needs
+``../shared/data/neuralrti-example``.
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -61,7 +64,10 @@ FLOORS = (0.0, 10.0, 20.0, 30.0)
 BAND_FLOORS = (0.0, 10.0, 20.0)
 REAL_DRAWS = 48
 REAL_REMOVED = 8
+#: Seed of the committed tables' draws; other seeds (``--seed``) give fresh draws and only print.
 SEED = 0
+#: Seed of the bootstrap intervals, the same whatever the draws' seed.
+BOOTSTRAP_SEED = 0
 
 #: (label, material, ceiling) of the planned strategies.
 PLANNED: tuple[tuple[str, str, float], ...] = (
@@ -132,14 +138,16 @@ def add_bars(
     return names
 
 
-def sim_rows() -> list[str]:
+def sim_rows(seed: int = SEED) -> list[str]:
+    """Table rows of the simulator part: every scene's paired draws (``seed``), with the bars
+    tuned once over every N, as ``benchmarks.planner_sim_draws`` does."""
     settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     rows = []
     for scene in settings.scenes:
         data = render_scene_data(scene, settings)
         cand = data.candidate_dirs
         light = settings.preview_light_az_el_deg
-        rng = np.random.default_rng(SEED)
+        rng = np.random.default_rng(seed)
         err: dict[tuple[int, str], list[float]] = {}
         for n, keep, sub in paired_draws(cand, COUNTS, DRAWS, REMOVED, rng):
 
@@ -161,13 +169,15 @@ def sim_rows() -> list[str]:
     return rows
 
 
-def real_rows() -> tuple[list[str], list[str]]:
+def real_rows(seed: int = SEED) -> tuple[list[str], list[str]]:
+    """Table rows of the real-dome part (``seed``'s draws, bars tuned per N, as
+    ``benchmarks.planner_real_draws`` does) and the relighting PSNR rows of the same layouts."""
     dome, images, rgb8 = load(DATA)
     dirs = dome.directions
     ref, mask = reference(images, dirs)
     az, el = az_el_from_direction(dirs)
     previews = preview_leds(el)
-    rng = np.random.default_rng(SEED)
+    rng = np.random.default_rng(seed)
     err: dict[tuple[int, str], list[float]] = {}
     psnr: dict[tuple[int, str], list[float]] = {}
     for n in NS:
@@ -231,16 +241,29 @@ def _rows(
     rows = []
     for first, second in pairs:
         cells = " | ".join(
-            cell(np.array(err[(n, first)]), np.array(err[(n, second)]), SEED) for n in counts
+            cell(np.array(err[(n, first)]), np.array(err[(n, second)]), BOOTSTRAP_SEED)
+            for n in counts
         )
         shown = f"{names.get(first, first)} → {names.get(second, second)}"
         rows.append(f"| {what} | {shown} | {cells} |")
     return rows
 
 
-def main(parts: Sequence[str] = ("sim", "real")) -> str:
+def parts_arg(text: str) -> tuple[str, ...]:
+    """The command line's parts, refused unless each is ``sim`` or ``real`` (a typo would
+    otherwise run nothing and succeed)."""
+    parts = tuple(p.strip() for p in text.split(","))
+    unknown = [p for p in parts if p not in ("sim", "real")]
+    if unknown or not parts:
+        raise argparse.ArgumentTypeError(f"unknown part {unknown}: give sim, real or sim,real")
+    return parts
+
+
+def main(parts: Sequence[str] = ("sim", "real"), seed: int = SEED) -> str:
     """Run the parts asked for; each writes its own section of docs/planner.md, so the two can
-    run at the same time (``python -m benchmarks.planner_ceiling sim`` / ``real``)."""
+    run at the same time (``python -m benchmarks.planner_ceiling sim`` / ``real``). With another
+    ``seed`` than :data:`SEED` the draws are fresh and the tables are printed, not written: the
+    docs quote such runs as checks of the committed tables."""
     head = (
         f"Ceiling {CEILING:g}° (set before any run), {SENSITIVITY[0]:g}° and {SENSITIVITY[1]:g}° "
         "for the planner's sensitivity. Cells: mean normal error (°) of the first strategy → "
@@ -252,26 +275,27 @@ def main(parts: Sequence[str] = ("sim", "real")) -> str:
     out = []
     if "sim" in parts:
         t0 = time.perf_counter()
-        sim = sim_rows()
+        sim = sim_rows(seed)
         md = "\n".join(
             [
                 f"Command: `python -m benchmarks.planner_ceiling sim` (total "
-                f"{time.perf_counter() - t0:.0f} s, seed {SEED}). Simulator: {DRAWS} draws per "
+                f"{time.perf_counter() - t0:.0f} s, seed {seed}). Simulator: {DRAWS} draws per "
                 f"N, {REMOVED} of 240 candidates out of service. {head}",
                 "",
                 *table_head("scene", "comparison"),
                 *sim,
             ]
         )
-        write_section("planner_ceiling_sim", md, DOC)
+        if seed == SEED:
+            write_section("planner_ceiling_sim", md, DOC)
         out.append(md)
     if "real" in parts:
         t0 = time.perf_counter()
-        real, relit = real_rows()
+        real, relit = real_rows(seed)
         md = "\n".join(
             [
                 f"Command: `python -m benchmarks.planner_ceiling real` (total "
-                f"{time.perf_counter() - t0:.0f} s, seed {SEED}). Real dome (neuralrti-example, "
+                f"{time.perf_counter() - t0:.0f} s, seed {seed}). Real dome (neuralrti-example, "
                 f"{REAL_DRAWS} draws per N, {REAL_REMOVED} LEDs out of service, previews lit "
                 f"from 40–62°). {head}",
                 "",
@@ -287,7 +311,8 @@ def main(parts: Sequence[str] = ("sim", "real")) -> str:
                 *relit,
             ]
         )
-        write_section("planner_ceiling_real", md, DOC)
+        if seed == SEED:
+            write_section("planner_ceiling_real", md, DOC)
         out.append(md)
     text = "\n\n".join(out)
     print(text)
@@ -295,4 +320,14 @@ def main(parts: Sequence[str] = ("sim", "real")) -> str:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1].split(",") if len(sys.argv) > 1 else ("sim", "real"))
+    cli = argparse.ArgumentParser(prog="python -m benchmarks.planner_ceiling")
+    cli.add_argument(
+        "parts",
+        nargs="?",
+        default="sim,real",
+        type=parts_arg,
+        help="sim, real or sim,real",
+    )
+    cli.add_argument("--seed", type=int, default=SEED, help="draws' seed (not 0: print only)")
+    args = cli.parse_args()
+    main(args.parts, args.seed)

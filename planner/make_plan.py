@@ -9,7 +9,9 @@ Pipeline (each step a pure function in its own module):
 2. the method: ``uniform`` (homogeneous, no preview needed), ``kmeans`` (the paper's) or
    ``optimal`` (exchange search on an objective, :mod:`planner.optimal`);
 3. the rig's constraints (usable LEDs without repeats / reachable arm band) and its order
-   (ascending LED index on a dome; shortest moves from the park pose on an arm).
+   (ascending LED index on a dome; on an arm the ``arm_order`` passed in — the CLI passes the
+   servos' move-time order, :func:`planner.arm_order.order_for_arm` — else nearest neighbour
+   from the park pose).
 
 The evidence behind a plan is a :class:`planner.plan_report.PlanReport`. The default objective
 is ``normals``: see docs/planner.md for the real-dome evidence behind it.

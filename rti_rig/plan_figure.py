@@ -31,6 +31,8 @@ FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
 #: it and larger, so that a planned light at the preview's position keeps its number visible.
 LIGHT_SIZE = 150
 PREVIEW_STAR_SIZE = 520
+#: The preview star's size in the legend (the map's own is larger, to show around a light).
+LEGEND_STAR_SIZE = 220
 
 
 def polar_coordinates(directions: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -72,7 +74,8 @@ def layout_figure(
     """The map of ``chosen`` (N×3 directions, in firing order) on ``geometry``.
 
     A dome's LEDs are grey dots; an arm's reachable band is shaded and its keep-out cone
-    hatched. The chosen lights are numbered 1…N; ``preview`` (the preview's light) is a star.
+    hatched. The chosen lights are numbered 1…N; ``preview`` (the preview's light) is a star,
+    drawn under them so that a light planned at the preview's place keeps its number.
     An elevation floor above 0° (``--min-elevation-deg``) and a ceiling below 90°
     (``--max-elevation-deg``) are dashed and dotted rings: the planner took no light outside
     them, so LEDs there were excluded on purpose, not overlooked.
@@ -126,7 +129,7 @@ def layout_figure(
             zorder=3.5,
             gid="preview",
         )
-        ax.scatter([], [], s=220, marker="*", c="tab:orange", label="preview light")
+        ax.scatter([], [], s=LEGEND_STAR_SIZE, marker="*", c="tab:orange", label="preview light")
     ax.scatter([], [], s=60, c="tab:blue", label=f"planned lights ({len(t)}), in firing order")
     fig.legend(loc="outside lower center", ncol=2, fontsize=8, frameon=False)
     if title:
