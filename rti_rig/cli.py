@@ -465,7 +465,8 @@ def plan(
         Path | None,
         typer.Argument(
             help="One preview image of the object (8-bit JPEG/PNG/TIFF = sRGB, 16-bit "
-            "PNG/TIFF = linear, as 'rti-rig run' writes them), or the session folder "
+            "PNG/TIFF = linear, as 'rti-rig run' writes them; a camera RAW file - DNG, CR2, "
+            "NEF, ARW... - is decoded linearly), or the session folder "
             "'rti-rig preview' wrote. "
             "Needed by 'kmeans'; without it 'optimal' plans for a level surface (matte unless "
             "--material glossy)."
@@ -577,8 +578,7 @@ def plan(
         plan_with_report,
     )
     from planner.objectives import OBJECTIVES, check_material, check_signal_noise
-    from planner.topography import read_preview
-    from rti_rig.compose import arm_order_for
+    from rti_rig.compose import arm_order_for, read_preview_image
     from rti_rig.config import default_config_path, load_rig_config, rig_geometry
     from rti_rig.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
     from rti_rig.preview_source import resolve_preview
@@ -657,7 +657,7 @@ def plan(
             source = resolve_preview(preview, rig_lp, az_el is not None)
             if az_el is None and source.light_az_el_deg is not None:
                 az_el, light_note = source.light_az_el_deg, source.light_source
-            image = read_preview(source.image)
+            image = read_preview_image(source.image)
         schedule, report = plan_with_report(
             image,
             geometry,  # type: ignore[arg-type]

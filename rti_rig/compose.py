@@ -7,6 +7,7 @@ This is the one place in the core that imports ``simulator`` (and, as backends a
 from __future__ import annotations
 
 import contextlib
+from pathlib import Path
 
 from rti_rig.assembly import Rig
 from rti_rig.clock import Clock, SystemClock, VirtualClock
@@ -247,3 +248,34 @@ def arm_order_for(loaded: LoadedRig):  # type: ignore[no-untyped-def]
 
     settings = arm.dynamixel
     return lambda directions, start: order_for_arm(directions, start, settings)
+
+
+def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
+    """The preview file as the planner takes it, RAW files included.
+
+    A DSLR rig's preview is often a RAW file (DNG, CR2, NEF, ARW…). It is decoded here, in the
+    composition root, because the decoder is the camera drivers' (the planner may not import
+    drivers, :func:`drivers.cameras.raw_decode.decode_raw`, the DSLR path's): LibRaw's 2×2
+    super-pixels, linear 16-bit RGB, unity white balance, nothing automatic (half resolution
+    is plenty: the planner works at 256 px). Every other file goes to
+    :func:`planner.topography.read_preview`.
+    """
+    from drivers.cameras.folder_watch import RAW_SUFFIXES
+    from planner.topography import read_preview
+    from rti_rig.errors import CaptureError, ScheduleError
+
+    p = Path(path)
+    if p.suffix.lower() not in RAW_SUFFIXES or p.is_dir():
+        return read_preview(p)
+    if not p.is_file():
+        raise ScheduleError(f"{p}: preview image not found")
+    from drivers.cameras.raw_decode import decode_raw
+    from drivers.cameras.settings import RawDecodeSettings
+
+    try:
+        return decode_raw(p, RawDecodeSettings(mode="half")).pixels
+    except CaptureError as exc:
+        raise ScheduleError(
+            f"{p}: cannot decode this RAW preview ({exc}); give the camera's JPEG or a 16-bit "
+            "TIFF of it instead"
+        ) from exc

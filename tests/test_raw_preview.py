@@ -1,0 +1,93 @@
+"""A camera RAW file as the planner's preview: decoded linearly, planned like its linear TIFF.
+
+The DNGs are written by the test itself (``drivers.cameras.dng_writer``), no camera files.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tifffile
+from conftest import REPO
+from typer.testing import CliRunner
+
+from drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+from planner.topography import planning_image
+from rti_rig.cli import app
+from rti_rig.compose import read_preview_image
+from rti_rig.errors import ScheduleError
+from rti_rig.geometry import direction_from_az_el
+from rti_rig.lp_format import read_lp
+
+BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
+LIGHT = (45.0, 50.0)
+
+
+def shaded_relief(size: int = 512) -> np.ndarray:
+    """Linear grey shading (fraction of full scale) of a bumpy relief under :data:`LIGHT`:
+    asymmetric on purpose, so that a flipped or rotated decode would not match."""
+    y, x = np.mgrid[0:size, 0:size] / size
+    h = 6 * np.exp(-((x - 0.3) ** 2 + (y - 0.6) ** 2) / 0.02) + 3 * np.sin(9 * x) * y
+    gy, gx = np.gradient(h)
+    n = np.dstack([-gx, gy, np.ones_like(h)])  # rows run down, y up (DESIGN.md frame)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    shade = np.clip(n @ direction_from_az_el(*LIGHT), 0.0, None)
+    return 0.05 + 0.8 * shade * (0.6 + 0.4 * x)  # some albedo variation, below saturation
+
+
+def test_a_raw_preview_decodes_to_the_planning_image_of_its_linear_data(tmp_path: Path) -> None:
+    """Same planning image (within rounding) as the 16-bit linear TIFF of the same scene:
+    linear, scaled to full range, black level removed, not flipped or rotated."""
+    linear = shaded_relief()
+    dng = write_dng(
+        tmp_path / "preview.DNG",
+        linear_to_mosaic(linear, "RGGB", BLACK, WHITE),
+        black_level=BLACK,
+        white_level=WHITE,
+    )
+    raw = read_preview_image(dng)
+    assert raw.dtype == np.uint16 and raw.ndim == 3  # linear 16-bit RGB, half resolution
+    tif = tmp_path / "preview.tif"
+    tifffile.imwrite(tif, np.round(linear * 65535).astype(np.uint16))
+    from_raw, from_tif = planning_image(raw), planning_image(read_preview_image(tif))
+    assert from_raw.shape == from_tif.shape
+    np.testing.assert_allclose(from_raw, from_tif, atol=0.01)
+    assert abs(np.corrcoef(from_raw.ravel(), from_tif.ravel())[0, 1] - 1) < 1e-3
+
+
+def test_plan_takes_a_raw_preview_and_refuses_a_broken_one_by_name(tmp_path: Path) -> None:
+    """The same lights as from the scene's linear TIFF; a file LibRaw cannot read is refused,
+    named, with what to give instead, and no plan is written."""
+    linear = shaded_relief()
+    dng = write_dng(
+        tmp_path / "shot.dng",
+        linear_to_mosaic(linear, "RGGB", BLACK, WHITE),
+        black_level=BLACK,
+        white_level=WHITE,
+    )
+    tif = tmp_path / "shot.tif"
+    tifffile.imwrite(tif, np.round(linear * 65535).astype(np.uint16))
+    rig = REPO / "rig_configs" / "simulated_dome.toml"
+    args = ["--rig", str(rig), "--lights", "9", "--preview-light", "45,50"]
+    plans = []
+    for source in (dng, tif):
+        plan = tmp_path / f"plan_{source.suffix[1:]}.lp"
+        r = CliRunner().invoke(app, ["plan", str(source), *args, "--out", str(plan)])
+        assert r.exit_code == 0, r.output
+        plans.append([e.name for e in read_lp(plan)])
+    assert len(plans[0]) == 9 and plans[0] == plans[1]
+
+    broken = tmp_path / "broken.CR2"
+    broken.write_bytes(b"not a raw file at all")
+    plan = tmp_path / "plan_broken.lp"
+    r = CliRunner().invoke(app, ["plan", str(broken), *args, "--out", str(plan)])
+    assert r.exit_code != 0
+    assert "broken.CR2" in r.output and "RAW" in r.output and "TIFF" in r.output
+    assert not plan.exists()
+
+
+def test_a_missing_raw_preview_is_named() -> None:
+    with pytest.raises(ScheduleError, match=r"absent\.nef: preview image not found"):
+        read_preview_image(Path("absent.nef"))
