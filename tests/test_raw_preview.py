@@ -37,20 +37,26 @@ def shaded_relief(size: int = 512) -> np.ndarray:
     return 0.05 + 0.8 * shade * (0.6 + 0.4 * x)  # some albedo variation, below saturation
 
 
-def test_a_raw_preview_decodes_to_the_planning_image_of_its_linear_data(tmp_path: Path) -> None:
-    """Same planning image (within rounding) as the 16-bit linear TIFF of the same scene:
-    linear, scaled to full range, black level removed, not flipped or rotated."""
+def shot_files(folder: Path, name: str) -> tuple[Path, Path]:
+    """The same scene as a 14-bit RAW (DNG, ``name``) and as a 16-bit linear TIFF beside it."""
     linear = shaded_relief()
     dng = write_dng(
-        tmp_path / "preview.DNG",
+        folder / name,
         linear_to_mosaic(linear, "RGGB", BLACK, WHITE),
         black_level=BLACK,
         white_level=WHITE,
     )
+    tif = dng.with_suffix(".tif")
+    tifffile.imwrite(tif, np.round(linear * 65535).astype(np.uint16))
+    return dng, tif
+
+
+def test_a_raw_preview_decodes_to_the_planning_image_of_its_linear_data(tmp_path: Path) -> None:
+    """Same planning image (within rounding) as the 16-bit linear TIFF of the same scene:
+    linear, scaled to full range, black level removed, not flipped or rotated."""
+    dng, tif = shot_files(tmp_path, "preview.DNG")
     raw = read_preview_image(dng)
     assert raw.dtype == np.uint16 and raw.ndim == 3  # linear 16-bit RGB, half resolution
-    tif = tmp_path / "preview.tif"
-    tifffile.imwrite(tif, np.round(linear * 65535).astype(np.uint16))
     from_raw, from_tif = planning_image(raw), planning_image(read_preview_image(tif))
     assert from_raw.shape == from_tif.shape
     np.testing.assert_allclose(from_raw, from_tif, atol=0.01)
@@ -60,15 +66,7 @@ def test_a_raw_preview_decodes_to_the_planning_image_of_its_linear_data(tmp_path
 def test_plan_takes_a_raw_preview_and_refuses_a_broken_one_by_name(tmp_path: Path) -> None:
     """The same lights as from the scene's linear TIFF; a file LibRaw cannot read is refused,
     named, with what to give instead, and no plan is written."""
-    linear = shaded_relief()
-    dng = write_dng(
-        tmp_path / "shot.dng",
-        linear_to_mosaic(linear, "RGGB", BLACK, WHITE),
-        black_level=BLACK,
-        white_level=WHITE,
-    )
-    tif = tmp_path / "shot.tif"
-    tifffile.imwrite(tif, np.round(linear * 65535).astype(np.uint16))
+    dng, tif = shot_files(tmp_path, "shot.dng")
     rig = REPO / "rig_configs" / "simulated_dome.toml"
     args = ["--rig", str(rig), "--lights", "9", "--preview-light", "45,50"]
     plans = []
