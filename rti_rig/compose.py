@@ -257,15 +257,17 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
     composition root, because the decoder is the camera drivers' (the planner may not import
     drivers, :func:`drivers.cameras.raw_decode.decode_raw`, the DSLR path's): LibRaw's 2×2
     super-pixels, linear 16-bit RGB, unity white balance, nothing automatic (half resolution
-    is plenty: the planner works at 256 px). Every other file goes to
+    is plenty: the planner works at 256 px). The rig's own decode settings are not applied:
+    they live in its camera driver's config, and white balance barely moves the luminance the
+    planner reads. Every other file goes to
     :func:`planner.topography.read_preview`.
     """
-    from drivers.cameras.folder_watch import RAW_SUFFIXES
+    from drivers.cameras.folder_watch import is_raw_file
     from planner.topography import read_preview
     from rti_rig.errors import CaptureError, ScheduleError
 
     p = Path(path)
-    if p.suffix.lower() not in RAW_SUFFIXES or p.is_dir():
+    if not is_raw_file(p) or p.is_dir():
         return read_preview(p)
     if not p.is_file():
         raise ScheduleError(f"{p}: preview image not found")
@@ -274,8 +276,8 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
 
     try:
         return decode_raw(p, RawDecodeSettings(mode="half")).pixels
-    except CaptureError as exc:
+    except CaptureError as exc:  # its message names the file and LibRaw's reason
         raise ScheduleError(
-            f"{p}: cannot decode this RAW preview ({exc}); give the camera's JPEG or a 16-bit "
-            "TIFF of it instead"
+            f"RAW preview {exc.message} Otherwise give the camera's JPEG or a 16-bit linear "
+            "TIFF of it as the preview"
         ) from exc

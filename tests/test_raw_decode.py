@@ -234,3 +234,20 @@ def test_any_dng_round_trips_bit_exactly(h, w, black, span, pattern, seed):
     np.testing.assert_array_equal(f.pixels, mosaic.astype(np.int64) - black)
     assert f.white_level == white - black
     assert f.metadata["cfa_pattern"] == pattern
+
+
+def test_half_size_saturation_mask_fits_odd_sensor_sizes():
+    """An odd visible size (301×401) leaves an incomplete last super-pixel row and column: the
+    mask must still map onto LibRaw's half-size output (it used to fail to reshape)."""
+    from drivers.cameras.raw_decode import half_size_mask
+
+    mask = np.zeros((301, 401), dtype=bool)
+    mask[300, 400] = True  # the lone photosite of the last, incomplete super-pixel
+    mask[0, 1] = True
+    out = half_size_mask(mask, 151, 201)
+    assert out.shape == (151, 201)
+    assert out[150, 200] and out[0, 0]
+    assert out.sum() == 2
+    even = np.zeros((4, 6), dtype=bool)
+    even[3, 5] = True
+    np.testing.assert_array_equal(half_size_mask(even, 2, 3), [[0, 0, 0], [0, 0, 1]])

@@ -74,8 +74,9 @@ def test_plan_takes_a_raw_preview_and_refuses_a_broken_one_by_name(tmp_path: Pat
         plan = tmp_path / f"plan_{source.suffix[1:]}.lp"
         r = CliRunner().invoke(app, ["plan", str(source), *args, "--out", str(plan)])
         assert r.exit_code == 0, r.output
-        plans.append([e.name for e in read_lp(plan)])
-    assert len(plans[0]) == 9 and plans[0] == plans[1]
+        plans.append(np.array([e.direction for e in read_lp(plan)]))
+    assert len(plans[0]) == 9
+    np.testing.assert_allclose(plans[0], plans[1], atol=1e-6)  # the same lights, same order
 
     broken = tmp_path / "broken.CR2"
     broken.write_bytes(b"not a raw file at all")
@@ -89,3 +90,25 @@ def test_plan_takes_a_raw_preview_and_refuses_a_broken_one_by_name(tmp_path: Pat
 def test_a_missing_raw_preview_is_named() -> None:
     with pytest.raises(ScheduleError, match=r"absent\.nef: preview image not found"):
         read_preview_image(Path("absent.nef"))
+
+
+def test_a_raw_preview_keeps_its_colour_channels_in_rgb_order(tmp_path: Path) -> None:
+    """The planner weighs R, G and B as Rec. 709 luminance: a red-and-blue scene must come
+    out red where it was red (a BGR swap would put it in the blue channel)."""
+    size = 64
+    linear = np.zeros((size, size, 3))
+    linear[:, : size // 2] = (0.8, 0.1, 0.05)  # red left half
+    linear[:, size // 2 :] = (0.05, 0.1, 0.8)  # blue right half
+    dng = write_dng(
+        tmp_path / "colour.dng",
+        linear_to_mosaic(linear, "RGGB", BLACK, WHITE),
+        black_level=BLACK,
+        white_level=WHITE,
+    )
+    raw = read_preview_image(dng).astype(float) / 65535
+    left, right = (
+        raw[:, : size // 4 - 1].mean(axis=(0, 1)),
+        raw[:, -(size // 4 - 1) :].mean(axis=(0, 1)),
+    )
+    np.testing.assert_allclose(left, (0.8, 0.1, 0.05), atol=0.01)
+    np.testing.assert_allclose(right, (0.05, 0.1, 0.8), atol=0.01)

@@ -110,6 +110,16 @@ def _postprocess_params(settings: RawDecodeSettings) -> dict[str, Any]:
     return params
 
 
+def half_size_mask(mask: NDArray[np.bool_], h: int, w: int) -> NDArray[np.bool_]:
+    """The photosite ``mask`` on LibRaw's h×w half-size output: a super-pixel is marked when
+    any of its 2×2 photosites is. A sensor with an odd visible size has a last, incomplete
+    row or column of super-pixels; the mask is padded (unmarked) to fit instead of failing."""
+    full = np.zeros((2 * h, 2 * w), dtype=bool)
+    rows, cols = min(mask.shape[0], 2 * h), min(mask.shape[1], 2 * w)
+    full[:rows, :cols] = mask[:rows, :cols]
+    return full.reshape(h, 2, w, 2).any(axis=(1, 3))
+
+
 def _dilate(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     """3×3 dilation: a demosaiced pixel draws on its neighbours' photosites."""
     p = np.pad(mask, 1)
@@ -178,7 +188,7 @@ def decode_raw(
                 pixels = np.asarray(rgb, dtype=np.uint16)
                 h, w = pixels.shape[:2]
                 if settings.mode == "half":
-                    s = saturated[: 2 * h, : 2 * w].reshape(h, 2, w, 2).any(axis=(1, 3))
+                    s = half_size_mask(saturated, h, w)
                 else:
                     s = _dilate(saturated)[:h, :w]
                 pixels[s] = white_level
