@@ -272,13 +272,14 @@ def main(parts: Sequence[str] = ("sim", "real"), seed: int = SEED) -> str:
         "the ceiling (0/10/20°) are tuned with hindsight: per scene on the simulator, per N "
         "on the real dome (as the other benchmarks of each do)."
     )
+    flag = "" if seed == SEED else f" --seed {seed}"
     out = []
     if "sim" in parts:
         t0 = time.perf_counter()
         sim = sim_rows(seed)
         md = "\n".join(
             [
-                f"Command: `python -m benchmarks.planner_ceiling sim` (total "
+                f"Command: `python -m benchmarks.planner_ceiling sim{flag}` (total "
                 f"{time.perf_counter() - t0:.0f} s, seed {seed}). Simulator: {DRAWS} draws per "
                 f"N, {REMOVED} of 240 candidates out of service. {head}",
                 "",
@@ -294,7 +295,7 @@ def main(parts: Sequence[str] = ("sim", "real"), seed: int = SEED) -> str:
         real, relit = real_rows(seed)
         md = "\n".join(
             [
-                f"Command: `python -m benchmarks.planner_ceiling real` (total "
+                f"Command: `python -m benchmarks.planner_ceiling real{flag}` (total "
                 f"{time.perf_counter() - t0:.0f} s, seed {seed}). Real dome (neuralrti-example, "
                 f"{REAL_DRAWS} draws per N, {REAL_REMOVED} LEDs out of service, previews lit "
                 f"from 40–62°). {head}",

@@ -25,7 +25,7 @@ def test_the_committed_seed_writes_both_sections(fake_parts: list[tuple[str, str
     """Seed 0 is the committed tables' draws: each part writes its own section."""
     text = ceiling.main(("sim", "real"))
     assert [name for name, _ in fake_parts] == ["planner_ceiling_sim", "planner_ceiling_real"]
-    assert "seed 0" in text and "rows of seed 0" in text
+    assert "seed 0" in text and "rows of seed 0" in text and "--seed" not in text
 
 
 def test_a_fresh_seed_draws_anew_and_only_prints(fake_parts: list[tuple[str, str]]) -> None:
@@ -33,6 +33,7 @@ def test_a_fresh_seed_draws_anew_and_only_prints(fake_parts: list[tuple[str, str
     text = ceiling.main(("real",), seed=1)
     assert fake_parts == []  # the committed table is left alone
     assert "seed 1" in text and "real rows of seed 1" in text
+    assert "planner_ceiling real --seed 1`" in text  # the command that reproduces it
     assert "sim rows" not in text
 
 
