@@ -267,10 +267,8 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
     from rti_rig.errors import CaptureError, ScheduleError
 
     p = Path(path)
-    if not is_raw_file(p) or p.is_dir():
-        return read_preview(p)
-    if not p.is_file():
-        raise ScheduleError(f"{p}: preview image not found")
+    if not is_raw_file(p) or not p.is_file():
+        return read_preview(p)  # which also refuses a folder or a missing file, by name
     from drivers.cameras.raw_decode import decode_raw
     from drivers.cameras.settings import RawDecodeSettings
 
