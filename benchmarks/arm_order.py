@@ -5,7 +5,7 @@ Run: ``python -m benchmarks.arm_order`` (writes the "arm_order" section of docs/
 Light sets: directions drawn uniformly on the reachable part of the hemisphere (elevation
 5..70 deg, azimuth within the joint limits) of the XL430 test arm used by the tests, in random
 order ("plan order": a planner's output order carries no motion sense). Times come from the
-motion-time model (planner.arm_motion); one ordered schedule is also executed by the real
+motion-time model (rti_rig.core.arm_motion); one ordered schedule is also executed by the real
 driver over the real SDK against the emulated servos, to check the model against emulator time.
 """
 
@@ -16,15 +16,21 @@ import sys
 import time
 
 import numpy as np
+from rti_rig.drivers.dynamixel.arm import DynamixelArm
+from rti_rig.drivers.dynamixel.settings import ArmSettings
+from rti_rig.planner.arm_order import (
+    EXACT_MAX,
+    held_karp,
+    heuristic_order,
+    order_for_arm,
+    path_time_s,
+)
+from rti_rig.simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
 
 from benchmarks.report import machine_line, write_section
-from drivers.dynamixel.arm import DynamixelArm
-from drivers.dynamixel.settings import ArmSettings
-from planner.arm_motion import move_time_matrix
-from planner.arm_order import EXACT_MAX, held_karp, heuristic_order, order_for_arm, path_time_s
-from rti_rig.clock import VirtualClock
-from rti_rig.geometry import az_el_from_direction, direction_from_az_el
-from simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
+from rti_rig.core.arm_motion import move_time_matrix
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
 
 SIZES = (8, 12, 25, 50, 100)
 TRIALS = 7
@@ -144,7 +150,8 @@ def main() -> int:
             machine_line(),
             f"Median total move time in seconds over {TRIALS} random light sets per N (XL430 arm, "
             "20 rpm / 2000 rev/min² profiles, 0.05 s settle per move; model of "
-            "`planner.arm_motion`). *Plan* = planner output order, *sweep* = sorted by azimuth, "
+            "`rti_rig.core.arm_motion`). *Plan* = planner output order, *sweep* = sorted by "
+            "azimuth, "
             "*ordered* = `order_for_arm` (exact Held–Karp for N ≤ 12; beyond, nearest neighbour + "
             "2-opt + Or-opt + iterated local search with double-bridge kicks"
             "). Ratios are medians of per-set ratios.",

@@ -2,7 +2,7 @@
 
 For each protocol profile (default line ASCII with checksum, framed ``<cmd,…>``, binary with a
 one-byte ack) and two line speeds, the firmware emulator serves a 48-LED dome on a pty and the
-real driver stack (``drivers.led_dome.build_dome``: codec, pyserial, retry/thermal policy)
+real driver stack (``rti_rig.app.dome_factory.build_dome``: codec, pyserial, retry/thermal policy)
 lights LEDs one after another. Timed per call, on the wall clock: ``light`` (command, wait for
 the acknowledgement) and ``all_off``. The emulator delays each reply by the bytes' time on the
 wire at the configured baud rate, so the figures are protocol + line time + pty + Python — not a
@@ -17,12 +17,12 @@ import statistics
 import time
 
 import numpy as np
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 
 from benchmarks.report import machine_line, write_section
-from drivers.led_dome import build_dome
-from drivers.led_dome.settings import DomeSerialSettings
-from rti_rig.clock import SystemClock
-from simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+from rti_rig.app.dome_factory import build_dome
+from rti_rig.core.clock import SystemClock
 
 LEDS = 48
 REPEATS = 200

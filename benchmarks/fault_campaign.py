@@ -20,23 +20,23 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-
-from rti_rig.compose import build_rig
-from rti_rig.config import load_rig_config
-from rti_rig.controller import run_session
-from rti_rig.errors import RtiRigError
-from rti_rig.rig_geometry import DomeGeometry
-from rti_rig.schedule import LightSchedule
-from rti_rig.session import SessionFolder, read_manifest
-from simulator.faults import (
+from rti_rig.simulator.faults import (
     FaultPlan,
     FaultyCamera,
     FaultyCarrier,
     FaultyLightSource,
     ServoFaultCarrier,
 )
-from simulator.kill_hooks import popen_session
-from simulator.verify import wrong_light_steps
+
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.core.schedule import LightSchedule
+from rti_rig.runtime.controller import run_session
+from rti_rig.runtime.session import SessionFolder, read_manifest
+from rti_rig.testing.kill_hooks import popen_session
+from rti_rig.testing.verify import wrong_light_steps
 
 REPO = Path(__file__).resolve().parent.parent
 IN_PROCESS = ("camera-failure", "light-failure")
@@ -113,7 +113,7 @@ def run_in_process(cfg: Path, out: Path, n: int, fault: FaultPlan | None, resume
 
 
 def _run(rig, out: Path, n: int, fault: FaultPlan | None, resume: bool) -> None:  # type: ignore[no-untyped-def]
-    from planner.uniform import plan_uniform
+    from rti_rig.planner.uniform import plan_uniform
 
     if fault is not None:
         if fault.kind in SERVO:

@@ -25,8 +25,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from benchmarks.metrics import angular_error_deg, relight_psnr, relight_ssim
 from benchmarks.report import machine_line, write_section
-from rti_rig.metrics import angular_error_deg, relight_psnr, relight_ssim
 from rti_rig.reconstruct import N_COEFFICIENTS, fit_model, select_model
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 

@@ -31,6 +31,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
+from rti_rig.planner.objectives import models_for
+from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import (
     DATA,
@@ -51,11 +53,9 @@ from benchmarks.planner_sim_draws import (
     table_head,
 )
 from benchmarks.report import write_section
-from planner.objectives import models_for
-from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
-from rti_rig.geometry import az_el_from_direction
-from rti_rig.rig_geometry import DomeGeometry
+from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
+from rti_rig.core.geometry import az_el_from_direction
+from rti_rig.core.rig_geometry import DomeGeometry
 
 CEILING = 60.0
 SENSITIVITY = (50.0, 70.0)

@@ -12,8 +12,8 @@ those images, and scored against the all-light reference:
   stereo on all 72 lights (the reference), over the object mask;
 * relighting PSNR: a PTM/HSH fitted on the subset, relit to every light *not* in the subset and
   compared with the real images (linear luminance, data range 1). The basis is fixed per N for
-  every layout (the one :func:`planner.objectives.models_for` allows: HSH1 at 6, PTM at 9 and
-  12, HSH2 at 18), so layouts are compared, not models.
+  every layout (the one :func:`rti_rig.planner.objectives.models_for` allows: HSH1 at 6, PTM at 9
+  and 12, HSH2 at 18), so layouts are compared, not models.
 
 Subset normals use robust photometric stereo (shadows and highlights discarded per pixel); when
 it refuses an ill-conditioned subset (lights nearly coplanar) plain least squares with a
@@ -41,17 +41,17 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.objectives import models_for
+from rti_rig.planner.topography import REC709
+from rti_rig.planner.uniform import select_uniform_leds
 
-from planner.make_plan import plan_with_report
-from planner.objectives import models_for
-from planner.topography import REC709
-from planner.uniform import select_uniform_leds
-from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
-from rti_rig.lp_format import read_lp
-from rti_rig.metrics import angular_error_map, relight_psnr
+from benchmarks.metrics import angular_error_map, relight_psnr
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.core.rti_bases import design_matrix
 from rti_rig.reconstruct import ReconstructionError, fit_hsh, fit_photometric_stereo, fit_ptm
-from rti_rig.reconstruct.bases import design_matrix
-from rti_rig.rig_geometry import DomeGeometry
 
 #: The real acquisition, in the shared folder beside the repository (not needed by tests).
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "neuralrti-example"
@@ -68,7 +68,7 @@ PLANNED = (
     ("optimal, normals", "optimal", "normals", True, "auto"),
     ("optimal, relight", "optimal", "relight", True, "auto"),
     ("optimal, normals, light estimated", "optimal", "normals", False, "auto"),
-    # the icon is gilded: what its owner would declare (planner.objectives.MATERIALS)
+    # the icon is gilded: what its owner would declare (rti_rig.planner.objectives.MATERIALS)
     ("optimal, normals, declared glossy", "optimal", "normals", True, "glossy"),
     ("optimal, relight, declared glossy", "optimal", "relight", True, "glossy"),
 )

@@ -35,6 +35,8 @@ import sys
 import time
 
 import numpy as np
+from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
+from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.paired import compare
 from benchmarks.planner_real_data import (
@@ -48,10 +50,8 @@ from benchmarks.planner_real_data import (
     reference,
 )
 from benchmarks.report import write_section
-from planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
-from planner.uniform import select_uniform_leds
-from rti_rig.geometry import az_el_from_direction
-from rti_rig.rig_geometry import DomeGeometry
+from rti_rig.core.geometry import az_el_from_direction
+from rti_rig.core.rig_geometry import DomeGeometry
 
 DRAWS = 144
 REMOVED = 8

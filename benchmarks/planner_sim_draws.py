@@ -23,16 +23,16 @@ import time
 from collections.abc import Iterator, Sequence
 
 import numpy as np
+from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
+from rti_rig.planner.topography import REC709
+from rti_rig.planner.uniform import select_uniform_leds
 
+from benchmarks.metrics import relight_psnr
 from benchmarks.paired import compare
 from benchmarks.planner_real_data import DOC, planned_leds, relight_model
 from benchmarks.report import write_section
-from planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
-from planner.topography import REC709
-from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
-from rti_rig.metrics import relight_psnr
-from rti_rig.rig_geometry import DomeGeometry
+from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
+from rti_rig.core.rig_geometry import DomeGeometry
 
 DRAWS = 8
 REMOVED = 24
@@ -110,7 +110,7 @@ def scene_errors(scene: str, settings: TradeoffSettings, rng: np.random.Generato
     """Normal error and relighting PSNR per (N, strategy) over the paired draws of one scene,
     and the scene's material.
 
-    Relighting: the basis :func:`planner.objectives.models_for` allows at N (the richest, as
+    Relighting: the basis :func:`rti_rig.planner.objectives.models_for` allows at N (the richest, as
     in the real-dome benchmarks), fitted on the chosen lights' luminance and relit to every
     other candidate light; mean PSNR over those lights (data range 1 = the white level).
     """

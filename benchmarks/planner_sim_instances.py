@@ -6,7 +6,7 @@ tilted plane's 50° tilt. A win or a loss there could belong to that instance. T
 repeats its paired design — ``DRAWS`` draws per light count with ``REMOVED`` of the 240
 candidates out of service, the tuned homogeneous layout against the planner from the same
 preview — on other instances (:data:`INSTANCES`, the scene and camera-noise seed of
-:class:`rti_rig.bench_tradeoff.TradeoffSettings`), with the draws' own generator restarted per
+:class:`benchmarks.tradeoff.TradeoffSettings`), with the draws' own generator restarted per
 scene. The homogeneous floor is tuned per scene and instance, with hindsight, as there.
 
 Run: ``python -m benchmarks.planner_sim_instances`` (about 10 minutes; writes its section of
@@ -20,6 +20,7 @@ import time
 from collections.abc import Iterable, Sequence
 
 import numpy as np
+from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import DOC, planned_leds
 from benchmarks.planner_sim_draws import (
@@ -33,8 +34,7 @@ from benchmarks.planner_sim_draws import (
     table_head,
 )
 from benchmarks.report import write_section
-from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
+from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
 
 #: Scene seeds run here (seed 0 is the instance of ``benchmarks.planner_sim_draws``).
 INSTANCES = (1, 2)

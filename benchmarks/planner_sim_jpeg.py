@@ -30,6 +30,9 @@ import time
 import cv2
 import numpy as np
 from numpy.typing import NDArray
+from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME
+from rti_rig.planner.uniform import select_uniform_leds
+from rti_rig.simulator.camera_model import encode_jpeg, to_srgb8
 
 from benchmarks.planner_real_data import DOC, planned_leds, srgb_to_linear
 from benchmarks.planner_sim_draws import (
@@ -43,10 +46,7 @@ from benchmarks.planner_sim_draws import (
     table_head,
 )
 from benchmarks.report import write_section
-from planner.objectives import SIGNAL_NOISE_JPEG_DOME
-from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import TradeoffSettings, normal_error, render_scene_data
-from simulator.camera_model import encode_jpeg, to_srgb8
+from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
 
 #: JPEG quality of the simulated 8-bit camera (the simulator's ``encode_jpeg`` default; the
 #: real dome's is not recorded).

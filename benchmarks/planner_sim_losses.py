@@ -16,9 +16,9 @@ each loss can be traced to what the simulator renders and what the planner's mod
 * ``all``: everything, as the benchmarks score it.
 
 It also prints the planner's own expected-error terms for both layouts (variance and the prior
-on non-Lambertian reflectance: :class:`planner.objectives.NormalsObjective`), to show which term
-made it choose what it chose. Errors are mean angles (°) over every pixel, robust
-photometric stereo against the true normals (``rti_rig.bench_tradeoff.normal_error``).
+on non-Lambertian reflectance: :class:`rti_rig.planner.objectives.NormalsObjective`), to show which
+term made it choose what it chose. Errors are mean angles (°) over every pixel, robust
+photometric stereo against the true normals (``benchmarks.tradeoff.normal_error``).
 
 Run: ``python -m benchmarks.planner_sim_losses`` (writes its section of docs/planner.md).
 """
@@ -30,21 +30,21 @@ import time
 
 import numpy as np
 from numpy.typing import NDArray
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.objectives import HELD_OUT, NormalsObjective, candidates_for
+from rti_rig.planner.surface_estimate import estimate_surface, sample_surface
+from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import DOC
 from benchmarks.report import write_section
-from planner.make_plan import plan_with_report
-from planner.objectives import HELD_OUT, NormalsObjective, candidates_for
-from planner.surface_estimate import estimate_surface, sample_surface
-from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import (
+from benchmarks.tradeoff import (
     TradeoffSettings,
     normal_error,
     render_scene_data,
     scene_camera,
 )
-from rti_rig.geometry import az_el_from_direction, fibonacci_cap
-from rti_rig.rig_geometry import DomeGeometry
+from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
+from rti_rig.core.rig_geometry import DomeGeometry
 
 COUNTS = (6, 12, 20, 30)
 FLOORS = (0.0, 10.0, 20.0, 30.0)

@@ -26,20 +26,20 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 from numpy.typing import NDArray
+from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import DOC, hindsight_exchange, planned_leds
 from benchmarks.planner_sim_draws import COUNTS, FLOORS
 from benchmarks.report import write_section
-from planner.uniform import select_uniform_leds
-from rti_rig.bench_tradeoff import (
+from benchmarks.tradeoff import (
     SceneData,
     TradeoffSettings,
     normal_error,
     render_scene_data,
     scene_camera,
 )
-from rti_rig.geometry import az_el_from_direction
-from rti_rig.rig_geometry import DomeGeometry
+from rti_rig.core.geometry import az_el_from_direction
+from rti_rig.core.rig_geometry import DomeGeometry
 
 SWEEPS = 2
 STRIDE = 2

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.planner_real_data import DATA, load
-from rti_rig.geometry import az_el_from_direction
+from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.reconstruct import fit_photometric_stereo
 
 DRAWS = 3000

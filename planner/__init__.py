@@ -1,1 +1,4 @@
-"""planner package."""
+"""The light planner: preview → relief → normals → an ordered light schedule.
+
+Installed as ``rti_rig.planner``; built on ``rti_rig.core`` only.
+"""

@@ -1,7 +1,7 @@
 """Order the stops of an arm schedule to minimise the total move time.
 
 This is an open travelling-salesman path from the arm's start pose through every stop, with
-the move-time model of :mod:`planner.arm_motion` as the distance. Exact Held-Karp dynamic
+the move-time model of :mod:`rti_rig.core.arm_motion` as the distance. Exact Held-Karp dynamic
 programming up to :data:`EXACT_MAX` stops (2^12 * 12 states, vectorised with numpy: a few ms);
 beyond that nearest-neighbour construction from several seeds, improved by 2-opt and Or-opt
 (segments of 1-3 stops moved, possibly reversed) until no move helps, then iterated local
@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from planner.arm_motion import move_time_matrix, sequence_time_s
+from rti_rig.core.arm_motion import move_time_matrix, sequence_time_s
 
 #: Largest stop count solved exactly.
 EXACT_MAX = 12

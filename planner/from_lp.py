@@ -11,10 +11,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rti_rig.errors import ScheduleError
-from rti_rig.lp_format import LpEntry
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
-from rti_rig.schedule import LightSchedule
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.lp_format import LpEntry
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.schedule import LightSchedule
 
 #: Plan directions farther than this from every LED are not that dome's LEDs.
 SNAP_TOLERANCE_DEG = 1.0

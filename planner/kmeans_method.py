@@ -24,8 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-
-from planner.objectives import Candidates, snap_unique
+from rti_rig.planner.objectives import Candidates, snap_unique
 
 #: Normals fed to k-means (a random subset; clustering needs the distribution, not every pixel).
 KMEANS_PIXELS = 5000

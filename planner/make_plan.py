@@ -2,19 +2,19 @@
 
 Pipeline (each step a pure function in its own module):
 
-1. the surface (:mod:`planner.surface_estimate`): the preview reduced to a planning image, its
-   light (given or estimated), a relief (an ONNX depth model or shape from shading) scaled by
+1. the surface (:mod:`rti_rig.planner.surface_estimate`): the preview reduced to a planning image,
+   its light (given or estimated), a relief (an ONNX depth model or shape from shading) scaled by
    the preview's shading, and normals — or, with no preview at all, a level, matte surface
-   (:func:`planner.surface_estimate.flat_surface`; on the benchmarks it planned as well);
+   (:func:`rti_rig.planner.surface_estimate.flat_surface`; on the benchmarks it planned as well);
 2. the method: ``uniform`` (homogeneous, no preview needed), ``kmeans`` (the paper's) or
-   ``optimal`` (exchange search on an objective, :mod:`planner.optimal`);
+   ``optimal`` (exchange search on an objective, :mod:`rti_rig.planner.optimal`);
 3. the rig's constraints (usable LEDs without repeats / reachable arm band) and its order
    (ascending LED index on a dome; on an arm the ``arm_order`` passed in — the CLI passes the
-   servos' move-time order, :func:`planner.arm_order.order_for_arm` — else nearest neighbour
+   servos' move-time order, :func:`rti_rig.planner.arm_order.order_for_arm` — else nearest neighbour
    from the park pose).
 
-The evidence behind a plan is a :class:`planner.plan_report.PlanReport`. The default objective
-is ``normals``: see docs/planner.md for the real-dome evidence behind it.
+The evidence behind a plan is a :class:`rti_rig.planner.plan_report.PlanReport`. The default
+objective is ``normals``: see docs/planner.md for the real-dome evidence behind it.
 """
 
 from __future__ import annotations
@@ -26,10 +26,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from threadpoolctl import threadpool_limits
-
-from planner.kmeans_method import plan_kmeans
-from planner.objectives import (
+from rti_rig.planner.kmeans_method import plan_kmeans
+from rti_rig.planner.objectives import (
     GLOSSY_SPECULAR,
     GLOSSY_WIDTH_DEG,
     HELD_OUT,
@@ -42,9 +40,9 @@ from planner.objectives import (
     check_signal_noise,
     make_objective,
 )
-from planner.optimal import exchange_search
-from planner.plan_report import PlanReport
-from planner.surface_estimate import (
+from rti_rig.planner.optimal import exchange_search
+from rti_rig.planner.plan_report import PlanReport
+from rti_rig.planner.surface_estimate import (
     SurfaceEstimate,
     estimate_surface,
     flat_surface,
@@ -52,12 +50,14 @@ from planner.surface_estimate import (
     sample_surface,
     tilt_stats,
 )
-from planner.topography import DepthModelSpec
-from planner.uniform import arm_below, order_nearest_neighbour, select_uniform_leds
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import az_el_from_direction, fibonacci_cap
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
-from rti_rig.schedule import LightSchedule
+from rti_rig.planner.topography import DepthModelSpec
+from rti_rig.planner.uniform import arm_below, order_nearest_neighbour, select_uniform_leds
+from threadpoolctl import threadpool_limits
+
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.schedule import LightSchedule
 
 METHODS: tuple[str, ...] = ("uniform", "kmeans", "optimal")
 
@@ -191,14 +191,14 @@ def plan_with_report(
     the camera axis put mirror highlights on a level glossy object (docs/planner.md, "An
     elevation ceiling").
 
-    ``material``: what the user knows of the surface (:data:`planner.objectives.MATERIALS`):
+    ``material``: what the user knows of the surface (:data:`rti_rig.planner.objectives.MATERIALS`):
     ``auto`` (default) reads highlights from the preview, ``matte`` models none, ``glossy``
     (polished metal, gilding, varnish) models a strong, broad highlight lobe even when the
     preview does not show one — on a flat glossy object it never does (docs/planner.md).
 
     ``signal_noise``: image noise proportional to the signal, relative to it (0.05 = 5 %), for
     the ``normals`` objective — an uncalibrated dome's LED spread and 8-bit JPEG captures
-    (:data:`planner.objectives.SIGNAL_NOISE_JPEG_DOME`); 0 models additive noise only.
+    (:data:`rti_rig.planner.objectives.SIGNAL_NOISE_JPEG_DOME`); 0 models additive noise only.
 
     BLAS is held to one thread while planning: every matrix here is small (3 to 16 columns),
     and a threaded BLAS on a busy machine made such products 40× slower, not faster.
@@ -566,11 +566,11 @@ def make_plan(
     """An ordered schedule of ``n`` lights for ``geometry`` planned from one preview.
 
     ``preview`` is an image (H, W) or (H, W, 3): uint8 is sRGB, uint16 and float are linear
-    (see :mod:`planner.topography`). It may be ``None`` for ``uniform`` (no preview needed) and
-    ``optimal`` (which then plans for a level, matte surface:
-    :func:`planner.surface_estimate.flat_surface`). Dome steps carry LED indices and the dome's
-    LED names as labels, in ascending LED order; arm steps are ordered for short moves from the
-    park pose. The evidence is in ``schedule.provenance["report"]`` (or use
+    (see :mod:`rti_rig.planner.topography`). It may be ``None`` for ``uniform`` (no preview needed)
+    and ``optimal`` (which then plans for a level, matte surface:
+    :func:`rti_rig.planner.surface_estimate.flat_surface`). Dome steps carry LED indices and the
+    dome's LED names as labels, in ascending LED order; arm steps are ordered for short moves from
+    the park pose. The evidence is in ``schedule.provenance["report"]`` (or use
     :func:`plan_with_report`).
     """
     args = (preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg)

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.errors import ScheduleError
+from rti_rig.core.errors import ScheduleError
 
 #: Fraction of non-finite relief values above which the relief is refused rather than repaired.
 MAX_NONFINITE_FRACTION = 0.5

@@ -28,10 +28,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
-from rti_rig.reconstruct.bases import N_COEFFICIENTS, design_matrix
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix
 
 Objective = Literal["normals", "relight"]
 OBJECTIVES: tuple[str, ...] = ("normals", "relight")
@@ -163,7 +163,7 @@ class SurfaceSample:
     ``lit_candidates[p, k]`` / ``lit_held_out[p, t]`` are 1 where light k / t reaches pixel p
     without a cast shadow (from the preview's relief) and 0 where it is blocked;
     ``specular`` (0..1) is the strength of the highlight lobe, from the preview's hint or the
-    user's declared material (``planner.surface_estimate.sample_surface``).
+    user's declared material (``rti_rig.planner.surface_estimate.sample_surface``).
     """
 
     normals: NDArray[np.float64]
@@ -176,7 +176,7 @@ class SurfaceSample:
     #: None keeps :data:`HIGHLIGHT_WEIGHT_WIDTH_DEG` / :data:`HIGHLIGHT_MODEL_WIDTH_DEG`
     highlight_width_deg: float | None = None
     #: how many leading rows are the estimated surface itself (the rest: hedge copies of it,
-    #: :func:`planner.surface_estimate.hedge_global_tilt`); None means every row
+    #: :func:`rti_rig.planner.surface_estimate.hedge_global_tilt`); None means every row
     base_count: int | None = None
 
 
@@ -317,7 +317,7 @@ class NormalsObjective:
             self.g_all = self._solve(all_m[:, None], self.cross.sum(axis=1)[:, None])[:, 0]
         # single-precision copies for the batched swap scans, the planner's hot loop: they halve
         # the memory traffic, and every accepted swap is re-scored in double precision
-        # (:func:`planner.optimal.exchange_search`), so rounding can only cost a missed swap
+        # (:func:`rti_rig.planner.optimal.exchange_search`), so rounding can only cost a missed swap
         self.outer32 = self.outer.astype(np.float32)
         self.cross32 = self.cross.astype(np.float32) if self.tau2 > 0 else None
 

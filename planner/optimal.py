@@ -1,11 +1,11 @@
 """The "optimal" method: exchange search over the rig's lights for the chosen objective.
 
 Design of experiments, not clustering: the lights that minimise the expected reconstruction
-error over the preview's normals (:mod:`planner.objectives`: Cramér–Rao bound of the Lambertian
-fit with attached/cast shadows and highlights removed, or relighting bias² + variance for the
-basis the light count supports). The search is a Fedorov-style exchange: start from the best of
-several layouts that need no preview (homogeneous layouts with different elevation floors, plus
-the k-means layout when given), then sweep over the chosen lights, replacing each by the
+error over the preview's normals (:mod:`rti_rig.planner.objectives`: Cramér–Rao bound of the
+Lambertian fit with attached/cast shadows and highlights removed, or relighting bias² + variance
+for the basis the light count supports). The search is a Fedorov-style exchange: start from the
+best of several layouts that need no preview (homogeneous layouts with different elevation floors,
+plus the k-means layout when given), then sweep over the chosen lights, replacing each by the
 unused candidate that lowers the cost most (if any does), until a sweep changes nothing.
 
 Because the starting set includes the homogeneous layout the user would otherwise get and only
@@ -21,8 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
-
-from planner.objectives import NormalsObjective, RelightObjective
+from rti_rig.planner.objectives import NormalsObjective, RelightObjective
 
 #: At most this many sweeps over the chosen lights (a bound on run time; rarely reached).
 MAX_PASSES = 4

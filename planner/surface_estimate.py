@@ -1,16 +1,17 @@
 """What one preview says about the surface: the planner's model of the object.
 
 Every objective of the planner scores lights against a surface, and this module is where that
-surface comes from, kept apart from the choice of lights (:mod:`planner.make_plan`) so it can
-be estimated, inspected and tested on its own (the tests and the benchmarks do):
+surface comes from, kept apart from the choice of lights (:mod:`rti_rig.planner.make_plan`) so it
+can be estimated, inspected and tested on its own (the tests and the benchmarks do):
 
-1. :func:`planner.topography.planning_image` — downsample early, linearise, reduce to luminance;
+1. :func:`rti_rig.planner.topography.planning_image` — downsample early, linearise, reduce to
+luminance;
 2. the preview's light: ``preview_light`` (azimuth, elevation in degrees, frame of DESIGN.md) or
-   :func:`planner.topography.estimate_light`;
-3. a relief: the user's ONNX depth model (:func:`planner.topography.depth_from_onnx`) or the
-   weight-free :func:`planner.topography.shape_from_shading` — or, with no preview at all, a
+   :func:`rti_rig.planner.topography.estimate_light`;
+3. a relief: the user's ONNX depth model (:func:`rti_rig.planner.topography.depth_from_onnx`) or the
+   weight-free :func:`rti_rig.planner.topography.shape_from_shading` — or, with no preview at all, a
    level, matte surface (:func:`flat_surface`);
-4. its scale from the preview's shading and then normals (:mod:`planner.normals`), shrunk by
+4. its scale from the preview's shading and then normals (:mod:`rti_rig.planner.normals`), shrunk by
    how much of the preview they explain (:func:`relief_trust`).
 
 :func:`sample_surface` then draws the seeded pixel sample the objectives score, with cast-shadow
@@ -25,14 +26,13 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-
-from planner.normals import (
+from rti_rig.planner.normals import (
     ReliefFit,
     fit_relief_scale,
     normals_from_height,
     sanitize_height,
 )
-from planner.objectives import (
+from rti_rig.planner.objectives import (
     GLOSSY_SPECULAR,
     GLOSSY_WIDTH_DEG,
     Candidates,
@@ -40,7 +40,7 @@ from planner.objectives import (
     cast_shadow_visibility,
     check_material,
 )
-from planner.topography import (
+from rti_rig.planner.topography import (
     DepthModelSpec,
     depth_from_onnx,
     estimate_light,
@@ -48,7 +48,8 @@ from planner.topography import (
     planning_image,
     shape_from_shading,
 )
-from rti_rig.errors import ScheduleError
+
+from rti_rig.core.errors import ScheduleError
 
 #: Pixels sampled for the objectives.
 SAMPLE_PIXELS = 256
@@ -171,7 +172,7 @@ def sample_surface(
 ) -> SurfaceSample:
     """A seeded pixel sample with cast-shadow maps for the candidates and held-out lights.
 
-    ``material`` (:data:`planner.objectives.MATERIALS`) sets the highlight model: ``auto``
+    ``material`` (:data:`rti_rig.planner.objectives.MATERIALS`) sets the highlight model: ``auto``
     from the preview's bright outliers, ``matte`` none, ``glossy`` the declared lobe.
     """
     check_material(material)

@@ -1,7 +1,7 @@
 """Topography from one preview shot: linearise, downsample, find the light, recover relief.
 
 Three routes lead from a preview photo to a relief (a height field up to an unknown scale), which
-:mod:`planner.normals` turns into normals:
+:mod:`rti_rig.planner.normals` turns into normals:
 
 * :func:`depth_from_onnx` runs a monocular depth network the user supplies (MiDaS / DPT / Depth
   Anything output relative *inverse* depth, "bright = near"; LeReS outputs affine-invariant
@@ -33,8 +33,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.errors import ConfigError, ScheduleError
-from rti_rig.geometry import direction_from_az_el, normalize
+from rti_rig.core.errors import ConfigError, ScheduleError
+from rti_rig.core.geometry import direction_from_az_el, normalize
 
 #: Long side, in pixels, of the image the planner works on.
 PLANNING_SIDE_PX = 256
@@ -201,7 +201,7 @@ def shape_from_shading(
     linearised about the flat surface, ``p, q`` the height slopes), so in Fourier space the
     height is the shading divided by ``-i (ω·t) sin σ``; frequencies orthogonal to the light's
     tilt ``t`` carry no information and are zeroed (the known blind spot of a single raking
-    light; the scale is refitted from evidence in :mod:`planner.normals`).
+    light; the scale is refitted from evidence in :mod:`rti_rig.planner.normals`).
 
     Near-zenith light — the first-order term vanishes; to second order
     ``E ≈ ρ (1 - |∇h|² / 2)``, which gives the slope magnitude, and the height is taken to rise
@@ -293,7 +293,7 @@ def depth_from_onnx(
     The preview is resized to the model's input, normalised and fed as NCHW float32; the first
     output (N,H,W), (N,1,H,W) or (H,W) is resized to ``out_shape`` (default the preview's). An
     inverse-depth output is already "larger = nearer" and is used as the height; a depth output is
-    negated. Non-finite outputs are kept as NaN for :mod:`planner.normals` to handle.
+    negated. Non-finite outputs are kept as NaN for :mod:`rti_rig.planner.normals` to handle.
     """
     import onnxruntime as ort
 

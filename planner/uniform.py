@@ -16,10 +16,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
-from rti_rig.schedule import LightSchedule
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.schedule import LightSchedule
 
 
 def band_text(min_elevation_deg: float, max_elevation_deg: float) -> str:
@@ -114,7 +114,8 @@ def plan_uniform(
     for the rig.
 
     Dome steps go in LED order. Arm steps go in ``arm_order`` (the move-time-optimal order of
-    :mod:`planner.arm_order` when the arm's servos are known), else nearest neighbour by angle.
+    :mod:`rti_rig.planner.arm_order` when the arm's servos are known), else nearest neighbour by
+    angle.
     """
     provenance = {
         "n": n,

@@ -1,7 +1,7 @@
 """The `rti-rig` command line: run sessions, plan lights, export `.lp` files.
 
-Every user-facing failure is an :class:`~rti_rig.errors.RtiRigError` printed as one clear message
-(file, line or key, and what to do) with exit status 2, never a traceback.
+Every user-facing failure is an :class:`~rti_rig.core.errors.RtiRigError` printed as one clear
+message (file, line or key, and what to do) with exit status 2, never a traceback.
 """
 
 from __future__ import annotations
@@ -18,12 +18,12 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from rti_rig.errors import RtiRigError
+from rti_rig.core.errors import RtiRigError
 
 if TYPE_CHECKING:
-    from planner.plan_report import PlanReport
-    from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
-    from rti_rig.schedule import LightSchedule
+    from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+    from rti_rig.core.schedule import LightSchedule
+    from rti_rig.planner.plan_report import PlanReport
 
 app = typer.Typer(
     help=(
@@ -56,7 +56,7 @@ def _check_output_file(
     them is refused even with ``--force``, as is replacing a file inside a session folder —
     nothing already captured is ever overwritten. ``option`` is the flag that named the file.
     """
-    from rti_rig.session import MANIFEST
+    from rti_rig.runtime.session import MANIFEST
 
     if out_file.is_dir():
         raise RtiRigError(f"{option} {out_file} is a folder: give the name of the file to write")
@@ -81,7 +81,7 @@ def _check_output_file(
 
 
 def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
-    from rti_rig.rig_geometry import DomeGeometry
+    from rti_rig.core.rig_geometry import DomeGeometry
 
     cfg = loaded.config
     if isinstance(geometry, DomeGeometry):
@@ -104,8 +104,8 @@ def _checked_rig(loaded, schedule):  # type: ignore[no-untyped-def]
 
     The rig is closed (lights off, arm stopped) if the check fails, whatever the exception.
     """
-    from rti_rig.compose import build_rig
-    from rti_rig.controller import validate_schedule
+    from rti_rig.app.compose import build_rig
+    from rti_rig.runtime.controller import validate_schedule
 
     rig = build_rig(loaded)
     try:
@@ -124,7 +124,7 @@ def _open_new_session(  # type: ignore[no-untyped-def]
     The folder is checked first, so nothing lights or moves for a session that could not be
     written; the rig is closed if anything after opening it fails, whatever the exception.
     """
-    from rti_rig.session import SessionFolder
+    from rti_rig.runtime.session import SessionFolder
 
     SessionFolder.check_new(out_dir)
     rig = _checked_rig(loaded, schedule)
@@ -202,14 +202,14 @@ def run(
     pauses or resumes between images. An interrupted session can be
     continued with --resume.
     """
-    from planner.from_lp import schedule_from_lp
-    from planner.make_plan import check_elevation_band
-    from planner.uniform import plan_uniform
-    from rti_rig.compose import arm_order_for
-    from rti_rig.config import load_rig_config, rig_geometry
-    from rti_rig.lp_format import read_lp
-    from rti_rig.schedule import LightSchedule
-    from rti_rig.session import SessionFolder
+    from rti_rig.app.compose import arm_order_for
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.core.lp_format import read_lp
+    from rti_rig.core.schedule import LightSchedule
+    from rti_rig.planner.from_lp import schedule_from_lp
+    from rti_rig.planner.make_plan import check_elevation_band
+    from rti_rig.planner.uniform import plan_uniform
+    from rti_rig.runtime.session import SessionFolder
 
     try:
         _check_max_saturated(max_saturated)
@@ -267,9 +267,9 @@ def run(
 
 def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyped-def]
     """Meter the session's exposure with the camera driver layer's test series."""
-    from drivers.cameras.exposure import meter_exposure
-    from drivers.cameras.settings import ExposureRule
-    from rti_rig.exposure_policy import fix_session_exposure
+    from rti_rig.drivers.cameras.exposure import meter_exposure
+    from rti_rig.drivers.cameras.settings import ExposureRule
+    from rti_rig.runtime.exposure_policy import fix_session_exposure
 
     cam = rig.camera_config
     rule = ExposureRule(
@@ -293,7 +293,7 @@ def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyp
 
 def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on."""
-    from rti_rig.controller import (
+    from rti_rig.runtime.controller import (
         CancelToken,
         EmergencyStop,
         FinishReason,
@@ -301,7 +301,7 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
         StepCompleted,
         run_session,
     )
-    from rti_rig.session import LP_NAME
+    from rti_rig.runtime.session import LP_NAME
 
     cancel = CancelToken()
 
@@ -415,8 +415,8 @@ def preview(
     The session records the light that fired, so `rti-rig plan OUT_DIR --rig RIG ...` plans from
     its linear image with that light (no --preview-light needed).
     """
-    from planner.preview_shot import preview_schedule
-    from rti_rig.config import load_rig_config, rig_geometry
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.planner.preview_shot import preview_schedule
 
     try:
         _check_max_saturated(max_saturated)
@@ -572,19 +572,19 @@ def plan(
     The plan's lights are the rig's own (a dome's LEDs, used once each; an arm's reachable
     directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.
     """
-    from planner.make_plan import (
+    from rti_rig.app.compose import arm_order_for, read_preview_image
+    from rti_rig.app.config import default_config_path, load_rig_config, rig_geometry
+    from rti_rig.app.preview_source import resolve_preview
+    from rti_rig.core.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
+    from rti_rig.core.rig_geometry import DomeGeometry, coincident_leds
+    from rti_rig.planner.make_plan import (
         DEFAULT_OBJECTIVE,
         METHODS,
         check_elevation_band,
         plan_with_report,
     )
-    from planner.objectives import OBJECTIVES, check_material, check_signal_noise
-    from rti_rig.compose import arm_order_for, read_preview_image
-    from rti_rig.config import default_config_path, load_rig_config, rig_geometry
-    from rti_rig.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
-    from rti_rig.preview_source import resolve_preview
-    from rti_rig.rig_geometry import DomeGeometry, coincident_leds
-    from rti_rig.session import image_names
+    from rti_rig.planner.objectives import OBJECTIVES, check_material, check_signal_noise
+    from rti_rig.runtime.session import image_names
 
     rig = rig or default_config_path()
     try:
@@ -621,7 +621,7 @@ def plan(
             inputs["rig's LED calibration (lp_file)"] = loaded.folder / loaded.config.dome.lp_file
         _check_output_file(out_file, force, inputs)
         if figure is not None:
-            from rti_rig.plan_figure import check_figure_path  # matplotlib only when asked
+            from rti_rig.app.plan_figure import check_figure_path  # matplotlib only when asked
 
             check_figure_path(figure)
             _check_output_file(figure, force, inputs, "--figure")
@@ -718,8 +718,8 @@ def _write_plan_figure(
 ) -> None:
     """Draw the plan's map (``plan --figure``); the .lp is already written, so a failure here
     names the map file and leaves the plan in place."""
-    from rti_rig.geometry import direction_from_az_el
-    from rti_rig.plan_figure import expected_caption, layout_figure, write_layout_figure
+    from rti_rig.app.plan_figure import expected_caption, layout_figure, write_layout_figure
+    from rti_rig.core.geometry import direction_from_az_el
 
     light = report.preview_light_az_el_deg
     caption = expected_caption(report.expected_meaning or "expected error", report.expected)
@@ -751,8 +751,8 @@ def export_lp(
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
     """Write the .lp of a session (from the lights that actually fired)."""
-    from rti_rig.lp_format import write_lp
-    from rti_rig.session import session_lp_entries
+    from rti_rig.core.lp_format import write_lp
+    from rti_rig.runtime.session import session_lp_entries
 
     try:
         entries = session_lp_entries(session_dir, linear=linear)
@@ -821,8 +821,8 @@ def calibrate_lights(
 
     import numpy as np
 
-    from rti_rig.config import load_rig_config, rig_geometry
-    from rti_rig.light_calibration import calibrate_dome, calibration_toml, read_card_session
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.app.light_calibration import calibrate_dome, calibration_toml, read_card_session
 
     try:
         normal = _parse_normal(card_normal)
@@ -833,7 +833,7 @@ def calibrate_lights(
                 f"{rig_config}: rig '{loaded.config.name}' has no [dome.serial]: only a serial "
                 "dome can dim its LEDs (the simulated backend's are exact)"
             )
-        from drivers.led_dome.profiles import make_codec
+        from rti_rig.drivers.led_dome.profiles import make_codec
 
         if not make_codec(serial).has_level:
             raise RtiRigError(
@@ -915,12 +915,12 @@ def check(
     """Self-test the rig's lights: a dome lights each LED in turn and reports what answered; an
     arm visits poses spanning its band (checking where it really got to), flashes the lamp at
     each and parks."""
-    from rti_rig.arm_check import arm_self_test
-    from rti_rig.compose import build_rig
-    from rti_rig.config import load_rig_config
-    from rti_rig.dome_policy import self_test
-    from rti_rig.lighting import ArmLighting, DomeLighting
-    from rti_rig.rig_geometry import ArmGeometry
+    from rti_rig.app.compose import build_rig
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.core.rig_geometry import ArmGeometry
+    from rti_rig.runtime.arm_check import arm_self_test
+    from rti_rig.runtime.dome_policy import self_test
+    from rti_rig.runtime.lighting import ArmLighting, DomeLighting
 
     try:
         if not 0.0 < intensity <= 1.0:
@@ -966,7 +966,7 @@ def bench_tradeoff(
     """Error against number of lights and session time, for every planner, on simulated scenes."""
     import time
 
-    from rti_rig.bench_tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
+    from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
 
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()
     t0 = time.perf_counter()

@@ -1,9 +1,9 @@
 """An LED dome firmware emulator that speaks the drivers' bytes, with deterministic faults.
 
 The emulator decodes commands and encodes replies with the very codec of the configured profile
-(``drivers.led_dome``), so the real driver runs unchanged against it: in-process through
+(``rti_rig.drivers.led_dome``), so the real driver runs unchanged against it: in-process through
 :class:`InProcessDomeTransport` on a virtual clock, or over a pseudo-terminal through real
-pyserial (``simulator.pty_link.emulated_dome_on_pty``).
+pyserial (``rti_rig.simulator.pty_link.emulated_dome_on_pty``).
 
 It keeps the **truth**: :attr:`DomeFirmware.lit` is the LED that really emits light (after dead
 LEDs, the watchdog, resets and dropped commands), so a simulated camera can render what the
@@ -23,8 +23,8 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from drivers.led_dome.codec_base import DomeCodec
-from drivers.led_dome.messages import (
+from rti_rig.drivers.led_dome.codec_base import DomeCodec
+from rti_rig.drivers.led_dome.messages import (
     ERR_BAD_ARGUMENT,
     ERR_LED_FAULT,
     ERR_LED_OUT_OF_RANGE,
@@ -40,11 +40,12 @@ from drivers.led_dome.messages import (
     Query,
     Shutter,
 )
-from drivers.led_dome.profiles import make_codec
-from drivers.led_dome.settings import DomeSerialSettings
-from drivers.led_dome.transport import TransportError
-from rti_rig.clock import Clock, SystemClock
-from simulator.pty_link import PtyLink, serve_on_pty
+from rti_rig.drivers.led_dome.profiles import make_codec
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.drivers.led_dome.transport import TransportError
+from rti_rig.simulator.pty_link import PtyLink, serve_on_pty
+
+from rti_rig.core.clock import Clock, SystemClock
 
 
 class FaultKind(StrEnum):
@@ -318,7 +319,8 @@ class DomeFirmware:
 
 
 class InProcessDomeTransport:
-    """A :class:`drivers.led_dome.transport.Transport` wired straight to a :class:`DomeFirmware`.
+    """A :class:`rti_rig.drivers.led_dome.transport.Transport` wired straight to a
+    :class:`DomeFirmware`.
 
     Reads wait on the firmware's (virtual) clock: a reply due later than the read's timeout is not
     seen, exactly like a late reply on a real port, but no test ever really sleeps.
@@ -393,7 +395,9 @@ def emulated_dome_on_pty(firmware: DomeFirmware) -> Iterator[PtyLink]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Serve an emulated dome on a pty until interrupted: ``python -m simulator.dome_firmware``.
+    """Serve an emulated dome on a pty until interrupted.
+
+    Run as ``python -m rti_rig.simulator.dome_firmware``.
 
     Prints the port path, so that a rig config (or ``rti-rig check``) can be pointed at it for a
     dry run through the real driver and real pyserial.

@@ -31,9 +31,10 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from drivers.dynamixel import control_table as ct
-from drivers.dynamixel import protocol2 as p2
-from rti_rig.clock import Clock
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel import protocol2 as p2
+
+from rti_rig.core.clock import Clock
 
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
@@ -558,7 +559,9 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
 
     Their Min/Max Position Limit are left at the factory 0..4095, so the driver's connect-time
     check has something to synchronise, as on a fresh servo."""
-    from drivers.dynamixel.kinematics import ArmKinematics  # the emulator speaks their geometry
+    from rti_rig.drivers.dynamixel.kinematics import (
+        ArmKinematics,  # the emulator speaks their geometry
+    )
 
     kin = ArmKinematics(settings)
     park = kin.ticks_of_pose(settings.park_azimuth_deg, settings.park_elevation_deg)
@@ -579,7 +582,7 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
 def lamp_direction(emulator: DynamixelBusEmulator, settings: Any) -> Any:
     """Unit direction of the lamp *now* (emulator time), from the servos' present positions:
     what a simulated camera should render, wherever the arm really is (even mid-move)."""
-    from drivers.dynamixel.kinematics import ArmKinematics
+    from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
 
     pos = emulator.joint_positions()
     return ArmKinematics(settings).direction_of_ticks(
@@ -614,7 +617,7 @@ def emulated_arm_port(
 
 def main() -> None:  # pragma: no cover - manual tool
     """Serve two XL430s (ids 1, 2) on a pty until Ctrl-C, in real time (SystemClock)."""
-    from rti_rig.clock import SystemClock
+    from rti_rig.core.clock import SystemClock
 
     clock = SystemClock()
     emulator = DynamixelBusEmulator(

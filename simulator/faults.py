@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rti_rig.errors import CaptureError, DeviceError
-from rti_rig.rig import Frame
+from rti_rig.core.devices import Frame
+from rti_rig.core.errors import CaptureError, DeviceError
 
 
 @dataclass
@@ -113,7 +113,7 @@ class ServoFaultCarrier:
         return getattr(self.inner, name)
 
     def move_to(self, direction: np.ndarray) -> np.ndarray:
-        from drivers.dynamixel.control_table import HardwareFault
+        from rti_rig.drivers.dynamixel.control_table import HardwareFault
 
         if self.plan.due():
             kind = self.plan.kind

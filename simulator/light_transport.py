@@ -31,9 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-
-from simulator.scenes import KNOWN_PASSES, Scene, SceneError
-from simulator.shadows import directional_visibility, point_visibility
+from rti_rig.simulator.scenes import KNOWN_PASSES, Scene, SceneError
+from rti_rig.simulator.shadows import directional_visibility, point_visibility
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.errors import RtiRigError
+from rti_rig.core.errors import RtiRigError
 
 #: Render passes a scene may ask for. Diffuse (Lambertian) shading is always rendered.
 KNOWN_PASSES = frozenset({"shadows", "specular"})

@@ -11,11 +11,11 @@ from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
+from rti_rig.simulator.sim_lights import LightState
 
-from rti_rig.clock import Clock
-from rti_rig.errors import CaptureError
-from rti_rig.rig import Frame
-from simulator.sim_lights import LightState
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import Frame
+from rti_rig.core.errors import CaptureError
 
 #: A renderer maps (light direction or None, intensity) to linear radiance (H, W, 3) in [0, ~1].
 Renderer = Callable[[NDArray[np.float64] | None, float], NDArray[np.float64]]
@@ -108,8 +108,8 @@ class SimulatedCamera:
 
     def _through_raw(self, linear: NDArray[np.float64], exposure_s: float, t0: float) -> Frame:
         """Deliver the frame as a DSLR would: Bayer mosaic → DNG → the real rawpy decode path."""
-        from drivers.cameras.raw_roundtrip import encode_decode
-        from drivers.cameras.settings import RawDecodeSettings
+        from rti_rig.drivers.cameras.raw_roundtrip import encode_decode
+        from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
         frame = encode_decode(
             linear, exposure_s, RawDecodeSettings(mode="demosaic"), timestamp_s=t0

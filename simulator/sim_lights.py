@@ -12,11 +12,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from planner.arm_motion import joint_move_time_s
-from rti_rig.clock import Clock
-from rti_rig.errors import DeviceError
-from rti_rig.geometry import az_el_from_direction, direction_from_az_el
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.arm_motion import joint_move_time_s
+from rti_rig.core.clock import Clock
+from rti_rig.core.errors import DeviceError
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 
 @dataclass

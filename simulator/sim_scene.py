@@ -12,8 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-
-from simulator.scenes import normals_from_height
+from rti_rig.simulator.scenes import normals_from_height
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,7 +67,7 @@ def renderer_for(
     """``render(direction | None, intensity) -> (H, W, 3)`` radiance for a named scene.
 
     ``relief`` is this module's simple Lambertian scene; every other name is a scene of the
-    library (:mod:`simulator.scenes`), rendered with the passes it needs (cast shadows, GGX
+    library (:mod:`rti_rig.simulator.scenes`), rendered with the passes it needs (cast shadows, GGX
     specular) under a directional light, or a point lamp at ``light_distance_mm`` (the dome's
     radius or the arm's reach) when given. The simulated camera and the wrong-light check both
     render through this one function, so they cannot disagree about what a light looks like.
@@ -83,8 +82,8 @@ def renderer_for(
 
         return render_relief
 
-    from simulator.light_transport import light_at, render_radiance
-    from simulator.scenes import make_scene
+    from rti_rig.simulator.light_transport import light_at, render_radiance
+    from rti_rig.simulator.scenes import make_scene
 
     library = make_scene(name, height_px, width_px, seed=seed)
 

@@ -9,12 +9,12 @@ import pytest
 from conftest import CONFIGS
 from typer.testing import CliRunner
 
-from rti_rig.arm_check import arm_self_test, self_test_poses
 from rti_rig.cli import app
-from rti_rig.clock import VirtualClock
-from rti_rig.errors import DeviceError
-from rti_rig.geometry import az_el_from_direction, direction_from_az_el
-from rti_rig.rig_geometry import ArmGeometry
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.errors import DeviceError
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.core.rig_geometry import ArmGeometry
+from rti_rig.runtime.arm_check import arm_self_test, self_test_poses
 
 runner = CliRunner()
 ARM = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
@@ -135,8 +135,8 @@ def test_park_after_session_off_is_respected() -> None:
 def test_the_real_driver_is_not_parked_after_an_error(tmp_path: Path) -> None:
     """Emulated XL430s through the real SDK: a move that fails (an obstruction, say) leaves the
     arm where it stopped — the driver's close must not park it behind the test's back."""
-    from rti_rig.compose import build_rig
-    from rti_rig.config import load_rig_config
+    from rti_rig.app.compose import build_rig
+    from rti_rig.app.config import load_rig_config
 
     with build_rig(load_rig_config(inprocess_arm_config(tmp_path))) as rig:
         carrier = rig.lighting.carrier  # type: ignore[attr-defined]

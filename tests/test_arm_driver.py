@@ -6,21 +6,21 @@ import dynamixel_sdk as sdk
 import numpy as np
 import pytest
 from pydantic import ValidationError
-
-from drivers.dynamixel import control_table as ct
-from drivers.dynamixel.arm import DynamixelArm
-from drivers.dynamixel.faults import (
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel.arm import DynamixelArm
+from rti_rig.drivers.dynamixel.faults import (
     ConfigMismatchError,
     HardwareFaultError,
     MoveTimeoutError,
     SafetyViolation,
     UnreachableError,
 )
-from planner.arm_motion import move_time_s
-from rti_rig.clock import VirtualClock
-from rti_rig.geometry import angle_between_deg, direction_from_az_el
-from rti_rig.rig import LightCarrier
-from simulator.dynamixel_emulator import InProcessPort, PtyServoServer, emulator_for_arm
+from rti_rig.simulator.dynamixel_emulator import InProcessPort, PtyServoServer, emulator_for_arm
+
+from rti_rig.core.arm_motion import move_time_s
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.devices import LightCarrier
+from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
 from tests.test_dxl_support import (
     arm_settings,
     wide_sdk_timeouts,  # noqa: F401  (fixture)
@@ -207,7 +207,7 @@ def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
 @pytest.mark.usefixtures("wide_sdk_timeouts")
 @pytest.mark.parametrize("transport", ["pty", "inprocess"])
 def test_emulated_arm_port_dry_run(transport: str) -> None:
-    from simulator.dynamixel_emulator import emulated_arm_port
+    from rti_rig.simulator.dynamixel_emulator import emulated_arm_port
 
     settings = arm_settings()
     clock = VirtualClock()
@@ -215,7 +215,7 @@ def test_emulated_arm_port_dry_run(transport: str) -> None:
         arm = DynamixelArm(settings, port, clock)
         with arm:
             reached = arm.move_to(direction_from_az_el(45, 45))
-            from simulator.dynamixel_emulator import lamp_direction
+            from rti_rig.simulator.dynamixel_emulator import lamp_direction
 
             assert angle_between_deg(lamp_direction(emu, settings), reached) < 0.01
             # mid-move the lamp is between start and goal
@@ -247,7 +247,7 @@ def test_reboot_after_fault_then_home() -> None:
 def test_settings_from_a_rig_toml_table() -> None:
     import tomllib
 
-    from drivers.dynamixel.settings import ArmSettings
+    from rti_rig.drivers.dynamixel.settings import ArmSettings
 
     text = """
     [arm]
@@ -282,7 +282,7 @@ def test_the_documented_rig_config_validates_and_dry_runs() -> None:
     import tomllib
     from pathlib import Path
 
-    from drivers.dynamixel.settings import ArmSettings
+    from rti_rig.drivers.dynamixel.settings import ArmSettings
 
     doc = Path(__file__).resolve().parent.parent / "docs" / "protocols" / "dynamixel-arm.md"
     block = re.search(r"```toml\n(.*?)```", doc.read_text(encoding="utf-8"), re.DOTALL)

@@ -9,9 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-from planner.arm_motion import joint_move_time_s, move_time_matrix, move_time_s
-from planner.arm_order import (
+from rti_rig.planner.arm_order import (
     EXACT_MAX,
     held_karp,
     heuristic_order,
@@ -19,7 +17,9 @@ from planner.arm_order import (
     order_from_matrix,
     path_time_s,
 )
-from rti_rig.geometry import direction_from_az_el
+
+from rti_rig.core.arm_motion import joint_move_time_s, move_time_matrix, move_time_s
+from rti_rig.core.geometry import direction_from_az_el
 from tests.test_dxl_support import arm_settings
 
 
@@ -86,7 +86,7 @@ def test_order_for_arm_beats_plan_order_and_is_a_permutation() -> None:
 
 
 def test_sequence_time_follows_multi_turn_choices() -> None:
-    from planner.arm_motion import sequence_time_s
+    from rti_rig.core.arm_motion import sequence_time_s
 
     s = arm_settings(
         azimuth=dict(operating_mode="extended_position", min_deg=-360.0, max_deg=360.0),
@@ -103,7 +103,7 @@ def test_sequence_time_follows_multi_turn_choices() -> None:
 
 
 def test_multi_turn_ordering_uses_the_short_way_when_it_helps() -> None:
-    from planner.arm_motion import sequence_time_s
+    from rti_rig.core.arm_motion import sequence_time_s
 
     s = arm_settings(
         azimuth=dict(operating_mode="extended_position", min_deg=-540.0, max_deg=540.0)

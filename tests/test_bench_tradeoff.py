@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rti_rig.bench_tradeoff import (
+from benchmarks.tradeoff import (
     PER_LIGHT_S,
     TradeoffSettings,
     plot,

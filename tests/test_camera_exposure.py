@@ -6,16 +6,16 @@ import json
 
 import numpy as np
 import pytest
-
-from drivers.cameras.exposure import (
+from rti_rig.drivers.cameras.exposure import (
     choose_exposure,
     choose_from_series,
     meter_exposure,
     predicted_saturated_fraction,
 )
-from drivers.cameras.raw_roundtrip import RawRoundTripCamera
-from drivers.cameras.settings import ExposureRule
-from rti_rig.rig import Frame
+from rti_rig.drivers.cameras.raw_roundtrip import RawRoundTripCamera
+from rti_rig.drivers.cameras.settings import ExposureRule
+
+from rti_rig.core.devices import Frame
 
 
 def ramp_frame(exposure_s=0.01, white=1000) -> Frame:
@@ -124,7 +124,7 @@ def test_meter_exposure_through_the_raw_path_converges_and_verifies(tmp_path):
     assert len(shots) <= rule.max_attempts and shots[0] == 2.0
     assert choice.test_exposures_s[-1] == choice.exposure_s
     # close to the true optimum: the mosaic's 99.8th percentile reaches white
-    from drivers.cameras.dng_writer import linear_to_mosaic
+    from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic
 
     mosaic_radiance = linear_to_mosaic(radiance / 4.0, "RGGB", 0, 65535) / 65535 * 4.0
     optimum = 1.0 / np.quantile(mosaic_radiance, 1 - 0.002)

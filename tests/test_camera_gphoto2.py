@@ -9,18 +9,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
-
-from drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic
-from drivers.cameras.gphoto2_camera import (
+from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic
+from rti_rig.drivers.cameras.gphoto2_camera import (
     Gphoto2Camera,
     load_gphoto2,
     nearest_shutter,
     parse_shutter,
 )
-from drivers.cameras.settings import Gphoto2CameraSettings
-from rti_rig.clock import VirtualClock
-from rti_rig.errors import CaptureError, DeviceError
-from rti_rig.rig import Camera
+from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
+
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.devices import Camera
+from rti_rig.core.errors import CaptureError, DeviceError
 
 SHUTTERS = ["bulb", "30", "2", "1", "0.5", "1/4", "1/8", "1/15", "1/30", "1/60", "1/125", "1/250"]
 BLACK, WHITE = 512, 16383

@@ -5,15 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from pydantic import ValidationError
-
-from drivers.cameras.dark_frames import capture_master_dark
-from drivers.cameras.factory import build_camera
-from drivers.cameras.folder_watch import FolderWatchCamera
-from drivers.cameras.gphoto2_camera import Gphoto2Camera
-from drivers.cameras.opencv_camera import OpenCvCamera
-from drivers.cameras.raw_decode import subtract_dark
-from drivers.cameras.raw_roundtrip import RawRoundTripCamera
-from drivers.cameras.settings import (
+from rti_rig.drivers.cameras.dark_frames import capture_master_dark
+from rti_rig.drivers.cameras.factory import build_camera
+from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
+from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
+from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera
+from rti_rig.drivers.cameras.raw_decode import subtract_dark
+from rti_rig.drivers.cameras.raw_roundtrip import RawRoundTripCamera
+from rti_rig.drivers.cameras.settings import (
     ExposureRule,
     FolderWatchSettings,
     Gphoto2CameraSettings,
@@ -21,7 +20,8 @@ from drivers.cameras.settings import (
     RawDecodeSettings,
     parse_camera_settings,
 )
-from rti_rig.rig import Camera
+
+from rti_rig.core.devices import Camera
 
 
 def test_kind_selects_the_backend_and_builds_the_driver(tmp_path):

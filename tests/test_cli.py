@@ -12,9 +12,9 @@ from conftest import REPO, SMALL_DOME, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.geometry import az_el_from_direction
-from rti_rig.image_files import read_linear_tiff
-from rti_rig.lp_format import read_lp
+from rti_rig.core.geometry import az_el_from_direction
+from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.lp_format import read_lp
 
 runner = CliRunner()
 
@@ -416,12 +416,13 @@ def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
 
 def test_plan_orders_an_arm_by_move_time_with_its_servo_settings(tmp_path: Path) -> None:
     """``rti-rig plan`` on an arm with ``[arm.dynamixel]`` fires its stops in the move-time
-    order of ``planner.arm_order`` (the issue's "move-time order for arms"), which here is
+    order of ``rti_rig.planner.arm_order`` (the issue's "move-time order for arms"), which here is
     faster than the nearest-neighbour fallback."""
-    from planner.arm_motion import sequence_time_s
-    from planner.arm_order import order_for_arm
-    from planner.uniform import order_nearest_neighbour
-    from rti_rig.config import load_rig_config, rig_geometry
+    from rti_rig.planner.arm_order import order_for_arm
+    from rti_rig.planner.uniform import order_nearest_neighbour
+
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.core.arm_motion import sequence_time_s
 
     rig = REPO / "rig_configs" / "simulated_arm.toml"
     plan = tmp_path / "plan.lp"

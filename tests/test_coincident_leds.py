@@ -13,11 +13,11 @@ import pytest
 from conftest import SMALL_DOME, write_config
 from typer.testing import CliRunner
 
+from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
-from rti_rig.config import load_rig_config
-from rti_rig.errors import ConfigError
-from rti_rig.geometry import direction_from_az_el
-from rti_rig.rig_geometry import COINCIDENT_LED_DEG, coincident_leds
+from rti_rig.core.errors import ConfigError
+from rti_rig.core.geometry import direction_from_az_el
+from rti_rig.core.rig_geometry import COINCIDENT_LED_DEG, coincident_leds
 
 
 def test_coincident_leds_finds_the_first_pair_only_within_tolerance() -> None:

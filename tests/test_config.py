@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from conftest import SMALL_DOME, write_config
 
-from rti_rig.config import default_config_path, load_rig_config, rig_geometry
-from rti_rig.errors import ConfigError
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.app.config import default_config_path, load_rig_config, rig_geometry
+from rti_rig.core.errors import ConfigError
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 
 def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> None:

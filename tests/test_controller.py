@@ -8,21 +8,21 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import REPO, SMALL_DOME, write_config
+from rti_rig.planner.uniform import plan_uniform
 
-from planner.uniform import plan_uniform
-from rti_rig.assembly import Rig
-from rti_rig.compose import build_rig
-from rti_rig.config import load_rig_config
-from rti_rig.controller import (
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
+from rti_rig.core.errors import CaptureError, DeviceError, ScheduleError, SessionError
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.runtime.controller import (
     CancelToken,
     FinishReason,
     StepCompleted,
     run_session,
 )
-from rti_rig.errors import CaptureError, DeviceError, ScheduleError, SessionError
-from rti_rig.lp_format import read_lp
-from rti_rig.schedule import LightSchedule, LightStep
-from rti_rig.session import SessionFolder
+from rti_rig.runtime.rig import Rig
+from rti_rig.runtime.session import SessionFolder
 
 
 def small_rig(tmp_path: Path) -> Rig:
@@ -241,7 +241,7 @@ def test_arm_session_records_reached_directions_and_parks(
 def test_arm_emergency_stop_follows_parking_policy(
     tmp_path: Path, arm_config_path: Path, park_on_emergency: bool
 ) -> None:
-    from rti_rig.controller import EmergencyStop
+    from rti_rig.runtime.controller import EmergencyStop
 
     text = arm_config_path.read_text().replace("width = 512", "width = 32")
     text = text.replace("height = 512", "height = 32")
@@ -268,7 +268,7 @@ def test_emulated_dynamixel_arm_stays_put_after_an_emergency_stop_unless_told(
     tmp_path: Path, park_on_emergency: bool
 ) -> None:
     """The real driver's close must not park behind the policy's back (it once did)."""
-    from rti_rig.controller import EmergencyStop
+    from rti_rig.runtime.controller import EmergencyStop
 
     text = (REPO / "rig_configs" / "simulated_arm.toml").read_text()
     text = text.replace("width = 256", "width = 32").replace("height = 256", "height = 32")

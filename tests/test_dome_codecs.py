@@ -5,11 +5,10 @@ from __future__ import annotations
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-
-from drivers.led_dome.codec_binary import BinaryCodec
-from drivers.led_dome.codec_default import DefaultCodec
-from drivers.led_dome.codec_framed import FramedCodec, FramedSpec
-from drivers.led_dome.messages import (
+from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
+from rti_rig.drivers.led_dome.codec_default import DefaultCodec
+from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
+from rti_rig.drivers.led_dome.messages import (
     Ack,
     AllOff,
     BadRequest,
@@ -23,8 +22,8 @@ from drivers.led_dome.messages import (
     Query,
     Shutter,
 )
-from drivers.led_dome.profiles import make_codec
-from drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.drivers.led_dome.profiles import make_codec
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 
 IDENT = DomeIdentity("RTIDOME", "1.2.0", 48)
 

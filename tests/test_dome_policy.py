@@ -10,12 +10,22 @@ import itertools
 
 import numpy as np
 import pytest
+from rti_rig.drivers.led_dome import DomeSerialSettings
+from rti_rig.drivers.led_dome.codec_default import DefaultCodec
+from rti_rig.drivers.led_dome.driver import LedDomeDriver
+from rti_rig.simulator.dome_firmware import (
+    Fault,
+    FaultKind,
+    FaultPlan,
+    InProcessDomeTransport,
+    firmware_for,
+)
 
-from drivers.led_dome import DomeSerialSettings, build_dome
-from drivers.led_dome.codec_default import DefaultCodec
-from drivers.led_dome.driver import LedDomeDriver
-from rti_rig.clock import VirtualClock
-from rti_rig.dome_policy import (
+from rti_rig.app.dome_factory import build_dome
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.devices import DiscreteLightSource
+from rti_rig.core.errors import DeviceError
+from rti_rig.runtime.dome_policy import (
     DomeLedError,
     DomeLinkError,
     DomePolicy,
@@ -23,15 +33,6 @@ from rti_rig.dome_policy import (
     ThermalGuard,
     ThermalLimits,
     self_test,
-)
-from rti_rig.errors import DeviceError
-from rti_rig.rig import DiscreteLightSource
-from simulator.dome_firmware import (
-    Fault,
-    FaultKind,
-    FaultPlan,
-    InProcessDomeTransport,
-    firmware_for,
 )
 
 PROFILES = ["default", "framed", "binary"]

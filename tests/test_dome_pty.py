@@ -11,18 +11,19 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from drivers.led_dome import DomeSerialSettings, build_dome
-from rti_rig.clock import SystemClock, VirtualClock
-from rti_rig.dome_policy import DomeLedError, DomeLinkError, self_test
-from rti_rig.errors import DeviceError
-from simulator.dome_firmware import (
+from rti_rig.drivers.led_dome import DomeSerialSettings
+from rti_rig.simulator.dome_firmware import (
     Fault,
     FaultKind,
     FaultPlan,
     emulated_dome_on_pty,
     firmware_for,
 )
+
+from rti_rig.app.dome_factory import build_dome
+from rti_rig.core.clock import SystemClock, VirtualClock
+from rti_rig.core.errors import DeviceError
+from rti_rig.runtime.dome_policy import DomeLedError, DomeLinkError, self_test
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
 
@@ -197,14 +198,14 @@ def test_loop_url_transport_opens_without_a_lock():
 
 
 def test_dry_run_against_the_emulator_in_another_process():
-    """``python -m simulator.dome_firmware`` serves a dome that any program can open by path."""
+    """``python -m rti_rig.simulator.dome_firmware`` serves a dome any program can open by path."""
     import subprocess
 
     proc = subprocess.Popen(
         [
             sys.executable,
             "-m",
-            "simulator.dome_firmware",
+            "rti_rig.simulator.dome_firmware",
             "--leds",
             "6",
             "--dead",

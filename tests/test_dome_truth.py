@@ -10,17 +10,18 @@ from __future__ import annotations
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
-from drivers.led_dome import DomeSerialSettings, build_dome
-from rti_rig.clock import VirtualClock
-from rti_rig.errors import DeviceError
-from simulator.dome_firmware import (
+from rti_rig.drivers.led_dome import DomeSerialSettings
+from rti_rig.simulator.dome_firmware import (
     Fault,
     FaultKind,
     FaultPlan,
     InProcessDomeTransport,
     firmware_for,
 )
+
+from rti_rig.app.dome_factory import build_dome
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.errors import DeviceError
 
 N_LEDS = 8
 

@@ -4,17 +4,21 @@ from __future__ import annotations
 
 import dynamixel_sdk as sdk
 import pytest
-
-from drivers.dynamixel import control_table as ct
-from drivers.dynamixel.bus import DxlBus
-from drivers.dynamixel.faults import CommunicationError, HardwareFaultError, ServoStatusError
-from rti_rig.clock import VirtualClock
-from simulator.dynamixel_emulator import (
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel.bus import DxlBus
+from rti_rig.drivers.dynamixel.faults import (
+    CommunicationError,
+    HardwareFaultError,
+    ServoStatusError,
+)
+from rti_rig.simulator.dynamixel_emulator import (
     DynamixelBusEmulator,
     EmulatedServo,
     InProcessPort,
     PtyServoServer,
 )
+
+from rti_rig.core.clock import VirtualClock
 from tests.test_dxl_support import wide_sdk_timeouts  # noqa: F401  (fixture)
 
 
@@ -187,7 +191,7 @@ def test_bulk_read_write_reg_write_action_in_process() -> None:
 
 def test_emulator_accepts_properly_stuffed_packets() -> None:
     """Other clients stuff FF FF FD in bodies (the e-manual rule); both forms must work."""
-    from drivers.dynamixel import protocol2 as p2
+    from rti_rig.drivers.dynamixel import protocol2 as p2
 
     clock = VirtualClock()
     emu = two_servos(clock, mode=4)

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import pytest
-
-from drivers.dynamixel.settings import ArmSettings
+from rti_rig.drivers.dynamixel.settings import ArmSettings
 
 
 def arm_settings(**overrides) -> ArmSettings:

@@ -8,18 +8,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import CONFIGS, write_config
+from rti_rig.planner.uniform import plan_uniform
 from typer.testing import CliRunner
 
-from planner.uniform import plan_uniform
+from rti_rig.app.compose import arm_order_for, build_rig
+from rti_rig.app.config import load_rig_config, rig_geometry
 from rti_rig.cli import app
-from rti_rig.compose import arm_order_for, build_rig
-from rti_rig.config import load_rig_config, rig_geometry
-from rti_rig.controller import run_session
-from rti_rig.errors import ConfigError, ScheduleError
-from rti_rig.geometry import angle_between_deg
-from rti_rig.schedule import LightSchedule, LightStep
-from rti_rig.session import SessionFolder
-from simulator.verify import wrong_light_steps
+from rti_rig.core.errors import ConfigError, ScheduleError
+from rti_rig.core.geometry import angle_between_deg
+from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.runtime.controller import run_session
+from rti_rig.runtime.session import SessionFolder
+from rti_rig.testing.verify import wrong_light_steps
 
 runner = CliRunner()
 
@@ -47,7 +47,7 @@ def test_arm_parks_and_switches_off_after_the_session(tmp_path: Path) -> None:
     with build_rig(loaded) as rig:
         schedule = plan_uniform(rig.geometry, 5, arm_order=arm_order_for(loaded))
         run_session(rig, schedule, SessionFolder.create(tmp_path / "s", 5))
-        from simulator.dynamixel_emulator import lamp_direction
+        from rti_rig.simulator.dynamixel_emulator import lamp_direction
 
         arm = rig.lighting.carrier  # type: ignore[attr-defined]
         assert not arm.lamp_is_on
@@ -57,7 +57,7 @@ def test_arm_parks_and_switches_off_after_the_session(tmp_path: Path) -> None:
 
 
 def test_move_time_order_beats_plan_order(tmp_path: Path) -> None:
-    from planner.arm_motion import sequence_time_s
+    from rti_rig.core.arm_motion import sequence_time_s
 
     loaded = load_rig_config(small_arm(tmp_path, "inprocess"))
     settings = loaded.config.arm.dynamixel  # type: ignore[union-attr]

@@ -9,14 +9,14 @@ import pytest
 from conftest import CONFIGS, write_config
 from typer.testing import CliRunner
 
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
-from rti_rig.compose import build_rig
-from rti_rig.config import load_rig_config
-from rti_rig.controller import run_session
-from rti_rig.errors import ConfigError, DeviceError
-from rti_rig.lp_format import read_lp
-from rti_rig.session import SessionFolder
-from simulator.verify import wrong_light_steps
+from rti_rig.core.errors import ConfigError, DeviceError
+from rti_rig.core.lp_format import read_lp
+from rti_rig.runtime.controller import run_session
+from rti_rig.runtime.session import SessionFolder
+from rti_rig.testing.verify import wrong_light_steps
 
 runner = CliRunner()
 
@@ -49,7 +49,7 @@ def test_cli_dry_run_through_the_emulated_dome(tmp_path: Path) -> None:
 
 def test_firmware_really_lit_each_recorded_led(tmp_path: Path) -> None:
     loaded = load_rig_config(small_emulated(tmp_path))
-    from planner.uniform import plan_uniform
+    from rti_rig.planner.uniform import plan_uniform
 
     with build_rig(loaded) as rig:
         fw = rig.emulator  # type: ignore[attr-defined]
@@ -81,7 +81,7 @@ def test_check_passes_and_names_a_dead_led(tmp_path: Path) -> None:
 def test_dead_led_stops_the_session_naming_it(tmp_path: Path) -> None:
     cfg = small_emulated(tmp_path, "\n[emulator]\ndead_leds = [3]\n")
     loaded = load_rig_config(cfg)
-    from rti_rig.schedule import LightSchedule
+    from rti_rig.core.schedule import LightSchedule
 
     with build_rig(loaded) as rig:
         dirs = rig.geometry.directions

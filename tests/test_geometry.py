@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rti_rig.geometry import (
+from rti_rig.core.geometry import (
     angle_between_deg,
     az_el_from_direction,
     direction_from_az_el,

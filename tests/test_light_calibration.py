@@ -17,10 +17,10 @@ import pytest
 from conftest import CONFIGS, write_config
 from typer.testing import CliRunner
 
+from rti_rig.app.config import load_rig_config
+from rti_rig.app.light_calibration import CardSession, calibrate_dome, read_card_session
 from rti_rig.cli import app
-from rti_rig.config import load_rig_config
-from rti_rig.errors import ConfigError, SessionError
-from rti_rig.light_calibration import CardSession, calibrate_dome, read_card_session
+from rti_rig.core.errors import ConfigError, SessionError
 
 runner = CliRunner()
 

@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rti_rig.errors import LpFormatError
-from rti_rig.lp_format import LpEntry, format_lp, parse_lp, read_lp, write_lp
+from rti_rig.core.errors import LpFormatError
+from rti_rig.core.lp_format import LpEntry, format_lp, parse_lp, read_lp, write_lp
 
 DATA = Path(__file__).parent / "data"
 # The profile of DESIGN.md: count line, then 'name x y z' with fixed-point 0.xxxxxx values.

@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rti_rig.geometry import direction_from_az_el
-from rti_rig.metrics import (
+from benchmarks.metrics import (
     angular_error_deg,
     normal_map_psnr,
     normal_map_ssim,
@@ -17,6 +16,7 @@ from rti_rig.metrics import (
     ssim,
     ssim_map,
 )
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.reconstruct import fit_hsh, fit_photometric_stereo
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
@@ -135,7 +135,7 @@ def test_relighting_metrics_on_held_out_lights() -> None:
 
 
 def test_score_reconstruction_applies_each_metric_where_it_can() -> None:
-    from rti_rig.metrics import score_reconstruction
+    from benchmarks.metrics import score_reconstruction
     from rti_rig.reconstruct import fit_model
 
     normals, inside = sphere_normals(40, 40)

@@ -1,4 +1,4 @@
-"""The map of a light plan (rti_rig.plan_figure, `rti-rig plan --figure`).
+"""The map of a light plan (rti_rig.app.plan_figure, `rti-rig plan --figure`).
 
 A plan is checked on this map before the rig moves, so the map must put every light where the
 frame of DESIGN.md says it is (azimuth from +x towards +y, distance from the centre = 90° −
@@ -13,18 +13,18 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from rti_rig.cli import app
-from rti_rig.errors import RtiRigError
-from rti_rig.geometry import direction_from_az_el, fibonacci_cap
-from rti_rig.lp_format import read_lp
-from rti_rig.plan_figure import (
+from rti_rig.app.plan_figure import (
     check_figure_path,
     expected_caption,
     layout_figure,
     polar_coordinates,
     write_layout_figure,
 )
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.cli import app
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 REPO = Path(__file__).resolve().parents[1]
 DOME = DomeGeometry(fibonacci_cap(40, 5.0, 85.0), tuple(f"led{i:02d}" for i in range(40)))
@@ -163,7 +163,7 @@ def test_plan_cli_map_shows_the_lights_of_the_plan_file_in_its_order(
 ) -> None:
     """The map drawn is of the plan written: the same lights, in the .lp's (firing) order, and
     the preview light the plan used."""
-    import rti_rig.plan_figure as plan_figure
+    import rti_rig.app.plan_figure as plan_figure
 
     drawn = []
     monkeypatch.setattr(plan_figure, "write_layout_figure", lambda path, fig: drawn.append(fig))
@@ -198,7 +198,7 @@ def test_plan_cli_map_shows_the_lights_of_the_plan_file_in_its_order(
 def test_plan_cli_map_failure_keeps_the_plan_and_its_report(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import rti_rig.plan_figure as plan_figure
+    import rti_rig.app.plan_figure as plan_figure
 
     def fail(path: Path, fig: object) -> None:
         raise OSError("disk full")

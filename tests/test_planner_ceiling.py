@@ -11,17 +11,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rti_rig.planner.make_plan import arm_below, check_elevation_band, make_plan, plan_with_report
+from rti_rig.planner.objectives import candidates_for
+from rti_rig.planner.uniform import select_uniform_leds
+from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 from typer.testing import CliRunner
 
-from planner.make_plan import arm_below, check_elevation_band, make_plan, plan_with_report
-from planner.objectives import candidates_for
-from planner.uniform import select_uniform_leds
 from rti_rig.cli import app
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
-from rti_rig.lp_format import read_lp
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
-from simulator.sim_scene import lambert_radiance, relief_scene
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 REPO = Path(__file__).resolve().parents[1]
 DOME = DomeGeometry(fibonacci_cap(60, 5.0, 88.0), tuple(f"led{i:02d}" for i in range(60)))
@@ -119,7 +119,7 @@ def test_relight_objective_scores_relighting_above_the_ceiling_too(
 ) -> None:
     """A user relights from every direction, so the held-out directions the relight objective
     scores reach above the ceiling the planned lights respect."""
-    import planner.objectives as objectives
+    import rti_rig.planner.objectives as objectives
 
     seen = []
     original = objectives.RelightObjective.__init__
@@ -163,7 +163,7 @@ def test_report_and_provenance_record_the_ceiling() -> None:
 def test_plan_cli_keeps_the_plan_below_the_ceiling_and_draws_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import rti_rig.plan_figure as plan_figure
+    import rti_rig.app.plan_figure as plan_figure
 
     drawn = []
     monkeypatch.setattr(plan_figure, "write_layout_figure", lambda path, fig: drawn.append(fig))
@@ -250,7 +250,7 @@ def test_ceiling_benchmark_bars_are_tuned_per_n_on_the_real_dome_and_once_on_the
 @pytest.mark.parametrize("geometry", [DOME, ARM], ids=["dome", "arm"])
 def test_homogeneous_schedule_under_a_ceiling(geometry) -> None:
     """plan_uniform (what 'rti-rig run --lights N' runs) keeps to the band too."""
-    from planner.uniform import plan_uniform
+    from rti_rig.planner.uniform import plan_uniform
 
     sched = plan_uniform(geometry, 10, 10.0, max_elevation_deg=45.0)
     el = _elevations(sched)

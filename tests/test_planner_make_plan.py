@@ -7,14 +7,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, MANY_LIGHTS, make_plan, plan_with_report
+from rti_rig.planner.uniform import plan_uniform
+from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
-from planner.make_plan import DEFAULT_OBJECTIVE, MANY_LIGHTS, make_plan, plan_with_report
-from planner.uniform import plan_uniform
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import angle_between_deg, direction_from_az_el, fibonacci_cap
-from rti_rig.lp_format import read_lp
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
-from simulator.sim_scene import lambert_radiance, relief_scene
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import angle_between_deg, direction_from_az_el, fibonacci_cap
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 DATA = Path(__file__).parent / "data" / "neuralrti"
 _LP = read_lp(DATA / "dirs.lp")
@@ -246,7 +246,7 @@ def test_uniform_does_not_fail_on_a_useless_preview() -> None:
 
 def test_three_lights_keep_a_homogeneous_layout() -> None:
     """N = 3 has no redundancy: the optimal method keeps the homogeneous layout at the floor."""
-    from planner.uniform import select_uniform_leds
+    from rti_rig.planner.uniform import select_uniform_leds
 
     for floor in (0.0, 20.0):
         sched, rep = plan_with_report(

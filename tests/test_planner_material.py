@@ -12,10 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
-
-from planner.make_plan import plan_with_report
-from planner.objectives import (
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.objectives import (
     GLOSSY_SPECULAR,
     GLOSSY_WIDTH_DEG,
     HIGHLIGHT_WEIGHT_WIDTH_DEG,
@@ -23,12 +21,14 @@ from planner.objectives import (
     light_weights,
     reflectance,
 )
-from planner.surface_estimate import estimate_surface, flat_surface, sample_surface
+from rti_rig.planner.surface_estimate import estimate_surface, flat_surface, sample_surface
+from typer.testing import CliRunner
+
 from rti_rig.cli import app
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import direction_from_az_el, fibonacci_cap
-from rti_rig.lp_format import read_lp
-from rti_rig.rig_geometry import DomeGeometry
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.rig_geometry import DomeGeometry
 
 DATA = Path(__file__).parent / "data" / "neuralrti"
 _LP = read_lp(DATA / "dirs.lp")

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from planner.normals import fit_relief_scale, normals_from_height, sanitize_height
-from planner.objectives import cast_shadow_visibility
-from planner.topography import (
+from rti_rig.planner.normals import fit_relief_scale, normals_from_height, sanitize_height
+from rti_rig.planner.objectives import cast_shadow_visibility
+from rti_rig.planner.topography import (
     PLANNING_SIDE_PX,
     estimate_light,
     given_light,
@@ -15,9 +14,10 @@ from planner.topography import (
     planning_image,
     shape_from_shading,
 )
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import angle_between_deg, direction_from_az_el
-from simulator.sim_scene import relief_scene
+from rti_rig.simulator.sim_scene import relief_scene
+
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
 
 
 def sphere_normals(size: int = 96) -> np.ndarray:
@@ -134,8 +134,7 @@ def test_cast_shadow_from_a_wall() -> None:
 
 def test_read_preview_keeps_type_and_rgb_order(tmp_path) -> None:
     import cv2
-
-    from planner.topography import read_preview
+    from rti_rig.planner.topography import read_preview
 
     rgb = np.zeros((4, 5, 3), np.uint8)
     rgb[..., 0] = 200  # red

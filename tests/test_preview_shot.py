@@ -13,15 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import REPO, SMALL_DOME, write_config
+from rti_rig.planner.preview_shot import PREVIEW_AZ_EL_DEG, preview_schedule
 from typer.testing import CliRunner
 
-from planner.preview_shot import PREVIEW_AZ_EL_DEG, preview_schedule
+from rti_rig.app.preview_source import resolve_preview
 from rti_rig.cli import app
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import az_el_from_direction, direction_from_az_el
-from rti_rig.lp_format import LpEntry, read_lp, write_lp
-from rti_rig.preview_source import resolve_preview
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 runner = CliRunner()
 IMAGE = REPO / "tests" / "data" / "neuralrti" / "image11_small.jpg"
@@ -192,7 +192,7 @@ def test_preview_refuses_before_anything_moves(
 ) -> None:
     """Bad options and an --out that cannot be written are refused before the rig is opened:
     no metering series, no LED, no arm move for a session that could not be kept."""
-    import rti_rig.compose
+    import rti_rig.app.compose
 
     def no_rig(*_: object) -> None:
         raise AssertionError("the rig was opened")
@@ -200,7 +200,7 @@ def test_preview_refuses_before_anything_moves(
     cfg = write_config(tmp_path, SMALL_DOME)
     out = tmp_path / "p"
     (out / "x").mkdir(parents=True)
-    monkeypatch.setattr(rti_rig.compose, "build_rig", no_rig)
+    monkeypatch.setattr(rti_rig.app.compose, "build_rig", no_rig)
     for extra in (["--light", "north"], ["--light", "10,95"], ["--auto-exposure"], []):
         r = runner.invoke(app, ["preview", str(cfg), "--out", str(out), *extra])
         assert r.exit_code == 2, r.output
@@ -224,23 +224,23 @@ def test_the_rig_is_closed_whatever_interrupts_the_start(
 ) -> None:
     """Ctrl-C (or any exception) between opening the rig and the session's start still turns
     the lights off and stops the arm: the rig is closed, and the interruption goes on."""
+    import rti_rig.app.compose
     import rti_rig.cli as cli
-    import rti_rig.compose
-    import rti_rig.controller
-    from rti_rig.session import SessionFolder
+    import rti_rig.runtime.controller
+    from rti_rig.runtime.session import SessionFolder
 
     rig = _FakeRig()
-    monkeypatch.setattr(rti_rig.compose, "build_rig", lambda loaded: rig)
+    monkeypatch.setattr(rti_rig.app.compose, "build_rig", lambda loaded: rig)
 
     def interrupted(*_: object) -> None:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(rti_rig.controller, "validate_schedule", interrupted)
+    monkeypatch.setattr(rti_rig.runtime.controller, "validate_schedule", interrupted)
     with pytest.raises(KeyboardInterrupt):
         cli._checked_rig(None, None)
     assert rig.closed
     rig.closed = False
-    monkeypatch.setattr(rti_rig.controller, "validate_schedule", lambda r, s: None)
+    monkeypatch.setattr(rti_rig.runtime.controller, "validate_schedule", lambda r, s: None)
     monkeypatch.setattr(SessionFolder, "create", interrupted)
     with pytest.raises(KeyboardInterrupt):
         cli._open_new_session(None, [], tmp_path / "new", False, 0.001)

@@ -6,11 +6,16 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic, write_dng
+from rti_rig.drivers.cameras.raw_decode import (
+    average_frames,
+    decode_raw,
+    exposure_stats,
+    subtract_dark,
+)
+from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
-from drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic, write_dng
-from drivers.cameras.raw_decode import average_frames, decode_raw, exposure_stats, subtract_dark
-from drivers.cameras.settings import RawDecodeSettings
-from rti_rig.errors import CaptureError
+from rti_rig.core.errors import CaptureError
 
 BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
 
@@ -239,7 +244,7 @@ def test_any_dng_round_trips_bit_exactly(h, w, black, span, pattern, seed):
 def test_half_size_saturation_mask_fits_odd_sensor_sizes():
     """An odd visible size (301×401) leaves an incomplete last super-pixel row and column: the
     mask must still map onto LibRaw's half-size output (it used to fail to reshape)."""
-    from drivers.cameras.raw_decode import half_size_mask
+    from rti_rig.drivers.cameras.raw_decode import half_size_mask
 
     mask = np.zeros((301, 401), dtype=bool)
     mask[300, 400] = True  # the lone photosite of the last, incomplete super-pixel

@@ -1,6 +1,6 @@
 """A camera RAW file as the planner's preview: decoded linearly, planned like its linear TIFF.
 
-The DNGs are written by the test itself (``drivers.cameras.dng_writer``), no camera files.
+The DNGs are written by the test itself (``rti_rig.drivers.cameras.dng_writer``), no camera files.
 """
 
 from __future__ import annotations
@@ -11,15 +11,15 @@ import numpy as np
 import pytest
 import tifffile
 from conftest import REPO
+from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+from rti_rig.planner.topography import planning_image
 from typer.testing import CliRunner
 
-from drivers.cameras.dng_writer import linear_to_mosaic, write_dng
-from planner.topography import planning_image
+from rti_rig.app.compose import read_preview_image
 from rti_rig.cli import app
-from rti_rig.compose import read_preview_image
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import direction_from_az_el
-from rti_rig.lp_format import read_lp
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import direction_from_az_el
+from rti_rig.core.lp_format import read_lp
 
 BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
 LIGHT = (45.0, 50.0)

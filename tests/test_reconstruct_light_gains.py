@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rti_rig.metrics import angular_error_deg
+from benchmarks.metrics import angular_error_deg
 from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
 from rti_rig.reconstruct.light_gains import apply_light_gains, estimate_light_gains
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals

@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rti_rig.geometry import direction_from_az_el
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.reconstruct import fit_model, fit_photometric_stereo
 from rti_rig.reconstruct.synthetic import fibonacci_lights
 

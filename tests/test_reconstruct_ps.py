@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rti_rig.geometry import direction_from_az_el
-from rti_rig.metrics import angular_error_deg
+from benchmarks.metrics import angular_error_deg
+from rti_rig.core.devices import Frame
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.reconstruct import (
     ReconstructionError,
     fit_photometric_stereo,
@@ -14,7 +15,6 @@ from rti_rig.reconstruct import (
 )
 from rti_rig.reconstruct.photometric_stereo import SHADOW_K
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
-from rti_rig.rig import Frame
 
 
 def _gentle_normals(h: int = 24, w: int = 20, max_tilt_deg: float = 25.0) -> np.ndarray:

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rti_rig.metrics import relight_psnr
+from benchmarks.metrics import relight_psnr
 from rti_rig.reconstruct import fit_model, fit_photometric_stereo, select_model
 
 DATA = Path(__file__).parent / "data" / "reconstruct_neuralrti" / "crop.npz"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rti_rig.geometry import direction_from_az_el
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.reconstruct import ReconstructionError, design_matrix, select_model
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 

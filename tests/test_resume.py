@@ -12,16 +12,16 @@ from pathlib import Path
 
 import pytest
 from conftest import SMALL_DOME, write_config
+from rti_rig.planner.uniform import plan_uniform
 from typer.testing import CliRunner
 
-from planner.uniform import plan_uniform
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
-from rti_rig.compose import build_rig
-from rti_rig.config import load_rig_config
-from rti_rig.controller import CancelToken, FinishReason, Paused, StepCompleted, run_session
-from rti_rig.errors import SessionError
-from rti_rig.session import SessionFolder
-from simulator.kill_hooks import popen_session
+from rti_rig.core.errors import SessionError
+from rti_rig.runtime.controller import CancelToken, FinishReason, Paused, StepCompleted, run_session
+from rti_rig.runtime.session import SessionFolder
+from rti_rig.testing.kill_hooks import popen_session
 
 runner = CliRunner()
 LIGHTS = 8
@@ -205,7 +205,7 @@ def test_wrong_light_oracle_catches_a_swapped_record(
     """The campaign's oracle must see a mislabelled image (else 'wrong lights: 0' means nothing)."""
     import shutil
 
-    from simulator.verify import wrong_light_steps
+    from rti_rig.testing.verify import wrong_light_steps
 
     cfg, ref = reference
     assert wrong_light_steps(cfg, ref) == []

@@ -3,8 +3,7 @@
 import cv2
 import numpy as np
 import pytest
-
-from simulator.camera_model import CameraModel, encode_jpeg, to_srgb8
+from rti_rig.simulator.camera_model import CameraModel, encode_jpeg, to_srgb8
 
 
 def test_noise_mean_and_variance_match_model():

@@ -6,12 +6,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from rti_rig.geometry import direction_from_az_el
-from simulator.camera_model import CameraModel, to_srgb8
-from simulator.ground_truth import homogeneous_directions, render_ground_truth
-from simulator.light_transport import DirectionalLight, PointLight, light_at, render_radiance
-from simulator.scenes import (
+from rti_rig.simulator.camera_model import CameraModel, to_srgb8
+from rti_rig.simulator.ground_truth import homogeneous_directions, render_ground_truth
+from rti_rig.simulator.light_transport import (
+    DirectionalLight,
+    PointLight,
+    light_at,
+    render_radiance,
+)
+from rti_rig.simulator.scenes import (
     SCENE_NAMES,
     Scene,
     make_scene,
@@ -19,6 +22,8 @@ from simulator.scenes import (
     scene_from_depth_file,
     scene_from_normal_file,
 )
+
+from rti_rig.core.geometry import direction_from_az_el
 
 
 def plane(height: np.ndarray, albedo: float = 0.5, passes=(), roughness: float = 0.5) -> Scene:  # type: ignore[no-untyped-def]

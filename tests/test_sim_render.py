@@ -4,12 +4,17 @@ import math
 
 import numpy as np
 import pytest
+from rti_rig.simulator.ground_truth import homogeneous_directions, render_ground_truth
+from rti_rig.simulator.light_transport import (
+    DirectionalLight,
+    PointLight,
+    light_at,
+    render_radiance,
+)
+from rti_rig.simulator.scenes import SCENE_NAMES, Scene, make_scene, normals_from_height
+from rti_rig.simulator.shadows import directional_visibility, point_visibility
 
-from rti_rig.geometry import direction_from_az_el
-from simulator.ground_truth import homogeneous_directions, render_ground_truth
-from simulator.light_transport import DirectionalLight, PointLight, light_at, render_radiance
-from simulator.scenes import SCENE_NAMES, Scene, make_scene, normals_from_height
-from simulator.shadows import directional_visibility, point_visibility
+from rti_rig.core.geometry import direction_from_az_el
 
 
 def _plane_scene(height, albedo=0.5, spec=0.0, rough=1.0, passes=()):
@@ -125,7 +130,7 @@ def test_ggx_peak_matches_closed_form_at_normal_incidence():
 
 
 def test_passes_not_needed_are_skipped(monkeypatch):
-    import simulator.light_transport as lt
+    import rti_rig.simulator.light_transport as lt
 
     def boom(*_a, **_k):
         raise AssertionError("pass should have been skipped")

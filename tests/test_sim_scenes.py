@@ -3,8 +3,7 @@
 import cv2
 import numpy as np
 import pytest
-
-from simulator.scenes import (
+from rti_rig.simulator.scenes import (
     SCENE_NAMES,
     SceneError,
     height_from_normals,

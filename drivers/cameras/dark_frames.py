@@ -7,8 +7,9 @@ lights off, and subtract the master with ``raw_decode.subtract_dark`` after each
 
 from __future__ import annotations
 
-from drivers.cameras.raw_decode import average_frames
-from rti_rig.rig import Camera, DiscreteLightSource, Frame
+from rti_rig.drivers.cameras.raw_decode import average_frames
+
+from rti_rig.core.devices import Camera, DiscreteLightSource, Frame
 
 
 def capture_master_dark(

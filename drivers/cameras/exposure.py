@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from rti_rig.drivers.cameras.settings import ExposureRule
 
-from drivers.cameras.settings import ExposureRule
-from rti_rig.errors import CaptureError
-from rti_rig.rig import Camera, Frame
+from rti_rig.core.devices import Camera, Frame
+from rti_rig.core.errors import CaptureError
 
 
 @dataclass(frozen=True)

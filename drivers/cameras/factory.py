@@ -11,17 +11,18 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from drivers.cameras.folder_watch import FolderWatchCamera
-from drivers.cameras.gphoto2_camera import Gphoto2Camera
-from drivers.cameras.opencv_camera import OpenCvCamera
-from drivers.cameras.settings import (
+from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
+from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
+from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera
+from rti_rig.drivers.cameras.settings import (
     CameraSettings,
     FolderWatchSettings,
     Gphoto2CameraSettings,
     OpenCvCameraSettings,
 )
-from rti_rig.clock import Clock
-from rti_rig.rig import Camera
+
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import Camera
 
 
 def build_camera(

@@ -16,7 +16,7 @@ import numpy as np
 import tifffile
 from numpy.typing import NDArray
 
-from rti_rig.errors import CaptureError
+from rti_rig.core.errors import CaptureError
 
 Response = Literal["linear", "srgb"]
 

@@ -17,10 +17,10 @@ from typing import Any
 import numpy as np
 import rawpy
 from numpy.typing import NDArray
+from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
-from drivers.cameras.settings import RawDecodeSettings
-from rti_rig.errors import CaptureError
-from rti_rig.rig import Frame
+from rti_rig.core.devices import Frame
+from rti_rig.core.errors import CaptureError
 
 DECODER = "raw-decode"
 _COLOR_NAMES = "RGBG"

@@ -6,8 +6,8 @@ addresses, units, fault bits), :mod:`settings` (validated arm config), :mod:`kin
 place that talks to the official ``dynamixel_sdk``) and :mod:`arm` (the ``LightCarrier``).
 """
 
-from drivers.dynamixel.arm import DynamixelArm
-from drivers.dynamixel.faults import (
+from rti_rig.drivers.dynamixel.arm import DynamixelArm
+from rti_rig.drivers.dynamixel.faults import (
     CommunicationError,
     ConfigMismatchError,
     DynamixelError,
@@ -17,8 +17,8 @@ from drivers.dynamixel.faults import (
     ServoStatusError,
     UnreachableError,
 )
-from drivers.dynamixel.kinematics import ArmKinematics
-from drivers.dynamixel.settings import ArmSettings, JointSettings
+from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
+from rti_rig.drivers.dynamixel.settings import ArmSettings, JointSettings
 
 __all__ = [
     "ArmKinematics",

@@ -1,8 +1,8 @@
 """The servo-arm light carrier: policy for two Dynamixel X-series joints.
 
-Safe state (``rti_rig.rig.LightCarrier``): lamp off, motion stopped. ``close`` restores it as far
-as the hardware allows without moving the arm (parking is the caller's policy), then applies the
-torque policy ("hold": servos keep holding where they are, so the arm cannot fall;
+Safe state (``rti_rig.core.devices.LightCarrier``): lamp off, motion stopped. ``close`` restores it
+as far as the hardware allows without moving the arm (parking is the caller's policy), then applies
+the torque policy ("hold": servos keep holding where they are, so the arm cannot fall;
 "release_on_close": torque off, but only if the arm is at the park pose).
 
 The lamp is **tracked in software** by default (the lamp's own switch is outside the servo
@@ -20,11 +20,10 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-
-from drivers.dynamixel import control_table as ct
-from drivers.dynamixel import protocol2 as p2
-from drivers.dynamixel.bus import DxlBus
-from drivers.dynamixel.faults import (
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel import protocol2 as p2
+from rti_rig.drivers.dynamixel.bus import DxlBus
+from rti_rig.drivers.dynamixel.faults import (
     ConfigMismatchError,
     DynamixelError,
     HardwareFaultError,
@@ -32,9 +31,10 @@ from drivers.dynamixel.faults import (
     SafetyViolation,
     UnreachableError,
 )
-from drivers.dynamixel.kinematics import ArmKinematics, as_direction, clamp_ticks
-from drivers.dynamixel.settings import ArmSettings
-from rti_rig.clock import Clock
+from rti_rig.drivers.dynamixel.kinematics import ArmKinematics, as_direction, clamp_ticks
+from rti_rig.drivers.dynamixel.settings import ArmSettings
+
+from rti_rig.core.clock import Clock
 
 log = logging.getLogger("rti_rig.dynamixel.arm")
 

@@ -18,10 +18,9 @@ from collections.abc import Mapping
 from typing import Any
 
 import dynamixel_sdk as sdk
-
-from drivers.dynamixel import control_table as ct
-from drivers.dynamixel import protocol2 as p2
-from drivers.dynamixel.faults import (
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel import protocol2 as p2
+from rti_rig.drivers.dynamixel.faults import (
     CommunicationError,
     HardwareFaultError,
     ServoStatusError,

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from drivers.dynamixel import control_table as ct
-from rti_rig.errors import DeviceError, ScheduleError
+from rti_rig.drivers.dynamixel import control_table as ct
+
+from rti_rig.core.errors import DeviceError, ScheduleError
 
 
 class DynamixelError(DeviceError):

@@ -15,13 +15,16 @@ stays safe.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from rti_rig.drivers.dynamixel import control_table as ct
 
-from drivers.dynamixel import control_table as ct
-from drivers.dynamixel.settings import ArmSettings, JointSettings
-from rti_rig.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
+
+if TYPE_CHECKING:  # annotations only: settings validates a park pose with these kinematics
+    from rti_rig.drivers.dynamixel.settings import ArmSettings, JointSettings
 
 #: Slack when comparing joint angles to limits, for floating-point round trips.
 EPS_DEG = 1e-9

@@ -18,8 +18,8 @@ import math
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
-
-from drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
 
 #: Baud rates that dynamixel_sdk's PortHandler accepts (others make openPort return False).
 SDK_BAUDRATES = (
@@ -176,8 +176,6 @@ class ArmSettings(BaseModel):
             self.elevation.servo_id,
         ):
             raise ValueError("lamp = 'servo_led' needs lamp_servo_id set to one of the arm's ids")
-        from drivers.dynamixel.kinematics import ArmKinematics  # local: avoid import cycle
-
         reason = ArmKinematics(self).pose_reason(self.park_azimuth_deg, self.park_elevation_deg)
         if reason:
             raise ValueError(

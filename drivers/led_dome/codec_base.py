@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from drivers.led_dome.messages import BadRequest, Command, DomeIdentity, Reply
+from rti_rig.drivers.led_dome.messages import BadRequest, Command, DomeIdentity, Reply
 
 
 class DomeCodec(Protocol):

@@ -19,8 +19,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from drivers.led_dome.codec_base import xor_checksum
-from drivers.led_dome.messages import (
+from rti_rig.drivers.led_dome.codec_base import xor_checksum
+from rti_rig.drivers.led_dome.messages import (
     ERR_BAD_CHECKSUM,
     ERR_UNKNOWN_COMMAND,
     ERROR_CODES,

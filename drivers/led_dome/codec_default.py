@@ -15,8 +15,8 @@ on port open, and reveals a reset in the middle of a session.
 
 from __future__ import annotations
 
-from drivers.led_dome.codec_base import xor_checksum
-from drivers.led_dome.messages import (
+from rti_rig.drivers.led_dome.codec_base import xor_checksum
+from rti_rig.drivers.led_dome.messages import (
     ERR_BAD_ARGUMENT,
     ERR_BAD_CHECKSUM,
     ERR_UNKNOWN_COMMAND,

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from drivers.led_dome.messages import (
+from rti_rig.drivers.led_dome.messages import (
     ERR_BAD_ARGUMENT,
     ERR_UNKNOWN_COMMAND,
     Ack,

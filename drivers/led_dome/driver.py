@@ -2,8 +2,8 @@
 
 The driver translates verbs into a profile's bytes over an injected transport and reports
 exactly what went wrong (timeout, garbled reply, wrong echo, reboot banner, lost port, firmware
-error) as a :class:`rti_rig.dome_policy.DomeLinkError`. It never retries: deciding what is safe
-to resend is the rig policy's job (``rti_rig.dome_policy.DomePolicy``).
+error) as a :class:`rti_rig.runtime.dome_policy.DomeLinkError`. It never retries: deciding what is
+safe to resend is the rig policy's job (``rti_rig.runtime.dome_policy.DomePolicy``).
 
 Stale input is handled here, because only the codec-aware layer can recognise it: before each
 command, bytes already waiting are read and classified (a late reply to an earlier command is
@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import logging
 
-from drivers.led_dome.codec_base import DomeCodec
-from drivers.led_dome.messages import (
+from rti_rig.drivers.led_dome.codec_base import DomeCodec
+from rti_rig.drivers.led_dome.messages import (
     ERROR_CODES,
     TRANSIENT_ERROR_CODES,
     Ack,
@@ -35,15 +35,16 @@ from drivers.led_dome.messages import (
     describe,
     error_text,
 )
-from drivers.led_dome.transport import Transport, TransportError
-from rti_rig.dome_policy import DomeInfo, DomeLinkError, LinkFault
+from rti_rig.drivers.led_dome.transport import Transport, TransportError
+
+from rti_rig.core.dome_link import DomeInfo, DomeLinkError, LinkFault
 
 #: Every byte to and from the dome goes through this logger (DEBUG, hex).
 traffic_log = logging.getLogger("rti_rig.dome.traffic")
 
 
 class LedDomeDriver:
-    """Implements :class:`rti_rig.dome_policy.DomeLink` for one protocol profile."""
+    """Implements :class:`rti_rig.runtime.dome_policy.DomeLink` for one protocol profile."""
 
     def __init__(
         self,

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from drivers.led_dome.codec_base import DomeCodec
-from drivers.led_dome.codec_binary import BinaryCodec
-from drivers.led_dome.codec_default import DefaultCodec
-from drivers.led_dome.codec_framed import FramedCodec, FramedSpec
-from drivers.led_dome.settings import (
+from rti_rig.drivers.led_dome.codec_base import DomeCodec
+from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
+from rti_rig.drivers.led_dome.codec_default import DefaultCodec
+from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec
+from rti_rig.drivers.led_dome.settings import (
     BinaryOptions,
     DefaultProfileOptions,
     DomeSerialSettings,

@@ -2,7 +2,7 @@
 
 The driver never touches pyserial directly; it is handed a :class:`Transport`, so the same driver
 runs on a USB serial port, on the emulator over a pseudo-terminal (still real pyserial), or on
-the emulator in-process (``simulator.dome_firmware.InProcessDomeTransport``).
+the emulator in-process (``rti_rig.simulator.dome_firmware.InProcessDomeTransport``).
 
 A transport carries the clock its reads wait on: real ports wait in real time whatever clock the
 rig uses, while the in-process emulator waits on the simulation's clock. The driver measures its
@@ -17,7 +17,7 @@ from typing import Protocol
 
 import serial
 
-from rti_rig.clock import Clock, SystemClock
+from rti_rig.core.clock import Clock, SystemClock
 
 try:  # pyserial lets termios.error (not an OSError) escape from tcdrain/tcsetattr on POSIX
     import termios

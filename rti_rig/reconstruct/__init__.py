@@ -5,7 +5,7 @@ uint16 frame pixels, see :func:`stack_from_frames`); lights are unit directions 
 frame of DESIGN.md. See docs/reconstruction.md.
 """
 
-from rti_rig.reconstruct.bases import N_COEFFICIENTS, design_matrix, hsh_basis, ptm_basis
+from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix, hsh_basis, ptm_basis
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.hsh import HSHModel, fit_hsh
 from rti_rig.reconstruct.light_gains import LightGains, apply_light_gains, estimate_light_gains

@@ -8,7 +8,7 @@ which model, which light or image, and what to do.
 
 from __future__ import annotations
 
-from rti_rig.errors import RtiRigError
+from rti_rig.core.errors import RtiRigError
 
 
 class ReconstructionError(RtiRigError):

@@ -1,7 +1,7 @@
 """Hemispherical harmonics (Gautron et al. 2004) of order 1, 2, 3: 4, 9, 16 coefficients.
 
 The basis, its index order and the exponent 1.5 of the order-3 terms are documented in
-:mod:`rti_rig.reconstruct.bases` and docs/reconstruction.md.
+:mod:`rti_rig.core.rti_bases` and docs/reconstruction.md.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.reconstruct.bases import hsh_basis
+from rti_rig.core.rti_bases import hsh_basis
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.linear_model import fit_coefficients
 from rti_rig.reconstruct.solve import COND_LIMIT, FitReport, IllConditioned

@@ -14,7 +14,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.reconstruct.bases import design_matrix
+from rti_rig.core.rti_bases import design_matrix
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.solve import COND_LIMIT, FitReport, IllConditioned, solve_matrix
 from rti_rig.reconstruct.stack import ImageStack, as_direction, validate_lights

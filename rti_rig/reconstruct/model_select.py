@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rti_rig.reconstruct.bases import N_COEFFICIENTS, design_matrix
+from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.linear_model import RelightModel
 from rti_rig.reconstruct.registry import RELIGHT_MODELS, fit_model

@@ -148,7 +148,8 @@ class ImageStack:
 
 
 def stack_from_frames(frames: Sequence[Any]) -> ImageStack:
-    """Stack of captured :class:`rti_rig.rig.Frame` objects, kept as uint16 (no float copy).
+    """Stack of captured :class:`rti_rig.core.devices.Frame` objects, kept as uint16 (no float
+    copy).
 
     Values are scaled by 1 / white level, so the stack's saturation level is 1.0.
     """

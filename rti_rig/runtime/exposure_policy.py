@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from rti_rig.assembly import Rig
-from rti_rig.controller import validate_schedule
-from rti_rig.schedule import LightSchedule
+from rti_rig.core.schedule import LightSchedule
+from rti_rig.runtime.controller import validate_schedule
+from rti_rig.runtime.rig import Rig
 
 #: ``meter(camera, start_exposure_s) -> choice`` where ``choice.exposure_s`` is the pick and
 #: ``choice.to_manifest()`` the evidence.

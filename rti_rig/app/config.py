@@ -3,7 +3,7 @@
 A bad config is reported with the file, the dotted key and what is wrong, e.g.
 ``rig.toml: key 'dome.rings[2].count': Input should be greater than 0 (got -4)``.
 The config describes *what* the rig is (light layout, camera, timing, limits) and which backend
-drives it; building devices from it happens in :mod:`rti_rig.compose` (the composition root).
+drives it; building devices from it happens in :mod:`rti_rig.app.compose` (the composition root).
 """
 
 from __future__ import annotations
@@ -19,12 +19,12 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from drivers.dynamixel.settings import ArmSettings
-from drivers.led_dome.settings import DomeSerialSettings
-from rti_rig.errors import ConfigError, LpFormatError
-from rti_rig.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
-from rti_rig.lp_format import read_lp
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
+from rti_rig.core.errors import ConfigError, LpFormatError
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
+from rti_rig.drivers.dynamixel.settings import ArmSettings
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 
 
 class _Strict(BaseModel):
@@ -144,7 +144,7 @@ class SceneConfig(_Strict):
 
     @model_validator(mode="after")
     def _known_scene(self) -> SceneConfig:
-        from simulator.scenes import SCENE_NAMES
+        from rti_rig.simulator.scenes import SCENE_NAMES
 
         if self.name not in ("relief", *SCENE_NAMES):
             raise ValueError(
@@ -445,7 +445,7 @@ def load_rig_config(path: Path | str) -> LoadedRig:
 
 def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
     """The validated driver settings of the rig's real camera (``[camera.device]``)."""
-    from drivers.cameras.settings import parse_camera_settings
+    from rti_rig.drivers.cameras.settings import parse_camera_settings
 
     try:
         return parse_camera_settings(rig.config.camera.device or {})
@@ -461,7 +461,7 @@ _CAMERA_KINDS = ("opencv", "gphoto2", "folder_watch")
 
 def default_config_path() -> Path:
     """The embedded simulated dome config shipped with the package."""
-    return Path(str(resources.files("rig_configs").joinpath("simulated_dome.toml")))
+    return Path(str(resources.files("rti_rig.rig_configs").joinpath("simulated_dome.toml")))
 
 
 def _ring_directions(rings: list[Ring]) -> NDArray[np.float64]:

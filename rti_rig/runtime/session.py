@@ -28,10 +28,10 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from rti_rig.errors import SessionError
-from rti_rig.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
-from rti_rig.lp_format import LpEntry, write_lp
-from rti_rig.rig import Frame
+from rti_rig.core.devices import Frame
+from rti_rig.core.errors import SessionError
+from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
+from rti_rig.core.lp_format import LpEntry, write_lp
 
 MANIFEST = "manifest.json"
 JOURNAL = "journal.jsonl"

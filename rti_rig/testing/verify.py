@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from rti_rig.config import load_rig_config, rig_geometry
-from rti_rig.image_files import read_linear_tiff
-from rti_rig.rig_geometry import DomeGeometry
-from rti_rig.session import read_manifest
-from simulator.sim_scene import renderer_for
+from rti_rig.app.config import load_rig_config, rig_geometry
+from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.runtime.session import read_manifest
+from rti_rig.simulator.sim_scene import renderer_for
 
 
 def wrong_light_steps(config_path: Path, session_dir: Path) -> list[int]:

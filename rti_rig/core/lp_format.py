@@ -21,7 +21,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.errors import LpFormatError
+from rti_rig.core.errors import LpFormatError
 
 #: relight refuses files with more lights than this.
 MAX_LIGHTS = 1000

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.geometry import az_el_from_direction, normalize
-from rti_rig.lp_format import LpEntry
+from rti_rig.core.geometry import az_el_from_direction, normalize
+from rti_rig.core.lp_format import LpEntry
 
 
 @dataclass(frozen=True)

@@ -16,11 +16,11 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from enum import StrEnum
 
-from rti_rig.assembly import Rig
-from rti_rig.errors import ScheduleError
-from rti_rig.lp_format import MAX_LIGHTS
-from rti_rig.schedule import LightSchedule, LightStep
-from rti_rig.session import (
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.lp_format import MAX_LIGHTS
+from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.runtime.rig import Rig
+from rti_rig.runtime.session import (
     SessionFolder,
     StepRecord,
     check_free_space,

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import (
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import (
     angle_between_deg,
     az_el_from_direction,
     direction_from_az_el,

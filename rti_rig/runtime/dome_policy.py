@@ -2,7 +2,7 @@
 
 Policy above, bytes below. A dome driver (``drivers/led_dome``) only turns verbs into bytes and
 reports precisely what went wrong as a :class:`DomeLinkError`. This module decides what that
-means for an acquisition, and implements :class:`rti_rig.rig.DiscreteLightSource`:
+means for an acquisition, and implements :class:`rti_rig.core.devices.DiscreteLightSource`:
 
 * idempotent commands (light one LED, all off, handshake, query) are resent a bounded number of
   times after a timeout, a garbled or mismatched reply; a shutter pulse never is;
@@ -16,8 +16,9 @@ means for an acquisition, and implements :class:`rti_rig.rig.DiscreteLightSource
   clock for an LED to cool rather than overdriving it;
 * LED index ↔ direction comes from the dome's calibrated ``.lp`` (passed in as directions).
 
-The rig core must not import ``drivers``: the driver is reached through the :class:`DomeLink`
-protocol below and builds its errors from :class:`DomeLinkError`.
+The runtime never imports ``drivers``: the driver is reached through the core's
+:class:`rti_rig.core.dome_link.DomeLink` protocol and builds its errors from
+:class:`rti_rig.core.dome_link.DomeLinkError`.
 """
 
 from __future__ import annotations
@@ -27,99 +28,19 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from enum import StrEnum
-from typing import Protocol, TypeVar
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.clock import Clock
-from rti_rig.errors import DeviceError
-from rti_rig.rig import DiscreteLightSource
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import DiscreteLightSource
+from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLink, DomeLinkError, LinkFault
+from rti_rig.core.errors import DeviceError
 
 log = logging.getLogger("rti_rig.dome")
 
 T = TypeVar("T")
-
-
-# ----------------------------------------------------------------------------- link interface
-
-
-class LinkFault(StrEnum):
-    """What went wrong on the link, as the driver saw it."""
-
-    TIMEOUT = "timeout"  # no reply in time (dropped or late)
-    GARBLED = "garbled"  # bytes that are not a valid reply
-    MISMATCH = "mismatch"  # the echo says the firmware did something else
-    RESET = "reset"  # an unexpected boot banner: the board rebooted
-    DISCONNECTED = "disconnected"  # the port went away (USB drop) or is not open
-    REJECTED = "rejected"  # the firmware answered ERR
-
-
-class DomeLinkError(DeviceError):
-    """A failed exchange with the dome. ``retryable``: resending the same command may succeed."""
-
-    def __init__(
-        self,
-        device: str,
-        message: str,
-        command: str | None,
-        fault: LinkFault,
-        *,
-        retryable: bool,
-        code: int | None = None,
-    ) -> None:
-        super().__init__(device, message, command)
-        self.fault = fault
-        self.retryable = retryable
-        self.code = code
-
-
-@dataclass(frozen=True)
-class DomeInfo:
-    """What the handshake told about the board."""
-
-    firmware_id: str
-    version: str
-    led_count: int
-
-
-class DomeLink(Protocol):
-    """The verbs of a dome driver (one exchange each; errors are :class:`DomeLinkError`)."""
-
-    device: str
-    #: The light command carries the firmware watchdog time (max on-time).
-    has_watchdog: bool
-    #: The light acknowledgement echoes the LED index and level that were executed.
-    echoes_light: bool
-    #: Highest PWM level the firmware takes.
-    max_level: int
-
-    def connect(self) -> DomeInfo:
-        """Open the port, wait for the ready banner, handshake."""
-        ...
-
-    def close(self) -> None: ...
-
-    def hello(self) -> DomeInfo: ...
-
-    def light(self, index: int, level: int, max_on_ms: int | None) -> None: ...
-
-    def all_off(self) -> None: ...
-
-    def shutter(self, pulse_ms: int) -> None: ...
-
-    def query(self) -> tuple[int | None, int]:
-        """(index lit or None, level) as the firmware sees it."""
-        ...
-
-
-class DomeLedError(DeviceError):
-    """An error about one LED (dead, thermal limit, unknown light during a capture)."""
-
-    def __init__(self, device: str, led: int, message: str, command: str | None) -> None:
-        super().__init__(device, message, command)
-        self.led = led
 
 
 # ----------------------------------------------------------------------------- thermal guard

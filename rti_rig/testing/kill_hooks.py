@@ -4,7 +4,7 @@ This is how the resume tests and the fault campaign reproduce the worst interrup
 no ``finally``, no flush, a half-written file. Run as a module it installs the hooks and then
 runs the ``rti-rig`` command line with the remaining arguments::
 
-    python -m simulator.kill_hooks STAGE K run RIG.toml --out DIR --lights 8
+    python -m rti_rig.testing.kill_hooks STAGE K run RIG.toml --out DIR --lights 8
 
 Stages: ``before_light``, ``after_light``, ``during_capture``, ``during_write`` (half a TIFF in
 its temporary file), ``between_files`` (TIFF renamed, JPEG not written), ``before_journal`` (both
@@ -34,10 +34,10 @@ STAGES = (
 
 def install(stage: str, k: int) -> None:
     """Patch the simulated devices and the session writer so the process dies at step ``k``."""
-    import rti_rig.image_files as image_files
-    import rti_rig.session as session
-    import simulator.sim_camera as sim_camera
-    import simulator.sim_lights as sim_lights
+    import rti_rig.core.image_files as image_files
+    import rti_rig.runtime.session as session
+    import rti_rig.simulator.sim_camera as sim_camera
+    import rti_rig.simulator.sim_lights as sim_lights
 
     if stage not in STAGES:
         raise SystemExit(f"unknown stage {stage!r}; choose from {', '.join(STAGES)}")
@@ -113,7 +113,7 @@ def popen_session(
     argv = [
         sys.executable,
         "-m",
-        "simulator.kill_hooks",
+        "rti_rig.testing.kill_hooks",
         stage,
         str(k),
         "run",

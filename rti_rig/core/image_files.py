@@ -15,7 +15,7 @@ import numpy as np
 import tifffile
 from numpy.typing import NDArray
 
-from rti_rig.errors import SessionError
+from rti_rig.core.errors import SessionError
 
 
 def linear_to_srgb8(pixels: NDArray[np.uint16], white_level: int) -> NDArray[np.uint8]:

@@ -25,10 +25,10 @@ from typing import Any
 
 import numpy as np
 
-from rti_rig.errors import ScheduleError
-from rti_rig.geometry import angle_between_deg, az_el_from_direction
-from rti_rig.lp_format import LpEntry
-from rti_rig.session import LINEAR_DIR, MANIFEST, read_manifest
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
+from rti_rig.core.lp_format import LpEntry
+from rti_rig.runtime.session import LINEAR_DIR, MANIFEST, read_manifest
 
 #: A bare `.lp` given as ``--rig``: its path and its entries.
 RigLp = tuple[Path, Sequence[LpEntry]]

@@ -5,7 +5,7 @@ Profile Acceleration, cruise at the Profile Velocity, decelerate), or a triangle
 is too short to reach the cruise speed. Both joints start together (one Sync Write), so a move
 lasts as long as its slower joint, plus ``settle_time_s`` for the in-position check and the bus.
 
-The settings object is duck-typed (``drivers.dynamixel.settings.ArmSettings`` fits), so the
+The settings object is duck-typed (``rti_rig.drivers.dynamixel.settings.ArmSettings`` fits), so the
 planner does not import driver code: it needs ``azimuth``/``elevation`` joints with
 ``min_deg``, ``max_deg``, ``joint_velocity_deg_s`` and ``joint_acceleration_deg_s2``, and
 ``park_azimuth_deg``, ``park_elevation_deg`` and ``settle_time_s``.
@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.geometry import az_el_from_direction
+from rti_rig.core.geometry import az_el_from_direction
 
 
 def joint_move_time_s(distance_deg: float, velocity_deg_s: float, accel_deg_s2: float) -> float:

@@ -16,11 +16,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.clock import Clock
-from rti_rig.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
-from rti_rig.lighting import attempt_all
-from rti_rig.rig import LightCarrier
-from rti_rig.rig_geometry import ArmGeometry
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import LightCarrier
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
+from rti_rig.core.rig_geometry import ArmGeometry
+from rti_rig.runtime.lighting import attempt_all
 
 #: Largest angle between the asked and the reached direction that passes (degrees).
 TOLERANCE_DEG = 1.0

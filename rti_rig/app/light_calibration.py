@@ -29,12 +29,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from planner.topography import downsample
-from rti_rig.config import CALIBRATION_FORMAT as FORMAT
-from rti_rig.errors import SessionError
-from rti_rig.image_files import read_linear_tiff
+from rti_rig.app.config import CALIBRATION_FORMAT as FORMAT
+from rti_rig.core.errors import SessionError
+from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.planner.topography import downsample
 from rti_rig.reconstruct import ReconstructionError, estimate_light_gains
-from rti_rig.session import read_manifest
+from rti_rig.runtime.session import read_manifest
 
 #: Card images are area-averaged to at most this many pixels on their long side: the gains are
 #: medians over the card, so full resolution only costs memory (72 × 24 MP would be 7 GB).

@@ -20,9 +20,9 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.errors import RtiRigError
-from rti_rig.geometry import az_el_from_direction
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.geometry import az_el_from_direction
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 #: File types the map can be written as (by the file name's suffix).
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")

@@ -9,11 +9,11 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-from rti_rig.assembly import Rig
-from rti_rig.clock import Clock, SystemClock, VirtualClock
-from rti_rig.config import LoadedRig, rig_geometry
-from rti_rig.lighting import ArmLighting, DomeLighting
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.app.config import LoadedRig, rig_geometry
+from rti_rig.core.clock import Clock, SystemClock, VirtualClock
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.runtime.lighting import ArmLighting, DomeLighting
+from rti_rig.runtime.rig import Rig
 
 
 def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
@@ -36,8 +36,8 @@ SIMULATED_SCENE_EXPOSURE_S = 0.05
 
 def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[no-untyped-def]
     """A camera that renders the scene under whatever light ``state`` says is really on."""
-    from simulator.sim_camera import SimulatedCamera
-    from simulator.sim_scene import renderer_for
+    from rti_rig.simulator.sim_camera import SimulatedCamera
+    from rti_rig.simulator.sim_scene import renderer_for
 
     cfg = loaded.config
     render = renderer_for(
@@ -81,8 +81,8 @@ class _FirmwareLight:
 
 def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock) -> Rig:
     """The real dome driver over real pyserial, talking to the firmware emulator on a pty."""
-    from drivers.led_dome import build_dome
-    from simulator.dome_firmware import (
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.simulator.dome_firmware import (
         Fault,
         FaultKind,
         FaultPlan,
@@ -138,7 +138,7 @@ class _ArmLamp:
 
     @property
     def direction(self):  # type: ignore[no-untyped-def]
-        from simulator.dynamixel_emulator import lamp_direction
+        from rti_rig.simulator.dynamixel_emulator import lamp_direction
 
         if not self._arm.lamp_is_on:
             return None
@@ -161,8 +161,8 @@ def _arm_lighting(loaded: LoadedRig, carrier) -> ArmLighting:  # type: ignore[no
 
 def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) -> Rig:
     """The real Dynamixel driver and SDK against emulated servos (pty or in-process)."""
-    from drivers.dynamixel.arm import DynamixelArm
-    from simulator.dynamixel_emulator import emulated_arm_port
+    from rti_rig.drivers.dynamixel.arm import DynamixelArm
+    from rti_rig.simulator.dynamixel_emulator import emulated_arm_port
 
     arm_cfg = loaded.config.arm
     assert arm_cfg is not None and arm_cfg.dynamixel is not None
@@ -184,21 +184,21 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
 
 def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
     """Real devices: the dome or arm on its port, the camera from [camera.device]."""
-    from drivers.cameras.factory import build_camera
-    from rti_rig.config import camera_device_settings
+    from rti_rig.app.config import camera_device_settings
+    from rti_rig.drivers.cameras.factory import build_camera
 
     cfg = loaded.config
     geometry = rig_geometry(loaded)
     camera = build_camera(camera_device_settings(loaded), clock=clock)
     if isinstance(geometry, DomeGeometry):
-        from drivers.led_dome import build_dome
+        from rti_rig.app.dome_factory import build_dome
 
         assert cfg.dome is not None and cfg.dome.serial is not None
         dome = build_dome(cfg.dome.serial, clock, directions=geometry.directions, name="dome")
         return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
     import dynamixel_sdk
 
-    from drivers.dynamixel.arm import DynamixelArm
+    from rti_rig.drivers.dynamixel.arm import DynamixelArm
 
     assert cfg.arm is not None and cfg.arm.dynamixel is not None
     settings = cfg.arm.dynamixel
@@ -207,7 +207,7 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
 
 
 def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
-    from simulator.sim_lights import LightState, SimulatedArm, SimulatedDome
+    from rti_rig.simulator.sim_lights import LightState, SimulatedArm, SimulatedDome
 
     cfg = loaded.config
     geometry = rig_geometry(loaded)
@@ -244,7 +244,7 @@ def arm_order_for(loaded: LoadedRig):  # type: ignore[no-untyped-def]
     arm = loaded.config.arm
     if arm is None or arm.dynamixel is None:
         return None
-    from planner.arm_order import order_for_arm
+    from rti_rig.planner.arm_order import order_for_arm
 
     settings = arm.dynamixel
     return lambda directions, start: order_for_arm(directions, start, settings)
@@ -255,22 +255,22 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
 
     A DSLR rig's preview is often a RAW file (DNG, CR2, NEF, ARW…). It is decoded here, in the
     composition root, because the decoder is the camera drivers' (the planner may not import
-    drivers, :func:`drivers.cameras.raw_decode.decode_raw`, the DSLR path's): LibRaw's 2×2
+    drivers, :func:`rti_rig.drivers.cameras.raw_decode.decode_raw`, the DSLR path's): LibRaw's 2×2
     super-pixels, linear 16-bit RGB, unity white balance, nothing automatic (half resolution
     is plenty: the planner works at 256 px). The rig's own decode settings are not applied:
     they live in its camera driver's config, and white balance barely moves the luminance the
     planner reads. Every other file goes to
-    :func:`planner.topography.read_preview`.
+    :func:`rti_rig.planner.topography.read_preview`.
     """
-    from drivers.cameras.folder_watch import is_raw_file
-    from planner.topography import read_preview
-    from rti_rig.errors import CaptureError, ScheduleError
+    from rti_rig.core.errors import CaptureError, ScheduleError
+    from rti_rig.drivers.cameras.folder_watch import is_raw_file
+    from rti_rig.planner.topography import read_preview
 
     p = Path(path)
     if not is_raw_file(p) or not p.is_file():
         return read_preview(p)  # which also refuses a folder or a missing file, by name
-    from drivers.cameras.raw_decode import decode_raw
-    from drivers.cameras.settings import RawDecodeSettings
+    from rti_rig.drivers.cameras.raw_decode import decode_raw
+    from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
     try:
         return decode_raw(p, RawDecodeSettings(mode="half")).pixels

@@ -13,11 +13,11 @@ from typing import Protocol
 
 import numpy as np
 
-from rti_rig.errors import DeviceError
-from rti_rig.geometry import angle_between_deg
-from rti_rig.rig import DiscreteLightSource, LightCarrier
-from rti_rig.rig_geometry import DomeGeometry
-from rti_rig.schedule import LightStep
+from rti_rig.core.devices import DiscreteLightSource, LightCarrier
+from rti_rig.core.errors import DeviceError
+from rti_rig.core.geometry import angle_between_deg
+from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.core.schedule import LightStep
 
 #: A dome step's direction must match its LED's calibrated direction this closely (degrees).
 LED_MATCH_TOLERANCE_DEG = 0.5

@@ -30,9 +30,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rti_rig.clock import VirtualClock
-from rti_rig.geometry import fibonacci_cap
-from rti_rig.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.geometry import fibonacci_cap
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 FULL_COUNTS = (3, 4, 5, 6, 8, 10, 12, 16, 20, 30, 50, 100)
 QUICK_COUNTS = (3, 6, 12, 30)
@@ -116,9 +116,9 @@ def scene_camera(
     scales the light before the camera exposes, so a brighter LED saturates as it would
     (``benchmarks.planner_sim_jpeg``'s LED spread).
     """
-    from simulator.camera_model import CameraModel
-    from simulator.light_transport import DirectionalLight, render_radiance
-    from simulator.scenes import make_scene
+    from rti_rig.simulator.camera_model import CameraModel
+    from rti_rig.simulator.light_transport import DirectionalLight, render_radiance
+    from rti_rig.simulator.scenes import make_scene
 
     scene = make_scene(name, s.size_px, s.size_px, seed=s.seed)
     camera = CameraModel()
@@ -152,7 +152,7 @@ def render_scene_data(
     before the camera exposes, as an uncalibrated LED would (``benchmarks.planner_sim_jpeg``);
     the candidates are shot first, so their noise stream is the same whatever the factors.
     """
-    from simulator.ground_truth import homogeneous_directions
+    from rti_rig.simulator.ground_truth import homogeneous_directions
 
     scene, camera_shot = scene_camera(name, s)
     rng = np.random.default_rng(s.seed)
@@ -193,7 +193,7 @@ def normal_error(
 ) -> tuple[float, float, float]:
     """Mean and median angle (°) of robust photometric stereo to ``truth`` over every pixel,
     and the solved fraction; unsolved pixels (or a refused fit) count as facing the camera."""
-    from rti_rig.metrics import angular_error_deg
+    from benchmarks.metrics import angular_error_deg
     from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
 
     everywhere = np.ones(truth.shape[:2], dtype=bool)
@@ -211,7 +211,7 @@ def score_plan(
     data: SceneData, chosen: NDArray[np.intp]
 ) -> tuple[float, float, float, str, float, float]:
     """Normal error (robust PS, every pixel) and relighting quality of one plan."""
-    from rti_rig.metrics import relight_psnr, relight_ssim
+    from benchmarks.metrics import relight_psnr, relight_ssim
     from rti_rig.reconstruct import N_COEFFICIENTS, ReconstructionError, fit_model, select_model
 
     images = data.candidate_images[chosen]
@@ -252,8 +252,8 @@ def session_times(
     is the arm planner's job) and pays each move under its trapezoidal velocity profile.
     Lights the arm cannot reach (inside its keep-out cone) are clamped to its band for timing.
     """
-    from planner.uniform import order_nearest_neighbour
-    from simulator.sim_lights import LightState, SimulatedArm
+    from rti_rig.planner.uniform import order_nearest_neighbour
+    from rti_rig.simulator.sim_lights import LightState, SimulatedArm
 
     dome_s = len(directions) * per_light_s
     clock = VirtualClock()
@@ -268,7 +268,7 @@ def session_times(
 
 
 def _clamp_to_band(d: NDArray[np.float64], arm: ArmGeometry) -> NDArray[np.float64]:
-    from rti_rig.geometry import az_el_from_direction, direction_from_az_el
+    from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
 
     az, el = az_el_from_direction(d)
     top = min(arm.max_elevation_deg, 90.0 - arm.keep_out_half_angle_deg - 1e-6)
@@ -296,9 +296,10 @@ def run_scene(
     data: SceneData, s: TradeoffSettings, progress: Callable[[str], None] = print
 ) -> list[Row]:
     """Every plan for one rendered scene."""
-    from planner.make_plan import make_plan
-    from planner.uniform import select_uniform_leds
-    from rti_rig.errors import ScheduleError
+    from rti_rig.planner.make_plan import make_plan
+    from rti_rig.planner.uniform import select_uniform_leds
+
+    from rti_rig.core.errors import ScheduleError
 
     dome = DomeGeometry(data.candidate_dirs, tuple(f"c{i:03d}" for i in range(s.candidates)))
     rows: list[Row] = []

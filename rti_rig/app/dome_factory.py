@@ -1,0 +1,51 @@
+"""A ready-to-connect dome: the driver for its serial settings under the runtime's policy.
+
+This is composition (it joins a driver to the runtime's :class:`DomePolicy`), so it lives beside
+the composition root rather than in ``rti_rig.drivers``, which is built on the core only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.core.clock import Clock
+from rti_rig.drivers.led_dome.factory import build_driver
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.drivers.led_dome.transport import Transport
+from rti_rig.runtime.dome_policy import DomePolicy, DomePolicySettings, ThermalLimits
+
+
+def policy_settings(settings: DomeSerialSettings) -> DomePolicySettings:
+    """The policy part of the serial settings."""
+    t = settings.thermal
+    corr = settings.intensity_correction
+    return DomePolicySettings(
+        retries=settings.retries,
+        retry_backoff_s=settings.retry_backoff_s,
+        reconnect_attempts=settings.reconnect_attempts,
+        reconnect_backoff_s=settings.reconnect_backoff_s,
+        thermal=ThermalLimits(t.max_on_s, t.max_duty, t.duty_window_s),
+        intensity_correction=None if corr is None else tuple(corr),
+        confirm_with_query=settings.confirm_with_query,
+        expected_led_count=settings.expected_led_count,
+        shutter_pulse_ms=settings.shutter_pulse_ms,
+    )
+
+
+def build_dome(
+    settings: DomeSerialSettings,
+    clock: Clock,
+    *,
+    transport: Transport | None = None,
+    directions: NDArray[np.float64] | None = None,
+    name: str = "dome",
+) -> DomePolicy:
+    """A ready-to-connect dome light source (a ``DiscreteLightSource``); nothing is opened yet."""
+    return DomePolicy(
+        build_driver(settings, transport, name=name),
+        clock,
+        policy_settings(settings),
+        directions=directions,
+        name=name,
+    )

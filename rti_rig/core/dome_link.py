@@ -1,0 +1,94 @@
+"""The dome link: the verbs a dome driver offers the rig and the errors it reports.
+
+It sits in the core so that both sides can speak it without knowing each other: drivers
+(``rti_rig.drivers.led_dome``) implement :class:`DomeLink` and raise :class:`DomeLinkError`;
+the runtime's :class:`rti_rig.runtime.dome_policy.DomePolicy` decides what a fault means for an
+acquisition (retry, reconnect, stop).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Protocol
+
+from rti_rig.core.errors import DeviceError
+
+
+class LinkFault(StrEnum):
+    """What went wrong on the link, as the driver saw it."""
+
+    TIMEOUT = "timeout"  # no reply in time (dropped or late)
+    GARBLED = "garbled"  # bytes that are not a valid reply
+    MISMATCH = "mismatch"  # the echo says the firmware did something else
+    RESET = "reset"  # an unexpected boot banner: the board rebooted
+    DISCONNECTED = "disconnected"  # the port went away (USB drop) or is not open
+    REJECTED = "rejected"  # the firmware answered ERR
+
+
+class DomeLinkError(DeviceError):
+    """A failed exchange with the dome. ``retryable``: resending the same command may succeed."""
+
+    def __init__(
+        self,
+        device: str,
+        message: str,
+        command: str | None,
+        fault: LinkFault,
+        *,
+        retryable: bool,
+        code: int | None = None,
+    ) -> None:
+        super().__init__(device, message, command)
+        self.fault = fault
+        self.retryable = retryable
+        self.code = code
+
+
+@dataclass(frozen=True)
+class DomeInfo:
+    """What the handshake told about the board."""
+
+    firmware_id: str
+    version: str
+    led_count: int
+
+
+class DomeLink(Protocol):
+    """The verbs of a dome driver (one exchange each; errors are :class:`DomeLinkError`)."""
+
+    device: str
+    #: The light command carries the firmware watchdog time (max on-time).
+    has_watchdog: bool
+    #: The light acknowledgement echoes the LED index and level that were executed.
+    echoes_light: bool
+    #: Highest PWM level the firmware takes.
+    max_level: int
+
+    def connect(self) -> DomeInfo:
+        """Open the port, wait for the ready banner, handshake."""
+        ...
+
+    def close(self) -> None: ...
+
+    def hello(self) -> DomeInfo: ...
+
+    def light(self, index: int, level: int, max_on_ms: int | None) -> None: ...
+
+    def all_off(self) -> None: ...
+
+    def shutter(self, pulse_ms: int) -> None: ...
+
+    def query(self) -> tuple[int | None, int]:
+        """(index lit or None, level) as the firmware sees it."""
+        ...
+
+
+class DomeLedError(DeviceError):
+    """An error about one LED (dead, thermal limit, unknown light during a capture)."""
+
+    def __init__(self, device: str, led: int, message: str, command: str | None) -> None:
+        super().__init__(device, message, command)
+        self.led = led
+
+

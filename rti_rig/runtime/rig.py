@@ -1,0 +1,91 @@
+"""A rig: lighting + camera + clock + timing, assembled from a config by the composition root.
+
+The runtime must not depend on how a rig is configured (TOML, pydantic, drivers' settings), so
+what it reads of the loaded config is written here as protocols; the composition root's
+``rti_rig.app.config.LoadedRig`` satisfies them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import Camera
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.runtime.lighting import Lighting
+
+
+class CameraConfig(Protocol):
+    """What the runtime reads of a rig's camera settings."""
+
+    width: int
+    height: int
+    exposure_s: float
+    min_exposure_s: float
+    max_exposure_s: float
+
+
+class TimingConfig(Protocol):
+    """The rig's timing, as the controller waits on it."""
+
+    settle_s: float
+
+
+class RigConfig(Protocol):
+    name: str
+    kind: str
+    backend: str
+
+    @property
+    def camera(self) -> CameraConfig: ...
+
+    @property
+    def timing(self) -> TimingConfig: ...
+
+
+class LoadedRig(Protocol):
+    """A rig config as loaded: the parsed config, where it came from and its exact text."""
+
+    @property
+    def config(self) -> RigConfig: ...
+
+    path: str
+    sha256: str
+    raw: dict[str, Any]
+
+
+@dataclass
+class Rig:
+    """Everything the controller needs to run a schedule."""
+
+    loaded: LoadedRig
+    geometry: DomeGeometry | ArmGeometry
+    lighting: Lighting
+    camera: Camera
+    clock: Clock
+    #: Things the rig holds open besides its devices (an emulator's pseudo-terminal…).
+    resources: contextlib.ExitStack = field(default_factory=contextlib.ExitStack)
+
+    def close(self) -> None:
+        """Release what ``build_rig`` opened; the controller has already made devices safe."""
+        self.resources.close()
+
+    def __enter__(self) -> Rig:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def name(self) -> str:
+        return self.loaded.config.name
+
+    @property
+    def camera_config(self) -> CameraConfig:
+        return self.loaded.config.camera
+
+    @property
+    def timing(self) -> TimingConfig:
+        return self.loaded.config.timing

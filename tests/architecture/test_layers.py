@@ -1,0 +1,77 @@
+"""The layer contract (pyproject's [tool.importlinter]) holds, and it bites when broken.
+
+import-linter reads a package from its folder, but rti_rig's sub-packages live in top-level
+folders mapped by setuptools' package-dir; so the test lays the installed tree out in a temporary
+folder exactly as ``pip install .`` would (from the same mapping) and checks that copy.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+PYPROJECT = REPO / "pyproject.toml"
+
+
+def installed_layout(dest: Path) -> Path:
+    """Copy the sources into ``dest`` as the installed package tree (package-dir mapping)."""
+    setup = tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))["tool"]["setuptools"]
+    mapping: dict[str, str] = setup["package-dir"]
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc")
+    for package, folder in sorted(mapping.items(), key=lambda kv: kv[0].count(".")):
+        target = dest.joinpath(*package.split("."))
+        shutil.copytree(REPO / folder, target, ignore=ignore, dirs_exist_ok=True)
+    return dest
+
+
+def lint_imports(tree: Path, config: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    code = "import sys; from importlinter.cli import lint_imports_command; lint_imports_command()"
+    return subprocess.run(
+        [sys.executable, "-c", code, "--config", str(config), "--no-cache"],
+        cwd=tree,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
+def test_every_mapped_package_is_listed_for_installation():
+    setup = tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))["tool"]["setuptools"]
+    listed = set(setup["packages"])
+    on_disk = set()
+    for package, folder in setup["package-dir"].items():
+        for init in (REPO / folder).rglob("__init__.py"):
+            rel = init.parent.relative_to(REPO / folder)
+            on_disk.add(".".join([package, *rel.parts]))
+    # a sub-package mapped by a parent's folder (rti_rig/core under rti_rig) counts once
+    assert on_disk - listed == set(), "add these to [tool.setuptools] packages"
+
+
+@pytest.mark.slow
+def test_the_layer_contract_holds(tmp_path):
+    tree = installed_layout(tmp_path / "site")
+    result = lint_imports(tree, PYPROJECT)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "broken" not in result.stdout.lower() or "0 broken" in result.stdout.lower()
+
+
+@pytest.mark.slow
+def test_the_contract_fails_when_a_core_module_imports_a_driver(tmp_path):
+    tree = installed_layout(tmp_path / "site")
+    geometry = tree / "rti_rig" / "core" / "geometry.py"
+    geometry.write_text(
+        geometry.read_text(encoding="utf-8") + "\nimport rti_rig.drivers.led_dome.driver\n",
+        encoding="utf-8",
+    )
+    result = lint_imports(tree, PYPROJECT)
+    assert result.returncode != 0
+    assert "rti_rig.core.geometry -> rti_rig.drivers.led_dome.driver" in result.stdout
