@@ -21,26 +21,25 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.planner.kmeans_method import plan_kmeans
+from rti_rig.planner.builtin_methods import MANY_LIGHTS, MIN_LIGHTS_FOR_EXCHANGE
+from rti_rig.planner.methods import MethodContext, PlanMethod, get_method
 from rti_rig.planner.objectives import (
     GLOSSY_SPECULAR,
     GLOSSY_WIDTH_DEG,
     HELD_OUT,
     OBJECTIVES,
     Candidates,
-    NormalsObjective,
-    RelightObjective,
     candidates_for,
     check_material,
     check_signal_noise,
     make_objective,
 )
-from rti_rig.planner.optimal import exchange_search
 from rti_rig.planner.plan_report import PlanReport
 from rti_rig.planner.surface_estimate import (
     SurfaceEstimate,
@@ -56,10 +55,11 @@ from threadpoolctl import threadpool_limits
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
+from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule
 
-METHODS: tuple[str, ...] = ("uniform", "kmeans", "optimal")
+__all__ = ["MANY_LIGHTS", "PlanRequest", "make_plan", "plan", "plan_with_report"]
 
 #: The objective used when none is asked for (evidence in docs/planner.md).
 DEFAULT_OBJECTIVE = "normals"
@@ -71,17 +71,6 @@ START_FLOORS_DEG = (10.0, 20.0, 30.0, 40.0)
 TINY_PREVIEW_PX = 16
 
 ArmOrder = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.intp]]
-
-#: Below this many lights the exchange search is not run (see ``_run_method``): 3 lights are exactly
-#: the unknowns of the Lambertian fit, with no redundancy left for a shadow or a highlight.
-MIN_LIGHTS_FOR_EXCHANGE = 4
-
-#: From this light count up the benchmarks found the ``optimal`` normals plan's gain over a
-#: homogeneous layout small and object-dependent (real dome: a tie at 12 lights and −0.39° at 18
-#: by default, wins at both declared glossy; simulator: losses on brushed steel at 20 and 30
-#: against a 10° floor), so the report says so.
-MANY_LIGHTS = 12
-
 
 def check_elevation_band(min_elevation_deg: float, max_elevation_deg: float) -> None:
     """Refuse an elevation band that is empty or leaves the hemisphere."""
@@ -168,24 +157,13 @@ def _schedule(
     return LightSchedule.from_directions(dirs[order], method=method, provenance=provenance)
 
 
-def plan_with_report(
-    preview: NDArray | None,
-    geometry: DomeGeometry | ArmGeometry,
-    n: int,
-    method: str = "optimal",
-    objective: str = DEFAULT_OBJECTIVE,
-    preview_light: tuple[float, float] | None = None,
-    depth_model: Path | None = None,
-    min_elevation_deg: float = 0.0,
-    *,
-    depth_spec: DepthModelSpec | None = None,
-    arm_order: ArmOrder | None = None,
-    seed: int = 0,
-    signal_noise: float = 0.0,
-    material: str = "auto",
-    max_elevation_deg: float = 90.0,
-) -> tuple[LightSchedule, PlanReport]:
-    """The schedule and the evidence behind it; see :func:`make_plan`.
+@dataclass(frozen=True)
+class PlanRequest:
+    """Everything one plan depends on; :meth:`check` is the one place its values are checked.
+
+    ``preview`` is an image (H, W) or (H, W, 3): uint8 is sRGB, uint16 and float are linear
+    (see :mod:`rti_rig.planner.topography`); it may be ``None`` for a method whose
+    :attr:`~rti_rig.planner.methods.PlanMethod.surface` is not ``"preview"``.
 
     ``max_elevation_deg``: no light above this elevation (90 = none excluded): lights near
     the camera axis put mirror highlights on a level glossy object (docs/planner.md, "An
@@ -200,114 +178,222 @@ def plan_with_report(
     the ``normals`` objective — an uncalibrated dome's LED spread and 8-bit JPEG captures
     (:data:`rti_rig.planner.objectives.SIGNAL_NOISE_JPEG_DOME`); 0 models additive noise only.
 
+    ``arm_order`` orders an arm's lights (the composition root passes the servos' move-time
+    order, :func:`rti_rig.planner.arm_order.order_for_arm`); without it, nearest neighbour from
+    the park pose.
+    """
+
+    preview: NDArray | None
+    geometry: DomeGeometry | ArmGeometry
+    n: int
+    method: str = "optimal"
+    objective: str = DEFAULT_OBJECTIVE
+    preview_light: tuple[float, float] | None = None
+    depth_model: Path | None = None
+    min_elevation_deg: float = 0.0
+    max_elevation_deg: float = 90.0
+    signal_noise: float = 0.0
+    material: str = "auto"
+    depth_spec: DepthModelSpec | None = None
+    arm_order: ArmOrder | None = None
+    seed: int = 0
+
+    def check(self) -> PlanMethod:
+        """Refuse what cannot be planned, before any work; returns the method to plan with."""
+        return check_plan_options(
+            method=self.method,
+            objective=self.objective,
+            n=self.n,
+            has_preview=self.preview is not None,
+            preview_light=self.preview_light,
+            depth_model=self.depth_model,
+            min_elevation_deg=self.min_elevation_deg,
+            max_elevation_deg=self.max_elevation_deg,
+            signal_noise=self.signal_noise,
+            material=self.material,
+        )
+
+
+def check_plan_options(
+    *,
+    method: str,
+    objective: str,
+    n: int,
+    has_preview: bool,
+    preview_light: tuple[float, float] | None = None,
+    depth_model: Path | None = None,
+    min_elevation_deg: float = 0.0,
+    max_elevation_deg: float = 90.0,
+    signal_noise: float = 0.0,
+    material: str = "auto",
+) -> PlanMethod:
+    """The one definition of what a plan may ask; returns the method to plan with.
+
+    Refused, naming the command-line option: an unknown method, objective or material; a signal
+    noise the objective does not model; a method that needs a preview without one; a preview's
+    light or depth model without a preview; a depth model that is not a file; an empty elevation
+    band; a light count outside 1..1000 (the most an .lp file may list). Callers check early
+    (before reading any image) with ``has_preview``; :func:`plan` checks its request again.
+    """
+    chosen = get_method(method)
+    if objective not in OBJECTIVES:
+        known = ", ".join(OBJECTIVES)
+        raise ScheduleError(f"--objective {objective!r} is not known; choose {known}")
+    check_signal_noise(signal_noise, objective)
+    check_material(material)
+    if not has_preview and chosen.surface == "preview":
+        raise ScheduleError(chosen.needs_preview_reason)
+    if not has_preview and (preview_light is not None or depth_model is not None):
+        given = "--preview-light" if preview_light is not None else "--depth-model"
+        raise ScheduleError(
+            f"{given} describes a preview shot, but no preview was given: give the preview, "
+            f"or drop {given}"
+        )
+    if depth_model is not None and not Path(depth_model).is_file():
+        raise ScheduleError(f"--depth-model {depth_model}: file not found")
+    check_elevation_band(min_elevation_deg, max_elevation_deg)
+    if n < 1:
+        raise ScheduleError(f"--lights must be at least 1, got {n}")
+    if n > MAX_LIGHTS:
+        raise ScheduleError(
+            f"--lights {n}: at most {MAX_LIGHTS} lights (the most an .lp file may list "
+            "for readers such as relight)"
+        )
+    return chosen
+
+
+def plan(request: PlanRequest) -> tuple[LightSchedule, PlanReport]:
+    """The schedule for ``request`` and the evidence behind it.
+
+    Dome steps carry LED indices and the dome's LED names as labels, in ascending LED order; arm
+    steps are ordered for short moves. The evidence is also in
+    ``schedule.provenance["report"]``.
+
     BLAS is held to one thread while planning: every matrix here is small (3 to 16 columns),
     and a threaded BLAS on a busy machine made such products 40× slower, not faster.
     """
+    method = request.check()
     with threadpool_limits(limits=1):
-        return _plan(
-            preview,
-            geometry,
-            n,
-            method,
-            objective,
-            preview_light,
-            depth_model,
-            min_elevation_deg,
-            depth_spec,
-            arm_order,
-            seed,
-            signal_noise,
-            material,
-            max_elevation_deg,
-        )
+        return _plan(request, method)
 
 
-def _plan(
+def plan_with_report(
     preview: NDArray | None,
     geometry: DomeGeometry | ArmGeometry,
     n: int,
-    method: str,
-    objective: str,
-    preview_light: tuple[float, float] | None,
-    depth_model: Path | None,
-    min_elevation_deg: float,
-    depth_spec: DepthModelSpec | None,
-    arm_order: ArmOrder | None,
-    seed: int,
-    signal_noise: float = 0.0,
-    material: str = "auto",
-    max_elevation_deg: float = 90.0,
+    method: str = "optimal",
+    objective: str = DEFAULT_OBJECTIVE,
+    preview_light: tuple[float, float] | None = None,
+    depth_model: Path | None = None,
+    min_elevation_deg: float = 0.0,
+    **options: Any,
 ) -> tuple[LightSchedule, PlanReport]:
-    t0 = time.perf_counter()
-    _check_request(
-        n, method, objective, signal_noise, material, min_elevation_deg, max_elevation_deg
-    )
-    relit_band, cut = _relit_band(geometry, min_elevation_deg, max_elevation_deg)
-    if isinstance(geometry, ArmGeometry):
-        geometry = arm_below(geometry, max_elevation_deg)
-    candidates, starts = _candidates_and_starts(geometry, n, min_elevation_deg, max_elevation_deg)
-    rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
-    report = PlanReport(
+    """:func:`plan` with the request's fields as arguments (``options``: the other fields of
+    :class:`PlanRequest` by name)."""
+    request = PlanRequest(
+        preview,
+        geometry,
+        n,
         method,
         objective,
+        preview_light,
+        depth_model,
+        min_elevation_deg,
+        **options,
+    )
+    return plan(request)
+
+
+def make_plan(
+    preview: NDArray | None,
+    geometry: DomeGeometry | ArmGeometry,
+    n: int,
+    method: str = "optimal",
+    objective: str = DEFAULT_OBJECTIVE,
+    preview_light: tuple[float, float] | None = None,
+    depth_model: Path | None = None,
+    min_elevation_deg: float = 0.0,
+    **options: Any,
+) -> LightSchedule:
+    """An ordered schedule of ``n`` lights for ``geometry`` (:func:`plan_with_report` without
+    the report; it stays in ``schedule.provenance["report"]``)."""
+    return plan_with_report(
+        preview,
+        geometry,
+        n,
+        method,
+        objective,
+        preview_light,
+        depth_model,
+        min_elevation_deg,
+        **options,
+    )[0]
+
+
+def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanReport]:
+    t0 = time.perf_counter()
+    geometry, n = req.geometry, req.n
+    relit_band, cut = _relit_band(geometry, req.min_elevation_deg, req.max_elevation_deg)
+    if isinstance(geometry, ArmGeometry):
+        geometry = arm_below(geometry, req.max_elevation_deg)
+    candidates, starts = _candidates_and_starts(
+        geometry, n, req.min_elevation_deg, req.max_elevation_deg
+    )
+    rig = f"a dome of {geometry.count} LEDs" if isinstance(geometry, DomeGeometry) else "an arm"
+    report = PlanReport(
+        method.name,
+        req.objective,
         n,
         rig,
         len(candidates),
-        min_elevation_deg,
-        max_elevation_deg if cut else 90.0,  # a ceiling above every light changes nothing
-        material=material,
+        req.min_elevation_deg,
+        req.max_elevation_deg if cut else 90.0,  # a ceiling above every light changes nothing
+        material=req.material,
     )
     prov: dict[str, Any] = {
         "n": n,
-        "min_elevation_deg": min_elevation_deg,
-        "max_elevation_deg": max_elevation_deg,
-        "objective": objective,
+        "min_elevation_deg": req.min_elevation_deg,
+        "max_elevation_deg": req.max_elevation_deg,
+        "objective": req.objective,
     }
 
     chosen = starts[0][1]
-    surface = _surface_for(
-        preview, method, material, preview_light, depth_model, depth_spec, report
-    )
+    surface = _surface_for(req, method, report)
     if surface is not None:
         held_out = _held_out_lights(candidates, relit_band, cut)
-        sample = sample_surface(surface, candidates, held_out, seed=seed, material=material)
-        if method == "kmeans":
-            chosen = _run_kmeans(surface, n, candidates, seed, cut, max_elevation_deg, report)
-            starts.append(("kmeans", chosen))
-        obj = make_objective(objective, sample, candidates, n, starts[0][1], signal_noise)
-        report.signal_noise = signal_noise
-        _note_assumptions(report, method, objective, n, signal_noise, material)
-        chosen = _run_method(obj, method, objective, n, material, starts, chosen, report)
-    if surface is None and material != "auto":
+        sample = sample_surface(surface, candidates, held_out, seed=req.seed, material=req.material)
+        ctx = MethodContext(
+            n,
+            candidates,
+            starts,
+            surface,
+            report,
+            req.seed,
+            req.material,
+            req.objective,
+            req.max_elevation_deg,
+            cut,
+        )
+        chosen = method.prepare(ctx)
+        obj = make_objective(req.objective, sample, candidates, n, starts[0][1], req.signal_noise)
+        report.signal_noise = req.signal_noise
+        _note_assumptions(report, method, req)
+        report.model = getattr(obj, "model", "lambert (photometric stereo)")
+        report.expected_meaning = (
+            "expected RMS normal error (degrees)"
+            if req.objective == "normals"
+            else f"expected relighting MSE per unit albedo ({report.model})"
+        )
+        chosen = method.decide(ctx, obj, chosen)
+    if surface is None and req.material != "auto":
         report.notes.append(
-            f"--material {material} is not used: no surface was modelled ({method} needs none)"
+            f"--material {req.material} is not used: no surface was modelled "
+            f"({method.name} needs none)"
         )
     report.seconds = time.perf_counter() - t0
     prov["report"] = report.to_dict()
-    schedule = _schedule(geometry, candidates, chosen, method, prov, arm_order)
+    schedule = _schedule(geometry, candidates, chosen, method.name, prov, req.arm_order)
     return schedule, report
-
-
-def _check_request(
-    n: int,
-    method: str,
-    objective: str,
-    signal_noise: float,
-    material: str,
-    min_elevation_deg: float,
-    max_elevation_deg: float,
-) -> None:
-    """Refuse an unknown method, objective or material, a light count below 1, a signal noise
-    the objective does not model and an empty elevation band."""
-    if method not in METHODS:
-        raise ScheduleError(f"unknown method '{method}'; use one of {', '.join(METHODS)}")
-    if objective not in OBJECTIVES:
-        raise ScheduleError(f"unknown objective '{objective}'; use one of {', '.join(OBJECTIVES)}")
-    if n < 1:
-        raise ScheduleError(f"--lights must be at least 1, got {n}")
-    check_signal_noise(signal_noise, objective)
-    check_material(material)
-    check_elevation_band(min_elevation_deg, max_elevation_deg)
 
 
 def _relit_band(
@@ -351,29 +437,14 @@ def _candidates_and_starts(
 
 
 def _surface_for(
-    preview: NDArray | None,
-    method: str,
-    material: str,
-    preview_light: tuple[float, float] | None,
-    depth_model: Path | None,
-    depth_spec: DepthModelSpec | None,
-    report: PlanReport,
+    req: PlanRequest, method: PlanMethod, report: PlanReport
 ) -> SurfaceEstimate | None:
-    """The surface to plan for: estimated from the preview, assumed level without one (for
-    ``optimal``), or None when the method needs none; its facts go into ``report``."""
-    if method == "kmeans" and preview is None:
-        raise ScheduleError(
-            "--method kmeans clusters the preview's normals; give a preview shot, or use "
-            "--method optimal (which plans for a flat surface without one) or uniform"
-        )
+    """The surface to plan for: estimated from the preview, assumed level without one (for a
+    method that plans for a ``flat`` surface), or None when the method needs none; its facts go
+    into ``report``."""
+    preview, material = req.preview, req.material
     surface: SurfaceEstimate | None = None
-    if preview is None and (preview_light is not None or depth_model is not None):
-        given = "--preview-light" if preview_light is not None else "--depth-model"
-        raise ScheduleError(
-            f"{given} describes a preview shot, but no preview was given: give the preview, "
-            f"or drop {given}"
-        )
-    if preview is None and method == "optimal":
+    if preview is None and method.surface == "flat":
         surface = flat_surface()
         kind = "glossy" if material == "glossy" else "matte"
         report.notes.append(
@@ -382,11 +453,13 @@ def _surface_for(
         )
     elif preview is not None:
         try:
-            surface = estimate_surface(preview, preview_light, depth_model, depth_spec)
+            surface = estimate_surface(
+                preview, req.preview_light, req.depth_model, req.depth_spec
+            )
         except ScheduleError as exc:
-            if method != "uniform":
+            if method.surface != "none":
                 raise
-            # the homogeneous layout does not need the preview: report, do not fail
+            # a method that needs no surface does not need the preview: report, do not fail
             report.notes.append(f"preview not evaluated: {exc}")
     if surface is not None:
         report.relief_source = surface.relief_source
@@ -433,54 +506,21 @@ def _held_out_lights(
     return fibonacci_cap(HELD_OUT, max(lo, 0.0), hi if hi > lo + 1.0 else 90.0)
 
 
-def _run_kmeans(
-    surface: SurfaceEstimate,
-    n: int,
-    candidates: Candidates,
-    seed: int,
-    cut: bool,
-    max_elevation_deg: float,
-    report: PlanReport,
-) -> NDArray[np.intp]:
-    """The paper's method: the usable positions nearest the preview's normal clusters."""
-    # the paper clusters the depth gradient's normals as they come: no shrinkage
-    raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
-    chosen, km = plan_kmeans(raw, n, candidates, seed)
-    report.kmeans_distinct_normals = km.distinct_normals
-    if cut:
-        report.notes.append(
-            f"kmeans puts each light at the usable position nearest its cluster centre: "
-            f"under the {max_elevation_deg:g}° ceiling the clusters of a near-level "
-            "surface all land on the ceiling's ring"
-        )
-    if km.distinct_normals < n:
-        report.notes.append(
-            f"only {km.distinct_normals} distinct normals for {n} clusters: the "
-            "remaining lights sit on the usable positions nearest the cluster centres"
-        )
-    return chosen
-
-
-def _note_assumptions(
-    report: PlanReport,
-    method: str,
-    objective: str,
-    n: int,
-    signal_noise: float,
-    material: str,
-) -> None:
+def _note_assumptions(report: PlanReport, method: PlanMethod, req: PlanRequest) -> None:
     """Notes on the declared signal noise and material and on the objective's evidence."""
-    if signal_noise > 0 and (method != "optimal" or n < MIN_LIGHTS_FOR_EXCHANGE):
+    n, material = req.n, req.material
+    chooses_by_objective = method.optimises_objective and n >= MIN_LIGHTS_FOR_EXCHANGE
+    if req.signal_noise > 0 and not chooses_by_objective:
         report.notes.append(
             f"--signal-noise changes only the expected errors reported here, not the "
-            f"lights {method} chooses"
+            f"lights {method.name} chooses"
         )
     if material != "auto":
         unused = (
             ""
-            if method == "optimal" and n >= MIN_LIGHTS_FOR_EXCHANGE
+            if chooses_by_objective
             else f" (it changes only the expected errors reported here, not the lights "
-            f"{method} chooses)"
+            f"{method.name} chooses)"
         )
         what = (
             f"highlights modelled as a {GLOSSY_WIDTH_DEG:g}° lobe of strength "
@@ -489,91 +529,10 @@ def _note_assumptions(
             else "no highlight modelled"
         )
         report.notes.append(f"declared {material}: {what}, whatever the preview shows{unused}")
-    if objective == "relight" and method == "optimal":
+    if req.objective == "relight" and method.optimises_objective:
         report.notes.append(
             "evidence: on the real dome of docs/planner.md the normals objective's layouts "
             "relit better than this objective's at 6, 9, 12 and 18 lights (mean PSNR over "
             "144 draws; median over 8 previews with --material glossy too); for "
             "relighting, --objective normals is the tested choice"
         )
-
-
-def _run_method(
-    obj: NormalsObjective | RelightObjective,
-    method: str,
-    objective: str,
-    n: int,
-    material: str,
-    starts: list[tuple[str, NDArray[np.intp]]],
-    chosen: NDArray[np.intp],
-    report: PlanReport,
-) -> NDArray[np.intp]:
-    """The lights ``method`` chooses (``chosen`` unless it is ``optimal``), with the expected
-    errors of the layouts it compared recorded in ``report``."""
-    report.model = getattr(obj, "model", "lambert (photometric stereo)")
-    report.expected_meaning = (
-        "expected RMS normal error (degrees)"
-        if objective == "normals"
-        else f"expected relighting MSE per unit albedo ({report.model})"
-    )
-    if method == "optimal" and n <= MIN_LIGHTS_FOR_EXCHANGE - 1:
-        # With as many lights as unknowns, one shadowed or clipped light leaves a pixel
-        # unsolvable: a cliff the expected-error objective cannot see. On the simulated
-        # scenes, exchanges at N = 3 collapsed on the tilted one (43° against 1.2°), and
-        # choosing among elevation floors by the objective picked near-coplanar high
-        # lights (painting 14.6° against 3.7°). So three lights stay homogeneous at the
-        # user's floor: the preview-free choice, never worse than itself.
-        label, chosen = starts[0]
-        report.start_layout, report.swaps = label, 0
-        report.expected[label] = obj.cost(chosen)
-        report.notes.append(
-            f"{n} lights leave no redundancy for a shadow or a highlight: the homogeneous "
-            f"layout ({label}) is kept"
-        )
-    elif method == "optimal":
-        res = exchange_search(obj, starts)
-        chosen = res.chosen
-        report.start_layout, report.swaps = res.start_label, res.swaps
-        report.expected.update(res.start_costs)
-        report.expected["optimal"] = res.cost
-        if n >= MANY_LIGHTS and objective == "normals" and res.swaps > 0:
-            glossy = "" if material == "glossy" else "; for gilding, --material glossy helped"
-            report.notes.append(
-                f"from {MANY_LIGHTS} lights the planner gained little over an even layout in "
-                "the tests (docs/planner.md): for brushed metal at 20 lights or more, "
-                f"--method uniform --min-elevation-deg 10 did better{glossy}"
-            )
-    else:
-        report.expected[starts[0][0]] = obj.cost(starts[0][1])
-        if method == "kmeans":
-            report.expected["kmeans"] = obj.cost(chosen)
-    return chosen
-
-
-def make_plan(
-    preview: NDArray | None,
-    geometry: DomeGeometry | ArmGeometry,
-    n: int,
-    method: str = "optimal",
-    objective: str = DEFAULT_OBJECTIVE,
-    preview_light: tuple[float, float] | None = None,
-    depth_model: Path | None = None,
-    min_elevation_deg: float = 0.0,
-    signal_noise: float = 0.0,
-    material: str = "auto",
-    max_elevation_deg: float = 90.0,
-) -> LightSchedule:
-    """An ordered schedule of ``n`` lights for ``geometry`` planned from one preview.
-
-    ``preview`` is an image (H, W) or (H, W, 3): uint8 is sRGB, uint16 and float are linear
-    (see :mod:`rti_rig.planner.topography`). It may be ``None`` for ``uniform`` (no preview needed)
-    and ``optimal`` (which then plans for a level, matte surface:
-    :func:`rti_rig.planner.surface_estimate.flat_surface`). Dome steps carry LED indices and the
-    dome's LED names as labels, in ascending LED order; arm steps are ordered for short moves from
-    the park pose. The evidence is in ``schedule.provenance["report"]`` (or use
-    :func:`plan_with_report`).
-    """
-    args = (preview, geometry, n, method, objective, preview_light, depth_model, min_elevation_deg)
-    return plan_with_report(
-        *args, signal_noise=signal_noise, material=material, max_elevation_deg=max_elevation_deg
-    )[0]

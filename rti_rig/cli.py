@@ -21,9 +21,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rti_rig.core.errors import RtiRigError
 
 if TYPE_CHECKING:
-    from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
-    from rti_rig.core.schedule import LightSchedule
-    from rti_rig.planner.plan_report import PlanReport
+    pass
 
 app = typer.Typer(
     help=(
@@ -45,39 +43,6 @@ def _fail(exc: RtiRigError) -> typer.Exit:
     # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
     err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
     return typer.Exit(code=2)
-
-
-def _check_output_file(
-    out_file: Path, force: bool, inputs: dict[str, Path | None], option: str = "--out"
-) -> None:
-    """Refuse, before any work, an output the command could not write or should not replace.
-
-    ``inputs`` names the files the command reads (``{"PREVIEW": path, ...}``): replacing one of
-    them is refused even with ``--force``, as is replacing a file inside a session folder —
-    nothing already captured is ever overwritten. ``option`` is the flag that named the file.
-    """
-    from rti_rig.runtime.session import MANIFEST
-
-    if out_file.is_dir():
-        raise RtiRigError(f"{option} {out_file} is a folder: give the name of the file to write")
-    parent = out_file.parent
-    if not parent.is_dir():
-        raise RtiRigError(f"{option} {out_file}: folder {parent} does not exist; create it first")
-    if not out_file.exists():
-        return
-    for what, path in inputs.items():
-        if path is not None and path.exists() and out_file.samefile(path):
-            raise RtiRigError(
-                f"{option} {out_file} is the {what} this command reads; choose another"
-            )
-    for folder in out_file.resolve().parents:
-        if (folder / MANIFEST).is_file():
-            raise RtiRigError(
-                f"{option} {out_file} would replace a file of the session in {folder}; a "
-                "session's files are never overwritten: write it elsewhere"
-            )
-    if not force:
-        raise RtiRigError(f"{option} {out_file} exists; use --force to replace it")
 
 
 def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
@@ -572,172 +537,42 @@ def plan(
     The plan's lights are the rig's own (a dome's LEDs, used once each; an arm's reachable
     directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.
     """
-    from rti_rig.app.compose import arm_order_for, read_preview_image
-    from rti_rig.app.config import default_config_path, load_rig_config, rig_geometry
-    from rti_rig.app.preview_source import resolve_preview
-    from rti_rig.core.lp_format import MAX_LIGHTS, LpEntry, read_lp, write_lp
-    from rti_rig.core.rig_geometry import DomeGeometry, coincident_leds
-    from rti_rig.planner.make_plan import (
-        DEFAULT_OBJECTIVE,
-        METHODS,
-        check_elevation_band,
-        plan_with_report,
-    )
-    from rti_rig.planner.objectives import OBJECTIVES, check_material, check_signal_noise
-    from rti_rig.runtime.session import image_names
+    from rti_rig.app.config import default_config_path
+    from rti_rig.app.usecases.plan import PlanLightsRequest, draw_plan_figure, plan_lights
 
-    rig = rig or default_config_path()
     try:
-        method = method or ("optimal" if preview is not None else "uniform")
-        if method not in METHODS:
-            raise RtiRigError(f"--method {method!r} is not known; choose {', '.join(METHODS)}")
-        objective = objective or DEFAULT_OBJECTIVE
-        if objective not in OBJECTIVES:
-            raise RtiRigError(
-                f"--objective {objective!r} is not known; choose {', '.join(OBJECTIVES)}"
-            )
-        if signal_noise is not None:
-            check_signal_noise(signal_noise, objective)
-        check_material(material)
-        if method == "kmeans" and preview is None:
-            raise RtiRigError(
-                "--method kmeans clusters the preview's normals: give PREVIEW (or use "
-                "--method optimal, which plans for a flat surface without one)"
-            )
-        if depth_model is not None and not depth_model.is_file():
-            raise RtiRigError(f"--depth-model {depth_model}: file not found")
-        check_elevation_band(min_elevation_deg, max_elevation_deg)
-        if lights > MAX_LIGHTS:
-            raise RtiRigError(
-                f"--lights {lights}: at most {MAX_LIGHTS} lights (the most an .lp file may list "
-                "for readers such as relight)"
-            )
-        az_el = _parse_az_el(preview_light)
-        bare_lp = rig.suffix.lower() == ".lp"
-        loaded = None if bare_lp else load_rig_config(rig)
-        inputs = {"preview": preview, "rig file": rig, "depth model": depth_model}
-        if loaded is not None and loaded.config.dome is not None and loaded.config.dome.lp_file:
-            # the dome's LED calibration is an input too
-            inputs["rig's LED calibration (lp_file)"] = loaded.folder / loaded.config.dome.lp_file
-        _check_output_file(out_file, force, inputs)
-        if figure is not None:
-            from rti_rig.app.plan_figure import check_figure_path  # matplotlib only when asked
-
-            check_figure_path(figure)
-            _check_output_file(figure, force, inputs, "--figure")
-            if figure.resolve() == out_file.resolve():
-                raise RtiRigError(f"--figure {figure} is the --out plan file; choose another")
-        arm_order = None
-        if loaded is None:
-            entries = read_lp(rig, upper_hemisphere=True)
-            pair = coincident_leds([e.direction for e in entries])
-            if pair is not None:
-                i, j = pair
-                raise RtiRigError(
-                    f"{rig}: lights {i + 1} ({entries[i].name}) and {j + 1} "
-                    f"({entries[j].name}) give the same direction; as --rig, an .lp means a "
-                    "dome with exactly these lights, each listed once (remove the repeats)"
-                )
-            geometry: object = DomeGeometry(
-                [e.direction for e in entries], tuple(e.name for e in entries)
-            )
-        else:
-            geometry = rig_geometry(loaded)
-            arm_order = arm_order_for(loaded)
-            if signal_noise is None and loaded.config.camera.signal_noise > 0:
-                signal_noise = loaded.config.camera.signal_noise
-                if objective != "normals":
-                    raise RtiRigError(
-                        f"{rig}: [camera] signal_noise = {signal_noise:g} is modelled by the "
-                        f"normals objective only; give --signal-noise 0 to plan for "
-                        f"--objective {objective}"
-                    )
-        image, light_note = None, None
-        if preview is not None:
-            rig_lp = (rig, entries) if loaded is None else None
-            source = resolve_preview(preview, rig_lp, az_el is not None)
-            if az_el is None and source.light_az_el_deg is not None:
-                az_el, light_note = source.light_az_el_deg, source.light_source
-            image = read_preview_image(source.image)
-        schedule, report = plan_with_report(
-            image,
-            geometry,  # type: ignore[arg-type]
-            lights,
-            method,
-            objective,
-            preview_light=az_el,
+        request = PlanLightsRequest(
+            rig=rig or default_config_path(),
+            out_file=out_file,
+            lights=lights,
+            preview=preview,
+            method=method,
+            objective=objective,
+            preview_light=_parse_az_el(preview_light),
             depth_model=depth_model,
             min_elevation_deg=min_elevation_deg,
-            arm_order=arm_order,
-            signal_noise=signal_noise or 0.0,
-            material=material,
             max_elevation_deg=max_elevation_deg,
+            signal_noise=signal_noise,
+            material=material,
+            figure=figure,
+            force=force,
         )
-        if light_note and report.preview_light_source == "given":
-            report.preview_light_source = light_note
-        if bare_lp:
-            names = [s.label for s in schedule.steps]
-        else:
-            names = [f"{n}.jpg" for n in image_names(len(schedule))]
-        write_lp(
-            out_file, [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)]
-        )
+        planned = plan_lights(request)
     except RtiRigError as exc:
         raise _fail(exc) from None
-    for line in report.lines():
+    for line in planned.report.lines():
         out.print(line, highlight=False, markup=False)
-    out.print(f"Planned {len(schedule)} lights ({method}, {objective}) → {out_file}")
+    out.print(
+        f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
+        f"{out_file}"
+    )
     if figure is not None:
         # after the report: a map that cannot be drawn must not hide a plan that was written
-        how = f"{method}/{objective}"
         try:
-            _write_plan_figure(
-                figure,
-                schedule,
-                geometry,  # type: ignore[arg-type]
-                report,
-                how,
-                rig,
-                min_elevation_deg,
-                max_elevation_deg,
-            )
+            draw_plan_figure(request, planned)
         except RtiRigError as exc:
             raise _fail(exc) from None
         out.print(f"Map of the plan → {figure}")
-
-
-def _write_plan_figure(
-    path: Path,
-    schedule: LightSchedule,
-    geometry: DomeGeometry | ArmGeometry,
-    report: PlanReport,
-    how: str,
-    rig: Path,
-    min_elevation_deg: float = 0.0,
-    max_elevation_deg: float = 90.0,
-) -> None:
-    """Draw the plan's map (``plan --figure``); the .lp is already written, so a failure here
-    names the map file and leaves the plan in place."""
-    from rti_rig.app.plan_figure import expected_caption, layout_figure, write_layout_figure
-    from rti_rig.core.geometry import direction_from_az_el
-
-    light = report.preview_light_az_el_deg
-    caption = expected_caption(report.expected_meaning or "expected error", report.expected)
-    try:
-        fig = layout_figure(
-            [s.direction for s in schedule.steps],
-            geometry,
-            None if light is None else direction_from_az_el(*light),
-            f"{len(schedule.steps)} lights · {how} · {rig.name}",
-            [caption] if caption else [],
-            min_elevation_deg,
-            max_elevation_deg,
-        )
-        write_layout_figure(path, fig)
-    except (OSError, ValueError, RuntimeError) as exc:
-        raise RtiRigError(
-            f"--figure {path}: could not write the map ({exc}); the plan itself was written"
-        ) from None
 
 
 @app.command("export-lp")
@@ -751,12 +586,13 @@ def export_lp(
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
     """Write the .lp of a session (from the lights that actually fired)."""
+    from rti_rig.app.output_files import check_output_file
     from rti_rig.core.lp_format import write_lp
     from rti_rig.runtime.session import session_lp_entries
 
     try:
         entries = session_lp_entries(session_dir, linear=linear)
-        _check_output_file(out_file, force, {})
+        check_output_file(out_file, force, {})
         write_lp(out_file, entries)
     except RtiRigError as exc:
         raise _fail(exc) from None
@@ -821,45 +657,29 @@ def calibrate_lights(
 
     import numpy as np
 
-    from rti_rig.app.config import load_rig_config, rig_geometry
-    from rti_rig.app.light_calibration import calibrate_dome, calibration_toml, read_card_session
+    from rti_rig.app.usecases.calibrate import CalibrateRequest, calibrate_lights
 
     try:
-        normal = _parse_normal(card_normal)
-        loaded = load_rig_config(rig_config)
-        serial = loaded.config.dome.serial if loaded.config.dome else None
-        if serial is None:
-            raise RtiRigError(
-                f"{rig_config}: rig '{loaded.config.name}' has no [dome.serial]: only a serial "
-                "dome can dim its LEDs (the simulated backend's are exact)"
+        done = calibrate_lights(
+            CalibrateRequest(
+                card_session,
+                rig_config,
+                out_file,
+                _parse_normal(card_normal),
+                min_elevation_deg,
+                force,
             )
-        from rti_rig.drivers.led_dome.profiles import make_codec
-
-        if not make_codec(serial).has_level:
-            raise RtiRigError(
-                f"{rig_config}: the dome's '{serial.profile}' profile sends no PWM level "
-                "(send_level = false), so it cannot dim an LED; divide the gains out of the "
-                "images instead (rti_rig.reconstruct.apply_light_gains)"
-            )
-        geometry = rig_geometry(loaded)
-        card = read_card_session(card_session, rig_name=loaded.config.name)
-        target = out_file or card_session / "light_calibration.toml"
-        if out_file is None and target.exists():
-            raise RtiRigError(
-                f"{target} exists: this card session was calibrated already (its file is never "
-                "replaced); give --out to write the calibration elsewhere"
-            )
-        _check_output_file(target, force, {"RIG": rig_config})
-        cal = calibrate_dome(
-            card, geometry.count, card_normal=normal, min_elevation_deg=min_elevation_deg
         )
-        text = calibration_toml(cal, loaded.config.name, card_session.resolve(), geometry.names)
-        try:
-            target.write_text(text, encoding="utf-8")
-        except OSError as exc:
-            raise RtiRigError(f"cannot write {target}: {exc.strerror or exc}") from None
     except RtiRigError as exc:
         raise _fail(exc) from None
+    cal, card, loaded, geometry, target = (
+        done.calibration,
+        done.card,
+        done.loaded,
+        done.geometry,
+        done.target,
+    )
+    normal = np.asarray(_parse_normal(card_normal))
     measured = np.flatnonzero(cal.measured)
     elevation = np.degrees(np.arcsin(np.clip(geometry.directions[measured] @ normal, -1, 1)))
     lowest = float(elevation.min())

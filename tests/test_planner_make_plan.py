@@ -166,9 +166,10 @@ def test_more_lights_than_leds_is_a_clear_error() -> None:
 
 
 def test_bad_method_objective_and_floor() -> None:
-    with pytest.raises(ScheduleError, match="unknown method"):
+    known = "choose uniform, kmeans, optimal"
+    with pytest.raises(ScheduleError, match=f"--method 'random' is not known; {known}"):
         make_plan(PREVIEW, DOME, 5, "random")
-    with pytest.raises(ScheduleError, match="unknown objective"):
+    with pytest.raises(ScheduleError, match="--objective 'beauty' is not known; choose normals"):
         make_plan(PREVIEW, DOME, 5, "optimal", "beauty")
     with pytest.raises(ScheduleError, match="no reachable band"):
         make_plan(PREVIEW, ARM, 5, "optimal", min_elevation_deg=85.0)

@@ -10,7 +10,6 @@ import hashlib
 import os
 from pathlib import Path
 
-import cv2
 import numpy as np
 import tifffile
 from numpy.typing import NDArray
@@ -50,6 +49,8 @@ def write_linear_tiff(path: Path, pixels: NDArray[np.uint16]) -> str:
 
 def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> str:
     """Write an 8-bit sRGB JPEG (RGB order in, as OpenCV wants BGR on disk); returns SHA-256."""
+    import cv2  # on use: importing the controller must not load a device library
+
     img = srgb8[..., ::-1] if srgb8.ndim == 3 else srgb8
     ok, enc = cv2.imencode(".jpg", np.ascontiguousarray(img), [cv2.IMWRITE_JPEG_QUALITY, quality])
     if not ok:
@@ -62,6 +63,8 @@ def read_linear_tiff(path: Path) -> NDArray[np.uint16]:
 
 
 def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
+    import cv2
+
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {path}")

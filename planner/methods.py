@@ -1,0 +1,116 @@
+"""Planning methods: what a method is, and the registry the planner looks methods up in.
+
+A method turns the rig's usable lights (``candidates``), the homogeneous starting layouts and,
+when there is one, the estimated surface into the indices of the lights to fire. The pipeline
+around it (surface, objective, order, report) is the same for every method, so adding a method
+is one new module that defines a :class:`PlanMethod` and calls :func:`register_method` (and, for
+a built-in, its module's name in :data:`BUILTIN_MODULES`): ``--method NAME`` finds it, and the
+checks, the error's list of choices and the report follow from the registry
+(docs/extending.md).
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.core.errors import ScheduleError
+
+if TYPE_CHECKING:
+    from rti_rig.planner.objectives import Candidates, NormalsObjective, RelightObjective
+    from rti_rig.planner.plan_report import PlanReport
+    from rti_rig.planner.surface_estimate import SurfaceEstimate
+
+#: What a method needs of the object's surface:
+#: ``none`` — nothing (a preview, if given, is evaluated for the report only, and a preview that
+#: cannot be read is a note, not an error); ``flat`` — a surface, assumed level and matte (or
+#: glossy if declared) when there is no preview; ``preview`` — a surface estimated from a
+#: preview, which must be given.
+SurfaceNeed = Literal["none", "flat", "preview"]
+
+#: Modules whose import registers the built-in methods (in the order --help lists them).
+BUILTIN_MODULES = ("rti_rig.planner.builtin_methods",)
+
+
+@dataclass
+class MethodContext:
+    """What a method may use to choose lights (one planning request)."""
+
+    n: int
+    candidates: Candidates
+    #: Homogeneous layouts as (label, candidate indices), the one at the user's floor first.
+    starts: list[tuple[str, NDArray[np.intp]]]
+    surface: SurfaceEstimate
+    report: PlanReport
+    seed: int
+    material: str
+    objective: str
+    #: The elevation ceiling, and whether it cuts the rig's range above the floor.
+    max_elevation_deg: float
+    ceiling_cuts: bool
+
+
+class PlanMethod(Protocol):
+    """One way of choosing lights.
+
+    ``prepare`` runs before the objective exists (a clustering method finds its layout here and
+    may add it to ``ctx.starts`` as a starting layout); ``decide`` returns the lights, given the
+    objective, and records in ``ctx.report.expected`` the expected errors of the layouts it
+    compared. Without a surface (``surface == "none"`` and no preview) neither is called and the
+    homogeneous layout at the user's floor is planned.
+    """
+
+    name: str
+    #: One line for ``--help``.
+    summary: str
+    surface: SurfaceNeed
+    #: Why a preview is needed (the error when ``surface == "preview"`` and none was given).
+    needs_preview_reason: str
+    #: Whether the chosen lights depend on the objective (else the objective only scores them).
+    optimises_objective: bool
+
+    def prepare(self, ctx: MethodContext) -> NDArray[np.intp]: ...
+
+    def decide(
+        self,
+        ctx: MethodContext,
+        objective: NormalsObjective | RelightObjective,
+        chosen: NDArray[np.intp],
+    ) -> NDArray[np.intp]: ...
+
+
+_METHODS: dict[str, PlanMethod] = {}
+
+
+def register_method(method: PlanMethod) -> PlanMethod:
+    """Make ``method`` available by its name (``--method NAME``); a name is registered once."""
+    if method.name in _METHODS and _METHODS[method.name] is not method:
+        raise ValueError(f"a planning method named {method.name!r} is already registered")
+    _METHODS[method.name] = method
+    return method
+
+
+def _load_builtins() -> None:
+    for module in BUILTIN_MODULES:
+        importlib.import_module(module)
+
+
+def method_names() -> tuple[str, ...]:
+    """The registered methods' names, built-ins first."""
+    _load_builtins()
+    return tuple(_METHODS)
+
+
+def get_method(name: str) -> PlanMethod:
+    """The method called ``name``; an unknown name is refused with the known ones."""
+    _load_builtins()
+    try:
+        return _METHODS[name]
+    except KeyError:
+        raise ScheduleError(
+            f"--method {name!r} is not known; choose {', '.join(_METHODS)}"
+        ) from None

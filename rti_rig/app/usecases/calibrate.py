@@ -1,0 +1,96 @@
+"""Use case: measure each LED of a dome from a card session and write its intensity correction.
+
+What ``rti-rig calibrate-lights`` does, without the command line: the card session (a level
+matte white card shot under every LED with ``rti-rig run``) gives each LED's own light
+(:mod:`rti_rig.app.light_calibration`); the correction that evens the dome out is written as a
+TOML file for ``[dome.serial] intensity_correction_file``. Nothing is measured before every
+input and the output are checked, and a card session's own calibration file is never replaced.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
+from rti_rig.app.light_calibration import (
+    CardSession,
+    LightCalibration,
+    calibrate_dome,
+    calibration_toml,
+    read_card_session,
+)
+from rti_rig.app.output_files import check_output_file
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+
+
+@dataclass(frozen=True)
+class CalibrateRequest:
+    card_session: Path
+    rig_config: Path
+    #: None: CARD_SESSION/light_calibration.toml (never replaced).
+    out_file: Path | None = None
+    #: The card's unit normal (up out of the card, towards the camera).
+    card_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    min_elevation_deg: float = 5.0
+    force: bool = False
+
+    @property
+    def target(self) -> Path:
+        return self.out_file or self.card_session / "light_calibration.toml"
+
+
+@dataclass(frozen=True)
+class CalibrationWritten:
+    calibration: LightCalibration
+    card: CardSession
+    loaded: LoadedRig
+    geometry: DomeGeometry | ArmGeometry
+    target: Path
+
+
+def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
+    serial = loaded.config.dome.serial if loaded.config.dome else None
+    if serial is None:
+        raise RtiRigError(
+            f"{req.rig_config}: rig '{loaded.config.name}' has no [dome.serial]: only a serial "
+            "dome can dim its LEDs (the simulated backend's are exact)"
+        )
+    from rti_rig.drivers.led_dome.profiles import make_codec
+
+    if not make_codec(serial).has_level:
+        raise RtiRigError(
+            f"{req.rig_config}: the dome's '{serial.profile}' profile sends no PWM level "
+            "(send_level = false), so it cannot dim an LED; divide the gains out of the "
+            "images instead (rti_rig.reconstruct.apply_light_gains)"
+        )
+
+
+def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
+    """Check, measure, and write the calibration file; returns what was measured."""
+    loaded = load_rig_config(req.rig_config)
+    _check_dome_can_dim(req, loaded)
+    geometry = rig_geometry(loaded)
+    card = read_card_session(req.card_session, rig_name=loaded.config.name)
+    target = req.target
+    if req.out_file is None and target.exists():
+        raise RtiRigError(
+            f"{target} exists: this card session was calibrated already (its file is never "
+            "replaced); give --out to write the calibration elsewhere"
+        )
+    check_output_file(target, req.force, {"RIG": req.rig_config})
+    cal = calibrate_dome(
+        card,
+        geometry.count,
+        card_normal=req.card_normal,
+        min_elevation_deg=req.min_elevation_deg,
+    )
+    text = calibration_toml(
+        cal, loaded.config.name, req.card_session.resolve(), geometry.names
+    )
+    try:
+        target.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise RtiRigError(f"cannot write {target}: {exc.strerror or exc}") from None
+    return CalibrationWritten(cal, card, loaded, geometry, target)

@@ -1,0 +1,210 @@
+"""Use case: plan an ordered set of lights for a rig and write it as an ``.lp`` file.
+
+What ``rti-rig plan`` does, as a Python function that needs no command line:
+:func:`plan_lights` checks the request (every check before any file is read), reads the rig and
+the preview, plans (:func:`rti_rig.planner.make_plan.plan`) and writes the plan;
+:func:`draw_plan_figure` then draws its map. The rig is a rig config TOML, or a bare ``.lp``
+meaning "a dome with exactly these lights".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, PlanRequest, check_plan_options, plan
+from rti_rig.planner.plan_report import PlanReport
+
+from rti_rig.app.compose import arm_order_for, read_preview_image
+from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
+from rti_rig.app.output_files import check_output_file
+from rti_rig.app.preview_source import resolve_preview
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.geometry import direction_from_az_el
+from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
+from rti_rig.core.schedule import LightSchedule
+from rti_rig.runtime.session import image_names
+
+
+@dataclass(frozen=True)
+class PlanLightsRequest:
+    """What to plan, for which rig, and where to write it (the options of ``rti-rig plan``)."""
+
+    rig: Path
+    out_file: Path = Path("plan.lp")
+    lights: int = 12
+    #: A preview image or the session folder ``rti-rig preview`` wrote (None: plan without one).
+    preview: Path | None = None
+    #: None: ``optimal`` with a preview, ``uniform`` without.
+    method: str | None = None
+    objective: str | None = None
+    #: (azimuth, elevation) in degrees; None: recorded with the preview, or estimated.
+    preview_light: tuple[float, float] | None = None
+    depth_model: Path | None = None
+    min_elevation_deg: float = 0.0
+    max_elevation_deg: float = 90.0
+    #: None: the rig config's ``[camera] signal_noise`` (0 for a bare ``.lp``).
+    signal_noise: float | None = None
+    material: str = "auto"
+    figure: Path | None = None
+    force: bool = False
+
+    @property
+    def method_or_default(self) -> str:
+        return self.method or ("optimal" if self.preview is not None else "uniform")
+
+    @property
+    def objective_or_default(self) -> str:
+        return self.objective or DEFAULT_OBJECTIVE
+
+
+@dataclass(frozen=True)
+class PlannedLights:
+    """A written plan and the evidence behind it."""
+
+    schedule: LightSchedule
+    report: PlanReport
+    geometry: DomeGeometry | ArmGeometry
+    out_file: Path
+    method: str
+    objective: str
+
+
+def _bare_lp_dome(rig: Path) -> tuple[DomeGeometry, list[LpEntry]]:
+    """A bare ``.lp`` as a rig: a dome with exactly these lights, each listed once."""
+    entries = read_lp(rig, upper_hemisphere=True)
+    pair = coincident_leds([e.direction for e in entries])
+    if pair is not None:
+        i, j = pair
+        raise RtiRigError(
+            f"{rig}: lights {i + 1} ({entries[i].name}) and {j + 1} "
+            f"({entries[j].name}) give the same direction; as --rig, an .lp means a "
+            "dome with exactly these lights, each listed once (remove the repeats)"
+        )
+    return DomeGeometry([e.direction for e in entries], tuple(e.name for e in entries)), entries
+
+
+def _signal_noise(req: PlanLightsRequest, loaded: LoadedRig | None, objective: str) -> float:
+    """The signal noise to plan for: the request's, else the rig config's camera's."""
+    if req.signal_noise is not None:
+        return req.signal_noise
+    if loaded is None or loaded.config.camera.signal_noise <= 0:
+        return 0.0
+    noise = loaded.config.camera.signal_noise
+    if objective != "normals":
+        raise RtiRigError(
+            f"{req.rig}: [camera] signal_noise = {noise:g} is modelled by the normals objective "
+            f"only; give --signal-noise 0 to plan for --objective {objective}"
+        )
+    return noise
+
+
+def _check_outputs(req: PlanLightsRequest, loaded: LoadedRig | None) -> None:
+    inputs: dict[str, Path | None] = {
+        "preview": req.preview,
+        "rig file": req.rig,
+        "depth model": req.depth_model,
+    }
+    if loaded is not None and loaded.config.dome is not None and loaded.config.dome.lp_file:
+        # the dome's LED calibration is an input too
+        inputs["rig's LED calibration (lp_file)"] = loaded.folder / loaded.config.dome.lp_file
+    check_output_file(req.out_file, req.force, inputs)
+    if req.figure is not None:
+        from rti_rig.app.plan_figure import check_figure_path  # matplotlib only when asked
+
+        check_figure_path(req.figure)
+        check_output_file(req.figure, req.force, inputs, "--figure")
+        if req.figure.resolve() == req.out_file.resolve():
+            raise RtiRigError(f"--figure {req.figure} is the --out plan file; choose another")
+
+
+def plan_lights(req: PlanLightsRequest) -> PlannedLights:
+    """Check, plan and write ``req.out_file``; nothing is read before the options are checked."""
+    method, objective = req.method_or_default, req.objective_or_default
+    check_plan_options(
+        method=method,
+        objective=objective,
+        n=req.lights,
+        has_preview=req.preview is not None,
+        preview_light=req.preview_light,
+        depth_model=req.depth_model,
+        min_elevation_deg=req.min_elevation_deg,
+        max_elevation_deg=req.max_elevation_deg,
+        signal_noise=req.signal_noise or 0.0,
+        material=req.material,
+    )
+    bare_lp = req.rig.suffix.lower() == ".lp"
+    loaded = None if bare_lp else load_rig_config(req.rig)
+    _check_outputs(req, loaded)
+    arm_order = None
+    entries: list[LpEntry] = []
+    geometry: DomeGeometry | ArmGeometry
+    if loaded is None:
+        geometry, entries = _bare_lp_dome(req.rig)
+    else:
+        geometry = rig_geometry(loaded)
+        arm_order = arm_order_for(loaded)
+    signal_noise = _signal_noise(req, loaded, objective)
+    az_el, light_note, image = req.preview_light, None, None
+    if req.preview is not None:
+        rig_lp = (req.rig, entries) if loaded is None else None
+        source = resolve_preview(req.preview, rig_lp, az_el is not None)
+        if az_el is None and source.light_az_el_deg is not None:
+            az_el, light_note = source.light_az_el_deg, source.light_source
+        image = read_preview_image(source.image)
+    schedule, report = plan(
+        PlanRequest(
+            image,
+            geometry,
+            req.lights,
+            method,
+            objective,
+            preview_light=az_el,
+            depth_model=req.depth_model,
+            min_elevation_deg=req.min_elevation_deg,
+            max_elevation_deg=req.max_elevation_deg,
+            signal_noise=signal_noise,
+            material=req.material,
+            arm_order=arm_order,
+        )
+    )
+    if light_note and report.preview_light_source == "given":
+        report.preview_light_source = light_note
+    if bare_lp:
+        names = [s.label for s in schedule.steps]
+    else:
+        names = [f"{n}.jpg" for n in image_names(len(schedule))]
+    write_lp(
+        req.out_file,
+        [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
+    )
+    return PlannedLights(schedule, report, geometry, req.out_file, method, objective)
+
+
+def draw_plan_figure(req: PlanLightsRequest, planned: PlannedLights) -> Path:
+    """Draw the plan's map to ``req.figure``; the .lp is already written, so a failure here
+    names the map file and leaves the plan in place."""
+    from rti_rig.app.plan_figure import expected_caption, layout_figure, write_layout_figure
+
+    assert req.figure is not None
+    report = planned.report
+    light = report.preview_light_az_el_deg
+    caption = expected_caption(report.expected_meaning or "expected error", report.expected)
+    how = f"{planned.method}/{planned.objective}"
+    try:
+        fig = layout_figure(
+            [s.direction for s in planned.schedule.steps],
+            planned.geometry,
+            None if light is None else direction_from_az_el(*light),
+            f"{len(planned.schedule.steps)} lights · {how} · {req.rig.name}",
+            [caption] if caption else [],
+            req.min_elevation_deg,
+            req.max_elevation_deg,
+        )
+        write_layout_figure(req.figure, fig)
+    except (OSError, ValueError, RuntimeError) as exc:
+        raise RtiRigError(
+            f"--figure {req.figure}: could not write the map ({exc}); the plan itself was written"
+        ) from None
+    return req.figure
