@@ -47,11 +47,17 @@ def lint_imports(tree: Path, config: Path) -> subprocess.CompletedProcess[str]:
 def test_every_mapped_package_is_listed_for_installation():
     setup = tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))["tool"]["setuptools"]
     listed = set(setup["packages"])
-    on_disk = set()
+    on_disk, no_init = set(), set()
     for package, folder in setup["package-dir"].items():
-        for init in (REPO / folder).rglob("__init__.py"):
-            rel = init.parent.relative_to(REPO / folder)
-            on_disk.add(".".join([package, *rel.parts]))
+        for module in (REPO / folder).rglob("*.py"):
+            if "__pycache__" in module.parts:
+                continue
+            rel = module.parent.relative_to(REPO / folder)
+            name = ".".join([package, *rel.parts])
+            on_disk.add(name)
+            if not (module.parent / "__init__.py").is_file():
+                no_init.add(name)  # a namespace folder: `pip install .` would leave it out
+    assert no_init == set(), "give these folders an __init__.py"
     # a sub-package mapped by a parent's folder (rti_rig/core under rti_rig) counts once
     assert on_disk - listed == set(), "add these to [tool.setuptools] packages"
 
