@@ -67,6 +67,7 @@ class KMeansMethod:
     def prepare(self, ctx: MethodContext) -> NDArray[np.intp]:
         # the paper clusters the depth gradient's normals as they come: no shrinkage
         surface, report = ctx.surface, ctx.report
+        assert surface is not None  # surface = "preview": the request's check saw to it
         raw = surface.fitted_normals if surface.fitted_normals is not None else surface.normals
         chosen, km = plan_kmeans(raw, ctx.n, ctx.candidates, ctx.seed)
         report.kmeans_distinct_normals = km.distinct_normals

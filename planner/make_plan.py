@@ -357,24 +357,23 @@ def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanRepo
         "objective": req.objective,
     }
 
-    chosen = starts[0][1]
     surface = _surface_for(req, method, report)
+    ctx = MethodContext(
+        n,
+        candidates,
+        starts,
+        surface,
+        report,
+        req.seed,
+        req.material,
+        req.objective,
+        req.max_elevation_deg,
+        cut,
+    )
+    chosen = method.prepare(ctx)
     if surface is not None:
         held_out = _held_out_lights(candidates, relit_band, cut)
         sample = sample_surface(surface, candidates, held_out, seed=req.seed, material=req.material)
-        ctx = MethodContext(
-            n,
-            candidates,
-            starts,
-            surface,
-            report,
-            req.seed,
-            req.material,
-            req.objective,
-            req.max_elevation_deg,
-            cut,
-        )
-        chosen = method.prepare(ctx)
         obj = make_objective(req.objective, sample, candidates, n, starts[0][1], req.signal_noise)
         report.signal_noise = req.signal_noise
         _note_assumptions(report, method, req)

@@ -44,7 +44,8 @@ class MethodContext:
     candidates: Candidates
     #: Homogeneous layouts as (label, candidate indices), the one at the user's floor first.
     starts: list[tuple[str, NDArray[np.intp]]]
-    surface: SurfaceEstimate
+    #: None when the method needs none and no preview was given.
+    surface: SurfaceEstimate | None
     report: PlanReport
     seed: int
     material: str
@@ -57,11 +58,12 @@ class MethodContext:
 class PlanMethod(Protocol):
     """One way of choosing lights.
 
-    ``prepare`` runs before the objective exists (a clustering method finds its layout here and
-    may add it to ``ctx.starts`` as a starting layout); ``decide`` returns the lights, given the
+    ``prepare`` picks the lights before any objective exists (a clustering method finds its
+    layout here and may add it to ``ctx.starts`` as a starting layout); it is always called.
+    When there is a surface to score against, ``decide`` then returns the lights, given the
     objective, and records in ``ctx.report.expected`` the expected errors of the layouts it
-    compared. Without a surface (``surface == "none"`` and no preview) neither is called and the
-    homogeneous layout at the user's floor is planned.
+    compared; without one (``surface == "none"`` and no preview) ``prepare``'s lights are
+    planned as they are.
     """
 
     name: str

@@ -12,9 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, PlanRequest, check_plan_options, plan
-from rti_rig.planner.plan_report import PlanReport
-
 from rti_rig.app.compose import arm_order_for, read_preview_image
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
 from rti_rig.app.output_files import check_output_file
@@ -24,6 +21,8 @@ from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
+from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, PlanRequest, check_plan_options, plan
+from rti_rig.planner.plan_report import PlanReport
 from rti_rig.runtime.session import image_names
 
 
