@@ -30,7 +30,7 @@ oracle)"): near-bounds for any planner of that objective on this object, and tog
 show how far the two objectives pull apart here.
 
 Run: ``python -m benchmarks.planner_real_data`` (reads ../shared/data/neuralrti-example beside
-the repository; writes the results section of docs/planner.md).
+the repository; writes the results section of docs/research/planner.md).
 """
 
 from __future__ import annotations
