@@ -55,7 +55,7 @@ from rti_rig.reconstruct import ReconstructionError, fit_hsh, fit_photometric_st
 
 #: The real acquisition, in the shared folder beside the repository (not needed by tests).
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "neuralrti-example"
-DOC = Path(__file__).resolve().parent.parent / "docs" / "planner.md"
+DOC = Path(__file__).resolve().parent.parent / "docs" / "research" / "planner.md"
 NS = (6, 9, 12, 18)
 FLOORS = (0.0, 10.0, 20.0, 30.0, 40.0)
 #: Orientations of the homogeneous layout tried (azimuth offsets, degrees): each is an equally
