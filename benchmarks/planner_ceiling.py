@@ -16,9 +16,9 @@ run; :data:`SENSITIVITY` gives the planner at 50° and 70° too, to show how muc
 The bar is the homogeneous layout with its floor tuned with hindsight, as everywhere.
 
 Run: ``python -m benchmarks.planner_ceiling`` (``sim`` or ``real`` for one part: 18 and 20
-minutes when run side by side on 2 cores; each writes its section of docs/planner.md).
+minutes when run side by side on 2 cores; each writes its section of docs/research/planner.md).
 ``--seed K`` (K ≠ 0) draws fresh subsets and only prints its tables: the checks of the
-committed ones that docs/planner.md quotes. The real part needs
+committed ones that docs/research/planner.md quotes. The real part needs
 ``../shared/data/neuralrti-example``.
 """
 
@@ -260,10 +260,10 @@ def parts_arg(text: str) -> tuple[str, ...]:
 
 
 def main(parts: Sequence[str] = ("sim", "real"), seed: int = SEED) -> str:
-    """Run the parts asked for; each writes its own section of docs/planner.md, so the two can
-    run at the same time (``python -m benchmarks.planner_ceiling sim`` / ``real``). With another
-    ``seed`` than :data:`SEED` the draws are fresh and the tables are printed, not written: the
-    docs quote such runs as checks of the committed tables."""
+    """Run the parts asked for; each writes its own section of docs/research/planner.md, so the
+    two can run at the same time (``python -m benchmarks.planner_ceiling sim`` / ``real``). With
+    another ``seed`` than :data:`SEED` the draws are fresh and the tables are printed, not
+    written: the docs quote such runs as checks of the committed tables."""
     head = (
         f"Ceiling {CEILING:g}° (set before any run), {SENSITIVITY[0]:g}° and {SENSITIVITY[1]:g}° "
         "for the planner's sensitivity. Cells: mean normal error (°) of the first strategy → "

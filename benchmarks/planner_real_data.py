@@ -30,7 +30,7 @@ oracle)"): near-bounds for any planner of that objective on this object, and tog
 show how far the two objectives pull apart here.
 
 Run: ``python -m benchmarks.planner_real_data`` (reads ../shared/data/neuralrti-example beside
-the repository; writes the results section of docs/planner.md).
+the repository; writes the results section of docs/research/planner.md).
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ from rti_rig.reconstruct import ReconstructionError, fit_hsh, fit_photometric_st
 
 #: The real acquisition, in the shared folder beside the repository (not needed by tests).
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "neuralrti-example"
-DOC = Path(__file__).resolve().parent.parent / "docs" / "planner.md"
+DOC = Path(__file__).resolve().parent.parent / "docs" / "research" / "planner.md"
 NS = (6, 9, 12, 18)
 FLOORS = (0.0, 10.0, 20.0, 30.0, 40.0)
 #: Orientations of the homogeneous layout tried (azimuth offsets, degrees): each is an equally

@@ -26,7 +26,8 @@ same draw, and how sure that is (:mod:`benchmarks.paired`: the mean paired diffe
 95 % bootstrap interval and the sign test).
 
 Run: ``python -m benchmarks.planner_real_draws [DRAWS] [SEED]`` (reads
-../shared/data/neuralrti-example beside the repository; writes its section of docs/planner.md).
+../shared/data/neuralrti-example beside the repository; writes its section of
+docs/research/planner.md).
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ truth can do); the planner told the object is glossy (``--material glossy``); an
 ``relight`` objective, the relighting PSNR of the homogeneous layout (floor tuned on PSNR), the
 ``normals`` plan and the ``relight`` plan.
 
-Run: ``python -m benchmarks.planner_sim_draws`` (writes its section of docs/planner.md).
+Run: ``python -m benchmarks.planner_sim_draws`` (writes its section of docs/research/planner.md).
 """
 
 from __future__ import annotations

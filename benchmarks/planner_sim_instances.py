@@ -10,7 +10,7 @@ preview — on other instances (:data:`INSTANCES`, the scene and camera-noise se
 scene. The homogeneous floor is tuned per scene and instance, with hindsight, as there.
 
 Run: ``python -m benchmarks.planner_sim_instances`` (about 10 minutes; writes its section of
-docs/planner.md).
+docs/research/planner.md).
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ The draw design, the strategies' planning and the scoring are ``benchmarks.plann
 the preview only, so both camera variants score the same plans. The homogeneous floor is tuned
 with hindsight per scene and variant.
 
-Run: ``python -m benchmarks.planner_sim_jpeg`` (writes its section of docs/planner.md).
+Run: ``python -m benchmarks.planner_sim_jpeg`` (writes its section of docs/research/planner.md).
 """
 
 from __future__ import annotations

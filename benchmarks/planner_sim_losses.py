@@ -20,7 +20,7 @@ on non-Lambertian reflectance: :class:`rti_rig.planner.objectives.NormalsObjecti
 term made it choose what it chose. Errors are mean angles (°) over every pixel, robust
 photometric stereo against the true normals (``benchmarks.tradeoff.normal_error``).
 
-Run: ``python -m benchmarks.planner_sim_losses`` (writes its section of docs/planner.md).
+Run: ``python -m benchmarks.planner_sim_losses`` (writes its section of docs/research/planner.md).
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ every layout is scored again on a second shot of the same lights with fresh sens
 greedy search from one start.
 
 Run: ``python -m benchmarks.planner_sim_oracle`` (53 minutes in the committed run, sharing 2
-cores with two other benchmarks; writes its section of docs/planner.md).
+cores with two other benchmarks; writes its section of docs/research/planner.md).
 """
 
 from __future__ import annotations

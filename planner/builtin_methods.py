@@ -140,7 +140,7 @@ class OptimalMethod:
             glossy = "" if ctx.material == "glossy" else "; for gilding, --material glossy helped"
             report.notes.append(
                 f"from {MANY_LIGHTS} lights the planner gained little over an even layout in "
-                "the tests (docs/planner.md): for brushed metal at 20 lights or more, "
+                "the tests (docs/research/planner.md): for brushed metal at 20 lights or more, "
                 f"--method uniform --min-elevation-deg 10 did better{glossy}"
             )
         return res.chosen

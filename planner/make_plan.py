@@ -14,7 +14,7 @@ Pipeline (each step a pure function in its own module):
    from the park pose).
 
 The evidence behind a plan is a :class:`rti_rig.planner.plan_report.PlanReport`. The default
-objective is ``normals``: see docs/planner.md for the real-dome evidence behind it.
+objective is ``normals``: see docs/research/planner.md for the real-dome evidence behind it.
 """
 
 from __future__ import annotations
@@ -61,7 +61,7 @@ from rti_rig.core.schedule import LightSchedule
 
 __all__ = ["MANY_LIGHTS", "PlanRequest", "make_plan", "plan", "plan_with_report"]
 
-#: The objective used when none is asked for (evidence in docs/planner.md).
+#: The objective used when none is asked for (evidence in docs/research/planner.md).
 DEFAULT_OBJECTIVE = "normals"
 
 #: Extra elevation floors tried for the homogeneous starting layouts of ``optimal``.
@@ -166,13 +166,13 @@ class PlanRequest:
     :attr:`~rti_rig.planner.methods.PlanMethod.surface` is not ``"preview"``.
 
     ``max_elevation_deg``: no light above this elevation (90 = none excluded): lights near
-    the camera axis put mirror highlights on a level glossy object (docs/planner.md, "An
+    the camera axis put mirror highlights on a level glossy object (docs/research/planner.md, "An
     elevation ceiling").
 
     ``material``: what the user knows of the surface (:data:`rti_rig.planner.objectives.MATERIALS`):
     ``auto`` (default) reads highlights from the preview, ``matte`` models none, ``glossy``
     (polished metal, gilding, varnish) models a strong, broad highlight lobe even when the
-    preview does not show one — on a flat glossy object it never does (docs/planner.md).
+    preview does not show one — on a flat glossy object it never does (docs/research/planner.md).
 
     ``signal_noise``: image noise proportional to the signal, relative to it (0.05 = 5 %), for
     the ``normals`` objective — an uncalibrated dome's LED spread and 8-bit JPEG captures
@@ -448,7 +448,7 @@ def _surface_for(
         kind = "glossy" if material == "glossy" else "matte"
         report.notes.append(
             f"no preview: planned for a level, {kind} surface (the model alone; on the "
-            "benchmarks in docs/planner.md this did as well as planning from a preview)"
+            "benchmarks in docs/research/planner.md this did as well as planning from a preview)"
         )
     elif preview is not None:
         try:
@@ -530,8 +530,8 @@ def _note_assumptions(report: PlanReport, method: PlanMethod, req: PlanRequest) 
         report.notes.append(f"declared {material}: {what}, whatever the preview shows{unused}")
     if req.objective == "relight" and method.optimises_objective:
         report.notes.append(
-            "evidence: on the real dome of docs/planner.md the normals objective's layouts "
-            "relit better than this objective's at 6, 9, 12 and 18 lights (mean PSNR over "
+            "evidence: on the real dome of docs/research/planner.md the normals objective's "
+            "layouts relit better than this objective's at 6, 9, 12 and 18 lights (mean PSNR over "
             "144 draws; median over 8 previews with --material glossy too); for "
             "relighting, --objective normals is the tested choice"
         )

@@ -53,7 +53,7 @@ def sanitize_height(height: NDArray, source: str = "relief") -> tuple[NDArray[np
 
 
 def height_gradients(height: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
-    """Slopes (dh/dx, dh/dy) in the frame of DESIGN.md (y up, so the row derivative flips)."""
+    """Slopes (dh/dx, dh/dy) in the frame of docs/conventions.md (y up: row derivative flips)."""
     if height.shape[0] < 2 or height.shape[1] < 2:
         return np.zeros_like(height), np.zeros_like(height)
     d_row, d_col = np.gradient(height)

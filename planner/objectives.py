@@ -50,14 +50,14 @@ BIAS_REL = 0.05
 #: whose steps in linear units grow with brightness. Observation k of a pixel then has variance
 #: ``σ² + (signal_noise · ρ n·l_k)²``: a light striking the surface head-on is worth less than
 #: the additive model says, and the planner takes more oblique lights. This value was chosen
-#: among 2, 5 and 10 % on the real dome's paired draws (docs/planner.md), not derived.
+#: among 2, 5 and 10 % on the real dome's paired draws (docs/research/planner.md), not derived.
 SIGNAL_NOISE_JPEG_DOME = 0.05
 
 #: What the user may declare about the object's surface (``material`` of the planner):
 #: ``auto`` reads the highlight strength from the preview's bright outliers (the default),
 #: ``matte`` models no highlight, ``glossy`` models a strong, broad one whatever the preview
 #: shows. One preview of a flat glossy object does not show its gloss (the gilded icon of
-#: docs/planner.md reads ≈ 0), but its owner knows it.
+#: docs/research/planner.md reads ≈ 0), but its owner knows it.
 MATERIALS: tuple[str, ...] = ("auto", "matte", "glossy")
 
 #: Highlight lobe widths (degrees between the half vector and the normal) the preview's hint
@@ -68,7 +68,7 @@ HIGHLIGHT_MODEL_WIDTH_DEG = 10.0
 
 #: A declared glossy surface: the hint's ceiling strength on a 30° lobe. Chosen between 0.5 on
 #: 25° and 0.8 on 30° on the simulator's polished coin and an ad hoc run of the real gilded
-#: dome's paired draws, where both lowered the normal error at every N (docs/planner.md).
+#: dome's paired draws, where both lowered the normal error at every N (docs/research/planner.md).
 GLOSSY_SPECULAR = 0.8
 GLOSSY_WIDTH_DEG = 30.0
 

@@ -11,7 +11,7 @@ unused candidate that lowers the cost most (if any does), until a sweep changes 
 Because the starting set includes the homogeneous layout the user would otherwise get and only
 improving swaps are accepted, the result is never worse than that layout *on the objective
 being optimised* — which is a statement about the model, not about the real surface; the
-real-data benchmark (docs/planner.md) is where that is checked.
+real-data benchmark (docs/research/planner.md) is where that is checked.
 """
 
 from __future__ import annotations

@@ -70,7 +70,7 @@ class PlanReport:
                 f"noise modelled: {100 * self.signal_noise:g} % of the signal on top of the "
                 "additive noise (in the tests it cost accuracy on a steeply tilted flat object, "
                 "and on brushed steel from 12 lights: give --signal-noise 0 for such objects; "
-                "docs/planner.md)"
+                "docs/research/planner.md)"
             )
         if self.expected and self.expected_meaning:
             parts = ", ".join(f"{k} {v:#.4g}" for k, v in self.expected.items())

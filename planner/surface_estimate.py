@@ -6,7 +6,8 @@ can be estimated, inspected and tested on its own (the tests and the benchmarks 
 
 1. :func:`rti_rig.planner.topography.planning_image` — downsample early, linearise, reduce to
 luminance;
-2. the preview's light: ``preview_light`` (azimuth, elevation in degrees, frame of DESIGN.md) or
+2. the preview's light: ``preview_light`` (azimuth, elevation in degrees, frame of
+   docs/conventions.md) or
    :func:`rti_rig.planner.topography.estimate_light`;
 3. a relief: the user's ONNX depth model (:func:`rti_rig.planner.topography.depth_from_onnx`) or the
    weight-free :func:`rti_rig.planner.topography.shape_from_shading` — or, with no preview at all, a
@@ -118,7 +119,7 @@ def estimate_surface(
         source = "shape from shading"
     fit = fit_relief_scale(height, image, light)
     # shrink the relief by the share of the preview it explains: a preview that is mostly
-    # albedo (a painting) must not be read as steep relief (see docs/planner.md)
+    # albedo (a painting) must not be read as steep relief (see docs/research/planner.md)
     relief = fit.scale * relief_trust(fit) * height
     return SurfaceEstimate(
         image,
@@ -142,7 +143,8 @@ def flat_surface() -> SurfaceEstimate:
 
     The model alone (shadows of the tilt hedge, noise propagation, the reflectance prior) then
     chooses the lights. On the real dome and on the simulator's scenes this did as well as
-    planning from a preview (docs/planner.md), so a preview shot is optional for ``optimal``.
+    planning from a preview (docs/research/planner.md), so a preview shot is optional for
+    ``optimal``.
     It is exactly what a uniform grey preview yields (tested, down to 1×1): no relief, no
     highlight hint.
     """

@@ -16,11 +16,11 @@ Three routes lead from a preview photo to a relief (a height field up to an unkn
 
 Assumptions about the preview (what :func:`linear_luminance` converts): ``uint8`` is sRGB and is
 linearised with the sRGB transfer curve; ``uint16`` and floating point are already linear
-(RAW decoded with gamma 1, DESIGN.md "Linear data"); ``uint16`` is scaled by 65535 and floats are
-used as they are. Colour is reduced to Rec. 709 luminance. Everything downstream works on a
-preview downsampled early to at most :data:`PLANNING_SIDE_PX` pixels on its long side: planning
-needs the distribution of normals, not their detail, and a 24-megapixel preview would otherwise
-cost seconds.
+(RAW decoded with gamma 1, docs/conventions.md "Linear data"); ``uint16`` is scaled by 65535
+and floats are used as they are. Colour is reduced to Rec. 709 luminance. Everything downstream
+works on a preview downsampled early to at most :data:`PLANNING_SIDE_PX` pixels on its long
+side: planning needs the distribution of normals, not their detail, and a 24-megapixel preview
+would otherwise cost seconds.
 """
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ def read_preview(path: Path) -> NDArray:
     """The preview image file as an array in RGB order, keeping its type (the CLI's edge).
 
     8-bit files (JPEG, PNG) are taken as sRGB; 16-bit files (TIFF, PNG) as linear data, which
-    is what ``rti-rig run`` writes for fitting (DESIGN.md "Linear data").
+    is what ``rti-rig run`` writes for fitting (docs/conventions.md "Linear data").
     """
     p = Path(path)
     if p.is_dir():
@@ -141,7 +141,8 @@ def estimate_light(image: NDArray[np.float64]) -> LightEstimate:
 
     With mean ``mu1`` and mean square ``mu2`` of the shading, ``g = sqrt(6 pi^2 mu2 - 48 mu1^2)``,
     albedo ``g / pi``, slant ``arccos(4 mu1 / g)``; the tilt is the direction of the mean unit
-    image gradient (in the frame of DESIGN.md: rows run down, so the row derivative flips sign).
+    image gradient (in the frame of docs/conventions.md: rows run down, so the row derivative
+    flips sign).
     Degenerate images (constant, black) give the zenith: the least committal answer.
     """
     e = image / max(float(image.max()), 1e-12)
@@ -168,7 +169,7 @@ def estimate_light(image: NDArray[np.float64]) -> LightEstimate:
 
 
 def given_light(az_el_deg: tuple[float, float]) -> NDArray[np.float64]:
-    """Direction of ``--preview-light AZ,EL`` (degrees, frame of DESIGN.md), validated."""
+    """Direction of ``--preview-light AZ,EL`` (degrees, frame of docs/conventions.md), validated."""
     az, el = (float(v) for v in az_el_deg)
     if not (np.isfinite(az) and np.isfinite(el)) or not 0.0 < el <= 90.0:
         raise ScheduleError(

@@ -491,7 +491,7 @@ def plan(
             help="Highest elevation allowed (degrees; 90 = up to the zenith). Lights near the "
             "camera axis put mirror highlights on a level glossy object: 60 helped on gilding, "
             "varnish and polished metal in the tests and cost on brushed steel at 20-30 lights "
-            "and on a steeply tilted object (docs/planner.md).",
+            "and on a steeply tilted object (docs/research/planner.md).",
         ),
     ] = 90.0,
     signal_noise: Annotated[
@@ -500,7 +500,7 @@ def plan(
             "--signal-noise",
             help="Image noise proportional to the signal, as a fraction (normals objective): "
             "0.05 models 8-bit JPEG captures on a dome without LED intensity calibration "
-            "(docs/planner.md); 0 models additive noise only. Default: the rig config's "
+            "(docs/research/planner.md); 0 models additive noise only. Default: the rig config's "
             "[camera] signal_noise (0 if absent, and for a bare .lp).",
         ),
     ] = None,
@@ -510,7 +510,7 @@ def plan(
             "--material",
             help="What you know of the surface: auto (highlights read from the preview; "
             "default), matte, or glossy (polished metal, gilding, varnish: one preview of a "
-            "flat glossy object does not show its gloss; docs/planner.md).",
+            "flat glossy object does not show its gloss; docs/research/planner.md).",
         ),
     ] = "auto",
     out_file: Annotated[Path, typer.Option("--out", help="Plan file to write (.lp).")] = Path(
@@ -531,8 +531,8 @@ def plan(
     """Plan an ordered set of lights from one preview shot and write it as an .lp file.
 
     Without PREVIEW: `uniform` (the default then) or `optimal`, which plans for a level surface,
-    matte unless `--material glossy` (on the benchmarks in docs/planner.md it did as well as
-    with a preview).
+    matte unless `--material glossy` (on the benchmarks in docs/research/planner.md it did as
+    well as with a preview).
 
     The plan's lights are the rig's own (a dome's LEDs, used once each; an arm's reachable
     directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.
@@ -778,7 +778,7 @@ app.add_typer(bench_app, name="bench")
 def bench_tradeoff(
     out_dir: Annotated[
         Path, typer.Option("--out", help="Folder for results.csv, the plots and summary.md.")
-    ] = Path("docs/tradeoff"),
+    ] = Path("docs/research/tradeoff"),
     quick: Annotated[
         bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
     ] = False,

@@ -56,8 +56,9 @@ class DirectionalLight:
 
 @dataclass(frozen=True)
 class PointLight:
-    """An isotropic lamp at ``position_mm`` (frame of DESIGN.md, origin at the image centre on
-    the zero-height plane); ``power`` is its radiant intensity in W/sr, so E = power / r[m]²."""
+    """An isotropic lamp at ``position_mm`` (frame of docs/conventions.md, origin at the image
+    centre on the zero-height plane); ``power`` is its radiant intensity in W/sr, so
+    E = power / r[m]²."""
 
     position_mm: tuple[float, float, float]
     power: float = 1.0

@@ -6,7 +6,8 @@ stresses something different — fine relief under grazing light (painting, tabl
 highlights on metal (coin, industrial), normals far from the camera axis (tilted), and the
 degenerate flat plate on which every method must be perfect.
 
-Conventions (DESIGN.md): frame x right, y **up** (towards image row 0), z towards the camera.
+Conventions (docs/conventions.md): frame x right, y **up** (towards image row 0), z towards the
+camera.
 ``height`` is in *pixel units* (unit pixel pitch), so normals follow from finite differences:
 ``n ∝ (-∂h/∂x, -∂h/∂y, 1)`` with ``∂/∂y = -∂/∂row``. Depth from the camera is ``-height``.
 Shapes are defined in coordinates normalised by the image size and heights scale with it, so
@@ -50,7 +51,7 @@ class Scene:
     name: str
     seed: int
     height: NDArray[np.float64]  # (H, W) pixel units, larger = nearer the camera
-    normals: NDArray[np.float64]  # (H, W, 3) unit, frame of DESIGN.md
+    normals: NDArray[np.float64]  # (H, W, 3) unit, frame of docs/conventions.md
     albedo: NDArray[np.float64]  # (H, W, 3) linear diffuse albedo in [0, 1]
     specular_albedo: NDArray[np.float64]  # (H, W, 3) Fresnel F0 of the GGX lobe, [0, 1]
     roughness: NDArray[np.float64]  # (H, W) GGX roughness r in (0, 1]; alpha = r²

@@ -54,7 +54,7 @@ def directional_visibility(
 ) -> NDArray[np.float32]:
     """Visibility (1 lit, 0 in cast shadow) of each pixel from a directional light.
 
-    ``direction`` is the unit vector towards the light in the frame of DESIGN.md (x right,
+    ``direction`` is the unit vector towards the light in the frame of docs/conventions.md (x right,
     y up, z to camera). A light at the zenith casts no shadow; a light below the horizon still
     reaches slopes that face it unless something is in the way.
     """

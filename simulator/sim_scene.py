@@ -17,7 +17,7 @@ from rti_rig.simulator.scenes import normals_from_height
 
 @dataclass(frozen=True, eq=False)
 class HeightFieldScene:
-    """Ground truth of a scene: height in pixel units, unit normals (frame of DESIGN.md), albedo."""
+    """Ground truth: height in pixel units, unit normals (frame: docs/conventions.md), albedo."""
 
     name: str
     height: NDArray[np.float64]

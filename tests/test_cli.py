@@ -35,7 +35,7 @@ def readme_run_args() -> list[str]:
 
 
 def brightest_azimuth_deg(lum: np.ndarray) -> float:
-    """Azimuth (frame of DESIGN.md) of the centroid of the brightest 2 % of pixels."""
+    """Azimuth (frame of docs/conventions.md) of the centroid of the brightest 2 % of pixels."""
     h, w = lum.shape
     top = lum >= np.quantile(lum, 0.98)
     rows, cols = np.nonzero(top)

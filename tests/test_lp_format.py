@@ -14,7 +14,7 @@ from rti_rig.core.errors import LpFormatError
 from rti_rig.core.lp_format import LpEntry, format_lp, parse_lp, read_lp, write_lp
 
 DATA = Path(__file__).parent / "data"
-# The profile of DESIGN.md: count line, then 'name x y z' with fixed-point 0.xxxxxx values.
+# The profile of docs/conventions.md: count line, then 'name x y z' in fixed point 0.xxxxxx.
 PROFILE_LINE = re.compile(r"^[^\s]+( -?0\.\d{6}){3}$")
 
 unit = (

@@ -1,8 +1,8 @@
 """The map of a light plan (rti_rig.app.plan_figure, `rti-rig plan --figure`).
 
 A plan is checked on this map before the rig moves, so the map must put every light where the
-frame of DESIGN.md says it is (azimuth from +x towards +y, distance from the centre = 90° −
-elevation) and number the lights in the order they fire.
+frame of docs/conventions.md says it is (azimuth from +x towards +y, distance from the
+centre = 90° − elevation) and number the lights in the order they fire.
 """
 
 from __future__ import annotations

@@ -316,7 +316,7 @@ def test_many_light_normals_plans_carry_the_evidence_of_small_gains() -> None:
     """From 12 lights up the benchmarks found the optimal plan's gain small and object-dependent
     (it lost on brushed steel at 20 and 30): the report says so once, with or without a preview,
     on a dome or an arm, and only there; it names --material glossy unless it was declared."""
-    assert MANY_LIGHTS == 12  # the light count the evidence in docs/planner.md is quoted at
+    assert MANY_LIGHTS == 12  # the light count docs/research/planner.md's evidence is quoted at
 
     def notes(*args, **kwargs) -> list[str]:
         _, rep = plan_with_report(*args, **kwargs)

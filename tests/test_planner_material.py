@@ -111,7 +111,7 @@ def test_declared_glossy_keeps_lights_off_the_mirror_direction() -> None:
 
 def test_declared_glossy_reaches_the_relight_objective() -> None:
     """The relight objective models the declared lobe in its reflectance: its plan changes.
-    (Whether for the better is the benchmarks' question: docs/planner.md.)"""
+    (Whether for the better is the benchmarks' question: docs/research/planner.md.)"""
     plans = {
         m: plan_with_report(None, DOME, 12, "optimal", "relight", material=m)
         for m in ("auto", "glossy")

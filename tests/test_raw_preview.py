@@ -31,7 +31,7 @@ def shaded_relief(size: int = 512) -> np.ndarray:
     y, x = np.mgrid[0:size, 0:size] / size
     h = 6 * np.exp(-((x - 0.3) ** 2 + (y - 0.6) ** 2) / 0.02) + 3 * np.sin(9 * x) * y
     gy, gx = np.gradient(h)
-    n = np.dstack([-gx, gy, np.ones_like(h)])  # rows run down, y up (DESIGN.md frame)
+    n = np.dstack([-gx, gy, np.ones_like(h)])  # rows run down, y up (docs/conventions.md frame)
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
     shade = np.clip(n @ direction_from_az_el(*LIGHT), 0.0, None)
     return 0.05 + 0.8 * shade * (0.6 + 0.4 * x)  # some albedo variation, below saturation

@@ -1,6 +1,6 @@
 """Real dome data (a crop of the NeuralRTI example, MIT): conventions and sanity, no ground truth.
 
-Two things synthetic data cannot show: that the DESIGN.md frame (y up while image rows run
+Two things synthetic data cannot show: that the docs/conventions.md frame (y up while image rows run
 down) is the one the fitted normals live in, and that robust photometric stereo and model
 choice behave on real, non-Lambertian pixels.
 """

@@ -103,7 +103,8 @@ class CameraConfig(_Strict):
     "folder_watch"``, see docs/cameras.md); a simulated or emulated rig renders its images.
     ``signal_noise``: noise in this rig's images that grows in proportion to the signal, as a
     fraction, for the planner (``rti-rig plan`` uses it unless ``--signal-noise`` is given):
-    0.05 for 8-bit JPEGs on a dome whose LED intensities are not calibrated (docs/planner.md),
+    0.05 for 8-bit JPEGs on a dome whose LED intensities are not calibrated
+    (docs/research/planner.md),
     0 (the default) when the noise is additive and shot noise only, as on the simulated rigs.
     """
 

@@ -4,9 +4,9 @@ Why: a plan is checked before anything moves. Lights crowded on one side, a gap 
 object's relief faces, a light near the camera axis over a gilded object, an arm's plan hugging
 its limits: a map shows these at a glance, where an ``.lp`` listing of vectors does not.
 
-The map is the view from above in the frame of DESIGN.md: the zenith (the camera axis) at the
-centre, the horizon at the rim, azimuth 0° (+x) to the right and 90° (+y) up; the distance from
-the centre is 90° minus the elevation.
+The map is the view from above in the frame of docs/conventions.md: the zenith (the camera axis)
+at the centre, the horizon at the rim, azimuth 0° (+x) to the right and 90° (+y) up; the distance
+from the centre is 90° minus the elevation.
 """
 
 from __future__ import annotations

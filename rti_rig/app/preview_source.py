@@ -2,7 +2,7 @@
 
 A preview shot on a rig is an image *and* the light that made it; the planner reads the light's
 direction far better than it can estimate it from the image (on the real icon of
-docs/planner.md the estimate is 17–59° off). So when the user does not give
+docs/research/planner.md the estimate is 17–59° off). So when the user does not give
 ``--preview-light``, the light is taken from what records it, and only from that:
 
 * an rti-rig session folder holding one image (``rti-rig preview`` writes one): its linear

@@ -1,7 +1,7 @@
 """Reading and writing `.lp` light-position files.
 
-The writer emits the one profile every known reader accepts (see DESIGN.md): a count line (at
-most 1000), then ``name x y z`` with one space, LF endings, unit vectors in fixed point as
+The writer emits the one profile every known reader accepts (see docs/conventions.md): a count
+line (at most 1000), then ``name x y z`` with one space, LF endings, unit vectors in fixed point as
 ``0.xxxxxx`` / ``-0.xxxxxx`` (RTIBuilder finds numbers with the regex ``-?0\\.[0-9]+``, so ``1``,
 ``1.0`` and exponents are never written; components are clamped to ±0.999999).
 
@@ -165,8 +165,8 @@ def parse_lp(text: str, source: str = "<lp>", upper_hemisphere: bool = False) ->
                 source,
                 lineno,
                 f"direction ({x}, {y}, {z}) points below the object plane (z < 0): a light "
-                "there cannot light the object; check the sign convention (DESIGN.md: z up, "
-                "towards the camera)",
+                "there cannot light the object; check the sign convention "
+                "(docs/conventions.md: z up, towards the camera)",
             )
         _check_name(name, source, lineno)
         if name in seen:

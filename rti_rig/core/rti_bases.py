@@ -2,7 +2,7 @@
 
 A per-pixel relighting model is ``I(l) = sum_k c_k * f_k(l)``; fitting every pixel is one
 matrix product with the pseudo-inverse of the design matrix ``A[i, k] = f_k(l_i)``.
-Lights are unit vectors (N, 3) in the frame of DESIGN.md (x right, y up, z to the camera).
+Lights are unit vectors (N, 3) in the frame of docs/conventions.md (x right, y up, z to the camera).
 
 * Lambert (3): ``(l_x, l_y, l_z)``; the coefficients are albedo times normal.
 * PTM (6), Malzbender et al. 2001, in their coefficient order a0..a5:

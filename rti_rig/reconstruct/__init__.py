@@ -2,7 +2,7 @@
 
 Images are linear float arrays (N, H, W) or (N, H, W, C), or sequences of such images (e.g.
 uint16 frame pixels, see :func:`stack_from_frames`); lights are unit directions (N, 3) in the
-frame of DESIGN.md. See docs/reconstruction.md.
+frame of docs/conventions.md. See docs/reconstruction.md.
 """
 
 from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix, hsh_basis, ptm_basis

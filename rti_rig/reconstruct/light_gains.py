@@ -4,7 +4,7 @@ Photometric stereo, PTM and HSH all assume every light of a session has the same
 The LEDs of a real dome do not: on neuralrti-example (72 LEDs) images under some LEDs are
 19–37 % darker than the all-light fit predicts, consistently over the whole object, and a
 light too dim tilts every normal it helps to fit. A layout's error then depends on which dim
-or bright LEDs it happens to take — the "lottery" of docs/planner.md.
+or bright LEDs it happens to take — the "lottery" of docs/research/planner.md.
 
 The calibration here is the usual one for a dome: a matte white card laid level under it,
 shot under every light. Its normal is known (``target_normal``, default the zenith), so each
@@ -123,8 +123,8 @@ def estimate_light_gains(
 ) -> LightGains:
     """Each light's gain from linear ``images`` (N, H, W[, C]) of a level matte target.
 
-    ``target_normal`` is the card's normal in the frame of DESIGN.md (the zenith for a card
-    lying flat). A light is measured where its shading on the card (cosine of incidence) is at
+    ``target_normal`` is the card's normal in the frame of docs/conventions.md (the zenith for a
+    card lying flat). A light is measured where its shading on the card (cosine of incidence) is at
     least ``min_shading`` — by default :data:`WELL_LIT_FRACTION` of the best-placed lights'
     (their 90th percentile); a calibration that must cover a dome's low ring passes the sine of
     its lowest elevation instead, and accepts that a tilt of the card biases those gains most.

@@ -32,7 +32,7 @@ class RelightModel(Protocol):
     def n_coefficients(self) -> int: ...
 
     def relight(self, direction: ArrayLike) -> NDArray[np.float32]:
-        """Image (H, W) or (H, W, C) under the unit light ``direction`` (DESIGN.md frame)."""
+        """Image (H, W) or (H, W, C) under the unit light ``direction`` (docs/conventions.md)."""
         ...
 
 

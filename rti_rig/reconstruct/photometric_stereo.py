@@ -58,7 +58,7 @@ HIGHLIGHT_FLOOR_FRACTION = 0.01
 DARK_PIXEL_FRACTION = 1e-6
 #: Threshold of the partial-shadow test in robust noise scales (rule 4). On by default: it turns
 #: the planner's losses on the simulated tablet into ties and moves the real dome's means by at
-#: most 0.1°, no verdict (docs/planner.md).
+#: most 0.1°, no verdict (docs/research/planner.md).
 SHADOW_K = 3.0
 #: The partial-shadow test never leaves a pixel fewer observations than this.
 SHADOW_MIN_KEPT = 5
@@ -68,9 +68,9 @@ SHADOW_MIN_KEPT = 5
 class PSResult:
     """Normals, albedo and the evidence of a photometric-stereo fit.
 
-    ``normals`` (H, W, 3) float32 unit vectors with z >= 0 (DESIGN.md frame), ``albedo`` (H, W)
-    or (H, W, C), ``residual`` RMS grey residual over the used observations, ``valid`` (H, W),
-    ``used_lights`` (H, W) count of observations used per pixel.
+    ``normals`` (H, W, 3) float32 unit vectors with z >= 0 (docs/conventions.md frame),
+    ``albedo`` (H, W) or (H, W, C), ``residual`` RMS grey residual over the used observations,
+    ``valid`` (H, W), ``used_lights`` (H, W) count of observations used per pixel.
     """
 
     normals: NDArray[np.float32]

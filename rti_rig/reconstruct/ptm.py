@@ -1,8 +1,8 @@
 """Polynomial texture maps (Malzbender, Gelb, Wolters 2001): 6 coefficients per pixel.
 
 ``I(l) = a0 l_u^2 + a1 l_v^2 + a2 l_u l_v + a3 l_u + a4 l_v + a5`` with ``(l_u, l_v)`` the light's
-projection on the image plane, ``(l_x, l_y)`` in the DESIGN.md frame. The fit needs lights at
-two or more elevations: on a single ring ``l_u^2 + l_v^2`` is constant and the design is
+projection on the image plane, ``(l_x, l_y)`` in the docs/conventions.md frame. The fit needs
+lights at two or more elevations: on a single ring ``l_u^2 + l_v^2`` is constant and the design is
 singular (regularised or refused, see :mod:`rti_rig.reconstruct.solve`).
 """
 

@@ -184,7 +184,7 @@ def validate_lights(lights: ArrayLike, n_images: int | None = None) -> NDArray[n
         if abs(norm - 1.0) > UNIT_TOLERANCE:
             raise ReconstructionError(
                 f"light {i} has length {norm:.4f}; light directions must be unit vectors "
-                "(object to light, DESIGN.md frame)"
+                "(object to light, docs/conventions.md frame)"
             )
         if v[2] / norm < -HORIZON_TOLERANCE:
             raise ReconstructionError(

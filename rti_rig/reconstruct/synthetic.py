@@ -23,7 +23,7 @@ def fibonacci_lights(n: int, min_elevation_deg: float = 10.0) -> NDArray[np.floa
 def sphere_normals(
     height: int, width: int, radius_fraction: float = 0.45
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Normals (H, W, 3) of a sphere seen from +z (DESIGN.md frame, y up) and its mask.
+    """Normals (H, W, 3) of a sphere seen from +z (docs/conventions.md frame, y up) and its mask.
 
     Outside the sphere the normal is (0, 0, 1), a flat background.
     """

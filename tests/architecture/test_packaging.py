@@ -9,6 +9,7 @@ notebook, a test, another program) without loading a single device library.
 from __future__ import annotations
 
 import ast
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -73,13 +74,21 @@ def test_the_check_has_teeth():
 
 @pytest.mark.slow
 def test_the_wheel_holds_one_top_level_package(tmp_path):
+    # built from a copy: an in-tree build would leave a build/ folder in the checkout
+    source = tmp_path / "src"
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
+    for folder in ("rti_rig", "drivers", "planner", "simulator", "rig_configs"):
+        shutil.copytree(REPO / folder, source / folder, ignore=ignore)
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy2(REPO / name, source / name)
+    wheels = tmp_path / "wheels"
     built = subprocess.run(
         [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation",
-         "-w", str(tmp_path), str(REPO)],
+         "-w", str(wheels), str(source)],
         capture_output=True, text=True, timeout=600,
     )
     assert built.returncode == 0, built.stderr
-    (wheel,) = tmp_path.glob("rti_rig-*.whl")
+    (wheel,) = wheels.glob("rti_rig-*.whl")
     with zipfile.ZipFile(wheel) as zf:
         names = zf.namelist()
         (top_level,) = [n for n in names if n.endswith(".dist-info/top_level.txt")]
