@@ -100,7 +100,7 @@ def test_file_still_growing_is_not_taken(tmp_path):
     cam = watch(tmp_path, clock, timeout_s=5.0, poll_interval_s=0.125, stable_polls=3)
     cam.connect()
     f = cam.capture(0.5)
-    assert f.pixels.shape == (32, 32)
+    assert f.pixels.shape == (32, 32, 3)  # colour by default
     assert clock.now() == 1.0  # seen at 0.75, 0.875, 1.0: three equal sizes
 
 

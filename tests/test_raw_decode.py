@@ -20,6 +20,9 @@ from rti_rig.core.errors import CaptureError
 BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
 
 
+MOSAIC = RawDecodeSettings(mode="mosaic")
+
+
 def random_mosaic(seed: int = 0, shape: tuple[int, int] = (48, 64)) -> np.ndarray:
     rng = np.random.default_rng(seed)
     return rng.integers(BLACK, WHITE, shape, endpoint=False).astype(np.uint16)
@@ -41,7 +44,7 @@ def test_mosaic_mode_is_bit_exact_from_file(tmp_path):
         exposure_s=1 / 125,
         iso=200,
     )
-    frame = decode_raw(path)
+    frame = decode_raw(path, MOSAIC)
     assert frame.pixels.dtype == np.uint16
     assert frame.pixels.shape == mosaic.shape
     np.testing.assert_array_equal(frame.pixels, mosaic.astype(np.int64) - BLACK)
@@ -57,7 +60,7 @@ def test_mosaic_mode_is_bit_exact_from_file(tmp_path):
 def test_per_channel_black_levels_are_removed_per_photosite():
     mosaic = random_mosaic(4)
     blacks = (500, 510, 520, 530)  # R, G (row 0), G (row 1), B
-    f = decode_raw(dng_bytes(mosaic, black_level=blacks, white_level=WHITE))
+    f = decode_raw(dng_bytes(mosaic, black_level=blacks, white_level=WHITE), MOSAIC)
     per_site = np.tile(np.array(blacks).reshape(2, 2), (24, 32))
     np.testing.assert_array_equal(
         f.pixels, np.clip(mosaic.astype(np.int64) - per_site, 0, WHITE - 530)
@@ -70,8 +73,8 @@ def test_bytes_and_file_decode_identically(tmp_path):
     mosaic = random_mosaic(3)
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
     (tmp_path / "a.dng").write_bytes(data)
-    a = decode_raw(data)
-    b = decode_raw(tmp_path / "a.dng")
+    a = decode_raw(data, MOSAIC)
+    b = decode_raw(tmp_path / "a.dng", MOSAIC)
     np.testing.assert_array_equal(a.pixels, b.pixels)
     assert a.metadata["source_file"] is None
 
@@ -96,7 +99,7 @@ def test_postprocess_modes_are_linear_and_never_rescaled(mode):
 def test_unity_white_balance_keeps_channel_ratios_camera_wb_changes_them():
     mosaic = patch_mosaic([0.4, 0.4, 0.4])
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE, as_shot_neutral=(0.5, 1.0, 0.8))
-    unity = decode_raw(data, RawDecodeSettings(mode="half"))
+    unity = decode_raw(data, RawDecodeSettings(mode="half", white_balance="unity"))
     cam = decode_raw(data, RawDecodeSettings(mode="half", white_balance="camera"))
     px = unity.pixels[8, 2].astype(float)
     assert px[0] == pytest.approx(px[1], rel=1e-3) == pytest.approx(px[2], rel=1e-3)
@@ -126,7 +129,7 @@ def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
 def test_saturation_detected_on_raw_and_pinned_through_processing():
     mosaic = patch_mosaic([0.3, 1.5], width=16)  # second stripe clips at the white level
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
-    m = decode_raw(data)
+    m = decode_raw(data, MOSAIC)
     assert m.saturated_fraction == pytest.approx(0.5)
     assert m.metadata["saturated_fraction"] == pytest.approx(0.5)
     h = decode_raw(data, RawDecodeSettings(mode="half"))
@@ -139,15 +142,15 @@ def test_saturation_detected_on_raw_and_pinned_through_processing():
 def test_saturation_level_below_nominal_white():
     mosaic = patch_mosaic([0.3, 0.97], width=16)
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
-    assert decode_raw(data).saturated_fraction == 0.0
-    f = decode_raw(data, RawDecodeSettings(saturation_level=0.95))
+    assert decode_raw(data, MOSAIC).saturated_fraction == 0.0
+    f = decode_raw(data, RawDecodeSettings(mode="mosaic", saturation_level=0.95))
     assert f.saturated_fraction == pytest.approx(0.5)
     assert np.all(f.pixels[:, 16:] == f.white_level)
 
 
 def test_underexposure_fraction():
     mosaic = patch_mosaic([0.0, 0.0005, 0.5, 0.5])
-    f = decode_raw(dng_bytes(mosaic, black_level=BLACK, white_level=WHITE))
+    f = decode_raw(dng_bytes(mosaic, black_level=BLACK, white_level=WHITE), MOSAIC)
     assert f.metadata["underexposed_fraction"] == pytest.approx(0.5)
     assert exposure_stats(f.pixels, f.white_level, 0.0)["underexposed_fraction"] == 0.25
 
@@ -159,9 +162,11 @@ def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
     light = linear_to_mosaic(scene + dark_lin, "RGGB", BLACK, WHITE)
     dark = linear_to_mosaic(dark_lin, "RGGB", BLACK, WHITE)
     write_dng(tmp_path / "dark.dng", dark, black_level=BLACK, white_level=WHITE, exposure_s=0.5)
-    dark_frame = decode_raw(tmp_path / "dark.dng")
+    dark_frame = decode_raw(tmp_path / "dark.dng", MOSAIC)
     img = decode_raw(
-        dng_bytes(light, black_level=BLACK, white_level=WHITE, exposure_s=0.5), dark=dark_frame
+        dng_bytes(light, black_level=BLACK, white_level=WHITE, exposure_s=0.5),
+        MOSAIC,
+        dark=dark_frame,
     )
     assert img.metadata["dark_subtracted"] is True
     assert img.metadata["dark_file"] == str(tmp_path / "dark.dng")
@@ -172,22 +177,18 @@ def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
 
 
 def test_dark_with_other_exposure_or_shape_is_refused():
-    a = decode_raw(
-        dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE, exposure_s=0.5)
-    )
-    b = decode_raw(
-        dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE, exposure_s=0.25)
-    )
+    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE, exposure_s=0.5), MOSAIC)
+    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE, exposure_s=0.25), MOSAIC)
     with pytest.raises(CaptureError, match="exposure"):
         subtract_dark(a, b)
-    c = decode_raw(dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE))
+    c = decode_raw(dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE), MOSAIC)
     with pytest.raises(CaptureError, match="shape"):
         subtract_dark(a, c)
 
 
 def test_average_frames_is_a_rounded_mean():
-    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE))
-    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE))
+    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE), MOSAIC)
+    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE), MOSAIC)
     m = average_frames([a, b])
     want = np.rint((a.pixels.astype(float) + b.pixels) / 2).astype(np.uint16)
     np.testing.assert_array_equal(m.pixels, want)
@@ -197,9 +198,9 @@ def test_unreadable_and_missing_files_name_the_file(tmp_path):
     bad = tmp_path / "broken.dng"
     bad.write_bytes(b"not a raw file at all" * 10)
     with pytest.raises(CaptureError, match=r"broken\.dng"):
-        decode_raw(bad)
+        decode_raw(bad, MOSAIC)
     with pytest.raises(CaptureError, match="not found"):
-        decode_raw(tmp_path / "missing.dng")
+        decode_raw(tmp_path / "missing.dng", MOSAIC)
 
 
 def test_dng_writer_validates_its_input():
@@ -235,7 +236,7 @@ def test_any_dng_round_trips_bit_exactly(h, w, black, span, pattern, seed):
     white = min(black + span, 65535)
     rng = np.random.default_rng(seed)
     mosaic = rng.integers(black, white, (h, w), endpoint=False).astype(np.uint16)
-    f = decode_raw(dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white))
+    f = decode_raw(dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white), MOSAIC)
     np.testing.assert_array_equal(f.pixels, mosaic.astype(np.int64) - black)
     assert f.white_level == white - black
     assert f.metadata["cfa_pattern"] == pattern

@@ -38,13 +38,17 @@ def _atomic_write(path: Path, data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def write_linear_tiff(path: Path, pixels: NDArray[np.uint16]) -> str:
-    """Write a linear 16-bit TIFF; returns its SHA-256."""
+def write_linear_tiff(
+    path: Path, pixels: NDArray[np.uint16], description: str | None = None
+) -> str:
+    """Write a linear 16-bit TIFF (``description`` goes into ImageDescription); returns its
+    SHA-256."""
     import io
 
     buf = io.BytesIO()
     photometric = "rgb" if pixels.ndim == 3 else "minisblack"
-    tifffile.imwrite(buf, pixels, photometric=photometric, compression="zlib")
+    extra = {"description": description, "metadata": None} if description else {}
+    tifffile.imwrite(buf, pixels, photometric=photometric, compression="zlib", **extra)
     return _atomic_write(path, buf.getvalue())
 
 
