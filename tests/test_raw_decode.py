@@ -177,11 +177,17 @@ def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
 
 
 def test_dark_with_other_exposure_or_shape_is_refused():
-    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE, exposure_s=0.5), MOSAIC)
-    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE, exposure_s=0.25), MOSAIC)
+    a = decode_raw(
+        dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE, exposure_s=0.5), MOSAIC
+    )
+    b = decode_raw(
+        dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE, exposure_s=0.25), MOSAIC
+    )
     with pytest.raises(CaptureError, match="exposure"):
         subtract_dark(a, b)
-    c = decode_raw(dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE), MOSAIC)
+    c = decode_raw(
+        dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE), MOSAIC
+    )
     with pytest.raises(CaptureError, match="shape"):
         subtract_dark(a, c)
 
@@ -236,7 +242,9 @@ def test_any_dng_round_trips_bit_exactly(h, w, black, span, pattern, seed):
     white = min(black + span, 65535)
     rng = np.random.default_rng(seed)
     mosaic = rng.integers(black, white, (h, w), endpoint=False).astype(np.uint16)
-    f = decode_raw(dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white), MOSAIC)
+    f = decode_raw(
+        dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white), MOSAIC
+    )
     np.testing.assert_array_equal(f.pixels, mosaic.astype(np.int64) - black)
     assert f.white_level == white - black
     assert f.metadata["cfa_pattern"] == pattern
