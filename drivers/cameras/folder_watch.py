@@ -190,6 +190,9 @@ class FolderWatchCamera:
         metadata.update(
             {
                 "camera": self.name,
+                # the session copies the file under raw/ with its own name (the watched
+                # folder belongs to another program)
+                "originals": [{"path": str(path), "name": path.name}],
                 "exposure_requested_s": exposure_s,
                 "exposure_source": "file" if file_exposure else "requested",
                 "capture_started_s": started,

@@ -206,6 +206,12 @@ class FolderWatchSettings(_Strict):
     kind: Literal["folder_watch"] = "folder_watch"
     name: str = "folder-camera"
     folder: Path
+    trigger: Literal["none", "dome_shutter"] = Field(
+        "none",
+        description="who fires the camera: 'none' (someone else: a vendor program, an "
+        "intervalometer) or 'dome_shutter' (rti-rig pulses the dome's camera-release line, "
+        "[dome.serial] shutter_pulse_ms long, once the LED is lit and settled)",
+    )
     patterns: tuple[str, ...] = ("*.dng", "*.DNG")
     timeout_s: float = Field(10.0, gt=0.0)
     poll_interval_s: float = Field(0.05, gt=0.0)
@@ -223,6 +229,12 @@ class FolderWatchSettings(_Strict):
         "linearise with the inverse sRGB curve, or take them as linear",
     )
     decode: RawDecodeSettings = RawDecodeSettings()
+
+    @field_validator("folder")
+    @classmethod
+    def _home(cls, v: Path) -> Path:
+        """``~/Pictures/...`` as a user writes it in a config shared between machines."""
+        return v.expanduser()
 
 
 CameraSettings = Annotated[
