@@ -21,13 +21,13 @@ import serial
 from conftest import CONFIGS
 from dng_spec_writer import dng, mosaic_from_rgb, srgb8
 from fake_gphoto2 import Body, make_module
+from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.core.clock import SystemClock
 from rti_rig.core.image_files import read_jpeg_rgb, read_linear_tiff
-from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 
 pytestmark = [pytest.mark.pty, pytest.mark.e2e]
 
@@ -190,3 +190,89 @@ def test_folder_watch_example_fired_by_the_dome_shutter_line(dome, tmp_path, mon
     check_images(out)
     names = [list(e["originals"].values())[0] for e in journal(out)]
     assert names == [f"_DSC{i:04d}.DNG" for i in range(1, 5)]
+
+
+#: Flat colour patches (linear, fractions of full scale), a 2×3 grid of 32×32 squares.
+PATCHES = np.array(
+    [
+        [(0.2, 0.5, 0.8), (0.9, 0.1, 0.3), (0.05, 0.6, 0.25)],
+        [(0.5, 0.5, 0.5), (0.7, 0.35, 0.02), (0.15, 0.15, 0.9)],
+    ]
+)
+SIDE = 32
+#: per shot: CFA pattern, black levels per 2×2 site (row by row), Orientation tag, byte order
+SHOTS = [
+    ("RGGB", (256, 300, 280, 320), 1, False),
+    ("BGGR", (600, 512, 540, 580), 6, True),
+    ("GRBG", (64, 80, 72, 96), 8, False),
+    ("GBRG", (1024, 1000, 1040, 990), 3, True),
+]
+
+
+def patch_image() -> np.ndarray:
+    return np.repeat(np.repeat(PATCHES, SIDE, axis=0), SIDE, axis=1)
+
+
+@pytest.mark.parametrize("dome", [WATCH_CONFIG], indirect=True)
+def test_folder_watch_session_of_spec_written_dngs_gives_true_colour(dome, tmp_path, monkeypatch):
+    """Must show: DNGs from the tests' own writer (all four CFA patterns, unequal black levels,
+    orientation tags, both byte orders) give sRGB JPEGs within 1 code value, linear TIFFs
+    within 0.1 %, and the provenance in the manifest."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    watched = tmp_path / "Pictures" / "rti-tether"
+    watched.mkdir(parents=True)
+    files = []
+    for i, (pattern, black, orientation, big) in enumerate(SHOTS):
+        raw = mosaic_from_rgb(patch_image(), pattern, black, WHITE)
+        files.append(dng(raw, pattern, black, WHITE, orientation, big_endian=big))
+    stop = threading.Event()
+
+    def tethering_program() -> None:
+        seen = 0
+        while not stop.is_set():
+            pulses = [e for e in list(dome.history) if e.what == "shutter"]
+            for _ in pulses[seen:]:
+                (watched / f"SHOT{seen + 1}.DNG").write_bytes(files[seen])
+                seen += 1
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=tethering_program, daemon=True)
+    thread.start()
+    try:
+        out = tmp_path / "s"
+        result = run(str(WATCH_CONFIG), "--out", str(out), "--lights", "4")
+    finally:
+        stop.set()
+        thread.join(2)
+    assert result.exit_code == 0, result.output
+    # the user is told that a rotated camera gave sensor-oriented images
+    assert "rotated" in result.output and "sensor" in result.output
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert any("Orientation tag 6" in n for n in manifest["notices"])
+    expected_srgb = srgb8(PATCHES)
+    for step, (pattern, black, orientation, _) in zip(manifest["steps"], SHOTS, strict=True):
+        tif = read_linear_tiff(out / step["linear_image"]) / 65535
+        jpg = read_jpeg_rgb(out / step["image"]).astype(int)
+        for r in range(2):
+            for c in range(3):
+                inner = np.s_[r * SIDE + 8 : (r + 1) * SIDE - 8, c * SIDE + 8 : (c + 1) * SIDE - 8]
+                np.testing.assert_allclose(
+                    tif[inner], np.broadcast_to(PATCHES[r, c], (16, 16, 3)), rtol=1e-3
+                )
+                assert np.abs(jpg[inner] - expected_srgb[r, c]).max() <= 1, (pattern, r, c)
+        d = step["decode"]
+        assert d["mode"] == "demosaic" and d["content"] == "rgb"
+        assert d["cfa_pattern"] == pattern
+        sites = dict(zip(pattern[:2] + pattern[2:].replace("G", "g"), black, strict=True))
+        assert d["black_level_per_channel"]["R"] == sites["R"]
+        assert d["black_level_per_channel"]["B"] == sites["B"]
+        assert sorted(d["black_level_per_channel"].values()) == sorted(black)
+        assert d["white_level"] == WHITE
+        assert d["white_balance"].startswith("unity")  # the files carry no as-shot neutral
+        assert d["color_space"].startswith("camera RGB")  # ... and no colour matrix
+        assert d["orientation"]["orientation_tag"] == orientation
+        assert d["orientation"]["applied"] is False
+        assert d["orientation"]["camera_rotated"] is (orientation != 1)
+        assert d["source_file"].endswith(f"SHOT{step['index'] + 1}.DNG")
+        (raw,) = step["originals"]
+        assert (out / raw).read_bytes() == files[step["index"]]

@@ -355,10 +355,13 @@ def decode_raw(
     }
     notices = []
     if orientation["camera_rotated"]:
+        tag = orientation["orientation_tag"]
+        meaning = orientation["orientation_tag_meaning"] or orientation["flip_meaning"]
         notices.append(
-            f"{Path(name).name}: the camera was rotated ({orientation['flip_meaning']}, "
-            f"Orientation tag {orientation['orientation_tag']}); rti-rig keeps sensor "
-            "orientation, so these images (and the .lp directions) are NOT turned upright"
+            f"the camera was rotated (Orientation tag {tag}: {meaning}): rti-rig keeps "
+            "sensor orientation, as the camera's RAW data and JPEG previews are stored, so "
+            "these images are not turned upright; the .lp light directions are in the same "
+            "(sensor) frame, so fitting is unaffected (docs/cameras.md)"
         )
     metadata: dict[str, Any] = {
         "source_file": source_file,

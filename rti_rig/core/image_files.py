@@ -55,7 +55,12 @@ def write_linear_tiff(
 def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> str:
     """Write an 8-bit sRGB JPEG (RGB order in, as OpenCV wants BGR on disk); returns SHA-256."""
     img = srgb8[..., ::-1] if srgb8.ndim == 3 else srgb8
-    ok, enc = cv2.imencode(".jpg", np.ascontiguousarray(img), [cv2.IMWRITE_JPEG_QUALITY, quality])
+    params = [cv2.IMWRITE_JPEG_QUALITY, quality]
+    if img.ndim == 3 and hasattr(cv2, "IMWRITE_JPEG_SAMPLING_FACTOR"):
+        # full-resolution colour (4:4:4): 4:2:0 chroma subsampling moves colours at patch and
+        # demosaic edges by several code values; 4:4:4 keeps them within 1
+        params += [cv2.IMWRITE_JPEG_SAMPLING_FACTOR, cv2.IMWRITE_JPEG_SAMPLING_FACTOR_444]
+    ok, enc = cv2.imencode(".jpg", np.ascontiguousarray(img), params)
     if not ok:
         raise SessionError(f"could not encode {path.name} as JPEG")
     return _atomic_write(path, enc.tobytes())

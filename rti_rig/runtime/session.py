@@ -312,9 +312,28 @@ class SessionFolder:
                 },
                 "lp_file": LP_NAME if ordered else None,
                 "steps": [asdict(r) for r in ordered],
+                "notices": session_notices(ordered),
             }
         )
         _write_json_atomic(self.root / MANIFEST, self.manifest)
+
+
+def session_notices(records: list[StepRecord]) -> list[str]:
+    """What the user should know about the images as a whole (each distinct notice once, with
+    how many images it concerns), e.g. that a rotated camera gave sensor-oriented images, or
+    that the images are CFA mosaics rather than pictures."""
+    counts: dict[str, int] = {}
+    for r in records:
+        for n in r.notices:
+            counts[n] = counts.get(n, 0) + 1
+        if r.decode.get("mode") == "mosaic":
+            n = (
+                "the images are CFA mosaics (decode.mode = 'mosaic'): one colour per pixel, "
+                "not demosaiced; the JPEGs are grey checkerboards, not pictures"
+            )
+            counts[n] = counts.get(n, 0) + 1
+    total = len(records)
+    return [f"{n} [{c} of {total} images]" for n, c in counts.items()]
 
 
 @dataclass
