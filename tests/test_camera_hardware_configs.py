@@ -116,7 +116,7 @@ def test_dslr_example_downloads_into_the_session_and_keeps_the_raws(body, tmp_pa
     check_images(out)
     entries = journal(out)
     # the camera's own names (RAM target: the same folder every time) are kept in the journal
-    names = [list(e["originals"].values())[0] for e in entries]
+    names = [next(iter(e["originals"].values())) for e in entries]
     assert names == ["/IMG_0001.CR2", "/IMG_0002.CR2", "/IMG_0003.CR2", "/IMG_0004.CR2"]
     assert body.config["imageformat"] == "RAW" and body.config["capturetarget"] == "Internal RAM"
     assert body.shots == 4 and not body.ram  # nothing left behind in the camera
@@ -139,7 +139,7 @@ def test_camera_switched_off_mid_session_is_named_and_resume_loses_and_repeats_n
     entries = journal(out)
     assert [e["index"] for e in entries] == [0, 1, 2, 3]  # none repeated, none lost
     assert body.shots == 4
-    names = [list(e["originals"].values())[0] for e in entries]
+    names = [next(iter(e["originals"].values())) for e in entries]
     assert len(set(names)) == 4
 
 
@@ -149,7 +149,7 @@ def test_camera_that_names_every_shot_the_same_never_overwrites(body, tmp_path):
     result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
     assert result.exit_code == 0, result.output
     check_images(out)
-    names = [list(e["originals"].values())[0] for e in journal(out)]
+    names = [next(iter(e["originals"].values())) for e in journal(out)]
     assert names == ["/capt0000.CR2"] * 4
     raws = sorted(p.name for p in (out / "raw").glob("image_*"))
     assert raws == [f"image_00{i}.cr2" for i in range(1, 5)]
@@ -188,7 +188,7 @@ def test_folder_watch_example_fired_by_the_dome_shutter_line(dome, tmp_path, mon
     assert result.exit_code == 0, result.output
     assert sum(e.what == "shutter" for e in dome.history) == 4
     check_images(out)
-    names = [list(e["originals"].values())[0] for e in journal(out)]
+    names = [next(iter(e["originals"].values())) for e in journal(out)]
     assert names == [f"_DSC{i:04d}.DNG" for i in range(1, 5)]
 
 
@@ -222,7 +222,7 @@ def test_folder_watch_session_of_spec_written_dngs_gives_true_colour(dome, tmp_p
     watched = tmp_path / "Pictures" / "rti-tether"
     watched.mkdir(parents=True)
     files = []
-    for i, (pattern, black, orientation, big) in enumerate(SHOTS):
+    for pattern, black, orientation, big in SHOTS:
         raw = mosaic_from_rgb(patch_image(), pattern, black, WHITE)
         files.append(dng(raw, pattern, black, WHITE, orientation, big_endian=big))
     stop = threading.Event()

@@ -61,6 +61,7 @@ class CameraGoneError(CaptureError):
 class CardFullError(CaptureError):
     """The camera refused to shoot because its memory card is full."""
 
+
 NO_CAMERA_HELP = (
     "gphoto2 found no camera: check the USB cable, that the camera is switched on and in PC/PTP "
     "mode, and that no other program (gvfs-gphoto2-volume-monitor, a gphoto2 shell, the vendor "
@@ -373,9 +374,7 @@ class Gphoto2Camera:
                 "camera_files": list(camera_path.values()),
                 # the session keeps these under raw/ with its own names (the camera's in the
                 # journal): a wrapped or repeated camera counter can never overwrite a shot
-                "originals": [
-                    {"path": str(p), "name": camera_path[n]} for n, p in saved.items()
-                ],
+                "originals": [{"path": str(p), "name": camera_path[n]} for n, p in saved.items()],
                 "jpeg_file": jpeg[0] if jpeg else None,
                 "capture_started_s": t_capture,
                 "capture_finished_s": self._clock.now(),
