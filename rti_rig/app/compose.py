@@ -303,7 +303,8 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
     from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
     try:
-        return decode_raw(p, RawDecodeSettings(mode="half")).pixels
+        settings = RawDecodeSettings(mode="half", white_balance="unity", output_color="raw")
+        return decode_raw(p, settings).pixels
     except CaptureError as exc:  # its message names the file and LibRaw's reason
         raise ScheduleError(
             f"RAW preview {exc.message} Otherwise give the camera's JPEG or a 16-bit linear "
