@@ -167,3 +167,32 @@ def test_resume_verifies_raw_originals_and_sets_aside_uncommitted_downloads(tmp_
     assert not (folder.root / RAW_INCOMING / "cap2.CR2").exists()
     lines = [json.loads(x) for x in (folder.root / "journal.jsonl").read_text().splitlines()]
     assert lines[0]["originals"] == {"raw/image_001.cr2": "/IMG_0.CR2"}
+
+
+def test_metering_shots_before_the_session_exists_go_to_a_private_folder(tmp_path):
+    body = Body(render=render)
+    with camera(body, None) as cam:
+        f = cam.capture(1 / 60)
+    staged = f.metadata["originals"][0]["path"]
+    assert "rti-rig-dslr-" in staged and tmp_path.as_posix() not in staged
+
+
+def test_mosaic_sessions_are_labelled_in_tiff_journal_and_manifest(tmp_path):
+    import tifffile
+    from rti_rig.drivers.cameras.raw_decode import decode_raw
+    from rti_rig.drivers.cameras.settings import RawDecodeSettings
+
+    src = tmp_path / "IMG_0001.DNG"
+    src.write_bytes(render())
+    f = decode_raw(src, RawDecodeSettings(mode="mosaic"))
+    folder = SessionFolder.create(tmp_path / "s", 1)
+    folder.begin({"rig": {}, "schedule": {"steps": [{}]}})
+    rec = folder.write_step(0, f, _fields())
+    assert rec.decode["content"] == "cfa-mosaic" and rec.decode["cfa_pattern"] == "RGGB"
+    with tifffile.TiffFile(folder.root / rec.linear_image) as tif:
+        assert "CFA mosaic (RGGB)" in tif.pages.first.description
+    folder.finish([rec], {"finish_reason": "completed"}, {})
+    manifest = json.loads((folder.root / "manifest.json").read_text())
+    assert any("CFA mosaics" in n for n in manifest["notices"])
+    assert manifest["steps"][0]["decode"]["mode"] == "mosaic"
+    assert src.exists()  # a watched folder's file is copied, never taken away

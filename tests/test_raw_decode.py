@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -265,3 +267,58 @@ def test_half_size_saturation_mask_fits_odd_sensor_sizes():
     even = np.zeros((4, 6), dtype=bool)
     even[3, 5] = True
     np.testing.assert_array_equal(half_size_mask(even, 2, 3), [[0, 0, 0], [0, 0, 1]])
+
+
+@pytest.mark.parametrize("mode", ["half", "demosaic"])
+def test_unequal_black_levels_are_corrected_exactly_in_colour_modes(mode):
+    # blacks 512/600/540/580 at white 4095: LibRaw's min-black scaling would be 2.6 % off
+    blacks = (512, 600, 540, 580)
+    rgb = np.broadcast_to(np.array([0.2, 0.5, 0.8]), (32, 48, 3))
+    h_, w_ = rgb.shape[:2]
+    raw = np.empty((h_, w_), np.uint16)
+    codes = (0, 1, 1, 2)  # RGGB
+    for k, (dy, dx) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
+        raw[dy::2, dx::2] = np.rint(blacks[k] + rgb[dy::2, dx::2, codes[k]] * (4095 - blacks[k]))
+    f = decode_raw(
+        dng_bytes(raw, black_level=blacks, white_level=4095),
+        RawDecodeSettings(mode=mode, white_balance="unity"),
+    )
+    inner = f.pixels[6:-6, 6:-6].reshape(-1, 3) / 65535
+    np.testing.assert_allclose(inner, np.broadcast_to([0.2, 0.5, 0.8], inner.shape), rtol=1e-3)
+    assert f.metadata["decode"]["black_level_per_channel"] == {
+        "R": 512,
+        "G": 600,
+        "B": 580,
+        "G2": 540,
+    }
+
+
+def test_srgb_from_camera_keeps_neutrals_and_is_identity_for_srgb_primaries():
+    from rti_rig.drivers.cameras.raw_decode import XYZ_FROM_SRGB, srgb_from_camera
+
+    assert srgb_from_camera(np.zeros((4, 3))) is None  # minimal DNG: no matrix, no conversion
+    ident = srgb_from_camera(np.linalg.inv(XYZ_FROM_SRGB))
+    np.testing.assert_allclose(ident, np.eye(3), atol=1e-9)
+    rng = np.random.default_rng(3)
+    cam_xyz = np.eye(3) + 0.2 * rng.standard_normal((3, 3))
+    m = srgb_from_camera(cam_xyz)
+    np.testing.assert_allclose(m @ np.ones(3), np.ones(3), atol=1e-9)  # white stays white
+
+
+def test_orientation_is_recorded_not_applied_and_a_rotation_is_noticed():
+    import tifffile
+
+    buf = dng_bytes(random_mosaic(), black_level=BLACK, white_level=WHITE)
+    # rewrite the file with an Orientation tag (6: rotate 90° CW to view)
+    with tifffile.TiffFile(io.BytesIO(buf)) as tif:
+        arr = tif.pages.first.asarray()
+    upright = decode_raw(buf)
+    assert upright.metadata["decode"]["orientation"]["camera_rotated"] is False
+    assert upright.metadata["notices"] == []
+    from dng_spec_writer import dng as spec_dng
+
+    rotated = decode_raw(spec_dng(arr, "RGGB", (BLACK,) * 4, WHITE, orientation=6))
+    o = rotated.metadata["decode"]["orientation"]
+    assert o["orientation_tag"] == 6 and o["libraw_flip"] == 6 and o["applied"] is False
+    assert rotated.pixels.shape[:2] == arr.shape  # not rotated
+    assert "sensor orientation" in rotated.metadata["notices"][0]
