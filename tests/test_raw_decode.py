@@ -110,8 +110,9 @@ def test_unity_white_balance_keeps_channel_ratios_camera_wb_changes_them():
     assert cpx[2] / cpx[1] == pytest.approx(1.25, rel=0.02)  # 1 / 0.8 for blue
 
 
+@pytest.mark.parametrize("mode", ["half", "demosaic"])
 @pytest.mark.parametrize("pattern", ["RGGB", "BGGR", "GRBG", "GBRG"])
-def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
+def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern, mode):
     h, w = 24, 24
     rgb = np.zeros((h, w, 3))
     rgb[..., 0], rgb[..., 1], rgb[..., 2] = 0.2, 0.5, 0.8
@@ -122,7 +123,7 @@ def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
             black_level=BLACK,
             white_level=WHITE,
         ),
-        RawDecodeSettings(mode="half"),
+        RawDecodeSettings(mode=mode),
     )
     assert frame.metadata["cfa_pattern"] == pattern
     np.testing.assert_allclose(frame.pixels[5, 5] / 65535, [0.2, 0.5, 0.8], atol=2e-4)

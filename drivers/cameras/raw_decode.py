@@ -18,6 +18,7 @@ import io
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import rawpy
 from numpy.typing import NDArray
@@ -213,6 +214,76 @@ def _dilate(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     return out
 
 
+#: OpenCV's Bayer conversion codes, by our CFA name (OpenCV names a pattern by the second row's
+#: second and third pixels, hence the apparent swap; checked for all four patterns in the tests).
+_CV_BAYER = {
+    "RGGB": cv2.COLOR_BayerBG2RGB,
+    "BGGR": cv2.COLOR_BayerRG2RGB,
+    "GRBG": cv2.COLOR_BayerGB2RGB,
+    "GBRG": cv2.COLOR_BayerGR2RGB,
+}
+
+
+def _colour(
+    raw: NDArray[np.uint16],
+    colors: NDArray[np.integer],
+    black_pc: NDArray[np.int64],
+    white: int,
+    wb: NDArray[np.float64],
+    rgb_index: NDArray[np.intp],
+    mode: str,
+) -> NDArray[np.float32]:
+    """Black-corrected (per site, exactly), white-balanced linear RGB, full or half size.
+
+    A 2×2 Bayer sensor (the usual case) is handled site by site on strided views, and
+    demosaiced with OpenCV's bilinear Bayer conversion; any other CFA goes through the
+    per-photosite path and :func:`bilinear_demosaic`.
+    """
+    h, w = raw.shape
+    tile = colors[:2, :2] if colors.shape[0] >= 2 and colors.shape[1] >= 2 else None
+    names = "".join("RGB"[rgb_index[int(c)]] for c in tile.ravel()) if tile is not None else ""
+    bayer = (
+        names in _CV_BAYER
+        and h % 2 == 0
+        and w % 2 == 0
+        and np.array_equal(colors, np.tile(tile, (h // 2, w // 2)))
+    )
+    gain = wb / (white - black_pc)  # per colour index: (raw − black_c) × gain_c
+    if not bayer:
+        norm = (raw.astype(np.float32) - black_pc[colors].astype(np.float32)) * gain.astype(
+            np.float32
+        )[colors]
+        norm = np.clip(norm, 0.0, wb.astype(np.float32)[colors])
+        channel = rgb_index[colors]
+        return half_size(norm, channel) if mode == "half" else bilinear_demosaic(norm, channel)
+    sites = {}
+    for dy in (0, 1):
+        for dx in (0, 1):
+            c = int(tile[dy, dx])
+            v = raw[dy::2, dx::2].astype(np.float32)
+            v -= np.float32(black_pc[c])
+            v *= np.float32(gain[c])
+            np.clip(v, 0.0, np.float32(wb[c]), out=v)
+            sites[(dy, dx)] = (rgb_index[c], v)
+    if mode == "half":
+        out = np.empty((h // 2, w // 2, 3), dtype=np.float32)
+        greens = [v for ch, v in sites.values() if ch == 1]
+        for ch, v in sites.values():
+            if ch != 1:
+                out[..., ch] = v
+        out[..., 1] = (greens[0] + greens[1]) * np.float32(0.5)
+        return out
+    top = float(max(wb.max(), 1.0))  # white-balanced values reach up to the largest multiplier
+    plane = np.empty((h, w), dtype=np.float32)
+    for (dy, dx), (_, v) in sites.items():
+        plane[dy::2, dx::2] = v
+    plane *= np.float32(65535.0 / top)
+    mosaic = np.rint(plane, out=plane).astype(np.uint16)
+    rgb = cv2.cvtColor(mosaic, _CV_BAYER[names]).astype(np.float32)
+    rgb *= np.float32(top / 65535.0)
+    return rgb
+
+
 def _orientation_tag(source: Path | str | bytes) -> int | None:
     """The TIFF/EXIF Orientation tag (274) of IFD0 of a TIFF-based RAW, if it has one."""
     try:
@@ -301,23 +372,17 @@ def decode_raw(
         pixels[saturated] = white_level
         color_space = "none (CFA mosaic: one colour per pixel)"
     else:
-        span = (white - black_pc).astype(np.float32)  # white − black_c per colour index
-        norm = (raw_vis.astype(np.float32) - black_pc[colors].astype(np.float32)) / span[colors]
-        norm = np.clip(norm, 0.0, 1.0) * wb.astype(np.float32)[colors]
         rgb_index = np.array([_rgb_channel(desc, int(i)) for i in range(4)], dtype=np.intp)
-        channel = rgb_index[colors]
         try:
-            rgb = (
-                half_size(norm, channel)
-                if settings.mode == "half"
-                else bilinear_demosaic(norm, channel)
-            )
+            rgb = _colour(raw_vis, colors, black_pc, white, wb, rgb_index, settings.mode)
         except ValueError as exc:
             raise CaptureError(DECODER, f"{name}: {exc}", "decode") from exc
         if to_srgb is not None:
-            rgb = np.einsum("ij,hwj->hwi", to_srgb.astype(np.float32), rgb)
+            rgb = cv2.transform(rgb, to_srgb.astype(np.float32))
         white_level = 65535
-        pixels = np.rint(np.clip(rgb, 0.0, 1.0) * white_level).astype(np.uint16)
+        np.clip(rgb, 0.0, 1.0, out=rgb)
+        rgb *= white_level
+        pixels = np.rint(rgb, out=rgb).astype(np.uint16)
         h, w = pixels.shape[:2]
         sat = half_size_mask(saturated, h, w) if settings.mode == "half" else _dilate(saturated)
         pixels[sat[:h, :w]] = white_level
