@@ -276,3 +276,12 @@ def test_folder_watch_session_of_spec_written_dngs_gives_true_colour(dome, tmp_p
         assert d["source_file"].endswith(f"SHOT{step['index'] + 1}.DNG")
         (raw,) = step["originals"]
         assert (out / raw).read_bytes() == files[step["index"]]
+
+
+def test_dslr_busy_after_every_shot_is_retried_and_the_session_completes(body, tmp_path):
+    body.busy_after_shot = 1  # a body still writing the previous file answers "busy" once
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    assert result.exit_code == 0, result.output
+    check_images(out)
+    assert body.shots == 4 and body.calls.count("capture") == 4 + 3
