@@ -16,7 +16,9 @@ writer's mistakes. This writer uses nothing of rti_rig (nor tifffile): it packs 
   1 = green, 2 = blue, row by row), ExposureTime (33434, RATIONAL), DNGVersion (50706,
   BYTE[4]), UniqueCameraModel (50708, ASCII), CFAPlaneColor (50710), CFALayout (50711, 1 =
   rectangular), BlackLevelRepeatDim (50713, SHORT[2]), BlackLevel (50714, one value per
-  repeat cell, row by row), WhiteLevel (50717).
+  repeat cell, row by row), WhiteLevel (50717), ColorMatrix1 (50721, SRATIONAL[9]: XYZ →
+  camera RGB, row by row), CalibrationIlluminant1 (50778, 21 = D65); type 10 SRATIONAL is two
+  signed LONGs.
 
 Licence: part of rti-rig's tests (same licence as the project). Source: the two specifications
 named above; no code was copied.
@@ -29,8 +31,8 @@ from fractions import Fraction
 
 import numpy as np
 
-BYTE, ASCII, SHORT, LONG, RATIONAL = 1, 2, 3, 4, 5
-_SIZES = {BYTE: 1, ASCII: 1, SHORT: 2, LONG: 4, RATIONAL: 8}
+BYTE, ASCII, SHORT, LONG, RATIONAL, SRATIONAL = 1, 2, 3, 4, 5, 10
+_SIZES = {BYTE: 1, ASCII: 1, SHORT: 2, LONG: 4, RATIONAL: 8, SRATIONAL: 8}
 #: CFAPattern codes (0 red, 1 green, 2 blue) of the 2×2 tile, row by row.
 PATTERNS = {
     "RGGB": (0, 1, 1, 2),
@@ -43,11 +45,12 @@ PATTERNS = {
 def _pack_values(order: str, typ: int, values: list) -> bytes:  # type: ignore[type-arg]
     if typ == ASCII:
         return values[0].encode("ascii") + b"\0"
-    if typ == RATIONAL:
+    if typ in (RATIONAL, SRATIONAL):
+        code = "II" if typ == RATIONAL else "ii"
         out = b""
         for v in values:
             f = Fraction(v).limit_denominator(1_000_000)
-            out += struct.pack(order + "II", f.numerator, f.denominator)
+            out += struct.pack(order + code, f.numerator, f.denominator)
         return out
     code = {BYTE: "B", SHORT: "H", LONG: "I"}[typ]
     return struct.pack(order + code * len(values), *values)
@@ -118,6 +121,7 @@ def dng(
     exposure_s: float | None = None,
     big_endian: bool = False,
     model: str = "spec-writer test camera",
+    color_matrix: np.ndarray | None = None,
 ) -> bytes:
     """An uncompressed 16-bit CFA DNG of ``mosaic`` (raw codes, black included)."""
     h, w = mosaic.shape
@@ -146,6 +150,9 @@ def dng(
     }
     if exposure_s is not None:
         entries[33434] = (RATIONAL, [exposure_s])
+    if color_matrix is not None:  # ColorMatrix1 (XYZ → camera), CalibrationIlluminant1 = D65
+        entries[50721] = (SRATIONAL, [float(v) for v in np.ravel(color_matrix)])
+        entries[50778] = (SHORT, [21])
     data = np.ascontiguousarray(mosaic, dtype=">u2" if big_endian else "<u2").tobytes()
     return tiff_bytes(entries, data, big_endian)
 

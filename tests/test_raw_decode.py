@@ -323,3 +323,23 @@ def test_orientation_is_recorded_not_applied_and_a_rotation_is_noticed():
     assert o["orientation_tag"] == 6 and o["libraw_flip"] == 6 and o["applied"] is False
     assert rotated.pixels.shape[:2] == arr.shape  # not rotated
     assert "sensor orientation" in rotated.metadata["notices"][0]
+
+
+def test_file_colour_matrix_takes_a_camera_back_to_srgb():
+    """A camera whose primaries mix sRGB (camera = A · sRGB) and says so in ColorMatrix1
+    (XYZ → camera = A · sRGB←XYZ, DNG 1.4 §6) decodes to the scene's sRGB values."""
+    from dng_spec_writer import dng as spec_dng
+    from dng_spec_writer import mosaic_from_rgb
+    from rti_rig.drivers.cameras.raw_decode import XYZ_FROM_SRGB
+
+    srgb = np.array([0.2, 0.5, 0.6])
+    a = np.array([[0.7, 0.25, 0.05], [0.15, 0.75, 0.1], [0.05, 0.2, 0.75]])
+    camera_rgb = np.broadcast_to(a @ srgb, (32, 48, 3))
+    raw = mosaic_from_rgb(np.array(camera_rgb), "RGGB", (0, 0, 0, 0), 16383)
+    data = spec_dng(raw, "RGGB", (0, 0, 0, 0), 16383, color_matrix=a @ np.linalg.inv(XYZ_FROM_SRGB))
+    f = decode_raw(data)
+    inner = f.pixels[4:-4, 4:-4].reshape(-1, 3) / 65535
+    np.testing.assert_allclose(inner, np.broadcast_to(srgb, inner.shape), rtol=1e-3)
+    assert f.metadata["decode"]["color_space"].startswith("linear sRGB")
+    cam = decode_raw(data, RawDecodeSettings(output_color="raw"))
+    np.testing.assert_allclose(cam.pixels[16, 24] / 65535, a @ srgb, rtol=1e-3)

@@ -133,6 +133,18 @@ def srgb_from_camera(cam_xyz: NDArray[np.float64]) -> NDArray[np.float64] | None
         return None
 
 
+def srgb_matrix(
+    rgb_cam: NDArray[np.float64], cam_xyz: NDArray[np.float64]
+) -> NDArray[np.float64] | None:
+    """Camera RGB → linear sRGB for this file: LibRaw's ``color_matrix`` (its ``rgb_cam``,
+    which for a DNG it builds from ColorMatrix1/2 and leaves ``rgb_xyz_matrix`` empty), else
+    one built from ``rgb_xyz_matrix`` (:func:`srgb_from_camera`), else ``None``."""
+    m = np.asarray(rgb_cam, dtype=np.float64)[:3, :3]
+    if m.shape == (3, 3) and np.any(m) and np.all(np.isfinite(m)):
+        return m
+    return srgb_from_camera(cam_xyz)
+
+
 def white_balance_multipliers(
     requested: str | tuple[float, float, float, float], camera_wb: list[float]
 ) -> tuple[NDArray[np.float64], str]:
@@ -338,6 +350,7 @@ def decode_raw(
             desc = raw.color_desc.decode("ascii", "replace") if raw.color_desc else _COLOR_NAMES
             camera_wb = list(raw.camera_whitebalance)
             cam_xyz = np.array(raw.rgb_xyz_matrix)
+            rgb_cam = np.array(raw.color_matrix)
             flip = int(raw.sizes.flip)
             other = raw.other
     except rawpy.LibRawError as exc:
@@ -361,7 +374,7 @@ def decode_raw(
     threshold = black + np.floor(settings.saturation_level * (white - black))
     saturated = raw_vis >= threshold
     wb, wb_source = white_balance_multipliers(settings.white_balance, camera_wb)
-    to_srgb = srgb_from_camera(cam_xyz) if settings.output_color == "srgb" else None
+    to_srgb = srgb_matrix(rgb_cam, cam_xyz) if settings.output_color == "srgb" else None
     if settings.mode == "mosaic":
         white_level = int(white - black_pc.max())
         if uniform:

@@ -218,7 +218,18 @@ def _camera_trigger(settings, dome):  # type: ignore[no-untyped-def]
     camera's remote line, never resent), when the config asks for it."""
     if getattr(settings, "trigger", "none") != "dome_shutter":
         return None
-    return lambda _exposure_s: dome.shutter()
+    from rti_rig.core.dome_link import DomeLinkError, LinkFault
+    from rti_rig.drivers.cameras.folder_watch import TriggerUnconfirmed
+
+    def fire(_exposure_s: float) -> None:
+        try:
+            dome.shutter()
+        except DomeLinkError as exc:
+            if exc.fault is LinkFault.TIMEOUT:  # sent, reply lost: the camera may have fired
+                raise TriggerUnconfirmed(f"{exc.device}: {exc.message}") from exc
+            raise
+
+    return fire
 
 
 def _session_hook(camera):  # type: ignore[no-untyped-def]
