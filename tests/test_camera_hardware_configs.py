@@ -276,6 +276,7 @@ def test_folder_watch_session_of_spec_written_dngs_gives_true_colour(dome, tmp_p
         assert d["source_file"].endswith(f"SHOT{step['index'] + 1}.DNG")
         (raw,) = step["originals"]
         assert (out / raw).read_bytes() == files[step["index"]]
+        assert d["raw_file"] == raw and d["camera_file"] == f"SHOT{step['index'] + 1}.DNG"
 
 
 def test_dslr_busy_after_every_shot_is_retried_and_the_session_completes(body, tmp_path):

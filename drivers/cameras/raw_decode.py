@@ -352,6 +352,12 @@ def decode_raw(
             cam_xyz = np.array(raw.rgb_xyz_matrix)
             rgb_cam = np.array(raw.color_matrix)
             flip = int(raw.sizes.flip)
+            per_channel_white = getattr(raw, "camera_white_level_per_channel", None)
+            white_per_channel = (
+                None
+                if per_channel_white is None or not any(per_channel_white)
+                else [int(v) for v in per_channel_white]
+            )
             other = raw.other
     except rawpy.LibRawError as exc:
         raise CaptureError(
@@ -419,6 +425,7 @@ def decode_raw(
         "black_level_by_color_index": [int(b) for b in black_pc],
         "black_correction": "exact per CFA site: (raw − black_c) / (white − black_c)",
         "white_level": white,
+        "white_level_per_channel": white_per_channel,
         "white_balance": wb_source if settings.mode != "mosaic" else "none (mosaic)",
         "white_balance_multipliers": None
         if settings.mode == "mosaic"

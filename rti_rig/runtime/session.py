@@ -223,7 +223,13 @@ class SessionFolder:
         base = self.names[index]
         jpg, tif = f"{base}.jpg", f"{LINEAR_DIR}/{base}.tif"
         decode = dict(frame.metadata.get("decode") or {})
-        originals = self._keep_originals(base, frame.metadata.get("originals") or [])
+        listed = frame.metadata.get("originals") or []
+        originals = self._keep_originals(base, listed)
+        for item, rel in zip(listed, originals, strict=True):
+            if decode.get("source_file") == str(item["path"]):
+                # where the decoded RAW is kept now, and the camera's own name for it
+                decode["raw_file"] = rel
+                decode["camera_file"] = originals[rel][1]
         sha = {name: digest for name, (digest, _) in originals.items()}
         sha[tif] = write_linear_tiff(
             self.root / tif, frame.pixels, description=_tiff_description(decode)
