@@ -337,6 +337,8 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
         f"Session time on the real rig: {result.rig_time_s:.1f} s"
         + (f" (simulated in {result.wall_time_s:.1f} s)" if dry else "")
     )
+    for note in folder.manifest.get("notices") or []:
+        err.print(f"[yellow]note:[/] {escape(str(note))}")
     for failure in result.teardown_failures:
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
     if result.finish_reason is FinishReason.CANCELLED:

@@ -13,7 +13,7 @@ from rti_rig.drivers.cameras.exposure import (
     predicted_saturated_fraction,
 )
 from rti_rig.drivers.cameras.raw_roundtrip import RawRoundTripCamera
-from rti_rig.drivers.cameras.settings import ExposureRule
+from rti_rig.drivers.cameras.settings import ExposureRule, RawDecodeSettings
 
 from rti_rig.core.devices import Frame
 
@@ -115,7 +115,7 @@ def test_meter_exposure_through_the_raw_path_converges_and_verifies(tmp_path):
         shots.append(t)
         return radiance * t
 
-    cam = RawRoundTripCamera("sim", render, output_dir=tmp_path)
+    cam = RawRoundTripCamera("sim", render, RawDecodeSettings(mode="mosaic"), output_dir=tmp_path)
     cam.connect()
     rule = ExposureRule(max_saturated_fraction=0.002, max_attempts=5)
     choice = meter_exposure(cam, rule, start_exposure_s=2.0)

@@ -100,7 +100,7 @@ def test_file_still_growing_is_not_taken(tmp_path):
     cam = watch(tmp_path, clock, timeout_s=5.0, poll_interval_s=0.125, stable_polls=3)
     cam.connect()
     f = cam.capture(0.5)
-    assert f.pixels.shape == (32, 32)
+    assert f.pixels.shape == (32, 32, 3)  # colour by default
     assert clock.now() == 1.0  # seen at 0.75, 0.875, 1.0: three equal sizes
 
 
@@ -143,3 +143,37 @@ def test_missing_folder_and_not_connected(tmp_path):
         watch(tmp_path / "nope", VirtualClock()).connect()
     with pytest.raises(CaptureError, match="not connected"):
         watch(tmp_path, VirtualClock()).capture(0.5)
+
+
+def test_trigger_whose_confirmation_is_lost_waits_for_the_file(tmp_path):
+    from rti_rig.drivers.cameras.folder_watch import TriggerUnconfirmed
+
+    fired = []
+
+    def trigger(exposure_s):
+        fired.append(exposure_s)
+        dng(tmp_path / "IMG_0001.dng")  # the camera did fire
+        raise TriggerUnconfirmed("dome: no reply within 0.5 s")
+
+    cam = FolderWatchCamera(
+        FolderWatchSettings(folder=tmp_path), clock=VirtualClock(), trigger=trigger
+    )
+    cam.connect()
+    f = cam.capture(0.5)
+    assert fired == [0.5]  # sent once, never resent
+    assert f.metadata["trigger_unconfirmed"] == "dome: no reply within 0.5 s"
+    assert any("confirmation was lost" in n for n in f.metadata["notices"])
+
+
+def test_trigger_unconfirmed_and_no_file_is_an_error_naming_both(tmp_path):
+    from rti_rig.drivers.cameras.folder_watch import TriggerUnconfirmed
+
+    def trigger(exposure_s):
+        raise TriggerUnconfirmed("dome: no reply within 0.5 s")
+
+    cam = FolderWatchCamera(
+        FolderWatchSettings(folder=tmp_path, timeout_s=1.0), clock=VirtualClock(), trigger=trigger
+    )
+    cam.connect()
+    with pytest.raises(CaptureError, match=r"no new file.*not confirmed either.*no reply"):
+        cam.capture(0.5)

@@ -231,7 +231,7 @@ def test_connect_applies_settings_and_capture_downloads_and_decodes_raw(tmp_path
     assert body.config["shutterspeed"] == "1/125"
     assert f.exposure_s == pytest.approx(1 / 125)
     assert f.gain == 100.0 and f.metadata["gain_unit"] == "iso"
-    assert f.pixels.dtype == np.uint16 and f.pixels.shape == (32, 48)
+    assert f.pixels.dtype == np.uint16 and f.pixels.shape == (32, 48, 3)  # colour by default
     # linear: 0.25 × (60/125) of full scale, black removed
     assert np.mean(f.pixels) / f.white_level == pytest.approx(0.25 * 60 / 125, abs=1e-4)
     src = tmp_path / "cap0001_IMG_0001.DNG"
@@ -290,10 +290,10 @@ def test_busy_is_retried_on_the_injected_clock(tmp_path):
     with camera(body, tmp_path, clock=clock, retry_delay_s=0.5) as cam:
         f = cam.capture(1 / 60)
     assert body.shots == 1 and cam.retries_used == 2
-    assert clock.now() == pytest.approx(1.0)  # two waits of 0.5 s, none real
+    assert clock.now() == pytest.approx(1.5)  # waits of 0.5 s then 1.0 s (backoff), none real
     assert f.timestamp_s == pytest.approx(0.0)
     assert f.metadata["capture_started_s"] == 0.0
-    assert f.metadata["capture_finished_s"] == pytest.approx(1.0)
+    assert f.metadata["capture_finished_s"] == pytest.approx(1.5)
 
 
 def test_busy_forever_gives_up_with_a_clear_error(tmp_path):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import SMALL_DOME, write_config
+from conftest import REPO, SMALL_DOME, write_config
 
 from rti_rig.app.config import default_config_path, load_rig_config, rig_geometry
 from rti_rig.core.errors import ConfigError
@@ -122,3 +122,14 @@ def test_missing_backend_with_device_tables_is_refused(tmp_path: Path) -> None:
     assert load_rig_config(write_config(tmp_path, plain, "plain.toml")).config.backend == (
         "simulated"
     )
+
+
+def test_dome_shutter_trigger_needs_a_dome(tmp_path):
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.core.errors import ConfigError
+
+    text = (REPO / "rig_configs" / "simulated_arm.toml").read_text()
+    text = text.replace('backend = "emulated"', 'backend = "hardware"')
+    text += '\n[camera.device]\nkind = "folder_watch"\nfolder = "."\ntrigger = "dome_shutter"\n'
+    with pytest.raises(ConfigError, match=r"camera\.device\.trigger.*needs a dome"):
+        load_rig_config(write_config(tmp_path, text))

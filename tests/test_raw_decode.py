@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -18,6 +20,9 @@ from rti_rig.drivers.cameras.settings import RawDecodeSettings
 from rti_rig.core.errors import CaptureError
 
 BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
+
+
+MOSAIC = RawDecodeSettings(mode="mosaic")
 
 
 def random_mosaic(seed: int = 0, shape: tuple[int, int] = (48, 64)) -> np.ndarray:
@@ -41,7 +46,7 @@ def test_mosaic_mode_is_bit_exact_from_file(tmp_path):
         exposure_s=1 / 125,
         iso=200,
     )
-    frame = decode_raw(path)
+    frame = decode_raw(path, MOSAIC)
     assert frame.pixels.dtype == np.uint16
     assert frame.pixels.shape == mosaic.shape
     np.testing.assert_array_equal(frame.pixels, mosaic.astype(np.int64) - BLACK)
@@ -57,7 +62,7 @@ def test_mosaic_mode_is_bit_exact_from_file(tmp_path):
 def test_per_channel_black_levels_are_removed_per_photosite():
     mosaic = random_mosaic(4)
     blacks = (500, 510, 520, 530)  # R, G (row 0), G (row 1), B
-    f = decode_raw(dng_bytes(mosaic, black_level=blacks, white_level=WHITE))
+    f = decode_raw(dng_bytes(mosaic, black_level=blacks, white_level=WHITE), MOSAIC)
     per_site = np.tile(np.array(blacks).reshape(2, 2), (24, 32))
     np.testing.assert_array_equal(
         f.pixels, np.clip(mosaic.astype(np.int64) - per_site, 0, WHITE - 530)
@@ -70,8 +75,8 @@ def test_bytes_and_file_decode_identically(tmp_path):
     mosaic = random_mosaic(3)
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
     (tmp_path / "a.dng").write_bytes(data)
-    a = decode_raw(data)
-    b = decode_raw(tmp_path / "a.dng")
+    a = decode_raw(data, MOSAIC)
+    b = decode_raw(tmp_path / "a.dng", MOSAIC)
     np.testing.assert_array_equal(a.pixels, b.pixels)
     assert a.metadata["source_file"] is None
 
@@ -96,7 +101,7 @@ def test_postprocess_modes_are_linear_and_never_rescaled(mode):
 def test_unity_white_balance_keeps_channel_ratios_camera_wb_changes_them():
     mosaic = patch_mosaic([0.4, 0.4, 0.4])
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE, as_shot_neutral=(0.5, 1.0, 0.8))
-    unity = decode_raw(data, RawDecodeSettings(mode="half"))
+    unity = decode_raw(data, RawDecodeSettings(mode="half", white_balance="unity"))
     cam = decode_raw(data, RawDecodeSettings(mode="half", white_balance="camera"))
     px = unity.pixels[8, 2].astype(float)
     assert px[0] == pytest.approx(px[1], rel=1e-3) == pytest.approx(px[2], rel=1e-3)
@@ -105,8 +110,9 @@ def test_unity_white_balance_keeps_channel_ratios_camera_wb_changes_them():
     assert cpx[2] / cpx[1] == pytest.approx(1.25, rel=0.02)  # 1 / 0.8 for blue
 
 
+@pytest.mark.parametrize("mode", ["half", "demosaic"])
 @pytest.mark.parametrize("pattern", ["RGGB", "BGGR", "GRBG", "GBRG"])
-def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
+def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern, mode):
     h, w = 24, 24
     rgb = np.zeros((h, w, 3))
     rgb[..., 0], rgb[..., 1], rgb[..., 2] = 0.2, 0.5, 0.8
@@ -117,7 +123,7 @@ def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
             black_level=BLACK,
             white_level=WHITE,
         ),
-        RawDecodeSettings(mode="half"),
+        RawDecodeSettings(mode=mode),
     )
     assert frame.metadata["cfa_pattern"] == pattern
     np.testing.assert_allclose(frame.pixels[5, 5] / 65535, [0.2, 0.5, 0.8], atol=2e-4)
@@ -126,7 +132,7 @@ def test_cfa_pattern_places_colours_where_the_decoder_expects_them(pattern):
 def test_saturation_detected_on_raw_and_pinned_through_processing():
     mosaic = patch_mosaic([0.3, 1.5], width=16)  # second stripe clips at the white level
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
-    m = decode_raw(data)
+    m = decode_raw(data, MOSAIC)
     assert m.saturated_fraction == pytest.approx(0.5)
     assert m.metadata["saturated_fraction"] == pytest.approx(0.5)
     h = decode_raw(data, RawDecodeSettings(mode="half"))
@@ -139,15 +145,15 @@ def test_saturation_detected_on_raw_and_pinned_through_processing():
 def test_saturation_level_below_nominal_white():
     mosaic = patch_mosaic([0.3, 0.97], width=16)
     data = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
-    assert decode_raw(data).saturated_fraction == 0.0
-    f = decode_raw(data, RawDecodeSettings(saturation_level=0.95))
+    assert decode_raw(data, MOSAIC).saturated_fraction == 0.0
+    f = decode_raw(data, RawDecodeSettings(mode="mosaic", saturation_level=0.95))
     assert f.saturated_fraction == pytest.approx(0.5)
     assert np.all(f.pixels[:, 16:] == f.white_level)
 
 
 def test_underexposure_fraction():
     mosaic = patch_mosaic([0.0, 0.0005, 0.5, 0.5])
-    f = decode_raw(dng_bytes(mosaic, black_level=BLACK, white_level=WHITE))
+    f = decode_raw(dng_bytes(mosaic, black_level=BLACK, white_level=WHITE), MOSAIC)
     assert f.metadata["underexposed_fraction"] == pytest.approx(0.5)
     assert exposure_stats(f.pixels, f.white_level, 0.0)["underexposed_fraction"] == 0.25
 
@@ -159,9 +165,11 @@ def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
     light = linear_to_mosaic(scene + dark_lin, "RGGB", BLACK, WHITE)
     dark = linear_to_mosaic(dark_lin, "RGGB", BLACK, WHITE)
     write_dng(tmp_path / "dark.dng", dark, black_level=BLACK, white_level=WHITE, exposure_s=0.5)
-    dark_frame = decode_raw(tmp_path / "dark.dng")
+    dark_frame = decode_raw(tmp_path / "dark.dng", MOSAIC)
     img = decode_raw(
-        dng_bytes(light, black_level=BLACK, white_level=WHITE, exposure_s=0.5), dark=dark_frame
+        dng_bytes(light, black_level=BLACK, white_level=WHITE, exposure_s=0.5),
+        MOSAIC,
+        dark=dark_frame,
     )
     assert img.metadata["dark_subtracted"] is True
     assert img.metadata["dark_file"] == str(tmp_path / "dark.dng")
@@ -173,21 +181,23 @@ def test_dark_subtraction_keeps_saturated_pixels_flagged(tmp_path):
 
 def test_dark_with_other_exposure_or_shape_is_refused():
     a = decode_raw(
-        dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE, exposure_s=0.5)
+        dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE, exposure_s=0.5), MOSAIC
     )
     b = decode_raw(
-        dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE, exposure_s=0.25)
+        dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE, exposure_s=0.25), MOSAIC
     )
     with pytest.raises(CaptureError, match="exposure"):
         subtract_dark(a, b)
-    c = decode_raw(dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE))
+    c = decode_raw(
+        dng_bytes(random_mosaic(2, (48, 48)), black_level=BLACK, white_level=WHITE), MOSAIC
+    )
     with pytest.raises(CaptureError, match="shape"):
         subtract_dark(a, c)
 
 
 def test_average_frames_is_a_rounded_mean():
-    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE))
-    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE))
+    a = decode_raw(dng_bytes(random_mosaic(1), black_level=BLACK, white_level=WHITE), MOSAIC)
+    b = decode_raw(dng_bytes(random_mosaic(2), black_level=BLACK, white_level=WHITE), MOSAIC)
     m = average_frames([a, b])
     want = np.rint((a.pixels.astype(float) + b.pixels) / 2).astype(np.uint16)
     np.testing.assert_array_equal(m.pixels, want)
@@ -197,9 +207,9 @@ def test_unreadable_and_missing_files_name_the_file(tmp_path):
     bad = tmp_path / "broken.dng"
     bad.write_bytes(b"not a raw file at all" * 10)
     with pytest.raises(CaptureError, match=r"broken\.dng"):
-        decode_raw(bad)
+        decode_raw(bad, MOSAIC)
     with pytest.raises(CaptureError, match="not found"):
-        decode_raw(tmp_path / "missing.dng")
+        decode_raw(tmp_path / "missing.dng", MOSAIC)
 
 
 def test_dng_writer_validates_its_input():
@@ -235,7 +245,9 @@ def test_any_dng_round_trips_bit_exactly(h, w, black, span, pattern, seed):
     white = min(black + span, 65535)
     rng = np.random.default_rng(seed)
     mosaic = rng.integers(black, white, (h, w), endpoint=False).astype(np.uint16)
-    f = decode_raw(dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white))
+    f = decode_raw(
+        dng_bytes(mosaic, cfa_pattern=pattern, black_level=black, white_level=white), MOSAIC
+    )
     np.testing.assert_array_equal(f.pixels, mosaic.astype(np.int64) - black)
     assert f.white_level == white - black
     assert f.metadata["cfa_pattern"] == pattern
@@ -256,3 +268,78 @@ def test_half_size_saturation_mask_fits_odd_sensor_sizes():
     even = np.zeros((4, 6), dtype=bool)
     even[3, 5] = True
     np.testing.assert_array_equal(half_size_mask(even, 2, 3), [[0, 0, 0], [0, 0, 1]])
+
+
+@pytest.mark.parametrize("mode", ["half", "demosaic"])
+def test_unequal_black_levels_are_corrected_exactly_in_colour_modes(mode):
+    # blacks 512/600/540/580 at white 4095: LibRaw's min-black scaling would be 2.6 % off
+    blacks = (512, 600, 540, 580)
+    rgb = np.broadcast_to(np.array([0.2, 0.5, 0.8]), (32, 48, 3))
+    h_, w_ = rgb.shape[:2]
+    raw = np.empty((h_, w_), np.uint16)
+    codes = (0, 1, 1, 2)  # RGGB
+    for k, (dy, dx) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
+        raw[dy::2, dx::2] = np.rint(blacks[k] + rgb[dy::2, dx::2, codes[k]] * (4095 - blacks[k]))
+    f = decode_raw(
+        dng_bytes(raw, black_level=blacks, white_level=4095),
+        RawDecodeSettings(mode=mode, white_balance="unity"),
+    )
+    inner = f.pixels[6:-6, 6:-6].reshape(-1, 3) / 65535
+    np.testing.assert_allclose(inner, np.broadcast_to([0.2, 0.5, 0.8], inner.shape), rtol=1e-3)
+    assert f.metadata["decode"]["black_level_per_channel"] == {
+        "R": 512,
+        "G": 600,
+        "B": 580,
+        "G2": 540,
+    }
+
+
+def test_srgb_from_camera_keeps_neutrals_and_is_identity_for_srgb_primaries():
+    from rti_rig.drivers.cameras.raw_decode import XYZ_FROM_SRGB, srgb_from_camera
+
+    assert srgb_from_camera(np.zeros((4, 3))) is None  # minimal DNG: no matrix, no conversion
+    ident = srgb_from_camera(np.linalg.inv(XYZ_FROM_SRGB))
+    np.testing.assert_allclose(ident, np.eye(3), atol=1e-9)
+    rng = np.random.default_rng(3)
+    cam_xyz = np.eye(3) + 0.2 * rng.standard_normal((3, 3))
+    m = srgb_from_camera(cam_xyz)
+    np.testing.assert_allclose(m @ np.ones(3), np.ones(3), atol=1e-9)  # white stays white
+
+
+def test_orientation_is_recorded_not_applied_and_a_rotation_is_noticed():
+    import tifffile
+
+    buf = dng_bytes(random_mosaic(), black_level=BLACK, white_level=WHITE)
+    # rewrite the file with an Orientation tag (6: rotate 90° CW to view)
+    with tifffile.TiffFile(io.BytesIO(buf)) as tif:
+        arr = tif.pages.first.asarray()
+    upright = decode_raw(buf)
+    assert upright.metadata["decode"]["orientation"]["camera_rotated"] is False
+    assert upright.metadata["notices"] == []
+    from dng_spec_writer import dng as spec_dng
+
+    rotated = decode_raw(spec_dng(arr, "RGGB", (BLACK,) * 4, WHITE, orientation=6))
+    o = rotated.metadata["decode"]["orientation"]
+    assert o["orientation_tag"] == 6 and o["libraw_flip"] == 6 and o["applied"] is False
+    assert rotated.pixels.shape[:2] == arr.shape  # not rotated
+    assert "sensor orientation" in rotated.metadata["notices"][0]
+
+
+def test_file_colour_matrix_takes_a_camera_back_to_srgb():
+    """A camera whose primaries mix sRGB (camera = A · sRGB) and says so in ColorMatrix1
+    (XYZ → camera = A · sRGB←XYZ, DNG 1.4 §6) decodes to the scene's sRGB values."""
+    from dng_spec_writer import dng as spec_dng
+    from dng_spec_writer import mosaic_from_rgb
+    from rti_rig.drivers.cameras.raw_decode import XYZ_FROM_SRGB
+
+    srgb = np.array([0.2, 0.5, 0.6])
+    a = np.array([[0.7, 0.25, 0.05], [0.15, 0.75, 0.1], [0.05, 0.2, 0.75]])
+    camera_rgb = np.broadcast_to(a @ srgb, (32, 48, 3))
+    raw = mosaic_from_rgb(np.array(camera_rgb), "RGGB", (0, 0, 0, 0), 16383)
+    data = spec_dng(raw, "RGGB", (0, 0, 0, 0), 16383, color_matrix=a @ np.linalg.inv(XYZ_FROM_SRGB))
+    f = decode_raw(data)
+    inner = f.pixels[4:-4, 4:-4].reshape(-1, 3) / 65535
+    np.testing.assert_allclose(inner, np.broadcast_to(srgb, inner.shape), rtol=1e-3)
+    assert f.metadata["decode"]["color_space"].startswith("linear sRGB")
+    cam = decode_raw(data, RawDecodeSettings(output_color="raw"))
+    np.testing.assert_allclose(cam.pixels[16, 24] / 65535, a @ srgb, rtol=1e-3)

@@ -49,6 +49,13 @@ RAW_SUFFIXES = {
 }
 
 
+class TriggerUnconfirmed(Exception):
+    """The trigger was sent but its confirmation was lost (e.g. the dome's reply to a shutter
+    pulse timed out): the camera may well have fired. The pulse is never resent (that could
+    take a second picture); the camera waits for the file, and only if none comes is it an
+    error."""
+
+
 def is_raw_file(path: Path) -> bool:
     """True for file names LibRaw should decode (by suffix)."""
     return path.suffix.lower() in RAW_SUFFIXES
@@ -148,10 +155,31 @@ class FolderWatchCamera:
         if self._seen is None:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
         started = self._clock.now()
+        unconfirmed: str | None = None
         if self._trigger is not None:
-            self._trigger(exposure_s)
-        path = self.wait_for_file()
-        return self._decode(path, exposure_s, started)
+            try:
+                self._trigger(exposure_s)
+            except TriggerUnconfirmed as exc:
+                unconfirmed = str(exc)
+        try:
+            path = self.wait_for_file()
+        except CaptureError as exc:
+            if unconfirmed is None:
+                raise
+            raise CaptureError(
+                self.name,
+                f"{exc.message}; the trigger was not confirmed either ({unconfirmed})",
+                "wait for file",
+            ) from exc
+        frame = self._decode(path, exposure_s, started)
+        if unconfirmed is not None:
+            frame.metadata["trigger_unconfirmed"] = unconfirmed
+            frame.metadata.setdefault("notices", [])
+            frame.metadata["notices"] = [
+                *frame.metadata["notices"],
+                "the trigger's confirmation was lost but the camera's file arrived",
+            ]
+        return frame
 
     def _decode(self, path: Path, exposure_s: float, started: float) -> Frame:
         s = self.settings
@@ -190,6 +218,9 @@ class FolderWatchCamera:
         metadata.update(
             {
                 "camera": self.name,
+                # the session copies the file under raw/ with its own name (the watched
+                # folder belongs to another program)
+                "originals": [{"path": str(path), "name": path.name}],
                 "exposure_requested_s": exposure_s,
                 "exposure_source": "file" if file_exposure else "requested",
                 "capture_started_s": started,

@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import math
 import re
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
@@ -40,7 +41,27 @@ GP_ERROR_HINTS = {
     "or a file manager mounted it): stop that program or unmount the camera",
     -105: "no camera model detected: is it on, connected, and in PC/PTP mode?",
     -110: "camera busy: still writing the previous file? raise busy_retries or retry_delay_s",
+    -115: "the camera's memory card is full: free space on it, or set capture_target = "
+    "'Internal RAM' so that shots are only downloaded, never stored on the card",
 }
+#: Codes with which libgphoto2 reports a camera that went away (switched off, cable pulled,
+#: auto power-off): -7 I/O error, -10 timeout, -52 USB device not found, -105 model not found.
+GONE_CODES = frozenset({-7, -10, -52, -105})
+
+
+class CameraGoneError(CaptureError):
+    """The camera stopped answering mid-session (switched off, unplugged, powered down).
+
+    The step it was taking is not recorded; every image already committed is kept, and
+    ``rti-rig run --resume SESSION`` continues from the first missing image once the camera is
+    back.
+    """
+
+
+class CardFullError(CaptureError):
+    """The camera refused to shoot because its memory card is full."""
+
+
 NO_CAMERA_HELP = (
     "gphoto2 found no camera: check the USB cable, that the camera is switched on and in PC/PTP "
     "mode, and that no other program (gvfs-gphoto2-volume-monitor, a gphoto2 shell, the vendor "
@@ -108,6 +129,7 @@ class Gphoto2Camera:
         self._shutters: list[tuple[float, str]] = []
         self._shutter_label: str | None = None
         self._count = 0
+        self._staging_tmp: Path | None = None
         self.retries_used = 0
         self.camera_model: str | None = None
 
@@ -118,6 +140,7 @@ class Gphoto2Camera:
         """Run one gphoto2 call, retrying the transient (busy) codes with the injected clock."""
         gp = self._gp
         s = self.settings
+        delay = s.retry_delay_s
         for attempt in range(s.busy_retries + 1):
             try:
                 return fn()
@@ -125,13 +148,23 @@ class Gphoto2Camera:
                 code = getattr(exc, "code", None)
                 if code in s.retry_codes and attempt < s.busy_retries:
                     self.retries_used += 1
-                    self._clock.sleep(s.retry_delay_s)
+                    self._clock.sleep(delay)
+                    delay = min(delay * s.retry_backoff, s.retry_max_delay_s)
                     continue
                 hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
                 tries = f" after {attempt + 1} attempts" if attempt else ""
-                raise error(
-                    self.name, f"gphoto2 error {code} ({exc}){tries}: {hint}", command
-                ) from exc
+                text = f"gphoto2 error {code} ({exc}){tries}: {hint}"
+                if code in GONE_CODES and self._cam is not None:
+                    raise CameraGoneError(
+                        self.name,
+                        f"the camera stopped answering during '{command}' (switched off, "
+                        f"unplugged or powered down?); {text}. Images already taken are kept: "
+                        "reconnect it, then continue with 'rti-rig run --resume SESSION'",
+                        command,
+                    ) from exc
+                if code == -115:
+                    raise CardFullError(self.name, text, command) from exc
+                raise error(self.name, text, command) from exc
         raise AssertionError("unreachable")  # pragma: no cover
 
     # -- lifecycle -------------------------------------------------------------------------
@@ -283,8 +316,6 @@ class Gphoto2Camera:
             raise CaptureError(
                 self.name, "camera is not connected; call connect() first", "capture"
             )
-        if self.output_dir is None:
-            raise CaptureError(self.name, "no output_dir set for downloaded files", "capture")
         s = self.settings
         gp = self._gp
         cam = self._cam
@@ -313,12 +344,12 @@ class Gphoto2Camera:
                 "the camera's RAW (or RAW+JPEG) value",
                 "capture",
             )
-        self.output_dir.mkdir(parents=True, exist_ok=True)
+        staging = self._staging_dir()
         saved: dict[str, Path] = {}
         for folder, name in files:
             if not is_raw_file(Path(name)) and not s.keep_jpeg:
                 continue
-            target = self.output_dir / f"cap{self._count:04d}_{name}"
+            target = _unused(staging, f"cap{self._count:04d}_{name}")
             camera_file = self._call(
                 "download", lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL)
             )
@@ -330,6 +361,7 @@ class Gphoto2Camera:
         jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
         iso = _number(s.iso) or decoded.gain
         metadata = dict(decoded.metadata)
+        camera_path = {n: f"{f.rstrip('/')}/{n}" for f, n in files}
         metadata.update(
             {
                 "camera": self.name,
@@ -339,7 +371,10 @@ class Gphoto2Camera:
                 "iso": s.iso,
                 "aperture": s.aperture,
                 "gain_unit": "iso",
-                "camera_files": [f"{f.rstrip('/')}/{n}" for f, n in files],
+                "camera_files": list(camera_path.values()),
+                # the session keeps these under raw/ with its own names (the camera's in the
+                # journal): a wrapped or repeated camera counter can never overwrite a shot
+                "originals": [{"path": str(p), "name": camera_path[n]} for n, p in saved.items()],
                 "jpeg_file": jpeg[0] if jpeg else None,
                 "capture_started_s": t_capture,
                 "capture_finished_s": self._clock.now(),
@@ -353,6 +388,16 @@ class Gphoto2Camera:
             timestamp_s=t_capture,
             metadata=metadata,
         )
+
+    def _staging_dir(self) -> Path:
+        """Where downloads land: the session's ``raw/.incoming`` once the rig told the camera
+        its session (``output_dir``), else a private temporary folder (metering shots)."""
+        if self.output_dir is not None:
+            self.output_dir.mkdir(parents=True, exist_ok=True)
+            return self.output_dir
+        if self._staging_tmp is None:
+            self._staging_tmp = Path(tempfile.mkdtemp(prefix=f"rti-rig-{self.name}-"))
+        return self._staging_tmp
 
     def _more_files(self, files: list[tuple[str, str]]) -> list[tuple[str, str]]:
         """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet."""
@@ -380,6 +425,16 @@ class Gphoto2Camera:
             # files in camera RAM may vanish once downloaded
             with contextlib.suppress(gp.GPhoto2Error):
                 self._cam.file_delete(folder, name)
+
+
+def _unused(folder: Path, name: str) -> Path:
+    """``folder/name``, or with a ``-2``, ``-3``… suffix if taken: never overwrite a download."""
+    target = folder / name
+    n = 2
+    while target.exists():
+        target = folder / f"{Path(name).stem}-{n}{Path(name).suffix}"
+        n += 1
+    return target
 
 
 def _number(text: str | None) -> float:

@@ -1,11 +1,15 @@
-"""RAW files to linear 16-bit frames through rawpy (LibRaw), with nothing automatic.
+"""RAW files to linear 16-bit frames: LibRaw (rawpy) reads the file, the rest is ours.
 
 Why a module of its own: every camera path that yields RAW (gphoto2 downloads, watched folders,
 the simulated camera's DNGs) must produce *the same* linear data, so they all call
-:func:`decode_raw`. The settings that matter for radiometry (checked against rawpy 0.28 /
-LibRaw 0.22 with synthetic DNGs in tests/test_raw_decode.py):
-gamma (1, 1), ``no_auto_bright``, 16-bit output, ``adjust_maximum_thr=0`` (the default 0.75
-rescales to the data maximum and breaks linearity), a fixed white balance, no rotation.
+:func:`decode_raw`. LibRaw only unpacks the photosites and the metadata (CFA pattern, black
+levels per channel, white level, white balance, colour matrix, orientation); black removal,
+white balance, demosaic and colour are done here, because LibRaw's ``postprocess`` subtracts
+each channel's black but scales every channel by ``white − min(black)``: with unequal black
+levels per CFA site that is a per-channel gain error of ``(black_c − black_min) / (white −
+black_min)`` (2.6 % for blacks 512/600 at white 4095). Here each site is normalised by its own
+``white − black_c`` exactly. Nothing is automatic (no auto-bright, no rescaling to the data
+maximum), nothing is rotated.
 """
 
 from __future__ import annotations
@@ -14,10 +18,12 @@ import io
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import rawpy
 from numpy.typing import NDArray
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
+from scipy.ndimage import correlate
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
@@ -83,31 +89,120 @@ def _pattern_name(raw: rawpy.RawPy) -> str:
     return "".join(desc[int(i)] if int(i) < len(desc) else "?" for i in pattern.ravel())
 
 
-def _postprocess_params(settings: RawDecodeSettings) -> dict[str, Any]:
-    params: dict[str, Any] = {
-        "gamma": (1, 1),
-        "no_auto_bright": True,
-        "output_bps": 16,
-        "user_flip": 0,
-        "adjust_maximum_thr": 0.0,
-        "highlight_mode": rawpy.HighlightMode.Clip,
-        "use_auto_wb": False,
-        "output_color": rawpy.ColorSpace.raw
-        if settings.output_color == "raw"
-        else rawpy.ColorSpace.sRGB,
-    }
-    wb = settings.white_balance
-    if wb == "unity":
-        params["user_wb"] = [1.0, 1.0, 1.0, 1.0]
-    elif wb == "camera":
-        params["use_camera_wb"] = True
-    else:
-        params["user_wb"] = [float(x) for x in wb]
-    if settings.mode == "half":
-        params["half_size"] = True
-    else:
-        params["demosaic_algorithm"] = rawpy.DemosaicAlgorithm.LINEAR
-    return params
+#: sRGB (linear, D65) → CIE XYZ, IEC 61966-2-1; dcraw/LibRaw build camera → sRGB from it.
+XYZ_FROM_SRGB = np.array(
+    [
+        [0.4124564, 0.3575761, 0.1804375],
+        [0.2126729, 0.7151522, 0.0721750],
+        [0.0193339, 0.1191920, 0.9503041],
+    ]
+)
+#: LibRaw's Orientation codes (``sizes.flip``) and what they mean for the picture.
+FLIP_NAMES = {0: "none", 3: "rotated 180°", 5: "rotated 90° CCW", 6: "rotated 90° CW"}
+#: TIFF/EXIF Orientation tag values (TIFF 6.0 tag 274).
+ORIENTATION_NAMES = {
+    1: "top-left (as stored)",
+    2: "mirrored horizontally",
+    3: "rotated 180°",
+    4: "mirrored vertically",
+    5: "transposed",
+    6: "rotate 90° CW to view",
+    7: "transversed",
+    8: "rotate 90° CCW to view",
+}
+
+
+def srgb_from_camera(cam_xyz: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """Camera RGB (white-balanced) → linear sRGB, from LibRaw's ``rgb_xyz_matrix`` (pure).
+
+    As dcraw does: camera ← sRGB is ``cam_xyz · XYZ_FROM_SRGB``, each row normalised to sum 1
+    (so a white-balanced neutral stays neutral), and inverted. ``None`` when the file carries
+    no usable matrix (all zeros, as in a minimal DNG): the colour then stays camera RGB.
+    """
+    m = np.asarray(cam_xyz, dtype=np.float64)[:3, :3]
+    if not np.any(m) or not np.all(np.isfinite(m)):
+        return None
+    cam_rgb = m @ XYZ_FROM_SRGB
+    sums = cam_rgb.sum(axis=1, keepdims=True)
+    if np.any(np.abs(sums) < 1e-9):
+        return None
+    cam_rgb = cam_rgb / sums
+    try:
+        return np.linalg.inv(cam_rgb)
+    except np.linalg.LinAlgError:
+        return None
+
+
+def srgb_matrix(
+    rgb_cam: NDArray[np.float64], cam_xyz: NDArray[np.float64]
+) -> NDArray[np.float64] | None:
+    """Camera RGB → linear sRGB for this file: LibRaw's ``color_matrix`` (its ``rgb_cam``,
+    which for a DNG it builds from ColorMatrix1/2 and leaves ``rgb_xyz_matrix`` empty), else
+    one built from ``rgb_xyz_matrix`` (:func:`srgb_from_camera`), else ``None``."""
+    m = np.asarray(rgb_cam, dtype=np.float64)[:3, :3]
+    if m.shape == (3, 3) and np.any(m) and np.all(np.isfinite(m)):
+        return m
+    return srgb_from_camera(cam_xyz)
+
+
+def white_balance_multipliers(
+    requested: str | tuple[float, float, float, float], camera_wb: list[float]
+) -> tuple[NDArray[np.float64], str]:
+    """Multipliers per colour index (R, G, B, G2) normalised to green = 1, and what they are."""
+    if requested == "unity":
+        return np.ones(4), "unity"
+    if requested == "camera":
+        wb = np.asarray(camera_wb, dtype=np.float64)
+        if wb.size < 3 or wb[0] <= 0 or wb[1] <= 0 or wb[2] <= 0:
+            return np.ones(4), "unity (the file has no as-shot white balance)"
+        wb = np.resize(wb, 4)
+        if wb[3] <= 0:
+            wb[3] = wb[1]
+        return wb / wb[1], "camera (as shot)"
+    wb = np.asarray(requested, dtype=np.float64)
+    return wb / wb[1], "user"
+
+
+_K_RB = np.array([[1.0, 2.0, 1.0], [2.0, 4.0, 2.0], [1.0, 2.0, 1.0]])
+_K_G = np.array([[0.0, 1.0, 0.0], [1.0, 4.0, 1.0], [0.0, 1.0, 0.0]])
+
+
+def bilinear_demosaic(
+    values: NDArray[np.float32], channel: NDArray[np.intp]
+) -> NDArray[np.float32]:
+    """Bilinear demosaic by normalised convolution (pure): each photosite keeps its own value,
+    a missing colour is the weighted mean of that colour's neighbours (4-neighbours for green,
+    the 3×3 ring for red and blue). Borders use only the neighbours that exist."""
+    h, w = values.shape
+    out = np.empty((h, w, 3), dtype=np.float32)
+    for c in range(3):
+        mask = (channel == c).astype(np.float32)
+        k = _K_G if c == 1 else _K_RB
+        num = correlate(values * mask, k, mode="constant")
+        den = correlate(mask, k, mode="constant")
+        with np.errstate(invalid="ignore", divide="ignore"):
+            interp = np.where(den > 0, num / np.maximum(den, 1e-12), 0.0)
+        out[..., c] = np.where(mask > 0, values, interp)
+    return out
+
+
+def half_size(values: NDArray[np.float32], channel: NDArray[np.intp]) -> NDArray[np.float32]:
+    """2×2 super-pixels (pure): red, the mean of the two greens, blue; no interpolation."""
+    h, w = (values.shape[0] // 2) * 2, (values.shape[1] // 2) * 2
+    v = (
+        values[:h, :w]
+        .reshape(h // 2, 2, w // 2, 2)
+        .transpose(0, 2, 1, 3)
+        .reshape(h // 2, w // 2, 4)
+    )
+    ch = channel[:2, :2].ravel()
+    out = np.empty((h // 2, w // 2, 3), dtype=np.float32)
+    for c in range(3):
+        sites = np.flatnonzero(ch == c)
+        if sites.size == 0:
+            raise ValueError("the CFA's 2×2 tile lacks a colour: half-size needs a Bayer pattern")
+        out[..., c] = v[..., sites].mean(axis=-1)
+    return out
 
 
 def half_size_mask(mask: NDArray[np.bool_], h: int, w: int) -> NDArray[np.bool_]:
@@ -131,6 +226,104 @@ def _dilate(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     return out
 
 
+#: OpenCV's Bayer conversion codes, by our CFA name (OpenCV names a pattern by the second row's
+#: second and third pixels, hence the apparent swap; checked for all four patterns in the tests).
+_CV_BAYER = {
+    "RGGB": cv2.COLOR_BayerBG2RGB,
+    "BGGR": cv2.COLOR_BayerRG2RGB,
+    "GRBG": cv2.COLOR_BayerGB2RGB,
+    "GBRG": cv2.COLOR_BayerGR2RGB,
+}
+
+
+def _colour(
+    raw: NDArray[np.uint16],
+    colors: NDArray[np.integer],
+    black_pc: NDArray[np.int64],
+    white: int,
+    wb: NDArray[np.float64],
+    rgb_index: NDArray[np.intp],
+    mode: str,
+) -> NDArray[np.float32]:
+    """Black-corrected (per site, exactly), white-balanced linear RGB, full or half size.
+
+    A 2×2 Bayer sensor (the usual case) is handled site by site on strided views, and
+    demosaiced with OpenCV's bilinear Bayer conversion; any other CFA goes through the
+    per-photosite path and :func:`bilinear_demosaic`.
+    """
+    h, w = raw.shape
+    tile = colors[:2, :2] if colors.shape[0] >= 2 and colors.shape[1] >= 2 else None
+    names = "".join("RGB"[rgb_index[int(c)]] for c in tile.ravel()) if tile is not None else ""
+    bayer = (
+        names in _CV_BAYER
+        and h % 2 == 0
+        and w % 2 == 0
+        and np.array_equal(colors, np.tile(tile, (h // 2, w // 2)))
+    )
+    gain = wb / (white - black_pc)  # per colour index: (raw − black_c) × gain_c
+    if not bayer:
+        norm = (raw.astype(np.float32) - black_pc[colors].astype(np.float32)) * gain.astype(
+            np.float32
+        )[colors]
+        norm = np.clip(norm, 0.0, wb.astype(np.float32)[colors])
+        channel = rgb_index[colors]
+        return half_size(norm, channel) if mode == "half" else bilinear_demosaic(norm, channel)
+    sites = {}
+    for dy in (0, 1):
+        for dx in (0, 1):
+            c = int(tile[dy, dx])
+            v = raw[dy::2, dx::2].astype(np.float32)
+            v -= np.float32(black_pc[c])
+            v *= np.float32(gain[c])
+            np.clip(v, 0.0, np.float32(wb[c]), out=v)
+            sites[(dy, dx)] = (rgb_index[c], v)
+    if mode == "half":
+        out = np.empty((h // 2, w // 2, 3), dtype=np.float32)
+        greens = [v for ch, v in sites.values() if ch == 1]
+        for ch, v in sites.values():
+            if ch != 1:
+                out[..., ch] = v
+        out[..., 1] = (greens[0] + greens[1]) * np.float32(0.5)
+        return out
+    top = float(max(wb.max(), 1.0))  # white-balanced values reach up to the largest multiplier
+    plane = np.empty((h, w), dtype=np.float32)
+    for (dy, dx), (_, v) in sites.items():
+        plane[dy::2, dx::2] = v
+    plane *= np.float32(65535.0 / top)
+    mosaic = np.rint(plane, out=plane).astype(np.uint16)
+    rgb = cv2.cvtColor(mosaic, _CV_BAYER[names]).astype(np.float32)
+    rgb *= np.float32(top / 65535.0)
+    return rgb
+
+
+def _orientation_tag(source: Path | str | bytes) -> int | None:
+    """The TIFF/EXIF Orientation tag (274) of IFD0 of a TIFF-based RAW, if it has one."""
+    try:
+        import tifffile
+
+        handle = io.BytesIO(bytes(source)) if isinstance(source, bytes | bytearray) else source
+        with tifffile.TiffFile(handle) as tif:
+            tag = tif.pages.first.tags.get(274)
+            return None if tag is None else int(tag.value)
+    except Exception:  # not TIFF-based: LibRaw's flip stands alone
+        return None
+
+
+def orientation_record(flip: int, tag: int | None) -> dict[str, Any]:
+    """What the file says of the camera's orientation, and that the pixels are not rotated."""
+    rotated = flip not in (0,) or (tag is not None and tag != 1)
+    return {
+        "applied": False,
+        "pixels": "sensor orientation (as stored in the RAW; the camera's JPEG previews and "
+        "the rti-rig JPEGs agree)",
+        "libraw_flip": int(flip),
+        "flip_meaning": FLIP_NAMES.get(int(flip), f"code {flip}"),
+        "orientation_tag": tag,
+        "orientation_tag_meaning": None if tag is None else ORIENTATION_NAMES.get(tag),
+        "camera_rotated": bool(rotated),
+    }
+
+
 def decode_raw(
     source: Path | str | bytes,
     settings: RawDecodeSettings | None = None,
@@ -143,55 +336,29 @@ def decode_raw(
     marks its output pixel saturated: pinned at ``white_level``), so it survives dark
     subtraction and white balance. ``exposure_s`` and ``gain`` (ISO) come from the file's
     metadata (0.0 when absent); callers that set the exposure themselves record theirs too.
+    ``metadata["decode"]`` is the provenance the session journals for each image.
     """
     settings = settings or RawDecodeSettings()
     name, handle = _source(source)
     try:
         with rawpy.imread(handle) as raw:
             raw_vis = np.array(raw.raw_image_visible)  # uint16 copy out of LibRaw memory
+            colors = np.array(raw.raw_colors_visible)
             black_pc = np.asarray(raw.black_level_per_channel, dtype=np.int64)
             white = int(raw.white_level)
             pattern = _pattern_name(raw)
+            desc = raw.color_desc.decode("ascii", "replace") if raw.color_desc else _COLOR_NAMES
+            camera_wb = list(raw.camera_whitebalance)
+            cam_xyz = np.array(raw.rgb_xyz_matrix)
+            rgb_cam = np.array(raw.color_matrix)
+            flip = int(raw.sizes.flip)
+            per_channel_white = getattr(raw, "camera_white_level_per_channel", None)
+            white_per_channel = (
+                None
+                if per_channel_white is None or not any(per_channel_white)
+                else [int(v) for v in per_channel_white]
+            )
             other = raw.other
-            if raw_vis.ndim != 2:
-                raise CaptureError(DECODER, f"{name}: not a single-plane CFA RAW", "decode")
-            white_level = int(white - black_pc.max())
-            if white_level <= 0:
-                raise CaptureError(
-                    DECODER,
-                    f"{name}: white level {white} is not above the "
-                    f"black levels {black_pc.tolist()}",
-                    "decode",
-                )
-            # Uniform black (the usual case) stays scalar: uint16 arithmetic, no index arrays.
-            black: int | NDArray[np.int64] = (
-                int(black_pc[0])
-                if np.all(black_pc == black_pc[0])
-                else black_pc[np.array(raw.raw_colors_visible)]
-            )
-            threshold = (
-                int(black + np.floor(settings.saturation_level * (white - black)))
-                if isinstance(black, int)
-                else black + np.floor(settings.saturation_level * (white - black))
-            )
-            saturated = raw_vis >= threshold
-            if settings.mode == "mosaic":
-                if isinstance(black, int):
-                    pixels = np.clip(raw_vis, black, black + white_level) - np.uint16(black)
-                else:
-                    pixels = np.clip(raw_vis.astype(np.int64) - black, 0, white_level)
-                pixels = pixels.astype(np.uint16, copy=False)
-                pixels[saturated] = white_level
-            else:
-                rgb = raw.postprocess(**_postprocess_params(settings))
-                white_level = 65535
-                pixels = np.asarray(rgb, dtype=np.uint16)
-                h, w = pixels.shape[:2]
-                if settings.mode == "half":
-                    s = half_size_mask(saturated, h, w)
-                else:
-                    s = _dilate(saturated)[:h, :w]
-                pixels[s] = white_level
     except rawpy.LibRawError as exc:
         raise CaptureError(
             DECODER,
@@ -199,12 +366,90 @@ def decode_raw(
             "is it a complete RAW/DNG download?",
             "decode",
         ) from exc
+    if raw_vis.ndim != 2:
+        raise CaptureError(DECODER, f"{name}: not a single-plane CFA RAW", "decode")
+    if white <= int(black_pc.max()):
+        raise CaptureError(
+            DECODER,
+            f"{name}: white level {white} is not above the black levels {black_pc.tolist()}",
+            "decode",
+        )
+    # Uniform black (the usual case) stays scalar: uint16 arithmetic, no index arrays.
+    uniform = bool(np.all(black_pc == black_pc[0]))
+    black: int | NDArray[np.int64] = int(black_pc[0]) if uniform else black_pc[colors]
+    threshold = black + np.floor(settings.saturation_level * (white - black))
+    saturated = raw_vis >= threshold
+    wb, wb_source = white_balance_multipliers(settings.white_balance, camera_wb)
+    to_srgb = srgb_matrix(rgb_cam, cam_xyz) if settings.output_color == "srgb" else None
+    if settings.mode == "mosaic":
+        white_level = int(white - black_pc.max())
+        if uniform:
+            pixels = np.clip(raw_vis, black, black + white_level) - np.uint16(black)
+        else:
+            pixels = np.clip(raw_vis.astype(np.int64) - black, 0, white_level)
+        pixels = pixels.astype(np.uint16, copy=False)
+        pixels[saturated] = white_level
+        color_space = "none (CFA mosaic: one colour per pixel)"
+    else:
+        rgb_index = np.array([_rgb_channel(desc, int(i)) for i in range(4)], dtype=np.intp)
+        try:
+            rgb = _colour(raw_vis, colors, black_pc, white, wb, rgb_index, settings.mode)
+        except ValueError as exc:
+            raise CaptureError(DECODER, f"{name}: {exc}", "decode") from exc
+        if to_srgb is not None:
+            rgb = cv2.transform(rgb, to_srgb.astype(np.float32))
+        white_level = 65535
+        np.clip(rgb, 0.0, 1.0, out=rgb)
+        rgb *= white_level
+        pixels = np.rint(rgb, out=rgb).astype(np.uint16)
+        h, w = pixels.shape[:2]
+        sat = half_size_mask(saturated, h, w) if settings.mode == "half" else _dilate(saturated)
+        pixels[sat[:h, :w]] = white_level
+        if to_srgb is not None:
+            color_space = "linear sRGB (IEC 61966-2-1 primaries, D65) from the file's matrix"
+        elif settings.output_color == "srgb":
+            color_space = "camera RGB (the file has no colour matrix, so none was applied)"
+        else:
+            color_space = "camera RGB"
     iso = float(other.iso_speed) or _iso_from_tiff(source)
     exposure = float(other.shutter_speed)
     if timestamp_s is None:
         timestamp_s = Path(name).stat().st_mtime if name != "<bytes>" else 0.0
+    source_file = None if name == "<bytes>" else name
+    orientation = orientation_record(flip, _orientation_tag(source))
+    decode = {
+        "mode": settings.mode,
+        "content": "cfa-mosaic" if settings.mode == "mosaic" else "rgb",
+        "cfa_pattern": pattern,
+        "black_level_per_channel": _per_channel(black_pc, desc),
+        "black_level_by_color_index": [int(b) for b in black_pc],
+        "black_correction": "exact per CFA site: (raw − black_c) / (white − black_c)",
+        "white_level": white,
+        "white_level_per_channel": white_per_channel,
+        "white_balance": wb_source if settings.mode != "mosaic" else "none (mosaic)",
+        "white_balance_multipliers": None
+        if settings.mode == "mosaic"
+        else [round(float(x), 6) for x in wb[:3]],
+        "color_space": color_space,
+        "srgb_from_camera": None if to_srgb is None else np.round(to_srgb, 6).tolist(),
+        "source_file": source_file,
+        "orientation": orientation,
+        "decoder": f"rti-rig raw_decode (LibRaw {rawpy.libraw_version} for unpacking)"
+        if hasattr(rawpy, "libraw_version")
+        else "rti-rig raw_decode (LibRaw for unpacking)",
+    }
+    notices = []
+    if orientation["camera_rotated"]:
+        tag = orientation["orientation_tag"]
+        meaning = orientation["orientation_tag_meaning"] or orientation["flip_meaning"]
+        notices.append(
+            f"the camera was rotated (Orientation tag {tag}: {meaning}): rti-rig keeps "
+            "sensor orientation, as the camera's RAW data and JPEG previews are stored, so "
+            "these images are not turned upright; the .lp light directions are in the same "
+            "(sensor) frame, so fitting is unaffected (docs/cameras.md)"
+        )
     metadata: dict[str, Any] = {
-        "source_file": None if name == "<bytes>" else name,
+        "source_file": source_file,
         "decode_mode": settings.mode,
         "white_balance": settings.white_balance,
         "output_color": settings.output_color if settings.mode != "mosaic" else "raw",
@@ -215,6 +460,8 @@ def decode_raw(
         "iso_from_file": iso or None,
         "aperture_from_file": float(other.aperture) or None,
         "dark_subtracted": False,
+        "decode": decode,
+        "notices": notices,
     }
     metadata.update(exposure_stats(pixels, white_level, settings.underexposed_level))
     frame = Frame(
@@ -228,6 +475,21 @@ def decode_raw(
     if dark is not None:
         frame = subtract_dark(frame, dark, settings.underexposed_level)
     return frame
+
+
+def _rgb_channel(desc: str, index: int) -> int:
+    """RGB plane (0, 1, 2) of LibRaw colour index ``index`` (``color_desc`` 'RGBG')."""
+    letter = desc[index] if index < len(desc) else "G"
+    return {"R": 0, "G": 1, "B": 2}.get(letter, 1)
+
+
+def _per_channel(black_pc: NDArray[np.int64], desc: str) -> dict[str, int]:
+    """{colour name: black} for LibRaw's colour indices, the second green named 'G2'."""
+    out: dict[str, int] = {}
+    for i, b in enumerate(black_pc[: len(desc)]):
+        key = desc[i] if desc[i] not in out else f"{desc[i]}2"
+        out[key] = int(b)
+    return out
 
 
 def subtract_dark(frame: Frame, dark: Frame, underexposed_level: float = 0.001) -> Frame:

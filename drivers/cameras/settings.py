@@ -27,20 +27,28 @@ class _Strict(BaseModel):
 
 
 class RawDecodeSettings(_Strict):
-    """How a RAW file becomes linear data (see ``raw_decode.decode_raw``).
+    """How a RAW file becomes linear data (see ``raw_decode.decode_raw`` and docs/cameras.md).
 
     ``mode``:
-      * ``"mosaic"`` – the sensor values themselves, black removed, no demosaic, no white balance:
-        the most transparent route, bit-exact with the file (shape H×W, one colour per photosite).
-      * ``"half"`` – LibRaw 2×2 super-pixels (no interpolation), RGB at half resolution.
-      * ``"demosaic"`` – LibRaw bilinear demosaic, RGB at full resolution.
-    The last two run ``postprocess`` with gamma 1, no auto-bright, ``adjust_maximum_thr=0`` (so
-    LibRaw never rescales to the data maximum), no rotation and a *fixed* white balance.
+      * ``"demosaic"`` (default) – colour at full resolution: bilinear demosaic of the
+        black-corrected photosites, white balance, camera → sRGB primaries (linear).
+      * ``"half"`` – colour at half resolution: 2×2 super-pixels (R, mean of the two greens, B),
+        no interpolation at all.
+      * ``"mosaic"`` – the sensor values themselves, black removed, no demosaic, no white
+        balance: bit-exact with the file, one colour per pixel (shape H×W). Labelled as such in
+        the journal, the manifest and the TIFF; its JPEG is a grey checkerboard, not a picture.
+    Black levels are removed per CFA site exactly (``(raw − black_c) / (white − black_c)``),
+    never LibRaw's scaling by the lowest black level; nothing is rescaled to the data maximum,
+    nothing is rotated (images stay in sensor orientation; the Orientation tag is recorded).
+    ``white_balance``: ``"camera"`` (as shot; unity when the file has none), ``"unity"`` (raw
+    channel ratios) or four multipliers (R, G, B, G2). ``output_color``: ``"srgb"`` (linear
+    sRGB primaries through the file's colour matrix; camera RGB when the file has none, and
+    recorded so) or ``"raw"`` (camera RGB).
     """
 
-    mode: Literal["mosaic", "half", "demosaic"] = "mosaic"
-    white_balance: Literal["unity", "camera"] | tuple[float, float, float, float] = "unity"
-    output_color: Literal["raw", "srgb"] = "raw"
+    mode: Literal["mosaic", "half", "demosaic"] = "demosaic"
+    white_balance: Literal["unity", "camera"] | tuple[float, float, float, float] = "camera"
+    output_color: Literal["raw", "srgb"] = "srgb"
     saturation_level: float = Field(
         1.0,
         gt=0.0,
@@ -173,7 +181,9 @@ class Gphoto2CameraSettings(_Strict):
         "nearest shutter speed the camera offers (1/3 stop is 0.26)",
     )
     busy_retries: int = Field(5, ge=0)
-    retry_delay_s: float = Field(0.5, ge=0.0)
+    retry_delay_s: float = Field(0.5, ge=0.0, description="first wait after a 'busy' reply")
+    retry_backoff: float = Field(2.0, ge=1.0, description="each further wait is this much longer")
+    retry_max_delay_s: float = Field(4.0, ge=0.0, description="longest wait between retries")
     retry_codes: tuple[int, ...] = Field(
         (-110,), description="GPhoto2Error codes retried: -110 = camera busy / not ready"
     )
@@ -196,6 +206,12 @@ class FolderWatchSettings(_Strict):
     kind: Literal["folder_watch"] = "folder_watch"
     name: str = "folder-camera"
     folder: Path
+    trigger: Literal["none", "dome_shutter"] = Field(
+        "none",
+        description="who fires the camera: 'none' (someone else: a vendor program, an "
+        "intervalometer) or 'dome_shutter' (rti-rig pulses the dome's camera-release line, "
+        "[dome.serial] shutter_pulse_ms long, once the LED is lit and settled)",
+    )
     patterns: tuple[str, ...] = ("*.dng", "*.DNG")
     timeout_s: float = Field(10.0, gt=0.0)
     poll_interval_s: float = Field(0.05, gt=0.0)
@@ -213,6 +229,12 @@ class FolderWatchSettings(_Strict):
         "linearise with the inverse sRGB curve, or take them as linear",
     )
     decode: RawDecodeSettings = RawDecodeSettings()
+
+    @field_validator("folder")
+    @classmethod
+    def _home(cls, v: Path) -> Path:
+        """``~/Pictures/...`` as a user writes it in a config shared between machines."""
+        return v.expanduser()
 
 
 CameraSettings = Annotated[

@@ -189,21 +189,62 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
 
     cfg = loaded.config
     geometry = rig_geometry(loaded)
-    camera = build_camera(camera_device_settings(loaded), clock=clock)
+    camera_settings = camera_device_settings(loaded)
     if isinstance(geometry, DomeGeometry):
         from rti_rig.app.dome_factory import build_dome
 
         assert cfg.dome is not None and cfg.dome.serial is not None
         dome = build_dome(cfg.dome.serial, clock, directions=geometry.directions, name="dome")
-        return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
-    import dynamixel_sdk
+        camera = build_camera(
+            camera_settings, clock=clock, trigger=_camera_trigger(camera_settings, dome)
+        )
+        rig = Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
+    else:
+        import dynamixel_sdk
 
-    from rti_rig.drivers.dynamixel.arm import DynamixelArm
+        from rti_rig.drivers.dynamixel.arm import DynamixelArm
 
-    assert cfg.arm is not None and cfg.arm.dynamixel is not None
-    settings = cfg.arm.dynamixel
-    arm = DynamixelArm(settings, dynamixel_sdk.PortHandler(settings.port), clock)
-    return Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock)
+        assert cfg.arm is not None and cfg.arm.dynamixel is not None
+        settings = cfg.arm.dynamixel
+        arm = DynamixelArm(settings, dynamixel_sdk.PortHandler(settings.port), clock)
+        camera = build_camera(camera_settings, clock=clock)
+        rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock)
+    rig.session_hooks.append(_session_hook(camera))
+    return rig
+
+
+def _camera_trigger(settings, dome):  # type: ignore[no-untyped-def]
+    """The release that fires a watched-folder camera: the dome's shutter verb (a pulse on the
+    camera's remote line, never resent), when the config asks for it."""
+    if getattr(settings, "trigger", "none") != "dome_shutter":
+        return None
+    from rti_rig.core.dome_link import DomeLinkError, LinkFault
+    from rti_rig.drivers.cameras.folder_watch import TriggerUnconfirmed
+
+    def fire(_exposure_s: float) -> None:
+        try:
+            dome.shutter()
+        except DomeLinkError as exc:
+            if exc.fault is LinkFault.TIMEOUT:  # sent, reply lost: the camera may have fired
+                raise TriggerUnconfirmed(f"{exc.device}: {exc.message}") from exc
+            raise
+
+    return fire
+
+
+def _session_hook(camera):  # type: ignore[no-untyped-def]
+    """Tell a downloading camera (a DSLR) to stage its files inside the session folder.
+
+    The session then moves them to ``raw/`` under its own names when the step is committed;
+    whatever a crash leaves in ``raw/.incoming`` is set aside by ``--resume``, never lost.
+    """
+    from rti_rig.runtime.session import RAW_INCOMING
+
+    def hook(root: Path) -> None:
+        if hasattr(camera, "output_dir"):
+            camera.output_dir = root / RAW_INCOMING
+
+    return hook
 
 
 def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
@@ -273,7 +314,8 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
     from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
     try:
-        return decode_raw(p, RawDecodeSettings(mode="half")).pixels
+        settings = RawDecodeSettings(mode="half", white_balance="unity", output_color="raw")
+        return decode_raw(p, settings).pixels
     except CaptureError as exc:  # its message names the file and LibRaw's reason
         raise ScheduleError(
             f"RAW preview {exc.message} Otherwise give the camera's JPEG or a 16-bit linear "

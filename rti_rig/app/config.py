@@ -440,7 +440,14 @@ def load_rig_config(path: Path | str) -> LoadedRig:
                 f"{len(power)} values for {len(dirs)} LEDs: give one per LED, in LED order",
             )
     if config.camera.device is not None:
-        camera_device_settings(loaded)
+        cam = camera_device_settings(loaded)
+        if getattr(cam, "trigger", "none") == "dome_shutter" and config.kind != "dome":
+            raise ConfigError(
+                path,
+                "camera.device.trigger",
+                "'dome_shutter' needs a dome (its camera-release line fires the camera); on an "
+                "arm rig let the camera fire itself (trigger = 'none')",
+            )
     return loaded
 
 

@@ -37,13 +37,17 @@ def _atomic_write(path: Path, data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def write_linear_tiff(path: Path, pixels: NDArray[np.uint16]) -> str:
-    """Write a linear 16-bit TIFF; returns its SHA-256."""
+def write_linear_tiff(
+    path: Path, pixels: NDArray[np.uint16], description: str | None = None
+) -> str:
+    """Write a linear 16-bit TIFF (``description`` goes into ImageDescription); returns its
+    SHA-256."""
     import io
 
     buf = io.BytesIO()
     photometric = "rgb" if pixels.ndim == 3 else "minisblack"
-    tifffile.imwrite(buf, pixels, photometric=photometric, compression="zlib")
+    extra = {"description": description, "metadata": None} if description else {}
+    tifffile.imwrite(buf, pixels, photometric=photometric, compression="zlib", **extra)
     return _atomic_write(path, buf.getvalue())
 
 
@@ -52,7 +56,12 @@ def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> 
     import cv2  # on use: importing the controller must not load a device library
 
     img = srgb8[..., ::-1] if srgb8.ndim == 3 else srgb8
-    ok, enc = cv2.imencode(".jpg", np.ascontiguousarray(img), [cv2.IMWRITE_JPEG_QUALITY, quality])
+    params = [cv2.IMWRITE_JPEG_QUALITY, quality]
+    if img.ndim == 3 and hasattr(cv2, "IMWRITE_JPEG_SAMPLING_FACTOR"):
+        # full-resolution colour (4:4:4): 4:2:0 chroma subsampling moves colours at patch and
+        # demosaic edges by several code values; 4:4:4 keeps them within 1
+        params += [cv2.IMWRITE_JPEG_SAMPLING_FACTOR, cv2.IMWRITE_JPEG_SAMPLING_FACTOR_444]
+    ok, enc = cv2.imencode(".jpg", np.ascontiguousarray(img), params)
     if not ok:
         raise SessionError(f"could not encode {path.name} as JPEG")
     return _atomic_write(path, enc.tobytes())

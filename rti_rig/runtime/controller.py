@@ -203,6 +203,7 @@ def run_session(
     rig_t0, wall_t0 = clock.now(), time.perf_counter()
     total = len(schedule)
     try:
+        rig.bind_session(folder.root)
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()

@@ -8,7 +8,9 @@ what it reads of the loaded config is written here as protocols; the composition
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Protocol
 
 from rti_rig.core.clock import Clock
@@ -67,6 +69,14 @@ class Rig:
     clock: Clock
     #: Things the rig holds open besides its devices (an emulator's pseudo-terminal…).
     resources: contextlib.ExitStack = field(default_factory=contextlib.ExitStack)
+    #: Called with the session folder before the devices connect: a DSLR's downloads go there
+    #: (the composition root registers what its devices need to know of the session).
+    session_hooks: list[Callable[[Path], None]] = field(default_factory=list)
+
+    def bind_session(self, root: Path) -> None:
+        """Tell the devices which session folder this run writes (before ``connect``)."""
+        for hook in self.session_hooks:
+            hook(Path(root))
 
     def close(self) -> None:
         """Release what ``build_rig`` opened; the controller has already made devices safe."""

@@ -6,6 +6,9 @@ Layout (opens directly in relight-cli's folder mode, which takes the first ``*.l
     SESSION/
       image_001.jpg ...      8-bit sRGB, one per step, named in execution order
       linear/image_001.tif   16-bit linear data for fitting (same numbering)
+      raw/image_001.nef      the camera's original file(s) for the step, named by the session
+                             (the camera's own name is kept in the journal); RAW+JPEG pairs
+                             keep both files
       lights.lp              one line per image, from the light that actually fired
       journal.jsonl          one line per completed step, flushed to disk as it happens
       manifest.json          rig config, schedule, per-step timings, versions, finish reason
@@ -37,6 +40,10 @@ MANIFEST = "manifest.json"
 JOURNAL = "journal.jsonl"
 LP_NAME = "lights.lp"
 LINEAR_DIR = "linear"
+RAW_DIR = "raw"
+#: Where a DSLR downloads before the step is committed (files left here by a crash are moved to
+#: recovered/ on resume, never used as a step's image and never deleted).
+RAW_INCOMING = f"{RAW_DIR}/.incoming"
 FORMAT = "rti-rig-session/1"
 
 
@@ -59,6 +66,12 @@ class StepRecord:
     saturated_fraction: float
     black_fraction: float
     sha256: dict[str, str] = field(default_factory=dict)
+    #: session file → the camera's (or watched folder's) own name for it
+    originals: dict[str, str] = field(default_factory=dict)
+    #: how the linear image was made from the RAW file (mode, CFA pattern, black/white levels
+    #: per channel, white balance, colour, orientation, source file); empty for non-RAW cameras
+    decode: dict[str, Any] = field(default_factory=dict)
+    notices: list[str] = field(default_factory=list)
 
 
 def image_names(total: int) -> list[str]:
@@ -209,8 +222,21 @@ class SessionFolder:
         t0 = time.perf_counter()
         base = self.names[index]
         jpg, tif = f"{base}.jpg", f"{LINEAR_DIR}/{base}.tif"
-        sha_tif = write_linear_tiff(self.root / tif, frame.pixels)
-        sha_jpg = write_srgb_jpeg(self.root / jpg, linear_to_srgb8(frame.pixels, frame.white_level))
+        decode = dict(frame.metadata.get("decode") or {})
+        listed = frame.metadata.get("originals") or []
+        originals = self._keep_originals(base, listed)
+        for item, rel in zip(listed, originals, strict=True):
+            if decode.get("source_file") == str(item["path"]):
+                # where the decoded RAW is kept now, and the camera's own name for it
+                decode["raw_file"] = rel
+                decode["camera_file"] = originals[rel][1]
+        sha = {name: digest for name, (digest, _) in originals.items()}
+        sha[tif] = write_linear_tiff(
+            self.root / tif, frame.pixels, description=_tiff_description(decode)
+        )
+        sha[jpg] = write_srgb_jpeg(
+            self.root / jpg, linear_to_srgb8(frame.pixels, frame.white_level)
+        )
         record = StepRecord(
             index=index,
             image=jpg,
@@ -219,7 +245,10 @@ class SessionFolder:
             saturated_fraction=frame.saturated_fraction,
             black_fraction=frame.black_fraction,
             write_wall_s=time.perf_counter() - t0,
-            sha256={jpg: sha_jpg, tif: sha_tif},
+            sha256=sha,
+            originals={name: source for name, (_, source) in originals.items()},
+            decode=decode,
+            notices=[str(n) for n in frame.metadata.get("notices") or []],
             **record_fields,
         )
         with open(self.root / JOURNAL, "a", encoding="utf-8") as fh:
@@ -227,6 +256,41 @@ class SessionFolder:
             fh.flush()
             os.fsync(fh.fileno())
         return record
+
+    def _keep_originals(
+        self, base: str, originals: list[dict[str, Any]]
+    ) -> dict[str, tuple[str, str]]:
+        """Put the camera's own files under ``raw/`` with the session's name for the step.
+
+        A file already inside the session (a DSLR download staged in ``raw/.incoming``) is
+        moved; a file elsewhere (a watched folder another program owns) is copied. The session
+        names the files itself, so a camera whose counter wraps or repeats names can never make
+        one step's original overwrite another's. Returns {session name: (sha256, camera name)}.
+        """
+        kept: dict[str, tuple[str, str]] = {}
+        root = self.root.resolve()
+        for item in originals:
+            src = Path(item["path"])
+            suffix = src.suffix.lower()
+            rel = f"{RAW_DIR}/{base}{suffix}"
+            n = 2
+            while rel in kept:  # two files of one step with one suffix
+                rel = f"{RAW_DIR}/{base}_{n}{suffix}"
+                n += 1
+            dest = self.root / rel
+            if dest.exists():
+                raise SessionError(f"{dest} already exists: refusing to overwrite a captured file")
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            inside = src.resolve().is_relative_to(root)
+            tmp = dest.with_name(f".{dest.name}.partial")
+            if inside:
+                os.replace(src, tmp)
+            else:
+                shutil.copyfile(src, tmp)
+            digest = _fsync_sha256(tmp)
+            os.replace(tmp, dest)
+            kept[rel] = (digest, str(item.get("name") or src.name))
+        return kept
 
     def finish(
         self, records: list[StepRecord], runner: dict[str, Any], timing: dict[str, Any]
@@ -254,9 +318,28 @@ class SessionFolder:
                 },
                 "lp_file": LP_NAME if ordered else None,
                 "steps": [asdict(r) for r in ordered],
+                "notices": session_notices(ordered),
             }
         )
         _write_json_atomic(self.root / MANIFEST, self.manifest)
+
+
+def session_notices(records: list[StepRecord]) -> list[str]:
+    """What the user should know about the images as a whole (each distinct notice once, with
+    how many images it concerns), e.g. that a rotated camera gave sensor-oriented images, or
+    that the images are CFA mosaics rather than pictures."""
+    counts: dict[str, int] = {}
+    for r in records:
+        for n in r.notices:
+            counts[n] = counts.get(n, 0) + 1
+        if r.decode.get("mode") == "mosaic":
+            n = (
+                "the images are CFA mosaics (decode.mode = 'mosaic'): one colour per pixel, "
+                "not demosaiced; the JPEGs are grey checkerboards, not pictures"
+            )
+            counts[n] = counts.get(n, 0) + 1
+    total = len(records)
+    return [f"{n} [{c} of {total} images]" for n, c in counts.items()]
 
 
 @dataclass
@@ -289,6 +372,31 @@ def read_journal(root: Path) -> list[dict[str, Any]]:
                 "in this folder has been changed)"
             ) from None
     return out
+
+
+def _fsync_sha256(path: Path) -> str:
+    """SHA-256 of a file just written, after making sure it is on disk."""
+    h = hashlib.sha256()
+    with open(path, "rb+") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+        os.fsync(fh.fileno())
+    return h.hexdigest()
+
+
+def _tiff_description(decode: dict[str, Any]) -> str | None:
+    """A label inside the linear TIFF saying what its pixels are, for RAW-derived images."""
+    if not decode:
+        return None
+    if decode.get("mode") == "mosaic":
+        return (
+            f"rti-rig: CFA mosaic ({decode.get('cfa_pattern')}), black level removed per "
+            "photosite, NOT demosaiced, no white balance: one colour per pixel"
+        )
+    return (
+        f"rti-rig: linear {decode.get('color_space')} RGB from RAW ({decode.get('mode')}), "
+        f"white balance {decode.get('white_balance')}, sensor orientation"
+    )
 
 
 def _sha256(path: Path) -> str | None:
@@ -337,7 +445,13 @@ def prepare_resume(root: Path) -> ResumeState:
     keep = {name for rec in done.values() for name in rec.sha256}
     recovered: list[str] = []
     stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
-    for path in sorted([*root.glob("image_*"), *(root / LINEAR_DIR).glob("image_*")]):
+    leftovers = [
+        *root.glob("image_*"),
+        *(root / LINEAR_DIR).glob("image_*"),
+        *(root / RAW_DIR).glob("image_*"),
+        *(p for p in (root / RAW_INCOMING).glob("*") if p.is_file()),
+    ]
+    for path in sorted(leftovers):
         rel = path.relative_to(root).as_posix()
         if rel in keep:
             continue
@@ -345,7 +459,12 @@ def prepare_resume(root: Path) -> ResumeState:
         dest.parent.mkdir(parents=True, exist_ok=True)
         os.replace(path, dest)
         recovered.append(dest.relative_to(root).as_posix())
-    for partial in [*root.glob(".*.partial"), *(root / LINEAR_DIR).glob(".*.partial")]:
+    partials = [
+        *root.glob(".*.partial"),
+        *(root / LINEAR_DIR).glob(".*.partial"),
+        *(root / RAW_DIR).glob(".*.partial"),
+    ]
+    for partial in partials:
         partial.unlink()
     (root / LINEAR_DIR).mkdir(exist_ok=True)
     return ResumeState(manifest=manifest, done=done, recovered=recovered)

@@ -1,0 +1,270 @@
+"""A stand-in for python-gphoto2's camera API, with a camera body behind it.
+
+Modelled on the documented python-gphoto2 2.x API and libgphoto2's behaviour (not on our
+driver): ``gp.Camera.autodetect()`` → [(model, port)], ``Camera().init()/exit()``,
+``get_config()``/``set_config()`` with widgets (``get_child_by_name``, ``get_value``,
+``set_value``, ``count_choices``, ``get_choice``), ``capture(GP_CAPTURE_IMAGE)`` → a path with
+``.folder``/``.name``, ``wait_for_event(ms)`` → (event type, data), ``file_get(folder, name,
+GP_FILE_TYPE_NORMAL)`` → a CameraFile with ``save(path)``, ``file_delete``; errors are
+``GPhoto2Error`` with ``.code`` (libgphoto2's result codes: -7 I/O, -52 USB device not found,
+-105 unknown model, -110 busy, -115 no space left).
+
+Quirks of real bodies it reproduces (from gphoto/libgphoto2 issue threads, see
+/work/shared/reference/hardware-notes.md §5): "busy" right after a shot, a body switched off or
+unplugged (every call then fails with -7 and autodetect finds nothing), a card that fills up,
+a file counter that wraps (IMG_9999 → IMG_0001) or a RAM target that names every shot the same
+(Nikon's ``capt0000.nef``), and RAW+JPEG delivered as two files, the second through a
+FILE_ADDED event.
+"""
+
+from __future__ import annotations
+
+import types
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+GP_CAPTURE_IMAGE = 0
+GP_FILE_TYPE_NORMAL = 1
+GP_EVENT_UNKNOWN, GP_EVENT_TIMEOUT, GP_EVENT_FILE_ADDED = 0, 1, 2
+GP_EVENT_CAPTURE_COMPLETE = 4
+SHUTTERS = ["bulb", "30", "2", "1", "0.5", "1/4", "1/8", "1/15", "1/30", "1/60", "1/125", "1/250"]
+
+
+class GPhoto2Error(Exception):
+    def __init__(self, code: int) -> None:
+        super().__init__(f"[{code}] libgphoto2 error")
+        self.code = code
+
+
+@dataclass
+class Body:
+    """The physical camera: ``render()`` gives the RAW file's bytes for the current shot."""
+
+    render: Callable[[], bytes]
+    model: str = "Canon EOS 600D"
+    port: str = "usb:001,005"
+    raw_suffix: str = ".CR2"
+    naming: str = "counter"  # or "repeat" (every shot capt0000.*, as Nikon RAM targets do)
+    counter_start: int = 1
+    counter_wrap: int = 9999
+    config: dict[str, str] = field(
+        default_factory=lambda: {
+            "capturetarget": "Memory card",
+            "imageformat": "Large Fine JPEG",
+            "iso": "Auto",
+            "aperture": "5.6",
+            "shutterspeed": "1/60",
+        }
+    )
+    choices: dict[str, list[str]] = field(
+        default_factory=lambda: {
+            "capturetarget": ["Internal RAM", "Memory card"],
+            "imageformat": ["Large Fine JPEG", "RAW", "RAW + Large Fine JPEG"],
+            "iso": ["Auto", "100", "200", "400"],
+            "aperture": ["5.6", "8", "11"],
+            "shutterspeed": SHUTTERS,
+        }
+    )
+    #: op name → error codes raised by its next calls, in order
+    failures: dict[str, list[int]] = field(default_factory=dict)
+    busy_after_shot: int = 0  # the next N captures after a shot answer -110 first
+    card_free_shots: int = 1000
+    jpeg_first: bool = False  # RAW+JPEG: capture() returns the JPEG, the RAW comes by event
+    powered: bool = True
+    off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
+    shots: int = 0
+    card: dict[str, bytes] = field(default_factory=dict)
+    ram: dict[str, bytes] = field(default_factory=dict)
+    deleted: list[str] = field(default_factory=list)
+    calls: list[str] = field(default_factory=list)
+    _events: list[tuple[int, object]] = field(default_factory=list)
+    _busy: int = 0
+    _counter: int = 0
+
+    def switch_off(self) -> None:
+        """Switched off or unplugged: every call fails, nothing is detected."""
+        self.powered = False
+
+    def switch_on(self) -> None:
+        self.powered = True
+
+    def check(self, op: str) -> None:
+        self.calls.append(op)
+        if not self.powered:
+            raise GPhoto2Error(-7 if op != "autodetect" else -52)
+        queue = self.failures.get(op)
+        if queue:
+            raise GPhoto2Error(queue.pop(0))
+
+    def next_stem(self) -> str:
+        if self.naming == "repeat":
+            return "capt0000"
+        n = (self.counter_start - 1 + self._counter) % self.counter_wrap + 1
+        self._counter += 1
+        return f"IMG_{n:04d}"
+
+    def store(self) -> dict[str, bytes]:
+        return self.ram if self.config["capturetarget"] == "Internal RAM" else self.card
+
+
+class _Widget:
+    def __init__(self, values: dict[str, str], choices: list[str]) -> None:
+        self._values, self._choices = values, choices
+        self.name = ""
+
+    def get_value(self) -> str:
+        return self._values[self.name]
+
+    def set_value(self, v: str) -> None:
+        self._values[self.name] = v
+
+    def count_choices(self) -> int:
+        return len(self._choices)
+
+    def get_choice(self, i: int) -> str:
+        return self._choices[i]
+
+
+def make_module(body: Body) -> types.ModuleType:
+    """A module object that can stand in for ``gphoto2`` (``sys.modules["gphoto2"]``)."""
+    mod = types.ModuleType("gphoto2")
+
+    class Config:
+        def __init__(self) -> None:
+            self.values = dict(body.config)
+
+        def get_child_by_name(self, name: str) -> _Widget:
+            if name not in self.values:
+                raise GPhoto2Error(-2)
+            w = _Widget(self.values, body.choices.get(name, []))
+            w.name = name
+            return w
+
+    class CameraFilePath:
+        def __init__(self, folder: str, name: str) -> None:
+            self.folder, self.name = folder, name
+
+    class CameraFile:
+        def __init__(self, data: bytes) -> None:
+            self._data = data
+
+        def save(self, target: str) -> None:
+            with open(target, "wb") as fh:
+                fh.write(self._data)
+
+    class Camera:
+        @staticmethod
+        def autodetect() -> list[tuple[str, str]]:
+            body.check("autodetect")
+            return [(body.model, body.port)]
+
+        def init(self) -> None:
+            body.check("init")
+
+        def exit(self) -> None:
+            body.calls.append("exit")
+
+        def get_config(self) -> Config:
+            body.check("get_config")
+            return Config()
+
+        def set_config(self, config: Config) -> None:
+            body.check("set_config")
+            for k, v in config.values.items():
+                if body.choices.get(k) and v not in body.choices[k]:
+                    raise GPhoto2Error(-2)
+                body.config[k] = v
+
+        def capture(self, kind: int) -> CameraFilePath:
+            if body.off_at_shot is not None and body.shots + 1 == body.off_at_shot:
+                body.off_at_shot = None
+                body.switch_off()
+            body.check("capture")
+            if body._busy:
+                body._busy -= 1
+                raise GPhoto2Error(-110)
+            store = body.store()
+            if store is body.card and body.card_free_shots <= 0:
+                raise GPhoto2Error(-115)
+            fmt = body.config["imageformat"]
+            stem = body.next_stem()
+            files = []
+            if "RAW" in fmt:
+                files.append(stem + body.raw_suffix)
+            if "JPEG" in fmt:
+                files.append(stem + ".JPG")
+            raw_data = body.render()
+            for name in files:
+                store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"
+            if store is body.card:
+                body.card_free_shots -= 1
+            body.shots += 1
+            body._busy = body.busy_after_shot
+            if body.jpeg_first:
+                files.sort(key=lambda n: not n.endswith(".JPG"))
+            folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"
+            for name in files[1:]:
+                body._events.append((GP_EVENT_FILE_ADDED, CameraFilePath(folder, name)))
+            return CameraFilePath(folder, files[0])
+
+        def wait_for_event(self, timeout_ms: int) -> tuple[int, object]:
+            body.check("wait_for_event")
+            if body._events:
+                return body._events.pop(0)
+            return GP_EVENT_TIMEOUT, None
+
+        def file_get(self, folder: str, name: str, kind: int) -> CameraFile:
+            body.check("file_get")
+            store = body.store()
+            if name not in store:
+                raise GPhoto2Error(-108)
+            return CameraFile(store[name])
+
+        def file_delete(self, folder: str, name: str) -> None:
+            body.check("file_delete")
+            store = body.store()
+            if store is body.ram:
+                store.pop(name, None)  # RAM files vanish once downloaded
+                raise GPhoto2Error(-108)
+            if name not in store:
+                raise GPhoto2Error(-108)
+            del store[name]
+            body.deleted.append(name)
+            body.card_free_shots += 1
+
+        def set_port_info(self, info: object) -> None:
+            body.calls.append("set_port_info")
+
+        def set_abilities(self, abilities: object) -> None:
+            body.calls.append("set_abilities")
+
+    class PortInfoList(list):  # type: ignore[type-arg]
+        def load(self) -> None:
+            self.append(body.port)
+
+        def lookup_path(self, path: str) -> int:
+            return self.index(path)
+
+    class CameraAbilitiesList(list):  # type: ignore[type-arg]
+        def load(self) -> None:
+            self.append(body.model)
+
+        def lookup_model(self, model: str) -> int:
+            return self.index(model)
+
+    for name, value in {
+        "GPhoto2Error": GPhoto2Error,
+        "Camera": Camera,
+        "CameraFile": CameraFile,
+        "CameraFilePath": CameraFilePath,
+        "PortInfoList": PortInfoList,
+        "CameraAbilitiesList": CameraAbilitiesList,
+        "GP_CAPTURE_IMAGE": GP_CAPTURE_IMAGE,
+        "GP_FILE_TYPE_NORMAL": GP_FILE_TYPE_NORMAL,
+        "GP_EVENT_UNKNOWN": GP_EVENT_UNKNOWN,
+        "GP_EVENT_TIMEOUT": GP_EVENT_TIMEOUT,
+        "GP_EVENT_FILE_ADDED": GP_EVENT_FILE_ADDED,
+        "GP_EVENT_CAPTURE_COMPLETE": GP_EVENT_CAPTURE_COMPLETE,
+    }.items():
+        setattr(mod, name, value)
+    return mod

@@ -1,0 +1,288 @@
+"""The shipped hardware example configs, run through `rti-rig run` up to the device boundary.
+
+The rig is built from the file in rig_configs/ by the composition root, as a user's command
+builds it. Only the device libraries are replaced, at their API boundary: python-gphoto2 by a
+fake module with a camera body behind it (tests/fake_gphoto2.py), pyserial's port by the dome
+firmware emulator on a pseudo-terminal (the configured port name is redirected to the pty;
+everything above ``serial.serial_for_url`` is the real stack).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import serial
+from conftest import CONFIGS
+from dng_spec_writer import dng, mosaic_from_rgb, srgb8
+from fake_gphoto2 import Body, make_module
+from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+from typer.testing import CliRunner
+
+from rti_rig.app.config import load_rig_config
+from rti_rig.cli import app
+from rti_rig.core.clock import SystemClock
+from rti_rig.core.image_files import read_jpeg_rgb, read_linear_tiff
+
+pytestmark = [pytest.mark.pty, pytest.mark.e2e]
+
+DSLR_CONFIG = CONFIGS / "example_dome_48.toml"
+WATCH_CONFIG = CONFIGS / "example_dome_48_folder_watch.toml"
+H, W = 64, 96
+BLACK = (512, 560, 530, 600)  # unequal per CFA site, as some sensors report
+WHITE = 16383
+BASE = np.array([0.2, 0.5, 0.8])  # the issue's flat patch
+
+
+def patch_level(led: int | None) -> float:
+    """How bright the flat patch is under LED ``led`` (none lit: dark)."""
+    return 0.0 if led is None else 0.4 + 0.012 * led
+
+
+@pytest.fixture
+def dome(monkeypatch, request):
+    """The shipped config's dome firmware on a pty; its configured port is redirected there."""
+    path = getattr(request, "param", DSLR_CONFIG)
+    settings = load_rig_config(path).config.dome.serial
+    firmware = firmware_for(settings, led_count=48, clock=SystemClock())
+    real = serial.serial_for_url
+
+    with emulated_dome_on_pty(firmware) as link:
+
+        def redirect(url, *args, **kwargs):
+            return real(link.port if url == settings.port else url, *args, **kwargs)
+
+        monkeypatch.setattr(serial, "serial_for_url", redirect)
+        yield firmware
+
+
+def render_for(firmware):
+    """A body's picture: the flat patch, as bright as the LED the emulated firmware lit."""
+
+    def render() -> bytes:
+        lit = firmware.lit
+        rgb = np.broadcast_to(BASE * patch_level(None if lit is None else lit[0]), (H, W, 3))
+        return dng(mosaic_from_rgb(np.array(rgb), "RGGB", BLACK, WHITE), "RGGB", BLACK, WHITE)
+
+    return render
+
+
+@pytest.fixture
+def body(dome, monkeypatch):
+    b = Body(render=render_for(dome))
+    monkeypatch.setitem(sys.modules, "gphoto2", make_module(b))
+    return b
+
+
+def run(*args: str):
+    return CliRunner().invoke(app, ["run", *args])
+
+
+def journal(out: Path) -> list[dict]:
+    return [json.loads(x) for x in (out / "journal.jsonl").read_text().splitlines() if x]
+
+
+def check_images(out: Path, n: int = 4) -> None:
+    """Every step's files are there, in colour, and as bright as its LED made them."""
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] == "completed"
+    steps = manifest["steps"]
+    assert [s["index"] for s in steps] == list(range(n))
+    for s in steps:
+        expected = BASE * patch_level(s["led"])
+        tif = read_linear_tiff(out / s["linear_image"])
+        assert tif.shape == (H, W, 3)
+        np.testing.assert_allclose(
+            tif[8:-8, 8:-8] / 65535, np.broadcast_to(expected, (48, 80, 3)), rtol=1e-3
+        )
+        jpg = read_jpeg_rgb(out / s["image"]).astype(int)
+        assert np.abs(jpg[8:-8, 8:-8] - srgb8(expected)).max() <= 1
+        assert s["decode"]["mode"] == "demosaic" and s["decode"]["cfa_pattern"] == "RGGB"
+        assert s["decode"]["black_level_per_channel"] == {"R": 512, "G": 560, "B": 600, "G2": 530}
+        (raw,) = [k for k in s["originals"]]
+        assert raw.startswith("raw/image_") and (out / raw).is_file()
+        assert raw in s["sha256"]
+
+
+def test_dslr_example_downloads_into_the_session_and_keeps_the_raws(body, tmp_path):
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    assert result.exit_code == 0, result.output
+    check_images(out)
+    entries = journal(out)
+    # the camera's own names (RAM target: the same folder every time) are kept in the journal
+    names = [next(iter(e["originals"].values())) for e in entries]
+    assert names == ["/IMG_0001.CR2", "/IMG_0002.CR2", "/IMG_0003.CR2", "/IMG_0004.CR2"]
+    assert body.config["imageformat"] == "RAW" and body.config["capturetarget"] == "Internal RAM"
+    assert body.shots == 4 and not body.ram  # nothing left behind in the camera
+    assert not any((out / "raw" / ".incoming").iterdir())
+
+
+def test_camera_switched_off_mid_session_is_named_and_resume_loses_and_repeats_nothing(
+    body, tmp_path
+):
+    out = tmp_path / "s"
+    body.off_at_shot = 3
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    assert result.exit_code == 2
+    assert "stopped answering" in result.output and "--resume" in result.output
+    assert len(journal(out)) == 2
+    body.switch_on()
+    result = run("--resume", str(out))
+    assert result.exit_code == 0, result.output
+    check_images(out)
+    entries = journal(out)
+    assert [e["index"] for e in entries] == [0, 1, 2, 3]  # none repeated, none lost
+    assert body.shots == 4
+    names = [next(iter(e["originals"].values())) for e in entries]
+    assert len(set(names)) == 4
+
+
+def test_camera_that_names_every_shot_the_same_never_overwrites(body, tmp_path):
+    body.naming = "repeat"
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    assert result.exit_code == 0, result.output
+    check_images(out)
+    names = [next(iter(e["originals"].values())) for e in journal(out)]
+    assert names == ["/capt0000.CR2"] * 4
+    raws = sorted(p.name for p in (out / "raw").glob("image_*"))
+    assert raws == [f"image_00{i}.cr2" for i in range(1, 5)]
+    # each kept original is the shot it belongs to (its own brightness), by checksum
+    digests = {json.dumps(e["sha256"], sort_keys=True) for e in journal(out)}
+    assert len(digests) == 4
+
+
+@pytest.mark.parametrize("dome", [WATCH_CONFIG], indirect=True)
+def test_folder_watch_example_fired_by_the_dome_shutter_line(dome, tmp_path, monkeypatch):
+    """A tethering program saves a file into the watched folder each time the dome pulses the
+    camera's release line; the session takes each as its light's image."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    watched = tmp_path / "Pictures" / "rti-tether"
+    watched.mkdir(parents=True)
+    render = render_for(dome)
+    stop = threading.Event()
+
+    def tethering_program() -> None:
+        seen = 0
+        while not stop.is_set():
+            pulses = [e for e in list(dome.history) if e.what == "shutter"]
+            for _ in pulses[seen:]:
+                seen += 1
+                (watched / f"_DSC{seen:04d}.DNG").write_bytes(render())
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=tethering_program, daemon=True)
+    thread.start()
+    try:
+        out = tmp_path / "s"
+        result = run(str(WATCH_CONFIG), "--out", str(out), "--lights", "4")
+    finally:
+        stop.set()
+        thread.join(2)
+    assert result.exit_code == 0, result.output
+    assert sum(e.what == "shutter" for e in dome.history) == 4
+    check_images(out)
+    names = [next(iter(e["originals"].values())) for e in journal(out)]
+    assert names == [f"_DSC{i:04d}.DNG" for i in range(1, 5)]
+
+
+#: Flat colour patches (linear, fractions of full scale), a 2×3 grid of 32×32 squares.
+PATCHES = np.array(
+    [
+        [(0.2, 0.5, 0.8), (0.9, 0.1, 0.3), (0.05, 0.6, 0.25)],
+        [(0.5, 0.5, 0.5), (0.7, 0.35, 0.02), (0.15, 0.15, 0.9)],
+    ]
+)
+SIDE = 32
+#: per shot: CFA pattern, black levels per 2×2 site (row by row), Orientation tag, byte order
+SHOTS = [
+    ("RGGB", (256, 300, 280, 320), 1, False),
+    ("BGGR", (600, 512, 540, 580), 6, True),
+    ("GRBG", (64, 80, 72, 96), 8, False),
+    ("GBRG", (1024, 1000, 1040, 990), 3, True),
+]
+
+
+def patch_image() -> np.ndarray:
+    return np.repeat(np.repeat(PATCHES, SIDE, axis=0), SIDE, axis=1)
+
+
+@pytest.mark.parametrize("dome", [WATCH_CONFIG], indirect=True)
+def test_folder_watch_session_of_spec_written_dngs_gives_true_colour(dome, tmp_path, monkeypatch):
+    """Must show: DNGs from the tests' own writer (all four CFA patterns, unequal black levels,
+    orientation tags, both byte orders) give sRGB JPEGs within 1 code value, linear TIFFs
+    within 0.1 %, and the provenance in the manifest."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    watched = tmp_path / "Pictures" / "rti-tether"
+    watched.mkdir(parents=True)
+    files = []
+    for pattern, black, orientation, big in SHOTS:
+        raw = mosaic_from_rgb(patch_image(), pattern, black, WHITE)
+        files.append(dng(raw, pattern, black, WHITE, orientation, big_endian=big))
+    stop = threading.Event()
+
+    def tethering_program() -> None:
+        seen = 0
+        while not stop.is_set():
+            pulses = [e for e in list(dome.history) if e.what == "shutter"]
+            for _ in pulses[seen:]:
+                (watched / f"SHOT{seen + 1}.DNG").write_bytes(files[seen])
+                seen += 1
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=tethering_program, daemon=True)
+    thread.start()
+    try:
+        out = tmp_path / "s"
+        result = run(str(WATCH_CONFIG), "--out", str(out), "--lights", "4")
+    finally:
+        stop.set()
+        thread.join(2)
+    assert result.exit_code == 0, result.output
+    # the user is told that a rotated camera gave sensor-oriented images
+    assert "rotated" in result.output and "sensor" in result.output
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert any("Orientation tag 6" in n for n in manifest["notices"])
+    expected_srgb = srgb8(PATCHES)
+    for step, (pattern, black, orientation, _) in zip(manifest["steps"], SHOTS, strict=True):
+        tif = read_linear_tiff(out / step["linear_image"]) / 65535
+        jpg = read_jpeg_rgb(out / step["image"]).astype(int)
+        for r in range(2):
+            for c in range(3):
+                inner = np.s_[r * SIDE + 8 : (r + 1) * SIDE - 8, c * SIDE + 8 : (c + 1) * SIDE - 8]
+                np.testing.assert_allclose(
+                    tif[inner], np.broadcast_to(PATCHES[r, c], (16, 16, 3)), rtol=1e-3
+                )
+                assert np.abs(jpg[inner] - expected_srgb[r, c]).max() <= 1, (pattern, r, c)
+        d = step["decode"]
+        assert d["mode"] == "demosaic" and d["content"] == "rgb"
+        assert d["cfa_pattern"] == pattern
+        sites = dict(zip(pattern[:2] + pattern[2:].replace("G", "g"), black, strict=True))
+        assert d["black_level_per_channel"]["R"] == sites["R"]
+        assert d["black_level_per_channel"]["B"] == sites["B"]
+        assert sorted(d["black_level_per_channel"].values()) == sorted(black)
+        assert d["white_level"] == WHITE
+        assert d["white_balance"].startswith("unity")  # the files carry no as-shot neutral
+        assert d["color_space"].startswith("camera RGB")  # ... and no colour matrix
+        assert d["orientation"]["orientation_tag"] == orientation
+        assert d["orientation"]["applied"] is False
+        assert d["orientation"]["camera_rotated"] is (orientation != 1)
+        assert d["source_file"].endswith(f"SHOT{step['index'] + 1}.DNG")
+        (raw,) = step["originals"]
+        assert (out / raw).read_bytes() == files[step["index"]]
+        assert d["raw_file"] == raw and d["camera_file"] == f"SHOT{step['index'] + 1}.DNG"
+
+
+def test_dslr_busy_after_every_shot_is_retried_and_the_session_completes(body, tmp_path):
+    body.busy_after_shot = 1  # a body still writing the previous file answers "busy" once
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    assert result.exit_code == 0, result.output
+    check_images(out)
+    assert body.shots == 4 and body.calls.count("capture") == 4 + 3
