@@ -351,14 +351,19 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
 
             result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event)
     except EmergencyStop as exc:
+        from rti_rig.app.usecases.safe_state import lights_state
+
         err.print(
-            f"[red]Emergency stop ({escape(str(exc))}):[/] lights off, devices safe; images kept."
+            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}; "
+            "images kept."
         )
         err.print(resume_hint)
         raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:
+        from rti_rig.app.usecases.safe_state import lights_state
+
         err.print(
-            f"Images already captured are kept in {out_dir}; lights are off. {resume_hint}",
+            f"Images already captured are kept in {out_dir}; {lights_state(rig)}. {resume_hint}",
             markup=False,
         )
         raise _fail(exc) from None

@@ -128,6 +128,9 @@ class _Server:
                     data = b""
                 if data:
                     self.pending += self.device.receive(data)
+            tick = getattr(self.device, "tick", None)  # devices that act on their own time
+            if tick is not None and self.opened:
+                self.pending += tick()
             down = self.device.take_disconnect()
             if down is not None:
                 self._unplug(down)
