@@ -985,6 +985,22 @@ def bench_tradeoff(
     out.print(text, highlight=False)
 
 
+@app.command()
+def probe(
+    port: Annotated[str, typer.Argument(help="Serial port of the dome, e.g. /dev/ttyACM0.")],
+) -> None:
+    """Identify which known dome firmware answers on PORT (least intrusive probes first, never
+    leaving a light on) and print the rig-config lines to use."""
+    from rti_rig.app.usecases.probe import ProbeRequest
+    from rti_rig.app.usecases.probe import probe as run_probe
+
+    result = run_probe(ProbeRequest(port))
+    for line in result.lines():
+        out.print(line, highlight=False, markup=False)
+    if result.profile is None:
+        raise typer.Exit(code=1)
+
+
 def main() -> None:
     app()
 

@@ -20,6 +20,7 @@ import contextlib
 import os
 import select
 import tempfile
+import termios
 import threading
 import time
 import tty
@@ -128,6 +129,8 @@ class _Server:
                     data = b""
                 if data:
                     self.pending += self.device.receive(data)
+            if hasattr(self.device, "host_baud"):  # the host's UART speed, as the board sees it
+                self.device.host_baud = _host_baud(self.master)
             tick = getattr(self.device, "tick", None)  # devices that act on their own time
             if tick is not None and self.opened:
                 self.pending += tick()
@@ -172,6 +175,21 @@ class _Server:
         self.stop.wait(max(0.0, down_s))
         if not self.stop.is_set():
             self.new_pty()
+
+
+_SPEEDS = {
+    getattr(termios, f"B{n}"): n
+    for n in (300, 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400)
+    if hasattr(termios, f"B{n}")
+}
+
+
+def _host_baud(master: int) -> int | None:
+    """The baud rate the host set on the slave (a pty pair shares its termios)."""
+    try:
+        return _SPEEDS.get(termios.tcgetattr(master)[4])
+    except (termios.error, OSError):
+        return None
 
 
 @contextlib.contextmanager

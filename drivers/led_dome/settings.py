@@ -177,9 +177,11 @@ class DomeSerialSettings(_Strict):
         """A built-in firmware's baud rate unless the config gives one."""
         if isinstance(data, dict) and "baudrate" not in data:
             name = data.get("profile")
+            over = data.get("protocol") if isinstance(data.get("protocol"), dict) else {}
             if isinstance(name, str) and name in described_profiles():
-                over = data.get("protocol") if isinstance(data.get("protocol"), dict) else {}
                 data = {**data, "baudrate": over.get("baudrate", builtin_spec(name)["baudrate"])}
+            elif name == "custom":
+                data = {**data, "baudrate": over.get("baudrate", 9600)}
         return data
 
     @model_validator(mode="after")

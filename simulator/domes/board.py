@@ -80,7 +80,11 @@ class Board:
         self.powered = False
         self._mode: Fault | None = None
         self._disconnect: float | None = None
+        self._reset_pending = False
         self.heard = bytearray()  # every byte the firmware received (for tests)
+        #: The host's UART speed (set by the pty server); at another speed than the board's,
+        #: both sides read garbage, as two UARTs at different baud rates do.
+        self.host_baud: int | None = None
 
     # ------------------------------------------------------------------ firmware side
 
@@ -91,6 +95,8 @@ class Board:
     def print(self, data: bytes | str) -> None:
         """Send ``data`` (paced at the baud rate, after anything already queued)."""
         raw = data.encode("latin-1") if isinstance(data, str) else data
+        if self._baud_mismatch():
+            raw = misread(raw)
         mode = self._mode
         if mode is not None and mode.kind is FaultKind.DROP_REPLY:
             return
@@ -98,7 +104,8 @@ class Board:
             raw = garble(raw)
         start = max(self.t, self._tx_free)
         if mode is not None and mode.kind is FaultKind.DELAY_REPLY:
-            start += mode.delay_s
+            start += mode.delay_s  # once: the rest of the reply follows it, in order
+            self._mode = None
         due = start + len(raw) * 10.0 / self.baudrate
         self._tx_free = due
         self._out.append(Output(due, raw))
@@ -122,7 +129,7 @@ class Board:
         for fault in self.faults.at(self.commands):
             self.event(f"fault {fault.kind} at command {self.commands}")
             if fault.kind is FaultKind.RESET:
-                self._power_on(self.t)
+                self._reset_pending = True  # done once the running firmware yields
                 return False
             if fault.kind is FaultKind.DISCONNECT:
                 self._disconnect = fault.delay_s
@@ -164,6 +171,8 @@ class Board:
             now = self.clock.now()
             self._advance(now)
             per_byte = 10.0 / self.baudrate
+            if self._baud_mismatch():
+                data = misread(data)
             for i, b in enumerate(data):
                 t = now + i * per_byte
                 if not self.powered or t < self._boot_until or len(self._rx) >= RX_BUFFER:
@@ -187,6 +196,9 @@ class Board:
             return down
 
     # ------------------------------------------------------------------ internals
+
+    def _baud_mismatch(self) -> bool:
+        return self.host_baud is not None and self.host_baud != self.baudrate
 
     def _lit_off_unpowered(self) -> None:
         self.set_lit(frozenset())
@@ -236,11 +248,19 @@ class Board:
     def _resume(self, value: int | None) -> None:
         assert self._gen is not None
         try:
-            self._wait = self._gen.send(value) if self._wait is not None else next(self._gen)
+            self._wait = self._gen.send(value)
         except StopIteration:
             self._gen = None
             return
         self._wait_start = self.t
+        if self._reset_pending:
+            self._reset_pending = False
+            self._power_on(self.t)
+
+
+def misread(data: bytes) -> bytes:
+    """What a UART at the wrong baud rate makes of ``data`` (deterministic garbage)."""
+    return bytes((b ^ 0x5A) | 0x80 for b in data)
 
 
 def atoi(text: str) -> int:
