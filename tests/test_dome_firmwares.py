@@ -14,6 +14,10 @@ from pathlib import Path
 
 import pytest
 from conftest import CONFIGS
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.planner.uniform import plan_uniform
+from rti_rig.simulator.domes import board_for
+from rti_rig.simulator.pty_link import serve_on_pty
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import build_rig
@@ -21,12 +25,8 @@ from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import read_lp
-from rti_rig.drivers.led_dome.settings import DomeSerialSettings
-from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.controller import run_session
 from rti_rig.runtime.session import SessionFolder
-from rti_rig.simulator.domes import board_for
-from rti_rig.simulator.pty_link import serve_on_pty
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
 runner = CliRunner()
@@ -201,5 +201,5 @@ def test_custom_description_drives_a_dome_like_a_built_in(tmp_path: Path) -> Non
 
 
 def test_unknown_profile_lists_the_known_ones() -> None:
-    with pytest.raises(ValueError, match="nab-rti-v1.*rtipy"):
+    with pytest.raises(ValueError, match=r"nab-rti-v1.*rtipy"):
         DomeSerialSettings(port="x", profile="nab")
