@@ -203,3 +203,45 @@ def test_custom_description_drives_a_dome_like_a_built_in(tmp_path: Path) -> Non
 def test_unknown_profile_lists_the_known_ones() -> None:
     with pytest.raises(ValueError, match=r"nab-rti-v1.*rtipy"):
         DomeSerialSettings(port="x", profile="nab")
+
+
+def test_failed_handshake_on_the_lit_nab_sketch_still_sends_all_off_and_says_so() -> None:
+    """The issue's case: the project's 'framed' profile on the RTI v1.0 sketch, which boots with
+    every LED on. The handshake fails; the all-off is sent anyway and reported unconfirmed."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.dome_link import OffOutcome
+    from rti_rig.core.errors import DeviceError
+
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        settings = DomeSerialSettings(
+            port=link.port, profile="framed", baudrate=9600, ready_timeout_s=2.5
+        )
+        dome = build_dome(settings, VirtualClock())
+        with pytest.raises(DeviceError, match="no handshake"):
+            dome.connect()
+        assert eventually(lambda: board.lit == frozenset())  # <0> reached the sketch
+        assert dome.off_report is not None
+        assert dome.off_report.outcome is OffOutcome.SENT_UNCONFIRMED
+        assert "lights are off" not in dome.off_report.sentence()
+
+
+def test_a_capture_outlasting_a_timed_led_is_refused_naming_the_led() -> None:
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.dome_link import DomeLedError
+
+    board = board_for("rtipy")
+    with serve_on_pty(board, "rtipy") as link:
+        settings = DomeSerialSettings(port=link.port, profile="rtipy", protocol={"light_on_s": 1})
+        dome = build_dome(settings, VirtualClock())
+        dome.connect()
+        dome.light(15)
+        assert eventually(lambda: board.lit == frozenset({15}))
+        time.sleep(1.5)  # a capture far longer than the 1 s window (real time: the board's)
+        with pytest.raises(DomeLedError, match="LED 15 went dark by itself") as info:
+            dome.all_off()
+        assert info.value.led == 15
+        assert board.lit == frozenset()
+        dome.close()

@@ -171,6 +171,18 @@ class DomeSerialSettings(_Strict):
                 )
         return value
 
+    @field_validator("profile")
+    @classmethod
+    def _known_profile(cls, value: str) -> str:
+        if value not in all_profiles():
+            raise ValueError(
+                f"profile '{value}' is not known: this project's own protocols are 'default', "
+                "'framed' or 'binary'; real firmwares: "
+                + ", ".join(described_profiles())
+                + "; or 'custom' with a [dome.serial.protocol] description (docs/domes.md)"
+            )
+        return value
+
     @model_validator(mode="before")
     @classmethod
     def _profile_baud(cls, data: Any) -> Any:
@@ -186,12 +198,6 @@ class DomeSerialSettings(_Strict):
 
     @model_validator(mode="after")
     def _profile_options(self) -> DomeSerialSettings:
-        if self.profile not in all_profiles():
-            raise ValueError(
-                f"profile '{self.profile}' is not known; choose one of "
-                + ", ".join(all_profiles())
-                + " (see docs/domes.md)"
-            )
         described = self.profile in described_profiles() or self.profile == "custom"
         if not described and (self.protocol is not None or self.led_map_file is not None):
             raise ValueError(
