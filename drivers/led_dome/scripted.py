@@ -215,6 +215,8 @@ class ScriptedDomeDriver:
     def _await(self, cmd: CommandSpec, index: int | None, name: str, sent: float, n: int) -> str:
         reply = cmd.reply
         if reply.kind == "none":
+            # No answer ever comes: the least the command takes is its bytes' time on the wire.
+            self.transport.clock.sleep(self._wire_s(n))
             return ""
         clock = self.transport.clock
         deadline = sent + self._wire_s(n) + self.spec.frame_silence_s + reply.timeout_s
@@ -315,7 +317,6 @@ class ScriptedDomeDriver:
                 f"port lost: {exc}", "wait after opening", LinkFault.DISCONNECTED
             ) from exc
         self.boot_text = heard.decode("latin-1")
-        self._last_end = clock.now()
 
     def _feed(self, data: bytes) -> None:
         if data:

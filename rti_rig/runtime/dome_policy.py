@@ -212,7 +212,13 @@ class DomePolicy:
         log.info(
             "%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version, info.led_count
         )
-        if not self.link.echoes_light and not self.settings.confirm_with_query:
+        if not getattr(self.link, "can_query", True) and not self.link.echoes_light:
+            log.info(
+                "%s: this firmware does not say which LED it lit; only the images can tell "
+                "(rti-rig's wrong-light check)",
+                self.name,
+            )
+        elif not self.link.echoes_light and not self.settings.confirm_with_query:
             log.warning(
                 "%s: this profile's light acknowledgement does not say which LED was lit; set "
                 "confirm_with_query = true to have the firmware confirm every LED",
