@@ -245,3 +245,46 @@ def test_a_capture_outlasting_a_timed_led_is_refused_naming_the_led() -> None:
         assert info.value.led == 15
         assert board.lit == frozenset()
         dome.close()
+
+
+def elexol_with_map(tmp_path: Path, map_text: str, section: str = "Dome main") -> Path:
+    (tmp_path / "maps.txt").write_text(map_text)
+    text = (CONFIGS / "emulated_elexol.toml").read_text()
+    text = text.replace("count = 12", "count = 8").replace("led_count = 12", "led_count = 8")
+    text = text.replace(
+        'profile = "elexol-24r1"',
+        f'profile = "elexol-24r1"\nled_map_file = "maps.txt"\nled_map_section = "{section}"',
+    )
+    path = tmp_path / "rig.toml"
+    path.write_text(text)
+    return path
+
+
+def test_elexol_led_map_file_relative_to_the_config_drives_the_mapped_outputs(
+    tmp_path: Path,
+) -> None:
+    data = Path(__file__).parent / "data" / "domes" / "led-maps.txt"
+    cfg = elexol_with_map(tmp_path, data.read_text())
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 0, r.output
+    assert "RESULT: PASS" in r.output
+
+
+def test_a_bad_led_map_file_is_refused_at_load_naming_file_and_line(tmp_path: Path) -> None:
+    cfg = elexol_with_map(tmp_path, "** Dome main **\n0x01, zz, 0x00\n")
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2
+    assert "maps.txt:2" in said(r) and "led_map_file" in said(r)
+
+
+@pytest.mark.parametrize("kind", ["garble_reply", "drop_reply"])
+def test_a_stepping_dome_rewinds_after_a_doubtful_step_and_labels_every_image_right(
+    kind: str, tmp_path: Path
+) -> None:
+    from rti_rig.testing.verify import wrong_light_steps
+
+    cfg = with_faults("nichlock", tmp_path, f'faults = [{{at_command = 8, kind = "{kind}"}}]\n')
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])
+    assert r.exit_code == 0, r.output
+    assert wrong_light_steps(cfg, out) == []

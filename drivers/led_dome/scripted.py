@@ -62,7 +62,7 @@ class ScriptedDomeDriver:
         self._lit: frozenset[int] = frozenset()
         self._window_end: float | None = None
         self._timed_led: int | None = None
-        self._position = 0  # stepping: the LED the next step lights
+        self._position: int | None = 0  # stepping: the LED the next step lights (None: unknown)
         #: Text heard while waiting after opening (boot banner), for the probe and messages.
         self.boot_text = ""
         self.banners_seen = 0
@@ -125,6 +125,7 @@ class ScriptedDomeDriver:
             self._wait_window("all off")
             self._lit = frozenset()
             return
+        self._position = None  # unknown until the all-off is confirmed
         self._exchange(self.spec.all_off, None, "all off", lit=frozenset())
         self._lit = frozenset()
         self._position = 0
@@ -146,12 +147,17 @@ class ScriptedDomeDriver:
     # ------------------------------------------------------------------ stepping / timing
 
     def _step_to(self, index: int, name: str) -> None:
-        if index < self._position or self._lit:
-            self.all_off()  # rewinds to the first LED (and switches the lit one off)
-        while self._position <= index:
-            target = self._position
-            self._exchange(self.spec.light, target, f"{name} (step to LED {target})")
-            self._position = target + 1
+        try:
+            if self._position is None or index < self._position or self._lit:
+                self.all_off()  # rewinds to the first LED (and switches the lit one off)
+            assert self._position is not None
+            while self._position <= index:
+                target = self._position
+                self._exchange(self.spec.light, target, f"{name} (step to LED {target})")
+                self._position = target + 1
+        except DomeLinkError:
+            self._position = None  # the firmware may or may not have stepped: rewind next time
+            raise
         self._lit = frozenset({index})
 
     def _wait_window(self, name: str) -> None:
