@@ -121,9 +121,14 @@ def campaign(sessions: int, seed: int) -> dict:
                 if not (out / name).exists()
                 or hashlib.sha256((out / name).read_bytes()).hexdigest() != digest
             )
-            stats["wrong_light_images"] += len(wrong_light_steps(clean, out))
+            wrong = wrong_light_steps(clean, out)
+            stats["wrong_light_images"] += len(wrong)
             stats["images_checked"] += len(m["steps"])
-            print(f"{i + 1}/{sessions} {profile} {kind}@{at}: {first}", flush=True)
+            print(
+                f"{i + 1}/{sessions} {profile} {kind}@{at}: {first}; resumes {resumes}, "
+                f"wrong-light steps {wrong}, dark after the first run: {dark}",
+                flush=True,
+            )
     return {"stats": dict(stats), "faults": dict(per_kind)}
 
 

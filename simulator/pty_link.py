@@ -17,8 +17,10 @@ Shutdown is bounded: the thread polls with a short timeout and is joined with a 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import select
+import struct
 import tempfile
 import termios
 import threading
@@ -55,9 +57,39 @@ class PtyLink:
     _thread: threading.Thread
     errors: list[BaseException]
 
+    _server: _Server | None = None
+
     @property
     def alive(self) -> bool:
         return self._thread.is_alive()
+
+    def wait_delivered(self, timeout_s: float = 5.0) -> bool:
+        """Wait until the device has been handed every byte the host wrote (bounded).
+
+        A real UART delivers a byte within its wire time; a pty's server thread may lag behind
+        under CPU load. A simulated camera calls this before it looks at the emulated light, so
+        the dry run sees what the board would have done by then, whatever the load.
+        """
+        server = self._server
+        if server is None:
+            return True
+        end = time.monotonic() + timeout_s
+        while time.monotonic() < end:
+            if server.master < 0:
+                return False
+            try:
+                pending = struct.unpack(
+                    "i", fcntl.ioctl(server.master, termios.FIONREAD, b"\0" * 4)
+                )[0]
+            except OSError:
+                return False
+            if pending == 0:
+                seen = server.iterations
+                while server.iterations < seen + 2 and time.monotonic() < end:
+                    time.sleep(0.001)
+                return server.iterations >= seen + 2
+            time.sleep(0.001)
+        return False
 
     def stop(self, timeout_s: float = 2.0) -> None:
         self._stop.set()
@@ -75,6 +107,7 @@ class _Server:
         self.opened = False
         self.pending: list[TimedOutput] = []
         self.errors: list[BaseException] = []
+        self.iterations = 0  # loops run (wait_delivered waits for the next ones)
 
     def new_pty(self) -> None:
         master, slave = os.openpty()
@@ -106,6 +139,7 @@ class _Server:
         poller = select.poll()
         registered = -1
         while not self.stop.is_set():
+            self.iterations += 1
             if registered != self.master:
                 if registered >= 0:
                     with contextlib.suppress(KeyError, ValueError):
@@ -201,7 +235,7 @@ def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
     server = _Server(device, link_path, stop)
     server.new_pty()
     thread = threading.Thread(target=server.run, name=f"pty-{name}", daemon=True)
-    link = PtyLink(str(link_path), device, stop, thread, server.errors)
+    link = PtyLink(str(link_path), device, stop, thread, server.errors, server)
     thread.start()
     try:
         yield link

@@ -135,11 +135,12 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
 class _BoardLight:
     """The light a real-firmware emulator really produces (one LED, or none/ambiguous)."""
 
-    def __init__(self, board, geometry: DomeGeometry) -> None:  # type: ignore[no-untyped-def]
-        self._board, self._geometry = board, geometry
+    def __init__(self, board, geometry: DomeGeometry, link) -> None:  # type: ignore[no-untyped-def]
+        self._board, self._geometry, self._link = board, geometry, link
 
     @property
     def direction(self):  # type: ignore[no-untyped-def]
+        self._link.wait_delivered()  # what a UART would have delivered by now, whatever the load
         lit = self._board.lit
         if len(lit) != 1 or next(iter(lit)) >= self._geometry.count:
             return None  # dark, or several LEDs at once (a boot-lit dome): no single light
@@ -179,7 +180,7 @@ def _build_emulated_firmware_dome(loaded: LoadedRig, geometry: DomeGeometry, clo
             directions=geometry.directions,
             name=f"dome on {link.port} (emulated {serial.profile})",
         )
-        camera = _simulated_camera(loaded, _BoardLight(board, geometry), clock)
+        camera = _simulated_camera(loaded, _BoardLight(board, geometry, link), clock)
     except BaseException:
         stack.close()
         raise

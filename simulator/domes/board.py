@@ -81,6 +81,7 @@ class Board:
         self._mode: Fault | None = None
         self._disconnect: float | None = None
         self._reset_pending = False
+        self._unplugged = False
         self.heard = bytearray()  # every byte the firmware received (for tests)
         #: The host's UART speed (set by the pty server); at another speed than the board's,
         #: both sides read garbage, as two UARTs at different baud rates do.
@@ -114,6 +115,8 @@ class Board:
         self.print(text + "\r\n")
 
     def set_lit(self, leds: frozenset[int] | set[int]) -> None:
+        if self._unplugged:
+            return  # no power: nothing lights, whatever the firmware's last steps would do
         lit = frozenset(i for i in leds if 0 <= i < self.led_count)
         if lit != self._lit:
             self._lit = lit
@@ -134,6 +137,7 @@ class Board:
             if fault.kind is FaultKind.DISCONNECT:
                 self._disconnect = fault.delay_s
                 self._lit_off_unpowered()
+                self._unplugged = True
                 return False
             self._mode = fault
         return True
@@ -204,6 +208,7 @@ class Board:
         self.set_lit(frozenset())
 
     def _power_on(self, now: float) -> None:
+        self._unplugged = False
         self.t = now
         self.event("boot")
         self._rx.clear()

@@ -16,8 +16,10 @@ SPEC = {
     "boot_wait_s": 0.2,
     "handshake": {"send": "3F", "reply": {"kind": "pattern", "pattern": r"USB I/O 24R1\r\n"}},
     "init": [{"send": "21 41 00 21 42 00 21 43 00"}],
-    "light": {"send": "41 {map0} 42 {map1} 43 {map2}"},
-    "all_off": {"send": "41 00 42 00 43 00"},
+    # The board never answers, so a power blip that turned its ports back into inputs would go
+    # unseen: every light and all-off sets the directions again first (9 bytes, 2.3 ms).
+    "light": {"send": "21 41 00 21 42 00 21 43 00 41 {map0} 42 {map1} 43 {map2}"},
+    "all_off": {"send": "21 41 00 21 42 00 21 43 00 41 00 42 00 43 00"},
     "led_map": DEFAULT_MAP,
     "note": "Elexol USB I/O 24R1 relay/IO board (rtiacquire): LED map file, no acknowledgements",
 }
