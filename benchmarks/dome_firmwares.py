@@ -29,8 +29,8 @@ LIGHTS = 8
 OVERRIDES = {"rtipy": {"light_on_s": 1.0}}
 
 
-def measure(profile: str) -> tuple[float, list[float]]:
-    """(connect seconds, seconds per light = light + all_off) on the wall clock."""
+def measure(profile: str) -> tuple[float, list[float], int]:
+    """(connect seconds, seconds per light = light + all_off, resends) on the wall clock."""
     board = board_for(profile)
     with serve_on_pty(board, profile) as link:
         settings = DomeSerialSettings(
@@ -49,15 +49,15 @@ def measure(profile: str) -> tuple[float, list[float]]:
                 per_light.append(time.perf_counter() - t0)
         finally:
             dome.close()
-    return connect_s, per_light
+    return connect_s, per_light, dome.stats.retries
 
 
 def main(argv: list[str]) -> str:
     rows = []
     for profile in described_profiles():
-        connect_s, per = measure(profile)
+        connect_s, per, retries = measure(profile)
         med = statistics.median(per)
-        rows.append(f"| {profile} | {connect_s:.2f} | {med:.3f} | {max(per):.3f} |")
+        rows.append(f"| {profile} | {connect_s:.2f} | {med:.3f} | {max(per):.3f} | {retries} |")
         print(
             f"{profile:12s} connect {connect_s:.2f} s, per light median {med:.3f} s, "
             f"max {max(per):.3f} s",
@@ -79,8 +79,8 @@ def main(argv: list[str]) -> str:
             "index); nab-rti-v1, ~100 reply characters at 9600 baud. *Connect* includes the boot "
             "wait after the port opens (Arduino auto-reset).",
             "",
-            "| profile | connect s | per light median s | per light max s |",
-            "|---|---|---|---|",
+            "| profile | connect s | per light median s | per light max s | resends |",
+            "|---|---|---|---|---|",
             *rows,
         ]
     )
