@@ -140,7 +140,7 @@ def test_lost_garbled_late_reply_is_retried_and_the_session_completes(
 ) -> None:
     # command 1 is the init all-off, 2 the connect all-off, 3 the controller's all-off, 4 light 0
     cfg = with_faults(
-        "nab-rti-v1", tmp_path, f'faults = [{{at_command = 4, kind = "{kind}", delay_s = 1.5}}]\n'
+        "nab-rti-v1", tmp_path, f'faults = [{{at_command = 4, kind = "{kind}", delay_s = 4.0}}]\n'
     )
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])

@@ -46,7 +46,14 @@ def build_driver(
     """The driver for ``settings`` on ``transport`` (default: the serial port it names)."""
     port = transport or SerialTransport(settings.port, settings.baudrate)
     if settings.is_described:
-        return ScriptedDomeDriver(port, protocol_for(settings), device=name)
+        # reply_timeout_s is a floor under the profile's own timeouts (a slow USB bridge, or an
+        # emulator sharing the CPU); its default 0.5 s is below every profile's.
+        return ScriptedDomeDriver(
+            port,
+            protocol_for(settings),
+            device=name,
+            min_reply_timeout_s=settings.reply_timeout_s,
+        )
     return LedDomeDriver(
         port,
         make_codec(settings),

@@ -36,9 +36,18 @@ TIMED_MARGIN_S = 0.05
 class ScriptedDomeDriver:
     """Implements :class:`rti_rig.core.dome_link.DomeLink` from a :class:`ProtocolSpec`."""
 
-    def __init__(self, transport: Transport, spec: ProtocolSpec, *, device: str = "dome") -> None:
+    def __init__(
+        self,
+        transport: Transport,
+        spec: ProtocolSpec,
+        *,
+        device: str = "dome",
+        min_reply_timeout_s: float = 0.0,
+    ) -> None:
         self.transport = transport
         self.spec = spec
+        #: Floor under every reply timeout (``reply_timeout_s`` of the serial settings).
+        self.min_reply_timeout_s = min_reply_timeout_s
         self.device = f"{device} ({transport.name}, {spec.name} profile)"
         self.has_watchdog = False
         self.max_level = 1  # on/off only
@@ -225,7 +234,8 @@ class ScriptedDomeDriver:
             self.transport.clock.sleep(self._wire_s(n))
             return ""
         clock = self.transport.clock
-        deadline = sent + self._wire_s(n) + self.spec.frame_silence_s + reply.timeout_s
+        timeout = max(reply.timeout_s, self.min_reply_timeout_s)
+        deadline = sent + self._wire_s(n) + self.spec.frame_silence_s + timeout
         wanted = self.spec.reply_regex(reply.pattern, index) if reply.kind == "pattern" else None
         step = self.spec.step_regex(reply.pattern) if self.spec.stepping and reply.pattern else None
         while True:
