@@ -84,6 +84,19 @@ def _listen(t: SerialTransport, seconds: float) -> bytes:
     return bytes(out)
 
 
+def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
+    """The Nab sketch answered: it boots with every LED on, so switch them off before leaving."""
+    result.profile = "nab-rti-v1"
+    off = _exchange(result.port, 9600, wait, b"<0>", 0.6)
+    result.heard.append(("all off <0>", off))
+    result.lights = (
+        "the sketch boots with every LED on; all-off sent and acknowledged"
+        if "<All lights turned off.>" in off
+        else "the sketch boots with every LED on; all-off sent but NOT acknowledged: check the dome"
+    )
+    return result
+
+
 def probe(request: ProbeRequest) -> ProbeResult:
     """Try the known firmwares on ``request.port``; see the module docstring for the order."""
     result = ProbeResult(request.port)
@@ -92,16 +105,7 @@ def probe(request: ProbeRequest) -> ProbeResult:
         text = _exchange(port, 9600, wait, b"", 0)
         result.heard.append(("listen at 9600 baud", text))
         if "RTI-Dome intialized" in text or "<All lights turned on.>" in text:
-            result.profile = "nab-rti-v1"
-            off = _exchange(port, 9600, wait, b"<0>", 0.6)
-            result.heard.append(("all off <0>", off))
-            result.lights = (
-                "the sketch boots with every LED on; all-off sent and acknowledged"
-                if "<All lights turned off.>" in off
-                else "the sketch boots with every LED on; all-off sent but NOT acknowledged: "
-                "check the dome"
-            )
-            return result
+            return _nab_found(result, wait)
         text = _exchange(port, 115200, wait, b"", 0)
         result.heard.append(("listen at 115200 baud", text))
         if "Reflectance Transformation Imager Serial Interface" in text:
@@ -122,16 +126,7 @@ def probe(request: ProbeRequest) -> ProbeResult:
         text = _exchange(port, 9600, wait, b"<9>", 0.6)
         result.heard.append(("'<9>' (an unknown code) at 9600 baud", text))
         if "<INCORRECT FUNCTION CALL: 9>" in text or "RTI-Dome intialized" in text:
-            result.profile = "nab-rti-v1"
-            off = _exchange(port, 9600, wait, b"<0>", 0.6)
-            result.heard.append(("all off <0>", off))
-            result.lights = (
-                "the sketch boots with every LED on; all-off sent and acknowledged"
-                if "<All lights turned off.>" in off
-                else "the sketch boots with every LED on; all-off sent but NOT acknowledged: "
-                "check the dome"
-            )
-            return result
+            return _nab_found(result, wait)
         text = _exchange(port, 9600, 1.6, b"\x42" + bytes(8), 0.5)
         result.heard.append(("0x42 + empty mask at 9600 baud", text))
         if text.endswith("\x01"):
