@@ -303,7 +303,9 @@ def main() -> None:
     result = campaign(args.sessions, args.seed)
     text = report(result, args.sessions, args.seed, time.perf_counter() - t0)
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text)
+    old = args.out.read_text() if args.out.exists() else ""
+    keep = old[old.find("<!-- BEGIN firmware_faults -->") :] if "firmware_faults" in old else ""
+    args.out.write_text(text.rstrip() + ("\n\n" + keep if keep else "\n"))  # its own section
     print(text)
 
 

@@ -316,14 +316,19 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
 
             result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event)
     except EmergencyStop as exc:
+        from rti_rig.app.usecases.safe_state import lights_state
+
         err.print(
-            f"[red]Emergency stop ({escape(str(exc))}):[/] lights off, devices safe; images kept."
+            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}; "
+            "images kept."
         )
         err.print(resume_hint)
         raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:
+        from rti_rig.app.usecases.safe_state import lights_state
+
         err.print(
-            f"Images already captured are kept in {out_dir}; lights are off. {resume_hint}",
+            f"Images already captured are kept in {out_dir}; {lights_state(rig)}. {resume_hint}",
             markup=False,
         )
         raise _fail(exc) from None
@@ -800,6 +805,22 @@ def bench_tradeoff(
     text = summarise(rows, settings, time.perf_counter() - t0, command)
     (out_dir / "summary.md").write_text(text, encoding="utf-8")
     out.print(text, highlight=False)
+
+
+@app.command()
+def probe(
+    port: Annotated[str, typer.Argument(help="Serial port of the dome, e.g. /dev/ttyACM0.")],
+) -> None:
+    """Identify which known dome firmware answers on PORT (least intrusive probes first, never
+    leaving a light on) and print the rig-config lines to use."""
+    from rti_rig.app.usecases.probe import ProbeRequest
+    from rti_rig.app.usecases.probe import probe as run_probe
+
+    result = run_probe(ProbeRequest(port))
+    for line in result.lines():
+        out.print(line, highlight=False, markup=False)
+    if result.profile is None:
+        raise typer.Exit(code=1)
 
 
 def main() -> None:

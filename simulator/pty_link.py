@@ -17,9 +17,12 @@ Shutdown is bounded: the thread polls with a short timeout and is joined with a 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import select
+import struct
 import tempfile
+import termios
 import threading
 import time
 import tty
@@ -54,9 +57,39 @@ class PtyLink:
     _thread: threading.Thread
     errors: list[BaseException]
 
+    _server: _Server | None = None
+
     @property
     def alive(self) -> bool:
         return self._thread.is_alive()
+
+    def wait_delivered(self, timeout_s: float = 5.0) -> bool:
+        """Wait until the device has been handed every byte the host wrote (bounded).
+
+        A real UART delivers a byte within its wire time; a pty's server thread may lag behind
+        under CPU load. A simulated camera calls this before it looks at the emulated light, so
+        the dry run sees what the board would have done by then, whatever the load.
+        """
+        server = self._server
+        if server is None:
+            return True
+        end = time.monotonic() + timeout_s
+        while time.monotonic() < end:
+            if server.master < 0:
+                return False
+            try:
+                pending = struct.unpack(
+                    "i", fcntl.ioctl(server.master, termios.FIONREAD, b"\0" * 4)
+                )[0]
+            except OSError:
+                return False
+            if pending == 0:
+                seen = server.iterations
+                while server.iterations < seen + 2 and time.monotonic() < end:
+                    time.sleep(0.001)
+                return server.iterations >= seen + 2
+            time.sleep(0.001)
+        return False
 
     def stop(self, timeout_s: float = 2.0) -> None:
         self._stop.set()
@@ -74,6 +107,7 @@ class _Server:
         self.opened = False
         self.pending: list[TimedOutput] = []
         self.errors: list[BaseException] = []
+        self.iterations = 0  # loops run (wait_delivered waits for the next ones)
 
     def new_pty(self) -> None:
         master, slave = os.openpty()
@@ -105,6 +139,7 @@ class _Server:
         poller = select.poll()
         registered = -1
         while not self.stop.is_set():
+            self.iterations += 1
             if registered != self.master:
                 if registered >= 0:
                     with contextlib.suppress(KeyError, ValueError):
@@ -128,6 +163,11 @@ class _Server:
                     data = b""
                 if data:
                     self.pending += self.device.receive(data)
+            if hasattr(self.device, "host_baud"):  # the host's UART speed, as the board sees it
+                self.device.host_baud = _host_baud(self.master)
+            tick = getattr(self.device, "tick", None)  # devices that act on their own time
+            if tick is not None and self.opened:
+                self.pending += tick()
             down = self.device.take_disconnect()
             if down is not None:
                 self._unplug(down)
@@ -171,6 +211,21 @@ class _Server:
             self.new_pty()
 
 
+_SPEEDS = {
+    getattr(termios, f"B{n}"): n
+    for n in (300, 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400)
+    if hasattr(termios, f"B{n}")
+}
+
+
+def _host_baud(master: int) -> int | None:
+    """The baud rate the host set on the slave (a pty pair shares its termios)."""
+    try:
+        return _SPEEDS.get(termios.tcgetattr(master)[4])
+    except (termios.error, OSError):
+        return None
+
+
 @contextlib.contextmanager
 def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
     """Serve ``device`` on a pty; yields a :class:`PtyLink` whose ``port`` pyserial can open."""
@@ -180,7 +235,7 @@ def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
     server = _Server(device, link_path, stop)
     server.new_pty()
     thread = threading.Thread(target=server.run, name=f"pty-{name}", daemon=True)
-    link = PtyLink(str(link_path), device, stop, thread, server.errors)
+    link = PtyLink(str(link_path), device, stop, thread, server.errors, server)
     thread.start()
     try:
         yield link

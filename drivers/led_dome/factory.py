@@ -2,23 +2,60 @@
 
 The retry/thermal policy above the driver is the runtime's; the composition root joins the two
 (:func:`rti_rig.app.dome_factory.build_dome`). Tests and the dry run pass their own transport
-(the emulator in-process or on a pty) and the same settings.
+(the emulator in-process or on a pty) and the same settings. This project's own protocols run
+on :class:`LedDomeDriver` with a codec; real firmwares (built-in profiles by name, or "custom")
+run on :class:`ScriptedDomeDriver` from their protocol description.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from rti_rig.drivers.led_dome.driver import LedDomeDriver
 from rti_rig.drivers.led_dome.profiles import make_codec
+from rti_rig.drivers.led_dome.protocol_spec import ProtocolSpec, parse_led_map
+from rti_rig.drivers.led_dome.scripted import ScriptedDomeDriver
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.drivers.led_dome.transport import SerialTransport, Transport
+
+from rti_rig.core.errors import ConfigError
+
+
+def protocol_for(settings: DomeSerialSettings) -> ProtocolSpec:
+    """The protocol description of a firmware profile, its LED map file read if it names one."""
+    led_map = None
+    if settings.led_map_file is not None:
+        path = Path(settings.led_map_file)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ConfigError(
+                str(path), "dome.serial.led_map_file", f"cannot read it: {exc.strerror or exc}"
+            ) from None
+        try:
+            led_map = parse_led_map(text, settings.led_map_section, str(path))
+            return settings.protocol_spec(led_map)
+        except ValueError as exc:
+            raise ConfigError(str(path), "dome.serial.led_map_file", str(exc)) from None
+    return settings.protocol_spec()
 
 
 def build_driver(
     settings: DomeSerialSettings, transport: Transport | None = None, *, name: str = "dome"
-) -> LedDomeDriver:
+) -> LedDomeDriver | ScriptedDomeDriver:
     """The driver for ``settings`` on ``transport`` (default: the serial port it names)."""
+    port = transport or SerialTransport(settings.port, settings.baudrate)
+    if settings.is_described:
+        # reply_timeout_s is a floor under the profile's own timeouts (a slow USB bridge, or an
+        # emulator sharing the CPU); its default 0.5 s is below every profile's.
+        return ScriptedDomeDriver(
+            port,
+            protocol_for(settings),
+            device=name,
+            min_reply_timeout_s=settings.reply_timeout_s,
+        )
     return LedDomeDriver(
-        transport or SerialTransport(settings.port, settings.baudrate),
+        port,
         make_codec(settings),
         device=name,
         reply_timeout_s=settings.reply_timeout_s,

@@ -8,9 +8,23 @@ the session starts.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+from rti_rig.drivers.led_dome.dome_profiles import (
+    all_profiles,
+    builtin_spec,
+    described_profiles,
+    merge,
+)
+from rti_rig.drivers.led_dome.protocol_spec import ProtocolSpec
 
 
 class _Strict(BaseModel):
@@ -106,7 +120,7 @@ class ThermalSettings(_Strict):
         return self
 
 
-Profile = Literal["default", "framed", "binary"]
+CodecProfile = Literal["default", "framed", "binary"]
 
 
 class DomeSerialSettings(_Strict):
@@ -114,7 +128,14 @@ class DomeSerialSettings(_Strict):
 
     port: str = Field(..., min_length=1, description="e.g. /dev/ttyACM0, COM3, loop://")
     baudrate: int = Field(115200, gt=0, le=4_000_000)
-    profile: Profile = "default"
+    #: default / framed / binary (this project's own protocols), a built-in firmware's name
+    #: (``dome_profiles``), or "custom" with a full [dome.serial.protocol] description.
+    profile: str = "default"
+    #: The protocol description (profile = "custom"), or fields laid over a built-in one.
+    protocol: dict[str, Any] | None = None
+    #: An LED map file (rtiacquire ``led-maps.txt`` format) and the section to use.
+    led_map_file: str | None = None
+    led_map_section: str | None = None
     default: DefaultProfileOptions | None = None
     framed: FramedOptions | None = None
     binary: BinaryOptions | None = None
@@ -150,8 +171,47 @@ class DomeSerialSettings(_Strict):
                 )
         return value
 
+    @field_validator("profile")
+    @classmethod
+    def _known_profile(cls, value: str) -> str:
+        if value not in all_profiles():
+            raise ValueError(
+                f"profile '{value}' is not known: this project's own protocols are 'default', "
+                "'framed' or 'binary'; real firmwares: "
+                + ", ".join(described_profiles())
+                + "; or 'custom' with a [dome.serial.protocol] description (docs/domes.md)"
+            )
+        return value
+
+    @model_validator(mode="before")
+    @classmethod
+    def _profile_baud(cls, data: Any) -> Any:
+        """A built-in firmware's baud rate unless the config gives one."""
+        if isinstance(data, dict) and "baudrate" not in data:
+            name = data.get("profile")
+            over = data.get("protocol") if isinstance(data.get("protocol"), dict) else {}
+            if isinstance(name, str) and name in described_profiles():
+                data = {**data, "baudrate": over.get("baudrate", builtin_spec(name)["baudrate"])}
+            elif name == "custom":
+                data = {**data, "baudrate": over.get("baudrate", 9600)}
+        return data
+
     @model_validator(mode="after")
     def _profile_options(self) -> DomeSerialSettings:
+        described = self.profile in described_profiles() or self.profile == "custom"
+        if not described and (self.protocol is not None or self.led_map_file is not None):
+            raise ValueError(
+                f"[dome.serial.protocol] and led_map_file describe a firmware's protocol; the "
+                f"'{self.profile}' profile is this project's own: remove them or choose a "
+                "firmware profile (or 'custom')"
+            )
+        if self.profile == "custom" and self.protocol is None:
+            raise ValueError(
+                "profile = 'custom' needs a [dome.serial.protocol] table describing the firmware "
+                "(docs/domes.md, 'Describing a new dome')"
+            )
+        if described:
+            self.protocol_spec()  # refuse a bad description now, naming its key
         for other in ("default", "framed", "binary"):
             if other != self.profile and getattr(self, other) is not None:
                 raise ValueError(
@@ -168,6 +228,32 @@ class DomeSerialSettings(_Strict):
                 f"expected_led_count = {n}"
             )
         return self
+
+    def protocol_spec(self, led_map: tuple[tuple[int, ...], ...] | None = None) -> ProtocolSpec:
+        """The validated protocol description of a firmware profile (built-in or custom).
+
+        ``led_map``: rows read from ``led_map_file`` (they set the LED count too).
+        """
+        base: dict[str, Any] = (
+            builtin_spec(self.profile) if self.profile in described_profiles() else {}
+        )
+        merged = merge(base, self.protocol or {})
+        merged["baudrate"] = self.baudrate
+        if led_map is not None:
+            merged["led_map"] = [list(r) for r in led_map]
+            merged["led_count"] = len(led_map)
+        try:
+            return ProtocolSpec.model_validate(merged)
+        except ValidationError as exc:
+            first = exc.errors()[0]
+            where = ".".join(str(p) for p in first["loc"])
+            msg = first["msg"].removeprefix("Value error, ")
+            raise ValueError(f"protocol.{where}: {msg}" if where else f"protocol: {msg}") from None
+
+    @property
+    def is_described(self) -> bool:
+        """True for firmware profiles (driven from a protocol description, not a codec)."""
+        return self.profile in described_profiles() or self.profile == "custom"
 
     def check_led_count(self, count: int) -> str | None:
         """Why ``count`` LEDs (e.g. from the dome's ``.lp``) do not fit these settings, or None."""

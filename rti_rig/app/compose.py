@@ -93,6 +93,8 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
     cfg = loaded.config
     assert cfg.dome is not None and cfg.dome.serial is not None
     serial = cfg.dome.serial
+    if serial.is_described:
+        return _build_emulated_firmware_dome(loaded, geometry, clock)
     firmware = firmware_for(
         serial,
         led_count=geometry.count,
@@ -127,6 +129,63 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
         raise
     rig = Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock, stack)
     rig.emulator = firmware  # type: ignore[attr-defined]  # for tests and the fault campaign
+    return rig
+
+
+class _BoardLight:
+    """The light a real-firmware emulator really produces (one LED, or none/ambiguous)."""
+
+    def __init__(self, board, geometry: DomeGeometry, link) -> None:  # type: ignore[no-untyped-def]
+        self._board, self._geometry, self._link = board, geometry, link
+
+    @property
+    def direction(self):  # type: ignore[no-untyped-def]
+        self._link.wait_delivered()  # what a UART would have delivered by now, whatever the load
+        lit = self._board.lit
+        if len(lit) != 1 or next(iter(lit)) >= self._geometry.count:
+            return None  # dark, or several LEDs at once (a boot-lit dome): no single light
+        return self._geometry.directions[next(iter(lit))]
+
+    @property
+    def intensity(self) -> float:
+        return 0.0 if self.direction is None else 1.0
+
+
+def _build_emulated_firmware_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock) -> Rig:
+    """The scripted driver over real pyserial, against a real firmware's emulator on a pty."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.drivers.led_dome.factory import protocol_for
+    from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
+    from rti_rig.simulator.domes import board_for
+    from rti_rig.simulator.pty_link import serve_on_pty
+
+    cfg = loaded.config
+    assert cfg.dome is not None and cfg.dome.serial is not None
+    serial = cfg.dome.serial
+    spec = protocol_for(serial)
+    board = board_for(
+        serial.profile,
+        clock=SystemClock(),
+        faults=FaultPlan(
+            tuple(Fault(f.at_command, FaultKind(f.kind), f.delay_s) for f in cfg.emulator.faults)
+        ),
+        led_map=spec.led_map,
+    )
+    stack = contextlib.ExitStack()
+    link = stack.enter_context(serve_on_pty(board, serial.profile))
+    try:
+        dome = build_dome(
+            serial.model_copy(update={"port": link.port}),
+            clock,
+            directions=geometry.directions,
+            name=f"dome on {link.port} (emulated {serial.profile})",
+        )
+        camera = _simulated_camera(loaded, _BoardLight(board, geometry, link), clock)
+    except BaseException:
+        stack.close()
+        raise
+    rig = Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock, stack)
+    rig.emulator = board  # type: ignore[attr-defined]  # for tests and the fault campaign
     return rig
 
 

@@ -403,6 +403,17 @@ def _with_correction_file(
     )
 
 
+def _with_led_map_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """``[dome.serial] led_map_file`` relative to the config's folder, like ``lp_file``."""
+    dome = data.get("dome")
+    serial = dome.get("serial") if isinstance(dome, dict) else None
+    name = serial.get("led_map_file") if isinstance(serial, dict) else None
+    if not isinstance(name, str) or Path(name).is_absolute():
+        return data
+    resolved = {**serial, "led_map_file": str((folder / name).resolve())}  # type: ignore[dict-item]
+    return {**data, "dome": {**dome, "serial": resolved}}  # type: ignore[dict-item]
+
+
 def load_rig_config(path: Path | str) -> LoadedRig:
     """Read and validate a rig config TOML file."""
     path = Path(path)
@@ -415,7 +426,13 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(path, None, f"not valid TOML: {exc}") from None
     data, settings, correction_bytes = _with_correction_file(data, path)
+    settings = _with_led_map_path(settings, path.parent)
     config = parse_rig_config(settings, str(path))
+    serial_cfg = config.dome.serial if config.dome is not None else None
+    if serial_cfg is not None and serial_cfg.led_map_file is not None:  # refuse a bad map now
+        from rti_rig.drivers.led_dome.factory import protocol_for
+
+        protocol_for(serial_cfg)
     loaded = LoadedRig(
         config=config,
         path=str(path.resolve()),

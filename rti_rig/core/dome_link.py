@@ -92,3 +92,46 @@ class DomeLedError(DeviceError):
         self.led = led
 
 
+
+
+class OffOutcome(StrEnum):
+    """What is known about the dome's lights after an all-off was attempted."""
+
+    ACKNOWLEDGED = "acknowledged"  # sent, and the firmware confirmed it
+    SENT_NO_ACK = "sent-no-ack"  # sent; this firmware never acknowledges anything
+    SENT_UNCONFIRMED = "sent-unconfirmed"  # sent, but the expected acknowledgement never came
+    SELF_TIMED = "self-timed"  # no all-off command: the firmware switches each LED off itself
+    NOT_SENT = "not-sent"  # the link did not allow it (port gone, never opened)
+
+
+@dataclass(frozen=True)
+class OffReport:
+    """The honest state of the lights after the last all-off attempt (what a user is told)."""
+
+    outcome: OffOutcome
+    detail: str = ""
+
+    @property
+    def lights_known_off(self) -> bool:
+        return self.outcome in (OffOutcome.ACKNOWLEDGED, OffOutcome.SELF_TIMED)
+
+    def sentence(self) -> str:
+        why = f" ({self.detail})" if self.detail else ""
+        return {
+            OffOutcome.ACKNOWLEDGED: "all-off sent and acknowledged by the dome: lights are off",
+            OffOutcome.SENT_NO_ACK: (
+                f"all-off sent; this firmware never acknowledges{why}, so lights are most likely "
+                "off but that is not confirmed"
+            ),
+            OffOutcome.SENT_UNCONFIRMED: (
+                f"all-off sent but not acknowledged{why}: lights may still be on; check the dome"
+            ),
+            OffOutcome.SELF_TIMED: (
+                f"this firmware has no all-off command{why}: it switches each LED off by itself "
+                "at the end of its on-time"
+            ),
+            OffOutcome.NOT_SENT: (
+                f"all-off could NOT be sent{why}: lights may still be on; switch the dome off at "
+                "its power supply"
+            ),
+        }[self.outcome]

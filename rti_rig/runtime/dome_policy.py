@@ -35,7 +35,15 @@ from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import DiscreteLightSource
-from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLink, DomeLinkError, LinkFault
+from rti_rig.core.dome_link import (
+    DomeInfo,
+    DomeLedError,
+    DomeLink,
+    DomeLinkError,
+    LinkFault,
+    OffOutcome,
+    OffReport,
+)
 from rti_rig.core.errors import DeviceError
 
 log = logging.getLogger("rti_rig.dome")
@@ -175,6 +183,8 @@ class DomePolicy:
         self.stats = DomeStats()
         self.info: DomeInfo | None = None
         self._lit: _Lit | None = None
+        #: What the last all-off attempt established (None: none attempted yet).
+        self.off_report: OffReport | None = None
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -182,6 +192,9 @@ class DomePolicy:
         try:
             info = self.link.connect()
         except DomeLinkError as exc:
+            # A board that answered nothing we understood may still be lit (one sketch boots
+            # with every LED on): send the all-off anyway wherever the port is open.
+            self._attempt_off(f"after the failed connection: {exc.message}")
             self._quiet_close()
             raise DeviceError(
                 self.name,
@@ -191,6 +204,7 @@ class DomePolicy:
             ) from exc
         problem = self._check_identity(info)
         if problem:
+            self._attempt_off("after the identity check failed")
             self._quiet_close()
             raise DeviceError(self.name, problem, "handshake")
         self.info = info
@@ -198,7 +212,13 @@ class DomePolicy:
         log.info(
             "%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version, info.led_count
         )
-        if not self.link.echoes_light and not self.settings.confirm_with_query:
+        if not getattr(self.link, "can_query", True) and not self.link.echoes_light:
+            log.info(
+                "%s: this firmware does not say which LED it lit; only the images can tell "
+                "(rti-rig's wrong-light check)",
+                self.name,
+            )
+        elif not self.link.echoes_light and not self.settings.confirm_with_query:
             log.warning(
                 "%s: this profile's light acknowledgement does not say which LED was lit; set "
                 "confirm_with_query = true to have the firmware confirm every LED",
@@ -286,9 +306,11 @@ class DomePolicy:
             return
         try:
             self._run(self.link.all_off, "all off")
-        except DomeLinkError:
+        except DomeLinkError as exc:
             self._lit = None
+            self.off_report = _failed_off(exc)
             raise
+        self.off_report = OffReport(getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED))
         self._check_on_time("all off")
         if self._lit is not None:
             self.guard.record(self._lit.index, self._lit.since, self.clock.now())
@@ -483,11 +505,23 @@ class DomePolicy:
 
     def _fail_safe(self) -> None:
         """Try to reach the safe state after an error, without masking that error."""
+        self._attempt_off("after an error")
+        self._lit = None
+
+    def _attempt_off(self, when: str) -> None:
+        """One all-off, whatever state the link is in; record what it established."""
         try:
             self.link.all_off()
+        except DomeLinkError as exc:
+            log.warning("%s: all off %s failed: %s", self.name, when, exc)
+            self.off_report = _failed_off(exc)
         except DeviceError as exc:
-            log.warning("%s: all off after an error failed too: %s", self.name, exc)
-        self._lit = None
+            log.warning("%s: all off %s failed: %s", self.name, when, exc)
+            self.off_report = OffReport(OffOutcome.SENT_UNCONFIRMED, str(exc))
+        else:
+            self.off_report = OffReport(
+                getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED), when
+            )
 
     def _require_connected(self, command: str) -> DomeInfo:
         if self.info is None:
@@ -509,6 +543,21 @@ class DomePolicy:
             self.link.close()
         except Exception as exc:  # closing must never mask the error that led here
             log.warning("%s: error while closing the port: %s", self.name, exc)
+
+
+def _failed_off(exc: DomeLinkError) -> OffReport:
+    """A failed all-off: not sent if the port was gone, else sent but unconfirmed."""
+    if exc.fault is LinkFault.DISCONNECTED:
+        return OffReport(OffOutcome.NOT_SENT, exc.message)
+    return OffReport(OffOutcome.SENT_UNCONFIRMED, f"{exc.fault}: {exc.message}")
+
+
+def lights_state_sentence(source: object) -> str:
+    """What is known about a light source's lights after it was closed (for messages)."""
+    report = getattr(source, "off_report", None)
+    if report is None:
+        return "no all-off was attempted (the dome was never reached): check the dome's lights"
+    return str(report.sentence())
 
 
 # ----------------------------------------------------------------------------- self test
@@ -537,6 +586,8 @@ class SelfTestReport:
     #: Wall-clock seconds each successful ``light`` call took (the command's round trip over
     #: the real link, whatever clock the rig uses): a measured ``light_switch_s``.
     light_latency_s: list[float] = field(default_factory=list)
+    #: What is known about the lights at the end (the last all-off's outcome).
+    lights_state: str = ""
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -583,6 +634,8 @@ class SelfTestReport:
             )
         if self.aborted:
             out.append(f"ABORTED: {self.aborted}")
+        if self.lights_state:
+            out.append(f"lights: {self.lights_state}")
         out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
 
@@ -616,7 +669,7 @@ def self_test(
                 source.light(i, intensity)
                 report.light_latency_s.append(time.perf_counter() - t0)
                 clock.sleep(settle_s)
-                if isinstance(source, DomePolicy):
+                if isinstance(source, DomePolicy) and getattr(source.link, "can_query", True):
                     lit, _ = source.lit_state()
                     if lit != i:
                         report.checks.append(LedCheck(i, False, f"firmware reports LED {lit} lit"))
@@ -634,4 +687,6 @@ def self_test(
         except DeviceError as exc:
             report.aborted = report.aborted or str(exc)
         report.elapsed_s = clock.now() - started
+        if isinstance(source, DomePolicy):
+            report.lights_state = lights_state_sentence(source)
     return report

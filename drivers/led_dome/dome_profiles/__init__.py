@@ -1,0 +1,60 @@
+"""Built-in dome protocols by name: each is one module holding a ``SPEC`` (a protocol description
+as the rig config would write it) and one line in :data:`_MODULES`.
+
+A new built-in profile = one new module here + its name in ``_MODULES``. Facts behind each
+profile (firmware source, published host code) are cited in its module and in ``docs/domes.md``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: profile name → module holding its SPEC (the registration).
+_MODULES = {
+    "nab-rti-v1": "nab_rti_v1",
+    "rtipy": "rtipy",
+    "minirti": "minirti",
+    "elexol-24r1": "elexol",
+    "rti-dome-m": "rti_dome",
+    "nichlock": "nichlock",
+}
+
+#: The projects' own protocols (codecs in ``codec_*.py``), not descriptions.
+CODEC_PROFILES = ("default", "framed", "binary")
+
+
+def described_profiles() -> tuple[str, ...]:
+    """Names of the built-in protocol descriptions."""
+    return tuple(_MODULES)
+
+
+def all_profiles() -> tuple[str, ...]:
+    return (*CODEC_PROFILES, *_MODULES, "custom")
+
+
+def builtin_spec(name: str) -> dict[str, Any]:
+    """The protocol description of built-in profile ``name`` (a fresh dict, safe to merge into)."""
+    if name not in _MODULES:
+        raise KeyError(name)
+    module = importlib.import_module(f"{__name__}.{_MODULES[name]}")
+    return _deep_copy(module.SPEC)
+
+
+def merge(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
+    """``override`` laid over ``base`` table by table (the rig config's [dome.serial.protocol])."""
+    out = _deep_copy(base)
+    for key, value in override.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = _deep_copy(value)
+    return out
+
+
+def _deep_copy(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _deep_copy(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_deep_copy(v) for v in value]
+    return value

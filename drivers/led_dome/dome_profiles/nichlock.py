@@ -1,0 +1,34 @@
+"""nichlock/rti (``arduino-program/src/main.cpp``): 192 LEDs on three channels, stepping only.
+
+From the firmware: one character a command, no line endings (a ``\\n`` gets
+``!Please disable newlines!``); each command is echoed (char + CR LF) and ends with a ``>``
+prompt. ``0`` lights the next LED and prints ``LED number: N; on pin P``; ``x`` switches all off
+and rewinds to LED 0 (``All LEDs shut off, active LED number reset to zero.``). There is no
+addressing, so the driver steps and checks the number the firmware prints (a missed or double
+step is a named error). Baud rate from EEPROM (115200 by default). Arduino Mega: resets when the
+port opens and prints a banner ending with ``For help, press 'h'`` and the prompt.
+"""
+
+SPEC = {
+    "name": "nichlock",
+    "led_count": 192,
+    "encoding": "text",
+    "baudrate": 115200,
+    "boot_wait_s": 4.0,
+    "ready_pattern": r"For help, press 'h'\r?\n>",
+    "stepping": True,
+    "light": {
+        "send": "0",
+        "reply": {"kind": "pattern", "pattern": r"LED number: {index}; on pin \d+\r\n>"},
+    },
+    "all_off": {
+        "send": "x",
+        "reply": {
+            "kind": "pattern",
+            "pattern": r"All LEDs shut off, active LED number reset to zero\.\r\n>",
+        },
+    },
+    "reset_pattern": r"Reflectance Transformation Imager Serial Interface",
+    "error_pattern": r"Did nothing; that key is not assigned",
+    "note": "nichlock/rti Arduino Mega shield: step next/all-off, position verified",
+}

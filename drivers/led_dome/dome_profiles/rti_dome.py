@@ -1,0 +1,19 @@
+"""hadrian2/RTI_Dome (``ATMEGA_code.txt``): 32 LEDs on four TLC5940-style drivers.
+
+From the sketch: 9600 baud; one character then ``Serial.parseInt()`` (1 s timeout): ``M<n>``
+clears the registers, lights LED n, then pulses the camera line (100 ms wait, 100 ms pulse,
+100 ms wait); ``A`` runs the whole sequence. No replies at all, no all-off: ``M`` with n ≥ 32
+selects no driver, which leaves every LED off (and still pulses the camera). parseInt waits its
+1 s timeout for more digits, so each command takes about 1.3 s. The board (ATmega32u4, native
+USB) does not reset when the port opens.
+"""
+
+SPEC = {
+    "name": "rti-dome-m",
+    "led_count": 32,
+    "encoding": "text",
+    "baudrate": 9600,
+    "light": {"send": "M{index}", "delay_after_s": 1.5},
+    "all_off": {"send": "M99", "delay_after_s": 1.5},
+    "note": "hadrian2/RTI_Dome: M<n> lights LED n and pulses the camera; never answers",
+}

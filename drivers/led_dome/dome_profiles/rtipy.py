@@ -1,0 +1,27 @@
+"""RTIPy / Ashmolean micro dome (BeebBenjamin/RTIPy, ``arduino/rti_py/rti_py.ino``).
+
+From the sketch: 9600 baud; a command is whatever arrives before 1 s of silence
+(``Serial.readString``). ``T,x,y,secs`` lights LoLShield LED (x = column 0..13, y = row 0..8),
+**blocks** for ``secs`` whole seconds, then switches it off. The reply, printed before the LED
+lights, is ``I received: <command> the instructionByte was: T`` with no line ending. There is no
+"on until told off" command and no all-off: the LED goes dark by itself.
+"""
+
+SPEC = {
+    "name": "rtipy",
+    "led_count": 126,
+    "encoding": "text",
+    "columns": 14,
+    "baudrate": 9600,
+    "boot_wait_s": 2.0,
+    "frame_silence_s": 1.0,
+    "light_on_s": 2.0,
+    "light": {
+        "send": "T,{col},{row},{secs}",
+        "reply": {
+            "kind": "pattern",
+            "pattern": r"I received: T,{col},{row},{secs} the instructionByte was: T",
+        },
+    },
+    "note": "RTIPy sketch (Palaeopi / Ashmolean): timed LEDs, no all-off, never reads the host",
+}

@@ -1,0 +1,344 @@
+"""A dome driver run from a protocol description (:class:`ProtocolSpec`), for real firmwares.
+
+Real dome firmwares answer no identity handshake and no OK/ERR; some never answer, some answer
+free text, some block for seconds, some frame commands by silence, some only step. This driver
+does what a description says and reports what it could establish:
+
+* replies are matched against the description (a line, a pattern, a byte); text the firmware
+  prints that matches ``reset_pattern`` means the board rebooted (:attr:`LinkFault.RESET`),
+  ``error_pattern`` that it refused (:attr:`LinkFault.REJECTED`), anything else unmatched within
+  the timeout is reported with what was heard (:attr:`LinkFault.GARBLED`) or as silence
+  (:attr:`LinkFault.TIMEOUT`);
+* a timed firmware (the LED goes dark by itself) is asked to light only; ``all_off`` then waits
+  for the end of the on-window, and an image taken after it is refused;
+* a stepping firmware is stepped to the wanted LED and the number it prints is checked, so a
+  missed or double step is a :attr:`LinkFault.MISMATCH`, never a mislabelled image.
+
+Like :class:`LedDomeDriver` it never retries: the runtime's ``DomePolicy`` decides.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+
+from rti_rig.drivers.led_dome.protocol_spec import CommandSpec, ProtocolSpec
+from rti_rig.drivers.led_dome.transport import Transport, TransportError
+
+from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
+
+traffic_log = logging.getLogger("rti_rig.dome.traffic")
+
+#: Extra seconds the host allows past the end of a timed LED's on-window.
+TIMED_MARGIN_S = 0.05
+
+
+class ScriptedDomeDriver:
+    """Implements :class:`rti_rig.core.dome_link.DomeLink` from a :class:`ProtocolSpec`."""
+
+    def __init__(
+        self,
+        transport: Transport,
+        spec: ProtocolSpec,
+        *,
+        device: str = "dome",
+        min_reply_timeout_s: float = 0.0,
+    ) -> None:
+        self.transport = transport
+        self.spec = spec
+        #: Floor under every reply timeout (``reply_timeout_s`` of the serial settings).
+        self.min_reply_timeout_s = min_reply_timeout_s
+        self.device = f"{device} ({transport.name}, {spec.name} profile)"
+        self.has_watchdog = False
+        self.max_level = 1  # on/off only
+        pat = spec.light.reply.pattern or ""
+        self.echoes_light = spec.light.reply.kind == "pattern" and (
+            "{index}" in pat or ("{row}" in pat and "{col}" in pat)
+        )
+        #: The firmware can say which LED is lit (none of the described firmwares can).
+        self.can_query = False
+        #: What an all-off establishes on this firmware.
+        self.off_outcome = (
+            OffOutcome.SELF_TIMED
+            if spec.all_off is None
+            else OffOutcome.SENT_NO_ACK
+            if spec.all_off.reply.kind == "none"
+            else OffOutcome.ACKNOWLEDGED
+        )
+        self._rx = bytearray()
+        self._open = False
+        self._last_end = -1e9
+        self._lit: frozenset[int] = frozenset()
+        self._window_end: float | None = None
+        self._timed_led: int | None = None
+        self._position: int | None = 0  # stepping: the LED the next step lights (None: unknown)
+        #: Text heard while waiting after opening (boot banner), for the probe and messages.
+        self.boot_text = ""
+        self.banners_seen = 0
+
+    # ------------------------------------------------------------------ lifecycle
+
+    def connect(self) -> DomeInfo:
+        self.close()
+        try:
+            self.transport.open()
+        except TransportError as exc:
+            raise self._error(str(exc), "open port", LinkFault.DISCONNECTED) from exc
+        self._open = True
+        self._rx.clear()
+        self._wait_boot()
+        return self.hello()
+
+    def close(self) -> None:
+        self._open = False
+        self._rx.clear()
+        self.transport.close()
+
+    @property
+    def port_open(self) -> bool:
+        return self._open
+
+    def hello(self) -> DomeInfo:
+        """Handshake (if the firmware has one) and the init commands; the board's state is
+        unknown afterwards (a reboot may have lit it), so nothing is assumed lit or dark."""
+        if self.spec.handshake is not None:
+            self._exchange(self.spec.handshake, None, "handshake")
+        for i, cmd in enumerate(self.spec.init):
+            self._exchange(cmd, None, f"init command {i + 1}")
+        self._position = 0
+        self._lit = frozenset()
+        return DomeInfo(self.spec.name, "", self.spec.led_count)
+
+    # ------------------------------------------------------------------ verbs
+
+    def light(self, index: int, level: int = 1, max_on_ms: int | None = None) -> None:
+        name = f"light LED {index}"
+        if not 0 <= index < self.spec.led_count:
+            raise self._error(
+                f"LED {index} outside 0..{self.spec.led_count - 1}", name, LinkFault.REJECTED
+            )
+        if self.spec.stepping:
+            self._step_to(index, name)
+            return
+        self._wait_window(name)
+        self._exchange(self.spec.light, index, name, lit=frozenset({index}))
+        self._lit = frozenset({index})
+        if self.spec.light_on_s is not None:
+            secs = max(1, round(self.spec.light_on_s))
+            # the reply is printed just before the LED lights: the window starts about now
+            self._window_end = self.transport.clock.now() + secs
+            self._timed_led = index
+
+    def all_off(self) -> None:
+        if self.spec.all_off is None:
+            self._wait_window("all off")
+            self._lit = frozenset()
+            return
+        self._position = None  # unknown until the all-off is confirmed
+        self._exchange(self.spec.all_off, None, "all off", lit=frozenset())
+        self._lit = frozenset()
+        self._position = 0
+
+    def shutter(self, pulse_ms: int = 50) -> None:
+        if self.spec.shutter is None:
+            raise self._error(
+                "this firmware has no shutter command; let the camera trigger itself",
+                "shutter",
+                LinkFault.REJECTED,
+            )
+        self._exchange(self.spec.shutter, None, "shutter", lit=self._lit)
+
+    def query(self) -> tuple[int | None, int]:
+        raise self._error(
+            "this firmware cannot say which LED is lit", "query lit LED", LinkFault.REJECTED
+        )
+
+    # ------------------------------------------------------------------ stepping / timing
+
+    def _step_to(self, index: int, name: str) -> None:
+        try:
+            if self._position is None or index < self._position or self._lit:
+                self.all_off()  # rewinds to the first LED (and switches the lit one off)
+            assert self._position is not None
+            while self._position <= index:
+                target = self._position
+                self._exchange(self.spec.light, target, f"{name} (step to LED {target})")
+                self._position = target + 1
+        except DomeLinkError:
+            self._position = None  # the firmware may or may not have stepped: rewind next time
+            raise
+        self._lit = frozenset({index})
+
+    def _wait_window(self, name: str) -> None:
+        """Timed firmware: wait for the lit LED's window to end (the firmware blocks till then).
+
+        An all-off that comes after the window ended means the capture outlasted the light.
+        """
+        end, led = self._window_end, self._timed_led
+        if end is None:
+            return
+        clock = self.transport.clock
+        now = clock.now()
+        self._window_end = self._timed_led = None
+        if name == "all off" and led is not None and now > end + TIMED_MARGIN_S:
+            raise DomeLedError(
+                self.device,
+                led,
+                f"LED {led} went dark by itself {now - end:.2f} s before the capture ended (its "
+                f"on-time is {self.spec.light_on_s:g} s): the image may be dark; raise "
+                "light_on_s in [dome.serial.protocol] or shorten settle and exposure",
+                name,
+            )
+        if end + TIMED_MARGIN_S > now:
+            clock.sleep(end + TIMED_MARGIN_S - now)
+
+    # ------------------------------------------------------------------ exchange
+
+    def _exchange(
+        self,
+        cmd: CommandSpec,
+        index: int | None,
+        name: str,
+        *,
+        lit: frozenset[int] = frozenset(),
+    ) -> str:
+        if not self._open:
+            raise self._error("port not open (connect first)", name, LinkFault.DISCONNECTED)
+        clock = self.transport.clock
+        try:
+            self._drain_stale(name)
+            gap = self._last_end + max(self.spec.min_gap_s, self.spec.frame_silence_s)
+            if gap > clock.now():
+                clock.sleep(gap - clock.now())
+            data = self.spec.render(cmd.send, index, lit)
+            traffic_log.debug("%s >> %s", self.device, data.hex(" "))
+            self.transport.write(data)
+            sent_at = clock.now()
+            heard = self._await(cmd, index, name, sent_at, len(data))
+            if cmd.delay_after_s:
+                clock.sleep(cmd.delay_after_s)
+            self._last_end = clock.now()
+            return heard
+        except TransportError as exc:
+            self._open = False
+            self.transport.close()
+            raise self._error(f"port lost: {exc}", name, LinkFault.DISCONNECTED) from exc
+
+    def _wire_s(self, n: int) -> float:
+        return n * 10.0 / self.spec.baudrate
+
+    def _await(self, cmd: CommandSpec, index: int | None, name: str, sent: float, n: int) -> str:
+        reply = cmd.reply
+        if reply.kind == "none":
+            # No answer ever comes: the least the command takes is its bytes' time on the wire.
+            self.transport.clock.sleep(self._wire_s(n))
+            return ""
+        clock = self.transport.clock
+        timeout = max(reply.timeout_s, self.min_reply_timeout_s)
+        deadline = sent + self._wire_s(n) + self.spec.frame_silence_s + timeout
+        wanted = self.spec.reply_regex(reply.pattern, index) if reply.kind == "pattern" else None
+        step = self.spec.step_regex(reply.pattern) if self.spec.stepping and reply.pattern else None
+        while True:
+            text = self._rx.decode("latin-1")
+            self._check_reset_or_error(text, name)
+            if reply.kind == "byte" and self._rx:
+                got = self._rx[0]
+                del self._rx[:1]
+                if got == reply.byte:
+                    return ""
+                raise self._error(
+                    f"expected acknowledgement byte 0x{reply.byte:02x}, got 0x{got:02x}",
+                    name,
+                    LinkFault.GARBLED,
+                )
+            if reply.kind == "line":
+                cut = text.find("\n")
+                if cut >= 0:
+                    del self._rx[: cut + 1]
+                    return text[: cut + 1]
+            if wanted is not None:
+                m = wanted.search(text)
+                if m:
+                    del self._rx[: len(text[: m.end()].encode("latin-1"))]
+                    return m.group(0)
+                if step is not None and (s := step.search(text)) is not None:
+                    del self._rx[: len(text[: s.end()].encode("latin-1"))]
+                    raise self._error(
+                        f"the firmware stepped to LED {int(s.group(1)) - self.spec.index_base}, "
+                        f"not LED {index} (a missed or double step)",
+                        name,
+                        LinkFault.MISMATCH,
+                    )
+            remaining = deadline - clock.now()
+            if remaining <= 0:
+                if text.strip():
+                    self._rx.clear()
+                    raise self._error(
+                        f"unexpected reply {text[-120:]!r} within {deadline - sent:.2f} s",
+                        name,
+                        LinkFault.GARBLED,
+                    )
+                raise self._error(
+                    f"no reply within {deadline - sent:.2f} s (lost or late)",
+                    name,
+                    LinkFault.TIMEOUT,
+                )
+            self._feed(self.transport.read(remaining))
+
+    def _check_reset_or_error(self, text: str, name: str) -> None:
+        spec = self.spec
+        if spec.reset_pattern and re.search(spec.reset_pattern, text):
+            self.banners_seen += 1
+            self._rx.clear()
+            self._lit = frozenset()
+            self._window_end = self._timed_led = None
+            self._wait_ready(self.transport.clock.now() + spec.boot_wait_s, text)
+            raise self._error(
+                "the board rebooted (boot banner) before answering", name, LinkFault.RESET
+            )
+        if spec.error_pattern and (m := re.search(spec.error_pattern, text)):
+            self._rx.clear()
+            raise self._error(f"the firmware refused: {m.group(0)!r}", name, LinkFault.REJECTED)
+
+    def _drain_stale(self, name: str) -> None:
+        self._feed(self.transport.read(0.0))
+        if self._rx:
+            text = self._rx.decode("latin-1")
+            self._check_reset_or_error(text, name)
+            traffic_log.debug("%s: dropped stale input %r", self.device, text)
+            self._rx.clear()
+
+    def _wait_boot(self) -> None:
+        """After opening: wait for the ready text or the boot time (the board may reset)."""
+        clock = self.transport.clock
+        self._wait_ready(clock.now() + self.spec.boot_wait_s, "")
+
+    def _wait_ready(self, deadline: float, already: str) -> None:
+        clock = self.transport.clock
+        heard = bytearray(already.encode("latin-1"))
+        ready = re.compile(self.spec.ready_pattern) if self.spec.ready_pattern else None
+        try:
+            while True:
+                heard += self._rx
+                self._rx.clear()
+                if ready is not None and ready.search(heard.decode("latin-1")):
+                    break
+                remaining = deadline - clock.now()
+                if remaining <= 0:
+                    break
+                self._feed(self.transport.read(remaining))
+        except TransportError as exc:
+            self._open = False
+            raise self._error(
+                f"port lost: {exc}", "wait after opening", LinkFault.DISCONNECTED
+            ) from exc
+        self.boot_text = heard.decode("latin-1")
+
+    def _feed(self, data: bytes) -> None:
+        if data:
+            traffic_log.debug("%s << %s", self.device, data.hex(" "))
+            self._rx.extend(data)
+
+    def _error(self, message: str, command: str, fault: LinkFault) -> DomeLinkError:
+        retryable = fault not in (LinkFault.REJECTED,)
+        return DomeLinkError(self.device, message, command, fault, retryable=retryable)

@@ -1,0 +1,146 @@
+"""``rti-rig probe PORT``: which known dome firmware answers on a serial port.
+
+Least intrusive first: listen to what the board prints when the port opens (the Nab sketch and
+nichlock's firmware print banners), then ask questions that light nothing (the Elexol board's
+``?``), then commands that switch everything off (minirti's all-zero mask), and last RTIPy's
+``T,0,0,0`` (LED 0 for zero seconds). A firmware identified with its LEDs possibly on (the Nab
+sketch boots fully lit) is sent its all-off before the probe returns. A dome that never answers
+(hadrian2/RTI_Dome) cannot be identified; the result says so, with what was heard.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
+
+
+@dataclass(frozen=True)
+class ProbeRequest:
+    port: str
+    #: Seconds to listen after opening (covers an Arduino's bootloader and banner).
+    listen_s: float = 2.6
+
+
+@dataclass
+class ProbeResult:
+    port: str
+    profile: str | None = None
+    #: What each probe heard (probe description → text), in the order tried.
+    heard: list[tuple[str, str]] = field(default_factory=list)
+    lights: str = "nothing was lit by the probe"
+    error: str | None = None
+
+    def config_lines(self) -> list[str]:
+        if self.profile is None:
+            return []
+        return [
+            "[dome.serial]",
+            f'port = "{self.port}"',
+            f'profile = "{self.profile}"',
+        ]
+
+    def lines(self) -> list[str]:
+        out = []
+        for what, text in self.heard:
+            shown = text.strip().replace("\r", "")[-200:] or "(nothing)"
+            out.append(f"{what}: {shown!r}")
+        if self.error:
+            out.append(f"ERROR: {self.error}")
+        if self.profile is None:
+            out.append(
+                "No known dome firmware answered. Domes that never answer (hadrian2/RTI_Dome) "
+                'cannot be identified by probing: set profile = "rti-dome-m" yourself, or '
+                "describe the firmware (docs/domes.md)."
+            )
+        else:
+            out.append(f"Found: {self.profile}. Rig-config lines to use:")
+            out += ["  " + line for line in self.config_lines()]
+        out.append(f"Lights: {self.lights}")
+        return out
+
+
+def _exchange(port: str, baud: int, wait_s: float, send: bytes, listen_s: float) -> str:
+    """Open at ``baud``, wait ``wait_s`` (collecting the banner), send, listen; all text heard."""
+    t = SerialTransport(port, baud)
+    t.open()
+    try:
+        heard = bytearray()
+        heard += _listen(t, wait_s)
+        if send:
+            t.write(send)
+            heard += _listen(t, listen_s)
+        return heard.decode("latin-1")
+    finally:
+        t.close()
+
+
+def _listen(t: SerialTransport, seconds: float) -> bytes:
+    out = bytearray()
+    end = time.monotonic() + seconds
+    while (left := end - time.monotonic()) > 0:
+        out += t.read(min(left, 0.1))
+    return bytes(out)
+
+
+def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
+    """The Nab sketch answered: it boots with every LED on, so switch them off before leaving."""
+    result.profile = "nab-rti-v1"
+    off = _exchange(result.port, 9600, wait, b"<0>", 0.6)
+    result.heard.append(("all off <0>", off))
+    result.lights = (
+        "the sketch boots with every LED on; all-off sent and acknowledged"
+        if "<All lights turned off.>" in off
+        else "the sketch boots with every LED on; all-off sent but NOT acknowledged: check the dome"
+    )
+    return result
+
+
+def probe(request: ProbeRequest) -> ProbeResult:
+    """Try the known firmwares on ``request.port``; see the module docstring for the order."""
+    result = ProbeResult(request.port)
+    port, wait = request.port, request.listen_s
+    try:
+        text = _exchange(port, 9600, wait, b"", 0)
+        result.heard.append(("listen at 9600 baud", text))
+        if "RTI-Dome intialized" in text or "<All lights turned on.>" in text:
+            return _nab_found(result, wait)
+        text = _exchange(port, 115200, wait, b"", 0)
+        result.heard.append(("listen at 115200 baud", text))
+        if "Reflectance Transformation Imager Serial Interface" in text:
+            result.profile = "nichlock"
+            result.lights = "the firmware boots with every LED off; nothing was sent"
+            return result
+        text = _exchange(port, 38400, 0.2, b"?", 0.5)
+        result.heard.append(("'?' at 38400 baud", text))
+        if "USB I/O 24R1" in text:
+            result.profile = "elexol-24r1"
+            return result
+        text = _exchange(port, 115200, wait, b"m", 0.5)
+        result.heard.append(("'m' (free RAM) at 115200 baud", text))
+        if "RAM bytes remaining" in text or "Reflectance Transformation Imager" in text:
+            result.profile = "nichlock"
+            result.lights = "the firmware boots with every LED off; nothing that lights was sent"
+            return result
+        text = _exchange(port, 9600, wait, b"<9>", 0.6)
+        result.heard.append(("'<9>' (an unknown code) at 9600 baud", text))
+        if "<INCORRECT FUNCTION CALL: 9>" in text or "RTI-Dome intialized" in text:
+            return _nab_found(result, wait)
+        text = _exchange(port, 9600, 1.6, b"\x42" + bytes(8), 0.5)
+        result.heard.append(("0x42 + empty mask at 9600 baud", text))
+        if text.endswith("\x01"):
+            result.profile = "minirti"
+            result.lights = "the probe sent an all-off mask, acknowledged"
+            return result
+        text = _exchange(port, 9600, wait, b"T,0,0,0", 1.8)
+        result.heard.append(("'T,0,0,0' at 9600 baud", text))
+        if "I received: T,0,0,0 the instructionByte was: T" in text:
+            result.profile = "rtipy"
+            result.lights = "LED (0, 0) was asked for zero seconds: it stays dark"
+            return result
+        result.lights = "nothing that lights an LED was sent"
+    except TransportError as exc:
+        result.error = str(exc)
+        result.lights = "the port could not be used; nothing was sent"
+    return result

@@ -1,0 +1,22 @@
+"""What a user is told about the lights after a session or check ended early.
+
+Never "lights are off" unless that was established: a dome reports the outcome of its last
+all-off (acknowledged, sent to a firmware that never acknowledges, sent but unconfirmed, not
+sent), an arm that its lamp-off was requested.
+"""
+
+from __future__ import annotations
+
+from rti_rig.runtime.dome_policy import lights_state_sentence
+from rti_rig.runtime.lighting import DomeLighting
+
+
+def lights_state(rig) -> str:  # type: ignore[no-untyped-def]
+    """One sentence on the lights of ``rig`` after its teardown."""
+    lighting = rig.lighting
+    if isinstance(lighting, DomeLighting):
+        source = lighting.source
+        if hasattr(source, "off_report"):
+            return lights_state_sentence(source)
+        return "lights were switched off"  # a simulated dome: its state is the simulation's
+    return "lamp off and stop were requested (see any teardown problem above)"

@@ -1,0 +1,290 @@
+"""Real dome firmwares (their emulators, written from their sources) through the front door.
+
+Each built-in firmware profile is probed, checked and run with 8 lights by the CLI over a
+pseudo-terminal through real pyserial; the emulator's record of which LEDs were lit is checked
+at every capture and at the end. Timeouts on the pty are generous (seconds), and the dry run's
+own clock is virtual, so CPU load cannot exhaust them.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.planner.uniform import plan_uniform
+from rti_rig.simulator.domes import board_for
+from rti_rig.simulator.pty_link import serve_on_pty
+from typer.testing import CliRunner
+
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
+from rti_rig.cli import app
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.lp_format import read_lp
+from rti_rig.runtime.controller import run_session
+from rti_rig.runtime.session import SessionFolder
+
+pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
+runner = CliRunner()
+
+CONFIG = {
+    "nab-rti-v1": "emulated_nab_rti_v1.toml",
+    "rtipy": "emulated_rtipy.toml",
+    "minirti": "emulated_minirti.toml",
+    "elexol-24r1": "emulated_elexol.toml",
+    "rti-dome-m": "emulated_rti_dome.toml",
+    "nichlock": "emulated_nichlock.toml",
+}
+PROBED = ["nab-rti-v1", "rtipy", "minirti", "elexol-24r1", "nichlock"]
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+def eventually(predicate, timeout_s: float = 10.0) -> bool:  # type: ignore[no-untyped-def]
+    """True once ``predicate()`` is; bytes on a pty reach the emulator's thread after a delay
+    the CPU load decides, so the record is read once it has caught up (bounded)."""
+    end = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.005)
+    return True
+
+
+@pytest.mark.parametrize("profile", PROBED)
+def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
+    board = board_for(profile)
+    with serve_on_pty(board, profile) as link:
+        r = runner.invoke(app, ["probe", link.port])
+        assert r.exit_code == 0, r.output
+        assert f'profile = "{profile}"' in r.output
+        assert eventually(lambda: board.lit == frozenset())
+
+
+def test_probe_says_plainly_when_nothing_known_answers() -> None:
+    board = board_for("rti-dome-m")  # never answers anything
+    with serve_on_pty(board, "silent") as link:
+        r = runner.invoke(app, ["probe", link.port])
+    assert r.exit_code == 1
+    assert "No known dome firmware answered" in said(r)
+    assert "(nothing)" in r.output
+    assert board.lit == frozenset()
+
+
+@pytest.mark.parametrize("profile", list(CONFIG))
+def test_check_passes_on_each_firmware(profile: str) -> None:
+    r = runner.invoke(app, ["check", str(CONFIGS / CONFIG[profile])])
+    assert r.exit_code == 0, r.output
+    assert "RESULT: PASS" in r.output
+    assert "lights:" in r.output
+
+
+@pytest.mark.parametrize("profile", list(CONFIG))
+def test_session_of_8_lights_has_the_scheduled_led_lit_at_every_capture(
+    profile: str, tmp_path: Path
+) -> None:
+    loaded = load_rig_config(CONFIGS / CONFIG[profile])
+    with build_rig(loaded) as rig:
+        board = rig.emulator  # type: ignore[attr-defined]
+        schedule = plan_uniform(rig.geometry, 8)
+        seen: list[frozenset[int]] = []
+        real_capture = rig.camera.capture
+        current: list[int] = []
+
+        def set_light(step):  # type: ignore[no-untyped-def]
+            current[:] = [step.led]
+            return real_set(step)
+
+        real_set = rig.lighting.set
+        rig.lighting.set = set_light  # type: ignore[method-assign]
+
+        def capture(exposure_s: float):  # type: ignore[no-untyped-def]
+            want = frozenset(current)
+            eventually(lambda: board.lit == want)
+            seen.append(board.lit)
+            return real_capture(exposure_s)
+
+        rig.camera.capture = capture  # type: ignore[method-assign]
+        result = run_session(rig, schedule, SessionFolder.create(tmp_path / "s", 8))
+        assert [frozenset({r.led}) for r in result.records] == seen
+        assert len(seen) == 8
+        assert eventually(lambda: board.lit == frozenset())
+
+
+@pytest.mark.parametrize("profile", ["nab-rti-v1", "minirti"])
+def test_cli_run_8_lights(profile: str, tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(CONFIGS / CONFIG[profile]), "--out", str(out), "--lights", "8"]
+    )
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(out / "lights.lp")) == 8
+
+
+def with_faults(profile: str, tmp_path: Path, faults: str) -> Path:
+    text = (CONFIGS / CONFIG[profile]).read_text() + "\n[emulator]\n" + faults
+    path = tmp_path / "rig.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("kind", ["drop_reply", "garble_reply", "delay_reply"])
+def test_lost_garbled_late_reply_is_retried_and_the_session_completes(
+    kind: str, tmp_path: Path
+) -> None:
+    # command 1 is the init all-off, 2 the connect all-off, 3 the controller's all-off, 4 light 0
+    cfg = with_faults(
+        "nab-rti-v1", tmp_path, f'faults = [{{at_command = 4, kind = "{kind}", delay_s = 4.0}}]\n'
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(out / "lights.lp")) == 8
+
+
+def test_board_reset_mid_session_stops_naming_the_led_keeps_images_and_ends_dark(
+    tmp_path: Path,
+) -> None:
+    cfg = with_faults("nab-rti-v1", tmp_path, 'faults = [{at_command = 7, kind = "reset"}]\n')
+    loaded = load_rig_config(cfg)
+    with build_rig(loaded) as rig:
+        board = rig.emulator  # type: ignore[attr-defined]
+        folder = SessionFolder.create(tmp_path / "s", 8)
+        with pytest.raises(RtiRigError, match=r"LED \d+"):
+            run_session(rig, plan_uniform(rig.geometry, 8), folder)
+        assert eventually(lambda: board.lit == frozenset())  # it rebooted fully lit
+    assert len(list((tmp_path / "s").glob("*.png")) + list((tmp_path / "s").rglob("*.tif*"))) >= 1
+    r_text = (tmp_path / "s" / "manifest.json").read_text()
+    assert "rebooted" in r_text
+
+
+def test_port_gone_for_good_is_a_named_error_and_says_lights_unknown(tmp_path: Path) -> None:
+    cfg = with_faults(
+        "nab-rti-v1", tmp_path, 'faults = [{at_command = 6, kind = "disconnect", delay_s = 60}]\n'
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "lights are off" not in text
+    assert "could NOT be sent" in text or "not acknowledged" in text
+
+
+@pytest.mark.parametrize(
+    ("protocol", "key"),
+    [
+        ({"led_count": 4, "light": {"send": "L{idx}"}}, "light.send"),
+        ({"led_count": 4, "light": {"send": "L", "reply": {"kind": "pattern"}}}, "light.reply"),
+        ({"led_count": 4, "encoding": "bytes", "light": {"send": "4G"}}, "light.send"),
+        ({"led_count": 0, "light": {"send": "L"}}, "led_count"),
+        ({"led_count": 4, "light": {"send": "L"}, "reset_pattern": "(("}, "reset_pattern"),
+    ],
+)
+def test_bad_descriptions_are_refused_naming_the_key(protocol: dict, key: str) -> None:
+    with pytest.raises(ValueError, match=key.replace(".", r"\.")):
+        DomeSerialSettings(port="x", profile="custom", protocol=protocol)
+
+
+def test_custom_description_drives_a_dome_like_a_built_in(tmp_path: Path) -> None:
+    from rti_rig.drivers.led_dome.dome_profiles import builtin_spec
+
+    spec = builtin_spec("nab-rti-v1")
+    s = DomeSerialSettings(port="x", profile="custom", protocol=spec)
+    built = DomeSerialSettings(port="x", profile="nab-rti-v1").protocol_spec()
+    assert s.protocol_spec().model_dump() == built.model_dump()
+
+
+def test_unknown_profile_lists_the_known_ones() -> None:
+    with pytest.raises(ValueError, match=r"nab-rti-v1.*rtipy"):
+        DomeSerialSettings(port="x", profile="nab")
+
+
+def test_failed_handshake_on_the_lit_nab_sketch_still_sends_all_off_and_says_so() -> None:
+    """The issue's case: the project's 'framed' profile on the RTI v1.0 sketch, which boots with
+    every LED on. The handshake fails; the all-off is sent anyway and reported unconfirmed."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.dome_link import OffOutcome
+    from rti_rig.core.errors import DeviceError
+
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        settings = DomeSerialSettings(
+            port=link.port, profile="framed", baudrate=9600, ready_timeout_s=2.5
+        )
+        dome = build_dome(settings, VirtualClock())
+        with pytest.raises(DeviceError, match="no handshake"):
+            dome.connect()
+        assert eventually(lambda: board.lit == frozenset())  # <0> reached the sketch
+        assert dome.off_report is not None
+        assert dome.off_report.outcome is OffOutcome.SENT_UNCONFIRMED
+        assert "lights are off" not in dome.off_report.sentence()
+
+
+def test_a_capture_outlasting_a_timed_led_is_refused_naming_the_led() -> None:
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.dome_link import DomeLedError
+
+    board = board_for("rtipy")
+    with serve_on_pty(board, "rtipy") as link:
+        settings = DomeSerialSettings(port=link.port, profile="rtipy", protocol={"light_on_s": 1})
+        dome = build_dome(settings, VirtualClock())
+        dome.connect()
+        dome.light(15)
+        assert eventually(lambda: board.lit == frozenset({15}))
+        time.sleep(1.5)  # a capture far longer than the 1 s window (real time: the board's)
+        with pytest.raises(DomeLedError, match="LED 15 went dark by itself") as info:
+            dome.all_off()
+        assert info.value.led == 15
+        assert board.lit == frozenset()
+        dome.close()
+
+
+def elexol_with_map(tmp_path: Path, map_text: str, section: str = "Dome main") -> Path:
+    (tmp_path / "maps.txt").write_text(map_text)
+    text = (CONFIGS / "emulated_elexol.toml").read_text()
+    text = text.replace("count = 12", "count = 8").replace("led_count = 12", "led_count = 8")
+    text = text.replace(
+        'profile = "elexol-24r1"',
+        f'profile = "elexol-24r1"\nled_map_file = "maps.txt"\nled_map_section = "{section}"',
+    )
+    path = tmp_path / "rig.toml"
+    path.write_text(text)
+    return path
+
+
+def test_elexol_led_map_file_relative_to_the_config_drives_the_mapped_outputs(
+    tmp_path: Path,
+) -> None:
+    data = Path(__file__).parent / "data" / "domes" / "led-maps.txt"
+    cfg = elexol_with_map(tmp_path, data.read_text())
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 0, r.output
+    assert "RESULT: PASS" in r.output
+
+
+def test_a_bad_led_map_file_is_refused_at_load_naming_file_and_line(tmp_path: Path) -> None:
+    cfg = elexol_with_map(tmp_path, "** Dome main **\n0x01, zz, 0x00\n")
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2
+    assert "maps.txt:2" in said(r) and "led_map_file" in said(r)
+
+
+@pytest.mark.parametrize("kind", ["garble_reply", "drop_reply"])
+def test_a_stepping_dome_rewinds_after_a_doubtful_step_and_labels_every_image_right(
+    kind: str, tmp_path: Path
+) -> None:
+    from rti_rig.testing.verify import wrong_light_steps
+
+    cfg = with_faults("nichlock", tmp_path, f'faults = [{{at_command = 8, kind = "{kind}"}}]\n')
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])
+    assert r.exit_code == 0, r.output
+    assert wrong_light_steps(cfg, out) == []
