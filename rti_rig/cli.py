@@ -47,6 +47,12 @@ def _fail(exc: RtiRigError) -> typer.Exit:
     return typer.Exit(code=2)
 
 
+def _print_notes(notes) -> None:  # type: ignore[no-untyped-def]
+    """What a tolerant reader accepted but the user should know (file, line, what was done)."""
+    for note in notes:
+        err.print(f"[yellow]note:[/] {escape(note)}", highlight=False, soft_wrap=True)
+
+
 def _check_output_file(
     out_file: Path, force: bool, inputs: dict[str, Path | None], option: str = "--out"
 ) -> None:
@@ -243,13 +249,16 @@ def run(
             if rig_config is None or out_dir is None:
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
             loaded = load_rig_config(rig_config)
+            _print_notes(loaded.notes)
             geometry = rig_geometry(loaded)
             if plan is not None:
                 if lights is not None:
                     raise RtiRigError("give either --plan or --lights, not both")
+                plan_notes: list[str] = []
                 schedule = schedule_from_lp(
-                    read_lp(plan, upper_hemisphere=True), geometry, str(plan)
+                    read_lp(plan, upper_hemisphere=True, notes=plan_notes), geometry, str(plan)
                 )
+                _print_notes(plan_notes)
             else:
                 check_elevation_band(min_elevation_deg, max_elevation_deg)
                 n = lights if lights is not None else _default_lights(loaded, geometry)
@@ -615,6 +624,8 @@ def plan(
         az_el = _parse_az_el(preview_light)
         bare_lp = rig.suffix.lower() == ".lp"
         loaded = None if bare_lp else load_rig_config(rig)
+        if loaded is not None:
+            _print_notes(loaded.notes)
         inputs = {"preview": preview, "rig file": rig, "depth model": depth_model}
         if loaded is not None and loaded.config.dome is not None and loaded.config.dome.lp_file:
             # the dome's LED calibration is an input too
@@ -629,7 +640,9 @@ def plan(
                 raise RtiRigError(f"--figure {figure} is the --out plan file; choose another")
         arm_order = None
         if loaded is None:
-            entries = read_lp(rig, upper_hemisphere=True)
+            lp_notes: list[str] = []
+            entries = read_lp(rig, upper_hemisphere=True, notes=lp_notes)
+            _print_notes(lp_notes)
             pair = coincident_leds([e.direction for e in entries])
             if pair is not None:
                 i, j = pair

@@ -26,6 +26,8 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
     cfg = loaded.config
     if cfg.backend == "hardware":
         return _build_hardware(loaded, clock or SystemClock())
+    if cfg.backend == "replay":
+        return _build_replay(loaded, clock or VirtualClock())
     return _build_simulated(loaded, clock or VirtualClock())
 
 
@@ -204,6 +206,29 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
     settings = cfg.arm.dynamixel
     arm = DynamixelArm(settings, dynamixel_sdk.PortHandler(settings.port), clock)
     return Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock)
+
+
+def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
+    """A recorded acquisition: a dome with exactly its lights, a camera that returns the image
+    recorded for the LED fired (:mod:`rti_rig.simulator.replay`)."""
+    from rti_rig.simulator.replay import ReplayCamera
+    from rti_rig.simulator.sim_lights import LightState, SimulatedDome
+
+    cfg = loaded.config
+    geometry = rig_geometry(loaded)
+    assert isinstance(geometry, DomeGeometry)
+    folder = Path(loaded.path).parent
+    dome = SimulatedDome(geometry, LightState(), clock, cfg.timing.light_switch_s)
+    dome.name = "replayed dome"
+    camera = ReplayCamera(
+        [folder / name for name in geometry.names],
+        dome,
+        clock,
+        shape=(cfg.camera.height, cfg.camera.width),
+        readout_s=cfg.timing.readout_s,
+        transfer_s=cfg.timing.transfer_s,
+    )
+    return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
 
 
 def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
