@@ -200,6 +200,22 @@ def run(
             "only the steps not yet done.",
         ),
     ] = None,
+    adaptive: Annotated[
+        bool,
+        typer.Option(
+            "--adaptive",
+            help="Choose each next light from the images captured so far (up to --lights; "
+            "docs/adaptive.md).",
+        ),
+    ] = False,
+    until_error: Annotated[
+        float | None,
+        typer.Option(
+            "--until-error",
+            help="Adaptive: stop once the estimated mean normal error is at most this many "
+            "degrees (with --lights: whichever comes first).",
+        ),
+    ] = None,
 ) -> None:
     """Run a capture session (a dry run when the config's backend is 'simulated').
 
@@ -217,6 +233,7 @@ def run(
     from rti_rig.planner.uniform import plan_uniform
     from rti_rig.runtime.session import SessionFolder
 
+    source = None  # an adaptive session's step source (rti_rig.app.usecases.adaptive)
     try:
         _check_max_saturated(max_saturated)
         if resume is not None:
@@ -245,6 +262,26 @@ def run(
                 )
             )
             rig = _checked_rig(loaded, schedule)
+            if "adaptive" in manifest:
+                from rti_rig.app.usecases.adaptive import resume_adaptive_source
+
+                try:
+                    source = resume_adaptive_source(rig, folder)
+                except BaseException:
+                    rig.close()
+                    raise
+        elif adaptive or until_error is not None:
+            from rti_rig.app.usecases.adaptive import open_adaptive_session
+
+            if rig_config is None or out_dir is None:
+                raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
+            if plan is not None or auto_exposure:
+                raise RtiRigError("--adaptive chooses its own lights: drop --plan/--auto-exposure")
+            loaded = load_rig_config(rig_config)
+            _print_notes(loaded.notes)
+            rig, schedule, folder, source = open_adaptive_session(
+                loaded, out_dir, lights, until_error
+            )
         else:
             if rig_config is None or out_dir is None:
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
@@ -271,7 +308,18 @@ def run(
     except RtiRigError as exc:
         raise _fail(exc) from None
     with rig:
-        _execute(rig, schedule, folder, out_dir)
+        _execute(rig, schedule, folder, out_dir, source)
+    if source is not None:
+        from rti_rig.app.usecases.adaptive import record_result
+
+        result = source.conclude()
+        record_result(out_dir, result)
+        est = result["estimated_error_deg"]
+        out.print(
+            f"Adaptive: {result['lights_used']} lights; stopped: {result['stop']['reason']}; "
+            f"estimated mean normal error {'n/a' if est is None else f'{est:.2f}°'}",
+            highlight=False,
+        )
 
 
 def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyped-def]
@@ -300,7 +348,7 @@ def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyp
     return fixed
 
 
-def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-untyped-def]
+def _execute(rig, schedule, folder, out_dir: Path, source=None) -> None:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on."""
     from rti_rig.runtime.controller import (
         CancelToken,
@@ -336,9 +384,12 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
         handlers[signal.SIGUSR1] = on_sigusr1
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
     dry = " (dry run)" if rig.loaded.config.backend != "hardware" else ""
-    todo = len(schedule) - len(folder.done)
+    total = len(schedule) if source is None else source.total
+    todo = total - len(folder.done)
     out.print(
-        f"Rig [bold]{escape(rig.name)}[/]{dry}: {todo} of {len(schedule)} lights → "
+        f"Rig [bold]{escape(rig.name)}[/]{dry}: {todo} of {total} lights"
+        + (" at most, adaptive" if source is not None else "")
+        + " → "
         f"{escape(str(out_dir))}"
     )
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
@@ -350,7 +401,7 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
             TimeElapsedColumn(),
             console=out,
         ) as progress:
-            task = progress.add_task("capturing", total=len(schedule), completed=len(folder.done))
+            task = progress.add_task("capturing", total=total, completed=len(folder.done))
 
             def on_event(event):  # type: ignore[no-untyped-def]
                 if isinstance(event, StepCompleted):
@@ -358,7 +409,9 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
                 elif isinstance(event, Paused):
                     progress.update(task, description="paused")
 
-            result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event)
+            result = run_session(
+                rig, schedule, folder, cancel=cancel, on_event=on_event, source=source
+            )
     except EmergencyStop as exc:
         err.print(
             f"[red]Emergency stop ({escape(str(exc))}):[/] lights off, devices safe; images kept."

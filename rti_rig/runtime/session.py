@@ -59,6 +59,14 @@ class StepRecord:
     saturated_fraction: float
     black_fraction: float
     sha256: dict[str, str] = field(default_factory=dict)
+    #: an adaptive session's decision for this step and its evidence (None: a fixed schedule)
+    decision: dict[str, Any] | None = None
+
+
+def planned_steps(manifest: dict[str, Any]) -> int:
+    """How many steps a session may take: its schedule's, or an adaptive session's maximum."""
+    adaptive = manifest.get("adaptive") or {}
+    return int(adaptive.get("max_lights") or len(manifest.get("schedule", {}).get("steps", [])))
 
 
 def image_names(total: int) -> list[str]:
@@ -158,7 +166,7 @@ class SessionFolder:
         :func:`prepare_resume`.
         """
         state = prepare_resume(Path(root))
-        folder = cls(Path(root), len(state.manifest["schedule"]["steps"]))
+        folder = cls(Path(root), planned_steps(state.manifest))
         folder.manifest = state.manifest
         folder.resume = state
         return folder
@@ -307,7 +315,7 @@ def prepare_resume(root: Path) -> ResumeState:
     deleted; half-written temporary files are removed (they never were an image).
     """
     manifest = read_manifest(root)
-    total = len(manifest.get("schedule", {}).get("steps", []))
+    total = planned_steps(manifest)
     if total == 0:
         raise SessionError(f"{root}: the manifest holds no schedule, so there is nothing to resume")
     runner = manifest.get("runner", {})
