@@ -193,7 +193,7 @@ def calibrate(results: dict) -> tuple[float, list[str]]:
     return scale, rows
 
 
-def real(draws: int, scale: float, seed: int = 0) -> dict:
+def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
     """The neuralrti-example dome (JPEGs linearised), paired draws, REAL_REMOVED LEDs out."""
     from benchmarks.planner_real_data import (
         DATA,
@@ -204,7 +204,7 @@ def real(draws: int, scale: float, seed: int = 0) -> dict:
         reference,
     )
 
-    dome, images, rgb8 = load(DATA)
+    dome, images, rgb8 = load(data or DATA)
     dirs = dome.directions
     ref, mask = reference(images, dirs)
     az, el = az_el_from_direction(dirs)
@@ -273,12 +273,18 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument("--sim-draws", type=int, default=8)
     ap.add_argument("--real-draws", type=int, default=24)
     ap.add_argument("--write", action="store_true", help="write the tables into docs/adaptive.md")
+    ap.add_argument(
+        "--data",
+        type=Path,
+        default=Path("/work/shared/data/neuralrti-example"),
+        help="the real acquisition (a folder with dirs.lp and its images)",
+    )
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     results, _ = sim(args.sim_draws)
     scale, calib_rows = calibrate(results)
     print(f"calibrated ESTIMATE_SCALE = {scale:.3f}")
-    rr = real(args.real_draws, scale) if args.real_draws else None
+    rr = real(args.real_draws, scale, args.data) if args.real_draws else None
     head = "| object | tuned floor | " + " | ".join(f"N = {n}" for n in NS) + " |"
     sep = "|" + "---|" * (2 + len(NS))
     e_rows, p_rows = [], []

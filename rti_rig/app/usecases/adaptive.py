@@ -51,7 +51,7 @@ from rti_rig.planner.uniform import select_uniform_leds
 #: Width (px) of the grey copies the decisions are fitted on (a 24-MP image is shrunk once).
 FIT_PX = 128
 #: Pixels sampled from the fit for the chooser.
-SAMPLE = 3000
+SAMPLE = 2000
 #: Noise floor of one observation relative to the stack's bright level (quantisation, sensor).
 NOISE_FLOOR = 0.003
 #: An adaptive run that gives only --until-error on an arm stops at this many lights at most.
@@ -63,6 +63,10 @@ def small_grey(pixels: NDArray, white_level: float = 65535.0) -> NDArray[np.floa
     """A frame shrunk to :data:`FIT_PX` wide (area average), grey, in units of white."""
     px = np.asarray(pixels)
     h, w = px.shape[:2]
+    step = w // (4 * FIT_PX)
+    if step > 1:  # a 24-MP frame: every step-th pixel first (an area average of 16 at the end)
+        px = np.ascontiguousarray(px[::step, ::step])
+        h, w = px.shape[:2]
     if w > FIT_PX:
         size = (FIT_PX, max(1, round(h * FIT_PX / w)))
         px = cv2.resize(px, size, interpolation=cv2.INTER_AREA)
@@ -85,31 +89,30 @@ def fit_state(images: NDArray[np.float32], lights: NDArray[np.float64]) -> Surfa
     k = len(lights)
     if k < 3:
         return None
+    flat = np.asarray(images, dtype=np.float32).reshape(k, -1)
+    # the same pixels every time (a decision is a function of the images), fitted alone: the
+    # chooser needs a sample, and fitting only it keeps a decision fast
+    rng = np.random.default_rng(0)
+    pick = np.sort(rng.choice(flat.shape[1], min(SAMPLE, flat.shape[1]), replace=False))
+    obs = flat[:, pick]
     try:
-        ps = fit_photometric_stereo(images, lights, robust=True)
+        ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
     except ReconstructionError:
         return None
-    flat = images.reshape(k, -1)
-    ref = float(np.percentile(flat, 99)) or 1.0
-    seen = flat.max(axis=0) > ps.dark_threshold  # not dark under every light so far
-    pool = np.flatnonzero(seen)
-    if pool.size == 0:
+    seen = obs.max(axis=0) > ps.dark_threshold  # not dark under every light so far
+    if not seen.any():
         return None
-    rng = np.random.default_rng(0)
-    pick = np.sort(rng.choice(pool, min(SAMPLE, pool.size), replace=False))
-    valid = ps.valid.ravel()[pick]
-    normals = ps.normals.reshape(-1, 3)[pick].astype(np.float64)
+    obs = obs[:, seen]
+    valid = ps.valid.ravel()[seen]
+    normals = ps.normals.reshape(-1, 3)[seen].astype(np.float64)
     normals[~valid] = (0.0, 0.0, 1.0)
-    albedo = (
-        ps.albedo.reshape(-1)[pick].astype(np.float64)
-        if ps.albedo.ndim == 2
-        else (ps.albedo.reshape(-1, ps.albedo.shape[-1])[pick].mean(axis=1).astype(np.float64))
-    )
-    albedo = np.where(valid, albedo, flat[:, pick].max(axis=0))
-    resid = ps.residual.ravel()[pick].astype(np.float64)
+    albedo = ps.albedo.reshape(-1)[seen].astype(np.float64)
+    albedo = np.where(valid, albedo, obs.max(axis=0))
+    resid = ps.residual.ravel()[seen].astype(np.float64)
+    ref = float(np.percentile(obs, 99)) or 1.0
     dof = max(k - 3, 1)
     noise = np.sqrt((NOISE_FLOOR * ref) ** 2 + resid**2 * k / dof)
-    lit = (flat[:, pick] > ps.dark_threshold).T
+    lit = (obs > ps.dark_threshold).T
     return SurfaceState(normals, albedo, noise, lit, np.asarray(lights, dtype=np.float64))
 
 
