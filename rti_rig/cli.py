@@ -1028,9 +1028,30 @@ def bench_tradeoff(
     quick: Annotated[
         bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
     ] = False,
+    from_lp: Annotated[
+        Path | None,
+        typer.Option(
+            "--from",
+            help="A dense acquisition of your own (an .lp with its images beside it): the trade "
+            "for uniform, optimal and adaptive against all its lights.",
+        ),
+    ] = None,
 ) -> None:
-    """Error against number of lights and session time, for every planner, on simulated scenes."""
+    """Error against number of lights and session time, for every planner, on simulated scenes
+    (or on your own acquisition with --from)."""
     import time
+
+    if from_lp is not None:
+        from benchmarks.tradeoff_from import bench_from
+
+        try:
+            text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
+        except RtiRigError as exc:
+            raise _fail(exc) from None
+        except ValueError as exc:
+            raise _fail(RtiRigError(str(exc))) from None
+        out.print(text, highlight=False)
+        return
 
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
 
