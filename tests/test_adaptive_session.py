@@ -152,6 +152,9 @@ def test_until_error_stops_when_the_estimate_is_reached(
     assert (out / "lights.lp").read_text().splitlines()[1:] == (
         ref / "lights.lp"
     ).read_text().splitlines()[1 : k + 1]
+    r = runner.invoke(app, ["run", "--resume", str(out)])  # it chose to stop: nothing to do
+    assert r.exit_code == 2
+    assert f"stopped after {k} of at most 12 lights (estimated error" in said(r)
     # --lights and --until-error together: the first reached stops
     out2 = tmp_path / "s2"
     r = runner.invoke(

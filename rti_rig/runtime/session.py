@@ -320,6 +320,13 @@ def prepare_resume(root: Path) -> ResumeState:
         raise SessionError(f"{root}: the manifest holds no schedule, so there is nothing to resume")
     runner = manifest.get("runner", {})
     if runner.get("finish_reason") == "completed":
+        done = runner.get("steps_done", total)
+        if manifest.get("adaptive") and done < total:  # an adaptive session that chose to stop
+            stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
+            raise SessionError(
+                f"{root}: this adaptive session already completed: it stopped after {done} of "
+                f"at most {total} lights ({stop.get('reason', 'its stopping rule')})"
+            )
         raise SessionError(f"{root}: this session already completed all {total} steps")
     names = image_names(total)
     fields = set(StepRecord.__dataclass_fields__)
