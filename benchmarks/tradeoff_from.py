@@ -63,6 +63,7 @@ def run_tradeoff_from(lp: Path, progress: Callable[[str], None] = print) -> list
 
     from benchmarks.planner_real_data import evaluate, planned_leds, reference
     from rti_rig.app.usecases.adaptive import AdaptiveChooser
+    from rti_rig.core.errors import ScheduleError
     from rti_rig.core.rig_geometry import DomeGeometry
 
     images, dirs, names = load_acquisition(Path(lp))
@@ -107,7 +108,11 @@ def run_tradeoff_from(lp: Path, progress: Callable[[str], None] = print) -> list
 
     for n in counts:
         for f in FLOORS:
-            add("uniform", f, n, select_uniform_leds(dome, n, f), 0.0)
+            try:
+                leds = select_uniform_leds(dome, n, f)
+            except ScheduleError:  # fewer LEDs above this floor than N: no such layout
+                continue
+            add("uniform", f, n, leds, 0.0)
         t1 = time.perf_counter()
         opt = planned_leds(None, dome, n, None)
         add("optimal", 0.0, n, opt, time.perf_counter() - t1)
@@ -117,6 +122,7 @@ def run_tradeoff_from(lp: Path, progress: Callable[[str], None] = print) -> list
 
 
 def _best_floor(rows: list[Row]) -> float:
+    """The floor with the lowest mean error over the N it could serve (every N for floor 0)."""
     return min(
         FLOORS,
         key=lambda f: float(
