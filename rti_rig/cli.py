@@ -45,6 +45,12 @@ def _fail(exc: RtiRigError) -> typer.Exit:
     return typer.Exit(code=2)
 
 
+def _print_notes(notes) -> None:  # type: ignore[no-untyped-def]
+    """What a tolerant reader accepted but the user should know (file, line, what was done)."""
+    for note in notes:
+        err.print(f"[yellow]note:[/] {escape(note)}", highlight=False, soft_wrap=True)
+
+
 def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
     from rti_rig.core.rig_geometry import DomeGeometry
 
@@ -159,6 +165,22 @@ def run(
             "only the steps not yet done.",
         ),
     ] = None,
+    adaptive: Annotated[
+        bool,
+        typer.Option(
+            "--adaptive",
+            help="Choose each next light from the images captured so far (up to --lights; "
+            "docs/adaptive.md).",
+        ),
+    ] = False,
+    until_error: Annotated[
+        float | None,
+        typer.Option(
+            "--until-error",
+            help="Adaptive: stop once the estimated mean normal error is at most this many "
+            "degrees (with --lights: whichever comes first).",
+        ),
+    ] = None,
 ) -> None:
     """Run a capture session (a dry run when the config's backend is 'simulated').
 
@@ -176,6 +198,7 @@ def run(
     from rti_rig.planner.uniform import plan_uniform
     from rti_rig.runtime.session import SessionFolder
 
+    source = None  # an adaptive session's step source (rti_rig.app.usecases.adaptive)
     try:
         _check_max_saturated(max_saturated)
         if resume is not None:
@@ -204,17 +227,40 @@ def run(
                 )
             )
             rig = _checked_rig(loaded, schedule)
+            if "adaptive" in manifest:
+                from rti_rig.app.usecases.adaptive import resume_adaptive_source
+
+                try:
+                    source = resume_adaptive_source(rig, folder)
+                except BaseException:
+                    rig.close()
+                    raise
+        elif adaptive or until_error is not None:
+            from rti_rig.app.usecases.adaptive import open_adaptive_session
+
+            if rig_config is None or out_dir is None:
+                raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
+            if plan is not None or auto_exposure:
+                raise RtiRigError("--adaptive chooses its own lights: drop --plan/--auto-exposure")
+            loaded = load_rig_config(rig_config)
+            _print_notes(loaded.notes)
+            rig, schedule, folder, source = open_adaptive_session(
+                loaded, out_dir, lights, until_error
+            )
         else:
             if rig_config is None or out_dir is None:
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
             loaded = load_rig_config(rig_config)
+            _print_notes(loaded.notes)
             geometry = rig_geometry(loaded)
             if plan is not None:
                 if lights is not None:
                     raise RtiRigError("give either --plan or --lights, not both")
+                plan_notes: list[str] = []
                 schedule = schedule_from_lp(
-                    read_lp(plan, upper_hemisphere=True), geometry, str(plan)
+                    read_lp(plan, upper_hemisphere=True, notes=plan_notes), geometry, str(plan)
                 )
+                _print_notes(plan_notes)
             else:
                 check_elevation_band(min_elevation_deg, max_elevation_deg)
                 n = lights if lights is not None else _default_lights(loaded, geometry)
@@ -227,7 +273,18 @@ def run(
     except RtiRigError as exc:
         raise _fail(exc) from None
     with rig:
-        _execute(rig, schedule, folder, out_dir)
+        _execute(rig, schedule, folder, out_dir, source)
+    if source is not None:
+        from rti_rig.app.usecases.adaptive import record_result
+
+        result = source.conclude()
+        record_result(out_dir, result)
+        est = result["estimated_error_deg"]
+        out.print(
+            f"Adaptive: {result['lights_used']} lights; stopped: {result['stop']['reason']}; "
+            f"estimated mean normal error {'n/a' if est is None else f'{est:.2f}°'}",
+            highlight=False,
+        )
 
 
 def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyped-def]
@@ -256,7 +313,7 @@ def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyp
     return fixed
 
 
-def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-untyped-def]
+def _execute(rig, schedule, folder, out_dir: Path, source=None) -> None:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on."""
     from rti_rig.runtime.controller import (
         CancelToken,
@@ -292,9 +349,12 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
         handlers[signal.SIGUSR1] = on_sigusr1
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
     dry = " (dry run)" if rig.loaded.config.backend != "hardware" else ""
-    todo = len(schedule) - len(folder.done)
+    total = len(schedule) if source is None else source.total
+    todo = total - len(folder.done)
     out.print(
-        f"Rig [bold]{escape(rig.name)}[/]{dry}: {todo} of {len(schedule)} lights → "
+        f"Rig [bold]{escape(rig.name)}[/]{dry}: {todo} of {total} lights"
+        + (" at most, adaptive" if source is not None else "")
+        + " → "
         f"{escape(str(out_dir))}"
     )
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
@@ -306,7 +366,7 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
             TimeElapsedColumn(),
             console=out,
         ) as progress:
-            task = progress.add_task("capturing", total=len(schedule), completed=len(folder.done))
+            task = progress.add_task("capturing", total=total, completed=len(folder.done))
 
             def on_event(event):  # type: ignore[no-untyped-def]
                 if isinstance(event, StepCompleted):
@@ -314,7 +374,9 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
                 elif isinstance(event, Paused):
                     progress.update(task, description="paused")
 
-            result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event)
+            result = run_session(
+                rig, schedule, folder, cancel=cancel, on_event=on_event, source=source
+            )
     except EmergencyStop as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
@@ -567,6 +629,7 @@ def plan(
         planned = plan_lights(request)
     except RtiRigError as exc:
         raise _fail(exc) from None
+    _print_notes(planned.notes)
     for line in planned.report.lines():
         out.print(line, highlight=False, markup=False)
     out.print(
@@ -789,9 +852,30 @@ def bench_tradeoff(
     quick: Annotated[
         bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
     ] = False,
+    from_lp: Annotated[
+        Path | None,
+        typer.Option(
+            "--from",
+            help="A dense acquisition of your own (an .lp with its images beside it): the trade "
+            "for uniform, optimal and adaptive against all its lights.",
+        ),
+    ] = None,
 ) -> None:
-    """Error against number of lights and session time, for every planner, on simulated scenes."""
+    """Error against number of lights and session time, for every planner, on simulated scenes
+    (or on your own acquisition with --from)."""
     import time
+
+    if from_lp is not None:
+        from benchmarks.tradeoff_from import bench_from
+
+        try:
+            text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
+        except RtiRigError as exc:
+            raise _fail(exc) from None
+        except ValueError as exc:
+            raise _fail(RtiRigError(str(exc))) from None
+        out.print(text, highlight=False)
+        return
 
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
 

@@ -77,7 +77,6 @@ def test_tolerant_reading() -> None:
 @pytest.mark.parametrize(
     ("text", "line", "fragment"),
     [
-        ("3\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n", 1, "count line says 3 lights but the file lists 2"),
         ("2\na_1.jpg 0 0 1\na_2.jpg 0 x 1\n", 3, "y component 'x' is not a number"),
         ("1\na_1.jpg 0,5 0 1\n", 2, "decimal separator"),
         ("1\na_1.jpg 0 0 0\n", 2, "nearly) zero"),
@@ -131,3 +130,49 @@ def test_lights_below_the_object_plane_named_by_line_when_asked() -> None:
         parse_lp(text, "mixed.lp", upper_hemisphere=True)
     # the horizon itself is allowed
     assert len(parse_lp("1\nimage_1.jpg 1 0 0\n", upper_hemisphere=True)) == 1
+
+
+def test_count_line_that_disagrees_is_reported_and_the_lines_used() -> None:
+    """A real dome file says 47 above 48 listed lights: the lines win, the note says so."""
+    notes: list[str] = []
+    text = "3\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n"
+    entries = parse_lp(text, "dome.lp", notes=notes)
+    assert [e.name for e in entries] == ["a_1.jpg", "a_2.jpg"]
+    assert notes == [
+        "dome.lp, line 1: count line says 3 lights but the file lists 2; the 2 listed lights "
+        "are used"
+    ]
+    notes.clear()
+    assert len(parse_lp("1\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n", "x.lp", notes=notes)) == 2
+    assert "count line says 1 lights but the file lists 2" in notes[0]
+    assert parse_lp("2\na_1.jpg 0 0 1\na_2.jpg 0 1 0\n", notes=(n := [])) and n == []
+
+
+def test_light_a_hair_below_the_horizon_is_clamped_and_reported() -> None:
+    """z = -0.0012 (calibration noise, seen in a real file) is kept at the horizon."""
+    notes: list[str] = []
+    text = "2\nimage_1.jpg 0.6 0.0 0.8\nimage_2.jpg 0.8 -0.6 -0.0012\n"
+    entries = parse_lp(text, "real.lp", upper_hemisphere=True, notes=notes)
+    d = np.array(entries[1].direction)
+    assert d[2] == 0.0
+    np.testing.assert_allclose(d, (0.8, -0.6, 0.0), atol=1e-12)
+    assert len(notes) == 1 and notes[0].startswith("real.lp, line 3: light z = -0.0012")
+    assert "clamped to z = 0" in notes[0]
+    # read as other tools' files (no hemisphere rule) it is left as it is, silently
+    notes.clear()
+    assert parse_lp(text, "real.lp", notes=notes)[1].direction[2] < 0 and notes == []
+
+
+def test_lower_than_the_tolerance_is_still_refused() -> None:
+    text = "1\nimage_1.jpg 0.99 0.0 -0.011\n"
+    with pytest.raises(LpFormatError, match=r"x\.lp, line 2: .*below the object plane"):
+        parse_lp(text, "x.lp", upper_hemisphere=True, notes=[])
+
+
+def test_read_lp_passes_notes(tmp_path: Path) -> None:
+    p = tmp_path / "d.lp"
+    p.write_text("5\nimage_1.jpg 1 0 -0.005\n", encoding="ascii")
+    notes: list[str] = []
+    (entry,) = read_lp(p, upper_hemisphere=True, notes=notes)
+    assert entry.direction == (1.0, 0.0, 0.0)
+    assert len(notes) == 2 and all(n.startswith(f"{p}, line ") for n in notes)

@@ -26,6 +26,8 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
     cfg = loaded.config
     if cfg.backend == "hardware":
         return _build_hardware(loaded, clock or SystemClock())
+    if cfg.backend == "replay":
+        return _build_replay(loaded, clock or VirtualClock())
     return _build_simulated(loaded, clock or VirtualClock())
 
 
@@ -304,6 +306,29 @@ def _session_hook(camera):  # type: ignore[no-untyped-def]
             camera.output_dir = root / RAW_INCOMING
 
     return hook
+
+
+def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
+    """A recorded acquisition: a dome with exactly its lights, a camera that returns the image
+    recorded for the LED fired (:mod:`rti_rig.simulator.replay`)."""
+    from rti_rig.simulator.replay import ReplayCamera
+    from rti_rig.simulator.sim_lights import LightState, SimulatedDome
+
+    cfg = loaded.config
+    geometry = rig_geometry(loaded)
+    assert isinstance(geometry, DomeGeometry)
+    folder = Path(loaded.path).parent
+    dome = SimulatedDome(geometry, LightState(), clock, cfg.timing.light_switch_s)
+    dome.name = "replayed dome"
+    camera = ReplayCamera(
+        [folder / name for name in geometry.names],
+        dome,
+        clock,
+        shape=(cfg.camera.height, cfg.camera.width),
+        readout_s=cfg.timing.readout_s,
+        transfer_s=cfg.timing.transfer_s,
+    )
+    return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
 
 
 def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:

@@ -226,7 +226,7 @@ class RigConfig(_Strict):
 
     name: str = Field(min_length=1)
     kind: Literal["dome", "arm"]
-    backend: Literal["simulated", "emulated", "hardware"] = "simulated"
+    backend: Literal["simulated", "emulated", "hardware", "replay"] = "simulated"
     description: str = ""
     dome: DomeConfig | None = None
     arm: ArmConfig | None = None
@@ -257,7 +257,13 @@ class RigConfig(_Strict):
                 "add backend = 'hardware' to drive them (or 'emulated' / 'simulated' for a "
                 "dry run)"
             )
-        if self.backend != "simulated" and self.kind == "dome" and self.dome.serial is None:  # type: ignore[union-attr]
+        if self.backend == "replay" and (self.kind != "dome" or self.dome.layout != "lp"):  # type: ignore[union-attr]
+            raise ValueError(
+                "backend 'replay' replays a recorded acquisition: it needs kind = 'dome' with "
+                "layout = 'lp' and lp_file naming the acquisition's .lp (images beside it)"
+            )
+        driven = self.backend in ("emulated", "hardware")
+        if driven and self.kind == "dome" and self.dome.serial is None:  # type: ignore[union-attr]
             raise ValueError(
                 f"backend '{self.backend}' drives the dome over serial: add a [dome.serial] "
                 "table (port, profile; see docs/protocols/led-dome.md)"
@@ -293,6 +299,9 @@ class LoadedRig(BaseModel):
     path: str
     sha256: str  # of the config file, and of its light calibration file if it names one
     raw: dict[str, Any]  # the parsed TOML (a correction file's values filled in)
+    #: what was tolerated while reading it (an .lp's clamped horizon light, its wrong count
+    #: line), each naming the file and line: shown to the user and kept in the manifest
+    notes: tuple[str, ...] = ()
 
     @property
     def folder(self) -> Path:
@@ -415,8 +424,10 @@ def _with_led_map_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:
 
 
 def load_rig_config(path: Path | str) -> LoadedRig:
-    """Read and validate a rig config TOML file."""
+    """Read and validate a rig config TOML file (or an acquisition's `.lp`: a replay rig)."""
     path = Path(path)
+    if path.suffix.lower() == ".lp":
+        return load_replay_rig(path)
     try:
         raw_bytes = path.read_bytes()
     except OSError as exc:
@@ -441,7 +452,9 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         raw=data,
     )
     if config.kind == "dome":
-        dirs, _ = dome_led_directions(loaded)  # fail now, not when the session starts
+        notes: list[str] = []
+        dirs, _ = dome_led_directions(loaded, notes)  # fail now, not when the session starts
+        loaded = loaded.model_copy(update={"notes": tuple(notes)})
         serial = config.dome.serial if config.dome else None
         if serial is not None and (problem := serial.check_led_count(len(dirs))):
             key = "dome.serial.expected_led_count"
@@ -497,8 +510,12 @@ def _ring_directions(rings: list[Ring]) -> NDArray[np.float64]:
     return np.concatenate(dirs, axis=0)
 
 
-def dome_led_directions(rig: LoadedRig) -> tuple[NDArray[np.float64], list[str]]:
-    """The dome's calibrated LED directions (N, 3) and their names, in LED index order."""
+def dome_led_directions(
+    rig: LoadedRig, notes: list[str] | None = None
+) -> tuple[NDArray[np.float64], list[str]]:
+    """The dome's calibrated LED directions (N, 3) and their names, in LED index order.
+
+    What a calibration `.lp` needed tolerated is appended to ``notes``."""
     dome = rig.config.dome
     if dome is None:
         raise ConfigError(rig.path, "kind", "this rig is not a dome")
@@ -517,7 +534,7 @@ def dome_led_directions(rig: LoadedRig) -> tuple[NDArray[np.float64], list[str]]
                 f"file {lp_path} does not exist (paths are relative to the config file's folder)",
             )
         try:
-            entries = read_lp(lp_path, upper_hemisphere=True)
+            entries = read_lp(lp_path, upper_hemisphere=True, notes=notes)
         except LpFormatError as exc:
             raise ConfigError(rig.path, "dome.lp_file", str(exc)) from None
         dirs = np.array([e.direction for e in entries])
@@ -596,3 +613,52 @@ def rig_geometry(rig: LoadedRig) -> DomeGeometry | ArmGeometry:
         park_azimuth_deg=arm.park_azimuth_deg,
         park_elevation_deg=arm.park_elevation_deg,
     )
+
+
+def load_replay_rig(lp_path: Path | str) -> LoadedRig:
+    """A recorded acquisition as a rig: a dome with exactly the `.lp`'s lights (backend
+    ``replay``) whose camera returns the image recorded beside the `.lp` for the light fired.
+
+    Every image is checked to exist before anything runs, and the first one is read for the
+    camera's size; the rig's identity (``sha256``) is that of the `.lp` file. The timing is the
+    default dome's (about 1 s a light), so a replayed session reports what a real dome would
+    take.
+    """
+    from rti_rig.core.image_files import probe_image_size
+
+    lp_path = Path(lp_path).resolve()
+    try:
+        raw_bytes = lp_path.read_bytes()
+    except OSError as exc:
+        raise LpFormatError(lp_path, None, f"cannot read: {exc.strerror or exc}") from None
+    notes: list[str] = []
+    entries = read_lp(lp_path, upper_hemisphere=True, notes=notes)
+    missing = [e.name for e in entries if not (lp_path.parent / e.name).is_file()]
+    if missing:
+        more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
+        shown = ", ".join(missing[:5]) + more
+        raise ConfigError(
+            lp_path,
+            None,
+            f"as a rig, an .lp is a recorded acquisition whose images lie beside it: "
+            f"{len(missing)} of {len(entries)} image(s) missing in {lp_path.parent} ({shown})",
+        )
+    height, width = probe_image_size(lp_path.parent / entries[0].name)
+    data: dict[str, Any] = {
+        "name": f"replay of {lp_path.parent.name}/{lp_path.name}",
+        "kind": "dome",
+        "backend": "replay",
+        "description": "a recorded acquisition replayed (rti-rig run ACQ/dirs.lp)",
+        "dome": {"layout": "lp", "lp_file": str(lp_path)},
+        "camera": {"width": width, "height": height},
+    }
+    config = parse_rig_config(data, str(lp_path))
+    loaded = LoadedRig(
+        config=config,
+        path=str(lp_path),
+        sha256=hashlib.sha256(raw_bytes).hexdigest(),
+        raw=data,
+        notes=tuple(notes),
+    )
+    dome_led_directions(loaded)  # the coincident-light check, as for any dome
+    return loaded

@@ -78,3 +78,33 @@ def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
     if img is None:
         raise SessionError(f"cannot read image {path}")
     return img[..., ::-1] if img.ndim == 3 else img
+
+
+def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
+    """A recorded image as stored: 8-bit (JPEG, 8-bit PNG/TIFF) or 16-bit (TIFF, PNG), RGB
+    order, shape (H, W) or (H, W, 3); refused with the file's name if it cannot be read."""
+    p = Path(path)
+    if p.suffix.lower() in (".tif", ".tiff"):
+        try:
+            img = tifffile.imread(p)
+        except Exception as exc:  # tifffile raises many kinds; the user needs the file's name
+            raise SessionError(f"cannot read image {p}: {exc}") from None
+        if img.dtype not in (np.uint8, np.uint16) or img.ndim not in (2, 3):
+            raise SessionError(f"image {p}: {img.dtype} {img.shape} is not 8/16-bit grey or RGB")
+        return img[..., :3] if img.ndim == 3 else img
+    import cv2
+
+    img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")
+    if img.dtype not in (np.uint8, np.uint16):
+        raise SessionError(f"image {p}: {img.dtype} is not 8- or 16-bit")
+    if img.ndim == 3:
+        img = img[..., 2::-1] if img.shape[2] >= 3 else img[..., 0]
+    return np.ascontiguousarray(img)
+
+
+def probe_image_size(path: Path) -> tuple[int, int]:
+    """(height, width) of an image file, read as :func:`read_image_any` reads it."""
+    img = read_image_any(path)
+    return int(img.shape[0]), int(img.shape[1])

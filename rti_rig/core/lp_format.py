@@ -7,7 +7,15 @@ line (at most 1000), then ``name x y z`` with one space, LF endings, unit vector
 
 The reader is tolerant of what real files contain (tabs, CRLF, trailing blanks, blank lines, a
 missing count line, non-unit vectors, which are renormalised) and precise about what it rejects:
-every error names the file, the line and the reason.
+every error names the file, the line and the reason. Two flaws of real calibrated files are kept
+and *reported* (appended to ``notes``, each naming the file and line) rather than refused:
+
+* a count line that disagrees with the lines listed (one real dome file says 47 above 48
+  lights): the listed lines are used;
+* a light a hair below the object plane where lights must be above it (``upper_hemisphere``):
+  calibration noise at the horizon (one real file has z = -0.0012). A normalised z in
+  (-HORIZON_TOLERANCE, 0) is clamped to the horizon (z = 0, x and y renormalised); anything
+  lower is still refused.
 """
 
 from __future__ import annotations
@@ -27,6 +35,9 @@ from rti_rig.core.errors import LpFormatError
 MAX_LIGHTS = 1000
 #: relight rejects directions shorter than this; so do we.
 MIN_NORM = 1e-4
+#: a light this little below the object plane (normalised z) is calibration noise at the
+#: horizon: kept, clamped to z = 0 and reported where lights must be above the plane.
+HORIZON_TOLERANCE = 0.01
 _CLAMP = 0.999999
 _NAME_OK = re.compile(r"^[^\s]+$")
 
@@ -112,13 +123,21 @@ def _parse_float(token: str, source: str, lineno: int, axis: str) -> float:
     return value
 
 
-def parse_lp(text: str, source: str = "<lp>", upper_hemisphere: bool = False) -> list[LpEntry]:
-    """Parse `.lp` text; ``source`` names the file in errors.
+def parse_lp(
+    text: str,
+    source: str = "<lp>",
+    upper_hemisphere: bool = False,
+    notes: list[str] | None = None,
+) -> list[LpEntry]:
+    """Parse `.lp` text; ``source`` names the file in errors and notes.
 
     ``upper_hemisphere`` refuses lights below the object plane (z < 0), naming the line: for a
     rig's own lights or a plan to run, where such a light cannot be meant (a reader of other
-    tools' files leaves it off and lets the fit decide).
+    tools' files leaves it off and lets the fit decide). A light less than
+    :data:`HORIZON_TOLERANCE` below is clamped to the horizon instead. What was tolerated is
+    appended to ``notes`` (``"FILE, line N: what and what was done"``) for the caller to show.
     """
+    notes = notes if notes is not None else []
     lines = text.splitlines()  # handles LF, CRLF and CR
     numbered = [(i + 1, ln.strip()) for i, ln in enumerate(lines)]
     content = [(n, ln) for n, ln in numbered if ln]
@@ -160,6 +179,13 @@ def parse_lp(text: str, source: str = "<lp>", upper_hemisphere: bool = False) ->
             raise LpFormatError(
                 source, lineno, f"direction ({x}, {y}, {z}) is (nearly) zero: it has no orientation"
             )
+        if upper_hemisphere and -HORIZON_TOLERANCE < z / norm < -1e-9:
+            flat = math.hypot(x, y)
+            notes.append(
+                f"{source}, line {lineno}: light z = {z / norm:.4f} is a hair below the object "
+                f"plane (calibration noise at the horizon?); clamped to z = 0"
+            )
+            x, y, z, norm = x / flat, y / flat, 0.0, 1.0
         if upper_hemisphere and z / norm < -1e-9:
             raise LpFormatError(
                 source,
@@ -176,19 +202,21 @@ def parse_lp(text: str, source: str = "<lp>", upper_hemisphere: bool = False) ->
         seen[name] = lineno
         entries.append(LpEntry(name, (x / norm, y / norm, z / norm)))
 
-    if declared is not None and declared != len(entries):
-        raise LpFormatError(
-            source,
-            first_no,
-            f"count line says {declared} lights but the file lists {len(entries)}",
-        )
     if not entries:
         raise LpFormatError(source, None, "no light lines after the count line")
+    if declared is not None and declared != len(entries):
+        notes.append(
+            f"{source}, line {first_no}: count line says {declared} lights but the file lists "
+            f"{len(entries)}; the {len(entries)} listed lights are used"
+        )
     return entries
 
 
-def read_lp(path: Path | str, upper_hemisphere: bool = False) -> list[LpEntry]:
-    """Read an `.lp` file tolerantly; errors name the file and line (see :func:`parse_lp`)."""
+def read_lp(
+    path: Path | str, upper_hemisphere: bool = False, notes: list[str] | None = None
+) -> list[LpEntry]:
+    """Read an `.lp` file tolerantly; errors and ``notes`` name the file and line (see
+    :func:`parse_lp`)."""
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -198,7 +226,7 @@ def read_lp(path: Path | str, upper_hemisphere: bool = False) -> list[LpEntry]:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         text = raw.decode("latin-1")
-    return parse_lp(text, str(path), upper_hemisphere)
+    return parse_lp(text, str(path), upper_hemisphere, notes)
 
 
 def directions_of(entries: Iterable[LpEntry]) -> NDArray[np.float64]:

@@ -15,7 +15,9 @@ import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import Any, Protocol
 
+from rti_rig.core.devices import Frame
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
@@ -113,6 +115,31 @@ class SessionResult:
 Event = StepStarted | StepCompleted | Paused
 
 
+class StepSource(Protocol):
+    """Steps decided as the session goes (adaptive acquisition), instead of a fixed schedule.
+
+    The controller keeps every guarantee of a fixed schedule (checks before a light moves,
+    lights off after each capture, teardown, journal) and asks the source, before step
+    ``index``, what to do: a step and the evidence of that decision (journaled with the step),
+    or ``None`` to end the session there. After each capture the source sees the frame.
+    Decisions must depend only on the frames seen (in index order), so that ``--resume``, which
+    shows the source the frames already on disk, continues the session deterministically.
+    """
+
+    @property
+    def total(self) -> int:
+        """The most steps the session may take (the session folder is sized for it)."""
+        ...
+
+    def header(self) -> dict[str, Any]:
+        """What the manifest records of the source (its settings), under ``adaptive``."""
+        ...
+
+    def next_step(self, index: int) -> tuple[LightStep, dict[str, Any]] | None: ...
+
+    def observe(self, index: int, frame: Frame, record: StepRecord) -> None: ...
+
+
 def step_exposure(rig: Rig, step: LightStep) -> float:
     return step.exposure_s if step.exposure_s is not None else rig.camera_config.exposure_s
 
@@ -171,13 +198,19 @@ def run_session(
     *,
     cancel: CancelToken | None = None,
     on_event: Callable[[Event], None] | None = None,
+    source: StepSource | None = None,
 ) -> SessionResult:
-    """Run ``schedule`` on ``rig`` into ``folder``; see the module docstring for the guarantees."""
+    """Run ``schedule`` on ``rig`` into ``folder``; see the module docstring for the guarantees.
+
+    With ``source`` the steps are the source's decisions, step by step (adaptive acquisition);
+    ``schedule`` is then the starting layout recorded in the manifest, checked like any other.
+    """
     validate_schedule(rig, schedule)
-    if folder.total_steps != len(schedule):
+    total = len(schedule) if source is None else source.total
+    if folder.total_steps != total:
         raise ScheduleError("session folder was sized for another schedule")
     done = folder.done
-    todo = [i for i in range(len(schedule)) if i not in done]
+    todo = [i for i in range(total) if i not in done]
     cam = rig.camera_config
     check_free_space(folder.root, len(todo), estimated_bytes_per_image(cam.width, cam.height))
     cancel = cancel or CancelToken()
@@ -194,6 +227,7 @@ def run_session(
                 "config": rig.loaded.raw,
             },
             "schedule": schedule.to_dict(),
+            **({"adaptive": source.header()} if source is not None else {}),
         }
     )
     records: list[StepRecord] = []
@@ -201,20 +235,28 @@ def run_session(
     error: str | None = None
     teardown: list[str] = []
     rig_t0, wall_t0 = clock.now(), time.perf_counter()
-    total = len(schedule)
     try:
         rig.bind_session(folder.root)
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()
         for i in todo:
-            step = schedule.steps[i]
             if cancel.paused:
                 emit(Paused(i, total))
                 cancel.wait_while_paused()
             if cancel.cancelled:
                 reason = FinishReason.CANCELLED
                 break
+            decision: dict[str, Any] | None = None
+            if source is None:
+                step = schedule.steps[i]
+            else:
+                decided = source.next_step(i)
+                if decided is None:  # the source says the session is done
+                    reason = FinishReason.COMPLETED
+                    break
+                step, decision = decided
+                validate_schedule(rig, LightSchedule((step,)))  # before this light moves
             emit(StepStarted(i, total, step))
             t_start = clock.now()
             actual = rig.lighting.set(step)
@@ -235,8 +277,11 @@ def run_session(
                     "light_s": t_lit - t_start,
                     "settle_s": t_settled - t_lit,
                     "capture_s": t_captured - t_settled,
+                    **({"decision": decision} if decision is not None else {}),
                 },
             )
+            if source is not None:
+                source.observe(i, frame, record)
             records.append(record)
             emit(StepCompleted(i, total, record))
         else:

@@ -72,6 +72,14 @@ class StepRecord:
     #: per channel, white balance, colour, orientation, source file); empty for non-RAW cameras
     decode: dict[str, Any] = field(default_factory=dict)
     notices: list[str] = field(default_factory=list)
+    #: an adaptive session's decision for this step and its evidence (None: a fixed schedule)
+    decision: dict[str, Any] | None = None
+
+
+def planned_steps(manifest: dict[str, Any]) -> int:
+    """How many steps a session may take: its schedule's, or an adaptive session's maximum."""
+    adaptive = manifest.get("adaptive") or {}
+    return int(adaptive.get("max_lights") or len(manifest.get("schedule", {}).get("steps", [])))
 
 
 def image_names(total: int) -> list[str]:
@@ -171,7 +179,7 @@ class SessionFolder:
         :func:`prepare_resume`.
         """
         state = prepare_resume(Path(root))
-        folder = cls(Path(root), len(state.manifest["schedule"]["steps"]))
+        folder = cls(Path(root), planned_steps(state.manifest))
         folder.manifest = state.manifest
         folder.resume = state
         return folder
@@ -415,11 +423,18 @@ def prepare_resume(root: Path) -> ResumeState:
     deleted; half-written temporary files are removed (they never were an image).
     """
     manifest = read_manifest(root)
-    total = len(manifest.get("schedule", {}).get("steps", []))
+    total = planned_steps(manifest)
     if total == 0:
         raise SessionError(f"{root}: the manifest holds no schedule, so there is nothing to resume")
     runner = manifest.get("runner", {})
     if runner.get("finish_reason") == "completed":
+        done = runner.get("steps_done", total)
+        if manifest.get("adaptive") and done < total:  # an adaptive session that chose to stop
+            stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
+            raise SessionError(
+                f"{root}: this adaptive session already completed: it stopped after {done} of "
+                f"at most {total} lights ({stop.get('reason', 'its stopping rule')})"
+            )
         raise SessionError(f"{root}: this session already completed all {total} steps")
     names = image_names(total)
     fields = set(StepRecord.__dataclass_fields__)

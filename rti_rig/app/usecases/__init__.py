@@ -8,4 +8,5 @@ place before anything moves or is written, does the work and returns what happen
 - :mod:`.plan` — :func:`~.plan.plan_lights`, :func:`~.plan.draw_plan_figure`
 - :mod:`.calibrate` — :func:`~.calibrate.calibrate_lights`
 - :mod:`.probe` — :func:`~.probe.probe`
+- :mod:`.adaptive` — the adaptive acquisition loop (``run --adaptive``)
 """

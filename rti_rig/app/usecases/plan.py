@@ -68,11 +68,13 @@ class PlannedLights:
     out_file: Path
     method: str
     objective: str
+    #: What the tolerant ``.lp`` reader accepted but the user should know (file, line, what).
+    notes: tuple[str, ...] = ()
 
 
-def _bare_lp_dome(rig: Path) -> tuple[DomeGeometry, list[LpEntry]]:
+def _bare_lp_dome(rig: Path, notes: list[str]) -> tuple[DomeGeometry, list[LpEntry]]:
     """A bare ``.lp`` as a rig: a dome with exactly these lights, each listed once."""
-    entries = read_lp(rig, upper_hemisphere=True)
+    entries = read_lp(rig, upper_hemisphere=True, notes=notes)
     pair = coincident_leds([e.direction for e in entries])
     if pair is not None:
         i, j = pair
@@ -135,12 +137,13 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     )
     bare_lp = req.rig.suffix.lower() == ".lp"
     loaded = None if bare_lp else load_rig_config(req.rig)
+    notes: list[str] = [] if loaded is None else list(loaded.notes)
     _check_outputs(req, loaded)
     arm_order = None
     entries: list[LpEntry] = []
     geometry: DomeGeometry | ArmGeometry
     if loaded is None:
-        geometry, entries = _bare_lp_dome(req.rig)
+        geometry, entries = _bare_lp_dome(req.rig, notes)
     else:
         geometry = rig_geometry(loaded)
         arm_order = arm_order_for(loaded)
@@ -178,7 +181,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         req.out_file,
         [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
     )
-    return PlannedLights(schedule, report, geometry, req.out_file, method, objective)
+    return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
 
 
 def draw_plan_figure(req: PlanLightsRequest, planned: PlannedLights) -> Path:

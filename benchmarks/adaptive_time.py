@@ -1,0 +1,114 @@
+"""Planning time against the number of lights: every adaptive decision, and `plan --method
+optimal`, at N = 6 … 100 on a dome and on an arm.
+
+* **Adaptive decision** (what `run --adaptive` does between two images): shrink the newest
+  24-megapixel frame (6000×4000 RGB, 16-bit) to the fit's 128 px, robust photometric stereo on
+  the N small images so far, and the choice among the rig's candidates. Targets: ≤ 0.2 s on 2
+  cores. The N images are the simulator's relief scene rendered at the fit's size (the shrink
+  is timed on a real 24-MP frame, once per decision, as in a session).
+* **`plan --method optimal`** with no preview (a level surface, as `plan --rig RIG --lights N
+  --method optimal`): a 200-LED Fibonacci dome (a 72-LED dome cannot take 100 lights) and the
+  simulated arm. Target ≤ 1 s at 100 lights.
+
+Median of ``--repeats`` runs (1 for the optimal planner above 24 lights: it is slow there).
+Run: ``python -m benchmarks.adaptive_time [--write]`` (``--write``: docs/adaptive.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+from rti_rig.planner.adaptive import choose_next
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.objectives import candidates_for
+from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
+
+from benchmarks.adaptive import DOC
+from benchmarks.report import machine_line, write_section
+from rti_rig.app.usecases.adaptive import fit_state, small_grey
+from rti_rig.core.geometry import fibonacci_cap
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+
+NS = (6, 9, 12, 18, 24, 36, 50, 75, 100)
+
+
+def _median(fn, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def main(argv: list[str] | None = None) -> str:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--max-optimal-n", type=int, default=100)
+    ap.add_argument("--write", action="store_true")
+    args = ap.parse_args(argv)
+    dome = DomeGeometry(fibonacci_cap(200, 5.0), tuple(f"led_{i:03d}" for i in range(200)))
+    arm = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
+    scene = relief_scene(85, 128, seed=0)
+    frame = np.random.default_rng(0).integers(0, 65535, (4000, 6000, 3), dtype=np.uint16)
+    shrink = _median(lambda: small_grey(frame), args.repeats)
+    print(f"shrink 24 MP -> 128 px: {shrink:.3f} s", flush=True)
+    rows = []
+    for rig_name, geometry in (("200-LED dome", dome), ("arm", arm)):
+        cands = candidates_for(geometry).directions
+        for n in NS:
+            if n > len(cands) - 1:
+                continue
+            lights = cands[np.linspace(0, len(cands) - 1, n).round().astype(int)]
+            images = np.stack([lambert_radiance(scene, d).mean(axis=-1) for d in lights])
+            images = images.astype(np.float32)
+            available = np.ones(len(cands), dtype=bool)
+
+            def decide(images=images, lights=lights, available=available, cands=cands) -> None:
+                small_grey(frame)
+                state = fit_state(images, lights)
+                assert state is not None
+                choose_next(state, cands, available)
+
+            t_dec = _median(decide, args.repeats)
+            t_opt = float("nan")
+            if n <= args.max_optimal_n:
+                reps = args.repeats if n <= 24 else 1
+                t_opt = _median(
+                    lambda g=geometry, n=n: plan_with_report(None, g, n, "optimal", "normals"),
+                    reps,
+                )
+            rows.append((rig_name, n, len(cands), t_dec, t_opt))
+            print(
+                f"{rig_name:12s} N={n:3d} candidates={len(cands)} adaptive decision "
+                f"{t_dec:.3f} s, optimal plan {t_opt:.2f} s",
+                flush=True,
+            )
+    lines = [
+        "Command: `python -m benchmarks.adaptive_time --write`. "
+        + machine_line()
+        + f" os.cpu_count() = {os.cpu_count()}; medians of {args.repeats} runs (the optimal "
+        "planner: 1 run above 24 lights). Other jobs shared the 2 cores while this ran.",
+        "",
+        f"Shrinking one 24-MP frame (6000×4000×3, 16-bit) to the fit's 128 px: {shrink:.3f} s "
+        "(inside every decision below).",
+        "",
+        "| rig | N (images so far / planned lights) | candidates | adaptive decision s "
+        "(target ≤ 0.2) | `plan --method optimal` s (target ≤ 1) |",
+        "|---|---|---|---|---|",
+    ]
+    lines += [f"| {r} | {n} | {c} | {d:.3f} | {o:.2f} |" for r, n, c, d, o in rows]
+    md = "\n".join(lines)
+    print(md)
+    if args.write:
+        write_section("adaptive_time", md, DOC)
+    return md
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

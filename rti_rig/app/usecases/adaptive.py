@@ -1,0 +1,439 @@
+"""Adaptive acquisition (`rti-rig run RIG --adaptive --lights N` / `--until-error DEG`).
+
+Design: the controller runs the session as it runs any schedule, but asks a *step source*
+(:class:`rti_rig.runtime.controller.StepSource`) for each next step; this module's
+:class:`AdaptiveSteps` is that source. It keeps a small grey copy of every image captured,
+fits normals and albedo to them with the project's robust photometric stereo
+(:mod:`rti_rig.reconstruct`), and passes what is known of the surface to the pure chooser
+(:mod:`rti_rig.planner.adaptive`), which picks the next light among what the rig can do (a
+dome's LEDs; an arm's reachable set, move time counted). Why a step source rather than
+one-step schedules run back to back: one session, one manifest and journal, one teardown and one
+set of signal rules (Ctrl-C, SIGTERM, pause) whatever decides the steps, and the fixed path
+is unchanged (no source: the schedule's steps).
+
+Decisions are data: each step's decision and its evidence (estimated error now and predicted
+after, the best candidates, the time each took) go into the journal line and the manifest's
+steps; the settings into the manifest's ``adaptive`` table. A decision depends only on the
+images before it, so ``--resume`` re-reads the linear TIFFs on disk and continues exactly as the
+uninterrupted session would have.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.core.arm_motion import move_time_s
+from rti_rig.core.devices import Frame
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.planner.adaptive import (
+    ESTIMATE_SCALE,
+    START_FLOOR_DEG,
+    START_LIGHTS,
+    SurfaceState,
+    choose_next,
+    estimate_error_deg,
+)
+from rti_rig.planner.objectives import candidates_for, snap_unique
+from rti_rig.planner.uniform import select_uniform_leds
+
+#: Width (px) of the grey copies the decisions are fitted on (a 24-MP image is shrunk once).
+FIT_PX = 128
+#: Pixels sampled from the fit for the chooser.
+SAMPLE = 2000
+#: Noise floor of one observation relative to the stack's bright level (quantisation, sensor).
+NOISE_FLOOR = 0.003
+#: An adaptive run that gives only --until-error on an arm stops at this many lights at most.
+ARM_MAX_LIGHTS = 100
+FORMAT = "rti-rig-adaptive/1"
+
+
+def small_grey(pixels: NDArray, white_level: float = 65535.0) -> NDArray[np.float32]:
+    """A frame shrunk to :data:`FIT_PX` wide (area average), grey, in units of white."""
+    px = np.asarray(pixels)
+    h, w = px.shape[:2]
+    step = w // (4 * FIT_PX)
+    if step > 1:  # a 24-MP frame: every step-th pixel first (an area average of 16 at the end)
+        px = np.ascontiguousarray(px[::step, ::step])
+        h, w = px.shape[:2]
+    if w > FIT_PX:
+        size = (FIT_PX, max(1, round(h * FIT_PX / w)))
+        px = cv2.resize(px, size, interpolation=cv2.INTER_AREA)
+    g = px.astype(np.float32)
+    if g.ndim == 3:
+        g = g.mean(axis=2)
+    return g / np.float32(white_level)
+
+
+def fit_state(images: NDArray[np.float32], lights: NDArray[np.float64]) -> SurfaceState | None:
+    """What the images so far say of the surface, for the chooser (None: not yet solvable).
+
+    Robust photometric stereo on the small grey stack; a fixed pixel sample (same pixels every
+    time, so decisions are deterministic). Pixels the fit cannot solve yet (fewer than three
+    lights reach them) are kept with a level normal and their brightest observation as albedo:
+    they are where the next light is most needed.
+    """
+    from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
+
+    k = len(lights)
+    if k < 3:
+        return None
+    flat = np.asarray(images, dtype=np.float32).reshape(k, -1)
+    # the same pixels every time (a decision is a function of the images), fitted alone: the
+    # chooser needs a sample, and fitting only it keeps a decision fast
+    rng = np.random.default_rng(0)
+    pick = np.sort(rng.choice(flat.shape[1], min(SAMPLE, flat.shape[1]), replace=False))
+    obs = flat[:, pick]
+    try:
+        ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
+    except ReconstructionError:
+        return None
+    seen = obs.max(axis=0) > ps.dark_threshold  # not dark under every light so far
+    if not seen.any():
+        return None
+    obs = obs[:, seen]
+    valid = ps.valid.ravel()[seen]
+    normals = ps.normals.reshape(-1, 3)[seen].astype(np.float64)
+    normals[~valid] = (0.0, 0.0, 1.0)
+    albedo = ps.albedo.reshape(-1)[seen].astype(np.float64)
+    albedo = np.where(valid, albedo, obs.max(axis=0))
+    resid = ps.residual.ravel()[seen].astype(np.float64)
+    ref = float(np.percentile(obs, 99)) or 1.0
+    dof = max(k - 3, 1)
+    noise = np.sqrt((NOISE_FLOOR * ref) ** 2 + resid**2 * k / dof)
+    lit = (obs > ps.dark_threshold).T
+    return SurfaceState(normals, albedo, noise, lit, np.asarray(lights, dtype=np.float64))
+
+
+MoveTimes = Callable[[NDArray[np.float64] | None], NDArray[np.float64] | None]
+
+
+class AdaptiveChooser:
+    """The decision loop, independent of the controller (the benchmarks drive it directly).
+
+    ``candidates`` (C, 3): the lights the rig can give; ``start``: candidate indices of the
+    starting layout; ``move_times(current direction) -> (C,)`` seconds, or None for a dome.
+    """
+
+    def __init__(
+        self,
+        candidates: NDArray[np.float64],
+        start: list[int],
+        max_lights: int,
+        until_error_deg: float | None = None,
+        capture_s: float = 1.0,
+        move_times: MoveTimes | None = None,
+        scale: float = ESTIMATE_SCALE,
+    ) -> None:
+        self.candidates = np.asarray(candidates, dtype=np.float64)
+        self.start = list(start)
+        self.max_lights = max_lights
+        self.until_error_deg = until_error_deg
+        self.capture_s = capture_s
+        self.move_times = move_times
+        self.scale = scale
+        self.images: list[NDArray[np.float32]] = []
+        self.lights: list[NDArray[np.float64]] = []
+        self.used: list[int] = []
+        self.stop_evidence: dict[str, Any] | None = None
+
+    def observe(self, candidate: int, direction: NDArray[np.float64], image: NDArray) -> None:
+        self.used.append(int(candidate))
+        self.lights.append(np.asarray(direction, dtype=np.float64))
+        self.images.append(image)
+
+    def state(self) -> SurfaceState | None:
+        if not self.images:
+            return None
+        return fit_state(np.stack(self.images), np.stack(self.lights))
+
+    def decide(self, index: int) -> tuple[int | None, dict[str, Any]]:
+        """Candidate for step ``index`` (None: stop) and the evidence of the decision."""
+        t0 = time.perf_counter()
+        if index < len(self.start) and index < self.max_lights:
+            return self.start[index], {"kind": "start", "reason": "starting layout"}
+        state = self.state()
+        if index >= self.max_lights:
+            est = None if state is None else estimate_error_deg(state, self.scale)
+            self.stop_evidence = {
+                "kind": "stop",
+                "reason": f"reached --lights {self.max_lights}",
+                "estimated_error_deg": None if est is None else round(est, 4),
+            }
+            return None, self.stop_evidence
+        if state is None:  # the starting layout cannot be fitted: fall back to coverage
+            available = np.ones(len(self.candidates), dtype=bool)
+            available[self.used] = False
+            far = np.flatnonzero(available)
+            if far.size == 0:
+                return None, {"kind": "stop", "reason": "no candidate light left"}
+            dots = self.candidates[far] @ np.stack(self.lights).T if self.lights else None
+            pick = int(far[0] if dots is None else far[np.argmin(dots.max(axis=1))])
+            return pick, {"kind": "coverage", "reason": "fit not yet possible: farthest light"}
+        est = estimate_error_deg(state, self.scale)
+        if self.until_error_deg is not None and est <= self.until_error_deg:
+            self.stop_evidence = {
+                "kind": "stop",
+                "reason": f"estimated error {est:.2f}° ≤ --until-error {self.until_error_deg:g}°",
+                "estimated_error_deg": round(est, 4),
+            }
+            return None, self.stop_evidence
+        available = np.ones(len(self.candidates), dtype=bool)
+        available[self.used] = False
+        current = self.lights[-1] if self.lights else None
+        move = None if self.move_times is None else self.move_times(current)
+        d = choose_next(
+            state,
+            self.candidates,
+            available,
+            capture_s=self.capture_s,
+            move_s=move,
+            scale=self.scale,
+        )
+        if d.candidate is None:
+            self.stop_evidence = {"kind": "stop", **d.evidence()}
+            return None, self.stop_evidence
+        return d.candidate, {
+            "kind": "adaptive",
+            **d.evidence(),
+            "decision_s": round(time.perf_counter() - t0, 4),
+        }
+
+    def conclude(self) -> dict[str, Any]:
+        """The estimate after the last image, for the manifest."""
+        state = self.state()
+        est = None if state is None else estimate_error_deg(state, self.scale)
+        return {
+            "lights_used": len(self.used),
+            "estimated_error_deg": None if est is None else round(est, 4),
+            "stop": self.stop_evidence
+            or {"kind": "stop", "reason": f"reached --lights {self.max_lights}"},
+        }
+
+
+# --- the rig side: candidates, starting layout, move times, the step source ---------------
+
+
+def _capture_s(rig) -> float:  # type: ignore[no-untyped-def]
+    t = rig.loaded.config.timing
+    return t.light_switch_s + t.settle_s + rig.camera_config.exposure_s + t.readout_s + t.transfer_s
+
+
+def _arm_motion_settings(loaded) -> Any:  # type: ignore[no-untyped-def]
+    """The move-time model's settings: the servos' when configured, else the simulated arm's."""
+    arm = loaded.config.arm
+    if arm.dynamixel is not None:
+        return arm.dynamixel
+    joint = SimpleNamespace(
+        joint_velocity_deg_s=arm.speed_deg_s, joint_acceleration_deg_s2=arm.acceleration_deg_s2
+    )
+    az = SimpleNamespace(min_deg=-180.0, max_deg=179.999, **vars(joint))
+    el = SimpleNamespace(min_deg=0.0, max_deg=90.0, **vars(joint))
+    return SimpleNamespace(
+        azimuth=az,
+        elevation=el,
+        park_azimuth_deg=arm.park_azimuth_deg,
+        park_elevation_deg=arm.park_elevation_deg,
+        settle_time_s=0.0,
+    )
+
+
+@dataclass(frozen=True)
+class AdaptivePlan:
+    """What the rig can do, for the adaptive loop: candidates and the starting layout."""
+
+    candidates: NDArray[np.float64]
+    leds: NDArray[np.intp] | None  # a dome's LED of each candidate
+    start: list[int]
+    max_lights: int
+
+
+def adaptive_plan(rig, lights: int | None, start_lights: int = START_LIGHTS) -> AdaptivePlan:  # type: ignore[no-untyped-def]
+    """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
+    homogeneous starting layout of ``start_lights``."""
+    geometry = rig.geometry
+    if isinstance(geometry, DomeGeometry):
+        cands = candidates_for(geometry)
+        dirs, leds = cands.directions, cands.leds
+        assert leds is not None
+        cap = geometry.count
+    else:
+        assert isinstance(geometry, ArmGeometry)
+        dirs = candidates_for(geometry).directions
+        ok = [rig.lighting.problem(LightStep(tuple(d))) is None for d in dirs]
+        dirs, leds = dirs[np.asarray(ok, dtype=bool)], None
+        cap = ARM_MAX_LIGHTS
+    max_lights = min(lights if lights is not None else cap, len(dirs))
+    k0 = min(start_lights, max_lights)
+    if isinstance(geometry, DomeGeometry):
+        chosen = select_uniform_leds(geometry, k0, START_FLOOR_DEG)
+        lookup = {int(led): i for i, led in enumerate(leds)}  # type: ignore[union-attr]
+        start = [lookup[int(led)] for led in chosen]
+    else:
+        from rti_rig.planner.objectives import Candidates
+
+        targets = geometry.homogeneous(k0, START_FLOOR_DEG)
+        start = [int(i) for i in snap_unique(targets, Candidates(dirs, None, None))]
+    return AdaptivePlan(dirs, leds, start, max_lights)
+
+
+class AdaptiveSteps:
+    """The controller's step source for an adaptive session (see the module docstring)."""
+
+    def __init__(self, rig, plan: AdaptivePlan, until_error_deg: float | None) -> None:  # type: ignore[no-untyped-def]
+        self.plan = plan
+        self.until_error_deg = until_error_deg
+        move: MoveTimes | None = None
+        if isinstance(rig.geometry, ArmGeometry):
+            settings = _arm_motion_settings(rig.loaded)
+            park = rig.geometry.park_direction
+
+            def move(current):  # type: ignore[no-untyped-def]
+                here = park if current is None else current
+                return np.array([move_time_s(here, d, settings) for d in plan.candidates])
+
+        self.chooser = AdaptiveChooser(
+            plan.candidates,
+            plan.start,
+            plan.max_lights,
+            until_error_deg,
+            capture_s=_capture_s(rig),
+            move_times=move,
+        )
+        self._pending: dict[int, int] = {}
+
+    @property
+    def total(self) -> int:
+        return self.plan.max_lights
+
+    def start_schedule(self) -> LightSchedule:
+        """The starting layout, recorded as the session's schedule in the manifest."""
+        return LightSchedule(tuple(self._step(c) for c in self.plan.start), method="adaptive")
+
+    def header(self) -> dict[str, Any]:
+        return {
+            "format": FORMAT,
+            "max_lights": self.plan.max_lights,
+            "until_error_deg": self.until_error_deg,
+            "start_lights": len(self.plan.start),
+            "candidates": len(self.plan.candidates),
+            "fit_px": FIT_PX,
+            "estimate_scale": self.chooser.scale,
+        }
+
+    def _step(self, candidate: int) -> LightStep:
+        d = self.plan.candidates[candidate]
+        led = None if self.plan.leds is None else int(self.plan.leds[candidate])
+        return LightStep((float(d[0]), float(d[1]), float(d[2])), led=led)
+
+    def next_step(self, index: int) -> tuple[LightStep, dict[str, Any]] | None:
+        candidate, evidence = self.chooser.decide(index)
+        if candidate is None:
+            return None
+        self._pending[index] = candidate
+        return self._step(candidate), evidence
+
+    def observe(self, index: int, frame: Frame, record) -> None:  # type: ignore[no-untyped-def]
+        self.chooser.observe(
+            self._pending.pop(index),
+            np.asarray(record.actual_direction),
+            small_grey(frame.pixels),  # as --resume reads it back from the linear TIFF
+        )
+
+    def replay(self, folder) -> None:  # type: ignore[no-untyped-def]
+        """Show the chooser the steps already on disk (``--resume``), in index order, and check
+        that each would be decided again as it was (else the session cannot continue as it
+        began)."""
+        done = folder.done
+        for i in range(len(done)):
+            if i not in done:
+                raise RtiRigError(
+                    f"{folder.root}: step {i + 1} is missing but later ones are on disk; an "
+                    "adaptive session continues only from an unbroken run of steps"
+                )
+            rec = done[i]
+            candidate, _ = self.chooser.decide(i)
+            planned = (
+                None
+                if candidate is None
+                else tuple(float(c) for c in self.plan.candidates[candidate])
+            )
+            if planned is None or not np.allclose(planned, rec.planned_direction, atol=1e-9):
+                raise RtiRigError(
+                    f"{folder.root}: step {i + 1} was decided differently when the session "
+                    "began (another rig config, software version or image on disk); it cannot "
+                    "be continued deterministically: start a new session"
+                )
+            pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
+            self._pending[i] = candidate
+            self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
+
+    def conclude(self) -> dict[str, Any]:
+        return self.chooser.conclude()
+
+
+def record_result(folder_root: Path, result: dict[str, Any]) -> None:
+    """Add the adaptive run's outcome (lights used, final estimate, why it stopped) to the
+    manifest, after the controller has written it."""
+    from rti_rig.runtime.session import MANIFEST, _write_json_atomic, read_manifest
+
+    manifest = read_manifest(folder_root)
+    manifest.setdefault("adaptive", {})["result"] = result
+    _write_json_atomic(Path(folder_root) / MANIFEST, manifest)
+
+
+def open_adaptive_session(loaded, out_dir: Path, lights: int | None, until_error_deg: float | None):  # type: ignore[no-untyped-def]
+    """Check the request and the folder, open the rig, plan the start, make the folder.
+
+    Returns (rig, starting schedule, folder, step source); the rig is closed if anything after
+    opening it fails.
+    """
+    from rti_rig.app.compose import build_rig
+    from rti_rig.runtime.controller import validate_schedule
+    from rti_rig.runtime.session import SessionFolder
+
+    if until_error_deg is not None and not (np.isfinite(until_error_deg) and until_error_deg > 0):
+        raise RtiRigError(f"--until-error {until_error_deg:g}: give a positive angle in degrees")
+    if lights is not None and lights < START_LIGHTS + 1:
+        raise RtiRigError(
+            f"--adaptive --lights {lights}: an adaptive session starts from {START_LIGHTS} lights "
+            f"and chooses from there; give at least {START_LIGHTS + 1}"
+        )
+    SessionFolder.check_new(out_dir)
+    rig = build_rig(loaded)
+    try:
+        source = AdaptiveSteps(rig, adaptive_plan(rig, lights), until_error_deg)
+        schedule = source.start_schedule()
+        validate_schedule(rig, schedule)
+        folder = SessionFolder.create(out_dir, source.total)
+    except BaseException:
+        rig.close()
+        raise
+    return rig, schedule, folder, source
+
+
+def resume_adaptive_source(rig, folder) -> AdaptiveSteps:  # type: ignore[no-untyped-def]
+    """The step source of an interrupted adaptive session, brought up to its last step."""
+    header = folder.manifest["adaptive"]
+    if header.get("format") != FORMAT:
+        raise RtiRigError(f"{folder.root}: unknown adaptive format {header.get('format')!r}")
+    plan = adaptive_plan(rig, header["max_lights"], header["start_lights"])
+    if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
+        raise RtiRigError(
+            f"{folder.root}: the rig now offers {len(plan.candidates)} candidate lights, the "
+            f"session began with {header['candidates']}: it cannot continue as it began"
+        )
+    source = AdaptiveSteps(rig, plan, header.get("until_error_deg"))
+    source.replay(folder)
+    return source

@@ -1,0 +1,122 @@
+"""A recorded acquisition replayed: the camera returns the image recorded for the light fired.
+
+With the simulated dome of the same `.lp`, a real acquisition becomes a rig, so that every
+planner (adaptive or not) can be rehearsed on real data. What the session then holds:
+
+* **16-bit sources** (linear TIFF or PNG): the frame *is* the recorded pixels, so the session's
+  linear TIFF holds exactly the source's pixels (and, for a source written by rti-rig, the same
+  bytes: same writer, same settings).
+* **8-bit sources** (JPEG): a JPEG cannot be re-encoded to the same bytes, and the session's
+  Frame is linear 16-bit. The decoded 8-bit pixels are mapped through :data:`SRGB8_TO_LINEAR16`,
+  a table chosen so that the session's own sRGB encoding
+  (:func:`rti_rig.core.image_files.linear_to_srgb8`) gives back exactly the decoded pixels: the
+  session's linear TIFF, encoded as the session encodes it, is pixel-identical to the decoded
+  source JPEG. The session's JPEG is a re-encoding (quality 95) and is not byte-identical.
+
+Exposure is not modelled: the recorded image is returned whatever exposure is asked (it is
+noted in the frame's metadata). Capturing advances the injected clock as a camera would.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import Frame
+from rti_rig.core.errors import CaptureError
+from rti_rig.core.image_files import linear_to_srgb8, read_image_any
+
+WHITE = 65535
+
+
+def _srgb8_to_linear16() -> NDArray[np.uint16]:
+    """For each 8-bit code, the middle 16-bit linear value that the session encodes back to it."""
+    codes = linear_to_srgb8(np.arange(WHITE + 1, dtype=np.uint16), WHITE)
+    table = np.zeros(256, dtype=np.uint16)
+    for v in range(256):
+        hits = np.flatnonzero(codes == v)
+        if hits.size == 0:  # pragma: no cover - the sRGB curve reaches every code at 16 bits
+            raise AssertionError(f"8-bit code {v} has no 16-bit linear value")
+        table[v] = hits[hits.size // 2]
+    return table
+
+
+#: 8-bit sRGB code → 16-bit linear value that ``linear_to_srgb8`` maps back to the same code.
+SRGB8_TO_LINEAR16 = _srgb8_to_linear16()
+
+
+def recorded_frame_pixels(path: Path) -> NDArray[np.uint16]:
+    """The recorded image as a linear 16-bit frame (see the module docstring)."""
+    img = read_image_any(path)
+    if img.dtype == np.uint8:
+        return SRGB8_TO_LINEAR16[img]
+    return img.astype(np.uint16, copy=False)
+
+
+class LitLed(Protocol):
+    """What the replay camera needs of the dome: which LED is lit (``None`` when all are off)."""
+
+    lit: int | None
+
+
+class ReplayCamera:
+    """Returns the recorded image of the LED the dome has lit (one image per LED, in order)."""
+
+    def __init__(
+        self,
+        images: Sequence[Path],
+        dome: LitLed,
+        clock: Clock,
+        *,
+        shape: tuple[int, ...],
+        readout_s: float = 0.3,
+        transfer_s: float = 0.7,
+    ) -> None:
+        self.name = "replay camera"
+        self._images = [Path(p) for p in images]
+        self._dome = dome
+        self._clock = clock
+        self._shape = shape
+        self._readout_s = readout_s
+        self._transfer_s = transfer_s
+        self._connected = False
+
+    def connect(self) -> None:
+        self._connected = True
+
+    def close(self) -> None:
+        self._connected = False
+
+    def capture(self, exposure_s: float) -> Frame:
+        if not self._connected:
+            raise CaptureError(self.name, "not connected; call connect() first", "capture")
+        t0 = self._clock.now()
+        lit = self._dome.lit
+        if lit is None:  # no recorded dark frame: a black one
+            pixels = np.zeros(self._shape, dtype=np.uint16)
+            source = None
+        else:
+            path = self._images[lit]
+            pixels = recorded_frame_pixels(path)
+            if pixels.shape[:2] != self._shape[:2]:
+                raise CaptureError(
+                    self.name,
+                    f"{path} is {pixels.shape[1]}x{pixels.shape[0]} but the acquisition's first "
+                    f"image is {self._shape[1]}x{self._shape[0]}: one acquisition, one size",
+                    "capture",
+                )
+            source = str(path)
+        self._clock.sleep(exposure_s + self._readout_s + self._transfer_s)
+        return Frame(
+            pixels=pixels,
+            exposure_s=exposure_s,
+            gain=1.0,
+            white_level=WHITE,
+            timestamp_s=t0,
+            metadata={"source": "replay", "replayed_image": source, "exposure_modelled": False},
+        )

@@ -1,0 +1,214 @@
+"""Adaptive acquisition through the front door: `rti-rig run RIG --adaptive / --until-error`.
+
+Decisions are data (journal, manifest), the stopping rule stops, an interrupted session resumes
+to exactly the session it would have been, arms count move time, replayed acquisitions work.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS, SMALL_DOME, write_config
+from typer.testing import CliRunner
+
+from rti_rig.app.config import load_rig_config
+from rti_rig.app.usecases.adaptive import open_adaptive_session
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
+from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted, run_session
+
+REPO = Path(__file__).resolve().parent.parent
+runner = CliRunner()
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+def journal(session: Path) -> list[dict]:
+    return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]
+
+
+def manifest(session: Path) -> dict:
+    return json.loads((session / "manifest.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    base = tmp_path_factory.mktemp("adaptive")
+    cfg = write_config(base, SMALL_DOME)
+    out = base / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--adaptive", "--lights", "8"])
+    assert r.exit_code == 0, r.output
+    assert "Adaptive: 8 lights; stopped: reached --lights 8" in said(r)
+    return cfg, out
+
+
+def test_decisions_are_in_the_journal_and_the_manifest(uninterrupted: tuple[Path, Path]) -> None:
+    _, out = uninterrupted
+    steps = journal(out)
+    assert len(steps) == 8 == len(read_lp(out / "lights.lp"))
+    kinds = [s["decision"]["kind"] for s in steps]
+    assert kinds == ["start"] * 4 + ["adaptive"] * 4
+    leds = [s["led"] for s in steps]
+    assert len(set(leds)) == 8  # a dome's LED is used once
+    for s in steps[4:]:
+        d = s["decision"]
+        assert d["candidate"] == s["led"]  # a dome's candidates are its LEDs
+        best = d["best_candidates"][0]
+        assert best["candidate"] == s["led"]
+        assert d["predicted_error_deg"] <= d["estimated_error_deg"]
+    m = manifest(out)
+    assert m["adaptive"]["max_lights"] == 8 and m["adaptive"]["start_lights"] == 4
+    assert m["adaptive"]["result"]["lights_used"] == 8
+    assert m["adaptive"]["result"]["estimated_error_deg"] > 0
+    assert [s["decision"] for s in m["steps"]] == [s["decision"] for s in steps]
+    # lights.lp lists what actually fired, in order
+    fired = [tuple(s["actual_direction"]) for s in steps]
+    np.testing.assert_allclose([e.direction for e in read_lp(out / "lights.lp")], fired, atol=2e-6)
+
+
+def test_an_interrupted_adaptive_session_resumes_to_the_same_session(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    cfg, ref = uninterrupted
+    out = tmp_path / "cut"
+    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 5:
+            cancel.cancel()
+
+    with rig:
+        result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    assert result.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 6
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert (out / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+
+    def choices(session: Path) -> list[dict]:  # the decisions without their wall time
+        return [
+            {k: v for k, v in s["decision"].items() if k != "decision_s"} for s in journal(session)
+        ]
+
+    assert choices(out) == choices(ref)
+    for a, b in zip(journal(out), journal(ref), strict=True):
+        assert a["sha256"] == b["sha256"]  # the very same images
+
+
+def test_a_resumed_session_whose_images_changed_is_refused(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """Deterministic continuation is checked, not assumed: a session whose earlier decision
+    would now come out differently is refused, nothing moves."""
+    cfg, _ = uninterrupted
+    out = tmp_path / "cut"
+    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 5:
+            cancel.cancel()
+
+    with rig:
+        run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    m = manifest(out)
+    step = m["steps"][5]
+    step["planned_direction"] = [0.0, 0.6, 0.8]  # as if another decision had been taken
+    (out / "manifest.json").write_text(json.dumps(m))
+    lines = (out / "journal.jsonl").read_text().splitlines()
+    entry = json.loads(lines[5])
+    entry["planned_direction"] = [0.0, 0.6, 0.8]
+    lines[5] = json.dumps(entry)
+    (out / "journal.jsonl").write_text("\n".join(lines) + "\n")
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "step 6 was decided differently" in said(r)
+
+
+def test_until_error_stops_when_the_estimate_is_reached(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """The target is set between two estimates of the uninterrupted run (same decisions until
+    the stop), so the run must stop exactly at the first light whose estimate reaches it."""
+    cfg, ref = uninterrupted
+    est = {i: s["decision"]["estimated_error_deg"] for i, s in enumerate(journal(ref)) if i >= 4}
+    est[8] = manifest(ref)["adaptive"]["result"]["estimated_error_deg"]
+    k = next(i for i in range(5, 9) if est[i] < min(est[j] for j in range(4, i)))
+    target = (est[k] + min(est[j] for j in range(4, k))) / 2
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", str(target)])
+    assert r.exit_code == 0, r.output
+    m = manifest(out)
+    assert m["adaptive"]["result"]["lights_used"] == k
+    stop = m["adaptive"]["result"]["stop"]
+    assert stop["kind"] == "stop" and f"--until-error {target:g}" in stop["reason"]
+    assert stop["estimated_error_deg"] <= target
+    assert len(read_lp(out / "lights.lp")) == k
+    assert (out / "lights.lp").read_text().splitlines()[1:] == (
+        ref / "lights.lp"
+    ).read_text().splitlines()[1 : k + 1]
+    r = runner.invoke(app, ["run", "--resume", str(out)])  # it chose to stop: nothing to do
+    assert r.exit_code == 2
+    assert f"stopped after {k} of at most 12 lights (estimated error" in said(r)
+    # --lights and --until-error together: the first reached stops
+    out2 = tmp_path / "s2"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(out2), "--until-error", "0.0001", "--lights", "6"]
+    )
+    assert r.exit_code == 0, r.output
+    assert manifest(out2)["adaptive"]["result"]["lights_used"] == 6
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--until-error", "0"], "positive angle"),
+        (["--adaptive", "--lights", "4"], "at least 5"),
+    ],
+)
+def test_bad_requests_are_refused_before_anything_moves(
+    tmp_path: Path, args: list[str], fragment: str
+) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), *args])
+    assert r.exit_code == 2 and fragment in said(r)
+    assert not (tmp_path / "s").exists()
+
+
+def test_adaptive_on_an_arm_counts_move_time(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "virtual_arm.toml"),
+            "--out",
+            str(out),
+            "--adaptive",
+            "--lights",
+            "7",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    steps = journal(out)
+    assert len(steps) == 7
+    for s in steps[4:]:
+        best = s["decision"]["best_candidates"]
+        assert any(b["move_s"] > 0 for b in best)
+        np.testing.assert_allclose(s["planned_direction"], s["actual_direction"], atol=0.02)
+
+
+def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
+    acq = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(acq), "--out", str(out), "--adaptive", "--lights", "7"])
+    assert r.exit_code == 0, r.output
+    source = read_lp(acq)
+    for s in journal(out):
+        np.testing.assert_allclose(s["actual_direction"], source[s["led"]].direction, atol=1e-9)
+    assert manifest(out)["rig"]["backend"] == "replay"

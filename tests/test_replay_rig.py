@@ -1,0 +1,134 @@
+"""A recorded acquisition as a rig (`rti-rig run ACQ/dirs.lp`), and real `.lp` flaws tolerated.
+
+The replay rig must give back the source's images: for 16-bit sources the same linear TIFF
+bytes; for JPEG sources the same decoded pixels (the session's linear TIFF, encoded as the
+session encodes it, equals the decoded source JPEG).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+from rti_rig.simulator.replay import SRGB8_TO_LINEAR16
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.image_files import (
+    linear_to_srgb8,
+    read_jpeg_rgb,
+    read_linear_tiff,
+)
+from rti_rig.core.lp_format import read_lp
+from tests.conftest import SMALL_DOME, write_config
+
+REPO = Path(__file__).resolve().parent.parent
+ACQ = REPO / "tests" / "data" / "neuralrti_replay"
+runner = CliRunner()
+
+
+def _journal(session: Path) -> list[dict]:
+    return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]
+
+
+def test_srgb_table_round_trips_every_code() -> None:
+    codes = np.arange(256, dtype=np.uint8)
+    assert np.array_equal(linear_to_srgb8(SRGB8_TO_LINEAR16[codes], 65535), codes)
+    assert np.all(np.diff(SRGB8_TO_LINEAR16.astype(int)) > 0)  # monotone: it is a linearisation
+
+
+def test_replay_of_a_real_jpeg_acquisition_gives_its_decoded_pixels(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(ACQ / "dirs.lp"), "--out", str(out), "--lights", "6"])
+    assert r.exit_code == 0, r.output
+    assert "Session time on the real rig" in r.output
+    source = read_lp(ACQ / "dirs.lp")
+    steps = _journal(out)
+    assert len(steps) == 6 and len({s["led"] for s in steps}) == 6
+    fired = read_lp(out / "lights.lp")
+    for step, entry in zip(steps, fired, strict=True):
+        src = source[step["led"]]
+        decoded = read_jpeg_rgb(ACQ / src.name)
+        mine = linear_to_srgb8(read_linear_tiff(out / step["linear_image"]), 65535)
+        assert mine.shape == decoded.shape == (395, 402, 3)
+        assert np.array_equal(mine, decoded), src.name
+        np.testing.assert_allclose(entry.direction, src.direction, atol=2e-6)
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["rig"]["backend"] == "replay"
+
+
+def test_replay_of_a_16bit_acquisition_gives_byte_identical_linear_tiffs(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    first = tmp_path / "first"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(first)])
+    assert r.exit_code == 0, r.output
+    acq = first / "linear.lp"
+    r = runner.invoke(app, ["export-lp", str(first), "--out", str(acq), "--linear"])
+    assert r.exit_code == 0, r.output
+    again = tmp_path / "again"
+    r = runner.invoke(app, ["run", str(acq), "--out", str(again)])  # every light
+    assert r.exit_code == 0, r.output
+    names = [e.name for e in read_lp(acq)]
+    steps = _journal(again)
+    assert len(steps) == len(names) == 12
+    for step in steps:
+        src = (first / names[step["led"]]).read_bytes()
+        assert (again / step["linear_image"]).read_bytes() == src, names[step["led"]]
+
+
+def _flawed_acquisition(tmp_path: Path, count_line: str, z_of_line_4: str) -> Path:
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    lines = (acq / "dirs.lp").read_text().splitlines()
+    lines[0] = count_line
+    fields = lines[3].split()
+    fields[3] = z_of_line_4
+    lines[3] = " ".join(fields)
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
+    return acq / "dirs.lp"
+
+
+def test_real_flaws_are_tolerated_and_reported_by_plan_and_run(tmp_path: Path) -> None:
+    lp = _flawed_acquisition(tmp_path, "17", "-0.0012")
+    plan = tmp_path / "p.lp"
+    r = runner.invoke(
+        app, ["plan", "--rig", str(lp), "--lights", "6", "--method", "optimal", "--out", str(plan)]
+    )
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert f"{lp}, line 4: light z = -0.0" in text and "clamped to z = 0" in text
+    assert f"{lp}, line 1: count line says 17 lights but the file lists 18" in text
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--plan", str(plan)])
+    assert r.exit_code == 0, r.output
+    assert "clamped to z = 0" in " ".join(r.output.split())
+    assert len(read_lp(out / "lights.lp")) == 6
+
+
+def test_a_light_well_below_the_plane_is_refused_with_file_and_line(tmp_path: Path) -> None:
+    lp = _flawed_acquisition(tmp_path, "18", "-0.2")
+    for args in (
+        ["plan", "--rig", str(lp), "--lights", "6", "--out", str(tmp_path / "p.lp")],
+        ["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"],
+    ):
+        r = runner.invoke(app, args)
+        assert r.exit_code == 2, r.output
+        text = " ".join(r.output.split())
+        assert f"{lp}, line 4" in text and "below the object plane" in text
+        assert "Traceback" not in r.output
+    assert not (tmp_path / "s").exists()
+
+
+def test_an_acquisition_with_missing_images_is_refused_before_anything_runs(
+    tmp_path: Path,
+) -> None:
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    (acq / "image05.jpg").unlink()
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")])
+    assert r.exit_code == 2
+    text = " ".join(r.output.split())
+    assert "1 of 18 image(s) missing" in text and "image05.jpg" in text
+    assert not (tmp_path / "s").exists()
