@@ -28,7 +28,10 @@ from rti_rig.core.lp_format import read_lp
 from rti_rig.runtime.controller import run_session
 from rti_rig.runtime.session import SessionFolder
 
-pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
 runner = CliRunner()
 
 CONFIG = {
@@ -57,6 +60,7 @@ def eventually(predicate, timeout_s: float = 10.0) -> bool:  # type: ignore[no-u
     return True
 
 
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 @pytest.mark.parametrize("profile", PROBED)
 def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
     board = board_for(profile)
@@ -67,6 +71,7 @@ def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
         assert eventually(lambda: board.lit == frozenset())
 
 
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 def test_probe_says_plainly_when_nothing_known_answers() -> None:
     board = board_for("rti-dome-m")  # never answers anything
     with serve_on_pty(board, "silent") as link:
@@ -77,6 +82,7 @@ def test_probe_says_plainly_when_nothing_known_answers() -> None:
     assert board.lit == frozenset()
 
 
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 @pytest.mark.parametrize("profile", list(CONFIG))
 def test_check_passes_on_each_firmware(profile: str) -> None:
     r = runner.invoke(app, ["check", str(CONFIGS / CONFIG[profile])])
@@ -85,6 +91,7 @@ def test_check_passes_on_each_firmware(profile: str) -> None:
     assert "lights:" in r.output
 
 
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 @pytest.mark.parametrize("profile", list(CONFIG))
 def test_session_of_8_lights_has_the_scheduled_led_lit_at_every_capture(
     profile: str, tmp_path: Path
@@ -117,6 +124,7 @@ def test_session_of_8_lights_has_the_scheduled_led_lit_at_every_capture(
         assert eventually(lambda: board.lit == frozenset())
 
 
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 @pytest.mark.parametrize("profile", ["nab-rti-v1", "minirti"])
 def test_cli_run_8_lights(profile: str, tmp_path: Path) -> None:
     out = tmp_path / "s"
