@@ -80,62 +80,12 @@ def _check_output_file(
         raise RtiRigError(f"{option} {out_file} exists; use --force to replace it")
 
 
-def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
-    from rti_rig.core.rig_geometry import DomeGeometry
-
-    cfg = loaded.config
-    if isinstance(geometry, DomeGeometry):
-        assert cfg.dome is not None
-        return cfg.dome.default_lights or geometry.count
-    assert cfg.arm is not None
-    return cfg.arm.default_lights
-
-
-def _check_max_saturated(max_saturated: float) -> None:
-    if not 0.0 <= max_saturated < 1.0:
-        raise RtiRigError(
-            f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
-            "e.g. 0.001 for 0.1 %"
-        )
-
-
-def _checked_rig(loaded, schedule):  # type: ignore[no-untyped-def]
-    """The rig, opened, with ``schedule`` checked against it before anything moves.
-
-    The rig is closed (lights off, arm stopped) if the check fails, whatever the exception.
-    """
-    from rti_rig.app.compose import build_rig
-    from rti_rig.runtime.controller import validate_schedule
-
-    rig = build_rig(loaded)
-    try:
-        validate_schedule(rig, schedule)
-    except BaseException:
-        rig.close()
-        raise
-    return rig
-
-
-def _open_new_session(  # type: ignore[no-untyped-def]
-    loaded, schedule, out_dir: Path, auto_exposure: bool, max_saturated: float
-):
-    """Check the folder, open and check the rig, meter if asked, make the folder.
-
-    The folder is checked first, so nothing lights or moves for a session that could not be
-    written; the rig is closed if anything after opening it fails, whatever the exception.
-    """
-    from rti_rig.runtime.session import SessionFolder
-
-    SessionFolder.check_new(out_dir)
-    rig = _checked_rig(loaded, schedule)
-    try:
-        if auto_exposure:
-            schedule = _fix_exposure(rig, schedule, max_saturated)
-        folder = SessionFolder.create(out_dir, len(schedule))
-    except BaseException:
-        rig.close()
-        raise
-    return rig, schedule, folder
+def _print_note(note) -> None:  # type: ignore[no-untyped-def]
+    """Show a use case's note: information on stdout, warnings on stderr."""
+    if note.level == "warning":
+        err.print(f"[yellow]note:[/] {escape(note.text)}", soft_wrap=True)
+    else:
+        out.print(note.text, highlight=False, markup=False)
 
 
 @app.command()
@@ -202,104 +152,52 @@ def run(
     pauses or resumes between images. An interrupted session can be
     continued with --resume.
     """
-    from rti_rig.app.compose import arm_order_for
-    from rti_rig.app.config import load_rig_config, rig_geometry
-    from rti_rig.core.lp_format import read_lp
-    from rti_rig.core.schedule import LightSchedule
-    from rti_rig.planner.from_lp import schedule_from_lp
-    from rti_rig.planner.make_plan import check_elevation_band
-    from rti_rig.planner.uniform import plan_uniform
-    from rti_rig.runtime.session import SessionFolder
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        ResumeRequest,
+        open_new_session,
+        open_resumed_session,
+    )
 
     try:
-        _check_max_saturated(max_saturated)
         if resume is not None:
             if out_dir is not None or plan is not None or lights is not None:
                 raise RtiRigError(
                     "--resume continues a session as planned: drop --out, --plan, --lights"
                 )
-            folder = SessionFolder.reopen(resume)
-            manifest = folder.manifest
-            config_path = rig_config or Path(manifest["rig"]["config_path"])
-            loaded = load_rig_config(config_path)
-            if loaded.sha256 != manifest["rig"].get("config_sha256"):
-                err.print(
-                    f"[yellow]note:[/] {escape(str(config_path))} has changed since the session "
-                    "began; the remaining steps are checked against it before anything moves."
-                )
-            schedule = LightSchedule.from_dict(manifest["schedule"])
-            out_dir = resume
-            done = len(folder.done)
-            out.print(
-                f"Resuming {resume}: {done} of {len(schedule)} images verified on disk"
-                + (
-                    f", {len(folder.resume.recovered)} unverified file(s) moved to recovered/"
-                    if folder.resume and folder.resume.recovered
-                    else ""
-                )
+            opened = open_resumed_session(
+                ResumeRequest(resume, rig_config, max_saturated=max_saturated), _print_note
             )
-            rig = _checked_rig(loaded, schedule)
         else:
             if rig_config is None or out_dir is None:
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
-            loaded = load_rig_config(rig_config)
-            geometry = rig_geometry(loaded)
-            if plan is not None:
-                if lights is not None:
-                    raise RtiRigError("give either --plan or --lights, not both")
-                schedule = schedule_from_lp(
-                    read_lp(plan, upper_hemisphere=True), geometry, str(plan)
-                )
-            else:
-                check_elevation_band(min_elevation_deg, max_elevation_deg)
-                n = lights if lights is not None else _default_lights(loaded, geometry)
-                schedule = plan_uniform(
-                    geometry, n, min_elevation_deg, arm_order_for(loaded), max_elevation_deg
-                )
-            rig, schedule, folder = _open_new_session(
-                loaded, schedule, out_dir, auto_exposure, max_saturated
+            opened = open_new_session(
+                NewSessionRequest(
+                    rig_config,
+                    out_dir,
+                    lights=lights,
+                    plan=plan,
+                    min_elevation_deg=min_elevation_deg,
+                    max_elevation_deg=max_elevation_deg,
+                    auto_exposure=auto_exposure,
+                    max_saturated=max_saturated,
+                ),
+                _print_note,
             )
     except RtiRigError as exc:
         raise _fail(exc) from None
-    with rig:
-        _execute(rig, schedule, folder, out_dir)
+    _execute(opened)
 
 
-def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyped-def]
-    """Meter the session's exposure with the camera driver layer's test series."""
-    from rti_rig.drivers.cameras.exposure import meter_exposure
-    from rti_rig.drivers.cameras.settings import ExposureRule
-    from rti_rig.runtime.exposure_policy import fix_session_exposure
-
-    cam = rig.camera_config
-    rule = ExposureRule(
-        max_saturated_fraction=max_saturated,
-        headroom=1.25,  # other planned lights may be a little brighter than the metered one
-        min_exposure_s=cam.min_exposure_s,
-        max_exposure_s=cam.max_exposure_s,
-    )
-
-    def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
-        shutter = getattr(camera, "available_exposures_s", None)
-        return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
-
-    fixed = fix_session_exposure(rig, schedule, meter)
-    chosen = fixed.provenance["exposure"]
-    out.print(
-        f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})", highlight=False
-    )
-    return fixed
-
-
-def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-untyped-def]
+def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on."""
+    from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
         CancelToken,
         EmergencyStop,
         FinishReason,
         Paused,
         StepCompleted,
-        run_session,
     )
     from rti_rig.runtime.session import LP_NAME
 
@@ -326,10 +224,10 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
     if hasattr(signal, "SIGUSR1"):
         handlers[signal.SIGUSR1] = on_sigusr1
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
-    dry = " (dry run)" if rig.loaded.config.backend != "hardware" else ""
-    todo = len(schedule) - len(folder.done)
+    rig, schedule, folder, out_dir = opened.rig, opened.schedule, opened.folder, opened.out_dir
+    dry = " (dry run)" if opened.dry_run else ""
     out.print(
-        f"Rig [bold]{escape(rig.name)}[/]{dry}: {todo} of {len(schedule)} lights → "
+        f"Rig [bold]{escape(rig.name)}[/]{dry}: {opened.steps_to_do} of {len(schedule)} lights → "
         f"{escape(str(out_dir))}"
     )
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
@@ -349,7 +247,7 @@ def _execute(rig, schedule, folder, out_dir: Path) -> None:  # type: ignore[no-u
                 elif isinstance(event, Paused):
                     progress.update(task, description="paused")
 
-            result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event)
+            result = run_opened_session(opened, cancel, on_event)
     except EmergencyStop as exc:
         err.print(
             f"[red]Emergency stop ({escape(str(exc))}):[/] lights off, devices safe; images kept."
@@ -415,23 +313,22 @@ def preview(
     The session records the light that fired, so `rti-rig plan OUT_DIR --rig RIG ...` plans from
     its linear image with that light (no --preview-light needed).
     """
-    from rti_rig.app.config import load_rig_config, rig_geometry
-    from rti_rig.planner.preview_shot import preview_schedule
+    from rti_rig.app.usecases.session import PreviewRequest, open_preview_session
 
     try:
-        _check_max_saturated(max_saturated)
-        az_el = _parse_az_el(light, "--light")
-        loaded = load_rig_config(rig_config)
-        schedule, notes = preview_schedule(rig_geometry(loaded), az_el)
-        for note in notes:
-            err.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
-        rig, schedule, folder = _open_new_session(
-            loaded, schedule, out_dir, auto_exposure, max_saturated
+        opened = open_preview_session(
+            PreviewRequest(
+                rig_config,
+                out_dir,
+                _parse_az_el(light, "--light"),
+                auto_exposure=auto_exposure,
+                max_saturated=max_saturated,
+            ),
+            _print_note,
         )
     except RtiRigError as exc:
         raise _fail(exc) from None
-    with rig:
-        _execute(rig, schedule, folder, out_dir)
+    _execute(opened)
     out.print(
         f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
         f"{shlex.quote(str(rig_config))} --lights N --out plan.lp",

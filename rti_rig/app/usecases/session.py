@@ -1,0 +1,294 @@
+"""Capture sessions as use cases: start one, resume one, shoot a preview, run what was opened.
+
+Everything that can be checked is checked here, once, before anything moves: the options, the
+light count, the session folder, then the rig is opened and the schedule checked against it. The
+CLI only parses its options into a request, calls these functions and prints what they report.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.schedule import LightSchedule
+from rti_rig.runtime.controller import (
+    CancelToken,
+    Event,
+    SessionResult,
+    run_session,
+    validate_schedule,
+)
+from rti_rig.runtime.rig import Rig
+from rti_rig.runtime.session import SessionFolder
+
+
+@dataclass(frozen=True)
+class Note:
+    """A message for the user while a session is being opened.
+
+    ``level`` is ``"info"`` (what happens: the exposure chosen, what resume found) or
+    ``"warning"`` (something the user should know before the lights come on).
+    """
+
+    text: str
+    level: str = "info"
+
+
+NoteSink = Callable[[Note], None]
+
+
+def _ignore(_note: Note) -> None:
+    pass
+
+
+@dataclass(frozen=True)
+class NewSessionRequest:
+    """Start a session of a homogeneous layout (``lights``) or of a plan (``plan``, an .lp)."""
+
+    rig_config: Path
+    out_dir: Path
+    lights: int | None = None
+    plan: Path | None = None
+    min_elevation_deg: float = 0.0
+    max_elevation_deg: float = 90.0
+    auto_exposure: bool = False
+    max_saturated: float = 0.001
+
+
+@dataclass(frozen=True)
+class ResumeRequest:
+    """Continue an interrupted session; ``rig_config`` defaults to the session's own."""
+
+    session_dir: Path
+    rig_config: Path | None = None
+    max_saturated: float = 0.001
+
+
+@dataclass(frozen=True)
+class PreviewRequest:
+    """Shoot one image under one light (``light_az_el_deg``; default: the planner's choice)."""
+
+    rig_config: Path
+    out_dir: Path
+    light_az_el_deg: tuple[float, float] | None = None
+    auto_exposure: bool = False
+    max_saturated: float = 0.001
+
+
+@dataclass
+class OpenedSession:
+    """A rig opened and checked, its schedule, and the session folder to write into.
+
+    Use it as a context manager (or pass it to :func:`run_opened_session`) so the rig is
+    closed whatever happens.
+    """
+
+    rig: Rig
+    schedule: LightSchedule
+    folder: SessionFolder
+    out_dir: Path
+    resumed: bool = False
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def dry_run(self) -> bool:
+        return self.rig.loaded.config.backend != "hardware"
+
+    @property
+    def steps_done_before(self) -> int:
+        """Images verified on disk before this run (a resumed session's)."""
+        return len(self.folder.done)
+
+    @property
+    def steps_to_do(self) -> int:
+        return len(self.schedule) - self.steps_done_before
+
+    def close(self) -> None:
+        self.rig.close()
+
+    def __enter__(self) -> OpenedSession:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def check_max_saturated(max_saturated: float) -> None:
+    if not 0.0 <= max_saturated < 1.0:
+        raise RtiRigError(
+            f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
+            "e.g. 0.001 for 0.1 %"
+        )
+
+
+def default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
+    """The light count a run uses without ``--lights``: every LED of a dome (or its
+    ``default_lights``), the arm's ``default_lights``."""
+    from rti_rig.core.rig_geometry import DomeGeometry
+
+    cfg = loaded.config
+    if isinstance(geometry, DomeGeometry):
+        assert cfg.dome is not None
+        return int(cfg.dome.default_lights or geometry.count)
+    assert cfg.arm is not None
+    return int(cfg.arm.default_lights)
+
+
+def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-untyped-def]
+    """The rig, opened, with ``schedule`` checked against it before anything moves.
+
+    The rig is closed (lights off, arm stopped) if the check fails, whatever the exception.
+    """
+    from rti_rig.app.compose import build_rig
+
+    rig = build_rig(loaded)
+    try:
+        validate_schedule(rig, schedule)
+    except BaseException:
+        rig.close()
+        raise
+    return rig
+
+
+def fix_exposure(
+    rig: Rig, schedule: LightSchedule, max_saturated: float, on_note: NoteSink = _ignore
+) -> LightSchedule:
+    """Meter the session's exposure with the camera driver layer's test series."""
+    from rti_rig.drivers.cameras.exposure import meter_exposure
+    from rti_rig.drivers.cameras.settings import ExposureRule
+    from rti_rig.runtime.exposure_policy import fix_session_exposure
+
+    cam = rig.camera_config
+    rule = ExposureRule(
+        max_saturated_fraction=max_saturated,
+        headroom=1.25,  # other planned lights may be a little brighter than the metered one
+        min_exposure_s=cam.min_exposure_s,
+        max_exposure_s=cam.max_exposure_s,
+    )
+
+    def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
+        shutter = getattr(camera, "available_exposures_s", None)
+        return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
+
+    fixed = fix_session_exposure(rig, schedule, meter)
+    chosen = fixed.provenance["exposure"]
+    on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})"))
+    return fixed
+
+
+def _open_new(
+    loaded,  # type: ignore[no-untyped-def]
+    schedule: LightSchedule,
+    out_dir: Path,
+    auto_exposure: bool,
+    max_saturated: float,
+    on_note: NoteSink,
+) -> OpenedSession:
+    """Check the folder, open and check the rig, meter if asked, make the folder.
+
+    The folder is checked first, so nothing lights or moves for a session that could not be
+    written; the rig is closed if anything after opening it fails, whatever the exception.
+    """
+    SessionFolder.check_new(out_dir)
+    rig = checked_rig(loaded, schedule)
+    try:
+        if auto_exposure:
+            schedule = fix_exposure(rig, schedule, max_saturated, on_note)
+        folder = SessionFolder.create(out_dir, len(schedule))
+    except BaseException:
+        rig.close()
+        raise
+    return OpenedSession(rig, schedule, folder, Path(out_dir))
+
+
+def new_session_schedule(req: NewSessionRequest, loaded) -> LightSchedule:  # type: ignore[no-untyped-def]
+    """The schedule a new session runs: the plan's, or a homogeneous layout."""
+    from rti_rig.app.compose import arm_order_for
+    from rti_rig.app.config import rig_geometry
+    from rti_rig.core.lp_format import read_lp
+    from rti_rig.planner.from_lp import schedule_from_lp
+    from rti_rig.planner.make_plan import check_elevation_band
+    from rti_rig.planner.uniform import plan_uniform
+
+    geometry = rig_geometry(loaded)
+    if req.plan is not None:
+        if req.lights is not None:
+            raise RtiRigError("give either --plan or --lights, not both")
+        return schedule_from_lp(read_lp(req.plan, upper_hemisphere=True), geometry, str(req.plan))
+    check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
+    n = req.lights if req.lights is not None else default_lights(loaded, geometry)
+    return plan_uniform(
+        geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
+    )
+
+
+def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """Check a new session's request, open and check the rig, and prepare its folder."""
+    from rti_rig.app.config import load_rig_config
+
+    check_max_saturated(req.max_saturated)
+    loaded = load_rig_config(req.rig_config)
+    schedule = new_session_schedule(req, loaded)
+    return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+
+
+def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """Verify an interrupted session on disk, open its rig and check the remaining steps."""
+    from rti_rig.app.config import load_rig_config
+
+    check_max_saturated(req.max_saturated)
+    folder = SessionFolder.reopen(req.session_dir)
+    manifest = folder.manifest
+    config_path = req.rig_config or Path(manifest["rig"]["config_path"])
+    loaded = load_rig_config(config_path)
+    if loaded.sha256 != manifest["rig"].get("config_sha256"):
+        on_note(
+            Note(
+                f"{config_path} has changed since the session began; the remaining steps are "
+                "checked against it before anything moves.",
+                "warning",
+            )
+        )
+    schedule = LightSchedule.from_dict(manifest["schedule"])
+    done = len(folder.done)
+    recovered = folder.resume.recovered if folder.resume else []
+    on_note(
+        Note(
+            f"Resuming {req.session_dir}: {done} of {len(schedule)} images verified on disk"
+            + (f", {len(recovered)} unverified file(s) moved to recovered/" if recovered else "")
+        )
+    )
+    rig = checked_rig(loaded, schedule)
+    return OpenedSession(rig, schedule, folder, Path(req.session_dir), resumed=True)
+
+
+def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """A one-image session under the preview light (the planner's input)."""
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.planner.preview_shot import preview_schedule
+
+    check_max_saturated(req.max_saturated)
+    loaded = load_rig_config(req.rig_config)
+    schedule, notes = preview_schedule(rig_geometry(loaded), req.light_az_el_deg)
+    for note in notes:
+        on_note(Note(note, "warning"))
+    return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+
+
+def run_opened_session(
+    opened: OpenedSession,
+    cancel: CancelToken | None = None,
+    on_event: Callable[[Event], None] | None = None,
+) -> SessionResult:
+    """Run an opened session to its end (or cancel / error); the rig is closed afterwards.
+
+    The controller's guarantees hold: devices are put in their safe state and the session's
+    `.lp` and manifest are written from what is on disk, whatever happens.
+    """
+    with opened:
+        return run_session(
+            opened.rig, opened.schedule, opened.folder, cancel=cancel, on_event=on_event
+        )
