@@ -141,9 +141,17 @@ def run(
         typer.Option(
             "--resume",
             help="Continue an interrupted session folder: verify what is on disk and capture "
-            "only the steps not yet done.",
+            "only the steps not yet done (on the rig the session began on).",
         ),
     ] = None,
+    accept_rig_change: Annotated[
+        bool,
+        typer.Option(
+            "--accept-rig-change",
+            help="With --resume: go on although the rig differs from the session's (a "
+            "repaired LED, a new exposure); the change is recorded in the manifest.",
+        ),
+    ] = False,
 ) -> None:
     """Run a capture session (a dry run when the config's backend is 'simulated').
 
@@ -166,11 +174,19 @@ def run(
                     "--resume continues a session as planned: drop --out, --plan, --lights"
                 )
             opened = open_resumed_session(
-                ResumeRequest(resume, rig_config, max_saturated=max_saturated), _print_note
+                ResumeRequest(
+                    resume,
+                    rig_config,
+                    max_saturated=max_saturated,
+                    accept_rig_change=accept_rig_change,
+                ),
+                _print_note,
             )
         else:
             if rig_config is None or out_dir is None:
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
+            if accept_rig_change:
+                raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
             opened = open_new_session(
                 NewSessionRequest(
                     rig_config,
@@ -187,6 +203,22 @@ def run(
     except RtiRigError as exc:
         raise _fail(exc) from None
     _execute(opened)
+
+
+def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
+    """What a stopped session left on disk and how to go on (never a resume hint for nothing)."""
+    from rti_rig.runtime.session import LP_NAME
+
+    folder, out_dir = opened.folder, opened.out_dir
+    if folder.images_kept:
+        return (
+            f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}. {resume_hint}"
+        )
+    if opened.resumed:
+        return f"No new image was captured. {resume_hint}"
+    if folder.begun:
+        return f"Nothing was captured: {out_dir} holds no image and may be used again."
+    return f"Nothing was captured and nothing was written to {out_dir}."
 
 
 def _execute(opened) -> None:  # type: ignore[no-untyped-def]
@@ -252,13 +284,10 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         err.print(
             f"[red]Emergency stop ({escape(str(exc))}):[/] lights off, devices safe; images kept."
         )
-        err.print(resume_hint)
+        err.print(_after_stop(opened, resume_hint), markup=False, soft_wrap=True)
         raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:
-        err.print(
-            f"Images already captured are kept in {out_dir}; lights are off. {resume_hint}",
-            markup=False,
-        )
+        err.print(f"Lights are off. {_after_stop(opened, resume_hint)}", markup=False)
         raise _fail(exc) from None
     finally:
         for sig, h in previous.items():
@@ -647,16 +676,23 @@ def export_lp(
     ] = False,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
-    """Write the .lp of a session (from the lights that actually fired)."""
+    """Write the .lp of a session from its verified journal: the lights that actually fired,
+    for every image on disk as captured (an interrupted session's too)."""
     from rti_rig.core.lp_format import write_lp
-    from rti_rig.runtime.session import session_lp_entries
+    from rti_rig.runtime.session import session_lp_report
 
     try:
-        entries = session_lp_entries(session_dir, linear=linear)
+        entries, left_out = session_lp_report(session_dir, linear=linear)
         _check_output_file(out_file, force, {})
         write_lp(out_file, entries)
     except RtiRigError as exc:
         raise _fail(exc) from None
+    if left_out:
+        err.print(
+            f"[yellow]note:[/] left out, missing or changed since they were captured: "
+            f"{escape(', '.join(left_out))}",
+            soft_wrap=True,
+        )
     out.print(f"{len(entries)} lights → {out_file}")
 
 

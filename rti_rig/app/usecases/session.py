@@ -60,11 +60,17 @@ class NewSessionRequest:
 
 @dataclass(frozen=True)
 class ResumeRequest:
-    """Continue an interrupted session; ``rig_config`` defaults to the session's own."""
+    """Continue an interrupted session; ``rig_config`` defaults to the session's own.
+
+    The rig must be the one the session began on (see :mod:`rti_rig.app.rig_identity`); a
+    deliberate change (a repaired LED, a new exposure) needs ``accept_rig_change`` and is
+    recorded in the manifest's run.
+    """
 
     session_dir: Path
     rig_config: Path | None = None
     max_saturated: float = 0.001
+    accept_rig_change: bool = False
 
 
 @dataclass(frozen=True)
@@ -137,6 +143,24 @@ def default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
     return int(cfg.arm.default_lights)
 
 
+class RigChangedError(RtiRigError):
+    """A resume was asked on a rig whose images would not match the session's."""
+
+
+def check_light_count(n: int) -> None:
+    """Refuse a light count no session can run, before any layout is built, on every rig
+    (the planner names a dome's own limit, its LED count)."""
+    from rti_rig.core.lp_format import MAX_LIGHTS
+
+    if n < 1:
+        raise RtiRigError(f"--lights {n}: give at least 1 light")
+    if n > MAX_LIGHTS:
+        raise RtiRigError(
+            f"--lights {n}: at most {MAX_LIGHTS} lights per session (the most an .lp file may "
+            "list for readers such as relight)"
+        )
+
+
 def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-untyped-def]
     """The rig, opened, with ``schedule`` checked against it before anything moves.
 
@@ -192,12 +216,16 @@ def _open_new(
     The folder is checked first, so nothing lights or moves for a session that could not be
     written; the rig is closed if anything after opening it fails, whatever the exception.
     """
+    from rti_rig.app.rig_identity import rig_identity
+
     SessionFolder.check_new(out_dir)
+    identity = rig_identity(loaded)
     rig = checked_rig(loaded, schedule)
     try:
         if auto_exposure:
             schedule = fix_exposure(rig, schedule, max_saturated, on_note)
         folder = SessionFolder.create(out_dir, len(schedule))
+        folder.rig_identity = identity
     except BaseException:
         rig.close()
         raise
@@ -217,9 +245,12 @@ def new_session_schedule(req: NewSessionRequest, loaded) -> LightSchedule:  # ty
     if req.plan is not None:
         if req.lights is not None:
             raise RtiRigError("give either --plan or --lights, not both")
-        return schedule_from_lp(read_lp(req.plan, upper_hemisphere=True), geometry, str(req.plan))
+        entries = read_lp(req.plan, upper_hemisphere=True)
+        check_light_count(len(entries))
+        return schedule_from_lp(entries, geometry, str(req.plan))
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
+    check_light_count(n)
     return plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )
@@ -235,32 +266,87 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
 
 
-def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
-    """Verify an interrupted session on disk, open its rig and check the remaining steps."""
-    from rti_rig.app.config import load_rig_config
+def check_resume_rig(
+    manifest: dict[str, Any], loaded, config_path: Path, accept_change: bool, on_note: NoteSink
+) -> tuple[dict[str, Any], list[str]]:  # type: ignore[no-untyped-def]
+    """The rig's identity, checked against the session's; the differences the user accepted.
 
-    check_max_saturated(req.max_saturated)
-    folder = SessionFolder.reopen(req.session_dir)
-    manifest = folder.manifest
-    config_path = req.rig_config or Path(manifest["rig"]["config_path"])
-    loaded = load_rig_config(config_path)
-    if loaded.sha256 != manifest["rig"].get("config_sha256"):
+    Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``.
+    """
+    from rti_rig.app.rig_identity import identity_differences, rig_identity
+
+    identity = rig_identity(loaded)
+    recorded = (manifest.get("rig") or {}).get("identity")
+    if recorded is None:  # a session from before identities were recorded
+        if loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
+            on_note(
+                Note(
+                    f"{config_path} has changed since the session began; the remaining steps "
+                    "are checked against it before anything moves.",
+                    "warning",
+                )
+            )
+        return identity, []
+    diffs = identity_differences(recorded, identity)
+    if diffs and not accept_change:
+        raise RigChangedError(
+            f"{config_path} does not describe the rig this session began on ("
+            + "; ".join(diffs)
+            + "): its images would not match the ones already taken. Resume with the "
+            "session's own config (rti-rig run --resume DIR), or, if the change is deliberate "
+            "(a repaired LED, a new exposure), add --accept-rig-change to record it"
+        )
+    if diffs:
+        on_note(Note("rig change accepted and recorded: " + "; ".join(diffs), "warning"))
+    elif loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
         on_note(
             Note(
-                f"{config_path} has changed since the session began; the remaining steps are "
-                "checked against it before anything moves.",
+                f"{config_path} has been edited since the session began, in nothing the images "
+                "depend on (kind, lights, camera, exposure, decoding are the same).",
                 "warning",
             )
         )
-    schedule = LightSchedule.from_dict(manifest["schedule"])
+    return identity, diffs
+
+
+def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """Check the rig against the session, verify and repair the session on disk, open the
+    rig and check the remaining steps on it.
+
+    The rig is checked from the manifest alone (nothing in the folder changes if it is
+    refused); only then is the journal repaired and anything unverified set aside.
+    """
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.runtime.session import read_manifest
+
+    check_max_saturated(req.max_saturated)
+    manifest = read_manifest(req.session_dir)
+    rig_entry = manifest.get("rig") or {}
+    if req.rig_config is None and not rig_entry.get("config_path"):
+        raise RtiRigError(
+            f"{req.session_dir}: the manifest does not say which rig config it was shot with; "
+            "give it: rti-rig run RIG.toml --resume DIR"
+        )
+    config_path = req.rig_config or Path(rig_entry["config_path"])
+    loaded = load_rig_config(config_path)
+    identity, diffs = check_resume_rig(
+        manifest, loaded, config_path, req.accept_rig_change, on_note
+    )
+    folder = SessionFolder.reopen(req.session_dir)
+    folder.rig_identity = identity
+    folder.rig_change = diffs or None
+    schedule = LightSchedule.from_dict(folder.manifest["schedule"])
     done = len(folder.done)
-    recovered = folder.resume.recovered if folder.resume else []
+    resume = folder.resume
+    recovered = resume.recovered if resume else []
     on_note(
         Note(
             f"Resuming {req.session_dir}: {done} of {len(schedule)} images verified on disk"
             + (f", {len(recovered)} unverified file(s) moved to recovered/" if recovered else "")
         )
     )
+    for line in resume.journal_repair if resume else []:
+        on_note(Note(f"{line}: set aside in recovered/, not appended onto", "warning"))
     rig = checked_rig(loaded, schedule)
     return OpenedSession(rig, schedule, folder, Path(req.session_dir), resumed=True)
 
