@@ -297,14 +297,24 @@ def main() -> None:
     )
     ap.add_argument("--sessions", type=int, default=200)
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--out", type=Path, default=REPO / "docs" / "reliability.md")
+    ap.add_argument(
+        "--out", type=Path, default=None, help="write the report to this file (default: print only)"
+    )
+    ap.add_argument(
+        "--write",
+        action="store_true",
+        help="write the report to the repository's docs/reliability.md",
+    )
     args = ap.parse_args()
+    out = args.out or (REPO / "docs" / "reliability.md" if args.write else None)
     t0 = time.perf_counter()
     result = campaign(args.sessions, args.seed)
     text = report(result, args.sessions, args.seed, time.perf_counter() - t0)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text)
     print(text)
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(text)
+        print(f"report → {out}")
 
 
 if __name__ == "__main__":

@@ -890,13 +890,21 @@ app.add_typer(bench_app, name="bench")
 @bench_app.command("tradeoff")
 def bench_tradeoff(
     out_dir: Annotated[
-        Path, typer.Option("--out", help="Folder for results.csv, the plots and summary.md.")
-    ] = Path("docs/tradeoff"),
+        Path | None,
+        typer.Option(
+            "--out",
+            help="Folder to write results.csv, the plots and summary.md into (the repository's "
+            "committed results are docs/tradeoff). Without it the summary is only printed.",
+        ),
+    ] = None,
     quick: Annotated[
         bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
     ] = False,
 ) -> None:
-    """Error against number of lights and session time, for every planner, on simulated scenes."""
+    """Error against number of lights and session time, for every planner, on simulated scenes.
+
+    Nothing is written unless --out is given, so a quick run never replaces the committed
+    full-run results."""
     import time
 
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
@@ -904,13 +912,18 @@ def bench_tradeoff(
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()
     t0 = time.perf_counter()
     rows = run_tradeoff(settings, progress=lambda msg: out.print(msg, highlight=False))
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_csv(rows, out_dir / "results.csv")
-    plot(rows, out_dir)
-    command = "rti-rig bench tradeoff" + (" --quick" if quick else "") + f" --out {out_dir}"
+    command = "rti-rig bench tradeoff" + (" --quick" if quick else "")
+    if out_dir is not None:
+        command += f" --out {out_dir}"
     text = summarise(rows, settings, time.perf_counter() - t0, command)
-    (out_dir / "summary.md").write_text(text, encoding="utf-8")
+    if out_dir is not None:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        write_csv(rows, out_dir / "results.csv")
+        plot(rows, out_dir)
+        (out_dir / "summary.md").write_text(text, encoding="utf-8")
     out.print(text, highlight=False)
+    if out_dir is None:
+        out.print("(nothing written: give --out DIR to keep the results)", highlight=False)
 
 
 def main() -> None:
