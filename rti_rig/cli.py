@@ -41,6 +41,27 @@ err = Console(stderr=True)
 out = Console()
 
 
+def _flags_show_no_type() -> None:
+    """Show on/off flags in help without a value type: typer 0.29 labels them ``<bool>``, as if
+    ``--force`` took a value (it takes none). Every command's flags at once, in one place."""
+    from typer.core import TyperOption
+
+    original = TyperOption.display_type_rich
+    if getattr(original, "_rti_rig", False):
+        return
+
+    def display_type_rich(self, ctx):  # type: ignore[no-untyped-def]
+        if getattr(self, "is_flag", False) and self.metavar is None:
+            return None
+        return original(self, ctx)
+
+    display_type_rich._rti_rig = True  # type: ignore[attr-defined]
+    TyperOption.display_type_rich = display_type_rich  # type: ignore[method-assign]
+
+
+_flags_show_no_type()
+
+
 def _fail(exc: RtiRigError) -> typer.Exit:
     # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
     err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
@@ -803,11 +824,30 @@ def calibrate_lights(
         f"'{escape(loaded.config.name)}'; {len(measured)} of {geometry.count} LEDs measured "
         f"(lowest {lowest:.1f}° above the card)."
     )
-    out.print(
-        f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light from "
-        f"{cal.output[weak]:.2f} (LED {weak}, {escape(names[weak])}) to {cal.output[strong]:.2f} "
-        f"(LED {strong}, {escape(names[strong])}) of the median."
-    )
+    in_force = card.correction is not None
+    #: what is left after a correction in force that needs no further calibration
+    even_enough = 0.01
+    if in_force:
+        # a re-shot card under the correction: the spread as shot is what is left, the LEDs'
+        # own (uncorrected) outputs are the same as before, which is no failure
+        change = float(np.max(np.abs(cal.correction / np.maximum(cal.previous, 1e-9) - 1.0)))
+        out.print(
+            f"Lights as shot, with the intensity correction in force: spread "
+            f"{100 * cal.shot_spread:.1f} % RMS"
+            + (" — the dome is even." if cal.shot_spread < even_enough else ".")
+        )
+        out.print(
+            f"Each LED's own light, without the correction, is still {cal.output[weak]:.2f} "
+            f"(LED {weak}, {escape(names[weak])}) to {cal.output[strong]:.2f} "
+            f"(LED {strong}, {escape(names[strong])}) of the median; the new correction "
+            f"differs from the one in force by at most {100 * change:.1f} %."
+        )
+    else:
+        out.print(
+            f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light "
+            f"from {cal.output[weak]:.2f} (LED {weak}, {escape(names[weak])}) to "
+            f"{cal.output[strong]:.2f} (LED {strong}, {escape(names[strong])}) of the median."
+        )
     out.print(
         f"Evened out, every LED gives {cal.evened_light:.2f} of the median LED's light "
         f"({cal.stops_lost:.2f} stop(s) more exposure)."
@@ -831,11 +871,23 @@ def calibrate_lights(
     )
     rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
     out.print(f"Calibration → {escape(str(target))}")
-    out.print(
-        f"To use it, add under {escape('[dome.serial]')} in {escape(str(rig_config))}:  "
-        f'intensity_correction_file = "{escape(rel)}"\n'
-        "Then shoot the card again and calibrate that session: its spread is what is left."
-    )
+    if in_force and cal.shot_spread < even_enough:
+        out.print(
+            "The correction in force is good: no new calibration is needed. To use this "
+            f"one instead, set under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            highlight=False,
+        )
+    else:
+        out.print(
+            f"To use it, add under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            highlight=False,
+        )
+    # the line to paste, on its own and never wrapped (a wrapped line pastes as two)
+    out.print(f'intensity_correction_file = "{rel}"', markup=False, highlight=False, soft_wrap=True)
+    if not (in_force and cal.shot_spread < even_enough):
+        out.print(
+            "Then shoot the card again and calibrate that session: its spread is what is left."
+        )
 
 
 @app.command()
