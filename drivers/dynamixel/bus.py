@@ -98,6 +98,9 @@ class DxlBus:
                 what,
                 comm_text(self.ph, reply[-2]),
             )
+            if reply[-2] == sdk.COMM_RX_TIMEOUT:
+                # a reply that was only late must not be read as the answer to a later command
+                self.drain_reply()
             reply = call()
         return reply
 
