@@ -288,6 +288,12 @@ class SessionFolder:
                 run["rig_change"] = self.rig_change
             if self.rig_identity is not None:
                 self.manifest.setdefault("rig", {})["identity"] = self.rig_identity
+            new_path = (header.get("rig") or {}).get("config_path")
+            if new_path:
+                # the config this run used is the session's own from now on (a change of rig was
+                # accepted, or the same rig's config was given from elsewhere)
+                run["config_path"] = new_path
+                self.manifest.setdefault("rig", {})["config_path"] = new_path
             runs.append(run)
             self.manifest["runner"] = {"state": "running", "finish_reason": None}
         else:
