@@ -97,10 +97,16 @@ def test_resume_on_another_rig_is_refused_with_what_differs(
 
     r = runner.invoke(app, ["run", str(CONFIGS / "virtual_arm.toml"), "--resume", str(out)])
     assert r.exit_code == 2, r.output
-    assert "rig kind: dome → arm" in said(r) and "--accept-rig-change" in said(r)
+    assert "cannot change kind of rig" in said(r) and f"run --resume {out}" in said(r)
+    r = runner.invoke(
+        app,
+        ["run", str(CONFIGS / "virtual_arm.toml"), "--resume", str(out), "--accept-rig-change"],
+    )
+    assert r.exit_code == 2 and "cannot change kind of rig" in said(r), r.output
     smaller = write_config(tmp_path, SMALL_DOME.replace("width = 64", "width = 32"), "small.toml")
     r = runner.invoke(app, ["run", str(smaller), "--resume", str(out)])
     assert r.exit_code == 2 and "camera size: 64×64 → 32×64" in said(r), r.output
+    assert "--accept-rig-change" in said(r)
     # the session's own config, edited since: --resume alone uses it, and sees the edit
     cfg.write_text(SMALL_DOME.replace("exposure_s = 0.05", "exposure_s = 0.04"))
     r = runner.invoke(app, ["run", "--resume", str(out)])

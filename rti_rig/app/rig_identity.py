@@ -73,10 +73,13 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
 def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[str]:
     """Each difference as ``"camera size: 512×512 → 256×256"`` (empty if the rigs agree)."""
     out = []
+    other_kind = before.get("kind") != now.get("kind")
     for key in [*before, *(k for k in now if k not in before)]:
         old, new = before.get(key), now.get(key)
         if old == new:
             continue
+        if other_kind and key in ("light_positions", "intensity_correction", "arm_reach"):
+            continue  # a dome and an arm differ in these by nature: the kind says it all
         label = LABELS.get(key, key)
         if key in ("light_positions", "intensity_correction", "decode", "scene"):
             out.append(f"{label}: changed" if old and new else f"{label}: {old} → {new}")

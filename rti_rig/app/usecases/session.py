@@ -266,9 +266,14 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
 
 
-def check_resume_rig(
-    manifest: dict[str, Any], loaded, config_path: Path, accept_change: bool, on_note: NoteSink
-) -> tuple[dict[str, Any], list[str]]:  # type: ignore[no-untyped-def]
+def check_resume_rig(  # type: ignore[no-untyped-def]
+    manifest: dict[str, Any],
+    loaded,
+    config_path: Path,
+    accept_change: bool,
+    on_note: NoteSink,
+    session_dir: Path | str = "DIR",
+) -> tuple[dict[str, Any], list[str]]:
     """The rig's identity, checked against the session's; the differences the user accepted.
 
     Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``.
@@ -288,13 +293,21 @@ def check_resume_rig(
             )
         return identity, []
     diffs = identity_differences(recorded, identity)
+    if recorded.get("kind") != identity.get("kind"):
+        raise RigChangedError(
+            f"{config_path} is a rig of kind '{identity.get('kind')}', and this session was "
+            f"begun on a '{recorded.get('kind')}': a session cannot change kind of rig, even "
+            f"with --accept-rig-change. Resume with its own config (rti-rig run --resume "
+            f"{session_dir}) or start a new session"
+        )
     if diffs and not accept_change:
         raise RigChangedError(
             f"{config_path} does not describe the rig this session began on ("
             + "; ".join(diffs)
             + "): its images would not match the ones already taken. Resume with the "
-            "session's own config (rti-rig run --resume DIR), or, if the change is deliberate "
-            "(a repaired LED, a new exposure), add --accept-rig-change to record it"
+            f"session's own config (rti-rig run --resume {session_dir}), or, if the change "
+            "is deliberate (a repaired LED, a new exposure), add --accept-rig-change to "
+            "record it"
         )
     if diffs:
         on_note(Note("rig change accepted and recorded: " + "; ".join(diffs), "warning"))
@@ -330,7 +343,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     config_path = req.rig_config or Path(rig_entry["config_path"])
     loaded = load_rig_config(config_path)
     identity, diffs = check_resume_rig(
-        manifest, loaded, config_path, req.accept_rig_change, on_note
+        manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
     )
     folder = SessionFolder.reopen(req.session_dir)
     folder.rig_identity = identity
