@@ -124,6 +124,14 @@ def committed_files(root: Path) -> dict[str, str]:
     return out
 
 
+def first_finish_reason(out: Path) -> str | None:
+    """How the first run ended; ``"error"`` if it stopped before writing anything (a rig that
+    fails at connect leaves nothing on disk)."""
+    if not (out / "manifest.json").exists():
+        return "error"
+    return read_manifest(out)["runner"].get("finish_reason")
+
+
 class Tracebacks:
     """Exceptions that were not named errors (each one a traceback a user would have seen)."""
 
@@ -317,7 +325,7 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                 faulty = make_config(tmpdir, "emulated", seed_i, (command, kind_name))
                 run_in_process(faulty, out, n, None, False, tracebacks)
                 faults[fault_kind] += 1
-                first = read_manifest(out)["runner"].get("finish_reason")
+                first = first_finish_reason(out)
                 stats["serial_faults_recovered_in_session"] += int(first == "completed")
                 stats["serial_faults_stopped_with_error"] += int(first == "error")
                 cfg = make_config(tmpdir, "emulated", seed_i)  # the fault was a one-off
@@ -328,7 +336,7 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                 plan = FaultPlan(fault_kind, k)
                 run_in_process(cfg, out, n, plan, False, tracebacks)
                 faults.update(plan.fired)
-                first = read_manifest(out)["runner"].get("finish_reason")
+                first = first_finish_reason(out)
                 stats["servo_faults_stopped_with_error"] += int(first == "error")
             elif fault_kind in SESSION:
                 cfg = session_fault(
