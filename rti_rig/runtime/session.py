@@ -382,6 +382,15 @@ class SessionFolder:
             return
         for r in records:
             self.committed.setdefault(r.index, r)
+        # a stop that came between a journal line and its return (a signal during the fsync)
+        # still leaves a committed step: the journal is the commit point, so it is read back
+        with contextlib.suppress(SessionError):
+            late = [
+                e
+                for e in scan_journal(self.root, self.names).records
+                if e["index"] not in self.committed
+            ]
+            self.committed.update(verified_steps(self.root, late))
         ordered = [self.committed[i] for i in sorted(self.committed)]
         lp_error: SessionWriteError | None = None
         try:
