@@ -3,9 +3,18 @@
 For every session it checks that no committed image was lost or changed, that the final folder is
 complete and consistent, and that every recorded light is the light that really lit the image (by
 re-rendering the scene for the recorded direction and for every other light the rig has: the
-recorded one must explain the image best). Figures go to ``docs/reliability.md``.
+recorded one must explain the image best). Sessions are opened and resumed through the session
+use cases (``rti_rig.app.usecases.session``), as the command line does.
 
-    python -m benchmarks.fault_campaign [--sessions 200] [--seed 1]
+Besides device faults and SIGKILLs it plays what a user or a disk does to a session: a resume
+on a changed rig (which must be refused, then the session's own rig finishes it), a journal cut
+short followed by a chain of resumes each killed in turn, a disk that fills up (or turns
+read-only, or fails) at every write point, and junk lines in the journal. Any exception that is
+not a named error counts as a traceback.
+
+    python -m benchmarks.fault_campaign [--sessions 200] [--seed 1] [--write | --out FILE]
+
+The report is printed; it is written to ``docs/reliability.md`` only with ``--write``.
 """
 
 from __future__ import annotations
@@ -13,10 +22,10 @@ from __future__ import annotations
 import argparse
 import contextlib
 import hashlib
-import json
 import tempfile
 import time
 from collections import Counter
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -28,13 +37,19 @@ from rti_rig.simulator.faults import (
     ServoFaultCarrier,
 )
 
-from rti_rig.app.compose import build_rig
-from rti_rig.app.config import load_rig_config
+from rti_rig.app.usecases.session import (
+    NewSessionRequest,
+    OpenedSession,
+    ResumeRequest,
+    RigChangedError,
+    open_new_session,
+    open_resumed_session,
+    run_opened_session,
+)
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import DomeGeometry
-from rti_rig.core.schedule import LightSchedule
-from rti_rig.runtime.controller import run_session
-from rti_rig.runtime.session import SessionFolder, read_manifest
+from rti_rig.runtime.session import read_manifest, scan_journal
+from rti_rig.testing.disk_faults import ERRNOS, WRITE_POINTS, failing_writes
 from rti_rig.testing.kill_hooks import popen_session
 from rti_rig.testing.verify import wrong_light_steps
 
@@ -57,6 +72,14 @@ KILLS = (
     "sigkill-between-files",
     "sigkill-before-journal",
 )
+#: What a user or a disk does to a session (issue #30).
+SESSION = (
+    "rig-changed-at-resume",
+    "torn-journal-killed-resumes",
+    "junk-journal-line",
+    *(f"disk-full-{point}" for point in WRITE_POINTS),
+)
+JUNK_LINES = ("42", "[]", "null", '"text"', "{}", '{"index": 1}', "not json", '{"index": 0, ')
 SIZE = 48
 
 
@@ -88,17 +111,12 @@ def make_config(folder: Path, kind: str, seed: int, fault: tuple[int, str] | Non
 
 
 def committed_files(root: Path) -> dict[str, str]:
-    """Files of every committed, verified step: these must survive unchanged."""
+    """Files of every committed, verified step: these must survive unchanged.
+
+    The journal is read as resume reads it (well-formed records only: a torn or junk line
+    commits nothing)."""
     out = {}
-    for line in (
-        (root / "journal.jsonl").read_text().splitlines()
-        if (root / "journal.jsonl").exists()
-        else []
-    ):
-        try:
-            entry = json.loads(line)
-        except json.JSONDecodeError:
-            continue
+    for entry in scan_journal(root).records:
         for name, digest in entry["sha256"].items():
             p = root / name
             if p.exists() and hashlib.sha256(p.read_bytes()).hexdigest() == digest:
@@ -106,35 +124,169 @@ def committed_files(root: Path) -> dict[str, str]:
     return out
 
 
-def run_in_process(cfg: Path, out: Path, n: int, fault: FaultPlan | None, resume: bool) -> None:
-    """One run (new or resumed) in this process, with an optional injected device fault."""
-    with build_rig(load_rig_config(cfg)) as rig:
-        _run(rig, out, n, fault, resume)
+def first_finish_reason(out: Path) -> str | None:
+    """How the first run ended; ``"error"`` if it stopped before writing anything (a rig that
+    fails at connect leaves nothing on disk)."""
+    if not (out / "manifest.json").exists():
+        return "error"
+    return read_manifest(out)["runner"].get("finish_reason")
 
 
-def _run(rig, out: Path, n: int, fault: FaultPlan | None, resume: bool) -> None:  # type: ignore[no-untyped-def]
-    from rti_rig.planner.uniform import plan_uniform
+class Tracebacks:
+    """Exceptions that were not named errors (each one a traceback a user would have seen)."""
 
-    if fault is not None:
-        if fault.kind in SERVO:
-            servo_id = rig.loaded.config.arm.dynamixel.elevation.servo_id
-            rig.lighting.carrier = ServoFaultCarrier(  # type: ignore[attr-defined]
-                rig.lighting.carrier, rig.emulator, fault, servo_id
-            )
-        elif fault.kind == "camera-failure":
-            rig.camera = FaultyCamera(rig.camera, fault)
-        elif isinstance(rig.geometry, DomeGeometry):
-            rig.lighting.source = FaultyLightSource(rig.lighting.source, fault)  # type: ignore[attr-defined]
-        else:
-            rig.lighting.carrier = FaultyCarrier(rig.lighting.carrier, fault)  # type: ignore[attr-defined]
-    if resume:
-        folder = SessionFolder.reopen(out)
-        schedule = LightSchedule.from_dict(folder.manifest["schedule"])
+    def __init__(self) -> None:
+        self.seen: list[str] = []
+
+    @contextlib.contextmanager
+    def watch(self) -> Iterator[None]:
+        try:
+            yield
+        except RtiRigError:
+            pass  # a named error: the injected fault, met as it should be
+        except Exception as exc:
+            self.seen.append(f"{type(exc).__name__}: {exc}")
+
+
+def _inject(opened: OpenedSession, fault: FaultPlan | None) -> None:
+    rig = opened.rig
+    if fault is None:
+        return
+    if fault.kind in SERVO:
+        servo_id = rig.loaded.config.arm.dynamixel.elevation.servo_id
+        rig.lighting.carrier = ServoFaultCarrier(  # type: ignore[attr-defined]
+            rig.lighting.carrier, rig.emulator, fault, servo_id
+        )
+    elif fault.kind == "camera-failure":
+        rig.camera = FaultyCamera(rig.camera, fault)
+    elif isinstance(rig.geometry, DomeGeometry):
+        rig.lighting.source = FaultyLightSource(rig.lighting.source, fault)  # type: ignore[attr-defined]
     else:
-        schedule = plan_uniform(rig.geometry, n)
-        folder = SessionFolder.create(out, len(schedule))
-    with contextlib.suppress(RtiRigError):  # the injected fault; the folder shows what happened
-        run_session(rig, schedule, folder)
+        rig.lighting.carrier = FaultyCarrier(rig.lighting.carrier, fault)  # type: ignore[attr-defined]
+
+
+def run_in_process(
+    cfg: Path | None,
+    out: Path,
+    n: int,
+    fault: FaultPlan | None,
+    resume: bool,
+    tracebacks: Tracebacks,
+    cancel_after: int | None = None,
+) -> None:
+    """One run (new or resumed) in this process, through the session use cases, with an
+    optional injected device fault or a cancel after ``cancel_after`` images."""
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    with tracebacks.watch():
+        if resume:
+            opened = open_resumed_session(ResumeRequest(out, cfg))
+        else:
+            assert cfg is not None
+            opened = open_new_session(NewSessionRequest(cfg, out, lights=n))
+        _inject(opened, fault)
+        cancel = CancelToken()
+
+        def on_event(e) -> None:  # type: ignore[no-untyped-def]
+            done = len(opened.folder.committed)
+            if cancel_after is not None and isinstance(e, StepCompleted) and done >= cancel_after:
+                cancel.cancel()
+
+        run_opened_session(opened, cancel, on_event)
+
+
+def run_killed_resume(out: Path, at_light: int) -> tuple[int, bytes]:
+    """``rti-rig run --resume OUT`` in a child process, SIGKILLed before light ``at_light``."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    argv = [sys.executable, "-m", "rti_rig.testing.kill_hooks", "before_light", str(at_light)]
+    proc = subprocess.run(
+        [*argv, "run", "--resume", str(out)], env=env, capture_output=True, timeout=300
+    )
+    return proc.returncode, proc.stderr
+
+
+def other_rig(tmpdir: Path, cfg: Path, kind: str, seed: int, rng: np.random.Generator) -> Path:
+    """A config that differs from ``cfg`` in something the images depend on."""
+    change = str(rng.choice(["kind", "size", "exposure"]))
+    if change == "kind":
+        return make_config(tmpdir, "arm" if kind == "dome" else "dome", seed)
+    text = cfg.read_text()
+    if change == "size":
+        text = text.replace(f"width = {SIZE}", f"width = {SIZE // 2}")
+    else:
+        text = text.replace("exposure_s = 0.05", "exposure_s = 0.04")
+    path = tmpdir / f"changed_{kind}.toml"
+    path.write_text(text)
+    return path
+
+
+def session_fault(
+    fault_kind: str,
+    tmpdir: Path,
+    out: Path,
+    n: int,
+    k: int,
+    seed_i: int,
+    rng: np.random.Generator,
+    stats: Counter,
+    faults: Counter,
+    tracebacks: Tracebacks,
+) -> Path:
+    """Play one of the :data:`SESSION` faults on a new session; returns its config."""
+    kind = "dome" if rng.random() < 0.6 else "arm"
+    cfg = make_config(tmpdir, kind, seed_i)
+    if fault_kind.startswith("disk-full-"):
+        point = fault_kind.removeprefix("disk-full-")
+        code_name = str(rng.choice(list(ERRNOS)))
+        # the manifest is written at begin and at the end; other points once per image
+        after = int(rng.integers(0, 2)) if point == "manifest" else k
+        with failing_writes(point, after=after, errno_code=ERRNOS[code_name]) as fake:
+            run_in_process(cfg, out, n, None, False, tracebacks)
+        faults[fault_kind] += int(fake.failed > 0)
+        faults[f"disk-{code_name}"] += int(fake.failed > 0)
+        leftover = [*out.rglob(".*.partial"), *out.rglob(".*.tmp")] if out.exists() else []
+        stats["partial_files_left"] += len(leftover)
+        return cfg
+    run_in_process(cfg, out, n, None, False, tracebacks, cancel_after=max(1, k))
+    if not (out / "manifest.json").exists():
+        return cfg
+    if fault_kind == "rig-changed-at-resume":
+        changed = other_rig(tmpdir, cfg, kind, seed_i, rng)
+        before = sorted(p.as_posix() for p in out.rglob("*"))
+        try:
+            open_resumed_session(ResumeRequest(out, changed)).close()
+            stats["rig_changes_accepted_silently"] += 1
+        except RigChangedError:
+            stats["rig_changes_refused"] += 1
+        except Exception as exc:
+            tracebacks.seen.append(f"{type(exc).__name__}: {exc}")
+        after_files = sorted(p.as_posix() for p in out.rglob("*"))
+        stats["folders_changed_by_a_refused_resume"] += int(before != after_files)
+        faults[fault_kind] += 1
+    elif fault_kind == "junk-journal-line":
+        journal = out / "journal.jsonl"
+        lines = journal.read_text().splitlines(keepends=True) if journal.exists() else []
+        at = int(rng.integers(0, len(lines) + 1))
+        lines.insert(at, str(rng.choice(JUNK_LINES)) + "\n")
+        journal.write_text("".join(lines))
+        faults[fault_kind] += 1
+    elif fault_kind == "torn-journal-killed-resumes":
+        journal = out / "journal.jsonl"
+        for _ in range(int(rng.integers(1, 4))):  # a chain of interrupted resumes
+            if journal.exists() and journal.stat().st_size:
+                data = journal.read_bytes()
+                journal.write_bytes(data[: -int(rng.integers(1, min(60, len(data)) + 1))])
+            code, stderr = run_killed_resume(out, int(rng.integers(0, 3)))
+            faults["torn-journal-cut"] += 1
+            faults["resume-killed"] += int(code == -9)
+            if b"Traceback" in stderr:
+                tracebacks.seen.append(stderr.decode(errors="replace").strip().splitlines()[-1])
+        faults[fault_kind] += 1
+    return cfg
 
 
 def run_killed(cfg: Path, out: Path, n: int, stage: str, k: int) -> int:
@@ -143,16 +295,27 @@ def run_killed(cfg: Path, out: Path, n: int, stage: str, k: int) -> int:
     return proc.returncode
 
 
-def campaign(sessions: int, seed: int) -> dict:
+GROUPS = {
+    "device": IN_PROCESS,
+    "kill": KILLS,
+    "serial": SERIAL,
+    "servo": SERVO,
+    "session": SESSION,
+}
+
+
+def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) -> dict:
     rng = np.random.default_rng(seed)
+    kinds = tuple(k for g in groups for k in GROUPS[g])
     faults: Counter[str] = Counter()
-    stats = Counter()
+    stats: Counter[str] = Counter()
+    tracebacks = Tracebacks()
     with tempfile.TemporaryDirectory() as tmp:
         tmpdir = Path(tmp)
         for i in range(sessions):
             n = int(rng.integers(6, 17))
             out = tmpdir / f"session_{i:04d}"
-            fault_kind = str(rng.choice(IN_PROCESS + KILLS + SERIAL + SERVO))
+            fault_kind = str(rng.choice(kinds))
             k = int(rng.integers(0, n))
             seed_i = int(rng.integers(0, 1000))
             if fault_kind in SERIAL:
@@ -160,24 +323,30 @@ def campaign(sessions: int, seed: int) -> dict:
                 command = 2 + 2 * k + int(rng.integers(0, 2))
                 kind_name = fault_kind.removeprefix("serial-").replace("-", "_")
                 faulty = make_config(tmpdir, "emulated", seed_i, (command, kind_name))
-                run_in_process(faulty, out, n, None, resume=False)
+                run_in_process(faulty, out, n, None, False, tracebacks)
                 faults[fault_kind] += 1
-                first = read_manifest(out)["runner"].get("finish_reason")
+                first = first_finish_reason(out)
                 stats["serial_faults_recovered_in_session"] += int(first == "completed")
                 stats["serial_faults_stopped_with_error"] += int(first == "error")
                 cfg = make_config(tmpdir, "emulated", seed_i)  # the fault was a one-off
+                # the fault was in the firmware, not the config: the same rig, told so
+                faulty.write_text(cfg.read_text())
             elif fault_kind in SERVO:
                 cfg = make_config(tmpdir, "servo", seed_i)
                 plan = FaultPlan(fault_kind, k)
-                run_in_process(cfg, out, n, plan, resume=False)
+                run_in_process(cfg, out, n, plan, False, tracebacks)
                 faults.update(plan.fired)
-                first = read_manifest(out)["runner"].get("finish_reason")
+                first = first_finish_reason(out)
                 stats["servo_faults_stopped_with_error"] += int(first == "error")
+            elif fault_kind in SESSION:
+                cfg = session_fault(
+                    fault_kind, tmpdir, out, n, k, seed_i, rng, stats, faults, tracebacks
+                )
             else:
                 cfg = make_config(tmpdir, "dome" if rng.random() < 0.6 else "arm", seed_i)
                 if fault_kind in IN_PROCESS:
                     plan = FaultPlan(fault_kind, k)
-                    run_in_process(cfg, out, n, plan, resume=False)
+                    run_in_process(cfg, out, n, plan, False, tracebacks)
                     faults.update(plan.fired)
                 else:
                     stage = fault_kind.removeprefix("sigkill-").replace("-", "_")
@@ -187,6 +356,12 @@ def campaign(sessions: int, seed: int) -> dict:
             snapshots: dict[str, str] = {}
             resumes = 0
             while True:
+                if not (out / "manifest.json").exists():
+                    # stopped before anything was written: the folder (if any) holds no
+                    # image, and the same command is simply run again
+                    stats["sessions_restarted_from_nothing"] += 1
+                    run_in_process(cfg, out, n, None, False, tracebacks)
+                    continue
                 snapshots.update(committed_files(out))
                 m = read_manifest(out)
                 if m["runner"].get("finish_reason") == "completed":
@@ -198,7 +373,7 @@ def campaign(sessions: int, seed: int) -> dict:
                 again = None
                 if rng.random() < 0.3:
                     again = FaultPlan(str(rng.choice(IN_PROCESS)), int(rng.integers(0, n)))
-                run_in_process(cfg, out, n, again, resume=True)
+                run_in_process(None, out, n, again, True, tracebacks)
                 if again is not None:  # counted only if its step was still to be captured
                     faults.update(again.fired)
             stats["sessions"] += 1
@@ -209,6 +384,7 @@ def campaign(sessions: int, seed: int) -> dict:
             jpgs = sorted(p.name for p in out.glob("image_*.jpg"))
             consistent = lp_lines[0] == str(n) and [ln.split()[0] for ln in lp_lines[1:]] == jpgs
             stats["sessions_completed"] += int(complete and consistent)
+            stats["sessions_not_finished"] += int(not (complete and consistent))
             lost = sum(
                 1
                 for name, digest in snapshots.items()
@@ -220,10 +396,15 @@ def campaign(sessions: int, seed: int) -> dict:
             stats["images_checked"] += len(m["steps"])
             if (i + 1) % 20 == 0:
                 print(f"{i + 1}/{sessions} sessions", flush=True)
+    stats["tracebacks"] = len(tracebacks.seen)
+    for line in tracebacks.seen[:10]:
+        print(f"traceback: {line}", flush=True)
     return {"stats": dict(stats), "faults": dict(faults)}
 
 
-def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
+def report(
+    result: dict, sessions: int, seed: int, seconds: float, groups: tuple[str, ...] = tuple(GROUPS)
+) -> str:
     s, f = result["stats"], result["faults"]
     labels = [
         ("sessions run", "sessions"),
@@ -254,17 +435,36 @@ def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
             "servo_faults_stopped_with_error",
         ),
         ("sessions abandoned after 10 resumes", "sessions_abandoned"),
+        ("**sessions that could not be finished**", "sessions_not_finished"),
+        ("**tracebacks** (an exception that was not a named error)", "tracebacks"),
+        ("resumes on a changed rig refused (folder untouched)", "rig_changes_refused"),
+        (
+            "resumes on a changed rig accepted without --accept-rig-change",
+            "rig_changes_accepted_silently",
+        ),
+        ("folders changed by a refused resume", "folders_changed_by_a_refused_resume"),
+        ("partial or temporary files left after a failed write", "partial_files_left"),
+        (
+            "sessions stopped before their first write, run again into the same folder",
+            "sessions_restarted_from_nothing",
+        ),
         ("SIGKILL faults that failed to kill", "kills_that_did_not_kill"),
     ]
     figures = "\n".join(f"| {label} | {s.get(key, 0)} |" for label, key in labels)
     rows = "\n".join(f"| {k} | {v} |" for k, v in sorted(f.items()))
+    faults_opt = "" if set(groups) == set(GROUPS) else f" --faults {','.join(groups)}"
+    command = (
+        f"python -m benchmarks.fault_campaign --sessions {sessions} --seed {seed}{faults_opt} "
+        "--write"
+    )
     return f"""# Reliability: fault campaign
 
-Measured with `python -m benchmarks.fault_campaign --sessions {sessions} --seed {seed}`
-({seconds:.0f} s). Each session runs a homogeneous plan of 6–16 lights on the simulated dome (60 %)
-or arm (40 %), or for serial faults on the emulated dome, at {SIZE}×{SIZE} pixels, with a
-fault at a random step; it is then resumed with
-`--resume` semantics until complete, and 30 % of resumes get a further in-process fault.
+Measured with `{command}`
+({seconds:.0f} s; without `--write` the report is only printed). Each session runs a
+homogeneous plan of 6–16 lights on the simulated dome (60 %) or arm (40 %), or for serial faults
+on the emulated dome, at {SIZE}×{SIZE} pixels, with a fault at a random step; it is then resumed
+through the same use cases as `rti-rig run --resume` until complete, and 30 % of resumes get a
+further in-process fault.
 
 | figure | value |
 |---|---|
@@ -287,7 +487,19 @@ fault at a random step; it is then resumed with
 
 - `servo-*`: the emulated Dynamixel servos (real SDK, in-process port) report overload or
   overheating in their Hardware Error Status, corrupt their status packets' CRC, or fall silent,
-  just as a move is commanded.
+  just as a move is commanded (a read that meets one lost or corrupt reply is retried once).
+- `rig-changed-at-resume`: the session is stopped, then resumed with another rig config (the
+  other kind of rig, half the image width, or another exposure); the resume must be refused
+  without touching the folder, and the session's own rig then finishes it.
+- `torn-journal-killed-resumes`: the session is stopped, then 1–3 times in a row the journal's
+  tail is cut by 1–60 bytes and `rti-rig run --resume` is SIGKILLed before one of its first
+  lights (`torn-journal-cut`, `resume-killed` count each link of the chain).
+- `junk-journal-line`: a line that is not a record (`42`, `[]`, `null`, a record without its
+  checksum, half a record…) is inserted anywhere in the journal of a stopped session.
+- `disk-full-*`: the n-th write to one kind of session file fails as a full disk (`ENOSPC`), a
+  read-only one (`EROFS`) or a failing one (`EIO`) would (`disk-E*` count the errors):
+  the TIFF, the JPEG, the journal line, `lights.lp` or the manifest (`failing_writes` in
+  `rti_rig.testing.disk_faults`).
 """
 
 
@@ -297,16 +509,36 @@ def main() -> None:
     )
     ap.add_argument("--sessions", type=int, default=200)
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--out", type=Path, default=REPO / "docs" / "reliability.md")
+    ap.add_argument(
+        "--out", type=Path, default=None, help="write the report to this file (default: print only)"
+    )
+    ap.add_argument(
+        "--write",
+        action="store_true",
+        help="write the report to the repository's docs/reliability.md",
+    )
+    ap.add_argument(
+        "--faults",
+        default=",".join(GROUPS),
+        help=f"fault groups to draw from, comma-separated (default all: {','.join(GROUPS)})",
+    )
     args = ap.parse_args()
+    groups = tuple(g.strip() for g in args.faults.split(",") if g.strip())
+    unknown = [g for g in groups if g not in GROUPS]
+    if unknown:
+        ap.error(f"unknown fault group(s) {', '.join(unknown)}; choose from {', '.join(GROUPS)}")
+    out = args.out or (REPO / "docs" / "reliability.md" if args.write else None)
     t0 = time.perf_counter()
-    result = campaign(args.sessions, args.seed)
-    text = report(result, args.sessions, args.seed, time.perf_counter() - t0)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    old = args.out.read_text() if args.out.exists() else ""
-    keep = old[old.find("<!-- BEGIN firmware_faults -->") :] if "firmware_faults" in old else ""
-    args.out.write_text(text.rstrip() + ("\n\n" + keep if keep else "\n"))  # its own section
+    result = campaign(args.sessions, args.seed, groups)
+    text = report(result, args.sessions, args.seed, time.perf_counter() - t0, groups)
     print(text)
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        old = out.read_text() if out.exists() else ""
+        # the dome firmwares' campaign (benchmarks.firmware_fault_campaign) owns its own section
+        keep = old[old.find("<!-- BEGIN firmware_faults -->") :] if "firmware_faults" in old else ""
+        out.write_text(text.rstrip() + ("\n\n" + keep if keep else "\n"))
+        print(f"report → {out}")
 
 
 if __name__ == "__main__":

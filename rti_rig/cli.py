@@ -39,6 +39,27 @@ err = Console(stderr=True)
 out = Console()
 
 
+def _flags_show_no_type() -> None:
+    """Show on/off flags in help without a value type: typer 0.29 labels them ``<bool>``, as if
+    ``--force`` took a value (it takes none). Every command's flags at once, in one place."""
+    from typer.core import TyperOption
+
+    original = TyperOption.display_type_rich
+    if getattr(original, "_rti_rig", False):
+        return
+
+    def display_type_rich(self, ctx):  # type: ignore[no-untyped-def]
+        if getattr(self, "is_flag", False) and self.metavar is None:
+            return None
+        return original(self, ctx)
+
+    display_type_rich._rti_rig = True  # type: ignore[attr-defined]
+    TyperOption.display_type_rich = display_type_rich  # type: ignore[method-assign]
+
+
+_flags_show_no_type()
+
+
 def _fail(exc: RtiRigError) -> typer.Exit:
     # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
     err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
@@ -51,62 +72,12 @@ def _print_notes(notes) -> None:  # type: ignore[no-untyped-def]
         err.print(f"[yellow]note:[/] {escape(note)}", highlight=False, soft_wrap=True)
 
 
-def _default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
-    from rti_rig.core.rig_geometry import DomeGeometry
-
-    cfg = loaded.config
-    if isinstance(geometry, DomeGeometry):
-        assert cfg.dome is not None
-        return cfg.dome.default_lights or geometry.count
-    assert cfg.arm is not None
-    return cfg.arm.default_lights
-
-
-def _check_max_saturated(max_saturated: float) -> None:
-    if not 0.0 <= max_saturated < 1.0:
-        raise RtiRigError(
-            f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
-            "e.g. 0.001 for 0.1 %"
-        )
-
-
-def _checked_rig(loaded, schedule):  # type: ignore[no-untyped-def]
-    """The rig, opened, with ``schedule`` checked against it before anything moves.
-
-    The rig is closed (lights off, arm stopped) if the check fails, whatever the exception.
-    """
-    from rti_rig.app.compose import build_rig
-    from rti_rig.runtime.controller import validate_schedule
-
-    rig = build_rig(loaded)
-    try:
-        validate_schedule(rig, schedule)
-    except BaseException:
-        rig.close()
-        raise
-    return rig
-
-
-def _open_new_session(  # type: ignore[no-untyped-def]
-    loaded, schedule, out_dir: Path, auto_exposure: bool, max_saturated: float
-):
-    """Check the folder, open and check the rig, meter if asked, make the folder.
-
-    The folder is checked first, so nothing lights or moves for a session that could not be
-    written; the rig is closed if anything after opening it fails, whatever the exception.
-    """
-    from rti_rig.runtime.session import SessionFolder
-
-    SessionFolder.check_new(out_dir)
-    rig = _checked_rig(loaded, schedule)
-    try:
-        if auto_exposure:
-            schedule = _fix_exposure(rig, schedule, max_saturated)
-        folder = SessionFolder.create(out_dir, len(schedule))
-    except BaseException:
-        rig.close()
-        raise
-    return rig, schedule, folder
+def _print_note(note) -> None:  # type: ignore[no-untyped-def]
+    """Show a use case's note: information on stdout, warnings on stderr."""
+    if note.level == "warning":
+        err.print(f"[yellow]note:[/] {escape(note.text)}", soft_wrap=True)
+    else:
+        out.print(note.text, highlight=False, markup=False)
 
 
 @app.command()
@@ -162,9 +133,17 @@ def run(
         typer.Option(
             "--resume",
             help="Continue an interrupted session folder: verify what is on disk and capture "
-            "only the steps not yet done.",
+            "only the steps not yet done (on the rig the session began on).",
         ),
     ] = None,
+    accept_rig_change: Annotated[
+        bool,
+        typer.Option(
+            "--accept-rig-change",
+            help="With --resume: go on although the rig differs from the session's (a "
+            "repaired LED, a new exposure); the change is recorded in the manifest.",
+        ),
+    ] = False,
     adaptive: Annotated[
         bool,
         typer.Option(
@@ -189,139 +168,78 @@ def run(
     pauses or resumes between images. An interrupted session can be
     continued with --resume.
     """
-    from rti_rig.app.compose import arm_order_for
-    from rti_rig.app.config import load_rig_config, rig_geometry
-    from rti_rig.core.lp_format import read_lp
-    from rti_rig.core.schedule import LightSchedule
-    from rti_rig.planner.from_lp import schedule_from_lp
-    from rti_rig.planner.make_plan import check_elevation_band
-    from rti_rig.planner.uniform import plan_uniform
-    from rti_rig.runtime.session import SessionFolder
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        ResumeRequest,
+        open_new_session,
+        open_resumed_session,
+    )
 
-    source = None  # an adaptive session's step source (rti_rig.app.usecases.adaptive)
     try:
-        _check_max_saturated(max_saturated)
         if resume is not None:
             if out_dir is not None or plan is not None or lights is not None:
                 raise RtiRigError(
                     "--resume continues a session as planned: drop --out, --plan, --lights"
                 )
-            folder = SessionFolder.reopen(resume)
-            manifest = folder.manifest
-            config_path = rig_config or Path(manifest["rig"]["config_path"])
-            loaded = load_rig_config(config_path)
-            if loaded.sha256 != manifest["rig"].get("config_sha256"):
-                err.print(
-                    f"[yellow]note:[/] {escape(str(config_path))} has changed since the session "
-                    "began; the remaining steps are checked against it before anything moves."
-                )
-            schedule = LightSchedule.from_dict(manifest["schedule"])
-            out_dir = resume
-            done = len(folder.done)
-            out.print(
-                f"Resuming {resume}: {done} of {len(schedule)} images verified on disk"
-                + (
-                    f", {len(folder.resume.recovered)} unverified file(s) moved to recovered/"
-                    if folder.resume and folder.resume.recovered
-                    else ""
-                )
-            )
-            rig = _checked_rig(loaded, schedule)
-            if "adaptive" in manifest:
-                from rti_rig.app.usecases.adaptive import resume_adaptive_source
-
-                try:
-                    source = resume_adaptive_source(rig, folder)
-                except BaseException:
-                    rig.close()
-                    raise
-        elif adaptive or until_error is not None:
-            from rti_rig.app.usecases.adaptive import open_adaptive_session
-
-            if rig_config is None or out_dir is None:
-                raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
-            if plan is not None or auto_exposure:
-                raise RtiRigError("--adaptive chooses its own lights: drop --plan/--auto-exposure")
-            loaded = load_rig_config(rig_config)
-            _print_notes(loaded.notes)
-            rig, schedule, folder, source = open_adaptive_session(
-                loaded, out_dir, lights, until_error
+            opened = open_resumed_session(
+                ResumeRequest(
+                    resume,
+                    rig_config,
+                    max_saturated=max_saturated,
+                    accept_rig_change=accept_rig_change,
+                ),
+                _print_note,
             )
         else:
             if rig_config is None or out_dir is None:
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
-            loaded = load_rig_config(rig_config)
-            _print_notes(loaded.notes)
-            geometry = rig_geometry(loaded)
-            if plan is not None:
-                if lights is not None:
-                    raise RtiRigError("give either --plan or --lights, not both")
-                plan_notes: list[str] = []
-                schedule = schedule_from_lp(
-                    read_lp(plan, upper_hemisphere=True, notes=plan_notes), geometry, str(plan)
-                )
-                _print_notes(plan_notes)
-            else:
-                check_elevation_band(min_elevation_deg, max_elevation_deg)
-                n = lights if lights is not None else _default_lights(loaded, geometry)
-                schedule = plan_uniform(
-                    geometry, n, min_elevation_deg, arm_order_for(loaded), max_elevation_deg
-                )
-            rig, schedule, folder = _open_new_session(
-                loaded, schedule, out_dir, auto_exposure, max_saturated
+            if accept_rig_change:
+                raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
+            opened = open_new_session(
+                NewSessionRequest(
+                    rig_config,
+                    out_dir,
+                    lights=lights,
+                    plan=plan,
+                    min_elevation_deg=min_elevation_deg,
+                    max_elevation_deg=max_elevation_deg,
+                    auto_exposure=auto_exposure,
+                    max_saturated=max_saturated,
+                    adaptive=adaptive,
+                    until_error_deg=until_error,
+                ),
+                _print_note,
             )
     except RtiRigError as exc:
         raise _fail(exc) from None
-    with rig:
-        _execute(rig, schedule, folder, out_dir, source)
-    if source is not None:
-        from rti_rig.app.usecases.adaptive import record_result
+    _execute(opened)
 
-        result = source.conclude()
-        record_result(out_dir, result)
-        est = result["estimated_error_deg"]
-        out.print(
-            f"Adaptive: {result['lights_used']} lights; stopped: {result['stop']['reason']}; "
-            f"estimated mean normal error {'n/a' if est is None else f'{est:.2f}°'}",
-            highlight=False,
+
+def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
+    """What a stopped session left on disk and how to go on (never a resume hint for nothing)."""
+    from rti_rig.runtime.session import LP_NAME
+
+    folder, out_dir = opened.folder, opened.out_dir
+    if folder.images_kept:
+        return (
+            f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}. {resume_hint}"
         )
+    if opened.resumed:
+        return f"No new image was captured. {resume_hint}"
+    if folder.begun:
+        return f"Nothing was captured: {out_dir} holds no image and may be used again."
+    return f"Nothing was captured and nothing was written to {out_dir}."
 
 
-def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyped-def]
-    """Meter the session's exposure with the camera driver layer's test series."""
-    from rti_rig.drivers.cameras.exposure import meter_exposure
-    from rti_rig.drivers.cameras.settings import ExposureRule
-    from rti_rig.runtime.exposure_policy import fix_session_exposure
-
-    cam = rig.camera_config
-    rule = ExposureRule(
-        max_saturated_fraction=max_saturated,
-        headroom=1.25,  # other planned lights may be a little brighter than the metered one
-        min_exposure_s=cam.min_exposure_s,
-        max_exposure_s=cam.max_exposure_s,
-    )
-
-    def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
-        shutter = getattr(camera, "available_exposures_s", None)
-        return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
-
-    fixed = fix_session_exposure(rig, schedule, meter)
-    chosen = fixed.provenance["exposure"]
-    out.print(
-        f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})", highlight=False
-    )
-    return fixed
-
-
-def _execute(rig, schedule, folder, out_dir: Path, source=None) -> None:  # type: ignore[no-untyped-def]
+def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on."""
+    from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
         CancelToken,
         EmergencyStop,
         FinishReason,
         Paused,
         StepCompleted,
-        run_session,
     )
     from rti_rig.runtime.session import LP_NAME
 
@@ -348,14 +266,12 @@ def _execute(rig, schedule, folder, out_dir: Path, source=None) -> None:  # type
     if hasattr(signal, "SIGUSR1"):
         handlers[signal.SIGUSR1] = on_sigusr1
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
-    dry = " (dry run)" if rig.loaded.config.backend != "hardware" else ""
-    total = len(schedule) if source is None else source.total
-    todo = total - len(folder.done)
+    rig, folder, out_dir = opened.rig, opened.folder, opened.out_dir
+    dry = " (dry run)" if opened.dry_run else ""
+    adaptive = " at most, adaptive" if opened.source is not None else ""
     out.print(
-        f"Rig [bold]{escape(rig.name)}[/]{dry}: {todo} of {total} lights"
-        + (" at most, adaptive" if source is not None else "")
-        + " → "
-        f"{escape(str(out_dir))}"
+        f"Rig [bold]{escape(rig.name)}[/]{dry}: {opened.steps_to_do} of {opened.total_steps} "
+        f"lights{adaptive} → {escape(str(out_dir))}"
     )
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
     try:
@@ -366,7 +282,9 @@ def _execute(rig, schedule, folder, out_dir: Path, source=None) -> None:  # type
             TimeElapsedColumn(),
             console=out,
         ) as progress:
-            task = progress.add_task("capturing", total=total, completed=len(folder.done))
+            task = progress.add_task(
+                "capturing", total=opened.total_steps, completed=len(folder.done)
+            )
 
             def on_event(event):  # type: ignore[no-untyped-def]
                 if isinstance(event, StepCompleted):
@@ -374,24 +292,21 @@ def _execute(rig, schedule, folder, out_dir: Path, source=None) -> None:  # type
                 elif isinstance(event, Paused):
                     progress.update(task, description="paused")
 
-            result = run_session(
-                rig, schedule, folder, cancel=cancel, on_event=on_event, source=source
-            )
+            result = run_opened_session(opened, cancel, on_event)
     except EmergencyStop as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
         err.print(
-            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}; "
-            "images kept."
+            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}."
         )
-        err.print(resume_hint)
+        err.print(_after_stop(opened, resume_hint), markup=False, soft_wrap=True)
         raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
+        state = lights_state(rig)
         err.print(
-            f"Images already captured are kept in {out_dir}; {lights_state(rig)}. {resume_hint}",
-            markup=False,
+            f"{state[:1].upper()}{state[1:]}. {_after_stop(opened, resume_hint)}", markup=False
         )
         raise _fail(exc) from None
     finally:
@@ -408,6 +323,15 @@ def _execute(rig, schedule, folder, out_dir: Path, source=None) -> None:  # type
         err.print(f"[yellow]note:[/] {escape(str(note))}")
     for failure in result.teardown_failures:
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
+    adaptive_result = opened.extra.get("adaptive_result")
+    if adaptive_result is not None:
+        est = adaptive_result["estimated_error_deg"]
+        out.print(
+            f"Adaptive: {adaptive_result['lights_used']} lights; stopped: "
+            f"{adaptive_result['stop']['reason']}; estimated mean normal error "
+            f"{'n/a' if est is None else f'{est:.2f}°'}",
+            highlight=False,
+        )
     if result.finish_reason is FinishReason.CANCELLED:
         err.print(
             f"[yellow]Session cancelled; the images captured so far are kept.[/] {resume_hint}"
@@ -449,23 +373,22 @@ def preview(
     The session records the light that fired, so `rti-rig plan OUT_DIR --rig RIG ...` plans from
     its linear image with that light (no --preview-light needed).
     """
-    from rti_rig.app.config import load_rig_config, rig_geometry
-    from rti_rig.planner.preview_shot import preview_schedule
+    from rti_rig.app.usecases.session import PreviewRequest, open_preview_session
 
     try:
-        _check_max_saturated(max_saturated)
-        az_el = _parse_az_el(light, "--light")
-        loaded = load_rig_config(rig_config)
-        schedule, notes = preview_schedule(rig_geometry(loaded), az_el)
-        for note in notes:
-            err.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
-        rig, schedule, folder = _open_new_session(
-            loaded, schedule, out_dir, auto_exposure, max_saturated
+        opened = open_preview_session(
+            PreviewRequest(
+                rig_config,
+                out_dir,
+                _parse_az_el(light, "--light"),
+                auto_exposure=auto_exposure,
+                max_saturated=max_saturated,
+            ),
+            _print_note,
         )
     except RtiRigError as exc:
         raise _fail(exc) from None
-    with rig:
-        _execute(rig, schedule, folder, out_dir)
+    _execute(opened)
     out.print(
         f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
         f"{shlex.quote(str(rig_config))} --lights N --out plan.lp",
@@ -655,17 +578,24 @@ def export_lp(
     ] = False,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
-    """Write the .lp of a session (from the lights that actually fired)."""
+    """Write the .lp of a session from its verified journal: the lights that actually fired,
+    for every image on disk as captured (an interrupted session's too)."""
     from rti_rig.app.output_files import check_output_file
     from rti_rig.core.lp_format import write_lp
-    from rti_rig.runtime.session import session_lp_entries
+    from rti_rig.runtime.session import session_lp_report
 
     try:
-        entries = session_lp_entries(session_dir, linear=linear)
+        entries, left_out = session_lp_report(session_dir, linear=linear)
         check_output_file(out_file, force, {})
         write_lp(out_file, entries)
     except RtiRigError as exc:
         raise _fail(exc) from None
+    if left_out:
+        err.print(
+            f"[yellow]note:[/] left out, missing or changed since they were captured: "
+            f"{escape(', '.join(left_out))}",
+            soft_wrap=True,
+        )
     out.print(f"{len(entries)} lights → {out_file}")
 
 
@@ -760,11 +690,30 @@ def calibrate_lights(
         f"'{escape(loaded.config.name)}'; {len(measured)} of {geometry.count} LEDs measured "
         f"(lowest {lowest:.1f}° above the card)."
     )
-    out.print(
-        f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light from "
-        f"{cal.output[weak]:.2f} (LED {weak}, {escape(names[weak])}) to {cal.output[strong]:.2f} "
-        f"(LED {strong}, {escape(names[strong])}) of the median."
-    )
+    in_force = card.correction is not None
+    #: what is left after a correction in force that needs no further calibration
+    even_enough = 0.01
+    if in_force:
+        # a re-shot card under the correction: the spread as shot is what is left, the LEDs'
+        # own (uncorrected) outputs are the same as before, which is no failure
+        change = float(np.max(np.abs(cal.correction / np.maximum(cal.previous, 1e-9) - 1.0)))
+        out.print(
+            f"Lights as shot, with the intensity correction in force: spread "
+            f"{100 * cal.shot_spread:.1f} % RMS"
+            + (" — the dome is even." if cal.shot_spread < even_enough else ".")
+        )
+        out.print(
+            f"Each LED's own light, without the correction, is still {cal.output[weak]:.2f} "
+            f"(LED {weak}, {escape(names[weak])}) to {cal.output[strong]:.2f} "
+            f"(LED {strong}, {escape(names[strong])}) of the median; the new correction "
+            f"differs from the one in force by at most {100 * change:.1f} %."
+        )
+    else:
+        out.print(
+            f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light "
+            f"from {cal.output[weak]:.2f} (LED {weak}, {escape(names[weak])}) to "
+            f"{cal.output[strong]:.2f} (LED {strong}, {escape(names[strong])}) of the median."
+        )
     out.print(
         f"Evened out, every LED gives {cal.evened_light:.2f} of the median LED's light "
         f"({cal.stops_lost:.2f} stop(s) more exposure)."
@@ -788,11 +737,23 @@ def calibrate_lights(
     )
     rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
     out.print(f"Calibration → {escape(str(target))}")
-    out.print(
-        f"To use it, add under {escape('[dome.serial]')} in {escape(str(rig_config))}:  "
-        f'intensity_correction_file = "{escape(rel)}"\n'
-        "Then shoot the card again and calibrate that session: its spread is what is left."
-    )
+    if in_force and cal.shot_spread < even_enough:
+        out.print(
+            "The correction in force is good: no new calibration is needed. To use this "
+            f"one instead, set under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            highlight=False,
+        )
+    else:
+        out.print(
+            f"To use it, add under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            highlight=False,
+        )
+    # the line to paste, on its own and never wrapped (a wrapped line pastes as two)
+    out.print(f'intensity_correction_file = "{rel}"', markup=False, highlight=False, soft_wrap=True)
+    if not (in_force and cal.shot_spread < even_enough):
+        out.print(
+            "Then shoot the card again and calibrate that session: its spread is what is left."
+        )
 
 
 @app.command()
@@ -847,8 +808,14 @@ app.add_typer(bench_app, name="bench")
 @bench_app.command("tradeoff")
 def bench_tradeoff(
     out_dir: Annotated[
-        Path, typer.Option("--out", help="Folder for results.csv, the plots and summary.md.")
-    ] = Path("docs/research/tradeoff"),
+        Path | None,
+        typer.Option(
+            "--out",
+            help="Folder to write results.csv, the plots and summary.md into (the repository's "
+            "committed results are docs/research/tradeoff). Without it the summary is only "
+            "printed.",
+        ),
+    ] = None,
     quick: Annotated[
         bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
     ] = False,
@@ -862,12 +829,30 @@ def bench_tradeoff(
     ] = None,
 ) -> None:
     """Error against number of lights and session time, for every planner, on simulated scenes
-    (or on your own acquisition with --from)."""
+    (or on your own acquisition with --from).
+
+    Nothing is written unless --out is given, so a quick run never replaces the committed
+    full-run results. The benchmarks live in the repository's benchmarks/ folder (they are not
+    installed): run this from a checkout."""
     import time
 
-    if from_lp is not None:
+    try:
+        from benchmarks.tradeoff import (
+            TradeoffSettings,
+            plot,
+            run_tradeoff,
+            summarise,
+            write_csv,
+        )
         from benchmarks.tradeoff_from import bench_from
-
+    except ImportError:
+        raise _fail(
+            RtiRigError(
+                "rti-rig bench runs the benchmarks of a checkout of the rti-rig repository "
+                "(they are not installed): run it from the repository's folder"
+            )
+        ) from None
+    if from_lp is not None:
         try:
             text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
         except RtiRigError as exc:
@@ -877,18 +862,21 @@ def bench_tradeoff(
         out.print(text, highlight=False)
         return
 
-    from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
-
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()
     t0 = time.perf_counter()
     rows = run_tradeoff(settings, progress=lambda msg: out.print(msg, highlight=False))
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_csv(rows, out_dir / "results.csv")
-    plot(rows, out_dir)
-    command = "rti-rig bench tradeoff" + (" --quick" if quick else "") + f" --out {out_dir}"
+    command = "rti-rig bench tradeoff" + (" --quick" if quick else "")
+    if out_dir is not None:
+        command += f" --out {out_dir}"
     text = summarise(rows, settings, time.perf_counter() - t0, command)
-    (out_dir / "summary.md").write_text(text, encoding="utf-8")
+    if out_dir is not None:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        write_csv(rows, out_dir / "results.csv")
+        plot(rows, out_dir)
+        (out_dir / "summary.md").write_text(text, encoding="utf-8")
     out.print(text, highlight=False)
+    if out_dir is None:
+        out.print("(nothing written: give --out DIR to keep the results)", highlight=False)
 
 
 @app.command()

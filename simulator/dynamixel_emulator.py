@@ -39,6 +39,9 @@ from rti_rig.core.clock import Clock
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
 DEFAULT_FIRMWARE = 46
+#: Drive Mode (address 10) bit 3 and the firmware that brought it (ROBOTIS e-manual, X series).
+TORQUE_ON_BY_GOAL_UPDATE = 0x08
+TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE = 45
 
 
 def _ticks_per_s(velocity_units: int) -> float:
@@ -228,6 +231,15 @@ class EmulatedServo:
             if not lo <= value <= hi:
                 return p2.ERR_DATA_LIMIT
             self.table[address:end] = data
+            if (
+                not self.torque_on
+                and not self.hardware_error
+                and self.get(ct.DRIVE_MODE) & TORQUE_ON_BY_GOAL_UPDATE
+                and self.get(ct.FIRMWARE_VERSION) >= TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE
+            ):
+                # e-manual, Drive Mode bit 3 "Torque On by Goal Update" (firmware 45+): a goal
+                # written while Torque Enable is 0 switches torque on, and the servo moves to it
+                self.table[ct.TORQUE_ENABLE.address] = 1
             self._start_move(value)
             return 0
         if address <= ct.TORQUE_ENABLE.address < end:

@@ -73,3 +73,40 @@ def test_outputs(rows, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     assert len(pngs) == 6 and all(p.stat().st_size > 1000 for p in pngs)
     text = summarise(rows, TINY, 1.0, "test")
     assert "## painting" in text and "What the numbers say" in text
+
+
+def test_bench_writes_nothing_unless_asked(  # type: ignore[no-untyped-def]
+    rows, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`bench tradeoff --quick` must never replace the committed docs/tradeoff results."""
+    from typer.testing import CliRunner
+
+    import benchmarks.tradeoff as tradeoff
+    from rti_rig.cli import app
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(tradeoff, "run_tradeoff", lambda settings, progress: rows)
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick"])
+    assert r.exit_code == 0, r.output
+    assert list(tmp_path.rglob("*")) == []
+    assert "nothing written" in r.output
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--quick", "--out", "res"])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "res" / "summary.md").is_file()
+    assert (tmp_path / "res" / "results.csv").is_file()
+
+
+def test_fault_campaign_writes_its_report_only_when_asked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import sys
+
+    import benchmarks.fault_campaign as fc
+
+    monkeypatch.setattr(fc, "REPO", tmp_path)
+    monkeypatch.setattr(sys, "argv", ["fault_campaign", "--sessions", "0"])
+    fc.main()
+    assert not (tmp_path / "docs").exists()
+    monkeypatch.setattr(sys, "argv", ["fault_campaign", "--sessions", "0", "--write"])
+    fc.main()
+    assert (tmp_path / "docs" / "reliability.md").is_file()

@@ -108,6 +108,7 @@ def test_raw_plus_jpeg_arriving_as_two_files_keeps_both(tmp_path, jpeg_first):
         body, tmp_path / RAW_INCOMING, image_format="RAW + Large Fine JPEG", keep_jpeg=True
     ) as cam:
         folder = SessionFolder.create(tmp_path / "s", 1)
+        folder.begin({"rig": {}, "schedule": {"steps": [{}]}})  # as the controller does
         cam.output_dir = folder.root / RAW_INCOMING
         f = cam.capture(1 / 60)
     assert f.pixels.ndim == 3  # decoded from the RAW, whichever came first

@@ -193,6 +193,7 @@ def test_never_writes_into_a_non_empty_folder(tmp_path: Path) -> None:
 def test_image_write_refuses_to_overwrite(tmp_path: Path) -> None:
     rig = small_rig(tmp_path)
     folder = SessionFolder.create(tmp_path / "s", 2)
+    (folder.root / "linear").mkdir(parents=True)  # create() writes nothing; begin() would
     (folder.root / "image_001.jpg").write_bytes(b"earlier capture")
     rig.camera.connect()
     frame = rig.camera.capture(0.05)

@@ -147,9 +147,14 @@ def test_corrupted_crc_and_silence_are_communication_errors() -> None:
     bus = DxlBus(InProcessPort(emu), "arm")
     bus.open(57600)
     emu.corrupt_next_replies = 1
+    assert bus.read(1, ct.PRESENT_POSITION) == 2048  # a read is retried once: no harm done
+    emu.corrupt_next_replies = 2
     with pytest.raises(CommunicationError, match="COMM_RX_CORRUPT"):
         bus.read(1, ct.PRESENT_POSITION)
     assert bus.read(1, ct.PRESENT_POSITION) == 2048  # next reply is clean
+    emu.corrupt_next_replies = 1
+    with pytest.raises(CommunicationError, match="COMM_RX_CORRUPT"):
+        bus.write(1, ct.LED, 1)  # a write is never retried by the bus
     emu.silent_ids.add(2)
     with pytest.raises(CommunicationError, match="servo 2") as info:
         bus.ping(2)

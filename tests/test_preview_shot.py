@@ -225,23 +225,24 @@ def test_the_rig_is_closed_whatever_interrupts_the_start(
     """Ctrl-C (or any exception) between opening the rig and the session's start still turns
     the lights off and stops the arm: the rig is closed, and the interruption goes on."""
     import rti_rig.app.compose
-    import rti_rig.cli as cli
-    import rti_rig.runtime.controller
+    import rti_rig.app.rig_identity
+    import rti_rig.app.usecases.session as uc
     from rti_rig.runtime.session import SessionFolder
 
     rig = _FakeRig()
     monkeypatch.setattr(rti_rig.app.compose, "build_rig", lambda loaded: rig)
+    monkeypatch.setattr(rti_rig.app.rig_identity, "rig_identity", lambda loaded: {})
 
     def interrupted(*_: object) -> None:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(rti_rig.runtime.controller, "validate_schedule", interrupted)
+    monkeypatch.setattr(uc, "validate_schedule", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        cli._checked_rig(None, None)
+        uc.checked_rig(None, None)
     assert rig.closed
     rig.closed = False
-    monkeypatch.setattr(rti_rig.runtime.controller, "validate_schedule", lambda r, s: None)
+    monkeypatch.setattr(uc, "validate_schedule", lambda r, s: None)
     monkeypatch.setattr(SessionFolder, "create", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        cli._open_new_session(None, [], tmp_path / "new", False, 0.001)
+        uc._open_new(None, [], tmp_path / "new", False, 0.001, uc._ignore)  # type: ignore[arg-type]
     assert rig.closed

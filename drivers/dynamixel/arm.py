@@ -60,6 +60,7 @@ class DynamixelArm:
         self._bus = DxlBus(port, settings.name, packet_handler)
         self._connected = False
         self._lamp_on = False
+        self._emergency_stopped = False
         self._goal: tuple[int, int] | None = None
 
     # -- lifecycle --------------------------------------------------------------------------
@@ -83,6 +84,7 @@ class DynamixelArm:
             raise
         self._connected = True
         self._lamp_on = False
+        self._emergency_stopped = False
         self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is
 
     def _check_servo(self, joint) -> None:
@@ -118,6 +120,18 @@ class DynamixelArm:
                 "connect",
                 sid,
             )
+        if drive & ct.DRIVE_MODE_TORQUE_ON_BY_GOAL_UPDATE:
+            firmware = self._bus.read(sid, ct.FIRMWARE_VERSION)
+            if firmware >= ct.TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE:
+                raise ConfigMismatchError(
+                    dev,
+                    f"drive mode 0x{drive:02X} has bit 3 'Torque On by Goal Update' set "
+                    f"(firmware {firmware}): any goal written after an emergency stop would "
+                    "switch torque back on and move the arm; clear bit 3 of Drive Mode "
+                    "(address 10) with Dynamixel Wizard (torque off)",
+                    "connect",
+                    sid,
+                )
         if joint.mode == ct.OperatingMode.POSITION:
             self._check_position_limits(joint)
 
@@ -273,6 +287,10 @@ class DynamixelArm:
         """Stop motion by making the present position the goal (torque stays on: no falling)."""
         if not self._connected:
             return
+        if self._emergency_stopped:
+            # torque is off on purpose: writing a goal now is pointless at best, and on a servo
+            # whose Drive Mode has "Torque On by Goal Update" it would switch torque back on
+            return
         ticks = self.joint_ticks()
         goal = tuple(clamp_ticks(j, t) for j, t in zip(self.settings.joints, ticks, strict=True))
         self._send_goal(goal, "stop")  # type: ignore[arg-type]
@@ -282,6 +300,7 @@ class DynamixelArm:
 
         Use when the bus may be unreliable or the arm is hitting something: the arm goes limp
         and may drop under gravity, which is why ``stop`` (hold) is the normal safe stop."""
+        self._emergency_stopped = True
         self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
         self._lamp_on = False
 

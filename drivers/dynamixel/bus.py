@@ -7,6 +7,8 @@ Known SDK behaviours handled here:
 * A unicast Action or ``*TxOnly`` leaves the servo's status reply unread, and it corrupts the
   next read -> the arm never sends those; :meth:`DxlBus.write_no_wait` (the only TxOnly here)
   drains the reply, and :meth:`DxlBus.action` always broadcasts (no reply at all).
+* A status packet lost or corrupted on the wire fails one exchange -> reads (ping, read) are
+  idempotent and retried once (:meth:`DxlBus._exchange`); writes are never retried here.
 * Instruction packets go out without byte stuffing -> harmless for servos (they parse by
   length); the emulator parses by length too.
 """
@@ -81,10 +83,33 @@ class DxlBus:
             status = self.read(dxl_id, ct.HARDWARE_ERROR_STATUS, check_alert=False)
             raise HardwareFaultError(self.device, dxl_id, status, command)
 
+    #: Results that mean the status packet was lost or damaged (not that the servo refused).
+    RETRYABLE = (sdk.COMM_RX_TIMEOUT, sdk.COMM_RX_CORRUPT)
+
+    def _exchange(self, call, what: str, dxl_id: int):  # type: ignore[no-untyped-def]
+        """Run an idempotent read ``call`` (returning ``(..., result, error)``), retried once
+        if its status packet was lost or corrupt: reading twice changes nothing on the servo."""
+        reply = call()
+        if reply[-2] in self.RETRYABLE:
+            log.warning(
+                "%s: id %d %s: %s; retrying once",
+                self.device,
+                dxl_id,
+                what,
+                comm_text(self.ph, reply[-2]),
+            )
+            if reply[-2] == sdk.COMM_RX_TIMEOUT:
+                # a reply that was only late must not be read as the answer to a later command
+                self.drain_reply()
+            reply = call()
+        return reply
+
     # -- commands ---------------------------------------------------------------------------
     def ping(self, dxl_id: int) -> int:
         """Model number of servo ``dxl_id`` (raises if it does not answer)."""
-        model, result, error = self.ph.ping(self.port, dxl_id)
+        model, result, error = self._exchange(
+            lambda: self.ph.ping(self.port, dxl_id), "ping", dxl_id
+        )
         log.debug("%s: ping %d -> model %s (%d, %d)", self.device, dxl_id, model, result, error)
         self._check(result, error, dxl_id, "ping", alert=False)
         return int(model)
@@ -92,7 +117,9 @@ class DxlBus:
     def read(self, dxl_id: int, reg: ct.Register, check_alert: bool = True) -> int:
         command = f"read {reg.name}"
         fn = {1: self.ph.read1ByteTxRx, 2: self.ph.read2ByteTxRx, 4: self.ph.read4ByteTxRx}
-        value, result, error = fn[reg.size](self.port, dxl_id, reg.address)
+        value, result, error = self._exchange(
+            lambda: fn[reg.size](self.port, dxl_id, reg.address), command, dxl_id
+        )
         log.debug("%s: id %d %s -> %s (%d, %d)", self.device, dxl_id, command, value, result, error)
         self._check(result, error, dxl_id, command, alert=check_alert)
         return p2.to_signed(value, reg.size) if reg.signed else int(value)
@@ -101,7 +128,11 @@ class DxlBus:
         """Raw bytes of ``length`` registers from ``address`` and the status ERR byte.
 
         Hardware alerts are *not* raised here; the caller decides (it may want the data)."""
-        data, result, error = self.ph.readTxRx(self.port, dxl_id, address, length)
+        data, result, error = self._exchange(
+            lambda: self.ph.readTxRx(self.port, dxl_id, address, length),
+            f"read {address}+{length}",
+            dxl_id,
+        )
         log.debug(
             "%s: id %d read %d+%d -> %s (%d, %d)",
             self.device,

@@ -29,6 +29,11 @@ ID = Register("ID", 7, 1, eeprom=True)
 BAUD_RATE = Register("Baud Rate", 8, 1, eeprom=True)
 RETURN_DELAY_TIME = Register("Return Delay Time", 9, 1, eeprom=True)
 DRIVE_MODE = Register("Drive Mode", 10, 1, eeprom=True)
+#: Drive Mode bit 3, "Torque On by Goal Update" (firmware 45 and later): a Goal Position written
+#: while Torque Enable is 0 switches torque on and the servo moves to it (ROBOTIS e-manual,
+#: X-series control table, Drive Mode).
+DRIVE_MODE_TORQUE_ON_BY_GOAL_UPDATE = 0x08
+TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE = 45
 OPERATING_MODE = Register("Operating Mode", 11, 1, eeprom=True)
 HOMING_OFFSET = Register("Homing Offset", 20, 4, eeprom=True, signed=True)
 MOVING_THRESHOLD = Register("Moving Threshold", 24, 4, eeprom=True)

@@ -6,6 +6,7 @@ existing file, so an interrupted or repeated write can never damage an image alr
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 from pathlib import Path
@@ -29,11 +30,17 @@ def _atomic_write(path: Path, data: bytes) -> str:
     if path.exists():
         raise SessionError(f"{path} already exists: refusing to overwrite a captured file")
     tmp = path.with_name(f".{path.name}.partial")
-    with open(tmp, "wb") as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError:
+        # a write that failed (no space, read-only, I/O error) leaves no partial file behind
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise
     return hashlib.sha256(data).hexdigest()
 
 

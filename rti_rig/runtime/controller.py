@@ -23,7 +23,9 @@ from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
+    NoSpaceError,
     SessionFolder,
+    SessionWriteError,
     StepRecord,
     check_free_space,
     estimated_bytes_per_image,
@@ -36,6 +38,10 @@ class FinishReason(StrEnum):
     ERROR = "error"
     INTERRUPTED = "interrupted"
     EMERGENCY_STOP = "emergency-stop"
+    #: a session file could not be written (no space, read-only, I/O error)
+    WRITE_FAILED = "write-failed"
+    #: the disk could not hold the next image (checked before each one)
+    NO_SPACE = "no-space"
 
 
 class EmergencyStop(BaseException):
@@ -212,24 +218,23 @@ def run_session(
     done = folder.done
     todo = [i for i in range(total) if i not in done]
     cam = rig.camera_config
-    check_free_space(folder.root, len(todo), estimated_bytes_per_image(cam.width, cam.height))
+    per_image = estimated_bytes_per_image(cam.width, cam.height)
+    check_free_space(folder.root, len(todo), per_image)
     cancel = cancel or CancelToken()
     emit = on_event or (lambda _e: None)
     clock = rig.clock
-    folder.begin(
-        {
-            "rig": {
-                "name": rig.name,
-                "kind": rig.loaded.config.kind,
-                "backend": rig.loaded.config.backend,
-                "config_path": rig.loaded.path,
-                "config_sha256": rig.loaded.sha256,
-                "config": rig.loaded.raw,
-            },
-            "schedule": schedule.to_dict(),
-            **({"adaptive": source.header()} if source is not None else {}),
-        }
-    )
+    header = {
+        "rig": {
+            "name": rig.name,
+            "kind": rig.loaded.config.kind,
+            "backend": rig.loaded.config.backend,
+            "config_path": rig.loaded.path,
+            "config_sha256": rig.loaded.sha256,
+            "config": rig.loaded.raw,
+        },
+        "schedule": schedule.to_dict(),
+        **({"adaptive": source.header()} if source is not None else {}),
+    }
     records: list[StepRecord] = []
     reason = FinishReason.ERROR
     error: str | None = None
@@ -240,6 +245,8 @@ def run_session(
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()
+        # only now, with the rig known to answer, is anything written to disk
+        folder.begin(header)
         for i in todo:
             if cancel.paused:
                 emit(Paused(i, total))
@@ -257,6 +264,7 @@ def run_session(
                     break
                 step, decision = decided
                 validate_schedule(rig, LightSchedule((step,)))  # before this light moves
+            check_free_space(folder.root, 1, per_image)
             emit(StepStarted(i, total, step))
             t_start = clock.now()
             actual = rig.lighting.set(step)
@@ -292,6 +300,12 @@ def run_session(
     except EmergencyStop as exc:
         reason, error = FinishReason.EMERGENCY_STOP, f"emergency stop: {exc}"
         raise
+    except NoSpaceError as exc:
+        reason, error = FinishReason.NO_SPACE, str(exc)
+        raise
+    except SessionWriteError as exc:
+        reason, error = FinishReason.WRITE_FAILED, str(exc)
+        raise
     except Exception as exc:
         reason, error = FinishReason.ERROR, f"{type(exc).__name__}: {exc}"
         raise
@@ -308,16 +322,21 @@ def run_session(
                     teardown.append(f"{label}: {exc}")
             rig_time = clock.now() - rig_t0
             wall_time = time.perf_counter() - wall_t0
-            folder.finish(
-                records,
-                runner={
-                    "state": "finished",
-                    "finish_reason": str(reason),
-                    "error": error,
-                    "teardown_failures": teardown,
-                    "steps_planned": total,
-                    "steps_done_this_run": len(records),
-                },
-                timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
-            )
+            try:
+                folder.finish(
+                    records,
+                    runner={
+                        "state": "finished",
+                        "finish_reason": str(reason),
+                        "error": error,
+                        "teardown_failures": teardown,
+                        "steps_planned": total,
+                        "steps_done_this_run": len(records),
+                    },
+                    timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
+                )
+            except SessionWriteError as exc:
+                if error is None:  # nothing else went wrong: this is the session's failure
+                    raise
+                teardown.append(f"session record: {exc}")  # the first failure is the story
     return SessionResult(reason, tuple(records), rig_time, wall_time, error, tuple(teardown))

@@ -12,13 +12,19 @@ Layout (opens directly in relight-cli's folder mode, which takes the first ``*.l
       lights.lp              one line per image, from the light that actually fired
       journal.jsonl          one line per completed step, flushed to disk as it happens
       manifest.json          rig config, schedule, per-step timings, versions, finish reason
+      recovered/STAMP/...    what a resume set aside: unverified images, rejected journal lines
 
-Nothing already captured is ever overwritten: a folder that is not empty is refused, and image
-writes refuse existing files.
+Nothing already captured is ever overwritten: a folder holding images is refused, and image
+writes refuse existing files. Nothing is created on disk until :meth:`SessionFolder.begin`
+(called once the rig is connected), and ``lights.lp`` is rewritten atomically after every
+committed image, so a killed session opens in relight at once. Other writers (a camera's RAW
+originals, say) may add their own sub-folders: only ``image_*`` files and the files above are
+the session store's.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -34,7 +40,7 @@ from typing import Any
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
-from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.core.lp_format import LpEntry, format_lp
 
 MANIFEST = "manifest.json"
 JOURNAL = "journal.jsonl"
@@ -107,14 +113,46 @@ def _now_iso() -> str:
     return datetime.now(UTC).isoformat(timespec="seconds")
 
 
-def _write_json_atomic(path: Path, data: dict[str, Any]) -> None:
+class SessionWriteError(SessionError):
+    """A session file could not be written (no space, read-only, I/O error): the session stops.
+
+    ``path`` is the file; ``errno_name`` the system's reason (``ENOSPC``, ``EROFS``, ``EIO``…).
+    """
+
+    def __init__(self, path: Path, exc: OSError) -> None:
+        import errno as _errno
+
+        self.path = Path(path)
+        self.errno_name = _errno.errorcode.get(exc.errno or 0, "") if exc.errno else ""
+        reason = exc.strerror or str(exc)
+        code = f" ({self.errno_name})" if self.errno_name else ""
+        super().__init__(f"cannot write {self.path}: {reason}{code}")
+
+
+def _write_bytes_atomic(path: Path, data: bytes) -> None:
+    """Replace ``path`` with ``data`` atomically (temporary file, fsync, rename); the temporary
+    file is removed if anything fails, so a failed write leaves the old file and nothing else."""
     tmp = path.with_name(f".{path.name}.tmp")
-    with open(tmp, "w", encoding="utf-8") as fh:
-        json.dump(data, fh, indent=2, default=str)
-        fh.write("\n")
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
+        raise SessionWriteError(path, exc) from None
+
+
+def _write_json_atomic(path: Path, data: dict[str, Any]) -> None:
+    text = json.dumps(data, indent=2, default=str) + "\n"
+    _write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def write_lp_atomic(path: Path, entries: list[LpEntry]) -> None:
+    """Write an `.lp` file atomically, fsynced (relight may open it at any moment)."""
+    _write_bytes_atomic(path, format_lp(entries).encode("ascii"))
 
 
 def estimated_bytes_per_image(width: int, height: int, channels: int = 3) -> int:
@@ -123,22 +161,54 @@ def estimated_bytes_per_image(width: int, height: int, channels: int = 3) -> int
     return 2 * pixels + pixels // 2 + 16_384
 
 
+class NoSpaceError(SessionError):
+    """The disk cannot hold the next image(s): checked before the rig starts and before each
+    image, so the session stops cleanly rather than on a write that fails half-way."""
+
+
 def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
-    """Refuse to start when the disk cannot hold the images still to be captured."""
+    """Refuse to go on when the disk cannot hold the images still to be captured."""
     probe = Path(root)
     while not probe.exists():
         probe = probe.parent
     free = shutil.disk_usage(probe).free
     need = steps * bytes_per_image + 8 * 1024 * 1024
     if free < need:
-        raise SessionError(
+        raise NoSpaceError(
             f"not enough free disk space for {steps} image(s) under {probe}: need about "
             f"{need / 1e6:.0f} MB, {free / 1e6:.0f} MB free; free space or choose another --out"
         )
 
 
+#: Files a session folder that holds no image may contain (left by a session that stopped
+#: before its first image): such a folder may be reused for a new session.
+_NO_IMAGE_FILES = {MANIFEST, JOURNAL, LP_NAME}
+
+
+def _holds_no_image(root: Path) -> bool:
+    """True if ``root`` holds nothing but an image-less session's own files."""
+    for path in root.rglob("*"):
+        rel = path.relative_to(root)
+        if path.is_dir():
+            if rel.as_posix() != LINEAR_DIR:
+                return False
+            continue
+        name = rel.as_posix()
+        if name.startswith(".") and name.endswith((".tmp", ".partial")):
+            continue
+        if name not in _NO_IMAGE_FILES:
+            return False
+    journal = root / JOURNAL
+    return not (journal.exists() and scan_journal(root).records)
+
+
 class SessionFolder:
-    """Writes one session: created empty (or reopened to resume), filled step by step."""
+    """Writes one session: created empty (or reopened to resume), filled step by step.
+
+    ``rig_identity`` (set by whoever opens the session) is what the images depend on — the
+    rig's kind, lights, camera size, exposure, decoding — recorded in the manifest so a resume
+    can refuse another rig; ``rig_change`` records a difference the user accepted.
+    """
 
     def __init__(self, root: Path, total_steps: int) -> None:
         self.root = Path(root)
@@ -146,15 +216,24 @@ class SessionFolder:
         self.names = image_names(total_steps)
         self.manifest: dict[str, Any] = {}
         self.resume: ResumeState | None = None
+        self.rig_identity: dict[str, Any] | None = None
+        self.rig_change: list[str] | None = None
+        self.begun = False
+        #: every committed step (earlier runs' verified ones and this run's), by index
+        self.committed: dict[int, StepRecord] = {}
 
     @staticmethod
     def check_new(root: Path) -> None:
         """Refuse a folder a new session may not be written into (checked before the rig is
-        even opened, so nothing moves or lights for a session that cannot be kept)."""
+        even opened, so nothing moves or lights for a session that cannot be kept).
+
+        A folder that holds no image (empty, or left by a session that stopped before its
+        first image) may be reused.
+        """
         root = Path(root)
         if root.exists() and not root.is_dir():
             raise SessionError(f"{root} exists and is not a folder: choose another --out")
-        if root.exists() and any(root.iterdir()):
+        if root.exists() and any(root.iterdir()) and not _holds_no_image(root):
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "
                 "choose a new --out folder, or continue an interrupted session with "
@@ -163,34 +242,51 @@ class SessionFolder:
 
     @classmethod
     def create(cls, root: Path, total_steps: int) -> SessionFolder:
+        """A new session in ``root`` (checked, but not created: :meth:`begin` creates it)."""
         root = Path(root)
         cls.check_new(root)
-        try:
-            (root / LINEAR_DIR).mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise SessionError(f"cannot create {root}: {exc.strerror or exc}") from None
         return cls(root, total_steps)
 
     @classmethod
     def reopen(cls, root: Path) -> SessionFolder:
         """Open an interrupted session to capture the steps it has not done yet.
 
-        What is on disk is verified against the journal's checksums first; see
-        :func:`prepare_resume`.
+        What is on disk is verified against the journal's checksums first, and the journal is
+        repaired; see :func:`prepare_resume`.
         """
         state = prepare_resume(Path(root))
         folder = cls(Path(root), planned_steps(state.manifest))
         folder.manifest = state.manifest
         folder.resume = state
+        folder.committed = dict(state.done)
         return folder
 
     @property
     def done(self) -> dict[int, StepRecord]:
         return dict(self.resume.done) if self.resume else {}
 
+    @property
+    def images_kept(self) -> int:
+        """Committed images in the folder (earlier runs' and this one's)."""
+        return len(self.committed)
+
+    def _make_folder(self) -> None:
+        try:
+            (self.root / LINEAR_DIR).mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise SessionWriteError(self.root, exc) from None
+        # an image-less session left here before (see check_new): its files go
+        for name in (JOURNAL, LP_NAME):
+            with contextlib.suppress(FileNotFoundError):
+                (self.root / name).unlink()
+
     def begin(self, header: dict[str, Any]) -> None:
-        """Record what is about to run, before anything moves."""
-        run = {
+        """Record what is about to run, once the rig is connected and before anything moves.
+
+        A new session's folder is created here, not before: a rig that cannot be reached leaves
+        nothing on disk.
+        """
+        run: dict[str, Any] = {
             "started_at": _now_iso(),
             "software": software_versions(),
             # which config (and light calibration) this run's images were shot with
@@ -207,44 +303,68 @@ class SessionFolder:
                 old.setdefault("finish_reason", "crashed")
             run["resumed_with_steps_done"] = len(self.resume.done)
             run["recovered_files"] = self.resume.recovered
+            if self.resume.journal_repair:
+                run["journal_repair"] = self.resume.journal_repair
+            if self.rig_change:
+                run["rig_change"] = self.rig_change
+            if self.rig_identity is not None:
+                self.manifest.setdefault("rig", {})["identity"] = self.rig_identity
+            new_path = (header.get("rig") or {}).get("config_path")
+            if new_path:
+                # the config this run used is the session's own from now on (a change of rig was
+                # accepted, or the same rig's config was given from elsewhere)
+                run["config_path"] = new_path
+                self.manifest.setdefault("rig", {})["config_path"] = new_path
             runs.append(run)
             self.manifest["runner"] = {"state": "running", "finish_reason": None}
         else:
+            self._make_folder()
+            rig = dict(header.get("rig") or {})
+            if self.rig_identity is not None:
+                rig["identity"] = self.rig_identity
             self.manifest = {
                 "format": FORMAT,
                 "software": run["software"],
                 "started_at": run["started_at"],
                 **header,
+                "rig": rig,
                 "runner": {"state": "running", "finish_reason": None},
                 "runs": [run],
                 "steps": [],
             }
         _write_json_atomic(self.root / MANIFEST, self.manifest)
+        self.begun = True
 
     def write_step(self, index: int, frame: Frame, record_fields: dict[str, Any]) -> StepRecord:
         """Write one captured frame (linear TIFF, then sRGB JPEG), then journal it.
 
         The journal line is the commit point: a step is done only once its line is on disk, and
-        its checksums prove the files are the ones written.
+        its checksums prove the files are the ones written. ``lights.lp`` is then rewritten
+        from every committed step. A write that fails (no space, read-only, I/O error) raises
+        :class:`SessionWriteError` naming the file, with no temporary file left behind and the
+        journal as it was.
         """
         t0 = time.perf_counter()
         base = self.names[index]
         jpg, tif = f"{base}.jpg", f"{LINEAR_DIR}/{base}.tif"
         decode = dict(frame.metadata.get("decode") or {})
         listed = frame.metadata.get("originals") or []
-        originals = self._keep_originals(base, listed)
-        for item, rel in zip(listed, originals, strict=True):
-            if decode.get("source_file") == str(item["path"]):
-                # where the decoded RAW is kept now, and the camera's own name for it
-                decode["raw_file"] = rel
-                decode["camera_file"] = originals[rel][1]
-        sha = {name: digest for name, (digest, _) in originals.items()}
-        sha[tif] = write_linear_tiff(
-            self.root / tif, frame.pixels, description=_tiff_description(decode)
-        )
-        sha[jpg] = write_srgb_jpeg(
-            self.root / jpg, linear_to_srgb8(frame.pixels, frame.white_level)
-        )
+        current = self.root / RAW_DIR
+        try:
+            originals = self._keep_originals(base, listed)
+            for item, rel in zip(listed, originals, strict=True):
+                if decode.get("source_file") == str(item["path"]):
+                    # where the decoded RAW is kept now, and the camera's own name for it
+                    decode["raw_file"] = rel
+                    decode["camera_file"] = originals[rel][1]
+            sha = {name: digest for name, (digest, _) in originals.items()}
+            current = self.root / tif
+            description = _tiff_description(decode)
+            sha[tif] = write_linear_tiff(current, frame.pixels, description=description)
+            current = self.root / jpg
+            sha[jpg] = write_srgb_jpeg(current, linear_to_srgb8(frame.pixels, frame.white_level))
+        except OSError as exc:
+            raise SessionWriteError(current, exc) from None
         record = StepRecord(
             index=index,
             image=jpg,
@@ -259,10 +379,9 @@ class SessionFolder:
             notices=[str(n) for n in frame.metadata.get("notices") or []],
             **record_fields,
         )
-        with open(self.root / JOURNAL, "a", encoding="utf-8") as fh:
-            fh.write(json.dumps(asdict(record)) + "\n")
-            fh.flush()
-            os.fsync(fh.fileno())
+        self._append_journal(json.dumps(asdict(record)) + "\n")
+        self.committed[index] = record
+        self.write_lp()
         return record
 
     def _keep_originals(
@@ -300,18 +419,54 @@ class SessionFolder:
             kept[rel] = (digest, str(item.get("name") or src.name))
         return kept
 
+    def _append_journal(self, line: str) -> None:
+        """Append one line and fsync it; on failure cut the journal back to what it was."""
+        path = self.root / JOURNAL
+        size = path.stat().st_size if path.exists() else 0
+        try:
+            with open(path, "a", encoding="utf-8") as fh:
+                fh.write(line)
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                os.truncate(path, size)
+            raise SessionWriteError(path, exc) from None
+
+    def write_lp(self) -> None:
+        """Rewrite ``lights.lp`` from every committed step, in step order (atomically)."""
+        ordered = [self.committed[i] for i in sorted(self.committed)]
+        if ordered:
+            write_lp_atomic(
+                self.root / LP_NAME, [LpEntry(r.image, r.actual_direction) for r in ordered]
+            )
+
     def finish(
         self, records: list[StepRecord], runner: dict[str, Any], timing: dict[str, Any]
     ) -> None:
-        """Write the `.lp` from what actually ran (all runs, in step order), then the manifest."""
-        every = {r.index: r for r in self.done.values()}
-        every.update({r.index: r for r in records})
-        ordered = [every[i] for i in sorted(every)]
-        if ordered:
-            write_lp(
-                self.root / LP_NAME,
-                [LpEntry(r.image, r.actual_direction) for r in ordered],
-            )
+        """Write the `.lp` from what actually ran (all runs, in step order), then the manifest.
+
+        Does nothing for a session that never began (nothing was created on disk).
+        """
+        if not self.begun:
+            return
+        for r in records:
+            self.committed.setdefault(r.index, r)
+        # a stop that came between a journal line and its return (a signal during the fsync)
+        # still leaves a committed step: the journal is the commit point, so it is read back
+        with contextlib.suppress(SessionError):
+            late = [
+                e
+                for e in scan_journal(self.root, self.names).records
+                if e["index"] not in self.committed
+            ]
+            self.committed.update(verified_steps(self.root, late))
+        ordered = [self.committed[i] for i in sorted(self.committed)]
+        lp_error: SessionWriteError | None = None
+        try:
+            self.write_lp()
+        except SessionWriteError as exc:  # the manifest still says how the run ended
+            lp_error = exc
         run = self.manifest["runs"][-1]
         run.update({"finished_at": _now_iso(), "finish_reason": runner["finish_reason"], **timing})
         runs = self.manifest["runs"]
@@ -324,12 +479,14 @@ class SessionFolder:
                     "wall_time_s": sum(r.get("wall_time_s", 0.0) for r in runs),
                     "runs": len(runs),
                 },
-                "lp_file": LP_NAME if ordered else None,
+                "lp_file": LP_NAME if ordered and lp_error is None else None,
                 "steps": [asdict(r) for r in ordered],
                 "notices": session_notices(ordered),
             }
         )
         _write_json_atomic(self.root / MANIFEST, self.manifest)
+        if lp_error is not None:
+            raise lp_error
 
 
 def session_notices(records: list[StepRecord]) -> list[str]:
@@ -357,29 +514,114 @@ class ResumeState:
     manifest: dict[str, Any]
     done: dict[int, StepRecord]
     recovered: list[str]
+    #: what was done to the journal before appending to it (torn tail, rejected lines)
+    journal_repair: list[str] = field(default_factory=list)
+
+
+@dataclass
+class JournalScan:
+    """A journal read tolerantly: its well-formed records and what is not one.
+
+    ``kept`` holds the raw bytes of the good lines (each ending in a newline), ``rejected``
+    the line numbers, texts and reasons of the others, ``torn`` a last line with no newline
+    (the process died while appending it: never committed).
+    """
+
+    records: list[dict[str, Any]] = field(default_factory=list)
+    kept: list[bytes] = field(default_factory=list)
+    rejected: list[tuple[int, str, str]] = field(default_factory=list)
+    torn: bytes = b""
+
+    @property
+    def needs_repair(self) -> bool:
+        return bool(self.rejected or self.torn)
+
+
+_REQUIRED = {
+    name
+    for name, f in StepRecord.__dataclass_fields__.items()
+    if f.default is f.default_factory  # both MISSING: a field every record must have
+}
+
+
+def _record_problem(entry: object, names: list[str] | None) -> str | None:
+    """Why a parsed journal line is not a step record (``None`` if it is one)."""
+    if not isinstance(entry, dict):
+        return f"a JSON {type(entry).__name__}, not a step record"
+    missing = sorted(_REQUIRED - entry.keys())
+    if missing:
+        return f"a record without {', '.join(missing)}"
+    sha = entry.get("sha256")
+    if (
+        not isinstance(sha, dict)
+        or not sha
+        or not all(isinstance(k, str) and isinstance(v, str) for k, v in sha.items())
+    ):
+        return "a record without its checksums (sha256)"
+    idx = entry["index"]
+    if not isinstance(idx, int) or isinstance(idx, bool):
+        return f"index {idx!r} is not a step number"
+    if names is not None:
+        if not 0 <= idx < len(names):
+            return f"index {idx} is outside the schedule's {len(names)} steps"
+        own = {entry["image"], entry["linear_image"]}
+        originals = entry.get("originals") or {}
+        # besides its JPEG and TIFF a step may keep the camera's own files, under raw/
+        kept_raw = all(
+            name in originals and name.startswith(f"{RAW_DIR}/{names[idx]}")
+            for name in set(sha) - own
+        )
+        if entry["image"] != f"{names[idx]}.jpg" or not own <= set(sha) or not kept_raw:
+            return f"image {entry['image']!r} does not fit step {idx + 1} of the schedule"
+    try:
+        _to_record(entry)
+    except (TypeError, ValueError) as exc:
+        return f"a malformed record ({exc})"
+    return None
+
+
+def _to_record(entry: dict[str, Any]) -> StepRecord:
+    rec = {k: v for k, v in entry.items() if k in StepRecord.__dataclass_fields__}
+    for key in ("planned_direction", "actual_direction"):
+        vec = tuple(float(x) for x in rec[key])
+        if len(vec) != 3:
+            raise ValueError(f"{key} has {len(vec)} components")
+        rec[key] = vec
+    return StepRecord(**rec)
+
+
+def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
+    """Read the journal without changing it; every line is either a record or rejected."""
+    path = Path(root) / JOURNAL
+    scan = JournalScan()
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        return scan
+    except OSError as exc:
+        raise SessionError(f"cannot read {path}: {exc.strerror or exc}") from None
+    *lines, scan.torn = data.split(b"\n")
+    for i, raw in enumerate(lines):
+        if not raw.strip():
+            continue
+        try:
+            text = raw.decode("utf-8")
+            entry = json.loads(text)
+        except (UnicodeDecodeError, json.JSONDecodeError):
+            scan.rejected.append((i + 1, raw.decode("utf-8", "replace"), "not valid JSON"))
+            continue
+        problem = _record_problem(entry, names)
+        if problem:
+            scan.rejected.append((i + 1, text, problem))
+            continue
+        scan.records.append(entry)
+        scan.kept.append(raw + b"\n")
+    return scan
 
 
 def read_journal(root: Path) -> list[dict[str, Any]]:
-    """Journal lines; a torn last line (the process died while appending) is ignored."""
-    path = Path(root) / JOURNAL
-    if not path.exists():
-        return []
-    lines = path.read_text(encoding="utf-8").split("\n")
-    out = []
-    for i, line in enumerate(lines):
-        if not line.strip():
-            continue
-        try:
-            out.append(json.loads(line))
-        except json.JSONDecodeError:
-            if i == len(lines) - 1:  # no newline after it: torn by a crash, never committed
-                break
-            raise SessionError(
-                f"{path}, line {i + 1}: not valid JSON, so it cannot be known which images are "
-                "complete; restore the journal from a backup or start a new session (nothing "
-                "in this folder has been changed)"
-            ) from None
-    return out
+    """The journal's well-formed records (torn or junk lines are left out; nothing changes)."""
+    return scan_journal(root).records
 
 
 def _fsync_sha256(path: Path) -> str:
@@ -410,23 +652,81 @@ def _tiff_description(decode: dict[str, Any]) -> str | None:
 def _sha256(path: Path) -> str | None:
     try:
         return hashlib.sha256(path.read_bytes()).hexdigest()
-    except FileNotFoundError:
+    except (FileNotFoundError, IsADirectoryError):
         return None
 
 
-def prepare_resume(root: Path) -> ResumeState:
-    """Verify an interrupted session and set aside anything that is not a committed step.
+def verified_steps(root: Path, records: list[dict[str, Any]]) -> dict[int, StepRecord]:
+    """The steps whose files are on disk with their journaled checksums (the later record of a
+    step wins: a recaptured image replaces one set aside)."""
+    done: dict[int, StepRecord] = {}
+    for entry in records:
+        idx = entry["index"]
+        if all(_sha256(Path(root) / name) == digest for name, digest in entry["sha256"].items()):
+            done[idx] = _to_record(entry)
+        else:
+            done.pop(idx, None)
+    return done
 
-    A step counts as done when its journal line exists and every file it names is on disk with
-    the journaled checksum. Image files that no committed step accounts for (a write cut short
-    between the TIFF and the JPEG, a checksum mismatch) are *moved* to ``recovered/``, never
-    deleted; half-written temporary files are removed (they never were an image).
+
+def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[str]:
+    """Set aside what is not a record, then rewrite the journal with the records only.
+
+    The torn tail and every rejected line go, with the reason, to
+    ``recovered/STAMP/journal-rejected.txt``; the journal is then replaced atomically by its
+    good lines, so the next record is never appended onto a torn one.
     """
+    notes: list[str] = []
+    report = []
+    for lineno, text, reason in scan.rejected:
+        notes.append(f"journal line {lineno}: {reason}")
+        report.append(f"# line {lineno}: {reason}\n{text}\n")
+    if scan.torn:
+        notes.append(f"journal: a torn last line of {len(scan.torn)} byte(s) (never committed)")
+        report.append(
+            "# torn last line (no newline: the process died while writing it; never "
+            f"committed)\n{scan.torn.decode('utf-8', 'replace')}\n"
+        )
+    dest = root / "recovered" / stamp / "journal-rejected.txt"
+    try:
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        with open(dest, "a", encoding="utf-8") as fh:
+            fh.write("".join(report))
+            fh.flush()
+            os.fsync(fh.fileno())
+    except OSError as exc:
+        raise SessionWriteError(dest, exc) from None
+    _write_bytes_atomic(root / JOURNAL, b"".join(scan.kept))
+    return notes
+
+
+def _new_stamp(root: Path) -> str:
+    """A ``recovered/`` sub-folder name not used yet (resumes may follow within a second)."""
+    base = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
+    stamp, n = base, 1
+    while (root / "recovered" / stamp).exists():
+        n += 1
+        stamp = f"{base}-{n}"
+    return stamp
+
+
+def prepare_resume(root: Path) -> ResumeState:
+    """Verify an interrupted session, repair its journal and set aside what is not committed.
+
+    A step counts as done when its journal line is a well-formed record and every file it names
+    is on disk with the journaled checksum. Journal lines that are not records (a torn last
+    line, junk) are moved to ``recovered/`` with the reason and the journal rewritten without
+    them, before anything is appended. Image files that no committed step accounts for (a write
+    cut short between the TIFF and the JPEG, a checksum mismatch) are *moved* to
+    ``recovered/``, never deleted; half-written temporary files are removed (they never were
+    an image).
+    """
+    root = Path(root)
     manifest = read_manifest(root)
     total = planned_steps(manifest)
     if total == 0:
         raise SessionError(f"{root}: the manifest holds no schedule, so there is nothing to resume")
-    runner = manifest.get("runner", {})
+    runner = manifest.get("runner") or {}
     if runner.get("finish_reason") == "completed":
         done = runner.get("steps_done", total)
         if manifest.get("adaptive") and done < total:  # an adaptive session that chose to stop
@@ -437,29 +737,12 @@ def prepare_resume(root: Path) -> ResumeState:
             )
         raise SessionError(f"{root}: this session already completed all {total} steps")
     names = image_names(total)
-    fields = set(StepRecord.__dataclass_fields__)
-    done: dict[int, StepRecord] = {}
-    for entry in read_journal(root):
-        idx = entry.get("index")
-        if (
-            not isinstance(idx, int)
-            or not 0 <= idx < total
-            or entry.get("image") != f"{names[idx]}.jpg"
-        ):
-            raise SessionError(
-                f"{root}: journal entry {entry.get('image')!r} does not fit the schedule"
-            )
-        ok = all(_sha256(root / name) == digest for name, digest in entry["sha256"].items())
-        if ok:
-            rec = {k: v for k, v in entry.items() if k in fields}
-            for key in ("planned_direction", "actual_direction"):
-                rec[key] = tuple(rec[key])
-            done[idx] = StepRecord(**rec)
-        else:
-            done.pop(idx, None)
+    stamp = _new_stamp(root)
+    scan = scan_journal(root, names)
+    repair = _repair_journal(root, scan, stamp) if scan.needs_repair else []
+    done = verified_steps(root, scan.records)
     keep = {name for rec in done.values() for name in rec.sha256}
     recovered: list[str] = []
-    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
     leftovers = [
         *root.glob("image_*"),
         *(root / LINEAR_DIR).glob("image_*"),
@@ -471,18 +754,26 @@ def prepare_resume(root: Path) -> ResumeState:
         if rel in keep:
             continue
         dest = root / "recovered" / stamp / rel
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        os.replace(path, dest)
+        try:
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(path, dest)
+        except OSError as exc:
+            raise SessionWriteError(dest, exc) from None
         recovered.append(dest.relative_to(root).as_posix())
-    partials = [
+    for partial in [
         *root.glob(".*.partial"),
         *(root / LINEAR_DIR).glob(".*.partial"),
         *(root / RAW_DIR).glob(".*.partial"),
-    ]
-    for partial in partials:
+        *root.glob(".*.tmp"),
+    ]:
         partial.unlink()
-    (root / LINEAR_DIR).mkdir(exist_ok=True)
-    return ResumeState(manifest=manifest, done=done, recovered=recovered)
+    try:
+        (root / LINEAR_DIR).mkdir(exist_ok=True)
+    except OSError as exc:
+        raise SessionWriteError(root / LINEAR_DIR, exc) from None
+    if repair:
+        recovered.append(f"recovered/{stamp}/journal-rejected.txt")
+    return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
 
 
 def read_manifest(root: Path) -> dict[str, Any]:
@@ -507,11 +798,32 @@ def read_manifest(root: Path) -> dict[str, Any]:
     return data
 
 
-def session_lp_entries(root: Path, linear: bool = False) -> list[LpEntry]:
-    """`.lp` entries of a finished session, from the directions that actually ran."""
+def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], list[str]]:
+    """`.lp` entries of a session from its verified journal, and the images left out.
+
+    Works on a finished session and on an interrupted or killed one alike: a step is listed when
+    its journal record is well formed and its files are on disk with the journaled checksums,
+    with the direction that actually ran. The second list names journaled images that are
+    missing or changed since (left out).
+    """
     manifest = read_manifest(root)
-    steps = manifest.get("steps") or []
-    if not steps:
+    steps = (manifest.get("schedule") or {}).get("steps")
+    names = image_names(len(steps)) if isinstance(steps, list) and steps else None
+    records = scan_journal(root, names).records
+    done = verified_steps(root, records)
+    if not records:
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
+    left_out = sorted({r["image"] for r in records if r["index"] not in done})
+    if not done:
+        raise SessionError(
+            f"{root}: none of the {len(left_out)} journaled image(s) is on disk as captured "
+            "(missing or changed), so there is no .lp to export"
+        )
     key = "linear_image" if linear else "image"
-    return [LpEntry(s[key], tuple(s["actual_direction"])) for s in steps]
+    entries = [LpEntry(getattr(done[i], key), done[i].actual_direction) for i in sorted(done)]
+    return entries, left_out
+
+
+def session_lp_entries(root: Path, linear: bool = False) -> list[LpEntry]:
+    """`.lp` entries of a session's verified images (see :func:`session_lp_report`)."""
+    return session_lp_report(root, linear)[0]

@@ -1,0 +1,100 @@
+"""What a session's images depend on in its rig, so a resume can refuse another rig.
+
+A session shot half on one rig and half on another is not one session: a dome finished by an
+arm, 512² images next to 256² ones, or a different exposure make the images disagree with each
+other and with the `.lp`. The identity lists what changes the images — the rig's kind and
+backend, where its lights can be, the LEDs' intensity correction, the camera's size, exposure,
+gain and RAW decoding, and (for a dry run) the simulated scene — and nothing that does not (a
+serial port's name, timing, parking policy), so a rig moved to another USB port resumes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from typing import Any
+
+from rti_rig.app.config import LoadedRig, rig_geometry
+from rti_rig.core.rig_geometry import DomeGeometry
+
+#: How each identity key is named in a refusal.
+LABELS = {
+    "kind": "rig kind",
+    "backend": "backend",
+    "lights": "lights",
+    "light_positions": "light positions",
+    "intensity_correction": "LED intensity correction",
+    "arm_reach": "arm reach",
+    "camera_size": "camera size",
+    "exposure_s": "exposure (s)",
+    "gain": "camera gain",
+    "camera_device": "camera driver",
+    "decode": "RAW decoding",
+    "scene": "simulated scene",
+}
+
+
+def _digest(value: Any) -> str:
+    text = json.dumps(value, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
+    """The rig's identity as a flat JSON-able dict (see the module docstring)."""
+    cfg = loaded.config
+    geometry = rig_geometry(loaded)
+    ident: dict[str, Any] = {"kind": cfg.kind, "backend": cfg.backend}
+    if isinstance(geometry, DomeGeometry):
+        ident["lights"] = f"{geometry.count} LEDs"
+        ident["light_positions"] = _digest(
+            [[round(float(x), 5) for x in d] for d in geometry.directions]
+        )
+        serial = cfg.dome.serial if cfg.dome else None
+        corr = getattr(serial, "intensity_correction", None)
+        ident["intensity_correction"] = None if corr is None else _digest(list(corr))
+    else:
+        ident["lights"] = "one lamp on an arm"
+        ident["arm_reach"] = {
+            k: round(float(v), 6) for k, v in dataclasses.asdict(geometry).items()
+        }
+    cam = cfg.camera
+    ident["camera_size"] = f"{cam.width}×{cam.height}"
+    ident["exposure_s"] = cam.exposure_s
+    ident["gain"] = cam.gain
+    device = cam.device or {}
+    ident["camera_device"] = device.get("kind")
+    ident["decode"] = None if device.get("decode") is None else _digest(device.get("decode"))
+    if cfg.backend != "hardware":
+        ident["scene"] = _digest(cfg.scene.model_dump())
+    return ident
+
+
+def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[str]:
+    """Each difference as ``"camera size: 512×512 → 256×256"`` (empty if the rigs agree)."""
+    out = []
+    other_kind = before.get("kind") != now.get("kind")
+    for key in [*before, *(k for k in now if k not in before)]:
+        old, new = before.get(key), now.get(key)
+        if old == new:
+            continue
+        if other_kind and key in ("light_positions", "intensity_correction", "arm_reach"):
+            continue  # a dome and an arm differ in these by nature: the kind says it all
+        label = LABELS.get(key, key)
+        if key in ("light_positions", "intensity_correction", "decode", "scene"):
+            out.append(f"{label}: changed" if old and new else f"{label}: {old} → {new}")
+        elif isinstance(old, dict) and isinstance(new, dict):
+            changed = [k for k in {**old, **new} if old.get(k) != new.get(k)]
+            out.append(
+                f"{label}: "
+                + ", ".join(f"{k} {_show(old.get(k))} → {_show(new.get(k))}" for k in changed)
+            )
+        else:
+            out.append(f"{label}: {_show(old)} → {_show(new)}")
+    return out
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:g}"
+    return "none" if value is None else str(value)

@@ -1,0 +1,460 @@
+"""Capture sessions as use cases: start one, resume one, shoot a preview, run what was opened.
+
+Everything that can be checked is checked here, once, before anything moves: the options, the
+light count, the session folder, then the rig is opened and the schedule checked against it. The
+CLI only parses its options into a request, calls these functions and prints what they report.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.schedule import LightSchedule
+from rti_rig.runtime.controller import (
+    CancelToken,
+    Event,
+    FinishReason,
+    SessionResult,
+    run_session,
+    validate_schedule,
+)
+from rti_rig.runtime.rig import Rig
+from rti_rig.runtime.session import SessionFolder
+
+
+@dataclass(frozen=True)
+class Note:
+    """A message for the user while a session is being opened.
+
+    ``level`` is ``"info"`` (what happens: the exposure chosen, what resume found) or
+    ``"warning"`` (something the user should know before the lights come on).
+    """
+
+    text: str
+    level: str = "info"
+
+
+NoteSink = Callable[[Note], None]
+
+
+def _ignore(_note: Note) -> None:
+    pass
+
+
+@dataclass(frozen=True)
+class NewSessionRequest:
+    """Start a session of a homogeneous layout (``lights``) or of a plan (``plan``, an .lp)."""
+
+    rig_config: Path
+    out_dir: Path
+    lights: int | None = None
+    plan: Path | None = None
+    min_elevation_deg: float = 0.0
+    max_elevation_deg: float = 90.0
+    auto_exposure: bool = False
+    max_saturated: float = 0.001
+    #: Choose each next light from the images so far (up to ``lights``; docs/adaptive.md).
+    adaptive: bool = False
+    #: Adaptive: stop once the estimated mean normal error is at most this (degrees).
+    until_error_deg: float | None = None
+
+    @property
+    def is_adaptive(self) -> bool:
+        return self.adaptive or self.until_error_deg is not None
+
+
+@dataclass(frozen=True)
+class ResumeRequest:
+    """Continue an interrupted session; ``rig_config`` defaults to the session's own.
+
+    The rig must be the one the session began on (see :mod:`rti_rig.app.rig_identity`); a
+    deliberate change (a repaired LED, a new exposure) needs ``accept_rig_change`` and is
+    recorded in the manifest's run.
+    """
+
+    session_dir: Path
+    rig_config: Path | None = None
+    max_saturated: float = 0.001
+    accept_rig_change: bool = False
+
+
+@dataclass(frozen=True)
+class PreviewRequest:
+    """Shoot one image under one light (``light_az_el_deg``; default: the planner's choice)."""
+
+    rig_config: Path
+    out_dir: Path
+    light_az_el_deg: tuple[float, float] | None = None
+    auto_exposure: bool = False
+    max_saturated: float = 0.001
+
+
+@dataclass
+class OpenedSession:
+    """A rig opened and checked, its schedule, and the session folder to write into.
+
+    Use it as a context manager (or pass it to :func:`run_opened_session`) so the rig is
+    closed whatever happens.
+    """
+
+    rig: Rig
+    schedule: LightSchedule
+    folder: SessionFolder
+    out_dir: Path
+    resumed: bool = False
+    extra: dict[str, Any] = field(default_factory=dict)
+    #: An adaptive session's step source (:mod:`rti_rig.app.usecases.adaptive`); None: the
+    #: schedule is run as it is.
+    source: Any = None
+
+    @property
+    def dry_run(self) -> bool:
+        return self.rig.loaded.config.backend != "hardware"
+
+    @property
+    def steps_done_before(self) -> int:
+        """Images verified on disk before this run (a resumed session's)."""
+        return len(self.folder.done)
+
+    @property
+    def total_steps(self) -> int:
+        """The session's steps: the schedule's, or an adaptive session's maximum."""
+        return len(self.schedule) if self.source is None else self.source.total
+
+    @property
+    def steps_to_do(self) -> int:
+        return self.total_steps - self.steps_done_before
+
+    def close(self) -> None:
+        self.rig.close()
+
+    def __enter__(self) -> OpenedSession:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def check_max_saturated(max_saturated: float) -> None:
+    if not 0.0 <= max_saturated < 1.0:
+        raise RtiRigError(
+            f"--max-saturated {max_saturated:g}: give a fraction of pixels in [0, 1), "
+            "e.g. 0.001 for 0.1 %"
+        )
+
+
+def default_lights(loaded, geometry) -> int:  # type: ignore[no-untyped-def]
+    """The light count a run uses without ``--lights``: every LED of a dome (or its
+    ``default_lights``), the arm's ``default_lights``."""
+    from rti_rig.core.rig_geometry import DomeGeometry
+
+    cfg = loaded.config
+    if isinstance(geometry, DomeGeometry):
+        assert cfg.dome is not None
+        return int(cfg.dome.default_lights or geometry.count)
+    assert cfg.arm is not None
+    return int(cfg.arm.default_lights)
+
+
+class RigChangedError(RtiRigError):
+    """A resume was asked on a rig whose images would not match the session's."""
+
+
+def check_light_count(n: int) -> None:
+    """Refuse a light count no session can run, before any layout is built, on every rig
+    (the planner names a dome's own limit, its LED count)."""
+    from rti_rig.core.lp_format import MAX_LIGHTS
+
+    if n < 1:
+        raise RtiRigError(f"--lights {n}: give at least 1 light")
+    if n > MAX_LIGHTS:
+        raise RtiRigError(
+            f"--lights {n}: at most {MAX_LIGHTS} lights per session (the most an .lp file may "
+            "list for readers such as relight)"
+        )
+
+
+def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-untyped-def]
+    """The rig, opened, with ``schedule`` checked against it before anything moves.
+
+    The rig is closed (lights off, arm stopped) if the check fails, whatever the exception.
+    """
+    from rti_rig.app.compose import build_rig
+
+    rig = build_rig(loaded)
+    try:
+        validate_schedule(rig, schedule)
+    except BaseException:
+        rig.close()
+        raise
+    return rig
+
+
+def fix_exposure(
+    rig: Rig, schedule: LightSchedule, max_saturated: float, on_note: NoteSink = _ignore
+) -> LightSchedule:
+    """Meter the session's exposure with the camera driver layer's test series."""
+    from rti_rig.drivers.cameras.exposure import meter_exposure
+    from rti_rig.drivers.cameras.settings import ExposureRule
+    from rti_rig.runtime.exposure_policy import fix_session_exposure
+
+    cam = rig.camera_config
+    rule = ExposureRule(
+        max_saturated_fraction=max_saturated,
+        headroom=1.25,  # other planned lights may be a little brighter than the metered one
+        min_exposure_s=cam.min_exposure_s,
+        max_exposure_s=cam.max_exposure_s,
+    )
+
+    def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
+        shutter = getattr(camera, "available_exposures_s", None)
+        return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
+
+    fixed = fix_session_exposure(rig, schedule, meter)
+    chosen = fixed.provenance["exposure"]
+    on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})"))
+    return fixed
+
+
+def _open_new(
+    loaded,  # type: ignore[no-untyped-def]
+    schedule: LightSchedule,
+    out_dir: Path,
+    auto_exposure: bool,
+    max_saturated: float,
+    on_note: NoteSink,
+) -> OpenedSession:
+    """Check the folder, open and check the rig, meter if asked, make the folder.
+
+    The folder is checked first, so nothing lights or moves for a session that could not be
+    written; the rig is closed if anything after opening it fails, whatever the exception.
+    """
+    from rti_rig.app.rig_identity import rig_identity
+
+    SessionFolder.check_new(out_dir)
+    identity = rig_identity(loaded)
+    rig = checked_rig(loaded, schedule)
+    try:
+        if auto_exposure:
+            schedule = fix_exposure(rig, schedule, max_saturated, on_note)
+        folder = SessionFolder.create(out_dir, len(schedule))
+        folder.rig_identity = identity
+    except BaseException:
+        rig.close()
+        raise
+    return OpenedSession(rig, schedule, folder, Path(out_dir))
+
+
+def new_session_schedule(  # type: ignore[no-untyped-def]
+    req: NewSessionRequest, loaded, on_note: NoteSink = _ignore
+) -> LightSchedule:
+    """The schedule a new session runs: the plan's, or a homogeneous layout."""
+    from rti_rig.app.compose import arm_order_for
+    from rti_rig.app.config import rig_geometry
+    from rti_rig.core.lp_format import read_lp
+    from rti_rig.planner.from_lp import schedule_from_lp
+    from rti_rig.planner.make_plan import check_elevation_band
+    from rti_rig.planner.uniform import plan_uniform
+
+    geometry = rig_geometry(loaded)
+    if req.plan is not None:
+        if req.lights is not None:
+            raise RtiRigError("give either --plan or --lights, not both")
+        plan_notes: list[str] = []
+        entries = read_lp(req.plan, upper_hemisphere=True, notes=plan_notes)
+        for note in plan_notes:
+            on_note(Note(note, "warning"))
+        check_light_count(len(entries))
+        return schedule_from_lp(entries, geometry, str(req.plan))
+    check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
+    n = req.lights if req.lights is not None else default_lights(loaded, geometry)
+    check_light_count(n)
+    return plan_uniform(
+        geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
+    )
+
+
+def _open_adaptive(req: NewSessionRequest, loaded, on_note: NoteSink) -> OpenedSession:  # type: ignore[no-untyped-def]
+    """A new adaptive session: the starting layout, the step source and the folder."""
+    from rti_rig.app.rig_identity import rig_identity
+    from rti_rig.app.usecases.adaptive import open_adaptive_session
+
+    if req.plan is not None or req.auto_exposure:
+        raise RtiRigError("--adaptive chooses its own lights: drop --plan/--auto-exposure")
+    if req.lights is not None:
+        check_light_count(req.lights)
+    identity = rig_identity(loaded)
+    rig, schedule, folder, source = open_adaptive_session(
+        loaded, req.out_dir, req.lights, req.until_error_deg
+    )
+    folder.rig_identity = identity
+    return OpenedSession(rig, schedule, folder, Path(req.out_dir), source=source)
+
+
+def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """Check a new session's request, open and check the rig, and prepare its folder."""
+    from rti_rig.app.config import load_rig_config
+
+    check_max_saturated(req.max_saturated)
+    loaded = load_rig_config(req.rig_config)
+    for note in loaded.notes:
+        on_note(Note(note, "warning"))
+    if req.is_adaptive:
+        return _open_adaptive(req, loaded, on_note)
+    schedule = new_session_schedule(req, loaded, on_note)
+    return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+
+
+def check_resume_rig(  # type: ignore[no-untyped-def]
+    manifest: dict[str, Any],
+    loaded,
+    config_path: Path,
+    accept_change: bool,
+    on_note: NoteSink,
+    session_dir: Path | str = "DIR",
+) -> tuple[dict[str, Any], list[str]]:
+    """The rig's identity, checked against the session's; the differences the user accepted.
+
+    Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``.
+    """
+    from rti_rig.app.rig_identity import identity_differences, rig_identity
+
+    identity = rig_identity(loaded)
+    recorded = (manifest.get("rig") or {}).get("identity")
+    if recorded is None:  # a session from before identities were recorded
+        if loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
+            on_note(
+                Note(
+                    f"{config_path} has changed since the session began; the remaining steps "
+                    "are checked against it before anything moves.",
+                    "warning",
+                )
+            )
+        return identity, []
+    diffs = identity_differences(recorded, identity)
+    if recorded.get("kind") != identity.get("kind"):
+        raise RigChangedError(
+            f"{config_path} is a rig of kind '{identity.get('kind')}', and this session was "
+            f"begun on a '{recorded.get('kind')}': a session cannot change kind of rig, even "
+            f"with --accept-rig-change. Resume with its own config (rti-rig run --resume "
+            f"{session_dir}) or start a new session"
+        )
+    if diffs and not accept_change:
+        raise RigChangedError(
+            f"{config_path} does not describe the rig this session began on ("
+            + "; ".join(diffs)
+            + "): its images would not match the ones already taken. Resume with the "
+            f"session's own config (rti-rig run --resume {session_dir}), or, if the change "
+            "is deliberate (a repaired LED, a new exposure), add --accept-rig-change to "
+            "record it"
+        )
+    if diffs:
+        on_note(Note("rig change accepted and recorded: " + "; ".join(diffs), "warning"))
+    elif loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
+        on_note(
+            Note(
+                f"{config_path} has been edited since the session began, in nothing the images "
+                "depend on (kind, lights, camera, exposure, decoding are the same).",
+                "warning",
+            )
+        )
+    return identity, diffs
+
+
+def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """Check the rig against the session, verify and repair the session on disk, open the
+    rig and check the remaining steps on it.
+
+    The rig is checked from the manifest alone (nothing in the folder changes if it is
+    refused); only then is the journal repaired and anything unverified set aside.
+    """
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.runtime.session import read_manifest
+
+    check_max_saturated(req.max_saturated)
+    manifest = read_manifest(req.session_dir)
+    rig_entry = manifest.get("rig") or {}
+    if req.rig_config is None and not rig_entry.get("config_path"):
+        raise RtiRigError(
+            f"{req.session_dir}: the manifest does not say which rig config it was shot with; "
+            "give it: rti-rig run RIG.toml --resume DIR"
+        )
+    config_path = req.rig_config or Path(rig_entry["config_path"])
+    loaded = load_rig_config(config_path)
+    identity, diffs = check_resume_rig(
+        manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
+    )
+    folder = SessionFolder.reopen(req.session_dir)
+    folder.rig_identity = identity
+    folder.rig_change = diffs or None
+    schedule = LightSchedule.from_dict(folder.manifest["schedule"])
+    done = len(folder.done)
+    resume = folder.resume
+    recovered = resume.recovered if resume else []
+    on_note(
+        Note(
+            f"Resuming {req.session_dir}: {done} of {folder.total_steps} images verified on disk"
+            + (f", {len(recovered)} unverified file(s) moved to recovered/" if recovered else "")
+        )
+    )
+    for line in resume.journal_repair if resume else []:
+        on_note(Note(f"{line}: set aside in recovered/, not appended onto", "warning"))
+    rig = checked_rig(loaded, schedule)
+    source = None
+    if "adaptive" in folder.manifest:
+        from rti_rig.app.usecases.adaptive import resume_adaptive_source
+
+        try:
+            source = resume_adaptive_source(rig, folder)
+        except BaseException:
+            rig.close()
+            raise
+    return OpenedSession(
+        rig, schedule, folder, Path(req.session_dir), resumed=True, source=source
+    )
+
+
+def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> OpenedSession:
+    """A one-image session under the preview light (the planner's input)."""
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.planner.preview_shot import preview_schedule
+
+    check_max_saturated(req.max_saturated)
+    loaded = load_rig_config(req.rig_config)
+    schedule, notes = preview_schedule(rig_geometry(loaded), req.light_az_el_deg)
+    for note in notes:
+        on_note(Note(note, "warning"))
+    return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+
+
+def run_opened_session(
+    opened: OpenedSession,
+    cancel: CancelToken | None = None,
+    on_event: Callable[[Event], None] | None = None,
+) -> SessionResult:
+    """Run an opened session to its end (or cancel / error); the rig is closed afterwards.
+
+    The controller's guarantees hold: devices are put in their safe state and the session's
+    `.lp` and manifest are written from what is on disk, whatever happens.
+    """
+    with opened:
+        result = run_session(
+            opened.rig,
+            opened.schedule,
+            opened.folder,
+            cancel=cancel,
+            on_event=on_event,
+            source=opened.source,
+        )
+    if opened.source is not None and result.finish_reason is FinishReason.COMPLETED:
+        from rti_rig.app.usecases.adaptive import record_result
+
+        # the adaptive run's outcome (lights used, final estimate, why it stopped)
+        outcome = opened.source.conclude()
+        record_result(opened.out_dir, outcome)
+        opened.extra["adaptive_result"] = outcome
+    return result

@@ -1,0 +1,48 @@
+"""What the command line says must read right (issue #30, finding 10): a config line to paste
+comes out whole, a good second calibration does not read as a failure, flags take no value."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from test_light_calibration import card_rig, shoot
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+@pytest.mark.parametrize("command", ["run", "preview", "plan", "export-lp", "calibrate-lights"])
+def test_flags_show_no_value_type_in_help(command: str) -> None:
+    r = runner.invoke(app, [command, "--help"], terminal_width=100)
+    assert r.exit_code == 0, r.output
+    assert "<bool>" not in r.output
+    assert "--force" in r.output or "--auto-exposure" in r.output or "--linear" in r.output
+
+
+def test_calibration_config_line_is_whole_and_a_good_second_report_is_no_failure(
+    tmp_path: Path,
+) -> None:
+    deep = tmp_path / "a-rather-long-folder-name-for-the-rig" / "and-its-calibration-sessions"
+    deep.mkdir(parents=True)
+    cfg = card_rig(deep)
+    card1 = "card1-the-matte-white-card-shot-under-every-led"
+    shoot(cfg, deep / card1)
+    r = runner.invoke(app, ["calibrate-lights", str(deep / card1), "--rig", str(cfg)])
+    assert r.exit_code == 0, r.output
+    line = f'intensity_correction_file = "{card1}/light_calibration.toml"'
+    assert len(line) > 80
+    assert line in r.output.splitlines()  # one line, as pasted, on an 80-column terminal
+    assert "shoot the card again" in r.output
+
+    cfg2 = card_rig(deep, f"{line}\n", "cal.toml")
+    shoot(cfg2, deep / "card2")
+    r = runner.invoke(app, ["calibrate-lights", str(deep / "card2"), "--rig", str(cfg2)])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "with the intensity correction in force" in text and "the dome is even" in text
+    assert "no new calibration is needed" in text
+    assert "shoot the card again" not in text
+    assert 'intensity_correction_file = "card2/light_calibration.toml"' in r.output.splitlines()

@@ -1,0 +1,393 @@
+"""Sessions that cannot be mixed, torn or stranded (issue #30, findings 1-7).
+
+Each test plays what a user did to break a session — resume on another rig, a torn journal and
+a chain of interrupted resumes, a full disk at every write point, junk journal lines, a killed
+session opened in relight, a rig that does not answer — through the command line, and checks the
+folder against an uninterrupted run of the same plan, file by file.
+"""
+
+from __future__ import annotations
+
+import errno
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, SMALL_DOME, write_config
+from typer.testing import CliRunner
+
+from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
+from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+from rti_rig.testing.disk_faults import WRITE_POINTS, failing_writes
+
+runner = CliRunner()
+LIGHTS = 8
+REPO = Path(__file__).resolve().parent.parent
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+def digests(folder: Path) -> dict[str, str]:
+    files = [*folder.glob("image_*.jpg"), *(folder / "linear").glob("*.tif"), folder / "lights.lp"]
+    return {
+        p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest() for p in files
+    }
+
+
+def manifest(folder: Path) -> dict:
+    return json.loads((folder / "manifest.json").read_text())
+
+
+def leftovers(folder: Path) -> list[Path]:
+    return [*folder.rglob(".*.partial"), *folder.rglob(".*.tmp")]
+
+
+@pytest.fixture
+def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    base = tmp_path_factory.mktemp("ref")
+    cfg = write_config(base, SMALL_DOME)
+    out = base / "uninterrupted"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 0, r.output
+    return cfg, out
+
+
+def cancelled_after(cfg: Path, out: Path, n: int) -> None:
+    """A session stopped after ``n`` images, through the use-case API (no typer)."""
+    cancel = CancelToken()
+
+    def on_event(e) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(e, StepCompleted) and e.index == n - 1:
+            cancel.cancel()
+
+    opened = open_new_session(NewSessionRequest(cfg, out, lights=LIGHTS))
+    result = run_opened_session(opened, cancel, on_event)
+    assert result.finish_reason is FinishReason.CANCELLED
+
+
+def killed_resume(out: Path, at_light: int) -> None:
+    """``rti-rig run --resume OUT`` SIGKILLed before its ``at_light``-th light (0-based)."""
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    argv = [sys.executable, "-m", "rti_rig.testing.kill_hooks", "before_light", str(at_light)]
+    proc = subprocess.run(
+        [*argv, "run", "--resume", str(out)], env=env, capture_output=True, timeout=120
+    )
+    assert proc.returncode == -signal.SIGKILL, proc.stderr.decode()
+
+
+# 1. A session knows its rig ------------------------------------------------------------------
+
+
+def test_resume_on_another_rig_is_refused_with_what_differs(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    cfg, _ = reference
+    out = tmp_path / "s"
+    cancelled_after(cfg, out, 3)
+    before = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
+
+    r = runner.invoke(app, ["run", str(CONFIGS / "virtual_arm.toml"), "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "cannot change kind of rig" in said(r) and f"run --resume {out}" in said(r)
+    r = runner.invoke(
+        app,
+        ["run", str(CONFIGS / "virtual_arm.toml"), "--resume", str(out), "--accept-rig-change"],
+    )
+    assert r.exit_code == 2 and "cannot change kind of rig" in said(r), r.output
+    smaller = write_config(tmp_path, SMALL_DOME.replace("width = 64", "width = 32"), "small.toml")
+    r = runner.invoke(app, ["run", str(smaller), "--resume", str(out)])
+    assert r.exit_code == 2 and "camera size: 64×64 → 32×64" in said(r), r.output
+    assert "--accept-rig-change" in said(r)
+    # the session's own config, edited since: --resume alone uses it, and sees the edit
+    cfg.write_text(SMALL_DOME.replace("exposure_s = 0.05", "exposure_s = 0.04"))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2 and "exposure (s): 0.05 → 0.04" in said(r), r.output
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before  # untouched
+
+    # a deliberate change goes through with the flag, and is recorded
+    r = runner.invoke(app, ["run", "--resume", str(out), "--accept-rig-change"])
+    assert r.exit_code == 0, r.output
+    run = manifest(out)["runs"][-1]
+    assert run["rig_change"] == ["exposure (s): 0.05 → 0.04"]
+    assert manifest(out)["rig"]["identity"]["exposure_s"] == 0.04
+
+
+def test_resume_with_the_same_rig_needs_no_flag(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    cfg, ref = reference
+    out = tmp_path / "s"
+    cancelled_after(cfg, out, 3)
+    cfg.write_text(SMALL_DOME + "\n# a comment changes nothing the images depend on\n")
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref)
+
+
+# 2. The journal is repaired before it is appended to ------------------------------------------
+
+
+def test_torn_journal_and_a_chain_of_killed_resumes_stay_resumable(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    cfg, ref = reference
+    out = tmp_path / "s"
+    cancelled_after(cfg, out, 4)
+    journal = out / "journal.jsonl"
+    for at_light in (1, 0, 2):  # cut the tail, resume, kill the resume; again and again
+        data = journal.read_bytes()
+        journal.write_bytes(data[:-40])
+        killed_resume(out, at_light)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref)
+    for line in journal.read_text().splitlines():
+        json.loads(line)  # never a record appended onto a torn one
+    rejected = list((out / "recovered").rglob("journal-rejected.txt"))
+    assert rejected and all("torn last line" in p.read_text() for p in rejected)
+    assert manifest(out)["runner"]["finish_reason"] == "completed"
+
+
+# 3. Every write failure stops the session by name ---------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("point", "code"),
+    [(p, errno.ENOSPC) for p in WRITE_POINTS]
+    + [("jpeg", errno.EROFS), ("journal", errno.EIO), ("lp", errno.EIO)],
+)
+def test_write_failure_stops_by_name_and_resumes(
+    tmp_path: Path, reference: tuple[Path, Path], point: str, code: int
+) -> None:
+    cfg, ref = reference
+    out = tmp_path / "s"
+    after = 1 if point == "manifest" else 3  # the manifest: begin is written, the end is not
+    with failing_writes(point, after=after, errno_code=code) as fault:
+        r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert fault.failed >= 1
+    assert r.exit_code == 2, r.output
+    assert r.exception is None or isinstance(r.exception, SystemExit)
+    text = said(r)
+    assert f"({errno.errorcode[code]})" in text and "cannot write" in text
+    assert "Traceback" not in r.output
+    assert f"rti-rig run --resume {out}" in text
+    assert leftovers(out) == []
+    listed = [e.name for e in read_lp(out / "lights.lp")]
+    assert len(listed) >= 3 and all((out / name).is_file() for name in listed)
+    if point != "manifest":
+        assert manifest(out)["runner"]["finish_reason"] == "write-failed"
+        assert errno.errorcode[code] in manifest(out)["runner"]["error"]
+
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref)
+
+
+def test_free_space_is_checked_before_each_image(
+    tmp_path: Path, reference: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import shutil
+
+    cfg, ref = reference
+    real = shutil.disk_usage
+    calls = {"n": 0}
+
+    def usage(path):  # type: ignore[no-untyped-def]
+        calls["n"] += 1
+        u = real(path)
+        # the start-up check and three images see room; then the disk is full
+        return u if calls["n"] <= 4 else u._replace(free=1_000_000)
+
+    monkeypatch.setattr(shutil, "disk_usage", usage)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2, r.output
+    assert "not enough free disk space" in said(r) and "--resume" in said(r)
+    assert manifest(out)["runner"]["finish_reason"] == "no-space"
+    assert len(read_lp(out / "lights.lp")) == 3
+    monkeypatch.setattr(shutil, "disk_usage", real)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref)
+
+
+# 4. Junk journal lines -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "junk",
+    [
+        "42",
+        "[]",
+        '"text"',
+        "null",
+        '{"index": 1}',
+        "not json at all",
+        "{}",
+    ],
+)
+def test_junk_journal_lines_are_set_aside(
+    tmp_path: Path, reference: tuple[Path, Path], junk: str
+) -> None:
+    cfg, ref = reference
+    out = tmp_path / "s"
+    cancelled_after(cfg, out, 4)
+    journal = out / "journal.jsonl"
+    lines = journal.read_text().splitlines(keepends=True)
+    no_checksum = json.loads(lines[2])
+    del no_checksum["sha256"]
+    lines[2] = json.dumps(no_checksum) + "\n"  # a record without its checksum
+    lines.insert(1, junk + "\n")
+    journal.write_text("".join(lines))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "3 of 8 images verified" in said(r)
+    assert digests(out) == digests(ref)
+    (rejected,) = (out / "recovered").rglob("journal-rejected.txt")
+    assert "without its checksums" in rejected.read_text() or "sha256" in rejected.read_text()
+    assert junk in rejected.read_text()
+
+
+# 5. lights.lp kept current; export-lp from the verified journal --------------------------------
+
+
+def test_killed_session_has_its_lp_and_exports(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    from rti_rig.testing.kill_hooks import popen_session
+
+    cfg, ref = reference
+    out = tmp_path / "s"
+    proc = popen_session("before_light", 3, cfg, out, LIGHTS)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    ref_lp = read_lp(ref / "lights.lp")
+    assert read_lp(out / "lights.lp") == ref_lp[:3]  # relight can open it at once
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "k.lp")])
+    assert r.exit_code == 0, r.output
+    assert read_lp(tmp_path / "k.lp") == ref_lp[:3]
+
+
+def test_export_leaves_out_an_image_deleted_since(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    import shutil
+
+    _, ref = reference
+    done = tmp_path / "done"
+    shutil.copytree(ref, done)
+    (done / "image_002.jpg").unlink()
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 0, r.output
+    names = [e.name for e in read_lp(tmp_path / "x.lp")]
+    assert "image_002.jpg" not in names and len(names) == LIGHTS - 1
+    assert "image_002.jpg" in said(r)
+
+
+# 6. Nothing on disk before the rig works ------------------------------------------------------
+
+
+def test_unreachable_rig_creates_nothing_and_promises_no_resume(
+    tmp_path: Path, reference: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from rti_rig.simulator.sim_lights import SimulatedDome
+
+    from rti_rig.core.errors import DeviceError
+
+    cfg, _ = reference
+
+    def unreachable(self) -> None:  # type: ignore[no-untyped-def]
+        raise DeviceError("dome on /dev/ttyACM0", "no answer to the handshake")
+
+    monkeypatch.setattr(SimulatedDome, "connect", unreachable)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2, r.output
+    assert "no answer to the handshake" in said(r)
+    assert not out.exists()
+    assert "--resume" not in said(r) and "images kept" not in said(r).lower()
+
+
+def test_no_space_at_start_creates_nothing(
+    tmp_path: Path, reference: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import shutil
+
+    cfg, _ = reference
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=1_000_000))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2 and "not enough free disk space" in said(r), r.output
+    assert not out.exists()
+    assert "--resume" not in said(r)
+
+
+def test_a_folder_holding_no_image_may_be_reused(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    cfg, ref = reference
+    out = tmp_path / "s"
+    with failing_writes("tiff", after=0):  # the first image cannot be written
+        r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2, r.output
+    assert "--resume" not in said(r) and "may be used again" in said(r)
+    assert out.is_dir()
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref)
+
+
+# 7. Counts and caps before any layout is built -------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "config", ["virtual_arm.toml", "simulated_arm.toml", "example_dome_48.toml"]
+)
+def test_light_cap_is_checked_before_any_layout(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, config: str
+) -> None:
+    import rti_rig.planner.uniform as uniform
+
+    def no_layout(*_a, **_k):  # type: ignore[no-untyped-def]
+        raise AssertionError("a layout was built before the light count was checked")
+
+    monkeypatch.setattr(uniform, "plan_uniform", no_layout)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(CONFIGS / config), "--out", str(out), "--lights", "1000000"])
+    assert r.exit_code == 2, r.output
+    assert "at most 1000 lights" in said(r)
+    assert not out.exists()
+
+
+def test_plan_with_too_many_lights_is_refused_before_it_is_matched(tmp_path: Path) -> None:
+    from rti_rig.core.geometry import direction_from_az_el
+
+    plan = tmp_path / "big.lp"
+    lines = [f"{1001}"]
+    for i in range(1001):
+        d = direction_from_az_el(i * 0.35, 20 + (i % 50))
+        lines.append(f"l{i}.jpg {d[0]:.6f} {d[1]:.6f} {d[2]:.6f}")
+    plan.write_text("\n".join(lines) + "\n")
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "virtual_arm.toml"),
+            "--out",
+            str(tmp_path / "s"),
+            "--plan",
+            str(plan),
+        ],
+    )
+    assert r.exit_code == 2, r.output
+    assert "1000" in said(r)
