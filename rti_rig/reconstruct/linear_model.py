@@ -8,7 +8,7 @@ fit undershoots in shadow.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
@@ -83,6 +83,33 @@ class LambertModel(LinearBasisModel):
         return out.astype(np.float32)
 
 
+def _weighted_columns(
+    design: NDArray[np.float64],
+    values: NDArray[np.float32],
+    usable: NDArray[np.bool_],
+    cond_limit: float,
+) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:
+    """Least squares per column of ``values`` (N, K) on its ``usable`` observations only.
+
+    Returns coefficients (p, K) and whether each column could be fitted: at least p usable
+    observations whose design rows are well-conditioned (ratio of extreme eigenvalues of the
+    normal matrix within ``cond_limit^2``); others get zeros. Only the few columns with an
+    excluded observation come here, so a batched p × p solve is cheap.
+    """
+    n, p = design.shape
+    outer = (design[:, :, None] * design[:, None, :]).reshape(n, p * p)
+    wt = usable.T.astype(np.float64)  # (K, N)
+    normal = (wt @ outer).reshape(-1, p, p)
+    rhs = (np.where(usable, values, 0.0).T.astype(np.float64)) @ design  # (K, p)
+    count = usable.sum(axis=0)
+    eig = np.linalg.eigvalsh(normal)
+    ok = (count >= p) & (eig[:, 0] > eig[:, -1] / cond_limit**2) & (eig[:, -1] > 0)
+    coef = np.zeros((values.shape[1], p))
+    if ok.any():
+        coef[ok] = np.linalg.solve(normal[ok], rhs[ok][..., None])[..., 0]
+    return coef.T.astype(np.float32), ok
+
+
 def fit_coefficients(
     images: Any,
     design: NDArray[np.float64],
@@ -92,6 +119,8 @@ def fit_coefficients(
     ill_conditioned: IllConditioned = "regularise",
     cond_limit: float = COND_LIMIT,
     out: NDArray[Any] | None = None,
+    saturation: float | None = None,
+    basis: str | None = None,
 ) -> tuple[NDArray[Any], FitReport]:
     """Fit ``design`` to every pixel of ``images``, a band of rows at a time.
 
@@ -100,11 +129,16 @@ def fit_coefficients(
     computed once in float64 and applied in float32. ``out`` (same shape) receives the
     coefficients instead of a new array: a ``numpy.memmap`` keeps a 24-megapixel HSH3 fit
     (4.6 GB of float32 colour coefficients) out of memory.
+
+    Saturated (at or above ``saturation``, default the stack's level) and NaN observations are
+    excluded: a pixel value with any of them is fitted by least squares on its other
+    observations, or left at 0 and counted as unfitted when too few remain. The report counts
+    both.
     """
-    stack = ImageStack(images)
+    stack = ImageStack(images, saturation_level=saturation)
     if design.shape[0] != stack.n:
         raise ValueError(f"design has {design.shape[0]} rows for {stack.n} images")
-    w, report = solve_matrix(design, model, ill_conditioned, cond_limit)
+    w, report = solve_matrix(design, model, ill_conditioned, cond_limit, basis=basis)
     w32 = w.astype(np.float32)
     p = w.shape[0]
     rows = tile_rows or rows_for_budget(stack.n, stack.width, stack.channels)
@@ -112,11 +146,25 @@ def fit_coefficients(
     if out is not None and out.shape != shape:
         raise ReconstructionError(f"out has shape {out.shape}, the coefficients need {shape}")
     coef = np.empty(shape, dtype=np.float32) if out is None else out
+    missing = unfitted = 0
     for sl in row_tiles(stack.height, rows):
-        band = stack.rows(sl)  # (N, r, W, C)
+        band = stack.rows(sl, strict=False)  # (N, r, W, C)
+        bad = stack.unusable(band)
         r = band.shape[1]
-        tile = (w32 @ band.reshape(stack.n, -1)).reshape(p, r, stack.width, stack.channels)
+        flat = band.reshape(stack.n, -1)
+        tile = w32 @ flat
+        if bad is not None:
+            cols = np.flatnonzero(bad.reshape(stack.n, -1).any(axis=0))
+            sub, ok = _weighted_columns(
+                design, flat[:, cols], ~bad.reshape(stack.n, -1)[:, cols], cond_limit
+            )
+            tile[:, cols] = sub
+            missing += cols.size
+            unfitted += int((~ok).sum())
+        tile = tile.reshape(p, r, stack.width, stack.channels)
         coef[:, sl] = tile[..., 0] if stack.grey else tile
+    if missing:
+        report = replace(report, pixels_with_missing=missing, pixels_unfitted=unfitted)
     return coef, report
 
 
@@ -127,11 +175,13 @@ def fit_lambert(
     tile_rows: int | None = None,
     ill_conditioned: IllConditioned = "refuse",
     out: NDArray[Any] | None = None,
+    saturation: float | None = None,
 ) -> LambertModel:
     """Least-squares Lambertian model (no shadow handling): the lowest-order relighting model.
 
-    Refuses ill-conditioned (near-coplanar) light sets by default: its coefficients are read as
-    normals, and a regularised normal is biased towards the well-lit plane.
+    Refuses ill-conditioned light sets by default, judged like photometric stereo judges them
+    (over the hemisphere: near-coplanar lights, or a cap near the zenith): its coefficients are
+    read as normals, and a regularised normal is biased towards the well-lit plane.
     """
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
@@ -142,5 +192,6 @@ def fit_lambert(
         tile_rows=tile_rows,
         ill_conditioned=ill_conditioned,
         out=out,
+        saturation=saturation,
     )
     return LambertModel(coef, report)

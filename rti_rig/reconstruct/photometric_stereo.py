@@ -347,11 +347,9 @@ def fit_photometric_stereo(
     """
     if shadow_k is not None and not (np.isfinite(shadow_k) and shadow_k > 0):
         raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
-    stack = ImageStack(images)
+    stack = ImageStack(images, saturation_level=saturation)
     lt = validate_lights(lights, stack.n)
-    w_ls, report = solve_matrix(
-        lt, "photometric stereo", "refuse", cond_limit, normalise_columns=False
-    )
+    w_ls, report = solve_matrix(lt, "photometric stereo", "refuse", cond_limit)
     h, wd = stack.height, stack.width
     if mask is None:
         inside_all = np.ones((h, wd), dtype=bool)
@@ -377,15 +375,22 @@ def fit_photometric_stereo(
     # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
-        band = stack.rows(sl)  # (N, r, W, C)
+        band = stack.rows(sl, strict=False)  # (N, r, W, C)
+        bad = stack.unusable(band)  # NaN / saturated: zeroed, excluded below
         r = band.shape[1]
         flat = band.reshape(stack.n, r * wd, stack.channels)
         g = flat.mean(axis=2) if stack.channels > 1 else flat[..., 0]
         inside = inside_all[sl].ravel()
+        usable = None if bad is None else ~bad.reshape(stack.n, r * wd, -1).any(axis=2)
         if robust:
+            if usable is not None:
+                inside_robust = inside
+                g = np.where(usable, g, np.float32(-1.0))  # below any dark threshold
+            else:
+                inside_robust = inside
             b, w, ok = _robust_band(
                 g,
-                inside,
+                inside_robust,
                 lt,
                 dark,
                 saturation,
@@ -399,6 +404,17 @@ def fit_photometric_stereo(
         else:
             n, alb, rms, ok = _albedo_residual_all(w32, inside, g, flat, lt, gram, eps_b)
             count = np.full(ok.shape, stack.n)
+            if usable is not None:
+                # pixels with an excluded observation: least squares on the others only
+                cols = np.flatnonzero(~usable.all(axis=0) & inside)
+                gc = np.ascontiguousarray(g[:, cols])
+                wc = usable[:, cols].T
+                bc, okc = _solve_weighted(gc.T, wc, lt, cond_limit)
+                n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
+                    bc, wc.T, okc, gc, flat[:, cols], lt, eps_b
+                )
+                n[cols], alb[cols], rms[cols] = n_c, alb_c, rms_c
+                count[cols], ok[cols] = count_c, ok_c
         normals[sl] = n.reshape(r, wd, 3)
         albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
         residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)

@@ -8,6 +8,9 @@ demand, so a stack larger than memory can be fitted from a memmap or from frames
 
 Integer images are scaled to [0, 1] by ``scale`` (default 1 / the dtype's maximum, or
 1 / white level via :func:`stack_from_frames`); float images are taken as linear values as given.
+Saturation: integer images saturate at their top code value; float images have no known
+saturation level unless one is given (``saturation_level``, or ``saturation=`` of every fit),
+and then every fit honours it. NaN and infinite values are missing observations.
 """
 
 from __future__ import annotations
@@ -94,8 +97,15 @@ class ImageStack:
         if self.height < 1 or self.width < 1 or self.channels < 1:
             raise ReconstructionError(f"images are empty: shape {shape}")
 
-    def rows(self, sl: slice, indices: ArrayLike | None = None) -> NDArray[np.float32]:
-        """Band of rows ``sl`` of images ``indices`` (default all) as float32 (n, r, W, C)."""
+    def rows(
+        self, sl: slice, indices: ArrayLike | None = None, *, strict: bool = True
+    ) -> NDArray[np.float32]:
+        """Band of rows ``sl`` of images ``indices`` (default all) as float32 (n, r, W, C).
+
+        ``strict`` refuses NaN or infinity; the fits read with ``strict=False`` and treat such
+        values as missing observations (see :meth:`unusable`), so that one bad pixel, masked
+        or not, never aborts a whole fit.
+        """
         idx = np.arange(self.n) if indices is None else np.asarray(indices)
         if self._array is not None:
             band = np.asarray(self._array[idx, sl])
@@ -107,13 +117,26 @@ class ImageStack:
             out *= np.float32(self.scale)
         if out.ndim == 3:
             out = out[..., None]
-        if not np.all(np.isfinite(out)):
+        if strict and not np.all(np.isfinite(out)):
             bad = int(np.argwhere(~np.isfinite(out))[0][0])
             raise ReconstructionError(
                 f"image {int(idx[bad])} holds NaN or infinity in rows {sl.start}:{sl.stop}; "
                 "fitting needs finite linear values"
             )
         return out
+
+    def unusable(self, band: NDArray[np.float32]) -> NDArray[np.bool_] | None:
+        """Observations of ``band`` a fit must not use: NaN/infinite, or at or above the
+        saturation level. Sets them to 0 in place (so sums stay finite) and returns the mask,
+        or None when every observation is usable (the fast path)."""
+        bad = ~np.isfinite(band)
+        if self.saturation_level is not None:
+            with np.errstate(invalid="ignore"):
+                bad |= band >= np.float32(self.saturation_level)
+        if not bad.any():
+            return None
+        band[bad] = 0.0
+        return bad
 
     def pixel_sample(self, max_pixels: int) -> tuple[NDArray[np.float32], NDArray[np.intp]]:
         """A regular grid of at most ``max_pixels`` pixels: values (N, P, C) and flat indices.
@@ -131,7 +154,7 @@ class ImageStack:
             cols = np.array([self.width // 2])
         parts = []
         for r in rows:
-            band = self.rows(slice(int(r), int(r) + 1))  # (N, 1, W, C)
+            band = self.rows(slice(int(r), int(r) + 1), strict=False)  # (N, 1, W, C)
             parts.append(band[:, 0, cols, :])
         values = np.concatenate(parts, axis=1)
         flat = (rows[:, None] * self.width + cols[None, :]).ravel()
@@ -143,7 +166,8 @@ class ImageStack:
         Thresholds (dark, highlight floor) are fractions of it, so they follow the exposure.
         """
         values, _ = self.pixel_sample(max_pixels)
-        level = float(np.percentile(values, 99.0))
+        finite = values[np.isfinite(values)]
+        level = float(np.percentile(finite, 99.0)) if finite.size else 0.0
         return level if level > 0 else 1.0
 
 
