@@ -194,6 +194,9 @@ def run(
             "only the steps not yet done.",
         ),
     ] = None,
+    no_verdict: Annotated[
+        bool, typer.Option("--no-verdict", help="Do not print the QA verdict at the end.")
+    ] = False,
 ) -> None:
     """Run a capture session (a dry run when the config's backend is 'simulated').
 
@@ -263,6 +266,8 @@ def run(
         raise _fail(exc) from None
     with rig:
         _execute(rig, schedule, folder, out_dir)
+    if not no_verdict:
+        _print_verdict(out_dir)
 
 
 def _fix_exposure(rig, schedule, max_saturated: float):  # type: ignore[no-untyped-def]
@@ -978,6 +983,56 @@ def bench_tradeoff(
     text = summarise(rows, settings, time.perf_counter() - t0, command)
     (out_dir / "summary.md").write_text(text, encoding="utf-8")
     out.print(text, highlight=False)
+
+
+def _print_verdict(session: Path | None) -> None:
+    """Last line of ``run``: the QA verdict (never fails the run: it is advice)."""
+    from rti_rig.app.usecases.fit import verdict_for_session
+
+    if session is None:
+        return
+    try:
+        out.print(f"QA verdict: {escape(verdict_for_session(session))}")
+    except (RtiRigError, ValueError) as exc:
+        err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
+
+
+@app.command()
+def fit(
+    source: Annotated[
+        Path, typer.Argument(help="Session folder, or an .lp file with its images beside it.")
+    ],
+    out_dir: Annotated[Path, typer.Option("--out", help="New or empty folder for outputs.")],
+    model: Annotated[
+        str,
+        typer.Option(
+            "--model",
+            help="auto (evidence-based choice), ps, robust-ps, lambert, ptm, hsh1, hsh2, hsh3.",
+        ),
+    ] = "auto",
+    no_qa: Annotated[bool, typer.Option("--no-qa", help="Skip the QA verdict.")] = False,
+) -> None:
+    """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
+    from rti_rig.app.usecases.fit import FitRequest, run_fit
+    from rti_rig.reconstruct.registry import model_spec
+
+    try:
+        if model != "auto":
+            try:
+                model_spec(model)
+            except ValueError as exc:
+                raise RtiRigError(str(exc)) from None
+        result = run_fit(FitRequest(source, out_dir, model=model, qa=not no_qa))
+    except RtiRigError as exc:
+        raise _fail(exc) from None
+    out.print(f"Model: {escape(result.reason)}")
+    for text in result.warnings:
+        err.print(f"[yellow]warning:[/] {escape(text)}")
+    out.print(
+        f"Wrote {len(result.files)} files to {escape(str(out_dir))} in {result.seconds:.1f} s"
+    )
+    if result.qa is not None:
+        out.print(f"QA verdict: {escape(result.qa.verdict)}")
 
 
 def main() -> None:

@@ -1,0 +1,235 @@
+"""`rti-rig fit`: normals, albedo, relightable files and a QA verdict from a finished session.
+
+Input: a session folder (``lights.lp`` and ``linear/*.tif`` 16-bit linear, as
+:mod:`rti_rig.runtime.session` writes it) or any ``.lp`` with its images beside it (16-bit TIFF
+used as linear; 8-bit JPEG/PNG decoded from sRGB). Frames are held as ``uint16`` — never the
+stack as floats — and every fit streams them a band of rows at a time.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.lp_format import directions_of, read_lp
+from rti_rig.reconstruct import exporters
+from rti_rig.reconstruct.qa import QAReport, assess
+from rti_rig.reconstruct.registry import RELIGHT_MODELS, model_spec
+from rti_rig.reconstruct.stack import ImageStack
+
+#: What ``--model`` accepts besides the registered model names.
+AUTO = "auto"
+
+
+class FitInputError(RtiRigError):
+    """The session or .lp cannot be read for fitting."""
+
+
+@dataclass(frozen=True)
+class FitRequest:
+    source: Path
+    out_dir: Path
+    model: str = AUTO
+    write_ptm: bool = True
+    hsh_order: int | None = None  # None: the chosen HSH order, else 2
+    qa: bool = True
+
+
+@dataclass
+class FitResult:
+    out_dir: Path
+    model: str
+    reason: str
+    files: list[Path] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    qa: QAReport | None = None
+    seconds: float = 0.0
+
+
+def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
+    x = np.arange(256) / 255.0
+    lin = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+    lut = np.round(lin * 65535).astype(np.uint16)
+    return lut[img]
+
+
+def _read_image(path: Path) -> np.ndarray:
+    if not path.is_file():
+        raise FitInputError(f"image {path} listed in the .lp is missing")
+    if path.suffix.lower() in (".tif", ".tiff"):
+        import tifffile
+
+        img = tifffile.imread(path)
+    else:
+        img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        if img is None:
+            raise FitInputError(f"cannot read image {path}")
+        if img.ndim == 3:
+            img = img[..., ::-1]
+    if img.dtype == np.uint8:
+        img = _srgb_to_linear16(img)
+    if img.dtype != np.uint16:
+        raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
+    return np.ascontiguousarray(img)
+
+
+def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[str], str]:
+    """Frames (uint16), lights (N, 3), image names, and a description of what was read."""
+    if source.is_dir():
+        lps = sorted(source.glob("*.lp"))
+        if not lps:
+            raise FitInputError(f"{source} holds no .lp file: not a session folder")
+        lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]
+    elif source.suffix.lower() == ".lp" and source.is_file():
+        lp = source
+    else:
+        raise FitInputError(f"{source}: give a session folder or an .lp file")
+    entries = read_lp(lp, upper_hemisphere=True)
+    lights = directions_of(entries)
+    frames, names = [], []
+    for e in entries:
+        stem = Path(e.name).stem
+        linear = lp.parent / "linear" / f"{stem}.tif"
+        path = linear if linear.is_file() else lp.parent / e.name
+        frames.append(_read_image(path))
+        names.append(stem)
+    shapes = {f.shape for f in frames}
+    if len(shapes) != 1:
+        raise FitInputError(f"images of {lp} differ in shape: {sorted(shapes)}")
+    return frames, lights, names, f"{len(frames)} images from {lp}"
+
+
+def _save_png(path: Path, rgb: np.ndarray) -> Path:
+    cv2.imwrite(str(path), rgb[..., ::-1] if rgb.ndim == 3 else rgb)
+    return path
+
+
+def run_fit(req: FitRequest) -> FitResult:
+    """Fit, write every output into ``req.out_dir``, and judge the acquisition."""
+    t0 = time.perf_counter()
+    frames, lights, names, what = load_acquisition(req.source)
+    out = req.out_dir
+    if out.exists() and any(out.iterdir()):
+        raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
+    out.mkdir(parents=True, exist_ok=True)
+    stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = _fit_all(req, stack, lights, out)
+    result.warnings = [str(w.message) for w in caught or []]
+    result.files.append(
+        exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
+    )
+    if req.qa:
+        result.qa = assess(frames, lights, names)
+        result.files += write_qa_report(out, result.qa, result)
+    summary = {
+        "source": str(req.source),
+        "read": what,
+        "model": result.model,
+        "why": result.reason,
+        "warnings": result.warnings,
+        "files": [p.name for p in result.files],
+        "verdict": result.qa.verdict if result.qa else None,
+    }
+    (out / "fit.json").write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
+    result.files.append(out / "fit.json")
+    result.seconds = time.perf_counter() - t0
+    return result
+
+
+def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) -> FitResult:
+    from rti_rig.reconstruct.model_select import select_model
+
+    files: list[Path] = []
+    name = req.model
+    if name == AUTO:
+        choice = select_model(stack, lights)
+        model_name = choice.model
+        reason = choice.to_markdown()
+        (out / "model_choice.md").write_text(reason + "\n", encoding="utf-8")
+        files.append(out / "model_choice.md")
+        reason_line = (
+            f"{choice.model}: lowest order within {choice.tolerance:.0%} of the best held-out "
+            f"error ({choice.best_model}), {choice.holdout}"
+        )
+    else:
+        model_name = model_spec(name).name
+        reason_line = f"{model_name}: chosen by --model"
+    # normals: robust PS unless a model with normals was asked for
+    normal_source = model_name if model_name in ("ps", "lambert", "ptm") else "ps-robust"
+    ps = model_spec(normal_source).fit(stack, lights) if normal_source.startswith("ps") else None
+    if ps is not None:
+        files += exporters.write_normal_map(out / "normals", ps.normals)
+        files += exporters.write_albedo(out / "albedo", ps.albedo)
+    relit_models: dict[str, Any] = {}
+    if model_name in RELIGHT_MODELS:
+        relit_models[model_name] = model_spec(model_name).fit(stack, lights)
+    if req.write_ptm and "ptm" not in relit_models and len(lights) >= 6:
+        relit_models["ptm"] = model_spec("ptm").fit(stack, lights)
+    order = req.hsh_order or (int(model_name[-1]) if model_name.startswith("hsh") else 2)
+    hsh = f"hsh{order}"
+    if hsh not in relit_models and len(lights) >= (order + 1) ** 2:
+        relit_models[hsh] = model_spec(hsh).fit(stack, lights)
+    if "ptm" in relit_models:
+        files.append(exporters.write_ptm_rgb(out / "fit.ptm", relit_models["ptm"].coefficients))
+    if hsh in relit_models:
+        files.append(exporters.write_hsh_rti(out / "fit.rti", relit_models[hsh].coefficients))
+    if ps is None:
+        m = relit_models.get(normal_source)
+        if m is not None and hasattr(m, "normals"):
+            files += exporters.write_normal_map(out / "normals", m.normals())
+    return FitResult(out, model_name, reason_line, files)
+
+
+def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
+    """``qa.json`` and a one-page ``qa.html`` with the coverage map and per-image table."""
+    cov = qa.coverage.astype(np.float32)
+    cov_img = cv2.applyColorMap(
+        np.clip(cov / max(float(cov.max()), 1.0) * 255, 0, 255).astype(np.uint8),
+        cv2.COLORMAP_VIRIDIS,
+    )
+    cov_img[qa.coverage < 3] = (0, 0, 255)
+    cv2.imwrite(str(out / "qa_coverage.png"), cov_img)
+    (out / "qa.json").write_text(json.dumps(qa.to_json(), indent=1) + "\n", encoding="utf-8")
+    rows = "\n".join(
+        f"<tr{' class=bad' if c.problems else ''}><td>{html.escape(c.name)}</td>"
+        f"<td>{c.saturated_fraction:.2%}</td><td>{c.dark_fraction:.1%}</td>"
+        f"<td>{c.gain:.2f}</td><td>{c.residual:.3f}</td><td>{c.direction_error_deg:.1f}</td>"
+        f"<td>{c.drift_px[0]:+.2f}, {c.drift_px[1]:+.2f}</td>"
+        f"<td>{html.escape('; '.join(c.problems))}</td></tr>"
+        for c in qa.images
+    )
+    normals = '<img src="normals.png" width="320">' if (out / "normals.png").exists() else ""
+    page = f"""<!doctype html><html><head><meta charset="utf-8"><title>rti-rig QA</title>
+<style>body{{font-family:sans-serif;margin:1em}} td,th{{padding:2px 6px;font-size:12px}}
+tr.bad{{background:#fdd}} .v{{font-size:20px;font-weight:bold}}</style></head><body>
+<p class="v">Verdict: {html.escape(qa.verdict)}</p>
+<p>Model: {html.escape(result.model)} — {html.escape(result.reason)}.
+Expected normal error (median, bound): {qa.expected_normal_error_deg:.2f}°;
+noise σ {qa.noise_sigma:.4f}; pixels lit by fewer than 3 usable images:
+{qa.undercovered_fraction:.1%} (red in the coverage map).</p>
+<p>{normals} <img src="qa_coverage.png" width="320"></p>
+<p>Fit warnings: {html.escape("; ".join(result.warnings) or "none")}</p>
+<table border=1 cellspacing=0><tr><th>image</th><th>saturated</th><th>dark</th><th>gain</th>
+<th>residual</th><th>direction error °</th><th>drift px (x, y)</th><th>problems</th></tr>
+{rows}</table>
+<p>Thresholds: {html.escape(json.dumps(qa.thresholds))}</p></body></html>
+"""
+    (out / "qa.html").write_text(page, encoding="utf-8")
+    return [out / "qa.html", out / "qa.json", out / "qa_coverage.png"]
+
+
+def verdict_for_session(session: Path) -> str:
+    """The QA verdict line of a session folder (for ``rti-rig run``'s last line)."""
+    frames, lights, names, _ = load_acquisition(session)
+    return assess(frames, lights, names).verdict
