@@ -19,7 +19,7 @@ from rti_rig.cli import app
 from rti_rig.core.rti_bases import hsh_basis, ptm_basis
 
 sys.path.insert(0, str(Path(__file__).parent))
-from fit_sessions import make_session  # noqa: E402
+from fit_sessions import make_session
 
 runner = CliRunner()
 
@@ -92,9 +92,10 @@ def _read_rti(path: Path) -> np.ndarray:
 
 
 def test_ptm_and_rti_read_back_relight_like_the_fit(clean, tmp_path: Path) -> None:
+    import tifffile
+
     from rti_rig.reconstruct import fit_hsh, fit_ptm
     from rti_rig.reconstruct.stack import ImageStack
-    import tifffile
 
     session, lights, _ = clean
     out = tmp_path / "out"

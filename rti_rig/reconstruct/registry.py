@@ -61,9 +61,7 @@ register(ModelSpec("ptm", 6, fit_ptm, True, "Lambertian reading of the PTM"))
 register(ModelSpec("hsh2", 9, partial(fit_hsh, order=2), True, "none"))
 register(ModelSpec("hsh3", 16, partial(fit_hsh, order=3), True, "none"))
 register(
-    ModelSpec(
-        "ps", 3, partial(fit_photometric_stereo, robust=False), False, "least-squares PS"
-    )
+    ModelSpec("ps", 3, partial(fit_photometric_stereo, robust=False), False, "least-squares PS")
 )
 register(
     ModelSpec(
