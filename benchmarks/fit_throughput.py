@@ -171,14 +171,18 @@ def main() -> None:
     parser.add_argument(
         "--tile-rows", type=int, default=None, help="rows per band (default: 256 MB budget)"
     )
+    parser.add_argument(
+        "--write", action="store_true", help="write the tables into docs/benchmarks.md"
+    )
     args = parser.parse_args()
     markdown = run(args.size, args.lights, args.repeats, args.tile_rows)
-    path = write_section("fit_throughput", markdown)
-    print(f"written to {path}")
+    if args.write:
+        print(f"written to {write_section('fit_throughput', markdown)}")
     if args.accuracy_size:
         table = accuracy(args.accuracy_size, args.lights)
         print(table)
-        write_section("reconstruction_accuracy", table)
+        if args.write:
+            write_section("reconstruction_accuracy", table)
 
 
 if __name__ == "__main__":

@@ -50,66 +50,127 @@ def _rgb_planes(coefficients: NDArray[Any]) -> NDArray[np.float32]:
     return c
 
 
-def _atomic_bytes(path: Path, chunks: list[bytes]) -> Path:
-    tmp = path.with_name(path.name + ".part")
-    with open(tmp, "wb") as fh:
-        for chunk in chunks:
-            fh.write(chunk)
-    tmp.replace(path)
-    return path
+def ptm_quantisation(lo: ArrayLike, hi: ArrayLike) -> tuple[NDArray[np.float64], NDArray]:
+    """PTM scale (float) and integer bias per coefficient for display-unit ranges lo..hi."""
+    lo = np.minimum(np.asarray(lo, dtype=np.float64), 0.0)
+    hi = np.maximum(np.asarray(hi, dtype=np.float64), 0.0)
+    scale = np.maximum((hi - lo) / 255.0, 1e-12)
+    bias = np.clip(np.round(-lo / scale), 0, 255).astype(int)
+    return scale, bias
+
+
+class PtmWriter:
+    """``PTM_FORMAT_RGB`` written a band of rows at a time (file laid out first, then filled).
+
+    ``lo``/``hi``: range of each of the 6 coefficients in display units (images × 255) over
+    all pixels and colours; values outside are clipped. A fit that streams knows them from a
+    pixel sample (:func:`coefficient_ranges`).
+    """
+
+    def __init__(self, path: Path, width: int, height: int, lo: ArrayLike, hi: ArrayLike) -> None:
+        self.path, self.width, self.height = path, int(width), int(height)
+        self.scale, self.bias = ptm_quantisation(lo, hi)
+        header = (
+            "PTM_1.2\nPTM_FORMAT_RGB\n"
+            f"{self.width}\n{self.height}\n"
+            + " ".join(f"{v:.9g}" for v in self.scale)
+            + "\n"
+            + " ".join(str(v) for v in self.bias)
+            + "\n"
+        ).encode("ascii")
+        self._tmp = path.with_name(path.name + ".part")
+        self._fh = open(self._tmp, "wb")  # noqa: SIM115 - open across bands, closed by close()
+        self._fh.write(header)
+        self._start = len(header)
+        self._plane = self.width * self.height * 6
+        self._fh.truncate(self._start + 3 * self._plane)
+
+    def write_rows(self, top: int, coefficients: NDArray[Any]) -> None:
+        """Coefficients (6, r, W[, 3]) of image rows ``top .. top + r`` (top-down)."""
+        c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
+        r = c.shape[1]
+        sc = self.scale[:, None, None].astype(np.float32)
+        bi = self.bias[:, None, None].astype(np.float32)
+        first_file_row = self.height - (top + r)  # scanlines run bottom-up
+        for ch in range(3):
+            q = np.clip(np.round(c[..., ch] / sc + bi), 0, 255).astype(np.uint8)
+            block = np.ascontiguousarray(np.moveaxis(q, 0, -1)[::-1])
+            self._fh.seek(self._start + ch * self._plane + first_file_row * self.width * 6)
+            self._fh.write(block.tobytes())
+
+    def close(self) -> Path:
+        self._fh.close()
+        self._tmp.replace(self.path)
+        return self.path
+
+
+class RtiWriter:
+    """HSH ``.rti`` written a band of rows at a time; ``lo``/``hi`` per term, display units."""
+
+    def __init__(self, path: Path, width: int, height: int, lo: ArrayLike, hi: ArrayLike) -> None:
+        self.path, self.width, self.height = path, int(width), int(height)
+        self.lo = np.asarray(lo, dtype=np.float64)
+        self.scale = np.maximum(np.asarray(hi, dtype=np.float64) - self.lo, 1e-12)
+        self.terms = self.lo.size
+        if self.terms not in (4, 9, 16):
+            raise ReconstructionError(f"HSH has 4, 9 or 16 terms, got {self.terms}")
+        header = (
+            f"#HSH1.2\n#written by rti-rig\n3\n{self.width} {self.height} 3\n{self.terms} 2 1\n"
+        ).encode("ascii")
+        self._tmp = path.with_name(path.name + ".part")
+        self._fh = open(self._tmp, "wb")  # noqa: SIM115 - open across bands, closed by close()
+        self._fh.write(header)
+        self._fh.write(self.scale.astype("<f4").tobytes())
+        self._fh.write(self.lo.astype("<f4").tobytes())
+        self._start = self._fh.tell()
+        self._fh.truncate(self._start + self.width * self.height * 3 * self.terms)
+
+    def write_rows(self, top: int, coefficients: NDArray[Any]) -> None:
+        """Coefficients (terms, r, W[, 3]) of image rows ``top .. top + r`` (top-down)."""
+        c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
+        r = c.shape[1]
+        lo = self.lo[:, None, None, None].astype(np.float32)
+        sc = self.scale[:, None, None, None].astype(np.float32)
+        q = np.clip(np.round((c - lo) / sc * 255.0), 0, 255).astype(np.uint8)
+        block = np.ascontiguousarray(np.transpose(q, (1, 2, 3, 0))[::-1])  # rows, x, colour, k
+        first_file_row = self.height - (top + r)
+        self._fh.seek(self._start + first_file_row * self.width * 3 * self.terms)
+        self._fh.write(block.tobytes())
+
+    def close(self) -> Path:
+        self._fh.close()
+        self._tmp.replace(self.path)
+        return self.path
+
+
+def coefficient_ranges(
+    coefficients: NDArray[Any], margin: float = 0.0
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per-coefficient (lo, hi) in display units of coefficients (p, ...), widened by
+    ``margin`` × the range on each side (for ranges taken from a sample)."""
+    c = np.asarray(coefficients, dtype=np.float64).reshape(coefficients.shape[0], -1)
+    c = c * DISPLAY_SCALE
+    lo, hi = np.nanmin(c, axis=1), np.nanmax(c, axis=1)
+    pad = (hi - lo) * margin
+    return lo - pad, hi + pad
 
 
 def write_ptm_rgb(path: Path, coefficients: NDArray[Any]) -> Path:
     """Write PTM coefficients (6, H, W[, 3]) in Malzbender order as ``PTM_FORMAT_RGB``."""
-    c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
+    c = np.asarray(coefficients)
     if c.shape[0] != 6:
         raise ReconstructionError(f"a PTM has 6 coefficients, got {c.shape[0]}")
-    _, h, w, _ = c.shape
-    lo = np.minimum(c.reshape(6, -1).min(axis=1), 0.0).astype(np.float64)
-    hi = np.maximum(c.reshape(6, -1).max(axis=1), 0.0).astype(np.float64)
-    scale = np.maximum((hi - lo) / 255.0, 1e-12)
-    bias = np.clip(np.round(-lo / scale), 0, 255).astype(int)
-    header = (
-        "PTM_1.2\nPTM_FORMAT_RGB\n"
-        f"{w}\n{h}\n"
-        + " ".join(f"{s:.9g}" for s in scale)
-        + "\n"
-        + " ".join(str(b) for b in bias)
-        + "\n"
-    ).encode("ascii")
-    chunks = [header]
-    for ch in range(3):
-        plane = c[..., ch]  # (6, H, W)
-        q = np.round(plane / scale[:, None, None].astype(np.float32) + bias[:, None, None])
-        q = np.clip(q, 0, 255).astype(np.uint8)
-        chunks.append(np.ascontiguousarray(np.moveaxis(q, 0, -1)[::-1]).tobytes())
-    return _atomic_bytes(path, chunks)
+    writer = PtmWriter(path, c.shape[2], c.shape[1], *coefficient_ranges(c))
+    writer.write_rows(0, c)
+    return writer.close()
 
 
 def write_hsh_rti(path: Path, coefficients: NDArray[Any]) -> Path:
     """Write HSH coefficients (terms, H, W[, 3]) in ``.rti`` index order as an HSH ``.rti``."""
-    c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
-    terms, h, w, _ = c.shape
-    if terms not in (4, 9, 16):
-        raise ReconstructionError(f"HSH has 4, 9 or 16 terms, got {terms}")
-    lo = c.reshape(terms, -1).min(axis=1).astype(np.float64)
-    hi = c.reshape(terms, -1).max(axis=1).astype(np.float64)
-    scale = np.maximum(hi - lo, 1e-12)
-    header = f"#HSH1.2\n#written by rti-rig\n3\n{w} {h} 3\n{terms} 2 1\n".encode("ascii")
-    q = np.round(
-        (c - lo[:, None, None, None].astype(np.float32))
-        / scale[:, None, None, None].astype(np.float32)
-        * 255.0
-    )
-    q = np.clip(q, 0, 255).astype(np.uint8)  # (terms, H, W, 3)
-    body = np.ascontiguousarray(np.transpose(q, (1, 2, 3, 0))[::-1])  # rows bottom-up, x, c, k
-    chunks = [
-        header,
-        scale.astype("<f4").tobytes(),
-        lo.astype("<f4").tobytes(),
-        body.tobytes(),
-    ]
-    return _atomic_bytes(path, chunks)
+    c = np.asarray(coefficients)
+    writer = RtiWriter(path, c.shape[2], c.shape[1], *coefficient_ranges(c))
+    writer.write_rows(0, c)
+    return writer.close()
 
 
 def write_relight_dome(
@@ -133,25 +194,34 @@ def write_relight_dome(
     return path
 
 
-def write_normal_map(stem: Path, normals: NDArray[Any]) -> list[Path]:
-    """``stem.png`` (16-bit RGB, ``(n + 1) / 2``) and ``stem.npy`` (float32 (H, W, 3))."""
-    n = np.asarray(normals, dtype=np.float32)
+def write_normal_map(stem: Path, normals: NDArray[Any], npy: bool = True) -> list[Path]:
+    """``stem.png`` (16-bit RGB, ``(n + 1) / 2``) and ``stem.npy`` (float32 (H, W, 3)); with
+    ``npy=False`` the ``.npy`` is taken to exist already (a memmap the fit wrote into)."""
     png = stem.with_suffix(".png")
-    enc = np.clip(np.round((n + 1.0) * 0.5 * 65535.0), 0, 65535).astype(np.uint16)
+    enc = np.empty(np.shape(normals), dtype=np.uint16)
+    for top in range(0, enc.shape[0], 512):  # bounded temporaries for large maps
+        n = np.asarray(normals[top : top + 512], dtype=np.float32)
+        enc[top : top + 512] = np.clip(np.round((n + 1.0) * 0.5 * 65535.0), 0, 65535)
     if not cv2.imwrite(str(png), enc[..., ::-1]):
         raise ReconstructionError(f"could not write {png}")
-    npy = stem.with_suffix(".npy")
-    np.save(npy, n)
-    return [png, npy]
+    path = stem.with_suffix(".npy")
+    if npy:
+        np.save(path, np.asarray(normals, dtype=np.float32))
+    return [png, path]
 
 
-def write_albedo(stem: Path, albedo: NDArray[Any], white: float = 1.0) -> list[Path]:
+def write_albedo(
+    stem: Path, albedo: NDArray[Any], white: float = 1.0, npy: bool = True
+) -> list[Path]:
     """``stem.png`` (16-bit, linear, white = ``white``) and ``stem.npy`` (float32)."""
-    a = np.asarray(albedo, dtype=np.float32)
     png = stem.with_suffix(".png")
-    enc = np.clip(np.round(a / white * 65535.0), 0, 65535).astype(np.uint16)
+    enc = np.empty(np.shape(albedo), dtype=np.uint16)
+    for top in range(0, enc.shape[0], 512):
+        a = np.asarray(albedo[top : top + 512], dtype=np.float32)
+        enc[top : top + 512] = np.clip(np.round(a / white * 65535.0), 0, 65535)
     if not cv2.imwrite(str(png), enc[..., ::-1] if enc.ndim == 3 else enc):
         raise ReconstructionError(f"could not write {png}")
-    npy = stem.with_suffix(".npy")
-    np.save(npy, a)
-    return [png, npy]
+    path = stem.with_suffix(".npy")
+    if npy:
+        np.save(path, np.asarray(albedo, dtype=np.float32))
+    return [png, path]

@@ -92,22 +92,37 @@ def _weighted_columns(
     """Least squares per column of ``values`` (N, K) on its ``usable`` observations only.
 
     Returns coefficients (p, K) and whether each column could be fitted: at least p usable
-    observations whose design rows are well-conditioned (ratio of extreme eigenvalues of the
-    normal matrix within ``cond_limit^2``); others get zeros. Only the few columns with an
-    excluded observation come here, so a batched p × p solve is cheap.
+    observations whose design rows are well-conditioned (condition number of the column-scaled
+    subset within ``cond_limit``); others get zeros. Columns are grouped by their pattern of
+    usable observations — saturation and NaN tend to hit the same few lights over a region — so
+    each distinct pattern costs one small pseudo-inverse and one matrix product.
     """
-    n, p = design.shape
-    outer = (design[:, :, None] * design[:, None, :]).reshape(n, p * p)
-    wt = usable.T.astype(np.float64)  # (K, N)
-    normal = (wt @ outer).reshape(-1, p, p)
-    rhs = (np.where(usable, values, 0.0).T.astype(np.float64)) @ design  # (K, p)
-    count = usable.sum(axis=0)
-    eig = np.linalg.eigvalsh(normal)
-    ok = (count >= p) & (eig[:, 0] > eig[:, -1] / cond_limit**2) & (eig[:, -1] > 0)
-    coef = np.zeros((values.shape[1], p))
-    if ok.any():
-        coef[ok] = np.linalg.solve(normal[ok], rhs[ok][..., None])[..., 0]
-    return coef.T.astype(np.float32), ok
+    p = design.shape[1]
+    k = values.shape[1]
+    coef = np.zeros((p, k), dtype=np.float32)
+    ok = np.zeros(k, dtype=bool)
+    if k == 0:
+        return coef, ok
+    packed = np.packbits(usable.T, axis=1)  # (K, ceil(N/8))
+    keys = np.ascontiguousarray(packed).view(np.dtype((np.void, packed.shape[1])))[:, 0]
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    order = np.argsort(inverse, kind="stable")
+    bounds = np.searchsorted(inverse[order], np.arange(first.size + 1))
+    for u, j in enumerate(first):
+        cols = order[bounds[u] : bounds[u + 1]]
+        rows = np.flatnonzero(usable[:, j])
+        if rows.size < p:
+            continue
+        sub = design[rows]
+        norms = np.linalg.norm(sub, axis=0)
+        norms = np.where(norms > 1e-12, norms, 1.0)
+        uu, sv, vt = np.linalg.svd(sub / norms, full_matrices=False)
+        if sv[-1] <= 0 or sv[0] / sv[-1] > cond_limit:
+            continue
+        w = ((vt.T / sv) @ uu.T / norms[:, None]).astype(np.float32)
+        coef[:, cols] = w @ values[np.ix_(rows, cols)]
+        ok[cols] = True
+    return coef, ok
 
 
 def fit_coefficients(

@@ -338,12 +338,15 @@ def fit_photometric_stereo(
     max_passes: int = 10,
     cond_limit: float = COND_LIMIT,
     shadow_k: float | None = SHADOW_K,
+    reference_level: float | None = None,
 ) -> PSResult:
     """Normals and albedo of linear ``images`` (N, H, W[, C]) under unit ``lights`` (N, 3).
 
     See the module docstring for the robust rules; ``shadow_k`` (rule 4) is read only by the
-    robust fit, since least squares discards nothing. Raises :class:`ReconstructionError` for
-    fewer than 3 lights or an ill-conditioned (near-coplanar) light set.
+    robust fit, since least squares discards nothing. ``reference_level`` overrides the stack's
+    own (a caller fitting band by band passes the whole acquisition's, so thresholds agree).
+    Raises :class:`ReconstructionError` for fewer than 3 lights or an ill-conditioned
+    (near-coplanar) light set.
     """
     if shadow_k is not None and not (np.isfinite(shadow_k) and shadow_k > 0):
         raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
@@ -357,7 +360,7 @@ def fit_photometric_stereo(
         inside_all = np.asarray(mask, dtype=bool)
         if inside_all.shape != (h, wd):
             raise ReconstructionError(f"mask has shape {inside_all.shape}, images are {(h, wd)}")
-    ref = stack.reference_level()
+    ref = stack.reference_level() if reference_level is None else float(reference_level)
     dark = float(dark_threshold) if dark_threshold is not None else DARK_FRACTION * ref
     if saturation is None:
         saturation = stack.saturation_level

@@ -155,38 +155,39 @@ def assess(
     *,
     saturation: float | None = None,
 ) -> QAReport:
-    """Check an acquisition: ``frames`` (N arrays (H, W[, C]), uint16 or float), ``lights``."""
-    arrays = [np.asarray(f) for f in frames]
-    n = len(arrays)
+    """Check an acquisition: ``frames`` (N arrays or row-readable array-likes (H, W[, C]),
+    uint16 or float), ``lights``. Frames are read one at a time."""
+    n = len(frames)
     lt = validate_lights(lights, n)
+    first = frames[0]
+    h, w = int(first.shape[0]), int(first.shape[1])
     if saturation is None:
-        dt = arrays[0].dtype
+        dt = np.dtype(first.dtype)
         saturation = float(np.iinfo(dt).max) if np.issubdtype(dt, np.integer) else float("inf")
-    h, w = arrays[0].shape[:2]
-    # full-resolution fractions and a reduced grey stack for coverage
-    sat_masks = [
-        np.any(a >= saturation, axis=-1) if a.ndim == 3 else a >= saturation for a in arrays
-    ]
-    sat_frac = np.array([float(m.mean()) for m in sat_masks])
     factor = max(1, int(np.ceil(max(h, w) / COVERAGE_SIDE)))
     small_shape = (max(1, w // factor), max(1, h // factor))
-    small = np.stack(
-        [cv2.resize(_grey(a), small_shape, interpolation=cv2.INTER_AREA) for a in arrays]
-    )
-    small_sat = np.stack(
-        [
+    rs, cs = _crop_slices(h, w)
+    sat_frac = np.zeros(n)
+    small_list, small_sat_list, crop = [], [], []
+    for f in frames:  # one frame in memory at a time
+        a = np.asarray(f[0:h])
+        m = np.any(a >= saturation, axis=-1) if a.ndim == 3 else a >= saturation
+        sat_frac[len(crop)] = float(m.mean())
+        g = _grey(a)
+        small_list.append(cv2.resize(g, small_shape, interpolation=cv2.INTER_AREA))
+        small_sat_list.append(
             cv2.resize(m.astype(np.float32), small_shape, interpolation=cv2.INTER_AREA) > 0
-            for m in sat_masks
-        ]
-    )
+        )
+        crop.append(g[rs, cs].copy())
+        del a, g, m
+    small = np.stack(small_list)
+    small_sat = np.stack(small_sat_list)
     ref = float(np.percentile(small, 99.0)) or 1.0
     dark = DARK_FRACTION * ref
     dark_frac = (small < dark).mean(axis=(1, 2))
     coverage = ((small > dark) & ~small_sat).sum(axis=0).astype(np.int16)
 
     # per-image evidence on a full-resolution central crop
-    rs, cs = _crop_slices(h, w)
-    crop = [_grey(a[rs, cs]) for a in arrays]
     crop_arr = np.stack(crop) / np.float32(saturation if np.isfinite(saturation) else 1.0)
     sat_level = 1.0 if np.isfinite(saturation) else None
     ps = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)

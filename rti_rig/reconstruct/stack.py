@@ -1,7 +1,9 @@
 """Images and lights as the fitting code sees them, checked once at the edge.
 
 Images arrive as one array (N, H, W) or (N, H, W, C) — possibly a ``numpy.memmap`` — or as a
-sequence of N arrays (H, W) / (H, W, C), e.g. the ``uint16`` pixels of captured frames. Nothing
+sequence of N arrays (H, W) / (H, W, C), e.g. the ``uint16`` pixels of captured frames, or
+row-readable array-likes such as :class:`rti_rig.core.tiff_rows.TiffRows` (files read a band at
+a time). Nothing
 here converts the whole stack: :meth:`ImageStack.rows` converts one band of rows to float32 on
 demand, so a stack larger than memory can be fitted from a memmap or from frames kept as
 ``uint16``.
@@ -62,7 +64,7 @@ class ImageStack:
             shape = images.shape[1:]
             dtype = images.dtype
         elif isinstance(images, Sequence) and len(images) > 0:
-            arrays = [np.asarray(im) for im in images]
+            arrays = [im if _row_readable(im) else np.asarray(im) for im in images]
             shape = arrays[0].shape
             for i, a in enumerate(arrays):
                 if a.shape != shape:
@@ -169,6 +171,17 @@ class ImageStack:
         finite = values[np.isfinite(values)]
         level = float(np.percentile(finite, 99.0)) if finite.size else 0.0
         return level if level > 0 else 1.0
+
+
+def _row_readable(obj: Any) -> bool:
+    """An array-like read a band of rows at a time (``shape``, ``dtype``, ``obj[a:b]``), e.g.
+    :class:`rti_rig.core.tiff_rows.TiffRows`: kept as is, never read whole."""
+    return (
+        not isinstance(obj, np.ndarray)
+        and hasattr(obj, "shape")
+        and hasattr(obj, "dtype")
+        and hasattr(obj, "__getitem__")
+    )
 
 
 def stack_from_frames(frames: Sequence[Any]) -> ImageStack:

@@ -2,8 +2,9 @@
 
 Input: a session folder (``lights.lp`` and ``linear/*.tif`` 16-bit linear, as
 :mod:`rti_rig.runtime.session` writes it) or any ``.lp`` with its images beside it (16-bit TIFF
-used as linear; 8-bit JPEG/PNG decoded from sRGB). Frames are held as ``uint16`` — never the
-stack as floats — and every fit streams them a band of rows at a time.
+used as linear; 8-bit JPEG/PNG decoded from sRGB). TIFFs are read a band of rows at a time
+(:class:`rti_rig.core.tiff_rows.TiffRows`); JPEG/PNG are decoded whole and held as ``uint16``.
+The stack is never held as floats; one streamed pass computes every output.
 """
 
 from __future__ import annotations
@@ -21,9 +22,10 @@ import numpy as np
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
+from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
 from rti_rig.reconstruct.qa import QAReport, assess
-from rti_rig.reconstruct.registry import RELIGHT_MODELS, model_spec
+from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
 
 #: What ``--model`` accepts besides the registered model names.
@@ -66,9 +68,10 @@ def _read_image(path: Path) -> np.ndarray:
     if not path.is_file():
         raise FitInputError(f"image {path} listed in the .lp is missing")
     if path.suffix.lower() in (".tif", ".tiff"):
-        import tifffile
-
-        img = tifffile.imread(path)
+        rows = TiffRows(path)  # read a band at a time by the fit, never whole
+        if rows.dtype != np.uint16:
+            raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
+        return rows  # type: ignore[return-value]
     else:
         img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
         if img is None:
@@ -147,16 +150,39 @@ def run_fit(req: FitRequest) -> FitResult:
     return result
 
 
+#: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
+#: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
+BAND_BUDGET_BYTES = 24 * 1024 * 1024
+
+
 def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) -> FitResult:
+    """One streamed pass over the acquisition: every output is computed band by band.
+
+    Each band of rows of all images is read once (from the TIFFs, a strip at a time) and fitted
+    by photometric stereo (normals, albedo) and by the PTM and HSH written to ``.ptm`` and
+    ``.rti``; nothing holds the stack as floats. The 8-bit quantisation ranges of the exported
+    coefficients come from a fit of the same pixel sample model choice uses (widened by 50 %;
+    values beyond are clipped, and counted in ``fit.json``).
+    """
+    from rti_rig.core.rti_bases import design_matrix
+    from rti_rig.reconstruct.errors import FitTrustWarning
+    from rti_rig.reconstruct.linear_model import fit_coefficients
     from rti_rig.reconstruct.model_select import select_model
+    from rti_rig.reconstruct.photometric_stereo import (
+        DARK_FRACTION,
+        HIGHLIGHT_FLOOR_FRACTION,
+        fit_photometric_stereo,
+    )
+    from rti_rig.reconstruct.solve import solve_matrix
+    from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
 
     files: list[Path] = []
     name = req.model
+    n = stack.n
     if name == AUTO:
         choice = select_model(stack, lights)
         model_name = choice.model
-        reason = choice.to_markdown()
-        (out / "model_choice.md").write_text(reason + "\n", encoding="utf-8")
+        (out / "model_choice.md").write_text(choice.to_markdown() + "\n", encoding="utf-8")
         files.append(out / "model_choice.md")
         reason_line = (
             f"{choice.model}: lowest order within {choice.tolerance:.0%} of the best held-out "
@@ -165,29 +191,86 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
     else:
         model_name = model_spec(name).name
         reason_line = f"{model_name}: chosen by --model"
-    # normals: robust PS unless a model with normals was asked for
     normal_source = model_name if model_name in ("ps", "lambert", "ptm") else "ps-robust"
-    ps = model_spec(normal_source).fit(stack, lights) if normal_source.startswith("ps") else None
-    if ps is not None:
-        files += exporters.write_normal_map(out / "normals", ps.normals)
-        files += exporters.write_albedo(out / "albedo", ps.albedo)
-    relit_models: dict[str, Any] = {}
-    if model_name in RELIGHT_MODELS:
-        relit_models[model_name] = model_spec(model_name).fit(stack, lights)
-    if req.write_ptm and "ptm" not in relit_models and len(lights) >= 6:
-        relit_models["ptm"] = model_spec("ptm").fit(stack, lights)
+
+    # linear models to export, their solve matrices (warnings issued once, here)
     order = req.hsh_order or (int(model_name[-1]) if model_name.startswith("hsh") else 2)
-    hsh = f"hsh{order}"
-    if hsh not in relit_models and len(lights) >= (order + 1) ** 2:
-        relit_models[hsh] = model_spec(hsh).fit(stack, lights)
-    if "ptm" in relit_models:
-        files.append(exporters.write_ptm_rgb(out / "fit.ptm", relit_models["ptm"].coefficients))
-    if hsh in relit_models:
-        files.append(exporters.write_hsh_rti(out / "fit.rti", relit_models[hsh].coefficients))
-    if ps is None:
-        m = relit_models.get(normal_source)
-        if m is not None and hasattr(m, "normals"):
-            files += exporters.write_normal_map(out / "normals", m.normals())
+    linear: dict[str, np.ndarray] = {}
+    if req.write_ptm and n >= 6:
+        linear["ptm"] = design_matrix("ptm", lights)
+    if n >= (order + 1) ** 2:
+        linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
+    if normal_source == "lambert":
+        linear["lambert"] = design_matrix("lambert", lights)
+    sample, _ = stack.pixel_sample(20_000)
+    obs = sample.reshape(n, -1)
+    keep = np.all(np.isfinite(obs), axis=0)
+    if stack.saturation_level is not None:
+        keep &= np.all(obs < stack.saturation_level, axis=0)
+    obs = obs[:, keep] if keep.any() else np.nan_to_num(obs)
+    writers: dict[str, Any] = {}
+    for key, design in linear.items():
+        ill = "refuse" if key == "lambert" else "regularise"
+        w, _ = solve_matrix(design, key, ill)
+        if key == "lambert":
+            continue
+        lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5)
+        if key == "ptm":
+            writers[key] = exporters.PtmWriter(out / "fit.ptm", stack.width, stack.height, lo, hi)
+        else:
+            writers[key] = exporters.RtiWriter(out / "fit.rti", stack.width, stack.height, lo, hi)
+
+    ref = stack.reference_level()
+    h, wd = stack.height, stack.width
+    normals = np.lib.format.open_memmap(out / "normals.npy", "w+", np.float32, (h, wd, 3))
+    albedo_shape = (h, wd) if stack.grey else (h, wd, stack.channels)
+    albedo = np.lib.format.open_memmap(out / "albedo.npy", "w+", np.float32, albedo_shape)
+    rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
+    sat = stack.saturation_level
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
+        for sl in row_tiles(h, rows):
+            band = stack.rows(sl, strict=False)
+            if stack.grey:
+                band = band[..., 0]
+            coefs = {
+                key: fit_coefficients(band, design, key, saturation=sat, tile_rows=rows)[0]
+                for key, design in linear.items()
+            }
+            for key, writer in writers.items():
+                writer.write_rows(sl.start, coefs[key])
+            if normal_source.startswith("ps"):
+                ps = fit_photometric_stereo(
+                    band,
+                    lights,
+                    robust=normal_source == "ps-robust",
+                    tile_rows=rows,
+                    saturation=sat,
+                    dark_threshold=DARK_FRACTION * ref,
+                    highlight_floor=HIGHLIGHT_FLOOR_FRACTION * ref,
+                    reference_level=ref,
+                )
+                normals[sl], albedo[sl] = ps.normals, ps.albedo
+            else:
+                from rti_rig.reconstruct.linear_model import LambertModel
+                from rti_rig.reconstruct.ptm import PTMModel
+                from rti_rig.reconstruct.solve import FitReport
+
+                report = FitReport(normal_source, n, 0, 0.0, 0.0, False, 0.0)
+                cls = PTMModel if normal_source == "ptm" else LambertModel
+                normals[sl] = cls(coefs[normal_source], report).normals()
+                if normal_source == "lambert":
+                    b = coefs["lambert"]
+                    albedo[sl] = np.linalg.norm(b, axis=0)
+                else:
+                    albedo[sl] = coefs["ptm"][5]  # the PTM's constant term: mean brightness
+    for writer in writers.values():
+        files.append(writer.close())
+    normals.flush()
+    albedo.flush()
+    files += exporters.write_normal_map(out / "normals", normals, npy=False)
+    files += exporters.write_albedo(out / "albedo", albedo, npy=False)
+    del normals, albedo
     return FitResult(out, model_name, reason_line, files)
 
 
