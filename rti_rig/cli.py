@@ -1011,6 +1011,11 @@ def fit(
         ),
     ] = "auto",
     no_qa: Annotated[bool, typer.Option("--no-qa", help="Skip the QA verdict.")] = False,
+    no_ptm: Annotated[bool, typer.Option("--no-ptm", help="Do not write fit.ptm.")] = False,
+    no_hsh: Annotated[bool, typer.Option("--no-hsh", help="Do not write fit.rti.")] = False,
+    no_normals: Annotated[
+        bool, typer.Option("--no-normals", help="Do not fit normal and albedo maps.")
+    ] = False,
 ) -> None:
     """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
     from rti_rig.app.usecases.fit import FitRequest, run_fit
@@ -1022,7 +1027,16 @@ def fit(
                 model_spec(model)
             except ValueError as exc:
                 raise RtiRigError(str(exc)) from None
-        result = run_fit(FitRequest(source, out_dir, model=model, qa=not no_qa))
+        request = FitRequest(
+            source,
+            out_dir,
+            model=model,
+            qa=not no_qa,
+            write_ptm=not no_ptm,
+            write_hsh=not no_hsh,
+            write_normals=not no_normals,
+        )
+        result = run_fit(request)
     except RtiRigError as exc:
         raise _fail(exc) from None
     out.print(f"Model: {escape(result.reason)}")

@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.solve import COND_LIMIT, solve_matrix
-from rti_rig.reconstruct.stack import ImageStack, as_direction, validate_lights
+from rti_rig.reconstruct.stack import ImageStack, as_direction, channel_mean, validate_lights
 from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
 
 #: Default shadow threshold as a fraction of the stack's reference level.
@@ -382,9 +382,11 @@ def fit_photometric_stereo(
         bad = stack.unusable(band)  # NaN / saturated: zeroed, excluded below
         r = band.shape[1]
         flat = band.reshape(stack.n, r * wd, stack.channels)
-        g = flat.mean(axis=2) if stack.channels > 1 else flat[..., 0]
+        g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
         inside = inside_all[sl].ravel()
-        usable = None if bad is None else ~bad.reshape(stack.n, r * wd, -1).any(axis=2)
+        usable = (
+            None if bad is None else ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
+        )
         if robust:
             if usable is not None:
                 inside_robust = inside

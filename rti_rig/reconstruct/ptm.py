@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.linear_model import LinearBasisModel, fit_coefficients
 from rti_rig.reconstruct.solve import COND_LIMIT, IllConditioned
-from rti_rig.reconstruct.stack import ImageStack, validate_lights
+from rti_rig.reconstruct.stack import ImageStack, channel_mean, validate_lights
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,7 @@ class PTMModel(LinearBasisModel):
             sl = slice(start, min(h, start + tile_rows))
             band = np.asarray(c[:, sl], dtype=np.float32)
             if band.ndim == 4:
-                band = band.mean(axis=-1)
+                band = channel_mean(band)
             r = band.shape[1]
             vals = basis @ band.reshape(6, -1)  # (K, P)
             peak = vals.max(axis=0)

@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
-from rti_rig.reconstruct.stack import validate_lights
+from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
 #: Side of the central crop the per-image checks fit on (full resolution).
 CROP = 384
@@ -116,7 +116,7 @@ class QAReport:
 
 def _grey(frame: NDArray[Any]) -> NDArray[np.float32]:
     f = np.asarray(frame, dtype=np.float32)
-    return f.mean(axis=-1) if f.ndim == 3 else f
+    return channel_mean(f) if f.ndim == 3 else f
 
 
 def _crop_slices(h: int, w: int) -> tuple[slice, slice]:

@@ -13,6 +13,7 @@ import html
 import json
 import time
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,8 @@ class FitRequest:
     out_dir: Path
     model: str = AUTO
     write_ptm: bool = True
+    write_hsh: bool = True
+    write_normals: bool = True
     hsh_order: int | None = None  # None: the chosen HSH order, else 2
     qa: bool = True
 
@@ -150,6 +153,9 @@ def run_fit(req: FitRequest) -> FitResult:
     return result
 
 
+#: Pixel sample shared by model choice, quantisation ranges and the reference level: one
+#: decode pass of the files for all three.
+SAMPLE_PIXELS = 100_000
 #: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
 #: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
 BAND_BUDGET_BYTES = 24 * 1024 * 1024
@@ -180,7 +186,7 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
     name = req.model
     n = stack.n
     if name == AUTO:
-        choice = select_model(stack, lights)
+        choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS)
         model_name = choice.model
         (out / "model_choice.md").write_text(choice.to_markdown() + "\n", encoding="utf-8")
         files.append(out / "model_choice.md")
@@ -198,11 +204,11 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
     linear: dict[str, np.ndarray] = {}
     if req.write_ptm and n >= 6:
         linear["ptm"] = design_matrix("ptm", lights)
-    if n >= (order + 1) ** 2:
+    if req.write_hsh and n >= (order + 1) ** 2:
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
     if normal_source == "lambert":
         linear["lambert"] = design_matrix("lambert", lights)
-    sample, _ = stack.pixel_sample(20_000)
+    sample, _ = stack.pixel_sample(SAMPLE_PIXELS)  # the sample model choice read (cached)
     obs = sample.reshape(n, -1)
     keep = np.all(np.isfinite(obs), axis=0)
     if stack.saturation_level is not None:
@@ -220,17 +226,26 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
         else:
             writers[key] = exporters.RtiWriter(out / "fit.rti", stack.width, stack.height, lo, hi)
 
-    ref = stack.reference_level()
+    if not req.write_normals:
+        normal_source = ""
+        linear.pop("lambert", None)
+    ref = stack.reference_level(SAMPLE_PIXELS)
     h, wd = stack.height, stack.width
-    normals = np.lib.format.open_memmap(out / "normals.npy", "w+", np.float32, (h, wd, 3))
-    albedo_shape = (h, wd) if stack.grey else (h, wd, stack.channels)
+    maps = (h, wd) if req.write_normals else (1, 1)
+    normals = np.lib.format.open_memmap(out / "normals.npy", "w+", np.float32, (*maps, 3))
+    albedo_shape = maps if stack.grey else (*maps, stack.channels)
     albedo = np.lib.format.open_memmap(out / "albedo.npy", "w+", np.float32, albedo_shape)
     rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
     sat = stack.saturation_level
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
-        for sl in row_tiles(h, rows):
-            band = stack.rows(sl, strict=False)
+        tiles = list(row_tiles(h, rows))
+        pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="prefetch")
+        pending = pool.submit(stack.rows, tiles[0], strict=False)
+        for t, sl in enumerate(tiles):
+            band = pending.result()  # read while the previous band was being fitted
+            if t + 1 < len(tiles):
+                pending = pool.submit(stack.rows, tiles[t + 1], strict=False)
             if stack.grey:
                 band = band[..., 0]
             coefs = {
@@ -239,7 +254,9 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
             }
             for key, writer in writers.items():
                 writer.write_rows(sl.start, coefs[key])
-            if normal_source.startswith("ps"):
+            if not normal_source:
+                pass
+            elif normal_source.startswith("ps"):
                 ps = fit_photometric_stereo(
                     band,
                     lights,
@@ -264,13 +281,18 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
                     albedo[sl] = np.linalg.norm(b, axis=0)
                 else:
                     albedo[sl] = coefs["ptm"][5]  # the PTM's constant term: mean brightness
+        pool.shutdown()
     for writer in writers.values():
         files.append(writer.close())
     normals.flush()
     albedo.flush()
-    files += exporters.write_normal_map(out / "normals", normals, npy=False)
-    files += exporters.write_albedo(out / "albedo", albedo, npy=False)
+    if req.write_normals:
+        files += exporters.write_normal_map(out / "normals", normals, npy=False)
+        files += exporters.write_albedo(out / "albedo", albedo, npy=False)
     del normals, albedo
+    if not req.write_normals:
+        (out / "normals.npy").unlink()
+        (out / "albedo.npy").unlink()
     return FitResult(out, model_name, reason_line, files)
 
 
