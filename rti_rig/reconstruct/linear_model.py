@@ -162,17 +162,27 @@ def fit_coefficients(
         raise ReconstructionError(f"out has shape {out.shape}, the coefficients need {shape}")
     coef = np.empty(shape, dtype=np.float32) if out is None else out
     missing = unfitted = 0
+    sat = stack.saturation_level
     for sl in row_tiles(stack.height, rows):
-        band = stack.rows(sl, strict=False)  # (N, r, W, C)
-        bad = stack.unusable(band)
+        band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
         r = band.shape[1]
         flat = band.reshape(stack.n, -1)
         tile = w32 @ flat
-        if bad is not None:
-            cols = np.flatnonzero(bad.reshape(stack.n, -1).any(axis=0))
-            sub, ok = _weighted_columns(
-                design, flat[:, cols], ~bad.reshape(stack.n, -1)[:, cols], cond_limit
-            )
+        # NaN/inf in an observation propagates into its column's coefficients: find them there
+        # (p rows, not N); saturation needs one max-reduction over the band
+        bad_cols = ~np.isfinite(tile).all(axis=0)
+        hit = stack.suspect_columns(flat)
+        if hit is not None:
+            bad_cols |= hit
+        if bad_cols.any():
+            cols = np.flatnonzero(bad_cols)
+            vals = flat[:, cols]
+            usable = np.isfinite(vals)
+            if sat is not None:
+                with np.errstate(invalid="ignore"):
+                    usable &= vals < np.float32(sat)
+            vals = np.where(usable, vals, np.float32(0.0))
+            sub, ok = _weighted_columns(design, vals, usable, cond_limit)
             tile[:, cols] = sub
             missing += cols.size
             unfitted += int((~ok).sum())

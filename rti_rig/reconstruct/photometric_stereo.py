@@ -292,7 +292,6 @@ def _albedo_residual_used(
 
 
 def _albedo_residual_all(
-    w32: NDArray[np.float32],
     inside: NDArray[np.bool_],
     g: NDArray[np.float32],
     flat: NDArray[np.float32],
@@ -300,27 +299,29 @@ def _albedo_residual_all(
     gram: NDArray[np.float64],
     eps_b: float,
 ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
-    """Least squares over all lights without (N, P) temporaries: matrix products only.
+    """Least squares over all lights with matrix products only.
 
-    With every light used, ``sum_k s_k I_k = n . (L^T I)`` and ``sum_k s_k^2 = n^T (L^T L) n``,
-    so albedo and residual need three (3 × N) @ (N × P) products and one sum of squares.
+    ``L^T I`` is the one pass over the band for the normals (``b = (L^T L)^-1 L^T I``); with
+    every light used, ``sum_k s_k I_k = n . (L^T I)`` and ``sum_k s_k^2 = n^T (L^T L) n``, so the
+    albedo needs nothing more for grey images and one more product for colour; the residual is
+    one prediction product and one sum of squares.
     """
-    b = (w32 @ g).T.astype(np.float64)
+    lt32 = lights.T.astype(np.float32)
+    ltg = (lt32 @ g).T.astype(np.float64)  # (P, 3)
+    b = ltg @ np.linalg.inv(gram).T
     n, norm, ok = _unit_normals(b, inside.copy(), eps_b)
     ss = np.einsum("pi,ij,pj->p", n, gram, n)
     ss = np.where(ss > 0, ss, 1.0)
-    lt32 = lights.T.astype(np.float32)
     channels = flat.shape[2]
-    alb = np.empty((g.shape[1], channels))
-    for c in range(channels):
-        proj = (lt32 @ np.ascontiguousarray(flat[..., c])).T.astype(np.float64)  # (P, 3)
-        alb[:, c] = np.sum(n * proj, axis=1) / ss
-    # float64 here: the residual is a small difference of large sums
-    g64 = g.astype(np.float64)
-    ltg = (lights.T @ g64).T
-    g2 = np.einsum("np,np->p", g64, g64)
-    sse = g2 - 2.0 * norm * np.sum(n * ltg, axis=1) + norm * norm * ss
-    rms = np.sqrt(np.maximum(sse, 0.0) / g.shape[0])
+    if channels == 1:
+        alb = (np.sum(n * ltg, axis=1) / ss)[:, None]
+    else:
+        proj = (lt32 @ flat.reshape(flat.shape[0], -1)).reshape(3, -1, channels)
+        alb = np.einsum("pi,ipc->pc", n, proj.astype(np.float64)) / ss[:, None]
+    # the residual directly (not as a difference of large sums, which float32 cannot resolve)
+    diff = (n * norm[:, None]).astype(np.float32) @ lt32  # (P, N) predictions
+    diff -= g.T
+    rms = np.sqrt(np.einsum("pn,pn->p", diff, diff) / g.shape[0]).astype(np.float64)
     return n, alb, rms, ok
 
 
@@ -352,7 +353,7 @@ def fit_photometric_stereo(
         raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
     stack = ImageStack(images, saturation_level=saturation)
     lt = validate_lights(lights, stack.n)
-    w_ls, report = solve_matrix(lt, "photometric stereo", "refuse", cond_limit)
+    _, report = solve_matrix(lt, "photometric stereo", "refuse", cond_limit)
     h, wd = stack.height, stack.width
     if mask is None:
         inside_all = np.ones((h, wd), dtype=bool)
@@ -373,13 +374,14 @@ def fit_photometric_stereo(
     residual = np.zeros((h, wd), dtype=np.float32)
     valid = np.zeros((h, wd), dtype=bool)
     used = np.zeros((h, wd), dtype=np.int16)
-    w32 = w_ls.astype(np.float32)
     gram = lt.T @ lt
     # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
-        band = stack.rows(sl, strict=False)  # (N, r, W, C)
-        bad = stack.unusable(band)  # NaN / saturated: zeroed, excluded below
+        band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
+        bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
+        if bad is not None:
+            band = np.where(bad, np.float32(0.0), band)
         r = band.shape[1]
         flat = band.reshape(stack.n, r * wd, stack.channels)
         g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
@@ -407,7 +409,7 @@ def fit_photometric_stereo(
             )
             n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
         else:
-            n, alb, rms, ok = _albedo_residual_all(w32, inside, g, flat, lt, gram, eps_b)
+            n, alb, rms, ok = _albedo_residual_all(inside, g, flat, lt, gram, eps_b)
             count = np.full(ok.shape, stack.n)
             if usable is not None:
                 # pixels with an excluded observation: least squares on the others only

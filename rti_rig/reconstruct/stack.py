@@ -107,17 +107,23 @@ class ImageStack:
             raise ReconstructionError(f"images are empty: shape {shape}")
 
     def rows(
-        self, sl: slice, indices: ArrayLike | None = None, *, strict: bool = True
+        self,
+        sl: slice,
+        indices: ArrayLike | None = None,
+        *,
+        strict: bool = True,
+        copy: bool = True,
     ) -> NDArray[np.float32]:
         """Band of rows ``sl`` of images ``indices`` (default all) as float32 (n, r, W, C).
 
         ``strict`` refuses NaN or infinity; the fits read with ``strict=False`` and treat such
         values as missing observations (see :meth:`unusable`), so that one bad pixel, masked
-        or not, never aborts a whole fit.
+        or not, never aborts a whole fit. ``copy=False`` may return a view of float32 input
+        (no conversion needed): the caller must not write into it.
         """
         idx = np.arange(self.n) if indices is None else np.asarray(indices)
         if self._array is not None:
-            band = np.asarray(self._array[idx, sl])
+            band = np.asarray(self._array[:, sl] if indices is None else self._array[idx, sl])
         else:
             assert self._frames is not None
             frames = self._frames
@@ -127,7 +133,7 @@ class ImageStack:
                 band = np.stack(parts)
             else:
                 band = np.stack([np.asarray(frames[i][sl]) for i in idx])
-        out = band.astype(np.float32, copy=True)
+        out = band.astype(np.float32, copy=copy or self.scale != 1.0)
         if self.scale != 1.0:
             out *= np.float32(self.scale)
         if out.ndim == 3:
@@ -142,16 +148,25 @@ class ImageStack:
 
     def unusable(self, band: NDArray[np.float32]) -> NDArray[np.bool_] | None:
         """Observations of ``band`` a fit must not use: NaN/infinite, or at or above the
-        saturation level. Sets them to 0 in place (so sums stay finite) and returns the mask,
-        or None when every observation is usable (the fast path)."""
+        saturation level; None when every observation is usable (the fast path). Read-only:
+        callers zero the unusable values in their own copy."""
         bad = ~np.isfinite(band)
         if self.saturation_level is not None:
             with np.errstate(invalid="ignore"):
                 bad |= band >= np.float32(self.saturation_level)
         if not bad.any():
             return None
-        band[bad] = 0.0
         return bad
+
+    def suspect_columns(self, flat: NDArray[np.float32]) -> NDArray[np.bool_] | None:
+        """Columns of ``flat`` (N, K) holding a saturated value, by one max-reduction (no
+        temporary of the band's size); None when the level is unknown or nothing reaches it.
+        Non-finite values are found by the caller from its results (NaN propagates)."""
+        if self.saturation_level is None:
+            return None
+        with np.errstate(invalid="ignore"):
+            hit = np.max(flat, axis=0) >= np.float32(self.saturation_level)
+        return hit if hit.any() else None
 
     def pixel_sample(self, max_pixels: int) -> tuple[NDArray[np.float32], NDArray[np.intp]]:
         """A regular grid of at most ``max_pixels`` pixels: values (N, P, C) and flat indices.
