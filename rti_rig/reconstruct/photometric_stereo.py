@@ -310,7 +310,7 @@ def _albedo_residual_all(
     ltg = (lt32 @ g).T.astype(np.float64)  # (P, 3)
     b = ltg @ np.linalg.inv(gram).T
     n, norm, ok = _unit_normals(b, inside.copy(), eps_b)
-    ss = np.einsum("pi,ij,pj->p", n, gram, n)
+    ss = np.sum((n @ gram) * n, axis=1)
     ss = np.where(ss > 0, ss, 1.0)
     channels = flat.shape[2]
     if channels == 1:
@@ -319,9 +319,10 @@ def _albedo_residual_all(
         proj = (lt32 @ flat.reshape(flat.shape[0], -1)).reshape(3, -1, channels)
         alb = np.einsum("pi,ipc->pc", n, proj.astype(np.float64)) / ss[:, None]
     # the residual directly (not as a difference of large sums, which float32 cannot resolve)
-    diff = (n * norm[:, None]).astype(np.float32) @ lt32  # (P, N) predictions
-    diff -= g.T
-    rms = np.sqrt(np.einsum("pn,pn->p", diff, diff) / g.shape[0]).astype(np.float64)
+    diff = lt32.T @ np.ascontiguousarray((n * norm[:, None]).T, dtype=np.float32)  # (N, P)
+    diff -= g
+    np.square(diff, out=diff)
+    rms = np.sqrt(np.add.reduce(diff, axis=0) / g.shape[0]).astype(np.float64)
     return n, alb, rms, ok
 
 
