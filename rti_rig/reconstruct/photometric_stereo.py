@@ -281,13 +281,21 @@ def _albedo_residual_used(
     """Normals, per-channel albedo, RMS residual and counts over each pixel's used lights."""
     n, norm, ok = _unit_normals(b, ok, eps_b)
     wf = w & ok[None, :]
-    s = lights @ n.T  # (N, P)
-    shade = s * wf
-    den = np.sum(shade * shade, axis=0)
-    alb = np.einsum("np,npc->pc", shade, flat) / np.where(den > 0, den, 1.0)[:, None]
-    count = wf.sum(axis=0)
-    res = np.where(wf, g - norm[None, :] * s, 0.0)
-    rms = np.sqrt(np.sum(res * res, axis=0) / np.maximum(count, 1))
+    # float32 (N, P) work arrays, reductions over the contiguous first axis
+    shade = lights.astype(np.float32) @ np.ascontiguousarray(n.T, dtype=np.float32)
+    shade *= wf
+    den = np.add.reduce(shade * shade, axis=0).astype(np.float64)
+    den = np.where(den > 0, den, 1.0)
+    channels = flat.shape[2]
+    alb = np.empty((shade.shape[1], channels))
+    for c in range(channels):
+        alb[:, c] = np.add.reduce(shade * flat[..., c], axis=0) / den
+    count = np.add.reduce(wf, axis=0, dtype=np.int32)
+    res = shade * norm.astype(np.float32)[None, :]  # prediction where used, 0 elsewhere
+    res -= g
+    res *= wf
+    np.square(res, out=res)
+    rms = np.sqrt(np.add.reduce(res, axis=0).astype(np.float64) / np.maximum(count, 1))
     return n, alb, rms, count, ok
 
 
