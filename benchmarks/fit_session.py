@@ -82,6 +82,9 @@ def main() -> None:
     parser.add_argument("--height", type=int, default=1296)
     parser.add_argument("--lights", type=int, default=72)
     parser.add_argument("--write", action="store_true")
+    parser.add_argument(
+        "--only", default="", help="run only the cases whose label contains this text"
+    )
     args = parser.parse_args()
     work = Path(tempfile.mkdtemp(prefix="fit_bench_"))
     try:
@@ -90,6 +93,8 @@ def main() -> None:
         print(f"session written in {time.perf_counter() - t0:.1f} s")
         rows = []
         for label, extra in CASES.items():
+            if args.only not in label:
+                continue
             wall, peak = time_fit(session, extra)
             rows.append((label, wall, peak))
             print(f"{label:45s} {wall:7.1f} s  peak RSS {peak:7.0f} MB", flush=True)

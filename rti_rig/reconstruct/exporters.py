@@ -27,6 +27,7 @@ coefficient with one scale and bias per coefficient index (over all pixels and c
 from __future__ import annotations
 
 import json
+import mmap
 from pathlib import Path
 from typing import Any
 
@@ -194,15 +195,25 @@ def write_relight_dome(
     return path
 
 
+def _drop_pages(array: Any) -> None:
+    """For a file-backed (memmap) map: drop the pages read so far from the resident set."""
+    mm = getattr(array, "_mmap", None)
+    if mm is not None and hasattr(mm, "madvise") and hasattr(mmap, "MADV_DONTNEED"):
+        if getattr(array, "mode", "r") != "r":
+            array.flush()
+        mm.madvise(mmap.MADV_DONTNEED)
+
+
 def write_normal_map(stem: Path, normals: NDArray[Any], npy: bool = True) -> list[Path]:
     """``stem.png`` (16-bit RGB, ``(n + 1) / 2``) and ``stem.npy`` (float32 (H, W, 3)); with
     ``npy=False`` the ``.npy`` is taken to exist already (a memmap the fit wrote into)."""
     png = stem.with_suffix(".png")
-    enc = np.empty(np.shape(normals), dtype=np.uint16)
+    enc = np.empty(np.shape(normals), dtype=np.uint16)  # BGR, as OpenCV writes it: no copy
     for top in range(0, enc.shape[0], 512):  # bounded temporaries for large maps
         n = np.asarray(normals[top : top + 512], dtype=np.float32)
-        enc[top : top + 512] = np.clip(np.round((n + 1.0) * 0.5 * 65535.0), 0, 65535)
-    if not cv2.imwrite(str(png), enc[..., ::-1]):
+        enc[top : top + 512] = np.clip(np.round((n[..., ::-1] + 1.0) * 0.5 * 65535.0), 0, 65535)
+        _drop_pages(normals)
+    if not cv2.imwrite(str(png), enc):
         raise ReconstructionError(f"could not write {png}")
     path = stem.with_suffix(".npy")
     if npy:
@@ -215,11 +226,14 @@ def write_albedo(
 ) -> list[Path]:
     """``stem.png`` (16-bit, linear, white = ``white``) and ``stem.npy`` (float32)."""
     png = stem.with_suffix(".png")
-    enc = np.empty(np.shape(albedo), dtype=np.uint16)
+    enc = np.empty(np.shape(albedo), dtype=np.uint16)  # BGR for colour, as OpenCV writes it
     for top in range(0, enc.shape[0], 512):
         a = np.asarray(albedo[top : top + 512], dtype=np.float32)
+        if a.ndim == 3:
+            a = a[..., ::-1]
         enc[top : top + 512] = np.clip(np.round(a / white * 65535.0), 0, 65535)
-    if not cv2.imwrite(str(png), enc[..., ::-1] if enc.ndim == 3 else enc):
+        _drop_pages(albedo)
+    if not cv2.imwrite(str(png), enc):
         raise ReconstructionError(f"could not write {png}")
     path = stem.with_suffix(".npy")
     if npy:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import html
 import json
+import mmap
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -281,6 +282,8 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
                     albedo[sl] = np.linalg.norm(b, axis=0)
                 else:
                     albedo[sl] = coefs["ptm"][5]  # the PTM's constant term: mean brightness
+            _release(normals)  # written pages go to the file, not the resident set
+            _release(albedo)
         pool.shutdown()
     for writer in writers.values():
         files.append(writer.close())
@@ -294,6 +297,14 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
         (out / "normals.npy").unlink()
         (out / "albedo.npy").unlink()
     return FitResult(out, model_name, reason_line, files)
+
+
+def _release(mapped: np.memmap) -> None:
+    """Flush a writable memmap and drop its pages from memory (they are in the file now)."""
+    mapped.flush()
+    mm = getattr(mapped, "_mmap", None)
+    if mm is not None and hasattr(mm, "madvise") and hasattr(mmap, "MADV_DONTNEED"):
+        mm.madvise(mmap.MADV_DONTNEED)
 
 
 def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
