@@ -26,6 +26,7 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
+from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.qa import QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
@@ -137,8 +138,12 @@ def run_fit(req: FitRequest) -> FitResult:
         exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
     )
     if req.qa:
-        result.qa = assess(frames, lights, names)
-        result.files += write_qa_report(out, result.qa, result)
+        try:
+            result.qa = assess(frames, lights, names)
+        except ReconstructionError as exc:  # e.g. too few or coplanar lights for PS
+            result.warnings.append(f"QA not possible: {exc}")
+        else:
+            result.files += write_qa_report(out, result.qa, result)
     summary = {
         "source": str(req.source),
         "read": what,
