@@ -161,7 +161,7 @@ def run_fit(req: FitRequest) -> FitResult:
 
 #: Pixel sample shared by model choice, quantisation ranges and the reference level: one
 #: decode pass of the files for all three.
-SAMPLE_PIXELS = 100_000
+SAMPLE_PIXELS = 30_000
 #: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
 #: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
 BAND_BUDGET_BYTES = 24 * 1024 * 1024
