@@ -76,6 +76,52 @@ def time_fit(session: Path, extra: list[str]) -> tuple[float, float]:
     return float(wall), float(peak_kb) / 1024.0
 
 
+def memory_scaling(lights: int, write: bool) -> None:
+    """Peak RSS of the full fit at two sizes, extrapolated linearly to 24 MP (6000 × 4000).
+
+    24 MP × 100 lights is too slow to render and fit on the shared 2-core machine; the fit's
+    memory is a fixed part (interpreter, libraries, the 30 000-pixel sample, the QA crop, one
+    24 MB band and its temporaries) plus a per-pixel part (the PNG encoding buffers; the
+    memmapped maps are dropped from memory band by band), so two sizes give the line.
+    """
+    sizes = [(684, 456), (1368, 912)]
+    points = []
+    work = Path(tempfile.mkdtemp(prefix="fit_mem_"))
+    try:
+        for w, h in sizes:
+            session = make_session(work / f"s{w}", w, h, lights)
+            wall, peak = time_fit(session, CASES["everything (auto, normals, .ptm, .rti, QA)"])
+            points.append((w * h / 1e6, peak, wall))
+            print(f"{w} x {h} x {lights}: {wall:.1f} s, peak RSS {peak:.0f} MB", flush=True)
+            shutil.rmtree(session, ignore_errors=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    (m0, p0, _), (m1, p1, _) = points
+    slope = (p1 - p0) / (m1 - m0)
+    at24 = p0 + slope * (24.0 - m0)
+    table = "\n".join(
+        [
+            "## `rti-rig fit` memory at 24 MP (extrapolated)",
+            "",
+            f"{machine_line()} Command: `python -m benchmarks.fit_session --memory-scaling "
+            f"--lights {lights}`.",
+            "",
+            f"Full fit (auto model, normals, .ptm, .rti, QA) of {lights} RGB 16-bit TIFFs, peak "
+            "RSS of the whole process at two sizes; 24 MP is extrapolated linearly "
+            f"({slope:.0f} MB per megapixel) because rendering and fitting it takes too long "
+            "on this shared machine. Target (issue #29): within 2 GB.",
+            "",
+            "| size (MP) | peak RSS (MB) | wall (s) |",
+            "|---|---|---|",
+            *[f"| {m:.2f} | {p:.0f} | {t:.0f} |" for m, p, t in points],
+            f"| 24 (extrapolated) | {at24:.0f} | — |",
+        ]
+    )
+    print(table)
+    if write:
+        print(f"written to {write_section('fit_memory', table)}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--width", type=int, default=1936)
@@ -85,7 +131,11 @@ def main() -> None:
     parser.add_argument(
         "--only", default="", help="run only the cases whose label contains this text"
     )
+    parser.add_argument("--memory-scaling", action="store_true", help="see memory_scaling()")
     args = parser.parse_args()
+    if args.memory_scaling:
+        memory_scaling(args.lights if args.lights != 72 else 100, args.write)
+        return
     work = Path(tempfile.mkdtemp(prefix="fit_bench_"))
     try:
         t0 = time.perf_counter()
