@@ -161,3 +161,23 @@ def test_run_prints_the_verdict_unless_told_not_to(tmp_path: Path) -> None:
         app, ["run", str(cfg), "--out", str(tmp_path / "b"), "--lights", "12", "--no-verdict"]
     )
     assert r.exit_code == 0 and "QA verdict" not in r.output
+
+
+def test_fit_from_a_bare_lp_with_its_images_beside_it(clean, tmp_path: Path) -> None:
+    import shutil
+
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+    session, _, truth = clean
+    folder = tmp_path / "bare"
+    folder.mkdir()
+    entries = []
+    for e in read_lp(session / "lights.lp"):
+        name = Path(e.name).stem + ".tif"
+        shutil.copy(session / "linear" / name, folder / name)
+        entries.append(LpEntry(name, e.direction))
+    write_lp(folder / "my_dome.lp", entries)
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(folder / "my_dome.lp"), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert float(np.median(_angles(np.load(out / "normals.npy"), truth))) < 3.0
