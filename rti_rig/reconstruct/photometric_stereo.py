@@ -334,6 +334,17 @@ def _albedo_residual_all(
     return n, alb, rms, ok
 
 
+def _band_is_clean(band: NDArray[np.float32], saturation: float | None) -> bool:
+    """No NaN/inf and nothing saturated, by one max-reduction (NaN propagates through max):
+    the common case costs no mask of the band's size."""
+    with np.errstate(invalid="ignore"):
+        top = np.max(band.reshape(band.shape[0], -1), axis=0)
+        ok = np.isfinite(top)
+        if saturation is not None:
+            ok &= top < np.float32(saturation)
+    return bool(ok.all())
+
+
 def fit_photometric_stereo(
     images: Any,
     lights: ArrayLike,
@@ -388,7 +399,10 @@ def fit_photometric_stereo(
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
         band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
-        bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
+        if robust or not _band_is_clean(band, stack.saturation_level):
+            bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
+        else:
+            bad = None
         if bad is not None:
             band = np.where(bad, np.float32(0.0), band)
         r = band.shape[1]
