@@ -999,8 +999,12 @@ def _print_verdict(session: Path | None) -> None:
 
 @app.command()
 def fit(
-    source: Annotated[
-        Path, typer.Argument(help="Session folder, or an .lp file with its images beside it.")
+    sources: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Session folder(s), or .lp file(s) with their images beside them. With more "
+            "than one, a resumable batch: each goes to OUT/<name>, finished ones are skipped."
+        ),
     ],
     out_dir: Annotated[Path, typer.Option("--out", help="New or empty folder for outputs.")],
     model: Annotated[
@@ -1018,7 +1022,7 @@ def fit(
     ] = False,
 ) -> None:
     """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
-    from rti_rig.app.usecases.fit import FitRequest, run_fit
+    from rti_rig.app.usecases.fit import FitRequest, run_batch, run_fit
     from rti_rig.reconstruct.registry import model_spec
 
     try:
@@ -1028,7 +1032,7 @@ def fit(
             except ValueError as exc:
                 raise RtiRigError(str(exc)) from None
         request = FitRequest(
-            source,
+            sources[0],
             out_dir,
             model=model,
             qa=not no_qa,
@@ -1036,6 +1040,16 @@ def fit(
             write_hsh=not no_hsh,
             write_normals=not no_normals,
         )
+        if len(sources) > 1:
+            items = run_batch(sources, out_dir, request)
+            for item in items:
+                line = f"{item.source}: {item.status}"
+                if item.verdict:
+                    line += f"; QA verdict: {item.verdict}"
+                out.print(escape(line))
+            if any(i.status.startswith("failed") for i in items):
+                raise typer.Exit(code=2)
+            return
         result = run_fit(request)
     except RtiRigError as exc:
         raise _fail(exc) from None

@@ -181,3 +181,26 @@ def test_fit_from_a_bare_lp_with_its_images_beside_it(clean, tmp_path: Path) -> 
     r = runner.invoke(app, ["fit", str(folder / "my_dome.lp"), "--out", str(out), "--no-qa"])
     assert r.exit_code == 0, r.output
     assert float(np.median(_angles(np.load(out / "normals.npy"), truth))) < 3.0
+
+
+def test_batch_fit_is_resumable(clean, tmp_path: Path) -> None:
+    import shutil
+
+    session = clean[0]
+    second = tmp_path / "second"
+    shutil.copytree(session, second)
+    out = tmp_path / "batch"
+    # a killed earlier run left a partial folder for the second session
+    (out / ".second.partial").mkdir(parents=True)
+    (out / ".second.partial" / "junk").write_text("x")
+    args = ["fit", str(session), str(second), "--out", str(out), "--model", "ps", "--no-qa"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    assert r.output.count(": done") == 2
+    assert (out / session.name / "normals.npy").is_file()
+    assert (out / "second" / "fit.json").is_file() and not (out / "second" / "junk").exists()
+    assert not (out / ".second.partial").exists()
+    first = np.load(out / "second" / "normals.npy")
+    np.testing.assert_array_equal(first, np.load(out / session.name / "normals.npy"))
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0 and r.output.count("(finished earlier)") == 2

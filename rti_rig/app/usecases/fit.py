@@ -354,3 +354,55 @@ def verdict_for_session(session: Path) -> str:
     """The QA verdict line of a session folder (for ``rti-rig run``'s last line)."""
     frames, lights, names, _ = load_acquisition(session)
     return assess(frames, lights, names).verdict
+
+
+@dataclass(frozen=True)
+class BatchItem:
+    source: Path
+    out_dir: Path
+    status: str  # "done", "skipped (finished earlier)", or "failed: ..."
+    verdict: str | None = None
+
+
+def batch_out_dir(root: Path, source: Path) -> Path:
+    """Where a batch writes one source: ``root/<session folder name or .lp stem>``."""
+    return root / (source.name if source.is_dir() else source.stem)
+
+
+def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[BatchItem]:
+    """Fit several sessions one after another, resumably.
+
+    Each goes to :func:`batch_out_dir`, built in a hidden ``.name.partial`` folder and renamed
+    when complete: a finished session (its folder exists) is skipped, a killed batch leaves at
+    most one partial folder, which the next run removes and redoes. A session that fails is
+    reported and the batch goes on. (Sessions run in this process, one at a time: the Dask
+    scale-out of issue #29 is not implemented.)
+    """
+    import shutil
+    from dataclasses import replace
+
+    names = [batch_out_dir(root, s).name for s in sources]
+    dupes = {n for n in names if names.count(n) > 1}
+    if dupes:
+        raise FitInputError(f"two sources would write to the same folder: {sorted(dupes)}")
+    root.mkdir(parents=True, exist_ok=True)
+    items = []
+    for source in sources:
+        final = batch_out_dir(root, source)
+        if final.exists():
+            items.append(BatchItem(source, final, "skipped (finished earlier)"))
+            continue
+        partial = root / f".{final.name}.partial"
+        if partial.exists():
+            shutil.rmtree(partial)
+        try:
+            result = run_fit(replace(template, source=source, out_dir=partial))
+        except RtiRigError as exc:
+            shutil.rmtree(partial, ignore_errors=True)
+            items.append(BatchItem(source, final, f"failed: {exc}"))
+            continue
+        partial.rename(final)
+        items.append(
+            BatchItem(source, final, "done", result.qa.verdict if result.qa is not None else None)
+        )
+    return items
