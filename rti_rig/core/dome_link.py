@@ -90,3 +90,5 @@ class DomeLedError(DeviceError):
     def __init__(self, device: str, led: int, message: str, command: str | None) -> None:
         super().__init__(device, message, command)
         self.led = led
+
+
