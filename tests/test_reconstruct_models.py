@@ -148,7 +148,7 @@ def test_ptm_normals_from_the_maximum() -> None:
     coef = np.array([-1.0, -1.0, 0.0, 2 * u0, 2 * v0, 1.0 - u0 * u0 - v0 * v0])
     lights = fibonacci_lights(25)
     images = _images_from_coefficients("ptm", coef[:, None, None] * np.ones((6, 2, 3)), lights)
-    normals = fit_ptm(images, lights).normals()
+    normals = fit_ptm(images, lights).normals_from_maximum()
     expected = [u0, v0, np.sqrt(1 - u0 * u0 - v0 * v0)]
     np.testing.assert_allclose(normals, np.broadcast_to(expected, (2, 3, 3)), atol=1e-4)
 

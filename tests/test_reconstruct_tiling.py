@@ -68,7 +68,13 @@ def test_images_must_be_finite_and_consistent() -> None:
     images = np.ones((6, 4, 4), dtype=np.float32)
     images[3, 2, 1] = np.nan
     with pytest.raises(ReconstructionError, match="image 3 holds NaN"):
-        fit_model("ptm", images, lights)
+        ImageStack(images).rows(slice(0, 4))
+    # a fit treats it as a missing observation: with 6 lights that pixel cannot be fitted by
+    # PTM (6 coefficients) and is counted, every other pixel is fitted as usual
+    fitted = fit_model("ptm", images, lights)
+    assert fitted.report.pixels_unfitted == 1 and fitted.report.pixels_with_missing == 1
+    assert np.all(fitted.coefficients[:, 2, 1] == 0)
+    assert np.allclose(fitted.relight([0, 0, 1])[0, 0], 1.0, atol=1e-4)
     with pytest.raises(ReconstructionError, match="image 1 has shape"):
         ImageStack([np.ones((4, 4)), np.ones((4, 5))])
     with pytest.raises(ReconstructionError, match="shape"):

@@ -50,6 +50,7 @@ def fit_hsh(
     ill_conditioned: IllConditioned = "regularise",
     cond_limit: float = COND_LIMIT,
     out: NDArray[Any] | None = None,
+    saturation: float | None = None,
 ) -> HSHModel:
     """Fit HSH of ``order`` (1, 2, 3) to linear ``images``; needs N >= 4, 9, 16 lights.
 
@@ -69,5 +70,6 @@ def fit_hsh(
         ill_conditioned=ill_conditioned,
         cond_limit=cond_limit,
         out=out,
+        saturation=saturation,
     )
     return HSHModel(coef, report, order)

@@ -8,7 +8,7 @@ fit undershoots in shadow.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
@@ -83,6 +83,48 @@ class LambertModel(LinearBasisModel):
         return out.astype(np.float32)
 
 
+def _weighted_columns(
+    design: NDArray[np.float64],
+    values: NDArray[np.float32],
+    usable: NDArray[np.bool_],
+    cond_limit: float,
+) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:
+    """Least squares per column of ``values`` (N, K) on its ``usable`` observations only.
+
+    Returns coefficients (p, K) and whether each column could be fitted: at least p usable
+    observations whose design rows are well-conditioned (condition number of the column-scaled
+    subset within ``cond_limit``); others get zeros. Columns are grouped by their pattern of
+    usable observations — saturation and NaN tend to hit the same few lights over a region — so
+    each distinct pattern costs one small pseudo-inverse and one matrix product.
+    """
+    p = design.shape[1]
+    k = values.shape[1]
+    coef = np.zeros((p, k), dtype=np.float32)
+    ok = np.zeros(k, dtype=bool)
+    if k == 0:
+        return coef, ok
+    packed = np.packbits(usable.T, axis=1)  # (K, ceil(N/8))
+    keys = np.ascontiguousarray(packed).view(np.dtype((np.void, packed.shape[1])))[:, 0]
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    order = np.argsort(inverse, kind="stable")
+    bounds = np.searchsorted(inverse[order], np.arange(first.size + 1))
+    for u, j in enumerate(first):
+        cols = order[bounds[u] : bounds[u + 1]]
+        rows = np.flatnonzero(usable[:, j])
+        if rows.size < p:
+            continue
+        sub = design[rows]
+        norms = np.linalg.norm(sub, axis=0)
+        norms = np.where(norms > 1e-12, norms, 1.0)
+        uu, sv, vt = np.linalg.svd(sub / norms, full_matrices=False)
+        if sv[-1] <= 0 or sv[0] / sv[-1] > cond_limit:
+            continue
+        w = ((vt.T / sv) @ uu.T / norms[:, None]).astype(np.float32)
+        coef[:, cols] = w @ values[np.ix_(rows, cols)]
+        ok[cols] = True
+    return coef, ok
+
+
 def fit_coefficients(
     images: Any,
     design: NDArray[np.float64],
@@ -92,6 +134,8 @@ def fit_coefficients(
     ill_conditioned: IllConditioned = "regularise",
     cond_limit: float = COND_LIMIT,
     out: NDArray[Any] | None = None,
+    saturation: float | None = None,
+    basis: str | None = None,
 ) -> tuple[NDArray[Any], FitReport]:
     """Fit ``design`` to every pixel of ``images``, a band of rows at a time.
 
@@ -100,11 +144,16 @@ def fit_coefficients(
     computed once in float64 and applied in float32. ``out`` (same shape) receives the
     coefficients instead of a new array: a ``numpy.memmap`` keeps a 24-megapixel HSH3 fit
     (4.6 GB of float32 colour coefficients) out of memory.
+
+    Saturated (at or above ``saturation``, default the stack's level) and NaN observations are
+    excluded: a pixel value with any of them is fitted by least squares on its other
+    observations, or left at 0 and counted as unfitted when too few remain. The report counts
+    both.
     """
-    stack = ImageStack(images)
+    stack = ImageStack(images, saturation_level=saturation)
     if design.shape[0] != stack.n:
         raise ValueError(f"design has {design.shape[0]} rows for {stack.n} images")
-    w, report = solve_matrix(design, model, ill_conditioned, cond_limit)
+    w, report = solve_matrix(design, model, ill_conditioned, cond_limit, basis=basis)
     w32 = w.astype(np.float32)
     p = w.shape[0]
     rows = tile_rows or rows_for_budget(stack.n, stack.width, stack.channels)
@@ -112,11 +161,35 @@ def fit_coefficients(
     if out is not None and out.shape != shape:
         raise ReconstructionError(f"out has shape {out.shape}, the coefficients need {shape}")
     coef = np.empty(shape, dtype=np.float32) if out is None else out
+    missing = unfitted = 0
+    sat = stack.saturation_level
     for sl in row_tiles(stack.height, rows):
-        band = stack.rows(sl)  # (N, r, W, C)
+        band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
         r = band.shape[1]
-        tile = (w32 @ band.reshape(stack.n, -1)).reshape(p, r, stack.width, stack.channels)
+        flat = band.reshape(stack.n, -1)
+        tile = w32 @ flat
+        # NaN/inf in an observation propagates into its column's coefficients: find them there
+        # (p rows, not N); saturation needs one max-reduction over the band
+        bad_cols = ~np.isfinite(tile).all(axis=0)
+        hit = stack.suspect_columns(flat)
+        if hit is not None:
+            bad_cols |= hit
+        if bad_cols.any():
+            cols = np.flatnonzero(bad_cols)
+            vals = flat[:, cols]
+            usable = np.isfinite(vals)
+            if sat is not None:
+                with np.errstate(invalid="ignore"):
+                    usable &= vals < np.float32(sat)
+            vals = np.where(usable, vals, np.float32(0.0))
+            sub, ok = _weighted_columns(design, vals, usable, cond_limit)
+            tile[:, cols] = sub
+            missing += cols.size
+            unfitted += int((~ok).sum())
+        tile = tile.reshape(p, r, stack.width, stack.channels)
         coef[:, sl] = tile[..., 0] if stack.grey else tile
+    if missing:
+        report = replace(report, pixels_with_missing=missing, pixels_unfitted=unfitted)
     return coef, report
 
 
@@ -127,11 +200,13 @@ def fit_lambert(
     tile_rows: int | None = None,
     ill_conditioned: IllConditioned = "refuse",
     out: NDArray[Any] | None = None,
+    saturation: float | None = None,
 ) -> LambertModel:
     """Least-squares Lambertian model (no shadow handling): the lowest-order relighting model.
 
-    Refuses ill-conditioned (near-coplanar) light sets by default: its coefficients are read as
-    normals, and a regularised normal is biased towards the well-lit plane.
+    Refuses ill-conditioned light sets by default, judged like photometric stereo judges them
+    (over the hemisphere: near-coplanar lights, or a cap near the zenith): its coefficients are
+    read as normals, and a regularised normal is biased towards the well-lit plane.
     """
     stack = ImageStack(images)
     lt = validate_lights(lights, stack.n)
@@ -142,5 +217,6 @@ def fit_lambert(
         tile_rows=tile_rows,
         ill_conditioned=ill_conditioned,
         out=out,
+        saturation=saturation,
     )
     return LambertModel(coef, report)

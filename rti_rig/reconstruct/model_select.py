@@ -128,6 +128,13 @@ def select_model(
     ordered = sorted(candidates, key=lambda c: N_COEFFICIENTS[c])
     values, _ = stack.pixel_sample(max_pixels)  # (N, P, C)
     obs = values.reshape(stack.n, -1).astype(np.float64)
+    # sampled pixel values with a saturated or NaN observation cannot be held out honestly
+    keep = np.all(np.isfinite(obs), axis=0)
+    if stack.saturation_level is not None:
+        keep &= np.all(obs < stack.saturation_level, axis=0)
+    if keep.any():
+        obs = obs[:, keep]
+    values = obs
     ref = float(np.percentile(values, 99.0)) or 1.0
     folds, how = _folds(stack.n, holdout, seed)
 
@@ -142,7 +149,9 @@ def select_model(
                 note = f"needs {p} fitting lights, a fold leaves {train.size}"
                 break
             try:
-                w, report = solve_matrix(design[train], name, ill_conditioned, cond_limit)
+                w, report = solve_matrix(
+                    design[train], name, ill_conditioned, cond_limit, warn=False
+                )
             except ReconstructionError as exc:
                 note = f"refused: {exc}"
                 break

@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.solve import COND_LIMIT, solve_matrix
-from rti_rig.reconstruct.stack import ImageStack, as_direction, validate_lights
+from rti_rig.reconstruct.stack import ImageStack, as_direction, channel_mean, validate_lights
 from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
 
 #: Default shadow threshold as a fraction of the stack's reference level.
@@ -281,18 +281,25 @@ def _albedo_residual_used(
     """Normals, per-channel albedo, RMS residual and counts over each pixel's used lights."""
     n, norm, ok = _unit_normals(b, ok, eps_b)
     wf = w & ok[None, :]
-    s = lights @ n.T  # (N, P)
-    shade = s * wf
-    den = np.sum(shade * shade, axis=0)
-    alb = np.einsum("np,npc->pc", shade, flat) / np.where(den > 0, den, 1.0)[:, None]
-    count = wf.sum(axis=0)
-    res = np.where(wf, g - norm[None, :] * s, 0.0)
-    rms = np.sqrt(np.sum(res * res, axis=0) / np.maximum(count, 1))
+    # float32 (N, P) work arrays, reductions over the contiguous first axis
+    shade = lights.astype(np.float32) @ np.ascontiguousarray(n.T, dtype=np.float32)
+    shade *= wf
+    den = np.add.reduce(shade * shade, axis=0).astype(np.float64)
+    den = np.where(den > 0, den, 1.0)
+    channels = flat.shape[2]
+    alb = np.empty((shade.shape[1], channels))
+    for c in range(channels):
+        alb[:, c] = np.add.reduce(shade * flat[..., c], axis=0) / den
+    count = np.add.reduce(wf, axis=0, dtype=np.int32)
+    res = shade * norm.astype(np.float32)[None, :]  # prediction where used, 0 elsewhere
+    res -= g
+    res *= wf
+    np.square(res, out=res)
+    rms = np.sqrt(np.add.reduce(res, axis=0).astype(np.float64) / np.maximum(count, 1))
     return n, alb, rms, count, ok
 
 
 def _albedo_residual_all(
-    w32: NDArray[np.float32],
     inside: NDArray[np.bool_],
     g: NDArray[np.float32],
     flat: NDArray[np.float32],
@@ -300,28 +307,42 @@ def _albedo_residual_all(
     gram: NDArray[np.float64],
     eps_b: float,
 ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
-    """Least squares over all lights without (N, P) temporaries: matrix products only.
+    """Least squares over all lights with matrix products only.
 
-    With every light used, ``sum_k s_k I_k = n . (L^T I)`` and ``sum_k s_k^2 = n^T (L^T L) n``,
-    so albedo and residual need three (3 × N) @ (N × P) products and one sum of squares.
+    ``L^T I`` is the one pass over the band for the normals (``b = (L^T L)^-1 L^T I``); with
+    every light used, ``sum_k s_k I_k = n . (L^T I)`` and ``sum_k s_k^2 = n^T (L^T L) n``, so the
+    albedo needs nothing more for grey images and one more product for colour; the residual is
+    one prediction product and one sum of squares.
     """
-    b = (w32 @ g).T.astype(np.float64)
-    n, norm, ok = _unit_normals(b, inside.copy(), eps_b)
-    ss = np.einsum("pi,ij,pj->p", n, gram, n)
-    ss = np.where(ss > 0, ss, 1.0)
     lt32 = lights.T.astype(np.float32)
+    ltg = (lt32 @ g).T.astype(np.float64)  # (P, 3)
+    b = ltg @ np.linalg.inv(gram).T
+    n, norm, ok = _unit_normals(b, inside.copy(), eps_b)
+    ss = np.sum((n @ gram) * n, axis=1)
+    ss = np.where(ss > 0, ss, 1.0)
     channels = flat.shape[2]
-    alb = np.empty((g.shape[1], channels))
-    for c in range(channels):
-        proj = (lt32 @ np.ascontiguousarray(flat[..., c])).T.astype(np.float64)  # (P, 3)
-        alb[:, c] = np.sum(n * proj, axis=1) / ss
-    # float64 here: the residual is a small difference of large sums
-    g64 = g.astype(np.float64)
-    ltg = (lights.T @ g64).T
-    g2 = np.einsum("np,np->p", g64, g64)
-    sse = g2 - 2.0 * norm * np.sum(n * ltg, axis=1) + norm * norm * ss
-    rms = np.sqrt(np.maximum(sse, 0.0) / g.shape[0])
+    if channels == 1:
+        alb = (np.sum(n * ltg, axis=1) / ss)[:, None]
+    else:
+        proj = (lt32 @ flat.reshape(flat.shape[0], -1)).reshape(3, -1, channels)
+        alb = np.einsum("pi,ipc->pc", n, proj.astype(np.float64)) / ss[:, None]
+    # the residual directly (not as a difference of large sums, which float32 cannot resolve)
+    diff = lt32.T @ np.ascontiguousarray((n * norm[:, None]).T, dtype=np.float32)  # (N, P)
+    diff -= g
+    np.square(diff, out=diff)
+    rms = np.sqrt(np.add.reduce(diff, axis=0) / g.shape[0]).astype(np.float64)
     return n, alb, rms, ok
+
+
+def _band_is_clean(band: NDArray[np.float32], saturation: float | None) -> bool:
+    """No NaN/inf and nothing saturated, by one max-reduction (NaN propagates through max):
+    the common case costs no mask of the band's size."""
+    with np.errstate(invalid="ignore"):
+        top = np.max(band.reshape(band.shape[0], -1), axis=0)
+        ok = np.isfinite(top)
+        if saturation is not None:
+            ok &= top < np.float32(saturation)
+    return bool(ok.all())
 
 
 def fit_photometric_stereo(
@@ -338,20 +359,21 @@ def fit_photometric_stereo(
     max_passes: int = 10,
     cond_limit: float = COND_LIMIT,
     shadow_k: float | None = SHADOW_K,
+    reference_level: float | None = None,
 ) -> PSResult:
     """Normals and albedo of linear ``images`` (N, H, W[, C]) under unit ``lights`` (N, 3).
 
     See the module docstring for the robust rules; ``shadow_k`` (rule 4) is read only by the
-    robust fit, since least squares discards nothing. Raises :class:`ReconstructionError` for
-    fewer than 3 lights or an ill-conditioned (near-coplanar) light set.
+    robust fit, since least squares discards nothing. ``reference_level`` overrides the stack's
+    own (a caller fitting band by band passes the whole acquisition's, so thresholds agree).
+    Raises :class:`ReconstructionError` for fewer than 3 lights or an ill-conditioned
+    (near-coplanar) light set.
     """
     if shadow_k is not None and not (np.isfinite(shadow_k) and shadow_k > 0):
         raise ReconstructionError(f"shadow_k must be a positive number, got {shadow_k!r}")
-    stack = ImageStack(images)
+    stack = ImageStack(images, saturation_level=saturation)
     lt = validate_lights(lights, stack.n)
-    w_ls, report = solve_matrix(
-        lt, "photometric stereo", "refuse", cond_limit, normalise_columns=False
-    )
+    _, report = solve_matrix(lt, "photometric stereo", "refuse", cond_limit)
     h, wd = stack.height, stack.width
     if mask is None:
         inside_all = np.ones((h, wd), dtype=bool)
@@ -359,7 +381,7 @@ def fit_photometric_stereo(
         inside_all = np.asarray(mask, dtype=bool)
         if inside_all.shape != (h, wd):
             raise ReconstructionError(f"mask has shape {inside_all.shape}, images are {(h, wd)}")
-    ref = stack.reference_level()
+    ref = stack.reference_level() if reference_level is None else float(reference_level)
     dark = float(dark_threshold) if dark_threshold is not None else DARK_FRACTION * ref
     if saturation is None:
         saturation = stack.saturation_level
@@ -372,20 +394,33 @@ def fit_photometric_stereo(
     residual = np.zeros((h, wd), dtype=np.float32)
     valid = np.zeros((h, wd), dtype=bool)
     used = np.zeros((h, wd), dtype=np.int16)
-    w32 = w_ls.astype(np.float32)
     gram = lt.T @ lt
     # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
-        band = stack.rows(sl)  # (N, r, W, C)
+        band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
+        if robust or not _band_is_clean(band, stack.saturation_level):
+            bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
+        else:
+            bad = None
+        if bad is not None:
+            band = np.where(bad, np.float32(0.0), band)
         r = band.shape[1]
         flat = band.reshape(stack.n, r * wd, stack.channels)
-        g = flat.mean(axis=2) if stack.channels > 1 else flat[..., 0]
+        g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
         inside = inside_all[sl].ravel()
+        usable = (
+            None if bad is None else ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
+        )
         if robust:
+            if usable is not None:
+                inside_robust = inside
+                g = np.where(usable, g, np.float32(-1.0))  # below any dark threshold
+            else:
+                inside_robust = inside
             b, w, ok = _robust_band(
                 g,
-                inside,
+                inside_robust,
                 lt,
                 dark,
                 saturation,
@@ -397,8 +432,19 @@ def fit_photometric_stereo(
             )
             n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
         else:
-            n, alb, rms, ok = _albedo_residual_all(w32, inside, g, flat, lt, gram, eps_b)
+            n, alb, rms, ok = _albedo_residual_all(inside, g, flat, lt, gram, eps_b)
             count = np.full(ok.shape, stack.n)
+            if usable is not None:
+                # pixels with an excluded observation: least squares on the others only
+                cols = np.flatnonzero(~usable.all(axis=0) & inside)
+                gc = np.ascontiguousarray(g[:, cols])
+                wc = usable[:, cols].T
+                bc, okc = _solve_weighted(gc.T, wc, lt, cond_limit)
+                n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
+                    bc, wc.T, okc, gc, flat[:, cols], lt, eps_b
+                )
+                n[cols], alb[cols], rms[cols] = n_c, alb_c, rms_c
+                count[cols], ok[cols] = count_c, ok_c
         normals[sl] = n.reshape(r, wd, 3)
         albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
         residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)

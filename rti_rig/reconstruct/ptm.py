@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.linear_model import LinearBasisModel, fit_coefficients
 from rti_rig.reconstruct.solve import COND_LIMIT, IllConditioned
-from rti_rig.reconstruct.stack import ImageStack, validate_lights
+from rti_rig.reconstruct.stack import ImageStack, channel_mean, validate_lights
 
 
 @dataclass(frozen=True)
@@ -25,13 +25,60 @@ class PTMModel(LinearBasisModel):
 
     model_name: ClassVar[str] = "ptm"
 
-    def normals(self) -> NDArray[np.float32]:
+    def normals(self, tile_rows: int = 256) -> NDArray[np.float32]:
+        """Normals (H, W, 3) by a Lambertian reading of the PTM, a band of rows at a time.
+
+        The PTM is evaluated at :data:`VIRTUAL_LIGHTS` directions and photometric stereo is
+        solved on those virtual images: first on every direction the PTM predicts lit (above
+        :data:`LIT_FRACTION` of the pixel's brightest), then again without the directions
+        within :data:`TERMINATOR_COS` of the shadow line of that first normal, where the
+        quadratic smooths the attached shadow. The quadratic's maximum (Malzbender §3.2, kept
+        as :meth:`normals_from_maximum`) is biased by design: attached shadows and highlights
+        flatten and shift it (28–46° on a glossy sphere where this reading gives 2–14°,
+        docs/reconstruction.md). Colour coefficients are averaged first; pixels the PTM
+        predicts dark everywhere get the view axis.
+        """
+        # local import: photometric_stereo's per-pixel solver, shared rather than repeated
+        from rti_rig.reconstruct.photometric_stereo import _solve_weighted
+
+        c = self.coefficients
+        h, w = c.shape[1], c.shape[2]
+        dirs = _virtual_lights()
+        basis = self.design(dirs).astype(np.float32)  # (K, 6)
+        out = np.empty((h, w, 3), dtype=np.float32)
+        for start in range(0, h, tile_rows):
+            sl = slice(start, min(h, start + tile_rows))
+            band = np.asarray(c[:, sl], dtype=np.float32)
+            if band.ndim == 4:
+                band = channel_mean(band)
+            r = band.shape[1]
+            vals = basis @ band.reshape(6, -1)  # (K, P)
+            peak = vals.max(axis=0)
+            g = np.ascontiguousarray(vals.T)  # (P, K)
+            lit = g > LIT_FRACTION * np.maximum(peak, 0.0)[:, None]
+            lit &= (peak > 0)[:, None]
+            b, ok = _solve_weighted(g, lit, dirs, 1e3)
+            norm = np.linalg.norm(b, axis=1, keepdims=True)
+            n = np.where(norm > 0, b / np.where(norm > 0, norm, 1.0), 0.0)
+            keep = lit & ((n @ dirs.T) > TERMINATOR_COS)
+            b2, ok2 = _solve_weighted(g, keep, dirs, 1e3)
+            b = np.where(ok2[:, None], b2, b)
+            ok = ok | ok2
+            b[:, 2] = np.maximum(b[:, 2], 0.0)
+            norm = np.linalg.norm(b, axis=1, keepdims=True)
+            good = ok & (norm[:, 0] > 0)
+            n = np.where(good[:, None], b / np.where(norm > 0, norm, 1.0), [0.0, 0.0, 1.0])
+            out[sl] = n.reshape(r, w, 3)
+        return out
+
+    def normals_from_maximum(self) -> NDArray[np.float32]:
         """Normals (H, W, 3) from the maximum of the biquadratic (Malzbender §3.2).
 
         The maximum ``(l_u0, l_v0)`` of the luminance polynomial is taken as the normal's
         projection; where the quadratic has no maximum inside the unit disc (not concave, or
         outside) the normal is clipped to the disc edge along the same direction, or set to
         the view axis when there is no maximum at all. Colour coefficients are averaged first.
+        Biased by design on real surfaces; kept for comparison (see :meth:`normals`).
         """
         c = self.coefficients.astype(np.float64)
         if c.ndim == 4:
@@ -49,6 +96,25 @@ class PTMModel(LinearBasisModel):
         return np.stack([u, v, z], axis=-1).astype(np.float32)
 
 
+#: Virtual light directions at which :meth:`PTMModel.normals` reads the PTM.
+VIRTUAL_LIGHTS = 64
+#: A virtual observation counts as lit above this fraction of the pixel's brightest.
+LIT_FRACTION = 0.05
+#: Second pass: directions closer than this cosine to the first normal's shadow line are dropped.
+TERMINATOR_COS = 0.3
+
+
+def _virtual_lights() -> NDArray[np.float64]:
+    """Fibonacci hemisphere above 15° elevation: where a PTM's fitting lights usually are."""
+    n = VIRTUAL_LIGHTS
+    i = np.arange(n) + 0.5
+    zmin = np.sin(np.radians(15.0))
+    z = 1.0 - (1.0 - zmin) * i / n
+    rr = np.sqrt(1.0 - z * z)
+    phi = i * np.pi * (3.0 - np.sqrt(5.0))
+    return np.stack([rr * np.cos(phi), rr * np.sin(phi), z], axis=1)
+
+
 def fit_ptm(
     images: Any,
     lights: ArrayLike,
@@ -57,6 +123,7 @@ def fit_ptm(
     ill_conditioned: IllConditioned = "regularise",
     cond_limit: float = COND_LIMIT,
     out: NDArray[Any] | None = None,
+    saturation: float | None = None,
 ) -> PTMModel:
     """Fit a PTM to linear ``images`` (N, H, W[, C]) lit from unit ``lights`` (N, 3); N >= 6.
 
@@ -72,5 +139,6 @@ def fit_ptm(
         ill_conditioned=ill_conditioned,
         cond_limit=cond_limit,
         out=out,
+        saturation=saturation,
     )
     return PTMModel(coef, report)

@@ -1,11 +1,16 @@
-"""Fit any model by name: the single entry point a benchmark or CLI loops over.
+"""Fit any model by name: the registry a benchmark, the CLI and model choice loop over.
 
-Names: ``lambert`` (3), ``hsh1`` (4), ``ptm`` (6), ``hsh2`` (9), ``hsh3`` (16) — linear relighting
-bases — and ``ps`` / ``ps-robust``, Lambertian photometric stereo (least squares / robust).
+A model is one module with a fit function ``fit(images, lights, **kwargs) -> RelightModel`` and
+one :func:`register` line below. Names: ``lambert`` (3), ``hsh1`` (4), ``ptm`` (6), ``hsh2`` (9),
+``hsh3`` (16) — linear relighting bases, candidates of model choice — and ``ps`` / ``ps-robust``
+(alias ``robust-ps``), Lambertian photometric stereo (least squares / robust).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from numpy.typing import ArrayLike
@@ -15,22 +20,71 @@ from rti_rig.reconstruct.linear_model import RelightModel, fit_lambert
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
 from rti_rig.reconstruct.ptm import fit_ptm
 
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """One registered model: its fit function and what it gives."""
+
+    name: str
+    n_coefficients: int
+    fit: Callable[..., RelightModel]
+    #: a linear relighting basis (a candidate of model choice, exportable coefficients)
+    relighting: bool
+    #: what its normals mean, for reports
+    normals: str
+    aliases: tuple[str, ...] = ()
+
+
+_REGISTRY: dict[str, ModelSpec] = {}
+
+
+def register(spec: ModelSpec) -> ModelSpec:
+    """Add a model (and its aliases) to the registry; a name may be registered once."""
+    for key in (spec.name, *spec.aliases):
+        if key in _REGISTRY:
+            raise ValueError(f"model name '{key}' is already registered")
+        _REGISTRY[key] = spec
+    return spec
+
+
+def model_spec(name: str) -> ModelSpec:
+    """The registered model ``name`` (or alias); ValueError naming the known ones."""
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        raise ValueError(f"unknown model '{name}'; known: {', '.join(MODEL_NAMES)}") from None
+
+
+register(ModelSpec("lambert", 3, fit_lambert, True, "albedo × normal, no shadow handling"))
+register(ModelSpec("hsh1", 4, partial(fit_hsh, order=1), True, "none"))
+register(ModelSpec("ptm", 6, fit_ptm, True, "Lambertian reading of the PTM"))
+register(ModelSpec("hsh2", 9, partial(fit_hsh, order=2), True, "none"))
+register(ModelSpec("hsh3", 16, partial(fit_hsh, order=3), True, "none"))
+register(
+    ModelSpec("ps", 3, partial(fit_photometric_stereo, robust=False), False, "least-squares PS")
+)
+register(
+    ModelSpec(
+        "ps-robust",
+        3,
+        partial(fit_photometric_stereo, robust=True),
+        False,
+        "robust PS (shadows, highlights, saturation dropped)",
+        aliases=("robust-ps",),
+    )
+)
+
 #: Linear relighting models in increasing coefficient count: the order "lowest order first".
-RELIGHT_MODELS = ("lambert", "hsh1", "ptm", "hsh2", "hsh3")
-#: Every name :func:`fit_model` accepts.
-MODEL_NAMES = (*RELIGHT_MODELS, "ps", "ps-robust")
+RELIGHT_MODELS = tuple(
+    sorted(
+        (s.name for s in {id(s): s for s in _REGISTRY.values()}.values() if s.relighting),
+        key=lambda n: _REGISTRY[n].n_coefficients,
+    )
+)
+#: Every canonical name :func:`fit_model` accepts (aliases too, see :func:`model_spec`).
+MODEL_NAMES = tuple(dict.fromkeys(s.name for s in _REGISTRY.values()))
 
 
 def fit_model(name: str, images: Any, lights: ArrayLike, **kwargs: Any) -> RelightModel:
     """Fit the model ``name`` (see :data:`MODEL_NAMES`); ``kwargs`` go to its fit function."""
-    if name == "lambert":
-        return fit_lambert(images, lights, **kwargs)
-    if name == "ptm":
-        return fit_ptm(images, lights, **kwargs)
-    if name in ("hsh1", "hsh2", "hsh3"):
-        return fit_hsh(images, lights, int(name[-1]), **kwargs)
-    if name == "ps":
-        return fit_photometric_stereo(images, lights, robust=False, **kwargs)
-    if name == "ps-robust":
-        return fit_photometric_stereo(images, lights, robust=True, **kwargs)
-    raise ValueError(f"unknown model '{name}'; known: {', '.join(MODEL_NAMES)}")
+    return model_spec(name).fit(images, lights, **kwargs)

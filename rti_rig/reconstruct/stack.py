@@ -1,18 +1,25 @@
 """Images and lights as the fitting code sees them, checked once at the edge.
 
 Images arrive as one array (N, H, W) or (N, H, W, C) — possibly a ``numpy.memmap`` — or as a
-sequence of N arrays (H, W) / (H, W, C), e.g. the ``uint16`` pixels of captured frames. Nothing
+sequence of N arrays (H, W) / (H, W, C), e.g. the ``uint16`` pixels of captured frames, or
+row-readable array-likes such as :class:`rti_rig.core.tiff_rows.TiffRows` (files read a band at
+a time). Nothing
 here converts the whole stack: :meth:`ImageStack.rows` converts one band of rows to float32 on
 demand, so a stack larger than memory can be fitted from a memmap or from frames kept as
 ``uint16``.
 
 Integer images are scaled to [0, 1] by ``scale`` (default 1 / the dtype's maximum, or
 1 / white level via :func:`stack_from_frames`); float images are taken as linear values as given.
+Saturation: integer images saturate at their top code value; float images have no known
+saturation level unless one is given (``saturation_level``, or ``saturation=`` of every fit),
+and then every fit honours it. NaN and infinite values are missing observations.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -42,6 +49,8 @@ class ImageStack:
         if isinstance(images, ImageStack):
             self._frames: Sequence[Any] | None = images._frames
             self._array = images._array
+            self._lazy = images._lazy
+            self._samples = images._samples
             self.n, self.height, self.width = images.n, images.height, images.width
             self.channels, self.grey = images.channels, images.grey
             self.dtype, self.scale = images.dtype, images.scale if scale is None else scale
@@ -56,10 +65,11 @@ class ImageStack:
                 )
             self._array: NDArray[Any] | None = images
             self._frames = None
+            self._lazy = False
             shape = images.shape[1:]
             dtype = images.dtype
         elif isinstance(images, Sequence) and len(images) > 0:
-            arrays = [np.asarray(im) for im in images]
+            arrays = [im if _row_readable(im) else np.asarray(im) for im in images]
             shape = arrays[0].shape
             for i, a in enumerate(arrays):
                 if a.shape != shape:
@@ -74,6 +84,7 @@ class ImageStack:
                 raise ReconstructionError(f"each image must be (H, W) or (H, W, C), got {shape}")
             self._array = None
             self._frames = arrays
+            self._lazy = any(_row_readable(a) for a in arrays)
             dtype = arrays[0].dtype
         else:
             raise ReconstructionError("images must be an array (N, H, W[, C]) or a list of images")
@@ -91,23 +102,43 @@ class ImageStack:
             saturation_level = float(np.iinfo(dtype).max) * self.scale
         #: Scaled value at or above which an observation is saturated (None: unknown).
         self.saturation_level = saturation_level
+        self._samples: dict[int, tuple[NDArray[np.float32], NDArray[np.intp]]] = {}
         if self.height < 1 or self.width < 1 or self.channels < 1:
             raise ReconstructionError(f"images are empty: shape {shape}")
 
-    def rows(self, sl: slice, indices: ArrayLike | None = None) -> NDArray[np.float32]:
-        """Band of rows ``sl`` of images ``indices`` (default all) as float32 (n, r, W, C)."""
+    def rows(
+        self,
+        sl: slice,
+        indices: ArrayLike | None = None,
+        *,
+        strict: bool = True,
+        copy: bool = True,
+    ) -> NDArray[np.float32]:
+        """Band of rows ``sl`` of images ``indices`` (default all) as float32 (n, r, W, C).
+
+        ``strict`` refuses NaN or infinity; the fits read with ``strict=False`` and treat such
+        values as missing observations (see :meth:`unusable`), so that one bad pixel, masked
+        or not, never aborts a whole fit. ``copy=False`` may return a view of float32 input
+        (no conversion needed): the caller must not write into it.
+        """
         idx = np.arange(self.n) if indices is None else np.asarray(indices)
         if self._array is not None:
-            band = np.asarray(self._array[idx, sl])
+            band = np.asarray(self._array[:, sl] if indices is None else self._array[idx, sl])
         else:
             assert self._frames is not None
-            band = np.stack([np.asarray(self._frames[i][sl]) for i in idx])
-        out = band.astype(np.float32, copy=True)
+            frames = self._frames
+            if self._lazy:
+                # files decoded strip by strip: zlib releases the GIL, so decode in parallel
+                parts = list(_reader_pool().map(lambda i: np.asarray(frames[i][sl]), idx))
+                band = np.stack(parts)
+            else:
+                band = np.stack([np.asarray(frames[i][sl]) for i in idx])
+        out = band.astype(np.float32, copy=copy or self.scale != 1.0)
         if self.scale != 1.0:
             out *= np.float32(self.scale)
         if out.ndim == 3:
             out = out[..., None]
-        if not np.all(np.isfinite(out)):
+        if strict and not np.all(np.isfinite(out)):
             bad = int(np.argwhere(~np.isfinite(out))[0][0])
             raise ReconstructionError(
                 f"image {int(idx[bad])} holds NaN or infinity in rows {sl.start}:{sl.stop}; "
@@ -115,12 +146,37 @@ class ImageStack:
             )
         return out
 
+    def unusable(self, band: NDArray[np.float32]) -> NDArray[np.bool_] | None:
+        """Observations of ``band`` a fit must not use: NaN/infinite, or at or above the
+        saturation level; None when every observation is usable (the fast path). Read-only:
+        callers zero the unusable values in their own copy."""
+        bad = ~np.isfinite(band)
+        if self.saturation_level is not None:
+            with np.errstate(invalid="ignore"):
+                bad |= band >= np.float32(self.saturation_level)
+        if not bad.any():
+            return None
+        return bad
+
+    def suspect_columns(self, flat: NDArray[np.float32]) -> NDArray[np.bool_] | None:
+        """Columns of ``flat`` (N, K) holding a saturated value, by one max-reduction (no
+        temporary of the band's size); None when the level is unknown or nothing reaches it.
+        Non-finite values are found by the caller from its results (NaN propagates)."""
+        if self.saturation_level is None:
+            return None
+        with np.errstate(invalid="ignore"):
+            hit = np.max(flat, axis=0) >= np.float32(self.saturation_level)
+        return hit if hit.any() else None
+
     def pixel_sample(self, max_pixels: int) -> tuple[NDArray[np.float32], NDArray[np.intp]]:
         """A regular grid of at most ``max_pixels`` pixels: values (N, P, C) and flat indices.
 
         A strided grid rather than a random draw, so that the sample (and a model choice made
         on it) is reproducible and touches every part of the image.
         """
+        cached = self._samples.get(max_pixels)
+        if cached is not None:  # a file-backed stack pays one decode pass per sample
+            return cached
         total = self.height * self.width
         step = max(1, int(np.ceil(np.sqrt(total / max(1, max_pixels)))))
         rows = np.arange(step // 2, self.height, step)
@@ -131,10 +187,11 @@ class ImageStack:
             cols = np.array([self.width // 2])
         parts = []
         for r in rows:
-            band = self.rows(slice(int(r), int(r) + 1))  # (N, 1, W, C)
+            band = self.rows(slice(int(r), int(r) + 1), strict=False)  # (N, 1, W, C)
             parts.append(band[:, 0, cols, :])
         values = np.concatenate(parts, axis=1)
         flat = (rows[:, None] * self.width + cols[None, :]).ravel()
+        self._samples[max_pixels] = (values, flat)
         return values, flat
 
     def reference_level(self, max_pixels: int = 10_000) -> float:
@@ -143,8 +200,31 @@ class ImageStack:
         Thresholds (dark, highlight floor) are fractions of it, so they follow the exposure.
         """
         values, _ = self.pixel_sample(max_pixels)
-        level = float(np.percentile(values, 99.0))
+        finite = values[np.isfinite(values)]
+        level = float(np.percentile(finite, 99.0)) if finite.size else 0.0
         return level if level > 0 else 1.0
+
+
+_POOL: ThreadPoolExecutor | None = None
+
+
+def _reader_pool() -> ThreadPoolExecutor:
+    """Threads that decode file-backed frames (one per core)."""
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=os.cpu_count() or 2, thread_name_prefix="rows")
+    return _POOL
+
+
+def _row_readable(obj: Any) -> bool:
+    """An array-like read a band of rows at a time (``shape``, ``dtype``, ``obj[a:b]``), e.g.
+    :class:`rti_rig.core.tiff_rows.TiffRows`: kept as is, never read whole."""
+    return (
+        not isinstance(obj, np.ndarray)
+        and hasattr(obj, "shape")
+        and hasattr(obj, "dtype")
+        and hasattr(obj, "__getitem__")
+    )
 
 
 def stack_from_frames(frames: Sequence[Any]) -> ImageStack:
@@ -194,6 +274,18 @@ def validate_lights(lights: ArrayLike, n_images: int | None = None) -> NDArray[n
     out = arr / np.linalg.norm(arr, axis=1, keepdims=True)
     out[:, 2] = np.clip(out[:, 2], 0.0, 1.0)
     return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+def channel_mean(values: NDArray[Any]) -> NDArray[np.float32]:
+    """Mean over the last (channel) axis as a sum of slices: numpy's ``mean(axis=-1)`` over a
+    length-3 axis is a strided reduction about 10× slower than this on large bands."""
+    c = values.shape[-1]
+    out = np.array(values[..., 0], dtype=np.float32)
+    for k in range(1, c):
+        out += values[..., k]
+    if c > 1:
+        out *= np.float32(1.0 / c)
+    return out
 
 
 def as_direction(direction: ArrayLike) -> NDArray[np.float64]:

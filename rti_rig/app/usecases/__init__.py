@@ -9,6 +9,7 @@ place before anything moves or is written, does the work and returns what happen
 - :mod:`.plan` — :func:`~.plan.plan_lights`, :func:`~.plan.draw_plan_figure`
 - :mod:`.calibrate` — :func:`~.calibrate.calibrate_lights`
 - :mod:`.probe` — :func:`~.probe.probe`
+- :mod:`.fit` — :func:`~.fit.run_fit`: normals, albedo, PTM/HSH and the QA verdict of a session
 - :mod:`.adaptive` — the adaptive acquisition loop (``run --adaptive``)
 
 Messages meant for the user along the way go to an optional ``on_note`` callback.

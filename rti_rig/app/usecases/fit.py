@@ -1,0 +1,408 @@
+"""`rti-rig fit`: normals, albedo, relightable files and a QA verdict from a finished session.
+
+Input: a session folder (``lights.lp`` and ``linear/*.tif`` 16-bit linear, as
+:mod:`rti_rig.runtime.session` writes it) or any ``.lp`` with its images beside it (16-bit TIFF
+used as linear; 8-bit JPEG/PNG decoded from sRGB). TIFFs are read a band of rows at a time
+(:class:`rti_rig.core.tiff_rows.TiffRows`); JPEG/PNG are decoded whole and held as ``uint16``.
+The stack is never held as floats; one streamed pass computes every output.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import mmap
+import time
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.lp_format import directions_of, read_lp
+from rti_rig.core.tiff_rows import TiffRows
+from rti_rig.reconstruct import exporters
+from rti_rig.reconstruct.errors import ReconstructionError
+from rti_rig.reconstruct.qa import QAReport, assess
+from rti_rig.reconstruct.registry import model_spec
+from rti_rig.reconstruct.stack import ImageStack
+
+#: What ``--model`` accepts besides the registered model names.
+AUTO = "auto"
+
+
+class FitInputError(RtiRigError):
+    """The session or .lp cannot be read for fitting."""
+
+
+@dataclass(frozen=True)
+class FitRequest:
+    source: Path
+    out_dir: Path
+    model: str = AUTO
+    write_ptm: bool = True
+    write_hsh: bool = True
+    write_normals: bool = True
+    hsh_order: int | None = None  # None: the chosen HSH order, else 2
+    qa: bool = True
+
+
+@dataclass
+class FitResult:
+    out_dir: Path
+    model: str
+    reason: str
+    files: list[Path] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    qa: QAReport | None = None
+    seconds: float = 0.0
+
+
+def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
+    x = np.arange(256) / 255.0
+    lin = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+    lut = np.round(lin * 65535).astype(np.uint16)
+    return lut[img]
+
+
+def _read_image(path: Path) -> np.ndarray:
+    if not path.is_file():
+        raise FitInputError(f"image {path} listed in the .lp is missing")
+    if path.suffix.lower() in (".tif", ".tiff"):
+        rows = TiffRows(path)  # read a band at a time by the fit, never whole
+        if rows.dtype != np.uint16:
+            raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
+        return rows  # type: ignore[return-value]
+    else:
+        img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        if img is None:
+            raise FitInputError(f"cannot read image {path}")
+        if img.ndim == 3:
+            img = img[..., ::-1]
+    if img.dtype == np.uint8:
+        img = _srgb_to_linear16(img)
+    if img.dtype != np.uint16:
+        raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
+    return np.ascontiguousarray(img)
+
+
+def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[str], str]:
+    """Frames (uint16), lights (N, 3), image names, and a description of what was read."""
+    if source.is_dir():
+        lps = sorted(source.glob("*.lp"))
+        if not lps:
+            raise FitInputError(f"{source} holds no .lp file: not a session folder")
+        lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]
+    elif source.suffix.lower() == ".lp" and source.is_file():
+        lp = source
+    else:
+        raise FitInputError(f"{source}: give a session folder or an .lp file")
+    entries = read_lp(lp, upper_hemisphere=True)
+    lights = directions_of(entries)
+    frames, names = [], []
+    for e in entries:
+        stem = Path(e.name).stem
+        linear = lp.parent / "linear" / f"{stem}.tif"
+        path = linear if linear.is_file() else lp.parent / e.name
+        frames.append(_read_image(path))
+        names.append(stem)
+    shapes = {f.shape for f in frames}
+    if len(shapes) != 1:
+        raise FitInputError(f"images of {lp} differ in shape: {sorted(shapes)}")
+    return frames, lights, names, f"{len(frames)} images from {lp}"
+
+
+def _save_png(path: Path, rgb: np.ndarray) -> Path:
+    cv2.imwrite(str(path), rgb[..., ::-1] if rgb.ndim == 3 else rgb)
+    return path
+
+
+def run_fit(req: FitRequest) -> FitResult:
+    """Fit, write every output into ``req.out_dir``, and judge the acquisition."""
+    t0 = time.perf_counter()
+    frames, lights, names, what = load_acquisition(req.source)
+    out = req.out_dir
+    if out.exists() and any(out.iterdir()):
+        raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
+    out.mkdir(parents=True, exist_ok=True)
+    stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = _fit_all(req, stack, lights, out)
+    result.warnings = [str(w.message) for w in caught or []]
+    result.files.append(
+        exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
+    )
+    if req.qa:
+        try:
+            result.qa = assess(frames, lights, names)
+        except ReconstructionError as exc:  # e.g. too few or coplanar lights for PS
+            result.warnings.append(f"QA not possible: {exc}")
+        else:
+            result.files += write_qa_report(out, result.qa, result)
+    summary = {
+        "source": str(req.source),
+        "read": what,
+        "model": result.model,
+        "why": result.reason,
+        "warnings": result.warnings,
+        "files": [p.name for p in result.files],
+        "verdict": result.qa.verdict if result.qa else None,
+    }
+    (out / "fit.json").write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
+    result.files.append(out / "fit.json")
+    result.seconds = time.perf_counter() - t0
+    return result
+
+
+#: Pixel sample shared by model choice, quantisation ranges and the reference level: one
+#: decode pass of the files for all three.
+SAMPLE_PIXELS = 30_000
+#: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
+#: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
+BAND_BUDGET_BYTES = 24 * 1024 * 1024
+
+
+def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) -> FitResult:
+    """One streamed pass over the acquisition: every output is computed band by band.
+
+    Each band of rows of all images is read once (from the TIFFs, a strip at a time) and fitted
+    by photometric stereo (normals, albedo) and by the PTM and HSH written to ``.ptm`` and
+    ``.rti``; nothing holds the stack as floats. The 8-bit quantisation ranges of the exported
+    coefficients come from a fit of the same pixel sample model choice uses (widened by 50 %;
+    values beyond are clipped, and counted in ``fit.json``).
+    """
+    from rti_rig.core.rti_bases import design_matrix
+    from rti_rig.reconstruct.errors import FitTrustWarning
+    from rti_rig.reconstruct.linear_model import fit_coefficients
+    from rti_rig.reconstruct.model_select import select_model
+    from rti_rig.reconstruct.photometric_stereo import (
+        DARK_FRACTION,
+        HIGHLIGHT_FLOOR_FRACTION,
+        fit_photometric_stereo,
+    )
+    from rti_rig.reconstruct.solve import solve_matrix
+    from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
+
+    files: list[Path] = []
+    name = req.model
+    n = stack.n
+    if name == AUTO:
+        choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS)
+        model_name = choice.model
+        (out / "model_choice.md").write_text(choice.to_markdown() + "\n", encoding="utf-8")
+        files.append(out / "model_choice.md")
+        reason_line = (
+            f"{choice.model}: lowest order within {choice.tolerance:.0%} of the best held-out "
+            f"error ({choice.best_model}), {choice.holdout}"
+        )
+    else:
+        model_name = model_spec(name).name
+        reason_line = f"{model_name}: chosen by --model"
+    normal_source = model_name if model_name in ("ps", "lambert", "ptm") else "ps-robust"
+
+    # linear models to export, their solve matrices (warnings issued once, here)
+    order = req.hsh_order or (int(model_name[-1]) if model_name.startswith("hsh") else 2)
+    linear: dict[str, np.ndarray] = {}
+    if req.write_ptm and n >= 6:
+        linear["ptm"] = design_matrix("ptm", lights)
+    if req.write_hsh and n >= (order + 1) ** 2:
+        linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
+    if normal_source == "lambert":
+        linear["lambert"] = design_matrix("lambert", lights)
+    sample, _ = stack.pixel_sample(SAMPLE_PIXELS)  # the sample model choice read (cached)
+    obs = sample.reshape(n, -1)
+    keep = np.all(np.isfinite(obs), axis=0)
+    if stack.saturation_level is not None:
+        keep &= np.all(obs < stack.saturation_level, axis=0)
+    obs = obs[:, keep] if keep.any() else np.nan_to_num(obs)
+    writers: dict[str, Any] = {}
+    for key, design in linear.items():
+        ill = "refuse" if key == "lambert" else "regularise"
+        w, _ = solve_matrix(design, key, ill)
+        if key == "lambert":
+            continue
+        lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5)
+        if key == "ptm":
+            writers[key] = exporters.PtmWriter(out / "fit.ptm", stack.width, stack.height, lo, hi)
+        else:
+            writers[key] = exporters.RtiWriter(out / "fit.rti", stack.width, stack.height, lo, hi)
+
+    if not req.write_normals:
+        normal_source = ""
+        linear.pop("lambert", None)
+    ref = stack.reference_level(SAMPLE_PIXELS)
+    h, wd = stack.height, stack.width
+    maps = (h, wd) if req.write_normals else (1, 1)
+    normals = np.lib.format.open_memmap(out / "normals.npy", "w+", np.float32, (*maps, 3))
+    albedo_shape = maps if stack.grey else (*maps, stack.channels)
+    albedo = np.lib.format.open_memmap(out / "albedo.npy", "w+", np.float32, albedo_shape)
+    rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
+    sat = stack.saturation_level
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
+        tiles = list(row_tiles(h, rows))
+        pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="prefetch")
+        pending = pool.submit(stack.rows, tiles[0], strict=False)
+        for t, sl in enumerate(tiles):
+            band = pending.result()  # read while the previous band was being fitted
+            if t + 1 < len(tiles):
+                pending = pool.submit(stack.rows, tiles[t + 1], strict=False)
+            if stack.grey:
+                band = band[..., 0]
+            coefs = {
+                key: fit_coefficients(band, design, key, saturation=sat, tile_rows=rows)[0]
+                for key, design in linear.items()
+            }
+            for key, writer in writers.items():
+                writer.write_rows(sl.start, coefs[key])
+            if not normal_source:
+                pass
+            elif normal_source.startswith("ps"):
+                ps = fit_photometric_stereo(
+                    band,
+                    lights,
+                    robust=normal_source == "ps-robust",
+                    tile_rows=rows,
+                    saturation=sat,
+                    dark_threshold=DARK_FRACTION * ref,
+                    highlight_floor=HIGHLIGHT_FLOOR_FRACTION * ref,
+                    reference_level=ref,
+                )
+                normals[sl], albedo[sl] = ps.normals, ps.albedo
+            else:
+                from rti_rig.reconstruct.linear_model import LambertModel
+                from rti_rig.reconstruct.ptm import PTMModel
+                from rti_rig.reconstruct.solve import FitReport
+
+                report = FitReport(normal_source, n, 0, 0.0, 0.0, False, 0.0)
+                cls = PTMModel if normal_source == "ptm" else LambertModel
+                normals[sl] = cls(coefs[normal_source], report).normals()
+                if normal_source == "lambert":
+                    b = coefs["lambert"]
+                    albedo[sl] = np.linalg.norm(b, axis=0)
+                else:
+                    albedo[sl] = coefs["ptm"][5]  # the PTM's constant term: mean brightness
+            _release(normals)  # written pages go to the file, not the resident set
+            _release(albedo)
+        pool.shutdown()
+    for writer in writers.values():
+        files.append(writer.close())
+    normals.flush()
+    albedo.flush()
+    if req.write_normals:
+        files += exporters.write_normal_map(out / "normals", normals, npy=False)
+        files += exporters.write_albedo(out / "albedo", albedo, npy=False)
+    del normals, albedo
+    if not req.write_normals:
+        (out / "normals.npy").unlink()
+        (out / "albedo.npy").unlink()
+    return FitResult(out, model_name, reason_line, files)
+
+
+def _release(mapped: np.memmap) -> None:
+    """Flush a writable memmap and drop its pages from memory (they are in the file now)."""
+    mapped.flush()
+    mm = getattr(mapped, "_mmap", None)
+    if mm is not None and hasattr(mm, "madvise") and hasattr(mmap, "MADV_DONTNEED"):
+        mm.madvise(mmap.MADV_DONTNEED)
+
+
+def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
+    """``qa.json`` and a one-page ``qa.html`` with the coverage map and per-image table."""
+    cov = qa.coverage.astype(np.float32)
+    cov_img = cv2.applyColorMap(
+        np.clip(cov / max(float(cov.max()), 1.0) * 255, 0, 255).astype(np.uint8),
+        cv2.COLORMAP_VIRIDIS,
+    )
+    cov_img[qa.coverage < 3] = (0, 0, 255)
+    cv2.imwrite(str(out / "qa_coverage.png"), cov_img)
+    (out / "qa.json").write_text(json.dumps(qa.to_json(), indent=1) + "\n", encoding="utf-8")
+    rows = "\n".join(
+        f"<tr{' class=bad' if c.problems else ''}><td>{html.escape(c.name)}</td>"
+        f"<td>{c.saturated_fraction:.2%}</td><td>{c.dark_fraction:.1%}</td>"
+        f"<td>{c.gain:.2f}</td><td>{c.residual:.3f}</td><td>{c.direction_error_deg:.1f}</td>"
+        f"<td>{c.drift_px[0]:+.2f}, {c.drift_px[1]:+.2f}</td>"
+        f"<td>{html.escape('; '.join(c.problems))}</td></tr>"
+        for c in qa.images
+    )
+    normals = '<img src="normals.png" width="320">' if (out / "normals.png").exists() else ""
+    page = f"""<!doctype html><html><head><meta charset="utf-8"><title>rti-rig QA</title>
+<style>body{{font-family:sans-serif;margin:1em}} td,th{{padding:2px 6px;font-size:12px}}
+tr.bad{{background:#fdd}} .v{{font-size:20px;font-weight:bold}}</style></head><body>
+<p class="v">Verdict: {html.escape(qa.verdict)}</p>
+<p>Model: {html.escape(result.model)} — {html.escape(result.reason)}.
+Expected normal error (median, bound): {qa.expected_normal_error_deg:.2f}°;
+noise σ {qa.noise_sigma:.4f}; pixels lit by fewer than 3 usable images:
+{qa.undercovered_fraction:.1%} (red in the coverage map).</p>
+<p>{normals} <img src="qa_coverage.png" width="320"></p>
+<p>Fit warnings: {html.escape("; ".join(result.warnings) or "none")}</p>
+<table border=1 cellspacing=0><tr><th>image</th><th>saturated</th><th>dark</th><th>gain</th>
+<th>residual</th><th>direction error °</th><th>drift px (x, y)</th><th>problems</th></tr>
+{rows}</table>
+<p>Thresholds: {html.escape(json.dumps(qa.thresholds))}</p></body></html>
+"""
+    (out / "qa.html").write_text(page, encoding="utf-8")
+    return [out / "qa.html", out / "qa.json", out / "qa_coverage.png"]
+
+
+def verdict_for_session(session: Path) -> str:
+    """The QA verdict line of a session folder (for ``rti-rig run``'s last line)."""
+    frames, lights, names, _ = load_acquisition(session)
+    return assess(frames, lights, names).verdict
+
+
+@dataclass(frozen=True)
+class BatchItem:
+    source: Path
+    out_dir: Path
+    status: str  # "done", "skipped (finished earlier)", or "failed: ..."
+    verdict: str | None = None
+
+
+def batch_out_dir(root: Path, source: Path) -> Path:
+    """Where a batch writes one source: ``root/<session folder name or .lp stem>``."""
+    return root / (source.name if source.is_dir() else source.stem)
+
+
+def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[BatchItem]:
+    """Fit several sessions one after another, resumably.
+
+    Each goes to :func:`batch_out_dir`, built in a hidden ``.name.partial`` folder and renamed
+    when complete: a finished session (its folder exists) is skipped, a killed batch leaves at
+    most one partial folder, which the next run removes and redoes. A session that fails is
+    reported and the batch goes on. (Sessions run in this process, one at a time: the Dask
+    scale-out of issue #29 is not implemented.)
+    """
+    import shutil
+    from dataclasses import replace
+
+    names = [batch_out_dir(root, s).name for s in sources]
+    dupes = {n for n in names if names.count(n) > 1}
+    if dupes:
+        raise FitInputError(f"two sources would write to the same folder: {sorted(dupes)}")
+    root.mkdir(parents=True, exist_ok=True)
+    items = []
+    for source in sources:
+        final = batch_out_dir(root, source)
+        if final.exists():
+            items.append(BatchItem(source, final, "skipped (finished earlier)"))
+            continue
+        partial = root / f".{final.name}.partial"
+        if partial.exists():
+            shutil.rmtree(partial)
+        try:
+            result = run_fit(replace(template, source=source, out_dir=partial))
+        except RtiRigError as exc:
+            shutil.rmtree(partial, ignore_errors=True)
+            items.append(BatchItem(source, final, f"failed: {exc}"))
+            continue
+        partial.rename(final)
+        items.append(
+            BatchItem(source, final, "done", result.qa.verdict if result.qa is not None else None)
+        )
+    return items

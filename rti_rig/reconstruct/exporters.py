@@ -1,0 +1,241 @@
+"""Files that viewers people already use open: ``.ptm``, HSH ``.rti``, relight ``.dome``, maps.
+
+Formats, as published (no code copied):
+
+* **PTM 1.2, ``PTM_FORMAT_RGB``** (Malzbender, Gelb, Wolters; HP Labs "PTM file format 1.2";
+  the layout relight's ``LRti`` reader in cnr-isti-vclab/relight ``src/legacy_rti.cpp`` reads):
+  text lines ``PTM_1.2``, ``PTM_FORMAT_RGB``, width, height, six scale floats, six integer
+  biases, then bytes: for each colour plane R, G, B, for each scanline, for each pixel, the six
+  coefficients a0..a5. Coefficient ``a_i = (byte - bias_i) × scale_i``. Scanlines run from the
+  bottom of the image up (the origin of a PTM is its lower-left corner), and ``(l_u, l_v)`` are
+  the light's projection with ``v`` up — the DESIGN.md frame.
+* **HSH ``.rti``** (RTIViewer's format, as relight's ``LRti::loadHSH`` reads it): comment lines
+  starting ``#`` (the first is ``#HSH1.2``), the file type ``3`` (HSH), ``width height 3``,
+  ``terms basis_type element_size`` (we write ``2 1``: the basis type is ignored by readers,
+  one byte per element), then ``terms`` little-endian float32 scales and ``terms`` biases,
+  then bytes: scanlines from the bottom up, for each pixel, for each colour, for each term.
+  Coefficient ``c = byte / 255 × scale_k + bias_k``. Our basis is the true HSH (order-3
+  exponent 1.5, see :mod:`rti_rig.core.rti_bases`).
+* **relight ``.dome``** (cnr-isti-vclab/relight, "Dome configuration file format"): JSON with
+  ``diameter`` (cm), ``imageWidth`` (cm), ``verticalOffset`` (cm) and ``directions`` (unit
+  vectors, z up, x right, y towards the top of the image) or ``positions`` (cm).
+
+Coefficients are written in units of the fitted (linear) images × 255, quantised to 8 bits per
+coefficient with one scale and bias per coefficient index (over all pixels and colours).
+"""
+
+from __future__ import annotations
+
+import json
+import mmap
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rti_rig.reconstruct.errors import ReconstructionError
+
+#: Coefficients are stored for images scaled to 0–255 (what PTM/RTI viewers display).
+DISPLAY_SCALE = 255.0
+
+
+def _rgb_planes(coefficients: NDArray[Any]) -> NDArray[np.float32]:
+    """(p, H, W, 3) float32 from (p, H, W) grey or (p, H, W, C) colour coefficients."""
+    c = np.asarray(coefficients, dtype=np.float32)
+    if c.ndim == 3:
+        c = np.repeat(c[..., None], 3, axis=-1)
+    if c.shape[-1] != 3:
+        raise ReconstructionError(f"export needs grey or RGB coefficients, got {c.shape}")
+    return c
+
+
+def ptm_quantisation(lo: ArrayLike, hi: ArrayLike) -> tuple[NDArray[np.float64], NDArray]:
+    """PTM scale (float) and integer bias per coefficient for display-unit ranges lo..hi."""
+    lo = np.minimum(np.asarray(lo, dtype=np.float64), 0.0)
+    hi = np.maximum(np.asarray(hi, dtype=np.float64), 0.0)
+    scale = np.maximum((hi - lo) / 255.0, 1e-12)
+    bias = np.clip(np.round(-lo / scale), 0, 255).astype(int)
+    return scale, bias
+
+
+class PtmWriter:
+    """``PTM_FORMAT_RGB`` written a band of rows at a time (file laid out first, then filled).
+
+    ``lo``/``hi``: range of each of the 6 coefficients in display units (images × 255) over
+    all pixels and colours; values outside are clipped. A fit that streams knows them from a
+    pixel sample (:func:`coefficient_ranges`).
+    """
+
+    def __init__(self, path: Path, width: int, height: int, lo: ArrayLike, hi: ArrayLike) -> None:
+        self.path, self.width, self.height = path, int(width), int(height)
+        self.scale, self.bias = ptm_quantisation(lo, hi)
+        header = (
+            "PTM_1.2\nPTM_FORMAT_RGB\n"
+            f"{self.width}\n{self.height}\n"
+            + " ".join(f"{v:.9g}" for v in self.scale)
+            + "\n"
+            + " ".join(str(v) for v in self.bias)
+            + "\n"
+        ).encode("ascii")
+        self._tmp = path.with_name(path.name + ".part")
+        self._fh = open(self._tmp, "wb")  # noqa: SIM115 - open across bands, closed by close()
+        self._fh.write(header)
+        self._start = len(header)
+        self._plane = self.width * self.height * 6
+        self._fh.truncate(self._start + 3 * self._plane)
+
+    def write_rows(self, top: int, coefficients: NDArray[Any]) -> None:
+        """Coefficients (6, r, W[, 3]) of image rows ``top .. top + r`` (top-down)."""
+        c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
+        r = c.shape[1]
+        sc = self.scale[:, None, None].astype(np.float32)
+        bi = self.bias[:, None, None].astype(np.float32)
+        first_file_row = self.height - (top + r)  # scanlines run bottom-up
+        for ch in range(3):
+            q = np.clip(np.round(c[..., ch] / sc + bi), 0, 255).astype(np.uint8)
+            block = np.ascontiguousarray(np.moveaxis(q, 0, -1)[::-1])
+            self._fh.seek(self._start + ch * self._plane + first_file_row * self.width * 6)
+            self._fh.write(block.tobytes())
+
+    def close(self) -> Path:
+        self._fh.close()
+        self._tmp.replace(self.path)
+        return self.path
+
+
+class RtiWriter:
+    """HSH ``.rti`` written a band of rows at a time; ``lo``/``hi`` per term, display units."""
+
+    def __init__(self, path: Path, width: int, height: int, lo: ArrayLike, hi: ArrayLike) -> None:
+        self.path, self.width, self.height = path, int(width), int(height)
+        self.lo = np.asarray(lo, dtype=np.float64)
+        self.scale = np.maximum(np.asarray(hi, dtype=np.float64) - self.lo, 1e-12)
+        self.terms = self.lo.size
+        if self.terms not in (4, 9, 16):
+            raise ReconstructionError(f"HSH has 4, 9 or 16 terms, got {self.terms}")
+        header = (
+            f"#HSH1.2\n#written by rti-rig\n3\n{self.width} {self.height} 3\n{self.terms} 2 1\n"
+        ).encode("ascii")
+        self._tmp = path.with_name(path.name + ".part")
+        self._fh = open(self._tmp, "wb")  # noqa: SIM115 - open across bands, closed by close()
+        self._fh.write(header)
+        self._fh.write(self.scale.astype("<f4").tobytes())
+        self._fh.write(self.lo.astype("<f4").tobytes())
+        self._start = self._fh.tell()
+        self._fh.truncate(self._start + self.width * self.height * 3 * self.terms)
+
+    def write_rows(self, top: int, coefficients: NDArray[Any]) -> None:
+        """Coefficients (terms, r, W[, 3]) of image rows ``top .. top + r`` (top-down)."""
+        c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
+        r = c.shape[1]
+        lo = self.lo[:, None, None, None].astype(np.float32)
+        sc = self.scale[:, None, None, None].astype(np.float32)
+        q = np.clip(np.round((c - lo) / sc * 255.0), 0, 255).astype(np.uint8)
+        block = np.ascontiguousarray(np.transpose(q, (1, 2, 3, 0))[::-1])  # rows, x, colour, k
+        first_file_row = self.height - (top + r)
+        self._fh.seek(self._start + first_file_row * self.width * 3 * self.terms)
+        self._fh.write(block.tobytes())
+
+    def close(self) -> Path:
+        self._fh.close()
+        self._tmp.replace(self.path)
+        return self.path
+
+
+def coefficient_ranges(
+    coefficients: NDArray[Any], margin: float = 0.0
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per-coefficient (lo, hi) in display units of coefficients (p, ...), widened by
+    ``margin`` × the range on each side (for ranges taken from a sample)."""
+    c = np.asarray(coefficients, dtype=np.float64).reshape(coefficients.shape[0], -1)
+    c = c * DISPLAY_SCALE
+    lo, hi = np.nanmin(c, axis=1), np.nanmax(c, axis=1)
+    pad = (hi - lo) * margin
+    return lo - pad, hi + pad
+
+
+def write_ptm_rgb(path: Path, coefficients: NDArray[Any]) -> Path:
+    """Write PTM coefficients (6, H, W[, 3]) in Malzbender order as ``PTM_FORMAT_RGB``."""
+    c = np.asarray(coefficients)
+    if c.shape[0] != 6:
+        raise ReconstructionError(f"a PTM has 6 coefficients, got {c.shape[0]}")
+    writer = PtmWriter(path, c.shape[2], c.shape[1], *coefficient_ranges(c))
+    writer.write_rows(0, c)
+    return writer.close()
+
+
+def write_hsh_rti(path: Path, coefficients: NDArray[Any]) -> Path:
+    """Write HSH coefficients (terms, H, W[, 3]) in ``.rti`` index order as an HSH ``.rti``."""
+    c = np.asarray(coefficients)
+    writer = RtiWriter(path, c.shape[2], c.shape[1], *coefficient_ranges(c))
+    writer.write_rows(0, c)
+    return writer.close()
+
+
+def write_relight_dome(
+    path: Path,
+    directions: ArrayLike,
+    *,
+    diameter_cm: float | None = None,
+    image_width_cm: float | None = None,
+    label: str = "",
+) -> Path:
+    """relight's ``.dome`` JSON for these light ``directions`` (N, 3), z up, y to image top."""
+    d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    doc: dict[str, Any] = {
+        "label": label,
+        "diameter": float(diameter_cm) if diameter_cm else 0.0,
+        "imageWidth": float(image_width_cm) if image_width_cm else 0.0,
+        "verticalOffset": 0.0,
+        "directions": [[round(float(x), 6) for x in row] for row in d],
+    }
+    path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+    return path
+
+
+def _drop_pages(array: Any) -> None:
+    """For a file-backed (memmap) map: drop the pages read so far from the resident set."""
+    mm = getattr(array, "_mmap", None)
+    if mm is not None and hasattr(mm, "madvise") and hasattr(mmap, "MADV_DONTNEED"):
+        if getattr(array, "mode", "r") != "r":
+            array.flush()
+        mm.madvise(mmap.MADV_DONTNEED)
+
+
+def write_normal_map(stem: Path, normals: NDArray[Any], npy: bool = True) -> list[Path]:
+    """``stem.png`` (16-bit RGB, ``(n + 1) / 2``) and ``stem.npy`` (float32 (H, W, 3)); with
+    ``npy=False`` the ``.npy`` is taken to exist already (a memmap the fit wrote into)."""
+    png = stem.with_suffix(".png")
+    enc = np.empty(np.shape(normals), dtype=np.uint16)  # BGR, as OpenCV writes it: no copy
+    for top in range(0, enc.shape[0], 512):  # bounded temporaries for large maps
+        n = np.asarray(normals[top : top + 512], dtype=np.float32)
+        enc[top : top + 512] = np.clip(np.round((n[..., ::-1] + 1.0) * 0.5 * 65535.0), 0, 65535)
+        _drop_pages(normals)
+    if not cv2.imwrite(str(png), enc):
+        raise ReconstructionError(f"could not write {png}")
+    path = stem.with_suffix(".npy")
+    if npy:
+        np.save(path, np.asarray(normals, dtype=np.float32))
+    return [png, path]
+
+
+def write_albedo(
+    stem: Path, albedo: NDArray[Any], white: float = 1.0, npy: bool = True
+) -> list[Path]:
+    """``stem.png`` (16-bit, linear, white = ``white``) and ``stem.npy`` (float32)."""
+    png = stem.with_suffix(".png")
+    enc = np.empty(np.shape(albedo), dtype=np.uint16)  # BGR for colour, as OpenCV writes it
+    for top in range(0, enc.shape[0], 512):
+        a = np.asarray(albedo[top : top + 512], dtype=np.float32)
+        if a.ndim == 3:
+            a = a[..., ::-1]
+        enc[top : top + 512] = np.clip(np.round(a / white * 65535.0), 0, 65535)
+        _drop_pages(albedo)
+    if not cv2.imwrite(str(png), enc):
+        raise ReconstructionError(f"could not write {png}")
+    path = stem.with_suffix(".npy")
+    if npy:
+        np.save(path, np.asarray(albedo, dtype=np.float32))
+    return [png, path]

@@ -1,0 +1,206 @@
+"""`rti-rig fit` through the front door, its files read back independently, and the QA verdict.
+
+The `.ptm` and `.rti` readers here are written from the published format descriptions (HP's PTM
+1.2 layout; RTIViewer's HSH `.rti` as relight's legacy reader documents it), not from our writer.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.rti_bases import hsh_basis, ptm_basis
+
+sys.path.insert(0, str(Path(__file__).parent))
+from fit_sessions import make_session
+
+runner = CliRunner()
+
+
+def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.degrees(np.arccos(np.clip(np.sum(a * b, axis=-1), -1.0, 1.0)))
+
+
+@pytest.fixture(scope="module")
+def clean(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, np.ndarray, np.ndarray]:
+    return make_session(tmp_path_factory.mktemp("clean") / "s")
+
+
+# normal error bounds per model on the simulated tablet (degrees, median over the image)
+BOUNDS = {"robust-ps": 3.0, "ps": 8.0, "lambert": 8.0, "ptm": 10.0, "auto": 3.0}
+
+
+@pytest.mark.parametrize("model", list(BOUNDS))
+def test_fit_normals_against_simulator_truth(clean, tmp_path: Path, model: str) -> None:
+    session, _, truth = clean
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--model", model, "--no-qa"])
+    assert r.exit_code == 0, r.output
+    normals = np.load(out / "normals.npy")
+    err = float(np.median(_angles(normals, truth)))
+    assert err < BOUNDS[model], f"{model}: median normal error {err:.2f}°"
+    summary = json.loads((out / "fit.json").read_text())
+    assert summary["why"]
+    assert (out / "lights.dome").is_file() and (out / "fit.ptm").is_file()
+
+
+def _read_ptm(path: Path) -> np.ndarray:
+    """PTM 1.2 PTM_FORMAT_RGB: text header, then per colour plane, scanlines bottom-up, six
+    bytes per pixel; a_i = (byte - bias_i) * scale_i. Returns (6, H, W, 3) top-down."""
+    data = path.read_bytes()
+    lines, pos = [], 0
+    for _ in range(6):
+        end = data.index(b"\n", pos)
+        lines.append(data[pos:end].decode("ascii").strip())
+        pos = end + 1
+    assert lines[0] == "PTM_1.2" and lines[1] == "PTM_FORMAT_RGB"
+    w, h = int(lines[2]), int(lines[3])
+    scale = np.array([float(x) for x in lines[4].split()])
+    bias = np.array([int(x) for x in lines[5].split()])
+    raw = np.frombuffer(data, np.uint8, offset=pos).reshape(3, h, w, 6)
+    coef = (raw.astype(np.float64) - bias) * scale  # (3, H, W, 6)
+    return np.transpose(coef, (3, 1, 2, 0))[:, ::-1]
+
+
+def _read_rti(path: Path) -> np.ndarray:
+    """HSH .rti: '#' comment lines, type 3, 'W H 3', 'terms type size', float32 scales and
+    biases, then scanlines bottom-up, per pixel, per colour, per term: byte/255*scale+bias."""
+    data = path.read_bytes()
+    pos = 0
+    fields: list[str] = []
+    while len(fields) < 3:
+        end = data.index(b"\n", pos)
+        line = data[pos:end].decode("ascii")
+        pos = end + 1
+        if not line.startswith("#"):
+            fields.append(line)
+    assert int(fields[0]) == 3
+    w, h, bands = (int(x) for x in fields[1].split())
+    terms = int(fields[2].split()[0])
+    scale = np.array(struct.unpack(f"<{terms}f", data[pos : pos + 4 * terms]))
+    bias = np.array(struct.unpack(f"<{terms}f", data[pos + 4 * terms : pos + 8 * terms]))
+    raw = np.frombuffer(data, np.uint8, offset=pos + 8 * terms).reshape(h, w, bands, terms)
+    coef = raw / 255.0 * scale + bias  # (H, W, 3, terms)
+    return np.transpose(coef, (3, 0, 1, 2))[:, ::-1]
+
+
+def test_ptm_and_rti_read_back_relight_like_the_fit(clean, tmp_path: Path) -> None:
+    import tifffile
+
+    from rti_rig.reconstruct import fit_hsh, fit_ptm
+    from rti_rig.reconstruct.stack import ImageStack
+
+    session, lights, _ = clean
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    frames = [tifffile.imread(p) for p in sorted((session / "linear").glob("*.tif"))]
+    ptm = fit_ptm(ImageStack(frames), lights)
+    hsh = fit_hsh(ImageStack(frames), lights, 2)
+    ptm_file = _read_ptm(out / "fit.ptm")
+    rti_file = _read_rti(out / "fit.rti")
+    assert ptm_file.shape == ptm.coefficients.shape and rti_file.shape == hsh.coefficients.shape
+    # relight at directions between the lights, in 0..255 display units
+    for d in ([0.3, 0.2, 0.9327], [-0.5, 0.4, 0.7681], [0.7, -0.1, 0.7071]):
+        d = np.array(d) / np.linalg.norm(d)
+        ref = np.tensordot(ptm_basis(d[None])[0], ptm.coefficients, axes=(0, 0)) * 255
+        got = np.tensordot(ptm_basis(d[None])[0], ptm_file, axes=(0, 0))
+        assert np.percentile(np.abs(got - ref), 99) < 2.5  # 8-bit quantisation of 6 terms
+        ref = np.tensordot(hsh_basis(d[None], 2)[0], hsh.coefficients, axes=(0, 0)) * 255
+        got = np.tensordot(hsh_basis(d[None], 2)[0], rti_file, axes=(0, 0))
+        assert np.percentile(np.abs(got - ref), 99) < 4.0  # 9 terms
+    dome = json.loads((out / "lights.dome").read_text())
+    np.testing.assert_allclose(np.array(dome["directions"]), lights, atol=1e-5)
+
+
+CASES = {
+    "clean": ({}, set(), ""),
+    "misfire": ({"misfire": 5}, {"image_006"}, "misfired"),
+    "swap": ({"swap": (3, 20)}, {"image_004", "image_021"}, "wrong light"),
+    "moved": ({"move": (33, 3, 2)}, {"image_034", "image_035", "image_036"}, "moved"),
+    "saturated": ({"saturate": 12}, {"image_013"}, "saturated"),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_qa_flags_each_fault_by_name(tmp_path: Path, case: str) -> None:
+    kwargs, expected, word = CASES[case]
+    session, _, _ = make_session(tmp_path / "s", **kwargs)
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    qa = json.loads((out / "qa.json").read_text())
+    assert set(qa["reshoot"]) == expected, qa["verdict"]
+    if not expected:
+        assert qa["verdict"] == "good" and "QA verdict: good" in r.output
+    else:
+        assert word in qa["verdict"]
+    assert (out / "qa.html").read_text().count("<tr") == len(qa["images"]) + 1
+
+
+def test_fit_refuses_a_missing_source_and_an_unknown_model(tmp_path: Path, clean) -> None:
+    r = runner.invoke(app, ["fit", str(tmp_path / "nope"), "--out", str(tmp_path / "o")])
+    assert r.exit_code == 2 and "session folder or an .lp" in r.output
+    r = runner.invoke(app, ["fit", str(clean[0]), "--out", str(tmp_path / "o"), "--model", "x"])
+    assert r.exit_code == 2 and "unknown model" in r.output
+
+
+def test_run_prints_the_verdict_unless_told_not_to(tmp_path: Path) -> None:
+    cfg = Path(__file__).parents[1] / "rig_configs" / "simulated_dome.toml"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "a"), "--lights", "12"])
+    assert r.exit_code == 0, r.output
+    assert "QA verdict:" in r.output
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(tmp_path / "b"), "--lights", "12", "--no-verdict"]
+    )
+    assert r.exit_code == 0 and "QA verdict" not in r.output
+
+
+def test_fit_from_a_bare_lp_with_its_images_beside_it(clean, tmp_path: Path) -> None:
+    import shutil
+
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+    session, _, truth = clean
+    folder = tmp_path / "bare"
+    folder.mkdir()
+    entries = []
+    for e in read_lp(session / "lights.lp"):
+        name = Path(e.name).stem + ".tif"
+        shutil.copy(session / "linear" / name, folder / name)
+        entries.append(LpEntry(name, e.direction))
+    write_lp(folder / "my_dome.lp", entries)
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(folder / "my_dome.lp"), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert float(np.median(_angles(np.load(out / "normals.npy"), truth))) < 3.0
+
+
+def test_batch_fit_is_resumable(clean, tmp_path: Path) -> None:
+    import shutil
+
+    session = clean[0]
+    second = tmp_path / "second"
+    shutil.copytree(session, second)
+    out = tmp_path / "batch"
+    # a killed earlier run left a partial folder for the second session
+    (out / ".second.partial").mkdir(parents=True)
+    (out / ".second.partial" / "junk").write_text("x")
+    args = ["fit", str(session), str(second), "--out", str(out), "--model", "ps", "--no-qa"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    assert r.output.count(": done") == 2
+    assert (out / session.name / "normals.npy").is_file()
+    assert (out / "second" / "fit.json").is_file() and not (out / "second" / "junk").exists()
+    assert not (out / ".second.partial").exists()
+    first = np.load(out / "second" / "normals.npy")
+    np.testing.assert_array_equal(first, np.load(out / session.name / "normals.npy"))
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0 and r.output.count("(finished earlier)") == 2
