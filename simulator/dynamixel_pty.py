@@ -206,12 +206,39 @@ class EmulatedLinkPortHandler(_port_handler_class()):  # type: ignore[misc]
                     ledger.held.clear()
                     self._server.send(data)
 
+    def closePort(self) -> None:
+        """Close after the link has settled: statuses the host never read are lost with the
+        port, as on a real adapter (they would have arrived within 0.5 ms, before any reopen)."""
+        if self.is_open and self.ser is not None:
+            self._settle()
+        super().closePort()
+
+    def _settle(self) -> None:
+        """Wait until the emulator has handled every byte sent, drop what it holds, and
+        discard what reached the port unread (bounded by :data:`LOST_LINK_S`)."""
+        ledger = self._ledger
+        deadline = time.monotonic() + LOST_LINK_S
+        while time.monotonic() < deadline:
+            with ledger.lock:
+                if ledger.device_read >= ledger.host_sent:
+                    ledger.held.clear()
+                    if ledger.host_got >= ledger.device_sent:
+                        ledger.listening = False
+                        return
+            waiting = self.ser.in_waiting
+            if waiting:
+                data = self.ser.read(waiting)
+                with ledger.lock:
+                    ledger.host_got += len(data)
+            else:
+                select.select([self.ser.fileno()], [], [], HOST_WAIT_S)
+
     def setupPort(self, cflag_baud: Any) -> bool:
-        ok = super().setupPort(cflag_baud)  # flushes the input buffer: start from a clean slate
+        ok = super().setupPort(cflag_baud)  # closes (settled) if open; flushes the input
         ledger = self._ledger
         with ledger.lock:
             ledger.held.clear()
-            ledger.host_got = ledger.device_sent
+            ledger.host_got = max(ledger.host_got, ledger.device_sent)
             ledger.listening = False
         return ok
 

@@ -196,6 +196,7 @@ def test_check_command_on_the_shipped_arm_configs(config: str, tmp_path: Path) -
     assert r.output.count(" ok\n") == 8
 
 
+@pytest.mark.e2e
 def test_check_command_fails_on_a_missing_config(tmp_path: Path) -> None:
     r = runner.invoke(app, ["check", str(tmp_path / "nope.toml")])
     assert r.exit_code != 0

@@ -25,7 +25,10 @@ from rti_rig.core.clock import SystemClock, VirtualClock
 from rti_rig.core.errors import DeviceError
 from rti_rig.runtime.dome_policy import DomeLedError, DomeLinkError, self_test
 
-pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
 
 PROFILES = ["default", "framed", "binary"]
 N_LEDS = 5

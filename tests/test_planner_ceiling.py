@@ -160,6 +160,7 @@ def test_report_and_provenance_record_the_ceiling() -> None:
     assert not any("elevation (none near" in line for line in full.lines())
 
 
+@pytest.mark.e2e
 def test_plan_cli_keeps_the_plan_below_the_ceiling_and_draws_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -258,6 +259,7 @@ def test_homogeneous_schedule_under_a_ceiling(geometry) -> None:
     assert sched.provenance["max_elevation_deg"] == 45.0
 
 
+@pytest.mark.e2e
 def test_run_cli_runs_the_homogeneous_layout_under_the_ceiling(tmp_path: Path) -> None:
     import json
 
