@@ -3,9 +3,9 @@
 Why: no test and no dry run may depend on CPU load (emulators on a pty are threads of the host's
 process and must not race it). This is the evidence behind docs/reliability.md::
 
-    python benchmarks/load_soak.py --hogs 2 --runs 20 -- .venv/bin/rti-rig check rig_configs/simulated_arm.toml
     python benchmarks/load_soak.py --hogs 2 --runs 20 --configs
-    python benchmarks/load_soak.py --hogs 2 --runs 20 -- .venv/bin/python -m pytest -q -p no:cacheprovider -m pty
+    python benchmarks/load_soak.py --hogs 2 --runs 20 -- \
+        .venv/bin/python -m pytest -q -p no:cacheprovider -m pty
 
 ``--configs`` runs ``rti-rig check`` on every simulated and emulated config in rig_configs/.
 A run passes when its exit code is 0. The hogs (``while True: pass``) are this script's own

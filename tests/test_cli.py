@@ -44,6 +44,7 @@ def brightest_azimuth_deg(lum: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(y, x)) % 360)
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_readme_first_command_dry_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     args = readme_run_args()
@@ -351,6 +352,7 @@ def test_plan_optimal_without_a_preview(tmp_path: Path) -> None:
     assert not (tmp_path / "x.lp").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_plan_signal_noise(tmp_path: Path) -> None:
     """--signal-noise reaches the planner (its report line is printed) and bad values are
@@ -375,6 +377,7 @@ def _rig_with_signal_noise(tmp_path: Path, value: str) -> Path:
     return rig
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
     """A rig declares its images' signal-proportional noise once ([camera] signal_noise); the
@@ -427,6 +430,7 @@ def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
     assert lp.read_text() == calibration
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_plan_orders_an_arm_by_move_time_with_its_servo_settings(tmp_path: Path) -> None:
     """``rti-rig plan`` on an arm with ``[arm.dynamixel]`` fires its stops in the move-time

@@ -130,6 +130,7 @@ def test_map_file_types(tmp_path: Path) -> None:
     assert path.read_text().lstrip().startswith("<?xml")
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_plan_cli_writes_the_map_and_never_overwrites_unasked(tmp_path: Path) -> None:
     rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"

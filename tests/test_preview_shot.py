@@ -173,6 +173,7 @@ def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
     assert "az 135.0°, el 50.0° (given)" in r.output
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_plan_uses_the_recorded_light_unless_one_is_given(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)

@@ -59,6 +59,7 @@ def child(stage: str, k: int, cfg: Path, out: Path) -> subprocess.Popen:
     return popen_session(stage, k, cfg, out, LIGHTS)
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 @pytest.mark.parametrize(
     ("stage", "recovered"),
@@ -94,6 +95,7 @@ def test_sigkill_at_every_stage_then_resume(
     assert [run.get("finish_reason") for run in m["runs"]] == ["crashed", "completed"]
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_sigterm_is_an_emergency_stop_that_can_be_resumed(
     tmp_path: Path, reference: tuple[Path, Path]
@@ -224,6 +226,7 @@ def test_wrong_light_oracle_catches_a_swapped_record(
     assert wrong_light_steps(cfg, bad) == [2, 5]
 
 
+@pytest.mark.slow
 @pytest.mark.e2e
 def test_arm_session_killed_mid_move_resumes_identically(
     tmp_path: Path, arm_config_path: Path
