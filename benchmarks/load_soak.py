@@ -32,10 +32,12 @@ def soak(command: list[str], runs: int) -> tuple[int, list[str]]:
         r = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
         if r.returncode == 0:
             passes += 1
-        else:
-            tail = "\n".join((r.stdout + r.stderr).strip().splitlines()[-4:])
-            failures.append(f"run {i + 1}: exit {r.returncode}\n{tail}")
-        print(f"  run {i + 1}/{runs}: {'pass' if r.returncode == 0 else 'FAIL'}", flush=True)
+            print(f"  run {i + 1}/{runs}: pass", flush=True)
+            continue
+        lines = (r.stdout + r.stderr).strip().splitlines()
+        tail = [ln for ln in lines if ln.startswith(("FAILED", "ERROR", "RESULT", "ABORTED"))]
+        failures.append(f"run {i + 1}: exit {r.returncode}\n" + "\n".join(tail or lines[-4:]))
+        print(f"  run {i + 1}/{runs}: FAIL\n" + "\n".join(lines[-40:]), flush=True)
     return passes, failures
 
 

@@ -39,6 +39,7 @@ import time
 import tty
 from typing import Any
 
+import dynamixel_sdk
 from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
 
 #: Wall-time bound on a reply wait that is still *not* causally over (bytes lost in the kernel,
@@ -178,13 +179,7 @@ class PtyServoServer:
         self.stop()
 
 
-def _port_handler_class() -> type:
-    import dynamixel_sdk
-
-    return dynamixel_sdk.PortHandler
-
-
-class EmulatedLinkPortHandler(_port_handler_class()):  # type: ignore[misc]
+class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
     """``dynamixel_sdk.PortHandler`` whose reply timeout is causal, not wall time.
 
     Everything else is the SDK's own (pyserial on the pty, baud checks, packet timing
