@@ -10,8 +10,9 @@ and fault injection: hardware errors (shutdown: torque off, motion frozen), corr
 replies, and silent (disconnected) servos.
 
 Deliberate simplifications: a new goal during a move restarts the profile from the present
-position at zero velocity (the firmware blends); no load, current or temperature dynamics;
-Return Delay Time is not waited.
+position at zero velocity (the firmware blends); no load, current or temperature dynamics.
+Return Delay Time is modelled by the pty server (:mod:`rti_rig.simulator.dynamixel_pty`): a
+status reaches the host only once it listens, never in wall time.
 
 Like a real servo, a unicast Action and unicast writes *are* answered; the SDK does not read
 those replies (a pitfall the driver handles). Instruction packets are parsed by length, because
@@ -22,11 +23,8 @@ from __future__ import annotations
 
 import contextlib
 import math
-import os
-import select
 import threading
 import time
-import tty
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -441,7 +439,8 @@ class InProcessPort:
     """A stand-in for ``dynamixel_sdk.PortHandler`` wired straight to an emulator.
 
     Replies are produced synchronously on write, so "no more bytes" means "timed out": silence
-    costs no wall time (unlike a pty, where the SDK busy-waits its ~34 ms timeout)."""
+    costs no wall time. (The pty transport gives the same guarantee with a causal timeout: see
+    :mod:`rti_rig.simulator.dynamixel_pty`.)"""
 
     def __init__(self, emulator: DynamixelBusEmulator, name: str = "inprocess") -> None:
         self.emulator = emulator
@@ -498,74 +497,6 @@ class InProcessPort:
         return not self._rx
 
 
-class PtyServoServer:
-    """Serve an emulator on a pseudo-terminal; ``start()`` returns the device path
-    (e.g. /dev/pts/5) to give to ``dynamixel_sdk.PortHandler``.
-
-    A slave fd stays open for the server's lifetime (otherwise reads fail with EIO whenever the
-    SDK closes its port); ``stop()`` joins the thread within a bounded time.
-
-    ``reply_delay_s`` models the servos' Return Delay Time (default 250 x 2 us = 0.5 ms) in
-    real time: replies then arrive *after* the SDK has returned from a command it did not wait
-    for, which is what makes the unread-status pitfall bite on real hardware."""
-
-    def __init__(
-        self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, reply_delay_s: float = 0.0005
-    ) -> None:
-        self.emulator = emulator
-        self.poll_s = poll_s
-        self.reply_delay_s = reply_delay_s
-        self.device_path: str | None = None
-        self._fds: tuple[int, int] | None = None
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-
-    def start(self) -> str:
-        master, slave = os.openpty()
-        tty.setraw(slave)
-        self._fds = (master, slave)
-        self.device_path = os.ttyname(slave)
-        self._stop.clear()
-        self._thread = threading.Thread(target=self._serve, name="dxl-emulator", daemon=True)
-        self._thread.start()
-        return self.device_path
-
-    def _serve(self) -> None:
-        assert self._fds is not None
-        master = self._fds[0]
-        while not self._stop.is_set():
-            ready, _, _ = select.select([master], [], [], self.poll_s)
-            if not ready:
-                continue
-            try:
-                data = os.read(master, 4096)
-            except OSError:
-                continue
-            reply = self.emulator.receive(data)
-            if reply:
-                if self.reply_delay_s > 0:
-                    time.sleep(self.reply_delay_s)  # emulator thread only; tests never sleep
-                os.write(master, reply)
-
-    def stop(self, timeout_s: float = 1.0) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout_s)
-            self._thread = None
-        if self._fds is not None:
-            for fd in self._fds:
-                with contextlib.suppress(OSError):
-                    os.close(fd)
-            self._fds = None
-
-    def __enter__(self) -> PtyServoServer:
-        self.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-
 def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> DynamixelBusEmulator:
     """Servos matching an ``ArmSettings`` (ids, models, modes), resting at the park pose.
 
@@ -608,8 +539,10 @@ def emulated_arm_port(
 ) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
     """``(port, emulator)`` for a dry run of ``DynamixelArm`` against emulated servos.
 
-    ``transport="pty"``: a real ``dynamixel_sdk.PortHandler`` on a pseudo-terminal served by a
-    thread (the real SDK and pyserial run unchanged); ``"inprocess"``: an :class:`InProcessPort`
+    ``transport="pty"``: the SDK's ``PortHandler`` on a pseudo-terminal served by a thread (the
+    real SDK packet code and pyserial run unchanged; reply timeouts are causal, so a loaded
+    machine cannot make a present servo time out: see :mod:`rti_rig.simulator.dynamixel_pty`);
+    ``"inprocess"``: an :class:`InProcessPort`
     (no thread, no pty; fastest). The server is stopped on exit."""
     emulator = emulator_for_arm(settings, clock)
     if transport == "inprocess":
@@ -617,18 +550,20 @@ def emulated_arm_port(
         return
     if transport != "pty":
         raise ValueError(f"transport must be 'pty' or 'inprocess', not {transport!r}")
-    import dynamixel_sdk
+    from rti_rig.simulator.dynamixel_pty import PtyServoServer
 
     server = PtyServoServer(emulator)
-    path = server.start()
+    server.start()
     try:
-        yield dynamixel_sdk.PortHandler(path), emulator
+        yield server.port_handler(), emulator
     finally:
         server.stop()
 
 
 def main() -> None:  # pragma: no cover - manual tool
     """Serve two XL430s (ids 1, 2) on a pty until Ctrl-C, in real time (SystemClock)."""
+    from rti_rig.simulator.dynamixel_pty import PtyServoServer
+
     from rti_rig.core.clock import SystemClock
 
     clock = SystemClock()

@@ -168,8 +168,7 @@ def test_a_refused_pose_stops_the_test_before_anything_connects() -> None:
 
 def inprocess_arm_config(tmp_path: Path) -> Path:
     """simulated_arm.toml with the servos emulated in-process: the real driver and SDK packet
-    code without a pty thread, whose real-time replies can time out on a loaded CI machine
-    (the pty path has its own tests in test_emulated_arm.py)."""
+    code without a pty thread (the fastest path)."""
     text = (CONFIGS / "simulated_arm.toml").read_text()
     assert 'transport = "pty"' in text
     out = tmp_path / "arm.toml"
@@ -177,16 +176,27 @@ def inprocess_arm_config(tmp_path: Path) -> Path:
     return out
 
 
-@pytest.mark.parametrize("config", ["virtual_arm.toml", "simulated_arm.toml"])
+@pytest.mark.e2e
+@pytest.mark.parametrize(
+    "config",
+    [
+        "virtual_arm.toml",
+        pytest.param("simulated_arm.toml", marks=pytest.mark.pty),
+        "simulated_arm.toml (inprocess)",
+    ],
+)
 def test_check_command_on_the_shipped_arm_configs(config: str, tmp_path: Path) -> None:
-    """The pure simulated arm and the emulated Dynamixel arm (real driver) both pass."""
-    path = CONFIGS / config if config == "virtual_arm.toml" else inprocess_arm_config(tmp_path)
+    """The pure simulated arm and the emulated Dynamixel arm (real driver and SDK, on the pty
+    as shipped and in-process) all pass."""
+    path = inprocess_arm_config(tmp_path) if "inprocess" in config else CONFIGS / config
     r = runner.invoke(app, ["check", str(path)])
     assert r.exit_code == 0, r.output
     assert "RESULT: PASS" in r.output
     assert "8 poses" in r.output and "\nparked\n" in r.output and "NOT parked" not in r.output
+    assert r.output.count(" ok\n") == 8
 
 
+@pytest.mark.e2e
 def test_check_command_fails_on_a_missing_config(tmp_path: Path) -> None:
     r = runner.invoke(app, ["check", str(tmp_path / "nope.toml")])
     assert r.exit_code != 0

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dynamixel_sdk as sdk
 import numpy as np
 import pytest
 from pydantic import ValidationError
@@ -15,16 +14,14 @@ from rti_rig.drivers.dynamixel.faults import (
     SafetyViolation,
     UnreachableError,
 )
-from rti_rig.simulator.dynamixel_emulator import InProcessPort, PtyServoServer, emulator_for_arm
+from rti_rig.simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
+from rti_rig.simulator.dynamixel_pty import PtyServoServer
 
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.devices import LightCarrier
 from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
-from tests.test_dxl_support import (
-    arm_settings,
-    wide_sdk_timeouts,  # noqa: F401  (fixture)
-)
+from tests.test_dxl_support import arm_settings
 
 
 def make_arm(**overrides):
@@ -184,7 +181,7 @@ def test_settings_errors_name_the_problem() -> None:
         arm_settings(azimuth=dict(model_number=12))
 
 
-@pytest.mark.usefixtures("wide_sdk_timeouts")
+@pytest.mark.pty
 def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
     settings = arm_settings(
         azimuth=dict(operating_mode="extended_position", min_deg=-360.0, max_deg=360.0)
@@ -192,7 +189,7 @@ def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
     clock = VirtualClock()
     emu = emulator_for_arm(settings, clock)
     with PtyServoServer(emu) as server:
-        arm = DynamixelArm(settings, sdk.PortHandler(server.device_path), clock)
+        arm = DynamixelArm(settings, server.port_handler(), clock)
         with arm:
             reached = [arm.move_to(direction_from_az_el(az, 30)) for az in (170, -170, 10)]
         # multi-turn: 170 -> -170 deg goes the short way, through 180 (joint 190 deg)
@@ -204,8 +201,7 @@ def test_dry_run_with_the_real_sdk_over_a_pty() -> None:
     assert np.isfinite(clock.now())
 
 
-@pytest.mark.usefixtures("wide_sdk_timeouts")
-@pytest.mark.parametrize("transport", ["pty", "inprocess"])
+@pytest.mark.parametrize("transport", [pytest.param("pty", marks=pytest.mark.pty), "inprocess"])
 def test_emulated_arm_port_dry_run(transport: str) -> None:
     from rti_rig.simulator.dynamixel_emulator import emulated_arm_port
 

@@ -60,6 +60,7 @@ def test_held_karp_equals_brute_force(n: int, seed: int) -> None:
     assert path_time_s(order, cost) == pytest.approx(best)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(6))
 def test_heuristic_is_within_3_percent_of_optimal(seed: int) -> None:
     rng = np.random.default_rng(seed)
@@ -73,6 +74,7 @@ def test_heuristic_is_within_3_percent_of_optimal(seed: int) -> None:
     assert heur <= 1.03 * exact
 
 
+@pytest.mark.slow
 def test_order_for_arm_beats_plan_order_and_is_a_permutation() -> None:
     rng = np.random.default_rng(7)
     s = arm_settings()
@@ -102,6 +104,7 @@ def test_sequence_time_follows_multi_turn_choices() -> None:
     assert m[1, 2] == pytest.approx(t(340.0))
 
 
+@pytest.mark.slow
 def test_multi_turn_ordering_uses_the_short_way_when_it_helps() -> None:
     from rti_rig.core.arm_motion import sequence_time_s
 

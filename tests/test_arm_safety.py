@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
@@ -109,6 +110,7 @@ def schedules(cfg: ArmSettings):
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(cfg=arm_configs(), data=st.data())
+@pytest.mark.slow
 def test_no_unsafe_goal_ever_reaches_the_bus(cfg: ArmSettings, data) -> None:
     schedule = data.draw(schedules(cfg))
     clock = VirtualClock()

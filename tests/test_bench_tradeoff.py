@@ -36,6 +36,7 @@ def rows():  # type: ignore[no-untyped-def]
     return run_scene(data, TINY, progress=lambda _m: None)
 
 
+@pytest.mark.slow
 def test_every_plan_is_scored_and_timed(rows) -> None:  # type: ignore[no-untyped-def]
     kinds = {(r.method, r.objective, r.floor_deg) for r in rows}
     assert ("kmeans", "normals", 0.0) in kinds and ("optimal", "relight", 0.0) in kinds
@@ -66,6 +67,7 @@ def test_scores_see_a_bad_plan() -> None:
     assert bad[0] > 3 * good[0]
 
 
+@pytest.mark.slow
 def test_outputs(rows, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     csv_path = write_csv(rows, tmp_path / "results.csv")
     assert csv_path.read_text().count("\n") == len(rows) + 1

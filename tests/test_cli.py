@@ -44,6 +44,8 @@ def brightest_azimuth_deg(lum: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(y, x)) % 360)
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_readme_first_command_dry_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     args = readme_run_args()
     assert args[0] == "run" and args[1] == "rig_configs/simulated_dome.toml"
@@ -82,6 +84,7 @@ def test_readme_first_command_dry_run(tmp_path: Path, monkeypatch: pytest.Monkey
     assert checked == 24
 
 
+@pytest.mark.e2e
 def test_plan_then_run_then_export(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     plan = tmp_path / "plan.lp"
@@ -106,6 +109,7 @@ def test_plan_then_run_then_export(tmp_path: Path) -> None:
     assert read_lp(lin)[0].name == "linear/image_001.tif"
 
 
+@pytest.mark.e2e
 def test_plan_on_bare_lp_keeps_original_names(tmp_path: Path) -> None:
     src = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
     plan = tmp_path / "p.lp"
@@ -118,6 +122,7 @@ def test_plan_on_bare_lp_keeps_original_names(tmp_path: Path) -> None:
         np.testing.assert_allclose(e.direction, originals[e.name], atol=1e-6)
 
 
+@pytest.mark.e2e
 @pytest.mark.parametrize(
     ("args", "fragment"),
     [
@@ -151,6 +156,7 @@ def test_errors_are_one_clear_line(tmp_path: Path, args: list[str], fragment: st
     assert not (tmp_path / "s").exists() and not (tmp_path / "p.lp").exists()
 
 
+@pytest.mark.e2e
 def test_outputs_are_checked_before_work_and_inputs_never_replaced(tmp_path: Path) -> None:
     """A plan or .lp goes to a file in an existing folder; no input and no session file is
     ever replaced, even with --force."""
@@ -194,6 +200,7 @@ def test_outputs_are_checked_before_work_and_inputs_never_replaced(tmp_path: Pat
     assert read_lp(session / "linear.lp")[0].name == "linear/image_001.tif"
 
 
+@pytest.mark.e2e
 def test_plan_from_another_dome_is_refused(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     plan = tmp_path / "p.lp"
@@ -204,6 +211,7 @@ def test_plan_from_another_dome_is_refused(tmp_path: Path) -> None:
     assert not (tmp_path / "s").exists()
 
 
+@pytest.mark.e2e
 def test_help_explains_commands() -> None:
     r = runner.invoke(app, ["--help"])
     assert r.exit_code == 0
@@ -221,6 +229,7 @@ def test_ci_runs_the_readme_test_command() -> None:
     assert commands[0].replace(" || exit 1", "") in ci
 
 
+@pytest.mark.e2e
 @pytest.mark.parametrize("method", ["optimal", "kmeans"])
 def test_plan_from_a_real_preview_on_a_bare_lp(tmp_path: Path, method: str) -> None:
     """The issue's CLI contract on real data: a preview of the 72-LED dome, its own .lp."""
@@ -252,6 +261,7 @@ def test_plan_from_a_real_preview_on_a_bare_lp(tmp_path: Path, method: str) -> N
     assert f"method {method}" in r.output
 
 
+@pytest.mark.e2e
 def test_preview_shot_then_plan_then_run(tmp_path: Path) -> None:
     """The product's loop: one preview shot on the rig, a plan from it, the session."""
     cfg = write_config(tmp_path, SMALL_DOME)
@@ -311,6 +321,7 @@ def test_plan_option_errors(tmp_path: Path, extra: list[str], fragment: str) -> 
     assert r.exit_code == 2 and "give PREVIEW" in r.output
 
 
+@pytest.mark.e2e
 def test_plan_optimal_without_a_preview(tmp_path: Path) -> None:
     """`optimal` needs no preview: it plans for a level, matte surface and says so."""
     rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
@@ -341,6 +352,8 @@ def test_plan_optimal_without_a_preview(tmp_path: Path) -> None:
     assert not (tmp_path / "x.lp").exists()
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_plan_signal_noise(tmp_path: Path) -> None:
     """--signal-noise reaches the planner (its report line is printed) and bad values are
     refused before anything is written."""
@@ -364,6 +377,8 @@ def _rig_with_signal_noise(tmp_path: Path, value: str) -> Path:
     return rig
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
     """A rig declares its images' signal-proportional noise once ([camera] signal_noise); the
     flag overrides it; an objective that cannot model it is refused, naming the file."""
@@ -388,6 +403,7 @@ def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
     assert r.exit_code == 2 and "signal_noise" in flat and "jpeg_dome.toml" in flat
 
 
+@pytest.mark.e2e
 def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
     """Not even a captured image in a session's subfolder, nor the dome's LED calibration."""
     cfg = write_config(tmp_path, SMALL_DOME)
@@ -414,6 +430,8 @@ def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
     assert lp.read_text() == calibration
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_plan_orders_an_arm_by_move_time_with_its_servo_settings(tmp_path: Path) -> None:
     """``rti-rig plan`` on an arm with ``[arm.dynamixel]`` fires its stops in the move-time
     order of ``rti_rig.planner.arm_order`` (the issue's "move-time order for arms"), which here is

@@ -1,8 +1,12 @@
 """The real driver and real pyserial against the firmware emulator on a pseudo-terminal.
 
 The policy runs on a VirtualClock (back-offs and cool-downs cost no real time); replies and
-timeouts are real but short (0.3 s: generous on a loaded machine, where the emulator thread may
-wait for a CPU), so each fault costs well under a second.
+timeouts are real (the firmware emulator runs on the system clock). Its margins are wide enough
+that scheduling cannot exhaust them in practice: a 1.5 s reply timeout, a 0.3 s boot (a command
+sent right after a reset lands while the board boots), late replies 3 s late. With 0.3 s / 20 ms
+/ 0.6 s, these tests failed about 1 run in 6 beside two CPU hogs on a loaded 2-core machine (a
+reply later than 0.3 s; a command reaching the board after its 20 ms boot). A fault that waits
+for the timeout costs 1.5 s of wall time.
 """
 
 from __future__ import annotations
@@ -25,19 +29,25 @@ from rti_rig.core.clock import SystemClock, VirtualClock
 from rti_rig.core.errors import DeviceError
 from rti_rig.runtime.dome_policy import DomeLedError, DomeLinkError, self_test
 
-pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
 
 PROFILES = ["default", "framed", "binary"]
 N_LEDS = 5
 LIGHT_1 = 5  # commands: 1 handshake, 2 all off, then light(i) = 3 + 2i, all off = 4 + 2i
 OFF_AFTER_1 = 6
+REPLY_TIMEOUT_S = 1.5  # a reply later than this is lost or late
+BOOT_S = 0.3  # the board's boot after a reset, before its banner
+LATE_S = 2 * REPLY_TIMEOUT_S  # how late a DELAY_REPLY fault's reply comes
 
 
 def settings(profile, **kw):
     base = {
         "port": "set-later",
-        "reply_timeout_s": 0.3,
-        "ready_timeout_s": 0.5,
+        "reply_timeout_s": REPLY_TIMEOUT_S,
+        "ready_timeout_s": 3.0,
         "reconnect_backoff_s": 0.0,
     }
     base.update(kw)
@@ -51,7 +61,7 @@ def run_on_pty(profile, faults=(), dead=(), **kw):
         s,
         clock=SystemClock(),
         led_count=N_LEDS,
-        boot_delay_s=0.02,
+        boot_delay_s=BOOT_S,
         dead_leds=frozenset(dead),
         faults=FaultPlan(tuple(faults)),
     )
@@ -92,10 +102,11 @@ RECOVERABLE = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("profile", PROFILES)
 @pytest.mark.parametrize("kind", RECOVERABLE)
 def test_each_fault_while_lighting_recovers_with_the_right_led(profile, kind):
-    delay = 0.0 if kind is FaultKind.DISCONNECT else 0.6
+    delay = 0.0 if kind is FaultKind.DISCONNECT else LATE_S
     fw, pty, s = run_on_pty(profile, [Fault(LIGHT_1, kind, delay_s=delay)])
     with pty as link:
         dome = build_dome(s.model_copy(update={"port": link.port}), VirtualClock())
@@ -197,6 +208,7 @@ def test_loop_url_transport_opens_without_a_lock():
         dome.connect()
 
 
+@pytest.mark.slow
 def test_dry_run_against_the_emulator_in_another_process():
     """``python -m rti_rig.simulator.dome_firmware`` serves a dome any program can open by path."""
     import subprocess

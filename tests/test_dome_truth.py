@@ -8,6 +8,7 @@ capture must have been taken under exactly the LED asked for, at the level asked
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from rti_rig.drivers.led_dome import DomeSerialSettings
@@ -43,6 +44,7 @@ fault_plans = st.lists(
     dead=st.sets(st.integers(0, N_LEDS - 1), max_size=2),
     confirm=st.booleans(),
 )
+@pytest.mark.slow
 def test_no_capture_is_recorded_under_a_wrong_light(profile, faults, dead, confirm):
     clock = VirtualClock()
     extra = {"framed": {"sequence": False, "index_base": 1}} if profile == "framed-noseq" else {}

@@ -30,6 +30,9 @@ def small_arm(tmp_path: Path, transport: str = "pty") -> Path:
     return write_config(tmp_path, text.replace('transport = "pty"', f'transport = "{transport}"'))
 
 
+@pytest.mark.slow
+@pytest.mark.pty
+@pytest.mark.e2e
 def test_cli_dry_run_through_the_real_sdk_on_a_pty(tmp_path: Path) -> None:
     cfg = small_arm(tmp_path)
     out = tmp_path / "s"

@@ -34,6 +34,8 @@ def said(result) -> str:  # type: ignore[no-untyped-def]
     return " ".join(result.output.split())
 
 
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_cli_dry_run_through_the_emulated_dome(tmp_path: Path) -> None:
     cfg = small_emulated(tmp_path)
     out = tmp_path / "s"
@@ -47,6 +49,7 @@ def test_cli_dry_run_through_the_emulated_dome(tmp_path: Path) -> None:
     assert manifest["rig"]["backend"] == "emulated"
 
 
+@pytest.mark.pty
 def test_firmware_really_lit_each_recorded_led(tmp_path: Path) -> None:
     loaded = load_rig_config(small_emulated(tmp_path))
     from rti_rig.planner.uniform import plan_uniform
@@ -68,6 +71,8 @@ def test_firmware_really_lit_each_recorded_led(tmp_path: Path) -> None:
         assert fw.lit is None  # all off after the session
 
 
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_check_passes_and_names_a_dead_led(tmp_path: Path) -> None:
     r = runner.invoke(app, ["check", str(small_emulated(tmp_path))])
     assert r.exit_code == 0, r.output
@@ -78,6 +83,7 @@ def test_check_passes_and_names_a_dead_led(tmp_path: Path) -> None:
     assert "LED 5" in said(r)
 
 
+@pytest.mark.pty
 def test_dead_led_stops_the_session_naming_it(tmp_path: Path) -> None:
     cfg = small_emulated(tmp_path, "\n[emulator]\ndead_leds = [3]\n")
     loaded = load_rig_config(cfg)

@@ -18,6 +18,7 @@ from rti_rig.runtime.exposure_policy import brightest_step, fix_session_exposure
 runner = CliRunner()
 
 
+@pytest.mark.e2e
 @pytest.mark.parametrize("exposure", ["0.05", "0.8"])  # sensible, and four stops too long
 def test_auto_exposure_keeps_the_session_under_the_saturation_limit(
     tmp_path: Path, exposure: str

@@ -54,6 +54,9 @@ def relative(values: np.ndarray) -> np.ndarray:
     return values / np.exp(np.median(np.log(values)))
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_calibration_evens_out_the_dome(tmp_path: Path) -> None:
     cfg = card_rig(tmp_path)
     shoot(cfg, tmp_path / "card1")
@@ -164,6 +167,9 @@ def edit_manifest(folder: Path, change) -> None:  # type: ignore[no-untyped-def]
     path.write_text(json.dumps(data))
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_card_sessions_that_cannot_calibrate_are_refused_by_name(tmp_path: Path) -> None:
     cfg = card_rig(tmp_path)
     shoot(cfg, tmp_path / "card")
@@ -192,6 +198,9 @@ def test_card_sessions_that_cannot_calibrate_are_refused_by_name(tmp_path: Path)
         read_card_session(tmp_path / "card")
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_simulated_arm_and_missing_images_are_refused(tmp_path: Path) -> None:
     arm = tmp_path / "arm"
     r = runner.invoke(
@@ -207,6 +216,9 @@ def test_simulated_arm_and_missing_images_are_refused(tmp_path: Path) -> None:
         read_card_session(tmp_path / "card")
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_cli_refusals_name_what_is_wrong(tmp_path: Path) -> None:
     cfg = card_rig(tmp_path)
     card = tmp_path / "card"
@@ -285,6 +297,9 @@ def test_uneven_led_settings_are_checked(tmp_path: Path, emulator: str, fragment
         load_rig_config(write_config(tmp_path, sim, "s.toml"))
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_the_shipped_rehearsal_config_runs_as_its_comments_say(tmp_path: Path) -> None:
     """rig_configs/emulated_dome_card.toml: shoot, calibrate, add the line, shoot again."""
     text = (CONFIGS / "emulated_dome_card.toml").read_text()
@@ -304,6 +319,9 @@ def test_the_shipped_rehearsal_config_runs_as_its_comments_say(tmp_path: Path) -
     assert calibrate_dome(read_card_session(tmp_path / "sessions" / "card2"), 48).shot_spread < 0.01
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_resumed_unfinished_or_malformed_card_sessions_are_refused(tmp_path: Path) -> None:
     cfg = card_rig(tmp_path)
     card = tmp_path / "card"
@@ -331,6 +349,9 @@ def test_resumed_unfinished_or_malformed_card_sessions_are_refused(tmp_path: Pat
     refused(lambda m: m.update(rig=[]), "does not describe a card session")
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_a_step_shot_at_another_exposure_is_scaled_by_it(tmp_path: Path) -> None:
     cfg = card_rig(tmp_path)
     card = tmp_path / "card"

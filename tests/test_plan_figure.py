@@ -130,6 +130,8 @@ def test_map_file_types(tmp_path: Path) -> None:
     assert path.read_text().lstrip().startswith("<?xml")
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_plan_cli_writes_the_map_and_never_overwrites_unasked(tmp_path: Path) -> None:
     rig = REPO / "tests" / "data" / "neuralrti" / "dirs.lp"
     base = ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "9"]
@@ -158,6 +160,7 @@ def test_plan_cli_writes_the_map_and_never_overwrites_unasked(tmp_path: Path) ->
         assert not out.exists()
 
 
+@pytest.mark.e2e
 def test_plan_cli_map_shows_the_lights_of_the_plan_file_in_its_order(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -195,6 +198,7 @@ def test_plan_cli_map_shows_the_lights_of_the_plan_file_in_its_order(
     np.testing.assert_allclose(star.get_offsets(), [[np.radians(120.0), 50.0]], atol=1e-6)
 
 
+@pytest.mark.e2e
 def test_plan_cli_map_failure_keeps_the_plan_and_its_report(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -37,6 +37,7 @@ def _elevations(sched) -> np.ndarray:
     return np.array([s.elevation_deg for s in sched.steps])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["uniform", "kmeans", "optimal"])
 @pytest.mark.parametrize("geometry", [DOME, ARM], ids=["dome", "arm"])
 def test_every_light_stays_between_floor_and_ceiling(method: str, geometry) -> None:
@@ -135,6 +136,7 @@ def test_relight_objective_scores_relighting_above_the_ceiling_too(
     assert held_el.max() > 75.0
 
 
+@pytest.mark.slow
 def test_report_shows_the_ceiling_only_where_it_cuts() -> None:
     """An arm that cannot reach 85° is not "kept below 85°" by a ceiling there."""
     _, report = plan_with_report(None, ARM, 6, "optimal", max_elevation_deg=85.0)
@@ -160,6 +162,7 @@ def test_report_and_provenance_record_the_ceiling() -> None:
     assert not any("elevation (none near" in line for line in full.lines())
 
 
+@pytest.mark.e2e
 def test_plan_cli_keeps_the_plan_below_the_ceiling_and_draws_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -258,6 +261,8 @@ def test_homogeneous_schedule_under_a_ceiling(geometry) -> None:
     assert sched.provenance["max_elevation_deg"] == 45.0
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_run_cli_runs_the_homogeneous_layout_under_the_ceiling(tmp_path: Path) -> None:
     import json
 

@@ -81,6 +81,7 @@ def test_uniform_without_preview_matches_the_baseline() -> None:
         make_plan(None, DOME, 12, "kmeans")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("objective", ["normals", "relight"])
 @pytest.mark.parametrize(("n", "geometry"), [(6, DOME), (12, DOME), (9, ARM)])
 def test_optimal_without_preview_plans_for_a_level_matte_surface(
@@ -273,6 +274,7 @@ def _mean_elevation(schedule) -> float:
     return float(np.degrees(np.arcsin(np.clip(d[:, 2], -1, 1))).mean())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preview", [None, PREVIEW])
 def test_signal_noise_takes_more_oblique_lights(preview: np.ndarray | None) -> None:
     """Noise that grows with n·l makes head-on light worth less: on the real dome's 72 LEDs the
@@ -312,6 +314,7 @@ def test_relight_plans_carry_the_evidence_against_them() -> None:
         assert not any("tested choice" in line for line in rep.lines())
 
 
+@pytest.mark.slow
 def test_many_light_normals_plans_carry_the_evidence_of_small_gains() -> None:
     """From 12 lights up the benchmarks found the optimal plan's gain small and object-dependent
     (it lost on brushed steel at 20 and 30): the report says so once, with or without a preview,
@@ -342,6 +345,7 @@ def test_many_light_normals_plans_carry_the_evidence_of_small_gains() -> None:
     assert not notes(PREVIEW, small, 12, "optimal", "normals", (30.0, 50.0))
 
 
+@pytest.mark.slow
 def test_signal_noise_is_reported_only_where_it_was_modelled() -> None:
     """Without a preview `uniform` builds no objective: the report must not claim the noise was
     modelled. With a preview it is, but only in the expected errors: the report says so, and the

@@ -150,6 +150,7 @@ def test_material_is_checked_and_reported_when_unused() -> None:
     assert any("changes only the expected errors" in n for n in report.notes)
 
 
+@pytest.mark.e2e
 def test_cli_material(tmp_path: Path) -> None:
     """--material reaches the planner (its note is printed); a bad value is refused before
     anything is written."""

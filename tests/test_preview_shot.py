@@ -96,6 +96,7 @@ def test_light_comes_from_the_rig_lp_listing_the_image_and_no_other_lp(tmp_path:
         resolve_preview(img, (dome, read_lp(dome)))
 
 
+@pytest.mark.e2e
 def test_a_plan_beside_the_preview_is_never_read_as_its_light(tmp_path: Path) -> None:
     """A plan's entries are named like a session's images: planning twice from image_001.jpg
     with --out plan.lp beside it must not take a planned light as the preview's."""
@@ -112,6 +113,7 @@ def test_a_plan_beside_the_preview_is_never_read_as_its_light(tmp_path: Path) ->
     assert read_lp(plan)[0].name == "image_001.jpg"  # the trap was armed
 
 
+@pytest.mark.e2e
 def test_session_folders_as_previews(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     one = tmp_path / "one"
@@ -126,6 +128,7 @@ def test_session_folders_as_previews(tmp_path: Path) -> None:
         resolve_preview(tmp_path)
 
 
+@pytest.mark.e2e
 def test_images_of_a_session_take_their_step_s_light(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     many = tmp_path / "many"
@@ -151,6 +154,7 @@ def test_images_of_a_session_take_their_step_s_light(tmp_path: Path) -> None:
         resolve_preview(many / "image_003.jpg", (dome, read_lp(dome)))
 
 
+@pytest.mark.e2e
 def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     shot = tmp_path / "shot"
@@ -169,6 +173,8 @@ def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
     assert "az 135.0°, el 50.0° (given)" in r.output
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_plan_uses_the_recorded_light_unless_one_is_given(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     shot = tmp_path / "shot"
@@ -187,6 +193,7 @@ def test_plan_uses_the_recorded_light_unless_one_is_given(tmp_path: Path) -> Non
     assert r.exit_code == 0 and "az 300.0°, el 25.0° (given)" in r.output
 
 
+@pytest.mark.e2e
 def test_preview_refuses_before_anything_moves(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

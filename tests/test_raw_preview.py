@@ -63,6 +63,7 @@ def test_a_raw_preview_decodes_to_the_planning_image_of_its_linear_data(tmp_path
     assert abs(np.corrcoef(from_raw.ravel(), from_tif.ravel())[0, 1] - 1) < 1e-3
 
 
+@pytest.mark.slow
 def test_plan_takes_a_raw_preview_and_refuses_a_broken_one_by_name(tmp_path: Path) -> None:
     """The same lights as from the scene's linear TIFF; a file LibRaw cannot read is refused,
     named, with what to give instead, and no plan is written."""

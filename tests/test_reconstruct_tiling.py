@@ -81,6 +81,7 @@ def test_images_must_be_finite_and_consistent() -> None:
         ImageStack(np.ones((4, 4)))
 
 
+@pytest.mark.slow
 def test_robust_photometric_stereo_peak_memory_is_bounded_by_the_band() -> None:
     n, h, w = 40, 256, 256
     frames = [np.full((h, w), 1000 + 10 * i, dtype=np.uint16) for i in range(n)]

@@ -59,6 +59,8 @@ def child(stage: str, k: int, cfg: Path, out: Path) -> subprocess.Popen:
     return popen_session(stage, k, cfg, out, LIGHTS)
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 @pytest.mark.parametrize(
     ("stage", "recovered"),
     [
@@ -93,6 +95,8 @@ def test_sigkill_at_every_stage_then_resume(
     assert [run.get("finish_reason") for run in m["runs"]] == ["crashed", "completed"]
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_sigterm_is_an_emergency_stop_that_can_be_resumed(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:
@@ -118,6 +122,7 @@ def test_sigterm_is_an_emergency_stop_that_can_be_resumed(
     assert digests(out) == digests(ref)
 
 
+@pytest.mark.e2e
 def test_cancelled_session_resumes_and_corrupt_files_are_recaptured(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:
@@ -150,6 +155,7 @@ def test_cancelled_session_resumes_and_corrupt_files_are_recaptured(
     assert len(kept) == 1 and kept[0].read_bytes() == bytes(data)  # set aside, never deleted
 
 
+@pytest.mark.e2e
 def test_resume_refuses_what_it_cannot_do(tmp_path: Path, reference: tuple[Path, Path]) -> None:
     _, ref = reference
     r = runner.invoke(app, ["run", "--resume", str(ref)])
@@ -220,6 +226,8 @@ def test_wrong_light_oracle_catches_a_swapped_record(
     assert wrong_light_steps(cfg, bad) == [2, 5]
 
 
+@pytest.mark.slow
+@pytest.mark.e2e
 def test_arm_session_killed_mid_move_resumes_identically(
     tmp_path: Path, arm_config_path: Path
 ) -> None:

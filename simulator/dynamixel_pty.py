@@ -1,0 +1,276 @@
+"""Emulated Dynamixel servos served on a pseudo-terminal, on a link that cannot race the host.
+
+The official SDK decides that a servo is silent when no status packet has arrived within about
+34 ms of *wall* time (``LATENCY_TIMER * 2 + 2`` ms plus the bytes' wire time), measured in a
+busy loop. A real servo answers within its Return Delay Time (500 µs by default) plus the
+packet's wire time, so the window is right for hardware. An emulator on a pty is a thread of the
+host's own process: it must get a CPU *and* the GIL (which the SDK's busy loop holds) within
+that window, so on a loaded machine an emulated servo that is present "times out" — the host and
+the device model race each other in wall time, which no real bus does.
+
+:class:`PtyServoServer` with :meth:`PtyServoServer.port_handler` removes the race instead of
+widening the window. The host side is the SDK's own ``PortHandler`` (real pyserial on the pty,
+the SDK's packet code unchanged) with its clock replaced by causality: a shared
+:class:`LinkLedger` counts the bytes that crossed the pty in each direction, and a reply wait
+ends in ``COMM_RX_TIMEOUT`` exactly when the emulator has taken every byte the host sent, has
+answered all it is going to answer, and the host has consumed every byte answered — when no
+more bytes can come, which is what a timeout on a real bus means. A present servo therefore
+never times out however slow the machine, a silent one times out at once (no busy wait), and
+no test depends on CPU load.
+
+Return Delay Time is modelled causally too: a status packet is put on the wire only once the
+host listens (reads) after sending. That is the worst case of a real host, which sends its next
+instruction well within the 500 µs delay: a status the SDK does not read (unicast ``*TxOnly``
+or Action) therefore always arrives *after* the next instruction's ``clearPort`` and is taken as
+its answer — the SDK pitfall the driver must handle, reproduced every time instead of by luck.
+
+A plain ``dynamixel_sdk.PortHandler`` opened on :attr:`PtyServoServer.device_path` (or any other
+client) still works: without a ledger, replies are written in real time after
+``reply_delay_s``, as before, and the SDK's wall-time timeout applies.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import select
+import threading
+import time
+import tty
+from typing import Any
+
+import dynamixel_sdk
+from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
+
+#: Wall-time bound on a reply wait that is still *not* causally over (bytes lost in the kernel,
+#: a wedged emulator thread): a broken link fails a test in bounded time instead of hanging it.
+#: Never reached while the emulator thread runs, however loaded the machine.
+LOST_LINK_S = 30.0
+
+#: How long the host sleeps (GIL released) between checks while a reply is on its way; it
+#: wakes at once when bytes arrive.
+HOST_WAIT_S = 0.002
+
+
+class LinkLedger:
+    """What has crossed the pty, in bytes, each way; shared by the server and the host's port.
+
+    ``host_sent``: written by the host; ``device_read``: taken *and handled* by the emulator;
+    ``device_sent``: status bytes put on the wire; ``host_got``: consumed by the host (read or
+    discarded by ``clearPort``). ``held``: statuses waiting for the host to listen."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.host_sent = 0
+        self.device_read = 0
+        self.device_sent = 0
+        self.host_got = 0
+        self.listening = False
+        self.held: list[bytes] = []
+
+    def quiet(self) -> bool:
+        """No more bytes can reach the host until it sends again (call with ``lock`` held)."""
+        return (
+            not self.held
+            and self.device_read >= self.host_sent
+            and self.host_got >= self.device_sent
+        )
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        n = os.write(fd, view)
+        view = view[n:]
+
+
+class PtyServoServer:
+    """Serve an emulator on a pseudo-terminal; ``start()`` returns the device path
+    (e.g. /dev/pts/5); :meth:`port_handler` gives the SDK port to use on it.
+
+    A slave fd stays open for the server's lifetime (otherwise reads fail with EIO whenever the
+    SDK closes its port); ``stop()`` joins the thread within a bounded time.
+
+    ``reply_delay_s`` applies only to clients without a ledger (a plain ``PortHandler``): it
+    models the servos' Return Delay Time (default 250 x 2 µs = 0.5 ms) in real time."""
+
+    def __init__(
+        self, emulator: DynamixelBusEmulator, poll_s: float = 0.02, reply_delay_s: float = 0.0005
+    ) -> None:
+        self.emulator = emulator
+        self.poll_s = poll_s
+        self.reply_delay_s = reply_delay_s
+        self.device_path: str | None = None
+        self.ledger: LinkLedger | None = None
+        self._fds: tuple[int, int] | None = None
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self) -> str:
+        master, slave = os.openpty()
+        tty.setraw(slave)
+        self._fds = (master, slave)
+        self.device_path = os.ttyname(slave)
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._serve, name="dxl-emulator", daemon=True)
+        self._thread.start()
+        return self.device_path
+
+    def port_handler(self) -> EmulatedLinkPortHandler:
+        """The SDK's ``PortHandler`` on this pty, with causal reply timeouts (module docstring).
+
+        From the first call on, replies follow the ledger (held until the host listens)."""
+        if self.device_path is None:
+            raise RuntimeError("start() the server before asking for its port")
+        if self.ledger is None:
+            self.ledger = LinkLedger()
+        return EmulatedLinkPortHandler(self.device_path, self)
+
+    def send(self, data: bytes) -> None:
+        """Put status bytes on the wire (call with the ledger's lock held)."""
+        assert self._fds is not None and self.ledger is not None
+        self.ledger.device_sent += len(data)
+        with contextlib.suppress(OSError):
+            _write_all(self._fds[0], data)
+
+    def _serve(self) -> None:
+        assert self._fds is not None
+        master = self._fds[0]
+        while not self._stop.is_set():
+            ready, _, _ = select.select([master], [], [], self.poll_s)
+            if not ready:
+                continue
+            try:
+                data = os.read(master, 4096)
+            except OSError:
+                continue
+            reply = self.emulator.receive(data)
+            ledger = self.ledger
+            if ledger is not None:
+                with ledger.lock:
+                    ledger.device_read += len(data)
+                    if reply and ledger.listening:
+                        self.send(reply)
+                    elif reply:
+                        ledger.held.append(reply)
+                continue
+            if reply:
+                if self.reply_delay_s > 0:
+                    time.sleep(self.reply_delay_s)  # emulator thread only; tests never sleep
+                with contextlib.suppress(OSError):
+                    _write_all(master, reply)
+
+    def stop(self, timeout_s: float = 1.0) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout_s)
+            self._thread = None
+        if self._fds is not None:
+            for fd in self._fds:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+            self._fds = None
+
+    def __enter__(self) -> PtyServoServer:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
+    """``dynamixel_sdk.PortHandler`` whose reply timeout is causal, not wall time.
+
+    Everything else is the SDK's own (pyserial on the pty, baud checks, packet timing
+    bookkeeping). Counts every byte in and out in the server's :class:`LinkLedger`."""
+
+    def __init__(self, port_name: str, server: PtyServoServer) -> None:
+        super().__init__(port_name)
+        assert server.ledger is not None
+        self._server = server
+        self._ledger = server.ledger
+
+    def _listen(self) -> None:
+        ledger = self._ledger
+        with ledger.lock:
+            if not ledger.listening:
+                ledger.listening = True
+                if ledger.held:
+                    data = b"".join(ledger.held)
+                    ledger.held.clear()
+                    self._server.send(data)
+
+    def closePort(self) -> None:
+        """Close after the link has settled: statuses the host never read are lost with the
+        port, as on a real adapter (they would have arrived within 0.5 ms, before any reopen)."""
+        if self.is_open and self.ser is not None:
+            self._settle()
+        super().closePort()
+
+    def _settle(self) -> None:
+        """Wait until the emulator has handled every byte sent, drop what it holds, and
+        discard what reached the port unread (bounded by :data:`LOST_LINK_S`)."""
+        ledger = self._ledger
+        deadline = time.monotonic() + LOST_LINK_S
+        while time.monotonic() < deadline:
+            with ledger.lock:
+                if ledger.device_read >= ledger.host_sent:
+                    ledger.held.clear()
+                    if ledger.host_got >= ledger.device_sent:
+                        ledger.listening = False
+                        return
+            waiting = self.ser.in_waiting
+            if waiting:
+                data = self.ser.read(waiting)
+                with ledger.lock:
+                    ledger.host_got += len(data)
+            else:
+                select.select([self.ser.fileno()], [], [], HOST_WAIT_S)
+
+    def setupPort(self, cflag_baud: Any) -> bool:
+        ok = super().setupPort(cflag_baud)  # closes (settled) if open; flushes the input
+        ledger = self._ledger
+        with ledger.lock:
+            ledger.held.clear()
+            ledger.host_got = max(ledger.host_got, ledger.device_sent)
+            ledger.listening = False
+        return ok
+
+    def clearPort(self) -> None:
+        """Discard what has arrived (``reset_input_buffer``), counting it as consumed."""
+        ledger = self._ledger
+        with ledger.lock:
+            ledger.listening = False
+        waiting = self.ser.in_waiting
+        data = self.ser.read(waiting) if waiting else b""
+        with ledger.lock:
+            ledger.host_got += len(data)
+
+    def writePort(self, packet: Any) -> int:
+        ledger = self._ledger
+        with ledger.lock:
+            ledger.listening = False
+        n = super().writePort(packet)
+        with ledger.lock:
+            ledger.host_sent += int(n or 0)
+        return n
+
+    def readPort(self, length: int) -> bytes:
+        self._listen()
+        data = super().readPort(length)
+        with self._ledger.lock:
+            self._ledger.host_got += len(data)
+        return data
+
+    def isPacketTimeout(self) -> bool:
+        self._listen()
+        with self._ledger.lock:
+            over = self._ledger.quiet()
+        if over or self.getTimeSinceStart() > max(self.packet_timeout, LOST_LINK_S * 1000.0):
+            self.packet_timeout = 0
+            return True
+        # a reply is on its way: sleep (GIL released) until bytes arrive, briefly
+        with contextlib.suppress(OSError, ValueError):
+            select.select([self.ser.fileno()], [], [], HOST_WAIT_S)
+        return False
