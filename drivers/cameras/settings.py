@@ -14,7 +14,7 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
-    TypeAdapter,
+    ValidationError,
     field_validator,
     model_validator,
 )
@@ -243,13 +243,27 @@ CameraSettings = Annotated[
 ]
 """Any real camera's settings, told apart by ``kind`` (``[camera] kind = "gphoto2"``)."""
 
-CAMERA_SETTINGS_ADAPTER: TypeAdapter[CameraSettings] = TypeAdapter(CameraSettings)
+def parse_camera_settings(data: dict[str, object]) -> BaseModel:
+    """Validate a rig config's ``[camera.device]`` table into its kind's settings.
 
-
-def parse_camera_settings(data: dict[str, object]) -> CameraSettings:
-    """Validate a rig config's ``[camera]`` table into the right backend's settings.
-
-    Raises pydantic's ``ValidationError`` (the config loader turns it into a ConfigError that
-    names the file and key).
+    The kind (``kind = "gphoto2"``) picks the settings model from the registry
+    (:mod:`rti_rig.drivers.cameras.kinds`). Raises pydantic's ``ValidationError`` (the config
+    loader turns it into a ConfigError that names the file and key).
     """
-    return CAMERA_SETTINGS_ADAPTER.validate_python(data)
+    from rti_rig.drivers.cameras.kinds import camera_kind, camera_kind_names
+
+    kind = camera_kind(data.get("kind"))
+    if kind is None:
+        known = ", ".join(repr(k) for k in camera_kind_names())
+        raise ValidationError.from_exception_data(
+            "camera",
+            [
+                {
+                    "type": "value_error",
+                    "loc": ("kind",),
+                    "input": data.get("kind"),
+                    "ctx": {"error": ValueError(f"unknown camera kind; use one of {known}")},
+                }
+            ],
+        )
+    return kind.settings.model_validate(data)

@@ -489,12 +489,8 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
         return parse_camera_settings(rig.config.camera.device or {})
     except ValidationError as exc:
         err = exc.errors()[0]
-        loc = [p for p in err["loc"] if not (isinstance(p, str) and p in _CAMERA_KINDS)]
-        key = _key_of(("camera", "device", *loc))
+        key = _key_of(("camera", "device", *err["loc"]))
         raise ConfigError(rig.path, key, err["msg"].removeprefix("Value error, ")) from None
-
-
-_CAMERA_KINDS = ("opencv", "gphoto2", "folder_watch")
 
 
 def default_config_path() -> Path:

@@ -1,0 +1,37 @@
+"""Use case: write a session's ``.lp`` from its verified journal (``rti-rig export-lp``).
+
+The lights that actually fired, for every image on disk as it was captured — an interrupted
+session's too; an image missing or changed since is left out and named.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from rti_rig.app.output_files import check_output_file
+from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.runtime.session import session_lp_report
+
+
+@dataclass(frozen=True)
+class ExportLpRequest:
+    session_dir: Path
+    out_file: Path
+    #: Name the 16-bit linear TIFFs instead of the JPEGs.
+    linear: bool = False
+    force: bool = False
+
+
+@dataclass(frozen=True)
+class ExportedLp:
+    entries: list[LpEntry]
+    #: Images the journal lists that are missing or changed on disk (not in the file).
+    left_out: list[str]
+
+
+def export_lp(req: ExportLpRequest) -> ExportedLp:
+    entries, left_out = session_lp_report(req.session_dir, linear=req.linear)
+    check_output_file(req.out_file, req.force, {})
+    write_lp(req.out_file, entries)
+    return ExportedLp(list(entries), list(left_out))

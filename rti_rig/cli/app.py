@@ -1,0 +1,95 @@
+"""The `rti-rig` application object, its consoles and the helpers every command shares.
+
+Every user-facing failure is an :class:`~rti_rig.core.errors.RtiRigError` printed as one clear
+message (file, line or key, and what to do) with exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import math
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+
+from rti_rig.core.errors import RtiRigError
+
+app = typer.Typer(
+    help=(
+        "Drive Reflectance Transformation Imaging (RTI) rigs: LED domes and servo-arm light "
+        "carriers with a camera, or their simulation.\n\n"
+        "Typical use: 'rti-rig run RIG.toml --out SESSION' captures one image per light and "
+        "writes SESSION/lights.lp for relight or RTIBuilder. A rig config whose backend is "
+        "'simulated' gives a dry run that reports how long the real rig would take."
+    ),
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+err = Console(stderr=True)
+out = Console()
+
+
+def _flags_show_no_type() -> None:
+    """Show on/off flags in help without a value type: typer 0.29 labels them ``<bool>``, as if
+    ``--force`` took a value (it takes none). Every command's flags at once, in one place."""
+    from typer.core import TyperOption
+
+    original = TyperOption.display_type_rich
+    if getattr(original, "_rti_rig", False):
+        return
+
+    def display_type_rich(self, ctx):  # type: ignore[no-untyped-def]
+        if getattr(self, "is_flag", False) and self.metavar is None:
+            return None
+        return original(self, ctx)
+
+    display_type_rich._rti_rig = True  # type: ignore[attr-defined]
+    TyperOption.display_type_rich = display_type_rich  # type: ignore[method-assign]
+
+
+_flags_show_no_type()
+
+
+def fail(exc: RtiRigError) -> typer.Exit:
+    # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
+    err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
+    return typer.Exit(code=2)
+
+
+def print_notes(notes) -> None:  # type: ignore[no-untyped-def]
+    """What a tolerant reader accepted but the user should know (file, line, what was done)."""
+    for note in notes:
+        err.print(f"[yellow]note:[/] {escape(note)}", highlight=False, soft_wrap=True)
+
+
+def print_note(note) -> None:  # type: ignore[no-untyped-def]
+    """Show a use case's note: information on stdout, warnings on stderr."""
+    if note.level == "warning":
+        err.print(f"[yellow]note:[/] {escape(note.text)}", soft_wrap=True)
+    else:
+        out.print(note.text, highlight=False, markup=False)
+
+
+def parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[float, float] | None:
+    """``"AZ,EL"`` in degrees → a pair; a clear error naming ``option`` otherwise."""
+    if text is None:
+        return None
+    parts = text.replace(" ", "").split(",")
+    try:
+        az, el = (float(p) for p in parts)
+    except ValueError:
+        raise RtiRigError(
+            f"{option} {text!r}: give azimuth and elevation in degrees as AZ,EL (e.g. 45,30)"
+        ) from None
+    if not math.isfinite(az):
+        raise RtiRigError(f"{option} {text!r}: the azimuth {az:g} is not a finite angle")
+    if not 0.0 <= el <= 90.0:
+        raise RtiRigError(f"{option} {text!r}: the elevation {el:g}° is outside 0..90°")
+    return az, el
+
+
+
+
+def main() -> None:
+    app()

@@ -1,0 +1,88 @@
+"""`rti-rig bench`: the benchmarks of a checkout (imported lazily: they are not installed)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from rti_rig.cli.app import app, fail, out
+from rti_rig.core.errors import RtiRigError
+
+bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy trade.")
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command("tradeoff")
+def bench_tradeoff(
+    out_dir: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            help="Folder to write results.csv, the plots and summary.md into (the repository's "
+            "committed results are docs/research/tradeoff). Without it the summary is only "
+            "printed.",
+        ),
+    ] = None,
+    quick: Annotated[
+        bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
+    ] = False,
+    from_lp: Annotated[
+        Path | None,
+        typer.Option(
+            "--from",
+            help="A dense acquisition of your own (an .lp with its images beside it): the trade "
+            "for uniform, optimal and adaptive against all its lights.",
+        ),
+    ] = None,
+) -> None:
+    """Error against number of lights and session time, for every planner, on simulated scenes
+    (or on your own acquisition with --from).
+
+    Nothing is written unless --out is given, so a quick run never replaces the committed
+    full-run results. The benchmarks live in the repository's benchmarks/ folder (they are not
+    installed): run this from a checkout."""
+    import time
+
+    try:
+        from benchmarks.tradeoff import (
+            TradeoffSettings,
+            plot,
+            run_tradeoff,
+            summarise,
+            write_csv,
+        )
+        from benchmarks.tradeoff_from import bench_from
+    except ImportError:
+        raise fail(
+            RtiRigError(
+                "rti-rig bench runs the benchmarks of a checkout of the rti-rig repository "
+                "(they are not installed): run it from the repository's folder"
+            )
+        ) from None
+    if from_lp is not None:
+        try:
+            text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
+        except RtiRigError as exc:
+            raise fail(exc) from None
+        except ValueError as exc:
+            raise fail(RtiRigError(str(exc))) from None
+        out.print(text, highlight=False)
+        return
+
+    settings = TradeoffSettings.quick() if quick else TradeoffSettings()
+    t0 = time.perf_counter()
+    rows = run_tradeoff(settings, progress=lambda msg: out.print(msg, highlight=False))
+    command = "rti-rig bench tradeoff" + (" --quick" if quick else "")
+    if out_dir is not None:
+        command += f" --out {out_dir}"
+    text = summarise(rows, settings, time.perf_counter() - t0, command)
+    if out_dir is not None:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        write_csv(rows, out_dir / "results.csv")
+        plot(rows, out_dir)
+        (out_dir / "summary.md").write_text(text, encoding="utf-8")
+    out.print(text, highlight=False)
+    if out_dir is None:
+        out.print("(nothing written: give --out DIR to keep the results)", highlight=False)

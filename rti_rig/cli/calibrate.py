@@ -1,0 +1,169 @@
+"""`rti-rig calibrate-lights`: parse, call :mod:`rti_rig.app.usecases.calibrate`, print."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.markup import escape
+
+from rti_rig.cli.app import app, err, fail, out
+from rti_rig.core.errors import RtiRigError
+
+
+def _parse_normal(text: str) -> tuple[float, float, float]:
+    """``"X,Y,Z"`` → a unit vector pointing up out of the card; a clear error otherwise."""
+
+    try:
+        x, y, z = (float(p) for p in text.replace(" ", "").split(","))
+    except ValueError:
+        raise RtiRigError(
+            f"--card-normal {text!r}: give the card's normal as X,Y,Z (e.g. 0,0,1 for level)"
+        ) from None
+    norm = math.sqrt(x * x + y * y + z * z)
+    if not (math.isfinite(norm) and norm > 0 and z / norm > 0.5):
+        raise RtiRigError(
+            f"--card-normal {text!r}: the card must face the camera (z > 0, within 60° of the "
+            "zenith); give its normal as X,Y,Z"
+        )
+    return (x / norm, y / norm, z / norm)
+
+
+@app.command("calibrate-lights")
+def calibrate_lights(
+    card_session: Annotated[
+        Path,
+        typer.Argument(
+            help="A session of a level matte white card shot under every LED ('rti-rig run').",
+            show_default=False,
+        ),
+    ],
+    rig_config: Annotated[
+        Path, typer.Option("--rig", help="The dome's rig config (the one the card was shot on).")
+    ],
+    out_file: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            help="Calibration file to write (default: CARD_SESSION/light_calibration.toml).",
+        ),
+    ] = None,
+    card_normal: Annotated[
+        str, typer.Option("--card-normal", help="The card's normal as X,Y,Z if it is not level.")
+    ] = "0,0,1",
+    min_elevation_deg: Annotated[
+        float,
+        typer.Option(
+            "--min-elevation-deg",
+            help="LEDs lower than this above the card are not measured (grazing light on a "
+            "card is the most sensitive to its tilt and texture).",
+        ),
+    ] = 5.0,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Measure each LED's light from a card session and write the intensity correction that
+    evens the dome out (every LED dimmed to the weakest one's light), for [dome.serial]
+    intensity_correction_file in the rig config."""
+
+    import numpy as np
+
+    from rti_rig.app.usecases.calibrate import CalibrateRequest, calibrate_lights
+
+    try:
+        done = calibrate_lights(
+            CalibrateRequest(
+                card_session,
+                rig_config,
+                out_file,
+                _parse_normal(card_normal),
+                min_elevation_deg,
+                force,
+            )
+        )
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    cal, card, loaded, geometry, target = (
+        done.calibration,
+        done.card,
+        done.loaded,
+        done.geometry,
+        done.target,
+    )
+    normal = np.asarray(_parse_normal(card_normal))
+    measured = np.flatnonzero(cal.measured)
+    elevation = np.degrees(np.arcsin(np.clip(geometry.directions[measured] @ normal, -1, 1)))
+    lowest = float(elevation.min())
+    weak, strong = int(np.argmin(cal.output)), int(np.argmax(cal.output))
+    names = geometry.names
+    out.print(
+        f"Card session {escape(str(card_session))}: {len(card.leds)} images of rig "
+        f"'{escape(loaded.config.name)}'; {len(measured)} of {geometry.count} LEDs measured "
+        f"(lowest {lowest:.1f}° above the card)."
+    )
+    in_force = card.correction is not None
+    #: what is left after a correction in force that needs no further calibration
+    even_enough = 0.01
+    if in_force:
+        # a re-shot card under the correction: the spread as shot is what is left, the LEDs'
+        # own (uncorrected) outputs are the same as before, which is no failure
+        change = float(np.max(np.abs(cal.correction / np.maximum(cal.previous, 1e-9) - 1.0)))
+        out.print(
+            f"Lights as shot, with the intensity correction in force: spread "
+            f"{100 * cal.shot_spread:.1f} % RMS"
+            + (" — the dome is even." if cal.shot_spread < even_enough else ".")
+        )
+        out.print(
+            f"Each LED's own light, without the correction, is still {cal.output[weak]:.2f} "
+            f"(LED {weak}, {escape(names[weak])}) to {cal.output[strong]:.2f} "
+            f"(LED {strong}, {escape(names[strong])}) of the median; the new correction "
+            f"differs from the one in force by at most {100 * change:.1f} %."
+        )
+    else:
+        out.print(
+            f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light "
+            f"from {cal.output[weak]:.2f} (LED {weak}, {escape(names[weak])}) to "
+            f"{cal.output[strong]:.2f} (LED {strong}, {escape(names[strong])}) of the median."
+        )
+    out.print(
+        f"Evened out, every LED gives {cal.evened_light:.2f} of the median LED's light "
+        f"({cal.stops_lost:.2f} stop(s) more exposure)."
+    )
+    if not cal.measured.all():
+        skipped = ", ".join(names[i] for i in np.flatnonzero(~cal.measured))
+        err.print(
+            f"[yellow]note:[/] not measured (not in the session, or lower than "
+            f"{min_elevation_deg:g}° above the card), assumed to give the median light under "
+            f"the correction in force: {escape(skipped)}"
+        )
+    if cal.output[weak] < 0.5:
+        err.print(
+            f"[yellow]warning:[/] LED {weak} gives only {cal.output[weak]:.2f} of the median "
+            "light; check it (a failing LED, a dirty diffuser) before evening the dome out to it."
+        )
+    tilt_pct = 100 * math.tan(math.radians(1.0)) / math.tan(math.radians(lowest))
+    out.print(
+        f"A card tilted by 1° would move the lowest LEDs' figures by up to {tilt_pct:.0f} %: "
+        "level it with care."
+    )
+    rel = os.path.relpath(target.resolve(), rig_config.resolve().parent)
+    out.print(f"Calibration → {escape(str(target))}")
+    if in_force and cal.shot_spread < even_enough:
+        out.print(
+            "The correction in force is good: no new calibration is needed. To use this "
+            f"one instead, set under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            highlight=False,
+        )
+    else:
+        out.print(
+            f"To use it, add under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            highlight=False,
+        )
+    # the line to paste, on its own and never wrapped (a wrapped line pastes as two)
+    out.print(f'intensity_correction_file = "{rel}"', markup=False, highlight=False, soft_wrap=True)
+    if not (in_force and cal.shot_spread < even_enough):
+        out.print(
+            "Then shoot the card again and calibrate that session: its spread is what is left."
+        )

@@ -1,0 +1,90 @@
+"""`rti-rig fit`: parse, call :func:`rti_rig.app.usecases.fit.run_fit`, print the verdict."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.markup import escape
+
+from rti_rig.cli.app import app, err, fail, out
+from rti_rig.core.errors import RtiRigError
+
+
+def print_verdict(session: Path | None) -> None:
+    """Last line of ``run``: the QA verdict (never fails the run: it is advice)."""
+    from rti_rig.app.usecases.fit import verdict_for_session
+
+    if session is None:
+        return
+    try:
+        out.print(f"QA verdict: {escape(verdict_for_session(session))}")
+    except (RtiRigError, ValueError) as exc:
+        err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
+
+
+@app.command()
+def fit(
+    sources: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Session folder(s), or .lp file(s) with their images beside them. With more "
+            "than one, a resumable batch: each goes to OUT/<name>, finished ones are skipped."
+        ),
+    ],
+    out_dir: Annotated[Path, typer.Option("--out", help="New or empty folder for outputs.")],
+    model: Annotated[
+        str,
+        typer.Option(
+            "--model",
+            help="auto (evidence-based choice), ps, robust-ps, lambert, ptm, hsh1, hsh2, hsh3.",
+        ),
+    ] = "auto",
+    no_qa: Annotated[bool, typer.Option("--no-qa", help="Skip the QA verdict.")] = False,
+    no_ptm: Annotated[bool, typer.Option("--no-ptm", help="Do not write fit.ptm.")] = False,
+    no_hsh: Annotated[bool, typer.Option("--no-hsh", help="Do not write fit.rti.")] = False,
+    no_normals: Annotated[
+        bool, typer.Option("--no-normals", help="Do not fit normal and albedo maps.")
+    ] = False,
+) -> None:
+    """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
+    from rti_rig.app.usecases.fit import FitRequest, run_batch, run_fit
+    from rti_rig.reconstruct.registry import model_spec
+
+    try:
+        if model != "auto":
+            try:
+                model_spec(model)
+            except ValueError as exc:
+                raise RtiRigError(str(exc)) from None
+        request = FitRequest(
+            sources[0],
+            out_dir,
+            model=model,
+            qa=not no_qa,
+            write_ptm=not no_ptm,
+            write_hsh=not no_hsh,
+            write_normals=not no_normals,
+        )
+        if len(sources) > 1:
+            items = run_batch(sources, out_dir, request)
+            for item in items:
+                line = f"{item.source}: {item.status}"
+                if item.verdict:
+                    line += f"; QA verdict: {item.verdict}"
+                out.print(escape(line))
+            if any(i.status.startswith("failed") for i in items):
+                raise typer.Exit(code=2)
+            return
+        result = run_fit(request)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    out.print(f"Model: {escape(result.reason)}")
+    for text in result.warnings:
+        err.print(f"[yellow]warning:[/] {escape(text)}")
+    out.print(
+        f"Wrote {len(result.files)} files to {escape(str(out_dir))} in {result.seconds:.1f} s"
+    )
+    if result.qa is not None:
+        out.print(f"QA verdict: {escape(result.qa.verdict)}")

@@ -1,0 +1,163 @@
+"""`rti-rig plan`: parse, call :func:`rti_rig.app.usecases.plan.plan_lights`, print the report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from rti_rig.cli.app import app, fail, out, parse_az_el, print_notes
+from rti_rig.core.errors import RtiRigError
+
+
+@app.command()
+def plan(
+    preview: Annotated[
+        Path | None,
+        typer.Argument(
+            help="One preview image of the object (8-bit JPEG/PNG/TIFF = sRGB, 16-bit "
+            "PNG/TIFF = linear, as 'rti-rig run' writes them; a camera RAW file - DNG, CR2, "
+            "NEF, ARW... - is decoded linearly, its light taken from --preview-light or a "
+            "--rig .lp that lists it), or the session folder "
+            "'rti-rig preview' wrote. "
+            "Needed by 'kmeans'; without it 'optimal' plans for a level surface (matte unless "
+            "--material glossy)."
+        ),
+    ] = None,
+    rig: Annotated[
+        Path | None,
+        typer.Option(
+            "--rig",
+            help="Rig config TOML, or a bare .lp meaning 'a dome with exactly these lights' "
+            "(default: the simulated 48-LED dome shipped with rti-rig).",
+        ),
+    ] = None,
+    lights: Annotated[int, typer.Option("--lights", help="Number of lights to plan.")] = 12,
+    method: Annotated[
+        str | None,
+        typer.Option(
+            "--method",
+            help="uniform (homogeneous, no preview), kmeans (the paper's: k-means on the "
+            "preview's normals) or optimal (least expected error for the objective). "
+            "Default: optimal with a preview, uniform without.",
+        ),
+    ] = None,
+    objective: Annotated[
+        str | None,
+        typer.Option(
+            "--objective",
+            help="What the session is for: normals (surface inspection, normal maps; default) "
+            "or relight (interactive relighting with PTM/HSH).",
+        ),
+    ] = None,
+    preview_light: Annotated[
+        str | None,
+        typer.Option(
+            "--preview-light",
+            help="Azimuth,elevation of the preview's light in degrees (frame of the .lp files). "
+            "When omitted: the light the preview's rti-rig session recorded, or the line of "
+            "the bare .lp given as --rig that lists the image, else estimated from the image.",
+        ),
+    ] = None,
+    depth_model: Annotated[
+        Path | None,
+        typer.Option(
+            "--depth-model",
+            help="A monocular depth network (.onnx, MiDaS / Depth Anything / LeReS style) to "
+            "estimate the relief; without it, shape from shading is used.",
+        ),
+    ] = None,
+    min_elevation_deg: Annotated[
+        float, typer.Option("--min-elevation-deg", help="Lowest elevation allowed (degrees).")
+    ] = 0.0,
+    max_elevation_deg: Annotated[
+        float,
+        typer.Option(
+            "--max-elevation-deg",
+            help="Highest elevation allowed (degrees; 90 = up to the zenith). Lights near the "
+            "camera axis put mirror highlights on a level glossy object: 60 helped on gilding, "
+            "varnish and polished metal in the tests and cost on brushed steel at 20-30 lights "
+            "and on a steeply tilted object (docs/research/planner.md).",
+        ),
+    ] = 90.0,
+    signal_noise: Annotated[
+        float | None,
+        typer.Option(
+            "--signal-noise",
+            help="Image noise proportional to the signal, as a fraction (normals objective): "
+            "0.05 models 8-bit JPEG captures on a dome without LED intensity calibration "
+            "(docs/research/planner.md); 0 models additive noise only. Default: the rig config's "
+            "[camera] signal_noise (0 if absent, and for a bare .lp).",
+        ),
+    ] = None,
+    material: Annotated[
+        str,
+        typer.Option(
+            "--material",
+            help="What you know of the surface: auto (highlights read from the preview; "
+            "default), matte, or glossy (polished metal, gilding, varnish: one preview of a "
+            "flat glossy object does not show its gloss; docs/research/planner.md).",
+        ),
+    ] = "auto",
+    out_file: Annotated[Path, typer.Option("--out", help="Plan file to write (.lp).")] = Path(
+        "plan.lp"
+    ),
+    figure: Annotated[
+        Path | None,
+        typer.Option(
+            "--figure",
+            help="Also draw the plan as a map (.png, .svg or .pdf): the lights seen from above, "
+            "numbered in firing order, on the dome's LEDs or the arm's reach.",
+        ),
+    ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Overwrite an existing plan file (and --figure).")
+    ] = False,
+) -> None:
+    """Plan an ordered set of lights from one preview shot and write it as an .lp file.
+
+    Without PREVIEW: `uniform` (the default then) or `optimal`, which plans for a level surface,
+    matte unless `--material glossy` (on the benchmarks in docs/research/planner.md it did as
+    well as with a preview).
+
+    The plan's lights are the rig's own (a dome's LEDs, used once each; an arm's reachable
+    directions, ordered for the least move time); `rti-rig run RIG --plan PLAN.lp` runs it.
+    """
+    from rti_rig.app.config import default_config_path
+    from rti_rig.app.usecases.plan import PlanLightsRequest, draw_plan_figure, plan_lights
+
+    try:
+        request = PlanLightsRequest(
+            rig=rig or default_config_path(),
+            out_file=out_file,
+            lights=lights,
+            preview=preview,
+            method=method,
+            objective=objective,
+            preview_light=parse_az_el(preview_light),
+            depth_model=depth_model,
+            min_elevation_deg=min_elevation_deg,
+            max_elevation_deg=max_elevation_deg,
+            signal_noise=signal_noise,
+            material=material,
+            figure=figure,
+            force=force,
+        )
+        planned = plan_lights(request)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    print_notes(planned.notes)
+    for line in planned.report.lines():
+        out.print(line, highlight=False, markup=False)
+    out.print(
+        f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
+        f"{out_file}"
+    )
+    if figure is not None:
+        # after the report: a map that cannot be drawn must not hide a plan that was written
+        try:
+            draw_plan_figure(request, planned)
+        except RtiRigError as exc:
+            raise fail(exc) from None
+        out.print(f"Map of the plan → {figure}")

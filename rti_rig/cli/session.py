@@ -1,0 +1,372 @@
+"""`rti-rig run`, `preview` and `export-lp`: sessions, through :mod:`rti_rig.app.usecases.session`.
+
+The commands parse, call the use case and print; what is interactive lives here: the signal
+handlers (Ctrl-C, SIGTERM, SIGUSR1), the progress bar and the closing messages.
+"""
+
+from __future__ import annotations
+
+import shlex
+import signal
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note
+from rti_rig.core.errors import RtiRigError
+
+
+@app.command()
+def run(
+    rig_config: Annotated[
+        Path | None,
+        typer.Argument(
+            help="Rig config TOML (see rig_configs/), e.g. rig_configs/simulated_dome.toml. "
+            "Optional with --resume (the session's own config is used)."
+        ),
+    ] = None,
+    out_dir: Annotated[
+        Path | None, typer.Option("--out", help="New or empty folder to write the session into.")
+    ] = None,
+    lights: Annotated[
+        int | None,
+        typer.Option(
+            "--lights",
+            help="Number of lights in a homogeneous layout (default: every LED of a dome, "
+            "or the arm's default_lights).",
+        ),
+    ] = None,
+    plan: Annotated[
+        Path | None,
+        typer.Option("--plan", help="Run this plan (.lp from 'rti-rig plan') instead."),
+    ] = None,
+    min_elevation_deg: Annotated[
+        float,
+        typer.Option("--min-elevation-deg", help="Elevation floor of the homogeneous layout."),
+    ] = 0.0,
+    max_elevation_deg: Annotated[
+        float,
+        typer.Option(
+            "--max-elevation-deg",
+            help="Elevation ceiling of the homogeneous layout (90 = up to the zenith; 60 keeps "
+            "lights away from the camera axis, see 'plan --max-elevation-deg').",
+        ),
+    ] = 90.0,
+    auto_exposure: Annotated[
+        bool,
+        typer.Option(
+            "--auto-exposure",
+            help="Before starting, meter at the brightest planned light (a short test series) "
+            "and fix the exposure that keeps saturated pixels under --max-saturated.",
+        ),
+    ] = False,
+    max_saturated: Annotated[
+        float,
+        typer.Option("--max-saturated", help="Largest fraction of saturated pixels allowed."),
+    ] = 0.001,
+    resume: Annotated[
+        Path | None,
+        typer.Option(
+            "--resume",
+            help="Continue an interrupted session folder: verify what is on disk and capture "
+            "only the steps not yet done (on the rig the session began on).",
+        ),
+    ] = None,
+    accept_rig_change: Annotated[
+        bool,
+        typer.Option(
+            "--accept-rig-change",
+            help="With --resume: go on although the rig differs from the session's (a "
+            "repaired LED, a new exposure); the change is recorded in the manifest.",
+        ),
+    ] = False,
+    adaptive: Annotated[
+        bool,
+        typer.Option(
+            "--adaptive",
+            help="Choose each next light from the images captured so far (up to --lights; "
+            "docs/adaptive.md).",
+        ),
+    ] = False,
+    until_error: Annotated[
+        float | None,
+        typer.Option(
+            "--until-error",
+            help="Adaptive: stop once the estimated mean normal error is at most this many "
+            "degrees (with --lights: whichever comes first).",
+        ),
+    ] = None,
+    no_verdict: Annotated[
+        bool, typer.Option("--no-verdict", help="Do not print the QA verdict at the end.")
+    ] = False,
+) -> None:
+    """Run a capture session (a dry run when the config's backend is 'simulated').
+
+    Ctrl-C once stops after the current image; Ctrl-C twice or SIGTERM stops at once (lights
+    off, arm stopped, and parked if the config says park_on_emergency_stop = true); SIGUSR1
+    pauses or resumes between images. An interrupted session can be
+    continued with --resume.
+    """
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        ResumeRequest,
+        open_new_session,
+        open_resumed_session,
+    )
+
+    try:
+        if resume is not None:
+            if out_dir is not None or plan is not None or lights is not None:
+                raise RtiRigError(
+                    "--resume continues a session as planned: drop --out, --plan, --lights"
+                )
+            opened = open_resumed_session(
+                ResumeRequest(
+                    resume,
+                    rig_config,
+                    max_saturated=max_saturated,
+                    accept_rig_change=accept_rig_change,
+                ),
+                print_note,
+            )
+        else:
+            if rig_config is None or out_dir is None:
+                raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
+            if accept_rig_change:
+                raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
+            opened = open_new_session(
+                NewSessionRequest(
+                    rig_config,
+                    out_dir,
+                    lights=lights,
+                    plan=plan,
+                    min_elevation_deg=min_elevation_deg,
+                    max_elevation_deg=max_elevation_deg,
+                    auto_exposure=auto_exposure,
+                    max_saturated=max_saturated,
+                    adaptive=adaptive,
+                    until_error_deg=until_error,
+                ),
+                print_note,
+            )
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    _execute(opened)
+    if not no_verdict:
+        from rti_rig.cli.fit import print_verdict
+
+        print_verdict(opened.out_dir)
+
+
+def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
+    """What a stopped session left on disk and how to go on (never a resume hint for nothing)."""
+    from rti_rig.runtime.session import LP_NAME
+
+    folder, out_dir = opened.folder, opened.out_dir
+    if folder.images_kept:
+        return (
+            f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}. {resume_hint}"
+        )
+    if opened.resumed:
+        return f"No new image was captured. {resume_hint}"
+    if folder.begun:
+        return f"Nothing was captured: {out_dir} holds no image and may be used again."
+    return f"Nothing was captured and nothing was written to {out_dir}."
+
+
+def _execute(opened) -> None:  # type: ignore[no-untyped-def]
+    """Run with a progress bar and signal handling; print what happened and how to go on."""
+    from rti_rig.app.usecases.session import run_opened_session
+    from rti_rig.runtime.controller import (
+        CancelToken,
+        EmergencyStop,
+        FinishReason,
+        Paused,
+        StepCompleted,
+    )
+    from rti_rig.runtime.session import LP_NAME
+
+    cancel = CancelToken()
+
+    def on_sigint(signum, frame):  # type: ignore[no-untyped-def]
+        if cancel.cancelled:
+            raise EmergencyStop("second Ctrl-C")
+        cancel.cancel()
+        err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")
+
+    def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]
+        raise EmergencyStop("SIGTERM")
+
+    def on_sigusr1(signum, frame):  # type: ignore[no-untyped-def]
+        if cancel.paused:
+            cancel.resume()
+            err.print("[green]Resuming.[/]")
+        else:
+            cancel.pause()
+            err.print("[yellow]Pausing after this image (lights off); SIGUSR1 again resumes.[/]")
+
+    handlers = {signal.SIGINT: on_sigint, signal.SIGTERM: on_sigterm}
+    if hasattr(signal, "SIGUSR1"):
+        handlers[signal.SIGUSR1] = on_sigusr1
+    previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
+    rig, folder, out_dir = opened.rig, opened.folder, opened.out_dir
+    dry = " (dry run)" if opened.dry_run else ""
+    adaptive = " at most, adaptive" if opened.source is not None else ""
+    out.print(
+        f"Rig [bold]{escape(rig.name)}[/]{dry}: {opened.steps_to_do} of {opened.total_steps} "
+        f"lights{adaptive} → {escape(str(out_dir))}"
+    )
+    resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
+    try:
+        with Progress(
+            TextColumn("[progress.description]{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=out,
+        ) as progress:
+            task = progress.add_task(
+                "capturing", total=opened.total_steps, completed=len(folder.done)
+            )
+
+            def on_event(event):  # type: ignore[no-untyped-def]
+                if isinstance(event, StepCompleted):
+                    progress.advance(task)
+                elif isinstance(event, Paused):
+                    progress.update(task, description="paused")
+
+            result = run_opened_session(opened, cancel, on_event)
+    except EmergencyStop as exc:
+        from rti_rig.app.usecases.safe_state import lights_state
+
+        err.print(
+            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}."
+        )
+        err.print(_after_stop(opened, resume_hint), markup=False, soft_wrap=True)
+        raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
+    except RtiRigError as exc:
+        from rti_rig.app.usecases.safe_state import lights_state
+
+        state = lights_state(rig)
+        err.print(
+            f"{state[:1].upper()}{state[1:]}. {_after_stop(opened, resume_hint)}", markup=False
+        )
+        raise fail(exc) from None
+    finally:
+        for sig, h in previous.items():
+            signal.signal(sig, h)
+
+    total_done = len(folder.done) + len(result.records)
+    out.print(
+        f"{total_done} image(s) in the session; {LP_NAME} lists the lights that fired.\n"
+        f"Session time on the real rig: {result.rig_time_s:.1f} s"
+        + (f" (simulated in {result.wall_time_s:.1f} s)" if dry else "")
+    )
+    for note in folder.manifest.get("notices") or []:
+        err.print(f"[yellow]note:[/] {escape(str(note))}")
+    for failure in result.teardown_failures:
+        err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
+    adaptive_result = opened.extra.get("adaptive_result")
+    if adaptive_result is not None:
+        est = adaptive_result["estimated_error_deg"]
+        out.print(
+            f"Adaptive: {adaptive_result['lights_used']} lights; stopped: "
+            f"{adaptive_result['stop']['reason']}; estimated mean normal error "
+            f"{'n/a' if est is None else f'{est:.2f}°'}",
+            highlight=False,
+        )
+    if result.finish_reason is FinishReason.CANCELLED:
+        err.print(
+            f"[yellow]Session cancelled; the images captured so far are kept.[/] {resume_hint}"
+        )
+        raise typer.Exit(code=130)
+
+
+@app.command()
+def preview(
+    rig_config: Annotated[
+        Path, typer.Argument(help="Rig config TOML, e.g. rig_configs/simulated_dome.toml.")
+    ],
+    out_dir: Annotated[
+        Path, typer.Option("--out", help="New or empty folder to write the one-image session.")
+    ],
+    light: Annotated[
+        str | None,
+        typer.Option(
+            "--light",
+            help="Azimuth,elevation of the preview light in degrees (frame of the .lp files; "
+            "default 135,50: top left, in the paper's 45–60° band). A dome uses its nearest LED "
+            "(by default the nearest in that band, if it has LEDs there).",
+        ),
+    ] = None,
+    auto_exposure: Annotated[
+        bool,
+        typer.Option(
+            "--auto-exposure",
+            help="Meter first (a short test series) so the preview is not saturated.",
+        ),
+    ] = False,
+    max_saturated: Annotated[
+        float,
+        typer.Option("--max-saturated", help="Largest fraction of saturated pixels allowed."),
+    ] = 0.001,
+) -> None:
+    """Shoot the planner's preview: one image under one light, as a session of one image.
+
+    The session records the light that fired, so `rti-rig plan OUT_DIR --rig RIG ...` plans from
+    its linear image with that light (no --preview-light needed).
+    """
+    from rti_rig.app.usecases.session import PreviewRequest, open_preview_session
+
+    try:
+        opened = open_preview_session(
+            PreviewRequest(
+                rig_config,
+                out_dir,
+                parse_az_el(light, "--light"),
+                auto_exposure=auto_exposure,
+                max_saturated=max_saturated,
+            ),
+            print_note,
+        )
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    _execute(opened)
+    out.print(
+        f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
+        f"{shlex.quote(str(rig_config))} --lights N --out plan.lp",
+        highlight=False,
+        markup=False,
+        soft_wrap=True,
+    )
+
+
+@app.command("export-lp")
+def export_lp(
+    session_dir: Annotated[Path, typer.Argument(help="A session folder written by 'rti-rig run'.")],
+    out_file: Annotated[Path, typer.Option("--out", help="The .lp file to write.")],
+    linear: Annotated[
+        bool,
+        typer.Option("--linear", help="Name the 16-bit linear TIFFs instead of the JPEGs."),
+    ] = False,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Write the .lp of a session from its verified journal: the lights that actually fired,
+    for every image on disk as captured (an interrupted session's too)."""
+    from rti_rig.app.usecases.export import ExportLpRequest
+    from rti_rig.app.usecases.export import export_lp as write_session_lp
+
+    try:
+        done = write_session_lp(ExportLpRequest(session_dir, out_file, linear, force))
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    if done.left_out:
+        err.print(
+            f"[yellow]note:[/] left out, missing or changed since they were captured: "
+            f"{escape(', '.join(done.left_out))}",
+            soft_wrap=True,
+        )
+    out.print(f"{len(done.entries)} lights → {out_file}")
