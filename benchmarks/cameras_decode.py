@@ -48,6 +48,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--sizes", nargs="+", default=["480x640", "4000x6000"])
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument(
+        "--write", action="store_true", help="write the figures into docs/ (else print only)"
+    )
     args = parser.parse_args()
     import rawpy
 

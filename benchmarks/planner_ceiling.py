@@ -330,5 +330,8 @@ if __name__ == "__main__":
         help="sim, real or sim,real",
     )
     cli.add_argument("--seed", type=int, default=SEED, help="draws' seed (not 0: print only)")
+    cli.add_argument(
+        "--write", action="store_true", help="write the tables into docs/ (else print only)"
+    )
     args = cli.parse_args()
     main(args.parts, args.seed)

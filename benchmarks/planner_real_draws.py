@@ -50,7 +50,7 @@ from benchmarks.planner_real_data import (
     preview_leds,
     reference,
 )
-from benchmarks.report import write_section
+from benchmarks.report import positional_args, write_section
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
 
@@ -184,7 +184,8 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
 
 
 if __name__ == "__main__":
+    args = positional_args()
     main(
-        seed=int(sys.argv[2]) if len(sys.argv) > 2 else 0,
-        draws=int(sys.argv[1]) if len(sys.argv) > 1 else DRAWS,
+        seed=int(args[1]) if len(args) > 1 else 0,
+        draws=int(args[0]) if len(args) > 0 else DRAWS,
     )

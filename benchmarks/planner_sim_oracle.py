@@ -30,7 +30,7 @@ from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import DOC, hindsight_exchange, planned_leds
 from benchmarks.planner_sim_draws import COUNTS, FLOORS
-from benchmarks.report import write_section
+from benchmarks.report import positional_args, write_section
 from benchmarks.tradeoff import (
     SceneData,
     TradeoffSettings,
@@ -152,4 +152,5 @@ def main(scenes: Iterable[str] | None = None) -> str:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1].split(",") if len(sys.argv) > 1 else None)
+    args = positional_args()
+    main(args[0].split(",") if args else None)

@@ -100,6 +100,9 @@ def main() -> None:
     parser.add_argument("--figure", action="store_true", help="only write the docs figure")
     parser.add_argument("--size", type=int, default=1000)
     parser.add_argument("--lights", type=int, default=100)
+    parser.add_argument(
+        "--write", action="store_true", help="write the figures into docs/ (else print only)"
+    )
     args = parser.parse_args()
     if args.figure:
         print(figure())

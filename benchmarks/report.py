@@ -1,13 +1,16 @@
-"""Write one benchmark's figures into its own section of ``docs/benchmarks.md``.
+"""Write one benchmark's figures into its own section of ``docs/benchmarks.md``, when asked.
 
 Each benchmark owns a section delimited by HTML comment markers, so benchmarks can be rerun
-independently without clobbering each other's figures.
+independently without clobbering each other's figures. A benchmark prints its figures; it
+writes them into the repository's committed docs only when its command line says ``--write``,
+so a quick or exploratory run never replaces the committed results.
 """
 
 from __future__ import annotations
 
 import platform
 import re
+import sys
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -15,7 +18,7 @@ DOCS = Path(__file__).resolve().parent.parent / "docs" / "benchmarks.md"
 HEADER = (
     "# Benchmarks\n\n"
     "Figures written by the scripts in `benchmarks/`; each section names the command that "
-    "measured it. Rerun a script to refresh its section.\n"
+    "measured it. A script prints its figures; rerun it with `--write` to refresh its section.\n"
 )
 
 
@@ -29,8 +32,22 @@ def machine_line() -> str:
     return f"Measured {when} on {platform.machine()}, {cores} cores, Python {py}."
 
 
-def write_section(name: str, markdown: str, path: Path = DOCS) -> Path:
-    """Replace (or append) the section ``name`` of the benchmarks document with ``markdown``."""
+def write_asked(argv: list[str] | None = None) -> bool:
+    """Whether the command line asked for the figures to be written (``--write``)."""
+    return "--write" in (sys.argv[1:] if argv is None else argv)
+
+
+def positional_args(argv: list[str] | None = None) -> list[str]:
+    """The command line's arguments without ``--write`` (for scripts that read positionals)."""
+    return [a for a in (sys.argv[1:] if argv is None else argv) if a != "--write"]
+
+
+def write_section(name: str, markdown: str, path: Path = DOCS) -> Path | None:
+    """Replace (or append) the section ``name`` of ``path`` with ``markdown`` — only when the
+    command line says ``--write``; otherwise say how to, and write nothing (returns None)."""
+    if not write_asked():
+        print(f"(figures not written to {path.name}: rerun with --write to update it)")
+        return None
     begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
     block = f"{begin}\n{markdown.rstrip()}\n{end}"
     text = path.read_text(encoding="utf-8") if path.exists() else HEADER

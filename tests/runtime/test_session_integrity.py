@@ -29,7 +29,7 @@ from rti_rig.testing.disk_faults import WRITE_POINTS, failing_writes
 
 runner = CliRunner()
 LIGHTS = 8
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 def said(result) -> str:  # type: ignore[no-untyped-def]

@@ -15,7 +15,7 @@ import pytest
 from benchmarks.metrics import relight_psnr
 from rti_rig.reconstruct import fit_model, fit_photometric_stereo, select_model
 
-DATA = Path(__file__).parent / "data" / "reconstruct_neuralrti" / "crop.npz"
+DATA = Path(__file__).resolve().parents[1] / "data" / "reconstruct_neuralrti" / "crop.npz"
 
 
 @pytest.fixture(scope="module")

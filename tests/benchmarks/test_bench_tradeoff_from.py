@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 
-ACQ = Path(__file__).resolve().parent / "data" / "neuralrti_replay" / "dirs.lp"
+ACQ = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay" / "dirs.lp"
 
 
 def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:

@@ -16,7 +16,7 @@ from rti_rig.drivers.led_dome.messages import AllOff
 
 from rti_rig.app.dome_factory import policy_settings
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[3]
 
 
 def errors_of(**fields):

@@ -30,7 +30,7 @@ from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import DomeGeometry
 
-DATA = Path(__file__).parent / "data" / "neuralrti"
+DATA = Path(__file__).resolve().parents[1] / "data" / "neuralrti"
 _LP = read_lp(DATA / "dirs.lp")
 REAL_DOME = DomeGeometry(np.array([e.direction for e in _LP]), tuple(e.name for e in _LP))
 DOME = DomeGeometry(fibonacci_cap(96, 3.0, 88.0), tuple(f"led{i:02d}" for i in range(96)))

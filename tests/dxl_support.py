@@ -1,4 +1,4 @@
-"""Shared helpers for the Dynamixel arm tests (imported by the others), and their tests."""
+"""Shared helpers for the Dynamixel arm tests (imported by them from tests/)."""
 
 from __future__ import annotations
 
@@ -24,9 +24,3 @@ def arm_settings(**overrides) -> ArmSettings:
         else:
             base[key] = value
     return ArmSettings(**base)
-
-
-def test_default_test_arm_is_valid_and_overridable() -> None:
-    s = arm_settings(azimuth=dict(servo_id=7))
-    assert s.servo_ids == (7, 2)
-    assert s.azimuth.tick_limits == (114, 3982)  # 2048 -+ 170 deg / 0.0879 deg, rounded in

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from dxl_support import arm_settings
 from pydantic import ValidationError
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
@@ -21,7 +22,6 @@ from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.devices import LightCarrier
 from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
-from tests.test_dxl_support import arm_settings
 
 
 def make_arm(**overrides):
@@ -280,7 +280,7 @@ def test_the_documented_rig_config_validates_and_dry_runs() -> None:
 
     from rti_rig.drivers.dynamixel.settings import ArmSettings
 
-    doc = Path(__file__).resolve().parent.parent / "docs" / "protocols" / "dynamixel-arm.md"
+    doc = Path(__file__).resolve().parents[3] / "docs" / "protocols" / "dynamixel-arm.md"
     block = re.search(r"```toml\n(.*?)```", doc.read_text(encoding="utf-8"), re.DOTALL)
     assert block is not None
     table = tomllib.loads(block.group(1))["arm"]

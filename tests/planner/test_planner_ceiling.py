@@ -23,7 +23,7 @@ from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fi
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 DOME = DomeGeometry(fibonacci_cap(60, 5.0, 88.0), tuple(f"led{i:02d}" for i in range(60)))
 ARM = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
 SCENE = relief_scene(64, 64, seed=3)

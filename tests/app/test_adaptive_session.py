@@ -20,7 +20,7 @@ from rti_rig.cli import app
 from rti_rig.core.lp_format import read_lp
 from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted, run_session
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 
 

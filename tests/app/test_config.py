@@ -104,7 +104,7 @@ def test_led_below_plane_rejected(tmp_path: Path) -> None:
 
 def test_missing_backend_with_device_tables_is_refused(tmp_path: Path) -> None:
     """A hardware config that lost its backend line must not run as a dry run unnoticed."""
-    shipped = Path(__file__).parents[1] / "rig_configs" / "example_dome_48.toml"
+    shipped = Path(__file__).resolve().parents[2] / "rig_configs" / "example_dome_48.toml"
     text = shipped.read_text(encoding="utf-8")
     assert 'backend = "hardware"\n' in text
     (tmp_path / "example_dome_48.lp").write_text(

@@ -24,7 +24,7 @@ from rti_rig.core.image_files import (
 from rti_rig.core.lp_format import read_lp
 from tests.conftest import SMALL_DOME, write_config
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay"
 runner = CliRunner()
 

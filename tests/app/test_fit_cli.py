@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 from rti_rig.cli import app
 from rti_rig.core.rti_bases import hsh_basis, ptm_basis
 
-sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from fit_sessions import make_session
 
 runner = CliRunner()
@@ -153,7 +153,7 @@ def test_fit_refuses_a_missing_source_and_an_unknown_model(tmp_path: Path, clean
 
 
 def test_run_prints_the_verdict_unless_told_not_to(tmp_path: Path) -> None:
-    cfg = Path(__file__).parents[1] / "rig_configs" / "simulated_dome.toml"
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "a"), "--lights", "12"])
     assert r.exit_code == 0, r.output
     assert "QA verdict:" in r.output

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from rti_rig.core.errors import LpFormatError
 from rti_rig.core.lp_format import LpEntry, format_lp, parse_lp, read_lp, write_lp
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 # The profile of docs/conventions.md: count line, then 'name x y z' in fixed point 0.xxxxxx.
 PROFILE_LINE = re.compile(r"^[^\s]+( -?0\.\d{6}){3}$")
 

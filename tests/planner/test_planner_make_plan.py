@@ -16,7 +16,7 @@ from rti_rig.core.geometry import angle_between_deg, direction_from_az_el, fibon
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
-DATA = Path(__file__).parent / "data" / "neuralrti"
+DATA = Path(__file__).resolve().parents[1] / "data" / "neuralrti"
 _LP = read_lp(DATA / "dirs.lp")
 REAL_DOME = DomeGeometry(np.array([e.direction for e in _LP]), tuple(e.name for e in _LP))
 DOME = DomeGeometry(fibonacci_cap(48, 5.0, 88.0), tuple(f"led{i:02d}" for i in range(48)))

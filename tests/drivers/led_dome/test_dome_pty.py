@@ -229,7 +229,7 @@ def test_dry_run_against_the_emulator_in_another_process():
         ],
         stdout=subprocess.PIPE,
         text=True,
-        cwd=Path(__file__).resolve().parent.parent,
+        cwd=Path(__file__).resolve().parents[3],
     )
     try:
         line = proc.stdout.readline()

@@ -14,7 +14,7 @@ from rti_rig.drivers.cameras import kinds
 from rti_rig.drivers.cameras.factory import build_camera
 from rti_rig.drivers.cameras.settings import parse_camera_settings
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 DOC = REPO / "docs" / "extending.md"
 
 

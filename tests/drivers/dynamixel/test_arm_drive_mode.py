@@ -9,6 +9,7 @@ back to life. A lost or corrupt status packet fails one exchange; a read is safe
 from __future__ import annotations
 
 import pytest
+from dxl_support import arm_settings
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.faults import CommunicationError, ConfigMismatchError
@@ -16,7 +17,6 @@ from rti_rig.simulator.dynamixel_emulator import EmulatedServo, InProcessPort, e
 
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.geometry import direction_from_az_el
-from tests.test_dxl_support import arm_settings
 
 
 def make_arm(drive_mode: int = 0, firmware: int | None = None):  # type: ignore[no-untyped-def]

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from dxl_support import arm_settings
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from rti_rig.planner.arm_order import (
@@ -20,7 +21,6 @@ from rti_rig.planner.arm_order import (
 
 from rti_rig.core.arm_motion import joint_move_time_s, move_time_matrix, move_time_s
 from rti_rig.core.geometry import direction_from_az_el
-from tests.test_dxl_support import arm_settings
 
 
 def test_trapezoid_and_triangle() -> None:

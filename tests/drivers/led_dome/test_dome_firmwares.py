@@ -271,7 +271,7 @@ def elexol_with_map(tmp_path: Path, map_text: str, section: str = "Dome main") -
 def test_elexol_led_map_file_relative_to_the_config_drives_the_mapped_outputs(
     tmp_path: Path,
 ) -> None:
-    data = Path(__file__).parent / "data" / "domes" / "led-maps.txt"
+    data = Path(__file__).resolve().parents[2] / "data" / "domes" / "led-maps.txt"
     cfg = elexol_with_map(tmp_path, data.read_text())
     r = runner.invoke(app, ["check", str(cfg)])
     assert r.exit_code == 0, r.output

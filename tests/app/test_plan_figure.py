@@ -26,7 +26,7 @@ from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 DOME = DomeGeometry(fibonacci_cap(40, 5.0, 85.0), tuple(f"led{i:02d}" for i in range(40)))
 runner = CliRunner()
 
