@@ -33,10 +33,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-from rti_rig.planner.adaptive import START_FLOOR_DEG, START_LIGHTS
-from rti_rig.planner.objectives import models_for
-from rti_rig.planner.topography import REC709
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.metrics import relight_psnr
 from benchmarks.paired import compare
@@ -45,6 +41,10 @@ from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import AdaptiveChooser, small_grey
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.adaptive import START_FLOOR_DEG, START_LIGHTS
+from rti_rig.planner.objectives import models_for
+from rti_rig.planner.topography import REC709
+from rti_rig.planner.uniform import select_uniform_leds
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "adaptive.md"
 NS = (6, 9, 12, 18)

@@ -23,16 +23,16 @@ import sys
 import time
 
 import numpy as np
-from rti_rig.planner.adaptive import choose_next
-from rti_rig.planner.make_plan import plan_with_report
-from rti_rig.planner.objectives import candidates_for
-from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 from benchmarks.adaptive import DOC
 from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import fit_state, small_grey
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.planner.adaptive import choose_next
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.objectives import candidates_for
+from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 NS = (6, 9, 12, 18, 24, 36, 50, 75, 100)
 

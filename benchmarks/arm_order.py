@@ -16,6 +16,11 @@ import sys
 import time
 
 import numpy as np
+
+from benchmarks.report import machine_line, write_section
+from rti_rig.core.arm_motion import move_time_matrix
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.settings import ArmSettings
 from rti_rig.planner.arm_order import (
@@ -26,11 +31,6 @@ from rti_rig.planner.arm_order import (
     path_time_s,
 )
 from rti_rig.simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
-
-from benchmarks.report import machine_line, write_section
-from rti_rig.core.arm_motion import move_time_matrix
-from rti_rig.core.clock import VirtualClock
-from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
 
 SIZES = (8, 12, 25, 50, 100)
 TRIALS = 7

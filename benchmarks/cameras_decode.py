@@ -12,11 +12,11 @@ import statistics
 import time
 
 import numpy as np
+
+from benchmarks.report import machine_line, write_section
 from rti_rig.drivers.cameras.dng_writer import dng_bytes
 from rti_rig.drivers.cameras.raw_decode import decode_raw
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
-
-from benchmarks.report import machine_line, write_section
 
 MODES = ("mosaic", "half", "demosaic")
 

@@ -16,14 +16,13 @@ import statistics
 import sys
 import time
 
+from benchmarks.report import machine_line, write_section
+from rti_rig.app.dome_factory import build_dome
+from rti_rig.core.clock import VirtualClock
 from rti_rig.drivers.led_dome.dome_profiles import described_profiles
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.simulator.domes import board_for
 from rti_rig.simulator.pty_link import serve_on_pty
-
-from benchmarks.report import machine_line, write_section
-from rti_rig.app.dome_factory import build_dome
-from rti_rig.core.clock import VirtualClock
 
 LIGHTS = 8
 OVERRIDES = {"rtipy": {"light_on_s": 1.0}}

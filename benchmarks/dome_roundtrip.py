@@ -17,12 +17,12 @@ import statistics
 import time
 
 import numpy as np
-from rti_rig.drivers.led_dome.settings import DomeSerialSettings
-from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 
 from benchmarks.report import machine_line, write_section
 from rti_rig.app.dome_factory import build_dome
 from rti_rig.core.clock import SystemClock
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 
 LEDS = 48
 REPEATS = 200

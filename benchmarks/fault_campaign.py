@@ -29,13 +29,6 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
-from rti_rig.simulator.faults import (
-    FaultPlan,
-    FaultyCamera,
-    FaultyCarrier,
-    FaultyLightSource,
-    ServoFaultCarrier,
-)
 
 from rti_rig.app.usecases.session import (
     NewSessionRequest,
@@ -49,6 +42,13 @@ from rti_rig.app.usecases.session import (
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.runtime.session import read_manifest, scan_journal
+from rti_rig.simulator.faults import (
+    FaultPlan,
+    FaultyCamera,
+    FaultyCarrier,
+    FaultyLightSource,
+    ServoFaultCarrier,
+)
 from rti_rig.testing.disk_faults import ERRNOS, WRITE_POINTS, failing_writes
 from rti_rig.testing.kill_hooks import popen_session
 from rti_rig.testing.verify import wrong_light_steps

@@ -25,13 +25,13 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from rti_rig.planner.uniform import plan_uniform
 
 from benchmarks.fault_campaign import committed_files
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.schedule import LightSchedule
+from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.controller import run_session
 from rti_rig.runtime.session import SessionFolder, read_manifest
 from rti_rig.testing.verify import wrong_light_steps

@@ -31,8 +31,6 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.planner.objectives import models_for
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import (
     DATA,
@@ -56,6 +54,8 @@ from benchmarks.report import write_section
 from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.objectives import models_for
+from rti_rig.planner.uniform import select_uniform_leds
 
 CEILING = 60.0
 SENSITIVITY = (50.0, 70.0)

@@ -41,16 +41,16 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from rti_rig.planner.make_plan import plan_with_report
-from rti_rig.planner.objectives import models_for
-from rti_rig.planner.topography import REC709
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.metrics import angular_error_map, relight_psnr
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.rti_bases import design_matrix
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.objectives import models_for
+from rti_rig.planner.topography import REC709
+from rti_rig.planner.uniform import select_uniform_leds
 from rti_rig.reconstruct import ReconstructionError, fit_hsh, fit_photometric_stereo, fit_ptm
 
 #: The real acquisition, in the shared folder beside the repository (not needed by tests).

@@ -36,8 +36,6 @@ import sys
 import time
 
 import numpy as np
-from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.paired import compare
 from benchmarks.planner_real_data import (
@@ -53,6 +51,8 @@ from benchmarks.planner_real_data import (
 from benchmarks.report import positional_args, write_section
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
+from rti_rig.planner.uniform import select_uniform_leds
 
 DRAWS = 144
 REMOVED = 8

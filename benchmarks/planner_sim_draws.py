@@ -23,9 +23,6 @@ import time
 from collections.abc import Iterator, Sequence
 
 import numpy as np
-from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
-from rti_rig.planner.topography import REC709
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.metrics import relight_psnr
 from benchmarks.paired import compare
@@ -33,6 +30,9 @@ from benchmarks.planner_real_data import DOC, planned_leds, relight_model
 from benchmarks.report import write_section
 from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME, models_for
+from rti_rig.planner.topography import REC709
+from rti_rig.planner.uniform import select_uniform_leds
 
 DRAWS = 8
 REMOVED = 24

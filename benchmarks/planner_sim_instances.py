@@ -20,7 +20,6 @@ import time
 from collections.abc import Iterable, Sequence
 
 import numpy as np
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import DOC, planned_leds
 from benchmarks.planner_sim_draws import (
@@ -35,6 +34,7 @@ from benchmarks.planner_sim_draws import (
 )
 from benchmarks.report import write_section
 from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
+from rti_rig.planner.uniform import select_uniform_leds
 
 #: Scene seeds run here (seed 0 is the instance of ``benchmarks.planner_sim_draws``).
 INSTANCES = (1, 2)

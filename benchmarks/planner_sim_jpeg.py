@@ -30,9 +30,6 @@ import time
 import cv2
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME
-from rti_rig.planner.uniform import select_uniform_leds
-from rti_rig.simulator.camera_model import encode_jpeg, to_srgb8
 
 from benchmarks.planner_real_data import DOC, planned_leds, srgb_to_linear
 from benchmarks.planner_sim_draws import (
@@ -47,6 +44,9 @@ from benchmarks.planner_sim_draws import (
 )
 from benchmarks.report import write_section
 from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
+from rti_rig.planner.objectives import SIGNAL_NOISE_JPEG_DOME
+from rti_rig.planner.uniform import select_uniform_leds
+from rti_rig.simulator.camera_model import encode_jpeg, to_srgb8
 
 #: JPEG quality of the simulated 8-bit camera (the simulator's ``encode_jpeg`` default; the
 #: real dome's is not recorded).

@@ -30,10 +30,6 @@ import time
 
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.planner.make_plan import plan_with_report
-from rti_rig.planner.objectives import HELD_OUT, NormalsObjective, candidates_for
-from rti_rig.planner.surface_estimate import estimate_surface, sample_surface
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import DOC
 from benchmarks.report import write_section
@@ -45,6 +41,10 @@ from benchmarks.tradeoff import (
 )
 from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.objectives import HELD_OUT, NormalsObjective, candidates_for
+from rti_rig.planner.surface_estimate import estimate_surface, sample_surface
+from rti_rig.planner.uniform import select_uniform_leds
 
 COUNTS = (6, 12, 20, 30)
 FLOORS = (0.0, 10.0, 20.0, 30.0)

@@ -26,7 +26,6 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import DOC, hindsight_exchange, planned_leds
 from benchmarks.planner_sim_draws import COUNTS, FLOORS
@@ -40,6 +39,7 @@ from benchmarks.tradeoff import (
 )
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.uniform import select_uniform_leds
 
 SWEEPS = 2
 STRIDE = 2

@@ -17,14 +17,14 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from rti_rig.planner.make_plan import plan_with_report
-from rti_rig.planner.topography import planning_image
-from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 from benchmarks.report import machine_line, write_section
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.topography import planning_image
+from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 REPEATS = 5
 LP = Path(__file__).resolve().parent.parent / "tests" / "data" / "neuralrti" / "dirs.lp"

@@ -13,12 +13,12 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
+
+from benchmarks.report import machine_line, write_section
 from rti_rig.simulator import light_transport as lt
 from rti_rig.simulator.ground_truth import homogeneous_directions
 from rti_rig.simulator.light_transport import light_at, prepare, render_radiance
 from rti_rig.simulator.scenes import make_scene
-
-from benchmarks.report import machine_line, write_section
 
 FIGURE = Path(__file__).resolve().parent.parent / "docs" / "figures" / "sim_scenes.png"
 
@@ -70,9 +70,9 @@ def figure(size: int = 384) -> Path:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from rti_rig.simulator.camera_model import CameraModel, to_srgb8
 
     from rti_rig.core.geometry import direction_from_az_el
+    from rti_rig.simulator.camera_model import CameraModel, to_srgb8
 
     cam, rng = CameraModel(), np.random.default_rng(0)
     lights = [(0, 15), (120, 35), (240, 60), (0, 90)]

@@ -296,10 +296,9 @@ def run_scene(
     data: SceneData, s: TradeoffSettings, progress: Callable[[str], None] = print
 ) -> list[Row]:
     """Every plan for one rendered scene."""
+    from rti_rig.core.errors import ScheduleError
     from rti_rig.planner.make_plan import make_plan
     from rti_rig.planner.uniform import select_uniform_leds
-
-    from rti_rig.core.errors import ScheduleError
 
     dome = DomeGeometry(data.candidate_dirs, tuple(f"c{i:03d}" for i in range(s.candidates)))
     rows: list[Row] = []

@@ -57,14 +57,13 @@ def load_acquisition(lp: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
 
 def run_tradeoff_from(lp: Path, progress: Callable[[str], None] = print) -> list[Row]:
     """Rows (one per plan and N) for the acquisition ``lp``; see the module docstring."""
-    from rti_rig.planner.adaptive import START_FLOOR_DEG, START_LIGHTS
-    from rti_rig.planner.objectives import models_for
-    from rti_rig.planner.uniform import select_uniform_leds
-
     from benchmarks.planner_real_data import evaluate, planned_leds, reference
     from rti_rig.app.usecases.adaptive import AdaptiveChooser
     from rti_rig.core.errors import ScheduleError
     from rti_rig.core.rig_geometry import DomeGeometry
+    from rti_rig.planner.adaptive import START_FLOOR_DEG, START_LIGHTS
+    from rti_rig.planner.objectives import models_for
+    from rti_rig.planner.uniform import select_uniform_leds
 
     images, dirs, names = load_acquisition(Path(lp))
     dome = DomeGeometry(dirs, tuple(names))

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+
 from rti_rig.planner.kmeans_method import plan_kmeans
 from rti_rig.planner.methods import MethodContext, SurfaceNeed, register_method
 from rti_rig.planner.objectives import NormalsObjective, RelightObjective

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+
 from rti_rig.planner.objectives import Candidates, snap_unique
 
 #: Normals fed to k-means (a random subset; clustering needs the distribution, not every pixel).

@@ -27,6 +27,13 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from threadpoolctl import threadpool_limits
+
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
+from rti_rig.core.lp_format import MAX_LIGHTS
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.core.schedule import LightSchedule
 from rti_rig.planner.builtin_methods import MANY_LIGHTS, MIN_LIGHTS_FOR_EXCHANGE
 from rti_rig.planner.methods import MethodContext, PlanMethod, get_method
 from rti_rig.planner.objectives import (
@@ -51,13 +58,6 @@ from rti_rig.planner.surface_estimate import (
 )
 from rti_rig.planner.topography import DepthModelSpec
 from rti_rig.planner.uniform import arm_below, order_nearest_neighbour, select_uniform_leds
-from threadpoolctl import threadpool_limits
-
-from rti_rig.core.errors import ScheduleError
-from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
-from rti_rig.core.lp_format import MAX_LIGHTS
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
-from rti_rig.core.schedule import LightSchedule
 
 __all__ = ["MANY_LIGHTS", "PlanRequest", "make_plan", "plan", "plan_with_report"]
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
+
 from rti_rig.planner.objectives import NormalsObjective, RelightObjective
 
 #: At most this many sweeps over the chosen lights (a bound on run time; rarely reached).

@@ -9,12 +9,12 @@ reachable direction) and the direction that fired is recorded with the image.
 from __future__ import annotations
 
 import numpy as np
-from rti_rig.planner.from_lp import SNAP_TOLERANCE_DEG
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule
+from rti_rig.planner.from_lp import SNAP_TOLERANCE_DEG
 
 #: Default preview light (degrees): top left of the image, as objects are conventionally lit,
 #: at the middle of the paper's 45–60° band.

@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
+
+from rti_rig.core.errors import ScheduleError
 from rti_rig.planner.normals import (
     ReliefFit,
     fit_relief_scale,
@@ -49,8 +51,6 @@ from rti_rig.planner.topography import (
     planning_image,
     shape_from_shading,
 )
-
-from rti_rig.core.errors import ScheduleError
 
 #: Pixels sampled for the objectives.
 SAMPLE_PIXELS = 256

@@ -23,6 +23,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
 
+from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.drivers.led_dome.codec_base import DomeCodec
 from rti_rig.drivers.led_dome.messages import (
     ERR_BAD_ARGUMENT,
@@ -44,8 +45,6 @@ from rti_rig.drivers.led_dome.profiles import make_codec
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.drivers.led_dome.transport import TransportError
 from rti_rig.simulator.pty_link import PtyLink, serve_on_pty
-
-from rti_rig.core.clock import Clock, SystemClock
 
 
 class FaultKind(StrEnum):

@@ -29,10 +29,9 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
+from rti_rig.core.clock import Clock
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
-
-from rti_rig.core.clock import Clock
 
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
@@ -562,9 +561,8 @@ def emulated_arm_port(
 
 def main() -> None:  # pragma: no cover - manual tool
     """Serve two XL430s (ids 1, 2) on a pty until Ctrl-C, in real time (SystemClock)."""
-    from rti_rig.simulator.dynamixel_pty import PtyServoServer
-
     from rti_rig.core.clock import SystemClock
+    from rti_rig.simulator.dynamixel_pty import PtyServoServer
 
     clock = SystemClock()
     emulator = DynamixelBusEmulator(

@@ -40,6 +40,7 @@ import tty
 from typing import Any
 
 import dynamixel_sdk
+
 from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
 
 #: Wall-time bound on a reply wait that is still *not* causally over (bytes lost in the kernel,

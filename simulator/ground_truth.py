@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.simulator.light_transport import Light, light_at, render_radiance
-from rti_rig.simulator.scenes import Scene, SceneError
 
 from rti_rig.core.geometry import fibonacci_cap
+from rti_rig.simulator.light_transport import Light, light_at, render_radiance
+from rti_rig.simulator.scenes import Scene, SceneError
 
 #: Refuse to hold a ground truth larger than this in memory; use ``iter_ground_truth`` instead.
 DEFAULT_MAX_BYTES = 2 * 1024**3

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
 from rti_rig.simulator.scenes import KNOWN_PASSES, Scene, SceneError
 from rti_rig.simulator.shadows import directional_visibility, point_visibility
 

@@ -11,11 +11,11 @@ from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.simulator.sim_lights import LightState
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
+from rti_rig.simulator.sim_lights import LightState
 
 #: A renderer maps (light direction or None, intensity) to linear radiance (H, W, 3) in [0, ~1].
 Renderer = Callable[[NDArray[np.float64] | None, float], NDArray[np.float64]]

@@ -12,11 +12,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from rti_rig.simulator.light_transport import DirectionalLight, render_radiance
-from rti_rig.simulator.scenes import make_scene
 
 from rti_rig.core.image_files import write_linear_tiff
 from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.simulator.light_transport import DirectionalLight, render_radiance
+from rti_rig.simulator.scenes import make_scene
 
 
 def dome_lights() -> np.ndarray:

@@ -7,9 +7,8 @@ lights off, and subtract the master with ``raw_decode.subtract_dark`` after each
 
 from __future__ import annotations
 
-from rti_rig.drivers.cameras.raw_decode import average_frames
-
 from rti_rig.core.devices import Camera, DiscreteLightSource, Frame
+from rti_rig.drivers.cameras.raw_decode import average_frames
 
 
 def capture_master_dark(

@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from rti_rig.drivers.cameras.settings import ExposureRule
 
 from rti_rig.core.devices import Camera, Frame
 from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.settings import ExposureRule
 
 
 @dataclass(frozen=True)

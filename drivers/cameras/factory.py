@@ -13,6 +13,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import Camera
 from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
 from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
 from rti_rig.drivers.cameras.kinds import (
@@ -28,9 +30,6 @@ from rti_rig.drivers.cameras.settings import (
     Gphoto2CameraSettings,
     OpenCvCameraSettings,
 )
-
-from rti_rig.core.clock import Clock
-from rti_rig.core.devices import Camera
 
 
 def build_camera(

@@ -17,13 +17,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rti_rig.drivers.cameras.image_io import read_image_file, to_linear_uint16
-from rti_rig.drivers.cameras.raw_decode import decode_raw, exposure_stats
-from rti_rig.drivers.cameras.settings import FolderWatchSettings
 
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.drivers.cameras.image_io import read_image_file, to_linear_uint16
+from rti_rig.drivers.cameras.raw_decode import decode_raw, exposure_stats
+from rti_rig.drivers.cameras.settings import FolderWatchSettings
 
 RAW_SUFFIXES = {
     ".dng",

@@ -24,13 +24,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
-from rti_rig.drivers.cameras.folder_watch import is_raw_file
-from rti_rig.drivers.cameras.raw_decode import decode_raw
-from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
-
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.drivers.cameras.folder_watch import is_raw_file
+from rti_rig.drivers.cameras.raw_decode import decode_raw
+from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
 T = TypeVar("T")
 

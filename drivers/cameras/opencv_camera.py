@@ -22,13 +22,13 @@ from typing import Any, Protocol
 
 import cv2
 import numpy as np
-from rti_rig.drivers.cameras.image_io import to_linear_uint16
-from rti_rig.drivers.cameras.raw_decode import exposure_stats
-from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.drivers.cameras.image_io import to_linear_uint16
+from rti_rig.drivers.cameras.raw_decode import exposure_stats
+from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 
 RAW_GREY_FOURCCS = {"Y16 ", "Y10 ", "Y12 "}
 

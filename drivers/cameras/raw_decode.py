@@ -22,11 +22,11 @@ import cv2
 import numpy as np
 import rawpy
 from numpy.typing import NDArray
-from rti_rig.drivers.cameras.settings import RawDecodeSettings
 from scipy.ndimage import correlate
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
 DECODER = "raw-decode"
 _COLOR_NAMES = "RGBG"

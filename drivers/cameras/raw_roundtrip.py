@@ -13,13 +13,13 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic
-from rti_rig.drivers.cameras.raw_decode import decode_raw
-from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
 from rti_rig.core.clock import Clock, VirtualClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic
+from rti_rig.drivers.cameras.raw_decode import decode_raw
+from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
 
 def encode_decode(

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from rti_rig.core.clock import Clock
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.bus import DxlBus
@@ -33,8 +35,6 @@ from rti_rig.drivers.dynamixel.faults import (
 )
 from rti_rig.drivers.dynamixel.kinematics import ArmKinematics, as_direction, clamp_ticks
 from rti_rig.drivers.dynamixel.settings import ArmSettings
-
-from rti_rig.core.clock import Clock
 
 log = logging.getLogger("rti_rig.dynamixel.arm")
 

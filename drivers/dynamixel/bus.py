@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from typing import Any
 
 import dynamixel_sdk as sdk
+
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.faults import (

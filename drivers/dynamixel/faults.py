@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-from rti_rig.drivers.dynamixel import control_table as ct
-
 from rti_rig.core.errors import DeviceError, ScheduleError
+from rti_rig.drivers.dynamixel import control_table as ct
 
 
 class DynamixelError(DeviceError):

@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from rti_rig.drivers.dynamixel import control_table as ct
 
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.drivers.dynamixel import control_table as ct
 
 if TYPE_CHECKING:  # annotations only: settings validates a park pose with these kinematics
     from rti_rig.drivers.dynamixel.settings import ArmSettings, JointSettings

@@ -18,6 +18,7 @@ import math
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
 

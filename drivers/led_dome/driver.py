@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import logging
 
+from rti_rig.core.dome_link import DomeInfo, DomeLinkError, LinkFault
 from rti_rig.drivers.led_dome.codec_base import DomeCodec
 from rti_rig.drivers.led_dome.messages import (
     ERROR_CODES,
@@ -36,8 +37,6 @@ from rti_rig.drivers.led_dome.messages import (
     error_text,
 )
 from rti_rig.drivers.led_dome.transport import Transport, TransportError
-
-from rti_rig.core.dome_link import DomeInfo, DomeLinkError, LinkFault
 
 #: Every byte to and from the dome goes through this logger (DEBUG, hex).
 traffic_log = logging.getLogger("rti_rig.dome.traffic")

@@ -11,14 +11,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rti_rig.core.errors import ConfigError
 from rti_rig.drivers.led_dome.driver import LedDomeDriver
 from rti_rig.drivers.led_dome.profiles import make_codec
 from rti_rig.drivers.led_dome.protocol_spec import ProtocolSpec, parse_led_map
 from rti_rig.drivers.led_dome.scripted import ScriptedDomeDriver
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.drivers.led_dome.transport import SerialTransport, Transport
-
-from rti_rig.core.errors import ConfigError
 
 
 def protocol_for(settings: DomeSerialSettings) -> ProtocolSpec:

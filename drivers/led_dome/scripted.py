@@ -22,10 +22,9 @@ from __future__ import annotations
 import logging
 import re
 
+from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
 from rti_rig.drivers.led_dome.protocol_spec import CommandSpec, ProtocolSpec
 from rti_rig.drivers.led_dome.transport import Transport, TransportError
-
-from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
 
 traffic_log = logging.getLogger("rti_rig.dome.traffic")
 

@@ -18,6 +18,7 @@ from pydantic import (
     field_validator,
     model_validator,
 )
+
 from rti_rig.drivers.led_dome.dome_profiles import (
     all_profiles,
     builtin_spec,

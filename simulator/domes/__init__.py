@@ -3,10 +3,9 @@
 
 from __future__ import annotations
 
+from rti_rig.core.clock import Clock
 from rti_rig.simulator.dome_firmware import FaultPlan
 from rti_rig.simulator.domes.board import Board
-
-from rti_rig.core.clock import Clock
 
 
 def board_for(

@@ -25,9 +25,8 @@ from collections import deque
 from collections.abc import Generator
 from dataclasses import dataclass
 
-from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan, Output, garble
-
 from rti_rig.core.clock import Clock, SystemClock
+from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan, Output, garble
 
 RX_BUFFER = 64
 

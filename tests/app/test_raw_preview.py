@@ -11,8 +11,6 @@ import numpy as np
 import pytest
 import tifffile
 from conftest import REPO
-from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
-from rti_rig.planner.topography import planning_image
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import read_preview_image
@@ -20,6 +18,8 @@ from rti_rig.cli import app
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import read_lp
+from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+from rti_rig.planner.topography import planning_image
 
 BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
 LIGHT = (45.0, 50.0)

@@ -8,12 +8,12 @@ carries a highlight that no low-order basis can fit.
 from __future__ import annotations
 
 import numpy as np
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import hindsight_relight
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.rti_bases import design_matrix
+from rti_rig.planner.uniform import select_uniform_leds
 
 
 def _held_out_psnr(sel: np.ndarray, images: np.ndarray, dirs: np.ndarray) -> float:

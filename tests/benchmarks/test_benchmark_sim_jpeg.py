@@ -8,11 +8,11 @@ spread scaling the light before the camera, so a bright LED saturates as it woul
 from __future__ import annotations
 
 import numpy as np
-from rti_rig.simulator.camera_model import to_srgb8
 
 from benchmarks.planner_real_data import srgb_to_linear
 from benchmarks.planner_sim_jpeg import jpeg_round_trip, led_factors
 from benchmarks.tradeoff import TradeoffSettings, render_scene_data
+from rti_rig.simulator.camera_model import to_srgb8
 
 
 def _ramp() -> np.ndarray:

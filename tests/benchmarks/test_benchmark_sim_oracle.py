@@ -9,7 +9,6 @@ tried when it samples them; its cost must be the measured error against the trut
 from __future__ import annotations
 
 import numpy as np
-from rti_rig.planner.uniform import select_uniform_leds
 
 from benchmarks.planner_real_data import hindsight_exchange
 from benchmarks.planner_sim_instances import instance_errors
@@ -17,6 +16,7 @@ from benchmarks.planner_sim_oracle import fresh_shots, true_error_cost
 from benchmarks.tradeoff import SceneData, TradeoffSettings, render_scene_data
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.uniform import select_uniform_leds
 
 DIRS = fibonacci_cap(30, 10.0, 85.0)
 QUICK = TradeoffSettings(size_px=32, candidates=60, ground_truth_lights=50, held_out_lights=1)

@@ -436,11 +436,10 @@ def test_plan_orders_an_arm_by_move_time_with_its_servo_settings(tmp_path: Path)
     """``rti-rig plan`` on an arm with ``[arm.dynamixel]`` fires its stops in the move-time
     order of ``rti_rig.planner.arm_order`` (the issue's "move-time order for arms"), which here is
     faster than the nearest-neighbour fallback."""
-    from rti_rig.planner.arm_order import order_for_arm
-    from rti_rig.planner.uniform import order_nearest_neighbour
-
     from rti_rig.app.config import load_rig_config, rig_geometry
     from rti_rig.core.arm_motion import sequence_time_s
+    from rti_rig.planner.arm_order import order_for_arm
+    from rti_rig.planner.uniform import order_nearest_neighbour
 
     rig = REPO / "rig_configs" / "simulated_arm.toml"
     plan = tmp_path / "plan.lp"

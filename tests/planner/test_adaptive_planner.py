@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
+from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.planner.adaptive import (
     MAX_ERR2,
     SurfaceState,
@@ -12,8 +14,6 @@ from rti_rig.planner.adaptive import (
     estimate_error_deg,
     predicted_error2,
 )
-
-from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 
 
 def state_for(normals: np.ndarray, lights: np.ndarray, noise: float = 0.01) -> SurfaceState:

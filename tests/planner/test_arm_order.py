@@ -10,6 +10,9 @@ import pytest
 from dxl_support import arm_settings
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
+from rti_rig.core.arm_motion import joint_move_time_s, move_time_matrix, move_time_s
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.planner.arm_order import (
     EXACT_MAX,
     held_karp,
@@ -18,9 +21,6 @@ from rti_rig.planner.arm_order import (
     order_from_matrix,
     path_time_s,
 )
-
-from rti_rig.core.arm_motion import joint_move_time_s, move_time_matrix, move_time_s
-from rti_rig.core.geometry import direction_from_az_el
 
 
 def test_trapezoid_and_triangle() -> None:

@@ -9,14 +9,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rti_rig.planner import methods
-from rti_rig.planner.make_plan import plan_with_report
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.lp_format import read_lp
+from rti_rig.planner import methods
+from rti_rig.planner.make_plan import plan_with_report
 
 REPO = Path(__file__).resolve().parents[2]
 DOC = REPO / "docs" / "extending.md"

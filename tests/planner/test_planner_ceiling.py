@@ -11,10 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rti_rig.planner.make_plan import arm_below, check_elevation_band, make_plan, plan_with_report
-from rti_rig.planner.objectives import candidates_for
-from rti_rig.planner.uniform import select_uniform_leds
-from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -22,6 +18,10 @@ from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.planner.make_plan import arm_below, check_elevation_band, make_plan, plan_with_report
+from rti_rig.planner.objectives import candidates_for
+from rti_rig.planner.uniform import select_uniform_leds
+from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 REPO = Path(__file__).resolve().parents[2]
 DOME = DomeGeometry(fibonacci_cap(60, 5.0, 88.0), tuple(f"led{i:02d}" for i in range(60)))

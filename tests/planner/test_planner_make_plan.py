@@ -7,14 +7,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, MANY_LIGHTS, make_plan, plan_with_report
-from rti_rig.planner.uniform import plan_uniform
-from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, direction_from_az_el, fibonacci_cap
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, MANY_LIGHTS, make_plan, plan_with_report
+from rti_rig.planner.uniform import plan_uniform
+from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "neuralrti"
 _LP = read_lp(DATA / "dirs.lp")

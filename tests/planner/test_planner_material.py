@@ -12,6 +12,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
+from rti_rig.core.lp_format import read_lp
+from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner.make_plan import plan_with_report
 from rti_rig.planner.objectives import (
     GLOSSY_SPECULAR,
@@ -22,13 +29,6 @@ from rti_rig.planner.objectives import (
     reflectance,
 )
 from rti_rig.planner.surface_estimate import estimate_surface, flat_surface, sample_surface
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
-from rti_rig.core.errors import ScheduleError
-from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
-from rti_rig.core.lp_format import read_lp
-from rti_rig.core.rig_geometry import DomeGeometry
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "neuralrti"
 _LP = read_lp(DATA / "dirs.lp")

@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import angle_between_deg, direction_from_az_el, fibonacci_cap
+from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.planner.kmeans_method import cluster_normals, kmeans_targets, plan_kmeans
 from rti_rig.planner.objectives import (
     MAX_ERR2,
@@ -17,10 +21,6 @@ from rti_rig.planner.objectives import (
     snap_unique,
 )
 from rti_rig.planner.optimal import exchange_search
-
-from rti_rig.core.errors import ScheduleError
-from rti_rig.core.geometry import angle_between_deg, direction_from_az_el, fibonacci_cap
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
 SLANT_OPT = np.degrees(np.arccos(1 / np.sqrt(3)))  # 54.74°, Drbohlav & Chantler
 
@@ -117,9 +117,8 @@ def test_batched_swaps_equal_direct_costs(objective: str) -> None:
 
 def test_relight_cost_equals_a_per_pixel_held_out_evaluation() -> None:
     """The pixel-summed Gram form equals fitting each pixel and scoring it on held-out lights."""
-    from rti_rig.planner.objectives import reflectance
-
     from rti_rig.core.rti_bases import design_matrix
+    from rti_rig.planner.objectives import reflectance
 
     rng = np.random.default_rng(3)
     cands = candidates_for(DomeGeometry(fibonacci_cap(40, 5.0, 88.0), tuple(map(str, range(40)))))

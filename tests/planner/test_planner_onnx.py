@@ -8,12 +8,12 @@ import numpy as np
 import onnx
 import pytest
 from onnx import TensorProto, helper
-from rti_rig.planner.make_plan import plan_with_report
-from rti_rig.planner.topography import DepthModelSpec, depth_from_onnx
 
 from rti_rig.core.errors import ConfigError, ScheduleError
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.make_plan import plan_with_report
+from rti_rig.planner.topography import DepthModelSpec, depth_from_onnx
 
 DOME = DomeGeometry(fibonacci_cap(40, 5.0, 88.0), tuple(f"l{i:02d}.png" for i in range(40)))
 

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
+from rti_rig.core.errors import ScheduleError
+from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
 from rti_rig.planner.normals import fit_relief_scale, normals_from_height, sanitize_height
 from rti_rig.planner.objectives import cast_shadow_visibility
 from rti_rig.planner.topography import (
@@ -15,9 +18,6 @@ from rti_rig.planner.topography import (
     shape_from_shading,
 )
 from rti_rig.simulator.sim_scene import relief_scene
-
-from rti_rig.core.errors import ScheduleError
-from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
 
 
 def sphere_normals(size: int = 96) -> np.ndarray:
@@ -134,6 +134,7 @@ def test_cast_shadow_from_a_wall() -> None:
 
 def test_read_preview_keeps_type_and_rgb_order(tmp_path) -> None:
     import cv2
+
     from rti_rig.planner.topography import read_preview
 
     rgb = np.zeros((4, 5, 3), np.uint8)

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from rti_rig.planner.from_lp import schedule_from_lp
-from rti_rig.planner.uniform import plan_uniform, select_uniform_leds
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
 from rti_rig.core.lp_format import LpEntry
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.planner.from_lp import schedule_from_lp
+from rti_rig.planner.uniform import plan_uniform, select_uniform_leds
 
 DOME = DomeGeometry(fibonacci_cap(72, 5.0, 88.0), tuple(f"l{i:02d}.jpg" for i in range(72)))
 ARM = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)

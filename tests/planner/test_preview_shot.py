@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import REPO, SMALL_DOME, write_config
-from rti_rig.planner.preview_shot import PREVIEW_AZ_EL_DEG, preview_schedule
 from typer.testing import CliRunner
 
 from rti_rig.app.preview_source import resolve_preview
@@ -22,6 +21,7 @@ from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
 from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.planner.preview_shot import PREVIEW_AZ_EL_DEG, preview_schedule
 
 runner = CliRunner()
 IMAGE = REPO / "tests" / "data" / "neuralrti" / "image11_small.jpg"

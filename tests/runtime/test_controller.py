@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import REPO, SMALL_DOME, write_config
-from rti_rig.planner.uniform import plan_uniform
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.core.errors import CaptureError, DeviceError, ScheduleError, SessionError
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.controller import (
     CancelToken,
     FinishReason,

@@ -10,21 +10,14 @@ import itertools
 
 import numpy as np
 import pytest
-from rti_rig.drivers.led_dome import DomeSerialSettings
-from rti_rig.drivers.led_dome.codec_default import DefaultCodec
-from rti_rig.drivers.led_dome.driver import LedDomeDriver
-from rti_rig.simulator.dome_firmware import (
-    Fault,
-    FaultKind,
-    FaultPlan,
-    InProcessDomeTransport,
-    firmware_for,
-)
 
 from rti_rig.app.dome_factory import build_dome
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.devices import DiscreteLightSource
 from rti_rig.core.errors import DeviceError
+from rti_rig.drivers.led_dome import DomeSerialSettings
+from rti_rig.drivers.led_dome.codec_default import DefaultCodec
+from rti_rig.drivers.led_dome.driver import LedDomeDriver
 from rti_rig.runtime.dome_policy import (
     DomeLedError,
     DomeLinkError,
@@ -33,6 +26,13 @@ from rti_rig.runtime.dome_policy import (
     ThermalGuard,
     ThermalLimits,
     self_test,
+)
+from rti_rig.simulator.dome_firmware import (
+    Fault,
+    FaultKind,
+    FaultPlan,
+    InProcessDomeTransport,
+    firmware_for,
 )
 
 PROFILES = ["default", "framed", "binary"]

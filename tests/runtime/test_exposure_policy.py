@@ -7,12 +7,12 @@ from pathlib import Path
 
 import pytest
 from conftest import SMALL_DOME, write_config
-from rti_rig.planner.uniform import plan_uniform
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
+from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.exposure_policy import brightest_step, fix_session_exposure
 
 runner = CliRunner()

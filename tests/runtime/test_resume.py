@@ -12,13 +12,13 @@ from pathlib import Path
 
 import pytest
 from conftest import SMALL_DOME, write_config
-from rti_rig.planner.uniform import plan_uniform
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.core.errors import SessionError
+from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.controller import CancelToken, FinishReason, Paused, StepCompleted, run_session
 from rti_rig.runtime.session import SessionFolder
 from rti_rig.testing.kill_hooks import popen_session

@@ -299,9 +299,8 @@ def test_export_leaves_out_an_image_deleted_since(
 def test_unreachable_rig_creates_nothing_and_promises_no_resume(
     tmp_path: Path, reference: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from rti_rig.simulator.sim_lights import SimulatedDome
-
     from rti_rig.core.errors import DeviceError
+    from rti_rig.simulator.sim_lights import SimulatedDome
 
     cfg, _ = reference
 

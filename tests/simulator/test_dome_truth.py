@@ -11,6 +11,10 @@ from __future__ import annotations
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+
+from rti_rig.app.dome_factory import build_dome
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.errors import DeviceError
 from rti_rig.drivers.led_dome import DomeSerialSettings
 from rti_rig.simulator.dome_firmware import (
     Fault,
@@ -19,10 +23,6 @@ from rti_rig.simulator.dome_firmware import (
     InProcessDomeTransport,
     firmware_for,
 )
-
-from rti_rig.app.dome_factory import build_dome
-from rti_rig.core.clock import VirtualClock
-from rti_rig.core.errors import DeviceError
 
 N_LEDS = 8
 

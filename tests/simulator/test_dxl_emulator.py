@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dynamixel_sdk as sdk
 import pytest
+
+from rti_rig.core.clock import VirtualClock
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.bus import DxlBus
 from rti_rig.drivers.dynamixel.faults import (
@@ -17,8 +19,6 @@ from rti_rig.simulator.dynamixel_emulator import (
     InProcessPort,
 )
 from rti_rig.simulator.dynamixel_pty import PtyServoServer
-
-from rti_rig.core.clock import VirtualClock
 
 
 def two_servos(clock: VirtualClock, mode: int = 3) -> DynamixelBusEmulator:

@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import CONFIGS, write_config
-from rti_rig.planner.uniform import plan_uniform
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import arm_order_for, build_rig
@@ -17,6 +16,7 @@ from rti_rig.cli import app
 from rti_rig.core.errors import ConfigError, ScheduleError
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.controller import run_session
 from rti_rig.runtime.session import SessionFolder
 from rti_rig.testing.verify import wrong_light_steps

@@ -12,7 +12,6 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-from rti_rig.simulator.replay import SRGB8_TO_LINEAR16
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -22,6 +21,7 @@ from rti_rig.core.image_files import (
     read_linear_tiff,
 )
 from rti_rig.core.lp_format import read_lp
+from rti_rig.simulator.replay import SRGB8_TO_LINEAR16
 from tests.conftest import SMALL_DOME, write_config
 
 REPO = Path(__file__).resolve().parents[2]

@@ -3,6 +3,7 @@
 import cv2
 import numpy as np
 import pytest
+
 from rti_rig.simulator.camera_model import CameraModel, encode_jpeg, to_srgb8
 
 

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.simulator.camera_model import CameraModel, to_srgb8
 from rti_rig.simulator.ground_truth import homogeneous_directions, render_ground_truth
 from rti_rig.simulator.light_transport import (
@@ -22,8 +24,6 @@ from rti_rig.simulator.scenes import (
     scene_from_depth_file,
     scene_from_normal_file,
 )
-
-from rti_rig.core.geometry import direction_from_az_el
 
 
 def plane(height: np.ndarray, albedo: float = 0.5, passes=(), roughness: float = 0.5) -> Scene:  # type: ignore[no-untyped-def]

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.simulator.ground_truth import homogeneous_directions, render_ground_truth
 from rti_rig.simulator.light_transport import (
     DirectionalLight,
@@ -13,8 +15,6 @@ from rti_rig.simulator.light_transport import (
 )
 from rti_rig.simulator.scenes import SCENE_NAMES, Scene, make_scene, normals_from_height
 from rti_rig.simulator.shadows import directional_visibility, point_visibility
-
-from rti_rig.core.geometry import direction_from_az_el
 
 
 def _plane_scene(height, albedo=0.5, spec=0.0, rough=1.0, passes=()):

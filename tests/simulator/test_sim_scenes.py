@@ -3,6 +3,7 @@
 import cv2
 import numpy as np
 import pytest
+
 from rti_rig.simulator.scenes import (
     SCENE_NAMES,
     SceneError,

@@ -6,6 +6,8 @@ import json
 
 import numpy as np
 import pytest
+
+from rti_rig.core.devices import Frame
 from rti_rig.drivers.cameras.exposure import (
     choose_exposure,
     choose_from_series,
@@ -14,8 +16,6 @@ from rti_rig.drivers.cameras.exposure import (
 )
 from rti_rig.drivers.cameras.raw_roundtrip import RawRoundTripCamera
 from rti_rig.drivers.cameras.settings import ExposureRule, RawDecodeSettings
-
-from rti_rig.core.devices import Frame
 
 
 def ramp_frame(exposure_s=0.01, white=1000) -> Frame:

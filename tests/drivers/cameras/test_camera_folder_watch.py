@@ -8,13 +8,13 @@ import time
 import numpy as np
 import pytest
 import tifffile
-from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
-from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
-from rti_rig.drivers.cameras.settings import FolderWatchSettings
 
 from rti_rig.core.clock import SystemClock, VirtualClock
 from rti_rig.core.devices import Camera
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
+from rti_rig.drivers.cameras.settings import FolderWatchSettings
 
 
 class ScriptedClock(VirtualClock):

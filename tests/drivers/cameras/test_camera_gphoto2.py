@@ -9,6 +9,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
+
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.devices import Camera
+from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic
 from rti_rig.drivers.cameras.gphoto2_camera import (
     Gphoto2Camera,
@@ -17,10 +21,6 @@ from rti_rig.drivers.cameras.gphoto2_camera import (
     parse_shutter,
 )
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
-
-from rti_rig.core.clock import VirtualClock
-from rti_rig.core.devices import Camera
-from rti_rig.core.errors import CaptureError, DeviceError
 
 SHUTTERS = ["bulb", "30", "2", "1", "0.5", "1/4", "1/8", "1/15", "1/30", "1/60", "1/125", "1/250"]
 BLACK, WHITE = 512, 16383

@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 from dng_spec_writer import dng, mosaic_from_rgb
 from fake_gphoto2 import Body, make_module
-from rti_rig.drivers.cameras.gphoto2_camera import CameraGoneError, CardFullError, Gphoto2Camera
-from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.gphoto2_camera import CameraGoneError, CardFullError, Gphoto2Camera
+from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 from rti_rig.runtime.session import RAW_INCOMING, SessionFolder, prepare_resume
 
 
@@ -180,6 +180,7 @@ def test_metering_shots_before_the_session_exists_go_to_a_private_folder(tmp_pat
 
 def test_mosaic_sessions_are_labelled_in_tiff_journal_and_manifest(tmp_path):
     import tifffile
+
     from rti_rig.drivers.cameras.raw_decode import decode_raw
     from rti_rig.drivers.cameras.settings import RawDecodeSettings
 

@@ -21,13 +21,13 @@ import serial
 from conftest import CONFIGS
 from dng_spec_writer import dng, mosaic_from_rgb, srgb8
 from fake_gphoto2 import Body, make_module
-from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.core.clock import SystemClock
 from rti_rig.core.image_files import read_jpeg_rgb, read_linear_tiff
+from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 
 pytestmark = [pytest.mark.pty, pytest.mark.e2e]
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 from pydantic import ValidationError
+
 from rti_rig.drivers.cameras import kinds
 from rti_rig.drivers.cameras.factory import build_camera
 from rti_rig.drivers.cameras.settings import parse_camera_settings

@@ -8,12 +8,12 @@ from collections import deque
 import cv2
 import numpy as np
 import pytest
-from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera, fourcc_to_str
-from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.devices import Camera
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera, fourcc_to_str
+from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 
 
 def write_sequence(folder, values, dtype=np.uint16, shape=(6, 8)):

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from pydantic import ValidationError
+
+from rti_rig.core.devices import Camera
 from rti_rig.drivers.cameras.dark_frames import capture_master_dark
 from rti_rig.drivers.cameras.factory import build_camera
 from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
@@ -20,8 +22,6 @@ from rti_rig.drivers.cameras.settings import (
     RawDecodeSettings,
     parse_camera_settings,
 )
-
-from rti_rig.core.devices import Camera
 
 
 def test_kind_selects_the_backend_and_builds_the_driver(tmp_path):

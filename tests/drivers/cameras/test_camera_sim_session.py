@@ -9,13 +9,13 @@ from __future__ import annotations
 import json
 
 import numpy as np
+
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.devices import Camera, DiscreteLightSource
 from rti_rig.drivers.cameras.exposure import meter_exposure
 from rti_rig.drivers.cameras.raw_decode import decode_raw
 from rti_rig.drivers.cameras.raw_roundtrip import RawRoundTripCamera
 from rti_rig.drivers.cameras.settings import ExposureRule, RawDecodeSettings
-
-from rti_rig.core.clock import VirtualClock
-from rti_rig.core.devices import Camera, DiscreteLightSource
 
 SIZE = 64
 ALBEDO = np.array([0.8, 0.6, 0.4])

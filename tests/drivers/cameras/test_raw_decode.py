@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
+from rti_rig.core.errors import CaptureError
 from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic, write_dng
 from rti_rig.drivers.cameras.raw_decode import (
     average_frames,
@@ -16,8 +18,6 @@ from rti_rig.drivers.cameras.raw_decode import (
     subtract_dark,
 )
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
-
-from rti_rig.core.errors import CaptureError
 
 BLACK, WHITE = 512, 16383  # a 14-bit sensor with a black pedestal
 
@@ -330,6 +330,7 @@ def test_file_colour_matrix_takes_a_camera_back_to_srgb():
     (XYZ → camera = A · sRGB←XYZ, DNG 1.4 §6) decodes to the scene's sRGB values."""
     from dng_spec_writer import dng as spec_dng
     from dng_spec_writer import mosaic_from_rgb
+
     from rti_rig.drivers.cameras.raw_decode import XYZ_FROM_SRGB
 
     srgb = np.array([0.2, 0.5, 0.6])

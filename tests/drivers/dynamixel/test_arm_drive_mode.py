@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import pytest
 from dxl_support import arm_settings
+
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.faults import CommunicationError, ConfigMismatchError
 from rti_rig.simulator.dynamixel_emulator import EmulatedServo, InProcessPort, emulator_for_arm
-
-from rti_rig.core.clock import VirtualClock
-from rti_rig.core.geometry import direction_from_az_el
 
 
 def make_arm(drive_mode: int = 0, firmware: int | None = None):  # type: ignore[no-untyped-def]

@@ -6,6 +6,11 @@ import numpy as np
 import pytest
 from dxl_support import arm_settings
 from pydantic import ValidationError
+
+from rti_rig.core.arm_motion import move_time_s
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.devices import LightCarrier
+from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.faults import (
@@ -17,11 +22,6 @@ from rti_rig.drivers.dynamixel.faults import (
 )
 from rti_rig.simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
 from rti_rig.simulator.dynamixel_pty import PtyServoServer
-
-from rti_rig.core.arm_motion import move_time_s
-from rti_rig.core.clock import VirtualClock
-from rti_rig.core.devices import LightCarrier
-from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
 
 
 def make_arm(**overrides):

@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.faults import UnreachableError
 from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
 from rti_rig.drivers.dynamixel.settings import ArmSettings
 from rti_rig.simulator.dynamixel_emulator import InProcessPort, emulator_for_arm
-
-from rti_rig.core.clock import VirtualClock
-from rti_rig.core.geometry import direction_from_az_el
 
 DPT = 360.0 / 4096.0
 

@@ -6,10 +6,10 @@ import dynamixel_sdk as sdk
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from rti_rig.drivers.dynamixel import protocol2 as p2
-from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator, EmulatedServo, InProcessPort
 
 from rti_rig.core.clock import VirtualClock
+from rti_rig.drivers.dynamixel import protocol2 as p2
+from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator, EmulatedServo, InProcessPort
 
 
 def h(text: str) -> bytes:

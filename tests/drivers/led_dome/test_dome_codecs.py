@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+
 from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
 from rti_rig.drivers.led_dome.codec_framed import FramedCodec, FramedSpec

@@ -14,10 +14,6 @@ from pathlib import Path
 
 import pytest
 from conftest import CONFIGS
-from rti_rig.drivers.led_dome.settings import DomeSerialSettings
-from rti_rig.planner.uniform import plan_uniform
-from rti_rig.simulator.domes import board_for
-from rti_rig.simulator.pty_link import serve_on_pty
 from typer.testing import CliRunner
 
 from rti_rig.app.compose import build_rig
@@ -25,8 +21,12 @@ from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import read_lp
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.controller import run_session
 from rti_rig.runtime.session import SessionFolder
+from rti_rig.simulator.domes import board_for
+from rti_rig.simulator.pty_link import serve_on_pty
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),

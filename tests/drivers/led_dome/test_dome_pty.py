@@ -15,7 +15,12 @@ import sys
 from pathlib import Path
 
 import pytest
+
+from rti_rig.app.dome_factory import build_dome
+from rti_rig.core.clock import SystemClock, VirtualClock
+from rti_rig.core.errors import DeviceError
 from rti_rig.drivers.led_dome import DomeSerialSettings
+from rti_rig.runtime.dome_policy import DomeLedError, DomeLinkError, self_test
 from rti_rig.simulator.dome_firmware import (
     Fault,
     FaultKind,
@@ -23,11 +28,6 @@ from rti_rig.simulator.dome_firmware import (
     emulated_dome_on_pty,
     firmware_for,
 )
-
-from rti_rig.app.dome_factory import build_dome
-from rti_rig.core.clock import SystemClock, VirtualClock
-from rti_rig.core.errors import DeviceError
-from rti_rig.runtime.dome_policy import DomeLedError, DomeLinkError, self_test
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),

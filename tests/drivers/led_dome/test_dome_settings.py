@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from pydantic import ValidationError
+
+from rti_rig.app.dome_factory import policy_settings
 from rti_rig.drivers.led_dome import DomeSerialSettings, make_codec
 from rti_rig.drivers.led_dome.codec_binary import BinaryCodec
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
 from rti_rig.drivers.led_dome.codec_framed import FramedCodec
 from rti_rig.drivers.led_dome.messages import AllOff
-
-from rti_rig.app.dome_factory import policy_settings
 
 REPO = Path(__file__).resolve().parents[3]
 
