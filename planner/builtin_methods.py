@@ -28,6 +28,13 @@ MIN_LIGHTS_FOR_EXCHANGE = 4
 MANY_LIGHTS = 12
 
 
+def _score_start(ctx: MethodContext, objective: NormalsObjective | RelightObjective) -> None:
+    """Record the expected error of the homogeneous layout at the user's floor (the baseline
+    every report shows)."""
+    label, start = ctx.starts[0]
+    ctx.report.expected[label] = objective.cost(start)
+
+
 @dataclass(frozen=True)
 class UniformMethod:
     """The homogeneous layout at the user's floor; a preview is only scored against."""
@@ -47,8 +54,7 @@ class UniformMethod:
         objective: NormalsObjective | RelightObjective,
         chosen: NDArray[np.intp],
     ) -> NDArray[np.intp]:
-        label, start = ctx.starts[0]
-        ctx.report.expected[label] = objective.cost(start)
+        _score_start(ctx, objective)
         return chosen
 
 
@@ -92,8 +98,7 @@ class KMeansMethod:
         objective: NormalsObjective | RelightObjective,
         chosen: NDArray[np.intp],
     ) -> NDArray[np.intp]:
-        label, start = ctx.starts[0]
-        ctx.report.expected[label] = objective.cost(start)
+        _score_start(ctx, objective)
         ctx.report.expected["kmeans"] = objective.cost(chosen)
         return chosen
 

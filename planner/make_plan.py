@@ -191,9 +191,9 @@ class PlanRequest:
     preview_light: tuple[float, float] | None = None
     depth_model: Path | None = None
     min_elevation_deg: float = 0.0
-    max_elevation_deg: float = 90.0
     signal_noise: float = 0.0
     material: str = "auto"
+    max_elevation_deg: float = 90.0
     depth_spec: DepthModelSpec | None = None
     arm_order: ArmOrder | None = None
     seed: int = 0
@@ -277,57 +277,16 @@ def plan(request: PlanRequest) -> tuple[LightSchedule, PlanReport]:
         return _plan(request, method)
 
 
-def plan_with_report(
-    preview: NDArray | None,
-    geometry: DomeGeometry | ArmGeometry,
-    n: int,
-    method: str = "optimal",
-    objective: str = DEFAULT_OBJECTIVE,
-    preview_light: tuple[float, float] | None = None,
-    depth_model: Path | None = None,
-    min_elevation_deg: float = 0.0,
-    **options: Any,
-) -> tuple[LightSchedule, PlanReport]:
-    """:func:`plan` with the request's fields as arguments (``options``: the other fields of
-    :class:`PlanRequest` by name)."""
-    request = PlanRequest(
-        preview,
-        geometry,
-        n,
-        method,
-        objective,
-        preview_light,
-        depth_model,
-        min_elevation_deg,
-        **options,
-    )
-    return plan(request)
+def plan_with_report(*args: Any, **kwargs: Any) -> tuple[LightSchedule, PlanReport]:
+    """:func:`plan` with the fields of :class:`PlanRequest` as arguments, in its order
+    (``preview, geometry, n, method, objective, preview_light, depth_model, …``) or by name."""
+    return plan(PlanRequest(*args, **kwargs))
 
 
-def make_plan(
-    preview: NDArray | None,
-    geometry: DomeGeometry | ArmGeometry,
-    n: int,
-    method: str = "optimal",
-    objective: str = DEFAULT_OBJECTIVE,
-    preview_light: tuple[float, float] | None = None,
-    depth_model: Path | None = None,
-    min_elevation_deg: float = 0.0,
-    **options: Any,
-) -> LightSchedule:
-    """An ordered schedule of ``n`` lights for ``geometry`` (:func:`plan_with_report` without
-    the report; it stays in ``schedule.provenance["report"]``)."""
-    return plan_with_report(
-        preview,
-        geometry,
-        n,
-        method,
-        objective,
-        preview_light,
-        depth_model,
-        min_elevation_deg,
-        **options,
-    )[0]
+def make_plan(*args: Any, **kwargs: Any) -> LightSchedule:
+    """An ordered schedule (:func:`plan_with_report` without the report; it stays in
+    ``schedule.provenance["report"]``)."""
+    return plan_with_report(*args, **kwargs)[0]
 
 
 def _plan(req: PlanRequest, method: PlanMethod) -> tuple[LightSchedule, PlanReport]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from test_light_calibration import card_rig, shoot
+from card_support import card_rig, shoot
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
