@@ -99,7 +99,10 @@ def test_a_starved_emulator_thread_cannot_make_a_present_servo_time_out() -> Non
 def test_corrupted_crc_and_silence_over_pty(pty_bus) -> None:
     port, ph, emu, _clock = pty_bus
     bus = DxlBus(port, "arm", ph)
-    emu.corrupt_next_replies = 1
+    emu.corrupt_next_replies = 1  # one damaged status: a read is idempotent, retried once
+    assert bus.read(1, ct.PRESENT_POSITION) == 2048
+    assert emu.corrupt_next_replies == 0  # the damaged reply was really sent and met
+    emu.corrupt_next_replies = 2  # damaged again on the retry: a named error
     with pytest.raises(CommunicationError, match="COMM_RX_CORRUPT"):
         bus.read(1, ct.PRESENT_POSITION)
     assert bus.read(1, ct.PRESENT_POSITION) == 2048
