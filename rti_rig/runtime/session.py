@@ -84,8 +84,11 @@ class StepRecord:
 
 def planned_steps(manifest: dict[str, Any]) -> int:
     """How many steps a session may take: its schedule's, or an adaptive session's maximum."""
-    adaptive = manifest.get("adaptive") or {}
-    return int(adaptive.get("max_lights") or len(manifest.get("schedule", {}).get("steps", [])))
+    adaptive = manifest.get("adaptive")
+    if isinstance(adaptive, dict) and adaptive.get("max_lights"):
+        return int(adaptive["max_lights"])
+    steps = (manifest.get("schedule") or {}).get("steps")
+    return len(steps) if isinstance(steps, list) else 0
 
 
 def image_names(total: int) -> list[str]:
@@ -619,9 +622,6 @@ def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
     return scan
 
 
-def read_journal(root: Path) -> list[dict[str, Any]]:
-    """The journal's well-formed records (torn or junk lines are left out; nothing changes)."""
-    return scan_journal(root).records
 
 
 def _fsync_sha256(path: Path) -> str:
@@ -807,8 +807,8 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     missing or changed since (left out).
     """
     manifest = read_manifest(root)
-    steps = (manifest.get("schedule") or {}).get("steps")
-    names = image_names(len(steps)) if isinstance(steps, list) and steps else None
+    total = planned_steps(manifest)  # an adaptive session's maximum, not its starting layout
+    names = image_names(total) if total else None
     records = scan_journal(root, names).records
     done = verified_steps(root, records)
     if not records:
@@ -822,8 +822,3 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     key = "linear_image" if linear else "image"
     entries = [LpEntry(getattr(done[i], key), done[i].actual_direction) for i in sorted(done)]
     return entries, left_out
-
-
-def session_lp_entries(root: Path, linear: bool = False) -> list[LpEntry]:
-    """`.lp` entries of a session's verified images (see :func:`session_lp_report`)."""
-    return session_lp_report(root, linear)[0]

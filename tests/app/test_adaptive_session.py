@@ -71,6 +71,19 @@ def test_decisions_are_in_the_journal_and_the_manifest(uninterrupted: tuple[Path
     np.testing.assert_allclose([e.direction for e in read_lp(out / "lights.lp")], fired, atol=2e-6)
 
 
+def test_export_lp_lists_every_adaptive_step_not_only_the_start(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """The schedule of an adaptive session holds only its starting layout; the export must use
+    the session's maximum, or the chosen lights silently vanish from the .lp."""
+    _, out = uninterrupted
+    lp = tmp_path / "export.lp"
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(lp)])
+    assert r.exit_code == 0, r.output
+    assert "8 lights" in said(r) and "left out" not in said(r)
+    assert [e.name for e in read_lp(lp)] == [e.name for e in read_lp(out / "lights.lp")]
+
+
 def test_an_interrupted_adaptive_session_resumes_to_the_same_session(
     uninterrupted: tuple[Path, Path], tmp_path: Path
 ) -> None:
