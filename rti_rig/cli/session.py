@@ -119,9 +119,24 @@ def run(
 
     try:
         if resume is not None:
-            if out_dir is not None or plan is not None or lights is not None:
+            given = [
+                flag
+                for flag, value in (
+                    ("--out", out_dir is not None),
+                    ("--plan", plan is not None),
+                    ("--lights", lights is not None),
+                    ("--adaptive", adaptive),
+                    ("--until-error", until_error is not None),
+                    ("--auto-exposure", auto_exposure),
+                    ("--min-elevation-deg", min_elevation_deg != 0.0),
+                    ("--max-elevation-deg", max_elevation_deg != 90.0),
+                )
+                if value
+            ]
+            if given:
                 raise RtiRigError(
-                    "--resume continues a session as planned: drop --out, --plan, --lights"
+                    "--resume continues a session as it began (its lights, stopping rule and "
+                    f"exposure are in its manifest): drop {', '.join(given)}"
                 )
             opened = open_resumed_session(
                 ResumeRequest(
@@ -163,7 +178,7 @@ def run(
 
 def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
     """What a stopped session left on disk and how to go on (never a resume hint for nothing)."""
-    from rti_rig.runtime.session import LP_NAME
+    from rti_rig.runtime.session import LP_NAME, holds_no_image
 
     folder, out_dir = opened.folder, opened.out_dir
     if folder.images_kept:
@@ -172,9 +187,19 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         )
     if opened.resumed:
         return f"No new image was captured. {resume_hint}"
-    if folder.begun:
+    if not folder.begun:
+        return f"Nothing was captured and nothing was written to {out_dir}."
+    if holds_no_image(out_dir):
         return f"Nothing was captured: {out_dir} holds no image and may be used again."
-    return f"Nothing was captured and nothing was written to {out_dir}."
+    # e.g. a camera's file downloaded for a step that then failed: kept, never deleted
+    return f"No image was completed, but {out_dir} holds files of the camera. {resume_hint}"
+
+
+def _print_teardown_failures(folder) -> None:  # type: ignore[no-untyped-def]
+    """What could not be made safe when a session stopped early (the controller records it in
+    the manifest; the lights' state line that follows refers to it)."""
+    for failure in (folder.manifest.get("runner") or {}).get("teardown_failures") or []:
+        err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
 
 
 def _execute(opened) -> None:  # type: ignore[no-untyped-def]
@@ -242,6 +267,7 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     except EmergencyStop as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
+        _print_teardown_failures(folder)
         err.print(
             f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}."
         )
@@ -250,6 +276,7 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
+        _print_teardown_failures(folder)
         state = lights_state(rig)
         err.print(
             f"{state[:1].upper()}{state[1:]}. {_after_stop(opened, resume_hint)}", markup=False

@@ -188,7 +188,7 @@ def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
 _NO_IMAGE_FILES = {MANIFEST, JOURNAL, LP_NAME}
 
 
-def _holds_no_image(root: Path) -> bool:
+def holds_no_image(root: Path) -> bool:
     """True if ``root`` holds nothing but an image-less session's own files."""
     for path in root.rglob("*"):
         rel = path.relative_to(root)
@@ -236,7 +236,7 @@ class SessionFolder:
         root = Path(root)
         if root.exists() and not root.is_dir():
             raise SessionError(f"{root} exists and is not a folder: choose another --out")
-        if root.exists() and any(root.iterdir()) and not _holds_no_image(root):
+        if root.exists() and any(root.iterdir()) and not holds_no_image(root):
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "
                 "choose a new --out folder, or continue an interrupted session with "
@@ -352,9 +352,9 @@ class SessionFolder:
         jpg, tif = f"{base}.jpg", f"{LINEAR_DIR}/{base}.tif"
         decode = dict(frame.metadata.get("decode") or {})
         listed = frame.metadata.get("originals") or []
-        current = self.root / RAW_DIR
+        originals = self._keep_originals(base, listed)  # names the file if a write fails
+        current = self.root / tif
         try:
-            originals = self._keep_originals(base, listed)
             for item, rel in zip(listed, originals, strict=True):
                 if decode.get("source_file") == str(item["path"]):
                     # where the decoded RAW is kept now, and the camera's own name for it
@@ -410,15 +410,18 @@ class SessionFolder:
             dest = self.root / rel
             if dest.exists():
                 raise SessionError(f"{dest} already exists: refusing to overwrite a captured file")
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            inside = src.resolve().is_relative_to(root)
-            tmp = dest.with_name(f".{dest.name}.partial")
-            if inside:
-                os.replace(src, tmp)
-            else:
-                shutil.copyfile(src, tmp)
-            digest = _fsync_sha256(tmp)
-            os.replace(tmp, dest)
+            try:
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                if src.resolve().is_relative_to(root):
+                    # a download staged in raw/.incoming may be the only copy (the camera may
+                    # have deleted its own): checksummed where it lies, then renamed in one
+                    # step, so at every moment it is whole under one of its two names
+                    digest = _fsync_sha256(src)
+                    os.replace(src, dest)
+                else:
+                    digest = _copy_whole(src, dest)
+            except OSError as exc:
+                raise SessionWriteError(dest, exc) from None
             kept[rel] = (digest, str(item.get("name") or src.name))
         return kept
 
@@ -622,6 +625,21 @@ def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
     return scan
 
 
+
+
+def _copy_whole(src: Path, dest: Path) -> str:
+    """Copy ``src`` to ``dest`` through a temporary file, never leaving a partial one; returns
+    the copy's SHA-256."""
+    tmp = dest.with_name(f".{dest.name}.partial")
+    try:
+        shutil.copyfile(src, tmp)
+        digest = _fsync_sha256(tmp)
+        os.replace(tmp, dest)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise
+    return digest
 
 
 def _fsync_sha256(path: Path) -> str:

@@ -43,7 +43,7 @@ def uninterrupted(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]
     out = base / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--adaptive", "--lights", "8"])
     assert r.exit_code == 0, r.output
-    assert "Adaptive: 8 lights; stopped: reached --lights 8" in said(r)
+    assert "Adaptive: 8 lights; stopped: reached its maximum of 8 lights" in said(r)
     return cfg, out
 
 

@@ -46,3 +46,17 @@ def test_calibration_config_line_is_whole_and_a_good_second_report_is_no_failure
     assert "no new calibration is needed" in text
     assert "shoot the card again" not in text
     assert 'intensity_correction_file = "card2/light_calibration.toml"' in r.output.splitlines()
+
+
+def test_resume_refuses_options_it_would_otherwise_ignore(tmp_path):
+    """A resumed session runs as it began: an option that would change it is refused, not
+    silently ignored (the user would believe the stopping rule or the exposure changed)."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    args = ["run", "--resume", str(tmp_path), "--until-error", "1", "--auto-exposure"]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 2
+    text = " ".join(r.output.split())
+    assert "drop --until-error, --auto-exposure" in text

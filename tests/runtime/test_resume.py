@@ -163,7 +163,7 @@ def test_resume_refuses_what_it_cannot_do(tmp_path: Path, reference: tuple[Path,
     r = runner.invoke(app, ["run", "--resume", str(tmp_path)])
     assert r.exit_code == 2 and "not an rti-rig session folder" in " ".join(r.output.split())
     r = runner.invoke(app, ["run", "--resume", str(ref), "--lights", "3"])
-    assert r.exit_code == 2 and "drop --out" in said(r)
+    assert r.exit_code == 2 and "drop --lights" in said(r)
 
 
 def test_free_disk_is_checked_before_anything_moves(

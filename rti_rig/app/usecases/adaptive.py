@@ -158,6 +158,10 @@ class AdaptiveChooser:
             return None
         return fit_state(np.stack(self.images), np.stack(self.lights))
 
+    def _cap_reason(self) -> str:
+        # --lights N, or without it the rig's own cap: both are the session's maximum
+        return f"reached its maximum of {self.max_lights} lights"
+
     def decide(self, index: int) -> tuple[int | None, dict[str, Any]]:
         """Candidate for step ``index`` (None: stop) and the evidence of the decision."""
         t0 = time.perf_counter()
@@ -168,7 +172,7 @@ class AdaptiveChooser:
             est = None if state is None else estimate_error_deg(state, self.scale)
             self.stop_evidence = {
                 "kind": "stop",
-                "reason": f"reached --lights {self.max_lights}",
+                "reason": self._cap_reason(),
                 "estimated_error_deg": None if est is None else round(est, 4),
             }
             return None, self.stop_evidence
@@ -218,7 +222,7 @@ class AdaptiveChooser:
             "lights_used": len(self.used),
             "estimated_error_deg": None if est is None else round(est, 4),
             "stop": self.stop_evidence
-            or {"kind": "stop", "reason": f"reached --lights {self.max_lights}"},
+            or {"kind": "stop", "reason": self._cap_reason()},
         }
 
 

@@ -142,5 +142,18 @@ def probe(request: ProbeRequest) -> ProbeResult:
         result.lights = "nothing that lights an LED was sent"
     except TransportError as exc:
         result.error = str(exc)
-        result.lights = "the port could not be used; nothing was sent"
+        if result.profile == "nab-rti-v1":
+            # it answered, so it booted, and it boots with every LED on
+            result.lights = (
+                "the sketch boots with every LED on and the all-off could NOT be sent: the dome "
+                "may be fully lit; switch it off at its power supply"
+            )
+        elif result.heard:
+            sent = ", ".join(what for what, _ in result.heard)
+            result.lights = (
+                f"the port failed after these probes ({sent}); none of them lights an LED on "
+                "the firmwares known, but the dome's state is not known"
+            )
+        else:
+            result.lights = "the port could not be used; nothing was sent"
     return result
