@@ -16,8 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from rti_rig.core.errors import DeviceError
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.runtime.controller import validate_schedule
+from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
 
 #: ``meter(camera, start_exposure_s) -> choice`` where ``choice.exposure_s`` is the pick and
@@ -46,9 +48,17 @@ def fix_session_exposure(rig: Rig, schedule: LightSchedule, meter: Meter) -> Lig
         rig.clock.sleep(rig.timing.settle_s)
         choice = meter(rig.camera, rig.camera_config.exposure_s)
     finally:
-        rig.lighting.safe()
-        rig.camera.close()
-        rig.lighting.close()
+        # every step of the teardown runs, whatever one device does; what failed is said
+        failures = rig.lighting.safe() + attempt_all(
+            [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
+        )
+    if failures:
+        raise DeviceError(
+            rig.name,
+            "metering could not make the rig safe (" + "; ".join(failures) + "): check the "
+            "lights before anything else",
+            "meter",
+        )
     steps = tuple(replace(s, exposure_s=float(choice.exposure_s)) for s in schedule.steps)
     evidence = {**choice.to_manifest(), "metered_at_step": i + 1}
     fixed = replace(schedule, steps=steps, provenance={**schedule.provenance, "exposure": evidence})

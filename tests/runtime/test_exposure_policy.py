@@ -71,3 +71,26 @@ def test_metering_lights_the_brightest_step_and_switches_it_off(tmp_path: Path) 
     assert rig.lighting.source.lit is None  # type: ignore[attr-defined]
     assert all(s.exposure_s == 0.02 for s in fixed.steps)
     assert fixed.provenance["exposure"]["metered_at_step"] == brightest_step(schedule) + 1
+
+
+def test_a_teardown_that_fails_after_metering_is_an_error_not_silence(tmp_path: Path) -> None:
+    """The metering leaves the lights as it found them or says it could not: a failed all-off
+    must not be dropped on the floor (and the camera and lights are still closed)."""
+    from rti_rig.core.errors import DeviceError
+
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    schedule = plan_uniform(rig.geometry, 6)
+    closed = []
+    real_close = rig.lighting.close
+
+    class Choice:
+        exposure_s = 0.02
+
+        def to_manifest(self) -> dict:
+            return {"exposure_s": 0.02}
+
+    rig.lighting.safe = lambda emergency=False: ["all LEDs off: no reply"]  # type: ignore[method-assign]
+    rig.lighting.close = lambda: (closed.append("lights"), real_close())  # type: ignore[method-assign]
+    with pytest.raises(DeviceError, match=r"metering could not make the rig safe \(all LEDs off: no reply\)"):
+        fix_session_exposure(rig, schedule, lambda camera, start_s: Choice())
+    assert closed == ["lights"]
