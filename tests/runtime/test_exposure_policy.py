@@ -91,6 +91,7 @@ def test_a_teardown_that_fails_after_metering_is_an_error_not_silence(tmp_path: 
 
     rig.lighting.safe = lambda emergency=False: ["all LEDs off: no reply"]  # type: ignore[method-assign]
     rig.lighting.close = lambda: (closed.append("lights"), real_close())  # type: ignore[method-assign]
-    with pytest.raises(DeviceError, match=r"metering could not make the rig safe \(all LEDs off: no reply\)"):
+    expected = r"metering could not make the rig safe \(all LEDs off: no reply\)"
+    with pytest.raises(DeviceError, match=expected):
         fix_session_exposure(rig, schedule, lambda camera, start_s: Choice())
     assert closed == ["lights"]
