@@ -37,8 +37,9 @@ def check(
 def probe(
     port: Annotated[str, typer.Argument(help="Serial port of the dome, e.g. /dev/ttyACM0.")],
 ) -> None:
-    """Identify which known dome firmware answers on PORT (least intrusive probes first, never
-    leaving a light on) and print the rig-config lines to use."""
+    """Identify which known dome firmware answers on PORT (least intrusive probes first; none
+    lights an LED, and a dome that boots lit is switched off, or you are told it could not be)
+    and print the rig-config lines to use."""
     from rti_rig.app.usecases.probe import ProbeRequest
     from rti_rig.app.usecases.probe import probe as run_probe
 
