@@ -286,9 +286,8 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         for sig, h in previous.items():
             signal.signal(sig, h)
 
-    total_done = len(folder.done) + len(result.records)
     out.print(
-        f"{total_done} image(s) in the session; {LP_NAME} lists the lights that fired.\n"
+        f"{folder.images_kept} image(s) in the session; {LP_NAME} lists the lights that fired.\n"
         f"Session time on the real rig: {result.rig_time_s:.1f} s"
         + (f" (simulated in {result.wall_time_s:.1f} s)" if dry else "")
     )

@@ -380,7 +380,6 @@ class AdaptiveSteps:
                     "be continued deterministically: start a new session"
                 )
             pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
-            self._pending[i] = candidate
             self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
 
     def conclude(self) -> dict[str, Any]:
@@ -419,7 +418,7 @@ def open_adaptive_session(loaded, out_dir: Path, lights: int | None, until_error
     try:
         source = AdaptiveSteps(rig, adaptive_plan(rig, lights), until_error_deg)
         schedule = source.start_schedule()
-        validate_schedule(rig, schedule)
+        validate_schedule(rig, schedule)  # the starting layout, before anything moves
         folder = SessionFolder.create(out_dir, source.total)
     except BaseException:
         rig.close()

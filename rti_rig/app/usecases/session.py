@@ -278,7 +278,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     )
 
 
-def _open_adaptive(req: NewSessionRequest, loaded, on_note: NoteSink) -> OpenedSession:  # type: ignore[no-untyped-def]
+def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ignore[no-untyped-def]
     """A new adaptive session: the starting layout, the step source and the folder."""
     from rti_rig.app.rig_identity import rig_identity
     from rti_rig.app.usecases.adaptive import open_adaptive_session
@@ -304,7 +304,7 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     for note in loaded.notes:
         on_note(Note(note, "warning"))
     if req.is_adaptive:
-        return _open_adaptive(req, loaded, on_note)
+        return _open_adaptive(req, loaded)
     schedule = new_session_schedule(req, loaded, on_note)
     return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
 
