@@ -13,8 +13,9 @@ Quirks of real bodies it reproduces (from gphoto/libgphoto2 issue threads, see
 /work/shared/reference/hardware-notes.md §5): "busy" right after a shot, a body switched off or
 unplugged (every call then fails with -7 and autodetect finds nothing), a card that fills up,
 a file counter that wraps (IMG_9999 → IMG_0001) or a RAM target that names every shot the same
-(Nikon's ``capt0000.nef``), and RAW+JPEG delivered as two files, the second through a
-FILE_ADDED event.
+(Nikon's ``capt0000.nef``), RAW+JPEG delivered as two files, the second through a
+FILE_ADDED event (some bodies also announce the first one, and end with CAPTURE_COMPLETE),
+several bodies on the bus, and a setting that does not latch (the mode dial not on M).
 """
 
 from __future__ import annotations
@@ -38,9 +39,10 @@ class GPhoto2Error(Exception):
 
 @dataclass
 class Body:
-    """The physical camera: ``render()`` gives the RAW file's bytes for the current shot."""
+    """The physical camera: ``render(body)`` gives the RAW file's bytes for the current shot."""
 
-    render: Callable[[], bytes]
+    #: the RAW file's bytes for the current shot; it may read ``body.config`` (shutter, ISO)
+    render: Callable[[Body], bytes]
     model: str = "Canon EOS 600D"
     port: str = "usb:001,005"
     raw_suffix: str = ".CR2"
@@ -65,6 +67,12 @@ class Body:
             "shutterspeed": SHUTTERS,
         }
     )
+    #: what autodetect finds, when not just this body: [] for none, or several bodies
+    detected: list[tuple[str, str]] | None = None
+    #: settings the body accepts but does not change (e.g. the mode dial is not on M)
+    read_only: set[str] = field(default_factory=set)
+    announce_first: bool = False  # also send FILE_ADDED for the file capture() returned
+    capture_complete_event: bool = False  # end a shot's events with CAPTURE_COMPLETE
     #: op name → error codes raised by its next calls, in order
     failures: dict[str, list[int]] = field(default_factory=dict)
     busy_after_shot: int = 0  # the next N captures after a shot answer -110 first
@@ -102,6 +110,9 @@ class Body:
         n = (self.counter_start - 1 + self._counter) % self.counter_wrap + 1
         self._counter += 1
         return f"IMG_{n:04d}"
+
+    def bus(self) -> list[tuple[str, str]]:
+        return [(self.model, self.port)] if self.detected is None else list(self.detected)
 
     def store(self) -> dict[str, bytes]:
         return self.ram if self.config["capturetarget"] == "Internal RAM" else self.card
@@ -156,10 +167,12 @@ def make_module(body: Body) -> types.ModuleType:
         @staticmethod
         def autodetect() -> list[tuple[str, str]]:
             body.check("autodetect")
-            return [(body.model, body.port)]
+            return body.bus()
 
         def init(self) -> None:
             body.check("init")
+            if not body.bus():
+                raise GPhoto2Error(-105)
 
         def exit(self) -> None:
             body.calls.append("exit")
@@ -173,7 +186,8 @@ def make_module(body: Body) -> types.ModuleType:
             for k, v in config.values.items():
                 if body.choices.get(k) and v not in body.choices[k]:
                     raise GPhoto2Error(-2)
-                body.config[k] = v
+                if k not in body.read_only:
+                    body.config[k] = v
 
         def capture(self, kind: int) -> CameraFilePath:
             if body.off_at_shot is not None and body.shots + 1 == body.off_at_shot:
@@ -193,7 +207,7 @@ def make_module(body: Body) -> types.ModuleType:
                 files.append(stem + body.raw_suffix)
             if "JPEG" in fmt:
                 files.append(stem + ".JPG")
-            raw_data = body.render()
+            raw_data = body.render(body)
             for name in files:
                 store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"
             if store is body.card:
@@ -203,8 +217,10 @@ def make_module(body: Body) -> types.ModuleType:
             if body.jpeg_first:
                 files.sort(key=lambda n: not n.endswith(".JPG"))
             folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"
-            for name in files[1:]:
+            for name in files if body.announce_first else files[1:]:
                 body._events.append((GP_EVENT_FILE_ADDED, CameraFilePath(folder, name)))
+            if body.capture_complete_event:
+                body._events.append((GP_EVENT_CAPTURE_COMPLETE, None))
             return CameraFilePath(folder, files[0])
 
         def wait_for_event(self, timeout_ms: int) -> tuple[int, object]:
@@ -233,21 +249,21 @@ def make_module(body: Body) -> types.ModuleType:
             body.card_free_shots += 1
 
         def set_port_info(self, info: object) -> None:
-            body.calls.append("set_port_info")
+            body.calls.append(f"set_port_info {info}")
 
         def set_abilities(self, abilities: object) -> None:
-            body.calls.append("set_abilities")
+            body.calls.append(f"set_abilities {abilities}")
 
     class PortInfoList(list):  # type: ignore[type-arg]
         def load(self) -> None:
-            self.append(body.port)
+            self.extend(port for _, port in body.bus())
 
         def lookup_path(self, path: str) -> int:
             return self.index(path)
 
     class CameraAbilitiesList(list):  # type: ignore[type-arg]
         def load(self) -> None:
-            self.append(body.model)
+            self.extend(model for model, _ in body.bus())
 
         def lookup_model(self, model: str) -> int:
             return self.index(model)

@@ -21,7 +21,7 @@ from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 from rti_rig.runtime.session import RAW_INCOMING, SessionFolder, prepare_resume
 
 
-def render() -> bytes:
+def render(body: Body | None = None) -> bytes:
     rgb = np.broadcast_to(np.array([0.2, 0.5, 0.8]), (32, 48, 3))
     return dng(mosaic_from_rgb(np.array(rgb), "RGGB", (0, 0, 0, 0), 4095), white=4095)
 

@@ -64,7 +64,7 @@ def dome(monkeypatch, request):
 def render_for(firmware):
     """A body's picture: the flat patch, as bright as the LED the emulated firmware lit."""
 
-    def render() -> bytes:
+    def render(body: Body | None = None) -> bytes:
         lit = firmware.lit
         rgb = np.broadcast_to(BASE * patch_level(None if lit is None else lit[0]), (H, W, 3))
         return dng(mosaic_from_rgb(np.array(rgb), "RGGB", BLACK, WHITE), "RGGB", BLACK, WHITE)
