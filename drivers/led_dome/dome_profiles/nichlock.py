@@ -5,8 +5,10 @@ From the firmware: one character a command, no line endings (a ``\\n`` gets
 prompt. ``0`` lights the next LED and prints ``LED number: N; on pin P``; ``x`` switches all off
 and rewinds to LED 0 (``All LEDs shut off, active LED number reset to zero.``). There is no
 addressing, so the driver steps and checks the number the firmware prints (a missed or double
-step is a named error). Baud rate from EEPROM (115200 by default). Arduino Mega: resets when the
-port opens and prints a banner ending with ``For help, press 'h'`` and the prompt.
+step is a named error). Baud rate from EEPROM, 115200 on a fresh board: ``headers.h`` sets
+``DEFAULT_BAUD_RATE 115200`` and its settings menu lists "115200 (Default)"; the comment in
+``setup()`` that says 9600 is stale. A board whose EEPROM was set otherwise needs ``baudrate``
+in the rig config. Arduino Mega: resets when the port opens and prints a banner ending with ``For help, press 'h'`` and the prompt.
 """
 
 SPEC = {
