@@ -32,6 +32,7 @@ from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix
+from rti_rig.planner import rank_one
 
 Objective = Literal["normals", "relight"]
 OBJECTIVES: tuple[str, ...] = ("normals", "relight")
@@ -342,8 +343,13 @@ class NormalsObjective:
         proj = np.stack([1 - x * x, 1 - y * y, 1 - z * z, -2 * x * y, -2 * x * z, -2 * y * z])
         self.projector = (proj, proj.astype(np.float32))
         self.tau2 = (bias_rel * np.sqrt(2 * np.pi / 9)) ** 2  # RMS deviation = bias_rel
+        self.dirs = d
+        self.w_kp = np.ascontiguousarray(w.T)  # (K, P): the rank-one scans' weights
+        self.l6 = rank_one.quadratic_coefficients(d)
+        self.hsh = design_matrix("hsh2", d)  # (K, 9)
+        self._sums: tuple[bytes, NDArray, NDArray | None] | None = None
         if self.tau2 > 0:
-            hsh = design_matrix("hsh2", d)  # (K, 9)
+            hsh = self.hsh
             wsub = w[: self.n_bias]
             # cross term w_pk l_k h_kᵀ as (3, K, P_bias, 9)
             self.cross = np.ascontiguousarray(
@@ -351,11 +357,6 @@ class NormalsObjective:
             )
             all_m = self.outer[..., : self.n_bias].sum(axis=1)  # (6, P_bias)
             self.g_all = self._solve(all_m[:, None], self.cross.sum(axis=1)[:, None])[:, 0]
-        # single-precision copies for the batched swap scans, the planner's hot loop: they halve
-        # the memory traffic, and every accepted swap is re-scored in double precision
-        # (:func:`rti_rig.planner.optimal.exchange_search`), so rounding can only cost a missed swap
-        self.outer32 = self.outer.astype(np.float32)
-        self.cross32 = self.cross.astype(np.float32) if self.tau2 > 0 else None
 
     @staticmethod
     def _adjugate(m: NDArray[np.float64]) -> tuple[tuple[NDArray, ...], NDArray]:
@@ -378,12 +379,14 @@ class NormalsObjective:
             ]
         )
 
-    def _variance(self, m: NDArray[np.float64]) -> NDArray:
-        """Squared angular error (rad²) of noise from information entries ``m`` (6, B, P)."""
+    def _variance(self, m: NDArray[np.float64], pix: NDArray[np.intp] | None = None) -> NDArray:
+        """Squared angular error (rad²) of noise from information entries ``m`` (6, B, P) (of
+        the pixels ``pix`` when given)."""
         # closed-form adjugate of the symmetric 3×3 (batched np.linalg.inv is ~20× slower):
         # tr(P M⁻¹ P) = Σ_ij adj(M)_ij P_ij / det(M), P = I - n nᵀ (weights precomputed)
         (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
         q = self.projector[1 if m.dtype == np.float32 else 0]
+        q = q if pix is None else q[:, pix]
         num = c00 * q[0]
         for c, qq in ((c11, q[1]), (c22, q[2]), (c01, q[3]), (c02, q[4]), (c12, q[5])):
             num += c * qq
@@ -392,10 +395,14 @@ class NormalsObjective:
         num /= np.where(ok, det, 1.0)
         return np.clip(np.where(ok, num, MAX_ERR2), 0.0, MAX_ERR2)
 
-    def _bias(self, m: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray:
-        """Expected squared tangential bias (rad²) on the first pixels, (B, P_bias)."""
-        nb = self.n[: self.n_bias]
-        delta = self._solve(m, r) - self.g_all[:, None]  # (3, B, P_bias, 9)
+    def _bias(
+        self, m: NDArray[np.float64], r: NDArray[np.float64], pix: NDArray[np.intp] | None = None
+    ) -> NDArray:
+        """Expected squared tangential bias (rad²) on the first pixels (or the bias pixels
+        ``pix``), (B, P_bias)."""
+        nb = self.n[: self.n_bias] if pix is None else self.n[pix]
+        g_all = self.g_all if pix is None else self.g_all[:, pix]
+        delta = self._solve(m, r) - g_all[:, None]  # (3, B, P_bias, 9)
         along = nb[:, 0, None] * delta[0] + nb[:, 1, None] * delta[1] + nb[:, 2, None] * delta[2]
         tang = np.sum(delta * delta, axis=(0, -1)) - np.sum(along * along, axis=-1)
         return np.clip(self.tau2 * tang, 0.0, MAX_ERR2)
@@ -412,24 +419,47 @@ class NormalsObjective:
         r = self.cross[:, chosen].sum(axis=1)[:, None] if self.tau2 > 0 else None
         return float(self._total(m, r)[0])
 
+    def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
+        """Information and cross terms of the layout ``chosen`` (kept while it is unchanged:
+        a sweep scans every position of one layout until a swap is accepted)."""
+        key = np.asarray(chosen, dtype=np.intp).tobytes()
+        if self._sums is None or self._sums[0] != key:
+            r = self.cross[:, chosen].sum(axis=1) if self.tau2 > 0 else None
+            self._sums = (key, self.outer[:, chosen].sum(axis=1), r)
+        return self._sums[1], self._sums[2]
+
     def swap_costs(
         self, chosen: NDArray[np.intp], position: int, exact: bool = False
     ) -> NDArray[np.float64]:
         """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch.
 
-        Single precision unless ``exact``: enough to rank swaps, except where a pixel is lit
-        by one or two lights (a near-singular 3×3 whose determinant float32 cannot resolve);
-        the exchange search re-scans exactly when a proposed swap is not confirmed.
+        By rank-one updates (:mod:`rti_rig.planner.rank_one`; pixels whose information without
+        that light is near-singular are evaluated directly) unless ``exact``: then every pixel
+        and candidate is evaluated directly (the reference; the exchange search re-scans this
+        way when a proposed swap's cost is not confirmed).
         """
-        dtype = np.float64 if exact else np.float32
-        outer = self.outer if exact else self.outer32
-        base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
-        r = None
-        if self.tau2 > 0:
-            cross = self.cross if exact else self.cross32
-            rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
-            r = rb.astype(dtype)[:, None] + cross  # (3, K, P_bias, 9)
-        return self._total(base.astype(dtype)[:, None, :] + outer, r)
+        total_m, total_r = self._chosen_sums(chosen)
+        base = total_m - self.outer[:, chosen[position]]  # (6, P)
+        rb = None if total_r is None else total_r - self.cross[:, chosen[position]]
+        if exact:
+            r = None if rb is None else rb[:, None] + self.cross  # (3, K, P_bias, 9)
+            return self._total(base[:, None, :] + self.outer, r)
+        bias = None
+        if rb is not None:
+            bias = rank_one.BiasTerms(rb, self.g_all, self.hsh, self.wts_bias, self.tau2)
+        res = rank_one.scan(
+            base, self.w_kp, self.dirs, self.l6, self.n, self.wts, NOISE_REL**2, MAX_ERR2, bias
+        )
+        err2 = res.err2
+        if len(res.bad):
+            m = base[:, None, res.bad] + self.outer[..., res.bad]
+            err2 = err2 + self._variance(m, res.bad) @ self.wts[res.bad]
+        if rb is not None and len(res.bad_bias):
+            pix = res.bad_bias
+            m = base[:, None, pix] + self.outer[..., pix]
+            r = rb[:, None, pix] + self.cross[:, :, pix]
+            err2 = err2 + self._bias(m, r, pix) @ self.wts_bias[pix]
+        return np.degrees(np.sqrt(err2))
 
     def describe(self, value: float) -> str:
         signal = f" + {100 * self.gain_rel:g}% of the signal" if self.gain_rel > 0 else ""
