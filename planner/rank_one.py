@@ -125,19 +125,31 @@ def scan(
     pb = proj @ binv
     tr0 = np.trace(pb, axis1=1, axis2=2)  # tr(P B⁻¹)
     c = binv @ pb  # B⁻¹ P B⁻¹
-    q1 = l6 @ inv6[:, g]  # lᵀ B⁻¹ l  (K, G)
+    wg = w if len(g) == len(good) else w[:, g]
+    s = l6 @ inv6[:, g]  # lᵀ B⁻¹ l  (K, G)
+    s *= wg
+    s += 1.0
+    np.divide(wg, s, out=s)  # s = w / (1 + w lᵀ B⁻¹ l)
     q2 = l6 @ _entries(c)  # lᵀ B⁻¹ P B⁻¹ l = ‖P u‖²
-    wg = w[:, g]
-    s = wg / (1.0 + wg * q1)
-    var = np.clip(noise2 * (tr0[None] - s * q2), 0.0, max_err2)
-    err2 = var @ wts[g]
+    wts_g = wts[g]
+    # the variance σ²(tr(P B⁻¹) - s q2) lies in [0, σ² tr(P B⁻¹)]: only where that bound
+    # passes the cap does a pixel need clipping; elsewhere the weighted sum is taken directly
+    capped = noise2 * tr0 > max_err2
+    if bias is not None:  # the bias part below needs s and q2 on its pixels: keep copies
+        at = np.searchsorted(g, np.flatnonzero(good[: len(bias.wts)]))
+        sb, qb = s[:, at], q2[:, at]
+    if np.any(capped):
+        var = np.clip(noise2 * (tr0[None] - s * q2), 0.0, max_err2)
+        err2 = var @ wts_g
+    else:
+        q2 *= s
+        err2 = noise2 * (float(tr0 @ wts_g) - q2 @ wts_g)
     bad = np.flatnonzero(~good)
     bad_bias = np.zeros(0, dtype=np.intp)
     if bias is not None:
         nb = len(bias.wts)
         bad_bias = bad[bad < nb]
-        gb = np.flatnonzero(good[:nb])  # bias pixels that are well-conditioned
-        at = np.searchsorted(g, gb)  # their columns among the good pixels
+        gb = np.flatnonzero(good[:nb])  # bias pixels that are well-conditioned (columns at)
         bi, pr = binv[at], proj[at]
         rb = np.transpose(bias.rb[:, gb], (1, 0, 2))  # (Gb, 3, 9)
         ga = np.transpose(bias.g_all[:, gb], (1, 0, 2))
@@ -151,7 +163,6 @@ def scan(
         b1 = lh @ gbm.reshape(len(gb), 27).T  # lᵀ G_B h
         b2 = l6 @ _entries(gbm @ np.transpose(gbm, (0, 2, 1)))  # lᵀ G_B G_Bᵀ l
         hh = np.sum(bias.h * bias.h, axis=1)[:, None]
-        sb, qb = s[:, at], q2[:, at]
         tang = c0[None] + 2.0 * sb * (a1 - a2) + sb * sb * qb * (hh - 2.0 * b1 + b2)
         err2 = err2 + np.clip(bias.tau2 * tang, 0.0, max_err2) @ bias.wts[gb]
     return ScanResult(err2, bad, bad_bias)
