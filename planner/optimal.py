@@ -67,15 +67,19 @@ def exchange_search(
     n = len(chosen)
     limit = max_passes if max_passes is not None else MAX_PASSES
     swaps = 0
+    # only the unused candidates can replace a light (a light is never chosen twice): an
+    # objective that knows its candidate count scores only those (half of them at 100 of 200)
+    count = getattr(objective, "candidate_count", None)
     for _ in range(limit):
         changed = False
         before = cost
         for pos in range(n):
+            scan_kw = {} if count is None else {"among": np.setdiff1d(np.arange(count), chosen)}
             for exact_scan in (False, True):
                 # the fast scan may be approximate (rank-one updates, rounding): a swap is
                 # accepted on its exact cost, and a proposal that cost does not confirm earns an
                 # exact re-scan
-                trial = objective.swap_costs(chosen, pos, exact=exact_scan)
+                trial = objective.swap_costs(chosen, pos, exact=exact_scan, **scan_kw)
                 trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
                 k = int(np.argmin(trial))
                 if not float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):

@@ -173,3 +173,24 @@ def test_a_hundred_light_plan_on_the_arm_and_a_large_dome() -> None:
         assert report.expected["optimal"] <= min(
             v for k, v in report.expected.items() if k != "optimal"
         )
+
+
+def test_scans_among_the_unused_candidates_equal_full_scans() -> None:
+    """The exchange search scores only the unused candidates; on those the costs are the full
+    scan's, elsewhere inf (many pixel rows: the pool's arrays are gathered; few: masked)."""
+    cands = Candidates(fibonacci_cap(40, 5.0, 88.0), None, None)
+    rng = np.random.default_rng(5)
+    for rows in (80, 3):
+        normals = direction_from_az_el(rng.uniform(0, 360, rows), rng.uniform(5, 90, rows))
+        lit = (rng.random((rows, 40)) > 0.3).astype(np.float64)
+        sample = SurfaceSample(
+            normals, np.ones(rows), lit, fibonacci_cap(30, 5, 90), np.ones((rows, 30)), 0.3
+        )
+        obj = NormalsObjective(sample, cands)
+        chosen = np.array([0, 9, 21, 33, 38])
+        among = np.setdiff1d(np.arange(40), chosen)
+        for exact in (False, True):
+            full = obj.swap_costs(chosen, 2, exact=exact)
+            part = obj.swap_costs(chosen, 2, exact=exact, among=among)
+            assert part[among] == pytest.approx(full[among], rel=1e-9)
+            assert np.all(np.isinf(np.delete(part, among)))
