@@ -7,6 +7,8 @@ every pixel, and the fast exchange search's result to the slow search's on small
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
@@ -194,3 +196,30 @@ def test_scans_among_the_unused_candidates_equal_full_scans() -> None:
             part = obj.swap_costs(chosen, 2, exact=exact, among=among)
             assert part[among] == pytest.approx(full[among], rel=1e-9)
             assert np.all(np.isinf(np.delete(part, among)))
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_cli_plans_a_hundred_lights_on_the_shipped_arm_and_a_large_bare_lp(tmp_path) -> None:
+    """Through the front door: `plan --method optimal --lights 100` on the shipped simulated
+    arm and on a 200-LED dome given as a bare .lp (no shipped dome has 100 LEDs)."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+    from rti_rig.core.lp_format import read_lp
+
+    repo = Path(__file__).resolve().parents[2]
+    dirs = fibonacci_cap(200, 5.0)
+    lp = tmp_path / "dome200.lp"
+    lp.write_text(
+        "200\n" + "".join(f"led_{i:03d}.jpg {x:.6f} {y:.6f} {z:.6f}\n" for i, (x, y, z) in
+                          enumerate(dirs))
+    )  # fmt: skip
+    runner = CliRunner()
+    for rig in (repo / "rig_configs" / "simulated_arm.toml", lp):
+        out = tmp_path / f"{rig.stem}_plan.lp"
+        args = ["plan", "--rig", str(rig), "--lights", "100", "--method", "optimal"]
+        r = runner.invoke(app, [*args, "--out", str(out)])
+        assert r.exit_code == 0, r.output
+        assert "optimal" in r.output
+        assert len(read_lp(out)) == 100
