@@ -6,7 +6,9 @@ Lambertian fit with attached/cast shadows and highlights removed, or relighting 
 for the basis the light count supports). The search is a Fedorov-style exchange: start from the
 best of several layouts that need no preview (homogeneous layouts with different elevation floors,
 plus the k-means layout when given), then sweep over the chosen lights, replacing each by the
-unused candidate that lowers the cost most (if any does), until a sweep changes nothing.
+unused candidate that lowers the cost most (if any does), until a sweep changes nothing or
+gains less than :data:`SWEEP_GAIN` of the cost. A scan scores every unused candidate at once
+(for ``normals`` by rank-one updates, :mod:`rti_rig.planner.rank_one`).
 
 Because the starting set includes the homogeneous layout the user would otherwise get and only
 improving swaps are accepted, the result is never worse than that layout *on the objective
