@@ -8,9 +8,12 @@ optimal`, at N = 6 … 100 on a dome and on an arm.
   is timed on a real 24-MP frame, once per decision, as in a session).
 * **`plan --method optimal`** with no preview (a level surface, as `plan --rig RIG --lights N
   --method optimal`): a 200-LED Fibonacci dome (a 72-LED dome cannot take 100 lights) and the
-  simulated arm. Target ≤ 1 s at 100 lights.
+  simulated arm. Target ≤ 1 s at 100 lights. Beside it `plan --method uniform` in the same run
+  (the ratio optimal/uniform does not depend on the machine's load as the seconds do), and
+  `optimal` from a preview (the simulator's relief scene, 192×256, its light given), where the
+  sampled pixels are all different and the planner does the most work.
 
-Median of ``--repeats`` runs (1 for the optimal planner above 24 lights: it is slow there).
+Median of ``--repeats`` runs.
 Run: ``python -m benchmarks.adaptive_time [--write]`` (``--write``: docs/adaptive.md).
 """
 
@@ -27,7 +30,7 @@ import numpy as np
 from benchmarks.adaptive import DOC
 from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import fit_state, small_grey
-from rti_rig.core.geometry import fibonacci_cap
+from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.planner.adaptive import choose_next
 from rti_rig.planner.make_plan import plan_with_report
@@ -55,6 +58,9 @@ def main(argv: list[str] | None = None) -> str:
     dome = DomeGeometry(fibonacci_cap(200, 5.0), tuple(f"led_{i:03d}" for i in range(200)))
     arm = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
     scene = relief_scene(85, 128, seed=0)
+    preview_scene = relief_scene(192, 256, seed=0)
+    preview = lambert_radiance(preview_scene, direction_from_az_el(30.0, 50.0)).astype(np.float32)
+    load_before = os.getloadavg()
     frame = np.random.default_rng(0).integers(0, 65535, (4000, 6000, 3), dtype=np.uint16)
     shrink = _median(lambda: small_grey(frame), args.repeats)
     print(f"shrink 24 MP -> 128 px: {shrink:.3f} s", flush=True)
@@ -76,33 +82,51 @@ def main(argv: list[str] | None = None) -> str:
                 choose_next(state, cands, available)
 
             t_dec = _median(decide, args.repeats)
-            t_opt = float("nan")
+            t_opt = t_uni = t_prev = float("nan")
             if n <= args.max_optimal_n:
-                reps = args.repeats if n <= 24 else 1
+                t_uni = _median(
+                    lambda g=geometry, n=n: plan_with_report(None, g, n, "uniform", "normals"),
+                    args.repeats,
+                )
                 t_opt = _median(
                     lambda g=geometry, n=n: plan_with_report(None, g, n, "optimal", "normals"),
-                    reps,
+                    args.repeats,
                 )
-            rows.append((rig_name, n, len(cands), t_dec, t_opt))
+                t_prev = _median(
+                    lambda g=geometry, n=n: plan_with_report(
+                        preview, g, n, "optimal", "normals", (30.0, 50.0)
+                    ),
+                    args.repeats,
+                )
+            rows.append((rig_name, n, len(cands), t_dec, t_opt, t_uni, t_prev))
             print(
                 f"{rig_name:12s} N={n:3d} candidates={len(cands)} adaptive decision "
-                f"{t_dec:.3f} s, optimal plan {t_opt:.2f} s",
+                f"{t_dec:.3f} s, optimal plan {t_opt:.2f} s (uniform {t_uni:.3f} s, "
+                f"{t_opt / t_uni:.1f}×), from a preview {t_prev:.2f} s",
                 flush=True,
             )
     lines = [
         "Command: `python -m benchmarks.adaptive_time --write`. "
         + machine_line()
-        + f" os.cpu_count() = {os.cpu_count()}; medians of {args.repeats} runs (the optimal "
-        "planner: 1 run above 24 lights). Other jobs shared the 2 cores while this ran.",
+        + f" os.cpu_count() = {os.cpu_count()}; medians of {args.repeats} runs. Other jobs "
+        "shared the 2 cores while this ran: load average (1, 5, 15 min) "
+        + "/".join(f"{x:.1f}" for x in load_before)
+        + " at the start, "
+        + "/".join(f"{x:.1f}" for x in os.getloadavg())
+        + " at the end.",
         "",
         f"Shrinking one 24-MP frame (6000×4000×3, 16-bit) to the fit's 128 px: {shrink:.3f} s "
         "(inside every decision below).",
         "",
         "| rig | N (images so far / planned lights) | candidates | adaptive decision s "
-        "(target ≤ 0.2) | `plan --method optimal` s (target ≤ 1) |",
-        "|---|---|---|---|---|",
+        "(target ≤ 0.2) | `plan --method optimal` s (target ≤ 1) | `uniform` s | optimal / "
+        "uniform | `optimal` from a preview s |",
+        "|---|---|---|---|---|---|---|---|",
     ]
-    lines += [f"| {r} | {n} | {c} | {d:.3f} | {o:.2f} |" for r, n, c, d, o in rows]
+    lines += [
+        f"| {r} | {n} | {c} | {d:.3f} | {o:.2f} | {u:.3f} | {o / u:.1f}× | {p:.2f} |"
+        for r, n, c, d, o, u, p in rows
+    ]
     md = "\n".join(lines)
     print(md)
     if args.write:

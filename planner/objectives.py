@@ -32,6 +32,7 @@ from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix
+from rti_rig.planner import rank_one
 
 Objective = Literal["normals", "relight"]
 OBJECTIVES: tuple[str, ...] = ("normals", "relight")
@@ -71,6 +72,10 @@ HIGHLIGHT_MODEL_WIDTH_DEG = 10.0
 #: dome's paired draws, where both lowered the normal error at every N (docs/research/planner.md).
 GLOSSY_SPECULAR = 0.8
 GLOSSY_WIDTH_DEG = 30.0
+
+#: From this many pixel rows up, a swap scan gathers the arrays of the candidates it scores
+#: (below, scoring them all costs less than the gathering).
+POOL_MIN_PIXELS = 64
 
 #: Sampled normals used for the bias term (it varies smoothly with the normal).
 BIAS_PIXELS = 128
@@ -139,8 +144,7 @@ def candidates_for(
     dense = fibonacci_cap(ARM_CANDIDATES, lo, hi)
     if extra is not None and len(extra):
         dense = np.concatenate([np.asarray(extra, dtype=np.float64).reshape(-1, 3), dense])
-    ok = [geometry.unreachable_reason(d) is None for d in dense]
-    return Candidates(dense[np.asarray(ok, dtype=bool)], None, None)
+    return Candidates(dense[geometry.reachable(dense)], None, None)
 
 
 def snap_unique(targets: NDArray[np.float64], candidates: Candidates) -> NDArray[np.intp]:
@@ -202,8 +206,14 @@ def cast_shadow_visibility(
     t = np.arange(1, max_steps + 1, dtype=np.float64)
     h0 = height_px[rows, cols]
     vis = np.ones((len(rows), len(d)))
+    if len(rows) == 0:
+        return vis
+    # a light whose ray climbs from the lowest sampled pixel to above the highest terrain
+    # within one step cannot be blocked anywhere: skipped (all of them on a level surface)
+    climb = np.minimum(rise, max_steps * rise)
+    free = float(height_px.max()) - float(h0.min()) <= climb + 0.5
     for k in range(len(d)):
-        if horiz[k] < 1e-6:
+        if horiz[k] < 1e-6 or free[k]:
             continue
         cc = np.rint(cols[:, None] + t[None, :] * step_x[k]).astype(np.intp)
         rr = np.rint(rows[:, None] - t[None, :] * step_y[k]).astype(np.intp)
@@ -248,6 +258,27 @@ def reflectance(
     return f
 
 
+def merge_identical_pixels(
+    normals: NDArray[np.float64], w: NDArray[np.float64], wts: NDArray[np.float64], n_first: int
+) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
+    """One row per distinct pixel (normal and candidate weights equal bit for bit).
+
+    Returns the rows kept (each group's first pixel, in order of first appearance), the
+    group's summed weight ``wts``, and the normalised weights of the groups met among the first
+    ``n_first`` pixels (those groups come first: the bias term's sub-sample stays a prefix).
+    Every per-pixel term of :class:`NormalsObjective` depends on the pixel only through its
+    normal and weights, so the weighted mean over the groups is the mean over the pixels.
+    """
+    key = np.ascontiguousarray(np.concatenate([normals, w], axis=1))
+    seen: dict[bytes, int] = {}
+    group = np.array([seen.setdefault(row.tobytes(), len(seen)) for row in key], dtype=np.intp)
+    first = np.unique(group, return_index=True)[1].astype(np.intp)  # each group's earliest row
+    merged = np.bincount(group, weights=wts, minlength=len(seen))
+    head = group[:n_first]
+    firsts = np.bincount(head, weights=wts[:n_first], minlength=int(head.max()) + 1)
+    return first, merged, firsts / firsts.sum()
+
+
 class NormalsObjective:
     """Expected RMS normal error (degrees) of the Lambertian fit over the sample.
 
@@ -279,6 +310,7 @@ class NormalsObjective:
         candidates: Candidates,
         bias_rel: float = BIAS_REL,
         gain_rel: float = 0.0,
+        merge_pixels: bool = True,
     ) -> None:
         self.sample = sample
         self.gain_rel = gain_rel
@@ -288,26 +320,41 @@ class NormalsObjective:
             # observation variance σ²(1 + (g/σ)² (n·l)²) in units of σ²: weight = 1/variance
             shading = np.clip(sample.normals @ d.T, 0.0, None)
             w = w / (1.0 + (gain_rel / NOISE_REL) ** 2 * shading * shading)
+        # the bias term is smooth over normals: a sub-sample of the (random) pixels suffices
+        # ... taken from the estimated surface itself, never from its tilted hedge copies
+        # (with fewer sampled pixels than BIAS_PIXELS they would otherwise slip in)
+        n_bias = min(sample.base_count or len(sample.normals), BIAS_PIXELS)
+        # pixels that are the same to this objective (same normal, same weight for every
+        # candidate: a level preview's or a flat region's) are scored once, with their summed
+        # weight — the same cost, in a fraction of the time (no preview: 1792 rows → 7)
+        wts = sample.weights / sample.weights.sum()
+        if merge_pixels:
+            rows, wts, wts_bias = merge_identical_pixels(sample.normals, w, wts, n_bias)
+        else:
+            rows, wts_bias = np.arange(len(w)), wts[:n_bias] / wts[:n_bias].sum()
+        w = w[rows]
+        self.n = sample.normals[rows]
+        self.wts = wts
+        self.n_bias = len(wts_bias)
+        self.wts_bias = wts_bias
         # information contributed by candidate k at pixel p, as the 6 distinct entries of
         # w_pk l_k l_kᵀ: shape (6, K, P), contiguous per entry for fast batched swaps
         self.outer = np.ascontiguousarray(
             np.stack([w.T * (d[:, i] * d[:, j])[:, None] for i, j in self.PAIRS])
         )
-        self.n = sample.normals
         x, y, z = self.n.T
         # entries of P = I - n nᵀ paired with adj(M): diagonal once, off-diagonal twice
         proj = np.stack([1 - x * x, 1 - y * y, 1 - z * z, -2 * x * y, -2 * x * z, -2 * y * z])
         self.projector = (proj, proj.astype(np.float32))
-        self.wts = sample.weights / sample.weights.sum()
         self.tau2 = (bias_rel * np.sqrt(2 * np.pi / 9)) ** 2  # RMS deviation = bias_rel
-        # the bias term is smooth over normals: a sub-sample of the (random) pixels suffices
-        # ... taken from the estimated surface itself, never from its tilted hedge copies
-        # (with fewer sampled pixels than BIAS_PIXELS they would otherwise slip in)
-        self.n_bias = min(sample.base_count or len(self.n), BIAS_PIXELS)
-        wb = self.wts[: self.n_bias]
-        self.wts_bias = wb / wb.sum()
+        self.dirs = d
+        self.w_kp = np.ascontiguousarray(w.T)  # (K, P): the rank-one scans' weights
+        self.l6 = rank_one.quadratic_coefficients(d)
+        self.hsh = design_matrix("hsh2", d)  # (K, 9)
+        self._sums: tuple[bytes, NDArray, NDArray | None] | None = None
+        self._among: tuple[bytes, NDArray] | None = None
         if self.tau2 > 0:
-            hsh = design_matrix("hsh2", d)  # (K, 9)
+            hsh = self.hsh
             wsub = w[: self.n_bias]
             # cross term w_pk l_k h_kᵀ as (3, K, P_bias, 9)
             self.cross = np.ascontiguousarray(
@@ -315,11 +362,6 @@ class NormalsObjective:
             )
             all_m = self.outer[..., : self.n_bias].sum(axis=1)  # (6, P_bias)
             self.g_all = self._solve(all_m[:, None], self.cross.sum(axis=1)[:, None])[:, 0]
-        # single-precision copies for the batched swap scans, the planner's hot loop: they halve
-        # the memory traffic, and every accepted swap is re-scored in double precision
-        # (:func:`rti_rig.planner.optimal.exchange_search`), so rounding can only cost a missed swap
-        self.outer32 = self.outer.astype(np.float32)
-        self.cross32 = self.cross.astype(np.float32) if self.tau2 > 0 else None
 
     @staticmethod
     def _adjugate(m: NDArray[np.float64]) -> tuple[tuple[NDArray, ...], NDArray]:
@@ -342,12 +384,14 @@ class NormalsObjective:
             ]
         )
 
-    def _variance(self, m: NDArray[np.float64]) -> NDArray:
-        """Squared angular error (rad²) of noise from information entries ``m`` (6, B, P)."""
+    def _variance(self, m: NDArray[np.float64], pix: NDArray[np.intp] | None = None) -> NDArray:
+        """Squared angular error (rad²) of noise from information entries ``m`` (6, B, P) (of
+        the pixels ``pix`` when given)."""
         # closed-form adjugate of the symmetric 3×3 (batched np.linalg.inv is ~20× slower):
         # tr(P M⁻¹ P) = Σ_ij adj(M)_ij P_ij / det(M), P = I - n nᵀ (weights precomputed)
         (c00, c01, c02, c11, c12, c22), det = self._adjugate(m)
         q = self.projector[1 if m.dtype == np.float32 else 0]
+        q = q if pix is None else q[:, pix]
         num = c00 * q[0]
         for c, qq in ((c11, q[1]), (c22, q[2]), (c01, q[3]), (c02, q[4]), (c12, q[5])):
             num += c * qq
@@ -356,10 +400,14 @@ class NormalsObjective:
         num /= np.where(ok, det, 1.0)
         return np.clip(np.where(ok, num, MAX_ERR2), 0.0, MAX_ERR2)
 
-    def _bias(self, m: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray:
-        """Expected squared tangential bias (rad²) on the first pixels, (B, P_bias)."""
-        nb = self.n[: self.n_bias]
-        delta = self._solve(m, r) - self.g_all[:, None]  # (3, B, P_bias, 9)
+    def _bias(
+        self, m: NDArray[np.float64], r: NDArray[np.float64], pix: NDArray[np.intp] | None = None
+    ) -> NDArray:
+        """Expected squared tangential bias (rad²) on the first pixels (or the bias pixels
+        ``pix``), (B, P_bias)."""
+        nb = self.n[: self.n_bias] if pix is None else self.n[pix]
+        g_all = self.g_all if pix is None else self.g_all[:, pix]
+        delta = self._solve(m, r) - g_all[:, None]  # (3, B, P_bias, 9)
         along = nb[:, 0, None] * delta[0] + nb[:, 1, None] * delta[1] + nb[:, 2, None] * delta[2]
         tang = np.sum(delta * delta, axis=(0, -1)) - np.sum(along * along, axis=-1)
         return np.clip(self.tau2 * tang, 0.0, MAX_ERR2)
@@ -376,24 +424,80 @@ class NormalsObjective:
         r = self.cross[:, chosen].sum(axis=1)[:, None] if self.tau2 > 0 else None
         return float(self._total(m, r)[0])
 
-    def swap_costs(
-        self, chosen: NDArray[np.intp], position: int, exact: bool = False
-    ) -> NDArray[np.float64]:
-        """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch.
+    @property
+    def candidate_count(self) -> int:
+        return int(self.outer.shape[1])
 
-        Single precision unless ``exact``: enough to rank swaps, except where a pixel is lit
-        by one or two lights (a near-singular 3×3 whose determinant float32 cannot resolve);
-        the exchange search re-scans exactly when a proposed swap is not confirmed.
+    def _weights_among(self, among: NDArray[np.intp] | None) -> NDArray[np.float64]:
+        """The scan weights (K', P) of the candidates ``among``, kept while they are the same
+        (the unused candidates do not change until a swap is accepted)."""
+        if among is None:
+            return self.w_kp
+        key = np.asarray(among, dtype=np.intp).tobytes()
+        if self._among is None or self._among[0] != key:
+            self._among = (key, self.w_kp[np.asarray(among, dtype=np.intp)])
+        return self._among[1]
+
+    def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
+        """Information and cross terms of the layout ``chosen`` (kept while it is unchanged:
+        a sweep scans every position of one layout until a swap is accepted)."""
+        key = np.asarray(chosen, dtype=np.intp).tobytes()
+        if self._sums is None or self._sums[0] != key:
+            r = self.cross[:, chosen].sum(axis=1) if self.tau2 > 0 else None
+            self._sums = (key, self.outer[:, chosen].sum(axis=1), r)
+        return self._sums[1], self._sums[2]
+
+    def swap_costs(
+        self,
+        chosen: NDArray[np.intp],
+        position: int,
+        exact: bool = False,
+        among: NDArray[np.intp] | None = None,
+    ) -> NDArray[np.float64]:
+        """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch; with
+        ``among``, only those candidates are scored (the others cost inf: the exchange search
+        leaves out the lights already chosen, half the candidates at 100 of 200 LEDs).
+
+        By rank-one updates (:mod:`rti_rig.planner.rank_one`; pixels whose information without
+        that light is near-singular are evaluated directly) unless ``exact``: then every pixel
+        and candidate is evaluated directly (the reference; the exchange search re-scans this
+        way when a proposed swap's cost is not confirmed).
         """
-        dtype = np.float64 if exact else np.float32
-        outer = self.outer if exact else self.outer32
-        base = self.outer[:, chosen].sum(axis=1) - self.outer[:, chosen[position]]  # (6, P)
-        r = None
-        if self.tau2 > 0:
-            cross = self.cross if exact else self.cross32
-            rb = self.cross[:, chosen].sum(axis=1) - self.cross[:, chosen[position]]
-            r = rb.astype(dtype)[:, None] + cross  # (3, K, P_bias, 9)
-        return self._total(base.astype(dtype)[:, None, :] + outer, r)
+        total_m, total_r = self._chosen_sums(chosen)
+        base = total_m - self.outer[:, chosen[position]]  # (6, P)
+        rb = None if total_r is None else total_r - self.cross[:, chosen[position]]
+        # few pixel rows (a level surface: 7): scoring every candidate is cheaper than
+        # gathering the pool's arrays; the others are masked below
+        pooled = among is not None and self.outer.shape[-1] >= POOL_MIN_PIXELS
+        k = np.asarray(among, dtype=np.intp) if pooled else slice(None)
+        if exact:
+            r = None if rb is None else rb[:, None] + self.cross[:, k]  # (3, K, P_bias, 9)
+            costs = self._total(base[:, None, :] + self.outer[:, k], r)
+        else:
+            w_kp = self._weights_among(among if pooled else None)
+            bias = None
+            if rb is not None:
+                bias = rank_one.BiasTerms(rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2)
+            res = rank_one.scan(
+                base, w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2, MAX_ERR2,
+                bias,
+            )  # fmt: skip
+            err2 = res.err2
+            if len(res.bad):
+                m = base[:, None, res.bad] + self.outer[:, :, res.bad][:, k]
+                err2 = err2 + self._variance(m, res.bad) @ self.wts[res.bad]
+            if rb is not None and len(res.bad_bias):
+                pix = res.bad_bias
+                m = base[:, None, pix] + self.outer[:, :, pix][:, k]
+                r = rb[:, None, pix] + self.cross[:, :, pix][:, k]
+                err2 = err2 + self._bias(m, r, pix) @ self.wts_bias[pix]
+            costs = np.degrees(np.sqrt(err2))
+        if among is None:
+            return costs
+        out = np.full(self.outer.shape[1], np.inf)
+        keep = np.asarray(among, dtype=np.intp)
+        out[keep] = costs if pooled else costs[keep]
+        return out
 
     def describe(self, value: float) -> str:
         signal = f" + {100 * self.gain_rel:g}% of the signal" if self.gain_rel > 0 else ""
@@ -473,19 +577,31 @@ class RelightObjective:
         unmodelled = self.tau2 * np.mean(np.sum(miss * miss, axis=-1), axis=-1)
         return bias2 + var + unmodelled
 
+    @property
+    def candidate_count(self) -> int:
+        return len(self.a_cand)
+
     def cost(self, chosen: NDArray[np.intp]) -> float:
         return float(self._costs(np.asarray(chosen, dtype=np.intp)[None])[0])
 
     def swap_costs(
-        self, chosen: NDArray[np.intp], position: int, exact: bool = False
+        self,
+        chosen: NDArray[np.intp],
+        position: int,
+        exact: bool = False,
+        among: NDArray[np.intp] | None = None,
     ) -> NDArray[np.float64]:
-        """Cost of replacing ``chosen[position]`` by each candidate (always double precision)."""
+        """Cost of replacing ``chosen[position]`` by each candidate (always double precision);
+        with ``among``, only those candidates are scored (the others cost inf)."""
         k = len(self.a_cand)
-        idx = np.repeat(np.asarray(chosen, dtype=np.intp)[None], k, axis=0)
-        idx[:, position] = np.arange(k)
+        pool = np.arange(k) if among is None else np.asarray(among, dtype=np.intp)
+        idx = np.repeat(np.asarray(chosen, dtype=np.intp)[None], len(pool), axis=0)
+        idx[:, position] = pool
         with np.errstate(all="ignore"):
-            out = self._costs(idx)
-        return np.where(np.isfinite(out), out, np.inf)
+            costs = self._costs(idx)
+        out = np.full(k, np.inf)
+        out[pool] = np.where(np.isfinite(costs), costs, np.inf)
+        return out
 
     def describe(self, value: float) -> str:
         psnr = -10 * np.log10(max(value, 1e-12))

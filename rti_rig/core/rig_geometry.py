@@ -107,6 +107,21 @@ class ArmGeometry:
             )
         return None
 
+    def reachable(self, directions: ArrayLike) -> NDArray[np.bool_]:
+        """For each of ``directions`` (M, 3): may the arm go there? The limits of
+        :meth:`unreachable_reason`, checked for all at once (a planner checks hundreds)."""
+        d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+        az, el = az_el_from_direction(d)
+        off_axis = angle_between_deg(d, np.array([0.0, 0.0, 1.0]))
+        az = np.where(az > 180.0, az - 360.0, az)
+        return (
+            (off_axis >= self.keep_out_half_angle_deg)
+            & (el >= self.min_elevation_deg - 1e-9)
+            & (el <= self.max_elevation_deg + 1e-9)
+            & (az >= self.min_azimuth_deg - 1e-9)
+            & (az <= self.max_azimuth_deg + 1e-9)
+        )
+
     def elevation_band(self, min_elevation_deg: float = 0.0) -> tuple[float, float]:
         """The reachable elevations (degrees) at or above a floor; ScheduleError if none."""
         lo = max(min_elevation_deg, self.min_elevation_deg)

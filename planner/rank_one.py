@@ -1,0 +1,168 @@
+"""Every one-light swap of the normals objective scored at once, by rank-one updates.
+
+The exchange search (:mod:`rti_rig.planner.optimal`) asks, for one position of the layout, what
+the cost becomes when its light is replaced by each candidate ``k``. Each pixel's information
+matrix is then ``M = B + w l lᵀ``: the layout without that light (``B``, the same for every
+candidate) plus one rank-one term (candidate direction ``l``, the pixel's weight ``w`` for it).
+Sherman–Morrison gives ``M⁻¹ = B⁻¹ - s u uᵀ`` with ``u = B⁻¹ l``, ``s = w / (1 + w lᵀu)``, so the
+terms of :class:`rti_rig.planner.objectives.NormalsObjective` reduce to quadratic and bilinear
+forms in ``l`` (and the candidate's harmonics ``h``) whose per-pixel matrices are computed once
+per scan — the (candidates × pixels) work becomes a few small matrix products and a handful
+of element-wise operations instead of a 3×3 inverse and a 3×9 solve per candidate and pixel:
+
+* variance: ``tr(P M⁻¹) = tr(P B⁻¹) - s lᵀ(B⁻¹PB⁻¹)l``;
+* model bias: with ``G_B = B⁻¹R_B`` and ``D = G_B - G_all``, ``M⁻¹R = G_B + s u vᵀ`` where
+  ``v = h - G_Bᵀl``, so ``‖P(M⁻¹R - G_all)‖² = ‖PD‖² + 2s uᵀPDv + s² ‖Pu‖² ‖v‖²``, each
+  product expanded into forms in ``l`` and ``l ⊗ h``.
+
+It is the same objective, not an approximation; the formulas need ``B⁻¹``, so a pixel whose
+``B`` is singular or ill-conditioned (lit by fewer than three of the other lights) is left
+to the caller's direct evaluation (``bad`` in :class:`ScanResult`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: A pixel's ``B`` counts as invertible when det(B) exceeds this fraction of (tr(B)/3)³ (its
+#: value were ``B`` a multiple of the identity): a condition number of at most ~10⁸, where the
+#: double-precision updates keep ~8 digits. Others are evaluated directly.
+WELL_CONDITIONED = 1e-8
+
+#: Regularisation added to the diagonal, as in the direct evaluation (it must match).
+RIDGE = 1e-9
+
+
+def quadratic_coefficients(d: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Rows ``[x², 2xy, 2xz, y², 2yz, z²]`` per direction (K, 6): ``lᵀ S l`` is this row times
+    the entries ``[S00, S01, S02, S11, S12, S22]`` of a symmetric ``S``."""
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]
+    return np.stack([x * x, 2 * x * y, 2 * x * z, y * y, 2 * y * z, z * z], axis=1)
+
+
+def _entries(s: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The 6 entries (as in :func:`quadratic_coefficients`) of a batch of 3×3 (G, 3, 3),
+    symmetrised: (6, G)."""
+    return np.stack(
+        [
+            s[:, 0, 0],
+            0.5 * (s[:, 0, 1] + s[:, 1, 0]),
+            0.5 * (s[:, 0, 2] + s[:, 2, 0]),
+            s[:, 1, 1],
+            0.5 * (s[:, 1, 2] + s[:, 2, 1]),
+            s[:, 2, 2],
+        ]
+    )
+
+
+def _matrices(e: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Symmetric 3×3 matrices (G, 3, 3) from their 6 entries (6, G)."""
+    a, b, c, d, f, g = e
+    return np.stack([np.stack([a, b, c], -1), np.stack([b, d, f], -1), np.stack([c, f, g], -1)], 1)
+
+
+def inverse_entries(base: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """``(B + ridge·I)⁻¹`` as 6 entries per pixel (6, P), and which pixels are well-conditioned."""
+    a, b, c = base[0] + RIDGE, base[1], base[2]
+    d, e, f = base[3] + RIDGE, base[4], base[5] + RIDGE
+    c00, c11, c22 = d * f - e * e, a * f - c * c, a * d - b * b
+    c01, c02, c12 = c * e - b * f, b * e - c * d, b * c - a * e
+    det = a * c00 + b * c01 + c * c02
+    scale = ((a + d + f) / 3.0) ** 3
+    good = (det > 1e-12) & (det > WELL_CONDITIONED * scale)
+    inv = np.stack([c00, c01, c02, c11, c12, c22]) / np.where(good, det, 1.0)
+    return inv, good
+
+
+@dataclass(frozen=True)
+class ScanResult:
+    """Weighted squared error (rad²) of every candidate over the well-conditioned pixels, and
+    the pixels left to a direct evaluation (indices into the variance and bias pixels)."""
+
+    err2: NDArray[np.float64]
+    bad: NDArray[np.intp]
+    bad_bias: NDArray[np.intp]
+
+
+@dataclass(frozen=True)
+class BiasTerms:
+    """What the model-bias part needs: the layout's cross terms without the swapped light
+    ``rb`` (3, Pb, 9), the all-light fit ``g_all`` (3, Pb, 9), the candidates' harmonics
+    ``h`` (K, 9), their pixel weights and the prior's scale."""
+
+    rb: NDArray[np.float64]
+    g_all: NDArray[np.float64]
+    h: NDArray[np.float64]
+    wts: NDArray[np.float64]
+    tau2: float
+
+
+def scan(
+    base: NDArray[np.float64],
+    w: NDArray[np.float64],
+    d: NDArray[np.float64],
+    l6: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    wts: NDArray[np.float64],
+    noise2: float,
+    max_err2: float,
+    bias: BiasTerms | None,
+) -> ScanResult:
+    """Squared errors of ``B + w_k l_k l_kᵀ`` for every candidate ``k``.
+
+    ``base`` (6, P): entries of ``B`` per pixel; ``w`` (K, P): each candidate's weight per
+    pixel; ``d`` (K, 3) and ``l6 = quadratic_coefficients(d)``; ``normals`` (P, 3) and pixel
+    weights ``wts`` (P,); the bias pixels are the first ``len(bias.wts)`` pixels.
+    """
+    inv6, good = inverse_entries(base)
+    g = np.flatnonzero(good)
+    binv = _matrices(inv6[:, g])  # (G, 3, 3)
+    n = normals[g]
+    proj = np.eye(3)[None] - n[:, :, None] * n[:, None, :]  # (G, 3, 3)
+    pb = proj @ binv
+    tr0 = np.trace(pb, axis1=1, axis2=2)  # tr(P B⁻¹)
+    c = binv @ pb  # B⁻¹ P B⁻¹
+    wg = w if len(g) == len(good) else w[:, g]
+    s = l6 @ inv6[:, g]  # lᵀ B⁻¹ l  (K, G)
+    s *= wg
+    s += 1.0
+    np.divide(wg, s, out=s)  # s = w / (1 + w lᵀ B⁻¹ l)
+    q2 = l6 @ _entries(c)  # lᵀ B⁻¹ P B⁻¹ l = ‖P u‖²
+    wts_g = wts[g]
+    # the variance σ²(tr(P B⁻¹) - s q2) lies in [0, σ² tr(P B⁻¹)]: only where that bound
+    # passes the cap does a pixel need clipping; elsewhere the weighted sum is taken directly
+    capped = noise2 * tr0 > max_err2
+    if bias is not None:  # the bias part below needs s and q2 on its pixels: keep copies
+        at = np.searchsorted(g, np.flatnonzero(good[: len(bias.wts)]))
+        sb, qb = s[:, at], q2[:, at]
+    if np.any(capped):
+        var = np.clip(noise2 * (tr0[None] - s * q2), 0.0, max_err2)
+        err2 = var @ wts_g
+    else:
+        q2 *= s
+        err2 = noise2 * (float(tr0 @ wts_g) - q2 @ wts_g)
+    bad = np.flatnonzero(~good)
+    bad_bias = np.zeros(0, dtype=np.intp)
+    if bias is not None:
+        nb = len(bias.wts)
+        bad_bias = bad[bad < nb]
+        gb = np.flatnonzero(good[:nb])  # bias pixels that are well-conditioned (columns at)
+        bi, pr = binv[at], proj[at]
+        rb = np.transpose(bias.rb[:, gb], (1, 0, 2))  # (Gb, 3, 9)
+        ga = np.transpose(bias.g_all[:, gb], (1, 0, 2))
+        gbm = bi @ rb  # G_B = B⁻¹ R_B
+        pdm = pr @ (gbm - ga)  # P D
+        c0 = np.sum(pdm * pdm, axis=(1, 2))  # ‖P D‖²
+        f = bi @ pdm  # B⁻¹ P D, so uᵀ P D v = lᵀ F (h - G_Bᵀ l)
+        lh = (d[:, :, None] * bias.h[:, None, :]).reshape(len(d), 27)  # l ⊗ h
+        a1 = lh @ f.reshape(len(gb), 27).T  # lᵀ F h
+        a2 = l6 @ _entries(f @ np.transpose(gbm, (0, 2, 1)))  # lᵀ F G_Bᵀ l
+        b1 = lh @ gbm.reshape(len(gb), 27).T  # lᵀ G_B h
+        b2 = l6 @ _entries(gbm @ np.transpose(gbm, (0, 2, 1)))  # lᵀ G_B G_Bᵀ l
+        hh = np.sum(bias.h * bias.h, axis=1)[:, None]
+        tang = c0[None] + 2.0 * sb * (a1 - a2) + sb * sb * qb * (hh - 2.0 * b1 + b2)
+        err2 = err2 + np.clip(bias.tau2 * tang, 0.0, max_err2) @ bias.wts[gb]
+    return ScanResult(err2, bad, bad_bias)
