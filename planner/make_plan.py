@@ -384,6 +384,16 @@ def _candidates_and_starts(
     if not uniforms or uniforms[0][0] != f"uniform ≥{min_elevation_deg:g}°":
         # the user's own floor must work; the extra floors are optional starting points
         raise ScheduleError(uniform_error or "no homogeneous layout fits this rig")
+    if isinstance(geometry, ArmGeometry):
+        # an arm's starts are indexed by position among the extra directions candidates_for
+        # keeps first, so a start it would filter out (unreachable by rounding) is left out
+        # here, before it can shift the indices of the starts after it
+        kept = [u for u in uniforms if geometry.reachable(u[1]).all()]
+        if not kept or kept[0] is not uniforms[0]:
+            raise ScheduleError(
+                f"the homogeneous layout ≥{min_elevation_deg:g}° is not reachable by this arm"
+            )
+        uniforms = kept
     extra = np.concatenate([u[1] for u in uniforms]) if isinstance(geometry, ArmGeometry) else None
     candidates = candidates_for(geometry, min_elevation_deg, extra, max_elevation_deg)
     starts: list[tuple[str, NDArray[np.intp]]] = []

@@ -89,7 +89,7 @@ class ArmGeometry:
         _, el = az_el_from_direction(d)
         el = float(el)
         off_axis = float(angle_between_deg(d, (0.0, 0.0, 1.0)))
-        if off_axis < self.keep_out_half_angle_deg:
+        if off_axis < self.keep_out_half_angle_deg - 1e-9:
             return (
                 f"direction is {off_axis:.2f}° from the camera axis, inside the "
                 f"{self.keep_out_half_angle_deg:g}° keep-out cone"
@@ -115,7 +115,7 @@ class ArmGeometry:
         off_axis = angle_between_deg(d, np.array([0.0, 0.0, 1.0]))
         az = np.where(az > 180.0, az - 360.0, az)
         return (
-            (off_axis >= self.keep_out_half_angle_deg)
+            (off_axis >= self.keep_out_half_angle_deg - 1e-9)
             & (el >= self.min_elevation_deg - 1e-9)
             & (el <= self.max_elevation_deg + 1e-9)
             & (az >= self.min_azimuth_deg - 1e-9)

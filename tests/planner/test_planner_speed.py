@@ -223,3 +223,39 @@ def test_cli_plans_a_hundred_lights_on_the_shipped_arm_and_a_large_bare_lp(tmp_p
         assert r.exit_code == 0, r.output
         assert "optimal" in r.output
         assert len(read_lp(out)) == 100
+
+
+@pytest.mark.parametrize(
+    "arm",
+    [ARM, ArmGeometry(5.0, 85.0, 5.0, 0.0, 45.0), ArmGeometry(20.0, 70.0, 20.0, 0.0, 30.0)],
+)
+@pytest.mark.parametrize("n", [6, 12, 36])
+def test_arm_starting_layouts_are_the_candidates_they_index(arm, n):
+    """The homogeneous starts are indexed by position in the arm's candidate set, so the set
+    must hold each start's directions at those positions (the reachability filter now applies
+    to the dense band only; a start direction it dropped would shift every later index)."""
+    cands, starts = _candidates_and_starts(arm, n, 0.0, 90.0)
+    for label, idx in starts:
+        floor = float(label.split("≥")[1].rstrip("°"))
+        np.testing.assert_array_equal(cands.directions[idx], arm.homogeneous(n, floor))
+        assert arm.reachable(cands.directions[idx]).all()
+
+
+def test_an_unreachable_start_is_left_out_not_shifting_the_others():
+    """A start layout the reachability filter rejects (here: one direction of the second
+    start, as rounding on the keep-out cone's edge could) must not shift later indices."""
+    first = _candidates_and_starts(ARM, 12, 0.0, 90.0)[1]
+    assert len(first) >= 3
+    rejected = ARM.homogeneous(12, float(first[1][0].split("≥")[1].rstrip("°")))[0]
+
+    class Picky(ArmGeometry):
+        def reachable(self, directions):
+            d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+            return super().reachable(d) & ~np.all(np.isclose(d, rejected), axis=1)
+
+    arm = Picky(5.0, 80.0, 10.0, 0.0, 45.0)
+    cands, starts = _candidates_and_starts(arm, 12, 0.0, 90.0)
+    assert [label for label, _ in starts] == [first[0][0]] + [lab for lab, _ in first[2:]]
+    for label, idx in starts:
+        floor = float(label.split("≥")[1].rstrip("°"))
+        np.testing.assert_array_equal(cands.directions[idx], arm.homogeneous(12, floor))
