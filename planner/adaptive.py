@@ -34,10 +34,20 @@ GRAZING_COS = 0.15
 MAX_ERR2 = (np.pi / 2) ** 2
 #: Ridge added to each pixel's information matrix (fewer than 3 lit lights stay finite).
 RIDGE = 1e-4
+#: Prior spread (rad) of each tangential component of a normal before any light (None: none,
+#: only :data:`RIDGE`).
+PRIOR_TANGENT_RAD: float | None = None
 #: Calibrated factor from the bound's mean angle to the measured mean angular error: the
 #: geometric mean of measured/raw over the simulator's five scenes, 8 draws each, N = 6…18
 #: (``python -m benchmarks.adaptive``: 0.892; predicted against measured in docs/adaptive.md).
 ESTIMATE_SCALE = 0.892
+#: How much the estimate grows with the fraction of observations the fit discarded
+#: (:func:`estimate_factor`; calibrated with ESTIMATE_SCALE by ``python -m benchmarks.adaptive``).
+DISCARD_SLOPE = 0.0
+#: Prior chance a light that faces a pixel is kept by the fit, and its weight in observations
+#: (None: no keep model, the plain Lambertian bound).
+KEEP_PRIOR = 1.0
+PRIOR_WEIGHT: float | None = 20.0
 #: Lights of the starting layout (a homogeneous layout: robust, needs nothing known).
 START_LIGHTS = 4
 #: Elevation floor of the starting layout (no grazing light before anything is known).
@@ -86,8 +96,18 @@ def _inverse_information(state: SurfaceState) -> NDArray[np.float64]:
     """Per pixel ``(M + ridge I)⁻¹`` (P, 3, 3) from the lights that really lit it."""
     w = state.lit.astype(np.float64)  # (P, K)
     outer = (state.lights[:, :, None] * state.lights[:, None, :]).reshape(-1, 9)  # (K, 9)
-    m = (w @ outer).reshape(-1, 3, 3) + RIDGE * np.eye(3)
+    m = (w @ outer).reshape(-1, 3, 3) + _ridge(state)[:, None, None] * np.eye(3)
     return np.linalg.inv(m)
+
+
+def _ridge(state: SurfaceState) -> NDArray[np.float64]:
+    """Per pixel, what is added to ``M``: the prior on the normal (:data:`PRIOR_TANGENT_RAD`,
+    in units of the pixel's (σ/ρ)², so the bound becomes the posterior's error and an
+    unobservable normal is as uncertain as the prior says, not "90° wrong"), at least
+    :data:`RIDGE`."""
+    if PRIOR_TANGENT_RAD is None:
+        return np.full(len(state.normals), RIDGE)
+    return np.maximum(_scale2(state) / PRIOR_TANGENT_RAD**2, RIDGE)
 
 
 def _tangent_trace(minv: NDArray[np.float64], n: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -113,9 +133,90 @@ def bound_error2(state: SurfaceState) -> NDArray[np.float64]:
     )
 
 
+def discarded_fraction(state: SurfaceState) -> float:
+    """The fraction of observations the fit discarded among those whose light faced the pixel
+    (above :data:`GRAZING_COS`): what gloss, cast shadows and interreflection cost this object
+    so far — the misfit the Lambertian bound does not see."""
+    if state.lights.shape[0] == 0:
+        return 0.0
+    should = (state.normals @ state.lights.T) > GRAZING_COS
+    total = int(should.sum())
+    return 0.0 if total == 0 else float(1.0 - (should & state.lit).sum() / total)
+
+
+def estimate_factor(state: SurfaceState, scale: float = ESTIMATE_SCALE) -> float:
+    """From the bound's mean angle to the estimate: ``scale × exp(DISCARD_SLOPE × discarded
+    fraction)``, both calibrated against measured error on the simulator (docs/adaptive.md):
+    an object whose fit discards much (gloss, relief) is further from the bound."""
+    return scale * float(np.exp(DISCARD_SLOPE * discarded_fraction(state)))
+
+
 def estimate_error_deg(state: SurfaceState, scale: float = ESTIMATE_SCALE) -> float:
     """The calibrated estimate of the mean normal error (°) now."""
-    return scale * mean_error_deg(bound_error2(state))
+    return estimate_factor(state, scale) * mean_error_deg(bound_error2(state))
+
+
+def predicted_weight(state: SurfaceState, candidates: NDArray[np.float64]) -> NDArray:
+    """Per pixel and candidate (P, C): how much an observation under that light is expected to
+    count, in [0, 1].
+
+    The attached shadow from the fitted normal (soft below :data:`GRAZING_COS`), times the
+    chance the fit will keep the observation, learnt from every pixel and captured light of
+    this object: the fraction kept among observations that should have lit their pixel, by
+    the angle of incidence (cast shadows and interreflection grow towards grazing light) and
+    by the angle between the normal and the half-way vector to the camera (a highlight). A
+    table of :data:`KEEP_BINS` × :data:`KEEP_BINS`, each cell smoothed towards the prior
+    :data:`KEEP_PRIOR` as if it held :data:`PRIOR_WEIGHT` observations. So the Lambertian
+    bound's optimism is not unconditional: where this object's gloss or relief makes the fit
+    discard what it sees, a light of that kind is expected to be discarded too — on every
+    pixel, including lights not tried yet (a low light predicted from the incidence angles the
+    high ones already met).
+    """
+    n = state.normals.astype(np.float32)
+    lt = np.ascontiguousarray(candidates.T, dtype=np.float32)  # (3, C)
+    cos_c = n @ lt
+    w = np.clip(cos_c / GRAZING_COS, 0.0, 1.0)  # attached shadow, soft at grazing light
+    if state.lights.shape[0] == 0 or PRIOR_WEIGHT is None:
+        return w
+    lights = state.lights.astype(np.float32)
+    cos_k = n @ lights.T  # (P, K)
+    should = cos_k > GRAZING_COS  # facing the light, so it should have lit
+    kept = should & state.lit
+    table = _keep_table(cos_k[should], _half_cos(n, lights)[should], kept[should])
+    rate = table[_bin_incidence(cos_c), _bin_half(_half_cos(n, candidates.astype(np.float32)))]
+    return w * rate
+
+
+#: Bins of the keep table (per axis).
+KEEP_BINS = 6
+
+
+def _half_cos(n: NDArray, lights: NDArray) -> NDArray:
+    """cos of the angle between each normal (P, 3) and the half-way vector of each light (L, 3)
+    and the camera (straight above): (P, L)."""
+    h = lights + np.array([0.0, 0.0, 1.0], dtype=lights.dtype)
+    h = h / np.maximum(np.linalg.norm(h, axis=1, keepdims=True), 1e-6)
+    return n @ h.T
+
+
+def _bin_incidence(cos: NDArray) -> NDArray[np.intp]:
+    x = (np.clip(cos, GRAZING_COS, 1.0) - GRAZING_COS) / (1.0 - GRAZING_COS)
+    return np.minimum((x * KEEP_BINS).astype(np.intp), KEEP_BINS - 1)
+
+
+def _bin_half(cos: NDArray) -> NDArray[np.intp]:
+    # the half-way angle (0…90°) in equal steps: a highlight lives in the first bins
+    ang = np.degrees(np.arccos(np.clip(cos, 0.0, 1.0)))
+    return np.minimum((ang / (90.0 / KEEP_BINS)).astype(np.intp), KEEP_BINS - 1)
+
+
+def _keep_table(cos: NDArray, half: NDArray, kept: NDArray) -> NDArray[np.float32]:
+    """Smoothed fraction kept per (incidence, half-way) bin."""
+    idx = _bin_incidence(cos) * KEEP_BINS + _bin_half(half)
+    total = np.bincount(idx, minlength=KEEP_BINS * KEEP_BINS).astype(np.float64)
+    good = np.bincount(idx, weights=kept.astype(np.float64), minlength=KEEP_BINS * KEEP_BINS)
+    rate = (good + PRIOR_WEIGHT * KEEP_PRIOR) / (total + PRIOR_WEIGHT)
+    return rate.reshape(KEEP_BINS, KEEP_BINS).astype(np.float32)
 
 
 def predicted_error2(state: SurfaceState, candidates: NDArray[np.float64]) -> NDArray:
@@ -126,8 +227,7 @@ def predicted_error2(state: SurfaceState, candidates: NDArray[np.float64]) -> ND
     # single precision for the (P, 3, C) scan: it ranks candidates, and halves memory traffic
     minv, n = minv.astype(np.float32), n.astype(np.float32)
     lt = np.ascontiguousarray(candidates.T, dtype=np.float32)  # (3, C)
-    cos = n @ lt  # (P, C)
-    w = np.clip(cos / GRAZING_COS, 0.0, 1.0)  # attached shadow, soft at grazing light
+    w = predicted_weight(state, candidates)
     p = len(n)
     u = (minv.reshape(p * 3, 3) @ lt).reshape(p, 3, -1)  # M⁻¹ l, (P, 3, C): one product
     lu = (u * lt).sum(axis=1)
@@ -153,12 +253,13 @@ def choose_next(
     Ties go to the lower candidate index, so a decision is a deterministic function of its
     inputs (``--resume`` repeats it).
     """
-    now = scale * mean_error_deg(bound_error2(state))
+    factor = estimate_factor(state, scale)
+    now = factor * mean_error_deg(bound_error2(state))
     idx = np.flatnonzero(available)
     if idx.size == 0:
         return Decision(None, now, None, [], "no candidate light left")
     err2 = predicted_error2(state, candidates[idx])
-    after = scale * np.degrees(np.sqrt(err2)).mean(axis=0)  # (C',)
+    after = factor * np.degrees(np.sqrt(err2)).mean(axis=0)  # (C',)
     moves = np.zeros(idx.size) if move_s is None else np.asarray(move_s, float)[idx]
     gain = (now - after) / (capture_s + moves)
     order = np.lexsort((idx, -np.round(gain, 12)))  # best gain first, then lower index
@@ -177,4 +278,166 @@ def choose_next(
         float(after[best]),
         runner,
         "largest predicted drop of the mean normal error per second of rig time",
+    )
+
+
+# --- with the number of lights known: the rest of the design chosen as a whole ---------------
+
+#: Elevation floors (°) of the homogeneous designs an adaptive session with ``--lights N``
+#: chooses among (the floors a dome owner would tune over).
+DESIGN_FLOORS = (0.0, 10.0, 20.0, 30.0)
+#: A design other than the default (the homogeneous layout at :data:`START_FLOOR_DEG`, which
+#: holds the starting lights) is taken only if its predicted error is lower by this fraction:
+#: the evidence must justify leaving the robust layout.
+DESIGN_MARGIN = 0.10
+#: The floor of the default design (and of the starting lights when N is known): the floor
+#: that loses least to the best one over the simulator's scenes (docs/adaptive.md).
+DESIGN_DEFAULT_FLOOR = 10.0
+
+
+def design_error_deg(
+    state: SurfaceState, new_lights: NDArray[np.float64], scale: float = ESTIMATE_SCALE
+) -> float:
+    """The estimated mean normal error (°) once ``new_lights`` (J, 3) are added to the captured
+    ones, each weighted as :func:`predicted_weight` expects it to count."""
+    if len(new_lights) == 0:
+        return estimate_error_deg(state, scale)
+    w = predicted_weight(state, new_lights).astype(np.float64)  # (P, J)
+    outer = (new_lights[:, :, None] * new_lights[:, None, :]).reshape(-1, 9)
+    lit = state.lit.astype(np.float64)
+    old = (state.lights[:, :, None] * state.lights[:, None, :]).reshape(-1, 9)
+    m = (lit @ old + w @ outer).reshape(-1, 3, 3) + _ridge(state)[:, None, None] * np.eye(3)
+    err2 = np.minimum(_scale2(state) * _tangent_trace(np.linalg.inv(m), state.normals), MAX_ERR2)
+    return estimate_factor(state, scale) * mean_error_deg(err2)
+
+
+def _elevations(d: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.degrees(np.arcsin(np.clip(d[..., 2], -1.0, 1.0)))
+
+
+def _angles(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.arccos(np.clip(a @ b.T, -1.0, 1.0))
+
+
+def homogeneous_completion(
+    candidates: NDArray[np.float64],
+    available: NDArray[np.bool_],
+    used: NDArray[np.float64],
+    n_total: int,
+    floor_deg: float,
+) -> NDArray[np.intp] | None:
+    """Candidate indices completing the lights ``used`` (K, 3) to a homogeneous layout of
+    ``n_total`` above ``floor_deg`` (None: the band has too few candidates left).
+
+    The ideal equal-area layout of the band (as :func:`rti_rig.planner.uniform.select_uniform_leds`
+    builds it) is matched to the lights already used by minimum total angle; its unmatched
+    directions are matched, one-to-one, to the available candidates in the band.
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    from rti_rig.core.geometry import fibonacci_cap
+
+    k = len(used)
+    if n_total <= k:
+        return np.zeros(0, dtype=np.intp)
+    el = _elevations(candidates)
+    inband = np.flatnonzero(available & (el >= floor_deg - 1e-9))
+    if inband.size < n_total - k:
+        return None
+    lo = max(floor_deg, float(el[el >= floor_deg - 1e-9].min()))
+    hi = float(el.max())
+    ideal = fibonacci_cap(n_total, lo, hi) if hi > lo else fibonacci_cap(n_total, 0.0, 90.0)
+    rest = np.ones(n_total, dtype=bool)
+    if k:
+        _, cols = linear_sum_assignment(_angles(used, ideal))
+        rest[cols] = False
+    _, pick = linear_sum_assignment(_angles(ideal[rest], candidates[inband]))
+    return inband[pick]
+
+
+def start_subset(
+    layout: NDArray[np.float64], k: int, floor_deg: float = START_FLOOR_DEG
+) -> list[int]:
+    """Indices of ``k`` lights of ``layout`` (M, 3) closest to a homogeneous layout of ``k``:
+    the starting lights of a session of ``M`` lights, so that its homogeneous design at the
+    starting floor is exactly the homogeneous layout of ``M``."""
+    from scipy.optimize import linear_sum_assignment
+
+    from rti_rig.core.geometry import fibonacci_cap
+
+    if k >= len(layout):
+        return list(range(len(layout)))
+    floor_deg = START_FLOOR_DEG if floor_deg is None else floor_deg
+    el = _elevations(layout)
+    lo, hi = max(floor_deg, float(el.min())), float(el.max())
+    ideal = fibonacci_cap(k, lo, hi) if hi > lo else fibonacci_cap(k, 0.0, 90.0)
+    _, cols = linear_sum_assignment(_angles(ideal, layout))
+    return sorted(int(c) for c in cols)
+
+
+def choose_in_design(
+    state: SurfaceState,
+    candidates: NDArray[np.float64],
+    available: NDArray[np.bool_],
+    n_total: int,
+    *,
+    capture_s: float = 1.0,
+    move_s: NDArray[np.float64] | None = None,
+    scale: float = ESTIMATE_SCALE,
+    floors: tuple[float, ...] | None = None,
+    default_floor: float | None = None,
+    margin: float | None = None,
+    keep: int = 3,
+) -> Decision:
+    """With ``n_total`` lights known: the best complete design, then its most useful light.
+
+    Each design completes the lights captured so far to a homogeneous layout of ``n_total``
+    above one of ``floors``; each is scored by :func:`design_error_deg` under what the images
+    so far show. The default floor's design (which, from :func:`start_subset`'s start, is the
+    homogeneous layout itself) is kept unless another is predicted better by ``margin``: an
+    adaptive session falls back to the homogeneous layout when the evidence does not justify
+    leaving it. Within the design, the next light is the one with the largest predicted drop
+    per second (as :func:`choose_next`), so a session stopped early has its most useful lights.
+    """
+    floors = DESIGN_FLOORS if floors is None else floors
+    margin = DESIGN_MARGIN if margin is None else margin
+    default_floor = DESIGN_DEFAULT_FLOOR if default_floor is None else default_floor
+    now = estimate_error_deg(state, scale)
+    k = len(state.lights)
+    designs: dict[float, NDArray[np.intp]] = {}
+    scores: dict[float, float] = {}
+    for f in floors:
+        comp = homogeneous_completion(candidates, available, state.lights, n_total, f)
+        if comp is None or comp.size == 0:
+            continue
+        designs[f] = comp
+        scores[f] = design_error_deg(state, candidates[comp], scale)
+    if not designs:
+        d = choose_next(
+            state, candidates, available, capture_s=capture_s, move_s=move_s, scale=scale, keep=keep
+        )
+        return d
+    best = min(scores, key=lambda f: (scores[f], abs(f - default_floor)))
+    if default_floor in scores and scores[default_floor] <= (1.0 + margin) * scores[best]:
+        best = default_floor
+    mask = np.zeros(len(candidates), dtype=bool)
+    mask[designs[best]] = True
+    d = choose_next(
+        state,
+        candidates,
+        mask & available,
+        capture_s=capture_s,
+        move_s=move_s,
+        scale=scale,
+        keep=keep,
+    )
+    design = {f"{f:g}": round(v, 4) for f, v in sorted(scores.items())}
+    return Decision(
+        d.candidate,
+        now,
+        d.predicted_error_deg,
+        d.runner_up,
+        f"homogeneous design of {n_total} lights above {best:g}° (predicted "
+        f"{scores[best]:.3g}° after all {n_total}; by floor: {design}); within it, "
+        f"the largest predicted drop per second ({k} captured)",
     )
