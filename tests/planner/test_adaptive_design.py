@@ -39,9 +39,7 @@ def dome(n: int = 120) -> DomeGeometry:
 @pytest.mark.parametrize("floor", [0.0, 10.0, 20.0, 30.0])
 def test_a_completion_of_nothing_is_the_homogeneous_layout(floor: float) -> None:
     g = dome()
-    got = homogeneous_completion(
-        g.directions, np.ones(g.count, bool), np.zeros((0, 3)), 12, floor
-    )
+    got = homogeneous_completion(g.directions, np.ones(g.count, bool), np.zeros((0, 3)), 12, floor)
     assert got is not None
     assert sorted(got.tolist()) == sorted(select_uniform_leds(g, 12, floor).tolist())
 

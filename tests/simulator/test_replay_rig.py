@@ -128,8 +128,8 @@ def test_the_readers_notes_are_recorded_in_the_manifest(tmp_path: Path) -> None:
     plan = tmp_path / "plan.lp"
     entries = read_lp(lp, upper_hemisphere=True, notes=[])[:5]
     plan.write_text(
-        "4\n" + "".join(f"{e.name} {e.direction[0]} {e.direction[1]} {e.direction[2]}\n"
-                          for e in entries)
+        "4\n"
+        + "".join(f"{e.name} {e.direction[0]} {e.direction[1]} {e.direction[2]}\n" for e in entries)
     )
     out = tmp_path / "planned"
     r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--plan", str(plan)])
