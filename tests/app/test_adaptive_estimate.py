@@ -29,7 +29,7 @@ def _run(dirs: np.ndarray, images: np.ndarray, n: int) -> tuple[list[int], float
     geometry = DomeGeometry(dirs, tuple(f"l{i}" for i in range(len(dirs))))
     chooser = AdaptiveChooser(dirs, dome_start(geometry, 4, n), n, design_lights=n)
     for i in range(n + 1):
-        c, ev = chooser.decide(i)
+        c, _ = chooser.decide(i)
         if c is None:
             break
         chooser.observe(c, dirs[c], images[c])
