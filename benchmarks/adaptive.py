@@ -271,15 +271,19 @@ def calibrate(results: dict) -> tuple[float, float, list[str], str]:
     predicted-vs-measured rows, and how far off each model is (one global factor against the
     gloss-aware one, both left out per scene)."""
     allp = [p for r in results.values() for p in r["calib"]]
-    scale, slope = _fit_factor(allp, gloss=True)
-    rows = []
-    spread = {False: [], True: []}
+    spread: dict[bool, list[float]] = {False: [], True: []}
     for scene, r in results.items():
         others = [p for s, rr in results.items() if s != scene for p in rr["calib"]]
-        for gloss in (False, True):
-            k, b = _fit_factor(others, gloss)
-            spread[gloss].append(_log_spread(r["calib"], k, b))
-        k, b = _fit_factor(others, gloss=True)
+        for g in (False, True):
+            k, b = _fit_factor(others, g)
+            spread[g].append(_log_spread(r["calib"], k, b))
+    # the gloss-aware model is used only if it predicts left-out scenes better than one factor
+    gloss = float(np.mean(spread[True])) < float(np.mean(spread[False]))
+    scale, slope = _fit_factor(allp, gloss)
+    rows = []
+    for scene, r in results.items():
+        others = [p for s, rr in results.items() if s != scene for p in rr["calib"]]
+        k, b = _fit_factor(others, gloss)
         rows.append(
             f"| {scene} | {k:.2f}, {b:+.2f} | " + " | ".join(_calib_cells(r["calib"], k, b)) + " |"
         )
@@ -289,7 +293,8 @@ def calibrate(results: dict) -> tuple[float, float, list[str], str]:
         + ", ".join(f"×{np.exp(v):.2f}" for v in spread[False])
         + "; gloss-aware "
         + ", ".join(f"×{np.exp(v):.2f}" for v in spread[True])
-        + f" (scenes in order: {', '.join(results)})."
+        + f" (scenes in order: {', '.join(results)}): "
+        + ("the gloss-aware model is used." if gloss else "one global factor is used (slope 0).")
     )
     return scale, slope, rows, summary
 

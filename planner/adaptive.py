@@ -23,7 +23,9 @@ calibrated against measured error on the simulator (:data:`ESTIMATE_SCALE`, docs
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -68,6 +70,15 @@ class SurfaceState:
     noise: NDArray[np.float64]
     lit: NDArray[np.bool_]
     lights: NDArray[np.float64]
+    #: what one decision derives from the state more than once (the inverse information, the
+    #: keep table): computed once per state; the arrays above are not changed after creation
+    cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+
+def _memo(state: SurfaceState, key: str, make: Callable[[], Any]) -> Any:
+    if key not in state.cache:
+        state.cache[key] = make()
+    return state.cache[key]
 
 
 @dataclass(frozen=True)
@@ -92,12 +103,20 @@ class Decision:
         }
 
 
+def _information(state: SurfaceState) -> NDArray[np.float64]:
+    """Per pixel ``M + ridge I`` (P, 3, 3) from the observations kept."""
+
+    def make() -> NDArray[np.float64]:
+        w = state.lit.astype(np.float64)  # (P, K)
+        outer = (state.lights[:, :, None] * state.lights[:, None, :]).reshape(-1, 9)  # (K, 9)
+        return (w @ outer).reshape(-1, 3, 3) + _ridge(state)[:, None, None] * np.eye(3)
+
+    return _memo(state, "information", make)
+
+
 def _inverse_information(state: SurfaceState) -> NDArray[np.float64]:
-    """Per pixel ``(M + ridge I)⁻¹`` (P, 3, 3) from the lights that really lit it."""
-    w = state.lit.astype(np.float64)  # (P, K)
-    outer = (state.lights[:, :, None] * state.lights[:, None, :]).reshape(-1, 9)  # (K, 9)
-    m = (w @ outer).reshape(-1, 3, 3) + _ridge(state)[:, None, None] * np.eye(3)
-    return np.linalg.inv(m)
+    """Per pixel ``(M + ridge I)⁻¹`` (P, 3, 3) from the observations kept."""
+    return _memo(state, "inverse", lambda: np.linalg.inv(_information(state)))
 
 
 def _ridge(state: SurfaceState) -> NDArray[np.float64]:
@@ -128,8 +147,12 @@ def mean_error_deg(err2: NDArray[np.float64]) -> float:
 
 def bound_error2(state: SurfaceState) -> NDArray[np.float64]:
     """Per-pixel expected squared angular error (rad²) with the lights captured so far."""
-    return np.minimum(
-        _scale2(state) * _tangent_trace(_inverse_information(state), state.normals), MAX_ERR2
+    return _memo(
+        state,
+        "bound",
+        lambda: np.minimum(
+            _scale2(state) * _tangent_trace(_inverse_information(state), state.normals), MAX_ERR2
+        ),
     )
 
 
@@ -178,11 +201,15 @@ def predicted_weight(state: SurfaceState, candidates: NDArray[np.float64]) -> ND
     w = np.clip(cos_c / GRAZING_COS, 0.0, 1.0)  # attached shadow, soft at grazing light
     if state.lights.shape[0] == 0 or PRIOR_WEIGHT is None:
         return w
-    lights = state.lights.astype(np.float32)
-    cos_k = n @ lights.T  # (P, K)
-    should = cos_k > GRAZING_COS  # facing the light, so it should have lit
-    kept = should & state.lit
-    table = _keep_table(cos_k[should], _half_cos(n, lights)[should], kept[should])
+
+    def make() -> NDArray[np.float32]:
+        lights = state.lights.astype(np.float32)
+        cos_k = n @ lights.T  # (P, K)
+        should = cos_k > GRAZING_COS  # facing the light, so it should have lit
+        kept = should & state.lit
+        return _keep_table(cos_k[should], _half_cos(n, lights)[should], kept[should])
+
+    table = _memo(state, "keep_table", make)
     rate = table[_bin_incidence(cos_c), _bin_half(_half_cos(n, candidates.astype(np.float32)))]
     return w * rate
 
@@ -205,9 +232,10 @@ def _bin_incidence(cos: NDArray) -> NDArray[np.intp]:
 
 
 def _bin_half(cos: NDArray) -> NDArray[np.intp]:
-    # the half-way angle (0…90°) in equal steps: a highlight lives in the first bins
-    ang = np.degrees(np.arccos(np.clip(cos, 0.0, 1.0)))
-    return np.minimum((ang / (90.0 / KEEP_BINS)).astype(np.intp), KEEP_BINS - 1)
+    # the half-way angle (0…90°) in equal steps: a highlight lives in the first bins (the
+    # steps' cosines compared directly, no arccos over every pixel and candidate)
+    edges = np.cos(np.radians(np.arange(1, KEEP_BINS) * (90.0 / KEEP_BINS))).astype(cos.dtype)
+    return np.searchsorted(-edges, -cos, side="right").astype(np.intp)
 
 
 def _keep_table(cos: NDArray, half: NDArray, kept: NDArray) -> NDArray[np.float32]:
@@ -296,17 +324,20 @@ DESIGN_DEFAULT_FLOOR = 10.0
 
 
 def design_error_deg(
-    state: SurfaceState, new_lights: NDArray[np.float64], scale: float = ESTIMATE_SCALE
+    state: SurfaceState,
+    new_lights: NDArray[np.float64],
+    scale: float = ESTIMATE_SCALE,
+    weights: NDArray | None = None,
 ) -> float:
     """The estimated mean normal error (°) once ``new_lights`` (J, 3) are added to the captured
     ones, each weighted as :func:`predicted_weight` expects it to count."""
     if len(new_lights) == 0:
         return estimate_error_deg(state, scale)
-    w = predicted_weight(state, new_lights).astype(np.float64)  # (P, J)
+    if weights is None:
+        weights = predicted_weight(state, new_lights)
+    w = weights.astype(np.float64)  # (P, J)
     outer = (new_lights[:, :, None] * new_lights[:, None, :]).reshape(-1, 9)
-    lit = state.lit.astype(np.float64)
-    old = (state.lights[:, :, None] * state.lights[:, None, :]).reshape(-1, 9)
-    m = (lit @ old + w @ outer).reshape(-1, 3, 3) + _ridge(state)[:, None, None] * np.eye(3)
+    m = _information(state) + (w @ outer).reshape(-1, 3, 3)
     err2 = np.minimum(_scale2(state) * _tangent_trace(np.linalg.inv(m), state.normals), MAX_ERR2)
     return estimate_factor(state, scale) * mean_error_deg(err2)
 
@@ -406,12 +437,18 @@ def choose_in_design(
     k = len(state.lights)
     designs: dict[float, NDArray[np.intp]] = {}
     scores: dict[float, float] = {}
-    for f in floors:
-        comp = homogeneous_completion(candidates, available, state.lights, n_total, f)
-        if comp is None or comp.size == 0:
-            continue
+    comps = {
+        f: homogeneous_completion(candidates, available, state.lights, n_total, f) for f in floors
+    }
+    comps = {f: c for f, c in comps.items() if c is not None and c.size}
+    if comps:  # every design's lights weighted at once
+        union = np.unique(np.concatenate(list(comps.values())))
+        w_union = predicted_weight(state, candidates[union])
+        where = {int(c): i for i, c in enumerate(union)}
+    for f, comp in comps.items():
         designs[f] = comp
-        scores[f] = design_error_deg(state, candidates[comp], scale)
+        cols = [where[int(c)] for c in comp]
+        scores[f] = design_error_deg(state, candidates[comp], scale, w_union[:, cols])
     if not designs:
         d = choose_next(
             state, candidates, available, capture_s=capture_s, move_s=move_s, scale=scale, keep=keep
