@@ -28,6 +28,7 @@ puts the tables into docs/adaptive.md).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -431,7 +432,17 @@ def main(argv: list[str] | None = None) -> str:
     md = "\n".join(
         [
             f"Command: `python -m benchmarks.adaptive --sim-draws {args.sim_draws} "
-            f"--real-draws {args.real_draws} --write` ({time.perf_counter() - t0:.0f} s). "
+            f"--real-draws {args.real_draws}"
+            + (" --cache FILE" if args.cache else "")
+            + f" --write` ({time.perf_counter() - t0:.0f} s"
+            + (
+                "; the bars' scores — homogeneous layouts and `optimal`, which this branch does "
+                "not change — read from FILE, written by a run of the same command on the same "
+                "draws"
+                if args.cache
+                else ""
+            )
+            + f"; load average {os.getloadavg()[0]:.1f} at the end). "
             + machine_line(),
             "",
             f"Simulator: {args.sim_draws} paired draws per scene, {SIM_REMOVED} of 240 "

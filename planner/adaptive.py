@@ -317,7 +317,7 @@ DESIGN_FLOORS = (0.0, 10.0, 20.0, 30.0)
 #: A design other than the default (the homogeneous layout at :data:`START_FLOOR_DEG`, which
 #: holds the starting lights) is taken only if its predicted error is lower by this fraction:
 #: the evidence must justify leaving the robust layout.
-DESIGN_MARGIN = 0.10
+DESIGN_MARGIN = 0.03
 #: The floor of the default design (and of the starting lights when N is known): the floor
 #: that loses least to the best one over the simulator's scenes (docs/adaptive.md).
 DESIGN_DEFAULT_FLOOR = 10.0

@@ -37,7 +37,11 @@ def _run(dirs: np.ndarray, images: np.ndarray, n: int) -> tuple[list[int], float
     return chooser.used, float(est)
 
 
-def test_a_matte_scene_gets_the_homogeneous_layout_and_an_honest_estimate() -> None:
+def test_a_matte_scene_gets_the_homogeneous_layout_and_an_honest_estimate(
+    monkeypatch,  # type: ignore[no-untyped-def]
+) -> None:
+    # the bound favours low light here by ~5 %: with a 10 % margin that is not evidence enough
+    monkeypatch.setattr(adaptive, "DESIGN_MARGIN", 0.10)
     dirs = fibonacci_cap(90, 3.0)
     images, normals = _scene_images(dirs)
     geometry = DomeGeometry(dirs, tuple(f"l{i}" for i in range(len(dirs))))
