@@ -144,6 +144,35 @@ def test_the_readers_notes_are_recorded_in_the_manifest(tmp_path: Path) -> None:
     assert len(m["input_notes"]) == 2 and "clamped" in " ".join(m["input_notes"])
 
 
+def test_a_resumed_run_records_the_notes_of_the_rig_it_read_again(tmp_path: Path) -> None:
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        open_new_session,
+        run_opened_session,
+    )
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    lp = _flawed_acquisition(tmp_path, "17", "-0.0012")
+    out = tmp_path / "cut"
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 1:
+            cancel.cancel()
+
+    opened = open_new_session(NewSessionRequest(lp, out, lights=5))
+    run_opened_session(opened, cancel=cancel, on_event=on_event)
+    assert len(_journal(out)) == 2
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "clamped to z = 0" in " ".join(r.output.split())  # printed on resume too
+    m = _manifest(out)
+    assert len(m["runs"]) == 2 and len(_journal(out)) == 5
+    for run in m["runs"]:
+        assert len(run["input_notes"]) == 2 and "clamped" in " ".join(run["input_notes"])
+    assert m["input_notes"] == m["runs"][0]["input_notes"]
+
+
 def test_a_clean_acquisition_records_no_reader_notes(tmp_path: Path) -> None:
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(ACQ / "dirs.lp"), "--out", str(out), "--lights", "5"])
