@@ -9,8 +9,8 @@ N lights (those below the acquisition's count among 6, 9, 12, 18, 24, 36, 48):
 * `uniform` — the homogeneous layout, at floor 0° and at the floor that does best here
   (tuned with hindsight, which a user without this dense acquisition could not do);
 * `optimal` — `plan --rig ACQ/dirs.lp --method optimal` (no preview: a level surface);
-* `adaptive` — `run ACQ/dirs.lp --adaptive` (the same chooser, fed these images; one run to the
-  largest N, its first N lights for each N).
+* `adaptive` — `run ACQ/dirs.lp --adaptive --lights N` (the same chooser, fed these images; one
+  run per N, since with N known the design is chosen for N).
 
 Session time: N lights at the replayed dome's ~1.12 s a light (the default dome timing). The
 images are read as the replay rig reads them (JPEG decoded and linearised, 16-bit as they are),
