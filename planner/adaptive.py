@@ -36,9 +36,6 @@ GRAZING_COS = 0.15
 MAX_ERR2 = (np.pi / 2) ** 2
 #: Ridge added to each pixel's information matrix (fewer than 3 lit lights stay finite).
 RIDGE = 1e-4
-#: Prior spread (rad) of each tangential component of a normal before any light (None: none,
-#: only :data:`RIDGE`).
-PRIOR_TANGENT_RAD: float | None = None
 #: Calibrated factor from the bound's mean angle to the measured mean angular error: least
 #: squares of log measured/raw over the simulator's five scenes, 8 draws each, N = 6…18, the
 #: adaptive layouts of `--lights N` (``python -m benchmarks.adaptive``: 0.763; predicted
@@ -112,7 +109,7 @@ def _information(state: SurfaceState) -> NDArray[np.float64]:
     def make() -> NDArray[np.float64]:
         w = state.lit.astype(np.float64)  # (P, K)
         outer = (state.lights[:, :, None] * state.lights[:, None, :]).reshape(-1, 9)  # (K, 9)
-        return (w @ outer).reshape(-1, 3, 3) + _ridge(state)[:, None, None] * np.eye(3)
+        return (w @ outer).reshape(-1, 3, 3) + RIDGE * np.eye(3)
 
     return _memo(state, "information", make)
 
@@ -120,16 +117,6 @@ def _information(state: SurfaceState) -> NDArray[np.float64]:
 def _inverse_information(state: SurfaceState) -> NDArray[np.float64]:
     """Per pixel ``(M + ridge I)⁻¹`` (P, 3, 3) from the observations kept."""
     return _memo(state, "inverse", lambda: np.linalg.inv(_information(state)))
-
-
-def _ridge(state: SurfaceState) -> NDArray[np.float64]:
-    """Per pixel, what is added to ``M``: the prior on the normal (:data:`PRIOR_TANGENT_RAD`,
-    in units of the pixel's (σ/ρ)², so the bound becomes the posterior's error and an
-    unobservable normal is as uncertain as the prior says, not "90° wrong"), at least
-    :data:`RIDGE`."""
-    if PRIOR_TANGENT_RAD is None:
-        return np.full(len(state.normals), RIDGE)
-    return np.maximum(_scale2(state) / PRIOR_TANGENT_RAD**2, RIDGE)
 
 
 def _tangent_trace(minv: NDArray[np.float64], n: NDArray[np.float64]) -> NDArray[np.float64]:
