@@ -3,22 +3,27 @@
 Pure functions, no fitting: the caller (``rti_rig.app.usecases.adaptive``) fits normals and
 albedo to the images so far and passes a :class:`SurfaceState` — a sample of fitted pixels with
 their normal, albedo, noise and, for each light already captured, whether that observation
-really lit the pixel (not in shadow, not saturated). What one preview cannot show (the real
-relief, shadows, gloss — as residual misfit) arrives with every image.
+was kept (lit, and explained by the fit: not a shadow, a highlight or saturated). What one
+preview cannot show (the real relief, shadows, gloss — as residual misfit and discarded
+observations) arrives with every image.
 
 Model (the Cramér–Rao bound of the per-pixel Lambertian fit, algorithms notes §3): pixel ``p``
 with normal ``n``, albedo ``ρ`` and noise ``σ`` has information ``M = Σ_k w_k l_k l_kᵀ`` over the
-captured lights, ``w_k`` = 1 where observation k lit it, and expected squared angular error
+captured lights, ``w_k`` = 1 where observation k was kept, and expected squared angular error
 ``E[θ²] = (σ/ρ)² tr(P M⁻¹ P)``, ``P = I − n nᵀ`` (capped at 90°², an unobservable normal).
-A candidate light ``l`` with predicted weight ``w`` (attached shadow from the fitted normal,
-soft below :data:`GRAZING_COS`) updates ``M⁻¹`` by Sherman–Morrison, so the predicted error of
-every candidate on every sampled pixel is one vectorised expression.
+A candidate light ``l`` adds ``w l lᵀ`` with ``w`` from :func:`predicted_weight` (attached
+shadow from the fitted normal, soft below :data:`GRAZING_COS`, times the chance the fit keeps
+such an observation, learnt from this object's kept and discarded ones); Sherman–Morrison makes
+the predicted error of every candidate on every sampled pixel one vectorised expression.
 
-The next light is the available candidate with the largest predicted drop of the mean angular
-error per second of rig time (capture plus, on an arm, the move from the current light: counted
-as :func:`choose_next`'s ``move_s``); on a dome every light costs the same and this is the
-largest drop. The error estimate the stopping rule uses is the bound's mean angle times a factor
-calibrated against measured error on the simulator (:data:`ESTIMATE_SCALE`, docs/adaptive.md).
+Light by light (:func:`choose_next`, N unknown): the available candidate with the largest
+predicted drop of the mean angular error per second of rig time (capture plus, on an arm, the
+move from the current light: ``move_s``). With N known (:func:`choose_in_design`): the rest of
+the session as a whole — the homogeneous design above one of :data:`DESIGN_FLOORS` with the
+lowest predicted error, the default floor unless another is predicted better by
+:data:`DESIGN_MARGIN` — then its most useful light first. The stopping rule's estimate is the
+bound's mean angle times a factor calibrated against measured error on the simulator
+(:func:`estimate_factor`, docs/adaptive.md).
 """
 
 from __future__ import annotations
