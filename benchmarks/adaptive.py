@@ -4,25 +4,28 @@ Paired draws (``benchmarks.paired``): in each draw some candidate lights are out
 every strategy works on the same remaining ones:
 
 * **homogeneous**, floor tuned with hindsight (the floor with the lowest mean error over the
-  draws, per scene and N) — the bar;
+  draws and N, per scene) — the bar;
 * **optimal** (``plan --method optimal``, objective normals, from one preview);
 * **adaptive** (``run --adaptive``: the same :class:`AdaptiveChooser` the CLI runs, fed the
-  images of the lights it picks). Its decisions do not depend on N, so one run to 18 lights
-  gives its layouts at 6, 9, 12 and 18 (prefixes).
+  images of the lights it picks), as ``run --adaptive --lights N``: with N known the design is
+  chosen for N, so each N is its own session.
 
 Scored as the other planner benchmarks score: normal error of robust photometric stereo (sim:
 against the true normals, every pixel; real: against the all-light fit, on the object mask) and
 relighting PSNR (the richest basis N lights determine, relit to every other candidate).
 
-The stopping rule's estimate is calibrated here: its raw value (``ESTIMATE_SCALE`` = 1) against
-the measured error of the adaptive layouts on the simulator; the factor is the geometric mean
-of measured/raw over scenes, draws and N, and each scene's predicted error is shown with the
-factor fitted on the *other* scenes (leave one scene out), then on the real dome (never used
-for the fit). ``--until-error``: lights used and measured error per scene and target.
+The stopping rule's estimate is calibrated here: the bound's raw mean angle against the
+measured error of the adaptive layouts on the simulator, ``log(measured/raw) = log(scale) +
+slope × discarded fraction`` by least squares over scenes, draws and N — the gloss-aware slope
+kept only if it predicts left-out scenes better than one global factor (slope 0). Each scene's
+predicted error is shown with the factors fitted on the *other* scenes (leave one scene out),
+then on the real dome (never used for the fit). ``--until-error``: lights used and measured
+error per scene and target.
 
-Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--write]`` (the real
-acquisition is read from ../shared/data/neuralrti-example beside the repository; ``--write``
-puts the tables into docs/adaptive.md).
+Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
+[--cache FILE] [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
+beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
+tables into docs/adaptive.md).
 """
 
 from __future__ import annotations
