@@ -314,9 +314,7 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
         on_note(note)
 
     schedule = new_session_schedule(req, loaded, keep_note)
-    opened = _open_new(
-        loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note
-    )
+    opened = _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
     opened.folder.input_notes = [*loaded.notes, *(n.text for n in plan_notes)]
     return opened
 
