@@ -488,7 +488,7 @@ def main(argv: list[str] | None = None) -> str:
             *until_rows,
             "",
             f"Decision time on the simulator's 96-px images: median {np.median(dec) * 1e3:.0f} ms "
-            "per decision (fit + choice; for 24-MP images see `benchmarks.planning_time`).",
+            "per decision (fit + choice; for 24-MP images see `benchmarks.adaptive_time`).",
         ]
     )
     print(md)
