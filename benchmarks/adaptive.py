@@ -4,30 +4,34 @@ Paired draws (``benchmarks.paired``): in each draw some candidate lights are out
 every strategy works on the same remaining ones:
 
 * **homogeneous**, floor tuned with hindsight (the floor with the lowest mean error over the
-  draws, per scene and N) — the bar;
+  draws and N, per scene) — the bar;
 * **optimal** (``plan --method optimal``, objective normals, from one preview);
 * **adaptive** (``run --adaptive``: the same :class:`AdaptiveChooser` the CLI runs, fed the
-  images of the lights it picks). Its decisions do not depend on N, so one run to 18 lights
-  gives its layouts at 6, 9, 12 and 18 (prefixes).
+  images of the lights it picks), as ``run --adaptive --lights N``: with N known the design is
+  chosen for N, so each N is its own session.
 
 Scored as the other planner benchmarks score: normal error of robust photometric stereo (sim:
 against the true normals, every pixel; real: against the all-light fit, on the object mask) and
 relighting PSNR (the richest basis N lights determine, relit to every other candidate).
 
-The stopping rule's estimate is calibrated here: its raw value (``ESTIMATE_SCALE`` = 1) against
-the measured error of the adaptive layouts on the simulator; the factor is the geometric mean
-of measured/raw over scenes, draws and N, and each scene's predicted error is shown with the
-factor fitted on the *other* scenes (leave one scene out), then on the real dome (never used
-for the fit). ``--until-error``: lights used and measured error per scene and target.
+The stopping rule's estimate is calibrated here: the bound's raw mean angle against the
+measured error of the adaptive layouts on the simulator, ``log(measured/raw) = log(scale) +
+slope × discarded fraction`` by least squares over scenes, draws and N — the gloss-aware slope
+kept only if it predicts left-out scenes better than one global factor (slope 0). Each scene's
+predicted error is shown with the factors fitted on the *other* scenes (leave one scene out),
+then on the real dome (never used for the fit). ``--until-error``: lights used and measured
+error per scene and target.
 
-Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--write]`` (the real
-acquisition is read from ../shared/data/neuralrti-example beside the repository; ``--write``
-puts the tables into docs/adaptive.md).
+Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
+[--cache FILE] [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
+beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
+tables into docs/adaptive.md).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -38,10 +42,15 @@ from benchmarks.metrics import relight_psnr
 from benchmarks.paired import compare
 from benchmarks.planner_real_data import relight_model
 from benchmarks.report import machine_line, write_section
-from rti_rig.app.usecases.adaptive import AdaptiveChooser, small_grey
+from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start, small_grey
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
-from rti_rig.planner.adaptive import START_FLOOR_DEG, START_LIGHTS
+from rti_rig.planner.adaptive import (
+    START_LIGHTS,
+    bound_error2,
+    discarded_fraction,
+    mean_error_deg,
+)
 from rti_rig.planner.objectives import models_for
 from rti_rig.planner.topography import REC709
 from rti_rig.planner.uniform import select_uniform_leds
@@ -52,6 +61,37 @@ FLOORS = (0.0, 10.0, 20.0, 30.0)
 SIM_REMOVED = 24
 REAL_REMOVED = 8
 TARGETS_DEG = (1.0, 2.0, 4.0)
+#: Whether adaptive runs with N known choose a design of N as a whole (as the CLI does).
+DESIGN = True
+
+#: Scores of the bars (homogeneous layouts, `optimal`), which do not depend on the adaptive
+#: code: ``--cache FILE`` keeps them between runs, keyed by object, draw, N and layout (the
+#: draws are the same for the same seed), so that changing adaptive re-runs only adaptive.
+_CACHE: dict[str, list[float]] = {}
+_CACHE_PATH: list[Path] = []
+
+
+def _cached(key: str, compute) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+    if key not in _CACHE:
+        _CACHE[key] = [float(v) for v in compute()]
+    e, q = _CACHE[key]
+    return e, q
+
+
+def _load_cache(path: Path | None) -> None:
+    import json
+
+    if path is not None and path.exists():
+        _CACHE.update(json.loads(path.read_text()))
+
+
+def _save_cache(path: Path | None = None) -> None:
+    import json
+
+    if path is None and _CACHE_PATH:
+        path = _CACHE_PATH[0]
+    if path is not None:
+        path.write_text(json.dumps(_CACHE))
 
 
 def adaptive_run(
@@ -64,8 +104,10 @@ def adaptive_run(
 ) -> tuple[list[int], dict[int, float], float]:
     """The chooser on pre-shot images: chosen indices, raw estimate after k images (k ≥ 4),
     and the mean decision time (s)."""
-    start = [int(i) for i in select_uniform_leds(geometry, START_LIGHTS, START_FLOOR_DEG)]
-    chooser = AdaptiveChooser(dirs, start, n_max, until, scale=scale)
+    # as `run --adaptive --lights N` (N known); DESIGN False: light by light (for comparison)
+    design = n_max if until is None and DESIGN else None
+    start = dome_start(geometry, START_LIGHTS, design)
+    chooser = AdaptiveChooser(dirs, start, n_max, until, scale=scale, design_lights=design)
     estimates: dict[int, float] = {}
     times = []
     for i in range(n_max + 1):
@@ -78,6 +120,11 @@ def adaptive_run(
         if c is None:
             break
         chooser.observe(c, dirs[c], grey[c])
+    # the bound's raw mean angle and the discarded fraction after the last image (calibration)
+    state = chooser.state()
+    if state is not None:
+        estimates["raw"] = mean_error_deg(bound_error2(state))
+        estimates["discarded"] = discarded_fraction(state)
     return chooser.used, estimates, float(np.mean(times)) if times else 0.0
 
 
@@ -91,15 +138,17 @@ def _cell(bar: np.ndarray, plan: np.ndarray, higher_better: bool = False) -> str
     return f"{bar.mean():.2f} → {plan.mean():.2f} ({c.wins}/{c.draws}, {verdict})"
 
 
-def sim(draws: int, seed: int = 0) -> tuple[dict, dict]:
+def sim(draws: int, seed: int = 0, scenes: tuple[str, ...] = ()) -> tuple[dict, dict]:
     """Per scene: {(N, strategy): [errors]}, {(N, strategy): [psnr]}, and calibration pairs."""
     from benchmarks.planner_real_data import planned_leds
     from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
 
     settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
-    rng = np.random.default_rng(seed)
     out: dict = {}
-    for scene in settings.scenes:
+    for si, scene in enumerate(settings.scenes):
+        if scenes and scene not in scenes:
+            continue
+        rng = np.random.default_rng([seed, si])  # a scene's draws do not depend on the others
         t0 = time.perf_counter()
         data = render_scene_data(scene, settings)
         cand = data.candidate_dirs
@@ -109,24 +158,37 @@ def sim(draws: int, seed: int = 0) -> tuple[dict, dict]:
         psnr: dict = {}
         calib: list[tuple[int, float, float]] = []  # (N, raw estimate, measured)
         dec_t: list[float] = []
-        for _ in range(draws):
+        for d in range(draws):
             keep = np.sort(rng.choice(len(cand), len(cand) - SIM_REMOVED, replace=False))
             sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
-            used, est, dt = adaptive_run(grey[keep], cand[keep], sub, max(NS))
-            dec_t.append(dt)
             for n in NS:
+                # one adaptive session per N: with --lights N known, the chooser plans for it
+                used, est, dt = adaptive_run(grey[keep], cand[keep], sub, n)
+                dec_t.append(dt)
                 chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
                 light = settings.preview_light_az_el_deg
-                chosen["optimal"] = keep[planned_leds(data.preview, sub, n, light)]
+                chosen["optimal"] = None
                 chosen["adaptive"] = keep[np.array(used[:n])]
                 for label, idx in chosen.items():
-                    e = normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
+
+                    def score(  # type: ignore[no-untyped-def]
+                        idx=idx, n=n, keep=keep, sub=sub, light=light, data=data, cand=cand, lum=lum
+                    ):
+                        if idx is None:  # optimal: planned only when not in the cache
+                            idx = keep[planned_leds(data.preview, sub, n, light)]
+                        e = normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
+                        rest = np.setdiff1d(np.arange(len(cand)), idx)
+                        mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
+                        return e, relight_psnr(mdl, lum[rest], cand[rest])
+
+                    if label == "adaptive":
+                        e, q = score()
+                    else:
+                        e, q = _cached(f"{scene}|{seed}|{d}|{n}|{label}", score)
                     err.setdefault((n, label), []).append(e)
-                    rest = np.setdiff1d(np.arange(len(cand)), idx)
-                    mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
-                    psnr.setdefault((n, label), []).append(relight_psnr(mdl, lum[rest], cand[rest]))
-                if n in est:
-                    calib.append((n, est[n], err[(n, "adaptive")][-1]))
+                    psnr.setdefault((n, label), []).append(q)
+                if "raw" in est:
+                    calib.append((n, est["raw"], err[(n, "adaptive")][-1], est["discarded"]))
         until = []
         full = DomeGeometry(cand, tuple(f"c{i:03d}" for i in range(len(cand))))
         out[scene] = {
@@ -137,13 +199,18 @@ def sim(draws: int, seed: int = 0) -> tuple[dict, dict]:
             "data": (data, grey, full),
             "until": until,
         }
+        _save_cache()
         print(f"{scene}: {draws} draws in {time.perf_counter() - t0:.0f} s", flush=True)
     return out, {}
 
 
-def until_error_rows(results: dict, scale: float) -> list[str]:
-    """--until-error on every scene (all candidates, no draw) at each target."""
+def until_error_rows(results: dict, scale: float, slope: float) -> list[str]:
+    """--until-error on every scene (all candidates, no draw) at each target, with the
+    estimate calibrated here (scale and slope)."""
+    import rti_rig.planner.adaptive as chooser_module
     from benchmarks.tradeoff import normal_error
+
+    chooser_module.DISCARD_SLOPE = slope
 
     rows = []
     for scene, r in results.items():
@@ -156,7 +223,6 @@ def until_error_rows(results: dict, scale: float) -> list[str]:
             measured = normal_error(
                 data.normals, data.candidate_images[idx], data.candidate_dirs[idx]
             )[0]
-            last = max(est) if est else None
             estimate = est.get(len(used)) if est else None
             stopped = (
                 "estimate reached"
@@ -167,30 +233,74 @@ def until_error_rows(results: dict, scale: float) -> list[str]:
                 f"| {scene} | {target:g}° | {len(used)} | "
                 f"{'' if estimate is None else f'{estimate:.2f}°'} | {measured:.2f}° | {stopped} |"
             )
-            del last
     return rows
 
 
-def calibrate(results: dict) -> tuple[float, list[str]]:
-    """Geometric-mean factor measured/raw, and leave-one-scene-out predicted-vs-measured rows."""
-    logs = {s: np.array([np.log(m / e) for _, e, m in r["calib"]]) for s, r in results.items()}
-    scale = float(np.exp(np.mean(np.concatenate(list(logs.values())))))
+def _fit_factor(pairs: list[tuple], gloss: bool) -> tuple[float, float]:
+    """(scale, slope) of ``log(measured / raw) = log(scale) + slope × discarded``, least squares
+    (slope 0 when ``gloss`` is False: one global factor)."""
+    y = np.array([np.log(m / e) for _, e, m, _ in pairs])
+    if not gloss:
+        return float(np.exp(y.mean())), 0.0
+    x = np.array([d for *_, d in pairs])
+    a = np.stack([np.ones_like(x), x], axis=1)
+    (c0, c1), *_ = np.linalg.lstsq(a, y, rcond=None)
+    return float(np.exp(c0)), float(c1)
+
+
+def _predict(pairs: list[tuple], scale: float, slope: float) -> np.ndarray:
+    return np.array([e * scale * np.exp(slope * d) for _, e, _, d in pairs])
+
+
+def _calib_cells(pairs: list[tuple], scale: float, slope: float) -> list[str]:
+    cells = []
+    for n in NS:
+        sel = [p for p in pairs if p[0] == n]
+        if not sel:
+            cells.append("—")
+            continue
+        e = _predict(sel, scale, slope)
+        m = np.array([p[2] for p in sel])
+        cells.append(f"{e.mean():.2f} / {m.mean():.2f} (×{np.exp(np.mean(np.log(m / e))):.2f})")
+    return cells
+
+
+def _log_spread(pairs: list[tuple], scale: float, slope: float) -> float:
+    m = np.array([p[2] for p in pairs])
+    return float(np.sqrt(np.mean(np.log(m / _predict(pairs, scale, slope)) ** 2)))
+
+
+def calibrate(results: dict) -> tuple[float, float, list[str], str]:
+    """The estimate's (scale, slope) fitted on every simulated scene, leave-one-scene-out
+    predicted-vs-measured rows, and how far off each model is (one global factor against the
+    gloss-aware one, both left out per scene)."""
+    allp = [p for r in results.values() for p in r["calib"]]
+    spread: dict[bool, list[float]] = {False: [], True: []}
+    for scene, r in results.items():
+        others = [p for s, rr in results.items() if s != scene for p in rr["calib"]]
+        for g in (False, True):
+            k, b = _fit_factor(others, g)
+            spread[g].append(_log_spread(r["calib"], k, b))
+    # the gloss-aware model is used only if it predicts left-out scenes better than one factor
+    gloss = float(np.mean(spread[True])) < float(np.mean(spread[False]))
+    scale, slope = _fit_factor(allp, gloss)
     rows = []
     for scene, r in results.items():
-        others = np.concatenate([v for s, v in logs.items() if s != scene])
-        k = float(np.exp(np.mean(others)))
-        cells = []
-        for n in NS:
-            pairs = [(e, m) for nn, e, m in r["calib"] if nn == n]
-            if not pairs:
-                cells.append("—")
-                continue
-            e = np.array([p[0] for p in pairs]) * k
-            m = np.array([p[1] for p in pairs])
-            ratio = np.exp(np.mean(np.log(m / e)))
-            cells.append(f"{e.mean():.2f} / {m.mean():.2f} (×{ratio:.2f})")
-        rows.append(f"| {scene} | {k:.2f} | " + " | ".join(cells) + " |")
-    return scale, rows
+        others = [p for s, rr in results.items() if s != scene for p in rr["calib"]]
+        k, b = _fit_factor(others, gloss)
+        rows.append(
+            f"| {scene} | {k:.2f}, {b:+.2f} | " + " | ".join(_calib_cells(r["calib"], k, b)) + " |"
+        )
+    summary = (
+        "Typical factor between measured and estimated error (exp of the RMS log ratio, each "
+        "scene predicted from the others): one global factor "
+        + ", ".join(f"×{np.exp(v):.2f}" for v in spread[False])
+        + "; gloss-aware "
+        + ", ".join(f"×{np.exp(v):.2f}" for v in spread[True])
+        + f" (scenes in order: {', '.join(results)}): "
+        + ("the gloss-aware model is used." if gloss else "one global factor is used (slope 0).")
+    )
+    return scale, slope, rows, summary
 
 
 def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
@@ -218,21 +328,32 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
     for d in range(draws):
         keep = np.sort(rng.choice(len(dirs), len(dirs) - REAL_REMOVED, replace=False))
         sub = DomeGeometry(dirs[keep], tuple(dome.names[i] for i in keep))
-        used, est, dt = adaptive_run(grey[keep], dirs[keep], sub, max(NS), scale=scale)
-        dec_t.append(dt)
         p = previews[d % len(previews)]
         light = (float(az[p]), float(el[p]))
         for n in NS:
+            used, est, dt = adaptive_run(grey[keep], dirs[keep], sub, n, scale=scale)
+            dec_t.append(dt)
             model = models_for(n)[-1]
             chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
-            chosen["optimal"] = keep[planned_leds(rgb8[p], sub, n, light)]
+            chosen["optimal"] = None
             chosen["adaptive"] = keep[np.array(used[:n])]
             for label, idx in chosen.items():
-                e, q, _ = evaluate(idx, images, dirs, ref, mask, model)
+
+                def score(idx=idx, n=n, model=model, keep=keep, sub=sub, p=p, light=light):  # type: ignore[no-untyped-def]
+                    if idx is None:
+                        idx = keep[planned_leds(rgb8[p], sub, n, light)]
+                    e, q, _ = evaluate(idx, images, dirs, ref, mask, model)
+                    return e, q
+
+                if label == "adaptive":
+                    e, q = score()
+                else:
+                    e, q = _cached(f"real|{seed}|{d}|{n}|{label}", score)
                 err.setdefault((n, label), []).append(e)
                 psnr.setdefault((n, label), []).append(q)
-            if n in est:
-                calib.append((n, est[n], err[(n, "adaptive")][-1]))
+            if "raw" in est:
+                calib.append((n, est["raw"], err[(n, "adaptive")][-1], est["discarded"]))
+        _save_cache()
         print(f"real draw {d + 1}/{draws}", flush=True)
     return {"err": err, "psnr": psnr, "calib": calib, "decision_s": dec_t}
 
@@ -279,12 +400,20 @@ def main(argv: list[str] | None = None) -> str:
         default=Path("/work/shared/data/neuralrti-example"),
         help="the real acquisition (a folder with dirs.lp and its images)",
     )
+    ap.add_argument("--cache", type=Path, default=None, help="keep the bars' scores here")
+    ap.add_argument("--scenes", default="", help="comma-separated simulated scenes (default all)")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    results, _ = sim(args.sim_draws)
-    scale, calib_rows = calibrate(results)
-    print(f"calibrated ESTIMATE_SCALE = {scale:.3f}")
+    _load_cache(args.cache)
+    if args.cache is not None:
+        _CACHE_PATH.append(args.cache)
+    scenes = tuple(x for x in args.scenes.split(",") if x)
+    results, _ = sim(args.sim_draws, scenes=scenes)
+    _save_cache(args.cache)
+    scale, slope, calib_rows, calib_summary = calibrate(results)
+    print(f"calibrated ESTIMATE_SCALE = {scale:.3f}, DISCARD_SLOPE = {slope:.3f}")
     rr = real(args.real_draws, scale, args.data) if args.real_draws else None
+    _save_cache(args.cache)
     head = "| object | tuned floor | " + " | ".join(f"N = {n}" for n in NS) + " |"
     sep = "|" + "---|" * (2 + len(NS))
     e_rows, p_rows = [], []
@@ -297,19 +426,26 @@ def main(argv: list[str] | None = None) -> str:
         a, b = table("neuralrti-example (real)", rr)
         e_rows.append(a)
         p_rows.append(b)
-        cells = []
-        for n in NS:
-            pairs = [(e, m) for nn, e, m in rr["calib"] if nn == n]
-            e = np.array([p[0] for p in pairs])
-            m = np.array([p[1] for p in pairs])
-            cells.append(f"{e.mean():.2f} / {m.mean():.2f} (×{np.exp(np.mean(np.log(m / e))):.2f})")
-        real_calib.append(f"| neuralrti-example (real) | {scale:.2f} | " + " | ".join(cells) + " |")
-    until_rows = until_error_rows(results, scale)
+        cells = _calib_cells(rr["calib"], scale, slope)
+        real_calib.append(
+            f"| neuralrti-example (real) | {scale:.2f}, {slope:+.2f} | " + " | ".join(cells) + " |"
+        )
+    until_rows = until_error_rows(results, scale, slope)
     dec = np.concatenate([r["decision_s"] for r in results.values()])
     md = "\n".join(
         [
             f"Command: `python -m benchmarks.adaptive --sim-draws {args.sim_draws} "
-            f"--real-draws {args.real_draws} --write` ({time.perf_counter() - t0:.0f} s). "
+            f"--real-draws {args.real_draws}"
+            + (" --cache FILE" if args.cache else "")
+            + f" --write` ({time.perf_counter() - t0:.0f} s"
+            + (
+                "; the bars' scores — homogeneous layouts and `optimal`, which this branch does "
+                "not change — read from FILE, written by a run of the same command on the same "
+                "draws"
+                if args.cache
+                else ""
+            )
+            + f"; load average {os.getloadavg()[0]:.1f} at the end). "
             + machine_line(),
             "",
             f"Simulator: {args.sim_draws} paired draws per scene, {SIM_REMOVED} of 240 "
@@ -332,14 +468,15 @@ def main(argv: list[str] | None = None) -> str:
             sep,
             *p_rows,
             "",
-            f"Error estimate (the stopping rule's): calibration factor {scale:.3f} (geometric mean "
-            "of measured/raw over all simulated scenes, draws and N; `ESTIMATE_SCALE` in "
-            "planner/adaptive.py). Cells: mean predicted / mean measured (geometric-mean ratio "
-            "measured/predicted); simulator rows use the factor fitted on the *other* scenes; the "
-            "real row uses the simulator's factor (never fitted on it; measured = against the "
-            "all-72-light fit, which is itself not the truth).",
+            f"Error estimate (the stopping rule's): the bound's mean angle × {scale:.3f} × "
+            f"exp({slope:.2f} × the fraction of observations the fit discarded) (least squares "
+            "of log measured/raw over all simulated scenes, draws and N; `ESTIMATE_SCALE`, "
+            "`DISCARD_SLOPE` in planner/adaptive.py). Cells: mean predicted / mean measured "
+            "(geometric-mean ratio measured/predicted); simulator rows use the factors fitted on "
+            "the *other* scenes; the real row uses the simulator's (never fitted on it; measured "
+            "= against the all-72-light fit, which is itself not the truth). " + calib_summary,
             "",
-            "| object | factor used | " + " | ".join(f"N = {n}" for n in NS) + " |",
+            "| object | scale, slope used | " + " | ".join(f"N = {n}" for n in NS) + " |",
             "|" + "---|" * (2 + len(NS)),
             *calib_rows,
             *real_calib,
@@ -351,7 +488,7 @@ def main(argv: list[str] | None = None) -> str:
             *until_rows,
             "",
             f"Decision time on the simulator's 96-px images: median {np.median(dec) * 1e3:.0f} ms "
-            "per decision (fit + choice; for 24-MP images see `benchmarks.planning_time`).",
+            "per decision (fit + choice; for 24-MP images see `benchmarks.adaptive_time`).",
         ]
     )
     print(md)

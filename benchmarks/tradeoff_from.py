@@ -9,8 +9,8 @@ N lights (those below the acquisition's count among 6, 9, 12, 18, 24, 36, 48):
 * `uniform` — the homogeneous layout, at floor 0° and at the floor that does best here
   (tuned with hindsight, which a user without this dense acquisition could not do);
 * `optimal` — `plan --rig ACQ/dirs.lp --method optimal` (no preview: a level surface);
-* `adaptive` — `run ACQ/dirs.lp --adaptive` (the same chooser, fed these images; one run to the
-  largest N, its first N lights for each N).
+* `adaptive` — `run ACQ/dirs.lp --adaptive --lights N` (the same chooser, fed these images; one
+  run per N, since with N known the design is chosen for N).
 
 Session time: N lights at the replayed dome's ~1.12 s a light (the default dome timing). The
 images are read as the replay rig reads them (JPEG decoded and linearised, 16-bit as they are),
@@ -58,10 +58,10 @@ def load_acquisition(lp: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
 def run_tradeoff_from(lp: Path, progress: Callable[[str], None] = print) -> list[Row]:
     """Rows (one per plan and N) for the acquisition ``lp``; see the module docstring."""
     from benchmarks.planner_real_data import evaluate, planned_leds, reference
-    from rti_rig.app.usecases.adaptive import AdaptiveChooser
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start
     from rti_rig.core.errors import ScheduleError
     from rti_rig.core.rig_geometry import DomeGeometry
-    from rti_rig.planner.adaptive import START_FLOOR_DEG, START_LIGHTS
+    from rti_rig.planner.adaptive import START_LIGHTS
     from rti_rig.planner.objectives import models_for
     from rti_rig.planner.uniform import select_uniform_leds
 
@@ -72,15 +72,19 @@ def run_tradeoff_from(lp: Path, progress: Callable[[str], None] = print) -> list
     if not counts:
         raise ValueError(f"{lp}: {len(dirs)} lights; at least 7 are needed for a trade-off")
     name = f"{Path(lp).parent.name}/{Path(lp).name}"
-    start = [int(i) for i in select_uniform_leds(dome, START_LIGHTS, START_FLOOR_DEG)]
-    chooser = AdaptiveChooser(dirs, start, max(counts))
-    t0 = time.perf_counter()
-    for i in range(max(counts)):
-        c, _ = chooser.decide(i)
-        if c is None:
-            break
-        chooser.observe(c, dirs[c], images[c])
-    adaptive_s = (time.perf_counter() - t0) / max(1, max(counts) - START_LIGHTS)
+
+    def adaptive_run(n: int) -> tuple[list[int], float]:
+        """`run --adaptive --lights n` on the recorded images: its lights and the mean time of
+        a decision (with N known the design is chosen for N, so each N is its own session)."""
+        chooser = AdaptiveChooser(dirs, dome_start(dome, START_LIGHTS, n), n, design_lights=n)
+        t0 = time.perf_counter()
+        for i in range(n):
+            c, _ = chooser.decide(i)
+            if c is None:
+                break
+            chooser.observe(c, dirs[c], images[c])
+        return chooser.used, (time.perf_counter() - t0) / max(1, n - START_LIGHTS)
+
     rows: list[Row] = []
 
     def add(method: str, floor: float, n: int, leds: np.ndarray, plan_s: float) -> None:
@@ -115,7 +119,8 @@ def run_tradeoff_from(lp: Path, progress: Callable[[str], None] = print) -> list
         t1 = time.perf_counter()
         opt = planned_leds(None, dome, n, None)
         add("optimal", 0.0, n, opt, time.perf_counter() - t1)
-        add("adaptive", 0.0, n, np.array(chooser.used[:n]), adaptive_s)
+        used, adaptive_s = adaptive_run(n)
+        add("adaptive", 0.0, n, np.array(used), adaptive_s)
         progress(f"{name}: N = {n} done")
     return rows
 

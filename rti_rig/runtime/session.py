@@ -221,6 +221,10 @@ class SessionFolder:
         self.resume: ResumeState | None = None
         self.rig_identity: dict[str, Any] | None = None
         self.rig_change: list[str] | None = None
+        #: what reading the run's input files tolerated (a `.lp` light clamped at the horizon, a
+        #: count line that disagreed): recorded in the manifest, so the session says what it
+        #: was shot from and what was assumed about it, not only the terminal that ran it
+        self.input_notes: list[str] = []
         self.begun = False
         #: every committed step (earlier runs' verified ones and this run's), by index
         self.committed: dict[int, StepRecord] = {}
@@ -295,6 +299,8 @@ class SessionFolder:
             # which config (and light calibration) this run's images were shot with
             "config_sha256": (header.get("rig") or {}).get("config_sha256"),
         }
+        if self.input_notes:
+            run["input_notes"] = list(self.input_notes)
         if self.resume is not None:
             if header["schedule"] != self.manifest["schedule"]:
                 raise SessionError(
@@ -331,6 +337,7 @@ class SessionFolder:
                 "started_at": run["started_at"],
                 **header,
                 "rig": rig,
+                **({"input_notes": list(self.input_notes)} if self.input_notes else {}),
                 "runner": {"state": "running", "finish_reason": None},
                 "runs": [run],
                 "steps": [],

@@ -107,6 +107,80 @@ def test_real_flaws_are_tolerated_and_reported_by_plan_and_run(tmp_path: Path) -
     assert len(read_lp(out / "lights.lp")) == 6
 
 
+def _manifest(session: Path) -> dict:
+    return json.loads((session / "manifest.json").read_text())
+
+
+def test_the_readers_notes_are_recorded_in_the_manifest(tmp_path: Path) -> None:
+    """What the tolerant reader assumed is part of the session's record, not only the terminal:
+    the rig's own `.lp` (fixed and adaptive sessions) and a `--plan` file's."""
+    lp = _flawed_acquisition(tmp_path, "17", "-0.0012")
+    out = tmp_path / "fixed"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--lights", "5"])
+    assert r.exit_code == 0, r.output
+    m = _manifest(out)
+    notes = m["input_notes"]
+    assert notes == m["runs"][0]["input_notes"] and len(notes) == 2
+    assert any(n.startswith(f"{lp}, line 4: light z = -0.0") and "clamped" in n for n in notes)
+    assert any(f"{lp}, line 1: count line says 17" in n for n in notes)
+
+    # a --plan file with its own flaw: its note is recorded beside the rig's
+    plan = tmp_path / "plan.lp"
+    entries = read_lp(lp, upper_hemisphere=True, notes=[])[:5]
+    plan.write_text(
+        "4\n"
+        + "".join(f"{e.name} {e.direction[0]} {e.direction[1]} {e.direction[2]}\n" for e in entries)
+    )
+    out = tmp_path / "planned"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--plan", str(plan)])
+    assert r.exit_code == 0, r.output
+    notes = _manifest(out)["input_notes"]
+    assert len(notes) == 3 and any(f"{plan}, line 1: count line says 4" in n for n in notes)
+
+    out = tmp_path / "adaptive"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--adaptive", "--lights", "5"])
+    assert r.exit_code == 0, r.output
+    m = _manifest(out)
+    assert len(m["input_notes"]) == 2 and "clamped" in " ".join(m["input_notes"])
+
+
+def test_a_resumed_run_records_the_notes_of_the_rig_it_read_again(tmp_path: Path) -> None:
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        open_new_session,
+        run_opened_session,
+    )
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    lp = _flawed_acquisition(tmp_path, "17", "-0.0012")
+    out = tmp_path / "cut"
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 1:
+            cancel.cancel()
+
+    opened = open_new_session(NewSessionRequest(lp, out, lights=5))
+    run_opened_session(opened, cancel=cancel, on_event=on_event)
+    assert len(_journal(out)) == 2
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "clamped to z = 0" in " ".join(r.output.split())  # printed on resume too
+    m = _manifest(out)
+    assert len(m["runs"]) == 2 and len(_journal(out)) == 5
+    for run in m["runs"]:
+        assert len(run["input_notes"]) == 2 and "clamped" in " ".join(run["input_notes"])
+    assert m["input_notes"] == m["runs"][0]["input_notes"]
+
+
+def test_a_clean_acquisition_records_no_reader_notes(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(ACQ / "dirs.lp"), "--out", str(out), "--lights", "5"])
+    assert r.exit_code == 0, r.output
+    m = _manifest(out)
+    assert "input_notes" not in m and "input_notes" not in m["runs"][0]
+
+
 def test_a_light_well_below_the_plane_is_refused_with_file_and_line(tmp_path: Path) -> None:
     lp = _flawed_acquisition(tmp_path, "18", "-0.2")
     for args in (

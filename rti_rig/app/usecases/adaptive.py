@@ -42,8 +42,10 @@ from rti_rig.planner.adaptive import (
     START_FLOOR_DEG,
     START_LIGHTS,
     SurfaceState,
+    choose_in_design,
     choose_next,
     estimate_error_deg,
+    start_subset,
 )
 from rti_rig.planner.objectives import candidates_for, snap_unique
 from rti_rig.planner.uniform import select_uniform_leds
@@ -54,9 +56,13 @@ FIT_PX = 128
 SAMPLE = 2000
 #: Noise floor of one observation relative to the stack's bright level (quantisation, sensor).
 NOISE_FLOOR = 0.003
+#: An observation is explained by the fit within max(k × the pixel's RMS residual, a floor
+#: relative to the stack's bright level); beyond it, a highlight or a cast shadow.
+OUTLIER_K = 3.0
+OUTLIER_FLOOR = 0.02
 #: An adaptive run that gives only --until-error on an arm stops at this many lights at most.
 ARM_MAX_LIGHTS = 100
-FORMAT = "rti-rig-adaptive/1"
+FORMAT = "rti-rig-adaptive/2"
 
 
 def small_grey(pixels: NDArray, white_level: float = 65535.0) -> NDArray[np.float32]:
@@ -84,17 +90,28 @@ def fit_state(images: NDArray[np.float32], lights: NDArray[np.float64]) -> Surfa
     lights reach them) are kept with a level normal and their brightest observation as albedo:
     they are where the next light is most needed.
     """
+    if len(lights) < 3:
+        return None
+    return fit_sample(sample_pixels(images), lights)
+
+
+def sample_pixels(images: NDArray) -> NDArray[np.float32]:
+    """The chooser's pixel sample of each image (K, P) — the same pixels every time (a decision
+    is a function of the images), so a session samples each image once, as it arrives."""
+    flat = np.asarray(images, dtype=np.float32)
+    flat = flat.reshape(flat.shape[0], -1)
+    rng = np.random.default_rng(0)
+    pick = np.sort(rng.choice(flat.shape[1], min(SAMPLE, flat.shape[1]), replace=False))
+    return np.ascontiguousarray(flat[:, pick])
+
+
+def fit_sample(obs: NDArray[np.float32], lights: NDArray[np.float64]) -> SurfaceState | None:
+    """:func:`fit_state` on the pixel sample (K, P) of the images so far."""
     from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
 
     k = len(lights)
     if k < 3:
         return None
-    flat = np.asarray(images, dtype=np.float32).reshape(k, -1)
-    # the same pixels every time (a decision is a function of the images), fitted alone: the
-    # chooser needs a sample, and fitting only it keeps a decision fast
-    rng = np.random.default_rng(0)
-    pick = np.sort(rng.choice(flat.shape[1], min(SAMPLE, flat.shape[1]), replace=False))
-    obs = flat[:, pick]
     try:
         ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
     except ReconstructionError:
@@ -112,7 +129,14 @@ def fit_state(images: NDArray[np.float32], lights: NDArray[np.float64]) -> Surfa
     ref = float(np.percentile(obs, 99)) or 1.0
     dof = max(k - 3, 1)
     noise = np.sqrt((NOISE_FLOOR * ref) ** 2 + resid**2 * k / dof)
-    lit = (obs > ps.dark_threshold).T
+    # kept: lit (above the dark threshold) and explained by the fit — a highlight above it, or a
+    # cast shadow below it, by more than the fit's own outlier rule, is what the chooser must
+    # expect again from lights near that one (planner.adaptive.predicted_weight)
+    g = (ps.normals.reshape(-1, 3)[seen] @ np.asarray(lights, dtype=np.float32).T).T  # (K, P)
+    pred = np.maximum(g, 0.0) * ps.albedo.reshape(-1)[seen]
+    tol = np.maximum(OUTLIER_K * resid, OUTLIER_FLOOR * ref)
+    explained = np.abs(obs - pred) <= tol
+    lit = ((obs > ps.dark_threshold) & (explained | ~valid)).T
     return SurfaceState(normals, albedo, noise, lit, np.asarray(lights, dtype=np.float64))
 
 
@@ -135,15 +159,18 @@ class AdaptiveChooser:
         capture_s: float = 1.0,
         move_times: MoveTimes | None = None,
         scale: float = ESTIMATE_SCALE,
+        design_lights: int | None = None,
     ) -> None:
         self.candidates = np.asarray(candidates, dtype=np.float64)
+        #: the number of lights the design is for (``--lights N``); None: light by light
+        self.design_lights = design_lights
         self.start = list(start)
         self.max_lights = max_lights
         self.until_error_deg = until_error_deg
         self.capture_s = capture_s
         self.move_times = move_times
         self.scale = scale
-        self.images: list[NDArray[np.float32]] = []
+        self.samples: list[NDArray[np.float32]] = []  # each image's pixel sample
         self.lights: list[NDArray[np.float64]] = []
         self.used: list[int] = []
         self.stop_evidence: dict[str, Any] | None = None
@@ -151,12 +178,12 @@ class AdaptiveChooser:
     def observe(self, candidate: int, direction: NDArray[np.float64], image: NDArray) -> None:
         self.used.append(int(candidate))
         self.lights.append(np.asarray(direction, dtype=np.float64))
-        self.images.append(image)
+        self.samples.append(sample_pixels(np.asarray(image)[None])[0])
 
     def state(self) -> SurfaceState | None:
-        if not self.images:
+        if len(self.samples) < 3:
             return None
-        return fit_state(np.stack(self.images), np.stack(self.lights))
+        return fit_sample(np.stack(self.samples), np.stack(self.lights))
 
     def _cap_reason(self) -> str:
         # --lights N, or without it the rig's own cap: both are the session's maximum
@@ -197,14 +224,25 @@ class AdaptiveChooser:
         available[self.used] = False
         current = self.lights[-1] if self.lights else None
         move = None if self.move_times is None else self.move_times(current)
-        d = choose_next(
-            state,
-            self.candidates,
-            available,
-            capture_s=self.capture_s,
-            move_s=move,
-            scale=self.scale,
-        )
+        if self.design_lights is not None:
+            d = choose_in_design(
+                state,
+                self.candidates,
+                available,
+                self.design_lights,
+                capture_s=self.capture_s,
+                move_s=move,
+                scale=self.scale,
+            )
+        else:
+            d = choose_next(
+                state,
+                self.candidates,
+                available,
+                capture_s=self.capture_s,
+                move_s=move,
+                scale=self.scale,
+            )
         if d.candidate is None:
             self.stop_evidence = {"kind": "stop", **d.evidence()}
             return None, self.stop_evidence
@@ -221,8 +259,7 @@ class AdaptiveChooser:
         return {
             "lights_used": len(self.used),
             "estimated_error_deg": None if est is None else round(est, 4),
-            "stop": self.stop_evidence
-            or {"kind": "stop", "reason": self._cap_reason()},
+            "stop": self.stop_evidence or {"kind": "stop", "reason": self._cap_reason()},
         }
 
 
@@ -261,11 +298,28 @@ class AdaptivePlan:
     leds: NDArray[np.intp] | None  # a dome's LED of each candidate
     start: list[int]
     max_lights: int
+    #: ``--lights N``: the design is chosen for N lights as a whole; None: light by light
+    design_lights: int | None = None
 
 
-def adaptive_plan(rig, lights: int | None, start_lights: int = START_LIGHTS) -> AdaptivePlan:  # type: ignore[no-untyped-def]
+def dome_start(geometry: DomeGeometry, k: int, n_total: int | None) -> list[int]:
+    """LED indices of a dome's starting layout of ``k``: with ``n_total`` known, the ``k`` of
+    the homogeneous layout of ``n_total`` (at the starting floor) closest to a homogeneous
+    layout of ``k`` — so that the design at the starting floor is that layout exactly."""
+    if n_total is None or n_total <= k:
+        return [int(i) for i in select_uniform_leds(geometry, k, START_FLOOR_DEG)]
+    from rti_rig.planner import adaptive
+
+    full = select_uniform_leds(geometry, n_total, adaptive.DESIGN_DEFAULT_FLOOR)
+    return [int(full[i]) for i in start_subset(geometry.directions[full], k)]
+
+
+def adaptive_plan(  # type: ignore[no-untyped-def]
+    rig, lights: int | None, start_lights: int = START_LIGHTS, design: bool | None = None
+) -> AdaptivePlan:
     """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
-    homogeneous starting layout of ``start_lights``."""
+    homogeneous starting layout of ``start_lights``; with ``lights`` given (``design`` not
+    False) the rest is chosen as a design of that many lights."""
     geometry = rig.geometry
     if isinstance(geometry, DomeGeometry):
         cands = candidates_for(geometry)
@@ -280,16 +334,22 @@ def adaptive_plan(rig, lights: int | None, start_lights: int = START_LIGHTS) -> 
         cap = ARM_MAX_LIGHTS
     max_lights = min(lights if lights is not None else cap, len(dirs))
     k0 = min(start_lights, max_lights)
+    n_design = max_lights if (lights is not None and design is not False) else None
     if isinstance(geometry, DomeGeometry):
-        chosen = select_uniform_leds(geometry, k0, START_FLOOR_DEG)
+        chosen = dome_start(geometry, k0, n_design)
         lookup = {int(led): i for i, led in enumerate(leds)}  # type: ignore[union-attr]
-        start = [lookup[int(led)] for led in chosen]
+        start = [lookup[int(geometry_led)] for geometry_led in chosen]
     else:
+        from rti_rig.planner import adaptive
         from rti_rig.planner.objectives import Candidates
 
-        targets = geometry.homogeneous(k0, START_FLOOR_DEG)
-        start = [int(i) for i in snap_unique(targets, Candidates(dirs, None, None))]
-    return AdaptivePlan(dirs, leds, start, max_lights)
+        floor = START_FLOOR_DEG if n_design is None else adaptive.DESIGN_DEFAULT_FLOOR
+        targets = geometry.homogeneous(n_design or k0, floor)
+        snapped = snap_unique(targets, Candidates(dirs, None, None))
+        if n_design is not None and n_design > k0:
+            snapped = [snapped[i] for i in start_subset(dirs[np.asarray(snapped)], k0)]
+        start = [int(i) for i in snapped]
+    return AdaptivePlan(dirs, leds, start, max_lights, n_design)
 
 
 class AdaptiveSteps:
@@ -314,6 +374,7 @@ class AdaptiveSteps:
             until_error_deg,
             capture_s=_capture_s(rig),
             move_times=move,
+            design_lights=plan.design_lights,
         )
         self._pending: dict[int, int] = {}
 
@@ -331,6 +392,7 @@ class AdaptiveSteps:
             "max_lights": self.plan.max_lights,
             "until_error_deg": self.until_error_deg,
             "start_lights": len(self.plan.start),
+            "design_lights": self.plan.design_lights,
             "candidates": len(self.plan.candidates),
             "fit_px": FIT_PX,
             "estimate_scale": self.chooser.scale,
@@ -431,7 +493,12 @@ def resume_adaptive_source(rig, folder) -> AdaptiveSteps:  # type: ignore[no-unt
     header = folder.manifest["adaptive"]
     if header.get("format") != FORMAT:
         raise RtiRigError(f"{folder.root}: unknown adaptive format {header.get('format')!r}")
-    plan = adaptive_plan(rig, header["max_lights"], header["start_lights"])
+    plan = adaptive_plan(
+        rig,
+        header["max_lights"],
+        header["start_lights"],
+        design=header.get("design_lights") is not None,
+    )
     if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
         raise RtiRigError(
             f"{folder.root}: the rig now offers {len(plan.candidates)} candidate lights, the "

@@ -304,9 +304,19 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     for note in loaded.notes:
         on_note(Note(note, "warning"))
     if req.is_adaptive:
-        return _open_adaptive(req, loaded)
-    schedule = new_session_schedule(req, loaded, on_note)
-    return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+        opened = _open_adaptive(req, loaded)
+        opened.folder.input_notes = list(loaded.notes)
+        return opened
+    plan_notes: list[Note] = []
+
+    def keep_note(note: Note) -> None:  # the plan file's notes: printed and recorded
+        plan_notes.append(note)
+        on_note(note)
+
+    schedule = new_session_schedule(req, loaded, keep_note)
+    opened = _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+    opened.folder.input_notes = [*loaded.notes, *(n.text for n in plan_notes)]
+    return opened
 
 
 def check_resume_rig(  # type: ignore[no-untyped-def]
@@ -385,12 +395,15 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         )
     config_path = req.rig_config or Path(rig_entry["config_path"])
     loaded = load_rig_config(config_path)
+    for note in loaded.notes:
+        on_note(Note(note, "warning"))
     identity, diffs = check_resume_rig(
         manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
     )
     folder = SessionFolder.reopen(req.session_dir)
     folder.rig_identity = identity
     folder.rig_change = diffs or None
+    folder.input_notes = list(loaded.notes)  # recorded in this run's entry of the manifest
     schedule = LightSchedule.from_dict(folder.manifest["schedule"])
     done = len(folder.done)
     resume = folder.resume

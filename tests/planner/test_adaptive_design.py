@@ -1,0 +1,120 @@
+"""The adaptive chooser with N known (planner/adaptive.py): homogeneous designs, the fall-back
+to the homogeneous layout, the keep model that lowers a light's worth where the fit discards
+what it sees, and the gloss-aware estimate."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rti_rig.planner.adaptive as adaptive
+from rti_rig.core.geometry import fibonacci_cap
+from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.adaptive import (
+    SurfaceState,
+    choose_in_design,
+    design_error_deg,
+    discarded_fraction,
+    estimate_error_deg,
+    estimate_factor,
+    homogeneous_completion,
+    predicted_weight,
+    start_subset,
+)
+from rti_rig.planner.uniform import select_uniform_leds
+
+
+def state_for(normals: np.ndarray, lights: np.ndarray, noise: float = 0.01) -> SurfaceState:
+    normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
+    lit = normals @ lights.T > 0
+    p = len(normals)
+    return SurfaceState(normals, np.ones(p), np.full(p, noise), lit, lights)
+
+
+def dome(n: int = 120) -> DomeGeometry:
+    dirs = fibonacci_cap(n, 3.0)
+    return DomeGeometry(dirs, tuple(f"l{i}" for i in range(n)))
+
+
+@pytest.mark.parametrize("floor", [0.0, 10.0, 20.0, 30.0])
+def test_a_completion_of_nothing_is_the_homogeneous_layout(floor: float) -> None:
+    g = dome()
+    got = homogeneous_completion(g.directions, np.ones(g.count, bool), np.zeros((0, 3)), 12, floor)
+    assert got is not None
+    assert sorted(got.tolist()) == sorted(select_uniform_leds(g, 12, floor).tolist())
+
+
+def test_the_start_is_part_of_the_layout_and_the_default_design_completes_it() -> None:
+    """From start_subset's start, the default floor's design is the homogeneous layout itself:
+    the fall-back loses nothing to it."""
+    g = dome()
+    full = select_uniform_leds(g, 12, 10.0)
+    start = [int(full[i]) for i in start_subset(g.directions[full], 4)]
+    assert len(set(start)) == 4 and set(start) <= set(full.tolist())
+    available = np.ones(g.count, bool)
+    available[start] = False
+    rest = homogeneous_completion(g.directions, available, g.directions[start], 12, 10.0)
+    assert rest is not None
+    assert sorted([*start, *rest.tolist()]) == sorted(full.tolist())
+
+
+def test_it_falls_back_to_the_default_design_unless_another_is_clearly_better() -> None:
+    g = dome()
+    full = select_uniform_leds(g, 9, 10.0)
+    start = [int(full[i]) for i in start_subset(g.directions[full], 4)]
+    normals = fibonacci_cap(200, 60.0)  # a gently curved, matte surface
+    st = state_for(normals, g.directions[start])
+    available = np.ones(g.count, bool)
+    available[start] = False
+    scores = {
+        f: design_error_deg(
+            st,
+            g.directions[homogeneous_completion(g.directions, available, st.lights, 9, f)],
+        )
+        for f in (0.0, 10.0, 20.0, 30.0)
+    }
+    best = min(scores, key=scores.get)
+    d = choose_in_design(st, g.directions, available, 9, default_floor=10.0, margin=10.0)
+    assert d.candidate in full and "above 10°" in d.reason  # huge margin: always the default
+    d = choose_in_design(st, g.directions, available, 9, default_floor=10.0, margin=0.0)
+    assert f"above {best:g}°" in d.reason  # no margin: the best predicted design
+    chosen = homogeneous_completion(g.directions, available, st.lights, 9, best)
+    assert d.candidate in chosen.tolist()
+
+
+def test_the_keep_model_lowers_a_light_where_the_fit_discarded_its_kind() -> None:
+    """A glossy object: the fit discarded every observation near the mirror direction. A
+    candidate there is worth less than before; one far from it is not."""
+    normals = np.tile([0.0, 0.0, 1.0], (300, 1))
+    lights = fibonacci_cap(12, 20.0)
+    st = state_for(normals, lights)
+    near_mirror = lights[:, 2] > np.cos(np.radians(20))  # half-way vector within 10° of n
+    assert near_mirror.any() and not near_mirror.all()
+    glossy = SurfaceState(
+        st.normals, st.albedo, st.noise, st.lit & ~near_mirror[None, :], st.lights
+    )
+    cands = np.array([[0.0, 0.0, 1.0], [np.cos(np.radians(35)), 0.0, np.sin(np.radians(35))]])
+    matte_w = predicted_weight(st, cands)
+    glossy_w = predicted_weight(glossy, cands)
+    assert np.allclose(matte_w, 1.0)
+    assert glossy_w[:, 0].max() < 0.6  # the zenith light would likely be discarded again
+    assert np.allclose(glossy_w[:, 1], 1.0)  # an oblique light is still worth a light
+    assert discarded_fraction(st) == 0.0
+    assert discarded_fraction(glossy) == pytest.approx(near_mirror.mean())
+
+
+def test_the_estimate_grows_with_what_the_fit_discarded(monkeypatch: pytest.MonkeyPatch) -> None:
+    normals = fibonacci_cap(100, 50.0)
+    lights = fibonacci_cap(10, 20.0)
+    st = state_for(normals, lights)
+    lit = st.lit.copy()
+    lit[:, :3] = False
+    rough = SurfaceState(st.normals, st.albedo, st.noise, lit, st.lights)
+    monkeypatch.setattr(adaptive, "DISCARD_SLOPE", 0.0)
+    assert estimate_factor(rough, 0.8) == pytest.approx(0.8)
+    monkeypatch.setattr(adaptive, "DISCARD_SLOPE", 1.5)
+    d = discarded_fraction(rough)
+    assert 0.2 < d < 0.4
+    assert estimate_factor(rough, 0.8) == pytest.approx(0.8 * np.exp(1.5 * d))
+    assert estimate_factor(st, 0.8) == pytest.approx(0.8)
+    assert estimate_error_deg(rough, 0.8) > estimate_error_deg(st, 0.8)
