@@ -47,7 +47,7 @@ class FlashSyncSettings(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     firmware: Literal["cceh-rti"] = "cceh-rti"
-    check_after_images: int = Field(default=6, ge=3, le=100)
+    check_after_images: int = Field(default=3, ge=3, le=100)
 
     @property
     def timeout_s(self) -> float:

@@ -9,9 +9,11 @@ image matches the LED expected, before the label is committed.
 
 Evidence, cheapest first, on the grey image reduced to at most :data:`SIDE` pixels a side:
 
-1. **dark**: the image's 99th percentile below :data:`DARK_RATIO` of the median of the images
-   accepted so far (of full scale for the first image): no LED lit the exposure — the pulse
-   never reached the dome;
+1. **dark**: the image's 99th percentile below :data:`DARK_RATIO` of the brightest image
+   accepted so far (below :data:`DARK_FIRST` of full scale for the first image): no LED lit
+   the exposure — the pulse never reached the dome. Grazing light on a flat, dark or metallic
+   object can be 10 × dimmer than the brightest image; a missed pulse leaves only the
+   ambient light inside the dome, far below that;
 2. **which neighbour in the order explains it** (from :data:`MIN_FIT_IMAGES` accepted images
    on): the qa.py machinery — robust Lambertian photometric stereo
    (:func:`~rti_rig.reconstruct.photometric_stereo.fit_photometric_stereo`) on the images
@@ -40,9 +42,11 @@ from rti_rig.reconstruct.stack import channel_mean
 #: Side (pixels) the images are reduced to for the check (area averaging).
 SIDE = 64
 #: Images accepted before the neighbour test runs (a fit needs well-spread lights).
-MIN_FIT_IMAGES = 6
-#: An image whose 99th percentile is below this fraction of the accepted images' median is dark.
-DARK_RATIO = 0.15
+MIN_FIT_IMAGES = 3
+#: An image whose 99th percentile is below this fraction of the brightest accepted one is dark.
+DARK_RATIO = 0.03
+#: The first image is dark below this fraction of full scale.
+DARK_FIRST = 0.005
 #: A neighbour explaining the image with a residual below this fraction of the expected LED's
 #: residual is a slip.
 SLIP_RATIO = 0.5
@@ -114,14 +118,14 @@ class SequenceChecker:
         """Judge image ``index``; an image judged ``ok`` joins the fit for the next ones."""
         img = reduce_image(pixels, white_level)
         peak = float(np.percentile(img, 99.0))
-        ref = float(np.median(self._peaks)) if self._peaks else 1.0
+        ref = max(self._peaks) if self._peaks else 1.0
         ratio = peak / ref if ref > 0 else float("inf")
-        if ratio < DARK_RATIO:
+        if ratio < (DARK_RATIO if self._peaks else DARK_FIRST):
             return SequenceVerdict(
                 index,
                 MISSED,
                 f"dark: its brightest pixels reach {ratio:.0%} of "
-                + ("the other images'" if self._peaks else "full scale")
+                + ("the brightest image's" if self._peaks else "full scale")
                 + ": no LED lit the exposure (the flash pulse did not reach the dome, which "
                 "therefore did not step)",
                 None,
