@@ -106,6 +106,7 @@ class SlipGuard:
         from rti_rig.reconstruct.sequence_check import SequenceChecker
 
         self.geometry = geometry
+        self.settings = settings
         self.checker = SequenceChecker(geometry.directions, settings.check_after_images)
         self.verdicts: list[Any] = []
 
@@ -117,6 +118,17 @@ class SlipGuard:
         kept = keep_unlabelled(Path(root), index, frame, verdict.to_json())
         what = "missed step" if verdict.kind == "missed-step" else "double step"
         before = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
+        last = self.settings.firmware_led_count - 1
+        if verdict.fitted and verdict.best_position == index - 1 and index == last:
+            # the firmware re-lights its last LED once its order is exhausted: it got there early
+            raise LightSlipError(
+                f"image {index + 1} was lit by LED {index} again: the dome reached the end of its "
+                "sequence one image early, so it stepped twice earlier, within the first "
+                f"{self.settings.check_after_images} images, where the check cannot see a double "
+                f"step. The labels in lights.lp from that step on are WRONG: do not use this "
+                f"session. Image {index + 1} is kept, unlabelled, as {kept}. Long-press the "
+                "dome's start button to rewind it, then shoot again"
+            )
         raise LightSlipError(
             f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
             f"{verdict.reason}. The image is kept, unlabelled, as {kept}; lights.lp lists "
