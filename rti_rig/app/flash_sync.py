@@ -74,9 +74,21 @@ def flash_sync_of(loaded) -> FlashSyncSettings | None:  # type: ignore[no-untype
 
 
 def check_exposure(loaded) -> None:  # type: ignore[no-untyped-def]
-    """Refuse an exposure the firmware's off-timeout would cut short (at config load)."""
+    """Refuse, at config load, an exposure the firmware's off-timeout would cut short, and a
+    camera release through a dome link that does not exist."""
     fs = flash_sync_of(loaded)
-    if fs is not None and loaded.config.camera.exposure_s > fs.timeout_s:
+    if fs is None:
+        return
+    device = loaded.config.camera.device or {}
+    if device.get("trigger") == "dome_shutter":
+        raise ConfigError(
+            loaded.path,
+            "camera.device.trigger",
+            "'dome_shutter' fires the camera through the dome's serial link, and a "
+            "camera-triggered dome has none: let rti-rig fire the camera itself (gphoto2) and "
+            "plug its PC-sync output into the dome",
+        )
+    if loaded.config.camera.exposure_s > fs.timeout_s:
         raise ConfigError(
             loaded.path,
             "camera.exposure_s",
