@@ -227,6 +227,7 @@ def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-de
         "--auto-exposure": "each metering shot would step the dome to its next LED",
         "--resume": "the dome's own count no longer matches the session's",
         "preview": "a preview shot would step the dome to its next LED",
+        "plan": "the firmware lights its LEDs in its own order, so no plan can be run on it",
     }
     for option, present in given.items():
         if present:

@@ -145,6 +145,25 @@ def test_options_that_would_fire_the_camera_outside_the_sequence_are_refused(  #
     assert not out.exists() and rigs == []  # refused before the rig was built
 
 
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (["preview", str(SHIPPED), "--out", "OUT"], "preview cannot be used"),
+        (["plan", "--rig", str(SHIPPED), "--out", "OUT"], "plan cannot be used"),
+        (
+            ["run", str(SHIPPED), "--out", "OUT", "--plan", str(CONFIGS / "example_dome_48.lp")],
+            "--plan cannot be used",
+        ),
+    ],
+)
+def test_preview_and_plans_are_refused(tmp_path: Path, rigs, args: list[str], named: str) -> None:  # type: ignore[no-untyped-def]
+    out = tmp_path / "out"
+    result = runner.invoke(app, [str(out) if a == "OUT" else a for a in args])
+    assert result.exit_code == 2, result.output
+    assert named in " ".join(result.output.split())
+    assert not out.exists() and rigs == []
+
+
 def test_resume_is_refused_because_the_domes_count_went_on(tmp_path: Path) -> None:
     out = tmp_path / "s"
     cfg = with_fault(tmp_path, 5, "missed_pulse")
