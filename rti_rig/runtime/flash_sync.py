@@ -11,7 +11,6 @@ committed (:class:`CaptureCheck`); a slip stops the session with :class:`LightSl
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
 
@@ -44,11 +43,9 @@ class CameraTriggeredLighting:
         self.firmware = firmware
         self.timeout_s = timeout_s
         self.name = f"camera-triggered dome ({firmware})"
-        self.on_connect: Callable[[], None] | None = None
 
     def connect(self) -> None:
-        if self.on_connect is not None:
-            self.on_connect()
+        pass  # no link: the dome listens only to the camera's flash contact
 
     def close(self) -> None:
         pass
