@@ -8,8 +8,10 @@ root builds, the controller, the slip guard) into a temporary folder; then the e
 (which LED really lit each exposure) is compared with the session's ``lights.lp``.
 
 Printed per scene and fault: how many slips were caught **at the slipped image** (nothing
-mislabelled), **late** (the images between were labelled wrongly), or **never**, and how many
-clean sessions raised a false alarm. Run: ``python -m benchmarks.flash_sync_slips``
+mislabelled), **late with the session disowned** (the images between are in ``lights.lp`` with
+wrong lights, and the error says "do not use this session"), **late** (wrong lights in
+``lights.lp`` and the error does not say so), or **never**, and how many clean sessions raised a
+false alarm. Run: ``python -m benchmarks.flash_sync_slips``
 (``--quick`` fewer positions).
 """
 
@@ -47,11 +49,12 @@ def run_once(scene: str, fault: tuple[int, str] | None, root: Path) -> dict[str,
     rig = build_rig(loaded)
     schedule = plan_uniform(rig.geometry, rig.geometry.count, 0.0, None, 90.0)
     folder = SessionFolder.create(root, len(schedule))
-    caught = None
+    caught, disowned = None, False
     try:
         run_session(rig, schedule, folder)
     except LightSlipError as exc:
         caught = int(str(exc).split()[1])
+        disowned = "do not use this session" in str(exc)
     finally:
         rig.close()
     camera = rig.camera
@@ -68,14 +71,14 @@ def run_once(scene: str, fault: tuple[int, str] | None, root: Path) -> dict[str,
             led = truth[i]
             if led is None or not np.allclose(e.direction, dirs[led], atol=1e-6):
                 wrong += 1
-    return {"caught": caught, "wrong_in_lp": wrong}
+    return {"caught": caught, "wrong_in_lp": wrong, "disowned": disowned}
 
 
 def main(argv: list[str]) -> None:
     quick = "--quick" in argv
     positions = range(2, 60, 12) if quick else range(1, 60, 4)
     print(f"config {CONFIG.name}; fault positions (image, 1-based): {list(positions)}")
-    totals = {"missed_pulse": [0, 0, 0], "double_step": [0, 0, 0]}
+    totals = {"missed_pulse": [0, 0, 0, 0], "double_step": [0, 0, 0, 0]}
     false_alarms = 0
     with tempfile.TemporaryDirectory() as tmp:
         runs = 0
@@ -85,7 +88,7 @@ def main(argv: list[str]) -> None:
             false_alarms += clean["caught"] is not None or clean["wrong_in_lp"] != 0
             line = [f"{scene:9s} clean: {'FALSE ALARM' if clean['caught'] else 'ok'}"]
             for kind in totals:
-                at_slip = late = never = 0
+                at_slip = late = disowned = never = 0
                 mislabelled = 0
                 for pos in positions:
                     runs += 1
@@ -95,19 +98,22 @@ def main(argv: list[str]) -> None:
                         never += 1
                     elif r["caught"] == pos and r["wrong_in_lp"] == 0:
                         at_slip += 1
+                    elif r["disowned"]:
+                        disowned += 1
                     else:
                         late += 1
-                for k, v in enumerate((at_slip, late, never)):
+                for k, v in enumerate((at_slip, disowned, late, never)):
                     totals[kind][k] += v
                 line.append(
-                    f"{kind}: {at_slip} at the slip, {late} late, {never} never "
-                    f"({mislabelled} mislabelled lp entries)"
+                    f"{kind}: {at_slip} at the slip, {disowned} late and the session disowned, "
+                    f"{late} late, {never} never ({mislabelled} mislabelled lp entries)"
                 )
             print("; ".join(line), flush=True)
     n = len(SCENES) * len(positions)
-    for kind, (a, late, never) in totals.items():
+    for kind, (a, disowned, late, never) in totals.items():
         print(
-            f"{kind}: caught at the slipped image {a}/{n} ({a / n:.0%}), late {late}, never {never}"
+            f"{kind}: caught at the slipped image {a}/{n} ({a / n:.0%}), late with the session "
+            f"disowned {disowned}, late {late}, never {never}"
         )
     print(f"false alarms on clean sessions: {false_alarms}/{len(SCENES)}")
 

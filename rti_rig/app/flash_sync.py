@@ -129,23 +129,35 @@ class SlipGuard:
             return
         kept = keep_unlabelled(Path(root), index, frame, verdict.to_json())
         what = "missed step" if verdict.kind == "missed-step" else "double step"
-        before = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
+        rewind = (
+            "The dome's count no longer matches the session: long-press its start button to "
+            "rewind it, then start a new session"
+        )
         last = self.settings.firmware_led_count - 1
         if verdict.fitted and verdict.best_position == index - 1 and index == last:
             # the firmware re-lights its last LED once its order is exhausted: it got there early
             raise LightSlipError(
                 f"image {index + 1} was lit by LED {index} again: the dome reached the end of its "
-                "sequence one image early, so it stepped twice earlier, within the first "
-                f"{self.settings.check_after_images} images, where the check cannot see a double "
-                f"step. The labels in lights.lp from that step on are WRONG: do not use this "
-                f"session. Image {index + 1} is kept, unlabelled, as {kept}. Long-press the "
-                "dome's start button to rewind it, then shoot again"
+                "sequence one image early, so it stepped twice earlier, where the check did not "
+                "see it. The labels in lights.lp from that step on are WRONG: do not use this "
+                f"session. Image {index + 1} is kept, unlabelled, as {kept}. {rewind}"
             )
+        from rti_rig.reconstruct.sequence_check import SHIFT_FROM
+
+        if verdict.since is not None or (verdict.fitted and index <= SHIFT_FROM):
+            # a slip in the first images is seen only some images later (docs/domes.md)
+            first = max(1, verdict.since or 1)  # the slip's own image is uncertain by one
+            raise LightSlipError(
+                f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
+                f"{verdict.reason}. A slip in the first images is seen only some images later, "
+                f"so images {first}–{index} in lights.lp may be mislabelled: do not use this "
+                f"session. Image {index + 1} is kept, unlabelled, as {kept}. {rewind}"
+            )
+        before = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
         raise LightSlipError(
             f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
             f"{verdict.reason}. The image is kept, unlabelled, as {kept}; lights.lp lists "
-            f"{before} only. The dome's count no longer matches the session: long-press its "
-            "start button to rewind it, then start a new session"
+            f"{before} only. {rewind}"
         )
 
 

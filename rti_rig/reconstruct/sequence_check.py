@@ -22,6 +22,15 @@ Evidence, cheapest first, on the grey image reduced to at most :data:`SIDE` pixe
    whose relative residual is below :data:`SLIP_RATIO` of the expected LED's is a slip: the
    next LED means a double step, the previous one a missed step.
 
+3. **a slip before the neighbour test could run** (images :data:`SHIFT_FROM` + 1 to
+   :data:`SHIFT_UNTIL` + 1): a double step in the first images shifts every later image by
+   one LED, and the shifted images then explain one another. So the whole set is fitted
+   (least-squares photometric stereo) as labelled and under "one LED later (or earlier) from
+   image *j* on" for each *j* up to the first neighbour test; a hypothesis whose relative RMS
+   residual is :data:`SHIFT_MARGIN` below the labels' is a slip that started at image *j*
+   (:attr:`SequenceVerdict.since`). The images from *j* on were labelled before this could
+   be known.
+
 Before a fit exists (the first :data:`MIN_FIT_IMAGES` images, or while the lights seen so far
 cannot determine a normal) only a dark image is caught. The checker is pure: it holds the
 reduced images it accepted and reads no file, no clock, no device.
@@ -54,6 +63,11 @@ SLIP_RATIO = 0.5
 #: expected LED already explains the image as well as noise allows).
 MIN_RESIDUAL = 0.02
 
+#: The blind-spot test (3.) runs on images with these 0-based indices.
+SHIFT_FROM, SHIFT_UNTIL = 8, 20
+#: ...and names a shift whose residual is this fraction below the labels' residual.
+SHIFT_MARGIN = 0.05
+
 OK, MISSED, DOUBLE = "ok", "missed-step", "double-step"
 
 
@@ -73,6 +87,8 @@ class SequenceVerdict:
     fitted: bool
     residuals: dict[int, float] = field(default_factory=dict)
     brightness_ratio: float = float("nan")
+    #: For a slip found by the blind-spot test: the image (0-based) it started at.
+    since: int | None = None
 
     @property
     def slip(self) -> bool:
@@ -87,6 +103,7 @@ class SequenceVerdict:
             "fitted": self.fitted,
             "residuals": {str(k): v for k, v in self.residuals.items()},
             "brightness_ratio": self.brightness_ratio,
+            "since": self.since,
         }
 
 
@@ -133,6 +150,8 @@ class SequenceChecker:
                 brightness_ratio=ratio,
             )
         verdict = self._neighbour_test(index, img, ratio)
+        if not verdict.slip:
+            verdict = self._shift_test(index, img, ratio) or verdict
         if not verdict.slip:
             self._images.append(img)
             self._lights.append(self.order[index] if index < len(self.order) else self.order[-1])
@@ -183,4 +202,59 @@ class SequenceChecker:
             True,
             residuals,
             brightness_ratio=ratio,
+        )
+
+    def _shift_test(
+        self, index: int, img: NDArray[np.float32], ratio: float
+    ) -> SequenceVerdict | None:
+        """Test 3: did the labels slip by one LED in the first images (the blind spot)?"""
+        n = len(self.order)
+        if not SHIFT_FROM <= index <= SHIFT_UNTIL or index >= n:
+            return None
+        stack = np.stack([*self._images, img])
+        positions = [*range(len(self._images)), index]
+        if positions[-1] != len(positions) - 1:
+            return None  # the accepted images are not the run's consecutive first ones
+
+        def residual(labels: list[int]) -> float:
+            lights = self.order[labels]
+            ps = fit_photometric_stereo(stack, lights, robust=False, saturation=1.0)
+            rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
+            pred = np.maximum(np.einsum("hwc,nc->nhw", ps.normals, lights), 0.0) * rho
+            use = stack < 1.0
+            r = (stack - pred)[use]
+            return float(np.sqrt(np.mean(r**2)) / max(np.sqrt(np.mean(stack[use] ** 2)), 1e-12))
+
+        try:
+            as_labelled = residual(positions)
+        except ReconstructionError:
+            return None
+        best: tuple[float, int, int] | None = None
+        for start in range(0, min(self.min_fit_images, index) + 1):
+            for step in (1, -1):
+                labels = [p if k < start else p + step for k, p in enumerate(positions)]
+                if min(labels) < 0 or max(labels) >= n:
+                    continue
+                try:
+                    r = residual(labels)
+                except ReconstructionError:
+                    continue
+                if r < (1.0 - SHIFT_MARGIN) * as_labelled and (best is None or r < best[0]):
+                    best = (r, start, step)
+        if best is None:
+            return None
+        r, start, step = best
+        kind, how = (DOUBLE, "stepped twice") if step > 0 else (MISSED, "missed a step")
+        return SequenceVerdict(
+            index,
+            kind,
+            f"from image {start + 1} on, the images fit the order one LED "
+            f"{'later' if step > 0 else 'earlier'} than labelled (relative residual {r:.3f} "
+            f"against {as_labelled:.3f}): the dome {how} at image {start + 1}, before the check "
+            "could test it",
+            index + step,
+            True,
+            {index: as_labelled, index + step: r},
+            brightness_ratio=ratio,
+            since=start,
         )

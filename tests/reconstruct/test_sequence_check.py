@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from rti_rig.core.geometry import direction_from_az_el
-from rti_rig.reconstruct.sequence_check import DOUBLE, MISSED, OK, SequenceChecker
+from rti_rig.reconstruct.sequence_check import DOUBLE, MISSED, OK, SHIFT_UNTIL, SequenceChecker
 from rti_rig.simulator.sim_scene import renderer_for
 
 ORDER = np.concatenate(
@@ -53,3 +53,18 @@ def test_an_image_lit_by_the_previous_led_is_a_missed_step() -> None:
         chk.check(i, frame(ORDER[i]), 65535)
     v = chk.check(10, frame(ORDER[9]), 65535)
     assert v.kind == MISSED and v.best_position == 9 and "previous LED" in v.reason
+
+
+def test_a_shift_from_the_first_images_is_found_by_the_whole_set_test() -> None:
+    """Double step at image 2: every later image is lit one LED later, so the images explain
+    one another and the neighbour test sees nothing; the whole-set test names where it began."""
+    chk = SequenceChecker(ORDER)
+    verdicts = []
+    for i in range(25):
+        v = chk.check(i, frame(ORDER[i if i < 1 else i + 1]), 65535)
+        verdicts.append(v)
+        if v.slip:
+            break
+    v = verdicts[-1]
+    assert v.slip and v.kind == DOUBLE and v.since in (0, 1)
+    assert v.index <= SHIFT_UNTIL and "stepped twice" in v.reason
