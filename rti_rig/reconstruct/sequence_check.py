@@ -29,7 +29,11 @@ Evidence, cheapest first, on the grey image reduced to at most :data:`SIDE` pixe
    image *j* on" for each *j* up to the first neighbour test; a hypothesis whose relative RMS
    residual is :data:`SHIFT_MARGIN` below the labels' is a slip that started at image *j*
    (:attr:`SequenceVerdict.since`). The images from *j* on were labelled before this could
-   be known.
+   be known;
+4. **where a slip began**: when test 2 finds one at image *i*, the same whole-set comparison
+   over "shifted from image *j* on", *j* from *i* − :data:`LOOKBACK` to *i*, says whether
+   earlier images were already lit by the wrong LED (a slip test 2 saw only once the
+   difference grew, e.g. under grazing light).
 
 Before a fit exists (the first :data:`MIN_FIT_IMAGES` images, or while the lights seen so far
 cannot determine a normal) only a dark image is caught. The checker is pure: it holds the
@@ -67,6 +71,8 @@ MIN_RESIDUAL = 0.02
 SHIFT_FROM, SHIFT_UNTIL = 8, 20
 #: ...and names a shift whose residual is this fraction below the labels' residual.
 SHIFT_MARGIN = 0.05
+#: A slip the neighbour test finds may have begun up to this many images before (test 4).
+LOOKBACK = 8
 
 OK, MISSED, DOUBLE = "ok", "missed-step", "double-step"
 
@@ -150,7 +156,9 @@ class SequenceChecker:
                 brightness_ratio=ratio,
             )
         verdict = self._neighbour_test(index, img, ratio)
-        if not verdict.slip:
+        if verdict.slip:
+            verdict = self._locate_start(verdict, img)
+        else:
             verdict = self._shift_test(index, img, ratio) or verdict
         if not verdict.slip:
             self._images.append(img)
@@ -204,6 +212,50 @@ class SequenceChecker:
             brightness_ratio=ratio,
         )
 
+    def _whole_set_residual(self, stack: NDArray[np.float32], labels: list[int]) -> float:
+        """Relative RMS residual of a least-squares photometric-stereo fit of ``stack``
+        labelled with order positions ``labels`` (raises ReconstructionError if it cannot)."""
+        lights = self.order[labels]
+        ps = fit_photometric_stereo(stack, lights, robust=False, saturation=1.0)
+        rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
+        pred = np.maximum(np.einsum("hwc,nc->nhw", ps.normals, lights), 0.0) * rho
+        use = stack < 1.0
+        r = (stack - pred)[use]
+        return float(np.sqrt(np.mean(r**2)) / max(np.sqrt(np.mean(stack[use] ** 2)), 1e-12))
+
+    def _locate_start(self, verdict: SequenceVerdict, img: NDArray[np.float32]) -> SequenceVerdict:
+        """Test 4: did the slip test 2 found at ``verdict.index`` begin at an earlier image?"""
+        index = verdict.index
+        step = 1 if verdict.kind == DOUBLE else -1
+        n = len(self.order)
+        if len(self._images) != index:
+            return verdict
+        stack = np.stack([*self._images, img])
+        found: tuple[float, int] | None = None
+        for start in range(max(0, index - LOOKBACK), index + 1):
+            labels = [k if k < start else k + step for k in range(index + 1)]
+            if min(labels) < 0 or max(labels) >= n:
+                continue
+            try:
+                r = self._whole_set_residual(stack, labels)
+            except ReconstructionError:
+                continue
+            if found is None or r < found[0]:
+                found = (r, start)
+        if found is None or found[1] == index:
+            return verdict
+        return SequenceVerdict(
+            index,
+            verdict.kind,
+            f"{verdict.reason}; the images fit best with the slip beginning at image "
+            f"{found[1] + 1}",
+            verdict.best_position,
+            True,
+            verdict.residuals,
+            verdict.brightness_ratio,
+            since=found[1],
+        )
+
     def _shift_test(
         self, index: int, img: NDArray[np.float32], ratio: float
     ) -> SequenceVerdict | None:
@@ -217,13 +269,7 @@ class SequenceChecker:
             return None  # the accepted images are not the run's consecutive first ones
 
         def residual(labels: list[int]) -> float:
-            lights = self.order[labels]
-            ps = fit_photometric_stereo(stack, lights, robust=False, saturation=1.0)
-            rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
-            pred = np.maximum(np.einsum("hwc,nc->nhw", ps.normals, lights), 0.0) * rho
-            use = stack < 1.0
-            r = (stack - pred)[use]
-            return float(np.sqrt(np.mean(r**2)) / max(np.sqrt(np.mean(stack[use] ** 2)), 1e-12))
+            return self._whole_set_residual(stack, labels)
 
         try:
             as_labelled = residual(positions)

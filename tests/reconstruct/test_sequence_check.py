@@ -68,3 +68,26 @@ def test_a_shift_from_the_first_images_is_found_by_the_whole_set_test() -> None:
     v = verdicts[-1]
     assert v.slip and v.kind == DOUBLE and v.since in (0, 1)
     assert v.index <= SHIFT_UNTIL and "stepped twice" in v.reason
+
+
+def test_a_slip_found_late_is_traced_back_to_the_image_it_began_at() -> None:
+    """Test 4 (white-box): images 8-10 were lit one LED later but accepted (as under grazing
+    light, where the neighbour test sees a slip only once it grows); when the slip is found at
+    image 11 the whole set says it began at image 8."""
+    from rti_rig.reconstruct.sequence_check import SequenceVerdict, reduce_image
+
+    chk = SequenceChecker(ORDER)
+    for i in range(7):
+        assert chk.check(i, frame(ORDER[i]), 65535).kind == OK
+    for i in range(7, 10):  # accepted although lit by the next LED
+        chk._images.append(reduce_image(frame(ORDER[i + 1]), 65535))
+        chk._lights.append(ORDER[i])
+    found = SequenceVerdict(10, DOUBLE, "lit by the next LED", 11, True)
+    located = chk._locate_start(found, reduce_image(frame(ORDER[11]), 65535))
+    assert located.since == 7 and "beginning at image 8" in located.reason
+    # ...and a slip at its own image is left as it is
+    chk2 = SequenceChecker(ORDER)
+    for i in range(10):
+        chk2.check(i, frame(ORDER[i]), 65535)
+    v = chk2.check(10, frame(ORDER[11]), 65535)
+    assert v.kind == DOUBLE and v.since is None
