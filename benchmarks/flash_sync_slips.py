@@ -11,8 +11,8 @@ Printed per scene and fault: how many slips were caught **at the slipped image**
 mislabelled), **late with the session disowned** (the images between are in ``lights.lp`` with
 wrong lights, and the error says "do not use this session"), **late** (wrong lights in
 ``lights.lp`` and the error does not say so), or **never**, and how many clean sessions raised a
-false alarm. Run: ``python -m benchmarks.flash_sync_slips``
-(``--quick`` fewer positions).
+false alarm; then the wall time of one check on 512 × 512 px frames.
+Run: ``python -m benchmarks.flash_sync_slips`` (``--quick``: fewer positions).
 """
 
 from __future__ import annotations
@@ -74,6 +74,26 @@ def run_once(scene: str, fault: tuple[int, str] | None, root: Path) -> dict[str,
     return {"caught": caught, "wrong_in_lp": wrong, "disowned": disowned}
 
 
+def check_time_ms(side: int = 512) -> tuple[float, float]:
+    """Median and max wall time of one check (ms), on ``side`` px RGB frames of the 60-LED order."""
+    import time
+
+    from rti_rig.app.config import rig_geometry
+    from rti_rig.reconstruct.sequence_check import SequenceChecker
+    from rti_rig.simulator.sim_scene import renderer_for
+
+    dirs = rig_geometry(load_rig_config(CONFIG)).directions
+    render = renderer_for("relief", side, side, 0)
+    checker = SequenceChecker(dirs)
+    times = []
+    for i, d in enumerate(dirs):
+        pixels = np.round(np.clip(render(d, 1.0) * 0.75, 0, 1) * 65535).astype(np.uint16)
+        t0 = time.perf_counter()
+        checker.check(i, pixels, 65535)
+        times.append((time.perf_counter() - t0) * 1000)
+    return float(np.median(times)), float(np.max(times))
+
+
 def main(argv: list[str]) -> None:
     quick = "--quick" in argv
     positions = range(2, 60, 12) if quick else range(1, 60, 4)
@@ -116,6 +136,8 @@ def main(argv: list[str]) -> None:
             f"disowned {disowned}, late {late}, never {never}"
         )
     print(f"false alarms on clean sessions: {false_alarms}/{len(SCENES)}")
+    median, worst = check_time_ms()
+    print(f"time per check on 512 x 512 px frames: median {median:.0f} ms, max {worst:.0f} ms")
 
 
 if __name__ == "__main__":
