@@ -251,6 +251,14 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
     cfg = loaded.config
     geometry = rig_geometry(loaded)
     camera_settings = camera_device_settings(loaded)
+    if cfg.dome is not None and cfg.dome.flash_sync is not None:  # the camera steps the dome
+        from rti_rig.app.flash_sync import build_flash_sync_rig
+
+        assert isinstance(geometry, DomeGeometry)
+        camera = build_camera(camera_settings, clock=clock)
+        rig = build_flash_sync_rig(loaded, geometry, clock, camera)
+        rig.session_hooks.append(_session_hook(camera))
+        return rig
     if isinstance(geometry, DomeGeometry):
         from rti_rig.app.dome_factory import build_dome
 
@@ -336,6 +344,11 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
 
     cfg = loaded.config
     geometry = rig_geometry(loaded)
+    if cfg.dome is not None and cfg.dome.flash_sync is not None:  # the emulated cceh/rti
+        from rti_rig.app.flash_sync import build_flash_sync_rig
+
+        assert isinstance(geometry, DomeGeometry)
+        return build_flash_sync_rig(loaded, geometry, clock)
     if cfg.backend == "emulated" and isinstance(geometry, DomeGeometry):
         return _build_emulated_dome(loaded, geometry, clock)
     if cfg.backend == "emulated":

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from rti_rig.app.flash_sync import FlashSyncSettings, SyncFaultConfig
 from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.lp_format import read_lp
@@ -49,9 +50,16 @@ class DomeConfig(_Strict):
     lp_file: str | None = None
     default_lights: int | None = Field(default=None, gt=0, le=1000)
     serial: DomeSerialSettings | None = None
+    #: The camera's flash signal steps the dome (docs/domes.md); the host only shoots.
+    flash_sync: FlashSyncSettings | None = None
 
     @model_validator(mode="after")
     def _layout_has_its_keys(self) -> DomeConfig:
+        if self.flash_sync is not None and self.serial is not None:
+            raise ValueError(
+                "a camera-triggered dome ([dome.flash_sync]) has no serial link: remove "
+                "[dome.serial] (or [dome.flash_sync] if the host drives the dome)"
+            )
         if self.layout == "rings" and not self.rings:
             raise ValueError("layout 'rings' needs at least one [[dome.rings]] table")
         if self.layout == "fibonacci" and self.count is None:
@@ -192,6 +200,8 @@ class EmulatorConfig(_Strict):
     faults: list[EmulatorFault] = Field(default_factory=list)
     led_power: list[float] | None = None
     led_power_spread: float = Field(default=0.0, ge=0.0, le=1.0)
+    #: Flash pulses lost or bounced at chosen exposures (a camera-triggered dome).
+    sync_faults: list[SyncFaultConfig] = Field(default_factory=list)
 
     @model_validator(mode="after")
     def _one_power_model(self) -> EmulatorConfig:
@@ -263,7 +273,8 @@ class RigConfig(_Strict):
                 "layout = 'lp' and lp_file naming the acquisition's .lp (images beside it)"
             )
         driven = self.backend in ("emulated", "hardware")
-        if driven and self.kind == "dome" and self.dome.serial is None:  # type: ignore[union-attr]
+        flash_sync = self.kind == "dome" and self.dome.flash_sync is not None  # type: ignore[union-attr]
+        if driven and self.kind == "dome" and self.dome.serial is None and not flash_sync:  # type: ignore[union-attr]
             raise ValueError(
                 f"backend '{self.backend}' drives the dome over serial: add a [dome.serial] "
                 "table (port, profile; see docs/protocols/led-dome.md)"
@@ -462,6 +473,9 @@ def load_rig_config(path: Path | str) -> LoadedRig:
                 used_file = "intensity_correction_file" in data["dome"]["serial"]
                 key = "dome.serial.intensity_correction" + ("_file" if used_file else "")
             raise ConfigError(path, key, problem)
+        from rti_rig.app.flash_sync import check_exposure
+
+        check_exposure(loaded)
         power = config.emulator.led_power
         if power is not None and len(power) != len(dirs):
             raise ConfigError(

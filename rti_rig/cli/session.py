@@ -245,6 +245,8 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         f"lights{adaptive} → {escape(str(out_dir))}"
     )
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
+    if getattr(rig.lighting, "resume_hint", None):  # a dome whose own count cannot resume
+        resume_hint = rig.lighting.resume_hint
     try:
         with Progress(
             TextColumn("[progress.description]{task.description}"),

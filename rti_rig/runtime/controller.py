@@ -274,6 +274,8 @@ def run_session(
             frame = rig.camera.capture(step_exposure(rig, step))
             t_captured = clock.now()
             rig.lighting.off()
+            if rig.capture_check is not None:  # may keep the image aside and stop the session
+                rig.capture_check(i, frame, actual, folder.root)
             record = folder.write_step(
                 i,
                 frame,

@@ -72,6 +72,9 @@ class Rig:
     #: Called with the session folder before the devices connect: a DSLR's downloads go there
     #: (the composition root registers what its devices need to know of the session).
     session_hooks: list[Callable[[Path], None]] = field(default_factory=list)
+    #: Judges each image before its label is committed (a camera-triggered dome's
+    #: :class:`rti_rig.runtime.flash_sync.CaptureCheck`); None: labels are what was commanded.
+    capture_check: Callable[..., None] | None = None
 
     def bind_session(self, root: Path) -> None:
         """Tell the devices which session folder this run writes (before ``connect``)."""

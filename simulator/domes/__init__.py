@@ -1,5 +1,8 @@
 """Emulators of real dome firmwares, one module each, written from their published behaviour
-(never from this project's driver); :func:`board_for` picks one by profile name."""
+(never from this project's driver); :func:`board_for` picks a serial one by profile name.
+
+``cceh_rti`` has no serial link: the camera's flash contact steps it, so it is fired by
+:class:`rti_rig.simulator.flash_sync_camera.FlashSyncCamera`, not served on a pty."""
 
 from __future__ import annotations
 

@@ -34,6 +34,10 @@ def check_rig(req: CheckRequest) -> Any:
             f"--intensity {req.intensity:g}: give the LED drive level as a fraction in (0, 1]"
         )
     loaded = load_rig_config(req.rig_config)
+    if loaded.config.dome is not None and loaded.config.dome.flash_sync is not None:
+        from rti_rig.app.flash_sync import flash_sync_check
+
+        return flash_sync_check(loaded)
     with build_rig(loaded) as rig:
         if isinstance(rig.lighting, DomeLighting):
             return self_test(rig.lighting.source, rig.clock, intensity=req.intensity)

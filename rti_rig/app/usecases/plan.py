@@ -137,6 +137,10 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     )
     bare_lp = req.rig.suffix.lower() == ".lp"
     loaded = None if bare_lp else load_rig_config(req.rig)
+    if loaded is not None:
+        from rti_rig.app.flash_sync import refuse_options
+
+        refuse_options(loaded, plan=True)  # a camera-triggered dome runs its own order only
     notes: list[str] = [] if loaded is None else list(loaded.notes)
     _check_outputs(req, loaded)
     arm_order = None

@@ -14,6 +14,9 @@ from rti_rig.runtime.lighting import DomeLighting
 def lights_state(rig) -> str:  # type: ignore[no-untyped-def]
     """One sentence on the lights of ``rig`` after its teardown."""
     lighting = rig.lighting
+    own = getattr(lighting, "lights_state", None)
+    if callable(own):  # a lighting that knows best what it can say (a camera-triggered dome)
+        return str(own())
     if isinstance(lighting, DomeLighting):
         source = lighting.source
         if hasattr(source, "off_report"):

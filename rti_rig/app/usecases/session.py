@@ -303,6 +303,9 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     loaded = load_rig_config(req.rig_config)
     for note in loaded.notes:
         on_note(Note(note, "warning"))
+    from rti_rig.app.flash_sync import check_new_session
+
+    check_new_session(req, loaded)  # a camera-triggered dome runs its own sequence only
     if req.is_adaptive:
         opened = _open_adaptive(req, loaded)
         opened.folder.input_notes = list(loaded.notes)
@@ -397,6 +400,9 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
         on_note(Note(note, "warning"))
+    from rti_rig.app.flash_sync import refuse_options
+
+    refuse_options(loaded, **{"--resume": True})
     identity, diffs = check_resume_rig(
         manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
     )
@@ -438,6 +444,9 @@ def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> Op
 
     check_max_saturated(req.max_saturated)
     loaded = load_rig_config(req.rig_config)
+    from rti_rig.app.flash_sync import refuse_options
+
+    refuse_options(loaded, preview=True)
     schedule, notes = preview_schedule(rig_geometry(loaded), req.light_az_el_deg)
     for note in notes:
         on_note(Note(note, "warning"))

@@ -1,0 +1,329 @@
+"""Camera-triggered domes (``[dome.flash_sync]``): config, composition and the slip guard.
+
+A dome such as cceh/rti steps to its next LED on the camera's flash (PC-sync) signal and has no
+link to the host (docs/domes.md). A session on it is the firmware's own sequence: image *i* is
+LED *i* of the order the config lists (rings, Fibonacci or an `.lp`, in flash order). The host
+only shoots. Each image is judged (:mod:`rti_rig.reconstruct.sequence_check`) before its label
+is committed; on a missed or double step the image is kept in ``unlabelled/``, the session stops
+with :class:`~rti_rig.runtime.flash_sync.LightSlipError` naming the image and the slip, and
+``lights.lp`` lists only the images before it, which were correctly labelled as far as the
+check can tell.
+
+Everything that would fire the camera outside the sequence steps the dome too, so it is refused:
+``--lights`` other than the whole order, ``--plan``, ``--adaptive``, ``--auto-exposure``
+(metering shots), ``preview`` and ``--resume`` (the dome's count no longer matches the session's).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from rti_rig.core.clock import Clock
+from rti_rig.core.devices import Frame
+from rti_rig.core.errors import ConfigError, RtiRigError
+from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.runtime.flash_sync import CameraTriggeredLighting, LightSlipError
+from rti_rig.runtime.lighting import ActualLight
+
+#: What each known flash-stepped firmware does by itself (cceh/rti ``firmware/rti.cpp``).
+FIRMWARES: dict[str, dict[str, Any]] = {
+    "cceh-rti": {"led_count": 60, "timeout_s": 4.0},
+}
+UNLABELLED_DIR = "unlabelled"
+
+
+class FlashSyncSettings(BaseModel):
+    """``[dome.flash_sync]``: the dome steps on the camera's flash signal; the host only shoots.
+
+    ``firmware`` names the firmware (its LED count and off-timeout come from its source);
+    ``check_after_images``: the images accepted before the neighbour test of the slip guard
+    runs (a dark image is caught from the first one).
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    firmware: Literal["cceh-rti"] = "cceh-rti"
+    check_after_images: int = Field(default=3, ge=3, le=100)
+
+    @property
+    def timeout_s(self) -> float:
+        return float(FIRMWARES[self.firmware]["timeout_s"])
+
+    @property
+    def firmware_led_count(self) -> int:
+        return int(FIRMWARES[self.firmware]["led_count"])
+
+
+class SyncFaultConfig(BaseModel):
+    """``[[emulator.sync_faults]]``: a flash pulse lost, or bounced into a double step, at the
+    n-th exposure (1-based) of an emulated camera-triggered dome."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    at_image: int = Field(gt=0)
+    kind: Literal["missed_pulse", "double_step"]
+
+
+def flash_sync_of(loaded) -> FlashSyncSettings | None:  # type: ignore[no-untyped-def]
+    dome = loaded.config.dome
+    return None if dome is None else dome.flash_sync
+
+
+def check_exposure(loaded) -> None:  # type: ignore[no-untyped-def]
+    """Refuse, at config load, an exposure the firmware's off-timeout would cut short, and a
+    camera release through a dome link that does not exist."""
+    fs = flash_sync_of(loaded)
+    if fs is None:
+        return
+    device = loaded.config.camera.device or {}
+    if device.get("trigger") == "dome_shutter":
+        raise ConfigError(
+            loaded.path,
+            "camera.device.trigger",
+            "'dome_shutter' fires the camera through the dome's serial link, and a "
+            "camera-triggered dome has none: let rti-rig fire the camera itself (gphoto2) and "
+            "plug its PC-sync output into the dome",
+        )
+    if loaded.config.camera.exposure_s > fs.timeout_s:
+        raise ConfigError(
+            loaded.path,
+            "camera.exposure_s",
+            f"{loaded.config.camera.exposure_s:g} s: the {fs.firmware} firmware switches its "
+            f"LED off {fs.timeout_s:g} s after the flash pulse, so a longer exposure is partly "
+            "dark",
+        )
+
+
+def flash_sync_lighting(loaded, geometry: DomeGeometry) -> CameraTriggeredLighting:  # type: ignore[no-untyped-def]
+    fs = flash_sync_of(loaded)
+    assert fs is not None
+    if geometry.count > fs.firmware_led_count:
+        raise ConfigError(
+            loaded.path,
+            "dome",
+            f"{geometry.count} LEDs in the order, but the {fs.firmware} firmware fires "
+            f"{fs.firmware_led_count}: after its last one every flash re-lights the same LED",
+        )
+    return CameraTriggeredLighting(geometry, fs.firmware, fs.timeout_s)
+
+
+class SlipGuard:
+    """The rig's capture check: judge each image; on a slip keep it unlabelled and stop."""
+
+    def __init__(self, geometry: DomeGeometry, settings: FlashSyncSettings) -> None:
+        from rti_rig.reconstruct.sequence_check import SequenceChecker
+
+        self.geometry = geometry
+        self.settings = settings
+        self.checker = SequenceChecker(geometry.directions, settings.check_after_images)
+        self.verdicts: list[Any] = []
+
+    def __call__(self, index: int, frame: Frame, actual: ActualLight, root: Path) -> None:
+        verdict = self.checker.check(index, frame.pixels, frame.white_level)
+        self.verdicts.append(verdict)
+        if not verdict.slip:
+            return
+        kept = keep_unlabelled(Path(root), index, frame, verdict.to_json())
+        what = "missed step" if verdict.kind == "missed-step" else "double step"
+        rewind = (
+            "The dome's count no longer matches the session: long-press its start button to "
+            "rewind it, then start a new session"
+        )
+        last = self.settings.firmware_led_count - 1
+        if verdict.fitted and verdict.best_position == index - 1 and index == last:
+            # the firmware re-lights its last LED once its order is exhausted: it got there early
+            raise LightSlipError(
+                f"image {index + 1} was lit by LED {index} again: the dome reached the end of its "
+                "sequence one image early, so it stepped twice earlier, where the check did not "
+                "see it. The labels in lights.lp from that step on are WRONG: do not use this "
+                f"session. Image {index + 1} is kept, unlabelled, as {kept}. {rewind}"
+            )
+        from rti_rig.reconstruct.sequence_check import SHIFT_FROM
+
+        if verdict.since is not None or (verdict.fitted and index <= SHIFT_FROM):
+            # a slip in the first images is seen only some images later (docs/domes.md)
+            first = max(1, verdict.since or 1)  # the slip's own image is uncertain by one
+            raise LightSlipError(
+                f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
+                f"{verdict.reason}. A slip in the first images is seen only some images later, "
+                f"so images {first}–{index} in lights.lp may be mislabelled: do not use this "
+                f"session. Image {index + 1} is kept, unlabelled, as {kept}. {rewind}"
+            )
+        before = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
+        raise LightSlipError(
+            f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
+            f"{verdict.reason}. The image is kept, unlabelled, as {kept}; lights.lp lists "
+            f"{before} only. {rewind}"
+        )
+
+
+def keep_unlabelled(root: Path, index: int, frame: Frame, verdict: dict[str, Any]) -> str:
+    """Write a slipped image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the verdict)."""
+    from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
+
+    folder = root / UNLABELLED_DIR
+    folder.mkdir(parents=True, exist_ok=True)
+    base = f"image_{index + 1:03d}"
+    tif = folder / f"{base}.tif"
+    n = 2
+    while tif.exists():  # never overwrite a kept image
+        base = f"image_{index + 1:03d}_{n}"
+        tif, n = folder / f"{base}.tif", n + 1
+    write_linear_tiff(tif, frame.pixels)
+    write_srgb_jpeg(folder / f"{base}.jpg", linear_to_srgb8(frame.pixels, frame.white_level))
+    (folder / f"{base}.json").write_text(json.dumps(verdict, indent=1) + "\n", encoding="utf-8")
+    return f"{UNLABELLED_DIR}/{base}.tif"
+
+
+def emulated_flash_sync_camera(loaded, geometry: DomeGeometry, clock: Clock):  # type: ignore[no-untyped-def]
+    """The cceh/rti emulator fired by a simulated camera's sync contact; returns the camera
+    (its ``dome`` is the emulator)."""
+    from rti_rig.app.compose import SIMULATED_SCENE_EXPOSURE_S
+    from rti_rig.simulator.domes.cceh_rti import CcehRtiFirmware
+    from rti_rig.simulator.flash_sync_camera import FlashSyncCamera, SyncFault
+    from rti_rig.simulator.sim_scene import renderer_for
+
+    cfg = loaded.config
+    render = renderer_for(
+        cfg.scene.name,
+        cfg.camera.height,
+        cfg.camera.width,
+        cfg.scene.seed,
+        cfg.scene.light_distance_mm,
+    )
+    powers = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
+    return FlashSyncCamera(
+        render,
+        CcehRtiFirmware(start=clock.now()),
+        geometry.directions,
+        clock,
+        faults=tuple(SyncFault(f.at_image, f.kind) for f in cfg.emulator.sync_faults),
+        power=lambda led: float(powers[led]),
+        reference_exposure_s=SIMULATED_SCENE_EXPOSURE_S,
+        readout_s=cfg.timing.readout_s,
+        transfer_s=cfg.timing.transfer_s,
+        noise=cfg.scene.noise,
+        seed=cfg.scene.seed,
+        raw=cfg.scene.raw,
+    )
+
+
+def build_flash_sync_rig(loaded, geometry: DomeGeometry, clock: Clock, camera=None):  # type: ignore[no-untyped-def]
+    """The rig of a camera-triggered dome: ``camera`` (hardware), else the emulated pair."""
+    from rti_rig.runtime.rig import Rig
+
+    fs = flash_sync_of(loaded)
+    assert fs is not None
+    lighting = flash_sync_lighting(loaded, geometry)
+    emulated = camera is None
+    if emulated:
+        camera = emulated_flash_sync_camera(loaded, geometry, clock)
+    rig = Rig(loaded, geometry, lighting, camera, clock, capture_check=SlipGuard(geometry, fs))
+    if emulated:
+        rig.emulator = camera.dome  # type: ignore[attr-defined]  # the truth, for tests
+    return rig
+
+
+def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-def]
+    """Refuse, by name, what would fire the camera outside the firmware's sequence."""
+    fs = flash_sync_of(loaded)
+    if fs is None:
+        return
+    why = {
+        "--plan": "the firmware lights its LEDs in its own order; no plan can choose them",
+        "--adaptive": "the firmware lights its LEDs in its own order; nothing can choose the next",
+        "--auto-exposure": "each metering shot would step the dome to its next LED",
+        "--resume": "the dome's own count no longer matches the session's",
+        "preview": "a preview shot would step the dome to its next LED",
+        "plan": "the firmware lights its LEDs in its own order, so no plan can be run on it",
+    }
+    for option, present in given.items():
+        if present:
+            raise RtiRigError(
+                f"{loaded.path}: {option} cannot be used with a camera-triggered dome "
+                f"({fs.firmware}): {why[option]}. Long-press the dome's start button to rewind "
+                "it, then run the whole sequence: rti-rig run CONFIG --out DIR"
+            )
+
+
+def check_lights(loaded, geometry: DomeGeometry, lights: int | None) -> None:  # type: ignore[no-untyped-def]
+    """``--lights N`` must be the whole order: the firmware runs its own sequence."""
+    fs = flash_sync_of(loaded)
+    if fs is None or lights is None or lights == geometry.count:
+        return
+    raise RtiRigError(
+        f"--lights {lights}: this camera-triggered dome ({fs.firmware}) lights its "
+        f"{geometry.count} LEDs in its own order and rti-rig cannot choose which; a run shoots "
+        "them all. To shoot fewer, list only the first N of the firmware's order in the config "
+        "(its last flash then leaves the dome part-way: long-press start before the next run)"
+    )
+
+
+def check_lines(loaded, geometry: DomeGeometry) -> list[str]:  # type: ignore[no-untyped-def]
+    """What ``rti-rig check`` can say of a dome it cannot command."""
+    fs = flash_sync_of(loaded)
+    assert fs is not None
+    return [
+        f"dome: camera-triggered ({fs.firmware}); rti-rig cannot light its LEDs, so none was "
+        "tested",
+        f"  {geometry.count} LEDs in the order of the config, lit one per flash pulse of the "
+        f"camera (the firmware fires {fs.firmware_led_count})",
+        f"  the firmware switches an LED off at the end of the pulse, or {fs.timeout_s:g} s "
+        "after it at the latest; exposure "
+        f"{loaded.config.camera.exposure_s:g} s is within that",
+        "  before a run: long-press the dome's start button (rewinds it to its first LED) and "
+        "leave its camera-trigger cable unplugged, so that only rti-rig fires the camera",
+        "  each image is checked against its LED before it is labelled (a missed or double "
+        f"step stops the run; the neighbour test starts after {fs.check_after_images} images)",
+    ]
+
+
+def check_new_session(req, loaded) -> None:  # type: ignore[no-untyped-def]
+    """A new session's options, checked against a camera-triggered dome (nothing if not one)."""
+    if flash_sync_of(loaded) is None:
+        return
+    from rti_rig.app.config import rig_geometry
+
+    refuse_options(
+        loaded,
+        **{
+            "--plan": req.plan is not None,
+            "--adaptive": req.is_adaptive,
+            "--auto-exposure": req.auto_exposure,
+        },
+    )
+    check_lights(loaded, rig_geometry(loaded), req.lights)
+
+
+class FlashSyncCheckReport:
+    """``rti-rig check`` on a camera-triggered dome: what is known without firing a flash."""
+
+    def __init__(self, lines: list[str], ok: bool) -> None:
+        self._lines, self.ok = lines, ok
+
+    def lines(self) -> list[str]:
+        return list(self._lines)
+
+
+def flash_sync_check(loaded) -> FlashSyncCheckReport:  # type: ignore[no-untyped-def]
+    """Build the rig (the order is checked against the firmware), open and release the camera
+    without shooting (a shot would step the dome), and say what cannot be tested."""
+    from rti_rig.app.compose import build_rig
+
+    with build_rig(loaded) as rig:
+        assert isinstance(rig.geometry, DomeGeometry)
+        lines = check_lines(loaded, rig.geometry)
+        try:
+            rig.camera.connect()
+        except RtiRigError as exc:
+            return FlashSyncCheckReport([*lines, f"camera: FAILED to connect: {exc}"], False)
+        finally:
+            rig.camera.close()
+        lines.append(
+            f"camera: {rig.camera.name} connected (no image taken: it would step the dome)"
+        )
+    return FlashSyncCheckReport(lines, True)
