@@ -379,37 +379,63 @@ def batch_out_dir(root: Path, source: Path) -> Path:
 def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[BatchItem]:
     """Fit several sessions one after another, resumably.
 
-    Each goes to :func:`batch_out_dir`, built in a hidden ``.name.partial`` folder and renamed
-    when complete: a finished session (its folder exists) is skipped, a killed batch leaves at
-    most one partial folder, which the next run removes and redoes. A session that fails is
-    reported and the batch goes on. (Sessions run in this process, one at a time: the Dask
-    scale-out of issue #29 is not implemented.)
+    Each goes to :func:`batch_out_dir`, built in a hidden ``.name.*.partial`` folder and renamed
+    when complete: a finished session (its folder exists) is skipped, a killed batch leaves
+    partial folders only, which the next run removes and redoes. A session that fails is
+    reported and the batch goes on. (:func:`rti_rig.app.usecases.fit_dask.run_batch_dask` runs
+    the same :func:`fit_one` per session as parallel tasks on a Dask cluster.)
     """
+    plan_batch(sources, root)
+    return [fit_one(source, root, template) for source in sources]
+
+
+def plan_batch(sources: list[Path], root: Path) -> list[Path]:
+    """The sources of a batch still to fit (their output folder does not exist), after removing
+    the partial folders a killed run left for them. Refuses two sources with one output name."""
     import shutil
-    from dataclasses import replace
 
     names = [batch_out_dir(root, s).name for s in sources]
     dupes = {n for n in names if names.count(n) > 1}
     if dupes:
         raise FitInputError(f"two sources would write to the same folder: {sorted(dupes)}")
     root.mkdir(parents=True, exist_ok=True)
-    items = []
+    todo = []
     for source in sources:
         final = batch_out_dir(root, source)
         if final.exists():
-            items.append(BatchItem(source, final, "skipped (finished earlier)"))
             continue
-        partial = root / f".{final.name}.partial"
-        if partial.exists():
-            shutil.rmtree(partial)
-        try:
-            result = run_fit(replace(template, source=source, out_dir=partial))
-        except RtiRigError as exc:
+        for partial in root.glob(f".{final.name}.*partial"):
             shutil.rmtree(partial, ignore_errors=True)
-            items.append(BatchItem(source, final, f"failed: {exc}"))
-            continue
-        partial.rename(final)
-        items.append(
-            BatchItem(source, final, "done", result.qa.verdict if result.qa is not None else None)
-        )
-    return items
+        todo.append(source)
+    return todo
+
+
+def fit_one(
+    source: Path, root: Path, template: FitRequest, bands: BandRunner | None = None
+) -> BatchItem:
+    """One session of a batch: fitted into a partial folder of its own (unique per attempt, so
+    that a retried or orphaned attempt never writes into another's), renamed to
+    :func:`batch_out_dir` when complete. If another attempt finished first, its folder stands
+    and this one's is discarded. Runs in this process or as a task on a Dask worker; ``bands``
+    as for :func:`run_fit`."""
+    import os
+    import shutil
+    import uuid
+    from dataclasses import replace
+
+    final = batch_out_dir(root, source)
+    if final.exists():
+        return BatchItem(source, final, "skipped (finished earlier)")
+    partial = root / f".{final.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.partial"
+    try:
+        result = run_fit(replace(template, source=source, out_dir=partial), bands)
+    except RtiRigError as exc:
+        shutil.rmtree(partial, ignore_errors=True)
+        return BatchItem(source, final, f"failed: {exc}")
+    try:
+        partial.rename(final)  # atomic; refused when a finished folder is already there
+    except OSError:
+        shutil.rmtree(partial, ignore_errors=True)
+        if not final.exists():
+            raise
+    return BatchItem(source, final, "done", result.qa.verdict if result.qa is not None else None)
