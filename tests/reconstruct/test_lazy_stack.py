@@ -52,7 +52,7 @@ def files(tmp_path: Path) -> tuple[list[Path], np.ndarray]:
 
 
 def test_nothing_is_read_until_a_chunk_is_computed_then_only_its_rows(files) -> None:
-    paths, pixels = files
+    paths, _pixels = files
     stack = ImageStack([TiffRows(p) for p in paths])
     array = lazy_stack(StackSource.of(paths, stack, counting_opener), tile_rows=7)
     assert array.shape == (5, 41, 23, 3) and array.dtype == np.float32
@@ -74,7 +74,7 @@ def test_a_slice_across_chunks_reads_only_the_chunks_it_touches(files) -> None:
     np.testing.assert_array_equal(got, expected)
     # a chunk is a band of all lights: the two chunks the slice touches, once each, no more
     for _, start, stop in READS:
-        assert 7 <= start and stop <= 21, (start, stop)  # within chunks 7:14 and 14:21
+        assert start >= 7 and stop <= 21, (start, stop)  # within chunks 7:14 and 14:21
     assert sum(stop - start for _, start, stop in READS) <= len(paths) * 14
 
 
