@@ -97,7 +97,9 @@ def test_a_local_two_worker_cluster_gives_the_single_process_bytes(tmp_path: Pat
             got = json.loads((tmp_path / "batch" / s / "fit.json").read_text())
             ref = json.loads((tmp_path / "plainbatch" / s / "fit.json").read_text())
             assert Path(got.pop("source")) == (tmp_path / s).resolve()
-            assert got.pop("read").endswith(ref.pop("read"))  # "36 images from <lp>"
+            read = got.pop("read")  # "36 images from <the .lp, absolute>"
+            assert read == f"36 images from {(tmp_path / s / 'lights.lp').resolve()}"
+            assert ref.pop("read") == f"36 images from {s}/lights.lp"
             ref.pop("source")
             assert got == ref
         r = _cli([*batch, "--scheduler", address], env, tmp_path)
