@@ -29,7 +29,7 @@ OUTPUTS = ("normals.npy", "normals.png", "albedo.npy", "albedo.png", "fit.ptm", 
 def test_an_unreachable_scheduler_is_a_clear_error(tmp_path: Path, monkeypatch) -> None:
     from rti_rig.app.usecases import fit_dask
 
-    monkeypatch.setattr(fit_dask, "CONNECT_TIMEOUT_S", 2.0)
+    monkeypatch.setattr(fit_dask, "CONNECT_TIMEOUT_S", 1.0)
     session = make_session(tmp_path / "s", size=(24, 32))[0]
     for extra in ([], [str(session)]):  # one session, and a batch
         r = runner.invoke(
