@@ -392,6 +392,7 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
 def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     """The sources of a batch still to fit (their output folder does not exist), after removing
     the partial folders a killed run left for them. Refuses two sources with one output name."""
+    import glob
     import shutil
 
     names = [batch_out_dir(root, s).name for s in sources]
@@ -404,7 +405,7 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
         final = batch_out_dir(root, source)
         if final.exists():
             continue
-        for partial in root.glob(f".{final.name}.*partial"):
+        for partial in root.glob(f".{glob.escape(final.name)}.*partial"):
             shutil.rmtree(partial, ignore_errors=True)
         todo.append(source)
     return todo
