@@ -53,7 +53,8 @@ def fit(
             "--scheduler",
             help="Fit on Dask: 'threads' (this machine's cores, nothing to set up) or the "
             "address of a Dask scheduler (tcp://host:8786; its workers must see the session "
-            "files at the same paths). A batch then runs its sessions as parallel tasks.",
+            "files at the same paths). On a cluster, a batch runs its sessions as parallel "
+            "tasks.",
         ),
     ] = None,
 ) -> None:
