@@ -33,7 +33,9 @@ def same_files(a: Path, b: Path) -> list[str]:
     return names
 
 
-@pytest.mark.parametrize("model", ["auto", "robust-ps", "ptm"])
+@pytest.mark.parametrize(
+    "model", [pytest.param("auto", marks=pytest.mark.slow), "robust-ps", "ptm"]
+)
 def test_dask_threads_write_the_same_bytes_as_the_single_process_fit(
     session: Path, tmp_path: Path, model: str
 ) -> None:

@@ -14,8 +14,9 @@ Two ways to scale out, both with outputs identical to the single-process fit:
   batch stays resumable: finished sessions are skipped, a killed batch leaves only partial
   folders, which the next run removes and redoes.
 
-``scheduler`` is ``"threads"`` (Dask's local threaded scheduler in this process: nothing to set
-up) or the address of a ``dask scheduler`` (``tcp://host:8786``). Workers must see the session
+``scheduler`` is ``"threads"`` (local threads in this process, one per core, each computing a
+band's Dask graph: nothing to set up) or the address of a ``dask scheduler``
+(``tcp://host:8786``). Workers must see the session
 files at the same paths as this machine; every error says so.
 
 Dask is imported only here, and this module only when ``--scheduler`` is given.
@@ -27,6 +28,7 @@ import os
 import socket
 import threading
 from collections.abc import Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
@@ -122,10 +124,7 @@ def dask_bands(client: Any, address: str, source: Path) -> BandRunner:
             raise AssertionError(f"{len(blocks)} chunks for {len(tiles)} bands")
         if client is None:
             tasks = [dask.delayed(fit_band, pure=True)(b, plan) for b in blocks]
-            window = BANDS_IN_FLIGHT_PER_THREAD * (os.cpu_count() or 2)
-            for start in range(0, len(tasks), window):
-                done = dask.compute(*tasks[start : start + window], scheduler="threads")
-                yield from zip(tiles[start : start + window], done, strict=True)
+            yield from _in_threads(tasks, tiles)
         else:
             threads = blas_threads()
             tasks = [
@@ -134,6 +133,35 @@ def dask_bands(client: Any, address: str, source: Path) -> BandRunner:
             yield from _on_cluster(client, address, tasks, tiles)
 
     return run
+
+
+def _in_threads(tasks: list[Any], tiles: list[slice]) -> Iterator[tuple[slice, BandFit]]:
+    """Band fits computed in local threads (one per core), a bounded number in flight, yielded
+    as they finish: each band's graph (read the chunk, fit it) runs in a pool thread."""
+    import dask
+
+    threads = os.cpu_count() or 2
+    pending = iter(range(len(tasks)))
+    running: dict[Future[Any], int] = {}
+    pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="dask-band")
+
+    def submit_next() -> None:
+        i = next(pending, None)
+        if i is not None:
+            running[pool.submit(dask.compute, tasks[i], scheduler="sync")] = i
+
+    try:
+        for _ in range(BANDS_IN_FLIGHT_PER_THREAD * threads):
+            submit_next()
+        while running:
+            done, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in done:
+                i = running.pop(future)
+                (fitted,) = future.result()
+                yield tiles[i], fitted
+                submit_next()
+    finally:  # the caller stopped early or failed: drop what has not started
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _on_cluster(
