@@ -113,3 +113,29 @@ def test_the_threads_batch_is_resumable(session: Path, tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     for name in ("normals.npy", "normals.png", "albedo.npy", "fit.ptm", "fit.rti"):
         assert (plain / name).read_bytes() == (out / "second" / name).read_bytes(), name
+
+
+def test_eight_bit_images_beside_a_bare_lp_give_the_same_bytes(session: Path, tmp_path: Path):
+    """Images that cannot be read by rows (8-bit PNG, decoded whole from sRGB) go through the
+    lazy stack too, decoded once per process."""
+    import cv2
+    import tifffile
+
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+    folder = tmp_path / "png"
+    folder.mkdir()
+    entries = []
+    for e in read_lp(session / "lights.lp"):
+        name = Path(e.name).stem + ".png"
+        linear = tifffile.imread(session / "linear" / (Path(e.name).stem + ".tif")) / 65535.0
+        srgb = np.where(linear <= 0.0031308, linear * 12.92, 1.055 * linear ** (1 / 2.4) - 0.055)
+        cv2.imwrite(str(folder / name), np.round(srgb[..., ::-1] * 255).astype(np.uint8))
+        entries.append(LpEntry(name, e.direction))
+    write_lp(folder / "dome.lp", entries)
+    base = ["fit", str(folder / "dome.lp"), "--model", "ps", "--no-qa"]
+    r = runner.invoke(app, [*base, "--out", str(tmp_path / "plain")])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, [*base, "--out", str(tmp_path / "threads"), "--scheduler", "threads"])
+    assert r.exit_code == 0, r.output
+    same_files(tmp_path / "plain", tmp_path / "threads")

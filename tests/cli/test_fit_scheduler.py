@@ -43,6 +43,32 @@ def test_an_unreachable_scheduler_is_a_clear_error(tmp_path: Path, monkeypatch) 
         assert not (tmp_path / "o" / "s" / "fit.json").exists()
 
 
+def _unreadable(path: Path):
+    """An image opener standing for a worker that does not see the session's files."""
+    raise FileNotFoundError(2, "No such file or directory", str(path))
+
+
+def test_a_worker_that_cannot_read_the_images_exits_2_naming_the_cluster(
+    tmp_path: Path, monkeypatch
+) -> None:
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    monkeypatch.setattr(fit_dask, "read_image", _unreadable)  # what the workers open with
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        r = runner.invoke(
+            app, ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
+        )
+    assert r.exit_code == 2, r.output
+    assert address in r.output and "could not read the images" in r.output
+    assert "same paths" in r.output and "Traceback" not in r.output
+
+
 def _cli(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [*RTI_RIG, *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=900
