@@ -70,10 +70,19 @@ def main() -> None:
     parser.add_argument("--height", type=int, default=384)
     parser.add_argument("--lights", type=int, default=48)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument(
+        "--blas-threads",
+        type=int,
+        default=1,
+        help="OPENBLAS/OMP/MKL_NUM_THREADS of every rti-rig process (0: the library default)",
+    )
     parser.add_argument("--write", action="store_true")
     args = parser.parse_args()
 
     env = dict(os.environ)  # before LocalCluster sets OMP/OPENBLAS_NUM_THREADS=1 in ours
+    if args.blas_threads > 0:
+        for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+            env[var] = str(args.blas_threads)
     work = Path(tempfile.mkdtemp(prefix="fit_dask_bench_"))
     try:
         sessions = [
@@ -87,6 +96,9 @@ def main() -> None:
             n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
         )
         startup = time.perf_counter() - t0
+        # a cluster is long-lived: its workers have imported the fit before a batch arrives
+        warm = [make_session(work / f"warm_{k}", 32, 24, args.lights) for k in range(2)]
+        run_batch(warm, work / "warm_out", ["--scheduler", cluster.scheduler_address], env)
         load_before = load()
         modes = {
             "single process": [],
@@ -120,15 +132,18 @@ def main() -> None:
         "",
         f"{machine_line()} Command: `python -m benchmarks.fit_dask --sessions {args.sessions} "
         f"--width {args.width} --height {args.height} --lights {args.lights} "
-        f"--repeats {args.repeats}`.",
+        f"--repeats {args.repeats} --blas-threads {args.blas_threads}`.",
         "",
         f"A batch of {args.sessions} simulated sessions ({args.lights} RGB 16-bit TIFFs of "
         f"{args.width} × {args.height}, {mp:.2f} MP; default options: model choice, normals, "
         "`.ptm`, `.rti`, QA), each mode one `rti-rig fit S1 … SN --out ROOT` process, wall "
         f"time, median of {args.repeats} interleaved runs. The cluster "
         "(`distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True)`) was "
-        f"started once before the runs ({startup:.1f} s, not counted); on it each session is "
-        "one task. Load average before / after: "
+        f"started once before the runs ({startup:.1f} s, not counted) and warmed up with a "
+        "batch of two tiny sessions (its workers import the fit once); on it each session is "
+        "one task. BLAS threads of every process: "
+        f"{args.blas_threads or 'library default'} (the cluster's workers use the client's "
+        "count, for identical outputs). Load average before / after: "
         f"{load_before} → {load_after}, on 2 cores shared with other jobs — the ratios are "
         "noisy: a busy machine leaves the second worker little to run on.",
         "",
