@@ -43,6 +43,23 @@ def test_an_unreachable_scheduler_is_a_clear_error(tmp_path: Path, monkeypatch) 
         assert not (tmp_path / "o" / "s" / "fit.json").exists()
 
 
+def test_a_scheduler_without_workers_is_a_clear_error(tmp_path: Path, monkeypatch) -> None:
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    monkeypatch.setattr(fit_dask, "WORKERS_TIMEOUT_S", 1.0)
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        address = cluster.scheduler_address
+        r = runner.invoke(
+            app, ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
+        )
+    assert r.exit_code == 2, r.output
+    assert "has no workers" in r.output and f"dask worker {address}" in r.output
+    assert "Traceback" not in r.output
+
+
 def _unreadable(path: Path):
     """An image opener standing for a worker that does not see the session's files."""
     raise FileNotFoundError(2, "No such file or directory", str(path))
