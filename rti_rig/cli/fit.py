@@ -47,6 +47,16 @@ def fit(
     no_normals: Annotated[
         bool, typer.Option("--no-normals", help="Do not fit normal and albedo maps.")
     ] = False,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help="Fit on Dask: 'threads' (this machine's cores, nothing to set up) or the "
+            "address of a Dask scheduler (tcp://host:8786; its workers must see the session "
+            "files at the same paths). On a cluster, a batch runs its sessions as parallel "
+            "tasks.",
+        ),
+    ] = None,
 ) -> None:
     """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
     from rti_rig.app.usecases.fit import FitRequest, run_batch, run_fit
@@ -68,7 +78,12 @@ def fit(
             write_normals=not no_normals,
         )
         if len(sources) > 1:
-            items = run_batch(sources, out_dir, request)
+            if scheduler is None:
+                items = run_batch(sources, out_dir, request)
+            else:
+                from rti_rig.app.usecases.fit_dask import run_batch_dask
+
+                items = run_batch_dask(sources, out_dir, request, scheduler)
             for item in items:
                 line = f"{item.source}: {item.status}"
                 if item.verdict:
@@ -77,7 +92,12 @@ def fit(
             if any(i.status.startswith("failed") for i in items):
                 raise typer.Exit(code=2)
             return
-        result = run_fit(request)
+        if scheduler is None:
+            result = run_fit(request)
+        else:
+            from rti_rig.app.usecases.fit_dask import run_fit_dask
+
+            result = run_fit_dask(request, scheduler)
     except RtiRigError as exc:
         raise fail(exc) from None
     out.print(f"Model: {escape(result.reason)}")

@@ -105,3 +105,44 @@ def test_the_wheel_holds_one_top_level_package(tmp_path):
         "rti_rig/core/geometry.py",
     ):
         assert inside in names
+
+
+DASK_MODULES = ("dask", "distributed")
+
+
+@pytest.mark.parametrize(
+    "module",
+    [
+        "rti_rig",
+        "rti_rig.cli",
+        "rti_rig.app.usecases.fit",
+        "rti_rig.app.usecases.fit_dask",
+        "rti_rig.reconstruct.lazy_stack",
+    ],
+)
+def test_dask_is_imported_only_when_a_fit_runs_on_it(module):
+    """The plain fit, the CLI and even the Dask modules themselves load neither dask nor
+    distributed until ``--scheduler`` makes a lazy stack or a client."""
+    code = (
+        f"import sys, {module}; "
+        f"print(','.join(m for m in {DASK_MODULES!r} if m in sys.modules))"
+    )
+    loaded = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    ).stdout.strip()
+    assert loaded == ""
+
+
+def test_the_dask_check_has_teeth(tmp_path):
+    """Making a lazy stack does load dask (so an empty list above means absent)."""
+    code = (
+        "import sys, numpy as np\n"
+        "from rti_rig.reconstruct.lazy_stack import StackSource, lazy_stack\n"
+        "lazy_stack(StackSource(('a.tif',), (4, 4, 1), True, 1.0, None), 2)\n"
+        f"print(','.join(m for m in {DASK_MODULES!r} if m in sys.modules))"
+    )
+    loaded = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120,
+        cwd=tmp_path,
+    ).stdout.strip()
+    assert "dask" in loaded.split(",")

@@ -14,6 +14,7 @@ import json
 import mmap
 import time
 import warnings
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +23,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
 from rti_rig.core.tiff_rows import TiffRows
@@ -69,7 +71,9 @@ def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
     return lut[img]
 
 
-def _read_image(path: Path) -> np.ndarray:
+def read_image(path: Path) -> np.ndarray:
+    """One image of an acquisition as uint16: a :class:`TiffRows` (rows read on demand) for
+    16-bit TIFF, else decoded whole (8-bit taken as sRGB and linearised)."""
     if not path.is_file():
         raise FitInputError(f"image {path} listed in the .lp is missing")
     if path.suffix.lower() in (".tif", ".tiff"):
@@ -90,8 +94,9 @@ def _read_image(path: Path) -> np.ndarray:
     return np.ascontiguousarray(img)
 
 
-def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[str], str]:
-    """Frames (uint16), lights (N, 3), image names, and a description of what was read."""
+def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[str]]:
+    """The ``.lp`` of a session folder or ``.lp`` source, its lights (N, 3), the image file of
+    each light (``linear/<stem>.tif`` when there, else the file the ``.lp`` names) and names."""
     if source.is_dir():
         lps = sorted(source.glob("*.lp"))
         if not lps:
@@ -103,13 +108,19 @@ def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[s
         raise FitInputError(f"{source}: give a session folder or an .lp file")
     entries = read_lp(lp, upper_hemisphere=True)
     lights = directions_of(entries)
-    frames, names = [], []
+    paths, names = [], []
     for e in entries:
         stem = Path(e.name).stem
         linear = lp.parent / "linear" / f"{stem}.tif"
-        path = linear if linear.is_file() else lp.parent / e.name
-        frames.append(_read_image(path))
+        paths.append(linear if linear.is_file() else lp.parent / e.name)
         names.append(stem)
+    return lp, lights, paths, names
+
+
+def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[str], str]:
+    """Frames (uint16), lights (N, 3), image names, and a description of what was read."""
+    lp, lights, paths, names = acquisition_files(source)
+    frames = [read_image(path) for path in paths]
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
         raise FitInputError(f"images of {lp} differ in shape: {sorted(shapes)}")
@@ -121,8 +132,18 @@ def _save_png(path: Path, rgb: np.ndarray) -> Path:
     return path
 
 
-def run_fit(req: FitRequest) -> FitResult:
-    """Fit, write every output into ``req.out_dir``, and judge the acquisition."""
+#: How the bands of a fit are computed: given the stack, the plan and the row tiles, yield each
+#: tile with its :class:`BandFit` (any order). :func:`local_bands` by default; the Dask runner
+#: of :mod:`rti_rig.app.usecases.fit_dask` computes them on a scheduler.
+BandRunner = Callable[[ImageStack, BandPlan, list[slice]], Iterator[tuple[slice, BandFit]]]
+
+
+def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
+    """Fit, write every output into ``req.out_dir``, and judge the acquisition.
+
+    ``bands`` computes the per-band fits (default: in this process, :func:`local_bands`);
+    everything else — model choice, quantisation ranges, writing, QA — is the same code.
+    """
     t0 = time.perf_counter()
     frames, lights, names, what = load_acquisition(req.source)
     out = req.out_dir
@@ -132,7 +153,7 @@ def run_fit(req: FitRequest) -> FitResult:
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = _fit_all(req, stack, lights, out)
+        result = _fit_all(req, stack, lights, out, bands or local_bands)
     result.warnings = [str(w.message) for w in caught or []]
     result.files.append(
         exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
@@ -167,24 +188,21 @@ SAMPLE_PIXELS = 30_000
 BAND_BUDGET_BYTES = 24 * 1024 * 1024
 
 
-def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) -> FitResult:
+def _fit_all(
+    req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path, bands: BandRunner
+) -> FitResult:
     """One streamed pass over the acquisition: every output is computed band by band.
 
     Each band of rows of all images is read once (from the TIFFs, a strip at a time) and fitted
     by photometric stereo (normals, albedo) and by the PTM and HSH written to ``.ptm`` and
     ``.rti``; nothing holds the stack as floats. The 8-bit quantisation ranges of the exported
     coefficients come from a fit of the same pixel sample model choice uses (widened by 50 %;
-    values beyond are clipped, and counted in ``fit.json``).
+    values beyond are clipped, and counted in ``fit.json``). The bands themselves are fitted
+    by :func:`rti_rig.app.usecases.fit_bands.fit_band`, run by ``bands``.
     """
     from rti_rig.core.rti_bases import design_matrix
     from rti_rig.reconstruct.errors import FitTrustWarning
-    from rti_rig.reconstruct.linear_model import fit_coefficients
     from rti_rig.reconstruct.model_select import select_model
-    from rti_rig.reconstruct.photometric_stereo import (
-        DARK_FRACTION,
-        HIGHLIGHT_FLOOR_FRACTION,
-        fit_photometric_stereo,
-    )
     from rti_rig.reconstruct.solve import solve_matrix
     from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
 
@@ -242,54 +260,26 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
     albedo_shape = maps if stack.grey else (*maps, stack.channels)
     albedo = np.lib.format.open_memmap(out / "albedo.npy", "w+", np.float32, albedo_shape)
     rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
-    sat = stack.saturation_level
+    plan = BandPlan(
+        lights=np.asarray(lights),
+        linear=linear,
+        normal_source=normal_source,
+        tile_rows=rows,
+        saturation=stack.saturation_level,
+        reference_level=ref,
+        grey=stack.grey,
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
-        tiles = list(row_tiles(h, rows))
-        pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="prefetch")
-        pending = pool.submit(stack.rows, tiles[0], strict=False)
-        for t, sl in enumerate(tiles):
-            band = pending.result()  # read while the previous band was being fitted
-            if t + 1 < len(tiles):
-                pending = pool.submit(stack.rows, tiles[t + 1], strict=False)
-            if stack.grey:
-                band = band[..., 0]
-            coefs = {
-                key: fit_coefficients(band, design, key, saturation=sat, tile_rows=rows)[0]
-                for key, design in linear.items()
-            }
+        for sl, fitted in bands(stack, plan, list(row_tiles(h, rows))):
             for key, writer in writers.items():
-                writer.write_rows(sl.start, coefs[key])
-            if not normal_source:
-                pass
-            elif normal_source.startswith("ps"):
-                ps = fit_photometric_stereo(
-                    band,
-                    lights,
-                    robust=normal_source == "ps-robust",
-                    tile_rows=rows,
-                    saturation=sat,
-                    dark_threshold=DARK_FRACTION * ref,
-                    highlight_floor=HIGHLIGHT_FLOOR_FRACTION * ref,
-                    reference_level=ref,
-                )
-                normals[sl], albedo[sl] = ps.normals, ps.albedo
-            else:
-                from rti_rig.reconstruct.linear_model import LambertModel
-                from rti_rig.reconstruct.ptm import PTMModel
-                from rti_rig.reconstruct.solve import FitReport
-
-                report = FitReport(normal_source, n, 0, 0.0, 0.0, False, 0.0)
-                cls = PTMModel if normal_source == "ptm" else LambertModel
-                normals[sl] = cls(coefs[normal_source], report).normals()
-                if normal_source == "lambert":
-                    b = coefs["lambert"]
-                    albedo[sl] = np.linalg.norm(b, axis=0)
-                else:
-                    albedo[sl] = coefs["ptm"][5]  # the PTM's constant term: mean brightness
+                writer.write_rows(sl.start, fitted.coefficients[key])
+            if fitted.normals is not None:
+                normals[sl], albedo[sl] = fitted.normals, fitted.albedo
+            for category, text in fitted.warnings:  # from a band fitted in another process
+                warnings.warn(text, category, stacklevel=1)
             _release(normals)  # written pages go to the file, not the resident set
             _release(albedo)
-        pool.shutdown()
     for writer in writers.values():
         files.append(writer.close())
     normals.flush()
@@ -302,6 +292,23 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
         (out / "normals.npy").unlink()
         (out / "albedo.npy").unlink()
     return FitResult(out, model_name, reason_line, files)
+
+
+def local_bands(
+    stack: ImageStack, plan: BandPlan, tiles: list[slice]
+) -> Iterator[tuple[slice, BandFit]]:
+    """The single-process runner: bands in order, the next one read (in a thread) while the
+    current one is fitted."""
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="prefetch")
+    try:
+        pending = pool.submit(stack.rows, tiles[0], strict=False)
+        for t, sl in enumerate(tiles):
+            band = pending.result()  # read while the previous band was being fitted
+            if t + 1 < len(tiles):
+                pending = pool.submit(stack.rows, tiles[t + 1], strict=False)
+            yield sl, fit_band(band, plan)
+    finally:
+        pool.shutdown()
 
 
 def _release(mapped: np.memmap) -> None:
@@ -372,37 +379,64 @@ def batch_out_dir(root: Path, source: Path) -> Path:
 def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[BatchItem]:
     """Fit several sessions one after another, resumably.
 
-    Each goes to :func:`batch_out_dir`, built in a hidden ``.name.partial`` folder and renamed
-    when complete: a finished session (its folder exists) is skipped, a killed batch leaves at
-    most one partial folder, which the next run removes and redoes. A session that fails is
-    reported and the batch goes on. (Sessions run in this process, one at a time: the Dask
-    scale-out of issue #29 is not implemented.)
+    Each goes to :func:`batch_out_dir`, built in a hidden ``.name.*.partial`` folder and renamed
+    when complete: a finished session (its folder exists) is skipped, a killed batch leaves
+    partial folders only, which the next run removes and redoes. A session that fails is
+    reported and the batch goes on. (:func:`rti_rig.app.usecases.fit_dask.run_batch_dask` runs
+    the same :func:`fit_one` per session as parallel tasks on a Dask cluster.)
     """
+    plan_batch(sources, root)
+    return [fit_one(source, root, template) for source in sources]
+
+
+def plan_batch(sources: list[Path], root: Path) -> list[Path]:
+    """The sources of a batch still to fit (their output folder does not exist), after removing
+    the partial folders a killed run left for them. Refuses two sources with one output name."""
+    import glob
     import shutil
-    from dataclasses import replace
 
     names = [batch_out_dir(root, s).name for s in sources]
     dupes = {n for n in names if names.count(n) > 1}
     if dupes:
         raise FitInputError(f"two sources would write to the same folder: {sorted(dupes)}")
     root.mkdir(parents=True, exist_ok=True)
-    items = []
+    todo = []
     for source in sources:
         final = batch_out_dir(root, source)
         if final.exists():
-            items.append(BatchItem(source, final, "skipped (finished earlier)"))
             continue
-        partial = root / f".{final.name}.partial"
-        if partial.exists():
-            shutil.rmtree(partial)
-        try:
-            result = run_fit(replace(template, source=source, out_dir=partial))
-        except RtiRigError as exc:
+        for partial in root.glob(f".{glob.escape(final.name)}.*partial"):
             shutil.rmtree(partial, ignore_errors=True)
-            items.append(BatchItem(source, final, f"failed: {exc}"))
-            continue
-        partial.rename(final)
-        items.append(
-            BatchItem(source, final, "done", result.qa.verdict if result.qa is not None else None)
-        )
-    return items
+        todo.append(source)
+    return todo
+
+
+def fit_one(
+    source: Path, root: Path, template: FitRequest, bands: BandRunner | None = None
+) -> BatchItem:
+    """One session of a batch: fitted into a partial folder of its own (unique per attempt, so
+    that a retried or orphaned attempt never writes into another's), renamed to
+    :func:`batch_out_dir` when complete. If another attempt finished first, its folder stands
+    and this one's is discarded. Runs in this process or as a task on a Dask worker; ``bands``
+    as for :func:`run_fit`."""
+    import os
+    import shutil
+    import uuid
+    from dataclasses import replace
+
+    final = batch_out_dir(root, source)
+    if final.exists():
+        return BatchItem(source, final, "skipped (finished earlier)")
+    partial = root / f".{final.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.partial"
+    try:
+        result = run_fit(replace(template, source=source, out_dir=partial), bands)
+    except RtiRigError as exc:
+        shutil.rmtree(partial, ignore_errors=True)
+        return BatchItem(source, final, f"failed: {exc}")
+    try:
+        partial.rename(final)  # atomic; refused when a finished folder is already there
+    except OSError:
+        shutil.rmtree(partial, ignore_errors=True)
+        if not final.exists():
+            raise
+    return BatchItem(source, final, "done", result.qa.verdict if result.qa is not None else None)

@@ -1,0 +1,277 @@
+"""`rti-rig fit --scheduler`: the same fit, its bands (or a batch's sessions) run on Dask.
+
+Two ways to scale out, both with outputs identical to the single-process fit:
+
+* **One session, bands as tasks.** The acquisition becomes a lazily read ``dask.array``
+  (:func:`rti_rig.reconstruct.lazy_stack.lazy_stack`: bands of rows × all lights, each read
+  from the files where it is computed) and every band is fitted by the same
+  :func:`rti_rig.app.usecases.fit_bands.fit_band` the single-process loop calls, on the same
+  row bands. Model choice, quantisation ranges, writing the files and QA run here, in the
+  process that runs ``rti-rig fit`` (they read a pixel sample and a crop, not the stack).
+* **A batch, sessions as tasks** (``rti-rig fit S1 S2 … --out ROOT --scheduler ADDRESS``):
+  each unfinished session is one task running :func:`rti_rig.app.usecases.fit.fit_one` on a
+  worker — the whole single-process fit, into a partial folder renamed when complete — so the
+  batch stays resumable: finished sessions are skipped, a killed batch leaves only partial
+  folders, which the next run removes and redoes.
+
+``scheduler`` is ``"threads"`` (local threads in this process, one per core, each computing a
+band's Dask graph: nothing to set up) or the address of a ``dask scheduler``
+(``tcp://host:8786``). Workers must see the session
+files at the same paths as this machine; every error says so.
+
+Dask is imported only here, and this module only when ``--scheduler`` is given.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import threading
+from collections.abc import Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from contextlib import contextmanager
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from rti_rig.app.usecases.fit import (
+    BandRunner,
+    BatchItem,
+    FitRequest,
+    FitResult,
+    acquisition_files,
+    batch_out_dir,
+    fit_one,
+    plan_batch,
+    read_image,
+    run_fit,
+)
+from rti_rig.app.usecases.fit_bands import (
+    BandFit,
+    BandPlan,
+    blas_threads,
+    fit_band,
+    fit_band_recording,
+)
+from rti_rig.core.errors import RtiRigError
+from rti_rig.reconstruct.lazy_stack import ImageReadError, StackSource, lazy_stack
+from rti_rig.reconstruct.stack import ImageStack
+
+#: ``--scheduler`` value for Dask's threaded scheduler in this process.
+THREADS = "threads"
+#: Seconds to wait for the scheduler to answer, then for at least one worker to join.
+CONNECT_TIMEOUT_S = 20.0
+WORKERS_TIMEOUT_S = 60.0
+#: Bands in flight per worker thread (bounds the results waiting to be written).
+BANDS_IN_FLIGHT_PER_THREAD = 2
+
+SHARED_PATHS = (
+    "every Dask worker must see the session's files at the same paths as this machine "
+    "(a shared filesystem mounted at the same place)"
+)
+
+
+class SchedulerError(RtiRigError):
+    """The Dask scheduler cannot be used: unreachable, no workers, or workers that cannot read
+    the images."""
+
+
+@contextmanager
+def scheduler_client(address: str) -> Iterator[Any]:
+    """A ``distributed.Client`` connected to ``address`` (closed afterwards), or None for
+    :data:`THREADS`. Refuses clearly when the scheduler does not answer or has no workers."""
+    if address == THREADS:
+        yield None
+        return
+    from distributed import Client
+
+    try:
+        client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:
+        raise SchedulerError(
+            f"cannot reach the Dask scheduler at {address!r} ({type(exc).__name__}: {exc}). "
+            f"Start one with `dask scheduler` and workers with `dask worker {address}` — "
+            f"{SHARED_PATHS} — or leave out --scheduler to fit in this process."
+        ) from None
+    try:
+        try:
+            client.wait_for_workers(1, timeout=WORKERS_TIMEOUT_S)
+        except (TimeoutError, OSError):
+            raise SchedulerError(
+                f"the Dask scheduler at {address!r} has no workers after "
+                f"{WORKERS_TIMEOUT_S:.0f} s: start some with `dask worker {address}`; "
+                f"{SHARED_PATHS}."
+            ) from None
+        yield client
+    finally:
+        client.close()
+
+
+def dask_bands(client: Any, address: str, source: Path) -> BandRunner:
+    """A band runner for :func:`rti_rig.app.usecases.fit.run_fit`: the bands of ``source`` as
+    chunks of a lazily read ``dask.array``, each fitted by :func:`fit_band` — in threads here
+    (``client`` None) or on the cluster behind ``client``."""
+
+    def run(
+        stack: ImageStack, plan: BandPlan, tiles: list[slice]
+    ) -> Iterator[tuple[slice, BandFit]]:
+        import dask
+
+        _, _, paths, _ = acquisition_files(source)
+        array = lazy_stack(StackSource.of(paths, stack, read_image), plan.tile_rows)
+        blocks = array.to_delayed().ravel()  # one per band, in row order
+        if len(blocks) != len(tiles):
+            raise AssertionError(f"{len(blocks)} chunks for {len(tiles)} bands")
+        if client is None:
+            tasks = [dask.delayed(fit_band, pure=True)(b, plan) for b in blocks]
+            yield from _in_threads(tasks, tiles)
+        else:
+            threads = blas_threads()
+            tasks = [
+                dask.delayed(fit_band_recording, pure=True)(b, plan, threads) for b in blocks
+            ]
+            yield from _on_cluster(client, address, tasks, tiles)
+
+    return run
+
+
+def _in_threads(tasks: list[Any], tiles: list[slice]) -> Iterator[tuple[slice, BandFit]]:
+    """Band fits computed in local threads (one per core), a bounded number in flight, yielded
+    as they finish: each band's graph (read the chunk, fit it) runs in a pool thread."""
+    import dask
+
+    threads = os.cpu_count() or 2
+    pending = iter(range(len(tasks)))
+    running: dict[Future[Any], int] = {}
+    pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="dask-band")
+
+    def submit_next() -> None:
+        i = next(pending, None)
+        if i is not None:
+            running[pool.submit(dask.compute, tasks[i], scheduler="sync")] = i
+
+    try:
+        for _ in range(BANDS_IN_FLIGHT_PER_THREAD * threads):
+            submit_next()
+        while running:
+            done, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in done:
+                i = running.pop(future)
+                (fitted,) = future.result()
+                yield tiles[i], fitted
+                submit_next()
+    finally:  # the caller stopped early or failed: drop what has not started
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _on_cluster(
+    client: Any, address: str, tasks: list[Any], tiles: list[slice]
+) -> Iterator[tuple[slice, BandFit]]:
+    """Band fits computed on the cluster, a bounded number in flight, yielded as they finish."""
+    from distributed import as_completed
+
+    threads = max(1, sum(client.nthreads().values()))
+    window = BANDS_IN_FLIGHT_PER_THREAD * threads
+    pending = iter(range(len(tasks)))
+    outstanding: dict[Any, tuple[Any, int]] = {}
+
+    def submit_next() -> Any:
+        i = next(pending, None)
+        if i is None:
+            return None
+        future = client.compute(tasks[i])
+        outstanding[future.key] = (future, i)
+        return future
+
+    first = [f for f in (submit_next() for _ in range(window)) if f is not None]
+    running = as_completed(first, loop=client.loop)
+    try:
+        for future in running:
+            try:
+                fitted = future.result()
+            except ImageReadError as exc:
+                raise SchedulerError(
+                    f"a worker of the Dask cluster at {address!r} could not read the images: "
+                    f"{exc}. Note: {SHARED_PATHS}."
+                ) from None
+            except OSError as exc:  # the scheduler went away mid-fit
+                raise SchedulerError(
+                    f"lost the Dask scheduler at {address!r} while fitting: {exc}"
+                ) from None
+            yield tiles[outstanding.pop(future.key)[1]], fitted
+            future.release()
+            following = submit_next()
+            if following is not None:
+                running.add(following)
+    finally:  # the caller stopped early or failed: cancel what is left
+        running.clear()
+        if outstanding:
+            client.cancel([f for f, _ in outstanding.values()])
+
+
+def run_fit_dask(req: FitRequest, scheduler: str = THREADS) -> FitResult:
+    """:func:`run_fit` with its bands computed by Dask (``scheduler``: :data:`THREADS` or a
+    scheduler address)."""
+    with scheduler_client(scheduler) as client:
+        return run_fit(req, bands=dask_bands(client, scheduler, req.source))
+
+
+_SESSION_LOCK = threading.Lock()
+
+
+def _fit_one_task(
+    source: Path, root: Path, template: FitRequest, threads: int | None
+) -> BatchItem:
+    """One session of a batch, on a worker, with ``threads`` BLAS threads (the client's: see
+    :func:`rti_rig.app.usecases.fit_bands.fit_band_recording`). One session at a time per
+    worker process: a fit records its warnings with ``warnings.catch_warnings``, which is
+    process-wide state, so two sessions in two threads of one process would mix them up."""
+    from threadpoolctl import threadpool_limits
+
+    if not source.exists():
+        return BatchItem(
+            source,
+            batch_out_dir(root, source),
+            f"failed: {source} does not exist on worker host {socket.gethostname()}: "
+            f"{SHARED_PATHS}",
+        )
+    with _SESSION_LOCK, threadpool_limits(limits=threads, user_api="blas"):
+        return fit_one(source, root, template)
+
+
+def run_batch_dask(
+    sources: list[Path], root: Path, template: FitRequest, scheduler: str = THREADS
+) -> list[BatchItem]:
+    """A resumable batch (see :func:`rti_rig.app.usecases.fit.run_batch`) on Dask: with
+    :data:`THREADS`, sessions one after another with their bands in threads; on a cluster,
+    every unfinished session a task of its own (run in parallel across the workers)."""
+    if scheduler == THREADS:
+        plan_batch(sources, root)
+        return [
+            fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources
+        ]
+    given = dict(zip([s.resolve() for s in sources], sources, strict=True))
+    sources = list(given)  # absolute: workers do not share this process's working directory
+    root = root.resolve()
+    with scheduler_client(scheduler) as client:
+        todo = set(plan_batch(sources, root))
+        threads = blas_threads()
+        futures = {
+            s: client.submit(_fit_one_task, s, root, template, threads, pure=False) for s in todo
+        }
+        items = []
+        for s in sources:
+            if s not in futures:
+                items.append(BatchItem(s, batch_out_dir(root, s), "skipped (finished earlier)"))
+                continue
+            try:
+                items.append(futures[s].result())
+            except OSError as exc:
+                raise SchedulerError(
+                    f"lost the Dask scheduler at {scheduler!r} during the batch: {exc}; "
+                    "rerun the same command to resume (finished sessions are kept)"
+                ) from None
+            except Exception as exc:  # e.g. KilledWorker: this session failed, the batch goes on
+                status = f"failed on the Dask cluster: {type(exc).__name__}: {exc}"
+                items.append(BatchItem(s, batch_out_dir(root, s), status))
+        return [replace(item, source=given[item.source]) for item in items]

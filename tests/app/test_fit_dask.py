@@ -1,0 +1,141 @@
+"""`rti-rig fit --scheduler threads` and the Dask runner: outputs byte-identical to the
+single-process fit, the batch resumable, unreadable images on a worker refused clearly."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from fit_sessions import make_session
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return make_session(tmp_path_factory.mktemp("dask") / "s", size=(72, 88))[0]
+
+
+def same_files(a: Path, b: Path) -> list[str]:
+    """Names of the files of ``a``; asserts ``b`` has the same files with the same bytes."""
+    names = sorted(p.name for p in a.iterdir())
+    assert names == sorted(p.name for p in b.iterdir())
+    for name in names:
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
+    return names
+
+
+@pytest.mark.parametrize(
+    "model", [pytest.param("auto", marks=pytest.mark.slow), "robust-ps", "ptm"]
+)
+def test_dask_threads_write_the_same_bytes_as_the_single_process_fit(
+    session: Path, tmp_path: Path, model: str
+) -> None:
+    plain, threads = tmp_path / "plain", tmp_path / "threads"
+    base = ["fit", str(session), "--model", model]
+    r = runner.invoke(app, [*base, "--out", str(plain)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, [*base, "--out", str(threads), "--scheduler", "threads"])
+    assert r.exit_code == 0, r.output
+    names = same_files(plain, threads)
+    assert {"normals.npy", "normals.png", "albedo.npy", "fit.ptm", "fit.rti", "qa.json"} <= set(
+        names
+    )
+
+
+def test_several_bands_run_through_dask(session: Path, tmp_path: Path, monkeypatch) -> None:
+    """With small bands (many chunks, several computed at once) the bytes still agree."""
+    from rti_rig.app.usecases import fit as fit_mod
+    from rti_rig.app.usecases.fit import FitRequest, run_fit
+    from rti_rig.app.usecases.fit_dask import run_fit_dask
+
+    monkeypatch.setattr(fit_mod, "BAND_BUDGET_BYTES", 36 * 88 * 3 * 4 * 5)  # 5-row bands
+    req = FitRequest(session, tmp_path / "plain", model="ps", qa=False)
+    run_fit(req)
+    run_fit_dask(FitRequest(session, tmp_path / "dask", model="ps", qa=False), "threads")
+    same_files(tmp_path / "plain", tmp_path / "dask")
+
+
+def unreadable(path: Path) -> np.ndarray:
+    """An opener standing for a worker that does not see the session's files."""
+    raise FileNotFoundError(2, "No such file or directory", str(path))
+
+
+def test_a_worker_that_cannot_read_the_images_is_a_clear_error(
+    session: Path, tmp_path: Path, monkeypatch
+) -> None:
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+    from rti_rig.app.usecases.fit import FitRequest
+
+    # the client (this process) reads the .lp, the sample and the QA crop; the in-process
+    # workers open the files with the opener the lazy stack names
+    monkeypatch.setattr(fit_dask, "read_image", unreadable)
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        req = FitRequest(session, tmp_path / "out", model="ps", qa=False)
+        with pytest.raises(fit_dask.SchedulerError) as caught:
+            fit_dask.run_fit_dask(req, address)
+    text = str(caught.value)
+    assert address in text and "image_001.tif" in text and "same paths" in text
+
+
+def test_the_threads_batch_is_resumable(session: Path, tmp_path: Path) -> None:
+    second = tmp_path / "second"
+    shutil.copytree(session, second)
+    out = tmp_path / "batch"
+    args = ["fit", str(session), str(second), "--out", str(out), "--model", "ps", "--no-qa"]
+    r = runner.invoke(app, [*args, "--scheduler", "threads"])
+    assert r.exit_code == 0 and r.output.count(": done") == 2, r.output
+    # a killed run: the second session's folder is gone, a partial one was left behind
+    shutil.rmtree(out / "second")
+    (out / ".second.1234-abcd.partial").mkdir()
+    (out / ".second.1234-abcd.partial" / "junk").write_text("x")
+    first_bytes = (out / session.name / "normals.npy").read_bytes()
+    r = runner.invoke(app, [*args, "--scheduler", "threads"])
+    assert r.exit_code == 0, r.output
+    assert r.output.count("(finished earlier)") == 1 and r.output.count(": done") == 1
+    assert not list(out.glob(".*partial")) and not (out / "second" / "junk").exists()
+    assert (out / session.name / "normals.npy").read_bytes() == first_bytes
+    plain = tmp_path / "plain"
+    r = runner.invoke(app, ["fit", str(second), "--out", str(plain), "--model", "ps", "--no-qa"])
+    assert r.exit_code == 0, r.output
+    for name in ("normals.npy", "normals.png", "albedo.npy", "fit.ptm", "fit.rti"):
+        assert (plain / name).read_bytes() == (out / "second" / name).read_bytes(), name
+
+
+def test_eight_bit_images_beside_a_bare_lp_give_the_same_bytes(session: Path, tmp_path: Path):
+    """Images that cannot be read by rows (8-bit PNG, decoded whole from sRGB) go through the
+    lazy stack too, decoded once per process."""
+    import cv2
+    import tifffile
+
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+    folder = tmp_path / "png"
+    folder.mkdir()
+    entries = []
+    for e in read_lp(session / "lights.lp"):
+        name = Path(e.name).stem + ".png"
+        linear = tifffile.imread(session / "linear" / (Path(e.name).stem + ".tif")) / 65535.0
+        srgb = np.where(linear <= 0.0031308, linear * 12.92, 1.055 * linear ** (1 / 2.4) - 0.055)
+        cv2.imwrite(str(folder / name), np.round(srgb[..., ::-1] * 255).astype(np.uint8))
+        entries.append(LpEntry(name, e.direction))
+    write_lp(folder / "dome.lp", entries)
+    base = ["fit", str(folder / "dome.lp"), "--model", "ps", "--no-qa"]
+    r = runner.invoke(app, [*base, "--out", str(tmp_path / "plain")])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, [*base, "--out", str(tmp_path / "threads"), "--scheduler", "threads"])
+    assert r.exit_code == 0, r.output
+    same_files(tmp_path / "plain", tmp_path / "threads")

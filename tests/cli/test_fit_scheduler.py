@@ -1,0 +1,149 @@
+"""`rti-rig fit --scheduler ADDRESS` through the front door: a real two-worker Dask cluster
+(separate processes) gives the single-process fit's bytes, for one session (bands as tasks) and
+for a batch (sessions as tasks, resumable); an address nobody answers is a clear error."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from fit_sessions import make_session
+
+runner = CliRunner()
+RTI_RIG = [sys.executable, "-c", "from rti_rig.cli import main; main()"]
+#: Files whose bytes must match; fit.json and lights.dome name the source path as given
+#: (a cluster batch records it absolute, workers do not share our working directory).
+OUTPUTS = ("normals.npy", "normals.png", "albedo.npy", "albedo.png", "fit.ptm", "fit.rti")
+
+
+def test_an_unreachable_scheduler_is_a_clear_error(tmp_path: Path, monkeypatch) -> None:
+    from rti_rig.app.usecases import fit_dask
+
+    monkeypatch.setattr(fit_dask, "CONNECT_TIMEOUT_S", 1.0)
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    for extra in ([], [str(session)]):  # one session, and a batch
+        r = runner.invoke(
+            app,
+            ["fit", str(session), *extra, "--out", str(tmp_path / "o"), "--scheduler",
+             "tcp://127.0.0.1:1"],
+        )
+        assert r.exit_code == 2, r.output
+        assert "tcp://127.0.0.1:1" in r.output and "dask scheduler" in r.output
+        assert "same paths" in r.output and "Traceback" not in r.output
+        assert not (tmp_path / "o" / "s" / "fit.json").exists()
+
+
+def test_a_scheduler_without_workers_is_a_clear_error(tmp_path: Path, monkeypatch) -> None:
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    monkeypatch.setattr(fit_dask, "WORKERS_TIMEOUT_S", 1.0)
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        address = cluster.scheduler_address
+        r = runner.invoke(
+            app, ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
+        )
+    assert r.exit_code == 2, r.output
+    assert "has no workers" in r.output and f"dask worker {address}" in r.output
+    assert "Traceback" not in r.output
+
+
+def _unreadable(path: Path):
+    """An image opener standing for a worker that does not see the session's files."""
+    raise FileNotFoundError(2, "No such file or directory", str(path))
+
+
+def test_a_worker_that_cannot_read_the_images_exits_2_naming_the_cluster(
+    tmp_path: Path, monkeypatch
+) -> None:
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    monkeypatch.setattr(fit_dask, "read_image", _unreadable)  # what the workers open with
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        r = runner.invoke(
+            app, ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
+        )
+    assert r.exit_code == 2, r.output
+    assert address in r.output and "could not read the images" in r.output
+    assert "same paths" in r.output and "Traceback" not in r.output
+
+
+def _cli(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*RTI_RIG, *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=900
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_local_two_worker_cluster_gives_the_single_process_bytes(tmp_path: Path) -> None:
+    from distributed import LocalCluster
+
+    # LocalCluster sets OMP/OPENBLAS_NUM_THREADS=1 in this process's environment for its
+    # workers; both command lines get the environment from before it, as a user's shell would
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(Path(__file__).resolve().parents[2]), env.get("PYTHONPATH", "")]
+    )
+    for name, seed in (("s1", 0), ("s2", 1), ("s3", 2)):
+        make_session(tmp_path / name, size=(48, 64), seed=seed)
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        # one session, its bands as tasks
+        r = _cli(["fit", "s1", "--out", "plain1"], env, tmp_path)
+        assert r.returncode == 0, r.stderr
+        r = _cli(["fit", "s1", "--out", "dask1", "--scheduler", address], env, tmp_path)
+        assert r.returncode == 0, r.stdout + r.stderr
+        for name in sorted(p.name for p in (tmp_path / "plain1").iterdir()):
+            assert (tmp_path / "plain1" / name).read_bytes() == (
+                tmp_path / "dask1" / name
+            ).read_bytes(), name
+        # a batch, sessions as tasks; a killed earlier run finished s1 and left s2 partial
+        batch = ["fit", "s1", "s2", "s3", "--out", "batch", "--model", "ps"]
+        plain = ["fit", "s1", "s2", "s3", "--out", "plainbatch", "--model", "ps"]
+        assert _cli(plain, env, tmp_path).returncode == 0
+        (tmp_path / "batch").mkdir()
+        shutil.copytree(tmp_path / "plainbatch" / "s1", tmp_path / "batch" / "s1")
+        stamp = (tmp_path / "batch" / "s1" / "normals.npy").stat().st_mtime_ns
+        (tmp_path / "batch" / ".s2.99-dead.partial").mkdir()
+        (tmp_path / "batch" / ".s2.99-dead.partial" / "fit.ptm.part").write_text("x")
+        r = _cli([*batch, "--scheduler", address], env, tmp_path)
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "s1: skipped (finished earlier)" in r.stdout
+        assert "s2: done" in r.stdout and "s3: done" in r.stdout
+        assert not list((tmp_path / "batch").glob(".*partial"))
+        assert (tmp_path / "batch" / "s1" / "normals.npy").stat().st_mtime_ns == stamp
+        for s in ("s2", "s3"):
+            for name in OUTPUTS:
+                a = (tmp_path / "plainbatch" / s / name).read_bytes()
+                assert a == (tmp_path / "batch" / s / name).read_bytes(), (s, name)
+            got = json.loads((tmp_path / "batch" / s / "fit.json").read_text())
+            ref = json.loads((tmp_path / "plainbatch" / s / "fit.json").read_text())
+            assert Path(got.pop("source")) == (tmp_path / s).resolve()
+            read = got.pop("read")  # "36 images from <the .lp, absolute>"
+            assert read == f"36 images from {(tmp_path / s / 'lights.lp').resolve()}"
+            assert ref.pop("read") == f"36 images from {s}/lights.lp"
+            ref.pop("source")
+            assert got == ref
+        r = _cli([*batch, "--scheduler", address], env, tmp_path)
+        assert r.returncode == 0 and r.stdout.count("(finished earlier)") == 3, r.stdout
