@@ -163,8 +163,7 @@ def main(argv: list[str] | None = None) -> str:
     md = "\n".join(lines)
     print(md)
     if args.write:
-        # the decisions alone go to their own section, the full table to adaptive_time
-        write_section("adaptive_decision_time" if decisions_only else "adaptive_time", md, DOC)
+        write_section("adaptive_time", md, DOC)
     return md
 
 
