@@ -299,50 +299,80 @@ def _albedo_residual_used(
     return n, alb, rms, count, ok
 
 
-def _albedo_residual_all(
-    inside: NDArray[np.bool_],
-    g: NDArray[np.float32],
+#: Columns (pixels) per chunk of the least-squares pass: the chunk's (N, chunk) float32 work
+#: arrays stay in the L2/L3 cache, so the residual's extra passes cost little beyond the product.
+LS_CHUNK_BYTES = 1_536 * 1024
+
+
+def _least_squares_band(
     flat: NDArray[np.float32],
+    g: NDArray[np.float32],
+    inside: NDArray[np.bool_],
     lights: NDArray[np.float64],
     gram: NDArray[np.float64],
     eps_b: float,
-) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
-    """Least squares over all lights with matrix products only.
+    saturation: float | None,
+) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_], NDArray[np.intp]]:
+    """Least squares over all lights, a cache-sized chunk of pixels at a time.
 
-    ``L^T I`` is the one pass over the band for the normals (``b = (L^T L)^-1 L^T I``); with
-    every light used, ``sum_k s_k I_k = n . (L^T I)`` and ``sum_k s_k^2 = n^T (L^T L) n``, so the
-    albedo needs nothing more for grey images and one more product for colour; the residual is
-    one prediction product and one sum of squares.
+    ``flat`` (N, P, C) is the band (never written), ``g`` (N, P) its grey values. Per chunk:
+    ``L^T I`` (the one product that reads the band), ``b = (L^T L)^-1 L^T I``; with every light
+    used, the albedo is ``n . (L^T I) / n^T (L^T L) n`` (one more product for colour); the
+    residual is computed directly, ``|L b - I|`` (not as a difference of large sums, which
+    float32 cannot resolve), while the chunk is still in cache. A pixel with a NaN/infinite
+    observation (found in ``L^T I``, where it propagates) or a saturated one (one max-reduction
+    of the chunk) is returned in ``suspect`` for the caller's per-pixel path.
+
+    Returns normals (3, P) float32 (invalid: the view axis), albedo (P, C), RMS residual (P,),
+    validity (P,) and the suspect pixels' indices.
     """
-    lt32 = lights.T.astype(np.float32)
-    ltg = (lt32 @ g).T.astype(np.float64)  # (P, 3)
-    b = ltg @ np.linalg.inv(gram).T
-    n, norm, ok = _unit_normals(b, inside.copy(), eps_b)
-    ss = np.sum((n @ gram) * n, axis=1)
-    ss = np.where(ss > 0, ss, 1.0)
+    n_img, p = g.shape
     channels = flat.shape[2]
-    if channels == 1:
-        alb = (np.sum(n * ltg, axis=1) / ss)[:, None]
-    else:
-        proj = (lt32 @ flat.reshape(flat.shape[0], -1)).reshape(3, -1, channels)
-        alb = np.einsum("pi,ipc->pc", n, proj.astype(np.float64)) / ss[:, None]
-    # the residual directly (not as a difference of large sums, which float32 cannot resolve)
-    diff = lt32.T @ np.ascontiguousarray((n * norm[:, None]).T, dtype=np.float32)  # (N, P)
-    diff -= g
-    np.square(diff, out=diff)
-    rms = np.sqrt(np.add.reduce(diff, axis=0) / g.shape[0]).astype(np.float64)
-    return n, alb, rms, ok
-
-
-def _band_is_clean(band: NDArray[np.float32], saturation: float | None) -> bool:
-    """No NaN/inf and nothing saturated, by one max-reduction (NaN propagates through max):
-    the common case costs no mask of the band's size."""
-    with np.errstate(invalid="ignore"):
-        top = np.max(band.reshape(band.shape[0], -1), axis=0)
-        ok = np.isfinite(top)
-        if saturation is not None:
-            ok &= top < np.float32(saturation)
-    return bool(ok.all())
+    l32 = lights.astype(np.float32)
+    lt32 = np.ascontiguousarray(l32.T)
+    ginv32 = np.linalg.inv(gram).astype(np.float32)
+    gram32 = gram.astype(np.float32)
+    sat = None if saturation is None else np.float32(saturation)
+    normals = np.empty((3, p), dtype=np.float32)
+    alb = np.empty((p, channels), dtype=np.float32)
+    rms = np.empty(p, dtype=np.float32)
+    ok = np.empty(p, dtype=bool)
+    suspect = []
+    chunk = max(256, LS_CHUNK_BYTES // (4 * n_img * channels))
+    # one work buffer reused by every chunk: a fresh array of this size per chunk costs more
+    # in first-touch page faults than the arithmetic
+    work = np.empty((n_img, min(chunk, p)), dtype=np.float32)
+    with np.errstate(invalid="ignore", over="ignore"):  # NaN/inf pixels are returned as suspect
+        for s in range(0, p, chunk):
+            e = min(p, s + chunk)
+            gc = g[:, s:e]
+            ltg = lt32 @ gc  # (3, c)
+            bad = ~np.isfinite(ltg).all(axis=0)
+            if sat is not None:
+                top = np.max(flat[:, s:e].reshape(n_img, -1), axis=0)
+                bad |= (top >= sat).reshape(-1, channels).any(axis=1)
+            b = ginv32 @ ltg
+            np.maximum(b[2], np.float32(0.0), out=b[2])  # a normal facing away is unseen
+            pred = np.matmul(l32, b, out=work[:, : e - s])
+            pred -= gc
+            rms[s:e] = np.sqrt(np.einsum("ij,ij->j", pred, pred) / np.float32(n_img))
+            norm = np.sqrt(np.einsum("ij,ij->j", b, b))
+            good = inside[s:e] & ~bad & (norm > eps_b)
+            nn = b / np.where(norm > 0, norm, np.float32(1.0))
+            ss = np.einsum("ij,ij->j", gram32 @ nn, nn)
+            ss = np.where(ss > 0, ss, np.float32(1.0))
+            if channels == 1:
+                alb[s:e, 0] = np.einsum("ij,ij->j", nn, ltg) / ss
+            else:
+                proj = (lt32 @ flat[:, s:e].reshape(n_img, -1)).reshape(3, e - s, channels)
+                alb[s:e] = np.einsum("ip,ipc->pc", nn, proj) / ss[:, None]
+            nn[:, ~good] = np.array([[0.0], [0.0], [1.0]], dtype=np.float32)
+            normals[:, s:e] = nn
+            ok[s:e] = good
+            if bad.any():
+                suspect.append(s + np.flatnonzero(bad & inside[s:e]))
+    cols = np.concatenate(suspect) if suspect else np.zeros(0, dtype=np.intp)
+    return normals, alb, rms, ok, cols
 
 
 def fit_photometric_stereo(
@@ -399,52 +429,49 @@ def fit_photometric_stereo(
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
         band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
-        if robust or not _band_is_clean(band, stack.saturation_level):
-            bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
-        else:
-            bad = None
+        r = band.shape[1]
+        inside = inside_all[sl].ravel()
+        if not robust:
+            flat = band.reshape(stack.n, r * wd, stack.channels)
+            g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
+            n_t, alb, rms, ok, cols = _least_squares_band(
+                flat, g, inside, lt, gram, eps_b, stack.saturation_level
+            )
+            count = np.full(ok.shape, stack.n)
+            if cols.size:
+                # pixels with an excluded observation (NaN, saturated): least squares on the
+                # others only, per pixel
+                vals = flat[:, cols]  # (N, k, C) copy
+                bad_c = stack.unusable(vals)
+                if bad_c is None:  # unreachable in practice: the chunk test found them
+                    bad_c = np.zeros(vals.shape, dtype=bool)
+                vals[bad_c] = 0.0
+                usable = ~np.logical_or.reduce(bad_c, axis=2)
+                gc = channel_mean(vals) if stack.channels > 1 else vals[..., 0]
+                bc, okc = _solve_weighted(np.ascontiguousarray(gc.T), usable.T, lt, cond_limit)
+                n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
+                    bc, usable, okc, gc, vals, lt, eps_b
+                )
+                n_t[:, cols], alb[cols], rms[cols] = n_c.T, alb_c, rms_c
+                count[cols], ok[cols] = count_c, ok_c
+            normals[sl] = n_t.T.reshape(r, wd, 3)
+            albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
+            residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)
+            valid[sl] = ok.reshape(r, wd)
+            used[sl] = np.where(ok, count, 0).reshape(r, wd)
+            continue
+        bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
         if bad is not None:
             band = np.where(bad, np.float32(0.0), band)
-        r = band.shape[1]
         flat = band.reshape(stack.n, r * wd, stack.channels)
         g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
-        inside = inside_all[sl].ravel()
-        usable = (
-            None if bad is None else ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
+        if bad is not None:
+            usable = ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
+            g = np.where(usable, g, np.float32(-1.0))  # below any dark threshold
+        b, w, ok = _robust_band(
+            g, inside, lt, dark, saturation, highlight_k, floor, max_passes, cond_limit, shadow_k
         )
-        if robust:
-            if usable is not None:
-                inside_robust = inside
-                g = np.where(usable, g, np.float32(-1.0))  # below any dark threshold
-            else:
-                inside_robust = inside
-            b, w, ok = _robust_band(
-                g,
-                inside_robust,
-                lt,
-                dark,
-                saturation,
-                highlight_k,
-                floor,
-                max_passes,
-                cond_limit,
-                shadow_k,
-            )
-            n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
-        else:
-            n, alb, rms, ok = _albedo_residual_all(inside, g, flat, lt, gram, eps_b)
-            count = np.full(ok.shape, stack.n)
-            if usable is not None:
-                # pixels with an excluded observation: least squares on the others only
-                cols = np.flatnonzero(~usable.all(axis=0) & inside)
-                gc = np.ascontiguousarray(g[:, cols])
-                wc = usable[:, cols].T
-                bc, okc = _solve_weighted(gc.T, wc, lt, cond_limit)
-                n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
-                    bc, wc.T, okc, gc, flat[:, cols], lt, eps_b
-                )
-                n[cols], alb[cols], rms[cols] = n_c, alb_c, rms_c
-                count[cols], ok[cols] = count_c, ok_c
+        n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
         normals[sl] = n.reshape(r, wd, 3)
         albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
         residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)

@@ -127,15 +127,32 @@ class ImageStack:
         else:
             assert self._frames is not None
             frames = self._frames
-            if self._lazy:
-                # files decoded strip by strip: zlib releases the GIL, so decode in parallel
-                parts = list(_reader_pool().map(lambda i: np.asarray(frames[i][sl]), idx))
-                band = np.stack(parts)
+            first = np.asarray(frames[int(idx[0])][sl]) if len(idx) else None
+            if first is None:
+                band = np.empty((0, 0, self.width), dtype=self.dtype)
             else:
-                band = np.stack([np.asarray(frames[i][sl]) for i in idx])
+                # converted straight into the float32 band: no stacked integer copy
+                out = np.empty((len(idx), *first.shape), dtype=np.float32)
+
+                def put(j: int) -> None:
+                    src = first if j == 0 else np.asarray(frames[int(idx[j])][sl])
+                    np.multiply(src, np.float32(self.scale), out=out[j], casting="unsafe")
+
+                if self._lazy:
+                    # files decoded strip by strip: zlib releases the GIL, so decode in parallel
+                    list(_reader_pool().map(put, range(len(idx))))
+                else:
+                    for j in range(len(idx)):
+                        put(j)
+                return self._finish(out, idx, sl, strict)
         out = band.astype(np.float32, copy=copy or self.scale != 1.0)
         if self.scale != 1.0:
             out *= np.float32(self.scale)
+        return self._finish(out, idx, sl, strict)
+
+    def _finish(
+        self, out: NDArray[np.float32], idx: NDArray[Any], sl: slice, strict: bool
+    ) -> NDArray[np.float32]:
         if out.ndim == 3:
             out = out[..., None]
         if strict and not np.all(np.isfinite(out)):
@@ -185,11 +202,22 @@ class ImageStack:
             rows = np.array([self.height // 2])
         if cols.size == 0:
             cols = np.array([self.width // 2])
-        parts = []
-        for r in rows:
-            band = self.rows(slice(int(r), int(r) + 1), strict=False)  # (N, 1, W, C)
-            parts.append(band[:, 0, cols, :])
-        values = np.concatenate(parts, axis=1)
+        if self._array is not None or not self._lazy:
+            # one gather of the grid, not a float band per sampled row
+            if self._array is not None:
+                grid = np.asarray(self._array[:, rows[:, None], cols[None, :]])
+            else:
+                assert self._frames is not None
+                grid = np.stack([np.asarray(f)[rows[:, None], cols[None, :]] for f in self._frames])
+            values = grid.astype(np.float32).reshape(self.n, rows.size * cols.size, -1)
+            if self.scale != 1.0:
+                values *= np.float32(self.scale)
+        else:
+            parts = []
+            for r in rows:
+                band = self.rows(slice(int(r), int(r) + 1), strict=False)  # (N, 1, W, C)
+                parts.append(band[:, 0, cols, :])
+            values = np.concatenate(parts, axis=1)
         flat = (rows[:, None] * self.width + cols[None, :]).ravel()
         self._samples[max_pixels] = (values, flat)
         return values, flat
