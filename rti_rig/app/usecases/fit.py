@@ -12,6 +12,8 @@ from __future__ import annotations
 import html
 import json
 import mmap
+import os
+import tempfile
 import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -21,9 +23,11 @@ from typing import Any
 
 import cv2
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
+from rti_rig.core.raw_rows import RawRows
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
 from rti_rig.reconstruct.errors import ReconstructionError
@@ -69,29 +73,78 @@ def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
     return lut[img]
 
 
-def _read_image(path: Path) -> np.ndarray:
-    if not path.is_file():
-        raise FitInputError(f"image {path} listed in the .lp is missing")
+def _decode(path: Path) -> np.ndarray:
+    """A compressed image decoded whole: uint16 linear TIFF, or 8-/16-bit JPEG/PNG (RGB)."""
     if path.suffix.lower() in (".tif", ".tiff"):
-        rows = TiffRows(path)  # read a band at a time by the fit, never whole
-        if rows.dtype != np.uint16:
-            raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
-        return rows  # type: ignore[return-value]
+        img = np.asarray(TiffRows(path)[:])
     else:
         img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
         if img is None:
             raise FitInputError(f"cannot read image {path}")
         if img.ndim == 3:
             img = img[..., ::-1]
-    if img.dtype == np.uint8:
-        img = _srgb_to_linear16(img)
-    if img.dtype != np.uint16:
+    if img.dtype not in (np.uint8, np.uint16):
         raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
     return np.ascontiguousarray(img)
 
 
-def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[str], str]:
-    """Frames (uint16), lights (N, 3), image names, and a description of what was read."""
+#: 8-bit sRGB code value -> linear 16-bit (JPEG/PNG inputs are decoded from sRGB).
+_SRGB_TO_LINEAR16 = _srgb_to_linear16(np.arange(256, dtype=np.uint8))
+
+
+def _open_frames(paths: list[Path], label: str) -> list[Any]:
+    """Row-readable frames (uint16 linear) of ``paths``, each decoded at most once.
+
+    Uncompressed 16-bit TIFFs (what sessions write) are read in place a band of rows at a
+    time (:class:`TiffRows`). Compressed ones (zlib TIFFs of older sessions, JPEG, PNG) are
+    decoded once, in parallel, into an unlinked temporary file and read back as
+    :class:`RawRows`: every later pass (pixel sample, fit, QA) reads rows, never decodes, and
+    nothing holds the acquisition in memory. 8-bit images are kept 8-bit there and linearised
+    on read.
+    """
+    frames: list[Any] = [None] * len(paths)
+    pending = []
+    for i, path in enumerate(paths):
+        if not path.is_file():
+            raise FitInputError(f"image {path} listed in the .lp is missing")
+        if path.suffix.lower() in (".tif", ".tiff"):
+            rows = TiffRows(path)
+            if rows.dtype != np.uint16:
+                raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
+            if rows.reads_in_place:
+                frames[i] = rows
+                continue
+        pending.append(i)
+    if not pending:
+        return frames
+    first = _decode(paths[pending[0]])
+    shape, stored = first.shape, first.dtype
+    size = first.nbytes
+    # unlinked at once: gone when the last frame reading it is released
+    store = tempfile.TemporaryFile(prefix="rti-rig-decoded-")  # noqa: SIM115
+    lut = _SRGB_TO_LINEAR16 if stored == np.uint8 else None
+
+    def put(k: int, img: np.ndarray | None = None) -> None:
+        i = pending[k]
+        img = _decode(paths[i]) if img is None else img
+        if img.shape != shape or img.dtype != stored:
+            raise FitInputError(
+                f"images of {label} differ: {paths[i].name} is {img.shape} {img.dtype}, "
+                f"{paths[pending[0]].name} is {shape} {stored}"
+            )
+        os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), k * size)
+        frames[i] = RawRows(store, k * size, shape, stored, lut, name=str(paths[i]))
+
+    put(0, first)
+    del first
+    with ThreadPoolExecutor(max_workers=os.cpu_count() or 2, thread_name_prefix="decode") as ex:
+        list(ex.map(put, range(1, len(pending))))
+    return frames
+
+
+def load_acquisition(source: Path) -> tuple[list[Any], np.ndarray, list[str], str]:
+    """Frames (row-readable, uint16 linear), lights (N, 3), image names, and a description
+    of what was read."""
     if source.is_dir():
         lps = sorted(source.glob("*.lp"))
         if not lps:
@@ -103,13 +156,13 @@ def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[s
         raise FitInputError(f"{source}: give a session folder or an .lp file")
     entries = read_lp(lp, upper_hemisphere=True)
     lights = directions_of(entries)
-    frames, names = [], []
+    paths, names = [], []
     for e in entries:
         stem = Path(e.name).stem
         linear = lp.parent / "linear" / f"{stem}.tif"
-        path = linear if linear.is_file() else lp.parent / e.name
-        frames.append(_read_image(path))
+        paths.append(linear if linear.is_file() else lp.parent / e.name)
         names.append(stem)
+    frames = _open_frames(paths, str(lp))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
         raise FitInputError(f"images of {lp} differ in shape: {sorted(shapes)}")
@@ -243,7 +296,10 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
     albedo = np.lib.format.open_memmap(out / "albedo.npy", "w+", np.float32, albedo_shape)
     rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
     sat = stack.saturation_level
-    with warnings.catch_warnings():
+    # one BLAS thread: the fit is many small products over cache-sized chunks, where threaded
+    # BLAS spends more in start-up and (on a shared machine) spinning than it computes, and
+    # the second core decodes/reads the next band meanwhile
+    with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
         warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
         tiles = list(row_tiles(h, rows))
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="prefetch")
