@@ -161,6 +161,73 @@ def memory_scaling(lights: int, write: bool) -> None:
         print(f"written to {write_section('fit_memory', table)}")
 
 
+def make_jpeg_session(root: Path, width: int, height: int, n: int) -> Path:
+    """A large JPEG acquisition, cheaply: each image rendered at a quarter of the size and
+    upscaled (the fit's memory depends on the size, not on the detail)."""
+    import cv2
+
+    from rti_rig.core.image_files import linear_to_srgb8
+
+    root.mkdir(parents=True)
+    lights = fibonacci_lights(n, 15.0)
+    small = (max(1, height // 4), max(1, width // 4))
+    normals, _ = sphere_normals(*small, 0.4)
+    albedo = np.empty((*small, 3))
+    albedo[...] = (0.55, 0.45, 0.35)
+    entries = []
+    for i, d in enumerate(lights):
+        img = render(normals, albedo, d[None], specular=0.3, shininess=40.0)[0] * 0.7
+        big = cv2.resize(img, (width, height), interpolation=cv2.INTER_LINEAR)
+        srgb = linear_to_srgb8(np.clip(np.round(big * 65535), 0, 65535).astype(np.uint16), 65535)
+        name = f"image_{i + 1:03d}.jpg"
+        cv2.imwrite(str(root / name), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+        entries.append(LpEntry(name, tuple(float(x) for x in d)))
+    write_lp(root / "lights.lp", entries)
+    return root
+
+
+def memory_at(width: int, height: int, lights: int, write: bool) -> None:
+    """Peak RSS of `rti-rig fit --model ps` (normal maps, .ptm, .rti, QA) measured, not
+    extrapolated, on a JPEG acquisition of the given size."""
+    work = Path(tempfile.mkdtemp(prefix="fit_big_"))
+    try:
+        t0 = time.perf_counter()
+        session = make_jpeg_session(work / "jpeg", width, height, lights)
+        print(f"{lights} JPEGs written in {time.perf_counter() - t0:.0f} s", flush=True)
+        rows = []
+        for label, extra in (
+            ("normals only (least-squares PS)", NORMALS),
+            ("normals, .ptm, .rti (HSH2), QA", ["--model", "ps"]),
+        ):
+            wall, peak, cpu = time_fit(session, extra)
+            rows.append((label, wall, cpu, peak))
+            print(f"{label}: {wall:.0f} s, cpu {cpu:.0f} s, peak RSS {peak:.0f} MB", flush=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    mp = width * height / 1e6
+    table = "\n".join(
+        [
+            f"## `rti-rig fit` memory at {mp:.0f} MP (measured)",
+            "",
+            f"{machine_line()} Command: `python -m benchmarks.fit_session --memory-at "
+            f"{width}x{height} --lights {lights}`.",
+            "",
+            f"{lights} RGB JPEGs of {width} × {height} ({mp:.1f} MP; rendered at a quarter of "
+            "the size and upscaled, since the memory depends on the size, not on the detail), "
+            "one `python -m rti_rig fit` process per case, outputs written; peak resident set "
+            "of that process (`ru_maxrss`). Target (issue #29): 24 MP × 100 lights with normal "
+            "maps within 2 GB.",
+            "",
+            "| case | wall time (s) | CPU time (s) | peak RSS (MB) |",
+            "|---|---|---|---|",
+            *[f"| {label} | {w:.0f} | {c:.0f} | {p:.0f} |" for label, w, c, p in rows],
+        ]
+    )
+    print(table)
+    if write:
+        print(f"written to {write_section('fit_memory', table)}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--width", type=int, default=1936)
@@ -171,7 +238,12 @@ def main() -> None:
         "--only", default="", help="run only the cases whose label contains this text"
     )
     parser.add_argument("--memory-scaling", action="store_true", help="see memory_scaling()")
+    parser.add_argument("--memory-at", default="", help="WIDTHxHEIGHT: see memory_at()")
     args = parser.parse_args()
+    if args.memory_at:
+        w, h = (int(x) for x in args.memory_at.lower().split("x"))
+        memory_at(w, h, args.lights if args.lights != 72 else 100, args.write)
+        return
     if args.memory_scaling:
         memory_scaling(args.lights if args.lights != 72 else 100, args.write)
         return

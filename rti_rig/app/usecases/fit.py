@@ -304,6 +304,8 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
         tiles = list(row_tiles(h, rows))
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="prefetch")
         pending = pool.submit(stack.rows, tiles[0], strict=False)
+        written = 0
+        row_bytes = wd * (3 + (1 if stack.grey else stack.channels)) * 4 if req.write_normals else 0
         for t, sl in enumerate(tiles):
             band = pending.result()  # read while the previous band was being fitted
             if t + 1 < len(tiles):
@@ -343,8 +345,11 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
                     albedo[sl] = np.linalg.norm(b, axis=0)
                 else:
                     albedo[sl] = coefs["ptm"][5]  # the PTM's constant term: mean brightness
-            _release(normals)  # written pages go to the file, not the resident set
-            _release(albedo)
+            written += (sl.stop - sl.start) * row_bytes
+            if written >= RELEASE_BYTES or t + 1 == len(tiles):
+                _release(normals)  # written pages go to the file, not the resident set
+                _release(albedo)
+                written = 0
         pool.shutdown()
     for writer in writers.values():
         files.append(writer.close())
@@ -358,6 +363,11 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
         (out / "normals.npy").unlink()
         (out / "albedo.npy").unlink()
     return FitResult(out, model_name, reason_line, files)
+
+
+#: Written map pages are flushed and dropped from memory once this many have accumulated (each
+#: flush is a synchronous write: per band, it cost more than the fit of the band).
+RELEASE_BYTES = 64 * 1024 * 1024
 
 
 def _release(mapped: np.memmap) -> None:
