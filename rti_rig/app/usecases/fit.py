@@ -2,9 +2,10 @@
 
 Input: a session folder (``lights.lp`` and ``linear/*.tif`` 16-bit linear, as
 :mod:`rti_rig.runtime.session` writes it) or any ``.lp`` with its images beside it (16-bit TIFF
-used as linear; 8-bit JPEG/PNG decoded from sRGB). TIFFs are read a band of rows at a time
-(:class:`rti_rig.core.tiff_rows.TiffRows`); JPEG/PNG are decoded whole and held as ``uint16``.
-The stack is never held as floats; one streamed pass computes every output.
+used as linear; 8-bit JPEG/PNG decoded from sRGB). Uncompressed TIFFs are read a band of rows
+at a time in place (:class:`rti_rig.core.tiff_rows.TiffRows`); compressed ones and JPEG/PNG are
+decoded once into a temporary file and read back by rows (:class:`rti_rig.core.raw_rows.RawRows`).
+The stack is never held, as floats or otherwise; one streamed pass computes every output.
 """
 
 from __future__ import annotations
