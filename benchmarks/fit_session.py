@@ -162,8 +162,9 @@ def memory_scaling(lights: int, write: bool) -> None:
 
 
 def make_jpeg_session(root: Path, width: int, height: int, n: int) -> Path:
-    """A large JPEG acquisition, cheaply: each image rendered at a quarter of the size and
-    upscaled (the fit's memory depends on the size, not on the detail)."""
+    """A large JPEG acquisition, cheaply: each image rendered and encoded to sRGB at a quarter
+    of the size, then upscaled as 8 bits (the fit's memory depends on the size, not on the
+    detail)."""
     import cv2
 
     from rti_rig.core.image_files import linear_to_srgb8
@@ -177,8 +178,8 @@ def make_jpeg_session(root: Path, width: int, height: int, n: int) -> Path:
     entries = []
     for i, d in enumerate(lights):
         img = render(normals, albedo, d[None], specular=0.3, shininess=40.0)[0] * 0.7
-        big = cv2.resize(img, (width, height), interpolation=cv2.INTER_LINEAR)
-        srgb = linear_to_srgb8(np.clip(np.round(big * 65535), 0, 65535).astype(np.uint16), 65535)
+        srgb = linear_to_srgb8(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16), 65535)
+        srgb = cv2.resize(srgb, (width, height), interpolation=cv2.INTER_LINEAR)
         name = f"image_{i + 1:03d}.jpg"
         cv2.imwrite(str(root / name), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
         entries.append(LpEntry(name, tuple(float(x) for x in d)))
