@@ -40,11 +40,12 @@ class RawRows:
         self.dtype = np.dtype(lut.dtype) if lut is not None else self._stored
         self.name = name
         self._row_bytes = int(np.prod(self.shape[1:])) * self._stored.itemsize
+        self._float_luts: dict[float, NDArray[np.float32]] = {}
 
     def __len__(self) -> int:
         return self.shape[0]
 
-    def _read(self, start: int, stop: int) -> NDArray[Any]:
+    def _read(self, start: int, stop: int, mapped: bool = True) -> NDArray[Any]:
         out = np.empty((stop - start, *self.shape[1:]), dtype=self._stored)
         want = out.nbytes
         if want:
@@ -55,7 +56,19 @@ class RawRows:
             )
             if got != want:
                 raise OSError(f"{self.name}: short read of decoded rows ({got} of {want} bytes)")
-        return out if self._lut is None else self._lut[out]
+        return out if self._lut is None or not mapped else self._lut[out]
+
+    def rows_float32(self, key: slice, scale: float, out: NDArray[np.float32]) -> None:
+        """Rows ``key`` × ``scale`` into ``out`` (float32): through the LUT in one step, with
+        no integer copy of the band (what a fit's band reader wants)."""
+        start, stop, _ = key.indices(self.shape[0])
+        if self._lut is None:
+            np.multiply(self._read(start, stop), np.float32(scale), out=out, casting="unsafe")
+            return
+        lut = self._float_luts.get(scale)
+        if lut is None:
+            lut = self._float_luts[scale] = self._lut.astype(np.float32) * np.float32(scale)
+        np.take(lut, self._read(start, stop, mapped=False), out=out)
 
     def __getitem__(self, key: Any) -> NDArray[Any]:
         if isinstance(key, slice):

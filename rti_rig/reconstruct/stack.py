@@ -135,7 +135,11 @@ class ImageStack:
                 out = np.empty((len(idx), *first.shape), dtype=np.float32)
 
                 def put(j: int) -> None:
-                    src = first if j == 0 else np.asarray(frames[int(idx[j])][sl])
+                    frame = frames[int(idx[j])]
+                    if j > 0 and hasattr(frame, "rows_float32"):
+                        frame.rows_float32(sl, self.scale, out[j])  # e.g. 8-bit through a LUT
+                        return
+                    src = first if j == 0 else np.asarray(frame[sl])
                     np.multiply(src, np.float32(self.scale), out=out[j], casting="unsafe")
 
                 if self._lazy:

@@ -110,3 +110,8 @@ def test_raw_rows_read_back_what_was_written_and_map_through_the_lut() -> None:
         np.testing.assert_array_equal(rb[39:40], b[39:40])
         np.testing.assert_array_equal(np.asarray(rb), b)
         np.testing.assert_array_equal(rb[::2], b[::2])
+        band = np.empty((14, 30, 3), dtype=np.float32)
+        ra.rows_float32(slice(3, 17), 1 / 65535, band)
+        np.testing.assert_allclose(band, lut[a[3:17]] / np.float32(65535), rtol=1e-6)
+        rb.rows_float32(slice(3, 17), 0.5, band)
+        np.testing.assert_array_equal(band, b[3:17] * np.float32(0.5))
