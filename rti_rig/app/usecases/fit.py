@@ -218,7 +218,7 @@ def run_fit(req: FitRequest) -> FitResult:
 SAMPLE_PIXELS = 30_000
 #: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
 #: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
-BAND_BUDGET_BYTES = 24 * 1024 * 1024
+BAND_BUDGET_BYTES = 8 * 1024 * 1024
 
 
 def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) -> FitResult:
@@ -368,7 +368,7 @@ def _fit_all(req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path) 
 
 #: Written map pages are flushed and dropped from memory once this many have accumulated (each
 #: flush is a synchronous write: per band, it cost more than the fit of the band).
-RELEASE_BYTES = 64 * 1024 * 1024
+RELEASE_BYTES = 16 * 1024 * 1024
 
 
 def _release(mapped: np.memmap) -> None:
