@@ -398,6 +398,7 @@ def _least_squares_band(
     gram: NDArray[np.float64],
     eps_b: float,
     saturation: float | None,
+    normals: NDArray[np.float32] | None = None,
 ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_], NDArray[np.intp]]:
     """Least squares over all lights, a cache-sized chunk of pixels at a time.
 
@@ -409,8 +410,8 @@ def _least_squares_band(
     observation (found in ``L^T I``, where it propagates) or a saturated one (one max-reduction
     of the chunk) is returned in ``suspect`` for the caller's per-pixel path.
 
-    Returns normals (3, P) float32 (invalid: the view axis), albedo (P, C), RMS residual (P,),
-    validity (P,) and the suspect pixels' indices.
+    Returns normals (P, 3) float32 (invalid: the view axis; written into ``normals`` when
+    given), albedo (P, C), RMS residual (P,), validity (P,) and the suspect pixels' indices.
     """
     n_img, p = g.shape
     channels = flat.shape[2]
@@ -419,7 +420,8 @@ def _least_squares_band(
     ginv32 = np.linalg.inv(gram).astype(np.float32)
     gram32 = gram.astype(np.float32)
     sat = None if saturation is None else np.float32(saturation)
-    normals = np.empty((3, p), dtype=np.float32)
+    if normals is None:
+        normals = np.empty((p, 3), dtype=np.float32)
     alb = np.empty((p, channels), dtype=np.float32)
     rms = np.empty(p, dtype=np.float32)
     ok = np.empty(p, dtype=bool)
@@ -467,7 +469,7 @@ def _least_squares_band(
                 proj = (lt32 @ flat[:, s:e].reshape(n_img, -1)).reshape(3, e - s, channels)
                 alb[s:e] = np.einsum("ip,ipc->pc", nn, proj) / ss[:, None]
             nn[:, ~good] = np.array([[0.0], [0.0], [1.0]], dtype=np.float32)
-            normals[:, s:e] = nn
+            normals[s:e] = nn.T  # transposed while the chunk is in cache
             ok[s:e] = good
             if bad.any():
                 suspect.append(s + np.flatnonzero(bad & inside[s:e]))
@@ -518,12 +520,12 @@ def fit_photometric_stereo(
     floor = HIGHLIGHT_FLOOR_FRACTION * ref if highlight_floor is None else float(highlight_floor)
     eps_b = DARK_PIXEL_FRACTION * ref
 
-    normals = np.zeros((h, wd, 3), dtype=np.float32)
-    normals[..., 2] = 1.0
-    albedo = np.zeros((h, wd, stack.channels), dtype=np.float32)
-    residual = np.zeros((h, wd), dtype=np.float32)
-    valid = np.zeros((h, wd), dtype=bool)
-    used = np.zeros((h, wd), dtype=np.int16)
+    # every band writes every pixel of these (invalid ones too): no fill pass needed
+    normals = np.empty((h, wd, 3), dtype=np.float32)
+    albedo = np.empty((h, wd, stack.channels), dtype=np.float32)
+    residual = np.empty((h, wd), dtype=np.float32)
+    valid = np.empty((h, wd), dtype=bool)
+    used = np.empty((h, wd), dtype=np.int16)
     gram = lt.T @ lt
     # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
@@ -535,7 +537,14 @@ def fit_photometric_stereo(
             flat = band.reshape(stack.n, r * wd, stack.channels)
             g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
             n_t, alb, rms, ok, cols = _least_squares_band(
-                flat, g, inside, lt, gram, eps_b, stack.saturation_level
+                flat,
+                g,
+                inside,
+                lt,
+                gram,
+                eps_b,
+                stack.saturation_level,
+                normals[sl].reshape(r * wd, 3),  # a view: the normals are written in place
             )
             count = np.full(ok.shape, stack.n)
             if cols.size:
@@ -552,9 +561,8 @@ def fit_photometric_stereo(
                 n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
                     bc, usable, okc, gc, vals, lt, eps_b
                 )
-                n_t[:, cols], alb[cols], rms[cols] = n_c.T, alb_c, rms_c
+                n_t[cols], alb[cols], rms[cols] = n_c, alb_c, rms_c
                 count[cols], ok[cols] = count_c, ok_c
-            normals[sl].reshape(r * wd, 3).T[...] = n_t  # one strided write, no transposed copy
             alb[~ok] = 0.0
             albedo[sl] = alb.reshape(r, wd, stack.channels)
             rms[~ok] = 0.0

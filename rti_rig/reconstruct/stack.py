@@ -209,7 +209,19 @@ class ImageStack:
         if self._array is not None or not self._lazy:
             # one gather of the grid, not a float band per sampled row
             if self._array is not None:
-                grid = np.asarray(self._array[:, rows[:, None], cols[None, :]])
+                # the grid is a strided slice when both axes are sampled regularly
+                if (
+                    rows.size > 1
+                    and cols.size > 1
+                    and np.ptp(np.diff(rows)) == 0
+                    and np.ptp(np.diff(cols)) == 0
+                ):
+                    r0, rs, c0, cs = rows[0], rows[1] - rows[0], cols[0], cols[1] - cols[0]
+                    grid = np.asarray(
+                        self._array[:, r0 : rows[-1] + 1 : rs, c0 : cols[-1] + 1 : cs]
+                    )
+                else:
+                    grid = np.asarray(self._array[:, rows[:, None], cols[None, :]])
             else:
                 assert self._frames is not None
                 grid = np.stack([np.asarray(f)[rows[:, None], cols[None, :]] for f in self._frames])
