@@ -40,8 +40,8 @@ def _float64_least_squares(images: np.ndarray, lights: np.ndarray) -> tuple[np.n
 def test_least_squares_residual_and_normals_match_float64() -> None:
     """Many chunks (the image is wider than one), noisy glossy data: the residual taken from
     the normal equations agrees with the direct float64 residual to 1e-3."""
-    images, lights = _glossy(160, 24)
-    assert LS_CHUNK_BYTES // (4 * 24) < 160 * 160  # more than one chunk
+    images, lights = _glossy(220, 24)
+    assert LS_CHUNK_BYTES // (4 * 24) < 220 * 220  # more than one chunk
     res = fit_photometric_stereo(images, lights)
     b, rms = _float64_least_squares(images, lights)
     v = res.valid.ravel()
@@ -55,7 +55,7 @@ def test_least_squares_residual_and_normals_match_float64() -> None:
 def test_least_squares_excludes_saturated_and_nan_pixels_in_any_chunk() -> None:
     """Bad observations scattered over several chunks: those pixels are fitted on their other
     observations only, exactly like a float64 least squares on those observations."""
-    images, lights = _glossy(160, 24, seed=1)
+    images, lights = _glossy(220, 24, seed=1)
     images *= 0.9 / images.max()  # nothing saturated but the values set below
     rng = np.random.default_rng(3)
     flat = images.reshape(24, -1)
@@ -67,7 +67,7 @@ def test_least_squares_excludes_saturated_and_nan_pixels_in_any_chunk() -> None:
         keep = np.isfinite(flat[:, p]) & (flat[:, p] < 1.0)
         b = np.linalg.lstsq(lights[keep], flat[keep, p].astype(np.float64), rcond=None)[0]
         b[2] = max(b[2], 0.0)
-        y, x = divmod(int(p), 160)
+        y, x = divmod(int(p), 220)
         assert res.used_lights[y, x] == keep.sum()
         if res.valid[y, x]:
             np.testing.assert_allclose(res.normals[y, x], b / np.linalg.norm(b), atol=1e-4)
