@@ -5,8 +5,11 @@ HSH (27 planes) in 30.7 s within 615 MB and L2 normals in 7.3 s within 108 MB (m
 issue's author on this project's machine; relight-cli is not installed here, so the figures are
 quoted, not re-measured). This script writes a session of the same shape — a glossy sphere on a
 flat ground, rendered with the reconstruct package's synthetic shader, 16-bit linear TIFFs as
-`rti-rig run` writes them — and times `rti-rig fit` in a child process, reading its peak
-resident memory (``ru_maxrss`` of the child).
+`rti-rig run` writes them (uncompressed) — plus two twins of it: the same images as sRGB JPEGs
+(quality 95) with an ``.lp`` naming them, as relight was given, and as zlib-compressed TIFFs, as
+sessions were written before 2026-11-24. It times `rti-rig fit` in a child process, reading its
+peak resident memory (``ru_maxrss`` of the child) and its CPU time (user + system), which is
+the figure to compare when the shared machine is loaded.
 
 Run: ``python -m benchmarks.fit_session [--width 1936 --height 1296 --lights 72]``;
 ``--write`` puts the table into docs/benchmarks.md.
@@ -29,12 +32,24 @@ from rti_rig.core.image_files import write_linear_tiff
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
-CASES = {
-    "normals only (robust PS)": ["--model", "robust-ps", "--no-ptm", "--no-hsh", "--no-qa"],
-    "normals only (least-squares PS)": ["--model", "ps", "--no-ptm", "--no-hsh", "--no-qa"],
-    "HSH2 only (.rti)": ["--model", "hsh2", "--no-ptm", "--no-normals", "--no-qa"],
-    "everything (auto, normals, .ptm, .rti, QA)": [],
-}
+NORMALS = ["--model", "ps", "--no-ptm", "--no-hsh", "--no-qa"]
+HSH2 = ["--model", "hsh2", "--no-ptm", "--no-normals", "--no-qa"]
+#: (label, input, arguments): input "tiff" (as sessions are written), "jpeg" (relight's
+#: input), "zlib" (sessions written before 2026-11-24).
+CASES = [
+    ("normals only (least-squares PS)", "jpeg", NORMALS),
+    ("normals only (least-squares PS)", "tiff", NORMALS),
+    ("normals only (least-squares PS)", "zlib", NORMALS),
+    ("HSH2 only (.rti)", "jpeg", HSH2),
+    ("HSH2 only (.rti)", "tiff", HSH2),
+    ("HSH2 only (.rti)", "zlib", HSH2),
+    (
+        "normals only (robust PS)",
+        "tiff",
+        ["--model", "robust-ps", "--no-ptm", "--no-hsh", "--no-qa"],
+    ),
+    ("everything (auto, normals, .ptm, .rti, QA)", "tiff", []),
+]
 
 
 def make_session(root: Path, width: int, height: int, n: int) -> Path:
@@ -56,9 +71,32 @@ def make_session(root: Path, width: int, height: int, n: int) -> Path:
     return root
 
 
-def time_fit(session: Path, extra: list[str]) -> tuple[float, float]:
-    """Wall time and peak RSS (MB) of one `rti-rig fit` process (measured by a wrapper whose
-    only child it is, so ``ru_maxrss`` is that process's own)."""
+def make_twins(session: Path, jpeg: Path, zlib: Path) -> None:
+    """The session's images as sRGB JPEGs beside a copy of its .lp (relight's input), and as
+    zlib-compressed TIFFs (older sessions)."""
+    import cv2
+    import tifffile
+
+    from rti_rig.core.image_files import linear_to_srgb8
+
+    (zlib / "linear").mkdir(parents=True)
+    jpeg.mkdir(parents=True)
+    shutil.copy(session / "lights.lp", jpeg / "lights.lp")
+    shutil.copy(session / "lights.lp", zlib / "lights.lp")
+    for tif in sorted((session / "linear").glob("*.tif")):
+        px = tifffile.imread(tif)
+        write_linear_tiff(zlib / "linear" / tif.name, px, compression="zlib")
+        srgb = linear_to_srgb8(px, 65535)
+        cv2.imwrite(str(jpeg / f"{tif.stem}.jpg"), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+
+
+def folder_mb(path: Path) -> float:
+    return sum(p.stat().st_size for p in path.rglob("*") if p.is_file()) / 1e6
+
+
+def time_fit(session: Path, extra: list[str]) -> tuple[float, float, float]:
+    """Wall time, peak RSS (MB) and CPU seconds of one `rti-rig fit` process (measured by a
+    wrapper whose only child it is, so ``ru_maxrss`` is that process's own)."""
     out = Path(tempfile.mkdtemp(prefix="fit_out_"))
     shutil.rmtree(out)
     cmd = [sys.executable, "-m", "rti_rig", "fit", str(session), "--out", str(out), *extra]
@@ -66,14 +104,15 @@ def time_fit(session: Path, extra: list[str]) -> tuple[float, float]:
         "import resource, subprocess, sys, time\n"
         "t = time.perf_counter()\n"
         f"subprocess.run({cmd!r}, check=True, stdout=subprocess.DEVNULL)\n"
-        "print(time.perf_counter() - t, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
+        "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+        "print(time.perf_counter() - t, u.ru_maxrss, u.ru_utime + u.ru_stime)\n"
     )
     done = subprocess.run(
         [sys.executable, "-c", wrapper], check=True, capture_output=True, text=True
     )
-    wall, peak_kb = done.stdout.split()
+    wall, peak_kb, cpu = done.stdout.split()
     shutil.rmtree(out, ignore_errors=True)
-    return float(wall), float(peak_kb) / 1024.0
+    return float(wall), float(peak_kb) / 1024.0, float(cpu)
 
 
 def memory_scaling(lights: int, write: bool) -> None:
@@ -90,7 +129,7 @@ def memory_scaling(lights: int, write: bool) -> None:
     try:
         for w, h in sizes:
             session = make_session(work / f"s{w}", w, h, lights)
-            wall, peak = time_fit(session, CASES["everything (auto, normals, .ptm, .rti, QA)"])
+            wall, peak, _ = time_fit(session, [])
             points.append((w * h / 1e6, peak, wall))
             print(f"{w} x {h} x {lights}: {wall:.1f} s, peak RSS {peak:.0f} MB", flush=True)
             shutil.rmtree(session, ignore_errors=True)
@@ -122,6 +161,74 @@ def memory_scaling(lights: int, write: bool) -> None:
         print(f"written to {write_section('fit_memory', table)}")
 
 
+def make_jpeg_session(root: Path, width: int, height: int, n: int) -> Path:
+    """A large JPEG acquisition, cheaply: each image rendered and encoded to sRGB at a quarter
+    of the size, then upscaled as 8 bits (the fit's memory depends on the size, not on the
+    detail)."""
+    import cv2
+
+    from rti_rig.core.image_files import linear_to_srgb8
+
+    root.mkdir(parents=True)
+    lights = fibonacci_lights(n, 15.0)
+    small = (max(1, height // 4), max(1, width // 4))
+    normals, _ = sphere_normals(*small, 0.4)
+    albedo = np.empty((*small, 3))
+    albedo[...] = (0.55, 0.45, 0.35)
+    entries = []
+    for i, d in enumerate(lights):
+        img = render(normals, albedo, d[None], specular=0.3, shininess=40.0)[0] * 0.7
+        srgb = linear_to_srgb8(np.clip(np.round(img * 65535), 0, 65535).astype(np.uint16), 65535)
+        srgb = cv2.resize(srgb, (width, height), interpolation=cv2.INTER_LINEAR)
+        name = f"image_{i + 1:03d}.jpg"
+        cv2.imwrite(str(root / name), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+        entries.append(LpEntry(name, tuple(float(x) for x in d)))
+    write_lp(root / "lights.lp", entries)
+    return root
+
+
+def memory_at(width: int, height: int, lights: int, write: bool) -> None:
+    """Peak RSS of `rti-rig fit --model ps` (normal maps, .ptm, .rti, QA) measured, not
+    extrapolated, on a JPEG acquisition of the given size."""
+    work = Path(tempfile.mkdtemp(prefix="fit_big_"))
+    try:
+        t0 = time.perf_counter()
+        session = make_jpeg_session(work / "jpeg", width, height, lights)
+        print(f"{lights} JPEGs written in {time.perf_counter() - t0:.0f} s", flush=True)
+        rows = []
+        for label, extra in (
+            ("normals only (least-squares PS)", NORMALS),
+            ("normals, .ptm, .rti (HSH2), QA", ["--model", "ps"]),
+        ):
+            wall, peak, cpu = time_fit(session, extra)
+            rows.append((label, wall, cpu, peak))
+            print(f"{label}: {wall:.0f} s, cpu {cpu:.0f} s, peak RSS {peak:.0f} MB", flush=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    mp = width * height / 1e6
+    table = "\n".join(
+        [
+            f"## `rti-rig fit` memory at {mp:.0f} MP (measured)",
+            "",
+            f"{machine_line()} Command: `python -m benchmarks.fit_session --memory-at "
+            f"{width}x{height} --lights {lights}`.",
+            "",
+            f"{lights} RGB JPEGs of {width} × {height} ({mp:.1f} MP; rendered at a quarter of "
+            "the size and upscaled, since the memory depends on the size, not on the detail), "
+            "one `python -m rti_rig fit` process per case, outputs written; peak resident set "
+            "of that process (`ru_maxrss`). Target (issue #29): 24 MP × 100 lights with normal "
+            "maps within 2 GB.",
+            "",
+            "| case | wall time (s) | CPU time (s) | peak RSS (MB) |",
+            "|---|---|---|---|",
+            *[f"| {label} | {w:.0f} | {c:.0f} | {p:.0f} |" for label, w, c, p in rows],
+        ]
+    )
+    print(table)
+    if write:
+        print(f"written to {write_section('fit_memory', table)}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--width", type=int, default=1936)
@@ -132,40 +239,61 @@ def main() -> None:
         "--only", default="", help="run only the cases whose label contains this text"
     )
     parser.add_argument("--memory-scaling", action="store_true", help="see memory_scaling()")
+    parser.add_argument("--memory-at", default="", help="WIDTHxHEIGHT: see memory_at()")
     args = parser.parse_args()
+    if args.memory_at:
+        w, h = (int(x) for x in args.memory_at.lower().split("x"))
+        memory_at(w, h, args.lights if args.lights != 72 else 100, args.write)
+        return
     if args.memory_scaling:
         memory_scaling(args.lights if args.lights != 72 else 100, args.write)
         return
     work = Path(tempfile.mkdtemp(prefix="fit_bench_"))
     try:
         t0 = time.perf_counter()
-        session = make_session(work / "session", args.width, args.height, args.lights)
-        print(f"session written in {time.perf_counter() - t0:.1f} s")
+        sources = {"tiff": work / "session", "jpeg": work / "jpeg", "zlib": work / "zlib"}
+        make_session(sources["tiff"], args.width, args.height, args.lights)
+        make_twins(sources["tiff"], sources["jpeg"], sources["zlib"])
+        sizes = {k: folder_mb(v) for k, v in sources.items()}
+        print(f"sessions written in {time.perf_counter() - t0:.1f} s: {sizes}")
         rows = []
-        for label, extra in CASES.items():
+        for label, kind, extra in CASES:
             if args.only not in label:
                 continue
-            wall, peak = time_fit(session, extra)
-            rows.append((label, wall, peak))
-            print(f"{label:45s} {wall:7.1f} s  peak RSS {peak:7.0f} MB", flush=True)
+            wall, peak, cpu = time_fit(sources[kind], extra)
+            rows.append((label, kind, wall, cpu, peak))
+            print(
+                f"{label:45s} {kind:5s} {wall:7.1f} s  cpu {cpu:7.1f} s  peak RSS {peak:7.0f} MB",
+                flush=True,
+            )
     finally:
         shutil.rmtree(work, ignore_errors=True)
     mp = args.width * args.height / 1e6
+    inputs = {
+        "tiff": f"uncompressed 16-bit TIFF as sessions are written ({sizes['tiff']:.0f} MB)",
+        "jpeg": f"sRGB JPEG q95 beside the .lp, relight's input ({sizes['jpeg']:.0f} MB)",
+        "zlib": f"zlib 16-bit TIFF, sessions before 2026-11-24 ({sizes['zlib']:.0f} MB)",
+    }
     lines = [
         "## `rti-rig fit` end to end (whole processes)",
         "",
         f"{machine_line()} Command: `python -m benchmarks.fit_session --width {args.width} "
         f"--height {args.height} --lights {args.lights}`.",
         "",
-        f"{args.lights} RGB 16-bit TIFFs of {args.width} × {args.height} ({mp:.1f} MP), "
-        "synthetic glossy sphere; each case is one `python -m rti_rig fit` process, outputs "
-        "written. Peak memory is that process's maximum resident set (`ru_maxrss`). "
-        "relight-cli (quoted from issue "
-        "#29, same shape, JPEG in): HSH 30.7 s / 615 MB, L2 normals 7.3 s / 108 MB.",
+        f"{args.lights} RGB images of {args.width} × {args.height} ({mp:.1f} MP), synthetic glossy "
+        "sphere, as three inputs: "
+        + "; ".join(f"**{k}**: {v}" for k, v in inputs.items())
+        + ". Each case is one `python -m rti_rig fit` process, outputs written. Peak memory is "
+        "that process's maximum resident set (`ru_maxrss`); CPU is its user + system time "
+        "(the figure to compare when other jobs share the 2 cores). relight-cli (quoted from "
+        "issue #29, same shape, JPEG in): HSH 30.7 s / 615 MB, L2 normals 7.3 s / 108 MB.",
         "",
-        "| case | wall time (s) | peak RSS (MB) |",
-        "|---|---|---|",
-        *[f"| {label} | {wall:.1f} | {peak:.0f} |" for label, wall, peak in rows],
+        "| case | input | wall time (s) | CPU time (s) | peak RSS (MB) |",
+        "|---|---|---|---|---|",
+        *[
+            f"| {label} | {kind} | {wall:.1f} | {cpu:.1f} | {peak:.0f} |"
+            for label, kind, wall, cpu, peak in rows
+        ],
     ]
     table = "\n".join(lines)
     print(table)

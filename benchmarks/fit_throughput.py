@@ -45,6 +45,25 @@ def _median_time(fn: Callable[[], object], repeats: int) -> float:
     return statistics.median(times)
 
 
+def _paired_times(
+    a: Callable[[], object], b: Callable[[], object], repeats: int
+) -> tuple[float, float]:
+    """Medians of ``a`` and ``b`` timed alternately (a, b, a, b, …) after a warm-up of each:
+    on a shared machine both see the same load, so their ratio is fair."""
+    a()
+    b()
+    ta, tb = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        a()
+        t1 = time.perf_counter()
+        b()
+        t2 = time.perf_counter()
+        ta.append(t1 - t0)
+        tb.append(t2 - t1)
+    return statistics.median(ta), statistics.median(tb)
+
+
 def _peak_bytes(fn: Callable[[], object]) -> int:
     tracemalloc.start()
     try:
@@ -71,8 +90,11 @@ def run(size: int, n_lights: int, repeats: int, tile_rows: int | None) -> str:
     for name in MODELS:
         p = 3 if name.startswith("ps") else N_COEFFICIENTS[name]
         w = np.random.default_rng(1).normal(size=(p, n_lights)).astype(np.float32)
-        t_mm = _median_time(lambda w=w: w @ flat, repeats)
-        t_fit = _median_time(lambda name=name: fit_model(name, images, lights, **kwargs), repeats)
+        t_mm, t_fit = _paired_times(
+            lambda w=w: w @ flat,
+            lambda name=name: fit_model(name, images, lights, **kwargs),
+            repeats,
+        )
         t_u16 = _median_time(lambda name=name: fit_model(name, frames, lights, **kwargs), repeats)
         peak = _peak_bytes(
             lambda name=name: fit_model(name, frames, lights, tile_rows=PEAK_TILE_ROWS)
@@ -99,7 +121,9 @@ def run(size: int, n_lights: int, repeats: int, tile_rows: int | None) -> str:
         f"Shape: {size} × {size} grey pixels, {n_lights} lights (Fibonacci hemisphere), "
         f"synthetic sphere with highlights and noise; median of {repeats} runs after a warm-up. "
         '"matmul" is a float32 `(p × N) @ (N × pixels)` product, the same shape as the fit, '
-        "timed in the same run. Throughput is pixels × lights per second. Peak memory is the "
+        "timed alternately with the float32 fit in the same run (both see the same load; load "
+        f"average at the start: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores). "
+        "Throughput is pixels × lights per second. Peak memory is the "
         f"tracemalloc peak of one fit from uint16 frames in bands of {PEAK_TILE_ROWS} rows "
         f"(outputs included); the float32 stack would be {stack_bytes / 1e6:.0f} MB. Timings "
         "use the default band (256 MB budget).",

@@ -44,17 +44,31 @@ def _atomic_write(path: Path, data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
+#: Compression of the linear TIFFs a session writes. None (uncompressed) since 2026-11-24:
+#: zlib took 1–1.8 s per 2.5-megapixel frame to write and 0.2–0.3 s to decode each time a fit
+#: read it — most of `rti-rig fit`'s time (docs/benchmarks.md) — for files only 10–40 % smaller
+#: (16-bit sensor noise compresses poorly). Readers accept both (core/tiff_rows.py).
+LINEAR_TIFF_COMPRESSION: str | None = None
+#: Rows per strip of an uncompressed linear TIFF: readers fetch a band of rows in one read.
+LINEAR_TIFF_ROWS_PER_STRIP = 64
+
+
 def write_linear_tiff(
-    path: Path, pixels: NDArray[np.uint16], description: str | None = None
+    path: Path,
+    pixels: NDArray[np.uint16],
+    description: str | None = None,
+    compression: str | None = LINEAR_TIFF_COMPRESSION,
 ) -> str:
     """Write a linear 16-bit TIFF (``description`` goes into ImageDescription); returns its
-    SHA-256."""
+    SHA-256. ``compression``: None (default, see :data:`LINEAR_TIFF_COMPRESSION`) or "zlib"."""
     import io
 
     buf = io.BytesIO()
     photometric = "rgb" if pixels.ndim == 3 else "minisblack"
-    extra = {"description": description, "metadata": None} if description else {}
-    tifffile.imwrite(buf, pixels, photometric=photometric, compression="zlib", **extra)
+    extra: dict[str, object] = {"description": description, "metadata": None} if description else {}
+    if compression is None:
+        extra["rowsperstrip"] = LINEAR_TIFF_ROWS_PER_STRIP
+    tifffile.imwrite(buf, pixels, photometric=photometric, compression=compression, **extra)
     return _atomic_write(path, buf.getvalue())
 
 

@@ -1,10 +1,11 @@
 """Rows of a TIFF on demand: a captured image read a band at a time, never whole.
 
-A session's ``linear/*.tif`` are 16-bit, zlib-compressed in strips (tifffile's default). A fit
-streams through bands of rows of all images; decoding whole frames would hold the acquisition
-in memory. :class:`TiffRows` decodes only the strips that cover the rows asked for (keeping the
-last strip, since bands rarely align with strips) and otherwise falls back to reading the
-image whole — correct for any TIFF, lean for the ones rti-rig writes.
+A session's ``linear/*.tif`` are 16-bit, uncompressed (sessions written before 2026-11-24:
+zlib-compressed in strips). A fit streams through bands of rows of all images; decoding whole
+frames would hold the acquisition in memory. :class:`TiffRows` reads only the rows asked for
+(uncompressed: straight from their byte offsets) or decodes only the strips that cover them
+(zlib: keeping the last strip, since bands rarely align with strips), and otherwise falls back
+to reading the image whole — correct for any TIFF, lean for the ones rti-rig writes.
 """
 
 from __future__ import annotations
@@ -45,7 +46,9 @@ class TiffRows:
             self._compressed = comp != 1
             self._offsets = list(page.dataoffsets)
             self._counts = list(page.databytecounts)
-            self._rows_per_strip = int(page.rowsperstrip) if lean else 0
+            rps = int(page.rowsperstrip) if lean else 0
+            # tifffile reports rowsperstrip 0 or more than the height for a single strip
+            self._rows_per_strip = min(rps, self.shape[0]) if rps > 0 else self.shape[0]
         self._lean = lean
         self._full: NDArray[Any] | None = None
         self._cache: dict[int, NDArray[Any]] = {}
@@ -53,6 +56,12 @@ class TiffRows:
 
     def __len__(self) -> int:
         return self.shape[0]
+
+    @property
+    def reads_in_place(self) -> bool:
+        """True when rows are read straight from the file (uncompressed strips): nothing to
+        decode, so nothing gained by decoding the file once elsewhere."""
+        return self._lean and not self._compressed
 
     def _strip(self, k: int) -> NDArray[Any]:
         got = self._cache.get(k)
@@ -69,6 +78,28 @@ class TiffRows:
         self._cache = {k: arr}  # bands move forward: only the last strip is worth keeping
         return arr
 
+    def _raw_rows(self, start: int, stop: int) -> NDArray[Any]:
+        """Rows of an uncompressed TIFF read from their offsets: one read per strip touched."""
+        rps = self._rows_per_strip
+        row_bytes = int(np.prod(self._row_shape)) * self.dtype.itemsize
+        out = np.empty((stop - start, *self._row_shape), dtype=self.dtype)
+        view = memoryview(out.reshape(-1).view(np.uint8))
+        fd = os.open(self.path, os.O_RDONLY)
+        try:
+            pos = 0
+            for k in range(start // rps, (stop - 1) // rps + 1):
+                lo = max(start, k * rps)
+                hi = min(stop, (k + 1) * rps)
+                want = (hi - lo) * row_bytes
+                at = self._offsets[k] + (lo - k * rps) * row_bytes
+                got = os.preadv(fd, [view[pos : pos + want]], at)
+                if got != want:
+                    raise OSError(f"{self.path}: short read in strip {k} ({got} of {want} bytes)")
+                pos += want
+        finally:
+            os.close(fd)
+        return out
+
     def __getitem__(self, key: Any) -> NDArray[Any]:
         if not self._lean or not isinstance(key, slice):
             if self._full is None:
@@ -77,6 +108,8 @@ class TiffRows:
         start, stop, step = key.indices(self.shape[0])
         if step != 1 or stop <= start:
             return self[:][key] if step != 1 else np.empty((0, *self._row_shape), self.dtype)
+        if not self._compressed:
+            return self._raw_rows(start, stop)
         rps = self._rows_per_strip
         parts = []
         for k in range(start // rps, (stop - 1) // rps + 1):

@@ -167,10 +167,13 @@ def fit_coefficients(
         band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
         r = band.shape[1]
         flat = band.reshape(stack.n, -1)
-        tile = w32 @ flat
+        target = coef[:, sl].reshape(p, -1)  # a view for in-memory outputs: written in place
+        direct = np.may_share_memory(target, coef)
+        tile = np.matmul(w32, flat, out=target) if direct else w32 @ flat
         # NaN/inf in an observation propagates into its column's coefficients: find them there
-        # (p rows, not N); saturation needs one max-reduction over the band
-        bad_cols = ~np.isfinite(tile).all(axis=0)
+        # (one sum over the p rows, not N); saturation needs one max-reduction over the band
+        with np.errstate(invalid="ignore", over="ignore"):
+            bad_cols = ~np.isfinite(np.add.reduce(tile, axis=0))
         hit = stack.suspect_columns(flat)
         if hit is not None:
             bad_cols |= hit
@@ -186,8 +189,9 @@ def fit_coefficients(
             tile[:, cols] = sub
             missing += cols.size
             unfitted += int((~ok).sum())
-        tile = tile.reshape(p, r, stack.width, stack.channels)
-        coef[:, sl] = tile[..., 0] if stack.grey else tile
+        if not direct:
+            tile = tile.reshape(p, r, stack.width, stack.channels)
+            coef[:, sl] = tile[..., 0] if stack.grey else tile
     if missing:
         report = replace(report, pixels_with_missing=missing, pixels_unfitted=unfitted)
     return coef, report

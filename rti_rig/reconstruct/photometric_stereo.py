@@ -112,44 +112,69 @@ class PSResult:
         }
 
 
-def _sym3_inverse_and_cond(
-    m: NDArray[np.float64],
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Inverse and eigenvalue ratio of symmetric PSD 3 × 3 matrices packed as (P, 9).
+#: Index pairs of the 6 distinct entries of a symmetric 3 × 3 matrix, in the order used below.
+_SYM6 = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
-    Closed forms (adjugate; trigonometric eigenvalues) are ~20× faster than batched LAPACK
-    for millions of 3 × 3 systems. Singular matrices get ratio inf and a zero inverse.
+
+def _light_products(lights: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``l_i l_j`` of each light for the 6 distinct entries of ``l l^T``: (N, 6)."""
+    return np.stack([lights[:, i] * lights[:, j] for i, j in _SYM6], axis=1)
+
+
+def _normal_equations(
+    g: NDArray[np.float32], w: NDArray[np.bool_], lights: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """``sum_k w_k l_k l_k^T`` (6, P) in float64 (near-singular subsets must be detected),
+    ``sum_k w_k I_k l_k`` (3, P) and the count of used observations (P,), for pixel-major
+    ``g``, ``w`` (P, N)."""
+    m = np.ascontiguousarray((w.astype(np.float64) @ _light_products(lights)).T)
+    rhs = (np.where(w, g, np.float32(0.0)) @ lights.astype(np.float32)).T.astype(np.float64)
+    return m, rhs, w.sum(axis=1)
+
+
+def _solve_normal_equations(
+    m: NDArray[np.float64], rhs: NDArray[np.float64], count: NDArray[Any], cond_limit: float
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Solve the symmetric PSD systems ``m`` (6, P) ``b = rhs`` (3, P) in closed form.
+
+    Adjugate and trigonometric eigenvalues (Smith 1961), component by component on contiguous
+    rows: ~20× faster than batched LAPACK for millions of 3 × 3 systems. Returns b (P, 3)
+    (zero where unsolvable) and solvable (P,): at least 3 observations and an eigenvalue ratio
+    within ``cond_limit**2`` (the condition number of the light subset within ``cond_limit``).
     """
-    a, b, c = m[:, 0], m[:, 1], m[:, 2]
-    d, e, f = m[:, 4], m[:, 5], m[:, 8]
-    # symmetric: [[a b c] [b d e] [c e f]]
+    a, b, c, d, e, f = m
     co_a = d * f - e * e
     co_b = c * e - b * f
     co_c = b * e - c * d
-    det = a * co_a + b * co_b + c * co_c
     co_d = a * f - c * c
     co_e = b * c - a * e
     co_f = a * d - b * b
-    # eigenvalues (Smith 1961)
+    det = a * co_a + b * co_b + c * co_c
     q = (a + d + f) / 3.0
     p1 = b * b + c * c + e * e
-    p2 = (a - q) ** 2 + (d - q) ** 2 + (f - q) ** 2 + 2.0 * p1
+    aq, dq, fq = a - q, d - q, f - q
+    p2 = aq * aq + dq * dq + fq * fq + 2.0 * p1
     p = np.sqrt(np.maximum(p2, 0.0) / 6.0)
-    ps = np.where(p > 0, p, 1.0)
-    ba, bd, bf = (a - q) / ps, (d - q) / ps, (f - q) / ps
+    pos = p > 0
+    ps = np.where(pos, p, 1.0)
+    ba, bd, bf = aq / ps, dq / ps, fq / ps
     bb, bc, be = b / ps, c / ps, e / ps
     r = (ba * (bd * bf - be * be) - bb * (bb * bf - be * bc) + bc * (bb * be - bd * bc)) / 2.0
     phi = np.arccos(np.clip(r, -1.0, 1.0)) / 3.0
-    e1 = q + 2.0 * p * np.cos(phi)
-    e3 = q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0)
-    e3 = np.where(p > 0, e3, q)
-    e1 = np.where(p > 0, e1, q)
+    e1 = np.where(pos, q + 2.0 * p * np.cos(phi), q)
+    e3 = np.where(pos, q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0), q)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(e3 > e1 * 1e-14, e1 / e3, np.inf)
     ok = np.isfinite(ratio) & (np.abs(det) > 0)
     inv_det = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    inv = np.stack([co_a, co_b, co_c, co_b, co_d, co_e, co_c, co_e, co_f], axis=1)
-    return inv * inv_det[:, None], ratio
+    ok &= (count >= 3) & (ratio <= cond_limit**2)
+    inv_det[~ok] = 0.0
+    r0, r1, r2 = rhs
+    out = np.empty((m.shape[1], 3))
+    out[:, 0] = (co_a * r0 + co_b * r1 + co_c * r2) * inv_det
+    out[:, 1] = (co_b * r0 + co_d * r1 + co_e * r2) * inv_det
+    out[:, 2] = (co_c * r0 + co_e * r1 + co_f * r2) * inv_det
+    return out, ok
 
 
 def _solve_weighted(
@@ -161,14 +186,42 @@ def _solve_weighted(
     Returns b (P, 3) and solvable (P,): at least 3 observations and a light subset whose
     condition number is within ``cond_limit``.
     """
-    ll = (lights[:, :, None] * lights[:, None, :]).reshape(-1, 9)
-    m = w.astype(np.float64) @ ll  # (P, 9), float64: near-singular subsets must be detected
-    rhs = (np.where(w, g, np.float32(0.0)) @ lights.astype(np.float32)).astype(np.float64)
-    inv, ratio = _sym3_inverse_and_cond(m)
-    ok = (w.sum(axis=1) >= 3) & (ratio <= cond_limit**2)
-    b = np.einsum("pij,pj->pi", inv.reshape(-1, 3, 3), rhs)
-    b[~ok] = 0.0
-    return b, ok
+    m, rhs, count = _normal_equations(g, w, lights)
+    return _solve_normal_equations(m, rhs, count, cond_limit)
+
+
+def _remove_observations(
+    eqs: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]],
+    pix: NDArray[np.intp],
+    light: NDArray[np.intp],
+    values: NDArray[np.float32],
+    lights: NDArray[np.float64],
+    ll6: NDArray[np.float64],
+    cols: NDArray[np.intp],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]]:
+    """The normal equations of pixels ``cols`` after removing observations (``pix`` indexing
+    into ``cols``, ``light``, their ``values``): a downdate of the few removed terms (exact in
+    float64), not a new pass over all N observations of every pixel."""
+    m, rhs, count = eqs
+    k = cols.size
+    m_c = m[:, cols]
+    for j in range(6):
+        m_c[j] -= np.bincount(pix, weights=ll6[light, j], minlength=k)
+    rhs_c = rhs[:, cols]
+    gv = values.astype(np.float64)
+    for j in range(3):
+        rhs_c[j] -= np.bincount(pix, weights=gv * lights[light, j], minlength=k)
+    count_c = count[cols] - np.bincount(pix, minlength=k)
+    return m_c, rhs_c, count_c
+
+
+def _residuals(
+    g: NDArray[np.float32], b: NDArray[np.float64], l32: NDArray[np.float32]
+) -> NDArray[np.float32]:
+    """``g - b l^T`` (A, N) float32, in the buffer of the prediction."""
+    pred = b.astype(np.float32) @ l32.T
+    np.subtract(g, pred, out=pred)
+    return pred
 
 
 def _robust_band(
@@ -183,12 +236,20 @@ def _robust_band(
     cond_limit: float,
     shadow_k: float | None,
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
-    """Robust fit of one band ``g_nm`` (N, P): b (P, 3), used observations (N, P), solvable."""
+    """Robust fit of one band ``g_nm`` (N, P): b (P, 3), used observations (N, P), solvable.
+
+    The normal equations are built once per pixel; each pass then removes the dropped
+    observations from them (a few per pixel) and re-solves only the pixels that changed.
+    """
     g = np.ascontiguousarray(g_nm.T)  # (P, N)
     w = (g > dark) & inside[:, None]
     if saturation is not None:
         w &= g < saturation
-    b, ok = _solve_weighted(g, w, lights, cond_limit)
+    eqs = _normal_equations(g, w, lights)
+    b, ok = _solve_normal_equations(*eqs, cond_limit)
+    ll6 = _light_products(lights)
+    l32 = lights.astype(np.float32)
+    m, rhs, count = eqs
     # Only pixels that dropped an observation in the last pass are refitted: most converge in
     # one or two passes, so later passes touch few pixels.
     active = np.flatnonzero(ok)
@@ -196,31 +257,41 @@ def _robust_band(
         if active.size == 0:
             break
         ga, wa = g[active], w[active]
-        resid = ga - (b[active] @ lights.T).astype(np.float32)  # (A, N)
-        thr = np.maximum(highlight_k * _robust_sigma(resid, wa), highlight_floor)
+        resid = _residuals(ga, b[active], l32)  # (A, N)
+        thr = np.maximum(highlight_k * _robust_sigma(resid, wa, count[active]), highlight_floor)
         drop = wa & (resid > thr[:, None])
-        changed = drop.any(axis=1)
-        if not changed.any():
+        pix, light = np.nonzero(drop)
+        if pix.size == 0:
             break
-        active = active[changed]
-        wa = wa[changed] & ~drop[changed]
-        w[active] = wa
-        b[active], ok[active] = _solve_weighted(g[active], wa, lights, cond_limit)
-        active = active[ok[active]]
+        hits = np.bincount(pix, minlength=active.size)
+        changed = hits > 0
+        local = np.cumsum(changed) - 1  # index of each active pixel among the changed ones
+        cols = active[changed]
+        w[active[pix], light] = False
+        m_c, rhs_c, count_c = _remove_observations(
+            (m, rhs, count), local[pix], light, ga[pix, light], lights, ll6, cols
+        )
+        m[:, cols], rhs[:, cols], count[cols] = m_c, rhs_c, count_c
+        b[cols], ok[cols] = _solve_normal_equations(m_c, rhs_c, count_c, cond_limit)
+        active = cols[ok[cols]]
     if shadow_k is not None:
         _drop_partial_shadows(
-            g, w, b, ok, lights, shadow_k, highlight_floor, max_passes, cond_limit
+            g, w, b, ok, lights, shadow_k, highlight_floor, max_passes, cond_limit, eqs
         )
     return b, w.T, ok
 
 
-def _robust_sigma(resid: NDArray, used: NDArray[np.bool_]) -> NDArray:
+def _robust_sigma(
+    resid: NDArray, used: NDArray[np.bool_], count: NDArray[Any] | None = None
+) -> NDArray:
     """1.4826 × the median |residual| over each row's used observations (0 if none)."""
-    absr = np.where(used, np.abs(resid), np.float32(np.inf))
+    absr = np.abs(resid)
+    np.copyto(absr, np.float32(np.inf), where=~used)
     absr.sort(axis=1)
-    count = used.sum(axis=1)
+    if count is None:
+        count = used.sum(axis=1)
     mid = np.clip((count - 1) // 2, 0, used.shape[1] - 1)
-    med = np.take_along_axis(absr, mid[:, None], axis=1)[:, 0]
+    med = absr[np.arange(absr.shape[0]), mid]
     return 1.4826 * np.where(count > 0, med, 0.0)
 
 
@@ -234,28 +305,39 @@ def _drop_partial_shadows(
     floor: float,
     max_passes: int,
     cond_limit: float,
+    eqs: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]] | None = None,
 ) -> None:
-    """Rule 4, in place on ``w`` (P, N), ``b`` and ``ok``: the darkest outlier per pass."""
+    """Rule 4, in place on ``w`` (P, N), ``b``, ``ok`` (and the normal equations ``eqs`` of
+    ``w``, built here when not given): the darkest outlier per pass."""
+    m, rhs, count = _normal_equations(g, w, lights) if eqs is None else eqs
+    ll6 = _light_products(lights)
+    l32 = lights.astype(np.float32)
     active = np.flatnonzero(ok)
     for _ in range(max_passes):
         if active.size == 0:
             break
         wa = w[active]
-        resid = np.where(wa, g[active] - (b[active] @ lights.T).astype(np.float32), 0.0)
-        thr = np.maximum(shadow_k * _robust_sigma(resid, wa), floor)
+        resid = _residuals(g[active], b[active], l32)
+        resid[~wa] = 0.0
+        ca = count[active]
+        thr = np.maximum(shadow_k * _robust_sigma(resid, wa, ca), floor)
         worst = np.argmin(resid, axis=1)
         low = resid[np.arange(active.size), worst]
-        drop = (low < -thr) & (wa.sum(axis=1) > SHADOW_MIN_KEPT)
+        drop = (low < -thr) & (ca > SHADOW_MIN_KEPT)
         if not drop.any():
             break
-        active, worst = active[drop], worst[drop]
-        w[active, worst] = False
-        b_new, ok_new = _solve_weighted(g[active], w[active], lights, cond_limit)
-        # a drop that leaves the pixel unsolvable (ill-conditioned subset) is undone: the
-        # pixel keeps its earlier fit rather than turning invalid
-        w[active[~ok_new], worst[~ok_new]] = True
-        b[active[ok_new]] = b_new[ok_new]
-        active = active[ok_new]
+        cols, worst = active[drop], worst[drop]
+        m_c, rhs_c, count_c = _remove_observations(
+            (m, rhs, count), np.arange(cols.size), worst, g[cols, worst], lights, ll6, cols
+        )
+        b_new, ok_new = _solve_normal_equations(m_c, rhs_c, count_c, cond_limit)
+        # a drop that leaves the pixel unsolvable (ill-conditioned subset) is not made: the
+        # pixel keeps its observation and its earlier fit rather than turning invalid
+        keep, wk = cols[ok_new], worst[ok_new]
+        w[keep, wk] = False
+        m[:, keep], rhs[:, keep], count[keep] = m_c[:, ok_new], rhs_c[:, ok_new], count_c[ok_new]
+        b[keep] = b_new[ok_new]
+        active = keep
 
 
 def _unit_normals(
@@ -299,50 +381,101 @@ def _albedo_residual_used(
     return n, alb, rms, count, ok
 
 
-def _albedo_residual_all(
-    inside: NDArray[np.bool_],
-    g: NDArray[np.float32],
+#: Bytes of observations per chunk of the least-squares pass: the chunk's (N, chunk) float32 work
+#: arrays stay in the L3 cache, so the residual's extra passes cost little beyond the product
+#: (measured: 1.5 MB gave 3.2×, 4–24 MB 3.0× a same-shape product at 512² × 48).
+LS_CHUNK_BYTES = 4 * 1024 * 1024
+#: The least-squares residual is taken from the normal equations (``I.I - 2 b.L^T I + b^T G b``)
+#: where it is at least this fraction of ``I.I``; float32 sums are exact to ~1e-6 of ``I.I``, so
+#: its relative error stays below ~1e-4 there. Smaller residuals are computed directly.
+DIRECT_RESIDUAL_FRACTION = 1e-2
+
+
+def _least_squares_band(
     flat: NDArray[np.float32],
+    g: NDArray[np.float32],
+    inside: NDArray[np.bool_],
     lights: NDArray[np.float64],
     gram: NDArray[np.float64],
     eps_b: float,
-) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
-    """Least squares over all lights with matrix products only.
+    saturation: float | None,
+    normals: NDArray[np.float32] | None = None,
+) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_], NDArray[np.intp]]:
+    """Least squares over all lights, a cache-sized chunk of pixels at a time.
 
-    ``L^T I`` is the one pass over the band for the normals (``b = (L^T L)^-1 L^T I``); with
-    every light used, ``sum_k s_k I_k = n . (L^T I)`` and ``sum_k s_k^2 = n^T (L^T L) n``, so the
-    albedo needs nothing more for grey images and one more product for colour; the residual is
-    one prediction product and one sum of squares.
+    ``flat`` (N, P, C) is the band (never written), ``g`` (N, P) its grey values. Per chunk:
+    ``L^T I`` (the one product that reads the band), ``b = (L^T L)^-1 L^T I``; with every light
+    used, the albedo is ``n . (L^T I) / n^T (L^T L) n`` (one more product for colour); the
+    residual is computed directly, ``|L b - I|`` (not as a difference of large sums, which
+    float32 cannot resolve), while the chunk is still in cache. A pixel with a NaN/infinite
+    observation (found in ``L^T I``, where it propagates) or a saturated one (one max-reduction
+    of the chunk) is returned in ``suspect`` for the caller's per-pixel path.
+
+    Returns normals (P, 3) float32 (invalid: the view axis; written into ``normals`` when
+    given), albedo (P, C), RMS residual (P,), validity (P,) and the suspect pixels' indices.
     """
-    lt32 = lights.T.astype(np.float32)
-    ltg = (lt32 @ g).T.astype(np.float64)  # (P, 3)
-    b = ltg @ np.linalg.inv(gram).T
-    n, norm, ok = _unit_normals(b, inside.copy(), eps_b)
-    ss = np.sum((n @ gram) * n, axis=1)
-    ss = np.where(ss > 0, ss, 1.0)
+    n_img, p = g.shape
     channels = flat.shape[2]
-    if channels == 1:
-        alb = (np.sum(n * ltg, axis=1) / ss)[:, None]
-    else:
-        proj = (lt32 @ flat.reshape(flat.shape[0], -1)).reshape(3, -1, channels)
-        alb = np.einsum("pi,ipc->pc", n, proj.astype(np.float64)) / ss[:, None]
-    # the residual directly (not as a difference of large sums, which float32 cannot resolve)
-    diff = lt32.T @ np.ascontiguousarray((n * norm[:, None]).T, dtype=np.float32)  # (N, P)
-    diff -= g
-    np.square(diff, out=diff)
-    rms = np.sqrt(np.add.reduce(diff, axis=0) / g.shape[0]).astype(np.float64)
-    return n, alb, rms, ok
-
-
-def _band_is_clean(band: NDArray[np.float32], saturation: float | None) -> bool:
-    """No NaN/inf and nothing saturated, by one max-reduction (NaN propagates through max):
-    the common case costs no mask of the band's size."""
-    with np.errstate(invalid="ignore"):
-        top = np.max(band.reshape(band.shape[0], -1), axis=0)
-        ok = np.isfinite(top)
-        if saturation is not None:
-            ok &= top < np.float32(saturation)
-    return bool(ok.all())
+    l32 = lights.astype(np.float32)
+    lt32 = np.ascontiguousarray(l32.T)
+    ginv32 = np.linalg.inv(gram).astype(np.float32)
+    gram32 = gram.astype(np.float32)
+    sat = None if saturation is None else np.float32(saturation)
+    if normals is None:
+        normals = np.empty((p, 3), dtype=np.float32)
+    alb = np.empty((p, channels), dtype=np.float32)
+    rms = np.empty(p, dtype=np.float32)
+    ok = np.empty(p, dtype=bool)
+    suspect = []
+    chunk = max(256, LS_CHUNK_BYTES // (4 * n_img * channels))
+    # one work buffer reused by every chunk: a fresh array of this size per chunk costs more
+    # in first-touch page faults than the arithmetic
+    work = np.empty((n_img, min(chunk, p)), dtype=np.float32)
+    with np.errstate(invalid="ignore", over="ignore"):  # NaN/inf pixels are returned as suspect
+        for s in range(0, p, chunk):
+            e = min(p, s + chunk)
+            gc = g[:, s:e]
+            ltg = lt32 @ gc  # (3, c)
+            bad = ~np.isfinite(ltg).all(axis=0)
+            if sat is not None:
+                top = np.max(flat[:, s:e].reshape(n_img, -1), axis=0)
+                bad |= (top >= sat).reshape(-1, channels).any(axis=1)
+            b = ginv32 @ ltg
+            np.maximum(b[2], np.float32(0.0), out=b[2])  # a normal facing away is unseen
+            # |L b - I|^2 = I.I - 2 b.(L^T I) + b^T (L^T L) b: one pass over the chunk (I.I)
+            # instead of a prediction; where the residual is small against the signal, float32
+            # cannot resolve that difference and the prediction is computed directly
+            gg = np.einsum("ij,ij->j", gc, gc).astype(np.float64)
+            r2 = gg - 2.0 * np.einsum("ij,ij->j", b, ltg) + np.einsum("ij,ij->j", gram32 @ b, b)
+            direct = ~(r2 >= DIRECT_RESIDUAL_FRACTION * gg)  # NaN included
+            if direct.any():
+                k = np.flatnonzero(direct)
+                if 4 * k.size > e - s:
+                    k = slice(None)
+                    sub = gc
+                else:
+                    sub = gc[:, k]
+                pred = np.matmul(l32, b[:, k], out=work[:, : sub.shape[1]])
+                pred -= sub
+                r2[k] = np.einsum("ij,ij->j", pred, pred)
+            rms[s:e] = np.sqrt(np.maximum(r2, 0.0) / n_img)
+            norm = np.sqrt(np.einsum("ij,ij->j", b, b))
+            good = inside[s:e] & ~bad & (norm > eps_b)
+            nn = b / np.where(norm > 0, norm, np.float32(1.0))
+            ss = np.einsum("ij,ij->j", gram32 @ nn, nn)
+            ss = np.where(ss > 0, ss, np.float32(1.0))
+            if channels == 1:
+                alb[s:e, 0] = np.einsum("ij,ij->j", nn, ltg) / ss
+            else:
+                proj = (lt32 @ flat[:, s:e].reshape(n_img, -1)).reshape(3, e - s, channels)
+                alb[s:e] = np.einsum("ip,ipc->pc", nn, proj) / ss[:, None]
+            nn[:, ~good] = np.array([[0.0], [0.0], [1.0]], dtype=np.float32)
+            normals[s:e] = nn.T  # transposed while the chunk is in cache
+            ok[s:e] = good
+            if bad.any():
+                suspect.append(s + np.flatnonzero(bad & inside[s:e]))
+    cols = np.concatenate(suspect) if suspect else np.zeros(0, dtype=np.intp)
+    return normals, alb, rms, ok, cols
 
 
 def fit_photometric_stereo(
@@ -388,63 +521,68 @@ def fit_photometric_stereo(
     floor = HIGHLIGHT_FLOOR_FRACTION * ref if highlight_floor is None else float(highlight_floor)
     eps_b = DARK_PIXEL_FRACTION * ref
 
-    normals = np.zeros((h, wd, 3), dtype=np.float32)
-    normals[..., 2] = 1.0
-    albedo = np.zeros((h, wd, stack.channels), dtype=np.float32)
-    residual = np.zeros((h, wd), dtype=np.float32)
-    valid = np.zeros((h, wd), dtype=bool)
-    used = np.zeros((h, wd), dtype=np.int16)
+    # every band writes every pixel of these (invalid ones too): no fill pass needed
+    normals = np.empty((h, wd, 3), dtype=np.float32)
+    albedo = np.empty((h, wd, stack.channels), dtype=np.float32)
+    residual = np.empty((h, wd), dtype=np.float32)
+    valid = np.empty((h, wd), dtype=bool)
+    used = np.empty((h, wd), dtype=np.int16)
     gram = lt.T @ lt
     # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     for sl in row_tiles(h, rows):
         band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
-        if robust or not _band_is_clean(band, stack.saturation_level):
-            bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
-        else:
-            bad = None
+        r = band.shape[1]
+        inside = inside_all[sl].ravel()
+        if not robust:
+            flat = band.reshape(stack.n, r * wd, stack.channels)
+            g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
+            n_t, alb, rms, ok, cols = _least_squares_band(
+                flat,
+                g,
+                inside,
+                lt,
+                gram,
+                eps_b,
+                stack.saturation_level,
+                normals[sl].reshape(r * wd, 3),  # a view: the normals are written in place
+            )
+            count = np.full(ok.shape, stack.n)
+            if cols.size:
+                # pixels with an excluded observation (NaN, saturated): least squares on the
+                # others only, per pixel
+                vals = flat[:, cols]  # (N, k, C) copy
+                bad_c = stack.unusable(vals)
+                if bad_c is None:  # unreachable in practice: the chunk test found them
+                    bad_c = np.zeros(vals.shape, dtype=bool)
+                vals[bad_c] = 0.0
+                usable = ~np.logical_or.reduce(bad_c, axis=2)
+                gc = channel_mean(vals) if stack.channels > 1 else vals[..., 0]
+                bc, okc = _solve_weighted(np.ascontiguousarray(gc.T), usable.T, lt, cond_limit)
+                n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
+                    bc, usable, okc, gc, vals, lt, eps_b
+                )
+                n_t[cols], alb[cols], rms[cols] = n_c, alb_c, rms_c
+                count[cols], ok[cols] = count_c, ok_c
+            alb[~ok] = 0.0
+            albedo[sl] = alb.reshape(r, wd, stack.channels)
+            rms[~ok] = 0.0
+            residual[sl] = rms.reshape(r, wd)
+            valid[sl] = ok.reshape(r, wd)
+            used[sl] = np.where(ok, count, 0).reshape(r, wd)
+            continue
+        bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
         if bad is not None:
             band = np.where(bad, np.float32(0.0), band)
-        r = band.shape[1]
         flat = band.reshape(stack.n, r * wd, stack.channels)
         g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
-        inside = inside_all[sl].ravel()
-        usable = (
-            None if bad is None else ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
+        if bad is not None:
+            usable = ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
+            g = np.where(usable, g, np.float32(-1.0))  # below any dark threshold
+        b, w, ok = _robust_band(
+            g, inside, lt, dark, saturation, highlight_k, floor, max_passes, cond_limit, shadow_k
         )
-        if robust:
-            if usable is not None:
-                inside_robust = inside
-                g = np.where(usable, g, np.float32(-1.0))  # below any dark threshold
-            else:
-                inside_robust = inside
-            b, w, ok = _robust_band(
-                g,
-                inside_robust,
-                lt,
-                dark,
-                saturation,
-                highlight_k,
-                floor,
-                max_passes,
-                cond_limit,
-                shadow_k,
-            )
-            n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
-        else:
-            n, alb, rms, ok = _albedo_residual_all(inside, g, flat, lt, gram, eps_b)
-            count = np.full(ok.shape, stack.n)
-            if usable is not None:
-                # pixels with an excluded observation: least squares on the others only
-                cols = np.flatnonzero(~usable.all(axis=0) & inside)
-                gc = np.ascontiguousarray(g[:, cols])
-                wc = usable[:, cols].T
-                bc, okc = _solve_weighted(gc.T, wc, lt, cond_limit)
-                n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
-                    bc, wc.T, okc, gc, flat[:, cols], lt, eps_b
-                )
-                n[cols], alb[cols], rms[cols] = n_c, alb_c, rms_c
-                count[cols], ok[cols] = count_c, ok_c
+        n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
         normals[sl] = n.reshape(r, wd, 3)
         albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
         residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)

@@ -31,6 +31,7 @@ for Lambert.
 
 from __future__ import annotations
 
+import threading
 import warnings
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -152,6 +153,51 @@ def solve_matrix(
     ``normalise_columns=False`` measures the design as given. ``warn=False`` records the
     warnings in the report without issuing them (model selection's folds).
     """
+    key = (
+        design.shape,
+        np.ascontiguousarray(design, dtype=np.float64).tobytes(),
+        model,
+        ill_conditioned,
+        float(cond_limit),
+        bool(normalise_columns),
+        basis,
+        float(noise_gain_limit),
+    )
+    with _SOLVED_LOCK:
+        cached = _SOLVED.get(key)
+    if cached is None:
+        cached = _solve(
+            design, model, ill_conditioned, cond_limit, normalise_columns, basis, noise_gain_limit
+        )
+        with _SOLVED_LOCK:
+            if len(_SOLVED) >= _SOLVED_MAX:
+                _SOLVED.pop(next(iter(_SOLVED)))
+            _SOLVED[key] = cached
+    w, report, categories = cached
+    if warn:
+        for category, text in zip(categories, report.warnings, strict=True):
+            warnings.warn(text, category, stacklevel=3)
+    return w.copy(), report
+
+
+#: Solve matrices of the light sets seen lately: a streamed fit asks for the same one per band,
+#: and judging it over the hemisphere (an SVD and 2000 relighting gains) costs more than
+#: fitting a small band.
+_SOLVED: dict[tuple, tuple[NDArray[np.float64], FitReport, tuple[type[Warning], ...]]] = {}
+_SOLVED_MAX = 32
+_SOLVED_LOCK = threading.Lock()
+
+
+def _solve(
+    design: NDArray[np.float64],
+    model: str,
+    ill_conditioned: IllConditioned,
+    cond_limit: float,
+    normalise_columns: bool,
+    basis: str | None,
+    noise_gain_limit: float,
+) -> tuple[NDArray[np.float64], FitReport, tuple[type[Warning], ...]]:
+    """:func:`solve_matrix` without the cache and without issuing warnings."""
     n, p = design.shape
     if n < p:
         raise ReconstructionError(
@@ -209,10 +255,8 @@ def solve_matrix(
                 f"(condition number {cond:.3g}); add lights where the set leaves gaps",
             )
         )
-    if warn:
-        for category, text in texts:
-            warnings.warn(text, category, stacklevel=3)
     report = FitReport(
         model, n, p, cond, cond_limit, regularised, lam, gain, tuple(t for _, t in texts)
     )
-    return w, report
+    w.setflags(write=False)
+    return w, report, tuple(c for c, _ in texts)

@@ -2,9 +2,10 @@
 
 Input: a session folder (``lights.lp`` and ``linear/*.tif`` 16-bit linear, as
 :mod:`rti_rig.runtime.session` writes it) or any ``.lp`` with its images beside it (16-bit TIFF
-used as linear; 8-bit JPEG/PNG decoded from sRGB). TIFFs are read a band of rows at a time
-(:class:`rti_rig.core.tiff_rows.TiffRows`); JPEG/PNG are decoded whole and held as ``uint16``.
-The stack is never held as floats; one streamed pass computes every output.
+used as linear; 8-bit JPEG/PNG decoded from sRGB). Uncompressed TIFFs are read a band of rows
+at a time in place (:class:`rti_rig.core.tiff_rows.TiffRows`); compressed ones and JPEG/PNG are
+decoded once into a temporary file and read back by rows (:class:`rti_rig.core.raw_rows.RawRows`).
+The stack is never held, as floats or otherwise; one streamed pass computes every output.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from __future__ import annotations
 import html
 import json
 import mmap
+import os
+import tempfile
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -22,10 +25,12 @@ from typing import Any
 
 import cv2
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
+from rti_rig.core.raw_rows import RawRows
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
 from rti_rig.reconstruct.errors import ReconstructionError
@@ -73,25 +78,86 @@ def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
 
 def read_image(path: Path) -> np.ndarray:
     """One image of an acquisition as uint16: a :class:`TiffRows` (rows read on demand) for
-    16-bit TIFF, else decoded whole (8-bit taken as sRGB and linearised)."""
+    16-bit TIFF, else decoded whole (8-bit taken as sRGB and linearised). The lazy Dask stack
+    reads its chunks through this, in the process that computes them."""
     if not path.is_file():
         raise FitInputError(f"image {path} listed in the .lp is missing")
     if path.suffix.lower() in (".tif", ".tiff"):
-        rows = TiffRows(path)  # read a band at a time by the fit, never whole
+        rows = TiffRows(path)  # read a band at a time, never whole
         if rows.dtype != np.uint16:
             raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
         return rows  # type: ignore[return-value]
+    img = _decode(path)
+    return _SRGB_TO_LINEAR16[img] if img.dtype == np.uint8 else img
+
+
+def _decode(path: Path) -> np.ndarray:
+    """A compressed image decoded whole: uint16 linear TIFF, or 8-/16-bit JPEG/PNG (RGB)."""
+    if path.suffix.lower() in (".tif", ".tiff"):
+        img = np.asarray(TiffRows(path)[:])
     else:
         img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
         if img is None:
             raise FitInputError(f"cannot read image {path}")
         if img.ndim == 3:
             img = img[..., ::-1]
-    if img.dtype == np.uint8:
-        img = _srgb_to_linear16(img)
-    if img.dtype != np.uint16:
+    if img.dtype not in (np.uint8, np.uint16):
         raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
     return np.ascontiguousarray(img)
+
+
+#: 8-bit sRGB code value -> linear 16-bit (JPEG/PNG inputs are decoded from sRGB).
+_SRGB_TO_LINEAR16 = _srgb_to_linear16(np.arange(256, dtype=np.uint8))
+
+
+def _open_frames(paths: list[Path], label: str) -> list[Any]:
+    """Row-readable frames (uint16 linear) of ``paths``, each decoded at most once.
+
+    Uncompressed 16-bit TIFFs (what sessions write) are read in place a band of rows at a
+    time (:class:`TiffRows`). Compressed ones (zlib TIFFs of older sessions, JPEG, PNG) are
+    decoded once, in parallel, into an unlinked temporary file and read back as
+    :class:`RawRows`: every later pass (pixel sample, fit, QA) reads rows, never decodes, and
+    nothing holds the acquisition in memory. 8-bit images are kept 8-bit there and linearised
+    on read.
+    """
+    frames: list[Any] = [None] * len(paths)
+    pending = []
+    for i, path in enumerate(paths):
+        if not path.is_file():
+            raise FitInputError(f"image {path} listed in the .lp is missing")
+        if path.suffix.lower() in (".tif", ".tiff"):
+            rows = TiffRows(path)
+            if rows.dtype != np.uint16:
+                raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
+            if rows.reads_in_place:
+                frames[i] = rows
+                continue
+        pending.append(i)
+    if not pending:
+        return frames
+    first = _decode(paths[pending[0]])
+    shape, stored = first.shape, first.dtype
+    size = first.nbytes
+    # unlinked at once: gone when the last frame reading it is released
+    store = tempfile.TemporaryFile(prefix="rti-rig-decoded-")  # noqa: SIM115
+    lut = _SRGB_TO_LINEAR16 if stored == np.uint8 else None
+
+    def put(k: int, img: np.ndarray | None = None) -> None:
+        i = pending[k]
+        img = _decode(paths[i]) if img is None else img
+        if img.shape != shape or img.dtype != stored:
+            raise FitInputError(
+                f"images of {label} differ: {paths[i].name} is {img.shape} {img.dtype}, "
+                f"{paths[pending[0]].name} is {shape} {stored}"
+            )
+        os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), k * size)
+        frames[i] = RawRows(store, k * size, shape, stored, lut, name=str(paths[i]))
+
+    put(0, first)
+    del first
+    with ThreadPoolExecutor(max_workers=os.cpu_count() or 2, thread_name_prefix="decode") as ex:
+        list(ex.map(put, range(1, len(pending))))
+    return frames
 
 
 def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[str]]:
@@ -117,10 +183,11 @@ def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[
     return lp, lights, paths, names
 
 
-def load_acquisition(source: Path) -> tuple[list[np.ndarray], np.ndarray, list[str], str]:
-    """Frames (uint16), lights (N, 3), image names, and a description of what was read."""
+def load_acquisition(source: Path) -> tuple[list[Any], np.ndarray, list[str], str]:
+    """Frames (row-readable, uint16 linear), lights (N, 3), image names, and a description
+    of what was read."""
     lp, lights, paths, names = acquisition_files(source)
-    frames = [read_image(path) for path in paths]
+    frames = _open_frames(paths, str(lp))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
         raise FitInputError(f"images of {lp} differ in shape: {sorted(shapes)}")
@@ -185,7 +252,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
 SAMPLE_PIXELS = 30_000
 #: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
 #: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
-BAND_BUDGET_BYTES = 24 * 1024 * 1024
+BAND_BUDGET_BYTES = 8 * 1024 * 1024
 
 
 def _fit_all(
@@ -269,17 +336,27 @@ def _fit_all(
         reference_level=ref,
         grey=stack.grey,
     )
-    with warnings.catch_warnings():
+    written = 0
+    row_bytes = wd * (3 + (1 if stack.grey else stack.channels)) * 4 if req.write_normals else 0
+    tiles = list(row_tiles(h, rows))
+    # one BLAS thread: the fit is many small products over cache-sized chunks, where threaded
+    # BLAS spends more in start-up and (on a shared machine) spinning than it computes, and
+    # the second core decodes/reads the next band meanwhile. A Dask runner started inside reads
+    # this count (blas_threads) and fits its bands with it, so its outputs stay identical.
+    with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
         warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
-        for sl, fitted in bands(stack, plan, list(row_tiles(h, rows))):
+        for sl, fitted in bands(stack, plan, tiles):
             for key, writer in writers.items():
                 writer.write_rows(sl.start, fitted.coefficients[key])
             if fitted.normals is not None:
                 normals[sl], albedo[sl] = fitted.normals, fitted.albedo
             for category, text in fitted.warnings:  # from a band fitted in another process
                 warnings.warn(text, category, stacklevel=1)
-            _release(normals)  # written pages go to the file, not the resident set
-            _release(albedo)
+            written += (sl.stop - sl.start) * row_bytes
+            if written >= RELEASE_BYTES or sl.stop == h:
+                _release(normals)  # written pages go to the file, not the resident set
+                _release(albedo)
+                written = 0
     for writer in writers.values():
         files.append(writer.close())
     normals.flush()
@@ -292,6 +369,11 @@ def _fit_all(
         (out / "normals.npy").unlink()
         (out / "albedo.npy").unlink()
     return FitResult(out, model_name, reason_line, files)
+
+
+#: Written map pages are flushed and dropped from memory once this many have accumulated (each
+#: flush is a synchronous write: per band, it cost more than the fit of the band).
+RELEASE_BYTES = 16 * 1024 * 1024
 
 
 def local_bands(

@@ -1,0 +1,117 @@
+"""`rti-rig fit` reads every input kind once and the same: uncompressed TIFF sessions (written
+now), zlib TIFF sessions (written before 2026-11-24), and JPEG acquisitions beside an ``.lp``.
+Also the two row readers the fit streams through, against the arrays they hold."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import tifffile
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff
+from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+from rti_rig.core.raw_rows import RawRows
+from rti_rig.core.tiff_rows import TiffRows
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from fit_sessions import make_session
+
+runner = CliRunner()
+FIT = ["--model", "ps", "--no-qa", "--no-ptm", "--no-hsh"]
+
+
+def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.degrees(np.arccos(np.clip(np.sum(a * b, axis=-1), -1.0, 1.0)))
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("inputs")
+    session, _, _ = make_session(root / "tiff", size=(96, 112))
+    zlib, jpeg = root / "zlib", root / "jpeg"
+    (zlib / "linear").mkdir(parents=True)
+    jpeg.mkdir()
+    shutil.copy(session / "lights.lp", zlib / "lights.lp")
+    entries = []
+    for e in read_lp(session / "lights.lp"):
+        stem = Path(e.name).stem
+        px = tifffile.imread(session / "linear" / f"{stem}.tif")
+        write_linear_tiff(zlib / "linear" / f"{stem}.tif", px, compression="zlib")
+        srgb = linear_to_srgb8(px, 65535)
+        cv2.imwrite(str(jpeg / f"{stem}.jpg"), srgb[..., ::-1], [cv2.IMWRITE_JPEG_QUALITY, 98])
+        entries.append(LpEntry(f"{stem}.jpg", e.direction))
+    write_lp(jpeg / "acquisition.lp", entries)
+    return {"tiff": session, "zlib": zlib, "jpeg": jpeg / "acquisition.lp"}
+
+
+def _fit(source: Path, out: Path) -> tuple[np.ndarray, np.ndarray]:
+    r = runner.invoke(app, ["fit", str(source), "--out", str(out), *FIT])
+    assert r.exit_code == 0, r.output
+    return np.load(out / "normals.npy"), np.load(out / "albedo.npy")
+
+
+def test_sessions_now_write_uncompressed_tiffs_read_in_place(inputs: dict[str, Path]) -> None:
+    tif = next((inputs["tiff"] / "linear").glob("*.tif"))
+    with tifffile.TiffFile(tif) as tf:
+        assert int(tf.pages[0].compression) == 1
+    assert TiffRows(tif).reads_in_place
+    old = next((inputs["zlib"] / "linear").glob("*.tif"))
+    assert not TiffRows(old).reads_in_place
+
+
+def test_old_zlib_sessions_fit_exactly_like_new_ones(inputs: dict[str, Path], tmp_path) -> None:
+    n_new, a_new = _fit(inputs["tiff"], tmp_path / "new")
+    n_old, a_old = _fit(inputs["zlib"], tmp_path / "old")
+    np.testing.assert_array_equal(n_old, n_new)
+    np.testing.assert_array_equal(a_old, a_new)
+
+
+def test_jpeg_acquisition_fits_like_the_linear_session(inputs: dict[str, Path], tmp_path) -> None:
+    """8-bit sRGB quantisation and JPEG loss only: normals within a degree (median)."""
+    n_tif, _ = _fit(inputs["tiff"], tmp_path / "tif")
+    n_jpg, _ = _fit(inputs["jpeg"], tmp_path / "jpg")
+    assert float(np.median(_angles(n_jpg, n_tif))) < 1.0
+
+
+@pytest.mark.parametrize("compression", [None, "zlib"])
+def test_tiff_rows_return_the_rows_asked_for(tmp_path: Path, compression: str | None) -> None:
+    rng = np.random.default_rng(0)
+    for shape in [(301, 207, 3), (130, 77)]:
+        a = rng.integers(0, 65535, shape).astype(np.uint16)
+        path = tmp_path / f"{compression}_{len(shape)}.tif"
+        write_linear_tiff(path, a, compression=compression)
+        rows = TiffRows(path)
+        for sl in [slice(0, shape[0]), slice(5, 70), slice(63, 65), slice(shape[0] - 1, None)]:
+            np.testing.assert_array_equal(rows[sl], a[sl])
+        np.testing.assert_array_equal(np.asarray(rows), a)
+
+
+def test_raw_rows_read_back_what_was_written_and_map_through_the_lut() -> None:
+    rng = np.random.default_rng(1)
+    a = rng.integers(0, 255, (40, 30, 3)).astype(np.uint8)
+    b = rng.integers(0, 65535, (40, 30, 3)).astype(np.uint16)
+    lut = (np.arange(256, dtype=np.uint16) * 7).astype(np.uint16)
+    with tempfile.TemporaryFile() as store:
+        store.write(a.tobytes())
+        store.write(b.tobytes())
+        store.flush()
+        ra = RawRows(store, 0, a.shape, a.dtype, lut)
+        rb = RawRows(store, a.nbytes, b.shape, b.dtype)
+        assert ra.dtype == np.uint16 and rb.dtype == np.uint16
+        np.testing.assert_array_equal(ra[3:17], lut[a[3:17]])
+        np.testing.assert_array_equal(rb[39:40], b[39:40])
+        np.testing.assert_array_equal(np.asarray(rb), b)
+        np.testing.assert_array_equal(rb[::2], b[::2])
+        band = np.empty((14, 30, 3), dtype=np.float32)
+        ra.rows_float32(slice(3, 17), 1 / 65535, band)
+        np.testing.assert_allclose(band, lut[a[3:17]] / np.float32(65535), rtol=1e-6)
+        rb.rows_float32(slice(3, 17), 0.5, band)
+        np.testing.assert_array_equal(band, b[3:17] * np.float32(0.5))
