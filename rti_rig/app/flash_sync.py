@@ -17,6 +17,7 @@ Everything that would fire the camera outside the sequence steps the dome too, s
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
 
@@ -160,18 +161,59 @@ class SlipGuard:
             f"{before} only. {rewind}"
         )
 
+    def end_of_run(self, shoot: Callable[[], Frame], root: Path) -> list[str]:
+        """The end-of-run proof (:mod:`rti_rig.reconstruct.run_out_proof`): one more frame after
+        the last image; it must be the last LED again, and the image before must differ."""
+        from rti_rig.reconstruct.run_out_proof import prove_run_out
+        from rti_rig.reconstruct.sequence_check import reduce_image
 
-def keep_unlabelled(root: Path, index: int, frame: Frame, verdict: dict[str, Any]) -> str:
-    """Write a slipped image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the verdict)."""
+        n, fw = self.geometry.count, self.settings.firmware_led_count
+        images = self.checker.accepted_images
+        if n < fw:
+            return [
+                f"end-of-run proof NOT done: the order lists {n} of the {self.settings.firmware} "
+                f"firmware's {fw} LEDs, so the dome has not run out after image {n} and no frame "
+                "can show that its order held. A double step the per-image check did not see "
+                "would leave lights.lp mislabelled unnoticed (docs/domes.md); the run is not "
+                f"verified. List all {fw} LEDs of the order to get the proof"
+            ]
+        if len(images) != n or n < 3:
+            return ["end-of-run proof NOT done: the run's images were not all checked"]
+        frame = shoot()
+        proof = prove_run_out(images, reduce_image(frame.pixels, frame.white_level))
+        kept = keep_unlabelled(Path(root), n, frame, proof.to_json(), stem="proof")
+        if proof.proved:
+            return [
+                f"end-of-run proof passed: {proof.reason}. The proof frame is kept, "
+                f"unlabelled, as {kept}"
+            ]
+        what = (
+            "cannot verify the dome's order"
+            if proof.kind == "cannot-verify"
+            else ("a slip happened somewhere in the run")
+        )
+        raise LightSlipError(
+            f"end-of-run proof failed — {what}: {proof.reason}. The labels in lights.lp may be "
+            f"mislabelled (every image from the unseen slip on): do not use this session. The "
+            f"proof frame is kept, unlabelled, as {kept}. The dome's count no longer matches "
+            "the session: long-press its start button to rewind it, then start a new session"
+        )
+
+
+def keep_unlabelled(
+    root: Path, index: int, frame: Frame, verdict: dict[str, Any], stem: str = "image"
+) -> str:
+    """Write a slipped (or proof) image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the
+    verdict)."""
     from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
 
     folder = root / UNLABELLED_DIR
     folder.mkdir(parents=True, exist_ok=True)
-    base = f"image_{index + 1:03d}"
+    base = f"{stem}_{index + 1:03d}"
     tif = folder / f"{base}.tif"
     n = 2
     while tif.exists():  # never overwrite a kept image
-        base = f"image_{index + 1:03d}_{n}"
+        base = f"{stem}_{index + 1:03d}_{n}"
         tif, n = folder / f"{base}.tif", n + 1
     write_linear_tiff(tif, frame.pixels)
     write_srgb_jpeg(folder / f"{base}.jpg", linear_to_srgb8(frame.pixels, frame.white_level))
@@ -222,7 +264,16 @@ def build_flash_sync_rig(loaded, geometry: DomeGeometry, clock: Clock, camera=No
     emulated = camera is None
     if emulated:
         camera = emulated_flash_sync_camera(loaded, geometry, clock)
-    rig = Rig(loaded, geometry, lighting, camera, clock, capture_check=SlipGuard(geometry, fs))
+    guard = SlipGuard(geometry, fs)
+    rig = Rig(
+        loaded,
+        geometry,
+        lighting,
+        camera,
+        clock,
+        capture_check=guard,
+        end_check=guard.end_of_run,
+    )
     if emulated:
         rig.emulator = camera.dome  # type: ignore[attr-defined]  # the truth, for tests
     return rig
