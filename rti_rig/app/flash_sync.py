@@ -7,7 +7,10 @@ only shoots. Each image is judged (:mod:`rti_rig.reconstruct.sequence_check`) be
 is committed; on a missed or double step the image is kept in ``unlabelled/``, the session stops
 with :class:`~rti_rig.runtime.flash_sync.LightSlipError` naming the image and the slip, and
 ``lights.lp`` lists only the images before it, which were correctly labelled as far as the
-check can tell.
+check can tell. After the last image of an order that lists all the firmware's LEDs, one more
+frame is shot (:meth:`SlipGuard.end_of_run`): the firmware, run out, re-lights its last LED,
+which proves no step was doubled unseen anywhere in the run
+(:mod:`rti_rig.reconstruct.run_out_proof`); if it does not, the run is disowned (exit 2).
 
 Everything that would fire the camera outside the sequence steps the dome too, so it is refused:
 ``--lights`` other than the whole order, ``--plan``, ``--adaptive``, ``--auto-exposure``
@@ -330,6 +333,15 @@ def check_lines(loaded, geometry: DomeGeometry) -> list[str]:  # type: ignore[no
         "leave its camera-trigger cable unplugged, so that only rti-rig fires the camera",
         "  each image is checked against its LED before it is labelled (a missed or double "
         f"step stops the run; the neighbour test starts after {fs.check_after_images} images)",
+        (
+            "  after the last image one more flash is shot, the proof frame (kept in "
+            "unlabelled/, never labelled): the firmware must re-light its last LED, which proves "
+            "no step was doubled anywhere in the run"
+            if geometry.count == fs.firmware_led_count
+            else f"  the order stops before the firmware's last LED ({geometry.count} of "
+            f"{fs.firmware_led_count}): the end-of-run proof cannot be done, so a double step "
+            "the per-image check misses would go unnoticed (the run says 'not verified')"
+        ),
     ]
 
 
