@@ -8,6 +8,7 @@ correctly labelled images.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -94,6 +95,8 @@ def test_a_clean_run_labels_every_image_with_the_led_that_lit_it(tmp_path: Path,
     assert proof.with_suffix(".tif").is_file() and proof.with_suffix(".json").is_file()
     assert "proof" not in (out / "lights.lp").read_text(encoding="utf-8")
     assert len(list(out.glob("image_*.jpg"))) == 60
+    manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    assert "end-of-run proof passed" in manifest["runner"]["end_check"][0]
 
 
 @pytest.mark.parametrize(
