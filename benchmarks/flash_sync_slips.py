@@ -10,9 +10,12 @@ root builds, the controller, the slip guard) into a temporary folder; then the e
 Printed per scene and fault: how many slips were caught **at the slipped image** (nothing
 mislabelled), **late with the session disowned** (the images between are in ``lights.lp`` with
 wrong lights, and the error says "do not use this session"), **late** (wrong lights in
-``lights.lp`` and the error does not say so), or **never**, and how many clean sessions raised a
-false alarm; then the wall time of one check on 512 × 512 px frames.
-Run: ``python -m benchmarks.flash_sync_slips`` (``--quick``: fewer positions).
+``lights.lp`` and the error does not say so), **by the end-of-run proof** (the proof frame
+shot after the last image showed the dome ran out early; the session disowned), or **never**,
+and how many clean sessions raised a false alarm; then the wall time of one check on
+512 × 512 px frames.
+Run: ``python -m benchmarks.flash_sync_slips`` (``--quick``: fewer positions;
+``--scenes coin,painting``: only those scenes; ``--kinds double_step``: only that fault).
 """
 
 from __future__ import annotations
@@ -49,11 +52,12 @@ def run_once(scene: str, fault: tuple[int, str] | None, root: Path) -> dict[str,
     rig = build_rig(loaded)
     schedule = plan_uniform(rig.geometry, rig.geometry.count, 0.0, None, 90.0)
     folder = SessionFolder.create(root, len(schedule))
-    caught, disowned = None, False
+    caught, disowned, by_proof = None, False, False
     try:
         run_session(rig, schedule, folder)
     except LightSlipError as exc:
-        caught = int(str(exc).split()[1])
+        by_proof = str(exc).startswith("end-of-run proof")
+        caught = len(schedule) + 1 if by_proof else int(str(exc).split()[1])
         disowned = "do not use this session" in str(exc)
     finally:
         rig.close()
@@ -71,7 +75,7 @@ def run_once(scene: str, fault: tuple[int, str] | None, root: Path) -> dict[str,
             led = truth[i]
             if led is None or not np.allclose(e.direction, dirs[led], atol=1e-6):
                 wrong += 1
-    return {"caught": caught, "wrong_in_lp": wrong, "disowned": disowned}
+    return {"caught": caught, "wrong_in_lp": wrong, "disowned": disowned, "by_proof": by_proof}
 
 
 def check_time_ms(side: int = 512) -> tuple[float, float]:
@@ -94,21 +98,32 @@ def check_time_ms(side: int = 512) -> tuple[float, float]:
     return float(np.median(times)), float(np.max(times))
 
 
+def _option(argv: list[str], name: str, default: tuple[str, ...]) -> tuple[str, ...]:
+    if name in argv and argv.index(name) + 1 < len(argv):
+        return tuple(v for v in argv[argv.index(name) + 1].split(",") if v)
+    return default
+
+
 def main(argv: list[str]) -> None:
     quick = "--quick" in argv
+    scenes = _option(argv, "--scenes", SCENES)
+    kinds = _option(argv, "--kinds", ("missed_pulse", "double_step"))
     positions = range(2, 60, 12) if quick else range(1, 60, 4)
-    print(f"config {CONFIG.name}; fault positions (image, 1-based): {list(positions)}")
-    totals = {"missed_pulse": [0, 0, 0, 0], "double_step": [0, 0, 0, 0]}
+    print(
+        f"config {CONFIG.name}; scenes {list(scenes)}; fault positions (image, 1-based): "
+        f"{list(positions)}"
+    )
+    totals = {kind: [0, 0, 0, 0, 0] for kind in kinds}
     false_alarms = 0
     with tempfile.TemporaryDirectory() as tmp:
         runs = 0
-        for scene in SCENES:
+        for scene in scenes:
             runs += 1
             clean = run_once(scene, None, Path(tmp) / f"r{runs}")
             false_alarms += clean["caught"] is not None or clean["wrong_in_lp"] != 0
             line = [f"{scene:9s} clean: {'FALSE ALARM' if clean['caught'] else 'ok'}"]
             for kind in totals:
-                at_slip = late = disowned = never = 0
+                at_slip = late = disowned = never = proof = 0
                 mislabelled = 0
                 for pos in positions:
                     runs += 1
@@ -116,26 +131,29 @@ def main(argv: list[str]) -> None:
                     mislabelled += int(r["wrong_in_lp"])  # type: ignore[call-overload]
                     if r["caught"] is None:
                         never += 1
+                    elif r["by_proof"]:
+                        proof += 1
                     elif r["caught"] == pos and r["wrong_in_lp"] == 0:
                         at_slip += 1
                     elif r["disowned"]:
                         disowned += 1
                     else:
                         late += 1
-                for k, v in enumerate((at_slip, disowned, late, never)):
+                for k, v in enumerate((at_slip, disowned, late, never, proof)):
                     totals[kind][k] += v
                 line.append(
                     f"{kind}: {at_slip} at the slip, {disowned} late and the session disowned, "
-                    f"{late} late, {never} never ({mislabelled} mislabelled lp entries)"
+                    f"{late} late, {proof} by the end-of-run proof (session disowned), {never} "
+                    f"never ({mislabelled} lp entries mislabelled)"
                 )
             print("; ".join(line), flush=True)
-    n = len(SCENES) * len(positions)
-    for kind, (a, disowned, late, never) in totals.items():
+    n = len(scenes) * len(positions)
+    for kind, (a, disowned, late, never, proof) in totals.items():
         print(
             f"{kind}: caught at the slipped image {a}/{n} ({a / n:.0%}), late with the session "
-            f"disowned {disowned}, late {late}, never {never}"
+            f"disowned {disowned}, late {late}, by the end-of-run proof {proof}, never {never}"
         )
-    print(f"false alarms on clean sessions: {false_alarms}/{len(SCENES)}")
+    print(f"false alarms on clean sessions: {false_alarms}/{len(scenes)}")
     median, worst = check_time_ms()
     print(f"time per check on 512 x 512 px frames: median {median:.0f} ms, max {worst:.0f} ms")
 

@@ -7,7 +7,10 @@ only shoots. Each image is judged (:mod:`rti_rig.reconstruct.sequence_check`) be
 is committed; on a missed or double step the image is kept in ``unlabelled/``, the session stops
 with :class:`~rti_rig.runtime.flash_sync.LightSlipError` naming the image and the slip, and
 ``lights.lp`` lists only the images before it, which were correctly labelled as far as the
-check can tell.
+check can tell. After the last image of an order that lists all the firmware's LEDs, one more
+frame is shot (:meth:`SlipGuard.end_of_run`): the firmware, run out, re-lights its last LED,
+which proves no step was doubled unseen anywhere in the run
+(:mod:`rti_rig.reconstruct.run_out_proof`); if it does not, the run is disowned (exit 2).
 
 Everything that would fire the camera outside the sequence steps the dome too, so it is refused:
 ``--lights`` other than the whole order, ``--plan``, ``--adaptive``, ``--auto-exposure``
@@ -17,6 +20,7 @@ Everything that would fire the camera outside the sequence steps the dome too, s
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Literal
 
@@ -160,18 +164,59 @@ class SlipGuard:
             f"{before} only. {rewind}"
         )
 
+    def end_of_run(self, shoot: Callable[[], Frame], root: Path) -> list[str]:
+        """The end-of-run proof (:mod:`rti_rig.reconstruct.run_out_proof`): one more frame after
+        the last image; it must be the last LED again, and the image before must differ."""
+        from rti_rig.reconstruct.run_out_proof import prove_run_out
+        from rti_rig.reconstruct.sequence_check import reduce_image
 
-def keep_unlabelled(root: Path, index: int, frame: Frame, verdict: dict[str, Any]) -> str:
-    """Write a slipped image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the verdict)."""
+        n, fw = self.geometry.count, self.settings.firmware_led_count
+        images = self.checker.accepted_images
+        if n < fw:
+            return [
+                f"end-of-run proof NOT done: the order lists {n} of the {self.settings.firmware} "
+                f"firmware's {fw} LEDs, so the dome has not run out after image {n} and no frame "
+                "can show that its order held. A double step the per-image check did not see "
+                "would leave lights.lp mislabelled unnoticed (docs/domes.md); the run is not "
+                f"verified. List all {fw} LEDs of the order to get the proof"
+            ]
+        if len(images) != n or n < 3:
+            return ["end-of-run proof NOT done: the run's images were not all checked"]
+        frame = shoot()
+        proof = prove_run_out(images, reduce_image(frame.pixels, frame.white_level))
+        kept = keep_unlabelled(Path(root), n, frame, proof.to_json(), stem="proof")
+        if proof.proved:
+            return [
+                f"end-of-run proof passed: {proof.reason}. The proof frame is kept, "
+                f"unlabelled, as {kept}"
+            ]
+        what = (
+            "cannot verify the dome's order"
+            if proof.kind == "cannot-verify"
+            else ("a slip happened somewhere in the run")
+        )
+        raise LightSlipError(
+            f"end-of-run proof failed — {what}: {proof.reason}. The labels in lights.lp may be "
+            f"mislabelled (every image from the unseen slip on): do not use this session. The "
+            f"proof frame is kept, unlabelled, as {kept}. The dome's count no longer matches "
+            "the session: long-press its start button to rewind it, then start a new session"
+        )
+
+
+def keep_unlabelled(
+    root: Path, index: int, frame: Frame, verdict: dict[str, Any], stem: str = "image"
+) -> str:
+    """Write a slipped (or proof) image under ``unlabelled/`` (linear TIFF, sRGB JPEG, the
+    verdict)."""
     from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
 
     folder = root / UNLABELLED_DIR
     folder.mkdir(parents=True, exist_ok=True)
-    base = f"image_{index + 1:03d}"
+    base = f"{stem}_{index + 1:03d}"
     tif = folder / f"{base}.tif"
     n = 2
     while tif.exists():  # never overwrite a kept image
-        base = f"image_{index + 1:03d}_{n}"
+        base = f"{stem}_{index + 1:03d}_{n}"
         tif, n = folder / f"{base}.tif", n + 1
     write_linear_tiff(tif, frame.pixels)
     write_srgb_jpeg(folder / f"{base}.jpg", linear_to_srgb8(frame.pixels, frame.white_level))
@@ -222,7 +267,16 @@ def build_flash_sync_rig(loaded, geometry: DomeGeometry, clock: Clock, camera=No
     emulated = camera is None
     if emulated:
         camera = emulated_flash_sync_camera(loaded, geometry, clock)
-    rig = Rig(loaded, geometry, lighting, camera, clock, capture_check=SlipGuard(geometry, fs))
+    guard = SlipGuard(geometry, fs)
+    rig = Rig(
+        loaded,
+        geometry,
+        lighting,
+        camera,
+        clock,
+        capture_check=guard,
+        end_check=guard.end_of_run,
+    )
     if emulated:
         rig.emulator = camera.dome  # type: ignore[attr-defined]  # the truth, for tests
     return rig
@@ -279,6 +333,15 @@ def check_lines(loaded, geometry: DomeGeometry) -> list[str]:  # type: ignore[no
         "leave its camera-trigger cable unplugged, so that only rti-rig fires the camera",
         "  each image is checked against its LED before it is labelled (a missed or double "
         f"step stops the run; the neighbour test starts after {fs.check_after_images} images)",
+        (
+            "  after the last image one more flash is shot, the proof frame (kept in "
+            "unlabelled/, never labelled): the firmware must re-light its last LED, which proves "
+            "no step was doubled anywhere in the run"
+            if geometry.count == fs.firmware_led_count
+            else f"  the order stops before the firmware's last LED ({geometry.count} of "
+            f"{fs.firmware_led_count}): the end-of-run proof cannot be done, so a double step "
+            "the per-image check misses would go unnoticed (the run says 'not verified')"
+        ),
     ]
 
 

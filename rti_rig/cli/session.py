@@ -295,6 +295,8 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     )
     for note in folder.manifest.get("notices") or []:
         err.print(f"[yellow]note:[/] {escape(str(note))}")
+    for note in result.notes:
+        err.print(f"[yellow]note:[/] {escape(str(note))}")
     for failure in result.teardown_failures:
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
     adaptive_result = opened.extra.get("adaptive_result")

@@ -137,6 +137,11 @@ class SequenceChecker:
     def accepted(self) -> int:
         return len(self._images)
 
+    @property
+    def accepted_images(self) -> list[NDArray[np.float32]]:
+        """The reduced images accepted so far, in order (for the end-of-run proof)."""
+        return list(self._images)
+
     def check(self, index: int, pixels: ArrayLike, white_level: float) -> SequenceVerdict:
         """Judge image ``index``; an image judged ``ok`` joins the fit for the next ones."""
         img = reduce_image(pixels, white_level)

@@ -116,6 +116,8 @@ class SessionResult:
     wall_time_s: float
     error: str | None
     teardown_failures: tuple[str, ...]
+    #: What the rig's end-of-run check says (e.g. whether a flash-stepped dome's order held).
+    notes: tuple[str, ...] = ()
 
 
 Event = StepStarted | StepCompleted | Paused
@@ -236,6 +238,7 @@ def run_session(
         **({"adaptive": source.header()} if source is not None else {}),
     }
     records: list[StepRecord] = []
+    end_notes: list[str] = []
     reason = FinishReason.ERROR
     error: str | None = None
     teardown: list[str] = []
@@ -295,6 +298,16 @@ def run_session(
             records.append(record)
             emit(StepCompleted(i, total, record))
         else:
+            if rig.end_check is not None:  # e.g. a camera-triggered dome's proof frame
+                last = schedule.steps[-1] if source is None else None
+                exposure = cam.exposure_s if last is None else step_exposure(rig, last)
+
+                def shoot(exposure: float = exposure) -> Frame:
+                    frame = rig.camera.capture(exposure)
+                    rig.lighting.off()
+                    return frame
+
+                end_notes = list(rig.end_check(shoot, folder.root))
             reason = FinishReason.COMPLETED
     except KeyboardInterrupt:
         reason, error = FinishReason.INTERRUPTED, "interrupted by the user (Ctrl-C)"
@@ -334,6 +347,7 @@ def run_session(
                         "teardown_failures": teardown,
                         "steps_planned": total,
                         "steps_done_this_run": len(records),
+                        **({"end_check": end_notes} if rig.end_check is not None else {}),
                     },
                     timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
                 )
@@ -341,4 +355,6 @@ def run_session(
                 if error is None:  # nothing else went wrong: this is the session's failure
                     raise
                 teardown.append(f"session record: {exc}")  # the first failure is the story
-    return SessionResult(reason, tuple(records), rig_time, wall_time, error, tuple(teardown))
+    return SessionResult(
+        reason, tuple(records), rig_time, wall_time, error, tuple(teardown), tuple(end_notes)
+    )

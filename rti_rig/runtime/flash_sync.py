@@ -11,6 +11,7 @@ committed (:class:`CaptureCheck`); a slip stops the session with :class:`LightSl
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
 
@@ -33,6 +34,13 @@ class CaptureCheck(Protocol):
     (after keeping the image) when it was not lit by ``actual``."""
 
     def __call__(self, index: int, frame: Frame, actual: ActualLight, root: Path) -> None: ...
+
+
+class EndCheck(Protocol):
+    """Runs once after the last image of a completed run: may ``shoot`` extra frames (each
+    steps the dome), returns notes for the user, raises :class:`LightSlipError` to disown it."""
+
+    def __call__(self, shoot: Callable[[], Frame], root: Path) -> list[str]: ...
 
 
 class CameraTriggeredLighting:

@@ -75,6 +75,10 @@ class Rig:
     #: Judges each image before its label is committed (a camera-triggered dome's
     #: :class:`rti_rig.runtime.flash_sync.CaptureCheck`); None: labels are what was commanded.
     capture_check: Callable[..., None] | None = None
+    #: Called once after the last step of a completed run with a function that shoots one more
+    #: frame and the session folder; returns notes for the user, or raises to disown the run
+    #: (a camera-triggered dome's end-of-run proof, :class:`rti_rig.runtime.flash_sync.EndCheck`).
+    end_check: Callable[..., list[str]] | None = None
 
     def bind_session(self, root: Path) -> None:
         """Tell the devices which session folder this run writes (before ``connect``)."""

@@ -8,6 +8,7 @@ correctly labelled images.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -73,6 +74,7 @@ def test_check_says_what_it_cannot_test_and_shoots_nothing(rigs) -> None:  # typ
     assert "camera-triggered (cceh-rti)" in result.output
     assert "cannot light its LEDs" in result.output
     assert "long-press" in result.output
+    assert "the proof frame" in " ".join(result.output.split())
     assert rigs[0].camera.exposures == 0  # a shot would have stepped the dome
     assert rigs[0].camera.dome.led_index == 0
 
@@ -82,9 +84,19 @@ def test_a_clean_run_labels_every_image_with_the_led_that_lit_it(tmp_path: Path,
     result = runner.invoke(app, ["run", str(SHIPPED), "--out", str(out)])
     assert result.exit_code == 0, result.output
     rig = rigs[-1]
-    assert truth(rig) == list(range(60))  # the firmware's order, one LED per exposure
+    # the firmware's order, one LED per exposure; then the proof frame re-lit the last LED
+    assert truth(rig) == [*range(60), 59]
     assert lp_matches_truth(out, rig) == 60
-    assert rig.camera.dome.led_index == 60
+    assert rig.camera.dome.led_index == 61
+    text = " ".join(result.output.split())
+    assert "end-of-run proof passed" in text and "ran out exactly at image 60" in text
+    # the proof frame is kept, never labelled
+    proof = out / "unlabelled" / "proof_061"
+    assert proof.with_suffix(".tif").is_file() and proof.with_suffix(".json").is_file()
+    assert "proof" not in (out / "lights.lp").read_text(encoding="utf-8")
+    assert len(list(out.glob("image_*.jpg"))) == 60
+    manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    assert "end-of-run proof passed" in manifest["runner"]["end_check"][0]
 
 
 @pytest.mark.parametrize(
@@ -209,3 +221,56 @@ def test_a_double_step_in_the_first_images_disowns_the_session(  # type: ignore[
     assert "stepped twice at image" in text
     assert "may be mislabelled: do not use this session" in text
     assert len(read_lp(out / "lights.lp")) <= 20  # seen within the first 21 images
+
+
+def with_scene(path: Path, scene: str) -> Path:
+    path.write_text(
+        path.read_text(encoding="utf-8").replace('name = "relief"', f'name = "{scene}"'),
+        encoding="utf-8",
+    )
+    return path
+
+
+@pytest.mark.parametrize(("scene", "at_image"), [("coin", 17), ("coin", 45), ("painting", 5)])
+def test_a_double_step_the_check_missed_is_caught_by_the_proof_frame(  # type: ignore[no-untyped-def]
+    tmp_path: Path, rigs, scene: str, at_image: int
+) -> None:
+    """On the glossy coin and the low-relief painting the per-image check misses these double
+    steps (docs/domes.md); the dome then runs out one image early, so images 59 and 60 and the
+    proof frame are all its last LED: the run is disowned, not silently mislabelled."""
+    out = tmp_path / "s"
+    cfg = with_scene(with_fault(tmp_path, at_image, "double_step"), scene)
+    result = runner.invoke(app, ["run", str(cfg), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert "end-of-run proof failed" in text and "stepped twice" in text
+    assert "do not use this session" in text and "lights.lp may be mislabelled" in text
+    rig = rigs[-1]
+    leds = truth(rig)
+    assert leds[58:] == [59, 59, 59]  # the fault was real: the dome ran out one image early
+    assert leds[at_image] == at_image + 1  # every image after the bounce was one LED ahead
+    assert (out / "unlabelled" / "proof_061.tif").is_file()  # nothing captured is lost
+    assert not (out / "unlabelled" / "image_061.tif").exists()
+
+
+def test_an_order_shorter_than_the_firmware_says_it_is_not_verified(  # type: ignore[no-untyped-def]
+    tmp_path: Path, rigs
+) -> None:
+    """With only the first 52 LEDs listed the dome has not run out after the last image: no
+    frame can prove the order held, so none is shot and the run says so."""
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text(
+        SHIPPED.read_text(encoding="utf-8").replace(
+            "{ elevation_deg = 10.0, count = 16,", "{ elevation_deg = 10.0, count = 8,"
+        ),
+        encoding="utf-8",
+    )
+    out = tmp_path / "s"
+    result = runner.invoke(app, ["run", str(cfg), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "end-of-run proof NOT done" in text and "not verified" in text
+    rig = rigs[-1]
+    assert rig.camera.exposures == 52 and rig.camera.dome.led_index == 52  # no extra flash
+    assert lp_matches_truth(out, rig) == 52
+    assert not (out / "unlabelled").exists()
