@@ -8,7 +8,8 @@ addressing, so the driver steps and checks the number the firmware prints (a mis
 step is a named error). Baud rate from EEPROM, 115200 on a fresh board: ``headers.h`` sets
 ``DEFAULT_BAUD_RATE 115200`` and its settings menu lists "115200 (Default)"; the comment in
 ``setup()`` that says 9600 is stale. A board whose EEPROM was set otherwise needs ``baudrate``
-in the rig config. Arduino Mega: resets when the port opens and prints a banner ending with ``For help, press 'h'`` and the prompt.
+in the rig config. Arduino Mega: resets when the port opens and prints a banner ending with
+``For help, press 'h'`` and the prompt.
 """
 
 SPEC = {
