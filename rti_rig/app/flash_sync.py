@@ -141,10 +141,14 @@ class SlipGuard:
         if verdict.fitted and verdict.best_position == index - 1 and index == last:
             # the firmware re-lights its last LED once its order is exhausted: it got there early
             raise LightSlipError(
-                f"image {index + 1} was lit by LED {index} again: the dome reached the end of its "
-                "sequence one image early, so it stepped twice earlier, where the check did not "
-                "see it. The labels in lights.lp from that step on are WRONG: do not use this "
-                f"session. Image {index + 1} is kept, unlabelled, as {kept}. {rewind}"
+                _disowned(
+                    root,
+                    f"image {index + 1} was lit by LED {index} again: the dome reached the end of "
+                    "its sequence one image early, so it stepped twice earlier, where the check "
+                    "did not see it. The labels in lights.lp from that step on are WRONG: do not "
+                    f"use this session. Image {index + 1} is kept, unlabelled, as {kept}.",
+                )
+                + f" {rewind}"
             )
         from rti_rig.reconstruct.sequence_check import SHIFT_FROM
 
@@ -152,10 +156,14 @@ class SlipGuard:
             # a slip in the first images is seen only some images later (docs/domes.md)
             first = max(1, verdict.since or 1)  # the slip's own image is uncertain by one
             raise LightSlipError(
-                f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
-                f"{verdict.reason}. A slip in the first images is seen only some images later, "
-                f"so images {first}–{index} in lights.lp may be mislabelled: do not use this "
-                f"session. Image {index + 1} is kept, unlabelled, as {kept}. {rewind}"
+                _disowned(
+                    root,
+                    f"image {index + 1} was not lit by LED {index + 1} of the dome's order — "
+                    f"{what}: {verdict.reason}. A slip in the first images is seen only some "
+                    f"images later, so images {first}–{index} in lights.lp may be mislabelled: "
+                    f"do not use this session. Image {index + 1} is kept, unlabelled, as {kept}.",
+                )
+                + f" {rewind}"
             )
         before = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
         raise LightSlipError(
@@ -196,11 +204,24 @@ class SlipGuard:
             else ("a slip happened somewhere in the run")
         )
         raise LightSlipError(
-            f"end-of-run proof failed — {what}: {proof.reason}. The labels in lights.lp may be "
-            f"mislabelled (every image from the unseen slip on): do not use this session. The "
-            f"proof frame is kept, unlabelled, as {kept}. The dome's count no longer matches "
-            "the session: long-press its start button to rewind it, then start a new session"
+            _disowned(
+                root,
+                f"end-of-run proof failed — {what}: {proof.reason}. The labels in lights.lp may "
+                "be mislabelled (every image from the unseen slip on): do not use this session. "
+                f"The proof frame is kept, unlabelled, as {kept}.",
+            )
+            + " The dome's count no longer matches the session: long-press its start button to "
+            "rewind it, then start a new session"
         )
+
+
+def _disowned(root: Path, reason: str) -> str:
+    """Mark the session's labels as not to be used (``fit`` and ``export-lp`` then refuse it)
+    and return the message, naming the marker."""
+    from rti_rig.runtime.disowned import disown
+
+    marker = disown(Path(root), reason)
+    return f"{reason} {marker.name} in the session says so; fit and export-lp refuse it."
 
 
 def keep_unlabelled(

@@ -221,6 +221,7 @@ def test_a_double_step_in_the_first_images_disowns_the_session(  # type: ignore[
     assert "stepped twice at image" in text
     assert "may be mislabelled: do not use this session" in text
     assert len(read_lp(out / "lights.lp")) <= 20  # seen within the first 21 images
+    assert_disowned_session_is_not_used(tmp_path, out)
 
 
 def with_scene(path: Path, scene: str) -> Path:
@@ -251,6 +252,25 @@ def test_a_double_step_the_check_missed_is_caught_by_the_proof_frame(  # type: i
     assert leds[at_image] == at_image + 1  # every image after the bounce was one LED ahead
     assert (out / "unlabelled" / "proof_061.tif").is_file()  # nothing captured is lost
     assert not (out / "unlabelled" / "image_061.tif").exists()
+    assert_disowned_session_is_not_used(tmp_path, out)
+
+
+def assert_disowned_session_is_not_used(tmp_path: Path, out: Path) -> None:
+    """The disowned session's lights.lp still lists the mislabelled images (nothing is
+    rewritten), so fit and export-lp must refuse it, naming the marker that says why."""
+    marker = out / "LABELS_NOT_VERIFIED.txt"
+    assert marker.is_file() and "do not use this session" in marker.read_text(encoding="utf-8")
+    for args in (
+        ["fit", str(out), "--out", str(tmp_path / "fitted")],
+        ["fit", str(out / "lights.lp"), "--out", str(tmp_path / "fitted2")],
+        ["export-lp", str(out), "--out", str(tmp_path / "copy.lp")],
+    ):
+        result = runner.invoke(app, args)
+        assert result.exit_code == 2, (args, result.output)
+        text = " ".join(result.output.split())
+        assert "LABELS_NOT_VERIFIED.txt" in text and "wrong lights" in text, text
+        assert "Traceback" not in result.output
+    assert not (tmp_path / "fitted").exists() and not (tmp_path / "copy.lp").exists()
 
 
 def test_an_order_shorter_than_the_firmware_says_it_is_not_verified(  # type: ignore[no-untyped-def]

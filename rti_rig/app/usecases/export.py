@@ -11,6 +11,7 @@ from pathlib import Path
 
 from rti_rig.app.output_files import check_output_file
 from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import session_lp_report
 
 
@@ -31,6 +32,7 @@ class ExportedLp:
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
+    refuse_if_disowned(req.session_dir)
     entries, left_out = session_lp_report(req.session_dir, linear=req.linear)
     check_output_file(req.out_file, req.force, {})
     write_lp(req.out_file, entries)

@@ -37,6 +37,7 @@ from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.qa import QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
+from rti_rig.runtime.disowned import refuse_if_disowned
 
 #: What ``--model`` accepts besides the registered model names.
 AUTO = "auto"
@@ -172,6 +173,7 @@ def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[
         lp = source
     else:
         raise FitInputError(f"{source}: give a session folder or an .lp file")
+    refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
     entries = read_lp(lp, upper_hemisphere=True)
     lights = directions_of(entries)
     paths, names = [], []
