@@ -30,8 +30,11 @@ from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.runtime.disowned import MARKER as DISOWN_MARKER
+from rti_rig.runtime.disowned import disown
 from rti_rig.runtime.flash_sync import CameraTriggeredLighting, LightSlipError
 from rti_rig.runtime.lighting import ActualLight
+from rti_rig.runtime.session import SessionWriteError
 
 #: What each known flash-stepped firmware does by itself (cceh/rti ``firmware/rti.cpp``).
 FIRMWARES: dict[str, dict[str, Any]] = {
@@ -127,11 +130,16 @@ class SlipGuard:
         self.verdicts: list[Any] = []
 
     def __call__(self, index: int, frame: Frame, actual: ActualLight, root: Path) -> None:
+        if not self.verdicts and not (Path(root) / DISOWN_MARKER).exists():
+            # the labels are proven only by the end-of-run proof: until it passes (it removes
+            # this), a run stopped for any reason (a missed pulse caught at its own image after
+            # an unseen double step, Ctrl-C, a camera or disk error) is not used by fit/export
+            disown(Path(root), NOT_PROVEN)
         verdict = self.checker.check(index, frame.pixels, frame.white_level)
         self.verdicts.append(verdict)
         if not verdict.slip:
             return
-        kept = keep_unlabelled(Path(root), index, frame, verdict.to_json())
+        kept = _keep(Path(root), index, frame, verdict.to_json())
         what = "missed step" if verdict.kind == "missed-step" else "double step"
         rewind = (
             "The dome's count no longer matches the session: long-press its start button to "
@@ -186,14 +194,21 @@ class SlipGuard:
                 f"firmware's {fw} LEDs, so the dome has not run out after image {n} and no frame "
                 "can show that its order held. A double step the per-image check did not see "
                 "would leave lights.lp mislabelled unnoticed (docs/domes.md); the run is not "
-                f"verified. List all {fw} LEDs of the order to get the proof"
+                f"verified, and {DISOWN_MARKER} in the session says so (fit and export-lp "
+                f"refuse it). List all {fw} LEDs of the order to get the proof"
             ]
         if len(images) != n or n < 3:
-            return ["end-of-run proof NOT done: the run's images were not all checked"]
+            return [
+                "end-of-run proof NOT done: the run's images were not all checked; "
+                f"{DISOWN_MARKER} in the session says so (fit and export-lp refuse it)"
+            ]
         frame = shoot()
         proof = prove_run_out(images, reduce_image(frame.pixels, frame.white_level))
-        kept = keep_unlabelled(Path(root), n, frame, proof.to_json(), stem="proof")
+        kept = _keep(Path(root), n, frame, proof.to_json(), stem="proof")
         if proof.proved:
+            marker = Path(root) / DISOWN_MARKER
+            if marker.read_text(encoding="utf-8").strip() == NOT_PROVEN.strip():
+                marker.unlink()  # proven: only the "not yet proven" reason was in it
             return [
                 f"end-of-run proof passed: {proof.reason}. The proof frame is kept, "
                 f"unlabelled, as {kept}"
@@ -215,11 +230,33 @@ class SlipGuard:
         )
 
 
+#: What the marker says from a flash-sync run's first image until its end-of-run proof passes.
+NOT_PROVEN = (
+    "this camera-triggered run's labels are proven only by its end-of-run proof frame, and the "
+    "run did not pass it (it stopped early, or its order is shorter than the firmware's, so no "
+    "proof was possible): a double step the per-image check did not see would leave lights.lp "
+    "mislabelled (docs/domes.md)"
+)
+
+
+def _keep(
+    root: Path, index: int, frame: Frame, verdict: dict[str, Any], stem: str = "image"
+) -> str:
+    """:func:`keep_unlabelled`, with a write failure as a named error (the session is already
+    marked as not proven, so its labels are not used either way)."""
+    try:
+        return keep_unlabelled(root, index, frame, verdict, stem)
+    except OSError as exc:
+        raise SessionWriteError(
+            f"could not keep the unlabelled {stem} {index + 1} under {root / UNLABELLED_DIR}: "
+            f"{exc}. The session is marked {DISOWN_MARKER} (its labels are not used); free "
+            "disk space and start a new session"
+        ) from None
+
+
 def _disowned(root: Path, reason: str) -> str:
     """Mark the session's labels as not to be used (``fit`` and ``export-lp`` then refuse it)
     and return the message, naming the marker."""
-    from rti_rig.runtime.disowned import disown
-
     marker = disown(Path(root), reason)
     return f"{reason} {marker.name} in the session says so; fit and export-lp refuse it."
 

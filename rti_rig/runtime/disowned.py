@@ -34,10 +34,10 @@ def refuse_if_disowned(root: Path) -> None:
     """Raise :class:`DisownedSessionError` naming the marker when ``root`` holds one."""
     marker = Path(root) / MARKER
     if marker.is_file():
-        reason = marker.read_text(encoding="utf-8").strip().splitlines()
-        first = reason[0] if reason else "(no reason recorded)"
+        reasons = marker.read_text(encoding="utf-8").strip().splitlines()
+        last = reasons[-1] if reasons else "(no reason recorded)"  # the most specific one
         raise DisownedSessionError(
             f"{root}: the images of this session may be labelled with the wrong lights, so it "
-            f"is not used: {marker} says: {first} — reshoot the object (the images are kept; "
+            f"is not used: {marker} says: {last} — reshoot the object (the images are kept; "
             f"delete {marker.name} only if you have checked every label by hand)"
         )

@@ -97,6 +97,7 @@ def test_a_clean_run_labels_every_image_with_the_led_that_lit_it(tmp_path: Path,
     assert len(list(out.glob("image_*.jpg"))) == 60
     manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
     assert "end-of-run proof passed" in manifest["runner"]["end_check"][0]
+    assert not (out / "LABELS_NOT_VERIFIED.txt").exists()  # proven: the session may be used
 
 
 @pytest.mark.parametrize(
@@ -255,11 +256,13 @@ def test_a_double_step_the_check_missed_is_caught_by_the_proof_frame(  # type: i
     assert_disowned_session_is_not_used(tmp_path, out)
 
 
-def assert_disowned_session_is_not_used(tmp_path: Path, out: Path) -> None:
+def assert_disowned_session_is_not_used(
+    tmp_path: Path, out: Path, why: str = "do not use this session"
+) -> None:
     """The disowned session's lights.lp still lists the mislabelled images (nothing is
     rewritten), so fit and export-lp must refuse it, naming the marker that says why."""
     marker = out / "LABELS_NOT_VERIFIED.txt"
-    assert marker.is_file() and "do not use this session" in marker.read_text(encoding="utf-8")
+    assert marker.is_file() and why in marker.read_text(encoding="utf-8")
     for args in (
         ["fit", str(out), "--out", str(tmp_path / "fitted")],
         ["fit", str(out / "lights.lp"), "--out", str(tmp_path / "fitted2")],
@@ -294,3 +297,25 @@ def test_an_order_shorter_than_the_firmware_says_it_is_not_verified(  # type: ig
     assert rig.camera.exposures == 52 and rig.camera.dome.led_index == 52  # no extra flash
     assert lp_matches_truth(out, rig) == 52
     assert not (out / "unlabelled").exists()
+    marker = out / "LABELS_NOT_VERIFIED.txt"  # not proven, so not used by fit / export-lp
+    assert "did not pass it" in marker.read_text(encoding="utf-8")
+
+
+def test_a_run_stopped_before_its_proof_is_not_used(tmp_path: Path, rigs) -> None:  # type: ignore[no-untyped-def]
+    """An unseen double step (coin, image 29), then a missed pulse caught at its own image 41:
+    the run stops before the end-of-run proof, with images 29–40 mislabelled in lights.lp. The
+    session must be marked from its first image on, so fit and export-lp refuse it."""
+    out = tmp_path / "s"
+    cfg = with_scene(with_fault(tmp_path, 29, "double_step"), "coin")
+    cfg.write_text(
+        cfg.read_text(encoding="utf-8")
+        + '\n[[emulator.sync_faults]]\nat_image = 41\nkind = "missed_pulse"\n',
+        encoding="utf-8",
+    )
+    result = runner.invoke(app, ["run", str(cfg), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "image 41 was not lit by LED 41" in " ".join(result.output.split())
+    rig = rigs[-1]
+    assert truth(rig)[29] == 30  # the fault was real: from the bounce on, one LED ahead
+    assert len(read_lp(out / "lights.lp")) == 40  # …and those images are listed in lights.lp
+    assert_disowned_session_is_not_used(tmp_path, out, "did not pass it")
