@@ -20,6 +20,7 @@ the package, or running the single-process fit never loads it.
 
 from __future__ import annotations
 
+import os
 import socket
 import threading
 from collections import OrderedDict
@@ -47,6 +48,19 @@ class ImageReadError(ReconstructionError):
 OPEN_CACHE_SIZE = 2
 _OPEN: OrderedDict[tuple[Any, ...], ImageStack] = OrderedDict()
 _OPEN_LOCK = threading.Lock()
+
+
+def _stamps(paths: Sequence[str]) -> tuple[tuple[int, int], ...]:
+    """Size and modification time of each file ((-1, -1) for one that cannot be seen: opening
+    it then names it)."""
+    out = []
+    for p in paths:
+        try:
+            st = os.stat(p)
+            out.append((st.st_size, st.st_mtime_ns))
+        except OSError:
+            out.append((-1, -1))
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -97,7 +111,16 @@ class StackSource:
 
     def opened(self) -> ImageStack:
         """The files opened in this process (cached: headers are parsed once per process)."""
-        key = (self.paths, self.image_shape, self.scale, self.saturation_level, self.opener)
+        # the files' stamps are part of the key: a long-lived worker must not serve the pixels
+        # of a file since rewritten at the same path (a re-exported JPEG)
+        key = (
+            self.paths,
+            _stamps(self.paths),
+            self.image_shape,
+            self.scale,
+            self.saturation_level,
+            self.opener,
+        )
         with _OPEN_LOCK:
             stack = _OPEN.get(key)
             if stack is not None:

@@ -118,3 +118,35 @@ def test_a_file_of_another_shape_is_refused(files) -> None:
     write_linear_tiff(paths[1], np.zeros((40, 23, 3), np.uint16))
     with pytest.raises(ImageReadError, match=r"im1\.tif .*shape"):
         array[:, :7].compute(scheduler="sync")
+
+
+def test_a_file_rewritten_at_the_same_path_is_read_again(tmp_path: Path) -> None:
+    """A long-lived worker keeps opened acquisitions (decoded pixels, for images that cannot be
+    read by rows); one rewritten since at the same path (a re-exported PNG) must be read again,
+    not served from the cache."""
+    import os
+
+    import cv2
+
+    from rti_rig.app.usecases.fit import read_image
+
+    rng = np.random.default_rng(5)
+    paths = [tmp_path / f"im{i}.png" for i in range(3)]
+
+    def write(level: int) -> None:
+        for p in paths:
+            img = np.clip(rng.normal(level, 3, (20, 16, 3)), 0, 255).astype(np.uint8)
+            old = p.stat().st_mtime_ns if p.exists() else None
+            cv2.imwrite(str(p), img)
+            if old is not None:  # a later stamp even on a coarse file-system clock
+                os.utime(p, ns=(old + 10**9, old + 10**9))
+
+    def mean() -> float:
+        stack = ImageStack([read_image(p) for p in paths])
+        source = StackSource.of(paths, stack, read_image)
+        return float(lazy_stack(source, tile_rows=7).compute(scheduler="threads").mean())
+
+    write(20)
+    dark = mean()
+    write(200)
+    assert mean() > 10 * dark
