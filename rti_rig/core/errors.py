@@ -35,6 +35,11 @@ class LpFormatError(RtiRigError):
         super().__init__(f"{where}: {message}")
 
 
+class ImageFileError(RtiRigError, OSError):
+    """An image file that cannot be read as its header says (truncated, a short read): named,
+    with what to do. Also an ``OSError``, so code that handles unreadable files still does."""
+
+
 class ScheduleError(RtiRigError):
     """A light schedule cannot run on this rig (found before anything moves)."""
 

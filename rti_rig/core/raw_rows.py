@@ -17,6 +17,8 @@ from typing import IO, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.core.errors import ImageFileError
+
 
 class RawRows:
     """Read-only, array-like (H, W[, C]) image stored raw at ``offset`` of ``file``."""
@@ -55,7 +57,10 @@ class RawRows:
                 self._offset + start * self._row_bytes,
             )
             if got != want:
-                raise OSError(f"{self.name}: short read of decoded rows ({got} of {want} bytes)")
+                raise ImageFileError(
+                    f"{self.name}: short read of decoded rows ({got} of {want} bytes) from the "
+                    "temporary file: is the temporary folder's disk full?"
+                )
         return out if self._lut is None or not mapped else self._lut[out]
 
     def rows_float32(self, key: slice, scale: float, out: NDArray[np.float32]) -> None:

@@ -19,6 +19,8 @@ import numpy as np
 import tifffile
 from numpy.typing import NDArray
 
+from rti_rig.core.errors import ImageFileError
+
 #: TIFF compression codes decoded strip by strip here: none, Adobe deflate, deflate.
 _STRIPPED = {1: "none", 8: "zlib", 32946: "zlib"}
 
@@ -72,7 +74,13 @@ class TiffRows:
             raw = os.pread(fd, self._counts[k], self._offsets[k])
         finally:
             os.close(fd)
-        data = zlib.decompress(raw) if self._compressed else raw
+        try:
+            data = zlib.decompress(raw) if self._compressed else raw
+        except zlib.error as exc:
+            raise ImageFileError(
+                f"{self.path}: strip {k} cannot be decompressed ({exc}): the file is truncated "
+                "or damaged; copy it again from the original, or leave it out of the .lp"
+            ) from None
         rows = len(data) // (int(np.prod(self._row_shape)) * self.dtype.itemsize)
         arr = np.frombuffer(data, dtype=self.dtype).reshape((rows, *self._row_shape))
         self._cache = {k: arr}  # bands move forward: only the last strip is worth keeping
@@ -94,7 +102,11 @@ class TiffRows:
                 at = self._offsets[k] + (lo - k * rps) * row_bytes
                 got = os.preadv(fd, [view[pos : pos + want]], at)
                 if got != want:
-                    raise OSError(f"{self.path}: short read in strip {k} ({got} of {want} bytes)")
+                    raise ImageFileError(
+                        f"{self.path}: short read in strip {k} ({got} of {want} bytes): the file "
+                        "is truncated or was changed while being read; copy it again from the "
+                        "original, or leave it out of the .lp"
+                    )
                 pos += want
         finally:
             os.close(fd)

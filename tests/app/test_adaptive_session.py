@@ -230,3 +230,32 @@ def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
     for s in journal(out):
         np.testing.assert_allclose(s["actual_direction"], source[s["led"]].direction, atol=1e-9)
     assert manifest(out)["rig"]["backend"] == "replay"
+
+
+def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """A session begun by an earlier version (another chooser) cannot be continued with the
+    same choices: refused by name, saying its images are still usable; nothing is shot."""
+    cfg, _ = uninterrupted
+    out = tmp_path / "old"
+    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 3:
+            cancel.cancel()
+
+    with rig:
+        run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    m = manifest(out)
+    m["adaptive"]["format"] = "rti-rig-adaptive/1"
+    (out / "manifest.json").write_text(json.dumps(m))
+    before = sorted(p.name for p in out.rglob("*") if p.is_file())
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert "'rti-rig-adaptive/1'" in text and "export-lp" in text and "new session" in text
+    assert sorted(p.name for p in out.rglob("*") if p.is_file() and "journal" not in p.name) == [
+        n for n in before if "journal" not in n
+    ]

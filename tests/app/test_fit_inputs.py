@@ -115,3 +115,21 @@ def test_raw_rows_read_back_what_was_written_and_map_through_the_lut() -> None:
         np.testing.assert_allclose(band, lut[a[3:17]] / np.float32(65535), rtol=1e-6)
         rb.rows_float32(slice(3, 17), 0.5, band)
         np.testing.assert_array_equal(band, b[3:17] * np.float32(0.5))
+
+
+@pytest.mark.parametrize("kind", ["tiff", "zlib"])
+def test_a_truncated_image_is_a_named_error_not_a_traceback(
+    inputs: dict[str, Path], tmp_path: Path, kind: str
+) -> None:
+    """A session copied badly (one TIFF cut short): the fit names the file and says what to do,
+    exit code 2, no traceback."""
+    session = tmp_path / kind
+    shutil.copytree(inputs[kind], session)
+    victim = sorted((session / "linear").glob("*.tif"))[3]
+    data = victim.read_bytes()
+    victim.write_bytes(data[: len(data) * 2 // 3])
+    r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "out"), *FIT])
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert victim.name in text and ("truncated" in text or "cannot" in text), text
+    assert r.exception is None or isinstance(r.exception, SystemExit)

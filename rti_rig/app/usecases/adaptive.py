@@ -492,7 +492,13 @@ def resume_adaptive_source(rig, folder) -> AdaptiveSteps:  # type: ignore[no-unt
     """The step source of an interrupted adaptive session, brought up to its last step."""
     header = folder.manifest["adaptive"]
     if header.get("format") != FORMAT:
-        raise RtiRigError(f"{folder.root}: unknown adaptive format {header.get('format')!r}")
+        raise RtiRigError(
+            f"{folder.root}: this adaptive session was begun with format "
+            f"{header.get('format')!r}, and this version of rti-rig continues only {FORMAT!r} "
+            "(its choices would differ from the ones already made). The images are kept: "
+            "`rti-rig export-lp` and `rti-rig fit` use them as they are; start a new session to "
+            "shoot more"
+        )
     plan = adaptive_plan(
         rig,
         header["max_lights"],

@@ -127,9 +127,7 @@ def dask_bands(client: Any, address: str, source: Path) -> BandRunner:
             yield from _in_threads(tasks, tiles)
         else:
             threads = blas_threads()
-            tasks = [
-                dask.delayed(fit_band_recording, pure=True)(b, plan, threads) for b in blocks
-            ]
+            tasks = [dask.delayed(fit_band_recording, pure=True)(b, plan, threads) for b in blocks]
             yield from _on_cluster(client, address, tasks, tiles)
 
     return run
@@ -198,6 +196,14 @@ def _on_cluster(
                 raise SchedulerError(
                     f"lost the Dask scheduler at {address!r} while fitting: {exc}"
                 ) from None
+            except RtiRigError:
+                raise  # a named error of the fit itself, raised on the worker
+            except Exception as exc:  # e.g. KilledWorker: a worker died on this band
+                raise SchedulerError(
+                    f"a band of the fit failed on the Dask cluster at {address!r}: "
+                    f"{type(exc).__name__}: {exc}. Check the workers' logs (memory limit?) and "
+                    "run again; finished outputs are not kept for a single-session fit"
+                ) from None
             yield tiles[outstanding.pop(future.key)[1]], fitted
             future.release()
             following = submit_next()
@@ -219,9 +225,7 @@ def run_fit_dask(req: FitRequest, scheduler: str = THREADS) -> FitResult:
 _SESSION_LOCK = threading.Lock()
 
 
-def _fit_one_task(
-    source: Path, root: Path, template: FitRequest, threads: int | None
-) -> BatchItem:
+def _fit_one_task(source: Path, root: Path, template: FitRequest, threads: int | None) -> BatchItem:
     """One session of a batch, on a worker, with ``threads`` BLAS threads (the client's: see
     :func:`rti_rig.app.usecases.fit_bands.fit_band_recording`). One session at a time per
     worker process: a fit records its warnings with ``warnings.catch_warnings``, which is
@@ -247,9 +251,7 @@ def run_batch_dask(
     every unfinished session a task of its own (run in parallel across the workers)."""
     if scheduler == THREADS:
         plan_batch(sources, root)
-        return [
-            fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources
-        ]
+        return [fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources]
     given = dict(zip([s.resolve() for s in sources], sources, strict=True))
     sources = list(given)  # absolute: workers do not share this process's working directory
     root = root.resolve()
