@@ -133,3 +133,18 @@ def test_a_truncated_image_is_a_named_error_not_a_traceback(
     text = " ".join(r.output.split())
     assert victim.name in text and ("truncated" in text or "cannot" in text), text
     assert r.exception is None or isinstance(r.exception, SystemExit)
+
+
+def test_the_dask_readers_image_of_a_jpeg_is_rows_on_disk_not_pixels_in_memory(
+    inputs: dict[str, Path],
+) -> None:
+    """A Dask worker keeps the acquisitions it opened: a JPEG must be held as rows in a
+    temporary file (RawRows), read on demand, with the plain fit's values."""
+    from rti_rig.app.usecases.fit import load_acquisition, read_image
+
+    jpg = sorted(inputs["jpeg"].parent.glob("*.jpg"))[2]
+    img = read_image(jpg)
+    assert isinstance(img, RawRows) and not isinstance(img, np.ndarray)
+    frames, _, names, _ = load_acquisition(inputs["jpeg"])
+    plain = frames[names.index(jpg.stem)]
+    np.testing.assert_array_equal(img[5:9], plain[5:9])

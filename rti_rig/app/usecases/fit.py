@@ -77,10 +77,11 @@ def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
     return lut[img]
 
 
-def read_image(path: Path) -> np.ndarray:
-    """One image of an acquisition as uint16: a :class:`TiffRows` (rows read on demand) for
-    16-bit TIFF, else decoded whole (8-bit taken as sRGB and linearised). The lazy Dask stack
-    reads its chunks through this, in the process that computes them."""
+def read_image(path: Path) -> Any:
+    """One image of an acquisition, row-readable as uint16: a :class:`TiffRows` (rows read on
+    demand) for 16-bit TIFF, else decoded once into a temporary file (:class:`RawRows`; 8-bit
+    taken as sRGB and linearised on read). The lazy Dask stack reads its chunks through this,
+    in the process that computes them."""
     if not path.is_file():
         raise FitInputError(f"image {path} listed in the .lp is missing")
     if path.suffix.lower() in (".tif", ".tiff"):
@@ -88,8 +89,17 @@ def read_image(path: Path) -> np.ndarray:
         if rows.dtype != np.uint16:
             raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
         return rows  # type: ignore[return-value]
-    img = _decode(path)
-    return _SRGB_TO_LINEAR16[img] if img.dtype == np.uint8 else img
+    return _decoded_rows(_decode(path), str(path))
+
+
+def _decoded_rows(img: np.ndarray, name: str) -> RawRows:
+    """A decoded image moved to an unlinked temporary file and read back by rows (as the plain
+    fit does, :func:`_open_frames`): a process that keeps an acquisition open (a Dask worker)
+    then holds file handles, not every image decoded (72 × 24 MP would be ~10 GB)."""
+    store = tempfile.TemporaryFile(prefix="rti-rig-decoded-")  # noqa: SIM115
+    os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), 0)
+    lut = _SRGB_TO_LINEAR16 if img.dtype == np.uint8 else None
+    return RawRows(store, 0, img.shape, img.dtype, lut, name=name)
 
 
 def _decode(path: Path) -> np.ndarray:
