@@ -84,20 +84,26 @@ def test_export_lp_lists_every_adaptive_step_not_only_the_start(
     assert [e.name for e in read_lp(lp)] == [e.name for e in read_lp(out / "lights.lp")]
 
 
+def interrupted(cfg: Path, out: Path, after_step: int):  # type: ignore[no-untyped-def]
+    """An adaptive session of up to 8 lights in ``out``, cancelled once step ``after_step``
+    (0-based) is committed, as Ctrl-C would."""
+    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == after_step:
+            cancel.cancel()
+
+    with rig:
+        return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+
+
 def test_an_interrupted_adaptive_session_resumes_to_the_same_session(
     uninterrupted: tuple[Path, Path], tmp_path: Path
 ) -> None:
     cfg, ref = uninterrupted
     out = tmp_path / "cut"
-    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 5:
-            cancel.cancel()
-
-    with rig:
-        result = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    result = interrupted(cfg, out, after_step=5)
     assert result.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 6
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
@@ -120,15 +126,7 @@ def test_a_resumed_session_whose_images_changed_is_refused(
     would now come out differently is refused, nothing moves."""
     cfg, _ = uninterrupted
     out = tmp_path / "cut"
-    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 5:
-            cancel.cancel()
-
-    with rig:
-        run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    interrupted(cfg, out, after_step=5)
     m = manifest(out)
     step = m["steps"][5]
     step["planned_direction"] = [0.0, 0.6, 0.8]  # as if another decision had been taken
@@ -239,15 +237,7 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     same choices: refused by name, saying its images are still usable; nothing is shot."""
     cfg, _ = uninterrupted
     out = tmp_path / "old"
-    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 3:
-            cancel.cancel()
-
-    with rig:
-        run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    interrupted(cfg, out, after_step=3)
     m = manifest(out)
     m["adaptive"]["format"] = "rti-rig-adaptive/1"
     (out / "manifest.json").write_text(json.dumps(m))
