@@ -36,19 +36,26 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
 SIMULATED_SCENE_EXPOSURE_S = 0.05
 
 
-def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[no-untyped-def]
-    """A camera that renders the scene under whatever light ``state`` says is really on."""
-    from rti_rig.simulator.sim_camera import SimulatedCamera
+def scene_renderer(loaded: LoadedRig):  # type: ignore[no-untyped-def]
+    """The simulator's renderer of the config's ``[scene]`` at the camera's size."""
     from rti_rig.simulator.sim_scene import renderer_for
 
     cfg = loaded.config
-    render = renderer_for(
+    return renderer_for(
         cfg.scene.name,
         cfg.camera.height,
         cfg.camera.width,
         cfg.scene.seed,
         cfg.scene.light_distance_mm,
     )
+
+
+def _simulated_camera(loaded: LoadedRig, state, clock: Clock):  # type: ignore[no-untyped-def]
+    """A camera that renders the scene under whatever light ``state`` says is really on."""
+    from rti_rig.simulator.sim_camera import SimulatedCamera
+
+    cfg = loaded.config
+    render = scene_renderer(loaded)
 
     return SimulatedCamera(
         render,

@@ -285,19 +285,12 @@ def keep_unlabelled(
 def emulated_flash_sync_camera(loaded, geometry: DomeGeometry, clock: Clock):  # type: ignore[no-untyped-def]
     """The cceh/rti emulator fired by a simulated camera's sync contact; returns the camera
     (its ``dome`` is the emulator)."""
-    from rti_rig.app.compose import SIMULATED_SCENE_EXPOSURE_S
+    from rti_rig.app.compose import SIMULATED_SCENE_EXPOSURE_S, scene_renderer
     from rti_rig.simulator.domes.cceh_rti import CcehRtiFirmware
     from rti_rig.simulator.flash_sync_camera import FlashSyncCamera, SyncFault
-    from rti_rig.simulator.sim_scene import renderer_for
 
     cfg = loaded.config
-    render = renderer_for(
-        cfg.scene.name,
-        cfg.camera.height,
-        cfg.camera.width,
-        cfg.scene.seed,
-        cfg.scene.light_distance_mm,
-    )
+    render = scene_renderer(loaded)
     powers = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
     return FlashSyncCamera(
         render,
