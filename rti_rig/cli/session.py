@@ -288,8 +288,17 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         for sig, h in previous.items():
             signal.signal(sig, h)
 
+    from rti_rig.runtime.disowned import MARKER
+
+    marker = folder.root / MARKER
+    labels = (
+        f"{LP_NAME} lists the lights that fired."
+        if not marker.is_file()
+        else f"{LP_NAME} lists the lights the images are labelled with, NOT verified: {marker} "
+        "says why (fit and export-lp refuse this session)."
+    )
     out.print(
-        f"{folder.images_kept} image(s) in the session; {LP_NAME} lists the lights that fired.\n"
+        f"{folder.images_kept} image(s) in the session; {labels}\n"
         f"Session time on the real rig: {result.rig_time_s:.1f} s"
         + (f" (simulated in {result.wall_time_s:.1f} s)" if dry else "")
     )

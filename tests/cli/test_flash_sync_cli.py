@@ -293,6 +293,8 @@ def test_an_order_shorter_than_the_firmware_says_it_is_not_verified(  # type: ig
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
     assert "end-of-run proof NOT done" in text and "not verified" in text
+    assert "lists the lights that fired" not in text  # the labels are not claimed
+    assert "labelled with, NOT verified" in text and "LABELS_NOT_VERIFIED.txt" in text
     rig = rigs[-1]
     assert rig.camera.exposures == 52 and rig.camera.dome.led_index == 52  # no extra flash
     assert lp_matches_truth(out, rig) == 52
