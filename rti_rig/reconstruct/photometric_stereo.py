@@ -32,8 +32,10 @@ normal (0, 0, 1), albedo 0) — never silently guessed. Pixels outside ``mask`` 
 pixels are invalid too. The full light set must itself be well-conditioned, or the fit is refused:
 a regularised normal would be biased towards the plane of the lights.
 
-Per-pixel systems are solved in closed form (3 × 3 adjugate, closed-form symmetric eigenvalues),
-vectorised over the band: no Python loop over pixels.
+Per-pixel systems are solved in closed form (3 × 3 adjugate, closed-form symmetric eigenvalues
+where a cheap bound cannot decide the conditioning; :mod:`rti_rig.reconstruct.normal_equations`),
+vectorised over the band: no Python loop over pixels. The robust rules are computed chunk by
+chunk in :mod:`rti_rig.reconstruct.robust_ps` (why it is built that way is said there).
 """
 
 from __future__ import annotations
@@ -304,10 +306,10 @@ def fit_photometric_stereo(
     valid = np.empty((h, wd), dtype=bool)
     used = np.empty((h, wd), dtype=np.int16)
     gram = lt.T @ lt
-    # least squares keeps a few (N, pixels) work arrays besides the float32 band; the robust
-    # fit works in cache-sized chunks and needs only the band and its grey mean
-    extra = 1 if robust else 12
-    rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + extra)
+    # the least-squares fit keeps a few (N, pixels) work arrays besides the float32 band; the
+    # robust fit works in cache-sized chunks (robust_ps.CHUNK_PIXELS) and needs less, but the
+    # same band keeps the memory figures of docs/reconstruction.md valid for both
+    rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     rules = RobustRules(
         dark=dark,
         saturation=saturation,

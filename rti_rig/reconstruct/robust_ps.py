@@ -48,7 +48,10 @@ from rti_rig.reconstruct.normal_equations import light_products, solve_normal_eq
 #: Pixels per chunk: (N, chunk) float32 work arrays of a few hundred kB each stay in the L2/L3
 #: cache through all passes (measured at 48 lights: 2048–8192 within a few per cent; smaller
 #: chunks pay numpy's per-call overhead, ~60 calls per pass).
-CHUNK_PIXELS = 8192
+CHUNK_PIXELS = 16384
+#: Above this fraction of a chunk's pixels active, a pass computes every pixel's residuals rather
+#: than gathering the active ones' columns first.
+DENSE_FRACTION = 0.6
 #: Scale of the median absolute deviation to a Gaussian sigma (as float32 in the thresholds).
 MAD_SCALE = 1.4826
 #: Stand-in for an unused observation's |residual| when a chunk's rows are sorted: finite, so
@@ -166,15 +169,26 @@ class _Chunk:
             self.m, self.rhs, self.count, rules.cond_limit, light_major=True
         )  # b (3, c)
 
-    def residuals(self, act: NDArray[np.intp]) -> NDArray[np.float32]:
-        """``g - L b`` (N, a) of the pixels ``act``, NaN where an observation is unused."""
-        if act.size == self.gn.shape[1]:
-            ga, ba = self.gn, self.b
+    def residuals(
+        self, act: NDArray[np.intp]
+    ) -> tuple[NDArray[np.intp], NDArray[np.float32], NDArray[np.bool_] | None]:
+        """``g - L b`` (N, s) NaN where an observation is unused, of the pixels ``span``:
+        ``act`` itself, or every pixel of the chunk when most are active (a gather of the
+        active columns costs more than computing the others too); then also the mask of
+        the active ones among them (None: all are)."""
+        c = self.gn.shape[1]
+        if act.size == c:
+            span, ga, ba, inact = act, self.gn, self.b, None
+        elif act.size > DENSE_FRACTION * c:
+            span, ga, ba = np.arange(c), self.gn, self.b
+            inact = np.ones(c, dtype=bool)
+            inact[act] = False
         else:
+            span, inact = act, None
             ga, ba = np.take(self.gn, act, axis=1), np.take(self.b, act, axis=1)
         r = self.l32 @ ba.astype(np.float32)
         np.subtract(ga, r, out=r)
-        return r
+        return span, r, inact
 
     def _remove(self, cols: NDArray[np.intp], drop: NDArray[np.bool_]) -> tuple[NDArray, ...]:
         """Remove the observations ``drop`` (N, k) of pixels ``cols`` from their normal
@@ -208,19 +222,22 @@ class _Chunk:
         for _ in range(rules.max_passes):
             if act.size == 0:
                 break
-            r = self.residuals(act)
-            hit = np.flatnonzero(np.fmax.reduce(r, axis=0) > floor32)
+            span, r, inact = self.residuals(act)
+            top = np.fmax.reduce(r, axis=0)
+            if inact is not None:
+                top[inact] = -np.inf
+            hit = np.flatnonzero(top > floor32)
             if hit.size == 0:
                 break
-            sub = r if hit.size == act.size else np.take(r, hit, axis=1)
-            thr = _thresholds(sub, self.count[act[hit]], rules.highlight_k, floor32, cut)
+            sub = r if hit.size == span.size else np.take(r, hit, axis=1)
+            thr = _thresholds(sub, self.count[span[hit]], rules.highlight_k, floor32, cut)
             drop = sub > thr[None, :]  # NaN (unused): False
             changed = np.flatnonzero(np.logical_or.reduce(drop, axis=0))
             if changed.size == 0:
                 break
             if changed.size < drop.shape[1]:
                 drop = np.take(drop, changed, axis=1)
-            cols = act[hit[changed]]
+            cols = span[hit[changed]]
             m_c, rhs_c, count_c = self._remove(cols, drop)
             b_c, ok_c = solve_normal_equations(
                 m_c, rhs_c, count_c, rules.cond_limit, light_major=True
@@ -240,19 +257,21 @@ class _Chunk:
         for _ in range(rules.max_passes):
             if act.size == 0:
                 break
-            r = self.residuals(act)
+            span, r, inact = self.residuals(act)
             low = np.fmin.reduce(r, axis=0)
-            hit = np.flatnonzero((low < -floor32) & (self.count[act] > rules.shadow_min_kept))
+            if inact is not None:
+                low[inact] = np.inf
+            hit = np.flatnonzero((low < -floor32) & (self.count[span] > rules.shadow_min_kept))
             if hit.size == 0:
                 break
             sub = np.take(r, hit, axis=1)
-            thr = _thresholds(sub, self.count[act[hit]], rules.shadow_k, floor32, cut)
+            thr = _thresholds(sub, self.count[span[hit]], rules.shadow_k, floor32, cut)
             sel = np.flatnonzero(low[hit] < -thr)
             if sel.size == 0:
                 break
             # the first observation at the minimum, as argmin would pick it
             worst = np.argmax(np.take(sub, sel, axis=1) == low[hit[sel]][None, :], axis=0)
-            cols = act[hit[sel]]
+            cols = span[hit[sel]]
             m_c = self.m[:, cols] - self.ll6[worst].T
             rhs_c = (
                 self.rhs[:, cols] - self.g[worst, cols].astype(np.float64) * self.lights[worst].T
