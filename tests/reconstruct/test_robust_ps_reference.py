@@ -237,3 +237,37 @@ def test_threshold_cut_is_where_the_median_starts_to_matter(scale: float, floor:
     assert thr(cut) <= f
     assert thr(np.nextafter(cut, np.float32(np.inf))) > f
     assert threshold_cut(0.0, floor) > 1e38  # a zero scale: the floor for any finite median
+
+
+@pytest.mark.parametrize("floor", [0.01, 0.0])
+def test_thresholds_decide_exactly_as_the_sorted_median(floor: float) -> None:
+    """The bracketed threshold drops exactly what the plain one drops: random residual columns
+    (NaN unused), with values placed right at the plain thresholds and next to them."""
+    from rti_rig.reconstruct.robust_ps import _thresholds
+
+    rng = np.random.default_rng(7)
+    n, k = 40, 3000
+    sub = (rng.standard_cauchy((n, k)) * rng.uniform(0.001, 0.05, k)).astype(np.float32)
+    sub[rng.random((n, k)) < 0.3] = np.nan
+    counts = np.sum(~np.isnan(sub), axis=0)
+    f32 = np.float32
+
+    def plain(col: np.ndarray) -> np.float32:
+        used = np.sort(np.abs(col[~np.isnan(col)]))
+        med = used[(used.size - 1) // 2]
+        return max(f32(2.0) * (f32(1.4826) * med), f32(floor))
+
+    expected = np.array([plain(sub[:, j]) for j in range(k)], dtype=np.float32)
+    # knife edges: some values exactly at the threshold and one float32 step either side
+    for j in range(0, k, 3):
+        row = rng.integers(n)
+        if not np.isnan(sub[row, j]):
+            step = [0.0, np.inf, -np.inf][j % 9 // 3]
+            sub[row, j] = np.nextafter(expected[j], f32(step)) if step else expected[j]
+    expected = np.array([plain(sub[:, j]) for j in range(k)], dtype=np.float32)
+    cut = threshold_cut(2.0, floor)
+    thr = _thresholds(sub, counts, 2.0, f32(floor), cut, sub)
+    np.testing.assert_array_equal(sub > thr[None, :], sub > expected[None, :])
+    low = np.nanmin(sub, axis=0)
+    thr1 = _thresholds(sub, counts, 2.0, f32(floor), cut, -low[None, :])
+    np.testing.assert_array_equal(-low > thr1, -low > expected)
