@@ -193,6 +193,7 @@ class _Chunk:
         self.l32t = np.ascontiguousarray(self.l32.T)
         self.ll6 = ll6
         self.ll6t = np.ascontiguousarray(ll6.T)
+        self.lights_t = np.ascontiguousarray(lights.T)
         self.rules = rules
         sat = np.float32(np.inf if rules.saturation is None else rules.saturation)
         with np.errstate(invalid="ignore"):
@@ -202,6 +203,7 @@ class _Chunk:
                 w &= inside[None, :]
             # unused observations become NaN (0 * inf), used ones keep their value
             self.gn = np.minimum(g, w * np.float32(np.inf))
+        assert self.gn.flags.c_contiguous  # written through flat indices (see _remove)
         with np.errstate(invalid="ignore"):
             rhs = self.l32t @ (g * w)
         if not np.isfinite(rhs).all():  # NaN/inf observations (unused): zero them properly
@@ -244,16 +246,17 @@ class _Chunk:
         light, local = np.divmod(np.flatnonzero(drop), k)
         values = self.g[light, cols[local]].astype(np.float64)
         m_c = self.m[:, cols]
-        w6 = self.ll6[light]  # (drops, 6)
+        # per component from a contiguous table: bincount wants contiguous weights
         for j in range(6):
-            m_c[j] -= np.bincount(local, weights=w6[:, j], minlength=k)
+            m_c[j] -= np.bincount(local, weights=np.take(self.ll6t[j], light), minlength=k)
         rhs_c = self.rhs[:, cols]
-        lw = self.lights[light]
         for j in range(3):
-            rhs_c[j] -= np.bincount(local, weights=values * lw[:, j], minlength=k)
+            w = values * np.take(self.lights_t[j], light)
+            rhs_c[j] -= np.bincount(local, weights=w, minlength=k)
         count_c = self.count[cols] - np.bincount(local, minlength=k).astype(np.int32)
         self.m[:, cols], self.rhs[:, cols], self.count[cols] = m_c, rhs_c, count_c
-        self.gn[light, cols[local]] = np.nan
+        # flat indices into the (contiguous) working copy: ~2× faster than a 2-D fancy index
+        self.gn.reshape(-1)[light * self.gn.shape[1] + cols[local]] = np.nan
         return m_c, rhs_c, count_c
 
     def highlights(self) -> None:
