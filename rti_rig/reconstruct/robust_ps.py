@@ -273,11 +273,19 @@ class _Chunk:
             top = np.fmax.reduce(r, axis=0)
             if inact is not None:
                 top[inact] = -np.inf
-            hit = np.flatnonzero(top > floor32)
+            over = top > floor32
+            hit = np.flatnonzero(over)
             if hit.size == 0:
                 break
-            sub = r if hit.size == span.size else np.take(r, hit, axis=1)
-            thr = _thresholds(sub, self.count[span[hit]], rules.highlight_k, floor32, cut, sub)
+            if inact is None and hit.size > DENSE_FRACTION * span.size:
+                # most columns can drop: keep them all rather than gather the hits; the others
+                # get a count of 0, hence the floor as threshold, which none of theirs exceeds
+                counts = np.where(over, self.count[span], 0)
+                sub, hit = r, np.arange(span.size)
+            else:
+                sub = np.take(r, hit, axis=1)
+                counts = self.count[span[hit]]
+            thr = _thresholds(sub, counts, rules.highlight_k, floor32, cut, sub)
             drop = sub > thr[None, :]  # NaN (unused): False
             changed = np.flatnonzero(np.logical_or.reduce(drop, axis=0))
             if changed.size == 0:
