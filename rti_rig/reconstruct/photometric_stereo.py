@@ -373,7 +373,11 @@ def fit_photometric_stereo(
                 flat = np.where(bad, np.float32(0.0), band).reshape(flat.shape)
             g = channel_mean(flat)
             if bad is not None:
-                usable = ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
+                bad3 = bad.reshape(stack.n, r * wd, -1)
+                # channel by channel: a reduction over the short last axis is ~10× slower
+                usable = ~bad3[..., 0]
+                for ch in range(1, bad3.shape[2]):
+                    usable &= ~bad3[..., ch]
                 g = np.where(usable, g, np.float32(np.nan))  # an observation not used
             colour = flat
         n, alb, rms, count, ok = fit_robust_band(g, inside, lt, rules, colour)

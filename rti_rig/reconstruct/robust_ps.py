@@ -383,10 +383,11 @@ class _Chunk:
             alb = (np.einsum("ij,ij->j", n, self.rhs) / den)[:, None]
         else:
             used = ~np.isnan(self.gn)
-            alb = np.empty((n.shape[1], flat.shape[2]))
-            for ch in range(flat.shape[2]):
-                proj = (self.l32.T @ (flat[:, :, ch] * used)).astype(np.float64)
-                alb[:, ch] = np.einsum("ij,ij->j", n, proj) / den
+            n_img, c, channels = flat.shape
+            # all channels in one product over the (N, c * C) values of the used observations
+            kept = (flat * used[:, :, None]).reshape(n_img, c * channels)
+            proj = (self.l32t @ kept).reshape(3, c, channels).astype(np.float64)
+            alb = np.einsum("ij,ijk->jk", n, proj) / den[:, None]
         # RMS residual of the fitted (z-clamped) b over the used observations, computed
         # directly (a difference of large sums would not resolve a good fit's residual)
         res = self.l32 @ (n * norm).astype(np.float32)
