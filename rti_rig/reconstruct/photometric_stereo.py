@@ -32,8 +32,10 @@ normal (0, 0, 1), albedo 0) — never silently guessed. Pixels outside ``mask`` 
 pixels are invalid too. The full light set must itself be well-conditioned, or the fit is refused:
 a regularised normal would be biased towards the plane of the lights.
 
-Per-pixel systems are solved in closed form (3 × 3 adjugate, closed-form symmetric eigenvalues),
-vectorised over the band: no Python loop over pixels.
+Per-pixel systems are solved in closed form (3 × 3 adjugate, closed-form symmetric eigenvalues
+where a cheap bound cannot decide the conditioning; :mod:`rti_rig.reconstruct.normal_equations`),
+vectorised over the band: no Python loop over pixels. The robust rules are computed chunk by
+chunk in :mod:`rti_rig.reconstruct.robust_ps` (why it is built that way is said there).
 """
 
 from __future__ import annotations
@@ -45,6 +47,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
+from rti_rig.reconstruct.normal_equations import (
+    solve_weighted as _solve_weighted,
+)
+from rti_rig.reconstruct.robust_ps import RobustRules, fit_robust_band
 from rti_rig.reconstruct.solve import COND_LIMIT, solve_matrix
 from rti_rig.reconstruct.stack import ImageStack, as_direction, channel_mean, validate_lights
 from rti_rig.reconstruct.tiling import row_tiles, rows_for_budget
@@ -110,234 +116,6 @@ class PSResult:
             "median_residual": float(np.median(self.residual[v])) if v.any() else float("nan"),
             "condition_number": self.condition_number,
         }
-
-
-#: Index pairs of the 6 distinct entries of a symmetric 3 × 3 matrix, in the order used below.
-_SYM6 = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
-
-
-def _light_products(lights: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``l_i l_j`` of each light for the 6 distinct entries of ``l l^T``: (N, 6)."""
-    return np.stack([lights[:, i] * lights[:, j] for i, j in _SYM6], axis=1)
-
-
-def _normal_equations(
-    g: NDArray[np.float32], w: NDArray[np.bool_], lights: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
-    """``sum_k w_k l_k l_k^T`` (6, P) in float64 (near-singular subsets must be detected),
-    ``sum_k w_k I_k l_k`` (3, P) and the count of used observations (P,), for pixel-major
-    ``g``, ``w`` (P, N)."""
-    m = np.ascontiguousarray((w.astype(np.float64) @ _light_products(lights)).T)
-    rhs = (np.where(w, g, np.float32(0.0)) @ lights.astype(np.float32)).T.astype(np.float64)
-    return m, rhs, w.sum(axis=1)
-
-
-def _solve_normal_equations(
-    m: NDArray[np.float64], rhs: NDArray[np.float64], count: NDArray[Any], cond_limit: float
-) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Solve the symmetric PSD systems ``m`` (6, P) ``b = rhs`` (3, P) in closed form.
-
-    Adjugate and trigonometric eigenvalues (Smith 1961), component by component on contiguous
-    rows: ~20× faster than batched LAPACK for millions of 3 × 3 systems. Returns b (P, 3)
-    (zero where unsolvable) and solvable (P,): at least 3 observations and an eigenvalue ratio
-    within ``cond_limit**2`` (the condition number of the light subset within ``cond_limit``).
-    """
-    a, b, c, d, e, f = m
-    co_a = d * f - e * e
-    co_b = c * e - b * f
-    co_c = b * e - c * d
-    co_d = a * f - c * c
-    co_e = b * c - a * e
-    co_f = a * d - b * b
-    det = a * co_a + b * co_b + c * co_c
-    q = (a + d + f) / 3.0
-    p1 = b * b + c * c + e * e
-    aq, dq, fq = a - q, d - q, f - q
-    p2 = aq * aq + dq * dq + fq * fq + 2.0 * p1
-    p = np.sqrt(np.maximum(p2, 0.0) / 6.0)
-    pos = p > 0
-    ps = np.where(pos, p, 1.0)
-    ba, bd, bf = aq / ps, dq / ps, fq / ps
-    bb, bc, be = b / ps, c / ps, e / ps
-    r = (ba * (bd * bf - be * be) - bb * (bb * bf - be * bc) + bc * (bb * be - bd * bc)) / 2.0
-    phi = np.arccos(np.clip(r, -1.0, 1.0)) / 3.0
-    e1 = np.where(pos, q + 2.0 * p * np.cos(phi), q)
-    e3 = np.where(pos, q + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0), q)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(e3 > e1 * 1e-14, e1 / e3, np.inf)
-    ok = np.isfinite(ratio) & (np.abs(det) > 0)
-    inv_det = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    ok &= (count >= 3) & (ratio <= cond_limit**2)
-    inv_det[~ok] = 0.0
-    r0, r1, r2 = rhs
-    out = np.empty((m.shape[1], 3))
-    out[:, 0] = (co_a * r0 + co_b * r1 + co_c * r2) * inv_det
-    out[:, 1] = (co_b * r0 + co_d * r1 + co_e * r2) * inv_det
-    out[:, 2] = (co_c * r0 + co_e * r1 + co_f * r2) * inv_det
-    return out, ok
-
-
-def _solve_weighted(
-    g: NDArray[np.float32], w: NDArray[np.bool_], lights: NDArray[np.float64], cond_limit: float
-) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Least squares per pixel on its used observations.
-
-    ``g`` and ``w`` are pixel-major (P, N) so that gathering a subset of pixels is contiguous.
-    Returns b (P, 3) and solvable (P,): at least 3 observations and a light subset whose
-    condition number is within ``cond_limit``.
-    """
-    m, rhs, count = _normal_equations(g, w, lights)
-    return _solve_normal_equations(m, rhs, count, cond_limit)
-
-
-def _remove_observations(
-    eqs: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]],
-    pix: NDArray[np.intp],
-    light: NDArray[np.intp],
-    values: NDArray[np.float32],
-    lights: NDArray[np.float64],
-    ll6: NDArray[np.float64],
-    cols: NDArray[np.intp],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]]:
-    """The normal equations of pixels ``cols`` after removing observations (``pix`` indexing
-    into ``cols``, ``light``, their ``values``): a downdate of the few removed terms (exact in
-    float64), not a new pass over all N observations of every pixel."""
-    m, rhs, count = eqs
-    k = cols.size
-    m_c = m[:, cols]
-    for j in range(6):
-        m_c[j] -= np.bincount(pix, weights=ll6[light, j], minlength=k)
-    rhs_c = rhs[:, cols]
-    gv = values.astype(np.float64)
-    for j in range(3):
-        rhs_c[j] -= np.bincount(pix, weights=gv * lights[light, j], minlength=k)
-    count_c = count[cols] - np.bincount(pix, minlength=k)
-    return m_c, rhs_c, count_c
-
-
-def _residuals(
-    g: NDArray[np.float32], b: NDArray[np.float64], l32: NDArray[np.float32]
-) -> NDArray[np.float32]:
-    """``g - b l^T`` (A, N) float32, in the buffer of the prediction."""
-    pred = b.astype(np.float32) @ l32.T
-    np.subtract(g, pred, out=pred)
-    return pred
-
-
-def _robust_band(
-    g_nm: NDArray[np.float32],
-    inside: NDArray[np.bool_],
-    lights: NDArray[np.float64],
-    dark: float,
-    saturation: float | None,
-    highlight_k: float,
-    highlight_floor: float,
-    max_passes: int,
-    cond_limit: float,
-    shadow_k: float | None,
-) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
-    """Robust fit of one band ``g_nm`` (N, P): b (P, 3), used observations (N, P), solvable.
-
-    The normal equations are built once per pixel; each pass then removes the dropped
-    observations from them (a few per pixel) and re-solves only the pixels that changed.
-    """
-    g = np.ascontiguousarray(g_nm.T)  # (P, N)
-    w = (g > dark) & inside[:, None]
-    if saturation is not None:
-        w &= g < saturation
-    eqs = _normal_equations(g, w, lights)
-    b, ok = _solve_normal_equations(*eqs, cond_limit)
-    ll6 = _light_products(lights)
-    l32 = lights.astype(np.float32)
-    m, rhs, count = eqs
-    # Only pixels that dropped an observation in the last pass are refitted: most converge in
-    # one or two passes, so later passes touch few pixels.
-    active = np.flatnonzero(ok)
-    for _ in range(max_passes):
-        if active.size == 0:
-            break
-        ga, wa = g[active], w[active]
-        resid = _residuals(ga, b[active], l32)  # (A, N)
-        thr = np.maximum(highlight_k * _robust_sigma(resid, wa, count[active]), highlight_floor)
-        drop = wa & (resid > thr[:, None])
-        pix, light = np.nonzero(drop)
-        if pix.size == 0:
-            break
-        hits = np.bincount(pix, minlength=active.size)
-        changed = hits > 0
-        local = np.cumsum(changed) - 1  # index of each active pixel among the changed ones
-        cols = active[changed]
-        w[active[pix], light] = False
-        m_c, rhs_c, count_c = _remove_observations(
-            (m, rhs, count), local[pix], light, ga[pix, light], lights, ll6, cols
-        )
-        m[:, cols], rhs[:, cols], count[cols] = m_c, rhs_c, count_c
-        b[cols], ok[cols] = _solve_normal_equations(m_c, rhs_c, count_c, cond_limit)
-        active = cols[ok[cols]]
-    if shadow_k is not None:
-        _drop_partial_shadows(
-            g, w, b, ok, lights, shadow_k, highlight_floor, max_passes, cond_limit, eqs
-        )
-    return b, w.T, ok
-
-
-def _robust_sigma(
-    resid: NDArray, used: NDArray[np.bool_], count: NDArray[Any] | None = None
-) -> NDArray:
-    """1.4826 × the median |residual| over each row's used observations (0 if none)."""
-    absr = np.abs(resid)
-    np.copyto(absr, np.float32(np.inf), where=~used)
-    absr.sort(axis=1)
-    if count is None:
-        count = used.sum(axis=1)
-    mid = np.clip((count - 1) // 2, 0, used.shape[1] - 1)
-    med = absr[np.arange(absr.shape[0]), mid]
-    return 1.4826 * np.where(count > 0, med, 0.0)
-
-
-def _drop_partial_shadows(
-    g: NDArray[np.float32],
-    w: NDArray[np.bool_],
-    b: NDArray[np.float64],
-    ok: NDArray[np.bool_],
-    lights: NDArray[np.float64],
-    shadow_k: float,
-    floor: float,
-    max_passes: int,
-    cond_limit: float,
-    eqs: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]] | None = None,
-) -> None:
-    """Rule 4, in place on ``w`` (P, N), ``b``, ``ok`` (and the normal equations ``eqs`` of
-    ``w``, built here when not given): the darkest outlier per pass."""
-    m, rhs, count = _normal_equations(g, w, lights) if eqs is None else eqs
-    ll6 = _light_products(lights)
-    l32 = lights.astype(np.float32)
-    active = np.flatnonzero(ok)
-    for _ in range(max_passes):
-        if active.size == 0:
-            break
-        wa = w[active]
-        resid = _residuals(g[active], b[active], l32)
-        resid[~wa] = 0.0
-        ca = count[active]
-        thr = np.maximum(shadow_k * _robust_sigma(resid, wa, ca), floor)
-        worst = np.argmin(resid, axis=1)
-        low = resid[np.arange(active.size), worst]
-        drop = (low < -thr) & (ca > SHADOW_MIN_KEPT)
-        if not drop.any():
-            break
-        cols, worst = active[drop], worst[drop]
-        m_c, rhs_c, count_c = _remove_observations(
-            (m, rhs, count), np.arange(cols.size), worst, g[cols, worst], lights, ll6, cols
-        )
-        b_new, ok_new = _solve_normal_equations(m_c, rhs_c, count_c, cond_limit)
-        # a drop that leaves the pixel unsolvable (ill-conditioned subset) is not made: the
-        # pixel keeps its observation and its earlier fit rather than turning invalid
-        keep, wk = cols[ok_new], worst[ok_new]
-        w[keep, wk] = False
-        m[:, keep], rhs[:, keep], count[keep] = m_c[:, ok_new], rhs_c[:, ok_new], count_c[ok_new]
-        b[keep] = b_new[ok_new]
-        active = keep
 
 
 def _unit_normals(
@@ -528,8 +306,21 @@ def fit_photometric_stereo(
     valid = np.empty((h, wd), dtype=bool)
     used = np.empty((h, wd), dtype=np.int16)
     gram = lt.T @ lt
-    # the robust fit keeps ~6 float64 (N, pixels) work arrays besides the float32 band
+    # the least-squares fit keeps a few (N, pixels) work arrays besides the float32 band; the
+    # robust fit works in cache-sized chunks (robust_ps.CHUNK_PIXELS) and needs less, but the
+    # same band keeps the memory figures of docs/reconstruction.md valid for both
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
+    rules = RobustRules(
+        dark=dark,
+        saturation=saturation,
+        highlight_k=float(highlight_k),
+        floor=floor,
+        max_passes=max_passes,
+        cond_limit=cond_limit,
+        shadow_k=None if shadow_k is None else float(shadow_k),
+        shadow_min_kept=SHADOW_MIN_KEPT,
+        eps_b=eps_b,
+    )
     for sl in row_tiles(h, rows):
         band = stack.rows(sl, strict=False, copy=False)  # (N, r, W, C), maybe a view
         r = band.shape[1]
@@ -571,23 +362,30 @@ def fit_photometric_stereo(
             valid[sl] = ok.reshape(r, wd)
             used[sl] = np.where(ok, count, 0).reshape(r, wd)
             continue
-        bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
-        if bad is not None:
-            band = np.where(bad, np.float32(0.0), band)
         flat = band.reshape(stack.n, r * wd, stack.channels)
-        g = channel_mean(flat) if stack.channels > 1 else flat[..., 0]
-        if bad is not None:
-            usable = ~np.logical_or.reduce(bad.reshape(stack.n, r * wd, -1), axis=2)
-            g = np.where(usable, g, np.float32(-1.0))  # below any dark threshold
-        b, w, ok = _robust_band(
-            g, inside, lt, dark, saturation, highlight_k, floor, max_passes, cond_limit, shadow_k
-        )
-        n, alb, rms, count, ok = _albedo_residual_used(b, w, ok & inside, g, flat, lt, eps_b)
+        if stack.grey:
+            # NaN, infinite and saturated values are recognised (and not used) chunk by chunk
+            # by the robust fit itself: no pass over the band here
+            g, colour = flat[..., 0], None
+        else:
+            bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below
+            if bad is not None:
+                flat = np.where(bad, np.float32(0.0), band).reshape(flat.shape)
+            g = channel_mean(flat)
+            if bad is not None:
+                bad3 = bad.reshape(stack.n, r * wd, -1)
+                # channel by channel: a reduction over the short last axis is ~10× slower
+                usable = ~bad3[..., 0]
+                for ch in range(1, bad3.shape[2]):
+                    usable &= ~bad3[..., ch]
+                g = np.where(usable, g, np.float32(np.nan))  # an observation not used
+            colour = flat
+        n, alb, rms, count, ok = fit_robust_band(g, inside, lt, rules, colour)
         normals[sl] = n.reshape(r, wd, 3)
-        albedo[sl] = np.where(ok[:, None], alb, 0.0).reshape(r, wd, stack.channels)
-        residual[sl] = np.where(ok, rms, 0.0).reshape(r, wd)
+        albedo[sl] = alb.reshape(r, wd, stack.channels)
+        residual[sl] = rms.reshape(r, wd)
         valid[sl] = ok.reshape(r, wd)
-        used[sl] = np.where(ok, count, 0).reshape(r, wd)
+        used[sl] = count.reshape(r, wd)
     return PSResult(
         normals=normals,
         albedo=albedo[..., 0] if stack.grey else albedo,
