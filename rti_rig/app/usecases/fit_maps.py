@@ -6,8 +6,9 @@ resident set (``ru_maxrss`` counts file-backed pages) until it is flushed and dr
 synchronous flush per band cost more than the band's fit, so pages piled up between flushes
 (16 MB of them, at 2.5 MP a sixth of the memory relight's normals fit uses). :class:`MapFile`
 writes each band with ``pwrite`` instead: the bytes go to the page cache, which is not the
-process's memory, and nothing needs flushing. The file is laid out by ``numpy``'s own
-``open_memmap`` (same header, same size), so its bytes are what the memmap wrote.
+process's memory, and nothing needs flushing. The header is written by ``numpy.lib.format``
+(format 1.0, what ``np.save`` and ``open_memmap`` write for these shapes), so the file's bytes
+are what the memmap wrote.
 """
 
 from __future__ import annotations
@@ -27,9 +28,15 @@ class MapFile:
         self.path = path
         self.shape = tuple(int(x) for x in shape)
         self.dtype = np.dtype(np.float32)
-        layout = np.lib.format.open_memmap(path, "w+", self.dtype, self.shape)
-        self._offset = int(layout.offset)  # header length: where row 0 starts
-        del layout  # never touched: no page of it was ever resident
+        header = {
+            "descr": np.lib.format.dtype_to_descr(self.dtype),
+            "fortran_order": False,
+            "shape": self.shape,
+        }
+        with open(path, "wb") as fh:  # the header numpy's np.save / open_memmap write
+            np.lib.format.write_array_header_1_0(fh, header)
+            self._offset = fh.tell()  # where row 0 starts
+            fh.truncate(self._offset + int(np.prod(self.shape, dtype=np.int64)) * 4)
         self._row_bytes = int(np.prod(self.shape[1:], dtype=np.int64)) * self.dtype.itemsize
         self._fd: int | None = os.open(path, os.O_WRONLY)
 
