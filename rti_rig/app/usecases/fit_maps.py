@@ -58,6 +58,9 @@ class MapFile:
             os.close(self._fd)
             self._fd = None
 
+    def __del__(self) -> None:  # a fit that failed half-way drops its maps unclosed
+        self.close()
+
     def read(self) -> np.memmap:
         """The written map, read-only and file-backed (readers drop its pages as they go,
         e.g. :func:`rti_rig.reconstruct.exporters.write_normal_map`)."""
