@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import html
 import json
-import mmap
 import os
 import tempfile
+import threading
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -28,6 +28,9 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band
+from rti_rig.app.usecases.fit_decode import imread_rgb
+from rti_rig.app.usecases.fit_maps import MapFile
+from rti_rig.app.usecases.fit_memory import release_free_memory, use_one_heap
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
 from rti_rig.core.raw_rows import RawRows
@@ -102,16 +105,16 @@ def _decoded_rows(img: np.ndarray, name: str) -> RawRows:
     return RawRows(store, 0, img.shape, img.dtype, lut, name=name)
 
 
-def _decode(path: Path) -> np.ndarray:
-    """A compressed image decoded whole: uint16 linear TIFF, or 8-/16-bit JPEG/PNG (RGB)."""
+def _decode(path: Path, into: np.ndarray | None = None) -> np.ndarray:
+    """A compressed image decoded whole: uint16 linear TIFF, or 8-/16-bit JPEG/PNG (RGB);
+    JPEG/PNG into ``into`` when it fits (:func:`rti_rig.app.usecases.fit_decode.imread_rgb`)."""
     if path.suffix.lower() in (".tif", ".tiff"):
         img = np.asarray(TiffRows(path)[:])
     else:
-        img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-        if img is None:
+        decoded = imread_rgb(path, into)
+        if decoded is None:
             raise FitInputError(f"cannot read image {path}")
-        if img.ndim == 3:
-            img = img[..., ::-1]
+        img = decoded
     if img.dtype not in (np.uint8, np.uint16):
         raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
     return np.ascontiguousarray(img)
@@ -153,9 +156,15 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     store = tempfile.TemporaryFile(prefix="rti-rig-decoded-")  # noqa: SIM115
     lut = _SRGB_TO_LINEAR16 if stored == np.uint8 else None
 
+    buffers = threading.local()  # one decode buffer per thread, reused image after image
+
     def put(k: int, img: np.ndarray | None = None) -> None:
         i = pending[k]
-        img = _decode(paths[i]) if img is None else img
+        if img is None:
+            buffer = getattr(buffers, "image", None)
+            if buffer is None:
+                buffer = buffers.image = np.empty(shape, stored)
+            img = _decode(paths[i], buffer)
         if img.shape != shape or img.dtype != stored:
             raise FitInputError(
                 f"images of {label} differ: {paths[i].name} is {img.shape} {img.dtype}, "
@@ -166,8 +175,15 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
 
     put(0, first)
     del first
-    with ThreadPoolExecutor(max_workers=os.cpu_count() or 2, thread_name_prefix="decode") as ex:
-        list(ex.map(put, range(1, len(pending))))
+    # the images are decoded in parallel already: OpenCV's own worker threads would only add
+    # per-thread buffers (measured: 7 MB more at the peak, 21 MB kept after, at 2.5 MP)
+    cv_threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 2, thread_name_prefix="decode") as ex:
+            list(ex.map(put, range(1, len(pending))))
+    finally:
+        cv2.setNumThreads(cv_threads)
     return frames
 
 
@@ -224,7 +240,9 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     everything else — model choice, quantisation ranges, writing, QA — is the same code.
     """
     t0 = time.perf_counter()
+    use_one_heap()  # before the decode and reader threads: see fit_memory
     frames, lights, names, what = load_acquisition(req.source)
+    release_free_memory()  # the decode buffers
     out = req.out_dir
     if out.exists() and any(out.iterdir()):
         raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
@@ -237,6 +255,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     result.files.append(
         exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
     )
+    release_free_memory()  # the fit's bands and PNG buffers, before QA reads the images again
     if req.qa:
         try:
             result.qa = assess(frames, lights, names)
@@ -264,7 +283,11 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
 SAMPLE_PIXELS = 30_000
 #: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
 #: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
-BAND_BUDGET_BYTES = 8 * 1024 * 1024
+#: Measured at 72 images × 2.5 MP (3 rows a band): 8 MB put the band phase of a normals fit at
+#: ~104 MB, relight's 108 MB less noise; 6 MB ~95 MB. 4 MB (2 rows) cost uncompressed-TIFF
+#: sessions ~40 % more CPU (the band reads of 72 files each, not the fit, set the pace).
+#: The outputs do not depend on it (tests/app/test_fit_memory.py).
+BAND_BUDGET_BYTES = 6 * 1024 * 1024
 
 
 def _fit_all(
@@ -311,18 +334,15 @@ def _fit_all(
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
     if normal_source == "lambert":
         linear["lambert"] = design_matrix("lambert", lights)
-    sample, _ = stack.pixel_sample(SAMPLE_PIXELS)  # the sample model choice read (cached)
-    obs = sample.reshape(n, -1)
-    keep = np.all(np.isfinite(obs), axis=0)
-    if stack.saturation_level is not None:
-        keep &= np.all(obs < stack.saturation_level, axis=0)
-    obs = obs[:, keep] if keep.any() else np.nan_to_num(obs)
+    # the usable observations of the sample, only when an exported model needs their range
+    obs = _usable_sample(stack) if any(k != "lambert" for k in linear) else None
     writers: dict[str, Any] = {}
     for key, design in linear.items():
         ill = "refuse" if key == "lambert" else "regularise"
         w, _ = solve_matrix(design, key, ill)
         if key == "lambert":
             continue
+        assert obs is not None
         lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5)
         if key == "ptm":
             writers[key] = exporters.PtmWriter(out / "fit.ptm", stack.width, stack.height, lo, hi)
@@ -332,12 +352,16 @@ def _fit_all(
     if not req.write_normals:
         normal_source = ""
         linear.pop("lambert", None)
-    ref = stack.reference_level(SAMPLE_PIXELS)
+    # the last use of the sample: when nothing above read it, it is streamed, never held
+    ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
+    del obs
+    stack.forget_samples()  # planned: the sample is not needed while the bands are fitted
+    release_free_memory()
     h, wd = stack.height, stack.width
-    maps = (h, wd) if req.write_normals else (1, 1)
-    normals = np.lib.format.open_memmap(out / "normals.npy", "w+", np.float32, (*maps, 3))
-    albedo_shape = maps if stack.grey else (*maps, stack.channels)
-    albedo = np.lib.format.open_memmap(out / "albedo.npy", "w+", np.float32, albedo_shape)
+    normals = albedo = None
+    if req.write_normals:
+        normals = MapFile(out / "normals.npy", (h, wd, 3))
+        albedo = MapFile(out / "albedo.npy", (h, wd) if stack.grey else (h, wd, stack.channels))
     rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
     plan = BandPlan(
         lights=np.asarray(lights),
@@ -348,8 +372,6 @@ def _fit_all(
         reference_level=ref,
         grey=stack.grey,
     )
-    written = 0
-    row_bytes = wd * (3 + (1 if stack.grey else stack.channels)) * 4 if req.write_normals else 0
     tiles = list(row_tiles(h, rows))
     # one BLAS thread: the fit is many small products over cache-sized chunks, where threaded
     # BLAS spends more in start-up and (on a shared machine) spinning than it computes, and
@@ -360,32 +382,30 @@ def _fit_all(
         for sl, fitted in bands(stack, plan, tiles):
             for key, writer in writers.items():
                 writer.write_rows(sl.start, fitted.coefficients[key])
-            if fitted.normals is not None:
-                normals[sl], albedo[sl] = fitted.normals, fitted.albedo
+            if normals is not None and albedo is not None and fitted.normals is not None:
+                normals.write_rows(sl.start, fitted.normals)
+                albedo.write_rows(sl.start, fitted.albedo)
             for category, text in fitted.warnings:  # from a band fitted in another process
                 warnings.warn(text, category, stacklevel=1)
-            written += (sl.stop - sl.start) * row_bytes
-            if written >= RELEASE_BYTES or sl.stop == h:
-                _release(normals)  # written pages go to the file, not the resident set
-                _release(albedo)
-                written = 0
     for writer in writers.values():
         files.append(writer.close())
-    normals.flush()
-    albedo.flush()
-    if req.write_normals:
-        files += exporters.write_normal_map(out / "normals", normals, npy=False)
-        files += exporters.write_albedo(out / "albedo", albedo, npy=False)
-    del normals, albedo
-    if not req.write_normals:
-        (out / "normals.npy").unlink()
-        (out / "albedo.npy").unlink()
+    release_free_memory()  # the bands: the PNG buffers come next
+    if normals is not None and albedo is not None:
+        files += exporters.write_normal_map(out / "normals", normals.read(), npy=False)
+        release_free_memory()
+        files += exporters.write_albedo(out / "albedo", albedo.read(), npy=False)
     return FitResult(out, model_name, reason_line, files)
 
 
-#: Written map pages are flushed and dropped from memory once this many have accumulated (each
-#: flush is a synchronous write: per band, it cost more than the fit of the band).
-RELEASE_BYTES = 16 * 1024 * 1024
+def _usable_sample(stack: ImageStack) -> np.ndarray:
+    """The pixel sample's observations (N, P·C) of the pixels with no missing or saturated
+    value in any image (all of them, NaN taken as 0, when no pixel is clean)."""
+    sample, _ = stack.pixel_sample(SAMPLE_PIXELS)  # the sample model choice read (cached)
+    obs = sample.reshape(stack.n, -1)
+    keep = np.all(np.isfinite(obs), axis=0)
+    if stack.saturation_level is not None:
+        keep &= np.all(obs < stack.saturation_level, axis=0)
+    return obs[:, keep] if keep.any() else np.nan_to_num(obs)
 
 
 def local_bands(
@@ -403,14 +423,6 @@ def local_bands(
             yield sl, fit_band(band, plan)
     finally:
         pool.shutdown()
-
-
-def _release(mapped: np.memmap) -> None:
-    """Flush a writable memmap and drop its pages from memory (they are in the file now)."""
-    mapped.flush()
-    mm = getattr(mapped, "_mmap", None)
-    if mm is not None and hasattr(mm, "madvise") and hasattr(mmap, "MADV_DONTNEED"):
-        mm.madvise(mmap.MADV_DONTNEED)
 
 
 def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
