@@ -12,7 +12,8 @@ which is not the process's resident memory — and maps them through an optional
 from __future__ import annotations
 
 import os
-from typing import IO, Any
+import tempfile
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,12 +21,32 @@ from numpy.typing import NDArray
 from rti_rig.core.errors import ImageFileError
 
 
+class HasFileno(Protocol):
+    def fileno(self) -> int: ...
+
+
+class DecodedStore:
+    """An unlinked temporary file of decoded rows, shared by the :class:`RawRows` that read it
+    and closed when the last of them is released. Left to the garbage collector unclosed, a
+    file is a ``ResourceWarning`` raised wherever collection happens to run — inside a later
+    fit, which would record it among that fit's warnings."""
+
+    def __init__(self) -> None:
+        self.file = tempfile.TemporaryFile(prefix="rti-rig-decoded-")  # noqa: SIM115
+
+    def fileno(self) -> int:
+        return self.file.fileno()
+
+    def __del__(self) -> None:
+        self.file.close()
+
+
 class RawRows:
     """Read-only, array-like (H, W[, C]) image stored raw at ``offset`` of ``file``."""
 
     def __init__(
         self,
-        file: IO[bytes],
+        file: HasFileno,
         offset: int,
         shape: tuple[int, ...],
         stored: np.dtype[Any],

@@ -148,3 +148,54 @@ def test_the_dask_readers_image_of_a_jpeg_is_rows_on_disk_not_pixels_in_memory(
     frames, _, names, _ = load_acquisition(inputs["jpeg"])
     plain = frames[names.index(jpg.stem)]
     np.testing.assert_array_equal(img[5:9], plain[5:9])
+
+
+def test_decoded_rows_close_their_file_when_released() -> None:
+    """A released decode store closes its file itself: left unclosed to the garbage collector
+    it raised a ResourceWarning inside a later fit, which recorded it in fit.json."""
+    import gc
+    import warnings
+
+    from rti_rig.core.raw_rows import DecodedStore
+
+    store = DecodedStore()
+    fh = store.file
+    img = np.arange(12, dtype=np.uint16).reshape(3, 4)
+    fh.write(img.tobytes())
+    fh.flush()
+    rows = RawRows(store, 0, img.shape, img.dtype)
+    del store
+    assert np.array_equal(rows[1:3], img[1:3])  # the rows keep their store alive
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        del rows
+        gc.collect()
+    assert fh.closed
+    assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
+
+
+def test_a_fit_records_its_own_warnings_not_the_process_s(
+    inputs: dict[str, Path], tmp_path: Path, monkeypatch
+) -> None:
+    """fit.json lists what concerns the fit (here a numerical warning raised while fitting), not
+    a ResourceWarning or a DeprecationWarning that happened to be raised while it ran."""
+    import json
+    import warnings
+
+    from rti_rig.app.usecases import fit as fit_mod
+
+    real = fit_mod.fit_band
+
+    def noisy(*args, **kwargs):  # type: ignore[no-untyped-def]
+        warnings.warn("unclosed file <_io.BufferedRandom name=17>", ResourceWarning, stacklevel=1)
+        warnings.warn("some library API is deprecated", DeprecationWarning, stacklevel=1)
+        warnings.warn("overflow while fitting this band", RuntimeWarning, stacklevel=1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fit_mod, "fit_band", noisy)
+    out = tmp_path / "fit"
+    r = runner.invoke(app, ["fit", str(inputs["tiff"]), "--model", "ps", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    said = json.loads((out / "fit.json").read_text(encoding="utf-8"))["warnings"]
+    assert any("overflow while fitting" in w for w in said), said
+    assert not any("unclosed file" in w or "deprecated" in w for w in said), said

@@ -13,7 +13,6 @@ from __future__ import annotations
 import html
 import json
 import os
-import tempfile
 import threading
 import time
 import warnings
@@ -27,13 +26,13 @@ import cv2
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band
+from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band, fit_warnings
 from rti_rig.app.usecases.fit_decode import imread_rgb
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory, use_one_heap
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
-from rti_rig.core.raw_rows import RawRows
+from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
 from rti_rig.reconstruct.errors import ReconstructionError
@@ -99,7 +98,7 @@ def _decoded_rows(img: np.ndarray, name: str) -> RawRows:
     """A decoded image moved to an unlinked temporary file and read back by rows (as the plain
     fit does, :func:`_open_frames`): a process that keeps an acquisition open (a Dask worker)
     then holds file handles, not every image decoded (72 × 24 MP would be ~10 GB)."""
-    store = tempfile.TemporaryFile(prefix="rti-rig-decoded-")  # noqa: SIM115
+    store = DecodedStore()
     os.pwrite(store.fileno(), memoryview(img.reshape(-1).view(np.uint8)), 0)
     lut = _SRGB_TO_LINEAR16 if img.dtype == np.uint8 else None
     return RawRows(store, 0, img.shape, img.dtype, lut, name=name)
@@ -153,7 +152,7 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     shape, stored = first.shape, first.dtype
     size = first.nbytes
     # unlinked at once: gone when the last frame reading it is released
-    store = tempfile.TemporaryFile(prefix="rti-rig-decoded-")  # noqa: SIM115
+    store = DecodedStore()
     lut = _SRGB_TO_LINEAR16 if stored == np.uint8 else None
 
     buffers = threading.local()  # one decode buffer per thread, reused image after image
@@ -251,7 +250,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = _fit_all(req, stack, lights, out, bands or local_bands)
-    result.warnings = [str(w.message) for w in caught or []]
+    result.warnings = [str(w.message) for w in fit_warnings(caught)]
     result.files.append(
         exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
     )

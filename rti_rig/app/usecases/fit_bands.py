@@ -131,5 +131,22 @@ def fit_band_recording(band: np.ndarray, plan: BandPlan, threads: int | None = N
         else:
             with threadpool_limits(limits=threads, user_api="blas"):
                 result = fit_band(band, plan)
-    result.warnings = [(w.category, str(w.message)) for w in caught]
+    result.warnings = [(w.category, str(w.message)) for w in fit_warnings(caught)]
     return result
+
+
+#: Warnings about the process, not the fit (a file some other code left to the garbage
+#: collector, a library's deprecation): recording them would put them in ``fit.json``.
+PROCESS_WARNINGS = (ResourceWarning, DeprecationWarning, PendingDeprecationWarning, ImportWarning)
+
+
+def fit_warnings(caught: list[warnings.WarningMessage] | None) -> list[warnings.WarningMessage]:
+    """The warnings a fit recorded that concern the fit; the others are re-issued to the
+    filters outside the fit (which by default ignore a ``ResourceWarning``)."""
+    kept = []
+    for w in caught or []:
+        if issubclass(w.category, PROCESS_WARNINGS):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        else:
+            kept.append(w)
+    return kept
