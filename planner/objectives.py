@@ -212,18 +212,21 @@ def cast_shadow_visibility(
     vis = np.ones((len(rows), len(d)))
     if len(rows) == 0:
         return vis
-    # a light whose ray climbs from the lowest sampled pixel to above the highest terrain
-    # within one step cannot be blocked anywhere: skipped (all of them on a level surface)
-    climb = np.minimum(rise, max_steps * rise)
-    free = float(height_px.max()) - float(h0.min()) <= climb + 0.5
+    # a ray that has climbed from the lowest sampled pixel to within 0.5 px of the highest
+    # terrain cannot be blocked any further on: only the steps before are marched (none on a
+    # level surface or for a light that gets there in one step; the march is otherwise the same)
+    reach = (float(height_px.max()) - float(h0.min()) - 0.5) / np.maximum(rise, 1e-12)
+    steps = np.where(rise > 0, np.clip(np.ceil(reach) - 1, 0, max_steps), max_steps)
+    steps = steps.astype(np.intp)
     for k in range(len(d)):
-        if horiz[k] < 1e-6 or free[k]:
+        if horiz[k] < 1e-6 or steps[k] == 0:
             continue
-        cc = np.rint(cols[:, None] + t[None, :] * step_x[k]).astype(np.intp)
-        rr = np.rint(rows[:, None] - t[None, :] * step_y[k]).astype(np.intp)
+        tk = t[: steps[k]]
+        cc = np.rint(cols[:, None] + tk[None, :] * step_x[k]).astype(np.intp)
+        rr = np.rint(rows[:, None] - tk[None, :] * step_y[k]).astype(np.intp)
         inside = (cc >= 0) & (cc < w) & (rr >= 0) & (rr < h)
         hh = height_px[np.clip(rr, 0, h - 1), np.clip(cc, 0, w - 1)]
-        ray = h0[:, None] + t[None, :] * rise[k]
+        ray = h0[:, None] + tk[None, :] * rise[k]
         vis[:, k] = ~np.any(inside & (hh > ray + 0.5), axis=1)
     return vis
 
