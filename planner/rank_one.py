@@ -100,6 +100,29 @@ class BiasTerms:
     tau2: float
 
 
+def _projected_inverse(
+    inv6: NDArray[np.float64], n: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``tr(P B⁻¹)`` (G,) and the entries (6, G) of ``B⁻¹ P B⁻¹ = B⁻² - u uᵀ`` (``u = B⁻¹n``,
+    ``P = I - n nᵀ``) from the entries of ``B⁻¹`` (6, G): a few dozen operations on vectors,
+    not three batched 3×3 products."""
+    a, b, c, d, e, f = inv6
+    x, y, z = n.T
+    u0, u1, u2 = a * x + b * y + c * z, b * x + d * y + e * z, c * x + e * y + f * z
+    tr0 = a + d + f - (x * u0 + y * u1 + z * u2)
+    c6 = np.stack(
+        [
+            a * a + b * b + c * c - u0 * u0,
+            a * b + b * d + c * e - u0 * u1,
+            a * c + b * e + c * f - u0 * u2,
+            b * b + d * d + e * e - u1 * u1,
+            b * c + d * e + e * f - u1 * u2,
+            c * c + e * e + f * f - u2 * u2,
+        ]
+    )
+    return tr0, c6
+
+
 def scan(
     base: NDArray[np.float64],
     w: NDArray[np.float64],
@@ -116,53 +139,81 @@ def scan(
     ``base`` (6, P): entries of ``B`` per pixel; ``w`` (K, P): each candidate's weight per
     pixel; ``d`` (K, 3) and ``l6 = quadratic_coefficients(d)``; ``normals`` (P, 3) and pixel
     weights ``wts`` (P,); the bias pixels are the first ``len(bias.wts)`` pixels.
+
+    The (K, P) work is two products with ``l6`` and four element-wise passes;
+    the pixel weights are folded into ``B⁻¹PB⁻¹`` before the product, so the weighted sum over
+    pixels is a row-wise dot product.
     """
     inv6, good = inverse_entries(base)
+    every = bool(good.all())
     g = np.flatnonzero(good)
-    binv = _matrices(inv6[:, g])  # (G, 3, 3)
-    n = normals[g]
-    proj = np.eye(3)[None] - n[:, :, None] * n[:, None, :]  # (G, 3, 3)
-    pb = proj @ binv
-    tr0 = np.trace(pb, axis1=1, axis2=2)  # tr(P B⁻¹)
-    c = binv @ pb  # B⁻¹ P B⁻¹
-    wg = w if len(g) == len(good) else w[:, g]
-    s = l6 @ inv6[:, g]  # lᵀ B⁻¹ l  (K, G)
-    s *= wg
-    s += 1.0
-    np.divide(wg, s, out=s)  # s = w / (1 + w lᵀ B⁻¹ l)
-    q2 = l6 @ _entries(c)  # lᵀ B⁻¹ P B⁻¹ l = ‖P u‖²
-    wts_g = wts[g]
+    inv_g = inv6 if every else inv6[:, g]
+    wg = w if every else w[:, g]
+    wts_g = wts if every else wts[g]
+    tr0, c6 = _projected_inverse(inv_g, normals if every else normals[g])
     # the variance σ²(tr(P B⁻¹) - s q2) lies in [0, σ² tr(P B⁻¹)]: only where that bound
     # passes the cap does a pixel need clipping; elsewhere the weighted sum is taken directly
     capped = noise2 * tr0 > max_err2
-    if bias is not None:  # the bias part below needs s and q2 on its pixels: keep copies
-        at = np.searchsorted(g, np.flatnonzero(good[: len(bias.wts)]))
-        sb, qb = s[:, at], q2[:, at]
-    if np.any(capped):
+    any_capped = bool(np.any(capped))
+    s = l6 @ inv_g  # lᵀ B⁻¹ l  (K, G)
+    q2 = l6 @ (c6 if any_capped else c6 * wts_g)  # ‖P u‖² = lᵀ B⁻¹ P B⁻¹ l (times wts)
+    s *= wg
+    s += 1.0
+    np.divide(wg, s, out=s)  # s = w / (1 + w lᵀ B⁻¹ l)
+    if any_capped:
         var = np.clip(noise2 * (tr0[None] - s * q2), 0.0, max_err2)
         err2 = var @ wts_g
     else:
-        q2 *= s
-        err2 = noise2 * (float(tr0 @ wts_g) - q2 @ wts_g)
+        err2 = noise2 * (float(tr0 @ wts_g) - np.einsum("kp,kp->k", s, q2))
     bad = np.flatnonzero(~good)
     bad_bias = np.zeros(0, dtype=np.intp)
     if bias is not None:
         nb = len(bias.wts)
         bad_bias = bad[bad < nb]
-        gb = np.flatnonzero(good[:nb])  # bias pixels that are well-conditioned (columns at)
-        bi, pr = binv[at], proj[at]
-        rb = np.transpose(bias.rb[:, gb], (1, 0, 2))  # (Gb, 3, 9)
-        ga = np.transpose(bias.g_all[:, gb], (1, 0, 2))
-        gbm = bi @ rb  # G_B = B⁻¹ R_B
-        pdm = pr @ (gbm - ga)  # P D
-        c0 = np.sum(pdm * pdm, axis=(1, 2))  # ‖P D‖²
-        f = bi @ pdm  # B⁻¹ P D, so uᵀ P D v = lᵀ F (h - G_Bᵀ l)
-        lh = (d[:, :, None] * bias.h[:, None, :]).reshape(len(d), 27)  # l ⊗ h
-        a1 = lh @ f.reshape(len(gb), 27).T  # lᵀ F h
-        a2 = l6 @ _entries(f @ np.transpose(gbm, (0, 2, 1)))  # lᵀ F G_Bᵀ l
-        b1 = lh @ gbm.reshape(len(gb), 27).T  # lᵀ G_B h
-        b2 = l6 @ _entries(gbm @ np.transpose(gbm, (0, 2, 1)))  # lᵀ G_B G_Bᵀ l
-        hh = np.sum(bias.h * bias.h, axis=1)[:, None]
-        tang = c0[None] + 2.0 * sb * (a1 - a2) + sb * sb * qb * (hh - 2.0 * b1 + b2)
-        err2 = err2 + np.clip(bias.tau2 * tang, 0.0, max_err2) @ bias.wts[gb]
+        err2 = err2 + _bias_scan(inv6, good, d, l6, normals, w, bias, max_err2)
     return ScanResult(err2, bad, bad_bias)
+
+
+def _bias_scan(
+    inv6: NDArray[np.float64],
+    good: NDArray[np.bool_],
+    d: NDArray[np.float64],
+    l6: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    w: NDArray[np.float64],
+    bias: BiasTerms,
+    max_err2: float,
+) -> NDArray[np.float64]:
+    """The model-bias part of :func:`scan` over its well-conditioned bias pixels (K,)."""
+    nb = len(bias.wts)
+    gb = np.flatnonzero(good[:nb])  # bias pixels that are well-conditioned
+    inv_b = inv6[:, gb]
+    bi = _matrices(inv_b)  # (Gb, 3, 3)
+    n = normals[gb]
+    pr = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
+    _, qc6 = _projected_inverse(inv_b, n)
+    rb = np.transpose(bias.rb[:, gb], (1, 0, 2))  # (Gb, 3, 9)
+    ga = np.transpose(bias.g_all[:, gb], (1, 0, 2))
+    gbm = bi @ rb  # G_B = B⁻¹ R_B
+    pdm = pr @ (gbm - ga)  # P D
+    c0 = np.sum(pdm * pdm, axis=(1, 2))  # ‖P D‖²
+    f = bi @ pdm  # B⁻¹ P D, so uᵀ P D v = lᵀ F (h - G_Bᵀ l)
+    k, m = len(d), len(gb)
+    gbt = np.transpose(gbm, (0, 2, 1))
+    # every form in l the bias needs, from one product of [l ⊗ h, l6] (K, 33) with their
+    # coefficients: lᵀFh - lᵀFG_Bᵀl, -2 lᵀG_Bh + lᵀG_BG_Bᵀl, lᵀB⁻¹l and lᵀB⁻¹PB⁻¹l
+    lh = (d[:, :, None] * bias.h[:, None, :]).reshape(k, 27)  # l ⊗ h
+    coef = np.zeros((33, 4 * m))
+    coef[:27, :m] = f.reshape(m, 27).T
+    coef[:27, m : 2 * m] = -2.0 * gbm.reshape(m, 27).T
+    coef[27:, :m] = -_entries(f @ gbt)
+    coef[27:, m : 2 * m] = _entries(gbm @ gbt)
+    coef[27:, 2 * m : 3 * m] = inv_b
+    coef[27:, 3 * m :] = qc6
+    forms = np.concatenate([lh, l6], axis=1) @ coef  # (K, 4m)
+    cross, spread = forms[:, :m], forms[:, m : 2 * m]
+    wb = w[:, gb]
+    sb = wb / (1.0 + wb * forms[:, 2 * m : 3 * m])  # s = w / (1 + w lᵀ B⁻¹ l)
+    hh = np.sum(bias.h * bias.h, axis=1)[:, None]
+    tang = c0[None] + 2.0 * sb * cross + sb * sb * forms[:, 3 * m :] * (hh + spread)
+    return np.clip(bias.tau2 * tang, 0.0, max_err2) @ bias.wts[gb]
