@@ -139,8 +139,12 @@ class OptimalMethod:
                 f"layout ({label}) is kept"
             )
             return chosen
-        res = exchange_search(objective, ctx.starts, search=binned_objective(objective))
+        search = binned_objective(objective)
+        res = exchange_search(objective, ctx.starts, search=search)
         report.start_layout, report.swaps = res.start_label, res.swaps
+        if search is not objective:
+            assert isinstance(search, NormalsObjective) and isinstance(objective, NormalsObjective)
+            report.search_pixels = (len(objective.n), len(search.n))
         report.expected.update(res.start_costs)
         report.expected["optimal"] = res.cost
         if n >= MANY_LIGHTS and ctx.objective == "normals" and res.swaps > 0:
