@@ -188,6 +188,10 @@ class SurfaceSample:
     bias_weights: NDArray[np.float64] | None = None
 
 
+#: Lights whose shadow rays are marched together (bounds the (pixels, steps, lights) arrays).
+MARCH_GROUP = 16
+
+
 def cast_shadow_visibility(
     height_px: NDArray[np.float64],
     rows: NDArray[np.intp],
@@ -218,16 +222,20 @@ def cast_shadow_visibility(
     reach = (float(height_px.max()) - float(h0.min()) - 0.5) / np.maximum(rise, 1e-12)
     steps = np.where(rise > 0, np.clip(np.ceil(reach) - 1, 0, max_steps), max_steps)
     steps = steps.astype(np.intp)
-    for k in range(len(d)):
-        if horiz[k] < 1e-6 or steps[k] == 0:
+    # marched together in groups of similar step counts (a step past a light's own count
+    # cannot find it blocked, so a group marches as far as its longest)
+    marched = np.flatnonzero((horiz >= 1e-6) & (steps > 0))
+    marched = marched[np.argsort(steps[marched], kind="stable")]
+    for group in np.array_split(marched, max(1, -(-len(marched) // MARCH_GROUP))):
+        if len(group) == 0:
             continue
-        tk = t[: steps[k]]
-        cc = np.rint(cols[:, None] + tk[None, :] * step_x[k]).astype(np.intp)
-        rr = np.rint(rows[:, None] - tk[None, :] * step_y[k]).astype(np.intp)
+        tk = t[: int(steps[group].max())][None, :, None]  # (1, T, 1)
+        cc = np.rint(cols[:, None, None] + tk * step_x[group]).astype(np.intp)  # (P, T, G)
+        rr = np.rint(rows[:, None, None] - tk * step_y[group]).astype(np.intp)
         inside = (cc >= 0) & (cc < w) & (rr >= 0) & (rr < h)
         hh = height_px[np.clip(rr, 0, h - 1), np.clip(cc, 0, w - 1)]
-        ray = h0[:, None] + tk[None, :] * rise[k]
-        vis[:, k] = ~np.any(inside & (hh > ray + 0.5), axis=1)
+        ray = h0[:, None, None] + tk * rise[group]
+        vis[:, group] = ~np.any(inside & (hh > ray + 0.5), axis=1)
     return vis
 
 
@@ -367,7 +375,8 @@ class NormalsObjective:
         self.l6 = rank_one.quadratic_coefficients(d)
         self.hsh = design_matrix("hsh2", d)  # (K, 9)
         self._sums: tuple[bytes, NDArray, NDArray | None] | None = None
-        self._among: tuple[bytes, NDArray] | None = None
+        self._among: tuple[bytes, tuple[NDArray, NDArray]] | None = None
+        self._w32: NDArray[np.float32] | None = None
         if self.tau2 > 0:
             every = np.arange(len(d))
             all_m = self._information(every)[:, : self.n_bias]  # (6, P_bias)
@@ -469,14 +478,20 @@ class NormalsObjective:
     def candidate_count(self) -> int:
         return len(self.dirs)
 
-    def _weights_among(self, among: NDArray[np.intp] | None) -> NDArray[np.float64]:
-        """The scan weights (K', P) of the candidates ``among``, kept while they are the same
-        (the unused candidates do not change until a swap is accepted)."""
-        if among is None:
-            return self.w_kp
+    #: How the exchange search scans, fastest first: a proposed swap that the exact cost does
+    #: not confirm earns a scan at the next level (:mod:`rti_rig.planner.optimal`).
+    scan_levels = ({}, {"single": False}, {"exact": True})
+
+    def _weights_among(self, among: NDArray[np.intp]) -> tuple[NDArray, NDArray]:
+        """The single-precision scan weights (K', P) of the candidates ``among`` and their
+        weights at the bias pixels (K', P_bias), kept while they are the same (the unused
+        candidates do not change until a swap is accepted)."""
         key = np.asarray(among, dtype=np.intp).tobytes()
         if self._among is None or self._among[0] != key:
-            self._among = (key, self.w_kp[np.asarray(among, dtype=np.intp)])
+            k = np.asarray(among, dtype=np.intp)
+            if self._w32 is None:
+                self._w32 = self.w_kp.astype(np.float32)
+            self._among = (key, (self._w32[k], self.w_kp[k, : self.n_bias]))
         return self._among[1]
 
     def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
@@ -495,6 +510,7 @@ class NormalsObjective:
         position: int,
         exact: bool = False,
         among: NDArray[np.intp] | None = None,
+        single: bool = True,
     ) -> NDArray[np.float64]:
         """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch; with
         ``among``, only those candidates are scored (the others cost inf: the exchange search
@@ -502,8 +518,10 @@ class NormalsObjective:
 
         By rank-one updates (:mod:`rti_rig.planner.rank_one`; pixels whose information without
         that light is near-singular are evaluated directly) unless ``exact``: then every pixel
-        and candidate is evaluated directly (the reference; the exchange search re-scans this
-        way when a proposed swap's cost is not confirmed).
+        and candidate is evaluated directly (the reference). A pooled scan (``among`` over many
+        pixel rows: a preview's) runs its well-conditioned pixels in single precision unless
+        ``single`` is False. The exchange search re-scans in double precision, then exactly,
+        when a proposed swap's cost is not confirmed (:attr:`scan_levels`).
         """
         total_m, total_r = self._chosen_sums(chosen)
         out_light = np.asarray(chosen, dtype=np.intp)[position : position + 1]
@@ -518,13 +536,15 @@ class NormalsObjective:
             r = None if rb is None else rb[:, None] + self._cross_at(k, every)  # (3, K, Pb, 9)
             costs = self._total(base[:, None, :] + self._outer_at(k, every), r)
         else:
-            w_kp = self._weights_among(among if pooled else None)
+            w32, w_bias = self._weights_among(among) if pooled else (None, None)
             bias = None
             if rb is not None:
-                bias = rank_one.BiasTerms(rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2)
+                bias = rank_one.BiasTerms(
+                    rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2, w_bias
+                )
             res = rank_one.scan(
-                base, w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2, MAX_ERR2,
-                bias,
+                base, self.w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2,
+                MAX_ERR2, bias, rows=k if pooled else None, w32=w32 if single else None,
             )  # fmt: skip
             err2 = res.err2
             if len(res.bad):

@@ -96,6 +96,7 @@ def _sweeps(
     # only the unused candidates can replace a light (a light is never chosen twice): an
     # objective that knows its candidate count scores only those (half of them at 100 of 200)
     count = getattr(objective, "candidate_count", None)
+    levels = getattr(objective, "scan_levels", ({"exact": False}, {"exact": True}))
     unused = None if count is None else np.ones(count, dtype=bool)
     if unused is not None:
         unused[chosen] = False
@@ -104,11 +105,11 @@ def _sweeps(
         before = cost
         for pos in range(n):
             scan_kw = {} if unused is None else {"among": np.flatnonzero(unused)}
-            for exact_scan in (False, True):
-                # the fast scan may be approximate (rank-one updates, rounding): a swap is
-                # accepted on its exact cost, and a proposal that cost does not confirm earns an
-                # exact re-scan
-                trial = objective.swap_costs(chosen, pos, exact=exact_scan, **scan_kw)
+            for level in levels:
+                # the fast scan may be approximate (rank-one updates, single precision): a swap
+                # is accepted on its exact cost, and a proposal that cost does not confirm
+                # earns a re-scan at the next level (the last: every pixel evaluated directly)
+                trial = objective.swap_costs(chosen, pos, **level, **scan_kw)
                 trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
                 k = int(np.argmin(trial))
                 if not float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):
