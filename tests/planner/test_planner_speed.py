@@ -298,3 +298,48 @@ def test_cli_plans_a_hundred_arm_lights_from_a_preview(tmp_path) -> None:
     want = np.array([s.direction for s in sched.steps])
     dist = np.linalg.norm(got[:, None] - want[None], axis=-1)  # the .lp rounds to 1e-6
     assert np.all(dist.min(axis=1) < 1e-5) and np.all(dist.min(axis=0) < 1e-5)
+
+
+def test_single_precision_scans_are_within_a_millionth_of_the_exact_costs() -> None:
+    """A preview's pooled scan runs in single precision (it differs from the double one) and
+    stays within 1e-6 of the direct evaluation for every candidate, bias term included."""
+    cands, starts, sample = planning_problem(ARM, 36, estimate_surface(relief_preview(), (30, 50)))
+    obj = NormalsObjective(sample, cands)
+    chosen = starts[0][1]
+    among = np.setdiff1d(np.arange(len(cands)), chosen)
+    with threadpool_limits(limits=1):
+        for pos in (0, 17, 35):
+            single = obj.swap_costs(chosen, pos, among=among)
+            double = obj.swap_costs(chosen, pos, among=among, single=False)
+            exact = obj.swap_costs(chosen, pos, among=among, exact=True)
+            assert not np.array_equal(single[among], double[among])  # the fast path ran
+            assert single[among] == pytest.approx(exact[among], rel=1e-6)
+            assert double[among] == pytest.approx(exact[among], rel=1e-9)
+
+
+def test_a_proposal_the_exact_cost_rejects_is_rescanned_in_double_then_exactly() -> None:
+    """The scan levels of the normals objective in order: single precision, double, direct."""
+    calls: list[dict] = []
+
+    class Ladder:
+        scan_levels = NormalsObjective.scan_levels
+        candidate_count = 10
+
+        def cost(self, chosen: np.ndarray) -> float:
+            return float(np.sum(chosen))
+
+        def swap_costs(self, chosen, position, exact=False, among=None, single=True):
+            calls.append({"exact": exact, "single": single})
+            if not exact:  # both fast levels promise a swap that is no gain
+                out = np.full(10, np.inf)
+                out[9] = -1.0
+                return out
+            return np.array([float(np.sum(chosen) - chosen[position] + k) for k in range(10)])
+
+    res = exchange_search(Ladder(), [("start", np.array([4, 5, 6]))], max_passes=1)  # type: ignore[arg-type]
+    assert calls[:3] == [
+        {"exact": False, "single": True},
+        {"exact": False, "single": False},
+        {"exact": True, "single": True},
+    ]
+    assert sorted(res.chosen.tolist()) == [0, 1, 2]
