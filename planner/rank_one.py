@@ -18,6 +18,12 @@ of element-wise operations instead of a 3×3 inverse and a 3×9 solve per candid
 It is the same objective, not an approximation; the formulas need ``B⁻¹``, so a pixel whose
 ``B`` is singular or ill-conditioned (lit by fewer than three of the other lights) is left
 to the caller's direct evaluation (``bad`` in :class:`ScanResult`).
+
+The (candidates × pixels) passes may run in single precision on the pixels whose ``B`` is well
+conditioned (:data:`SINGLE_CONDITIONED`): on this machine 3–5× faster than double (the
+element-wise divisions most), with every candidate's cost within 1e-6 of the direct one (tested;
+measured ~1e-7). The exchange search accepts a swap only on its double-precision cost, and a
+proposal that cost rejects earns a double-precision, then a direct, re-scan.
 """
 
 from __future__ import annotations
