@@ -218,7 +218,7 @@ def scan(
         wb = weights(gb) if bias.w is None else bias.w[:, gb]
         single_b = w32 is not None and bool(single[gb].all())
         err2 = err2 + _bias_scan(
-            inv6[:, gb], normals[gb], d, l6, wb, bias, gb, max_err2, single_b
+            inv6[:, gb], c6[:, gb], normals[gb], d, l6, wb, bias, gb, max_err2, single_b
         )
     return ScanResult(err2, bad, bad_bias)
 
@@ -242,6 +242,7 @@ def _reduction(
 
 def _bias_scan(
     inv_b: NDArray[np.float64],
+    qc6: NDArray[np.float64],
     n: NDArray[np.float64],
     d: NDArray[np.float64],
     l6: NDArray[np.float64],
@@ -252,11 +253,11 @@ def _bias_scan(
     single: bool = False,
 ) -> NDArray[np.float64]:
     """The model-bias part of :func:`scan` over its well-conditioned bias pixels ``gb`` (K,):
-    their ``B⁻¹`` entries ``inv_b`` (6, Gb), normals (Gb, 3) and candidate weights (K, Gb);
+    their entries of ``B⁻¹`` and ``B⁻¹PB⁻¹`` (6, Gb), normals (Gb, 3) and candidate weights
+    (K, Gb);
     the (K, Gb) work in single precision when ``single``."""
     bi = _matrices(inv_b)  # (Gb, 3, 3)
     pr = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
-    _, qc6 = _projected_inverse(inv_b, n)
     rb = np.transpose(bias.rb[:, gb], (1, 0, 2))  # (Gb, 3, 9)
     ga = np.transpose(bias.g_all[:, gb], (1, 0, 2))
     gbm = bi @ rb  # G_B = B⁻¹ R_B
@@ -274,10 +275,10 @@ def _bias_scan(
     coef[:27, m:] = -2.0 * gbm.reshape(m, 27).T
     coef[27:, :m] = -_entries(f @ gbt)
     coef[27:, m:] = _entries(gbm @ gbt)
-    forms = np.concatenate([lh, l6], axis=1).astype(dt) @ coef.astype(dt)  # (K, 2m)
-    quad = l6.astype(dt) @ np.concatenate([inv_b, qc6], axis=1).astype(dt)  # (K, 2m)
+    forms = np.concatenate([lh, l6], axis=1).astype(dt, copy=False) @ coef.astype(dt, copy=False)
+    quad = l6.astype(dt, copy=False) @ np.concatenate([inv_b, qc6], axis=1).astype(dt, copy=False)
     cross, spread, sb, qb = forms[:, :m], forms[:, m:], quad[:, :m], quad[:, m:]
-    w = wb.astype(dt)
+    w = wb.astype(dt, copy=False)
     sb *= w
     sb += 1.0
     np.divide(w, sb, out=sb)  # s = w / (1 + w lᵀ B⁻¹ l)
