@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from rti_rig.planner.objectives import (
     BIAS_PIXELS,
+    POOL_MIN_PIXELS,
     NormalsObjective,
     RelightObjective,
     SurfaceSample,
@@ -101,6 +102,8 @@ def binned_objective(
     otherwise the objective itself (no preview: its 7 distinct rows already; the relight
     objective's cost does not grow with the pixels)."""
     if not isinstance(objective, NormalsObjective) or bin_deg <= 0:
+        return objective
+    if len(objective.n) < POOL_MIN_PIXELS:  # a few rows already: nothing worth the binning
         return objective
     binned = bin_pixels(objective.sample, bin_deg)
     if len(binned.normals) >= len(objective.n):
