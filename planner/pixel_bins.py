@@ -95,12 +95,14 @@ def bin_pixels(
 
 
 def binned_objective(
-    objective: NormalsObjective | RelightObjective, bin_deg: float = PIXEL_BIN_DEG
+    objective: NormalsObjective | RelightObjective, bin_deg: float | None = None
 ) -> NormalsObjective | RelightObjective:
     """The stand-in the exchange search sweeps with: the normals objective on the binned sample
     when that has fewer rows than the objective scores (from a preview: 1792 → 600–800);
     otherwise the objective itself (no preview: its 7 distinct rows already; the relight
-    objective's cost does not grow with the pixels)."""
+    objective's cost does not grow with the pixels). ``bin_deg`` None: :data:`PIXEL_BIN_DEG`
+    as it is when called (0 turns the binning off)."""
+    bin_deg = PIXEL_BIN_DEG if bin_deg is None else bin_deg
     if not isinstance(objective, NormalsObjective) or bin_deg <= 0:
         return objective
     if len(objective.n) < POOL_MIN_PIXELS:  # a few rows already: nothing worth the binning

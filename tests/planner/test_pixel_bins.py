@@ -157,3 +157,20 @@ def test_the_plan_report_says_the_search_was_binned() -> None:
     _, flat = plan_with_report(None, ARM, 24, "optimal", "normals")
     assert flat.search_pixels is None
 
+
+
+def test_pixel_bin_zero_turns_the_binning_off(monkeypatch) -> None:
+    """`PIXEL_BIN_DEG = 0`: the search sweeps every pixel row, and the plan is the one of the
+    search on the objective itself."""
+    from rti_rig.planner import pixel_bins
+
+    scene = relief_scene(96, 128, seed=0)
+    preview = lambert_radiance(scene, direction_from_az_el(30.0, 50.0)).astype(np.float32)
+    monkeypatch.setattr(pixel_bins, "PIXEL_BIN_DEG", 0.0)
+    sched, report = plan_with_report(preview, ARM, 24, "optimal", "normals", (30.0, 50.0))
+    assert report.search_pixels is None
+    cands, starts, sample = preview_problem(ARM, 24)
+    exact = NormalsObjective(sample, cands)
+    with threadpool_limits(limits=1):
+        want = exchange_search(exact, starts)
+    assert report.expected["optimal"] == pytest.approx(want.cost, rel=1e-12)
