@@ -167,7 +167,7 @@ def test_pixel_bin_zero_turns_the_binning_off(monkeypatch) -> None:
     scene = relief_scene(96, 128, seed=0)
     preview = lambert_radiance(scene, direction_from_az_el(30.0, 50.0)).astype(np.float32)
     monkeypatch.setattr(pixel_bins, "PIXEL_BIN_DEG", 0.0)
-    sched, report = plan_with_report(preview, ARM, 24, "optimal", "normals", (30.0, 50.0))
+    _, report = plan_with_report(preview, ARM, 24, "optimal", "normals", (30.0, 50.0))
     assert report.search_pixels is None
     cands, starts, sample = preview_problem(ARM, 24)
     exact = NormalsObjective(sample, cands)
