@@ -158,7 +158,6 @@ def test_the_plan_report_says_the_search_was_binned() -> None:
     assert flat.search_pixels is None
 
 
-
 def test_pixel_bin_zero_turns_the_binning_off(monkeypatch) -> None:
     """`PIXEL_BIN_DEG = 0`: the search sweeps every pixel row, and the plan is the one of the
     search on the objective itself."""
