@@ -121,7 +121,7 @@ def main(argv: list[str] | None = None) -> str:
                 f"{rig_name:12s} N={n:3d} candidates={len(cands)} adaptive decision "
                 f"{t_dec:.3f} s, design decision {t_des:.3f} s, optimal plan {t_opt:.2f} s "
                 f"(uniform {t_uni:.3f} s, "
-                f"{t_opt / t_uni:.1f}×), from a preview {t_prev:.2f} s",
+                f"{t_opt / t_uni:.1f}×), from a preview {t_prev:.2f} s ({t_prev / t_uni:.1f}×)",
                 flush=True,
             )
     decisions_only = args.max_optimal_n <= 0
@@ -153,11 +153,12 @@ def main(argv: list[str] | None = None) -> str:
             "| rig | N | candidates | light-by-light decision s, N images so far (target ≤ 0.2) "
             "| design decision s, N/2 images so far, N planned (target ≤ 0.2) "
             "| `plan --method optimal` s (target ≤ 1) | `uniform` s | optimal / uniform "
-            "| `optimal` from a preview s |",
-            "|---|---|---|---|---|---|---|---|---|",
+            "| `optimal` from a preview s (target ≤ 1) | from a preview / uniform |",
+            "|---|---|---|---|---|---|---|---|---|---|",
         ]
         lines += [
-            f"| {r} | {n} | {c} | {d:.3f} | {e:.3f} | {o:.2f} | {u:.3f} | {o / u:.1f}× | {p:.2f} |"
+            f"| {r} | {n} | {c} | {d:.3f} | {e:.3f} | {o:.2f} | {u:.3f} | {o / u:.1f}× | {p:.2f} "
+            f"| {p / u:.1f}× |"
             for r, n, c, d, e, o, u, p in rows
         ]
     md = "\n".join(lines)

@@ -111,45 +111,79 @@ def _two_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bo
 def _or_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
     """One pass of Or-opt: move a segment of 1-3 stops elsewhere, forwards or reversed.
 
-    Exact deltas (edges removed and added, plus the inner edges' change when reversed), with
-    all insertion points evaluated at once."""
+    Exact deltas (edges removed and added, plus the inner edges' change when reversed). The
+    segments are examined in path order and the first that can move is moved (then the same
+    place is examined again); the deltas of every remaining segment and insertion point are
+    evaluated at once, with the same arithmetic as one at a time."""
     improved = False
+    m = len(nodes)
     for seg in (1, 2, 3):
         i = 1
-        while i + seg <= len(nodes):
+        while i + seg <= m:
+            move = _first_segment_move(np.asarray(nodes), cost, seg, i)
+            if move is None:
+                break
+            i, pos, rev = move
             s = nodes[i : i + seg]
-            p = nodes[i - 1]
-            q = nodes[i + seg] if i + seg < len(nodes) else None
-            removed = cost[p, s[0]] + (cost[s[-1], q] if q is not None else 0.0)
-            bridged = cost[p, q] if q is not None else 0.0
-            inner_f = sum(cost[s[t], s[t + 1]] for t in range(seg - 1))
-            inner_b = sum(cost[s[t + 1], s[t]] for t in range(seg - 1))
-            rest = np.asarray(nodes[:i] + nodes[i + seg :])
-            x = rest  # insert after rest[pos-1] = x, before y (None at the end)
-            y = np.append(rest[1:], -1)
-            has_y = y >= 0
-            y_safe = np.where(has_y, y, 0)
-            opened = np.where(has_y, cost[x, y_safe], 0.0)
-            best_delta, best_move = -1e-12, None
-            for rev, first, last, inner in (
-                (False, s[0], s[-1], inner_f),
-                (True, s[-1], s[0], inner_b),
-            ):
-                added = cost[x, first] + np.where(has_y, cost[last, y_safe], 0.0)
-                delta = (bridged - removed) + (added - opened) + (inner - inner_f)
-                delta[i - 1] = np.inf  # that is where the segment came from
-                j = int(np.argmin(delta))
-                if delta[j] < best_delta:
-                    best_delta, best_move = float(delta[j]), (j + 1, rev)
-            if best_move is not None:
-                pos, rev = best_move
-                piece = s[::-1] if rev else s
-                rest_l = rest.tolist()
-                nodes = rest_l[:pos] + piece + rest_l[pos:]
-                improved = True
-            else:
-                i += 1
+            rest_l = nodes[:i] + nodes[i + seg :]
+            piece = s[::-1] if rev else s
+            nodes = rest_l[:pos] + piece + rest_l[pos:]
+            improved = True
     return nodes, improved
+
+
+def _first_segment_move(
+    arr: NDArray[np.intp], cost: NDArray[np.float64], seg: int, start: int
+) -> tuple[int, int, bool] | None:
+    """The first segment (from path position ``start`` on) of ``seg`` stops that an Or-opt
+    move shortens, as (position, insertion index into the path without it, reversed), or None.
+
+    Row ``r`` is the segment at position ``i = start + r``; column ``jj`` inserts it after the
+    ``jj``-th stop of the path without it (``x``), before the next (``y``, none at the end)."""
+    m = len(arr)
+    ii = np.arange(start, m - seg + 1)
+    if len(ii) == 0:
+        return None
+    first, last = arr[ii], arr[ii + seg - 1]
+    p = arr[ii - 1]
+    has_q = ii + seg < m
+    q = arr[np.minimum(ii + seg, m - 1)]
+    removed = cost[p, first] + np.where(has_q, cost[last, q], 0.0)
+    bridged = np.where(has_q, cost[p, q], 0.0)
+    inner_f = np.zeros(len(ii))
+    inner_b = np.zeros(len(ii))
+    for t in range(seg - 1):
+        inner_f = inner_f + cost[arr[ii + t], arr[ii + t + 1]]
+        inner_b = inner_b + cost[arr[ii + t + 1], arr[ii + t]]
+    # the path without the segment: rest[jj] = arr[jj] before it, arr[jj + seg] after it
+    n_rest = m - seg
+    jj = np.arange(n_rest)[None, :]
+    after = jj >= ii[:, None]
+    x = np.where(after, arr[np.minimum(jj + seg, m - 1)], arr[jj])
+    yj = jj + 1
+    has_y = yj < n_rest
+    y = np.where(yj >= ii[:, None], arr[np.minimum(yj + seg, m - 1)], arr[np.minimum(yj, m - 1)])
+    y_safe = np.where(has_y, y, 0)
+    opened = np.where(has_y, cost[x, y_safe], 0.0)
+    rows = np.arange(len(ii))
+    best_delta = np.full(len(ii), -1e-12)
+    best_pos = np.full(len(ii), -1)
+    best_rev = np.zeros(len(ii), dtype=bool)
+    for rev, a, b, inner in ((False, first, last, inner_f), (True, last, first, inner_b)):
+        added = cost[x, a[:, None]] + np.where(has_y, cost[b[:, None], y_safe], 0.0)
+        delta = (bridged - removed)[:, None] + (added - opened) + (inner - inner_f)[:, None]
+        delta[rows, ii - 1] = np.inf  # that is where the segment came from
+        j = np.argmin(delta, axis=1)
+        dj = delta[rows, j]
+        better = dj < best_delta
+        best_delta = np.where(better, dj, best_delta)
+        best_pos = np.where(better, j + 1, best_pos)
+        best_rev = np.where(better, rev, best_rev)
+    found = np.flatnonzero(best_pos >= 0)
+    if len(found) == 0:
+        return None
+    r = int(found[0])
+    return int(ii[r]), int(best_pos[r]), bool(best_rev[r])
 
 
 def _local_search(nodes: list[int], cost: NDArray[np.float64], max_rounds: int = 100) -> list[int]:

@@ -16,6 +16,7 @@ from rti_rig.planner.kmeans_method import plan_kmeans
 from rti_rig.planner.methods import MethodContext, SurfaceNeed, register_method
 from rti_rig.planner.objectives import NormalsObjective, RelightObjective
 from rti_rig.planner.optimal import exchange_search
+from rti_rig.planner.pixel_bins import binned_objective
 
 #: Below this many lights the exchange search is not run: 3 lights are exactly the unknowns of
 #: the Lambertian fit, with no redundancy left for a shadow or a highlight.
@@ -138,8 +139,12 @@ class OptimalMethod:
                 f"layout ({label}) is kept"
             )
             return chosen
-        res = exchange_search(objective, ctx.starts)
+        search = binned_objective(objective)
+        res = exchange_search(objective, ctx.starts, search=search)
         report.start_layout, report.swaps = res.start_label, res.swaps
+        if search is not objective:
+            assert isinstance(search, NormalsObjective) and isinstance(objective, NormalsObjective)
+            report.search_pixels = (len(objective.n), len(search.n))
         report.expected.update(res.start_costs)
         report.expected["optimal"] = res.cost
         if n >= MANY_LIGHTS and ctx.objective == "normals" and res.swaps > 0:

@@ -22,6 +22,7 @@ it has to rank layouts, not render images.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -182,6 +183,13 @@ class SurfaceSample:
     #: how many leading rows are the estimated surface itself (the rest: hedge copies of it,
     #: :func:`rti_rig.planner.surface_estimate.hedge_global_tilt`); None means every row
     base_count: int | None = None
+    #: a binned sample's (:func:`rti_rig.planner.pixel_bins.bin_pixels`): the weights of its
+    #: leading rows in the bias term's sub-sample; None: the first rows of the estimated surface
+    bias_weights: NDArray[np.float64] | None = None
+
+
+#: Lights whose shadow rays are marched together (bounds the (pixels, steps, lights) arrays).
+MARCH_GROUP = 16
 
 
 def cast_shadow_visibility(
@@ -208,19 +216,26 @@ def cast_shadow_visibility(
     vis = np.ones((len(rows), len(d)))
     if len(rows) == 0:
         return vis
-    # a light whose ray climbs from the lowest sampled pixel to above the highest terrain
-    # within one step cannot be blocked anywhere: skipped (all of them on a level surface)
-    climb = np.minimum(rise, max_steps * rise)
-    free = float(height_px.max()) - float(h0.min()) <= climb + 0.5
-    for k in range(len(d)):
-        if horiz[k] < 1e-6 or free[k]:
+    # a ray that has climbed from the lowest sampled pixel to within 0.5 px of the highest
+    # terrain cannot be blocked any further on: only the steps before are marched (none on a
+    # level surface or for a light that gets there in one step; the march is otherwise the same)
+    reach = (float(height_px.max()) - float(h0.min()) - 0.5) / np.maximum(rise, 1e-12)
+    steps = np.where(rise > 0, np.clip(np.ceil(reach) - 1, 0, max_steps), max_steps)
+    steps = steps.astype(np.intp)
+    # marched together in groups of similar step counts (a step past a light's own count
+    # cannot find it blocked, so a group marches as far as its longest)
+    marched = np.flatnonzero((horiz >= 1e-6) & (steps > 0))
+    marched = marched[np.argsort(steps[marched], kind="stable")]
+    for group in np.array_split(marched, max(1, -(-len(marched) // MARCH_GROUP))):
+        if len(group) == 0:
             continue
-        cc = np.rint(cols[:, None] + t[None, :] * step_x[k]).astype(np.intp)
-        rr = np.rint(rows[:, None] - t[None, :] * step_y[k]).astype(np.intp)
+        tk = t[: int(steps[group].max())][None, :, None]  # (1, T, 1)
+        cc = np.rint(cols[:, None, None] + tk * step_x[group]).astype(np.intp)  # (P, T, G)
+        rr = np.rint(rows[:, None, None] - tk * step_y[group]).astype(np.intp)
         inside = (cc >= 0) & (cc < w) & (rr >= 0) & (rr < h)
         hh = height_px[np.clip(rr, 0, h - 1), np.clip(cc, 0, w - 1)]
-        ray = h0[:, None] + t[None, :] * rise[k]
-        vis[:, k] = ~np.any(inside & (hh > ray + 0.5), axis=1)
+        ray = h0[:, None, None] + tk * rise[group]
+        vis[:, group] = ~np.any(inside & (hh > ray + 0.5), axis=1)
     return vis
 
 
@@ -313,6 +328,8 @@ class NormalsObjective:
         merge_pixels: bool = True,
     ) -> None:
         self.sample = sample
+        self.candidates = candidates
+        self.bias_rel = bias_rel
         self.gain_rel = gain_rel
         d = candidates.directions
         w = light_weights(sample, d)  # (P, K)
@@ -320,48 +337,80 @@ class NormalsObjective:
             # observation variance σ²(1 + (g/σ)² (n·l)²) in units of σ²: weight = 1/variance
             shading = np.clip(sample.normals @ d.T, 0.0, None)
             w = w / (1.0 + (gain_rel / NOISE_REL) ** 2 * shading * shading)
-        # the bias term is smooth over normals: a sub-sample of the (random) pixels suffices
-        # ... taken from the estimated surface itself, never from its tilted hedge copies
-        # (with fewer sampled pixels than BIAS_PIXELS they would otherwise slip in)
-        n_bias = min(sample.base_count or len(sample.normals), BIAS_PIXELS)
-        # pixels that are the same to this objective (same normal, same weight for every
-        # candidate: a level preview's or a flat region's) are scored once, with their summed
-        # weight — the same cost, in a fraction of the time (no preview: 1792 rows → 7)
         wts = sample.weights / sample.weights.sum()
-        if merge_pixels:
-            rows, wts, wts_bias = merge_identical_pixels(sample.normals, w, wts, n_bias)
+        if sample.bias_weights is not None:
+            # a binned sample (:mod:`rti_rig.planner.pixel_bins`): its rows are distinct and it
+            # says which lead the bias term and with what weights
+            rows = np.arange(len(w))
+            wts_bias = sample.bias_weights / sample.bias_weights.sum()
         else:
-            rows, wts_bias = np.arange(len(w)), wts[:n_bias] / wts[:n_bias].sum()
+            # the bias term is smooth over normals: a sub-sample of the (random) pixels
+            # suffices ... taken from the estimated surface itself, never from its tilted
+            # hedge copies (with fewer sampled pixels than BIAS_PIXELS they would otherwise
+            # slip in)
+            n_bias = min(sample.base_count or len(sample.normals), BIAS_PIXELS)
+            # pixels that are the same to this objective (same normal, same weight for every
+            # candidate: a level preview's or a flat region's) are scored once, with their
+            # summed weight — the same cost, in a fraction of the time (no preview: 1792 → 7)
+            if merge_pixels:
+                rows, wts, wts_bias = merge_identical_pixels(sample.normals, w, wts, n_bias)
+            else:
+                rows, wts_bias = np.arange(len(w)), wts[:n_bias] / wts[:n_bias].sum()
         w = w[rows]
         self.n = sample.normals[rows]
         self.wts = wts
         self.n_bias = len(wts_bias)
         self.wts_bias = wts_bias
-        # information contributed by candidate k at pixel p, as the 6 distinct entries of
-        # w_pk l_k l_kᵀ: shape (6, K, P), contiguous per entry for fast batched swaps
-        self.outer = np.ascontiguousarray(
-            np.stack([w.T * (d[:, i] * d[:, j])[:, None] for i, j in self.PAIRS])
-        )
         x, y, z = self.n.T
         # entries of P = I - n nᵀ paired with adj(M): diagonal once, off-diagonal twice
         proj = np.stack([1 - x * x, 1 - y * y, 1 - z * z, -2 * x * y, -2 * x * z, -2 * y * z])
         self.projector = (proj, proj.astype(np.float32))
         self.tau2 = (bias_rel * np.sqrt(2 * np.pi / 9)) ** 2  # RMS deviation = bias_rel
         self.dirs = d
-        self.w_kp = np.ascontiguousarray(w.T)  # (K, P): the rank-one scans' weights
+        # candidate k's information at pixel p is w_pk l_k l_kᵀ: its 6 distinct entries are
+        # d6[k] * w_kp[k, p], so a layout's information is one small matrix product
+        # (6 × N) @ (N × P), never a (6, K, P) array (:attr:`outer` builds that on demand)
+        self.w_kp = np.ascontiguousarray(w.T)  # (K, P): also the rank-one scans' weights
+        self.d6 = np.ascontiguousarray(np.stack([d[:, i] * d[:, j] for i, j in self.PAIRS], 1))
         self.l6 = rank_one.quadratic_coefficients(d)
         self.hsh = design_matrix("hsh2", d)  # (K, 9)
         self._sums: tuple[bytes, NDArray, NDArray | None] | None = None
-        self._among: tuple[bytes, NDArray] | None = None
+        self._among: tuple[bytes, tuple[NDArray, NDArray]] | None = None
+        self._w32: NDArray[np.float32] | None = None
         if self.tau2 > 0:
-            hsh = self.hsh
-            wsub = w[: self.n_bias]
-            # cross term w_pk l_k h_kᵀ as (3, K, P_bias, 9)
-            self.cross = np.ascontiguousarray(
-                d.T[:, :, None, None] * wsub.T[None, :, :, None] * hsh[None, :, None, :]
-            )
-            all_m = self.outer[..., : self.n_bias].sum(axis=1)  # (6, P_bias)
-            self.g_all = self._solve(all_m[:, None], self.cross.sum(axis=1)[:, None])[:, 0]
+            every = np.arange(len(d))
+            all_m = self._information(every)[:, : self.n_bias]  # (6, P_bias)
+            self.g_all = self._solve(all_m[:, None], self._cross_sum(every)[:, None])[:, 0]
+
+    def _information(self, chosen: NDArray[np.intp]) -> NDArray[np.float64]:
+        """Entries (6, P) of ``M = Σ_k w_pk l_k l_kᵀ`` over the lights ``chosen``."""
+        return self.d6[chosen].T @ self.w_kp[chosen]
+
+    def _cross_sum(self, chosen: NDArray[np.intp]) -> NDArray[np.float64]:
+        """The bias pixels' cross terms ``Σ_k w_pk l_k h_kᵀ`` over ``chosen``: (3, P_bias, 9)."""
+        wb = self.w_kp[chosen, : self.n_bias]  # (N, P_bias)
+        h = self.hsh[chosen]
+        return np.stack([(wb * self.dirs[chosen, i, None]).T @ h for i in range(3)])
+
+    def _outer_at(self, k: NDArray[np.intp] | slice, pix: NDArray[np.intp] | slice) -> NDArray:
+        """Information entries (6, K', P') of the candidates ``k`` at the pixels ``pix``."""
+        return self.d6[k].T[:, :, None] * self.w_kp[k][:, pix][None]
+
+    def _cross_at(self, k: NDArray[np.intp] | slice, pix: NDArray[np.intp] | slice) -> NDArray:
+        """Cross terms (3, K', P', 9) of the candidates ``k`` at the bias pixels ``pix``."""
+        wb = self.w_kp[k, : self.n_bias][:, pix]  # (K', P')
+        return self.dirs[k].T[:, :, None, None] * (wb[:, :, None] * self.hsh[k][:, None, :])[None]
+
+    @cached_property
+    def outer(self) -> NDArray[np.float64]:
+        """Every candidate's information entries per pixel (6, K, P) (for analyses; the search
+        never builds it)."""
+        return np.ascontiguousarray(self._outer_at(slice(None), slice(None)))
+
+    @cached_property
+    def cross(self) -> NDArray[np.float64]:
+        """Every candidate's cross terms at the bias pixels (3, K, P_bias, 9) (for analyses)."""
+        return np.ascontiguousarray(self._cross_at(slice(None), slice(None)))
 
     @staticmethod
     def _adjugate(m: NDArray[np.float64]) -> tuple[tuple[NDArray, ...], NDArray]:
@@ -420,22 +469,29 @@ class NormalsObjective:
         return np.degrees(np.sqrt(err2))
 
     def cost(self, chosen: NDArray[np.intp]) -> float:
-        m = self.outer[:, chosen].sum(axis=1)[:, None]  # (6, 1, P)
-        r = self.cross[:, chosen].sum(axis=1)[:, None] if self.tau2 > 0 else None
+        chosen = np.asarray(chosen, dtype=np.intp)
+        m = self._information(chosen)[:, None]  # (6, 1, P)
+        r = self._cross_sum(chosen)[:, None] if self.tau2 > 0 else None
         return float(self._total(m, r)[0])
 
     @property
     def candidate_count(self) -> int:
-        return int(self.outer.shape[1])
+        return len(self.dirs)
 
-    def _weights_among(self, among: NDArray[np.intp] | None) -> NDArray[np.float64]:
-        """The scan weights (K', P) of the candidates ``among``, kept while they are the same
-        (the unused candidates do not change until a swap is accepted)."""
-        if among is None:
-            return self.w_kp
+    #: How the exchange search scans, fastest first: a proposed swap that the exact cost does
+    #: not confirm earns a scan at the next level (:mod:`rti_rig.planner.optimal`).
+    scan_levels = ({}, {"single": False}, {"exact": True})
+
+    def _weights_among(self, among: NDArray[np.intp]) -> tuple[NDArray, NDArray]:
+        """The single-precision scan weights (K', P) of the candidates ``among`` and their
+        weights at the bias pixels (K', P_bias), kept while they are the same (the unused
+        candidates do not change until a swap is accepted)."""
         key = np.asarray(among, dtype=np.intp).tobytes()
         if self._among is None or self._among[0] != key:
-            self._among = (key, self.w_kp[np.asarray(among, dtype=np.intp)])
+            k = np.asarray(among, dtype=np.intp)
+            if self._w32 is None:
+                self._w32 = self.w_kp.astype(np.float32)
+            self._among = (key, (self._w32[k], self.w_kp[k, : self.n_bias]))
         return self._among[1]
 
     def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
@@ -443,8 +499,9 @@ class NormalsObjective:
         a sweep scans every position of one layout until a swap is accepted)."""
         key = np.asarray(chosen, dtype=np.intp).tobytes()
         if self._sums is None or self._sums[0] != key:
-            r = self.cross[:, chosen].sum(axis=1) if self.tau2 > 0 else None
-            self._sums = (key, self.outer[:, chosen].sum(axis=1), r)
+            chosen = np.asarray(chosen, dtype=np.intp)
+            r = self._cross_sum(chosen) if self.tau2 > 0 else None
+            self._sums = (key, self._information(chosen), r)
         return self._sums[1], self._sums[2]
 
     def swap_costs(
@@ -453,6 +510,7 @@ class NormalsObjective:
         position: int,
         exact: bool = False,
         among: NDArray[np.intp] | None = None,
+        single: bool = True,
     ) -> NDArray[np.float64]:
         """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch; with
         ``among``, only those candidates are scored (the others cost inf: the exchange search
@@ -460,41 +518,47 @@ class NormalsObjective:
 
         By rank-one updates (:mod:`rti_rig.planner.rank_one`; pixels whose information without
         that light is near-singular are evaluated directly) unless ``exact``: then every pixel
-        and candidate is evaluated directly (the reference; the exchange search re-scans this
-        way when a proposed swap's cost is not confirmed).
+        and candidate is evaluated directly (the reference). A pooled scan (``among`` over many
+        pixel rows: a preview's) runs its well-conditioned pixels in single precision unless
+        ``single`` is False. The exchange search re-scans in double precision, then exactly,
+        when a proposed swap's cost is not confirmed (:attr:`scan_levels`).
         """
         total_m, total_r = self._chosen_sums(chosen)
-        base = total_m - self.outer[:, chosen[position]]  # (6, P)
-        rb = None if total_r is None else total_r - self.cross[:, chosen[position]]
+        out_light = np.asarray(chosen, dtype=np.intp)[position : position + 1]
+        base = total_m - self._outer_at(out_light, slice(None))[:, 0]  # (6, P)
+        rb = None if total_r is None else total_r - self._cross_at(out_light, slice(None))[:, 0]
         # few pixel rows (a level surface: 7): scoring every candidate is cheaper than
         # gathering the pool's arrays; the others are masked below
-        pooled = among is not None and self.outer.shape[-1] >= POOL_MIN_PIXELS
+        pooled = among is not None and self.w_kp.shape[-1] >= POOL_MIN_PIXELS
         k = np.asarray(among, dtype=np.intp) if pooled else slice(None)
+        every = slice(None)
         if exact:
-            r = None if rb is None else rb[:, None] + self.cross[:, k]  # (3, K, P_bias, 9)
-            costs = self._total(base[:, None, :] + self.outer[:, k], r)
+            r = None if rb is None else rb[:, None] + self._cross_at(k, every)  # (3, K, Pb, 9)
+            costs = self._total(base[:, None, :] + self._outer_at(k, every), r)
         else:
-            w_kp = self._weights_among(among if pooled else None)
+            w32, w_bias = self._weights_among(among) if pooled else (None, None)
             bias = None
             if rb is not None:
-                bias = rank_one.BiasTerms(rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2)
+                bias = rank_one.BiasTerms(
+                    rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2, w_bias
+                )
             res = rank_one.scan(
-                base, w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2, MAX_ERR2,
-                bias,
+                base, self.w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2,
+                MAX_ERR2, bias, rows=k if pooled else None, w32=w32 if single else None,
             )  # fmt: skip
             err2 = res.err2
             if len(res.bad):
-                m = base[:, None, res.bad] + self.outer[:, :, res.bad][:, k]
+                m = base[:, None, res.bad] + self._outer_at(k, res.bad)
                 err2 = err2 + self._variance(m, res.bad) @ self.wts[res.bad]
             if rb is not None and len(res.bad_bias):
                 pix = res.bad_bias
-                m = base[:, None, pix] + self.outer[:, :, pix][:, k]
-                r = rb[:, None, pix] + self.cross[:, :, pix][:, k]
+                m = base[:, None, pix] + self._outer_at(k, pix)
+                r = rb[:, None, pix] + self._cross_at(k, pix)
                 err2 = err2 + self._bias(m, r, pix) @ self.wts_bias[pix]
             costs = np.degrees(np.sqrt(err2))
         if among is None:
             return costs
-        out = np.full(self.outer.shape[1], np.inf)
+        out = np.full(len(self.dirs), np.inf)
         keep = np.asarray(among, dtype=np.intp)
         out[keep] = costs if pooled else costs[keep]
         return out

@@ -52,6 +52,7 @@ def exchange_search(
     starts: Sequence[tuple[str, NDArray[np.intp]]],
     max_passes: int | None = None,
     min_gain: float = SWEEP_GAIN,
+    search: NormalsObjective | RelightObjective | None = None,
 ) -> ExchangeResult:
     """Exchange search from the cheapest of ``starts`` (label, candidate indices).
 
@@ -59,29 +60,56 @@ def exchange_search(
     taken if it lowers the cost. Stops after a sweep without a change (a local optimum for
     single swaps), after a sweep that gained less than ``min_gain`` (a fraction of the cost;
     :data:`SWEEP_GAIN` by default, 0 for none) or after :data:`MAX_PASSES` sweeps.
+
+    ``search``: a cheaper stand-in for ``objective`` over the same candidates (its binned
+    sample, :mod:`rti_rig.planner.pixel_bins`) that the sweeps score instead. The starts and
+    the result are costed on ``objective``; a result that is not cheaper than its start there
+    is dropped for the start, so the plan is never worse than its start on ``objective``.
     """
     if not starts:
         raise ValueError("exchange search needs at least one starting layout")
     costs = {label: objective.cost(np.asarray(s, dtype=np.intp)) for label, s in starts}
     label, first = min(starts, key=lambda ls: costs[ls[0]])
     chosen = np.asarray(first, dtype=np.intp).copy()
-    cost = costs[label]
+    if search is None or search is objective:
+        chosen, cost, swaps = _sweeps(objective, chosen, costs[label], max_passes, min_gain)
+        return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)
+    chosen, _, swaps = _sweeps(search, chosen, search.cost(chosen), max_passes, min_gain)
+    cost = objective.cost(chosen)
+    if not cost < costs[label]:
+        chosen, cost, swaps = np.asarray(first, dtype=np.intp).copy(), costs[label], 0
+    return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)
+
+
+def _sweeps(
+    objective: NormalsObjective | RelightObjective,
+    chosen: NDArray[np.intp],
+    cost: float,
+    max_passes: int | None,
+    min_gain: float,
+) -> tuple[NDArray[np.intp], float, int]:
+    """The sweeps of :func:`exchange_search` from ``chosen`` (of cost ``cost``): the layout,
+    its cost and the swaps accepted."""
     n = len(chosen)
     limit = max_passes if max_passes is not None else MAX_PASSES
     swaps = 0
     # only the unused candidates can replace a light (a light is never chosen twice): an
     # objective that knows its candidate count scores only those (half of them at 100 of 200)
     count = getattr(objective, "candidate_count", None)
+    levels = getattr(objective, "scan_levels", ({"exact": False}, {"exact": True}))
+    unused = None if count is None else np.ones(count, dtype=bool)
+    if unused is not None:
+        unused[chosen] = False
     for _ in range(limit):
         changed = False
         before = cost
         for pos in range(n):
-            scan_kw = {} if count is None else {"among": np.setdiff1d(np.arange(count), chosen)}
-            for exact_scan in (False, True):
-                # the fast scan may be approximate (rank-one updates, rounding): a swap is
-                # accepted on its exact cost, and a proposal that cost does not confirm earns an
-                # exact re-scan
-                trial = objective.swap_costs(chosen, pos, exact=exact_scan, **scan_kw)
+            scan_kw = {} if unused is None else {"among": np.flatnonzero(unused)}
+            for level in levels:
+                # the fast scan may be approximate (rank-one updates, single precision): a swap
+                # is accepted on its exact cost, and a proposal that cost does not confirm
+                # earns a re-scan at the next level (the last: every pixel evaluated directly)
+                trial = objective.swap_costs(chosen, pos, **level, **scan_kw)
                 trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
                 k = int(np.argmin(trial))
                 if not float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):
@@ -90,6 +118,8 @@ def exchange_search(
                 chosen[pos] = k
                 exact = objective.cost(chosen)
                 if exact < cost - 1e-9 * max(abs(cost), 1e-12):
+                    if unused is not None:
+                        unused[previous], unused[k] = True, False
                     cost = exact
                     swaps += 1
                     changed = True
@@ -97,4 +127,4 @@ def exchange_search(
                 chosen[pos] = previous
         if not changed or before - cost < min_gain * abs(before):
             break
-    return ExchangeResult(chosen, cost, costs[label], label, swaps, costs)
+    return chosen, cost, swaps

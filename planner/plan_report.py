@@ -36,6 +36,9 @@ class PlanReport:
     expected_meaning: str | None = None
     start_layout: str | None = None
     swaps: int | None = None
+    #: pixel rows the objective scores and the rows the exchange search swept, when it swept a
+    #: binned stand-in (:mod:`rti_rig.planner.pixel_bins`)
+    search_pixels: tuple[int, int] | None = None
     kmeans_distinct_normals: int | None = None
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
@@ -75,6 +78,12 @@ class PlanReport:
         if self.expected and self.expected_meaning:
             parts = ", ".join(f"{k} {v:#.4g}" for k, v in self.expected.items())
             out.append(f"{self.expected_meaning}: {parts}")
+        if self.search_pixels is not None:
+            every, binned = self.search_pixels
+            out.append(
+                f"searched on {binned} binned pixel rows of {every} (nearly equal normals, same "
+                f"shadows); the expected errors above are on all {every}"
+            )
         out.extend(self.notes)
         out.append(f"planned in {self.seconds:.2f} s")
         return out

@@ -259,3 +259,87 @@ def test_an_unreachable_start_is_left_out_not_shifting_the_others():
     for label, idx in starts:
         floor = float(label.split("≥")[1].rstrip("°"))
         np.testing.assert_array_equal(cands.directions[idx], arm.homogeneous(12, floor))
+
+
+@pytest.mark.e2e
+def test_cli_plans_a_hundred_arm_lights_from_a_preview(tmp_path) -> None:
+    """Through the front door, from a preview (16-bit PNG: linear) on the shipped virtual arm:
+    100 distinct reachable lights, the binned search reported, its plan cheaper on every pixel
+    than each homogeneous start, and the same lights as the library's plan."""
+    import cv2
+    from typer.testing import CliRunner
+
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.cli import app
+    from rti_rig.core.lp_format import read_lp
+
+    repo = Path(__file__).resolve().parents[2]
+    scene = relief_scene(96, 128, seed=0)
+    image = lambert_radiance(scene, direction_from_az_el(30.0, 50.0))
+    png = tmp_path / "preview.png"
+    cv2.imwrite(str(png), np.round(image / image.max() * 65535).astype(np.uint16)[..., ::-1])
+    out = tmp_path / "plan.lp"
+    rig = repo / "rig_configs" / "virtual_arm.toml"
+    args = ["plan", str(png), "--rig", str(rig), "--lights", "100", "--method", "optimal"]
+    r = CliRunner().invoke(app, [*args, "--preview-light", "30,50", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "searched on" in text and "binned pixel rows of 1792" in text
+    expected = text.split("expected RMS normal error (degrees): ")[1].split(" searched")[0]
+    costs = dict(part.rsplit(" ", 1) for part in expected.split(", "))
+    assert set(costs) > {"optimal", "uniform ≥0°"}
+    assert all(float(costs["optimal"]) < float(v) for k, v in costs.items() if k != "optimal")
+    got = np.array([e.direction for e in read_lp(out)])
+    assert len(got) == 100 and len(np.unique(got.round(6), axis=0)) == 100
+    geometry = rig_geometry(load_rig_config(rig))
+    assert geometry.reachable(got).all()
+    preview = cv2.cvtColor(cv2.imread(str(png), cv2.IMREAD_UNCHANGED), cv2.COLOR_BGR2RGB)
+    sched, _ = plan_with_report(preview, geometry, 100, "optimal", "normals", (30.0, 50.0))
+    want = np.array([s.direction for s in sched.steps])
+    dist = np.linalg.norm(got[:, None] - want[None], axis=-1)  # the .lp rounds to 1e-6
+    assert np.all(dist.min(axis=1) < 1e-5) and np.all(dist.min(axis=0) < 1e-5)
+
+
+def test_single_precision_scans_are_within_a_millionth_of_the_exact_costs() -> None:
+    """A preview's pooled scan runs in single precision (it differs from the double one) and
+    stays within 1e-6 of the direct evaluation for every candidate, bias term included."""
+    cands, starts, sample = planning_problem(ARM, 36, estimate_surface(relief_preview(), (30, 50)))
+    obj = NormalsObjective(sample, cands)
+    chosen = starts[0][1]
+    among = np.setdiff1d(np.arange(len(cands)), chosen)
+    with threadpool_limits(limits=1):
+        for pos in (0, 17, 35):
+            single = obj.swap_costs(chosen, pos, among=among)
+            double = obj.swap_costs(chosen, pos, among=among, single=False)
+            exact = obj.swap_costs(chosen, pos, among=among, exact=True)
+            assert not np.array_equal(single[among], double[among])  # the fast path ran
+            assert single[among] == pytest.approx(exact[among], rel=1e-6)
+            assert double[among] == pytest.approx(exact[among], rel=1e-9)
+
+
+def test_a_proposal_the_exact_cost_rejects_is_rescanned_in_double_then_exactly() -> None:
+    """The scan levels of the normals objective in order: single precision, double, direct."""
+    calls: list[dict] = []
+
+    class Ladder:
+        scan_levels = NormalsObjective.scan_levels
+        candidate_count = 10
+
+        def cost(self, chosen: np.ndarray) -> float:
+            return float(np.sum(chosen))
+
+        def swap_costs(self, chosen, position, exact=False, among=None, single=True):
+            calls.append({"exact": exact, "single": single})
+            if not exact:  # both fast levels promise a swap that is no gain
+                out = np.full(10, np.inf)
+                out[9] = -1.0
+                return out
+            return np.array([float(np.sum(chosen) - chosen[position] + k) for k in range(10)])
+
+    res = exchange_search(Ladder(), [("start", np.array([4, 5, 6]))], max_passes=1)  # type: ignore[arg-type]
+    assert calls[:3] == [
+        {"exact": False, "single": True},
+        {"exact": False, "single": False},
+        {"exact": True, "single": True},
+    ]
+    assert sorted(res.chosen.tolist()) == [0, 1, 2]
