@@ -45,12 +45,7 @@ from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start, small_grey
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
-from rti_rig.planner.adaptive import (
-    START_LIGHTS,
-    bound_error2,
-    discarded_fraction,
-    mean_error_deg,
-)
+from rti_rig.planner.adaptive import START_LIGHTS, discarded_fraction
 from rti_rig.planner.objectives import models_for
 from rti_rig.planner.topography import REC709
 from rti_rig.planner.uniform import select_uniform_leds
@@ -123,7 +118,7 @@ def adaptive_run(
     # the bound's raw mean angle and the discarded fraction after the last image (calibration)
     state = chooser.state()
     if state is not None:
-        estimates["raw"] = mean_error_deg(bound_error2(state))
+        estimates["raw"] = chooser.raw_estimate(state)
         estimates["discarded"] = discarded_fraction(state)
     return chooser.used, estimates, float(np.mean(times)) if times else 0.0
 
