@@ -14,8 +14,8 @@ Scored as the other planner benchmarks score: normal error of robust photometric
 against the true normals, every pixel; real: against the all-light fit, on the object mask) and
 relighting PSNR (the richest basis N lights determine, relit to every other candidate).
 
-The stopping rule's estimate is calibrated here: the bound's raw mean angle against the
-measured error of the adaptive layouts on the simulator, ``log(measured/raw) = log(scale) +
+The stopping rule's estimate is calibrated here: the raw estimate (the robust fit simulated on
+the object's model, ``AdaptiveChooser.raw_estimate``) against the measured error of the adaptive layouts on the simulator, ``log(measured/raw) = log(scale) +
 slope × discarded fraction`` by least squares over scenes, draws and N — the gloss-aware slope
 kept only if it predicts left-out scenes better than one global factor (slope 0). Each scene's
 predicted error is shown with the factors fitted on the *other* scenes (leave one scene out),
@@ -406,7 +406,7 @@ def main(argv: list[str] | None = None) -> str:
     results, _ = sim(args.sim_draws, scenes=scenes)
     _save_cache(args.cache)
     scale, slope, calib_rows, calib_summary = calibrate(results)
-    print(f"calibrated ESTIMATE_SCALE = {scale:.3f}, DISCARD_SLOPE = {slope:.3f}")
+    print(f"calibrated SIM_ESTIMATE_SCALE = {scale:.3f}, DISCARD_SLOPE = {slope:.3f}")
     rr = real(args.real_draws, scale, args.data) if args.real_draws else None
     _save_cache(args.cache)
     head = "| object | tuned floor | " + " | ".join(f"N = {n}" for n in NS) + " |"
@@ -463,10 +463,12 @@ def main(argv: list[str] | None = None) -> str:
             sep,
             *p_rows,
             "",
-            f"Error estimate (the stopping rule's): the bound's mean angle × {scale:.3f} × "
+            f"Error estimate (the stopping rule's): the *simulated* error — the robust fit run on "
+            "observations simulated from this object's model (gloss, cast shadows, noise; "
+            f"planner/adaptive_bias.py) under the lights so far — × {scale:.3f} × "
             f"exp({slope:.2f} × the fraction of observations the fit discarded) (least squares "
-            "of log measured/raw over all simulated scenes, draws and N; `ESTIMATE_SCALE`, "
-            "`DISCARD_SLOPE` in planner/adaptive.py). Cells: mean predicted / mean measured "
+            "of log measured/simulated over all simulated scenes, draws and N; "
+            "`SIM_ESTIMATE_SCALE` in planner/adaptive.py). Cells: mean predicted / mean measured "
             "(geometric-mean ratio measured/predicted); simulator rows use the factors fitted on "
             "the *other* scenes; the real row uses the simulator's (never fitted on it; measured "
             "= against the all-72-light fit, which is itself not the truth). " + calib_summary,

@@ -118,9 +118,11 @@ class Decision:
     predicted_error_deg: float | None  # the same estimate after the chosen light
     runner_up: list[dict[str, float]]  # the best few candidates: index, predicted, move_s
     reason: str
+    #: with N known: the elevation floor (°) of the design the light was chosen in
+    design_floor: float | None = None
 
     def evidence(self) -> dict[str, object]:
-        return {
+        out: dict[str, object] = {
             "candidate": self.candidate,
             "estimated_error_deg": round(self.estimated_error_deg, 4),
             "predicted_error_deg": (
@@ -129,6 +131,9 @@ class Decision:
             "best_candidates": self.runner_up,
             "reason": self.reason,
         }
+        if self.design_floor is not None:
+            out["design_floor_deg"] = self.design_floor
+        return out
 
 
 def _information(state: SurfaceState) -> NDArray[np.float64]:
@@ -341,7 +346,7 @@ DESIGN_MARGIN = 0.03
 DESIGN_DEFAULT_FLOOR = 10.0
 #: With the bias-aware score (a robust fit simulated on this object's model): another floor
 #: is taken only if its simulated error is lower by this fraction.
-SIM_MARGIN = 0.03
+SIM_MARGIN = 0.10
 
 
 def design_error_deg(
@@ -456,6 +461,7 @@ def choose_in_design(
     margin: float | None = None,
     keep: int = 3,
     fit: FitFn | None = None,
+    incumbent: float | None = None,
 ) -> Decision:
     """With ``n_total`` lights known: the best complete design, then its most useful light.
 
@@ -500,9 +506,14 @@ def choose_in_design(
         return d
     if margin is None:
         margin = DESIGN_MARGIN
-    best = min(scores, key=lambda f: (scores[f], abs(f - default_floor)))
-    if default_floor in scores and scores[default_floor] <= (1.0 + margin) * scores[best]:
-        best = default_floor
+    # the design kept unless another is better by the margin: the session's current design
+    # (``incumbent``, the floor of the previous decision) or, at first, the default floor — a
+    # session that has left the default for good evidence is not pulled back by near-ties once
+    # most of its lights are placed (a mixture of two designs is neither)
+    keep_floor = default_floor if incumbent is None or incumbent not in scores else incumbent
+    best = min(scores, key=lambda f: (scores[f], abs(f - keep_floor)))
+    if keep_floor in scores and scores[keep_floor] <= (1.0 + margin) * scores[best]:
+        best = keep_floor
     mask = np.zeros(len(candidates), dtype=bool)
     mask[designs[best]] = True
     d = choose_next(
@@ -524,6 +535,7 @@ def choose_in_design(
         f"homogeneous design of {n_total} lights above {best:g}° ({how}: "
         f"{scores[best]:.3g}° after all {n_total}; by floor: {design}); within it, "
         f"the largest predicted drop per second ({k} captured)",
+        design_floor=best,
     )
 
 

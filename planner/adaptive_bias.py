@@ -233,7 +233,8 @@ def _render(model: ObjectModel, lights: NDArray[np.float64], pix: NDArray[np.int
     vis = visibility(model, lights, pix)
     out = model.albedo[pix, None] * np.maximum(cos, 0.0)
     if model.spec_strength > 0:
-        out = out + model.spec_strength * _lobe(_half_cos(n, lights), model.spec_exponent) * (cos > 0)
+        lobe = _lobe(_half_cos(n, lights), model.spec_exponent)
+        out = out + model.spec_strength * lobe * (cos > 0)
     return (out * vis).T
 
 

@@ -238,6 +238,8 @@ class AdaptiveChooser:
         self.scale = scale
         self.samples: list[NDArray[np.float32]] = []  # each image's pixel sample
         self.images: list[NDArray[np.float32]] = []  # the small grey images (bias-aware)
+        #: the floor of the design the last decision chose in (None: none yet)
+        self.floor: float | None = None
         self.lights: list[NDArray[np.float64]] = []
         self.used: list[int] = []
         self.stop_evidence: dict[str, Any] | None = None
@@ -322,7 +324,9 @@ class AdaptiveChooser:
                 move_s=move,
                 scale=self.scale,
                 fit=robust_fit if self.bias_aware else None,
+                incumbent=self.floor if self.bias_aware else None,
             )
+            self.floor = d.design_floor
         else:
             d = choose_next(
                 state,
@@ -345,6 +349,7 @@ class AdaptiveChooser:
                     for r in d.runner_up
                 ],
                 d.reason,
+                d.design_floor,
             )
         if d.candidate is None:
             self.stop_evidence = {"kind": "stop", **d.evidence()}
