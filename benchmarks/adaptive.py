@@ -15,8 +15,9 @@ against the true normals, every pixel; real: against the all-light fit, on the o
 relighting PSNR (the richest basis N lights determine, relit to every other candidate).
 
 The stopping rule's estimate is calibrated here: the raw estimate (the robust fit simulated on
-the object's model, ``AdaptiveChooser.raw_estimate``) against the measured error of the adaptive layouts on the simulator, ``log(measured/raw) = log(scale) +
-slope × discarded fraction`` by least squares over scenes, draws and N — the gloss-aware slope
+the object's model, ``AdaptiveChooser.raw_estimate``) against the measured error of the
+adaptive layouts on the simulator, ``log(measured/raw) = log(scale) + slope × discarded
+fraction`` by least squares over scenes, draws and N — the gloss-aware slope
 kept only if it predicts left-out scenes better than one global factor (slope 0). Each scene's
 predicted error is shown with the factors fitted on the *other* scenes (leave one scene out),
 then on the real dome (never used for the fit). ``--until-error``: lights used and measured
