@@ -56,7 +56,7 @@ ESTIMATE_SCALE = 0.763
 #: Calibrated factor from the *simulated* error (a robust fit of this object's modelled
 #: observations, ``planner.adaptive_bias``) to the measured one (``python -m
 #: benchmarks.adaptive``, leave-one-scene-out figures in docs/adaptive.md).
-SIM_ESTIMATE_SCALE = 1.0
+SIM_ESTIMATE_SCALE = 0.865
 #: How much the estimate grows with the fraction of observations the fit discarded
 #: (:func:`estimate_factor`). 0: fitted with ESTIMATE_SCALE by ``python -m benchmarks.adaptive``,
 #: the gloss-aware factor predicted left-out scenes worse than one global factor (on the coin

@@ -169,9 +169,14 @@ def visibility(
     pix = np.arange(len(model.normals)) if pix is None else pix
     az, el = _az_el(lights)
     s_az, s_el = model.shadow_az[pix], model.shadow_el[pix]
-    daz = np.abs((s_az[:, :, None] - az[None, None, :] + 180.0) % 360.0 - 180.0)
-    blocked = (daz <= SHADOW_AZ_DEG) & (el[None, None, :] <= s_el[:, :, None] + 1e-9)
-    vis = ~blocked.any(axis=1)
+    blocked = np.zeros((len(pix), len(lights)), dtype=bool)
+    pp, kk = np.nonzero(np.isfinite(s_el))  # the few (pixel, captured light) shadows seen
+    if pp.size:
+        daz = np.abs((s_az[pp, kk][:, None] - az[None, :] + 180.0) % 360.0 - 180.0)
+        hit = (daz <= SHADOW_AZ_DEG) & (el[None, :] <= s_el[pp, kk][:, None] + 1e-9)
+        starts = np.flatnonzero(np.r_[True, pp[1:] != pp[:-1]])  # pp is sorted
+        blocked[pp[starts]] = np.logical_or.reduceat(hit, starts, axis=0)
+    vis = ~blocked
     if model.relief is not None:
         height, rows, cols = model.relief
         return vis * soft_visibility(height, rows[pix], cols[pix], lights)
