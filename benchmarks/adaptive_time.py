@@ -28,6 +28,7 @@ import sys
 import time
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from benchmarks.adaptive import DOC
 from benchmarks.report import machine_line, write_section
@@ -124,8 +125,10 @@ def main(argv: list[str] | None = None) -> str:
                 simulate_error_deg(object_model(state), lights, robust_fit)
                 choose_in_design(state, cands, available, n, fit=robust_fit)
 
-            t_dec = _median(decide, args.repeats)
-            t_des = _median(decide_design, args.repeats)
+            # as AdaptiveChooser.decide runs them: BLAS on one thread
+            with threadpool_limits(limits=1, user_api="blas"):
+                t_dec = _median(decide, args.repeats)
+                t_des = _median(decide_design, args.repeats)
             t_opt = t_uni = t_prev = float("nan")
             if n <= args.max_optimal_n:
                 t_uni = _median(

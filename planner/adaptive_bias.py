@@ -137,8 +137,10 @@ def fit_object_model(
     best = (np.inf, 0.0, LOBE_EXPONENTS[0])
     for e in LOBE_EXPONENTS:
         x = _lobe(c, e)
-        xx = float(x @ x)
-        ks = max(0.0, float(x @ r) / xx) if xx > 0 else 0.0
+        # element-wise sums, not BLAS dot products: on a busy machine a vector dot waits for
+        # BLAS's threads (measured 5–30 ms against 0.1 ms for these 30 000 terms)
+        xx = float((x * x).sum())
+        ks = max(0.0, float((x * r).sum()) / xx) if xx > 0 else 0.0
         sse = float(((r - ks * x) ** 2).sum())
         if sse < best[0] - 1e-12:
             best = (sse, ks, e)
