@@ -20,10 +20,14 @@ Light by light (:func:`choose_next`, N unknown): the available candidate with th
 predicted drop of the mean angular error per second of rig time (capture plus, on an arm, the
 move from the current light: ``move_s``). With N known (:func:`choose_in_design`): the rest of
 the session as a whole — the homogeneous design above one of :data:`DESIGN_FLOORS` with the
-lowest predicted error, the default floor unless another is predicted better by
-:data:`DESIGN_MARGIN` — then its most useful light first. The stopping rule's estimate is the
-bound's mean angle times a factor calibrated against measured error on the simulator
-(:func:`estimate_factor`, docs/adaptive.md).
+lowest error, scored (given a ``fit``, as the use case does) by a robust fit *simulated* on this
+object's model of gloss, cast shadows and noise (:mod:`rti_rig.planner.adaptive_bias`: what
+decides the best floor is bias, which the variance bound does not see), else by the bound; the
+current design (the default floor at first) is kept unless another is better by
+:data:`SIM_MARGIN` (:data:`DESIGN_MARGIN` for the bound) — then its most useful light first.
+The stopping rule's estimate (``AdaptiveChooser.estimate`` in the use case) is the simulated
+error times :data:`SIM_ESTIMATE_SCALE`, calibrated against measured error on the simulator
+(docs/adaptive.md); :func:`estimate_error_deg` is the bound's.
 """
 
 from __future__ import annotations
