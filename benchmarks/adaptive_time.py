@@ -28,18 +28,37 @@ import sys
 import time
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from benchmarks.adaptive import DOC
 from benchmarks.report import machine_line, write_section
-from rti_rig.app.usecases.adaptive import fit_sample, sample_pixels, small_grey
+from rti_rig.app.usecases.adaptive import (
+    fit_sample,
+    relief_px,
+    robust_fit,
+    sample_index,
+    sample_pixels,
+    small_grey,
+)
 from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
-from rti_rig.planner.adaptive import START_LIGHTS, choose_in_design, choose_next
+from rti_rig.planner.adaptive import START_LIGHTS, choose_in_design, choose_next, object_model
+from rti_rig.planner.adaptive_bias import simulate_error_deg
 from rti_rig.planner.make_plan import plan_with_report
 from rti_rig.planner.objectives import candidates_for
 from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 NS = (6, 9, 12, 18, 24, 36, 50, 75, 100)
+
+
+def _state(samples: np.ndarray, lights: np.ndarray, images: np.ndarray):  # type: ignore[no-untyped-def]
+    """The chooser's state as ``AdaptiveChooser.state`` makes it (bias-aware: with the
+    relief of the small images and where the sample lies in them)."""
+    shape = images.shape[1:3]
+    where = np.unravel_index(sample_index(shape[0] * shape[1]), shape)
+    state = fit_sample(samples, lights, where, relief_px(images, lights))
+    assert state is not None
+    return state
 
 
 def _median(fn, repeats: int) -> float:
@@ -79,11 +98,14 @@ def main(argv: list[str] | None = None) -> str:
 
             samples = sample_pixels(images)  # each image sampled once, as it arrived
 
-            def decide(samples=samples, lights=lights, available=available, cands=cands) -> None:
-                # the newest frame shrunk and sampled, the fit on the sample, the choice
+            def decide(
+                samples=samples, lights=lights, available=available, cands=cands, images=images
+            ) -> None:
+                # the newest frame shrunk and sampled, the fit on the sample (and the relief on
+                # the small images), the bias-aware estimate (a simulated fit), the choice
                 sample_pixels(small_grey(frame)[None])
-                state = fit_sample(samples, lights)
-                assert state is not None
+                state = _state(samples, lights, images)
+                simulate_error_deg(object_model(state), lights, robust_fit)
                 choose_next(state, cands, available)
 
             half = max(START_LIGHTS, n // 2)
@@ -91,15 +113,22 @@ def main(argv: list[str] | None = None) -> str:
             avail_half[np.linspace(0, len(cands) - 1, half).round().astype(int)] = False
 
             def decide_design(
-                samples=samples[:half], lights=lights[:half], available=avail_half, cands=cands, n=n
+                samples=samples[:half],
+                lights=lights[:half],
+                available=avail_half,
+                cands=cands,
+                n=n,
+                images=images[:half],
             ) -> None:
                 sample_pixels(small_grey(frame)[None])
-                state = fit_sample(samples, lights)
-                assert state is not None
-                choose_in_design(state, cands, available, n)
+                state = _state(samples, lights, images)
+                simulate_error_deg(object_model(state), lights, robust_fit)
+                choose_in_design(state, cands, available, n, fit=robust_fit)
 
-            t_dec = _median(decide, args.repeats)
-            t_des = _median(decide_design, args.repeats)
+            # as AdaptiveChooser.decide runs them: BLAS on one thread
+            with threadpool_limits(limits=1, user_api="blas"):
+                t_dec = _median(decide, args.repeats)
+                t_des = _median(decide_design, args.repeats)
             t_opt = t_uni = t_prev = float("nan")
             if n <= args.max_optimal_n:
                 t_uni = _median(

@@ -20,10 +20,14 @@ Light by light (:func:`choose_next`, N unknown): the available candidate with th
 predicted drop of the mean angular error per second of rig time (capture plus, on an arm, the
 move from the current light: ``move_s``). With N known (:func:`choose_in_design`): the rest of
 the session as a whole — the homogeneous design above one of :data:`DESIGN_FLOORS` with the
-lowest predicted error, the default floor unless another is predicted better by
-:data:`DESIGN_MARGIN` — then its most useful light first. The stopping rule's estimate is the
-bound's mean angle times a factor calibrated against measured error on the simulator
-(:func:`estimate_factor`, docs/adaptive.md).
+lowest error, scored (given a ``fit``, as the use case does) by a robust fit *simulated* on this
+object's model of gloss, cast shadows and noise (:mod:`rti_rig.planner.adaptive_bias`: what
+decides the best floor is bias, which the variance bound does not see), else by the bound; the
+current design (the default floor at first) is kept unless another is better by
+:data:`SIM_MARGIN` (:data:`DESIGN_MARGIN` for the bound) — then its most useful light first.
+The stopping rule's estimate (``AdaptiveChooser.estimate`` in the use case) is the simulated
+error times :data:`SIM_ESTIMATE_SCALE`, calibrated against measured error on the simulator
+(docs/adaptive.md); :func:`estimate_error_deg` is the bound's.
 """
 
 from __future__ import annotations
@@ -34,6 +38,13 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from rti_rig.planner.adaptive_bias import (
+    FitFn,
+    ObjectModel,
+    fit_object_model,
+    simulate_designs,
+)
 
 #: Below this n·l a light is treated as (softly) shadowed for a pixel, as in the objectives.
 GRAZING_COS = 0.15
@@ -46,6 +57,10 @@ RIDGE = 1e-4
 #: adaptive layouts of `--lights N` (``python -m benchmarks.adaptive``: 0.763; predicted
 #: against measured in docs/adaptive.md).
 ESTIMATE_SCALE = 0.763
+#: Calibrated factor from the *simulated* error (a robust fit of this object's modelled
+#: observations, ``planner.adaptive_bias``) to the measured one (``python -m
+#: benchmarks.adaptive``, leave-one-scene-out figures in docs/adaptive.md).
+SIM_ESTIMATE_SCALE = 0.865
 #: How much the estimate grows with the fraction of observations the fit discarded
 #: (:func:`estimate_factor`). 0: fitted with ESTIMATE_SCALE by ``python -m benchmarks.adaptive``,
 #: the gloss-aware factor predicted left-out scenes worse than one global factor (on the coin
@@ -75,6 +90,18 @@ class SurfaceState:
     noise: NDArray[np.float64]
     lit: NDArray[np.bool_]
     lights: NDArray[np.float64]
+    #: the observations themselves (K, P), the fit's validity (P,) and its shadow threshold:
+    #: what the bias-aware design score fits its object model to (None: not available)
+    obs: NDArray[np.float32] | None = field(default=None, compare=False, repr=False)
+    valid: NDArray[np.bool_] | None = field(default=None, compare=False, repr=False)
+    dark: float = 0.0
+    #: the noise floor of one observation (images' units)
+    noise_floor: float = 0.0
+    #: the sampled pixels' rows and columns in the small image and its relief (height in
+    #: pixels): cast shadows of lights not tried yet (None: not known)
+    rows: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
+    cols: NDArray[np.intp] | None = field(default=None, compare=False, repr=False)
+    height: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)
     #: what one decision derives from the state more than once (the inverse information, the
     #: keep table): computed once per state; the arrays above are not changed after creation
     cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
@@ -95,9 +122,11 @@ class Decision:
     predicted_error_deg: float | None  # the same estimate after the chosen light
     runner_up: list[dict[str, float]]  # the best few candidates: index, predicted, move_s
     reason: str
+    #: with N known: the elevation floor (°) of the design the light was chosen in
+    design_floor: float | None = None
 
     def evidence(self) -> dict[str, object]:
-        return {
+        out: dict[str, object] = {
             "candidate": self.candidate,
             "estimated_error_deg": round(self.estimated_error_deg, 4),
             "predicted_error_deg": (
@@ -106,6 +135,9 @@ class Decision:
             "best_candidates": self.runner_up,
             "reason": self.reason,
         }
+        if self.design_floor is not None:
+            out["design_floor_deg"] = self.design_floor
+        return out
 
 
 def _information(state: SurfaceState) -> NDArray[np.float64]:
@@ -316,6 +348,9 @@ DESIGN_MARGIN = 0.03
 #: The floor of the default design (and of the starting lights when N is known): the floor
 #: that loses least to the best one over the simulator's scenes (docs/adaptive.md).
 DESIGN_DEFAULT_FLOOR = 10.0
+#: With the bias-aware score (a robust fit simulated on this object's model): another floor
+#: is taken only if its simulated error is lower by this fraction.
+SIM_MARGIN = 0.10
 
 
 def design_error_deg(
@@ -373,6 +408,21 @@ def homogeneous_completion(
     lo = max(floor_deg, float(el[el >= floor_deg - 1e-9].min()))
     hi = float(el.max())
     ideal = fibonacci_cap(n_total, lo, hi) if hi > lo else fibonacci_cap(n_total, 0.0, 90.0)
+    # the homogeneous layout itself (ideal matched to every candidate of the band, as
+    # select_uniform_leds matches it): when the lights used so far are all part of it, the
+    # design is its remaining lights — so a session that keeps to one floor ends with exactly
+    # the homogeneous layout of that floor, whatever lights are out of service
+    band = np.flatnonzero(el >= floor_deg - 1e-9)
+    _, whole = linear_sum_assignment(_angles(ideal, candidates[band]))
+    layout = band[whole]
+    if k:
+        near = _angles(used, candidates[layout]) < 1e-6  # (K, n_total)
+        if near.any(axis=1).all():
+            rest_idx = layout[~near.any(axis=0)]
+            if available[rest_idx].all() and rest_idx.size == n_total - k:
+                return np.sort(rest_idx)
+    elif available[layout].all():
+        return np.sort(layout)
     rest = np.ones(n_total, dtype=bool)
     if k:
         _, cols = linear_sum_assignment(_angles(used, ideal))
@@ -414,6 +464,8 @@ def choose_in_design(
     default_floor: float | None = None,
     margin: float | None = None,
     keep: int = 3,
+    fit: FitFn | None = None,
+    incumbent: float | None = None,
 ) -> Decision:
     """With ``n_total`` lights known: the best complete design, then its most useful light.
 
@@ -426,7 +478,6 @@ def choose_in_design(
     per second (as :func:`choose_next`), so a session stopped early has its most useful lights.
     """
     floors = DESIGN_FLOORS if floors is None else floors
-    margin = DESIGN_MARGIN if margin is None else margin
     default_floor = DESIGN_DEFAULT_FLOOR if default_floor is None else default_floor
     now = estimate_error_deg(state, scale)
     k = len(state.lights)
@@ -436,22 +487,37 @@ def choose_in_design(
         f: homogeneous_completion(candidates, available, state.lights, n_total, f) for f in floors
     }
     comps = {f: c for f, c in comps.items() if c is not None and c.size}
-    if comps:  # every design's lights weighted at once
+    if comps and fit is None:  # every design's lights weighted at once
         union = np.unique(np.concatenate(list(comps.values())))
         w_union = predicted_weight(state, candidates[union])
         where = {int(c): i for i, c in enumerate(union)}
+    model = object_model(state) if fit is not None else None
     for f, comp in comps.items():
         designs[f] = comp
-        cols = [where[int(c)] for c in comp]
-        scores[f] = design_error_deg(state, candidates[comp], scale, w_union[:, cols])
+        if model is None:
+            cols = [where[int(c)] for c in comp]
+            scores[f] = design_error_deg(state, candidates[comp], scale, w_union[:, cols])
+    if model is not None and designs:  # bias-aware: each design simulated on this object
+        assert fit is not None
+        full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
+        scores = dict(zip(designs, simulate_designs(model, full, fit), strict=True))
+    if model is not None:
+        margin = SIM_MARGIN if margin is None else margin
     if not designs:
         d = choose_next(
             state, candidates, available, capture_s=capture_s, move_s=move_s, scale=scale, keep=keep
         )
         return d
-    best = min(scores, key=lambda f: (scores[f], abs(f - default_floor)))
-    if default_floor in scores and scores[default_floor] <= (1.0 + margin) * scores[best]:
-        best = default_floor
+    if margin is None:
+        margin = DESIGN_MARGIN
+    # the design kept unless another is better by the margin: the session's current design
+    # (``incumbent``, the floor of the previous decision) or, at first, the default floor — a
+    # session that has left the default for good evidence is not pulled back by near-ties once
+    # most of its lights are placed (a mixture of two designs is neither)
+    keep_floor = default_floor if incumbent is None or incumbent not in scores else incumbent
+    best = min(scores, key=lambda f: (scores[f], abs(f - keep_floor)))
+    if keep_floor in scores and scores[keep_floor] <= (1.0 + margin) * scores[best]:
+        best = keep_floor
     mask = np.zeros(len(candidates), dtype=bool)
     mask[designs[best]] = True
     d = choose_next(
@@ -464,12 +530,35 @@ def choose_in_design(
         keep=keep,
     )
     design = {f"{f:g}": round(v, 4) for f, v in sorted(scores.items())}
+    how = "bound" if model is None else "simulated with this object's gloss and shadows"
     return Decision(
         d.candidate,
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"homogeneous design of {n_total} lights above {best:g}° (predicted "
+        f"homogeneous design of {n_total} lights above {best:g}° ({how}: "
         f"{scores[best]:.3g}° after all {n_total}; by floor: {design}); within it, "
         f"the largest predicted drop per second ({k} captured)",
+        design_floor=best,
+    )
+
+
+def object_model(state: SurfaceState) -> ObjectModel | None:
+    """The object's reflectance model beyond Lambert from the state's observations (None:
+    the state carries none), computed once per state."""
+    if state.obs is None or state.valid is None:
+        return None
+    return _memo(
+        state,
+        "object_model",
+        lambda: fit_object_model(
+            state.obs,
+            state.lights,
+            state.normals,
+            state.albedo,
+            state.valid,
+            state.dark,
+            state.noise_floor,
+            None if state.height is None else (state.height, state.rows, state.cols),
+        ),
     )

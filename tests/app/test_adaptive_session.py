@@ -230,8 +230,9 @@ def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
     assert manifest(out)["rig"]["backend"] == "replay"
 
 
+@pytest.mark.parametrize("old", ["rti-rig-adaptive/1", "rti-rig-adaptive/2"])
 def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
-    uninterrupted: tuple[Path, Path], tmp_path: Path
+    uninterrupted: tuple[Path, Path], tmp_path: Path, old: str
 ) -> None:
     """A session begun by an earlier version (another chooser) cannot be continued with the
     same choices: refused by name, saying its images are still usable; nothing is shot."""
@@ -239,13 +240,13 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     out = tmp_path / "old"
     interrupted(cfg, out, after_step=3)
     m = manifest(out)
-    m["adaptive"]["format"] = "rti-rig-adaptive/1"
+    m["adaptive"]["format"] = old  # 2: before the bias-aware design score
     (out / "manifest.json").write_text(json.dumps(m))
     before = sorted(p.name for p in out.rglob("*") if p.is_file())
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
-    assert "'rti-rig-adaptive/1'" in text and "export-lp" in text and "new session" in text
+    assert f"'{old}'" in text and "export-lp" in text and "new session" in text
     assert sorted(p.name for p in out.rglob("*") if p.is_file() and "journal" not in p.name) == [
         n for n in before if "journal" not in n
     ]
