@@ -52,8 +52,10 @@ SOFT_PX = 1.0
 #: Below this n·l a light is not expected to light the pixel (as the chooser's GRAZING_COS).
 FACING_COS = 0.15
 
-#: ``fit(obs (L, P), lights (L, 3)) -> (normals (P, 3), valid (P,))``: the robust fit.
-FitFn = Callable[[NDArray[np.float32], NDArray[np.float64]], tuple[NDArray, NDArray]]
+#: ``fit(obs (L, P), lights (L, 3)) -> (normals (P, 3), valid (P,))``: the robust fit, or None
+#: when it refuses the light set (ill-conditioned). Any other error is a bug and propagates:
+#: scoring it 90° would silently steer every decision to the default design.
+FitFn = Callable[[NDArray[np.float32], NDArray[np.float64]], tuple[NDArray, NDArray] | None]
 
 
 @dataclass(frozen=True)
@@ -225,7 +227,8 @@ def render(model: ObjectModel, lights: NDArray[np.float64], pix: NDArray[np.intp
     """Noise-free modelled observations (L, P') of pixels ``pix`` under ``lights``; each
     light's column is kept in ``model.rendered`` (one decision renders a light once, whether
     for the estimate or for any design)."""
-    keys = [(tuple(np.round(v, 9)), len(pix)) for v in lights]
+    which = hash(pix.tobytes())  # which pixels, not only how many
+    keys = [(tuple(np.round(v, 9)), which) for v in lights]
     todo = [i for i, k in enumerate(keys) if k not in model.rendered]
     if todo:
         new = _render(model, lights[todo], pix)
@@ -298,11 +301,11 @@ def simulate_designs(
         errs = []
         for d in range(draws):
             noisy = np.clip(clean[cols] + noise[d][cols], 0.0, None).astype(np.float32)
-            try:
-                normals, valid = fit(noisy, lights)
-            except Exception:  # a refused (ill-conditioned) fit: "90° off"
+            fitted = fit(noisy, lights)
+            if fitted is None:  # a refused (ill-conditioned) fit: "90° off"
                 errs.append(90.0)
                 continue
+            normals, valid = fitted
             est = np.where(np.asarray(valid)[:, None], normals, [0.0, 0.0, 1.0])
             cosang = np.clip((est * truth).sum(axis=1), -1.0, 1.0)
             errs.append(float(np.degrees(np.arccos(cosang)).mean()))

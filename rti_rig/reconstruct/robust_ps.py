@@ -213,7 +213,8 @@ class _Chunk:
             if not inside.all():
                 w &= inside[None, :]
             # unused observations become NaN (0 * inf), used ones keep their value
-            self.gn = np.minimum(g, w * np.float32(np.inf))
+            # C order whatever the caller's layout (a transposed stack is F-ordered)
+            self.gn = np.minimum(g, w * np.float32(np.inf), order="C")
         assert self.gn.flags.c_contiguous  # written through flat indices (see _remove)
         with np.errstate(invalid="ignore"):
             rhs = self.l32t @ (g * w)

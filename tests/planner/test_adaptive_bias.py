@@ -168,6 +168,24 @@ def test_a_refused_fit_counts_as_ninety_degrees() -> None:
     )
 
     def refuse(obs, lights):  # type: ignore[no-untyped-def]
-        raise ValueError("ill-conditioned")
+        return None  # the fit refused the light set
 
     assert simulate_error_deg(m, lights, refuse) == 90.0
+
+    def broken(obs, lights):  # type: ignore[no-untyped-def]
+        raise ValueError("a bug in the fit")
+
+    with pytest.raises(ValueError, match="a bug"):  # not scored 90°, which hides it
+        simulate_error_deg(m, lights, broken)
+
+
+def test_the_use_case_s_fit_turns_only_a_refusal_into_none() -> None:
+    from rti_rig.app.usecases.adaptive import robust_fit
+
+    t = np.radians([20.0, 40.0, 60.0, 120.0, 140.0, 160.0])
+    flat = np.stack([np.cos(t), np.zeros(6), np.sin(t)], axis=1)  # one plane: refused
+    assert robust_fit(np.ones((6, 10), np.float32), flat) is None
+    good = fibonacci_cap(8, 20.0, 70.0)
+    n = _normals(10)
+    fitted = robust_fit(np.maximum(n @ good.T, 0).T.astype(np.float32), good)
+    assert fitted is not None and fitted[0].shape == (10, 3) and fitted[1].any()

@@ -271,3 +271,24 @@ def test_thresholds_decide_exactly_as_the_sorted_median(floor: float) -> None:
     low = np.nanmin(sub, axis=0)
     thr1 = _thresholds(sub, counts, 2.0, f32(floor), cut, -low[None, :])
     np.testing.assert_array_equal(-low > thr1, -low > expected)
+
+
+def test_a_transposed_stack_fits_like_a_contiguous_one() -> None:
+    """A caller's (N, H, W) stack built from a transposed array is not C-ordered; the chunked
+    fit writes its working copy through flat indices, so that copy must be C-ordered anyway
+    (it asserted and crashed on such input)."""
+    from rti_rig.reconstruct import fit_photometric_stereo
+
+    rng = np.random.default_rng(3)
+    lights = rng.normal(size=(12, 3)) * [0.5, 0.5, 0.2]
+    lights[:, 2] = np.abs(lights[:, 2]) + 0.6
+    lights /= np.linalg.norm(lights, axis=1, keepdims=True)
+    n = rng.normal(size=(40, 3)) * [0.3, 0.3, 1.0]
+    n[:, 2] = np.abs(n[:, 2]) + 0.5
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    obs_pl = np.maximum(n @ lights.T, 0.0).astype(np.float32)  # (P, L)
+    transposed = obs_pl.T[:, None, :]  # (L, 1, P), F-ordered underneath
+    assert not transposed.flags.c_contiguous
+    a = fit_photometric_stereo(transposed, lights, robust=True)
+    b = fit_photometric_stereo(np.ascontiguousarray(transposed), lights, robust=True)
+    assert np.array_equal(a.normals, b.normals) and np.array_equal(a.valid, b.valid)

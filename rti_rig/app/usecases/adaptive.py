@@ -191,12 +191,18 @@ def fit_sample(
     )
 
 
-def robust_fit(obs: NDArray[np.float32], lights: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+def robust_fit(
+    obs: NDArray[np.float32], lights: NDArray[np.float64]
+) -> tuple[NDArray, NDArray] | None:
     """The robust fit the benchmarks score, on an (L, P) sample: normals (P, 3), valid (P,) —
-    what the bias-aware design score (``planner.adaptive_bias``) runs on simulated images."""
-    from rti_rig.reconstruct import fit_photometric_stereo
+    what the bias-aware design score (``planner.adaptive_bias``) runs on simulated images;
+    None when the fit refuses the light set (only that: any other error propagates)."""
+    from rti_rig.reconstruct import ReconstructionError, fit_photometric_stereo
 
-    ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
+    try:
+        ps = fit_photometric_stereo(obs[:, None, :], lights, robust=True)
+    except ReconstructionError:
+        return None
     return ps.normals.reshape(-1, 3), ps.valid.ravel()
 
 
