@@ -403,6 +403,7 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument("--scenes", default="", help="comma-separated simulated scenes (default all)")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
+    cache_read = args.cache is not None and args.cache.exists()
     _load_cache(args.cache)
     if args.cache is not None:
         _CACHE_PATH.append(args.cache)
@@ -438,11 +439,11 @@ def main(argv: list[str] | None = None) -> str:
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
             + (
-                "; the bars' scores — homogeneous layouts and `optimal`, which this branch does "
-                "not change — read from FILE, written by a run of the same command on the same "
-                "draws"
-                if args.cache
-                else ""
+                "; the bars' scores — homogeneous layouts and `optimal` — read from FILE, written "
+                "by an earlier run of the same command on the same draws (valid only while those "
+                "planners and the fit are unchanged)"
+                if cache_read
+                else "; every score computed in this run"
             )
             + f"; load average {os.getloadavg()[0]:.1f} at the end). "
             + machine_line(),
