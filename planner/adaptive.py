@@ -411,7 +411,9 @@ def homogeneous_completion(
     # the homogeneous layout itself (ideal matched to every candidate of the band, as
     # select_uniform_leds matches it): when the lights used so far are all part of it, the
     # design is its remaining lights — so a session that keeps to one floor ends with exactly
-    # the homogeneous layout of that floor, whatever lights are out of service
+    # the homogeneous layout of that floor, whatever lights are out of service (when the lights
+    # used are the candidates themselves, to 1e-6 rad: a dome; an arm recording slightly other
+    # directions takes the general matching below)
     band = np.flatnonzero(el >= floor_deg - 1e-9)
     _, whole = linear_sum_assignment(_angles(ideal, candidates[band]))
     layout = band[whole]

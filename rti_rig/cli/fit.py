@@ -60,7 +60,13 @@ def fit(
 ) -> None:
     """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
     from rti_rig.app.usecases.fit import FitRequest, run_batch, run_fit
+    from rti_rig.app.usecases.fit_memory import use_one_heap
     from rti_rig.reconstruct.registry import model_spec
+
+    # One malloc heap for this process, before any decode or reader thread starts: it is
+    # process-wide and permanent, so the command (one fit or one batch per process) sets it,
+    # not the use case, which a Dask worker or a test process also runs (fit_memory).
+    use_one_heap()
 
     try:
         if model != "auto":

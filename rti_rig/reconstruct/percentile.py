@@ -7,8 +7,9 @@ acquisition has 108 MB in all (relight's figure, issue #29). Only the values abo
 percentile matter: the ``m`` largest values of the whole are among the ``m`` largest of any
 part that holds them, so :class:`TopValues` keeps, part by part, the ``m`` largest seen so far
 (about 1 % of the values at ``q`` = 99), and the percentile is read from those. It is exactly
-``numpy.percentile(values, q)`` (linear interpolation) of the finite values, computed by the
-same two order statistics and the same interpolation as before.
+what the fit computed before (``numpy.percentile``'s linear interpolation between the same two
+order statistics, in float64); against ``numpy.percentile`` on float32 input it can differ at
+the rounding level.
 """
 
 from __future__ import annotations

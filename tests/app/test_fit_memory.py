@@ -187,3 +187,20 @@ def test_the_heap_helpers_answer_on_glibc() -> None:
     del freed
     assert release_free_memory() is True
     del kept
+
+
+def test_only_the_command_caps_the_heap(
+    inputs: dict[str, Path], tmp_path: Path, monkeypatch
+) -> None:
+    """The one-heap cap lasts for the whole process, so `rti-rig fit` sets it and the use case
+    does not: a Dask worker or a test process that runs fits among other work keeps its
+    allocator."""
+    from rti_rig.app.usecases import fit_memory
+    from rti_rig.app.usecases.fit import FitRequest, run_fit
+
+    calls: list[str] = []
+    monkeypatch.setattr(fit_memory, "use_one_heap", lambda: calls.append("cap") or True)
+    run_fit(FitRequest(inputs["tiff"], tmp_path / "lib", model="ps", qa=False))
+    assert calls == []
+    _fit(inputs["tiff"], tmp_path / "cli", *NORMALS)
+    assert calls == ["cap"]

@@ -29,7 +29,7 @@ from threadpoolctl import threadpool_limits
 from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band, fit_warnings
 from rti_rig.app.usecases.fit_decode import imread_rgb
 from rti_rig.app.usecases.fit_maps import MapFile
-from rti_rig.app.usecases.fit_memory import release_free_memory, use_one_heap
+from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import directions_of, read_lp
 from rti_rig.core.raw_rows import DecodedStore, RawRows
@@ -239,7 +239,6 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     everything else — model choice, quantisation ranges, writing, QA — is the same code.
     """
     t0 = time.perf_counter()
-    use_one_heap()  # before the decode and reader threads: see fit_memory
     frames, lights, names, what = load_acquisition(req.source)
     release_free_memory()  # the decode buffers
     out = req.out_dir

@@ -25,7 +25,6 @@ changes a computed value).
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 from functools import cache
 from typing import Any
 
@@ -37,8 +36,8 @@ M_ARENA_MAX = -8
 def _glibc() -> Any | None:
     """The process's C library when it is glibc (has ``malloc_trim`` and ``mallopt``)."""
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-    except OSError:
+        libc = ctypes.CDLL(None)  # the C library already loaded (no ldconfig subprocess)
+    except (OSError, TypeError):  # Windows has no "the process itself" to open
         return None
     if not (hasattr(libc, "malloc_trim") and hasattr(libc, "mallopt")):
         return None
@@ -47,7 +46,9 @@ def _glibc() -> Any | None:
 
 def use_one_heap() -> bool:
     """Cap glibc at one malloc arena for this process (threads created afterwards share it).
-    True when the cap was set."""
+    True when the cap was set. It stays set for the life of the process, so `rti-rig fit`
+    calls it (one command per process), not :func:`rti_rig.app.usecases.fit.run_fit`, which
+    Dask workers and test processes run among other work."""
     libc = _glibc()
     return bool(libc is not None and libc.mallopt(M_ARENA_MAX, 1) == 1)
 
