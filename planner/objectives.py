@@ -375,7 +375,7 @@ class NormalsObjective:
         self.l6 = rank_one.quadratic_coefficients(d)
         self.hsh = design_matrix("hsh2", d)  # (K, 9)
         self._sums: tuple[bytes, NDArray, NDArray | None] | None = None
-        self._among: tuple[bytes, tuple[NDArray, NDArray]] | None = None
+        self._among: tuple[bytes, tuple[NDArray, ...]] | None = None
         self._w32: NDArray[np.float32] | None = None
         if self.tau2 > 0:
             every = np.arange(len(d))
@@ -482,16 +482,18 @@ class NormalsObjective:
     #: not confirm earns a scan at the next level (:mod:`rti_rig.planner.optimal`).
     scan_levels = ({}, {"single": False}, {"exact": True})
 
-    def _weights_among(self, among: NDArray[np.intp]) -> tuple[NDArray, NDArray]:
-        """The single-precision scan weights (K', P) of the candidates ``among`` and their
-        weights at the bias pixels (K', P_bias), kept while they are the same (the unused
-        candidates do not change until a swap is accepted)."""
+    def _weights_among(self, among: NDArray[np.intp]) -> tuple[NDArray, ...]:
+        """The single-precision scan weights (K', P) of the candidates ``among``, their
+        weights at the bias pixels (K', P_bias) and the bias scan's per-candidate forms
+        (:func:`rti_rig.planner.rank_one.candidate_forms`), kept while they are the same (the
+        unused candidates do not change until a swap is accepted)."""
         key = np.asarray(among, dtype=np.intp).tobytes()
         if self._among is None or self._among[0] != key:
             k = np.asarray(among, dtype=np.intp)
             if self._w32 is None:
                 self._w32 = self.w_kp.astype(np.float32)
-            self._among = (key, (self._w32[k], self.w_kp[k, : self.n_bias]))
+            forms = rank_one.candidate_forms(self.dirs[k], self.hsh[k], self.l6[k])
+            self._among = (key, (self._w32[k], self.w_kp[k, : self.n_bias], *forms))
         return self._among[1]
 
     def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
@@ -536,11 +538,13 @@ class NormalsObjective:
             r = None if rb is None else rb[:, None] + self._cross_at(k, every)  # (3, K, Pb, 9)
             costs = self._total(base[:, None, :] + self._outer_at(k, every), r)
         else:
-            w32, w_bias = self._weights_among(among) if pooled else (None, None)
+            w32, w_bias, forms_in, h2 = (
+                self._weights_among(among) if pooled else (None, None, None, None)
+            )
             bias = None
             if rb is not None:
                 bias = rank_one.BiasTerms(
-                    rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2, w_bias
+                    rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2, w_bias, forms_in, h2
                 )
             res = rank_one.scan(
                 base, self.w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2,

@@ -100,10 +100,18 @@ def _sweeps(
     unused = None if count is None else np.ones(count, dtype=bool)
     if unused is not None:
         unused[chosen] = False
+    # positions known to have no improving swap in the current layout (the one just swapped
+    # counts: its scan saw the same other lights): at n the layout is a local optimum for
+    # single swaps, and the rest of the sweep and the confirming sweep after it would find
+    # nothing — the same plan, fewer scans
+    idle = 0
     for _ in range(limit):
         changed = False
         before = cost
         for pos in range(n):
+            if idle >= n:
+                break
+            idle += 1
             scan_kw = {} if unused is None else {"among": np.flatnonzero(unused)}
             for level in levels:
                 # the fast scan may be approximate (rank-one updates, single precision): a swap
@@ -123,8 +131,9 @@ def _sweeps(
                     cost = exact
                     swaps += 1
                     changed = True
+                    idle = 1
                     break
                 chosen[pos] = previous
-        if not changed or before - cost < min_gain * abs(before):
+        if not changed or idle >= n or before - cost < min_gain * abs(before):
             break
     return chosen, cost, swaps

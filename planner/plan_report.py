@@ -6,6 +6,8 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from rti_rig.planner.pixel_bins import GRAZING_DEG
+
 
 @dataclass
 class PlanReport:
@@ -82,7 +84,8 @@ class PlanReport:
             every, binned = self.search_pixels
             out.append(
                 f"searched on {binned} binned pixel rows of {every} (nearly equal normals, same "
-                f"shadows); the expected errors above are on all {every}"
+                f"shadows from lights above {GRAZING_DEG:g}°); the expected errors above are on "
+                f"all {every}"
             )
         out.extend(self.notes)
         out.append(f"planned in {self.seconds:.2f} s")

@@ -122,6 +122,18 @@ class BiasTerms:
     tau2: float
     #: the candidates' weights at the bias pixels (K, Pb); None: the first columns of ``w``
     w: NDArray[np.float64] | None = None
+    #: ``[l ⊗ h, l6]`` (K, 33) and ``‖h‖²`` (K,) of these candidates, when the caller keeps
+    #: them (they change only with the scored candidates); None: computed here
+    forms_in: NDArray[np.float64] | None = None
+    h2: NDArray[np.float64] | None = None
+
+
+def candidate_forms(
+    d: NDArray[np.float64], h: NDArray[np.float64], l6: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``[l ⊗ h, l6]`` (K, 33) and ``‖h‖²`` (K,): the bias scan's per-candidate inputs."""
+    lh = (d[:, :, None] * h[:, None, :]).reshape(len(d), 27)
+    return np.concatenate([lh, l6], axis=1), np.sum(h * h, axis=1)
 
 
 def _projected_inverse(
@@ -264,18 +276,21 @@ def _bias_scan(
     pdm = pr @ (gbm - ga)  # P D
     c0 = np.sum(pdm * pdm, axis=(1, 2))  # ‖P D‖²
     f = bi @ pdm  # B⁻¹ P D, so uᵀ P D v = lᵀ F (h - G_Bᵀ l)
-    k, m = len(d), len(gb)
+    m = len(gb)
     gbt = np.transpose(gbm, (0, 2, 1))
     # the forms in l the bias needs: lᵀFh - lᵀFG_Bᵀl and -2 lᵀG_Bh + lᵀG_BG_Bᵀl from one
     # product of [l ⊗ h, l6] (K, 33); lᵀB⁻¹l and lᵀB⁻¹PB⁻¹l from one product of l6
     dt = np.float32 if single else np.float64
-    lh = (d[:, :, None] * bias.h[:, None, :]).reshape(k, 27)  # l ⊗ h
+    if bias.forms_in is None or bias.h2 is None:
+        forms_in, h2 = candidate_forms(d, bias.h, l6)
+    else:
+        forms_in, h2 = bias.forms_in, bias.h2
     coef = np.empty((33, 2 * m))
     coef[:27, :m] = f.reshape(m, 27).T
     coef[:27, m:] = -2.0 * gbm.reshape(m, 27).T
     coef[27:, :m] = -_entries(f @ gbt)
     coef[27:, m:] = _entries(gbm @ gbt)
-    forms = np.concatenate([lh, l6], axis=1).astype(dt, copy=False) @ coef.astype(dt, copy=False)
+    forms = forms_in.astype(dt, copy=False) @ coef.astype(dt, copy=False)
     quad = l6.astype(dt, copy=False) @ np.concatenate([inv_b, qc6], axis=1).astype(dt, copy=False)
     cross, spread, sb, qb = forms[:, :m], forms[:, m:], quad[:, :m], quad[:, m:]
     w = wb.astype(dt, copy=False)
@@ -283,7 +298,7 @@ def _bias_scan(
     sb += 1.0
     np.divide(w, sb, out=sb)  # s = w / (1 + w lᵀ B⁻¹ l)
     # ‖P(M⁻¹R - G_all)‖² = c0 + s (2 cross + s qb (‖h‖² + spread))
-    spread += np.sum(bias.h * bias.h, axis=1).astype(dt)[:, None]
+    spread += h2.astype(dt, copy=False)[:, None]
     spread *= qb
     spread *= sb
     cross *= 2.0

@@ -343,3 +343,38 @@ def test_a_proposal_the_exact_cost_rejects_is_rescanned_in_double_then_exactly()
         {"exact": True, "single": True},
     ]
     assert sorted(res.chosen.tolist()) == [0, 1, 2]
+
+
+def test_the_search_stops_once_every_position_is_known_to_have_no_improving_swap() -> None:
+    """After the last accepted swap, the search scans each other position once more and stops:
+    not the rest of that sweep and a whole confirming sweep after it. Its plan is a local
+    optimum for single swaps (checked by direct evaluation) all the same."""
+    surface = estimate_surface(relief_preview(), (30.0, 50.0))
+    cands, starts, sample = planning_problem(DOME, 12, surface)
+    obj = NormalsObjective(sample, cands)
+    seen: list[tuple[int, bytes]] = []
+
+    class Counting:
+        candidate_count = obj.candidate_count
+        scan_levels = obj.scan_levels
+
+        def cost(self, chosen: np.ndarray) -> float:
+            return obj.cost(chosen)
+
+        def swap_costs(self, chosen, position, **kw) -> np.ndarray:
+            seen.append((position, np.asarray(chosen).tobytes()))
+            return obj.swap_costs(chosen, position, **kw)
+
+    with threadpool_limits(limits=1):
+        res = exchange_search(Counting(), starts, min_gain=0.0)  # type: ignore[arg-type]
+    assert res.swaps > 0
+    final = res.chosen.tobytes()
+    first_final = next(i for i, (_, layout) in enumerate(seen) if layout == final)
+    # the scan that found the last swap saw the layout before it; after it, n - 1 positions
+    after = {pos for pos, _ in seen[first_final:]}
+    assert len(after) == len(seen[first_final:]) == 11
+    assert seen[first_final - 1][0] not in after
+    unused = np.setdiff1d(np.arange(len(cands)), res.chosen)
+    for pos in range(12):
+        trial = obj.swap_costs(res.chosen, pos, exact=True, among=unused)
+        assert trial[unused].min() >= res.cost * (1 - 1e-9)
