@@ -129,28 +129,3 @@ def solve_weighted(
     """
     m, rhs, count = normal_equations(g, w, lights)
     return solve_normal_equations(m, rhs, count, cond_limit)
-
-
-def remove_observations(
-    eqs: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]],
-    pix: NDArray[np.intp],
-    light: NDArray[np.intp],
-    values: NDArray[np.float32],
-    lights: NDArray[np.float64],
-    ll6: NDArray[np.float64],
-    cols: NDArray[np.intp],
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[Any]]:
-    """The normal equations of pixels ``cols`` after removing observations (``pix`` indexing
-    into ``cols``, ``light``, their ``values``): a downdate of the few removed terms (exact in
-    float64), not a new pass over all N observations of every pixel."""
-    m, rhs, count = eqs
-    k = cols.size
-    m_c = m[:, cols]
-    for j in range(6):
-        m_c[j] -= np.bincount(pix, weights=ll6[light, j], minlength=k)
-    rhs_c = rhs[:, cols]
-    gv = values.astype(np.float64)
-    for j in range(3):
-        rhs_c[j] -= np.bincount(pix, weights=gv * lights[light, j], minlength=k)
-    count_c = count[cols] - np.bincount(pix, minlength=k)
-    return m_c, rhs_c, count_c

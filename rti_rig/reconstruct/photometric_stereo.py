@@ -47,9 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
-from rti_rig.reconstruct.normal_equations import (
-    solve_weighted as _solve_weighted,
-)
+from rti_rig.reconstruct.normal_equations import solve_weighted
 from rti_rig.reconstruct.robust_ps import RobustRules, fit_robust_band
 from rti_rig.reconstruct.solve import COND_LIMIT, solve_matrix
 from rti_rig.reconstruct.stack import ImageStack, as_direction, channel_mean, validate_lights
@@ -349,7 +347,7 @@ def fit_photometric_stereo(
                 vals[bad_c] = 0.0
                 usable = ~np.logical_or.reduce(bad_c, axis=2)
                 gc = channel_mean(vals) if stack.channels > 1 else vals[..., 0]
-                bc, okc = _solve_weighted(np.ascontiguousarray(gc.T), usable.T, lt, cond_limit)
+                bc, okc = solve_weighted(np.ascontiguousarray(gc.T), usable.T, lt, cond_limit)
                 n_c, alb_c, rms_c, count_c, ok_c = _albedo_residual_used(
                     bc, usable, okc, gc, vals, lt, eps_b
                 )

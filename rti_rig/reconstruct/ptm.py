@@ -39,7 +39,7 @@ class PTMModel(LinearBasisModel):
         predicts dark everywhere get the view axis.
         """
         # local import: photometric_stereo's per-pixel solver, shared rather than repeated
-        from rti_rig.reconstruct.photometric_stereo import _solve_weighted
+        from rti_rig.reconstruct.normal_equations import solve_weighted
 
         c = self.coefficients
         h, w = c.shape[1], c.shape[2]
@@ -57,11 +57,11 @@ class PTMModel(LinearBasisModel):
             g = np.ascontiguousarray(vals.T)  # (P, K)
             lit = g > LIT_FRACTION * np.maximum(peak, 0.0)[:, None]
             lit &= (peak > 0)[:, None]
-            b, ok = _solve_weighted(g, lit, dirs, 1e3)
+            b, ok = solve_weighted(g, lit, dirs, 1e3)
             norm = np.linalg.norm(b, axis=1, keepdims=True)
             n = np.where(norm > 0, b / np.where(norm > 0, norm, 1.0), 0.0)
             keep = lit & ((n @ dirs.T) > TERMINATOR_COS)
-            b2, ok2 = _solve_weighted(g, keep, dirs, 1e3)
+            b2, ok2 = solve_weighted(g, keep, dirs, 1e3)
             b = np.where(ok2[:, None], b2, b)
             ok = ok | ok2
             b[:, 2] = np.maximum(b[:, 2], 0.0)

@@ -4,6 +4,9 @@ what it sees, and the gloss-aware estimate."""
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -23,12 +26,8 @@ from rti_rig.planner.adaptive import (
 )
 from rti_rig.planner.uniform import select_uniform_leds
 
-
-def state_for(normals: np.ndarray, lights: np.ndarray, noise: float = 0.01) -> SurfaceState:
-    normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
-    lit = normals @ lights.T > 0
-    p = len(normals)
-    return SurfaceState(normals, np.ones(p), np.full(p, noise), lit, lights)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from adaptive_states import state_for
 
 
 def dome(n: int = 120) -> DomeGeometry:

@@ -2,26 +2,23 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.planner.adaptive import (
     MAX_ERR2,
-    SurfaceState,
     bound_error2,
     choose_next,
     estimate_error_deg,
     predicted_error2,
 )
 
-
-def state_for(normals: np.ndarray, lights: np.ndarray, noise: float = 0.01) -> SurfaceState:
-    """A Lambertian surface of unit albedo: a light lights a pixel when n·l > 0."""
-    normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
-    lit = normals @ lights.T > 0
-    p = len(normals)
-    return SurfaceState(normals, np.ones(p), np.full(p, noise), lit, lights)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from adaptive_states import state_for
 
 
 def test_bound_matches_the_closed_form_for_an_orthogonal_ring() -> None:

@@ -12,8 +12,8 @@ import numpy as np
 
 from rti_rig.reconstruct import fit_photometric_stereo
 from rti_rig.reconstruct.hsh import fit_hsh
-from rti_rig.reconstruct.normal_equations import light_products
-from rti_rig.reconstruct.photometric_stereo import LS_CHUNK_BYTES, _solve_weighted
+from rti_rig.reconstruct.normal_equations import light_products, solve_weighted
+from rti_rig.reconstruct.photometric_stereo import LS_CHUNK_BYTES
 from rti_rig.reconstruct.robust_ps import RobustRules, _Chunk
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
@@ -87,7 +87,7 @@ def test_robust_downdated_equations_equal_rebuilt_ones() -> None:
     ok = state.ok
     assert ok.mean() > 0.5 and (~w).any()
     pixel_major = np.ascontiguousarray(g.T), np.ascontiguousarray(w.T)
-    b_re, ok_re = _solve_weighted(*pixel_major, lights, 100.0)
+    b_re, ok_re = solve_weighted(*pixel_major, lights, 100.0)
     assert np.array_equal(ok, ok_re)
     np.testing.assert_allclose(state.b.T[ok], b_re[ok], rtol=1e-5, atol=1e-7)
     np.testing.assert_array_equal(state.count, w.sum(axis=0))
