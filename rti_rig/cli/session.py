@@ -99,6 +99,16 @@ def run(
             "degrees (with --lights: whichever comes first).",
         ),
     ] = None,
+    objective: Annotated[
+        str | None,
+        typer.Option(
+            "--objective",
+            help="Adaptive with --lights N: choose the design for 'normals' (default: the "
+            "simulated normal error) or 'relight' (the simulated relighting PSNR on the lights "
+            "left out). --until-error is a normals criterion: refused with 'relight'. With "
+            "--resume: must be the session's own.",
+        ),
+    ] = None,
     no_verdict: Annotated[
         bool, typer.Option("--no-verdict", help="Do not print the QA verdict at the end.")
     ] = False,
@@ -144,6 +154,7 @@ def run(
                     rig_config,
                     max_saturated=max_saturated,
                     accept_rig_change=accept_rig_change,
+                    objective=objective,
                 ),
                 print_note,
             )
@@ -164,6 +175,7 @@ def run(
                     max_saturated=max_saturated,
                     adaptive=adaptive,
                     until_error_deg=until_error,
+                    objective=objective,
                 ),
                 print_note,
             )
