@@ -25,6 +25,9 @@ object's model of gloss, cast shadows and noise (:mod:`rti_rig.planner.adaptive_
 decides the best floor is bias, which the variance bound does not see), else by the bound; the
 current design (the default floor at first) is kept unless another is better by
 :data:`SIM_MARGIN` (:data:`DESIGN_MARGIN` for the bound) — then its most useful light first.
+With ``objective="relight"`` (``run --adaptive --lights N --objective relight``) the designs are
+scored instead by their simulated relighting PSNR on the lights they leave out
+(:mod:`rti_rig.planner.adaptive_relight`).
 The stopping rule's estimate (``AdaptiveChooser.estimate`` in the use case) is the simulated
 error times :data:`SIM_ESTIMATE_SCALE`, calibrated against measured error on the simulator
 (docs/adaptive.md); :func:`estimate_error_deg` is the bound's.

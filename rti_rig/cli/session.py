@@ -323,8 +323,10 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     adaptive_result = opened.extra.get("adaptive_result")
     if adaptive_result is not None:
         est = adaptive_result["estimated_error_deg"]
+        chosen_for = adaptive_result.get("objective", "normals")
         out.print(
-            f"Adaptive: {adaptive_result['lights_used']} lights; stopped: "
+            ("Adaptive" if chosen_for == "normals" else f"Adaptive (designs for {chosen_for})")
+            + f": {adaptive_result['lights_used']} lights; stopped: "
             f"{adaptive_result['stop']['reason']}; estimated mean normal error "
             f"{'n/a' if est is None else f'{est:.2f}°'}",
             highlight=False,

@@ -48,7 +48,7 @@ def relight_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ["run", str(DOME), "--out", str(out), "--adaptive", "--lights", "8", *RELIGHT],
     )
     assert r.exit_code == 0, r.output
-    assert "Adaptive: 8 lights" in said(r)
+    assert "Adaptive (designs for relight): 8 lights; stopped: reached" in said(r)
     return out
 
 
@@ -57,6 +57,7 @@ def test_the_relight_objective_is_in_the_settings_and_every_decision(relight_ses
     assert len(steps) == 8
     assert all(s["decision"]["objective"] == "relight" for s in steps)
     header = manifest(relight_session)["adaptive"]
+    assert header["result"]["objective"] == "relight"
     assert header["objective"] == "relight" and header["format"] == FORMAT == "rti-rig-adaptive/4"
     for s in steps[4:]:
         d = s["decision"]

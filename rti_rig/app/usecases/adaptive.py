@@ -425,6 +425,7 @@ class AdaptiveChooser:
         with threadpool_limits(limits=1, user_api="blas"):
             est = None if state is None else self.estimate(state)
         return {
+            "objective": self.objective,
             "lights_used": len(self.used),
             "estimated_error_deg": None if est is None else round(est, 4),
             "stop": self.stop_evidence or {"kind": "stop", "reason": self._cap_reason()},
