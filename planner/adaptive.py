@@ -25,6 +25,9 @@ object's model of gloss, cast shadows and noise (:mod:`rti_rig.planner.adaptive_
 decides the best floor is bias, which the variance bound does not see), else by the bound; the
 current design (the default floor at first) is kept unless another is better by
 :data:`SIM_MARGIN` (:data:`DESIGN_MARGIN` for the bound) — then its most useful light first.
+With ``objective="relight"`` (``run --adaptive --lights N --objective relight``) the designs are
+scored instead by their simulated relighting PSNR on the lights they leave out
+(:mod:`rti_rig.planner.adaptive_relight`).
 The stopping rule's estimate (``AdaptiveChooser.estimate`` in the use case) is the simulated
 error times :data:`SIM_ESTIMATE_SCALE`, calibrated against measured error on the simulator
 (docs/adaptive.md); :func:`estimate_error_deg` is the bound's.
@@ -44,6 +47,14 @@ from rti_rig.planner.adaptive_bias import (
     ObjectModel,
     fit_object_model,
     simulate_designs,
+)
+from rti_rig.planner.adaptive_relight import (
+    OBJECTIVES,
+    RelightFn,
+    held_out,
+    pick_floor,
+    relight_basis,
+    simulate_relight_designs,
 )
 
 #: Below this n·l a light is treated as (softly) shadowed for a pixel, as in the objectives.
@@ -124,6 +135,10 @@ class Decision:
     reason: str
     #: with N known: the elevation floor (°) of the design the light was chosen in
     design_floor: float | None = None
+    #: with N known: what the designs were scored by (``normals``: simulated or bound mean
+    #: normal error, °; ``relight``: simulated relighting PSNR, dB) and each floor's score
+    objective: str | None = None
+    design_scores: dict[str, float] | None = None
 
     def evidence(self) -> dict[str, object]:
         out: dict[str, object] = {
@@ -137,6 +152,11 @@ class Decision:
         }
         if self.design_floor is not None:
             out["design_floor_deg"] = self.design_floor
+        if self.objective is not None:
+            out["design_objective"] = self.objective
+        if self.design_scores is not None:
+            key = "design_psnr_db" if self.objective == "relight" else "design_error_deg"
+            out[key] = self.design_scores
         return out
 
 
@@ -468,6 +488,8 @@ def choose_in_design(
     keep: int = 3,
     fit: FitFn | None = None,
     incumbent: float | None = None,
+    objective: str = "normals",
+    relight: RelightFn | None = None,
 ) -> Decision:
     """With ``n_total`` lights known: the best complete design, then its most useful light.
 
@@ -478,7 +500,16 @@ def choose_in_design(
     adaptive session falls back to the homogeneous layout when the evidence does not justify
     leaving it. Within the design, the next light is the one with the largest predicted drop
     per second (as :func:`choose_next`), so a session stopped early has its most useful lights.
+
+    ``objective="relight"`` (with ``fit`` and ``relight`` given): the designs are scored by
+    their simulated relighting PSNR on this object's model instead
+    (:mod:`rti_rig.planner.adaptive_relight`); the order of the lights within the design is
+    still the bound's (it does not change the layout a completed session ends with).
     """
+    if objective not in OBJECTIVES:
+        raise ValueError(f"unknown objective {objective!r}; known: {', '.join(OBJECTIVES)}")
+    if objective == "relight" and (fit is None or relight is None):
+        raise ValueError("the relight objective simulates this object: give fit and relight")
     floors = DESIGN_FLOORS if floors is None else floors
     default_floor = DESIGN_DEFAULT_FLOOR if default_floor is None else default_floor
     now = estimate_error_deg(state, scale)
@@ -494,11 +525,32 @@ def choose_in_design(
         w_union = predicted_weight(state, candidates[union])
         where = {int(c): i for i, c in enumerate(union)}
     model = object_model(state) if fit is not None else None
+    if objective == "relight" and model is None:
+        raise ValueError("the relight objective needs the state's observations (obs, valid)")
     for f, comp in comps.items():
         designs[f] = comp
         if model is None:
             cols = [where[int(c)] for c in comp]
             scores[f] = design_error_deg(state, candidates[comp], scale, w_union[:, cols])
+    if model is not None and designs and objective == "relight":
+        assert relight is not None
+        full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
+        held = [held_out(candidates, available, c) for c in designs.values()]
+        psnr = simulate_relight_designs(model, full, held, relight, relight_basis(n_total))
+        return _relight_decision(
+            state,
+            candidates,
+            available,
+            n_total,
+            designs,
+            dict(zip(designs, psnr, strict=True)),
+            default_floor if incumbent is None or incumbent not in designs else incumbent,
+            now,
+            capture_s=capture_s,
+            move_s=move_s,
+            scale=scale,
+            keep=keep,
+        )
     if model is not None and designs:  # bias-aware: each design simulated on this object
         assert fit is not None
         full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
@@ -542,6 +594,42 @@ def choose_in_design(
         f"{scores[best]:.3g}° after all {n_total}; by floor: {design}); within it, "
         f"the largest predicted drop per second ({k} captured)",
         design_floor=best,
+        objective="normals",
+        design_scores=design,
+    )
+
+
+def _relight_decision(
+    state: SurfaceState,
+    candidates: NDArray[np.float64],
+    available: NDArray[np.bool_],
+    n_total: int,
+    designs: dict[float, NDArray[np.intp]],
+    psnr: dict[float, float],
+    keep_floor: float,
+    now: float,
+    **choose: Any,
+) -> Decision:
+    """The design with the best simulated relighting PSNR (kept unless another is better by
+    :data:`~rti_rig.planner.adaptive_relight.RELIGHT_MARGIN_DB`), then its most useful light."""
+    best = pick_floor(psnr, keep_floor)
+    mask = np.zeros(len(candidates), dtype=bool)
+    mask[designs[best]] = True
+    d = choose_next(state, candidates, mask & available, **choose)
+    by_floor = {f"{f:g}": round(v, 3) for f, v in sorted(psnr.items())}
+    return Decision(
+        d.candidate,
+        now,
+        d.predicted_error_deg,
+        d.runner_up,
+        f"homogeneous design of {n_total} lights above {best:g}° (relighting PSNR of "
+        f"{relight_basis(n_total)} simulated with this object's gloss and shadows: "
+        f"{psnr[best]:.3g} dB on the lights left out; by floor: {by_floor}); within it, "
+        f"the largest predicted drop of the normal error per second ({len(state.lights)} "
+        "captured)",
+        design_floor=best,
+        objective="relight",
+        design_scores=by_floor,
     )
 
 

@@ -99,6 +99,16 @@ def run(
             "degrees (with --lights: whichever comes first).",
         ),
     ] = None,
+    objective: Annotated[
+        str | None,
+        typer.Option(
+            "--objective",
+            help="Adaptive with --lights N: choose the design for 'normals' (default: the "
+            "simulated normal error) or 'relight' (the simulated relighting PSNR on the lights "
+            "left out). --until-error is a normals criterion: refused with 'relight'. With "
+            "--resume: must be the session's own.",
+        ),
+    ] = None,
     no_verdict: Annotated[
         bool, typer.Option("--no-verdict", help="Do not print the QA verdict at the end.")
     ] = False,
@@ -144,6 +154,7 @@ def run(
                     rig_config,
                     max_saturated=max_saturated,
                     accept_rig_change=accept_rig_change,
+                    objective=objective,
                 ),
                 print_note,
             )
@@ -164,6 +175,7 @@ def run(
                     max_saturated=max_saturated,
                     adaptive=adaptive,
                     until_error_deg=until_error,
+                    objective=objective,
                 ),
                 print_note,
             )
@@ -311,8 +323,10 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     adaptive_result = opened.extra.get("adaptive_result")
     if adaptive_result is not None:
         est = adaptive_result["estimated_error_deg"]
+        chosen_for = adaptive_result.get("objective", "normals")
         out.print(
-            f"Adaptive: {adaptive_result['lights_used']} lights; stopped: "
+            ("Adaptive" if chosen_for == "normals" else f"Adaptive (designs for {chosen_for})")
+            + f": {adaptive_result['lights_used']} lights; stopped: "
             f"{adaptive_result['stop']['reason']}; estimated mean normal error "
             f"{'n/a' if est is None else f'{est:.2f}°'}",
             highlight=False,

@@ -230,7 +230,7 @@ def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
     assert manifest(out)["rig"]["backend"] == "replay"
 
 
-@pytest.mark.parametrize("old", ["rti-rig-adaptive/1", "rti-rig-adaptive/2"])
+@pytest.mark.parametrize("old", ["rti-rig-adaptive/1", "rti-rig-adaptive/2", "rti-rig-adaptive/3"])
 def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     uninterrupted: tuple[Path, Path], tmp_path: Path, old: str
 ) -> None:

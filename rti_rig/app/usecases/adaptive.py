@@ -21,8 +21,9 @@ uninterrupted session would have.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -42,7 +43,6 @@ from rti_rig.planner.adaptive import (
     SIM_ESTIMATE_SCALE,
     START_FLOOR_DEG,
     START_LIGHTS,
-    Decision,
     SurfaceState,
     choose_in_design,
     choose_next,
@@ -51,6 +51,7 @@ from rti_rig.planner.adaptive import (
     start_subset,
 )
 from rti_rig.planner.adaptive_bias import simulate_error_deg
+from rti_rig.planner.adaptive_relight import OBJECTIVES
 from rti_rig.planner.objectives import candidates_for, snap_unique
 from rti_rig.planner.uniform import select_uniform_leds
 
@@ -66,7 +67,8 @@ OUTLIER_K = 3.0
 OUTLIER_FLOOR = 0.02
 #: An adaptive run that gives only --until-error on an arm stops at this many lights at most.
 ARM_MAX_LIGHTS = 100
-FORMAT = "rti-rig-adaptive/3"
+#: 4: the design objective (``normals``/``relight``) in the settings and every decision
+FORMAT = "rti-rig-adaptive/4"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
@@ -206,6 +208,33 @@ def robust_fit(
     return ps.normals.reshape(-1, 3), ps.valid.ravel()
 
 
+def relight_fit(
+    obs: NDArray[np.float32], lights: NDArray[np.float64], held: NDArray[np.float64], basis: str
+) -> NDArray | None:
+    """The relighting fit the benchmarks score (``fit_hsh``/``fit_ptm``, as
+    ``benchmarks.planner_real_data.relight_model`` fits it) on an (L, P) sample, relit to the
+    held-out lights (T, 3) and clamped at 0 as the models relight: (T, P) — what the relight
+    design score (``planner.adaptive_relight``) runs on simulated images; None when the fit
+    refuses the light set."""
+    from rti_rig.core.rti_bases import design_matrix
+    from rti_rig.reconstruct import ReconstructionError, fit_hsh, fit_lambert, fit_ptm
+
+    stack = np.asarray(obs, dtype=np.float32)[:, None, :]
+    try:
+        with warnings.catch_warnings():  # a ridge-regularised fit is scored as it is
+            warnings.simplefilter("ignore")
+            if basis == "ptm":
+                model = fit_ptm(stack, lights)
+            elif basis.startswith("hsh"):
+                model = fit_hsh(stack, lights, int(basis[-1]))
+            else:
+                model = fit_lambert(stack, lights, ill_conditioned="regularise")
+    except ReconstructionError:
+        return None
+    coef = model.coefficients.reshape(model.n_coefficients, -1).astype(np.float64)
+    return np.maximum(design_matrix(basis, held) @ coef, 0.0)
+
+
 MoveTimes = Callable[[NDArray[np.float64] | None], NDArray[np.float64] | None]
 
 
@@ -227,10 +256,18 @@ class AdaptiveChooser:
         scale: float | None = None,
         design_lights: int | None = None,
         bias_aware: bool | None = None,
+        objective: str = "normals",
     ) -> None:
         #: the design score and the estimate: a robust fit simulated on this object's model
         #: (None: BIAS_AWARE), else the Lambertian variance bound
         self.bias_aware = BIAS_AWARE if bias_aware is None else bias_aware
+        #: what the designs (``--lights N``) are chosen for: ``normals`` (the simulated normal
+        #: error) or ``relight`` (the simulated relighting PSNR: ``planner.adaptive_relight``)
+        if objective not in OBJECTIVES:
+            raise ValueError(f"unknown objective {objective!r}")
+        if objective == "relight" and (design_lights is None or not self.bias_aware):
+            raise ValueError("the relight objective chooses designs of N lights by simulation")
+        self.objective = objective
         if scale is None:
             scale = SIM_ESTIMATE_SCALE if self.bias_aware else ESTIMATE_SCALE
         self.candidates = np.asarray(candidates, dtype=np.float64)
@@ -294,7 +331,9 @@ class AdaptiveChooser:
         from threadpoolctl import threadpool_limits
 
         with threadpool_limits(limits=1, user_api="blas"):
-            return self._decide(index)
+            candidate, evidence = self._decide(index)
+        evidence.setdefault("objective", self.objective)  # every decision says what it serves
+        return candidate, evidence
 
     def _decide(self, index: int) -> tuple[int | None, dict[str, Any]]:
         t0 = time.perf_counter()
@@ -341,6 +380,8 @@ class AdaptiveChooser:
                 scale=self.scale,
                 fit=robust_fit if self.bias_aware else None,
                 incumbent=self.floor if self.bias_aware else None,
+                objective=self.objective,
+                relight=relight_fit if self.objective == "relight" else None,
             )
             self.floor = d.design_floor
         else:
@@ -356,16 +397,16 @@ class AdaptiveChooser:
             # the bound's predictions after each candidate, rescaled to the estimate now (the
             # simulated one, bias included): a ratio, so the candidates keep their ranking
             ratio = est / d.estimated_error_deg
-            d = Decision(
-                d.candidate,
-                est,
-                None if d.predicted_error_deg is None else d.predicted_error_deg * ratio,
-                [
+            d = replace(
+                d,
+                estimated_error_deg=est,
+                predicted_error_deg=(
+                    None if d.predicted_error_deg is None else d.predicted_error_deg * ratio
+                ),
+                runner_up=[
                     {**r, "predicted_error_deg": round(r["predicted_error_deg"] * ratio, 4)}
                     for r in d.runner_up
                 ],
-                d.reason,
-                d.design_floor,
             )
         if d.candidate is None:
             self.stop_evidence = {"kind": "stop", **d.evidence()}
@@ -384,6 +425,7 @@ class AdaptiveChooser:
         with threadpool_limits(limits=1, user_api="blas"):
             est = None if state is None else self.estimate(state)
         return {
+            "objective": self.objective,
             "lights_used": len(self.used),
             "estimated_error_deg": None if est is None else round(est, 4),
             "stop": self.stop_evidence or {"kind": "stop", "reason": self._cap_reason()},
@@ -482,9 +524,12 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
 class AdaptiveSteps:
     """The controller's step source for an adaptive session (see the module docstring)."""
 
-    def __init__(self, rig, plan: AdaptivePlan, until_error_deg: float | None) -> None:  # type: ignore[no-untyped-def]
+    def __init__(  # type: ignore[no-untyped-def]
+        self, rig, plan: AdaptivePlan, until_error_deg: float | None, objective: str = "normals"
+    ) -> None:
         self.plan = plan
         self.until_error_deg = until_error_deg
+        self.objective = objective
         move: MoveTimes | None = None
         if isinstance(rig.geometry, ArmGeometry):
             settings = _arm_motion_settings(rig.loaded)
@@ -502,6 +547,7 @@ class AdaptiveSteps:
             capture_s=_capture_s(rig),
             move_times=move,
             design_lights=plan.design_lights,
+            objective=objective,
         )
         self._pending: dict[int, int] = {}
 
@@ -520,6 +566,7 @@ class AdaptiveSteps:
             "until_error_deg": self.until_error_deg,
             "start_lights": len(self.plan.start),
             "design_lights": self.plan.design_lights,
+            "objective": self.objective,
             "candidates": len(self.plan.candidates),
             "fit_px": FIT_PX,
             "estimate_scale": self.chooser.scale,
@@ -585,7 +632,41 @@ def record_result(folder_root: Path, result: dict[str, Any]) -> None:
     _write_json_atomic(Path(folder_root) / MANIFEST, manifest)
 
 
-def open_adaptive_session(loaded, out_dir: Path, lights: int | None, until_error_deg: float | None):  # type: ignore[no-untyped-def]
+def check_objective(objective: str, lights: int | None, until_error_deg: float | None) -> None:
+    """Refuse an objective the adaptive session cannot serve, before anything is opened.
+
+    ``relight`` chooses the *design* of N lights by its simulated relighting PSNR, so it needs
+    ``--lights N``; ``--until-error`` is a criterion on the estimated mean *normal* error (the
+    only error the session estimates and that is calibrated against measured error), so it is
+    refused with ``relight`` rather than given a relighting meaning nobody calibrated."""
+    if objective not in OBJECTIVES:
+        raise RtiRigError(
+            f"--objective {objective}: an adaptive session chooses its lights for "
+            f"{' or '.join(OBJECTIVES)}"
+        )
+    if objective != "relight":
+        return
+    if until_error_deg is not None:
+        raise RtiRigError(
+            "--until-error goes with --objective normals only: it stops on the estimated mean "
+            "normal error, which a session chosen for relighting does not aim at (no relighting "
+            "error estimate is calibrated). Give --objective relight --lights N, or drop "
+            "--objective for --until-error"
+        )
+    if lights is None:
+        raise RtiRigError(
+            "--objective relight chooses a design of N lights by its simulated relighting: "
+            "give --lights N"
+        )
+
+
+def open_adaptive_session(  # type: ignore[no-untyped-def]
+    loaded,
+    out_dir: Path,
+    lights: int | None,
+    until_error_deg: float | None,
+    objective: str = "normals",
+):
     """Check the request and the folder, open the rig, plan the start, make the folder.
 
     Returns (rig, starting schedule, folder, step source); the rig is closed if anything after
@@ -602,10 +683,11 @@ def open_adaptive_session(loaded, out_dir: Path, lights: int | None, until_error
             f"--adaptive --lights {lights}: an adaptive session starts from {START_LIGHTS} lights "
             f"and chooses from there; give at least {START_LIGHTS + 1}"
         )
+    check_objective(objective, lights, until_error_deg)
     SessionFolder.check_new(out_dir)
     rig = build_rig(loaded)
     try:
-        source = AdaptiveSteps(rig, adaptive_plan(rig, lights), until_error_deg)
+        source = AdaptiveSteps(rig, adaptive_plan(rig, lights), until_error_deg, objective)
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
         folder = SessionFolder.create(out_dir, source.total)
@@ -615,8 +697,38 @@ def open_adaptive_session(loaded, out_dir: Path, lights: int | None, until_error
     return rig, schedule, folder, source
 
 
-def resume_adaptive_source(rig, folder) -> AdaptiveSteps:  # type: ignore[no-untyped-def]
-    """The step source of an interrupted adaptive session, brought up to its last step."""
+def check_resume_objective(manifest: dict, root: Path, objective: str | None) -> str:
+    """The objective an interrupted session was begun with; a different ``objective`` asked
+    for is refused (from the manifest alone, before anything on disk is touched)."""
+    header = manifest.get("adaptive")
+    if header is None:
+        if objective is None:
+            return "normals"
+        raise RtiRigError(
+            f"{root}: --objective goes with an adaptive session, and this one is not: drop "
+            f"--objective {objective}"
+        )
+    if header.get("format") != FORMAT:  # refused by name where the source is made
+        return "normals"
+    began = header.get("objective")
+    if began not in OBJECTIVES:
+        raise RtiRigError(
+            f"{root}: the manifest's adaptive settings do not say which objective the session "
+            f"was chosen for ({began!r}); it cannot continue as it began"
+        )
+    if objective is not None and objective != began:
+        raise RtiRigError(
+            f"{root}: this adaptive session was begun with --objective {began}; its lights so "
+            f"far were chosen for {began}, and a resume repeats and continues those decisions. "
+            f"Drop --objective {objective} to continue it for {began}, or start a new session "
+            f"for {objective}"
+        )
+    return str(began)
+
+
+def resume_adaptive_source(rig, folder, objective: str | None = None) -> AdaptiveSteps:  # type: ignore[no-untyped-def]
+    """The step source of an interrupted adaptive session, brought up to its last step
+    (``objective``: the one the user asks for, if any — it must be the session's own)."""
     header = folder.manifest["adaptive"]
     if header.get("format") != FORMAT:
         raise RtiRigError(
@@ -626,6 +738,7 @@ def resume_adaptive_source(rig, folder) -> AdaptiveSteps:  # type: ignore[no-unt
             "`rti-rig export-lp` and `rti-rig fit` use them as they are; start a new session to "
             "shoot more"
         )
+    began = check_resume_objective(folder.manifest, Path(folder.root), objective)
     plan = adaptive_plan(
         rig,
         header["max_lights"],
@@ -637,6 +750,6 @@ def resume_adaptive_source(rig, folder) -> AdaptiveSteps:  # type: ignore[no-unt
             f"{folder.root}: the rig now offers {len(plan.candidates)} candidate lights, the "
             f"session began with {header['candidates']}: it cannot continue as it began"
         )
-    source = AdaptiveSteps(rig, plan, header.get("until_error_deg"))
+    source = AdaptiveSteps(rig, plan, header.get("until_error_deg"), began)
     source.replay(folder)
     return source

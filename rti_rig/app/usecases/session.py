@@ -61,6 +61,9 @@ class NewSessionRequest:
     adaptive: bool = False
     #: Adaptive: stop once the estimated mean normal error is at most this (degrees).
     until_error_deg: float | None = None
+    #: Adaptive: what the design of ``lights`` is chosen for, ``normals`` or ``relight``
+    #: (None: normals; refused for a session that is not adaptive).
+    objective: str | None = None
 
     @property
     def is_adaptive(self) -> bool:
@@ -80,6 +83,8 @@ class ResumeRequest:
     rig_config: Path | None = None
     max_saturated: float = 0.001
     accept_rig_change: bool = False
+    #: An adaptive session's objective, if the user names it: it must be the session's own.
+    objective: str | None = None
 
 
 @dataclass(frozen=True)
@@ -289,7 +294,7 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         check_light_count(req.lights)
     identity = rig_identity(loaded)
     rig, schedule, folder, source = open_adaptive_session(
-        loaded, req.out_dir, req.lights, req.until_error_deg
+        loaded, req.out_dir, req.lights, req.until_error_deg, req.objective or "normals"
     )
     folder.rig_identity = identity
     return OpenedSession(rig, schedule, folder, Path(req.out_dir), source=source)
@@ -306,6 +311,12 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     from rti_rig.app.flash_sync import check_new_session
 
     check_new_session(req, loaded)  # a camera-triggered dome runs its own sequence only
+    if req.objective is not None and not req.is_adaptive:
+        raise RtiRigError(
+            f"--objective {req.objective} goes with --adaptive (it says what the adaptive "
+            "design is chosen for); a planned layout's objective is chosen with `rti-rig plan "
+            "--objective`, then run with --plan"
+        )
     if req.is_adaptive:
         opened = _open_adaptive(req, loaded)
         opened.folder.input_notes = list(loaded.notes)
@@ -390,6 +401,10 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
 
     check_max_saturated(req.max_saturated)
     manifest = read_manifest(req.session_dir)
+    if req.objective is not None or "adaptive" in manifest:
+        from rti_rig.app.usecases.adaptive import check_resume_objective
+
+        check_resume_objective(manifest, Path(req.session_dir), req.objective)
     rig_entry = manifest.get("rig") or {}
     if req.rig_config is None and not rig_entry.get("config_path"):
         raise RtiRigError(
@@ -428,7 +443,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         from rti_rig.app.usecases.adaptive import resume_adaptive_source
 
         try:
-            source = resume_adaptive_source(rig, folder)
+            source = resume_adaptive_source(rig, folder, req.objective)
         except BaseException:
             rig.close()
             raise

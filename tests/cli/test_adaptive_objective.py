@@ -1,0 +1,181 @@
+"""`rti-rig run RIG --adaptive --lights N --objective relight` through the front door, on the
+shipped simulated dome and on a replayed real acquisition: the designs are scored by their
+simulated relighting PSNR, the objective is data (settings and every decision), a resume
+continues it and refuses another objective, and what it cannot mean is refused clearly."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.app.config import load_rig_config
+from rti_rig.app.usecases.adaptive import FORMAT, open_adaptive_session
+from rti_rig.cli import app
+from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted, run_session
+
+REPO = Path(__file__).resolve().parents[2]
+DOME = REPO / "rig_configs" / "simulated_dome.toml"
+runner = CliRunner()
+RELIGHT = ("--objective", "relight", "--no-verdict")
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+def journal(session: Path) -> list[dict]:
+    return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]
+
+
+def manifest(session: Path) -> dict:
+    return json.loads((session / "manifest.json").read_text())
+
+
+def files(folder: Path) -> list[tuple[str, bytes]]:
+    return sorted(
+        (str(p.relative_to(folder)), p.read_bytes()) for p in folder.rglob("*") if p.is_file()
+    )
+
+
+@pytest.fixture(scope="module")
+def relight_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("relight") / "s"
+    r = runner.invoke(
+        app,
+        ["run", str(DOME), "--out", str(out), "--adaptive", "--lights", "8", *RELIGHT],
+    )
+    assert r.exit_code == 0, r.output
+    assert "Adaptive (designs for relight): 8 lights; stopped: reached" in said(r)
+    return out
+
+
+def test_the_relight_objective_is_in_the_settings_and_every_decision(relight_session: Path) -> None:
+    steps = journal(relight_session)
+    assert len(steps) == 8
+    assert all(s["decision"]["objective"] == "relight" for s in steps)
+    header = manifest(relight_session)["adaptive"]
+    assert header["result"]["objective"] == "relight"
+    assert header["objective"] == "relight" and header["format"] == FORMAT == "rti-rig-adaptive/4"
+    for s in steps[4:]:
+        d = s["decision"]
+        assert d["kind"] == "adaptive" and d["design_objective"] == "relight"
+        # every floor's design scored by its simulated relighting PSNR (dB), none by normals
+        assert set(d["design_psnr_db"]) == {"0", "10", "20", "30"}
+        assert all(5.0 < v < 100.0 for v in d["design_psnr_db"].values())
+        assert "design_error_deg" not in d and "relighting PSNR" in d["reason"]
+        # the floor chosen is one whose PSNR is within the margin of the best
+        best = max(d["design_psnr_db"].values())
+        assert d["design_psnr_db"][f"{d['design_floor_deg']:g}"] >= best - 0.5 - 1e-9
+    # the manifest's steps carry the same decisions as the journal
+    assert [s["decision"] for s in manifest(relight_session)["steps"]] == [
+        s["decision"] for s in steps
+    ]
+
+
+def test_the_default_objective_is_normals_and_says_so(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(DOME), "--out", str(out), "--adaptive", "--lights", "6", "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output
+    assert manifest(out)["adaptive"]["objective"] == "normals"
+    last = journal(out)[-1]["decision"]
+    assert last["objective"] == "normals" and last["design_objective"] == "normals"
+    assert set(last["design_error_deg"]) == {"0", "10", "20", "30"}
+    assert "design_psnr_db" not in last
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (
+            ["--adaptive", "--lights", "8", "--until-error", "2", "--objective", "relight"],
+            "--until-error goes with --objective normals only",
+        ),
+        (["--until-error", "2", "--objective", "relight"], "--objective normals only"),
+        (["--adaptive", "--objective", "relight"], "give --lights N"),
+        (["--lights", "8", "--objective", "relight"], "goes with --adaptive"),
+        (["--adaptive", "--lights", "8", "--objective", "psnr"], "normals or relight"),
+    ],
+)
+def test_what_the_objective_cannot_mean_is_refused_before_anything_moves(
+    tmp_path: Path, args: list[str], fragment: str
+) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(DOME), "--out", str(out), *args])
+    assert r.exit_code == 2, r.output
+    assert fragment in said(r)
+    assert "Traceback" not in r.output
+    assert not out.exists()
+
+
+def _interrupted(out: Path, after_step: int, objective: str):  # type: ignore[no-untyped-def]
+    """An adaptive session of 8 lights cancelled once step ``after_step`` is committed, as
+    Ctrl-C would."""
+    rig, schedule, folder, source = open_adaptive_session(
+        load_rig_config(DOME), out, 8, None, objective
+    )
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == after_step:
+            cancel.cancel()
+
+    with rig:
+        return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+
+
+def test_a_relight_session_resumes_to_the_same_session_and_refuses_another_objective(
+    relight_session: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "cut"
+    result = _interrupted(out, after_step=5, objective="relight")
+    assert result.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 6
+    before = files(out)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "normals"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "begun with --objective relight" in text and "Drop --objective normals" in text
+    assert files(out) == before  # refused from the manifest alone: nothing touched
+    # naming its own objective, or none, continues it: the same lights as uninterrupted
+    r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "relight", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert (out / "lights.lp").read_text() == (relight_session / "lights.lp").read_text()
+
+    def choices(session: Path) -> list[dict]:
+        return [
+            {k: v for k, v in s["decision"].items() if k != "decision_s"} for s in journal(session)
+        ]
+
+    assert choices(out) == choices(relight_session)
+
+
+def test_a_normals_session_refuses_a_resume_for_relighting(tmp_path: Path) -> None:
+    out = tmp_path / "cut"
+    _interrupted(out, after_step=4, objective="normals")
+    r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "relight"])
+    assert r.exit_code == 2 and "begun with --objective normals" in said(r)
+
+
+def test_a_fixed_session_refuses_an_objective_on_resume(tmp_path: Path) -> None:
+    out = tmp_path / "fixed"
+    r = runner.invoke(app, ["run", str(DOME), "--out", str(out), "--lights", "5", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "relight"])
+    assert r.exit_code == 2 and "not" in said(r) and "drop --objective relight" in said(r)
+
+
+def test_relight_objective_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
+    acq = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        ["run", str(acq), "--out", str(out), "--adaptive", "--lights", "7", *RELIGHT],
+    )
+    assert r.exit_code == 0, r.output
+    steps = journal(out)
+    assert len(steps) == 7 and manifest(out)["adaptive"]["objective"] == "relight"
+    assert all("design_psnr_db" in s["decision"] for s in steps[4:])
