@@ -80,12 +80,15 @@ def test_an_arm_plan_from_a_preview_loads_no_scipy_driver_or_tiff_writer(tmp_pat
 
 
 @pytest.mark.e2e
-def test_a_dome_plan_still_loads_the_assignment_solver_it_needs(tmp_path) -> None:
-    """The other side: the lazy import is there when a dome's layouts need it (and the plan is
-    written)."""
+@pytest.mark.parametrize(("lights", "needs_solver"), [(12, True), (48, False)])
+def test_a_dome_plan_loads_the_assignment_solver_when_its_layouts_need_it(
+    tmp_path, lights, needs_solver
+) -> None:
+    """The other side: a dome's homogeneous layouts of fewer lights than LEDs are matched to
+    its LEDs by scipy's solver, loaded then; a plan of all 48 LEDs matches nothing."""
     out = tmp_path / "plan.lp"
     rig = REPO / "rig_configs" / "simulated_dome.toml"
-    args = ["plan", "--rig", str(rig), "--lights", "12", "--method", "optimal"]
+    args = ["plan", "--rig", str(rig), "--lights", str(lights), "--method", "optimal"]
     modules = _modules_after([*args, "--out", str(out)])
     assert out.is_file()
-    assert "scipy.optimize" in modules
+    assert ("scipy.optimize" in modules) == needs_solver
