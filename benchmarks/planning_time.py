@@ -184,12 +184,14 @@ def cli_main(argv: list[str] | None = None) -> str:
     ap.add_argument("--cli", action="store_true")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--against", help="another rti-rig command to alternate with")
+    ap.add_argument("--label", default="this", help="name of this checkout's rows")
+    ap.add_argument("--against-label", default="against", help="name of --against's rows")
     ap.add_argument("--cases", type=int, nargs="*", help="indices into CLI_CASES (default all)")
     ap.add_argument("--write", action="store_true")
     args = ap.parse_args(argv)
-    variants = {"this": default_command()}
+    variants = {args.label: default_command()}
     if args.against:
-        variants["against"] = shlex.split(args.against)
+        variants[args.against_label] = shlex.split(args.against)
     picked = [CLI_CASES[i] for i in args.cases] if args.cases else list(CLI_CASES)
     load_before = os.getloadavg()
     rows = []
@@ -219,14 +221,15 @@ def cli_main(argv: list[str] | None = None) -> str:
                 )
                 _, _, _, wall, cpu, planned, same, _ = rows[-1]
                 print(
-                    f"{label:20s} N={n:3d} {v:7s} wall {wall:.2f} s, CPU {cpu:.2f} s, planned in "
+                    f"{label:20s} N={n:3d} {v:10s} wall {wall:.2f} s, CPU {cpu:.2f} s, planned in "
                     f"{planned:.2f} s{'' if same else ' (plans differ between repeats!)'}",
                     flush=True,
                 )
     load_after = os.getloadavg()
     cmd = f"python -m benchmarks.planning_time --cli --repeats {args.repeats}"
     if args.against:
-        cmd += f" --against '{args.against}'"
+        cmd += f" --against '{args.against}' --label '{args.label}'"
+        cmd += f" --against-label '{args.against_label}'"
     lines = [
         f"Command: `{cmd} --write`. "
         + machine_line()
@@ -243,8 +246,8 @@ def cli_main(argv: list[str] | None = None) -> str:
     ]
     if args.against:
         lines += [
-            "| rig | N | command | wall s (target ≤ 1 for the plan) | CPU s | planned in s "
-            "| same plan as the other |",
+            "| rig | N | command | wall s | CPU s | planned in s (target ≤ 1) "
+            "| the same plan (.lp bytes) as the other |",
             "|---|---|---|---|---|---|---|",
         ]
         by_case: dict[tuple[str, int], set[str]] = {}
@@ -252,8 +255,8 @@ def cli_main(argv: list[str] | None = None) -> str:
             by_case.setdefault((label, n), set()).add(sha)
         lines += [
             f"| {label} | {n} | {v} | {w:.2f} | {c:.2f} | {p:.2f} "
-            f"| {'yes' if len(by_case[(label, n)]) == 1 else 'NO'} |"
-            for label, n, v, w, c, p, _same, _sha in rows
+            f"| {'yes' if same and len(by_case[(label, n)]) == 1 else 'NO'} |"
+            for label, n, v, w, c, p, same, _sha in rows
         ]
     else:
         lines += [
