@@ -191,13 +191,17 @@ def _first_segment_move(
     has_y = yj < n_rest
     y = np.where(yj >= ii[:, None], arr[np.minimum(yj + seg, m - 1)], arr[np.minimum(yj, m - 1)])
     y_safe = np.where(has_y, y, 0)
-    opened = np.where(has_y, cost[x, y_safe], 0.0)
+    # the (rows × insertion points) lookups as flat indices into the matrix (the same entries;
+    # 2-D fancy indexing with broadcast index arrays was half of this function's time)
+    flat, width = np.ravel(cost), cost.shape[1]
+    xw = x * width
+    opened = np.where(has_y, flat[xw + y_safe], 0.0)
     rows = np.arange(len(ii))
     best_delta = np.full(len(ii), -1e-12)
     best_pos = np.full(len(ii), -1)
     best_rev = np.zeros(len(ii), dtype=bool)
     for rev, a, b, inner in ((False, first, last, inner_f), (True, last, first, inner_b)):
-        added = cost[x, a[:, None]] + np.where(has_y, cost[b[:, None], y_safe], 0.0)
+        added = flat[xw + a[:, None]] + np.where(has_y, flat[b[:, None] * width + y_safe], 0.0)
         delta = (bridged - removed)[:, None] + (added - opened) + (inner - inner_f)[:, None]
         delta[rows, ii - 1] = np.inf  # that is where the segment came from
         j = np.argmin(delta, axis=1)
