@@ -115,8 +115,9 @@ def _first_reversal(
     a, b = arr[ii - 1], arr[ii]
     ks = np.arange(m)
     c = arr[ks]
+    flat, width = np.ravel(cost), cost.shape[1]  # (rows × ends) lookups by flat index
     delta = (
-        cost[a[:, None], c[None, :]]
+        flat[a[:, None] * width + c[None, :]]
         - cost[a, b][:, None]
         + (bwd[ks][None, :] - bwd[ii][:, None])
         - (fwd[ks][None, :] - fwd[ii][:, None])
@@ -124,7 +125,7 @@ def _first_reversal(
     has_d = ks + 1 < m
     d = arr[np.minimum(ks + 1, m - 1)]
     delta = delta + np.where(
-        has_d[None, :], cost[b[:, None], d[None, :]] - cost[c, d][None, :], 0.0
+        has_d[None, :], flat[b[:, None] * width + d[None, :]] - cost[c, d][None, :], 0.0
     )
     delta[ks[None, :] <= ii[:, None]] = np.inf  # a segment ends after it starts
     best = np.argmin(delta, axis=1)
