@@ -83,29 +83,57 @@ def _two_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bo
     """One pass of 2-opt on an open path of matrix nodes (``nodes[0]`` is the fixed start).
 
     Deltas are exact for asymmetric costs (the reversed segment's inner edges are summed both
-    ways with prefix sums) and evaluated for all segment ends at once with numpy."""
+    ways with prefix sums). The segment starts are examined in path order: at the first that a
+    reversal shortens, its best reversal is made and the same start examined again; the deltas
+    of every remaining start and end are evaluated at once (:func:`_first_reversal`), with the
+    same arithmetic as one start at a time."""
     improved = False
-    m = len(nodes)
     i = 1
-    while i < m - 1:
-        arr = np.asarray(nodes)
-        fwd = np.concatenate([[0.0], np.cumsum(cost[arr[:-1], arr[1:]])])
-        bwd = np.concatenate([[0.0], np.cumsum(cost[arr[1:], arr[:-1]])])
-        a, b = arr[i - 1], arr[i]
-        ks = np.arange(i + 1, m)
-        c = arr[ks]
-        delta = cost[a, c] - cost[a, b] + (bwd[ks] - bwd[i]) - (fwd[ks] - fwd[i])
-        has_d = ks + 1 < m
-        d = arr[np.minimum(ks + 1, m - 1)]
-        delta = delta + np.where(has_d, cost[b, d] - cost[c, d], 0.0)
-        best = int(np.argmin(delta))
-        if delta[best] < -1e-12:
-            k = int(ks[best])
-            nodes = nodes[:i] + nodes[i : k + 1][::-1] + nodes[k + 1 :]
-            improved = True
-        else:
-            i += 1
-    return nodes, improved
+    while True:
+        move = _first_reversal(np.asarray(nodes), cost, i)
+        if move is None:
+            return nodes, improved
+        i, k = move
+        nodes = nodes[:i] + nodes[i : k + 1][::-1] + nodes[k + 1 :]
+        improved = True
+
+
+def _first_reversal(
+    arr: NDArray[np.intp], cost: NDArray[np.float64], start: int
+) -> tuple[int, int] | None:
+    """The first segment start ``i`` (from path position ``start`` on) whose best reversal of
+    ``arr[i..k]`` shortens the path, as (i, k), or None.
+
+    Row ``r`` is the start ``i = start + r`` (after ``a = arr[i - 1]``, first stop ``b``);
+    column ``k`` the segment's last stop ``c = arr[k]`` (``k > i``), followed by ``d``."""
+    m = len(arr)
+    ii = np.arange(start, m - 1)
+    if len(ii) == 0:
+        return None
+    fwd = np.concatenate([[0.0], np.cumsum(cost[arr[:-1], arr[1:]])])
+    bwd = np.concatenate([[0.0], np.cumsum(cost[arr[1:], arr[:-1]])])
+    a, b = arr[ii - 1], arr[ii]
+    ks = np.arange(m)
+    c = arr[ks]
+    flat, width = np.ravel(cost), cost.shape[1]  # (rows × ends) lookups by flat index
+    delta = (
+        flat[a[:, None] * width + c[None, :]]
+        - cost[a, b][:, None]
+        + (bwd[ks][None, :] - bwd[ii][:, None])
+        - (fwd[ks][None, :] - fwd[ii][:, None])
+    )
+    has_d = ks + 1 < m
+    d = arr[np.minimum(ks + 1, m - 1)]
+    delta = delta + np.where(
+        has_d[None, :], flat[b[:, None] * width + d[None, :]] - cost[c, d][None, :], 0.0
+    )
+    delta[ks[None, :] <= ii[:, None]] = np.inf  # a segment ends after it starts
+    best = np.argmin(delta, axis=1)
+    found = np.flatnonzero(delta[np.arange(len(ii)), best] < -1e-12)
+    if len(found) == 0:
+        return None
+    r = int(found[0])
+    return int(ii[r]), int(best[r])
 
 
 def _or_opt(nodes: list[int], cost: NDArray[np.float64]) -> tuple[list[int], bool]:
@@ -164,13 +192,17 @@ def _first_segment_move(
     has_y = yj < n_rest
     y = np.where(yj >= ii[:, None], arr[np.minimum(yj + seg, m - 1)], arr[np.minimum(yj, m - 1)])
     y_safe = np.where(has_y, y, 0)
-    opened = np.where(has_y, cost[x, y_safe], 0.0)
+    # the (rows × insertion points) lookups as flat indices into the matrix (the same entries;
+    # 2-D fancy indexing with broadcast index arrays was half of this function's time)
+    flat, width = np.ravel(cost), cost.shape[1]
+    xw = x * width
+    opened = np.where(has_y, flat[xw + y_safe], 0.0)
     rows = np.arange(len(ii))
     best_delta = np.full(len(ii), -1e-12)
     best_pos = np.full(len(ii), -1)
     best_rev = np.zeros(len(ii), dtype=bool)
     for rev, a, b, inner in ((False, first, last, inner_f), (True, last, first, inner_b)):
-        added = cost[x, a[:, None]] + np.where(has_y, cost[b[:, None], y_safe], 0.0)
+        added = flat[xw + a[:, None]] + np.where(has_y, flat[b[:, None] * width + y_safe], 0.0)
         delta = (bridged - removed)[:, None] + (added - opened) + (inner - inner_f)[:, None]
         delta[rows, ii - 1] = np.inf  # that is where the segment came from
         j = np.argmin(delta, axis=1)

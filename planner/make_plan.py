@@ -273,6 +273,13 @@ def plan(request: PlanRequest) -> tuple[LightSchedule, PlanReport]:
     and a threaded BLAS on a busy machine made such products 40× slower, not faster.
     """
     method = request.check()
+    dome = request.geometry if isinstance(request.geometry, DomeGeometry) else None
+    if (dome is not None and request.n < dome.count) or method.name == "kmeans":
+        # a dome's homogeneous layouts of fewer lights than LEDs and k-means' targets are
+        # matched to the rig's lights by scipy's assignment solver, imported on first use (0.3
+        # s; an arm's plan, or one of every LED, never loads it): loaded here so that the
+        # report's "planned in" times the planning, not an import
+        import scipy.optimize  # noqa: F401
     with threadpool_limits(limits=1):
         return _plan(request, method)
 

@@ -27,7 +27,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import linear_sum_assignment
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
@@ -154,6 +153,8 @@ def snap_unique(targets: NDArray[np.float64], candidates: Candidates) -> NDArray
         raise ScheduleError(
             f"asked for {len(targets)} lights but only {len(candidates)} are available"
         )
+    from scipy.optimize import linear_sum_assignment  # 0.3 s to import: only when needed
+
     cost = angle_between_deg(targets[:, None, :], candidates.directions[None, :, :])
     rows, cols = linear_sum_assignment(cost)
     out = np.empty(len(targets), dtype=np.intp)

@@ -109,7 +109,9 @@ def bin_pixels(
         lit[:, grazing] = _mean_rows(sample.lit_candidates[:, grazing], group, wts, weight)
     lit_held = sample.lit_held_out[rows]
     if not held_out_shadows:
-        lit_held = _mean_rows(sample.lit_held_out, group, wts, weight)
+        # the normals objective never reads these (the relight objective, which does, is not
+        # binned): summed by cell, not by the (cells × pixels) product the read rows above keep
+        lit_held = _cell_means(sample.lit_held_out, group, wts, weight)
     return SurfaceSample(
         mean,
         weight,
@@ -133,6 +135,21 @@ def _mean_rows(
     member = np.zeros((len(weight), len(group)))
     member[group, np.arange(len(group))] = wts
     return (member @ values) / weight[:, None]
+
+
+def _cell_means(
+    values: NDArray[np.float64],
+    group: NDArray[np.intp],
+    wts: NDArray[np.float64],
+    weight: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """:func:`_mean_rows` summed cell by cell in pixel order (every cell has a pixel): the same
+    means to rounding (their last bits may differ), without a dense (cells, P) matrix and its
+    product — 160 held-out lights × 1792 pixels × ~860 cells took ~20 ms."""
+    order = np.argsort(group, kind="stable")
+    starts = np.searchsorted(group[order], np.arange(len(weight)))
+    sums = np.add.reduceat(values[order] * wts[order, None], starts, axis=0)
+    return sums / weight[:, None]
 
 
 def binned_objective(

@@ -14,7 +14,6 @@ from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import linear_sum_assignment
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, fibonacci_cap
@@ -66,6 +65,9 @@ def select_uniform_leds(
         t = np.radians(azimuth_offset_deg)
         c, s = np.cos(t), np.sin(t)
         ideal = ideal @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
+    # scipy.optimize takes 0.3 s to import: an arm's plan (and `--help`) never needs it
+    from scipy.optimize import linear_sum_assignment
+
     cost = angle_between_deg(ideal[:, None, :], dome.directions[candidates][None, :, :])
     _, cols = linear_sum_assignment(cost)
     return np.sort(candidates[cols])

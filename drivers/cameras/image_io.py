@@ -13,7 +13,6 @@ from typing import Literal
 
 import cv2
 import numpy as np
-import tifffile
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import CaptureError
@@ -63,6 +62,8 @@ def read_image_file(path: Path, device: str) -> NDArray:
     """Read a non-RAW image file unchanged (bit depth and channels kept)."""
     suffix = path.suffix.lower()
     if suffix in (".tif", ".tiff"):
+        import tifffile  # on a TIFF only: `rti-rig plan` imports this module for any preview
+
         return tifffile.imread(path)
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:

@@ -22,7 +22,6 @@ import cv2
 import numpy as np
 import rawpy
 from numpy.typing import NDArray
-from scipy.ndimage import correlate
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
@@ -173,6 +172,10 @@ def bilinear_demosaic(
     """Bilinear demosaic by normalised convolution (pure): each photosite keeps its own value,
     a missing colour is the weighted mean of that colour's neighbours (4-neighbours for green,
     the 3×3 ring for red and blue). Borders use only the neighbours that exist."""
+    # scipy.ndimage takes 0.2 s to import: only a decode needs it, not every importer of this
+    # module (``rti-rig plan`` asks folder_watch whether a preview is a RAW file)
+    from scipy.ndimage import correlate
+
     h, w = values.shape
     out = np.empty((h, w, 3), dtype=np.float32)
     for c in range(3):

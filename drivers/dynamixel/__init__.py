@@ -6,19 +6,52 @@ addresses, units, fault bits), :mod:`settings` (validated arm config), :mod:`kin
 place that talks to the official ``dynamixel_sdk``) and :mod:`arm` (the ``LightCarrier``).
 """
 
-from rti_rig.drivers.dynamixel.arm import DynamixelArm
-from rti_rig.drivers.dynamixel.faults import (
-    CommunicationError,
-    ConfigMismatchError,
-    DynamixelError,
-    HardwareFaultError,
-    MoveTimeoutError,
-    SafetyViolation,
-    ServoStatusError,
-    UnreachableError,
-)
-from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
-from rti_rig.drivers.dynamixel.settings import ArmSettings, JointSettings
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+# The names below are loaded on first use (PEP 562): importing one light module of this
+# package (its settings, for a rig config) must not import the driver, its transport and the
+# vendor library (``rti-rig plan`` reads a config but drives nothing).
+_WHERE = {
+    "ArmKinematics": "rti_rig.drivers.dynamixel.kinematics",
+    "ArmSettings": "rti_rig.drivers.dynamixel.settings",
+    "CommunicationError": "rti_rig.drivers.dynamixel.faults",
+    "ConfigMismatchError": "rti_rig.drivers.dynamixel.faults",
+    "DynamixelArm": "rti_rig.drivers.dynamixel.arm",
+    "DynamixelError": "rti_rig.drivers.dynamixel.faults",
+    "HardwareFaultError": "rti_rig.drivers.dynamixel.faults",
+    "JointSettings": "rti_rig.drivers.dynamixel.settings",
+    "MoveTimeoutError": "rti_rig.drivers.dynamixel.faults",
+    "SafetyViolation": "rti_rig.drivers.dynamixel.faults",
+    "ServoStatusError": "rti_rig.drivers.dynamixel.faults",
+    "UnreachableError": "rti_rig.drivers.dynamixel.faults",
+}
+
+if TYPE_CHECKING:
+    from rti_rig.drivers.dynamixel.arm import DynamixelArm
+    from rti_rig.drivers.dynamixel.faults import (
+        CommunicationError,
+        ConfigMismatchError,
+        DynamixelError,
+        HardwareFaultError,
+        MoveTimeoutError,
+        SafetyViolation,
+        ServoStatusError,
+        UnreachableError,
+    )
+    from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
+    from rti_rig.drivers.dynamixel.settings import ArmSettings, JointSettings
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        value = getattr(importlib.import_module(_WHERE[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "ArmKinematics",

@@ -5,11 +5,39 @@ joined in :func:`rti_rig.app.dome_factory.build_dome`); the protocol is specifie
 ``docs/protocols/led-dome.md``.
 """
 
-from rti_rig.drivers.led_dome.driver import LedDomeDriver
-from rti_rig.drivers.led_dome.factory import build_driver
-from rti_rig.drivers.led_dome.profiles import make_codec
-from rti_rig.drivers.led_dome.settings import DomeSerialSettings
-from rti_rig.drivers.led_dome.transport import SerialTransport, Transport, TransportError
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+# The names below are loaded on first use (PEP 562): importing one light module of this
+# package (its settings, for a rig config) must not import the driver, its transport and the
+# vendor library (``rti-rig plan`` reads a config but drives nothing).
+_WHERE = {
+    "DomeSerialSettings": "rti_rig.drivers.led_dome.settings",
+    "LedDomeDriver": "rti_rig.drivers.led_dome.driver",
+    "SerialTransport": "rti_rig.drivers.led_dome.transport",
+    "Transport": "rti_rig.drivers.led_dome.transport",
+    "TransportError": "rti_rig.drivers.led_dome.transport",
+    "build_driver": "rti_rig.drivers.led_dome.factory",
+    "make_codec": "rti_rig.drivers.led_dome.profiles",
+}
+
+if TYPE_CHECKING:
+    from rti_rig.drivers.led_dome.driver import LedDomeDriver
+    from rti_rig.drivers.led_dome.factory import build_driver
+    from rti_rig.drivers.led_dome.profiles import make_codec
+    from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+    from rti_rig.drivers.led_dome.transport import SerialTransport, Transport, TransportError
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        value = getattr(importlib.import_module(_WHERE[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "DomeSerialSettings",

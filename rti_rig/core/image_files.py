@@ -12,7 +12,6 @@ import os
 from pathlib import Path
 
 import numpy as np
-import tifffile
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import SessionError
@@ -63,6 +62,8 @@ def write_linear_tiff(
     SHA-256. ``compression``: None (default, see :data:`LINEAR_TIFF_COMPRESSION`) or "zlib"."""
     import io
 
+    import tifffile  # imported by the writer only: reading a config or planning never needs it
+
     buf = io.BytesIO()
     photometric = "rgb" if pixels.ndim == 3 else "minisblack"
     extra: dict[str, object] = {"description": description, "metadata": None} if description else {}
@@ -89,6 +90,8 @@ def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> 
 
 
 def read_linear_tiff(path: Path) -> NDArray[np.uint16]:
+    import tifffile
+
     return tifffile.imread(path)
 
 
@@ -106,6 +109,8 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     order, shape (H, W) or (H, W, 3); refused with the file's name if it cannot be read."""
     p = Path(path)
     if p.suffix.lower() in (".tif", ".tiff"):
+        import tifffile
+
         try:
             img = tifffile.imread(p)
         except Exception as exc:  # tifffile raises many kinds; the user needs the file's name

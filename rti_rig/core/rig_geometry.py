@@ -138,7 +138,11 @@ class ArmGeometry:
         if n <= 0:
             raise ScheduleError(f"--lights must be at least 1, got {n}")
         lo, hi = self.elevation_band(min_elevation_deg)
-        return np.array([self.clamp_azimuth(d) for d in fibonacci_cap(n, lo, hi)])
+        # :meth:`clamp_azimuth` for all at once (the same numbers; a plan asks for 5 layouts)
+        az, el = az_el_from_direction(fibonacci_cap(n, lo, hi))
+        a = np.where(az > 180.0, az - 360.0, az)
+        a = np.minimum(np.maximum(a, self.min_azimuth_deg), self.max_azimuth_deg)
+        return direction_from_az_el(a, el)
 
     def clamp_azimuth(self, direction: ArrayLike) -> NDArray[np.float64]:
         """``direction`` with its azimuth moved to the nearest end of the arm's range if outside."""

@@ -17,7 +17,7 @@ from rti_rig.planner.objectives import (
     SurfaceSample,
 )
 from rti_rig.planner.optimal import exchange_search
-from rti_rig.planner.pixel_bins import bin_pixels, binned_objective
+from rti_rig.planner.pixel_bins import _cell_means, _mean_rows, bin_pixels, binned_objective
 from rti_rig.planner.surface_estimate import estimate_surface, flat_surface, sample_surface
 from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
@@ -230,3 +230,18 @@ def test_on_the_shipped_arm_grazing_lights_no_longer_keep_every_pixel_apart(n, s
         fast = exchange_search(exact, starts, search=binned)
     assert fast.cost <= full.cost * 1.01
     assert fast.cost < fast.start_cost and fast.swaps > 0
+
+
+def test_cell_means_are_the_dense_products_means() -> None:
+    """The held-out rows of a binned sample are summed cell by cell (no dense cells × pixels
+    matrix): the same weighted means as the dense product, to rounding."""
+    rng = np.random.default_rng(3)
+    for cells, pixels, cols in ((1, 5, 3), (40, 300, 17), (861, 1792, 160)):
+        group = np.concatenate([np.arange(cells), rng.integers(0, cells, pixels - cells)])
+        group = rng.permutation(group)
+        wts = rng.random(pixels)
+        weight = np.bincount(group, weights=wts, minlength=cells)
+        values = (rng.random((pixels, cols)) > 0.3).astype(np.float64)
+        want = _mean_rows(values, group, wts, weight)
+        got = _cell_means(values, group, wts, weight)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
