@@ -1,49 +1,24 @@
-"""Robust photometric stereo, one cache-sized chunk of pixels at a time.
+"""Robust photometric stereo: the rules' thresholds and the fit of a band.
 
 The rules (shadows, saturation, highlights, partial shadows) are those of
-:mod:`rti_rig.reconstruct.photometric_stereo`'s module docstring; this module is how they are
-computed fast. Measured at 512² × 48 lights, the former whole-band implementation took ~185× a
-same-shape matrix product; the costs were memory traffic (every pass gathered the active
-pixels' (A, N) rows out of a 50 MB array, built several (A, N) temporaries and sorted every row
-for its median) and Python-level work per pass. Here:
+:mod:`rti_rig.reconstruct.photometric_stereo`'s module docstring; they are computed pixel by
+pixel in a compiled kernel, :mod:`rti_rig.reconstruct.robust_kernel` (numba), imported only
+when a robust fit runs.
 
-* **Chunks in the cache.** A chunk of :data:`CHUNK_PIXELS` pixels, in the band's own
-  light-major layout (N, c) (no transposed copy of the band), goes through every pass of both
-  rules and its outputs (normals, albedo, residual) while it is in the cache. Reductions over
-  the lights run along the first axis, which numpy vectorises across pixels.
-* **Unused observations are NaN** in a working copy of the chunk: a residual ``g - L b`` is then
-  NaN exactly where an observation is not used, so ``fmax``/``fmin`` reductions and comparisons
-  skip them without masks (a masked ``where`` costs ~10× an arithmetic pass in numpy).
-* **The median only where it matters.** A highlight can be dropped only where some residual
-  exceeds the floor; there the threshold is the floor itself whenever
-  ``k * 1.4826 * median <= floor``, which is decided exactly by *counting* the residuals at or
-  below the float32 cut at which that product first exceeds the floor (the median is at most
-  the cut iff more than half of the used residuals are). For the other pixels six counting
-  bisections bracket the median; only pixels with a compared value between the thresholds of
-  the bracket's two ends (~5 % on the glossy benchmark scene) sort their |residuals| (as finite
-  float32, which numpy sorts with SIMD; NaN would make it 5× slower). A sort of a row of ~48
-  costs about as much as a dozen counting passes. The same holds for the partial-shadow rule
-  with its own scale.
-* **Downdated normal equations**, as before: a pass removes the few dropped observations from
-  each pixel's sums (per-drop sums by ``bincount``; dense products over the drop mask measured
-  1.4× slower) instead of rebuilding them; only pixels that changed are solved again (without
-  eigenvalues where a bound shows the conditioning, see ``normal_equations``) and only they are
-  visited in the next pass.
-* **Albedo from the normal equations**: with every light's direction a unit vector, the
-  least-squares albedo over the used observations is ``n . (sum I l) / n^T (sum l l^T) n``,
-  both sums already at hand, so grey albedo needs no pass over the data.
+Why compiled: the rules are sequential per pixel (a pass refits, then judges the residuals
+again: ~4.6 highlight passes and ~9 drops per pixel on the glossy benchmark scene), so a
+vectorised numpy version pays per pass a few hundred ns of call overhead and memory traffic per
+pixel for ~50 ns of arithmetic. Measured at 512² × 48 lights (``benchmarks.fit_throughput``):
+the first whole-band numpy implementation ~185× a same-shape matrix product, its chunked
+successor (NaN-as-unused, counting bisections for the medians, downdated normal equations)
+~99×, the kernel ~35× of CPU in one run that measured the chunked code at ~105×.
 
-What remains (measured at 512² × 48, ~100× a same-shape product): the passes themselves. The
-glossy scene drops ~9 observations per pixel over ~5 highlight passes; each pass of a pixel
-costs its residuals, counts, a few bisections and the downdate of its drops, ~100 ns each in
-numpy, against the product's ~0.5 ns per observation. Reaching 30× would take fewer passes (a
-different estimator) or compiled per-pixel loops, not more vectorisation.
-
-The decisions are the original ones: the same float32 residuals compared with the same float32
-thresholds (``fl32(k * fl32(1.4826 * median))``, floored), the same lower median, the same
-darkest-first choice. Results can differ only where a float rounding of a different (but
-equally exact) summation order lands on a threshold; tests/reconstruct check the fit against
-a slow per-pixel reference implementation.
+The decisions are the original ones and the fits bit-identical to the chunked numpy code (the
+kernel performs the same float32 and float64 operations in the same order, see its
+docstring): the same float32 residuals compared with the same float32 thresholds
+(``max(fl32(k * fl32(1.4826 * median)), floor)``, the lower median), the same darkest-first
+choice, the same conditioning refusal. tests/reconstruct check the fit against a slow
+per-pixel reference implementation.
 """
 
 from __future__ import annotations
@@ -70,36 +45,6 @@ class RobustRules:
     shadow_k: float | None
     shadow_min_kept: int
     eps_b: float
-
-
-def threshold_cut(scale: float, floor: float) -> np.float32:
-    """The largest float32 ``m >= 0`` with ``fl32(scale * fl32(MAD_SCALE * m)) <= fl32(floor)``.
-
-    The threshold of a pixel is ``max(fl32(scale * fl32(MAD_SCALE * median)), floor)`` in
-    float32; it is exactly the floor iff ``median <= cut`` (the product is monotone in the
-    median), so a count of residuals at or below the cut decides it without the median.
-    Found by bisection over the float32 bit patterns (monotone for non-negative floats).
-    """
-    f_floor = np.float32(floor)
-    s32, c32 = np.float32(scale), np.float32(MAD_SCALE)
-
-    def ok(bits: int) -> bool:
-        m = np.array([bits], dtype=np.int32).view(np.float32)[0]
-        with np.errstate(over="ignore"):
-            return bool(s32 * (c32 * m) <= f_floor)
-
-    lo, hi = 0, 0x7F800000  # 0.0 and +inf
-    if not ok(lo):
-        return np.float32(-1.0)  # never the floor (a negative floor): always the median
-    if ok(hi):
-        return np.float32(np.inf)
-    while hi - lo > 1:  # invariant: ok(lo), not ok(hi)
-        mid = (lo + hi) // 2
-        if ok(mid):
-            lo = mid
-        else:
-            hi = mid
-    return np.array([lo], dtype=np.int32).view(np.float32)[0]
 
 
 def fit_robust_band(
@@ -138,7 +83,6 @@ def fit_robust_band(
         np.array(
             [
                 rules.highlight_k,
-                threshold_cut(rules.highlight_k, rules.floor),
                 0.0 if rules.shadow_k is None else rules.shadow_k,  # 0: rule 4 off
                 rules.floor,
             ],
