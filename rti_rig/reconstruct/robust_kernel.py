@@ -40,9 +40,13 @@ product; callers that want cores fit bands in threads, which ``nogil`` allows).
 from __future__ import annotations
 
 import math
+import warnings
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from numba import njit, types
+from numba.core.errors import NumbaWarning
 from numba.extending import intrinsic
 
 from rti_rig.reconstruct.robust_ps import MAD_SCALE
@@ -53,6 +57,33 @@ _BOUND_MARGIN = 0.99
 BLOCK_PIXELS = 128
 #: The median absolute deviation's scale to a Gaussian sigma, as float32 in the thresholds.
 _MAD32 = np.float32(MAD_SCALE)
+
+
+def _jit(**options: Any) -> Callable[[Callable[..., Any]], Any]:
+    """``njit(cache=True, nogil=True)``: compiled once, then loaded from numba's cache (next
+    to this file, or in the user's cache folder when this folder is read-only). With no
+    writable place at all numba refuses ``cache=True``; the kernel is then compiled in every
+    process (seconds), said once by a :class:`NumbaWarning` — a warning about the process,
+    which the fit's report leaves out (``fit_bands.fit_warnings``)."""
+
+    def wrap(fn: Callable[..., Any]) -> Any:
+        try:
+            return njit(cache=True, nogil=True, **options)(fn)
+        except RuntimeError as exc:  # "cannot cache function ...: no locator available"
+            global _CACHE_WARNED
+            if not _CACHE_WARNED:
+                warnings.warn(
+                    f"robust photometric stereo's kernel is compiled in every process: {exc}",
+                    NumbaWarning,
+                    stacklevel=2,
+                )
+                _CACHE_WARNED = True
+            return njit(nogil=True, **options)(fn)
+
+    return wrap
+
+
+_CACHE_WARNED = False
 
 
 @intrinsic
@@ -66,7 +97,7 @@ def _fma32(typingctx, a, b, c):  # type: ignore[no-untyped-def]
     return sig, codegen
 
 
-@njit(cache=True, nogil=True)
+@_jit()
 def _eigen_ratio_ok(a, b, c, d, e, f, det, count, cond2):  # type: ignore[no-untyped-def]
     """``normal_equations._eigen_ratio_ok`` for one pixel (trigonometric eigenvalues)."""
     q = (a + d + f) / 3.0
@@ -92,7 +123,7 @@ def _eigen_ratio_ok(a, b, c, d, e, f, det, count, cond2):  # type: ignore[no-unt
     return count >= 3 and ratio <= cond2
 
 
-@njit(cache=True, nogil=True, inline="always")
+@_jit(inline="always")
 def _solve(m, rhs, count, cond2, b):  # type: ignore[no-untyped-def]
     """Solve ``m`` (6,) ``b = rhs`` (3,) into ``b`` as ``solve_normal_equations`` does (zero
     where unsolvable; ``cond2``: ``cond_limit**2``); returns whether the pixel is solvable."""
@@ -116,7 +147,7 @@ def _solve(m, rhs, count, cond2, b):  # type: ignore[no-untyped-def]
     return ok
 
 
-@njit(cache=True, nogil=True, inline="always")
+@_jit(inline="always")
 def _scales(r, scale, sc):  # type: ignore[no-untyped-def]
     """``sc = fl32(scale * fl32(1.4826 * |r|))``: each |residual| as the threshold it would
     set as the median (NaN where unused). Monotone in |r|, so the lower median of ``sc`` is
@@ -125,7 +156,7 @@ def _scales(r, scale, sc):  # type: ignore[no-untyped-def]
         sc[k] = scale * (_MAD32 * abs(r[k]))
 
 
-@njit(cache=True, nogil=True, inline="always")
+@_jit(inline="always")
 def _exceeds(x, sc, n, floor):  # type: ignore[no-untyped-def]
     """Whether ``x > max(median threshold, floor)`` (the lower median, index ``(n - 1) // 2``
     sorted, of the ``n`` used values of ``sc``, see ``_scales``) without the median: ``x``
@@ -138,7 +169,7 @@ def _exceeds(x, sc, n, floor):  # type: ignore[no-untyped-def]
     return below > (n - 1) // 2
 
 
-@njit(cache=True, nogil=True, inline="always")
+@_jit(inline="always")
 def _residuals(gv, lx, ly, lz, b, r):  # type: ignore[no-untyped-def]
     """``r = gv - fl32(L b)`` (float32, as BLAS), NaN where ``gv`` is (an unused observation):
     a loop without branches, in SIMD lanes."""
@@ -147,7 +178,7 @@ def _residuals(gv, lx, ly, lz, b, r):  # type: ignore[no-untyped-def]
         r[k] = gv[k] - _fma32(lz[k], b2, _fma32(ly[k], b1, lx[k] * b0))
 
 
-@njit(cache=True, nogil=True, inline="always")
+@_jit(inline="always")
 def _add_term(m, rhs, k, value, ll6, lights):  # type: ignore[no-untyped-def]
     """Add observation ``k`` (``value``) to the sums ``m``, ``rhs``."""
     for j in range(6):
@@ -157,7 +188,7 @@ def _add_term(m, rhs, k, value, ll6, lights):  # type: ignore[no-untyped-def]
         rhs[j] += v64 * lights[k, j]
 
 
-@njit(cache=True, nogil=True, inline="always")
+@_jit(inline="always")
 def _pixel_passes(  # type: ignore[no-untyped-def]
     gv, m, rhs, b, n, lx, ly, lz, ll6, lights, rules_f32, max_passes, shadow_min_kept, cond2,
     r, sc, mt, rhst, bt,
@@ -238,7 +269,7 @@ def _pixel_passes(  # type: ignore[no-untyped-def]
     return n, True
 
 
-@njit(cache=True, nogil=True)
+@_jit()
 def fit_pixels(  # type: ignore[no-untyped-def]
     g, inside, colour, lights, dark, sat, rules_f32, max_passes, shadow_min_kept, cond2,
     eps_b, normals, albedo, rms, count_out, ok_out,
