@@ -203,14 +203,15 @@ def _pixel_passes(  # type: ignore[no-untyped-def]
     # rule 3: highlights, every used residual above the threshold per pass, then a refit
     for _ in range(max_passes):
         _residuals(gv, lx, ly, lz, b, r)
-        _scales(r, highlight_k, sc)
         over = 0
-        small = 0
         for k in range(n_img):  # comparisons with NaN (unused) are False
             over += r[k] > floor
-            small += sc[k] <= floor
         if over == 0:
             break
+        _scales(r, highlight_k, sc)
+        small = 0
+        for k in range(n_img):
+            small += sc[k] <= floor
         # the threshold is the floor when the median's is at most the floor; else each
         # residual above the floor is judged by _exceeds (a count: no median computed)
         at_floor = small > (n - 1) // 2
