@@ -29,7 +29,7 @@ of them are below ``x`` (:func:`_exceeds`): one count per residual above the flo
 lanes. A sort or a selection of ~48 values costs more in mispredicted branches.
 
 Measured at 512² × 48 lights (the fit_throughput scene, ~4.6 highlight passes and ~9 drops
-per pixel): ~200 ms of CPU against ~650 ms for the numpy passes it replaced; about a quarter
+per pixel): ~210 ms of CPU against ~610 ms for the numpy code it replaced; about a quarter
 is the block set-up and outputs, the rest the passes (~100 ns each: residuals, counts, the
 refit).
 
