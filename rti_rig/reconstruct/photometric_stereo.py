@@ -34,8 +34,9 @@ a regularised normal would be biased towards the plane of the lights.
 
 Per-pixel systems are solved in closed form (3 × 3 adjugate, closed-form symmetric eigenvalues
 where a cheap bound cannot decide the conditioning; :mod:`rti_rig.reconstruct.normal_equations`),
-vectorised over the band: no Python loop over pixels. The robust rules are computed chunk by
-chunk in :mod:`rti_rig.reconstruct.robust_ps` (why it is built that way is said there).
+vectorised over the band: no Python loop over pixels. The robust rules are computed pixel by
+pixel in a compiled kernel (numba, imported only by a robust fit;
+:mod:`rti_rig.reconstruct.robust_ps` says why, :mod:`rti_rig.reconstruct.robust_kernel` how).
 """
 
 from __future__ import annotations
@@ -305,8 +306,8 @@ def fit_photometric_stereo(
     used = np.empty((h, wd), dtype=np.int16)
     gram = lt.T @ lt
     # the least-squares fit keeps a few (N, pixels) work arrays besides the float32 band; the
-    # robust fit works in cache-sized chunks (robust_ps.CHUNK_PIXELS) and needs less, but the
-    # same band keeps the memory figures of docs/reconstruction.md valid for both
+    # robust kernel works in blocks of 128 pixels (robust_kernel.BLOCK_PIXELS) and needs less,
+    # but the same band keeps the memory figures of docs/reconstruction.md valid for both
     rows = tile_rows or rows_for_budget(stack.n, wd, stack.channels + 12)
     rules = RobustRules(
         dark=dark,
@@ -362,8 +363,8 @@ def fit_photometric_stereo(
             continue
         flat = band.reshape(stack.n, r * wd, stack.channels)
         if stack.grey:
-            # NaN, infinite and saturated values are recognised (and not used) chunk by chunk
-            # by the robust fit itself: no pass over the band here
+            # NaN, infinite and saturated values are recognised (and not used) pixel by pixel
+            # by the robust kernel itself: no pass over the band here
             g, colour = flat[..., 0], None
         else:
             bad = stack.unusable(band)  # NaN / saturated: zeroed (in a copy), excluded below

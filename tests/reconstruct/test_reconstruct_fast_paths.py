@@ -12,9 +12,7 @@ import numpy as np
 
 from rti_rig.reconstruct import fit_photometric_stereo
 from rti_rig.reconstruct.hsh import fit_hsh
-from rti_rig.reconstruct.normal_equations import light_products, solve_weighted
 from rti_rig.reconstruct.photometric_stereo import LS_CHUNK_BYTES
-from rti_rig.reconstruct.robust_ps import RobustRules, _Chunk
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
 
@@ -72,25 +70,6 @@ def test_least_squares_excludes_saturated_and_nan_pixels_in_any_chunk() -> None:
     clean = np.ones(flat.shape[1], bool)
     clean[picks] = False
     assert np.all(res.used_lights.ravel()[clean & res.valid.ravel()] == 24)
-
-
-def test_robust_downdated_equations_equal_rebuilt_ones() -> None:
-    """After every pass of both rules, the fit of each pixel is the least squares on the
-    observations it kept: the downdated normal equations never drift from rebuilt ones."""
-    images, lights = _glossy(48, 36, seed=2)
-    g = images.reshape(36, -1)
-    rules = RobustRules(0.01, None, 2.0, 0.006, 10, 100.0, 3.0, 5, 1e-6)
-    state = _Chunk(g, np.ones(g.shape[1], bool), lights, light_products(lights), rules)
-    state.highlights()
-    state.partial_shadows()
-    w = ~np.isnan(state.gn)
-    ok = state.ok
-    assert ok.mean() > 0.5 and (~w).any()
-    pixel_major = np.ascontiguousarray(g.T), np.ascontiguousarray(w.T)
-    b_re, ok_re = solve_weighted(*pixel_major, lights, 100.0)
-    assert np.array_equal(ok, ok_re)
-    np.testing.assert_allclose(state.b.T[ok], b_re[ok], rtol=1e-5, atol=1e-7)
-    np.testing.assert_array_equal(state.count, w.sum(axis=0))
 
 
 def test_linear_fit_written_in_place_equals_product() -> None:

@@ -257,25 +257,3 @@ def test_partial_shadow_rule_options_are_checked() -> None:
     for bad in (0.0, -1.0, float("nan")):
         with pytest.raises(ReconstructionError, match="positive"):
             fit_photometric_stereo(images, lights, robust=True, shadow_k=bad)
-
-
-def test_partial_shadow_drop_that_leaves_a_pixel_unsolvable_is_undone() -> None:
-    """If the darkest observation is the only one off a plane of lights, dropping it would
-    leave an ill-conditioned subset: the pixel keeps its observation and its fit."""
-    from rti_rig.reconstruct.normal_equations import light_products
-    from rti_rig.reconstruct.robust_ps import RobustRules, _Chunk
-
-    in_plane = direction_from_az_el(np.array([0.0, 0.0, 0.0, 180.0, 180.0]), [20, 45, 80, 30, 60])
-    lights = np.vstack([in_plane, direction_from_az_el(90.0, 40.0)])
-    b = np.array([[0.0, 0.0, 0.6]])
-    g = (b @ lights.T).astype(np.float32)
-    g[0, 5] *= 0.2  # the only off-plane light reads dark against this (given) fit
-    rules = RobustRules(0.0, None, 2.0, 1e-4, 10, 100.0, SHADOW_K, 5, 1e-9)
-    state = _Chunk(
-        np.ascontiguousarray(g.T), np.array([True]), lights, light_products(lights), rules
-    )
-    assert state.ok.all() and state.count[0] == 6
-    state.b = b.T.copy()  # the fit the test gives
-    state.partial_shadows()
-    assert not np.isnan(state.gn).any() and state.ok.all() and state.count[0] == 6
-    np.testing.assert_allclose(state.b.T, [[0.0, 0.0, 0.6]])

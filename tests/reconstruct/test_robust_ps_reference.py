@@ -1,13 +1,14 @@
 """The fast robust photometric stereo equals a slow, obvious per-pixel implementation.
 
-``rti_rig.reconstruct.robust_ps`` computes the robust rules chunk by chunk, with NaN for unused
-observations, a median only where the floor does not decide, downdated normal equations and a
-bound instead of eigenvalues where it can. Each of those is a place to go wrong; the reference
-below is the rules as the docstring of ``photometric_stereo`` states them, one pixel at a time,
-in float64 with ``numpy.linalg`` (lstsq, cond). The fast path computes its residuals in float32,
-so an observation lying within float32 rounding of a threshold may go either way: the tests
-allow a handful of such pixels (none occur on these scenes today) and require identical kept
-observations everywhere else, with normals, albedo and residual to float32 precision.
+``rti_rig.reconstruct.robust_kernel`` computes the robust rules in compiled per-pixel loops,
+with NaN for unused observations, thresholds judged by counts instead of medians, downdated
+normal equations and a bound instead of eigenvalues where it can. Each of those is a place to
+go wrong; the reference below is the rules as the docstring of ``photometric_stereo`` states
+them, one pixel at a time, in float64 with ``numpy.linalg`` (lstsq, cond). The fast path
+computes its residuals in float32, so an observation lying within float32 rounding of a
+threshold may go either way: the tests allow a handful of such pixels on the random scenes
+(none occur today) and require identical kept observations everywhere else, with normals,
+albedo and residual to float32 precision.
 """
 
 from __future__ import annotations
@@ -16,17 +17,24 @@ import numpy as np
 import pytest
 
 from rti_rig.reconstruct import fit_photometric_stereo
+from rti_rig.reconstruct.errors import IllConditionedFitWarning
 from rti_rig.reconstruct.photometric_stereo import SHADOW_K, SHADOW_MIN_KEPT
-from rti_rig.reconstruct.robust_ps import RobustRules, fit_robust_band, threshold_cut
+from rti_rig.reconstruct.robust_ps import RobustRules, fit_robust_band
 from rti_rig.reconstruct.synthetic import fibonacci_lights, render, sphere_normals
 
 DARK, FLOOR, SAT, COND = 0.02, 0.01, 1.0, 100.0
 
 
 def _reference_pixel(
-    obs: np.ndarray, lights: np.ndarray, shadow_k: float | None, max_passes: int = 10
+    obs: np.ndarray,
+    lights: np.ndarray,
+    shadow_k: float | None,
+    max_passes: int = 10,
+    events: list[str] | None = None,
 ) -> tuple[np.ndarray | None, np.ndarray]:
-    """The rules, literally: b (or None if unsolvable) and the kept observations."""
+    """The rules, literally: b (or None if unsolvable) and the kept observations; ``events``
+    collects the rare branches taken (for tests that must reach them)."""
+    events = [] if events is None else events
     with np.errstate(invalid="ignore"):
         used = np.isfinite(obs) & (obs > DARK) & (obs < SAT)
 
@@ -49,6 +57,7 @@ def _reference_pixel(
         used = used & ~drop
         b = fit(used)
         if b is None:
+            events.append("highlight drop left it unsolvable")
             return None, used
     if shadow_k is not None:
         for _ in range(max_passes):  # rule 4: the darkest, one per pass
@@ -62,13 +71,18 @@ def _reference_pixel(
             trial[j] = False
             b_trial = fit(trial)
             if b_trial is None:  # a drop that leaves the pixel unsolvable is not made
+                events.append("partial-shadow drop refused")
                 break
             used, b = trial, b_trial
     return b, used
 
 
 def _reference(
-    images: np.ndarray, lights: np.ndarray, mask: np.ndarray, shadow_k: float | None
+    images: np.ndarray,
+    lights: np.ndarray,
+    mask: np.ndarray,
+    shadow_k: float | None,
+    events: list[str] | None = None,
 ) -> dict[str, np.ndarray]:
     n_img = images.shape[0]
     flat = images.reshape(n_img, -1, images.shape[3] if images.ndim == 4 else 1)
@@ -84,7 +98,7 @@ def _reference(
         "residual": np.zeros(p),
     }
     for i in np.flatnonzero(mask.ravel()):
-        b, used = _reference_pixel(grey[:, i], lights, shadow_k)
+        b, used = _reference_pixel(grey[:, i], lights, shadow_k, events=events)
         if b is None:
             continue
         b[2] = max(b[2], 0.0)
@@ -205,72 +219,142 @@ def test_rendered_glossy_sphere_matches_the_reference() -> None:
     _compare(fast, ref, max_flips=3)
 
 
-def test_chunk_boundaries_do_not_change_the_fit() -> None:
-    """The band is fitted chunk by chunk: any chunk size (1 pixel, a prime, the whole band)
-    keeps the same observations and gives the same fit (to float32 sums: BLAS may block a
-    product differently by its shape)."""
+def test_any_split_of_the_band_gives_the_same_fit_bit_for_bit() -> None:
+    """The kernel takes pixels in blocks (BLOCK_PIXELS) and each pixel on its own: a band, its
+    pixels one at a time and its slices of a prime length give identical outputs."""
+    from rti_rig.reconstruct.robust_kernel import BLOCK_PIXELS
+
     images, lights, mask = _random_stack(2, 30, 20)
     g = images.reshape(20, -1)
+    inside = mask.ravel()
+    assert g.shape[1] > 2 * BLOCK_PIXELS
     rules = RobustRules(DARK, SAT, 2.0, FLOOR, 10, COND, SHADOW_K, SHADOW_MIN_KEPT, 1e-6)
-    whole = fit_robust_band(g, mask.ravel(), lights, rules, chunk=g.shape[1])
-    for chunk in (1, 97):
-        part = fit_robust_band(g, mask.ravel(), lights, rules, chunk=chunk)
-        n_w, alb_w, rms_w, count_w, ok_w = whole
-        n_p, alb_p, rms_p, count_p, ok_p = part
-        np.testing.assert_array_equal(ok_w, ok_p)
-        np.testing.assert_array_equal(count_w, count_p)
-        np.testing.assert_allclose(n_w, n_p, atol=1e-5)
-        np.testing.assert_allclose(alb_w, alb_p, rtol=1e-4, atol=1e-6)
-        np.testing.assert_allclose(rms_w, rms_p, rtol=1e-3, atol=1e-6)
+    whole = fit_robust_band(g, inside, lights, rules)
+    for step in (1, 97):
+        parts = [
+            fit_robust_band(g[:, s : s + step], inside[s : s + step], lights, rules)
+            for s in range(0, g.shape[1], step)
+        ]
+        for w, p in zip(whole, zip(*parts, strict=True), strict=True):
+            np.testing.assert_array_equal(w, np.concatenate(p))
 
 
-@pytest.mark.parametrize("scale", [2.0, 3.0, 0.5])
-@pytest.mark.parametrize("floor", [0.01, 3e-5, 1.0])
-def test_threshold_cut_is_where_the_median_starts_to_matter(scale: float, floor: float) -> None:
-    """``threshold_cut`` is the last float32 median whose threshold is still the floor."""
-    cut = threshold_cut(scale, floor)
-    f = np.float32(floor)
-
-    def thr(m: np.float32) -> np.float32:
-        return np.float32(scale) * (np.float32(1.4826) * m)
-
-    assert thr(cut) <= f
-    assert thr(np.nextafter(cut, np.float32(np.inf))) > f
-    assert threshold_cut(0.0, floor) > 1e38  # a zero scale: the floor for any finite median
-
-
+@pytest.mark.parametrize("scale", [2.0, 3.0])
 @pytest.mark.parametrize("floor", [0.01, 0.0])
-def test_thresholds_decide_exactly_as_the_sorted_median(floor: float) -> None:
-    """The bracketed threshold drops exactly what the plain one drops: random residual columns
-    (NaN unused), with values placed right at the plain thresholds and next to them."""
-    from rti_rig.reconstruct.robust_ps import _thresholds
+def test_a_residual_exceeds_the_threshold_exactly_as_with_the_sorted_median(
+    scale: float, floor: float
+) -> None:
+    """The kernel never computes a median: a residual exceeds the threshold iff more than half
+    of the used |residuals|, each mapped to the threshold it would set, are below it. Random
+    columns (NaN unused), with values placed right at the plain thresholds and one float32
+    step either side."""
+    from rti_rig.reconstruct.robust_kernel import _exceeds, _scales
 
     rng = np.random.default_rng(7)
-    n, k = 40, 3000
+    n, k = 40, 1500
     sub = (rng.standard_cauchy((n, k)) * rng.uniform(0.001, 0.05, k)).astype(np.float32)
     sub[rng.random((n, k)) < 0.3] = np.nan
-    counts = np.sum(~np.isnan(sub), axis=0)
     f32 = np.float32
 
     def plain(col: np.ndarray) -> np.float32:
         used = np.sort(np.abs(col[~np.isnan(col)]))
         med = used[(used.size - 1) // 2]
-        return max(f32(2.0) * (f32(1.4826) * med), f32(floor))
+        return max(f32(scale) * (f32(1.4826) * med), f32(floor))
 
     expected = np.array([plain(sub[:, j]) for j in range(k)], dtype=np.float32)
-    # knife edges: some values exactly at the threshold and one float32 step either side
-    for j in range(0, k, 3):
+    for j in range(0, k, 3):  # knife edges: a value at the threshold and a step either side
         row = rng.integers(n)
         if not np.isnan(sub[row, j]):
             step = [0.0, np.inf, -np.inf][j % 9 // 3]
             sub[row, j] = np.nextafter(expected[j], f32(step)) if step else expected[j]
     expected = np.array([plain(sub[:, j]) for j in range(k)], dtype=np.float32)
-    cut = threshold_cut(2.0, floor)
-    thr = _thresholds(sub, counts, 2.0, f32(floor), cut, sub)
-    np.testing.assert_array_equal(sub > thr[None, :], sub > expected[None, :])
-    low = np.nanmin(sub, axis=0)
-    thr1 = _thresholds(sub, counts, 2.0, f32(floor), cut, -low[None, :])
-    np.testing.assert_array_equal(-low > thr1, -low > expected)
+    sc = np.empty(n, dtype=np.float32)
+    edges = 0
+    for j in range(k):
+        col = sub[:, j]
+        used = int((~np.isnan(col)).sum())
+        _scales(col, f32(scale), sc)
+        for x in col[~np.isnan(col)]:
+            assert _exceeds(x, sc, used, f32(floor)) == (x > expected[j])
+            edges += x == expected[j]
+        low = np.nanmin(col)
+        assert _exceeds(-low, sc, used, f32(floor)) == (-low > expected[j])
+    assert edges > 20  # values exactly at a threshold were judged
+
+
+def test_edge_cases_match_the_reference() -> None:
+    """Pixels built to hit each edge: every observation unused (dark, NaN, +inf, -inf,
+    saturated, outside the mask), fewer than 3 usable, exactly 3, NaN and infinite values
+    among good ones, a pixel whose highlights all saturate; fitted as one band."""
+    lights = fibonacci_lights(16)
+    normal = np.array([0.2, -0.1, 0.97])
+    normal /= np.linalg.norm(normal)
+    clean = (0.6 * np.maximum(lights @ normal, 0.0)).astype(np.float32)
+    cols = {}
+    cols["all dark"] = np.full(16, 0.001, np.float32)
+    cols["all NaN"] = np.full(16, np.nan, np.float32)
+    cols["all +inf"] = np.full(16, np.inf, np.float32)
+    cols["all -inf"] = np.full(16, -np.inf, np.float32)
+    cols["all saturated"] = np.full(16, SAT, np.float32)
+    for used in (2, 3, 4):
+        c = np.full(16, np.nan, np.float32)
+        c[:used] = clean[:used]
+        cols[f"{used} usable"] = c
+    c = clean.copy()
+    c[[1, 5, 9]] = [np.nan, np.inf, -np.inf]
+    cols["NaN and inf among good"] = c
+    c = clean.copy()
+    c[::3] = SAT + 0.1
+    cols["saturated highlights"] = c
+    c = clean.copy()
+    c[2] += 0.4  # one strong highlight
+    c[7] *= 0.3  # one partial shadow
+    cols["highlight and partial shadow"] = c
+    cols["outside the mask"] = clean.copy()
+    names = list(cols)
+    images = np.stack([cols[n] for n in names], axis=1)[:, None, :]  # (16, 1, pixels)
+    mask = np.array([[n != "outside the mask" for n in names]])
+    fast = _fast(images, lights, mask, SHADOW_K)
+    ref = _reference(images, lights, mask, SHADOW_K)
+    _compare(fast, ref, max_flips=0)
+    valid = dict(zip(names, fast["valid"], strict=True))
+    assert not any(valid[n] for n in names if n.startswith("all") or n.startswith("outside"))
+    assert not valid["2 usable"] and valid["3 usable"] and valid["4 usable"]
+    assert valid["NaN and inf among good"] and valid["highlight and partial shadow"]
+
+
+def test_ill_conditioned_subsets_and_refused_drops_match_the_reference() -> None:
+    """Lights near a plane: ten on one great circle, three just off it (elevation 88.6°), so
+    that the set's condition number is 87 and subsets left by a few drops exceed the limit of
+    100. A highlight drop that does so is final (the pixel turns invalid); a partial-shadow
+    drop that would is not made (the pixel keeps its observation and its fit). The scene
+    reaches both branches of the reference, and the fast fit agrees with it pixel for pixel."""
+    from rti_rig.core.geometry import direction_from_az_el
+
+    rng = np.random.default_rng(11)
+    az = np.concatenate([np.zeros(5), np.full(5, 180.0), [80.0, 90.0, 100.0]])
+    el = np.concatenate([np.linspace(15, 85, 5), np.linspace(20, 80, 5), [88.6] * 3])
+    lights = direction_from_az_el(az, el)
+    assert 80 < np.linalg.cond(lights) < COND
+    p = 1500
+    normals = rng.normal(size=(p, 3)) * [0.2, 0.2, 1.0]
+    normals[:, 2] = np.abs(normals[:, 2]) + 0.5
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    obs = 0.6 * np.maximum(lights @ normals.T, 0.0)
+    obs += rng.normal(0, 0.003, obs.shape)
+    darken = rng.random(obs.shape) < 0.15  # slightly: darker than the fit, not a shadow
+    obs[darken] *= rng.uniform(0.9, 0.99, darken.sum())
+    brighten = rng.random(obs.shape) < 0.1
+    obs[brighten] += rng.uniform(0.05, 0.3, brighten.sum())
+    images = obs.astype(np.float32)[:, None, :]
+    mask = np.ones((1, p), bool)
+    events: list[str] = []
+    with pytest.warns(IllConditionedFitWarning):  # the light set: near the limit
+        fast = _fast(images, lights, mask, SHADOW_K)
+    ref = _reference(images, lights, mask, SHADOW_K, events)
+    assert "partial-shadow drop refused" in events
+    assert "highlight drop left it unsolvable" in events
+    _compare(fast, ref, max_flips=0)
 
 
 def test_a_transposed_stack_fits_like_a_contiguous_one() -> None:

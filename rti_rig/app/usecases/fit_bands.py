@@ -142,10 +142,12 @@ PROCESS_WARNINGS = (ResourceWarning, DeprecationWarning, PendingDeprecationWarni
 
 def fit_warnings(caught: list[warnings.WarningMessage] | None) -> list[warnings.WarningMessage]:
     """The warnings a fit recorded that concern the fit; the others are re-issued to the
-    filters outside the fit (which by default ignore a ``ResourceWarning``)."""
+    filters outside the fit (which by default ignore a ``ResourceWarning``). Those of the JIT
+    compiler (numba's, e.g. a kernel it cannot cache) concern the process too."""
     kept = []
     for w in caught or []:
-        if issubclass(w.category, PROCESS_WARNINGS):
+        jit = w.category.__module__.partition(".")[0] in ("numba", "llvmlite")
+        if jit or issubclass(w.category, PROCESS_WARNINGS):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         else:
             kept.append(w)

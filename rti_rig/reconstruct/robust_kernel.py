@@ -1,0 +1,426 @@
+"""The compiled per-pixel loop of robust photometric stereo (numba).
+
+Imported only by :func:`rti_rig.reconstruct.robust_ps.fit_robust_band`, when a robust fit runs:
+numba and llvmlite cost tens of MB of memory and a fraction of a second to import, which a
+least-squares fit (whose memory is at relight's limit) must not pay.
+
+Pixels are taken in blocks of :data:`BLOCK_PIXELS`: the block's normal equations are summed
+across its pixels in SIMD lanes, straight from the band's light-major rows; then each pixel
+runs its passes alone (rules 3 and 4 of :mod:`rti_rig.reconstruct.photometric_stereo`) on a
+pixel-major copy of its values, and its outputs are computed at once. Every arithmetic step is
+the one the former numpy implementation (chunked, BLAS products) performed, in the same order,
+so the fits are bit-identical to it (measured on the benchmark scene and the reference tests):
+
+* float32 products accumulate with fused multiply-adds, one term after another in light order,
+  as OpenBLAS's sgemm does (checked bit for bit): the residuals ``g - L b`` (K = 3), the
+  initial ``sum I l`` (K = N), the colour projections, the RMS residual's prediction.
+* float64 sums (``sum l l^T``, the downdates by the dropped terms) run in light order from zero.
+* The 3 × 3 solve and its conditioning test are those of
+  :func:`rti_rig.reconstruct.normal_equations.solve_normal_equations`, term for term (numba
+  does not contract a product and a sum into a fused one without ``fastmath``). Only the
+  trigonometric eigenvalues (needed where the cheap bound cannot decide) may differ from
+  numpy's in the last bit, which matters only for a ratio within rounding of ``cond_limit``.
+
+No median is computed. Each used |residual| is mapped to the threshold it would set as the
+median, ``fl32(k * fl32(1.4826 * |r|))`` (monotone, so the lower median of these is the
+threshold of the lower median); the threshold is the floor when more than half of them are at
+most the floor, and otherwise a residual ``x`` above the floor exceeds it iff more than half
+of them are below ``x`` (:func:`_exceeds`): one count per residual above the floor, in SIMD
+lanes. A sort or a selection of ~48 values costs more in mispredicted branches.
+
+Measured at 512² × 48 lights (the fit_throughput scene, ~4.6 highlight passes and ~9 drops
+per pixel): ~210 ms of CPU against ~610 ms for the numpy code it replaced; about a quarter
+is the block set-up and outputs, the rest the passes (~100 ns each: residuals, counts, the
+refit).
+
+No ``parallel=True``: a band runs on one core (the benchmark's ratio is against a one-thread
+product; callers that want cores fit bands in threads, which ``nogil`` allows).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numba import njit, types
+from numba.core.errors import NumbaWarning
+from numba.extending import intrinsic
+
+from rti_rig.reconstruct.robust_ps import MAD_SCALE
+
+#: Margin of the eigenvalue-free conditioning test (as in ``normal_equations``).
+_BOUND_MARGIN = 0.99
+#: Pixels per block: the block's work arrays (~30 KB at 48 lights) stay in the L1/L2 cache.
+BLOCK_PIXELS = 128
+#: The median absolute deviation's scale to a Gaussian sigma, as float32 in the thresholds.
+_MAD32 = np.float32(MAD_SCALE)
+
+
+def _jit(**options: Any) -> Callable[[Callable[..., Any]], Any]:
+    """``njit(cache=True, nogil=True)``: compiled once, then loaded from numba's cache (next
+    to this file, or in the user's cache folder when this folder is read-only). With no
+    writable place at all numba refuses ``cache=True``; the kernel is then compiled in every
+    process (seconds), said once by a :class:`NumbaWarning` — a warning about the process,
+    which the fit's report leaves out (``fit_bands.fit_warnings``)."""
+
+    def wrap(fn: Callable[..., Any]) -> Any:
+        try:
+            return njit(cache=True, nogil=True, **options)(fn)
+        except RuntimeError as exc:  # "cannot cache function ...: no locator available"
+            global _CACHE_WARNED
+            if not _CACHE_WARNED:
+                warnings.warn(
+                    f"robust photometric stereo's kernel is compiled in every process: {exc}",
+                    NumbaWarning,
+                    stacklevel=2,
+                )
+                _CACHE_WARNED = True
+            return njit(nogil=True, **options)(fn)
+
+    return wrap
+
+
+_CACHE_WARNED = False
+
+
+@intrinsic
+def _fma32(typingctx, a, b, c):  # type: ignore[no-untyped-def]
+    """``fl32(a * b + c)`` rounded once (LLVM's fma: one instruction, vectorisable)."""
+    sig = types.float32(types.float32, types.float32, types.float32)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        return builder.fma(*args)
+
+    return sig, codegen
+
+
+@_jit()
+def _eigen_ratio_ok(a, b, c, d, e, f, det, count, cond2):  # type: ignore[no-untyped-def]
+    """``normal_equations._eigen_ratio_ok`` for one pixel (trigonometric eigenvalues)."""
+    q = (a + d + f) / 3.0
+    p1 = b * b + c * c + e * e
+    aq, dq, fq = a - q, d - q, f - q
+    p2 = aq * aq + dq * dq + fq * fq + 2.0 * p1
+    p = math.sqrt(max(p2, 0.0) / 6.0)
+    if p > 0:
+        ba, bd, bf = aq / p, dq / p, fq / p
+        bb, bc, be = b / p, c / p, e / p
+        r = (ba * (bd * bf - be * be) - bb * (bb * bf - be * bc) + bc * (bb * be - bd * bc)) / 2.0
+        phi = math.acos(min(max(r, -1.0), 1.0)) / 3.0
+        e1 = q + 2.0 * p * math.cos(phi)
+        e3 = q + 2.0 * p * math.cos(phi + 2.0 * math.pi / 3.0)
+    else:
+        e1 = q
+        e3 = q
+    if not e3 > e1 * 1e-14:
+        return False
+    ratio = e1 / e3
+    if not (math.isfinite(ratio) and abs(det) > 0):
+        return False
+    return count >= 3 and ratio <= cond2
+
+
+@_jit(inline="always")
+def _solve(m, rhs, count, cond2, b):  # type: ignore[no-untyped-def]
+    """Solve ``m`` (6,) ``b = rhs`` (3,) into ``b`` as ``solve_normal_equations`` does (zero
+    where unsolvable; ``cond2``: ``cond_limit**2``); returns whether the pixel is solvable."""
+    a, bb, c, d, e, f = m[0], m[1], m[2], m[3], m[4], m[5]
+    co_a = d * f - e * e
+    co_b = c * e - bb * f
+    co_c = bb * e - c * d
+    co_d = a * f - c * c
+    co_e = bb * c - a * e
+    co_f = a * d - bb * bb
+    det = a * co_a + bb * co_b + c * co_c
+    tr = a + d + f
+    ok = (4.0 / 27.0) * tr * tr * tr <= (_BOUND_MARGIN * cond2) * det
+    ok = ok and count >= 3 and det > 0
+    if not ok:
+        ok = _eigen_ratio_ok(a, bb, c, d, e, f, det, count, cond2)
+    inv_det = 1.0 / det if ok else 0.0
+    b[0] = (co_a * rhs[0] + co_b * rhs[1] + co_c * rhs[2]) * inv_det
+    b[1] = (co_b * rhs[0] + co_d * rhs[1] + co_e * rhs[2]) * inv_det
+    b[2] = (co_c * rhs[0] + co_e * rhs[1] + co_f * rhs[2]) * inv_det
+    return ok
+
+
+@_jit(inline="always")
+def _scales(r, scale, sc):  # type: ignore[no-untyped-def]
+    """``sc = fl32(scale * fl32(1.4826 * |r|))``: each |residual| as the threshold it would
+    set as the median (NaN where unused). Monotone in |r|, so the lower median of ``sc`` is
+    the threshold of the lower median of |r|, before the floor."""
+    for k in range(r.shape[0]):
+        sc[k] = scale * (_MAD32 * abs(r[k]))
+
+
+@_jit(inline="always")
+def _exceeds(x, sc, n, floor):  # type: ignore[no-untyped-def]
+    """Whether ``x > max(median threshold, floor)`` (the lower median, index ``(n - 1) // 2``
+    sorted, of the ``n`` used values of ``sc``, see ``_scales``) without the median: ``x``
+    exceeds it iff more than ``(n - 1) // 2`` used values are below ``x``."""
+    if not x > floor:
+        return False
+    below = 0
+    for k in range(sc.shape[0]):
+        below += sc[k] < x  # NaN: False
+    return below > (n - 1) // 2
+
+
+@_jit(inline="always")
+def _residuals(gv, lx, ly, lz, b, r):  # type: ignore[no-untyped-def]
+    """``r = gv - fl32(L b)`` (float32, as BLAS), NaN where ``gv`` is (an unused observation):
+    a loop without branches, in SIMD lanes."""
+    b0, b1, b2 = np.float32(b[0]), np.float32(b[1]), np.float32(b[2])
+    for k in range(gv.shape[0]):
+        r[k] = gv[k] - _fma32(lz[k], b2, _fma32(ly[k], b1, lx[k] * b0))
+
+
+@_jit(inline="always")
+def _add_term(m, rhs, k, value, ll6, lights):  # type: ignore[no-untyped-def]
+    """Add observation ``k`` (``value``) to the sums ``m``, ``rhs``."""
+    for j in range(6):
+        m[j] += ll6[k, j]
+    v64 = np.float64(value)
+    for j in range(3):
+        rhs[j] += v64 * lights[k, j]
+
+
+@_jit(inline="always")
+def _pixel_passes(  # type: ignore[no-untyped-def]
+    gv, m, rhs, b, n, lx, ly, lz, ll6, lights, rules_f32, max_passes, shadow_min_kept, cond2,
+    r, sc, mt, rhst, bt,
+):
+    """Rules 3 and 4 for one solvable pixel: its values ``gv`` (N,) (NaN: unused; a dropped
+    observation becomes NaN), normal equations ``m``, ``rhs`` and fit ``b`` (``n`` used), all
+    updated in place; returns the final count and solvability. ``rules_f32``: highlight_k,
+    shadow_k (0: off), floor; the last five arguments are scratch."""
+    highlight_k, shadow_k, floor = rules_f32[0], rules_f32[1], rules_f32[2]
+    n_img = gv.shape[0]
+    nan = np.float32(np.nan)
+    # rule 3: highlights, every used residual above the threshold per pass, then a refit
+    for _ in range(max_passes):
+        _residuals(gv, lx, ly, lz, b, r)
+        over = 0
+        for k in range(n_img):  # comparisons with NaN (unused) are False
+            over += r[k] > floor
+        if over == 0:
+            break
+        _scales(r, highlight_k, sc)
+        small = 0
+        for k in range(n_img):
+            small += sc[k] <= floor
+        # the threshold is the floor when the median's is at most the floor; else each
+        # residual above the floor is judged by _exceeds (a count: no median computed)
+        at_floor = small > (n - 1) // 2
+        # the dropped terms summed in light order from zero, then subtracted (as bincount did)
+        mt[:] = 0.0
+        rhst[:] = 0.0
+        dropped = 0
+        for k in range(n_img):
+            if r[k] > floor and (at_floor or _exceeds(r[k], sc, n, floor)):
+                _add_term(mt, rhst, k, gv[k], ll6, lights)
+                gv[k] = nan
+                dropped += 1
+        if dropped == 0:
+            break
+        for j in range(6):
+            m[j] -= mt[j]
+        for j in range(3):
+            rhs[j] -= rhst[j]
+        n -= dropped
+        if not _solve(m, rhs, n, cond2, b):
+            return n, False
+
+    # rule 4: partial shadows, the darkest observation per pass
+    if shadow_k <= 0:
+        return n, True
+    for _ in range(max_passes):
+        if n <= shadow_min_kept:
+            break
+        _residuals(gv, lx, ly, lz, b, r)
+        low = np.float32(np.inf)
+        for k in range(n_img):  # a select, not a branch: in SIMD lanes (NaN: not taken)
+            low = r[k] if r[k] < low else low
+        if not -low > floor:
+            break
+        _scales(r, shadow_k, sc)
+        if not _exceeds(-low, sc, n, floor):
+            break
+        worst = 0
+        while r[worst] != low:  # the first at the minimum, as argmin picks it
+            worst += 1
+        mt[:] = 0.0
+        rhst[:] = 0.0
+        _add_term(mt, rhst, worst, gv[worst], ll6, lights)
+        for j in range(6):
+            mt[j] = m[j] - mt[j]
+        for j in range(3):
+            rhst[j] = rhs[j] - rhst[j]
+        if not _solve(mt, rhst, n - 1, cond2, bt):
+            break  # a drop that leaves the pixel unsolvable is not made
+        gv[worst] = nan
+        n -= 1
+        for j in range(6):
+            m[j] = mt[j]
+        for j in range(3):
+            rhs[j], b[j] = rhst[j], bt[j]
+    return n, True
+
+
+@_jit()
+def fit_pixels(  # type: ignore[no-untyped-def]
+    g, inside, colour, lights, dark, sat, rules_f32, max_passes, shadow_min_kept, cond2,
+    eps_b, normals, albedo, rms, count_out, ok_out,
+):
+    """The robust fit of every pixel of ``g`` (N, P) float32 (C order; NaN, infinite and
+    saturated values are not used), ``inside`` (P,) the mask, ``colour`` (N, P, C) float32
+    (unusable values zeroed) or an empty array for grey albedo from the normal equations,
+    ``lights`` (N, 3) float64; ``dark``, ``sat`` and ``rules_f32`` (see ``_pixel_passes``)
+    float32. Writes ``normals`` (P, 3), ``albedo`` (P, C), ``rms`` (P,), ``count_out`` (P,)
+    and ``ok_out`` (P,).
+    """
+    n_img, p_total = g.shape
+    grey = colour.shape[0] == 0
+    channels = albedo.shape[1]
+    l32 = lights.astype(np.float32)
+    lx, ly, lz = l32[:, 0].copy(), l32[:, 1].copy(), l32[:, 2].copy()
+    ll6 = np.empty((n_img, 6))
+    for k in range(n_img):
+        x, y, z = lights[k, 0], lights[k, 1], lights[k, 2]
+        ll6[k, 0], ll6[k, 1], ll6[k, 2] = x * x, x * y, x * z
+        ll6[k, 3], ll6[k, 4], ll6[k, 5] = y * y, y * z, z * z
+    blk = BLOCK_PIXELS
+    # per block, across its pixels: the normal equations, summed in light order from zero as
+    # BLAS does (an unused term added as 0.0 changes nothing), one array per entry so the
+    # loops over the block's pixels run in SIMD lanes
+    m_b = np.empty((6, blk))
+    rhs_b = np.empty((3, blk), dtype=np.float32)
+    cnt = np.empty(blk, dtype=np.int64)
+    # per block, pixel-major: a pixel's values contiguous for its passes
+    g_b = np.empty((blk, n_img), dtype=np.float32)
+    r = np.empty(n_img, dtype=np.float32)
+    sc = np.empty(n_img, dtype=np.float32)
+    m = np.empty(6)
+    rhs = np.empty(3)
+    b = np.empty(3)
+    mt = np.empty(6)
+    rhst = np.empty(3)
+    bt = np.empty(3)
+    # per block, light-major again for the outputs: unit normals and albedo denominators,
+    # fitted b as float32, final masks, sums
+    n_b = np.empty((4, blk))
+    b32 = np.empty((3, blk), dtype=np.float32)
+    used_l = np.empty((n_img, blk), dtype=np.bool_)
+    acc_b = np.empty((3, blk), dtype=np.float32)
+    for p0 in range(0, p_total, blk):
+        nb = min(blk, p_total - p0)
+        ins = inside[p0 : p0 + nb]
+        m0, m1, m2, m3, m4, m5 = m_b[0], m_b[1], m_b[2], m_b[3], m_b[4], m_b[5]
+        a0, a1, a2 = rhs_b[0], rhs_b[1], rhs_b[2]
+        m_b[:] = 0.0
+        rhs_b[:] = 0.0
+        cnt[:] = 0
+        for k in range(n_img):
+            row = g[k, p0 : p0 + nb]
+            c0, c1, c2 = ll6[k, 0], ll6[k, 1], ll6[k, 2]
+            c3, c4, c5 = ll6[k, 3], ll6[k, 4], ll6[k, 5]
+            x, y, z = lx[k], ly[k], lz[k]
+            for j in range(nb):
+                v = row[j]
+                u = ins[j] and v > dark and v < sat  # NaN: False
+                cnt[j] += u
+                w = 1.0 if u else 0.0
+                m0[j] += c0 * w
+                m1[j] += c1 * w
+                m2[j] += c2 * w
+                m3[j] += c3 * w
+                m4[j] += c4 * w
+                m5[j] += c5 * w
+                gw = v if u else np.float32(0.0)
+                a0[j] = _fma32(x, gw, a0[j])
+                a1[j] = _fma32(y, gw, a1[j])
+                a2[j] = _fma32(z, gw, a2[j])
+            for j in range(nb):  # pixel-major, NaN where unused
+                v = row[j]
+                g_b[j, k] = v if ins[j] and v > dark and v < sat else np.float32(np.nan)
+        for q in range(nb):
+            p = p0 + q
+            n = cnt[q]
+            for c in range(6):
+                m[c] = m_b[c, q]
+            for c in range(3):
+                rhs[c] = rhs_b[c, q]
+            gv = g_b[q]
+            ok = _solve(m, rhs, n, cond2, b)
+            if ok:
+                n, ok = _pixel_passes(
+                    gv, m, rhs, b, n, lx, ly, lz, ll6, lights, rules_f32, max_passes,
+                    shadow_min_kept, cond2, r, sc, mt, rhst, bt,
+                )
+            # outputs: unit normal with z >= 0, albedo, RMS residual over the used observations
+            b[2] = max(b[2], 0.0)  # a normal facing away from the camera is unseen
+            norm = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
+            if not (ok and ins[q] and norm > eps_b):
+                normals[p, 0], normals[p, 1], normals[p, 2] = 0.0, 0.0, 1.0
+                albedo[p, :] = 0.0
+                rms[p] = 0.0
+                count_out[p] = 0
+                ok_out[p] = False
+                continue
+            n0, n1, n2 = b[0] / norm, b[1] / norm, b[2] / norm
+            normals[p, 0], normals[p, 1], normals[p, 2] = n0, n1, n2
+            den = (
+                m[0] * n0 * n0
+                + m[3] * n1 * n1
+                + m[5] * n2 * n2
+                + 2.0 * (m[1] * n0 * n1 + m[2] * n0 * n2 + m[4] * n1 * n2)
+            )
+            if not den > 0:
+                den = 1.0
+            if grey:
+                albedo[p, 0] = (n0 * rhs[0] + n1 * rhs[1] + n2 * rhs[2]) / den
+            n_b[0, q], n_b[1, q], n_b[2, q], n_b[3, q] = n0, n1, n2, den
+            # the fitted b (z-clamped) as float32, for the residual below
+            b32[0, q], b32[1, q], b32[2, q] = n0 * norm, n1 * norm, n2 * norm
+            for k in range(n_img):  # the final mask, light-major for the block's loops below
+                used_l[k, q] = gv[k] == gv[k]  # not NaN
+            count_out[p] = n
+            ok_out[p] = True
+        # across the block's pixels (SIMD lanes), each summed in light order: the RMS residual
+        # over the used observations (float32, as numpy summed it) and the colour projections
+        ok_b = ok_out[p0 : p0 + nb]
+        for q in range(nb):
+            if not ok_b[q]:
+                b32[0, q] = b32[1, q] = b32[2, q] = 0.0
+                used_l[:, q] = False
+        ss = acc_b[0]
+        ss[:] = 0.0
+        bx, by, bz = b32[0], b32[1], b32[2]
+        for k in range(n_img):
+            row, uk = g[k, p0 : p0 + nb], used_l[k]
+            x, y, z = lx[k], ly[k], lz[k]
+            for j in range(nb):
+                d = row[j] - _fma32(z, bz[j], _fma32(y, by[j], x * bx[j]))
+                ss[j] += d * d if uk[j] else np.float32(0.0)
+        for q in range(nb):
+            if ok_b[q]:
+                rms[p0 + q] = math.sqrt(np.float64(ss[q]) / count_out[p0 + q])
+        if not grey:
+            s0, s1, s2 = acc_b[0], acc_b[1], acc_b[2]
+            for c in range(channels):
+                acc_b[:] = 0.0
+                for k in range(n_img):
+                    uk = used_l[k]
+                    x, y, z = lx[k], ly[k], lz[k]
+                    for j in range(nb):
+                        v = colour[k, p0 + j, c] if uk[j] else np.float32(0.0)
+                        s0[j] = _fma32(x, v, s0[j])
+                        s1[j] = _fma32(y, v, s1[j])
+                        s2[j] = _fma32(z, v, s2[j])
+                for q in range(nb):
+                    if ok_b[q]:
+                        n0, n1, n2, den = n_b[0, q], n_b[1, q], n_b[2, q], n_b[3, q]
+                        albedo[p0 + q, c] = (n0 * s0[q] + n1 * s1[q] + n2 * s2[q]) / den
