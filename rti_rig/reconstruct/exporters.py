@@ -104,6 +104,10 @@ class PtmWriter:
         self._tmp.replace(self.path)
         return self.path
 
+    def abort(self) -> None:
+        """A fit that failed half-way: close the file and remove the partial ``.part``."""
+        _abort(self._fh, self._tmp)
+
 
 class RtiWriter:
     """HSH ``.rti`` written a band of rows at a time; ``lo``/``hi`` per term, display units."""
@@ -142,6 +146,17 @@ class RtiWriter:
         self._fh.close()
         self._tmp.replace(self.path)
         return self.path
+
+    def abort(self) -> None:
+        """A fit that failed half-way: close the file and remove the partial ``.part``."""
+        _abort(self._fh, self._tmp)
+
+
+def _abort(fh: Any, tmp: Path) -> None:
+    """Close a writer's file and remove its ``.part`` (never the finished file: ``close``
+    renames the ``.part`` only once every band is written)."""
+    fh.close()
+    tmp.unlink(missing_ok=True)
 
 
 def coefficient_ranges(

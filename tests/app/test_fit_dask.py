@@ -89,6 +89,9 @@ def test_a_worker_that_cannot_read_the_images_is_a_clear_error(
             fit_dask.run_fit_dask(req, address)
     text = str(caught.value)
     assert address in text and "image_001.tif" in text and "same paths" in text
+    # the failed fit closed and removed its half-written relightable files
+    out = tmp_path / "out"
+    assert not list(out.rglob("*.part")), sorted(out.rglob("*"))
 
 
 def test_the_threads_batch_is_resumable(session: Path, tmp_path: Path) -> None:

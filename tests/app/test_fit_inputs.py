@@ -171,7 +171,10 @@ def test_decoded_rows_close_their_file_when_released() -> None:
         del rows
         gc.collect()
     assert fh.closed
-    assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
+    # only this store's file: gc.collect() also finalises what earlier tests left behind
+    own = f"name={fh.name!r}"
+    mine = [w for w in caught if issubclass(w.category, ResourceWarning) and own in str(w.message)]
+    assert not mine
 
 
 def test_a_fit_records_its_own_warnings_not_the_process_s(

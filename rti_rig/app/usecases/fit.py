@@ -375,16 +375,26 @@ def _fit_all(
     # BLAS spends more in start-up and (on a shared machine) spinning than it computes, and
     # the second core decodes/reads the next band meanwhile. A Dask runner started inside reads
     # this count (blas_threads) and fits its bands with it, so its outputs stay identical.
-    with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
-        warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
-        for sl, fitted in bands(stack, plan, tiles):
-            for key, writer in writers.items():
-                writer.write_rows(sl.start, fitted.coefficients[key])
-            if normals is not None and albedo is not None and fitted.normals is not None:
-                normals.write_rows(sl.start, fitted.normals)
-                albedo.write_rows(sl.start, fitted.albedo)
-            for category, text in fitted.warnings:  # from a band fitted in another process
-                warnings.warn(text, category, stacklevel=1)
+    try:
+        with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
+            warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
+            for sl, fitted in bands(stack, plan, tiles):
+                for key, writer in writers.items():
+                    writer.write_rows(sl.start, fitted.coefficients[key])
+                if normals is not None and albedo is not None and fitted.normals is not None:
+                    normals.write_rows(sl.start, fitted.normals)
+                    albedo.write_rows(sl.start, fitted.albedo)
+                for category, text in fitted.warnings:  # from a band fitted in another process
+                    warnings.warn(text, category, stacklevel=1)
+    except BaseException:
+        # a band that failed (a worker that cannot read, Ctrl-C): no open file left to the
+        # garbage collector, no half-written .ptm/.rti left looking like an output
+        for writer in writers.values():
+            writer.abort()
+        for fmap in (normals, albedo):
+            if fmap is not None:
+                fmap.close()
+        raise
     for writer in writers.values():
         files.append(writer.close())
     release_free_memory()  # the bands: the PNG buffers come next
