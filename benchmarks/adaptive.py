@@ -467,6 +467,11 @@ def main(argv: list[str] | None = None) -> str:
         [
             f"Command: `python -m benchmarks.adaptive --sim-draws {args.sim_draws} "
             f"--real-draws {args.real_draws}"
+            + (f" --scenes {args.scenes}" if args.scenes else "")
+            + (f" --ns {args.ns}" if args.ns else "")
+            + (" --no-until" if args.no_until else "")
+            + (f" --start {args.start}" if args.start != "default" else "")
+            + (" --relief-gain" if args.relief_gain else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
             + (

@@ -18,7 +18,10 @@ The model (:class:`ObjectModel`), fitted to the K captured observations of P sam
 * **cast shadows** per pixel: a captured light that faced the pixel but left it dark (or far
   below the fit) marks a horizon in its azimuth: a candidate light within
   :data:`SHADOW_AZ_DEG` of that azimuth and not higher than it is modelled as shadowed too
-  (a relief's horizon rises monotonically as the light drops);
+  (a relief's horizon rises monotonically as the light drops); and, given the relief
+  integrated from the normals, shadows marched over it (:func:`soft_visibility`) — its depth
+  optionally fitted to the captured shadows (:data:`FIT_RELIEF_GAIN`,
+  :mod:`rti_rig.planner.adaptive_relief`; off: measured not to help, docs/adaptive.md);
 * **noise**: the robust scale of the kept observations' residuals (at least the noise floor).
 
 Simulations use fixed seeds (common random numbers across designs): a decision stays a
@@ -50,8 +53,8 @@ SIM_SEED = 20261124
 MARCH_STEPS = 24
 SOFT_PX = 1.0
 #: Whether the relief's depth is fitted to the captured shadows (``planner.adaptive_relief``).
-#: Off: measured (docs/adaptive.md, "What was tried for the three losses") it does not flip
-#: the tablet's ranking and makes the polished coin worse at 9 lights.
+#: Off: measured (docs/adaptive.md, "Why the three losses remain") it does not flip the
+#: tablet's ranking and makes the polished coin worse at 9 lights.
 FIT_RELIEF_GAIN = False
 #: Below this n·l a light is not expected to light the pixel (as the chooser's GRAZING_COS).
 FACING_COS = 0.15
