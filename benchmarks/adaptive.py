@@ -24,7 +24,8 @@ then on the real dome (never used for the fit). ``--until-error``: lights used a
 error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
-[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20] [--relief-gain] [--cache FILE]
+[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
+[--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
@@ -409,7 +410,7 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument(
         "--start",
         default="default",
-        choices=("default", "hedge-all", "hedge-20"),
+        choices=("default", "hedge-all", "hedge-20", "shared-3"),
         help="the starting lights with N known (benchmarks.adaptive_reach; default: what ships)",
     )
     ap.add_argument(

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.adaptive_reach import hedged_start, start_functions
+from benchmarks.adaptive_reach import hedged_start, shared_three_start, start_functions
 from rti_rig.app.usecases.adaptive import dome_start
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
@@ -38,3 +38,16 @@ def test_a_hedged_start_is_part_of_the_default_layout_and_shares_more(n: int, se
 def test_the_default_start_is_what_ships() -> None:
     dome = _dome(0)
     assert start_functions()["default"](dome, 4, 9) == dome_start(dome, 4, 9)
+
+
+@pytest.mark.parametrize("n", [6, 9, 12, 18])
+def test_the_three_light_start_belongs_to_both_layouts_or_is_the_shipped_one(n: int) -> None:
+    dome = _dome(0)
+    default = {int(i) for i in select_uniform_leds(dome, n, DESIGN_DEFAULT_FLOOR)}
+    partner = {int(i) for i in select_uniform_leds(dome, n, 20.0)}
+    start = shared_three_start(dome, 4, n)
+    if len(default & partner) >= 3:
+        assert len(start) == 3
+        assert set(start) <= default & partner
+    else:
+        assert start == dome_start(dome, 4, n)
