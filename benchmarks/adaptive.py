@@ -26,7 +26,9 @@ then on the real dome (never used for the fit). ``--until-error``: lights used a
 error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
-[--cache FILE] [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
+[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
+[--cache FILE]
+[--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
 """
@@ -61,6 +63,9 @@ REAL_REMOVED = 8
 TARGETS_DEG = (1.0, 2.0, 4.0)
 #: Whether adaptive runs with N known choose a design of N as a whole (as the CLI does).
 DESIGN = True
+#: The starting lights with N known (``--start``: what ships, or a start of
+#: ``benchmarks.adaptive_reach``, to measure it; nothing but this benchmark uses the others).
+START = {"start": dome_start}
 
 #: Scores of the bars (homogeneous layouts, `optimal`), which do not depend on the adaptive
 #: code: ``--cache FILE`` keeps them between runs, keyed by object, draw, N and layout (the
@@ -105,7 +110,7 @@ def adaptive_run(
     and the mean decision time (s). ``objective``: as ``run --adaptive --objective``."""
     # as `run --adaptive --lights N` (N known); DESIGN False: light by light (for comparison)
     design = n_max if until is None and DESIGN else None
-    start = dome_start(geometry, START_LIGHTS, design)
+    start = START["start"](geometry, START_LIGHTS, design)
     chooser = AdaptiveChooser(
         dirs, start, n_max, until, scale=scale, design_lights=design, objective=objective
     )
@@ -427,7 +432,34 @@ def main(argv: list[str] | None = None) -> str:
     )
     ap.add_argument("--cache", type=Path, default=None, help="keep the bars' scores here")
     ap.add_argument("--scenes", default="", help="comma-separated simulated scenes (default all)")
+    ap.add_argument("--ns", default="", help="comma-separated light counts (default 6,9,12,18)")
+    ap.add_argument(
+        "--start",
+        default="default",
+        choices=("default", "hedge-all", "hedge-20", "shared-3"),
+        help="the starting lights with N known (benchmarks.adaptive_reach; default: what ships)",
+    )
+    ap.add_argument(
+        "--relief-gain",
+        action="store_true",
+        help="fit the relief's depth to the captured shadows (planner.adaptive_relief; off in "
+        "what ships)",
+    )
+    ap.add_argument(
+        "--no-until", action="store_true", help="skip the --until-error rows (faster to iterate)"
+    )
     args = ap.parse_args(argv)
+    global NS
+    if args.ns:
+        NS = tuple(int(x) for x in args.ns.split(","))
+    if args.start != "default":
+        from benchmarks.adaptive_reach import start_functions
+
+        START["start"] = start_functions()[args.start]
+    if args.relief_gain:
+        import rti_rig.planner.adaptive_bias as bias
+
+        bias.FIT_RELIEF_GAIN = True
     t0 = time.perf_counter()
     cache_read = args.cache is not None and args.cache.exists()
     _load_cache(args.cache)
@@ -456,13 +488,18 @@ def main(argv: list[str] | None = None) -> str:
         real_calib.append(
             f"| neuralrti-example (real) | {scale:.2f}, {slope:+.2f} | " + " | ".join(cells) + " |"
         )
-    until_rows = until_error_rows(results, scale, slope)
+    until_rows = [] if args.no_until else until_error_rows(results, scale, slope)
     dec = np.concatenate([r["decision_s"] for r in results.values()])
     dec_r = np.concatenate([r["decision_relight_s"] for r in results.values()])
     md = "\n".join(
         [
             f"Command: `python -m benchmarks.adaptive --sim-draws {args.sim_draws} "
             f"--real-draws {args.real_draws}"
+            + (f" --scenes {args.scenes}" if args.scenes else "")
+            + (f" --ns {args.ns}" if args.ns else "")
+            + (" --no-until" if args.no_until else "")
+            + (f" --start {args.start}" if args.start != "default" else "")
+            + (" --relief-gain" if args.relief_gain else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
             + (

@@ -18,7 +18,10 @@ The model (:class:`ObjectModel`), fitted to the K captured observations of P sam
 * **cast shadows** per pixel: a captured light that faced the pixel but left it dark (or far
   below the fit) marks a horizon in its azimuth: a candidate light within
   :data:`SHADOW_AZ_DEG` of that azimuth and not higher than it is modelled as shadowed too
-  (a relief's horizon rises monotonically as the light drops);
+  (a relief's horizon rises monotonically as the light drops); and, given the relief
+  integrated from the normals, shadows marched over it (:func:`soft_visibility`) — its depth
+  optionally fitted to the captured shadows (:data:`FIT_RELIEF_GAIN`,
+  :mod:`rti_rig.planner.adaptive_relief`; off: measured not to help, docs/adaptive.md);
 * **noise**: the robust scale of the kept observations' residuals (at least the noise floor).
 
 Simulations use fixed seeds (common random numbers across designs): a decision stays a
@@ -49,6 +52,10 @@ SIM_SEED = 20261124
 #: ray (pixels) — shallow: the simulator's shadows of a tablet's impressions are 0.1–0.5 px deep.
 MARCH_STEPS = 24
 SOFT_PX = 1.0
+#: Whether the relief's depth is fitted to the captured shadows (``planner.adaptive_relief``).
+#: Off: measured (docs/adaptive.md, "Why the three losses remain") it does not flip the
+#: tablet's ranking and makes the polished coin worse at 9 lights.
+FIT_RELIEF_GAIN = False
 #: Below this n·l a light is not expected to light the pixel (as the chooser's GRAZING_COS).
 FACING_COS = 0.15
 
@@ -73,6 +80,8 @@ class ObjectModel:
     shadowed: NDArray[np.bool_]  # (P, K) captured observation found cast-shadowed
     #: (height in pixels, rows (P,), cols (P,)): the relief cast shadows are marched over
     relief: tuple[NDArray, NDArray, NDArray] | None = None
+    #: the gain of the relief's detail fitted to the captured shadows (1: as integrated)
+    relief_gain: float = 1.0
     #: rendered columns, by light (see :func:`render`)
     rendered: dict = field(default_factory=dict, compare=False, repr=False)
 
@@ -147,6 +156,13 @@ def fit_object_model(
         if sse < best[0] - 1e-12:
             best = (sse, ks, e)
     _, ks, e = best
+    gain = 1.0
+    if relief is not None and FIT_RELIEF_GAIN:
+        from rti_rig.planner.adaptive_relief import fit_relief_gain
+
+        height, rows, cols = relief
+        gain, height = fit_relief_gain(height, rows, cols, obs, lights, normals, albedo, valid)
+        relief = (height, rows, cols)
     az, el = _az_el(lights)
     shadow_el = np.where(shadowed, el[None, :], -np.inf)
     shadow_az = np.broadcast_to(az[None, :], shadowed.shape).copy()
@@ -161,6 +177,7 @@ def fit_object_model(
         lights=lights,
         shadowed=shadowed,
         relief=relief,
+        relief_gain=gain,
     )
 
 
