@@ -43,3 +43,26 @@ exposure_s = 0.05
 [scene]
 seed = 3
 """
+
+
+def interrupted(  # type: ignore[no-untyped-def]
+    cfg: Path, out: Path, after_step: int, objective: str = "normals"
+):
+    """An adaptive session of up to 8 lights in ``out`` (design ``objective``), cancelled once
+    step ``after_step`` (0-based) is committed, as Ctrl-C would (tests/app and
+    tests/cli resume it)."""
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases.adaptive import open_adaptive_session
+    from rti_rig.runtime.controller import CancelToken, StepCompleted, run_session
+
+    rig, schedule, folder, source = open_adaptive_session(
+        load_rig_config(cfg), out, 8, None, objective
+    )
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == after_step:
+            cancel.cancel()
+
+    with rig:
+        return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)

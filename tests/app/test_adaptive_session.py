@@ -11,14 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, SMALL_DOME, write_config
+from conftest import CONFIGS, SMALL_DOME, interrupted, write_config
 from typer.testing import CliRunner
 
-from rti_rig.app.config import load_rig_config
-from rti_rig.app.usecases.adaptive import open_adaptive_session
 from rti_rig.cli import app
 from rti_rig.core.lp_format import read_lp
-from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted, run_session
+from rti_rig.runtime.controller import FinishReason
 
 REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
@@ -82,20 +80,6 @@ def test_export_lp_lists_every_adaptive_step_not_only_the_start(
     assert r.exit_code == 0, r.output
     assert "8 lights" in said(r) and "left out" not in said(r)
     assert [e.name for e in read_lp(lp)] == [e.name for e in read_lp(out / "lights.lp")]
-
-
-def interrupted(cfg: Path, out: Path, after_step: int):  # type: ignore[no-untyped-def]
-    """An adaptive session of up to 8 lights in ``out``, cancelled once step ``after_step``
-    (0-based) is committed, as Ctrl-C would."""
-    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 8, None)
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == after_step:
-            cancel.cancel()
-
-    with rig:
-        return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
 
 
 def test_an_interrupted_adaptive_session_resumes_to_the_same_session(

@@ -9,12 +9,12 @@ import json
 from pathlib import Path
 
 import pytest
+from conftest import interrupted
 from typer.testing import CliRunner
 
-from rti_rig.app.config import load_rig_config
-from rti_rig.app.usecases.adaptive import FORMAT, open_adaptive_session
+from rti_rig.app.usecases.adaptive import FORMAT
 from rti_rig.cli import app
-from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted, run_session
+from rti_rig.runtime.controller import FinishReason
 
 REPO = Path(__file__).resolve().parents[2]
 DOME = REPO / "rig_configs" / "simulated_dome.toml"
@@ -112,27 +112,11 @@ def test_what_the_objective_cannot_mean_is_refused_before_anything_moves(
     assert not out.exists()
 
 
-def _interrupted(out: Path, after_step: int, objective: str):  # type: ignore[no-untyped-def]
-    """An adaptive session of 8 lights cancelled once step ``after_step`` is committed, as
-    Ctrl-C would."""
-    rig, schedule, folder, source = open_adaptive_session(
-        load_rig_config(DOME), out, 8, None, objective
-    )
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == after_step:
-            cancel.cancel()
-
-    with rig:
-        return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
-
-
 def test_a_relight_session_resumes_to_the_same_session_and_refuses_another_objective(
     relight_session: Path, tmp_path: Path
 ) -> None:
     out = tmp_path / "cut"
-    result = _interrupted(out, after_step=5, objective="relight")
+    result = interrupted(DOME, out, after_step=5, objective="relight")
     assert result.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 6
     before = files(out)
     r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "normals"])
@@ -155,7 +139,7 @@ def test_a_relight_session_resumes_to_the_same_session_and_refuses_another_objec
 
 def test_a_normals_session_refuses_a_resume_for_relighting(tmp_path: Path) -> None:
     out = tmp_path / "cut"
-    _interrupted(out, after_step=4, objective="normals")
+    interrupted(DOME, out, after_step=4, objective="normals")
     r = runner.invoke(app, ["run", "--resume", str(out), "--objective", "relight"])
     assert r.exit_code == 2 and "begun with --objective normals" in said(r)
 
