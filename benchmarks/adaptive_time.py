@@ -5,7 +5,8 @@ optimal`, at N = 6 … 100 on a dome and on an arm.
   24-megapixel frame (6000×4000 RGB, 16-bit) to the fit's 128 px and sample it, robust
   photometric stereo on the samples of the images so far, and the choice: light by light among
   the rig's candidates (N images so far, as `--until-error` alone does), or the rest of an
-  N-light design (N/2 images so far, as `--lights N` does). Targets: ≤ 0.2 s on 2
+  N-light design (N/2 images so far, as `--lights N` does; for ``--objective normals`` and
+  ``relight``, whose score renders every candidate left out). Targets: ≤ 0.2 s on 2
   cores. The N images are the simulator's relief scene rendered at the fit's size (the shrink
   is timed on a real 24-MP frame, once per decision, as in a session).
 * **`plan --method optimal`** with no preview (a level surface, as `plan --rig RIG --lights N
@@ -35,6 +36,7 @@ from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import (
     fit_sample,
     relief_px,
+    relight_fit,
     robust_fit,
     sample_index,
     sample_pixels,
@@ -113,6 +115,7 @@ def main(argv: list[str] | None = None) -> str:
             avail_half[np.linspace(0, len(cands) - 1, half).round().astype(int)] = False
 
             def decide_design(
+                objective: str,
                 samples=samples[:half],
                 lights=lights[:half],
                 available=avail_half,
@@ -123,12 +126,21 @@ def main(argv: list[str] | None = None) -> str:
                 sample_pixels(small_grey(frame)[None])
                 state = _state(samples, lights, images)
                 simulate_error_deg(object_model(state), lights, robust_fit)
-                choose_in_design(state, cands, available, n, fit=robust_fit)
+                choose_in_design(
+                    state,
+                    cands,
+                    available,
+                    n,
+                    fit=robust_fit,
+                    objective=objective,
+                    relight=relight_fit if objective == "relight" else None,
+                )
 
             # as AdaptiveChooser.decide runs them: BLAS on one thread
             with threadpool_limits(limits=1, user_api="blas"):
                 t_dec = _median(decide, args.repeats)
-                t_des = _median(decide_design, args.repeats)
+                t_des = _median(lambda d=decide_design: d("normals"), args.repeats)
+                t_rel = _median(lambda d=decide_design: d("relight"), args.repeats)
             t_opt = t_uni = t_prev = float("nan")
             if n <= args.max_optimal_n:
                 t_uni = _median(
@@ -145,10 +157,11 @@ def main(argv: list[str] | None = None) -> str:
                     ),
                     args.repeats,
                 )
-            rows.append((rig_name, n, len(cands), t_dec, t_des, t_opt, t_uni, t_prev))
+            rows.append((rig_name, n, len(cands), t_dec, t_des, t_rel, t_opt, t_uni, t_prev))
             print(
                 f"{rig_name:12s} N={n:3d} candidates={len(cands)} adaptive decision "
-                f"{t_dec:.3f} s, design decision {t_des:.3f} s, optimal plan {t_opt:.2f} s "
+                f"{t_dec:.3f} s, design decision {t_des:.3f} s (relight {t_rel:.3f} s), "
+                f"optimal plan {t_opt:.2f} s "
                 f"(uniform {t_uni:.3f} s, "
                 f"{t_opt / t_uni:.1f}×), from a preview {t_prev:.2f} s ({t_prev / t_uni:.1f}×)",
                 flush=True,
@@ -173,22 +186,26 @@ def main(argv: list[str] | None = None) -> str:
     if decisions_only:
         lines += [
             "| rig | N | candidates | light-by-light decision s, N images so far (target ≤ 0.2) "
-            "| design decision s, N/2 images so far, N planned (target ≤ 0.2) |",
-            "|---|---|---|---|---|",
+            "| design decision s, N/2 images so far, N planned (target ≤ 0.2) "
+            "| the same with `--objective relight` s |",
+            "|---|---|---|---|---|---|",
         ]
-        lines += [f"| {r} | {n} | {c} | {d:.3f} | {e:.3f} |" for r, n, c, d, e, *_ in rows]
+        lines += [
+            f"| {r} | {n} | {c} | {d:.3f} | {e:.3f} | {x:.3f} |" for r, n, c, d, e, x, *_ in rows
+        ]
     else:
         lines += [
             "| rig | N | candidates | light-by-light decision s, N images so far (target ≤ 0.2) "
             "| design decision s, N/2 images so far, N planned (target ≤ 0.2) "
+            "| the same with `--objective relight` s "
             "| `plan --method optimal` s (target ≤ 1) | `uniform` s | optimal / uniform "
             "| `optimal` from a preview s (target ≤ 1) | from a preview / uniform |",
-            "|---|---|---|---|---|---|---|---|---|---|",
+            "|---|---|---|---|---|---|---|---|---|---|---|",
         ]
         lines += [
-            f"| {r} | {n} | {c} | {d:.3f} | {e:.3f} | {o:.2f} | {u:.3f} | {o / u:.1f}× | {p:.2f} "
-            f"| {p / u:.1f}× |"
-            for r, n, c, d, e, o, u, p in rows
+            f"| {r} | {n} | {c} | {d:.3f} | {e:.3f} | {x:.3f} | {o:.2f} | {u:.3f} | {o / u:.1f}× "
+            f"| {p:.2f} | {p / u:.1f}× |"
+            for r, n, c, d, e, x, o, u, p in rows
         ]
     md = "\n".join(lines)
     print(md)
