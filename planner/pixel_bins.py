@@ -107,8 +107,9 @@ def bin_pixels(
     lit = sample.lit_candidates[rows]
     if grazing is not None and grazing.any():
         lit[:, grazing] = _mean_rows(sample.lit_candidates[:, grazing], group, wts, weight)
-    lit_held = sample.lit_held_out[rows]
-    if not held_out_shadows:
+    if held_out_shadows:
+        lit_held = sample.lit_held_out[rows]
+    else:
         # the normals objective never reads these (the relight objective, which does, is not
         # binned): summed by cell, not by the (cells × pixels) product the read rows above keep
         lit_held = _cell_means(sample.lit_held_out, group, wts, weight)

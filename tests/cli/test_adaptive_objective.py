@@ -66,9 +66,10 @@ def test_the_relight_objective_is_in_the_settings_and_every_decision(relight_ses
         assert set(d["design_psnr_db"]) == {"0", "10", "20", "30"}
         assert all(5.0 < v < 100.0 for v in d["design_psnr_db"].values())
         assert "design_error_deg" not in d and "relighting PSNR" in d["reason"]
-        # the floor chosen is one whose PSNR is within the margin of the best
+        # the floor chosen is one whose PSNR is within the margin of the best (the journal
+        # rounds the PSNRs to 3 decimals, hence the 1e-3)
         best = max(d["design_psnr_db"].values())
-        assert d["design_psnr_db"][f"{d['design_floor_deg']:g}"] >= best - 0.5 - 1e-9
+        assert d["design_psnr_db"][f"{d['design_floor_deg']:g}"] >= best - 0.5 - 1e-3
     # the manifest's steps carry the same decisions as the journal
     assert [s["decision"] for s in manifest(relight_session)["steps"]] == [
         s["decision"] for s in steps
