@@ -273,7 +273,7 @@ def test_a_residual_exceeds_the_threshold_exactly_as_with_the_sorted_median(
     for j in range(k):
         col = sub[:, j]
         used = int((~np.isnan(col)).sum())
-        _scales(col, f32(scale), sc)
+        _scales(col, f32(scale), f32(1.4826), sc)
         for x in col[~np.isnan(col)]:
             assert _exceeds(x, sc, used, f32(floor)) == (x > expected[j])
             edges += x == expected[j]
