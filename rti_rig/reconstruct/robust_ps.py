@@ -103,3 +103,28 @@ def fit_robust_band(
         ok,
     )
     return normals, albedo, rms, count, ok
+
+
+def warm_up() -> None:
+    """Load the compiled kernel now (compile it, the first time on a machine: seconds).
+
+    Why: an adaptive session fits after its fourth image; a first fit that imports numba
+    (~0.4 s) or compiles the kernel (~6 s with no cache) would stall the session between two
+    lights, and make its first decision look slow. A session calls this before the rig opens.
+    """
+    fit_robust_band(
+        np.ones((3, 1), dtype=np.float32),
+        np.ones(1, dtype=bool),
+        np.eye(3),
+        RobustRules(
+            dark=0.0,
+            saturation=None,
+            highlight_k=2.0,
+            floor=0.01,
+            max_passes=1,
+            cond_limit=100.0,
+            shadow_k=2.0,
+            shadow_min_kept=3,
+            eps_b=0.0,
+        ),
+    )

@@ -234,3 +234,27 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     assert sorted(p.name for p in out.rglob("*") if p.is_file() and "journal" not in p.name) == [
         n for n in before if "journal" not in n
     ]
+
+
+def test_the_robust_kernel_is_loaded_before_the_rig_opens(tmp_path: Path, monkeypatch) -> None:
+    """An adaptive session loads (or compiles) the robust fit's kernel before the rig opens,
+    not at its first decision between two lights (a compile takes seconds)."""
+    import sys
+
+    import rti_rig.app.compose as compose
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases import adaptive as usecase
+
+    order: list[str] = []
+    real_warm, real_build = usecase.warm_up_fit, compose.build_rig
+    monkeypatch.setattr(usecase, "warm_up_fit", lambda: (order.append("warm"), real_warm()))
+    monkeypatch.setattr(
+        compose, "build_rig", lambda loaded: (order.append("rig"), real_build(loaded))[1]
+    )
+    rig, _, _, _ = usecase.open_adaptive_session(
+        load_rig_config(CONFIGS / "simulated_dome.toml"), tmp_path / "s", 6, None
+    )
+    rig.close()
+    assert order == ["warm", "rig"]
+    kernel = sys.modules["rti_rig.reconstruct.robust_kernel"]
+    assert kernel.fit_pixels.signatures  # compiled or loaded, ready for the first decision

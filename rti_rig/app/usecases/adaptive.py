@@ -193,6 +193,14 @@ def fit_sample(
     )
 
 
+def warm_up_fit() -> None:
+    """Load (the first time on a machine: compile) the robust fit's kernel before the session
+    begins, so that its first decision does not stall between two lights."""
+    from rti_rig.reconstruct.robust_ps import warm_up
+
+    warm_up()
+
+
 def robust_fit(
     obs: NDArray[np.float32], lights: NDArray[np.float64]
 ) -> tuple[NDArray, NDArray] | None:
@@ -685,6 +693,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         )
     check_objective(objective, lights, until_error_deg)
     SessionFolder.check_new(out_dir)
+    warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:
         source = AdaptiveSteps(rig, adaptive_plan(rig, lights), until_error_deg, objective)
