@@ -335,47 +335,51 @@ def _fit_all(
     # the usable observations of the sample, only when an exported model needs their range
     obs = _usable_sample(stack) if any(k != "lambert" for k in linear) else None
     writers: dict[str, Any] = {}
-    for key, design in linear.items():
-        ill = "refuse" if key == "lambert" else "regularise"
-        w, _ = solve_matrix(design, key, ill)
-        if key == "lambert":
-            continue
-        assert obs is not None
-        lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5)
-        if key == "ptm":
-            writers[key] = exporters.PtmWriter(out / "fit.ptm", stack.width, stack.height, lo, hi)
-        else:
-            writers[key] = exporters.RtiWriter(out / "fit.rti", stack.width, stack.height, lo, hi)
-
-    if not req.write_normals:
-        normal_source = ""
-        linear.pop("lambert", None)
-    # the last use of the sample: when nothing above read it, it is streamed, never held
-    ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
-    del obs
-    stack.forget_samples()  # planned: the sample is not needed while the bands are fitted
-    release_free_memory()
-    h, wd = stack.height, stack.width
     normals = albedo = None
-    if req.write_normals:
-        normals = MapFile(out / "normals.npy", (h, wd, 3))
-        albedo = MapFile(out / "albedo.npy", (h, wd) if stack.grey else (h, wd, stack.channels))
-    rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
-    plan = BandPlan(
-        lights=np.asarray(lights),
-        linear=linear,
-        normal_source=normal_source,
-        tile_rows=rows,
-        saturation=stack.saturation_level,
-        reference_level=ref,
-        grey=stack.grey,
-    )
-    tiles = list(row_tiles(h, rows))
-    # one BLAS thread: the fit is many small products over cache-sized chunks, where threaded
-    # BLAS spends more in start-up and (on a shared machine) spinning than it computes, and
-    # the second core decodes/reads the next band meanwhile. A Dask runner started inside reads
-    # this count (blas_threads) and fits its bands with it, so its outputs stay identical.
     try:
+        for key, design in linear.items():
+            ill = "refuse" if key == "lambert" else "regularise"
+            w, _ = solve_matrix(design, key, ill)
+            if key == "lambert":
+                continue
+            assert obs is not None
+            lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5)
+            kind, name = (
+                (exporters.PtmWriter, "fit.ptm")
+                if key == "ptm"
+                else (exporters.RtiWriter, "fit.rti")
+            )
+            writers[key] = kind(out / name, stack.width, stack.height, lo, hi)
+
+        if not req.write_normals:
+            normal_source = ""
+            linear.pop("lambert", None)
+        # the last use of the sample: when nothing above read it, it is streamed, never held
+        ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
+        del obs
+        stack.forget_samples()  # planned: the sample is not needed while the bands are fitted
+        release_free_memory()
+        h, wd = stack.height, stack.width
+        if req.write_normals:
+            normals = MapFile(out / "normals.npy", (h, wd, 3))
+            albedo_shape = (h, wd) if stack.grey else (h, wd, stack.channels)
+            albedo = MapFile(out / "albedo.npy", albedo_shape)
+        rows = rows_for_budget(n, wd, stack.channels, BAND_BUDGET_BYTES)
+        plan = BandPlan(
+            lights=np.asarray(lights),
+            linear=linear,
+            normal_source=normal_source,
+            tile_rows=rows,
+            saturation=stack.saturation_level,
+            reference_level=ref,
+            grey=stack.grey,
+        )
+        tiles = list(row_tiles(h, rows))
+        # one BLAS thread: the fit is many small products over cache-sized chunks, where
+        # threaded BLAS spends more in start-up and (on a shared machine) spinning than it
+        # computes, and the second core decodes/reads the next band meanwhile. A Dask runner
+        # started inside reads this count (blas_threads) and fits its bands with it, so its
+        # outputs stay identical.
         with warnings.catch_warnings(), threadpool_limits(limits=1, user_api="blas"):
             warnings.simplefilter("ignore", FitTrustWarning)  # issued once above, not per band
             for sl, fitted in bands(stack, plan, tiles):
@@ -384,16 +388,17 @@ def _fit_all(
                 if normals is not None and albedo is not None and fitted.normals is not None:
                     normals.write_rows(sl.start, fitted.normals)
                     albedo.write_rows(sl.start, fitted.albedo)
-                for category, text in fitted.warnings:  # from a band fitted in another process
+                for category, text in fitted.warnings:  # a band fitted in another process
                     warnings.warn(text, category, stacklevel=1)
     except BaseException:
-        # a band that failed (a worker that cannot read, Ctrl-C): no open file left to the
-        # garbage collector, no half-written .ptm/.rti left looking like an output
+        # a failure before every band is written (a read error, a worker that cannot read,
+        # Ctrl-C): no open file left to the garbage collector, and nothing half-written left
+        # looking like an output (the folder was new and empty: a re-run can use it)
         for writer in writers.values():
             writer.abort()
         for fmap in (normals, albedo):
             if fmap is not None:
-                fmap.close()
+                fmap.discard()
         raise
     for writer in writers.values():
         files.append(writer.close())

@@ -58,6 +58,12 @@ class MapFile:
             os.close(self._fd)
             self._fd = None
 
+    def discard(self) -> None:
+        """A fit that failed: close and remove the map (a partly written ``.npy`` is a valid
+        file that would look like an output)."""
+        self.close()
+        self.path.unlink(missing_ok=True)
+
     def __del__(self) -> None:  # a fit that failed half-way drops its maps unclosed
         self.close()
 
