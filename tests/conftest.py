@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -66,3 +67,18 @@ def interrupted(  # type: ignore[no-untyped-def]
 
     with rig:
         return run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    """A CLI result's output with its line wrapping undone (rich wraps to the terminal)."""
+    return " ".join(result.output.split())
+
+
+def journal(session: Path) -> list[dict]:
+    """A session folder's journal entries."""
+    return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]
+
+
+def manifest(session: Path) -> dict:
+    """A session folder's manifest."""
+    return json.loads((session / "manifest.json").read_text())

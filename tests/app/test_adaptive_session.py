@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, SMALL_DOME, interrupted, write_config
+from conftest import CONFIGS, SMALL_DOME, interrupted, journal, manifest, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -20,18 +20,6 @@ from rti_rig.runtime.controller import FinishReason
 
 REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
-
-
-def said(result) -> str:  # type: ignore[no-untyped-def]
-    return " ".join(result.output.split())
-
-
-def journal(session: Path) -> list[dict]:
-    return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]
-
-
-def manifest(session: Path) -> dict:
-    return json.loads((session / "manifest.json").read_text())
 
 
 @pytest.fixture(scope="module")

@@ -5,11 +5,10 @@ continues it and refuses another objective, and what it cannot mean is refused c
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pytest
-from conftest import interrupted
+from conftest import interrupted, journal, manifest, said
 from typer.testing import CliRunner
 
 from rti_rig.app.usecases.adaptive import FORMAT
@@ -20,18 +19,6 @@ REPO = Path(__file__).resolve().parents[2]
 DOME = REPO / "rig_configs" / "simulated_dome.toml"
 runner = CliRunner()
 RELIGHT = ("--objective", "relight", "--no-verdict")
-
-
-def said(result) -> str:  # type: ignore[no-untyped-def]
-    return " ".join(result.output.split())
-
-
-def journal(session: Path) -> list[dict]:
-    return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]
-
-
-def manifest(session: Path) -> dict:
-    return json.loads((session / "manifest.json").read_text())
 
 
 def files(folder: Path) -> list[tuple[str, bytes]]:
