@@ -8,8 +8,9 @@ place that talks to the official ``dynamixel_sdk``) and :mod:`arm` (the ``LightC
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from rti_rig.core.lazy_names import lazy_getattr
 
 # The names below are loaded on first use (PEP 562): importing one light module of this
 # package (its settings, for a rig config) must not import the driver, its transport and the
@@ -45,12 +46,7 @@ if TYPE_CHECKING:
     from rti_rig.drivers.dynamixel.settings import ArmSettings, JointSettings
 
 
-def __getattr__(name: str) -> Any:
-    if name in _WHERE:
-        value = getattr(importlib.import_module(_WHERE[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_getattr(__name__, _WHERE, globals())
 
 
 __all__ = [

@@ -7,8 +7,9 @@ joined in :func:`rti_rig.app.dome_factory.build_dome`); the protocol is specifie
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from rti_rig.core.lazy_names import lazy_getattr
 
 # The names below are loaded on first use (PEP 562): importing one light module of this
 # package (its settings, for a rig config) must not import the driver, its transport and the
@@ -31,12 +32,7 @@ if TYPE_CHECKING:
     from rti_rig.drivers.led_dome.transport import SerialTransport, Transport, TransportError
 
 
-def __getattr__(name: str) -> Any:
-    if name in _WHERE:
-        value = getattr(importlib.import_module(_WHERE[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_getattr(__name__, _WHERE, globals())
 
 
 __all__ = [

@@ -57,3 +57,13 @@ def test_every_lazy_name_loads(rel: str) -> None:
 def test_the_contracts_count_type_checking_imports() -> None:
     config = tomllib.loads((REPO / "pyproject.toml").read_text(encoding="utf-8"))
     assert config["tool"]["importlinter"].get("exclude_type_checking_imports") is False
+
+
+@pytest.mark.parametrize("rel", LAZY)
+def test_an_unknown_name_is_an_attribute_error(rel: str) -> None:
+    package = "rti_rig." + rel.removesuffix("/__init__.py").replace("/", ".")
+    mod = importlib.import_module(package)
+    with pytest.raises(AttributeError, match="no attribute 'NoSuchDriver'"):
+        mod.NoSuchDriver  # noqa: B018
+    with pytest.raises(ImportError):
+        exec(f"from {package} import NoSuchDriver", {})
