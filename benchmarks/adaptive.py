@@ -449,6 +449,8 @@ def main(argv: list[str] | None = None) -> str:
         "--no-until", action="store_true", help="skip the --until-error rows (faster to iterate)"
     )
     args = ap.parse_args(argv)
+    if args.sim_draws < 2 or args.real_draws < 2:
+        ap.error("--sim-draws and --real-draws need at least 2 (the verdicts are paired tests)")
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
