@@ -1,8 +1,9 @@
 """Per-pixel least squares of photometric stereo through its 3 × 3 normal equations.
 
-Shared by the least-squares and robust photometric-stereo paths and by PTM's normal estimate:
+Used by least-squares photometric stereo's per-pixel path and by PTM's normal estimate:
 ``sum_k w_k l_k l_k^T`` and ``sum_k w_k I_k l_k`` per pixel, solved in closed form for millions
-of pixels at once, and downdated (not rebuilt) when a few observations are removed.
+of pixels at once. The robust fit's compiled kernel (:mod:`rti_rig.reconstruct.robust_kernel`)
+performs the same solve and conditioning test term for term, pixel by pixel.
 """
 
 from __future__ import annotations
@@ -75,14 +76,13 @@ def solve_normal_equations(
     rhs: NDArray[np.float64],
     count: NDArray[Any],
     cond_limit: float,
-    light_major: bool = False,
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """Solve the symmetric PSD systems ``m`` (6, P) ``b = rhs`` (3, P) in closed form.
 
     Adjugate, component by component on contiguous rows: ~20× faster than batched LAPACK for
-    millions of 3 × 3 systems. Returns b (P, 3), or (3, P) if ``light_major`` (zero where
-    unsolvable) and solvable (P,): at least 3 observations and an eigenvalue ratio within
-    ``cond_limit**2`` (the condition number of the light subset within ``cond_limit``).
+    millions of 3 × 3 systems. Returns b (P, 3) (zero where unsolvable) and solvable (P,): at
+    least 3 observations and an eigenvalue ratio within ``cond_limit**2`` (the condition number
+    of the light subset within ``cond_limit``).
 
     The ratio test needs the eigenvalues (trigonometric, Smith 1961: an arccos and two cosines
     per pixel, most of the solve's cost) only where a cheap bound cannot decide: with
@@ -110,8 +110,8 @@ def solve_normal_equations(
         inv_det = 1.0 / det
     inv_det[~ok] = 0.0
     r0, r1, r2 = rhs
-    out = np.empty((3, m.shape[1]) if light_major else (m.shape[1], 3))
-    o0, o1, o2 = out if light_major else out.T
+    out = np.empty((m.shape[1], 3))
+    o0, o1, o2 = out.T
     o0[:] = (co_a * r0 + co_b * r1 + co_c * r2) * inv_det
     o1[:] = (co_b * r0 + co_d * r1 + co_e * r2) * inv_det
     o2[:] = (co_c * r0 + co_e * r1 + co_f * r2) * inv_det

@@ -376,3 +376,12 @@ def test_a_transposed_stack_fits_like_a_contiguous_one() -> None:
     a = fit_photometric_stereo(transposed, lights, robust=True)
     b = fit_photometric_stereo(np.ascontiguousarray(transposed), lights, robust=True)
     assert np.array_equal(a.normals, b.normals) and np.array_equal(a.valid, b.valid)
+
+
+def test_the_kernel_keeps_the_solvers_bound_margin() -> None:
+    """The kernel holds its own copy of the conditioning bound's margin (numba's cache is keyed
+    by the kernel's file alone, so a constant imported from another module could go stale in
+    it): it must equal the numpy solver's."""
+    from rti_rig.reconstruct import normal_equations, robust_kernel
+
+    assert robust_kernel._BOUND_MARGIN == normal_equations._BOUND_MARGIN
