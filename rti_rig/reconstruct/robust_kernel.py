@@ -6,12 +6,16 @@ least-squares fit (whose memory is at relight's limit) must not pay.
 
 Pixels are taken in blocks of :data:`BLOCK_PIXELS`: the block's normal equations are summed
 across its pixels in SIMD lanes, straight from the band's light-major rows; then each pixel
-runs its passes alone (rules 3 and 4 of :mod:`rti_rig.reconstruct.photometric_stereo`) on a
-pixel-major copy of its values, and its outputs are computed at once. Every arithmetic step is
-the one the former numpy implementation (chunked, BLAS products) performed, in the same order,
-so the fits were bit-identical to it when it was replaced (compared old against new on the
-benchmark scene and 19 test scenes; no test keeps the old code, the tests compare with a slow
-per-pixel reference within tolerances):
+runs its passes alone (rules 3 and 4 of :mod:`rti_rig.reconstruct.photometric_stereo`) on its
+row of a pixel-major copy of the block's values, and its outputs are computed at once. Every
+arithmetic step is the one the former numpy implementation (chunked, BLAS products) performed,
+in the same order, so the fits were bit-identical to it when it was replaced (compared old
+against new on the benchmark scene and 19 test scenes; no test keeps the old code, the tests
+compare with a slow per-pixel reference within tolerances); the rewrite of 2026-11-24 (below)
+was compared with the kernel before it, call by call, outputs equal bit for bit: the
+benchmark scene, every call made by tests/reconstruct and by the adaptive and fit CLI tests
+(1231), and 62 random bands with NaN, infinite, saturated and dark values, masks, colour,
+3 to 130 lights and rule settings that reach the rare branches:
 
 * float32 products accumulate with fused multiply-adds, one term after another in light order,
   as OpenBLAS's sgemm does (checked bit for bit): the residuals ``g - L b`` (K = 3), the
@@ -27,13 +31,30 @@ No median is computed. Each used |residual| is mapped to the threshold it would 
 median, ``fl32(k * fl32(1.4826 * |r|))`` (monotone, so the lower median of these is the
 threshold of the lower median); the threshold is the floor when more than half of them are at
 most the floor, and otherwise a residual ``x`` above the floor exceeds it iff more than half
-of them are below ``x`` (:func:`_exceeds`): one count per residual above the floor, in SIMD
-lanes. A sort or a selection of ~48 values costs more in mispredicted branches.
+of them are below ``x`` (:func:`_exceeds`): one count per residual above the floor. A sort or
+a selection of ~48 values costs more in mispredicted branches.
 
-Measured at 512² × 48 lights (the fit_throughput scene, ~4.6 highlight passes and ~9 drops
-per pixel): ~210 ms of CPU against ~610 ms for the numpy code it replaced; about a quarter
-is the block set-up and outputs, the rest the passes (~100 ns each: residuals, counts, the
-refit).
+What the per-pixel path is made of (the rewrite of 2026-11-24): the passes hold the pixel's
+normal equations, fit and downdates in scalars and index the pixel's row of the block copy in
+place (``g_b[q, k]``), with no array view made per pixel or per pass (the kernel before called
+an inlined pass helper taking 19 arrays per pixel: measured, ~60 ns per pixel with no pass
+run at all). A drop clears its own entry of the light-major mask the outputs read
+(``used_l``, set in the block set-up) instead of each pixel's final mask being transposed
+into it. The counts, the largest single cost of the passes (~17 per pixel on the benchmark
+scene, a count of 48 values each), compare 8 float32 lanes at once: one vector compare, a
+move-mask and a popcount (:func:`_lanes_intrinsic`), where numba's own loop widened each
+comparison to an int64 lane; the rows are padded with NaN to whole registers. The candidates
+above the floor are kept as bits of 64-light words and visited lowest bit first (the light
+order the sums need).
+
+Measured at 512² × 48 lights (the fit_throughput scene: ~4.6 highlight passes, ~9 drops and
+~17 counts per pixel), the kernel before and after timed alternately in one run on the
+kernel's own arguments (median of 11, load average 4.6–5.0 on the 2 cores, CPU time):
+203 → 118 ms, of which the block set-up, first solve and outputs (no pass run) 63 → 35 ms and
+the passes ~140 → ~83 ms (~70 ns per highlight pass, the shadow pass included). Tried and
+not faster: caching the largest value kept and the smallest dropped to skip counts (the
+judgement is monotone), selects instead of the drop branch, two lights per sweep of the block
+set-up, the residual loops over whole registers.
 
 No ``parallel=True``: a band runs on one core (the benchmark's ratio is against a one-thread
 product; callers that want cores fit bands in threads, which ``nogil`` allows).
@@ -119,6 +140,13 @@ def _lanes_intrinsic(op: str, count: bool) -> Any:
 
     @intrinsic
     def lanes(typingctx, arr, j, x):  # type: ignore[no-untyped-def]
+        if not (
+            isinstance(arr, types.Array)
+            and arr.dtype == types.float32
+            and arr.ndim == 1
+            and arr.layout == "C"
+        ):
+            return None  # a typing error: the load below reads 8 contiguous float32
         sig = types.int64(arr, j, types.float32)
 
         def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
