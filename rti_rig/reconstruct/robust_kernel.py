@@ -36,7 +36,8 @@ a selection of ~48 values costs more in mispredicted branches.
 
 What the per-pixel path is made of (the rewrite of 2026-11-24): the passes hold the pixel's
 normal equations, fit and downdates in scalars and index the pixel's row of the block copy in
-place (``g_b[q, k]``), with no array view made per pixel or per pass (the kernel before called
+place (``g_b[q, k]``): no array view is made per pixel or per pass, and the only helpers there
+that take arrays are the small :func:`_scales` and :func:`_exceeds` (the kernel before called
 an inlined pass helper taking 19 arrays per pixel: measured, ~60 ns per pixel with no pass
 run at all). A drop clears its own entry of the light-major mask the outputs read
 (``used_l``, set in the block set-up) instead of each pixel's final mask being transposed
