@@ -11,9 +11,15 @@ vectorised numpy version pays per pass a few hundred ns of call overhead and mem
 pixel for ~50 ns of arithmetic. Measured at 512² × 48 lights (``benchmarks.fit_throughput``):
 the first whole-band numpy implementation ~185× a same-shape matrix product, its chunked
 successor (NaN-as-unused, counting bisections for the medians, downdated normal equations)
-~99×, the kernel 34× (33.8× against the chunked code's 98.1×, timed alternately in one run).
-The issue's target, 30×, is not reached: what remains is ~4.6 passes per pixel of ~100 ns each
-(residuals, counts, a downdate and a closed-form re-solve) plus the block set-up.
+~99×, the kernel 34× (33.8× against the chunked code's 98.1×, timed alternately in one run),
+and since the kernel's rewrite of 2026-11-24 (passes on scalars, no array view per pixel,
+counts 8 lanes at a time; see its docstring, bit-identical to the kernel before) 0.58× of
+that: whole fits timed alternately with the kernel before it, 258 against 440 ms wall and 128
+against 219 ms CPU (median of 15, load average 4.3–4.6, the matrix product 10.2 ms under that
+load); 25.4× in docs/benchmarks.md's table of the same hour (load 4.5). The issue's target,
+30×, is met (~20× expected at the load of the 34.3× table: 0.58 × 34.3). What remains is ~4.6
+passes per pixel of ~70 ns each (residuals, counts, a downdate and a closed-form re-solve)
+plus the block set-up.
 
 The decisions are the original ones and the fits were bit-identical to the chunked numpy code
 when it was replaced (compared old against new; the

@@ -150,10 +150,13 @@ def _fast(images: np.ndarray, lights: np.ndarray, mask: np.ndarray, shadow_k: fl
     }
 
 
-def _random_stack(seed: int, size: int, n: int, colour: bool = False) -> tuple[np.ndarray, ...]:
+def _random_stack(
+    seed: int, size: int, n: int, colour: bool = False, noise: float = 0.004
+) -> tuple[np.ndarray, ...]:
     """Random normals and albedo under random lights, then everything the rules are for:
     specular spikes and lobes, attached and partial shadows, saturation, NaN observations,
-    pixels left with few usable lights, a mask."""
+    pixels left with few usable lights, a mask; Gaussian noise of sigma ``noise`` (above
+    the floor's scale, the thresholds come from the medians rather than the floor)."""
     rng = np.random.default_rng(seed)
     lights = rng.normal(size=(n, 3))
     lights[:, 2] = np.abs(lights[:, 2]) + 0.3
@@ -170,7 +173,7 @@ def _random_stack(seed: int, size: int, n: int, colour: bool = False) -> tuple[n
     obs[spikes] += rng.uniform(0.05, 0.5, spikes.sum())
     partial = rng.random(obs.shape) < 0.05
     obs[partial] *= rng.uniform(0.2, 0.8, partial.sum())
-    obs += rng.normal(0, 0.004, obs.shape)
+    obs += rng.normal(0, noise, obs.shape)
     few = rng.random(size * size) < 0.05  # pixels that keep 2-6 usable lights
     for i in np.flatnonzero(few):
         obs[rng.permutation(n)[rng.integers(2, 7) :], i] = 0.0
@@ -194,6 +197,19 @@ def test_random_stacks_match_the_reference(seed: int, shadow_k: float | None) ->
     ref = _reference(images, lights, mask, shadow_k)
     assert 0.5 < ref["valid"].mean() < 0.95  # invalid pixels (few lights, mask) included
     _compare(fast, ref, max_flips=3)
+
+
+@pytest.mark.parametrize("n", [13, 70])
+def test_light_counts_off_the_kernels_simd_and_bit_words_match_the_reference(n: int) -> None:
+    """The kernel compares 8 residuals at a time (padded with NaN) and keeps the candidates
+    above the floor as bits of 64-light words: a count that is no multiple of 8, and one
+    beyond a word (with highlights and partial shadows on lights past the 64th)."""
+    for noise in (0.004, 0.02):
+        images, lights, mask = _random_stack(6 + n, 20, n, noise=noise)
+        fast = _fast(images, lights, mask, SHADOW_K)
+        ref = _reference(images, lights, mask, SHADOW_K)
+        assert ref["valid"].mean() > 0.5
+        _compare(fast, ref, max_flips=3)
 
 
 def test_colour_stack_matches_the_reference() -> None:
@@ -239,19 +255,21 @@ def test_any_split_of_the_band_gives_the_same_fit_bit_for_bit() -> None:
             np.testing.assert_array_equal(w, np.concatenate(p))
 
 
+@pytest.mark.parametrize("n", [40, 37])
 @pytest.mark.parametrize("scale", [2.0, 3.0])
 @pytest.mark.parametrize("floor", [0.01, 0.0])
 def test_a_residual_exceeds_the_threshold_exactly_as_with_the_sorted_median(
-    scale: float, floor: float
+    scale: float, floor: float, n: int
 ) -> None:
     """The kernel never computes a median: a residual exceeds the threshold iff more than half
     of the used |residuals|, each mapped to the threshold it would set, are below it. Random
     columns (NaN unused), with values placed right at the plain thresholds and one float32
-    step either side."""
+    step either side; ``n`` a multiple of the kernel's 8 SIMD lanes, or not (a scalar
+    tail)."""
     from rti_rig.reconstruct.robust_kernel import _exceeds, _scales
 
     rng = np.random.default_rng(7)
-    n, k = 40, 1500
+    k = 1500
     sub = (rng.standard_cauchy((n, k)) * rng.uniform(0.001, 0.05, k)).astype(np.float32)
     sub[rng.random((n, k)) < 0.3] = np.nan
     f32 = np.float32
