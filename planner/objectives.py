@@ -378,6 +378,7 @@ class NormalsObjective:
         self._sums: tuple[bytes, NDArray, NDArray | None] | None = None
         self._among: tuple[bytes, tuple[NDArray, ...]] | None = None
         self._w32: NDArray[np.float32] | None = None
+        self._l_max2 = float(np.max(np.sum(d * d, axis=1), initial=0.0))  # ‖l‖² ≤ this
         if self.tau2 > 0:
             every = np.arange(len(d))
             all_m = self._information(every)[:, : self.n_bias]  # (6, P_bias)
@@ -483,18 +484,24 @@ class NormalsObjective:
     #: not confirm earns a scan at the next level (:mod:`rti_rig.planner.optimal`).
     scan_levels = ({}, {"single": False}, {"exact": True})
 
+    #: :meth:`swap_costs` takes ``below`` (the exchange search passes the cost to beat).
+    bounded_scans = True
+
     def _weights_among(self, among: NDArray[np.intp]) -> tuple[NDArray, ...]:
         """The single-precision scan weights (K', P) of the candidates ``among``, their
-        weights at the bias pixels (K', P_bias) and the bias scan's per-candidate forms
-        (:func:`rti_rig.planner.rank_one.candidate_forms`), kept while they are the same (the
-        unused candidates do not change until a swap is accepted)."""
+        weights at the bias pixels (K', P_bias), the bias scan's per-candidate forms
+        (:func:`rti_rig.planner.rank_one.candidate_forms`) and the largest weight, kept while
+        they are the same (the unused candidates do not change until a swap is accepted)."""
         key = np.asarray(among, dtype=np.intp).tobytes()
         if self._among is None or self._among[0] != key:
             k = np.asarray(among, dtype=np.intp)
             if self._w32 is None:
                 self._w32 = self.w_kp.astype(np.float32)
             forms = rank_one.candidate_forms(self.dirs[k], self.hsh[k], self.l6[k])
-            self._among = (key, (self._w32[k], self.w_kp[k, : self.n_bias], *forms))
+            w32 = self._w32[k]
+            self._among = (
+                key, (w32, self.w_kp[k, : self.n_bias], *forms, float(w32.max(initial=0.0)))
+            )  # fmt: skip
         return self._among[1]
 
     def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
@@ -514,6 +521,7 @@ class NormalsObjective:
         exact: bool = False,
         among: NDArray[np.intp] | None = None,
         single: bool = True,
+        below: float | None = None,
     ) -> NDArray[np.float64]:
         """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch; with
         ``among``, only those candidates are scored (the others cost inf: the exchange search
@@ -525,6 +533,10 @@ class NormalsObjective:
         pixel rows: a preview's) runs its well-conditioned pixels in single precision unless
         ``single`` is False. The exchange search re-scans in double precision, then exactly,
         when a proposed swap's cost is not confirmed (:attr:`scan_levels`).
+
+        ``below`` (a cost): only the candidates that could cost less matter to the caller;
+        a single-precision scan may return ``inf`` for those it proves cannot (the others'
+        costs unchanged, bit for bit: :func:`rti_rig.planner.rank_one.scan`).
         """
         total_m, total_r = self._chosen_sums(chosen)
         out_light = np.asarray(chosen, dtype=np.intp)[position : position + 1]
@@ -539,8 +551,8 @@ class NormalsObjective:
             r = None if rb is None else rb[:, None] + self._cross_at(k, every)  # (3, K, Pb, 9)
             costs = self._total(base[:, None, :] + self._outer_at(k, every), r)
         else:
-            w32, w_bias, forms_in, h2 = (
-                self._weights_among(among) if pooled else (None, None, None, None)
+            w32, w_bias, forms_in, h2, w_max = (
+                self._weights_among(among) if pooled else (None, None, None, None, None)
             )
             bias = None
             if rb is not None:
@@ -550,6 +562,8 @@ class NormalsObjective:
             res = rank_one.scan(
                 base, self.w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2,
                 MAX_ERR2, bias, rows=k if pooled else None, w32=w32 if single else None,
+                below=None if below is None else np.radians(below) ** 2 * (1 + 1e-12),
+                w_max=w_max, l_max2=self._l_max2,
             )  # fmt: skip
             err2 = res.err2
             if len(res.bad):
