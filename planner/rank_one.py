@@ -509,5 +509,3 @@ def _bias_reach(
     h_max = float(np.sqrt(h2.max(initial=0.0)))
     reach = w_max * prep.trace * l_max * (h_max + prep.g_norm * l_max)
     return (np.sqrt(prep.c0) + reach) ** 2
-
-
