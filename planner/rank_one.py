@@ -247,7 +247,10 @@ def scan(
         nb = len(bias.wts)
         bad_bias = bad[bad < nb]
         gb = np.flatnonzero(good[:nb])
-        wb = weights(gb) if bias.w is None else bias.w[:, gb]
+        if bias.w is None:
+            wb = weights(gb)
+        else:  # the same values; no gather when every bias pixel is kept
+            wb = bias.w if len(gb) == bias.w.shape[1] else bias.w[:, gb]
         single_b = w32 is not None and bool(single[gb].all())
         prep = _bias_prep(inv6[:, gb], c6[:, gb], normals[gb], bias, gb)
         if bias.forms_in is None or bias.h2 is None:
