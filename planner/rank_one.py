@@ -195,7 +195,8 @@ def scan(
     precision ones (the caller confirms a swap on its exact cost) — and the others in double.
 
     ``below`` (squared error, rad²): only the candidates that could score under it are needed;
-    the others may be returned as ``inf``. When every pixel is scanned in single precision,
+    the others may be returned as ``inf``. When every pixel is scanned in single precision
+    (and the scan is large: :data:`BOUNDED_MIN_WORK`),
     the variance pass then runs only on the candidates whose lower bound
     (:func:`_variance_bound`) is under it, the others being proved not to — with the same
     values, bit for bit, as the full pass gives them (its products and passes are row by row;
@@ -227,7 +228,7 @@ def scan(
         sp = slice(None) if every else np.flatnonzero(single)
         f32 = np.float32
         args = (l6.astype(f32), inv6[:, sp].astype(f32), c6w[:, sp].astype(f32), w32[:, sp])
-        if below is not None and every and len(d) >= 2:
+        if below is not None and every and len(d) >= 2 and w32.size >= BOUNDED_MIN_WORK:
             bounded = args  # the variance pass waits for the bias term (below)
         else:
             err2 -= noise2 * _reduction(*args)
@@ -316,6 +317,11 @@ def _two_rows(rows: NDArray[np.intp]) -> NDArray[np.intp]:
     as a matrix-vector product, with other rounding than the same row among others."""
     return rows if len(rows) >= 2 else np.array([rows[0], 1 - min(int(rows[0]), 1)])
 
+
+#: A scan bounds its candidates (``below``) from this many (candidate, pixel) pairs: below, its
+#: few passes cost less than the bounds' fixed work (on this machine at ~200 000 pairs: the
+#: shipped arm's 36 lights gained 10 %, its 9 lights and the 200-LED dome at 100 lost 8–10 %).
+BOUNDED_MIN_WORK = 200_000
 
 #: Relative margin on the variance bound's product (far above single precision's rounding of
 #: it; the bound's own slack on the arm at 100 lights is ~3 % of the reduction).
