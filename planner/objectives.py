@@ -471,10 +471,9 @@ class NormalsObjective:
         return np.degrees(np.sqrt(err2))
 
     def cost(self, chosen: NDArray[np.intp]) -> float:
-        chosen = np.asarray(chosen, dtype=np.intp)
-        m = self._information(chosen)[:, None]  # (6, 1, P)
-        r = self._cross_sum(chosen)[:, None] if self.tau2 > 0 else None
-        return float(self._total(m, r)[0])
+        # the sums are kept: the exchange search costs a layout, then scans it
+        m, r = self._chosen_sums(np.asarray(chosen, dtype=np.intp))
+        return float(self._total(m[:, None], None if r is None else r[:, None])[0])
 
     @property
     def candidate_count(self) -> int:
