@@ -283,20 +283,20 @@ def scan(
     # the variance first with every weight at its largest (no (K, P) pass), then by the
     # product with the weights for the candidates that leaves (all of them when many do)
     lower = err2 - noise2 * _variance_bound(l6f, inv32, c6w32, None, l_max2, w_max) + bias_low
-    maybe = np.flatnonzero(lower < below)
+    maybe = np.flatnonzero(~(lower >= below))  # a NaN is kept: scored as in full
     if len(maybe):
         if 2 * len(maybe) > len(d):
             ub = _variance_bound(l6f, inv32, c6w32, w_s, l_max2, w_max)[maybe]
         else:
             ub = _variance_bound(l6f[maybe], inv32, c6w32, w_s[maybe], l_max2, w_max)
         lower[maybe] = err2[maybe] - noise2 * ub + bias_low[maybe]
-        maybe = maybe[lower[maybe] < below]
+        maybe = maybe[~(lower[maybe] >= below)]
     out = np.full(len(d), np.inf)
     if len(maybe) and chain is not None and bias_err2 is None:
         # the bias term itself where its bound left a chance, and the bound again
         pick = _two_rows(maybe)
         exact_b = _bias_chain(*chain, rows=pick)[: len(maybe)]
-        keep = lower[maybe] - bias_low[maybe] + exact_b < below
+        keep = ~(lower[maybe] - bias_low[maybe] + exact_b >= below)
         maybe, exact_b = maybe[keep], exact_b[keep]
         bias_err2 = np.zeros(len(d))
         bias_err2[maybe] = exact_b
