@@ -77,6 +77,10 @@ GLOSSY_WIDTH_DEG = 30.0
 #: (below, scoring them all costs less than the gathering).
 POOL_MIN_PIXELS = 64
 
+#: At most this many positions of a layout have their scans' per-pixel inverses computed at
+#: once (:meth:`NormalsObjective._inverses_at`).
+INVERSE_BATCH = 16
+
 #: Sampled normals used for the bias term (it varies smoothly with the normal).
 BIAS_PIXELS = 128
 
@@ -379,6 +383,8 @@ class NormalsObjective:
         self._among: tuple[bytes, tuple[NDArray, ...]] | None = None
         self._w32: NDArray[np.float32] | None = None
         self._l_max2 = float(np.max(np.sum(d * d, axis=1), initial=0.0))  # ‖l‖² ≤ this
+        self._inverse_batch: tuple[bytes, int, int, tuple[NDArray, ...]] | None = None
+        self._batch_size = 2
         if self.tau2 > 0:
             every = np.arange(len(d))
             all_m = self._information(every)[:, : self.n_bias]  # (6, P_bias)
@@ -503,6 +509,26 @@ class NormalsObjective:
             )  # fmt: skip
         return self._among[1]
 
+    def _inverses_at(
+        self, chosen: NDArray[np.intp], position: int, total_m: NDArray[np.float64]
+    ) -> tuple[NDArray, ...]:
+        """:func:`rti_rig.planner.rank_one.inverses` of the layout ``chosen`` without its light
+        at ``position``, computed for the next few positions at once (a sweep scans them in
+        order until a swap is accepted: 2 after a swap, twice as many each time the layout
+        outlives a batch, at most :data:`INVERSE_BATCH`); the same values as one by one."""
+        key = np.asarray(chosen, dtype=np.intp).tobytes()
+        batch = self._inverse_batch
+        if batch is not None and batch[0] == key and batch[1] <= position < batch[2]:
+            j = position - batch[1]
+            return tuple(a[:, j] if a.ndim == 3 else a[j] for a in batch[3])
+        size = 2 if batch is None or batch[0] != key else min(2 * self._batch_size, INVERSE_BATCH)
+        self._batch_size = size
+        stop = min(position + size, len(chosen))
+        lights = np.asarray(chosen, dtype=np.intp)[position:stop]
+        base = total_m[:, None, :] - self._outer_at(lights, slice(None))  # (6, B, P)
+        self._inverse_batch = (key, position, stop, rank_one.inverses(base, self.n))
+        return self._inverses_at(chosen, position, total_m)
+
     def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
         """Information and cross terms of the layout ``chosen`` (kept while it is unchanged:
         a sweep scans every position of one layout until a swap is accepted)."""
@@ -563,6 +589,7 @@ class NormalsObjective:
                 MAX_ERR2, bias, rows=k if pooled else None, w32=w32 if single else None,
                 below=None if below is None else np.radians(below) ** 2 * (1 + 1e-12),
                 w_max=w_max, l_max2=self._l_max2,
+                pre=self._inverses_at(chosen, position, total_m) if pooled else None,
             )  # fmt: skip
             err2 = res.err2
             if len(res.bad):

@@ -103,6 +103,20 @@ def _inverse_and_condition(
     return np.stack([c00, c01, c02, c11, c12, c22]) / scale, ratio
 
 
+def inverses(
+    base: NDArray[np.float64], normals: NDArray[np.float64]
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """The per-pixel start of :func:`scan` for the entries ``base`` (6, ..., P) of one or several
+    ``B``: the entries of ``B⁻¹`` (6, ..., P; not inverses where ill-conditioned), the condition
+    ratio (..., P), ``tr(P B⁻¹)`` (..., P) and the entries of ``B⁻¹PB⁻¹`` (6, ..., P). Every
+    operation is element by element, so a batch gives each ``B`` the values it gets alone, bit
+    for bit (tested); a batch costs far fewer calls than its ``B`` one by one."""
+    inv6, ratio = _inverse_and_condition(base)
+    inv6 = inv6 / np.where(ratio > WELL_CONDITIONED, ratio, 1.0)
+    tr0, c6 = _projected_inverse(inv6, normals)
+    return inv6, ratio, tr0, c6
+
+
 @dataclass(frozen=True)
 class ScanResult:
     """Weighted squared error (rad²) of every candidate over the well-conditioned pixels, and
@@ -179,6 +193,7 @@ def scan(
     below: float | None = None,
     w_max: float | None = None,
     l_max2: float | None = None,
+    pre: tuple[NDArray, NDArray, NDArray, NDArray] | None = None,
 ) -> ScanResult:
     """Squared errors of ``B + w_k l_k l_kᵀ`` for every candidate ``k``.
 
@@ -202,12 +217,11 @@ def scan(
     values, bit for bit, as the full pass gives them (its products and passes are row by row;
     tested), so a search that asks which candidate scores least and whether it is under
     ``below`` gets the same answer. ``w_max``: the largest of ``w32``, ``l_max2`` the largest
-    ``‖l‖²`` of ``d`` (or bounds on them: the caller may keep them).
+    ``‖l‖²`` of ``d`` (or bounds on them: the caller may keep them). ``pre``: what
+    :func:`inverses` gives for ``base`` (the caller may compute it for several bases at once).
     """
-    inv6, ratio = _inverse_and_condition(base)
+    inv6, ratio, tr0, c6 = inverses(base, normals) if pre is None else pre
     good = ratio > WELL_CONDITIONED
-    inv6 = inv6 / np.where(good, ratio, 1.0)
-    tr0, c6 = _projected_inverse(inv6, normals)
     # the variance σ²(tr(P B⁻¹) - s q2) lies in [0, σ² tr(P B⁻¹)]: only where that bound
     # passes the cap does a pixel need clipping; elsewhere the weighted sum is taken directly
     capped = good & (noise2 * tr0 > max_err2)

@@ -215,3 +215,33 @@ def test_the_shipped_arm_plan_is_the_same_file_with_and_without_the_bounds(
     assert seen  # the shipped arm's scans were bounded
     monkeypatch.setattr(NormalsObjective, "bounded_scans", False)
     assert plan(tmp_path / "plain.lp") == bounded
+
+
+@pytest.mark.parametrize(("geometry", "n", "seed"), CASES[:2])
+def test_the_inverses_of_a_batch_of_positions_are_those_of_each_alone(
+    geometry, n: int, seed: int
+) -> None:
+    """The scans' per-pixel inverses are computed for several positions at once: bit for bit
+    what each position gets alone, ill-conditioned pixels included."""
+    obj, starts = problem(geometry, n, seed)
+    rng = np.random.default_rng(seed)
+    for chosen in layouts(obj, starts, seed):
+        total = obj._information(chosen)
+        lights = chosen[: min(7, n)]
+        batch = total[:, None, :] - obj._outer_at(lights, slice(None))
+        # a few pixels made singular and nearly so
+        batch[:, :, :3] = 0.0
+        batch[:, :, 3:6] *= rng.uniform(0.0, 1e-9, size=(1, 1, 3))
+        got = rank_one.inverses(batch, obj.n)
+        for j in range(len(lights)):
+            alone = rank_one.inverses(np.ascontiguousarray(batch[:, j]), obj.n)
+            for a, b in zip(got, alone, strict=True):
+                assert np.array_equal(a[:, j] if a.ndim == 3 else a[j], b, equal_nan=True)
+        among = np.setdiff1d(np.arange(obj.candidate_count), chosen)
+        cost = obj.cost(chosen)
+        for pos in (0, 1, n - 1):  # through the objective: batched and recomputed alike
+            batched = obj.swap_costs(chosen, pos, among=among, below=cost)
+            obj._inverse_batch = None
+            fresh = obj.swap_costs(chosen, pos, among=among, below=cost)
+            obj._inverse_batch = None
+            assert np.array_equal(batched, fresh)
