@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -383,7 +383,7 @@ class NormalsObjective:
         self._among: tuple[bytes, tuple[NDArray, ...]] | None = None
         self._w32: NDArray[np.float32] | None = None
         self._l_max2 = float(np.max(np.sum(d * d, axis=1), initial=0.0))  # ‖l‖² ≤ this
-        self._inverse_batch: tuple[bytes, int, int, tuple[NDArray, ...]] | None = None
+        self._inverse_batch: tuple[bytes, int, int, tuple[NDArray, ...], list] | None = None
         self._batch_size = 2
         if self.tau2 > 0:
             every = np.arange(len(d))
@@ -511,22 +511,35 @@ class NormalsObjective:
 
     def _inverses_at(
         self, chosen: NDArray[np.intp], position: int, total_m: NDArray[np.float64]
-    ) -> tuple[NDArray, ...]:
+    ) -> tuple[tuple[NDArray, ...], Any]:
         """:func:`rti_rig.planner.rank_one.inverses` of the layout ``chosen`` without its light
-        at ``position``, computed for the next few positions at once (a sweep scans them in
-        order until a swap is accepted: 2 after a swap, twice as many each time the layout
-        outlives a batch, at most :data:`INVERSE_BATCH`); the same values as one by one."""
+        at ``position`` and its bias pixels' :func:`rti_rig.planner.rank_one.bias_prep_batch`
+        (None when one is ill-conditioned), computed for the next few positions at once (a
+        sweep scans them in order until a swap is accepted: 2 after a swap, twice as many each
+        time the layout outlives a batch, at most :data:`INVERSE_BATCH`); the same values as
+        one by one."""
         key = np.asarray(chosen, dtype=np.intp).tobytes()
         batch = self._inverse_batch
         if batch is not None and batch[0] == key and batch[1] <= position < batch[2]:
             j = position - batch[1]
-            return tuple(a[:, j] if a.ndim == 3 else a[j] for a in batch[3])
+            return tuple(a[:, j] if a.ndim == 3 else a[j] for a in batch[3]), batch[4][j]
         size = 2 if batch is None or batch[0] != key else min(2 * self._batch_size, INVERSE_BATCH)
         self._batch_size = size
         stop = min(position + size, len(chosen))
         lights = np.asarray(chosen, dtype=np.intp)[position:stop]
         base = total_m[:, None, :] - self._outer_at(lights, slice(None))  # (6, B, P)
-        self._inverse_batch = (key, position, stop, rank_one.inverses(base, self.n))
+        inv = rank_one.inverses(base, self.n)
+        prep: list = [None] * len(lights)
+        total_r = self._chosen_sums(chosen)[1]
+        nb = self.n_bias
+        if total_r is not None and np.all(inv[1][:, :nb] > rank_one.WELL_CONDITIONED):
+            every = np.arange(nb)  # gathered as a scan gathers its well-conditioned pixels
+            rb = total_r[:, None] - self._cross_at(lights, slice(None))  # (3, B, Pb, 9)
+            prep = rank_one.bias_prep_batch(
+                inv[0][:, :, every], inv[3][:, :, every], self.n[every], rb[:, :, every],
+                self.g_all[:, every],
+            )  # fmt: skip
+        self._inverse_batch = (key, position, stop, inv, prep)
         return self._inverses_at(chosen, position, total_m)
 
     def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
@@ -584,12 +597,13 @@ class NormalsObjective:
                 bias = rank_one.BiasTerms(
                     rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2, w_bias, forms_in, h2
                 )
+            pre = self._inverses_at(chosen, position, total_m) if pooled else None
             res = rank_one.scan(
                 base, self.w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2,
                 MAX_ERR2, bias, rows=k if pooled else None, w32=w32 if single else None,
                 below=None if below is None else np.radians(below) ** 2 * (1 + 1e-12),
                 w_max=w_max, l_max2=self._l_max2,
-                pre=self._inverses_at(chosen, position, total_m) if pooled else None,
+                pre=pre[0] if pre else None, bias_pre=pre[1] if pre else None,
             )  # fmt: skip
             err2 = res.err2
             if len(res.bad):

@@ -194,6 +194,7 @@ def scan(
     w_max: float | None = None,
     l_max2: float | None = None,
     pre: tuple[NDArray, NDArray, NDArray, NDArray] | None = None,
+    bias_pre: _BiasPrep | None = None,
 ) -> ScanResult:
     """Squared errors of ``B + w_k l_k l_kᵀ`` for every candidate ``k``.
 
@@ -218,7 +219,9 @@ def scan(
     tested), so a search that asks which candidate scores least and whether it is under
     ``below`` gets the same answer. ``w_max``: the largest of ``w32``, ``l_max2`` the largest
     ``‖l‖²`` of ``d`` (or bounds on them: the caller may keep them). ``pre``: what
-    :func:`inverses` gives for ``base`` (the caller may compute it for several bases at once).
+    :func:`inverses` gives for ``base`` (the caller may compute it for several bases at once);
+    ``bias_pre``: what :func:`bias_prep_batch` gives for it, used when every bias pixel is
+    well conditioned.
     """
     inv6, ratio, tr0, c6 = inverses(base, normals) if pre is None else pre
     good = ratio > WELL_CONDITIONED
@@ -267,7 +270,10 @@ def scan(
         else:  # the same values; no gather when every bias pixel is kept
             wb = bias.w if len(gb) == bias.w.shape[1] else bias.w[:, gb]
         single_b = w32 is not None and bool(single[gb].all())
-        prep = _bias_prep(inv6[:, gb], c6[:, gb], normals[gb], bias, gb)
+        if bias_pre is not None and len(gb) == nb:
+            prep = bias_pre
+        else:
+            prep = _bias_prep(inv6[:, gb], c6[:, gb], normals[gb], bias, gb)
         if bias.forms_in is None or bias.h2 is None:
             forms_in, h2 = candidate_forms(d, bias.h, l6)
         else:
@@ -429,6 +435,46 @@ def _bias_prep(
     quad = np.concatenate([inv_b, qc6], axis=1)
     trace = inv_b[0] + inv_b[3] + inv_b[5]
     return _BiasPrep(c0, coef, quad, trace, np.sqrt(np.sum(gbm * gbm, axis=(1, 2))))
+
+
+def bias_prep_batch(
+    inv_b: NDArray[np.float64],
+    qc6: NDArray[np.float64],
+    n: NDArray[np.float64],
+    rb: NDArray[np.float64],
+    g_all: NDArray[np.float64],
+) -> list[_BiasPrep]:
+    """:func:`_bias_prep` for several layouts at once: entries of ``B⁻¹`` and ``B⁻¹PB⁻¹``
+    (6, B, Gb), normals (Gb, 3), cross terms (3, B, Gb, 9) and the all-light fit (3, Gb, 9) of
+    the bias pixels kept. The same operations on a leading axis — each layout's values bit for
+    bit (tested) — in a tenth of the calls."""
+    nb, m = inv_b.shape[1], inv_b.shape[2]
+    bi = np.empty((nb, m, 3, 3))
+    a, b, c, d, f_, g = inv_b
+    bi[..., 0, 0], bi[..., 0, 1], bi[..., 0, 2] = a, b, c
+    bi[..., 1, 0], bi[..., 1, 1], bi[..., 1, 2] = b, d, f_
+    bi[..., 2, 0], bi[..., 2, 1], bi[..., 2, 2] = c, f_, g
+    pr = np.eye(3)[None] - n[:, :, None] * n[:, None, :]
+    rbm = np.transpose(rb, (1, 2, 0, 3))  # (B, Gb, 3, 9)
+    ga = np.transpose(g_all, (1, 0, 2))
+    gbm = bi @ rbm
+    pdm = pr @ (gbm - ga)
+    c0 = np.sum(pdm * pdm, axis=(2, 3))
+    fm = bi @ pdm
+    gbt = np.transpose(gbm, (0, 1, 3, 2))
+    fg, gg = fm @ gbt, gbm @ gbt
+    quad = np.concatenate([inv_b, qc6], axis=2)
+    trace = inv_b[0] + inv_b[3] + inv_b[5]
+    g_norm = np.sqrt(np.sum(gbm * gbm, axis=(2, 3)))
+    out = []
+    for j in range(nb):
+        coef = np.empty((33, 2 * m))
+        coef[:27, :m] = fm[j].reshape(m, 27).T
+        coef[:27, m:] = -2.0 * gbm[j].reshape(m, 27).T
+        coef[27:, :m] = -_entries(fg[j])
+        coef[27:, m:] = _entries(gg[j])
+        out.append(_BiasPrep(c0[j], coef, quad[:, j], trace[j], g_norm[j]))
+    return out
 
 
 def _bias_chain(

@@ -245,3 +245,37 @@ def test_the_inverses_of_a_batch_of_positions_are_those_of_each_alone(
             fresh = obj.swap_costs(chosen, pos, among=among, below=cost)
             obj._inverse_batch = None
             assert np.array_equal(batched, fresh)
+
+
+@pytest.mark.parametrize(("geometry", "n", "seed"), CASES)
+def test_the_bias_terms_of_a_batch_of_positions_are_those_of_each_alone(
+    geometry, n: int, seed: int
+) -> None:
+    """The bias term's per-pixel coefficients, computed for several positions at once, are bit
+    for bit those each position's scan computes alone."""
+    obj, starts = problem(geometry, n, seed)
+    nb = obj.n_bias
+    checked = 0
+    for chosen in layouts(obj, starts, seed):
+        total_m, total_r = obj._information(chosen), obj._cross_sum(chosen)
+        lights = chosen[: min(9, n)]
+        base = total_m[:, None, :] - obj._outer_at(lights, slice(None))
+        inv = rank_one.inverses(base, obj.n)
+        if not np.all(inv[1][:, :nb] > rank_one.WELL_CONDITIONED):
+            continue
+        every = np.arange(nb)
+        rb = total_r[:, None] - obj._cross_at(lights, slice(None))
+        batch = rank_one.bias_prep_batch(
+            inv[0][:, :, every], inv[3][:, :, every], obj.n[every], rb[:, :, every],
+            obj.g_all[:, every],
+        )  # fmt: skip
+        for j, light in enumerate(lights):
+            base_j = total_m - obj._outer_at(light[None], slice(None))[:, 0]
+            inv6, _, _, c6 = rank_one.inverses(base_j, obj.n)
+            rb_j = total_r - obj._cross_at(light[None], slice(None))[:, 0]
+            bias = rank_one.BiasTerms(rb_j, obj.g_all, obj.hsh, obj.wts_bias, obj.tau2)
+            alone = rank_one._bias_prep(inv6[:, every], c6[:, every], obj.n[every], bias, every)
+            for field in ("c0", "coef", "quad", "trace", "g_norm"):
+                assert np.array_equal(getattr(batch[j], field), getattr(alone, field)), field
+            checked += 1
+    assert checked >= len(lights)
