@@ -78,8 +78,14 @@ GLOSSY_WIDTH_DEG = 30.0
 POOL_MIN_PIXELS = 64
 
 #: At most this many positions of a layout have their scans' per-pixel inverses computed at
-#: once (:meth:`NormalsObjective._inverses_at`).
+#: once (:meth:`NormalsObjective._inverses_at`) ...
 INVERSE_BATCH = 16
+
+#: ... from this many lights: with fewer, swaps come often for the few scans of a sweep and
+#: the search stops part-way through one, so too much of a batch went unused (on this machine
+#: the shipped arm at 9 lights and the 48-LED dome at 24 scanned 8–10 % slower batched; the
+#: arm at 36 and the 200-LED dome at 100, 13 % and 8 % faster).
+INVERSE_BATCH_MIN_LIGHTS = 32
 
 #: Sampled normals used for the bias term (it varies smoothly with the normal).
 BIAS_PIXELS = 128
@@ -515,7 +521,7 @@ class NormalsObjective:
         """:func:`rti_rig.planner.rank_one.inverses` of the layout ``chosen`` without its light
         at ``position`` and its bias pixels' :func:`rti_rig.planner.rank_one.bias_prep_batch`
         (None when one is ill-conditioned), computed for the next few positions at once (a
-        sweep scans them in order until a swap is accepted: 2 after a swap, twice as many each
+        sweep scans them in order until a swap is accepted: 1 after a swap, twice as many each
         time the layout outlives a batch, at most :data:`INVERSE_BATCH`); the same values as
         one by one."""
         key = np.asarray(chosen, dtype=np.intp).tobytes()
@@ -523,7 +529,7 @@ class NormalsObjective:
         if batch is not None and batch[0] == key and batch[1] <= position < batch[2]:
             j = position - batch[1]
             return tuple(a[:, j] if a.ndim == 3 else a[j] for a in batch[3]), batch[4][j]
-        size = 2 if batch is None or batch[0] != key else min(2 * self._batch_size, INVERSE_BATCH)
+        size = 1 if batch is None or batch[0] != key else min(2 * self._batch_size, INVERSE_BATCH)
         self._batch_size = size
         stop = min(position + size, len(chosen))
         lights = np.asarray(chosen, dtype=np.intp)[position:stop]
@@ -597,7 +603,8 @@ class NormalsObjective:
                 bias = rank_one.BiasTerms(
                     rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2, w_bias, forms_in, h2
                 )
-            pre = self._inverses_at(chosen, position, total_m) if pooled else None
+            batched = pooled and len(chosen) >= INVERSE_BATCH_MIN_LIGHTS
+            pre = self._inverses_at(chosen, position, total_m) if batched else None
             res = rank_one.scan(
                 base, self.w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2,
                 MAX_ERR2, bias, rows=k if pooled else None, w32=w32 if single else None,

@@ -22,7 +22,7 @@ from typer.testing import CliRunner
 from rti_rig.cli import app
 from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
-from rti_rig.planner import rank_one
+from rti_rig.planner import objectives, rank_one
 from rti_rig.planner.make_plan import _candidates_and_starts, _held_out_lights
 from rti_rig.planner.objectives import MAX_ERR2, NormalsObjective
 from rti_rig.planner.optimal import exchange_search
@@ -49,9 +49,11 @@ CASES = [(ARM, 36, 0), (ARM, 20, 3), (DOME, 24, 1), (DOME, 40, 2)]
 
 @pytest.fixture(autouse=True)
 def bound_every_scan(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
-    """These small problems are bounded too (the planner bounds only large scans)."""
+    """These small problems are bounded and batched too (the planner does so only for large
+    scans and many lights)."""
     if "shipped" not in request.node.name:
         monkeypatch.setattr(rank_one, "BOUNDED_MIN_WORK", 0)
+        monkeypatch.setattr(objectives, "INVERSE_BATCH_MIN_LIGHTS", 0)
 
 
 def layouts(obj: NormalsObjective, starts, seed: int):
