@@ -390,7 +390,7 @@ class NormalsObjective:
         self._w32: NDArray[np.float32] | None = None
         self._l_max2 = float(np.max(np.sum(d * d, axis=1), initial=0.0))  # ‖l‖² ≤ this
         self._inverse_batch: tuple[bytes, int, int, tuple[NDArray, ...], list] | None = None
-        self._batch_size = 2
+        self._batch_size = 1
         if self.tau2 > 0:
             every = np.arange(len(d))
             all_m = self._information(every)[:, : self.n_bias]  # (6, P_bias)
