@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -76,6 +76,16 @@ GLOSSY_WIDTH_DEG = 30.0
 #: From this many pixel rows up, a swap scan gathers the arrays of the candidates it scores
 #: (below, scoring them all costs less than the gathering).
 POOL_MIN_PIXELS = 64
+
+#: At most this many positions of a layout have their scans' per-pixel inverses computed at
+#: once (:meth:`NormalsObjective._inverses_at`) ...
+INVERSE_BATCH = 16
+
+#: ... from this many lights: with fewer, swaps come often for the few scans of a sweep and
+#: the search stops part-way through one, so too much of a batch went unused (on this machine
+#: the shipped arm at 9 lights and the 48-LED dome at 24 scanned 8–10 % slower batched; the
+#: arm at 36 and the 200-LED dome at 100, 13 % and 8 % faster).
+INVERSE_BATCH_MIN_LIGHTS = 32
 
 #: Sampled normals used for the bias term (it varies smoothly with the normal).
 BIAS_PIXELS = 128
@@ -378,6 +388,9 @@ class NormalsObjective:
         self._sums: tuple[bytes, NDArray, NDArray | None] | None = None
         self._among: tuple[bytes, tuple[NDArray, ...]] | None = None
         self._w32: NDArray[np.float32] | None = None
+        self._l_max2 = float(np.max(np.sum(d * d, axis=1), initial=0.0))  # ‖l‖² ≤ this
+        self._inverse_batch: tuple[bytes, int, int, tuple[NDArray, ...], list] | None = None
+        self._batch_size = 1
         if self.tau2 > 0:
             every = np.arange(len(d))
             all_m = self._information(every)[:, : self.n_bias]  # (6, P_bias)
@@ -470,10 +483,9 @@ class NormalsObjective:
         return np.degrees(np.sqrt(err2))
 
     def cost(self, chosen: NDArray[np.intp]) -> float:
-        chosen = np.asarray(chosen, dtype=np.intp)
-        m = self._information(chosen)[:, None]  # (6, 1, P)
-        r = self._cross_sum(chosen)[:, None] if self.tau2 > 0 else None
-        return float(self._total(m, r)[0])
+        # the sums are kept: the exchange search costs a layout, then scans it
+        m, r = self._chosen_sums(np.asarray(chosen, dtype=np.intp))
+        return float(self._total(m[:, None], None if r is None else r[:, None])[0])
 
     @property
     def candidate_count(self) -> int:
@@ -483,19 +495,58 @@ class NormalsObjective:
     #: not confirm earns a scan at the next level (:mod:`rti_rig.planner.optimal`).
     scan_levels = ({}, {"single": False}, {"exact": True})
 
+    #: :meth:`swap_costs` takes ``below`` (the exchange search passes the cost to beat).
+    bounded_scans = True
+
     def _weights_among(self, among: NDArray[np.intp]) -> tuple[NDArray, ...]:
         """The single-precision scan weights (K', P) of the candidates ``among``, their
-        weights at the bias pixels (K', P_bias) and the bias scan's per-candidate forms
-        (:func:`rti_rig.planner.rank_one.candidate_forms`), kept while they are the same (the
-        unused candidates do not change until a swap is accepted)."""
+        weights at the bias pixels (K', P_bias), the bias scan's per-candidate forms
+        (:func:`rti_rig.planner.rank_one.candidate_forms`) and the largest weight, kept while
+        they are the same (the unused candidates do not change until a swap is accepted)."""
         key = np.asarray(among, dtype=np.intp).tobytes()
         if self._among is None or self._among[0] != key:
             k = np.asarray(among, dtype=np.intp)
             if self._w32 is None:
                 self._w32 = self.w_kp.astype(np.float32)
             forms = rank_one.candidate_forms(self.dirs[k], self.hsh[k], self.l6[k])
-            self._among = (key, (self._w32[k], self.w_kp[k, : self.n_bias], *forms))
+            w32 = self._w32[k]
+            self._among = (
+                key, (w32, self.w_kp[k, : self.n_bias], *forms, float(w32.max(initial=0.0)))
+            )  # fmt: skip
         return self._among[1]
+
+    def _inverses_at(
+        self, chosen: NDArray[np.intp], position: int, total_m: NDArray[np.float64]
+    ) -> tuple[tuple[NDArray, ...], Any]:
+        """:func:`rti_rig.planner.rank_one.inverses` of the layout ``chosen`` without its light
+        at ``position`` and its bias pixels' :func:`rti_rig.planner.rank_one.bias_prep_batch`
+        (None when one is ill-conditioned), computed for the next few positions at once (a
+        sweep scans them in order until a swap is accepted: 1 after a swap, twice as many each
+        time the layout outlives a batch, at most :data:`INVERSE_BATCH`); the same values as
+        one by one."""
+        key = np.asarray(chosen, dtype=np.intp).tobytes()
+        batch = self._inverse_batch
+        if batch is not None and batch[0] == key and batch[1] <= position < batch[2]:
+            j = position - batch[1]
+            return tuple(a[:, j] if a.ndim == 3 else a[j] for a in batch[3]), batch[4][j]
+        size = 1 if batch is None or batch[0] != key else min(2 * self._batch_size, INVERSE_BATCH)
+        self._batch_size = size
+        stop = min(position + size, len(chosen))
+        lights = np.asarray(chosen, dtype=np.intp)[position:stop]
+        base = total_m[:, None, :] - self._outer_at(lights, slice(None))  # (6, B, P)
+        inv = rank_one.inverses(base, self.n)
+        prep: list = [None] * len(lights)
+        total_r = self._chosen_sums(chosen)[1]
+        nb = self.n_bias
+        if total_r is not None and np.all(inv[1][:, :nb] > rank_one.WELL_CONDITIONED):
+            every = np.arange(nb)  # gathered as a scan gathers its well-conditioned pixels
+            rb = total_r[:, None] - self._cross_at(lights, slice(None))  # (3, B, Pb, 9)
+            prep = rank_one.bias_prep_batch(
+                inv[0][:, :, every], inv[3][:, :, every], self.n[every], rb[:, :, every],
+                self.g_all[:, every],
+            )  # fmt: skip
+        self._inverse_batch = (key, position, stop, inv, prep)
+        return self._inverses_at(chosen, position, total_m)
 
     def _chosen_sums(self, chosen: NDArray[np.intp]) -> tuple[NDArray, NDArray | None]:
         """Information and cross terms of the layout ``chosen`` (kept while it is unchanged:
@@ -514,6 +565,7 @@ class NormalsObjective:
         exact: bool = False,
         among: NDArray[np.intp] | None = None,
         single: bool = True,
+        below: float | None = None,
     ) -> NDArray[np.float64]:
         """Cost of replacing ``chosen[position]`` by each candidate (K,), in one batch; with
         ``among``, only those candidates are scored (the others cost inf: the exchange search
@@ -525,6 +577,10 @@ class NormalsObjective:
         pixel rows: a preview's) runs its well-conditioned pixels in single precision unless
         ``single`` is False. The exchange search re-scans in double precision, then exactly,
         when a proposed swap's cost is not confirmed (:attr:`scan_levels`).
+
+        ``below`` (a cost): only the candidates that could cost less matter to the caller;
+        a single-precision scan may return ``inf`` for those it proves cannot (the others'
+        costs unchanged, bit for bit: :func:`rti_rig.planner.rank_one.scan`).
         """
         total_m, total_r = self._chosen_sums(chosen)
         out_light = np.asarray(chosen, dtype=np.intp)[position : position + 1]
@@ -539,17 +595,22 @@ class NormalsObjective:
             r = None if rb is None else rb[:, None] + self._cross_at(k, every)  # (3, K, Pb, 9)
             costs = self._total(base[:, None, :] + self._outer_at(k, every), r)
         else:
-            w32, w_bias, forms_in, h2 = (
-                self._weights_among(among) if pooled else (None, None, None, None)
+            w32, w_bias, forms_in, h2, w_max = (
+                self._weights_among(among) if pooled else (None, None, None, None, None)
             )
             bias = None
             if rb is not None:
                 bias = rank_one.BiasTerms(
                     rb, self.g_all, self.hsh[k], self.wts_bias, self.tau2, w_bias, forms_in, h2
                 )
+            batched = pooled and len(chosen) >= INVERSE_BATCH_MIN_LIGHTS
+            pre = self._inverses_at(chosen, position, total_m) if batched else None
             res = rank_one.scan(
                 base, self.w_kp, self.dirs[k], self.l6[k], self.n, self.wts, NOISE_REL**2,
                 MAX_ERR2, bias, rows=k if pooled else None, w32=w32 if single else None,
+                below=None if below is None else np.radians(below) ** 2 * (1 + 1e-12),
+                w_max=w_max, l_max2=self._l_max2,
+                pre=pre[0] if pre else None, bias_pre=pre[1] if pre else None,
             )  # fmt: skip
             err2 = res.err2
             if len(res.bad):

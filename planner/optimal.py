@@ -97,6 +97,9 @@ def _sweeps(
     # objective that knows its candidate count scores only those (half of them at 100 of 200)
     count = getattr(objective, "candidate_count", None)
     levels = getattr(objective, "scan_levels", ({"exact": False}, {"exact": True}))
+    # an objective that can skip the candidates proved not to beat the current cost is told
+    # it (the same argmin whenever one beats it: the rest are inf, proved not to)
+    bounded = bool(getattr(objective, "bounded_scans", False))
     unused = None if count is None else np.ones(count, dtype=bool)
     if unused is not None:
         unused[chosen] = False
@@ -117,10 +120,12 @@ def _sweeps(
                 # the fast scan may be approximate (rank-one updates, single precision): a swap
                 # is accepted on its exact cost, and a proposal that cost does not confirm
                 # earns a re-scan at the next level (the last: every pixel evaluated directly)
-                trial = objective.swap_costs(chosen, pos, **level, **scan_kw)
+                target = cost - 1e-9 * max(abs(cost), 1e-12)
+                bound_kw = {"below": target} if bounded else {}
+                trial = objective.swap_costs(chosen, pos, **level, **scan_kw, **bound_kw)
                 trial[chosen] = np.inf  # no repeats (the current light itself is "no change")
                 k = int(np.argmin(trial))
-                if not float(trial[k]) < cost - 1e-9 * max(abs(cost), 1e-12):
+                if not float(trial[k]) < target:
                     break  # no improving swap at this position
                 previous = int(chosen[pos])
                 chosen[pos] = k
