@@ -634,7 +634,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     default dome's (about 1 s a light), so a replayed session reports what a real dome would
     take.
     """
-    from rti_rig.core.image_files import probe_image_size
+    from rti_rig.core.image_files import jpeg_truncation, probe_image_size
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -652,6 +652,19 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             None,
             f"as a rig, an .lp is a recorded acquisition whose images lie beside it: "
             f"{len(missing)} of {len(entries)} image(s) missing in {lp_path.parent} ({shown})",
+        )
+    damaged = [
+        f"{e.name}: {why}"
+        for e in entries
+        if (why := jpeg_truncation(lp_path.parent / e.name)) is not None
+    ]
+    if damaged:  # OpenCV would decode them with their missing part grey, and say nothing
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{len(damaged)} of {len(entries)} image(s) beside it are damaged JPEGs "
+            f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
+            "from the camera or card",
         )
     height, width = probe_image_size(lp_path.parent / entries[0].name)
     data: dict[str, Any] = {

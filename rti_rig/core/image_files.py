@@ -95,12 +95,54 @@ def read_linear_tiff(path: Path) -> NDArray[np.uint16]:
     return tifffile.imread(path)
 
 
+def jpeg_truncation(path: Path) -> str | None:
+    """Why the JPEG at ``path`` is cut short, or None when it is whole (or not a JPEG).
+
+    OpenCV decodes a truncated JPEG without an error (libjpeg only prints "Premature end of
+    JPEG file" and fills the rest with grey), so a copy cut short by a full card or an
+    interrupted transfer would be fitted as if it were an image. A whole JPEG ends its
+    compressed data with the end-of-image marker FF D9, which cannot occur inside that data
+    (a data byte FF is followed by 00 or a restart marker); the header segments before the
+    first scan (EXIF, whose thumbnail has its own FF D9) are skipped by their lengths."""
+    data = Path(path).read_bytes()
+    if not data.startswith(b"\xff\xd8"):
+        return None
+    pos = 2
+    while pos + 4 <= len(data):
+        if data[pos] != 0xFF:
+            return f"corrupt marker at byte {pos}"
+        marker = data[pos + 1]
+        if marker == 0xFF:  # fill byte
+            pos += 1
+            continue
+        if marker == 0xD9:
+            return "no image data (end-of-image before the first scan)"
+        length = int.from_bytes(data[pos + 2 : pos + 4], "big")
+        if marker == 0xDA:  # start of scan: the compressed data follows
+            if data.find(b"\xff\xd9", pos + 2 + length) < 0:
+                return "it ends before its end-of-image marker (cut short)"
+            return None
+        pos += 2 + length
+    return "it ends inside its header (cut short)"
+
+
+def refuse_truncated_jpeg(path: Path) -> None:
+    """Raise :class:`SessionError` naming ``path`` if it is a truncated JPEG."""
+    why = jpeg_truncation(path)
+    if why is not None:
+        raise SessionError(
+            f"image {path} is a damaged JPEG: {why}; copy it again from the camera or card "
+            "(a truncated image would be read with its missing part grey)"
+        )
+
+
 def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
     import cv2
 
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {path}")
+    refuse_truncated_jpeg(path)
     return img[..., ::-1] if img.ndim == 3 else img
 
 
@@ -123,6 +165,7 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")
+    refuse_truncated_jpeg(p)
     if img.dtype not in (np.uint8, np.uint16):
         raise SessionError(f"image {p}: {img.dtype} is not 8- or 16-bit")
     if img.ndim == 3:

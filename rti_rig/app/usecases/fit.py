@@ -31,6 +31,7 @@ from rti_rig.app.usecases.fit_decode import imread_rgb
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.image_files import jpeg_truncation
 from rti_rig.core.lp_format import directions_of, read_lp
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
@@ -113,6 +114,11 @@ def _decode(path: Path, into: np.ndarray | None = None) -> np.ndarray:
         decoded = imread_rgb(path, into)
         if decoded is None:
             raise FitInputError(f"cannot read image {path}")
+        why = jpeg_truncation(path)
+        if why is not None:  # OpenCV decodes it anyway, the missing part grey
+            raise FitInputError(
+                f"image {path} is a damaged JPEG: {why}; copy it again from the camera or card"
+            )
         img = decoded
     if img.dtype not in (np.uint8, np.uint16):
         raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
