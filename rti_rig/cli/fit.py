@@ -30,7 +30,8 @@ def fit(
         list[Path],
         typer.Argument(
             help="Session folder(s), or .lp file(s) with their images beside them. With more "
-            "than one, a resumable batch: each goes to OUT/<name>, finished ones are skipped."
+            "than one, a resumable batch: each goes to OUT/<session folder name> "
+            "(OUT/<folder>-<stem> for an .lp), finished ones are skipped."
         ),
     ],
     out_dir: Annotated[Path, typer.Option("--out", help="New or empty folder for outputs.")],

@@ -497,8 +497,14 @@ class BatchItem:
 
 
 def batch_out_dir(root: Path, source: Path) -> Path:
-    """Where a batch writes one source: ``root/<session folder name or .lp stem>``."""
-    return root / (source.name if source.is_dir() else source.stem)
+    """Where a batch writes one source: ``root/<session folder name>``, or for an ``.lp`` file
+    ``root/<its folder>-<its stem>``: acquisitions of a backlog often all name their file
+    ``dirs.lp`` (one folder per object), and the name must not depend on the rest of the batch
+    (a resumed batch finds what it finished by this name)."""
+    if source.is_dir():
+        return root / source.name
+    folder = source.resolve().parent.name
+    return root / (f"{folder}-{source.stem}" if folder else source.stem)
 
 
 def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[BatchItem]:
