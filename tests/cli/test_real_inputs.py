@@ -84,3 +84,61 @@ def test_whole_jpegs_are_not_called_damaged() -> None:
 
     for jpg in sorted(ACQ.glob("*.jpg")):
         assert jpeg_truncation(jpg) is None, jpg
+
+
+def _no_traceback(r) -> None:  # type: ignore[no-untyped-def]
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+
+
+def test_fit_out_that_cannot_be_written_is_refused_clearly(tmp_path: Path) -> None:
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    for out in (a_file, a_file / "sub"):
+        r = runner.invoke(app, ["fit", str(ACQ / "dirs.lp"), "--out", str(out), "--no-qa"])
+        assert r.exit_code == 2, r.output
+        _no_traceback(r)
+        assert str(out) in " ".join(r.output.split())
+    assert a_file.read_text() == "x"
+
+
+def test_plan_to_a_folder_that_cannot_be_written() -> None:
+    # the folder exists but nothing can be created in it (as on a read-only card: the tests
+    # may run as root, whom file modes do not stop, so /proc stands in for it)
+    target = Path("/proc/rti-rig-cannot-write-here.lp")
+    r = runner.invoke(app, ["plan", "--out", str(target)])
+    assert r.exit_code == 2, r.output
+    _no_traceback(r)
+    assert str(target) in " ".join(r.output.split()) and "cannot write" in r.output
+
+
+def test_batch_of_acquisitions_all_named_dirs_lp(tmp_path: Path) -> None:
+    first, second = tmp_path / "coin17", tmp_path / "coin18"
+    shutil.copytree(ACQ, first)
+    shutil.copytree(ACQ, second)
+    out = tmp_path / "batch"
+    args = ["fit", str(first / "dirs.lp"), str(second / "dirs.lp"), "--out", str(out)]
+    r = runner.invoke(app, [*args, "--model", "ps", "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert (out / "coin17-dirs" / "normals.npy").is_file()
+    assert (out / "coin18-dirs" / "normals.npy").is_file()
+    r = runner.invoke(app, [*args, "--model", "ps", "--no-qa"])
+    assert r.exit_code == 0 and r.output.count("(finished earlier)") == 2, r.output
+
+
+def test_fit_reports_what_the_tolerant_lp_reader_assumed(tmp_path: Path) -> None:
+    """A light a hair below the horizon and a count line that disagrees are accepted, as by
+    `run` and `plan`, and said: printed and recorded in fit.json."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    lines = (acq / "dirs.lp").read_text().splitlines()
+    name, x, y, _ = lines[5].split()
+    lines[5] = f"{name} {x} {y} -0.001"
+    lines[0] = str(int(lines[0]) - 1)
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
+    out = tmp_path / "fit"
+    r = runner.invoke(app, ["fit", str(acq / "dirs.lp"), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "line 6" in text and "clamped" in text and "line 1: count line" in text
+    notes = json.loads((out / "fit.json").read_text())["input_notes"]
+    assert len(notes) == 2 and all(str(acq / "dirs.lp") in n for n in notes)

@@ -71,6 +71,9 @@ class FitResult:
     warnings: list[str] = field(default_factory=list)
     qa: QAReport | None = None
     seconds: float = 0.0
+    #: What the tolerant .lp reader accepted but the user should know (a light clamped to the
+    #: horizon, a count line that disagrees): ``FILE, line N: ...``.
+    notes: list[str] = field(default_factory=list)
 
 
 def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
@@ -192,7 +195,9 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     return frames
 
 
-def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[str]]:
+def acquisition_files(
+    source: Path, notes: list[str] | None = None
+) -> tuple[Path, np.ndarray, list[Path], list[str]]:
     """The ``.lp`` of a session folder or ``.lp`` source, its lights (N, 3), the image file of
     each light (``linear/<stem>.tif`` when there, else the file the ``.lp`` names) and names."""
     if source.is_dir():
@@ -205,7 +210,7 @@ def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[
     else:
         raise FitInputError(f"{source}: give a session folder or an .lp file")
     refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
-    entries = read_lp(lp, upper_hemisphere=True)
+    entries = read_lp(lp, upper_hemisphere=True, notes=notes)
     lights = directions_of(entries)
     paths, names = [], []
     for e in entries:
@@ -216,10 +221,12 @@ def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[
     return lp, lights, paths, names
 
 
-def load_acquisition(source: Path) -> tuple[list[Any], np.ndarray, list[str], str]:
+def load_acquisition(
+    source: Path, notes: list[str] | None = None
+) -> tuple[list[Any], np.ndarray, list[str], str]:
     """Frames (row-readable, uint16 linear), lights (N, 3), image names, and a description
-    of what was read."""
-    lp, lights, paths, names = acquisition_files(source)
+    of what was read; the .lp reader's notes are appended to ``notes``."""
+    lp, lights, paths, names = acquisition_files(source, notes)
     frames = _open_frames(paths, str(lp))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
@@ -238,6 +245,25 @@ def _save_png(path: Path, rgb: np.ndarray) -> Path:
 BandRunner = Callable[[ImageStack, BandPlan, list[slice]], Iterator[tuple[slice, BandFit]]]
 
 
+def prepare_out_dir(out: Path) -> None:
+    """Create ``out`` (new or empty), or refuse clearly: never write over earlier outputs."""
+    if out.exists() and not out.is_dir():
+        raise FitInputError(f"--out {out} exists and is not a folder: choose another --out")
+    try:
+        if out.exists() and any(out.iterdir()):
+            raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".rti-rig-write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise FitInputError(
+            f"--out {out}: cannot write there ({exc.strerror or exc}"
+            f"{': ' + str(exc.filename) if exc.filename else ''}); choose a folder you can "
+            "write to"
+        ) from None
+
+
 def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     """Fit, write every output into ``req.out_dir``, and judge the acquisition.
 
@@ -245,17 +271,17 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     everything else — model choice, quantisation ranges, writing, QA — is the same code.
     """
     t0 = time.perf_counter()
-    frames, lights, names, what = load_acquisition(req.source)
+    notes: list[str] = []
+    frames, lights, names, what = load_acquisition(req.source, notes)
     release_free_memory()  # the decode buffers
     out = req.out_dir
-    if out.exists() and any(out.iterdir()):
-        raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
-    out.mkdir(parents=True, exist_ok=True)
+    prepare_out_dir(out)
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = _fit_all(req, stack, lights, out, bands or local_bands)
     result.warnings = [str(w.message) for w in fit_warnings(caught)]
+    result.notes = notes
     result.files.append(
         exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
     )
@@ -273,6 +299,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         "model": result.model,
         "why": result.reason,
         "warnings": result.warnings,
+        "input_notes": result.notes,
         "files": [p.name for p in result.files],
         "verdict": result.qa.verdict if result.qa else None,
     }
@@ -530,7 +557,13 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     dupes = {n for n in names if names.count(n) > 1}
     if dupes:
         raise FitInputError(f"two sources would write to the same folder: {sorted(dupes)}")
-    root.mkdir(parents=True, exist_ok=True)
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FitInputError(
+            f"--out {root}: cannot create the batch folder ({exc.strerror or exc}); choose a "
+            "folder you can write to"
+        ) from None
     todo = []
     for source in sources:
         final = batch_out_dir(root, source)
