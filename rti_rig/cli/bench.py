@@ -14,6 +14,28 @@ bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy tr
 app.add_typer(bench_app, name="bench")
 
 
+def _find_benchmarks() -> None:
+    """Make the checkout's ``benchmarks`` package importable for the installed command.
+
+    The ``rti-rig`` script's ``sys.path`` holds neither the current folder nor the checkout
+    (only ``python -m rti_rig`` puts the current folder first), so ``rti-rig bench`` failed
+    even when run from the repository as the README shows. An editable install (``pip install
+    -e .``, as the README does) runs the package from the checkout: its ``benchmarks/`` folder
+    lies next to ``rti_rig/``. The current folder is tried too (a checkout run from there)."""
+    import importlib.util
+    import sys
+
+    if importlib.util.find_spec("benchmarks") is not None:
+        return
+    import rti_rig
+
+    here = Path(rti_rig.__file__).resolve().parent.parent
+    for root in (here, Path.cwd()):
+        if (root / "benchmarks" / "tradeoff.py").is_file():
+            sys.path.insert(0, str(root))
+            return
+
+
 @bench_app.command("tradeoff")
 def bench_tradeoff(
     out_dir: Annotated[
@@ -45,6 +67,7 @@ def bench_tradeoff(
     installed): run this from a checkout."""
     import time
 
+    _find_benchmarks()
     try:
         from benchmarks.tradeoff import (
             TradeoffSettings,
@@ -58,7 +81,8 @@ def bench_tradeoff(
         raise fail(
             RtiRigError(
                 "rti-rig bench runs the benchmarks of a checkout of the rti-rig repository "
-                "(they are not installed): run it from the repository's folder"
+                "(they are not installed): install rti-rig from a checkout with 'pip install "
+                "-e .', or run it from the repository's folder"
             )
         ) from None
     if from_lp is not None:
