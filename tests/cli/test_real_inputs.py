@@ -142,3 +142,26 @@ def test_fit_reports_what_the_tolerant_lp_reader_assumed(tmp_path: Path) -> None
     assert "line 6" in text and "clamped" in text and "line 1: count line" in text
     notes = json.loads((out / "fit.json").read_text())["input_notes"]
     assert len(notes) == 2 and all(str(acq / "dirs.lp") in n for n in notes)
+
+
+def test_replayed_clipped_jpeg_pixels_stay_saturated(tmp_path: Path) -> None:
+    """image01 of the real acquisition has ~20 % of its pixels at 255 in some channel: the
+    replayed session's linear TIFF must keep them at the white level, so that a fit of the
+    session calls the image saturated as a fit of the source JPEGs does."""
+    import numpy as np
+    import tifffile
+
+    session = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(ACQ / "dirs.lp"), "--out", str(session), "--lights", "6", "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output
+    first = tifffile.imread(session / "linear" / "image_001.tif")
+    assert (first == 65535).any(axis=-1).mean() > 0.1
+    out = tmp_path / "fit"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    qa = json.loads((out / "qa.json").read_text())
+    assert qa["images"][0]["saturated_fraction"] > 0.1
+    assert "image_001 (saturated" in qa["verdict"], qa["verdict"]
+    assert np.isfinite(qa["images"][0]["gain"])
