@@ -85,6 +85,19 @@ def bench_tradeoff(
                 "-e .', or run it from the repository's folder"
             )
         ) from None
+    if out_dir is not None:  # before minutes of computing, not after
+        try:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            probe = out_dir / ".rti-rig-write-test"
+            probe.write_bytes(b"")
+            probe.unlink()
+        except OSError as exc:
+            raise fail(
+                RtiRigError(
+                    f"--out {out_dir}: cannot write there ({exc.strerror or exc}); choose a "
+                    "folder you can write to"
+                )
+            ) from None
     if from_lp is not None:
         try:
             text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
@@ -93,6 +106,8 @@ def bench_tradeoff(
         except ValueError as exc:
             raise fail(RtiRigError(str(exc))) from None
         out.print(text, highlight=False)
+        if out_dir is None:
+            out.print("(nothing written: give --out DIR to keep the results)", highlight=False)
         return
 
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()

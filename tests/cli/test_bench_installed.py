@@ -30,3 +30,32 @@ def test_installed_rti_rig_bench_finds_the_checkout_benchmarks(tmp_path: Path) -
         assert r.returncode == 2, text
         assert "checkout" not in text, text  # the benchmarks were found
         assert "Traceback" not in text and "dirs.lp" in text, text
+
+
+ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+
+
+def test_tradeoff_from_without_out_prints_and_writes_nothing(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(ACQ)])
+    assert r.exit_code == 0, r.output
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "adaptive" in r.output and "nothing written" in r.output
+
+
+def test_tradeoff_out_that_cannot_be_written_is_refused_before_computing(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    out = a_file / "trade"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out)])
+    assert r.exit_code == 2, r.output
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    text = " ".join(r.output.split())
+    assert str(out) in text and "N = 6 done" not in text  # refused before any work
