@@ -165,3 +165,15 @@ def test_replayed_clipped_jpeg_pixels_stay_saturated(tmp_path: Path) -> None:
     assert qa["images"][0]["saturated_fraction"] > 0.1
     assert "image_001 (saturated" in qa["verdict"], qa["verdict"]
     assert np.isfinite(qa["images"][0]["gain"])
+
+
+def test_rig_config_saved_with_a_bom_is_read(tmp_path: Path) -> None:
+    """Windows Notepad saves UTF-8 with a byte-order mark; the .lp reader takes it, and so must
+    the config loader (it said "not valid TOML: Invalid statement (at line 1, column 1)")."""
+    cfg = tmp_path / "my_dome.toml"
+    cfg.write_bytes(b"\xef\xbb\xbf" + (REPO / "rig_configs" / "simulated_dome.toml").read_bytes())
+    session = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(session), "--lights", "3", "--no-verdict"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    assert len((session / "lights.lp").read_text().splitlines()) == 4
