@@ -59,3 +59,17 @@ def test_tradeoff_out_that_cannot_be_written_is_refused_before_computing(tmp_pat
     assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
     text = " ".join(r.output.split())
     assert str(out) in text and "N = 6 done" not in text  # refused before any work
+
+
+def test_tradeoff_from_shows_fit_warnings_as_notes_not_python_warnings() -> None:
+    script = Path(sys.executable).parent / "rti-rig"
+    r = subprocess.run(
+        [str(script), "bench", "tradeoff", "--from", str(ACQ)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    text = r.stdout + r.stderr
+    assert r.returncode == 0, text
+    assert ".py:" not in text, text  # no "rti_rig/reconstruct/ptm.py:134: ...Warning"
+    assert "note: IllConditionedFitWarning" in " ".join(text.split())
