@@ -199,3 +199,25 @@ def test_a_clean_emulated_dome_dry_run_reports_no_move(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     text = " ".join(r.output.split())
     assert "QA verdict" in text and "moved" not in text, text
+
+
+def test_export_lp_outside_the_session_says_where_its_names_resolve(tmp_path: Path) -> None:
+    """The guide's `export-lp sessions/demo --out demo_linear.lp --linear` writes names relative
+    to the session folder into a file elsewhere, where `rti-rig fit` then reported only
+    "image linear/image_001.tif listed in the .lp is missing"."""
+    cfg = REPO / "rig_configs" / "simulated_dome.toml"
+    session = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(session), "--lights", "4", "--no-verdict"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    outside = tmp_path / "demo_linear.lp"
+    r = runner.invoke(app, ["export-lp", str(session), "--out", str(outside), "--linear"])
+    assert r.exit_code == 0, r.output
+    assert "move" in r.output and "relative to" in " ".join(r.output.split())
+    r = runner.invoke(app, ["fit", str(outside), "--out", str(tmp_path / "f"), "--no-qa"])
+    assert r.exit_code == 2
+    text = " ".join(r.output.split())
+    assert str(outside) in text and "relative to its own folder" in text
+    inside = session / "linear.lp"
+    r = runner.invoke(app, ["export-lp", str(session), "--out", str(inside), "--linear"])
+    assert r.exit_code == 0 and "move" not in r.output, r.output

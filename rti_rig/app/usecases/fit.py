@@ -146,7 +146,10 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     pending = []
     for i, path in enumerate(paths):
         if not path.is_file():
-            raise FitInputError(f"image {path} listed in the .lp is missing")
+            raise FitInputError(
+                f"image {path} listed in {label} is missing (an .lp's image names are read "
+                "relative to its own folder)"
+            )
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
             if rows.dtype != np.uint16:
