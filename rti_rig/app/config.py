@@ -504,7 +504,10 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
     except ValidationError as exc:
         err = exc.errors()[0]
         key = _key_of(("camera", "device", *err["loc"]))
-        raise ConfigError(rig.path, key, err["msg"].removeprefix("Value error, ")) from None
+        msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":  # as for every other table (parse_rig_config)
+            msg = "unknown key (check its spelling and the table it is in)"
+        raise ConfigError(rig.path, key, msg) from None
 
 
 def default_config_path() -> Path:

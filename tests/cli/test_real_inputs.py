@@ -221,3 +221,17 @@ def test_export_lp_outside_the_session_says_where_its_names_resolve(tmp_path: Pa
     inside = session / "linear.lp"
     r = runner.invoke(app, ["export-lp", str(session), "--out", str(inside), "--linear"])
     assert r.exit_code == 0 and "move" not in r.output, r.output
+
+
+def test_a_misspelt_camera_device_key_is_named_like_any_other(tmp_path: Path) -> None:
+    """docs/guide.md: a misspelt key is refused with the file and the key. Under
+    [camera.device] the message was pydantic's "Extra inputs are not permitted"."""
+    text = (REPO / "rig_configs" / "example_dome_48_folder_watch.toml").read_text()
+    assert "[camera.device]\n" in text
+    cfg = tmp_path / "my_dome.toml"
+    cfg.write_text(text.replace("[camera.device]\n", "[camera.device]\nisoo = 100\n", 1))
+    shutil.copy(REPO / "rig_configs" / "example_dome_48.lp", tmp_path / "example_dome_48.lp")
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert "camera.device.isoo" in text and "unknown key" in text, text
