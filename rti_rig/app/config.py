@@ -637,7 +637,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     default dome's (about 1 s a light), so a replayed session reports what a real dome would
     take.
     """
-    from rti_rig.core.image_files import jpeg_truncation, probe_image_size
+    from rti_rig.core.image_files import header_size, jpeg_truncation, probe_image_size
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -670,6 +670,18 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             "from the camera or card",
         )
     height, width = probe_image_size(lp_path.parent / entries[0].name)
+    # one size for all, checked from the headers now rather than by a capture that stops the
+    # session part-way (and whose resume would stop there again)
+    sizes = {e.name: header_size(lp_path.parent / e.name) for e in entries}
+    odd = [f"{n} is {hw[1]}x{hw[0]}" for n, hw in sizes.items() if hw and hw != (height, width)]
+    if odd:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"the images beside it differ in size: {entries[0].name} is {width}x{height} but "
+            f"{'; '.join(odd[:5])}{' ...' if len(odd) > 5 else ''}; an acquisition has one "
+            "image size (replace or resize those images, or list only the others)",
+        )
     data: dict[str, Any] = {
         "name": f"replay of {lp_path.parent.name}/{lp_path.name}",
         "kind": "dome",

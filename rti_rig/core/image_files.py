@@ -126,6 +126,44 @@ def jpeg_truncation(path: Path) -> str | None:
     return "it ends inside its header (cut short)"
 
 
+def header_size(path: Path) -> tuple[int, int] | None:
+    """(height, width) from the file's header alone (JPEG frame header, PNG IHDR, TIFF first
+    page), without decoding the pixels; None when the header does not say (another format,
+    or a damaged file: the decoder will say why)."""
+    p = Path(path)
+    with open(p, "rb") as fh:
+        head = fh.read(64 * 1024)
+    if head.startswith(b"\x89PNG\r\n\x1a\n") and head[12:16] == b"IHDR":
+        return int.from_bytes(head[20:24], "big"), int.from_bytes(head[16:20], "big")
+    if head[:4] in (b"II*\x00", b"MM\x00*"):
+        import tifffile
+
+        try:
+            with tifffile.TiffFile(p) as tif:
+                shape = tif.pages[0].shape
+        except Exception:  # tifffile raises many kinds; the decoder names the problem later
+            return None
+        return int(shape[0]), int(shape[1])
+    if not head.startswith(b"\xff\xd8"):
+        return None
+    data = head if len(head) < 64 * 1024 else p.read_bytes()
+    pos = 2
+    while pos + 9 <= len(data) and data[pos] == 0xFF:
+        marker = data[pos + 1]
+        if marker == 0xFF:
+            pos += 1
+            continue
+        length = int.from_bytes(data[pos + 2 : pos + 4], "big")
+        if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):  # start of frame
+            height = int.from_bytes(data[pos + 5 : pos + 7], "big")
+            width = int.from_bytes(data[pos + 7 : pos + 9], "big")
+            return height, width
+        if marker == 0xDA:
+            return None
+        pos += 2 + length
+    return None
+
+
 def refuse_truncated_jpeg(path: Path) -> None:
     """Raise :class:`SessionError` naming ``path`` if it is a truncated JPEG."""
     why = jpeg_truncation(path)

@@ -235,3 +235,21 @@ def test_a_misspelt_camera_device_key_is_named_like_any_other(tmp_path: Path) ->
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
     assert "camera.device.isoo" in text and "unknown key" in text, text
+
+
+def test_replay_rig_refuses_an_odd_sized_image_before_anything_runs(tmp_path: Path) -> None:
+    """One image of another size stopped the replayed session part-way ("Continue with:
+    rti-rig run --resume", which stopped at the same image again)."""
+    import cv2
+
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    odd = acq / "image21.jpg"
+    cv2.imwrite(str(odd), cv2.resize(cv2.imread(str(odd)), (200, 150)))
+    session = tmp_path / "s"
+    args = ["run", str(acq / "dirs.lp"), "--out", str(session), "--lights", "18"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert "image21.jpg is 200x150" in text and "differ in size" in text, text
+    assert not session.exists() or not any(session.iterdir())
