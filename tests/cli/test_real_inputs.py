@@ -253,3 +253,28 @@ def test_replay_rig_refuses_an_odd_sized_image_before_anything_runs(tmp_path: Pa
     text = " ".join(r.output.split())
     assert "image21.jpg is 200x150" in text and "differ in size" in text, text
     assert not session.exists() or not any(session.iterdir())
+
+
+def _six_light_session(tmp_path: Path) -> Path:
+    session = tmp_path / "s"
+    args = ["run", str(ACQ / "dirs.lp"), "--out", str(session), "--lights", "6", "--no-verdict"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    return session
+
+
+def test_fit_never_silently_leaves_out_what_was_asked(tmp_path: Path) -> None:
+    """`--model hsh3` on 6 lights said "hsh3: chosen by --model" and wrote no fit.rti, with no
+    word; `auto` left fit.rti out silently too."""
+    session = _six_light_session(tmp_path)
+    out = tmp_path / "hsh3"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--model", "hsh3", "--no-qa"])
+    assert r.exit_code == 2, r.output
+    assert "needs at least 16 lights" in " ".join(r.output.split())
+    out = tmp_path / "auto"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert not (out / "fit.rti").exists()
+    assert "fit.rti not written" in " ".join(r.output.split())
+    assert any("fit.rti not written" in w for w in json.loads((out / "fit.json").read_text())[
+        "warnings"])

@@ -283,7 +283,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = _fit_all(req, stack, lights, out, bands or local_bands)
-    result.warnings = [str(w.message) for w in fit_warnings(caught)]
+    result.warnings = [str(w.message) for w in fit_warnings(caught)] + result.warnings
     result.notes = notes
     result.files.append(
         exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
@@ -355,17 +355,32 @@ def _fit_all(
             f"error ({choice.best_model}), {choice.holdout}"
         )
     else:
-        model_name = model_spec(name).name
+        spec = model_spec(name)
+        model_name = spec.name
+        if n < spec.n_coefficients:  # asked for by name: refused, never silently not fitted
+            raise FitInputError(
+                f"--model {name} has {spec.n_coefficients} coefficients per pixel and needs at "
+                f"least {spec.n_coefficients} lights; {req.source} has {n}: choose a smaller "
+                "model, or --model auto"
+            )
         reason_line = f"{model_name}: chosen by --model"
     normal_source = model_name if model_name in ("ps", "lambert", "ptm") else "ps-robust"
 
     # linear models to export, their solve matrices (warnings issued once, here)
     order = req.hsh_order or (int(model_name[-1]) if model_name.startswith("hsh") else 2)
     linear: dict[str, np.ndarray] = {}
+    skipped: list[str] = []  # said, never silently left out
     if req.write_ptm and n >= 6:
         linear["ptm"] = design_matrix("ptm", lights)
+    elif req.write_ptm:
+        skipped.append(f"fit.ptm not written: a PTM needs at least 6 lights, there are {n}")
     if req.write_hsh and n >= (order + 1) ** 2:
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
+    elif req.write_hsh:
+        skipped.append(
+            f"fit.rti not written: HSH of order {order} needs at least {(order + 1) ** 2} "
+            f"lights, there are {n}"
+        )
     if normal_source == "lambert":
         linear["lambert"] = design_matrix("lambert", lights)
     # the usable observations of the sample, only when an exported model needs their range
@@ -443,7 +458,7 @@ def _fit_all(
         files += exporters.write_normal_map(out / "normals", normals.read(), npy=False)
         release_free_memory()
         files += exporters.write_albedo(out / "albedo", albedo.read(), npy=False)
-    return FitResult(out, model_name, reason_line, files)
+    return FitResult(out, model_name, reason_line, files, warnings=skipped)
 
 
 def _usable_sample(stack: ImageStack) -> np.ndarray:
