@@ -91,12 +91,12 @@ def read_preview(path: Path) -> NDArray:
         raise ScheduleError(f"{p} is a folder: give one preview image file")
     if not p.is_file():
         raise ScheduleError(f"{p}: preview image not found")
-    img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
-    if img is None:
-        raise ScheduleError(f"{p}: cannot read this file as an image (JPEG, PNG or TIFF)")
     why = jpeg_truncation(p)  # OpenCV decodes a cut-short JPEG, its missing part grey
     if why is not None:
         raise ScheduleError(f"{p}: damaged JPEG: {why}; copy it again from the camera or card")
+    img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ScheduleError(f"{p}: cannot read this file as an image (JPEG, PNG or TIFF)")
     if img.ndim == 3 and img.shape[2] >= 3:
         img = cv2.cvtColor(img[..., :3], cv2.COLOR_BGR2RGB)
     return img

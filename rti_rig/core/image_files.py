@@ -177,10 +177,11 @@ def refuse_truncated_jpeg(path: Path) -> None:
 def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
     import cv2
 
+    if Path(path).is_file():
+        refuse_truncated_jpeg(path)  # before OpenCV, which decodes it with a grey part
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {path}")
-    refuse_truncated_jpeg(path)
     return img[..., ::-1] if img.ndim == 3 else img
 
 
@@ -200,10 +201,11 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         return img[..., :3] if img.ndim == 3 else img
     import cv2
 
+    if p.is_file():
+        refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")
-    refuse_truncated_jpeg(p)
     if img.dtype not in (np.uint8, np.uint16):
         raise SessionError(f"image {p}: {img.dtype} is not 8- or 16-bit")
     if img.ndim == 3:

@@ -114,14 +114,14 @@ def _decode(path: Path, into: np.ndarray | None = None) -> np.ndarray:
     if path.suffix.lower() in (".tif", ".tiff"):
         img = np.asarray(TiffRows(path)[:])
     else:
-        decoded = imread_rgb(path, into)
-        if decoded is None:
-            raise FitInputError(f"cannot read image {path}")
-        why = jpeg_truncation(path)
-        if why is not None:  # OpenCV decodes it anyway, the missing part grey
+        why = jpeg_truncation(path) if path.is_file() else None
+        if why is not None:  # OpenCV would decode it anyway, the missing part grey
             raise FitInputError(
                 f"image {path} is a damaged JPEG: {why}; copy it again from the camera or card"
             )
+        decoded = imread_rgb(path, into)
+        if decoded is None:
+            raise FitInputError(f"cannot read image {path}")
         img = decoded
     if img.dtype not in (np.uint8, np.uint16):
         raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
