@@ -278,3 +278,29 @@ def test_fit_never_silently_leaves_out_what_was_asked(tmp_path: Path) -> None:
     assert "fit.rti not written" in " ".join(r.output.split())
     assert any("fit.rti not written" in w for w in json.loads((out / "fit.json").read_text())[
         "warnings"])
+
+
+def test_fit_reads_8bit_tiffs_as_srgb_like_jpegs(tmp_path: Path) -> None:
+    """plan reads an 8-bit TIFF as sRGB, as JPEG and PNG; fit refused a whole acquisition of
+    them ("expected 16-bit linear TIFF, got uint8")."""
+    import cv2
+    import numpy as np
+    import tifffile
+
+    acq = tmp_path / "tif8"
+    acq.mkdir()
+    lines = (ACQ / "dirs.lp").read_text().splitlines()
+    for line in lines[1:]:
+        name = line.split()[0]
+        rgb = cv2.imread(str(ACQ / name))[..., ::-1]
+        tifffile.imwrite(acq / name.replace(".jpg", ".tif"), np.ascontiguousarray(rgb))
+    (acq / "dirs.lp").write_text("\n".join(x.replace(".jpg", ".tif") for x in lines) + "\n")
+    outs = {}
+    for label, lp in (("tif", acq / "dirs.lp"), ("jpg", ACQ / "dirs.lp")):
+        outs[label] = tmp_path / label
+        args = ["fit", str(lp), "--out", str(outs[label]), "--model", "ps", "--no-qa"]
+        r = runner.invoke(app, args)
+        assert r.exit_code == 0, r.output
+    np.testing.assert_array_equal(
+        np.load(outs["tif"] / "normals.npy"), np.load(outs["jpg"] / "normals.npy")
+    )

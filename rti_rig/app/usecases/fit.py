@@ -92,10 +92,19 @@ def read_image(path: Path) -> Any:
         raise FitInputError(f"image {path} listed in the .lp is missing")
     if path.suffix.lower() in (".tif", ".tiff"):
         rows = TiffRows(path)  # read a band at a time, never whole
-        if rows.dtype != np.uint16:
-            raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
-        return rows  # type: ignore[return-value]
+        _check_tiff_type(path, rows.dtype)
+        if rows.dtype == np.uint16:
+            return rows  # type: ignore[return-value]
     return _decoded_rows(_decode(path), str(path))
+
+
+def _check_tiff_type(path: Path, dtype: Any) -> None:
+    """16-bit TIFFs are linear data, 8-bit ones sRGB like JPEG and PNG (as `plan` reads
+    them); anything else is refused with what to give instead."""
+    if dtype not in (np.uint16, np.uint8):
+        raise FitInputError(
+            f"{path}: a {dtype} TIFF; give 16-bit linear or 8-bit sRGB TIFFs (or JPEG/PNG)"
+        )
 
 
 def _decoded_rows(img: np.ndarray, name: str) -> RawRows:
@@ -152,9 +161,8 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
             )
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
-            if rows.dtype != np.uint16:
-                raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
-            if rows.reads_in_place:
+            _check_tiff_type(path, rows.dtype)
+            if rows.dtype == np.uint16 and rows.reads_in_place:
                 frames[i] = rows
                 continue
         pending.append(i)
