@@ -304,3 +304,15 @@ def test_fit_reads_8bit_tiffs_as_srgb_like_jpegs(tmp_path: Path) -> None:
     np.testing.assert_array_equal(
         np.load(outs["tif"] / "normals.npy"), np.load(outs["jpg"] / "normals.npy")
     )
+
+
+def test_auto_exposure_is_refused_on_a_replayed_acquisition(tmp_path: Path) -> None:
+    """The replay camera returns the recorded image whatever the exposure; --auto-exposure
+    said "Exposure fixed at 0.0001 s", an exposure that changed nothing."""
+    session = tmp_path / "s"
+    args = ["run", str(ACQ / "dirs.lp"), "--out", str(session), "--lights", "6", "--auto-exposure"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert "--auto-exposure" in text and "Exposure fixed" not in text
+    assert not session.exists() or not any(session.iterdir())
