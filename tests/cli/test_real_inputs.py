@@ -316,3 +316,28 @@ def test_auto_exposure_is_refused_on_a_replayed_acquisition(tmp_path: Path) -> N
     text = " ".join(r.output.split())
     assert "--auto-exposure" in text and "Exposure fixed" not in text
     assert not session.exists() or not any(session.iterdir())
+
+
+def _relight_reads_dome(doc: dict) -> tuple[list[tuple[float, float, float]], float]:
+    """relight's Dome::fromJson (cnr-isti-vclab/relight src/dome.cpp): each direction is
+    ``v.toObject()`` then ``o["x"].toDouble()`` ... (a JSON array is no object: its x, y, z
+    read as 0); the diameter is ``domeDiameter``."""
+    dirs = []
+    for v in doc.get("directions", []):
+        o = v if isinstance(v, dict) else {}
+        dirs.append((float(o.get("x", 0.0)), float(o.get("y", 0.0)), float(o.get("z", 0.0))))
+    return dirs, float(doc.get("domeDiameter", 0.0))
+
+
+def test_relight_reads_the_light_directions_of_lights_dome(tmp_path: Path) -> None:
+    import numpy as np
+
+    from rti_rig.core.lp_format import directions_of, read_lp
+
+    out = tmp_path / "fit"
+    r = runner.invoke(app, ["fit", str(ACQ / "dirs.lp"), "--out", str(out), "--model", "ps",
+                            "--no-qa"])
+    assert r.exit_code == 0, r.output
+    dirs, _ = _relight_reads_dome(json.loads((out / "lights.dome").read_text()))
+    expected = directions_of(read_lp(ACQ / "dirs.lp", upper_hemisphere=True))
+    np.testing.assert_allclose(np.array(dirs), expected, atol=1e-5)
