@@ -173,17 +173,21 @@ def summarise_from(rows: list[Row], seconds: float, command: str) -> str:
     return "\n".join(lines)
 
 
-def bench_from(lp: Path, out_dir: Path, progress: Callable[[str], None] = print) -> str:
-    """Run, write results.csv, the plots and summary.md into ``out_dir``; return the summary."""
+def bench_from(
+    lp: Path, out_dir: Path | None, progress: Callable[[str], None] = print
+) -> str:
+    """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
+    it is None: the summary is only returned); return the summary."""
     t0 = time.perf_counter()
     rows = run_tradeoff_from(lp, progress)
+    command = f"rti-rig bench tradeoff --from {lp}"
+    if out_dir is None:
+        return summarise_from(rows, time.perf_counter() - t0, command)
     out_dir.mkdir(parents=True, exist_ok=True)
     write_csv(rows, out_dir / "results.csv")
     for path in plot(rows, out_dir):
         if "arm_time" in path.name:  # a replayed acquisition is a dome: no arm time to plot
             path.unlink()
-    text = summarise_from(
-        rows, time.perf_counter() - t0, f"rti-rig bench tradeoff --from {lp} --out {out_dir}"
-    )
+    text = summarise_from(rows, time.perf_counter() - t0, f"{command} --out {out_dir}")
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text

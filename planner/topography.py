@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import ConfigError, ScheduleError
 from rti_rig.core.geometry import direction_from_az_el, normalize
+from rti_rig.core.image_files import jpeg_truncation
 
 #: Long side, in pixels, of the image the planner works on.
 PLANNING_SIDE_PX = 256
@@ -90,6 +91,9 @@ def read_preview(path: Path) -> NDArray:
         raise ScheduleError(f"{p} is a folder: give one preview image file")
     if not p.is_file():
         raise ScheduleError(f"{p}: preview image not found")
+    why = jpeg_truncation(p)  # OpenCV decodes a cut-short JPEG, its missing part grey
+    if why is not None:
+        raise ScheduleError(f"{p}: damaged JPEG: {why}; copy it again from the camera or card")
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ScheduleError(f"{p}: cannot read this file as an image (JPEG, PNG or TIFF)")

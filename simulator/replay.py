@@ -35,7 +35,8 @@ WHITE = 65535
 
 
 def _srgb8_to_linear16() -> NDArray[np.uint16]:
-    """For each 8-bit code, the middle 16-bit linear value that the session encodes back to it."""
+    """For each 8-bit code, the middle 16-bit linear value that the session encodes back to it
+    (the white level for 255: clipped stays clipped)."""
     codes = linear_to_srgb8(np.arange(WHITE + 1, dtype=np.uint16), WHITE)
     table = np.zeros(256, dtype=np.uint16)
     for v in range(256):
@@ -43,6 +44,10 @@ def _srgb8_to_linear16() -> NDArray[np.uint16]:
         if hits.size == 0:  # pragma: no cover - the sRGB curve reaches every code at 16 bits
             raise AssertionError(f"8-bit code {v} has no 16-bit linear value")
         table[v] = hits[hits.size // 2]
+    # A clipped 8-bit pixel stays clipped: the top code maps to the white level (which encodes
+    # back to 255 too), not to the middle of its range, where it would pass for a valid
+    # reading and the fit's saturation masks and the QA's "saturated" check would miss it.
+    table[255] = WHITE
     return table
 
 

@@ -360,7 +360,7 @@ def read_correction_file(path: Path, rig_name: str) -> list[float]:
     Raises ``ValueError`` with what is wrong (the config loader names the file and key).
     """
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM (Notepad) is no error
     except OSError as exc:
         raise ValueError(f"cannot read {path}: {exc.strerror or exc}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
@@ -444,7 +444,7 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     except OSError as exc:
         raise ConfigError(path, None, f"cannot read the file: {exc.strerror or exc}") from None
     try:
-        data = tomllib.loads(raw_bytes.decode("utf-8"))
+        data = tomllib.loads(raw_bytes.decode("utf-8-sig"))  # a BOM (Notepad) is no error
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(path, None, f"not valid TOML: {exc}") from None
     data, settings, correction_bytes = _with_correction_file(data, path)
@@ -504,7 +504,10 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
     except ValidationError as exc:
         err = exc.errors()[0]
         key = _key_of(("camera", "device", *err["loc"]))
-        raise ConfigError(rig.path, key, err["msg"].removeprefix("Value error, ")) from None
+        msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":  # as for every other table (parse_rig_config)
+            msg = "unknown key (check its spelling and the table it is in)"
+        raise ConfigError(rig.path, key, msg) from None
 
 
 def default_config_path() -> Path:
@@ -634,7 +637,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     default dome's (about 1 s a light), so a replayed session reports what a real dome would
     take.
     """
-    from rti_rig.core.image_files import probe_image_size
+    from rti_rig.core.image_files import header_size, jpeg_truncation, probe_image_size
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -653,7 +656,32 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             f"as a rig, an .lp is a recorded acquisition whose images lie beside it: "
             f"{len(missing)} of {len(entries)} image(s) missing in {lp_path.parent} ({shown})",
         )
+    damaged = [
+        f"{e.name}: {why}"
+        for e in entries
+        if (why := jpeg_truncation(lp_path.parent / e.name)) is not None
+    ]
+    if damaged:  # OpenCV would decode them with their missing part grey, and say nothing
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{len(damaged)} of {len(entries)} image(s) beside it are damaged JPEGs "
+            f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
+            "from the camera or card",
+        )
     height, width = probe_image_size(lp_path.parent / entries[0].name)
+    # one size for all, checked from the headers now rather than by a capture that stops the
+    # session part-way (and whose resume would stop there again)
+    sizes = {e.name: header_size(lp_path.parent / e.name) for e in entries}
+    odd = [f"{n} is {hw[1]}x{hw[0]}" for n, hw in sizes.items() if hw and hw != (height, width)]
+    if odd:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"the images beside it differ in size: {entries[0].name} is {width}x{height} but "
+            f"{'; '.join(odd[:5])}{' ...' if len(odd) > 5 else ''}; an acquisition has one "
+            "image size (replace or resize those images, or list only the others)",
+        )
     data: dict[str, Any] = {
         "name": f"replay of {lp_path.parent.name}/{lp_path.name}",
         "kind": "dome",

@@ -6,12 +6,35 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
-from rti_rig.cli.app import app, fail, out
+from rti_rig.cli.app import app, err, fail, out
 from rti_rig.core.errors import RtiRigError
 
 bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy trade.")
 app.add_typer(bench_app, name="bench")
+
+
+def _find_benchmarks() -> None:
+    """Make the checkout's ``benchmarks`` package importable for the installed command.
+
+    The ``rti-rig`` script's ``sys.path`` holds neither the current folder nor the checkout
+    (only ``python -m rti_rig`` puts the current folder first), so ``rti-rig bench`` failed
+    even when run from the repository as the README shows. An editable install (``pip install
+    -e .``, as the README does) runs the package from the checkout: its ``benchmarks/`` folder
+    lies next to ``rti_rig/``. The current folder is tried too (a checkout run from there)."""
+    import importlib.util
+    import sys
+
+    if importlib.util.find_spec("benchmarks") is not None:
+        return
+    import rti_rig
+
+    here = Path(rti_rig.__file__).resolve().parent.parent
+    for root in (here, Path.cwd()):
+        if (root / "benchmarks" / "tradeoff.py").is_file():
+            sys.path.insert(0, str(root))
+            return
 
 
 @bench_app.command("tradeoff")
@@ -43,24 +66,50 @@ def bench_tradeoff(
     Nothing is written unless --out is given, so a quick run never replaces the committed
     full-run results. The benchmarks live in the repository's benchmarks/ folder (they are not
     installed): run this from a checkout."""
-    import time
-
+    _find_benchmarks()
     try:
-        from benchmarks.tradeoff import (
-            TradeoffSettings,
-            plot,
-            run_tradeoff,
-            summarise,
-            write_csv,
-        )
-        from benchmarks.tradeoff_from import bench_from
+        import benchmarks.tradeoff  # found: _tradeoff imports from it
+        import benchmarks.tradeoff_from  # noqa: F401
     except ImportError:
         raise fail(
             RtiRigError(
                 "rti-rig bench runs the benchmarks of a checkout of the rti-rig repository "
-                "(they are not installed): run it from the repository's folder"
+                "(they are not installed): install rti-rig from a checkout with 'pip install "
+                "-e .', or run it from the repository's folder"
             )
         ) from None
+    # the fits' trust warnings (a layout too sparse for HSH3 ...) are information about a cell
+    # of the table: shown as notes, not as Python warnings with a source line and file path
+    import warnings
+
+    def _as_note(message, category, *_args, **_kwargs):  # type: ignore[no-untyped-def]
+        err.print(f"[yellow]note:[/] {escape(f'{category.__name__}: {message}')}", soft_wrap=True)
+
+    with warnings.catch_warnings():  # restored after: the CLI may run inside a test process
+        warnings.showwarning = _as_note
+        _tradeoff(out_dir, quick, from_lp)
+
+
+def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None) -> None:
+    """The body of ``bench tradeoff``, once the command has found the benchmarks."""
+    import time
+
+    from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
+    from benchmarks.tradeoff_from import bench_from
+
+    if out_dir is not None:  # before minutes of computing, not after
+        try:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            probe = out_dir / ".rti-rig-write-test"
+            probe.write_bytes(b"")
+            probe.unlink()
+        except OSError as exc:
+            raise fail(
+                RtiRigError(
+                    f"--out {out_dir}: cannot write there ({exc.strerror or exc}); choose a "
+                    "folder you can write to"
+                )
+            ) from None
     if from_lp is not None:
         try:
             text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
@@ -69,6 +118,8 @@ def bench_tradeoff(
         except ValueError as exc:
             raise fail(RtiRigError(str(exc))) from None
         out.print(text, highlight=False)
+        if out_dir is None:
+            out.print("(nothing written: give --out DIR to keep the results)", highlight=False)
         return
 
     settings = TradeoffSettings.quick() if quick else TradeoffSettings()

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out
+from rti_rig.cli.app import app, err, fail, out, print_notes
 from rti_rig.core.errors import RtiRigError
 
 
@@ -30,7 +30,8 @@ def fit(
         list[Path],
         typer.Argument(
             help="Session folder(s), or .lp file(s) with their images beside them. With more "
-            "than one, a resumable batch: each goes to OUT/<name>, finished ones are skipped."
+            "than one, a resumable batch: each goes to OUT/<session folder name> "
+            "(OUT/<folder>-<stem> for an .lp), finished ones are skipped."
         ),
     ],
     out_dir: Annotated[Path, typer.Option("--out", help="New or empty folder for outputs.")],
@@ -106,6 +107,7 @@ def fit(
             result = run_fit_dask(request, scheduler)
     except RtiRigError as exc:
         raise fail(exc) from None
+    print_notes(result.notes)
     out.print(f"Model: {escape(result.reason)}")
     for text in result.warnings:
         err.print(f"[yellow]warning:[/] {escape(text)}")

@@ -422,4 +422,12 @@ def export_lp(
             f"{escape(', '.join(done.left_out))}",
             soft_wrap=True,
         )
+    if done.outside_session:
+        err.print(
+            f"[yellow]note:[/] its image names are relative to {escape(str(session_dir))}, "
+            "and tools (relight, RTIBuilder, rti-rig fit) read them beside the .lp: move "
+            f"{escape(str(out_file))} into {escape(str(session_dir))} to use it (relight-cli "
+            "takes the first .lp of a folder: keep one there)",
+            soft_wrap=True,
+        )
     out.print(f"{len(done.entries)} lights → {out_file}")

@@ -95,9 +95,90 @@ def read_linear_tiff(path: Path) -> NDArray[np.uint16]:
     return tifffile.imread(path)
 
 
+def jpeg_truncation(path: Path) -> str | None:
+    """Why the JPEG at ``path`` is cut short, or None when it is whole (or not a JPEG).
+
+    OpenCV decodes a truncated JPEG without an error (libjpeg only prints "Premature end of
+    JPEG file" and fills the rest with grey), so a copy cut short by a full card or an
+    interrupted transfer would be fitted as if it were an image. A whole JPEG ends its
+    compressed data with the end-of-image marker FF D9, which cannot occur inside that data
+    (a data byte FF is followed by 00 or a restart marker); the header segments before the
+    first scan (EXIF, whose thumbnail has its own FF D9) are skipped by their lengths."""
+    data = Path(path).read_bytes()
+    if not data.startswith(b"\xff\xd8"):
+        return None
+    pos = 2
+    while pos + 4 <= len(data):
+        if data[pos] != 0xFF:
+            return f"corrupt marker at byte {pos}"
+        marker = data[pos + 1]
+        if marker == 0xFF:  # fill byte
+            pos += 1
+            continue
+        if marker == 0xD9:
+            return "no image data (end-of-image before the first scan)"
+        length = int.from_bytes(data[pos + 2 : pos + 4], "big")
+        if marker == 0xDA:  # start of scan: the compressed data follows
+            if data.find(b"\xff\xd9", pos + 2 + length) < 0:
+                return "it ends before its end-of-image marker (cut short)"
+            return None
+        pos += 2 + length
+    return "it ends inside its header (cut short)"
+
+
+def header_size(path: Path) -> tuple[int, int] | None:
+    """(height, width) from the file's header alone (JPEG frame header, PNG IHDR, TIFF first
+    page), without decoding the pixels; None when the header does not say (another format,
+    or a damaged file: the decoder will say why)."""
+    p = Path(path)
+    with open(p, "rb") as fh:
+        head = fh.read(64 * 1024)
+    if head.startswith(b"\x89PNG\r\n\x1a\n") and head[12:16] == b"IHDR":
+        return int.from_bytes(head[20:24], "big"), int.from_bytes(head[16:20], "big")
+    if head[:4] in (b"II*\x00", b"MM\x00*"):
+        import tifffile
+
+        try:
+            with tifffile.TiffFile(p) as tif:
+                shape = tif.pages[0].shape
+        except Exception:  # tifffile raises many kinds; the decoder names the problem later
+            return None
+        return int(shape[0]), int(shape[1])
+    if not head.startswith(b"\xff\xd8"):
+        return None
+    data = head if len(head) < 64 * 1024 else p.read_bytes()
+    pos = 2
+    while pos + 9 <= len(data) and data[pos] == 0xFF:
+        marker = data[pos + 1]
+        if marker == 0xFF:
+            pos += 1
+            continue
+        length = int.from_bytes(data[pos + 2 : pos + 4], "big")
+        if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):  # start of frame
+            height = int.from_bytes(data[pos + 5 : pos + 7], "big")
+            width = int.from_bytes(data[pos + 7 : pos + 9], "big")
+            return height, width
+        if marker == 0xDA:
+            return None
+        pos += 2 + length
+    return None
+
+
+def refuse_truncated_jpeg(path: Path) -> None:
+    """Raise :class:`SessionError` naming ``path`` if it is a truncated JPEG."""
+    why = jpeg_truncation(path)
+    if why is not None:
+        raise SessionError(
+            f"image {path} is a damaged JPEG: {why}; copy it again from the camera or card "
+            "(a truncated image would be read with its missing part grey)"
+        )
+
+
 def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
     import cv2
 
+    if Path(path).is_file():
+        refuse_truncated_jpeg(path)  # before OpenCV, which decodes it with a grey part
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {path}")
@@ -120,6 +201,8 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         return img[..., :3] if img.ndim == 3 else img
     import cv2
 
+    if p.is_file():
+        refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")

@@ -20,6 +20,7 @@ and *reported* (appended to ``notes``, each naming the file and line) rather tha
 
 from __future__ import annotations
 
+import contextlib
 import math
 import re
 from collections.abc import Iterable, Sequence
@@ -85,9 +86,16 @@ def write_lp(path: Path, entries: Sequence[LpEntry]) -> Path:
     path = Path(path)
     text = format_lp(entries)
     tmp = path.with_name(f".{path.name}.tmp")
-    with open(tmp, "w", encoding="ascii", newline="\n") as fh:
-        fh.write(text)
-    tmp.replace(path)
+    try:
+        with open(tmp, "w", encoding="ascii", newline="\n") as fh:
+            fh.write(text)
+        tmp.replace(path)
+    except OSError as exc:  # a read-only or missing folder, a full disk: say which file
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise LpFormatError(
+            path, None, f"cannot write: {exc.strerror or exc}; choose a folder you can write to"
+        ) from None
     return path
 
 

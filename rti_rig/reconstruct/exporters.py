@@ -16,9 +16,13 @@ Formats, as published (no code copied):
   then bytes: scanlines from the bottom up, for each pixel, for each colour, for each term.
   Coefficient ``c = byte / 255 × scale_k + bias_k``. Our basis is the true HSH (order-3
   exponent 1.5, see :mod:`rti_rig.core.rti_bases`).
-* **relight ``.dome``** (cnr-isti-vclab/relight, "Dome configuration file format"): JSON with
-  ``diameter`` (cm), ``imageWidth`` (cm), ``verticalOffset`` (cm) and ``directions`` (unit
-  vectors, z up, x right, y towards the top of the image) or ``positions`` (cm).
+* **relight ``.dome``** (cnr-isti-vclab/relight): JSON as relight's ``Dome::fromJson``
+  (src/dome.cpp) reads it — ``label``, ``notes``, ``imageWidth`` and ``domeDiameter`` (cm),
+  ``verticalOffset`` (cm), ``lightConfiguration`` (``"directional"``) and ``directions`` as an
+  array of objects ``{"x", "y", "z"}`` (unit vectors, z up, x right, y towards the top of the
+  image). relight's format page names the diameter ``diameter`` and does not say how a
+  direction is written; its reader wants ``domeDiameter`` and objects (a plain ``[x, y, z]``
+  array reads as (0, 0, 0)), so the reader is followed and ``diameter`` is written too.
 
 Coefficients are written in units of the fitted (linear) images × 255, quantised to 8 bits per
 coefficient with one scale and bias per coefficient index (over all pixels and colours).
@@ -199,12 +203,19 @@ def write_relight_dome(
 ) -> Path:
     """relight's ``.dome`` JSON for these light ``directions`` (N, 3), z up, y to image top."""
     d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    diameter = float(diameter_cm) if diameter_cm else 0.0
     doc: dict[str, Any] = {
         "label": label,
-        "diameter": float(diameter_cm) if diameter_cm else 0.0,
+        "notes": "written by rti-rig",
         "imageWidth": float(image_width_cm) if image_width_cm else 0.0,
+        "domeDiameter": diameter,
+        "diameter": diameter,  # the key relight's format page names
         "verticalOffset": 0.0,
-        "directions": [[round(float(x), 6) for x in row] for row in d],
+        "lightConfiguration": "directional",
+        "directions": [
+            {"x": round(float(x), 6), "y": round(float(y), 6), "z": round(float(z), 6)}
+            for x, y, z in d
+        ],
     }
     path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
     return path

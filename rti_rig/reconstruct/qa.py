@@ -7,13 +7,14 @@ Run before the object leaves the dome. The checks (all on linear images):
   resolution (at most :data:`CROP` pixels a side), then per image the Lambertian prediction
   ``rho max(0, n . l_i)`` over the pixels it lights:
 
-  - **gain** ``median(image / prediction)``: well below 1 means a misfired or dim light;
+  - **gain** ``median(image / prediction)``; its 90th percentile well below 1 means a
+    misfired or dim light (shadows lower the median, not the bright end);
   - **best direction**: the light direction that explains the image best (least squares of the
     image on ``rho n`` over its lit pixels). Far from the recorded direction means a wrong
     light (a swapped entry of the ``.lp``, a wrong LED); the report names the recorded light
     nearest to the best direction;
   - **drift**: the image's shift against its prediction by phase correlation (OpenCV,
-    sub-pixel): the object or the camera moved.
+    sub-pixel): the object or the camera moved (judged on images lighting most of the crop).
 
 * **coverage**: per pixel (on a ≤ :data:`COVERAGE_SIDE` grid) the number of images that light
   it without shadow or saturation; fewer than 3 cannot determine a normal.
@@ -51,6 +52,17 @@ DIM_GAIN = 0.6
 BRIGHT_GAIN = 1.6
 #: A best direction further than this from the recorded one (degrees) is a wrong light.
 WRONG_LIGHT_DEG = 8.0
+#: The wrong-light check is made only when the median over the images of the angle between
+#: best and recorded direction is at most this (degrees): else the fit cannot resolve directions.
+DIRECTION_CHECK_MEDIAN_DEG = WRONG_LIGHT_DEG / 2
+#: Dimness is judged on this percentile of image / prediction over the lit pixels (shadows
+#: the prediction does not model lower the median; a dim light lowers every pixel).
+DIM_PERCENTILE = 90.0
+#: The shift is judged only on images whose light reaches (n . l > 0.2) at least this fraction
+#: of the crop's pixels (a grazing light's shadows move the correlation peak).
+DRIFT_MIN_LIT = 0.5
+#: A shift is real only if moving the image back cuts its residual to at most this fraction.
+DRIFT_CONFIRM = 0.8
 #: A shift against the prediction larger than this (pixels) is a move.
 DRIFT_PX = 1.0
 #: Fewer lit, unshadowed, unsaturated images than this cannot determine a normal.
@@ -72,6 +84,8 @@ class ImageCheck:
     direction_error_deg: float
     drift_px: tuple[float, float]
     problems: tuple[str, ...] = field(default=())
+    #: False when the light reaches too little of the object to judge a shift.
+    drift_judged: bool = True
 
 
 @dataclass(frozen=True)
@@ -84,6 +98,21 @@ class QAReport:
     expected_normal_error_deg: float
     noise_sigma: float
     thresholds: dict[str, float]
+    #: Median angle between each image's best-fit and recorded direction (degrees).
+    median_direction_error_deg: float = 0.0
+    #: False when that median says the fit cannot resolve directions: no wrong-light check.
+    directions_checked: bool = True
+
+    @property
+    def caveats(self) -> list[str]:
+        """What the verdict could not check (said with it, never silently)."""
+        if self.directions_checked:
+            return []
+        return [
+            "light directions not checked: the fit cannot resolve them on this object (its "
+            f"best-fit directions lie a median {self.median_direction_error_deg:.0f}° from the "
+            "recorded ones: a near-flat or non-Lambertian surface)"
+        ]
 
     @property
     def reshoot(self) -> list[ImageCheck]:
@@ -96,10 +125,11 @@ class QAReport:
     @property
     def verdict(self) -> str:
         """``good`` or ``reshoot: name (why); ...``."""
+        tail = "".join(f"; {c}" for c in self.caveats)
         if self.good:
-            return "good"
+            return "good" + tail
         parts = [f"{c.name} ({'; '.join(c.problems)})" for c in self.reshoot]
-        return "reshoot: " + ", ".join(parts)
+        return "reshoot: " + ", ".join(parts) + tail
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -109,6 +139,8 @@ class QAReport:
             "expected_normal_error_deg": self.expected_normal_error_deg,
             "noise_sigma": self.noise_sigma,
             "undercovered_fraction": self.undercovered_fraction,
+            "directions_checked": self.directions_checked,
+            "median_direction_error_deg": self.median_direction_error_deg,
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
@@ -142,6 +174,29 @@ def _best_direction(
         d[2] = max(d[2], 0.0)
         d /= np.linalg.norm(d)
     return d
+
+
+def _confirmed_shift(
+    pred: NDArray, raw: NDArray, dx: float, dy: float, mask: NDArray[np.bool_]
+) -> tuple[bool, NDArray]:
+    """Is the shift ``(dx, dy)`` the correlation found real? Then the image moved back by it
+    matches the prediction better than as it is (median absolute residual over ``mask``, by
+    at least :data:`DRIFT_CONFIRM`). Where the prediction explains the image poorly (a glossy
+    coin on 48 px) the correlation peak lands anywhere — shifts of 13 to 24 px were reported
+    on every emulated dome's dry run — and undoing it explains nothing. Returns the verdict
+    and the image to judge the light on (moved back when the shift is real)."""
+    m = np.float32([[1, 0, -dx], [0, 1, -dy]])
+    back = cv2.warpAffine(raw, m, (raw.shape[1], raw.shape[0]), flags=cv2.INTER_LINEAR)
+    inner = mask.copy()  # pixels the warp filled from outside the image do not count
+    pad_x, pad_y = int(np.ceil(abs(dx))) + 1, int(np.ceil(abs(dy))) + 1
+    inner[:pad_y], inner[-pad_y:], inner[:, :pad_x], inner[:, -pad_x:] = False, False, False, False
+    if inner.sum() < 10:
+        return False, raw
+    before = float(np.median(np.abs(raw[inner] - pred[inner])))
+    after = float(np.median(np.abs(back[inner] - pred[inner])))
+    if after <= DRIFT_CONFIRM * before:
+        return True, back
+    return False, raw
 
 
 def _angle(a: NDArray, b: NDArray) -> float:
@@ -205,28 +260,57 @@ def assess(
         shift, _ = cv2.phaseCorrelate(pred.astype(np.float64), img.astype(np.float64), window)
         return float(shift[0]), float(shift[1])  # image axes: x right, y down
 
+    # first pass: each image's shift and the direction that explains it best
+    evidence = []
     for i in range(n):
         raw = crop_arr[i]
         shade = ps.normals @ lt[i].astype(np.float32)
         pred = rho * np.maximum(shade, 0.0)
         dx, dy = drift_of(pred, raw)
-        moved = bool(np.hypot(dx, dy) > DRIFT_PX)
-        img = raw
-        if moved:  # judge the light on the image moved back
-            m = np.float32([[1, 0, -dx], [0, 1, -dy]])
-            img = cv2.warpAffine(raw, m, (raw.shape[1], raw.shape[0]), flags=cv2.INTER_LINEAR)
+        # A grazing light leaves most of the object in shadow, which the prediction does not
+        # model: the correlation peak then moves by about a pixel with nothing moved (every
+        # dry run of the shipped arm, lights down to 1°, was called "moved"). The shift is
+        # judged on images that light most of the crop; a real move shows on those too.
+        lit = float((valid & (shade > 0.2)).sum()) / max(float(valid.sum()), 1.0)
+        drift_judged = lit >= DRIFT_MIN_LIT
+        compare = valid & (shade > 0.2) & ~crop_sat[i]
+        moved, img = False, raw
+        if drift_judged and np.hypot(dx, dy) > DRIFT_PX:
+            moved, img = _confirmed_shift(pred, raw, dx, dy, compare)
         usable = vflat & ~crop_sat[i].ravel()
         best = _best_direction(img.ravel().astype(np.float64), bflat, usable, lt[i])
-        err = _angle(best, lt[i])
-        wrong = err > WRONG_LIGHT_DEG
+        evidence.append(
+            (dx, dy, moved, img if moved else None, best, _angle(best, lt[i]), drift_judged)
+        )
+    # The best directions are only evidence where the fit can resolve them: on a near-flat
+    # object (every normal close to the camera axis) or one far from Lambertian they scatter
+    # tens of degrees around every recorded light (71 of 72 images of a real dome acquisition
+    # were called "wrong light"). A swapped or wrong light is an exception among the images,
+    # so the check is made only when most images agree with their records.
+    typical = float(np.median([e[5] for e in evidence])) if evidence else 0.0
+    directions_checked = typical <= DIRECTION_CHECK_MEDIAN_DEG
+    for i in range(n):
+        raw = crop_arr[i]
+        shade = ps.normals @ lt[i].astype(np.float32)
+        pred = rho * np.maximum(shade, 0.0)
+        dx, dy, moved, shifted, best, err, drift_judged = evidence[i]
+        img = raw if shifted is None else shifted
+        wrong = directions_checked and err > WRONG_LIGHT_DEG
         if wrong:  # a wrong light also shifts the phase correlation: measure against its fit
             pred_best = rho * np.maximum(ps.normals @ best.astype(np.float32), 0.0)
             dx, dy = drift_of(pred_best, raw)
-            moved = bool(np.hypot(dx, dy) > DRIFT_PX)
+            moved = drift_judged and np.hypot(dx, dy) > DRIFT_PX
+            if moved:
+                moved = _confirmed_shift(pred_best, raw, dx, dy, valid & ~crop_sat[i])[0]
         drift = (dx, -dy)  # x right, y up (DESIGN.md)
         use = valid & (shade > 0.2) & ~crop_sat[i] & (img > dark / saturation)
+        lit_gain = float("nan")
         if use.sum() >= 10:
-            gain = float(np.median(img[use] / np.maximum(pred[use], 1e-9)))
+            ratio = img[use] / np.maximum(pred[use], 1e-9)
+            gain = float(np.median(ratio))
+            # a dim or misfired light darkens every pixel; shadows the prediction does not
+            # model darken some (at grazing light most): judge dimness on the bright end
+            lit_gain = float(np.percentile(ratio, DIM_PERCENTILE))
             res = img[use] - pred[use]
             residual = float(np.median(np.abs(res)) / max(float(np.median(pred[use])), 1e-9))
             resid_all.append(res)
@@ -238,10 +322,11 @@ def assess(
                 f"saturated: {sat_frac[i]:.1%} of pixels clipped (limit {SATURATED_LIMIT:.0%}); "
                 "reshoot with less exposure"
             )
-        dim = np.isfinite(gain) and gain < DIM_GAIN
-        if dim and (not wrong or gain < DIM_GAIN * 0.5):
+        dim = np.isfinite(lit_gain) and lit_gain < DIM_GAIN
+        if dim and (not wrong or lit_gain < DIM_GAIN * 0.5):
             problems.append(
-                f"misfired or dim light: {gain:.0%} of the brightness the other images predict"
+                f"misfired or dim light: {lit_gain:.0%} of the brightness the other images "
+                "predict"
             )
         elif wrong:
             others = np.delete(np.arange(n), i)
@@ -270,6 +355,7 @@ def assess(
                 direction_error_deg=err,
                 drift_px=drift,
                 problems=tuple(problems),
+                drift_judged=drift_judged,
             )
         )
     flagged = {c.index for c in checks if c.problems}
@@ -283,9 +369,22 @@ def assess(
         "bright_gain": BRIGHT_GAIN,
         "wrong_light_deg": WRONG_LIGHT_DEG,
         "drift_px": DRIFT_PX,
+        "drift_min_lit": DRIFT_MIN_LIT,
+        "drift_confirm": DRIFT_CONFIRM,
+        "dim_percentile": DIM_PERCENTILE,
         "min_coverage": MIN_COVERAGE,
+        "direction_check_median_deg": DIRECTION_CHECK_MEDIAN_DEG,
     }
-    return QAReport(tuple(checks), coverage, undercovered, expected, sigma, thresholds)
+    return QAReport(
+        tuple(checks),
+        coverage,
+        undercovered,
+        expected,
+        sigma,
+        thresholds,
+        median_direction_error_deg=typical,
+        directions_checked=directions_checked,
+    )
 
 
 def _expected_error_deg(

@@ -29,6 +29,9 @@ class ExportedLp:
     entries: list[LpEntry]
     #: Images the journal lists that are missing or changed on disk (not in the file).
     left_out: list[str]
+    #: The file is not in the session folder, so its image names (relative to the session
+    #: folder) do not resolve beside it, where relight, RTIBuilder and ``rti-rig fit`` look.
+    outside_session: bool = False
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -36,4 +39,5 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     entries, left_out = session_lp_report(req.session_dir, linear=req.linear)
     check_output_file(req.out_file, req.force, {})
     write_lp(req.out_file, entries)
-    return ExportedLp(list(entries), list(left_out))
+    outside = Path(req.out_file).resolve().parent != Path(req.session_dir).resolve()
+    return ExportedLp(list(entries), list(left_out), outside)

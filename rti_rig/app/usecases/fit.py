@@ -31,6 +31,7 @@ from rti_rig.app.usecases.fit_decode import imread_rgb
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.image_files import jpeg_truncation
 from rti_rig.core.lp_format import directions_of, read_lp
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
@@ -70,6 +71,9 @@ class FitResult:
     warnings: list[str] = field(default_factory=list)
     qa: QAReport | None = None
     seconds: float = 0.0
+    #: What the tolerant .lp reader accepted but the user should know (a light clamped to the
+    #: horizon, a count line that disagrees): ``FILE, line N: ...``.
+    notes: list[str] = field(default_factory=list)
 
 
 def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
@@ -88,10 +92,19 @@ def read_image(path: Path) -> Any:
         raise FitInputError(f"image {path} listed in the .lp is missing")
     if path.suffix.lower() in (".tif", ".tiff"):
         rows = TiffRows(path)  # read a band at a time, never whole
-        if rows.dtype != np.uint16:
-            raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
-        return rows  # type: ignore[return-value]
+        _check_tiff_type(path, rows.dtype)
+        if rows.dtype == np.uint16:
+            return rows  # type: ignore[return-value]
     return _decoded_rows(_decode(path), str(path))
+
+
+def _check_tiff_type(path: Path, dtype: Any) -> None:
+    """16-bit TIFFs are linear data, 8-bit ones sRGB like JPEG and PNG (as `plan` reads
+    them); anything else is refused with what to give instead."""
+    if dtype not in (np.uint16, np.uint8):
+        raise FitInputError(
+            f"{path}: a {dtype} TIFF; give 16-bit linear or 8-bit sRGB TIFFs (or JPEG/PNG)"
+        )
 
 
 def _decoded_rows(img: np.ndarray, name: str) -> RawRows:
@@ -110,6 +123,11 @@ def _decode(path: Path, into: np.ndarray | None = None) -> np.ndarray:
     if path.suffix.lower() in (".tif", ".tiff"):
         img = np.asarray(TiffRows(path)[:])
     else:
+        why = jpeg_truncation(path) if path.is_file() else None
+        if why is not None:  # OpenCV would decode it anyway, the missing part grey
+            raise FitInputError(
+                f"image {path} is a damaged JPEG: {why}; copy it again from the camera or card"
+            )
         decoded = imread_rgb(path, into)
         if decoded is None:
             raise FitInputError(f"cannot read image {path}")
@@ -137,12 +155,14 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     pending = []
     for i, path in enumerate(paths):
         if not path.is_file():
-            raise FitInputError(f"image {path} listed in the .lp is missing")
+            raise FitInputError(
+                f"image {path} listed in {label} is missing (an .lp's image names are read "
+                "relative to its own folder)"
+            )
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
-            if rows.dtype != np.uint16:
-                raise FitInputError(f"{path}: expected 16-bit linear TIFF, got {rows.dtype}")
-            if rows.reads_in_place:
+            _check_tiff_type(path, rows.dtype)
+            if rows.dtype == np.uint16 and rows.reads_in_place:
                 frames[i] = rows
                 continue
         pending.append(i)
@@ -186,7 +206,9 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
     return frames
 
 
-def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[str]]:
+def acquisition_files(
+    source: Path, notes: list[str] | None = None
+) -> tuple[Path, np.ndarray, list[Path], list[str]]:
     """The ``.lp`` of a session folder or ``.lp`` source, its lights (N, 3), the image file of
     each light (``linear/<stem>.tif`` when there, else the file the ``.lp`` names) and names."""
     if source.is_dir():
@@ -199,7 +221,7 @@ def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[
     else:
         raise FitInputError(f"{source}: give a session folder or an .lp file")
     refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
-    entries = read_lp(lp, upper_hemisphere=True)
+    entries = read_lp(lp, upper_hemisphere=True, notes=notes)
     lights = directions_of(entries)
     paths, names = [], []
     for e in entries:
@@ -210,10 +232,12 @@ def acquisition_files(source: Path) -> tuple[Path, np.ndarray, list[Path], list[
     return lp, lights, paths, names
 
 
-def load_acquisition(source: Path) -> tuple[list[Any], np.ndarray, list[str], str]:
+def load_acquisition(
+    source: Path, notes: list[str] | None = None
+) -> tuple[list[Any], np.ndarray, list[str], str]:
     """Frames (row-readable, uint16 linear), lights (N, 3), image names, and a description
-    of what was read."""
-    lp, lights, paths, names = acquisition_files(source)
+    of what was read; the .lp reader's notes are appended to ``notes``."""
+    lp, lights, paths, names = acquisition_files(source, notes)
     frames = _open_frames(paths, str(lp))
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
@@ -232,6 +256,25 @@ def _save_png(path: Path, rgb: np.ndarray) -> Path:
 BandRunner = Callable[[ImageStack, BandPlan, list[slice]], Iterator[tuple[slice, BandFit]]]
 
 
+def prepare_out_dir(out: Path) -> None:
+    """Create ``out`` (new or empty), or refuse clearly: never write over earlier outputs."""
+    if out.exists() and not out.is_dir():
+        raise FitInputError(f"--out {out} exists and is not a folder: choose another --out")
+    try:
+        if out.exists() and any(out.iterdir()):
+            raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".rti-rig-write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise FitInputError(
+            f"--out {out}: cannot write there ({exc.strerror or exc}"
+            f"{': ' + str(exc.filename) if exc.filename else ''}); choose a folder you can "
+            "write to"
+        ) from None
+
+
 def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     """Fit, write every output into ``req.out_dir``, and judge the acquisition.
 
@@ -239,17 +282,17 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     everything else — model choice, quantisation ranges, writing, QA — is the same code.
     """
     t0 = time.perf_counter()
-    frames, lights, names, what = load_acquisition(req.source)
+    notes: list[str] = []
+    frames, lights, names, what = load_acquisition(req.source, notes)
     release_free_memory()  # the decode buffers
     out = req.out_dir
-    if out.exists() and any(out.iterdir()):
-        raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
-    out.mkdir(parents=True, exist_ok=True)
+    prepare_out_dir(out)
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = _fit_all(req, stack, lights, out, bands or local_bands)
-    result.warnings = [str(w.message) for w in fit_warnings(caught)]
+    result.warnings = [str(w.message) for w in fit_warnings(caught)] + result.warnings
+    result.notes = notes
     result.files.append(
         exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
     )
@@ -267,6 +310,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         "model": result.model,
         "why": result.reason,
         "warnings": result.warnings,
+        "input_notes": result.notes,
         "files": [p.name for p in result.files],
         "verdict": result.qa.verdict if result.qa else None,
     }
@@ -319,17 +363,32 @@ def _fit_all(
             f"error ({choice.best_model}), {choice.holdout}"
         )
     else:
-        model_name = model_spec(name).name
+        spec = model_spec(name)
+        model_name = spec.name
+        if n < spec.n_coefficients:  # asked for by name: refused, never silently not fitted
+            raise FitInputError(
+                f"--model {name} has {spec.n_coefficients} coefficients per pixel and needs at "
+                f"least {spec.n_coefficients} lights; {req.source} has {n}: choose a smaller "
+                "model, or --model auto"
+            )
         reason_line = f"{model_name}: chosen by --model"
     normal_source = model_name if model_name in ("ps", "lambert", "ptm") else "ps-robust"
 
     # linear models to export, their solve matrices (warnings issued once, here)
     order = req.hsh_order or (int(model_name[-1]) if model_name.startswith("hsh") else 2)
     linear: dict[str, np.ndarray] = {}
+    skipped: list[str] = []  # said, never silently left out
     if req.write_ptm and n >= 6:
         linear["ptm"] = design_matrix("ptm", lights)
+    elif req.write_ptm:
+        skipped.append(f"fit.ptm not written: a PTM needs at least 6 lights, there are {n}")
     if req.write_hsh and n >= (order + 1) ** 2:
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
+    elif req.write_hsh:
+        skipped.append(
+            f"fit.rti not written: HSH of order {order} needs at least {(order + 1) ** 2} "
+            f"lights, there are {n}"
+        )
     if normal_source == "lambert":
         linear["lambert"] = design_matrix("lambert", lights)
     # the usable observations of the sample, only when an exported model needs their range
@@ -407,7 +466,7 @@ def _fit_all(
         files += exporters.write_normal_map(out / "normals", normals.read(), npy=False)
         release_free_memory()
         files += exporters.write_albedo(out / "albedo", albedo.read(), npy=False)
-    return FitResult(out, model_name, reason_line, files)
+    return FitResult(out, model_name, reason_line, files, warnings=skipped)
 
 
 def _usable_sample(stack: ImageStack) -> np.ndarray:
@@ -491,8 +550,14 @@ class BatchItem:
 
 
 def batch_out_dir(root: Path, source: Path) -> Path:
-    """Where a batch writes one source: ``root/<session folder name or .lp stem>``."""
-    return root / (source.name if source.is_dir() else source.stem)
+    """Where a batch writes one source: ``root/<session folder name>``, or for an ``.lp`` file
+    ``root/<its folder>-<its stem>``: acquisitions of a backlog often all name their file
+    ``dirs.lp`` (one folder per object), and the name must not depend on the rest of the batch
+    (a resumed batch finds what it finished by this name)."""
+    if source.is_dir():
+        return root / source.name
+    folder = source.resolve().parent.name
+    return root / (f"{folder}-{source.stem}" if folder else source.stem)
 
 
 def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[BatchItem]:
@@ -518,7 +583,13 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     dupes = {n for n in names if names.count(n) > 1}
     if dupes:
         raise FitInputError(f"two sources would write to the same folder: {sorted(dupes)}")
-    root.mkdir(parents=True, exist_ok=True)
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FitInputError(
+            f"--out {root}: cannot create the batch folder ({exc.strerror or exc}); choose a "
+            "folder you can write to"
+        ) from None
     todo = []
     for source in sources:
         final = batch_out_dir(root, source)

@@ -84,7 +84,19 @@ def scheduler_client(address: str) -> Iterator[Any]:
         yield None
         return
     from distributed import Client
+    from distributed.comm import parse_address
+    from distributed.comm.addressing import parse_host_port
 
+    try:  # before a Client exists: one built on a bad address hangs 40 s in its __del__ and
+        # prints an "Exception ignored" traceback after the error
+        scheme, location = parse_address(address)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as exc:
+        raise SchedulerError(
+            f"--scheduler {address!r} is not a Dask scheduler address ({exc}): give "
+            f"'{THREADS}' or an address such as tcp://HOST:8786"
+        ) from None
     try:
         client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:

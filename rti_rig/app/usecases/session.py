@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from rti_rig.core.errors import RtiRigError
+from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.runtime.controller import (
     CancelToken,
@@ -241,6 +241,15 @@ def _open_new(
     from rti_rig.app.rig_identity import rig_identity
 
     SessionFolder.check_new(out_dir)
+    if auto_exposure and loaded.config.backend == "replay":
+        # the recorded images come back whatever the exposure: metering them would "fix" an
+        # exposure that changes nothing (a claim nothing established)
+        raise ConfigError(
+            loaded.path,
+            None,
+            "--auto-exposure cannot meter a replayed acquisition: its camera returns the "
+            "recorded images whatever the exposure; drop --auto-exposure",
+        )
     identity = rig_identity(loaded)
     rig = checked_rig(loaded, schedule)
     try:

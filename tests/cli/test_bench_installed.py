@@ -1,0 +1,75 @@
+"""`rti-rig bench` as the installed command runs it (README: `rti-rig bench tradeoff ...`).
+
+The console script's ``sys.path`` has neither the current folder nor the checkout, so the
+benchmarks (not installed) were not found even from the repository's folder; only
+``python -m rti_rig bench`` worked.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_installed_rti_rig_bench_finds_the_checkout_benchmarks(tmp_path: Path) -> None:
+    script = Path(sys.executable).parent / "rti-rig"
+    assert script.is_file(), "rti-rig is installed in this environment (pip install -e .)"
+    missing = tmp_path / "nowhere" / "dirs.lp"
+    for cwd in (REPO, tmp_path):
+        r = subprocess.run(
+            [str(script), "bench", "tradeoff", "--from", str(missing)],
+            cwd=cwd,
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+        text = " ".join((r.stdout + r.stderr).split())
+        assert r.returncode == 2, text
+        assert "checkout" not in text, text  # the benchmarks were found
+        assert "Traceback" not in text and "dirs.lp" in text, text
+
+
+ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+
+
+def test_tradeoff_from_without_out_prints_and_writes_nothing(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(ACQ)])
+    assert r.exit_code == 0, r.output
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "adaptive" in r.output and "nothing written" in r.output
+
+
+def test_tradeoff_out_that_cannot_be_written_is_refused_before_computing(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    out = a_file / "trade"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out)])
+    assert r.exit_code == 2, r.output
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    text = " ".join(r.output.split())
+    assert str(out) in text and "N = 6 done" not in text  # refused before any work
+
+
+def test_tradeoff_from_shows_fit_warnings_as_notes_not_python_warnings() -> None:
+    script = Path(sys.executable).parent / "rti-rig"
+    r = subprocess.run(
+        [str(script), "bench", "tradeoff", "--from", str(ACQ)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    text = r.stdout + r.stderr
+    assert r.returncode == 0, text
+    assert ".py:" not in text, text  # no "rti_rig/reconstruct/ptm.py:134: ...Warning"
+    assert "note: IllConditionedFitWarning" in " ".join(text.split())
