@@ -22,18 +22,18 @@ def _find_benchmarks() -> None:
     (only ``python -m rti_rig`` puts the current folder first), so ``rti-rig bench`` failed
     even when run from the repository as the README shows. An editable install (``pip install
     -e .``, as the README does) runs the package from the checkout: its ``benchmarks/`` folder
-    lies next to ``rti_rig/``. The current folder is tried too (a checkout run from there)."""
-    import importlib.util
+    lies next to ``rti_rig/``. The current folder is tried next (a checkout run from there).
+    The package's own checkout goes first, so that another importable ``benchmarks`` (an
+    unrelated package, a folder the command happens to run in) is not taken for ours."""
     import sys
 
-    if importlib.util.find_spec("benchmarks") is not None:
-        return
     import rti_rig
 
     here = Path(rti_rig.__file__).resolve().parent.parent
     for root in (here, Path.cwd()):
         if (root / "benchmarks" / "tradeoff.py").is_file():
-            sys.path.insert(0, str(root))
+            if str(root) not in sys.path:
+                sys.path.insert(0, str(root))
             return
 
 

@@ -23,6 +23,9 @@ Formats, as published (no code copied):
   image). relight's format page names the diameter ``diameter`` and does not say how a
   direction is written; its reader wants ``domeDiameter`` and objects (a plain ``[x, y, z]``
   array reads as (0, 0, 0)), so the reader is followed and ``diameter`` is written too.
+  Lengths: the format page and older ``dome.h`` say cm, newer ``dome.h`` says mm; rti-rig
+  writes 0 (unknown) for them, which a ``"directional"`` dome never reads, so the unit
+  question does not arise until a diameter is written.
 
 Coefficients are written in units of the fitted (linear) images × 255, quantised to 8 bits per
 coefficient with one scale and bias per coefficient index (over all pixels and colours).
