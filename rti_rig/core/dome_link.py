@@ -101,7 +101,8 @@ class OffOutcome(StrEnum):
     SENT_NO_ACK = "sent-no-ack"  # sent; this firmware never acknowledges anything
     SENT_UNCONFIRMED = "sent-unconfirmed"  # sent, but the expected acknowledgement never came
     SELF_TIMED = "self-timed"  # no all-off command: the firmware switches each LED off itself
-    NOT_SENT = "not-sent"  # the link did not allow it (port gone, never opened)
+    NOT_SENT = "not-sent"  # the link did not allow it (the port went away)
+    NEVER_OPENED = "never-opened"  # the port could not be opened: this run sent nothing at all
 
 
 @dataclass(frozen=True)
@@ -133,5 +134,10 @@ class OffReport:
             OffOutcome.NOT_SENT: (
                 f"all-off could NOT be sent{why}: lights may still be on; switch the dome off at "
                 "its power supply"
+            ),
+            OffOutcome.NEVER_OPENED: (
+                f"the dome's port could not be opened{why}, so this run lit nothing and could "
+                "not send an all-off either; if the dome is lit from an earlier run, switch it "
+                "off at its power supply"
             ),
         }[self.outcome]

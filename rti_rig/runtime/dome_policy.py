@@ -192,10 +192,21 @@ class DomePolicy:
         try:
             info = self.link.connect()
         except DomeLinkError as exc:
-            # A board that answered nothing we understood may still be lit (one sketch boots
-            # with every LED on): send the all-off anyway wherever the port is open.
-            self._attempt_off(f"after the failed connection: {exc.message}")
+            if exc.command == "open port":
+                # Nothing was ever sent: say so, not "all-off failed, lights may be on".
+                self.off_report = OffReport(OffOutcome.NEVER_OPENED, exc.message)
+            else:
+                # A board that answered nothing we understood may still be lit (one sketch
+                # boots with every LED on): send the all-off anyway wherever the port is open.
+                self._attempt_off(f"after the failed connection: {exc.message}")
             self._quiet_close()
+            if exc.command == "open port":
+                raise DeviceError(
+                    self.name,
+                    f"the dome's port could not be opened ({exc.message}); check that the board "
+                    "is plugged in and that the rig config's port names it",
+                    exc.command,
+                ) from exc
             raise DeviceError(
                 self.name,
                 f"no handshake with the dome ({exc.message}); check the port, the baud rate and "

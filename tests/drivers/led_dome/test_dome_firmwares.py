@@ -296,3 +296,19 @@ def test_a_stepping_dome_rewinds_after_a_doubtful_step_and_labels_every_image_ri
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])
     assert r.exit_code == 0, r.output
     assert wrong_light_steps(cfg, out) == []
+
+
+def test_a_port_that_never_opened_says_this_run_lit_nothing(tmp_path: Path) -> None:
+    """The shipped 48-LED dome config with no board attached: the port cannot be opened, so
+    nothing was sent at all. Saying "all-off could NOT be sent: lights may still be on" claimed
+    a failed all-off that never happened; the user is told what is known instead."""
+    out = tmp_path / "s"
+    cfg = Path(__file__).resolve().parents[3] / "rig_configs" / "example_dome_48.toml"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    assert r.exit_code == 2, r.output
+    text = " ".join(said(r).split())
+    assert "port could not be opened" in text
+    assert "this run lit nothing" in text
+    assert "could NOT be sent" not in text
+    assert "no handshake" not in text
+    assert "lights are off" not in text

@@ -181,8 +181,12 @@ def test_self_test_over_pty_reports_the_dead_led():
 def test_wrong_port_is_a_clear_error():
     s = settings("default", port="/nonexistent/tty-dome")
     dome = build_dome(s, VirtualClock())
-    with pytest.raises(DeviceError, match=r"no handshake.*cannot open serial port /nonexistent"):
+    with pytest.raises(
+        DeviceError, match=r"port could not be opened.*cannot open serial port /nonexistent"
+    ):
         dome.connect()
+    # nothing was sent: the report says so rather than "all-off could not be sent"
+    assert dome.off_report is not None and dome.off_report.outcome == "never-opened"
     dome.close()
 
 
