@@ -1,0 +1,89 @@
+"""`optimal` conditioned on the lights shot (planner.adaptive_optimal): measured as a design
+family by benchmarks.adaptive_reach --families; these tests pin what it must guarantee."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from rti_rig.core.geometry import fibonacci_cap
+from rti_rig.core.rig_geometry import DomeGeometry
+from rti_rig.planner.adaptive import homogeneous_completion, start_subset
+from rti_rig.planner.adaptive_optimal import (
+    PinnedObjective,
+    pinned_optimal_design,
+    state_sample,
+)
+from rti_rig.planner.objectives import Candidates, NormalsObjective
+from rti_rig.planner.optimal import exchange_search
+from rti_rig.planner.uniform import select_uniform_leds
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from adaptive_states import state_for
+
+
+def _setup(n_total: int = 9, tilt: float = 0.0):  # type: ignore[no-untyped-def]
+    dirs = fibonacci_cap(120, 3.0)
+    g = DomeGeometry(dirs, tuple(f"l{i}" for i in range(len(dirs))))
+    full = select_uniform_leds(g, n_total, 10.0)
+    shot = np.array([int(full[i]) for i in start_subset(dirs[full], 4)])
+    rng = np.random.default_rng(0)
+    normals = np.c_[rng.normal(0, 0.3, (200, 2)), np.ones(200)]
+    normals[:, 0] += tilt
+    state = state_for(normals, dirs[shot])
+    available = np.ones(len(dirs), bool)
+    available[shot] = False
+    starts = [
+        homogeneous_completion(dirs, available, dirs[shot], n_total, f) for f in (0.0, 10.0, 20.0)
+    ]
+    return dirs, shot, state, starts
+
+
+def test_the_design_completes_the_shot_lights_without_repeating_any() -> None:
+    dirs, shot, state, starts = _setup()
+    free = pinned_optimal_design(state, dirs, shot, starts)
+    assert len(free) == 9 - len(shot)
+    assert len(set(free.tolist())) == len(free)
+    assert not set(free.tolist()) & set(shot.tolist())
+
+
+def test_it_is_never_worse_on_its_objective_than_the_completions_it_starts_from() -> None:
+    dirs, shot, state, starts = _setup(tilt=0.6)  # a tilted surface: the floors differ
+    free = pinned_optimal_design(state, dirs, shot, starts)
+    objective = NormalsObjective(state_sample(state, dirs), Candidates(dirs, None, None))
+    got = objective.cost(np.r_[shot, free])
+    assert got <= min(objective.cost(np.r_[shot, s]) for s in starts) + 1e-12
+
+
+def test_the_pinned_objective_never_proposes_or_moves_a_shot_light() -> None:
+    dirs, shot, state, starts = _setup()
+    objective = NormalsObjective(state_sample(state, dirs), Candidates(dirs, None, None))
+    pinned = PinnedObjective(objective, shot)
+    costs = pinned.swap_costs(np.asarray(starts[1]), 0)
+    assert np.isinf(costs[shot]).all()
+    assert np.isfinite(costs).sum() > 0
+    # unpinned, the same search is free to drop a shot light: the wrapper is what keeps them
+    res = exchange_search(pinned, [("s", np.asarray(starts[0]))])
+    assert not set(res.chosen.tolist()) & set(shot.tolist())
+
+
+def test_cast_shadows_and_the_keep_table_lower_a_light_s_use() -> None:
+    """The sample's lit factor is 1 for a light the fit keeps on a flat relief, and a ridge of
+    relief casting a shadow takes it to 0 for the pixels behind it."""
+    dirs, shot, state, _ = _setup()
+    flat = state_sample(state, dirs)
+    assert flat.lit_candidates.shape == (len(state.normals), len(dirs))
+    assert np.all((flat.lit_candidates >= 0) & (flat.lit_candidates <= 1))
+    from dataclasses import replace
+
+    height = np.zeros((20, 20))
+    height[:, 10] = 50.0  # a wall along the column 10
+    rows = np.full(len(state.normals), 10)
+    cols = np.full(len(state.normals), 12)  # just east of the wall
+    walled = state_sample(replace(state, height=height, rows=rows, cols=cols), dirs)
+    west_low = (dirs[:, 0] < -0.9) & (dirs[:, 2] < 0.3)
+    assert west_low.any()
+    assert np.all(flat.lit_candidates[:, west_low] > 0)  # no relief: nothing casts a shadow
+    assert np.all(walled.lit_candidates[:, west_low] == 0)
