@@ -27,7 +27,7 @@ error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
-[--cache FILE]
+[--fitted-design] [--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
@@ -448,9 +448,22 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument(
         "--no-until", action="store_true", help="skip the --until-error rows (faster to iterate)"
     )
+    ap.add_argument(
+        "--fitted-design",
+        action="store_true",
+        help="also offer the design of planner.adaptive_optimal (optimal on the fitted surface, "
+        "the lights shot kept; off in what ships)",
+    )
     args = ap.parse_args(argv)
-    if args.sim_draws < 2 or args.real_draws < 2:
-        ap.error("--sim-draws and --real-draws need at least 2 (the verdicts are paired tests)")
+    if args.sim_draws < 2 or args.real_draws == 1:
+        ap.error(
+            "--sim-draws and --real-draws need at least 2 (the verdicts are paired tests; "
+            "--real-draws 0 skips the real acquisition)"
+        )
+    if args.fitted_design:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.FITTED_DESIGN = True
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
@@ -502,6 +515,7 @@ def main(argv: list[str] | None = None) -> str:
             + (" --no-until" if args.no_until else "")
             + (f" --start {args.start}" if args.start != "default" else "")
             + (" --relief-gain" if args.relief_gain else "")
+            + (" --fitted-design" if args.fitted_design else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
             + (

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
@@ -72,7 +73,7 @@ def test_the_pinned_objective_never_proposes_or_moves_a_shot_light() -> None:
 def test_cast_shadows_and_the_keep_table_lower_a_light_s_use() -> None:
     """The sample's lit factor is 1 for a light the fit keeps on a flat relief, and a ridge of
     relief casting a shadow takes it to 0 for the pixels behind it."""
-    dirs, shot, state, _ = _setup()
+    dirs, _, state, _ = _setup()
     flat = state_sample(state, dirs)
     assert flat.lit_candidates.shape == (len(state.normals), len(dirs))
     assert np.all((flat.lit_candidates >= 0) & (flat.lit_candidates <= 1))
@@ -87,3 +88,43 @@ def test_cast_shadows_and_the_keep_table_lower_a_light_s_use() -> None:
     assert west_low.any()
     assert np.all(flat.lit_candidates[:, west_low] > 0)  # no relief: nothing casts a shadow
     assert np.all(walled.lit_candidates[:, west_low] == 0)
+
+
+def _session(n_total: int) -> list[dict]:  # type: ignore[type-arg]
+    """The chooser's evidence over a session of ``n_total`` on a Lambertian bumpy surface."""
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start
+
+    dirs = fibonacci_cap(120, 3.0)
+    g = DomeGeometry(dirs, tuple(f"l{i}" for i in range(len(dirs))))
+    yy, xx = np.mgrid[0:48, 0:48] / 48.0
+    normals = np.dstack([0.5 * np.sin(6 * xx), 0.4 * np.cos(5 * yy), np.ones_like(xx)])
+    normals /= np.linalg.norm(normals, axis=2, keepdims=True)
+    images = np.clip(np.einsum("hwc,kc->khw", normals, dirs), 0.0, None).astype(np.float32)
+    chooser = AdaptiveChooser(dirs, dome_start(g, 4, n_total), n_total, design_lights=n_total)
+    evidence = []
+    for i in range(n_total + 1):
+        c, ev = chooser.decide(i)
+        evidence.append(ev)
+        if c is None:
+            break
+        chooser.observe(c, dirs[c], images[c])
+    assert len(chooser.used) == n_total == len(set(chooser.used))
+    return evidence
+
+
+def test_off_by_default_the_decisions_offer_only_floors() -> None:
+    evidence = [e for e in _session(6) if e.get("kind") == "adaptive"]
+    assert evidence and all("design_floor_deg" in e for e in evidence)
+    assert all("fitted" not in e["design_error_deg"] for e in evidence)
+
+
+def test_turned_on_the_fitted_design_is_scored_beside_the_floors(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import rti_rig.planner.adaptive as adaptive
+
+    monkeypatch.setattr(adaptive, "FITTED_DESIGN", True)
+    evidence = [e for e in _session(6) if e.get("kind") == "adaptive"]
+    assert evidence and all("fitted" in e["design_error_deg"] for e in evidence)
+    # a decision names either a floor or the fitted design, never both
+    assert all(("design" in e) != ("design_floor_deg" in e) for e in evidence)
