@@ -27,7 +27,7 @@ error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
-[--fitted-design] [--no-relight] [--cache FILE]
+[--fitted-design [--fitted-pixels K]] [--no-relight] [--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
@@ -478,6 +478,13 @@ def main(argv: list[str] | None = None) -> str:
         "the lights shot kept; off in what ships)",
     )
     ap.add_argument(
+        "--fitted-pixels",
+        type=int,
+        default=None,
+        help="with --fitted-design: search over at most this many sampled pixels "
+        "(planner.adaptive_optimal.SEARCH_PIXELS; default all)",
+    )
+    ap.add_argument(
         "--no-relight",
         action="store_true",
         help="skip the simulator's --objective relight sessions (the relighting table is then "
@@ -496,6 +503,10 @@ def main(argv: list[str] | None = None) -> str:
         import rti_rig.planner.adaptive as adaptive_planner
 
         adaptive_planner.FITTED_DESIGN = True
+        if args.fitted_pixels is not None:
+            import rti_rig.planner.adaptive_optimal as adaptive_optimal
+
+            adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
@@ -554,6 +565,7 @@ def main(argv: list[str] | None = None) -> str:
             + (f" --start {args.start}" if args.start != "default" else "")
             + (" --relief-gain" if args.relief_gain else "")
             + (" --fitted-design" if args.fitted_design else "")
+            + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels else "")
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"

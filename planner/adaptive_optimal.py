@@ -82,6 +82,32 @@ def state_sample(state: SurfaceState, candidates: NDArray[np.float64]) -> Surfac
     )
 
 
+#: At most this many of the state's sampled pixels are searched over (an even sub-sample):
+#: the search's cost grows with the pixels (None: all of them, 2000 in a session).
+SEARCH_PIXELS: int | None = None
+
+
+def _subsample(state: SurfaceState, k: int | None) -> SurfaceState:
+    from dataclasses import replace
+
+    p = len(state.normals)
+    if k is None or p <= k:
+        return state
+    pick = np.linspace(0, p - 1, k).round().astype(np.intp)
+    return replace(
+        state,
+        normals=state.normals[pick],
+        albedo=state.albedo[pick],
+        noise=state.noise[pick],
+        lit=state.lit[pick],
+        obs=None if state.obs is None else state.obs[:, pick],
+        valid=None if state.valid is None else state.valid[pick],
+        rows=None if state.rows is None else state.rows[pick],
+        cols=None if state.cols is None else state.cols[pick],
+        cache={},
+    )
+
+
 def pinned_optimal_design(
     state: SurfaceState,
     candidates: NDArray[np.float64],
@@ -93,6 +119,7 @@ def pinned_optimal_design(
     candidate indices, none of them shot, all of the same length)."""
     if not starts:
         raise ValueError("the search needs at least one starting completion")
+    state = _subsample(state, SEARCH_PIXELS)
     sample = state_sample(state, candidates)
     objective = NormalsObjective(sample, Candidates(candidates, None, None))
     pinned = PinnedObjective(objective, np.asarray(shot, dtype=np.intp))

@@ -128,3 +128,19 @@ def test_turned_on_the_fitted_design_is_scored_beside_the_floors(
     assert evidence and all("fitted" in e["design_error_deg"] for e in evidence)
     # a decision names either a floor or the fitted design, never both
     assert all(("design" in e) != ("design_floor_deg" in e) for e in evidence)
+
+
+def test_a_pixel_sub_sample_keeps_every_per_pixel_array_aligned(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import rti_rig.planner.adaptive_optimal as adaptive_optimal
+
+    dirs, shot, state, starts = _setup()
+    small = adaptive_optimal._subsample(state, 50)
+    assert len(small.normals) == len(small.albedo) == len(small.noise) == len(small.lit) == 50
+    assert np.array_equal(small.normals[0], state.normals[0])
+    assert np.array_equal(small.normals[-1], state.normals[-1])
+    assert adaptive_optimal._subsample(state, 10_000) is state
+    monkeypatch.setattr(adaptive_optimal, "SEARCH_PIXELS", 50)
+    free = pinned_optimal_design(state, dirs, shot, starts)
+    assert len(free) == 9 - len(shot) and not set(free.tolist()) & set(shot.tolist())
