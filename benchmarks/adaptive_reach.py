@@ -21,8 +21,14 @@ exactly that layout):
 * ``shared-3``: 3 lights that both the default and the 20° layouts hold (where they share 3;
   else ``default``): both designs stay exactly reachable, the first decision is on 3 images.
 
-Run: ``python -m benchmarks.adaptive_reach [--draws K] [--scenes a,b] [--write]`` (about
-1–2 min on 2 idle cores; ``--write`` puts the table into docs/adaptive.md).
+``--families``: instead, from the shipped start, the oracle of wider design families —
+completions to more floors, ``optimal`` conditioned on the starting lights (on the surface
+fitted to the starting images, ``planner.adaptive_optimal``, or on the benchmark's preview),
+and in cells given by ``--ceiling scene:N,...`` a greedy exchange on the true error (slow).
+
+Run: ``python -m benchmarks.adaptive_reach [--draws K] [--scenes a,b] [--families [--ceiling
+coin:9,...]] [--write]`` (about 1–2 min on 2 idle cores, ``--families`` 3 min, with the
+ceiling of three cells 10 min; ``--write`` puts the table into docs/adaptive.md).
 """
 
 from __future__ import annotations

@@ -8,10 +8,13 @@ candidate design: the ``optimal`` planner's objective (:class:`~rti_rig.planner.
 NormalsObjective`, the Lambertian fit's Cramér–Rao bound plus its model bias) over the
 *fitted* surface of the images so far (normals, cast shadows of their integrated relief, and
 how often this object's fit kept an observation of each kind), minimised by the same exchange
-search with the lights already shot kept. It is measured by ``python -m
-benchmarks.adaptive_reach --families``; it is not one of the designs a session chooses among
-(docs/adaptive.md, "Why the three losses remain": its oracle did not reach the bar where
-adaptive loses).
+search with the lights already shot kept. Its reach is measured by ``python -m
+benchmarks.adaptive_reach --families``, its effect through the chooser by ``python -m
+benchmarks.adaptive --fitted-design [--fitted-pixels K]``. A session offers it beside the
+floors only with ``planner.adaptive.FITTED_DESIGN`` (off: docs/adaptive.md, "Why the three
+losses remain" — it turns two of the three losses into ties and passes the selection rule
+with 500 pixels, but its decision exceeds 0.2 s at 75–100 lights on a 200-LED dome, and
+shipping it changes the decision format and the estimate's calibration).
 """
 
 from __future__ import annotations
