@@ -134,6 +134,7 @@ class Decision:
     runner_up: list[dict[str, float]]  # the best few candidates: index, predicted, move_s
     reason: str
     #: with N known: the elevation floor (°) of the design the light was chosen in
+    #: (:data:`FITTED_KEY`: the fitted design of ``FITTED_DESIGN``, recorded as ``design``)
     design_floor: float | None = None
     #: with N known: what the designs were scored by (``normals``: simulated or bound mean
     #: normal error, °; ``relight``: simulated relighting PSNR, dB) and each floor's score
@@ -375,8 +376,10 @@ DESIGN_DEFAULT_FLOOR = 10.0
 SIM_MARGIN = 0.10
 #: Also offer, with the bias-aware score and the normals objective, the design of
 #: :mod:`rti_rig.planner.adaptive_optimal` (``optimal`` on the fitted surface, the lights shot
-#: kept). Off: measured in docs/adaptive.md ("Why the three losses remain"), it does not reach
-#: the tuned layout where adaptive loses; ``benchmarks.adaptive --fitted-design`` turns it on.
+#: kept). Off (docs/adaptive.md, "Why the three losses remain"): it turns two of the three
+#: losses into ties and passes the selection rule searched over 500 pixels, but its decision
+#: exceeds 0.2 s at 75–100 lights on a 200-LED dome, and shipping it changes the decision
+#: format and the estimate's calibration. ``benchmarks.adaptive --fitted-design`` turns it on.
 FITTED_DESIGN = False
 #: The key of that design among the floors (its evidence says ``fitted``, not a floor).
 FITTED_KEY = -1.0
