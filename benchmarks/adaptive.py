@@ -27,7 +27,7 @@ error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
-[--cache FILE]
+[--fitted-design [--fitted-pixels K]] [--no-relight] [--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
@@ -66,6 +66,9 @@ DESIGN = True
 #: The starting lights with N known (``--start``: what ships, or a start of
 #: ``benchmarks.adaptive_reach``, to measure it; nothing but this benchmark uses the others).
 START = {"start": dome_start}
+#: Whether the simulator's ``--objective relight`` sessions are run (``--no-relight``: not,
+#: to iterate on the normals objective faster; the relighting table is then not a result).
+RELIGHT = True
 
 #: Scores of the bars (homogeneous layouts, `optimal`), which do not depend on the adaptive
 #: code: ``--cache FILE`` keeps them between runs, keyed by object, draw, N and layout (the
@@ -173,7 +176,12 @@ def sim(draws: int, seed: int = 0, scenes: tuple[str, ...] = ()) -> tuple[dict, 
                 # and one with --objective relight (scored in the relighting table)
                 used, est, dt = adaptive_run(grey[keep], cand[keep], sub, n)
                 dec_t.append(dt)
-                used_r, _, dt_r = adaptive_run(grey[keep], cand[keep], sub, n, objective="relight")
+                if RELIGHT:
+                    used_r, _, dt_r = adaptive_run(
+                        grey[keep], cand[keep], sub, n, objective="relight"
+                    )
+                else:  # --no-relight: the normals session stands in (its table is not a result)
+                    used_r, dt_r = used, dt
                 dec_t_relight.append(dt_r)
                 chosen = {f"uniform {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
                 light = settings.preview_light_az_el_deg
@@ -419,6 +427,21 @@ def table(name: str, r: dict) -> tuple[str, str]:
     )
 
 
+def relative_excess(r: dict) -> float:
+    """A scene's share of the criterion the adaptive constants are chosen by (docs/adaptive.md):
+    the sum over N of how far adaptive's mean normal error is above the tuned homogeneous
+    layout's, relative to it (0 where it is not above)."""
+    err = r["err"]
+    floor = min(
+        FLOORS, key=lambda f: float(np.mean([np.mean(err[(n, f"uniform {f:g}")]) for n in NS]))
+    )
+    total = 0.0
+    for n in NS:
+        hom = float(np.mean(err[(n, f"uniform {floor:g}")]))
+        total += max(0.0, float(np.mean(err[(n, "adaptive")])) / hom - 1.0)
+    return total
+
+
 def main(argv: list[str] | None = None) -> str:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sim-draws", type=int, default=8)
@@ -448,9 +471,42 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument(
         "--no-until", action="store_true", help="skip the --until-error rows (faster to iterate)"
     )
+    ap.add_argument(
+        "--fitted-design",
+        action="store_true",
+        help="also offer the design of planner.adaptive_optimal (optimal on the fitted surface, "
+        "the lights shot kept; off in what ships)",
+    )
+    ap.add_argument(
+        "--fitted-pixels",
+        type=int,
+        default=None,
+        help="with --fitted-design: search over at most this many sampled pixels "
+        "(planner.adaptive_optimal.SEARCH_PIXELS; default all)",
+    )
+    ap.add_argument(
+        "--no-relight",
+        action="store_true",
+        help="skip the simulator's --objective relight sessions (the relighting table is then "
+        "not a result; faster to iterate on the normals objective)",
+    )
     args = ap.parse_args(argv)
-    if args.sim_draws < 2 or args.real_draws < 2:
-        ap.error("--sim-draws and --real-draws need at least 2 (the verdicts are paired tests)")
+    if args.no_relight:
+        global RELIGHT
+        RELIGHT = False
+    if args.sim_draws < 2 or args.real_draws == 1:
+        ap.error(
+            "--sim-draws and --real-draws need at least 2 (the verdicts are paired tests; "
+            "--real-draws 0 skips the real acquisition)"
+        )
+    if args.fitted_design:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.FITTED_DESIGN = True
+        if args.fitted_pixels is not None:
+            import rti_rig.planner.adaptive_optimal as adaptive_optimal
+
+            adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
@@ -490,6 +546,12 @@ def main(argv: list[str] | None = None) -> str:
         real_calib.append(
             f"| neuralrti-example (real) | {scale:.2f}, {slope:+.2f} | " + " | ".join(cells) + " |"
         )
+    excess = {scene: relative_excess(r) for scene, r in results.items()}
+    excess_line = (
+        f"Σ relative excess over the tuned layout (normals, simulator): {sum(excess.values()):.3f}"
+        " (" + ", ".join(f"{k} {v:.3f}" for k, v in excess.items()) + ")."
+    )
+    print(excess_line, flush=True)
     until_rows = [] if args.no_until else until_error_rows(results, scale, slope)
     dec = np.concatenate([r["decision_s"] for r in results.values()])
     dec_r = np.concatenate([r["decision_relight_s"] for r in results.values()])
@@ -502,6 +564,9 @@ def main(argv: list[str] | None = None) -> str:
             + (" --no-until" if args.no_until else "")
             + (f" --start {args.start}" if args.start != "default" else "")
             + (" --relief-gain" if args.relief_gain else "")
+            + (" --fitted-design" if args.fitted_design else "")
+            + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels else "")
+            + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
             + (
@@ -526,6 +591,8 @@ def main(argv: list[str] | None = None) -> str:
             head,
             sep,
             *e_rows,
+            "",
+            excess_line,
             "",
             "Relighting PSNR (dB; floor tuned on PSNR; adaptive here is `run --adaptive --lights N "
             "--objective relight`, each cell also giving the PSNR of the normals-objective "

@@ -21,8 +21,14 @@ exactly that layout):
 * ``shared-3``: 3 lights that both the default and the 20° layouts hold (where they share 3;
   else ``default``): both designs stay exactly reachable, the first decision is on 3 images.
 
-Run: ``python -m benchmarks.adaptive_reach [--draws K] [--scenes a,b] [--write]`` (about
-1–2 min on 2 idle cores; ``--write`` puts the table into docs/adaptive.md).
+``--families``: instead, from the shipped start, the oracle of wider design families —
+completions to more floors, ``optimal`` conditioned on the starting lights (on the surface
+fitted to the starting images, ``planner.adaptive_optimal``, or on the benchmark's preview),
+and in cells given by ``--ceiling scene:N,...`` a greedy exchange on the true error (slow).
+
+Run: ``python -m benchmarks.adaptive_reach [--draws K] [--scenes a,b] [--families [--ceiling
+coin:9,...]] [--write]`` (about 1–2 min on 2 idle cores, ``--families`` 3 min, with the
+ceiling of three cells 10 min; ``--write`` puts the table into docs/adaptive.md).
 """
 
 from __future__ import annotations
@@ -31,6 +37,7 @@ import argparse
 import os
 import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -38,10 +45,11 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from benchmarks.report import machine_line, write_section
-from rti_rig.app.usecases.adaptive import dome_start
+from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner import adaptive
+from rti_rig.planner.adaptive_optimal import pinned_optimal_design
 from rti_rig.planner.uniform import select_uniform_leds
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "adaptive.md"
@@ -85,6 +93,103 @@ def shared_three_start(geometry: DomeGeometry, k: int, n_total: int | None) -> l
         return dome_start(geometry, k, n_total)
     pick = adaptive.start_subset(geometry.directions[both], 3)
     return sorted(int(both[i]) for i in pick)
+
+
+#: Extra elevation floors of the ``bands`` family (the shipped designs are ``FLOORS``).
+EXTRA_FLOORS = (5.0, 15.0, 25.0, 35.0, 40.0)
+
+
+class _PinnedObjective:
+    """An objective over the lights *not yet shot*: ``fixed`` (candidate indices) are always
+    part of the layout and never swapped out or in (the exchange search sees only the rest)."""
+
+    def __init__(self, objective, fixed: NDArray[np.intp]) -> None:  # type: ignore[no-untyped-def]
+        self.objective = objective
+        self.fixed = np.asarray(fixed, dtype=np.intp)
+        self.scan_levels = getattr(objective, "scan_levels", ({"exact": False}, {"exact": True}))
+        self.candidate_count = objective.candidate_count
+
+    def cost(self, free: NDArray[np.intp]) -> float:
+        return float(self.objective.cost(np.r_[self.fixed, free]))
+
+    def swap_costs(self, free: NDArray[np.intp], position: int, **kw) -> NDArray[np.float64]:  # type: ignore[no-untyped-def]
+        if kw.get("among") is not None:
+            kw["among"] = np.setdiff1d(kw["among"], self.fixed)
+        out = np.array(
+            self.objective.swap_costs(np.r_[self.fixed, free], position + len(self.fixed), **kw),
+            dtype=np.float64,
+        )
+        out[self.fixed] = np.inf
+        return out
+
+
+@dataclass
+class PinnedOptimal:
+    """``optimal`` conditioned on the lights already shot: the same objective (from the same
+    preview) and exchange search, the shot lights (``pinned``, LED indices) kept, the others
+    searched from the completions of the shot lights to each floor's homogeneous layout."""
+
+    pinned: list[int] = field(default_factory=list)
+    #: further starting completions (LED indices, the pinned ones excluded)
+    extra: list[list[int]] = field(default_factory=list)
+    floors: tuple[float, ...] = FLOORS
+    name: str = "optimal-pinned"
+    summary: str = "optimal with the lights already shot kept (benchmark only)"
+    surface: str = "flat"
+    needs_preview_reason: str = ""
+    optimises_objective: bool = True
+
+    def prepare(self, ctx):  # type: ignore[no-untyped-def]
+        return ctx.starts[0][1]
+
+    def decide(self, ctx, objective, chosen):  # type: ignore[no-untyped-def]
+        from rti_rig.planner.optimal import exchange_search
+        from rti_rig.planner.pixel_bins import binned_objective
+
+        cand = ctx.candidates
+        where = {int(led): i for i, led in enumerate(cand.leds)}
+        fixed = np.array([where[int(i)] for i in self.pinned], dtype=np.intp)
+        avail = np.ones(len(cand.directions), dtype=bool)
+        avail[fixed] = False
+        starts = []
+        for f in self.floors:
+            comp = adaptive.homogeneous_completion(
+                cand.directions, avail, cand.directions[fixed], ctx.n, f
+            )
+            if comp is not None:
+                starts.append((f"{f:g}", np.asarray(comp, dtype=np.intp)))
+        for j, e in enumerate(self.extra):
+            starts.append((f"extra {j}", np.array([where[int(i)] for i in e], dtype=np.intp)))
+        pinned = _PinnedObjective(objective, fixed)
+        search = binned_objective(objective)
+        res = exchange_search(
+            pinned, starts, search=None if search is objective else _PinnedObjective(search, fixed)
+        )
+        return np.r_[fixed, res.chosen]
+
+
+_PINNED = PinnedOptimal()
+
+
+def pinned_optimal(
+    preview: NDArray,
+    geometry: DomeGeometry,
+    n: int,
+    light: tuple[float, float],
+    pinned: list[int],
+    extra: list[list[int]] | None = None,
+) -> NDArray[np.intp]:
+    """LED indices (into ``geometry``) of ``optimal`` for ``n`` lights from ``preview``, the
+    ``pinned`` LEDs kept (``extra``: further starting completions, LED indices)."""
+    from rti_rig.planner.make_plan import plan_with_report
+    from rti_rig.planner.methods import _METHODS, register_method
+
+    if _PINNED.name not in _METHODS:
+        register_method(_PINNED)  # type: ignore[arg-type]
+    _PINNED.pinned = list(pinned)
+    _PINNED.extra = [list(e) for e in (extra or [])]
+    sched, _ = plan_with_report(preview, geometry, n, _PINNED.name, "normals", light)
+    return np.array([s.led for s in sched.steps], dtype=np.intp)
 
 
 def start_functions() -> dict:  # type: ignore[type-arg]
@@ -150,13 +255,182 @@ def reach(draws: int, scenes: tuple[str, ...] = (), seed: int = 0) -> list[str]:
     return rows
 
 
+def layout_completion(
+    dirs: NDArray[np.float64], layout: NDArray[np.intp], start: list[int]
+) -> NDArray[np.intp]:
+    """Complete ``start`` towards ``layout`` (indices into ``dirs``): the start's lights take the
+    places of the layout's lights nearest them (minimum total angle); the layout's other lights
+    are the completion (one already shot replaced by the nearest light not used)."""
+    cost = np.arccos(np.clip(dirs[start] @ dirs[layout].T, -1.0, 1.0))
+    _, cols = linear_sum_assignment(cost)
+    rest = [int(x) for j, x in enumerate(layout) if j not in set(cols.tolist())]
+    used = set(start) | set(rest)
+    out = []
+    for x in rest:
+        if x in start:
+            free = np.array([i for i in range(len(dirs)) if i not in used])
+            x = int(free[np.argmax(dirs[free] @ dirs[x])])
+            used.add(x)
+        out.append(x)
+    return np.array(out, dtype=np.intp)
+
+
+def families(
+    draws: int, scenes: tuple[str, ...] = (), seed: int = 0, ceiling: tuple[str, ...] = ()
+) -> list[str]:
+    """Table rows: from the shipped start, per scene and N, the tuned bar and the oracle (best
+    design per draw, true error) of each family of designs decided at the first decision:
+    ``floors`` (what ships: completions above ``FLOORS``), ``bands`` (those and completions
+    above ``EXTRA_FLOORS``), ``pinned`` (``optimal`` from the benchmark's preview with the
+    starting lights kept: one design), all of them; and unconditioned ``optimal`` (not
+    reachable from the start: for reference). ``ceiling`` (cells ``scene:N``): also a greedy
+    exchange on the *true* error with the start kept (what any completion could reach; slow)."""
+    from benchmarks.planner_real_data import planned_leds
+    from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
+
+    settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
+    light = settings.preview_light_az_el_deg
+    rows = []
+    for si, scene in enumerate(settings.scenes):
+        if scenes and scene not in scenes:
+            continue
+        rng = np.random.default_rng([seed, si])  # the draws of benchmarks.adaptive
+        data = render_scene_data(scene, settings)
+        cand = data.candidate_dirs
+        grey = data.candidate_images.mean(axis=-1)
+
+        def err(idx: NDArray[np.intp], data=data, cand=cand) -> float:  # type: ignore[no-untyped-def]
+            idx = np.sort(idx)
+            return normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
+
+        res: dict[tuple[int, str], list[float]] = {}
+        for _ in range(draws):
+            keep = np.sort(rng.choice(len(cand), len(cand) - SIM_REMOVED, replace=False))
+            sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
+            for n in NS:
+                for f in FLOORS:
+                    res.setdefault((n, f"hom {f:g}"), []).append(
+                        err(keep[select_uniform_leds(sub, n, f)])
+                    )
+                st = dome_start(sub, adaptive.START_LIGHTS, n)
+                avail = np.ones(len(keep), dtype=bool)
+                avail[st] = False
+                for f in FLOORS + EXTRA_FLOORS:
+                    comp = adaptive.homogeneous_completion(cand[keep], avail, cand[keep][st], n, f)
+                    e = np.inf if comp is None else err(keep[np.r_[st, comp]])
+                    res.setdefault((n, f"comp {f:g}"), []).append(e)
+                state = _start_state(cand[keep], grey[keep], list(st), n)
+                comps = [
+                    adaptive.homogeneous_completion(cand[keep], avail, cand[keep][st], n, f)
+                    for f in FLOORS
+                ]
+                free = pinned_optimal_design(state, cand[keep], np.asarray(st), comps)
+                res.setdefault((n, "fitted"), []).append(err(keep[np.r_[st, free]]))
+                opt = planned_leds(data.preview, sub, n, light)
+                res.setdefault((n, "optimal"), []).append(err(keep[opt]))
+                towards = layout_completion(cand[keep], opt, list(st))
+                res.setdefault((n, "towards"), []).append(err(keep[np.r_[st, towards]]))
+                pin = pinned_optimal(data.preview, sub, n, light, list(st), [list(towards)])
+                assert set(st) <= {int(i) for i in pin} and len(pin) == n
+                res.setdefault((n, "pinned"), []).append(err(keep[pin]))
+                if f"{scene}:{n}" in ceiling:
+                    best = min(FLOORS, key=lambda f: res[(n, f"comp {f:g}")][-1])
+                    start = adaptive.homogeneous_completion(
+                        cand[keep], avail, cand[keep][st], n, best
+                    )
+                    res.setdefault((n, "ceiling"), []).append(
+                        _true_greedy(err, keep, np.asarray(st), np.asarray(start), avail)
+                    )
+        tuned = min(FLOORS, key=lambda f: np.mean([np.mean(res[(n, f"hom {f:g}")]) for n in NS]))
+        for n in NS:
+            bar = float(np.mean(res[(n, f"hom {tuned:g}")]))
+
+            def oracle(labels: list[str], n=n, res=res) -> float:  # type: ignore[no-untyped-def]
+                return float(np.array([res[(n, x)] for x in labels]).min(axis=0).mean())
+
+            shipped = [f"comp {f:g}" for f in FLOORS]
+            bands = shipped + [f"comp {f:g}" for f in EXTRA_FLOORS]
+            cells = [
+                oracle(shipped),
+                oracle(bands),
+                float(np.mean(res[(n, "fitted")])),
+                oracle([*shipped, "fitted"]),
+                float(np.mean(res[(n, "towards")])),
+                float(np.mean(res[(n, "pinned")])),
+                oracle([*shipped, "towards", "pinned"]),
+                oracle([*bands, "fitted", "towards", "pinned"]),
+            ]
+            txt = [f"{c:.3g}" + (" **above**" if c > bar * (1 + 1e-9) else "") for c in cells]
+            extra = " ".join(
+                f"{f:g}°: {np.mean(res[(n, f'comp {f:g}')]):.3g}" for f in EXTRA_FLOORS
+            )
+            ceil = f"{np.mean(res[(n, 'ceiling')]):.3g}" if (n, "ceiling") in res else "–"
+            rows.append(
+                f"| {scene} | {n} | {tuned:g}°: {bar:.3g} | "
+                + " | ".join(txt)
+                + f" | {extra} | {np.mean(res[(n, 'optimal')]):.3g} | {ceil} |"
+            )
+        print(f"{scene} done", flush=True)
+    return rows
+
+
+#: The ``ceiling`` tries every CEILING_STRIDE-th available light at each position (offset by
+#: the position), so one sweep costs (N - 4) × 216 / CEILING_STRIDE robust fits.
+CEILING_STRIDE = 3
+
+
+def _start_state(dirs, grey, start: list[int], n: int):  # type: ignore[no-untyped-def]
+    """The chooser's surface state after the starting images (what the first decision sees)."""
+    chooser = AdaptiveChooser(dirs, start, n, None, design_lights=n)
+    for i in range(len(start)):
+        c, _ = chooser.decide(i)
+        assert c is not None
+        chooser.observe(c, dirs[c], grey[c])
+    return chooser.state()
+
+
+def _true_greedy(err, keep, st, start, avail, sweeps: int = 1) -> float:  # type: ignore[no-untyped-def]
+    """The true error after single-light exchanges of the lights not shot (``start``: a
+    completion), each replaced by the tried light that lowers the *true* error most, for
+    ``sweeps`` sweeps: a stand-in for the best any completion of the start reaches."""
+    free = list(start)
+    cur = err(keep[np.r_[st, free]])
+    for _ in range(sweeps):
+        for pos in range(len(free)):
+            used = set(free)
+            for c in np.flatnonzero(avail)[pos % CEILING_STRIDE :: CEILING_STRIDE]:
+                if int(c) in used:
+                    continue
+                trial = free.copy()
+                trial[pos] = int(c)
+                e = err(keep[np.r_[st, trial]])
+                if e < cur:
+                    cur, best_c = e, int(c)
+                    free[pos] = best_c
+                    used = set(free)
+    return cur
+
+
 def main(argv: list[str] | None = None) -> str:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--draws", type=int, default=8)
     ap.add_argument("--scenes", default="", help="comma-separated simulated scenes (default all)")
     ap.add_argument("--write", action="store_true", help="write the table into docs/adaptive.md")
+    ap.add_argument(
+        "--families",
+        action="store_true",
+        help="instead: the oracle of wider design families from the shipped start",
+    )
+    ap.add_argument(
+        "--ceiling",
+        default="",
+        help="with --families: cells scene:N (comma-separated) that also get a greedy exchange "
+        "on the true error (slow)",
+    )
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
+    if args.families:
+        return _families_main(args, t0)
     rows = reach(args.draws, tuple(x for x in args.scenes.split(",") if x))
     floors = "/".join(f"{f:g}°" for f in FLOORS)
     md = "\n".join(
@@ -180,6 +454,55 @@ def main(argv: list[str] | None = None) -> str:
     print(md)
     if args.write:
         write_section("adaptive_reach", md, DOC)
+    return md
+
+
+def _families_main(args: argparse.Namespace, t0: float) -> str:
+    ceiling = tuple(x for x in args.ceiling.split(",") if x)
+    rows = families(args.draws, tuple(x for x in args.scenes.split(",") if x), ceiling=ceiling)
+    extra = "/".join(f"{f:g}°" for f in EXTRA_FLOORS)
+    md = "\n".join(
+        [
+            f"Command: `python -m benchmarks.adaptive_reach --families --draws {args.draws}"
+            + (f" --ceiling {args.ceiling}" if ceiling else "")
+            + (f" --scenes {args.scenes}" if args.scenes else "")
+            + (" --write" if args.write else "")
+            + f"` ({time.perf_counter() - t0:.0f} s; load average {os.getloadavg()[0]:.1f} at "
+            "the end). " + machine_line(),
+            "",
+            f"Simulator, {args.draws} paired draws (those of `benchmarks.adaptive`), the shipped "
+            "start (4 lights), designs decided at the first decision. Per family, the oracle "
+            "(true mean normal error, °, of the best design of the family per draw): "
+            f"`floors` — completions above {'/'.join(f'{f:g}°' for f in FLOORS)} (what ships); "
+            f"`bands` — those and completions above {extra}; `fitted` — one design: "
+            "`optimal`'s objective "
+            "on the surface fitted to the 4 starting images (what a session knows: "
+            "`planner.adaptive_optimal`), exchange search with the starting lights kept, from "
+            "the shipped completions; `floors+fitted` — the best of `floors` and `fitted`; "
+            "the next three use the benchmark's preview (a session has none): `towards` — one "
+            "design: the start "
+            "completed towards the benchmark's `optimal` layout (its lights nearest the start's "
+            "replaced by them); `pinned` — one design: `optimal` (same preview, objective and "
+            "exchange search) with the 4 starting lights kept, searched from the shipped "
+            "completions and `towards`; `floors+preview` — the best of `floors`, `towards` "
+            "and `pinned`; `all` — the best of every design above. Then the "
+            "extra floors' completions alone (means), unconditioned `optimal` (not reachable "
+            "from the start; for reference) and, where measured, the `ceiling`: single-light "
+            "exchanges of the lights not shot on the *true* error (one sweep from the best "
+            f"shipped completion, every {CEILING_STRIDE}rd available light tried at each "
+            "place). **above**: above the bar (the hindsight-tuned homogeneous "
+            "layout).",
+            "",
+            "| scene | N | bar | `floors` (ships) | `bands` | `fitted` | `floors+fitted` | "
+            "`towards` | `pinned` | `floors+preview` | `all` | extra floors alone | `optimal` | "
+            "`ceiling` |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            *rows,
+        ]
+    )
+    print(md)
+    if args.write:
+        write_section("adaptive_reach_families", md, DOC)
     return md
 
 

@@ -51,3 +51,48 @@ def test_the_three_light_start_belongs_to_both_layouts_or_is_the_shipped_one(n: 
         assert set(start) <= default & partner
     else:
         assert start == dome_start(dome, 4, n)
+
+
+@pytest.mark.parametrize("n", [6, 9])
+def test_a_completion_towards_a_layout_keeps_the_start_and_the_layout_s_other_lights(
+    n: int,
+) -> None:
+    from benchmarks.adaptive_reach import layout_completion
+
+    dome = _dome(0)
+    layout = select_uniform_leds(dome, n, 20.0)
+    start = dome_start(dome, 4, n)
+    rest = layout_completion(dome.directions, layout, start)
+    assert len(rest) == n - 4 and not set(rest.tolist()) & set(start)
+    assert len(set(rest.tolist())) == n - 4
+    # a start inside the layout: the completion is the layout's other lights
+    inside = [int(i) for i in layout[:4]]
+    assert sorted(layout_completion(dome.directions, layout, inside).tolist()) == sorted(
+        int(i) for i in layout[4:]
+    )
+
+
+def test_optimal_pinned_keeps_the_lights_shot() -> None:
+    from benchmarks.adaptive_reach import pinned_optimal
+
+    dome = _dome(1)
+    start = dome_start(dome, 4, 9)
+    got = pinned_optimal(None, dome, 9, None, start)  # type: ignore[arg-type]
+    assert len(got) == 9 == len(set(got.tolist())) and set(start) <= set(got.tolist())
+
+
+def test_the_true_error_ceiling_is_never_worse_than_its_start() -> None:
+    from benchmarks.adaptive_reach import _true_greedy
+
+    target = np.linspace(0.0, 1.0, 30)
+
+    def err(idx: np.ndarray) -> float:  # a toy error: distance of the lights' mean from 0.2
+        return abs(float(target[idx].mean()) - 0.2)
+
+    keep = np.arange(30)
+    avail = np.ones(30, bool)
+    avail[[0, 1]] = False
+    start = np.array([20, 25, 29])
+    got = _true_greedy(err, keep, np.array([0, 1]), start, avail)
+    assert got <= err(keep[np.r_[[0, 1], start]])
+    assert got < 0.05  # the exchange found the low lights
