@@ -33,7 +33,7 @@ from typing import TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.core.clock import Clock
+from rti_rig.core.clock import Clock, VirtualClock
 from rti_rig.core.devices import DiscreteLightSource
 from rti_rig.core.dome_link import (
     DomeInfo,
@@ -185,12 +185,21 @@ class DomePolicy:
         self._lit: _Lit | None = None
         #: What the last all-off attempt established (None: none attempted yet).
         self.off_report: OffReport | None = None
+        #: The clock the link really waits on, when it is not the rig's simulated one: a real
+        #: firmware's emulator on a pseudo-terminal answers (and blocks: 1.5 s per LED for
+        #: rti-dome-m) in real time, which a dry run's rig time must count as the real rig
+        #: would spend it. ``None`` when the link waits on the rig's own clock.
+        link_clock = getattr(getattr(link, "transport", None), "clock", None)
+        separate = link_clock is not None and link_clock is not clock
+        self._link_clock: Clock | None = (
+            link_clock if separate and isinstance(clock, VirtualClock) else None
+        )
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> None:
         try:
-            info = self.link.connect()
+            info = self._counted(self.link.connect)
         except DomeLinkError as exc:
             if exc.command == "open port":
                 # Nothing was ever sent: say so, not "all-off failed, lights may be on".
@@ -374,7 +383,7 @@ class DomePolicy:
         while True:
             self.stats.commands += 1
             try:
-                return op()
+                return self._counted(op)
             except DomeLinkError as exc:
                 fault = exc.fault
                 log.warning(
@@ -430,7 +439,7 @@ class DomePolicy:
         elif exc.fault is LinkFault.RESET:
             self.stats.rehandshakes += 1
             try:
-                info = self.link.hello()
+                info = self._counted(self.link.hello)
             except DomeLinkError as again:
                 if again.fault is LinkFault.DISCONNECTED:
                     self._reconnect(command)
@@ -449,7 +458,7 @@ class DomePolicy:
         for attempt in range(self.settings.reconnect_attempts):
             self.clock.sleep(self.settings.reconnect_backoff_s * (2**attempt))
             try:
-                info = self.link.connect()
+                info = self._counted(self.link.connect)
             except DomeLinkError as exc:
                 last = exc.message
                 self._quiet_close()
@@ -519,10 +528,21 @@ class DomePolicy:
         self._attempt_off("after an error")
         self._lit = None
 
+    def _counted(self, op: Callable[[], T]) -> T:
+        """``op()``, its time on the link's real clock added to the rig's simulated clock
+        (see ``_link_clock``; nothing to add when the link waits on the rig's clock)."""
+        if self._link_clock is None:
+            return op()
+        t0 = self._link_clock.now()
+        try:
+            return op()
+        finally:
+            self.clock.sleep(max(0.0, self._link_clock.now() - t0))
+
     def _attempt_off(self, when: str) -> None:
         """One all-off, whatever state the link is in; record what it established."""
         try:
-            self.link.all_off()
+            self._counted(self.link.all_off)
         except DomeLinkError as exc:
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = _failed_off(exc)

@@ -8,6 +8,7 @@ own clock is virtual, so CPU load cannot exhaust them.
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from pathlib import Path
@@ -312,3 +313,17 @@ def test_a_port_that_never_opened_says_this_run_lit_nothing(tmp_path: Path) -> N
     assert "could NOT be sent" not in text
     assert "no handshake" not in text
     assert "lights are off" not in text
+
+
+@pytest.mark.slow  # rti-dome-m blocks 1.5 s per command over a real pty
+def test_a_dry_run_counts_the_time_the_firmware_really_blocks(tmp_path: Path) -> None:
+    """rti-dome-m blocks 1.5 s after every ``M<n>`` (docs/domes.md). The emulator does so in
+    real time on its pty while the dry run's rig clock is simulated: the rig time the session
+    reports (what the real rig would take) must count it. It reported 9.2 s for 8 lights."""
+    out = tmp_path / "s"
+    cfg = CONFIGS / CONFIG["rti-dome-m"]
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    timing = json.loads((out / "manifest.json").read_text())["timing"]
+    # at least: 2 lights and 2 all-offs (start, end), each blocking 1.5 s
+    assert timing["rig_time_s"] >= 4 * 1.5
