@@ -11,10 +11,11 @@ how often this object's fit kept an observation of each kind), minimised by the 
 search with the lights already shot kept. Its reach is measured by ``python -m
 benchmarks.adaptive_reach --families``, its effect through the chooser by ``python -m
 benchmarks.adaptive --fitted-design [--fitted-pixels K]``. A session offers it beside the
-floors only with ``planner.adaptive.FITTED_DESIGN`` (off: docs/adaptive.md, "Why the three
+floors with ``planner.adaptive.FITTED_DESIGN`` (on: docs/adaptive.md, "Why the three
 losses remain" — it turns two of the three losses into ties and passes the selection rule
-with 500 pixels, but its decision exceeds 0.2 s at 75–100 lights on a 200-LED dome, and
-shipping it changes the decision format and the estimate's calibration).
+searched over 500 pixels; :data:`SEARCH_SCANS` keeps its decision under 0.2 s up to 100
+lights; a decision that takes it records ``"design": "fitted"``, format
+``rti-rig-adaptive/5``).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from rti_rig.planner.objectives import (
     SurfaceSample,
     cast_shadow_visibility,
 )
-from rti_rig.planner.optimal import exchange_search
+from rti_rig.planner.optimal import MAX_PASSES, exchange_search
 
 
 class PinnedObjective:
@@ -86,8 +87,15 @@ def state_sample(state: SurfaceState, candidates: NDArray[np.float64]) -> Surfac
 
 
 #: At most this many of the state's sampled pixels are searched over (an even sub-sample):
-#: the search's cost grows with the pixels (None: all of them, 2000 in a session).
-SEARCH_PIXELS: int | None = None
+#: the search's cost grows with the pixels (None: all of them, 2000 in a session). 500 ships:
+#: chosen leave one scene out against every pixel and against no fitted design at all
+#: (docs/adaptive.md, "Why the three losses remain").
+SEARCH_PIXELS: int | None = 500
+#: A cap on the search's work: its sweeps over the F lights not shot yet are at most
+#: ``SEARCH_SCANS // F`` (1 … ``optimal.MAX_PASSES``), so a decision stays under 0.2 s at
+#: 100 lights (each sweep scans every free light's replacements). 56 = 4 sweeps × 14 free
+#: lights: it binds only beyond 18 lights (from the 4-light start, at most 14 are free).
+SEARCH_SCANS = 56
 
 
 def _subsample(state: SurfaceState, k: int | None) -> SurfaceState:
@@ -111,6 +119,11 @@ def _subsample(state: SurfaceState, k: int | None) -> SurfaceState:
     )
 
 
+def search_passes(free: int) -> int:
+    """The sweeps allowed over ``free`` lights not shot yet (:data:`SEARCH_SCANS`)."""
+    return int(np.clip(SEARCH_SCANS // max(free, 1), 1, MAX_PASSES))
+
+
 def pinned_optimal_design(
     state: SurfaceState,
     candidates: NDArray[np.float64],
@@ -126,5 +139,9 @@ def pinned_optimal_design(
     sample = state_sample(state, candidates)
     objective = NormalsObjective(sample, Candidates(candidates, None, None))
     pinned = PinnedObjective(objective, np.asarray(shot, dtype=np.intp))
-    res = exchange_search(pinned, [(str(i), np.asarray(s)) for i, s in enumerate(starts)])
+    res = exchange_search(
+        pinned,
+        [(str(i), np.asarray(s)) for i, s in enumerate(starts)],
+        max_passes=search_passes(len(starts[0])),
+    )
     return np.asarray(res.chosen, dtype=np.intp)
