@@ -91,11 +91,16 @@ def state_sample(state: SurfaceState, candidates: NDArray[np.float64]) -> Surfac
 #: chosen leave one scene out against every pixel and against no fitted design at all
 #: (docs/adaptive.md, "Why the three losses remain").
 SEARCH_PIXELS: int | None = 500
-#: A cap on the search's work: its sweeps over the F lights not shot yet are at most
-#: ``SEARCH_SCANS // F`` (1 … ``optimal.MAX_PASSES``), so a decision stays under 0.2 s at
-#: 100 lights (each sweep scans every free light's replacements). 56 = 4 sweeps × 14 free
-#: lights: it binds only beyond 18 lights (from the 4-light start, at most 14 are free).
+#: A cap on the search's work, so a decision stays under 0.2 s up to 100 lights (each sweep
+#: scans every free light's replacements over every searched pixel): with F lights not shot
+#: yet, at most ``SEARCH_SCANS // F`` sweeps (1 … ``optimal.MAX_PASSES``) over at most
+#: ``SEARCH_SWEEP_WORK // F`` pixels (at least ``SEARCH_MIN_PIXELS``). 56 = 4 sweeps × 14
+#: free lights and 7000 = 500 pixels × 14: both bind only beyond 18 lights (from the 4-light
+#: start at most 14 are free), where the design is searched more coarsely — it is still
+#: taken only if the object's simulation scores it better than the floors by the margin.
 SEARCH_SCANS = 56
+SEARCH_SWEEP_WORK = 7000
+SEARCH_MIN_PIXELS = 100
 
 
 def _subsample(state: SurfaceState, k: int | None) -> SurfaceState:
@@ -124,6 +129,14 @@ def search_passes(free: int) -> int:
     return int(np.clip(SEARCH_SCANS // max(free, 1), 1, MAX_PASSES))
 
 
+def search_pixels(free: int) -> int | None:
+    """The pixels searched over with ``free`` lights not shot yet (None: all of them):
+    :data:`SEARCH_PIXELS`, fewer beyond :data:`SEARCH_SWEEP_WORK` per sweep."""
+    if SEARCH_PIXELS is None:
+        return None
+    return min(SEARCH_PIXELS, max(SEARCH_MIN_PIXELS, SEARCH_SWEEP_WORK // max(free, 1)))
+
+
 def pinned_optimal_design(
     state: SurfaceState,
     candidates: NDArray[np.float64],
@@ -135,7 +148,7 @@ def pinned_optimal_design(
     candidate indices, none of them shot, all of the same length)."""
     if not starts:
         raise ValueError("the search needs at least one starting completion")
-    state = _subsample(state, SEARCH_PIXELS)
+    state = _subsample(state, search_pixels(len(starts[0])))
     sample = state_sample(state, candidates)
     objective = NormalsObjective(sample, Candidates(candidates, None, None))
     pinned = PinnedObjective(objective, np.asarray(shot, dtype=np.intp))

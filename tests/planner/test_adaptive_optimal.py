@@ -140,6 +140,15 @@ def test_the_search_s_cap_binds_only_beyond_18_lights() -> None:
     assert search_passes(50) == search_passes(96) == 1
 
 
+def test_the_search_s_pixels_shrink_only_beyond_18_lights() -> None:
+    from rti_rig.planner.adaptive import START_LIGHTS
+    from rti_rig.planner.adaptive_optimal import SEARCH_PIXELS, search_pixels
+
+    assert SEARCH_PIXELS == 500  # what was chosen leave one scene out
+    assert all(search_pixels(f) == SEARCH_PIXELS for f in range(1, 18 - START_LIGHTS + 1))
+    assert 100 <= search_pixels(50) < SEARCH_PIXELS and search_pixels(96) == 100
+
+
 def test_at_100_lights_the_search_scans_each_free_light_about_once(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
