@@ -10,7 +10,7 @@ NormalsObjective`, the Lambertian fit's Cramér–Rao bound plus its model bias)
 how often this object's fit kept an observation of each kind), minimised by the same exchange
 search with the lights already shot kept. Its reach is measured by ``python -m
 benchmarks.adaptive_reach --families``, its effect through the chooser by ``python -m
-benchmarks.adaptive --fitted-design [--fitted-pixels K]``. A session offers it beside the
+benchmarks.adaptive [--no-fitted-design] [--fitted-pixels K]``. A session offers it beside the
 floors with ``planner.adaptive.FITTED_DESIGN`` (on: docs/adaptive.md, "Why the three
 losses remain" — it turns two of the three losses into ties and passes the selection rule
 searched over 500 pixels; :data:`SEARCH_SCANS` keeps its decision under 0.2 s up to 100
