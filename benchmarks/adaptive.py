@@ -27,7 +27,7 @@ error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
-[--fitted-design [--fitted-pixels K]] [--no-relight] [--cache FILE]
+[--no-fitted-design] [--fitted-pixels K] [--no-relight] [--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
@@ -472,17 +472,17 @@ def main(argv: list[str] | None = None) -> str:
         "--no-until", action="store_true", help="skip the --until-error rows (faster to iterate)"
     )
     ap.add_argument(
-        "--fitted-design",
+        "--no-fitted-design",
         action="store_true",
-        help="also offer the design of planner.adaptive_optimal (optimal on the fitted surface, "
-        "the lights shot kept; off in what ships)",
+        help="do not offer the design of planner.adaptive_optimal (optimal on the fitted "
+        "surface, the lights shot kept; offered in what ships): the floors' completions only",
     )
     ap.add_argument(
         "--fitted-pixels",
         type=int,
         default=None,
-        help="with --fitted-design: search over at most this many sampled pixels "
-        "(planner.adaptive_optimal.SEARCH_PIXELS; default all)",
+        help="search the fitted design over at most this many sampled pixels, 0 for all "
+        "(planner.adaptive_optimal.SEARCH_PIXELS; default what ships, 500)",
     )
     ap.add_argument(
         "--no-relight",
@@ -499,14 +499,14 @@ def main(argv: list[str] | None = None) -> str:
             "--sim-draws and --real-draws need at least 2 (the verdicts are paired tests; "
             "--real-draws 0 skips the real acquisition)"
         )
-    if args.fitted_design:
+    if args.no_fitted_design:
         import rti_rig.planner.adaptive as adaptive_planner
 
-        adaptive_planner.FITTED_DESIGN = True
-        if args.fitted_pixels is not None:
-            import rti_rig.planner.adaptive_optimal as adaptive_optimal
+        adaptive_planner.FITTED_DESIGN = False
+    if args.fitted_pixels is not None:
+        import rti_rig.planner.adaptive_optimal as adaptive_optimal
 
-            adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels
+        adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels or None
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
@@ -564,8 +564,8 @@ def main(argv: list[str] | None = None) -> str:
             + (" --no-until" if args.no_until else "")
             + (f" --start {args.start}" if args.start != "default" else "")
             + (" --relief-gain" if args.relief_gain else "")
-            + (" --fitted-design" if args.fitted_design else "")
-            + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels else "")
+            + (" --no-fitted-design" if args.no_fitted_design else "")
+            + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"

@@ -458,6 +458,11 @@ def main(argv: list[str] | None = None) -> str:
 
 
 def _families_main(args: argparse.Namespace, t0: float) -> str:
+    import rti_rig.planner.adaptive_optimal as adaptive_optimal
+
+    # the family's reach is measured searching every sampled pixel, as its table in
+    # docs/adaptive.md was (a session searches SEARCH_PIXELS = 500 of them)
+    adaptive_optimal.SEARCH_PIXELS = None
     ceiling = tuple(x for x in args.ceiling.split(",") if x)
     rows = families(args.draws, tuple(x for x in args.scenes.split(",") if x), ceiling=ceiling)
     extra = "/".join(f"{f:g}°" for f in EXTRA_FLOORS)

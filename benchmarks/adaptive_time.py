@@ -77,7 +77,17 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--max-optimal-n", type=int, default=100)
     ap.add_argument("--write", action="store_true")
+    ap.add_argument(
+        "--no-fitted-design",
+        action="store_true",
+        help="time the design decisions without planner.adaptive_optimal's design (offered in "
+        "what ships): to compare",
+    )
     args = ap.parse_args(argv)
+    if args.no_fitted_design:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.FITTED_DESIGN = False
     dome = DomeGeometry(fibonacci_cap(200, 5.0), tuple(f"led_{i:03d}" for i in range(200)))
     arm = ArmGeometry(5.0, 80.0, 10.0, 0.0, 45.0)
     scene = relief_scene(85, 128, seed=0)
@@ -169,6 +179,7 @@ def main(argv: list[str] | None = None) -> str:
     decisions_only = args.max_optimal_n <= 0
     cmd = "python -m benchmarks.adaptive_time --repeats " + str(args.repeats)
     cmd += " --max-optimal-n 0" if decisions_only else ""
+    cmd += " --no-fitted-design" if args.no_fitted_design else ""
     lines = [
         f"Command: `{cmd} --write`. "
         + machine_line()

@@ -10,11 +10,12 @@ NormalsObjective`, the Lambertian fit's Cramér–Rao bound plus its model bias)
 how often this object's fit kept an observation of each kind), minimised by the same exchange
 search with the lights already shot kept. Its reach is measured by ``python -m
 benchmarks.adaptive_reach --families``, its effect through the chooser by ``python -m
-benchmarks.adaptive --fitted-design [--fitted-pixels K]``. A session offers it beside the
-floors only with ``planner.adaptive.FITTED_DESIGN`` (off: docs/adaptive.md, "Why the three
+benchmarks.adaptive [--no-fitted-design] [--fitted-pixels K]``. A session offers it beside the
+floors with ``planner.adaptive.FITTED_DESIGN`` (on: docs/adaptive.md, "Why the three
 losses remain" — it turns two of the three losses into ties and passes the selection rule
-with 500 pixels, but its decision exceeds 0.2 s at 75–100 lights on a 200-LED dome, and
-shipping it changes the decision format and the estimate's calibration).
+searched over 500 pixels; :data:`SEARCH_SCANS` keeps its decision under 0.2 s up to 100
+lights; a decision that takes it records ``"design": "fitted"``, format
+``rti-rig-adaptive/5``).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from rti_rig.planner.objectives import (
     SurfaceSample,
     cast_shadow_visibility,
 )
-from rti_rig.planner.optimal import exchange_search
+from rti_rig.planner.optimal import MAX_PASSES, exchange_search
 
 
 class PinnedObjective:
@@ -86,8 +87,20 @@ def state_sample(state: SurfaceState, candidates: NDArray[np.float64]) -> Surfac
 
 
 #: At most this many of the state's sampled pixels are searched over (an even sub-sample):
-#: the search's cost grows with the pixels (None: all of them, 2000 in a session).
-SEARCH_PIXELS: int | None = None
+#: the search's cost grows with the pixels (None: all of them, 2000 in a session). 500 ships:
+#: chosen leave one scene out against every pixel and against no fitted design at all
+#: (docs/adaptive.md, "Why the three losses remain").
+SEARCH_PIXELS: int | None = 500
+#: A cap on the search's work, so a decision stays under 0.2 s up to 100 lights (each sweep
+#: scans every free light's replacements over every searched pixel): with F lights not shot
+#: yet, at most ``SEARCH_SCANS // F`` sweeps (1 … ``optimal.MAX_PASSES``) over at most
+#: ``SEARCH_SWEEP_WORK // F`` pixels (at least ``SEARCH_MIN_PIXELS``). 56 = 4 sweeps × 14
+#: free lights and 7000 = 500 pixels × 14: both bind only beyond 18 lights (from the 4-light
+#: start at most 14 are free), where the design is searched more coarsely — it is still
+#: taken only if the object's simulation scores it better than the floors by the margin.
+SEARCH_SCANS = 56
+SEARCH_SWEEP_WORK = 7000
+SEARCH_MIN_PIXELS = 100
 
 
 def _subsample(state: SurfaceState, k: int | None) -> SurfaceState:
@@ -111,6 +124,19 @@ def _subsample(state: SurfaceState, k: int | None) -> SurfaceState:
     )
 
 
+def search_passes(free: int) -> int:
+    """The sweeps allowed over ``free`` lights not shot yet (:data:`SEARCH_SCANS`)."""
+    return int(np.clip(SEARCH_SCANS // max(free, 1), 1, MAX_PASSES))
+
+
+def search_pixels(free: int) -> int | None:
+    """The pixels searched over with ``free`` lights not shot yet (None: all of them):
+    :data:`SEARCH_PIXELS`, fewer beyond :data:`SEARCH_SWEEP_WORK` per sweep."""
+    if SEARCH_PIXELS is None:
+        return None
+    return min(SEARCH_PIXELS, max(SEARCH_MIN_PIXELS, SEARCH_SWEEP_WORK // max(free, 1)))
+
+
 def pinned_optimal_design(
     state: SurfaceState,
     candidates: NDArray[np.float64],
@@ -122,9 +148,13 @@ def pinned_optimal_design(
     candidate indices, none of them shot, all of the same length)."""
     if not starts:
         raise ValueError("the search needs at least one starting completion")
-    state = _subsample(state, SEARCH_PIXELS)
+    state = _subsample(state, search_pixels(len(starts[0])))
     sample = state_sample(state, candidates)
     objective = NormalsObjective(sample, Candidates(candidates, None, None))
     pinned = PinnedObjective(objective, np.asarray(shot, dtype=np.intp))
-    res = exchange_search(pinned, [(str(i), np.asarray(s)) for i, s in enumerate(starts)])
+    res = exchange_search(
+        pinned,
+        [(str(i), np.asarray(s)) for i, s in enumerate(starts)],
+        max_passes=search_passes(len(starts[0])),
+    )
     return np.asarray(res.chosen, dtype=np.intp)

@@ -112,22 +112,71 @@ def _session(n_total: int) -> list[dict]:  # type: ignore[type-arg]
     return evidence
 
 
-def test_off_by_default_the_decisions_offer_only_floors() -> None:
+def test_by_default_the_fitted_design_is_scored_beside_the_floors() -> None:
+    evidence = [e for e in _session(6) if e.get("kind") == "adaptive"]
+    assert evidence and all("fitted" in e["design_error_deg"] for e in evidence)
+    # a decision names either a floor or the fitted design, never both
+    assert all(("design" in e) != ("design_floor_deg" in e) for e in evidence)
+
+
+def test_turned_off_the_decisions_offer_only_floors(monkeypatch: pytest.MonkeyPatch) -> None:
+    import rti_rig.planner.adaptive as adaptive
+
+    monkeypatch.setattr(adaptive, "FITTED_DESIGN", False)
     evidence = [e for e in _session(6) if e.get("kind") == "adaptive"]
     assert evidence and all("design_floor_deg" in e for e in evidence)
     assert all("fitted" not in e["design_error_deg"] for e in evidence)
 
 
-def test_turned_on_the_fitted_design_is_scored_beside_the_floors(
+def test_the_search_s_cap_binds_only_beyond_18_lights() -> None:
+    """From the 4-light start at most 14 lights are free at N <= 18: every sweep allowed
+    there (the decisions unchanged); beyond, fewer sweeps, at least one."""
+    from rti_rig.planner.adaptive import START_LIGHTS
+    from rti_rig.planner.adaptive_optimal import search_passes
+    from rti_rig.planner.optimal import MAX_PASSES
+
+    assert all(search_passes(f) == MAX_PASSES for f in range(1, 18 - START_LIGHTS + 1))
+    assert search_passes(20) < MAX_PASSES
+    assert search_passes(50) == search_passes(96) == 1
+
+
+def test_the_search_s_pixels_shrink_only_beyond_18_lights() -> None:
+    from rti_rig.planner.adaptive import START_LIGHTS
+    from rti_rig.planner.adaptive_optimal import SEARCH_PIXELS, search_pixels
+
+    assert SEARCH_PIXELS == 500  # what was chosen leave one scene out
+    assert all(search_pixels(f) == SEARCH_PIXELS for f in range(1, 18 - START_LIGHTS + 1))
+    assert 100 <= search_pixels(50) < SEARCH_PIXELS and search_pixels(96) == 100
+
+
+def test_at_100_lights_the_search_scans_each_free_light_about_once(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    import rti_rig.planner.adaptive as adaptive
+    """The cap is what bounds a decision's time at large N: the single-light scans of the
+    search, counted, stay within one sweep (plus the re-scans of a proposal) at 100 lights."""
+    dirs = fibonacci_cap(200, 5.0)
+    g = DomeGeometry(dirs, tuple(f"l{i}" for i in range(len(dirs))))
+    full = select_uniform_leds(g, 100, 10.0)
+    shot = np.array([int(full[i]) for i in start_subset(dirs[full], 50)])
+    rng = np.random.default_rng(1)
+    normals = np.c_[rng.normal(0, 0.4, (300, 2)), np.ones(300)]
+    state = state_for(normals, dirs[shot])
+    available = np.ones(len(dirs), bool)
+    available[shot] = False
+    starts = [
+        homogeneous_completion(dirs, available, dirs[shot], 100, f) for f in (0.0, 10.0, 20.0)
+    ]
+    calls = []
+    real = NormalsObjective.swap_costs
 
-    monkeypatch.setattr(adaptive, "FITTED_DESIGN", True)
-    evidence = [e for e in _session(6) if e.get("kind") == "adaptive"]
-    assert evidence and all("fitted" in e["design_error_deg"] for e in evidence)
-    # a decision names either a floor or the fitted design, never both
-    assert all(("design" in e) != ("design_floor_deg" in e) for e in evidence)
+    def counted(self, *a, **kw):  # type: ignore[no-untyped-def]
+        calls.append(kw.get("exact"))
+        return real(self, *a, **kw)
+
+    monkeypatch.setattr(NormalsObjective, "swap_costs", counted)
+    free = pinned_optimal_design(state, dirs, shot, starts)
+    assert len(free) == 50 and not set(free.tolist()) & set(shot.tolist())
+    assert sum(1 for c in calls if not c) <= 50
 
 
 def test_a_pixel_sub_sample_keeps_every_per_pixel_array_aligned(

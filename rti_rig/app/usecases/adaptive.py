@@ -67,8 +67,11 @@ OUTLIER_K = 3.0
 OUTLIER_FLOOR = 0.02
 #: An adaptive run that gives only --until-error on an arm stops at this many lights at most.
 ARM_MAX_LIGHTS = 100
-#: 4: the design objective (``normals``/``relight``) in the settings and every decision
-FORMAT = "rti-rig-adaptive/4"
+#: 4: the design objective (``normals``/``relight``) in the settings and every decision;
+#: 5: the fitted design (``planner.adaptive_optimal``) offered beside the floors, a decision
+#: that takes it recording ``"design": "fitted"`` (a /4 session's choices would differ: its
+#: resume is refused, before anything on disk changes)
+FORMAT = "rti-rig-adaptive/5"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
@@ -706,6 +709,20 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     return rig, schedule, folder, source
 
 
+def refuse_other_format(header: dict, root: Path) -> None:
+    """Refuse an adaptive session begun under another decision format (its choices would
+    differ from the ones already made: /4 never offered the fitted design), by name and with
+    what to do — from the manifest alone, before the folder or the rig is touched."""
+    if header.get("format") != FORMAT:
+        raise RtiRigError(
+            f"{root}: this adaptive session was begun with format "
+            f"{header.get('format')!r}, and this version of rti-rig continues only {FORMAT!r} "
+            "(its choices would differ from the ones already made). The images are kept: "
+            "`rti-rig export-lp` and `rti-rig fit` use them as they are; start a new session to "
+            "shoot more"
+        )
+
+
 def check_resume_objective(manifest: dict, root: Path, objective: str | None) -> str:
     """The objective an interrupted session was begun with; a different ``objective`` asked
     for is refused (from the manifest alone, before anything on disk is touched)."""
@@ -717,8 +734,7 @@ def check_resume_objective(manifest: dict, root: Path, objective: str | None) ->
             f"{root}: --objective goes with an adaptive session, and this one is not: drop "
             f"--objective {objective}"
         )
-    if header.get("format") != FORMAT:  # refused by name where the source is made
-        return "normals"
+    refuse_other_format(header, root)
     began = header.get("objective")
     if began not in OBJECTIVES:
         raise RtiRigError(
@@ -739,14 +755,7 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
     """The step source of an interrupted adaptive session, brought up to its last step
     (``objective``: the one the user asks for, if any — it must be the session's own)."""
     header = folder.manifest["adaptive"]
-    if header.get("format") != FORMAT:
-        raise RtiRigError(
-            f"{folder.root}: this adaptive session was begun with format "
-            f"{header.get('format')!r}, and this version of rti-rig continues only {FORMAT!r} "
-            "(its choices would differ from the ones already made). The images are kept: "
-            "`rti-rig export-lp` and `rti-rig fit` use them as they are; start a new session to "
-            "shoot more"
-        )
+    refuse_other_format(header, Path(folder.root))
     began = check_resume_objective(folder.manifest, Path(folder.root), objective)
     plan = adaptive_plan(
         rig,
