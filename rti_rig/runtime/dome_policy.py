@@ -194,6 +194,8 @@ class DomePolicy:
         self._link_clock: Clock | None = (
             link_clock if separate and isinstance(clock, VirtualClock) else None
         )
+        #: Whether this policy ever had the port open (then something may have been sent).
+        self._port_was_open = False
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -201,10 +203,12 @@ class DomePolicy:
         try:
             info = self._counted(self.link.connect)
         except DomeLinkError as exc:
-            if exc.command == "open port":
+            if exc.command == "open port" and not self._port_was_open:
                 # Nothing was ever sent: say so, not "all-off failed, lights may be on".
                 self.off_report = OffReport(OffOutcome.NEVER_OPENED, exc.message)
             else:
+                if exc.command != "open port":
+                    self._port_was_open = True
                 # A board that answered nothing we understood may still be lit (one sketch
                 # boots with every LED on): send the all-off anyway wherever the port is open.
                 self._attempt_off(f"after the failed connection: {exc.message}")
@@ -222,6 +226,7 @@ class DomePolicy:
                 "the protocol profile in the rig config, and that the board is powered",
                 exc.command,
             ) from exc
+        self._port_was_open = True
         problem = self._check_identity(info)
         if problem:
             self._attempt_off("after the identity check failed")

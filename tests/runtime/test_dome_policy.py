@@ -497,3 +497,40 @@ def test_profile_without_intensity_refuses_a_dimmed_light_clearly():
     with pytest.raises(DomeLedError, match=r"send_level = false\): only full intensity 1\.0"):
         dome.light(3, 0.5)
     assert fw.lit is None
+
+
+def test_a_port_that_fails_to_open_again_after_lighting_is_not_called_never_opened():
+    """'This run lit nothing' only when the port was never open: a reconnection that fails at
+    open, after LEDs were lit, must not claim it (the all-off could not be sent)."""
+    from rti_rig.drivers.led_dome.transport import TransportError
+
+    dome, _fw, _clock = make("default")
+    dome.connect()
+    dome.light(1, 1.0)
+    dome.link.close()  # the USB cable pulled: the next connect cannot open the port
+
+    def gone() -> None:
+        raise TransportError("could not open port: no such device")
+
+    dome.link.transport.open = gone
+    dome.info = None
+    with pytest.raises(DeviceError, match="port could not be opened"):
+        dome.connect()
+    assert dome.off_report is not None
+    assert dome.off_report.outcome != "never-opened"
+    assert "lit nothing" not in dome.off_report.sentence()
+
+
+def test_a_port_that_never_opened_says_nothing_was_sent():
+    from rti_rig.drivers.led_dome.transport import TransportError
+
+    dome, _fw, _clock = make("default")
+
+    def gone() -> None:
+        raise TransportError("could not open port: no such device")
+
+    dome.link.transport.open = gone
+    with pytest.raises(DeviceError, match="port could not be opened"):
+        dome.connect()
+    assert dome.off_report is not None and dome.off_report.outcome == "never-opened"
+    assert "lit nothing" in dome.off_report.sentence()
