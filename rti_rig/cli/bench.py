@@ -32,8 +32,9 @@ def _find_benchmarks() -> None:
     here = Path(rti_rig.__file__).resolve().parent.parent
     for root in (here, Path.cwd()):
         if (root / "benchmarks" / "tradeoff.py").is_file():
-            if str(root) not in sys.path:
-                sys.path.insert(0, str(root))
+            while str(root) in sys.path:  # first, even if it is already further down
+                sys.path.remove(str(root))
+            sys.path.insert(0, str(root))
             return
 
 

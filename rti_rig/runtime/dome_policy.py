@@ -206,6 +206,15 @@ class DomePolicy:
             if exc.command == "open port" and not self._port_was_open:
                 # Nothing was ever sent: say so, not "all-off failed, lights may be on".
                 self.off_report = OffReport(OffOutcome.NEVER_OPENED, exc.message)
+            elif (
+                exc.command == "open port"
+                and self._lit is None
+                and self.off_report is not None
+                and self.off_report.lights_known_off
+            ):
+                # Open before (metering, then the session) and switched off with an
+                # established all-off since: nothing was sent after it, so that still holds.
+                pass
             else:
                 if exc.command != "open port":
                     self._port_was_open = True

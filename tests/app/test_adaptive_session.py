@@ -217,6 +217,11 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     m = manifest(out)
     m["adaptive"]["format"] = old  # 2: before the bias-aware design score
     (out / "manifest.json").write_text(json.dumps(m))
+    # cut mid-write, as a kill leaves it: a torn last journal line, which a resume would repair
+    # (and set aside) if it opened the folder before refusing
+    with (out / "journal.jsonl").open("a", encoding="utf-8") as f:
+        f.write('{"step": 4, "led": 1')
+
     def files() -> dict[str, bytes]:
         return {str(p.relative_to(out)): p.read_bytes() for p in out.rglob("*") if p.is_file()}
 

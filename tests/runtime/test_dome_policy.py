@@ -534,3 +534,84 @@ def test_a_port_that_never_opened_says_nothing_was_sent():
         dome.connect()
     assert dome.off_report is not None and dome.off_report.outcome == "never-opened"
     assert "lit nothing" in dome.off_report.sentence()
+
+
+def test_an_acknowledged_all_off_still_holds_when_the_port_then_fails_to_open():
+    """Metering connects, lights, switches off (acknowledged) and closes; the session's own
+    connect then fails at open. Nothing was sent since the acknowledged all-off."""
+    from rti_rig.drivers.led_dome.transport import TransportError
+
+    dome, _fw, _clock = make("default")
+    dome.connect()
+    dome.light(1, 1.0)
+    dome.close()
+    assert dome.off_report is not None and dome.off_report.lights_known_off
+
+    def gone() -> None:
+        raise TransportError("could not open port: no such device")
+
+    dome.link.transport.open = gone
+    with pytest.raises(DeviceError, match="port could not be opened"):
+        dome.connect()
+    assert dome.off_report.lights_known_off
+    assert "lit nothing" not in dome.off_report.sentence()
+
+
+class _TimedLink:
+    """A link whose every exchange takes 0.25 s on its transport's clock."""
+
+    has_watchdog = False
+    echoes_light = True
+    can_query = True
+    max_level = 255
+    device = "timed"
+
+    def __init__(self, transport_clock):
+        from types import SimpleNamespace
+
+        from rti_rig.core.dome_link import DomeInfo
+
+        self.transport = SimpleNamespace(clock=transport_clock)
+        self._info = DomeInfo("TIMED", "1.0", 4)
+
+    def _take(self):
+        self.transport.clock.sleep(0.25)
+
+    def connect(self):
+        self._take()
+        return self._info
+
+    def all_off(self):
+        self._take()
+
+    def light(self, index, level, max_on_ms=None):
+        self._take()
+
+    def close(self):
+        pass
+
+
+def test_link_time_on_its_own_clock_is_added_once_to_a_simulated_rig_clock():
+    rig_clock, link_clock = VirtualClock(), VirtualClock()
+    dome = DomePolicy(_TimedLink(link_clock), rig_clock)
+    dome.connect()  # connect + its all-off
+    dome.light(0, 1.0)
+    dome.all_off()
+    assert link_clock.now() == pytest.approx(1.0)
+    assert rig_clock.now() == pytest.approx(1.0)  # counted once, not twice, not zero
+
+
+def test_link_time_is_not_added_when_the_link_waits_on_the_rig_clock_itself():
+    clock = VirtualClock()
+    dome = DomePolicy(_TimedLink(clock), clock)
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    assert clock.now() == pytest.approx(1.0)  # the link's own sleeps only
+
+
+def test_a_real_time_rig_never_sleeps_for_the_link_again():
+    from rti_rig.core.clock import SystemClock
+
+    dome = DomePolicy(_TimedLink(VirtualClock()), SystemClock())
+    assert dome._link_clock is None  # a hardware rig's clock is real: nothing to add

@@ -3,7 +3,9 @@
 Each built-in firmware profile is probed, checked and run with 8 lights by the CLI over a
 pseudo-terminal through real pyserial; the emulator's record of which LEDs were lit is checked
 at every capture and at the end. Timeouts on the pty are generous (seconds), and the dry run's
-own clock is virtual, so CPU load cannot exhaust them.
+own clock is virtual, so CPU load cannot exhaust them; the link's real time is added to it
+(what the real rig would spend), so a dry run's reported rig time moves with load by the
+pty's latency (milliseconds), which no test here bounds from above.
 """
 
 from __future__ import annotations
