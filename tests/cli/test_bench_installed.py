@@ -73,3 +73,20 @@ def test_tradeoff_from_shows_fit_warnings_as_notes_not_python_warnings() -> None
     assert r.returncode == 0, text
     assert ".py:" not in text, text  # no "rti_rig/reconstruct/ptm.py:134: ...Warning"
     assert "note: IllConditionedFitWarning" in " ".join(text.split())
+
+
+def test_the_checkout_benchmarks_go_first_even_behind_another_benchmarks(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """Another importable ``benchmarks`` earlier on the path (PYTHONPATH, the folder the command
+    runs in) is not taken for the checkout's own."""
+    from rti_rig.cli.bench import _find_benchmarks
+
+    fake = tmp_path / "fake"
+    (fake / "benchmarks").mkdir(parents=True)
+    (fake / "benchmarks" / "__init__.py").write_text("")
+    (fake / "benchmarks" / "tradeoff.py").write_text("raise RuntimeError('not ours')\n")
+    monkeypatch.setattr(sys, "path", [str(fake), str(REPO), *sys.path])
+    _find_benchmarks()
+    assert sys.path[0] == str(REPO)
+    assert sys.path.count(str(REPO)) == 1
