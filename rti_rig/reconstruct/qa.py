@@ -57,6 +57,9 @@ WRONG_LIGHT_DEG = 8.0
 #: A best direction further from the recorded one than this many times the session's median
 #: error is a wrong light too (a systematic error shared by every image is not a fault).
 WRONG_LIGHT_SPREAD = 3.0
+#: Light directions are judged only when the fitted normals spread at least this much (degrees,
+#: the smallest axis of their second moment): a flat card leaves the azimuth undetermined.
+MIN_NORMAL_SPREAD_DEG = 2.0
 #: Refits of the reference without the images found faulty.
 MAX_ROUNDS = 4
 #: An image below this gain at its bright end had no light at all (a black frame).
@@ -65,8 +68,10 @@ NO_LIGHT_GAIN = 0.1
 #: the prediction does not model lower the median; a dim light lowers every pixel).
 DIM_PERCENTILE = 90.0
 #: The shift is judged only on images whose light reaches (n . l > 0.2) at least this fraction
-#: of the crop's pixels (a grazing light's shadows move the correlation peak).
-DRIFT_MIN_LIT = 0.5
+#: of the crop's pixels: below it there is too little lit surface to correlate. (It was 0.5,
+#: which left a whole 10°-elevation ring unjudged, moved or not; the confirmation below, not
+#: this gate, keeps a grazing light's unmodelled shadows from being called a move.)
+DRIFT_MIN_LIT = 0.1
 #: A shift is real only if moving the image back cuts its residual to at most this fraction.
 DRIFT_CONFIRM = 0.8
 #: A shift against the prediction larger than this (pixels) is a move.
@@ -131,7 +136,7 @@ class QAReport:
             ]
             if skipped:
                 why = (
-                    "its light reaches less than half of the object"
+                    f"its light reaches less than {DRIFT_MIN_LIT:.0%} of the object"
                     if attr == "drift_judged"
                     else "too few pixels lit"
                 )
@@ -287,7 +292,7 @@ def assess(
     # self-consistent), then from every image not flagged, until the set stops changing.
     keep = np.ones(n, bool)
     ps = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
-    ev = _evidence(crop_arr, crop_sat, ps, lt, dark_level)
+    ev = _evidence(crop_arr, crop_sat, ps, lt, dark_level, names)
     for rnd in range(MAX_ROUNDS):
         bad = ev.dim | ev.wrong | ev.moved
         spread = np.nanmedian(ev.err) if np.isfinite(ev.err).any() else 0.0
@@ -309,7 +314,7 @@ def assess(
         except ReconstructionError:  # the remaining lights cannot determine normals
             break
         keep, ps = new_keep, ps_next
-        ev = _evidence(crop_arr, crop_sat, ps, lt, dark_level)
+        ev = _evidence(crop_arr, crop_sat, ps, lt, dark_level, names)
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []
@@ -319,7 +324,7 @@ def assess(
                 "reshoot with less exposure"
             )
         wrong_i = bool(ev.wrong[i] and ev.direction_judged[i])
-        if ev.dim[i]:
+        if ev.dim[i] and (not wrong_i or ev.lit_gain[i] < DIM_GAIN * 0.5):
             dead = ev.lit_gain[i] < NO_LIGHT_GAIN
             what = "misfired, no light" if dead else "misfired or dim light"
             problems.append(
@@ -329,7 +334,7 @@ def assess(
         elif wrong_i:
             problems.append(
                 f"wrong light: lit from {ev.err[i]:.0f}° away from its recorded direction "
-                f"(against the {ev.typical:.1f}° the other images agree to), closest to the "
+                f"(the images that agree do to a median {ev.typical:.1f}°), closest to the "
                 f"light recorded for {names[int(ev.near[i])]} (swapped?)"
             )
         elif (
@@ -376,6 +381,7 @@ def assess(
         "bright_gain": BRIGHT_GAIN,
         "wrong_light_deg": WRONG_LIGHT_DEG,
         "misfit_limit": MISFIT_LIMIT,
+        "min_normal_spread_deg": MIN_NORMAL_SPREAD_DEG,
         "wrong_light_spread": WRONG_LIGHT_SPREAD,
         "drift_px": DRIFT_PX,
         "drift_min_lit": DRIFT_MIN_LIT,
@@ -416,7 +422,14 @@ class _Evidence:
     misfit: NDArray
 
 
-def _evidence(crop_arr: NDArray, crop_sat: NDArray, ps: Any, lt: NDArray, dark: float) -> _Evidence:
+def _evidence(
+    crop_arr: NDArray,
+    crop_sat: NDArray,
+    ps: Any,
+    lt: NDArray,
+    dark: float,
+    names: Sequence[str],
+) -> _Evidence:
     """Every image judged against one fit ``ps``."""
     n = crop_arr.shape[0]
     valid = ps.valid
@@ -480,15 +493,27 @@ def _evidence(crop_arr: NDArray, crop_sat: NDArray, ps: Any, lt: NDArray, dark: 
     # against the session's own spread (systematic errors are shared, a wrong light stands out)
     best = _unit_rows(sols)
     err = np.array([_angle(best[i], lt[i]) if np.any(sols[i]) else np.nan for i in range(n)])
-    cand = ~dim & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT) & np.isfinite(err)
+    dead = np.isfinite(lit_gain) & (lit_gain < NO_LIGHT_GAIN)
+    # a wrong light can look dim (its recorded light predicts a brighter image): only a frame
+    # with no light at all has no direction to judge
+    cand = ~dead & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT) & np.isfinite(err)
+    nv = ps.normals[valid].astype(np.float64)
+    moment = nv.T @ nv / max(len(nv), 1)
+    spread_deg = float(np.degrees(np.arcsin(np.sqrt(max(np.linalg.eigvalsh(moment)[0], 0.0)))))
     near = np.zeros(n, int)
     wrong = np.zeros(n, bool)
     judged = np.zeros(n, bool)
     typical = float("nan")
     note = ""
-    undimmed = int((~dim).sum())
-    if cand.sum() < max(5, (undimmed + 1) // 2):
-        spread = float(np.median(misfit[~dim & np.isfinite(misfit)])) if undimmed else np.nan
+    undimmed = int((~dead).sum())
+    if spread_deg < MIN_NORMAL_SPREAD_DEG:
+        note = (
+            f"light directions not checked: the fitted normals spread only {spread_deg:.1f}° "
+            f"(limit {MIN_NORMAL_SPREAD_DEG:.0f}°): on a near-flat object a light's azimuth "
+            "cannot be told from its image"
+        )
+    elif cand.sum() < max(5, (undimmed + 1) // 2):
+        spread = float(np.median(misfit[~dead & np.isfinite(misfit)])) if undimmed else np.nan
         note = (
             f"light directions not checked: only {int(cand.sum())} of {undimmed} images are "
             f"close to any Lambertian rendering of the fit (median misfit {spread:.0%}, limit "
@@ -511,11 +536,12 @@ def _evidence(crop_arr: NDArray, crop_sat: NDArray, ps: Any, lt: NDArray, dark: 
                 mv = _confirmed_shift(pred_best, crop_arr[i], dx, dy, valid & ~crop_sat[i])[0]
             moved[i] = mv
             drift[i] = (dx, -dy)
-        skipped = [i for i in range(n) if not cand[i] and not dim[i]]
+        skipped = [i for i in range(n) if not cand[i] and not dead[i]]
         if skipped:
             note = (
-                f"light direction not checked on {len(skipped)} image(s) (further than "
-                f"{MISFIT_LIMIT:.0%} from any Lambertian rendering of the fit)"
+                f"light direction not checked on {_names([names[i] for i in skipped])} "
+                f"(further than {MISFIT_LIMIT:.0%} from any Lambertian rendering of the fit: "
+                "grazing light, gloss or clipping)"
             )
     return _Evidence(
         gain,
