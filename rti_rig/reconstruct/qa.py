@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
-from rti_rig.reconstruct.qa_directions import MISFIT_LIMIT, relative_misfit
+from rti_rig.reconstruct.qa_directions import MISFIT_LIMIT, consensus_images, relative_misfit
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
 #: Side of the central crop the per-image checks fit on (full resolution).
@@ -299,9 +299,17 @@ def assess(
         if rnd == 0 and not bad.any() and not spread > WRONG_LIGHT_DEG / 2:
             break
         new_keep = ~bad
-        if rnd == 0:  # the better half: closest to a rendering and to its recorded light
+        if rnd == 0:
+            # the largest set of images that agree among themselves (a fit from all of them
+            # is not trusted), less those found moved; failing that the better half: closest
+            # to a rendering and to its recorded light
+            agree = consensus_images(
+                crop_arr, lt, ~ev.dim & ~ev.moved, 2 * WRONG_LIGHT_DEG, dark_level
+            )
             ok = np.isfinite(ev.misfit) & np.isfinite(ev.err) & ~ev.dim
-            if ok.sum() >= 12:
+            if agree.sum() >= max(6, int(ok.sum()) // 3):
+                new_keep = agree & ~ev.moved
+            elif ok.sum() >= 12:
                 score = np.full(n, np.inf)
                 score[ok] = _ranks(ev.misfit[ok]) + _ranks(ev.err[ok])
                 new_keep = ok & (score <= np.median(score[ok]))
