@@ -2,19 +2,25 @@
 
 Run before the object leaves the dome. The checks (all on linear images):
 
-* **saturated / dark fractions** per image (full resolution, every channel).
+* **saturated / dark fractions** per image (full resolution, every channel): always made.
 * **a fit to judge each image against**: robust photometric stereo on a central crop at full
-  resolution (at most :data:`CROP` pixels a side), then per image the Lambertian prediction
-  ``rho max(0, n . l_i)`` over the pixels it lights:
+  resolution (at most :data:`CROP` pixels a side), refitted without the images found faulty
+  (after a first fit that finds any, from the largest set of images that agree among
+  themselves: :func:`~rti_rig.reconstruct.qa_directions.consensus_images`), then per image the
+  Lambertian prediction ``rho max(0, n . l_i)`` over the pixels its recorded light reaches:
 
-  - **gain** ``median(image / prediction)``; its 90th percentile well below 1 means a
-    misfired or dim light (shadows lower the median, not the bright end);
+  - **gain** ``image / prediction``; its :data:`DIM_PERCENTILE` percentile below
+    :data:`DIM_GAIN` means a misfired or dim light, below :data:`NO_LIGHT_GAIN` no light (a
+    black frame); shadows lower the median, not the bright end;
   - **best direction**: the light direction that explains the image best (least squares of the
     image on ``rho n`` over its lit pixels). Far from the recorded direction means a wrong
     light (a swapped entry of the ``.lp``, a wrong LED); the report names the recorded light
-    nearest to the best direction;
+    nearest to the best direction. Judged only where measurable: normals that spread at least
+    :data:`MIN_NORMAL_SPREAD_DEG`, images within
+    :data:`~rti_rig.reconstruct.qa_directions.MISFIT_LIMIT` of a Lambertian rendering;
   - **drift**: the image's shift against its prediction by phase correlation (OpenCV,
-    sub-pixel): the object or the camera moved (judged on images lighting most of the crop).
+    sub-pixel), confirmed by the image moved back fitting better: the object or the camera
+    moved (judged on images lighting at least :data:`DRIFT_MIN_LIT` of the crop).
 
 * **coverage**: per pixel (on a ≤ :data:`COVERAGE_SIDE` grid) the number of images that light
   it without shadow or saturation; fewer than 3 cannot determine a normal.
@@ -22,7 +28,7 @@ Run before the object leaves the dome. The checks (all on linear images):
   lights (the Cramér–Rao bound of the algorithms notes §3), sigma the robust residual scale.
 
 Thresholds are module constants, named in the report; the verdict is "good" or the list of
-images to reshoot and why.
+images to reshoot and why, followed by every check that was not made (:attr:`QAReport.caveats`).
 """
 
 from __future__ import annotations
