@@ -31,6 +31,11 @@ def test_qa_does_not_call_every_light_of_a_real_acquisition_wrong(tmp_path: Path
     assert qa["directions_checked"] is False
     assert "light directions not checked" in qa["verdict"]
     assert "light directions not checked" in " ".join(r.output.split())
+    # the report marks the check as not made on each image, and shows what dimness was judged on
+    assert not any(c["direction_judged"] for c in qa["images"])
+    page = (out / "qa.html").read_text()
+    assert page.count("<i>not judged</i>") >= len(qa["images"])
+    assert "bright-end gain (judged)" in page and "Checks not made:" in page
 
 
 def _truncated_copy(tmp_path: Path) -> Path:
