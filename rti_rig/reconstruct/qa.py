@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
 from rti_rig.reconstruct.qa_directions import MISFIT_LIMIT, consensus_images, relative_misfit
+from rti_rig.reconstruct.qa_drift import edge_shifts_trusted, measure_drift, move_back
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
 #: Side of the central crop the per-image checks fit on (full resolution).
@@ -291,6 +292,26 @@ def assess(
     sat_level = 1.0 if np.isfinite(saturation) else None
     crop_sat = crop_arr >= 1.0 if sat_level is not None else np.zeros_like(crop_arr, bool)
     dark_level = dark / saturation if np.isfinite(saturation) else dark
+    # Image-to-image drift from edges, where the object holds its edges still under changing
+    # light (texture): it needs no fit, so a fit made from moved images cannot hide a move.
+    # Images it finds moved are moved back before they are judged against the fit.
+    edge_shift, _ = measure_drift(crop_arr, crop_arr.reshape(n, -1).max(axis=1) > dark_level)
+    edges_trusted, edge_dev = edge_shifts_trusted(edge_shift)
+    edge_moved = np.zeros(n, bool)
+    if edges_trusted:
+        edge_moved = np.isfinite(edge_dev[:, 0]) & (np.hypot(*edge_dev.T) > DRIFT_PX)
+        crop_arr = crop_arr.copy()
+        for i in np.flatnonzero(edge_moved):
+            crop_arr[i] = move_back(crop_arr[i], float(edge_dev[i, 0]), float(edge_dev[i, 1]))
+
+    def evidence_of(fit: Any) -> _Evidence:
+        ev = _evidence(crop_arr, crop_sat, fit, lt, dark_level, names)
+        for i in np.flatnonzero(edge_moved):
+            ev.moved[i] = True
+            ev.drift_judged[i] = True
+            ev.drift[i] = (float(edge_dev[i, 0]), -float(edge_dev[i, 1]))
+        return ev
+
     # The reference fit must not be made of the faults it judges: six swapped pairs of 36, or
     # the object moved from image 21 of 36 on, distort it until the faulty images look like
     # the rest. So it is refitted without the images found wrong, moved or dark; after a
@@ -298,9 +319,9 @@ def assess(
     # self-consistent), then from every image not flagged, until the set stops changing.
     keep = np.ones(n, bool)
     ps = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
-    ev = _evidence(crop_arr, crop_sat, ps, lt, dark_level, names)
+    ev = evidence_of(ps)
     for rnd in range(MAX_ROUNDS):
-        bad = ev.dim | ev.wrong | ev.moved
+        bad = ev.dim | ev.wrong | (ev.moved & ~edge_moved)  # edge-moved: moved back already
         spread = np.nanmedian(ev.err) if np.isfinite(ev.err).any() else 0.0
         if rnd == 0 and not bad.any() and not spread > WRONG_LIGHT_DEG / 2:
             break
@@ -328,7 +349,7 @@ def assess(
         except ReconstructionError:  # the remaining lights cannot determine normals
             break
         keep, ps = new_keep, ps_next
-        ev = _evidence(crop_arr, crop_sat, ps, lt, dark_level, names)
+        ev = evidence_of(ps)
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []
