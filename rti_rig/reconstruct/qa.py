@@ -129,6 +129,8 @@ class QAReport:
     directions_checked: bool = True
     #: Why (some) directions were not judged; empty when all were.
     direction_note: str = ""
+    #: Why no shift could be judged on this object; empty when it could.
+    drift_note: str = ""
 
     @property
     def caveats(self) -> list[str]:
@@ -137,7 +139,11 @@ class QAReport:
         if self.direction_note:
             out.append(self.direction_note)
         flagged = {c.index for c in self.reshoot}
+        if self.drift_note:
+            out.append(self.drift_note)
         for label, attr in (("shift", "drift_judged"), ("brightness", "gain_judged")):
+            if attr == "drift_judged" and self.drift_note:
+                continue
             skipped = [
                 c.name for c in self.images if not getattr(c, attr) and c.index not in flagged
             ]
@@ -178,6 +184,7 @@ class QAReport:
             "directions_checked": self.directions_checked,
             "median_direction_error_deg": self.median_direction_error_deg,
             "direction_note": self.direction_note,
+            "drift_note": self.drift_note,
             "caveats": self.caveats,
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
@@ -350,6 +357,20 @@ def assess(
             break
         keep, ps = new_keep, ps_next
         ev = evidence_of(ps)
+    # Against a fit that explains the images poorly (a glossy coin) a shift is confirmed only
+    # when large; where the edges do not hold still either, a move is not measurable: said.
+    finite = np.isfinite(ev.misfit)
+    poor_fit = float(np.median(ev.misfit[finite])) if finite.any() else float("inf")
+    drift_note = ""
+    if not edges_trusted and poor_fit > MISFIT_LIMIT:
+        for i in range(n):
+            if not ev.moved[i]:
+                ev.drift_judged[i] = False
+        drift_note = (
+            "shift not judged: the fit explains this object's images poorly (median misfit "
+            f"{poor_fit:.0%}, limit {MISFIT_LIMIT:.0%}) and its edges move with the light, so "
+            "a shift of a few pixels cannot be measured"
+        )
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []
@@ -434,6 +455,7 @@ def assess(
         median_direction_error_deg=ev.typical,
         directions_checked=bool(ev.direction_judged.any()),
         direction_note=ev.direction_note,
+        drift_note=drift_note,
     )
 
 
