@@ -329,7 +329,9 @@ def assess(
     ev = evidence_of(ps)
     for rnd in range(MAX_ROUNDS):
         bad = ev.dim | ev.wrong | (ev.moved & ~edge_moved)  # edge-moved: moved back already
-        spread = np.nanmedian(ev.err) if np.isfinite(ev.err).any() else 0.0
+        # (a large median error means something only where directions can be judged)
+        judged_err = ev.err[ev.direction_judged]
+        spread = float(np.median(judged_err)) if judged_err.size else 0.0
         if rnd == 0 and not bad.any() and not spread > WRONG_LIGHT_DEG / 2:
             break
         new_keep = ~bad
