@@ -30,6 +30,18 @@ def dome_lights() -> np.ndarray:
     return np.array(out)
 
 
+def grazing_last_lights() -> np.ndarray:
+    """36 lights whose last ring is at 10° elevation (taken last, as a planner sorting by
+    elevation would): rings at 30°, 45°, 60°, 75°, then 10 lights at 10°."""
+    out = []
+    for el, count, off in ((30, 9, 20), (45, 8, 0), (60, 6, 30), (75, 3, 0), (10, 10, 0)):
+        for k in range(count):
+            az = np.radians(off + 360.0 * k / count)
+            e = np.radians(el)
+            out.append((np.cos(e) * np.cos(az), np.cos(e) * np.sin(az), np.sin(e)))
+    return np.array(out)
+
+
 def make_session(
     root: Path,
     *,
@@ -39,19 +51,21 @@ def make_session(
     swap: tuple[int, int] | None = None,
     move: tuple[int, int, int] | None = None,  # (from image, dx, dy) pixels
     saturate: int | None = None,
+    black: int | None = None,  # a misfire that left a black frame (constant 2 of 65535)
+    swaps: tuple[tuple[int, int], ...] = (),  # more swapped pairs
+    lights: np.ndarray | None = None,
     seed: int = 0,
 ) -> tuple[Path, np.ndarray, np.ndarray]:
     """Write a session folder; returns (folder, lights as recorded, true normals)."""
     sc = make_scene(scene, size[0], size[1], seed=seed)
-    lights = dome_lights()
+    lights = dome_lights() if lights is None else lights
     rng = np.random.default_rng(seed)
     (root / "linear").mkdir(parents=True)
     images = [render_radiance(sc, DirectionalLight(tuple(d))) for d in lights]
     peak = float(np.percentile(np.stack(images), 99.5))
     entries = []
     recorded = lights.copy()
-    if swap is not None:
-        i, j = swap
+    for i, j in ((swap,) if swap is not None else ()) + tuple(swaps):
         recorded[[i, j]] = recorded[[j, i]]
     for k, img in enumerate(images):
         value = img / peak * 0.8
@@ -62,6 +76,8 @@ def make_session(
         if move is not None and k >= move[0]:
             value = np.roll(value, shift=(-move[2], move[1]), axis=(0, 1))
         value = value + rng.normal(0.0, 0.002, value.shape)
+        if black == k:
+            value = np.full_like(value, 2.0 / 65535.0)
         px = np.clip(np.round(value * 65535.0), 0, 65535).astype(np.uint16)
         name = f"image_{k + 1:03d}"
         write_linear_tiff(root / "linear" / f"{name}.tif", px)

@@ -2,19 +2,25 @@
 
 Run before the object leaves the dome. The checks (all on linear images):
 
-* **saturated / dark fractions** per image (full resolution, every channel).
+* **saturated / dark fractions** per image (full resolution, every channel): always made.
 * **a fit to judge each image against**: robust photometric stereo on a central crop at full
-  resolution (at most :data:`CROP` pixels a side), then per image the Lambertian prediction
-  ``rho max(0, n . l_i)`` over the pixels it lights:
+  resolution (at most :data:`CROP` pixels a side), refitted without the images found faulty
+  (after a first fit that finds any, from the largest set of images that agree among
+  themselves: :func:`~rti_rig.reconstruct.qa_directions.consensus_images`), then per image the
+  Lambertian prediction ``rho max(0, n . l_i)`` over the pixels its recorded light reaches:
 
-  - **gain** ``median(image / prediction)``; its 90th percentile well below 1 means a
-    misfired or dim light (shadows lower the median, not the bright end);
+  - **gain** ``image / prediction``; its :data:`DIM_PERCENTILE` percentile below
+    :data:`DIM_GAIN` means a misfired or dim light, below :data:`NO_LIGHT_GAIN` no light (a
+    black frame); shadows lower the median, not the bright end;
   - **best direction**: the light direction that explains the image best (least squares of the
     image on ``rho n`` over its lit pixels). Far from the recorded direction means a wrong
     light (a swapped entry of the ``.lp``, a wrong LED); the report names the recorded light
-    nearest to the best direction;
+    nearest to the best direction. Judged only where measurable: normals that spread at least
+    :data:`MIN_NORMAL_SPREAD_DEG`, images within
+    :data:`~rti_rig.reconstruct.qa_directions.MISFIT_LIMIT` of a Lambertian rendering;
   - **drift**: the image's shift against its prediction by phase correlation (OpenCV,
-    sub-pixel): the object or the camera moved (judged on images lighting most of the crop).
+    sub-pixel), confirmed by the image moved back fitting better: the object or the camera
+    moved (judged on images lighting at least :data:`DRIFT_MIN_LIT` of the crop).
 
 * **coverage**: per pixel (on a ≤ :data:`COVERAGE_SIDE` grid) the number of images that light
   it without shadow or saturation; fewer than 3 cannot determine a normal.
@@ -22,7 +28,7 @@ Run before the object leaves the dome. The checks (all on linear images):
   lights (the Cramér–Rao bound of the algorithms notes §3), sigma the robust residual scale.
 
 Thresholds are module constants, named in the report; the verdict is "good" or the list of
-images to reshoot and why.
+images to reshoot and why, followed by every check that was not made (:attr:`QAReport.caveats`).
 """
 
 from __future__ import annotations
@@ -35,7 +41,10 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
+from rti_rig.reconstruct.qa_directions import MISFIT_LIMIT, consensus_images, relative_misfit
+from rti_rig.reconstruct.qa_drift import edge_shifts_trusted, measure_drift, move_back
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
 #: Side of the central crop the per-image checks fit on (full resolution).
@@ -52,15 +61,24 @@ DIM_GAIN = 0.6
 BRIGHT_GAIN = 1.6
 #: A best direction further than this from the recorded one (degrees) is a wrong light.
 WRONG_LIGHT_DEG = 8.0
-#: The wrong-light check is made only when the median over the images of the angle between
-#: best and recorded direction is at most this (degrees): else the fit cannot resolve directions.
-DIRECTION_CHECK_MEDIAN_DEG = WRONG_LIGHT_DEG / 2
+#: A best direction further from the recorded one than this many times the session's median
+#: error is a wrong light too (a systematic error shared by every image is not a fault).
+WRONG_LIGHT_SPREAD = 3.0
+#: Light directions are judged only when the fitted normals spread at least this much (degrees,
+#: the smallest axis of their second moment): a flat card leaves the azimuth undetermined.
+MIN_NORMAL_SPREAD_DEG = 2.0
+#: Refits of the reference without the images found faulty.
+MAX_ROUNDS = 4
+#: An image below this gain at its bright end had no light at all (a black frame).
+NO_LIGHT_GAIN = 0.1
 #: Dimness is judged on this percentile of image / prediction over the lit pixels (shadows
 #: the prediction does not model lower the median; a dim light lowers every pixel).
 DIM_PERCENTILE = 90.0
 #: The shift is judged only on images whose light reaches (n . l > 0.2) at least this fraction
-#: of the crop's pixels (a grazing light's shadows move the correlation peak).
-DRIFT_MIN_LIT = 0.5
+#: of the crop's pixels: below it there is too little lit surface to correlate. (It was 0.5,
+#: which left a whole 10°-elevation ring unjudged, moved or not; the confirmation below, not
+#: this gate, keeps a grazing light's unmodelled shadows from being called a move.)
+DRIFT_MIN_LIT = 0.1
 #: A shift is real only if moving the image back cuts its residual to at most this fraction.
 DRIFT_CONFIRM = 0.8
 #: A shift against the prediction larger than this (pixels) is a move.
@@ -86,6 +104,13 @@ class ImageCheck:
     problems: tuple[str, ...] = field(default=())
     #: False when the light reaches too little of the object to judge a shift.
     drift_judged: bool = True
+    #: The ratio image / prediction at its :data:`DIM_PERCENTILE` percentile: what the
+    #: misfired/dim check compares with :data:`DIM_GAIN` (``gain`` is the median, shown).
+    bright_end_gain: float = float("nan")
+    #: False when the best direction could not be measured or the session agreed on no map.
+    direction_judged: bool = True
+    #: False when too few pixels were lit to compare the image with its prediction.
+    gain_judged: bool = True
 
 
 @dataclass(frozen=True)
@@ -100,19 +125,36 @@ class QAReport:
     thresholds: dict[str, float]
     #: Median angle between each image's best-fit and recorded direction (degrees).
     median_direction_error_deg: float = 0.0
-    #: False when that median says the fit cannot resolve directions: no wrong-light check.
+    #: False when no image's direction could be judged.
     directions_checked: bool = True
+    #: Why (some) directions were not judged; empty when all were.
+    direction_note: str = ""
+    #: Why no shift could be judged on this object; empty when it could.
+    drift_note: str = ""
 
     @property
     def caveats(self) -> list[str]:
-        """What the verdict could not check (said with it, never silently)."""
-        if self.directions_checked:
-            return []
-        return [
-            "light directions not checked: the fit cannot resolve them on this object (its "
-            f"best-fit directions lie a median {self.median_direction_error_deg:.0f}° from the "
-            "recorded ones: a near-flat or non-Lambertian surface)"
-        ]
+        """Every check not made, by name (said with the verdict, never silently)."""
+        out = []
+        if self.direction_note:
+            out.append(self.direction_note)
+        flagged = {c.index for c in self.reshoot}
+        if self.drift_note:
+            out.append(self.drift_note)
+        for label, attr in (("shift", "drift_judged"), ("brightness", "gain_judged")):
+            if attr == "drift_judged" and self.drift_note:
+                continue
+            skipped = [
+                c.name for c in self.images if not getattr(c, attr) and c.index not in flagged
+            ]
+            if skipped:
+                why = (
+                    f"its light reaches less than {DRIFT_MIN_LIT:.0%} of the object"
+                    if attr == "drift_judged"
+                    else "too few pixels lit"
+                )
+                out.append(f"{label} not judged on {_names(skipped)} ({why})")
+        return out
 
     @property
     def reshoot(self) -> list[ImageCheck]:
@@ -141,9 +183,18 @@ class QAReport:
             "undercovered_fraction": self.undercovered_fraction,
             "directions_checked": self.directions_checked,
             "median_direction_error_deg": self.median_direction_error_deg,
+            "direction_note": self.direction_note,
+            "drift_note": self.drift_note,
+            "caveats": self.caveats,
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
+
+
+def _names(names: list[str]) -> str:
+    if len(names) <= 6:
+        return ", ".join(names)
+    return f"{len(names)} images ({names[0]} ... {names[-1]})"
 
 
 def _grey(frame: NDArray[Any]) -> NDArray[np.float32]:
@@ -159,11 +210,14 @@ def _crop_slices(h: int, w: int) -> tuple[slice, slice]:
 
 def _best_direction(
     img: NDArray[np.float32], b: NDArray[np.float64], use: NDArray[np.bool_], start: NDArray
-) -> NDArray[np.float64]:
-    """Direction ``l`` minimising |img - b . l| over pixels lit by ``l`` (two refinements)."""
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Vector ``s`` minimising |img - b . s| over pixels lit by ``s`` (two refinements), not
+    normalised (its length is the light's brightness), and the pixels it was fitted on."""
     d = start.copy()
+    sol = start * 0.0
+    lit = use & ((b @ d) > 0.05 * np.linalg.norm(b, axis=-1))
     for _ in range(3):
-        lit = use & ((b @ d) > 0.05 * np.linalg.norm(b, axis=-1)) & (img > 0)
+        lit = use & ((b @ d) > 0.05 * np.linalg.norm(b, axis=-1))
         if lit.sum() < 10:
             break
         sol, *_ = np.linalg.lstsq(b[lit], img[lit], rcond=None)
@@ -171,9 +225,7 @@ def _best_direction(
         if norm <= 0:
             break
         d = sol / norm
-        d[2] = max(d[2], 0.0)
-        d /= np.linalg.norm(d)
-    return d
+    return sol, lit
 
 
 def _confirmed_shift(
@@ -245,102 +297,112 @@ def assess(
     # per-image evidence on a full-resolution central crop
     crop_arr = np.stack(crop) / np.float32(saturation if np.isfinite(saturation) else 1.0)
     sat_level = 1.0 if np.isfinite(saturation) else None
-    ps = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
-    valid = ps.valid
-    rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
-    b = (ps.normals * rho[..., None]).astype(np.float64)
-    bflat = b.reshape(-1, 3)
-    vflat = valid.ravel()
-    resid_all = []
-    checks: list[ImageCheck] = []
     crop_sat = crop_arr >= 1.0 if sat_level is not None else np.zeros_like(crop_arr, bool)
-    window = cv2.createHanningWindow((crop_arr.shape[2], crop_arr.shape[1]), cv2.CV_64F)
+    dark_level = dark / saturation if np.isfinite(saturation) else dark
+    # Image-to-image drift from edges, where the object holds its edges still under changing
+    # light (texture): it needs no fit, so a fit made from moved images cannot hide a move.
+    # Images it finds moved are moved back before they are judged against the fit.
+    edge_shift, _ = measure_drift(crop_arr, crop_arr.reshape(n, -1).max(axis=1) > dark_level)
+    edges_trusted, edge_dev = edge_shifts_trusted(edge_shift)
+    edge_moved = np.zeros(n, bool)
+    if edges_trusted:
+        edge_moved = np.isfinite(edge_dev[:, 0]) & (np.hypot(*edge_dev.T) > DRIFT_PX)
+        crop_arr = crop_arr.copy()
+        for i in np.flatnonzero(edge_moved):
+            crop_arr[i] = move_back(crop_arr[i], float(edge_dev[i, 0]), float(edge_dev[i, 1]))
 
-    def drift_of(pred: NDArray, img: NDArray) -> tuple[float, float]:
-        shift, _ = cv2.phaseCorrelate(pred.astype(np.float64), img.astype(np.float64), window)
-        return float(shift[0]), float(shift[1])  # image axes: x right, y down
+    def evidence_of(fit: Any) -> _Evidence:
+        ev = _evidence(crop_arr, crop_sat, fit, lt, dark_level, names)
+        for i in np.flatnonzero(edge_moved):
+            ev.moved[i] = True
+            ev.drift_judged[i] = True
+            ev.drift[i] = (float(edge_dev[i, 0]), -float(edge_dev[i, 1]))
+        return ev
 
-    # first pass: each image's shift and the direction that explains it best
-    evidence = []
-    for i in range(n):
-        raw = crop_arr[i]
-        shade = ps.normals @ lt[i].astype(np.float32)
-        pred = rho * np.maximum(shade, 0.0)
-        dx, dy = drift_of(pred, raw)
-        # A grazing light leaves most of the object in shadow, which the prediction does not
-        # model: the correlation peak then moves by about a pixel with nothing moved (every
-        # dry run of the shipped arm, lights down to 1°, was called "moved"). The shift is
-        # judged on images that light most of the crop; a real move shows on those too.
-        lit = float((valid & (shade > 0.2)).sum()) / max(float(valid.sum()), 1.0)
-        drift_judged = lit >= DRIFT_MIN_LIT
-        compare = valid & (shade > 0.2) & ~crop_sat[i]
-        moved, img = False, raw
-        if drift_judged and np.hypot(dx, dy) > DRIFT_PX:
-            moved, img = _confirmed_shift(pred, raw, dx, dy, compare)
-        usable = vflat & ~crop_sat[i].ravel()
-        best = _best_direction(img.ravel().astype(np.float64), bflat, usable, lt[i])
-        evidence.append(
-            (dx, dy, moved, img if moved else None, best, _angle(best, lt[i]), drift_judged)
+    # The reference fit must not be made of the faults it judges: six swapped pairs of 36, or
+    # the object moved from image 21 of 36 on, distort it until the faulty images look like
+    # the rest. So it is refitted without the images found wrong, moved or dark; after a
+    # first fit that found any, from the half of the images that best fit any light (the most
+    # self-consistent), then from every image not flagged, until the set stops changing.
+    keep = np.ones(n, bool)
+    ps = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
+    ev = evidence_of(ps)
+    for rnd in range(MAX_ROUNDS):
+        bad = ev.dim | ev.wrong | (ev.moved & ~edge_moved)  # edge-moved: moved back already
+        # (a large median error means something only where directions can be judged)
+        judged_err = ev.err[ev.direction_judged]
+        spread = float(np.median(judged_err)) if judged_err.size else 0.0
+        if rnd == 0 and not bad.any() and not spread > WRONG_LIGHT_DEG / 2:
+            break
+        new_keep = ~bad
+        if rnd == 0:
+            # the largest set of images that agree among themselves (a fit from all of them
+            # is not trusted), less those found moved; failing that the better half: closest
+            # to a rendering and to its recorded light
+            agree = consensus_images(
+                crop_arr, lt, ~ev.dim & ~ev.moved, 2 * WRONG_LIGHT_DEG, dark_level
+            )
+            ok = np.isfinite(ev.misfit) & np.isfinite(ev.err) & ~ev.dim
+            if agree.sum() >= max(6, int(ok.sum()) // 3):
+                new_keep = agree & ~ev.moved
+            elif ok.sum() >= 12:
+                score = np.full(n, np.inf)
+                score[ok] = _ranks(ev.misfit[ok]) + _ranks(ev.err[ok])
+                new_keep = ok & (score <= np.median(score[ok]))
+        if new_keep.sum() < 6 or np.array_equal(new_keep, keep):
+            break
+        try:
+            ps_next = fit_photometric_stereo(
+                crop_arr[new_keep], lt[new_keep], robust=True, saturation=sat_level
+            )
+        except ReconstructionError:  # the remaining lights cannot determine normals
+            break
+        keep, ps = new_keep, ps_next
+        ev = evidence_of(ps)
+    # Against a fit that explains the images poorly (a glossy coin) a shift is confirmed only
+    # when large; where the edges do not hold still either, a move is not measurable: said.
+    finite = np.isfinite(ev.misfit)
+    poor_fit = float(np.median(ev.misfit[finite])) if finite.any() else float("inf")
+    drift_note = ""
+    if not edges_trusted and poor_fit > MISFIT_LIMIT:
+        for i in range(n):
+            if not ev.moved[i]:
+                ev.drift_judged[i] = False
+        drift_note = (
+            "shift not judged: the fit explains this object's images poorly (median misfit "
+            f"{poor_fit:.0%}, limit {MISFIT_LIMIT:.0%}) and its edges move with the light, so "
+            "a shift of a few pixels cannot be measured"
         )
-    # The best directions are only evidence where the fit can resolve them: on a near-flat
-    # object (every normal close to the camera axis) or one far from Lambertian they scatter
-    # tens of degrees around every recorded light (71 of 72 images of a real dome acquisition
-    # were called "wrong light"). A swapped or wrong light is an exception among the images,
-    # so the check is made only when most images agree with their records.
-    typical = float(np.median([e[5] for e in evidence])) if evidence else 0.0
-    directions_checked = typical <= DIRECTION_CHECK_MEDIAN_DEG
+    checks: list[ImageCheck] = []
     for i in range(n):
-        raw = crop_arr[i]
-        shade = ps.normals @ lt[i].astype(np.float32)
-        pred = rho * np.maximum(shade, 0.0)
-        dx, dy, moved, shifted, best, err, drift_judged = evidence[i]
-        img = raw if shifted is None else shifted
-        wrong = directions_checked and err > WRONG_LIGHT_DEG
-        if wrong:  # a wrong light also shifts the phase correlation: measure against its fit
-            pred_best = rho * np.maximum(ps.normals @ best.astype(np.float32), 0.0)
-            dx, dy = drift_of(pred_best, raw)
-            moved = drift_judged and np.hypot(dx, dy) > DRIFT_PX
-            if moved:
-                moved = _confirmed_shift(pred_best, raw, dx, dy, valid & ~crop_sat[i])[0]
-        drift = (dx, -dy)  # x right, y up (DESIGN.md)
-        use = valid & (shade > 0.2) & ~crop_sat[i] & (img > dark / saturation)
-        lit_gain = float("nan")
-        if use.sum() >= 10:
-            ratio = img[use] / np.maximum(pred[use], 1e-9)
-            gain = float(np.median(ratio))
-            # a dim or misfired light darkens every pixel; shadows the prediction does not
-            # model darken some (at grazing light most): judge dimness on the bright end
-            lit_gain = float(np.percentile(ratio, DIM_PERCENTILE))
-            res = img[use] - pred[use]
-            residual = float(np.median(np.abs(res)) / max(float(np.median(pred[use])), 1e-9))
-            resid_all.append(res)
-        else:
-            gain, residual = float("nan"), float("nan")
         problems = []
         if sat_frac[i] > SATURATED_LIMIT:
             problems.append(
                 f"saturated: {sat_frac[i]:.1%} of pixels clipped (limit {SATURATED_LIMIT:.0%}); "
                 "reshoot with less exposure"
             )
-        dim = np.isfinite(lit_gain) and lit_gain < DIM_GAIN
-        if dim and (not wrong or lit_gain < DIM_GAIN * 0.5):
+        wrong_i = bool(ev.wrong[i] and ev.direction_judged[i])
+        if ev.dim[i] and (not wrong_i or ev.lit_gain[i] < DIM_GAIN * 0.5):
+            dead = ev.lit_gain[i] < NO_LIGHT_GAIN
+            what = "misfired, no light" if dead else "misfired or dim light"
             problems.append(
-                f"misfired or dim light: {lit_gain:.0%} of the brightness the other images "
-                "predict"
+                f"{what}: {max(ev.lit_gain[i], 0.0):.0%} of the brightness the other images "
+                "predict where its light should fall"
             )
-        elif wrong:
-            others = np.delete(np.arange(n), i)
-            near = int(others[np.argmax(lt[others] @ best)])
+        elif wrong_i:
             problems.append(
-                f"wrong light: lit from {err:.0f}° away from its recorded direction, closest to "
-                f"the light recorded for {names[near]} (swapped?)"
+                f"wrong light: lit from {ev.err[i]:.0f}° away from its recorded direction "
+                f"(the images that agree do to a median {ev.typical:.1f}°), closest to the "
+                f"light recorded for {names[int(ev.near[i])]} (swapped?)"
             )
-        elif np.isfinite(gain) and gain > BRIGHT_GAIN and sat_frac[i] <= SATURATED_LIMIT:
-            problems.append(f"{gain:.1f}× brighter than the other images predict")
-        if moved:
+        elif (
+            np.isfinite(ev.gain[i]) and ev.gain[i] > BRIGHT_GAIN and sat_frac[i] <= SATURATED_LIMIT
+        ):
+            problems.append(f"{ev.gain[i]:.1f}× brighter than the other images predict")
+        if ev.moved[i]:
+            dx, dy = ev.drift[i]
             problems.append(
-                f"object or camera moved: shifted ({drift[0]:+.1f}, {drift[1]:+.1f}) px against "
-                "the others"
+                f"object or camera moved: shifted ({dx:+.1f}, {dy:+.1f}) px against the others"
             )
         checks.append(
             ImageCheck(
@@ -348,32 +410,42 @@ def assess(
                 name=names[i],
                 saturated_fraction=float(sat_frac[i]),
                 dark_fraction=float(dark_frac[i]),
-                gain=gain,
-                residual=residual,
+                gain=float(ev.gain[i]),
+                residual=float(ev.residual[i]),
                 recorded_direction=tuple(float(x) for x in lt[i]),
-                best_direction=tuple(float(x) for x in best),
-                direction_error_deg=err,
-                drift_px=drift,
+                best_direction=tuple(float(x) for x in ev.best[i]),
+                direction_error_deg=float(ev.err[i]),
+                drift_px=(float(ev.drift[i][0]), float(ev.drift[i][1])),
                 problems=tuple(problems),
-                drift_judged=drift_judged,
+                drift_judged=bool(ev.drift_judged[i]),
+                bright_end_gain=float(ev.lit_gain[i]),
+                direction_judged=bool(ev.direction_judged[i]),
+                gain_judged=bool(np.isfinite(ev.lit_gain[i])),
             )
         )
     flagged = {c.index for c in checks if c.problems}
-    pooled = [r for i, r in enumerate(resid_all) if i not in flagged] or resid_all
+    pooled = [r for i, r in enumerate(ev.resid) if i not in flagged and r.size] or [
+        r for r in ev.resid if r.size
+    ]
     sigma = float(1.4826 * np.median(np.abs(np.concatenate(pooled)))) if pooled else float("nan")
+    valid = ps.valid
+    rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
     expected = _expected_error_deg(ps.normals[valid], rho[valid], lt, sigma)
     undercovered = float(np.mean(coverage < MIN_COVERAGE))
     thresholds = {
         "saturated_limit": SATURATED_LIMIT,
         "dim_gain": DIM_GAIN,
+        "no_light_gain": NO_LIGHT_GAIN,
         "bright_gain": BRIGHT_GAIN,
         "wrong_light_deg": WRONG_LIGHT_DEG,
+        "misfit_limit": MISFIT_LIMIT,
+        "min_normal_spread_deg": MIN_NORMAL_SPREAD_DEG,
+        "wrong_light_spread": WRONG_LIGHT_SPREAD,
         "drift_px": DRIFT_PX,
         "drift_min_lit": DRIFT_MIN_LIT,
         "drift_confirm": DRIFT_CONFIRM,
         "dim_percentile": DIM_PERCENTILE,
         "min_coverage": MIN_COVERAGE,
-        "direction_check_median_deg": DIRECTION_CHECK_MEDIAN_DEG,
     }
     return QAReport(
         tuple(checks),
@@ -382,9 +454,181 @@ def assess(
         expected,
         sigma,
         thresholds,
-        median_direction_error_deg=typical,
-        directions_checked=directions_checked,
+        median_direction_error_deg=ev.typical,
+        directions_checked=bool(ev.direction_judged.any()),
+        direction_note=ev.direction_note,
+        drift_note=drift_note,
     )
+
+
+@dataclass
+class _Evidence:
+    gain: NDArray
+    lit_gain: NDArray
+    residual: NDArray
+    resid: list[NDArray]
+    best: NDArray
+    err: NDArray
+    near: NDArray
+    drift: list[tuple[float, float]]
+    moved: NDArray
+    drift_judged: NDArray
+    dim: NDArray
+    wrong: NDArray
+    direction_judged: NDArray
+    typical: float
+    direction_note: str
+    misfit: NDArray
+
+
+def _evidence(
+    crop_arr: NDArray,
+    crop_sat: NDArray,
+    ps: Any,
+    lt: NDArray,
+    dark: float,
+    names: Sequence[str],
+) -> _Evidence:
+    """Every image judged against one fit ``ps``."""
+    n = crop_arr.shape[0]
+    valid = ps.valid
+    rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
+    b = (ps.normals * rho[..., None]).astype(np.float64)
+    bflat = b.reshape(-1, 3)
+    vflat = valid.ravel()
+    window = cv2.createHanningWindow((crop_arr.shape[2], crop_arr.shape[1]), cv2.CV_64F)
+
+    def drift_of(pred: NDArray, img: NDArray) -> tuple[float, float]:
+        shift, _ = cv2.phaseCorrelate(pred.astype(np.float64), img.astype(np.float64), window)
+        return float(shift[0]), float(shift[1])  # image axes: x right, y down
+
+    gain = np.full(n, np.nan)
+    lit_gain = np.full(n, np.nan)
+    residual = np.full(n, np.nan)
+    resid: list[NDArray] = []
+    sols = np.zeros((n, 3))
+    misfit = np.full(n, np.inf)
+    drift: list[tuple[float, float]] = []
+    moved = np.zeros(n, bool)
+    drift_judged = np.zeros(n, bool)
+    images = []
+    for i in range(n):
+        raw = crop_arr[i]
+        shade = ps.normals @ lt[i].astype(np.float32)
+        pred = rho * np.maximum(shade, 0.0)
+        dx, dy = drift_of(pred, raw)
+        lit_frac = float((valid & (shade > 0.2)).sum()) / max(float(valid.sum()), 1.0)
+        drift_judged[i] = lit_frac >= DRIFT_MIN_LIT
+        compare = valid & (shade > 0.2) & ~crop_sat[i]
+        img = raw
+        if drift_judged[i] and np.hypot(dx, dy) > DRIFT_PX:
+            moved[i], img = _confirmed_shift(pred, raw, dx, dy, compare)
+        images.append(img)
+        drift.append((dx, -dy))  # x right, y up (DESIGN.md)
+        # Gain over every pixel the recorded light should reach: a frame left black by a
+        # misfire is dark exactly there (requiring img > dark made its gain NaN, unjudged).
+        use = compare
+        if use.sum() >= 10:
+            ratio = img[use] / np.maximum(pred[use], 1e-9)
+            gain[i] = float(np.median(ratio))
+            # a dim or misfired light darkens every pixel; shadows the prediction does not
+            # model darken some (at grazing light most): judge dimness on the bright end
+            lit_gain[i] = float(np.percentile(ratio, DIM_PERCENTILE))
+            lit = use & (img > dark)
+            if lit.sum() >= 10:
+                res = img[lit] - pred[lit]
+                residual[i] = float(np.median(np.abs(res)) / max(float(np.median(pred[lit])), 1e-9))
+                resid.append(res)
+            else:
+                resid.append(np.zeros(0))
+        else:
+            resid.append(np.zeros(0))
+        usable = vflat & ~crop_sat[i].ravel()
+        flat_img = img.ravel().astype(np.float64)
+        sols[i], lit_px = _best_direction(flat_img, bflat, usable, lt[i])
+        misfit[i] = relative_misfit(bflat, flat_img, sols[i], lit_px)
+    dim = np.isfinite(lit_gain) & (lit_gain < DIM_GAIN)
+    # directions: judged where measurable (the image close to some rendering of the fit),
+    # against the session's own spread (systematic errors are shared, a wrong light stands out)
+    best = _unit_rows(sols)
+    err = np.array([_angle(best[i], lt[i]) if np.any(sols[i]) else np.nan for i in range(n)])
+    dead = np.isfinite(lit_gain) & (lit_gain < NO_LIGHT_GAIN)
+    # a wrong light can look dim (its recorded light predicts a brighter image): only a frame
+    # with no light at all has no direction to judge
+    cand = ~dead & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT) & np.isfinite(err)
+    nv = ps.normals[valid].astype(np.float64)
+    moment = nv.T @ nv / max(len(nv), 1)
+    spread_deg = float(np.degrees(np.arcsin(np.sqrt(max(np.linalg.eigvalsh(moment)[0], 0.0)))))
+    near = np.zeros(n, int)
+    wrong = np.zeros(n, bool)
+    judged = np.zeros(n, bool)
+    typical = float("nan")
+    note = ""
+    undimmed = int((~dead).sum())
+    if spread_deg < MIN_NORMAL_SPREAD_DEG:
+        note = (
+            f"light directions not checked: the fitted normals spread only {spread_deg:.1f}° "
+            f"(limit {MIN_NORMAL_SPREAD_DEG:.0f}°): on a near-flat object a light's azimuth "
+            "cannot be told from its image"
+        )
+    elif cand.sum() < max(5, (undimmed + 1) // 2):
+        spread = float(np.median(misfit[~dead & np.isfinite(misfit)])) if undimmed else np.nan
+        note = (
+            f"light directions not checked: only {int(cand.sum())} of {undimmed} images are "
+            f"close to any Lambertian rendering of the fit (median misfit {spread:.0%}, limit "
+            f"{MISFIT_LIMIT:.0%}): a glossy, saturated or non-Lambertian surface"
+        )
+    else:
+        judged = cand.copy()
+        agree = cand & (err <= WRONG_LIGHT_DEG)
+        typical = float(np.median(err[agree] if agree.any() else err[cand]))
+        limit = max(WRONG_LIGHT_DEG, WRONG_LIGHT_SPREAD * typical)
+        wrong = cand & (err > limit)
+        for i in np.flatnonzero(wrong):
+            others = np.delete(np.arange(n), i)
+            near[i] = int(others[np.argmax(lt[others] @ best[i])])
+            # a wrong light also shifts the phase correlation: measure against its fit
+            pred_best = rho * np.maximum(ps.normals @ best[i].astype(np.float32), 0.0)
+            dx, dy = drift_of(pred_best, crop_arr[i])
+            mv = bool(drift_judged[i] and np.hypot(dx, dy) > DRIFT_PX)
+            if mv:
+                mv = _confirmed_shift(pred_best, crop_arr[i], dx, dy, valid & ~crop_sat[i])[0]
+            moved[i] = mv
+            drift[i] = (dx, -dy)
+        skipped = [i for i in range(n) if not cand[i] and not dead[i]]
+        if skipped:
+            note = (
+                f"light direction not checked on {_names([names[i] for i in skipped])} "
+                f"(further than {MISFIT_LIMIT:.0%} from any Lambertian rendering of the fit: "
+                "grazing light, gloss or clipping)"
+            )
+    return _Evidence(
+        gain,
+        lit_gain,
+        residual,
+        resid,
+        best,
+        err,
+        near,
+        drift,
+        moved,
+        drift_judged,
+        dim,
+        wrong,
+        judged,
+        typical,
+        note,
+        misfit,
+    )
+
+
+def _ranks(v: NDArray) -> NDArray:
+    return np.argsort(np.argsort(v)).astype(float)
+
+
+def _unit_rows(v: NDArray) -> NDArray:
+    nrm = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.where(nrm > 0, nrm, 1.0)
 
 
 def _expected_error_deg(

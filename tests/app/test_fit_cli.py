@@ -19,7 +19,7 @@ from rti_rig.cli import app
 from rti_rig.core.rti_bases import hsh_basis, ptm_basis
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from fit_sessions import make_session
+from fit_sessions import grazing_last_lights, make_session
 
 runner = CliRunner()
 
@@ -123,11 +123,38 @@ def test_ptm_and_rti_read_back_relight_like_the_fit(clean, tmp_path: Path) -> No
     assert dome["lightConfiguration"] == "directional" and "domeDiameter" in dome
 
 
+def _names(indices) -> set[str]:
+    return {f"image_{k + 1:03d}" for k in indices}
+
+
+SIX_PAIRS = ((0, 5), (1, 6), (2, 7), (10, 14), (11, 15), (19, 23))
+NINE_PAIRS = (*SIX_PAIRS, (20, 24), (27, 30), (28, 31))
+
 CASES = {
     "clean": ({}, set(), ""),
     "misfire": ({"misfire": 5}, {"image_006"}, "misfired"),
+    # a misfire that left a black frame: its gain was NaN (no pixel above the dark level), so
+    # the dim check never ran and the image was called a wrong light
+    "black frame": ({"black": 5}, {"image_006"}, "misfired, no light"),
     "swap": ({"swap": (3, 20)}, {"image_004", "image_021"}, "wrong light"),
+    # six swapped pairs of 36 pushed the median direction error over the old gate: "good"
+    "six swaps": ({"swaps": SIX_PAIRS}, _names(np.ravel(SIX_PAIRS)), "wrong light"),
+    # nine pairs: half the lights wrong; a fit from all images is distorted until right and
+    # wrong look alike, so the reference comes from the largest set that agrees
+    "nine swaps": (
+        {"swaps": NINE_PAIRS},
+        _names(np.ravel(NINE_PAIRS)),
+        "wrong light",
+    ),
     "moved": ({"move": (33, 3, 2)}, {"image_034", "image_035", "image_036"}, "moved"),
+    # 16 of 36 images moved: the fit blended two positions and only image_021 was flagged
+    "moved mid-session": ({"move": (20, 3, 2)}, _names(range(20, 36)), "moved"),
+    # the 10° ring taken last and moved: no image of it was drift-judged, verdict "good"
+    "moved grazing ring": (
+        {"move": (26, 3, 2), "lights": grazing_last_lights()},
+        _names(range(26, 36)),
+        "moved",
+    ),
     "saturated": ({"saturate": 12}, {"image_013"}, "saturated"),
 }
 
@@ -145,6 +172,8 @@ def test_qa_flags_each_fault_by_name(tmp_path: Path, case: str) -> None:
         assert qa["verdict"] == "good" and "QA verdict: good" in r.output
     else:
         assert word in qa["verdict"]
+        for name in expected:  # each by name, with the word
+            assert any(c["name"] == name and word in "; ".join(c["problems"]) for c in qa["images"])
     assert (out / "qa.html").read_text().count("<tr") == len(qa["images"]) + 1
 
 

@@ -37,7 +37,7 @@ from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
 from rti_rig.reconstruct.errors import ReconstructionError
-from rti_rig.reconstruct.qa import QAReport, assess
+from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
 from rti_rig.runtime.disowned import refuse_if_disowned
@@ -507,32 +507,59 @@ def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
     cov_img[qa.coverage < 3] = (0, 0, 255)
     cv2.imwrite(str(out / "qa_coverage.png"), cov_img)
     (out / "qa.json").write_text(json.dumps(qa.to_json(), indent=1) + "\n", encoding="utf-8")
-    rows = "\n".join(
-        f"<tr{' class=bad' if c.problems else ''}><td>{html.escape(c.name)}</td>"
-        f"<td>{c.saturated_fraction:.2%}</td><td>{c.dark_fraction:.1%}</td>"
-        f"<td>{c.gain:.2f}</td><td>{c.residual:.3f}</td><td>{c.direction_error_deg:.1f}</td>"
-        f"<td>{c.drift_px[0]:+.2f}, {c.drift_px[1]:+.2f}</td>"
-        f"<td>{html.escape('; '.join(c.problems))}</td></tr>"
-        for c in qa.images
-    )
+    rows = "\n".join(_qa_row(c) for c in qa.images)
     normals = '<img src="normals.png" width="320">' if (out / "normals.png").exists() else ""
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>rti-rig QA</title>
 <style>body{{font-family:sans-serif;margin:1em}} td,th{{padding:2px 6px;font-size:12px}}
 tr.bad{{background:#fdd}} .v{{font-size:20px;font-weight:bold}}</style></head><body>
 <p class="v">Verdict: {html.escape(qa.verdict)}</p>
+{_qa_caveats(qa)}
 <p>Model: {html.escape(result.model)} — {html.escape(result.reason)}.
 Expected normal error (median, bound): {qa.expected_normal_error_deg:.2f}°;
 noise σ {qa.noise_sigma:.4f}; pixels lit by fewer than 3 usable images:
 {qa.undercovered_fraction:.1%} (red in the coverage map).</p>
 <p>{normals} <img src="qa_coverage.png" width="320"></p>
 <p>Fit warnings: {html.escape("; ".join(result.warnings) or "none")}</p>
-<table border=1 cellspacing=0><tr><th>image</th><th>saturated</th><th>dark</th><th>gain</th>
-<th>residual</th><th>direction error °</th><th>drift px (x, y)</th><th>problems</th></tr>
+<p>How each column was judged: <b>bright-end gain</b> (the {qa.thresholds["dim_percentile"]:.0f}th
+percentile of image / prediction where the recorded light falls) below
+{qa.thresholds["dim_gain"]} is a misfired or dim light, the median gain is shown for reference;
+<b>direction error</b> (best-fit against recorded light) above the larger of
+{qa.thresholds["wrong_light_deg"]}° and {qa.thresholds["wrong_light_spread"]}× the session's
+median is a wrong light, judged only on images within {qa.thresholds["misfit_limit"]:.0%} of a
+Lambertian rendering; <b>drift</b> (phase correlation against the prediction) above
+{qa.thresholds["drift_px"]} px is a move if moving the image back fits better. "not judged"
+marks a check that was not made on that image.</p>
+<table border=1 cellspacing=0><tr><th>image</th><th>saturated</th><th>dark</th>
+<th>bright-end gain (judged)</th><th>median gain</th><th>residual</th>
+<th>direction error °</th><th>drift px (x, y)</th><th>problems</th></tr>
 {rows}</table>
 <p>Thresholds: {html.escape(json.dumps(qa.thresholds))}</p></body></html>
 """
     (out / "qa.html").write_text(page, encoding="utf-8")
     return [out / "qa.html", out / "qa.json", out / "qa_coverage.png"]
+
+
+def _qa_caveats(qa: QAReport) -> str:
+    if not qa.caveats:
+        return "<p>Every check was made on every image.</p>"
+    items = "".join(f"<li>{html.escape(c)}</li>" for c in qa.caveats)
+    return f"<p>Checks not made:</p><ul>{items}</ul>"
+
+
+def _qa_row(c: ImageCheck) -> str:
+    """One image's row: the value each decision used, or "not judged" where none was made."""
+    nj = "<i>not judged</i>"
+    gain = f"{c.bright_end_gain:.2f}" if c.gain_judged else nj
+    median = f"{c.gain:.2f}" if np.isfinite(c.gain) else "—"
+    resid = f"{c.residual:.3f}" if np.isfinite(c.residual) else "—"
+    direction = f"{c.direction_error_deg:.1f}" if c.direction_judged else nj
+    drift = f"{c.drift_px[0]:+.2f}, {c.drift_px[1]:+.2f}" if c.drift_judged else nj
+    return (
+        f"<tr{' class=bad' if c.problems else ''}><td>{html.escape(c.name)}</td>"
+        f"<td>{c.saturated_fraction:.2%}</td><td>{c.dark_fraction:.1%}</td>"
+        f"<td>{gain}</td><td>{median}</td><td>{resid}</td><td>{direction}</td><td>{drift}</td>"
+        f"<td>{html.escape('; '.join(c.problems))}</td></tr>"
+    )
 
 
 def verdict_for_session(session: Path) -> str:
