@@ -251,6 +251,20 @@ def _confirmed_shift(
     return False, raw
 
 
+def _move_explains_better(
+    raw: NDArray, back: NDArray, pred_recorded: NDArray, pred_best: NDArray, mask: NDArray
+) -> bool:
+    """Whether the image moved back (``back``) under its recorded light's prediction is closer
+    (median absolute residual over ``mask``) than the image as it is (``raw``) under the best
+    other direction's: the two explanations of an image that is both shifted and off its
+    recorded shading, compared on the same pixels."""
+    if mask.sum() < 10:
+        return False
+    as_moved = float(np.median(np.abs(back[mask] - pred_recorded[mask])))
+    as_wrong = float(np.median(np.abs(raw[mask] - pred_best[mask])))
+    return as_moved <= as_wrong
+
+
 def _angle(a: NDArray, b: NDArray) -> float:
     return float(np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b)), float(np.dot(a, b)))))
 
@@ -585,10 +599,19 @@ def _evidence(
         limit = max(WRONG_LIGHT_DEG, WRONG_LIGHT_SPREAD * typical)
         wrong = cand & (err > limit)
         for i in np.flatnonzero(wrong):
+            pred_best = rho * np.maximum(ps.normals @ best[i].astype(np.float32), 0.0)
+            pred_rec = rho * np.maximum(ps.normals @ lt[i].astype(np.float32), 0.0)
+            mask = valid & ~crop_sat[i]
+            explained = _move_explains_better(crop_arr[i], images[i], pred_rec, pred_best, mask)
+            if moved[i] and explained:
+                # a confirmed move tilts the best-fit direction (6 px: ~10°): when the image
+                # moved back under its recorded light is explained better than as it is under
+                # another light, it is a move, not a wrong light
+                wrong[i] = False
+                continue
             others = np.delete(np.arange(n), i)
             near[i] = int(others[np.argmax(lt[others] @ best[i])])
             # a wrong light also shifts the phase correlation: measure against its fit
-            pred_best = rho * np.maximum(ps.normals @ best[i].astype(np.float32), 0.0)
             dx, dy = drift_of(pred_best, crop_arr[i])
             mv = bool(drift_judged[i] and np.hypot(dx, dy) > DRIFT_PX)
             if mv:

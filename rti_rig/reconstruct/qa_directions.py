@@ -51,7 +51,10 @@ def consensus_images(
     are wrong a fit from all images is distorted until wrong and right look alike; a draw of
     right images alone is not, and the right images then outnumber any other agreeing set."""
     n = stack.shape[0]
-    idx = np.flatnonzero(usable)
+    # drawn in an order of the lights themselves, not of the listing: the same acquisition
+    # listed in another order gets the same draws, so the same verdict
+    canonical = np.lexsort((lights[:, 2], lights[:, 1], lights[:, 0]))
+    idx = canonical[usable[canonical]]
     best = np.zeros(n, bool)
     if idx.size < CONSENSUS_PICK + 2:
         return best

@@ -526,7 +526,8 @@ percentile of image / prediction where the recorded light falls) below
 <b>direction error</b> (best-fit against recorded light) above the larger of
 {qa.thresholds["wrong_light_deg"]}° and {qa.thresholds["wrong_light_spread"]}× the session's
 median is a wrong light, judged only on images within {qa.thresholds["misfit_limit"]:.0%} of a
-Lambertian rendering; <b>drift</b> (phase correlation against the prediction) above
+Lambertian rendering; <b>drift</b> (phase correlation against the prediction, and image to
+image from edges where the session's edges hold still) above
 {qa.thresholds["drift_px"]} px is a move if moving the image back fits better. "not judged"
 marks a check that was not made on that image.</p>
 <table border=1 cellspacing=0><tr><th>image</th><th>saturated</th><th>dark</th>
