@@ -49,7 +49,7 @@ from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start
 from rti_rig.core.geometry import fibonacci_cap
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner import adaptive
-from rti_rig.planner.adaptive_optimal import pinned_optimal_design
+from rti_rig.planner.adaptive_optimal import PinnedObjective, pinned_optimal_design
 from rti_rig.planner.uniform import select_uniform_leds
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "adaptive.md"
@@ -99,30 +99,6 @@ def shared_three_start(geometry: DomeGeometry, k: int, n_total: int | None) -> l
 EXTRA_FLOORS = (5.0, 15.0, 25.0, 35.0, 40.0)
 
 
-class _PinnedObjective:
-    """An objective over the lights *not yet shot*: ``fixed`` (candidate indices) are always
-    part of the layout and never swapped out or in (the exchange search sees only the rest)."""
-
-    def __init__(self, objective, fixed: NDArray[np.intp]) -> None:  # type: ignore[no-untyped-def]
-        self.objective = objective
-        self.fixed = np.asarray(fixed, dtype=np.intp)
-        self.scan_levels = getattr(objective, "scan_levels", ({"exact": False}, {"exact": True}))
-        self.candidate_count = objective.candidate_count
-
-    def cost(self, free: NDArray[np.intp]) -> float:
-        return float(self.objective.cost(np.r_[self.fixed, free]))
-
-    def swap_costs(self, free: NDArray[np.intp], position: int, **kw) -> NDArray[np.float64]:  # type: ignore[no-untyped-def]
-        if kw.get("among") is not None:
-            kw["among"] = np.setdiff1d(kw["among"], self.fixed)
-        out = np.array(
-            self.objective.swap_costs(np.r_[self.fixed, free], position + len(self.fixed), **kw),
-            dtype=np.float64,
-        )
-        out[self.fixed] = np.inf
-        return out
-
-
 @dataclass
 class PinnedOptimal:
     """``optimal`` conditioned on the lights already shot: the same objective (from the same
@@ -160,10 +136,10 @@ class PinnedOptimal:
                 starts.append((f"{f:g}", np.asarray(comp, dtype=np.intp)))
         for j, e in enumerate(self.extra):
             starts.append((f"extra {j}", np.array([where[int(i)] for i in e], dtype=np.intp)))
-        pinned = _PinnedObjective(objective, fixed)
+        pinned = PinnedObjective(objective, fixed)
         search = binned_objective(objective)
         res = exchange_search(
-            pinned, starts, search=None if search is objective else _PinnedObjective(search, fixed)
+            pinned, starts, search=None if search is objective else PinnedObjective(search, fixed)
         )
         return np.r_[fixed, res.chosen]
 
