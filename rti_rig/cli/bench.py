@@ -10,6 +10,7 @@ from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.out_folders import ensure_writable_folder
 
 bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy trade.")
 app.add_typer(bench_app, name="bench")
@@ -100,17 +101,9 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None) -> None:
 
     if out_dir is not None:  # before minutes of computing, not after
         try:
-            out_dir.mkdir(parents=True, exist_ok=True)
-            probe = out_dir / ".rti-rig-write-test"
-            probe.write_bytes(b"")
-            probe.unlink()
-        except OSError as exc:
-            raise fail(
-                RtiRigError(
-                    f"--out {out_dir}: cannot write there ({exc.strerror or exc}); choose a "
-                    "folder you can write to"
-                )
-            ) from None
+            ensure_writable_folder(out_dir)
+        except RtiRigError as exc:
+            raise fail(exc) from None
     if from_lp is not None:
         try:
             text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))

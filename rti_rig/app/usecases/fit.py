@@ -33,6 +33,7 @@ from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import jpeg_truncation
 from rti_rig.core.lp_format import directions_of, read_lp
+from rti_rig.core.out_folders import ensure_writable_folder
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
@@ -263,16 +264,12 @@ def prepare_out_dir(out: Path) -> None:
     try:
         if out.exists() and any(out.iterdir()):
             raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / ".rti-rig-write-test"
-        probe.write_bytes(b"")
-        probe.unlink()
     except OSError as exc:
-        raise FitInputError(
-            f"--out {out}: cannot write there ({exc.strerror or exc}"
-            f"{': ' + str(exc.filename) if exc.filename else ''}); choose a folder you can "
-            "write to"
-        ) from None
+        raise FitInputError(f"--out {out}: cannot read it ({exc.strerror or exc})") from None
+    try:
+        ensure_writable_folder(out)
+    except RtiRigError as exc:
+        raise FitInputError(str(exc)) from None
 
 
 def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:

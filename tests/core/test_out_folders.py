@@ -1,0 +1,30 @@
+"""ensure_writable_folder: created and proven writable, or refused by name (no traceback)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.out_folders import PROBE_NAME, ensure_writable_folder
+
+
+def test_a_new_folder_is_created_and_left_empty(tmp_path: Path) -> None:
+    target = tmp_path / "a" / "b"
+    ensure_writable_folder(target)
+    assert target.is_dir() and not (target / PROBE_NAME).exists()
+
+
+def test_a_folder_under_a_file_is_refused_by_name(tmp_path: Path) -> None:
+    a_file = tmp_path / "f"
+    a_file.write_text("x")
+    with pytest.raises(RtiRigError, match=r"--out .*f/sub: cannot write there"):
+        ensure_writable_folder(a_file / "sub")
+    assert a_file.read_text() == "x"
+
+
+def test_a_folder_nothing_can_be_created_in_is_refused() -> None:
+    # /proc stands in for a read-only card (the tests may run as root, whom modes do not stop)
+    with pytest.raises(RtiRigError, match="cannot write there"):
+        ensure_writable_folder(Path("/proc/rti-rig-cannot-write-here"))
