@@ -600,10 +600,13 @@ def _evidence(
         wrong = cand & (err > limit)
         for i in np.flatnonzero(wrong):
             pred_best = rho * np.maximum(ps.normals @ best[i].astype(np.float32), 0.0)
-            pred_rec = rho * np.maximum(ps.normals @ lt[i].astype(np.float32), 0.0)
-            mask = valid & ~crop_sat[i]
-            explained = _move_explains_better(crop_arr[i], images[i], pred_rec, pred_best, mask)
-            if moved[i] and explained:
+            if moved[i] and _move_explains_better(
+                crop_arr[i],
+                images[i],  # moved back: the move was confirmed
+                rho * np.maximum(ps.normals @ lt[i].astype(np.float32), 0.0),
+                pred_best,
+                valid & ~crop_sat[i],
+            ):
                 # a confirmed move tilts the best-fit direction (6 px: ~10°): when the image
                 # moved back under its recorded light is explained better than as it is under
                 # another light, it is a move, not a wrong light
