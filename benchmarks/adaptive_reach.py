@@ -95,6 +95,32 @@ def shared_three_start(geometry: DomeGeometry, k: int, n_total: int | None) -> l
     return sorted(int(both[i]) for i in pick)
 
 
+def _layout_error(data):  # type: ignore[no-untyped-def]
+    """The true mean normal error of a layout (candidate indices) of a rendered scene, scored
+    in index order, as benchmarks.adaptive scores every layout."""
+    from benchmarks.tradeoff import normal_error
+
+    def err(idx: NDArray[np.intp]) -> float:
+        idx = np.sort(idx)
+        return normal_error(data.normals, data.candidate_images[idx], data.candidate_dirs[idx])[0]
+
+    return err
+
+
+def _draw_lights(
+    rng: np.random.Generator, count: int, cand: NDArray[np.float64]
+) -> tuple[NDArray[np.intp], DomeGeometry]:
+    """One draw of benchmarks.adaptive: ``SIM_REMOVED`` candidates out of service."""
+    keep = np.sort(rng.choice(count, count - SIM_REMOVED, replace=False))
+    return keep, DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
+
+
+def _score_floors(res, n: int, keep, sub: DomeGeometry, err) -> None:  # type: ignore[no-untyped-def]
+    """The homogeneous layouts of ``n`` lights above each shipped floor, scored into ``res``."""
+    for f in FLOORS:
+        res.setdefault((n, f"hom {f:g}"), []).append(err(keep[select_uniform_leds(sub, n, f)]))
+
+
 #: Extra elevation floors of the ``bands`` family (the shipped designs are ``FLOORS``).
 EXTRA_FLOORS = (5.0, 15.0, 25.0, 35.0, 40.0)
 
@@ -181,7 +207,7 @@ def start_functions() -> dict:  # type: ignore[type-arg]
 def reach(draws: int, scenes: tuple[str, ...] = (), seed: int = 0) -> list[str]:
     """Table rows: per scene and N, the tuned bar and, per start, each floor's completion (mean
     over draws) and the oracle."""
-    from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
+    from benchmarks.tradeoff import TradeoffSettings, render_scene_data
 
     settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     starts = start_functions()
@@ -193,19 +219,12 @@ def reach(draws: int, scenes: tuple[str, ...] = (), seed: int = 0) -> list[str]:
         data = render_scene_data(scene, settings)
         cand = data.candidate_dirs
 
-        def err(idx: NDArray[np.intp], data=data, cand=cand) -> float:  # type: ignore[no-untyped-def]
-            idx = np.sort(idx)  # index order, as benchmarks.adaptive scores every layout
-            return normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-
+        err = _layout_error(data)
         res: dict[tuple[int, str], list[float]] = {}
         for _ in range(draws):
-            keep = np.sort(rng.choice(len(cand), len(cand) - SIM_REMOVED, replace=False))
-            sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
+            keep, sub = _draw_lights(rng, len(cand), cand)
             for n in NS:
-                for f in FLOORS:
-                    res.setdefault((n, f"hom {f:g}"), []).append(
-                        err(keep[select_uniform_leds(sub, n, f)])
-                    )
+                _score_floors(res, n, keep, sub, err)
                 for name, fn in starts.items():
                     st = fn(sub, adaptive.START_LIGHTS, n)  # first decision after len(st)
                     avail = np.ones(len(keep), dtype=bool)
@@ -262,7 +281,7 @@ def families(
     reachable from the start: for reference). ``ceiling`` (cells ``scene:N``): also a greedy
     exchange on the *true* error with the start kept (what any completion could reach; slow)."""
     from benchmarks.planner_real_data import planned_leds
-    from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
+    from benchmarks.tradeoff import TradeoffSettings, render_scene_data
 
     settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     light = settings.preview_light_az_el_deg
@@ -275,19 +294,12 @@ def families(
         cand = data.candidate_dirs
         grey = data.candidate_images.mean(axis=-1)
 
-        def err(idx: NDArray[np.intp], data=data, cand=cand) -> float:  # type: ignore[no-untyped-def]
-            idx = np.sort(idx)
-            return normal_error(data.normals, data.candidate_images[idx], cand[idx])[0]
-
+        err = _layout_error(data)
         res: dict[tuple[int, str], list[float]] = {}
         for _ in range(draws):
-            keep = np.sort(rng.choice(len(cand), len(cand) - SIM_REMOVED, replace=False))
-            sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
+            keep, sub = _draw_lights(rng, len(cand), cand)
             for n in NS:
-                for f in FLOORS:
-                    res.setdefault((n, f"hom {f:g}"), []).append(
-                        err(keep[select_uniform_leds(sub, n, f)])
-                    )
+                _score_floors(res, n, keep, sub, err)
                 st = dome_start(sub, adaptive.START_LIGHTS, n)
                 avail = np.ones(len(keep), dtype=bool)
                 avail[st] = False

@@ -19,27 +19,26 @@ from rti_rig.simulator.light_transport import DirectionalLight, render_radiance
 from rti_rig.simulator.scenes import make_scene
 
 
-def dome_lights() -> np.ndarray:
-    """A 36-light dome: rings at 15°, 30°, 45°, 60°, 75° elevation."""
+def _rings(rings: tuple[tuple[float, int, float], ...]) -> np.ndarray:
+    """Unit lights in rings of (elevation °, count, azimuth offset °), in that order."""
     out = []
-    for el, count, off in ((15, 10, 0), (30, 9, 20), (45, 8, 0), (60, 6, 30), (75, 3, 0)):
+    for el, count, off in rings:
         for k in range(count):
             az = np.radians(off + 360.0 * k / count)
             e = np.radians(el)
             out.append((np.cos(e) * np.cos(az), np.cos(e) * np.sin(az), np.sin(e)))
     return np.array(out)
+
+
+def dome_lights() -> np.ndarray:
+    """A 36-light dome: rings at 15°, 30°, 45°, 60°, 75° elevation."""
+    return _rings(((15, 10, 0), (30, 9, 20), (45, 8, 0), (60, 6, 30), (75, 3, 0)))
 
 
 def grazing_last_lights() -> np.ndarray:
     """36 lights whose last ring is at 10° elevation (taken last, as a planner sorting by
     elevation would): rings at 30°, 45°, 60°, 75°, then 10 lights at 10°."""
-    out = []
-    for el, count, off in ((30, 9, 20), (45, 8, 0), (60, 6, 30), (75, 3, 0), (10, 10, 0)):
-        for k in range(count):
-            az = np.radians(off + 360.0 * k / count)
-            e = np.radians(el)
-            out.append((np.cos(e) * np.cos(az), np.cos(e) * np.sin(az), np.sin(e)))
-    return np.array(out)
+    return _rings(((30, 9, 20), (45, 8, 0), (60, 6, 30), (75, 3, 0), (10, 10, 0)))
 
 
 def make_session(
