@@ -160,12 +160,15 @@ def _albedo_residual_used(
 
 #: Bytes of observations per chunk of the least-squares pass: the chunk's (N, chunk) float32 work
 #: arrays stay in the L3 cache, so the residual's extra passes cost little beyond the product
-#: (measured: 1.5 MB gave 3.2×, 4–24 MB 3.0× a same-shape product at 512² × 48).
+#: (measured before its arithmetic was cut: 1.5 MB gave 3.2×, 4–24 MB 3.0× a same-shape product
+#: at 512² × 48).
 LS_CHUNK_BYTES = 4 * 1024 * 1024
-#: The least-squares residual is taken from the normal equations (``I.I - 2 b.L^T I + b^T G b``)
-#: where it is at least this fraction of ``I.I``; float32 sums are exact to ~1e-6 of ``I.I``, so
-#: its relative error stays below ~1e-4 there. Smaller residuals are computed directly.
+#: The least-squares residual is taken from the normal equations (``I.I - b.L^T I``, since
+#: ``b^T G b = b.L^T I`` for ``b = G^-1 L^T I``) where it is at least this fraction of ``I.I``;
+#: float32 sums are exact to ~1e-6 of ``I.I``, so its relative error stays below ~1e-4 there.
+#: Smaller residuals are computed directly.
 DIRECT_RESIDUAL_FRACTION = 1e-2
+_VIEW_AXIS = np.array([[0.0], [0.0], [1.0]], dtype=np.float32)
 
 
 def _least_squares_band(
@@ -181,12 +184,17 @@ def _least_squares_band(
     """Least squares over all lights, a cache-sized chunk of pixels at a time.
 
     ``flat`` (N, P, C) is the band (never written), ``g`` (N, P) its grey values. Per chunk:
-    ``L^T I`` (the one product that reads the band), ``b = (L^T L)^-1 L^T I``; with every light
-    used, the albedo is ``n . (L^T I) / n^T (L^T L) n`` (one more product for colour); the
-    residual is computed directly, ``|L b - I|`` (not as a difference of large sums, which
-    float32 cannot resolve), while the chunk is still in cache. A pixel with a NaN/infinite
-    observation (found in ``L^T I``, where it propagates) or a saturated one (one max-reduction
-    of the chunk) is returned in ``suspect`` for the caller's per-pixel path.
+    ``L^T I`` (the one product that reads the band) and ``I.I`` (one more pass, while the chunk
+    is in cache), ``b = (L^T L)^-1 L^T I``. Everything else is per pixel on 3-vectors, and uses
+    that ``b`` solves the normal equations: ``b^T (L^T L) b = b.(L^T I)``, so the residual is
+    ``I.I - b.(L^T I)`` and, with every light used, the albedo of the normal ``b / |b|`` is
+    ``|b|`` (its least-squares value ``n.(L^T I) / n^T (L^T L) n`` reduces to it). Where ``b``
+    points away from the camera and is clamped to ``b_z = 0`` it no longer solves them: those
+    few pixels take the general formulas. A residual small against the signal (which float32
+    cannot resolve as a difference of large sums) is computed directly, ``|L b - I|``. A pixel
+    with a NaN/infinite observation (found in ``I.I``, where it propagates) or a saturated one
+    (one max-reduction of the chunk) is returned in ``suspect`` for the caller's per-pixel
+    path.
 
     Returns normals (P, 3) float32 (invalid: the view axis; written into ``normals`` when
     given), albedo (P, C), RMS residual (P,), validity (P,) and the suspect pixels' indices.
@@ -208,22 +216,31 @@ def _least_squares_band(
     # one work buffer reused by every chunk: a fresh array of this size per chunk costs more
     # in first-touch page faults than the arithmetic
     work = np.empty((n_img, min(chunk, p)), dtype=np.float32)
-    with np.errstate(invalid="ignore", over="ignore"):  # NaN/inf pixels are returned as suspect
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        # NaN/inf pixels are returned as suspect
         for s in range(0, p, chunk):
             e = min(p, s + chunk)
             gc = g[:, s:e]
             ltg = lt32 @ gc  # (3, c)
-            bad = ~np.isfinite(ltg).all(axis=0)
+            gg = np.einsum("ij,ij->j", gc, gc)  # NaN or inf where an observation is
+            bad = ~np.isfinite(gg)
             if sat is not None:
                 top = np.max(flat[:, s:e].reshape(n_img, -1), axis=0)
                 bad |= (top >= sat).reshape(-1, channels).any(axis=1)
             b = ginv32 @ ltg
-            np.maximum(b[2], np.float32(0.0), out=b[2])  # a normal facing away is unseen
-            # |L b - I|^2 = I.I - 2 b.(L^T I) + b^T (L^T L) b: one pass over the chunk (I.I)
-            # instead of a prediction; where the residual is small against the signal, float32
-            # cannot resolve that difference and the prediction is computed directly
-            gg = np.einsum("ij,ij->j", gc, gc).astype(np.float64)
-            r2 = gg - 2.0 * np.einsum("ij,ij->j", b, ltg) + np.einsum("ij,ij->j", gram32 @ b, b)
+            bl = np.einsum("ij,ij->j", b, ltg)  # b^T G b while b solves the normal equations
+            r2 = gg - bl
+            clamped = np.flatnonzero(b[2] < 0)  # a normal facing away is unseen: b_z = 0
+            if clamped.size:
+                bk = b[:, clamped]
+                bk[2] = 0.0
+                b[:, clamped] = bk
+                lk = ltg[:, clamped]
+                r2[clamped] = (
+                    gg[clamped]
+                    - 2.0 * np.einsum("ij,ij->j", bk, lk)
+                    + np.einsum("ij,ij->j", gram32 @ bk, bk)
+                )
             direct = ~(r2 >= DIRECT_RESIDUAL_FRACTION * gg)  # NaN included
             if direct.any():
                 k = np.flatnonzero(direct)
@@ -235,19 +252,34 @@ def _least_squares_band(
                 pred = np.matmul(l32, b[:, k], out=work[:, : sub.shape[1]])
                 pred -= sub
                 r2[k] = np.einsum("ij,ij->j", pred, pred)
-            rms[s:e] = np.sqrt(np.maximum(r2, 0.0) / n_img)
+            np.maximum(r2, np.float32(0.0), out=r2)
+            r2 *= np.float32(1.0 / n_img)
+            rms[s:e] = np.sqrt(r2)
             norm = np.sqrt(np.einsum("ij,ij->j", b, b))
             good = inside[s:e] & ~bad & (norm > eps_b)
-            nn = b / np.where(norm > 0, norm, np.float32(1.0))
-            ss = np.einsum("ij,ij->j", gram32 @ nn, nn)
-            ss = np.where(ss > 0, ss, np.float32(1.0))
+            safe = np.where(norm > 0, norm, np.float32(1.0))
+            nn = b / safe  # divided, not times a reciprocal: the normals of before, bit for bit
             if channels == 1:
-                alb[s:e, 0] = np.einsum("ij,ij->j", nn, ltg) / ss
+                alb[s:e, 0] = norm
+                if clamped.size:
+                    nk = nn[:, clamped]
+                    sk = np.einsum("ij,ij->j", gram32 @ nk, nk)
+                    sk = np.where(sk > 0, sk, np.float32(1.0))
+                    alb[s + clamped, 0] = np.einsum("ij,ij->j", nk, ltg[:, clamped]) / sk
             else:
+                ss = bl / (safe * safe)  # n^T G n
+                if clamped.size:
+                    nk = nn[:, clamped]
+                    ss[clamped] = np.einsum("ij,ij->j", gram32 @ nk, nk)
+                ss = np.where(ss > 0, ss, np.float32(1.0))
                 proj = (lt32 @ flat[:, s:e].reshape(n_img, -1)).reshape(3, e - s, channels)
                 alb[s:e] = np.einsum("ip,ipc->pc", nn, proj) / ss[:, None]
-            nn[:, ~good] = np.array([[0.0], [0.0], [1.0]], dtype=np.float32)
-            normals[s:e] = nn.T  # transposed while the chunk is in cache
+            if not good.all():
+                nn[:, ~good] = _VIEW_AXIS
+            out = normals[s:e]  # column by column: 4× cheaper than a (3, c) transpose
+            out[:, 0] = nn[0]
+            out[:, 1] = nn[1]
+            out[:, 2] = nn[2]
             ok[s:e] = good
             if bad.any():
                 suspect.append(s + np.flatnonzero(bad & inside[s:e]))

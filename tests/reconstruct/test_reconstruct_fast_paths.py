@@ -48,6 +48,44 @@ def test_least_squares_residual_and_normals_match_float64() -> None:
     assert np.degrees(np.arccos(np.clip(cos, -1, 1))).max() < 0.05
 
 
+def _float64_albedo(images: np.ndarray, lights: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Least-squares albedo per channel given the normal ``b / |b|``: ``n.L^T I / n^T G n``."""
+    n_img = images.shape[0]
+    n = b / np.linalg.norm(b, axis=0)
+    shade = lights @ n  # (N, P)
+    flat = images.reshape(n_img, n.shape[1], -1).astype(np.float64)
+    return np.einsum("kp,kpc->pc", shade, flat) / np.sum(shade * shade, axis=0)[:, None]
+
+
+def test_least_squares_albedo_and_clamped_normals_match_float64() -> None:
+    """The chunked fit takes the albedo as |b| and the residual as I.I - b.L^T I, which hold
+    only while b solves the normal equations. A quarter of the pixels here are black
+    background with the dark level subtracted (zero-mean noise, as float input after a dark
+    frame is): about half of them get a least-squares b facing away from the camera (b_z < 0,
+    clamped to 0), where those identities fail. Their residual, normal and albedo must still
+    be those of a float64 least squares with the clamped b, grey and colour, over several
+    chunks."""
+    images, lights = _glossy(220, 24, seed=2)
+    n_img = images.shape[0]
+    flat = images.reshape(n_img, -1)
+    away = np.random.default_rng(5).choice(flat.shape[1], flat.shape[1] // 4, replace=False)
+    flat[:, away] = np.random.default_rng(6).normal(0, 0.01, (n_img, away.size))
+    for colour in (False, True):
+        stack = np.stack([images, 0.5 * images, 0.8 * images], axis=-1) if colour else images
+        res = fit_photometric_stereo(stack, lights)
+        b, rms = _float64_least_squares(stack.mean(axis=-1) if colour else images, lights)
+        assert (b[2, away] == 0.0).mean() > 0.3 and (b[2] > 0).mean() > 0.7  # both paths
+        v = res.valid.ravel()
+        assert v.mean() > 0.99
+        np.testing.assert_allclose(res.residual.ravel()[v], rms[v], rtol=1e-3, atol=1e-7)
+        n64 = (b / np.linalg.norm(b, axis=0)).T
+        cos = np.sum(res.normals.reshape(-1, 3)[v] * n64[v], axis=1)
+        assert np.degrees(np.arccos(np.clip(cos, -1, 1))).max() < 0.05
+        alb = _float64_albedo(stack, lights, b)
+        got = res.albedo.reshape(alb.shape[0], -1)
+        np.testing.assert_allclose(got[v], alb[v], rtol=1e-4, atol=1e-6)
+
+
 def test_least_squares_excludes_saturated_and_nan_pixels_in_any_chunk() -> None:
     """Bad observations scattered over several chunks: those pixels are fitted on their other
     observations only, exactly like a float64 least squares on those observations."""
