@@ -52,27 +52,38 @@ def run(data: Path | None, draws: int, targets: tuple[float, ...], cap: int) -> 
         else:
             keep = np.sort(rng.choice(len(dirs), len(dirs) - REAL_REMOVED, replace=False))
         sub = DomeGeometry(dirs[keep], tuple(dome.names[i] for i in keep))
+        # a decision does not depend on the target (only the stop does): the session that
+        # stops at a target is the prefix, up to the first light count whose estimate is at
+        # most that target, of the one run to the smallest target
+        t0 = time.perf_counter()
+        used, est, _ = adaptive_run(
+            grey[keep],
+            dirs[keep],
+            sub,
+            min(cap, len(keep)),
+            until=min(targets),
+            scale=SIM_ESTIMATE_SCALE,
+        )
+        seconds = time.perf_counter() - t0
+        ks = sorted(k for k in est if isinstance(k, int))
+        el = np.degrees(np.arcsin(np.clip(dirs[keep[np.array(used)], 2], -1, 1)))
+        print(
+            f"draw {d}: {len(used)} lights in {seconds:.0f} s; elevations "
+            f"{np.round(el).astype(int).tolist()}",
+            flush=True,
+        )
         for target in targets:
-            t0 = time.perf_counter()
-            used, est, _ = adaptive_run(
-                grey[keep],
-                dirs[keep],
-                sub,
-                min(cap, len(keep)),
-                until=target,
-                scale=SIM_ESTIMATE_SCALE,
-            )
-            seconds = time.perf_counter() - t0
-            idx = keep[np.array(used)]
+            k = next((k for k in ks if est[k] <= target), len(used))
+            idx = keep[np.array(used[:k])]
             measured = evaluate(idx, images, dirs, ref, mask, "ptm")[0]
-            estimate = est.get(len(used))
+            estimate = est.get(k)
             reached = estimate is not None and estimate <= target
             rows.append(
                 {
                     "draw": d,
                     "leds": len(keep),
                     "target": target,
-                    "lights": len(used),
+                    "lights": k,
                     "estimate": estimate,
                     "measured": measured,
                     "reached": reached,
@@ -80,7 +91,7 @@ def run(data: Path | None, draws: int, targets: tuple[float, ...], cap: int) -> 
                 }
             )
             print(
-                f"draw {d} target {target:g}: {len(used)} lights, estimate "
+                f"draw {d} target {target:g}: {k} lights, estimate "
                 f"{estimate if estimate is None else round(estimate, 2)}, measured "
                 f"{measured:.2f}",
                 flush=True,

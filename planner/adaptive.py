@@ -141,6 +141,9 @@ class Decision:
     #: normal error, °; ``relight``: simulated relighting PSNR, dB) and each floor's score
     objective: str | None = None
     design_scores: dict[str, float] | None = None
+    #: with only ``--until-error``: the guessed N whose design the light was chosen in
+    #: (:mod:`rti_rig.planner.adaptive_until`)
+    guessed_lights: int | None = None
 
     def evidence(self) -> dict[str, object]:
         out: dict[str, object] = {
@@ -161,6 +164,8 @@ class Decision:
         if self.design_scores is not None:
             key = "design_psnr_db" if self.objective == "relight" else "design_error_deg"
             out[key] = self.design_scores
+        if self.guessed_lights is not None:
+            out["guessed_lights"] = self.guessed_lights
         return out
 
 

@@ -52,6 +52,7 @@ from rti_rig.planner.adaptive import (
 )
 from rti_rig.planner.adaptive_bias import simulate_error_deg
 from rti_rig.planner.adaptive_relight import OBJECTIVES
+from rti_rig.planner.adaptive_until import choose_until
 from rti_rig.planner.objectives import candidates_for, snap_unique
 from rti_rig.planner.uniform import select_uniform_leds
 
@@ -75,6 +76,9 @@ FORMAT = "rti-rig-adaptive/5"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
+#: With only --until-error (N unknown): choose within the design for a guessed N that grows
+#: (``planner.adaptive_until``; format 6) rather than the bound's best light one at a time.
+UNTIL_DESIGN = True
 
 
 def small_grey(pixels: NDArray, white_level: float = 65535.0) -> NDArray[np.float32]:
@@ -393,6 +397,20 @@ class AdaptiveChooser:
                 incumbent=self.floor if self.bias_aware else None,
                 objective=self.objective,
                 relight=relight_fit if self.objective == "relight" else None,
+            )
+            self.floor = d.design_floor
+        elif self.bias_aware and UNTIL_DESIGN:
+            # N unknown: the design for a guessed N that grows (planner.adaptive_until)
+            d = choose_until(
+                state,
+                self.candidates,
+                available,
+                self.max_lights,
+                fit=robust_fit,
+                incumbent=self.floor,
+                capture_s=self.capture_s,
+                move_s=move,
+                scale=self.scale,
             )
             self.floor = d.design_floor
         else:
