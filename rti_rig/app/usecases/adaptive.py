@@ -71,8 +71,10 @@ ARM_MAX_LIGHTS = 100
 #: 4: the design objective (``normals``/``relight``) in the settings and every decision;
 #: 5: the fitted design (``planner.adaptive_optimal``) offered beside the floors, a decision
 #: that takes it recording ``"design": "fitted"`` (a /4 session's choices would differ: its
-#: resume is refused, before anything on disk changes)
-FORMAT = "rti-rig-adaptive/5"
+#: resume is refused, before anything on disk changes); 6: with only --until-error, each light
+#: chosen within the design for a guessed N that grows (``planner.adaptive_until``), recorded
+#: as ``guessed_lights`` with the design's floor and scores (a /5 session chose by the bound)
+FORMAT = "rti-rig-adaptive/6"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
