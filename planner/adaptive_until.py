@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.planner.adaptive import Decision, SurfaceState, choose_in_design
+from rti_rig.planner.adaptive import Decision, SurfaceState, choose_in_design, object_model
 from rti_rig.planner.adaptive_bias import FitFn
 
 #: The guessed numbers of lights: the benchmark's N = 6, 9, 12, 18 first (where the designs'
@@ -62,7 +62,10 @@ def choose_until(
     guesses: a session that left the default floor for good evidence keeps to its floor as
     the guess grows unless another is better by the margin)."""
     guess = guessed_lights(len(state.lights), max_lights)
+    # a state without observations has no object model: the designs are scored by the bound
+    # (choose_in_design given a fit but no model would not score them)
+    usable = fit if object_model(state) is not None else None
     d = choose_in_design(
-        state, candidates, available, guess, fit=fit, incumbent=incumbent, **choose
+        state, candidates, available, guess, fit=usable, incumbent=incumbent, **choose
     )
     return replace(d, guessed_lights=guess)
