@@ -162,7 +162,23 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument("--scale", type=float, default=SIM_ESTIMATE_SCALE)
     ap.add_argument("--greedy", action="store_true", help="format 5's light-by-light choice")
     ap.add_argument("--write", action="store_true", help="write the tables into docs/adaptive.md")
+    ap.add_argument("--guesses", default="", help="comma-separated guessed N (to compare)")
+    ap.add_argument(
+        "--first-start",
+        action="store_true",
+        help="start from the 4 lights of the first guess's homogeneous layout (to compare)",
+    )
     args = ap.parse_args(argv)
+    if args.first_start:
+        import benchmarks.adaptive as bench
+        from rti_rig.app.usecases.adaptive import dome_start
+        from rti_rig.planner.adaptive_until import GUESSES
+
+        bench.START["start"] = lambda g, k, n: dome_start(g, k, GUESSES[0] if n is None else n)
+    if args.guesses:
+        import rti_rig.planner.adaptive_until as until
+
+        until.GUESSES = tuple(int(g) for g in args.guesses.split(","))
     if args.greedy:
         usecase.UNTIL_DESIGN = False
     targets = tuple(float(t) for t in args.targets.split(","))
@@ -186,7 +202,9 @@ def main(argv: list[str] | None = None) -> str:
         )
     cmd = (
         f"python -m benchmarks.adaptive_until_sim --scenes {args.scenes} --cap {args.cap} "
-        f"--targets {args.targets}" + (" --greedy" if args.greedy else "")
+        f"--targets {args.targets}"
+        + (" --greedy" if args.greedy else "")
+        + (f" --guesses {args.guesses}" if args.guesses else "")
     )
     text = report(
         sessions, targets, args.scale, args.cap, cmd, time.perf_counter() - t0, args.greedy

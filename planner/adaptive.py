@@ -20,8 +20,9 @@ Light by light (:func:`choose_next`): the available candidate with the largest p
 drop of the mean angular error per second of rig time (capture plus, on an arm, the move from
 the current light: ``move_s``) — the order within a design; with N unknown (``--until-error``
 alone) a session chooses within the design for a guessed N that grows
-(:mod:`rti_rig.planner.adaptive_until`), not among every candidate by the bound alone. With N known (:func:`choose_in_design`): the rest of
-the session as a whole — the homogeneous design above one of :data:`DESIGN_FLOORS` with the
+(:mod:`rti_rig.planner.adaptive_until`), not among every candidate by the bound alone.
+With N known (:func:`choose_in_design`): the rest of the session as a whole — the
+homogeneous design above one of :data:`DESIGN_FLOORS` with the
 lowest error, scored (given a ``fit``, as the use case does) by a robust fit *simulated* on this
 object's model of gloss, cast shadows and noise (:mod:`rti_rig.planner.adaptive_bias`: what
 decides the best floor is bias, which the variance bound does not see), else by the bound; the
