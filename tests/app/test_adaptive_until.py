@@ -151,3 +151,24 @@ def test_the_shipped_simulated_dome_stops_where_its_estimate_reaches_the_target(
     else:
         assert stop["reason"] == f"reached its maximum of {cap} lights"
     assert f"Adaptive: {used} lights" in said(r)
+
+
+def test_an_arm_with_only_until_error_chooses_within_growing_designs_and_counts_moves(
+    tmp_path: Path,
+) -> None:
+    out = tmp_path / "arm"
+    cfg = CONFIGS / "virtual_arm.toml"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", "0.2"])
+    assert r.exit_code == 0, r.output
+    m = manifest(out)["adaptive"]
+    steps = journal(out)
+    assert m["design_lights"] is None and m["result"]["lights_used"] == len(steps)
+    assert len(steps) > 6  # decisions were taken (on this scene 0.2° needs several)
+    for k, s in enumerate(steps[4:], start=4):
+        d = s["decision"]
+        assert d["guessed_lights"] == guessed_lights(k, m["max_lights"])
+        assert d["estimated_error_deg"] > 0.2
+        assert all(c["move_s"] >= 0 for c in d["best_candidates"])
+        assert any(c["move_s"] > 0 for c in d["best_candidates"])  # an arm's moves are counted
+    stop = m["result"]["stop"]
+    assert len(steps) == m["max_lights"] or stop["estimated_error_deg"] <= 0.2
