@@ -4,7 +4,9 @@ optimal`, at N = 6 … 100 on a dome and on an arm.
 * **Adaptive decision** (what `run --adaptive` does between two images): shrink the newest
   24-megapixel frame (6000×4000 RGB, 16-bit) to the fit's 128 px and sample it, robust
   photometric stereo on the samples of the images so far, and the choice: light by light among
-  the rig's candidates (N images so far, as `--until-error` alone does), or the rest of an
+  the rig's candidates (N images so far, as `--until-error` alone does: within the design for
+  the next guessed N of ``planner.adaptive_until``; ``--greedy``: format 5's bound-only choice),
+  or the rest of an
   N-light design (N/2 images so far, as `--lights N` does; for ``--objective normals`` and
   ``relight``, whose score renders every candidate left out). Targets: ≤ 0.2 s on 2
   cores. The N images are the simulator's relief scene rendered at the fit's size (the shrink
@@ -46,11 +48,14 @@ from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.planner.adaptive import START_LIGHTS, choose_in_design, choose_next, object_model
 from rti_rig.planner.adaptive_bias import simulate_error_deg
+from rti_rig.planner.adaptive_until import choose_until
 from rti_rig.planner.make_plan import plan_with_report
 from rti_rig.planner.objectives import candidates_for
 from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
 
 NS = (6, 9, 12, 18, 24, 36, 50, 75, 100)
+#: ``--greedy``: time the light-by-light decision of format 5 (the bound's best light)
+GREEDY = False
 
 
 def _state(samples: np.ndarray, lights: np.ndarray, images: np.ndarray):  # type: ignore[no-untyped-def]
@@ -83,7 +88,15 @@ def main(argv: list[str] | None = None) -> str:
         help="time the design decisions without planner.adaptive_optimal's design (offered in "
         "what ships): to compare",
     )
+    ap.add_argument(
+        "--greedy",
+        action="store_true",
+        help="time format 5's light-by-light decision (the bound's best light) instead of the "
+        "design for a guessed N that grows: to compare",
+    )
     args = ap.parse_args(argv)
+    global GREEDY
+    GREEDY = args.greedy
     if args.no_fitted_design:
         import rti_rig.planner.adaptive as adaptive_planner
 
@@ -118,7 +131,10 @@ def main(argv: list[str] | None = None) -> str:
                 sample_pixels(small_grey(frame)[None])
                 state = _state(samples, lights, images)
                 simulate_error_deg(object_model(state), lights, robust_fit)
-                choose_next(state, cands, available)
+                if GREEDY:  # format 5's path: the bound's best light
+                    choose_next(state, cands, available)
+                else:  # N unknown: the design for a guessed N that grows (adaptive_until)
+                    choose_until(state, cands, available, len(cands), fit=robust_fit)
 
             half = max(START_LIGHTS, n // 2)
             avail_half = np.ones(len(cands), dtype=bool)
@@ -180,6 +196,7 @@ def main(argv: list[str] | None = None) -> str:
     cmd = "python -m benchmarks.adaptive_time --repeats " + str(args.repeats)
     cmd += " --max-optimal-n 0" if decisions_only else ""
     cmd += " --no-fitted-design" if args.no_fitted_design else ""
+    cmd += " --greedy" if args.greedy else ""
     lines = [
         f"Command: `{cmd} --write`. "
         + machine_line()

@@ -16,10 +16,13 @@ shadow from the fitted normal, soft below :data:`GRAZING_COS`, times the chance 
 such an observation, learnt from this object's kept and discarded ones); Sherman–Morrison makes
 the predicted error of every candidate on every sampled pixel one vectorised expression.
 
-Light by light (:func:`choose_next`, N unknown): the available candidate with the largest
-predicted drop of the mean angular error per second of rig time (capture plus, on an arm, the
-move from the current light: ``move_s``). With N known (:func:`choose_in_design`): the rest of
-the session as a whole — the homogeneous design above one of :data:`DESIGN_FLOORS` with the
+Light by light (:func:`choose_next`): the available candidate with the largest predicted
+drop of the mean angular error per second of rig time (capture plus, on an arm, the move from
+the current light: ``move_s``) — the order within a design; with N unknown (``--until-error``
+alone) a session chooses within the design for a guessed N that grows
+(:mod:`rti_rig.planner.adaptive_until`), not among every candidate by the bound alone.
+With N known (:func:`choose_in_design`): the rest of the session as a whole — the
+homogeneous design above one of :data:`DESIGN_FLOORS` with the
 lowest error, scored (given a ``fit``, as the use case does) by a robust fit *simulated* on this
 object's model of gloss, cast shadows and noise (:mod:`rti_rig.planner.adaptive_bias`: what
 decides the best floor is bias, which the variance bound does not see), else by the bound; the
@@ -141,6 +144,9 @@ class Decision:
     #: normal error, °; ``relight``: simulated relighting PSNR, dB) and each floor's score
     objective: str | None = None
     design_scores: dict[str, float] | None = None
+    #: with only ``--until-error``: the guessed N whose design the light was chosen in
+    #: (:mod:`rti_rig.planner.adaptive_until`)
+    guessed_lights: int | None = None
 
     def evidence(self) -> dict[str, object]:
         out: dict[str, object] = {
@@ -161,6 +167,8 @@ class Decision:
         if self.design_scores is not None:
             key = "design_psnr_db" if self.objective == "relight" else "design_error_deg"
             out[key] = self.design_scores
+        if self.guessed_lights is not None:
+            out["guessed_lights"] = self.guessed_lights
         return out
 
 

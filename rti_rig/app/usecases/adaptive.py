@@ -52,6 +52,7 @@ from rti_rig.planner.adaptive import (
 )
 from rti_rig.planner.adaptive_bias import simulate_error_deg
 from rti_rig.planner.adaptive_relight import OBJECTIVES
+from rti_rig.planner.adaptive_until import choose_until
 from rti_rig.planner.objectives import candidates_for, snap_unique
 from rti_rig.planner.uniform import select_uniform_leds
 
@@ -70,11 +71,16 @@ ARM_MAX_LIGHTS = 100
 #: 4: the design objective (``normals``/``relight``) in the settings and every decision;
 #: 5: the fitted design (``planner.adaptive_optimal``) offered beside the floors, a decision
 #: that takes it recording ``"design": "fitted"`` (a /4 session's choices would differ: its
-#: resume is refused, before anything on disk changes)
-FORMAT = "rti-rig-adaptive/5"
+#: resume is refused, before anything on disk changes); 6: with only --until-error, each light
+#: chosen within the design for a guessed N that grows (``planner.adaptive_until``), recorded
+#: as ``guessed_lights`` with the design's floor and scores (a /5 session chose by the bound)
+FORMAT = "rti-rig-adaptive/6"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
+#: With only --until-error (N unknown): choose within the design for a guessed N that grows
+#: (``planner.adaptive_until``; format 6) rather than the bound's best light one at a time.
+UNTIL_DESIGN = True
 
 
 def small_grey(pixels: NDArray, white_level: float = 65535.0) -> NDArray[np.float32]:
@@ -393,6 +399,20 @@ class AdaptiveChooser:
                 incumbent=self.floor if self.bias_aware else None,
                 objective=self.objective,
                 relight=relight_fit if self.objective == "relight" else None,
+            )
+            self.floor = d.design_floor
+        elif self.bias_aware and UNTIL_DESIGN:
+            # N unknown: the design for a guessed N that grows (planner.adaptive_until)
+            d = choose_until(
+                state,
+                self.candidates,
+                available,
+                self.max_lights,
+                fit=robust_fit,
+                incumbent=self.floor,
+                capture_s=self.capture_s,
+                move_s=move,
+                scale=self.scale,
             )
             self.floor = d.design_floor
         else:
