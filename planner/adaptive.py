@@ -543,11 +543,12 @@ def choose_in_design(
         f: homogeneous_completion(candidates, available, state.lights, n_total, f) for f in floors
     }
     comps = {f: c for f, c in comps.items() if c is not None and c.size}
-    if comps and fit is None:  # every design's lights weighted at once
+    model = object_model(state) if fit is not None else None
+    if comps and model is None:  # the bound's score: every design's lights weighted at once
+        # (also with ``fit`` given when the state has no observations to model the object on)
         union = np.unique(np.concatenate(list(comps.values())))
         w_union = predicted_weight(state, candidates[union])
         where = {int(c): i for i, c in enumerate(union)}
-    model = object_model(state) if fit is not None else None
     if objective == "relight" and model is None:
         raise ValueError("the relight objective needs the state's observations (obs, valid)")
     for f, comp in comps.items():

@@ -117,3 +117,22 @@ def test_the_estimate_grows_with_what_the_fit_discarded(monkeypatch: pytest.Monk
     assert estimate_factor(rough, 0.8) == pytest.approx(0.8 * np.exp(1.5 * d))
     assert estimate_factor(st, 0.8) == pytest.approx(0.8)
     assert estimate_error_deg(rough, 0.8) > estimate_error_deg(st, 0.8)
+
+
+def test_a_fit_without_observations_to_model_falls_back_to_the_bound() -> None:
+    """``fit`` given but the state carries no observations (no object model can be fitted):
+    the designs are scored by the bound, as without ``fit`` — it raised a NameError."""
+    g = dome()
+    full = select_uniform_leds(g, 9, 10.0)
+    start = [int(full[i]) for i in start_subset(g.directions[full], 4)]
+    st = state_for(fibonacci_cap(200, 60.0), g.directions[start])
+    assert st.obs is None
+    available = np.ones(g.count, bool)
+    available[start] = False
+
+    def never(*_args, **_kwargs):  # type: ignore[no-untyped-def]
+        raise AssertionError("no object model: nothing to simulate")
+
+    with_fit = choose_in_design(st, g.directions, available, 9, fit=never)
+    without = choose_in_design(st, g.directions, available, 9)
+    assert with_fit.candidate == without.candidate and with_fit.reason == without.reason
