@@ -43,6 +43,10 @@ OBJECTIVES = ("normals", "relight")
 #: current design's by this many dB: chosen leave one scene out on the simulator
 #: (``python -m benchmarks.adaptive_relight_margin``; docs/adaptive.md), never on real data.
 RELIGHT_MARGIN_DB = 0.5
+#: Also offer, with the relight objective, the fitted relight design
+#: (:mod:`rti_rig.planner.adaptive_relight_design`: ``optimal --objective relight`` on the object
+#: model fitted so far, the lights shot kept), scored and taken like the floors' designs.
+RELIGHT_FITTED_DESIGN = True
 #: PSNR reported for a perfect relighting (as ``benchmarks.metrics.PSNR_CAP_DB``).
 PSNR_CAP_DB = 100.0
 

@@ -70,8 +70,11 @@ ARM_MAX_LIGHTS = 100
 #: 4: the design objective (``normals``/``relight``) in the settings and every decision;
 #: 5: the fitted design (``planner.adaptive_optimal``) offered beside the floors, a decision
 #: that takes it recording ``"design": "fitted"`` (a /4 session's choices would differ: its
-#: resume is refused, before anything on disk changes)
-FORMAT = "rti-rig-adaptive/5"
+#: resume is refused, before anything on disk changes); 6: the fitted relight design
+#: (``planner.adaptive_relight_design``) offered to ``--objective relight`` beside the floors,
+#: its simulated PSNR recorded as ``design_psnr_db["fitted"]`` and a decision that takes it
+#: recording ``"design": "fitted"`` (a /5 relight session's choices would differ)
+FORMAT = "rti-rig-adaptive/6"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
