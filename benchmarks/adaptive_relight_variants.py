@@ -47,11 +47,11 @@ VARIANTS: dict[str, list[tuple[object, dict]]] = {
     "floors": [(adaptive_relight, {"RELIGHT_FITTED_DESIGN": False})],
     "fitted-mse": [
         (adaptive_relight, {"RELIGHT_FITTED_DESIGN": True}),
-        (relight_design, {"DB_WEIGHTED": False}),
+        (relight_design, {"DB_WEIGHTED": False, "UNMODELLED_REL": 0.05}),
     ],
     "fitted-db": [
         (adaptive_relight, {"RELIGHT_FITTED_DESIGN": True}),
-        (relight_design, {"DB_WEIGHTED": True}),
+        (relight_design, {"DB_WEIGHTED": True, "UNMODELLED_REL": 0.05}),
     ],
     # the same, hedged against a larger unmodelled deviation (2x, 4x optimal's BIAS_REL)
     "fitted-db-hedge2": [
@@ -65,7 +65,7 @@ VARIANTS: dict[str, list[tuple[object, dict]]] = {
     # the fitted design, and at N <= 6 a start of 3 lights (of the same 10° layout) instead of 4
     "fitted-db-start3": [
         (adaptive_relight, {"RELIGHT_FITTED_DESIGN": True}),
-        (relight_design, {"DB_WEIGHTED": True}),
+        (relight_design, {"DB_WEIGHTED": True, "UNMODELLED_REL": 0.05}),
         (bench, {"START": {"start": lambda g, k, n: dome_start(g, 3 if n and n <= 6 else k, n)}}),
     ],
 }

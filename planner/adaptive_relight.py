@@ -45,7 +45,10 @@ OBJECTIVES = ("normals", "relight")
 RELIGHT_MARGIN_DB = 0.5
 #: Also offer, with the relight objective, the fitted relight design
 #: (:mod:`rti_rig.planner.adaptive_relight_design`: ``optimal --objective relight`` on the object
-#: model fitted so far, the lights shot kept), scored and taken like the floors' designs.
+#: model fitted so far, the lights shot kept), scored and taken like the floors' designs (the
+#: same simulated PSNR, margin and hysteresis). On: chosen leave one scene out on the simulator
+#: against the floors alone (``python -m benchmarks.adaptive_relight_variants``,
+#: docs/adaptive.md); ``benchmarks.adaptive --no-relight-fitted-design`` turns it off.
 RELIGHT_FITTED_DESIGN = True
 #: PSNR reported for a perfect relighting (as ``benchmarks.metrics.PSNR_CAP_DB``).
 PSNR_CAP_DB = 100.0
