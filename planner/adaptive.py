@@ -670,6 +670,8 @@ def _fitted_relight(
 
     if not adaptive_relight.RELIGHT_FITTED_DESIGN:
         return None
+    if n_total > adaptive_relight.RELIGHT_FITTED_MAX_LIGHTS:  # its search's cost (0.2 s)
+        return None
     from rti_rig.planner.adaptive_relight_design import fitted_relight_design
 
     starts = list(designs.values())

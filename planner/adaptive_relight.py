@@ -50,6 +50,12 @@ RELIGHT_MARGIN_DB = 0.5
 #: against the floors alone (``python -m benchmarks.adaptive_relight_variants``,
 #: docs/adaptive.md); ``benchmarks.adaptive --no-relight-fitted-design`` turns it off.
 RELIGHT_FITTED_DESIGN = True
+#: ... for designs of at most this many lights: the range it was measured on (N = 6…18), where
+#: its exchange search (two dB-weighted rounds, up to 4 sweeps of at most 14 lights not shot)
+#: keeps a decision near 0.2 s from a 24-MP frame; beyond, its sweeps over more lights (and
+#: the 16 coefficients of HSH3) took 0.3–0.44 s (``benchmarks.adaptive_time``, docs), so
+#: larger designs are chosen among the floors alone, as before.
+RELIGHT_FITTED_MAX_LIGHTS = 18
 #: PSNR reported for a perfect relighting (as ``benchmarks.metrics.PSNR_CAP_DB``).
 PSNR_CAP_DB = 100.0
 

@@ -197,3 +197,22 @@ def test_a_relight_decision_offers_the_fitted_design_and_records_it(monkeypatch)
         assert best == "fitted"
     monkeypatch.setattr(adaptive_relight, "RELIGHT_FITTED_DESIGN", False)
     assert set(decide().design_scores) == {"0", "10", "20", "30"}
+
+
+def test_beyond_its_measured_range_the_fitted_relight_design_is_not_offered() -> None:
+    """Above ``RELIGHT_FITTED_MAX_LIGHTS`` (its search's cost) the floors alone are scored."""
+    model = _model(6)
+    shot = np.array([12, 33, 51, 77])
+    avail = np.ones(len(CANDIDATES), dtype=bool)
+    avail[shot] = False
+    n = adaptive_relight.RELIGHT_FITTED_MAX_LIGHTS + 1
+    d = choose_in_design(
+        _state(model, shot),
+        CANDIDATES,
+        avail,
+        n,
+        fit=lambda obs, lights: None,
+        objective="relight",
+        relight=relight_fit,
+    )
+    assert set(d.design_scores) == {"0", "10", "20", "30"}
