@@ -24,7 +24,9 @@ design is scored the way the benchmarks score relighting, on this object's model
   as ``benchmarks.metrics.relight_psnr`` averages them, then over the noise draws.
 
 The design kept is the current one unless another is simulated better by
-:data:`RELIGHT_MARGIN_DB` (the same hysteresis as the normals score's ``SIM_MARGIN``).
+:data:`RELIGHT_MARGIN_DB` (the same hysteresis as the normals score's ``SIM_MARGIN``). Beside
+the floors' designs, the fitted relight design (:data:`RELIGHT_FITTED_DESIGN`,
+:mod:`rti_rig.planner.adaptive_relight_design`) is scored and taken the same way.
 """
 
 from __future__ import annotations

@@ -15,6 +15,13 @@ light at the design score's sampled pixels, in the images' units, with the model
 
 The held-out lights are the candidates not shot yet (what a design's relighting is judged on,
 less the design's own lights: the same for every design, so the search need not re-render).
+The design score averages PSNR (dB) over the held-out lights, not their squared errors, so the
+search weights each held-out light's expected error by 1/(that error + the noise) at the best
+start (:data:`DB_WEIGHTED`: the first-order change of the mean dB), and re-weights once at the
+layout found (:data:`ROUNDS`). The unmodelled deviation is hedged at :data:`UNMODELLED_REL`
+(twice ``optimal``'s a-priori value: the model is fitted to a few images, and trusting it at
+``optimal``'s value made the polished coin lose at 9 lights). Both chosen leave one scene out
+on the simulator (``python -m benchmarks.adaptive_relight_variants``; docs/adaptive.md).
 
 A layout's cost depends on it only through small ``p × p`` sums (``p`` the basis' coefficients:
 4 for HSH1, 6 for PTM, 9 for HSH2), so a single-light exchange is a rank-one update of each and
