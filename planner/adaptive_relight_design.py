@@ -189,13 +189,15 @@ def fitted_relight_design(
     pix = np.arange(0, p, max(1, p // pixels))[:pixels]  # the design score's pixels
     clean = render(model, candidates, pix)  # (C, P'): cached for the score
     held = np.flatnonzero(available)
+    layouts = [np.asarray(s, dtype=np.intp) for s in starts]
+    if len(held) <= len(layouts[0]):  # every light left is in the design: nothing to relight
+        return np.sort(layouts[0])
     albedo_ms = float(np.mean(model.albedo[pix] ** 2))
     shot = np.asarray(shot, dtype=np.intp)
     gone = np.setdiff1d(np.flatnonzero(~np.asarray(available, dtype=bool)), shot)
     plain = FittedRelightObjective(
         clean, candidates, held, basis, model.noise, albedo_ms, bias_rel=UNMODELLED_REL
     )
-    layouts = [np.asarray(s, dtype=np.intp) for s in starts]
     if not DB_WEIGHTED:
         return _search(plain, shot, gone, layouts)
 

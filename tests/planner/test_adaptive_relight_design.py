@@ -216,3 +216,19 @@ def test_beyond_its_measured_range_the_fitted_relight_design_is_not_offered() ->
         relight=relight_fit,
     )
     assert set(d.design_scores) == {"0", "10", "20", "30"}
+
+
+def test_when_every_light_left_is_in_the_design_the_search_has_nothing_to_relight() -> None:
+    """A small dome whose N is all its lights: the completion itself, no warning."""
+    import warnings
+
+    model = _model(7)
+    avail = np.zeros(len(CANDIDATES), dtype=bool)
+    avail[[5, 20, 40, 60]] = True
+    shot = np.array([1, 2, 3, 4])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        free = fitted_relight_design(
+            model, CANDIDATES, avail, shot, [np.array([5, 20, 40, 60])], "hsh1"
+        )
+    assert free.tolist() == [5, 20, 40, 60]
