@@ -58,6 +58,11 @@ VARIANTS: dict[str, list[tuple[object, dict]]] = {
         (adaptive_relight, {"RELIGHT_FITTED_DESIGN": True}),
         (relight_design, {"DB_WEIGHTED": True, "UNMODELLED_REL": 0.10}),
     ],
+    # the shipped search with one dB-weighted round instead of two (cheaper)
+    "fitted-db-hedge2-r1": [
+        (adaptive_relight, {"RELIGHT_FITTED_DESIGN": True}),
+        (relight_design, {"DB_WEIGHTED": True, "UNMODELLED_REL": 0.10, "ROUNDS": 1}),
+    ],
     "fitted-db-hedge4": [
         (adaptive_relight, {"RELIGHT_FITTED_DESIGN": True}),
         (relight_design, {"DB_WEIGHTED": True, "UNMODELLED_REL": 0.20}),
