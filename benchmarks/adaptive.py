@@ -27,7 +27,8 @@ error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
-[--no-fitted-design] [--fitted-pixels K] [--no-relight] [--cache FILE]
+[--no-fitted-design] [--fitted-pixels K] [--no-relight-fitted-design] [--no-relight]
+[--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
@@ -485,6 +486,12 @@ def main(argv: list[str] | None = None) -> str:
         "(planner.adaptive_optimal.SEARCH_PIXELS; default what ships, 500)",
     )
     ap.add_argument(
+        "--no-relight-fitted-design",
+        action="store_true",
+        help="do not offer the fitted relight design to --objective relight "
+        "(planner.adaptive_relight_design; offered in what ships): the floors' completions only",
+    )
+    ap.add_argument(
         "--no-relight",
         action="store_true",
         help="skip the simulator's --objective relight sessions (the relighting table is then "
@@ -503,6 +510,10 @@ def main(argv: list[str] | None = None) -> str:
         import rti_rig.planner.adaptive as adaptive_planner
 
         adaptive_planner.FITTED_DESIGN = False
+    if args.no_relight_fitted_design:
+        import rti_rig.planner.adaptive_relight as adaptive_relight
+
+        adaptive_relight.RELIGHT_FITTED_DESIGN = False
     if args.fitted_pixels is not None:
         import rti_rig.planner.adaptive_optimal as adaptive_optimal
 
@@ -566,6 +577,7 @@ def main(argv: list[str] | None = None) -> str:
             + (" --relief-gain" if args.relief_gain else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
+            + (" --no-relight-fitted-design" if args.no_relight_fitted_design else "")
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"

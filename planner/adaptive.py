@@ -562,6 +562,9 @@ def choose_in_design(
             designs[FITTED_KEY] = fitted
     if model is not None and designs and objective == "relight":
         assert relight is not None
+        fitted = _fitted_relight(model, state, candidates, available, designs, n_total)
+        if fitted is not None:
+            designs[FITTED_KEY] = fitted
         full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
         held = [held_out(candidates, available, c) for c in designs.values()]
         psnr = simulate_relight_designs(model, full, held, relight, relight_basis(n_total))
@@ -637,6 +640,12 @@ def _design_name(f: float, n_total: int) -> str:
     return f"homogeneous design of {n_total} lights above {f:g}°"
 
 
+def _relight_design_name(f: float, n_total: int) -> str:
+    if f == FITTED_KEY:
+        return f"design of {n_total} lights of least expected relighting error on the fitted model"
+    return f"homogeneous design of {n_total} lights above {f:g}°"
+
+
 def _fitted_design(
     state: SurfaceState,
     candidates: NDArray[np.float64],
@@ -653,6 +662,33 @@ def _fitted_design(
         return None
     shot = np.argmax(near, axis=1).astype(np.intp)
     free = pinned_optimal_design(state, candidates, shot, starts)
+    return free if available[free].all() else None
+
+
+def _fitted_relight(
+    model: ObjectModel,
+    state: SurfaceState,
+    candidates: NDArray[np.float64],
+    available: NDArray[np.bool_],
+    designs: dict[float, NDArray[np.intp]],
+    n_total: int,
+) -> NDArray[np.intp] | None:
+    """The fitted relight design (:mod:`rti_rig.planner.adaptive_relight_design`) when offered
+    (``adaptive_relight.RELIGHT_FITTED_DESIGN``); None as :func:`_fitted_design`."""
+    from rti_rig.planner import adaptive_relight
+
+    if not adaptive_relight.RELIGHT_FITTED_DESIGN:
+        return None
+    if n_total > adaptive_relight.RELIGHT_FITTED_MAX_LIGHTS:  # its search's cost (0.2 s)
+        return None
+    from rti_rig.planner.adaptive_relight_design import fitted_relight_design
+
+    starts = list(designs.values())
+    near = _angles(state.lights, candidates) < 1e-6
+    if not near.any(axis=1).all() or len({len(s) for s in starts}) != 1:
+        return None
+    shot = np.argmax(near, axis=1).astype(np.intp)
+    free = fitted_relight_design(model, candidates, available, shot, starts, relight_basis(n_total))
     return free if available[free].all() else None
 
 
@@ -673,13 +709,13 @@ def _relight_decision(
     mask = np.zeros(len(candidates), dtype=bool)
     mask[designs[best]] = True
     d = choose_next(state, candidates, mask & available, **choose)
-    by_floor = {f"{f:g}": round(v, 3) for f, v in sorted(psnr.items())}
+    by_floor = {_label(f): round(v, 3) for f, v in sorted(psnr.items())}
     return Decision(
         d.candidate,
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"homogeneous design of {n_total} lights above {best:g}° (relighting PSNR of "
+        f"{_relight_design_name(best, n_total)} (relighting PSNR of "
         f"{relight_basis(n_total)} simulated with this object's gloss and shadows: "
         f"{psnr[best]:.3g} dB on the lights left out; by floor: {by_floor}); within it, "
         f"the largest predicted drop of the normal error per second ({len(state.lights)} "

@@ -24,7 +24,9 @@ design is scored the way the benchmarks score relighting, on this object's model
   as ``benchmarks.metrics.relight_psnr`` averages them, then over the noise draws.
 
 The design kept is the current one unless another is simulated better by
-:data:`RELIGHT_MARGIN_DB` (the same hysteresis as the normals score's ``SIM_MARGIN``).
+:data:`RELIGHT_MARGIN_DB` (the same hysteresis as the normals score's ``SIM_MARGIN``). Beside
+the floors' designs, the fitted relight design (:data:`RELIGHT_FITTED_DESIGN`,
+:mod:`rti_rig.planner.adaptive_relight_design`) is scored and taken the same way.
 """
 
 from __future__ import annotations
@@ -43,6 +45,19 @@ OBJECTIVES = ("normals", "relight")
 #: current design's by this many dB: chosen leave one scene out on the simulator
 #: (``python -m benchmarks.adaptive_relight_margin``; docs/adaptive.md), never on real data.
 RELIGHT_MARGIN_DB = 0.5
+#: Also offer, with the relight objective, the fitted relight design
+#: (:mod:`rti_rig.planner.adaptive_relight_design`: ``optimal --objective relight`` on the object
+#: model fitted so far, the lights shot kept), scored and taken like the floors' designs (the
+#: same simulated PSNR, margin and hysteresis). On: chosen leave one scene out on the simulator
+#: against the floors alone (``python -m benchmarks.adaptive_relight_variants``,
+#: docs/adaptive.md); ``benchmarks.adaptive --no-relight-fitted-design`` turns it off.
+RELIGHT_FITTED_DESIGN = True
+#: ... for designs of at most this many lights: the range it was measured on (N = 6…18), where
+#: its exchange search (two dB-weighted rounds, up to 4 sweeps of at most 14 lights not shot)
+#: keeps a decision near 0.2 s from a 24-MP frame; beyond, its sweeps over more lights (and
+#: the 16 coefficients of HSH3) took 0.3–0.44 s (``benchmarks.adaptive_time``, docs), so
+#: larger designs are chosen among the floors alone, as before.
+RELIGHT_FITTED_MAX_LIGHTS = 18
 #: PSNR reported for a perfect relighting (as ``benchmarks.metrics.PSNR_CAP_DB``).
 PSNR_CAP_DB = 100.0
 

@@ -49,14 +49,16 @@ def test_the_relight_objective_is_in_the_settings_and_every_decision(relight_ses
     for s in steps[4:]:
         d = s["decision"]
         assert d["kind"] == "adaptive" and d["design_objective"] == "relight"
-        # every floor's design scored by its simulated relighting PSNR (dB), none by normals
-        assert set(d["design_psnr_db"]) == {"0", "10", "20", "30"}
+        # every floor's design and the fitted relight design (planner.adaptive_relight_design)
+        # scored by its simulated relighting PSNR (dB), none by normals
+        assert set(d["design_psnr_db"]) == {"0", "10", "20", "30", "fitted"}
         assert all(5.0 < v < 100.0 for v in d["design_psnr_db"].values())
         assert "design_error_deg" not in d and "relighting PSNR" in d["reason"]
-        # the floor chosen is one whose PSNR is within the margin of the best (the journal
+        # the design chosen is one whose PSNR is within the margin of the best (the journal
         # rounds the PSNRs to 3 decimals, hence the 1e-3)
         best = max(d["design_psnr_db"].values())
-        assert d["design_psnr_db"][f"{d['design_floor_deg']:g}"] >= best - 0.5 - 1e-3
+        key = "fitted" if d.get("design") == "fitted" else f"{d['design_floor_deg']:g}"
+        assert d["design_psnr_db"][key] >= best - 0.5 - 1e-3
     # the manifest's steps carry the same decisions as the journal
     assert [s["decision"] for s in manifest(relight_session)["steps"]] == [
         s["decision"] for s in steps
@@ -72,8 +74,8 @@ def test_the_default_objective_is_normals_and_says_so(tmp_path: Path) -> None:
     assert manifest(out)["adaptive"]["objective"] == "normals"
     last = journal(out)[-1]["decision"]
     assert last["objective"] == "normals" and last["design_objective"] == "normals"
-    # the floors' completions and the fitted design (planner.adaptive_optimal, offered with
-    # the normals objective only)
+    # the floors' completions and the fitted design (planner.adaptive_optimal; the relight
+    # objective is offered its own, planner.adaptive_relight_design)
     assert set(last["design_error_deg"]) == {"0", "10", "20", "30", "fitted"}
     assert "design_psnr_db" not in last
 

@@ -114,11 +114,14 @@ def _state_of(model: ObjectModel) -> SurfaceState:
 def test_the_design_follows_the_objective_asked_for(monkeypatch: pytest.MonkeyPatch) -> None:
     """From the 0° layout (as a session whose current design it is), the normals objective
     moves to 10° and the relight objective to 20° (both beyond their margins), each recording
-    its own scores. Among the floors: the fitted design (offered with the normals objective
-    only, ``FITTED_DESIGN``) is left out here, or it would be the normals objective's pick."""
+    its own scores. Among the floors: the fitted designs (``FITTED_DESIGN`` for normals,
+    ``RELIGHT_FITTED_DESIGN`` for relight, tested in test_adaptive_relight_design.py) are left
+    out here, or they would be the objectives' picks."""
     import rti_rig.planner.adaptive as adaptive
+    import rti_rig.planner.adaptive_relight as adaptive_relight
 
     monkeypatch.setattr(adaptive, "FITTED_DESIGN", False)
+    monkeypatch.setattr(adaptive_relight, "RELIGHT_FITTED_DESIGN", False)
     avail = np.ones(len(CANDIDATES), dtype=bool)
     kw = dict(fit=robust_fit, default_floor=0.0)
     d_n = choose_in_design(_state_of(grazing_shadow_object(0)), CANDIDATES, avail, 9, **kw)

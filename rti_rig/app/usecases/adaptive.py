@@ -73,7 +73,11 @@ ARM_MAX_LIGHTS = 100
 #: that takes it recording ``"design": "fitted"`` (a /4 session's choices would differ: its
 #: resume is refused, before anything on disk changes); 6: with only --until-error, each light
 #: chosen within the design for a guessed N that grows (``planner.adaptive_until``), recorded
-#: as ``guessed_lights`` with the design's floor and scores (a /5 session chose by the bound)
+#: as ``guessed_lights`` with the design's floor and scores (a /5 session chose by the bound);
+#: and the fitted relight design (``planner.adaptive_relight_design``) offered to
+#: ``--objective relight`` beside the floors, its simulated PSNR recorded as
+#: ``design_psnr_db["fitted"]`` and a decision that takes it recording ``"design": "fitted"``
+#: (a /5 relight session's choices would differ)
 FORMAT = "rti-rig-adaptive/6"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.

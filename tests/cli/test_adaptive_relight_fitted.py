@@ -1,0 +1,104 @@
+"""The fitted relight design (``optimal --objective relight`` on the object model fitted so far,
+``planner.adaptive_relight_design``) offered to ``--objective relight`` through the front door:
+`rti-rig run RIG --adaptive --lights N --objective relight` scores it beside the floors' designs
+at every decision (format rti-rig-adaptive/6), records a decision that takes it as
+``"design": "fitted"``, and an interrupted session that took it resumes to the same session."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+REPO = Path(__file__).resolve().parents[2]
+DOME = REPO / "rig_configs" / "simulated_dome.toml"
+ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+runner = CliRunner()
+RELIGHT = ("--objective", "relight", "--no-verdict")
+#: on this replayed acquisition the fitted relight design is taken at 7 lights (checked below)
+N = 7
+
+
+def _journal(session: Path) -> list[dict]:
+    return [json.loads(x) for x in (session / "journal.jsonl").read_text().splitlines()]
+
+
+def _decisions(session: Path) -> list[dict]:
+    """The decisions without their wall time."""
+    return [
+        {k: v for k, v in s["decision"].items() if k != "decision_s"} for s in _journal(session)
+    ]
+
+
+def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(DOME), "--out", str(out), "--adaptive", "--lights", "6", *RELIGHT]
+    )
+    assert r.exit_code == 0, r.output
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/6"
+    adaptive = [d for d in _decisions(out) if d["kind"] == "adaptive"]
+    assert len(adaptive) == 2
+    for d in adaptive:
+        scores = d["design_psnr_db"]
+        assert set(scores) == {"0", "10", "20", "30", "fitted"}
+        assert 5.0 < scores["fitted"] < 100.0
+
+
+@pytest.fixture(scope="module")
+def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("relight_fitted") / "s"
+    r = runner.invoke(
+        app, ["run", str(ACQ), "--out", str(out), "--adaptive", "--lights", str(N), *RELIGHT]
+    )
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def test_a_relight_decision_that_takes_the_fitted_design_records_it(whole: Path) -> None:
+    adaptive = [d for d in _decisions(whole) if d["kind"] == "adaptive"]
+    assert len(adaptive) == N - 4
+    taken = [d for d in adaptive if d.get("design") == "fitted"]
+    assert taken, "the fitted relight design is taken on this acquisition at 7 lights"
+    for d in taken:  # names no floor; taken by the margin over the design kept before it
+        assert "design_floor_deg" not in d and d["design_objective"] == "relight"
+        assert "least expected relighting error on the fitted model" in d["reason"]
+        assert d["design_psnr_db"]["fitted"] >= max(d["design_psnr_db"].values()) - 0.5 - 1e-3
+    first = taken[0]
+    assert first["design_psnr_db"]["fitted"] >= first["design_psnr_db"]["10"] + 0.5 - 1e-3
+    manifest = json.loads((whole / "manifest.json").read_text())
+    assert [s["decision"] for s in manifest["steps"]] == [s["decision"] for s in _journal(whole)]
+    # lights.lp lists what fired: the N lights of the journal
+    assert len(_journal(whole)) == N
+
+
+def test_an_interrupted_relight_session_that_took_the_fitted_design_resumes_to_the_same_one(
+    whole: Path, tmp_path: Path
+) -> None:
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases.adaptive import open_adaptive_session
+    from rti_rig.runtime.controller import CancelToken, StepCompleted, run_session
+
+    out = tmp_path / "cut"
+    rig, schedule, folder, source = open_adaptive_session(
+        load_rig_config(ACQ), out, N, None, objective="relight"
+    )
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 4:  # one fitted decision made
+            cancel.cancel()
+
+    with rig:
+        run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    assert len(_journal(out)) == 5
+    assert _journal(out)[4]["decision"].get("design") == "fitted"
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert _decisions(out) == _decisions(whole)
+    assert (out / "lights.lp").read_text() == (whole / "lights.lp").read_text()
