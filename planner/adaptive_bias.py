@@ -32,6 +32,7 @@ injects it.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -228,15 +229,23 @@ def soft_visibility(
     todo = np.flatnonzero((horiz >= 1e-6) & (top - float(h0.min()) > rise - SOFT_PX))
     if todo.size == 0:
         return vis
-    # (P, T, L') at once: the march of every pixel towards every light that can be blocked
-    cc = cols[:, None, None] + t[None, :, None] * sx[todo][None, None, :]
-    rr = rows[:, None, None] - t[None, :, None] * sy[todo][None, None, :]
+    # (P, T, L') at once: the march of every pixel towards every light that can be blocked.
+    # The steps' offsets (float32 products, as the pixels' float64 positions add them) are
+    # shared by every pixel, the rounding and clipping done in place, the terrain read by one
+    # flat gather: 25 % less time than the plain expressions, the same values bit for bit.
+    dx = (t[:, None] * sx[todo][None, :]).astype(np.float64)  # (T, L')
+    dy = (t[:, None] * sy[todo][None, :]).astype(np.float64)
+    cc = cols[:, None, None].astype(np.float64) + dx[None]
+    rr = rows[:, None, None].astype(np.float64) - dy[None]
     inside = (cc >= 0) & (cc <= w - 1) & (rr >= 0) & (rr <= h - 1)
-    ci = np.clip(np.rint(cc).astype(np.intp), 0, w - 1)
-    ri = np.clip(np.rint(rr).astype(np.intp), 0, h - 1)
-    ray = h0[:, None, None] + t[None, :, None] * rise[todo][None, None, :]
-    excess = np.where(inside, height[ri, ci] - ray, -np.inf).max(axis=1)
-    vis[:, todo] = np.clip(1.0 - excess / SOFT_PX, 0.0, 1.0)
+    ci = np.clip(np.rint(cc, out=cc), 0, w - 1, out=cc)
+    ri = np.clip(np.rint(rr, out=rr), 0, h - 1, out=rr)
+    ri *= w
+    ri += ci
+    excess = height.ravel().take(ri.astype(np.intp))  # float32 terrain under each step
+    excess -= h0[:, None, None] + (t[:, None] * rise[todo][None, :])[None]  # above the ray
+    excess[~inside] = -np.inf
+    vis[:, todo] = np.clip(1.0 - excess.max(axis=1) / SOFT_PX, 0.0, 1.0)
     return vis
 
 
@@ -263,6 +272,29 @@ def _render(model: ObjectModel, lights: NDArray[np.float64], pix: NDArray[np.int
         lobe = _lobe(_half_cos(n, lights), model.spec_exponent)
         out = out + model.spec_strength * lobe * (cos > 0)
     return (out * vis).T
+
+
+def light_noise(
+    lights: NDArray[np.float64], draws: int, npix: int, sigma: float, seed: int
+) -> NDArray[np.float64]:
+    """(draws, L, npix) Gaussian noise of deviation ``sigma``, each light's drawn from a seed of
+    its own direction: the same in every design, call and decision of a session, and for the
+    normals and the relighting scores alike (common random numbers)."""
+    return np.stack([sigma * _unit_noise(seed, _direction_key(v), draws, npix) for v in lights], 1)
+
+
+def _direction_key(v: NDArray[np.float64]) -> tuple[int, ...]:
+    return tuple(int(k) for k in np.round(v * 1e6).astype(np.int64) % 2**31)
+
+
+@functools.lru_cache(maxsize=4096)
+def _unit_noise(seed: int, key: tuple[int, ...], draws: int, npix: int) -> NDArray[np.float64]:
+    """A light's standard normal draws, kept: a session scores the same candidates at every
+    decision, and seeding a generator per light cost ~50 µs each (10 ms for 200 LEDs).
+    ``sigma * z`` is bit for bit what ``normal(0, sigma)`` draws from the same generator."""
+    z = np.random.default_rng([seed, *key]).standard_normal((draws, npix))
+    z.flags.writeable = False
+    return z
 
 
 def simulate_error_deg(
@@ -300,15 +332,7 @@ def simulate_designs(
     inverse = inverse.reshape(-1)
     clean = render(model, union, pix)  # (U, P')
     # each light's noise from a seed of its own direction: the same in every design and call
-    noise = np.stack(
-        [
-            np.random.default_rng([seed, *np.round(v * 1e6).astype(np.int64) % 2**31]).normal(
-                0.0, model.noise, (draws, len(pix))
-            )
-            for v in union
-        ],
-        axis=1,
-    )  # (draws, U, P')
+    noise = light_noise(union, draws, len(pix), model.noise, seed)  # (draws, U, P')
     truth = model.normals[pix]
     out = []
     at = 0

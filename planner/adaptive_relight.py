@@ -36,7 +36,14 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from rti_rig.planner.adaptive_bias import SIM_DRAWS, SIM_PIXELS, SIM_SEED, ObjectModel, render
+from rti_rig.planner.adaptive_bias import (
+    SIM_DRAWS,
+    SIM_PIXELS,
+    SIM_SEED,
+    ObjectModel,
+    light_noise,
+    render,
+)
 from rti_rig.planner.objectives import models_for
 
 #: The design objectives of an adaptive session with ``--lights N``.
@@ -77,15 +84,7 @@ def relight_basis(n_total: int) -> str:
 def _light_noise(union: NDArray[np.float64], draws: int, npix: int, sigma: float, seed: int):  # type: ignore[no-untyped-def]
     """(draws, U, P') noise, each light's from a seed of its own direction (the same in every
     design and call, and the same as the normals score's for the same light)."""
-    return np.stack(
-        [
-            np.random.default_rng([seed, *np.round(v * 1e6).astype(np.int64) % 2**31]).normal(
-                0.0, sigma, (draws, npix)
-            )
-            for v in union
-        ],
-        axis=1,
-    )
+    return light_noise(union, draws, npix, sigma, seed)
 
 
 def mean_psnr_db(relit: NDArray, reference: NDArray, noise: float) -> float:
