@@ -184,17 +184,17 @@ def test_a_relight_decision_offers_the_fitted_design_and_records_it(monkeypatch)
     assert set(d.design_scores) == {"0", "10", "20", "30", "fitted"}
     ev = d.evidence()
     assert ev["design_psnr_db"] == d.design_scores
-    if d.design_floor == FITTED_KEY:
+    # taken only by the margin: the kept floor (10°, the default) unless another design's
+    # simulated PSNR beats it by the margin; what a decision that takes the fitted design
+    # records is checked through the front door (tests/cli/test_adaptive_relight_fitted.py)
+    key = "fitted" if d.design_floor == FITTED_KEY else f"{d.design_floor:g}"
+    assert key == "10" or (
+        d.design_scores[key] >= d.design_scores["10"] + adaptive_relight.RELIGHT_MARGIN_DB - 1e-3
+    )
+    if key == "fitted":
         assert ev["design"] == "fitted" and "design_floor_deg" not in ev
-        assert "least expected relighting error" in d.reason
-    # taken only by the margin: the fitted design's PSNR beats the kept floor's by it
-    best = max(d.design_scores, key=d.design_scores.get)
-    if d.design_floor == FITTED_KEY:
-        assert (
-            d.design_scores["fitted"]
-            >= d.design_scores["10"] + adaptive_relight.RELIGHT_MARGIN_DB - 1e-3
-        )
-        assert best == "fitted"
+    else:
+        assert ev["design_floor_deg"] == d.design_floor and "design" not in ev
     monkeypatch.setattr(adaptive_relight, "RELIGHT_FITTED_DESIGN", False)
     assert set(decide().design_scores) == {"0", "10", "20", "30"}
 
