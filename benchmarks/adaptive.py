@@ -26,9 +26,9 @@ then on the real dome (never used for the fit). ``--until-error``: lights used a
 error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
-[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
-[--no-fitted-design] [--fitted-pixels K] [--no-relight] [--cache FILE]
-[--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
+[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--default-floor F]
+[--relief-gain] [--no-fitted-design] [--fitted-margin M] [--fitted-pixels K] [--no-relight]
+[--cache FILE] [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
 beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
 """
@@ -463,6 +463,13 @@ def main(argv: list[str] | None = None) -> str:
         help="the starting lights with N known (benchmarks.adaptive_reach; default: what ships)",
     )
     ap.add_argument(
+        "--default-floor",
+        type=float,
+        default=None,
+        help="the default design's floor (°), which also places the starting lights "
+        "(planner.adaptive.DESIGN_DEFAULT_FLOOR; default what ships, 10)",
+    )
+    ap.add_argument(
         "--relief-gain",
         action="store_true",
         help="fit the relief's depth to the captured shadows (planner.adaptive_relief; off in "
@@ -485,6 +492,13 @@ def main(argv: list[str] | None = None) -> str:
         "(planner.adaptive_optimal.SEARCH_PIXELS; default what ships, 500)",
     )
     ap.add_argument(
+        "--fitted-margin",
+        type=float,
+        default=None,
+        help="the margin by which the fitted design must be simulated better to be taken "
+        "(planner.adaptive.FITTED_MARGIN; default what ships, the floors' SIM_MARGIN)",
+    )
+    ap.add_argument(
         "--no-relight",
         action="store_true",
         help="skip the simulator's --objective relight sessions (the relighting table is then "
@@ -503,6 +517,10 @@ def main(argv: list[str] | None = None) -> str:
         import rti_rig.planner.adaptive as adaptive_planner
 
         adaptive_planner.FITTED_DESIGN = False
+    if args.fitted_margin is not None:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.FITTED_MARGIN = args.fitted_margin
     if args.fitted_pixels is not None:
         import rti_rig.planner.adaptive_optimal as adaptive_optimal
 
@@ -510,7 +528,11 @@ def main(argv: list[str] | None = None) -> str:
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
-    if args.start != "default":
+    if args.default_floor is not None:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.DESIGN_DEFAULT_FLOOR = args.default_floor
+    if args.start != "default":  # after the default floor: a hedged start is of its layout
         from benchmarks.adaptive_reach import start_functions
 
         START["start"] = start_functions()[args.start]
@@ -563,9 +585,11 @@ def main(argv: list[str] | None = None) -> str:
             + (f" --ns {args.ns}" if args.ns else "")
             + (" --no-until" if args.no_until else "")
             + (f" --start {args.start}" if args.start != "default" else "")
+            + (f" --default-floor {args.default_floor:g}" if args.default_floor is not None else "")
             + (" --relief-gain" if args.relief_gain else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
+            + (f" --fitted-margin {args.fitted_margin:g}" if args.fitted_margin is not None else "")
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
