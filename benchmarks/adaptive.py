@@ -26,10 +26,10 @@ then on the real dome (never used for the fit). ``--until-error``: lights used a
 error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
-[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--default-floor F]
-[--relief-gain] [--no-fitted-design] [--fitted-margin M] [--fitted-pixels K] [--no-relight]
-[--cache FILE] [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
-beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
+[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
+[--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M] [--fitted-seeds F,F]
+[--fitted-pixels K] [--no-relight] [--cache FILE] [--write]`` (the real acquisition is read
+from ../shared/data/neuralrti-example beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
 tables into docs/adaptive.md).
 """
 
@@ -459,7 +459,7 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument(
         "--start",
         default="default",
-        choices=("default", "hedge-all", "hedge-20", "shared-3"),
+        choices=("default", "hedge-all", "hedge-20", "hedge-10", "shared-3"),
         help="the starting lights with N known (benchmarks.adaptive_reach; default: what ships)",
     )
     ap.add_argument(
@@ -499,6 +499,12 @@ def main(argv: list[str] | None = None) -> str:
         "(planner.adaptive.FITTED_MARGIN; default what ships, the floors' SIM_MARGIN)",
     )
     ap.add_argument(
+        "--fitted-seeds",
+        default="",
+        help="comma-separated extra floors (°) whose completions also seed the fitted design's "
+        "search (planner.adaptive.FITTED_SEED_FLOORS; default what ships, none)",
+    )
+    ap.add_argument(
         "--no-relight",
         action="store_true",
         help="skip the simulator's --objective relight sessions (the relighting table is then "
@@ -521,6 +527,10 @@ def main(argv: list[str] | None = None) -> str:
         import rti_rig.planner.adaptive as adaptive_planner
 
         adaptive_planner.FITTED_MARGIN = args.fitted_margin
+    if args.fitted_seeds:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.FITTED_SEED_FLOORS = tuple(float(x) for x in args.fitted_seeds.split(","))
     if args.fitted_pixels is not None:
         import rti_rig.planner.adaptive_optimal as adaptive_optimal
 
@@ -590,6 +600,7 @@ def main(argv: list[str] | None = None) -> str:
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
             + (f" --fitted-margin {args.fitted_margin:g}" if args.fitted_margin is not None else "")
+            + (f" --fitted-seeds {args.fitted_seeds}" if args.fitted_seeds else "")
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"

@@ -387,6 +387,9 @@ FITTED_DESIGN = True
 #: The margin by which the fitted design must be simulated better than the current design to
 #: be taken (None: :data:`SIM_MARGIN`, as the floors; ``benchmarks.adaptive --fitted-margin``).
 FITTED_MARGIN: float | None = None
+#: Floors beyond the designs' whose completions also seed the fitted design's exchange search
+#: (it starts from the cheapest on the fitted surface; ``benchmarks.adaptive --fitted-seeds``).
+FITTED_SEED_FLOORS: tuple[float, ...] = ()
 #: The key of that design among the floors (its evidence says ``fitted``, not a floor).
 FITTED_KEY = -1.0
 
@@ -551,7 +554,12 @@ def choose_in_design(
             cols = [where[int(c)] for c in comp]
             scores[f] = design_error_deg(state, candidates[comp], scale, w_union[:, cols])
     if model is not None and designs and objective == "normals" and FITTED_DESIGN:
-        fitted = _fitted_design(state, candidates, available, list(designs.values()))
+        seeds = list(designs.values())
+        for f in FITTED_SEED_FLOORS:  # more completions to search from (the cheapest is used)
+            c = homogeneous_completion(candidates, available, state.lights, n_total, f)
+            if c is not None and c.size:
+                seeds.append(c)
+        fitted = _fitted_design(state, candidates, available, seeds)
         if fitted is not None:
             designs[FITTED_KEY] = fitted
     if model is not None and designs and objective == "relight":
