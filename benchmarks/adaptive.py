@@ -29,8 +29,8 @@ Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes 
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
 [--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M] [--fitted-seeds F,F]
 [--fitted-pixels K] [--no-relight] [--cache FILE] [--write]`` (the real acquisition is read
-from ../shared/data/neuralrti-example beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
-tables into docs/adaptive.md).
+from ../shared/data/neuralrti-example beside the repository; ``--cache`` keeps the bars' scores
+between runs; ``--write`` puts the tables into docs/adaptive.md).
 """
 
 from __future__ import annotations
