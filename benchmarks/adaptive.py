@@ -28,9 +28,9 @@ error per scene and target.
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
 [--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M] [--fitted-seeds F,F]
-[--fitted-pixels K] [--no-relight] [--cache FILE] [--write]`` (the real acquisition is read
-from ../shared/data/neuralrti-example beside the repository; ``--cache`` keeps the bars' scores
-between runs; ``--write`` puts the tables into docs/adaptive.md).
+[--sim-margin M] [--fitted-pixels K] [--no-relight] [--cache FILE] [--write]`` (the real
+acquisition is read from ../shared/data/neuralrti-example beside the repository; ``--cache``
+keeps the bars' scores between runs; ``--write`` puts the tables into docs/adaptive.md).
 """
 
 from __future__ import annotations
@@ -499,6 +499,13 @@ def main(argv: list[str] | None = None) -> str:
         "(planner.adaptive.FITTED_MARGIN; default what ships, the floors' SIM_MARGIN)",
     )
     ap.add_argument(
+        "--sim-margin",
+        type=float,
+        default=None,
+        help="the margin by which another design must be simulated better to be taken "
+        "(planner.adaptive.SIM_MARGIN; default what ships, 0.10)",
+    )
+    ap.add_argument(
         "--fitted-seeds",
         default="",
         help="comma-separated extra floors (°) whose completions also seed the fitted design's "
@@ -527,6 +534,10 @@ def main(argv: list[str] | None = None) -> str:
         import rti_rig.planner.adaptive as adaptive_planner
 
         adaptive_planner.FITTED_MARGIN = args.fitted_margin
+    if args.sim_margin is not None:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.SIM_MARGIN = args.sim_margin
     if args.fitted_seeds:
         import rti_rig.planner.adaptive as adaptive_planner
 
@@ -601,6 +612,7 @@ def main(argv: list[str] | None = None) -> str:
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
             + (f" --fitted-margin {args.fitted_margin:g}" if args.fitted_margin is not None else "")
             + (f" --fitted-seeds {args.fitted_seeds}" if args.fitted_seeds else "")
+            + (f" --sim-margin {args.sim_margin:g}" if args.sim_margin is not None else "")
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
