@@ -27,10 +27,11 @@ error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
-[--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M] [--fitted-seeds F,F]
-[--sim-margin M] [--fitted-pixels K] [--no-relight] [--cache FILE] [--write]`` (the real
-acquisition is read from ../shared/data/neuralrti-example beside the repository; ``--cache``
-keeps the bars' scores between runs; ``--write`` puts the tables into docs/adaptive.md).
+[--floors F,F] [--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M]
+[--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight] [--cache FILE]
+[--write]`` (the real acquisition is read from ../shared/data/neuralrti-example beside the
+repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the tables into
+docs/adaptive.md).
 """
 
 from __future__ import annotations
@@ -463,6 +464,12 @@ def main(argv: list[str] | None = None) -> str:
         help="the starting lights with N known (benchmarks.adaptive_reach; default: what ships)",
     )
     ap.add_argument(
+        "--floors",
+        default="",
+        help="comma-separated floors (°) of the designs a session chooses among "
+        "(planner.adaptive.DESIGN_FLOORS; default what ships, 0,10,20,30)",
+    )
+    ap.add_argument(
         "--default-floor",
         type=float,
         default=None,
@@ -549,6 +556,10 @@ def main(argv: list[str] | None = None) -> str:
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
+    if args.floors:
+        import rti_rig.planner.adaptive as adaptive_planner
+
+        adaptive_planner.DESIGN_FLOORS = tuple(float(x) for x in args.floors.split(","))
     if args.default_floor is not None:
         import rti_rig.planner.adaptive as adaptive_planner
 
@@ -606,6 +617,7 @@ def main(argv: list[str] | None = None) -> str:
             + (f" --ns {args.ns}" if args.ns else "")
             + (" --no-until" if args.no_until else "")
             + (f" --start {args.start}" if args.start != "default" else "")
+            + (f" --floors {args.floors}" if args.floors else "")
             + (f" --default-floor {args.default_floor:g}" if args.default_floor is not None else "")
             + (" --relief-gain" if args.relief_gain else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
