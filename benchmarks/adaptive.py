@@ -516,7 +516,8 @@ def main(argv: list[str] | None = None) -> str:
         "--fitted-seeds",
         default="",
         help="comma-separated extra floors (°) whose completions also seed the fitted design's "
-        "search (planner.adaptive.FITTED_SEED_FLOORS; default what ships, none)",
+        "search, 'none' for none (planner.adaptive.FITTED_SEED_FLOORS; default what ships, "
+        "5,15,25,35,40)",
     )
     ap.add_argument(
         "--no-relight",
@@ -548,7 +549,11 @@ def main(argv: list[str] | None = None) -> str:
     if args.fitted_seeds:
         import rti_rig.planner.adaptive as adaptive_planner
 
-        adaptive_planner.FITTED_SEED_FLOORS = tuple(float(x) for x in args.fitted_seeds.split(","))
+        adaptive_planner.FITTED_SEED_FLOORS = (
+            ()
+            if args.fitted_seeds == "none"
+            else tuple(float(x) for x in args.fitted_seeds.split(","))
+        )
     if args.fitted_pixels is not None:
         import rti_rig.planner.adaptive_optimal as adaptive_optimal
 

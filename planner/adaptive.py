@@ -388,8 +388,11 @@ FITTED_DESIGN = True
 #: be taken (None: :data:`SIM_MARGIN`, as the floors; ``benchmarks.adaptive --fitted-margin``).
 FITTED_MARGIN: float | None = None
 #: Floors beyond the designs' whose completions also seed the fitted design's exchange search
-#: (it starts from the cheapest on the fitted surface; ``benchmarks.adaptive --fitted-seeds``).
-FITTED_SEED_FLOORS: tuple[float, ...] = ()
+#: (it starts from the cheapest on the fitted surface; they are seeds, not designs offered).
+#: Chosen leave one scene out against none (docs/adaptive.md, "Re-checked with the fitted
+#: design"); format ``rti-rig-adaptive/6``. ``benchmarks.adaptive --fitted-seeds none`` drops
+#: them.
+FITTED_SEED_FLOORS: tuple[float, ...] = (5.0, 15.0, 25.0, 35.0, 40.0)
 #: The key of that design among the floors (its evidence says ``fitted``, not a floor).
 FITTED_KEY = -1.0
 
