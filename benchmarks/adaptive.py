@@ -443,7 +443,43 @@ def relative_excess(r: dict) -> float:
     return total
 
 
-def main(argv: list[str] | None = None) -> str:
+def configure_planner(args: argparse.Namespace) -> None:
+    """Set the planner's constants the options name (the variants measured against what ships;
+    each option absent leaves its constant as it ships)."""
+    import rti_rig.planner.adaptive as adaptive_planner
+
+    if args.no_fitted_design:
+        adaptive_planner.FITTED_DESIGN = False
+    if args.fitted_margin is not None:
+        adaptive_planner.FITTED_MARGIN = args.fitted_margin
+    if args.sim_margin is not None:
+        adaptive_planner.SIM_MARGIN = args.sim_margin
+    if args.fitted_seeds:
+        adaptive_planner.FITTED_SEED_FLOORS = (
+            ()
+            if args.fitted_seeds == "none"
+            else tuple(float(x) for x in args.fitted_seeds.split(","))
+        )
+    if args.fitted_pixels is not None:
+        import rti_rig.planner.adaptive_optimal as adaptive_optimal
+
+        adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels or None
+    if args.floors:
+        adaptive_planner.DESIGN_FLOORS = tuple(float(x) for x in args.floors.split(","))
+    if args.default_floor is not None:
+        adaptive_planner.DESIGN_DEFAULT_FLOOR = args.default_floor
+    if args.start != "default":  # after the default floor: a hedged start is of its layout
+        from benchmarks.adaptive_reach import start_functions
+
+        START["start"] = start_functions()[args.start]
+    if args.relief_gain:
+        import rti_rig.planner.adaptive_bias as bias
+
+        bias.FIT_RELIEF_GAIN = True
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The options of :func:`main`."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sim-draws", type=int, default=8)
     ap.add_argument("--real-draws", type=int, default=24)
@@ -525,6 +561,11 @@ def main(argv: list[str] | None = None) -> str:
         help="skip the simulator's --objective relight sessions (the relighting table is then "
         "not a result; faster to iterate on the normals objective)",
     )
+    return ap
+
+
+def main(argv: list[str] | None = None) -> str:
+    ap = build_parser()
     args = ap.parse_args(argv)
     if args.no_relight:
         global RELIGHT
@@ -534,49 +575,10 @@ def main(argv: list[str] | None = None) -> str:
             "--sim-draws and --real-draws need at least 2 (the verdicts are paired tests; "
             "--real-draws 0 skips the real acquisition)"
         )
-    if args.no_fitted_design:
-        import rti_rig.planner.adaptive as adaptive_planner
-
-        adaptive_planner.FITTED_DESIGN = False
-    if args.fitted_margin is not None:
-        import rti_rig.planner.adaptive as adaptive_planner
-
-        adaptive_planner.FITTED_MARGIN = args.fitted_margin
-    if args.sim_margin is not None:
-        import rti_rig.planner.adaptive as adaptive_planner
-
-        adaptive_planner.SIM_MARGIN = args.sim_margin
-    if args.fitted_seeds:
-        import rti_rig.planner.adaptive as adaptive_planner
-
-        adaptive_planner.FITTED_SEED_FLOORS = (
-            ()
-            if args.fitted_seeds == "none"
-            else tuple(float(x) for x in args.fitted_seeds.split(","))
-        )
-    if args.fitted_pixels is not None:
-        import rti_rig.planner.adaptive_optimal as adaptive_optimal
-
-        adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels or None
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
-    if args.floors:
-        import rti_rig.planner.adaptive as adaptive_planner
-
-        adaptive_planner.DESIGN_FLOORS = tuple(float(x) for x in args.floors.split(","))
-    if args.default_floor is not None:
-        import rti_rig.planner.adaptive as adaptive_planner
-
-        adaptive_planner.DESIGN_DEFAULT_FLOOR = args.default_floor
-    if args.start != "default":  # after the default floor: a hedged start is of its layout
-        from benchmarks.adaptive_reach import start_functions
-
-        START["start"] = start_functions()[args.start]
-    if args.relief_gain:
-        import rti_rig.planner.adaptive_bias as bias
-
-        bias.FIT_RELIEF_GAIN = True
+    configure_planner(args)
     t0 = time.perf_counter()
     cache_read = args.cache is not None and args.cache.exists()
     _load_cache(args.cache)
