@@ -25,7 +25,7 @@ predicted error is shown with the factors fitted on the *other* scenes (leave on
 then on the real dome (never used for the fit). ``--until-error``: lights used and measured
 error per scene and target.
 
-Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
+Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b] [--seed S]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
 [--floors F,F] [--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M]
 [--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight] [--cache FILE]
@@ -494,6 +494,13 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--scenes", default="", help="comma-separated simulated scenes (default all)")
     ap.add_argument("--ns", default="", help="comma-separated light counts (default 6,9,12,18)")
     ap.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="the simulator's draws (0: those of the tables; another: fresh draws, to check a "
+        "variant chosen on draws 0 on draws it was not chosen on)",
+    )
+    ap.add_argument(
         "--start",
         default="default",
         choices=("default", "hedge-all", "hedge-20", "hedge-10", "shared-3"),
@@ -585,7 +592,7 @@ def main(argv: list[str] | None = None) -> str:
     if args.cache is not None:
         _CACHE_PATH.append(args.cache)
     scenes = tuple(x for x in args.scenes.split(",") if x)
-    results, _ = sim(args.sim_draws, scenes=scenes)
+    results, _ = sim(args.sim_draws, seed=args.seed, scenes=scenes)
     _save_cache(args.cache)
     scale, slope, calib_rows, calib_summary = calibrate(results)
     print(f"calibrated SIM_ESTIMATE_SCALE = {scale:.3f}, DISCARD_SLOPE = {slope:.3f}")
@@ -622,6 +629,7 @@ def main(argv: list[str] | None = None) -> str:
             f"--real-draws {args.real_draws}"
             + (f" --scenes {args.scenes}" if args.scenes else "")
             + (f" --ns {args.ns}" if args.ns else "")
+            + (f" --seed {args.seed}" if args.seed else "")
             + (" --no-until" if args.no_until else "")
             + (f" --start {args.start}" if args.start != "default" else "")
             + (f" --floors {args.floors}" if args.floors else "")
