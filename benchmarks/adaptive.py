@@ -560,7 +560,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="",
         help="comma-separated extra floors (°) whose completions also seed the fitted design's "
         "search, 'none' for none (planner.adaptive.FITTED_SEED_FLOORS; default what ships, "
-        "5,15,25,35,40)",
+        "none)",
     )
     ap.add_argument(
         "--no-relight",

@@ -15,9 +15,7 @@ floors with ``planner.adaptive.FITTED_DESIGN`` (on: docs/adaptive.md, "Why the t
 losses remain" — it turns two of the three losses into ties and passes the selection rule
 searched over 500 pixels; :data:`SEARCH_SCANS` keeps its decision under 0.2 s up to 100
 lights; a decision that takes it records ``"design": "fitted"``, format
-``rti-rig-adaptive/5``). Since format /6 its search is also seeded from the completions above
-the extra floors of ``planner.adaptive.FITTED_SEED_FLOORS`` (the cheapest seed on this
-objective is searched from; docs/adaptive.md, "Re-checked with the fitted design on").
+``rti-rig-adaptive/5``).
 """
 
 from __future__ import annotations

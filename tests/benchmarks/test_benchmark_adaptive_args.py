@@ -40,7 +40,7 @@ def test_without_options_the_planner_is_left_as_it_ships(planner_constants) -> N
     adaptive.configure_planner(adaptive.build_parser().parse_args([]))
     after = (planner.FITTED_SEED_FLOORS, planner.FITTED_MARGIN, planner.DESIGN_DEFAULT_FLOOR)
     assert after == before
-    assert planner.FITTED_SEED_FLOORS == (5.0, 15.0, 25.0, 35.0, 40.0)  # what ships
+    assert planner.FITTED_SEED_FLOORS == ()  # what ships
 
 
 def test_the_variants_options_set_the_planner_s_constants(planner_constants) -> None:

@@ -70,10 +70,8 @@ ARM_MAX_LIGHTS = 100
 #: 4: the design objective (``normals``/``relight``) in the settings and every decision;
 #: 5: the fitted design (``planner.adaptive_optimal``) offered beside the floors, a decision
 #: that takes it recording ``"design": "fitted"`` (a /4 session's choices would differ: its
-#: resume is refused, before anything on disk changes); 6: the fitted design's search also
-#: seeded from the completions above 5°/15°/25°/35°/40° (``planner.adaptive.FITTED_SEED_FLOORS``:
-#: a /5 session's fitted designs, so its choices, would differ)
-FORMAT = "rti-rig-adaptive/6"
+#: resume is refused, before anything on disk changes)
+FORMAT = "rti-rig-adaptive/5"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
