@@ -25,13 +25,14 @@ predicted error is shown with the factors fitted on the *other* scenes (leave on
 then on the real dome (never used for the fit). ``--until-error``: lights used and measured
 error per scene and target.
 
-Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b]
-[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|shared-3] [--relief-gain]
-[--no-fitted-design] [--fitted-pixels K] [--no-relight-fitted-design] [--no-relight]
-[--cache FILE]
-[--write]`` (the real acquisition is read from ../shared/data/neuralrti-example
-beside the repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the
-tables into docs/adaptive.md).
+Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b] [--seed S]
+[--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
+[--floors F,F] [--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M]
+[--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight-fitted-design]
+[--no-relight] [--cache FILE]
+[--write]`` (the real acquisition is read from ../shared/data/neuralrti-example beside the
+repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the tables into
+docs/adaptive.md).
 """
 
 from __future__ import annotations
@@ -443,7 +444,47 @@ def relative_excess(r: dict) -> float:
     return total
 
 
-def main(argv: list[str] | None = None) -> str:
+def configure_planner(args: argparse.Namespace) -> None:
+    """Set the planner's constants the options name (the variants measured against what ships;
+    each option absent leaves its constant as it ships)."""
+    import rti_rig.planner.adaptive as adaptive_planner
+
+    if args.no_fitted_design:
+        adaptive_planner.FITTED_DESIGN = False
+    if args.fitted_margin is not None:
+        adaptive_planner.FITTED_MARGIN = args.fitted_margin
+    if args.sim_margin is not None:
+        adaptive_planner.SIM_MARGIN = args.sim_margin
+    if args.fitted_seeds:
+        adaptive_planner.FITTED_SEED_FLOORS = (
+            ()
+            if args.fitted_seeds == "none"
+            else tuple(float(x) for x in args.fitted_seeds.split(","))
+        )
+    if args.no_relight_fitted_design:
+        import rti_rig.planner.adaptive_relight as adaptive_relight
+
+        adaptive_relight.RELIGHT_FITTED_DESIGN = False
+    if args.fitted_pixels is not None:
+        import rti_rig.planner.adaptive_optimal as adaptive_optimal
+
+        adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels or None
+    if args.floors:
+        adaptive_planner.DESIGN_FLOORS = tuple(float(x) for x in args.floors.split(","))
+    if args.default_floor is not None:
+        adaptive_planner.DESIGN_DEFAULT_FLOOR = args.default_floor
+    if args.start != "default":  # after the default floor: a hedged start is of its layout
+        from benchmarks.adaptive_reach import start_functions
+
+        START["start"] = start_functions()[args.start]
+    if args.relief_gain:
+        import rti_rig.planner.adaptive_bias as bias
+
+        bias.FIT_RELIEF_GAIN = True
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The options of :func:`main`."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sim-draws", type=int, default=8)
     ap.add_argument("--real-draws", type=int, default=24)
@@ -458,10 +499,30 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument("--scenes", default="", help="comma-separated simulated scenes (default all)")
     ap.add_argument("--ns", default="", help="comma-separated light counts (default 6,9,12,18)")
     ap.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="the simulator's draws (0: those of the tables; another: fresh draws, to check a "
+        "variant chosen on draws 0 on draws it was not chosen on)",
+    )
+    ap.add_argument(
         "--start",
         default="default",
-        choices=("default", "hedge-all", "hedge-20", "shared-3"),
+        choices=("default", "hedge-all", "hedge-20", "hedge-10", "shared-3"),
         help="the starting lights with N known (benchmarks.adaptive_reach; default: what ships)",
+    )
+    ap.add_argument(
+        "--floors",
+        default="",
+        help="comma-separated floors (°) of the designs a session chooses among "
+        "(planner.adaptive.DESIGN_FLOORS; default what ships, 0,10,20,30)",
+    )
+    ap.add_argument(
+        "--default-floor",
+        type=float,
+        default=None,
+        help="the default design's floor (°), which also places the starting lights "
+        "(planner.adaptive.DESIGN_DEFAULT_FLOOR; default what ships, 10)",
     )
     ap.add_argument(
         "--relief-gain",
@@ -492,11 +553,37 @@ def main(argv: list[str] | None = None) -> str:
         "(planner.adaptive_relight_design; offered in what ships): the floors' completions only",
     )
     ap.add_argument(
+        "--fitted-margin",
+        type=float,
+        default=None,
+        help="the margin by which the fitted design must be simulated better to be taken "
+        "(planner.adaptive.FITTED_MARGIN; default what ships, the floors' SIM_MARGIN)",
+    )
+    ap.add_argument(
+        "--sim-margin",
+        type=float,
+        default=None,
+        help="the margin by which another design must be simulated better to be taken "
+        "(planner.adaptive.SIM_MARGIN; default what ships, 0.10)",
+    )
+    ap.add_argument(
+        "--fitted-seeds",
+        default="",
+        help="comma-separated extra floors (°) whose completions also seed the fitted design's "
+        "search, 'none' for none (planner.adaptive.FITTED_SEED_FLOORS; default what ships, "
+        "none)",
+    )
+    ap.add_argument(
         "--no-relight",
         action="store_true",
         help="skip the simulator's --objective relight sessions (the relighting table is then "
         "not a result; faster to iterate on the normals objective)",
     )
+    return ap
+
+
+def main(argv: list[str] | None = None) -> str:
+    ap = build_parser()
     args = ap.parse_args(argv)
     if args.no_relight:
         global RELIGHT
@@ -506,36 +593,17 @@ def main(argv: list[str] | None = None) -> str:
             "--sim-draws and --real-draws need at least 2 (the verdicts are paired tests; "
             "--real-draws 0 skips the real acquisition)"
         )
-    if args.no_fitted_design:
-        import rti_rig.planner.adaptive as adaptive_planner
-
-        adaptive_planner.FITTED_DESIGN = False
-    if args.no_relight_fitted_design:
-        import rti_rig.planner.adaptive_relight as adaptive_relight
-
-        adaptive_relight.RELIGHT_FITTED_DESIGN = False
-    if args.fitted_pixels is not None:
-        import rti_rig.planner.adaptive_optimal as adaptive_optimal
-
-        adaptive_optimal.SEARCH_PIXELS = args.fitted_pixels or None
     global NS
     if args.ns:
         NS = tuple(int(x) for x in args.ns.split(","))
-    if args.start != "default":
-        from benchmarks.adaptive_reach import start_functions
-
-        START["start"] = start_functions()[args.start]
-    if args.relief_gain:
-        import rti_rig.planner.adaptive_bias as bias
-
-        bias.FIT_RELIEF_GAIN = True
+    configure_planner(args)
     t0 = time.perf_counter()
     cache_read = args.cache is not None and args.cache.exists()
     _load_cache(args.cache)
     if args.cache is not None:
         _CACHE_PATH.append(args.cache)
     scenes = tuple(x for x in args.scenes.split(",") if x)
-    results, _ = sim(args.sim_draws, scenes=scenes)
+    results, _ = sim(args.sim_draws, seed=args.seed, scenes=scenes)
     _save_cache(args.cache)
     scale, slope, calib_rows, calib_summary = calibrate(results)
     print(f"calibrated SIM_ESTIMATE_SCALE = {scale:.3f}, DISCARD_SLOPE = {slope:.3f}")
@@ -572,12 +640,18 @@ def main(argv: list[str] | None = None) -> str:
             f"--real-draws {args.real_draws}"
             + (f" --scenes {args.scenes}" if args.scenes else "")
             + (f" --ns {args.ns}" if args.ns else "")
+            + (f" --seed {args.seed}" if args.seed else "")
             + (" --no-until" if args.no_until else "")
             + (f" --start {args.start}" if args.start != "default" else "")
+            + (f" --floors {args.floors}" if args.floors else "")
+            + (f" --default-floor {args.default_floor:g}" if args.default_floor is not None else "")
             + (" --relief-gain" if args.relief_gain else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
             + (" --no-relight-fitted-design" if args.no_relight_fitted_design else "")
+            + (f" --fitted-margin {args.fitted_margin:g}" if args.fitted_margin is not None else "")
+            + (f" --fitted-seeds {args.fitted_seeds}" if args.fitted_seeds else "")
+            + (f" --sim-margin {args.sim_margin:g}" if args.sim_margin is not None else "")
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"

@@ -200,6 +200,7 @@ def start_functions() -> dict:  # type: ignore[type-arg]
         "default": dome_start,
         "hedge-all": lambda g, k, n: hedged_start(g, k, n, others),
         "hedge-20": lambda g, k, n: hedged_start(g, k, n, (20.0,)),
+        "hedge-10": lambda g, k, n: hedged_start(g, k, n, (10.0,)),
         "shared-3": shared_three_start,
     }
 

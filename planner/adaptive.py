@@ -392,6 +392,15 @@ SIM_MARGIN = 0.10
 #: ``"design": "fitted"`` (format ``rti-rig-adaptive/5``); ``SIM_ESTIMATE_SCALE`` is
 #: calibrated with it on. ``benchmarks.adaptive --no-fitted-design`` turns it off.
 FITTED_DESIGN = True
+#: The margin by which the fitted design must be simulated better than the current design to
+#: be taken (None: :data:`SIM_MARGIN`, as the floors; ``benchmarks.adaptive --fitted-margin``).
+FITTED_MARGIN: float | None = None
+#: Floors beyond the designs' whose completions also seed the fitted design's exchange search
+#: (it starts from the cheapest on the fitted surface; they are seeds, not designs offered).
+#: None ship: 5°/15°/25°/35°/40° passed the selection rule on the benchmark's draws but gained
+#: nothing on fresh ones (docs/adaptive.md, "Re-checked with the fitted design on");
+#: ``benchmarks.adaptive --fitted-seeds 5,15,25,35,40`` measures them.
+FITTED_SEED_FLOORS: tuple[float, ...] = ()
 #: The key of that design among the floors (its evidence says ``fitted``, not a floor).
 FITTED_KEY = -1.0
 
@@ -557,7 +566,12 @@ def choose_in_design(
             cols = [where[int(c)] for c in comp]
             scores[f] = design_error_deg(state, candidates[comp], scale, w_union[:, cols])
     if model is not None and designs and objective == "normals" and FITTED_DESIGN:
-        fitted = _fitted_design(state, candidates, available, list(designs.values()))
+        seeds = list(designs.values())
+        for f in FITTED_SEED_FLOORS:  # more completions to search from (the cheapest is used)
+            c = homogeneous_completion(candidates, available, state.lights, n_total, f)
+            if c is not None and c.size:
+                seeds.append(c)
+        fitted = _fitted_design(state, candidates, available, seeds)
         if fitted is not None:
             designs[FITTED_KEY] = fitted
     if model is not None and designs and objective == "relight":
@@ -600,9 +614,7 @@ def choose_in_design(
     # session that has left the default for good evidence is not pulled back by near-ties once
     # most of its lights are placed (a mixture of two designs is neither)
     keep_floor = default_floor if incumbent is None or incumbent not in scores else incumbent
-    best = min(scores, key=lambda f: (scores[f], abs(f - keep_floor)))
-    if keep_floor in scores and scores[keep_floor] <= (1.0 + margin) * scores[best]:
-        best = keep_floor
+    best = _switch(scores, keep_floor, margin, FITTED_MARGIN if model is not None else None)
     mask = np.zeros(len(candidates), dtype=bool)
     mask[designs[best]] = True
     d = choose_next(
@@ -628,6 +640,24 @@ def choose_in_design(
         objective="normals",
         design_scores=design,
     )
+
+
+def _switch(
+    scores: dict[float, float], keep: float, margin: float, fitted_margin: float | None
+) -> float:
+    """The design taken: ``keep`` unless another is better by its margin (``fitted_margin``
+    for the fitted design, None: ``margin``); the best-scored design that passes its margin.
+    With one margin this is the best design if it passes, else ``keep``."""
+    order = sorted(scores, key=lambda f: (scores[f], abs(f - keep)))
+    if keep not in scores:
+        return order[0]
+    for f in order:
+        if f == keep:
+            return keep
+        m = fitted_margin if f == FITTED_KEY and fitted_margin is not None else margin
+        if scores[keep] > (1.0 + m) * scores[f]:
+            return f
+    return keep
 
 
 def _label(f: float) -> str:

@@ -14,3 +14,71 @@ def test_one_draw_is_refused_up_front(args: list[str], capsys) -> None:
         adaptive.main(args)
     assert caught.value.code == 2
     assert "at least 2" in capsys.readouterr().err
+
+
+@pytest.fixture
+def planner_constants(monkeypatch: pytest.MonkeyPatch):  # type: ignore[no-untyped-def]
+    """The constants the options set, restored after the test."""
+    import rti_rig.planner.adaptive as planner
+
+    for name in (
+        "FITTED_DESIGN",
+        "FITTED_MARGIN",
+        "SIM_MARGIN",
+        "FITTED_SEED_FLOORS",
+        "DESIGN_FLOORS",
+        "DESIGN_DEFAULT_FLOOR",
+    ):
+        monkeypatch.setattr(planner, name, getattr(planner, name))
+    monkeypatch.setitem(adaptive.START, "start", adaptive.START["start"])
+    return planner
+
+
+def test_without_options_the_planner_is_left_as_it_ships(planner_constants) -> None:
+    planner = planner_constants
+    before = (planner.FITTED_SEED_FLOORS, planner.FITTED_MARGIN, planner.DESIGN_DEFAULT_FLOOR)
+    adaptive.configure_planner(adaptive.build_parser().parse_args([]))
+    after = (planner.FITTED_SEED_FLOORS, planner.FITTED_MARGIN, planner.DESIGN_DEFAULT_FLOOR)
+    assert after == before
+    assert planner.FITTED_SEED_FLOORS == ()  # what ships
+
+
+def test_the_variants_options_set_the_planner_s_constants(planner_constants) -> None:
+    planner = planner_constants
+    args = adaptive.build_parser().parse_args(
+        [
+            "--fitted-seeds",
+            "none",
+            "--fitted-margin",
+            "0.05",
+            "--sim-margin",
+            "0.2",
+            "--floors",
+            "0,10,15,20,30",
+            "--default-floor",
+            "15",
+        ]
+    )
+    adaptive.configure_planner(args)
+    assert planner.FITTED_SEED_FLOORS == ()
+    assert planner.FITTED_MARGIN == 0.05 and planner.SIM_MARGIN == 0.2
+    assert planner.DESIGN_FLOORS == (0.0, 10.0, 15.0, 20.0, 30.0)
+    assert planner.DESIGN_DEFAULT_FLOOR == 15.0
+    adaptive.configure_planner(adaptive.build_parser().parse_args(["--fitted-seeds", "5,15"]))
+    assert planner.FITTED_SEED_FLOORS == (5.0, 15.0)
+
+
+def test_a_hedged_start_is_built_for_the_default_floor_the_options_set(
+    planner_constants,
+) -> None:
+    """``--default-floor 20 --start hedge-10``: 4 lights of the 20° layout (the start is read
+    after the floor is set)."""
+    from rti_rig.core.geometry import fibonacci_cap
+    from rti_rig.core.rig_geometry import DomeGeometry
+    from rti_rig.planner.uniform import select_uniform_leds
+
+    args = adaptive.build_parser().parse_args(["--default-floor", "20", "--start", "hedge-10"])
+    adaptive.configure_planner(args)
+    dome = DomeGeometry(fibonacci_cap(120, 3.0), tuple(f"l{i}" for i in range(120)))
+    start = adaptive.START["start"](dome, 4, 9)
+    assert len(start) == 4 and set(start) <= set(select_uniform_leds(dome, 9, 20.0).tolist())

@@ -193,3 +193,61 @@ def test_a_pixel_sub_sample_keeps_every_per_pixel_array_aligned(
     monkeypatch.setattr(adaptive_optimal, "SEARCH_PIXELS", 50)
     free = pinned_optimal_design(state, dirs, shot, starts)
     assert len(free) == 9 - len(shot) and not set(free.tolist()) & set(shot.tolist())
+
+
+def _old_rule(scores: dict[float, float], keep: float, margin: float) -> float:
+    """The selection before FITTED_MARGIN: the best design if it beats ``keep`` by ``margin``."""
+    best = min(scores, key=lambda f: (scores[f], abs(f - keep)))
+    if keep in scores and scores[keep] <= (1.0 + margin) * scores[best]:
+        best = keep
+    return best
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_one_margin_for_every_design_is_the_rule_that_ships(seed: int) -> None:
+    from rti_rig.planner.adaptive import FITTED_KEY, _switch
+
+    rng = np.random.default_rng(seed)
+    keys = [FITTED_KEY, 0.0, 10.0, 20.0, 30.0]
+    scores = {k: float(v) for k, v in zip(keys, 1.0 + 0.2 * rng.random(5), strict=True)}
+    if seed % 4 == 0:  # ties
+        scores[20.0] = scores[10.0]
+    keep = [10.0, 20.0, FITTED_KEY, 5.0][seed % 4]  # 5: not among the designs
+    assert _switch(scores, keep, 0.1, None) == _old_rule(scores, keep, 0.1)
+    assert _switch(scores, keep, 0.1, 0.1) == _old_rule(scores, keep, 0.1)
+
+
+def test_a_larger_margin_for_the_fitted_design_lets_a_floor_that_passes_its_own_win() -> None:
+    from rti_rig.planner.adaptive import FITTED_KEY, _switch
+
+    scores = {FITTED_KEY: 0.80, 10.0: 1.00, 20.0: 0.85}
+    assert _switch(scores, 10.0, 0.1, None) == FITTED_KEY
+    assert _switch(scores, 10.0, 0.1, 0.3) == 20.0  # the fitted design short of its margin
+    assert _switch(scores, 10.0, 0.2, 0.3) == 10.0  # and the floor short of its own
+    assert _switch(scores, 20.0, 0.1, 0.01) == FITTED_KEY  # a smaller margin for the fitted
+
+
+def test_extra_seed_floors_only_add_starts_to_the_fitted_search(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """FITTED_SEED_FLOORS seeds the search with more completions (the search starts from the
+    cheapest of them on its objective), one per floor."""
+    import rti_rig.planner.adaptive as adaptive
+    import rti_rig.planner.adaptive_optimal as adaptive_optimal
+
+    seen: list[int] = []
+    real = adaptive_optimal.pinned_optimal_design
+
+    def spy(state, candidates, shot, starts):  # type: ignore[no-untyped-def]
+        seen.append(len(starts))
+        return real(state, candidates, shot, starts)
+
+    monkeypatch.setattr(adaptive_optimal, "pinned_optimal_design", spy)
+    monkeypatch.setattr(adaptive, "FITTED_SEED_FLOORS", ())
+    _session(9)
+    plain = list(seen)
+    seen.clear()
+    monkeypatch.setattr(adaptive, "FITTED_SEED_FLOORS", (5.0, 15.0))
+    _session(9)
+    assert plain and len(seen) == len(plain)
+    assert all(b == a + 2 for a, b in zip(plain, seen, strict=True))
