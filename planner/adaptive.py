@@ -627,14 +627,19 @@ def choose_in_design(
         keep=keep,
     )
     design = {_label(f): round(v, 4) for f, v in sorted(scores.items())}
-    how = "bound" if model is None else "simulated with this object's gloss and shadows"
+    if model is None:  # the bound's scores are estimates already (scaled)
+        after = f"bound: {scores[best]:.3g}° estimated after all {n_total}"
+    else:  # the scores rank; the estimate a user compares with --until-error is scaled
+        after = (
+            f"simulated with this object's gloss and shadows: {scores[best]:.3g}° simulated, "
+            f"{scale * scores[best]:.3g}° estimated after all {n_total}"
+        )
     return Decision(
         d.candidate,
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"{_design_name(best, n_total)} ({how}: "
-        f"{scores[best]:.3g}° after all {n_total}; by floor: {design}); within it, "
+        f"{_design_name(best, n_total)} ({after}; by floor: {design}); within it, "
         f"the largest predicted drop per second ({k} captured)",
         design_floor=best,
         objective="normals",

@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.lp_format import read_lp
+from rti_rig.planner.adaptive import SIM_ESTIMATE_SCALE
 from rti_rig.planner.adaptive_until import GUESSES, guessed_lights
 from rti_rig.runtime.controller import FinishReason
 
@@ -46,7 +47,7 @@ def test_each_light_is_chosen_within_the_design_for_the_guessed_n(
 ) -> None:
     _, out = never_reached
     m = manifest(out)
-    assert m["adaptive"]["format"] == "rti-rig-adaptive/6"
+    assert m["adaptive"]["format"] == "rti-rig-adaptive/7"
     assert m["adaptive"]["design_lights"] is None  # N unknown
     steps = journal(out)
     assert len(steps) == 12 == len(read_lp(out / "lights.lp"))
@@ -58,6 +59,11 @@ def test_each_light_is_chosen_within_the_design_for_the_guessed_n(
         assert ("design_floor_deg" in d) != (d.get("design") == "fitted")
         assert d["design_objective"] == "normals" and d["design_error_deg"]
         assert f"design of {guess} lights" in d["reason"]
+        # the reason gives the estimate (what --until-error is compared with) beside the
+        # simulated score that ranks the designs: estimate = SIM_ESTIMATE_SCALE × simulated
+        taken = "fitted" if d.get("design") == "fitted" else f"{d['design_floor_deg']:g}"
+        sim = d["design_error_deg"][taken]
+        assert f"{sim:.3g}° simulated, {SIM_ESTIMATE_SCALE * sim:.3g}° estimated" in d["reason"]
     # the guess grows 6 → 9 → 12 as each design is shot
     assert [s["decision"]["guessed_lights"] for s in steps[4:]] == [6, 6, 9, 9, 9, 12, 12, 12]
     assert m["adaptive"]["result"]["stop"]["reason"] == "reached its maximum of 12 lights"

@@ -71,19 +71,21 @@ ARM_MAX_LIGHTS = 100
 #: 4: the design objective (``normals``/``relight``) in the settings and every decision;
 #: 5: the fitted design (``planner.adaptive_optimal``) offered beside the floors, a decision
 #: that takes it recording ``"design": "fitted"`` (a /4 session's choices would differ: its
-#: resume is refused, before anything on disk changes); 6: with only --until-error, each light
+#: resume is refused, before anything on disk changes); 7: with only --until-error, each light
 #: chosen within the design for a guessed N that grows (``planner.adaptive_until``), recorded
 #: as ``guessed_lights`` with the design's floor and scores (a /5 session chose by the bound);
-#: and the fitted relight design (``planner.adaptive_relight_design``) offered to
+#: the fitted relight design (``planner.adaptive_relight_design``) offered to
 #: ``--objective relight`` beside the floors, its simulated PSNR recorded as
 #: ``design_psnr_db["fitted"]`` and a decision that takes it recording ``"design": "fitted"``
-#: (a /5 relight session's choices would differ)
-FORMAT = "rti-rig-adaptive/6"
+#: (a /5 relight session's choices would differ); a design's reason giving the estimate
+#: beside the simulated error. (6 was written by development builds that had only some of
+#: these changes: refused like any other.)
+FORMAT = "rti-rig-adaptive/7"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
 #: With only --until-error (N unknown): choose within the design for a guessed N that grows
-#: (``planner.adaptive_until``; format 6) rather than the bound's best light one at a time.
+#: (``planner.adaptive_until``; format 7) rather than the bound's best light one at a time.
 UNTIL_DESIGN = True
 
 
