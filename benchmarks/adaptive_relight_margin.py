@@ -33,23 +33,29 @@ from rti_rig.planner.topography import REC709
 from rti_rig.planner.uniform import select_uniform_leds
 
 
-def scene_psnr(scene: str, si: int, draws: int, margins: list[float], seed: int = 0) -> dict:
-    """{(N, label): [PSNR per draw]} for the homogeneous floors and each margin's adaptive."""
+def relight_scene(scene: str):  # type: ignore[no-untyped-def]
+    """A simulated scene as the relighting benchmarks score it: candidate directions, the grey
+    images a session sees, and the PSNR of a layout's relighting (the richest basis its N
+    lights determine, relit to every other candidate, on luminance)."""
     from benchmarks.tradeoff import TradeoffSettings, render_scene_data
 
-    settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
-    rng = np.random.default_rng([seed, si])  # as benchmarks.adaptive.sim draws
-    data = render_scene_data(scene, settings)
+    data = render_scene_data(scene, TradeoffSettings(held_out_lights=1, ground_truth_lights=50))
     cand = data.candidate_dirs
     lum = data.candidate_images @ REC709.astype(np.float32)
-    grey = data.candidate_images.mean(axis=-1)
-    out: dict = {}
 
     def psnr(idx: np.ndarray, n: int) -> float:
         rest = np.setdiff1d(np.arange(len(cand)), idx)
         mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
         return relight_psnr(mdl, lum[rest], cand[rest])
 
+    return cand, data.candidate_images.mean(axis=-1), psnr
+
+
+def scene_psnr(scene: str, si: int, draws: int, margins: list[float], seed: int = 0) -> dict:
+    """{(N, label): [PSNR per draw]} for the homogeneous floors and each margin's adaptive."""
+    rng = np.random.default_rng([seed, si])  # as benchmarks.adaptive.sim draws
+    cand, grey, psnr = relight_scene(scene)
+    out: dict = {}
     for _ in range(draws):
         keep = np.sort(rng.choice(len(cand), len(cand) - SIM_REMOVED, replace=False))
         sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))

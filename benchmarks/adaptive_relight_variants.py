@@ -31,15 +31,11 @@ from pathlib import Path
 import numpy as np
 
 import benchmarks.adaptive as bench
-from benchmarks.metrics import relight_psnr
 from benchmarks.paired import compare
-from benchmarks.planner_real_data import relight_model
 from rti_rig.app.usecases.adaptive import dome_start
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner import adaptive_relight
 from rti_rig.planner import adaptive_relight_design as relight_design
-from rti_rig.planner.objectives import models_for
-from rti_rig.planner.topography import REC709
 from rti_rig.planner.uniform import select_uniform_leds
 
 #: name -> the module settings of the variant (restored after each session)
@@ -93,21 +89,11 @@ def scene_results(
     scene: str, si: int, draws: int, ns: tuple[int, ...], variants: list[str], results: dict
 ) -> dict:
     """{(N, label): [PSNR per draw]} for the homogeneous floors and each variant."""
-    from benchmarks.tradeoff import TradeoffSettings, render_scene_data
+    from benchmarks.adaptive_relight_margin import relight_scene
 
-    settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     rng = np.random.default_rng([0, si])  # as benchmarks.adaptive.sim draws (seed 0)
-    data = render_scene_data(scene, settings)
-    cand = data.candidate_dirs
-    lum = data.candidate_images @ REC709.astype(np.float32)
-    grey = data.candidate_images.mean(axis=-1)
+    cand, grey, psnr = relight_scene(scene)
     out: dict = {}
-
-    def psnr(idx: np.ndarray, n: int) -> float:
-        rest = np.setdiff1d(np.arange(len(cand)), idx)
-        mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
-        return relight_psnr(mdl, lum[rest], cand[rest])
-
     for d in range(max(draws, 8)):
         keep = np.sort(rng.choice(len(cand), len(cand) - bench.SIM_REMOVED, replace=False))
         sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))

@@ -79,6 +79,13 @@ def journal(session: Path) -> list[dict]:
     return [json.loads(line) for line in (session / "journal.jsonl").read_text().splitlines()]
 
 
+def decisions(session: Path) -> list[dict]:
+    """A session's recorded decisions without their wall time (what must repeat exactly)."""
+    return [
+        {k: v for k, v in s["decision"].items() if k != "decision_s"} for s in journal(session)
+    ]
+
+
 def manifest(session: Path) -> dict:
     """A session folder's manifest."""
     return json.loads((session / "manifest.json").read_text())

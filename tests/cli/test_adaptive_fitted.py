@@ -10,6 +10,7 @@ import json
 from pathlib import Path
 
 import pytest
+from conftest import decisions, journal
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -19,17 +20,6 @@ ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
 runner = CliRunner()
 #: on this replayed acquisition the fitted design is taken at 7 lights (checked below)
 N = 7
-
-
-def _journal(session: Path) -> list[dict]:
-    return [json.loads(x) for x in (session / "journal.jsonl").read_text().splitlines()]
-
-
-def _decisions(session: Path) -> list[dict]:
-    """The decisions without their wall time."""
-    return [
-        {k: v for k, v in s["decision"].items() if k != "decision_s"} for s in _journal(session)
-    ]
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +33,7 @@ def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_by_default_a_session_records_the_fitted_decisions_it_takes(whole: Path) -> None:
     manifest = json.loads((whole / "manifest.json").read_text())
     assert manifest["adaptive"]["format"] == "rti-rig-adaptive/7"
-    adaptive = [d for d in _decisions(whole) if d["kind"] == "adaptive"]
+    adaptive = [d for d in decisions(whole) if d["kind"] == "adaptive"]
     assert len(adaptive) == N - 4
     # offered at every design decision, scored beside the floors
     assert all("fitted" in d["design_error_deg"] for d in adaptive)
@@ -52,7 +42,7 @@ def test_by_default_a_session_records_the_fitted_decisions_it_takes(whole: Path)
     for d in taken:  # a fitted decision names no floor, and is the best scored
         assert "design_floor_deg" not in d
         assert "least expected error on the fitted surface" in d["reason"]
-    assert [s["decision"] for s in manifest["steps"]] == [s["decision"] for s in _journal(whole)]
+    assert [s["decision"] for s in manifest["steps"]] == [s["decision"] for s in journal(whole)]
 
 
 def test_an_interrupted_session_that_took_the_fitted_design_resumes_to_the_same_one(
@@ -72,8 +62,8 @@ def test_an_interrupted_session_that_took_the_fitted_design_resumes_to_the_same_
 
     with rig:
         run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
-    assert len(_journal(out)) == 5
+    assert len(journal(out)) == 5
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
-    assert _decisions(out) == _decisions(whole)
+    assert decisions(out) == decisions(whole)
     assert (out / "lights.lp").read_text() == (whole / "lights.lp").read_text()

@@ -10,6 +10,7 @@ import json
 from pathlib import Path
 
 import pytest
+from conftest import decisions, journal
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -23,17 +24,6 @@ RELIGHT = ("--objective", "relight", "--no-verdict")
 N = 7
 
 
-def _journal(session: Path) -> list[dict]:
-    return [json.loads(x) for x in (session / "journal.jsonl").read_text().splitlines()]
-
-
-def _decisions(session: Path) -> list[dict]:
-    """The decisions without their wall time."""
-    return [
-        {k: v for k, v in s["decision"].items() if k != "decision_s"} for s in _journal(session)
-    ]
-
-
 def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path: Path) -> None:
     out = tmp_path / "s"
     r = runner.invoke(
@@ -42,7 +32,7 @@ def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path
     assert r.exit_code == 0, r.output
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["adaptive"]["format"] == "rti-rig-adaptive/7"
-    adaptive = [d for d in _decisions(out) if d["kind"] == "adaptive"]
+    adaptive = [d for d in decisions(out) if d["kind"] == "adaptive"]
     assert len(adaptive) == 2
     for d in adaptive:
         scores = d["design_psnr_db"]
@@ -61,7 +51,7 @@ def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_a_relight_decision_that_takes_the_fitted_design_records_it(whole: Path) -> None:
-    adaptive = [d for d in _decisions(whole) if d["kind"] == "adaptive"]
+    adaptive = [d for d in decisions(whole) if d["kind"] == "adaptive"]
     assert len(adaptive) == N - 4
     taken = [d for d in adaptive if d.get("design") == "fitted"]
     assert taken, "the fitted relight design is taken on this acquisition at 7 lights"
@@ -72,9 +62,9 @@ def test_a_relight_decision_that_takes_the_fitted_design_records_it(whole: Path)
     first = taken[0]
     assert first["design_psnr_db"]["fitted"] >= first["design_psnr_db"]["10"] + 0.5 - 1e-3
     manifest = json.loads((whole / "manifest.json").read_text())
-    assert [s["decision"] for s in manifest["steps"]] == [s["decision"] for s in _journal(whole)]
+    assert [s["decision"] for s in manifest["steps"]] == [s["decision"] for s in journal(whole)]
     # lights.lp lists what fired: the N lights of the journal
-    assert len(_journal(whole)) == N
+    assert len(journal(whole)) == N
 
 
 def test_an_interrupted_relight_session_that_took_the_fitted_design_resumes_to_the_same_one(
@@ -96,9 +86,9 @@ def test_an_interrupted_relight_session_that_took_the_fitted_design_resumes_to_t
 
     with rig:
         run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
-    assert len(_journal(out)) == 5
-    assert _journal(out)[4]["decision"].get("design") == "fitted"
+    assert len(journal(out)) == 5
+    assert journal(out)[4]["decision"].get("design") == "fitted"
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
-    assert _decisions(out) == _decisions(whole)
+    assert decisions(out) == decisions(whole)
     assert (out / "lights.lp").read_text() == (whole / "lights.lp").read_text()
