@@ -47,17 +47,22 @@ seed = 3
 
 
 def interrupted(  # type: ignore[no-untyped-def]
-    cfg: Path, out: Path, after_step: int, objective: str = "normals"
+    cfg: Path,
+    out: Path,
+    after_step: int,
+    objective: str = "normals",
+    lights: int | None = 8,
+    until: float | None = None,
 ):
-    """An adaptive session of up to 8 lights in ``out`` (design ``objective``), cancelled once
-    step ``after_step`` (0-based) is committed, as Ctrl-C would (tests/app and
+    """An adaptive session (``--lights``, ``--until-error``, design ``objective``) in ``out``,
+    cancelled once step ``after_step`` (0-based) is committed, as Ctrl-C would (tests/app and
     tests/cli resume it)."""
     from rti_rig.app.config import load_rig_config
     from rti_rig.app.usecases.adaptive import open_adaptive_session
     from rti_rig.runtime.controller import CancelToken, StepCompleted, run_session
 
     rig, schedule, folder, source = open_adaptive_session(
-        load_rig_config(cfg), out, 8, None, objective
+        load_rig_config(cfg), out, lights, until, objective
     )
     cancel = CancelToken()
 
@@ -81,9 +86,7 @@ def journal(session: Path) -> list[dict]:
 
 def decisions(session: Path) -> list[dict]:
     """A session's recorded decisions without their wall time (what must repeat exactly)."""
-    return [
-        {k: v for k, v in s["decision"].items() if k != "decision_s"} for s in journal(session)
-    ]
+    return [{k: v for k, v in s["decision"].items() if k != "decision_s"} for s in journal(session)]
 
 
 def manifest(session: Path) -> dict:

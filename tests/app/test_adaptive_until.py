@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, SMALL_DOME, journal, manifest, said, write_config
+from conftest import CONFIGS, SMALL_DOME, interrupted, journal, manifest, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -93,21 +93,9 @@ def test_an_interrupted_until_error_session_resumes_to_the_same_session(
 ) -> None:
     """The design the session was choosing in (its floor, kept across guesses) is re-derived
     by the replay, so the continuation makes the same choices."""
-    from rti_rig.app.config import load_rig_config
-    from rti_rig.app.usecases.adaptive import open_adaptive_session
-    from rti_rig.runtime.controller import CancelToken, StepCompleted, run_session
-
     cfg, ref = never_reached
     out = tmp_path / "cut"
-    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, None, 1e-9)
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 6:
-            cancel.cancel()
-
-    with rig:
-        res = run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    res = interrupted(cfg, out, 6, lights=None, until=1e-9)
     assert res.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 7
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output

@@ -10,7 +10,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import decisions, journal
+from conftest import decisions, interrupted, journal
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -48,20 +48,8 @@ def test_by_default_a_session_records_the_fitted_decisions_it_takes(whole: Path)
 def test_an_interrupted_session_that_took_the_fitted_design_resumes_to_the_same_one(
     whole: Path, tmp_path: Path
 ) -> None:
-    from rti_rig.app.config import load_rig_config
-    from rti_rig.app.usecases.adaptive import open_adaptive_session
-    from rti_rig.runtime.controller import CancelToken, StepCompleted, run_session
-
     out = tmp_path / "cut"
-    rig, schedule, folder, source = open_adaptive_session(load_rig_config(ACQ), out, N, None)
-    cancel = CancelToken()
-
-    def on_event(event) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(event, StepCompleted) and event.index == 4:  # one fitted decision made
-            cancel.cancel()
-
-    with rig:
-        run_session(rig, schedule, folder, cancel=cancel, on_event=on_event, source=source)
+    interrupted(ACQ, out, 4, lights=N)  # one fitted decision made
     assert len(journal(out)) == 5
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
