@@ -81,12 +81,6 @@ def relight_basis(n_total: int) -> str:
     return models_for(n_total)[-1]
 
 
-def _light_noise(union: NDArray[np.float64], draws: int, npix: int, sigma: float, seed: int):  # type: ignore[no-untyped-def]
-    """(draws, U, P') noise, each light's from a seed of its own direction (the same in every
-    design and call, and the same as the normals score's for the same light)."""
-    return light_noise(union, draws, npix, sigma, seed)
-
-
 def mean_psnr_db(relit: NDArray, reference: NDArray, noise: float) -> float:
     """Mean over held-out lights (rows) of the PSNR (dB, data range 1) of ``relit`` against a
     photograph of ``reference``: the squared error plus the photograph's noise ``noise²``."""
@@ -115,7 +109,7 @@ def simulate_relight_designs(
     union, inverse = np.unique(np.round(allx, 9), axis=0, return_inverse=True)
     inverse = inverse.reshape(-1)
     clean = render(model, union, pix)  # (U, P'): every light rendered once, for all designs
-    noise = _light_noise(union, draws, len(pix), model.noise, seed)
+    noise = light_noise(union, draws, len(pix), model.noise, seed)  # (draws, U, P')
     n_design = sum(len(d) for d in designs)
     d_cols, h_cols = inverse[:n_design], inverse[n_design:]
     out = []
