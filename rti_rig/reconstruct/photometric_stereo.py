@@ -244,13 +244,9 @@ def _least_squares_band(
             if short_residual:
                 r2 = gg - bl
                 if clamped.size:
-                    r2[clamped] = (
-                        gg[clamped]
-                        - 2.0 * np.einsum("ij,ij->j", bk, ltg[:, clamped])
-                        + np.einsum("ij,ij->j", gram32 @ bk, bk)
-                    )
+                    r2[clamped] = _stationary_r2(gg[clamped], bk, ltg[:, clamped], gram32)
             else:
-                r2 = gg - 2.0 * np.einsum("ij,ij->j", b, ltg) + np.einsum("ij,ij->j", gram32 @ b, b)
+                r2 = _stationary_r2(gg, b, ltg, gram32)
             direct = ~(r2 >= DIRECT_RESIDUAL_FRACTION * gg)  # NaN included
             if direct.any():
                 k = np.flatnonzero(direct)
@@ -269,19 +265,19 @@ def _least_squares_band(
             good = inside[s:e] & ~bad & (norm > eps_b)
             safe = np.where(norm > 0, norm, np.float32(1.0))
             nn = b / safe  # divided, not times a reciprocal: the normals of before, bit for bit
+            if clamped.size:  # n^T G n where b no longer solves the normal equations
+                nk = nn[:, clamped]
+                sk = np.einsum("ij,ij->j", gram32 @ nk, nk)
+                sk = np.where(sk > 0, sk, np.float32(1.0))
             if channels == 1:
                 alb[s:e, 0] = norm
                 if clamped.size:
-                    nk = nn[:, clamped]
-                    sk = np.einsum("ij,ij->j", gram32 @ nk, nk)
-                    sk = np.where(sk > 0, sk, np.float32(1.0))
                     alb[s + clamped, 0] = np.einsum("ij,ij->j", nk, ltg[:, clamped]) / sk
             else:
-                ss = bl / (safe * safe)  # n^T G n
-                if clamped.size:
-                    nk = nn[:, clamped]
-                    ss[clamped] = np.einsum("ij,ij->j", gram32 @ nk, nk)
+                ss = bl / (safe * safe)  # n^T G n while b solves them
                 ss = np.where(ss > 0, ss, np.float32(1.0))
+                if clamped.size:
+                    ss[clamped] = sk
                 proj = (lt32 @ flat[:, s:e].reshape(n_img, -1)).reshape(3, e - s, channels)
                 alb[s:e] = np.einsum("ip,ipc->pc", nn, proj) / ss[:, None]
             if not good.all():
@@ -295,6 +291,14 @@ def _least_squares_band(
                 suspect.append(s + np.flatnonzero(bad & inside[s:e]))
     cols = np.concatenate(suspect) if suspect else np.zeros(0, dtype=np.intp)
     return normals, alb, rms, ok, cols
+
+
+def _stationary_r2(
+    gg: NDArray[np.float32], b: NDArray[np.float32], ltg: NDArray[np.float32], gram32: NDArray
+) -> NDArray[np.float32]:
+    """``|L b - I|² = I.I - 2 b.L^T I + b^T G b`` per pixel, for any ``b`` (stationary at the
+    least-squares one: the rounding of a float32 ``b`` enters it to second order only)."""
+    return gg - 2.0 * np.einsum("ij,ij->j", b, ltg) + np.einsum("ij,ij->j", gram32 @ b, b)
 
 
 def fit_photometric_stereo(
