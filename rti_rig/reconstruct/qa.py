@@ -67,6 +67,9 @@ WRONG_LIGHT_SPREAD = 3.0
 #: Light directions are judged only when the fitted normals spread at least this much (degrees,
 #: the smallest axis of their second moment): a flat card leaves the azimuth undetermined.
 MIN_NORMAL_SPREAD_DEG = 2.0
+#: Light directions are judged only on at least this many lit images that some Lambertian
+#: rendering of the fit explains (fewer cannot tell one wrong light from the rest).
+MIN_DIRECTION_IMAGES = 5
 #: Refits of the reference without the images found faulty.
 MAX_ROUNDS = 4
 #: An image below this gain at its bright end had no light at all (a black frame).
@@ -585,7 +588,12 @@ def _evidence(
             f"(limit {MIN_NORMAL_SPREAD_DEG:.0f}°): on a near-flat object a light's azimuth "
             "cannot be told from its image"
         )
-    elif cand.sum() < max(5, (undimmed + 1) // 2):
+    elif undimmed < MIN_DIRECTION_IMAGES:
+        note = (
+            f"light directions not checked: {undimmed} image(s) with light, too few to tell a "
+            f"wrong light from the others (at least {MIN_DIRECTION_IMAGES} are needed)"
+        )
+    elif cand.sum() < max(MIN_DIRECTION_IMAGES, (undimmed + 1) // 2):
         spread = float(np.median(misfit[~dead & np.isfinite(misfit)])) if undimmed else np.nan
         note = (
             f"light directions not checked: only {int(cand.sum())} of {undimmed} images are "
