@@ -688,16 +688,24 @@ def _fitted_design(
     starts: list[NDArray[np.intp]],
 ) -> NDArray[np.intp] | None:
     """:func:`rti_rig.planner.adaptive_optimal.pinned_optimal_design` from the completions
-    ``starts``; None when a light shot is not one of the candidates (an arm's recorded
-    direction) or the completions differ in length."""
+    ``starts`` over the available candidates; None as :func:`_shot_indices`."""
     from rti_rig.planner.adaptive_optimal import pinned_optimal_design
 
+    shot = _shot_indices(state, candidates, starts)
+    if shot is None:
+        return None
+    return pinned_optimal_design(state, candidates, shot, starts, available)
+
+
+def _shot_indices(
+    state: SurfaceState, candidates: NDArray[np.float64], starts: list[NDArray[np.intp]]
+) -> NDArray[np.intp] | None:
+    """The candidate index of each light shot, for a search pinned to them; None when one is
+    not a candidate (an arm's recorded direction) or the completions differ in length."""
     near = _angles(state.lights, candidates) < 1e-6
     if not near.any(axis=1).all() or len({len(s) for s in starts}) != 1:
         return None
-    shot = np.argmax(near, axis=1).astype(np.intp)
-    free = pinned_optimal_design(state, candidates, shot, starts)
-    return free if available[free].all() else None
+    return np.argmax(near, axis=1).astype(np.intp)
 
 
 def _fitted_relight(
@@ -719,12 +727,10 @@ def _fitted_relight(
     from rti_rig.planner.adaptive_relight_design import fitted_relight_design
 
     starts = list(designs.values())
-    near = _angles(state.lights, candidates) < 1e-6
-    if not near.any(axis=1).all() or len({len(s) for s in starts}) != 1:
+    shot = _shot_indices(state, candidates, starts)
+    if shot is None:
         return None
-    shot = np.argmax(near, axis=1).astype(np.intp)
-    free = fitted_relight_design(model, candidates, available, shot, starts, relight_basis(n_total))
-    return free if available[free].all() else None
+    return fitted_relight_design(model, candidates, available, shot, starts, relight_basis(n_total))
 
 
 def _relight_decision(

@@ -39,11 +39,16 @@ from rti_rig.planner.optimal import MAX_PASSES, exchange_search
 class PinnedObjective:
     """An objective over the lights not shot yet: ``fixed`` (candidate indices) are always in
     the layout, never swapped out, and never proposed as a replacement (the exchange search
-    sees only the others)."""
+    sees only the others); ``excluded`` (lights out of service) are never proposed either."""
 
-    def __init__(self, objective: Any, fixed: NDArray[np.intp]) -> None:
+    def __init__(
+        self, objective: Any, fixed: NDArray[np.intp], excluded: NDArray[np.intp] | None = None
+    ) -> None:
         self.objective = objective
         self.fixed = np.asarray(fixed, dtype=np.intp)
+        self.never = (
+            self.fixed if excluded is None else np.union1d(self.fixed, excluded).astype(np.intp)
+        )
         self.scan_levels = getattr(objective, "scan_levels", ({"exact": False}, {"exact": True}))
         self.candidate_count = int(objective.candidate_count)
 
@@ -52,13 +57,35 @@ class PinnedObjective:
 
     def swap_costs(self, free: NDArray[np.intp], position: int, **kw: Any) -> NDArray[np.float64]:
         if kw.get("among") is not None:
-            kw["among"] = np.setdiff1d(kw["among"], self.fixed)
+            kw["among"] = np.setdiff1d(kw["among"], self.never)
         out = np.array(
             self.objective.swap_costs(np.r_[self.fixed, free], position + len(self.fixed), **kw),
             dtype=np.float64,
         )
-        out[self.fixed] = np.inf
+        out[self.never] = np.inf
         return out
+
+
+def pinned_search(
+    objective: Any,
+    shot: NDArray[np.intp],
+    available: NDArray[np.bool_],
+    starts: Sequence[NDArray[np.intp]],
+) -> NDArray[np.intp]:
+    """``optimal``'s exchange search of ``objective`` over the lights not shot (``shot``
+    fixed; lights neither shot nor ``available`` never proposed), from the cheapest of
+    ``starts`` (completions of the same length), its sweeps capped by :func:`search_passes`.
+    Sorted candidate indices."""
+    if not starts:
+        raise ValueError("the search needs at least one starting completion")
+    shot = np.asarray(shot, dtype=np.intp)
+    gone = np.setdiff1d(np.flatnonzero(~np.asarray(available, dtype=bool)), shot)
+    res = exchange_search(
+        PinnedObjective(objective, shot, gone),
+        [(str(i), np.asarray(s)) for i, s in enumerate(starts)],
+        max_passes=search_passes(len(starts[0])),
+    )
+    return np.sort(np.asarray(res.chosen, dtype=np.intp))
 
 
 def state_sample(state: SurfaceState, candidates: NDArray[np.float64]) -> SurfaceSample:
@@ -142,19 +169,17 @@ def pinned_optimal_design(
     candidates: NDArray[np.float64],
     shot: NDArray[np.intp],
     starts: Sequence[NDArray[np.intp]],
+    available: NDArray[np.bool_] | None = None,
 ) -> NDArray[np.intp]:
     """Candidate indices completing the lights ``shot`` (candidate indices) to the layout of
     least expected error on the fitted surface, searched from each of ``starts`` (completions:
-    candidate indices, none of them shot, all of the same length)."""
+    candidate indices, none of them shot, all of the same length) over the ``available``
+    candidates (None: all)."""
     if not starts:
         raise ValueError("the search needs at least one starting completion")
     state = _subsample(state, search_pixels(len(starts[0])))
     sample = state_sample(state, candidates)
     objective = NormalsObjective(sample, Candidates(candidates, None, None))
-    pinned = PinnedObjective(objective, np.asarray(shot, dtype=np.intp))
-    res = exchange_search(
-        pinned,
-        [(str(i), np.asarray(s)) for i, s in enumerate(starts)],
-        max_passes=search_passes(len(starts[0])),
-    )
-    return np.asarray(res.chosen, dtype=np.intp)
+    if available is None:
+        available = np.ones(len(candidates), dtype=bool)
+    return pinned_search(objective, shot, available, starts)

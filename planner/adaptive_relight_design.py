@@ -41,8 +41,8 @@ from numpy.typing import NDArray
 
 from rti_rig.core.rti_bases import design_matrix
 from rti_rig.planner.adaptive_bias import SIM_PIXELS, ObjectModel, render
+from rti_rig.planner.adaptive_optimal import pinned_search
 from rti_rig.planner.objectives import BIAS_REL
-from rti_rig.planner.optimal import exchange_search
 
 #: Ridge on the basis' normal matrix (as :class:`~rti_rig.planner.objectives.RelightObjective`).
 RIDGE = 1e-8
@@ -194,12 +194,11 @@ def fitted_relight_design(
         return np.sort(layouts[0])
     albedo_ms = float(np.mean(model.albedo[pix] ** 2))
     shot = np.asarray(shot, dtype=np.intp)
-    gone = np.setdiff1d(np.flatnonzero(~np.asarray(available, dtype=bool)), shot)
     plain = FittedRelightObjective(
         clean, candidates, held, basis, model.noise, albedo_ms, bias_rel=UNMODELLED_REL
     )
     if not DB_WEIGHTED:
-        return _search(plain, shot, gone, layouts)
+        return pinned_search(plain, shot, available, layouts)
 
     # the score averages PSNR (dB) over the held-out lights, not their squared errors: each
     # light's error weighted by 1/(its expected error + the photograph's noise) at the current
@@ -222,7 +221,7 @@ def fitted_relight_design(
             bias_rel=UNMODELLED_REL,
             weights=1.0 / e,
         )
-        found = _search(weighted, shot, gone, [best, *layouts])
+        found = pinned_search(weighted, shot, available, [best, *layouts])
         if db(found) <= db(best):
             break
         best = found
@@ -240,30 +239,3 @@ DB_WEIGHTED = True
 UNMODELLED_REL = 2 * BIAS_REL
 #: Re-weightings of the dB-weighted search (each a full exchange search from the layout found).
 ROUNDS = 2
-
-
-def _search(
-    objective: FittedRelightObjective,
-    shot: NDArray[np.intp],
-    gone: NDArray[np.intp],
-    starts: list[NDArray[np.intp]],
-) -> NDArray[np.intp]:
-    """``optimal``'s exchange search over the lights not shot (``shot`` fixed, ``gone`` never
-    proposed), from the cheapest of ``starts``."""
-    from rti_rig.planner.adaptive_optimal import PinnedObjective, search_passes
-
-    pinned = PinnedObjective(objective, shot)
-    pinned_swap = pinned.swap_costs
-
-    def swap_costs(free: NDArray[np.intp], position: int, **kw):  # type: ignore[no-untyped-def]
-        out = pinned_swap(free, position, **kw)
-        out[gone] = np.inf
-        return out
-
-    pinned.swap_costs = swap_costs  # type: ignore[method-assign]
-    res = exchange_search(
-        pinned,
-        [(str(i), np.asarray(s)) for i, s in enumerate(starts)],
-        max_passes=search_passes(len(starts[0])),
-    )
-    return np.sort(np.asarray(res.chosen, dtype=np.intp))

@@ -70,6 +70,20 @@ def test_the_pinned_objective_never_proposes_or_moves_a_shot_light() -> None:
     assert not set(res.chosen.tolist()) & set(shot.tolist())
 
 
+def test_lights_out_of_service_are_never_proposed_and_the_design_is_kept() -> None:
+    """The lights the search would take, put out of service: it completes the design with
+    others instead (the fitted design was dropped whenever its search wandered onto one)."""
+    dirs, shot, state, starts = _setup(tilt=0.6)
+    free = pinned_optimal_design(state, dirs, shot, starts)
+    available = np.ones(len(dirs), bool)
+    available[shot] = False
+    out = np.setdiff1d(free, np.concatenate(starts))  # chosen by the search, in no start
+    assert out.size  # the premise: the search leaves the starts
+    available[out] = False
+    again = pinned_optimal_design(state, dirs, shot, starts, available)
+    assert len(again) == len(free) and available[again].all()
+
+
 def test_cast_shadows_and_the_keep_table_lower_a_light_s_use() -> None:
     """The sample's lit factor is 1 for a light the fit keeps on a flat relief, and a ridge of
     relief casting a shadow takes it to 0 for the pixels behind it."""
@@ -238,9 +252,9 @@ def test_extra_seed_floors_only_add_starts_to_the_fitted_search(
     seen: list[int] = []
     real = adaptive_optimal.pinned_optimal_design
 
-    def spy(state, candidates, shot, starts):  # type: ignore[no-untyped-def]
+    def spy(state, candidates, shot, starts, available=None):  # type: ignore[no-untyped-def]
         seen.append(len(starts))
-        return real(state, candidates, shot, starts)
+        return real(state, candidates, shot, starts, available)
 
     monkeypatch.setattr(adaptive_optimal, "pinned_optimal_design", spy)
     monkeypatch.setattr(adaptive, "FITTED_SEED_FLOORS", ())
