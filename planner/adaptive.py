@@ -143,7 +143,7 @@ class Decision:
     #: with N known: what the designs were scored by (``normals``: simulated or bound mean
     #: normal error, °; ``relight``: simulated relighting PSNR, dB) and each floor's score
     objective: str | None = None
-    design_scores: dict[str, float] | None = None
+    design_scores: dict[str, float | None] | None = None
     #: with only ``--until-error``: the guessed N whose design the light was chosen in
     #: (:mod:`rti_rig.planner.adaptive_until`)
     guessed_lights: int | None = None
@@ -589,6 +589,7 @@ def choose_in_design(
             n_total,
             designs,
             dict(zip(designs, psnr, strict=True)),
+            {f for f, h in zip(designs, held, strict=True) if len(h) == 0},
             default_floor if incumbent is None or incumbent not in designs else incumbent,
             now,
             capture_s=capture_s,
@@ -740,25 +741,36 @@ def _relight_decision(
     n_total: int,
     designs: dict[float, NDArray[np.intp]],
     psnr: dict[float, float],
+    unjudged: set[float],
     keep_floor: float,
     now: float,
     **choose: Any,
 ) -> Decision:
     """The design with the best simulated relighting PSNR (kept unless another is better by
-    :data:`~rti_rig.planner.adaptive_relight.RELIGHT_MARGIN_DB`), then its most useful light."""
+    :data:`~rti_rig.planner.adaptive_relight.RELIGHT_MARGIN_DB`), then its most useful light.
+
+    A design that leaves no available light out (``unjudged``: every light the rig has left is
+    in it) has nothing to judge its relighting on: it is recorded without a PSNR (null), and
+    the reason says so, rather than the perfect score it is ranked by."""
     best = pick_floor(psnr, keep_floor)
     mask = np.zeros(len(candidates), dtype=bool)
     mask[designs[best]] = True
     d = choose_next(state, candidates, mask & available, **choose)
-    by_floor = {_label(f): round(v, 3) for f, v in sorted(psnr.items())}
+    by_floor: dict[str, float | None] = {
+        _label(f): None if f in unjudged else round(v, 3) for f, v in sorted(psnr.items())
+    }
+    judged = (
+        "no light of the rig is left out of it, so there is nothing to judge its relighting on"
+        if best in unjudged
+        else f"relighting PSNR of {relight_basis(n_total)} simulated with this object's gloss "
+        f"and shadows: {psnr[best]:.3g} dB on the lights left out"
+    )
     return Decision(
         d.candidate,
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"{_relight_design_name(best, n_total)} (relighting PSNR of "
-        f"{relight_basis(n_total)} simulated with this object's gloss and shadows: "
-        f"{psnr[best]:.3g} dB on the lights left out; by floor: {by_floor}); within it, "
+        f"{_relight_design_name(best, n_total)} ({judged}; by floor: {by_floor}); within it, "
         f"the largest predicted drop of the normal error per second ({len(state.lights)} "
         "captured)",
         design_floor=best,

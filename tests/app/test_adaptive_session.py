@@ -236,6 +236,52 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     assert files() == before
 
 
+def test_the_manifest_records_every_decision_constant(uninterrupted: tuple[Path, Path]) -> None:
+    """What a session was chosen under is on record: margins, floors, the fitted search's
+    budget (``SEARCH_*``), the object model's settings, the usecase's image reduction."""
+    from rti_rig.planner import adaptive, adaptive_optimal
+
+    _, out = uninterrupted
+    constants = manifest(out)["adaptive"]["constants"]
+    assert constants["planner.adaptive.SIM_MARGIN"] == adaptive.SIM_MARGIN
+    assert constants["planner.adaptive.DESIGN_FLOORS"] == list(adaptive.DESIGN_FLOORS)
+    assert constants["planner.adaptive_optimal.SEARCH_PIXELS"] == adaptive_optimal.SEARCH_PIXELS
+    assert constants["planner.adaptive_optimal.SEARCH_SCANS"] == adaptive_optimal.SEARCH_SCANS
+    assert constants["planner.adaptive_relight.RELIGHT_MARGIN_DB"] == 0.5
+    assert constants["app.usecases.adaptive.FIT_PX"] == 128
+
+
+def test_a_session_begun_under_other_constants_is_refused_by_name(
+    uninterrupted: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Same format, another margin: this build would not repeat the session's choices, so the
+    resume is refused naming the constant, from the manifest alone (not a byte changes)."""
+    from rti_rig.planner import adaptive, adaptive_optimal
+
+    cfg, _ = uninterrupted
+    out = tmp_path / "other"
+    interrupted(cfg, out, after_step=4)
+
+    def files() -> dict[str, bytes]:
+        return {str(p.relative_to(out)): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+
+    before = files()
+    monkeypatch.setattr(adaptive, "SIM_MARGIN", 0.25)
+    monkeypatch.setattr(adaptive_optimal, "SEARCH_PIXELS", 400)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert "other decision constants" in text
+    assert "planner.adaptive.SIM_MARGIN 0.1 → 0.25" in text
+    assert "planner.adaptive_optimal.SEARCH_PIXELS 500 → 400" in text
+    assert "export-lp" in text and "Traceback" not in text
+    assert files() == before
+    monkeypatch.undo()  # the build that began it continues it
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert len(journal(out)) == 8
+
+
 def test_the_robust_kernel_is_loaded_before_the_rig_opens(tmp_path: Path, monkeypatch) -> None:
     """An adaptive session loads (or compiles) the robust fit's kernel before the rig opens,
     not at its first decision between two lights (a compile takes seconds)."""

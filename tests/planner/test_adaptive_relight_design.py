@@ -232,3 +232,25 @@ def test_when_every_light_left_is_in_the_design_the_search_has_nothing_to_religh
             model, CANDIDATES, avail, shot, [np.array([5, 20, 40, 60])], "hsh1"
         )
     assert free.tolist() == [5, 20, 40, 60]
+
+
+def test_a_relight_decision_with_no_light_left_out_records_no_psnr() -> None:
+    """Every available light in the design: nothing is held out to judge relighting on, so the
+    decision records no PSNR (null) and says why — not the perfect score it is ranked by."""
+    model = _model(8)
+    shot = np.array([12, 33, 51, 77])
+    avail = np.zeros(len(CANDIDATES), dtype=bool)
+    avail[[5, 20, 40, 60, 70]] = True
+    d = choose_in_design(
+        _state(model, shot),
+        CANDIDATES,
+        avail,
+        9,
+        fit=lambda obs, lights: None,
+        objective="relight",
+        relight=relight_fit,
+    )
+    assert d.candidate in (5, 20, 40, 60, 70)
+    assert d.design_scores and all(v is None for v in d.design_scores.values())
+    assert "nothing to judge its relighting on" in d.reason
+    assert "dB on the lights left out" not in d.reason

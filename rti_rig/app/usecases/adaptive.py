@@ -32,6 +32,11 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.app.usecases.adaptive_constants import (
+    constant_differences,
+    decision_constants,
+    describe_differences,
+)
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
@@ -607,6 +612,7 @@ class AdaptiveSteps:
             "candidates": len(self.plan.candidates),
             "fit_px": FIT_PX,
             "estimate_scale": self.chooser.scale,
+            "constants": decision_constants(),
         }
 
     def _step(self, candidate: int) -> LightStep:
@@ -749,6 +755,23 @@ def refuse_other_format(header: dict, root: Path) -> None:
         )
 
 
+def refuse_other_constants(header: dict, root: Path) -> None:
+    """Refuse a session whose recorded decision constants differ from this build's (its
+    choices would not be repeated), naming them — from the manifest alone. A session that
+    recorded none (written before they were recorded) is left to the replay's own check."""
+    recorded = header.get("constants")
+    if not isinstance(recorded, dict):
+        return
+    differ = constant_differences(recorded, decision_constants())
+    if differ:
+        raise RtiRigError(
+            f"{root}: this adaptive session was begun with other decision constants "
+            f"({describe_differences(differ)}): this build would not repeat its choices. The "
+            "images are kept: `rti-rig export-lp` and `rti-rig fit` use them as they are; "
+            "continue it with the build that began it, or start a new session to shoot more"
+        )
+
+
 def check_resume_objective(manifest: dict, root: Path, objective: str | None) -> str:
     """The objective an interrupted session was begun with; a different ``objective`` asked
     for is refused (from the manifest alone, before anything on disk is touched)."""
@@ -761,6 +784,7 @@ def check_resume_objective(manifest: dict, root: Path, objective: str | None) ->
             f"--objective {objective}"
         )
     refuse_other_format(header, root)
+    refuse_other_constants(header, root)
     began = header.get("objective")
     if began not in OBJECTIVES:
         raise RtiRigError(

@@ -1,0 +1,80 @@
+"""The constants an adaptive session's decisions depend on, recorded in its manifest.
+
+Why: a decision is a function of the images *and* of the planner's constants (margins, floors,
+the search's budget, the object model's settings). The decision format names what a session
+records; it does not catch a constant changed between two builds of the same format. Recording
+every constant lets a reader see what a session was chosen under, and lets ``--resume`` refuse,
+from the manifest alone and naming the constant, a session whose choices this build would not
+repeat.
+
+The constants are collected, not listed by hand, so one added to a module is recorded without
+anyone remembering to: every public upper-case module attribute holding plain data (numbers,
+strings, booleans, None, or tuples/dicts of them) of the modules below, keyed by the module's
+path under ``rti_rig`` (``planner.adaptive.SIM_MARGIN``, ``app.usecases.adaptive.FIT_PX``).
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+from typing import Any
+
+#: The modules whose constants shape an adaptive decision (the choosers, the object model, the
+#: fitted designs' searches and the objectives they call, the usecase's image reduction).
+DECISION_MODULES = (
+    "rti_rig.planner.adaptive",
+    "rti_rig.planner.adaptive_bias",
+    "rti_rig.planner.adaptive_optimal",
+    "rti_rig.planner.adaptive_relief",
+    "rti_rig.planner.adaptive_relight",
+    "rti_rig.planner.adaptive_relight_design",
+    "rti_rig.planner.adaptive_until",
+    "rti_rig.planner.objectives",
+    "rti_rig.planner.optimal",
+    "rti_rig.app.usecases.adaptive",
+)
+
+#: How many differing constants a refusal names (the rest are counted).
+NAMED_DIFFERENCES = 5
+
+
+def _plain(value: Any) -> bool:
+    if value is None or isinstance(value, bool | int | float | str):
+        return True
+    if isinstance(value, tuple | list):
+        return all(_plain(v) for v in value)
+    if isinstance(value, dict):
+        return all(isinstance(k, str) and _plain(v) for k, v in value.items())
+    return False
+
+
+def decision_constants() -> dict[str, Any]:
+    """``module.NAME`` (the module's path under ``rti_rig``) → value (as JSON reads it back:
+    tuples as lists) for every constant of :data:`DECISION_MODULES`, read now (so a value a
+    benchmark sets is what is recorded)."""
+    out: dict[str, Any] = {}
+    for name in DECISION_MODULES:
+        module = importlib.import_module(name)
+        short = name.removeprefix("rti_rig.")
+        for key, value in sorted(vars(module).items()):
+            if key.isupper() and not key.startswith("_") and _plain(value):
+                out[f"{short}.{key}"] = value
+    return json.loads(json.dumps(out))
+
+
+def constant_differences(recorded: dict[str, Any], current: dict[str, Any]) -> list[str]:
+    """What differs between a session's recorded constants and this build's, one line each
+    (``NAME recorded → now``; a constant one side lacks shows as ``absent``)."""
+    lines = []
+    for key in sorted(set(recorded) | set(current)):
+        was, now = recorded.get(key, "absent"), current.get(key, "absent")
+        if was != now:
+            lines.append(f"{key} {was!r} → {now!r}")
+    return lines
+
+
+def describe_differences(lines: list[str]) -> str:
+    """The first :data:`NAMED_DIFFERENCES` differences, then how many more."""
+    shown = "; ".join(lines[:NAMED_DIFFERENCES])
+    more = len(lines) - NAMED_DIFFERENCES
+    return shown + (f"; and {more} more" if more > 0 else "")
