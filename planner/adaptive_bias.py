@@ -59,6 +59,9 @@ SOFT_PX = 1.0
 FIT_RELIEF_GAIN = False
 #: Below this n·l a light is not expected to light the pixel (as the chooser's GRAZING_COS).
 FACING_COS = 0.15
+#: Whether the pixels the robust fit left unsolved are modelled with their least-squares
+#: normal (:func:`solve_unsolved`) rather than the level normal the chooser keeps for them.
+SOLVE_UNSOLVED = True
 
 #: ``fit(obs (L, P), lights (L, 3)) -> (normals (P, 3), valid (P,))``: the robust fit, or None
 #: when it refuses the light set (ill-conditioned). Any other error is a bug and propagates:
@@ -114,6 +117,58 @@ def _az_el(d: NDArray) -> tuple[NDArray, NDArray]:
     )
 
 
+def solve_unsolved(
+    obs: NDArray,
+    lights: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    albedo: NDArray[np.float64],
+    valid: NDArray[np.bool_],
+    dark: float,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+    """(normals, albedo, valid) with the pixels the robust fit left unsolved (``valid`` False)
+    solved by least squares on their lit observations (above ``dark``), where at least three
+    are and they determine a normal facing the camera (and then counted valid); the others as
+    given.
+
+    Why: the robust fit refuses a pixel whose lit lights are ill-conditioned (its
+    ``cond_limit``), and the chooser keeps such a pixel with a level normal and its brightest
+    observation as albedo — right for the bound (it is where the next light is most needed),
+    wrong as the object the designs are simulated on. On the simulator's 50°-tilted plane at 6
+    lights, the 4 starting lights leave one light on the far side of the plane and the other
+    three at condition ~116 (> 100): every pixel unsolved, the model a level plane 50° off,
+    whose simulated relighting ranked the floors wrongly (docs/adaptive.md, "Why the model
+    rendered a matte tilted plane wrongly"). Three lit lights do determine the normal (with the
+    noise amplified by their conditioning): a noisy tilted plane is the better model. Counted
+    valid, the pixels solved so are also evidence for the lobe, shadows and noise: left out,
+    the specular lobe of that tilted plane was fitted to the 2 pixels the robust fit solved
+    (ks 272, e 128 on a matte surface)."""
+    valid = np.asarray(valid, dtype=bool)
+    todo = np.flatnonzero(~valid)
+    if todo.size == 0:
+        return normals, albedo, valid
+    o = np.asarray(obs, dtype=np.float64)[:, todo].T  # (U, K)
+    w = (o > dark).astype(np.float64)
+    enough = w.sum(axis=1) >= 3
+    lt = np.asarray(lights, dtype=np.float64)
+    gram = np.einsum("uk,ki,kj->uij", w, lt, lt)  # (U, 3, 3) over each pixel's lit lights
+    rhs = np.einsum("uk,uk,ki->ui", w, o, lt)
+    det = np.linalg.det(gram)
+    ok = enough & (det > 1e-12)
+    normals = np.array(normals, dtype=np.float64, copy=True)
+    albedo = np.array(albedo, dtype=np.float64, copy=True)
+    if not ok.any():
+        return normals, albedo, valid
+    b = np.linalg.solve(gram[ok], rhs[ok][..., None])[..., 0]
+    rho = np.linalg.norm(b, axis=1)
+    good = (rho > 0) & (b[:, 2] > 0)
+    which = todo[ok][good]
+    normals[which] = b[good] / rho[good, None]
+    albedo[which] = rho[good]
+    valid = valid.copy()
+    valid[which] = True
+    return normals, albedo, valid
+
+
 def fit_object_model(
     obs: NDArray,
     lights: NDArray[np.float64],
@@ -124,8 +179,12 @@ def fit_object_model(
     noise_floor: float,
     relief: tuple[NDArray, NDArray, NDArray] | None = None,
 ) -> ObjectModel:
-    """The object's model from its K × P observations and the robust fit's normals/albedo."""
+    """The object's model from its K × P observations and the robust fit's normals/albedo
+    (the pixels it left unsolved solved by least squares where their lit lights allow:
+    :func:`solve_unsolved`, then counted valid)."""
     obs = np.asarray(obs, dtype=np.float64)  # (K, P)
+    if SOLVE_UNSOLVED:
+        normals, albedo, valid = solve_unsolved(obs, lights, normals, albedo, valid, dark)
     cos = (normals @ lights.T).T  # (K, P)
     lam = albedo[None, :] * np.maximum(cos, 0.0)
     resid = obs - lam

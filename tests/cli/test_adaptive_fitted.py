@@ -32,7 +32,7 @@ def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_by_default_a_session_records_the_fitted_decisions_it_takes(whole: Path) -> None:
     manifest = json.loads((whole / "manifest.json").read_text())
-    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/7"
+    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/8"
     adaptive = [d for d in decisions(whole) if d["kind"] == "adaptive"]
     assert len(adaptive) == N - 4
     # offered at every design decision, scored beside the floors

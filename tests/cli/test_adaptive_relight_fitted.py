@@ -31,7 +31,7 @@ def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path
     )
     assert r.exit_code == 0, r.output
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/7"
+    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/8"
     adaptive = [d for d in decisions(out) if d["kind"] == "adaptive"]
     assert len(adaptive) == 2
     for d in adaptive:

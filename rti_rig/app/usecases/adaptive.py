@@ -84,8 +84,12 @@ ARM_MAX_LIGHTS = 100
 #: ``design_psnr_db["fitted"]`` and a decision that takes it recording ``"design": "fitted"``
 #: (a /5 relight session's choices would differ); a design's reason giving the estimate
 #: beside the simulated error. (6 was written by development builds that had only some of
-#: these changes: refused like any other.)
-FORMAT = "rti-rig-adaptive/7"
+#: these changes: refused like any other.) 8: the object model the designs are simulated on
+#: solves the pixels the robust fit left unsolved by least squares where three lit lights
+#: determine them, and counts them as evidence for its lobe, shadows and noise
+#: (``planner.adaptive_bias.solve_unsolved``): a /7 session on a tilted object could have
+#: chosen on a level-plane model, so its choices would differ.
+FORMAT = "rti-rig-adaptive/8"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
