@@ -35,27 +35,39 @@ CHECK = (6, 9, 12, 18, 27, 40, 60)
 NEVER = 1e-6  # a target no estimate reaches
 
 
-def session(scene: str, cap: int) -> dict:
-    """One capped session on ``scene``: used lights, estimate after k, measured after k."""
+def session(scene: str, cap: int, draw: int = 0, seed: int = 0) -> dict:
+    """One capped session on ``scene``: used lights, estimate after k, measured after k.
+
+    Draw 0 offers all 240 candidates; draw d > 0 has ``SIM_REMOVED`` of them out (drawn with
+    ``seed``, per scene), as ``benchmarks.adaptive``'s simulator draws."""
+    from benchmarks.adaptive import SIM_REMOVED
     from benchmarks.tradeoff import TradeoffSettings, normal_error, render_scene_data
 
     settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     data = render_scene_data(scene, settings)
-    cand = data.candidate_dirs
-    grey = data.candidate_images.mean(axis=-1)
-    full = DomeGeometry(cand, tuple(f"c{i:03d}" for i in range(len(cand))))
+    cand_all = data.candidate_dirs
+    keep = np.arange(len(cand_all))
+    if draw > 0:
+        si = settings.scenes.index(scene)
+        rng = np.random.default_rng([seed, si, draw])
+        keep = np.sort(rng.choice(len(cand_all), len(cand_all) - SIM_REMOVED, replace=False))
+    cand = cand_all[keep]
+    images = data.candidate_images[keep]
+    grey = images.mean(axis=-1)
+    full = DomeGeometry(cand, tuple(f"c{i:03d}" for i in keep))
     t0 = time.perf_counter()
     used, est, dt = adaptive_run(grey, cand, full, cap, until=NEVER, scale=1.0)
     seconds = time.perf_counter() - t0
     idx = np.array(used)
     measured = {
-        k: normal_error(data.normals, data.candidate_images[idx[:k]], cand[idx[:k]])[0]
+        k: normal_error(data.normals, images[idx[:k]], cand[idx[:k]])[0]
         for k in range(4, len(used) + 1)
     }
     raw = {k: v for k, v in est.items() if isinstance(k, int)}
     elev = np.degrees(np.arcsin(np.clip(cand[idx, 2], -1, 1)))
     return {
         "scene": scene,
+        "draw": draw,
         "used": used,
         "raw": raw,
         "measured": measured,
@@ -65,14 +77,35 @@ def session(scene: str, cap: int) -> dict:
     }
 
 
+def _name(s: dict) -> str:
+    return s["scene"] if not s.get("draw") else f"{s['scene']} #{s['draw']}"
+
+
+def save_traces(path: Path, sessions: list[dict]) -> None:
+    """Each session's raw estimate (simulated error, factor 1) and measured error per light
+    count, as JSON (``benchmarks.adaptive_until_bound`` reads it)."""
+    import json
+
+    rows = [
+        {
+            "scene": s["scene"],
+            "draw": s["draw"],
+            "used": [int(u) for u in s["used"]],
+            "raw": {str(k): float(v) for k, v in s["raw"].items()},
+            "measured": {str(k): float(v) for k, v in s["measured"].items()},
+        }
+        for s in sessions
+    ]
+    path.write_text(json.dumps({"source": "sim", "sessions": rows}, indent=1))
+
+
 def loo_scales(sessions: list[dict]) -> dict[str, float]:
     """Per scene: the factor fitted on the other scenes (log least squares, k ≥ 6)."""
-    pairs = {
-        s["scene"]: [
+    pairs: dict[str, list[tuple[float, float]]] = {}
+    for s in sessions:
+        pairs.setdefault(s["scene"], []).extend(
             (s["raw"][k], s["measured"][k]) for k in s["measured"] if k >= 6 and k in s["raw"]
-        ]
-        for s in sessions
-    }
+        )
     out = {}
     for scene in pairs:
         logs = [np.log(m / r) for o, ps in pairs.items() if o != scene for r, m in ps if r > 0]
@@ -125,7 +158,7 @@ def report(
                 cells.append(f"{scale * s['raw'][k]:.2f} / {s['measured'][k]:.2f}")
             else:
                 cells.append("")
-        lines.append(f"| {s['scene']} | " + " | ".join(cells) + f" | {s['decision_s']:.2f} s |")
+        lines.append(f"| {_name(s)} | " + " | ".join(cells) + f" | {s['decision_s']:.2f} s |")
     lines += [
         "",
         "The stop per target (estimate with the shipped factor; the last column with the factor "
@@ -144,7 +177,7 @@ def report(
             why = "" if e is not None and e <= t else " (cap)"
             why2 = "" if e2 is not None and e2 <= t else " (cap)"
             lines.append(
-                f"| {s['scene']} | {t:g}° | {k}{why} | {'' if e is None else f'{e:.2f}°'} | "
+                f"| {_name(s)} | {t:g}° | {k}{why} | {'' if e is None else f'{e:.2f}°'} | "
                 f"{m:.2f}° | ×{m / e:.2f} | ×{loo[s['scene']]:.3f}: {k2}{why2}, "
                 f"{'' if e2 is None else f'{e2:.2f}°'}, {m2:.2f}° |"
             )
@@ -163,6 +196,17 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument("--greedy", action="store_true", help="format 5's light-by-light choice")
     ap.add_argument("--write", action="store_true", help="write the tables into docs/adaptive.md")
     ap.add_argument("--guesses", default="", help="comma-separated guessed N (to compare)")
+    ap.add_argument(
+        "--draws", type=int, default=1, help="sessions per scene (draw d > 0: 24 candidates out)"
+    )
+    ap.add_argument("--seed", type=int, default=0, help="the draws' seed")
+    ap.add_argument(
+        "--traces",
+        type=Path,
+        default=None,
+        help="write every session's raw estimate and measured error per light count (JSON: "
+        "what benchmarks.adaptive_until_bound chooses the stop's upper factor from)",
+    )
     ap.add_argument(
         "--first-start",
         action="store_true",
@@ -184,11 +228,16 @@ def main(argv: list[str] | None = None) -> str:
     targets = tuple(float(t) for t in args.targets.split(","))
     t0 = time.perf_counter()
     sessions = []
-    for scene in args.scenes.split(","):
-        s = session(scene, args.cap)
+    for scene, draw in (
+        (sc, d) for sc in args.scenes.split(",") for d in range(args.draws)
+    ):
+        s = session(scene, args.cap, draw, args.seed)
         sessions.append(s)
+        if args.traces is not None:  # after each session: a long run keeps what it measured
+            save_traces(args.traces, sessions)
         print(
-            f"{scene}: {s['seconds']:.0f} s; elevations {np.round(s['elev']).astype(int).tolist()}",
+            f"{scene} draw {draw}: {s['seconds']:.0f} s; elevations "
+            f"{np.round(s['elev']).astype(int).tolist()}",
             flush=True,
         )
         print(
@@ -203,6 +252,7 @@ def main(argv: list[str] | None = None) -> str:
     cmd = (
         f"python -m benchmarks.adaptive_until_sim --scenes {args.scenes} --cap {args.cap} "
         f"--targets {args.targets}"
+        + (f" --draws {args.draws} --seed {args.seed}" if args.draws > 1 else "")
         + (" --greedy" if args.greedy else "")
         + (f" --guesses {args.guesses}" if args.guesses else "")
     )

@@ -124,8 +124,9 @@ def test_until_error_stops_when_the_estimate_is_reached(
     r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--until-error", "1e-9"])
     assert r.exit_code == 0, r.output
     assert manifest(ref)["adaptive"]["design_lights"] is None
-    est = {i: s["decision"]["estimated_error_deg"] for i, s in enumerate(journal(ref)) if i >= 4}
-    est[8] = est.get(8) or manifest(ref)["adaptive"]["result"]["estimated_error_deg"]
+    # the stop compares the upper estimate (point × upper factor) with the target
+    est = {i: s["decision"]["upper_error_deg"] for i, s in enumerate(journal(ref)) if i >= 4}
+    est[8] = est.get(8) or manifest(ref)["adaptive"]["result"]["upper_error_deg"]
     k = next(i for i in range(5, 9) if est[i] < min(est[j] for j in range(4, i)))
     target = (est[k] + min(est[j] for j in range(4, k))) / 2
     out = tmp_path / "s"
@@ -135,14 +136,17 @@ def test_until_error_stops_when_the_estimate_is_reached(
     assert m["adaptive"]["result"]["lights_used"] == k
     stop = m["adaptive"]["result"]["stop"]
     assert stop["kind"] == "stop" and f"--until-error {target:g}" in stop["reason"]
-    assert stop["estimated_error_deg"] <= target
+    assert stop["upper_error_deg"] <= target
+    assert stop["upper_error_deg"] == pytest.approx(
+        stop["upper_factor"] * stop["estimated_error_deg"], abs=1e-3
+    )
     assert len(read_lp(out / "lights.lp")) == k
     assert (out / "lights.lp").read_text().splitlines()[1:] == (
         ref / "lights.lp"
     ).read_text().splitlines()[1 : k + 1]
     r = runner.invoke(app, ["run", "--resume", str(out)])  # it chose to stop: nothing to do
     assert r.exit_code == 2
-    assert f"stopped after {k} of at most 12 lights (estimated error" in said(r)
+    assert f"stopped after {k} of at most 12 lights (upper estimate" in said(r)
     # --lights and --until-error together: the first reached stops
     out2 = tmp_path / "s2"
     r = runner.invoke(
@@ -204,7 +208,7 @@ def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(
     "old",
-    [f"rti-rig-adaptive/{k}" for k in range(1, 7)],
+    [f"rti-rig-adaptive/{k}" for k in range(1, 8)],
 )
 def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     uninterrupted: tuple[Path, Path], tmp_path: Path, old: str
@@ -229,7 +233,7 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
-    assert f"'{old}'" in text and "rti-rig-adaptive/7" in text
+    assert f"'{old}'" in text and "rti-rig-adaptive/8" in text
     assert "export-lp" in text and "new session" in text
     # refused from the manifest: nothing in the folder changed (journal not repaired, nothing
     # set aside), not a byte

@@ -45,7 +45,7 @@ def test_the_relight_objective_is_in_the_settings_and_every_decision(relight_ses
     assert all(s["decision"]["objective"] == "relight" for s in steps)
     header = manifest(relight_session)["adaptive"]
     assert header["result"]["objective"] == "relight"
-    assert header["objective"] == "relight" and header["format"] == FORMAT == "rti-rig-adaptive/7"
+    assert header["objective"] == "relight" and header["format"] == FORMAT == "rti-rig-adaptive/8"
     for s in steps[4:]:
         d = s["decision"]
         assert d["kind"] == "adaptive" and d["design_objective"] == "relight"
