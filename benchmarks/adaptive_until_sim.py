@@ -251,9 +251,7 @@ def main(argv: list[str] | None = None) -> str:
     targets = tuple(float(t) for t in args.targets.split(","))
     t0 = time.perf_counter()
     sessions = []
-    for scene, draw in (
-        (sc, d) for sc in args.scenes.split(",") for d in range(args.draws)
-    ):
+    for scene, draw in ((sc, d) for sc in args.scenes.split(",") for d in range(args.draws)):
         s = session(scene, args.cap, draw, args.seed)
         sessions.append(s)
         if args.traces is not None:  # after each session: a long run keeps what it measured

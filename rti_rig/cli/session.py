@@ -95,8 +95,9 @@ def run(
         float | None,
         typer.Option(
             "--until-error",
-            help="Adaptive: stop once the estimated mean normal error is at most this many "
-            "degrees (with --lights: whichever comes first).",
+            help="Adaptive: stop once the upper estimate of the mean normal error (the "
+            "estimate × a factor calibrated on the simulator, docs/adaptive.md) is at most "
+            "this many degrees (with --lights: whichever comes first).",
         ),
     ] = None,
     objective: Annotated[
