@@ -164,6 +164,31 @@ def test_an_interrupted_until_error_session_resumes_to_the_same_session(
     assert (out / "lights.lp").read_text() == (ref / "lights.lp").read_text()
 
 
+def test_a_resumed_session_keeps_the_upper_factor_it_began_with(
+    never_reached: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """The target means the same to the end of a session: a resume compares the upper
+    estimate with the factor the manifest recorded, not this version's, and says so in every
+    later decision and the result (the choices do not depend on it: the same lights)."""
+    import json
+
+    cfg, ref = never_reached
+    out = tmp_path / "cut"
+    interrupted(cfg, out, 6, lights=None, until=1e-9)
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["adaptive"]["upper_factor"] == UPPER_FACTOR
+    m["adaptive"]["upper_factor"] = 3.0  # as a session begun by a version with another factor
+    (out / "manifest.json").write_text(json.dumps(m))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    steps = journal(out)
+    assert [s["led"] for s in steps] == [s["led"] for s in journal(ref)]
+    assert {s["decision"]["upper_factor"] for s in steps[7:]} == {3.0}
+    result = manifest(out)["adaptive"]["result"]
+    assert result["upper_factor"] == 3.0
+    assert result["upper_error_deg"] == pytest.approx(3.0 * result["estimated_error_deg"], abs=1e-3)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("target", "lights"), [(2.0, 18), (0.3, None), (0.3, 18)])
 def test_the_shipped_simulated_dome_stops_where_its_estimate_reaches_the_target(

@@ -606,7 +606,12 @@ class AdaptiveSteps:
     """The controller's step source for an adaptive session (see the module docstring)."""
 
     def __init__(  # type: ignore[no-untyped-def]
-        self, rig, plan: AdaptivePlan, until_error_deg: float | None, objective: str = "normals"
+        self,
+        rig,
+        plan: AdaptivePlan,
+        until_error_deg: float | None,
+        objective: str = "normals",
+        upper_factor: float | None = None,
     ) -> None:
         self.plan = plan
         self.until_error_deg = until_error_deg
@@ -629,6 +634,7 @@ class AdaptiveSteps:
             move_times=move,
             design_lights=plan.design_lights,
             objective=objective,
+            upper_factor=upper_factor,
         )
         self._pending: dict[int, int] = {}
 
@@ -855,6 +861,9 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
             f"{folder.root}: the rig now offers {len(plan.candidates)} candidate lights, the "
             f"session began with {header['candidates']}: it cannot continue as it began"
         )
-    source = AdaptiveSteps(rig, plan, header.get("until_error_deg"), began)
+    # the stop's factor the session began with (its target means the same to the end)
+    source = AdaptiveSteps(
+        rig, plan, header.get("until_error_deg"), began, header.get("upper_factor")
+    )
     source.replay(folder)
     return source
