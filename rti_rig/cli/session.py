@@ -95,8 +95,9 @@ def run(
         float | None,
         typer.Option(
             "--until-error",
-            help="Adaptive: stop once the estimated mean normal error is at most this many "
-            "degrees (with --lights: whichever comes first).",
+            help="Adaptive: stop once the upper estimate of the mean normal error (the "
+            "estimate × a factor calibrated on the simulator, docs/adaptive.md) is at most "
+            "this many degrees (with --lights: whichever comes first).",
         ),
     ] = None,
     objective: Annotated[
@@ -322,13 +323,13 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
     adaptive_result = opened.extra.get("adaptive_result")
     if adaptive_result is not None:
-        est = adaptive_result["estimated_error_deg"]
+        from rti_rig.app.usecases.adaptive import estimate_phrase
+
         chosen_for = adaptive_result.get("objective", "normals")
         out.print(
             ("Adaptive" if chosen_for == "normals" else f"Adaptive (designs for {chosen_for})")
             + f": {adaptive_result['lights_used']} lights; stopped: "
-            f"{adaptive_result['stop']['reason']}; estimated mean normal error "
-            f"{'n/a' if est is None else f'{est:.2f}°'}",
+            f"{adaptive_result['stop']['reason']}; {estimate_phrase(adaptive_result)}",
             highlight=False,
         )
     if result.finish_reason is FinishReason.CANCELLED:

@@ -124,8 +124,9 @@ def test_until_error_stops_when_the_estimate_is_reached(
     r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--until-error", "1e-9"])
     assert r.exit_code == 0, r.output
     assert manifest(ref)["adaptive"]["design_lights"] is None
-    est = {i: s["decision"]["estimated_error_deg"] for i, s in enumerate(journal(ref)) if i >= 4}
-    est[8] = est.get(8) or manifest(ref)["adaptive"]["result"]["estimated_error_deg"]
+    # the stop compares the upper estimate (point × upper factor) with the target
+    est = {i: s["decision"]["upper_error_deg"] for i, s in enumerate(journal(ref)) if i >= 4}
+    est[8] = est.get(8) or manifest(ref)["adaptive"]["result"]["upper_error_deg"]
     k = next(i for i in range(5, 9) if est[i] < min(est[j] for j in range(4, i)))
     target = (est[k] + min(est[j] for j in range(4, k))) / 2
     out = tmp_path / "s"
@@ -135,14 +136,17 @@ def test_until_error_stops_when_the_estimate_is_reached(
     assert m["adaptive"]["result"]["lights_used"] == k
     stop = m["adaptive"]["result"]["stop"]
     assert stop["kind"] == "stop" and f"--until-error {target:g}" in stop["reason"]
-    assert stop["estimated_error_deg"] <= target
+    assert stop["upper_error_deg"] <= target
+    assert stop["upper_error_deg"] == pytest.approx(
+        stop["upper_factor"] * stop["estimated_error_deg"], abs=1e-3
+    )
     assert len(read_lp(out / "lights.lp")) == k
     assert (out / "lights.lp").read_text().splitlines()[1:] == (
         ref / "lights.lp"
     ).read_text().splitlines()[1 : k + 1]
     r = runner.invoke(app, ["run", "--resume", str(out)])  # it chose to stop: nothing to do
     assert r.exit_code == 2
-    assert f"stopped after {k} of at most 12 lights (estimated error" in said(r)
+    assert f"stopped after {k} of at most 12 lights (upper estimate" in said(r)
     # --lights and --until-error together: the first reached stops
     out2 = tmp_path / "s2"
     r = runner.invoke(
@@ -276,6 +280,14 @@ def test_a_session_begun_under_other_constants_is_refused_by_name(
     assert "planner.adaptive_optimal.SEARCH_PIXELS 500 → 400" in text
     assert "export-lp" in text and "Traceback" not in text
     assert files() == before
+    # the stop's factor is taken from the session's own settings: no reason to refuse
+    from rti_rig.planner import adaptive_until
+
+    monkeypatch.undo()
+    monkeypatch.setattr(adaptive_until, "UPPER_FACTOR", 2.5)
+    from rti_rig.app.usecases.adaptive_constants import constant_differences, decision_constants
+
+    assert constant_differences(manifest(out)["adaptive"]["constants"], decision_constants()) == []
     monkeypatch.undo()  # the build that began it continues it
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output

@@ -2,7 +2,8 @@
 
 Each light is chosen within the design for a guessed N that grows
 (``rti_rig.planner.adaptive_until``), recorded with the guess, the design and its score; the
-session stops at the first light whose estimate reaches the target; an interrupted session
+session stops at the first light whose *upper* estimate reaches the target (format 8: the point
+estimate × ``UPPER_FACTOR``, both recorded); an interrupted session
 resumes to the same session; the shipped simulated dome stops where its estimates say.
 """
 
@@ -17,7 +18,7 @@ from typer.testing import CliRunner
 from rti_rig.cli import app
 from rti_rig.core.lp_format import read_lp
 from rti_rig.planner.adaptive import SIM_ESTIMATE_SCALE
-from rti_rig.planner.adaptive_until import GUESSES, guessed_lights
+from rti_rig.planner.adaptive_until import GUESSES, UPPER_FACTOR, guessed_lights
 from rti_rig.runtime.controller import FinishReason
 
 runner = CliRunner()
@@ -31,7 +32,57 @@ def never_reached(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]
     out = base / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", "1e-9"])
     assert r.exit_code == 0, r.output
+    (out.parent / "said.txt").write_text(said(r))
     return cfg, out
+
+
+def test_every_decision_the_stop_and_the_result_record_the_point_and_upper_estimates(
+    never_reached: tuple[Path, Path],
+) -> None:
+    """What the stop compared is data: the point estimate, the upper one and the factor
+    between them, in each decision (journal), the stop and the result (manifest), the factor
+    in the settings; and the CLI's final message gives both estimates."""
+    _, out = never_reached
+    m = manifest(out)["adaptive"]
+    assert m["upper_factor"] == UPPER_FACTOR > 1.0
+    for s in journal(out)[4:]:
+        d = s["decision"]
+        assert d["upper_factor"] == UPPER_FACTOR
+        assert d["upper_error_deg"] == pytest.approx(
+            UPPER_FACTOR * d["estimated_error_deg"], abs=1e-3
+        )
+    result = m["result"]
+    for rec in (result, result["stop"]):
+        assert rec["upper_error_deg"] == pytest.approx(
+            UPPER_FACTOR * rec["estimated_error_deg"], abs=1e-3
+        )
+    text = (out.parent / "said.txt").read_text()
+    assert (
+        f"estimated mean normal error {result['estimated_error_deg']:.2f}°, upper estimate "
+        f"{result['upper_error_deg']:.2f}° (×{UPPER_FACTOR:g}: what --until-error is compared "
+        "with)"
+    ) in text
+
+
+def test_a_point_estimate_under_the_target_does_not_claim_it(
+    never_reached: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """A target between the first decision's point estimate and its upper one: format 7 (the
+    point estimate) stopped there, at 4 lights; the upper estimate is above it, so the session
+    goes on, and every light it shot was decided with an upper estimate above the target."""
+    cfg, ref = never_reached
+    first = journal(ref)[4]["decision"]
+    assert first["estimated_error_deg"] < first["upper_error_deg"]
+    target = (first["estimated_error_deg"] + first["upper_error_deg"]) / 2
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", f"{target!r}"])
+    assert r.exit_code == 0, r.output
+    result = manifest(out)["adaptive"]["result"]
+    assert result["lights_used"] > 4
+    for s in journal(out)[4:]:
+        assert s["decision"]["upper_error_deg"] > target
+    stop = result["stop"]
+    assert stop["upper_error_deg"] <= target or result["lights_used"] == 12
 
 
 def test_guessed_lights_grow_through_the_series_and_stop_at_the_rig() -> None:
@@ -66,7 +117,10 @@ def test_each_light_is_chosen_within_the_design_for_the_guessed_n(
         assert f"{sim:.3g}° simulated, {SIM_ESTIMATE_SCALE * sim:.3g}° estimated" in d["reason"]
     # the guess grows 6 → 9 → 12 as each design is shot
     assert [s["decision"]["guessed_lights"] for s in steps[4:]] == [6, 6, 9, 9, 9, 12, 12, 12]
-    assert m["adaptive"]["result"]["stop"]["reason"] == "reached its maximum of 12 lights"
+    assert m["adaptive"]["result"]["stop"]["reason"].startswith(
+        "reached its maximum of 12 lights before --until-error 1e-09° was reached (upper estimate"
+    )
+    assert "the target is not claimed" in m["adaptive"]["result"]["stop"]["reason"]
 
 
 def test_the_session_stops_at_the_first_light_whose_estimate_reaches_the_target(
@@ -75,8 +129,9 @@ def test_the_session_stops_at_the_first_light_whose_estimate_reaches_the_target(
     """Decisions do not depend on the target, only the stop: a target set between two
     estimates of the session that never stops must stop exactly there."""
     cfg, ref = never_reached
-    est = {i: s["decision"]["estimated_error_deg"] for i, s in enumerate(journal(ref)) if i >= 4}
-    est[12] = manifest(ref)["adaptive"]["result"]["estimated_error_deg"]
+    # the stop compares the upper estimate (point × upper factor) with the target
+    est = {i: s["decision"]["upper_error_deg"] for i, s in enumerate(journal(ref)) if i >= 4}
+    est[12] = manifest(ref)["adaptive"]["result"]["upper_error_deg"]
     k = next(i for i in range(5, 13) if est[i] < min(est[j] for j in range(4, i)))
     target = (est[k] + min(est[j] for j in range(4, k))) / 2
     out = tmp_path / "s"
@@ -84,7 +139,7 @@ def test_the_session_stops_at_the_first_light_whose_estimate_reaches_the_target(
     assert r.exit_code == 0, r.output
     result = manifest(out)["adaptive"]["result"]
     assert result["lights_used"] == k == len(read_lp(out / "lights.lp"))
-    assert result["stop"]["estimated_error_deg"] <= target
+    assert result["stop"]["upper_error_deg"] <= target
     assert [s["led"] for s in journal(out)] == [s["led"] for s in journal(ref)][:k]
 
 
@@ -107,6 +162,31 @@ def test_an_interrupted_until_error_session_resumes_to_the_same_session(
 
     assert choices(out) == choices(ref)
     assert (out / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+
+
+def test_a_resumed_session_keeps_the_upper_factor_it_began_with(
+    never_reached: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """The target means the same to the end of a session: a resume compares the upper
+    estimate with the factor the manifest recorded, not this version's, and says so in every
+    later decision and the result (the choices do not depend on it: the same lights)."""
+    import json
+
+    cfg, ref = never_reached
+    out = tmp_path / "cut"
+    interrupted(cfg, out, 6, lights=None, until=1e-9)
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["adaptive"]["upper_factor"] == UPPER_FACTOR
+    m["adaptive"]["upper_factor"] = 3.0  # as a session begun by a version with another factor
+    (out / "manifest.json").write_text(json.dumps(m))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    steps = journal(out)
+    assert [s["led"] for s in steps] == [s["led"] for s in journal(ref)]
+    assert {s["decision"]["upper_factor"] for s in steps[7:]} == {3.0}
+    result = manifest(out)["adaptive"]["result"]
+    assert result["upper_factor"] == 3.0
+    assert result["upper_error_deg"] == pytest.approx(3.0 * result["estimated_error_deg"], abs=1e-3)
 
 
 @pytest.mark.slow
@@ -132,7 +212,11 @@ def test_the_shipped_simulated_dome_stops_where_its_estimate_reaches_the_target(
     assert m["design_lights"] == lights and m["until_error_deg"] == target
     for k, s in enumerate(steps[4:], start=4):
         d = s["decision"]
-        assert d["estimated_error_deg"] > target  # it did not stop: the estimate was above
+        # it did not stop: the upper estimate was above (the point one may be under)
+        assert d["upper_error_deg"] > target
+        assert d["upper_error_deg"] == pytest.approx(
+            d["upper_factor"] * d["estimated_error_deg"], abs=1e-3
+        )
         guess = None if lights is not None else guessed_lights(k, m["max_lights"])
         assert d.get("guessed_lights") == guess
     if target < 1.0:
@@ -140,11 +224,13 @@ def test_the_shipped_simulated_dome_stops_where_its_estimate_reaches_the_target(
     stop = m["result"]["stop"]
     cap = m["max_lights"]
     if used < cap:
-        assert stop["estimated_error_deg"] <= target
+        assert stop["upper_error_deg"] <= target
         assert f"--until-error {target:g}°" in stop["reason"]
     else:
-        assert stop["reason"] == f"reached its maximum of {cap} lights"
+        assert stop["reason"].startswith(f"reached its maximum of {cap} lights before")
+        assert stop["upper_error_deg"] > target  # not claimed
     assert f"Adaptive: {used} lights" in said(r)
+    assert f"upper estimate {m['result']['upper_error_deg']:.2f}° (×{UPPER_FACTOR:g}" in said(r)
 
 
 def test_an_arm_with_only_until_error_chooses_within_growing_designs_and_counts_moves(
@@ -161,8 +247,8 @@ def test_an_arm_with_only_until_error_chooses_within_growing_designs_and_counts_
     for k, s in enumerate(steps[4:], start=4):
         d = s["decision"]
         assert d["guessed_lights"] == guessed_lights(k, m["max_lights"])
-        assert d["estimated_error_deg"] > 0.2
+        assert d["upper_error_deg"] > 0.2
         assert all(c["move_s"] >= 0 for c in d["best_candidates"])
         assert any(c["move_s"] > 0 for c in d["best_candidates"])  # an arm's moves are counted
     stop = m["result"]["stop"]
-    assert len(steps) == m["max_lights"] or stop["estimated_error_deg"] <= 0.2
+    assert len(steps) == m["max_lights"] or stop["upper_error_deg"] <= 0.2

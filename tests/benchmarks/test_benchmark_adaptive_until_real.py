@@ -25,12 +25,25 @@ def test_report_summarises_each_target() -> None:
         _row(4.0, 11, 3.6, 3.6),
     ]
     text = report(rows, "python -m benchmarks.adaptive_until_real", 1.0)
-    lines = {ln.split(" |")[0]: ln for ln in text.splitlines() if ln.startswith("| ")}
-    two = lines["| 2°"]
+    # without a factor: the stop on the point estimate (format 7)
+    lines = {ln.split(" |")[1]: ln for ln in text.splitlines() if ln.startswith("| point")}
+    two = lines[" 2°"]
     assert "| 2 | 45 (30–60) |" in two  # draws, median and range of lights
     assert "2.20°" in two and "2.52°" in two  # mean estimate, mean measured
     assert "×1.00 (0.50–2.00)" in two  # geometric mean and range of measured / estimate
     assert "1 of 2" in two  # measured above the target
     assert "estimate reached 1, cap 1" in two
-    four = lines["| 4°"]
+    four = lines[" 4°"]
     assert "×1.00 (1.00–1.00)" in four and "0 of 1" in four and "estimate reached 1, cap 0" in four
+
+
+def test_report_separates_the_point_and_upper_stops() -> None:
+    rows = [
+        {**_row(2.0, 30, 1.9, 3.8), "factor": 1.0},
+        {**_row(2.0, 60, 1.2, 1.5), "factor": 2.0, "reached": False},
+    ]
+    text = report(rows, "python -m benchmarks.adaptive_until_real", 1.0)
+    point = next(ln for ln in text.splitlines() if ln.startswith("| point estimate | 2°"))
+    upper = next(ln for ln in text.splitlines() if ln.startswith("| upper (point × 2) | 2°"))
+    assert "1 of 1" in point and "estimate reached 1, cap 0" in point
+    assert "0 of 1" in upper and "upper reached 0, cap 1" in upper

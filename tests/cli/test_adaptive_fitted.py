@@ -1,6 +1,6 @@
 """The fitted design (``optimal`` on the surface fitted so far, ``planner.adaptive_optimal``)
 offered by default through the front door: `rti-rig run ACQ/dirs.lp --adaptive --lights N`
-records the decisions that take it as ``"design": "fitted"`` (format rti-rig-adaptive/7; /5
+records the decisions that take it as ``"design": "fitted"`` (format rti-rig-adaptive/8; /5
 before the relight objective was offered its own), and an interrupted session that took it
 resumes to the very same session."""
 

@@ -1,7 +1,7 @@
 """The fitted relight design (``optimal --objective relight`` on the object model fitted so far,
 ``planner.adaptive_relight_design``) offered to ``--objective relight`` through the front door:
 `rti-rig run RIG --adaptive --lights N --objective relight` scores it beside the floors' designs
-at every decision (format rti-rig-adaptive/7), records a decision that takes it as
+at every decision (format rti-rig-adaptive/8), records a decision that takes it as
 ``"design": "fitted"``, and an interrupted session that took it resumes to the same session."""
 
 from __future__ import annotations

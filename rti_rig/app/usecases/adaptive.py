@@ -57,7 +57,7 @@ from rti_rig.planner.adaptive import (
 )
 from rti_rig.planner.adaptive_bias import simulate_error_deg
 from rti_rig.planner.adaptive_relight import OBJECTIVES
-from rti_rig.planner.adaptive_until import choose_until
+from rti_rig.planner.adaptive_until import UPPER_FACTOR, choose_until, upper_error_deg
 from rti_rig.planner.objectives import candidates_for, snap_unique
 from rti_rig.planner.uniform import select_uniform_leds
 
@@ -88,7 +88,12 @@ ARM_MAX_LIGHTS = 100
 #: solves the pixels the robust fit left unsolved by least squares where three lit lights
 #: determine them, and counts them as evidence for its lobe, shadows and noise
 #: (``planner.adaptive_bias.solve_unsolved``): a /7 session on a tilted object could have
-#: chosen on a level-plane model, so its choices would differ.
+#: chosen on a level-plane model; the stop claims --until-error only when the *upper*
+#: estimate (the point estimate × ``planner.adaptive_until.UPPER_FACTOR``) is under it, and
+#: every decision, the stop and the result record both estimates and the factor
+#: (``upper_error_deg``, ``upper_factor``; a /7 session stopped on the point estimate); the
+#: settings record every decision constant (``constants``, checked on resume), and a relight
+#: design with no light left out records a null PSNR.
 FORMAT = "rti-rig-adaptive/8"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
@@ -289,7 +294,10 @@ class AdaptiveChooser:
         design_lights: int | None = None,
         bias_aware: bool | None = None,
         objective: str = "normals",
+        upper_factor: float | None = None,
     ) -> None:
+        #: the stop's upper estimate = the point estimate × this (None: UPPER_FACTOR)
+        self.upper_factor = UPPER_FACTOR if upper_factor is None else upper_factor
         #: the design score and the estimate: a robust fit simulated on this object's model
         #: (None: BIAS_AWARE), else the Lambertian variance bound
         self.bias_aware = BIAS_AWARE if bias_aware is None else bias_aware
@@ -350,6 +358,44 @@ class AdaptiveChooser:
         """The calibrated estimate of the mean normal error (°) now: ``scale`` × raw."""
         return self.scale * self.raw_estimate(state)
 
+    def upper(self, estimate_deg: float) -> float:
+        """The upper estimate (°) the stop compares with the target: the point estimate ×
+        ``upper_factor`` (``planner.adaptive_until.upper_error_deg``)."""
+        return upper_error_deg(estimate_deg, self.upper_factor)
+
+    def stop_terms(self, estimate_deg: float | None) -> dict[str, Any]:
+        """What the stop compares, for the record: the point estimate, the upper one and the
+        factor between them (None estimates before anything can be fitted)."""
+        return {
+            "estimated_error_deg": None if estimate_deg is None else round(estimate_deg, 4),
+            "upper_error_deg": (
+                None if estimate_deg is None else round(self.upper(estimate_deg), 4)
+            ),
+            "upper_factor": self.upper_factor,
+        }
+
+    def _cap_stop(self, est: float | None) -> dict[str, Any]:
+        """The stop at the session's maximum, with what the stop compared; with
+        --until-error, whether the last light reached the target too or the target is not
+        claimed (so that a capped session is not read as having reached it)."""
+        reason = self._cap_reason()
+        if self.until_error_deg is not None and est is not None:
+            up = self.upper(est)
+            if up <= self.until_error_deg:  # the last light reached the target as well
+                reason = self._reached_reason(est)
+            else:
+                reason += (
+                    f" before --until-error {self.until_error_deg:g}° was reached (upper "
+                    f"estimate {up:.2f}°: the target is not claimed)"
+                )
+        return {"kind": "stop", "reason": reason, **self.stop_terms(est)}
+
+    def _reached_reason(self, est: float) -> str:
+        return (
+            f"upper estimate {self.upper(est):.2f}° (estimate {est:.2f}° × "
+            f"{self.upper_factor:g}) ≤ --until-error {self.until_error_deg:g}°"
+        )
+
     def _cap_reason(self) -> str:
         # --lights N, or without it the rig's own cap: both are the session's maximum
         return f"reached its maximum of {self.max_lights} lights"
@@ -374,11 +420,7 @@ class AdaptiveChooser:
         state = self.state()
         if index >= self.max_lights:
             est = None if state is None else self.estimate(state)
-            self.stop_evidence = {
-                "kind": "stop",
-                "reason": self._cap_reason(),
-                "estimated_error_deg": None if est is None else round(est, 4),
-            }
+            self.stop_evidence = self._cap_stop(est)
             return None, self.stop_evidence
         if state is None:  # the starting layout cannot be fitted: fall back to coverage
             available = np.ones(len(self.candidates), dtype=bool)
@@ -390,11 +432,13 @@ class AdaptiveChooser:
             pick = int(far[0] if dots is None else far[np.argmin(dots.max(axis=1))])
             return pick, {"kind": "coverage", "reason": "fit not yet possible: farthest light"}
         est = self.estimate(state)
-        if self.until_error_deg is not None and est <= self.until_error_deg:
+        up = self.upper(est)
+        if self.until_error_deg is not None and up <= self.until_error_deg:
+            # the target is claimed only when the upper estimate is under it
             self.stop_evidence = {
                 "kind": "stop",
-                "reason": f"estimated error {est:.2f}° ≤ --until-error {self.until_error_deg:g}°",
-                "estimated_error_deg": round(est, 4),
+                "reason": self._reached_reason(est),
+                **self.stop_terms(est),
             }
             return None, self.stop_evidence
         available = np.ones(len(self.candidates), dtype=bool)
@@ -455,11 +499,12 @@ class AdaptiveChooser:
                 ],
             )
         if d.candidate is None:
-            self.stop_evidence = {"kind": "stop", **d.evidence()}
+            self.stop_evidence = {"kind": "stop", **d.evidence(), **self.stop_terms(est)}
             return None, self.stop_evidence
         return d.candidate, {
             "kind": "adaptive",
             **d.evidence(),
+            **self.stop_terms(est),  # what the stop compared before this light (not reached)
             "decision_s": round(time.perf_counter() - t0, 4),
         }
 
@@ -473,8 +518,9 @@ class AdaptiveChooser:
         return {
             "objective": self.objective,
             "lights_used": len(self.used),
-            "estimated_error_deg": None if est is None else round(est, 4),
-            "stop": self.stop_evidence or {"kind": "stop", "reason": self._cap_reason()},
+            **self.stop_terms(est),
+            # a session run to its maximum is never asked for the step past it: the stop here
+            "stop": self.stop_evidence or self._cap_stop(est),
         }
 
 
@@ -571,7 +617,12 @@ class AdaptiveSteps:
     """The controller's step source for an adaptive session (see the module docstring)."""
 
     def __init__(  # type: ignore[no-untyped-def]
-        self, rig, plan: AdaptivePlan, until_error_deg: float | None, objective: str = "normals"
+        self,
+        rig,
+        plan: AdaptivePlan,
+        until_error_deg: float | None,
+        objective: str = "normals",
+        upper_factor: float | None = None,
     ) -> None:
         self.plan = plan
         self.until_error_deg = until_error_deg
@@ -594,6 +645,7 @@ class AdaptiveSteps:
             move_times=move,
             design_lights=plan.design_lights,
             objective=objective,
+            upper_factor=upper_factor,
         )
         self._pending: dict[int, int] = {}
 
@@ -616,6 +668,7 @@ class AdaptiveSteps:
             "candidates": len(self.plan.candidates),
             "fit_px": FIT_PX,
             "estimate_scale": self.chooser.scale,
+            "upper_factor": self.chooser.upper_factor,
             "constants": decision_constants(),
         }
 
@@ -677,6 +730,22 @@ def record_result(folder_root: Path, result: dict[str, Any]) -> None:
     manifest = read_manifest(folder_root)
     manifest.setdefault("adaptive", {})["result"] = result
     _write_json_atomic(Path(folder_root) / MANIFEST, manifest)
+
+
+def estimate_phrase(result: dict[str, Any]) -> str:
+    """The result's estimates in words, for the final message: the point estimate and the
+    upper one the stop compares with --until-error, with the factor between them."""
+    est = result.get("estimated_error_deg")
+    if est is None:
+        return "estimated mean normal error n/a"
+    up = result.get("upper_error_deg")
+    text = f"estimated mean normal error {est:.2f}°"
+    if up is not None:
+        text += (
+            f", upper estimate {up:.2f}° (×{result.get('upper_factor', up / est if est else 0):g}:"
+            " what --until-error is compared with)"
+        )
+    return text
 
 
 def check_objective(objective: str, lights: int | None, until_error_deg: float | None) -> None:
@@ -822,6 +891,9 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
             f"{folder.root}: the rig now offers {len(plan.candidates)} candidate lights, the "
             f"session began with {header['candidates']}: it cannot continue as it began"
         )
-    source = AdaptiveSteps(rig, plan, header.get("until_error_deg"), began)
+    # the stop's factor the session began with (its target means the same to the end)
+    source = AdaptiveSteps(
+        rig, plan, header.get("until_error_deg"), began, header.get("upper_factor")
+    )
     source.replay(folder)
     return source

@@ -34,6 +34,11 @@ DECISION_MODULES = (
     "rti_rig.app.usecases.adaptive",
 )
 
+#: Constants a resume takes from the session's own settings rather than from this build (the
+#: stop's factor: it decides only when to stop, never which light, and the settings hold it as
+#: ``upper_factor``), so a difference in them is no reason to refuse.
+RESTORED_ON_RESUME = frozenset({"planner.adaptive_until.UPPER_FACTOR"})
+
 #: How many differing constants a refusal names (the rest are counted).
 NAMED_DIFFERENCES = 5
 
@@ -64,9 +69,10 @@ def decision_constants() -> dict[str, Any]:
 
 def constant_differences(recorded: dict[str, Any], current: dict[str, Any]) -> list[str]:
     """What differs between a session's recorded constants and this build's, one line each
-    (``NAME recorded → now``; a constant one side lacks shows as ``absent``)."""
+    (``NAME recorded → now``; a constant one side lacks shows as ``absent``), apart from
+    :data:`RESTORED_ON_RESUME`."""
     lines = []
-    for key in sorted(set(recorded) | set(current)):
+    for key in sorted((set(recorded) | set(current)) - RESTORED_ON_RESUME):
         was, now = recorded.get(key, "absent"), current.get(key, "absent")
         if was != now:
             lines.append(f"{key} {was!r} → {now!r}")

@@ -59,7 +59,7 @@ class NewSessionRequest:
     max_saturated: float = 0.001
     #: Choose each next light from the images so far (up to ``lights``; docs/adaptive.md).
     adaptive: bool = False
-    #: Adaptive: stop once the estimated mean normal error is at most this (degrees).
+    #: Adaptive: stop once the upper estimate of the mean normal error is at most this (°).
     until_error_deg: float | None = None
     #: Adaptive: what the design of ``lights`` is chosen for, ``normals`` or ``relight``
     #: (None: normals; refused for a session that is not adaptive).
