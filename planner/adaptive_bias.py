@@ -62,6 +62,12 @@ FACING_COS = 0.15
 #: Whether the pixels the robust fit left unsolved are modelled with their least-squares
 #: normal (:func:`solve_unsolved`) rather than the level normal the chooser keeps for them.
 SOLVE_UNSOLVED = True
+#: The worst condition number of a pixel's lit lights that :func:`solve_unsolved` solves (the
+#: robust fit's ``COND_LIMIT`` is 100; the planner may not import it): 3× it, so that the
+#: tilted plane's starting lights (~116) are solved, while at ~420 the noise amplified by the
+#: conditioning left the solved normals further off than the level fallback (measured by a
+#: second reader: 23° against 18° on a synthetic plane at σ = 0.003).
+UNSOLVED_COND_LIMIT = 300.0
 
 #: ``fit(obs (L, P), lights (L, 3)) -> (normals (P, 3), valid (P,))``: the robust fit, or None
 #: when it refuses the light set (ill-conditioned). Any other error is a bug and propagates:
@@ -124,11 +130,14 @@ def solve_unsolved(
     albedo: NDArray[np.float64],
     valid: NDArray[np.bool_],
     dark: float,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
-    """(normals, albedo, valid) with the pixels the robust fit left unsolved (``valid`` False)
-    solved by least squares on their lit observations (above ``dark``), where at least three
-    are and they determine a normal facing the camera (and then counted valid); the others as
-    given.
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.intp]]:
+    """(normals, albedo, valid, lit count) with the pixels the robust fit left unsolved
+    (``valid`` False) solved by least squares on their lit observations (above ``dark``), where
+    at least three are, their lights' condition number is at most
+    :data:`UNSOLVED_COND_LIMIT`, and the normal found faces the camera and every light that lit
+    the pixel (then counted valid); the others as given. The lit count (per pixel, 0 for those
+    not solved here) tells the caller how many degrees of freedom a solved pixel's residuals
+    have: with exactly three they are zero by construction.
 
     Why: the robust fit refuses a pixel whose lit lights are ill-conditioned (its
     ``cond_limit``), and the chooser keeps such a pixel with a level normal and its brightest
@@ -139,34 +148,44 @@ def solve_unsolved(
     whose simulated relighting ranked the floors wrongly (docs/adaptive.md, "Why the model
     rendered a matte tilted plane wrongly"). Three lit lights do determine the normal (with the
     noise amplified by their conditioning): a noisy tilted plane is the better model. Counted
-    valid, the pixels solved so are also evidence for the lobe, shadows and noise: left out,
-    the specular lobe of that tilted plane was fitted to the 2 pixels the robust fit solved
-    (ks 272, e 128 on a matte surface)."""
+    valid, the pixels solved so are also evidence for the lobe and shadows, and, where they have
+    residual degrees of freedom, for the noise (:func:`fit_object_model`): left out, the
+    specular lobe of that tilted plane was fitted to the 2 pixels the robust fit solved (ks 272,
+    e 128 on a matte surface)."""
     valid = np.asarray(valid, dtype=bool)
+    lit_count = np.zeros(valid.shape, dtype=np.intp)
     todo = np.flatnonzero(~valid)
     if todo.size == 0:
-        return normals, albedo, valid
+        return normals, albedo, valid, lit_count
     o = np.asarray(obs, dtype=np.float64)[:, todo].T  # (U, K)
     w = (o > dark).astype(np.float64)
-    enough = w.sum(axis=1) >= 3
+    count = w.sum(axis=1)
     lt = np.asarray(lights, dtype=np.float64)
     gram = np.einsum("uk,ki,kj->uij", w, lt, lt)  # (U, 3, 3) over each pixel's lit lights
     rhs = np.einsum("uk,uk,ki->ui", w, o, lt)
-    det = np.linalg.det(gram)
-    ok = enough & (det > 1e-12)
+    ok = count >= 3
+    if ok.any():
+        eig = np.linalg.eigvalsh(gram[ok])  # ascending; cond(G) = cond(lit lights)²
+        sub = eig[:, 0] > eig[:, -1] / UNSOLVED_COND_LIMIT**2
+        ok[np.flatnonzero(ok)[~sub]] = False
     normals = np.array(normals, dtype=np.float64, copy=True)
     albedo = np.array(albedo, dtype=np.float64, copy=True)
     if not ok.any():
-        return normals, albedo, valid
+        return normals, albedo, valid, lit_count
     b = np.linalg.solve(gram[ok], rhs[ok][..., None])[..., 0]
     rho = np.linalg.norm(b, axis=1)
-    good = (rho > 0) & (b[:, 2] > 0)
+    n = b / np.maximum(rho, 1e-300)[:, None]
+    # facing the camera, and every light that lit the pixel in front of it (a lit observation
+    # behind the normal found says the Lambertian solve is not what lit it)
+    lit_behind = ((n @ lt.T) <= 0.0) & (w[ok] > 0)
+    good = (rho > 0) & (n[:, 2] > 0) & ~lit_behind.any(axis=1)
     which = todo[ok][good]
-    normals[which] = b[good] / rho[good, None]
+    normals[which] = n[good]
     albedo[which] = rho[good]
     valid = valid.copy()
     valid[which] = True
-    return normals, albedo, valid
+    lit_count[which] = count[ok][good].astype(np.intp)
+    return normals, albedo, valid, lit_count
 
 
 def fit_object_model(
@@ -183,15 +202,22 @@ def fit_object_model(
     (the pixels it left unsolved solved by least squares where their lit lights allow:
     :func:`solve_unsolved`, then counted valid)."""
     obs = np.asarray(obs, dtype=np.float64)  # (K, P)
+    # the pixels whose residuals say something about noise and gloss: the robust fit's, and
+    # those solved here from more than three lit lights (three fit exactly: zero residuals
+    # would pull the noise to its floor and the lobe to zero whatever the surface)
+    evidence = np.asarray(valid, dtype=bool)
     if SOLVE_UNSOLVED:
-        normals, albedo, valid = solve_unsolved(obs, lights, normals, albedo, valid, dark)
+        normals, albedo, valid, lit_count = solve_unsolved(
+            obs, lights, normals, albedo, valid, dark
+        )
+        evidence = evidence | (lit_count > 3)
     cos = (normals @ lights.T).T  # (K, P)
     lam = albedo[None, :] * np.maximum(cos, 0.0)
     resid = obs - lam
     facing = (cos > FACING_COS) & valid[None, :]
     lit = facing & (obs > dark)
     # noise: robust scale of the residuals of lit observations near the fit
-    r_lit = np.abs(resid[lit])
+    r_lit = np.abs(resid[lit & evidence[None, :]])
     noise = float(1.4826 * np.median(r_lit)) if r_lit.size else 0.0
     k = len(lights)
     if k > 3:
@@ -202,7 +228,7 @@ def fit_object_model(
     shadowed = shadowed.T  # (P, K)
     # specular lobe: least squares of the positive-side residuals on ks * (n.h)^e
     hc = _half_cos(normals, lights).T  # (K, P)
-    use = lit & ~shadowed.T
+    use = lit & ~shadowed.T & evidence[None, :]
     r = resid[use]
     c = hc[use]
     best = (np.inf, 0.0, LOBE_EXPONENTS[0])

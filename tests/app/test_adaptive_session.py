@@ -30,6 +30,8 @@ def uninterrupted(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--adaptive", "--lights", "8"])
     assert r.exit_code == 0, r.output
     assert "Adaptive: 8 lights; stopped: reached its maximum of 8 lights" in said(r)
+    # no target: the upper estimate is given, but not as what a target was compared with
+    assert "what --until-error would be compared with" in said(r)
     return cfg, out
 
 
@@ -280,18 +282,44 @@ def test_a_session_begun_under_other_constants_is_refused_by_name(
     assert "planner.adaptive_optimal.SEARCH_PIXELS 500 → 400" in text
     assert "export-lp" in text and "Traceback" not in text
     assert files() == before
-    # the stop's factor is taken from the session's own settings: no reason to refuse
+    # a build with another stop factor continues it (the factor is the session's own: its
+    # settings hold it) — what a release that re-chose UPPER_FACTOR looks like
     from rti_rig.planner import adaptive_until
 
     monkeypatch.undo()
-    monkeypatch.setattr(adaptive_until, "UPPER_FACTOR", 2.5)
-    from rti_rig.app.usecases.adaptive_constants import constant_differences, decision_constants
+    recorded = manifest(out)["adaptive"]["upper_factor"]
+    monkeypatch.setattr(adaptive_until, "UPPER_FACTOR", recorded + 0.55)
+    from rti_rig.app.usecases import adaptive as usecase
 
-    assert constant_differences(manifest(out)["adaptive"]["constants"], decision_constants()) == []
-    monkeypatch.undo()  # the build that began it continues it
+    if hasattr(usecase, "UPPER_FACTOR"):  # a copy imported by name changes with the build too
+        monkeypatch.setattr(usecase, "UPPER_FACTOR", recorded + 0.55)
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
     assert len(journal(out)) == 8
+    assert manifest(out)["adaptive"]["result"]["upper_factor"] == recorded
+
+
+def test_a_session_of_this_format_without_its_constants_is_refused(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """Every session of this format records its constants: one without them was written by a
+    development build, whose choices this build cannot vouch for — refused, nothing touched."""
+    cfg, _ = uninterrupted
+    out = tmp_path / "dev"
+    interrupted(cfg, out, after_step=4)
+    m = manifest(out)
+    del m["adaptive"]["constants"]
+    (out / "manifest.json").write_text(json.dumps(m))
+
+    def files() -> dict[str, bytes]:
+        return {str(p.relative_to(out)): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+
+    before = files()
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert "do not record its decision constants" in text and "export-lp" in text
+    assert files() == before
 
 
 def test_the_robust_kernel_is_loaded_before_the_rig_opens(tmp_path: Path, monkeypatch) -> None:

@@ -126,7 +126,8 @@ def test_solve_unsolved_keeps_solved_pixels_and_refuses_what_the_lights_do_not_d
     given_n[1] = [0.6, 0.0, 0.8]  # pixel 1: solved by the robust fit, kept
     given_a = np.array([0.5, 0.4, 0.5])
     valid = np.array([False, True, False])
-    n, a, v = solve_unsolved(obs, lights, given_n, given_a, valid, dark=0.01)
+    n, a, v, count = solve_unsolved(obs, lights, given_n, given_a, valid, dark=0.01)
+    np.testing.assert_array_equal(count, [4, 0, 0])  # pixel 0 solved from its 4 lit lights
     np.testing.assert_allclose(n[0], n_true[0], atol=1e-9)
     np.testing.assert_allclose(a[0], 0.5, atol=1e-9)
     np.testing.assert_array_equal(n[1], given_n[1])
@@ -135,3 +136,58 @@ def test_solve_unsolved_keeps_solved_pixels_and_refuses_what_the_lights_do_not_d
     # inputs not changed in place
     np.testing.assert_array_equal(valid, [False, True, False])
     np.testing.assert_array_equal(given_n[0], [0.0, 0.0, 1.0])
+
+
+def test_solve_unsolved_refuses_ill_conditioned_and_inconsistent_solutions() -> None:
+    """Three lit lights bunched together (condition far above ``UNSOLVED_COND_LIMIT``: the
+    noise amplified past the level fallback) are not solved; nor is a pixel whose solution
+    leaves a light that lit it behind the normal, or one facing away from the camera."""
+    bunched = np.stack([_dir(0, 60), _dir(0.5, 60.25), _dir(1, 60)])
+    assert np.linalg.cond(bunched) > adaptive_bias.UNSOLVED_COND_LIMIT
+    n0 = np.array([[0.2, 0.1, 0.97]])
+    n0 /= np.linalg.norm(n0)
+    obs = (0.5 * (n0 @ bunched.T)).T
+    level = np.array([[0.0, 0.0, 1.0]])
+    n, _a, v, count = solve_unsolved(obs, bunched, level, np.array([0.5]), np.array([False]), 0.01)
+    np.testing.assert_array_equal(n, level)
+    assert not v[0] and count[0] == 0
+    # well-conditioned lights, but observations no Lambertian normal explains: the
+    # least-squares normal leaves the light opposite the bright one, which lit the pixel,
+    # behind it (a highlight, say, not a Lambertian pixel)
+    ring = np.stack([_dir(0, 30), _dir(90, 30), _dir(180, 30), _dir(270, 30)])
+    weird = np.array([[0.9], [0.05], [0.03], [0.05]])
+    n, _a, v, _c = solve_unsolved(weird, ring, level, np.array([0.5]), np.array([False]), 0.01)
+    assert not v[0]
+    np.testing.assert_array_equal(n, level)
+    # the same lights and a Lambertian pixel: solved
+    lam = (0.5 * (n0 @ ring.T)).T
+    n, _a, v, _c = solve_unsolved(lam, ring, level, np.array([0.5]), np.array([False]), 0.01)
+    assert v[0]
+    np.testing.assert_allclose(n, n0, atol=1e-9)
+
+
+def test_pixels_solved_from_exactly_three_lights_are_no_evidence_of_noise_or_gloss() -> None:
+    """Three lit lights fit exactly (zero residuals): counted as evidence they pulled the noise
+    to its floor (0.003 where the images' is 0.02) and any lobe to zero. Such pixels are
+    modelled, but the noise and the lobe are estimated from the pixels with residual freedom."""
+    from rti_rig.planner.adaptive_bias import fit_object_model
+
+    rng = np.random.default_rng(3)
+    lights = np.stack([_dir(0, 35), _dir(120, 35), _dir(240, 35), _dir(60, 75), _dir(300, 20)])
+    p = 600
+    n = rng.normal(size=(p, 3)) * [0.25, 0.25, 1.0]
+    n[:, 2] = np.abs(n[:, 2]) + 0.5
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    albedo = np.full(p, 0.6)
+    obs = (albedo[:, None] * np.maximum(n @ lights.T, 0.0)).T + rng.normal(0, 0.02, size=(5, p))
+    obs = np.maximum(obs, 0.0)
+    # most pixels lit by only three of the lights (the other two below the dark level), as
+    # on the tilted plane, where the robust fit solved almost none
+    half = np.arange(p) < (9 * p) // 10
+    obs[3:, half] = 0.0
+    valid = ~half  # the robust fit solved the others
+    model = fit_object_model(
+        obs, lights, n.copy(), albedo.copy(), valid, dark=0.05, noise_floor=0.003
+    )
+    assert model.noise > 0.012  # ~0.02 × sqrt(5/2) from the other pixels; not the floor
+    assert (model.normals[half] != [0.0, 0.0, 1.0]).any()  # the three-light pixels modelled

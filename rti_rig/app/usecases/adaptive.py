@@ -43,6 +43,7 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.planner import adaptive_until
 from rti_rig.planner.adaptive import (
     ESTIMATE_SCALE,
     SIM_ESTIMATE_SCALE,
@@ -57,7 +58,7 @@ from rti_rig.planner.adaptive import (
 )
 from rti_rig.planner.adaptive_bias import simulate_error_deg
 from rti_rig.planner.adaptive_relight import OBJECTIVES
-from rti_rig.planner.adaptive_until import UPPER_FACTOR, choose_until, upper_error_deg
+from rti_rig.planner.adaptive_until import choose_until, reaches_target, upper_error_deg
 from rti_rig.planner.objectives import candidates_for, snap_unique
 from rti_rig.planner.uniform import select_uniform_leds
 
@@ -296,8 +297,9 @@ class AdaptiveChooser:
         objective: str = "normals",
         upper_factor: float | None = None,
     ) -> None:
-        #: the stop's upper estimate = the point estimate × this (None: UPPER_FACTOR)
-        self.upper_factor = UPPER_FACTOR if upper_factor is None else upper_factor
+        #: the stop's upper estimate = the point estimate × this (None: this build's
+        #: ``adaptive_until.UPPER_FACTOR``, read now; a resume passes the session's own)
+        self.upper_factor = adaptive_until.UPPER_FACTOR if upper_factor is None else upper_factor
         #: the design score and the estimate: a robust fit simulated on this object's model
         #: (None: BIAS_AWARE), else the Lambertian variance bound
         self.bias_aware = BIAS_AWARE if bias_aware is None else bias_aware
@@ -379,16 +381,25 @@ class AdaptiveChooser:
         --until-error, whether the last light reached the target too or the target is not
         claimed (so that a capped session is not read as having reached it)."""
         reason = self._cap_reason()
-        if self.until_error_deg is not None and est is not None:
-            up = self.upper(est)
-            if up <= self.until_error_deg:  # the last light reached the target as well
+        if self.until_error_deg is not None and est is None:  # nothing could be fitted
+            reason += (
+                f" before --until-error {self.until_error_deg:g}° could be judged (no "
+                "estimate: the images so far cannot be fitted; the target is not claimed)"
+            )
+        elif self.until_error_deg is not None and est is not None:
+            if self._reaches(est):  # the last light reached the target as well
                 reason = self._reached_reason(est)
             else:
                 reason += (
                     f" before --until-error {self.until_error_deg:g}° was reached (upper "
-                    f"estimate {up:.2f}°: the target is not claimed)"
+                    f"estimate {self.upper(est):.2f}°: the target is not claimed)"
                 )
         return {"kind": "stop", "reason": reason, **self.stop_terms(est)}
+
+    def _reaches(self, est: float) -> bool:
+        """Whether the stop may claim --until-error (``adaptive_until.reaches_target``)."""
+        assert self.until_error_deg is not None
+        return reaches_target(est, self.until_error_deg, self.upper_factor)
 
     def _reached_reason(self, est: float) -> str:
         return (
@@ -427,13 +438,18 @@ class AdaptiveChooser:
             available[self.used] = False
             far = np.flatnonzero(available)
             if far.size == 0:
-                return None, {"kind": "stop", "reason": "no candidate light left"}
+                self.stop_evidence = {
+                    "kind": "stop",
+                    "reason": "no candidate light left (the images so far cannot be fitted: "
+                    "no estimate, nothing claimed)",
+                    **self.stop_terms(None),
+                }
+                return None, self.stop_evidence
             dots = self.candidates[far] @ np.stack(self.lights).T if self.lights else None
             pick = int(far[0] if dots is None else far[np.argmin(dots.max(axis=1))])
             return pick, {"kind": "coverage", "reason": "fit not yet possible: farthest light"}
         est = self.estimate(state)
-        up = self.upper(est)
-        if self.until_error_deg is not None and up <= self.until_error_deg:
+        if self.until_error_deg is not None and self._reaches(est):
             # the target is claimed only when the upper estimate is under it
             self.stop_evidence = {
                 "kind": "stop",
@@ -518,6 +534,7 @@ class AdaptiveChooser:
         return {
             "objective": self.objective,
             "lights_used": len(self.used),
+            "until_error_deg": self.until_error_deg,
             **self.stop_terms(est),
             # a session run to its maximum is never asked for the step past it: the stop here
             "stop": self.stop_evidence or self._cap_stop(est),
@@ -734,17 +751,21 @@ def record_result(folder_root: Path, result: dict[str, Any]) -> None:
 
 def estimate_phrase(result: dict[str, Any]) -> str:
     """The result's estimates in words, for the final message: the point estimate and the
-    upper one the stop compares with --until-error, with the factor between them."""
+    upper one, with the factor between them — said to be what --until-error was compared with
+    only when the session had a target."""
     est = result.get("estimated_error_deg")
     if est is None:
         return "estimated mean normal error n/a"
     up = result.get("upper_error_deg")
     text = f"estimated mean normal error {est:.2f}°"
     if up is not None:
-        text += (
-            f", upper estimate {up:.2f}° (×{result.get('upper_factor', up / est if est else 0):g}:"
-            " what --until-error is compared with)"
+        factor = result.get("upper_factor", up / est if est else 0)
+        role = (
+            "what --until-error is compared with"
+            if result.get("until_error_deg") is not None
+            else "what --until-error would be compared with"
         )
+        text += f", upper estimate {up:.2f}° (×{factor:g}: {role})"
     return text
 
 
@@ -830,11 +851,16 @@ def refuse_other_format(header: dict, root: Path) -> None:
 
 def refuse_other_constants(header: dict, root: Path) -> None:
     """Refuse a session whose recorded decision constants differ from this build's (its
-    choices would not be repeated), naming them — from the manifest alone. A session that
-    recorded none (written before they were recorded) is left to the replay's own check."""
+    choices would not be repeated), naming them — from the manifest alone. A session of this
+    format that recorded none was written by a development build: refused too."""
     recorded = header.get("constants")
-    if not isinstance(recorded, dict):
-        return
+    if not isinstance(recorded, dict):  # every session of this format records them
+        raise RtiRigError(
+            f"{root}: this adaptive session's settings do not record its decision constants "
+            "(a development build of this format wrote it): this build cannot tell whether it "
+            "would repeat its choices. The images are kept: `rti-rig export-lp` and `rti-rig "
+            "fit` use them as they are; start a new session to shoot more"
+        )
     differ = constant_differences(recorded, decision_constants())
     if differ:
         raise RtiRigError(

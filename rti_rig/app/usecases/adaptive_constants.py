@@ -20,7 +20,8 @@ import json
 from typing import Any
 
 #: The modules whose constants shape an adaptive decision (the choosers, the object model, the
-#: fitted designs' searches and the objectives they call, the usecase's image reduction).
+#: fitted designs' searches and the objectives they call, the starting layout, the robust fit
+#: the designs are scored by and the sample is fitted with, the usecase's image reduction).
 DECISION_MODULES = (
     "rti_rig.planner.adaptive",
     "rti_rig.planner.adaptive_bias",
@@ -31,13 +32,19 @@ DECISION_MODULES = (
     "rti_rig.planner.adaptive_until",
     "rti_rig.planner.objectives",
     "rti_rig.planner.optimal",
+    "rti_rig.planner.uniform",
+    "rti_rig.reconstruct.photometric_stereo",
+    "rti_rig.reconstruct.robust_ps",
+    "rti_rig.reconstruct.solve",
     "rti_rig.app.usecases.adaptive",
 )
 
 #: Constants a resume takes from the session's own settings rather than from this build (the
 #: stop's factor: it decides only when to stop, never which light, and the settings hold it as
 #: ``upper_factor``), so a difference in them is no reason to refuse.
-RESTORED_ON_RESUME = frozenset({"planner.adaptive_until.UPPER_FACTOR"})
+RESTORED_ON_RESUME = frozenset(
+    {"planner.adaptive_until.UPPER_FACTOR", "planner.adaptive_until.UPPER_QUANTILE"}
+)
 
 #: How many differing constants a refusal names (the rest are counted).
 NAMED_DIFFERENCES = 5
@@ -58,12 +65,19 @@ def decision_constants() -> dict[str, Any]:
     tuples as lists) for every constant of :data:`DECISION_MODULES`, read now (so a value a
     benchmark sets is what is recorded)."""
     out: dict[str, Any] = {}
+    seen: dict[str, list[object]] = {}  # name → the objects earlier modules hold under it
     for name in DECISION_MODULES:
         module = importlib.import_module(name)
         short = name.removeprefix("rti_rig.")
         for key, value in sorted(vars(module).items()):
-            if key.isupper() and not key.startswith("_") and _plain(value):
-                out[f"{short}.{key}"] = value
+            if not (key.isupper() and not key.startswith("_") and _plain(value)):
+                continue
+            # a name imported from a module listed before is that module's constant: recorded
+            # once, under it (else a resume would compare a stale copy, e.g. the usecase's)
+            if any(value is v for v in seen.get(key, ())):
+                continue
+            seen.setdefault(key, []).append(value)
+            out[f"{short}.{key}"] = value
     return json.loads(json.dumps(out))
 
 
