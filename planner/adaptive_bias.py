@@ -74,6 +74,8 @@ NOISE_BINS = 8
 NOISE_BIN_MIN = 20
 NOISE_MIN_BINS = 3
 NOISE_MIN_SPAN = 2.0
+#: Pixels the noise is fitted on (every k-th of the sample).
+NOISE_PIXELS = 500
 #: Median of a χ²₁ variable: a bin's variance is its median squared residual over this.
 _CHI2_1_MEDIAN = 0.45493642311957283
 #: Whether the pixels the robust fit left unsolved are modelled with their least-squares
@@ -247,17 +249,21 @@ def fit_noise_model(
 
 
 def standardized_residuals2(
-    resid: NDArray, lights: NDArray[np.float64], use: NDArray[np.bool_]
-) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    resid: NDArray, signal: NDArray, lights: NDArray[np.float64], use: NDArray[np.bool_]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
     """(K, P) squared residuals over ``1 − h`` (``h`` each observation's leverage in its
-    pixel's least-squares fit on the observations ``use`` (K, P) marks), and where that is
-    informative: a pixel with at least 4 such observations and ``1 − h`` ≥ 0.1.
+    pixel's least-squares fit on the observations ``use`` (K, P) marks), the signal each stands
+    for, and where that is informative: a pixel with at least 4 such observations and
+    ``1 − h`` ≥ 0.1.
 
     Why: a pixel fitted on 3 lit lights has residuals 0 whatever the noise (the tilted plane's
-    first decision: every pixel so), and on 4 the one residual degree of freedom falls on each
-    light by its leverage — a light's residual is ``σ²(1 − h)`` in expectation, not ``σ²``, so
-    the lights' bins differ by their geometry, not their noise. The constant's ``k/(k−3)`` is
-    the average of this correction."""
+    first decision: every pixel so), and on few lights the residual degrees of freedom fall on
+    each light by its leverage. With ``M = (I − H)²`` (element-wise) a residual's variance is
+    ``Σ_j M_kj σ_j²``: for ``σ² = a + b s`` that is ``(1 − h_kk)(a + b s̄_k)`` with ``s̄_k`` the
+    ``M``-weighted mean signal of the pixel's observations — so a residual over ``1 − h_kk``
+    measures the noise at ``s̄_k``, not at its own signal (a dark observation's residual
+    carries the bright ones' noise too). The constant's ``k/(k−3)`` is the average of this
+    correction."""
     w = np.asarray(use, dtype=np.float64)
     lt = np.asarray(lights, dtype=np.float64)
     m = w.sum(axis=0)
@@ -265,11 +271,17 @@ def standardized_residuals2(
     ok_p = (m >= 4) & (np.linalg.det(gram) > 1e-12)
     inv = np.zeros_like(gram)
     inv[ok_p] = np.linalg.inv(gram[ok_p])
-    h = np.einsum("ki,pij,kj->kp", lt, inv, lt)
-    one_h = 1.0 - h
+    # the hat matrix of each pixel's fit over its used observations (P, K, K)
+    hat = np.einsum("ki,pij,lj->pkl", lt, inv, lt) * (w.T[:, :, None] * w.T[:, None, :])
+    resid_op = w.T[:, :, None] * np.eye(len(lt))[None] - hat
+    mm = resid_op**2  # (P, K, K)
+    one_h = np.einsum("pkk->kp", resid_op)  # 1 − h_kk on used observations
+    sig = np.asarray(signal, dtype=np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s_eff = np.einsum("pkl,lp->kp", mm, sig) / mm.sum(axis=2).T
     good = np.asarray(use, dtype=bool) & ok_p[None, :] & (one_h >= 0.1)
     r2 = np.where(good, np.asarray(resid, np.float64) ** 2 / np.maximum(one_h, 0.1), 0.0)
-    return r2, good
+    return r2, np.where(good, s_eff, 0.0), good
 
 
 def fit_object_model(
@@ -322,8 +334,13 @@ def fit_object_model(
     noise_ab = None
     if SIGNAL_NOISE:  # the kept observations' residuals against the signal fitted to them
         kept = use & (np.abs(resid) <= np.maximum(4.0 * noise, 0.25 * lam))  # no highlight
-        r2, good = standardized_residuals2(resid, lights, kept)
-        noise_ab = fit_noise_model(lam[good], r2[good], noise_floor)
+        # on a fixed subset of the pixels (the fit needs a few hundred observations, and the
+        # leverages cost K² per pixel)
+        sub = np.arange(0, lam.shape[1], max(1, lam.shape[1] // NOISE_PIXELS))
+        r2, s_eff, good = standardized_residuals2(
+            resid[:, sub], lam[:, sub], lights, kept[:, sub]
+        )
+        noise_ab = fit_noise_model(s_eff[good], r2[good], noise_floor)
     gain = 1.0
     if relief is not None and FIT_RELIEF_GAIN:
         from rti_rig.planner.adaptive_relief import fit_relief_gain
