@@ -204,9 +204,7 @@ def solve_unsolved(
     return normals, albedo, valid
 
 
-def fit_noise_model(
-    signal: NDArray, resid2: NDArray, floor: float
-) -> tuple[float, float] | None:
+def fit_noise_model(signal: NDArray, resid2: NDArray, floor: float) -> tuple[float, float] | None:
     """(a, b) of the noise's variance ``a + b × signal`` from kept observations' fitted
     ``signal`` and their squared *standardized* residuals ``resid2`` (each over its ``1 − h``,
     :func:`standardized_residuals2`), or None where the fit cannot separate a from b (then the
@@ -342,9 +340,7 @@ def fit_object_model(
         # on a fixed subset of the pixels (the fit needs a few hundred observations, and the
         # leverages cost K² per pixel)
         sub = np.arange(0, lam.shape[1], max(1, lam.shape[1] // NOISE_PIXELS))
-        r2, s_eff, good = standardized_residuals2(
-            resid[:, sub], lam[:, sub], lights, kept[:, sub]
-        )
+        r2, s_eff, good = standardized_residuals2(resid[:, sub], lam[:, sub], lights, kept[:, sub])
         noise_ab = fit_noise_model(s_eff[good], r2[good], noise_floor)
     gain = 1.0
     if relief is not None and FIT_RELIEF_GAIN:

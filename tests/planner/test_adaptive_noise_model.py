@@ -135,3 +135,49 @@ def test_a_dark_photograph_adds_little_noise_to_its_reference() -> None:
     const = mean_psnr_db(relit, ref, float(np.sqrt((sd**2).mean())))
     assert per_obs > const + 3.0
     assert mean_psnr_db(relit, ref, np.zeros_like(ref)) == pytest.approx(60.0)
+
+
+def _plane_shots(k: int):  # type: ignore[no-untyped-def]
+    """A matte plane tilted 30° with a gentle relief, shot under ``k`` lights from a cap with
+    the simulator's shot noise (variance 1.7·10⁻⁵ × signal)."""
+    size = 48
+    rows, cols = np.indices((size, size), dtype=np.float64)
+    h = -np.tan(np.radians(30.0)) * cols + 2.0 * np.sin(cols / 9.0) * np.cos(rows / 11.0)
+    d_row, d_col = np.gradient(h)
+    n = np.stack([-d_col, d_row, np.ones_like(h)], axis=-1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    albedo = 0.55 + 0.1 * np.cos(rows / 7.0)
+    rng = np.random.default_rng(5)
+    lights = fibonacci_cap(k, 25.0)
+    shots = []
+    for v in lights:
+        clean = albedo * np.maximum(n @ v, 0.0)
+        shots.append(np.maximum(clean + rng.normal(size=clean.shape) * np.sqrt(1.7e-5 * clean), 0))
+    return lights, shots
+
+
+def test_the_chooser_model_measures_the_cameras_shot_noise() -> None:
+    """Through the chooser (the robust fit's residuals, as a session has them): after 12
+    images its model's noise is the camera's shot noise within 35 % (plus the noise floor in
+    the dark); after 4 (one residual degree of freedom, a narrow signal range) it keeps the
+    constant."""
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser
+    from rti_rig.planner.adaptive import object_model
+
+    lights, shots = _plane_shots(12)
+    chooser = AdaptiveChooser(lights, list(range(4)), 12, design_lights=12, objective="relight")
+    for i in range(4):
+        chooser.observe(i, lights[i], shots[i])
+    early = object_model(chooser.state())
+    assert early is not None
+    for i in range(4, 12):
+        chooser.observe(i, lights[i], shots[i])
+    model = object_model(chooser.state())
+    assert model is not None and model.noise_var0 is not None
+    assert model.noise_slope == pytest.approx(1.7e-5, rel=0.35)
+    floor = chooser.state().noise_floor  # the intercept's floor: 0.3 % of the bright level
+    assert model.noise_var0 == pytest.approx(floor**2, rel=0.5)
+    sd = np.asarray(model.noise_sd(np.array([0.05, 0.5])))
+    assert sd[1] == pytest.approx(np.sqrt(1.7e-5 * 0.5 + floor**2), rel=0.2)
+    assert sd[0] < 0.7 * sd[1]
+    assert early.noise_var0 is None
