@@ -76,6 +76,14 @@ NOISE_MIN_BINS = 3
 NOISE_MIN_SPAN = 2.0
 #: Pixels the noise is fitted on (every k-th of the sample).
 NOISE_PIXELS = 500
+#: The largest slope ``b`` taken for a camera's shot noise (variance per unit signal, the
+#: images' units: 1 = full scale): 1/b is the full-well capacity in electrons at full scale,
+#: and 1000 is far below any camera's (phones ~5 000, DSLRs 20 000–60 000; the simulator's
+#: 1.7·10⁻⁵ is ~60 000). A steeper slope is the model's misfit growing with the signal (the
+#: industrial scene's gloss and shadows: b 0.05–1.1), not noise in the photographs: the
+#: constant is kept. Set a priori from that physics, after the industrial scene lost with no
+#: bound (docs/adaptive.md, "Signal-dependent noise").
+NOISE_MAX_SLOPE = 1e-3
 #: Median of a χ²₁ variable: a bin's variance is its median squared residual over this.
 _CHI2_1_MEDIAN = 0.45493642311957283
 #: Whether the pixels the robust fit left unsolved are modelled with their least-squares
@@ -219,7 +227,8 @@ def fit_noise_model(signal: NDArray, resid2: NDArray, floor: float) -> tuple[flo
     squared residual over the χ²₁ median (robust to highlights and shadows the fit left in);
     the line through the bins' (median signal, variance) is Theil–Sen's (the median of
     pairwise slopes: robust, deterministic). ``a`` is at least ``floor²`` (the constant's
-    floor); a slope that is not positive is no evidence of shot noise: None."""
+    floor); a slope that is not positive is no evidence of shot noise, one above
+    :data:`NOISE_MAX_SLOPE` is misfit, not a camera's noise: None for both."""
     s = np.asarray(signal, dtype=np.float64).ravel()
     r2 = np.asarray(resid2, dtype=np.float64).ravel()
     if s.size < NOISE_BIN_MIN * NOISE_MIN_BINS:
@@ -240,7 +249,7 @@ def fit_noise_model(signal: NDArray, resid2: NDArray, floor: float) -> tuple[flo
     if not ok.any():
         return None
     b = float(np.median((v[j] - v[i])[ok] / dx[ok]))
-    if not b > 0:
+    if not 0 < b <= NOISE_MAX_SLOPE:
         return None
     a = float(np.median(v - b * x))
     return max(a, floor**2), b

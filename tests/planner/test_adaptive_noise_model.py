@@ -98,6 +98,8 @@ def test_three_lit_lights_give_no_noise_evidence() -> None:
         (np.full(500, 0.3), np.full(500, 1e-5)),  # one signal level: a and b not separable
         (np.linspace(0.1, 0.5, 40), np.full(40, 1e-5)),  # too few observations
         (np.linspace(0.1, 0.5, 800), np.linspace(2e-5, 1e-5, 800)),  # noise falls with signal
+        # misfit growing with the signal (a camera of 20 electrons at full scale): not noise
+        (np.linspace(0.1, 0.5, 800), 0.05 * np.linspace(0.1, 0.5, 800) * 0.4549),
     ],
 )
 def test_the_fit_falls_back_to_the_constant(signal: np.ndarray, resid2: np.ndarray) -> None:
