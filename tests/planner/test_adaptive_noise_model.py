@@ -183,3 +183,21 @@ def test_the_chooser_model_measures_the_cameras_shot_noise() -> None:
     assert sd[1] == pytest.approx(np.sqrt(1.7e-5 * 0.5 + floor**2), rel=0.2)
     assert sd[0] < 0.7 * sd[1]
     assert early.noise_var0 is None
+
+
+def test_the_error_estimate_keeps_the_constant_and_the_ranking_takes_the_shot_noise() -> None:
+    """``--until-error``'s estimate is calibrated with the constant noise (the coin stopped
+    early with the signal-dependent one); the designs' scores draw each observation's own."""
+    from rti_rig.planner.adaptive_bias import simulate_designs, simulate_error_deg
+
+    model = _model(12)
+    assert model.noise_var0 is not None
+
+    def fit(obs, lights):  # type: ignore[no-untyped-def]
+        g = np.linalg.lstsq(lights, obs.astype(np.float64), rcond=None)[0].T
+        return g / np.linalg.norm(g, axis=1, keepdims=True), np.ones(len(g), dtype=bool)
+
+    lights = fibonacci_cap(8, 40.0)
+    est = simulate_error_deg(model, lights, fit)
+    assert est == simulate_designs(model, [lights], fit, signal_noise=False)[0]
+    assert est != simulate_designs(model, [lights], fit)[0]
