@@ -94,7 +94,8 @@ def check(scene_name: str, draw: int, n: int, seed: int = 0) -> None:
     )
     print(
         f"   lobe: ks {model.spec_strength:.4f} e {model.spec_exponent:g}; "
-        f"noise {model.noise:.4f};"
+        f"noise {model.noise:.4f} (variance {model.noise_var0 or 0:.3g} + "
+        f"{model.noise_slope:.3g} × signal);"
         f" captured-shadow fraction {model.shadowed.mean():.3f}; relief "
         f"{'none' if model.relief is None else 'yes'}"
     )

@@ -22,7 +22,10 @@ The model (:class:`ObjectModel`), fitted to the K captured observations of P sam
   integrated from the normals, shadows marched over it (:func:`soft_visibility`) — its depth
   optionally fitted to the captured shadows (:data:`FIT_RELIEF_GAIN`,
   :mod:`rti_rig.planner.adaptive_relief`; off: measured not to help, docs/adaptive.md);
-* **noise**: the robust scale of the kept observations' residuals (at least the noise floor).
+* **noise**: the robust scale of the kept observations' residuals (at least the noise floor),
+  and its dependence on the signal (:func:`fit_noise_model`: variance ``a + b × signal``, a
+  camera's shot noise), with which every simulated observation and held-out photograph is
+  drawn (:meth:`ObjectModel.noise_sd`).
 
 Simulations use fixed seeds (common random numbers across designs): a decision stays a
 deterministic function of the images, so ``--resume`` repeats it. The robust fit is passed in
@@ -59,6 +62,37 @@ SOFT_PX = 1.0
 FIT_RELIEF_GAIN = False
 #: Below this n·l a light is not expected to light the pixel (as the chooser's GRAZING_COS).
 FACING_COS = 0.15
+#: Whether the simulated noise depends on the signal (:func:`fit_noise_model`) rather than
+#: being the one constant ``noise`` for every observation (docs/adaptive.md, "Signal-dependent
+#: noise").
+SIGNAL_NOISE = True
+#: The noise fit's signal bins (quantiles of the kept observations' fitted signal) and the
+#: fewest observations a bin needs; fewer than :data:`NOISE_MIN_BINS` such bins, or a signal
+#: range of less than :data:`NOISE_MIN_SPAN` (ratio of the top bin's to the bottom bin's
+#: signal), and the fit cannot separate ``a`` from ``b``: the constant is kept.
+NOISE_BINS = 8
+NOISE_BIN_MIN = 20
+NOISE_MIN_BINS = 3
+NOISE_MIN_SPAN = 2.0
+#: Pixels the noise is fitted on (every k-th of the sample).
+NOISE_PIXELS = 500
+#: The largest slope ``b`` taken for a camera's shot noise (variance per unit signal, the
+#: images' units: 1 = full scale): 1/b is the full-well capacity in electrons at full scale,
+#: and 1000 is far below any camera's (phones ~5 000, DSLRs 20 000–60 000; the simulator's
+#: 1.7·10⁻⁵ is ~60 000). A steeper slope is the model's misfit growing with the signal (the
+#: industrial scene's gloss and shadows: b 0.05–1.1), not noise in the photographs: the
+#: constant is kept. Set a priori from that physics, after the industrial scene lost with no
+#: bound (docs/adaptive.md, "Signal-dependent noise").
+NOISE_MAX_SLOPE = 1e-3
+#: Whether the error *estimate* (``simulate_error_deg``: ``--until-error``'s stopping rule)
+#: draws the signal-dependent noise too. Off: the estimate is calibrated
+#: (``planner.adaptive.SIM_ESTIMATE_SCALE``) with the constant, which carries the model's
+#: misfit as noise; with the signal-dependent noise the dark polished coin's estimate fell to
+#: half its measured error and its 2° and 4° sessions stopped early (3.58° at 46 lights, 6.10°
+#: at 15; docs/adaptive.md, "Signal-dependent noise"). The designs are ranked with it.
+ESTIMATE_SIGNAL_NOISE = False
+#: Median of a χ²₁ variable: a bin's variance is its median squared residual over this.
+_CHI2_1_MEDIAN = 0.45493642311957283
 #: Whether the pixels the robust fit left unsolved are modelled with their least-squares
 #: normal (:func:`solve_unsolved`) rather than the level normal the chooser keeps for them.
 SOLVE_UNSOLVED = True
@@ -83,7 +117,7 @@ class ObjectModel:
     albedo: NDArray[np.float64]  # (P,)
     spec_strength: float  # ks, in the images' units
     spec_exponent: float
-    noise: float  # per observation, images' units
+    noise: float  # per observation, images' units (the constant: shadows' threshold, evidence)
     shadow_el: NDArray[np.float64]  # (P, S) elevation (°) of each shadowing light, -inf: none
     shadow_az: NDArray[np.float64]  # (P, S) its azimuth (°)
     lights: NDArray[np.float64]  # (K, 3) captured
@@ -92,16 +126,32 @@ class ObjectModel:
     relief: tuple[NDArray, NDArray, NDArray] | None = None
     #: the gain of the relief's detail fitted to the captured shadows (1: as integrated)
     relief_gain: float = 1.0
+    #: the noise's variance ``noise_var0 + noise_slope × signal`` (:func:`fit_noise_model`);
+    #: ``noise_var0`` None: the constant ``noise`` for every observation
+    noise_var0: float | None = None
+    noise_slope: float = 0.0
     #: rendered columns, by light (see :func:`render`)
     rendered: dict = field(default_factory=dict, compare=False, repr=False)
 
+    def noise_sd(self, clean: NDArray) -> NDArray[np.float64] | float:
+        """The noise's deviation of observations whose noise-free value is ``clean`` (any
+        shape; a float when the model's noise is the constant)."""
+        if self.noise_var0 is None:
+            return self.noise
+        var = self.noise_var0 + self.noise_slope * np.maximum(np.asarray(clean, np.float64), 0.0)
+        return np.sqrt(var)
+
     def evidence(self) -> dict[str, float]:
-        return {
+        out = {
             "spec_strength": round(self.spec_strength, 5),
             "spec_exponent": self.spec_exponent,
             "noise": round(self.noise, 5),
             "shadowed_fraction": round(float(self.shadowed.mean()), 4),
         }
+        if self.noise_var0 is not None:
+            out["noise_var0"] = float(f"{self.noise_var0:.4g}")
+            out["noise_slope"] = float(f"{self.noise_slope:.4g}")
+        return out
 
 
 def _half_cos(n: NDArray, lights: NDArray) -> NDArray:
@@ -188,6 +238,90 @@ def solve_unsolved(
     return normals, albedo, valid, lit_count
 
 
+def fit_noise_model(signal: NDArray, resid2: NDArray, floor: float) -> tuple[float, float] | None:
+    """(a, b) of the noise's variance ``a + b × signal`` from kept observations' fitted
+    ``signal`` and their squared *standardized* residuals ``resid2`` (each over its ``1 − h``,
+    :func:`standardized_residuals2`), or None where the fit cannot separate a from b (then the
+    constant serves).
+
+    Why: a camera's noise is shot noise (the simulator's variance ≈ 1.7·10⁻⁵ × signal, ~0 in
+    the dark; a real camera's likewise, plus read noise); the relighting score averages
+    per-light PSNRs, and one constant σ for every observation makes a held-out light that
+    leaves the object mostly dark as noisy as a bright one — it compressed the simulated
+    ranking of the floors on the tilted plane (docs/adaptive.md). How: the observations are
+    binned by quantiles of their signal (:data:`NOISE_BINS`); each bin's variance is its median
+    squared residual over the χ²₁ median (robust to highlights and shadows the fit left in);
+    the line through the bins' (median signal, variance) is Theil–Sen's (the median of
+    pairwise slopes: robust, deterministic). ``a`` is at least ``floor²`` (the constant's
+    floor); a slope that is not positive is no evidence of shot noise, one above
+    :data:`NOISE_MAX_SLOPE` is misfit, not a camera's noise: None for both."""
+    s = np.asarray(signal, dtype=np.float64).ravel()
+    r2 = np.asarray(resid2, dtype=np.float64).ravel()
+    if s.size < NOISE_BIN_MIN * NOISE_MIN_BINS:
+        return None
+    order = np.argsort(s, kind="stable")
+    xs, vs = [], []
+    for chunk in np.array_split(order, NOISE_BINS):
+        if chunk.size < NOISE_BIN_MIN:
+            continue
+        xs.append(float(np.median(s[chunk])))
+        vs.append(float(np.median(r2[chunk])) / _CHI2_1_MEDIAN)
+    x, v = np.array(xs), np.array(vs)
+    if x.size < NOISE_MIN_BINS or x[0] <= 0 or x[-1] < NOISE_MIN_SPAN * x[0]:
+        return None
+    i, j = np.triu_indices(x.size, 1)
+    dx = x[j] - x[i]
+    ok = dx > 0
+    if not ok.any():
+        return None
+    b = float(np.median((v[j] - v[i])[ok] / dx[ok]))
+    if not 0 < b <= NOISE_MAX_SLOPE:
+        return None
+    a = float(np.median(v - b * x))
+    return max(a, floor**2), b
+
+
+def standardized_residuals2(
+    resid: NDArray, signal: NDArray, lights: NDArray[np.float64], use: NDArray[np.bool_]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+    """(K, P) squared residuals over ``1 − h`` (``h`` each observation's leverage in its
+    pixel's least-squares fit on the observations ``use`` (K, P) marks), the signal each stands
+    for, and where that is informative: a pixel with at least 4 such observations and
+    ``1 − h`` ≥ 0.1.
+
+    Why: a pixel fitted on 3 lit lights has residuals 0 whatever the noise (the tilted plane's
+    first decision: every pixel so), and on few lights the residual degrees of freedom fall on
+    each light by its leverage. With ``M = (I − H)²`` (element-wise) a residual's variance is
+    ``Σ_j M_kj σ_j²``: for ``σ² = a + b s`` that is ``(1 − h_kk)(a + b s̄_k)`` with ``s̄_k`` the
+    ``M``-weighted mean signal of the pixel's observations — so a residual over ``1 − h_kk``
+    measures the noise at ``s̄_k``, not at its own signal (a dark observation's residual
+    carries the bright ones' noise too). The constant's ``k/(k−3)`` is the average of this
+    correction."""
+    w = np.asarray(use, dtype=np.float64)
+    lt = np.asarray(lights, dtype=np.float64)
+    m = w.sum(axis=0)
+    gram = np.einsum("kp,ki,kj->pij", w, lt, lt)
+    ok_p = (m >= 4) & (np.linalg.det(gram) > 1e-12)
+    inv = np.zeros_like(gram)
+    inv[ok_p] = np.linalg.inv(gram[ok_p])
+    # the hat matrix of each pixel's fit over its used observations (P, K, K)
+    wt = w.T  # (P, K)
+    hat = np.matmul(np.matmul(lt, inv), lt.T)  # (P, K, K), batched products (einsum: 4× slower)
+    hat *= wt[:, :, None]
+    hat *= wt[:, None, :]
+    resid_op = -hat
+    idx = np.arange(len(lt))
+    resid_op[:, idx, idx] += wt
+    one_h = resid_op[:, idx, idx].T  # 1 − h_kk on used observations (K, P)
+    mm = np.square(resid_op, out=resid_op)  # (P, K, K)
+    sig = np.asarray(signal, dtype=np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s_eff = (np.matmul(mm, sig.T[:, :, None])[..., 0] / mm.sum(axis=2)).T
+    good = np.asarray(use, dtype=bool) & ok_p[None, :] & (one_h >= 0.1)
+    r2 = np.where(good, np.asarray(resid, np.float64) ** 2 / np.maximum(one_h, 0.1), 0.0)
+    return r2, np.where(good, s_eff, 0.0), good
+
+
 def fit_object_model(
     obs: NDArray,
     lights: NDArray[np.float64],
@@ -242,6 +376,14 @@ def fit_object_model(
         if sse < best[0] - 1e-12:
             best = (sse, ks, e)
     _, ks, e = best
+    noise_ab = None
+    if SIGNAL_NOISE:  # the kept observations' residuals against the signal fitted to them
+        kept = use & (np.abs(resid) <= np.maximum(4.0 * noise, 0.25 * lam))  # no highlight
+        # on a fixed subset of the pixels (the fit needs a few hundred observations, and the
+        # leverages cost K² per pixel)
+        sub = np.arange(0, lam.shape[1], max(1, lam.shape[1] // NOISE_PIXELS))
+        r2, s_eff, good = standardized_residuals2(resid[:, sub], lam[:, sub], lights, kept[:, sub])
+        noise_ab = fit_noise_model(s_eff[good], r2[good], noise_floor)
     gain = 1.0
     if relief is not None and FIT_RELIEF_GAIN:
         from rti_rig.planner.adaptive_relief import fit_relief_gain
@@ -264,6 +406,8 @@ def fit_object_model(
         shadowed=shadowed,
         relief=relief,
         relief_gain=gain,
+        noise_var0=None if noise_ab is None else noise_ab[0],
+        noise_slope=0.0 if noise_ab is None else noise_ab[1],
     )
 
 
@@ -360,12 +504,22 @@ def _render(model: ObjectModel, lights: NDArray[np.float64], pix: NDArray[np.int
 
 
 def light_noise(
-    lights: NDArray[np.float64], draws: int, npix: int, sigma: float, seed: int
+    lights: NDArray[np.float64],
+    draws: int,
+    npix: int,
+    sigma: float | NDArray[np.float64],
+    seed: int,
 ) -> NDArray[np.float64]:
-    """(draws, L, npix) Gaussian noise of deviation ``sigma``, each light's drawn from a seed of
-    its own direction: the same in every design, call and decision of a session, and for the
-    normals and the relighting scores alike (common random numbers)."""
-    return np.stack([sigma * _unit_noise(seed, _direction_key(v), draws, npix) for v in lights], 1)
+    """(draws, L, npix) Gaussian noise of deviation ``sigma`` (a float, or (L, npix): each
+    observation's, :meth:`ObjectModel.noise_sd`), each light's drawn from a seed of its own
+    direction: the same in every design, call and decision of a session, and for the normals
+    and the relighting scores alike (common random numbers)."""
+    if np.ndim(sigma) == 0:
+        return np.stack(
+            [sigma * _unit_noise(seed, _direction_key(v), draws, npix) for v in lights], 1
+        )
+    z = np.stack([_unit_noise(seed, _direction_key(v), draws, npix) for v in lights], 1)
+    return z * np.asarray(sigma, dtype=np.float64)[None]
 
 
 def _direction_key(v: NDArray[np.float64]) -> tuple[int, ...]:
@@ -391,8 +545,11 @@ def simulate_error_deg(
     seed: int = SIM_SEED,
 ) -> float:
     """Mean angle (°) between the robust fit of simulated observations under ``lights`` and
-    the model's normals (see :func:`simulate_designs`)."""
-    return simulate_designs(model, [lights], fit, pixels, draws, seed)[0]
+    the model's normals (see :func:`simulate_designs`; the noise: see
+    :data:`ESTIMATE_SIGNAL_NOISE`)."""
+    return simulate_designs(
+        model, [lights], fit, pixels, draws, seed, signal_noise=ESTIMATE_SIGNAL_NOISE
+    )[0]
 
 
 def simulate_designs(
@@ -402,11 +559,13 @@ def simulate_designs(
     pixels: int = SIM_PIXELS,
     draws: int = SIM_DRAWS,
     seed: int = SIM_SEED,
+    signal_noise: bool = True,
 ) -> list[float]:
     """Per design (its full light set, (L, 3)): the mean angle (°) between the robust fit of
     simulated observations and the model's normals, over a fixed pixel subset and ``draws``
-    noise draws (a pixel the fit cannot solve counts with the view axis, as the benchmarks
-    count it; a refused fit counts 90°).
+    noise draws (each observation's deviation the model's, :meth:`ObjectModel.noise_sd`; with
+    ``signal_noise`` False the constant ``noise``); a pixel the fit cannot solve counts with
+    the view axis, as the benchmarks count it; a refused fit counts 90°.
 
     Every light is rendered once for all designs, and its noise is the same in every design
     that has it (common random numbers: the designs are compared, not the draws)."""
@@ -417,7 +576,8 @@ def simulate_designs(
     inverse = inverse.reshape(-1)
     clean = render(model, union, pix)  # (U, P')
     # each light's noise from a seed of its own direction: the same in every design and call
-    noise = light_noise(union, draws, len(pix), model.noise, seed)  # (draws, U, P')
+    sd = model.noise_sd(clean) if signal_noise else model.noise
+    noise = light_noise(union, draws, len(pix), sd, seed)  # (draws, U, P')
     truth = model.normals[pix]
     out = []
     at = 0

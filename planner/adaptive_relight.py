@@ -81,10 +81,15 @@ def relight_basis(n_total: int) -> str:
     return models_for(n_total)[-1]
 
 
-def mean_psnr_db(relit: NDArray, reference: NDArray, noise: float) -> float:
+def mean_psnr_db(relit: NDArray, reference: NDArray, noise: float | NDArray) -> float:
     """Mean over held-out lights (rows) of the PSNR (dB, data range 1) of ``relit`` against a
-    photograph of ``reference``: the squared error plus the photograph's noise ``noise²``."""
-    mse = ((np.asarray(relit, np.float64) - reference) ** 2).mean(axis=1) + noise**2
+    photograph of ``reference``: the squared error plus the photograph's noise ``noise²``
+    (``noise``: a float, or each observation's deviation, as ``reference``)."""
+    mse = ((np.asarray(relit, np.float64) - reference) ** 2).mean(axis=1)
+    if np.ndim(noise) == 0:
+        mse = mse + noise**2
+    else:
+        mse = mse + (np.asarray(noise, np.float64) ** 2).mean(axis=1)
     with np.errstate(divide="ignore"):
         db = np.where(mse > 0, -10.0 * np.log10(np.maximum(mse, 1e-300)), PSNR_CAP_DB)
     return float(np.minimum(db, PSNR_CAP_DB).mean())
@@ -109,7 +114,8 @@ def simulate_relight_designs(
     union, inverse = np.unique(np.round(allx, 9), axis=0, return_inverse=True)
     inverse = inverse.reshape(-1)
     clean = render(model, union, pix)  # (U, P'): every light rendered once, for all designs
-    noise = light_noise(union, draws, len(pix), model.noise, seed)  # (draws, U, P')
+    sd = model.noise_sd(clean)  # each observation's noise (a float: the constant)
+    noise = light_noise(union, draws, len(pix), sd, seed)  # (draws, U, P')
     n_design = sum(len(d) for d in designs)
     d_cols, h_cols = inverse[:n_design], inverse[n_design:]
     out = []
@@ -129,7 +135,8 @@ def simulate_relight_designs(
             if relit is None:
                 scores.append(0.0)
                 continue
-            scores.append(mean_psnr_db(relit, clean[hcols], model.noise))
+            ref_sd = sd if np.ndim(sd) == 0 else sd[hcols]
+            scores.append(mean_psnr_db(relit, clean[hcols], ref_sd))
         out.append(float(np.mean(scores)))
     return out
 

@@ -74,7 +74,12 @@ class FittedRelightObjective:
         albedo_ms: float,
         bias_rel: float = BIAS_REL,
         weights: NDArray[np.float64] | None = None,
+        noise_var: NDArray[np.float64] | None = None,
     ) -> None:
+        """``noise_var`` (C,): each candidate's mean noise variance over the pixels (the
+        model's signal-dependent noise); None: ``noise²`` for every one. The fit's noise
+        propagation takes their mean (an observation's variance on average); each held-out
+        light's photograph its own (:attr:`ref_var`)."""
         f = np.asarray(clean, dtype=np.float64)  # (C, P)
         p_count = f.shape[1]
         held = np.asarray(held, dtype=np.intp)
@@ -90,7 +95,13 @@ class FittedRelightObjective:
         self._f = f
         self.psi = f @ (f[held].T @ (a_t * w[:, None])) / p_count  # (C, p)
         self.k = float(np.mean(f[held] ** 2, axis=1) @ w) if len(held) else 0.0
-        self.noise2 = float(noise) ** 2
+        if noise_var is None:
+            self.noise2 = float(noise) ** 2
+            self.ref_var = np.full(len(held), self.noise2)
+        else:
+            nv = np.asarray(noise_var, dtype=np.float64)
+            self.noise2 = float(nv.mean())
+            self.ref_var = nv[held]  # (T,) each held-out photograph's noise
         d = design_matrix(DEVIATION_BASIS, candidates)  # (C, 16)
         self.d = d
         self.z = a_t.T @ (d[held] * w[:, None])  # (p, 16)
@@ -194,8 +205,17 @@ def fitted_relight_design(
         return np.sort(layouts[0])
     albedo_ms = float(np.mean(model.albedo[pix] ** 2))
     shot = np.asarray(shot, dtype=np.intp)
+    sd = model.noise_sd(clean)
+    noise_var = None if np.ndim(sd) == 0 else np.mean(np.asarray(sd) ** 2, axis=1)
     plain = FittedRelightObjective(
-        clean, candidates, held, basis, model.noise, albedo_ms, bias_rel=UNMODELLED_REL
+        clean,
+        candidates,
+        held,
+        basis,
+        model.noise,
+        albedo_ms,
+        bias_rel=UNMODELLED_REL,
+        noise_var=noise_var,
     )
     if not DB_WEIGHTED:
         return pinned_search(plain, shot, available, layouts)
@@ -205,12 +225,12 @@ def fitted_relight_design(
     # layout is the first-order change of that mean (a relative error counts, not an absolute
     # one); re-weighted at the layout found, ROUNDS times
     def db(layout: NDArray[np.intp]) -> float:
-        e = plain.per_light(np.r_[shot, layout]) + plain.noise2
+        e = plain.per_light(np.r_[shot, layout]) + plain.ref_var
         return float(np.mean(-10.0 * np.log10(np.maximum(e, 1e-30))))
 
     best = max(layouts, key=db)
     for _ in range(ROUNDS):
-        e = plain.per_light(np.r_[shot, best]) + plain.noise2
+        e = plain.per_light(np.r_[shot, best]) + plain.ref_var
         weighted = FittedRelightObjective(
             clean,
             candidates,
@@ -220,6 +240,7 @@ def fitted_relight_design(
             albedo_ms,
             bias_rel=UNMODELLED_REL,
             weights=1.0 / e,
+            noise_var=noise_var,
         )
         found = pinned_search(weighted, shot, available, [best, *layouts])
         if db(found) <= db(best):
