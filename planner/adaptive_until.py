@@ -51,8 +51,8 @@ GUESSES = (6, 9, 12, 18, 27, 40, 60, 90, 135, 200)
 #: 0.95 broke 2 of 119 claims at 0.25–8°, 0.9 broke 6 of 121, the point estimate 30 of 135;
 #: a window on the estimate, max of the last 3 or 6, cost more lights for no fewer broken
 #: claims) and checked on other candidate subsets of the same scenes (``--seed 1``, draw 0 —
-#: all candidates — shared: 0 of 115 claims broken, the point estimate 35 of 132). The real dome never used to choose (docs/adaptive.md, "The stop's
-#: upper estimate").
+#: all candidates — shared: 0 of 115 claims broken, the point estimate 35 of 132). The real
+#: dome never used to choose (docs/adaptive.md, "The stop's upper estimate").
 UPPER_FACTOR = 1.95
 UPPER_QUANTILE = 0.95
 
