@@ -153,8 +153,12 @@ def main() -> None:
     for mode in modes:
         med = statistics.median(times[mode])
         runs = ", ".join(f"{t:.1f}" for t in times[mode])
-        same = "reference" if mode == "single process" else (
-            "yes" if not mismatches[mode] else f"NO: {', '.join(sorted(set(mismatches[mode])))}"
+        same = (
+            "reference"
+            if mode == "single process"
+            else (
+                "yes" if not mismatches[mode] else f"NO: {', '.join(sorted(set(mismatches[mode])))}"
+            )
         )
         lines.append(f"| {mode} | {med:.1f} | {runs} | {med / base:.2f} | {same} |")
     table = "\n".join(lines)

@@ -173,9 +173,7 @@ def summarise_from(rows: list[Row], seconds: float, command: str) -> str:
     return "\n".join(lines)
 
 
-def bench_from(
-    lp: Path, out_dir: Path | None, progress: Callable[[str], None] = print
-) -> str:
+def bench_from(lp: Path, out_dir: Path | None, progress: Callable[[str], None] = print) -> str:
     """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
     it is None: the summary is only returned); return the summary."""
     t0 = time.perf_counter()

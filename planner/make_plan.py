@@ -72,6 +72,7 @@ TINY_PREVIEW_PX = 16
 
 ArmOrder = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.intp]]
 
+
 def check_elevation_band(min_elevation_deg: float, max_elevation_deg: float) -> None:
     """Refuse an elevation band that is empty or leaves the hemisphere."""
     if not 0.0 <= min_elevation_deg < 90.0:
@@ -428,9 +429,7 @@ def _surface_for(
         )
     elif preview is not None:
         try:
-            surface = estimate_surface(
-                preview, req.preview_light, req.depth_model, req.depth_spec
-            )
+            surface = estimate_surface(preview, req.preview_light, req.depth_model, req.depth_spec)
         except ScheduleError as exc:
             if method.surface != "none":
                 raise

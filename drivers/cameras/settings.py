@@ -243,6 +243,7 @@ CameraSettings = Annotated[
 ]
 """Any real camera's settings, told apart by ``kind`` (``[camera] kind = "gphoto2"``)."""
 
+
 def parse_camera_settings(data: dict[str, object]) -> BaseModel:
     """Validate a rig config's ``[camera.device]`` table into its kind's settings.
 

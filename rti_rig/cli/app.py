@@ -89,7 +89,5 @@ def parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[floa
     return az, el
 
 
-
-
 def main() -> None:
     app()

@@ -283,9 +283,7 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         from rti_rig.app.usecases.safe_state import lights_state
 
         _print_teardown_failures(folder)
-        err.print(
-            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}."
-        )
+        err.print(f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}.")
         err.print(_after_stop(opened, resume_hint), markup=False, soft_wrap=True)
         raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:

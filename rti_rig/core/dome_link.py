@@ -92,8 +92,6 @@ class DomeLedError(DeviceError):
         self.led = led
 
 
-
-
 class OffOutcome(StrEnum):
     """What is known about the dome's lights after an all-off was attempted."""
 

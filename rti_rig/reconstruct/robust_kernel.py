@@ -260,8 +260,22 @@ def _exceeds(x, sc, n, floor):  # type: ignore[no-untyped-def]
 
 @_jit()
 def fit_pixels(  # type: ignore[no-untyped-def]
-    g, inside, colour, lights, dark, sat, rules_f32, max_passes, shadow_min_kept, cond2,
-    eps_b, normals, albedo, rms, count_out, ok_out,
+    g,
+    inside,
+    colour,
+    lights,
+    dark,
+    sat,
+    rules_f32,
+    max_passes,
+    shadow_min_kept,
+    cond2,
+    eps_b,
+    normals,
+    albedo,
+    rms,
+    count_out,
+    ok_out,
 ):
     """The robust fit of every pixel of ``g`` (N, P) float32 (C order; NaN, infinite and
     saturated values are not used), ``inside`` (P,) the mask, ``colour`` (N, P, C) float32

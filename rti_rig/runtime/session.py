@@ -632,8 +632,6 @@ def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
     return scan
 
 
-
-
 def _copy_whole(src: Path, dest: Path) -> str:
     """Copy ``src`` to ``dest`` through a temporary file, never leaving a partial one; returns
     the copy's SHA-256."""

@@ -25,6 +25,7 @@ from rti_rig.core.errors import ConfigError, SessionError
 
 runner = CliRunner()
 
+
 def relative(values: np.ndarray) -> np.ndarray:
     return values / np.exp(np.median(np.log(values)))
 

@@ -83,9 +83,21 @@ def test_the_wheel_holds_one_top_level_package(tmp_path):
         shutil.copy2(REPO / name, source / name)
     wheels = tmp_path / "wheels"
     built = subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation",
-         "-w", str(wheels), str(source)],
-        capture_output=True, text=True, timeout=600,
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            "-q",
+            "--no-deps",
+            "--no-build-isolation",
+            "-w",
+            str(wheels),
+            str(source),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert built.returncode == 0, built.stderr
     (wheel,) = wheels.glob("rti_rig-*.whl")
@@ -123,10 +135,7 @@ DASK_MODULES = ("dask", "distributed")
 def test_dask_is_imported_only_when_a_fit_runs_on_it(module):
     """The plain fit, the CLI and even the Dask modules themselves load neither dask nor
     distributed until ``--scheduler`` makes a lazy stack or a client."""
-    code = (
-        f"import sys, {module}; "
-        f"print(','.join(m for m in {DASK_MODULES!r} if m in sys.modules))"
-    )
+    code = f"import sys, {module}; print(','.join(m for m in {DASK_MODULES!r} if m in sys.modules))"
     loaded = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
     ).stdout.strip()
@@ -142,7 +151,11 @@ def test_the_dask_check_has_teeth(tmp_path):
         f"print(','.join(m for m in {DASK_MODULES!r} if m in sys.modules))"
     )
     loaded = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120,
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=120,
         cwd=tmp_path,
     ).stdout.strip()
     assert "dask" in loaded.split(",")

@@ -16,9 +16,25 @@ REPO = Path(__file__).resolve().parents[2]
 def test_fit_dask_benchmark_runs_and_finds_identical_outputs() -> None:
     before = (REPO / "docs" / "benchmarks.md").read_bytes()
     done = subprocess.run(
-        [sys.executable, "-m", "benchmarks.fit_dask", "--sessions", "2", "--width", "40",
-         "--height", "32", "--lights", "20", "--repeats", "1"],
-        capture_output=True, text=True, cwd=REPO, timeout=900,
+        [
+            sys.executable,
+            "-m",
+            "benchmarks.fit_dask",
+            "--sessions",
+            "2",
+            "--width",
+            "40",
+            "--height",
+            "32",
+            "--lights",
+            "20",
+            "--repeats",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=900,
     )
     assert done.returncode == 0, done.stderr
     rows = [line for line in done.stdout.splitlines() if line.startswith("| ")]

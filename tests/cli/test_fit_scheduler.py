@@ -34,8 +34,15 @@ def test_an_unreachable_scheduler_is_a_clear_error(tmp_path: Path, monkeypatch) 
     for extra in ([], [str(session)]):  # one session, and a batch
         r = runner.invoke(
             app,
-            ["fit", str(session), *extra, "--out", str(tmp_path / "o"), "--scheduler",
-             "tcp://127.0.0.1:1"],
+            [
+                "fit",
+                str(session),
+                *extra,
+                "--out",
+                str(tmp_path / "o"),
+                "--scheduler",
+                "tcp://127.0.0.1:1",
+            ],
         )
         assert r.exit_code == 2, r.output
         assert "tcp://127.0.0.1:1" in r.output and "dask scheduler" in r.output

@@ -58,9 +58,7 @@ def grazing_shadow_object(seed: int = 0, p: int = 400, horizon_deg: float = 12.0
 def _designs(n_total: int, used: np.ndarray | None = None) -> dict[float, np.ndarray]:
     used = np.zeros((0, 3)) if used is None else used
     avail = np.ones(len(CANDIDATES), dtype=bool)
-    out = {
-        f: homogeneous_completion(CANDIDATES, avail, used, n_total, f) for f in DESIGN_FLOORS
-    }
+    out = {f: homogeneous_completion(CANDIDATES, avail, used, n_total, f) for f in DESIGN_FLOORS}
     return {f: c for f, c in out.items() if c is not None}
 
 
@@ -169,9 +167,7 @@ def test_the_score_is_the_benchmarks_relighting_psnr() -> None:
     fit_idx, held_idx = np.arange(0, 40, 3), np.setdiff1d(np.arange(40), np.arange(0, 40, 3))
     for basis, fit in (("ptm", fit_ptm), ("hsh2", lambda im, lt: fit_hsh(im, lt, 2))):
         model = fit(images[fit_idx].reshape(-1, h, w), lights[fit_idx])
-        expected = relight_psnr(
-            model, images[held_idx].reshape(-1, h, w), lights[held_idx], 1.0
-        )
+        expected = relight_psnr(model, images[held_idx].reshape(-1, h, w), lights[held_idx], 1.0)
         relit = relight_fit(images[fit_idx], lights[fit_idx], lights[held_idx], basis)
         assert mean_psnr_db(relit, images[held_idx], 0.0) == pytest.approx(expected, abs=1e-3)
     # the photograph's noise adds to the squared error of every held-out light

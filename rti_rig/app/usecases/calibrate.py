@@ -86,9 +86,7 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
         card_normal=req.card_normal,
         min_elevation_deg=req.min_elevation_deg,
     )
-    text = calibration_toml(
-        cal, loaded.config.name, req.card_session.resolve(), geometry.names
-    )
+    text = calibration_toml(cal, loaded.config.name, req.card_session.resolve(), geometry.names)
     try:
         target.write_text(text, encoding="utf-8")
     except OSError as exc:

@@ -456,9 +456,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         except BaseException:
             rig.close()
             raise
-    return OpenedSession(
-        rig, schedule, folder, Path(req.session_dir), resumed=True, source=source
-    )
+    return OpenedSession(rig, schedule, folder, Path(req.session_dir), resumed=True, source=source)
 
 
 def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> OpenedSession:
