@@ -630,10 +630,17 @@ def choose_in_design(
     design = {_label(f): round(v, 4) for f, v in sorted(scores.items())}
     if model is None:  # the bound's scores are estimates already (scaled)
         after = f"bound: {scores[best]:.3g}° estimated after all {n_total}"
-    else:  # the scores rank; the estimate a user compares with --until-error is scaled
+    elif model.noise_slope == 0.0:  # the scores rank; scaled, the estimate --until-error uses
         after = (
             f"simulated with this object's gloss and shadows: {scores[best]:.3g}° simulated, "
             f"{scale * scores[best]:.3g}° estimated after all {n_total}"
+        )
+    else:  # simulated with the noise growing with the signal: the estimate's scale is not
+        # calibrated for it (the stop's estimate simulates the constant noise), so none is given
+        after = (
+            f"simulated with this object's gloss, shadows and signal-dependent noise: "
+            f"{scores[best]:.3g}° simulated after all {n_total} (a ranking score, not the "
+            "stop's estimate)"
         )
     return Decision(
         d.candidate,

@@ -201,3 +201,33 @@ def test_the_error_estimate_keeps_the_constant_and_the_ranking_takes_the_shot_no
     est = simulate_error_deg(model, lights, fit)
     assert est == simulate_designs(model, [lights], fit, signal_noise=False)[0]
     assert est != simulate_designs(model, [lights], fit)[0]
+
+
+@pytest.mark.parametrize("ks", [0.02, 0.05, 0.3])
+def test_the_gloss_the_model_renders_is_not_taken_for_noise(ks: float) -> None:
+    """On a glossy surface the noise is fitted against what the model renders — the
+    Lambertian part and the fitted lobe — not the Lambertian part alone, which counted the
+    gloss twice (as lobe and as noise growing with the signal). Constant noise: the constant
+    is kept; shot noise: its slope found whatever the gloss."""
+    from rti_rig.planner.adaptive_bias import _half_cos, _lobe, fit_object_model
+
+    rng = np.random.default_rng(1)
+    p = 2000
+    lights = fibonacci_cap(18, 15.0)
+    n = rng.normal(size=(p, 3)) * [0.3, 0.3, 1.0]
+    n[:, 2] = np.abs(n[:, 2]) + 0.6
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    albedo = rng.uniform(0.3, 0.6, p)
+    cos = lights @ n.T
+    signal = albedo[None] * np.maximum(cos, 0) + ks * _lobe(_half_cos(n, lights).T, 16.0) * (
+        cos > 0
+    )
+
+    def model(var):  # type: ignore[no-untyped-def]
+        obs = np.maximum(signal + rng.normal(size=signal.shape) * np.sqrt(var), 0.0)
+        return fit_object_model(obs, lights, n, albedo, np.ones(p, bool), 0.01, 0.003)
+
+    flat = model(np.full(signal.shape, 0.004**2))
+    assert flat.noise_slope == 0.0  # constant noise: no slope (the lobe's residual was one)
+    shot = model(1e-6 + 1.7e-4 * signal)
+    assert 1.7e-4 / 1.6 < shot.noise_slope < 1.7e-4 * 1.6
