@@ -24,8 +24,10 @@ The model (:class:`ObjectModel`), fitted to the K captured observations of P sam
   :mod:`rti_rig.planner.adaptive_relief`; off: measured not to help, docs/adaptive.md);
 * **noise**: the robust scale of the kept observations' residuals (at least the noise floor),
   and its dependence on the signal (:func:`fit_noise_model`: variance ``a + b × signal``, a
-  camera's shot noise), with which every simulated observation and held-out photograph is
-  drawn (:meth:`ObjectModel.noise_sd`).
+  camera's shot noise, fitted against what the model renders), with which the design
+  scores' simulated observations and held-out photographs are drawn
+  (:meth:`ObjectModel.noise_sd`) — not the stop's estimate, which keeps the constant it is
+  calibrated with (:data:`ESTIMATE_SIGNAL_NOISE`).
 
 Simulations use fixed seeds (common random numbers across designs): a decision stays a
 deterministic function of the images, so ``--resume`` repeats it. The robust fit is passed in

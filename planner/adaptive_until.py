@@ -59,13 +59,13 @@ UPPER_FACTOR = 1.95
 UPPER_QUANTILE = 0.95
 
 
-def upper_error_deg(estimate_deg: float, factor: float = UPPER_FACTOR) -> float:
+def upper_error_deg(estimate_deg: float, factor: float | None = None) -> float:
     """The upper estimate (°) the stop compares with ``--until-error``: the point estimate
-    × ``factor``."""
-    return factor * estimate_deg
+    × ``factor`` (None: :data:`UPPER_FACTOR`, read now)."""
+    return (UPPER_FACTOR if factor is None else factor) * estimate_deg
 
 
-def reaches_target(estimate_deg: float, target_deg: float, factor: float = UPPER_FACTOR) -> bool:
+def reaches_target(estimate_deg: float, target_deg: float, factor: float | None = None) -> bool:
     """Whether the stop may claim ``target_deg``: the upper estimate is at most the target."""
     return upper_error_deg(estimate_deg, factor) <= target_deg
 

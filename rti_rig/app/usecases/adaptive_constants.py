@@ -39,12 +39,11 @@ DECISION_MODULES = (
     "rti_rig.app.usecases.adaptive",
 )
 
-#: Constants a resume takes from the session's own settings rather than from this build (the
+#: Constants (by bare name, under whichever module records them) a resume takes from the
+#: session's own settings rather than from this build (the
 #: stop's factor: it decides only when to stop, never which light, and the settings hold it as
 #: ``upper_factor``), so a difference in them is no reason to refuse.
-RESTORED_ON_RESUME = frozenset(
-    {"planner.adaptive_until.UPPER_FACTOR", "planner.adaptive_until.UPPER_QUANTILE"}
-)
+RESTORED_ON_RESUME = frozenset({"UPPER_FACTOR", "UPPER_QUANTILE"})
 
 #: How many differing constants a refusal names (the rest are counted).
 NAMED_DIFFERENCES = 5
@@ -72,8 +71,11 @@ def decision_constants() -> dict[str, Any]:
         for key, value in sorted(vars(module).items()):
             if not (key.isupper() and not key.startswith("_") and _plain(value)):
                 continue
-            # a name imported from a module listed before is that module's constant: recorded
-            # once, under it (else a resume would compare a stale copy, e.g. the usecase's)
+            # the same object under the same name as in a module listed before is (almost
+            # always) an import of it: recorded once, under the first (else a resume would
+            # compare a stale copy). Two equal small ints or interned strings defined apart
+            # collapse too; a later change then shows as "absent", which refuses, never
+            # accepts silently
             if any(value is v for v in seen.get(key, ())):
                 continue
             seen.setdefault(key, []).append(value)
@@ -86,7 +88,9 @@ def constant_differences(recorded: dict[str, Any], current: dict[str, Any]) -> l
     (``NAME recorded → now``; a constant one side lacks shows as ``absent``), apart from
     :data:`RESTORED_ON_RESUME`."""
     lines = []
-    for key in sorted((set(recorded) | set(current)) - RESTORED_ON_RESUME):
+    for key in sorted(set(recorded) | set(current)):
+        if key.rsplit(".", 1)[-1] in RESTORED_ON_RESUME:
+            continue
         was, now = recorded.get(key, "absent"), current.get(key, "absent")
         if was != now:
             lines.append(f"{key} {was!r} → {now!r}")
