@@ -115,7 +115,12 @@ def test_each_light_is_chosen_within_the_design_for_the_guessed_n(
         taken = "fitted" if d.get("design") == "fitted" else f"{d['design_floor_deg']:g}"
         sim = d["design_error_deg"][taken]
         if "signal-dependent noise" in d["reason"]:  # not the noise the estimate is scaled for
-            assert f"{sim:.3g}° simulated after all" in d["reason"]
+            import re
+
+            said_ = r"([0-9.]+)° simulated after all (\d+) \(a ranking score"
+            shown = re.search(said_, d["reason"])
+            assert shown and int(shown[2]) == guess
+            assert float(shown[1]) == pytest.approx(sim, rel=2e-3)
             assert "estimated" not in d["reason"]
         else:
             assert f"{sim:.3g}° simulated, {SIM_ESTIMATE_SCALE * sim:.3g}° estimated" in d["reason"]
