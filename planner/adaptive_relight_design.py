@@ -207,16 +207,21 @@ def fitted_relight_design(
     shot = np.asarray(shot, dtype=np.intp)
     sd = model.noise_sd(clean)
     noise_var = None if np.ndim(sd) == 0 else np.mean(np.asarray(sd) ** 2, axis=1)
-    plain = FittedRelightObjective(
-        clean,
-        candidates,
-        held,
-        basis,
-        model.noise,
-        albedo_ms,
-        bias_rel=UNMODELLED_REL,
-        noise_var=noise_var,
-    )
+
+    def objective(weights: NDArray[np.float64] | None = None) -> FittedRelightObjective:
+        return FittedRelightObjective(
+            clean,
+            candidates,
+            held,
+            basis,
+            model.noise,
+            albedo_ms,
+            bias_rel=UNMODELLED_REL,
+            weights=weights,
+            noise_var=noise_var,
+        )
+
+    plain = objective()
     if not DB_WEIGHTED:
         return pinned_search(plain, shot, available, layouts)
 
@@ -231,17 +236,7 @@ def fitted_relight_design(
     best = max(layouts, key=db)
     for _ in range(ROUNDS):
         e = plain.per_light(np.r_[shot, best]) + plain.ref_var
-        weighted = FittedRelightObjective(
-            clean,
-            candidates,
-            held,
-            basis,
-            model.noise,
-            albedo_ms,
-            bias_rel=UNMODELLED_REL,
-            weights=1.0 / e,
-            noise_var=noise_var,
-        )
+        weighted = objective(weights=1.0 / e)
         found = pinned_search(weighted, shot, available, [best, *layouts])
         if db(found) <= db(best):
             break
