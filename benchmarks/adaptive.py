@@ -52,7 +52,7 @@ from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start, small_grey
 from rti_rig.core.geometry import az_el_from_direction
 from rti_rig.core.rig_geometry import DomeGeometry
-from rti_rig.planner.adaptive import START_LIGHTS, discarded_fraction
+from rti_rig.planner.adaptive import SIM_ESTIMATE_SCALE, START_LIGHTS, discarded_fraction
 from rti_rig.planner.adaptive_until import UPPER_FACTOR
 from rti_rig.planner.objectives import models_for
 from rti_rig.planner.topography import REC709
@@ -698,8 +698,9 @@ def main(argv: list[str] | None = None) -> str:
             "observations simulated from this object's model (gloss, cast shadows, noise; "
             f"planner/adaptive_bias.py) under the lights so far — × {scale:.3f} × "
             f"exp({slope:.2f} × the fraction of observations the fit discarded) (least squares "
-            "of log measured/simulated over all simulated scenes, draws and N; "
-            "`SIM_ESTIMATE_SCALE` in planner/adaptive.py). Cells: mean predicted / mean measured "
+            "of log measured/simulated over all simulated scenes, draws and N, fitted by this "
+            f"run; the shipped `SIM_ESTIMATE_SCALE` in planner/adaptive.py is "
+            f"{SIM_ESTIMATE_SCALE:.3f}). Cells: mean predicted / mean measured "
             "(geometric-mean ratio measured/predicted); simulator rows use the factors fitted on "
             "the *other* scenes; the real row uses the simulator's (never fitted on it; measured "
             "= against the all-72-light fit, which is itself not the truth). " + calib_summary,

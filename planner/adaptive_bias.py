@@ -381,7 +381,10 @@ def fit_object_model(
         # against what the model renders — the Lambertian part *and* the fitted lobe: a
         # residual against the Lambertian part alone takes the gloss the model already
         # renders for noise, counting it twice (a second reader: the coin's b 1.1e-4 at 18
-        # images); the signal the noise grows with is the rendered one
+        # images); the signal the noise grows with is the rendered one. Not rendered here:
+        # the relief's soft cast shadows (the model's visibility, built after this fit) — an
+        # observation in a penumbra that the shadow test above and the highlight test below
+        # both pass counts its shading as noise (a small, noise-inflating bias)
         shown = lam + ks * _lobe(hc, e) * (cos > 0.0)
         dev = obs - shown
         kept = use & (np.abs(dev) <= np.maximum(4.0 * noise, 0.25 * shown))  # no highlight

@@ -80,6 +80,35 @@ def test_the_residuals_are_standardized_by_their_leverage() -> None:
     assert r2[dim].mean() > 1.05 * b * clean[dim, 0]
 
 
+def test_the_closed_form_leverages_match_the_hat_matrix_on_a_partial_mask() -> None:
+    """The closed form (no (P, K, K) arrays) against the definition, pixel by pixel, where
+    each pixel uses its own subset of the lights: H = A (AᵀWA)⁻¹ AᵀW, M = (diag(w) − H)²,
+    the signal a residual stands for M·s / ΣM, its square over 1 − h."""
+    rng = np.random.default_rng(11)
+    k, p = 12, 50
+    lights = fibonacci_cap(k, 15.0)
+    use = rng.random((k, p)) < 0.7
+    use[:3, :5] = False  # a few pixels with fewer lights, down to too few
+    use[3:, 5] = False  # pixel 5: 3 lights, no evidence
+    resid = rng.normal(size=(k, p))
+    sig = rng.random((k, p)) + 0.1
+    r2, s_eff, good = standardized_residuals2(resid, sig, lights, use)
+    for px in range(p):
+        w = use[:, px].astype(float)
+        if w.sum() < 4:
+            assert not good[:, px].any()
+            continue
+        hat = lights @ np.linalg.inv(lights.T @ (w[:, None] * lights)) @ (lights.T * w)
+        m = (np.diag(w) - hat) ** 2
+        one_h = w - np.diag(hat) * w
+        ok = use[:, px] & (one_h >= 0.1)
+        np.testing.assert_array_equal(good[:, px], ok)
+        want_s = (m @ (w * sig[:, px])) / np.maximum(m @ w, 1e-300)
+        np.testing.assert_allclose(s_eff[ok, px], want_s[ok], rtol=1e-9)
+        np.testing.assert_allclose(r2[ok, px], resid[ok, px] ** 2 / one_h[ok], rtol=1e-9)
+    assert not good[:, 5].any() and good.any()
+
+
 def test_three_lit_lights_give_no_noise_evidence() -> None:
     """A pixel fitted on 3 lights has residual 0 whatever the noise: no evidence, and the model
     keeps its constant (the tilted plane's first decision)."""

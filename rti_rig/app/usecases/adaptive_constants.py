@@ -39,10 +39,12 @@ DECISION_MODULES = (
     "rti_rig.app.usecases.adaptive",
 )
 
-#: Constants (by bare name, under whichever module records them) a resume takes from the
-#: session's own settings rather than from this build (the
-#: stop's factor: it decides only when to stop, never which light, and the settings hold it as
-#: ``upper_factor``), so a difference in them is no reason to refuse.
+#: Constants (by bare name, under whichever module records them: the dedup below keeps an
+#: import under the first module that holds it) whose difference is no reason to refuse a
+#: resume: the stop's factor decides only when to stop, never which light, and a resume takes
+#: it from the session's settings (``upper_factor``); the quantile only derived that factor
+#: and is read by nothing at run time. A test checks that no decision module defines another
+#: constant under these names (it would be exempted too).
 RESTORED_ON_RESUME = frozenset({"UPPER_FACTOR", "UPPER_QUANTILE"})
 
 #: How many differing constants a refusal names (the rest are counted).
@@ -62,7 +64,10 @@ def _plain(value: Any) -> bool:
 def decision_constants() -> dict[str, Any]:
     """``module.NAME`` (the module's path under ``rti_rig``) → value (as JSON reads it back:
     tuples as lists) for every constant of :data:`DECISION_MODULES`, read now (so a value a
-    benchmark sets is what is recorded)."""
+    benchmark sets on the module is what is recorded). A constant a function takes as a
+    default argument (``SIM_PIXELS``, ``ESTIMATE_SCALE`` …) was bound when its module was
+    imported: one set on the module later is recorded but not used — set it before the import,
+    or pass the argument."""
     out: dict[str, Any] = {}
     seen: dict[str, list[object]] = {}  # name → the objects earlier modules hold under it
     for name in DECISION_MODULES:

@@ -1,0 +1,40 @@
+"""The decision constants a resume compares: which are exempt, and that the exemption by bare
+name cannot hide a constant that steers decisions."""
+
+from __future__ import annotations
+
+import importlib
+
+from rti_rig.app.usecases.adaptive_constants import (
+    DECISION_MODULES,
+    RESTORED_ON_RESUME,
+    constant_differences,
+    decision_constants,
+)
+from rti_rig.planner import adaptive_until
+
+
+def test_only_the_stop_factor_and_its_quantile_are_defined_under_the_exempt_names() -> None:
+    """A decision module that defined its own UPPER_FACTOR (say, a bound for a design) would be
+    exempt from the resume check by name: every module that holds one of these names must hold
+    the stop module's very object (an import of it)."""
+    for name in DECISION_MODULES:
+        module = importlib.import_module(name)
+        for key in RESTORED_ON_RESUME:
+            if hasattr(module, key):
+                assert getattr(module, key) is getattr(adaptive_until, key), f"{name}.{key}"
+
+
+def test_the_exempt_names_are_exempt_under_any_module_and_nothing_else_is() -> None:
+    now = decision_constants()
+    assert now["planner.adaptive_until.UPPER_FACTOR"] == adaptive_until.UPPER_FACTOR
+    recorded = dict(now)
+    recorded["planner.adaptive_until.UPPER_FACTOR"] = 2.5
+    recorded["planner.adaptive.UPPER_QUANTILE"] = 0.5  # recorded under another module
+    assert constant_differences(recorded, now) == []
+    recorded["planner.adaptive.SIM_MARGIN"] = -1.0
+    del recorded["planner.adaptive_optimal.SEARCH_PIXELS"]
+    lines = constant_differences(recorded, now)
+    assert len(lines) == 2
+    assert lines[0].startswith("planner.adaptive.SIM_MARGIN -1.0 → ")
+    assert lines[1].startswith("planner.adaptive_optimal.SEARCH_PIXELS 'absent' → ")
