@@ -22,6 +22,12 @@ REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 
 
+def folder_bytes(out: Path) -> dict[str, bytes]:
+    """Every file under a session folder with its bytes: a refused resume must leave them all
+    as they were."""
+    return {str(p.relative_to(out)): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+
+
 @pytest.fixture(scope="module")
 def uninterrupted(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     base = tmp_path_factory.mktemp("adaptive")
@@ -228,10 +234,7 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     with (out / "journal.jsonl").open("a", encoding="utf-8") as f:
         f.write('{"step": 4, "led": 1')
 
-    def files() -> dict[str, bytes]:
-        return {str(p.relative_to(out)): p.read_bytes() for p in out.rglob("*") if p.is_file()}
-
-    before = files()
+    before = folder_bytes(out)
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
@@ -239,7 +242,7 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     assert "export-lp" in text and "new session" in text
     # refused from the manifest: nothing in the folder changed (journal not repaired, nothing
     # set aside), not a byte
-    assert files() == before
+    assert folder_bytes(out) == before
 
 
 def test_the_manifest_records_every_decision_constant(uninterrupted: tuple[Path, Path]) -> None:
@@ -268,10 +271,7 @@ def test_a_session_begun_under_other_constants_is_refused_by_name(
     out = tmp_path / "other"
     interrupted(cfg, out, after_step=4)
 
-    def files() -> dict[str, bytes]:
-        return {str(p.relative_to(out)): p.read_bytes() for p in out.rglob("*") if p.is_file()}
-
-    before = files()
+    before = folder_bytes(out)
     monkeypatch.setattr(adaptive, "SIM_MARGIN", 0.25)
     monkeypatch.setattr(adaptive_optimal, "SEARCH_PIXELS", 400)
     r = runner.invoke(app, ["run", "--resume", str(out)])
@@ -281,7 +281,7 @@ def test_a_session_begun_under_other_constants_is_refused_by_name(
     assert "planner.adaptive.SIM_MARGIN 0.1 → 0.25" in text
     assert "planner.adaptive_optimal.SEARCH_PIXELS 500 → 400" in text
     assert "export-lp" in text and "Traceback" not in text
-    assert files() == before
+    assert folder_bytes(out) == before
     # a build with another stop factor continues it (the factor is the session's own: its
     # settings hold it) — what a release that re-chose UPPER_FACTOR looks like
     from rti_rig.planner import adaptive_until
@@ -311,15 +311,12 @@ def test_a_session_of_this_format_without_its_constants_is_refused(
     del m["adaptive"]["constants"]
     (out / "manifest.json").write_text(json.dumps(m))
 
-    def files() -> dict[str, bytes]:
-        return {str(p.relative_to(out)): p.read_bytes() for p in out.rglob("*") if p.is_file()}
-
-    before = files()
+    before = folder_bytes(out)
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
     assert "do not record its decision constants" in text and "export-lp" in text
-    assert files() == before
+    assert folder_bytes(out) == before
 
 
 def test_the_robust_kernel_is_loaded_before_the_rig_opens(tmp_path: Path, monkeypatch) -> None:
