@@ -100,6 +100,15 @@ def run(
             "this many degrees (with --lights: whichever comes first).",
         ),
     ] = None,
+    min_lights: Annotated[
+        int | None,
+        typer.Option(
+            "--min-lights",
+            help="With --until-error: shoot at least this many lights before the stop may "
+            "claim the target (a PTM needs 6, HSH of order 2 needs 9; without it a session "
+            "that reaches its target early has a normal map and no RTI).",
+        ),
+    ] = None,
     objective: Annotated[
         str | None,
         typer.Option(
@@ -138,6 +147,7 @@ def run(
                     ("--lights", lights is not None),
                     ("--adaptive", adaptive),
                     ("--until-error", until_error is not None),
+                    ("--min-lights", min_lights is not None),
                     ("--auto-exposure", auto_exposure),
                     ("--min-elevation-deg", min_elevation_deg != 0.0),
                     ("--max-elevation-deg", max_elevation_deg != 90.0),
@@ -177,6 +187,7 @@ def run(
                     adaptive=adaptive,
                     until_error_deg=until_error,
                     objective=objective,
+                    min_lights=min_lights,
                 ),
                 print_note,
             )
@@ -321,7 +332,7 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
     adaptive_result = opened.extra.get("adaptive_result")
     if adaptive_result is not None:
-        from rti_rig.app.usecases.adaptive import estimate_phrase
+        from rti_rig.app.usecases.adaptive import estimate_phrase, few_lights_note
 
         chosen_for = adaptive_result.get("objective", "normals")
         out.print(
@@ -330,6 +341,9 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
             f"{adaptive_result['stop']['reason']}; {estimate_phrase(adaptive_result)}",
             highlight=False,
         )
+        short = few_lights_note(adaptive_result)
+        if short is not None:
+            err.print(f"[yellow]note:[/] {escape(short)}", highlight=False)
     if result.finish_reason is FinishReason.CANCELLED:
         err.print(
             f"[yellow]Session cancelled; the images captured so far are kept.[/] {resume_hint}"

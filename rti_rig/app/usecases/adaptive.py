@@ -296,7 +296,12 @@ class AdaptiveChooser:
         bias_aware: bool | None = None,
         objective: str = "normals",
         upper_factor: float | None = None,
+        min_lights: int | None = None,
     ) -> None:
+        #: with --until-error: the fewest lights the stop may claim the target at (None: no
+        #: minimum). The normal error is not the only thing a session is for: a PTM needs 6
+        #: lights and HSH of order 2 needs 9, and a stop at 4 gives a normal map and no RTI.
+        self.min_lights = min_lights
         #: the stop's upper estimate = the point estimate × this (None: this build's
         #: ``adaptive_until.UPPER_FACTOR``, read now; a resume passes the session's own)
         self.upper_factor = adaptive_until.UPPER_FACTOR if upper_factor is None else upper_factor
@@ -401,11 +406,18 @@ class AdaptiveChooser:
         assert self.until_error_deg is not None
         return reaches_target(est, self.until_error_deg, self.upper_factor)
 
-    def _reached_reason(self, est: float) -> str:
-        return (
+    def _past_minimum(self, index: int) -> bool:
+        """Whether ``index`` lights are at least the --min-lights asked for (always, without)."""
+        return self.min_lights is None or index >= self.min_lights
+
+    def _reached_reason(self, est: float, index: int | None = None) -> str:
+        reason = (
             f"upper estimate {self.upper(est):.2f}° (estimate {est:.2f}° × "
             f"{self.upper_factor:g}) ≤ --until-error {self.until_error_deg:g}°"
         )
+        if self.min_lights is not None and index == self.min_lights:
+            reason += f", at the --min-lights {self.min_lights} asked for"
+        return reason
 
     def _cap_reason(self) -> str:
         # --lights N, or without it the rig's own cap: both are the session's maximum
@@ -449,11 +461,11 @@ class AdaptiveChooser:
             pick = int(far[0] if dots is None else far[np.argmin(dots.max(axis=1))])
             return pick, {"kind": "coverage", "reason": "fit not yet possible: farthest light"}
         est = self.estimate(state)
-        if self.until_error_deg is not None and self._reaches(est):
+        if self.until_error_deg is not None and self._reaches(est) and self._past_minimum(index):
             # the target is claimed only when the upper estimate is under it
             self.stop_evidence = {
                 "kind": "stop",
-                "reason": self._reached_reason(est),
+                "reason": self._reached_reason(est, index),
                 **self.stop_terms(est),
             }
             return None, self.stop_evidence
@@ -535,6 +547,7 @@ class AdaptiveChooser:
             "objective": self.objective,
             "lights_used": len(self.used),
             "until_error_deg": self.until_error_deg,
+            "min_lights": self.min_lights,
             **self.stop_terms(est),
             # a session run to its maximum is never asked for the step past it: the stop here
             "stop": self.stop_evidence or self._cap_stop(est),
@@ -640,9 +653,11 @@ class AdaptiveSteps:
         until_error_deg: float | None,
         objective: str = "normals",
         upper_factor: float | None = None,
+        min_lights: int | None = None,
     ) -> None:
         self.plan = plan
         self.until_error_deg = until_error_deg
+        self.min_lights = min_lights
         self.objective = objective
         move: MoveTimes | None = None
         if isinstance(rig.geometry, ArmGeometry):
@@ -663,6 +678,7 @@ class AdaptiveSteps:
             design_lights=plan.design_lights,
             objective=objective,
             upper_factor=upper_factor,
+            min_lights=min_lights,
         )
         self._pending: dict[int, int] = {}
 
@@ -679,6 +695,7 @@ class AdaptiveSteps:
             "format": FORMAT,
             "max_lights": self.plan.max_lights,
             "until_error_deg": self.until_error_deg,
+            "min_lights": self.min_lights,
             "start_lights": len(self.plan.start),
             "design_lights": self.plan.design_lights,
             "objective": self.objective,
@@ -769,6 +786,30 @@ def estimate_phrase(result: dict[str, Any]) -> str:
     return text
 
 
+#: The fewest lights `rti-rig fit` writes each relighting file from (the file, its model, the
+#: lights: a PTM's 6 coefficients, HSH of order 2's 9; rti_rig.app.usecases.fit).
+RTI_FILE_LIGHTS = (("fit.ptm", "a PTM", 6), ("fit.rti", "HSH of order 2", 9))
+
+
+def few_lights_note(result: dict[str, Any]) -> str | None:
+    """What a session stopped by --until-error before it had the lights of an RTI file gives
+    and does not give, and how to ask for more (None: nothing to say). The target is a normal
+    error; a user who came for a PTM or an .rti learns it here, not when `fit` skips them."""
+    used = int(result.get("lights_used") or 0)
+    if result.get("until_error_deg") is None or result.get("min_lights") is not None:
+        return None
+    short = [(name, what, n) for name, what, n in RTI_FILE_LIGHTS if used < n]
+    if not short:
+        return None
+    needs = " and ".join(f"{what} needs {n}" for _, what, n in short)
+    files = " and ".join(name for name, _, _ in short)
+    return (
+        f"{used} lights reached the normal-error target, but {needs}: `rti-rig fit` will "
+        f"write the normal map without {files}. For them, start a session with "
+        f"--min-lights {short[-1][2]}"
+    )
+
+
 def check_objective(objective: str, lights: int | None, until_error_deg: float | None) -> None:
     """Refuse an objective the adaptive session cannot serve, before anything is opened.
 
@@ -797,12 +838,35 @@ def check_objective(objective: str, lights: int | None, until_error_deg: float |
         )
 
 
+def check_min_lights(
+    min_lights: int | None, lights: int | None, until_error_deg: float | None
+) -> None:
+    """Refuse a --min-lights that cannot mean anything, before anything is opened: it bounds
+    the --until-error stop from below, so it needs --until-error and must not exceed
+    --lights."""
+    if min_lights is None:
+        return
+    if until_error_deg is None:
+        raise RtiRigError(
+            f"--min-lights {min_lights} goes with --until-error (it is the fewest lights the "
+            "stop may claim the target at); with --lights N alone the session shoots N lights"
+        )
+    if min_lights < 1:
+        raise RtiRigError(f"--min-lights {min_lights}: give a positive number of lights")
+    if lights is not None and min_lights > lights:
+        raise RtiRigError(
+            f"--min-lights {min_lights} is above --lights {lights}, the session's maximum: "
+            "give a minimum at most the maximum"
+        )
+
+
 def open_adaptive_session(  # type: ignore[no-untyped-def]
     loaded,
     out_dir: Path,
     lights: int | None,
     until_error_deg: float | None,
     objective: str = "normals",
+    min_lights: int | None = None,
 ):
     """Check the request and the folder, open the rig, plan the start, make the folder.
 
@@ -821,11 +885,18 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
             f"and chooses from there; give at least {START_LIGHTS + 1}"
         )
     check_objective(objective, lights, until_error_deg)
+    check_min_lights(min_lights, lights, until_error_deg)
     SessionFolder.check_new(out_dir)
     warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:
-        source = AdaptiveSteps(rig, adaptive_plan(rig, lights), until_error_deg, objective)
+        plan = adaptive_plan(rig, lights)
+        if min_lights is not None and min_lights > plan.max_lights:
+            raise RtiRigError(
+                f"--min-lights {min_lights}: this rig offers {plan.max_lights} lights an "
+                f"adaptive session can use; give at most {plan.max_lights}"
+            )
+        source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
         folder = SessionFolder.create(out_dir, source.total)
@@ -919,7 +990,12 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         )
     # the stop's factor the session began with (its target means the same to the end)
     source = AdaptiveSteps(
-        rig, plan, header.get("until_error_deg"), began, header.get("upper_factor")
+        rig,
+        plan,
+        header.get("until_error_deg"),
+        began,
+        header.get("upper_factor"),
+        min_lights=header.get("min_lights"),  # absent in sessions begun before it existed
     )
     source.replay(folder)
     return source

@@ -64,6 +64,9 @@ class NewSessionRequest:
     #: Adaptive: what the design of ``lights`` is chosen for, ``normals`` or ``relight``
     #: (None: normals; refused for a session that is not adaptive).
     objective: str | None = None
+    #: Adaptive with ``until_error_deg``: the fewest lights the stop may claim the target at
+    #: (None: no minimum; a PTM needs 6, HSH of order 2 needs 9).
+    min_lights: int | None = None
 
     @property
     def is_adaptive(self) -> bool:
@@ -303,7 +306,12 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         check_light_count(req.lights)
     identity = rig_identity(loaded)
     rig, schedule, folder, source = open_adaptive_session(
-        loaded, req.out_dir, req.lights, req.until_error_deg, req.objective or "normals"
+        loaded,
+        req.out_dir,
+        req.lights,
+        req.until_error_deg,
+        req.objective or "normals",
+        req.min_lights,
     )
     folder.rig_identity = identity
     return OpenedSession(rig, schedule, folder, Path(req.out_dir), source=source)
@@ -312,8 +320,10 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
 def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> OpenedSession:
     """Check a new session's request, open and check the rig, and prepare its folder."""
     from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases.adaptive import check_min_lights
 
     check_max_saturated(req.max_saturated)
+    check_min_lights(req.min_lights, req.lights, req.until_error_deg)
     loaded = load_rig_config(req.rig_config)
     for note in loaded.notes:
         on_note(Note(note, "warning"))

@@ -1,0 +1,118 @@
+"""`rti-rig run RIG --until-error DEG --min-lights M`, through the front door.
+
+A loose target is reached by the four starting lights: the session then has a normal map and
+no RTI file (a PTM needs 6 lights, HSH of order 2 needs 9). ``--min-lights`` keeps the stop
+from claiming the target before M lights, with the same choices a session without a target
+makes; a resume restores the minimum from the manifest; a session that stops short of an RTI
+file without it says so and how to ask for one; a minimum that cannot mean anything is refused
+before anything is opened.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import SMALL_DOME, interrupted, journal, manifest, said, write_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
+from rti_rig.runtime.controller import FinishReason
+
+runner = CliRunner()
+
+#: a target every estimate on the small dome is under (the upper estimates are a few degrees)
+LOOSE = "90"
+
+
+@pytest.fixture(scope="module")
+def dome(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The 12-LED dome and a session on it whose target is never reached (every LED)."""
+    base = tmp_path_factory.mktemp("minlights")
+    cfg = write_config(base, SMALL_DOME)
+    ref = base / "ref"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--until-error", "1e-9"])
+    assert r.exit_code == 0, r.output
+    return cfg, ref
+
+
+def _run(cfg: Path, out: Path, *extra: str):  # type: ignore[no-untyped-def]
+    return runner.invoke(app, ["run", str(cfg), "--out", str(out), "--no-verdict", *extra])
+
+
+def test_a_loose_target_stops_at_the_start_and_says_no_rti_file_follows(
+    dome: tuple[Path, Path], tmp_path: Path
+) -> None:
+    cfg, _ = dome
+    out = tmp_path / "s"
+    r = _run(cfg, out, "--until-error", LOOSE)
+    assert r.exit_code == 0, r.output
+    assert manifest(out)["adaptive"]["result"]["lights_used"] == 4
+    text = said(r)
+    assert "a PTM needs 6 and HSH of order 2 needs 9" in text
+    assert "without fit.ptm and fit.rti" in text and "--min-lights 9" in text
+
+
+def test_min_lights_holds_the_stop_until_m_lights_with_the_choices_of_no_target(
+    dome: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """The minimum binds (every decision before it already had its upper estimate under the
+    target), the stop says it stopped at the minimum, lights.lp lists M lights, and the lights
+    are those of the session that never reached its target (the target only stops)."""
+    cfg, ref = dome
+    out = tmp_path / "s"
+    r = _run(cfg, out, "--until-error", LOOSE, "--min-lights", "7")
+    assert r.exit_code == 0, r.output
+    m = manifest(out)["adaptive"]
+    assert m["min_lights"] == 7 and m["result"]["min_lights"] == 7
+    steps = journal(out)
+    assert m["result"]["lights_used"] == 7 == len(steps) == len(read_lp(out / "lights.lp"))
+    for s in steps[4:]:
+        assert s["decision"]["upper_error_deg"] <= float(LOOSE)  # the target alone would stop
+    assert "at the --min-lights 7 asked for" in m["result"]["stop"]["reason"]
+    assert [s["led"] for s in steps] == [s["led"] for s in journal(ref)][:7]
+    assert "--min-lights 9" not in said(r)  # asked for a minimum: no advice to ask for one
+
+
+def test_an_interrupted_session_resumes_with_its_minimum(
+    dome: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """The minimum is in the manifest: the replay decides the steps on disk again under it
+    (without it, the fifth step would have been a stop, and the resume refused), and the
+    continuation stops at the same M."""
+    cfg, ref = dome
+    out = tmp_path / "cut"
+    res = interrupted(cfg, out, 5, lights=None, until=float(LOOSE), min_lights=8)
+    assert res.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 6
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert [s["led"] for s in journal(out)] == [s["led"] for s in journal(ref)][:8]
+    assert manifest(out)["adaptive"]["result"]["lights_used"] == 8
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--adaptive", "--lights", "8", "--min-lights", "6"], "goes with --until-error"),
+        (["--min-lights", "6"], "goes with --until-error"),
+        (["--until-error", "2", "--lights", "8", "--min-lights", "9"], "above --lights 8"),
+        (["--until-error", "2", "--min-lights", "0"], "give a positive number"),
+        (["--until-error", "2", "--min-lights", "13"], "this rig offers 12 lights"),
+    ],
+)
+def test_a_minimum_that_cannot_mean_anything_is_refused_before_anything_is_written(
+    dome: tuple[Path, Path], tmp_path: Path, args: list[str], message: str
+) -> None:
+    cfg, _ = dome
+    out = tmp_path / "s"
+    r = _run(cfg, out, *args)
+    assert r.exit_code == 2, r.output
+    assert message in said(r)
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_resume_refuses_a_new_minimum(dome: tuple[Path, Path]) -> None:
+    _, ref = dome
+    r = runner.invoke(app, ["run", "--resume", str(ref), "--min-lights", "6"])
+    assert r.exit_code == 2 and "drop --min-lights" in said(r)
