@@ -44,7 +44,13 @@ from numpy.typing import ArrayLike, NDArray
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
 from rti_rig.reconstruct.qa_directions import MISFIT_LIMIT, consensus_images, relative_misfit
-from rti_rig.reconstruct.qa_drift import edge_shifts_trusted, measure_drift, move_back
+from rti_rig.reconstruct.qa_drift import (
+    MAX_SHIFT_PX,
+    edge_shifts_trusted,
+    measure_drift,
+    move_back,
+    still_spread_px,
+)
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
 #: Side of the central crop the per-image checks fit on (full resolution).
@@ -254,14 +260,19 @@ def _confirmed_shift(
     return False, raw
 
 
-def _edges_agree(drift_up: tuple[float, float], edge_dev: NDArray) -> bool:
+#: An edge shift shows a move only beyond this many times the still images' edge noise.
+EDGE_NOISE_FACTOR = 3.0
+
+
+def _edges_agree(drift_up: tuple[float, float], edge_dev: NDArray, noise_px: float) -> bool:
     """Does the image's edge shift (image axes, y down; NaN when not measured) show the shift
-    found against the fit (``drift_up``: x right, y up) — a move of more than
-    :data:`DRIFT_PX`, within :data:`DRIFT_PX` or half the shift of it?"""
+    found against the fit (``drift_up``: x right, y up) — a move beyond :data:`DRIFT_PX` and
+    :data:`EDGE_NOISE_FACTOR` × the edge noise of the images that held still (``noise_px``),
+    within :data:`DRIFT_PX` or half the shift of it?"""
     if not np.all(np.isfinite(edge_dev)):
         return False
     fit = np.array([drift_up[0], -drift_up[1]])
-    if np.hypot(*edge_dev) <= DRIFT_PX:
+    if not np.hypot(*edge_dev) > max(DRIFT_PX, EDGE_NOISE_FACTOR * noise_px):
         return False
     return bool(np.hypot(*(fit - edge_dev)) <= max(DRIFT_PX, 0.5 * float(np.hypot(*fit))))
 
@@ -389,23 +400,31 @@ def assess(
         keep, ps = new_keep, ps_next
         ev = evidence_of(ps)
     # Against a fit that explains the images poorly (a glossy coin) the shift against it is
-    # no measurement: a move is claimed only where the image's own edges moved the same way
-    # (the dark coin of an exposure of 0.005 s was "moved" by 84 to 121 px on 4 images of a
-    # session that held still, while its edges sat within 1 px). Where the edges do not hold
-    # still either, a move of a few pixels is not measurable: said.
+    # no measurement: a move is claimed only where the image's own edges moved the same way,
+    # beyond their noise (the dark coin of an exposure of 0.005 s was "moved" by 84 to 121 px
+    # on 4 images of a session that held still, while its edges sat within 1 px). A smaller
+    # move, or one beyond the edges' search (about 11 px), is not measurable there: said.
     finite = np.isfinite(ev.misfit)
     poor_fit = float(np.median(ev.misfit[finite])) if finite.any() else float("inf")
     drift_note = ""
     if not edges_trusted and poor_fit > MISFIT_LIMIT:
+        noise = still_spread_px(edge_dev)
         for i in range(n):
-            if ev.moved[i] and not _edges_agree(ev.drift[i], edge_dev[i]):
+            if ev.moved[i] and not _edges_agree(ev.drift[i], edge_dev[i], noise):
                 ev.moved[i] = False
             if not ev.moved[i]:
                 ev.drift_judged[i] = False
+        shown = max(DRIFT_PX, EDGE_NOISE_FACTOR * noise)
         drift_note = (
             "shift not judged: the fit explains this object's images poorly (median misfit "
             f"{poor_fit:.0%}, limit {MISFIT_LIMIT:.0%}) and its edges move with the light, so "
-            "a shift of a few pixels cannot be measured"
+            "a shift is claimed only where the fit and the image's own edges show it alike"
+            + (
+                f" (beyond {shown:.1f} px and up to about {MAX_SHIFT_PX - 1} px); a smaller "
+                "or larger one cannot be measured"
+                if np.isfinite(shown)
+                else "; here too few images hold their edges still to tell: none is claimed"
+            )
         )
     checks: list[ImageCheck] = []
     for i in range(n):

@@ -21,9 +21,11 @@ import tifffile
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.reconstruct.qa import CROP
+from rti_rig.reconstruct.qa import CROP, _edges_agree
 from rti_rig.reconstruct.qa_drift import (
     MAX_SHIFT_PX,
+    MIN_RESPONSE,
+    _confirmed,
     edge_shifts_trusted,
     local_phase_correlation,
     measure_drift,
@@ -82,10 +84,12 @@ def test_a_still_relief_session_measures_every_image_within_half_a_pixel(relief)
 
 
 def test_a_moved_block_of_the_relief_is_measured(relief) -> None:
-    """12 of 48 images moved by (3, 2) px: the two blocks are that far apart, each tight."""
+    """12 of 48 images moved by (3, 2) px: the two blocks are that far apart, each tight (an
+    image whose peak is too weak to place is not measured: at most one per block)."""
     shifts, _ = measure_drift(_move(relief, 36, 3.0, 2.0), np.ones(len(relief), bool))
     still, moved = shifts[:36], shifts[36:]
-    assert np.isfinite(still).all() and np.isfinite(moved).all()
+    assert np.isfinite(still[:, 0]).sum() >= 35 and np.isfinite(moved[:, 0]).sum() >= 11
+    still, moved = still[np.isfinite(still[:, 0])], moved[np.isfinite(moved[:, 0])]
     gap = np.median(moved, axis=0) - np.median(still, axis=0)
     np.testing.assert_allclose(gap, [3.0, 2.0], atol=0.5)
     for block in (still, moved):
@@ -128,7 +132,8 @@ def test_a_dark_glossy_session_that_held_still_is_not_called_moved(tmp_path: Pat
 
 def test_the_local_phase_correlation_agrees_with_opencv_near_zero_and_refuses_far() -> None:
     """The hand-written search is OpenCV's estimate restricted to a window: within it both
-    find a known shift; beyond it the peak sits on the window's border, which is no answer."""
+    find a known shift; beyond it the highest peak lies outside the window, higher than
+    anything within it (or, for a shift just past it, on the window's border): no answer."""
     rng = np.random.default_rng(0)
     texture = cv2.GaussianBlur(rng.random((128, 128)).astype(np.float32), (0, 0), 2.0)
     window = cv2.createHanningWindow((128, 128), cv2.CV_64F)
@@ -147,3 +152,40 @@ def test_the_local_phase_correlation_agrees_with_opencv_near_zero_and_refuses_fa
     far = shifted(MAX_SHIFT_PX + 10.0, 0.0).astype(np.float64)
     (dx, _), _ = local_phase_correlation(ref, far, window)
     assert np.isnan(dx)
+
+
+def test_a_weak_peak_placed_by_its_side_lobes_is_no_measurement() -> None:
+    """A faint copy (0.15 ×) of a texture, shifted (5, 3), under noise: OpenCV's 5 × 5 signed
+    centroid let side-lobes pull most estimates more than a pixel off (the code before the
+    fix: 101 of 252 within a pixel); a centroid more than a pixel from its peak is now no
+    measurement, and most of what remains is right."""
+    rng = np.random.default_rng(2)
+    window = np.outer(np.hanning(64), np.hanning(64))
+    found = right = 0
+    for _ in range(300):
+        ref = rng.random((64, 64))
+        img = 0.15 * np.roll(ref, (3, 5), (0, 1)) + rng.random((64, 64))
+        (dx, dy), response = local_phase_correlation(ref, img, window)
+        if np.isfinite(dx) and response >= MIN_RESPONSE:
+            found += 1
+            right += bool(np.hypot(dx - 5.0, dy - 3.0) <= 1.0)
+    assert found >= 60 and right >= 0.75 * found, (found, right)
+
+
+def test_a_shift_counts_only_if_moving_back_by_it_agrees_better() -> None:
+    rng = np.random.default_rng(1)
+    ref = cv2.GaussianBlur(rng.random((96, 96)).astype(np.float32), (0, 0), 2.0)
+    m = np.float32([[1, 0, 4.0], [0, 1, 3.0]])
+    edge = cv2.warpAffine(ref, m, (96, 96), borderMode=cv2.BORDER_REFLECT)
+    assert _confirmed(ref, edge, 4.0, 3.0)
+    assert not _confirmed(ref, edge, -4.0, 6.0)
+
+
+def test_a_move_against_a_poor_fit_is_claimed_only_where_the_edges_show_it_alike() -> None:
+    """The fit's shift is x right, y up; the edges' is image axes, y down: (3, 2) px down the
+    image is (3, -2) against the fit. Edges within their noise (3 × 0.66 px) show nothing."""
+    assert _edges_agree((3.0, -2.0), np.array([3.0, 2.0]), 0.3)
+    assert not _edges_agree((3.0, 2.0), np.array([3.0, 2.0]), 0.3)  # y the other way
+    assert not _edges_agree((3.0, -2.0), np.array([np.nan, np.nan]), 0.3)
+    assert not _edges_agree((1.6, -0.6), np.array([1.6, 0.6]), 0.66)  # within 3 × noise
+    assert _edges_agree((2.6, -0.6), np.array([2.4, 0.6]), 0.66)
