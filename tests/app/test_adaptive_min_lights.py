@@ -16,6 +16,7 @@ import pytest
 from conftest import SMALL_DOME, interrupted, journal, manifest, said, write_config
 from typer.testing import CliRunner
 
+from rti_rig.app.usecases.adaptive import FORMAT, FORMAT_MIN_LIGHTS
 from rti_rig.cli import app
 from rti_rig.core.lp_format import read_lp
 from rti_rig.runtime.controller import FinishReason
@@ -51,7 +52,38 @@ def test_a_loose_target_stops_at_the_start_and_says_no_rti_file_follows(
     assert manifest(out)["adaptive"]["result"]["lights_used"] == 4
     text = said(r)
     assert "a PTM needs 6 and HSH of order 2 needs 9" in text
-    assert "without fit.ptm and fit.rti" in text and "--min-lights 9" in text
+    assert "without fit.ptm and fit.rti" in text
+    assert "To get fit.ptm and fit.rti, start a session with --min-lights 9" in text
+
+
+def test_the_advice_stays_within_the_session_s_maximum(
+    dome: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """With --lights 8 a minimum of 9 would be refused: the note offers 6 (a PTM) and says
+    the .rti needs more than the session's maximum."""
+    cfg, _ = dome
+    out = tmp_path / "s"
+    r = _run(cfg, out, "--until-error", LOOSE, "--lights", "8")
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "To get fit.ptm, start a session with --min-lights 6" in text, text
+    assert "fit.rti needs more than this session's maximum of 8 lights" in text, text
+    assert "--min-lights 9" not in text
+
+
+def test_a_session_that_did_not_reach_its_target_gives_no_such_note(
+    dome: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """Capped at 5 lights short of its target: the stop says the target is not claimed, and
+    nothing says it was reached."""
+    cfg, _ = dome
+    out = tmp_path / "s"
+    r = _run(cfg, out, "--until-error", "1e-9", "--lights", "5")
+    assert r.exit_code == 0, r.output
+    result = manifest(out)["adaptive"]["result"]
+    assert result["lights_used"] == 5 and result["target_claimed"] is False
+    text = said(r)
+    assert "the target is not claimed" in text and "reached the normal-error target" not in text
 
 
 def test_min_lights_holds_the_stop_until_m_lights_with_the_choices_of_no_target(
@@ -66,10 +98,13 @@ def test_min_lights_holds_the_stop_until_m_lights_with_the_choices_of_no_target(
     assert r.exit_code == 0, r.output
     m = manifest(out)["adaptive"]
     assert m["min_lights"] == 7 and m["result"]["min_lights"] == 7
+    assert m["format"] == FORMAT_MIN_LIGHTS != FORMAT  # an older build refuses it by name
+    assert m["result"]["target_claimed"] is True
     steps = journal(out)
     assert m["result"]["lights_used"] == 7 == len(steps) == len(read_lp(out / "lights.lp"))
     for s in steps[4:]:
         assert s["decision"]["upper_error_deg"] <= float(LOOSE)  # the target alone would stop
+        assert s["decision"]["held"] == "--min-lights 7"  # and the journal says why it did not
     assert "at the --min-lights 7 asked for" in m["result"]["stop"]["reason"]
     assert [s["led"] for s in steps] == [s["led"] for s in journal(ref)][:7]
     assert "--min-lights 9" not in said(r)  # asked for a minimum: no advice to ask for one
@@ -116,3 +151,35 @@ def test_a_resume_refuses_a_new_minimum(dome: tuple[Path, Path]) -> None:
     _, ref = dome
     r = runner.invoke(app, ["run", "--resume", str(ref), "--min-lights", "6"])
     assert r.exit_code == 2 and "drop --min-lights" in said(r)
+
+
+def test_a_dome_refuses_a_minimum_above_its_leds_before_opening_a_port(
+    dome: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import rti_rig.app.compose as compose
+
+    def no_rig(*_a, **_k):  # type: ignore[no-untyped-def]
+        raise AssertionError("the rig was opened before the refusal")
+
+    monkeypatch.setattr(compose, "build_rig", no_rig)
+    cfg, _ = dome
+    r = _run(cfg, tmp_path / "s", "--until-error", "2", "--min-lights", "13")
+    assert r.exit_code == 2 and "this rig offers 12 lights" in said(r), r.output
+
+
+def test_a_session_begun_before_the_minimum_existed_resumes_without_one(
+    dome: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """A format-8 manifest has no ``min_lights`` key: the resume decides as it began."""
+    import json
+
+    cfg, ref = dome
+    out = tmp_path / "cut"
+    interrupted(cfg, out, 5, lights=None, until=1e-9)
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["adaptive"]["format"] == FORMAT
+    del m["adaptive"]["min_lights"]
+    (out / "manifest.json").write_text(json.dumps(m))
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert [s["led"] for s in journal(out)] == [s["led"] for s in journal(ref)]

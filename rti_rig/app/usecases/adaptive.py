@@ -96,6 +96,10 @@ ARM_MAX_LIGHTS = 100
 #: settings record every decision constant (``constants``, checked on resume), and a relight
 #: design with no light left out records a null PSNR.
 FORMAT = "rti-rig-adaptive/8"
+#: Format 8 with ``--min-lights``: the same decisions, a stop held until the minimum. Its own
+#: label so that a build that does not know the minimum refuses the session by name instead of
+#: resuming it without (and claiming the target at 4 lights). This build continues both.
+FORMAT_MIN_LIGHTS = "rti-rig-adaptive/8+min-lights"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
@@ -461,7 +465,9 @@ class AdaptiveChooser:
             pick = int(far[0] if dots is None else far[np.argmin(dots.max(axis=1))])
             return pick, {"kind": "coverage", "reason": "fit not yet possible: farthest light"}
         est = self.estimate(state)
-        if self.until_error_deg is not None and self._reaches(est) and self._past_minimum(index):
+        reached = self.until_error_deg is not None and self._reaches(est)
+        held = reached and not self._past_minimum(index)  # the target alone would stop here
+        if reached and not held:
             # the target is claimed only when the upper estimate is under it
             self.stop_evidence = {
                 "kind": "stop",
@@ -532,7 +538,9 @@ class AdaptiveChooser:
         return d.candidate, {
             "kind": "adaptive",
             **d.evidence(),
-            **self.stop_terms(est),  # what the stop compared before this light (not reached)
+            **self.stop_terms(est),  # what the stop compared before this light (not reached,
+            # or reached and held by --min-lights: said)
+            **({"held": f"--min-lights {self.min_lights}"} if held else {}),
             "decision_s": round(time.perf_counter() - t0, 4),
         }
 
@@ -546,8 +554,14 @@ class AdaptiveChooser:
         return {
             "objective": self.objective,
             "lights_used": len(self.used),
+            "max_lights": self.max_lights,
             "until_error_deg": self.until_error_deg,
             "min_lights": self.min_lights,
+            # whether the stop claims --until-error (what the stop compared after the last
+            # image; a capped or unfittable session does not)
+            "target_claimed": bool(
+                self.until_error_deg is not None and est is not None and self._reaches(est)
+            ),
             **self.stop_terms(est),
             # a session run to its maximum is never asked for the step past it: the stop here
             "stop": self.stop_evidence or self._cap_stop(est),
@@ -692,7 +706,7 @@ class AdaptiveSteps:
 
     def header(self) -> dict[str, Any]:
         return {
-            "format": FORMAT,
+            "format": FORMAT if self.min_lights is None else FORMAT_MIN_LIGHTS,
             "max_lights": self.plan.max_lights,
             "until_error_deg": self.until_error_deg,
             "min_lights": self.min_lights,
@@ -792,22 +806,36 @@ RTI_FILE_LIGHTS = (("fit.ptm", "a PTM", 6), ("fit.rti", "HSH of order 2", 9))
 
 
 def few_lights_note(result: dict[str, Any]) -> str | None:
-    """What a session stopped by --until-error before it had the lights of an RTI file gives
-    and does not give, and how to ask for more (None: nothing to say). The target is a normal
-    error; a user who came for a PTM or an .rti learns it here, not when `fit` skips them."""
+    """What a session whose --until-error target was reached before it had the lights of an
+    RTI file gives and does not give, and how to ask for more (None: nothing to say — no
+    target, not reached, a minimum asked for, or lights enough). The target is a normal
+    error; a user who came for a PTM or an .rti learns it here, not when `fit` skips them.
+    The advice never exceeds the session's maximum (``--lights`` or the rig's lights)."""
     used = int(result.get("lights_used") or 0)
-    if result.get("until_error_deg") is None or result.get("min_lights") is not None:
+    if not result.get("target_claimed") or result.get("min_lights") is not None:
         return None
     short = [(name, what, n) for name, what, n in RTI_FILE_LIGHTS if used < n]
     if not short:
         return None
     needs = " and ".join(f"{what} needs {n}" for _, what, n in short)
     files = " and ".join(name for name, _, _ in short)
-    return (
+    text = (
         f"{used} lights reached the normal-error target, but {needs}: `rti-rig fit` will "
-        f"write the normal map without {files}. For them, start a session with "
-        f"--min-lights {short[-1][2]}"
+        f"write the normal map without {files}."
     )
+    cap = int(result.get("max_lights") or 0)
+    reachable = [(name, n) for name, _, n in short if n <= cap]
+    if reachable:
+        names = " and ".join(name for name, _ in reachable)
+        text += f" To get {names}, start a session with --min-lights {reachable[-1][1]}"
+    beyond = [name for name, _, n in short if n > cap]
+    if beyond:
+        verb = "needs" if len(beyond) == 1 else "need"
+        text += (
+            f"{';' if reachable else ''} {' and '.join(beyond)} {verb} more than this session's "
+            f"maximum of {cap} lights (--lights, or the lights the rig offers)"
+        )
+    return text
 
 
 def check_objective(objective: str, lights: int | None, until_error_deg: float | None) -> None:
@@ -860,6 +888,14 @@ def check_min_lights(
         )
 
 
+def _check_min_within(min_lights: int, offered: int) -> None:
+    if min_lights > offered:
+        raise RtiRigError(
+            f"--min-lights {min_lights}: this rig offers {offered} lights an adaptive session "
+            f"can use; give at most {offered}"
+        )
+
+
 def open_adaptive_session(  # type: ignore[no-untyped-def]
     loaded,
     out_dir: Path,
@@ -886,16 +922,19 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         )
     check_objective(objective, lights, until_error_deg)
     check_min_lights(min_lights, lights, until_error_deg)
+    if min_lights is not None:  # a dome's lights are known from its config: before any port
+        from rti_rig.app.config import rig_geometry
+
+        geometry = rig_geometry(loaded)
+        if isinstance(geometry, DomeGeometry):
+            _check_min_within(min_lights, len(candidates_for(geometry).directions))
     SessionFolder.check_new(out_dir)
     warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:
         plan = adaptive_plan(rig, lights)
-        if min_lights is not None and min_lights > plan.max_lights:
-            raise RtiRigError(
-                f"--min-lights {min_lights}: this rig offers {plan.max_lights} lights an "
-                f"adaptive session can use; give at most {plan.max_lights}"
-            )
+        if min_lights is not None:  # an arm's reachable lights need the rig's own rules
+            _check_min_within(min_lights, len(plan.candidates))
         source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
@@ -910,7 +949,7 @@ def refuse_other_format(header: dict, root: Path) -> None:
     """Refuse an adaptive session begun under another decision format (its choices would
     differ from the ones already made: /4 never offered the fitted design), by name and with
     what to do — from the manifest alone, before the folder or the rig is touched."""
-    if header.get("format") != FORMAT:
+    if header.get("format") not in (FORMAT, FORMAT_MIN_LIGHTS):
         raise RtiRigError(
             f"{root}: this adaptive session was begun with format "
             f"{header.get('format')!r}, and this version of rti-rig continues only {FORMAT!r} "
