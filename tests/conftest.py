@@ -93,3 +93,22 @@ def decisions(session: Path) -> list[dict]:
 def manifest(session: Path) -> dict:
     """A session folder's manifest."""
     return json.loads((session / "manifest.json").read_text())
+
+
+@pytest.fixture(scope="session")
+def never_reached(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """(config, session): an `--until-error 1e-9` session on :data:`SMALL_DOME` whose target
+    is never reached, so it runs to every LED — the reference the adaptive stop's tests
+    compare with (read only: tests write their own sessions). Its CLI output, unwrapped, is
+    in ``said.txt`` beside the session."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    base = tmp_path_factory.mktemp("until")
+    cfg = write_config(base, SMALL_DOME)
+    out = base / "s"
+    r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", "1e-9"])
+    assert r.exit_code == 0, r.output
+    (out.parent / "said.txt").write_text(said(r))
+    return cfg, out

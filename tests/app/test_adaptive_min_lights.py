@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import SMALL_DOME, interrupted, journal, manifest, said, write_config
+from conftest import interrupted, journal, manifest, said
 from typer.testing import CliRunner
 
 from rti_rig.app.usecases.adaptive import FORMAT, FORMAT_MIN_LIGHTS
@@ -27,25 +27,14 @@ runner = CliRunner()
 LOOSE = "90"
 
 
-@pytest.fixture(scope="module")
-def dome(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    """The 12-LED dome and a session on it whose target is never reached (every LED)."""
-    base = tmp_path_factory.mktemp("minlights")
-    cfg = write_config(base, SMALL_DOME)
-    ref = base / "ref"
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--until-error", "1e-9"])
-    assert r.exit_code == 0, r.output
-    return cfg, ref
-
-
 def _run(cfg: Path, out: Path, *extra: str):  # type: ignore[no-untyped-def]
     return runner.invoke(app, ["run", str(cfg), "--out", str(out), "--no-verdict", *extra])
 
 
 def test_a_loose_target_stops_at_the_start_and_says_no_rti_file_follows(
-    dome: tuple[Path, Path], tmp_path: Path
+    never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:
-    cfg, _ = dome
+    cfg, _ = never_reached
     out = tmp_path / "s"
     r = _run(cfg, out, "--until-error", LOOSE)
     assert r.exit_code == 0, r.output
@@ -57,11 +46,11 @@ def test_a_loose_target_stops_at_the_start_and_says_no_rti_file_follows(
 
 
 def test_the_advice_stays_within_the_session_s_maximum(
-    dome: tuple[Path, Path], tmp_path: Path
+    never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:
     """With --lights 8 a minimum of 9 would be refused: the note offers 6 (a PTM) and says
     the .rti needs more than the session's maximum."""
-    cfg, _ = dome
+    cfg, _ = never_reached
     out = tmp_path / "s"
     r = _run(cfg, out, "--until-error", LOOSE, "--lights", "8")
     assert r.exit_code == 0, r.output
@@ -72,11 +61,11 @@ def test_the_advice_stays_within_the_session_s_maximum(
 
 
 def test_a_session_that_did_not_reach_its_target_gives_no_such_note(
-    dome: tuple[Path, Path], tmp_path: Path
+    never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:
     """Capped at 5 lights short of its target: the stop says the target is not claimed, and
     nothing says it was reached."""
-    cfg, _ = dome
+    cfg, _ = never_reached
     out = tmp_path / "s"
     r = _run(cfg, out, "--until-error", "1e-9", "--lights", "5")
     assert r.exit_code == 0, r.output
@@ -87,12 +76,12 @@ def test_a_session_that_did_not_reach_its_target_gives_no_such_note(
 
 
 def test_min_lights_holds_the_stop_until_m_lights_with_the_choices_of_no_target(
-    dome: tuple[Path, Path], tmp_path: Path
+    never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:
     """The minimum binds (every decision before it already had its upper estimate under the
     target), the stop says it stopped at the minimum, lights.lp lists M lights, and the lights
     are those of the session that never reached its target (the target only stops)."""
-    cfg, ref = dome
+    cfg, ref = never_reached
     out = tmp_path / "s"
     r = _run(cfg, out, "--until-error", LOOSE, "--min-lights", "7")
     assert r.exit_code == 0, r.output
@@ -111,12 +100,12 @@ def test_min_lights_holds_the_stop_until_m_lights_with_the_choices_of_no_target(
 
 
 def test_an_interrupted_session_resumes_with_its_minimum(
-    dome: tuple[Path, Path], tmp_path: Path
+    never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:
     """The minimum is in the manifest: the replay decides the steps on disk again under it
     (without it, the fifth step would have been a stop, and the resume refused), and the
     continuation stops at the same M."""
-    cfg, ref = dome
+    cfg, ref = never_reached
     out = tmp_path / "cut"
     res = interrupted(cfg, out, 5, lights=None, until=float(LOOSE), min_lights=8)
     assert res.finish_reason is FinishReason.CANCELLED and len(journal(out)) == 6
@@ -137,9 +126,9 @@ def test_an_interrupted_session_resumes_with_its_minimum(
     ],
 )
 def test_a_minimum_that_cannot_mean_anything_is_refused_before_anything_is_written(
-    dome: tuple[Path, Path], tmp_path: Path, args: list[str], message: str
+    never_reached: tuple[Path, Path], tmp_path: Path, args: list[str], message: str
 ) -> None:
-    cfg, _ = dome
+    cfg, _ = never_reached
     out = tmp_path / "s"
     r = _run(cfg, out, *args)
     assert r.exit_code == 2, r.output
@@ -147,14 +136,14 @@ def test_a_minimum_that_cannot_mean_anything_is_refused_before_anything_is_writt
     assert not out.exists() or not any(out.iterdir())
 
 
-def test_a_resume_refuses_a_new_minimum(dome: tuple[Path, Path]) -> None:
-    _, ref = dome
+def test_a_resume_refuses_a_new_minimum(never_reached: tuple[Path, Path]) -> None:
+    _, ref = never_reached
     r = runner.invoke(app, ["run", "--resume", str(ref), "--min-lights", "6"])
     assert r.exit_code == 2 and "drop --min-lights" in said(r)
 
 
 def test_a_dome_refuses_a_minimum_above_its_leds_before_opening_a_port(
-    dome: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    never_reached: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import rti_rig.app.compose as compose
 
@@ -162,18 +151,18 @@ def test_a_dome_refuses_a_minimum_above_its_leds_before_opening_a_port(
         raise AssertionError("the rig was opened before the refusal")
 
     monkeypatch.setattr(compose, "build_rig", no_rig)
-    cfg, _ = dome
+    cfg, _ = never_reached
     r = _run(cfg, tmp_path / "s", "--until-error", "2", "--min-lights", "13")
     assert r.exit_code == 2 and "this rig offers 12 lights" in said(r), r.output
 
 
 def test_a_session_begun_before_the_minimum_existed_resumes_without_one(
-    dome: tuple[Path, Path], tmp_path: Path
+    never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:
     """A format-8 manifest has no ``min_lights`` key: the resume decides as it began."""
     import json
 
-    cfg, ref = dome
+    cfg, ref = never_reached
     out = tmp_path / "cut"
     interrupted(cfg, out, 5, lights=None, until=1e-9)
     m = json.loads((out / "manifest.json").read_text())

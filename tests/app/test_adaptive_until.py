@@ -14,7 +14,7 @@ import re
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, SMALL_DOME, interrupted, journal, manifest, said, write_config
+from conftest import CONFIGS, interrupted, journal, manifest, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -24,18 +24,6 @@ from rti_rig.planner.adaptive_until import GUESSES, UPPER_FACTOR, guessed_lights
 from rti_rig.runtime.controller import FinishReason
 
 runner = CliRunner()
-
-
-@pytest.fixture(scope="module")
-def never_reached(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    """A session on a 12-LED dome whose target is never reached: it runs to every LED."""
-    base = tmp_path_factory.mktemp("until")
-    cfg = write_config(base, SMALL_DOME)
-    out = base / "s"
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--until-error", "1e-9"])
-    assert r.exit_code == 0, r.output
-    (out.parent / "said.txt").write_text(said(r))
-    return cfg, out
 
 
 def _printed_tol(value: float) -> float:

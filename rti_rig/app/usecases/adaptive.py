@@ -953,6 +953,7 @@ def refuse_other_format(header: dict, root: Path) -> None:
         raise RtiRigError(
             f"{root}: this adaptive session was begun with format "
             f"{header.get('format')!r}, and this version of rti-rig continues only {FORMAT!r} "
+            f"and {FORMAT_MIN_LIGHTS!r} "
             "(its choices would differ from the ones already made). The images are kept: "
             "`rti-rig export-lp` and `rti-rig fit` use them as they are; start a new session to "
             "shoot more"
