@@ -16,9 +16,10 @@ Here each image is reduced to its **edge strength** (gradient magnitude of the l
 image, scaled by its own 99th percentile): edges of the relief and the albedo sit in the same
 place whatever the light, with a sign and strength that vary, which the magnitude and the scaling
 remove. The reference is the per-pixel **median** of those edge images, so it stays where most
-images are; each image's shift against it is found by phase correlation (OpenCV, sub-pixel), the
-images are moved back and the median recomputed (a few rounds), so a block of moved images does
-not drag the reference. An image is judged only when its edge image correlates with the reference
+images are; each image's shift against it is found by phase correlation (OpenCV's estimate,
+computed here so that its peak is searched near no shift: below), the images are moved back
+and the median recomputed (a few rounds), so a block of moved images does not drag the
+reference. An image is judged only when its edge image correlates with the reference
 (the peak's response): a black frame or a featureless image has no position to measure.
 
 The peak is searched **within** :data:`MAX_SHIFT_PX` of no shift. An edge image under one light
