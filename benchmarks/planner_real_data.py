@@ -130,11 +130,18 @@ def evaluate(
     ref: np.ndarray,
     mask: np.ndarray,
     model: str,
+    held: np.ndarray | None = None,
 ) -> tuple[float, float, bool]:
+    """(normal error, relighting PSNR, whether the fit fell back to least squares) of the
+    layout ``leds``. Relighting is scored on ``held`` (indices no layout may take, the same
+    for every layout compared) or, when None, on the lights this layout did not take — which
+    differ between layouts, so such PSNRs compare layouts on different lights."""
     leds = np.asarray(sorted(int(i) for i in leds))
+    if held is not None and np.intersect1d(leds, held).size:
+        raise ValueError("a layout took a held-out light")
     normals, fallback = subset_normals(images[leds], dirs[leds])
     err = float(np.nanmean(angular_error_map(normals, ref)[mask]))
-    rest = np.setdiff1d(np.arange(len(dirs)), leds)
+    rest = np.setdiff1d(np.arange(len(dirs)), leds) if held is None else np.asarray(held)
     mdl = relight_model(images[leds], dirs[leds], model)
     psnr = relight_psnr(mdl, images[rest], dirs[rest], 1.0, mask)
     return err, psnr, fallback

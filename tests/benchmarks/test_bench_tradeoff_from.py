@@ -5,6 +5,8 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -18,7 +20,10 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     rows = list(csv.DictReader((out / "results.csv").open()))
     counts = sorted({int(row["n"]) for row in rows})
-    assert counts == [6, 9, 12]  # those below the acquisition's 18 lights
+    # those below the 15 lights not held out (18 lights, 3 held out), and every one of them
+    assert counts == [6, 9, 12, 15]
+    assert [row["method"] for row in rows if int(row["n"]) == 15] == ["all"]
+    assert ("adaptive", "relight") in {(row["method"], row["objective"]) for row in rows}
     methods = {(row["method"], float(row["floor_deg"])) for row in rows}
     assert {("optimal", 0.0), ("adaptive", 0.0), ("uniform", 0.0), ("uniform", 30.0)} <= methods
     for row in rows:
@@ -30,17 +35,68 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     assert not list(out.glob("*arm_time*"))
     text = (out / "summary.md").read_text()
     assert "--from" in text and "adaptive" in text
+    assert "on the same 3 held-out lights for every plan" in text
+
+
+def test_every_plan_is_scored_on_the_same_held_out_lights(monkeypatch) -> None:
+    """Relighting PSNR compares plans only if it is measured on the same lights for all: each
+    plan is scored on one held-out set, fixed before planning, that no plan took."""
+    import benchmarks.planner_real_data as real
+    from benchmarks.tradeoff_from import run_tradeoff_from
+
+    calls: list[tuple[np.ndarray, np.ndarray]] = []
+    evaluate = real.evaluate
+
+    def spy(leds, images, dirs, ref, mask, model, held=None):  # type: ignore[no-untyped-def]
+        calls.append((np.asarray(leds), held))
+        return evaluate(leds, images, dirs, ref, mask, model, held=held)
+
+    monkeypatch.setattr(real, "evaluate", spy)
+    rows, held_names = run_tradeoff_from(ACQ, progress=lambda _m: None)
+    assert len(calls) == len(rows) > 10
+    held = calls[0][1]
+    assert held is not None and len(held) == len(held_names) == 3
+    for leds, h in calls:
+        np.testing.assert_array_equal(h, held)
+        assert not set(leds.tolist()) & set(held.tolist())
+    lp_names = [line.split()[0] for line in ACQ.read_text().splitlines()[1:]]
+    assert [lp_names[i] for i in held] == held_names
+
+
+def test_held_out_lights_follow_the_acquisitions_elevations() -> None:
+    """One light in each band of equal count by elevation, a sixth of them, the same each run."""
+    from benchmarks.tradeoff_from import held_out_lights
+
+    rng = np.random.default_rng(3)
+    el = np.radians(np.concatenate([rng.uniform(2, 20, 40), rng.uniform(20, 85, 32)]))
+    az = rng.uniform(0, 2 * np.pi, 72)
+    dirs = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
+    held = held_out_lights(dirs)
+    assert len(held) == 12 and len(set(held.tolist())) == 12
+    np.testing.assert_array_equal(held, held_out_lights(dirs))
+    rank = np.argsort(np.argsort(dirs[:, 2]))  # each light's place by elevation
+    assert sorted((rank[held] // 6).tolist()) == list(range(12))  # one per band of 6
+    assert len(held_out_lights(dirs[:10])) == 3  # never fewer than 3
+
+
+def test_a_layout_that_took_a_held_out_light_is_refused() -> None:
+    from benchmarks.planner_real_data import evaluate
+
+    images = np.ones((8, 4, 4), np.float32)
+    dirs = np.tile([0.0, 0.0, 1.0], (8, 1))
+    with pytest.raises(ValueError, match="held-out"):
+        evaluate(np.array([0, 1, 2, 3, 4, 5]), images, dirs, None, None, "ptm", np.array([5, 6]))
 
 
 def test_tradeoff_from_too_small_an_acquisition_is_refused(tmp_path: Path) -> None:
     small = tmp_path / "acq"
     small.mkdir()
-    lines = ACQ.read_text().splitlines()[1:7]
+    lines = ACQ.read_text().splitlines()[1:10]  # 9 lights: 7 to plan from, 3 held out is 10
     for line in lines:
         name = line.split()[0]
         (small / name).write_bytes((ACQ.parent / name).read_bytes())
-    (small / "dirs.lp").write_text("6\n" + "\n".join(lines) + "\n")
+    (small / "dirs.lp").write_text("9\n" + "\n".join(lines) + "\n")
     r = CliRunner().invoke(
         app, ["bench", "tradeoff", "--from", str(small / "dirs.lp"), "--out", str(tmp_path / "o")]
     )
-    assert r.exit_code == 2 and "at least 7" in r.output
+    assert r.exit_code == 2 and "at least 10" in r.output and "held out" in r.output
