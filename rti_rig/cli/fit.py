@@ -48,6 +48,15 @@ def fit(
     no_normals: Annotated[
         bool, typer.Option("--no-normals", help="Do not fit normal and albedo maps.")
     ] = False,
+    export_encoding: Annotated[
+        str,
+        typer.Option(
+            "--export-encoding",
+            help="What fit.ptm and fit.rti hold: srgb (the photographs' JPEG values, as "
+            "RTIBuilder writes them: what RTIViewer and relight show as they are) or linear "
+            "(the linear light the normals are fitted to; darker in a viewer).",
+        ),
+    ] = "srgb",
     scheduler: Annotated[
         str | None,
         typer.Option(
@@ -70,6 +79,11 @@ def fit(
     use_one_heap()
 
     try:
+        if export_encoding not in ("srgb", "linear"):
+            raise RtiRigError(
+                f"--export-encoding {export_encoding!r}: choose srgb (what viewers expect) or "
+                "linear"
+            )
         if model != "auto":
             try:
                 model_spec(model)
@@ -83,6 +97,7 @@ def fit(
             write_ptm=not no_ptm,
             write_hsh=not no_hsh,
             write_normals=not no_normals,
+            export_encoding=export_encoding,
         )
         if len(sources) > 1:
             if scheduler is None:

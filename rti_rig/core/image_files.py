@@ -17,11 +17,37 @@ from numpy.typing import NDArray
 from rti_rig.core.errors import SessionError
 
 
+def _srgb_curve(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The sRGB transfer curve (IEC 61966-2-1) on linear values in [0, 1]."""
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
+
+
+#: the curve at every 16-bit level: a table, not ``np.power`` on the data, because numpy's
+#: vectorised float32 power can differ in the last bit with the array's memory alignment, and
+#: a fit's bands must give the same bytes in every process (the Dask runner's guarantee)
+_SRGB_LUT = _srgb_curve(np.arange(65536, dtype=np.float64) / 65535.0).astype(np.float32)
+
+
+def srgb_encode(linear: NDArray[np.floating]) -> NDArray[np.float32]:
+    """The sRGB curve on linear values in units of full scale, at 16-bit resolution (exact for
+    16-bit data, within 1/65535 of the input for any other), clipped to [0, 1]; NaN stays NaN
+    (a missing observation). Worked in one float32 copy and a 16-bit index (a fit encodes its
+    whole pixel sample at once)."""
+    x = np.array(linear, dtype=np.float32, copy=True)
+    missing = np.isnan(x)
+    np.clip(x, 0.0, 1.0, out=x)
+    x *= np.float32(65535.0)
+    np.rint(x, out=x)
+    x[missing] = 0.0
+    np.take(_SRGB_LUT, x.astype(np.uint16), out=x)
+    x[missing] = np.nan
+    return x
+
+
 def linear_to_srgb8(pixels: NDArray[np.uint16], white_level: int) -> NDArray[np.uint8]:
     """Encode linear data with the sRGB transfer curve into 8 bits (for viewers and relight)."""
     x = np.clip(pixels.astype(np.float32) / float(white_level), 0.0, 1.0)
-    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
-    return np.round(srgb * 255.0).astype(np.uint8)
+    return np.round(_srgb_curve(x) * 255.0).astype(np.uint8)
 
 
 def _atomic_write(path: Path, data: bytes) -> str:

@@ -9,13 +9,20 @@ Formats, as published (no code copied):
   coefficients a0..a5. Coefficient ``a_i = (byte - bias_i) × scale_i``. Scanlines run from the
   bottom of the image up (the origin of a PTM is its lower-left corner), and ``(l_u, l_v)`` are
   the light's projection with ``v`` up — the DESIGN.md frame.
-* **HSH ``.rti``** (RTIViewer's format, as relight's ``LRti::loadHSH`` reads it): comment lines
-  starting ``#`` (the first is ``#HSH1.2``), the file type ``3`` (HSH), ``width height 3``,
-  ``terms basis_type element_size`` (we write ``2 1``: the basis type is ignored by readers,
-  one byte per element), then ``terms`` little-endian float32 scales and ``terms`` biases,
-  then bytes: scanlines from the bottom up, for each pixel, for each colour, for each term.
-  Coefficient ``c = byte / 255 × scale_k + bias_k``. Our basis is the true HSH (order-3
-  exponent 1.5, see :mod:`rti_rig.core.rti_bases`).
+* **HSH ``.rti``** (RTIViewer's format: its ``Hsh::loadData``, the ``.rti`` branch; relight's
+  ``LRti::loadHSH`` in cnr-isti-vclab/relight ``src/legacy_rti.cpp``; CHI's Java HSH viewer
+  ``org.thadeus.rtiviewer.RTI``): comment lines starting ``#`` (the first is ``#HSH1.2``), the
+  file type ``3`` (HSH), ``width height 3``, ``terms basis_type element_size`` (we write
+  ``2 1``: the basis type is ignored by readers, one byte per element), then ``terms``
+  little-endian float32 scales and ``terms`` biases, then bytes: scanlines **from the top
+  down** (unlike a PTM: relight stores file row ``y`` of an HSH at row ``height - 1 - y`` of
+  the same bottom-up buffer it reads a PTM's file rows into unflipped; RTIViewer reads row
+  ``j`` to image row ``j``; the Java viewer flips ``j`` for OpenGL's bottom-up origin), for
+  each pixel, for each colour, for each term. Coefficient ``c = byte / 255 × scale_k +
+  bias_k``, in units where **1 is full scale**: the Java viewer clamps the relit sum to [0, 1]
+  and multiplies by 255 for display, JedMills' RTIViewer shader writes it out as a 0–1 colour.
+  Our basis is the true HSH
+  (order-3 exponent 1.5, see :mod:`rti_rig.core.rti_bases`).
 * **relight ``.dome``** (cnr-isti-vclab/relight): JSON as relight's ``Dome::fromJson``
   (src/dome.cpp) reads it — ``label``, ``notes``, ``imageWidth`` and ``domeDiameter`` (cm),
   ``verticalOffset`` (cm), ``lightConfiguration`` (``"directional"``) and ``directions`` as an
@@ -27,8 +34,12 @@ Formats, as published (no code copied):
   writes 0 (unknown) for them, which a ``"directional"`` dome never reads, so the unit
   question does not arise until a diameter is written.
 
-Coefficients are written in units of the fitted (linear) images × 255, quantised to 8 bits per
-coefficient with one scale and bias per coefficient index (over all pixels and colours).
+Coefficients are written in the units each viewer displays — a PTM's relit value is shown
+as the byte value itself (images × 255), an HSH's as the fraction of full scale (images × 1) —
+quantised to 8 bits per coefficient with one scale and bias per coefficient index (over all
+pixels and colours). Which images is the caller's choice (`rti-rig fit --export-encoding`):
+viewers apply no transfer curve, so the sRGB-encoded observations look as the JPEGs do and the
+linear ones darker.
 """
 
 from __future__ import annotations
@@ -44,8 +55,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
 
-#: Coefficients are stored for images scaled to 0–255 (what PTM/RTI viewers display).
+#: A PTM's coefficients are stored for images scaled to 0–255: PTM viewers show the relit
+#: value as the byte itself (RTIViewer's ``evalPoly`` result goes straight to a byte).
 DISPLAY_SCALE = 255.0
+#: An HSH ``.rti``'s coefficients are stored for images in 0–1: the viewers display the relit
+#: sum as a fraction of full scale (CHI's Java viewer clamps it to [0, 1], then × 255).
+HSH_DISPLAY_SCALE = 1.0
 
 
 def _rgb_planes(coefficients: NDArray[Any]) -> NDArray[np.float32]:
@@ -75,6 +90,8 @@ class PtmWriter:
     pixel sample (:func:`coefficient_ranges`).
     """
 
+    display_scale = DISPLAY_SCALE
+
     def __init__(self, path: Path, width: int, height: int, lo: ArrayLike, hi: ArrayLike) -> None:
         self.path, self.width, self.height = path, int(width), int(height)
         self.scale, self.bias = ptm_quantisation(lo, hi)
@@ -95,7 +112,7 @@ class PtmWriter:
 
     def write_rows(self, top: int, coefficients: NDArray[Any]) -> None:
         """Coefficients (6, r, W[, 3]) of image rows ``top .. top + r`` (top-down)."""
-        c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
+        c = _rgb_planes(coefficients) * np.float32(self.display_scale)
         r = c.shape[1]
         sc = self.scale[:, None, None].astype(np.float32)
         bi = self.bias[:, None, None].astype(np.float32)
@@ -117,7 +134,10 @@ class PtmWriter:
 
 
 class RtiWriter:
-    """HSH ``.rti`` written a band of rows at a time; ``lo``/``hi`` per term, display units."""
+    """HSH ``.rti`` written a band of rows at a time; ``lo``/``hi`` per term, in this format's
+    display units (images × :data:`HSH_DISPLAY_SCALE`: ``coefficient_ranges(c, scale=...)``)."""
+
+    display_scale = HSH_DISPLAY_SCALE
 
     def __init__(self, path: Path, width: int, height: int, lo: ArrayLike, hi: ArrayLike) -> None:
         self.path, self.width, self.height = path, int(width), int(height)
@@ -138,15 +158,14 @@ class RtiWriter:
         self._fh.truncate(self._start + self.width * self.height * 3 * self.terms)
 
     def write_rows(self, top: int, coefficients: NDArray[Any]) -> None:
-        """Coefficients (terms, r, W[, 3]) of image rows ``top .. top + r`` (top-down)."""
-        c = _rgb_planes(coefficients) * np.float32(DISPLAY_SCALE)
-        r = c.shape[1]
+        """Coefficients (terms, r, W[, 3]) of image rows ``top .. top + r`` (top-down, as the
+        file's scanlines run)."""
+        c = _rgb_planes(coefficients) * np.float32(self.display_scale)
         lo = self.lo[:, None, None, None].astype(np.float32)
         sc = self.scale[:, None, None, None].astype(np.float32)
         q = np.clip(np.round((c - lo) / sc * 255.0), 0, 255).astype(np.uint8)
-        block = np.ascontiguousarray(np.transpose(q, (1, 2, 3, 0))[::-1])  # rows, x, colour, k
-        first_file_row = self.height - (top + r)
-        self._fh.seek(self._start + first_file_row * self.width * 3 * self.terms)
+        block = np.ascontiguousarray(np.transpose(q, (1, 2, 3, 0)))  # rows, x, colour, term
+        self._fh.seek(self._start + top * self.width * 3 * self.terms)
         self._fh.write(block.tobytes())
 
     def close(self) -> Path:
@@ -167,12 +186,13 @@ def _abort(fh: Any, tmp: Path) -> None:
 
 
 def coefficient_ranges(
-    coefficients: NDArray[Any], margin: float = 0.0
+    coefficients: NDArray[Any], margin: float = 0.0, scale: float = DISPLAY_SCALE
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Per-coefficient (lo, hi) in display units of coefficients (p, ...), widened by
-    ``margin`` × the range on each side (for ranges taken from a sample)."""
+    """Per-coefficient (lo, hi) of coefficients (p, ...) in display units (× ``scale``: a
+    writer's ``display_scale``), widened by ``margin`` × the range on each side (for ranges
+    taken from a sample)."""
     c = np.asarray(coefficients, dtype=np.float64).reshape(coefficients.shape[0], -1)
-    c = c * DISPLAY_SCALE
+    c = c * scale
     lo, hi = np.nanmin(c, axis=1), np.nanmax(c, axis=1)
     pad = (hi - lo) * margin
     return lo - pad, hi + pad
@@ -191,7 +211,8 @@ def write_ptm_rgb(path: Path, coefficients: NDArray[Any]) -> Path:
 def write_hsh_rti(path: Path, coefficients: NDArray[Any]) -> Path:
     """Write HSH coefficients (terms, H, W[, 3]) in ``.rti`` index order as an HSH ``.rti``."""
     c = np.asarray(coefficients)
-    writer = RtiWriter(path, c.shape[2], c.shape[1], *coefficient_ranges(c))
+    ranges = coefficient_ranges(c, scale=RtiWriter.display_scale)
+    writer = RtiWriter(path, c.shape[2], c.shape[1], *ranges)
     writer.write_rows(0, c)
     return writer.close()
 

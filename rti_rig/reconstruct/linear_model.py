@@ -119,10 +119,17 @@ def _weighted_columns(
         uu, sv, vt = np.linalg.svd(sub / norms, full_matrices=False)
         if sv[-1] <= 0 or sv[0] / sv[-1] > cond_limit:
             continue
-        w = ((vt.T / sv) @ uu.T / norms[:, None]).astype(np.float32)
-        coef[:, cols] = w @ values[np.ix_(rows, cols)]
+        w = (vt.T / sv) @ uu.T / norms[:, None]
+        # in float64, rounded on assignment: a group's column count depends on the band, and a
+        # float32 product's last bit on the column count (see fit_coefficients)
+        coef[:, cols] = w @ values[np.ix_(rows, cols)].astype(np.float64)
         ok[cols] = True
     return coef, ok
+
+
+#: columns (pixel values) per float64 product in :func:`fit_coefficients`: the float64 copy
+#: of a slice, not of the whole band or pixel sample (which model choice fits at once)
+PRODUCT_COLUMNS = 8192
 
 
 def fit_coefficients(
@@ -141,9 +148,10 @@ def fit_coefficients(
 
     Returns coefficients (p, H, W) or (p, H, W, C) float32 and the fit report. The float32
     working set is one band (see :mod:`rti_rig.reconstruct.tiling`); the solve matrix is
-    computed once in float64 and applied in float32. ``out`` (same shape) receives the
-    coefficients instead of a new array: a ``numpy.memmap`` keeps a 24-megapixel HSH3 fit
-    (4.6 GB of float32 colour coefficients) out of memory.
+    computed once in float64 and applied in float64 to the float32 band, rounded to float32
+    (so that a pixel's coefficients do not depend on the band's width). ``out`` (same shape)
+    receives the coefficients instead of a new array: a ``numpy.memmap`` keeps a 24-megapixel
+    HSH3 fit (4.6 GB of float32 colour coefficients) out of memory.
 
     Saturated (at or above ``saturation``, default the stack's level) and NaN observations are
     excluded: a pixel value with any of them is fitted by least squares on its other
@@ -154,7 +162,6 @@ def fit_coefficients(
     if design.shape[0] != stack.n:
         raise ValueError(f"design has {design.shape[0]} rows for {stack.n} images")
     w, report = solve_matrix(design, model, ill_conditioned, cond_limit, basis=basis)
-    w32 = w.astype(np.float32)
     p = w.shape[0]
     rows = tile_rows or rows_for_budget(stack.n, stack.width, stack.channels)
     shape = (p, stack.height, stack.width) + (() if stack.grey else (stack.channels,))
@@ -169,7 +176,14 @@ def fit_coefficients(
         flat = band.reshape(stack.n, -1)
         target = coef[:, sl].reshape(p, -1)  # a view for in-memory outputs: written in place
         direct = np.may_share_memory(target, coef)
-        tile = np.matmul(w32, flat, out=target) if direct else w32 @ flat
+        # summed in float64, then rounded to float32: a float32 product's last bit depends on
+        # how BLAS blocks the band's columns (its width), and the exported 8-bit coefficients
+        # of a pixel must not depend on the band size or the process that fitted it (a pixel
+        # near a rounding boundary flipped a byte of fit.ptm between band sizes)
+        tile = target if direct else np.empty((p, flat.shape[1]), dtype=np.float32)
+        for c0 in range(0, flat.shape[1], PRODUCT_COLUMNS):  # float64 a slice at a time
+            cols = slice(c0, c0 + PRODUCT_COLUMNS)
+            tile[:, cols] = w @ flat[:, cols].astype(np.float64)
         # NaN/inf in an observation propagates into its column's coefficients: find them there
         # (one sum over the p rows, not N); saturation needs one max-reduction over the band
         with np.errstate(invalid="ignore", over="ignore"):

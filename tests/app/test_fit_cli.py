@@ -1,7 +1,9 @@
 """`rti-rig fit` through the front door, its files read back independently, and the QA verdict.
 
-The `.ptm` and `.rti` readers here are written from the published format descriptions (HP's PTM
-1.2 layout; RTIViewer's HSH `.rti` as relight's legacy reader documents it), not from our writer.
+The `.ptm` and `.rti` readers here are written from the published format descriptions and the
+viewers people open them with (HP's PTM 1.2 layout; the HSH `.rti` as RTIViewer's
+`Hsh::loadData`, relight's `LRti::loadHSH` and CHI's Java HSH viewer read it), not from our
+writer.
 """
 
 from __future__ import annotations
@@ -71,7 +73,10 @@ def _read_ptm(path: Path) -> np.ndarray:
 
 def _read_rti(path: Path) -> np.ndarray:
     """HSH .rti: '#' comment lines, type 3, 'W H 3', 'terms type size', float32 scales and
-    biases, then scanlines bottom-up, per pixel, per colour, per term: byte/255*scale+bias."""
+    biases, then scanlines top-down (the viewers read file row 0 as the image's top row, where
+    a PTM's first scanline is its bottom one), per pixel, per colour, per term:
+    byte/255*scale+bias, in units of full scale (the viewers display the relit sum × 255, or
+    256, after clamping it to 0..1). Returns (terms, H, W, 3) top-down, in those units."""
     data = path.read_bytes()
     pos = 0
     fields: list[str] = []
@@ -88,7 +93,7 @@ def _read_rti(path: Path) -> np.ndarray:
     bias = np.array(struct.unpack(f"<{terms}f", data[pos + 4 * terms : pos + 8 * terms]))
     raw = np.frombuffer(data, np.uint8, offset=pos + 8 * terms).reshape(h, w, bands, terms)
     coef = raw / 255.0 * scale + bias  # (H, W, 3, terms)
-    return np.transpose(coef, (3, 0, 1, 2))[:, ::-1]
+    return np.transpose(coef, (3, 0, 1, 2))
 
 
 def test_ptm_and_rti_read_back_relight_like_the_fit(clean, tmp_path: Path) -> None:
@@ -99,7 +104,8 @@ def test_ptm_and_rti_read_back_relight_like_the_fit(clean, tmp_path: Path) -> No
 
     session, lights, _ = clean
     out = tmp_path / "out"
-    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps"])
+    args = ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps"]
+    r = runner.invoke(app, [*args, "--export-encoding", "linear"])
     assert r.exit_code == 0, r.output
     frames = [tifffile.imread(p) for p in sorted((session / "linear").glob("*.tif"))]
     ptm = fit_ptm(ImageStack(frames), lights)
@@ -107,20 +113,73 @@ def test_ptm_and_rti_read_back_relight_like_the_fit(clean, tmp_path: Path) -> No
     ptm_file = _read_ptm(out / "fit.ptm")
     rti_file = _read_rti(out / "fit.rti")
     assert ptm_file.shape == ptm.coefficients.shape and rti_file.shape == hsh.coefficients.shape
-    # relight at directions between the lights, in 0..255 display units
+    # relight at directions between the lights, in each format's display units: a PTM's relit
+    # value is the byte shown (0..255), an HSH's the fraction of full scale (0..1)
     for d in ([0.3, 0.2, 0.9327], [-0.5, 0.4, 0.7681], [0.7, -0.1, 0.7071]):
         d = np.array(d) / np.linalg.norm(d)
         ref = np.tensordot(ptm_basis(d[None])[0], ptm.coefficients, axes=(0, 0)) * 255
         got = np.tensordot(ptm_basis(d[None])[0], ptm_file, axes=(0, 0))
         assert np.percentile(np.abs(got - ref), 99) < 2.5  # 8-bit quantisation of 6 terms
-        ref = np.tensordot(hsh_basis(d[None], 2)[0], hsh.coefficients, axes=(0, 0)) * 255
+        ref = np.tensordot(hsh_basis(d[None], 2)[0], hsh.coefficients, axes=(0, 0))
         got = np.tensordot(hsh_basis(d[None], 2)[0], rti_file, axes=(0, 0))
-        assert np.percentile(np.abs(got - ref), 99) < 4.0  # 9 terms
+        assert np.percentile(np.abs(got - ref), 99) < 4.0 / 255  # 9 terms
+        # the image the right way up: the rows read back the other way round match far worse
+        # (a file written bottom-up opens upside down in RTIViewer and relight)
+        flipped = np.tensordot(hsh_basis(d[None], 2)[0], rti_file[:, ::-1], axes=(0, 0))
+        assert np.percentile(np.abs(flipped - ref), 99) > 10 * np.percentile(np.abs(got - ref), 99)
+        # and in the viewers' units: 255x too large (as written before) shows white in RTIViewer
+        assert 0.0 <= float(np.median(got)) <= 1.0
     dome = json.loads((out / "lights.dome").read_text())
     # as relight's Dome::fromJson reads it: objects with x, y, z (an [x, y, z] array reads as 0)
     got = np.array([[o["x"], o["y"], o["z"]] for o in dome["directions"]])
     np.testing.assert_allclose(got, lights, atol=1e-5)
     assert dome["lightConfiguration"] == "directional" and "domeDiameter" in dome
+
+
+def test_ptm_and_rti_hold_the_photographs_values_by_default(clean, tmp_path: Path) -> None:
+    """Viewers show a PTM's or an HSH's relit value as it is, with no transfer curve, and
+    RTIBuilder fits the JPEGs: so by default the files hold sRGB-encoded values, and relit at a
+    captured light they give the photograph as its JPEG shows it. Linear values (asked for
+    with --export-encoding linear) show it far darker."""
+    import tifffile
+
+    from rti_rig.core.image_files import srgb_encode
+
+    session, lights, _ = clean
+    files = {}
+    for encoding in ("srgb", "linear"):
+        out = tmp_path / encoding
+        args = ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps"]
+        if encoding == "linear":
+            args += ["--export-encoding", "linear"]
+        r = runner.invoke(app, args)
+        assert r.exit_code == 0, r.output
+        assert json.loads((out / "fit.json").read_text())["export_encoding"] == encoding
+        files[encoding] = (_read_ptm(out / "fit.ptm"), _read_rti(out / "fit.rti"))
+    tifs = sorted((session / "linear").glob("*.tif"))
+    for k in (0, 9, 20, 30):
+        photo = srgb_encode(tifffile.imread(tifs[k]) / 65535.0)  # the JPEG's values, 0..1
+        if photo.ndim == 3:
+            photo = photo.mean(axis=-1)
+        deviation = {}
+        for encoding, (ptm, rti) in files.items():
+            relit_ptm = np.tensordot(ptm_basis(lights[k][None])[0], ptm, axes=(0, 0)) / 255
+            relit_rti = np.tensordot(hsh_basis(lights[k][None], 2)[0], rti, axes=(0, 0))
+            deviation[encoding] = [
+                float(np.median(np.abs(relit.mean(axis=-1) - photo)))
+                for relit in (relit_ptm, relit_rti)
+            ]
+        # a PTM relights a grazing light less well (its quadratic); the offset is what counts
+        assert max(deviation["srgb"]) < 0.06, deviation  # within ~15 levels of 255
+        assert min(deviation["linear"]) > 0.15, deviation  # linear light is far darker
+
+
+def test_an_unknown_export_encoding_is_refused(clean, tmp_path: Path) -> None:
+    session, _, _ = clean
+    out = tmp_path / "o"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--export-encoding", "gamma"])
+    assert r.exit_code == 2 and "--export-encoding" in r.output and "srgb" in r.output
+    assert not out.exists() or not any(out.iterdir())
 
 
 def _names(indices) -> set[str]:

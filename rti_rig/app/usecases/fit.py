@@ -61,6 +61,10 @@ class FitRequest:
     write_normals: bool = True
     hsh_order: int | None = None  # None: the chosen HSH order, else 2
     qa: bool = True
+    #: what fit.ptm and fit.rti hold: "srgb" (the photographs' encoded values, as RTIBuilder
+    #: writes them and viewers show them) or "linear" (the fitted linear light: darker in a
+    #: viewer, which applies no transfer curve). Normals are fitted to the linear light either way.
+    export_encoding: str = "srgb"
 
 
 @dataclass
@@ -306,6 +310,8 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         "read": what,
         "model": result.model,
         "why": result.reason,
+        # what fit.ptm / fit.rti hold (a viewer cannot tell: neither format records it)
+        "export_encoding": req.export_encoding,
         "warnings": result.warnings,
         "input_notes": result.notes,
         "files": [p.name for p in result.files],
@@ -341,6 +347,7 @@ def _fit_all(
     values beyond are clipped, and counted in ``fit.json``). The bands themselves are fitted
     by :func:`rti_rig.app.usecases.fit_bands.fit_band`, run by ``bands``.
     """
+    from rti_rig.core.image_files import srgb_encode
     from rti_rig.core.rti_bases import design_matrix
     from rti_rig.reconstruct.errors import FitTrustWarning
     from rti_rig.reconstruct.model_select import select_model
@@ -399,11 +406,16 @@ def _fit_all(
             if key == "lambert":
                 continue
             assert obs is not None
-            lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5)
             kind, name = (
                 (exporters.PtmWriter, "fit.ptm")
                 if key == "ptm"
                 else (exporters.RtiWriter, "fit.rti")
+            )
+            # no name holds the sample (or its encoded copy): `del obs` below must free it
+            lo, hi = exporters.coefficient_ranges(
+                w @ (srgb_encode(obs) if req.export_encoding == "srgb" else obs),
+                margin=0.5,
+                scale=kind.display_scale,
             )
             writers[key] = kind(out / name, stack.width, stack.height, lo, hi)
 
@@ -429,6 +441,7 @@ def _fit_all(
             saturation=stack.saturation_level,
             reference_level=ref,
             grey=stack.grey,
+            export_encoding=req.export_encoding,
         )
         tiles = list(row_tiles(h, rows))
         # one BLAS thread: the fit is many small products over cache-sized chunks, where

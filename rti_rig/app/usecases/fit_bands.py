@@ -38,11 +38,17 @@ class BandPlan:
     saturation: float | None
     reference_level: float
     grey: bool
+    export_encoding: str = "linear"
+
+
+#: the linear models a fit writes to files (the others — Lambert — only give normals)
+EXPORTED = ("ptm", "hsh1", "hsh2", "hsh3")
 
 
 @dataclass
 class BandFit:
-    """Outputs of one band: coefficients per linear model (``(p, r, W[, C])``), normals
+    """Outputs of one band: coefficients per linear model as the files get them (``(p, r, W[,
+    C])``; see ``BandPlan.export_encoding``), normals
     ``(r, W, 3)`` and albedo ``(r, W[, C])`` (None when no normal maps are fitted), and the
     texts of warnings the band's fit issued (re-issued by whoever collects the band)."""
 
@@ -69,10 +75,25 @@ def fit_band(band: np.ndarray, plan: BandPlan) -> BandFit:
         band = band[..., 0]
     rows, sat, ref = plan.tile_rows, plan.saturation, plan.reference_level
     source = plan.normal_source
-    coefs = {
-        key: fit_coefficients(band, design, key, saturation=sat, tile_rows=rows)[0]
-        for key, design in plan.linear.items()
-    }
+    shown = shown_sat = None
+    if plan.export_encoding == "srgb" and any(k in EXPORTED for k in plan.linear):
+        from rti_rig.core.image_files import srgb_encode
+
+        shown = srgb_encode(band)  # clipped at full scale: saturation stays at 1.0
+        shown_sat = None if sat is None else float(srgb_encode(np.float32(min(sat, 1.0))))
+    coefs: dict[str, np.ndarray] = {}  # fitted to the linear light: what normals are read from
+    written: dict[str, np.ndarray] = {}  # what the files get
+    for key, design in plan.linear.items():
+        if shown is not None and key in EXPORTED:
+            written[key] = fit_coefficients(
+                shown, design, key, saturation=shown_sat, tile_rows=rows
+            )[0]
+            if key == source:  # `--model ptm`: its normals from the PTM of the linear light
+                coefs[key] = fit_coefficients(band, design, key, saturation=sat, tile_rows=rows)[0]
+        else:
+            coefs[key] = fit_coefficients(band, design, key, saturation=sat, tile_rows=rows)[0]
+            written[key] = coefs[key]
+    del shown
     normals = albedo = None
     if not source:
         pass
@@ -100,7 +121,7 @@ def fit_band(band: np.ndarray, plan: BandPlan) -> BandFit:
             albedo = np.linalg.norm(coefs["lambert"], axis=0)
         else:
             albedo = coefs["ptm"][5]  # the PTM's constant term: mean brightness
-    return BandFit(coefs, normals, albedo)
+    return BandFit(written, normals, albedo)
 
 
 def blas_threads() -> int | None:
