@@ -174,6 +174,7 @@ def run_tradeoff_from(
         for objective in ("normals", "relight"):
             used, adaptive_s = adaptive_run(n, objective)
             add("adaptive", 0.0, n, np.array(used), adaptive_s, objective)
+        progress(f"{name}: N = {n} done")
     # every light not held out, fitted with the model its count gets (a reference, not a bound)
     add("all", 0.0, len(keep), np.arange(len(keep)), 0.0, "normals")
     return rows, [names[i] for i in held]
@@ -231,9 +232,9 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
         f"({every.relight_model}): every light not held out | | | | |",
         "",
         "Cells: mean normal error against the all-light reference / relighting PSNR on the "
-        "held-out lights, fitted with the richest basis N lights determine (in brackets; at 9 "
-        "lights HSH of order 2 has as many coefficients as lights, so it interpolates the noise "
-        "of every image, and PSNR need not rise with N). One acquisition, one layout per cell: "
+        "held-out lights, fitted with the richest basis the planner gives N lights (in "
+        "brackets: HSH1 from 6, PTM from 9, HSH2 from 14, HSH3 from 24; the basis changes with "
+        "N, so PSNR need not rise at every step). One acquisition, one layout per cell: "
         "differences of a few tenths of a degree or dB between layouts are within what one "
         "layout's luck moves (docs/planner.md); read the trend with N, not single cells.",
     ]

@@ -320,3 +320,17 @@ def test_qa_verdict_does_not_depend_on_the_order_images_are_listed(tmp_path: Pat
         assert r.exit_code == 0, r.output
         qa = json.loads((out / "qa.json").read_text())
         assert set(qa["reshoot"]) == expected, qa["verdict"]
+
+
+def test_ptm_normals_without_a_ptm_file(clean, tmp_path: Path) -> None:
+    """`--model ptm --no-ptm`: the PTM gives the normals and is not written (it had stopped
+    with a KeyError traceback and left an empty folder)."""
+    session, _, truth = clean
+    out = tmp_path / "out"
+    r = runner.invoke(
+        app, ["fit", str(session), "--out", str(out), "--model", "ptm", "--no-ptm", "--no-qa"]
+    )
+    assert r.exit_code == 0, r.output
+    assert not (out / "fit.ptm").exists() and (out / "fit.rti").is_file()
+    err = float(np.median(_angles(np.load(out / "normals.npy"), truth)))
+    assert err < BOUNDS["ptm"]

@@ -393,17 +393,20 @@ def _fit_all(
             f"fit.rti not written: HSH of order {order} needs at least {(order + 1) ** 2} "
             f"lights, there are {n}"
         )
+    exported = {k for k in linear if k != "lambert"}  # the models written to files
     if normal_source == "lambert":
         linear["lambert"] = design_matrix("lambert", lights)
+    if normal_source == "ptm" and "ptm" not in linear:  # --model ptm --no-ptm: fitted, not written
+        linear["ptm"] = design_matrix("ptm", lights)
     # the usable observations of the sample, only when an exported model needs their range
-    obs = _usable_sample(stack) if any(k != "lambert" for k in linear) else None
+    obs = _usable_sample(stack) if exported else None
     writers: dict[str, Any] = {}
     normals = albedo = None
     try:
         for key, design in linear.items():
             ill = "refuse" if key == "lambert" else "regularise"
             w, _ = solve_matrix(design, key, ill)
-            if key == "lambert":
+            if key not in exported:
                 continue
             assert obs is not None
             kind, name = (
@@ -419,9 +422,9 @@ def _fit_all(
             )
             writers[key] = kind(out / name, stack.width, stack.height, lo, hi)
 
-        if not req.write_normals:
+        if not req.write_normals:  # the models kept only for normals are not fitted
             normal_source = ""
-            linear.pop("lambert", None)
+            linear = {k: v for k, v in linear.items() if k in exported}
         # the last use of the sample: when nothing above read it, it is streamed, never held
         ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
         del obs
