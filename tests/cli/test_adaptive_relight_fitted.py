@@ -20,8 +20,11 @@ DOME = REPO / "rig_configs" / "simulated_dome.toml"
 ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
 runner = CliRunner()
 RELIGHT = ("--objective", "relight", "--no-verdict")
-#: on this replayed acquisition the fitted relight design is taken at 7 lights (checked below)
-N = 7
+#: on this replayed acquisition the fitted relight design is taken at 11 lights, from the
+#: second decision on, by 0.62 dB over the 10° design (checked below). At 7 lights it had been
+#: taken over the 20° design it equalled only through float32 rounding noise in the fits; with
+#: the fits summed in float64 the two tie exactly and the floor's design is kept.
+N = 11
 
 
 def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path: Path) -> None:
@@ -54,7 +57,7 @@ def test_a_relight_decision_that_takes_the_fitted_design_records_it(whole: Path)
     adaptive = [d for d in decisions(whole) if d["kind"] == "adaptive"]
     assert len(adaptive) == N - 4
     taken = [d for d in adaptive if d.get("design") == "fitted"]
-    assert taken, "the fitted relight design is taken on this acquisition at 7 lights"
+    assert taken, f"the fitted relight design is taken on this acquisition at {N} lights"
     for d in taken:  # names no floor; taken by the margin over the design kept before it
         assert "design_floor_deg" not in d and d["design_objective"] == "relight"
         assert "least expected relighting error on the fitted model" in d["reason"]
@@ -71,9 +74,9 @@ def test_an_interrupted_relight_session_that_took_the_fitted_design_resumes_to_t
     whole: Path, tmp_path: Path
 ) -> None:
     out = tmp_path / "cut"
-    interrupted(ACQ, out, 4, "relight", lights=N)  # one fitted decision made
-    assert len(journal(out)) == 5
-    assert journal(out)[4]["decision"].get("design") == "fitted"
+    interrupted(ACQ, out, 5, "relight", lights=N)  # one fitted decision made
+    assert len(journal(out)) == 6
+    assert journal(out)[5]["decision"].get("design") == "fitted"
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert decisions(out) == decisions(whole)
