@@ -35,7 +35,7 @@ Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes 
 [--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight-fitted-design]
 [--no-relight] [--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example beside the
-repository; ``--cache`` keeps the bars' scores between runs; ``--write`` puts the tables into
+repository; ``--cache`` keeps `optimal`'s layouts between runs; ``--write`` puts the tables into
 docs/adaptive.md).
 """
 
@@ -77,9 +77,11 @@ START = {"start": dome_start}
 #: to iterate on the normals objective faster; the relighting table is then not a result).
 RELIGHT = True
 
-#: Scores of the bars (homogeneous layouts, `optimal`), which do not depend on the adaptive
-#: code: ``--cache FILE`` keeps them between runs, keyed by object, draw, N and layout (the
-#: draws are the same for the same seed), so that changing adaptive re-runs only adaptive.
+#: `optimal`'s layouts (the slow bar to plan), which do not depend on the adaptive code:
+#: ``--cache FILE`` keeps them between runs, keyed by object, draw, N and layout (the draws
+#: are the same for the same seed). Scores are computed every run: the held-out set they use
+#: depends on every layout compared. (Entries of the older (error, PSNR) form are still read
+#: by ``benchmarks.adaptive_relight_variants`` where a cache file has them.)
 _CACHE: dict[str, list[float]] = {}
 _CACHE_PATH: list[Path] = []
 
@@ -527,7 +529,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=Path("/work/shared/data/neuralrti-example"),
         help="the real acquisition (a folder with dirs.lp and its images)",
     )
-    ap.add_argument("--cache", type=Path, default=None, help="keep the bars' scores here")
+    ap.add_argument("--cache", type=Path, default=None, help="keep `optimal`'s layouts here")
     ap.add_argument("--scenes", default="", help="comma-separated simulated scenes (default all)")
     ap.add_argument("--ns", default="", help="comma-separated light counts (default 6,9,12,18)")
     ap.add_argument(
@@ -701,9 +703,9 @@ def main(argv: list[str] | None = None) -> str:
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"
             + (
-                "; the bars' scores — homogeneous layouts and `optimal` — read from FILE, written "
-                "by an earlier run of the same command on the same draws (valid only while those "
-                "planners and the fit are unchanged)"
+                "; `optimal`'s layouts read from FILE, planned by an earlier run of the same "
+                "command on the same draws (valid only while that planner is unchanged); every "
+                "score computed in this run"
                 if cache_read
                 else "; every score computed in this run"
             )
