@@ -17,14 +17,14 @@ from numpy.typing import NDArray
 from rti_rig.core.errors import SessionError
 
 
-def _srgb_curve(x: NDArray[np.float64]) -> NDArray[np.float64]:
+def _srgb_curve(x: NDArray[np.floating]) -> NDArray[np.floating]:
     """The sRGB transfer curve (IEC 61966-2-1) on linear values in [0, 1]."""
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
 
 
-#: the curve at every 16-bit level: a table, not ``np.power`` on the data, because numpy's
-#: vectorised float32 power can differ in the last bit with the array's memory alignment, and
-#: a fit's bands must give the same bytes in every process (the Dask runner's guarantee)
+#: the curve at every 16-bit level: a fit encodes every band and its pixel sample, and a table
+#: lookup is cheaper than a power and gives one value per input however numpy vectorises it (a
+#: fit's bands must give the same bytes in every process: the Dask runner's guarantee)
 _SRGB_LUT = _srgb_curve(np.arange(65536, dtype=np.float64) / 65535.0).astype(np.float32)
 
 
