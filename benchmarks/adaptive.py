@@ -86,15 +86,6 @@ _CACHE: dict[str, list[float]] = {}
 _CACHE_PATH: list[Path] = []
 
 
-def _cached(key: str, compute) -> tuple[float, float]:  # type: ignore[no-untyped-def]
-    """(normal error, PSNR) of a bar, as cached before the common held-out set (kept for
-    ``benchmarks.adaptive_relight_variants``, which reads such entries when they exist)."""
-    if key not in _CACHE:
-        _CACHE[key] = [float(v) for v in compute()]
-    e, q = _CACHE[key]
-    return e, q
-
-
 def _cached_layout(key: str, compute) -> np.ndarray:  # type: ignore[no-untyped-def]
     """A bar's layout (indices), planned once and kept under ``layout|key``: its scores are
     computed every run, since the held-out set they use depends on every layout compared."""

@@ -400,6 +400,8 @@ def _fit_all(
         linear["ptm"] = design_matrix("ptm", lights)
     # the usable observations of the sample, only when an exported model needs their range
     obs = _usable_sample(stack) if exported else None
+    if obs is not None and req.export_encoding == "srgb":  # the values the files will hold
+        obs = srgb_encode(obs)
     writers: dict[str, Any] = {}
     normals = albedo = None
     try:
@@ -414,12 +416,7 @@ def _fit_all(
                 if key == "ptm"
                 else (exporters.RtiWriter, "fit.rti")
             )
-            # no name holds the sample (or its encoded copy): `del obs` below must free it
-            lo, hi = exporters.coefficient_ranges(
-                w @ (srgb_encode(obs) if req.export_encoding == "srgb" else obs),
-                margin=0.5,
-                scale=kind.display_scale,
-            )
+            lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5, scale=kind.display_scale)
             writers[key] = kind(out / name, stack.width, stack.height, lo, hi)
 
         if not req.write_normals:  # the models kept only for normals are not fitted
