@@ -70,16 +70,14 @@ def test_tradeoff_from_shows_fit_warnings_as_notes_not_python_warnings(tmp_path:
 
     import numpy as np
 
-    lines = ACQ.read_text().split("\n")[1:]
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
     bunched = []
-    for line in filter(str.strip, lines):
-        name, *xyz = line.split()
-        v = np.array([float(xyz[0]) * 0.45, float(xyz[1]) * 0.45, float(xyz[2])])
-        v /= np.linalg.norm(v)
-        shutil.copy(ACQ.parent / name, tmp_path / name)
-        bunched.append(f"{name} {v[0]:.6f} {v[1]:.6f} {v[2]:.6f}")
-    lp = tmp_path / "dirs.lp"
-    lp.write_text(f"{len(bunched)}\n" + "\n".join(bunched) + "\n")
+    for e in read_lp(ACQ):
+        v = np.array([e.direction[0] * 0.45, e.direction[1] * 0.45, e.direction[2]])
+        shutil.copy(ACQ.parent / e.name, tmp_path / e.name)
+        bunched.append(LpEntry(e.name, tuple(float(x) for x in v / np.linalg.norm(v))))
+    lp = write_lp(tmp_path / "dirs.lp", bunched)
     script = Path(sys.executable).parent / "rti-rig"
     r = subprocess.run(
         [str(script), "bench", "tradeoff", "--from", str(lp)],
