@@ -11,6 +11,14 @@ from rich.markup import escape
 from rti_rig.cli.app import app, err, fail, out, print_notes
 from rti_rig.core.errors import RtiRigError
 
+#: how the normal maps' estimator is named to a user
+NORMALS_SHOWN = {
+    "ps-robust": "robust photometric stereo (shadows and highlights discarded per pixel)",
+    "ps": "least-squares photometric stereo (--model ps)",
+    "lambert": "least-squares Lambert fit (--model lambert)",
+    "ptm": "the PTM's Lambertian reading (--model ptm)",
+}
+
 
 def print_verdict(session: Path | None) -> None:
     """Last line of ``run``: the QA verdict (never fails the run: it is advice)."""
@@ -124,6 +132,8 @@ def fit(
         raise fail(exc) from None
     print_notes(result.notes)
     out.print(f"Model: {escape(result.reason)}")
+    if result.normals_from:
+        out.print(f"Normals: {NORMALS_SHOWN.get(result.normals_from, result.normals_from)}")
     for text in result.warnings:
         err.print(f"[yellow]warning:[/] {escape(text)}")
     out.print(
