@@ -134,7 +134,7 @@ def adaptive_run(
     and the mean decision time (s). ``objective``: as ``run --adaptive --objective``."""
     # as `run --adaptive --lights N` (N known); DESIGN False: light by light (for comparison)
     design = n_max if until is None and DESIGN else None
-    start = START["start"](geometry, START_LIGHTS, design)
+    start = START["start"](geometry, START_LIGHTS, design, objective)
     chooser = AdaptiveChooser(
         dirs, start, n_max, until, scale=scale, design_lights=design, objective=objective
     )
@@ -498,6 +498,8 @@ def configure_planner(args: argparse.Namespace) -> None:
         adaptive_planner.DESIGN_FLOORS = tuple(float(x) for x in args.floors.split(","))
     if args.default_floor is not None:
         adaptive_planner.DESIGN_DEFAULT_FLOOR = args.default_floor
+    if args.relight_default_floor is not None:
+        adaptive_planner.RELIGHT_DEFAULT_FLOOR = args.relight_default_floor
     if args.start != "default":  # after the default floor: a hedged start is of its layout
         from benchmarks.adaptive_reach import start_functions
 
@@ -548,6 +550,13 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="the default design's floor (°), which also places the starting lights "
         "(planner.adaptive.DESIGN_DEFAULT_FLOOR; default what ships, 10)",
+    )
+    ap.add_argument(
+        "--relight-default-floor",
+        type=float,
+        default=None,
+        help="the same for --objective relight sessions "
+        "(planner.adaptive.RELIGHT_DEFAULT_FLOOR; default what ships)",
     )
     ap.add_argument(
         "--relief-gain",
@@ -683,6 +692,11 @@ def main(argv: list[str] | None = None) -> str:
             + (f" --start {args.start}" if args.start != "default" else "")
             + (f" --floors {args.floors}" if args.floors else "")
             + (f" --default-floor {args.default_floor:g}" if args.default_floor is not None else "")
+            + (
+                f" --relight-default-floor {args.relight_default_floor:g}"
+                if args.relight_default_floor is not None
+                else ""
+            )
             + (" --relief-gain" if args.relief_gain else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")

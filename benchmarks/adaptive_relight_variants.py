@@ -67,7 +67,16 @@ VARIANTS: dict[str, list[tuple[object, dict]]] = {
     "fitted-db-start3": [
         (adaptive_relight, {"RELIGHT_FITTED_DESIGN": True}),
         (relight_design, {"DB_WEIGHTED": True, "UNMODELLED_REL": 0.05}),
-        (bench, {"START": {"start": lambda g, k, n: dome_start(g, 3 if n and n <= 6 else k, n)}}),
+        (
+            bench,
+            {
+                "START": {
+                    "start": lambda g, k, n, objective="normals": dome_start(
+                        g, 3 if n and n <= 6 else k, n, objective
+                    )
+                }
+            },
+        ),
     ],
 }
 

@@ -44,7 +44,7 @@ def check(scene_name: str, draw: int, n: int, seed: int = 0) -> None:
     for _ in range(draw + 1):
         keep = np.sort(rng.choice(len(cand), len(cand) - SIM_REMOVED, replace=False))
     sub = DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
-    start = dome_start(sub, START_LIGHTS, n)
+    start = dome_start(sub, START_LIGHTS, n, "relight")
     chooser = AdaptiveChooser(cand[keep], start, n, design_lights=n, objective="relight")
     for i in start[:START_LIGHTS]:
         chooser.observe(i, cand[keep][i], grey[keep][i])

@@ -122,7 +122,11 @@ def run_tradeoff_from(
         chosen for N, so each N is its own session)."""
         sub = dirs[keep]
         chooser = AdaptiveChooser(
-            sub, dome_start(dome, START_LIGHTS, n), n, design_lights=n, objective=objective
+            sub,
+            dome_start(dome, START_LIGHTS, n, objective),
+            n,
+            design_lights=n,
+            objective=objective,
         )
         t0 = time.perf_counter()
         for i in range(n):

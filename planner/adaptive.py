@@ -380,6 +380,18 @@ DESIGN_MARGIN = 0.03
 #: The floor of the default design (and of the starting lights when N is known): the floor
 #: that loses least to the best one over the simulator's scenes (docs/adaptive.md).
 DESIGN_DEFAULT_FLOOR = 10.0
+#: The same for ``--objective relight`` (its starting lights and the design it keeps without
+#: clear evidence): chosen on the relighting table (docs/adaptive.md).
+RELIGHT_DEFAULT_FLOOR = 10.0
+
+
+def default_floor_for(objective: str) -> float:
+    """The floor of the default design, and of the starting lights when N is known, for an
+    objective: the start is shot before anything is known, so it is the one place where the
+    objective alone decides."""
+    return RELIGHT_DEFAULT_FLOOR if objective == "relight" else DESIGN_DEFAULT_FLOOR
+
+
 #: With the bias-aware score (a robust fit simulated on this object's model): another floor
 #: is taken only if its simulated error is lower by this fraction.
 SIM_MARGIN = 0.10
@@ -543,7 +555,7 @@ def choose_in_design(
     if objective == "relight" and (fit is None or relight is None):
         raise ValueError("the relight objective simulates this object: give fit and relight")
     floors = DESIGN_FLOORS if floors is None else floors
-    default_floor = DESIGN_DEFAULT_FLOOR if default_floor is None else default_floor
+    default_floor = default_floor_for(objective) if default_floor is None else default_floor
     now = estimate_error_deg(state, scale)
     k = len(state.lights)
     designs: dict[float, NDArray[np.intp]] = {}

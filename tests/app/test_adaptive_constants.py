@@ -38,3 +38,20 @@ def test_the_exempt_names_are_exempt_under_any_module_and_nothing_else_is() -> N
     assert len(lines) == 2
     assert lines[0].startswith("planner.adaptive.SIM_MARGIN -1.0 → ")
     assert lines[1].startswith("planner.adaptive_optimal.SEARCH_PIXELS 'absent' → ")
+
+
+def test_a_session_recorded_before_the_relight_floor_was_split_off_resumes_when_it_agrees(
+    monkeypatch,  # type: ignore[no-untyped-def]
+) -> None:
+    """Sessions recorded before `RELIGHT_DEFAULT_FLOOR` existed lack it; their relight start
+    was the normals objective's floor. Agreeing values are no difference; others are named."""
+    from rti_rig.planner import adaptive
+
+    key = "planner.adaptive.RELIGHT_DEFAULT_FLOOR"
+    now = decision_constants()
+    older = {k: v for k, v in now.items() if k != key}
+    assert now[key] == now["planner.adaptive.DESIGN_DEFAULT_FLOOR"]
+    assert constant_differences(older, now) == []
+    monkeypatch.setattr(adaptive, "RELIGHT_DEFAULT_FLOOR", 30.0)
+    lines = constant_differences(older, decision_constants())
+    assert lines == [f"{key} 10.0 → 30.0"]

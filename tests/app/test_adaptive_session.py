@@ -341,3 +341,34 @@ def test_the_robust_kernel_is_loaded_before_the_rig_opens(tmp_path: Path, monkey
     assert order == ["warm", "rig"]
     kernel = sys.modules["rti_rig.reconstruct.robust_kernel"]
     assert kernel.fit_pixels.signatures  # compiled or loaded, ready for the first decision
+
+
+def test_the_starting_lights_follow_the_objective_s_default_floor(
+    tmp_path: Path,
+    monkeypatch,  # type: ignore[no-untyped-def]
+) -> None:
+    """With N known, the 4 lights shot before anything is known are 4 of the homogeneous layout
+    of N at the *objective's* default floor (`planner.adaptive.default_floor_for`): the start
+    is where the objective alone decides. Through the CLI on the shipped dome, with the relight
+    objective's floor set to 30° (one whose layout of 9 differs from the 10° one)."""
+    from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.planner import adaptive
+    from rti_rig.planner.uniform import select_uniform_leds
+
+    monkeypatch.setattr(adaptive, "RELIGHT_DEFAULT_FLOOR", 30.0)
+    cfg = REPO / "rig_configs" / "simulated_dome.toml"
+    geometry = rig_geometry(load_rig_config(cfg))
+    layouts = {f: {int(i) for i in select_uniform_leds(geometry, 9, f)} for f in (10.0, 30.0)}
+    assert not layouts[30.0] >= layouts[10.0] and not layouts[10.0] >= layouts[30.0]
+    for objective, floor in (("relight", 30.0), ("normals", adaptive.DESIGN_DEFAULT_FLOOR)):
+        out = tmp_path / objective
+        args = ["run", str(cfg), "--out", str(out), "--adaptive", "--lights", "9"]
+        r = runner.invoke(app, [*args, "--objective", objective])
+        assert r.exit_code == 0, r.output
+        start = {int(s["led"]) for s in journal(out)[:4]}
+        assert start <= layouts[floor], (objective, start)
+        other = layouts[10.0 if floor == 30.0 else 30.0]
+        assert not start <= other, (objective, start)
+        assert (
+            manifest(out)["adaptive"]["constants"]["planner.adaptive.RELIGHT_DEFAULT_FLOOR"] == 30.0
+        )

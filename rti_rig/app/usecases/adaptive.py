@@ -607,24 +607,31 @@ class AdaptivePlan:
     design_lights: int | None = None
 
 
-def dome_start(geometry: DomeGeometry, k: int, n_total: int | None) -> list[int]:
+def dome_start(
+    geometry: DomeGeometry, k: int, n_total: int | None, objective: str = "normals"
+) -> list[int]:
     """LED indices of a dome's starting layout of ``k``: with ``n_total`` known, the ``k`` of
-    the homogeneous layout of ``n_total`` (at the starting floor) closest to a homogeneous
-    layout of ``k`` — so that the design at the starting floor is that layout exactly."""
+    the homogeneous layout of ``n_total`` (at the objective's default floor) closest to a
+    homogeneous layout of ``k`` — so that the default design is that layout exactly."""
     if n_total is None or n_total <= k:
         return [int(i) for i in select_uniform_leds(geometry, k, START_FLOOR_DEG)]
     from rti_rig.planner import adaptive
 
-    full = select_uniform_leds(geometry, n_total, adaptive.DESIGN_DEFAULT_FLOOR)
+    full = select_uniform_leds(geometry, n_total, adaptive.default_floor_for(objective))
     return [int(full[i]) for i in start_subset(geometry.directions[full], k)]
 
 
 def adaptive_plan(  # type: ignore[no-untyped-def]
-    rig, lights: int | None, start_lights: int = START_LIGHTS, design: bool | None = None
+    rig,
+    lights: int | None,
+    start_lights: int = START_LIGHTS,
+    design: bool | None = None,
+    objective: str = "normals",
 ) -> AdaptivePlan:
     """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
     homogeneous starting layout of ``start_lights``; with ``lights`` given (``design`` not
-    False) the rest is chosen as a design of that many lights."""
+    False) the rest is chosen as a design of that many lights, starting from the objective's
+    default floor."""
     geometry = rig.geometry
     if isinstance(geometry, DomeGeometry):
         cands = candidates_for(geometry)
@@ -641,14 +648,14 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     k0 = min(start_lights, max_lights)
     n_design = max_lights if (lights is not None and design is not False) else None
     if isinstance(geometry, DomeGeometry):
-        chosen = dome_start(geometry, k0, n_design)
+        chosen = dome_start(geometry, k0, n_design, objective)
         lookup = {int(led): i for i, led in enumerate(leds)}  # type: ignore[union-attr]
         start = [lookup[int(geometry_led)] for geometry_led in chosen]
     else:
         from rti_rig.planner import adaptive
         from rti_rig.planner.objectives import Candidates
 
-        floor = START_FLOOR_DEG if n_design is None else adaptive.DESIGN_DEFAULT_FLOOR
+        floor = START_FLOOR_DEG if n_design is None else adaptive.default_floor_for(objective)
         targets = geometry.homogeneous(n_design or k0, floor)
         snapped = snap_unique(targets, Candidates(dirs, None, None))
         if n_design is not None and n_design > k0:
@@ -932,7 +939,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:
-        plan = adaptive_plan(rig, lights)
+        plan = adaptive_plan(rig, lights, objective=objective)
         if min_lights is not None:  # an arm's reachable lights need the rig's own rules
             _check_min_within(min_lights, len(plan.candidates))
         source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
@@ -1022,6 +1029,7 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         header["max_lights"],
         header["start_lights"],
         design=header.get("design_lights") is not None,
+        objective=began,
     )
     if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
         raise RtiRigError(

@@ -88,15 +88,23 @@ def decision_constants() -> dict[str, Any]:
     return json.loads(json.dumps(out))
 
 
+#: Constants split off an older one: a session recorded before the split lacks the new name,
+#: and its value then was the old constant's (``--objective relight`` started from the normals
+#: objective's default floor until ``RELIGHT_DEFAULT_FLOOR`` existed), so such a session still
+#: resumes when the values agree.
+SPLIT_FROM = {"planner.adaptive.RELIGHT_DEFAULT_FLOOR": "planner.adaptive.DESIGN_DEFAULT_FLOOR"}
+
+
 def constant_differences(recorded: dict[str, Any], current: dict[str, Any]) -> list[str]:
     """What differs between a session's recorded constants and this build's, one line each
-    (``NAME recorded → now``; a constant one side lacks shows as ``absent``), apart from
-    :data:`RESTORED_ON_RESUME`."""
+    (``NAME recorded → now``; a constant one side lacks shows as ``absent``, unless it was
+    split off a recorded one, :data:`SPLIT_FROM`), apart from :data:`RESTORED_ON_RESUME`."""
     lines = []
     for key in sorted(set(recorded) | set(current)):
         if key.rsplit(".", 1)[-1] in RESTORED_ON_RESUME:
             continue
-        was, now = recorded.get(key, "absent"), current.get(key, "absent")
+        was = recorded.get(key, recorded.get(SPLIT_FROM.get(key, ""), "absent"))
+        now = current.get(key, "absent")
         if was != now:
             lines.append(f"{key} {was!r} → {now!r}")
     return lines
