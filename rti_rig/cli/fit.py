@@ -132,6 +132,8 @@ def fit(
         raise fail(exc) from None
     print_notes(result.notes)
     out.print(f"Model: {escape(result.reason)}")
+    if result.rti:
+        out.print(f"fit.rti: {escape(result.rti)}")
     if result.normals_from:
         out.print(f"Normals: {NORMALS_SHOWN.get(result.normals_from, result.normals_from)}")
     for text in result.warnings:

@@ -105,7 +105,7 @@ def run(
         typer.Option(
             "--min-lights",
             help="With --until-error: shoot at least this many lights before the stop may "
-            "claim the target (a PTM needs 6, HSH of order 2 needs 9; without it a session "
+            "claim the target (a PTM needs 6, an HSH fit.rti 5; without it a session "
             "that reaches its target early has a normal map and no RTI).",
         ),
     ] = None,

@@ -1,7 +1,7 @@
 """`rti-rig run RIG --until-error DEG --min-lights M`, through the front door.
 
 A loose target is reached by the four starting lights: the session then has a normal map and
-no RTI file (a PTM needs 6 lights, HSH of order 2 needs 9). ``--min-lights`` keeps the stop
+no RTI file (a PTM needs 6 lights, an HSH fit 5). ``--min-lights`` keeps the stop
 from claiming the target before M lights, with the same choices a session without a target
 makes; a resume restores the minimum from the manifest; a session that stops short of an RTI
 file without it says so and how to ask for one; a minimum that cannot mean anything is refused
@@ -40,24 +40,24 @@ def test_a_loose_target_stops_at_the_start_and_says_no_rti_file_follows(
     assert r.exit_code == 0, r.output
     assert manifest(out)["adaptive"]["result"]["lights_used"] == 4
     text = said(r)
-    assert "a PTM needs 6 and HSH of order 2 needs 9" in text
+    assert "a PTM needs 6 and an HSH fit needs 5" in text
     assert "without fit.ptm and fit.rti" in text
-    assert "To get fit.ptm and fit.rti, start a session with --min-lights 9" in text
+    assert "To get fit.ptm and fit.rti, start a session with --min-lights 6" in text
 
 
 def test_the_advice_stays_within_the_session_s_maximum(
     never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:
-    """With --lights 8 a minimum of 9 would be refused: the note offers 6 (a PTM) and says
-    the .rti needs more than the session's maximum."""
+    """With --lights 5 a minimum of 6 would be refused: the note offers 5 (an HSH fit) and
+    says the PTM needs more than the session's maximum."""
     cfg, _ = never_reached
     out = tmp_path / "s"
-    r = _run(cfg, out, "--until-error", LOOSE, "--lights", "8")
+    r = _run(cfg, out, "--until-error", LOOSE, "--lights", "5")
     assert r.exit_code == 0, r.output
     text = said(r)
-    assert "To get fit.ptm, start a session with --min-lights 6" in text, text
-    assert "fit.rti needs more than this session's maximum of 8 lights" in text, text
-    assert "--min-lights 9" not in text
+    assert "To get fit.rti, start a session with --min-lights 5" in text, text
+    assert "fit.ptm needs more than this session's maximum of 5 lights" in text, text
+    assert "--min-lights 6" not in text
 
 
 def test_a_session_that_did_not_reach_its_target_gives_no_such_note(

@@ -368,3 +368,52 @@ def test_an_auto_fit_takes_its_normals_from_robust_ps_whatever_model_it_chooses(
     auto_err = float(np.mean(_angles(normals, truth)))
     lambert_err = float(np.mean(_angles(maps["lambert"][0], truth)))
     assert auto_err < 0.75 * lambert_err, (auto_err, lambert_err)
+
+
+def test_a_six_light_session_gets_the_hsh_order_its_evidence_supports(tmp_path: Path) -> None:
+    """At 6 lights `--model auto` chooses Lambert (not an HSH) and order 2 needs 9 lights: an
+    auto fit wrote no fit.rti at all, only a PTM its 6 lights determine exactly. The HSH order
+    is now chosen from the same held-out evidence (order 1 here, 4 terms), written, and relit
+    as an independent HSH fit of the same images; fit.json and the CLI say why."""
+    import tifffile
+
+    from rti_rig.reconstruct import fit_hsh
+    from rti_rig.reconstruct.stack import ImageStack
+
+    lights = _rings(((30, 3, 0), (60, 3, 60)))
+    session, _, _ = make_session(tmp_path / "s", scene="tablet", lights=lights, size=(64, 80))
+    out = tmp_path / "out"
+    args = ["fit", str(session), "--out", str(out), "--no-qa", "--export-encoding", "linear"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    summary = json.loads((out / "fit.json").read_text())
+    assert summary["model"] == "lambert", summary["why"]  # the case this test is for
+    assert summary["rti"].startswith("hsh1: the lowest HSH order") and "fit.rti: hsh1" in r.output
+    assert not any("fit.rti not written" in w for w in summary["warnings"])
+    rti_file = _read_rti(out / "fit.rti")
+    assert rti_file.shape[0] == 4
+    frames = [tifffile.imread(p) for p in sorted((session / "linear").glob("*.tif"))]
+    hsh = fit_hsh(ImageStack(frames), lights, 1)
+    for d in ([0.3, 0.2, 0.9327], [-0.5, 0.4, 0.7681]):
+        d = np.array(d) / np.linalg.norm(d)
+        ref = np.tensordot(hsh_basis(d[None], 1)[0], hsh.coefficients, axes=(0, 0))
+        got = np.tensordot(hsh_basis(d[None], 1)[0], rti_file, axes=(0, 0))
+        assert np.percentile(np.abs(got - ref), 99) < 3.0 / 255  # 8-bit quantisation, 4 terms
+
+
+def test_without_evidence_the_hsh_order_follows_the_light_count(tmp_path: Path) -> None:
+    """`--model ps` gives no held-out evidence: order 2 from 9 lights, order 1 from 6 (it was
+    order 2 or nothing), and below 6 no fit.rti, said with what to do."""
+    for count, terms in ((7, 4), (5, None)):
+        lights = _rings(((25, count - 2, 0), (60, 2, 45)))
+        session, _, _ = make_session(tmp_path / f"s{count}", lights=lights, size=(48, 56))
+        out = tmp_path / f"out{count}"
+        r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-qa", "--model", "ps"])
+        assert r.exit_code == 0, r.output
+        summary = json.loads((out / "fit.json").read_text())
+        if terms is None:
+            assert not (out / "fit.rti").exists() and summary["rti"] is None
+            assert any("--model auto measures it" in w for w in summary["warnings"])
+        else:
+            assert _read_rti(out / "fit.rti").shape[0] == terms
+            assert summary["rti"].startswith("hsh1: the default order without held-out evidence")

@@ -314,7 +314,9 @@ def _six_light_session(tmp_path: Path) -> Path:
 
 def test_fit_never_silently_leaves_out_what_was_asked(tmp_path: Path) -> None:
     """`--model hsh3` on 6 lights said "hsh3: chosen by --model" and wrote no fit.rti, with no
-    word; `auto` left fit.rti out silently too."""
+    word; `auto` left fit.rti out silently too. Now `auto` writes the HSH order its held-out
+    evidence supports (order 1 here) and says so; `--model ps` on 4 of the lights (no
+    evidence, too few for order 1) says why there is no fit.rti."""
     session = _six_light_session(tmp_path)
     out = tmp_path / "hsh3"
     r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--model", "hsh3", "--no-qa"])
@@ -322,6 +324,16 @@ def test_fit_never_silently_leaves_out_what_was_asked(tmp_path: Path) -> None:
     assert "needs at least 16 lights" in " ".join(r.output.split())
     out = tmp_path / "auto"
     r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert (out / "fit.rti").is_file()
+    said_rti = json.loads((out / "fit.json").read_text())["rti"]
+    assert said_rti.startswith("hsh1: ") and "fit.rti: hsh1" in " ".join(r.output.split())
+    lp = session / "lights.lp"
+    lines = lp.read_text().splitlines()
+    four = session / "four.lp"  # 4 of the 6 lights: the count line, then 4 lines
+    four.write_text("\n".join(["4", *[x for x in lines[1:] if x.strip()][:4]]) + "\n")
+    out = tmp_path / "ps4"
+    r = runner.invoke(app, ["fit", str(four), "--out", str(out), "--no-qa", "--model", "ps"])
     assert r.exit_code == 0, r.output
     assert not (out / "fit.rti").exists()
     assert "fit.rti not written" in " ".join(r.output.split())

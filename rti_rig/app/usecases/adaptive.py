@@ -37,6 +37,7 @@ from rti_rig.app.usecases.adaptive_constants import (
     decision_constants,
     describe_differences,
 )
+from rti_rig.app.usecases.fit_rti_order import HSH_FEWEST_LIGHTS
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
@@ -304,7 +305,8 @@ class AdaptiveChooser:
     ) -> None:
         #: with --until-error: the fewest lights the stop may claim the target at (None: no
         #: minimum). The normal error is not the only thing a session is for: a PTM needs 6
-        #: lights and HSH of order 2 needs 9, and a stop at 4 gives a normal map and no RTI.
+        #: lights and an HSH fit 5 (RTI_FILE_LIGHTS), and a stop at 4 gives a normal map and
+        #: no RTI.
         self.min_lights = min_lights
         #: the stop's upper estimate = the point estimate × this (None: this build's
         #: ``adaptive_until.UPPER_FACTOR``, read now; a resume passes the session's own)
@@ -808,8 +810,9 @@ def estimate_phrase(result: dict[str, Any]) -> str:
 
 
 #: The fewest lights `rti-rig fit` writes each relighting file from (the file, its model, the
-#: lights: a PTM's 6 coefficients, HSH of order 2's 9; rti_rig.app.usecases.fit).
-RTI_FILE_LIGHTS = (("fit.ptm", "a PTM", 6), ("fit.rti", "HSH of order 2", 9))
+#: lights: a PTM's 6 coefficients; an HSH of order 1 once its held-out error can be measured:
+#: rti_rig.app.usecases.fit).
+RTI_FILE_LIGHTS = (("fit.ptm", "a PTM", 6), ("fit.rti", "an HSH fit", HSH_FEWEST_LIGHTS))
 
 
 def few_lights_note(result: dict[str, Any]) -> str | None:
@@ -834,7 +837,8 @@ def few_lights_note(result: dict[str, Any]) -> str | None:
     reachable = [(name, n) for name, _, n in short if n <= cap]
     if reachable:
         names = " and ".join(name for name, _ in reachable)
-        text += f" To get {names}, start a session with --min-lights {reachable[-1][1]}"
+        fewest = max(n for _, n in reachable)
+        text += f" To get {names}, start a session with --min-lights {fewest}"
     beyond = [name for name, _, n in short if n > cap]
     if beyond:
         verb = "needs" if len(beyond) == 1 else "need"

@@ -30,6 +30,7 @@ from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band, fit_warn
 from rti_rig.app.usecases.fit_decode import imread_rgb
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
+from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import jpeg_truncation
 from rti_rig.core.lp_format import directions_of, read_lp
@@ -59,7 +60,7 @@ class FitRequest:
     write_ptm: bool = True
     write_hsh: bool = True
     write_normals: bool = True
-    hsh_order: int | None = None  # None: the chosen HSH order, else 2
+    hsh_order: int | None = None  # None: fit_rti_order.hsh_order chooses
     qa: bool = True
     #: what fit.ptm and fit.rti hold: "srgb" (the photographs' encoded values, as RTIBuilder
     #: writes them and viewers show them) or "linear" (the fitted linear light: darker in a
@@ -82,6 +83,8 @@ class FitResult:
     #: where the normal maps came from (``ps-robust``, ``ps``, ``lambert``, ``ptm``; ``""``
     #: when none were fitted)
     normals_from: str = ""
+    #: fit.rti's HSH order and why (``""`` when no fit.rti was written)
+    rti: str = ""
 
 
 def _srgb_to_linear16(img: np.ndarray) -> np.ndarray:
@@ -316,6 +319,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         # the normal maps' estimator: robust PS unless --model named another (never the
         # relighting model an auto choice picked)
         "normals_from": result.normals_from or None,
+        "rti": result.rti or None,
         # what fit.ptm / fit.rti hold (a viewer cannot tell: neither format records it)
         "export_encoding": req.export_encoding,
         "warnings": result.warnings,
@@ -363,6 +367,7 @@ def _fit_all(
     files: list[Path] = []
     name = req.model
     n = stack.n
+    choice = None
     if name == AUTO:
         choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS)
         model_name = choice.model
@@ -385,14 +390,16 @@ def _fit_all(
     normal_source = _normal_source(name, model_name)
 
     # linear models to export, their solve matrices (warnings issued once, here)
-    order = req.hsh_order or (int(model_name[-1]) if model_name.startswith("hsh") else 2)
+    order, rti_why = hsh_order(req.hsh_order, model_name, choice, n)
     linear: dict[str, np.ndarray] = {}
     skipped: list[str] = []  # said, never silently left out
     if req.write_ptm and n >= 6:
         linear["ptm"] = design_matrix("ptm", lights)
     elif req.write_ptm:
         skipped.append(f"fit.ptm not written: a PTM needs at least 6 lights, there are {n}")
-    if req.write_hsh and n >= (order + 1) ** 2:
+    if req.write_hsh and order is None:
+        skipped.append(rti_why)
+    elif req.write_hsh and n >= (order + 1) ** 2:
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
     elif req.write_hsh:
         skipped.append(
@@ -483,7 +490,13 @@ def _fit_all(
         release_free_memory()
         files += exporters.write_albedo(out / "albedo", albedo.read(), npy=False)
     return FitResult(
-        out, model_name, reason_line, files, warnings=skipped, normals_from=normal_source
+        out,
+        model_name,
+        reason_line,
+        files,
+        warnings=skipped,
+        normals_from=normal_source,
+        rti=rti_why if f"hsh{order}" in exported else "",
     )
 
 

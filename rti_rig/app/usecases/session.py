@@ -65,7 +65,7 @@ class NewSessionRequest:
     #: (None: normals; refused for a session that is not adaptive).
     objective: str | None = None
     #: Adaptive with ``until_error_deg``: the fewest lights the stop may claim the target at
-    #: (None: no minimum; a PTM needs 6, HSH of order 2 needs 9).
+    #: (None: no minimum; a PTM needs 6, an HSH fit.rti 5).
     min_lights: int | None = None
 
     @property
