@@ -89,6 +89,11 @@ class Row:
     dome_time_s: float
     arm_time_s: float
     plan_s: float
+    #: relighting of the fit.rti `rti-rig fit --model auto` would write for this layout (its
+    #: HSH order, chosen on the layout's own images) on the same held-out lights
+    #: (``benchmarks.tradeoff_from``; empty / NaN where not measured)
+    file_model: str = ""
+    file_psnr_db: float = float("nan")
 
 
 @dataclass

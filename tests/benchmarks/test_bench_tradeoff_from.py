@@ -36,6 +36,11 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     text = (out / "summary.md").read_text()
     assert "--from" in text and "adaptive" in text
     assert "on the same 3 held-out lights for every plan" in text
+    # and what the user opens: the fit.rti `rti-rig fit` would write, on the same lights
+    assert "**Relighting as `rti-rig fit` writes it**" in text
+    for row in rows:
+        assert row["file_model"].startswith("hsh"), row
+        assert 5.0 < float(row["file_psnr_db"]) < 80.0
 
 
 def test_every_plan_is_scored_on_the_same_held_out_lights(monkeypatch) -> None:
