@@ -241,7 +241,9 @@ def main(argv: list[str] | None = None) -> str:
         from rti_rig.app.usecases.adaptive import dome_start
         from rti_rig.planner.adaptive_until import GUESSES
 
-        bench.START["start"] = lambda g, k, n: dome_start(g, k, GUESSES[0] if n is None else n)
+        bench.START["start"] = lambda g, k, n, objective="normals": dome_start(
+            g, k, GUESSES[0] if n is None else n, objective
+        )
     if args.guesses:
         import rti_rig.planner.adaptive_until as until
 

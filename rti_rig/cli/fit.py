@@ -14,9 +14,11 @@ from rti_rig.core.errors import RtiRigError
 #: how the normal maps' estimator is named to a user
 NORMALS_SHOWN = {
     "ps-robust": "robust photometric stereo (shadows and highlights discarded per pixel)",
-    "ps": "least-squares photometric stereo (--model ps)",
-    "lambert": "least-squares Lambert fit (--model lambert)",
-    "ptm": "the PTM's Lambertian reading (--model ptm)",
+    "ps": "least-squares photometric stereo",
+    "lambert": "the least-squares Lambert fit (the model used; --model robust-ps for robust "
+    "photometric stereo)",
+    "ptm": "the PTM's Lambertian reading (the model used; --model robust-ps for robust "
+    "photometric stereo)",
 }
 
 
@@ -65,6 +67,15 @@ def fit(
             "(the linear light the normals are fitted to; darker in a viewer).",
         ),
     ] = "srgb",
+    hsh_order: Annotated[
+        int | None,
+        typer.Option(
+            "--hsh-order",
+            help="The HSH order of fit.rti: 1 (4 terms), 2 (9) or 3 (16). Default: the model "
+            "chosen when it is an HSH, else the lowest order within 5% of the best held-out "
+            "error (5-fold cross-validation over the lights).",
+        ),
+    ] = None,
     scheduler: Annotated[
         str | None,
         typer.Option(
@@ -92,6 +103,8 @@ def fit(
                 f"--export-encoding {export_encoding!r}: choose srgb (what viewers expect) or "
                 "linear"
             )
+        if hsh_order is not None and hsh_order not in (1, 2, 3):
+            raise RtiRigError(f"--hsh-order {hsh_order}: choose 1, 2 or 3")
         if model != "auto":
             try:
                 model_spec(model)
@@ -106,6 +119,7 @@ def fit(
             write_hsh=not no_hsh,
             write_normals=not no_normals,
             export_encoding=export_encoding,
+            hsh_order=hsh_order,
         )
         if len(sources) > 1:
             if scheduler is None:

@@ -55,3 +55,21 @@ def test_a_session_recorded_before_the_relight_floor_was_split_off_resumes_when_
     monkeypatch.setattr(adaptive, "RELIGHT_DEFAULT_FLOOR", 30.0)
     lines = constant_differences(older, decision_constants())
     assert lines == [f"{key} 10.0 → 30.0"]
+
+
+def test_the_advice_only_constants_steer_nothing_and_live_in_the_usecase() -> None:
+    """A name exempt from the resume check must not be a decision's constant anywhere: only
+    the usecase defines RTI_FILE_LIGHTS, and its value never reaches a chooser."""
+    from rti_rig.app.usecases.adaptive_constants import ADVICE_ONLY
+
+    holders = {
+        name
+        for name in DECISION_MODULES
+        for key in ADVICE_ONLY
+        if hasattr(importlib.import_module(name), key)
+    }
+    assert holders == {"rti_rig.app.usecases.adaptive"}
+    now = decision_constants()
+    recorded = dict(now)
+    recorded["app.usecases.adaptive.RTI_FILE_LIGHTS"] = [["fit.rti", "HSH of order 2", 9]]
+    assert constant_differences(recorded, now) == []

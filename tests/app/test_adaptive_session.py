@@ -372,3 +372,47 @@ def test_the_starting_lights_follow_the_objective_s_default_floor(
         assert (
             manifest(out)["adaptive"]["constants"]["planner.adaptive.RELIGHT_DEFAULT_FLOOR"] == 30.0
         )
+    # a resume starts from the same floor (the objective is the session's own)
+    cut = tmp_path / "cut"
+    interrupted(cfg, cut, after_step=5, objective="relight", lights=9)
+    r = runner.invoke(app, ["run", "--resume", str(cut)])
+    assert r.exit_code == 0, r.output
+    assert (cut / "lights.lp").read_text() == (tmp_path / "relight" / "lights.lp").read_text()
+
+
+def test_a_session_recorded_by_the_build_before_resumes(tmp_path: Path) -> None:
+    """A relight session begun by the build before 2026-11-25 recorded no
+    RELIGHT_DEFAULT_FLOOR (its start was the normals objective's floor) and the advice's older
+    words (RTI_FILE_LIGHTS: HSH of order 2 from 9 lights). Neither changes a choice: it resumes
+    through the CLI to the session an uninterrupted run makes. (A build that still recorded
+    the note's constant as a decision refused it: "other decision constants".)"""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    ref = tmp_path / "ref"
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(cfg),
+            "--out",
+            str(ref),
+            "--adaptive",
+            "--lights",
+            "8",
+            "--objective",
+            "relight",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    out = tmp_path / "old"
+    interrupted(cfg, out, after_step=4, objective="relight")
+    m = manifest(out)
+    constants = m["adaptive"]["constants"]
+    del constants["planner.adaptive.RELIGHT_DEFAULT_FLOOR"]
+    constants["app.usecases.adaptive.RTI_FILE_LIGHTS"] = [
+        ["fit.ptm", "a PTM", 6],
+        ["fit.rti", "HSH of order 2", 9],
+    ]
+    (out / "manifest.json").write_text(json.dumps(m))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert (out / "lights.lp").read_text() == (ref / "lights.lp").read_text()

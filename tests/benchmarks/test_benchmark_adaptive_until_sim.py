@@ -33,3 +33,18 @@ def test_report_counts_the_claims_above_target() -> None:
     # 4°: both claim at 4 lights (point 2°, upper 4°), measured 4.0°: at, not above, the target
     assert rows[1].startswith("| s | 4° | 4 | 2.00° | 4.00° | ×2.00 | 4 | 4.00° | 4.00° |")
     assert "point estimate 1 of 2, upper estimate 0 of 2" in text
+
+
+def test_the_first_start_option_runs_with_the_start_signature_benchmarks_adaptive_calls(
+    monkeypatch,  # type: ignore[no-untyped-def]
+) -> None:
+    """`--first-start` replaces benchmarks.adaptive's start with its own, which must take the
+    objective the session passes (a 3-argument start raised a TypeError)."""
+    import benchmarks.adaptive as bench
+    from benchmarks.adaptive_until_sim import main
+
+    monkeypatch.setitem(bench.START, "start", bench.START["start"])  # restored afterwards
+    text = main(
+        ["--first-start", "--scenes", "tablet", "--draws", "1", "--cap", "6", "--targets", "4"]
+    )
+    assert "| tablet | 4° | " in text

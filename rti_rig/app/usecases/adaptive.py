@@ -32,12 +32,12 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rti_rig.app.usecases import fit_rti_order
 from rti_rig.app.usecases.adaptive_constants import (
     constant_differences,
     decision_constants,
     describe_differences,
 )
-from rti_rig.app.usecases.fit_rti_order import HSH_FEWEST_LIGHTS
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
@@ -811,8 +811,12 @@ def estimate_phrase(result: dict[str, Any]) -> str:
 
 #: The fewest lights `rti-rig fit` writes each relighting file from (the file, its model, the
 #: lights: a PTM's 6 coefficients; an HSH of order 1 once its held-out error can be measured:
-#: rti_rig.app.usecases.fit).
-RTI_FILE_LIGHTS = (("fit.ptm", "a PTM", 6), ("fit.rti", "an HSH fit", HSH_FEWEST_LIGHTS))
+#: rti_rig.app.usecases.fit_rti_order). Words of a note, never of a decision: a resume does not
+#: compare it (``adaptive_constants.ADVICE_ONLY``).
+RTI_FILE_LIGHTS = (
+    ("fit.ptm", "a PTM", 6),
+    ("fit.rti", "an HSH fit", fit_rti_order.HSH_FEWEST_LIGHTS),
+)
 
 
 def few_lights_note(result: dict[str, Any]) -> str | None:

@@ -47,6 +47,12 @@ DECISION_MODULES = (
 #: constant under these names (it would be exempted too).
 RESTORED_ON_RESUME = frozenset({"UPPER_FACTOR", "UPPER_QUANTILE"})
 
+#: Constants of a decision module that only word the advice a session prints (how many lights
+#: `rti-rig fit` needs for each file), never a choice of light: recorded, not compared, so a
+#: build that words the advice otherwise still resumes the sessions of an earlier one. A test
+#: checks that they live where they are expected and nowhere else.
+ADVICE_ONLY = frozenset({"RTI_FILE_LIGHTS"})
+
 #: How many differing constants a refusal names (the rest are counted).
 NAMED_DIFFERENCES = 5
 
@@ -98,10 +104,11 @@ SPLIT_FROM = {"planner.adaptive.RELIGHT_DEFAULT_FLOOR": "planner.adaptive.DESIGN
 def constant_differences(recorded: dict[str, Any], current: dict[str, Any]) -> list[str]:
     """What differs between a session's recorded constants and this build's, one line each
     (``NAME recorded → now``; a constant one side lacks shows as ``absent``, unless it was
-    split off a recorded one, :data:`SPLIT_FROM`), apart from :data:`RESTORED_ON_RESUME`."""
+    split off a recorded one, :data:`SPLIT_FROM`), apart from :data:`RESTORED_ON_RESUME` and
+    :data:`ADVICE_ONLY`."""
     lines = []
     for key in sorted(set(recorded) | set(current)):
-        if key.rsplit(".", 1)[-1] in RESTORED_ON_RESUME:
+        if key.rsplit(".", 1)[-1] in RESTORED_ON_RESUME | ADVICE_ONLY:
             continue
         was = recorded.get(key, recorded.get(SPLIT_FROM.get(key, ""), "absent"))
         now = current.get(key, "absent")

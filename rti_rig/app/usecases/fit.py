@@ -60,7 +60,7 @@ class FitRequest:
     write_ptm: bool = True
     write_hsh: bool = True
     write_normals: bool = True
-    hsh_order: int | None = None  # None: fit_rti_order.hsh_order chooses
+    hsh_order: int | None = None  # --hsh-order; None: fit_rti_order.hsh_order chooses
     qa: bool = True
     #: what fit.ptm and fit.rti hold: "srgb" (the photographs' encoded values, as RTIBuilder
     #: writes them and viewers show them) or "linear" (the fitted linear light: darker in a
@@ -316,8 +316,8 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         "read": what,
         "model": result.model,
         "why": result.reason,
-        # the normal maps' estimator: robust PS unless --model named another (never the
-        # relighting model an auto choice picked)
+        # the normal maps' estimator (robust PS unless the model used is PS, Lambert or the
+        # PTM: also when auto chose it)
         "normals_from": result.normals_from or None,
         "rti": result.rti or None,
         # what fit.ptm / fit.rti hold (a viewer cannot tell: neither format records it)
@@ -387,10 +387,25 @@ def _fit_all(
                 "model, or --model auto"
             )
         reason_line = f"{model_name}: chosen by --model"
-    normal_source = _normal_source(name, model_name)
+    normal_source = _normal_source(model_name)
 
     # linear models to export, their solve matrices (warnings issued once, here)
-    order, rti_why = hsh_order(req.hsh_order, model_name, choice, n)
+    evidence = choice
+    if (
+        evidence is None
+        and req.write_hsh
+        and not req.hsh_order
+        and not model_name.startswith("hsh")
+    ):
+        # a model named by --model that fit.rti cannot hold: its HSH order is still measured
+        evidence = hsh_evidence(stack, lights)
+    order, rti_why = hsh_order(req.hsh_order, model_name, evidence, n)
+    if req.hsh_order and req.write_hsh and n < (req.hsh_order + 1) ** 2:  # asked: refused
+        raise FitInputError(
+            f"--hsh-order {req.hsh_order} has {(req.hsh_order + 1) ** 2} coefficients per pixel "
+            f"and needs at least {(req.hsh_order + 1) ** 2} lights; {req.source} has {n}: "
+            "choose a lower order, or leave --hsh-order out"
+        )
     linear: dict[str, np.ndarray] = {}
     skipped: list[str] = []  # said, never silently left out
     if req.write_ptm and n >= 6:
@@ -500,22 +515,37 @@ def _fit_all(
     )
 
 
-#: What ``--model`` names for the normals it asks for (``auto`` and the HSH models: robust PS).
+def hsh_evidence(stack: ImageStack, lights: np.ndarray) -> Any:
+    """The held-out evidence of the HSH orders alone (``select_model`` over them on the fit's
+    pixel sample), or None where none can be measured (fewer than 5 lights)."""
+    from rti_rig.reconstruct.model_select import select_model
+
+    try:
+        return select_model(
+            stack, lights, max_pixels=SAMPLE_PIXELS, candidates=("hsh1", "hsh2", "hsh3")
+        )
+    except ReconstructionError:
+        return None
+
+
+#: The normal maps' estimator for the model a fit uses (``auto``'s choice or ``--model``): robust
+#: photometric stereo unless the model is least-squares PS, Lambert or the PTM.
 NORMALS_BY_MODEL = {"ps": "ps", "lambert": "lambert", "ptm": "ptm"}
 
 
-def _normal_source(asked: str, model_name: str) -> str:
-    """Where the normal maps come from: robust photometric stereo unless ``--model`` named
-    least-squares PS, Lambert or the PTM.
+def _normal_source(model_name: str) -> str:
+    """Where the normal maps come from: the Lambert fit or the PTM's Lambertian reading when
+    that is the model used — also when ``--model auto`` chose it — else robust photometric
+    stereo.
 
-    With ``--model auto`` the choice is a *relighting* model (the lowest order that predicts
-    held-out lights), so it never decides the normals: at 7–12 lights it often picks Lambert,
-    whose least-squares normals ignore shadows and highlights (on the simulated painting at
-    12 lights, 1.48° mean error against robust PS's 0.56°), and until 2026-11-25 an auto fit
-    read its normals from the model it chose.
+    Why ``auto``'s choice is followed (tried otherwise on 2026-11-25 and measured: docs/
+    reconstruction.md, "Where an auto fit's normals come from"): ``auto`` picks Lambert at 7–12
+    lights both on matte objects, where robust PS gives the better normals (the simulated
+    painting at 12 lights: 0.56° against Lambert's 1.48°), and on glossy metal, where robust PS
+    is left with 3 observations a pixel and is far worse (the coin at 7 lights: 43.9° against
+    7.2°). Neither estimator is right on both; the fit says which it used (``normals_from``)
+    and ``--model robust-ps`` or ``--model ps`` asks for one.
     """
-    if asked == AUTO:
-        return "ps-robust"
     return NORMALS_BY_MODEL.get(model_name, "ps-robust")
 
 
