@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import time
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,7 @@ from benchmarks.planner_real_data import relight_model
 from benchmarks.report import machine_line, write_section
 from benchmarks.tradeoff_from import held_out_lights, load_acquisition
 from rti_rig.app.usecases.fit_rti_order import hsh_order
+from rti_rig.core.errors import ScheduleError
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner.uniform import select_uniform_leds
 from rti_rig.reconstruct.model_select import select_model
@@ -39,32 +41,47 @@ FLOORS = (0.0, 10.0, 20.0)
 BASES = {"hsh1": 4, "ptm": 6, "hsh2": 9, "hsh3": 16}
 
 
-def rows(data: Path) -> list[str]:
-    """One table row per N and floor."""
+Layout = tuple[int, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def real_layouts(
+    data: Path, ns: tuple[int, ...] = NS, floors: tuple[float, ...] = FLOORS
+) -> Iterator[Layout]:
+    """(N, floor, images, lights, held-out images, held-out lights, mask) of each homogeneous
+    layout of an acquisition's lights not held out (``held_out_lights``); a floor with fewer
+    lights above it than N is skipped."""
     images, dirs, names = load_acquisition(data / "dirs.lp")
     held = held_out_lights(dirs)
     keep = np.setdiff1d(np.arange(len(dirs)), held)
     dome = DomeGeometry(dirs[keep], tuple(names[i] for i in keep))
     mask = images.max(axis=0) > 0.02
+    for n in (n for n in ns if n <= len(keep)):
+        for floor in floors:
+            try:
+                sel = keep[np.asarray(select_uniform_leds(dome, n, floor))]
+            except ScheduleError:
+                continue
+            yield n, floor, images[sel], dirs[sel], images[held], dirs[held], mask
+
+
+def rows(data: Path) -> list[str]:
+    """One table row per N and floor."""
     out = []
-    for n in (n for n in NS if n <= len(keep)):
-        for floor in FLOORS:
-            sel = keep[np.asarray(select_uniform_leds(dome, n, floor))]
-            psnr = {}
-            for basis, terms in BASES.items():
-                if n >= terms:
-                    mdl = relight_model(images[sel], dirs[sel], basis)
-                    psnr[basis] = relight_psnr(mdl, images[held], dirs[held], 1.0, mask)
-            choice = select_model(images[sel], dirs[sel])
-            order, _ = hsh_order(None, choice.model, choice, n)
-            before = choice.model if choice.model.startswith("hsh") else ("hsh2" if n >= 9 else "—")
-            cells = [f"{psnr[b]:.1f}" if b in psnr else "—" for b in BASES]
-            before = f"{before} ({psnr[before]:.1f} dB)" if before in psnr else before
-            now = f"hsh{order} ({psnr[f'hsh{order}']:.1f} dB)" if order else "—"
-            out.append(
-                f"| {n} | {floor:g}° | " + " | ".join(cells) + f" | {choice.model} | "
-                f"{before} | {now} |"
-            )
+    for n, floor, im, lights, held_im, held_l, mask in real_layouts(data):
+        psnr = {}
+        for basis, terms in BASES.items():
+            if n >= terms:
+                mdl = relight_model(im, lights, basis)
+                psnr[basis] = relight_psnr(mdl, held_im, held_l, 1.0, mask)
+        choice = select_model(im, lights)
+        order, _ = hsh_order(None, choice.model, choice, n)
+        before = choice.model if choice.model.startswith("hsh") else ("hsh2" if n >= 9 else "—")
+        cells = [f"{psnr[b]:.1f}" if b in psnr else "—" for b in BASES]
+        before = f"{before} ({psnr[before]:.1f} dB)" if before in psnr else before
+        now = f"hsh{order} ({psnr[f'hsh{order}']:.1f} dB)" if order else "—"
+        out.append(
+            f"| {n} | {floor:g}° | " + " | ".join(cells) + f" | {choice.model} | {before} | {now} |"
+        )
     return out
 
 

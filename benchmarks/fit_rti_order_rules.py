@@ -21,11 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.fit_rti_order import real_layouts
 from benchmarks.metrics import relight_psnr
 from benchmarks.planner_real_data import relight_model
 from benchmarks.tradeoff import TradeoffSettings, render_scene_data
-from benchmarks.tradeoff_from import held_out_lights, load_acquisition
-from rti_rig.core.errors import ScheduleError
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.planner.uniform import select_uniform_leds
 from rti_rig.reconstruct.model_select import select_model
@@ -42,18 +41,8 @@ Case = tuple[str, int, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np
 
 def cases(data: Path) -> Iterator[Case]:
     """(scene, N, floor, images, lights, held-out images, held-out lights, mask) per layout."""
-    images, dirs, names = load_acquisition(data / "dirs.lp")
-    held = held_out_lights(dirs)
-    keep = np.setdiff1d(np.arange(len(dirs)), held)
-    dome = DomeGeometry(dirs[keep], tuple(names[i] for i in keep))
-    mask = images.max(axis=0) > 0.02
-    for n in NS:
-        for f in FLOORS:
-            try:
-                sel = keep[np.asarray(select_uniform_leds(dome, n, f))]
-            except ScheduleError:  # fewer lights above this floor than N
-                continue
-            yield "real", n, f, images[sel], dirs[sel], images[held], dirs[held], mask
+    for n, f, im, lights, held_im, held_l, mask in real_layouts(data, NS, FLOORS):
+        yield "real", n, f, im, lights, held_im, held_l, mask
     settings = TradeoffSettings(held_out_lights=40, ground_truth_lights=150)
     for scene in settings.scenes:
         d = render_scene_data(scene, settings)

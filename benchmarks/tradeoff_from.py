@@ -228,13 +228,7 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
         "|---|---|---|---|---|---|---|",
     ]
     for n in counts:
-        cells = [
-            by[("uniform", "normals", 0.0, n)],
-            by[("uniform", "normals", floor, n)],
-            by[("optimal", "normals", 0.0, n)],
-            by[("adaptive", "normals", 0.0, n)],
-            by[("adaptive", "relight", 0.0, n)],
-        ]
+        cells = _columns(by, floor, n)
         lines.append(
             f"| {n} | {n * PER_LIGHT_S:.0f} | "
             + " | ".join(
@@ -266,16 +260,22 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
         "|---|---|---|---|---|---|",
     ]
     for n in counts:
-        cells = [
-            by[("uniform", "normals", 0.0, n)],
-            by[("uniform", "normals", floor, n)],
-            by[("optimal", "normals", 0.0, n)],
-            by[("adaptive", "normals", 0.0, n)],
-            by[("adaptive", "relight", 0.0, n)],
-        ]
+        cells = _columns(by, floor, n)
         lines.append(f"| {n} | " + " | ".join(_file_cell(r) for r in cells) + " |")
     lines.append(f"| all {every.n} | {_file_cell(every)} | | | | |")
     return "\n".join(lines)
+
+
+def _columns(by: dict, floor: float, n: int) -> list[Row]:  # type: ignore[type-arg]
+    """The rows of one N in the summary's column order (both tables)."""
+    keys = [
+        ("uniform", "normals", 0.0),
+        ("uniform", "normals", floor),
+        ("optimal", "normals", 0.0),
+        ("adaptive", "normals", 0.0),
+        ("adaptive", "relight", 0.0),
+    ]
+    return [by[(*k, n)] for k in keys]
 
 
 def _file_cell(r: Row) -> str:
