@@ -31,7 +31,8 @@ error per scene and target.
 
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b] [--seed S]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
-[--floors F,F] [--default-floor F] [--relief-gain] [--no-fitted-design] [--fitted-margin M]
+[--floors F,F] [--default-floor F] [--relight-default-floor F] [--relief-gain]
+[--no-fitted-design] [--fitted-margin M]
 [--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight-fitted-design]
 [--no-relight] [--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example beside the
