@@ -51,6 +51,7 @@ def test_fit_normals_against_simulator_truth(clean, tmp_path: Path, model: str) 
     summary = json.loads((out / "fit.json").read_text())
     assert summary["why"]
     assert (out / "lights.dome").is_file() and (out / "fit.ptm").is_file()
+    assert not any(w.startswith("fit.ptm is written from") for w in summary["warnings"])  # 36
 
 
 def _read_ptm(path: Path) -> np.ndarray:
@@ -390,6 +391,9 @@ def test_a_six_light_session_gets_the_hsh_order_its_evidence_supports(tmp_path: 
     assert summary["model"] == "lambert", summary["why"]  # the case this test is for
     assert summary["rti"].startswith("hsh1: the lowest HSH order") and "fit.rti: hsh1" in r.output
     assert not any("fit.rti not written" in w for w in summary["warnings"])
+    # the PTM beside it is written, with a word on what it is worth (nothing measures it here)
+    assert any(w.startswith("fit.ptm is written from 6 lights") for w in summary["warnings"])
+    assert "prefer fit.rti" in " ".join(r.output.split())
     rti_file = _read_rti(out / "fit.rti")
     assert rti_file.shape[0] == 4
     frames = [tifffile.imread(p) for p in sorted((session / "linear").glob("*.tif"))]
