@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.report import machine_line, write_section
+from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.reconstruct import fit_photometric_stereo
 from rti_rig.reconstruct.model_select import select_model
 from rti_rig.simulator.light_transport import DirectionalLight, render_radiance
@@ -40,13 +41,13 @@ NOISE = 0.002
 
 
 def rings(spec: tuple[tuple[float, int, float], ...]) -> np.ndarray:
-    """Unit light directions of the rings."""
-    out = []
-    for el, count, off in spec:
-        for k in range(count):
-            az, e = np.radians(off + 360.0 * k / count), np.radians(el)
-            out.append((np.cos(e) * np.cos(az), np.cos(e) * np.sin(az), np.sin(e)))
-    return np.array(out)
+    """Unit light directions of the rings (the project's frame, as a dome config's rings)."""
+    return np.concatenate(
+        [
+            direction_from_az_el(off + 360.0 * np.arange(count) / count, np.full(count, el))
+            for el, count, off in spec
+        ]
+    )
 
 
 def angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
