@@ -34,6 +34,7 @@ Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes 
 [--floors F,F] [--default-floor F] [--relight-default-floor F] [--relief-gain]
 [--no-fitted-design] [--fitted-margin M]
 [--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight-fitted-design]
+[--relight-basis B]
 [--no-relight] [--cache FILE]
 [--write]`` (the real acquisition is read from ../shared/data/neuralrti-example beside the
 repository; ``--cache`` keeps `optimal`'s layouts between runs; ``--write`` puts the tables into
@@ -52,7 +53,7 @@ import numpy as np
 
 from benchmarks.metrics import relight_psnr
 from benchmarks.paired import compare
-from benchmarks.planner_real_data import relight_model
+from benchmarks.planner_real_data import relight_model, written_rti_psnr
 from benchmarks.report import machine_line, write_section
 from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start, small_grey
 from rti_rig.core.geometry import az_el_from_direction
@@ -187,6 +188,8 @@ def sim(draws: int, seed: int = 0, scenes: tuple[str, ...] = ()) -> tuple[dict, 
         grey = data.candidate_images.mean(axis=-1)
         err: dict = {}
         psnr: dict = {}
+        fpsnr: dict = {}  # relighting of the fit.rti `rti-rig fit` writes (its HSH order)
+        fbasis: dict = {}
         calib: list[tuple[int, float, float]] = []  # (N, raw estimate, measured)
         dec_t: list[float] = []
         dec_t_relight: list[float] = []
@@ -229,6 +232,9 @@ def sim(draws: int, seed: int = 0, scenes: tuple[str, ...] = ()) -> tuple[dict, 
                     mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
                     err.setdefault((n, label), []).append(e)
                     psnr.setdefault((n, label), []).append(relight_psnr(mdl, lum[held], cand[held]))
+                    basis, q = written_rti_psnr(lum[idx], cand[idx], lum[held], cand[held])
+                    fpsnr.setdefault((n, label), []).append(q)
+                    fbasis.setdefault((n, label), []).append(basis)
                 held_counts.append(len(held))
                 if "raw" in est:
                     calib.append((n, est["raw"], err[(n, "adaptive")][-1], est["discarded"]))
@@ -237,6 +243,8 @@ def sim(draws: int, seed: int = 0, scenes: tuple[str, ...] = ()) -> tuple[dict, 
         out[scene] = {
             "err": err,
             "psnr": psnr,
+            "file_psnr": fpsnr,
+            "file_basis": fbasis,
             "calib": calib,
             "decision_s": dec_t,
             "decision_relight_s": dec_t_relight,
@@ -371,6 +379,8 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
     rng = np.random.default_rng(seed)
     err: dict = {}
     psnr: dict = {}
+    fpsnr: dict = {}  # relighting of the fit.rti `rti-rig fit` writes (its HSH order)
+    fbasis: dict = {}
     calib = []
     dec_t: list[float] = []
     dec_t_relight: list[float] = []
@@ -407,6 +417,9 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
                 e, q, _ = evaluate(idx, images, dirs, ref, mask, model, held=held)
                 err.setdefault((n, label), []).append(e)
                 psnr.setdefault((n, label), []).append(q)
+                basis, fq = written_rti_psnr(images[idx], dirs[idx], images[held], dirs[held], mask)
+                fpsnr.setdefault((n, label), []).append(fq)
+                fbasis.setdefault((n, label), []).append(basis)
             if "raw" in est:
                 calib.append((n, est["raw"], err[(n, "adaptive")][-1], est["discarded"]))
         _save_cache()
@@ -414,6 +427,8 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
     return {
         "err": err,
         "psnr": psnr,
+        "file_psnr": fpsnr,
+        "file_basis": fbasis,
         "calib": calib,
         "decision_s": dec_t,
         "decision_relight_s": dec_t_relight,
@@ -421,16 +436,35 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
     }
 
 
-def table(name: str, r: dict) -> tuple[str, str]:
-    """Rows of the normals and PSNR tables for one object."""
-    err, psnr = r["err"], r["psnr"]
-    floor = min(
-        FLOORS, key=lambda f: float(np.mean([np.mean(err[(n, f"uniform {f:g}")]) for n in NS]))
-    )
+def _psnr_row(name: str, psnr: dict) -> str:
+    """One object's row of a relighting table: the floor tuned on this PSNR with hindsight,
+    then per N the tuned layout / `optimal` / adaptive (--objective relight) and the verdicts."""
     pfloor = max(
         FLOORS, key=lambda f: float(np.mean([np.mean(psnr[(n, f"uniform {f:g}")]) for n in NS]))
     )
-    e_cells, p_cells = [], []
+    cells = []
+    for n in NS:
+        phom = np.array(psnr[(n, f"uniform {pfloor:g}")])
+        # the relighting table scores adaptive chosen for relighting (--objective relight)
+        popt, pada = np.array(psnr[(n, "optimal")]), np.array(psnr[(n, "adaptive relight")])
+        pnorm = np.array(psnr[(n, "adaptive")])
+        c1, c2 = compare(-pada, -phom), compare(-pada, -popt)
+        cells.append(
+            f"{phom.mean():.2f} / {popt.mean():.2f} / {pada.mean():.2f} "
+            f"(normals objective {pnorm.mean():.2f}): vs hom "
+            f"{c1.wins}/{len(pada)} {c1.verdict()}; vs opt {c2.wins}/{len(pada)} {c2.verdict()}"
+        )
+    return f"| {name} | {pfloor:g}° | " + " | ".join(cells) + " |"
+
+
+def table(name: str, r: dict) -> tuple[str, str, str]:
+    """Rows of the normals table, the relighting table (the richest basis N lights determine)
+    and the written-file relighting table (fit.rti as `rti-rig fit` writes it) for one object."""
+    err = r["err"]
+    floor = min(
+        FLOORS, key=lambda f: float(np.mean([np.mean(err[(n, f"uniform {f:g}")]) for n in NS]))
+    )
+    e_cells = []
     for n in NS:
         hom = np.array(err[(n, f"uniform {floor:g}")])
         opt, ada = np.array(err[(n, "optimal")]), np.array(err[(n, "adaptive")])
@@ -439,20 +473,28 @@ def table(name: str, r: dict) -> tuple[str, str]:
             f"{compare(ada, hom).wins}/{len(ada)} {compare(ada, hom).verdict()}; vs opt "
             f"{compare(ada, opt).wins}/{len(ada)} {compare(ada, opt).verdict()}"
         )
-        phom = np.array(psnr[(n, f"uniform {pfloor:g}")])
-        # the relighting table scores adaptive chosen for relighting (--objective relight)
-        popt, pada = np.array(psnr[(n, "optimal")]), np.array(psnr[(n, "adaptive relight")])
-        pnorm = np.array(psnr[(n, "adaptive")])
-        c1, c2 = compare(-pada, -phom), compare(-pada, -popt)
-        p_cells.append(
-            f"{phom.mean():.2f} / {popt.mean():.2f} / {pada.mean():.2f} "
-            f"(normals objective {pnorm.mean():.2f}): vs hom "
-            f"{c1.wins}/{len(pada)} {c1.verdict()}; vs opt {c2.wins}/{len(pada)} {c2.verdict()}"
-        )
     return (
         f"| {name} | {floor:g}° | " + " | ".join(e_cells) + " |",
-        f"| {name} | {pfloor:g}° | " + " | ".join(p_cells) + " |",
+        _psnr_row(name, r["psnr"]),
+        _psnr_row(name, r["file_psnr"]),
     )
+
+
+def file_bases(results: dict) -> str:
+    """Which HSH orders the written fit.rti had, per N, over every layout and draw."""
+    parts = []
+    for n in NS:
+        got: dict[str, int] = {}
+        for r in results.values():
+            for (m, _), bases in r["file_basis"].items():
+                if m == n:
+                    for b in bases:
+                        got[b or "none"] = got.get(b or "none", 0) + 1
+        total = sum(got.values()) or 1
+        parts.append(
+            f"N = {n}: " + ", ".join(f"{k} {v / total:.0%}" for k, v in sorted(got.items()))
+        )
+    return "; ".join(parts)
 
 
 def relative_excess(r: dict) -> float:
@@ -501,6 +543,9 @@ def configure_planner(args: argparse.Namespace) -> None:
         adaptive_planner.DESIGN_DEFAULT_FLOOR = args.default_floor
     if args.relight_default_floor is not None:
         adaptive_planner.RELIGHT_DEFAULT_FLOOR = args.relight_default_floor
+    if args.relight_basis is not None:  # the name the chooser calls (no constant: not shipped)
+        basis = args.relight_basis
+        adaptive_planner.relight_basis = lambda n_total: basis
     if args.start != "default":  # after the default floor: a hedged start is of its layout
         from benchmarks.adaptive_reach import start_functions
 
@@ -582,6 +627,13 @@ def build_parser() -> argparse.ArgumentParser:
         "(planner.adaptive_optimal.SEARCH_PIXELS; default what ships, 500)",
     )
     ap.add_argument(
+        "--relight-basis",
+        default=None,
+        choices=("ptm", "hsh1", "hsh2", "hsh3"),
+        help="the basis --objective relight sessions score designs by (e.g. hsh1: the fit.rti "
+        "`rti-rig fit` mostly writes); default: the richest basis N lights determine",
+    )
+    ap.add_argument(
         "--no-relight-fitted-design",
         action="store_true",
         help="do not offer the fitted relight design to --objective relight "
@@ -646,16 +698,18 @@ def main(argv: list[str] | None = None) -> str:
     _save_cache(args.cache)
     head = "| object | tuned floor | " + " | ".join(f"N = {n}" for n in NS) + " |"
     sep = "|" + "---|" * (2 + len(NS))
-    e_rows, p_rows = [], []
+    e_rows, p_rows, f_rows = [], [], []
     for scene, r in results.items():
-        a, b = table(scene, r)
+        a, b, c = table(scene, r)
         e_rows.append(a)
         p_rows.append(b)
+        f_rows.append(c)
     real_calib = []
     if rr is not None:
-        a, b = table("neuralrti-example (real)", rr)
+        a, b, c = table("neuralrti-example (real)", rr)
         e_rows.append(a)
         p_rows.append(b)
+        f_rows.append(c)
         cells = _calib_cells(rr["calib"], scale, slope)
         real_calib.append(
             f"| neuralrti-example (real) | {scale:.2f}, {slope:+.2f} | " + " | ".join(cells) + " |"
@@ -701,6 +755,7 @@ def main(argv: list[str] | None = None) -> str:
             + (" --relief-gain" if args.relief_gain else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
+            + (f" --relight-basis {args.relight_basis}" if args.relight_basis else "")
             + (" --no-relight-fitted-design" if args.no_relight_fitted_design else "")
             + (f" --fitted-margin {args.fitted_margin:g}" if args.fitted_margin is not None else "")
             + (f" --fitted-seeds {args.fitted_seeds}" if args.fitted_seeds else "")
@@ -742,6 +797,17 @@ def main(argv: list[str] | None = None) -> str:
             head,
             sep,
             *p_rows,
+            "",
+            "Relighting PSNR of the file a user opens (dB): fit.rti as `rti-rig fit` writes it, "
+            "its HSH order chosen on held-out lights (`rti_rig/app/usecases/fit_rti_order.py`), "
+            "not the richest basis the lights determine; the same held-out lights, layouts and "
+            "sessions as the table above, the floor tuned on this PSNR. Orders written: "
+            + file_bases({**results, **({"real": rr} if rr is not None else {})})
+            + ".",
+            "",
+            head,
+            sep,
+            *f_rows,
             "",
             f"Error estimate (the stopping rule's): the *simulated* error — the robust fit run on "
             "observations simulated from this object's model (gloss, cast shadows, noise; "

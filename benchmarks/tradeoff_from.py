@@ -94,16 +94,18 @@ def run_tradeoff_from(
 ) -> tuple[list[Row], list[str]]:
     """Rows (one per plan and N, and the row ``all``: every light not held out) for the
     acquisition ``lp``, and the names of the held-out lights; see the module docstring."""
-    from benchmarks.metrics import relight_psnr
-    from benchmarks.planner_real_data import evaluate, planned_leds, reference, relight_model
+    from benchmarks.planner_real_data import (
+        evaluate,
+        planned_leds,
+        reference,
+        written_rti_psnr,
+    )
     from rti_rig.app.usecases.adaptive import AdaptiveChooser, dome_start
-    from rti_rig.app.usecases.fit_rti_order import hsh_order
     from rti_rig.core.errors import ScheduleError
     from rti_rig.core.rig_geometry import DomeGeometry
     from rti_rig.planner.adaptive import START_LIGHTS
     from rti_rig.planner.objectives import models_for
     from rti_rig.planner.uniform import select_uniform_leds
-    from rti_rig.reconstruct.model_select import select_model
 
     images, dirs, names = load_acquisition(Path(lp))
     smallest = MIN_CANDIDATES + MIN_HELD_OUT
@@ -149,13 +151,9 @@ def run_tradeoff_from(
         model = models_for(n)[-1]  # the richest basis n lights determine, as benchmarks.adaptive
         err, psnr, _ = evaluate(chosen, images, dirs, ref, mask, model, held=held)
         # what the user would open: fit.rti as `rti-rig fit` (--model auto) writes it
-        choice = select_model(images[chosen], dirs[chosen])
-        order, _ = hsh_order(None, choice.model, choice, len(chosen))
-        file_model, file_psnr = "", float("nan")
-        if order is not None and len(chosen) >= (order + 1) ** 2:
-            file_model = f"hsh{order}"
-            fitted = relight_model(images[chosen], dirs[chosen], file_model)
-            file_psnr = relight_psnr(fitted, images[held], dirs[held], 1.0, mask)
+        file_model, file_psnr = written_rti_psnr(
+            images[chosen], dirs[chosen], images[held], dirs[held], mask
+        )
         t = n * PER_LIGHT_S
         rows.append(
             Row(

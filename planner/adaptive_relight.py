@@ -77,7 +77,10 @@ RelightFn = Callable[
 
 
 def relight_basis(n_total: int) -> str:
-    """The relighting basis a session of ``n_total`` lights is scored with (the benchmarks')."""
+    """The relighting basis a session of ``n_total`` lights is scored with (the benchmarks'
+    relighting table's). Scoring instead the order-1 HSH that `rti-rig fit` writes from 6–12
+    lights was measured (``benchmarks.adaptive --relight-basis hsh1``; docs/adaptive.md): no loss
+    of either table removed, four wins of this one lost."""
     return models_for(n_total)[-1]
 
 

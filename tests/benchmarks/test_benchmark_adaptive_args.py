@@ -82,3 +82,17 @@ def test_a_hedged_start_is_built_for_the_default_floor_the_options_set(
     dome = DomeGeometry(fibonacci_cap(120, 3.0), tuple(f"l{i}" for i in range(120)))
     start = adaptive.START["start"](dome, 4, 9)
     assert len(start) == 4 and set(start) <= set(select_uniform_leds(dome, 9, 20.0).tolist())
+
+
+def test_relight_basis_sets_what_the_chooser_scores_designs_by(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``--relight-basis hsh1``: every relight decision scores its designs by that basis (the
+    chooser's name for the function is replaced; nothing of what ships changes without it)."""
+    import rti_rig.planner.adaptive as planner
+
+    monkeypatch.setattr(planner, "relight_basis", planner.relight_basis)
+    adaptive.configure_planner(adaptive.build_parser().parse_args([]))
+    assert planner.relight_basis(9) == "ptm"  # the richest basis 9 lights determine
+    adaptive.configure_planner(adaptive.build_parser().parse_args(["--relight-basis", "hsh1"]))
+    assert planner.relight_basis(9) == planner.relight_basis(18) == "hsh1"
