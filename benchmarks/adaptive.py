@@ -14,11 +14,14 @@ every strategy works on the same remaining ones:
 
 Scored as the other planner benchmarks score: normal error of robust photometric stereo (sim:
 against the true normals, every pixel; real: against the all-light fit, on the object mask) and
-relighting PSNR (the richest basis N lights determine) on **one held-out set per draw and N,
-the same for every strategy**: the candidates none of the compared layouts took (the lights out
-of service included). Before 2026-11-24 each layout was scored on the lights *it* did not take,
-so two layouts were compared on different lights (a layout that took the grazing lights was
-judged on easier ones); the tables of that time are kept in docs/adaptive.md with that caveat.
+relighting PSNR on **one held-out set per draw and N, the same for every strategy**, twice:
+of the richest basis N lights determine (what the relight objective's designs are scored by)
+and of the fit.rti `rti-rig fit` writes (its HSH order chosen on held-out lights, as the fit
+chooses it: ``planner_real_data.written_rti_psnr``; what a user opens). The held-out set
+is the candidates none of the compared layouts took (the lights out of service included).
+Before 2026-11-24 each layout was scored on the lights *it* did not take, so two layouts were
+compared on different lights (a layout that took the grazing lights was judged on easier
+ones); the tables of that time are kept in docs/adaptive.md with that caveat.
 
 The stopping rule's estimate is calibrated here: the raw estimate (the robust fit simulated on
 the object's model, ``AdaptiveChooser.raw_estimate``) against the measured error of the
@@ -232,7 +235,13 @@ def sim(draws: int, seed: int = 0, scenes: tuple[str, ...] = ()) -> tuple[dict, 
                     mdl = relight_model(lum[idx], cand[idx], models_for(n)[-1])
                     err.setdefault((n, label), []).append(e)
                     psnr.setdefault((n, label), []).append(relight_psnr(mdl, lum[held], cand[held]))
-                    basis, q = written_rti_psnr(lum[idx], cand[idx], lum[held], cand[held])
+                    basis, q = written_rti_psnr(
+                        lum[idx],
+                        cand[idx],
+                        lum[held],
+                        cand[held],
+                        chosen_on=data.candidate_images[idx],
+                    )
                     fpsnr.setdefault((n, label), []).append(q)
                     fbasis.setdefault((n, label), []).append(basis)
                 held_counts.append(len(held))
@@ -368,6 +377,7 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
         planned_leds,
         preview_leds,
         reference,
+        srgb_to_linear,
     )
 
     dome, images, rgb8 = load(data or DATA)
@@ -417,7 +427,11 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
                 e, q, _ = evaluate(idx, images, dirs, ref, mask, model, held=held)
                 err.setdefault((n, label), []).append(e)
                 psnr.setdefault((n, label), []).append(q)
-                basis, fq = written_rti_psnr(images[idx], dirs[idx], images[held], dirs[held], mask)
+                # the colour stack the fit reads (the JPEGs linearised): its order choice
+                rgb = srgb_to_linear(np.stack([rgb8[i] for i in idx]).astype(np.float32) / 255.0)
+                basis, fq = written_rti_psnr(
+                    images[idx], dirs[idx], images[held], dirs[held], mask, chosen_on=rgb
+                )
                 fpsnr.setdefault((n, label), []).append(fq)
                 fbasis.setdefault((n, label), []).append(basis)
             if "raw" in est:
@@ -629,7 +643,7 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument(
         "--relight-basis",
         default=None,
-        choices=("ptm", "hsh1", "hsh2", "hsh3"),
+        choices=("ptm", "hsh1"),  # bases every N measured (6 lights or more) determines
         help="the basis --objective relight sessions score designs by (e.g. hsh1: the fit.rti "
         "`rti-rig fit` mostly writes); default: the richest basis N lights determine",
     )

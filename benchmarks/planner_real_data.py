@@ -123,26 +123,45 @@ def relight_model(images: np.ndarray, lights: np.ndarray, model: str):
     return fit_hsh(images, lights, int(model[-1]))
 
 
+def written_rti_order(stack: np.ndarray, dirs: np.ndarray) -> int | None:
+    """The HSH order of the fit.rti `rti-rig fit` (``--model auto``) writes from ``stack``
+    under ``dirs``, chosen as the fit chooses it: its model choice on the same pixel sample
+    (``SAMPLE_PIXELS``) of the colour stack, with saturated observations left out, then
+    :func:`rti_rig.app.usecases.fit_rti_order.hsh_order`. None where no fit.rti is written.
+
+    ``stack``: the linear images the fit reads, (N, H, W, 3) or (N, H, W), in units of the
+    white (clipped at 1.0, as the camera's top code: the fit's saturation level)."""
+    from rti_rig.app.usecases.fit import SAMPLE_PIXELS
+    from rti_rig.app.usecases.fit_rti_order import hsh_order
+    from rti_rig.reconstruct.model_select import select_model
+    from rti_rig.reconstruct.stack import ImageStack
+
+    choice = select_model(ImageStack(stack, saturation_level=1.0), dirs, max_pixels=SAMPLE_PIXELS)
+    order, _ = hsh_order(None, choice.model, choice, len(dirs))
+    return order
+
+
 def written_rti_psnr(
     images: np.ndarray,
     dirs: np.ndarray,
     held_images: np.ndarray,
     held_dirs: np.ndarray,
     mask: np.ndarray | None = None,
+    *,
+    chosen_on: np.ndarray | None = None,
 ) -> tuple[str, float]:
     """The basis and relighting PSNR (on the held-out lights) of the fit.rti `rti-rig fit`
-    (``--model auto``) writes from ``images`` under ``dirs``: the HSH order its held-out
-    evidence chooses (:func:`rti_rig.app.usecases.fit_rti_order.hsh_order`), not the richest
-    basis the lights determine. ("", nan) where it writes no fit.rti.
+    (``--model auto``) writes: the HSH order its held-out evidence chooses
+    (:func:`written_rti_order`, on ``chosen_on``: the colour stack the fit reads; default
+    ``images``, an approximation), not the richest basis the lights determine, fitted on
+    ``images`` (the luminance the other relighting measure scores: the fit is linear, so this
+    is the luminance of the colour fit; the file's 8-bit sRGB-encoded coefficients are not
+    modelled). ("", nan) where it writes no fit.rti.
 
     Why: what a user relights is the file the fit writes; the richest basis (PTM at 9–12
     lights, order 2 from 9) is what the benchmarks had scored, and at 9 lights order 2
     interpolates the lights it was fitted on."""
-    from rti_rig.app.usecases.fit_rti_order import hsh_order
-    from rti_rig.reconstruct.model_select import select_model
-
-    choice = select_model(images, dirs)
-    order, _ = hsh_order(None, choice.model, choice, len(dirs))
+    order = written_rti_order(images if chosen_on is None else chosen_on, dirs)
     if order is None or len(dirs) < (order + 1) ** 2:
         return "", float("nan")
     fitted = relight_model(images, dirs, f"hsh{order}")

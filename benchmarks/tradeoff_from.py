@@ -54,11 +54,20 @@ PER_LIGHT_S = 0.02 + 0.1 + 0.05 + 0.3 + 0.7  # the default dome timing and expos
 
 def load_acquisition(lp: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """(grey linear images (N, H, W) float32, directions (N, 3), names) of an acquisition."""
+    grey, _, dirs, names = load_acquisition_colour(lp)
+    return grey, dirs, names
+
+
+def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
+    """(grey linear images (N, H, W), the linear colour images the fit reads (N, H, W, C),
+    directions, names), both shrunk to at most ``MAX_PX`` wide. The colour stack is for the
+    choice of fit.rti's order, which `rti-rig fit` makes on colour pixels with the saturated
+    ones left out (a grey mean hides a channel at its top code)."""
     from rti_rig.core.image_files import read_image_any
     from rti_rig.core.lp_format import read_lp
 
     entries = read_lp(lp, upper_hemisphere=True)
-    images = []
+    images, colour = [], []
     for e in entries:
         img = read_image_any(lp.parent / e.name)
         x = img.astype(np.float32) / (255.0 if img.dtype == np.uint8 else 65535.0)
@@ -68,9 +77,12 @@ def load_acquisition(lp: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
         if g.shape[1] > MAX_PX:
             size = (MAX_PX, max(1, round(g.shape[0] * MAX_PX / g.shape[1])))
             g = cv2.resize(g, size, interpolation=cv2.INTER_AREA)
+            # nearest: an area mean would pull a saturated pixel below the top code
+            x = cv2.resize(x, size, interpolation=cv2.INTER_NEAREST)
         images.append(g.astype(np.float32))
+        colour.append(x.astype(np.float32))
     dirs = np.array([e.direction for e in entries])
-    return np.stack(images), dirs, [e.name for e in entries]
+    return np.stack(images), np.stack(colour), dirs, [e.name for e in entries]
 
 
 def held_out_lights(dirs: np.ndarray, seed: int = 0) -> np.ndarray:
@@ -107,7 +119,7 @@ def run_tradeoff_from(
     from rti_rig.planner.objectives import models_for
     from rti_rig.planner.uniform import select_uniform_leds
 
-    images, dirs, names = load_acquisition(Path(lp))
+    images, colour, dirs, names = load_acquisition_colour(Path(lp))
     smallest = MIN_CANDIDATES + MIN_HELD_OUT
     if len(dirs) < smallest:
         raise ValueError(
@@ -152,7 +164,7 @@ def run_tradeoff_from(
         err, psnr, _ = evaluate(chosen, images, dirs, ref, mask, model, held=held)
         # what the user would open: fit.rti as `rti-rig fit` (--model auto) writes it
         file_model, file_psnr = written_rti_psnr(
-            images[chosen], dirs[chosen], images[held], dirs[held], mask
+            images[chosen], dirs[chosen], images[held], dirs[held], mask, chosen_on=colour[chosen]
         )
         t = n * PER_LIGHT_S
         rows.append(

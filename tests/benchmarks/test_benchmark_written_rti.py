@@ -7,11 +7,18 @@ chooses (order 1 at 6–11 lights). A user relights the file; the tables now sco
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
+import pytest
 
 from benchmarks.metrics import relight_psnr
-from benchmarks.planner_real_data import relight_model, written_rti_psnr
+from benchmarks.planner_real_data import relight_model, written_rti_order, written_rti_psnr
+from rti_rig.app.usecases.fit import FitRequest, run_fit
 from rti_rig.core.geometry import direction_from_az_el
+from rti_rig.core.image_files import read_image_any
+from rti_rig.core.lp_format import read_lp
 
 
 def _lambert(lights: np.ndarray, size: int = 24) -> np.ndarray:
@@ -45,3 +52,24 @@ def test_too_few_lights_write_no_file() -> None:
     held = _ring(8, 50.0)
     assert written_rti_psnr(_lambert(shot), shot, _lambert(held), held)[0] == ""
     assert np.isnan(written_rti_psnr(_lambert(shot), shot, _lambert(held), held)[1])
+
+
+@pytest.mark.parametrize(("scene", "step"), [("coin", 1), ("tablet", 1), ("tablet", 2)])
+def test_the_order_is_the_one_rti_rig_fit_writes(tmp_path: Path, scene: str, step: int) -> None:
+    """Through the front door: a simulated session (16-bit TIFFs, 36 or 18 lights) fitted by
+    the fit use case; its fit.json names the order the benchmark's choice must repeat (here
+    orders 3, 2 and 1: a rule that always said order 1 would fail)."""
+    from fit_sessions import dome_lights, make_session
+
+    lights = dome_lights()[::step]
+    session, _, _ = make_session(tmp_path / "s", scene=scene, lights=lights, size=(80, 96))
+    run_fit(FitRequest(session, tmp_path / "f", qa=False, write_normals=False, write_ptm=False))
+    written = json.loads((tmp_path / "f" / "fit.json").read_text(encoding="utf-8"))["rti"]
+    entries = read_lp(session / "lights.lp")
+    stack = np.stack(
+        [read_image_any(session / "linear" / f"{Path(e.name).stem}.tif") for e in entries]
+    )
+    dirs = np.array([e.direction for e in entries])
+    order = written_rti_order(stack.astype(np.float32) / 65535.0, dirs)
+    assert written.startswith(f"hsh{order}:"), written
+    assert order == {("coin", 1): 3, ("tablet", 1): 2, ("tablet", 2): 1}[(scene, step)]
