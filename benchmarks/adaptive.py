@@ -450,12 +450,19 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
     }
 
 
+def _tuned_floor(scores: dict, higher_is_better: bool = False) -> float:
+    """The homogeneous floor with the best mean score over N (the bar, tuned with hindsight)."""
+
+    def mean(f: float) -> float:
+        return float(np.mean([np.mean(scores[(n, f"uniform {f:g}")]) for n in NS]))
+
+    return max(FLOORS, key=mean) if higher_is_better else min(FLOORS, key=mean)
+
+
 def _psnr_row(name: str, psnr: dict) -> str:
     """One object's row of a relighting table: the floor tuned on this PSNR with hindsight,
     then per N the tuned layout / `optimal` / adaptive (--objective relight) and the verdicts."""
-    pfloor = max(
-        FLOORS, key=lambda f: float(np.mean([np.mean(psnr[(n, f"uniform {f:g}")]) for n in NS]))
-    )
+    pfloor = _tuned_floor(psnr, higher_is_better=True)
     cells = []
     for n in NS:
         phom = np.array(psnr[(n, f"uniform {pfloor:g}")])
@@ -475,9 +482,7 @@ def table(name: str, r: dict) -> tuple[str, str, str]:
     """Rows of the normals table, the relighting table (the richest basis N lights determine)
     and the written-file relighting table (fit.rti as `rti-rig fit` writes it) for one object."""
     err = r["err"]
-    floor = min(
-        FLOORS, key=lambda f: float(np.mean([np.mean(err[(n, f"uniform {f:g}")]) for n in NS]))
-    )
+    floor = _tuned_floor(err)
     e_cells = []
     for n in NS:
         hom = np.array(err[(n, f"uniform {floor:g}")])
@@ -516,9 +521,7 @@ def relative_excess(r: dict) -> float:
     the sum over N of how far adaptive's mean normal error is above the tuned homogeneous
     layout's, relative to it (0 where it is not above)."""
     err = r["err"]
-    floor = min(
-        FLOORS, key=lambda f: float(np.mean([np.mean(err[(n, f"uniform {f:g}")]) for n in NS]))
-    )
+    floor = _tuned_floor(err)
     total = 0.0
     for n in NS:
         hom = float(np.mean(err[(n, f"uniform {floor:g}")]))
