@@ -125,20 +125,21 @@ def relight_model(images: np.ndarray, lights: np.ndarray, model: str):
 
 def written_rti_order(stack: np.ndarray, dirs: np.ndarray) -> int | None:
     """The HSH order of the fit.rti `rti-rig fit` (``--model auto``) writes from ``stack``
-    under ``dirs``, chosen as the fit chooses it: its model choice on the same pixel sample
-    (``SAMPLE_PIXELS``) of the colour stack, with saturated observations left out, then
-    :func:`rti_rig.app.usecases.fit_rti_order.hsh_order`. None where no fit.rti is written.
+    under ``dirs``, chosen by the fit's own code: its model choice on the same pixel sample
+    (``SAMPLE_PIXELS``) of the colour stack, saturated observations left out, then
+    :func:`rti_rig.app.usecases.fit.rti_order` (which keeps the clipped observations for the
+    order where the choice left some out). None where no fit.rti is written.
 
     ``stack``: the linear images the fit reads, (N, H, W, 3) or (N, H, W), in units of the
     white (clipped at 1.0, as the camera's top code: the fit's saturation level)."""
-    from rti_rig.app.usecases.fit import SAMPLE_PIXELS
-    from rti_rig.app.usecases.fit_rti_order import hsh_order
+    from rti_rig.app.usecases.fit import SAMPLE_PIXELS, FitRequest, rti_order
     from rti_rig.reconstruct.model_select import select_model
     from rti_rig.reconstruct.stack import ImageStack
 
-    choice = select_model(ImageStack(stack, saturation_level=1.0), dirs, max_pixels=SAMPLE_PIXELS)
-    order, _ = hsh_order(None, choice.model, choice, len(dirs))
-    return order
+    images = ImageStack(stack, saturation_level=1.0)
+    choice = select_model(images, dirs, max_pixels=SAMPLE_PIXELS)
+    request = FitRequest(source=Path("."), out_dir=Path("."))  # --model auto, fit.rti written
+    return rti_order(images, np.asarray(dirs, dtype=np.float64), request, choice.model, choice)[0]
 
 
 def written_rti_psnr(

@@ -36,9 +36,12 @@ def test_every_layout_of_a_draw_is_scored_on_the_same_lights(monkeypatch) -> Non
         scored.append(np.asarray(lights))
         return relight_psnr(model, images, lights, *args)
 
-    def written_spy(images, lights, held_images, held_lights, *args):  # type: ignore[no-untyped-def]
+    def written_spy(images, lights, held_images, held_lights, *args, **kwargs):  # type: ignore[no-untyped-def]
         written.append(np.asarray(held_lights))
-        return written_rti_psnr(images, lights, held_images, held_lights, *args)
+        # the order is chosen on the colour images of the same layout, as the fit chooses it
+        assert kwargs["chosen_on"].shape[:1] == images.shape[:1]
+        assert kwargs["chosen_on"].shape[-1] == 3
+        return written_rti_psnr(images, lights, held_images, held_lights, *args, **kwargs)
 
     monkeypatch.setattr(bench, "_CACHE", {})  # plan afresh, and leave no entry behind
     monkeypatch.setattr(bench, "NS", (6,))

@@ -12,7 +12,7 @@ ACQ = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay" / "dirs.
 
 
 def test_each_layout_gets_both_orders_and_their_cost() -> None:
-    rows, lost = bench.rows(ACQ, ns=(9, 12), floors=(0.0, 20.0))
+    rows, lost = bench.rows(bench.real_layouts(ACQ, (9, 12), (0.0, 20.0)))
     assert len(rows) == len(lost) == 4
     for row in rows:
         cells = [c.strip() for c in row.strip("|").split("|")]

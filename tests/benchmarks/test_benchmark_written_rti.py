@@ -58,7 +58,10 @@ def test_too_few_lights_write_no_file() -> None:
 def test_the_order_is_the_one_rti_rig_fit_writes(tmp_path: Path, scene: str, step: int) -> None:
     """Through the front door: a simulated session (16-bit TIFFs, 36 or 18 lights) fitted by
     the fit use case; its fit.json names the order the benchmark's choice must repeat (here
-    orders 3, 2 and 1: a rule that always said order 1 would fail)."""
+    orders 1, 2 and 1: a rule that always said order 1 would fail on the tablet's 36 lights).
+    The coin's highlights clip: its order is chosen with the clipped observations kept (the
+    model choice alone, which leaves those pixels out, says order 3; order 1 relights other
+    lights of the same simulated coin best, 27.4 dB against 26.6 for order 3)."""
     from fit_sessions import dome_lights, make_session
 
     lights = dome_lights()[::step]
@@ -72,4 +75,4 @@ def test_the_order_is_the_one_rti_rig_fit_writes(tmp_path: Path, scene: str, ste
     dirs = np.array([e.direction for e in entries])
     order = written_rti_order(stack.astype(np.float32) / 65535.0, dirs)
     assert written.startswith(f"hsh{order}:"), written
-    assert order == {("coin", 1): 3, ("tablet", 1): 2, ("tablet", 2): 1}[(scene, step)]
+    assert order == {("coin", 1): 1, ("tablet", 1): 2, ("tablet", 2): 1}[(scene, step)]

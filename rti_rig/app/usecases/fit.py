@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import html
 import json
+import math
 import os
 import threading
 import time
@@ -394,16 +395,7 @@ def _fit_all(
     normal_source = _normal_source(model_name)
 
     # linear models to export, their solve matrices (warnings issued once, here)
-    evidence = choice
-    if (
-        evidence is None
-        and req.write_hsh
-        and not req.hsh_order
-        and not model_name.startswith("hsh")
-    ):
-        # a model named by --model that fit.rti cannot hold: its HSH order is still measured
-        evidence = hsh_evidence(stack, lights)
-    order, rti_why = hsh_order(req.hsh_order, model_name, evidence, n)
+    order, rti_why = rti_order(stack, lights, req, model_name, choice)
     if req.hsh_order and req.write_hsh and n < (req.hsh_order + 1) ** 2:  # asked: refused
         raise FitInputError(
             f"--hsh-order {req.hsh_order} has {(req.hsh_order + 1) ** 2} coefficients per pixel "
@@ -525,6 +517,30 @@ def _fit_all(
         normals_from=normal_source,
         rti=rti_why if f"hsh{order}" in exported else "",
     )
+
+
+def rti_order(
+    stack: ImageStack, lights: np.ndarray, req: FitRequest, model_name: str, choice: Any
+) -> tuple[int | None, str]:
+    """fit.rti's HSH order and why (:func:`~rti_rig.app.usecases.fit_rti_order.hsh_order`),
+    from the evidence this fit has: ``auto``'s model choice, or for a ``--model`` fit.rti cannot
+    hold the HSH orders' own; and, where that evidence left saturated pixels out, the HSH
+    orders' evidence with the clipped observations kept (not for an HSH model named by
+    ``--model``: written as asked). The benchmarks call this too, so that they score the order
+    the fit writes."""
+    evidence = choice
+    if not (req.write_hsh and not req.hsh_order):
+        return hsh_order(req.hsh_order, model_name, evidence, stack.n)
+    named_hsh = req.model != AUTO and model_name.startswith("hsh")
+    if evidence is None and not named_hsh:
+        # a model named by --model that fit.rti cannot hold: its HSH order is still measured
+        evidence = hsh_evidence(stack, lights)
+    clipped = None
+    if evidence is not None and not named_hsh and stack.saturation_level is not None:
+        kept = hsh_evidence(ImageStack(stack, saturation_level=math.inf), lights)
+        if kept is not None and kept.n_pixels > evidence.n_pixels:  # the rule left some out
+            clipped = kept
+    return hsh_order(req.hsh_order, model_name, evidence, stack.n, clipped)
 
 
 def hsh_evidence(stack: ImageStack, lights: np.ndarray) -> Any:
