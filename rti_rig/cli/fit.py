@@ -71,9 +71,10 @@ def fit(
         int | None,
         typer.Option(
             "--hsh-order",
-            help="The HSH order of fit.rti: 1 (4 terms), 2 (9) or 3 (16). Default: the model "
-            "chosen when it is an HSH, else the lowest order within 5% of the best held-out "
-            "error (5-fold cross-validation over the lights).",
+            help="The HSH order of fit.rti: 1 (4 terms), 2 (9) or 3 (16). Default: the lowest "
+            "order within 5% of the best held-out error (5-fold cross-validation over the "
+            "lights), with clipped highlights kept in that evidence; an HSH --model is written "
+            "as named.",
         ),
     ] = None,
     scheduler: Annotated[

@@ -10,6 +10,7 @@ clipped observations kept 0.99 dB (`benchmarks.fit_rti_order_saturation`, docs/r
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 from fit_sessions import dome_lights, make_session
@@ -26,9 +27,14 @@ def _rti_line(tmp_path: Path, scene: str, **kwargs) -> str:  # type: ignore[no-u
 
 def test_a_glossy_session_s_order_is_chosen_with_its_clipped_values(tmp_path: Path) -> None:
     line = _rti_line(tmp_path, "coin")
-    # the model choice alone (its clipped pixels left out) chose hsh3; with them kept, hsh1
-    assert line.startswith("hsh1:"), line
-    assert "with clipped observations kept" in line and "as saturated" in line
+    # the model choice alone (its clipped pixels left out) chose hsh3, which fit.rti had been
+    # written in; judged with them kept a lower order is within 5 % (hsh1 on this seed, by a
+    # small margin: either lower order passes, the old hsh3 does not)
+    assert line.startswith(("hsh1:", "hsh2:")), line
+    assert "with clipped observations kept" in line and "clip in some image" in line
+    assert "hsh3, the model used, was judged without them" in line
+    share = float(re.search(r"\(([\d.]+)% of the sampled pixels clip", line)[1])  # type: ignore[index]
+    assert 1.0 < share < 50.0
 
 
 def test_a_session_with_nothing_clipped_keeps_the_model_choice_s_order(tmp_path: Path) -> None:

@@ -535,12 +535,14 @@ def rti_order(
     if evidence is None and not named_hsh:
         # a model named by --model that fit.rti cannot hold: its HSH order is still measured
         evidence = hsh_evidence(stack, lights)
-    clipped = None
+    clipped, share = None, 0.0
     if evidence is not None and not named_hsh and stack.saturation_level is not None:
-        kept = hsh_evidence(ImageStack(stack, saturation_level=math.inf), lights)
-        if kept is not None and kept.n_pixels > evidence.n_pixels:  # the rule left some out
-            clipped = kept
-    return hsh_order(req.hsh_order, model_name, evidence, stack.n, clipped)
+        # the model choice's sample (cached: no second read), and how much of it clips
+        values, _ = stack.pixel_sample(SAMPLE_PIXELS)
+        share = float(np.any(values >= stack.saturation_level, axis=(0, 2)).mean())
+        if share > 0.0:  # the choice left those values out: judge the orders with them kept
+            clipped = hsh_evidence(ImageStack(stack, saturation_level=math.inf), lights)
+    return hsh_order(req.hsh_order, model_name, evidence, stack.n, clipped, share)
 
 
 def hsh_evidence(stack: ImageStack, lights: np.ndarray) -> Any:

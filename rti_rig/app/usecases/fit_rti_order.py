@@ -15,7 +15,12 @@ HSH_FEWEST_LIGHTS = 5
 
 
 def hsh_order(
-    asked: int | None, model: str, choice: Any, n: int, clipped: Any = None
+    asked: int | None,
+    model: str,
+    choice: Any,
+    n: int,
+    clipped: Any = None,
+    clipped_share: float = 0.0,
 ) -> tuple[int | None, str]:
     """The HSH order fit.rti is written in, and why (a line for fit.json and the CLI).
 
@@ -33,14 +38,14 @@ def hsh_order(
     so.
 
     ``clipped``: the HSH orders' held-out evidence on the same pixel sample with the clipped
-    observations kept, given where the model choice left pixels out as saturated: the order is
-    then chosen on it. Why: the model choice drops every pixel saturated in *any* image (a
-    clipped value cannot be held out honestly), which on a glossy object is most of it — 37–53 %
-    of the shared real acquisition's pixels at 18–48 lights — and judged on the matte rest a low
-    order looks enough. The file itself is fitted on the clipped values, and a viewer shows
-    them clipped: kept, the chosen order relit held-out lights 0.99 dB below the best order in
-    hindsight on average instead of 1.75 on that acquisition, 0.77 instead of 1.12 on the
-    simulator's five scenes, never worse on average on any of the six
+    observations kept, given where the model choice left pixels out as saturated (``clipped_share``
+    of the sampled pixels clip in some image): the order is then chosen on it. Why: the model choice
+    drops every pixel saturated in *any* image (a clipped value cannot be held out honestly), which
+    on a glossy object is most of it — 37–53 % of the shared real acquisition's pixels at 18–48
+    lights — and judged on the matte rest a low order looks enough. The file itself is fitted on the
+    clipped values, and a viewer shows them clipped: kept, the chosen order relit held-out lights
+    0.99 dB below the best order in hindsight on average instead of 1.75 on that acquisition, 0.77
+    instead of 1.12 on the simulator's five scenes, never worse on average on any of the six
     (``benchmarks.fit_rti_order_saturation``; docs/reconstruction.md).
     """
     if asked:
@@ -48,11 +53,11 @@ def hsh_order(
     if clipped is not None:
         picked = _lowest_within(clipped)
         if picked is not None:
-            share = 1.0 - choice.n_pixels / clipped.n_pixels if choice is not None else 0.0
             return int(picked.model[-1]), (
                 f"{picked.model}: the lowest HSH order within {clipped.tolerance:.0%} of the best "
-                f"HSH held-out error, with clipped observations kept (the model choice left out "
-                f"{share:.0%} of its sampled pixel values as saturated)"
+                f"HSH held-out error, with clipped observations kept ({clipped_share:.1%} of the "
+                f"sampled pixels clip in some image; the model choice leaves them out, and "
+                f"{model}, the model used, was judged without them)"
             )
     if model.startswith("hsh"):
         return int(model[-1]), f"{model}: the model chosen"
