@@ -51,37 +51,39 @@ def hsh_order(
     if asked:
         return asked, f"hsh{asked}: asked for"
     if clipped is not None:
-        picked = _lowest_within(clipped)
+        picked = _from_evidence(
+            clipped,
+            f", with clipped observations kept ({clipped_share:.1%} of the sampled pixels clip "
+            f"in some image; the model choice leaves them out, and {model}, the model used, was "
+            "judged without them)",
+        )
         if picked is not None:
-            return int(picked.model[-1]), (
-                f"{picked.model}: the lowest HSH order within {clipped.tolerance:.0%} of the best "
-                f"HSH held-out error, with clipped observations kept ({clipped_share:.1%} of the "
-                f"sampled pixels clip in some image; the model choice leaves them out, and "
-                f"{model}, the model used, was judged without them)"
-            )
+            return picked
     if model.startswith("hsh"):
         return int(model[-1]), f"{model}: the model chosen"
     if choice is not None:
-        pick = _lowest_within(choice)
-        if pick is not None:
-            return int(pick.model[-1]), (
-                f"{pick.model}: the lowest HSH order within {choice.tolerance:.0%} of the best "
-                f"HSH held-out error ({model}, the model used, is not an HSH)"
-            )
+        picked = _from_evidence(choice, f" ({model}, the model used, is not an HSH)")
+        if picked is not None:
+            return picked
     return None, (
         f"fit.rti not written: an HSH order is chosen on held-out lights, which needs at least "
         f"{HSH_FEWEST_LIGHTS} lights; there are {n} (--hsh-order 1 writes order 1 from 4)"
     )
 
 
-def _lowest_within(choice: Any) -> Any:
+def _from_evidence(choice: Any, why: str) -> tuple[int, str] | None:
     """The lowest HSH order of ``choice``'s evidence within its tolerance of the best HSH
-    order's held-out error, or None where no HSH order was scored."""
+    order's held-out error, and the reason (``why`` appended); None where no HSH order was
+    scored."""
     scored = [e for e in choice.evidence if e.model.startswith("hsh") and e.rmse is not None]
     if not scored:
         return None
     best = min(e.rmse for e in scored)
-    return min(
+    pick = min(
         (e for e in scored if e.rmse <= best * (1.0 + choice.tolerance)),
         key=lambda e: e.n_coefficients,
+    )
+    return int(pick.model[-1]), (
+        f"{pick.model}: the lowest HSH order within {choice.tolerance:.0%} of the best HSH "
+        f"held-out error{why}"
     )
