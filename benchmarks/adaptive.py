@@ -563,6 +563,14 @@ def configure_planner(args: argparse.Namespace) -> None:
     if args.relight_basis is not None:  # the name the chooser calls (no constant: not shipped)
         basis = args.relight_basis
         adaptive_planner.relight_basis = lambda n_total: basis
+    if args.start_above_floor is not None:
+        from rti_rig.planner.adaptive_relight import OBJECTIVES
+
+        named = tuple(x for x in args.start_above_floor.split(",") if x and x != "none")
+        unknown = [x for x in named if x not in OBJECTIVES]
+        if unknown:
+            raise SystemExit(f"--start-above-floor: unknown objective {', '.join(unknown)}")
+        adaptive_planner.START_ABOVE_FLOOR = named
     if args.start != "default":  # after the default floor: a hedged start is of its layout
         from benchmarks.adaptive_reach import start_functions
 
@@ -600,6 +608,13 @@ def build_parser() -> argparse.ArgumentParser:
         default="default",
         choices=("default", "hedge-all", "hedge-20", "hedge-10", "shared-3"),
         help="the starting lights with N known (benchmarks.adaptive_reach; default: what ships)",
+    )
+    ap.add_argument(
+        "--start-above-floor",
+        default=None,
+        help="comma-separated objectives whose starting lights are matched only among the "
+        "default layout's lights at or above START_FLOOR_DEG, 'none' for none "
+        "(planner.adaptive.START_ABOVE_FLOOR; default what ships, relight)",
     )
     ap.add_argument(
         "--floors",

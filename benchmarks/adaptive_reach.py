@@ -19,16 +19,25 @@ exactly that layout):
   closest to a homogeneous layout of 4 (lexicographic);
 * ``hedge-20``: the same with the 20° layout only;
 * ``shared-3``: 3 lights that both the default and the 20° layouts hold (where they share 3;
-  else ``default``): both designs stay exactly reachable, the first decision is on 3 images.
+  else ``default``): both designs stay exactly reachable, the first decision is on 3 images;
+* ``above-floor``: matched only among the default layout's lights at or above
+  ``START_FLOOR_DEG`` (what ships for ``--objective relight`` since format 9), and
+  ``all-lights``: among all of them (what ships for the normals objective; up to format 8 for
+  both) — whatever the objective.
+
+``--measure relight`` scores every layout by the relighting PSNR of the fit.rti `rti-rig fit`
+writes (as ``benchmarks.adaptive``'s table "of the file a user opens") instead of the normal
+error, the starts placed as for ``--objective relight``; its table goes to its own section.
 
 ``--families``: instead, from the shipped start, the oracle of wider design families —
 completions to more floors, ``optimal`` conditioned on the starting lights (on the surface
 fitted to the starting images, ``planner.adaptive_optimal``, or on the benchmark's preview),
 and in cells given by ``--ceiling scene:N,...`` a greedy exchange on the true error (slow).
 
-Run: ``python -m benchmarks.adaptive_reach [--draws K] [--scenes a,b] [--families [--ceiling
-coin:9,...]] [--write]`` (about 1–2 min on 2 idle cores, ``--families`` 3 min, with the
-ceiling of three cells 10 min; ``--write`` puts the table into docs/adaptive.md).
+Run: ``python -m benchmarks.adaptive_reach [--draws K] [--scenes a,b] [--measure
+normals|relight] [--families [--ceiling coin:9,...]] [--write]`` (about 20 s for 8 draws on 2
+idle cores, ``--measure relight`` with 16 draws 18 min under load 4, ``--families`` 3 min,
+with the ceiling of three cells 10 min; ``--write`` puts the table into docs/adaptive.md).
 """
 
 from __future__ import annotations
@@ -95,6 +104,29 @@ def shared_three_start(
         return dome_start(geometry, k, n_total)
     pick = adaptive.start_subset(geometry.directions[both], 3)
     return sorted(int(both[i]) for i in pick)
+
+
+def _start_rule(above_floor: bool):  # type: ignore[no-untyped-def]
+    def start(
+        geometry: DomeGeometry, k: int, n_total: int | None, objective: str = "normals"
+    ) -> list[int]:
+        if n_total is None or n_total <= k:
+            return dome_start(geometry, k, n_total, objective)
+        full = select_uniform_leds(geometry, n_total, adaptive.default_floor_for(objective))
+        pick = adaptive.start_subset(
+            geometry.directions[full], k, objective=objective, above_floor=above_floor
+        )
+        return [int(full[i]) for i in pick]
+
+    return start
+
+
+#: The start matched only among the default layout's lights at or above ``START_FLOOR_DEG``
+#: (what ships for ``--objective relight`` since format 9), whatever the objective.
+above_floor_start = _start_rule(True)
+#: The start matched among all the default layout's lights (what ships for the normals
+#: objective; up to format 8 for both): it may take a light below ``START_FLOOR_DEG``.
+all_lights_start = _start_rule(False)
 
 
 def _layout_error(data):  # type: ignore[no-untyped-def]
@@ -206,16 +238,55 @@ def start_functions() -> dict:  # type: ignore[type-arg]
         "hedge-20": lambda g, k, n, objective="normals": hedged_start(g, k, n, (20.0,)),
         "hedge-10": lambda g, k, n, objective="normals": hedged_start(g, k, n, (10.0,)),
         "shared-3": shared_three_start,
+        "above-floor": above_floor_start,
+        "all-lights": all_lights_start,
     }
 
 
-def reach(draws: int, scenes: tuple[str, ...] = (), seed: int = 0) -> list[str]:
+#: What ``reach`` scores a layout by: the true mean normal error (°, lower is better), or the
+#: relighting PSNR (dB, higher is better) of the fit.rti `rti-rig fit` writes from it (its HSH
+#: order chosen by the fit's own code, ``benchmarks.planner_real_data.written_rti_psnr``) on
+#: the lights none of the compared layouts took — as ``benchmarks.adaptive``'s table "of the
+#: file a user opens" scores it.
+MEASURES = ("normals", "relight")
+
+
+def _layout_scores(data, measure: str):  # type: ignore[no-untyped-def]
+    """``score(layouts: {key: candidate indices}) -> {key: value}`` for one draw and N."""
+    if measure == "normals":
+        err = _layout_error(data)
+        return lambda layouts: {k: err(v) for k, v in layouts.items()}
+    from benchmarks.adaptive import common_held_out
+    from benchmarks.planner_real_data import written_rti_psnr
+    from rti_rig.planner.topography import REC709
+
+    lum = data.candidate_images @ REC709.astype(np.float32)
+    cand = data.candidate_dirs
+
+    def psnr(layouts: dict) -> dict:  # type: ignore[type-arg]
+        held = common_held_out(len(cand), layouts)
+        out = {}
+        for k, idx in layouts.items():
+            idx = np.sort(idx)  # in index order, as benchmarks.adaptive scores every layout
+            out[k] = written_rti_psnr(
+                lum[idx], cand[idx], lum[held], cand[held], chosen_on=data.candidate_images[idx]
+            )[1]
+        return out
+
+    return psnr
+
+
+def reach(
+    draws: int, scenes: tuple[str, ...] = (), seed: int = 0, measure: str = "normals"
+) -> list[str]:
     """Table rows: per scene and N, the tuned bar and, per start, each floor's completion (mean
-    over draws) and the oracle."""
+    over draws) and the oracle (``measure``: one of :data:`MEASURES`)."""
     from benchmarks.tradeoff import TradeoffSettings, render_scene_data
 
     settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     starts = start_functions()
+    objective = "relight" if measure == "relight" else "normals"
+    sign = -1.0 if measure == "relight" else 1.0  # lower sign × score is better
     rows = []
     for si, scene in enumerate(settings.scenes):
         if scenes and scene not in scenes:
@@ -223,15 +294,14 @@ def reach(draws: int, scenes: tuple[str, ...] = (), seed: int = 0) -> list[str]:
         rng = np.random.default_rng([seed, si])  # the draws of benchmarks.adaptive
         data = render_scene_data(scene, settings)
         cand = data.candidate_dirs
-
-        err = _layout_error(data)
+        score = _layout_scores(data, measure)
         res: dict[tuple[int, str], list[float]] = {}
         for _ in range(draws):
             keep, sub = _draw_lights(rng, len(cand), cand)
             for n in NS:
-                _score_floors(res, n, keep, sub, err)
+                layouts = {f"hom {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
                 for name, fn in starts.items():
-                    st = fn(sub, adaptive.START_LIGHTS, n)  # first decision after len(st)
+                    st = fn(sub, adaptive.START_LIGHTS, n, objective)  # decided after len(st)
                     avail = np.ones(len(keep), dtype=bool)
                     avail[st] = False
                     for f in FLOORS:
@@ -239,18 +309,25 @@ def reach(draws: int, scenes: tuple[str, ...] = (), seed: int = 0) -> list[str]:
                             cand[keep], avail, cand[keep][st], n, f
                         )
                         assert comp is not None
-                        res.setdefault((n, f"{name} {f:g}"), []).append(err(keep[np.r_[st, comp]]))
-        tuned = min(FLOORS, key=lambda f: np.mean([np.mean(res[(n, f"hom {f:g}")]) for n in NS]))
+                        layouts[f"{name} {f:g}"] = keep[np.r_[st, comp]]
+                for k, v in score(layouts).items():
+                    res.setdefault((n, k), []).append(v)
+
+        def mean_over_n(f: float, res: dict = res) -> float:  # type: ignore[type-arg]
+            return sign * float(np.mean([np.mean(res[(n, f"hom {f:g}")]) for n in NS]))
+
+        tuned = min(FLOORS, key=mean_over_n)
         for n in NS:
             bar = float(np.mean(res[(n, f"hom {tuned:g}")]))
             cells = []
             for name in starts:
                 per = np.array([res[(n, f"{name} {f:g}")] for f in FLOORS])  # (F, draws)
-                oracle = float(per.min(axis=0).mean())
+                oracle = sign * float((sign * per).min(axis=0).mean())
                 fixed = " ".join(f"{v:.3g}" for v in per.mean(axis=1))
-                flag = " **above the bar**" if oracle > bar * (1 + 1e-9) else ""
-                cells.append(f"{fixed}; oracle {oracle:.3g}{flag}")
-            rows.append(f"| {scene} | {n} | {tuned:g}°: {bar:.3g} | " + " | ".join(cells) + " |")
+                short = sign * oracle > sign * bar + 1e-9 * abs(bar)
+                flag = f" **{'below' if sign < 0 else 'above'} the bar**" if short else ""
+                cells.append(f"{fixed}; oracle {oracle:.4g}{flag}")
+            rows.append(f"| {scene} | {n} | {tuned:g}°: {bar:.4g} | " + " | ".join(cells) + " |")
         print(f"{scene} done", flush=True)
     return rows
 
@@ -420,33 +497,55 @@ def main(argv: list[str] | None = None) -> str:
         help="with --families: cells scene:N (comma-separated) that also get a greedy exchange "
         "on the true error (slow)",
     )
+    ap.add_argument(
+        "--measure",
+        choices=MEASURES,
+        default="normals",
+        help="score layouts by normal error (default) or by the relighting PSNR of the fit.rti "
+        "`rti-rig fit` writes",
+    )
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     if args.families:
         return _families_main(args, t0)
-    rows = reach(args.draws, tuple(x for x in args.scenes.split(",") if x))
+    rows = reach(args.draws, tuple(x for x in args.scenes.split(",") if x), measure=args.measure)
     floors = "/".join(f"{f:g}°" for f in FLOORS)
+    starts = list(start_functions())
+    what = (
+        "the true mean normal error (°)"
+        if args.measure == "normals"
+        else "the relighting PSNR (dB) of the fit.rti `rti-rig fit` writes (its HSH order "
+        "chosen by the fit's own code; on the lights none of the compared layouts took)"
+    )
+    option = "" if args.measure == "normals" else f" --measure {args.measure}"
     md = "\n".join(
         [
-            f"Command: `python -m benchmarks.adaptive_reach --draws {args.draws} --write` "
+            f"Command: `python -m benchmarks.adaptive_reach --draws {args.draws}{option} --write` "
             f"({time.perf_counter() - t0:.0f} s; load average {os.getloadavg()[0]:.1f} at the "
             "end). " + machine_line(),
             "",
             f"Simulator, {args.draws} paired draws (the draws of `benchmarks.adaptive`). Per "
-            f"start: the true mean normal error (°) of the design completed above {floors} when "
+            f"start: {what} of the design completed above {floors} when "
             "decided at the first decision (after the starting lights: 4 images, 3 for "
             "`shared-3` where it applies), then the oracle (the best floor per draw: a "
-            "perfect model). The bar: the hindsight-tuned homogeneous layout.",
+            "perfect model). The bar: the hindsight-tuned homogeneous layout. `default` is "
+            "the start that ships for the measure's objective; `above-floor` matches the start "
+            f"only among the default layout's lights at or above {adaptive.START_FLOOR_DEG:g}° "
+            "(what ships for relighting), `all-lights` among all of them (what ships for "
+            "normals, and up to format 8 for both).",
             "",
-            "| scene | N | bar | start `default` (ships) | start `hedge-all` | start `hedge-20` | "
-            "start `shared-3` |",
-            "|---|---|---|---|---|---|---|",
+            "| scene | N | bar | " + " | ".join(f"start `{s}`" for s in starts) + " |",
+            "|---|---|---|" + "---|" * len(starts),
             *rows,
         ]
     )
     print(md)
     if args.write:
-        write_section("adaptive_reach", md, DOC)
+        write_section(
+            "adaptive_reach" if args.measure == "normals" else f"adaptive_reach_{args.measure}",
+            md,
+            DOC,
+        )
     return md
 
 

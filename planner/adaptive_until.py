@@ -19,7 +19,7 @@ guess is complete, the guess grows to the next size, whose design completes the 
 far. Each stop check happens after every light, so a session never shoots more than one light
 past the point where its estimate reaches the target.
 
-The stop (format ``rti-rig-adaptive/8``) claims the target only when an *upper* estimate is
+The stop (since format ``rti-rig-adaptive/8``) claims the target only when an *upper* estimate is
 under it (:func:`upper_error_deg`): the point estimate (the simulated error ×
 ``SIM_ESTIMATE_SCALE``, a least-squares factor: right on average, off by ×0.55–×2 on single
 scenes) times :data:`UPPER_FACTOR`, a quantile of measured / estimated over the simulator's

@@ -216,7 +216,7 @@ def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(
     "old",
-    [f"rti-rig-adaptive/{k}" for k in range(1, 8)],
+    [f"rti-rig-adaptive/{k}" for k in range(1, 9)],
 )
 def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     uninterrupted: tuple[Path, Path], tmp_path: Path, old: str
@@ -238,7 +238,7 @@ def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2, r.output
     text = " ".join(r.output.split())
-    assert f"'{old}'" in text and "rti-rig-adaptive/8" in text
+    assert f"'{old}'" in text and "rti-rig-adaptive/9" in text
     assert "export-lp" in text and "new session" in text
     # refused from the manifest: nothing in the folder changed (journal not repaired, nothing
     # set aside), not a byte

@@ -95,7 +95,7 @@ def test_each_light_is_chosen_within_the_design_for_the_guessed_n(
 ) -> None:
     _, out = never_reached
     m = manifest(out)
-    assert m["adaptive"]["format"] == "rti-rig-adaptive/8"
+    assert m["adaptive"]["format"] == "rti-rig-adaptive/9"
     assert m["adaptive"]["design_lights"] is None  # N unknown
     steps = journal(out)
     assert len(steps) == 12 == len(read_lp(out / "lights.lp"))

@@ -3,6 +3,7 @@ anything (it crashed in the paired test after minutes of simulation)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from benchmarks import adaptive
@@ -28,6 +29,7 @@ def planner_constants(monkeypatch: pytest.MonkeyPatch):  # type: ignore[no-untyp
         "FITTED_SEED_FLOORS",
         "DESIGN_FLOORS",
         "DESIGN_DEFAULT_FLOOR",
+        "START_ABOVE_FLOOR",
     ):
         monkeypatch.setattr(planner, name, getattr(planner, name))
     monkeypatch.setitem(adaptive.START, "start", adaptive.START["start"])
@@ -96,3 +98,30 @@ def test_relight_basis_sets_what_the_chooser_scores_designs_by(
     assert planner.relight_basis(9) == "ptm"  # the richest basis 9 lights determine
     adaptive.configure_planner(adaptive.build_parser().parse_args(["--relight-basis", "hsh1"]))
     assert planner.relight_basis(9) == planner.relight_basis(18) == "hsh1"
+
+
+def test_start_above_floor_sets_which_objectives_start_above_it(planner_constants) -> None:
+    """``--start-above-floor normals,relight`` (the variant measured against what ships): the
+    normals objective's start then keeps above START_FLOOR_DEG too; ``none`` for neither; an
+    unknown objective is refused by name."""
+    from rti_rig.app.usecases.adaptive import dome_start
+    from rti_rig.core.geometry import fibonacci_cap
+    from rti_rig.core.rig_geometry import DomeGeometry
+
+    planner = planner_constants
+    assert planner.START_ABOVE_FLOOR == ("relight",)  # what ships
+    dome = DomeGeometry(fibonacci_cap(240, 0.0), tuple(f"l{i}" for i in range(240)))
+    el = np.degrees(np.arcsin(dome.directions[:, 2]))
+    assert el[dome_start(dome, 4, 9, "normals")].min() < planner.START_FLOOR_DEG
+    adaptive.configure_planner(
+        adaptive.build_parser().parse_args(["--start-above-floor", "normals,relight"])
+    )
+    assert planner.START_ABOVE_FLOOR == ("normals", "relight")
+    assert el[dome_start(dome, 4, 9, "normals")].min() >= planner.START_FLOOR_DEG
+    adaptive.configure_planner(adaptive.build_parser().parse_args(["--start-above-floor", "none"]))
+    assert planner.START_ABOVE_FLOOR == ()
+    assert el[dome_start(dome, 4, 9, "relight")].min() < planner.START_FLOOR_DEG
+    with pytest.raises(SystemExit, match="unknown objective gloss"):
+        adaptive.configure_planner(
+            adaptive.build_parser().parse_args(["--start-above-floor", "gloss"])
+        )

@@ -96,3 +96,61 @@ def test_the_true_error_ceiling_is_never_worse_than_its_start() -> None:
     got = _true_greedy(err, keep, np.array([0, 1]), start, avail)
     assert got <= err(keep[np.r_[[0, 1], start]])
     assert got < 0.05  # the exchange found the low lights
+
+
+@pytest.mark.parametrize("objective", ["normals", "relight"])
+@pytest.mark.parametrize("n", [6, 9, 12, 18])
+def test_the_start_variants_are_the_two_rules_whatever_the_objective(
+    n: int, objective: str
+) -> None:
+    """``above-floor`` (what ships for relighting) keeps every starting light at or above
+    START_FLOOR_DEG, ``all-lights`` (what ships for normals) took one below it on this dome;
+    both are 4 lights of the default layout (its design stays reachable), and ``default`` is
+    whichever ships for the objective."""
+    from benchmarks.adaptive_reach import above_floor_start, all_lights_start
+    from rti_rig.planner.adaptive import START_ABOVE_FLOOR, START_FLOOR_DEG
+
+    dome = _dome(0)
+    default = {int(i) for i in select_uniform_leds(dome, n, DESIGN_DEFAULT_FLOOR)}
+    above, every = above_floor_start(dome, 4, n, objective), all_lights_start(dome, 4, n, objective)
+    assert set(above) <= default and set(every) <= default and len(set(above)) == 4
+    el = np.degrees(np.arcsin(dome.directions[:, 2]))
+    assert el[every].min() < START_FLOOR_DEG <= el[above].min()
+    shipped = above if objective in START_ABOVE_FLOOR else every
+    assert dome_start(dome, 4, n, objective) == shipped
+
+
+def test_the_relight_measure_scores_every_layout_on_lights_none_of_them_took() -> None:
+    """``--measure relight``: each layout's fit.rti (as `rti-rig fit` writes it) relit to the
+    lights none of the compared layouts took (a layout joining the comparison changes that set,
+    not the method); the normals measure scores the same layouts by their normal error."""
+    from types import SimpleNamespace
+
+    from benchmarks.adaptive_reach import _layout_scores
+
+    dirs = fibonacci_cap(60, 5.0)
+    rng = np.random.default_rng(3)
+    albedo = 0.3 + 0.4 * rng.random((12, 12, 3))
+    normal = np.array([0.2, 0.1, 1.0]) / np.linalg.norm([0.2, 0.1, 1.0])
+    shade = np.maximum(dirs @ normal, 0.0)[:, None, None, None]
+    images = (shade * albedo[None]).astype(np.float32)
+    data = SimpleNamespace(candidate_images=images, candidate_dirs=dirs)
+    score = _layout_scores(data, "relight")
+    layouts = {"a": np.arange(0, 60, 10), "b": np.arange(1, 60, 4)}
+    got = score(layouts)
+    assert set(got) == {"a", "b"} and all(np.isfinite(v) and v > 20.0 for v in got.values())
+    from benchmarks.planner_real_data import written_rti_psnr
+    from rti_rig.planner.topography import REC709
+
+    lum = images @ REC709.astype(np.float32)
+    held = np.setdiff1d(np.arange(60), np.r_[layouts["a"], layouts["b"]])
+    a = layouts["a"]
+    want = written_rti_psnr(lum[a], dirs[a], lum[held], dirs[held], chosen_on=images[a])[1]
+    assert got["a"] == want
+    # another layout joining the comparison changes the held-out set, not the method
+    more = score({**layouts, "c": np.arange(2, 60, 7)})
+    assert set(more) == {"a", "b", "c"}
+    normals = _layout_scores(
+        SimpleNamespace(**vars(data), normals=np.broadcast_to(normal, (12, 12, 3))), "normals"
+    )
+    assert set(normals(layouts)) == {"a", "b"}

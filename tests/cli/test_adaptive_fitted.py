@@ -1,6 +1,6 @@
 """The fitted design (``optimal`` on the surface fitted so far, ``planner.adaptive_optimal``)
 offered by default through the front door: `rti-rig run ACQ/dirs.lp --adaptive --lights N`
-records the decisions that take it as ``"design": "fitted"`` (format rti-rig-adaptive/8; /5
+records the decisions that take it as ``"design": "fitted"`` (format rti-rig-adaptive/9; /5
 before the relight objective was offered its own), and an interrupted session that took it
 resumes to the very same session."""
 
@@ -32,7 +32,7 @@ def whole(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_by_default_a_session_records_the_fitted_decisions_it_takes(whole: Path) -> None:
     manifest = json.loads((whole / "manifest.json").read_text())
-    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/8"
+    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/9"
     adaptive = [d for d in decisions(whole) if d["kind"] == "adaptive"]
     assert len(adaptive) == N - 4
     # offered at every design decision, scored beside the floors

@@ -45,7 +45,7 @@ def test_the_relight_objective_is_in_the_settings_and_every_decision(relight_ses
     assert all(s["decision"]["objective"] == "relight" for s in steps)
     header = manifest(relight_session)["adaptive"]
     assert header["result"]["objective"] == "relight"
-    assert header["objective"] == "relight" and header["format"] == FORMAT == "rti-rig-adaptive/8"
+    assert header["objective"] == "relight" and header["format"] == FORMAT == "rti-rig-adaptive/9"
     for s in steps[4:]:
         d = s["decision"]
         assert d["kind"] == "adaptive" and d["design_objective"] == "relight"
@@ -63,6 +63,21 @@ def test_the_relight_objective_is_in_the_settings_and_every_decision(relight_ses
     assert [s["decision"] for s in manifest(relight_session)["steps"]] == [
         s["decision"] for s in steps
     ]
+
+
+def test_the_starting_lights_are_above_the_start_floor(relight_session: Path) -> None:
+    """Through the front door on the shipped dome: the 4 lights shot before anything is known
+    are all at or above START_FLOOR_DEG, in the order lights.lp lists what fired (format 9; the
+    10° layout of 8 on this dome has a 10° light, which a /8 session shot first)."""
+    import numpy as np
+
+    from rti_rig.core.lp_format import directions_of, read_lp
+    from rti_rig.planner.adaptive import START_FLOOR_DEG, START_LIGHTS
+
+    dirs = directions_of(read_lp(relight_session / "lights.lp"))
+    el = np.degrees(np.arcsin(dirs[:, 2]))
+    assert len(el) == 8
+    assert el[:START_LIGHTS].min() >= START_FLOOR_DEG - 1e-6
 
 
 def test_the_default_objective_is_normals_and_says_so(tmp_path: Path) -> None:

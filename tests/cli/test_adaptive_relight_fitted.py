@@ -1,7 +1,7 @@
 """The fitted relight design (``optimal --objective relight`` on the object model fitted so far,
 ``planner.adaptive_relight_design``) offered to ``--objective relight`` through the front door:
 `rti-rig run RIG --adaptive --lights N --objective relight` scores it beside the floors' designs
-at every decision (format rti-rig-adaptive/8), records a decision that takes it as
+at every decision (format rti-rig-adaptive/9), records a decision that takes it as
 ``"design": "fitted"``, and an interrupted session that took it resumes to the same session."""
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path
     )
     assert r.exit_code == 0, r.output
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/8"
+    assert manifest["adaptive"]["format"] == "rti-rig-adaptive/9"
     adaptive = [d for d in decisions(out) if d["kind"] == "adaptive"]
     assert len(adaptive) == 2
     for d in adaptive:

@@ -57,6 +57,35 @@ def test_the_start_is_part_of_the_layout_and_the_default_design_completes_it() -
     assert sorted([*start, *rest.tolist()]) == sorted(full.tolist())
 
 
+@pytest.mark.parametrize("n", [6, 9, 12, 18])
+def test_a_relight_start_takes_no_light_below_its_floor(n: int) -> None:
+    """With --objective relight the 4 starting lights (shot before anything is known) are none
+    below START_FLOOR_DEG, although the default layout (10°) has lights there; the normals
+    objective's start is matched among all the layout's lights and, on this dome, takes one.
+    Up to format 8 both did: the 16° light of the relight start was in every design the
+    session could complete, so the 20° and 30° layouts were out of reach."""
+    g = DomeGeometry(fibonacci_cap(240, 0.0), tuple(f"l{i}" for i in range(240)))
+    full = select_uniform_leds(g, n, 10.0)
+    layout = g.directions[full]
+    el = np.degrees(np.arcsin(layout[:, 2]))
+    assert el.min() < adaptive.START_FLOOR_DEG  # the layout has low lights
+    start = start_subset(layout, 4, objective="relight")
+    assert len(set(start)) == 4 and el[start].min() >= adaptive.START_FLOOR_DEG
+    # still spread over the dome (a robust photometric stereo start): no two within 30°
+    angles = np.degrees(np.arccos(np.clip(layout[start] @ layout[start].T, -1.0, 1.0)))
+    assert angles[~np.eye(4, dtype=bool)].min() > 30.0
+    normals = start_subset(layout, 4, objective="normals")
+    assert len(set(normals)) == 4 and el[normals].min() < adaptive.START_FLOOR_DEG
+    assert start_subset(layout, 4, objective="normals", above_floor=True) == start
+
+
+def test_a_layout_with_too_few_lights_above_the_floor_starts_with_its_highest() -> None:
+    layout = fibonacci_cap(8, 0.0, 25.0)  # at most a few above 20°
+    el = np.degrees(np.arcsin(layout[:, 2]))
+    assert (el >= adaptive.START_FLOOR_DEG).sum() < 4
+    assert start_subset(layout, 4, objective="relight") == sorted(np.argsort(-el)[:4].tolist())
+
+
 def test_it_falls_back_to_the_default_design_unless_another_is_clearly_better() -> None:
     g = dome()
     full = select_uniform_leds(g, 9, 10.0)

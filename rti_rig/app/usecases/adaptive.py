@@ -95,12 +95,15 @@ ARM_MAX_LIGHTS = 100
 #: every decision, the stop and the result record both estimates and the factor
 #: (``upper_error_deg``, ``upper_factor``; a /7 session stopped on the point estimate); the
 #: settings record every decision constant (``constants``, checked on resume), and a relight
-#: design with no light left out records a null PSNR.
-FORMAT = "rti-rig-adaptive/8"
-#: Format 8 with ``--min-lights``: the same decisions, a stop held until the minimum. Its own
+#: design with no light left out records a null PSNR. 9: with N known and ``--objective
+#: relight``, the starting lights are matched only among the default layout's lights at or
+#: above ``START_FLOOR_DEG`` (``planner.adaptive.START_ABOVE_FLOOR``, ``start_subset``; a /8
+#: relight session could start on a light below 20°, and a resume of it would shoot others).
+FORMAT = "rti-rig-adaptive/9"
+#: Format 9 with ``--min-lights``: the same decisions, a stop held until the minimum. Its own
 #: label so that a build that does not know the minimum refuses the session by name instead of
 #: resuming it without (and claiming the target at 4 lights). This build continues both.
-FORMAT_MIN_LIGHTS = "rti-rig-adaptive/8+min-lights"
+FORMAT_MIN_LIGHTS = "rti-rig-adaptive/9+min-lights"
 #: Whether designs (``--lights N``) are scored by a robust fit simulated on this object's
 #: model (gloss, cast shadows, noise: ``planner.adaptive_bias``) rather than the variance bound.
 BIAS_AWARE = True
@@ -620,7 +623,7 @@ def dome_start(
     from rti_rig.planner import adaptive
 
     full = select_uniform_leds(geometry, n_total, adaptive.default_floor_for(objective))
-    return [int(full[i]) for i in start_subset(geometry.directions[full], k)]
+    return [int(full[i]) for i in start_subset(geometry.directions[full], k, objective=objective)]
 
 
 def adaptive_plan(  # type: ignore[no-untyped-def]
@@ -661,7 +664,8 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
         targets = geometry.homogeneous(n_design or k0, floor)
         snapped = snap_unique(targets, Candidates(dirs, None, None))
         if n_design is not None and n_design > k0:
-            snapped = [snapped[i] for i in start_subset(dirs[np.asarray(snapped)], k0)]
+            pick = start_subset(dirs[np.asarray(snapped)], k0, objective=objective)
+            snapped = [snapped[i] for i in pick]
         start = [int(i) for i in snapped]
     return AdaptivePlan(dirs, leds, start, max_lights, n_design)
 
