@@ -571,6 +571,14 @@ def configure_planner(args: argparse.Namespace) -> None:
         if unknown:
             raise SystemExit(f"--start-above-floor: unknown objective {', '.join(unknown)}")
         adaptive_planner.START_ABOVE_FLOOR = named
+    if args.no_saturation:
+        import rti_rig.planner.adaptive_relight as adaptive_relight
+
+        adaptive_relight.SATURATION = None
+    if args.per_design_held_out:
+        import rti_rig.planner.adaptive_relight as adaptive_relight
+
+        adaptive_relight.SHARED_HELD_OUT = False
     if args.start != "default":  # after the default floor: a hedged start is of its layout
         from benchmarks.adaptive_reach import start_functions
 
@@ -615,6 +623,18 @@ def build_parser() -> argparse.ArgumentParser:
         help="comma-separated objectives whose starting lights are matched only among the "
         "default layout's lights at or above START_FLOOR_DEG, 'none' for none "
         "(planner.adaptive.START_ABOVE_FLOOR; default what ships, relight)",
+    )
+    ap.add_argument(
+        "--no-saturation",
+        action="store_true",
+        help="the relight score's renderings unclipped (planner.adaptive_relight.SATURATION "
+        "None; clipped at the images' top code in what ships)",
+    )
+    ap.add_argument(
+        "--per-design-held-out",
+        action="store_true",
+        help="judge each relight design on the lights it leaves out, not on those none of the "
+        "designs takes (planner.adaptive_relight.SHARED_HELD_OUT False)",
     )
     ap.add_argument(
         "--floors",

@@ -276,6 +276,32 @@ def _layout_scores(data, measure: str):  # type: ignore[no-untyped-def]
     return psnr
 
 
+def scene_rows(scene: str, res: dict, starts: list[str], measure: str = "normals") -> list[str]:  # type: ignore[type-arg]
+    """One scene's table rows from ``res`` ({(N, "hom F" or "start F"): [score per draw]}):
+    the bar (the homogeneous layout of the floor best on the mean over N: the lowest error, or
+    with ``measure`` "relight" the highest PSNR), each start's completions (mean over draws)
+    and its oracle (the best floor per draw), flagged where it falls short of the bar."""
+    sign = -1.0 if measure == "relight" else 1.0  # lower sign × score is better
+
+    def mean_over_n(f: float) -> float:
+        return sign * float(np.mean([np.mean(res[(n, f"hom {f:g}")]) for n in NS]))
+
+    tuned = min(FLOORS, key=mean_over_n)
+    rows = []
+    for n in NS:
+        bar = float(np.mean(res[(n, f"hom {tuned:g}")]))
+        cells = []
+        for name in starts:
+            per = np.array([res[(n, f"{name} {f:g}")] for f in FLOORS])  # (F, draws)
+            oracle = sign * float((sign * per).min(axis=0).mean())
+            fixed = " ".join(f"{v:.3g}" for v in per.mean(axis=1))
+            short = sign * oracle > sign * bar + 1e-9 * abs(bar)
+            flag = f" **{'below' if sign < 0 else 'above'} the bar**" if short else ""
+            cells.append(f"{fixed}; oracle {oracle:.4g}{flag}")
+        rows.append(f"| {scene} | {n} | {tuned:g}°: {bar:.4g} | " + " | ".join(cells) + " |")
+    return rows
+
+
 def reach(
     draws: int, scenes: tuple[str, ...] = (), seed: int = 0, measure: str = "normals"
 ) -> list[str]:
@@ -286,7 +312,6 @@ def reach(
     settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     starts = start_functions()
     objective = "relight" if measure == "relight" else "normals"
-    sign = -1.0 if measure == "relight" else 1.0  # lower sign × score is better
     rows = []
     for si, scene in enumerate(settings.scenes):
         if scenes and scene not in scenes:
@@ -313,21 +338,7 @@ def reach(
                 for k, v in score(layouts).items():
                     res.setdefault((n, k), []).append(v)
 
-        def mean_over_n(f: float, res: dict = res) -> float:  # type: ignore[type-arg]
-            return sign * float(np.mean([np.mean(res[(n, f"hom {f:g}")]) for n in NS]))
-
-        tuned = min(FLOORS, key=mean_over_n)
-        for n in NS:
-            bar = float(np.mean(res[(n, f"hom {tuned:g}")]))
-            cells = []
-            for name in starts:
-                per = np.array([res[(n, f"{name} {f:g}")] for f in FLOORS])  # (F, draws)
-                oracle = sign * float((sign * per).min(axis=0).mean())
-                fixed = " ".join(f"{v:.3g}" for v in per.mean(axis=1))
-                short = sign * oracle > sign * bar + 1e-9 * abs(bar)
-                flag = f" **{'below' if sign < 0 else 'above'} the bar**" if short else ""
-                cells.append(f"{fixed}; oracle {oracle:.4g}{flag}")
-            rows.append(f"| {scene} | {n} | {tuned:g}°: {bar:.4g} | " + " | ".join(cells) + " |")
+        rows += scene_rows(scene, res, list(starts), measure)
         print(f"{scene} done", flush=True)
     return rows
 

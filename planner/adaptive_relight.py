@@ -65,6 +65,20 @@ RELIGHT_FITTED_DESIGN = True
 #: the 16 coefficients of HSH3) took 0.3–0.44 s (``benchmarks.adaptive_time``, docs), so
 #: larger designs are chosen among the floors alone, as before.
 RELIGHT_FITTED_MAX_LIGHTS = 18
+#: The images' top code in their units (``small_grey`` divides by the white level, and the
+#: camera clips there): the object model's renderings, as the relighting score uses them (the
+#: designs' simulated photographs and the held-out references), are clipped to it, as a
+#: photograph is. Why: with few images the lobe fit can choose a sharp exponent whose strength
+#: only the lobe's tail constrains (a matte tilted plane after its 4 starting images: ks 9e4
+#: at exponent 512); unclipped it rendered held-out lights at 8e4 × white and every floor's
+#: design read −10 to −27 dB at 18 lights, a ranking of noise (docs/adaptive.md, "A rendering
+#: no camera can give"). None: unclipped (up to format 9's first builds). The normals score is
+#: not clipped: its robust fit discards such highlights, and clipping it was measured worse.
+SATURATION: float | None = 1.0
+#: Judge every design's relighting on the same lights: those still available that none of the
+#: designs takes (:func:`shared_held_out`), as the benchmarks compare layouts since
+#: 2026-11-24. False: each design on the lights it leaves out (up to format 9's first builds).
+SHARED_HELD_OUT = True
 #: PSNR reported for a perfect relighting (as ``benchmarks.metrics.PSNR_CAP_DB``).
 PSNR_CAP_DB = 100.0
 
@@ -82,6 +96,11 @@ def relight_basis(n_total: int) -> str:
     lights was measured (``benchmarks.adaptive --relight-basis hsh1``; docs/adaptive.md): no loss
     of either table removed, four wins of this one lost."""
     return models_for(n_total)[-1]
+
+
+def saturated(clean: NDArray) -> NDArray:
+    """The model's rendering as a camera records it: nothing above :data:`SATURATION`."""
+    return clean if SATURATION is None else np.minimum(clean, SATURATION)
 
 
 def mean_psnr_db(relit: NDArray, reference: NDArray, noise: float | NDArray) -> float:
@@ -116,7 +135,7 @@ def simulate_relight_designs(
     allx = np.concatenate([*designs, *[h for h in held if len(h)]])
     union, inverse = np.unique(np.round(allx, 9), axis=0, return_inverse=True)
     inverse = inverse.reshape(-1)
-    clean = render(model, union, pix)  # (U, P'): every light rendered once, for all designs
+    clean = saturated(render(model, union, pix))  # (U, P'): every light once, for all designs
     sd = model.noise_sd(clean)  # each observation's noise (a float: the constant)
     noise = light_noise(union, draws, len(pix), sd, seed)  # (draws, U, P')
     n_design = sum(len(d) for d in designs)
@@ -133,7 +152,7 @@ def simulate_relight_designs(
             continue
         scores = []
         for d in range(draws):
-            noisy = np.clip(clean[cols] + noise[d][cols], 0.0, None).astype(np.float32)
+            noisy = np.clip(clean[cols] + noise[d][cols], 0.0, SATURATION).astype(np.float32)
             relit = relight(noisy, lights, ho, basis)
             if relit is None:
                 scores.append(0.0)
@@ -152,6 +171,26 @@ def held_out(
     mask = np.asarray(available, dtype=bool).copy()
     mask[np.asarray(design, dtype=np.intp)] = False
     return candidates[mask]
+
+
+def shared_held_out(
+    candidates: NDArray[np.float64],
+    available: NDArray[np.bool_],
+    designs: list[NDArray[np.intp]],
+) -> list[NDArray[np.float64]]:
+    """Per design, the lights its relighting is judged on: the candidates still available that
+    *none* of the designs takes, the same for every design (as the benchmarks compare layouts
+    since 2026-11-24), so that a design is not ranked higher for taking the one light the
+    model renders worst. Where the designs together take every available light, each design's
+    own held-out lights (:func:`held_out`)."""
+    if not SHARED_HELD_OUT:
+        return [held_out(candidates, available, d) for d in designs]
+    mask = np.asarray(available, dtype=bool).copy()
+    for d in designs:
+        mask[np.asarray(d, dtype=np.intp)] = False
+    if not mask.any():
+        return [held_out(candidates, available, d) for d in designs]
+    return [candidates[mask]] * len(designs)
 
 
 def pick_floor(

@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from rti_rig.core.rti_bases import design_matrix
 from rti_rig.planner.adaptive_bias import SIM_PIXELS, ObjectModel, render
 from rti_rig.planner.adaptive_optimal import pinned_search
+from rti_rig.planner.adaptive_relight import saturated
 from rti_rig.planner.objectives import BIAS_REL
 
 #: Ridge on the basis' normal matrix (as :class:`~rti_rig.planner.objectives.RelightObjective`).
@@ -198,7 +199,7 @@ def fitted_relight_design(
         raise ValueError("the search needs at least one starting completion")
     p = len(model.normals)
     pix = np.arange(0, p, max(1, p // pixels))[:pixels]  # the design score's pixels
-    clean = render(model, candidates, pix)  # (C, P'): cached for the score
+    clean = saturated(render(model, candidates, pix))  # (C, P'), as a camera records it
     held = np.flatnonzero(available)
     layouts = [np.asarray(s, dtype=np.intp) for s in starts]
     if len(held) <= len(layouts[0]):  # every light left is in the design: nothing to relight

@@ -216,7 +216,7 @@ def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(
     "old",
-    [f"rti-rig-adaptive/{k}" for k in range(1, 9)],
+    [*(f"rti-rig-adaptive/{k}" for k in range(1, 9)), "rti-rig-adaptive/8+min-lights"],
 )
 def test_a_session_of_an_older_adaptive_format_is_refused_with_what_to_do(
     uninterrupted: tuple[Path, Path], tmp_path: Path, old: str

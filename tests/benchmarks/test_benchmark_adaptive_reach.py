@@ -147,10 +147,44 @@ def test_the_relight_measure_scores_every_layout_on_lights_none_of_them_took() -
     a = layouts["a"]
     want = written_rti_psnr(lum[a], dirs[a], lum[held], dirs[held], chosen_on=images[a])[1]
     assert got["a"] == want
-    # another layout joining the comparison changes the held-out set, not the method
-    more = score({**layouts, "c": np.arange(2, 60, 7)})
+    # another layout joining the comparison takes its lights out of everyone's held-out set
+    c = np.arange(2, 60, 7)
+    more = score({**layouts, "c": c})
     assert set(more) == {"a", "b", "c"}
+    held = np.setdiff1d(held, c)
+    want = written_rti_psnr(lum[a], dirs[a], lum[held], dirs[held], chosen_on=images[a])[1]
+    assert more["a"] == want != got["a"]
     normals = _layout_scores(
         SimpleNamespace(**vars(data), normals=np.broadcast_to(normal, (12, 12, 3))), "normals"
     )
     assert set(normals(layouts)) == {"a", "b"}
+
+
+def test_a_relight_table_tunes_the_bar_and_the_oracle_to_the_highest_psnr() -> None:
+    """``scene_rows``: for normal error the bar is the floor of the lowest mean error and the
+    oracle the per-draw minimum, flagged "above the bar"; for relighting PSNR the floor of the
+    highest mean PSNR and the per-draw maximum, flagged "below the bar"."""
+    from benchmarks.adaptive_reach import FLOORS, NS, scene_rows
+
+    base = {0.0: 20.0, 10.0: 21.0, 20.0: 22.0, 30.0: 23.0}
+    res: dict = {}
+    for n in NS:
+        for f in FLOORS:
+            res[(n, f"hom {f:g}")] = [base[f], base[f]]
+            # the start's completions: below every homogeneous layout, except one draw at 0°
+            res[(n, f"s {f:g}")] = [base[f] - 5.0, base[f] - 5.0]
+        res[(n, "s 0")] = [30.0, 10.0]
+    psnr = scene_rows("x", res, ["s"], "relight")
+    assert all(r.startswith(f"| x | {n} | 30°: 23 |") for r, n in zip(psnr, NS, strict=True))
+    # per draw the best of (30, 16, 17, 18) and (10, 16, 17, 18): (30 + 18) / 2 = 24 ≥ 23
+    assert all("oracle 24;" in r or r.endswith("oracle 24 |") for r in psnr)
+    assert not any("below the bar" in r for r in psnr)
+    err = scene_rows("x", res, ["s"], "normals")
+    assert all(r.startswith(f"| x | {n} | 0°: 20 |") for r, n in zip(err, NS, strict=True))
+    # per draw the lowest: (16 + 10) / 2 = 13 ≤ 20, no flag; a start worse everywhere is flagged
+    assert all(r.endswith("oracle 13 |") for r in err)
+    for n in NS:
+        for f in FLOORS:
+            res[(n, f"s {f:g}")] = [base[f] + 1.0, base[f] + 1.0]
+    assert all("**above the bar**" in r for r in scene_rows("x", res, ["s"], "normals"))
+    assert not any("below the bar" in r for r in scene_rows("x", res, ["s"], "relight"))

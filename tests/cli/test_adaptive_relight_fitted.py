@@ -20,11 +20,13 @@ DOME = REPO / "rig_configs" / "simulated_dome.toml"
 ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
 runner = CliRunner()
 RELIGHT = ("--objective", "relight", "--no-verdict")
-#: on this replayed acquisition the fitted relight design is taken at 11 lights, from the
-#: second decision on, by 0.62 dB over the 10° design (checked below). At 7 lights it had been
-#: taken over the 20° design it equalled only through float32 rounding noise in the fits; with
-#: the fits summed in float64 the two tie exactly and the floor's design is kept.
-N = 11
+#: on this replayed acquisition the fitted relight design is taken at 14 lights, from the
+#: second decision on, by 1.77 dB over the best floor's design (checked below). Format 9's start
+#: and relight score (clipped renderings, shared held-out lights) changed which N takes it: at
+#: 11 lights (the N of format 8, by 0.62 dB) none does now, at 12–17 all do. At 7 lights it had
+#: once been taken over the 20° design it equalled only through float32 rounding noise in the
+#: fits; with the fits summed in float64 the two tie exactly and the floor's design is kept.
+N = 14
 
 
 def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path: Path) -> None:

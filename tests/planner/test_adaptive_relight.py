@@ -183,3 +183,53 @@ def test_pick_floor_keeps_the_current_design_within_the_margin() -> None:
     assert pick_floor(scores, 20.0) == 10.0  # beyond it: the best
     assert pick_floor(scores, 0.0, margin_db=0.0) == 10.0
     assert pick_floor({0.0: 30.0, 10.0: 30.0, 20.0: 30.0}, 10.0, margin_db=0.0) == 10.0
+
+
+def test_every_design_is_judged_on_the_same_lights(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The held-out lights are those still available that none of the designs takes, the same
+    for all (as the benchmarks compare layouts); where the designs take every available light,
+    each design's own; ``SHARED_HELD_OUT = False`` gives each its own."""
+    import rti_rig.planner.adaptive_relight as adaptive_relight
+
+    avail = np.ones(len(CANDIDATES), dtype=bool)
+    avail[[0, 1, 2]] = False  # shot already
+    designs = [np.array([5, 6, 7]), np.array([7, 8, 9, 10])]
+    held = adaptive_relight.shared_held_out(CANDIDATES, avail, designs)
+    expected = np.setdiff1d(np.arange(len(CANDIDATES)), [0, 1, 2, 5, 6, 7, 8, 9, 10])
+    assert len(held) == 2
+    for h in held:
+        assert np.array_equal(h, CANDIDATES[expected])
+    few = np.zeros(len(CANDIDATES), dtype=bool)
+    few[[5, 6, 7, 8]] = True  # the designs take every light left: each its own
+    own = adaptive_relight.shared_held_out(CANDIDATES, few, [np.array([5, 6]), np.array([7, 8])])
+    assert np.array_equal(own[0], CANDIDATES[[7, 8]]) and np.array_equal(own[1], CANDIDATES[[5, 6]])
+    monkeypatch.setattr(adaptive_relight, "SHARED_HELD_OUT", False)
+    apart = adaptive_relight.shared_held_out(CANDIDATES, avail, designs)
+    assert np.array_equal(apart[0], held_out(CANDIDATES, avail, designs[0]))
+
+
+def test_a_lobe_no_camera_could_show_is_relit_as_a_camera_records_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A lobe fitted on few images can be sharp and very strong (a matte tilted plane after its
+    4 starting images: ks 9e4 at exponent 512). The relight score simulates what a camera
+    records — nothing above its top code — so every design's simulated relighting stays a
+    relighting score; unclipped, the designs read far below 0 dB."""
+    import dataclasses
+
+    import rti_rig.planner.adaptive_relight as adaptive_relight
+    from rti_rig.planner.adaptive_bias import render
+
+    model = dataclasses.replace(grazing_shadow_object(0), spec_strength=9.0e4, spec_exponent=512.0)
+    designs = _designs(12)
+    full = [CANDIDATES[c] for c in designs.values()]
+    avail = np.ones(len(CANDIDATES), dtype=bool)
+    held = [held_out(CANDIDATES, avail, c) for c in designs.values()]
+    pix = np.arange(len(model.normals))
+    assert render(model, CANDIDATES, pix).max() > 100.0  # the model's own rendering
+    assert adaptive_relight.saturated(render(model, CANDIDATES, pix)).max() == 1.0
+    assert adaptive_relight.SATURATION == 1.0
+    clipped = simulate_relight_designs(model, full, held, relight_fit, "ptm")
+    assert min(clipped) > 10.0
+    monkeypatch.setattr(adaptive_relight, "SATURATION", None)
+    assert min(simulate_relight_designs(model, full, held, relight_fit, "ptm")) < 0.0

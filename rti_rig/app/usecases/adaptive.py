@@ -98,7 +98,10 @@ ARM_MAX_LIGHTS = 100
 #: design with no light left out records a null PSNR. 9: with N known and ``--objective
 #: relight``, the starting lights are matched only among the default layout's lights at or
 #: above ``START_FLOOR_DEG`` (``planner.adaptive.START_ABOVE_FLOOR``, ``start_subset``; a /8
-#: relight session could start on a light below 20°, and a resume of it would shoot others).
+#: relight session could start on a light below 20°), and the relight score clips the object
+#: model's renderings at white and judges every design on the same held-out lights
+#: (``planner.adaptive_relight.SATURATION``, ``SHARED_HELD_OUT``): a resume of a /8 relight
+#: session would shoot other lights.
 FORMAT = "rti-rig-adaptive/9"
 #: Format 9 with ``--min-lights``: the same decisions, a stop held until the minimum. Its own
 #: label so that a build that does not know the minimum refuses the session by name instead of
