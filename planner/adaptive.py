@@ -629,6 +629,7 @@ def choose_in_design(
         full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
         held = shared_held_out(candidates, available, list(designs.values()))
         psnr = simulate_relight_designs(model, full, held, relight, relight_basis(n_total))
+        shared = all(h is held[0] for h in held) and len(held[0]) > 0
         return _relight_decision(
             state,
             candidates,
@@ -639,6 +640,12 @@ def choose_in_design(
             {f for f, h in zip(designs, held, strict=True) if len(h) == 0},
             default_floor if incumbent is None or incumbent not in designs else incumbent,
             now,
+            held_desc=(
+                f"on the {len(held[0])} light{'' if len(held[0]) == 1 else 's'} none of "
+                "the designs takes"
+                if shared
+                else "on the lights it leaves out (together the designs take every light left)"
+            ),
             capture_s=capture_s,
             move_s=move_s,
             scale=scale,
@@ -798,10 +805,12 @@ def _relight_decision(
     unjudged: set[float],
     keep_floor: float,
     now: float,
+    held_desc: str = "on the lights left out",
     **choose: Any,
 ) -> Decision:
     """The design with the best simulated relighting PSNR (kept unless another is better by
-    :data:`~rti_rig.planner.adaptive_relight.RELIGHT_MARGIN_DB`), then its most useful light.
+    :data:`~rti_rig.planner.adaptive_relight.RELIGHT_MARGIN_DB`), then its most useful light;
+    ``held_desc`` says which lights the designs were judged on (the reason records it).
 
     A design that leaves no available light out (``unjudged``: every light the rig has left is
     in it) has nothing to judge its relighting on: it is recorded without a PSNR (null), and
@@ -817,7 +826,7 @@ def _relight_decision(
         "no light of the rig is left out of it, so there is nothing to judge its relighting on"
         if best in unjudged
         else f"relighting PSNR of {relight_basis(n_total)} simulated with this object's gloss "
-        f"and shadows: {psnr[best]:.3g} dB on the lights left out"
+        f"and shadows: {psnr[best]:.3g} dB {held_desc}"
     )
     return Decision(
         d.candidate,

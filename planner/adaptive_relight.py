@@ -16,8 +16,10 @@ design is scored the way the benchmarks score relighting, on this object's model
 * **the relighting basis the benchmarks fit** at N lights (:func:`relight_basis`: the richest
   basis N lights determine, ``objectives.models_for(N)[-1]``: HSH1 at 6, PTM at 9 and 12, HSH2
   at 18) is fitted on them by the project's own fit (injected as ``relight``: the planner does
-  not import :mod:`rti_rig.reconstruct`), and relit to every candidate light *not* in the
-  design — the benchmarks' held-out lights;
+  not import :mod:`rti_rig.reconstruct`), and relit to every candidate light still available
+  that *none* of the designs takes (:func:`shared_held_out`: the same lights for every design,
+  as the benchmarks compare layouts; each design's own left-out lights only where the designs
+  take every light left) — the renderings clipped at white (:data:`SATURATION`);
 * each held-out light's PSNR (data range 1, the images' white) against the model's rendering
   under it, with the model's noise in the reference (a held-out image is a photograph: its
   noise adds ``σ²`` to the squared error, in expectation), averaged over the held-out lights
@@ -167,7 +169,8 @@ def held_out(
     candidates: NDArray[np.float64], available: NDArray[np.bool_], design: NDArray[np.intp]
 ) -> NDArray[np.float64]:
     """The candidate directions a design leaves out (still available — not captured — and not
-    in the design): what its relighting is judged on, as the benchmarks judge it."""
+    in the design): what its relighting is judged on where the designs compared leave no light
+    out in common (:func:`shared_held_out`)."""
     mask = np.asarray(available, dtype=bool).copy()
     mask[np.asarray(design, dtype=np.intp)] = False
     return candidates[mask]

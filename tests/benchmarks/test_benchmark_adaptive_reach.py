@@ -188,3 +188,7 @@ def test_a_relight_table_tunes_the_bar_and_the_oracle_to_the_highest_psnr() -> N
             res[(n, f"s {f:g}")] = [base[f] + 1.0, base[f] + 1.0]
     assert all("**above the bar**" in r for r in scene_rows("x", res, ["s"], "normals"))
     assert not any("below the bar" in r for r in scene_rows("x", res, ["s"], "relight"))
+    for n in NS:
+        for f in FLOORS:
+            res[(n, f"s {f:g}")] = [base[f] - 1.0, base[f] - 1.0]
+    assert all("**below the bar**" in r for r in scene_rows("x", res, ["s"], "relight"))

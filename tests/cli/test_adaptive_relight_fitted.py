@@ -65,7 +65,8 @@ def test_a_relight_decision_that_takes_the_fitted_design_records_it(whole: Path)
         assert "least expected relighting error on the fitted model" in d["reason"]
         assert d["design_psnr_db"]["fitted"] >= max(d["design_psnr_db"].values()) - 0.5 - 1e-3
     first = taken[0]
-    assert first["design_psnr_db"]["fitted"] >= first["design_psnr_db"]["10"] + 0.5 - 1e-3
+    floors = [v for k, v in first["design_psnr_db"].items() if k != "fitted"]
+    assert first["design_psnr_db"]["fitted"] >= max(floors) + 0.5 - 1e-3
     manifest = json.loads((whole / "manifest.json").read_text())
     assert [s["decision"] for s in manifest["steps"]] == [s["decision"] for s in journal(whole)]
     # lights.lp lists what fired: the N lights of the journal

@@ -229,7 +229,13 @@ def test_a_lobe_no_camera_could_show_is_relit_as_a_camera_records_it(
     assert render(model, CANDIDATES, pix).max() > 100.0  # the model's own rendering
     assert adaptive_relight.saturated(render(model, CANDIDATES, pix)).max() == 1.0
     assert adaptive_relight.SATURATION == 1.0
-    clipped = simulate_relight_designs(model, full, held, relight_fit, "ptm")
-    assert min(clipped) > 10.0
+    brightest: list[float] = []
+
+    def relight(obs, lights, ho, basis):  # type: ignore[no-untyped-def]
+        brightest.append(float(obs.max()))  # the simulated photographs, as a camera clips
+        return relight_fit(obs, lights, ho, basis)
+
+    clipped = simulate_relight_designs(model, full, held, relight, "ptm")
+    assert min(clipped) > 10.0 and max(brightest) <= 1.0
     monkeypatch.setattr(adaptive_relight, "SATURATION", None)
     assert min(simulate_relight_designs(model, full, held, relight_fit, "ptm")) < 0.0

@@ -254,3 +254,49 @@ def test_a_relight_decision_with_no_light_left_out_records_no_psnr() -> None:
     assert d.design_scores and all(v is None for v in d.design_scores.values())
     assert "nothing to judge its relighting on" in d.reason
     assert "dB on the lights left out" not in d.reason
+
+
+def test_a_relight_decision_judges_every_design_on_the_same_lights_and_says_so(
+    monkeypatch,
+) -> None:
+    """The floors' designs and the fitted one are simulated on one held-out set (the lights
+    none of them takes), the fitted design's search on renderings clipped at white, and the
+    reason names how many lights the designs were judged on."""
+    import rti_rig.planner.adaptive as planner
+    import rti_rig.planner.adaptive_relight_design as relight_design
+
+    seen: dict = {}
+    simulate = planner.simulate_relight_designs
+
+    def spy(model, full, held, relight, basis, **kw):  # type: ignore[no-untyped-def]
+        seen["held"] = held
+        return simulate(model, full, held, relight, basis, **kw)
+
+    clipped: list = []
+    saturated = relight_design.saturated
+
+    def spy_saturated(clean):  # type: ignore[no-untyped-def]
+        out = saturated(clean)
+        clipped.append(float(np.max(out)))
+        return out
+
+    monkeypatch.setattr(planner, "simulate_relight_designs", spy)
+    monkeypatch.setattr(relight_design, "saturated", spy_saturated)
+    model = _model(5, spec=50.0)  # a lobe far brighter than white
+    shot = np.array([12, 33, 51, 77])
+    avail = np.ones(len(CANDIDATES), dtype=bool)
+    avail[shot] = False
+    d = choose_in_design(
+        _state(model, shot),
+        CANDIDATES,
+        avail,
+        9,
+        fit=lambda obs, lights: None,
+        objective="relight",
+        relight=relight_fit,
+    )
+    held = seen["held"]
+    assert len(held) == len(d.design_scores) == 5
+    assert all(np.array_equal(h, held[0]) for h in held)
+    assert f"dB on the {len(held[0])} lights none of the designs takes" in d.reason
+    assert clipped and max(clipped) <= adaptive_relight.SATURATION

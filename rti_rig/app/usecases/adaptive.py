@@ -101,7 +101,9 @@ ARM_MAX_LIGHTS = 100
 #: relight session could start on a light below 20°), and the relight score clips the object
 #: model's renderings at white and judges every design on the same held-out lights
 #: (``planner.adaptive_relight.SATURATION``, ``SHARED_HELD_OUT``): a resume of a /8 relight
-#: session would shoot other lights.
+#: session would shoot other lights. (A development build of 2026-11-25 wrote /9 with the new
+#: start but not the new score: its sessions lack those two constants and are refused by the
+#: constants check.)
 FORMAT = "rti-rig-adaptive/9"
 #: Format 9 with ``--min-lights``: the same decisions, a stop held until the minimum. Its own
 #: label so that a build that does not know the minimum refuses the session by name instead of
