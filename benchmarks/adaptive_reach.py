@@ -110,13 +110,7 @@ def _start_rule(above_floor: bool):  # type: ignore[no-untyped-def]
     def start(
         geometry: DomeGeometry, k: int, n_total: int | None, objective: str = "normals"
     ) -> list[int]:
-        if n_total is None or n_total <= k:
-            return dome_start(geometry, k, n_total, objective)
-        full = select_uniform_leds(geometry, n_total, adaptive.default_floor_for(objective))
-        pick = adaptive.start_subset(
-            geometry.directions[full], k, objective=objective, above_floor=above_floor
-        )
-        return [int(full[i]) for i in pick]
+        return dome_start(geometry, k, n_total, objective, above_floor=above_floor)
 
     return start
 

@@ -627,9 +627,8 @@ def choose_in_design(
         if fitted is not None:
             designs[FITTED_KEY] = fitted
         full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
-        held = shared_held_out(candidates, available, list(designs.values()))
+        held, shared = shared_held_out(candidates, available, list(designs.values()))
         psnr = simulate_relight_designs(model, full, held, relight, relight_basis(n_total))
-        shared = all(h is held[0] for h in held) and len(held[0]) > 0
         return _relight_decision(
             state,
             candidates,

@@ -180,20 +180,19 @@ def shared_held_out(
     candidates: NDArray[np.float64],
     available: NDArray[np.bool_],
     designs: list[NDArray[np.intp]],
-) -> list[NDArray[np.float64]]:
-    """Per design, the lights its relighting is judged on: the candidates still available that
-    *none* of the designs takes, the same for every design (as the benchmarks compare layouts
-    since 2026-11-24), so that a design is not ranked higher for taking the one light the
-    model renders worst. Where the designs together take every available light, each design's
-    own held-out lights (:func:`held_out`)."""
-    if not SHARED_HELD_OUT:
-        return [held_out(candidates, available, d) for d in designs]
+) -> tuple[list[NDArray[np.float64]], bool]:
+    """Per design, the lights its relighting is judged on, and whether they are shared: the
+    candidates still available that *none* of the designs takes, the same for every design (as
+    the benchmarks compare layouts since 2026-11-24), so that a design is not ranked higher for
+    taking the one light the model renders worst. Where the designs together take every
+    available light (or with :data:`SHARED_HELD_OUT` off), each design's own held-out lights
+    (:func:`held_out`)."""
     mask = np.asarray(available, dtype=bool).copy()
     for d in designs:
         mask[np.asarray(d, dtype=np.intp)] = False
-    if not mask.any():
-        return [held_out(candidates, available, d) for d in designs]
-    return [candidates[mask]] * len(designs)
+    if not SHARED_HELD_OUT or not mask.any():
+        return [held_out(candidates, available, d) for d in designs], False
+    return [candidates[mask]] * len(designs), True
 
 
 def pick_floor(

@@ -194,17 +194,21 @@ def test_every_design_is_judged_on_the_same_lights(monkeypatch: pytest.MonkeyPat
     avail = np.ones(len(CANDIDATES), dtype=bool)
     avail[[0, 1, 2]] = False  # shot already
     designs = [np.array([5, 6, 7]), np.array([7, 8, 9, 10])]
-    held = adaptive_relight.shared_held_out(CANDIDATES, avail, designs)
+    held, shared = adaptive_relight.shared_held_out(CANDIDATES, avail, designs)
     expected = np.setdiff1d(np.arange(len(CANDIDATES)), [0, 1, 2, 5, 6, 7, 8, 9, 10])
-    assert len(held) == 2
+    assert len(held) == 2 and shared
     for h in held:
         assert np.array_equal(h, CANDIDATES[expected])
     few = np.zeros(len(CANDIDATES), dtype=bool)
     few[[5, 6, 7, 8]] = True  # the designs take every light left: each its own
-    own = adaptive_relight.shared_held_out(CANDIDATES, few, [np.array([5, 6]), np.array([7, 8])])
+    own, shared = adaptive_relight.shared_held_out(
+        CANDIDATES, few, [np.array([5, 6]), np.array([7, 8])]
+    )
+    assert not shared
     assert np.array_equal(own[0], CANDIDATES[[7, 8]]) and np.array_equal(own[1], CANDIDATES[[5, 6]])
     monkeypatch.setattr(adaptive_relight, "SHARED_HELD_OUT", False)
-    apart = adaptive_relight.shared_held_out(CANDIDATES, avail, designs)
+    apart, shared = adaptive_relight.shared_held_out(CANDIDATES, avail, designs)
+    assert not shared
     assert np.array_equal(apart[0], held_out(CANDIDATES, avail, designs[0]))
 
 

@@ -199,22 +199,25 @@ def test_a_relight_decision_offers_the_fitted_design_and_records_it(monkeypatch)
     assert set(decide().design_scores) == {"0", "10", "20", "30"}
 
 
-def test_beyond_its_measured_range_the_fitted_relight_design_is_not_offered() -> None:
-    """Above ``RELIGHT_FITTED_MAX_LIGHTS`` (its search's cost) the floors alone are scored."""
-    model = _model(6)
+def _relight_decision(model: ObjectModel, n_total: int):  # type: ignore[no-untyped-def]
+    """The relight decision after 4 lights shot (12, 33, 51, 77) on ``model``."""
     shot = np.array([12, 33, 51, 77])
     avail = np.ones(len(CANDIDATES), dtype=bool)
     avail[shot] = False
-    n = adaptive_relight.RELIGHT_FITTED_MAX_LIGHTS + 1
-    d = choose_in_design(
+    return choose_in_design(
         _state(model, shot),
         CANDIDATES,
         avail,
-        n,
+        n_total,
         fit=lambda obs, lights: None,
         objective="relight",
         relight=relight_fit,
     )
+
+
+def test_beyond_its_measured_range_the_fitted_relight_design_is_not_offered() -> None:
+    """Above ``RELIGHT_FITTED_MAX_LIGHTS`` (its search's cost) the floors alone are scored."""
+    d = _relight_decision(_model(6), adaptive_relight.RELIGHT_FITTED_MAX_LIGHTS + 1)
     assert set(d.design_scores) == {"0", "10", "20", "30"}
 
 
@@ -282,19 +285,7 @@ def test_a_relight_decision_judges_every_design_on_the_same_lights_and_says_so(
 
     monkeypatch.setattr(planner, "simulate_relight_designs", spy)
     monkeypatch.setattr(relight_design, "saturated", spy_saturated)
-    model = _model(5, spec=50.0)  # a lobe far brighter than white
-    shot = np.array([12, 33, 51, 77])
-    avail = np.ones(len(CANDIDATES), dtype=bool)
-    avail[shot] = False
-    d = choose_in_design(
-        _state(model, shot),
-        CANDIDATES,
-        avail,
-        9,
-        fit=lambda obs, lights: None,
-        objective="relight",
-        relight=relight_fit,
-    )
+    d = _relight_decision(_model(5, spec=50.0), 9)  # a lobe far brighter than white
     held = seen["held"]
     assert len(held) == len(d.design_scores) == 5
     assert all(np.array_equal(h, held[0]) for h in held)

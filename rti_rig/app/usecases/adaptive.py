@@ -618,17 +618,23 @@ class AdaptivePlan:
 
 
 def dome_start(
-    geometry: DomeGeometry, k: int, n_total: int | None, objective: str = "normals"
+    geometry: DomeGeometry,
+    k: int,
+    n_total: int | None,
+    objective: str = "normals",
+    above_floor: bool | None = None,
 ) -> list[int]:
     """LED indices of a dome's starting layout of ``k``: with ``n_total`` known, the ``k`` of
     the homogeneous layout of ``n_total`` (at the objective's default floor) closest to a
-    homogeneous layout of ``k`` — so that the default design is that layout exactly."""
+    homogeneous layout of ``k`` — so that the default design is that layout exactly
+    (``above_floor``: as ``start_subset``'s, for the benchmarks' variants)."""
     if n_total is None or n_total <= k:
         return [int(i) for i in select_uniform_leds(geometry, k, START_FLOOR_DEG)]
     from rti_rig.planner import adaptive
 
     full = select_uniform_leds(geometry, n_total, adaptive.default_floor_for(objective))
-    return [int(full[i]) for i in start_subset(geometry.directions[full], k, objective=objective)]
+    pick = start_subset(geometry.directions[full], k, objective=objective, above_floor=above_floor)
+    return [int(full[i]) for i in pick]
 
 
 def adaptive_plan(  # type: ignore[no-untyped-def]
