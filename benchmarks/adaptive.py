@@ -450,11 +450,12 @@ def real(draws: int, scale: float, data: Path, seed: int = 0) -> dict:
     }
 
 
-def _tuned_floor(scores: dict, higher_is_better: bool = False) -> float:
-    """The homogeneous floor with the best mean score over N (the bar, tuned with hindsight)."""
+def _tuned_floor(scores: dict, higher_is_better: bool = False, prefix: str = "uniform") -> float:
+    """The homogeneous floor with the best mean score over N (the bar, tuned with hindsight);
+    ``scores`` keyed (N, f"{prefix} {floor}")."""
 
     def mean(f: float) -> float:
-        return float(np.mean([np.mean(scores[(n, f"uniform {f:g}")]) for n in NS]))
+        return float(np.mean([np.mean(scores[(n, f"{prefix} {f:g}")]) for n in NS]))
 
     return max(FLOORS, key=mean) if higher_is_better else min(FLOORS, key=mean)
 

@@ -275,12 +275,10 @@ def scene_rows(scene: str, res: dict, starts: list[str], measure: str = "normals
     the bar (the homogeneous layout of the floor best on the mean over N: the lowest error, or
     with ``measure`` "relight" the highest PSNR), each start's completions (mean over draws)
     and its oracle (the best floor per draw), flagged where it falls short of the bar."""
+    from benchmarks.adaptive import _tuned_floor
+
     sign = -1.0 if measure == "relight" else 1.0  # lower sign × score is better
-
-    def mean_over_n(f: float) -> float:
-        return sign * float(np.mean([np.mean(res[(n, f"hom {f:g}")]) for n in NS]))
-
-    tuned = min(FLOORS, key=mean_over_n)
+    tuned = _tuned_floor(res, higher_is_better=sign < 0, prefix="hom")
     rows = []
     for n in NS:
         bar = float(np.mean(res[(n, f"hom {tuned:g}")]))
