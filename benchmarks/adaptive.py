@@ -541,6 +541,10 @@ def configure_planner(args: argparse.Namespace) -> None:
         adaptive_planner.FITTED_MARGIN = args.fitted_margin
     if args.sim_margin is not None:
         adaptive_planner.SIM_MARGIN = args.sim_margin
+    if args.relight_margin is not None:
+        import rti_rig.planner.adaptive_relight as adaptive_relight
+
+        adaptive_relight.RELIGHT_MARGIN_DB = args.relight_margin
     if args.fitted_seeds:
         adaptive_planner.FITTED_SEED_FLOORS = (
             ()
@@ -707,6 +711,14 @@ def build_parser() -> argparse.ArgumentParser:
         "(planner.adaptive.SIM_MARGIN; default what ships, 0.10)",
     )
     ap.add_argument(
+        "--relight-margin",
+        type=float,
+        default=None,
+        help="the dB by which another design's simulated relighting PSNR must be higher to be "
+        "taken with --objective relight (planner.adaptive_relight.RELIGHT_MARGIN_DB; default "
+        "what ships, 0.5)",
+    )
+    ap.add_argument(
         "--fitted-seeds",
         default="",
         help="comma-separated extra floors (°) whose completions also seed the fitted design's "
@@ -813,6 +825,11 @@ def main(argv: list[str] | None = None) -> str:
             + (f" --fitted-margin {args.fitted_margin:g}" if args.fitted_margin is not None else "")
             + (f" --fitted-seeds {args.fitted_seeds}" if args.fitted_seeds else "")
             + (f" --sim-margin {args.sim_margin:g}" if args.sim_margin is not None else "")
+            + (
+                f" --relight-margin {args.relight_margin:g}"
+                if args.relight_margin is not None
+                else ""
+            )
             + (" --no-relight" if args.no_relight else "")
             + (" --cache FILE" if args.cache else "")
             + f" --write` ({time.perf_counter() - t0:.0f} s"

@@ -125,3 +125,19 @@ def test_start_above_floor_sets_which_objectives_start_above_it(planner_constant
         adaptive.configure_planner(
             adaptive.build_parser().parse_args(["--start-above-floor", "gloss"])
         )
+
+
+def test_relight_margin_sets_the_relight_objective_s_hysteresis(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``--relight-margin 0.25``: a relight decision leaves its design for one simulated 0.3 dB
+    better (kept at the 0.5 dB that ships); absent, the constant is left as it ships."""
+    import rti_rig.planner.adaptive_relight as relight
+
+    monkeypatch.setattr(relight, "RELIGHT_MARGIN_DB", relight.RELIGHT_MARGIN_DB)
+    adaptive.configure_planner(adaptive.build_parser().parse_args([]))
+    assert relight.RELIGHT_MARGIN_DB == 0.5
+    assert relight.pick_floor({10.0: 30.0, 20.0: 30.3}, keep_floor=10.0) == 10.0
+    adaptive.configure_planner(adaptive.build_parser().parse_args(["--relight-margin", "0.25"]))
+    assert relight.RELIGHT_MARGIN_DB == 0.25
+    assert relight.pick_floor({10.0: 30.0, 20.0: 30.3}, keep_floor=10.0) == 20.0
