@@ -32,6 +32,7 @@ import platform
 import shutil
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -255,13 +256,16 @@ class SessionFolder:
         return cls(root, total_steps)
 
     @classmethod
-    def reopen(cls, root: Path) -> SessionFolder:
+    def reopen(
+        cls, root: Path, check_done: Callable[[dict[int, StepRecord]], None] | None = None
+    ) -> SessionFolder:
         """Open an interrupted session to capture the steps it has not done yet.
 
         What is on disk is verified against the journal's checksums first, and the journal is
-        repaired; see :func:`prepare_resume`.
+        repaired; see :func:`prepare_resume` (``check_done`` may refuse the verified steps
+        before anything in the folder changes).
         """
-        state = prepare_resume(Path(root))
+        state = prepare_resume(Path(root), check_done)
         folder = cls(Path(root), planned_steps(state.manifest))
         folder.manifest = state.manifest
         folder.resume = state
@@ -733,8 +737,13 @@ def _new_stamp(root: Path) -> str:
     return stamp
 
 
-def prepare_resume(root: Path) -> ResumeState:
+def prepare_resume(
+    root: Path, check_done: Callable[[dict[int, StepRecord]], None] | None = None
+) -> ResumeState:
     """Verify an interrupted session, repair its journal and set aside what is not committed.
+
+    ``check_done`` sees the verified steps before anything is repaired or moved: a resume it
+    refuses (by raising) leaves the folder exactly as it was.
 
     A step counts as done when its journal line is a well-formed record and every file it names
     is on disk with the journaled checksum. Journal lines that are not records (a torn last
@@ -762,8 +771,10 @@ def prepare_resume(root: Path) -> ResumeState:
     names = image_names(total)
     stamp = _new_stamp(root)
     scan = scan_journal(root, names)
-    repair = _repair_journal(root, scan, stamp) if scan.needs_repair else []
     done = verified_steps(root, scan.records)
+    if check_done is not None:
+        check_done(done)
+    repair = _repair_journal(root, scan, stamp) if scan.needs_repair else []
     keep = {name for rec in done.values() for name in rec.sha256}
     recovered: list[str] = []
     leftovers = [

@@ -121,6 +121,34 @@ def test_a_resumed_session_whose_images_changed_is_refused(
     assert "step 6 was decided differently" in said(r)
 
 
+@pytest.mark.parametrize("damage", ["deleted", "one byte changed"])
+def test_a_resume_with_an_earlier_image_gone_is_refused_before_the_folder_changes(
+    uninterrupted: tuple[Path, Path], tmp_path: Path, damage: str
+) -> None:
+    """QA's "reshoot image_003" invites deleting it and resuming. The lights after it were
+    chosen from it, so the resume is refused — before it sets anything aside: it had moved the
+    intact linear/image_003.tif to recovered/ and then refused, leaving a lights.lp that listed
+    an image the folder no longer held."""
+    cfg, _ = uninterrupted
+    out = tmp_path / "cut"
+    interrupted(cfg, out, after_step=5)
+    jpeg = out / "image_003.jpg"
+    if damage == "deleted":
+        jpeg.unlink()
+    else:
+        data = bytearray(jpeg.read_bytes())
+        data[len(data) // 2] ^= 0xFF
+        jpeg.write_bytes(bytes(data))
+    before = folder_bytes(out)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "step 3 (image_003) is missing or differs from its journaled checksum" in text
+    assert "nothing in the folder was changed" in text and "another --out" in text
+    assert folder_bytes(out) == before
+    assert not (out / "recovered").exists()
+
+
 def test_until_error_stops_when_the_estimate_is_reached(
     uninterrupted: tuple[Path, Path], tmp_path: Path
 ) -> None:

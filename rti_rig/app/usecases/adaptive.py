@@ -768,12 +768,8 @@ class AdaptiveSteps:
         that each would be decided again as it was (else the session cannot continue as it
         began)."""
         done = folder.done
+        refuse_broken_run(Path(folder.root), folder.total_steps)(done)
         for i in range(len(done)):
-            if i not in done:
-                raise RtiRigError(
-                    f"{folder.root}: step {i + 1} is missing but later ones are on disk; an "
-                    "adaptive session continues only from an unbroken run of steps"
-                )
             rec = done[i]
             candidate, _ = self.chooser.decide(i)
             planned = (
@@ -1039,6 +1035,37 @@ def check_resume_objective(manifest: dict, root: Path, objective: str | None) ->
             f"for {objective}"
         )
     return str(began)
+
+
+def refuse_broken_run(root: Path, total_steps: int) -> Callable[[dict[int, Any]], None]:
+    """A check of the steps verified on disk (``SessionFolder.reopen``'s ``check_done``): an
+    adaptive session continues only from an unbroken run of steps, since each light after a
+    missing image was chosen from it. Refused before the resume moves anything, with what to
+    do (a QA verdict of "reshoot image_003" invites deleting it and resuming)."""
+
+    def check(done: dict[int, Any]) -> None:
+        gaps = [i for i in range(max(done, default=-1) + 1) if i not in done]
+        if not gaps:
+            return
+        from rti_rig.runtime.session import image_names
+
+        every = image_names(total_steps)
+        names = ", ".join(every[i] for i in gaps)
+        which = (
+            f"step {gaps[0] + 1} ({names}) is missing or differs from its journaled checksum"
+            if len(gaps) == 1
+            else f"steps {', '.join(str(i + 1) for i in gaps)} ({names}) are missing or differ "
+            "from their journaled checksums"
+        )
+        raise RtiRigError(
+            f"{root}: {which}, but later steps are on disk. The lights "
+            "after a step were chosen from its image, so an adaptive session cannot reshoot it "
+            "in place; nothing in the folder was changed. Put the original image files back "
+            "(the JPEG and linear/ TIFF; an earlier resume sets files it cannot verify aside in "
+            "recovered/) and resume again, or start a new session with another --out"
+        )
+
+    return check
 
 
 def resume_adaptive_source(rig, folder, objective: str | None = None) -> AdaptiveSteps:  # type: ignore[no-untyped-def]

@@ -440,7 +440,13 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     identity, diffs = check_resume_rig(
         manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
     )
-    folder = SessionFolder.reopen(req.session_dir)
+    check_done = None
+    if "adaptive" in manifest:
+        from rti_rig.app.usecases.adaptive import refuse_broken_run
+        from rti_rig.runtime.session import planned_steps
+
+        check_done = refuse_broken_run(Path(req.session_dir), planned_steps(manifest))
+    folder = SessionFolder.reopen(req.session_dir, check_done)
     folder.rig_identity = identity
     folder.rig_change = diffs or None
     folder.input_notes = list(loaded.notes)  # recorded in this run's entry of the manifest
