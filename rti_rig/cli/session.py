@@ -226,6 +226,22 @@ def _print_teardown_failures(folder) -> None:  # type: ignore[no-untyped-def]
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
 
 
+def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def]
+    """The session's time on the real rig: a resumed session's is the sum of its runs (the
+    manifest's), not this run's alone."""
+    simulated = f"simulated in {result.wall_time_s:.1f} s" if dry else ""
+    timing = (folder.manifest or {}).get("timing") or {}
+    runs = int(timing.get("runs") or 1)
+    if runs < 2:
+        return f"Session time on the real rig: {result.rig_time_s:.1f} s" + (
+            f" ({simulated})" if dry else ""
+        )
+    return (
+        f"Session time on the real rig: {float(timing['rig_time_s']):.1f} s over {runs} runs "
+        f"(this run {result.rig_time_s:.1f} s" + (f", {simulated})" if dry else ")")
+    )
+
+
 def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on."""
     from rti_rig.app.usecases.session import run_opened_session
@@ -321,8 +337,7 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     )
     out.print(
         f"{folder.images_kept} image(s) in the session; {labels}\n"
-        f"Session time on the real rig: {result.rig_time_s:.1f} s"
-        + (f" (simulated in {result.wall_time_s:.1f} s)" if dry else "")
+        + _time_line(folder, result, dry)
     )
     for note in folder.manifest.get("notices") or []:
         err.print(f"[yellow]note:[/] {escape(str(note))}")

@@ -88,6 +88,10 @@ def test_an_interrupted_adaptive_session_resumes_to_the_same_session(
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
     assert (out / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+    # the session's time on the rig is both runs', as the manifest sums them, not the resume's
+    total = manifest(out)["timing"]["rig_time_s"]
+    assert total > manifest(ref)["timing"]["rig_time_s"] * 0.99
+    assert f"Session time on the real rig: {total:.1f} s over 2 runs (this run " in said(r)
 
     def choices(session: Path) -> list[dict]:  # the decisions without their wall time
         return [
@@ -444,3 +448,7 @@ def test_a_session_recorded_by_the_build_before_resumes(tmp_path: Path) -> None:
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0, r.output
     assert (out / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+    # the session's time on the rig is both runs', as the manifest sums them, not the resume's
+    total = manifest(out)["timing"]["rig_time_s"]
+    assert total > manifest(ref)["timing"]["rig_time_s"] * 0.99
+    assert f"Session time on the real rig: {total:.1f} s over 2 runs (this run " in said(r)
