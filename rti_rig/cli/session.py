@@ -45,14 +45,18 @@ def run(
     ] = None,
     min_elevation_deg: Annotated[
         float,
-        typer.Option("--min-elevation-deg", help="Elevation floor of the homogeneous layout."),
+        typer.Option(
+            "--min-elevation-deg",
+            help="Elevation floor of the homogeneous layout (not with --adaptive/--until-error).",
+        ),
     ] = 0.0,
     max_elevation_deg: Annotated[
         float,
         typer.Option(
             "--max-elevation-deg",
             help="Elevation ceiling of the homogeneous layout (90 = up to the zenith; 60 keeps "
-            "lights away from the camera axis, see 'plan --max-elevation-deg').",
+            "lights away from the camera axis, see 'plan --max-elevation-deg'; not with "
+            "--adaptive/--until-error).",
         ),
     ] = 90.0,
     auto_exposure: Annotated[

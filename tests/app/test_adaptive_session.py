@@ -201,6 +201,17 @@ def test_until_error_stops_when_the_estimate_is_reached(
     [
         (["--until-error", "0"], "positive angle"),
         (["--adaptive", "--lights", "4"], "at least 5"),
+        # the band was dropped without a word: lights fired above a 45° ceiling
+        (
+            ["--adaptive", "--lights", "6", "--max-elevation-deg", "45"],
+            "--min-elevation-deg/--max-elevation-deg are not applied to adaptive sessions",
+        ),
+        (
+            ["--until-error", "1", "--min-elevation-deg", "30"],
+            "are not applied to adaptive sessions",
+        ),
+        # capped without a word: 100 asked of a dome ran its every LED
+        (["--adaptive", "--lights", "100"], "--adaptive --lights 100: this rig offers"),
     ],
 )
 def test_bad_requests_are_refused_before_anything_moves(

@@ -922,6 +922,16 @@ def _check_min_within(min_lights: int, offered: int) -> None:
         )
 
 
+def _check_lights_within(lights: int | None, offered: int) -> None:
+    """``--lights N`` above what the rig offers is refused, as a planned session's is (it was
+    capped without a word: 100 asked of a 48-LED dome ran 48)."""
+    if lights is not None and lights > offered:
+        raise RtiRigError(
+            f"--adaptive --lights {lights}: this rig offers {offered} lights an adaptive "
+            f"session can use; give at most {offered}"
+        )
+
+
 def open_adaptive_session(  # type: ignore[no-untyped-def]
     loaded,
     out_dir: Path,
@@ -948,19 +958,23 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         )
     check_objective(objective, lights, until_error_deg)
     check_min_lights(min_lights, lights, until_error_deg)
-    if min_lights is not None:  # a dome's lights are known from its config: before any port
-        from rti_rig.app.config import rig_geometry
+    from rti_rig.app.config import rig_geometry
 
-        geometry = rig_geometry(loaded)
-        if isinstance(geometry, DomeGeometry):
-            _check_min_within(min_lights, len(candidates_for(geometry).directions))
+    geometry = rig_geometry(loaded)
+    if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
+        offered = len(candidates_for(geometry).directions)  # any port is opened
+        _check_lights_within(lights, offered)
+        if min_lights is not None:
+            _check_min_within(min_lights, offered)
     SessionFolder.check_new(out_dir)
     warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:
         plan = adaptive_plan(rig, lights, objective=objective)
-        if min_lights is not None:  # an arm's reachable lights need the rig's own rules
-            _check_min_within(min_lights, len(plan.candidates))
+        if not isinstance(geometry, DomeGeometry):  # an arm's reachable lights need the rig's
+            _check_lights_within(lights, len(plan.candidates))  # own rules
+            if min_lights is not None:
+                _check_min_within(min_lights, len(plan.candidates))
         source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves

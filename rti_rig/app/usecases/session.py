@@ -302,6 +302,16 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
 
     if req.plan is not None or req.auto_exposure:
         raise RtiRigError("--adaptive chooses its own lights: drop --plan/--auto-exposure")
+    if req.min_elevation_deg != 0.0 or req.max_elevation_deg != 90.0:
+        # refused rather than dropped: the band was silently ignored (lights fired above a
+        # 45° ceiling asked for to keep a gilded object's highlights off the camera)
+        raise RtiRigError(
+            "--min-elevation-deg/--max-elevation-deg are not applied to adaptive sessions "
+            "(--adaptive, --until-error): they choose among every light the rig can run. "
+            "Drop them, or plan the band and run the plan: rti-rig plan PREVIEW --rig RIG "
+            "--lights N --max-elevation-deg DEG --out plan.lp, then rti-rig run RIG --out DIR "
+            "--plan plan.lp"
+        )
     if req.lights is not None:
         check_light_count(req.lights)
     identity = rig_identity(loaded)
