@@ -637,7 +637,8 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     default dome's (about 1 s a light), so a replayed session reports what a real dome would
     take.
     """
-    from rti_rig.core.image_files import header_size, jpeg_truncation, probe_image_size
+    from rti_rig.core.errors import SessionError
+    from rti_rig.core.image_files import header_layout, jpeg_truncation, read_image_any
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -669,11 +670,33 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
             "from the camera or card",
         )
-    height, width = probe_image_size(lp_path.parent / entries[0].name)
-    # one size for all, checked from the headers now rather than by a capture that stops the
-    # session part-way (and whose resume would stop there again)
-    sizes = {e.name: header_size(lp_path.parent / e.name) for e in entries}
-    odd = [f"{n} is {hw[1]}x{hw[0]}" for n, hw in sizes.items() if hw and hw != (height, width)]
+    # one size and one kind (colour or grey) for all, checked now rather than by a capture
+    # that stops the session part-way (and whose resume would stop there again): from the
+    # headers, and by decoding the images whose header does not say (an empty file, another
+    # format), which is what a capture would do
+    layouts: dict[str, tuple[int, int, bool]] = {}
+    unreadable: list[str] = []
+    for e in entries:
+        path = lp_path.parent / e.name
+        layout = header_layout(path)
+        if layout is None:
+            try:
+                img = read_image_any(path)
+            except SessionError as exc:
+                unreadable.append(str(exc))
+                continue
+            layout = (int(img.shape[0]), int(img.shape[1]), img.ndim == 3)
+        layouts[e.name] = layout
+    if unreadable:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{len(unreadable)} of {len(entries)} image(s) beside it cannot be read "
+            f"({'; '.join(unreadable[:5])}{' ...' if len(unreadable) > 5 else ''}); copy them "
+            "again from the camera or card, or list only the others",
+        )
+    height, width, colour = layouts[entries[0].name]
+    odd = [f"{n} is {w}x{h}" for n, (h, w, _) in layouts.items() if (h, w) != (height, width)]
     if odd:
         raise ConfigError(
             lp_path,
@@ -681,6 +704,17 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             f"the images beside it differ in size: {entries[0].name} is {width}x{height} but "
             f"{'; '.join(odd[:5])}{' ...' if len(odd) > 5 else ''}; an acquisition has one "
             "image size (replace or resize those images, or list only the others)",
+        )
+    kind = "colour" if colour else "greyscale"
+    other = [n for n, (_, _, c) in layouts.items() if c != colour]
+    if other:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"the images beside it are not all {kind}: {entries[0].name} is {kind} but "
+            f"{', '.join(other[:5])}{' ...' if len(other) > 5 else ''} "
+            f"{'is' if len(other) == 1 else 'are'} {'greyscale' if colour else 'colour'}; an "
+            "acquisition has one kind of image (convert those images, or list only the others)",
         )
     data: dict[str, Any] = {
         "name": f"replay of {lp_path.parent.name}/{lp_path.name}",

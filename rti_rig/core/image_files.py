@@ -153,28 +153,37 @@ def jpeg_truncation(path: Path) -> str | None:
 
 
 def header_size(path: Path) -> tuple[int, int] | None:
-    """(height, width) from the file's header alone (JPEG frame header, PNG IHDR, TIFF first
-    page), without decoding the pixels; None when the header does not say (another format,
-    or a damaged file: the decoder will say why)."""
+    """(height, width) from the file's header alone; see :func:`header_layout`."""
+    layout = header_layout(path)
+    return None if layout is None else (layout[0], layout[1])
+
+
+def header_layout(path: Path) -> tuple[int, int, bool] | None:
+    """(height, width, colour) from the file's header alone (JPEG frame header, PNG IHDR, TIFF
+    first page), without decoding the pixels; ``colour`` as :func:`read_image_any` would
+    return it (3 channels, not grey). None when the header does not say (another format, or a
+    damaged or empty file: the decoder will say why)."""
     p = Path(path)
     with open(p, "rb") as fh:
         head = fh.read(64 * 1024)
-    if head.startswith(b"\x89PNG\r\n\x1a\n") and head[12:16] == b"IHDR":
-        return int.from_bytes(head[20:24], "big"), int.from_bytes(head[16:20], "big")
+    if head.startswith(b"\x89PNG\r\n\x1a\n") and head[12:16] == b"IHDR" and len(head) >= 26:
+        # colour type 0 grey, 4 grey + alpha; 2 RGB, 3 palette (decoded to RGB), 6 RGBA
+        colour = head[25] not in (0, 4)
+        return int.from_bytes(head[20:24], "big"), int.from_bytes(head[16:20], "big"), colour
     if head[:4] in (b"II*\x00", b"MM\x00*"):
         import tifffile
 
         try:
             with tifffile.TiffFile(p) as tif:
-                shape = tif.pages[0].shape
+                page = tif.pages[0]
+                return int(page.imagelength), int(page.imagewidth), page.samplesperpixel >= 3
         except Exception:  # tifffile raises many kinds; the decoder names the problem later
             return None
-        return int(shape[0]), int(shape[1])
     if not head.startswith(b"\xff\xd8"):
         return None
     data = head if len(head) < 64 * 1024 else p.read_bytes()
     pos = 2
-    while pos + 9 <= len(data) and data[pos] == 0xFF:
+    while pos + 10 <= len(data) and data[pos] == 0xFF:
         marker = data[pos + 1]
         if marker == 0xFF:
             pos += 1
@@ -183,7 +192,7 @@ def header_size(path: Path) -> tuple[int, int] | None:
         if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):  # start of frame
             height = int.from_bytes(data[pos + 5 : pos + 7], "big")
             width = int.from_bytes(data[pos + 7 : pos + 9], "big")
-            return height, width
+            return height, width, data[pos + 9] != 1  # components: 1 grey, 3 YCbCr, 4 CMYK
         if marker == 0xDA:
             return None
         pos += 2 + length

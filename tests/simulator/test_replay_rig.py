@@ -12,6 +12,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -206,3 +207,49 @@ def test_an_acquisition_with_missing_images_is_refused_before_anything_runs(
     text = " ".join(r.output.split())
     assert "1 of 18 image(s) missing" in text and "image05.jpg" in text
     assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize(
+    ("damage", "fragment"),
+    [
+        # an empty file has no header to read its size from: it had passed the check, and the
+        # session stopped at its light part-way (and its resume stopped there again)
+        ("empty", "1 of 18 image(s) beside it cannot be read (cannot read image"),
+        # one greyscale image among colour ones: the session ran, then QA and fit failed on
+        # "images differ in shape"
+        ("greyscale", "image01.jpg is colour but image45.jpg is greyscale"),
+    ],
+)
+def test_an_acquisition_with_an_unreadable_or_other_kind_of_image_is_refused_up_front(
+    tmp_path: Path, damage: str, fragment: str
+) -> None:
+    import cv2
+
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    target = acq / "image45.jpg"
+    if damage == "empty":
+        target.write_bytes(b"")
+    else:
+        grey = cv2.cvtColor(cv2.imread(str(target)), cv2.COLOR_BGR2GRAY)
+        assert cv2.imwrite(str(target), grey)
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")])
+    assert r.exit_code == 2, r.output
+    assert fragment in " ".join(r.output.split())
+    assert not (tmp_path / "s").exists()
+
+
+def test_an_all_greyscale_acquisition_replays_and_fits(tmp_path: Path) -> None:
+    """A monochrome camera's acquisition is one kind of image: replayed and fitted."""
+    import cv2
+
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    for jpg in acq.glob("*.jpg"):
+        assert cv2.imwrite(str(jpg), cv2.cvtColor(cv2.imread(str(jpg)), cv2.COLOR_BGR2GRAY))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--lights", "6"])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "f"), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "f" / "fit.json").is_file()
