@@ -30,6 +30,17 @@ class TiffRows:
 
     def __init__(self, path: Path | str) -> None:
         self.path = Path(path)
+        try:
+            self._read_header()
+        except ImageFileError:
+            raise
+        except Exception as exc:  # tifffile raises many kinds (TiffFileError, IndexError, …)
+            raise _unreadable(self.path, exc) from None
+        self._full: NDArray[Any] | None = None
+        self._cache: dict[int, NDArray[Any]] = {}
+        self._row_shape = self.shape[1:]
+
+    def _read_header(self) -> None:
         with tifffile.TiffFile(self.path) as tf:
             page = tf.pages[0]
             self.shape: tuple[int, ...] = tuple(int(x) for x in page.shape)
@@ -52,9 +63,6 @@ class TiffRows:
             # tifffile reports rowsperstrip 0 or more than the height for a single strip
             self._rows_per_strip = min(rps, self.shape[0]) if rps > 0 else self.shape[0]
         self._lean = lean
-        self._full: NDArray[Any] | None = None
-        self._cache: dict[int, NDArray[Any]] = {}
-        self._row_shape = self.shape[1:]
 
     def __len__(self) -> int:
         return self.shape[0]
@@ -115,7 +123,10 @@ class TiffRows:
     def __getitem__(self, key: Any) -> NDArray[Any]:
         if not self._lean or not isinstance(key, slice):
             if self._full is None:
-                self._full = tifffile.imread(self.path)
+                try:
+                    self._full = tifffile.imread(self.path)
+                except Exception as exc:  # damaged data, a codec this install lacks, …
+                    raise _unreadable(self.path, exc) from None
             return self._full[key]
         start, stop, step = key.indices(self.shape[0])
         if step != 1 or stop <= start:
@@ -134,3 +145,13 @@ class TiffRows:
     def __array__(self, dtype: Any = None, copy: Any = None) -> NDArray[Any]:
         full = self[0 : self.shape[0]]
         return full.astype(dtype) if dtype is not None else np.array(full)
+
+
+def _unreadable(path: Path, exc: BaseException) -> ImageFileError:
+    """A TIFF tifffile cannot read, named with tifffile's reason and what to do (it had
+    reached the user as a traceback)."""
+    return ImageFileError(
+        f"{path}: cannot be read as a TIFF ({type(exc).__name__}: {exc}); copy it again from "
+        "the original, save it again as an uncompressed or zlib/LZW 8- or 16-bit TIFF, or "
+        "leave it out of the .lp"
+    )

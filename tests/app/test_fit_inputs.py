@@ -135,6 +135,55 @@ def test_a_truncated_image_is_a_named_error_not_a_traceback(
     assert r.exception is None or isinstance(r.exception, SystemExit)
 
 
+def test_an_lzw_tiff_acquisition_fits_exactly_like_the_session(
+    inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """LZW is what OpenCV, Photoshop and ImageMagick write: it had stopped the fit with a
+    traceback asking for the 'imagecodecs' package (now a dependency)."""
+    lzw = tmp_path / "lzw"
+    (lzw / "linear").mkdir(parents=True)
+    shutil.copy(inputs["tiff"] / "lights.lp", lzw / "lights.lp")
+    entries = []
+    for e in read_lp(inputs["tiff"] / "lights.lp"):
+        stem = Path(e.name).stem
+        px = tifffile.imread(inputs["tiff"] / "linear" / f"{stem}.tif")
+        tifffile.imwrite(lzw / f"{stem}.tif", px, compression="lzw")
+        entries.append(LpEntry(f"{stem}.tif", e.direction))
+    write_lp(lzw / "acquisition.lp", entries)
+    n_new, a_new = _fit(inputs["tiff"], tmp_path / "new")
+    n_lzw, a_lzw = _fit(lzw / "acquisition.lp", tmp_path / "out")
+    np.testing.assert_array_equal(n_lzw, n_new)
+    np.testing.assert_array_equal(a_lzw, a_new)
+
+
+@pytest.mark.parametrize("damage", ["empty", "header offset"])
+def test_a_tiff_that_is_no_tiff_is_a_named_error_and_a_batch_goes_on(
+    inputs: dict[str, Path], tmp_path: Path, damage: str
+) -> None:
+    """An empty TIFF, or one whose first-page offset is overwritten: tifffile's own exception
+    (TiffFileError, IndexError) had reached the user as a traceback and stopped a batch."""
+    bad = tmp_path / "bad"
+    shutil.copytree(inputs["tiff"], bad)
+    victim = sorted((bad / "linear").glob("*.tif"))[2]
+    if damage == "empty":
+        victim.write_bytes(b"")
+    else:
+        data = bytearray(victim.read_bytes())
+        data[4:8] = b"\xff\xff\xff\x7f"
+        victim.write_bytes(bytes(data))
+    r = runner.invoke(app, ["fit", str(bad), "--out", str(tmp_path / "out"), *FIT])
+    assert r.exit_code == 2, r.output
+    text = " ".join(r.output.split())
+    assert victim.name in text and "cannot be read as a TIFF" in text, text
+    assert r.exception is None or isinstance(r.exception, SystemExit)
+    # in a batch the damaged session is reported and the next one still fitted
+    r = runner.invoke(
+        app, ["fit", str(bad), str(inputs["tiff"]), "--out", str(tmp_path / "batch"), *FIT]
+    )
+    assert r.exit_code == 2, r.output
+    assert (tmp_path / "batch" / inputs["tiff"].name / "normals.npy").is_file()
+
+
 def test_the_dask_readers_image_of_a_jpeg_is_rows_on_disk_not_pixels_in_memory(
     inputs: dict[str, Path],
 ) -> None:
