@@ -228,7 +228,8 @@ def _solve(
                 f"light set is ill-conditioned for {model}: condition number {cond:.3g} over the "
                 f"hemisphere exceeds {cond_limit:g} (lights nearly coplanar or bunched near the "
                 "zenith for Lambert, on a single ring or a small cap for PTM/HSH); add lights "
-                "at other elevations, or pass ill_conditioned='regularise'"
+                "at other elevations (from Python, ill_conditioned='regularise' fits it "
+                "regularised)"
             )
         lam = float((s[0] / cond_limit) ** 2)
         filt = s / (s * s + lam)

@@ -21,7 +21,7 @@ from rti_rig.cli import app
 from rti_rig.core.rti_bases import hsh_basis, ptm_basis
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from fit_sessions import _rings, grazing_last_lights, make_session
+from fit_sessions import _rings, dome_lights, grazing_last_lights, make_session
 
 runner = CliRunner()
 
@@ -189,6 +189,27 @@ def test_an_hsh_order_that_does_not_exist_is_refused(clean, tmp_path: Path) -> N
     r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--hsh-order", "4"])
     assert r.exit_code == 2 and "--hsh-order 4: choose 1, 2 or 3" in " ".join(r.output.split())
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_refused_fit_leaves_nothing_so_the_corrected_command_runs(tmp_path: Path) -> None:
+    """A fit refused once it had begun writing (model_choice.md) left --out not empty: the
+    corrected command was then refused for that. An --out that existed empty stays, empty."""
+    session, _, _ = make_session(tmp_path / "s", lights=dome_lights()[:12], size=(48, 64))
+    out = tmp_path / "o"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--hsh-order", "3"])
+    assert r.exit_code == 2 and "needs at least 16 lights" in " ".join(r.output.split())
+    assert not out.exists()
+    three, _, _ = make_session(tmp_path / "s3", lights=dome_lights()[::12][:3], size=(48, 64))
+    out.mkdir()
+    r = runner.invoke(app, ["fit", str(three), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 2, r.output
+    assert "no candidate model can be fitted from 3 lights" in " ".join(r.output.split())
+    assert "--model ps" in r.output  # what still works, said
+    assert out.is_dir() and not any(out.iterdir())
+    r = runner.invoke(app, ["fit", str(three), "--out", str(out), "--model", "ps", "--no-qa"])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "o2"), "--hsh-order", "2"])
+    assert r.exit_code == 0, r.output
 
 
 def _names(indices) -> set[str]:

@@ -283,6 +283,21 @@ def prepare_out_dir(out: Path) -> None:
         raise FitInputError(str(exc)) from None
 
 
+def _discard_outputs(out: Path, created: bool) -> None:
+    """Remove what a failed fit wrote into ``out`` (checked new or empty before it began), and
+    ``out`` itself if this run created it."""
+    import shutil
+
+    if created:
+        shutil.rmtree(out, ignore_errors=True)
+        return
+    for path in list(out.iterdir()) if out.is_dir() else []:
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink(missing_ok=True)
+
+
 def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     """Fit, write every output into ``req.out_dir``, and judge the acquisition.
 
@@ -294,11 +309,19 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     frames, lights, names, what = load_acquisition(req.source, notes)
     release_free_memory()  # the decode buffers
     out = req.out_dir
+    created = not out.exists()
     prepare_out_dir(out)
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = _fit_all(req, stack, lights, out, bands or local_bands)
+        try:
+            result = _fit_all(req, stack, lights, out, bands or local_bands)
+        except BaseException:
+            # a refused fit (an --hsh-order the lights cannot support, lights that cannot be
+            # solved) had left model_choice.md behind, and the corrected command then found
+            # --out not empty; ``out`` was new or empty, so what is in it is this run's
+            _discard_outputs(out, created)
+            raise
     result.warnings = [str(w.message) for w in fit_warnings(caught)] + result.warnings
     result.notes = notes
     result.files.append(
@@ -373,8 +396,22 @@ def _fit_all(
     name = req.model
     n = stack.n
     choice = None
+    if req.hsh_order and req.write_hsh and n < (req.hsh_order + 1) ** 2:  # asked: refused
+        raise FitInputError(
+            f"--hsh-order {req.hsh_order} has {(req.hsh_order + 1) ** 2} coefficients per pixel "
+            f"and needs at least {(req.hsh_order + 1) ** 2} lights; {req.source} has {n}: "
+            "choose a lower order, or leave --hsh-order out"
+        )
     if name == AUTO:
-        choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS)
+        try:
+            choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS)
+        except ReconstructionError as exc:
+            if n < 3:
+                raise
+            raise FitInputError(
+                f"--model auto: {exc}. Photometric stereo alone (normals and albedo, no "
+                "relighting model) may still be fitted: --model ps"
+            ) from None
         model_name = choice.model
         (out / "model_choice.md").write_text(choice.to_markdown() + "\n", encoding="utf-8")
         files.append(out / "model_choice.md")
@@ -396,12 +433,6 @@ def _fit_all(
 
     # linear models to export, their solve matrices (warnings issued once, here)
     order, rti_why = rti_order(stack, lights, req, model_name, choice)
-    if req.hsh_order and req.write_hsh and n < (req.hsh_order + 1) ** 2:  # asked: refused
-        raise FitInputError(
-            f"--hsh-order {req.hsh_order} has {(req.hsh_order + 1) ** 2} coefficients per pixel "
-            f"and needs at least {(req.hsh_order + 1) ** 2} lights; {req.source} has {n}: "
-            "choose a lower order, or leave --hsh-order out"
-        )
     linear: dict[str, np.ndarray] = {}
     skipped: list[str] = []  # said, never silently left out
     if req.write_ptm and n >= 6:
