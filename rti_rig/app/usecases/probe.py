@@ -48,7 +48,15 @@ class ProbeResult:
             out.append(f"{what}: {shown!r}")
         if self.error:
             out.append(f"ERROR: {self.error}")
-        if self.profile is None:
+        if self.error and not self.heard:
+            # the port never opened: nothing was asked, so nothing can be concluded about a
+            # firmware (it had gone on to advise setting a profile for a port that is not there)
+            out.append(
+                "The port could not be opened, so no firmware was asked. Check the port's name "
+                "(ls /dev/ttyACM* /dev/ttyUSB*; on Windows COM3 ...), that the dome is plugged "
+                "in and powered, and that no other program holds the port."
+            )
+        elif self.profile is None:
             out.append(
                 "No known dome firmware answered. Domes that never answer (hadrian2/RTI_Dome) "
                 'cannot be identified by probing: set profile = "rti-dome-m" yourself, or '

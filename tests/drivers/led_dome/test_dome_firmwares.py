@@ -85,6 +85,18 @@ def test_probe_says_plainly_when_nothing_known_answers() -> None:
     assert board.lit == frozenset()
 
 
+def test_probe_of_a_port_that_cannot_be_opened_concludes_nothing_about_firmware(
+    tmp_path: Path,
+) -> None:
+    """A mistyped port had been told 'No known dome firmware answered' and to set a profile."""
+    r = runner.invoke(app, ["probe", str(tmp_path / "ttyACM9")])
+    assert r.exit_code == 1
+    text = said(r)
+    assert "cannot open serial port" in text and "no firmware was asked" in text
+    assert "No known dome firmware answered" not in text and "profile =" not in text
+    assert "nothing was sent" in text
+
+
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 @pytest.mark.parametrize("profile", list(CONFIG))
 def test_check_passes_on_each_firmware(profile: str) -> None:
