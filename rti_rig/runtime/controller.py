@@ -181,22 +181,36 @@ def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
 
 @contextlib.contextmanager
 def _signals_deferred() -> Iterator[None]:
-    """Hold SIGINT/SIGTERM while devices are put in their safe state.
+    """Hold SIGINT/SIGTERM while devices are put in their safe state, or while a captured
+    image is committed (its files and journal line).
 
-    An emergency-stop handler raising in the middle of teardown could leave a light on; the
-    signals are delivered (and acted on) as soon as teardown is done.
+    An emergency-stop handler raising in the middle of teardown could leave a light on, and in
+    the middle of a commit an image that ``lights.lp`` does not list; the signals are delivered
+    (and acted on) as soon as the block is done. Held at the level of Python's handlers, not
+    the thread's signal mask: a signal sent to the process is delivered to any thread that does
+    not block it (BLAS, the progress bar, an emulator's), and Python then runs the handler in
+    the main thread all the same — a mask in the main thread alone had held nothing.
     """
-    deferrable = hasattr(signal, "pthread_sigmask") and (
-        threading.current_thread() is threading.main_thread()
-    )
-    held = {signal.SIGINT, signal.SIGTERM}
-    if deferrable:
-        signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    if threading.current_thread() is not threading.main_thread():
+        yield  # handlers can only be set from the main thread, where they run
+        return
+    pending: list[tuple[int, Any]] = []
+
+    def hold(signum: int, frame: Any) -> None:
+        pending.append((signum, frame))
+
+    previous = {sig: signal.signal(sig, hold) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        if deferrable:
-            signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        for signum, frame in pending:  # delivered now, as they would have been
+            handler = previous[signum]
+            if callable(handler):
+                handler(signum, frame)
+            elif handler != signal.SIG_IGN:  # the default action (or a handler set outside
+                signal.raise_signal(signum)  # Python): raised again, now unheld
 
 
 def run_session(
@@ -279,20 +293,21 @@ def run_session(
             rig.lighting.off()
             if rig.capture_check is not None:  # may keep the image aside and stop the session
                 rig.capture_check(i, frame, actual, folder.root)
-            record = folder.write_step(
-                i,
-                frame,
-                {
-                    "planned_direction": step.direction,
-                    "actual_direction": actual.direction,
-                    "led": actual.led,
-                    "rig_start_s": t_start - rig_t0,
-                    "light_s": t_lit - t_start,
-                    "settle_s": t_settled - t_lit,
-                    "capture_s": t_captured - t_settled,
-                    **({"decision": decision} if decision is not None else {}),
-                },
-            )
+            fields = {
+                "planned_direction": step.direction,
+                "actual_direction": actual.direction,
+                "led": actual.led,
+                "rig_start_s": t_start - rig_t0,
+                "light_s": t_lit - t_start,
+                "settle_s": t_settled - t_lit,
+                "capture_s": t_captured - t_settled,
+                **({"decision": decision} if decision is not None else {}),
+            }
+            # the lights are off; an emergency stop raised between the files' rename and the
+            # journal line left an image on disk that lights.lp did not list: the commit of a
+            # captured image is finished first (a fraction of a second), then the stop acts
+            with _signals_deferred():
+                record = folder.write_step(i, frame, fields)
             if source is not None:
                 source.observe(i, frame, record)
             records.append(record)

@@ -305,3 +305,41 @@ def test_simulated_dslr_frames_go_through_the_raw_decode_path(tmp_path: Path) ->
     result = run_session(rig2, plan_uniform(rig2.geometry, 6), SessionFolder.create(out, 6))
     assert result.finish_reason is FinishReason.COMPLETED
     assert_images_intact(out, 6)
+
+
+def test_an_emergency_stop_during_an_image_s_commit_leaves_it_listed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A real SIGTERM (the CLI's handler raises EmergencyStop) arriving while step 4's files are
+    written: the commit finishes first, so every image on disk is in lights.lp and the
+    manifest. It had stopped between the files and the journal line, leaving an image on disk
+    that lights.lp did not list (found with a double Ctrl-C through the command line)."""
+    import os
+    import signal
+
+    import rti_rig.runtime.session as session_module
+    from rti_rig.runtime.controller import EmergencyStop
+
+    real_write = session_module.write_srgb_jpeg
+    calls = {"n": 0}
+
+    def write_and_get_killed(path, pixels):  # type: ignore[no-untyped-def]
+        calls["n"] += 1
+        if calls["n"] == 4:
+            os.kill(os.getpid(), signal.SIGTERM)  # acted on by the handler at once, unless held
+        return real_write(path, pixels)
+
+    def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]
+        raise EmergencyStop("SIGTERM")
+
+    monkeypatch.setattr(session_module, "write_srgb_jpeg", write_and_get_killed)
+    previous = signal.signal(signal.SIGTERM, on_sigterm)
+    try:
+        rig = small_rig(tmp_path)
+        out = tmp_path / "s"
+        with pytest.raises(EmergencyStop):
+            run_session(rig, plan_uniform(rig.geometry, 8), SessionFolder.create(out, 8))
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert manifest(out)["runner"]["finish_reason"] == "emergency-stop"
+    assert_images_intact(out, 4)
