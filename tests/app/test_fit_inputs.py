@@ -4,6 +4,7 @@ Also the two row readers the fit streams through, against the arrays they hold."
 
 from __future__ import annotations
 
+import json
 import shutil
 import sys
 import tempfile
@@ -182,6 +183,32 @@ def test_a_tiff_that_is_no_tiff_is_a_named_error_and_a_batch_goes_on(
     )
     assert r.exit_code == 2, r.output
     assert (tmp_path / "batch" / inputs["tiff"].name / "normals.npy").is_file()
+
+
+def test_a_session_missing_a_linear_tiff_says_its_8_bit_file_stood_in(
+    inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """linear/image_005.tif gone: the fit reads image_005.jpg instead, and says so (it had mixed
+    lossy 8-bit data into the linear fit without a word)."""
+    session = tmp_path / "s"
+    shutil.copytree(inputs["tiff"], session)
+    stem = Path(read_lp(session / "lights.lp")[4].name).stem
+    (session / "linear" / f"{stem}.tif").unlink()
+    cv2.imwrite(
+        str(session / f"{stem}.jpg"),
+        linear_to_srgb8(tifffile.imread(inputs["tiff"] / "linear" / f"{stem}.tif"), 65535)[
+            ..., ::-1
+        ],
+    )
+    r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "out"), *FIT])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "1 of 36 image(s) have no linear/ TIFF" in text and f"{stem}.jpg" in text, text
+    notes = json.loads((tmp_path / "out" / "fit.json").read_text())["input_notes"]
+    assert any("read from their 8-bit file instead" in n for n in notes)
+    # a session whose every TIFF is there says nothing of the kind
+    r = runner.invoke(app, ["fit", str(inputs["tiff"]), "--out", str(tmp_path / "o2"), *FIT])
+    assert "no linear/ TIFF" not in r.output
 
 
 def test_the_dask_readers_image_of_a_jpeg_is_rows_on_disk_not_pixels_in_memory(

@@ -235,12 +235,23 @@ def acquisition_files(
     refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
     entries = read_lp(lp, upper_hemisphere=True, notes=notes)
     lights = directions_of(entries)
-    paths, names = [], []
+    paths, names, stand_ins = [], [], []
     for e in entries:
         stem = Path(e.name).stem
         linear = lp.parent / "linear" / f"{stem}.tif"
         paths.append(linear if linear.is_file() else lp.parent / e.name)
         names.append(stem)
+        if not linear.is_file():
+            stand_ins.append(e.name)
+    if notes is not None and stand_ins and len(stand_ins) < len(entries):
+        # a session's linear/ lacks some TIFFs: their 8-bit files are read instead, said (the
+        # fit had mixed lossy 8-bit data into a linear one without a word)
+        shown = ", ".join(stand_ins[:5]) + (" ..." if len(stand_ins) > 5 else "")
+        notes.append(
+            f"{len(stand_ins)} of {len(entries)} image(s) have no linear/ TIFF and were read "
+            f"from their 8-bit file instead ({shown}): lossy, sRGB-decoded data beside linear "
+            "16-bit data; restore the TIFFs from a copy for a fully linear fit"
+        )
     return lp, lights, paths, names
 
 
