@@ -64,12 +64,12 @@ def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarra
     choice of fit.rti's order, which `rti-rig fit` makes on colour pixels with the saturated
     ones left out (a grey mean hides a channel at its top code)."""
     from rti_rig.core.image_files import read_image_any
-    from rti_rig.core.lp_format import read_lp
+    from rti_rig.core.lp_format import image_path, read_lp
 
     entries = read_lp(lp, upper_hemisphere=True)
     images, colour = [], []
     for e in entries:
-        img = read_image_any(lp.parent / e.name)
+        img = read_image_any(image_path(lp.parent, e.name))
         x = img.astype(np.float32) / (255.0 if img.dtype == np.uint8 else 65535.0)
         if img.dtype == np.uint8:  # sRGB decoding
             x = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)

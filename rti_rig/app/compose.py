@@ -326,6 +326,7 @@ def _session_hook(camera):  # type: ignore[no-untyped-def]
 def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
     """A recorded acquisition: a dome with exactly its lights, a camera that returns the image
     recorded for the LED fired (:mod:`rti_rig.simulator.replay`)."""
+    from rti_rig.core.lp_format import image_path
     from rti_rig.simulator.replay import ReplayCamera
     from rti_rig.simulator.sim_lights import LightState, SimulatedDome
 
@@ -336,7 +337,7 @@ def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
     dome = SimulatedDome(geometry, LightState(), clock, cfg.timing.light_switch_s)
     dome.name = "replayed dome"
     camera = ReplayCamera(
-        [folder / name for name in geometry.names],
+        [image_path(folder, name) for name in geometry.names],
         dome,
         clock,
         shape=(cfg.camera.height, cfg.camera.width),

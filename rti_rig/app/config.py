@@ -639,6 +639,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     """
     from rti_rig.core.errors import SessionError
     from rti_rig.core.image_files import header_layout, jpeg_truncation, read_image_any
+    from rti_rig.core.lp_format import image_path, is_absolute_name
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -647,7 +648,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         raise LpFormatError(lp_path, None, f"cannot read: {exc.strerror or exc}") from None
     notes: list[str] = []
     entries = read_lp(lp_path, upper_hemisphere=True, notes=notes)
-    missing = [e.name for e in entries if not (lp_path.parent / e.name).is_file()]
+    missing = [e.name for e in entries if not image_path(lp_path.parent, e.name).is_file()]
     if missing:
         more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
         shown = ", ".join(missing[:5]) + more
@@ -655,12 +656,19 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             lp_path,
             None,
             f"as a rig, an .lp is a recorded acquisition whose images lie beside it: "
-            f"{len(missing)} of {len(entries)} image(s) missing in {lp_path.parent} ({shown})",
+            f"{len(missing)} of {len(entries)} image(s) missing in {lp_path.parent} ({shown})"
+            + (
+                "; an absolute name (a path on the machine that wrote the .lp) is looked for "
+                "by its file name beside the .lp and in a jpeg-exports folder beside it or "
+                "beside its folder"
+                if any(is_absolute_name(m) for m in missing)
+                else ""
+            ),
         )
     damaged = [
         f"{e.name}: {why}"
         for e in entries
-        if (why := jpeg_truncation(lp_path.parent / e.name)) is not None
+        if (why := jpeg_truncation(image_path(lp_path.parent, e.name))) is not None
     ]
     if damaged:  # OpenCV would decode them with their missing part grey, and say nothing
         raise ConfigError(
@@ -677,7 +685,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     layouts: dict[str, tuple[int, int, bool]] = {}
     unreadable: list[str] = []
     for e in entries:
-        path = lp_path.parent / e.name
+        path = image_path(lp_path.parent, e.name)
         layout = header_layout(path)
         if layout is None:
             try:

@@ -27,7 +27,7 @@ import numpy as np
 
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
-from rti_rig.core.lp_format import LpEntry
+from rti_rig.core.lp_format import LpEntry, image_path
 from rti_rig.runtime.session import LINEAR_DIR, MANIFEST, read_manifest
 
 #: A bare `.lp` given as ``--rig``: its path and its entries.
@@ -94,7 +94,7 @@ def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any]]:
     if rig_lp is not None:
         lp, entries = rig_lp
         for e in entries:
-            if (lp.parent / e.name).resolve() == target:
+            if image_path(lp.parent, e.name).resolve() == target:
                 found.append((str(lp), lp.name, e.direction))
                 break
     return found

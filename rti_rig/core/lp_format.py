@@ -99,16 +99,52 @@ def write_lp(path: Path, entries: Sequence[LpEntry]) -> Path:
     return path
 
 
+def is_absolute_name(name: str) -> bool:
+    """An image name that is a path from the root, on either system's rules."""
+    return any(
+        pure.is_absolute() or bool(pure.drive) or bool(pure.anchor)
+        for pure in (PurePosixPath(name), PureWindowsPath(name))
+    )
+
+
+def image_file_name(name: str) -> str:
+    """The file name alone of an image an `.lp` line names, whichever system wrote the path
+    (``H:\\RTI\\jpeg-exports\\a_01.jpg`` -> ``a_01.jpg``)."""
+    return PureWindowsPath(name).name if "\\" in name else PurePosixPath(name).name
+
+
+def image_path(lp_dir: Path, name: str) -> Path:
+    """Where the image an `.lp` line names is, for an `.lp` in ``lp_dir``.
+
+    A relative name is read relative to the `.lp`'s folder (``\\`` as a folder separator, as
+    Windows tools write it). An absolute name — what RTIBuilder writes, the project's path on
+    the machine that built it (``H:\\RTI_Data\\proj\\jpeg-exports\\proj_01.jpg``) — is looked
+    for by its file name beside the `.lp`, then in a ``jpeg-exports`` folder beside it or beside
+    its folder (RTIBuilder keeps the `.lp` in ``assembly-files/``), then at the path itself. The
+    first that exists is returned; none existing, the file beside the `.lp` (for the caller's
+    "missing" message)."""
+    lp_dir = Path(lp_dir)
+    if not is_absolute_name(name):
+        literal = lp_dir / name
+        portable = lp_dir / PureWindowsPath(name).as_posix() if "\\" in name else literal
+        return literal if literal.exists() and not portable.exists() else portable
+    base = image_file_name(name)
+    candidates = [
+        lp_dir / base,
+        lp_dir / "jpeg-exports" / base,
+        lp_dir.parent / "jpeg-exports" / base,
+    ]
+    if PurePosixPath(name).is_absolute():
+        candidates.append(Path(name))
+    return next((c for c in candidates if c.is_file()), candidates[0])
+
+
 def _check_name(name: str, source: str, lineno: int) -> None:
-    """Reject names that would resolve outside the `.lp` file's own folder."""
+    """Reject relative names that would resolve outside the `.lp` file's own folder (an
+    absolute name is a tool's path on its own machine: see :func:`image_path`)."""
+    if is_absolute_name(name):
+        return
     for pure in (PurePosixPath(name), PureWindowsPath(name)):
-        if pure.is_absolute() or pure.drive or pure.anchor:
-            raise LpFormatError(
-                source,
-                lineno,
-                f"image name {name!r} is an absolute path; names must be relative to the .lp "
-                "file's folder (rewrite the name as a bare file name)",
-            )
         if ".." in pure.parts:
             raise LpFormatError(
                 source,
@@ -149,6 +185,18 @@ def parse_lp(
     lines = text.splitlines()  # handles LF, CRLF and CR
     numbered = [(i + 1, ln.strip()) for i, ln in enumerate(lines)]
     content = [(n, ln) for n, ln in numbered if ln]
+    comments = [n for n, ln in content if ln.startswith("#")]
+    if comments:
+        # no .lp writer we know of writes them, but a hand-annotated file is no wrong file:
+        # skipped, and said (a '# LP file from RTIBuilder, dome A' header had been refused as
+        # "x component 'RTIBuilder,' is not a number"; one ending in three numbers would have
+        # been read as a light)
+        content = [(n, ln) for n, ln in content if not ln.startswith("#")]
+        notes.append(
+            f"{source}, line{'s' if len(comments) > 1 else ''} "
+            f"{', '.join(map(str, comments[:5]))}{' ...' if len(comments) > 5 else ''}: "
+            "comment line(s) starting with '#' skipped"
+        )
     if not content:
         raise LpFormatError(source, None, "the file is empty; expected a count line and lights")
 

@@ -11,7 +11,15 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rti_rig.core.errors import LpFormatError
-from rti_rig.core.lp_format import LpEntry, format_lp, parse_lp, read_lp, write_lp
+from rti_rig.core.lp_format import (
+    LpEntry,
+    format_lp,
+    image_file_name,
+    image_path,
+    parse_lp,
+    read_lp,
+    write_lp,
+)
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 # The profile of docs/conventions.md: count line, then 'name x y z' in fixed point 0.xxxxxx.
@@ -82,8 +90,7 @@ def test_tolerant_reading() -> None:
         ("1\na_1.jpg 0 0 0\n", 2, "nearly) zero"),
         ("1\n../a_1.jpg 0 0 1\n", 2, "climbs out"),
         ("1\nsub/../../a_1.jpg 0 0 1\n", 2, "climbs out"),
-        ("1\n/etc/a_1.jpg 0 0 1\n", 2, "absolute path"),
-        ("1\nC:\\data\\a_1.jpg 0 0 1\n", 2, "absolute path"),
+        ("1\nsub\\..\\..\\a_1.jpg 0 0 1\n", 2, "climbs out"),
         ("2\na_1.jpg 0 0 1\na_1.jpg 0 1 0\n", 3, "already used on line 2"),
         ("1\na_1.jpg 0 0 nan\n", 2, "not finite"),
         ("1\na_1.jpg 0 1\n", 2, "expected 'name x y z'"),
@@ -97,6 +104,46 @@ def test_malformed_files_name_line_and_reason(text: str, line: int, fragment: st
     assert info.value.line == line
     assert fragment in str(info.value)
     assert str(info.value).startswith(f"plan.lp, line {line}: ")
+
+
+def test_absolute_names_as_rtibuilder_writes_them_are_read(tmp_path: Path) -> None:
+    """RTIBuilder writes the image's path on the machine that built the project
+    (``H:\\RTI_Data\\proj\\jpeg-exports\\proj_01.jpg``) into an .lp kept in assembly-files/:
+    such files had been refused ("an absolute path"). The images are found by file name beside
+    the .lp, in jpeg-exports/ beside it or beside its folder; relative names with backslashes
+    as folders."""
+    text = (
+        "3\r\n"
+        "H:\\RTI_Data\\proj\\jpeg-exports\\proj_01.jpg 0.1 0.2 0.97\r\n"
+        "/home/me/proj/jpeg-exports/proj_02.jpg 0.2 0.1 0.97\r\n"
+        "jpeg-exports\\proj_03.jpg -0.2 0.1 0.97\r\n"
+    )
+    entries = parse_lp(text, "proj.lp")
+    assert [image_file_name(e.name) for e in entries] == [
+        "proj_01.jpg",
+        "proj_02.jpg",
+        "proj_03.jpg",
+    ]
+    lp_dir = tmp_path / "proj" / "assembly-files"
+    exports = tmp_path / "proj" / "jpeg-exports"
+    lp_dir.mkdir(parents=True)
+    exports.mkdir()
+    for k in (1, 2):
+        (exports / f"proj_0{k}.jpg").write_bytes(b"")
+    assert image_path(lp_dir, entries[0].name) == exports / "proj_01.jpg"
+    assert image_path(lp_dir, entries[1].name) == exports / "proj_02.jpg"
+    (lp_dir / "proj_01.jpg").write_bytes(b"")  # beside the .lp comes first
+    assert image_path(lp_dir, entries[0].name) == lp_dir / "proj_01.jpg"
+    assert image_path(lp_dir, entries[2].name) == lp_dir / "jpeg-exports" / "proj_03.jpg"
+    # nothing found: the file beside the .lp, for the caller's "missing" message
+    assert image_path(lp_dir, "Z:\\x\\gone.jpg") == lp_dir / "gone.jpg"
+
+
+def test_comment_lines_are_skipped_and_said() -> None:
+    notes: list[str] = []
+    entries = parse_lp("# LP file from RTIBuilder, dome A\n1\na_1.jpg 0 0 1\n", "x.lp", notes=notes)
+    assert [e.name for e in entries] == ["a_1.jpg"]
+    assert notes == ["x.lp, line 1: comment line(s) starting with '#' skipped"]
 
 
 def test_empty_and_missing(tmp_path: Path) -> None:

@@ -253,3 +253,31 @@ def test_an_all_greyscale_acquisition_replays_and_fits(tmp_path: Path) -> None:
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "f"), "--no-qa"])
     assert r.exit_code == 0, r.output
     assert (tmp_path / "f" / "fit.json").is_file()
+
+
+def test_an_rtibuilder_project_replays_and_fits_with_its_absolute_windows_names(
+    tmp_path: Path,
+) -> None:
+    """RTIBuilder keeps the .lp in assembly-files/ and names each image by its path on the
+    machine that built the project: such a real .lp had been refused ("an absolute path").
+    Replayed, every image is the recorded one for its light; fitted, every light is used."""
+    project = tmp_path / "icon_RTI"
+    (project / "assembly-files").mkdir(parents=True)
+    shutil.copytree(ACQ, project / "jpeg-exports", ignore=shutil.ignore_patterns("*.lp"))
+    lines = (ACQ / "dirs.lp").read_text().splitlines()
+    windows = [lines[0]] + [
+        f"H:\\RTI_Data\\icon_RTI\\jpeg-exports\\{line}" for line in lines[1:] if line.strip()
+    ]
+    lp = project / "assembly-files" / "icon_RTI.lp"
+    lp.write_bytes(("\r\n".join(windows) + "\r\n").encode())
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(lp), "--out", str(out), "--lights", "6", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    source = read_lp(ACQ / "dirs.lp")
+    for step in _journal(out):
+        decoded = read_jpeg_rgb(ACQ / source[step["led"]].name)
+        mine = linear_to_srgb8(read_linear_tiff(out / step["linear_image"]), 65535)
+        assert np.array_equal(mine, decoded)
+    r = runner.invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    assert json.loads((tmp_path / "f" / "fit.json").read_text())["read"].startswith("18 images")
