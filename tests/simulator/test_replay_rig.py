@@ -259,14 +259,15 @@ def test_an_rtibuilder_project_replays_and_fits_with_its_absolute_windows_names(
     tmp_path: Path,
 ) -> None:
     """RTIBuilder keeps the .lp in assembly-files/ and names each image by its path on the
-    machine that built the project: such a real .lp had been refused ("an absolute path").
+    machine that built the project (here with a space in a folder's name): such a real .lp had
+    been refused ("an absolute path").
     Replayed, every image is the recorded one for its light; fitted, every light is used."""
     project = tmp_path / "icon_RTI"
     (project / "assembly-files").mkdir(parents=True)
     shutil.copytree(ACQ, project / "jpeg-exports", ignore=shutil.ignore_patterns("*.lp"))
     lines = (ACQ / "dirs.lp").read_text().splitlines()
     windows = [lines[0]] + [
-        f"H:\\RTI_Data\\icon_RTI\\jpeg-exports\\{line}" for line in lines[1:] if line.strip()
+        f"H:\\RTI Data\\icon_RTI\\jpeg-exports\\{line}" for line in lines[1:] if line.strip()
     ]
     lp = project / "assembly-files" / "icon_RTI.lp"
     lp.write_bytes(("\r\n".join(windows) + "\r\n").encode())
@@ -281,3 +282,12 @@ def test_an_rtibuilder_project_replays_and_fits_with_its_absolute_windows_names(
     r = runner.invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"])
     assert r.exit_code == 0, r.output
     assert json.loads((tmp_path / "f" / "fit.json").read_text())["read"].startswith("18 images")
+    # a plan on it (the names have a space: its writer had stopped with a traceback), then run
+    plan = tmp_path / "plan.lp"
+    r = runner.invoke(app, ["plan", "--rig", str(lp), "--lights", "6", "--out", str(plan)])
+    assert r.exit_code == 0, r.output
+    assert [e.name for e in read_lp(plan)][0] == "image01.jpg"
+    r = runner.invoke(
+        app, ["run", str(lp), "--out", str(tmp_path / "p"), "--plan", str(plan), "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output

@@ -18,7 +18,7 @@ from rti_rig.app.output_files import check_output_file
 from rti_rig.app.preview_source import resolve_preview
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import direction_from_az_el
-from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, PlanRequest, check_plan_options, plan
@@ -178,7 +178,10 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if light_note and report.preview_light_source == "given":
         report.preview_light_source = light_note
     if bare_lp:
-        names = [s.label for s in schedule.steps]
+        # the acquisition's own names, written as the .lp profile allows (no whitespace): a
+        # name with spaces (RTIBuilder's 'H:\\RTI Data\\...' paths) had stopped the plan with a
+        # traceback; the plan is run by its directions, the names are labels
+        names = [_lp_label(s.label) for s in schedule.steps]
     else:
         names = [f"{n}.jpg" for n in image_names(len(schedule))]
     write_lp(
@@ -186,6 +189,14 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
     )
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
+
+
+def _lp_label(label: str) -> str:
+    """``label`` as an .lp name: unchanged without whitespace, else its file name with any
+    whitespace left as underscores."""
+    if not any(c.isspace() for c in label):
+        return label
+    return "_".join(image_file_name(label).split())
 
 
 def draw_plan_figure(req: PlanLightsRequest, planned: PlannedLights) -> Path:
