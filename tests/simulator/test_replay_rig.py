@@ -286,7 +286,7 @@ def test_an_rtibuilder_project_replays_and_fits_with_its_absolute_windows_names(
     plan = tmp_path / "plan.lp"
     r = runner.invoke(app, ["plan", "--rig", str(lp), "--lights", "6", "--out", str(plan)])
     assert r.exit_code == 0, r.output
-    assert [e.name for e in read_lp(plan)][0] == "image01.jpg"
+    assert read_lp(plan)[0].name == "image01.jpg"
     r = runner.invoke(
         app, ["run", str(lp), "--out", str(tmp_path / "p"), "--plan", str(plan), "--no-verdict"]
     )
