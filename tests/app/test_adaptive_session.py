@@ -463,3 +463,21 @@ def test_a_session_recorded_by_the_build_before_resumes(tmp_path: Path) -> None:
     total = manifest(out)["timing"]["rig_time_s"]
     assert total > manifest(ref)["timing"]["rig_time_s"] * 0.99
     assert f"Session time on the real rig: {total:.1f} s over 2 runs (this run " in said(r)
+
+
+def test_a_resume_whose_rig_config_moved_says_to_give_it(tmp_path: Path) -> None:
+    """The config moved after the shoot: the resume had said only 'cannot read the file'."""
+    (tmp_path / "a").mkdir()
+    cfg = write_config(tmp_path / "a", SMALL_DOME)
+    out = tmp_path / "cut"
+    interrupted(cfg, out, after_step=2)
+    moved = tmp_path / "b" / "dome.toml"
+    moved.parent.mkdir()
+    cfg.rename(moved)
+    before = folder_bytes(out)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "is not there any more" in said(r) and "rti-rig run RIG.toml --resume" in said(r)
+    assert folder_bytes(out) == before
+    r = runner.invoke(app, ["run", str(moved), "--resume", str(out)])
+    assert r.exit_code == 0, r.output

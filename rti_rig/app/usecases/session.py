@@ -441,6 +441,13 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
             "give it: rti-rig run RIG.toml --resume DIR"
         )
     config_path = req.rig_config or Path(rig_entry["config_path"])
+    if req.rig_config is None and not config_path.is_file():
+        raise RtiRigError(
+            f"{req.session_dir}: the rig config it was shot with, {config_path}, is not there "
+            "any more (moved or renamed?); give it: rti-rig run RIG.toml --resume "
+            f"{req.session_dir} (the session's manifest keeps a copy of the config it began "
+            "with, and a resume checks the rig against it)"
+        )
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
         on_note(Note(note, "warning"))
