@@ -51,7 +51,10 @@ def bench_tradeoff(
         ),
     ] = None,
     quick: Annotated[
-        bool, typer.Option("--quick", help="Fewer scenes, light counts and pixels (minutes).")
+        bool,
+        typer.Option(
+            "--quick", help="Fewer scenes, light counts and pixels (minutes; not with --from)."
+        ),
     ] = False,
     from_lp: Annotated[
         Path | None,
@@ -99,6 +102,13 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None) -> None:
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
     from benchmarks.tradeoff_from import bench_from
 
+    if from_lp is not None and quick:  # accepted and ignored, it had changed nothing
+        raise fail(
+            RtiRigError(
+                "--quick has no effect with --from (the trade is measured on every light of "
+                "your acquisition): drop --quick"
+            )
+        )
     if out_dir is not None:  # before minutes of computing, not after
         try:
             ensure_writable_folder(out_dir)

@@ -105,3 +105,12 @@ def test_tradeoff_from_too_small_an_acquisition_is_refused(tmp_path: Path) -> No
         app, ["bench", "tradeoff", "--from", str(small / "dirs.lp"), "--out", str(tmp_path / "o")]
     )
     assert r.exit_code == 2 and "at least 10" in r.output and "held out" in r.output
+
+
+def test_quick_with_from_is_refused_before_anything_is_written(tmp_path: Path) -> None:
+    """--quick did nothing with --from (the run took as long), yet was accepted in silence."""
+    r = CliRunner().invoke(
+        app, ["bench", "tradeoff", "--quick", "--from", str(ACQ), "--out", str(tmp_path / "o")]
+    )
+    assert r.exit_code == 2 and "--quick has no effect with --from" in " ".join(r.output.split())
+    assert not (tmp_path / "o").exists()
