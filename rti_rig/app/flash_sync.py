@@ -420,7 +420,9 @@ class FlashSyncCheckReport:
         self._lines, self.ok = lines, ok
 
     def lines(self) -> list[str]:
-        return list(self._lines)
+        # ends, as every check does, with its result: what was tested (the camera) passed or not
+        result = "PASS (the camera; the LEDs cannot be tested)" if self.ok else "FAIL"
+        return [*self._lines, f"RESULT: {result}"]
 
 
 def flash_sync_check(loaded) -> FlashSyncCheckReport:  # type: ignore[no-untyped-def]

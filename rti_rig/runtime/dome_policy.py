@@ -658,7 +658,7 @@ class SelfTestReport:
             if self.firmware
             else "unknown firmware"
         )
-        out = [f"{self.name}: {fw}, {self.led_count} LEDs"]
+        out = [f"{self.name}: {' '.join(fw.split())}, {self.led_count} LEDs"]
         passed = sum(c.ok for c in self.checks)
         out.append(
             f"LEDs stepped: {len(self.checks)}, passed: {passed}, "

@@ -75,6 +75,8 @@ def test_check_says_what_it_cannot_test_and_shoots_nothing(rigs) -> None:  # typ
     assert "cannot light its LEDs" in result.output
     assert "long-press" in result.output
     assert "the proof frame" in " ".join(result.output.split())
+    # it ends, as the guide says every check does, with its result
+    assert result.output.rstrip().splitlines()[-1].startswith("RESULT: PASS (the camera;")
     assert rigs[0].camera.exposures == 0  # a shot would have stepped the dome
     assert rigs[0].camera.dome.led_index == 0
 
