@@ -106,6 +106,8 @@ def fit(
             )
         if hsh_order is not None and hsh_order not in (1, 2, 3):
             raise RtiRigError(f"--hsh-order {hsh_order}: choose 1, 2 or 3")
+        if hsh_order is not None and no_hsh:  # it had been accepted and ignored
+            raise RtiRigError("--hsh-order sets fit.rti's order, which --no-hsh does not write")
         if model != "auto":
             try:
                 model_spec(model)

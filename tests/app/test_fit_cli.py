@@ -189,6 +189,9 @@ def test_an_hsh_order_that_does_not_exist_is_refused(clean, tmp_path: Path) -> N
     r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--hsh-order", "4"])
     assert r.exit_code == 2 and "--hsh-order 4: choose 1, 2 or 3" in " ".join(r.output.split())
     assert not out.exists() or not any(out.iterdir())
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--hsh-order", "2", "--no-hsh"])
+    assert r.exit_code == 2 and "which --no-hsh does not write" in " ".join(r.output.split())
+    assert not out.exists() or not any(out.iterdir())
 
 
 def test_a_refused_fit_leaves_nothing_so_the_corrected_command_runs(tmp_path: Path) -> None:
