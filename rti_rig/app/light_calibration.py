@@ -41,6 +41,12 @@ from rti_rig.runtime.session import read_manifest
 WORK_SIZE = 512
 #: A card image with more saturated pixels than this is refused (its gain would be clipped).
 MAX_SATURATED = 0.01
+#: A card session whose photometric-stereo normals spread more than this (degrees, 90th
+#: percentile of their angle to the mean normal) is not of a flat card: refused. Measured:
+#: the emulated dome's card session 1.3°, its coin scene (6 LEDs) 35°; a real card's would
+#: rise with the lights' change of direction across it (near LEDs, a large card), hence the
+#: room left.
+MAX_CARD_SPREAD_DEG = 10.0
 
 
 @dataclass(frozen=True)
@@ -196,6 +202,23 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         drive=np.array(drive),
         correction=None if correction is None else tuple(float(v) for v in correction),
     )
+
+
+def card_spread_deg(card: CardSession) -> float:
+    """How far the card session's images are from a flat card's: the 90th percentile of the
+    angle between each pixel's least-squares photometric-stereo normal and their mean. A level
+    card gives about a degree; an object's relief, tens (the coin scene of the emulated dome:
+    35°), and its "gains" would be its relief's, not the LEDs'."""
+    from rti_rig.reconstruct import fit_photometric_stereo
+
+    ps = fit_photometric_stereo(card.images, card.directions, robust=False)
+    normals = ps.normals[ps.valid].astype(np.float64)
+    if len(normals) == 0:
+        return float("inf")
+    mean = normals.mean(axis=0)
+    mean /= max(float(np.linalg.norm(mean)), 1e-12)
+    angles = np.degrees(np.arccos(np.clip(normals @ mean, -1.0, 1.0)))
+    return float(np.percentile(angles, 90))
 
 
 def _work_image(pixels: NDArray[Any]) -> NDArray[np.float32]:

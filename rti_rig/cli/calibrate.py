@@ -63,6 +63,14 @@ def calibrate_lights(
         ),
     ] = 5.0,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+    not_flat_ok: Annotated[
+        bool,
+        typer.Option(
+            "--not-flat-ok",
+            help="Calibrate even if the images do not look like a flat card's (their normals "
+            "spread more than 10°: a card large for its dome).",
+        ),
+    ] = False,
 ) -> None:
     """Measure each LED's light from a card session and write the intensity correction that
     evens the dome out (every LED dimmed to the weakest one's light), for [dome.serial]
@@ -81,6 +89,7 @@ def calibrate_lights(
                 _parse_normal(card_normal),
                 min_elevation_deg,
                 force,
+                not_flat_ok,
             )
         )
     except RtiRigError as exc:

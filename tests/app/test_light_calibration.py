@@ -362,3 +362,25 @@ def test_the_calibration_file_counts_in_the_rig_fingerprint_and_follows_symlinks
             load_rig_config(cfg)
         assert info.value.key == "dome.serial.intensity_correction_file"
         assert fragment in info.value.message
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
+def test_a_session_of_an_object_is_not_calibrated_as_a_card(tmp_path: Path) -> None:
+    """The coin, not the card, shot on the same dome: its relief had been read as the LEDs'
+    differences and the user told to install the correction. Refused, nothing written; a card
+    large for its dome can still be calibrated with --not-flat-ok."""
+    cfg = card_rig(tmp_path)
+    text = cfg.read_text().replace('name = "flat"', 'name = "coin"')
+    text = text.replace("exposure_s = 0.05", "exposure_s = 0.005")  # the coin's face unclipped
+    coin_cfg = write_config(tmp_path, text, "coin.toml")
+    coin = tmp_path / "coin"
+    r = runner.invoke(app, ["run", str(coin_cfg), "--out", str(coin), "--lights", "12"])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["calibrate-lights", str(coin), "--rig", str(coin_cfg)])
+    assert r.exit_code == 2, r.output
+    assert "these images are not of a flat card" in said(r) and "--not-flat-ok" in said(r)
+    assert not (coin / "light_calibration.toml").exists()
+    r = runner.invoke(app, ["calibrate-lights", str(coin), "--rig", str(coin_cfg), "--not-flat-ok"])
+    assert r.exit_code == 0, r.output

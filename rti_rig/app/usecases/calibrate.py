@@ -14,10 +14,12 @@ from pathlib import Path
 
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
 from rti_rig.app.light_calibration import (
+    MAX_CARD_SPREAD_DEG,
     CardSession,
     LightCalibration,
     calibrate_dome,
     calibration_toml,
+    card_spread_deg,
     read_card_session,
 )
 from rti_rig.app.output_files import check_output_file
@@ -35,6 +37,8 @@ class CalibrateRequest:
     card_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
     min_elevation_deg: float = 5.0
     force: bool = False
+    #: Skip the check that the images are of a flat card (see ``MAX_CARD_SPREAD_DEG``).
+    not_flat_ok: bool = False
 
     @property
     def target(self) -> Path:
@@ -80,6 +84,17 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             "replaced); give --out to write the calibration elsewhere"
         )
     check_output_file(target, req.force, {"RIG": req.rig_config})
+    spread = card_spread_deg(card)
+    if spread > MAX_CARD_SPREAD_DEG and not req.not_flat_ok:
+        # an object's session had been "calibrated" into a correction the user was told to
+        # install: its relief read as the LEDs' differences
+        raise RtiRigError(
+            f"{req.card_session}: these images are not of a flat card: their fitted normals "
+            f"spread {spread:.0f}° (90th percentile from their mean; a level card gives about "
+            f"1°, the limit is {MAX_CARD_SPREAD_DEG:g}°), so what differs between them is the "
+            "object's relief, not the LEDs. Shoot a level matte white card under every LED; "
+            "if this is one (a card large for its dome), give --not-flat-ok"
+        )
     cal = calibrate_dome(
         card,
         geometry.count,
