@@ -255,6 +255,7 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
         FinishReason,
         Paused,
         StepCompleted,
+        StepStarted,
     )
     from rti_rig.runtime.session import LP_NAME
 
@@ -308,6 +309,8 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
                     progress.advance(task)
                 elif isinstance(event, Paused):
                     progress.update(task, description="paused")
+                elif isinstance(event, StepStarted):  # after a pause: capturing again
+                    progress.update(task, description="capturing")
 
             result = run_opened_session(opened, cancel, on_event)
     except EmergencyStop as exc:
