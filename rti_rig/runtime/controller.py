@@ -195,22 +195,46 @@ def _signals_deferred() -> Iterator[None]:
         yield  # handlers can only be set from the main thread, where they run
         return
     pending: list[tuple[int, Any]] = []
+    raised: list[BaseException] = []  # by a pending signal's handler as a handler was swapped
 
     def hold(signum: int, frame: Any) -> None:
         pending.append((signum, frame))
 
-    previous = {sig: signal.signal(sig, hold) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
+    installed: dict[int, Any] = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(sig) is None:  # set outside Python: it could not be put back
+            continue
+        installed[sig] = _swap_handler(sig, hold, raised)
+    try:  # a stop that came as the hold was set (in ``raised``) acts after the block too
         yield
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        for sig, handler in installed.items():
+            _swap_handler(sig, handler, raised)
         for signum, frame in pending:  # delivered now, as they would have been
-            handler = previous[signum]
+            handler = installed.get(signum)
+            if handler is None:
+                continue
             if callable(handler):
-                handler(signum, frame)
-            elif handler != signal.SIG_IGN:  # the default action (or a handler set outside
-                signal.raise_signal(signum)  # Python): raised again, now unheld
+                try:
+                    handler(signum, frame)
+                except BaseException as exc:
+                    raised.append(exc)
+            elif handler != signal.SIG_IGN:  # the default action: raised again, now unheld
+                signal.raise_signal(signum)
+        if raised:
+            raise raised[0]
+
+
+def _swap_handler(sig: int, handler: Any, raised: list[BaseException]) -> Any:
+    """``signal.signal(sig, handler)``, made to happen: Python first runs the handlers of any
+    signal already pending, and one that raises (the CLI's emergency stop) would skip the swap
+    and leave a hold half set or half undone. Its exception is kept in ``raised``, the swap
+    tried again."""
+    while True:
+        try:
+            return signal.signal(sig, handler)
+        except BaseException as exc:
+            raised.append(exc)
 
 
 def run_session(
