@@ -639,7 +639,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     """
     from rti_rig.core.errors import SessionError
     from rti_rig.core.image_files import header_layout, jpeg_truncation, read_image_any
-    from rti_rig.core.lp_format import image_path, is_absolute_name
+    from rti_rig.core.lp_format import image_paths, is_absolute_name
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -648,7 +648,8 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         raise LpFormatError(lp_path, None, f"cannot read: {exc.strerror or exc}") from None
     notes: list[str] = []
     entries = read_lp(lp_path, upper_hemisphere=True, notes=notes)
-    missing = [e.name for e in entries if not image_path(lp_path.parent, e.name).is_file()]
+    paths = dict(zip((e.name for e in entries), image_paths(lp_path, entries), strict=True))
+    missing = [e.name for e in entries if not paths[e.name].is_file()]
     if missing:
         more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
         shown = ", ".join(missing[:5]) + more
@@ -666,9 +667,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             ),
         )
     damaged = [
-        f"{e.name}: {why}"
-        for e in entries
-        if (why := jpeg_truncation(image_path(lp_path.parent, e.name))) is not None
+        f"{e.name}: {why}" for e in entries if (why := jpeg_truncation(paths[e.name])) is not None
     ]
     if damaged:  # OpenCV would decode them with their missing part grey, and say nothing
         raise ConfigError(
@@ -685,7 +684,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     layouts: dict[str, tuple[int, int, bool]] = {}
     unreadable: list[str] = []
     for e in entries:
-        path = image_path(lp_path.parent, e.name)
+        path = paths[e.name]
         layout = header_layout(path)
         if layout is None:
             try:

@@ -72,6 +72,8 @@ def format_lp(entries: Sequence[LpEntry]) -> str:
     for e in entries:
         if not _NAME_OK.match(e.name):
             raise ValueError(f"image name {e.name!r} is empty or contains whitespace")
+        if not e.name.isascii() or e.name.startswith("#"):  # written as ASCII; '#' a comment
+            raise ValueError(f"image name {e.name!r} is not ASCII or starts with '#'")
         d = np.asarray(e.direction, dtype=np.float64)
         n = float(np.linalg.norm(d))
         if not math.isfinite(n) or n < MIN_NORM:
@@ -90,9 +92,12 @@ def write_lp(path: Path, entries: Sequence[LpEntry]) -> Path:
         with open(tmp, "w", encoding="ascii", newline="\n") as fh:
             fh.write(text)
         tmp.replace(path)
-    except OSError as exc:  # a read-only or missing folder, a full disk: say which file
+    except BaseException as exc:  # the temporary file never outlives a failed write
         with contextlib.suppress(OSError):
             tmp.unlink()
+        if not isinstance(exc, OSError):
+            raise
+        # a read-only or missing folder, a full disk: say which file
         raise LpFormatError(
             path, None, f"cannot write: {exc.strerror or exc}; choose a folder you can write to"
         ) from None
@@ -120,9 +125,10 @@ def image_path(lp_dir: Path, name: str) -> Path:
     Windows tools write it). An absolute name — what RTIBuilder writes, the project's path on
     the machine that built it (``H:\\RTI_Data\\proj\\jpeg-exports\\proj_01.jpg``) — is looked
     for by its file name beside the `.lp`, then in a ``jpeg-exports`` folder beside it or beside
-    its folder (RTIBuilder keeps the `.lp` in ``assembly-files/``), then at the path itself. The
-    first that exists is returned; none existing, the file beside the `.lp` (for the caller's
-    "missing" message)."""
+    its folder (RTIBuilder keeps the `.lp` in ``assembly-files/``); never at the path itself,
+    which is another machine's (and would let an `.lp` read any file, where a relative name
+    that climbs out with ``..`` is refused). The first that exists is returned; none
+    existing, the file beside the `.lp` (for the caller's "missing" message)."""
     lp_dir = Path(lp_dir)
     if not is_absolute_name(name):
         literal = lp_dir / name
@@ -134,9 +140,24 @@ def image_path(lp_dir: Path, name: str) -> Path:
         lp_dir / "jpeg-exports" / base,
         lp_dir.parent / "jpeg-exports" / base,
     ]
-    if PurePosixPath(name).is_absolute():
-        candidates.append(Path(name))
     return next((c for c in candidates if c.is_file()), candidates[0])
+
+
+def image_paths(lp_path: Path, entries: Sequence[LpEntry]) -> list[Path]:
+    """:func:`image_path` of every entry of the `.lp` at ``lp_path``; two lines that come to
+    one file (absolute names in two folders with one file name) are refused, naming them."""
+    paths = [image_path(Path(lp_path).parent, e.name) for e in entries]
+    first: dict[Path, str] = {}
+    for e, p in zip(entries, paths, strict=True):
+        if p in first:
+            raise LpFormatError(
+                lp_path,
+                None,
+                f"{first[p]!r} and {e.name!r} are both read from {p}: two lights cannot share "
+                "an image (their names differ only in folders the .lp's machine had)",
+            )
+        first[p] = e.name
+    return paths
 
 
 def _check_name(name: str, source: str, lineno: int) -> None:

@@ -16,6 +16,7 @@ from rti_rig.core.lp_format import (
     format_lp,
     image_file_name,
     image_path,
+    image_paths,
     parse_lp,
     read_lp,
     write_lp,
@@ -137,6 +138,42 @@ def test_absolute_names_as_rtibuilder_writes_them_are_read(tmp_path: Path) -> No
     assert image_path(lp_dir, entries[2].name) == lp_dir / "jpeg-exports" / "proj_03.jpg"
     # nothing found: the file beside the .lp, for the caller's "missing" message
     assert image_path(lp_dir, "Z:\\x\\gone.jpg") == lp_dir / "gone.jpg"
+
+
+def test_two_names_that_come_to_one_file_are_refused(tmp_path: Path) -> None:
+    entries = parse_lp("2\nC:\\a\\x_1.jpg 0 0 1\nD:\\b\\x_1.jpg 0 1 1\n", "two.lp")
+    with pytest.raises(LpFormatError, match="are both read from"):
+        image_paths(tmp_path / "two.lp", entries)
+    # an absolute name is never read at its own path (another machine's; any file)
+    assert image_path(tmp_path, "/etc/passwd") == tmp_path / "passwd"
+
+
+def test_the_writer_refuses_what_the_reader_would_not_read_back(tmp_path: Path) -> None:
+    for name in ("pièce_1.jpg", "#1.jpg"):
+        with pytest.raises(ValueError, match="not ASCII or starts with '#'"):
+            format_lp([LpEntry(name, (0, 0, 1))])
+    with pytest.raises(LpFormatError):
+        write_lp(tmp_path / "missing" / "x.lp", [LpEntry("a.jpg", (0, 0, 1))])
+    with pytest.raises(ValueError):
+        write_lp(tmp_path / "x.lp", [LpEntry("é.jpg", (0, 0, 1))])
+    assert not list(tmp_path.glob(".*tmp"))
+
+
+def test_plan_labels_become_names_the_writer_takes() -> None:
+    """plan --rig on an .lp of RTIBuilder's names (spaces, accents, one file name in two
+    folders) had stopped with a traceback (whitespace, then UnicodeEncodeError)."""
+    from rti_rig.app.usecases.plan import _lp_labels
+
+    names = _lp_labels(
+        [
+            "H:\\Données RTI\\p\\pièce 01.jpg",
+            "img_2.jpg",
+            "C:\\a b\\img 2.jpg",
+            "#3.jpg",
+        ]
+    )
+    assert names == ["piece_01.jpg", "img_2.jpg", "img_2-2.jpg", "3.jpg"]
+    format_lp([LpEntry(n, (0, 0, 1)) for n in names])
 
 
 def test_comment_lines_are_skipped_and_said() -> None:

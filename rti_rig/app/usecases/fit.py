@@ -34,7 +34,7 @@ from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import jpeg_truncation
-from rti_rig.core.lp_format import directions_of, image_file_name, image_path, read_lp
+from rti_rig.core.lp_format import directions_of, image_file_name, image_paths, read_lp
 from rti_rig.core.out_folders import ensure_writable_folder
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
@@ -236,10 +236,10 @@ def acquisition_files(
     entries = read_lp(lp, upper_hemisphere=True, notes=notes)
     lights = directions_of(entries)
     paths, names, stand_ins = [], [], []
-    for e in entries:
+    for e, listed in zip(entries, image_paths(lp, entries), strict=True):
         stem = Path(image_file_name(e.name)).stem
         linear = lp.parent / "linear" / f"{stem}.tif"
-        paths.append(linear if linear.is_file() else image_path(lp.parent, e.name))
+        paths.append(linear if linear.is_file() else listed)
         names.append(stem)
         if not linear.is_file():
             stand_ins.append(e.name)

@@ -181,7 +181,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         # the acquisition's own names, written as the .lp profile allows (no whitespace): a
         # name with spaces (RTIBuilder's 'H:\\RTI Data\\...' paths) had stopped the plan with a
         # traceback; the plan is run by its directions, the names are labels
-        names = [_lp_label(s.label) for s in schedule.steps]
+        names = _lp_labels([s.label for s in schedule.steps])
     else:
         names = [f"{n}.jpg" for n in image_names(len(schedule))]
     write_lp(
@@ -191,12 +191,26 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
 
 
-def _lp_label(label: str) -> str:
-    """``label`` as an .lp name: unchanged without whitespace, else its file name with any
-    whitespace left as underscores."""
-    if not any(c.isspace() for c in label):
-        return label
-    return "_".join(image_file_name(label).split())
+def _lp_labels(labels: list[str]) -> list[str]:
+    """``labels`` as .lp names: each unchanged where the .lp profile allows it (ASCII, no
+    whitespace, no leading '#'), else its file name with accents dropped and whitespace as
+    underscores; kept unique (``-2``, ``-3``... before the extension where two coincide)."""
+    import unicodedata
+
+    out: list[str] = []
+    for label in labels:
+        name = label
+        if not (name.isascii() and name.split() == [name] and not name.startswith("#")):
+            plain = unicodedata.normalize("NFKD", image_file_name(label))
+            plain = plain.encode("ascii", "ignore").decode()
+            name = "_".join(plain.split()).lstrip("#") or "light"
+        stem, dot, ext = name.rpartition(".")
+        base, k = name, 2
+        while name in out:
+            name = f"{stem}-{k}.{ext}" if dot else f"{base}-{k}"
+            k += 1
+        out.append(name)
+    return out
 
 
 def draw_plan_figure(req: PlanLightsRequest, planned: PlannedLights) -> Path:
