@@ -32,7 +32,7 @@ class TiffRows:
         self.path = Path(path)
         try:
             self._read_header()
-        except ImageFileError:
+        except (ImageFileError, MemoryError):
             raise
         except Exception as exc:  # tifffile raises many kinds (TiffFileError, IndexError, …)
             raise _unreadable(self.path, exc) from None
@@ -125,6 +125,8 @@ class TiffRows:
             if self._full is None:
                 try:
                     self._full = tifffile.imread(self.path)
+                except MemoryError:
+                    raise
                 except Exception as exc:  # damaged data, a codec this install lacks, …
                     raise _unreadable(self.path, exc) from None
             return self._full[key]

@@ -367,6 +367,7 @@ def assess(
     keep = np.ones(n, bool)
     ps = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
     ev = evidence_of(ps)
+    before = (ps, ev)  # the fit and evidence a refit replaced
     for rnd in range(MAX_ROUNDS):
         bad = ev.dim | ev.wrong | (ev.moved & ~edge_moved)  # edge-moved: moved back already
         # (a large median error means something only where directions can be judged)
@@ -374,7 +375,10 @@ def assess(
         spread = float(np.median(judged_err)) if judged_err.size else 0.0
         if rnd == 0 and not bad.any() and not spread > WRONG_LIGHT_DEG / 2 and not ev.most_disagree:
             break
-        if rnd > 0 and ev.most_disagree:  # a refit most images contradict: nothing to drop
+        if rnd > 0 and ev.most_disagree:
+            # a refit most images contradict judges nothing: the fit before it stands (what
+            # it found is not erased by a refit that can find nothing)
+            ps, ev = before
             break
         new_keep = ~bad
         if rnd == 0:
@@ -399,6 +403,7 @@ def assess(
             )
         except ReconstructionError:  # the remaining lights cannot determine normals
             break
+        before = (ps, ev)
         keep, ps = new_keep, ps_next
         ev = evidence_of(ps)
     # Against a fit that explains the images poorly (a glossy coin) the shift against it is

@@ -215,6 +215,35 @@ def test_a_refused_fit_leaves_nothing_so_the_corrected_command_runs(tmp_path: Pa
     assert r.exit_code == 0, r.output
 
 
+def test_a_fit_that_fails_after_writing_leaves_its_out_folder_empty(
+    clean, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A failure once the maps and model files are written (here: the relight .dome, written
+    after them) takes this run's files with it; the folder the user made stays, empty."""
+    from rti_rig.app.usecases import fit as fit_module
+    from rti_rig.core.errors import RtiRigError
+
+    def fail_writing(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise RtiRigError("disk full (simulated)")
+
+    monkeypatch.setattr(fit_module.exporters, "write_relight_dome", fail_writing)
+    out = tmp_path / "o"
+    out.mkdir()
+    seen: list[str] = []
+    real_fit_all = fit_module._fit_all
+
+    def spy(*args, **kwargs):  # type: ignore[no-untyped-def]
+        result = real_fit_all(*args, **kwargs)
+        seen.extend(p.name for p in out.iterdir())
+        return result
+
+    monkeypatch.setattr(fit_module, "_fit_all", spy)
+    r = runner.invoke(app, ["fit", str(clean[0]), "--out", str(out), "--no-qa"])
+    assert r.exit_code == 2 and "disk full (simulated)" in r.output
+    assert "normals.png" in seen  # files had been written before the failure
+    assert out.is_dir() and not any(out.iterdir())
+
+
 def _names(indices) -> set[str]:
     return {f"image_{k + 1:03d}" for k in indices}
 

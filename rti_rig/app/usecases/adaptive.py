@@ -1074,8 +1074,9 @@ def refuse_broken_run(root: Path, total_steps: int) -> Callable[[dict[int, Any]]
         raise RtiRigError(
             f"{root}: {which}, but later steps are on disk. The lights "
             "after a step were chosen from its image, so an adaptive session cannot reshoot it "
-            "in place; nothing in the folder was changed. Put the original image files back "
-            "(the JPEG and linear/ TIFF; an earlier resume sets files it cannot verify aside in "
+            "in place; nothing in the folder was changed. Put the step's original files back "
+            "(its JPEG, linear/ TIFF and any raw/ original, as the journal lists them with "
+            "their checksums; an earlier resume sets files it cannot verify aside in "
             "recovered/) and resume again, or start a new session with another --out"
         )
 

@@ -84,8 +84,8 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             "replaced); give --out to write the calibration elsewhere"
         )
     check_output_file(target, req.force, {"RIG": req.rig_config})
-    spread = card_spread_deg(card)
-    if spread > MAX_CARD_SPREAD_DEG and not req.not_flat_ok:
+    spread = 0.0 if req.not_flat_ok else card_spread_deg(card)
+    if spread > MAX_CARD_SPREAD_DEG:
         # an object's session had been "calibrated" into a correction the user was told to
         # install: its relief read as the LEDs' differences
         raise RtiRigError(

@@ -313,7 +313,9 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     """Fit, write every output into ``req.out_dir``, and judge the acquisition.
 
     ``bands`` computes the per-band fits (default: in this process, :func:`local_bands`);
-    everything else — model choice, quantisation ranges, writing, QA — is the same code.
+    everything else — model choice, quantisation ranges, writing, QA — is the same code. A fit
+    that fails (or is interrupted) leaves ``req.out_dir`` as it found it: a refused fit had
+    left model_choice.md behind, and the corrected command then found --out not empty.
     """
     t0 = time.perf_counter()
     notes: list[str] = []
@@ -322,17 +324,23 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     out = req.out_dir
     created = not out.exists()
     prepare_out_dir(out)
+    try:
+        result = _fit_into(req, out, frames, lights, names, what, notes, bands)
+    except BaseException:
+        _discard_outputs(out, created)  # ``out`` was new or empty: what is in it is this run's
+        raise
+    result.seconds = time.perf_counter() - t0
+    return result
+
+
+def _fit_into(  # type: ignore[no-untyped-def]
+    req: FitRequest, out: Path, frames, lights, names, what: str, notes: list[str], bands
+) -> FitResult:
+    """Every output of :func:`run_fit` written into the prepared ``out``."""
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        try:
-            result = _fit_all(req, stack, lights, out, bands or local_bands)
-        except BaseException:
-            # a refused fit (an --hsh-order the lights cannot support, lights that cannot be
-            # solved) had left model_choice.md behind, and the corrected command then found
-            # --out not empty; ``out`` was new or empty, so what is in it is this run's
-            _discard_outputs(out, created)
-            raise
+        result = _fit_all(req, stack, lights, out, bands or local_bands)
     result.warnings = [str(w.message) for w in fit_warnings(caught)] + result.warnings
     result.notes = notes
     result.files.append(
@@ -364,7 +372,6 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     }
     (out / "fit.json").write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
     result.files.append(out / "fit.json")
-    result.seconds = time.perf_counter() - t0
     return result
 
 
