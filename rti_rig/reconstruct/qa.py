@@ -376,9 +376,11 @@ def assess(
         if rnd == 0 and not bad.any() and not spread > WRONG_LIGHT_DEG / 2 and not ev.most_disagree:
             break
         if rnd > 0 and ev.most_disagree:
-            # a refit most images contradict judges nothing: the fit before it stands (what
-            # it found is not erased by a refit that can find nothing)
-            ps, ev = before
+            # a refit most images contradict judges nothing; where the fit before it named
+            # wrong lights, that fit stands (its finding is not erased by a refit that can
+            # find nothing); else the refit's "not checked" is the honest word
+            if before[1].wrong.any():
+                ps, ev = before
             break
         new_keep = ~bad
         if rnd == 0:
