@@ -233,16 +233,16 @@ def _print_teardown_failures(folder) -> None:  # type: ignore[no-untyped-def]
 def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def]
     """The session's time on the real rig: a resumed session's is the sum of its runs (the
     manifest's), not this run's alone."""
-    simulated = f"simulated in {result.wall_time_s:.1f} s" if dry else ""
     timing = (folder.manifest or {}).get("timing") or {}
     runs = int(timing.get("runs") or 1)
-    if runs < 2:
-        return f"Session time on the real rig: {result.rig_time_s:.1f} s" + (
-            f" ({simulated})" if dry else ""
-        )
-    return (
-        f"Session time on the real rig: {float(timing['rig_time_s']):.1f} s over {runs} runs "
-        f"(this run {result.rig_time_s:.1f} s" + (f", {simulated})" if dry else ")")
+    beside = [f"simulated in {result.wall_time_s:.1f} s"] if dry else []
+    total = result.rig_time_s
+    if runs > 1:
+        total = float(timing["rig_time_s"])
+        beside.insert(0, f"this run {result.rig_time_s:.1f} s")
+    over = f" over {runs} runs" if runs > 1 else ""
+    return f"Session time on the real rig: {total:.1f} s{over}" + (
+        f" ({', '.join(beside)})" if beside else ""
     )
 
 

@@ -152,12 +152,6 @@ def jpeg_truncation(path: Path) -> str | None:
     return "it ends inside its header (cut short)"
 
 
-def header_size(path: Path) -> tuple[int, int] | None:
-    """(height, width) from the file's header alone; see :func:`header_layout`."""
-    layout = header_layout(path)
-    return None if layout is None else (layout[0], layout[1])
-
-
 def header_layout(path: Path) -> tuple[int, int, bool] | None:
     """(height, width, colour) from the file's header alone (JPEG frame header, PNG IHDR, TIFF
     first page), without decoding the pixels; ``colour`` as :func:`read_image_any` would
@@ -246,9 +240,3 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     if img.ndim == 3:
         img = img[..., 2::-1] if img.shape[2] >= 3 else img[..., 0]
     return np.ascontiguousarray(img)
-
-
-def probe_image_size(path: Path) -> tuple[int, int]:
-    """(height, width) of an image file, read as :func:`read_image_any` reads it."""
-    img = read_image_any(path)
-    return int(img.shape[0]), int(img.shape[1])
