@@ -200,7 +200,7 @@ class FolderWatchCamera:
                 )
             response = "linear" if s.eight_bit_response == "refuse" else s.eight_bit_response
             try:
-                pixels, white = to_linear_uint16(image, response)
+                pixels, white = to_linear_uint16(image, response, order="rgb")
             except ValueError as exc:
                 raise CaptureError(self.name, f"{path.name}: {exc}", "decode") from exc
             file_exposure, gain = None, s.gain

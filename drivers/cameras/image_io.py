@@ -30,11 +30,18 @@ _SRGB_LUT = _srgb_to_linear_lut()
 
 
 def to_linear_uint16(
-    image: NDArray, response: Response, black_level: int = 0, white_level: int = 65535
+    image: NDArray,
+    response: Response,
+    black_level: int = 0,
+    white_level: int = 65535,
+    *,
+    order: Literal["bgr", "rgb"],
 ) -> tuple[NDArray[np.uint16], int]:
     """Return ``(pixels, white_level)``: linear uint16, RGB order for colour input (pure).
 
-    OpenCV delivers colour as BGR; it is reordered to RGB to match rawpy's output.
+    ``order`` is the channel order of ``image``: OpenCV delivers BGR (a UVC frame,
+    ``cv2.imread``), tifffile RGB as stored. It is required because a wrong guess swaps red
+    and blue in every image of a session without an error (a watched folder of TIFFs did).
     """
     img = np.asarray(image)
     if img.ndim == 3 and img.shape[2] == 1:
@@ -42,7 +49,8 @@ def to_linear_uint16(
     if img.ndim == 3 and img.shape[2] == 4:
         img = img[..., :3]
     if img.ndim == 3 and img.shape[2] == 3:
-        img = img[..., ::-1]
+        if order == "bgr":
+            img = img[..., ::-1]
     elif img.ndim != 2:
         raise ValueError(f"expected an H×W or H×W×3 image, got shape {img.shape}")
     if img.dtype == np.uint16:
@@ -59,7 +67,8 @@ def to_linear_uint16(
 
 
 def read_image_file(path: Path, device: str) -> NDArray:
-    """Read a non-RAW image file unchanged (bit depth and channels kept)."""
+    """Read a non-RAW image file with its bit depth kept, colour in **RGB** order whatever the
+    format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers)."""
     suffix = path.suffix.lower()
     if suffix in (".tif", ".tiff"):
         import tifffile  # on a TIFF only: `rti-rig plan` imports this module for any preview
@@ -68,4 +77,6 @@ def read_image_file(path: Path, device: str) -> NDArray:
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise CaptureError(device, f"cannot read image file {path}", "read")
+    if img.ndim == 3 and img.shape[2] in (3, 4):
+        img = np.ascontiguousarray(img[..., 2::-1])  # BGR(A) -> RGB, alpha dropped
     return img

@@ -256,7 +256,9 @@ class OpenCvCamera:
             )
         self._frames_read += 1
         image = np.asarray(image)
-        pixels, white = to_linear_uint16(image, s.response, s.black_level, s.white_level)
+        pixels, white = to_linear_uint16(
+            image, s.response, s.black_level, s.white_level, order="bgr"
+        )
         metadata: dict[str, Any] = {
             "camera": self.name,
             "backend": s.backend,

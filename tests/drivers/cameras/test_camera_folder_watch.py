@@ -138,6 +138,30 @@ def test_16bit_tiff_accepted_8bit_refused(tmp_path):
         cam.capture(0.5)
 
 
+@pytest.mark.parametrize("suffix", [".tif", ".png"])
+def test_colour_file_arrives_in_rgb_order(tmp_path, suffix):
+    """A red 16-bit file is red in the frame, whatever library decodes it: tifffile hands over
+    RGB as stored, OpenCV BGR (the TIFF path had been reversed as if it were OpenCV's, so a
+    watched folder of TIFFs gave a session with red and blue swapped)."""
+    rgb = np.zeros((4, 6, 3), np.uint16)
+    rgb[..., 0], rgb[..., 2] = 50000, 1000
+
+    def write():
+        import cv2
+
+        path = tmp_path / f"IMG_0001{suffix}"
+        if suffix == ".tif":
+            tifffile.imwrite(path, rgb, photometric="rgb")
+        else:
+            assert cv2.imwrite(str(path), rgb[..., ::-1])  # OpenCV writes BGR arrays
+
+    cam = watch(tmp_path, ScriptedClock({0.1: write}), patterns=(f"*{suffix}",))
+    cam.connect()
+    f = cam.capture(0.5)
+    assert f.pixels.shape == (4, 6, 3)
+    assert np.all(f.pixels[..., 0] == 50000) and np.all(f.pixels[..., 2] == 1000)
+
+
 def test_missing_folder_and_not_connected(tmp_path):
     with pytest.raises(DeviceError, match="does not exist"):
         watch(tmp_path / "nope", VirtualClock()).connect()
