@@ -16,6 +16,11 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import SessionError
 
+#: How a linear TIFF's ImageDescription begins when its pixels are a CFA mosaic (one colour per
+#: photosite, ``decode.mode = "mosaic"``): the session writes it, and readers that need a
+#: picture (``rti-rig fit``) refuse such a file by it rather than fit a checkerboard.
+MOSAIC_TIFF_LABEL = "rti-rig: CFA mosaic"
+
 
 def _srgb_curve(x: NDArray[np.floating]) -> NDArray[np.floating]:
     """The sRGB transfer curve (IEC 61966-2-1) on linear values in [0, 1]."""

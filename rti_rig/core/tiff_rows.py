@@ -46,6 +46,9 @@ class TiffRows:
             self.shape: tuple[int, ...] = tuple(int(x) for x in page.shape)
             self.dtype = np.dtype(page.dtype)
             self.ndim = len(self.shape)
+            #: the first page's ImageDescription ("" when none): what the writer said the
+            #: pixels are (a session's mosaic TIFFs say so, :data:`MOSAIC_TIFF_LABEL`)
+            self.description: str = str(page.description or "")
             comp = int(page.compression)
             lean = (
                 comp in _STRIPPED

@@ -40,7 +40,12 @@ from typing import Any
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import SessionError
-from rti_rig.core.image_files import linear_to_srgb8, write_linear_tiff, write_srgb_jpeg
+from rti_rig.core.image_files import (
+    MOSAIC_TIFF_LABEL,
+    linear_to_srgb8,
+    write_linear_tiff,
+    write_srgb_jpeg,
+)
 from rti_rig.core.lp_format import LpEntry, format_lp
 
 MANIFEST = "manifest.json"
@@ -667,7 +672,7 @@ def _tiff_description(decode: dict[str, Any]) -> str | None:
         return None
     if decode.get("mode") == "mosaic":
         return (
-            f"rti-rig: CFA mosaic ({decode.get('cfa_pattern')}), black level removed per "
+            f"{MOSAIC_TIFF_LABEL} ({decode.get('cfa_pattern')}), black level removed per "
             "photosite, NOT demosaiced, no white balance: one colour per pixel"
         )
     return (

@@ -487,3 +487,32 @@ def test_every_model_gets_the_hsh_order_its_evidence_supports(tmp_path: Path) ->
             assert _read_rti(out / "fit.rti").shape[0] == 4
             assert summary["rti"].startswith("hsh1: the lowest HSH order within 5%")
             assert "ps, the model used, is not an HSH" in summary["rti"]
+
+
+def test_fit_refuses_a_cfa_mosaic_session_by_name(tmp_path: Path) -> None:
+    """A session shot with ``decode.mode = "mosaic"`` holds one colour per pixel: ``fit`` had
+    fitted the checkerboard at a white level of 65535 (the sensor's range is lower) and
+    written normals, .ptm and .rti without a warning. It is refused, naming the file and
+    what to do; nothing is left in --out."""
+    from rti_rig.core.image_files import write_linear_tiff
+    from rti_rig.core.lp_format import LpEntry, write_lp
+    from rti_rig.runtime.session import _tiff_description
+
+    label = _tiff_description({"mode": "mosaic", "cfa_pattern": "RGGB"})
+    session = tmp_path / "s"
+    (session / "linear").mkdir(parents=True)
+    rng = np.random.default_rng(0)
+    entries = []
+    for k, d in enumerate(dome_lights()[:8]):
+        name = f"image_{k + 1:03d}"
+        px = rng.integers(100, 15000, (32, 40), dtype=np.uint16)  # one plane, 14-bit range
+        write_linear_tiff(session / "linear" / f"{name}.tif", px, description=label)
+        entries.append(LpEntry(f"{name}.jpg", tuple(float(x) for x in d)))
+    write_lp(session / "lights.lp", entries)
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, r.output
+    assert "image_001.tif is a CFA mosaic" in said and 'decode.mode = "demosaic"' in said
+    assert "Traceback" not in r.output
+    assert not out.exists() or not any(out.iterdir())

@@ -33,7 +33,7 @@ from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.image_files import jpeg_truncation
+from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, jpeg_truncation
 from rti_rig.core.lp_format import directions_of, image_file_name, image_paths, read_lp
 from rti_rig.core.out_folders import ensure_writable_folder
 from rti_rig.core.raw_rows import DecodedStore, RawRows
@@ -104,18 +104,29 @@ def read_image(path: Path) -> Any:
         raise FitInputError(f"image {path} listed in the .lp is missing")
     if path.suffix.lower() in (".tif", ".tiff"):
         rows = TiffRows(path)  # read a band at a time, never whole
-        _check_tiff_type(path, rows.dtype)
+        _check_tiff_type(path, rows)
         if rows.dtype == np.uint16:
             return rows  # type: ignore[return-value]
     return _decoded_rows(_decode(path), str(path))
 
 
-def _check_tiff_type(path: Path, dtype: Any) -> None:
+def _check_tiff_type(path: Path, rows: TiffRows) -> None:
     """16-bit TIFFs are linear data, 8-bit ones sRGB like JPEG and PNG (as `plan` reads
-    them); anything else is refused with what to give instead."""
-    if dtype not in (np.uint16, np.uint8):
+    them); anything else is refused with what to give instead, and so is a CFA mosaic (a
+    session shot with ``decode.mode = "mosaic"``): one colour per photosite is no picture,
+    and a fit of it is a checkerboard at the wrong white level (the black-subtracted sensor
+    range, not 65535) that no viewer or check would question."""
+    if rows.dtype not in (np.uint16, np.uint8):
         raise FitInputError(
-            f"{path}: a {dtype} TIFF; give 16-bit linear or 8-bit sRGB TIFFs (or JPEG/PNG)"
+            f"{path}: a {rows.dtype} TIFF; give 16-bit linear or 8-bit sRGB TIFFs (or JPEG/PNG)"
+        )
+    if rows.description.startswith(MOSAIC_TIFF_LABEL):
+        raise FitInputError(
+            f"{path} is a CFA mosaic (the session was shot with decode.mode = \"mosaic\"): one "
+            "colour per pixel, not a picture, so it cannot be fitted; decode the camera's RAW "
+            "files kept in the session's raw/ folder to linear RGB (demosaiced) TIFFs with "
+            "your RAW converter, list them in an .lp and fit that, and set decode.mode = "
+            "\"demosaic\" or \"half\" in the rig config for the next session"
         )
 
 
@@ -173,7 +184,7 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
             )
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
-            _check_tiff_type(path, rows.dtype)
+            _check_tiff_type(path, rows)
             if rows.dtype == np.uint16 and rows.reads_in_place:
                 frames[i] = rows
                 continue
