@@ -688,13 +688,20 @@ def _sha256(path: Path) -> str | None:
         return None
 
 
-def verified_steps(root: Path, records: list[dict[str, Any]]) -> dict[int, StepRecord]:
+def verified_steps(
+    root: Path, records: list[dict[str, Any]], only: str | None = None
+) -> dict[int, StepRecord]:
     """The steps whose files are on disk with their journaled checksums (the later record of a
-    step wins: a recaptured image replaces one set aside)."""
+    step wins: a recaptured image replaces one set aside). ``only`` ("image" or
+    "linear_image"): the step's file of that kind is the one checked, for a listing that names
+    only it (an ``.lp`` of the TIFFs needs no intact JPEG)."""
     done: dict[int, StepRecord] = {}
     for entry in records:
         idx = entry["index"]
-        if all(_sha256(Path(root) / name) == digest for name, digest in entry["sha256"].items()):
+        sums = entry["sha256"]
+        if only is not None:
+            sums = {entry[only]: sums.get(entry[only])}
+        if all(_sha256(Path(root) / name) == digest for name, digest in sums.items()):
             done[idx] = _to_record(entry)
         else:
             done.pop(idx, None)
@@ -841,23 +848,24 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     """`.lp` entries of a session from its verified journal, and the images left out.
 
     Works on a finished session and on an interrupted or killed one alike: a step is listed when
-    its journal record is well formed and its files are on disk with the journaled checksums,
-    with the direction that actually ran. The second list names journaled images that are
-    missing or changed since (left out).
+    its journal record is well formed and the file the ``.lp`` names (the JPEG, or with
+    ``linear`` the TIFF) is on disk with its journaled checksum, with the direction that
+    actually ran. The second list names journaled files of that kind missing or changed since
+    (left out): a damaged JPEG does not drop an intact TIFF from an ``.lp`` of TIFFs.
     """
     manifest = read_manifest(root)
     total = planned_steps(manifest)  # an adaptive session's maximum, not its starting layout
     names = image_names(total) if total else None
     records = scan_journal(root, names).records
-    done = verified_steps(root, records)
+    key = "linear_image" if linear else "image"
+    done = verified_steps(root, records, only=key)  # the file the .lp names, as captured
     if not records:
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
-    left_out = sorted({r["image"] for r in records if r["index"] not in done})
+    left_out = sorted({r[key] for r in records if r["index"] not in done})
     if not done:
         raise SessionError(
             f"{root}: none of the {len(left_out)} journaled image(s) is on disk as captured "
             "(missing or changed), so there is no .lp to export"
         )
-    key = "linear_image" if linear else "image"
     entries = [LpEntry(getattr(done[i], key), done[i].actual_direction) for i in sorted(done)]
     return entries, left_out

@@ -293,6 +293,31 @@ def test_export_leaves_out_an_image_deleted_since(
     assert "image_002.jpg" in said(r)
 
 
+def test_export_names_only_the_file_kind_it_lists(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """An .lp of the TIFFs keeps an image whose JPEG is gone (its linear TIFF is intact), and
+    an .lp of the JPEGs one whose TIFF is damaged: each is judged by the file it names (a
+    lost JPEG had dropped its intact TIFF from the --linear listing)."""
+    import shutil
+
+    _, ref = reference
+    done = tmp_path / "done"
+    shutil.copytree(ref, done)
+    (done / "image_002.jpg").unlink()
+    (done / "linear" / "image_003.tif").write_bytes(b"damaged")
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(done / "t.lp"), "--linear"])
+    assert r.exit_code == 0, r.output
+    names = [e.name for e in read_lp(done / "t.lp")]
+    assert "linear/image_002.tif" in names and "linear/image_003.tif" not in names
+    assert len(names) == LIGHTS - 1 and "linear/image_003.tif" in said(r)
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(done / "j.lp")])
+    assert r.exit_code == 0, r.output
+    names = [e.name for e in read_lp(done / "j.lp")]
+    assert "image_003.jpg" in names and "image_002.jpg" not in names
+    assert len(names) == LIGHTS - 1 and "image_002.jpg" in said(r)
+
+
 # 6. Nothing on disk before the rig works ------------------------------------------------------
 
 
