@@ -99,6 +99,11 @@ class LedDomeDriver:
         self._rx.clear()
         self.transport.close()
 
+    @property
+    def port_open(self) -> bool:
+        """The port is open (a board that resets on open may be booting, and boot lit)."""
+        return self._open
+
     # ------------------------------------------------------------------ verbs
 
     def hello(self) -> DomeInfo:

@@ -235,6 +235,16 @@ class DomePolicy:
                 "the protocol profile in the rig config, and that the board is powered",
                 exc.command,
             ) from exc
+        except BaseException:
+            # an emergency stop (SIGTERM, a second Ctrl-C) while the board boots or answers
+            # the handshake: the port is open and a board may boot lit, so the all-off is
+            # sent before the stop goes on (it had been told "the dome was never reached"
+            # with every LED of a board that boots lit still on)
+            if getattr(self.link, "port_open", True):
+                self._port_was_open = True
+                self._attempt_off("after the connection was interrupted")
+            self._quiet_close()
+            raise
         self._port_was_open = True
         problem = self._check_identity(info)
         if problem:

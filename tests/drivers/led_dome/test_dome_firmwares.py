@@ -228,6 +228,31 @@ def test_unknown_profile_lists_the_known_ones() -> None:
         DomeSerialSettings(port="x", profile="nab")
 
 
+def test_a_stop_during_the_handshake_of_the_lit_nab_sketch_sends_all_off() -> None:
+    """SIGTERM (or a second Ctrl-C) while the board that boots with every LED on answers the
+    handshake: the all-off is sent before the stop goes on. It had been left fully lit and the
+    user told "no all-off was attempted (the dome was never reached)"."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.runtime.controller import EmergencyStop
+
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        settings = DomeSerialSettings(port=link.port, profile="nab-rti-v1")
+        dome = build_dome(settings, VirtualClock())
+
+        def stopped_here():  # type: ignore[no-untyped-def]
+            assert eventually(lambda: len(board.lit) > 1)  # booted, every LED on
+            raise EmergencyStop("SIGTERM")
+
+        dome.link.hello = stopped_here
+        with pytest.raises(EmergencyStop):
+            dome.connect()
+        assert eventually(lambda: board.lit == frozenset())
+        assert dome.off_report is not None
+        assert "never reached" not in dome.off_report.sentence()
+
+
 def test_failed_handshake_on_the_lit_nab_sketch_still_sends_all_off_and_says_so() -> None:
     """The issue's case: the project's 'framed' profile on the RTI v1.0 sketch, which boots with
     every LED on. The handshake fails; the all-off is sent anyway and reported unconfirmed."""
