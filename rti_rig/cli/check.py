@@ -2,13 +2,41 @@
 
 from __future__ import annotations
 
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
-from rti_rig.cli.app import app, fail, out
+from rti_rig.cli.app import app, err, fail, out
 from rti_rig.core.errors import RtiRigError
+
+
+@contextmanager
+def stop_on_signals() -> Iterator[None]:
+    """Ctrl-C or SIGTERM stops a check at once, through its teardown (all-off; lamp off, arm
+    stopped): without a handler SIGTERM killed the process with an LED lit and said nothing.
+    A second signal while the first is being handled is ignored: the teardown it would cut
+    short is what switches the lights off."""
+    from rti_rig.runtime.controller import EmergencyStop
+
+    stopping: list[str] = []
+
+    def on_signal(signum, frame):  # type: ignore[no-untyped-def]
+        if stopping:
+            return
+        stopping.append(signal.Signals(signum).name)
+        raise EmergencyStop("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, h in previous.items():
+            signal.signal(sig, h)
 
 
 @app.command()
@@ -21,10 +49,19 @@ def check(
     """Self-test the rig's lights: a dome lights each LED in turn and reports what answered; an
     arm visits poses spanning its band (checking where it really got to), flashes the lamp at
     each and parks."""
-    from rti_rig.app.usecases.check import CheckRequest, check_rig
+    from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
+    from rti_rig.runtime.controller import EmergencyStop
 
     try:
-        report = check_rig(CheckRequest(rig_config, intensity))
+        with stop_on_signals():
+            err.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
+            report = check_rig(CheckRequest(rig_config, intensity))
+    except CheckStopped as exc:
+        err.print(f"[red]Check stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
+        raise typer.Exit(code=143 if exc.why == "SIGTERM" else 130) from None
+    except EmergencyStop as exc:  # stopped outside a self-test (loading, a camera's check)
+        err.print(f"[red]Check stopped ({escape(str(exc))}):[/] check the rig's lights.")
+        raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
     except RtiRigError as exc:
         raise fail(exc) from None
     for line in report.lines():

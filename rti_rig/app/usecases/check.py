@@ -13,11 +13,23 @@ from typing import Any
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
+from rti_rig.app.usecases.safe_state import lights_state
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.arm_check import arm_self_test
+from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.runtime.dome_policy import self_test
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
+
+
+class CheckStopped(Exception):
+    """The check was stopped (SIGTERM, Ctrl-C) part-way; the rig was torn down first."""
+
+    def __init__(self, why: str, lights: str) -> None:
+        super().__init__(f"check stopped ({why}): {lights}")
+        self.why = why
+        #: what is known about the lights after the teardown (never "off" unless established)
+        self.lights = lights
 
 
 @dataclass(frozen=True)
@@ -39,13 +51,17 @@ def check_rig(req: CheckRequest) -> Any:
 
         return flash_sync_check(loaded)
     with build_rig(loaded) as rig:
-        if isinstance(rig.lighting, DomeLighting):
-            return self_test(rig.lighting.source, rig.clock, intensity=req.intensity)
-        if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
-            return arm_self_test(
-                rig.lighting.carrier,
-                rig.geometry,
-                rig.clock,
-                park=rig.lighting.park_after_session,
-            )
+        try:
+            if isinstance(rig.lighting, DomeLighting):
+                return self_test(rig.lighting.source, rig.clock, intensity=req.intensity)
+            if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
+                return arm_self_test(
+                    rig.lighting.carrier,
+                    rig.geometry,
+                    rig.clock,
+                    park=rig.lighting.park_after_session,
+                )
+        except EmergencyStop as exc:
+            # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
+            raise CheckStopped(str(exc), lights_state(rig)) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
