@@ -771,19 +771,26 @@ def prepare_resume(
     if total == 0:
         raise SessionError(f"{root}: the manifest holds no schedule, so there is nothing to resume")
     runner = manifest.get("runner") or {}
-    if runner.get("finish_reason") == "completed":
-        done = runner.get("steps_done", total)
-        if manifest.get("adaptive") and done < total:  # an adaptive session that chose to stop
-            stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
-            raise SessionError(
-                f"{root}: this adaptive session already completed: it stopped after {done} of "
-                f"at most {total} lights ({stop.get('reason', 'its stopping rule')})"
-            )
-        raise SessionError(f"{root}: this session already completed all {total} steps")
     names = image_names(total)
-    stamp = _new_stamp(root)
     scan = scan_journal(root, names)
     done = verified_steps(root, scan.records)
+    if runner.get("finish_reason") == "completed":
+        finished = runner.get("steps_done", total)
+        lost = sorted({r["image"] for r in scan.records} - {d.image for d in done.values()})
+        if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
+            stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
+            raise SessionError(
+                f"{root}: this adaptive session already completed: it stopped after "
+                f"{finished} of at most {total} lights ({stop.get('reason', 'its stopping rule')})"
+                + _lost_note(root, lost)
+            )
+        if not lost or manifest.get("adaptive"):
+            raise SessionError(
+                f"{root}: this session already completed all {total} steps" + _lost_note(root, lost)
+            )
+        # a completed session whose images were lost or changed since: the resume reshoots
+        # them (set aside in recovered/ below when changed, never deleted)
+    stamp = _new_stamp(root)
     if check_done is not None:
         check_done(done)
     repair = _repair_journal(root, scan, stamp) if scan.needs_repair else []
@@ -822,6 +829,19 @@ def prepare_resume(
     return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
 
 
+def _lost_note(root: Path, lost: list[str]) -> str:
+    """The images of a finished adaptive session that are gone or changed since capture, and
+    what to do, since a resume cannot reshoot them."""
+    if not lost:
+        return ""
+    shown = ", ".join(lost[:5]) + (" …" if len(lost) > 5 else "")
+    return (
+        f"; but {len(lost)} of its images are missing or changed since capture ({shown}): put "
+        "the originals back from a copy (an adaptive session cannot reshoot one image: the "
+        "lights after it were chosen from it), or start a new session with another --out"
+    )
+
+
 def read_manifest(root: Path) -> dict[str, Any]:
     """The manifest of a session folder, with a clear error if it is not one."""
     path = Path(root) / MANIFEST
@@ -842,6 +862,36 @@ def read_manifest(root: Path) -> dict[str, Any]:
     if data.get("format") != FORMAT:
         raise SessionError(f"{path}: unknown session format {data.get('format')!r}")
     return data
+
+
+def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
+    """Per image (its base name, ``image_010``) the files of its committed step that are gone
+    or changed since they were journaled: a JPEG is checked against its checksum (it is what
+    relight and RTIBuilder pair with the ``.lp``), a TIFF or RAW original for its presence (a
+    fit reads every pixel of a TIFF anyway, and hashing gigabytes for a verdict would not do).
+    Empty for a folder without a journal (an ``.lp`` acquisition is no session)."""
+    root = Path(root)
+    if not (root / JOURNAL).is_file() or not (root / MANIFEST).is_file():
+        return {}
+    try:
+        total = planned_steps(read_manifest(root))
+    except SessionError:
+        return {}
+    latest: dict[int, dict[str, Any]] = {}
+    for rec in scan_journal(root, image_names(total) if total else None).records:
+        latest[rec["index"]] = rec  # the later record of a step wins (a reshot image)
+    lost: dict[str, list[str]] = {}
+    for rec in latest.values():
+        gone = []
+        for name, digest in rec["sha256"].items():
+            path = root / name
+            if not path.is_file():
+                gone.append(f"{name} missing")
+            elif name.endswith(".jpg") and _sha256(path) != digest:
+                gone.append(f"{name} changed")
+        if gone:
+            lost[Path(rec["image"]).stem] = gone
+    return lost
 
 
 def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], list[str]]:

@@ -481,3 +481,29 @@ def test_a_resume_whose_rig_config_moved_says_to_give_it(tmp_path: Path) -> None
     assert folder_bytes(out) == before
     r = runner.invoke(app, ["run", str(moved), "--resume", str(out)])
     assert r.exit_code == 0, r.output
+
+
+def test_a_finished_adaptive_session_with_an_image_lost_says_what_to_do(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """A JPEG deleted after an adaptive session finished: QA names it (it had said "good") and
+    the resume, which cannot reshoot one image of an adaptive session, says so and what to do
+    instead of only "already completed"; nothing in the folder changes."""
+    import shutil
+
+    _, ref = uninterrupted
+    out = tmp_path / "s"
+    shutil.copytree(ref, out)
+    (out / "image_002.jpg").unlink()
+    before = folder_bytes(out)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "already completed" in said(r) and "image_002.jpg" in said(r)
+    assert "put the originals back from a copy" in said(r)
+    assert folder_bytes(out) == before
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "image_002 (image_002.jpg missing since capture" in verdict, verdict
+    assert "an adaptive session cannot reshoot one image" in verdict
+    assert "--resume" not in verdict

@@ -277,6 +277,24 @@ def test_killed_session_has_its_lp_and_exports(
     assert read_lp(tmp_path / "k.lp") == ref_lp[:3]
 
 
+def test_a_resume_after_a_kill_says_its_time_is_a_lower_bound(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A run killed outright records no time; the resumed session's time line had summed the
+    runs that did (12.9 s "over 2 runs" for a session of 56 s) as if that were all of it."""
+    from rti_rig.testing.kill_hooks import popen_session
+
+    cfg, _ = reference
+    out = tmp_path / "s"
+    proc = popen_session("before_light", 5, cfg, out, LIGHTS)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "Session time on the real rig: at least " in said(r), said(r)
+    assert "1 run(s) killed before recording their time not counted" in said(r)
+
+
 def test_export_leaves_out_an_image_deleted_since(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:
@@ -316,6 +334,59 @@ def test_export_names_only_the_file_kind_it_lists(
     names = [e.name for e in read_lp(done / "j.lp")]
     assert "image_003.jpg" in names and "image_002.jpg" not in names
     assert len(names) == LIGHTS - 1 and "image_002.jpg" in said(r)
+
+
+def test_an_image_lost_since_capture_is_named_by_qa_and_reshot_by_resume(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A finished session whose JPEG was deleted, or truncated, since capture: QA had said
+    "good" (fit reads the intact TIFFs) while lights.lp still listed the JPEG, so relight
+    paired every later image with the wrong light, and `run --resume` refused ("already
+    completed"). Now the verdict names the image and the resume reshoots it, setting aside
+    what it cannot verify, and the session is whole again."""
+    import shutil
+
+    _, ref = reference
+    done = tmp_path / "done"
+    shutil.copytree(ref, done)
+    (done / "image_003.jpg").unlink()
+    jpg = done / "image_006.jpg"
+    jpg.write_bytes(jpg.read_bytes()[:2000])
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert verdict.startswith("reshoot: image_003 (image_003.jpg missing since capture"), verdict
+    assert "image_006 (image_006.jpg changed since capture" in verdict
+    assert "relight and RTIBuilder pair the images after it with the wrong lights" in verdict
+    assert f"rti-rig run --resume {done}" in verdict
+    tif = (done / "linear" / "image_003.tif").read_bytes()
+    r = runner.invoke(app, ["run", "--resume", str(done)])
+    assert r.exit_code == 0, r.output
+    assert "2 of 8 lights" in said(r) and "QA verdict: good" in said(r)
+    assert digests(done) == digests(ref)  # a dry run reshoots the very same images
+    # nothing captured is lost: the intact TIFF of the deleted JPEG and the truncated JPEG
+    kept = {p.name: p.read_bytes() for p in (done / "recovered").rglob("image_*")}
+    assert kept["image_003.tif"] == tif and len(kept["image_006.jpg"]) == 2000
+
+
+def test_a_session_without_its_lights_lp_is_told_how_to_rebuild_it(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """fit on a session whose lights.lp was deleted had said "not a session folder"; it names
+    the export-lp command that rebuilds it from the journal, and that command works."""
+    import shutil
+
+    _, ref = reference
+    done = tmp_path / "done"
+    shutil.copytree(ref, done)
+    (done / "lights.lp").unlink()
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 2, r.output
+    command = f"rti-rig export-lp {done} --out {done / 'lights.lp'}"
+    assert command in said(r), said(r)
+    r = runner.invoke(app, command.split()[1:])
+    assert r.exit_code == 0, r.output
+    assert read_lp(done / "lights.lp") == read_lp(ref / "lights.lp")
 
 
 # 6. Nothing on disk before the rig works ------------------------------------------------------

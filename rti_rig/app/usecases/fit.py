@@ -32,6 +32,7 @@ from rti_rig.app.usecases.fit_decode import imread_rgb
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
+from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, jpeg_truncation
 from rti_rig.core.lp_format import directions_of, image_file_name, image_paths, read_lp
@@ -44,6 +45,7 @@ from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
 from rti_rig.runtime.disowned import refuse_if_disowned
+from rti_rig.runtime.session import JOURNAL, LP_NAME
 
 #: What ``--model`` accepts besides the registered model names.
 AUTO = "auto"
@@ -237,6 +239,12 @@ def acquisition_files(
     if source.is_dir():
         lps = sorted(source.glob("*.lp"))
         if not lps:
+            if (source / JOURNAL).is_file():  # a session that lost its lights.lp
+                raise FitInputError(
+                    f"{source} is a session folder without its {LP_NAME}; rebuild it from the "
+                    f"session's journal with: rti-rig export-lp {source} --out "
+                    f"{source / LP_NAME}"
+                )
             raise FitInputError(f"{source} holds no .lp file: not a session folder")
         lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]
     elif source.suffix.lower() == ".lp" and source.is_file():
@@ -360,7 +368,7 @@ def _fit_into(  # type: ignore[no-untyped-def]
     release_free_memory()  # the fit's bands and PNG buffers, before QA reads the images again
     if req.qa:
         try:
-            result.qa = assess(frames, lights, names)
+            result.qa = with_lost_files(assess(frames, lights, names), req.source)
         except ReconstructionError as exc:  # e.g. too few or coplanar lights for PS
             result.warnings.append(f"QA not possible: {exc}")
         else:
@@ -736,7 +744,7 @@ def _qa_row(c: ImageCheck) -> str:
 def verdict_for_session(session: Path) -> str:
     """The QA verdict line of a session folder (for ``rti-rig run``'s last line)."""
     frames, lights, names, _ = load_acquisition(session)
-    return assess(frames, lights, names).verdict
+    return with_lost_files(assess(frames, lights, names), session).verdict
 
 
 @dataclass(frozen=True)
