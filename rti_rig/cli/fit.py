@@ -32,6 +32,11 @@ def print_verdict(session: Path | None) -> None:
         out.print(f"QA verdict: {escape(verdict_for_session(session))}")
     except (RtiRigError, ValueError) as exc:
         err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
+    except KeyboardInterrupt:  # the session is complete: only the advice is cut short
+        err.print(
+            "[yellow]QA verdict skipped (Ctrl-C):[/] the session is complete; "
+            f"rti-rig fit {escape(str(session))} --out FOLDER gives the verdict"
+        )
 
 
 @app.command()

@@ -237,11 +237,17 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
     runs = int(timing.get("runs") or 1)
     beside = [f"simulated in {result.wall_time_s:.1f} s"] if dry else []
     total = result.rig_time_s
+    at_least = ""
     if runs > 1:
         total = float(timing["rig_time_s"])
         beside.insert(0, f"this run {result.rig_time_s:.1f} s")
+        # a run killed outright (kill -9, power) recorded no time: the sum leaves it out
+        untimed = sum(1 for r in folder.manifest.get("runs") or [] if r.get("rig_time_s") is None)
+        if untimed:
+            at_least = "at least "
+            beside.append(f"{untimed} run(s) killed before recording their time not counted")
     over = f" over {runs} runs" if runs > 1 else ""
-    return f"Session time on the real rig: {total:.1f} s{over}" + (
+    return f"Session time on the real rig: {at_least}{total:.1f} s{over}" + (
         f" ({', '.join(beside)})" if beside else ""
     )
 

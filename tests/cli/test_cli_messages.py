@@ -60,3 +60,25 @@ def test_resume_refuses_options_it_would_otherwise_ignore(tmp_path):
     assert r.exit_code == 2
     text = " ".join(r.output.split())
     assert "drop --until-error, --auto-exposure" in text
+
+
+def test_ctrl_c_during_the_verdict_of_a_complete_session_says_it_is_complete(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C while the QA verdict is computed (seconds, after the last image) had ended the
+    command with exit code 130 and no word: a complete session read as an interrupted one."""
+    from conftest import SMALL_DOME, write_config
+
+    import rti_rig.app.usecases.fit as fit_usecase
+
+    def interrupted(session: Path) -> str:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(fit_usecase, "verdict_for_session", interrupted)
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "QA verdict skipped (Ctrl-C): the session is complete" in said
+    assert f"rti-rig fit {out} --out FOLDER" in said
