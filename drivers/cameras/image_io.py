@@ -37,7 +37,14 @@ def to_linear_uint16(
     *,
     order: Literal["bgr", "rgb"],
 ) -> tuple[NDArray[np.uint16], int]:
-    """Return ``(pixels, white_level)``: linear uint16, RGB order for colour input (pure).
+    """Return ``(pixels, white_level)``: linear uint16 at full scale (white 65535), RGB order
+    for colour input (pure).
+
+    16-bit data of a sensor whose range ends lower (``white_level`` − ``black_level``: a 12-bit
+    sensor's 4095) is scaled up to 65535, as the RAW path's demosaiced output is: a session's
+    linear TIFF carries no white level, so every reader of it (``rti-rig fit``, its QA, relight)
+    takes 65535 as white; unscaled, saturation went unseen there and the sRGB exports came out
+    16× too dark. The scaling maps distinct codes to distinct codes: nothing is lost.
 
     ``order`` is the channel order of ``image``: OpenCV delivers BGR (a UVC frame,
     ``cv2.imread``), tifffile RGB as stored. It is required because a wrong guess swaps red
@@ -57,8 +64,10 @@ def to_linear_uint16(
         wl = white_level - black_level
         if wl <= 0:
             raise ValueError(f"white_level {white_level} must exceed black_level {black_level}")
-        px = np.clip(img.astype(np.int64) - black_level, 0, wl).astype(np.uint16)
-        return np.ascontiguousarray(px), wl
+        px = np.clip(img.astype(np.int64) - black_level, 0, wl)
+        if wl != 65535:
+            px = (px * 65535 + wl // 2) // wl  # rounded, exact in integers
+        return np.ascontiguousarray(px.astype(np.uint16)), 65535
     if img.dtype == np.uint8:
         if response == "srgb":
             return np.ascontiguousarray(_SRGB_LUT[img]), 65535

@@ -54,8 +54,10 @@ def test_image_sequence_black_level_and_white_level(tmp_path):
     with cam:
         a = cam.capture(0.01)
         b = cam.capture(0.01)
-    assert a.white_level == 4031 and np.all(a.pixels == 36)
-    assert b.saturated_fraction == 1.0
+    # scaled to full range: a session's TIFF carries no white level, and its readers take
+    # 65535 as white (the sensor's 4031 had left saturation unseen and exports dark)
+    assert a.white_level == 65535 and np.all(a.pixels == round(36 * 65535 / 4031))
+    assert b.saturated_fraction == 1.0 and np.all(b.pixels == 65535)
 
 
 def test_image_sequence_8bit_colour_is_rgb_and_linearised(tmp_path):
