@@ -43,8 +43,8 @@ def to_linear_uint16(
     16-bit data of a sensor whose range ends lower (``white_level`` − ``black_level``: a 12-bit
     sensor's 4095) is scaled up to 65535, as the RAW path's demosaiced output is: a session's
     linear TIFF carries no white level, so every reader of it (``rti-rig fit``, its QA, relight)
-    takes 65535 as white; unscaled, saturation went unseen there and the sRGB exports came out
-    16× too dark. The scaling maps distinct codes to distinct codes: nothing is lost.
+    takes 65535 as white; unscaled, saturation went unseen there and the exports came out 16×
+    too dark in linear terms. The scaling maps distinct codes to distinct codes: nothing is lost.
 
     ``order`` is the channel order of ``image``: OpenCV delivers BGR (a UVC frame,
     ``cv2.imread``), tifffile RGB as stored. It is required because a wrong guess swaps red
