@@ -253,7 +253,25 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
 
 
 def _execute(opened) -> None:  # type: ignore[no-untyped-def]
-    """Run with a progress bar and signal handling; print what happened and how to go on."""
+    """Run with a progress bar and signal handling; print what happened and how to go on.
+
+    The handlers in place before are back only once the summary is printed: a second Ctrl-C
+    meant as "stop at once", arriving just after the session stopped on the first, had cut
+    the summary and its resume hint off (exit 130, no word)."""
+    previous = {sig: signal.getsignal(sig) for sig in _HANDLED}
+    try:
+        _run_and_report(opened)
+    finally:
+        for sig, h in previous.items():
+            signal.signal(sig, h)
+
+
+_HANDLED = (signal.SIGINT, signal.SIGTERM) + (
+    (signal.SIGUSR1,) if hasattr(signal, "SIGUSR1") else ()
+)
+
+
+def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
     from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
         CancelToken,
@@ -338,6 +356,8 @@ def _execute(opened) -> None:  # type: ignore[no-untyped-def]
     finally:
         for sig, h in previous.items():
             signal.signal(sig, h)
+        # the session is over (stopped or done): a late Ctrl-C must not cut the summary
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     from rti_rig.runtime.disowned import MARKER
 

@@ -82,3 +82,32 @@ def test_ctrl_c_during_the_verdict_of_a_complete_session_says_it_is_complete(
     assert r.exit_code == 0, said
     assert "QA verdict skipped (Ctrl-C): the session is complete" in said
     assert f"rti-rig fit {out} --out FOLDER" in said
+
+
+def test_a_late_ctrl_c_does_not_cut_the_summary(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second Ctrl-C (meant as "stop at once") that arrives just after the session stopped
+    had landed on Python's default handler while the summary was printed: exit 130 and no
+    summary or resume hint. Until the summary is out, a late Ctrl-C is ignored."""
+    import os
+    import signal
+
+    from conftest import SMALL_DOME, write_config
+
+    import rti_rig.cli.session as session_cli
+
+    real = session_cli._time_line
+
+    def with_a_late_ctrl_c(*args):  # type: ignore[no-untyped-def]
+        os.kill(os.getpid(), signal.SIGINT)
+        return real(*args)
+
+    monkeypatch.setattr(session_cli, "_time_line", with_a_late_ctrl_c)
+    before = signal.getsignal(signal.SIGINT)
+    cfg = write_config(tmp_path, SMALL_DOME)
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "6 image(s) in the session" in said and "Session time on the real rig" in said
+    assert signal.getsignal(signal.SIGINT) is before  # the handlers before are back
