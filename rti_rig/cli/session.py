@@ -361,6 +361,10 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
 
     from rti_rig.runtime.disowned import MARKER
 
+    if result.finish_reason is FinishReason.CANCELLED and not folder.images_kept:
+        # stopped before the first image: no lights.lp to speak of, no resume for nothing
+        err.print(f"[yellow]Session cancelled.[/] {escape(_after_stop(opened, resume_hint))}")
+        raise typer.Exit(code=130)
     marker = folder.root / MARKER
     labels = (
         f"{LP_NAME} lists the lights that fired."

@@ -111,3 +111,32 @@ def test_a_late_ctrl_c_does_not_cut_the_summary(
     assert r.exit_code == 0, said
     assert "6 image(s) in the session" in said and "Session time on the real rig" in said
     assert signal.getsignal(signal.SIGINT) is before  # the handlers before are back
+
+
+def test_a_session_cancelled_before_its_first_image_offers_no_resume(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C before the first image had printed "0 image(s) in the session; lights.lp lists
+    the lights that fired … Continue with: rti-rig run --resume" for a folder with no lights.lp
+    and nothing to resume (SIGTERM at the same moment said it may be used again)."""
+    import os
+    import signal
+
+    from conftest import SMALL_DOME, write_config
+
+    from rti_rig.simulator.sim_lights import SimulatedDome
+
+    real = SimulatedDome.connect
+
+    def ctrl_c_while_connecting(self):  # type: ignore[no-untyped-def]
+        os.kill(os.getpid(), signal.SIGINT)
+        return real(self)
+
+    monkeypatch.setattr(SimulatedDome, "connect", ctrl_c_while_connecting)
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert "Session cancelled. Nothing was captured" in said, said
+    assert "--resume" not in said and "lists the lights" not in said
