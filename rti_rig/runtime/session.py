@@ -247,10 +247,14 @@ class SessionFolder:
         if root.exists() and not root.is_dir():
             raise SessionError(f"{root} exists and is not a folder: choose another --out")
         if root.exists() and any(root.iterdir()) and not holds_no_image(root):
+            resume = (
+                f", or continue the interrupted session in it with 'rti-rig run --resume {root}'"
+                if (root / MANIFEST).is_file()
+                else ""  # not a session: no resume to offer
+            )
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "
-                "choose a new --out folder, or continue an interrupted session with "
-                f"'rti-rig run --resume {root}'"
+                f"choose a new --out folder{resume}"
             )
 
     @classmethod

@@ -185,9 +185,13 @@ def test_never_writes_into_a_non_empty_folder(tmp_path: Path) -> None:
     out = tmp_path / "s"
     out.mkdir()
     (out / "keep.jpg").write_bytes(b"precious")
-    with pytest.raises(SessionError, match="not empty"):
+    with pytest.raises(SessionError, match="not empty") as refused:
         SessionFolder.create(out, 3)
+    assert "--resume" not in str(refused.value)  # no session there to resume
     assert (out / "keep.jpg").read_bytes() == b"precious"
+    (out / "manifest.json").write_text("{}")
+    with pytest.raises(SessionError, match=f"rti-rig run --resume {out}"):
+        SessionFolder.create(out, 3)
 
 
 def test_image_write_refuses_to_overwrite(tmp_path: Path) -> None:
