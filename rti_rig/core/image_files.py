@@ -235,8 +235,9 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         return img[..., :3] if img.ndim == 3 else img
     import cv2
 
-    if p.is_file():
-        refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
+    if not p.is_file():  # said here, before OpenCV prints its own warning line about it
+        raise SessionError(f"cannot read image {p}: there is no such file")
+    refuse_truncated_jpeg(p)  # before OpenCV, which decodes it with a grey part
     img = cv2.imread(str(p), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise SessionError(f"cannot read image {p} (missing, or not an image OpenCV decodes)")
