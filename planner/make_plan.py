@@ -215,6 +215,11 @@ class PlanRequest:
         )
 
 
+#: Fewer lights than this determine no surface normal: ``plan`` refuses them by name
+#: (``run --lights N`` may still shoot fewer, e.g. to try a rig out).
+MIN_PLAN_LIGHTS = 3
+
+
 def check_plan_options(
     *,
     method: str,
@@ -253,8 +258,12 @@ def check_plan_options(
     if depth_model is not None and not Path(depth_model).is_file():
         raise ScheduleError(f"--depth-model {depth_model}: file not found")
     check_elevation_band(min_elevation_deg, max_elevation_deg)
-    if n < 1:
-        raise ScheduleError(f"--lights must be at least 1, got {n}")
+    if n < MIN_PLAN_LIGHTS:
+        raise ScheduleError(
+            f"--lights {n}: plan at least {MIN_PLAN_LIGHTS} lights; fewer cannot determine a "
+            "surface normal (photometric stereo needs 3, a PTM 6, an HSH fit.rti 4), so no "
+            "planner can do better than another (a 2-light plan read 90° expected error)"
+        )
     if n > MAX_LIGHTS:
         raise ScheduleError(
             f"--lights {n}: at most {MAX_LIGHTS} lights (the most an .lp file may list "

@@ -424,7 +424,7 @@ def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
     lp_cfg = write_config(tmp_path, text, "lp_dome.toml")
     calibration = lp.read_text()
     r = runner.invoke(
-        app, ["plan", "--rig", str(lp_cfg), "--lights", "2", "--out", str(lp), "--force"]
+        app, ["plan", "--rig", str(lp_cfg), "--lights", "3", "--out", str(lp), "--force"]
     )
     assert r.exit_code == 2 and "LED calibration" in " ".join(r.output.split())
     assert lp.read_text() == calibration

@@ -161,8 +161,11 @@ def test_flat_surface_one_normal(method: str) -> None:
 def test_more_lights_than_leds_is_a_clear_error() -> None:
     with pytest.raises(ScheduleError, match="only 48 LEDs"):
         make_plan(PREVIEW, DOME, 49, "optimal")
-    with pytest.raises(ScheduleError, match="at least 1"):
+    with pytest.raises(ScheduleError, match="at least 3"):
         make_plan(PREVIEW, DOME, 0, "kmeans")
+    # two lights determine no normal: refused by name (a 2-light plan had read 90° expected)
+    with pytest.raises(ScheduleError, match="--lights 2: plan at least 3 lights"):
+        make_plan(PREVIEW, DOME, 2, "optimal")
     assert len(make_plan(PREVIEW, DOME, 48, "optimal")) == 48
 
 
