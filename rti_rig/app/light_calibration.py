@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -60,6 +60,8 @@ class CardSession:
     leds: NDArray[np.intp]  # (n,) LED index of each image
     drive: NDArray[np.float64]  # (n,) PWM level / max level × exposure / longest exposure
     correction: tuple[float, ...] | None  # the dome's intensity_correction when it was shot
+    #: LED index → the session's image of it (``image_019.jpg``): what a user opens to look
+    image_of: dict[int, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -163,6 +165,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     max_level = int(serial.get("max_level", 255))
     exposures = np.array([float(s["exposure_s"]) for s in steps])
     images, drive, leds, names = [], [], [], []
+    image_of: dict[int, str] = {}
     seen: dict[int, str] = {}
     for s, exposure in zip(steps, exposures, strict=True):
         led, name = s["led"], s["linear_image"]
@@ -193,6 +196,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         drive.append(level * exposure / exposures.max())
         leds.append(led)
         names.append(name)
+        image_of[led] = str(s.get("image") or name)
     return CardSession(
         root=root,
         rig_name=str(rig.get("name")),
@@ -201,6 +205,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         leds=np.array(leds, dtype=np.intp),
         drive=np.array(drive),
         correction=None if correction is None else tuple(float(v) for v in correction),
+        image_of=image_of,
     )
 
 

@@ -107,6 +107,12 @@ def calibrate_lights(
     lowest = float(elevation.min())
     weak, strong = int(np.argmin(cal.output)), int(np.argmax(cal.output))
     names = geometry.names
+
+    def led(i: int) -> str:
+        """An LED as the dome names it and as the session shot it (the image to open)."""
+        shot = card.image_of.get(i)
+        return f"LED {i}, {names[i]}" + (f", session image {shot}" if shot else "")
+
     out.print(
         f"Card session {escape(str(card_session))}: {len(card.leds)} images of rig "
         f"'{escape(loaded.config.name)}'; {len(measured)} of {geometry.count} LEDs measured "
@@ -126,15 +132,15 @@ def calibrate_lights(
         )
         out.print(
             f"Each LED's own light, without the correction, is still {cal.output[weak]:.2f} "
-            f"(LED {weak}, {escape(names[weak])}) to {cal.output[strong]:.2f} "
-            f"(LED {strong}, {escape(names[strong])}) of the median; the new correction "
+            f"({escape(led(weak))}) to {cal.output[strong]:.2f} "
+            f"({escape(led(strong))}) of the median; the new correction "
             f"differs from the one in force by at most {100 * change:.1f} %."
         )
     else:
         out.print(
             f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light "
-            f"from {cal.output[weak]:.2f} (LED {weak}, {escape(names[weak])}) to "
-            f"{cal.output[strong]:.2f} (LED {strong}, {escape(names[strong])}) of the median."
+            f"from {cal.output[weak]:.2f} ({escape(led(weak))}) to "
+            f"{cal.output[strong]:.2f} ({escape(led(strong))}) of the median."
         )
     out.print(
         f"Evened out, every LED gives {cal.evened_light:.2f} of the median LED's light "
@@ -149,8 +155,9 @@ def calibrate_lights(
         )
     if cal.output[weak] < 0.5:
         err.print(
-            f"[yellow]warning:[/] LED {weak} gives only {cal.output[weak]:.2f} of the median "
-            "light; check it (a failing LED, a dirty diffuser) before evening the dome out to it."
+            f"[yellow]warning:[/] {escape(led(weak))} gives only {cal.output[weak]:.2f} of the "
+            "median light; check it (a failing LED, a dirty diffuser) before evening the dome "
+            "out to it."
         )
     tilt_pct = 100 * math.tan(math.radians(1.0)) / math.tan(math.radians(lowest))
     out.print(

@@ -140,3 +140,22 @@ def test_a_session_cancelled_before_its_first_image_offers_no_resume(
     assert r.exit_code == 130, said
     assert "Session cancelled. Nothing was captured" in said, said
     assert "--resume" not in said and "lists the lights" not in said
+
+
+def test_calibration_names_the_weakest_led_by_its_session_image(tmp_path: Path) -> None:
+    """The weakest and strongest LEDs were named only by the dome .lp's labels (led_18.jpg),
+    not by the session image a user opens to look at them (image_019.jpg)."""
+    import json
+
+    import numpy as np
+    from card_support import TRUE_POWER
+
+    cfg = card_rig(tmp_path)
+    shoot(cfg, tmp_path / "card")
+    r = runner.invoke(app, ["calibrate-lights", str(tmp_path / "card"), "--rig", str(cfg)])
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
+    steps = [json.loads(line) for line in (tmp_path / "card" / "journal.jsonl").open()]
+    image_of = {s["led"]: s["image"] for s in steps}
+    weak = int(np.argmin(TRUE_POWER))
+    assert f"(LED {weak}, " in said and f"session image {image_of[weak]})" in said, said
