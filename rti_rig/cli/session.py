@@ -87,6 +87,16 @@ def run(
             "repaired LED, a new exposure); the change is recorded in the manifest.",
         ),
     ] = False,
+    reshoot_lost: Annotated[
+        bool,
+        typer.Option(
+            "--reshoot-lost",
+            help="With --resume on a session that completed: reshoot exactly the images whose "
+            "JPEG or linear TIFF was lost or changed since capture (the QA verdict names "
+            "them), with the object where it was; they are set aside in recovered/, never "
+            "deleted.",
+        ),
+    ] = False,
     adaptive: Annotated[
         bool,
         typer.Option(
@@ -170,6 +180,7 @@ def run(
                     max_saturated=max_saturated,
                     accept_rig_change=accept_rig_change,
                     objective=objective,
+                    reshoot_lost=reshoot_lost,
                 ),
                 print_note,
             )
@@ -178,6 +189,8 @@ def run(
                 raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
             if accept_rig_change:
                 raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
+            if reshoot_lost:
+                raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
             opened = open_new_session(
                 NewSessionRequest(
                     rig_config,

@@ -29,6 +29,7 @@ import hashlib
 import json
 import os
 import platform
+import shlex
 import shutil
 import sys
 import time
@@ -266,15 +267,19 @@ class SessionFolder:
 
     @classmethod
     def reopen(
-        cls, root: Path, check_done: Callable[[dict[int, StepRecord]], None] | None = None
+        cls,
+        root: Path,
+        check_done: Callable[[dict[int, StepRecord]], None] | None = None,
+        reshoot_lost: bool = False,
     ) -> SessionFolder:
         """Open an interrupted session to capture the steps it has not done yet.
 
         What is on disk is verified against the journal's checksums first, and the journal is
         repaired; see :func:`prepare_resume` (``check_done`` may refuse the verified steps
-        before anything in the folder changes).
+        before anything in the folder changes; ``reshoot_lost`` reopens a completed session to
+        reshoot what was lost since capture).
         """
-        state = prepare_resume(Path(root), check_done)
+        state = prepare_resume(Path(root), check_done, reshoot_lost)
         folder = cls(Path(root), planned_steps(state.manifest))
         folder.manifest = state.manifest
         folder.resume = state
@@ -754,12 +759,19 @@ def _new_stamp(root: Path) -> str:
 
 
 def prepare_resume(
-    root: Path, check_done: Callable[[dict[int, StepRecord]], None] | None = None
+    root: Path,
+    check_done: Callable[[dict[int, StepRecord]], None] | None = None,
+    reshoot_lost: bool = False,
 ) -> ResumeState:
     """Verify an interrupted session, repair its journal and set aside what is not committed.
 
     ``check_done`` sees the verified steps before anything is repaired or moved: a resume it
     refuses (by raising) leaves the folder exactly as it was.
+
+    A session that **completed** is refused, unless ``reshoot_lost``: then exactly the steps
+    whose JPEG or linear TIFF is gone or changed since capture (:func:`_lost_files`, what the
+    QA verdict names) are reshot; every other step stands as it is (a TIFF rewritten, a RAW
+    original archived elsewhere, are not reasons to reshoot a finished session).
 
     A step counts as done when its journal line is a well-formed record and every file it names
     is on disk with the journaled checksum. Journal lines that are not records (a torn last
@@ -777,23 +789,32 @@ def prepare_resume(
     runner = manifest.get("runner") or {}
     names = image_names(total)
     scan = scan_journal(root, names)
-    done = verified_steps(root, scan.records)
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
-        lost = sorted({r["image"] for r in scan.records} - {d.image for d in done.values()})
+        latest = _latest_records(scan.records)
+        lost = {i: _lost_files(root, rec) for i, rec in latest.items()}
+        lost = {i: gone for i, gone in lost.items() if gone}
         if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
             stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
             raise SessionError(
                 f"{root}: this adaptive session already completed: it stopped after "
                 f"{finished} of at most {total} lights ({stop.get('reason', 'its stopping rule')})"
-                + _lost_note(root, lost)
+                + _lost_note(root, latest, lost, adaptive=True)
             )
-        if not lost or manifest.get("adaptive"):
+        if not lost or manifest.get("adaptive") or not reshoot_lost:
             raise SessionError(
-                f"{root}: this session already completed all {total} steps" + _lost_note(root, lost)
+                f"{root}: this session already completed all {total} steps"
+                + _lost_note(root, latest, lost, adaptive=bool(manifest.get("adaptive")))
             )
-        # a completed session whose images were lost or changed since: the resume reshoots
-        # them (set aside in recovered/ below when changed, never deleted)
+        # the lost steps are reshot; the others stand as they are, verified or not
+        done = {i: _to_record(rec) for i, rec in latest.items() if i not in lost}
+    else:
+        if reshoot_lost:
+            raise SessionError(
+                f"{root}: --reshoot-lost is for a session that completed; this one did not, and "
+                "its resume reshoots whatever it cannot verify anyway: drop --reshoot-lost"
+            )
+        done = verified_steps(root, scan.records)
     stamp = _new_stamp(root)
     if check_done is not None:
         check_done(done)
@@ -833,16 +854,28 @@ def prepare_resume(
     return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
 
 
-def _lost_note(root: Path, lost: list[str]) -> str:
-    """The images of a finished adaptive session that are gone or changed since capture, and
-    what to do, since a resume cannot reshoot them."""
+def _lost_note(
+    root: Path,
+    latest: dict[int, dict[str, Any]],
+    lost: dict[int, list[str]],
+    adaptive: bool,
+) -> str:
+    """The images of a finished session lost since capture, and what to do about them."""
     if not lost:
         return ""
-    shown = ", ".join(lost[:5]) + (" …" if len(lost) > 5 else "")
-    return (
-        f"; but {len(lost)} of its images are missing or changed since capture ({shown}): put "
-        "the originals back from a copy (an adaptive session cannot reshoot one image: the "
-        "lights after it were chosen from it), or start a new session with another --out"
+    shown = ", ".join(Path(latest[i]["image"]).stem for i in sorted(lost)[:5]) + (
+        " …" if len(lost) > 5 else ""
+    )
+    head = f"; but {len(lost)} of its images are missing or changed since capture ({shown}): "
+    if adaptive:
+        return head + (
+            "put the originals back from a copy (an adaptive session cannot reshoot one "
+            "image: the lights after it were chosen from it), or start a new session with "
+            "another --out"
+        )
+    return head + (
+        "put the originals back from a copy, or reshoot exactly those, with the object where "
+        f"it was: rti-rig run --resume {shlex.quote(str(root))} --reshoot-lost"
     )
 
 
@@ -868,12 +901,28 @@ def read_manifest(root: Path) -> dict[str, Any]:
     return data
 
 
+def _lost_files(root: Path, rec: dict[str, Any]) -> list[str]:
+    """The image files of one journaled step gone or changed since capture: its JPEG against
+    its checksum (what relight and RTIBuilder read), its linear TIFF for its presence (a fit
+    reads every pixel anyway; hashing gigabytes for a verdict would not do). RAW originals
+    are not counted: archiving them elsewhere is normal, and the images stand without them."""
+    lost = []
+    for name, digest in rec["sha256"].items():
+        if name not in (rec.get("image"), rec.get("linear_image")):
+            continue
+        path = root / name
+        if not path.is_file():
+            lost.append(f"{name} missing")
+        elif name == rec.get("image") and _sha256(path) != digest:
+            lost.append(f"{name} changed")
+    return lost
+
+
 def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
-    """Per image (its base name, ``image_010``) the files of its committed step that are gone
-    or changed since they were journaled: a JPEG is checked against its checksum (it is what
-    relight and RTIBuilder pair with the ``.lp``), a TIFF or RAW original for its presence (a
-    fit reads every pixel of a TIFF anyway, and hashing gigabytes for a verdict would not do).
-    Empty for a folder without a journal (an ``.lp`` acquisition is no session)."""
+    """Per image (its base name, ``image_010``) of a session, its JPEG or linear TIFF gone or
+    changed since capture (:func:`_lost_files`): what the QA verdict names and what
+    ``run --resume --reshoot-lost`` reshoots, one criterion for both. Empty for a folder
+    without a journal (an ``.lp`` acquisition is no session)."""
     root = Path(root)
     if not (root / JOURNAL).is_file() or not (root / MANIFEST).is_file():
         return {}
@@ -881,21 +930,18 @@ def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
         total = planned_steps(read_manifest(root))
     except SessionError:
         return {}
-    latest: dict[int, dict[str, Any]] = {}
-    for rec in scan_journal(root, image_names(total) if total else None).records:
-        latest[rec["index"]] = rec  # the later record of a step wins (a reshot image)
     lost: dict[str, list[str]] = {}
-    for rec in latest.values():
-        gone = []
-        for name, digest in rec["sha256"].items():
-            path = root / name
-            if not path.is_file():
-                gone.append(f"{name} missing")
-            elif name.endswith(".jpg") and _sha256(path) != digest:
-                gone.append(f"{name} changed")
+    records = scan_journal(root, image_names(total) if total else None).records
+    for rec in _latest_records(records).values():
+        gone = _lost_files(root, rec)
         if gone:
             lost[Path(rec["image"]).stem] = gone
     return lost
+
+
+def _latest_records(records: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
+    """Each step's last journal record (a later record of a step replaces an earlier one)."""
+    return {rec["index"]: rec for rec in records}
 
 
 def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], list[str]]:

@@ -336,14 +336,15 @@ def test_export_names_only_the_file_kind_it_lists(
     assert len(names) == LIGHTS - 1 and "image_002.jpg" in said(r)
 
 
-def test_an_image_lost_since_capture_is_named_by_qa_and_reshot_by_resume(
+def test_an_image_lost_since_capture_is_named_by_qa_and_reshot_on_request(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:
     """A finished session whose JPEG was deleted, or truncated, since capture: QA had said
     "good" (fit reads the intact TIFFs) while lights.lp still listed the JPEG, so relight
-    paired every later image with the wrong light, and `run --resume` refused ("already
-    completed"). Now the verdict names the image and the resume reshoots it, setting aside
-    what it cannot verify, and the session is whole again."""
+    paired every later image with the wrong light, and `run --resume` could not repair it.
+    Now the verdict names the images, a plain resume still refuses a completed session but
+    names them and the command, and `--reshoot-lost` reshoots exactly those, setting aside
+    their surviving files."""
     import shutil
 
     _, ref = reference
@@ -356,17 +357,53 @@ def test_an_image_lost_since_capture_is_named_by_qa_and_reshot_by_resume(
     assert r.exit_code == 0, r.output
     verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
     assert verdict.startswith("reshoot: image_003 (image_003.jpg missing since capture"), verdict
-    assert "image_006 (image_006.jpg changed since capture" in verdict
-    assert "relight and RTIBuilder pair the images after it with the wrong lights" in verdict
-    assert f"rti-rig run --resume {done}" in verdict
-    tif = (done / "linear" / "image_003.tif").read_bytes()
+    assert "lights.lp still lists it, so relight" in verdict
+    assert "image_006 (image_006.jpg changed since capture; put the original back" in verdict
+    assert f"rti-rig run --resume {done} --reshoot-lost" in verdict
+    before = {p: p.read_bytes() for p in done.rglob("*") if p.is_file()}
     r = runner.invoke(app, ["run", "--resume", str(done)])
+    assert r.exit_code == 2, r.output
+    assert "already completed" in said(r) and "image_003, image_006" in said(r)
+    assert f"rti-rig run --resume {done} --reshoot-lost" in said(r)
+    assert {p: p.read_bytes() for p in done.rglob("*") if p.is_file()} == before
+    tif = (done / "linear" / "image_003.tif").read_bytes()
+    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
     assert r.exit_code == 0, r.output
     assert "2 of 8 lights" in said(r) and "QA verdict: good" in said(r)
     assert digests(done) == digests(ref)  # a dry run reshoots the very same images
     # nothing captured is lost: the intact TIFF of the deleted JPEG and the truncated JPEG
     kept = {p.name: p.read_bytes() for p in (done / "recovered").rglob("image_*")}
     assert kept["image_003.tif"] == tif and len(kept["image_006.jpg"]) == 2000
+
+
+def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tiff(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """RAW originals moved to an archive, a TIFF rewritten by another tool: the images stand,
+    the verdict is good, and --reshoot-lost finds nothing to reshoot (a review found both made
+    a completed session reshoot every image, its intact files moved aside)."""
+    import shutil
+
+    import tifffile
+
+    _, ref = reference
+    done = tmp_path / "done"
+    shutil.copytree(ref, done)
+    lines = (done / "journal.jsonl").read_text().splitlines()
+    records = [json.loads(line) for line in lines]
+    for rec in records:  # as a DSLR session's: each step's RAW original, since archived
+        rec["sha256"][f"raw/{Path(rec['image']).stem}.cr2"] = "0" * 64
+    (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    tif = done / "linear" / "image_004.tif"
+    tifffile.imwrite(tif, tifffile.imread(tif), description="re-saved")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"] == "good"
+    before = {p: p.read_bytes() for p in done.rglob("*") if p.is_file()}
+    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
+    assert r.exit_code == 2, r.output
+    assert "already completed all 8 steps" in said(r) and "missing or changed" not in said(r)
+    assert {p: p.read_bytes() for p in done.rglob("*") if p.is_file()} == before
 
 
 def test_a_session_without_its_lights_lp_is_told_how_to_rebuild_it(

@@ -14,6 +14,7 @@ import html
 import json
 import math
 import os
+import shlex
 import threading
 import time
 import warnings
@@ -242,8 +243,8 @@ def acquisition_files(
             if (source / JOURNAL).is_file():  # a session that lost its lights.lp
                 raise FitInputError(
                     f"{source} is a session folder without its {LP_NAME}; rebuild it from the "
-                    f"session's journal with: rti-rig export-lp {source} --out "
-                    f"{source / LP_NAME}"
+                    f"session's journal with: rti-rig export-lp {shlex.quote(str(source))} "
+                    f"--out {shlex.quote(str(source / LP_NAME))}"
                 )
             raise FitInputError(f"{source} holds no .lp file: not a session folder")
         lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]

@@ -88,6 +88,9 @@ class ResumeRequest:
     accept_rig_change: bool = False
     #: An adaptive session's objective, if the user names it: it must be the session's own.
     objective: str | None = None
+    #: A session that completed: reshoot the images lost or changed since capture (the QA
+    #: verdict names them), with the object where it was.
+    reshoot_lost: bool = False
 
 
 @dataclass(frozen=True)
@@ -463,7 +466,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         from rti_rig.runtime.session import planned_steps
 
         check_done = refuse_broken_run(Path(req.session_dir), planned_steps(manifest))
-    folder = SessionFolder.reopen(req.session_dir, check_done)
+    folder = SessionFolder.reopen(req.session_dir, check_done, req.reshoot_lost)
     folder.rig_identity = identity
     folder.rig_change = diffs or None
     folder.input_notes = list(loaded.notes)  # recorded in this run's entry of the manifest

@@ -1,23 +1,29 @@
-"""A session's QA verdict also names the files lost since capture.
+"""A session's QA verdict also names the images lost since capture.
 
 Why: the QA judges the pixels it can read, and ``fit`` reads a session's linear TIFFs; a JPEG
-deleted or truncated since capture went unseen, the verdict said "good", while ``lights.lp``
-still listed it, so relight and RTIBuilder (which pair the ``.lp`` with the JPEGs in order)
-gave every later image the wrong light. The journal's checksums say what was captured.
+deleted or truncated since capture went unseen and the verdict said "good", while
+``lights.lp`` still listed it, so relight (which pairs the ``.lp``'s lines with the folder's
+JPEGs in order) gave every later image the wrong light. The journal says what was captured;
+:func:`rti_rig.runtime.session.files_lost_since_capture` is the one criterion the verdict and
+``run --resume --reshoot-lost`` share.
 """
 
 from __future__ import annotations
 
+import shlex
 from dataclasses import replace
 from pathlib import Path
 
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.lp_format import read_lp
 from rti_rig.reconstruct.qa import QAReport
 from rti_rig.runtime.session import LP_NAME, files_lost_since_capture, read_manifest
 
 
 def with_lost_files(qa: QAReport, source: Path) -> QAReport:
-    """``qa`` with a problem added to each image of session ``source`` whose files are gone or
-    changed since capture (unchanged for an ``.lp`` acquisition, which has no journal)."""
+    """``qa`` with a problem added to each image of session ``source`` whose JPEG or linear
+    TIFF is gone or changed since capture (unchanged for an ``.lp`` acquisition, which has no
+    journal)."""
     source = Path(source)
     if not source.is_dir():
         if source.name != LP_NAME:  # an .lp of its own, not a session's lights.lp
@@ -31,20 +37,28 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         "put the original back from a copy (an adaptive session cannot reshoot one image: "
         "the lights after it were chosen from it)"
         if adaptive
-        else f"reshoot it with: rti-rig run --resume {source} (the object where it was), or "
-        "put the original back from a copy"
+        else "put the original back from a copy, or reshoot it with the object where it was: "
+        f"rti-rig run --resume {shlex.quote(str(source))} --reshoot-lost"
     )
+    listed = _listed(source / LP_NAME)
     images = []
     for check in qa.images:
         gone = lost.get(check.name)
         if gone:
-            pairing = (
-                f"; {LP_NAME} still lists it, so relight and RTIBuilder pair the images after "
-                "it with the wrong lights"
-                if any(g.endswith(".jpg missing") or g.endswith(".jpg changed") for g in gone)
-                else ""
-            )
-            problem = f"{', '.join(gone)} since capture{pairing}; {todo}"
-            check = replace(check, problems=(*check.problems, problem))
+            problem = f"{', '.join(gone)} since capture"
+            if f"{check.name}.jpg" in listed and f"{check.name}.jpg missing" in gone:
+                problem += (
+                    f"; {LP_NAME} still lists it, so relight (which pairs the .lp's lines with "
+                    "the JPEGs in order) gives every later image the wrong light"
+                )
+            check = replace(check, problems=(*check.problems, f"{problem}; {todo}"))
         images.append(check)
     return replace(qa, images=tuple(images))
+
+
+def _listed(lp: Path) -> set[str]:
+    """The image names a session's ``.lp`` lists (none when it is gone or unreadable)."""
+    try:
+        return {e.name for e in read_lp(lp)}
+    except (OSError, RtiRigError):
+        return set()
