@@ -240,10 +240,17 @@ class DomePolicy:
             # the handshake: the port is open and a board may boot lit, so the all-off is
             # sent before the stop goes on (it had been told "the dome was never reached"
             # with every LED of a board that boots lit still on)
-            if getattr(self.link, "port_open", True):
-                self._port_was_open = True
-                self._attempt_off("after the connection was interrupted")
-            self._quiet_close()
+            try:
+                if getattr(self.link, "port_open", True):
+                    self._port_was_open = True
+                    # what stands if a further signal cuts the attempt short (the attempt
+                    # replaces it with what it established)
+                    self.off_report = OffReport(
+                        OffOutcome.NOT_SENT, "a further stop cut the all-off short"
+                    )
+                    self._attempt_off("after the connection was interrupted")
+            finally:
+                self._quiet_close()
             raise
         self._port_was_open = True
         problem = self._check_identity(info)

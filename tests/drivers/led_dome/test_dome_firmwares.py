@@ -253,6 +253,30 @@ def test_a_stop_during_the_handshake_of_the_lit_nab_sketch_sends_all_off() -> No
         assert "never reached" not in dome.off_report.sentence()
 
 
+def test_a_second_stop_during_that_all_off_says_it_was_not_sent_and_closes() -> None:
+    """A further signal cuts the all-off of an interrupted connection short: the port is
+    still closed, and the user is told the all-off was not sent (not "never reached")."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.dome_link import OffOutcome
+    from rti_rig.runtime.controller import EmergencyStop
+
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        dome = build_dome(DomeSerialSettings(port=link.port, profile="nab-rti-v1"), VirtualClock())
+
+        def stopped(*args):  # type: ignore[no-untyped-def]
+            raise EmergencyStop("SIGTERM")
+
+        dome.link.hello = stopped
+        dome.link.all_off = stopped
+        with pytest.raises(EmergencyStop):
+            dome.connect()
+        assert not dome.link.port_open
+        assert dome.off_report is not None and dome.off_report.outcome is OffOutcome.NOT_SENT
+        assert "switch the dome off at its power supply" in dome.off_report.sentence()
+
+
 def test_failed_handshake_on_the_lit_nab_sketch_still_sends_all_off_and_says_so() -> None:
     """The issue's case: the project's 'framed' profile on the RTI v1.0 sketch, which boots with
     every LED on. The handshake fails; the all-off is sent anyway and reported unconfirmed."""
