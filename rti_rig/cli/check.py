@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import signal
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -19,14 +21,19 @@ from rti_rig.core.errors import RtiRigError
 def stop_on_signals() -> Iterator[None]:
     """Ctrl-C or SIGTERM stops a check at once, through its teardown (all-off; lamp off, arm
     stopped): without a handler SIGTERM killed the process with an LED lit and said nothing.
-    A second signal while the first is being handled is ignored: the teardown it would cut
-    short is what switches the lights off."""
+    A further signal while the first is handled only says so: the teardown it would cut short
+    is what switches the lights off (``kill -9`` still ends the process)."""
     from rti_rig.runtime.controller import EmergencyStop
 
+    if threading.current_thread() is not threading.main_thread():
+        yield  # signal handlers can only be set from the main thread
+        return
     stopping: list[str] = []
 
     def on_signal(signum, frame):  # type: ignore[no-untyped-def]
         if stopping:
+            if stopping[0] != "done":
+                os.write(2, b"Still stopping: making the rig safe first (lights, lamp, arm)...\n")
             return
         stopping.append(signal.Signals(signum).name)
         raise EmergencyStop("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
@@ -35,6 +42,7 @@ def stop_on_signals() -> Iterator[None]:
     try:
         yield
     finally:
+        stopping.insert(0, "done")  # a signal from here on is ignored, not raised mid-restore
         for sig, h in previous.items():
             signal.signal(sig, h)
 
@@ -57,6 +65,8 @@ def check(
             err.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
             report = check_rig(CheckRequest(rig_config, intensity))
     except CheckStopped as exc:
+        for failure in exc.teardown_failures:
+            err.print(f"[red]teardown problem:[/] {escape(failure)}")
         err.print(f"[red]Check stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
         raise typer.Exit(code=143 if exc.why == "SIGTERM" else 130) from None
     except EmergencyStop as exc:  # stopped outside a self-test (loading, a camera's check)

@@ -135,7 +135,8 @@ class ImageCheck:
     #: False when too few pixels were lit to compare the image with its prediction.
     gain_judged: bool = True
     #: The median gain over the median of its nearest lights' (:data:`NEIGHBOUR_COUNT`
-    #: within :data:`NEIGHBOUR_SPAN_DEG`); NaN where the lights are too far apart to compare.
+    #: within :data:`NEIGHBOUR_SPAN_DEG`); NaN where the lights are too far apart, there are
+    #: too few lights, or a gain could not be judged.
     neighbour_gain_ratio: float = float("nan")
 
 

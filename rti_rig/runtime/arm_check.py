@@ -161,6 +161,10 @@ def arm_self_test(
             report.parked = True
     except Exception as exc:  # a self-test reports what went wrong; teardown follows
         report.aborted = f"{type(exc).__name__}: {exc}"
+    except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
+        report.aborted = f"stopped ({exc})"
+        exc.self_test_report = report  # type: ignore[attr-defined]
+        raise
     finally:
         report.teardown_failures = attempt_all(
             [

@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -46,6 +47,8 @@ def test_a_stopped_check_switches_the_dome_off_and_says_so(sig, code, name) -> N
         env={**os.environ, "COLUMNS": "200"},
     )
     assert proc.stderr is not None
+    watchdog = threading.Timer(180.0, proc.kill)  # a child that stalls fails, not hangs
+    watchdog.start()
     for line in proc.stderr:  # the third LED is lit and its firmware has acknowledged it
         if line.startswith("LIT 2"):
             break
@@ -53,6 +56,7 @@ def test_a_stopped_check_switches_the_dome_off_and_says_so(sig, code, name) -> N
         raise AssertionError(f"the walk never reached the third LED: {proc.communicate()}")
     proc.send_signal(sig)
     out, errs = proc.communicate(timeout=120)
+    watchdog.cancel()
     said = " ".join((out + errs).split())
     assert proc.returncode == code, said
     assert "Traceback" not in said
@@ -61,3 +65,37 @@ def test_a_stopped_check_switches_the_dome_off_and_says_so(sig, code, name) -> N
     # reached" for a dome whose port was open
     assert "never reached" not in said
     assert "all-off sent and acknowledged" in said, said
+
+
+def test_a_stopped_arm_check_says_what_its_teardown_could_not_do(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A stop during an arm's walk goes through the lamp-off and stop; what failed there is
+    said before the line that refers to it (it had been dropped with the self-test's report)."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+    from rti_rig.core.errors import DeviceError
+    from rti_rig.runtime.controller import EmergencyStop
+    from rti_rig.simulator.sim_lights import SimulatedArm
+
+    real_move = SimulatedArm.move_to
+    moves: list[int] = []
+
+    def move_to(self, direction):  # type: ignore[no-untyped-def]
+        moves.append(1)
+        if len(moves) == 2:
+            raise EmergencyStop("SIGTERM")
+        return real_move(self, direction)
+
+    def lamp(self, on):  # type: ignore[no-untyped-def]
+        if not on and len(moves) >= 2:  # the teardown's lamp-off, after the stop
+            raise DeviceError("lamp relay", "no answer to lamp off")
+
+    monkeypatch.setattr(SimulatedArm, "move_to", move_to)
+    monkeypatch.setattr(SimulatedArm, "lamp", lamp)
+    r = CliRunner().invoke(app, ["check", str(REPO / "rig_configs" / "virtual_arm.toml")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 143, said
+    assert "teardown problem: lamp off" in said and "no answer to lamp off" in said, said
+    assert said.index("teardown problem") < said.index("Check stopped (SIGTERM)")

@@ -25,11 +25,13 @@ from rti_rig.runtime.lighting import ArmLighting, DomeLighting
 class CheckStopped(Exception):
     """The check was stopped (SIGTERM, Ctrl-C) part-way; the rig was torn down first."""
 
-    def __init__(self, why: str, lights: str) -> None:
+    def __init__(self, why: str, lights: str, teardown_failures: tuple[str, ...] = ()) -> None:
         super().__init__(f"check stopped ({why}): {lights}")
         self.why = why
         #: what is known about the lights after the teardown (never "off" unless established)
         self.lights = lights
+        #: what the teardown could not do (an arm's lamp off, stop), to be said first
+        self.teardown_failures = teardown_failures
 
 
 @dataclass(frozen=True)
@@ -63,5 +65,7 @@ def check_rig(req: CheckRequest) -> Any:
                 )
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
-            raise CheckStopped(str(exc), lights_state(rig)) from None
+            report = getattr(exc, "self_test_report", None)
+            failures = tuple(str(f) for f in getattr(report, "teardown_failures", None) or ())
+            raise CheckStopped(str(exc), lights_state(rig), failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
