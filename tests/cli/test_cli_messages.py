@@ -62,24 +62,30 @@ def test_resume_refuses_options_it_would_otherwise_ignore(tmp_path):
     assert "drop --until-error, --auto-exposure" in text
 
 
+def _small_run(tmp_path: Path) -> tuple[int, str, Path]:
+    """A 6-light dry run on the small simulated dome: exit code, what it said, its folder."""
+    from conftest import SMALL_DOME, write_config
+
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(write_config(tmp_path, SMALL_DOME)), "--out", str(out), "--lights", "6"]
+    )
+    return r.exit_code, " ".join(r.output.split()), out
+
+
 def test_ctrl_c_during_the_verdict_of_a_complete_session_says_it_is_complete(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Ctrl-C while the QA verdict is computed (seconds, after the last image) had ended the
     command with exit code 130 and no word: a complete session read as an interrupted one."""
-    from conftest import SMALL_DOME, write_config
-
     import rti_rig.app.usecases.fit as fit_usecase
 
     def interrupted(session: Path) -> str:
         raise KeyboardInterrupt
 
     monkeypatch.setattr(fit_usecase, "verdict_for_session", interrupted)
-    cfg = write_config(tmp_path, SMALL_DOME)
-    out = tmp_path / "s"
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6"])
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    code, said, out = _small_run(tmp_path)
+    assert code == 0, said
     assert "QA verdict skipped (Ctrl-C): the session is complete" in said
     assert f"rti-rig fit {out} --out FOLDER" in said
 
@@ -93,8 +99,6 @@ def test_a_late_ctrl_c_does_not_cut_the_summary(
     import os
     import signal
 
-    from conftest import SMALL_DOME, write_config
-
     import rti_rig.cli.session as session_cli
 
     real = session_cli._time_line
@@ -105,10 +109,8 @@ def test_a_late_ctrl_c_does_not_cut_the_summary(
 
     monkeypatch.setattr(session_cli, "_time_line", with_a_late_ctrl_c)
     before = signal.getsignal(signal.SIGINT)
-    cfg = write_config(tmp_path, SMALL_DOME)
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"])
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    code, said, _ = _small_run(tmp_path)
+    assert code == 0, said
     assert "6 image(s) in the session" in said and "Session time on the real rig" in said
     assert signal.getsignal(signal.SIGINT) is before  # the handlers before are back
 
@@ -122,8 +124,6 @@ def test_a_session_cancelled_before_its_first_image_offers_no_resume(
     import os
     import signal
 
-    from conftest import SMALL_DOME, write_config
-
     from rti_rig.simulator.sim_lights import SimulatedDome
 
     real = SimulatedDome.connect
@@ -133,11 +133,8 @@ def test_a_session_cancelled_before_its_first_image_offers_no_resume(
         return real(self)
 
     monkeypatch.setattr(SimulatedDome, "connect", ctrl_c_while_connecting)
-    cfg = write_config(tmp_path, SMALL_DOME)
-    out = tmp_path / "s"
-    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6"])
-    said = " ".join(r.output.split())
-    assert r.exit_code == 130, said
+    code, said, _ = _small_run(tmp_path)
+    assert code == 130, said
     assert "Session cancelled. Nothing was captured" in said, said
     assert "--resume" not in said and "lists the lights" not in said
 

@@ -51,6 +51,15 @@ def leftovers(folder: Path) -> list[Path]:
     return [*folder.rglob(".*.partial"), *folder.rglob(".*.tmp")]
 
 
+def copied(ref: Path, tmp_path: Path) -> Path:
+    """A copy of the finished reference session, to be damaged by a test."""
+    import shutil
+
+    done = tmp_path / "done"
+    shutil.copytree(ref, done)
+    return done
+
+
 @pytest.fixture
 def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     base = tmp_path_factory.mktemp("ref")
@@ -298,11 +307,8 @@ def test_a_resume_after_a_kill_says_its_time_is_a_lower_bound(
 def test_export_leaves_out_an_image_deleted_since(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:
-    import shutil
-
     _, ref = reference
-    done = tmp_path / "done"
-    shutil.copytree(ref, done)
+    done = copied(ref, tmp_path)
     (done / "image_002.jpg").unlink()
     r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "x.lp")])
     assert r.exit_code == 0, r.output
@@ -317,11 +323,8 @@ def test_export_names_only_the_file_kind_it_lists(
     """An .lp of the TIFFs keeps an image whose JPEG is gone (its linear TIFF is intact), and
     an .lp of the JPEGs one whose TIFF is damaged: each is judged by the file it names (a
     lost JPEG had dropped its intact TIFF from the --linear listing)."""
-    import shutil
-
     _, ref = reference
-    done = tmp_path / "done"
-    shutil.copytree(ref, done)
+    done = copied(ref, tmp_path)
     (done / "image_002.jpg").unlink()
     (done / "linear" / "image_003.tif").write_bytes(b"damaged")
     r = runner.invoke(app, ["export-lp", str(done), "--out", str(done / "t.lp"), "--linear"])
@@ -345,11 +348,8 @@ def test_an_image_lost_since_capture_is_named_by_qa_and_reshot_on_request(
     Now the verdict names the images, a plain resume still refuses a completed session but
     names them and the command, and `--reshoot-lost` reshoots exactly those, setting aside
     their surviving files."""
-    import shutil
-
     _, ref = reference
-    done = tmp_path / "done"
-    shutil.copytree(ref, done)
+    done = copied(ref, tmp_path)
     (done / "image_003.jpg").unlink()
     jpg = done / "image_006.jpg"
     jpg.write_bytes(jpg.read_bytes()[:2000])
@@ -382,13 +382,10 @@ def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tif
     """RAW originals moved to an archive, a TIFF rewritten by another tool: the images stand,
     the verdict is good, and --reshoot-lost finds nothing to reshoot (a review found both made
     a completed session reshoot every image, its intact files moved aside)."""
-    import shutil
-
     import tifffile
 
     _, ref = reference
-    done = tmp_path / "done"
-    shutil.copytree(ref, done)
+    done = copied(ref, tmp_path)
     lines = (done / "journal.jsonl").read_text().splitlines()
     records = [json.loads(line) for line in lines]
     for rec in records:  # as a DSLR session's: each step's RAW original, since archived
@@ -411,11 +408,8 @@ def test_a_session_without_its_lights_lp_is_told_how_to_rebuild_it(
 ) -> None:
     """fit on a session whose lights.lp was deleted had said "not a session folder"; it names
     the export-lp command that rebuilds it from the journal, and that command works."""
-    import shutil
-
     _, ref = reference
-    done = tmp_path / "done"
-    shutil.copytree(ref, done)
+    done = copied(ref, tmp_path)
     (done / "lights.lp").unlink()
     r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 2, r.output
