@@ -291,9 +291,45 @@ class DynamixelArm:
             # torque is off on purpose: writing a goal now is pointless at best, and on a servo
             # whose Drive Mode has "Torque On by Goal Update" it would switch torque back on
             return
-        ticks = self.joint_ticks()
-        goal = tuple(clamp_ticks(j, t) for j, t in zip(self.settings.joints, ticks, strict=True))
-        self._send_goal(goal, "stop")  # type: ignore[arg-type]
+        present: dict[int, int] = {}
+        failed: list[tuple[str, DynamixelError]] = []
+        for joint, role in zip(self.settings.joints, ("azimuth", "elevation"), strict=True):
+            try:
+                present[joint.servo_id] = clamp_ticks(
+                    joint, self._bus.read(joint.servo_id, ct.PRESENT_POSITION)
+                )
+            except DynamixelError as exc:  # a faulted or silent servo: hold the others anyway
+                failed.append((role, exc))
+        if not failed:
+            goal = tuple(present[j.servo_id] for j in self.settings.joints)
+            self._send_goal(goal, "stop")  # type: ignore[arg-type]
+            return
+        # One joint cannot be read: each other joint is held where it is, one by one (a fault
+        # on one servo had left the other swinging on to its goal, torque on, while the user
+        # was told "the arm is left where it stopped").
+        held = []
+        for joint, role in zip(self.settings.joints, ("azimuth", "elevation"), strict=True):
+            if joint.servo_id not in present:
+                continue
+            try:
+                self._bus.write(joint.servo_id, ct.GOAL_POSITION, present[joint.servo_id])
+                held.append(f"servo {joint.servo_id} ({role}) held where it is")
+            except DynamixelError as exc:
+                failed.append((role, exc))
+        said = "; ".join(
+            [*held]
+            + [
+                f"{role}: {exc}"
+                + (
+                    ""
+                    if isinstance(exc, HardwareFaultError)
+                    else " — it may still be moving to its last goal, a pose checked safe "
+                    "before it was sent; switch the arm's power off if it does not stop"
+                )
+                for role, exc in failed
+            ]
+        )
+        raise DynamixelError(self.name, f"stop incomplete: {said}", "stop")
 
     def emergency_stop(self) -> None:
         """Torque off on every servo now (one broadcast packet, no reply to wait for).

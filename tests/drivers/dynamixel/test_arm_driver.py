@@ -15,6 +15,7 @@ from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.faults import (
     ConfigMismatchError,
+    DynamixelError,
     HardwareFaultError,
     MoveTimeoutError,
     SafetyViolation,
@@ -144,9 +145,19 @@ def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
     with pytest.raises(HardwareFaultError) as info:
         arm.move_to(direction_from_az_el(150, 30))
     assert info.value.fault_names == ["overload"] and info.value.servo_id == 1
-    with pytest.raises(HardwareFaultError):
+    assert emu.servos[2].is_moving()  # the elevation joint is still on its way
+    with pytest.raises(
+        DynamixelError, match=r"stop incomplete: servo 2 \(elevation\) held"
+    ) as stop:
         arm.close()  # stopping a faulted servo fails, loudly, but the port is released
+    assert "azimuth" in str(stop.value) and "overload" in str(stop.value)
     assert not arm.lamp_is_on
+    # the joint that answered was held where it was, not left to swing on to its goal
+    held = emu.servos[2].position()
+    clock.sleep = real_sleep  # type: ignore[method-assign]
+    clock.sleep(5.0)
+    assert not emu.servos[2].is_moving()
+    assert emu.servos[2].position() == pytest.approx(held, abs=1.0)  # within the tick read
 
 
 def test_stalled_move_times_out_and_stops() -> None:
