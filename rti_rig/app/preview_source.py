@@ -28,7 +28,7 @@ import numpy as np
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.core.lp_format import LpEntry, image_path
-from rti_rig.runtime.session import LINEAR_DIR, MANIFEST, read_manifest
+from rti_rig.runtime.session import LINEAR_DIR, MANIFEST, RAW_DIR, read_manifest
 
 #: A bare `.lp` given as ``--rig``: its path and its entries.
 RigLp = tuple[Path, Sequence[LpEntry]]
@@ -48,9 +48,10 @@ class PreviewSource:
 
 def _session_root(image: Path) -> Path | None:
     """The rti-rig session folder ``image`` belongs to (its own folder, or the one above a
-    session's ``linear/`` folder), if any."""
+    session's ``linear/`` or ``raw/`` folder: a DSLR user hands over the camera's RAW), if
+    any."""
     folder = image.resolve().parent
-    roots = (folder, folder.parent) if folder.name == LINEAR_DIR else (folder,)
+    roots = (folder, folder.parent) if folder.name in (LINEAR_DIR, RAW_DIR) else (folder,)
     return next((r for r in roots if (r / MANIFEST).is_file()), None)
 
 
@@ -85,7 +86,7 @@ def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any]]:
     root = _session_root(image)
     if root is not None:
         for step in _finished_steps(root):
-            names = (step.get("image"), step.get("linear_image"))
+            names = (step.get("image"), step.get("linear_image"), *(step.get("originals") or {}))
             if any(n and (root / n).resolve() == target for n in names):
                 found.append(
                     (f"the session {root}", f"the session {root.name}", step["actual_direction"])

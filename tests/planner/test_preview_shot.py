@@ -141,6 +141,16 @@ def test_images_of_a_session_take_their_step_s_light(tmp_path: Path) -> None:
         got = _az_el(direction_from_az_el(*src.light_az_el_deg))
         assert got == _az_el(lights[k].direction)
         assert src.light_source == "recorded by the session many"
+    # a DSLR session's RAW original in raw/ (as its manifest lists it) takes its step's light
+    # too: it had been "estimated" 11° off while the session's JPEG was "recorded"
+    manifest = json.loads((many / "manifest.json").read_text())
+    manifest["steps"][1]["originals"] = {"raw/image_002.dng": "IMG_0002.DNG"}
+    (many / "manifest.json").write_text(json.dumps(manifest))
+    (many / "raw").mkdir()
+    shutil.copy(many / "linear" / "image_002.tif", many / "raw" / "image_002.dng")
+    src = resolve_preview(many / "raw" / "image_002.dng")
+    assert _az_el(direction_from_az_el(*src.light_az_el_deg)) == _az_el(lights[1].direction)
+    assert src.light_source == "recorded by the session many"
     # a folder called linear that is no session's records nothing
     stray = tmp_path / "stray" / "linear"
     stray.mkdir(parents=True)
