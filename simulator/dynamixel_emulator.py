@@ -302,6 +302,12 @@ class DynamixelBusEmulator:
         self.servos = {s.dxl_id: s for s in servos}
         self.clock = clock
         self.silent_ids: set[int] = set()
+        #: The host's line speed, where the transport knows it (set with the port's baud
+        #: rate). A servo whose Baud Rate (address 8) is another speed sees framing noise and
+        #: answers nothing, as a real one does: a config with the wrong baud rate fails here
+        #: as on the rig (it had passed `check`).
+        self.host_baud: int | None = None
+        self._deaf: set[int] = set()
         self.corrupt_next_replies = 0
         self.goal_log: list[tuple[int, int]] = []
         self.instructions: list[p2.Packet] = []
@@ -322,12 +328,18 @@ class DynamixelBusEmulator:
     def receive(self, data: bytes) -> bytes:
         """Feed instruction bytes; return the status bytes the servos send back."""
         with self._lock:
+            self._deaf = self.silent_ids | {
+                i
+                for i, servo in self.servos.items()
+                if self.host_baud is not None
+                and ct.BAUD_CODES.get(servo.get(ct.BAUD_RATE)) != self.host_baud
+            }
             self._parser.feed(bytes(data))
             out = bytearray()
             for item in self._parser.packets():
                 if isinstance(item, p2.CrcMismatch):
                     dxl_id = item.raw[4]
-                    if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                    if dxl_id in self.servos and dxl_id not in self._deaf:
                         out += self._reply(dxl_id, p2.ERR_CRC)
                     continue
                 self.instructions.append(item)
@@ -355,7 +367,7 @@ class DynamixelBusEmulator:
             ids = sorted(self.servos)
         else:
             ids = [pkt.dxl_id] if pkt.dxl_id in self.servos else []
-        return [self.servos[i] for i in ids if i not in self.silent_ids]
+        return [self.servos[i] for i in ids if i not in self._deaf]
 
     def _log_goal(self, dxl_id: int, address: int, data: bytes) -> None:
         g = ct.GOAL_POSITION.address
@@ -372,7 +384,7 @@ class DynamixelBusEmulator:
             for i in range(4, len(prm), length + 1):
                 dxl_id, data = prm[i], prm[i + 1 : i + 1 + length]
                 self._log_goal(dxl_id, address, data)
-                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                if dxl_id in self.servos and dxl_id not in self._deaf:
                     self.servos[dxl_id].write(address, data)
             return b""
         if inst == p2.INST_BULK_WRITE:
@@ -383,14 +395,14 @@ class DynamixelBusEmulator:
                 length = int.from_bytes(prm[i + 3 : i + 5], "little")
                 data = prm[i + 5 : i + 5 + length]
                 self._log_goal(dxl_id, address, data)
-                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                if dxl_id in self.servos and dxl_id not in self._deaf:
                     self.servos[dxl_id].write(address, data)
                 i += 5 + length
             return b""
         if inst == p2.INST_SYNC_READ:
             address, length = int.from_bytes(prm[0:2], "little"), int.from_bytes(prm[2:4], "little")
             for dxl_id in prm[4:]:
-                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                if dxl_id in self.servos and dxl_id not in self._deaf:
                     err, data = self.servos[dxl_id].read(address, length)
                     out += self._reply(dxl_id, err, data)
             return bytes(out)
@@ -399,7 +411,7 @@ class DynamixelBusEmulator:
                 dxl_id = prm[i]
                 address = int.from_bytes(prm[i + 1 : i + 3], "little")
                 length = int.from_bytes(prm[i + 3 : i + 5], "little")
-                if dxl_id in self.servos and dxl_id not in self.silent_ids:
+                if dxl_id in self.servos and dxl_id not in self._deaf:
                     err, data = self.servos[dxl_id].read(address, length)
                     out += self._reply(dxl_id, err, data)
             return bytes(out)
@@ -462,6 +474,7 @@ class InProcessPort:
 
     def setBaudRate(self, baudrate: int) -> bool:
         self.baudrate = baudrate
+        self.emulator.host_baud = baudrate
         return True
 
     def getBaudRate(self) -> int:

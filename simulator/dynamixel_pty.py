@@ -229,6 +229,12 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
             else:
                 select.select([self.ser.fileno()], [], [], HOST_WAIT_S)
 
+    def setBaudRate(self, baudrate: int) -> bool:
+        """The SDK's, and the emulated servos learn the line speed (a pty carries none)."""
+        ok = bool(super().setBaudRate(baudrate))
+        self._server.emulator.host_baud = baudrate
+        return ok
+
     def setupPort(self, cflag_baud: Any) -> bool:
         ok = super().setupPort(cflag_baud)  # closes (settled) if open; flushes the input
         ledger = self._ledger

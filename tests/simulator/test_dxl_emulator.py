@@ -124,13 +124,29 @@ def test_reopening_the_port_starts_from_a_clean_slate() -> None:
     ph = sdk.PacketHandler(2.0)
     with PtyServoServer(emu) as server:
         port = server.port_handler()
-        assert port.openPort()
+        assert port.openPort() and port.setBaudRate(57600)  # kept for the reopen
         ph.write1ByteTxOnly(port, 1, ct.LED.address, 1)  # its status is never read
         port.closePort()
         assert port.openPort()
         assert ph.read1ByteTxRx(port, 1, ct.LED.address) == (1, sdk.COMM_SUCCESS, 0)
         emu.silent_ids.add(1)
         assert ph.ping(port, 1)[1] == sdk.COMM_RX_TIMEOUT
+        port.closePort()
+
+
+@pytest.mark.pty
+def test_a_servo_at_another_baud_rate_answers_nothing() -> None:
+    """A servo hears only its own Baud Rate (address 8; factory 57600): the SDK's default
+    1 Mbps, or a config's wrong rate, gets no reply (the emulator had answered at any rate, so
+    a wrong baud rate in a rig config passed `check`)."""
+    clock = VirtualClock()
+    ph = sdk.PacketHandler(2.0)
+    with PtyServoServer(two_servos(clock)) as server:
+        port = server.port_handler()
+        assert port.openPort()  # the SDK's default 1 Mbps
+        assert ph.ping(port, 1)[1] == sdk.COMM_RX_TIMEOUT
+        assert port.setBaudRate(57600)
+        assert ph.ping(port, 1)[1] == sdk.COMM_SUCCESS
         port.closePort()
 
 

@@ -1,0 +1,30 @@
+"""A rig config with the wrong baud rate for its servos fails `check` as on the rig, naming
+the servo and the baud rate (the emulated servos had answered at any rate)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_check_on_the_wrong_baud_rate_names_it(tmp_path: Path) -> None:
+    text = (REPO / "rig_configs" / "simulated_arm.toml").read_text()
+    assert "baudrate = 57600" in text  # the servos' factory rate, set in the shipped config
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace("baudrate = 57600", "baudrate = 1000000"))
+    r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0, said
+    assert "baud rate" in said and "servo 1" in said, said
+    assert "Traceback" not in said
+    assert (
+        CliRunner()
+        .invoke(app, ["check", str(REPO / "rig_configs" / "simulated_arm.toml")])
+        .exit_code
+        == 0
+    )
