@@ -62,7 +62,7 @@ def check(
 
     try:
         with stop_on_signals():
-            err.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
+            out.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
             report = check_rig(CheckRequest(rig_config, intensity))
     except CheckStopped as exc:
         for failure in exc.teardown_failures:
