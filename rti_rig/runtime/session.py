@@ -854,6 +854,20 @@ def prepare_resume(
     return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
 
 
+def lost_image_advice(root: Path, adaptive: bool) -> str:
+    """What to do about images of a finished session lost since capture (the QA verdict and
+    a refused resume say the same)."""
+    if adaptive:
+        return (
+            "put the originals back from a copy (an adaptive session cannot reshoot one image: "
+            "the lights after it were chosen from it), or start a new session with another --out"
+        )
+    return (
+        "put the originals back from a copy, or reshoot exactly those, with the object where "
+        f"it was: rti-rig run --resume {shlex.quote(str(root))} --reshoot-lost"
+    )
+
+
 def _lost_note(
     root: Path,
     latest: dict[int, dict[str, Any]],
@@ -866,16 +880,9 @@ def _lost_note(
     shown = ", ".join(Path(latest[i]["image"]).stem for i in sorted(lost)[:5]) + (
         " …" if len(lost) > 5 else ""
     )
-    head = f"; but {len(lost)} of its images are missing or changed since capture ({shown}): "
-    if adaptive:
-        return head + (
-            "put the originals back from a copy (an adaptive session cannot reshoot one "
-            "image: the lights after it were chosen from it), or start a new session with "
-            "another --out"
-        )
-    return head + (
-        "put the originals back from a copy, or reshoot exactly those, with the object where "
-        f"it was: rti-rig run --resume {shlex.quote(str(root))} --reshoot-lost"
+    return (
+        f"; but {len(lost)} of its images are missing or changed since capture ({shown}): "
+        + lost_image_advice(root, adaptive)
     )
 
 

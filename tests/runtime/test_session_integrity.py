@@ -358,7 +358,7 @@ def test_an_image_lost_since_capture_is_named_by_qa_and_reshot_on_request(
     verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
     assert verdict.startswith("reshoot: image_003 (image_003.jpg missing since capture"), verdict
     assert "lights.lp still lists it, so relight" in verdict
-    assert "image_006 (image_006.jpg changed since capture; put the original back" in verdict
+    assert "image_006 (image_006.jpg changed since capture; put the originals back" in verdict
     assert f"rti-rig run --resume {done} --reshoot-lost" in verdict
     before = {p: p.read_bytes() for p in done.rglob("*") if p.is_file()}
     r = runner.invoke(app, ["run", "--resume", str(done)])

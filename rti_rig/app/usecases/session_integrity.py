@@ -10,14 +10,18 @@ JPEGs in order) gave every later image the wrong light. The journal says what wa
 
 from __future__ import annotations
 
-import shlex
 from dataclasses import replace
 from pathlib import Path
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import read_lp
 from rti_rig.reconstruct.qa import QAReport
-from rti_rig.runtime.session import LP_NAME, files_lost_since_capture, read_manifest
+from rti_rig.runtime.session import (
+    LP_NAME,
+    files_lost_since_capture,
+    lost_image_advice,
+    read_manifest,
+)
 
 
 def with_lost_files(qa: QAReport, source: Path) -> QAReport:
@@ -32,14 +36,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
-    adaptive = bool(read_manifest(source).get("adaptive"))
-    todo = (
-        "put the original back from a copy (an adaptive session cannot reshoot one image: "
-        "the lights after it were chosen from it)"
-        if adaptive
-        else "put the original back from a copy, or reshoot it with the object where it was: "
-        f"rti-rig run --resume {shlex.quote(str(source))} --reshoot-lost"
-    )
+    todo = lost_image_advice(source, bool(read_manifest(source).get("adaptive")))
     listed = _listed(source / LP_NAME)
     images = []
     for check in qa.images:
