@@ -9,8 +9,10 @@ The lamp is **tracked in software** by default (the lamp's own switch is outside
 bus); with ``lamp = "servo_led"`` the state is also mirrored on the LED register (65) of
 ``lamp_servo_id``, which is where a lamp driven from a servo board output would be wired.
 
-Every goal goes through :meth:`DynamixelArm._send_goal`, which runs the tick-level safety gate
-(:meth:`ArmKinematics.ticks_reason`) before anything reaches the bus.
+Every goal a move sends goes through :meth:`DynamixelArm._send_goal`, which runs the tick-level
+safety gate (:meth:`ArmKinematics.ticks_reason`) before anything reaches the bus; a stop's hold
+of the present position (:meth:`DynamixelArm.stop`) is no move, and is clamped into the joints'
+limits only.
 """
 
 from __future__ import annotations
@@ -284,52 +286,62 @@ class DynamixelArm:
         return self._lamp_on
 
     def stop(self) -> None:
-        """Stop motion by making the present position the goal (torque stays on: no falling)."""
+        """Stop motion by making each joint's present position its goal (torque stays on).
+
+        A hold is not a move: it is written wherever the arm stands, clamped only into each
+        joint's limits, not refused by the keep-out gate (an arm found inside the cone was
+        left moving because its hold was "unsafe"). A joint whose servo cannot be read (a
+        hardware fault, no reply) does not keep the others from being held (a fault on one
+        servo had left the other swinging on to its goal, torque on); the error then names
+        what was held and what was not."""
         if not self._connected:
             return
         if self._emergency_stopped:
             # torque is off on purpose: writing a goal now is pointless at best, and on a servo
             # whose Drive Mode has "Torque On by Goal Update" it would switch torque back on
             return
+        roles = dict(zip(self.settings.servo_ids, ("azimuth", "elevation"), strict=True))
         present: dict[int, int] = {}
-        failed: list[tuple[str, DynamixelError]] = []
-        for joint, role in zip(self.settings.joints, ("azimuth", "elevation"), strict=True):
+        failed: list[tuple[int, DynamixelError]] = []
+        for joint in self.settings.joints:
             try:
                 present[joint.servo_id] = clamp_ticks(
                     joint, self._bus.read(joint.servo_id, ct.PRESENT_POSITION)
                 )
             except DynamixelError as exc:  # a faulted or silent servo: hold the others anyway
-                failed.append((role, exc))
+                failed.append((joint.servo_id, exc))
         if not failed:
-            goal = tuple(present[j.servo_id] for j in self.settings.joints)
-            self._send_goal(goal, "stop")  # type: ignore[arg-type]
+            self._bus.sync_write(ct.GOAL_POSITION, present)  # both at once, as a move's goal
+        else:
+            for sid in list(present):
+                try:
+                    self._bus.write(sid, ct.GOAL_POSITION, present[sid])
+                except DynamixelError as exc:
+                    failed.append((sid, exc))
+                    del present[sid]
+        if len(present) == len(self.settings.servo_ids) or self._goal is not None:
+            # a joint not held keeps the goal it was last sent (a later move's turn choice
+            # starts from where each joint is headed)
+            old = self._goal or (0, 0)
+            self._goal = tuple(  # type: ignore[assignment]
+                present.get(sid, old[k]) for k, sid in enumerate(self.settings.servo_ids)
+            )
+        if not failed:
             return
-        # One joint cannot be read: each other joint is held where it is, one by one (a fault
-        # on one servo had left the other swinging on to its goal, torque on, while the user
-        # was told "the arm is left where it stopped").
-        held = []
-        for joint, role in zip(self.settings.joints, ("azimuth", "elevation"), strict=True):
-            if joint.servo_id not in present:
-                continue
-            try:
-                self._bus.write(joint.servo_id, ct.GOAL_POSITION, present[joint.servo_id])
-                held.append(f"servo {joint.servo_id} ({role}) held where it is")
-            except DynamixelError as exc:
-                failed.append((role, exc))
         said = "; ".join(
-            [*held]
+            [f"servo {sid} ({roles[sid]}) held where it is" for sid in present]
             + [
-                f"{role}: {exc}"
+                f"{roles[sid]}: {exc}"
                 + (
-                    ""
+                    " — its torque is off, so that joint is limp (the arm may sag)"
                     if isinstance(exc, HardwareFaultError)
                     else " — it may still be moving to its last goal, a pose checked safe "
                     "before it was sent; switch the arm's power off if it does not stop"
                 )
-                for role, exc in failed
+                for sid, exc in failed
             ]
         )
-        raise DynamixelError(self.name, f"stop incomplete: {said}", "stop")
+        raise DynamixelError(self.name, f"stop incomplete: {said}", "stop") from failed[0][1]
 
     def emergency_stop(self) -> None:
         """Torque off on every servo now (one broadcast packet, no reply to wait for).

@@ -82,7 +82,10 @@ class ArmSelfTestReport:
         if moves:
             out.append(f"move time: median {np.median(moves):.2f} s, longest {max(moves):.2f} s")
         if self.aborted:
-            out.append(f"ABORTED: {self.aborted} (the arm is left where it stopped, not parked)")
+            out.append(
+                f"ABORTED: {self.aborted} (not parked: the arm was stopped where it was"
+                + ("; see the teardown below)" if self.teardown_failures else ")")
+            )
         out.extend(f"teardown FAILED: {f}" for f in self.teardown_failures)
         if self.parked:
             out.append("parked")

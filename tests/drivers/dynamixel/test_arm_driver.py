@@ -160,6 +160,19 @@ def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
     assert emu.servos[2].position() == pytest.approx(held, abs=1.0)  # within the tick read
 
 
+def test_a_stop_holds_an_arm_found_inside_the_keep_out_cone() -> None:
+    """A hold is no move: an arm found inside the cone (an overshoot, a push by hand) is held
+    where it is. The stop had sent its hold through the move gate, which refused it, and left
+    both joints on their way."""
+    arm, emu, _clock = make_arm()
+    arm.connect()
+    in_cone = arm.kin.ticks_of_pose(0.0, 80.0)[1]  # the cone starts at 75°
+    emu.servos[2]._profile.start = emu.servos[2]._profile.goal = float(in_cone)
+    before = len(emu.goal_log)
+    arm.stop()
+    assert (2, in_cone) in emu.goal_log[before:]
+
+
 def test_stalled_move_times_out_and_stops() -> None:
     arm, emu, clock = make_arm(move_timeout_s=1.0)
     arm.connect()
