@@ -238,8 +238,9 @@ def check_plan_options(
     Refused, naming the command-line option: an unknown method, objective or material; a signal
     noise the objective does not model; a method that needs a preview without one; a preview's
     light or depth model without a preview; a depth model that is not a file; an empty elevation
-    band; a light count outside 1..1000 (the most an .lp file may list). Callers check early
-    (before reading any image) with ``has_preview``; :func:`plan` checks its request again.
+    band; a light count outside 3..1000 (fewer determine no normal; 1000 is the most an .lp
+    file may list). Callers check early (before reading any image) with ``has_preview``;
+    :func:`plan` checks its request again.
     """
     chosen = get_method(method)
     if objective not in OBJECTIVES:

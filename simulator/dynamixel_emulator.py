@@ -463,7 +463,9 @@ class InProcessPort:
         self.tx_log: list[bytes] = []
 
     def openPort(self) -> bool:
+        """Opened at the current baud rate, as the SDK's ``openPort`` (1 Mbps unless set)."""
         self.is_open = True
+        self.emulator.host_baud = self.baudrate
         return True
 
     def closePort(self) -> None:

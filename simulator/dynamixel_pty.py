@@ -42,6 +42,7 @@ from typing import Any
 import dynamixel_sdk
 
 from rti_rig.simulator.dynamixel_emulator import DynamixelBusEmulator
+from rti_rig.simulator.pty_link import host_baud
 
 #: Wall-time bound on a reply wait that is still *not* causally over (bytes lost in the kernel,
 #: a wedged emulator thread): a broken link fails a test in bounded time instead of hanging it.
@@ -145,6 +146,9 @@ class PtyServoServer:
                 data = os.read(master, 4096)
             except OSError:
                 continue
+            # the line speed the host set on its end (a pty pair shares its termios), as the
+            # servos hear it: one at another Baud Rate answers nothing
+            self.emulator.host_baud = host_baud(master)
             reply = self.emulator.receive(data)
             ledger = self.ledger
             if ledger is not None:
@@ -228,12 +232,6 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
                     ledger.host_got += len(data)
             else:
                 select.select([self.ser.fileno()], [], [], HOST_WAIT_S)
-
-    def setBaudRate(self, baudrate: int) -> bool:
-        """The SDK's, and the emulated servos learn the line speed (a pty carries none)."""
-        ok = bool(super().setBaudRate(baudrate))
-        self._server.emulator.host_baud = baudrate
-        return ok
 
     def setupPort(self, cflag_baud: Any) -> bool:
         ok = super().setupPort(cflag_baud)  # closes (settled) if open; flushes the input

@@ -164,7 +164,7 @@ class _Server:
                 if data:
                     self.pending += self.device.receive(data)
             if hasattr(self.device, "host_baud"):  # the host's UART speed, as the board sees it
-                self.device.host_baud = _host_baud(self.master)
+                self.device.host_baud = host_baud(self.master)
             tick = getattr(self.device, "tick", None)  # devices that act on their own time
             if tick is not None and self.opened:
                 self.pending += tick()
@@ -213,12 +213,16 @@ class _Server:
 
 _SPEEDS = {
     getattr(termios, f"B{n}"): n
-    for n in (300, 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400)
+    for n in (
+        *(300, 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400),
+        *(460800, 500000, 576000, 921600, 1000000, 1152000, 2000000, 2500000, 3000000),
+        *(3500000, 4000000),
+    )
     if hasattr(termios, f"B{n}")
 }
 
 
-def _host_baud(master: int) -> int | None:
+def host_baud(master: int) -> int | None:
     """The baud rate the host set on the slave (a pty pair shares its termios)."""
     try:
         return _SPEEDS.get(termios.tcgetattr(master)[4])

@@ -46,6 +46,8 @@ class DxlBus:
         self.port = port
         self.device = device
         self.ph = packet_handler or sdk.PacketHandler(2.0)
+        #: the line speed the port was opened at (named when a servo does not answer)
+        self.baudrate: int | None = None
 
     # -- port -------------------------------------------------------------------------------
     def open(self, baudrate: int) -> None:
@@ -62,6 +64,7 @@ class DxlBus:
                 f"port {self.port.getPortName()!r} refused baud rate {baudrate}",
                 "open",
             )
+        self.baudrate = baudrate
 
     def close(self) -> None:
         if getattr(self.port, "is_open", False):
@@ -70,9 +73,11 @@ class DxlBus:
     # -- checks -----------------------------------------------------------------------------
     def _check(self, result: int, error: int, dxl_id: int, command: str, alert: bool = True):
         if result != sdk.COMM_SUCCESS:
+            at = f" at {self.baudrate} baud" if self.baudrate else ""
             raise CommunicationError(
                 self.device,
-                f"{comm_text(self.ph, result)} (check power, cabling, id and baud rate)",
+                f"{comm_text(self.ph, result)}{at} (check power, cabling, id and baud rate: "
+                "X-series servos ship at 57600)",
                 command,
                 dxl_id,
             )

@@ -148,6 +148,11 @@ def test_a_servo_at_another_baud_rate_answers_nothing() -> None:
         assert port.setBaudRate(57600)
         assert ph.ping(port, 1)[1] == sdk.COMM_SUCCESS
         port.closePort()
+        # read from the pty's own settings: the SDK's plain PortHandler is heard the same way
+        plain = sdk.PortHandler(server.device_path)
+        assert plain.openPort() and plain.setBaudRate(115200)
+        assert ph.ping(plain, 1)[1] == sdk.COMM_RX_TIMEOUT
+        plain.closePort()
 
 
 @pytest.mark.pty
@@ -279,7 +284,7 @@ def test_bulk_read_write_reg_write_action_in_process() -> None:
     clock = VirtualClock()
     emu = two_servos(clock)
     port = InProcessPort(emu)
-    port.openPort()
+    assert port.openPort() and port.setBaudRate(57600)  # the servos' factory rate
     ph = sdk.PacketHandler(2.0)
     bw = sdk.GroupBulkWrite(port, ph)
     bw.addParam(1, ct.LED.address, 1, [1])

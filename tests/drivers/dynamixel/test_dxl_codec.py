@@ -137,7 +137,7 @@ def test_sdk_emits_the_emanual_ping_and_unstuffed_writes() -> None:
         [EmulatedServo(1, 1030, VirtualClock(), operating_mode=4)], VirtualClock()
     )
     port = InProcessPort(emu)
-    port.openPort()
+    assert port.openPort() and port.setBaudRate(57600)  # the servo's factory rate
     ph = sdk.PacketHandler(2.0)
     assert ph.ping(port, 1) == (1030, sdk.COMM_SUCCESS, 0)
     assert port.tx_log[-1] == h("FF FF FD 00 01 03 00 01 19 4E")
