@@ -89,5 +89,11 @@ def parse_az_el(text: str | None, option: str = "--preview-light") -> tuple[floa
     return az, el
 
 
+def stop_exit_code(why: str) -> int:
+    """The exit code of a command stopped by a signal: 128 + its number, as a shell reports
+    a process the signal ended (SIGTERM 143, Ctrl-C 130)."""
+    return 143 if why == "SIGTERM" else 130
+
+
 def main() -> None:
     app()

@@ -13,7 +13,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out
+from rti_rig.cli.app import app, err, fail, out, stop_exit_code
 from rti_rig.core.errors import RtiRigError
 
 
@@ -28,21 +28,22 @@ def stop_on_signals() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread():
         yield  # signal handlers can only be set from the main thread
         return
-    stopping: list[str] = []
+    phase = "checking"  # then "stopping" (first signal), "done" (handlers being restored)
 
     def on_signal(signum, frame):  # type: ignore[no-untyped-def]
-        if stopping:
-            if stopping[0] != "done":
-                os.write(2, b"Still stopping: making the rig safe first (lights, lamp, arm)...\n")
-            return
-        stopping.append(signal.Signals(signum).name)
+        nonlocal phase
+        if phase == "stopping":
+            os.write(2, b"Still stopping: making the rig safe first (lights, lamp, arm)...\n")
+        if phase != "checking":
+            return  # never raised mid-teardown, nor mid-restore
+        phase = "stopping"
         raise EmergencyStop("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
 
     previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        stopping.insert(0, "done")  # a signal from here on is ignored, not raised mid-restore
+        phase = "done"
         for sig, h in previous.items():
             signal.signal(sig, h)
 
@@ -68,10 +69,10 @@ def check(
         for failure in exc.teardown_failures:
             err.print(f"[red]teardown problem:[/] {escape(failure)}")
         err.print(f"[red]Check stopped ({escape(exc.why)}):[/] {escape(exc.lights)}.")
-        raise typer.Exit(code=143 if exc.why == "SIGTERM" else 130) from None
+        raise typer.Exit(code=stop_exit_code(exc.why)) from None
     except EmergencyStop as exc:  # stopped outside a self-test (loading, a camera's check)
         err.print(f"[red]Check stopped ({escape(str(exc))}):[/] check the rig's lights.")
-        raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
+        raise typer.Exit(code=stop_exit_code(str(exc))) from None
     except RtiRigError as exc:
         raise fail(exc) from None
     for line in report.lines():

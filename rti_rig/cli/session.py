@@ -15,7 +15,7 @@ import typer
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note
+from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note, stop_exit_code
 from rti_rig.core.errors import RtiRigError
 
 
@@ -356,7 +356,7 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
         _print_teardown_failures(folder)
         err.print(f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}.")
         err.print(_after_stop(opened, resume_hint), markup=False, soft_wrap=True)
-        raise typer.Exit(code=143 if str(exc) == "SIGTERM" else 130) from None
+        raise typer.Exit(code=stop_exit_code(str(exc))) from None
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
