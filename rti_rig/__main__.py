@@ -1,5 +1,5 @@
 """Allow `python -m rti_rig`."""
 
-from rti_rig.cli import main
+from rti_rig.launch import main
 
 main()
