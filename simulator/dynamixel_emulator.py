@@ -6,8 +6,10 @@ registers, position limits in position mode, Operating Mode changes resetting th
 Ping/Read/Write/Reg Write/Action/Reboot/Clear/Sync Read/Sync Write/Bulk Read/Bulk Write,
 Status Return Level, the Alert bit, motion under Profile Velocity/Acceleration (trapezoid in
 *emulator time* read from an injected clock, so a dry run with a ``VirtualClock`` never waits)
-and fault injection: hardware errors (shutdown: torque off, motion frozen), corrupted CRC on
-replies, and silent (disconnected) servos.
+and fault injection: hardware errors (Alert in every status; torque off and motion frozen only
+for the errors the Shutdown register selects, as the e-manual says), corrupted CRC on replies,
+and silent (disconnected) servos. A Hardware Error Status bit stays set until a Reboot (not
+verified for a non-shutdown error whose cause has passed).
 
 Deliberate simplifications: a new goal during a move restarts the profile from the present
 position at zero velocity (the firmware blends); no load, current or temperature dynamics.
@@ -139,6 +141,7 @@ class EmulatedServo:
         self._set(ct.GOAL_POSITION, present_ticks)
         self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
         self._registered: tuple[int, bytes] | None = None
+        self._shut_down = False
 
     # -- table helpers ----------------------------------------------------------------------
     def _set(self, reg: ct.Register, value: int) -> None:
@@ -184,13 +187,27 @@ class EmulatedServo:
         self._profile = _Profile(p, p, now, 1.0, 1.0)
 
     # -- faults -----------------------------------------------------------------------------
+    @property
+    def shut_down(self) -> bool:
+        """True after a fault the Shutdown register selects, until a Reboot."""
+        return self._shut_down
+
     def inject_hardware_error(self, bits: int) -> None:
-        """Set Hardware Error Status bits: torque off, motion frozen, Alert in every status."""
-        self._freeze()
-        self.table[ct.HARDWARE_ERROR_STATUS.address] |= bits & 0xFF
-        self.table[ct.TORQUE_ENABLE.address] = 0
+        """Set Hardware Error Status bits; shut down only for the bits Shutdown selects.
+
+        e-manual, Shutdown (63): a detected error sets its bit in Hardware Error Status and the
+        Alert flag of every status packet; only if the bit is also set in Shutdown does Torque
+        Enable go to 0 (motion stops), and then only a Reboot lets torque back on. The factory
+        Shutdown (0x34) does not select an input-voltage error: the servo keeps driving."""
+        bits &= 0xFF
+        self.table[ct.HARDWARE_ERROR_STATUS.address] |= bits
+        if bits & self.get(ct.SHUTDOWN):
+            self._shut_down = True
+            self._freeze()
+            self.table[ct.TORQUE_ENABLE.address] = 0
 
     def reboot(self) -> None:
+        self._shut_down = False
         self._freeze()
         self.table[ct.HARDWARE_ERROR_STATUS.address] = 0
         self.table[ct.TORQUE_ENABLE.address] = 0
@@ -230,7 +247,7 @@ class EmulatedServo:
             self.table[address:end] = data
             if (
                 not self.torque_on
-                and not self.hardware_error
+                and not self._shut_down
                 and self.get(ct.DRIVE_MODE) & TORQUE_ON_BY_GOAL_UPDATE
                 and self.get(ct.FIRMWARE_VERSION) >= TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE
             ):
@@ -241,7 +258,7 @@ class EmulatedServo:
             return 0
         if address <= ct.TORQUE_ENABLE.address < end:
             on = data[ct.TORQUE_ENABLE.address - address]
-            if on and self.hardware_error:
+            if on and self._shut_down:
                 return p2.ERR_RESULT_FAIL  # after a shutdown only a reboot re-enables torque
             if not on:
                 self._freeze()
@@ -258,7 +275,7 @@ class EmulatedServo:
         return 0
 
     def _start_move(self, goal: int) -> None:
-        if not self.torque_on or self.hardware_error:
+        if not self.torque_on:
             return
         now = self.clock.now()
         v_units = self.get(ct.PROFILE_VELOCITY) or self.get(ct.VELOCITY_LIMIT) or 1

@@ -103,7 +103,7 @@ class DynamixelArm:
             )
         status = self._bus.read(sid, ct.HARDWARE_ERROR_STATUS, check_alert=False)
         if status:
-            raise HardwareFaultError(dev, sid, status, "connect")
+            raise self._bus.hardware_fault(sid, "connect", status)
         mode = self._bus.read(sid, ct.OPERATING_MODE)
         if mode != joint.mode:
             raise ConfigMismatchError(
@@ -302,23 +302,37 @@ class DynamixelArm:
             return
         roles = dict(zip(self.settings.servo_ids, ("azimuth", "elevation"), strict=True))
         present: dict[int, int] = {}
+        alerted: dict[int, HardwareFaultError] = {}
         failed: list[tuple[int, DynamixelError]] = []
         for joint in self.settings.joints:
+            sid = joint.servo_id
             try:
-                present[joint.servo_id] = clamp_ticks(
-                    joint, self._bus.read(joint.servo_id, ct.PRESENT_POSITION)
-                )
-            except DynamixelError as exc:  # a faulted or silent servo: hold the others anyway
-                failed.append((joint.servo_id, exc))
-        if not failed:
+                try:
+                    ticks = self._bus.read(sid, ct.PRESENT_POSITION)
+                except HardwareFaultError as exc:
+                    if exc.torque_on is False:
+                        raise
+                    # a fault the servo does not shut down for leaves the joint driven: it
+                    # must be held like the others, not reported limp
+                    ticks = self._bus.read(sid, ct.PRESENT_POSITION, check_alert=False)
+                    alerted[sid] = exc
+                present[sid] = clamp_ticks(joint, ticks)
+            except DynamixelError as exc:  # a limp or silent servo: hold the others anyway
+                failed.append((sid, exc))
+        if not failed and not alerted:
             self._bus.sync_write(ct.GOAL_POSITION, present)  # both at once, as a move's goal
         else:
             for sid in list(present):
                 try:
-                    self._bus.write(sid, ct.GOAL_POSITION, present[sid])
+                    self._bus.write(
+                        sid, ct.GOAL_POSITION, present[sid], check_alert=sid not in alerted
+                    )
                 except DynamixelError as exc:
                     failed.append((sid, exc))
                     del present[sid]
+        for sid, fault in alerted.items():
+            if sid in present:
+                log.warning("%s: servo %d held despite a hardware alert: %s", self.name, sid, fault)
         if len(present) == len(self.settings.servo_ids) or self._goal is not None:
             # a joint not held keeps the goal it was last sent (a later move's turn choice
             # starts from where each joint is headed)
@@ -329,12 +343,16 @@ class DynamixelArm:
         if not failed:
             return
         said = "; ".join(
-            [f"servo {sid} ({roles[sid]}) held where it is" for sid in present]
+            [
+                f"servo {sid} ({roles[sid]}) held where it is"
+                + (" (hardware alert, torque still on)" if sid in alerted else "")
+                for sid in present
+            ]
             + [
                 f"{roles[sid]}: {exc}"
                 + (
-                    " — its torque is off, so that joint is limp (the arm may sag)"
-                    if isinstance(exc, HardwareFaultError)
+                    " (the arm may sag)"
+                    if isinstance(exc, HardwareFaultError) and exc.torque_on is False
                     else " — it may still be moving to its last goal, a pose checked safe "
                     "before it was sent; switch the arm's power off if it does not stop"
                 )
@@ -398,10 +416,7 @@ class DynamixelArm:
                     joint.servo_id, ct.STATUS_BLOCK_START, ct.STATUS_BLOCK_LENGTH
                 )
                 if error & p2.ERR_ALERT:
-                    status = self._bus.read(
-                        joint.servo_id, ct.HARDWARE_ERROR_STATUS, check_alert=False
-                    )
-                    raise HardwareFaultError(self.name, joint.servo_id, status, command)
+                    raise self._bus.hardware_fault(joint.servo_id, command)
                 moving = moving or data[0] != 0
                 off = ct.PRESENT_POSITION.address - ct.STATUS_BLOCK_START
                 present.append(p2.to_signed(int.from_bytes(data[off : off + 4], "little"), 4))

@@ -25,6 +25,7 @@ from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.faults import (
     CommunicationError,
+    DynamixelError,
     HardwareFaultError,
     ServoStatusError,
 )
@@ -86,8 +87,23 @@ class DxlBus:
                 self.device, dxl_id, error, command, f"servo answered {p2.describe_error(error)}"
             )
         if alert and error & p2.ERR_ALERT:
+            raise self.hardware_fault(dxl_id, command)
+
+    def hardware_fault(
+        self, dxl_id: int, command: str, status: int | None = None
+    ) -> HardwareFaultError:
+        """The fault a servo's Alert flag signals, with its torque as read, not as assumed.
+
+        Torque Enable is read because a servo drops torque only for the faults its Shutdown
+        register selects: an input-voltage error on a factory-set X-series servo leaves the
+        joint driven. A torque that cannot be read is reported as unknown."""
+        if status is None:
             status = self.read(dxl_id, ct.HARDWARE_ERROR_STATUS, check_alert=False)
-            raise HardwareFaultError(self.device, dxl_id, status, command)
+        try:
+            torque_on: bool | None = bool(self.read(dxl_id, ct.TORQUE_ENABLE, check_alert=False))
+        except DynamixelError:
+            torque_on = None
+        return HardwareFaultError(self.device, dxl_id, status, command, torque_on)
 
     #: Results that mean the status packet was lost or damaged (not that the servo refused).
     RETRYABLE = (sdk.COMM_RX_TIMEOUT, sdk.COMM_RX_CORRUPT)
@@ -159,13 +175,13 @@ class DxlBus:
             )
         return bytes(data), int(error)
 
-    def write(self, dxl_id: int, reg: ct.Register, value: int) -> None:
+    def write(self, dxl_id: int, reg: ct.Register, value: int, check_alert: bool = True) -> None:
         command = f"write {reg.name} = {value}"
         raw = value & ((1 << (8 * reg.size)) - 1)
         fn = {1: self.ph.write1ByteTxRx, 2: self.ph.write2ByteTxRx, 4: self.ph.write4ByteTxRx}
         result, error = fn[reg.size](self.port, dxl_id, reg.address, raw)
         log.debug("%s: id %d %s (%d, %d)", self.device, dxl_id, command, result, error)
-        self._check(result, error, dxl_id, command)
+        self._check(result, error, dxl_id, command, alert=check_alert)
 
     def write_no_wait(self, dxl_id: int, reg: ct.Register, value: int) -> None:
         """Unicast write without waiting for success, *then drain the reply* it provokes.

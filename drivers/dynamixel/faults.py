@@ -30,17 +30,31 @@ class ServoStatusError(DynamixelError):
 
 
 class HardwareFaultError(DynamixelError):
-    """Hardware Error Status has bits set: the servo has shut its torque off."""
+    """Hardware Error Status has bits set; whether torque went off is said only as read.
 
-    def __init__(self, device: str, servo_id: int, status: int, command: str | None) -> None:
+    A servo switches its torque off only for the faults its Shutdown register (address 63)
+    selects (e-manual, Shutdown; factory 0x34 on XL430/XM430: overheating, electrical shock,
+    overload — not an input-voltage error). ``torque_on`` is Torque Enable as read after the
+    fault (``None``: it could not be read), so the message never claims a limp joint that is
+    still driven, or a held one that is limp."""
+
+    def __init__(
+        self,
+        device: str,
+        servo_id: int,
+        status: int,
+        command: str | None,
+        torque_on: bool | None = None,
+    ) -> None:
         self.status = status
+        self.torque_on = torque_on
         self.faults = ct.decode_hardware_error(status)
         names = ", ".join(f.name.lower().replace("_", " ") for f in self.faults) or "unknown"
         advice = "; ".join(ct.FAULT_ADVICE[f] for f in self.faults)
         super().__init__(
             device,
             f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}. "
-            "Torque stays off until the servo is rebooted.",
+            + torque_statement(torque_on),
             command,
             servo_id,
         )
@@ -49,6 +63,25 @@ class HardwareFaultError(DynamixelError):
     def fault_names(self) -> list[str]:
         """Lower-case names, e.g. ['overload', 'overheating']."""
         return [f.name.lower() for f in self.faults]
+
+
+def torque_statement(torque_on: bool | None) -> str:
+    """What a fault left of the servo's torque, as read (never assumed)."""
+    if torque_on is False:
+        return (
+            "Its torque is off: the joint is limp (a fault the servo shuts down for keeps it "
+            "off until the servo is rebooted)."
+        )
+    if torque_on is True:
+        return (
+            "This fault is not one the servo shuts down for (its Shutdown setting): its "
+            "torque is still ON and the joint is still driven; switch the arm's power off "
+            "before touching it."
+        )
+    return (
+        "Whether its torque is off could not be read: treat the joint as driven and "
+        "switch the arm's power off before touching it."
+    )
 
 
 class ConfigMismatchError(DynamixelError):

@@ -317,3 +317,34 @@ def test_emulator_accepts_properly_stuffed_packets() -> None:
     raw = emu.receive(p2.read(1, ct.GOAL_POSITION.address, 4))
     status = p2.decode(raw)
     assert p2.to_signed(int.from_bytes(status.params, "little"), 4) == -131073
+
+
+def test_a_fault_outside_the_shutdown_setting_alerts_but_leaves_torque_on() -> None:
+    """e-manual, Shutdown (63): an error sets its Hardware Error Status bit and the Alert flag;
+    torque goes off only for the errors Shutdown selects (factory 0x34: not input voltage)."""
+    clock = VirtualClock()
+    emu = two_servos(clock)
+    bus = DxlBus(InProcessPort(emu), "arm")
+    bus.open(57600)
+    bus.write(1, ct.TORQUE_ENABLE, 1)
+    emu.inject_hardware_error(1, ct.HardwareFault.INPUT_VOLTAGE)
+    servo = emu.servos[1]
+    assert servo.torque_on and not servo.shut_down
+    with pytest.raises(HardwareFaultError) as info:
+        bus.read(1, ct.PRESENT_POSITION)
+    assert info.value.torque_on is True and "still ON" in str(info.value)
+    bus.write(1, ct.GOAL_POSITION, 3000, check_alert=False)
+    clock.sleep(5.0)
+    assert bus.read(1, ct.PRESENT_POSITION, check_alert=False) == 3000  # it still drives
+    # the same error once Shutdown selects it: torque off, motion frozen, no torque-on
+    bus.write(2, ct.SHUTDOWN, 0x35)
+    bus.write(2, ct.TORQUE_ENABLE, 1)
+    emu.inject_hardware_error(2, ct.HardwareFault.INPUT_VOLTAGE)
+    assert emu.servos[2].shut_down and not emu.servos[2].torque_on
+    with pytest.raises(ServoStatusError, match="result fail"):
+        bus.write(2, ct.TORQUE_ENABLE, 1)
+    with pytest.raises(HardwareFaultError) as info:
+        bus.read(2, ct.PRESENT_POSITION)
+    assert info.value.torque_on is False and "limp" in str(info.value)
+    bus.reboot(2)
+    bus.write(2, ct.TORQUE_ENABLE, 1)  # a reboot lifts the shutdown

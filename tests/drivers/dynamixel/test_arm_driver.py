@@ -160,6 +160,49 @@ def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
     assert emu.servos[2].position() == pytest.approx(held, abs=1.0)  # within the tick read
 
 
+def test_a_fault_the_servo_does_not_shut_down_for_is_held_not_called_limp() -> None:
+    """An input-voltage error (a supply sagging as both joints start) is outside the factory
+    Shutdown setting: the servo keeps its torque and drives on to its goal. The error must say
+    the joint is still driven, and the stop must hold it — it had been reported limp and left
+    swinging on to its goal."""
+    arm, emu, clock = make_arm()
+    arm.connect()
+    real_sleep = clock.sleep
+
+    def sleep_then_sag(s: float) -> None:
+        real_sleep(s)
+        if clock.now() > 0.3 and not emu.servos[1].hardware_error:
+            emu.servos[1].inject_hardware_error(ct.HardwareFault.INPUT_VOLTAGE)
+
+    clock.sleep = sleep_then_sag  # type: ignore[method-assign]
+    with pytest.raises(HardwareFaultError) as info:
+        arm.move_to(direction_from_az_el(150, 30))
+    assert info.value.fault_names == ["input_voltage"] and info.value.torque_on is True
+    assert "still ON" in str(info.value) and "limp" not in str(info.value)
+    assert emu.servos[1].is_moving() and emu.servos[1].torque_on
+    arm.close()  # both joints answer and are held: the stop is complete
+    held = {sid: emu.servos[sid].position() for sid in (1, 2)}
+    clock.sleep = real_sleep  # type: ignore[method-assign]
+    clock.sleep(5.0)
+    for sid in (1, 2):
+        assert not emu.servos[sid].is_moving()
+        assert emu.servos[sid].position() == pytest.approx(held[sid], abs=1.0)
+
+
+def test_a_shutdown_fault_is_reported_limp_as_read() -> None:
+    arm, emu, _clock = make_arm()
+    arm.connect()
+    emu.servos[1].inject_hardware_error(ct.HardwareFault.OVERLOAD)
+    with pytest.raises(HardwareFaultError) as info:
+        arm.move_to(direction_from_az_el(20, 40))
+    assert info.value.torque_on is False and "limp" in str(info.value)
+    with pytest.raises(
+        DynamixelError, match=r"stop incomplete: servo 2 \(elevation\) held"
+    ) as stop:
+        arm.stop()
+    assert "the arm may sag" in str(stop.value)
+
+
 def test_a_stop_holds_an_arm_found_inside_the_keep_out_cone() -> None:
     """A hold is no move: an arm found inside the cone (an overshoot, a push by hand) is held
     where it is. The stop had sent its hold through the move gate, which refused it, and left
