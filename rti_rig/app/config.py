@@ -162,7 +162,7 @@ class SceneConfig(_Strict):
         return self
 
     name: str = "relief"
-    seed: int = 0
+    seed: int = Field(default=0, ge=0)
     noise: bool = True
     #: None: directional lights; else point lamps at this distance (dome radius, arm reach).
     light_distance_mm: float | None = Field(default=None, gt=0)

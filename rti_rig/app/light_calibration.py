@@ -34,7 +34,13 @@ from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.planner.topography import downsample
 from rti_rig.reconstruct import ReconstructionError, estimate_light_gains
-from rti_rig.runtime.session import read_manifest
+from rti_rig.runtime.session import (
+    JOURNAL,
+    image_names,
+    read_manifest,
+    scan_journal,
+    verified_steps,
+)
 
 #: Card images are area-averaged to at most this many pixels on their long side: the gains are
 #: medians over the card, so full resolution only costs memory (72 × 24 MP would be 7 GB).
@@ -161,6 +167,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
             f"{root}: {len(steps)} image(s); shoot the card under every LED of the dome "
             "(rti-rig run RIG --out CARD_SESSION, with no --lights)"
         )
+    _refuse_unverified(root, steps, len(planned))
     correction = serial.get("intensity_correction")
     max_level = int(serial.get("max_level", 255))
     exposures = np.array([float(s["exposure_s"]) for s in steps])
@@ -207,6 +214,33 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         correction=None if correction is None else tuple(float(v) for v in correction),
         image_of=image_of,
     )
+
+
+def _refuse_unverified(root: Path, steps: list[dict[str, Any]], total: int) -> None:
+    """Refuse a card session whose linear TIFFs are not as captured (checked against the
+    journal's checksums): one halved TIFF had read as a dome "0.37 of the median", and the
+    correction written from it would have dimmed every other LED."""
+    scan = scan_journal(root, image_names(total))
+    verified = verified_steps(root, scan.records, only="linear_image")
+    recorded = {rec["index"] for rec in scan.records}
+    bad = []
+    for s in steps:
+        if s["index"] in verified:
+            continue
+        name = s["linear_image"]
+        if not (root / name).is_file():
+            bad.append(f"{name} (LED {s['led']}) missing")
+        elif s["index"] in recorded:
+            bad.append(f"{name} (LED {s['led']}) changed since capture")
+        else:
+            bad.append(f"{name} (LED {s['led']}) has no readable record in {JOURNAL}")
+    if bad:
+        shown = "; ".join(bad[:6]) + (f"; and {len(bad) - 6} more" if len(bad) > 6 else "")
+        raise SessionError(
+            f"{root}: {len(bad)} card image(s) not as captured ({shown}): a calibration "
+            "measured from them would misjudge those LEDs, or all of them; restore the "
+            "originals from a backup copy of the folder, or shoot the card again"
+        )
 
 
 def card_spread_deg(card: CardSession) -> float:

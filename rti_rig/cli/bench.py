@@ -64,6 +64,12 @@ def bench_tradeoff(
             "for uniform, optimal and adaptive against all its lights.",
         ),
     ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force", help="Write into an --out folder that is not empty (replacing results)."
+        ),
+    ] = False,
 ) -> None:
     """Error against number of lights and session time, for every planner, on simulated scenes
     (or on your own acquisition with --from).
@@ -92,10 +98,32 @@ def bench_tradeoff(
 
     with warnings.catch_warnings():  # restored after: the CLI may run inside a test process
         warnings.showwarning = _as_note
-        _tradeoff(out_dir, quick, from_lp)
+        _tradeoff(out_dir, quick, from_lp, force)
 
 
-def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None) -> None:
+def _check_out_folder(out_dir: Path, force: bool) -> None:
+    """Refuse, before minutes of computing, a folder whose files the results would replace.
+
+    A session folder (or one inside it) is refused even with ``--force``: nothing captured is
+    ever overwritten; any other folder that is not empty needs ``--force`` (a user's own
+    summary.md had been replaced without a word)."""
+    from rti_rig.runtime.session import MANIFEST
+
+    for folder in (out_dir.resolve(), *out_dir.resolve().parents):
+        if (folder / MANIFEST).is_file():
+            raise RtiRigError(
+                f"--out {out_dir} is inside the session in {folder}; a session's folder is "
+                "never written into: choose another folder"
+            )
+    if out_dir.is_dir() and any(out_dir.iterdir()) and not force:
+        raise RtiRigError(
+            f"--out {out_dir} is not empty: its results.csv, summary.md and plots would be "
+            "replaced; choose an empty or new folder, or give --force"
+        )
+    ensure_writable_folder(out_dir)
+
+
+def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bool) -> None:
     """The body of ``bench tradeoff``, once the command has found the benchmarks."""
     import time
 
@@ -111,7 +139,7 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None) -> None:
         )
     if out_dir is not None:  # before minutes of computing, not after
         try:
-            ensure_writable_folder(out_dir)
+            _check_out_folder(out_dir, force)
         except RtiRigError as exc:
             raise fail(exc) from None
     if from_lp is not None:
@@ -131,7 +159,7 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None) -> None:
     rows = run_tradeoff(settings, progress=lambda msg: out.print(msg, highlight=False))
     command = "rti-rig bench tradeoff" + (" --quick" if quick else "")
     if out_dir is not None:
-        command += f" --out {out_dir}"
+        command += f" --out {out_dir}" + (" --force" if force else "")
     text = summarise(rows, settings, time.perf_counter() - t0, command)
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)

@@ -500,6 +500,12 @@ def export_lp(
             f"{escape(', '.join(done.left_out))}",
             soft_wrap=True,
         )
+    if done.unchecked:
+        err.print(
+            f"[yellow]note:[/] left out, on disk but not verifiable as captured "
+            f"({escape(done.unchecked_why)}): {escape(', '.join(done.unchecked))}",
+            soft_wrap=True,
+        )
     if done.outside_session:
         err.print(
             f"[yellow]note:[/] its image names are relative to {escape(str(session_dir))}, "

@@ -158,11 +158,14 @@ class QAReport:
     direction_note: str = ""
     #: Why no shift could be judged on this object; empty when it could.
     drift_note: str = ""
+    #: Images whose files could not be checked against their capture checksums, and why (set
+    #: by the application for a session folder); empty when every image was checkable.
+    integrity_note: str = ""
 
     @property
     def caveats(self) -> list[str]:
         """Every check not made, by name (said with the verdict, never silently)."""
-        out = []
+        out = [self.integrity_note] if self.integrity_note else []
         if self.direction_note:
             out.append(self.direction_note)
         flagged = {c.index for c in self.reshoot}
@@ -772,8 +775,10 @@ def neighbour_ratio(gain: NDArray, lt: NDArray) -> NDArray:
     span = np.degrees(np.arccos(np.clip(np.take_along_axis(cos, near, axis=1), -1.0, 1.0)))
     for i in range(n):
         others = gain[near[i]]
-        if span[i].max() <= NEIGHBOUR_SPAN_DEG and np.isfinite(gain[i]) and np.all(
-            np.isfinite(others)
+        if (
+            span[i].max() <= NEIGHBOUR_SPAN_DEG
+            and np.isfinite(gain[i])
+            and np.all(np.isfinite(others))
         ):
             ref = float(np.median(others))
             if ref > 0:

@@ -886,6 +886,16 @@ def _lost_note(
     )
 
 
+_JSON_KIND = {
+    list: "array",
+    str: "string",
+    type(None): "null",
+    bool: "boolean",
+    int: "number",
+    float: "number",
+}
+
+
 def read_manifest(root: Path) -> dict[str, Any]:
     """The manifest of a session folder, with a clear error if it is not one."""
     path = Path(root) / MANIFEST
@@ -895,14 +905,29 @@ def read_manifest(root: Path) -> dict[str, Any]:
         raise SessionError(
             f"{root} is a file: give the session folder that holds it (the one with {MANIFEST})"
         )
+    # rti-rig writes the manifest atomically, so a damaged one was damaged outside it (a disk,
+    # a sync tool, an editor): say what is still intact and what to do, never a traceback
+    damaged = (
+        f"; the images and {JOURNAL} do not depend on it and are untouched: restore {MANIFEST} "
+        "from a backup copy of the folder"
+    )
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise SessionError(
             f"{root} has no {MANIFEST}: it is not an rti-rig session folder"
         ) from None
-    except json.JSONDecodeError as exc:
-        raise SessionError(f"{path} is not valid JSON ({exc}); the journal may help") from None
+    except IsADirectoryError:
+        raise SessionError(f"{path} is a folder, not the session's manifest{damaged}") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise SessionError(f"{path} is not valid JSON ({exc}){damaged}") from None
+    except OSError as exc:
+        raise SessionError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if not isinstance(data, dict):
+        kind = _JSON_KIND.get(type(data), "value")
+        raise SessionError(
+            f"{path} is not a session manifest (it holds a JSON {kind}, not an object){damaged}"
+        )
     if data.get("format") != FORMAT:
         raise SessionError(f"{path}: unknown session format {data.get('format')!r}")
     return data
@@ -946,6 +971,51 @@ def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
     return lost
 
 
+def unchecked_images(root: Path) -> tuple[list[str], str]:
+    """Images of a session on disk that no readable journal record vouches for, and why.
+
+    The journal holds the checksums taken at capture; an image without a readable record (the
+    journal gone, a line damaged, a last line cut short) cannot be checked, and a verdict that
+    said "good" without saying so claimed what it had not established. Returns the image base
+    names (``image_006``) and the reason; ``([], "")`` for a folder that is no session, or whose
+    journal vouches for every image on disk."""
+    root = Path(root)
+    if not (root / MANIFEST).exists():
+        return [], ""
+    present = {
+        p.stem
+        for folder in (root, root / LINEAR_DIR)
+        for p in folder.glob("image_*")
+        if p.is_file()
+    }
+    try:
+        total = planned_steps(read_manifest(root))
+    except SessionError:
+        # the journal's records can be matched to image names only through the manifest
+        return sorted(present), f"{MANIFEST} unreadable"
+    if not total:
+        return [], ""
+    names = image_names(total)
+    scan = scan_journal(root, names)
+    recorded = {Path(r["image"]).stem for r in scan.records}
+    unchecked = [n for n in names if n in present and n not in recorded]
+    if not unchecked:
+        return [], ""
+    if not (root / JOURNAL).is_file():
+        why = f"{JOURNAL} is missing"
+    else:
+        parts = []
+        if scan.rejected:
+            lines = ", ".join(str(n) for n, _, _ in scan.rejected)
+            parts.append(
+                f"{JOURNAL} line{'s' if len(scan.rejected) > 1 else ''} {lines} unreadable"
+            )
+        if scan.torn.strip():
+            parts.append(f"the last line of {JOURNAL} was cut short")
+        why = "; ".join(parts) or f"no record of them in {JOURNAL}"
+    return unchecked, why
+
+
 def _latest_records(records: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
     """Each step's last journal record (a later record of a step replaces an earlier one)."""
     return {rec["index"]: rec for rec in records}
@@ -967,6 +1037,11 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     key = "linear_image" if linear else "image"
     done = verified_steps(root, records, only=key)  # the file the .lp names, as captured
     if not records:
+        if not (Path(root) / JOURNAL).is_file():
+            raise SessionError(
+                f"{root}: {JOURNAL} is missing, so no image can be verified as captured with "
+                f"its light: restore {JOURNAL} from a backup copy of the folder"
+            )
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
     left_out = sorted({r[key] for r in records if r["index"] not in done})
     if not done:

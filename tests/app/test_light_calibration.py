@@ -188,8 +188,32 @@ def test_simulated_arm_and_missing_images_are_refused(tmp_path: Path) -> None:
     cfg = card_rig(tmp_path)
     shoot(cfg, tmp_path / "card")
     (tmp_path / "card" / "linear" / "image_003.tif").unlink()
-    with pytest.raises(SessionError, match=r"image_003.tif \(LED 2\) cannot be read"):
+    with pytest.raises(SessionError, match=r"image_003.tif \(LED 2\) missing"):
         read_card_session(tmp_path / "card")
+
+
+def test_a_card_image_changed_since_capture_is_refused_not_measured(tmp_path: Path) -> None:
+    """A halved TIFF had been measured: the dome read "0.37 of the median" and the correction
+    written from it would have dimmed every other LED. The journal's checksums say what was
+    captured; an image without a readable record cannot be vouched for either."""
+    import tifffile
+
+    cfg = card_rig(tmp_path)
+    card = tmp_path / "card"
+    shoot(cfg, card)
+    read_card_session(card)  # intact: measured
+    tif = card / "linear" / "image_005.tif"
+    tifffile.imwrite(tif, tifffile.imread(tif) // 2)
+    with pytest.raises(SessionError, match=r"image_005.tif \(LED 4\) changed since capture"):
+        read_card_session(card)
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
+    assert r.exit_code != 0 and "changed since capture" in said(r) and "Traceback" not in r.output
+    assert not (card / "light_calibration.toml").exists()
+    journal = card / "journal.jsonl"
+    lines = journal.read_text().splitlines(keepends=True)
+    journal.write_text("".join(lines[:3]) + "{not json\n" + "".join(lines[4:]))
+    with pytest.raises(SessionError, match=r"image_004.tif \(LED 3\) has no readable record"):
+        read_card_session(card)
 
 
 @pytest.mark.slow

@@ -61,6 +61,33 @@ def test_tradeoff_out_that_cannot_be_written_is_refused_before_computing(tmp_pat
     assert str(out) in text and "N = 6 done" not in text  # refused before any work
 
 
+def test_tradeoff_refuses_to_replace_a_folder_s_files_without_force(tmp_path: Path) -> None:
+    """A user's own summary.md had been replaced without a word; a session folder is never
+    written into, --force or not. Refused before any work."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "summary.md").write_text("my notes")
+    session = tmp_path / "session"
+    session.mkdir()
+    (session / "manifest.json").write_text("{}")
+    for out, force, expect in (
+        (mine, [], "is not empty"),
+        (session, ["--force"], "never written into"),
+        (session / "sub", ["--force"], "never written into"),
+    ):
+        r = CliRunner().invoke(
+            app, ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out), *force]
+        )
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2 and expect in text and "N = 6 done" not in text, text
+    assert (mine / "summary.md").read_text() == "my notes"
+    assert not (session / "sub").exists()
+
+
 def test_tradeoff_from_shows_fit_warnings_as_notes_not_python_warnings(tmp_path: Path) -> None:
     """A fit warning (here HSH2 on lights bunched towards the zenith: the acquisition's lights
     pulled in to within ~50° of it) is a note in the report, not a Python warning with a source

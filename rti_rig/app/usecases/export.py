@@ -6,13 +6,13 @@ session's too; an image missing or changed since is left out and named.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from rti_rig.app.output_files import check_output_file
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
-from rti_rig.runtime.session import session_lp_report
+from rti_rig.runtime.session import session_lp_report, unchecked_images
 
 
 @dataclass(frozen=True)
@@ -32,6 +32,9 @@ class ExportedLp:
     #: The file is not in the session folder, so its image names (relative to the session
     #: folder) do not resolve beside it, where relight, RTIBuilder and ``rti-rig fit`` look.
     outside_session: bool = False
+    #: Images on disk that no readable journal record vouches for (not in the file), and why.
+    unchecked: list[str] = field(default_factory=list)
+    unchecked_why: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -40,4 +43,5 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     check_output_file(req.out_file, req.force, {})
     write_lp(req.out_file, entries)
     outside = Path(req.out_file).resolve().parent != Path(req.session_dir).resolve()
-    return ExportedLp(list(entries), list(left_out), outside)
+    unchecked, why = unchecked_images(req.session_dir)
+    return ExportedLp(list(entries), list(left_out), outside, unchecked, why)

@@ -125,11 +125,11 @@ def _check_tiff_type(path: Path, rows: TiffRows) -> None:
         )
     if rows.description.startswith(MOSAIC_TIFF_LABEL):
         raise FitInputError(
-            f"{path} is a CFA mosaic (the session was shot with decode.mode = \"mosaic\"): one "
+            f'{path} is a CFA mosaic (the session was shot with decode.mode = "mosaic"): one '
             "colour per pixel, not a picture, so it cannot be fitted; decode the camera's RAW "
             "files kept in the session's raw/ folder to linear RGB (demosaiced) TIFFs with "
             "your RAW converter, list them in an .lp and fit that, and set decode.mode = "
-            "\"demosaic\" or \"half\" in the rig config for the next session"
+            '"demosaic" or "half" in the rig config for the next session'
         )
 
 

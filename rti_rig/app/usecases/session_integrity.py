@@ -17,10 +17,12 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import read_lp
 from rti_rig.reconstruct.qa import QAReport
 from rti_rig.runtime.session import (
+    JOURNAL,
     LP_NAME,
     files_lost_since_capture,
     lost_image_advice,
     read_manifest,
+    unchecked_images,
 )
 
 
@@ -33,6 +35,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         if source.name != LP_NAME:  # an .lp of its own, not a session's lights.lp
             return qa
         source = source.parent
+    qa = _with_unchecked(qa, source)
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
@@ -51,6 +54,22 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             check = replace(check, problems=(*check.problems, f"{problem}; {todo}"))
         images.append(check)
     return replace(qa, images=tuple(images))
+
+
+def _with_unchecked(qa: QAReport, source: Path) -> QAReport:
+    """``qa`` with a caveat naming the images no readable journal record vouches for."""
+    unchecked, why = unchecked_images(source)
+    if not unchecked:
+        return qa
+    shown = ", ".join(unchecked[:8]) + (
+        f" and {len(unchecked) - 8} more" if len(unchecked) > 8 else ""
+    )
+    note = (
+        f"{shown} not checked against {'its' if len(unchecked) == 1 else 'their'} capture "
+        f"checksum{'' if len(unchecked) == 1 else 's'} ({why}): a change since capture would go "
+        f"unseen; restore {JOURNAL} from a backup copy of the folder"
+    )
+    return replace(qa, integrity_note=note)
 
 
 def _listed(lp: Path) -> set[str]:

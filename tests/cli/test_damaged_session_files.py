@@ -1,0 +1,120 @@
+"""A session whose manifest or journal was damaged outside rti-rig, through the front door.
+
+Found by an input audit: a manifest holding JSON that is no object (a list, null, a string) or
+binary bytes gave a Python traceback on export-lp, fit, run --resume and calibrate-lights; with
+the journal gone or a line of it damaged, the QA verdict said "good" for a session with a
+changed JPEG and export-lp left an image out without a word, because nothing could be checked
+and nothing said so. A config's negative scene seed was numpy's traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("dry") / "s"
+    r = runner.invoke(
+        app, ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "12"]
+    )
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def _copy(session: Path, tmp_path: Path) -> Path:
+    copy = tmp_path / "s"
+    shutil.copytree(session, copy)
+    return copy
+
+
+@pytest.mark.parametrize(
+    ("content", "kind"),
+    [(b"[1, 2, 3]", "array"), (b"null", "null"), (b'"hi"', "string"), (b"\xff\xfe\x00", "JSON")],
+)
+def test_a_manifest_that_is_no_object_is_named_not_a_traceback(
+    session: Path, tmp_path: Path, content: bytes, kind: str
+) -> None:
+    s = _copy(session, tmp_path)
+    (s / "manifest.json").write_bytes(content)
+    for args in (
+        ["export-lp", str(s), "--out", str(tmp_path / "a.lp")],
+        ["run", "--resume", str(s)],
+        ["calibrate-lights", str(s), "--rig", str(CONFIGS / "emulated_dome.toml")],
+    ):
+        r = runner.invoke(app, args)
+        text = said(r)
+        assert r.exit_code not in (0, None) and isinstance(r.exception, SystemExit), (args, text)
+        assert "Traceback" not in r.output, (args, r.output)
+        assert "manifest.json" in text and kind in text, (args, text)
+        assert "restore manifest.json from a backup copy" in text, (args, text)
+    # fit reads lights.lp, not the manifest: it fits, and its verdict says what it could not check
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "not checked against their capture checksums (manifest.json unreadable)" in verdict
+
+
+def test_a_missing_journal_is_said_by_the_verdict_and_export_lp(
+    session: Path, tmp_path: Path
+) -> None:
+    s = _copy(session, tmp_path)
+    jpeg = s / "image_004.jpg"
+    jpeg.write_bytes(jpeg.read_bytes()[:-200] + b"\x00" * 200)  # changed since capture
+    (s / "journal.jsonl").unlink()
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    qa = json.loads((tmp_path / "fit" / "qa.json").read_text())
+    assert any("not checked against their capture checksums" in c for c in qa["caveats"]), qa
+    assert "journal.jsonl is missing" in qa["verdict"] and "image_004" in qa["verdict"]
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(tmp_path / "a.lp")])
+    assert r.exit_code != 0 and "journal.jsonl is missing" in said(r), r.output
+
+
+def test_a_damaged_journal_line_is_said_by_the_verdict_and_export_lp(
+    session: Path, tmp_path: Path
+) -> None:
+    s = _copy(session, tmp_path)
+    journal = s / "journal.jsonl"
+    lines = journal.read_text().splitlines(keepends=True)
+    journal.write_text("".join(lines[:5]) + lines[5][:40] + "\n" + "".join(lines[6:]))
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "image_006 not checked against its capture checksum" in verdict, verdict
+    assert "journal.jsonl line 6 unreadable" in verdict
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(tmp_path / "a.lp")])
+    assert r.exit_code == 0, r.output
+    assert "not verifiable as captured (journal.jsonl line 6 unreadable): image_006" in said(r)
+    assert "image_006" not in (tmp_path / "a.lp").read_text()
+
+
+def test_an_intact_session_has_no_integrity_caveat(session: Path, tmp_path: Path) -> None:
+    r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    qa = json.loads((tmp_path / "fit" / "qa.json").read_text())
+    assert not any("capture checksum" in c for c in qa["caveats"]), qa["caveats"]
+
+
+def test_a_negative_scene_seed_is_a_named_config_error(tmp_path: Path) -> None:
+    text = (CONFIGS / "simulated_dome.toml").read_text()
+    assert "seed = 0" in text
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text(text.replace("seed = 0", "seed = -1"))
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code != 0 and "Traceback" not in r.output
+    assert "seed" in said(r) and "greater than or equal to 0" in said(r), r.output
