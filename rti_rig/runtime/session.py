@@ -257,6 +257,16 @@ class SessionFolder:
                 f"{root} is not empty: refusing to write a session over existing files; "
                 f"choose a new --out folder{resume}"
             )
+        # where the session's folder would be made: found unwritable only at the first image,
+        # a session had lit the rig (and on an arm, moved it) for nothing
+        nearest = root
+        while not nearest.exists() and nearest != nearest.parent:
+            nearest = nearest.parent
+        if nearest.is_dir() and not os.access(nearest, os.W_OK | os.X_OK):
+            raise SessionError(
+                f"{root}: cannot write there ({nearest} is read-only or not writable by you); "
+                "choose an --out folder you can write to"
+            )
 
     @classmethod
     def create(cls, root: Path, total_steps: int) -> SessionFolder:

@@ -118,3 +118,34 @@ def test_a_negative_scene_seed_is_a_named_config_error(tmp_path: Path) -> None:
     r = runner.invoke(app, ["check", str(cfg)])
     assert r.exit_code != 0 and "Traceback" not in r.output
     assert "seed" in said(r) and "greater than or equal to 0" in said(r), r.output
+
+
+def test_an_unwritable_out_is_refused_before_the_rig_lights(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On a read-only disk a session had lit the rig and begun capturing before finding it
+    could not write its first image. The folder's nearest existing parent is checked first.
+    (The test stands in for a read-only mount, which needs privileges to make, by the
+    operating system's answer for that folder.)"""
+    import os
+
+    import rti_rig.runtime.session as session_module
+
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_access = os.access
+
+    def access(path, mode, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if Path(path) == locked and mode & os.W_OK:
+            return False
+        return real_access(path, mode, *args, **kwargs)
+
+    monkeypatch.setattr(session_module.os, "access", access)
+    out = locked / "new" / "s"
+    r = runner.invoke(
+        app, ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "6"]
+    )
+    text = said(r)
+    assert r.exit_code != 0 and "cannot write there" in text and str(locked) in text, text
+    assert "capturing" not in text and "Rig simulated-dome-48" not in text
+    assert not (locked / "new").exists()
