@@ -66,6 +66,22 @@ class DomeConfig(_Strict):
             raise ValueError("layout 'fibonacci' needs key 'count' (number of LEDs)")
         if self.layout == "lp" and not self.lp_file:
             raise ValueError("layout 'lp' needs key 'lp_file' (path relative to the config)")
+        # a key another layout reads is refused, not ignored: an lp_file naming a file that
+        # does not exist passed a check, and the dome ran rings the user did not describe
+        unused = [
+            f"{key} (read only with layout = {layout!r})"
+            for key, layout, given in (
+                ("rings", "rings", bool(self.rings)),
+                ("count", "fibonacci", self.count is not None),
+                ("lp_file", "lp", self.lp_file is not None),
+            )
+            if given and self.layout != layout
+        ]
+        if unused:
+            raise ValueError(
+                f"layout is {self.layout!r}, so {' and '.join(unused)} would be ignored: "
+                "remove it, or change the layout"
+            )
         return self
 
 
@@ -251,6 +267,14 @@ class RigConfig(_Strict):
             raise ValueError("kind 'dome' needs a [dome] table")
         if self.kind == "arm" and self.arm is None:
             raise ValueError("kind 'arm' needs an [arm] table")
+        if self.kind == "dome" and self.arm is not None:
+            raise ValueError(
+                "kind 'dome' reads no [arm] table: remove it (or set kind = 'arm' for an arm)"
+            )
+        if self.kind == "arm" and self.dome is not None:
+            raise ValueError(
+                "kind 'arm' reads no [dome] table: remove it (or set kind = 'dome' for a dome)"
+            )
         devices = [
             name
             for name, present in (

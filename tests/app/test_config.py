@@ -34,6 +34,18 @@ def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> 
         (("exposure_s = 0.05", "exposure_s = 100.0"), "camera", "outside"),
         (("width = 64", 'width = "wide"'), "camera.width", "integer"),
         (('layout = "rings"', 'layout = "lp"'), "dome", "needs key 'lp_file'"),
+        # a key another layout reads is refused, not ignored (an lp_file naming no file passed)
+        (
+            ('layout = "rings"', 'layout = "rings"\nlp_file = "nosuch.lp"'),
+            "dome",
+            "lp_file (read only with layout = 'lp') would be ignored",
+        ),
+        (
+            ('layout = "rings"', 'layout = "rings"\ncount = 12'),
+            "dome",
+            "count (read only with layout = 'fibonacci') would be ignored",
+        ),
+        (("seed = 3", "seed = -1"), "scene.seed", "greater than or equal to 0"),
     ],
 )
 def test_bad_values_name_file_and_key(
@@ -47,6 +59,14 @@ def test_bad_values_name_file_and_key(
     assert info.value.key == key
     assert fragment in info.value.message
     assert str(path) in str(info.value)
+
+
+def test_a_table_the_kind_does_not_read_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match=r"kind 'dome' reads no \[arm\] table"):
+        load_rig_config(write_config(tmp_path, SMALL_DOME + "[arm]\n"))
+    arm = (REPO / "rig_configs" / "virtual_arm.toml").read_text()
+    with pytest.raises(ConfigError, match=r"kind 'arm' reads no \[dome\] table"):
+        load_rig_config(write_config(tmp_path, arm + '\n[dome]\nlayout = "fibonacci"\ncount = 8\n'))
 
 
 def test_missing_table_and_bad_toml(tmp_path: Path) -> None:
