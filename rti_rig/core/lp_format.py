@@ -188,6 +188,33 @@ def _parse_float(token: str, source: str, lineno: int, axis: str) -> float:
     return value
 
 
+#: File name endings of the images an ``.lp`` lists (to tell a name from a stray column).
+_IMAGE_ENDINGS = (".jpg", ".jpeg", ".tif", ".tiff", ".png", ".dng", ".cr2", ".nef", ".arw")
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def _refuse_extra_columns(tokens: list[str], line: str, source: str, lineno: int) -> None:
+    """Refuse a line whose image name is followed by a number before the vector: a fourth
+    column (an intensity, a weight), not a name with spaces. It had been read as the name
+    ``image01.jpg 0.2051`` and reported as a missing image."""
+    if len(tokens) < 5 or not tokens[0].lower().endswith(_IMAGE_ENDINGS):
+        return
+    if any(_is_number(t) for t in tokens[1:-3]):
+        raise LpFormatError(
+            source,
+            lineno,
+            f"expected 'name x y z', found {len(tokens)} fields: {line.strip()!r} (an extra "
+            "column after the name? an .lp line is the image name and the light's x y z only)",
+        )
+
+
 def parse_lp(
     text: str,
     source: str = "<lp>",
@@ -247,6 +274,7 @@ def parse_lp(
             )
         # Like relight: the last three fields are the vector, the rest is the name.
         name = " ".join(tokens[:-3])
+        _refuse_extra_columns(tokens, line, source, lineno)
         x, y, z = (
             _parse_float(t, source, lineno, axis)
             for t, axis in zip(tokens[-3:], "xyz", strict=True)

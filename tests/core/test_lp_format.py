@@ -81,6 +81,9 @@ def test_tolerant_reading() -> None:
     np.testing.assert_allclose(entries[1].direction, (0, 0, 1))  # renormalised
     no_count = parse_lp("x_1.jpg 0 0.6 0.8\nx_2.jpg 0.6 0 0.8\n")
     assert len(no_count) == 2
+    # names with spaces still read (the first word is no image file name, or no number follows)
+    spaced = parse_lp("IMG 001.jpg 0 0.6 0.8\nshot 2 b.tif 0.6 0 0.8\nmy photo.jpg x.jpg 0 0 1\n")
+    assert [e.name for e in spaced] == ["IMG 001.jpg", "shot 2 b.tif", "my photo.jpg x.jpg"]
 
 
 @pytest.mark.parametrize(
@@ -97,6 +100,9 @@ def test_tolerant_reading() -> None:
         ("1\na_1.jpg 0 1\n", 2, "expected 'name x y z'"),
         ("two\na_1.jpg 0 0 1\n", 1, "not a whole number"),
         ("0\n", 1, "must be positive"),
+        # a column after the name (an intensity) is no name with a space in it
+        ("1\na_1.jpg 0.6 0 0.8 1.0\n", 2, "found 5 fields"),
+        ("1\na_1.JPG 1.0 0.6 0 0.8\n", 2, "an extra column after the name?"),
     ],
 )
 def test_malformed_files_name_line_and_reason(text: str, line: int, fragment: str) -> None:
