@@ -891,7 +891,8 @@ def _lost_note(
         " …" if len(lost) > 5 else ""
     )
     return (
-        f"; but {len(lost)} of its images are missing or changed since capture ({shown}): "
+        f"; but {len(lost)} of its images {'is' if len(lost) == 1 else 'are'} missing or changed "
+        f"since capture ({shown}): "
         + lost_image_advice(root, adaptive)
     )
 
