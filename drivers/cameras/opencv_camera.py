@@ -189,7 +189,25 @@ class OpenCvCamera:
                 "together (`v4l2-ctl --list-formats-ext`)",
                 "verify fourcc",
             )
+        if s.response is None and info.get("fourcc") not in RAW_GREY_FOURCCS:
+            # an 8-bit stream is refused at connect, before a session lights anything
+            ok, frame = cap.read()
+            if ok and frame is not None:
+                self._refuse_unset_response(np.asarray(frame))
         self.connection_info = info
+
+    def _refuse_unset_response(self, image: np.ndarray) -> None:
+        """An 8-bit frame with no ``response`` configured is refused, not taken as linear: such
+        frames are gamma-encoded on nearly every camera, and read as linear they bias every
+        fitted normal without a word (the default had been "linear")."""
+        if image.dtype == np.uint8 and self.settings.response is None:
+            raise DeviceError(
+                self.name,
+                "the camera delivers 8-bit frames, which are gamma-encoded on nearly every "
+                "camera: set response = \"srgb\" in [camera.device] (or \"linear\" if yours "
+                "is linear), or ask for a 16-bit format (fourcc = \"Y16 \") if it offers one",
+                "capture",
+            )
 
     # -- capture ---------------------------------------------------------------------------
     def _require_open(self) -> VideoCaptureLike:
@@ -256,8 +274,9 @@ class OpenCvCamera:
             )
         self._frames_read += 1
         image = np.asarray(image)
+        self._refuse_unset_response(image)
         pixels, white = to_linear_uint16(
-            image, s.response, s.black_level, s.white_level, order="bgr"
+            image, s.response or "linear", s.black_level, s.white_level, order="bgr"
         )
         metadata: dict[str, Any] = {
             "camera": self.name,

@@ -133,10 +133,11 @@ class OpenCvCameraSettings(_Strict):
     )
     min_exposure_s: float = Field(100e-6, gt=0.0)
     max_exposure_s: float = Field(2.0, gt=0.0)
-    response: Literal["linear", "srgb"] = Field(
-        "linear",
+    response: Literal["linear", "srgb"] | None = Field(
+        None,
         description="how 8-bit frames map to linear data: 'linear' (scale only) or 'srgb' "
-        "(inverse sRGB curve). 16-bit frames are always taken as linear.",
+        "(inverse sRGB curve); unset, an 8-bit frame is refused (gamma-encoded on nearly every "
+        "camera: taken as linear it biases every normal). 16-bit frames are always linear.",
     )
     black_level: int = Field(0, ge=0, description="code value subtracted from 16-bit frames")
     white_level: int = Field(65535, gt=0, le=65535, description="saturation code of 16-bit frames")

@@ -257,3 +257,32 @@ def test_settings_reject_unknown_keys_and_bad_fourcc():
         OpenCvCameraSettings(exposure_unti_s=1e-4)
     with pytest.raises(ValueError, match="4 characters"):
         OpenCvCameraSettings(fourcc="Y16")
+
+
+class EightBitV4l2(FakeV4l2):
+    """A UVC camera that offers only YUYV: OpenCV hands over 8-bit BGR frames."""
+
+    def _frame(self):
+        return np.full((4, 6, 3), 128, np.uint8)
+
+
+def test_an_8bit_stream_without_a_response_is_refused_at_connect_not_taken_as_linear():
+    """The default had been "linear": a UVC camera's gamma-encoded 8-bit frames went into the
+    fit as linear light. Refused at connect (before a session lights anything), named, with
+    the setting that accepts them."""
+    fake = EightBitV4l2(formats=("YUYV",))
+    cam = v4l2_camera(fake, fourcc=None, require_fourcc=False)
+    with pytest.raises(DeviceError, match=r"8-bit frames.*response = \"srgb\""):
+        cam.connect()
+    fake = EightBitV4l2(formats=("YUYV",))
+    with v4l2_camera(fake, fourcc=None, require_fourcc=False, response="srgb") as cam:
+        frame = cam.capture(0.01)
+    assert frame.metadata["response"] == "srgb"
+    assert frame.pixels[0, 0, 0] == round(((128 / 255 + 0.055) / 1.055) ** 2.4 * 65535)
+
+
+def test_an_8bit_image_sequence_without_a_response_is_refused(tmp_path):
+    cv2.imwrite(str(tmp_path / "c_000.png"), np.full((4, 4, 3), 128, np.uint8))
+    with images_camera(str(tmp_path / "c_%03d.png"), drain_frames=0) as cam:
+        with pytest.raises(DeviceError, match="8-bit frames"):
+            cam.capture(0.01)
