@@ -257,7 +257,7 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
         "brackets: HSH1 from 6, PTM from 9, HSH2 from 14, HSH3 from 24; the basis changes with "
         "N, so PSNR need not rise at every step). One acquisition, one layout per cell: "
         "differences of a few tenths of a degree or dB between layouts are within what one "
-        "layout's luck moves (docs/planner.md); read the trend with N, not single cells.",
+        "layout's luck moves (docs/research/planner.md); read the trend with N, not single cells.",
         "",
         "**Relighting as `rti-rig fit` writes it**: the PSNR on the same held-out lights of the "
         "fit.rti that `rti-rig fit` (`--model auto`) would write for each layout — its HSH "
