@@ -83,8 +83,9 @@ def run(
         bool,
         typer.Option(
             "--accept-rig-change",
-            help="With --resume: go on although the rig differs from the session's (a "
-            "repaired LED, a new exposure); the change is recorded in the manifest.",
+            help="With --resume: go on although the rig's lights differ from the session's (a "
+            "repaired LED, recalibrated positions); the change is recorded in the manifest. "
+            "A change to the images (exposure, gain, size, decoding, camera) is refused.",
         ),
     ] = False,
     reshoot_lost: Annotated[

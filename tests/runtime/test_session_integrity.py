@@ -113,21 +113,29 @@ def test_resume_on_another_rig_is_refused_with_what_differs(
     )
     assert r.exit_code == 2 and "cannot change kind of rig" in said(r), r.output
     smaller = write_config(tmp_path, SMALL_DOME.replace("width = 64", "width = 32"), "small.toml")
-    r = runner.invoke(app, ["run", str(smaller), "--resume", str(out)])
-    assert r.exit_code == 2 and "camera size: 64×64 → 32×64" in said(r), r.output
-    assert "--accept-rig-change" in said(r)
-    # the session's own config, edited since: --resume alone uses it, and sees the edit
+    for flag in ([], ["--accept-rig-change"]):
+        r = runner.invoke(app, ["run", str(smaller), "--resume", str(out), *flag])
+        assert r.exit_code == 2 and "camera size: 64×64 → 32×64" in said(r), r.output
+        assert "cannot be accepted into this session, even with --accept-rig-change" in said(r)
+    # the session's own config, edited since: --resume alone uses it, and sees the edit; a new
+    # exposure is no change a session can take (accepted, it went into the fit as a brighter
+    # light: normals 5.5° off with a "good" verdict)
     cfg.write_text(SMALL_DOME.replace("exposure_s = 0.05", "exposure_s = 0.04"))
-    r = runner.invoke(app, ["run", "--resume", str(out)])
-    assert r.exit_code == 2 and "exposure (s): 0.05 → 0.04" in said(r), r.output
+    for flag in ([], ["--accept-rig-change"]):
+        r = runner.invoke(app, ["run", "--resume", str(out), *flag])
+        assert r.exit_code == 2 and "exposure (s): 0.05 → 0.04" in said(r), r.output
+        assert "set it back to continue" in said(r)
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before  # untouched
 
-    # a deliberate change goes through with the flag, and is recorded
+    # a deliberate change to the rest of the rig (here the dry run's scene) goes through with
+    # the flag, and is recorded
+    cfg.write_text(SMALL_DOME.replace("seed = 3", "seed = 4"))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2 and "add --accept-rig-change to record it" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out), "--accept-rig-change"])
     assert r.exit_code == 0, r.output
     run = manifest(out)["runs"][-1]
-    assert run["rig_change"] == ["exposure (s): 0.05 → 0.04"]
-    assert manifest(out)["rig"]["identity"]["exposure_s"] == 0.04
+    assert run["rig_change"] == ["simulated scene: changed"]
 
 
 def test_resume_with_the_same_rig_needs_no_flag(
@@ -389,7 +397,11 @@ def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tif
     lines = (done / "journal.jsonl").read_text().splitlines()
     records = [json.loads(line) for line in lines]
     for rec in records:  # as a DSLR session's: each step's RAW original, since archived
-        rec["sha256"][f"raw/{Path(rec['image']).stem}.cr2"] = "0" * 64
+        raw = f"raw/{Path(rec['image']).stem}.cr2"
+        rec["sha256"][raw] = "0" * 64
+        # the camera's own name, as a DSLR session journals it (without it the record is no
+        # step record, and the verdict had been "good" only because nothing was checked)
+        rec.setdefault("originals", {})[raw] = f"/store_00010001/DCIM/IMG_{rec['index']:04d}.CR2"
     (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
     tif = done / "linear" / "image_004.tif"
     tifffile.imwrite(tif, tifffile.imread(tif), description="re-saved")

@@ -78,8 +78,9 @@ class ResumeRequest:
     """Continue an interrupted session; ``rig_config`` defaults to the session's own.
 
     The rig must be the one the session began on (see :mod:`rti_rig.app.rig_identity`); a
-    deliberate change (a repaired LED, a new exposure) needs ``accept_rig_change`` and is
-    recorded in the manifest's run.
+    deliberate change to its lights (a repaired LED, recalibrated positions) needs
+    ``accept_rig_change`` and is recorded in the manifest's run. A change to what the images
+    are (exposure, gain, size, decoding, camera) is refused even then.
     """
 
     session_dir: Path
@@ -377,7 +378,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
 
     Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``.
     """
-    from rti_rig.app.rig_identity import identity_differences, rig_identity
+    from rti_rig.app.rig_identity import IMAGE_LABELS, identity_differences, rig_identity
 
     identity = rig_identity(loaded)
     recorded = (manifest.get("rig") or {}).get("identity")
@@ -392,6 +393,20 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             )
         return identity, []
     diffs = identity_differences(recorded, identity)
+    image_diffs = [d for d in diffs if d.split(":")[0] in IMAGE_LABELS]
+    if recorded.get("kind") == identity.get("kind") and image_diffs:
+        # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
+        # on average, with a "good" verdict; nothing downstream corrects for it
+        raise RigChangedError(
+            f"{config_path} changes what this session's images are ("
+            + "; ".join(image_diffs)
+            + "): images shot now would not match the ones already taken (another exposure "
+            "or gain reads as a brighter or darker light, another size or decoding as another "
+            "picture), and fit, relight and RTIBuilder take a session's images as one set. "
+            "That cannot be accepted into this session, even with --accept-rig-change: set it "
+            f"back to continue (rti-rig run --resume {session_dir} with the session's own "
+            "config), or start a new session with the new settings"
+        )
     if recorded.get("kind") != identity.get("kind"):
         raise RigChangedError(
             f"{config_path} is a rig of kind '{identity.get('kind')}', and this session was "
@@ -405,8 +420,8 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             + "; ".join(diffs)
             + "): its images would not match the ones already taken. Resume with the "
             f"session's own config (rti-rig run --resume {session_dir}), or, if the change "
-            "is deliberate (a repaired LED, a new exposure), add --accept-rig-change to "
-            "record it"
+            "is deliberate (a repaired LED, recalibrated light positions), add "
+            "--accept-rig-change to record it"
         )
     if diffs:
         on_note(Note("rig change accepted and recorded: " + "; ".join(diffs), "warning"))
