@@ -140,6 +140,10 @@ class ImageCheck:
     neighbour_gain_ratio: float = float("nan")
 
 
+#: The saturation check's advice (replaced where a session cannot follow it).
+LESS_EXPOSURE = "reshoot with less exposure"
+
+
 @dataclass(frozen=True)
 class QAReport:
     """Per-image checks, coverage, expected normal error and the verdict."""
@@ -161,11 +165,14 @@ class QAReport:
     #: Images whose files could not be checked against their capture checksums, and why (set
     #: by the application for a session folder); empty when every image was checkable.
     integrity_note: str = ""
+    #: What the session's kind allows of the advice (a replay or an adaptive session cannot
+    #: reshoot one image), set by the application; empty for a session that can.
+    session_note: str = ""
 
     @property
     def caveats(self) -> list[str]:
         """Every check not made, by name (said with the verdict, never silently)."""
-        out = [self.integrity_note] if self.integrity_note else []
+        out = [n for n in (self.integrity_note, self.session_note) if n]
         if self.direction_note:
             out.append(self.direction_note)
         flagged = {c.index for c in self.reshoot}
@@ -462,7 +469,7 @@ def assess(
         if sat_frac[i] > SATURATED_LIMIT:
             problems.append(
                 f"saturated: {sat_frac[i]:.1%} of pixels clipped (limit {SATURATED_LIMIT:.0%}); "
-                "reshoot with less exposure"
+                + LESS_EXPOSURE
             )
         wrong_i = bool(ev.wrong[i] and ev.direction_judged[i])
         if ev.dim[i] and (not wrong_i or ev.lit_gain[i] < DIM_GAIN * 0.5):

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import read_lp
-from rti_rig.reconstruct.qa import QAReport
+from rti_rig.reconstruct.qa import LESS_EXPOSURE, QAReport
 from rti_rig.runtime.session import (
     JOURNAL,
     LP_NAME,
@@ -28,14 +28,16 @@ from rti_rig.runtime.session import (
 
 def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     """``qa`` with a problem added to each image of session ``source`` whose JPEG or linear
-    TIFF is gone or changed since capture (unchanged for an ``.lp`` acquisition, which has no
-    journal)."""
+    TIFF is gone or changed since capture, a caveat naming the images no journal record
+    vouches for, and advice a replayed or adaptive session can follow (unchanged for an
+    ``.lp`` acquisition, which has no journal)."""
     source = Path(source)
     if not source.is_dir():
         if source.name != LP_NAME:  # an .lp of its own, not a session's lights.lp
             return qa
         source = source.parent
     qa = _with_unchecked(qa, source)
+    qa = _with_session_kind(qa, source)
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
@@ -54,6 +56,35 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             check = replace(check, problems=(*check.problems, f"{problem}; {todo}"))
         images.append(check)
     return replace(qa, images=tuple(images))
+
+
+def _with_session_kind(qa: QAReport, source: Path) -> QAReport:
+    """``qa`` with its advice fitted to what the session can do: a replayed acquisition cannot
+    be reshot, and an adaptive one cannot reshoot one image ("reshoot with less exposure" had
+    been the advice to both, which neither could follow)."""
+    try:
+        manifest = read_manifest(source)
+    except RtiRigError:
+        return qa
+    if (manifest.get("rig") or {}).get("backend") == "replay":
+        advice = "clipped in the recording (a replayed acquisition cannot be reshot)"
+        note = (
+            "this session replays a recorded acquisition: the problems named are the "
+            "recording's, and cannot be reshot here"
+        )
+    elif manifest.get("adaptive"):
+        advice = "a new session with a shorter camera.exposure_s avoids it"
+        note = (
+            "an adaptive session cannot reshoot single images (the lights after each were "
+            "chosen from it): the images named are fixed only by a new session"
+        )
+    else:
+        return qa
+    images = tuple(
+        replace(c, problems=tuple(p.replace(LESS_EXPOSURE, advice) for p in c.problems))
+        for c in qa.images
+    )
+    return replace(qa, images=images, session_note=note if qa.reshoot else "")
 
 
 def _with_unchecked(qa: QAReport, source: Path) -> QAReport:

@@ -1,0 +1,57 @@
+"""The QA verdict's advice is one the session can follow, through the front door.
+
+Found by an audit: a replayed acquisition and an adaptive session were both told "reshoot with
+less exposure" for a clipped image; a replay cannot be reshot at all, and an adaptive session
+cannot reshoot one image (the lights after it were chosen from it).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+REPO = Path(__file__).resolve().parents[2]
+ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+runner = CliRunner()
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+def test_a_replayed_acquisition_is_not_told_to_reshoot_with_less_exposure(tmp_path: Path) -> None:
+    r = runner.invoke(app, ["run", str(ACQ), "--out", str(tmp_path / "s"), "--lights", "9"])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "saturated" in text, text  # the recording's own clipped images
+    assert "reshoot with less exposure" not in text
+    assert "clipped in the recording (a replayed acquisition cannot be reshot)" in text
+    assert "this session replays a recorded acquisition" in text
+
+
+@pytest.mark.pty
+def test_an_adaptive_session_is_not_told_to_reshoot_one_image(tmp_path: Path) -> None:
+    cfg = CONFIGS / "emulated_dome.toml"  # a polished coin at a fixed 0.05 s: the top clips
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--adaptive", "--lights", "9"]
+    )
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "saturated" in text, text
+    assert "reshoot with less exposure" not in text
+    assert "a new session with a shorter camera.exposure_s avoids it" in text
+    assert "an adaptive session cannot reshoot single images" in text
+
+
+@pytest.mark.pty
+def test_a_planned_session_keeps_the_advice(tmp_path: Path) -> None:
+    cfg = CONFIGS / "emulated_dome.toml"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "48"])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "reshoot with less exposure" in text and "cannot reshoot" not in text
