@@ -283,6 +283,8 @@ def test_an_8bit_stream_without_a_response_is_refused_at_connect_not_taken_as_li
 
 def test_an_8bit_image_sequence_without_a_response_is_refused(tmp_path):
     cv2.imwrite(str(tmp_path / "c_000.png"), np.full((4, 4, 3), 128, np.uint8))
-    with images_camera(str(tmp_path / "c_%03d.png"), drain_frames=0) as cam:
-        with pytest.raises(DeviceError, match="8-bit frames"):
-            cam.capture(0.01)
+    with (
+        images_camera(str(tmp_path / "c_%03d.png"), drain_frames=0) as cam,
+        pytest.raises(DeviceError, match="8-bit frames"),
+    ):
+        cam.capture(0.01)
