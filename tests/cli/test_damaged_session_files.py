@@ -149,3 +149,24 @@ def test_an_unwritable_out_is_refused_before_the_rig_lights(
     assert r.exit_code != 0 and "cannot write there" in text and str(locked) in text, text
     assert "capturing" not in text and "Rig simulated-dome-48" not in text
     assert not (locked / "new").exists()
+
+
+def test_the_verdict_of_an_unfinished_session_says_so(tmp_path: Path) -> None:
+    """An adaptive session cancelled after 5 of at most 8 images was fitted with "QA verdict:
+    good" and no word that it was unfinished and could be continued."""
+    from conftest import SMALL_DOME, interrupted, write_config
+
+    cfg = write_config(tmp_path, SMALL_DOME)
+    part = tmp_path / "part"
+    interrupted(cfg, part, after_step=4, lights=8)
+    r = runner.invoke(app, ["fit", str(part), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "the session is not finished (5 of at most 8 images; stopped by Ctrl-C)" in verdict
+    assert f"rti-rig run --resume {part}" in verdict
+    # finished, it says nothing of the kind
+    r = runner.invoke(app, ["run", "--resume", str(part)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["fit", str(part), "--out", str(tmp_path / "fit2")])
+    verdict = json.loads((tmp_path / "fit2" / "qa.json").read_text())["verdict"]
+    assert "not finished" not in verdict, verdict

@@ -10,6 +10,7 @@ JPEGs in order) gave every later image the wrong light. The journal says what wa
 
 from __future__ import annotations
 
+import shlex
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,8 +21,11 @@ from rti_rig.runtime.session import (
     JOURNAL,
     LP_NAME,
     files_lost_since_capture,
+    image_names,
     lost_image_advice,
+    planned_steps,
     read_manifest,
+    scan_journal,
     unchecked_images,
 )
 
@@ -38,6 +42,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         source = source.parent
     qa = _with_unchecked(qa, source)
     qa = _with_session_kind(qa, source)
+    qa = _with_unfinished(qa, source)
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
@@ -85,6 +90,45 @@ def _with_session_kind(qa: QAReport, source: Path) -> QAReport:
         for c in qa.images
     )
     return replace(qa, images=images, session_note=note if qa.reshoot else "")
+
+
+#: How a session that did not finish ended, as the manifest's finish_reason records it.
+_ENDED = {
+    "cancelled": "stopped by Ctrl-C",
+    "interrupted": "interrupted",
+    "error": "stopped by an error",
+    "emergency-stop": "stopped by an emergency stop",
+    "write-failed": "a file could not be written",
+    "no-space": "the disk was full",
+    "crashed": "the program stopped without finishing it",
+}
+
+
+def _with_unfinished(qa: QAReport, source: Path) -> QAReport:
+    """``qa`` with a caveat for a session that did not finish: its verdict judges the images
+    taken so far, and a "good" there had read as a session to fit and archive."""
+    try:
+        manifest = read_manifest(source)
+    except RtiRigError:
+        return qa
+    runner = manifest.get("runner") or {}
+    reason = runner.get("finish_reason")
+    if reason == "completed":
+        return qa
+    total = planned_steps(manifest)
+    taken = len({r["index"] for r in scan_journal(source, image_names(total)).records})
+    how = (
+        _ENDED.get(reason or "", f"it ended: {reason}")
+        if reason
+        else ("it stopped without recording why (killed, or a power cut?)")
+    )
+    of = f"of at most {total}" if manifest.get("adaptive") else f"of {total}"
+    note = (
+        f"the session is not finished ({taken} {of} images; {how}): this verdict judges the "
+        f"images taken so far; continue it with rti-rig run --resume {shlex.quote(str(source))}"
+    )
+    joined = f"{qa.session_note}; {note}" if qa.session_note else note
+    return replace(qa, session_note=joined)
 
 
 def _with_unchecked(qa: QAReport, source: Path) -> QAReport:
