@@ -258,8 +258,16 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
         # a run killed outright (kill -9, power) recorded no time: the sum leaves it out
         untimed = sum(1 for r in folder.manifest.get("runs") or [] if r.get("rig_time_s") is None)
         if untimed:
+            # the journal still times every image the killed run committed ("at least 0.0 s"
+            # had been said for 15 images shot in 17.5 s)
+            from rti_rig.runtime.session import journal_rig_time
+
             at_least = "at least "
-            beside.append(f"{untimed} run(s) killed before recording their time not counted")
+            total = max(total, journal_rig_time(folder.root))
+            beside.append(
+                f"{untimed} run(s) killed before recording their time, counted from their "
+                "images' times"
+            )
     over = f" over {runs} runs" if runs > 1 else ""
     return f"Session time on the real rig: {at_least}{total:.1f} s{over}" + (
         f" ({', '.join(beside)})" if beside else ""

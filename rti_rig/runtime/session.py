@@ -892,8 +892,7 @@ def _lost_note(
     )
     return (
         f"; but {len(lost)} of its images {'is' if len(lost) == 1 else 'are'} missing or changed "
-        f"since capture ({shown}): "
-        + lost_image_advice(root, adaptive)
+        f"since capture ({shown}): " + lost_image_advice(root, adaptive)
     )
 
 
@@ -1025,6 +1024,26 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
             parts.append(f"the last line of {JOURNAL} was cut short")
         why = "; ".join(parts) or f"no record of them in {JOURNAL}"
     return unchecked, why
+
+
+def journal_rig_time(root: Path) -> float:
+    """The rig time a session's journal accounts for: each run's last image's start on that
+    run's clock plus its light, settle and capture (a run's clock starts at 0, so a drop in
+    ``rig_start_s`` marks the next run). A lower bound of the session's time that a run killed
+    outright (which recorded no time of its own) still counts in."""
+    total, last_start, last_end = 0.0, -1.0, 0.0
+    for rec in scan_journal(Path(root)).records:
+        try:
+            start = float(rec["rig_start_s"])
+            end = start + sum(
+                float(rec.get(k) or 0.0) for k in ("light_s", "settle_s", "capture_s")
+            )
+        except (KeyError, TypeError, ValueError):
+            continue
+        if start < last_start:  # the next run's clock
+            total += last_end
+        last_start, last_end = start, end
+    return total + last_end
 
 
 def _latest_records(records: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
