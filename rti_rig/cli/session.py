@@ -237,11 +237,13 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     return f"No image was completed, but {out_dir} holds files of the camera. {resume_hint}"
 
 
-def _print_teardown_failures(folder) -> None:  # type: ignore[no-untyped-def]
+def _print_teardown_failures(folder) -> bool:  # type: ignore[no-untyped-def]
     """What could not be made safe when a session stopped early (the controller records it in
-    the manifest; the lights' state line that follows refers to it)."""
-    for failure in (folder.manifest.get("runner") or {}).get("teardown_failures") or []:
+    the manifest; the lights' state line that follows refers to it); True if any."""
+    failures = (folder.manifest.get("runner") or {}).get("teardown_failures") or []
+    for failure in failures:
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
+    return bool(failures)
 
 
 def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def]
@@ -362,15 +364,16 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
     except EmergencyStop as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
-        _print_teardown_failures(folder)
-        err.print(f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig))}.")
+        failed = _print_teardown_failures(folder)
+        err.print(
+            f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig, failed))}."
+        )
         err.print(_after_stop(opened, resume_hint), markup=False, soft_wrap=True)
         raise typer.Exit(code=stop_exit_code(str(exc))) from None
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
-        _print_teardown_failures(folder)
-        state = lights_state(rig)
+        state = lights_state(rig, _print_teardown_failures(folder))
         err.print(
             f"{state[:1].upper()}{state[1:]}. {_after_stop(opened, resume_hint)}", markup=False
         )

@@ -248,11 +248,20 @@ class SessionFolder:
         if root.exists() and not root.is_dir():
             raise SessionError(f"{root} exists and is not a folder: choose another --out")
         if root.exists() and any(root.iterdir()) and not holds_no_image(root):
-            resume = (
-                f", or continue the interrupted session in it with 'rti-rig run --resume {root}'"
-                if (root / MANIFEST).is_file()
-                else ""  # not a session: no resume to offer
-            )
+            resume = ""  # not a session: no resume to offer
+            if (root / MANIFEST).is_file():
+                try:
+                    finished = (read_manifest(root).get("runner") or {}).get(
+                        "finish_reason"
+                    ) == "completed"
+                except SessionError:
+                    finished = False
+                resume = (
+                    f" (it holds a finished session: fit it with 'rti-rig fit {root} --out DIR')"
+                    if finished
+                    else ", or continue the interrupted session in it with "
+                    f"'rti-rig run --resume {root}'"
+                )
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "
                 f"choose a new --out folder{resume}"

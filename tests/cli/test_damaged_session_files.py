@@ -170,3 +170,14 @@ def test_the_verdict_of_an_unfinished_session_says_so(tmp_path: Path) -> None:
     r = runner.invoke(app, ["fit", str(part), "--out", str(tmp_path / "fit2")])
     verdict = json.loads((tmp_path / "fit2" / "qa.json").read_text())["verdict"]
     assert "not finished" not in verdict, verdict
+
+
+def test_a_new_session_into_a_finished_one_is_not_offered_a_resume(session: Path) -> None:
+    """It had said "or continue the interrupted session in it with rti-rig run --resume",
+    which then answered "already completed"."""
+    r = runner.invoke(
+        app, ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(session), "--lights", "6"]
+    )
+    text = said(r)
+    assert r.exit_code != 0 and "is not empty" in text, text
+    assert "--resume" not in text and "it holds a finished session: fit it with" in text

@@ -299,9 +299,9 @@ def test_a_resume_after_a_kill_says_its_time_is_a_lower_bound(
 ) -> None:
     """A run killed outright records no time; the resumed session's time line had summed the
     runs that did (12.9 s "over 2 runs" for a session of 56 s) as if that were all of it."""
-    from rti_rig.testing.kill_hooks import popen_session
-
     import re
+
+    from rti_rig.testing.kill_hooks import popen_session
 
     cfg, ref = reference
     out = tmp_path / "s"

@@ -927,8 +927,8 @@ def _check_lights_within(lights: int | None, offered: int) -> None:
     capped without a word: 100 asked of a 48-LED dome ran 48)."""
     if lights is not None and lights > offered:
         raise RtiRigError(
-            f"--adaptive --lights {lights}: this rig offers {offered} lights an adaptive "
-            f"session can use; give at most {offered}"
+            f"--lights {lights}: this rig offers {offered} lights an adaptive session can "
+            f"use; give at most {offered}"
         )
 
 
@@ -952,8 +952,9 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     if until_error_deg is not None and not (np.isfinite(until_error_deg) and until_error_deg > 0):
         raise RtiRigError(f"--until-error {until_error_deg:g}: give a positive angle in degrees")
     if lights is not None and lights < START_LIGHTS + 1:
+        asked = "--until-error … " if until_error_deg is not None else "--adaptive "
         raise RtiRigError(
-            f"--adaptive --lights {lights}: an adaptive session starts from {START_LIGHTS} lights "
+            f"{asked}--lights {lights}: an adaptive session starts from {START_LIGHTS} lights "
             f"and chooses from there; give at least {START_LIGHTS + 1}"
         )
     check_objective(objective, lights, until_error_deg)

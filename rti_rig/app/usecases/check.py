@@ -67,5 +67,5 @@ def check_rig(req: CheckRequest) -> Any:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
             report = getattr(exc, "self_test_report", None)
             failures = tuple(str(f) for f in getattr(report, "teardown_failures", None) or ())
-            raise CheckStopped(str(exc), lights_state(rig), failures) from None
+            raise CheckStopped(str(exc), lights_state(rig, bool(failures)), failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")

@@ -11,9 +11,12 @@ from rti_rig.runtime.dome_policy import lights_state_sentence
 from rti_rig.runtime.lighting import DomeLighting
 
 
-def lights_state(rig) -> str:  # type: ignore[no-untyped-def]
-    """One sentence on the lights of ``rig`` after its teardown."""
+def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-untyped-def]
+    """One sentence on the lights of ``rig`` after its teardown (``teardown_failed``: the
+    teardown's failures were printed just before, and the sentence points at them)."""
     lighting = rig.lighting
+    if getattr(rig.loaded.config, "backend", None) == "replay":
+        return "a replayed acquisition has no lights to switch off"
     own = getattr(lighting, "lights_state", None)
     if callable(own):  # a lighting that knows best what it can say (a camera-triggered dome)
         return str(own())
@@ -22,4 +25,6 @@ def lights_state(rig) -> str:  # type: ignore[no-untyped-def]
         if hasattr(source, "off_report"):
             return lights_state_sentence(source)
         return "lights were switched off"  # a simulated dome: its state is the simulation's
-    return "lamp off and stop were requested (see any teardown problem above)"
+    return "lamp off and stop were requested" + (
+        " (see the teardown problems above)" if teardown_failed else ""
+    )
