@@ -13,10 +13,34 @@ INTERRUPTED_EXIT = 130
 
 
 def main() -> None:
-    """Import the command line and run it; a Ctrl-C during the import ends quietly."""
+    """Import the command line and run it; a Ctrl-C no command handled ends quietly."""
     try:
         from rti_rig.cli import main as run_cli
     except KeyboardInterrupt:
         sys.stderr.write("rti-rig: stopped while starting (Ctrl-C); nothing was done\n")
         raise SystemExit(INTERRUPTED_EXIT) from None
-    run_cli()
+    try:
+        run_cli()
+    except KeyboardInterrupt:
+        # a Ctrl-C no command handled: one line, not Python's traceback
+        sys.stderr.write("rti-rig: stopped (Ctrl-C)\n")
+        raise SystemExit(INTERRUPTED_EXIT) from None
+    except SystemExit as exc:
+        if exc.code == INTERRUPTED_EXIT and _from_keyboard_interrupt(exc):
+            # typer turns a Ctrl-C no command handled (its options still being parsed, a
+            # command with nothing to make safe) into exit 130 without a word
+            sys.stderr.write("rti-rig: stopped (Ctrl-C)\n")
+        raise
+
+
+def _from_keyboard_interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` was raised while handling a KeyboardInterrupt (its chain holds one);
+    a command's own exit 130 after its message is raised ``from None`` and holds none."""
+    seen: set[int] = set()
+    link: BaseException | None = exc
+    while link is not None and id(link) not in seen:
+        if isinstance(link, KeyboardInterrupt):
+            return True
+        seen.add(id(link))
+        link = link.__cause__ or (None if link.__suppress_context__ else link.__context__)
+    return False

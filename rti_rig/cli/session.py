@@ -211,6 +211,23 @@ def run(
             )
     except RtiRigError as exc:
         raise fail(exc) from None
+    except KeyboardInterrupt:
+        # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
+        # had been 130 with no word at all
+        if resume is not None:
+            said = (
+                f"Stopped (Ctrl-C) before the session went on: no new image was captured; "
+                f"continue it with rti-rig run --resume {resume}"
+            )
+        else:
+            said = (
+                "Stopped (Ctrl-C) before the first image: nothing was captured or written to "
+                f"{out_dir}"
+            )
+        if auto_exposure:
+            said += "; metering, if it had begun, sent its all-off on the way out: check the lights"
+        err.print(f"[yellow]{escape(said)}.[/]")
+        raise typer.Exit(code=130) from None
     _execute(opened)
     if not no_verdict:
         from rti_rig.cli.fit import print_verdict
