@@ -87,7 +87,16 @@ class SerialTransport:
                 **lock,
             )
         except (*_PORT_ERRORS, ValueError) as exc:
-            raise TransportError(f"cannot open serial port {self.port}: {exc}") from exc
+            # pyserial's text repeats the port twice ("could not open port P: [Errno 2] No such
+            # file or directory: 'P'"): the system's reason alone, where it gives one
+            errno = getattr(exc, "errno", None)
+            if "lock" in str(exc).lower():
+                why = "another program holds it (it could not be locked)"
+            elif isinstance(errno, int) and errno > 0:
+                why = os.strerror(errno)
+            else:
+                why = str(exc)
+            raise TransportError(f"cannot open serial port {self.port}: {why}") from exc
         self._timeout = 0
 
     def close(self) -> None:

@@ -52,7 +52,11 @@ def model_spec(name: str) -> ModelSpec:
     try:
         return _REGISTRY[name]
     except KeyError:
-        raise ValueError(f"unknown model '{name}'; known: {', '.join(MODEL_NAMES)}") from None
+        named = [
+            n + (f" (or {', '.join(_REGISTRY[n].aliases)})" if _REGISTRY[n].aliases else "")
+            for n in MODEL_NAMES
+        ]
+        raise ValueError(f"unknown model '{name}'; known: {', '.join(named)}") from None
 
 
 register(ModelSpec("lambert", 3, fit_lambert, True, "albedo × normal, no shadow handling"))

@@ -820,6 +820,12 @@ def prepare_resume(
                 f"{finished} of at most {total} lights ({stop.get('reason', 'its stopping rule')})"
                 + _lost_note(root, latest, lost, adaptive=True)
             )
+        if reshoot_lost and not lost and not manifest.get("adaptive"):
+            raise SessionError(
+                f"{root}: nothing to reshoot: this session completed all {total} steps and "
+                "every image is as captured (each JPEG matches its journaled checksum, each "
+                "linear TIFF is there)"
+            )
         if not lost or manifest.get("adaptive") or not reshoot_lost:
             raise SessionError(
                 f"{root}: this session already completed all {total} steps"

@@ -308,6 +308,8 @@ def test_fit_refuses_a_missing_source_and_an_unknown_model(tmp_path: Path, clean
     assert r.exit_code == 2 and "session folder or an .lp" in r.output
     r = runner.invoke(app, ["fit", str(clean[0]), "--out", str(tmp_path / "o"), "--model", "x"])
     assert r.exit_code == 2 and "unknown model" in r.output
+    # the name --help gives is among the names the refusal lists (it gave only ps-robust)
+    assert "robust-ps" in " ".join(r.output.split())
 
 
 def test_run_prints_the_verdict_unless_told_not_to(tmp_path: Path) -> None:

@@ -431,3 +431,13 @@ def test_a_real_acquisition_moved_part_way_is_flagged_image_by_image(tmp_path: P
         if c["name"] in moved:
             assert abs(c["drift_px"][0] - 3) < 0.5 and abs(c["drift_px"][1] - 2) < 0.5, c
     assert "wrong light" not in qa["verdict"] and "dim" not in qa["verdict"], qa["verdict"]
+
+
+def test_too_many_lights_of_a_replay_are_counted_as_its_images(tmp_path: Path) -> None:
+    """It had said "the dome has only 18 LEDs" of an acquisition of 18 images."""
+    r = runner.invoke(
+        app, ["run", str(ACQ / "dirs.lp"), "--out", str(tmp_path / "s"), "--lights", "50"]
+    )
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2 and "has only 18 images; use --lights 18 or fewer" in text, text
+    assert "LEDs" not in text and not (tmp_path / "s").exists()

@@ -294,6 +294,11 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
     check_light_count(n)
+    if loaded.config.backend == "replay" and n > geometry.count:  # its "LEDs" are images
+        raise RtiRigError(
+            f"--lights {n}: the acquisition {loaded.path} has only {geometry.count} images; "
+            f"use --lights {geometry.count} or fewer"
+        )
     return plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )

@@ -1,0 +1,36 @@
+"""A serial port that cannot be opened is named once, with the system's reason.
+
+pyserial's text repeats the port ("could not open port P: [Errno 2] No such file or directory:
+'P'"), and the dome's message wrapped it again: the path came three times in one line.
+"""
+
+from __future__ import annotations
+
+import os
+import pty
+
+import pytest
+import serial
+
+from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
+
+
+def test_a_missing_port_is_named_once_with_its_reason(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    port = str(tmp_path / "ttyNOPE")
+    with pytest.raises(TransportError) as info:
+        SerialTransport(port).open()
+    assert str(info.value) == f"cannot open serial port {port}: No such file or directory"
+
+
+@pytest.mark.pty
+def test_a_port_another_program_holds_says_so() -> None:
+    main, sub = pty.openpty()
+    name = os.ttyname(sub)
+    holder = serial.Serial(name, exclusive=True)
+    try:
+        with pytest.raises(TransportError, match="another program holds it"):
+            SerialTransport(name).open()
+    finally:
+        holder.close()
+        os.close(main)
+        os.close(sub)
