@@ -192,6 +192,10 @@ def _parse_float(token: str, source: str, lineno: int, axis: str) -> float:
 _IMAGE_ENDINGS = (".jpg", ".jpeg", ".tif", ".tiff", ".png", ".dng", ".cr2", ".nef", ".arw")
 
 
+#: A light vector further than this from unit length is noted (normalised all the same).
+UNIT_TOLERANCE = 0.05
+
+
 def _is_number(token: str) -> bool:
     try:
         float(token)
@@ -264,6 +268,7 @@ def parse_lp(
 
     entries: list[LpEntry] = []
     seen: dict[str, int] = {}
+    off_unit: list[tuple[int, float]] = []
     for lineno, line in content:
         tokens = line.split()
         if len(tokens) < 4:
@@ -305,10 +310,24 @@ def parse_lp(
                 source, lineno, f"image name {name!r} already used on line {seen[name]}"
             )
         seen[name] = lineno
+        if abs(norm - 1.0) > UNIT_TOLERANCE:
+            off_unit.append((lineno, norm))
         entries.append(LpEntry(name, (x / norm, y / norm, z / norm)))
 
     if not entries:
         raise LpFormatError(source, None, "no light lines after the count line")
+    if off_unit:
+        # rounding noise is no news; vectors of length 3 may be lamp positions read as
+        # directions, which is worth a line (they are normalised either way)
+        lengths = [n for _, n in off_unit]
+        notes.append(
+            f"{source}, line {off_unit[0][0]}"
+            + (f" and {len(off_unit) - 1} more" if len(off_unit) > 1 else "")
+            + f": light vector length {min(lengths):.3g}"
+            + (f"–{max(lengths):.3g}" if len(off_unit) > 1 else "")
+            + ", not 1; read as directions (normalised). If the file gives lamp positions "
+            "rather than directions, they are only right for a distant lamp"
+        )
     if declared is not None and declared != len(entries):
         notes.append(
             f"{source}, line {first_no}: count line says {declared} lights but the file lists "

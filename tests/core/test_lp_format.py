@@ -266,3 +266,13 @@ def test_read_lp_passes_notes(tmp_path: Path) -> None:
     (entry,) = read_lp(p, upper_hemisphere=True, notes=notes)
     assert entry.direction == (1.0, 0.0, 0.0)
     assert len(notes) == 2 and all(n.startswith(f"{p}, line ") for n in notes)
+
+
+def test_vectors_far_from_unit_length_are_noted_rounding_noise_is_not() -> None:
+    notes: list[str] = []
+    parse_lp("2\na_1.jpg 0 0 3\na_2.jpg 0 2.9 0.5\n", "far.lp", notes=notes)
+    assert len(notes) == 1 and notes[0].startswith("far.lp, line 2 and 1 more: light vector")
+    assert "read as directions (normalised)" in notes[0]
+    quiet: list[str] = []
+    parse_lp("1\na_1.jpg 0.6001 0 0.8002\n", "near.lp", notes=quiet)
+    assert quiet == []
