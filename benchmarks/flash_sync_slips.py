@@ -159,4 +159,7 @@ def main(argv: list[str]) -> None:
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     main(sys.argv[1:])

@@ -498,4 +498,7 @@ def main(data: Path = DATA, n_previews: int = PREVIEWS) -> str:
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     main()

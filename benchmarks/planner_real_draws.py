@@ -184,6 +184,9 @@ def main(seed: int = 0, draws: int = DRAWS) -> str:
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     args = positional_args()
     main(
         seed=int(args[1]) if len(args) > 1 else 0,

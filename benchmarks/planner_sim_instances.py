@@ -103,4 +103,7 @@ def main(instances: Iterable[int] = INSTANCES, scenes: Iterable[str] | None = No
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     main()

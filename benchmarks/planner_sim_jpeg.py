@@ -167,4 +167,7 @@ def main(seed: int = 0) -> str:
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     main()

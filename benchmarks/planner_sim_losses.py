@@ -148,4 +148,7 @@ def main() -> str:
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     main()

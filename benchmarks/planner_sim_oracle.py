@@ -152,5 +152,8 @@ def main(scenes: Iterable[str] | None = None) -> str:
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     args = positional_args()
     main(args[0].split(",") if args else None)

@@ -280,4 +280,7 @@ if __name__ == "__main__":
     if "--cli" in sys.argv[1:]:
         cli_main(sys.argv[1:])
     else:
+        from benchmarks.report import exit_on_help
+
+        exit_on_help(f"{__doc__}\n--cli: time rti-rig plan as a whole process (--cli --help)")
         main()

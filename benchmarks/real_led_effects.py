@@ -79,4 +79,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    from benchmarks.report import exit_on_help
+
+    exit_on_help(__doc__)
     main()

@@ -37,6 +37,16 @@ def write_asked(argv: list[str] | None = None) -> bool:
     return "--write" in (sys.argv[1:] if argv is None else argv)
 
 
+def exit_on_help(doc: str | None, argv: list[str] | None = None) -> None:
+    """For a script without an argument parser: ``-h``/``--help`` prints its docstring and
+    exits, instead of running the whole benchmark (minutes) as an unknown argument would."""
+    args = sys.argv[1:] if argv is None else argv
+    if "-h" in args or "--help" in args:
+        print((doc or "").strip())
+        print("\nOptions: --write  update the figures in docs/ (otherwise they are only printed)")
+        raise SystemExit(0)
+
+
 def positional_args(argv: list[str] | None = None) -> list[str]:
     """The command line's arguments without ``--write`` (for scripts that read positionals)."""
     return [a for a in (sys.argv[1:] if argv is None else argv) if a != "--write"]
