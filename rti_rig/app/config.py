@@ -143,6 +143,11 @@ class CameraConfig(_Strict):
 
     @model_validator(mode="after")
     def _exposure_in_range(self) -> CameraConfig:
+        if self.min_exposure_s > self.max_exposure_s:
+            raise ValueError(
+                f"min_exposure_s {self.min_exposure_s:g} is above max_exposure_s "
+                f"{self.max_exposure_s:g}: the limits are the wrong way round"
+            )
         if not self.min_exposure_s <= self.exposure_s <= self.max_exposure_s:
             raise ValueError(
                 f"exposure_s {self.exposure_s} is outside "

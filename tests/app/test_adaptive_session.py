@@ -215,6 +215,11 @@ def test_until_error_stops_when_the_estimate_is_reached(
         # named by the options given: --adaptive had been named when only --until-error was
         (["--until-error", "2", "--lights", "4"], "--until-error … --lights 4: an adaptive"),
         (["--adaptive", "--lights", "4"], "--adaptive --lights 4: an adaptive"),
+        # the reason and a way to meter it (it had said "chooses its own lights")
+        (
+            ["--adaptive", "--lights", "6", "--auto-exposure"],
+            "--adaptive cannot meter the exposure",
+        ),
     ],
 )
 def test_bad_requests_are_refused_before_anything_moves(

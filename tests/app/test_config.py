@@ -46,6 +46,11 @@ def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> 
             "count (read only with layout = 'fibonacci') would be ignored",
         ),
         (("seed = 3", "seed = -1"), "scene.seed", "greater than or equal to 0"),
+        (
+            ("exposure_s = 0.05", "exposure_s = 0.05\nmin_exposure_s = 40.0"),
+            "camera",
+            "min_exposure_s 40 is above max_exposure_s 30: the limits are the wrong way round",
+        ),
     ],
 )
 def test_bad_values_name_file_and_key(

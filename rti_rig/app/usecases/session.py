@@ -309,8 +309,16 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     from rti_rig.app.rig_identity import rig_identity
     from rti_rig.app.usecases.adaptive import open_adaptive_session
 
-    if req.plan is not None or req.auto_exposure:
-        raise RtiRigError("--adaptive chooses its own lights: drop --plan/--auto-exposure")
+    if req.plan is not None:
+        raise RtiRigError("--adaptive chooses its own lights: drop --plan")
+    if req.auto_exposure:
+        raise RtiRigError(
+            "--adaptive cannot meter the exposure: its lights are chosen as the images "
+            "arrive, so there is no brightest planned light to meter at. Meter once with a "
+            f"planned run (rti-rig run {req.rig_config} --out TEST --lights 6 --auto-exposure "
+            "prints 'Exposure fixed at T s'), set camera.exposure_s = T in the rig config, then "
+            "run --adaptive; drop --auto-exposure"
+        )
     if req.min_elevation_deg != 0.0 or req.max_elevation_deg != 90.0:
         # refused rather than dropped: the band was silently ignored (lights fired above a
         # 45° ceiling asked for to keep a gilded object's highlights off the camera)
