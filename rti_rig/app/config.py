@@ -157,12 +157,14 @@ class CameraConfig(_Strict):
 
 
 class TimingConfig(_Strict):
-    """How long the real rig takes for each part of a step (seconds)."""
+    """How long the real rig takes for each part of a step (seconds; at most
+    ten minutes each: ``settle_s = 1e6`` had been accepted, a real session would
+    have waited eleven days per image, and a dry run reported it without a word)."""
 
-    light_switch_s: float = Field(default=0.02, ge=0)
-    settle_s: float = Field(default=0.1, ge=0)
-    readout_s: float = Field(default=0.3, ge=0)
-    transfer_s: float = Field(default=0.7, ge=0)
+    light_switch_s: float = Field(default=0.02, ge=0, le=600)
+    settle_s: float = Field(default=0.1, ge=0, le=600)
+    readout_s: float = Field(default=0.3, ge=0, le=600)
+    transfer_s: float = Field(default=0.7, ge=0, le=600)
 
 
 class SceneConfig(_Strict):

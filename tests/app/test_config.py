@@ -47,6 +47,11 @@ def test_shipped_configs_load(dome_config_path: Path, arm_config_path: Path) -> 
         ),
         (("seed = 3", "seed = -1"), "scene.seed", "greater than or equal to 0"),
         (
+            ("seed = 3", "seed = 3\n[timing]\nsettle_s = 1e6"),
+            "timing.settle_s",
+            "less than or equal to 600",
+        ),
+        (
             ("exposure_s = 0.05", "exposure_s = 0.05\nmin_exposure_s = 40.0"),
             "camera",
             "min_exposure_s 40 is above max_exposure_s 30: the limits are the wrong way round",
