@@ -360,6 +360,20 @@ def _key_of(loc: tuple[Any, ...]) -> str:
     return out
 
 
+def _error_text(err: Any) -> str:
+    """One pydantic error in a user's words: what is wrong, the value given, and for a number
+    where the driver wants the camera's own text (``iso = 100``), how to write it."""
+    msg = str(err["msg"]).removeprefix("Value error, ")
+    if err["type"] == "extra_forbidden":
+        return "unknown key (check its spelling and the table it is in)"
+    if err["type"] in ("value_error", "missing") or "input" not in err:
+        return msg
+    got = err["input"]
+    if err["type"] == "string_type" and isinstance(got, int | float) and not isinstance(got, bool):
+        return f'{msg} (got {got!r}: write it in quotes, "{got}", as the camera names it)'
+    return f"{msg} (got {got!r})"
+
+
 def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
     """Validate parsed TOML; the first problem becomes a :class:`ConfigError`."""
     try:
@@ -367,13 +381,7 @@ def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
     except ValidationError as exc:
         problems = []
         for err in exc.errors():
-            key = _key_of(err["loc"]) or None
-            msg = err["msg"].removeprefix("Value error, ")
-            if err["type"] == "extra_forbidden":
-                msg = "unknown key (check its spelling and the table it is in)"
-            elif err["type"] != "value_error" and "input" in err and err["type"] != "missing":
-                msg += f" (got {err['input']!r})"
-            problems.append((key, msg))
+            problems.append((_key_of(err["loc"]) or None, _error_text(err)))
         key, msg = problems[0]
         if len(problems) > 1:
             rest = "; ".join(f"'{k}': {m}" if k else m for k, m in problems[1:])
@@ -533,12 +541,10 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
     try:
         return parse_camera_settings(rig.config.camera.device or {})
     except ValidationError as exc:
-        err = exc.errors()[0]
-        key = _key_of(("camera", "device", *err["loc"]))
-        msg = err["msg"].removeprefix("Value error, ")
-        if err["type"] == "extra_forbidden":  # as for every other table (parse_rig_config)
-            msg = "unknown key (check its spelling and the table it is in)"
-        raise ConfigError(rig.path, key, msg) from None
+        err = exc.errors()[0]  # said as every other table's (parse_rig_config)
+        raise ConfigError(
+            rig.path, _key_of(("camera", "device", *err["loc"])), _error_text(err)
+        ) from None
 
 
 def default_config_path() -> Path:

@@ -163,3 +163,19 @@ def test_dome_shutter_trigger_needs_a_dome(tmp_path):
     text += '\n[camera.device]\nkind = "folder_watch"\nfolder = "."\ntrigger = "dome_shutter"\n'
     with pytest.raises(ConfigError, match=r"camera\.device\.trigger.*needs a dome"):
         load_rig_config(write_config(tmp_path, text))
+
+
+def test_a_camera_setting_given_as_a_number_says_how_to_write_it(tmp_path: Path) -> None:
+    """`iso = 100` was refused as "Input should be a valid string", with no value and no way."""
+    import shutil
+
+    from rti_rig.app.config import camera_device_settings
+
+    shutil.copy(REPO / "rig_configs" / "example_dome_48.lp", tmp_path)
+    text = (REPO / "rig_configs" / "example_dome_48.toml").read_text()
+    assert 'iso = "100"' in text
+    path = write_config(tmp_path, text.replace('iso = "100"', "iso = 100"), "dslr.toml")
+    with pytest.raises(ConfigError) as info:
+        camera_device_settings(load_rig_config(path))
+    assert info.value.key == "camera.device.iso"
+    assert 'got 100: write it in quotes, "100"' in info.value.message
