@@ -101,6 +101,26 @@ def bench_tradeoff(
         _tradeoff(out_dir, quick, from_lp, force)
 
 
+def _acquisition_lp(given: Path) -> Path:
+    """The ``.lp`` of ``--from``: the file, or a folder's only ``.lp`` (a session's lights.lp),
+    as ``rti-rig fit`` takes a folder ("Is a directory" had been the answer)."""
+    if not given.is_dir():
+        return given
+    found = sorted(given.glob("*.lp"))
+    if len(found) == 1:
+        return found[0]
+    raise RtiRigError(
+        f"--from {given}: a folder with "
+        + (
+            f"{len(found)} .lp files ({', '.join(p.name for p in found[:5])}"
+            + (", …)" if len(found) > 5 else ")")
+            if found
+            else "no .lp file"
+        )
+        + "; give the .lp of the acquisition itself"
+    )
+
+
 def _check_out_folder(out_dir: Path, force: bool) -> None:
     """Refuse, before minutes of computing, a folder whose files the results would replace.
 
@@ -144,6 +164,7 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
             raise fail(exc) from None
     if from_lp is not None:
         try:
+            from_lp = _acquisition_lp(from_lp)
             text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
         except RtiRigError as exc:
             raise fail(exc) from None

@@ -133,3 +133,20 @@ def test_the_checkout_benchmarks_go_first_even_behind_another_benchmarks(
     _find_benchmarks()
     assert sys.path[0] == str(REPO)
     assert sys.path.count(str(REPO)) == 1
+
+
+def test_tradeoff_from_a_folder_takes_its_only_lp(tmp_path: Path) -> None:
+    """`--from SESSION_DIR` had answered "Is a directory"; `rti-rig fit` takes a folder."""
+    import pytest
+
+    from rti_rig.cli.bench import _acquisition_lp
+    from rti_rig.core.errors import RtiRigError
+
+    assert _acquisition_lp(ACQ.parent) == ACQ
+    assert _acquisition_lp(ACQ) == ACQ
+    with pytest.raises(RtiRigError, match="a folder with no .lp file"):
+        _acquisition_lp(tmp_path)
+    for name in ("a.lp", "b.lp"):
+        (tmp_path / name).write_text("1\nx.jpg 0 0 1\n")
+    with pytest.raises(RtiRigError, match=r"2 \.lp files \(a\.lp, b\.lp\)"):
+        _acquisition_lp(tmp_path)
