@@ -144,7 +144,7 @@ def test_tradeoff_from_a_folder_takes_its_only_lp(tmp_path: Path) -> None:
 
     assert _acquisition_lp(ACQ.parent) == ACQ
     assert _acquisition_lp(ACQ) == ACQ
-    with pytest.raises(RtiRigError, match="a folder with no .lp file"):
+    with pytest.raises(RtiRigError, match=r"a folder with no \.lp file"):
         _acquisition_lp(tmp_path)
     for name in ("a.lp", "b.lp"):
         (tmp_path / name).write_text("1\nx.jpg 0 0 1\n")
