@@ -310,8 +310,8 @@ class DynamixelArm:
                 try:
                     ticks = self._bus.read(sid, ct.PRESENT_POSITION)
                 except HardwareFaultError as exc:
-                    if exc.torque_on is False:
-                        raise
+                    if exc.torque_on is not True:
+                        raise  # limp, or its torque unknown: not claimed held
                     # a fault the servo does not shut down for leaves the joint driven: it
                     # must be held like the others, not reported limp
                     ticks = self._bus.read(sid, ct.PRESENT_POSITION, check_alert=False)

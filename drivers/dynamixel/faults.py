@@ -69,8 +69,8 @@ def torque_statement(torque_on: bool | None) -> str:
     """What a fault left of the servo's torque, as read (never assumed)."""
     if torque_on is False:
         return (
-            "Its torque is off: the joint is limp (a fault the servo shuts down for keeps it "
-            "off until the servo is rebooted)."
+            "Its torque is off (as read after the fault): the joint is limp; if the servo shut "
+            "down for this fault, only a reboot lets its torque back on."
         )
     if torque_on is True:
         return (

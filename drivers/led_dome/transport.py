@@ -90,7 +90,7 @@ class SerialTransport:
             # pyserial's text repeats the port twice ("could not open port P: [Errno 2] No such
             # file or directory: 'P'"): the system's reason alone, where it gives one
             errno = getattr(exc, "errno", None)
-            if "lock" in str(exc).lower():
+            if "exclusively lock" in str(exc):  # pyserial's words (the path may hold "lock")
                 why = "another program holds it (it could not be locked)"
             elif isinstance(errno, int) and errno > 0:
                 why = os.strerror(errno)

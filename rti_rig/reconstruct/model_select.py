@@ -174,9 +174,7 @@ def select_model(
             else f"no candidate model can be fitted from {stack.n} lights"
         )
         raise ReconstructionError(
-            f"{plain} (with {how}: "
-            + "; ".join(f"{k}: {v[2]}" for k, v in results.items())
-            + ")"
+            f"{plain} (with {how}: " + "; ".join(f"{k}: {v[2]}" for k, v in results.items()) + ")"
         )
     best = min(fitted, key=lambda k: (fitted[k], N_COEFFICIENTS[k]))
     limit = fitted[best] * (1.0 + tolerance)

@@ -821,6 +821,14 @@ def prepare_resume(
                 + _lost_note(root, latest, lost, adaptive=True)
             )
         if reshoot_lost and not lost and not manifest.get("adaptive"):
+            unchecked, why = unchecked_images(root)
+            if unchecked:  # nothing found lost is not nothing lost
+                raise SessionError(
+                    f"{root}: --reshoot-lost finds nothing lost among the images it can check, "
+                    f"but {', '.join(unchecked[:8])}{' …' if len(unchecked) > 8 else ''} cannot "
+                    f"be checked ({why}): restore {MANIFEST if MANIFEST in why else JOURNAL} "
+                    "from a backup copy of the folder, then run this again"
+                )
             raise SessionError(
                 f"{root}: nothing to reshoot: this session completed all {total} steps and "
                 "every image is as captured (each JPEG matches its journaled checksum, each "
@@ -997,7 +1005,8 @@ def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
 
 
 def unchecked_images(root: Path) -> tuple[list[str], str]:
-    """Images of a session on disk that no readable journal record vouches for, and why.
+    """Images of a session (on disk, or taken by a session that completed) that no readable
+    journal record vouches for, and why.
 
     The journal holds the checksums taken at capture; an image without a readable record (the
     journal gone, a line damaged, a last line cut short) cannot be checked, and a verdict that
@@ -1014,16 +1023,21 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
         if p.is_file()
     }
     try:
-        total = planned_steps(read_manifest(root))
+        manifest = read_manifest(root)
     except SessionError:
         # the journal's records can be matched to image names only through the manifest
         return sorted(present), f"{MANIFEST} unreadable"
+    total = planned_steps(manifest)
     if not total:
         return [], ""
     names = image_names(total)
     scan = scan_journal(root, names)
     recorded = {Path(r["image"]).stem for r in scan.records}
-    unchecked = [n for n in names if n in present and n not in recorded]
+    expected = set(present)
+    runner = manifest.get("runner") or {}
+    if runner.get("finish_reason") == "completed":  # every step it took was captured
+        expected |= set(names[: int(runner.get("steps_done") or total)])
+    unchecked = [n for n in names if n in expected and n not in recorded]
     if not unchecked:
         return [], ""
     if not (root / JOURNAL).is_file():
@@ -1042,20 +1056,25 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
 
 
 def journal_rig_time(root: Path) -> float:
-    """The rig time a session's journal accounts for: each run's last image's start on that
-    run's clock plus its light, settle and capture (a run's clock starts at 0, so a drop in
-    ``rig_start_s`` marks the next run). A lower bound of the session's time that a run killed
-    outright (which recorded no time of its own) still counts in."""
+    """The rig time a session's journal accounts for (:func:`rig_time_of_records`): a lower
+    bound of the session's time that a run killed outright (which recorded no time of its own)
+    still counts in."""
+    return rig_time_of_records(scan_journal(Path(root)).records)
+
+
+def rig_time_of_records(records: list[dict[str, Any]]) -> float:
+    """Each run's last image's start on that run's clock plus its light, settle and capture,
+    summed over runs (pure). A run's clock starts at 0 with its first image, so a start that
+    does not grow marks the next run."""
     total, last_start, last_end = 0.0, -1.0, 0.0
-    for rec in scan_journal(Path(root)).records:
+    for rec in records:
         try:
             start = float(rec["rig_start_s"])
-            end = start + sum(
-                float(rec.get(k) or 0.0) for k in ("light_s", "settle_s", "capture_s")
-            )
+            parts = ("light_s", "settle_s", "capture_s")
+            end = start + sum(float(rec.get(k) or 0.0) for k in parts)
         except (KeyError, TypeError, ValueError):
             continue
-        if start < last_start:  # the next run's clock
+        if start <= last_start:  # the next run's clock (its first image starts at 0.0)
             total += last_end
         last_start, last_end = start, end
     return total + last_end

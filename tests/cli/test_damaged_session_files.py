@@ -67,6 +67,7 @@ def test_a_manifest_that_is_no_object_is_named_not_a_traceback(
     assert r.exit_code == 0, r.output
     verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
     assert "not checked against their capture checksums (manifest.json unreadable)" in verdict
+    assert "restore manifest.json from a backup copy" in verdict  # not the journal
 
 
 def test_a_missing_journal_is_said_by_the_verdict_and_export_lp(
@@ -181,3 +182,22 @@ def test_a_new_session_into_a_finished_one_is_not_offered_a_resume(session: Path
     text = said(r)
     assert r.exit_code != 0 and "is not empty" in text, text
     assert "--resume" not in text and "it holds a finished session: fit it with" in text
+
+
+def test_reshoot_lost_does_not_vouch_for_what_it_cannot_check(
+    session: Path, tmp_path: Path
+) -> None:
+    """Found by a review: with image_006's journal line damaged and its files deleted,
+    --reshoot-lost answered "every image is as captured"."""
+    s = _copy(session, tmp_path)
+    journal = s / "journal.jsonl"
+    lines = journal.read_text().splitlines(keepends=True)
+    journal.write_text("".join(lines[:5]) + lines[5][:40] + "\n" + "".join(lines[6:]))
+    (s / "image_006.jpg").unlink()
+    (s / "linear" / "image_006.tif").unlink()
+    r = runner.invoke(app, ["run", "--resume", str(s), "--reshoot-lost"])
+    text = said(r)
+    assert r.exit_code == 2 and "every image is as captured" not in text, text
+    assert "image_006 cannot be checked (journal.jsonl line 6 unreadable)" in text
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code != 0 and "image_006" in said(r), said(r)  # lights.lp lists it: named

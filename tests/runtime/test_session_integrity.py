@@ -536,3 +536,17 @@ def test_plan_with_too_many_lights_is_refused_before_it_is_matched(tmp_path: Pat
     )
     assert r.exit_code == 2, r.output
     assert "1000" in said(r)
+
+
+def test_the_journal_time_counts_a_killed_run_of_one_image() -> None:
+    """Each run's first image starts at 0.0 on its clock: a killed run that journaled one image
+    had been merged into the next and its time dropped."""
+    from rti_rig.runtime.session import rig_time_of_records
+
+    def rec(start: float) -> dict[str, float]:
+        return {"rig_start_s": start, "light_s": 0.1, "settle_s": 0.2, "capture_s": 0.7}
+
+    one_run = [rec(0.0), rec(1.0), rec(2.0)]
+    assert rig_time_of_records(one_run) == pytest.approx(3.0)
+    killed_after_one = [rec(0.0), rec(0.0), rec(1.0)]  # run 1: one image; run 2: two
+    assert rig_time_of_records(killed_after_one) == pytest.approx(1.0 + 2.0)

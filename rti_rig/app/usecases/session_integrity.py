@@ -20,6 +20,7 @@ from rti_rig.reconstruct.qa import LESS_EXPOSURE, QAReport
 from rti_rig.runtime.session import (
     JOURNAL,
     LP_NAME,
+    MANIFEST,
     files_lost_since_capture,
     image_names,
     lost_image_advice,
@@ -142,7 +143,8 @@ def _with_unchecked(qa: QAReport, source: Path) -> QAReport:
     note = (
         f"{shown} not checked against {'its' if len(unchecked) == 1 else 'their'} capture "
         f"checksum{'' if len(unchecked) == 1 else 's'} ({why}): a change since capture would go "
-        f"unseen; restore {JOURNAL} from a backup copy of the folder"
+        f"unseen; restore {MANIFEST if MANIFEST in why else JOURNAL} from a backup copy of the "
+        "folder"
     )
     return replace(qa, integrity_note=note)
 

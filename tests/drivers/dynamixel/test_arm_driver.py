@@ -203,6 +203,31 @@ def test_a_shutdown_fault_is_reported_limp_as_read() -> None:
     assert "the arm may sag" in str(stop.value)
 
 
+def test_a_faulted_servo_whose_torque_cannot_be_read_is_not_called_held() -> None:
+    """Found by a review: with Torque Enable unreadable after an alert, the stop wrote a goal
+    to the servo and counted it held — while it had shut down, limp."""
+    from rti_rig.drivers.dynamixel.faults import CommunicationError
+
+    arm, emu, _clock = make_arm()
+    arm.connect()
+    emu.servos[1].inject_hardware_error(ct.HardwareFault.OVERLOAD)  # torque really off
+    real_read = arm._bus.read
+
+    def read(dxl_id, reg, check_alert=True):  # type: ignore[no-untyped-def]
+        if reg is ct.TORQUE_ENABLE:
+            raise CommunicationError("arm", "COMM_RX_TIMEOUT", f"read {reg.name}", dxl_id)
+        return real_read(dxl_id, reg, check_alert)
+
+    arm._bus.read = read  # type: ignore[method-assign]
+    with pytest.raises(
+        DynamixelError, match=r"stop incomplete: servo 2 \(elevation\) held"
+    ) as stop:
+        arm.stop()
+    text = str(stop.value)
+    assert "azimuth" in text and "could not be read" in text
+    assert "servo 1 (azimuth) held" not in text
+
+
 def test_a_stop_holds_an_arm_found_inside_the_keep_out_cone() -> None:
     """A hold is no move: an arm found inside the cone (an overshoot, a push by hand) is held
     where it is. The stop had sent its hold through the move gate, which refused it, and left

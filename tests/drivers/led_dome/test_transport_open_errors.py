@@ -34,3 +34,11 @@ def test_a_port_another_program_holds_says_so() -> None:
         holder.close()
         os.close(main)
         os.close(sub)
+
+
+def test_a_missing_port_whose_path_says_lock_is_not_called_held(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """The word "lock" in the path had made a missing port "held by another program"."""
+    port = str(tmp_path / "usb-Blocksmith_dome")
+    with pytest.raises(TransportError) as info:
+        SerialTransport(port).open()
+    assert str(info.value).endswith("No such file or directory")
