@@ -195,10 +195,15 @@ class EmulatedServo:
     def inject_hardware_error(self, bits: int) -> None:
         """Set Hardware Error Status bits; shut down only for the bits Shutdown selects.
 
-        e-manual, Shutdown (63): a detected error sets its bit in Hardware Error Status and the
-        Alert flag of every status packet; only if the bit is also set in Shutdown does Torque
-        Enable go to 0 (motion stops), and then only a Reboot lets torque back on. The factory
-        Shutdown (0x34) does not select an input-voltage error: the servo keeps driving."""
+        e-manual, X-series control table: Max/Min Voltage Limit (32/34) — "Input Voltage Error
+        Bit(0x01) and Hardware Error Bit(0x80) in the Hardware Error Status(70) are set. If
+        Input Voltage Error Bit is configured in the Shutdown(63), Torque Enable(64) is cleared";
+        Temperature Limit (31) says the same of overheating. So an error sets its bit and the
+        Alert flag of every status packet, and only a bit Shutdown selects clears Torque Enable
+        (motion stops; then only a Reboot lets torque back on). The factory Shutdown modelled is
+        0x34 for every model (XL430/XM430's, hardware notes), which does not select an
+        input-voltage error; an XL330 reportedly ships with 0x35 (a third-party bench note, not
+        verified), which does — set it with ``_set(ct.SHUTDOWN, ...)`` to model one."""
         bits &= 0xFF
         self.table[ct.HARDWARE_ERROR_STATUS.address] |= bits
         if bits & self.get(ct.SHUTDOWN):
