@@ -295,9 +295,15 @@ def _file_cell(r: Row) -> str:
     return f"{r.file_psnr_db:.1f} dB ({r.file_model})"
 
 
-def bench_from(lp: Path, out_dir: Path | None, progress: Callable[[str], None] = print) -> str:
+def bench_from(
+    lp: Path,
+    out_dir: Path | None,
+    progress: Callable[[str], None] = print,
+    force: bool = False,
+) -> str:
     """Run, write results.csv, the plots and summary.md into ``out_dir`` (nothing written when
-    it is None: the summary is only returned); return the summary."""
+    it is None: the summary is only returned); return the summary (its command line says
+    ``--force`` when the folder's files were replaced with it)."""
     t0 = time.perf_counter()
     rows, held = run_tradeoff_from(lp, progress)
     command = f"rti-rig bench tradeoff --from {lp}"
@@ -308,6 +314,7 @@ def bench_from(lp: Path, out_dir: Path | None, progress: Callable[[str], None] =
     for path in plot(rows, out_dir):
         if "arm_time" in path.name:  # a replayed acquisition is a dome: no arm time to plot
             path.unlink()
-    text = summarise_from(rows, time.perf_counter() - t0, f"{command} --out {out_dir}", held)
+    command += f" --out {out_dir}" + (" --force" if force else "")
+    text = summarise_from(rows, time.perf_counter() - t0, command, held)
     (out_dir / "summary.md").write_text(text + "\n", encoding="utf-8")
     return text

@@ -26,10 +26,12 @@ def main() -> None:
         sys.stderr.write("rti-rig: stopped (Ctrl-C)\n")
         raise SystemExit(INTERRUPTED_EXIT) from None
     except SystemExit as exc:
-        if exc.code == INTERRUPTED_EXIT and _from_keyboard_interrupt(exc):
+        if _from_keyboard_interrupt(exc):
             # typer turns a Ctrl-C no command handled (its options still being parsed, a
-            # command with nothing to make safe) into exit 130 without a word
+            # command with nothing to make safe) into exit 130 without a word (older typer:
+            # "Aborted!" and exit 1): said, and the shell's code for a Ctrl-C either way
             sys.stderr.write("rti-rig: stopped (Ctrl-C)\n")
+            raise SystemExit(INTERRUPTED_EXIT) from None
         raise
 
 

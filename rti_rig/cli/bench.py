@@ -165,7 +165,9 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
     if from_lp is not None:
         try:
             from_lp = _acquisition_lp(from_lp)
-            text = bench_from(from_lp, out_dir, lambda msg: out.print(msg, highlight=False))
+            text = bench_from(
+                from_lp, out_dir, lambda msg: out.print(msg, highlight=False), force=force
+            )
         except RtiRigError as exc:
             raise fail(exc) from None
         except ValueError as exc:

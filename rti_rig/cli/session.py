@@ -210,8 +210,10 @@ def run(
                 print_note,
             )
     except RtiRigError as exc:
+        for failure in getattr(exc, "teardown_failures", None) or ():  # metering's
+            err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
         raise fail(exc) from None
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
         # had been 130 with no word at all
         if resume is not None:
@@ -224,8 +226,13 @@ def run(
                 "Stopped (Ctrl-C) before the first image: nothing was captured or written to "
                 f"{out_dir}"
             )
+        for failure in getattr(exc, "teardown_failures", None) or ():
+            err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
         if auto_exposure:
-            said += "; metering, if it had begun, sent its all-off on the way out: check the lights"
+            said += (
+                "; metering, if it had begun, attempted an all-off on its way out: check the "
+                "rig's lights"
+            )
         err.print(f"[yellow]{escape(said)}.[/]")
         raise typer.Exit(code=130) from None
     _execute(opened)

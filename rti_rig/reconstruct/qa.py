@@ -168,6 +168,9 @@ class QAReport:
     #: What the session's kind allows of the advice (a replay or an adaptive session cannot
     #: reshoot one image), set by the application; empty for a session that can.
     session_note: str = ""
+    #: The verdict's word for images with problems: "reshoot", or what fits a session that
+    #: cannot reshoot (a replayed acquisition's images are the recording's: "flawed").
+    verdict_word: str = "reshoot"
 
     @property
     def caveats(self) -> list[str]:
@@ -208,7 +211,7 @@ class QAReport:
         if self.good:
             return "good" + tail
         parts = [f"{c.name} ({'; '.join(c.problems)})" for c in self.reshoot]
-        return "reshoot: " + ", ".join(parts) + tail
+        return f"{self.verdict_word}: " + ", ".join(parts) + tail
 
     def to_json(self) -> dict[str, Any]:
         return {

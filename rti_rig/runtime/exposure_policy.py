@@ -41,17 +41,25 @@ def fix_session_exposure(rig: Rig, schedule: LightSchedule, meter: Meter) -> Lig
     """
     validate_schedule(rig, schedule)
     i = brightest_step(schedule)
+
+    def teardown() -> list[str]:
+        # every step of the teardown runs, whatever one device does; what failed is said
+        return rig.lighting.safe() + attempt_all(
+            [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
+        )
+
     try:
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.set(schedule.steps[i])
         rig.clock.sleep(rig.timing.settle_s)
         choice = meter(rig.camera, rig.camera_config.exposure_s)
-    finally:
-        # every step of the teardown runs, whatever one device does; what failed is said
-        failures = rig.lighting.safe() + attempt_all(
-            [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
-        )
+    except BaseException as exc:
+        # a Ctrl-C or an error while metering: what the teardown could not do travels with it
+        # (it had been dropped, and the user told an all-off was sent)
+        exc.teardown_failures = teardown()  # type: ignore[attr-defined]
+        raise
+    failures = teardown()
     if failures:
         raise DeviceError(
             rig.name,

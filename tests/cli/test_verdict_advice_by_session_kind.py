@@ -32,6 +32,7 @@ def test_a_replayed_acquisition_is_not_told_to_reshoot_with_less_exposure(tmp_pa
     assert "reshoot with less exposure" not in text
     assert "clipped in the recording (a replayed acquisition cannot be reshot)" in text
     assert "this session replays a recorded acquisition" in text
+    assert "QA verdict: flawed: image_" in text and "QA verdict: reshoot" not in text
 
 
 @pytest.mark.pty

@@ -95,3 +95,18 @@ def test_a_teardown_that_fails_after_metering_is_an_error_not_silence(tmp_path: 
     with pytest.raises(DeviceError, match=expected):
         fix_session_exposure(rig, schedule, lambda camera, start_s: Choice())
     assert closed == ["lights"]
+
+
+def test_a_stop_during_metering_carries_what_the_teardown_could_not_do(tmp_path: Path) -> None:
+    """A Ctrl-C while metering had dropped the teardown's failures, and the user was told an
+    all-off had been sent."""
+    rig = build_rig(load_rig_config(write_config(tmp_path, SMALL_DOME)))
+    schedule = plan_uniform(rig.geometry, 6)
+    rig.lighting.safe = lambda emergency=False: ["all LEDs off: no reply"]  # type: ignore[method-assign]
+
+    def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        fix_session_exposure(rig, schedule, meter)
+    assert stopped.value.teardown_failures == ["all LEDs off: no reply"]  # type: ignore[attr-defined]

@@ -72,7 +72,9 @@ def _with_session_kind(qa: QAReport, source: Path) -> QAReport:
         manifest = read_manifest(source)
     except RtiRigError:
         return qa
+    word = "reshoot"
     if (manifest.get("rig") or {}).get("backend") == "replay":
+        word = "flawed"  # "reshoot: …" headed advice that said it could not be
         advice = "clipped in the recording (a replayed acquisition cannot be reshot)"
         note = (
             "this session replays a recorded acquisition: the problems named are the "
@@ -90,7 +92,7 @@ def _with_session_kind(qa: QAReport, source: Path) -> QAReport:
         replace(c, problems=tuple(p.replace(LESS_EXPOSURE, advice) for p in c.problems))
         for c in qa.images
     )
-    return replace(qa, images=images, session_note=note if qa.reshoot else "")
+    return replace(qa, images=images, session_note=note if qa.reshoot else "", verdict_word=word)
 
 
 #: How a session that did not finish ended, as the manifest's finish_reason records it.
