@@ -1,29 +1,46 @@
-"""A Ctrl-C while `rti-rig` is still importing its command line ends without a traceback."""
+"""A Ctrl-C that no command handles ends in one line and exit 130, never a traceback or silence.
+
+The Ctrl-C is raised where it would land, by a finder that interrupts the import of a named
+module: the command line's own import (the first tenths of a second), a command's lazy import
+(a command with nothing to make safe), or the composition root (while a session's rig opens).
+"""
 
 import subprocess
 import sys
+from pathlib import Path
 
-# Raise KeyboardInterrupt exactly where a Ctrl-C in the first tenths of a second lands: in the
-# import of the command line, before any command runs.
-_INTERRUPT_THE_IMPORT = """
+REPO = Path(__file__).resolve().parents[2]
+
+_INTERRUPTED_RUN = """
 import sys
+
+module, argv = sys.argv[1], sys.argv[2:]
 
 class Interrupt:
     def find_spec(self, name, path=None, target=None):
-        if name == "rti_rig.cli":
+        if name == module:
             raise KeyboardInterrupt
         return None
 
+sys.argv = ["rti-rig", *argv]
 sys.meta_path.insert(0, Interrupt())
 from rti_rig.launch import main
 main()
 """
 
 
-def test_ctrl_c_during_the_import_says_nothing_was_done() -> None:
-    done = subprocess.run(
-        [sys.executable, "-c", _INTERRUPT_THE_IMPORT], capture_output=True, text=True, timeout=60
+def interrupted(module: str, *argv: str) -> subprocess.CompletedProcess[str]:
+    """``rti-rig ARGV`` with a Ctrl-C at the import of ``module``."""
+    return subprocess.run(
+        [sys.executable, "-c", _INTERRUPTED_RUN, module, *argv],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
+
+
+def test_ctrl_c_during_the_import_says_nothing_was_done() -> None:
+    done = interrupted("rti_rig.cli", "--help")
     assert done.returncode == 130, done.stderr
     assert "Traceback" not in done.stderr
     assert "stopped while starting" in done.stderr and "nothing was done" in done.stderr
@@ -44,28 +61,9 @@ def test_python_dash_m_runs_the_command_line() -> None:
     assert "run" in done.stdout and "plan" in done.stdout
 
 
-# A Ctrl-C inside a command that does not handle it (here export-lp, in its own import): typer
-# turns it into exit 130 without a word; the entry point says it stopped.
-_INTERRUPT_A_COMMAND = """
-import sys
-
-class Interrupt:
-    def find_spec(self, name, path=None, target=None):
-        if name == "rti_rig.app.usecases.export":
-            raise KeyboardInterrupt
-        return None
-
-sys.argv = ["rti-rig", "export-lp", "nowhere", "--out", "nowhere.lp"]
-sys.meta_path.insert(0, Interrupt())
-from rti_rig.launch import main
-main()
-"""
-
-
 def test_ctrl_c_in_a_command_that_does_not_handle_it_is_said() -> None:
-    done = subprocess.run(
-        [sys.executable, "-c", _INTERRUPT_A_COMMAND], capture_output=True, text=True, timeout=60
-    )
+    """typer turns it into exit 130 without a word; the entry point says it stopped."""
+    done = interrupted("rti_rig.app.usecases.export", "export-lp", "nowhere", "--out", "x.lp")
     assert done.returncode == 130, done.stderr
     assert "Traceback" not in done.stderr
     assert done.stderr.strip() == "rti-rig: stopped (Ctrl-C)"
@@ -91,34 +89,11 @@ def test_a_command_s_own_exit_130_is_not_said_twice() -> None:
         assert _from_keyboard_interrupt(typers)
 
 
-_INTERRUPT_THE_RIG_OPENING = """
-import sys
-
-class Interrupt:
-    def find_spec(self, name, path=None, target=None):
-        if name == "rti_rig.app.compose":  # imported as the rig is built
-            raise KeyboardInterrupt
-        return None
-
-sys.argv = ["rti-rig", "run", sys.argv[1], "--out", sys.argv[2], "--lights", "4"]
-sys.meta_path.insert(0, Interrupt())
-from rti_rig.launch import main
-main()
-"""
-
-
-def test_ctrl_c_while_the_rig_opens_says_nothing_was_captured(tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_ctrl_c_while_the_rig_opens_says_nothing_was_captured(tmp_path: Path) -> None:
     """It had exited 130 with no word at all."""
-    from pathlib import Path
-
-    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    cfg = REPO / "rig_configs" / "simulated_dome.toml"
     out = tmp_path / "s"
-    done = subprocess.run(
-        [sys.executable, "-c", _INTERRUPT_THE_RIG_OPENING, str(cfg), str(out)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    done = interrupted("rti_rig.app.compose", "run", str(cfg), "--out", str(out), "--lights", "4")
     assert done.returncode == 130, done.stderr
     text = " ".join(done.stderr.split())
     assert "Traceback" not in text
