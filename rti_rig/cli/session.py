@@ -210,8 +210,7 @@ def run(
                 print_note,
             )
     except RtiRigError as exc:
-        for failure in getattr(exc, "teardown_failures", None) or ():  # metering's
-            err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
+        _print_failures(getattr(exc, "teardown_failures", None))  # metering's
         raise fail(exc) from None
     except KeyboardInterrupt as exc:
         # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
@@ -226,8 +225,7 @@ def run(
                 "Stopped (Ctrl-C) before the first image: nothing was captured or written to "
                 f"{out_dir}"
             )
-        for failure in getattr(exc, "teardown_failures", None) or ():
-            err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
+        _print_failures(getattr(exc, "teardown_failures", None))
         if auto_exposure:
             said += (
                 "; metering, if it had begun, attempted an all-off on its way out: check the "
@@ -264,8 +262,12 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
 def _print_teardown_failures(folder) -> bool:  # type: ignore[no-untyped-def]
     """What could not be made safe when a session stopped early (the controller records it in
     the manifest; the lights' state line that follows refers to it); True if any."""
-    failures = (folder.manifest.get("runner") or {}).get("teardown_failures") or []
-    for failure in failures:
+    return _print_failures((folder.manifest.get("runner") or {}).get("teardown_failures"))
+
+
+def _print_failures(failures) -> bool:  # type: ignore[no-untyped-def]
+    """Each teardown failure on its own line; True if there was any."""
+    for failure in failures or ():
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
     return bool(failures)
 
@@ -538,7 +540,7 @@ def export_lp(
         )
     if done.unchecked:
         err.print(
-            f"[yellow]note:[/] left out, on disk but not verifiable as captured "
+            f"[yellow]note:[/] left out, not verifiable as captured "
             f"({escape(done.unchecked_why)}): {escape(', '.join(done.unchecked))}",
             soft_wrap=True,
         )

@@ -32,7 +32,7 @@ class ExportedLp:
     #: The file is not in the session folder, so its image names (relative to the session
     #: folder) do not resolve beside it, where relight, RTIBuilder and ``rti-rig fit`` look.
     outside_session: bool = False
-    #: Images on disk that no readable journal record vouches for (not in the file), and why.
+    #: Images no readable journal record vouches for (not in the file), and why.
     unchecked: list[str] = field(default_factory=list)
     unchecked_why: str = ""
 

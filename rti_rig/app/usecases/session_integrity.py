@@ -42,8 +42,12 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             return qa
         source = source.parent
     qa = _with_unchecked(qa, source)
-    qa = _with_session_kind(qa, source)
-    qa = _with_unfinished(qa, source)
+    try:
+        manifest = read_manifest(source)  # once, for what the session's kind and end allow
+    except RtiRigError:
+        manifest = None
+    if manifest is not None:
+        qa = _with_unfinished(_with_session_kind(qa, manifest), source, manifest)
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
@@ -64,14 +68,10 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     return replace(qa, images=tuple(images))
 
 
-def _with_session_kind(qa: QAReport, source: Path) -> QAReport:
+def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignore[type-arg]
     """``qa`` with its advice fitted to what the session can do: a replayed acquisition cannot
     be reshot, and an adaptive one cannot reshoot one image ("reshoot with less exposure" had
     been the advice to both, which neither could follow)."""
-    try:
-        manifest = read_manifest(source)
-    except RtiRigError:
-        return qa
     word = "reshoot"
     if (manifest.get("rig") or {}).get("backend") == "replay":
         word = "flawed"  # "reshoot: …" headed advice that said it could not be
@@ -107,13 +107,9 @@ _ENDED = {
 }
 
 
-def _with_unfinished(qa: QAReport, source: Path) -> QAReport:
+def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  # type: ignore[type-arg]
     """``qa`` with a caveat for a session that did not finish: its verdict judges the images
     taken so far, and a "good" there had read as a session to fit and archive."""
-    try:
-        manifest = read_manifest(source)
-    except RtiRigError:
-        return qa
     runner = manifest.get("runner") or {}
     reason = runner.get("finish_reason")
     if reason == "completed":
