@@ -165,14 +165,14 @@ def select_model(
             results[name] = (float(np.sqrt(sse / max(count, 1))), regularised, "")
     fitted = {k: v[0] for k, v in results.items() if v[0] is not None}
     if not fitted:
-        fewest = min(N_COEFFICIENTS[k] for k in results) + 1  # one held out at least
-        plain = (
-            f"{stack.n} image{'s' if stack.n != 1 else ''} cannot be fitted: the simplest model "
-            f"needs at least {fewest} lit images to be fitted and checked on one left out; "
-            "shoot more lights"
-            if stack.n < fewest
-            else f"no candidate model can be fitted from {stack.n} lights"
-        )
+        simplest = min(results, key=lambda k: N_COEFFICIENTS[k])
+        fewest = N_COEFFICIENTS[simplest] + 1  # one held out at least
+        plain = f"no candidate model can be fitted from {stack.n} image(s)"
+        if stack.n < fewest:
+            plain += (
+                f": the simplest candidate ({simplest}) needs at least {fewest} lit images to "
+                "be fitted and checked on one left out; shoot more lights"
+            )
         raise ReconstructionError(
             f"{plain} (with {how}: " + "; ".join(f"{k}: {v[2]}" for k, v in results.items()) + ")"
         )

@@ -207,7 +207,7 @@ def test_a_refused_fit_leaves_nothing_so_the_corrected_command_runs(tmp_path: Pa
     r = runner.invoke(app, ["fit", str(three), "--out", str(out), "--no-qa"])
     assert r.exit_code == 2, r.output
     said = " ".join(r.output.split())
-    assert "3 images cannot be fitted: the simplest model needs at least 4" in said
+    assert "fitted from 3 image(s): the simplest candidate (lambert) needs at least 4" in said
     assert "--model ps" in r.output  # what still works, said
     assert out.is_dir() and not any(out.iterdir())
     r = runner.invoke(app, ["fit", str(three), "--out", str(out), "--model", "ps", "--no-qa"])
