@@ -38,7 +38,6 @@ LABELS = {
 #: The keys that change what the images are, not where the light comes from: a session cannot
 #: take images that differ in them, accepted or not (nothing downstream corrects for them).
 IMAGE_KEYS = ("camera_size", "exposure_s", "gain", "camera_device", "decode")
-IMAGE_LABELS = frozenset(LABELS[k] for k in IMAGE_KEYS)
 
 
 def _digest(value: Any) -> str:

@@ -391,7 +391,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
 
     Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``.
     """
-    from rti_rig.app.rig_identity import IMAGE_LABELS, identity_differences, rig_identity
+    from rti_rig.app.rig_identity import IMAGE_KEYS, identity_differences, rig_identity
 
     identity = rig_identity(loaded)
     recorded = (manifest.get("rig") or {}).get("identity")
@@ -406,7 +406,10 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             )
         return identity, []
     diffs = identity_differences(recorded, identity)
-    image_diffs = [d for d in diffs if d.split(":")[0] in IMAGE_LABELS]
+    image_diffs = identity_differences(  # the same comparison, on the image keys alone
+        {k: recorded[k] for k in IMAGE_KEYS if k in recorded},
+        {k: identity.get(k) for k in IMAGE_KEYS if k in recorded},
+    )
     if recorded.get("kind") == identity.get("kind") and image_diffs:
         # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
         # on average, with a "good" verdict; nothing downstream corrects for it
