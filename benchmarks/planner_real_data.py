@@ -37,12 +37,13 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from benchmarks.metrics import angular_error_map, relight_psnr
+from benchmarks.metrics import angular_error_map, relight_psnr, relight_ssim
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import DomeGeometry
@@ -169,6 +170,60 @@ def written_rti_psnr(
     return f"hsh{order}", relight_psnr(fitted, held_images, held_dirs, 1.0, mask)
 
 
+@dataclass(frozen=True)
+class LayoutScores:
+    """Every figure of one layout on a real acquisition (:func:`evaluate_scores`)."""
+
+    normal_mean_deg: float
+    normal_median_deg: float
+    relight_psnr_db: float
+    relight_ssim: float
+    fallback: bool  # the robust fit fell back to least squares
+
+
+def _fit_layout(
+    leds: np.ndarray,
+    images: np.ndarray,
+    dirs: np.ndarray,
+    ref: np.ndarray,
+    mask: np.ndarray,
+    model: str,
+    held: np.ndarray | None,
+) -> tuple[np.ndarray, bool, object, np.ndarray]:
+    """(normal errors on ``mask``, fallback, fitted relight model, lights to relight) of a
+    layout; the scoring of :func:`evaluate` and :func:`evaluate_scores` reads these."""
+    leds = np.asarray(sorted(int(i) for i in leds))
+    if held is not None and np.intersect1d(leds, held).size:
+        raise ValueError("a layout took a held-out light")
+    normals, fallback = subset_normals(images[leds], dirs[leds])
+    err_map = angular_error_map(normals, ref)[mask]
+    rest = np.setdiff1d(np.arange(len(dirs)), leds) if held is None else np.asarray(held)
+    return err_map, fallback, relight_model(images[leds], dirs[leds], model), rest
+
+
+def evaluate_scores(
+    leds: np.ndarray,
+    images: np.ndarray,
+    dirs: np.ndarray,
+    ref: np.ndarray,
+    mask: np.ndarray,
+    model: str,
+    held: np.ndarray | None = None,
+) -> LayoutScores:
+    """:func:`evaluate`'s figures with the median normal error and relighting SSIM.
+
+    Why: `bench tradeoff --from` writes them to a user's results.csv, where a column of NaN
+    in every row had read as a failure."""
+    err_map, fallback, mdl, rest = _fit_layout(leds, images, dirs, ref, mask, model, held)
+    return LayoutScores(
+        float(np.nanmean(err_map)),
+        float(np.nanmedian(err_map)),
+        relight_psnr(mdl, images[rest], dirs[rest], 1.0, mask),
+        relight_ssim(mdl, images[rest], dirs[rest], 1.0, mask),
+        fallback,
+    )
+
+
 def evaluate(
     leds: np.ndarray,
     images: np.ndarray,
@@ -182,15 +237,12 @@ def evaluate(
     layout ``leds``. Relighting is scored on ``held`` (indices no layout may take, the same
     for every layout compared) or, when None, on the lights this layout did not take — which
     differ between layouts, so such PSNRs compare layouts on different lights."""
-    leds = np.asarray(sorted(int(i) for i in leds))
-    if held is not None and np.intersect1d(leds, held).size:
-        raise ValueError("a layout took a held-out light")
-    normals, fallback = subset_normals(images[leds], dirs[leds])
-    err = float(np.nanmean(angular_error_map(normals, ref)[mask]))
-    rest = np.setdiff1d(np.arange(len(dirs)), leds) if held is None else np.asarray(held)
-    mdl = relight_model(images[leds], dirs[leds], model)
-    psnr = relight_psnr(mdl, images[rest], dirs[rest], 1.0, mask)
-    return err, psnr, fallback
+    err_map, fallback, mdl, rest = _fit_layout(leds, images, dirs, ref, mask, model, held)
+    return (
+        float(np.nanmean(err_map)),
+        relight_psnr(mdl, images[rest], dirs[rest], 1.0, mask),
+        fallback,
+    )
 
 
 def planned_leds(

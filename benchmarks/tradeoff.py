@@ -351,12 +351,16 @@ def best_floor(rows: Iterable[Row], scene: str) -> float:
 
 
 def write_csv(rows: list[Row], path: Path) -> Path:
+    """One line per row; a figure that does not apply (no arm on a replayed dome, no fit.rti
+    written) is an empty cell, which a spreadsheet reads as missing, not the text "nan"."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=list(asdict(rows[0])))
         writer.writeheader()
         for r in rows:
-            writer.writerow(asdict(r))
+            writer.writerow(
+                {k: "" if isinstance(v, float) and np.isnan(v) else v for k, v in asdict(r).items()}
+            )
     return path
 
 
@@ -368,9 +372,12 @@ def _series(rows: list[Row], scene: str) -> dict[str, list[Row]]:
         if r.scene != scene:
             continue
         if r.method == "uniform":
+            # when floor 0° is also the best floor, one line says so (two lines drawn on top
+            # of each other had hidden the first under the second)
             if r.floor_deg == 0.0:
-                out.setdefault("uniform", []).append(r)
-            if r.floor_deg == floor:
+                label = "uniform" if floor != 0.0 else "uniform (floor 0°, also the best here)"
+                out.setdefault(label, []).append(r)
+            elif r.floor_deg == floor:
                 out.setdefault(f"uniform, floor {floor:g}°", []).append(r)
         else:
             out.setdefault(f"{r.method} ({r.objective})", []).append(r)

@@ -39,7 +39,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from benchmarks.tradeoff import Row, plot, write_csv
+from benchmarks.tradeoff import Row, best_floor, plot, write_csv
 
 COUNTS = (6, 9, 12, 18, 24, 36, 48)
 FLOORS = (0.0, 10.0, 20.0, 30.0)
@@ -107,7 +107,7 @@ def run_tradeoff_from(
     """Rows (one per plan and N, and the row ``all``: every light not held out) for the
     acquisition ``lp``, and the names of the held-out lights; see the module docstring."""
     from benchmarks.planner_real_data import (
-        evaluate,
+        evaluate_scores,
         planned_leds,
         reference,
         written_rti_psnr,
@@ -161,7 +161,7 @@ def run_tradeoff_from(
         """One row; ``leds`` index ``keep`` (the lights not held out)."""
         chosen = keep[np.asarray(leds, dtype=int)]
         model = models_for(n)[-1]  # the richest basis n lights determine, as benchmarks.adaptive
-        err, psnr, _ = evaluate(chosen, images, dirs, ref, mask, model, held=held)
+        sc = evaluate_scores(chosen, images, dirs, ref, mask, model, held=held)
         # what the user would open: fit.rti as `rti-rig fit` (--model auto) writes it
         file_model, file_psnr = written_rti_psnr(
             images[chosen], dirs[chosen], images[held], dirs[held], mask, chosen_on=colour[chosen]
@@ -174,12 +174,12 @@ def run_tradeoff_from(
                 objective,
                 n,
                 floor,
-                err,
-                float("nan"),
+                sc.normal_mean_deg,
+                sc.normal_median_deg,
                 float(mask.mean()),
                 model,
-                psnr,
-                float("nan"),
+                sc.relight_psnr_db,
+                sc.relight_ssim,
                 t,
                 float("nan"),
                 plan_s,
@@ -207,19 +207,9 @@ def run_tradeoff_from(
     return rows, [names[i] for i in held]
 
 
-def _best_floor(rows: list[Row]) -> float:
-    """The floor with the lowest mean error over the N it could serve (every N for floor 0)."""
-    return min(
-        FLOORS,
-        key=lambda f: float(
-            np.mean([r.normal_mean_deg for r in rows if r.method == "uniform" and r.floor_deg == f])
-        ),
-    )
-
-
 def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str]) -> str:
     """The markdown summary; ``held``: the names of the held-out lights."""
-    floor = _best_floor(rows)
+    floor = best_floor(rows, rows[0].scene)  # as the plots' line: on the N every floor serves
     by = {(r.method, r.objective, r.floor_deg, r.n): r for r in rows}
     counts = sorted({r.n for r in rows if r.method != "all"})
     every = next(r for r in rows if r.method == "all")
@@ -243,6 +233,8 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
             f"| {n} | {n * PER_LIGHT_S:.0f} | "
             + " | ".join(
                 f"{r.normal_mean_deg:.2f}° / {r.relight_psnr_db:.1f} dB ({r.relight_model})"
+                if r is not None
+                else _NO_LAYOUT.format(floor=floor)
                 for r in cells
             )
             + " |"
@@ -271,13 +263,24 @@ def summarise_from(rows: list[Row], seconds: float, command: str, held: list[str
     ]
     for n in counts:
         cells = _columns(by, floor, n)
-        lines.append(f"| {n} | " + " | ".join(_file_cell(r) for r in cells) + " |")
+        lines.append(
+            f"| {n} | "
+            + " | ".join(
+                _file_cell(r) if r is not None else _NO_LAYOUT.format(floor=floor) for r in cells
+            )
+            + " |"
+        )
     lines.append(f"| all {every.n} | {_file_cell(every)} | | | | |")
     return "\n".join(lines)
 
 
-def _columns(by: dict, floor: float, n: int) -> list[Row]:  # type: ignore[type-arg]
-    """The rows of one N in the summary's column order (both tables)."""
+#: the cell of a floor with fewer lights above it than N (a high floor on a small dome)
+_NO_LAYOUT = "no layout: too few lights above {floor:g}°"
+
+
+def _columns(by: dict, floor: float, n: int) -> list[Row | None]:  # type: ignore[type-arg]
+    """The rows of one N in the summary's column order (both tables); None where the best
+    floor has too few lights above it for N (it is chosen on the N every floor serves)."""
     keys = [
         ("uniform", "normals", 0.0),
         ("uniform", "normals", floor),
@@ -285,7 +288,7 @@ def _columns(by: dict, floor: float, n: int) -> list[Row]:  # type: ignore[type-
         ("adaptive", "normals", 0.0),
         ("adaptive", "relight", 0.0),
     ]
-    return [by[(*k, n)] for k in keys]
+    return [by.get((*k, n)) for k in keys]
 
 
 def _file_cell(r: Row) -> str:

@@ -28,8 +28,12 @@ def test_tradeoff_from_a_real_acquisition(tmp_path: Path) -> None:
     assert {("optimal", 0.0), ("adaptive", 0.0), ("uniform", 0.0), ("uniform", 30.0)} <= methods
     for row in rows:
         assert 0.0 < float(row["normal_mean_deg"]) < 90.0
+        # the median and SSIM are measured (they were NaN in every row), and sensible
+        assert 0.0 < float(row["normal_median_deg"]) < 90.0
+        assert 0.0 < float(row["relight_ssim"]) <= 1.0
         assert 5.0 < float(row["relight_psnr_db"]) < 80.0
         assert float(row["dome_time_s"]) > 1.0 * int(row["n"])
+        assert row["arm_time_s"] == ""  # a replayed dome has no arm: an empty cell, not "nan"
     for name in ("normal_vs_n.png", "relight_vs_dome_time.png", "summary.md"):
         assert (out / name).stat().st_size > 0
     assert not list(out.glob("*arm_time*"))
@@ -50,13 +54,13 @@ def test_every_plan_is_scored_on_the_same_held_out_lights(monkeypatch) -> None:
     from benchmarks.tradeoff_from import run_tradeoff_from
 
     calls: list[tuple[np.ndarray, np.ndarray]] = []
-    evaluate = real.evaluate
+    evaluate = real.evaluate_scores
 
     def spy(leds, images, dirs, ref, mask, model, held=None):  # type: ignore[no-untyped-def]
         calls.append((np.asarray(leds), held))
         return evaluate(leds, images, dirs, ref, mask, model, held=held)
 
-    monkeypatch.setattr(real, "evaluate", spy)
+    monkeypatch.setattr(real, "evaluate_scores", spy)
     rows, held_names = run_tradeoff_from(ACQ, progress=lambda _m: None)
     assert len(calls) == len(rows) > 10
     held = calls[0][1]
@@ -84,13 +88,44 @@ def test_held_out_lights_follow_the_acquisitions_elevations() -> None:
     assert len(held_out_lights(dirs[:10])) == 3  # never fewer than 3
 
 
-def test_a_layout_that_took_a_held_out_light_is_refused() -> None:
-    from benchmarks.planner_real_data import evaluate
+@pytest.mark.parametrize("name", ["evaluate", "evaluate_scores"])
+def test_a_layout_that_took_a_held_out_light_is_refused(name: str) -> None:
+    import benchmarks.planner_real_data as real
 
     images = np.ones((8, 4, 4), np.float32)
     dirs = np.tile([0.0, 0.0, 1.0], (8, 1))
     with pytest.raises(ValueError, match="held-out"):
-        evaluate(np.array([0, 1, 2, 3, 4, 5]), images, dirs, None, None, "ptm", np.array([5, 6]))
+        getattr(real, name)(
+            np.array([0, 1, 2, 3, 4, 5]), images, dirs, None, None, "ptm", np.array([5, 6])
+        )
+
+
+def test_scores_agree_with_evaluate_and_the_median_is_the_median() -> None:
+    """evaluate_scores adds the median and SSIM to evaluate's mean and PSNR, from one fit."""
+    from benchmarks.planner_real_data import evaluate, evaluate_scores, reference
+    from benchmarks.tradeoff_from import load_acquisition
+
+    images, dirs, _ = load_acquisition(ACQ)
+    ref, mask = reference(images, dirs)
+    leds, held = np.array([0, 2, 4, 6, 8, 10, 12, 14, 16]), np.array([1, 9, 17])
+    sc = evaluate_scores(leds, images, dirs, ref, mask, "ptm", held=held)
+    err, psnr, fallback = evaluate(leds, images, dirs, ref, mask, "ptm", held=held)
+    assert (sc.normal_mean_deg, sc.relight_psnr_db, sc.fallback) == (err, psnr, fallback)
+    assert sc.normal_median_deg < sc.normal_mean_deg  # angle errors have a long upper tail
+    assert 0.0 < sc.relight_ssim < 1.0
+
+
+def test_a_best_floor_of_zero_is_one_line_not_two_on_top_of_each_other() -> None:
+    from benchmarks.tradeoff import Row, _series
+
+    def row(floor: float, n: int, err: float) -> Row:
+        nan = float("nan")
+        return Row("s", "uniform", "normals", n, floor, err, nan, 1.0, "ptm", 20.0, nan, n, nan, 0)
+
+    best_zero = [row(0.0, 6, 3.0), row(0.0, 9, 2.0), row(10.0, 6, 4.0), row(10.0, 9, 3.0)]
+    assert list(_series(best_zero, "s")) == ["uniform (floor 0°, also the best here)"]
+    best_ten = [row(0.0, 6, 5.0), row(0.0, 9, 4.0), row(10.0, 6, 4.0), row(10.0, 9, 3.0)]
+    assert list(_series(best_ten, "s")) == ["uniform", "uniform, floor 10°"]
 
 
 def test_tradeoff_from_too_small_an_acquisition_is_refused(tmp_path: Path) -> None:
@@ -114,3 +149,28 @@ def test_quick_with_from_is_refused_before_anything_is_written(tmp_path: Path) -
     )
     assert r.exit_code == 2 and "--quick has no effect with --from" in " ".join(r.output.split())
     assert not (tmp_path / "o").exists()
+
+
+def test_the_summary_and_the_plots_name_the_same_best_floor_even_one_short_of_a_count() -> None:
+    """The summary picked its floor on every N a floor served, the plots on the N every floor
+    serves: a high floor without the largest N (its lowest error) could be "best" in one and not
+    the other, and a best floor without a count had no cell (a KeyError)."""
+    from benchmarks.tradeoff import Row, _series
+    from benchmarks.tradeoff_from import summarise_from
+
+    nan = float("nan")
+
+    def row(method: str, floor: float, n: int, err: float, objective: str = "normals") -> Row:
+        return Row("acq/dirs.lp", method, objective, n, floor, err, err, 1.0, "ptm", 20.0, 0.5,
+                   n, nan, 0.0, "hsh1", 20.0)  # fmt: skip
+
+    rows = [row("uniform", 0.0, 6, 5.0), row("uniform", 0.0, 48, 1.0)]
+    rows += [row("uniform", 30.0, 6, 4.0)]  # better at 6; no layout of 48 above 30°
+    for n in (6, 48):
+        rows += [row("optimal", 0.0, n, 3.0), row("adaptive", 0.0, n, 3.0)]
+        rows += [row("adaptive", 0.0, n, 3.0, "relight")]
+    rows.append(row("all", 0.0, 60, 1.0))
+    assert "uniform, floor 30°" in _series(rows, "acq/dirs.lp")
+    text = summarise_from(rows, 1.0, "test", ["a.jpg", "b.jpg", "c.jpg"])
+    assert "(30°, hindsight)" in text
+    assert "no layout: too few lights above 30°" in text
