@@ -264,3 +264,23 @@ def test_an_arm_with_only_until_error_chooses_within_growing_designs_and_counts_
         assert any(c["move_s"] > 0 for c in d["best_candidates"])  # an arm's moves are counted
     stop = m["result"]["stop"]
     assert len(steps) == m["max_lights"] or stop["upper_error_deg"] <= 0.2
+
+
+def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() -> None:
+    """The reason printed the unrounded upper estimate (3.98500001 → "3.99°") and the final
+    line the recorded one (3.985 → "3.98°"): one number, two figures, in one message."""
+    from types import SimpleNamespace
+
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser, estimate_phrase
+    from rti_rig.planner.adaptive_until import upper_error_deg
+
+    fake = SimpleNamespace(upper_factor=1.95, until_error_deg=4.0, min_lights=None)
+    fake.upper = lambda e: upper_error_deg(e, 1.95)
+    fake.stop_terms = lambda e: AdaptiveChooser.stop_terms(fake, e)  # type: ignore[arg-type]
+    est = 3.98500001 / 1.95
+    assert f"{fake.upper(est):.2f}" == "3.99"  # the case: unrounded and recorded differ
+    reason = AdaptiveChooser._reached_reason(fake, est)  # type: ignore[arg-type]
+    line = estimate_phrase({**fake.stop_terms(est), "until_error_deg": 4.0})
+    shown = re.search(r"upper estimate ([\d.]+)°", line)
+    assert shown is not None and f"upper estimate {shown.group(1)}°" in reason
+    assert f"estimate {fake.stop_terms(est)['estimated_error_deg']:.2f}°" in reason

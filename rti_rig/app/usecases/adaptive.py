@@ -411,7 +411,8 @@ class AdaptiveChooser:
             else:
                 reason += (
                     f" before --until-error {self.until_error_deg:g}° was reached (upper "
-                    f"estimate {self.upper(est):.2f}°: the target is not claimed)"
+                    f"estimate {self.stop_terms(est)['upper_error_deg']:.2f}°: the target is "
+                    "not claimed)"
                 )
         return {"kind": "stop", "reason": reason, **self.stop_terms(est)}
 
@@ -425,9 +426,13 @@ class AdaptiveChooser:
         return self.min_lights is None or index >= self.min_lights
 
     def _reached_reason(self, est: float, index: int | None = None) -> str:
+        # the figures as recorded (rounded to 4 places), so that the reason and the result's
+        # line cannot print one upper estimate as 3.99° and 3.98° (3.98500… and 3.985)
+        terms = self.stop_terms(est)
         reason = (
-            f"upper estimate {self.upper(est):.2f}° (estimate {est:.2f}° × "
-            f"{self.upper_factor:g}) ≤ --until-error {self.until_error_deg:g}°"
+            f"upper estimate {terms['upper_error_deg']:.2f}° (estimate "
+            f"{terms['estimated_error_deg']:.2f}° × {self.upper_factor:g}) ≤ --until-error "
+            f"{self.until_error_deg:g}°"
         )
         if self.min_lights is not None and index == self.min_lights:
             reason += f", at the --min-lights {self.min_lights} asked for"
