@@ -156,3 +156,22 @@ def test_calibration_names_the_weakest_led_by_its_session_image(tmp_path: Path) 
     image_of = {s["led"]: s["image"] for s in steps}
     weak = int(np.argmin(TRUE_POWER))
     assert f"(LED {weak}, " in said and f"session image {image_of[weak]})" in said, said
+
+
+@pytest.mark.parametrize("lights, warned", [(2, True), (3, False)])
+def test_too_few_lights_to_fit_are_said_before_the_rig_moves(
+    tmp_path: Path, lights: int, warned: bool
+) -> None:
+    """`run --lights 1` or `2` is accepted (a test shot), but had been told only afterwards, by
+    the QA's "unavailable", that nothing can be fitted; `plan` refuses fewer than 3."""
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", str(lights)],
+        terminal_width=400,
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    note = "too few for normals or any relighting fit"
+    assert (note in text) is warned
+    if warned:
+        assert text.index(note) < text.index("Rig simulated-dome-48")  # before anything moves

@@ -190,6 +190,24 @@ def check_light_count(n: int) -> None:
         )
 
 
+def too_few_to_fit(n: int) -> Note | None:
+    """A warning for a session of fewer lights than any fit takes: accepted (a test shot of
+    one or two lights is a use), but said before the rig moves, not only by the QA afterwards."""
+    from rti_rig.core.rti_bases import N_COEFFICIENTS
+
+    fewest = N_COEFFICIENTS["lambert"]  # photometric stereo: the fewest coefficients of any fit
+    if n >= fewest:
+        return None
+    return Note(
+        f"{n} light{'s' if n != 1 else ''}: too few for normals or any relighting fit "
+        f"(photometric stereo needs {fewest}, a PTM {N_COEFFICIENTS['ptm']}); the images are "
+        "kept, but "
+        "`rti-rig fit` and the QA verdict will have nothing to fit. Fine for a test shot; for "
+        "an RTI give --lights 6 or more",
+        "warning",
+    )
+
+
 def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-untyped-def]
     """The rig, opened, with ``schedule`` checked against it before anything moves.
 
@@ -290,10 +308,14 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         for note in plan_notes:
             on_note(Note(note, "warning"))
         check_light_count(len(entries))
+        if (few := too_few_to_fit(len(entries))) is not None:
+            on_note(few)
         return schedule_from_lp(entries, geometry, str(req.plan))
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
     check_light_count(n)
+    if (few := too_few_to_fit(n)) is not None:
+        on_note(few)
     if loaded.config.backend == "replay" and n > geometry.count:  # its "LEDs" are images
         raise RtiRigError(
             f"--lights {n}: the acquisition {loaded.path} has only {geometry.count} images; "
