@@ -54,16 +54,17 @@ def interrupted(  # type: ignore[no-untyped-def]
     lights: int | None = 8,
     until: float | None = None,
     min_lights: int | None = None,
+    band: tuple[float, float] = (0.0, 90.0),
 ):
     """An adaptive session (``--lights``, ``--until-error``, design ``objective``,
-    ``--min-lights``) in ``out``, cancelled once step ``after_step`` (0-based) is committed, as
-    Ctrl-C would (tests/app and tests/cli resume it)."""
+    ``--min-lights``, the elevation ``band``) in ``out``, cancelled once step ``after_step``
+    (0-based) is committed, as Ctrl-C would (tests/app and tests/cli resume it)."""
     from rti_rig.app.config import load_rig_config
     from rti_rig.app.usecases.adaptive import open_adaptive_session
     from rti_rig.runtime.controller import CancelToken, StepCompleted, run_session
 
     rig, schedule, folder, source = open_adaptive_session(
-        load_rig_config(cfg), out, lights, until, objective, min_lights
+        load_rig_config(cfg), out, lights, until, objective, min_lights, band
     )
     cancel = CancelToken()
 

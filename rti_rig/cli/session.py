@@ -47,16 +47,17 @@ def run(
         float,
         typer.Option(
             "--min-elevation-deg",
-            help="Elevation floor of the homogeneous layout (not with --adaptive/--until-error).",
+            help="Elevation floor of the lights: of the homogeneous layout, or of every light "
+            "an adaptive session (--adaptive/--until-error) may choose.",
         ),
     ] = 0.0,
     max_elevation_deg: Annotated[
         float,
         typer.Option(
             "--max-elevation-deg",
-            help="Elevation ceiling of the homogeneous layout (90 = up to the zenith; 60 keeps "
-            "lights away from the camera axis, see 'plan --max-elevation-deg'; not with "
-            "--adaptive/--until-error).",
+            help="Elevation ceiling of the lights, as --min-elevation-deg (90 = up to the "
+            "zenith; 60 keeps lights away from the camera axis, see 'plan "
+            "--max-elevation-deg').",
         ),
     ] = 90.0,
     auto_exposure: Annotated[

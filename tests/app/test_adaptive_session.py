@@ -201,14 +201,14 @@ def test_until_error_stops_when_the_estimate_is_reached(
     [
         (["--until-error", "0"], "positive angle"),
         (["--adaptive", "--lights", "4"], "at least 5"),
-        # the band was dropped without a word: lights fired above a 45° ceiling
+        # the band is honoured, so it must hold the lights asked for, and be a band
         (
-            ["--adaptive", "--lights", "6", "--max-elevation-deg", "45"],
-            "--min-elevation-deg/--max-elevation-deg are not applied to adaptive sessions",
+            ["--adaptive", "--lights", "10", "--max-elevation-deg", "30"],
+            "--lights 10: this rig offers 8 lights between 0° and 30° elevation",
         ),
         (
-            ["--until-error", "1", "--min-elevation-deg", "30"],
-            "are not applied to adaptive sessions",
+            ["--until-error", "1", "--min-elevation-deg", "50", "--max-elevation-deg", "40"],
+            "elevation",
         ),
         # capped without a word: 100 asked of a dome ran its every LED
         (["--adaptive", "--lights", "100"], "--lights 100: this rig offers"),
@@ -515,3 +515,86 @@ def test_a_finished_adaptive_session_with_an_image_lost_says_what_to_do(
     assert "image_002 (image_002.jpg missing since capture" in verdict, verdict
     assert "an adaptive session cannot reshoot one image" in verdict
     assert "--resume" not in verdict
+
+
+def _elevations(session: Path) -> list[float]:
+    return [float(np.degrees(np.arcsin(e.direction[2]))) for e in read_lp(session / "lights.lp")]
+
+
+def _five_ring_dome(tmp_path: Path) -> Path:
+    """The shipped simulated dome (rings at 10°, 25°, 40°, 55°, 70°) with a small camera: 22
+    LEDs between 20° and 45° to choose among."""
+    text = (CONFIGS / "simulated_dome.toml").read_text()
+    return write_config(tmp_path, text.replace("width = 512", "width = 96").replace(
+        "height = 512", "height = 96"))  # fmt: skip
+
+
+@pytest.mark.parametrize("objective", ["normals", "relight"])
+def test_an_adaptive_session_keeps_to_the_elevation_band_asked_for(
+    tmp_path: Path, objective: str
+) -> None:
+    """`--max-elevation-deg 45` (a gilded object's highlights off the camera) had been refused
+    with --adaptive; before that, dropped without a word. Every light — start and decisions —
+    is now chosen in the band, the band is in the manifest, and a resume keeps to it."""
+    cfg = _five_ring_dome(tmp_path)
+    band = ["--min-elevation-deg", "20", "--max-elevation-deg", "45"]
+    ref = tmp_path / "ref"
+    args = ["--adaptive", "--lights", "8", "--objective", objective, *band]
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), *args])
+    assert r.exit_code == 0, r.output
+    el = _elevations(ref)
+    assert len(el) == 8 and all(20.0 - 1e-6 <= e <= 45.0 + 1e-6 for e in el), el
+    header = manifest(ref)["adaptive"]
+    assert (header["min_elevation_deg"], header["max_elevation_deg"]) == (20.0, 45.0)
+    # the same session without the band fires lights outside it: the band changed the choices
+    free = tmp_path / "free"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(free), "--adaptive", "--lights", "8",
+              "--objective", objective],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert any(e < 20.0 - 1e-6 or e > 45.0 + 1e-6 for e in _elevations(free))
+    # interrupted and resumed: the same lights, in the band (the manifest's band, not the CLI's)
+    cut = tmp_path / "cut"
+    interrupted(cfg, cut, after_step=5, objective=objective, band=(20.0, 45.0))
+    r = runner.invoke(app, ["run", "--resume", str(cut)])
+    assert r.exit_code == 0, r.output
+    assert (cut / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+
+
+def test_a_resume_cannot_change_the_band(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    cut = tmp_path / "cut"
+    interrupted(cfg, cut, after_step=4, band=(0.0, 45.0))
+    r = runner.invoke(app, ["run", "--resume", str(cut), "--max-elevation-deg", "60"])
+    assert r.exit_code == 2 and "drop --max-elevation-deg" in said(r)
+
+
+def test_an_adaptive_arm_session_keeps_to_the_band(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        ["run", str(CONFIGS / "virtual_arm.toml"), "--out", str(out), "--adaptive",
+         "--lights", "7", "--max-elevation-deg", "40"],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    el = _elevations(out)
+    assert len(el) == 7 and max(el) <= 40.0 + 0.5, el  # actual directions: the servos' rounding
+
+
+def test_a_session_begun_before_adaptive_sessions_took_a_band_resumes_over_every_elevation(
+    tmp_path: Path,
+) -> None:
+    """Its manifest has no band: it was chosen among every light, and continues so."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    ref = tmp_path / "ref"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--adaptive", "--lights", "8"])
+    assert r.exit_code == 0, r.output
+    cut = tmp_path / "cut"
+    interrupted(cfg, cut, after_step=5)
+    m = json.loads((cut / "manifest.json").read_text())
+    del m["adaptive"]["min_elevation_deg"], m["adaptive"]["max_elevation_deg"]
+    (cut / "manifest.json").write_text(json.dumps(m))
+    r = runner.invoke(app, ["run", "--resume", str(cut)])
+    assert r.exit_code == 0, r.output
+    assert (cut / "lights.lp").read_text() == (ref / "lights.lp").read_text()

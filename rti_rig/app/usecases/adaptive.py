@@ -610,6 +610,10 @@ def _arm_motion_settings(loaded) -> Any:  # type: ignore[no-untyped-def]
     )
 
 
+#: every elevation a rig offers: no ``--min/--max-elevation-deg`` given
+FULL_BAND = (0.0, 90.0)
+
+
 @dataclass(frozen=True)
 class AdaptivePlan:
     """What the rig can do, for the adaptive loop: candidates and the starting layout."""
@@ -620,6 +624,8 @@ class AdaptivePlan:
     max_lights: int
     #: ``--lights N``: the design is chosen for N lights as a whole; None: light by light
     design_lights: int | None = None
+    #: the elevation band (°) every light is chosen in (``--min/--max-elevation-deg``)
+    band: tuple[float, float] = FULL_BAND
 
 
 def dome_start(
@@ -648,20 +654,33 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     start_lights: int = START_LIGHTS,
     design: bool | None = None,
     objective: str = "normals",
+    band: tuple[float, float] = FULL_BAND,
 ) -> AdaptivePlan:
     """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
     homogeneous starting layout of ``start_lights``; with ``lights`` given (``design`` not
     False) the rest is chosen as a design of that many lights, starting from the objective's
-    default floor."""
+    default floor.
+
+    ``band`` (``--min/--max-elevation-deg``): only the lights between these elevations are
+    candidates, so every light of the session — the start, each decision, each design — is in
+    it (a gilded object's highlights kept off the camera by a 45° ceiling). The rig is seen as
+    that band alone: a dome as its LEDs in the band, an arm with its band cut at the ceiling."""
+    from rti_rig.planner import adaptive
+    from rti_rig.planner.uniform import arm_below
+
+    lo, hi = band
     geometry = rig.geometry
     if isinstance(geometry, DomeGeometry):
-        cands = candidates_for(geometry)
+        cands = candidates_for(geometry, lo, max_elevation_deg=hi)
         dirs, leds = cands.directions, cands.leds
         assert leds is not None
-        cap = geometry.count
+        cap = len(dirs)
+        # the band's LEDs as a dome of their own: its LED i is candidate i
+        sub = DomeGeometry(dirs, tuple(geometry.names[int(i)] for i in leds))
     else:
         assert isinstance(geometry, ArmGeometry)
-        dirs = candidates_for(geometry).directions
+        arm = arm_below(geometry, hi)
+        dirs = candidates_for(arm, lo).directions
         ok = [rig.lighting.problem(LightStep(tuple(d))) is None for d in dirs]
         dirs, leds = dirs[np.asarray(ok, dtype=bool)], None
         cap = ARM_MAX_LIGHTS
@@ -669,21 +688,18 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     k0 = min(start_lights, max_lights)
     n_design = max_lights if (lights is not None and design is not False) else None
     if isinstance(geometry, DomeGeometry):
-        chosen = dome_start(geometry, k0, n_design, objective)
-        lookup = {int(led): i for i, led in enumerate(leds)}  # type: ignore[union-attr]
-        start = [lookup[int(geometry_led)] for geometry_led in chosen]
+        start = dome_start(sub, k0, n_design, objective)
     else:
-        from rti_rig.planner import adaptive
         from rti_rig.planner.objectives import Candidates
 
         floor = START_FLOOR_DEG if n_design is None else adaptive.default_floor_for(objective)
-        targets = geometry.homogeneous(n_design or k0, floor)
+        targets = arm.homogeneous(n_design or k0, max(floor, lo))
         snapped = snap_unique(targets, Candidates(dirs, None, None))
         if n_design is not None and n_design > k0:
             pick = start_subset(dirs[np.asarray(snapped)], k0, objective=objective)
             snapped = [snapped[i] for i in pick]
         start = [int(i) for i in snapped]
-    return AdaptivePlan(dirs, leds, start, max_lights, n_design)
+    return AdaptivePlan(dirs, leds, start, max_lights, n_design, (float(lo), float(hi)))
 
 
 class AdaptiveSteps:
@@ -743,6 +759,8 @@ class AdaptiveSteps:
             "design_lights": self.plan.design_lights,
             "objective": self.objective,
             "candidates": len(self.plan.candidates),
+            "min_elevation_deg": self.plan.band[0],
+            "max_elevation_deg": self.plan.band[1],
             "fit_px": FIT_PX,
             "estimate_scale": self.chooser.scale,
             "upper_factor": self.chooser.upper_factor,
@@ -919,21 +937,33 @@ def check_min_lights(
         )
 
 
-def _check_min_within(min_lights: int, offered: int) -> None:
+def _check_min_within(
+    min_lights: int, offered: int, band: tuple[float, float] = FULL_BAND
+) -> None:
     if min_lights > offered:
         raise RtiRigError(
-            f"--min-lights {min_lights}: this rig offers {offered} lights an adaptive session "
-            f"can use; give at most {offered}"
+            f"--min-lights {min_lights}: this rig offers {offered} lights{_band_words(band)} "
+            f"an adaptive session can use; give at most {offered}"
         )
 
 
-def _check_lights_within(lights: int | None, offered: int) -> None:
+def _band_words(band: tuple[float, float]) -> str:
+    """`` between 0° and 45° elevation`` for a band asked for; nothing for every elevation."""
+    if tuple(band) == FULL_BAND:
+        return ""
+    return f" between {band[0]:g}° and {band[1]:g}° elevation"
+
+
+def _check_lights_within(
+    lights: int | None, offered: int, band: tuple[float, float] = FULL_BAND
+) -> None:
     """``--lights N`` above what the rig offers is refused, as a planned session's is (it was
     capped without a word: 100 asked of a 48-LED dome ran 48)."""
     if lights is not None and lights > offered:
+        widen = " (or widen --min/--max-elevation-deg)" if tuple(band) != FULL_BAND else ""
         raise RtiRigError(
-            f"--lights {lights}: this rig offers {offered} lights an adaptive session can "
-            f"use; give at most {offered}"
+            f"--lights {lights}: this rig offers {offered} lights{_band_words(band)} an "
+            f"adaptive session can use; give at most {offered}{widen}"
         )
 
 
@@ -944,8 +974,10 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     until_error_deg: float | None,
     objective: str = "normals",
     min_lights: int | None = None,
+    band: tuple[float, float] = FULL_BAND,
 ):
-    """Check the request and the folder, open the rig, plan the start, make the folder.
+    """Check the request and the folder, open the rig, plan the start, make the folder
+    (``band``: the elevations every light is chosen between, :func:`adaptive_plan`).
 
     Returns (rig, starting schedule, folder, step source); the rig is closed if anything after
     opening it fails.
@@ -968,19 +1000,19 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
 
     geometry = rig_geometry(loaded)
     if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
-        offered = len(candidates_for(geometry).directions)  # any port is opened
-        _check_lights_within(lights, offered)
+        offered = len(candidates_for(geometry, band[0], max_elevation_deg=band[1]).directions)
+        _check_lights_within(lights, offered, band)
         if min_lights is not None:
-            _check_min_within(min_lights, offered)
+            _check_min_within(min_lights, offered, band)
     SessionFolder.check_new(out_dir)
     warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:
-        plan = adaptive_plan(rig, lights, objective=objective)
+        plan = adaptive_plan(rig, lights, objective=objective, band=band)
         if not isinstance(geometry, DomeGeometry):  # an arm's reachable lights need the rig's
-            _check_lights_within(lights, len(plan.candidates))  # own rules
+            _check_lights_within(lights, len(plan.candidates), band)  # own rules
             if min_lights is not None:
-                _check_min_within(min_lights, len(plan.candidates))
+                _check_min_within(min_lights, len(plan.candidates), band)
         source = AdaptiveSteps(rig, plan, until_error_deg, objective, min_lights=min_lights)
         schedule = source.start_schedule()
         validate_schedule(rig, schedule)  # the starting layout, before anything moves
@@ -1101,6 +1133,11 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         header["start_lights"],
         design=header.get("design_lights") is not None,
         objective=began,
+        # absent in sessions begun before adaptive sessions took a band: every elevation
+        band=(
+            float(header.get("min_elevation_deg", FULL_BAND[0])),
+            float(header.get("max_elevation_deg", FULL_BAND[1])),
+        ),
     )
     if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
         raise RtiRigError(

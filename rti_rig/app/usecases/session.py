@@ -330,6 +330,7 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     """A new adaptive session: the starting layout, the step source and the folder."""
     from rti_rig.app.rig_identity import rig_identity
     from rti_rig.app.usecases.adaptive import open_adaptive_session
+    from rti_rig.planner.make_plan import check_elevation_band
 
     if req.plan is not None:
         raise RtiRigError("--adaptive chooses its own lights: drop --plan")
@@ -341,16 +342,9 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
             "prints 'Exposure fixed at T s'), set camera.exposure_s = T in the rig config, then "
             "run --adaptive; drop --auto-exposure"
         )
-    if req.min_elevation_deg != 0.0 or req.max_elevation_deg != 90.0:
-        # refused rather than dropped: the band was silently ignored (lights fired above a
-        # 45° ceiling asked for to keep a gilded object's highlights off the camera)
-        raise RtiRigError(
-            "--min-elevation-deg/--max-elevation-deg are not applied to adaptive sessions "
-            "(--adaptive, --until-error): they choose among every light the rig can run. "
-            "Drop them, or plan the band and run the plan: rti-rig plan PREVIEW --rig RIG "
-            "--lights N --max-elevation-deg DEG --out plan.lp, then rti-rig run RIG --out DIR "
-            "--plan plan.lp"
-        )
+    # every light of the session is chosen in the band (it had been refused: the adaptive
+    # loop chose among every light the rig can run)
+    check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     if req.lights is not None:
         check_light_count(req.lights)
     identity = rig_identity(loaded)
@@ -361,6 +355,7 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         req.until_error_deg,
         req.objective or "normals",
         req.min_lights,
+        (req.min_elevation_deg, req.max_elevation_deg),
     )
     folder.rig_identity = identity
     return OpenedSession(rig, schedule, folder, Path(req.out_dir), source=source)
