@@ -598,3 +598,27 @@ def test_a_session_begun_before_adaptive_sessions_took_a_band_resumes_over_every
     r = runner.invoke(app, ["run", "--resume", str(cut)])
     assert r.exit_code == 0, r.output
     assert (cut / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--adaptive", "--lights", "8"],
+        ["--adaptive", "--lights", "8", "--objective", "relight"],
+        ["--until-error", "2"],
+    ],
+)
+def test_a_band_below_the_starting_floor_starts_from_the_band_s_own_layout(
+    tmp_path: Path, args: list[str]
+) -> None:
+    """A ceiling of 30° over a dome whose only low ring is at 5°: the start's floor (10°, 20°)
+    is above every LED of the band; it had been "the dome has only 0 LEDs at or above 10°"."""
+    cfg = write_config(
+        tmp_path,
+        SMALL_DOME.replace("elevation_deg = 20.0, count = 8", "elevation_deg = 5.0, count = 12"),
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), *args, "--max-elevation-deg", "30"])
+    assert r.exit_code == 0, r.output
+    el = _elevations(out)
+    assert len(el) >= 4 and all(e <= 30.0 for e in el), el

@@ -628,6 +628,15 @@ class AdaptivePlan:
     band: tuple[float, float] = FULL_BAND
 
 
+def _floor_for(geometry: DomeGeometry, n: int, floor_deg: float = START_FLOOR_DEG) -> float:
+    """``floor_deg``, lowered to the elevation of the dome's ``n``-th highest LED where fewer
+    than ``n`` are above it: a band asked for (``--max-elevation-deg 15`` over a 5° ring) may
+    lie below the default floor, and the start is then the band's own layout. Unchanged
+    wherever the floor leaves ``n`` LEDs (it had been an error otherwise)."""
+    el = np.sort(np.degrees(np.arcsin(np.clip(geometry.directions[:, 2], -1.0, 1.0))))[::-1]
+    return float(min(floor_deg, el[min(n, len(el)) - 1]))
+
+
 def dome_start(
     geometry: DomeGeometry,
     k: int,
@@ -640,10 +649,11 @@ def dome_start(
     homogeneous layout of ``k`` — so that the default design is that layout exactly
     (``above_floor``: as ``start_subset``'s, for the benchmarks' variants)."""
     if n_total is None or n_total <= k:
-        return [int(i) for i in select_uniform_leds(geometry, k, START_FLOOR_DEG)]
+        return [int(i) for i in select_uniform_leds(geometry, k, _floor_for(geometry, k))]
     from rti_rig.planner import adaptive
 
-    full = select_uniform_leds(geometry, n_total, adaptive.default_floor_for(objective))
+    floor = _floor_for(geometry, n_total, adaptive.default_floor_for(objective))
+    full = select_uniform_leds(geometry, n_total, floor)
     pick = start_subset(geometry.directions[full], k, objective=objective, above_floor=above_floor)
     return [int(full[i]) for i in pick]
 
@@ -693,7 +703,9 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
         from rti_rig.planner.objectives import Candidates
 
         floor = START_FLOOR_DEG if n_design is None else adaptive.default_floor_for(objective)
-        targets = arm.homogeneous(n_design or k0, max(floor, lo))
+        # the floor within the band (a ceiling below the default floor: the band's own layout)
+        top = arm.elevation_band(lo)[1]
+        targets = arm.homogeneous(n_design or k0, min(max(floor, lo), (lo + top) / 2))
         snapped = snap_unique(targets, Candidates(dirs, None, None))
         if n_design is not None and n_design > k0:
             pick = start_subset(dirs[np.asarray(snapped)], k0, objective=objective)
