@@ -40,13 +40,58 @@ def comm_text(ph: Any, result: int) -> str:
     return f"{COMM_NAMES.get(result, result)}: {ph.getTxRxResult(result)}"
 
 
+class _ReleasingHandler:
+    """The SDK's packet handler, made safe to interrupt.
+
+    The SDK marks the port in use (``PortHandler.is_using``) when a packet goes out and clears
+    the mark only when the exchange completes. A Ctrl-C or SIGTERM raised while an exchange is
+    under way (the stop's signal handler raises in the main thread, wherever it is) leaves the
+    mark set, and every later packet — the teardown's hold, its torque-off — then fails with
+    COMM_PORT_BUSY: the stop could not reach the servos. So an exchange that is interrupted
+    releases the port as it unwinds, and the next command first discards the status reply the
+    interrupted one may still provoke (it would be read as the next command's answer)."""
+
+    def __init__(self, handler: Any, port: Any) -> None:
+        self._handler = handler
+        self._port = port
+        self._interrupted = False
+
+    def __getattr__(self, name: str) -> Any:
+        attr = getattr(self._handler, name)
+        if not callable(attr) or name == "getTxRxResult":
+            return attr
+
+        def call(*args: Any, **kwargs: Any) -> Any:
+            if self._interrupted:
+                self._recover()
+            try:
+                return attr(*args, **kwargs)
+            except BaseException:
+                self._port.is_using = False  # whatever the SDK was doing, it is not any more
+                self._interrupted = True
+                raise
+
+        return call
+
+    def _recover(self) -> None:
+        """Discard what the interrupted exchange left on the line (bounded by a short wait)."""
+        self._interrupted = False
+        self._port.is_using = False
+        log.debug("port released after an interrupted exchange; discarding a late reply")
+        try:
+            self._port.setPacketTimeout(11)
+            self._handler.rxPacket(self._port, False)
+        finally:
+            self._port.is_using = False
+
+
 class DxlBus:
     """Checked Protocol 2.0 commands over an SDK port (a ``PortHandler`` or a stand-in)."""
 
     def __init__(self, port: Any, device: str, packet_handler: Any | None = None) -> None:
         self.port = port
         self.device = device
-        self.ph = packet_handler or sdk.PacketHandler(2.0)
+        self.ph = _ReleasingHandler(packet_handler or sdk.PacketHandler(2.0), port)
         #: the line speed the port was opened at (named when a servo does not answer)
         self.baudrate: int | None = None
 

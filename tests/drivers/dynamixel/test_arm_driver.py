@@ -383,3 +383,60 @@ def test_the_documented_rig_config_validates_and_dry_runs() -> None:
     with DynamixelArm(settings, InProcessPort(emu), clock) as arm:
         arm.move_to(direction_from_az_el(-90, 45))
     assert clock.now() > 0.5
+
+
+class _Interrupt(BaseException):
+    """What the stop's signal handler raises in the main thread (EmergencyStop)."""
+
+
+def _interrupt_next_read(port: InProcessPort) -> None:
+    """The next reply is interrupted half-read, as a Ctrl-C inside the SDK's rxPacket would."""
+    read = port.readPort
+
+    def once(length: int) -> bytes:
+        port.readPort = read  # type: ignore[method-assign]
+        read(min(length, 3))
+        raise _Interrupt
+
+    port.readPort = once  # type: ignore[method-assign]
+
+
+def test_a_stop_reaches_the_servos_after_an_exchange_was_interrupted() -> None:
+    """A Ctrl-C raised inside an SDK exchange left the port marked in use: every later packet,
+    the stop's hold and torque-off among them, failed with COMM_PORT_BUSY and the arm went on
+    to its goal ("it may still be moving")."""
+    settings = arm_settings()
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    port = InProcessPort(emu)
+    arm = DynamixelArm(settings, port=port, clock=clock)
+    arm.connect()
+    goal = arm.kin.ticks_of_pose(90.0, 30.0)
+    arm._bus.write(1, ct.GOAL_POSITION, goal[0])  # on its way
+    _interrupt_next_read(port)
+    with pytest.raises(_Interrupt):
+        arm._bus.read(1, ct.PRESENT_POSITION)
+    before = len(emu.goal_log)
+    arm.stop()  # raised nothing: its packets got out
+    assert {sid for sid, _ in emu.goal_log[before:]} == {1, 2}  # both joints held
+    arm.emergency_stop()
+    assert not emu.servos[1].torque_on and not emu.servos[2].torque_on
+
+
+def test_a_late_reply_of_an_interrupted_read_is_not_the_next_answer() -> None:
+    """The interrupted exchange's status reply is discarded, not read as the next command's
+    answer (a 1-byte LED read taken for the 4-byte position)."""
+    from rti_rig.drivers.dynamixel.bus import DxlBus
+
+    clock = VirtualClock()
+    emu = emulator_for_arm(arm_settings(), clock)
+    port = InProcessPort(emu)
+    bus = DxlBus(port, "arm")
+    bus.open(57600)
+    position = bus.read(1, ct.PRESENT_POSITION)
+    emu.servos[1].table[ct.LED.address] = 1
+    _interrupt_next_read(port)
+    with pytest.raises(_Interrupt):
+        bus.read(1, ct.LED)
+    assert bus.read(1, ct.PRESENT_POSITION) == position
+    assert bus.read(1, ct.LED) == 1
