@@ -74,6 +74,8 @@ class ScriptedDomeDriver:
         #: Text heard while waiting after opening (boot banner), for the probe and messages.
         self.boot_text = ""
         self.banners_seen = 0
+        #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`)
+        self._booted = False
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -84,9 +86,19 @@ class ScriptedDomeDriver:
         except TransportError as exc:
             raise self._error(str(exc), "open port", LinkFault.DISCONNECTED) from exc
         self._open = True
+        self._booted = False
         self._rx.clear()
         self._wait_boot()
+        self._booted = True
         return self.hello()
+
+    def finish_boot(self) -> None:
+        """Wait out the boot a stopped :meth:`connect` cut short, so that what is sent next
+        reaches the firmware: bytes sent to a board still in its bootloader are lost (the
+        all-off of a stop there was, and the Nab sketch then lit every LED in ``setup()``)."""
+        if self._open and not self._booted:
+            self._wait_boot()
+            self._booted = True
 
     def close(self) -> None:
         self._open = False

@@ -248,6 +248,7 @@ class DomePolicy:
                     self.off_report = OffReport(
                         OffOutcome.NOT_SENT, "a further stop cut the all-off short"
                     )
+                    self._finish_boot()
                     self._attempt_off("after the connection was interrupted")
             finally:
                 self._quiet_close()
@@ -569,6 +570,18 @@ class DomePolicy:
             return op()
         finally:
             self.clock.sleep(max(0.0, self._link_clock.now() - t0))
+
+    def _finish_boot(self) -> None:
+        """Let a board the stop caught in its bootloader finish booting (up to the profile's
+        boot wait: 1.6 s for the Nab sketch) before the all-off, which would be lost there;
+        a link without a boot wait, or one that fails, goes straight on to the all-off."""
+        finish = getattr(self.link, "finish_boot", None)
+        if finish is None:
+            return
+        try:
+            self._counted(finish)
+        except DomeLinkError as exc:
+            log.warning("%s: waiting for the board to boot failed: %s", self.name, exc)
 
     def _attempt_off(self, when: str) -> None:
         """One all-off, whatever state the link is in; record what it established."""

@@ -253,6 +253,38 @@ def test_a_stop_during_the_handshake_of_the_lit_nab_sketch_sends_all_off() -> No
         assert "never reached" not in dome.off_report.sentence()
 
 
+def test_a_stop_while_the_board_is_still_in_its_bootloader_leaves_it_dark() -> None:
+    """SIGTERM (or a second Ctrl-C) before the board has booted: the all-off reaches the
+    bootloader and is lost, then the sketch lights every LED in setup(). The link sees the boot
+    banner and says RESET; the all-off is sent again, now to the sketch (the board had been
+    left with all its LEDs on)."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.runtime.controller import EmergencyStop
+
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        dome = build_dome(DomeSerialSettings(port=link.port, profile="nab-rti-v1"), VirtualClock())
+
+        wait_boot, stops = dome.link._wait_boot, []
+
+        def stopped_at_once():  # type: ignore[no-untyped-def]
+            if not stops:  # one signal, as the port has just opened: the board is booting
+                stops.append("SIGTERM")
+                raise EmergencyStop("SIGTERM")
+            wait_boot()
+
+        dome.link._wait_boot = stopped_at_once
+        with pytest.raises(EmergencyStop):
+            dome.connect()
+        assert any(what == "boot" for _, what in board.events)
+        # the pins float low in the bootloader, so "dark" means dark once the sketch runs
+        time.sleep(board.boot_s + 0.5)
+        assert board.lit == frozenset()
+        assert dome.off_report is not None
+        assert "rebooted" not in dome.off_report.sentence()  # the second all-off got through
+
+
 def test_a_second_stop_during_that_all_off_says_it_was_not_sent_and_closes() -> None:
     """A further signal cuts the all-off of an interrupted connection short: the port is
     still closed, and the user is told the all-off was not sent (not "never reached")."""
