@@ -212,6 +212,12 @@ def run(
             )
     except RtiRigError as exc:
         _print_failures(getattr(exc, "teardown_failures", None))  # metering's
+        state = getattr(exc, "lights_state", None)
+        if state is not None:  # metering failed: it had lit the rig; nothing was written yet
+            err.print(
+                f"{state[:1].upper()}{state[1:]}; nothing was captured or written to {out_dir}.",
+                markup=False,
+            )
         raise fail(exc) from None
     except KeyboardInterrupt as exc:
         # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
@@ -413,9 +419,19 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
 
     from rti_rig.runtime.disowned import MARKER
 
+    if result.finish_reason is FinishReason.CANCELLED:
+        from rti_rig.app.usecases.safe_state import lights_state
+
+        # what the teardown established, as a stop says it (a cancel had said nothing of the
+        # lights: not even "sent but not acknowledged" on a firmware that never confirms)
+        lights = lights_state(rig, bool(result.teardown_failures))
+        lights = f"{lights[:1].upper()}{lights[1:]}."
     if result.finish_reason is FinishReason.CANCELLED and not folder.images_kept:
         # stopped before the first image: no lights.lp to speak of, no resume for nothing
-        err.print(f"[yellow]Session cancelled.[/] {escape(_after_stop(opened, resume_hint))}")
+        err.print(
+            f"[yellow]Session cancelled.[/] {escape(lights)} "
+            f"{escape(_after_stop(opened, resume_hint))}"
+        )
         raise typer.Exit(code=130)
     marker = folder.root / MARKER
     labels = (
@@ -450,7 +466,8 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
             err.print(f"[yellow]note:[/] {escape(short)}", highlight=False)
     if result.finish_reason is FinishReason.CANCELLED:
         err.print(
-            f"[yellow]Session cancelled; the images captured so far are kept.[/] {resume_hint}"
+            f"[yellow]Session cancelled; the images captured so far are kept.[/] "
+            f"{escape(lights)} {resume_hint}"
         )
         raise typer.Exit(code=130)
 

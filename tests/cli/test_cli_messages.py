@@ -135,7 +135,7 @@ def test_a_session_cancelled_before_its_first_image_offers_no_resume(
     monkeypatch.setattr(SimulatedDome, "connect", ctrl_c_while_connecting)
     code, said, _ = _small_run(tmp_path)
     assert code == 130, said
-    assert "Session cancelled. Nothing was captured" in said, said
+    assert "Session cancelled. Lights were switched off. Nothing was captured" in said, said
     assert "--resume" not in said and "lists the lights" not in said
 
 
@@ -175,3 +175,67 @@ def test_too_few_lights_to_fit_are_said_before_the_rig_moves(
     assert (note in text) is warned
     if warned:
         assert text.index(note) < text.index("Rig simulated-dome-48")  # before anything moves
+
+
+@pytest.mark.parametrize(
+    ("config", "sentence"),
+    [
+        # a firmware that never confirms: the all-off was sent, and that is all that is known
+        ("emulated_rti_dome.toml", "All-off sent; this firmware never acknowledges"),
+        ("simulated_dome.toml", "Lights were switched off."),
+        ("virtual_arm.toml", "Lamp off and stop were requested."),
+    ],
+)
+def test_a_cancelled_session_says_what_is_known_of_the_lights(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, config: str, sentence: str
+) -> None:
+    """One Ctrl-C (cancel after the current image) had said only "Session cancelled; the
+    images captured so far are kept": nothing of the lights, where a stop says what it knows."""
+    import os
+    import signal
+
+    from rti_rig.simulator.sim_camera import SimulatedCamera
+
+    real, shots = SimulatedCamera.capture, []
+
+    def ctrl_c_at_the_third(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        shots.append(1)
+        if len(shots) == 3:
+            os.kill(os.getpid(), signal.SIGINT)
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(SimulatedCamera, "capture", ctrl_c_at_the_third)
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / config
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert "Session cancelled; the images captured so far are kept." in said
+    tail = said[said.index("Session cancelled") :]
+    assert sentence in tail, said
+
+
+def test_a_metering_failure_says_what_is_known_of_the_lights_and_that_nothing_was_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Metering lights the rig's brightest light; an error there had printed only the error."""
+    import rti_rig.drivers.cameras.exposure as exposure
+    from rti_rig.core.errors import CaptureError
+
+    def failing(camera, *args, **kwargs):  # type: ignore[no-untyped-def]
+        raise CaptureError("camera", "the camera stopped answering", "capture")
+
+    monkeypatch.setattr(exposure, "meter_exposure", failing)
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "emulated_rti_dome.toml"
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(out), "--lights", "6", "--auto-exposure"],
+        terminal_width=400,
+    )  # fmt: skip
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "the camera stopped answering" in said
+    assert "All-off sent; this firmware never acknowledges" in said
+    assert f"nothing was captured or written to {out}" in said
+    assert not out.exists()

@@ -244,7 +244,16 @@ def fix_exposure(
         shutter = getattr(camera, "available_exposures_s", None)
         return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
 
-    fixed = fix_session_exposure(rig, schedule, meter)
+    try:
+        fixed = fix_session_exposure(rig, schedule, meter)
+    except RtiRigError as exc:
+        # what metering's teardown established about the lights travels with the error (the
+        # user had been told only the error: no word of the lights metering had switched on)
+        from rti_rig.app.usecases.safe_state import lights_state
+
+        failures = getattr(exc, "teardown_failures", None)
+        exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
+        raise
     chosen = fixed.provenance["exposure"]
     on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})"))
     return fixed
