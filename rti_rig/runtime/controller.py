@@ -57,35 +57,42 @@ class CancelToken:
 
     ``cancel`` ends the session after the current step; ``pause`` holds the run between steps,
     with the lights off, until ``resume`` (or ``cancel``).
+
+    Plain flags, no lock: a Python signal handler runs in the main thread between two of its
+    bytecodes, possibly while that thread holds a ``threading.Event``'s lock inside
+    :meth:`wait_while_paused`; an ``Event.set`` in the handler then waited for that lock for
+    ever, and a SIGTERM sent with the SIGUSR1 that resumed was never acted on (a paused run
+    stopped only on two Ctrl-C).
     """
 
     def __init__(self) -> None:
-        self._cancel = threading.Event()
-        self._running = threading.Event()
-        self._running.set()
+        self._cancelled = False
+        self._paused = False
 
     def cancel(self) -> None:
-        self._cancel.set()
-        self._running.set()
+        self._cancelled = True
+        self._paused = False
 
     def pause(self) -> None:
-        self._running.clear()
+        self._paused = True
 
     def resume(self) -> None:
-        self._running.set()
+        self._paused = False
 
     @property
     def cancelled(self) -> bool:
-        return self._cancel.is_set()
+        return self._cancelled
 
     @property
     def paused(self) -> bool:
-        return not self._running.is_set()
+        return self._paused
 
-    def wait_while_paused(self, poll_s: float = 0.2) -> None:
-        """Block (in real time: a pause waits for a person) until resumed or cancelled."""
-        while not self._running.wait(poll_s):
-            pass
+    def wait_while_paused(self, poll_s: float = 0.05) -> None:
+        """Block (in real time: a pause waits for a person) until resumed or cancelled.
+
+        Sleeps, holding nothing a signal handler or another thread needs."""
+        while self._paused and not self._cancelled:
+            time.sleep(poll_s)
 
 
 @dataclass(frozen=True)
