@@ -61,6 +61,9 @@ class DynamixelArm:
         self.kin = ArmKinematics(settings)
         self._bus = DxlBus(port, settings.name, packet_handler)
         self._connected = False
+        #: whether a connect ever completed: until then no move, torque or lamp was commanded
+        #: (what a stop may truthfully say of an arm it never reached)
+        self.ever_connected = False
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal: tuple[int, int] | None = None
@@ -84,7 +87,7 @@ class DynamixelArm:
         except BaseException:
             self._bus.close()
             raise
-        self._connected = True
+        self._connected = self.ever_connected = True
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is

@@ -102,7 +102,11 @@ class DxlBus:
             ok = self.port.openPort() and self.port.setBaudRate(baudrate)
         except Exception as exc:  # pyserial raises SerialException/OSError
             raise CommunicationError(
-                self.device, f"cannot open port {self.port.getPortName()!r}: {exc}", "open"
+                self.device,
+                f"cannot open port {self.port.getPortName()!r}: {exc}; check that the arm's USB "
+                "adapter (e.g. a U2D2) is plugged in and that the rig config's [arm.dynamixel] "
+                "port names it",
+                "open",
             ) from exc
         if not ok:
             raise CommunicationError(

@@ -76,7 +76,7 @@ def check(
     except RtiRigError as exc:
         raise fail(exc) from None
     for line in report.lines():
-        out.print(line, highlight=False)
+        out.print(line, highlight=False, markup=False)  # a message may quote [a.table]
     if not report.ok:
         raise typer.Exit(code=1)
 

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import LightCarrier
+from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.lighting import attempt_all
@@ -51,6 +52,8 @@ class ArmSelfTestReport:
     aborted: str | None = None
     teardown_failures: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
+    #: the walk ended before the arm was connected: nothing was commanded
+    never_connected: bool = False
 
     @property
     def ok(self) -> bool:
@@ -81,7 +84,11 @@ class ArmSelfTestReport:
         moves = [c.move_s for c in self.checks if c.move_s is not None]
         if moves:
             out.append(f"move time: median {np.median(moves):.2f} s, longest {max(moves):.2f} s")
-        if self.aborted:
+        if self.aborted and self.never_connected:
+            # nothing was commanded: no stop or hold to speak of (it had said "stopped where it
+            # was" of an arm whose port could not even be opened)
+            out.append(f"ABORTED: {self.aborted} (the arm was not connected: nothing was moved)")
+        elif self.aborted:
             out.append(
                 f"ABORTED: {self.aborted} (not parked: the arm was stopped where it was"
                 + ("; see the teardown below)" if self.teardown_failures else ")")
@@ -142,8 +149,10 @@ def arm_self_test(
             report.aborted = f"pose '{label}' refused before moving: {reason}"
             report.elapsed_s = clock.now() - started
             return report
+    connected = False
     try:
         carrier.connect()
+        connected = True
         for label, d in poses:
             t0 = clock.now()
             try:
@@ -163,7 +172,12 @@ def arm_self_test(
             carrier.park()
             report.parked = True
     except Exception as exc:  # a self-test reports what went wrong; teardown follows
-        report.aborted = f"{type(exc).__name__}: {exc}"
+        # a device error names its device and command; anything else by its kind (the class
+        # name of our own errors had been printed to the user: "CommunicationError: arm …")
+        report.aborted = (
+            str(exc) if isinstance(exc, RtiRigError) else f"{type(exc).__name__}: {exc}"
+        )
+        report.never_connected = not connected
     except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
         report.aborted = f"stopped ({exc})"
         exc.self_test_report = report  # type: ignore[attr-defined]

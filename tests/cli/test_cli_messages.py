@@ -239,3 +239,41 @@ def test_a_metering_failure_says_what_is_known_of_the_lights_and_that_nothing_wa
     assert "All-off sent; this firmware never acknowledges" in said
     assert f"nothing was captured or written to {out}" in said
     assert not out.exists()
+
+
+def _hardware_arm(tmp_path: Path) -> Path:
+    """The shipped arm config on hardware, its port a path that does not exist."""
+    text = (Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_arm.toml").read_text()
+    text = text.replace('backend = "emulated"', 'backend = "hardware"')
+    text = text.replace('port = "emulated"', f'port = "{tmp_path / "ttyUSB9"}"')
+    text = "\n".join(line for line in text.splitlines() if not line.startswith("transport ="))
+    text = text[: text.index("[scene]")]
+    text = text.replace(
+        "exposure_s = 0.05\n",
+        f'exposure_s = 0.05\n[camera.device]\nkind = "opencv"\ndevice = "{tmp_path / "video9"}"\n'
+        'response = "srgb"\n',
+        1,
+    )
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text)
+    return cfg
+
+
+def test_an_arm_that_could_not_be_connected_is_not_said_to_be_stopped(tmp_path: Path) -> None:
+    """Its port could not be opened: nothing was sent. `check` had said "CommunicationError: …
+    (not parked: the arm was stopped where it was)" and `run` "Lamp off and stop were
+    requested"; neither said to check the adapter and the config's port."""
+    cfg = _hardware_arm(tmp_path)
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "the arm was not connected: nothing was moved" in said
+    assert "stopped where it was" not in said and "CommunicationError" not in said
+    assert "the rig config's [arm.dynamixel] port names it" in said  # the table, not eaten
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "Nothing was commanded: the arm could not be connected" in said
+    assert "Lamp off and stop were requested" not in said
+    assert "U2D2" in said and not out.exists()

@@ -25,6 +25,9 @@ def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-
         if hasattr(source, "off_report"):
             return lights_state_sentence(source)
         return "lights were switched off"  # a simulated dome: its state is the simulation's
+    if getattr(getattr(lighting, "carrier", None), "ever_connected", True) is False:
+        # the arm was never reached: no move, torque or lamp was commanded, nor could a stop be
+        return "nothing was commanded: the arm could not be connected"
     return "lamp off and stop were requested" + (
         " (see the teardown problems above)" if teardown_failed else ""
     )
