@@ -56,6 +56,12 @@ class ScriptedDomeDriver:
         )
         #: The firmware can say which LED is lit (none of the described firmwares can).
         self.can_query = False
+        #: Its connect shows the board speaks this profile (a handshake): else the first reply
+        #: will, or — for a firmware that answers nothing — nothing ever does.
+        self.identifies_itself = spec.handshake is not None
+        #: A light command is answered: else the self-test can only send it (whether the LED
+        #: lit is seen only on the dome).
+        self.light_confirmed = spec.light.reply.kind != "none"
         #: What an all-off establishes on this firmware.
         self.off_outcome = (
             OffOutcome.SELF_TIMED
