@@ -55,9 +55,9 @@ def check(
         float, typer.Option("--intensity", help="LED drive level for the walk, in (0, 1].")
     ] = 0.2,
 ) -> None:
-    """Self-test the rig's lights: a dome lights each LED in turn and reports what answered; an
-    arm visits poses spanning its band (checking where it really got to), flashes the lamp at
-    each and parks."""
+    """Self-test the rig: a dome lights each LED in turn and reports what answered; an arm
+    visits poses spanning its band (checking where it really got to), flashes the lamp at each
+    and parks; then the camera is opened and released (no image taken)."""
     from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
     from rti_rig.runtime.controller import EmergencyStop
 

@@ -1,8 +1,9 @@
-"""Use case: self-test a rig's lights before a session (``rti-rig check``).
+"""Use case: self-test a rig before a session (``rti-rig check``).
 
 A dome lights each LED in turn and reports what answered; an arm visits poses spanning its band,
 checking where it really got to, flashes its lamp at each and parks (if its config says so).
-The rig is closed — lights off, arm stopped — whatever happens.
+Then the camera is opened and released. The rig is closed — lights off, arm stopped — whatever
+happens.
 """
 
 from __future__ import annotations
@@ -55,17 +56,49 @@ def check_rig(req: CheckRequest) -> Any:
     with build_rig(loaded) as rig:
         try:
             if isinstance(rig.lighting, DomeLighting):
-                return self_test(rig.lighting.source, rig.clock, intensity=req.intensity)
+                lights = self_test(rig.lighting.source, rig.clock, intensity=req.intensity)
+                return WithCamera(lights, camera_line(rig))
             if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
-                return arm_self_test(
+                lights = arm_self_test(
                     rig.lighting.carrier,
                     rig.geometry,
                     rig.clock,
                     park=rig.lighting.park_after_session,
                 )
+                return WithCamera(lights, camera_line(rig))
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
             report = getattr(exc, "self_test_report", None)
             failures = tuple(str(f) for f in getattr(report, "teardown_failures", None) or ())
             raise CheckStopped(str(exc), lights_state(rig, bool(failures)), failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
+
+
+def camera_line(rig) -> tuple[str, bool]:  # type: ignore[no-untyped-def]
+    """Open and release the rig's camera, after the lights' walk (it takes no image: the lights
+    are off by then): the line to print and whether it connected. A check had passed a rig whose
+    camera then failed the session's first capture (gphoto2 not installed, no camera found)."""
+    try:
+        rig.camera.connect()
+    except RtiRigError as exc:
+        return f"camera: FAILED to connect: {exc}", False
+    finally:
+        rig.camera.close()
+    return f"camera: {rig.camera.name} connected (no image taken)", True
+
+
+@dataclass(frozen=True)
+class WithCamera:
+    """A lights self-test report with the camera's line before its result: a camera that does
+    not connect fails the check."""
+
+    lights: Any
+    camera: tuple[str, bool]
+
+    @property
+    def ok(self) -> bool:
+        return bool(self.lights.ok) and self.camera[1]
+
+    def lines(self) -> list[str]:
+        *body, result = self.lights.lines()
+        return [*body, self.camera[0], result if self.camera[1] else "RESULT: FAIL"]

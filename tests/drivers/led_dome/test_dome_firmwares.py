@@ -477,3 +477,18 @@ def test_a_dry_run_counts_the_time_the_firmware_really_blocks(tmp_path: Path) ->
     timing = json.loads((out / "manifest.json").read_text())["timing"]
     # at least: 2 lights and 2 all-offs (start, end), each blocking 1.5 s
     assert timing["rig_time_s"] >= 4 * 1.5
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_check_fails_a_dome_whose_camera_does_not_connect(tmp_path: Path) -> None:
+    """check walked the LEDs and said PASS; the session then failed at its first capture
+    (gphoto2 missing, no camera found). The camera is now opened and released after the walk."""
+    board = board_for("minirti")
+    with serve_on_pty(board, "minirti") as link:
+        cfg = _hardware(tmp_path, "emulated_minirti.toml", link.port)
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert "passed: 12, failed: 0" in text  # the lights were fine
+    assert "camera: FAILED to connect" in text and str(tmp_path / "v9") in text
+    assert r.output.rstrip().splitlines()[-1] == "RESULT: FAIL"
