@@ -209,9 +209,15 @@ class ProtocolSpec(_Strict):
 
     # ------------------------------------------------------------------ rendering
 
+    @property
+    def window_s(self) -> int | None:
+        """A timed firmware's on-window: ``light_on_s`` sent as whole seconds (at least 1), the
+        ``{secs}`` of the light command; None for a firmware whose LEDs stay on until told."""
+        return None if self.light_on_s is None else max(1, round(self.light_on_s))
+
     def values(self, index: int | None, lit: frozenset[int]) -> dict[str, int]:
         i = -1 if index is None else index
-        secs = 0 if self.light_on_s is None else max(1, round(self.light_on_s))
+        secs = self.window_s or 0
         return {
             "index": i + self.index_base,
             "row": i // self.columns,

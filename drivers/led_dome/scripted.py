@@ -124,7 +124,13 @@ class ScriptedDomeDriver:
             self._exchange(cmd, None, f"init command {i + 1}")
         self._position = 0
         self._lit = frozenset()
-        return DomeInfo(self.spec.name, "", self.spec.led_count)
+        # none of these firmwares says how many LEDs it has: the count is the description's
+        return DomeInfo(
+            self.spec.name,
+            "",
+            self.spec.led_count,
+            led_count_source=f"the {self.spec.name} protocol description (led_count)",
+        )
 
     # ------------------------------------------------------------------ verbs
 
@@ -140,8 +146,8 @@ class ScriptedDomeDriver:
         self._wait_window(name)
         self._exchange(self.spec.light, index, name, lit=frozenset({index}))
         self._lit = frozenset({index})
-        if self.spec.light_on_s is not None:
-            secs = max(1, round(self.spec.light_on_s))
+        secs = self.spec.window_s
+        if secs is not None:
             # the reply is printed just before the LED lights: the window starts about now
             self._window_end = self.transport.clock.now() + secs
             self._timed_led = index

@@ -506,6 +506,13 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         dirs, _ = dome_led_directions(loaded, notes)  # fail now, not when the session starts
         loaded = loaded.model_copy(update={"notes": tuple(notes)})
         serial = config.dome.serial if config.dome else None
+        if serial is not None and serial.is_described:
+            # a firmware that reports nothing: its LED count and on-window are the config's
+            # own, so a mismatch is found now, naming the key, not after the port opened
+            _check_firmware_led_count(loaded, len(dirs))
+            limit = timed_exposure_limit(loaded)
+            if limit is not None and config.camera.exposure_s > limit.max_exposure_s + 1e-9:
+                raise ConfigError(path, "camera.exposure_s", limit.refusal(config.camera))
         if serial is not None and (problem := serial.check_led_count(len(dirs))):
             key = "dome.serial.expected_led_count"
             if problem.startswith("intensity_correction"):
@@ -522,6 +529,16 @@ def load_rig_config(path: Path | str) -> LoadedRig:
                 "emulator.led_power",
                 f"{len(power)} values for {len(dirs)} LEDs: give one per LED, in LED order",
             )
+    if config.camera.device is not None and config.backend != "hardware":
+        # a dry run renders its images (the camera a simulated, emulated or replayed rig has):
+        # a real camera's table would be ignored without a word
+        raise ConfigError(
+            path,
+            "camera.device",
+            f"backend = '{config.backend}' renders its own images and does not drive a real "
+            "camera, so this table would be ignored: to shoot with that camera set backend = "
+            "'hardware'; for a dry run remove [camera.device]",
+        )
     if config.camera.device is not None:
         cam = camera_device_settings(loaded)
         if getattr(cam, "trigger", "none") == "dome_shutter" and config.kind != "dome":
@@ -532,6 +549,138 @@ def load_rig_config(path: Path | str) -> LoadedRig:
                 "arm rig let the camera fire itself (trigger = 'none')",
             )
     return loaded
+
+
+def _layout_said(dome: DomeConfig, count: int) -> str:
+    """The [dome] layout as the user wrote it, e.g. ``layout 'fibonacci' (count = 12)``."""
+    if dome.layout == "fibonacci":
+        return f"layout 'fibonacci' (count = {dome.count})"
+    if dome.layout == "lp":
+        return f"layout 'lp' ({dome.lp_file} lists {count})"
+    return f"layout 'rings' ({' + '.join(str(r.count) for r in dome.rings)} = {count})"
+
+
+def _check_firmware_led_count(rig: LoadedRig, count: int) -> None:
+    """Refuse a firmware profile's LED count that the firmware cannot drive or that differs from
+    the [dome] layout's, naming where the count came from (the firmwares report none)."""
+    from rti_rig.drivers.led_dome.dome_profiles import max_led_count
+    from rti_rig.drivers.led_dome.factory import protocol_for
+
+    dome = rig.config.dome
+    assert dome is not None and dome.serial is not None
+    serial = dome.serial
+    n = protocol_for(serial).led_count
+    if serial.led_map_file is not None:
+        key = "dome.serial.led_map_file"
+        section = f", section '{serial.led_map_section}'" if serial.led_map_section else ""
+        given = f"the LED map{section} has {n} rows (one per LED)"
+        fix = f"give the map one row per LED of the layout ({count})"
+    elif "led_count" in (serial.protocol or {}):
+        key = "dome.serial.protocol.led_count"
+        given = f"led_count = {n}"
+        fix = f"set led_count = {count}"
+    else:
+        key = "dome.serial.protocol.led_count"
+        given = f"not set, so the {serial.profile} profile's {n} applies"
+        fix = f"add led_count = {count} under [dome.serial.protocol]"
+    most = max_led_count(serial.profile)
+    if most is not None and n > most:
+        raise ConfigError(
+            rig.path,
+            key,
+            f"{given}, but the {serial.profile} firmware drives at most {most} LEDs: give the "
+            f"number of LEDs wired (at most {most}), as many as the [dome] layout lists",
+        )
+    if n != count:
+        raise ConfigError(
+            rig.path,
+            key,
+            f"{given} but [dome] {_layout_said(dome, count)} gives {count} lights: {fix} (the "
+            "LEDs wired, in the layout's order), or change the layout. The firmware reports no "
+            "count: this number is the rig config's own",
+        )
+
+
+class TimedExposureLimit(BaseModel):
+    """The longest exposure a timed firmware's self-timed on-window leaves room for.
+
+    The window (``light_on_s`` sent as whole seconds) starts when the firmware answers the light
+    command; the capture must end inside it: the all-off after each capture refuses an image
+    whose LED went dark first (``ScriptedDomeDriver._wait_window``), and a camera's capture ends
+    after the settle, the exposure, the readout and the transfer.
+    """
+
+    model_config = ConfigDict(frozen=True)
+
+    firmware: str
+    light_on_s: float
+    light_on_from_profile: bool
+    window_s: int
+    margin_s: float
+    settle_s: float
+    readout_s: float
+    transfer_s: float
+
+    @property
+    def max_exposure_s(self) -> float:
+        return self.window_s + self.margin_s - self.settle_s - self.readout_s - self.transfer_s
+
+    def window_said(self) -> str:
+        where = (
+            f"the {self.firmware} profile's light_on_s = {self.light_on_s:g}"
+            if self.light_on_from_profile
+            else f"dome.serial.protocol.light_on_s = {self.light_on_s:g}"
+        )
+        whole = "" if self.light_on_s == self.window_s else f", sent as {self.window_s} whole s"
+        return (
+            f"the {self.firmware} firmware lights each LED for {self.window_s} s ({where}{whole}) "
+            "and then switches it off by itself"
+        )
+
+    def refusal(self, cam: CameraConfig) -> str:
+        total = self.settle_s + cam.exposure_s + self.readout_s + self.transfer_s
+        need = math.ceil(total - self.margin_s - 1e-9)
+        room = self.max_exposure_s
+        fixed = self.settle_s + self.readout_s + self.transfer_s
+        shorten = (
+            f"shorten exposure_s to at most {room:.3g} s"
+            if room >= cam.min_exposure_s
+            else f"shorten the exposure and the timings (settle, readout and transfer alone take "
+            f"{fixed:.3g} s of the {self.window_s} s window)"
+        )
+        return (
+            f"{cam.exposure_s:g} s does not fit: {self.window_said()}, and each capture must end "
+            f"while its LED is lit (timing.settle_s {self.settle_s:g} + camera.exposure_s "
+            f"{cam.exposure_s:g} + timing.readout_s {self.readout_s:g} + timing.transfer_s "
+            f"{self.transfer_s:g} = {total:.3g} s from the LED lighting to the end of the "
+            f"capture); on the dome every capture would be refused. Raise "
+            f"dome.serial.protocol.light_on_s to {need} (whole seconds) or more, or {shorten}"
+        )
+
+
+def timed_exposure_limit(rig: LoadedRig) -> TimedExposureLimit | None:
+    """The exposure limit a timed firmware's on-window sets (RTIPy), or None (no such limit)."""
+    from rti_rig.drivers.led_dome.factory import protocol_for
+    from rti_rig.drivers.led_dome.scripted import TIMED_MARGIN_S
+
+    cfg = rig.config
+    serial = cfg.dome.serial if cfg.dome is not None else None
+    if serial is None or not serial.is_described:
+        return None
+    spec = protocol_for(serial)
+    if spec.window_s is None or spec.light_on_s is None:
+        return None
+    t = cfg.timing
+    return TimedExposureLimit(
+        firmware=spec.name,
+        light_on_s=spec.light_on_s,
+        light_on_from_profile="light_on_s" not in (serial.protocol or {}),
+        window_s=spec.window_s,
+        margin_s=TIMED_MARGIN_S,
+        settle_s=t.settle_s,
+        readout_s=t.readout_s,
+        transfer_s=t.transfer_s,
+    )
 
 
 def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]

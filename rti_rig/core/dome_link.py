@@ -52,6 +52,15 @@ class DomeInfo:
     firmware_id: str
     version: str
     led_count: int
+    #: Where ``led_count`` came from when the firmware did not report it (a firmware that
+    #: answers no identity: the rig config's protocol description); None: the firmware said.
+    led_count_source: str | None = None
+
+    def led_count_said(self) -> str:
+        """``the firmware reports N LEDs``, or where the count came from if not from it."""
+        if self.led_count_source is None:
+            return f"the firmware reports {self.led_count} LEDs"
+        return f"{self.led_count_source} gives {self.led_count} LEDs (the firmware reports none)"
 
 
 class DomeLink(Protocol):

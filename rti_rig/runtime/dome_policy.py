@@ -529,21 +529,17 @@ class DomePolicy:
     def _check_identity(self, info: DomeInfo) -> str | None:
         s = self.settings
         n = info.led_count
+        said = info.led_count_said()  # names where the count came from
         if n < 1:
-            return f"the firmware reports {n} LEDs"
+            return said
         if self.info is not None and n != self.info.led_count:
-            return f"the firmware now reports {n} LEDs, not {self.info.led_count}"
+            return f"{said}, not {self.info.led_count} as before"
         if s.expected_led_count is not None and n != s.expected_led_count:
-            return (
-                f"the firmware reports {n} LEDs but the rig config expects {s.expected_led_count}"
-            )
+            return f"{said} but the rig config expects {s.expected_led_count} (expected_led_count)"
         if self.directions is not None and len(self.directions) != n:
-            return f"the firmware reports {n} LEDs but the dome's .lp has {len(self.directions)}"
+            return f"{said} but the rig config's [dome] layout gives {len(self.directions)} lights"
         if s.intensity_correction is not None and len(s.intensity_correction) != n:
-            return (
-                f"intensity_correction has {len(s.intensity_correction)} factors but the "
-                f"firmware reports {n} LEDs"
-            )
+            return f"intensity_correction has {len(s.intensity_correction)} factors but {said}"
         return None
 
     def _check_on_time(self, command: str) -> None:

@@ -355,7 +355,10 @@ def test_directions_from_the_lp_must_match_the_led_count():
     assert dome.direction_of(3).tolist() == [0.0, 0.0, 1.0]
     fw2 = firmware_for(s, clock=clock, led_count=5)
     dome2 = build_dome(s, clock, transport=InProcessDomeTransport(fw2), directions=dirs)
-    with pytest.raises(DeviceError, match=r"reports 5 LEDs but the dome's \.lp has 4"):
+    with pytest.raises(
+        DeviceError,
+        match=r"the firmware reports 5 LEDs but the rig config's \[dome\] layout gives 4 lights",
+    ):
         dome2.connect()
 
 

@@ -41,6 +41,15 @@ def builtin_spec(name: str) -> dict[str, Any]:
     return _deep_copy(module.SPEC)
 
 
+def max_led_count(name: str) -> int | None:
+    """The most LEDs built-in firmware ``name`` can address (its module's ``MAX_LED_COUNT``), or
+    None where no fixed maximum is known (an LED map decides, or ``custom``)."""
+    if name not in _MODULES:
+        return None
+    module = importlib.import_module(f"{__name__}.{_MODULES[name]}")
+    return getattr(module, "MAX_LED_COUNT", None)
+
+
 def merge(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
     """``override`` laid over ``base`` table by table (the rig config's [dome.serial.protocol])."""
     out = _deep_copy(base)

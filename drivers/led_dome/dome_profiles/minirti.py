@@ -6,9 +6,12 @@ left); the dome acknowledges with the byte ``0x01``. The host waits 1.5 s after 
 bytes sent earlier get lost. All off = an all-zero mask.
 """
 
+#: The 8-byte bitmask carries 64 LEDs.
+MAX_LED_COUNT = 64
+
 SPEC = {
     "name": "minirti",
-    "led_count": 64,
+    "led_count": MAX_LED_COUNT,
     "encoding": "bytes",
     "mask_bit_order": "msb-first",
     "mask_bytes": 8,

@@ -10,9 +10,12 @@ prints a banner, which is why the init sends an all-off straight away. An unknow
 
 ALL_OFF = {"send": "<0>", "reply": {"kind": "pattern", "pattern": r"<All lights turned off\.>"}}
 
+#: The sketch drives an 8×8 matrix: ``<3,N>`` beyond LED 63 addresses no wired pin.
+MAX_LED_COUNT = 64
+
 SPEC = {
     "name": "nab-rti-v1",
-    "led_count": 64,
+    "led_count": MAX_LED_COUNT,
     "encoding": "text",
     "columns": 8,
     "baudrate": 9600,

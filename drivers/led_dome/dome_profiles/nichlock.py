@@ -12,9 +12,12 @@ in the rig config. Arduino Mega: resets when the port opens and prints a banner 
 ``For help, press 'h'`` and the prompt.
 """
 
+#: The Arduino Mega sketch steps through 192 LEDs.
+MAX_LED_COUNT = 192
+
 SPEC = {
     "name": "nichlock",
-    "led_count": 192,
+    "led_count": MAX_LED_COUNT,
     "encoding": "text",
     "baudrate": 115200,
     "boot_wait_s": 4.0,

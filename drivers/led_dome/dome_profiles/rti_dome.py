@@ -8,9 +8,12 @@ selects no driver, which leaves every LED off (and still pulses the camera). par
 USB) does not reset when the port opens.
 """
 
+#: Four shift-register drivers of 8 outputs (``M<n>`` selects none past 31).
+MAX_LED_COUNT = 32
+
 SPEC = {
     "name": "rti-dome-m",
-    "led_count": 32,
+    "led_count": MAX_LED_COUNT,
     "encoding": "text",
     "baudrate": 9600,
     "light": {"send": "M{index}", "delay_after_s": 1.5},

@@ -7,9 +7,12 @@ lights, is ``I received: <command> the instructionByte was: T`` with no line end
 "on until told off" command and no all-off: the LED goes dark by itself.
 """
 
+#: The LoLShield's 14 × 9 matrix (``T,x,y``: x 0..13, y 0..8).
+MAX_LED_COUNT = 126
+
 SPEC = {
     "name": "rtipy",
-    "led_count": 126,
+    "led_count": MAX_LED_COUNT,
     "encoding": "text",
     "columns": 14,
     "baudrate": 9600,

@@ -215,6 +215,7 @@ def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-unty
     """
     from rti_rig.app.compose import build_rig
 
+    _check_timed_window(loaded, schedule)  # before the port opens
     rig = build_rig(loaded)
     try:
         validate_schedule(rig, schedule)
@@ -224,20 +225,59 @@ def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-unty
     return rig
 
 
+def _check_timed_window(loaded, schedule: LightSchedule) -> None:  # type: ignore[no-untyped-def]
+    """Refuse a plan's own exposures that a timed firmware's on-window cannot hold (the config's
+    exposure_s is checked when the config loads)."""
+    from rti_rig.app.config import timed_exposure_limit
+    from rti_rig.core.errors import ScheduleError
+
+    limit = timed_exposure_limit(loaded)
+    if limit is None:
+        return
+    over = [
+        f"step {i + 1}: exposure {step.exposure_s:g} s"
+        for i, step in enumerate(schedule.steps)
+        if step.exposure_s is not None and step.exposure_s > limit.max_exposure_s + 1e-9
+    ]
+    if over:
+        raise ScheduleError(
+            f"{len(over)} step(s) expose longer than the {limit.max_exposure_s:.3g} s that fit: "
+            f"{limit.window_said()}, and each capture (settle + exposure + readout + transfer) "
+            f"must end while its LED is lit; nothing has moved: {'; '.join(over[:5])}"
+            f"{' ...' if len(over) > 5 else ''}"
+        )
+
+
 def fix_exposure(
     rig: Rig, schedule: LightSchedule, max_saturated: float, on_note: NoteSink = _ignore
 ) -> LightSchedule:
-    """Meter the session's exposure with the camera driver layer's test series."""
+    """Meter the session's exposure with the camera driver layer's test series.
+
+    On a timed firmware (RTIPy) the metering may choose no exposure longer than the LED's
+    self-timed window leaves room for: the camera's ``max_exposure_s`` is lowered to it, with
+    a note (a longer exposure would be refused at its capture on the dome)."""
     from rti_rig.drivers.cameras.exposure import meter_exposure
     from rti_rig.drivers.cameras.settings import ExposureRule
     from rti_rig.runtime.exposure_policy import fix_session_exposure
 
     cam = rig.camera_config
+    longest = cam.max_exposure_s
+    limit = _timed_limit(rig)
+    if limit is not None and limit.max_exposure_s < longest:
+        longest = max(limit.max_exposure_s, cam.min_exposure_s)
+        on_note(
+            Note(
+                f"Metering chooses no exposure longer than {longest:.3g} s (not the camera's "
+                f"max_exposure_s = {cam.max_exposure_s:g} s): {limit.window_said()}, and each "
+                "capture (settle + exposure + readout + transfer) must end while its LED is "
+                "lit. For longer exposures raise dome.serial.protocol.light_on_s"
+            )
+        )
     rule = ExposureRule(
         max_saturated_fraction=max_saturated,
         headroom=1.25,  # other planned lights may be a little brighter than the metered one
         min_exposure_s=cam.min_exposure_s,
-        max_exposure_s=cam.max_exposure_s,
+        max_exposure_s=longest,
     )
 
     def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
@@ -257,6 +297,12 @@ def fix_exposure(
     chosen = fixed.provenance["exposure"]
     on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})"))
     return fixed
+
+
+def _timed_limit(rig: Rig):  # type: ignore[no-untyped-def]
+    from rti_rig.app.config import LoadedRig, timed_exposure_limit
+
+    return timed_exposure_limit(rig.loaded) if isinstance(rig.loaded, LoadedRig) else None
 
 
 def _open_new(

@@ -1,0 +1,219 @@
+"""Config mistakes found by an audit through the CLI, refused when the config loads (before any
+port opens), naming the file, the key and what to do.
+
+* An RTIPy exposure longer than the LED's self-timed window passed the dry run (the emulated
+  window is counted on the wall clock, which a simulated camera does not use): a clean session
+  of images rendered fully lit, where every capture on the dome would be refused.
+* A firmware profile's ``led_count`` that differs from the [dome] layout was found only after
+  the port opened, blamed on the firmware ("the firmware reports 100 LEDs but the dome's .lp has
+  12": the Nab sketch reports nothing, and the layout was no .lp); a count above the sketch's
+  64 LEDs was not refused at all.
+* ``[camera.device]`` on a simulated or emulated rig was ignored without a word.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.app.config import load_rig_config
+from rti_rig.cli import app
+from rti_rig.core.errors import ConfigError
+
+REPO = Path(__file__).resolve().parents[2]
+CONFIGS = REPO / "rig_configs"
+runner = CliRunner()
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+def edited(tmp_path: Path, shipped: str, old: str, new: str, name: str = "rig.toml") -> Path:
+    text = (CONFIGS / shipped).read_text(encoding="utf-8")
+    assert old in text, old
+    path = tmp_path / name
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+    return path
+
+
+# ------------------------------------------------------------------ RTIPy's self-timed window
+
+
+def test_an_exposure_longer_than_the_rtipy_window_is_refused_before_the_port_opens(
+    tmp_path: Path,
+) -> None:
+    cfg = edited(tmp_path, "emulated_rtipy.toml", "exposure_s = 0.05", "exposure_s = 5.0")
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"{cfg}: key 'camera.exposure_s'" in text
+    assert "the rtipy firmware lights each LED for 2 s" in text
+    assert "dome.serial.protocol.light_on_s = 2" in text
+    assert "settle_s 0.1 + camera.exposure_s 5 + timing.readout_s 0.3" in text
+    assert "= 6.1 s" in text
+    assert "Raise dome.serial.protocol.light_on_s to 7" in text
+    assert "shorten exposure_s to at most 0.95 s" in text
+    assert not out.exists()  # refused before anything was written or opened
+    assert "Rig emulated-rtipy" not in text
+
+
+def test_the_window_counts_whole_seconds_and_the_profile_default(tmp_path: Path) -> None:
+    # light_on_s = 1.4 is sent as T,x,y,1: a 1 s window, not 1.4 s
+    cfg = edited(tmp_path, "emulated_rtipy.toml", "light_on_s = 2.0", "light_on_s = 1.4")
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    assert "for 1 s (dome.serial.protocol.light_on_s = 1.4, sent as 1 whole s)" in said(r)
+    # without the key the profile's own 2 s applies, and the message says so
+    cfg = edited(tmp_path, "emulated_rtipy.toml", "light_on_s = 2.0", "", "default.toml")
+    cfg.write_text(
+        cfg.read_text(encoding="utf-8").replace("exposure_s = 0.05", "exposure_s = 1.5"),
+        encoding="utf-8",
+    )
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    assert "the rtipy profile's light_on_s = 2" in said(r)
+
+
+def test_a_long_exposure_fits_a_window_raised_to_hold_it(tmp_path: Path) -> None:
+    cfg = edited(tmp_path, "emulated_rtipy.toml", "exposure_s = 0.05", "exposure_s = 5.0")
+    cfg.write_text(
+        cfg.read_text(encoding="utf-8").replace("light_on_s = 2.0", "light_on_s = 7.0"),
+        encoding="utf-8",
+    )
+    from rti_rig.app.config import timed_exposure_limit
+
+    loaded = load_rig_config(cfg)
+    limit = timed_exposure_limit(loaded)
+    assert limit is not None and limit.window_s == 7
+    assert limit.max_exposure_s == pytest.approx(7 + 0.05 - 0.1 - 0.3 - 0.7)
+
+
+def test_auto_exposure_meters_no_longer_than_the_window_holds(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """--auto-exposure on an RTIPy dome: the camera's max_exposure_s (30 s by default) is lowered
+    to what the window leaves room for, and the user is told; metering never picks more."""
+    import rti_rig.drivers.cameras.exposure as exposure
+    import rti_rig.runtime.exposure_policy as policy
+    from rti_rig.app.usecases.session import fix_exposure
+
+    loaded = load_rig_config(CONFIGS / "emulated_rtipy.toml")
+    assert loaded.config.camera.max_exposure_s == 30.0
+    rules = []
+
+    class Metered(Exception):
+        pass
+
+    def fake_fix(rig, schedule, meter):  # type: ignore[no-untyped-def]
+        meter(object(), 0.05)
+        raise Metered
+
+    monkeypatch.setattr(exposure, "meter_exposure", lambda cam, rule, *a: rules.append(rule))
+    monkeypatch.setattr(policy, "fix_session_exposure", fake_fix)
+
+    class FakeRig:
+        def __init__(self) -> None:
+            self.loaded = loaded
+            self.camera_config = loaded.config.camera
+
+    notes = []
+    with pytest.raises(Metered):
+        fix_exposure(FakeRig(), None, 0.001, notes.append)  # type: ignore[arg-type]
+    assert rules and rules[0].max_exposure_s == pytest.approx(0.95)
+    assert "Metering chooses no exposure longer than 0.95 s" in notes[0].text
+    assert "max_exposure_s = 30 s" in notes[0].text
+    # a dome with no self-timed window keeps the camera's own limit
+    loaded = load_rig_config(CONFIGS / "emulated_nab_rti_v1.toml")
+    notes.clear()
+    with pytest.raises(Metered):
+        fix_exposure(FakeRig(), None, 0.001, notes.append)  # type: ignore[arg-type]
+    assert rules[-1].max_exposure_s == 30.0 and not notes
+
+
+def test_a_plan_step_exposing_past_the_window_is_refused_before_the_port_opens(
+    tmp_path: Path,
+) -> None:
+    from rti_rig.app.usecases.session import checked_rig
+    from rti_rig.core.errors import ScheduleError
+    from rti_rig.core.schedule import LightSchedule, LightStep
+
+    loaded = load_rig_config(CONFIGS / "emulated_rtipy.toml")
+    step = LightStep(direction=(0.0, 0.0, 1.0), led=0, exposure_s=3.0)
+    with pytest.raises(ScheduleError, match=r"step 1: exposure 3 s") as info:
+        checked_rig(loaded, LightSchedule((step,)))
+    assert "0.95 s that fit" in str(info.value)
+
+
+# ------------------------------------------------------------------ led_count of a firmware profile
+
+
+def test_a_led_count_above_the_nab_sketchs_64_is_refused_naming_the_key(tmp_path: Path) -> None:
+    cfg = edited(tmp_path, "emulated_nab_rti_v1.toml", "led_count = 12 ", "led_count = 100 ")
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"{cfg}: key 'dome.serial.protocol.led_count': led_count = 100" in text
+    assert "the nab-rti-v1 firmware drives at most 64 LEDs" in text
+    assert "firmware reports" not in text and ".lp" not in text
+    assert "handshake" not in text  # found at load, not after the port opened
+
+
+def test_a_led_count_other_than_the_layouts_is_refused_naming_key_and_layout(
+    tmp_path: Path,
+) -> None:
+    cfg = edited(tmp_path, "emulated_nab_rti_v1.toml", "led_count = 12 ", "led_count = 8 ")
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert (
+        f"{cfg}: key 'dome.serial.protocol.led_count': led_count = 8 but [dome] layout "
+        "'fibonacci' (count = 12) gives 12 lights: set led_count = 12"
+    ) in text
+    assert "The firmware reports no count: this number is the rig config's own" in text
+    assert "handshake" not in text and ".lp has" not in text
+
+
+def test_a_led_count_left_to_the_profile_says_so(tmp_path: Path) -> None:
+    cfg = edited(tmp_path, "emulated_nab_rti_v1.toml", "led_count = 12 ", "# led_count = 12 ")
+    with pytest.raises(ConfigError) as info:
+        load_rig_config(cfg)
+    assert info.value.key == "dome.serial.protocol.led_count"
+    assert "not set, so the nab-rti-v1 profile's 64 applies" in info.value.message
+    assert "add led_count = 12 under [dome.serial.protocol]" in info.value.message
+
+
+def test_a_firmware_that_reports_no_count_is_not_said_to_report_one() -> None:
+    """The runtime check stays for firmwares that report a count; where the count is the
+    description's, the message says so."""
+    from rti_rig.core.dome_link import DomeInfo
+
+    assert DomeInfo("x", "1", 48).led_count_said() == "the firmware reports 48 LEDs"
+    said_ = DomeInfo("nab-rti-v1", "", 100, "the nab-rti-v1 protocol description").led_count_said()
+    assert said_ == "the nab-rti-v1 protocol description gives 100 LEDs (the firmware reports none)"
+
+
+# ------------------------------------------------------------------ [camera.device] on a dry run
+
+
+@pytest.mark.parametrize(
+    ("shipped", "backend"),
+    [("simulated_dome.toml", "simulated"), ("emulated_nab_rti_v1.toml", "emulated")],
+)
+def test_a_camera_device_on_a_dry_run_is_refused(
+    tmp_path: Path, shipped: str, backend: str
+) -> None:
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text(
+        (CONFIGS / shipped).read_text(encoding="utf-8") + '\n[camera.device]\nkind = "gphoto2"\n',
+        encoding="utf-8",
+    )
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"{cfg}: key 'camera.device': backend = '{backend}' renders its own images" in text
+    assert "set backend = 'hardware'" in text and "remove [camera.device]" in text
+    assert not (tmp_path / "s").exists()
