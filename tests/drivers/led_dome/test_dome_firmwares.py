@@ -114,16 +114,19 @@ def test_check_passes_on_each_firmware(profile: str) -> None:
 UNANSWERED_LIGHTS = ("elexol-24r1", "rti-dome-m")
 
 
-def _hardware(tmp_path: Path, shipped: str, port: str) -> Path:
-    """A shipped emulated config as the real dome's: backend hardware, on ``port``."""
+def _hardware(tmp_path: Path, shipped: str, port: str, camera_connects: bool = True) -> Path:
+    """A shipped emulated config as the real dome's: backend hardware, on ``port``; its camera
+    a tethering folder that exists (``camera_connects``) or a video device that does not."""
     text = (CONFIGS / shipped).read_text()
     text = text.replace('backend = "emulated"', 'backend = "hardware"')
     text = text.replace('port = "emulated"', f'port = "{port}"')
+    if camera_connects:
+        (tmp_path / "tether").mkdir(exist_ok=True)
+        device = f'kind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
+    else:
+        device = f'kind = "opencv"\ndevice = "{tmp_path / "v9"}"\nresponse = "srgb"\n'
     text = text[: text.index("[scene]")].replace(
-        "exposure_s = 0.05\n",
-        f'exposure_s = 0.05\n[camera.device]\nkind = "opencv"\ndevice = "{tmp_path / "v9"}"\n'
-        'response = "srgb"\n',
-        1,
+        "exposure_s = 0.05\n", f"exposure_s = 0.05\n[camera.device]\n{device}", 1
     )
     cfg = tmp_path / "dome.toml"
     cfg.write_text(text)
@@ -485,7 +488,7 @@ def test_check_fails_a_dome_whose_camera_does_not_connect(tmp_path: Path) -> Non
     (gphoto2 missing, no camera found). The camera is now opened and released after the walk."""
     board = board_for("minirti")
     with serve_on_pty(board, "minirti") as link:
-        cfg = _hardware(tmp_path, "emulated_minirti.toml", link.port)
+        cfg = _hardware(tmp_path, "emulated_minirti.toml", link.port, camera_connects=False)
         r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     text = said(r)
     assert r.exit_code == 1, text
