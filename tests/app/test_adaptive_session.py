@@ -594,6 +594,11 @@ def test_a_session_begun_before_adaptive_sessions_took_a_band_resumes_over_every
     interrupted(cfg, cut, after_step=5)
     m = json.loads((cut / "manifest.json").read_text())
     del m["adaptive"]["min_elevation_deg"], m["adaptive"]["max_elevation_deg"]
+    # nor any constant of the band (a public FULL_BAND had been recorded as a decision
+    # constant, and every older session refused as begun under other constants)
+    constants = m["adaptive"]["constants"]
+    for key in [k for k in constants if "BAND" in k.upper()]:
+        del constants[key]
     (cut / "manifest.json").write_text(json.dumps(m))
     r = runner.invoke(app, ["run", "--resume", str(cut)])
     assert r.exit_code == 0, r.output
@@ -622,3 +627,23 @@ def test_a_band_below_the_starting_floor_starts_from_the_band_s_own_layout(
     assert r.exit_code == 0, r.output
     el = _elevations(out)
     assert len(el) >= 4 and all(e <= 30.0 for e in el), el
+
+
+def test_an_arm_s_start_is_unchanged_where_its_floor_leaves_a_band(tmp_path: Path) -> None:
+    """The band's start-floor rule moved an arm's start whenever its reach ended below twice
+    the floor (a 30° arm, no band asked for): only a floor that leaves no band may move."""
+    from rti_rig.app.compose import build_rig
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases.adaptive import adaptive_plan
+    from rti_rig.core.geometry import az_el_from_direction
+    from rti_rig.planner.adaptive import START_FLOOR_DEG
+
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    assert "max_elevation_deg = 80.0" in text
+    cfg = write_config(
+        tmp_path, text.replace("max_elevation_deg = 80.0", "max_elevation_deg = 30.0")
+    )
+    with build_rig(load_rig_config(cfg)) as rig:
+        plan = adaptive_plan(rig, None)
+    _, el = az_el_from_direction(plan.candidates[plan.start])
+    assert min(el) >= START_FLOOR_DEG - 1.0, el  # the start's floor, as before the band

@@ -610,8 +610,11 @@ def _arm_motion_settings(loaded) -> Any:  # type: ignore[no-untyped-def]
     )
 
 
-#: every elevation a rig offers: no ``--min/--max-elevation-deg`` given
-FULL_BAND = (0.0, 90.0)
+#: every elevation a rig offers: no ``--min/--max-elevation-deg`` given. Private: the public
+#: upper-case names here are decision constants, recorded in every manifest and compared on
+#: resume (a new one refused every session begun before it); the band is the session's own,
+#: recorded as such.
+_FULL_BAND = (0.0, 90.0)
 
 
 @dataclass(frozen=True)
@@ -625,7 +628,7 @@ class AdaptivePlan:
     #: ``--lights N``: the design is chosen for N lights as a whole; None: light by light
     design_lights: int | None = None
     #: the elevation band (°) every light is chosen in (``--min/--max-elevation-deg``)
-    band: tuple[float, float] = FULL_BAND
+    band: tuple[float, float] = _FULL_BAND
 
 
 def _floor_for(geometry: DomeGeometry, n: int, floor_deg: float = START_FLOOR_DEG) -> float:
@@ -664,7 +667,7 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     start_lights: int = START_LIGHTS,
     design: bool | None = None,
     objective: str = "normals",
-    band: tuple[float, float] = FULL_BAND,
+    band: tuple[float, float] = _FULL_BAND,
 ) -> AdaptivePlan:
     """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
     homogeneous starting layout of ``start_lights``; with ``lights`` given (``design`` not
@@ -703,9 +706,13 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
         from rti_rig.planner.objectives import Candidates
 
         floor = START_FLOOR_DEG if n_design is None else adaptive.default_floor_for(objective)
-        # the floor within the band (a ceiling below the default floor: the band's own layout)
-        top = arm.elevation_band(lo)[1]
-        targets = arm.homogeneous(n_design or k0, min(max(floor, lo), (lo + top) / 2))
+        # the floor as before, moved only where it leaves no band (a ceiling at or below it:
+        # then the middle of the band, so that the start is the band's own layout)
+        reach_lo, top = arm.elevation_band(lo)
+        start_floor = max(floor, lo)
+        if start_floor >= top:
+            start_floor = (reach_lo + top) / 2
+        targets = arm.homogeneous(n_design or k0, start_floor)
         snapped = snap_unique(targets, Candidates(dirs, None, None))
         if n_design is not None and n_design > k0:
             pick = start_subset(dirs[np.asarray(snapped)], k0, objective=objective)
@@ -950,7 +957,7 @@ def check_min_lights(
 
 
 def _check_min_within(
-    min_lights: int, offered: int, band: tuple[float, float] = FULL_BAND
+    min_lights: int, offered: int, band: tuple[float, float] = _FULL_BAND
 ) -> None:
     if min_lights > offered:
         raise RtiRigError(
@@ -961,18 +968,18 @@ def _check_min_within(
 
 def _band_words(band: tuple[float, float]) -> str:
     """`` between 0° and 45° elevation`` for a band asked for; nothing for every elevation."""
-    if tuple(band) == FULL_BAND:
+    if tuple(band) == _FULL_BAND:
         return ""
     return f" between {band[0]:g}° and {band[1]:g}° elevation"
 
 
 def _check_lights_within(
-    lights: int | None, offered: int, band: tuple[float, float] = FULL_BAND
+    lights: int | None, offered: int, band: tuple[float, float] = _FULL_BAND
 ) -> None:
     """``--lights N`` above what the rig offers is refused, as a planned session's is (it was
     capped without a word: 100 asked of a 48-LED dome ran 48)."""
     if lights is not None and lights > offered:
-        widen = " (or widen --min/--max-elevation-deg)" if tuple(band) != FULL_BAND else ""
+        widen = " (or widen --min/--max-elevation-deg)" if tuple(band) != _FULL_BAND else ""
         raise RtiRigError(
             f"--lights {lights}: this rig offers {offered} lights{_band_words(band)} an "
             f"adaptive session can use; give at most {offered}{widen}"
@@ -986,7 +993,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     until_error_deg: float | None,
     objective: str = "normals",
     min_lights: int | None = None,
-    band: tuple[float, float] = FULL_BAND,
+    band: tuple[float, float] = _FULL_BAND,
 ):
     """Check the request and the folder, open the rig, plan the start, make the folder
     (``band``: the elevations every light is chosen between, :func:`adaptive_plan`).
@@ -1147,8 +1154,8 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         objective=began,
         # absent in sessions begun before adaptive sessions took a band: every elevation
         band=(
-            float(header.get("min_elevation_deg", FULL_BAND[0])),
-            float(header.get("max_elevation_deg", FULL_BAND[1])),
+            float(header.get("min_elevation_deg", _FULL_BAND[0])),
+            float(header.get("max_elevation_deg", _FULL_BAND[1])),
         ),
     )
     if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
