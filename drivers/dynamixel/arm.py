@@ -61,12 +61,18 @@ class DynamixelArm:
         self.kin = ArmKinematics(settings)
         self._bus = DxlBus(port, settings.name, packet_handler)
         self._connected = False
-        #: whether a connect ever completed: until then no move, torque or lamp was commanded
-        #: (what a stop may truthfully say of an arm it never reached)
+        #: whether a connect ever completed (what a stop may say of an arm it never reached)
         self.ever_connected = False
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal: tuple[int, int] | None = None
+
+    @property
+    def commanded(self) -> bool:
+        """Whether anything was ever written to a servo (a connect writes limits, torque off,
+        profiles, a goal, torque on): one that failed after its first write may have left a
+        servo holding under torque, so a stop may not say that nothing was commanded."""
+        return bool(self._bus.commanded)
 
     # -- lifecycle --------------------------------------------------------------------------
     def connect(self) -> None:

@@ -94,6 +94,9 @@ class DxlBus:
         self.ph = _ReleasingHandler(packet_handler or sdk.PacketHandler(2.0), port)
         #: the line speed the port was opened at (named when a servo does not answer)
         self.baudrate: int | None = None
+        #: whether anything that changes a servo's state (a write, an action, a reboot) was
+        #: ever sent: until then a stop may say nothing was commanded
+        self.commanded = False
 
     # -- port -------------------------------------------------------------------------------
     def open(self, baudrate: int) -> None:
@@ -225,6 +228,7 @@ class DxlBus:
         return bytes(data), int(error)
 
     def write(self, dxl_id: int, reg: ct.Register, value: int, check_alert: bool = True) -> None:
+        self.commanded = True
         command = f"write {reg.name} = {value}"
         raw = value & ((1 << (8 * reg.size)) - 1)
         fn = {1: self.ph.write1ByteTxRx, 2: self.ph.write2ByteTxRx, 4: self.ph.write4ByteTxRx}
@@ -237,6 +241,7 @@ class DxlBus:
 
         Without the drain, the status the servo sends back is read as the answer to the next
         command (SDK pitfall; ROBOTIS PR #646)."""
+        self.commanded = True
         raw = value & ((1 << (8 * reg.size)) - 1)
         data = list(raw.to_bytes(reg.size, "little"))
         result = self.ph.writeTxOnly(self.port, dxl_id, reg.address, reg.size, data)
@@ -256,6 +261,7 @@ class DxlBus:
 
     def sync_write(self, reg: ct.Register, values: Mapping[int, int]) -> None:
         """Same register on several servos in one broadcast packet (no reply to wait for)."""
+        self.commanded = True
         group = sdk.GroupSyncWrite(self.port, self.ph, reg.address, reg.size)
         for dxl_id, value in values.items():
             raw = int(value) & ((1 << (8 * reg.size)) - 1)
@@ -269,6 +275,7 @@ class DxlBus:
 
     def broadcast_write(self, reg: ct.Register, value: int) -> None:
         """Write to every servo at once; broadcast writes get no status, so none is left over."""
+        self.commanded = True
         raw = value & ((1 << (8 * reg.size)) - 1)
         data = list(raw.to_bytes(reg.size, "little"))
         result = self.ph.writeTxOnly(self.port, p2.BROADCAST_ID, reg.address, reg.size, data)
@@ -280,11 +287,13 @@ class DxlBus:
 
     def action(self) -> None:
         """Action to the broadcast id: unicast Action leaves a stale reply (SDK pitfall)."""
+        self.commanded = True
         result = self.ph.action(self.port, p2.BROADCAST_ID)
         if result != sdk.COMM_SUCCESS:
             raise CommunicationError(self.device, comm_text(self.ph, result), "action")
 
     def reboot(self, dxl_id: int) -> None:
+        self.commanded = True
         result, error = self.ph.reboot(self.port, dxl_id)
         log.debug("%s: reboot %d (%d, %d)", self.device, dxl_id, result, error)
         self._check(result, error, dxl_id, "reboot", alert=False)

@@ -52,8 +52,10 @@ class ArmSelfTestReport:
     aborted: str | None = None
     teardown_failures: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
-    #: the walk ended before the arm was connected: nothing was commanded
+    #: the walk ended before the arm was connected
     never_connected: bool = False
+    #: ... and whether its connect had written to a servo before it failed
+    commanded: bool = True
 
     @property
     def ok(self) -> bool:
@@ -84,10 +86,16 @@ class ArmSelfTestReport:
         moves = [c.move_s for c in self.checks if c.move_s is not None]
         if moves:
             out.append(f"move time: median {np.median(moves):.2f} s, longest {max(moves):.2f} s")
-        if self.aborted and self.never_connected:
+        if self.aborted and self.never_connected and not self.commanded:
             # nothing was commanded: no stop or hold to speak of (it had said "stopped where it
             # was" of an arm whose port could not even be opened)
             out.append(f"ABORTED: {self.aborted} (the arm was not connected: nothing was moved)")
+        elif self.aborted and self.never_connected:
+            out.append(
+                f"ABORTED: {self.aborted} (the connection failed part-way: a servo may be "
+                "holding its position under torque; switch the arm's power off before touching "
+                "it)"
+            )
         elif self.aborted:
             out.append(
                 f"ABORTED: {self.aborted} (not parked: the arm was stopped where it was"
@@ -178,6 +186,7 @@ def arm_self_test(
             str(exc) if isinstance(exc, RtiRigError) else f"{type(exc).__name__}: {exc}"
         )
         report.never_connected = not connected
+        report.commanded = bool(getattr(carrier, "commanded", True))
     except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
         report.aborted = f"stopped ({exc})"
         exc.self_test_report = report  # type: ignore[attr-defined]

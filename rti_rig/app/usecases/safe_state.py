@@ -25,9 +25,17 @@ def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-
         if hasattr(source, "off_report"):
             return lights_state_sentence(source)
         return "lights were switched off"  # a simulated dome: its state is the simulation's
-    if getattr(getattr(lighting, "carrier", None), "ever_connected", True) is False:
-        # the arm was never reached: no move, torque or lamp was commanded, nor could a stop be
-        return "nothing was commanded: the arm could not be connected"
+    carrier = getattr(lighting, "carrier", None)
+    if getattr(carrier, "ever_connected", True) is False:
+        if getattr(carrier, "commanded", True) is False:
+            # never reached: no move, torque or lamp was commanded, nor could a stop be
+            return "nothing was commanded: the arm could not be connected"
+        # its connect failed after writing to a servo (goal = where it was, then torque on)
+        return (
+            "the arm's connection failed part-way, after settings were written to its servos: "
+            "a servo may be holding its position under torque; switch the arm's power off "
+            "before touching it"
+        )
     return "lamp off and stop were requested" + (
         " (see the teardown problems above)" if teardown_failed else ""
     )

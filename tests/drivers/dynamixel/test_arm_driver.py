@@ -440,3 +440,40 @@ def test_a_late_reply_of_an_interrupted_read_is_not_the_next_answer() -> None:
         bus.read(1, ct.LED)
     assert bus.read(1, ct.PRESENT_POSITION) == position
     assert bus.read(1, ct.LED) == 1
+
+
+def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothing() -> None:
+    """A connect that failed at servo 2's torque-on had left servo 1 under torque, and the
+    check and the stop said "nothing was moved" / "nothing was commanded"."""
+    from types import SimpleNamespace
+
+    from rti_rig.app.usecases.safe_state import lights_state
+    from rti_rig.core.rig_geometry import ArmGeometry
+    from rti_rig.drivers.dynamixel.faults import CommunicationError
+    from rti_rig.runtime.arm_check import arm_self_test
+    from rti_rig.runtime.lighting import ArmLighting
+
+    arm, emu, clock = make_arm()
+    write = arm._bus.write
+
+    def torque_fails_on_2(dxl_id, reg, value, check_alert=True):  # type: ignore[no-untyped-def]
+        if reg is ct.TORQUE_ENABLE and dxl_id == 2 and value == 1:
+            raise CommunicationError("arm", "lost on the wire", "write Torque Enable", 2)
+        return write(dxl_id, reg, value, check_alert)
+
+    arm._bus.write = torque_fails_on_2  # type: ignore[method-assign]
+    geometry = ArmGeometry(5.0, 70.0, 15.0, 0.0, 10.0, -170.0, 170.0)
+    report = arm_self_test(arm, geometry, clock)
+    assert emu.servos[1].torque_on  # what the claim must not deny
+    text = " ".join(report.lines())
+    assert "nothing was moved" not in text and "failed part-way" in text
+    rig = SimpleNamespace(lighting=ArmLighting(arm), loaded=SimpleNamespace(config=None))
+    said = lights_state(rig)
+    assert "nothing was commanded" not in said and "under torque" in said
+    # a port that would not open: nothing was written, and that is said
+    never, _, _ = make_arm()
+    never._bus.port.openPort = lambda: False  # type: ignore[method-assign]
+    report = arm_self_test(never, geometry, clock)
+    assert "the arm was not connected: nothing was moved" in " ".join(report.lines())
+    rig = SimpleNamespace(lighting=ArmLighting(never), loaded=SimpleNamespace(config=None))
+    assert lights_state(rig) == "nothing was commanded: the arm could not be connected"
