@@ -74,8 +74,9 @@ class _ReleasingHandler:
         return call
 
     def _recover(self) -> None:
-        """Discard what the interrupted exchange left on the line (bounded by a short wait)."""
-        self._interrupted = False
+        """Discard what the interrupted exchange left on the line (bounded by a short wait).
+        The mark is cleared only once that is done: a further signal during the discard leaves
+        it for the next command to do."""
         self._port.is_using = False
         log.debug("port released after an interrupted exchange; discarding a late reply")
         try:
@@ -83,6 +84,7 @@ class _ReleasingHandler:
             self._handler.rxPacket(self._port, False)
         finally:
             self._port.is_using = False
+        self._interrupted = False
 
 
 class DxlBus:

@@ -423,23 +423,35 @@ def test_a_stop_reaches_the_servos_after_an_exchange_was_interrupted() -> None:
     assert not emu.servos[1].torque_on and not emu.servos[2].torque_on
 
 
+@pytest.mark.pty
 def test_a_late_reply_of_an_interrupted_read_is_not_the_next_answer() -> None:
-    """The interrupted exchange's status reply is discarded, not read as the next command's
-    answer (a 1-byte LED read taken for the 4-byte position)."""
+    """Over the real SDK and a pty, whose emulator sends a reply only once the host reads: a
+    read interrupted before its first byte leaves its status packet to come. It is discarded,
+    not read as the next command's answer (a 1-byte LED read taken for the 4-byte position)."""
     from rti_rig.drivers.dynamixel.bus import DxlBus
 
     clock = VirtualClock()
     emu = emulator_for_arm(arm_settings(), clock)
-    port = InProcessPort(emu)
-    bus = DxlBus(port, "arm")
-    bus.open(57600)
-    position = bus.read(1, ct.PRESENT_POSITION)
-    emu.servos[1].table[ct.LED.address] = 1
-    _interrupt_next_read(port)
-    with pytest.raises(_Interrupt):
-        bus.read(1, ct.LED)
-    assert bus.read(1, ct.PRESENT_POSITION) == position
-    assert bus.read(1, ct.LED) == 1
+    with PtyServoServer(emu) as server:
+        port = server.port_handler()
+        bus = DxlBus(port, "arm")
+        bus.open(57600)
+        try:
+            position = bus.read(1, ct.PRESENT_POSITION)
+            emu.servos[1].table[ct.LED.address] = 1
+            read = port.readPort
+
+            def interrupted(length: int) -> bytes:  # before any byte of the reply is read
+                port.readPort = read  # type: ignore[method-assign]
+                raise _Interrupt
+
+            port.readPort = interrupted  # type: ignore[method-assign]
+            with pytest.raises(_Interrupt):
+                bus.read(1, ct.LED)
+            assert bus.read(1, ct.PRESENT_POSITION) == position
+            assert bus.read(1, ct.LED) == 1
+        finally:
+            bus.close()
 
 
 def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothing() -> None:
