@@ -80,8 +80,10 @@ class ScriptedDomeDriver:
         #: Text heard while waiting after opening (boot banner), for the probe and messages.
         self.boot_text = ""
         self.banners_seen = 0
-        #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`)
+        #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`),
+        #: and when it ends
         self._booted = False
+        self._boot_deadline = 0.0
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -94,16 +96,18 @@ class ScriptedDomeDriver:
         self._open = True
         self._booted = False
         self._rx.clear()
+        self._boot_deadline = self.transport.clock.now() + self.spec.boot_wait_s
         self._wait_boot()
         self._booted = True
         return self.hello()
 
     def finish_boot(self) -> None:
-        """Wait out the boot a stopped :meth:`connect` cut short, so that what is sent next
-        reaches the firmware: bytes sent to a board still in its bootloader are lost (the
-        all-off of a stop there was, and the Nab sketch then lit every LED in ``setup()``)."""
+        """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same
+        deadline, not a fresh wait), so that what is sent next reaches the firmware: bytes sent
+        to a board still in its bootloader are lost (the all-off of a stop there was, and the
+        Nab sketch then lit every LED in ``setup()``)."""
         if self._open and not self._booted:
-            self._wait_boot()
+            self._wait_ready(self._boot_deadline, "")
             self._booted = True
 
     def close(self) -> None:
@@ -333,8 +337,7 @@ class ScriptedDomeDriver:
 
     def _wait_boot(self) -> None:
         """After opening: wait for the ready text or the boot time (the board may reset)."""
-        clock = self.transport.clock
-        self._wait_ready(clock.now() + self.spec.boot_wait_s, "")
+        self._wait_ready(self._boot_deadline, "")
 
     def _wait_ready(self, deadline: float, already: str) -> None:
         clock = self.transport.clock

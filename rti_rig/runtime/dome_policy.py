@@ -583,9 +583,9 @@ class DomePolicy:
             self.clock.sleep(max(0.0, self._link_clock.now() - t0))
 
     def _finish_boot(self) -> None:
-        """Let a board the stop caught in its bootloader finish booting (up to the profile's
-        boot wait: 1.6 s for the Nab sketch) before the all-off, which would be lost there;
-        a link without a boot wait, or one that fails, goes straight on to the all-off."""
+        """Let a board the stop caught in its bootloader finish booting (to the end of the
+        profile's boot wait begun when the port opened) before the all-off, which would be lost
+        there; a link without a boot wait, or one that fails, goes straight on to the all-off."""
         finish = getattr(self.link, "finish_boot", None)
         if finish is None:
             return

@@ -343,6 +343,32 @@ def test_a_stop_while_the_board_is_still_in_its_bootloader_leaves_it_dark() -> N
         assert "rebooted" not in dome.off_report.sentence()  # the second all-off got through
 
 
+def test_a_stop_late_in_the_boot_wait_finishes_that_wait_not_a_new_one() -> None:
+    """The all-off after a stop in the boot wait waits only for the rest of it: a fresh wait
+    (4 s for the Nab profile) had delayed the all-off of a stop late in the boot by as much."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.runtime.controller import EmergencyStop
+
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        dome = build_dome(DomeSerialSettings(port=link.port, profile="nab-rti-v1"), VirtualClock())
+        boot_wait = dome.link.spec.boot_wait_s
+        late = boot_wait - 1.0
+
+        def stopped_late():  # type: ignore[no-untyped-def]
+            time.sleep(late)  # most of the boot wait has passed
+            raise EmergencyStop("SIGTERM")
+
+        dome.link._wait_boot = stopped_late
+        t0 = time.monotonic()
+        with pytest.raises(EmergencyStop):
+            dome.connect()
+        took = time.monotonic() - t0
+        assert took < boot_wait + 0.9 * late, took  # a fresh wait: late + boot_wait
+        assert eventually(lambda: board.lit == frozenset())
+
+
 def test_a_second_stop_during_that_all_off_says_it_was_not_sent_and_closes() -> None:
     """A further signal cuts the all-off of an interrupted connection short: the port is
     still closed, and the user is told the all-off was not sent (not "never reached")."""
