@@ -215,7 +215,7 @@ def run(
         state = getattr(exc, "lights_state", None)
         if state is not None:  # metering failed: it had lit the rig; nothing was written yet
             err.print(
-                f"{state[:1].upper()}{state[1:]}; nothing was captured or written to {out_dir}.",
+                f"{_sentence(state)}; nothing was captured or written to {out_dir}.",
                 markup=False,
             )
         raise fail(exc) from None
@@ -245,6 +245,11 @@ def run(
         from rti_rig.cli.fit import print_verdict
 
         print_verdict(opened.out_dir)
+
+
+def _sentence(text: str) -> str:
+    """``text`` with its first letter a capital (a state clause printed as a sentence)."""
+    return text[:1].upper() + text[1:]
 
 
 def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
@@ -408,7 +413,7 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
 
         state = lights_state(rig, _print_teardown_failures(folder))
         err.print(
-            f"{state[:1].upper()}{state[1:]}. {_after_stop(opened, resume_hint)}", markup=False
+            f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False
         )
         raise fail(exc) from None
     finally:
@@ -424,8 +429,7 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
 
         # what the teardown established, as a stop says it (a cancel had said nothing of the
         # lights: not even "sent but not acknowledged" on a firmware that never confirms)
-        lights = lights_state(rig, bool(result.teardown_failures))
-        lights = f"{lights[:1].upper()}{lights[1:]}."
+        lights = _sentence(lights_state(rig, bool(result.teardown_failures))) + "."
     if result.finish_reason is FinishReason.CANCELLED and not folder.images_kept:
         # stopped before the first image: no lights.lp to speak of, no resume for nothing
         err.print(

@@ -52,10 +52,8 @@ class ArmSelfTestReport:
     aborted: str | None = None
     teardown_failures: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
-    #: the walk ended before the arm was connected
-    never_connected: bool = False
-    #: ... and whether its connect had written to a servo before it failed
-    commanded: bool = True
+    #: what may be said of an arm whose connect failed (:func:`not_connected_sentence`)
+    not_connected: str | None = None
 
     @property
     def ok(self) -> bool:
@@ -86,16 +84,10 @@ class ArmSelfTestReport:
         moves = [c.move_s for c in self.checks if c.move_s is not None]
         if moves:
             out.append(f"move time: median {np.median(moves):.2f} s, longest {max(moves):.2f} s")
-        if self.aborted and self.never_connected and not self.commanded:
-            # nothing was commanded: no stop or hold to speak of (it had said "stopped where it
-            # was" of an arm whose port could not even be opened)
-            out.append(f"ABORTED: {self.aborted} (the arm was not connected: nothing was moved)")
-        elif self.aborted and self.never_connected:
-            out.append(
-                f"ABORTED: {self.aborted} (the connection failed part-way: a servo may be "
-                "holding its position under torque; switch the arm's power off before touching "
-                "it)"
-            )
+        if self.aborted and self.not_connected:
+            # no stop or hold to speak of (it had said "stopped where it was" of an arm whose
+            # port could not even be opened)
+            out.append(f"ABORTED: {self.aborted} ({self.not_connected})")
         elif self.aborted:
             out.append(
                 f"ABORTED: {self.aborted} (not parked: the arm was stopped where it was"
@@ -109,6 +101,22 @@ class ArmSelfTestReport:
         out.append(f"elapsed {self.elapsed_s:.1f} s on the rig's clock")
         out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
+
+
+def not_connected_sentence(carrier: object, connected: bool | None = None) -> str | None:
+    """What may truthfully be said of an arm whose connect never completed (None: it did;
+    ``connected``: known by the caller, else the carrier's ``ever_connected``). Nothing was
+    commanded if nothing was ever written to a servo; a connect that failed after a write
+    (limits, profiles, a goal, torque on) may have left a servo holding under torque."""
+    if getattr(carrier, "ever_connected", True) if connected is None else connected:
+        return None
+    if getattr(carrier, "commanded", True) is False:
+        return "nothing was commanded: the arm could not be connected"
+    return (
+        "the arm's connection failed part-way, after settings were written to its servos: a "
+        "servo may be holding its position under torque; switch the arm's power off before "
+        "touching it"
+    )
 
 
 def self_test_poses(geometry: ArmGeometry) -> list[tuple[str, NDArray[np.float64]]]:
@@ -185,8 +193,7 @@ def arm_self_test(
         report.aborted = (
             str(exc) if isinstance(exc, RtiRigError) else f"{type(exc).__name__}: {exc}"
         )
-        report.never_connected = not connected
-        report.commanded = bool(getattr(carrier, "commanded", True))
+        report.not_connected = not_connected_sentence(carrier, connected)
     except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
         report.aborted = f"stopped ({exc})"
         exc.self_test_report = report  # type: ignore[attr-defined]

@@ -267,7 +267,7 @@ def test_an_arm_that_could_not_be_connected_is_not_said_to_be_stopped(tmp_path: 
     r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and "RESULT: FAIL" in said, said
-    assert "the arm was not connected: nothing was moved" in said
+    assert "nothing was commanded: the arm could not be connected" in said
     assert "stopped where it was" not in said and "CommunicationError" not in said
     assert "the rig config's [arm.dynamixel] port names it" in said  # the table, not eaten
     out = tmp_path / "s"

@@ -7,6 +7,7 @@ sent), an arm that its lamp-off was requested.
 
 from __future__ import annotations
 
+from rti_rig.runtime.arm_check import not_connected_sentence
 from rti_rig.runtime.dome_policy import lights_state_sentence
 from rti_rig.runtime.lighting import DomeLighting
 
@@ -25,17 +26,9 @@ def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-
         if hasattr(source, "off_report"):
             return lights_state_sentence(source)
         return "lights were switched off"  # a simulated dome: its state is the simulation's
-    carrier = getattr(lighting, "carrier", None)
-    if getattr(carrier, "ever_connected", True) is False:
-        if getattr(carrier, "commanded", True) is False:
-            # never reached: no move, torque or lamp was commanded, nor could a stop be
-            return "nothing was commanded: the arm could not be connected"
-        # its connect failed after writing to a servo (goal = where it was, then torque on)
-        return (
-            "the arm's connection failed part-way, after settings were written to its servos: "
-            "a servo may be holding its position under torque; switch the arm's power off "
-            "before touching it"
-        )
+    unreached = not_connected_sentence(getattr(lighting, "carrier", None))
+    if unreached is not None:
+        return unreached
     return "lamp off and stop were requested" + (
         " (see the teardown problems above)" if teardown_failed else ""
     )

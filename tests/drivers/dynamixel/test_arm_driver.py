@@ -486,6 +486,6 @@ def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothin
     never, _, _ = make_arm()
     never._bus.port.openPort = lambda: False  # type: ignore[method-assign]
     report = arm_self_test(never, geometry, clock)
-    assert "the arm was not connected: nothing was moved" in " ".join(report.lines())
+    assert "nothing was commanded: the arm could not be connected" in " ".join(report.lines())
     rig = SimpleNamespace(lighting=ArmLighting(never), loaded=SimpleNamespace(config=None))
     assert lights_state(rig) == "nothing was commanded: the arm could not be connected"
