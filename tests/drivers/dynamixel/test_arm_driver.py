@@ -478,7 +478,7 @@ def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothin
     report = arm_self_test(arm, geometry, clock)
     assert emu.servos[1].torque_on  # what the claim must not deny
     text = " ".join(report.lines())
-    assert "nothing was moved" not in text and "failed part-way" in text
+    assert "nothing was commanded" not in text and "failed part-way" in text
     rig = SimpleNamespace(lighting=ArmLighting(arm), loaded=SimpleNamespace(config=None))
     said = lights_state(rig)
     assert "nothing was commanded" not in said and "under torque" in said
