@@ -254,13 +254,17 @@ def test_the_rig_is_closed_whatever_interrupts_the_start(
     def interrupted(*_: object) -> None:
         raise KeyboardInterrupt
 
+    from rti_rig.app.config import load_rig_config
+
+    # a real config (its checks before the rig opens read it); the rig itself is the fake
+    loaded = load_rig_config(REPO / "rig_configs" / "simulated_dome.toml")
     monkeypatch.setattr(uc, "validate_schedule", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        uc.checked_rig(None, None)
+        uc.checked_rig(loaded, None)
     assert rig.closed
     rig.closed = False
     monkeypatch.setattr(uc, "validate_schedule", lambda r, s: None)
     monkeypatch.setattr(SessionFolder, "create", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        uc._open_new(None, [], tmp_path / "new", False, 0.001, uc._ignore)  # type: ignore[arg-type]
+        uc._open_new(loaded, [], tmp_path / "new", False, 0.001, uc._ignore)  # type: ignore[arg-type]
     assert rig.closed
