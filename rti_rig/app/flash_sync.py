@@ -429,17 +429,10 @@ def flash_sync_check(loaded) -> FlashSyncCheckReport:  # type: ignore[no-untyped
     """Build the rig (the order is checked against the firmware), open and release the camera
     without shooting (a shot would step the dome), and say what cannot be tested."""
     from rti_rig.app.compose import build_rig
+    from rti_rig.app.usecases.check import camera_line
 
     with build_rig(loaded) as rig:
         assert isinstance(rig.geometry, DomeGeometry)
         lines = check_lines(loaded, rig.geometry)
-        try:
-            rig.camera.connect()
-        except RtiRigError as exc:
-            return FlashSyncCheckReport([*lines, f"camera: FAILED to connect: {exc}"], False)
-        finally:
-            rig.camera.close()
-        lines.append(
-            f"camera: {rig.camera.name} connected (no image taken: it would step the dome)"
-        )
-    return FlashSyncCheckReport(lines, True)
+        camera, ok = camera_line(rig, "it would step the dome")
+    return FlashSyncCheckReport([*lines, camera], ok)

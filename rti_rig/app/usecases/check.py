@@ -74,17 +74,19 @@ def check_rig(req: CheckRequest) -> Any:
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
 
 
-def camera_line(rig) -> tuple[str, bool]:  # type: ignore[no-untyped-def]
-    """Open and release the rig's camera, after the lights' walk (it takes no image: the lights
-    are off by then): the line to print and whether it connected. A check had passed a rig whose
-    camera then failed the session's first capture (gphoto2 not installed, no camera found)."""
+def camera_line(rig, why_no_image: str = "") -> tuple[str, bool]:  # type: ignore[no-untyped-def]
+    """Open and release the rig's camera, taking no image (after a lights' walk the lights are
+    off; on a camera-triggered dome a shot would step it: ``why_no_image``): the line to print
+    and whether it connected. A check had passed a rig whose camera then failed the session's
+    first capture (gphoto2 not installed, no camera found)."""
     try:
         rig.camera.connect()
     except RtiRigError as exc:
         return f"camera: FAILED to connect: {exc}", False
     finally:
         rig.camera.close()
-    return f"camera: {rig.camera.name} connected (no image taken)", True
+    why = f": {why_no_image}" if why_no_image else ""
+    return f"camera: {rig.camera.name} connected (no image taken{why})", True
 
 
 @dataclass(frozen=True)
