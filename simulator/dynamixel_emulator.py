@@ -1,8 +1,12 @@
 """Dynamixel Protocol 2.0 X-series servos, emulated byte for byte, so that the official
 ``dynamixel_sdk`` runs unchanged against them (over a pty or an in-process port).
 
-What is modelled: the control table as bytes (EEPROM locked while torque is on, read-only
-registers, position limits in position mode, Operating Mode changes resetting the profile),
+What is modelled: the control table as bytes, starting from each model's factory table as the
+ROBOTIS e-manual publishes it (:mod:`rti_rig.simulator.dynamixel_models`, cited per model: the
+XL330's Shutdown 0x35, Velocity Limits, voltage limits, ...); EEPROM locked while torque is
+on, read-only registers, position limits in position mode, Profile Velocity refused above the
+Velocity Limit (Data Limit Error), the supply checked against the Min/Max Voltage Limit,
+Operating Mode changes resetting the profile;
 Ping/Read/Write/Reg Write/Action/Reboot/Clear/Sync Read/Sync Write/Bulk Read/Bulk Write,
 Status Return Level, the Alert bit, motion under Profile Velocity/Acceleration (trapezoid in
 *emulator time* read from an injected clock, so a dry run with a ``VirtualClock`` never waits)
@@ -34,6 +38,7 @@ from typing import Any
 from rti_rig.core.clock import Clock
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
+from rti_rig.simulator import dynamixel_models as models
 
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
@@ -117,31 +122,60 @@ class EmulatedServo:
         *,
         operating_mode: int = ct.OperatingMode.POSITION,
         present_ticks: int = 2048,
-        min_position: int = 0,
-        max_position: int = ct.MAX_TICK,
+        min_position: int | None = None,
+        max_position: int | None = None,
         firmware: int = DEFAULT_FIRMWARE,
+        supply_decivolts: int | None = None,
     ) -> None:
+        """A servo as it leaves the factory: the control table of ``model_number`` is the
+        e-manual's Initial Values for that model (:mod:`rti_rig.simulator.dynamixel_models`,
+        each cited), then ``dxl_id``, ``operating_mode`` and any position limits given.
+
+        ``supply_decivolts`` is the bench supply (0.1 V), the model's recommended input voltage
+        unless given; one outside the servo's voltage limits raises its Input Voltage Error as
+        :meth:`set_input_voltage` describes."""
         self.clock = clock
+        self.factory = models.factory_table(model_number)
+        f = self.factory
         self.table = bytearray(ct.TABLE_SIZE)
         self._set(ct.MODEL_NUMBER, model_number)
         self._set(ct.FIRMWARE_VERSION, firmware)
         self._set(ct.ID, dxl_id)
-        self._set(ct.BAUD_RATE, 1)
-        self._set(ct.RETURN_DELAY_TIME, 250)
+        self._set(ct.BAUD_RATE, f.baud_rate)
+        self._set(ct.RETURN_DELAY_TIME, f.return_delay_time)
+        self._set(ct.DRIVE_MODE, f.drive_mode)
+        self._set(ct.OPERATING_MODE, f.operating_mode)
+        self._set(ct.SECONDARY_ID, f.secondary_id)
+        self._set(ct.PROTOCOL_TYPE, f.protocol_type)
+        self._set(ct.HOMING_OFFSET, f.homing_offset)
+        self._set(ct.MOVING_THRESHOLD, f.moving_threshold)
+        self._set(ct.TEMPERATURE_LIMIT, f.temperature_limit)
+        self._set(ct.MAX_VOLTAGE_LIMIT, f.max_voltage_limit)
+        self._set(ct.MIN_VOLTAGE_LIMIT, f.min_voltage_limit)
+        self._set(ct.PWM_LIMIT, f.pwm_limit)
+        if f.current_limit is not None:  # absent on the XL430/2XL430: address 38 stays 0
+            self._set(ct.CURRENT_LIMIT, f.current_limit)
+        self._set(ct.VELOCITY_LIMIT, f.velocity_limit)
+        self._set(ct.MAX_POSITION_LIMIT, f.max_position_limit)
+        self._set(ct.MIN_POSITION_LIMIT, f.min_position_limit)
+        for address, (size, value) in f.extra.items():
+            self.table[address : address + size] = value.to_bytes(size, "little")
+        self._set(ct.SHUTDOWN, f.shutdown)
+        self._set(ct.STATUS_RETURN_LEVEL, f.status_return_level)
+        # configured for the rig (Operating Mode and limits are EEPROM: set before delivery)
         self._set(ct.OPERATING_MODE, int(operating_mode))
-        self._set(ct.MOVING_THRESHOLD, 10)
-        self._set(ct.TEMPERATURE_LIMIT, 72)
-        self._set(ct.VELOCITY_LIMIT, 265)
-        self._set(ct.MAX_POSITION_LIMIT, max_position)
-        self._set(ct.MIN_POSITION_LIMIT, min_position)
-        self._set(ct.SHUTDOWN, 0x34)
-        self._set(ct.STATUS_RETURN_LEVEL, 2)
-        self._set(ct.PRESENT_INPUT_VOLTAGE, 120)
+        if max_position is not None:
+            self._set(ct.MAX_POSITION_LIMIT, max_position)
+        if min_position is not None:
+            self._set(ct.MIN_POSITION_LIMIT, min_position)
         self._set(ct.PRESENT_TEMPERATURE, 30)
         self._set(ct.GOAL_POSITION, present_ticks)
         self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
         self._registered: tuple[int, bytes] | None = None
         self._shut_down = False
+        self.set_input_voltage(
+            f.recommended_supply_decivolts if supply_decivolts is None else supply_decivolts
+        )
 
     # -- table helpers ----------------------------------------------------------------------
     def _set(self, reg: ct.Register, value: int) -> None:
@@ -198,18 +232,32 @@ class EmulatedServo:
         e-manual, X-series control table: Max/Min Voltage Limit (32/34) — "Input Voltage Error
         Bit(0x01) and Hardware Error Bit(0x80) in the Hardware Error Status(70) are set. If
         Input Voltage Error Bit is configured in the Shutdown(63), Torque Enable(64) is cleared";
-        Temperature Limit (31) says the same of overheating. So an error sets its bit and the
-        Alert flag of every status packet, and only a bit Shutdown selects clears Torque Enable
-        (motion stops; then only a Reboot lets torque back on). The factory Shutdown modelled is
-        0x34 for every model (XL430/XM430's, hardware notes), which does not select an
-        input-voltage error; an XL330 reportedly ships with 0x35 (a third-party bench note, not
-        verified), which does — set it with ``_set(ct.SHUTDOWN, ...)`` to model one."""
+        Temperature Limit (31) says the same of overheating; Shutdown (63): "REBOOT is the only
+        method to reset Torque Enable(64) to '1' after the shutdown". So an error sets its bit
+        and the Alert flag of every status packet, and only a bit Shutdown selects clears
+        Torque Enable (motion stops; then only a Reboot lets torque back on). The factory
+        Shutdown is the model's (:mod:`rti_rig.simulator.dynamixel_models`): 0x34 on the
+        XL430/2XL430/XM430/XH430/XM540, which does not select an input-voltage error, and 0x35
+        on the XL330-M288, which does (e-manual ``docs/en/dxl/x/xl330-m288.md``, Shutdown
+        Initial Value 53; the Shutdown include marks its Input Voltage Error "(default)")."""
         bits &= 0xFF
         self.table[ct.HARDWARE_ERROR_STATUS.address] |= bits
         if bits & self.get(ct.SHUTDOWN):
             self._shut_down = True
             self._freeze()
             self.table[ct.TORQUE_ENABLE.address] = 0
+
+    def set_input_voltage(self, decivolts: int) -> None:
+        """The supply the servo sees (Present Input Voltage, 0.1 V).
+
+        e-manual, Min/Max Voltage Limit (32/34): when Present Input Voltage(144) exceeds the
+        range of Max Voltage Limit(32) and Min Voltage Limit(34), the Input Voltage Error bit
+        is set (and Torque Enable cleared if Shutdown selects it): here through
+        :meth:`inject_hardware_error`. A supply back inside the limits clears nothing (the bit
+        stays until a Reboot; not verified for a passed cause, as the module docstring says)."""
+        self._set(ct.PRESENT_INPUT_VOLTAGE, decivolts)
+        if not self.get(ct.MIN_VOLTAGE_LIMIT) <= decivolts <= self.get(ct.MAX_VOLTAGE_LIMIT):
+            self.inject_hardware_error(ct.HardwareFault.INPUT_VOLTAGE)
 
     def reboot(self) -> None:
         self._shut_down = False
@@ -272,6 +320,20 @@ class EmulatedServo:
                 # verified against the e-manual; the driver writes goal := present first anyway
                 self._freeze()
                 self._set(ct.GOAL_POSITION, round(self.position()))
+        pv = ct.PROFILE_VELOCITY
+        if (
+            address <= pv.address
+            and pv.address + pv.size <= end
+            and not self.get(ct.DRIVE_MODE) & ct.DRIVE_MODE_TIME_BASED_PROFILE
+        ):
+            # e-manual, Velocity Limit(44): "maximum velocity of Goal Velocity(104) and Profile
+            # Velocity(112)"; the control-table include adds "Values for Goal Velocity and
+            # Profile Velocity cannot be set to values exceeding the Velocity Limit ... Data
+            # Limit Error" (ROBOTIS-GIT/emanual _includes/en/dxl/control_table/velocity_limit.md
+            # @ 9344769ede3e0f19f4e4d876e3e80639f3188ae9)
+            value = int.from_bytes(data[pv.address - address : pv.address - address + 4], "little")
+            if value > self.get(ct.VELOCITY_LIMIT):
+                return p2.ERR_DATA_LIMIT
         mode_before = self.get(ct.OPERATING_MODE)
         self.table[address:end] = data
         if self.get(ct.OPERATING_MODE) != mode_before:
@@ -345,6 +407,11 @@ class DynamixelBusEmulator:
     def inject_hardware_error(self, dxl_id: int, fault: int) -> None:
         with self._lock:
             self.servos[dxl_id].inject_hardware_error(int(fault))
+
+    def set_input_voltage(self, dxl_id: int, decivolts: int) -> None:
+        """The supply servo ``dxl_id`` sees (0.1 V); outside its limits: Input Voltage Error."""
+        with self._lock:
+            self.servos[dxl_id].set_input_voltage(int(decivolts))
 
     # -- bytes ------------------------------------------------------------------------------
     def receive(self, data: bytes) -> bytes:
@@ -536,8 +603,9 @@ class InProcessPort:
 def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> DynamixelBusEmulator:
     """Servos matching an ``ArmSettings`` (ids, models, modes), resting at the park pose.
 
-    Their Min/Max Position Limit are left at the factory 0..4095, so the driver's connect-time
-    check has something to synchronise, as on a fresh servo."""
+    Each is its model's factory table (e-manual Initial Values); their Min/Max Position Limit
+    are left at the factory 0..4095, so the driver's connect-time check has something to
+    synchronise, as on a fresh servo; each sees its model's recommended supply voltage."""
     from rti_rig.drivers.dynamixel.kinematics import (
         ArmKinematics,  # the emulator speaks their geometry
     )

@@ -143,8 +143,31 @@ class DynamixelArm:
                     "connect",
                     sid,
                 )
+        self._check_velocity_limit(joint)
         if joint.mode == ct.OperatingMode.POSITION:
             self._check_position_limits(joint)
+
+    def _check_velocity_limit(self, joint) -> None:
+        """The profile velocity within the servo's Velocity Limit (44), checked before any write.
+
+        The servo refuses a Profile Velocity above its Velocity Limit (Data Limit Error), and
+        that limit differs per model (factory 0.229 rev/min units: XM540-W270 128 = 29.3 rpm,
+        XH430-W350 130, XM430-W350 200, XL430-W250 265, XL330-M288 445; ROBOTIS e-manual): a
+        speed fine for one servo failed a connect on another half-way through, after the
+        position limits were rewritten, as a bare "data limit error" on a register write."""
+        limit = self._bus.read(joint.servo_id, ct.VELOCITY_LIMIT)
+        if joint.velocity_units > limit:
+            raise ConfigMismatchError(
+                self.name,
+                f"profile_velocity_rpm = {joint.profile_velocity_rpm:g} (register value "
+                f"{joint.velocity_units}) exceeds the servo's Velocity Limit {limit} "
+                f"({limit * ct.RPM_PER_VELOCITY_UNIT:.1f} rpm, "
+                f"{ct.MODEL_NAMES.get(joint.model_number, 'this model')}); lower "
+                "profile_velocity_rpm, or raise Velocity Limit (address 44) with Dynamixel "
+                "Wizard (torque off) within the model's range",
+                "connect",
+                joint.servo_id,
+            )
 
     def _check_position_limits(self, joint) -> None:
         """Servo-side limits equal to the config's, so the servo refuses what the config does."""

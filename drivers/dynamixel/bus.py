@@ -149,15 +149,28 @@ class DxlBus:
         """The fault a servo's Alert flag signals, with its torque as read, not as assumed.
 
         Torque Enable is read because a servo drops torque only for the faults its Shutdown
-        register selects: an input-voltage error on a factory-set X-series servo leaves the
-        joint driven. A torque that cannot be read is reported as unknown."""
+        register selects, and the factory setting differs per model (ROBOTIS e-manual, Shutdown
+        Initial Value): 0x34 on the XL430/XM430/XH430/XM540, where an input-voltage error
+        leaves the joint driven, 0x35 on the XL330-M288, where it switches torque off. A torque
+        that cannot be read is reported as unknown. For an input-voltage error the supply and
+        the servo's own limits are read too (best effort): they differ per model (an XL330 is
+        a 3.5..7.0 V servo, an XL430 6.0..14.0 V, an XM430 9.5..16.0 V)."""
         if status is None:
             status = self.read(dxl_id, ct.HARDWARE_ERROR_STATUS, check_alert=False)
         try:
             torque_on: bool | None = bool(self.read(dxl_id, ct.TORQUE_ENABLE, check_alert=False))
         except DynamixelError:
             torque_on = None
-        return HardwareFaultError(self.device, dxl_id, status, command, torque_on)
+        voltage: tuple[int, int, int] | None = None
+        if status & ct.HardwareFault.INPUT_VOLTAGE:
+            try:
+                regs = (ct.PRESENT_INPUT_VOLTAGE, ct.MIN_VOLTAGE_LIMIT, ct.MAX_VOLTAGE_LIMIT)
+                voltage = tuple(  # type: ignore[assignment]
+                    self.read(dxl_id, reg, check_alert=False) for reg in regs
+                )
+            except DynamixelError:
+                voltage = None
+        return HardwareFaultError(self.device, dxl_id, status, command, torque_on, voltage)
 
     #: Results that mean the status packet was lost or damaged (not that the servo refused).
     RETRYABLE = (sdk.COMM_RX_TIMEOUT, sdk.COMM_RX_CORRUPT)

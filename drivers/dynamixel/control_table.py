@@ -2,7 +2,8 @@
 
 Sources: ROBOTIS e-manual pages for XL430-W250 and XM430-W350 (see
 docs/protocols/dynamixel-arm.md). Only the registers the arm driver and the emulator use are
-named here; the emulator keeps the whole table as bytes.
+named here; the emulator keeps the whole table as bytes. Addresses are common to the models in
+MODEL_NAMES; factory values are not (per model, cited: rti_rig.simulator.dynamixel_models).
 """
 
 from __future__ import annotations
@@ -29,17 +30,24 @@ ID = Register("ID", 7, 1, eeprom=True)
 BAUD_RATE = Register("Baud Rate", 8, 1, eeprom=True)
 RETURN_DELAY_TIME = Register("Return Delay Time", 9, 1, eeprom=True)
 DRIVE_MODE = Register("Drive Mode", 10, 1, eeprom=True)
+#: Drive Mode bit 2: time-based profile (Profile Velocity/Acceleration are then times in ms).
+DRIVE_MODE_TIME_BASED_PROFILE = 0x04
 #: Drive Mode bit 3, "Torque On by Goal Update" (firmware 45 and later): a Goal Position written
 #: while Torque Enable is 0 switches torque on and the servo moves to it (ROBOTIS e-manual,
 #: X-series control table, Drive Mode).
 DRIVE_MODE_TORQUE_ON_BY_GOAL_UPDATE = 0x08
 TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE = 45
 OPERATING_MODE = Register("Operating Mode", 11, 1, eeprom=True)
+SECONDARY_ID = Register("Secondary ID", 12, 1, eeprom=True)
+PROTOCOL_TYPE = Register("Protocol Type", 13, 1, eeprom=True)
 HOMING_OFFSET = Register("Homing Offset", 20, 4, eeprom=True, signed=True)
 MOVING_THRESHOLD = Register("Moving Threshold", 24, 4, eeprom=True)
 TEMPERATURE_LIMIT = Register("Temperature Limit", 31, 1, eeprom=True)
 MAX_VOLTAGE_LIMIT = Register("Max Voltage Limit", 32, 2, eeprom=True)
 MIN_VOLTAGE_LIMIT = Register("Min Voltage Limit", 34, 2, eeprom=True)
+PWM_LIMIT = Register("PWM Limit", 36, 2, eeprom=True)
+#: Not on every model: the XL430-W250 and 2XL430-W250 have no Current Limit (e-manual tables).
+CURRENT_LIMIT = Register("Current Limit", 38, 2, eeprom=True)
 VELOCITY_LIMIT = Register("Velocity Limit", 44, 4, eeprom=True)
 MAX_POSITION_LIMIT = Register("Max Position Limit", 48, 4, eeprom=True)
 MIN_POSITION_LIMIT = Register("Min Position Limit", 52, 4, eeprom=True)

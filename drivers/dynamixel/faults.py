@@ -33,10 +33,14 @@ class HardwareFaultError(DynamixelError):
     """Hardware Error Status has bits set; whether torque went off is said only as read.
 
     A servo switches its torque off only for the faults its Shutdown register (address 63)
-    selects (e-manual, Shutdown; factory 0x34 on XL430/XM430: overheating, electrical shock,
-    overload — not an input-voltage error). ``torque_on`` is Torque Enable as read after the
-    fault (``None``: it could not be read), so the message never claims a limp joint that is
-    still driven, or a held one that is limp."""
+    selects, and the factory setting is the model's (ROBOTIS e-manual, Shutdown Initial
+    Value, repo ROBOTIS-GIT/emanual docs/en/dxl/x/<model>.md): 52 = 0x34 on the XL430-W250,
+    2XL430-W250, XM430-W350/W210, XH430-W350 and XM540-W270 (overheating, electrical shock,
+    overload — not an input-voltage error), 53 = 0x35 on the XL330-M288 (input voltage too).
+    ``torque_on`` is Torque Enable as read after the fault (``None``: it could not be read),
+    so the message never claims a limp joint that is still driven, or a held one that is limp.
+    ``voltage`` is (Present Input Voltage, Min, Max Voltage Limit) in 0.1 V as read for an
+    input-voltage error (``None``: not read)."""
 
     def __init__(
         self,
@@ -45,12 +49,23 @@ class HardwareFaultError(DynamixelError):
         status: int,
         command: str | None,
         torque_on: bool | None = None,
+        voltage: tuple[int, int, int] | None = None,
     ) -> None:
         self.status = status
         self.torque_on = torque_on
+        self.voltage = voltage
         self.faults = ct.decode_hardware_error(status)
         names = ", ".join(f.name.lower().replace("_", " ") for f in self.faults) or "unknown"
-        advice = "; ".join(ct.FAULT_ADVICE[f] for f in self.faults)
+        advice = "; ".join(
+            ct.FAULT_ADVICE[f]
+            + (
+                f" (input {voltage[0] / 10:.1f} V as read; this servo's limits are "
+                f"{voltage[1] / 10:.1f}..{voltage[2] / 10:.1f} V)"
+                if f is ct.HardwareFault.INPUT_VOLTAGE and voltage is not None
+                else ""
+            )
+            for f in self.faults
+        )
         super().__init__(
             device,
             f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}. "

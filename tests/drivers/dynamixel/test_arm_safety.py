@@ -43,7 +43,9 @@ def arm_configs(draw) -> ArmSettings:
     el_max = draw(st.floats(el_min + 30.0, 90.0))
     keep_out = min(draw(st.floats(0.0, 60.0)), 89.0 - el_min - 5.0)
     park_el = draw(st.floats(el_min + 0.5, min(el_max, 90.0 - keep_out) - 0.5))
-    profile = dict(profile_velocity_rpm=50.0, profile_acceleration_rev_min2=5000.0)
+    # within both models' factory Velocity Limit (XM430-W350 200 x 0.229 = 45.8 rpm, e-manual):
+    # 50 rpm had passed only because the emulator gave every model the XL430's table
+    profile = dict(profile_velocity_rpm=40.0, profile_acceleration_rev_min2=5000.0)
     return ArmSettings(
         port="emulated",
         azimuth=dict(
