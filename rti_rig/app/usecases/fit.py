@@ -398,6 +398,11 @@ def _fit_into(  # type: ignore[no-untyped-def]
 #: The fewest lights whose 5-fold cross-validation leaves a PTM its 6 fitting lights in every
 #: fold: below, a fit.ptm is written with a word on what it is worth.
 PTM_MEASURED_FROM = 8
+#: The highest HSH order relight reads from an ``.rti``: its ``convertRTI`` (src/cli/
+#: convert_rti.cpp, through ``LRti``'s 9-entry HSH plane order in src/legacy_rti.cpp) and its
+#: viewer's ``Rti::lightWeightsHsh`` (src/rti.cpp, 9 weights) know 4 or 9 terms, and its
+#: converter back to ``.rti`` refuses any other plane count. RTIViewer reads 16.
+RELIGHT_HSH_ORDER = 2
 
 #: Pixel sample shared by model choice, quantisation ranges and the reference level: one
 #: decode pass of the files for all three.
@@ -489,6 +494,13 @@ def _fit_all(
         skipped.append(rti_why)
     elif req.write_hsh and n >= (order + 1) ** 2:
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
+        if order > RELIGHT_HSH_ORDER:  # written (RTIViewer reads it), but not for relight
+            skipped.append(
+                f"fit.rti holds an order-{order} HSH ({(order + 1) ** 2} terms): RTIViewer "
+                f"reads it, relight does not (its .rti converter and viewer know HSH of 4 or "
+                f"9 terms only); for relight, fit again with --hsh-order "
+                f"{RELIGHT_HSH_ORDER}, or fit the images with relight-cli"
+            )
     elif req.write_hsh:
         skipped.append(
             f"fit.rti not written: HSH of order {order} needs at least {(order + 1) ** 2} "
