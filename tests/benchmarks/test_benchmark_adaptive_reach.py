@@ -192,3 +192,61 @@ def test_a_relight_table_tunes_the_bar_and_the_oracle_to_the_highest_psnr() -> N
         for f in FLOORS:
             res[(n, f"s {f:g}")] = [base[f] - 1.0, base[f] - 1.0]
     assert all("**below the bar**" in r for r in scene_rows("x", res, ["s"], "relight"))
+
+
+def test_the_true_surface_sample_reads_shadows_from_the_images() -> None:
+    """A Lambertian pixel lit as its normal says reads fully lit; one darkened to a quarter
+    (a cast shadow the normal does not show) reads a quarter; one facing away, unlit."""
+    from types import SimpleNamespace
+
+    from benchmarks.adaptive_reach import true_surface_sample
+
+    dirs = fibonacci_cap(12, 10.0, 80.0)
+    normals = np.array([[0.0, 0.0, 1.0], [0.3, 0.0, 0.954], [0.0, 0.2, 0.98]])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    albedo = np.array([0.8, 0.5, 0.3])
+    shade = np.clip(normals @ dirs.T, 0.0, None) * albedo[:, None]  # (P, K)
+    shade[1, 3] *= 0.25  # pixel 1 partly shadowed under light 3
+    images = np.repeat(shade.T.reshape(12, 1, 3, 1), 3, axis=3).astype(np.float32)
+    data = SimpleNamespace(
+        normals=normals.reshape(1, 3, 3), candidate_dirs=dirs, candidate_images=images
+    )
+    sample = true_surface_sample(data, np.arange(12), np.arange(3))
+    lit = sample.lit_candidates
+    assert lit.shape == (3, 12)
+    assert lit[1, 3] == pytest.approx(0.25, abs=1e-5)
+    others = np.ones_like(lit, dtype=bool)
+    others[1, 3] = False
+    assert np.allclose(lit[others], 1.0, atol=1e-5)
+
+
+def test_the_simulated_search_never_leaves_a_worse_simulated_design() -> None:
+    """The exchange on the session's simulated score keeps the lights shot out of the design
+    and ends no worse, on that score, than where it began."""
+    from benchmarks.adaptive_reach import _simulated_search
+    from rti_rig.app.usecases.adaptive import robust_fit
+    from rti_rig.planner.adaptive_bias import ObjectModel, simulate_designs
+
+    rng = np.random.default_rng(3)
+    n = rng.normal(size=(60, 3)) * [0.3, 0.3, 1.0]
+    n[:, 2] = np.abs(n[:, 2]) + 0.5
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    dirs = fibonacci_cap(30, 10.0, 85.0)
+    shot = np.array([0, 7, 14, 21])
+    model = ObjectModel(  # a matte object without cast shadows
+        normals=n,
+        albedo=np.full(60, 0.6),
+        spec_strength=0.0,
+        spec_exponent=1.0,
+        noise=0.01,
+        shadow_el=np.full((60, 1), -np.inf),
+        shadow_az=np.zeros((60, 1)),
+        lights=dirs[shot],
+        shadowed=np.zeros((60, 4), dtype=bool),
+    )
+    start = np.array([3, 26])
+    full = lambda free: np.concatenate([dirs[shot], dirs[free]])  # noqa: E731
+    before = simulate_designs(model, [full(start)], robust_fit)[0]
+    out = _simulated_search(model, dirs, shot, start, before, sweeps=1)
+    assert len(out) == 2 and not set(out.tolist()) & set(shot.tolist())
+    assert simulate_designs(model, [full(out)], robust_fit)[0] <= before + 1e-12
