@@ -254,8 +254,10 @@ def planned_leds(
     objective: str = "normals",
     material: str = "auto",
     max_elevation_deg: float = 90.0,
+    min_elevation_deg: float = 0.0,
 ) -> np.ndarray:
-    """The ``optimal`` plan's LED indices into ``geometry`` (both draw benchmarks use it)."""
+    """The ``optimal`` plan's LED indices into ``geometry`` (both draw benchmarks use it;
+    ``min/max_elevation_deg``: as ``plan --min/--max-elevation-deg``)."""
     sched, _ = plan_with_report(
         preview,
         geometry,
@@ -266,6 +268,7 @@ def planned_leds(
         signal_noise=signal_noise,
         material=material,
         max_elevation_deg=max_elevation_deg,
+        min_elevation_deg=min_elevation_deg,
     )
     return np.array([s.led for s in sched.steps])
 

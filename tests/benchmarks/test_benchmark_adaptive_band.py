@@ -1,0 +1,137 @@
+"""`benchmarks.adaptive --min/--max-elevation-deg` measures adaptive within a band.
+
+With a band every strategy compared must keep to it: the adaptive sessions (planned by the CLI's
+own ``adaptive_plan``, as ``run --adaptive --max-elevation-deg 45`` plans them), the bar's
+homogeneous layouts (``plan --method uniform`` with the band, its floors raised to the band's)
+and `optimal` (``plan --method optimal`` with the band). Every layout the benchmark scores is
+caught where it is scored, so a strategy that ignored the band fails here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import benchmarks.adaptive as bench
+import benchmarks.planner_real_data as real_data
+import benchmarks.tradeoff as tradeoff
+
+
+def _elevations(lights: np.ndarray) -> np.ndarray:
+    return np.degrees(np.arcsin(np.clip(np.asarray(lights)[:, 2], -1.0, 1.0)))
+
+
+_RENDERED: dict = {}
+
+
+def _render_once(scene, settings):  # type: ignore[no-untyped-def]
+    """The scene rendered once for both bands (2 s each)."""
+    if scene not in _RENDERED:
+        _RENDERED[scene] = RENDER(scene, settings)
+    return _RENDERED[scene]
+
+
+RENDER = tradeoff.render_scene_data
+
+
+@pytest.mark.parametrize(
+    ("band", "floors"),
+    [((0.0, 45.0), (0.0, 10.0, 20.0, 30.0)), ((20.0, 90.0), (20.0, 30.0))],
+)
+def test_every_layout_scored_keeps_to_the_band(monkeypatch, band, floors) -> None:
+    scored: list[np.ndarray] = []
+    planned: list[dict] = []
+    normal_error, planned_leds = tradeoff.normal_error, real_data.planned_leds
+
+    def error_spy(normals, images, lights, *args, **kwargs):  # type: ignore[no-untyped-def]
+        scored.append(np.asarray(lights))
+        return normal_error(normals, images, lights, *args, **kwargs)
+
+    def optimal_spy(*args, **kwargs):  # type: ignore[no-untyped-def]
+        planned.append(kwargs)
+        return planned_leds(*args, **kwargs)
+
+    monkeypatch.setattr(bench, "_CACHE", {})  # plan afresh, and leave no entry behind
+    monkeypatch.setattr(bench, "NS", (9,))
+    monkeypatch.setattr(bench, "RELIGHT", False)  # the normals sessions: the band's path
+    monkeypatch.setattr(bench, "BAND", band)
+    monkeypatch.setattr(tradeoff, "normal_error", error_spy)
+    monkeypatch.setattr(real_data, "planned_leds", optimal_spy)
+    monkeypatch.setattr(tradeoff, "render_scene_data", _render_once)
+    # the relighting scores are not what is tested here (test_benchmark_adaptive_held_out)
+    monkeypatch.setattr(bench, "relight_model", lambda *a: None)
+    monkeypatch.setattr(bench, "relight_psnr", lambda *a: 0.0)
+    monkeypatch.setattr(bench, "written_rti_psnr", lambda *a, **k: ("hsh1", 0.0))
+    out, _ = bench.sim(1, scenes=("painting",))
+    err = out["painting"]["err"]
+    # the bar's floors within the band: 0/10/20/30 under a 45° ceiling, 20/30 above a 20° floor
+    assert bench.bar_floors() == floors
+    assert {label for _, label in err} == {
+        *(f"uniform {f:g}" for f in floors),
+        "optimal",
+        "adaptive",
+        "adaptive relight",
+    }
+    # `optimal` planned with the band, as `plan --method optimal --min/--max-elevation-deg`
+    assert planned == [{"min_elevation_deg": band[0], "max_elevation_deg": band[1]}]
+    # every layout scored (the floors, optimal, the adaptive session) has its 9 lights in it
+    assert len(scored) == len(floors) + 3
+    for lights in scored:
+        assert len(lights) == 9
+        el = _elevations(lights)
+        assert el.min() >= band[0] - 1e-6 and el.max() <= band[1] + 1e-6, el
+    # and the band changed something: the 45° ceiling takes the highest lights away (the
+    # homogeneous layouts of 9 over the hemisphere reach 70°), the 20° floor the lowest
+    top, bottom = (
+        max(_elevations(s).max() for s in scored),
+        min(_elevations(s).min() for s in scored),
+    )
+    assert top < 46.0 if band[1] < 90 else bottom > 19.0
+
+
+def test_the_band_s_adaptive_session_is_the_cli_s(monkeypatch) -> None:
+    """The session's start is `adaptive_plan`'s (the CLI's): its candidates are the band's, so
+    the start and every decision are in it; without a band the same session leaves it."""
+    from types import SimpleNamespace
+
+    from rti_rig.app.usecases.adaptive import adaptive_plan
+    from rti_rig.core.geometry import fibonacci_cap
+    from rti_rig.core.rig_geometry import DomeGeometry
+
+    dirs = fibonacci_cap(120, 0.0, 90.0)
+    dome = DomeGeometry(dirs, tuple(f"c{i:03d}" for i in range(len(dirs))))
+    rng = np.random.default_rng(0)
+    normals = rng.normal([0.0, 0.0, 3.0], 1.0, size=(24, 24, 3))
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    grey = np.clip(np.einsum("hwk,ck->chw", normals, dirs), 0, None).astype(np.float32)
+    free, _, _ = bench.adaptive_run(grey, dirs, dome, 8)
+    assert _elevations(dirs[free]).max() > 45.0  # every elevation: the ceiling would bind
+    monkeypatch.setattr(bench, "BAND", (0.0, 45.0))
+    used, _, _ = bench.adaptive_run(grey, dirs, dome, 8)
+    assert len(used) == 8 and _elevations(dirs[used]).max() <= 45.0 + 1e-6
+    plan = adaptive_plan(SimpleNamespace(geometry=dome), 8, band=(0.0, 45.0))
+    assert used[: len(plan.start)] == [int(plan.leds[c]) for c in plan.start]
+    relit, _, _ = bench.adaptive_run(grey, dirs, dome, 8, objective="relight")
+    assert len(relit) == 8 and _elevations(dirs[relit]).max() <= 45.0 + 1e-6
+    with pytest.raises(ValueError, match="as it ships"):  # no other path is measured so
+        bench.adaptive_run(grey, dirs, dome, 60, until=2.0)
+
+
+def test_a_band_is_written_to_its_own_section_and_checked_as_the_cli_checks_it(
+    monkeypatch, capsys
+) -> None:
+    parse = bench.build_parser().parse_args
+    assert bench.band_from(parse([])) is None
+    assert bench.band_from(parse(["--max-elevation-deg", "45"])) == (0.0, 45.0)
+    assert bench.band_from(parse(["--min-elevation-deg", "20"])) == (20.0, 90.0)
+    assert bench.band_section(None) == "adaptive_benchmark"  # the main tables, unchanged
+    assert bench.band_section((0.0, 45.0)) == "adaptive_band_max45"
+    assert bench.band_section((20.0, 90.0)) == "adaptive_band_min20"
+    from rti_rig.core.errors import ScheduleError
+
+    with pytest.raises(ScheduleError, match="max-elevation-deg"):
+        bench.band_from(parse(["--min-elevation-deg", "50", "--max-elevation-deg", "40"]))
+    monkeypatch.setattr(bench, "BAND", None)  # main sets it: restored after the test
+    with pytest.raises(SystemExit) as caught:  # the simulator is skipped only within a band
+        bench.main(["--sim-draws", "0"])
+    assert caught.value.code == 2 and "--sim-draws 0" in capsys.readouterr().err
