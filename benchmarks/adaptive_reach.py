@@ -720,12 +720,7 @@ def _families_main(args: argparse.Namespace, t0: float) -> str:
     extra = "/".join(f"{f:g}°" for f in EXTRA_FLOORS)
     md = "\n".join(
         [
-            f"Command: `python -m benchmarks.adaptive_reach --families --draws {args.draws}"
-            + (f" --ceiling {args.ceiling}" if ceiling else "")
-            + (f" --scenes {args.scenes}" if args.scenes else "")
-            + (" --write" if args.write else "")
-            + f"` ({time.perf_counter() - t0:.0f} s; load average {os.getloadavg()[0]:.1f} at "
-            "the end). " + machine_line(),
+            _command_line("--families", args, ceiling, t0),
             "",
             f"Simulator, {args.draws} paired draws (those of `benchmarks.adaptive`), the shipped "
             "start (4 lights), designs decided at the first decision. Per family, the oracle "
@@ -763,18 +758,25 @@ def _families_main(args: argparse.Namespace, t0: float) -> str:
     return md
 
 
+def _command_line(mode: str, args: argparse.Namespace, ceiling: tuple[str, ...], t0: float) -> str:
+    """The table's first line: the command that measured it, how long, at what load, where."""
+    return (
+        f"Command: `python -m benchmarks.adaptive_reach {mode} --draws {args.draws}"
+        + (f" --ceiling {args.ceiling}" if ceiling else "")
+        + (f" --scenes {args.scenes}" if args.scenes else "")
+        + (" --write" if args.write else "")
+        + f"` ({time.perf_counter() - t0:.0f} s; load average {os.getloadavg()[0]:.1f} at "
+        "the end). " + machine_line()
+    )
+
+
 def _truth_main(args: argparse.Namespace, t0: float) -> str:
     ceiling = tuple(x for x in args.ceiling.split(",") if x)
     scenes = tuple(x for x in args.scenes.split(",") if x)
     rows = truth_surface(args.draws, scenes, ceiling=ceiling)
     md = "\n".join(
         [
-            f"Command: `python -m benchmarks.adaptive_reach --truth-surface --draws {args.draws}"
-            + (f" --ceiling {args.ceiling}" if ceiling else "")
-            + (f" --scenes {args.scenes}" if args.scenes else "")
-            + (" --write" if args.write else "")
-            + f"` ({time.perf_counter() - t0:.0f} s; load average {os.getloadavg()[0]:.1f} at "
-            "the end). " + machine_line(),
+            _command_line("--truth-surface", args, ceiling, t0),
             "",
             f"Simulator, {args.draws} paired draws (those of `benchmarks.adaptive`), the shipped "
             "start (4 lights), the design decided at the first decision; true mean normal error "
