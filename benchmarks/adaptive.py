@@ -857,7 +857,7 @@ def band_from(args: argparse.Namespace) -> tuple[float, float] | None:
     lo = 0.0 if args.min_elevation_deg is None else args.min_elevation_deg
     hi = 90.0 if args.max_elevation_deg is None else args.max_elevation_deg
     check_elevation_band(lo, hi)
-    return (lo, hi)
+    return None if (lo, hi) == (0.0, 90.0) else (lo, hi)  # every elevation: the main tables
 
 
 def band_section(band: tuple[float, float] | None) -> str:

@@ -330,7 +330,11 @@ class EmulatedServo:
             # Velocity(112)"; the control-table include adds "Values for Goal Velocity and
             # Profile Velocity cannot be set to values exceeding the Velocity Limit ... Data
             # Limit Error" (ROBOTIS-GIT/emanual _includes/en/dxl/control_table/velocity_limit.md
-            # @ 9344769ede3e0f19f4e4d876e3e80639f3188ae9)
+            # @ 9344769ede3e0f19f4e4d876e3e80639f3188ae9, an include with Y-series branches; the
+            # X pages' own include, control_table_vellimit.md, says only "maximum velocity").
+            # Refused or capped on an X-series servo is NOT verified (a dynamixel-workbench
+            # issue, #207, reads as capped): refusing is modelled, the stricter case, and the
+            # driver checks the limit before writing, so it meets neither
             value = int.from_bytes(data[pv.address - address : pv.address - address + 4], "little")
             if value > self.get(ct.VELOCITY_LIMIT):
                 return p2.ERR_DATA_LIMIT

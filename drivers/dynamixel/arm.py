@@ -79,8 +79,11 @@ class DynamixelArm:
         """Open the port, check the servos against the config, set profiles, torque on."""
         self._bus.open(self.settings.baudrate)
         try:
-            for joint in self.settings.joints:
+            for joint in self.settings.joints:  # every check on every servo, then any write
                 self._check_servo(joint)
+            for joint in self.settings.joints:
+                if joint.mode == ct.OperatingMode.POSITION:
+                    self._check_position_limits(joint)  # may write (EEPROM, torque off)
             self._check_in_limits()
             for joint in self.settings.joints:
                 self._bus.write(joint.servo_id, ct.PROFILE_ACCELERATION, joint.acceleration_units)
@@ -144,15 +147,15 @@ class DynamixelArm:
                     sid,
                 )
         self._check_velocity_limit(joint)
-        if joint.mode == ct.OperatingMode.POSITION:
-            self._check_position_limits(joint)
 
     def _check_velocity_limit(self, joint) -> None:
         """The profile velocity within the servo's Velocity Limit (44), checked before any write.
 
-        The servo refuses a Profile Velocity above its Velocity Limit (Data Limit Error), and
-        that limit differs per model (factory 0.229 rev/min units: XM540-W270 128 = 29.3 rpm,
-        XH430-W350 130, XM430-W350 200, XL430-W250 265, XL330-M288 445; ROBOTIS e-manual): a
+        A Profile Velocity above the Velocity Limit is refused (Data Limit Error, in a generic
+        e-manual include) or capped (not verified for the X series): either way the arm would
+        not move at the configured speed, and the limit differs per model (factory, 0.229
+        rev/min units: XM540-W270 128 = 29.3 rpm, XH430-W350 130, XM430-W350 200, XL430-W250
+        265, XL330-M288 445; ROBOTIS e-manual): a
         speed fine for one servo failed a connect on another half-way through, after the
         position limits were rewritten, as a bare "data limit error" on a register write."""
         limit = self._bus.read(joint.servo_id, ct.VELOCITY_LIMIT)

@@ -122,6 +122,8 @@ def test_a_band_is_written_to_its_own_section_and_checked_as_the_cli_checks_it(
 ) -> None:
     parse = bench.build_parser().parse_args
     assert bench.band_from(parse([])) is None
+    # an explicit full range is no band: the main tables, not a section named "adaptive_band_"
+    assert bench.band_from(parse(["--min-elevation-deg", "0", "--max-elevation-deg", "90"])) is None
     assert bench.band_from(parse(["--max-elevation-deg", "45"])) == (0.0, 45.0)
     assert bench.band_from(parse(["--min-elevation-deg", "20"])) == (20.0, 90.0)
     assert bench.band_section(None) == "adaptive_benchmark"  # the main tables, unchanged

@@ -494,12 +494,11 @@ def _fit_all(
         skipped.append(rti_why)
     elif req.write_hsh and n >= (order + 1) ** 2:
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
-        if order > RELIGHT_HSH_ORDER:  # written (RTIViewer reads it), but not for relight
-            skipped.append(
-                f"fit.rti holds an order-{order} HSH ({(order + 1) ** 2} terms): RTIViewer "
-                f"reads it, relight does not (its .rti converter and viewer know HSH of 4 or "
-                f"9 terms only); for relight, fit again with --hsh-order "
-                f"{RELIGHT_HSH_ORDER}, or fit the images with relight-cli"
+        if order > RELIGHT_HSH_ORDER:  # said on fit.rti's own line: information, not a fault
+            rti_why += (
+                f" ({(order + 1) ** 2} terms: RTIViewer views them; relight's .rti converter "
+                f"and viewer know HSH of 4 or 9 terms only, so for relight fit again with "
+                f"--hsh-order {RELIGHT_HSH_ORDER}, or fit the images with relight-cli)"
             )
     elif req.write_hsh:
         skipped.append(

@@ -108,3 +108,22 @@ def test_an_xl330_on_a_12_volt_supply_is_refused_at_connect_naming_the_voltage()
         arm.connect()
     assert "input 12.0 V as read; this servo's limits are 3.5..7.0 V" in str(info.value)
     assert info.value.torque_on is False
+
+
+def test_a_second_joints_profile_velocity_above_its_limit_fails_connect_before_any_write() -> None:
+    """Every joint is checked before anything is written to any servo: an XL430 azimuth (its
+    position limits to synchronise) and an XM540 elevation at 40 rpm (Velocity Limit 128 =
+    29.3 rpm). The check ran per joint, after the previous joint's EEPROM position limits had
+    been rewritten (torque off, two EEPROM writes) — a connect that failed half-way."""
+    settings = arm_settings(
+        azimuth=dict(model_number=1060, profile_velocity_rpm=40.0),
+        elevation=dict(model_number=1120, profile_velocity_rpm=40.0),
+    )
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    arm = DynamixelArm(settings, InProcessPort(emu), clock)
+    with pytest.raises(ConfigMismatchError, match="profile_velocity_rpm"):
+        arm.connect()
+    assert not arm.commanded
+    for servo in emu.servos.values():
+        assert servo.get(ct.MIN_POSITION_LIMIT) == 0 and servo.get(ct.MAX_POSITION_LIMIT) == 4095
