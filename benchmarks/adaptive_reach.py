@@ -302,22 +302,27 @@ def scene_rows(scene: str, res: dict, starts: list[str], measure: str = "normals
     return rows
 
 
+def _scenes(scenes: tuple[str, ...], seed: int):  # type: ignore[no-untyped-def]
+    """Per simulated scene asked (all: ``()``): its index, name, rendered data and the draws'
+    generator — the draws of benchmarks.adaptive."""
+    from benchmarks.tradeoff import TradeoffSettings, render_scene_data
+
+    settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
+    for si, scene in enumerate(settings.scenes):
+        if scenes and scene not in scenes:
+            continue
+        yield si, scene, render_scene_data(scene, settings), np.random.default_rng([seed, si])
+
+
 def reach(
     draws: int, scenes: tuple[str, ...] = (), seed: int = 0, measure: str = "normals"
 ) -> list[str]:
     """Table rows: per scene and N, the tuned bar and, per start, each floor's completion (mean
     over draws) and the oracle (``measure``: one of :data:`MEASURES`)."""
-    from benchmarks.tradeoff import TradeoffSettings, render_scene_data
-
-    settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     starts = start_functions()
     objective = "relight" if measure == "relight" else "normals"
     rows = []
-    for si, scene in enumerate(settings.scenes):
-        if scenes and scene not in scenes:
-            continue
-        rng = np.random.default_rng([seed, si])  # the draws of benchmarks.adaptive
-        data = render_scene_data(scene, settings)
+    for _, scene, data, rng in _scenes(scenes, seed):
         cand = data.candidate_dirs
         score = _layout_scores(data, measure)
         res: dict[tuple[int, str], list[float]] = {}
@@ -374,16 +379,11 @@ def families(
     reachable from the start: for reference). ``ceiling`` (cells ``scene:N``): also a greedy
     exchange on the *true* error with the start kept (what any completion could reach; slow)."""
     from benchmarks.planner_real_data import planned_leds
-    from benchmarks.tradeoff import TradeoffSettings, render_scene_data
+    from benchmarks.tradeoff import TradeoffSettings
 
-    settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
-    light = settings.preview_light_az_el_deg
+    light = TradeoffSettings(held_out_lights=1, ground_truth_lights=50).preview_light_az_el_deg
     rows = []
-    for si, scene in enumerate(settings.scenes):
-        if scenes and scene not in scenes:
-            continue
-        rng = np.random.default_rng([seed, si])  # the draws of benchmarks.adaptive
-        data = render_scene_data(scene, settings)
+    for _, scene, data, rng in _scenes(scenes, seed):
         cand = data.candidate_dirs
         grey = data.candidate_images.mean(axis=-1)
 
@@ -495,16 +495,10 @@ def truth_surface(
     is the surface a session has fitted, which the objective itself — and, in ``ceiling``
     cells, the greedy exchange on the true error."""
     import rti_rig.planner.adaptive_optimal as ao
-    from benchmarks.tradeoff import TradeoffSettings, render_scene_data
     from rti_rig.planner.objectives import Candidates, NormalsObjective
 
-    settings = TradeoffSettings(held_out_lights=1, ground_truth_lights=50)
     rows = []
-    for si, scene in enumerate(settings.scenes):
-        if scenes and scene not in scenes:
-            continue
-        rng = np.random.default_rng([seed, si])  # the draws of benchmarks.adaptive
-        data = render_scene_data(scene, settings)
+    for si, scene, data, rng in _scenes(scenes, seed):
         cand = data.candidate_dirs
         grey = data.candidate_images.mean(axis=-1)
         finite = np.flatnonzero(np.isfinite(data.normals.reshape(-1, 3)).all(axis=1))
