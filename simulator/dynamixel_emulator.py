@@ -40,6 +40,28 @@ from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.simulator import dynamixel_models as models
 
+#: The registers a servo leaves the factory with, and the field of
+#: :class:`~rti_rig.simulator.dynamixel_models.FactoryTable` that holds each one's value.
+FACTORY_REGISTERS = (
+    (ct.BAUD_RATE, "baud_rate"),
+    (ct.RETURN_DELAY_TIME, "return_delay_time"),
+    (ct.DRIVE_MODE, "drive_mode"),
+    (ct.OPERATING_MODE, "operating_mode"),
+    (ct.SECONDARY_ID, "secondary_id"),
+    (ct.PROTOCOL_TYPE, "protocol_type"),
+    (ct.HOMING_OFFSET, "homing_offset"),
+    (ct.MOVING_THRESHOLD, "moving_threshold"),
+    (ct.TEMPERATURE_LIMIT, "temperature_limit"),
+    (ct.MAX_VOLTAGE_LIMIT, "max_voltage_limit"),
+    (ct.MIN_VOLTAGE_LIMIT, "min_voltage_limit"),
+    (ct.PWM_LIMIT, "pwm_limit"),
+    (ct.CURRENT_LIMIT, "current_limit"),
+    (ct.VELOCITY_LIMIT, "velocity_limit"),
+    (ct.MAX_POSITION_LIMIT, "max_position_limit"),
+    (ct.MIN_POSITION_LIMIT, "min_position_limit"),
+    (ct.SHUTDOWN, "shutdown"),
+    (ct.STATUS_RETURN_LEVEL, "status_return_level"),
+)
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
 DEFAULT_FIRMWARE = 46
@@ -141,27 +163,12 @@ class EmulatedServo:
         self._set(ct.MODEL_NUMBER, model_number)
         self._set(ct.FIRMWARE_VERSION, firmware)
         self._set(ct.ID, dxl_id)
-        self._set(ct.BAUD_RATE, f.baud_rate)
-        self._set(ct.RETURN_DELAY_TIME, f.return_delay_time)
-        self._set(ct.DRIVE_MODE, f.drive_mode)
-        self._set(ct.OPERATING_MODE, f.operating_mode)
-        self._set(ct.SECONDARY_ID, f.secondary_id)
-        self._set(ct.PROTOCOL_TYPE, f.protocol_type)
-        self._set(ct.HOMING_OFFSET, f.homing_offset)
-        self._set(ct.MOVING_THRESHOLD, f.moving_threshold)
-        self._set(ct.TEMPERATURE_LIMIT, f.temperature_limit)
-        self._set(ct.MAX_VOLTAGE_LIMIT, f.max_voltage_limit)
-        self._set(ct.MIN_VOLTAGE_LIMIT, f.min_voltage_limit)
-        self._set(ct.PWM_LIMIT, f.pwm_limit)
-        if f.current_limit is not None:  # absent on the XL430/2XL430: address 38 stays 0
-            self._set(ct.CURRENT_LIMIT, f.current_limit)
-        self._set(ct.VELOCITY_LIMIT, f.velocity_limit)
-        self._set(ct.MAX_POSITION_LIMIT, f.max_position_limit)
-        self._set(ct.MIN_POSITION_LIMIT, f.min_position_limit)
+        for reg, attr in FACTORY_REGISTERS:
+            value = getattr(f, attr)
+            if value is not None:  # None: the model lacks it (no Current Limit on an XL430)
+                self._set(reg, value)
         for address, (size, value) in f.extra.items():
             self.table[address : address + size] = value.to_bytes(size, "little")
-        self._set(ct.SHUTDOWN, f.shutdown)
-        self._set(ct.STATUS_RETURN_LEVEL, f.status_return_level)
         # configured for the rig (Operating Mode and limits are EEPROM: set before delivery)
         self._set(ct.OPERATING_MODE, int(operating_mode))
         if max_position is not None:
