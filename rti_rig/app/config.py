@@ -374,10 +374,53 @@ def _error_text(err: Any) -> str:
     return f"{msg} (got {got!r})"
 
 
+def quoted_value(raw: Any, value: Any, loc: tuple[Any, ...] = ()) -> tuple[str, str, Any] | None:
+    """(key, text, value) of the first value the TOML gave as a string that validation turned
+    into a number or a truth value (``exposure_s = "0.05"``, ``checksum = "false"``), else None.
+
+    Why: pydantic's lax mode converts such strings silently, but TOML has numbers and booleans
+    of its own, so quotes around one are a slip (often a line copied from elsewhere or written
+    by a script), and the reverse slip — a number where a camera wants its own text, ``iso =
+    100`` — is refused already. The walk compares the file's tree with the validated one, so it
+    needs no list of numeric keys and reaches every table and array."""
+    if isinstance(raw, str):
+        return (_key_of(loc), raw, value) if isinstance(value, bool | int | float) else None
+    if isinstance(raw, dict):
+        for k, sub_raw in raw.items():
+            if isinstance(value, BaseModel) and k in type(value).model_fields:
+                sub = getattr(value, k)
+            elif isinstance(value, dict) and k in value:
+                sub = value[k]
+            else:
+                continue
+            hit = quoted_value(sub_raw, sub, (*loc, k))
+            if hit is not None:
+                return hit
+    elif isinstance(raw, list) and isinstance(value, list | tuple) and len(raw) == len(value):
+        for i, (sub_raw, sub) in enumerate(zip(raw, value, strict=True)):
+            hit = quoted_value(sub_raw, sub, (*loc, i))
+            if hit is not None:
+                return hit
+    return None
+
+
+def refuse_quoted_value(path: str | Path, raw: Any, value: Any, loc: tuple[Any, ...] = ()) -> None:
+    """Raise a :class:`ConfigError` naming the key :func:`quoted_value` finds, if any."""
+    hit = quoted_value(raw, value, loc)
+    if hit is None:
+        return
+    key, text, got = hit
+    kind = "true or false" if isinstance(got, bool) else "a number"
+    raise ConfigError(
+        path, key, f"{text!r} is text in quotes, not {kind}: write it without the quotes"
+    )
+
+
 def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
-    """Validate parsed TOML; the first problem becomes a :class:`ConfigError`."""
+    """Validate parsed TOML; the first problem becomes a :class:`ConfigError`, and so does a
+    number or truth value written in quotes (:func:`quoted_value`)."""
     try:
-        return RigConfig.model_validate(data)
+        config = RigConfig.model_validate(data)
     except ValidationError as exc:
         problems = []
         for err in exc.errors():
@@ -387,6 +430,17 @@ def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
             rest = "; ".join(f"'{k}': {m}" if k else m for k, m in problems[1:])
             msg += f" — and also {rest}"
         raise ConfigError(path, key, msg) from None
+    refuse_quoted_value(path, data, config)
+    serial = config.dome.serial if config.dome is not None else None
+    if serial is not None and serial.protocol:
+        raw = data.get("dome", {}).get("serial", {}).get("protocol", {})
+        try:
+            spec = serial.protocol_spec()
+        except (ValueError, ValidationError):
+            spec = None  # refused by name elsewhere (the settings' own check)
+        if spec is not None:
+            refuse_quoted_value(path, raw, spec, ("dome", "serial", "protocol"))
+    return config
 
 
 #: Format tag of a light calibration file (``rti-rig calibrate-lights``).
@@ -687,13 +741,16 @@ def camera_device_settings(rig: LoadedRig):  # type: ignore[no-untyped-def]
     """The validated driver settings of the rig's real camera (``[camera.device]``)."""
     from rti_rig.drivers.cameras.settings import parse_camera_settings
 
+    raw = rig.config.camera.device or {}
     try:
-        return parse_camera_settings(rig.config.camera.device or {})
+        settings = parse_camera_settings(raw)
     except ValidationError as exc:
         err = exc.errors()[0]  # said as every other table's (parse_rig_config)
         raise ConfigError(
             rig.path, _key_of(("camera", "device", *err["loc"])), _error_text(err)
         ) from None
+    refuse_quoted_value(rig.path, raw, settings, ("camera", "device"))
+    return settings
 
 
 def default_config_path() -> Path:

@@ -217,3 +217,88 @@ def test_a_camera_device_on_a_dry_run_is_refused(
     assert f"{cfg}: key 'camera.device': backend = '{backend}' renders its own images" in text
     assert "set backend = 'hardware'" in text and "remove [camera.device]" in text
     assert not (tmp_path / "s").exists()
+
+
+# ------------------------------------------------------- a number or truth value in quotes
+
+
+@pytest.mark.parametrize(
+    ("shipped", "old", "new", "key", "kind"),
+    [
+        # a table's own number (pydantic's lax mode had read "0.05" as 0.05 without a word)
+        (
+            "simulated_dome.toml",
+            "exposure_s = 0.05",
+            'exposure_s = "0.05"',
+            "camera.exposure_s",
+            "a number",
+        ),
+        # a driver's settings table
+        ("emulated_rtipy.toml", "retries = 2", 'retries = "2"', "dome.serial.retries", "a number"),
+        # a firmware description, validated by the driver after the settings
+        (
+            "emulated_rtipy.toml",
+            "led_count = 8 ",
+            'led_count = "8" ',
+            "dome.serial.protocol.led_count",
+            "a number",
+        ),
+        # an element of an array of tables
+        (
+            "simulated_dome.toml",
+            "elevation_deg = 25.0",
+            'elevation_deg = "25.0"',
+            "dome.rings[1].elevation_deg",
+            "a number",
+        ),
+        # a servo arm's driver settings
+        (
+            "simulated_arm.toml",
+            "settle_time_s = 0.05",
+            'settle_time_s = "0.05"',
+            "arm.dynamixel.settle_time_s",
+            "a number",
+        ),
+        # a truth value
+        (
+            "simulated_arm.toml",
+            "[arm]",
+            '[arm]\npark_after_session = "false"',
+            "arm.park_after_session",
+            "true or false",
+        ),
+    ],
+)
+def test_a_quoted_number_is_refused_naming_its_key(
+    tmp_path: Path, shipped: str, old: str, new: str, key: str, kind: str
+) -> None:
+    cfg = edited(tmp_path, shipped, old, new)
+    with pytest.raises(ConfigError) as err:
+        load_rig_config(cfg)
+    assert err.value.key == key
+    assert f"is text in quotes, not {kind}: write it without the quotes" in err.value.message
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    assert f"key '{key}'" in said(r)
+    assert "Traceback" not in r.output
+
+
+def test_a_quoted_truth_value_in_the_camera_device_table_is_refused(tmp_path: Path) -> None:
+    """``[camera.device]`` is validated by the camera driver's settings after the rig's own
+    tables; its text values (``iso = "100"``) stay text, a quoted boolean is refused."""
+    (tmp_path / "example_dome_48.lp").write_bytes((CONFIGS / "example_dome_48.lp").read_bytes())
+    cfg = edited(tmp_path, "example_dome_48.toml", 'iso = "100"', 'iso = "100"\nkeep_jpeg = "true"')
+    with pytest.raises(ConfigError) as err:
+        load_rig_config(cfg)
+    assert err.value.key == "camera.device.keep_jpeg"
+    assert "'true' is text in quotes, not true or false" in err.value.message
+    # without the quotes it loads, and the camera's own text values are kept as text
+    fixed = edited(
+        tmp_path, "example_dome_48.toml", 'iso = "100"', 'iso = "100"\nkeep_jpeg = true', "ok.toml"
+    )
+    assert load_rig_config(fixed).config.camera.device["iso"] == "100"
+
+
+def test_every_shipped_config_has_no_quoted_number() -> None:
+    for cfg in sorted(CONFIGS.glob("*.toml")):
+        load_rig_config(cfg)  # raises on a quoted number
