@@ -6,9 +6,13 @@ line (at most 1000), then ``name x y z`` with one space, LF endings, unit vector
 ``1.0`` and exponents are never written; components are clamped to ±0.999999).
 
 The reader is tolerant of what real files contain (tabs, CRLF, trailing blanks, blank lines, a
-missing count line, non-unit vectors, which are renormalised) and precise about what it rejects:
-every error names the file, the line and the reason. Two flaws of real calibrated files are kept
-and *reported* (appended to ``notes``, each naming the file and line) rather than refused:
+missing count line, non-unit vectors, which are renormalised; a UTF-8 or UTF-16 byte-order mark)
+and precise about what it rejects: every error names the file, the line and the reason, and where
+a known tool writes such a file (relight's "0 0 0" for a light it did not find, a dome's nameless
+"skeleton" list, relight's JSON dome) the error says which, so the fix is plain.
+
+Two flaws of real calibrated files are kept and *reported* (appended to ``notes``, each naming
+the file and line) rather than refused:
 
 * a count line that disagrees with the lines listed (one real dome file says 47 above 48
   lights): the listed lines are used;
@@ -20,6 +24,7 @@ and *reported* (appended to ``notes``, each naming the file and line) rather tha
 
 from __future__ import annotations
 
+import codecs
 import contextlib
 import math
 import re
@@ -189,7 +194,10 @@ def _parse_float(token: str, source: str, lineno: int, axis: str) -> float:
 
 
 #: File name endings of the images an ``.lp`` lists (to tell a name from a stray column).
-_IMAGE_ENDINGS = (".jpg", ".jpeg", ".tif", ".tiff", ".png", ".dng", ".cr2", ".nef", ".arw")
+_IMAGE_ENDINGS = (
+    ".jpg", ".jpeg", ".tif", ".tiff", ".png", ".dng", ".cr2", ".nef", ".arw",
+    ".tga", ".ppm",  # HP's PTMfitter reads .jpg, .tga and .ppm
+)  # fmt: skip
 
 
 #: A light vector further than this from unit length is noted (normalised all the same).
@@ -219,6 +227,32 @@ def _refuse_extra_columns(tokens: list[str], line: str, source: str, lineno: int
         )
 
 
+def _refuse_non_lp_text(content: list[tuple[int, str]], source: str) -> None:
+    """Refuse, saying what it is, a file that is no ``.lp`` text at all, before its first line
+    is read as a count: NUL bytes (UTF-16 saved without a byte-order mark, or a file cut off
+    while being written, which FAT cards fill with zeros) had been shown as
+    ``count line '1\\x008\\x00'``; relight's JSON dome (``.dome``, or a ``.relight`` project)
+    as ``count line '{' is not a whole number``."""
+    for lineno, line in content:
+        if "\x00" in line:
+            raise LpFormatError(
+                source,
+                lineno,
+                "the line holds NUL bytes: not plain text (UTF-16 without a byte-order mark?) "
+                "or cut off while being written (a power loss, a full card?); save it again as "
+                "UTF-8 or ASCII text, or copy it again from where it was written",
+            )
+    first_no, first = content[0]
+    if first.startswith("{"):
+        raise LpFormatError(
+            source,
+            first_no,
+            "this is a JSON file, not an .lp (relight's .dome or .relight project?); give the "
+            "lights as an .lp: a count line, then 'image-name x y z' per image (relight can "
+            "save one from a project)",
+        )
+
+
 def parse_lp(
     text: str,
     source: str = "<lp>",
@@ -239,10 +273,10 @@ def parse_lp(
     content = [(n, ln) for n, ln in numbered if ln]
     comments = [n for n, ln in content if ln.startswith("#")]
     if comments:
-        # no .lp writer we know of writes them, but a hand-annotated file is no wrong file:
-        # skipped, and said (a '# LP file from RTIBuilder, dome A' header had been refused as
-        # "x component 'RTIBuilder,' is not a number"; one ending in three numbers would have
-        # been read as a light)
+        # cceh/rti's image-filer.py wrote a '# run of <date>' line above the count, and a
+        # hand-annotated file is no wrong file: skipped, and said (a '# LP file from RTIBuilder,
+        # dome A' header had been refused as "x component 'RTIBuilder,' is not a number"; one
+        # ending in three numbers would have been read as a light)
         content = [(n, ln) for n, ln in content if not ln.startswith("#")]
         notes.append(
             f"{source}, line{'s' if len(comments) > 1 else ''} "
@@ -251,6 +285,7 @@ def parse_lp(
         )
     if not content:
         raise LpFormatError(source, None, "the file is empty; expected a count line and lights")
+    _refuse_non_lp_text(content, source)
 
     declared: int | None = None
     first_no, first = content[0]
@@ -271,6 +306,16 @@ def parse_lp(
     off_unit: list[tuple[int, float]] = []
     for lineno, line in content:
         tokens = line.split()
+        if len(tokens) == 3 and all(_is_number(t) for t in tokens):
+            # cceh/rti's lp-builder.py writes a dome's lights as bare 'x y z' lines (its
+            # "skeleton" .lp, filled with names by its image-filer.py): no image to pair
+            raise LpFormatError(
+                source,
+                lineno,
+                f"expected 'name x y z', found three numbers and no image name: {line!r} (a "
+                "dome's light list without image names, such as the 'skeleton' .lp of cceh/rti's "
+                "lp-builder.py?); put each image's file name before its light, in shooting order",
+            )
         if len(tokens) < 4:
             raise LpFormatError(
                 source,
@@ -286,8 +331,14 @@ def parse_lp(
         )
         norm = math.sqrt(x * x + y * y + z * z)
         if norm < MIN_NORM:
+            # relight's saveLP writes '0 0 0' for an image whose light its sphere did not find
+            # (it warns "Missing N light directions" and saves all the same): say so
             raise LpFormatError(
-                source, lineno, f"direction ({x}, {y}, {z}) is (nearly) zero: it has no orientation"
+                source,
+                lineno,
+                f"direction ({x}, {y}, {z}) of {name!r} is (nearly) zero: it has no orientation "
+                "(a light the writing tool did not find? relight saves a missing direction as "
+                "'0 0 0'); find that light again, or remove the line and leave its image out",
             )
         if upper_hemisphere and -HORIZON_TOLERANCE < z / norm < -1e-9:
             flat = math.hypot(x, y)
@@ -346,11 +397,22 @@ def read_lp(
         raw = path.read_bytes()
     except OSError as exc:
         raise LpFormatError(path, None, f"cannot read: {exc.strerror or exc}") from None
+    return parse_lp(_decode(raw), str(path), upper_hemisphere, notes)
+
+
+def _decode(raw: bytes) -> str:
+    """The text of an `.lp`'s bytes. A byte-order mark says the encoding: UTF-8 (Notepad's
+    "UTF-8 with BOM") or UTF-16 (Notepad's "Unicode"; what Windows PowerShell 5.1's ``>`` and
+    ``Out-File`` write by default), which relight reads (Qt's QTextStream detects the mark) and
+    which had been refused as ``count line 'ÿþ1\\x008\\x00'``. Without a mark, UTF-8, else
+    Latin-1 (a Windows tool's ANSI names), which never fails."""
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        with contextlib.suppress(UnicodeDecodeError):  # cut off mid-character: NULs, said
+            return raw.decode("utf-16")
     try:
-        text = raw.decode("utf-8-sig")
+        return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
-        text = raw.decode("latin-1")
-    return parse_lp(text, str(path), upper_hemisphere, notes)
+        return raw.decode("latin-1")
 
 
 def directions_of(entries: Iterable[LpEntry]) -> NDArray[np.float64]:

@@ -276,3 +276,137 @@ def test_vectors_far_from_unit_length_are_noted_rounding_noise_is_not() -> None:
     quiet: list[str] = []
     parse_lp("1\na_1.jpg 0.6001 0 0.8002\n", "near.lp", notes=quiet)
     assert quiet == []
+
+
+# --- Files real tools write (sources: docs/conventions.md, "Files other tools write") ---------
+
+
+def test_hp_ptmfitter_sample_file_reads() -> None:
+    """HP Labs' "Making PTMs with a .lp File" sample (the PTMfitter's own example): absolute
+    Windows paths, a run of spaces before the vector, and the last ring at z = -0.000204 (a hair
+    below the horizon, clamped where lights must be above the plane)."""
+    text = (
+        "3\n"
+        "C:\\Leaves512\\91-001.jpg       -0.015760 0.196076 0.980462\n"
+        "C:\\Leaves512\\91-049.jpg       -0.950980 -0.309253 -0.000204\n"
+        "C:\\Leaves512\\91-050.jpg       -0.587692 0.809084 -0.000204\n"
+    )
+    notes: list[str] = []
+    entries = parse_lp(text, "leaves.lp", upper_hemisphere=True, notes=notes)
+    assert [image_file_name(e.name) for e in entries] == ["91-001.jpg", "91-049.jpg", "91-050.jpg"]
+    assert entries[1].direction[2] == 0.0 and entries[2].direction[2] == 0.0
+    assert len(notes) == 2 and "clamped to z = 0" in notes[0]
+
+
+def test_relight_savelp_output_reads() -> None:
+    """relight's Project::saveLP (cnr-isti-vclab/relight, src/project.cpp) streams floats through
+    Qt's QTextStream: six significant digits, so ``1``, ``0``, ``-0`` and exponents such as
+    ``1e-05``; the image names are the folder's file names as they are (spaces included)."""
+    text = (
+        "3\nIMG 0001.jpg 0 0 1\nIMG 0002.jpg 1e-05 -0 1\n"
+        "IMG 0003.jpg -0.707107 3.09086e-08 0.707107\n"
+    )
+    entries = parse_lp(text, "relight.lp")
+    assert [e.name for e in entries] == ["IMG 0001.jpg", "IMG 0002.jpg", "IMG 0003.jpg"]
+    np.testing.assert_allclose(entries[1].direction, (1e-05, 0, 1), atol=1e-9)
+    np.testing.assert_allclose(entries[2].direction, (-0.707107, 0, 0.707107), atol=1e-6)
+
+
+def test_relight_zero_direction_for_a_light_not_found_is_refused_naming_it() -> None:
+    """relight's Project::saveLP writes ``0 0 0`` for an image whose light the sphere did not
+    give (it warns "Missing N light directions" and saves all the same). Such a file is refused,
+    and now the error names the image and says what the zero means and what to do (it had said
+    only "is (nearly) zero: it has no orientation")."""
+    text = "2\nimg_01.jpg 0.6 0 0.8\nimg_02.jpg 0 0 0\n"
+    with pytest.raises(LpFormatError) as info:
+        parse_lp(text, "relight.lp")
+    message = str(info.value)
+    assert message.startswith("relight.lp, line 3: ")
+    assert "'img_02.jpg'" in message and "relight saves a missing direction as '0 0 0'" in message
+    assert "remove the line" in message
+
+
+def test_relight_json_dome_is_refused_as_json() -> None:
+    """relight's dome calibration (``.dome``) and project (``.relight``) are JSON: given where an
+    .lp goes, the error says so (it had been "count line '{' is not a whole number")."""
+    text = '{\n    "label": "dome",\n    "directions": [{"x": 0.1, "y": 0.2, "z": 0.97}]\n}\n'
+    with pytest.raises(LpFormatError) as info:
+        parse_lp(text, "my.dome")
+    assert str(info.value).startswith("my.dome, line 1: this is a JSON file, not an .lp")
+
+
+def test_cceh_skeleton_without_names_is_refused_saying_so() -> None:
+    """cceh/rti's lp-builder.py writes a dome's lights as bare ``x y z`` lines, no count and no
+    names (``dome1.lp``, the "skeleton" its image-filer.py fills with names): there is no image
+    to pair, so it is refused, and the error now says what the file is and what to add (it had
+    been "expected 'name x y z', found 3 field(s)")."""
+    text = "0.129535 0.129535 0.983078\n-0.129535 0.129535 0.983078\n"
+    with pytest.raises(LpFormatError) as info:
+        parse_lp(text, "dome1.lp")
+    message = str(info.value)
+    assert message.startswith("dome1.lp, line 1: expected 'name x y z', found three numbers")
+    assert "lp-builder.py" in message and "put each image's file name before its light" in message
+
+
+def test_cceh_image_filer_output_reads() -> None:
+    """cceh/rti's image-filer.py (an early version) wrote ``# run of <date>`` above the count,
+    and ``%f`` numbers, ``-0.000000`` included: read, the comment said in a note."""
+    text = (
+        "# run of 2018-11-11T22:38:29\n2\n"
+        "DSC_2827.jpg 0.129535 0.129535 0.983078\n"
+        "DSC_2828.jpg 0.469828 -0.000000 0.882758\n"
+    )
+    notes: list[str] = []
+    entries = parse_lp(text, "sample.lp", notes=notes)
+    assert [e.name for e in entries] == ["DSC_2827.jpg", "DSC_2828.jpg"]
+    assert notes == ["sample.lp, line 1: comment line(s) starting with '#' skipped"]
+
+
+def test_lpgen_tab_separated_lines_read() -> None:
+    """lpgen (Michael Hodgson, 2011; a PTM light-position generator) writes the name, a tab,
+    then the vector as the base file had it (spaces between the components)."""
+    entries = parse_lp("2\nxx-001.tga\t-0.015760 0.196076 0.980462\nxx-002.tga\t0 0.6 0.8\n")
+    assert [e.name for e in entries] == ["xx-001.tga", "xx-002.tga"]
+
+
+def test_ptmfitter_image_endings_tell_an_extra_column() -> None:
+    """HP's PTMfitter reads .tga and .ppm images: a number after such a name is a stray column,
+    refused as one (it had been read as the name ``xx-001.tga 1.0``)."""
+    for name in ("xx-001.tga", "xx-001.PPM"):
+        with pytest.raises(LpFormatError, match="an extra column after the name"):
+            parse_lp(f"1\n{name} 1.0 0.6 0 0.8\n", "ptm.lp")
+
+
+def test_utf8_bom_from_windows_editors_reads(tmp_path: Path) -> None:
+    """Notepad's "UTF-8 with BOM" and Windows PowerShell's ``Out-File -Encoding UTF8`` start
+    the file with a byte-order mark: read as if it were not there."""
+    p = tmp_path / "bom.lp"
+    p.write_bytes("\ufeff2\r\na_1.jpg 0 0 1\r\na_2.jpg 0 0.6 0.8\r\n".encode())
+    assert [e.name for e in read_lp(p)] == ["a_1.jpg", "a_2.jpg"]
+
+
+def test_utf16_from_windows_powershell_or_notepad_reads(tmp_path: Path) -> None:
+    """Windows PowerShell 5.1's ``>`` and ``Out-File`` write UTF-16 with a byte-order mark by
+    default, as does Notepad's "Unicode"; relight reads such a file (Qt's QTextStream detects
+    the mark). It had been refused as "count line 'ÿþ1\\x008\\x00' is not a whole number"."""
+    text = "2\r\nH:\\Données\\a_1.jpg 0 0 1\r\na_2.jpg 0 0.6 0.8\r\n"
+    for encoding in ("utf-16", "utf-16-be"):
+        p = tmp_path / f"{encoding}.lp"
+        raw = text.encode(encoding)
+        p.write_bytes(raw if encoding == "utf-16" else b"\xfe\xff" + raw)
+        entries = read_lp(p)
+        assert [e.name for e in entries] == ["H:\\Données\\a_1.jpg", "a_2.jpg"], encoding
+
+
+def test_nul_bytes_are_refused_saying_why(tmp_path: Path) -> None:
+    """UTF-16 without a byte-order mark, or a file cut off while written (a card fills the rest
+    with zeros): NUL bytes are no .lp text. The error says so on the line that holds them (it
+    had shown the count line as '1\\x008\\x00', or a light line of NULs as one field)."""
+    p = tmp_path / "nobom.lp"
+    p.write_bytes("1\na_1.jpg 0 0 1\n".encode("utf-16-le"))
+    with pytest.raises(LpFormatError, match=r"line 1: the line holds NUL bytes"):
+        read_lp(p)
+    cut = tmp_path / "cut.lp"
+    cut.write_bytes(b"2\na_1.jpg 0 0 1\na_2.jpg 0 0.6 0.8\n" + b"\x00" * 64)
+    with pytest.raises(LpFormatError, match=r"cut\.lp, line 4: the line holds NUL bytes"):
+        read_lp(cut)
