@@ -156,6 +156,11 @@ class Decision:
     #: with only ``--until-error``: the guessed N whose design the light was chosen in
     #: (:mod:`rti_rig.planner.adaptive_until`)
     guessed_lights: int | None = None
+    #: the elevation band (°) the candidates were cut to (``--min/--max-elevation-deg``; None:
+    #: every elevation). ``design_floor`` stays the key of the design among the floors (what
+    #: the next decision keeps as its incumbent); the evidence records the floor the band
+    #: really applied and its ceiling (:func:`applied_floor`), never a floor below the band
+    band: tuple[float, float] | None = None
 
     def evidence(self) -> dict[str, object]:
         out: dict[str, object] = {
@@ -170,7 +175,9 @@ class Decision:
         if self.design_floor == FITTED_KEY:  # not a floor (FITTED_DESIGN)
             out["design"] = "fitted"
         elif self.design_floor is not None:
-            out["design_floor_deg"] = self.design_floor
+            out["design_floor_deg"] = applied_floor(self.design_floor, self.band)
+            if _ceiling(self.band) is not None:
+                out["design_ceiling_deg"] = _ceiling(self.band)
         if self.objective is not None:
             out["design_objective"] = self.objective
         if self.design_scores is not None:
@@ -426,6 +433,50 @@ FITTED_SEED_FLOORS: tuple[float, ...] = ()
 FITTED_KEY = -1.0
 
 
+def applied_floor(floor: float, band: tuple[float, float] | None) -> float:
+    """The floor a design above ``floor`` really has among the candidates of ``band`` (the
+    elevation band they were cut to): the higher of the two; the fitted design's key as it is.
+
+    Why: a design above 0° or 10° among a 20° band's lights is that band's design above 20°:
+    :func:`homogeneous_completion` sees the same candidates above each of those floors and
+    spans its ideal layout from the same lowest light, so the three are one layout. Recording
+    it as "above 10°" would claim that lights between 10° and 20° were open to it."""
+    if band is None or floor == FITTED_KEY:
+        return floor
+    return max(floor, float(band[0]))
+
+
+def _ceiling(band: tuple[float, float] | None) -> float | None:
+    """The band's ceiling (°) where it has one (below 90°): the top of every design in it."""
+    if band is None or band[1] >= 90.0:
+        return None
+    return float(band[1])
+
+
+def _merged_floors(
+    floors: tuple[float, ...], band: tuple[float, float] | None
+) -> dict[float, list[float]]:
+    """The floors (keys of the designs) grouped by :func:`applied_floor`: the floors of each
+    group are one design in ``band`` (the fitted key on its own)."""
+    groups: dict[float, list[float]] = {}
+    for f in sorted(floors):
+        groups.setdefault(applied_floor(f, band), []).append(f)
+    return groups
+
+
+def _recorded_scores(
+    scores: dict[float, Any], band: tuple[float, float] | None, best: float
+) -> dict[str, Any]:
+    """The designs' scores as the evidence records them: one entry per design, keyed by the
+    floor the band applied (:func:`applied_floor`), so that designs which are one layout in the
+    band are named once (they score alike: the same lights; the taken design's own score where
+    it is among them)."""
+    out: dict[str, Any] = {}
+    for a, group in _merged_floors(tuple(scores), band).items():
+        out[_label(a)] = scores[best] if best in group else scores[group[0]]
+    return out
+
+
 def design_error_deg(
     state: SurfaceState,
     new_lights: NDArray[np.float64],
@@ -569,6 +620,7 @@ def choose_in_design(
     incumbent: float | None = None,
     objective: str = "normals",
     relight: RelightFn | None = None,
+    band: tuple[float, float] | None = None,
 ) -> Decision:
     """With ``n_total`` lights known: the best complete design, then its most useful light.
 
@@ -584,6 +636,11 @@ def choose_in_design(
     their simulated relighting PSNR on this object's model instead
     (:mod:`rti_rig.planner.adaptive_relight`); the order of the lights within the design is
     still the bound's (it does not change the layout a completed session ends with).
+
+    ``band``: the elevation band (°) the candidates were cut to (``--min/--max-elevation-deg``;
+    None: every elevation). It changes no choice, only what is recorded: each design is named
+    by the floor the band applied and its ceiling, designs that are one layout in the band once
+    (:func:`applied_floor`).
     """
     if objective not in OBJECTIVES:
         raise ValueError(f"unknown objective {objective!r}; known: {', '.join(OBJECTIVES)}")
@@ -649,6 +706,7 @@ def choose_in_design(
             move_s=move_s,
             scale=scale,
             keep=keep,
+            band=band,
         )
     if model is not None and designs:  # bias-aware: each design simulated on this object
         assert fit is not None
@@ -680,7 +738,7 @@ def choose_in_design(
         scale=scale,
         keep=keep,
     )
-    design = {_label(f): round(v, 4) for f, v in sorted(scores.items())}
+    design = {k: round(v, 4) for k, v in _recorded_scores(scores, band, best).items()}
     if model is None:  # the bound's scores are estimates already (scaled)
         after = f"bound: {scores[best]:.3g}° estimated after all {n_total}"
     elif model.noise_slope == 0.0:  # the scores rank; scaled, the estimate --until-error uses
@@ -700,11 +758,12 @@ def choose_in_design(
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"{_design_name(best, n_total)} ({after}; by floor: {design}); within it, "
-        f"the largest predicted drop per second ({k} captured)",
+        f"{_design_name(best, n_total, band, tuple(scores))} ({after}; {_by_floor(band)}: "
+        f"{design}); within it, the largest predicted drop per second ({k} captured)",
         design_floor=best,
         objective="normals",
         design_scores=design,
+        band=band,
     )
 
 
@@ -730,16 +789,48 @@ def _label(f: float) -> str:
     return "fitted" if f == FITTED_KEY else f"{f:g}"
 
 
-def _design_name(f: float, n_total: int) -> str:
+def _design_name(
+    f: float,
+    n_total: int,
+    band: tuple[float, float] | None = None,
+    floors: tuple[float, ...] = (),
+) -> str:
     if f == FITTED_KEY:
         return f"design of {n_total} lights of least expected error on the fitted surface"
-    return f"homogeneous design of {n_total} lights above {f:g}°"
+    return f"homogeneous design of {n_total} lights {_floor_words(f, band, floors)}"
 
 
-def _relight_design_name(f: float, n_total: int) -> str:
+def _relight_design_name(
+    f: float,
+    n_total: int,
+    band: tuple[float, float] | None = None,
+    floors: tuple[float, ...] = (),
+) -> str:
     if f == FITTED_KEY:
         return f"design of {n_total} lights of least expected relighting error on the fitted model"
-    return f"homogeneous design of {n_total} lights above {f:g}°"
+    return f"homogeneous design of {n_total} lights {_floor_words(f, band, floors)}"
+
+
+def _floor_words(f: float, band: tuple[float, float] | None, floors: tuple[float, ...]) -> str:
+    """Where the design of floor ``f`` lies in ``band``: ``above 20°``, or ``between 30° and
+    45°`` under a ceiling; where the band's floor is what bounds it, said so, with the floors
+    (of ``floors``, every design offered) whose designs are this one layout."""
+    a, top = applied_floor(f, band), _ceiling(band)
+    words = f"between {a:g}° and {top:g}°" if top is not None else f"above {a:g}°"
+    why = []
+    if band is not None and a > 0.0 and a == float(band[0]):
+        why.append("the band's floor")
+    same = _merged_floors(floors, band).get(a, [f])
+    if len(same) > 1:
+        named = ", ".join(f"{g:g}°" for g in same[:-1]) + f" and {same[-1]:g}°"
+        why.append(f"the designs above {named} are this one layout in the band")
+    return words + (f" ({'; '.join(why)})" if why else "")
+
+
+def _by_floor(band: tuple[float, float] | None) -> str:
+    """The heading of the designs' scores: by floor, each under the band's ceiling if any."""
+    top = _ceiling(band)
+    return "by floor" if top is None else f"by floor, each up to the {top:g}° ceiling"
 
 
 def _fitted_design(
@@ -805,6 +896,7 @@ def _relight_decision(
     keep_floor: float,
     now: float,
     held_desc: str = "on the lights left out",
+    band: tuple[float, float] | None = None,
     **choose: Any,
 ) -> Decision:
     """The design with the best simulated relighting PSNR (kept unless another is better by
@@ -818,9 +910,8 @@ def _relight_decision(
     mask = np.zeros(len(candidates), dtype=bool)
     mask[designs[best]] = True
     d = choose_next(state, candidates, mask & available, **choose)
-    by_floor: dict[str, float | None] = {
-        _label(f): None if f in unjudged else round(v, 3) for f, v in sorted(psnr.items())
-    }
+    recorded = {f: None if f in unjudged else round(v, 3) for f, v in psnr.items()}
+    by_floor: dict[str, float | None] = _recorded_scores(recorded, band, best)
     judged = (
         "no light of the rig is left out of it, so there is nothing to judge its relighting on"
         if best in unjudged
@@ -832,12 +923,13 @@ def _relight_decision(
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"{_relight_design_name(best, n_total)} ({judged}; by floor: {by_floor}); within it, "
-        f"the largest predicted drop of the normal error per second ({len(state.lights)} "
-        "captured)",
+        f"{_relight_design_name(best, n_total, band, tuple(psnr))} ({judged}; "
+        f"{_by_floor(band)}: {by_floor}); within it, the largest predicted drop of the normal "
+        f"error per second ({len(state.lights)} captured)",
         design_floor=best,
         objective="relight",
         design_scores=by_floor,
+        band=band,
     )
 
 

@@ -473,7 +473,31 @@ def _surface_for(
         report.rms_tilt_deg, report.p90_tilt_deg = tilt_stats(surface.normals)
     if surface is not None and preview is not None:
         _report_preview_facts(preview, surface, report)
+        if surface.light_source == "given":  # recorded or --preview-light: a known light
+            _note_preview_outside_band(surface, req, report)
     return surface
+
+
+def _note_preview_outside_band(
+    surface: SurfaceEstimate, req: PlanRequest, report: PlanReport
+) -> None:
+    """One line when the preview's known light lies outside the plan's band: a notice, not a
+    refusal (the plan still keeps to the band; the preview is evidence of the surface), but a
+    user who set a 45° ceiling for a gilded object should know the preview was shot at 50°,
+    and how to shoot one within the band. An estimated light is not known well enough to say
+    so (docs/research/planner.md: 17–59° off on the real icon)."""
+    _, el = az_el_from_direction(surface.light)
+    el = float(el)
+    lo, hi = req.min_elevation_deg, req.max_elevation_deg
+    if lo - 0.05 <= el <= hi + 0.05:  # the rounding of a recorded or typed light
+        return
+    flag = f"--max-elevation-deg {hi:g}" if el > hi else f"--min-elevation-deg {lo:g}"
+    side = "above" if el > hi else "below"
+    report.notes.append(
+        f"the preview's light is at {el:.1f}° elevation, {side} this plan's {flag}: the "
+        f"preview was shot under a light the plan keeps out (`rti-rig preview RIG --out P "
+        f"{flag}` shoots one within the band)"
+    )
 
 
 def _report_preview_facts(preview: NDArray, surface: SurfaceEstimate, report: PlanReport) -> None:

@@ -29,8 +29,21 @@ PAPER_BAND_DEG = (45.0, 60.0)
 PREVIEW_BAND_DEG = (30.0, 70.0)
 
 
+#: Every elevation: no ``--min/--max-elevation-deg`` given.
+FULL_BAND_DEG = (0.0, 90.0)
+
+
+def _band_option(el: float, band: tuple[float, float]) -> str:
+    """Which side of ``band`` ``el`` lies on, naming the option (``above --max-elevation-deg
+    45``): the user fixes what the message names."""
+    lo, hi = band
+    return f"above --max-elevation-deg {hi:g}" if el > hi else f"below --min-elevation-deg {lo:g}"
+
+
 def preview_schedule(
-    geometry: DomeGeometry | ArmGeometry, az_el_deg: tuple[float, float] | None = None
+    geometry: DomeGeometry | ArmGeometry,
+    az_el_deg: tuple[float, float] | None = None,
+    band: tuple[float, float] = FULL_BAND_DEG,
 ) -> tuple[LightSchedule, list[str]]:
     """A one-step schedule lighting from ``az_el_deg`` on this rig, and notes for the user.
 
@@ -38,24 +51,52 @@ def preview_schedule(
     rounding); by default (``None``: :data:`PREVIEW_AZ_EL_DEG`) the nearest among its LEDs in
     the paper's band, if it has any there. An arm goes there, or the limit it would break is
     the error.
+
+    ``band`` (``--min/--max-elevation-deg``, as ``plan`` and ``run`` take them): the preview
+    keeps to it, so that a user who plans a gilded object under a 45° ceiling is not handed a
+    preview already shot at 50°. The default light's elevation is clamped into the band (a dome
+    then takes its nearest LED in the band, preferring the paper's band only where the two
+    overlap by more than an edge); a light asked for outside the band is refused, naming the
+    option; a dome fires only an LED in the band, the nearest to the light asked for.
     """
-    az, el = az_el_deg if az_el_deg is not None else PREVIEW_AZ_EL_DEG
+    lo_band, hi_band = band
+    if az_el_deg is not None:
+        az, el = az_el_deg
+    else:  # the default direction, its elevation clamped into the band
+        az, el = PREVIEW_AZ_EL_DEG[0], min(max(PREVIEW_AZ_EL_DEG[1], lo_band), hi_band)
     if not 0.0 <= el <= 90.0:
         raise ScheduleError(f"preview light elevation {el:g}° is outside 0..90°")
+    if not lo_band - 1e-9 <= el <= hi_band + 1e-9:  # only a light asked for can be
+        raise ScheduleError(
+            f"--light {az:g},{el:g}: its elevation {el:g}° is {_band_option(el, band)} (the "
+            f"band {lo_band:g}–{hi_band:g}°): give a light within the band, or widen it"
+        )
     wanted = direction_from_az_el(az, el)
     notes: list[str] = []
-    prov = {"purpose": "preview", "wanted_az_el_deg": [float(az), float(el)]}
+    prov: dict[str, object] = {"purpose": "preview", "wanted_az_el_deg": [float(az), float(el)]}
+    if tuple(band) != FULL_BAND_DEG:
+        prov["elevation_band_deg"] = [float(lo_band), float(hi_band)]
     if isinstance(geometry, DomeGeometry):
-        led, off = geometry.nearest_led(wanted)
-        which = "the nearest"
-        if az_el_deg is None:
-            _, els = az_el_from_direction(geometry.directions)
-            lo, hi = PAPER_BAND_DEG
-            band = np.flatnonzero((els >= lo) & (els <= hi))
-            if band.size:
-                ang = angle_between_deg(geometry.directions[band], wanted)
-                led, off = int(band[np.argmin(ang)]), float(ang.min())
-                which = f"the nearest in the paper's {lo:g}–{hi:g}° band"
+        _, els = az_el_from_direction(geometry.directions)
+        allowed = np.flatnonzero((els >= lo_band - 1e-9) & (els <= hi_band + 1e-9))
+        if allowed.size == 0:
+            raise ScheduleError(
+                f"the dome has no LED between {lo_band:g}° and {hi_band:g}° elevation; widen "
+                "--min-elevation-deg / --max-elevation-deg"
+            )
+        ang = angle_between_deg(geometry.directions[allowed], wanted)
+        led, off = int(allowed[np.argmin(ang)]), float(ang.min())
+        which = "the nearest" if allowed.size == len(els) else "the nearest in the band"
+        # by default the paper's band where it is part of the band asked for (not merely its
+        # edge: under a 45° ceiling an LED at 45° across the dome would beat one at 40° beside
+        # the default direction)
+        lo, hi = max(PAPER_BAND_DEG[0], lo_band), min(PAPER_BAND_DEG[1], hi_band)
+        if az_el_deg is None and lo < hi:
+            paper = allowed[(els[allowed] >= lo) & (els[allowed] <= hi)]
+            if paper.size:
+                ang = angle_between_deg(geometry.directions[paper], wanted)
+                led, off = int(paper[np.argmin(ang)]), float(ang.min())
+                which = "the nearest in the paper's {:g}–{:g}° band".format(*PAPER_BAND_DEG)
         d = geometry.directions[led]
         if off > SNAP_TOLERANCE_DEG:
             got_az, got_el = (float(v) for v in az_el_from_direction(d))

@@ -493,6 +493,23 @@ def preview(
             "(by default the nearest in that band, if it has LEDs there).",
         ),
     ] = None,
+    min_elevation_deg: Annotated[
+        float,
+        typer.Option(
+            "--min-elevation-deg",
+            help="Lowest elevation allowed (degrees), as for 'plan' and 'run': the default "
+            "light is chosen within the band, a --light outside it is refused.",
+        ),
+    ] = 0.0,
+    max_elevation_deg: Annotated[
+        float,
+        typer.Option(
+            "--max-elevation-deg",
+            help="Highest elevation allowed (degrees; 90 = up to the zenith), as for 'plan' "
+            "and 'run': give the ceiling you will plan with (e.g. 45 for gilding) so the "
+            "preview is not shot above it.",
+        ),
+    ] = 90.0,
     auto_exposure: Annotated[
         bool,
         typer.Option(
@@ -520,15 +537,26 @@ def preview(
                 parse_az_el(light, "--light"),
                 auto_exposure=auto_exposure,
                 max_saturated=max_saturated,
+                min_elevation_deg=min_elevation_deg,
+                max_elevation_deg=max_elevation_deg,
             ),
             print_note,
         )
     except RtiRigError as exc:
         raise fail(exc) from None
     _execute(opened)
+    # the band given here is the one to plan in: said in the command to copy
+    band = "".join(
+        f" {flag} {value:g}"
+        for flag, value, given in (
+            ("--min-elevation-deg", min_elevation_deg, min_elevation_deg != 0.0),
+            ("--max-elevation-deg", max_elevation_deg, max_elevation_deg != 90.0),
+        )
+        if given
+    )
     out.print(
         f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
-        f"{shlex.quote(str(rig_config))} --lights N --out plan.lp",
+        f"{shlex.quote(str(rig_config))} --lights N{band} --out plan.lp",
         highlight=False,
         markup=False,
         soft_wrap=True,

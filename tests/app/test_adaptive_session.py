@@ -7,11 +7,21 @@ to exactly the session it would have been, arms count move time, replayed acquis
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, SMALL_DOME, interrupted, journal, manifest, said, write_config
+from conftest import (
+    CONFIGS,
+    SMALL_DOME,
+    decisions,
+    interrupted,
+    journal,
+    manifest,
+    said,
+    write_config,
+)
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -546,6 +556,7 @@ def test_an_adaptive_session_keeps_to_the_elevation_band_asked_for(
     assert len(el) == 8 and all(20.0 - 1e-6 <= e <= 45.0 + 1e-6 for e in el), el
     header = manifest(ref)["adaptive"]
     assert (header["min_elevation_deg"], header["max_elevation_deg"]) == (20.0, 45.0)
+    _assert_designs_named_as_the_band_made_them(ref, objective)
     # the same session without the band fires lights outside it: the band changed the choices
     free = tmp_path / "free"
     r = runner.invoke(
@@ -557,9 +568,62 @@ def test_an_adaptive_session_keeps_to_the_elevation_band_asked_for(
     # interrupted and resumed: the same lights, in the band (the manifest's band, not the CLI's)
     cut = tmp_path / "cut"
     interrupted(cfg, cut, after_step=5, objective=objective, band=(20.0, 45.0))
-    r = runner.invoke(app, ["run", "--resume", str(cut)])
-    assert r.exit_code == 0, r.output
-    assert (cut / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+    # the same, its first decisions recorded as a build before the band's floor was named
+    # wrote them ("design floor 10°"): the words were never compared on resume, and the choices
+    # are unchanged, so it continues (format and constants as they were)
+    old = tmp_path / "old"
+    shutil.copytree(cut, old)
+    _record_as_before_the_band_was_named(old)
+    for folder in (cut, old):
+        r = runner.invoke(app, ["run", "--resume", str(folder)])
+        assert r.exit_code == 0, r.output
+        assert (folder / "lights.lp").read_text() == (ref / "lights.lp").read_text()
+    assert decisions(cut) == decisions(ref)  # the evidence repeats too, words and all
+    assert decisions(old)[6:] == decisions(ref)[6:]
+
+
+def _assert_designs_named_as_the_band_made_them(session: Path, objective: str) -> None:
+    """Among a 20°–45° band's lights on the five-ring dome (rings at 25° and 40°) the designs
+    above 0°, 10° and 20° are one layout: every decision names it by the band's 20° floor, once,
+    and says the 45° ceiling (it had recorded "design floor 10°" and scores for 0°, 10° and 20°
+    alike)."""
+    key = "design_psnr_db" if objective == "relight" else "design_error_deg"
+    adaptive = [d for d in decisions(session) if d["kind"] == "adaptive"]
+    assert any("design_floor_deg" in d for d in adaptive)  # a floor's design was taken
+    for d in adaptive:
+        assert set(d[key]) <= {"20", "30", "fitted"} and "20" in d[key], d[key]
+        assert "by floor, each up to the 45° ceiling" in d["reason"]
+        if d.get("design") == "fitted":
+            continue
+        floor = d["design_floor_deg"]
+        assert floor in (20.0, 30.0) and d["design_ceiling_deg"] == 45.0, d
+        assert f"{floor:g}" in d[key]
+        assert d["reason"].startswith(f"homogeneous design of 8 lights between {floor:g}° and 45°")
+
+
+def _record_as_before_the_band_was_named(session: Path) -> None:
+    """Rewrite a band session's recorded decisions (journal and manifest) in the words of the
+    build before: the design floor unraised (the default 10° for the band's 20°), no ceiling,
+    a score for each of 0°, 10° and 20°."""
+
+    def before(d: dict) -> dict:
+        for key in ("design_error_deg", "design_psnr_db"):
+            if key in d and "20" in d[key]:
+                d[key] = {"0": d[key]["20"], "10": d[key]["20"], **d[key]}
+        if d.get("design_floor_deg") == 20.0:
+            d["design_floor_deg"] = 10.0
+        d.pop("design_ceiling_deg", None)
+        return d
+
+    lines = (session / "journal.jsonl").read_text().splitlines()
+    steps = [json.loads(line) for line in lines]
+    for step in steps:
+        before(step["decision"])
+    (session / "journal.jsonl").write_text("".join(json.dumps(s) + "\n" for s in steps))
+    m = json.loads((session / "manifest.json").read_text())
+    for step in m["steps"]:
+        before(step["decision"])
+    (session / "manifest.json").write_text(json.dumps(m))
 
 
 def test_a_resume_cannot_change_the_band(tmp_path: Path) -> None:

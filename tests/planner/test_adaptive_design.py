@@ -165,3 +165,49 @@ def test_a_fit_without_observations_to_model_falls_back_to_the_bound() -> None:
     with_fit = choose_in_design(st, g.directions, available, 9, fit=never)
     without = choose_in_design(st, g.directions, available, 9)
     assert with_fit.candidate == without.candidate and with_fit.reason == without.reason
+
+
+def test_within_a_band_each_design_is_named_by_the_floor_the_band_applied() -> None:
+    """Among a 20°–45° band's lights the designs above 0°, 10° and 20° are one layout: the
+    evidence had named it "above 10°" (the default floor), claiming lights below the band were
+    open to it. It names the floor the band applied, the ceiling, and the one layout once —
+    and the choice is the same as without the band's words (a resume repeats it)."""
+    g = dome()
+    el = np.degrees(np.arcsin(g.directions[:, 2]))
+    cand = g.directions[(el >= 20.0) & (el <= 45.0)]  # what adaptive_plan keeps of the band
+    band = DomeGeometry(cand, tuple(f"b{i}" for i in range(len(cand))))
+    full = select_uniform_leds(band, 9, 10.0)
+    start = [int(full[i]) for i in start_subset(cand[full], 4)]
+    st = state_for(fibonacci_cap(200, 60.0), cand[start])
+    available = np.ones(len(cand), bool)
+    available[start] = False
+    for margin in (10.0, 0.0):  # the default design kept; the best one taken
+        plain = choose_in_design(st, cand, available, 9, default_floor=10.0, margin=margin)
+        named = choose_in_design(
+            st, cand, available, 9, default_floor=10.0, margin=margin, band=(20.0, 45.0)
+        )
+        assert (named.candidate, named.design_floor) == (plain.candidate, plain.design_floor)
+        assert set(plain.evidence()["design_error_deg"]) == {"0", "10", "20", "30"}
+        ev = named.evidence()
+        assert set(ev["design_error_deg"]) == {"20", "30"}  # one entry per layout
+        assert ev["design_floor_deg"] == max(plain.design_floor, 20.0)
+        assert ev["design_ceiling_deg"] == 45.0
+        assert ev["design_error_deg"][f"{ev['design_floor_deg']:g}"] == pytest.approx(
+            plain.evidence()["design_error_deg"][f"{plain.design_floor:g}"]
+        )
+        assert f"between {ev['design_floor_deg']:g}° and 45°" in named.reason
+        assert "by floor, each up to the 45° ceiling" in named.reason
+        assert named.reason.startswith(
+            f"homogeneous design of 9 lights between {ev['design_floor_deg']:g}° and 45°"
+        )
+    kept = choose_in_design(
+        st, cand, available, 9, default_floor=10.0, margin=10.0, band=(20.0, 90.0)
+    )
+    assert kept.design_floor == 10.0  # the key the next decision keeps as its incumbent
+    assert kept.evidence()["design_floor_deg"] == 20.0 and "design_ceiling_deg" not in (
+        kept.evidence()
+    )
+    assert (
+        "above 20° (the band's floor; the designs above 0°, 10° and 20° are this one layout "
+        "in the band)" in kept.reason
+    )

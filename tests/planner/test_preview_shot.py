@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO, SMALL_DOME, write_config
+from conftest import REPO, SMALL_DOME, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.app.preview_source import resolve_preview
@@ -72,6 +72,73 @@ def test_arm_preview_goes_where_asked_or_names_the_limit() -> None:
         preview_schedule(arm, (0.0, 88.0))
     with pytest.raises(ScheduleError, match=r"outside 0\.\.90"):
         preview_schedule(arm, (0.0, -5.0))
+
+
+def test_a_preview_keeps_to_the_elevation_band_it_is_given() -> None:
+    """`plan --max-elevation-deg 45` for a gilded object had been handed a preview already
+    shot at 50°: with the band, the default light is chosen in it (a dome's nearest LED in the
+    band to the default direction, its elevation clamped), a light asked for outside it is
+    refused naming the option, and a dome never fires an LED outside it."""
+    az = np.array([135.0, 135.0, 140.0, 300.0])
+    el = np.array([50.0, 40.0, 25.0, 45.0])
+    dome = DomeGeometry(direction_from_az_el(az, el), ("paper", "low", "lower", "far"))
+    assert preview_schedule(dome)[0].steps[0].label == "paper"  # without a band: as before
+    schedule, notes = preview_schedule(dome, band=(0.0, 45.0))
+    assert schedule.steps[0].label == "low"
+    assert schedule.provenance["wanted_az_el_deg"] == [135.0, 45.0]
+    assert schedule.provenance["elevation_band_deg"] == [0.0, 45.0]
+    assert any("el 45°: the nearest in the band, low" in n for n in notes), notes
+    # the paper's band is preferred where it is part of the band, not where it is its edge
+    # ("far", at 45° across the dome, is not taken under the 45° ceiling)
+    assert preview_schedule(dome, band=(45.0, 90.0))[0].steps[0].label == "paper"
+    assert preview_schedule(dome, band=(30.0, 45.0))[0].steps[0].label == "low"
+    # a light asked for in the band: the nearest LED in the band, not the nearest overall
+    schedule, notes = preview_schedule(dome, (135.0, 46.0), band=(0.0, 46.0))
+    assert schedule.steps[0].label == "low"  # "paper" (50°) is nearer, above the band
+    assert any("the nearest in the band, low" in n for n in notes), notes
+    with pytest.raises(ScheduleError) as exc:
+        preview_schedule(dome, (135.0, 50.0), band=(0.0, 45.0))
+    assert "--light 135,50: its elevation 50° is above --max-elevation-deg 45 (the band 0–45°)" in (
+        str(exc.value)
+    )
+    with pytest.raises(ScheduleError, match="below --min-elevation-deg 30"):
+        preview_schedule(dome, (135.0, 25.0), band=(30.0, 90.0))
+    with pytest.raises(ScheduleError, match="no LED between 60° and 90°"):
+        preview_schedule(dome, band=(60.0, 90.0))
+    # an arm goes to the default azimuth at the elevation clamped into the band
+    arm = ArmGeometry(0.0, 80.0, 15.0, 0.0, 30.0)
+    assert _az_el(preview_schedule(arm, band=(0.0, 45.0))[0].steps[0].direction) == (135.0, 45.0)
+    assert _az_el(preview_schedule(arm, band=(55.0, 70.0))[0].steps[0].direction) == (135.0, 55.0)
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_preview_and_plan_under_a_ceiling_through_the_front_door(tmp_path: Path) -> None:
+    """The gilded object's workflow on the shipped dome: `preview --max-elevation-deg 45` fires
+    an LED at or below 45° and says to plan with the same ceiling; `plan` notes a preview shot
+    above its ceiling (the default preview, at 55°), and says nothing of one shot within it."""
+    cfg = write_config(
+        tmp_path,
+        (REPO / "rig_configs" / "simulated_dome.toml")
+        .read_text()
+        .replace("width = 512", "width = 96")
+        .replace("height = 512", "height = 96"),
+    )
+    inside, above = tmp_path / "inside", tmp_path / "above"
+    r = runner.invoke(app, ["preview", str(cfg), "--out", str(inside), "--max-elevation-deg", "45"])
+    assert r.exit_code == 0, r.output
+    fired = json.loads((inside / "manifest.json").read_text())["steps"][0]["actual_direction"]
+    assert _az_el(fired)[1] <= 45.0 + 1e-6
+    assert "--lights N --max-elevation-deg 45 --out plan.lp" in " ".join(r.output.split())
+    assert runner.invoke(app, ["preview", str(cfg), "--out", str(above)]).exit_code == 0
+    base = ["--rig", str(cfg), "--lights", "8", "--max-elevation-deg", "45"]
+    notice = "the preview's light is at 55.0° elevation, above this plan's --max-elevation-deg 45"
+    r = runner.invoke(app, ["plan", str(above), *base, "--out", str(tmp_path / "a.lp")])
+    assert r.exit_code == 0, r.output
+    assert notice in " ".join(r.output.split())
+    r = runner.invoke(app, ["plan", str(inside), *base, "--out", str(tmp_path / "b.lp")])
+    assert r.exit_code == 0, r.output
+    assert "the preview's light is at" not in r.output
 
 
 def test_light_comes_from_the_rig_lp_listing_the_image_and_no_other_lp(tmp_path: Path) -> None:
@@ -228,6 +295,16 @@ def test_preview_refuses_before_anything_moves(
     )
     # a folder that is no session is offered no resume (it had been told to resume it)
     assert "not empty" in r.output and "--resume" not in r.output
+    # a light outside the band, or a band that is none: refused by name, no traceback
+    fresh = tmp_path / "fresh"
+    for extra, says in (
+        (["--light", "135,50", "--max-elevation-deg", "45"], "above --max-elevation-deg 45"),
+        (["--min-elevation-deg", "60", "--max-elevation-deg", "40"], "--max-elevation-deg 40"),
+        (["--max-elevation-deg", "95"], "--max-elevation-deg 95"),
+    ):
+        r = runner.invoke(app, ["preview", str(cfg), "--out", str(fresh), *extra])
+        assert r.exit_code == 2 and says in said(r), r.output
+        assert "Traceback" not in r.output and not fresh.exists()
 
 
 class _FakeRig:

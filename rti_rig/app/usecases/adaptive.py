@@ -310,7 +310,12 @@ class AdaptiveChooser:
         objective: str = "normals",
         upper_factor: float | None = None,
         min_lights: int | None = None,
+        band: tuple[float, float] | None = None,
     ) -> None:
+        #: the elevation band (°) the candidates were cut to (None: every elevation): words
+        #: of the decisions' evidence only (each design named by the floor the band applied,
+        #: ``planner.adaptive.applied_floor``), never a choice
+        self.band = band
         #: with --until-error: the fewest lights the stop may claim the target at (None: no
         #: minimum). The normal error is not the only thing a session is for: a PTM needs 6
         #: lights and an HSH fit 5 (RTI_FILE_LIGHTS), and a stop at 4 gives a normal map and
@@ -507,6 +512,7 @@ class AdaptiveChooser:
                 incumbent=self.floor if self.bias_aware else None,
                 objective=self.objective,
                 relight=relight_fit if self.objective == "relight" else None,
+                band=self.band,
             )
             self.floor = d.design_floor
         elif self.bias_aware and UNTIL_DESIGN:
@@ -521,6 +527,7 @@ class AdaptiveChooser:
                 capture_s=self.capture_s,
                 move_s=move,
                 scale=self.scale,
+                band=self.band,
             )
             self.floor = d.design_floor
         else:
@@ -757,6 +764,7 @@ class AdaptiveSteps:
             objective=objective,
             upper_factor=upper_factor,
             min_lights=min_lights,
+            band=plan.band,
         )
         self._pending: dict[int, int] = {}
 

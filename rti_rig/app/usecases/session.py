@@ -103,6 +103,10 @@ class PreviewRequest:
     light_az_el_deg: tuple[float, float] | None = None
     auto_exposure: bool = False
     max_saturated: float = 0.001
+    #: the elevation band (°) the preview's light keeps to (``--min/--max-elevation-deg``, as
+    #: ``plan`` and ``run`` take them): the band the session will be planned in
+    min_elevation_deg: float = 0.0
+    max_elevation_deg: float = 90.0
 
 
 @dataclass
@@ -601,14 +605,20 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
 def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> OpenedSession:
     """A one-image session under the preview light (the planner's input)."""
     from rti_rig.app.config import load_rig_config, rig_geometry
+    from rti_rig.planner.make_plan import check_elevation_band
     from rti_rig.planner.preview_shot import preview_schedule
 
     check_max_saturated(req.max_saturated)
+    check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     loaded = load_rig_config(req.rig_config)
     from rti_rig.app.flash_sync import refuse_options
 
     refuse_options(loaded, preview=True)
-    schedule, notes = preview_schedule(rig_geometry(loaded), req.light_az_el_deg)
+    schedule, notes = preview_schedule(
+        rig_geometry(loaded),
+        req.light_az_el_deg,
+        (req.min_elevation_deg, req.max_elevation_deg),
+    )
     for note in notes:
         on_note(Note(note, "warning"))
     return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
