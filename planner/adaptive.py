@@ -794,20 +794,16 @@ def _design_name(
     n_total: int,
     band: tuple[float, float] | None = None,
     floors: tuple[float, ...] = (),
+    objective: str = "normals",
 ) -> str:
+    """A design's name in a decision's reason: the fitted design by what it minimises (for
+    ``objective``), a floor's by where its lights lie in the band (:func:`_floor_words`)."""
     if f == FITTED_KEY:
+        if objective == "relight":
+            return (
+                f"design of {n_total} lights of least expected relighting error on the fitted model"
+            )
         return f"design of {n_total} lights of least expected error on the fitted surface"
-    return f"homogeneous design of {n_total} lights {_floor_words(f, band, floors)}"
-
-
-def _relight_design_name(
-    f: float,
-    n_total: int,
-    band: tuple[float, float] | None = None,
-    floors: tuple[float, ...] = (),
-) -> str:
-    if f == FITTED_KEY:
-        return f"design of {n_total} lights of least expected relighting error on the fitted model"
     return f"homogeneous design of {n_total} lights {_floor_words(f, band, floors)}"
 
 
@@ -923,7 +919,7 @@ def _relight_decision(
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"{_relight_design_name(best, n_total, band, tuple(psnr))} ({judged}; "
+        f"{_design_name(best, n_total, band, tuple(psnr), 'relight')} ({judged}; "
         f"{_by_floor(band)}: {by_floor}); within it, the largest predicted drop of the normal "
         f"error per second ({len(state.lights)} captured)",
         design_floor=best,
