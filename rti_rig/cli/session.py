@@ -333,6 +333,19 @@ _HANDLED = (signal.SIGINT, signal.SIGTERM) + (
 )
 
 
+def _paused_lights(rig) -> str:  # type: ignore[no-untyped-def]
+    """What is known of the lights while a session is paused (after the last image's off).
+
+    The pause had said "lights off" for every rig, also for a firmware that never acknowledges
+    its all-off and for one that has no all-off (its LED goes off by itself)."""
+    from rti_rig.app.usecases.safe_state import lights_state
+    from rti_rig.runtime.lighting import ArmLighting
+
+    if isinstance(rig.lighting, ArmLighting):
+        return "lamp off"
+    return lights_state(rig)
+
+
 def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
     from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
@@ -362,7 +375,7 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
             err.print("[green]Resuming.[/]")
         else:
             cancel.pause()
-            err.print("[yellow]Pausing after this image (lights off); SIGUSR1 again resumes.[/]")
+            err.print("[yellow]Pausing after this image; SIGUSR1 again resumes.[/]")
 
     handlers = {signal.SIGINT: on_sigint, signal.SIGTERM: on_sigterm}
     if hasattr(signal, "SIGUSR1"):
@@ -395,6 +408,11 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
                     progress.advance(task)
                 elif isinstance(event, Paused):
                     progress.update(task, description="paused")
+                    err.print(
+                        f"Paused before image {event.index + 1}: {_paused_lights(rig)}. "
+                        "SIGUSR1 resumes.",
+                        markup=False,
+                    )
                 elif isinstance(event, StepStarted):  # after a pause: capturing again
                     progress.update(task, description="capturing")
 

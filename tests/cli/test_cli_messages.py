@@ -216,6 +216,51 @@ def test_a_cancelled_session_says_what_is_known_of_the_lights(
     assert sentence in tail, said
 
 
+@pytest.mark.skipif(not hasattr(__import__("signal"), "SIGUSR1"), reason="no SIGUSR1")
+@pytest.mark.parametrize(
+    ("config", "sentence"),
+    [
+        # a firmware that never confirms: the all-off after the image was sent, nothing more
+        ("emulated_elexol.toml", "this firmware never acknowledges"),
+        ("emulated_dome.toml", "all-off sent and acknowledged by the dome: lights are off"),
+        ("simulated_dome.toml", "lights were switched off"),
+        ("virtual_arm.toml", "lamp off"),
+    ],
+)
+def test_a_paused_session_says_what_is_known_of_the_lights(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, config: str, sentence: str
+) -> None:
+    """SIGUSR1 had printed "Pausing after this image (lights off)" whatever the rig: also for a
+    firmware that never acknowledges its all-off. The pause says what the last all-off
+    established, once it holds."""
+    import os
+    import signal
+
+    from rti_rig.runtime.controller import CancelToken
+    from rti_rig.simulator.sim_camera import SimulatedCamera
+
+    real, shots = SimulatedCamera.capture, []
+
+    def pause_at_the_third(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        shots.append(1)
+        if len(shots) == 3:
+            os.kill(os.getpid(), signal.SIGUSR1)
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(SimulatedCamera, "capture", pause_at_the_third)
+    monkeypatch.setattr(CancelToken, "wait_while_paused", lambda self, *a: self.resume())
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / config
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "lights off)" not in said, said
+    assert "Paused before image 4: " in said, said
+    tail = said[said.index("Paused before image 4: ") :]
+    assert sentence in tail.split(". SIGUSR1 resumes.")[0], said
+
+
 def test_a_metering_failure_says_what_is_known_of_the_lights_and_that_nothing_was_written(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
