@@ -171,6 +171,7 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     correction = serial.get("intensity_correction")
     max_level = int(serial.get("max_level", 255))
     exposures = np.array([float(s["exposure_s"]) for s in steps])
+    _refuse_saturated(root, manifest, steps, exposures)
     images, drive, leds, names = [], [], [], []
     image_of: dict[int, str] = {}
     seen: dict[int, str] = {}
@@ -184,12 +185,6 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
                 "LED once"
             )
         seen[led] = name
-        if float(s.get("saturated_fraction") or 0.0) > MAX_SATURATED:
-            raise SessionError(
-                f"{root}/{name} (LED {led}): {100 * s['saturated_fraction']:.1f} % of its pixels "
-                "are saturated; shoot the card again with a shorter exposure (rti-rig run "
-                "--auto-exposure meters one)"
-            )
         path = root / name
         try:
             pixels = read_linear_tiff(path)
@@ -213,6 +208,40 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         drive=np.array(drive),
         correction=None if correction is None else tuple(float(v) for v in correction),
         image_of=image_of,
+    )
+
+
+def _refuse_saturated(
+    root: Path, manifest: dict[str, Any], steps: list[dict[str, Any]], exposures: np.ndarray
+) -> None:
+    """Refuse a card session with clipped images, naming every one and an exposure to try.
+
+    The advice had been "rti-rig run --auto-exposure meters one", also for a session that
+    --auto-exposure had metered: it meters at the nominally brightest LED, and on a card (every
+    pixel at one level) under an uncalibrated dome a brighter LED clipped the whole frame."""
+    clipped = [s for s in steps if float(s.get("saturated_fraction") or 0.0) > MAX_SATURATED]
+    if not clipped:
+        return
+    worst = max(clipped, key=lambda s: float(s["saturated_fraction"]))
+    listed = ", ".join(f"{s['linear_image']} (LED {s['led']})" for s in clipped[:5]) + (
+        f" and {len(clipped) - 5} more" if len(clipped) > 5 else ""
+    )
+    exposure = float(exposures.min())
+    provenance = (manifest.get("schedule") or {}).get("provenance") or {}
+    metered = isinstance(provenance.get("exposure"), dict)
+    why = (
+        "--auto-exposure metered this session at one LED, and an uncalibrated dome's LEDs "
+        "differ by tens of percent, so a brighter one clipped the card: "
+        if metered
+        else ""
+    )
+    raise SessionError(
+        f"{root}/{worst['linear_image']} (LED {worst['led']}): "
+        f"{100 * float(worst['saturated_fraction']):.1f} % of its pixels are saturated "
+        f"({len(clipped)} of {len(steps)} images clipped over {100 * MAX_SATURATED:g} %: "
+        f"{listed}); {why}shoot the card again with a shorter fixed exposure, e.g. "
+        f"exposure_s = {exposure / 2:.4g} under [camera] in the rig config (half the "
+        f"session's {exposure:.4g} s), without --auto-exposure"
     )
 
 

@@ -177,6 +177,40 @@ def test_card_sessions_that_cannot_calibrate_are_refused_by_name(tmp_path: Path)
 @pytest.mark.slow
 @pytest.mark.e2e
 @pytest.mark.pty
+def test_a_clipped_card_metered_by_auto_exposure_is_not_told_to_meter_again(
+    tmp_path: Path,
+) -> None:
+    """--auto-exposure meters at the nominally brightest LED; on a card under an uncalibrated
+    dome a brighter LED then clipped the whole frame (the shipped emulated_dome_card.toml:
+    7 of 48 images), and the refusal advised "rti-rig run --auto-exposure meters one". It
+    names every clipped image and a fixed exposure to try instead."""
+    cfg = card_rig(tmp_path)
+    shoot(cfg, tmp_path / "card")
+    exposure = json.loads((tmp_path / "card" / "manifest.json").read_text())["steps"][0][
+        "exposure_s"
+    ]
+
+    def metered_and_clipped(m):  # type: ignore[no-untyped-def]
+        m["schedule"].setdefault("provenance", {})["exposure"] = {
+            "exposure_s": exposure,
+            "method": "test-series",
+        }
+        m["steps"][6]["saturated_fraction"] = 0.2
+        m["steps"][9]["saturated_fraction"] = 0.5
+
+    edit_manifest(tmp_path / "card", metered_and_clipped)
+    with pytest.raises(SessionError) as caught:
+        read_card_session(tmp_path / "card")
+    text = str(caught.value)
+    assert "image_010.tif (LED 9): 50.0 % of its pixels are saturated" in text, text
+    assert "2 of 48 images clipped" in text and "image_007.tif (LED 6)" in text, text
+    assert "meters one" not in text and "--auto-exposure metered this session" in text, text
+    assert f"exposure_s = {exposure / 2:.4g} under [camera]" in text, text
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.pty
 def test_simulated_arm_and_missing_images_are_refused(tmp_path: Path) -> None:
     arm = tmp_path / "arm"
     r = runner.invoke(
