@@ -62,7 +62,14 @@ def calibrate_lights(
             "card is the most sensitive to its tilt and texture).",
         ),
     ] = 5.0,
-    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force",
+            help="Overwrite an existing --out file (the card session's own "
+            "light_calibration.toml is never replaced).",
+        ),
+    ] = False,
     not_flat_ok: Annotated[
         bool,
         typer.Option(

@@ -274,7 +274,11 @@ def test_cli_refusals_name_what_is_wrong(tmp_path: Path) -> None:
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
     assert r.exit_code == 0, r.output
     # the calibration file inside the session is written once, never replaced, even forced
-    assert "calibrated already (its file is never replaced)" in calibrate("--force")
+    forced = calibrate("--force")
+    assert "calibrated already (its file is never replaced" in forced
+    # --force is refused here: the refusal says so, not only "give --out" (its help had said
+    # "Overwrite an existing file.", and the user had given it)
+    assert "even with --force" in forced, forced
     elsewhere = tmp_path / "cal.toml"
     assert (
         runner.invoke(

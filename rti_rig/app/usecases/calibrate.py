@@ -81,7 +81,8 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     if req.out_file is None and target.exists():
         raise RtiRigError(
             f"{target} exists: this card session was calibrated already (its file is never "
-            "replaced); give --out to write the calibration elsewhere"
+            "replaced, even with --force, which replaces only a file named by --out); give "
+            "--out to write the calibration elsewhere"
         )
     check_output_file(target, req.force, {"RIG": req.rig_config})
     spread = 0.0 if req.not_flat_ok else card_spread_deg(card)
