@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import shlex
 import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -240,11 +242,35 @@ def run(
             )
         err.print(f"[yellow]{escape(said)}.[/]")
         raise typer.Exit(code=130) from None
-    _execute(opened)
-    if not no_verdict:
-        from rti_rig.cli.fit import print_verdict
+    with _late_pause_ignored():
+        _execute(opened)
+        if not no_verdict:
+            from rti_rig.cli.fit import print_verdict
 
-        print_verdict(opened.out_dir)
+            print_verdict(opened.out_dir)
+
+
+@contextmanager
+def _late_pause_ignored() -> Iterator[None]:
+    """SIGUSR1 ignored (and said to be) outside the capture, until the run's last line.
+
+    A SIGUSR1 meant to pause that arrived once the capture was over (while the QA verdict was
+    computed) met the default action: the process ended at once, exit 138, the verdict unsaid.
+    The capture's own handler (:func:`_run_and_report`) pauses; this one is what it restores."""
+    usr1 = getattr(signal, "SIGUSR1", None)
+    if usr1 is None:
+        yield
+        return
+
+    def nothing_to_pause(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        err.print("[yellow]SIGUSR1 ignored: a session pauses only while it captures.[/]")
+
+    previous = signal.signal(usr1, nothing_to_pause)
+    try:
+        yield
+    finally:
+        if previous is not None:
+            signal.signal(usr1, previous)
 
 
 def _sentence(text: str) -> str:

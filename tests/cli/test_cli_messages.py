@@ -115,6 +115,38 @@ def test_a_late_ctrl_c_does_not_cut_the_summary(
     assert signal.getsignal(signal.SIGINT) is before  # the handlers before are back
 
 
+@pytest.mark.skipif(not hasattr(__import__("signal"), "SIGUSR1"), reason="no SIGUSR1")
+def test_a_late_sigusr1_does_not_end_the_run_before_its_verdict(tmp_path: Path) -> None:
+    """SIGUSR1 (pause) that arrives once the capture is over, while the QA verdict is computed,
+    had met Python's default action: the process ended at once with exit 138 and no word, the
+    verdict unsaid. It is ignored there, and said to be; the handlers before are back after."""
+    import subprocess
+    import sys
+
+    script = (
+        "import os, signal, sys\n"
+        "import rti_rig.app.usecases.fit as fit\n"
+        "real = fit.verdict_for_session\n"
+        "def late(session):\n"
+        "    os.kill(os.getpid(), signal.SIGUSR1)\n"
+        "    return real(session)\n"
+        "fit.verdict_for_session = late\n"
+        "from rti_rig.cli import app\n"
+        "app(sys.argv[1:], prog_name='rti-rig')\n"
+    )
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    args = ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"]
+    proc = subprocess.run(
+        [sys.executable, "-c", script, *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 0, (proc.returncode, said)
+    assert "SIGUSR1 ignored" in said and "QA verdict:" in said, said
+
+
 def test_a_session_cancelled_before_its_first_image_offers_no_resume(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
