@@ -706,13 +706,18 @@ class SelfTestReport:
             if self.firmware
             else "unknown firmware"
         )
-        out = [f"{self.name}: {' '.join(fw.split())}, {self.led_count} LEDs"]
-        passed = sum(c.ok for c in self.checks)
-        out.append(
-            f"LEDs stepped: {len(self.checks)}, "
-            + (f"passed: {passed}" if self.light_confirmed else f"sent without error: {passed}")
-            + f", failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
-        )
+        if self.aborted and self.firmware is None and not self.led_count and not self.checks:
+            # never reached: "unknown firmware, 0 LEDs" and "LEDs stepped: 0" had read as a
+            # dome that answered with no LEDs (the config's 48 were never asked about)
+            out = [f"{self.name}: not reached, no LED stepped (see ABORTED below)"]
+        else:
+            out = [f"{self.name}: {' '.join(fw.split())}, {self.led_count} LEDs"]
+            passed = sum(c.ok for c in self.checks)
+            out.append(
+                f"LEDs stepped: {len(self.checks)}, "
+                + (f"passed: {passed}" if self.light_confirmed else f"sent without error: {passed}")
+                + f", failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
+            )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
         if self.light_latency_s:
             lat = np.asarray(self.light_latency_s) * 1000

@@ -494,6 +494,18 @@ def test_a_port_that_never_opened_says_this_run_lit_nothing(tmp_path: Path) -> N
     assert "lights are off" not in text
 
 
+def test_a_check_whose_port_never_opened_does_not_report_a_dome_of_0_leds() -> None:
+    """`check` on the shipped 48-LED config with no board had printed "dome: unknown firmware,
+    0 LEDs" and "LEDs stepped: 0, passed: 0, failed: 0 in 0.00 s": a dome that answered with no
+    LEDs, where nothing was reached at all."""
+    cfg = Path(__file__).resolve().parents[3] / "rig_configs" / "example_dome_48.toml"
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = " ".join(r.output.split())
+    assert r.exit_code == 1 and "RESULT: FAIL" in text, text
+    assert "0 LEDs" not in text and "LEDs stepped: 0" not in text, text
+    assert "dome: not reached, no LED stepped" in text and "port could not be opened" in text
+
+
 @pytest.mark.slow  # rti-dome-m blocks 1.5 s per command over a real pty
 def test_a_dry_run_counts_the_time_the_firmware_really_blocks(tmp_path: Path) -> None:
     """rti-dome-m blocks 1.5 s after every ``M<n>`` (docs/domes.md). The emulator does so in
