@@ -212,6 +212,53 @@ def holds_no_image(root: Path) -> bool:
     return not (journal.exists() and scan_journal(root).records)
 
 
+#: session folders this process writes, locked against a second rti-rig process (resolved
+#: path → the folder's open descriptor, whose ``flock`` is the lock)
+_LOCKED: dict[str, int] = {}
+
+
+def lock_session(root: Path) -> None:
+    """Hold ``root`` for this process's session, or refuse: another process writes it.
+
+    Nothing stopped a second ``run --resume`` on a session still being captured (it seemed
+    stuck, or another terminal): it moved the running session's image in flight to
+    ``recovered/``, shot a step the first then failed on, and the manifest kept only one of the
+    two runs; on a real rig both would drive the dome. The lock is the kernel's ``flock`` on the
+    folder itself (no file is added to the session), released by :func:`unlock_session` or when
+    the process ends, however it ends (``kill -9`` included)."""
+    try:
+        import fcntl
+    except ImportError:  # not on POSIX: no lock
+        return
+    key = str(Path(root).resolve())
+    if key in _LOCKED:
+        return
+    try:
+        fd = os.open(key, os.O_RDONLY)
+    except OSError:  # a folder that cannot be opened for reading: its writes will say more
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise SessionError(
+            f"{root} is in use by another rti-rig process (a session is being captured or "
+            "resumed in it): let it finish, or stop it (Ctrl-C in its terminal), then "
+            f"continue with: rti-rig run --resume {root}"
+        ) from None
+    except OSError:  # a filesystem without flock (some network mounts): no lock, as before
+        os.close(fd)
+        return
+    _LOCKED[key] = fd
+
+
+def unlock_session(root: Path) -> None:
+    """Release :func:`lock_session`'s hold on ``root`` (nothing if it is not held)."""
+    fd = _LOCKED.pop(str(Path(root).resolve()), None)
+    if fd is not None:
+        os.close(fd)  # closing the descriptor releases its flock
+
+
 class SessionFolder:
     """Writes one session: created empty (or reopened to resume), filled step by step.
 
@@ -319,6 +366,7 @@ class SessionFolder:
             (self.root / LINEAR_DIR).mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise SessionWriteError(self.root, exc) from None
+        lock_session(self.root)  # two runs given the same new --out: the second stops here
         # an image-less session left here before (see check_new): its files go
         for name in (JOURNAL, LP_NAME):
             with contextlib.suppress(FileNotFoundError):
@@ -498,6 +546,14 @@ class SessionFolder:
 
         Does nothing for a session that never began (nothing was created on disk).
         """
+        try:
+            self._finish(records, runner, timing)
+        finally:
+            unlock_session(self.root)
+
+    def _finish(
+        self, records: list[StepRecord], runner: dict[str, Any], timing: dict[str, Any]
+    ) -> None:
         if not self.begun:
             return
         for r in records:
@@ -778,6 +834,25 @@ def _new_stamp(root: Path) -> str:
 
 
 def prepare_resume(
+    root: Path,
+    check_done: Callable[[dict[int, StepRecord]], None] | None = None,
+    reshoot_lost: bool = False,
+) -> ResumeState:
+    """:func:`_prepare_resume` with the folder locked (:func:`lock_session`) before anything in
+    it is read or moved: held for the resumed run, released if the resume is refused."""
+    root = Path(root)
+    held = str(root.resolve()) in _LOCKED
+    if root.is_dir():
+        lock_session(root)
+    try:
+        return _prepare_resume(root, check_done, reshoot_lost)
+    except BaseException:
+        if not held:
+            unlock_session(root)
+        raise
+
+
+def _prepare_resume(
     root: Path,
     check_done: Callable[[dict[int, StepRecord]], None] | None = None,
     reshoot_lost: bool = False,

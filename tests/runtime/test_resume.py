@@ -166,6 +166,61 @@ def test_resume_refuses_what_it_cannot_do(tmp_path: Path, reference: tuple[Path,
     assert r.exit_code == 2 and "drop --lights" in said(r)
 
 
+@pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="POSIX flock")
+def test_a_session_another_process_is_writing_is_not_resumed_under_it(tmp_path: Path) -> None:
+    """A second `run --resume` on a session still being captured (it looked stuck; another
+    terminal) had gone ahead: it moved the running session's image in flight to recovered/,
+    shot a step the first process then failed on, and the manifest kept one of the two runs.
+    The folder is locked by the process writing it; the resume is refused and nothing moves."""
+    import shutil
+    import sys
+
+    cfg = write_config(tmp_path, SMALL_DOME)
+    rig = build_rig(load_rig_config(cfg))
+    cancel = CancelToken()
+
+    def stop_after_four(e) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(e, StepCompleted) and e.index == 3:
+            cancel.cancel()
+
+    out = tmp_path / "s"
+    run_session(
+        rig,
+        plan_uniform(rig.geometry, LIGHTS),
+        SessionFolder.create(out, LIGHTS),
+        cancel=cancel,
+        on_event=stop_after_four,
+    )
+    # the other process's image in flight: on disk, not journaled yet
+    shutil.copy(out / "image_004.jpg", out / "image_005.jpg")
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import fcntl, os, sys, time\n"
+            "fd = os.open(sys.argv[1], os.O_RDONLY)\n"
+            "fcntl.flock(fd, fcntl.LOCK_EX)\n"
+            "print('held', flush=True)\n"
+            "time.sleep(120)\n",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        r = runner.invoke(app, ["run", "--resume", str(out)])
+        assert r.exit_code == 2, r.output
+        assert "in use by another rti-rig process" in said(r), said(r)
+        assert (out / "image_005.jpg").exists() and not (out / "recovered").exists()
+    finally:
+        holder.kill()
+        holder.wait()
+    r = runner.invoke(app, ["run", "--resume", str(out)])  # the other process has ended
+    assert r.exit_code == 0, r.output
+    assert "4 of 8 images verified" in said(r), said(r)
+
+
 def test_free_disk_is_checked_before_anything_moves(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
