@@ -410,10 +410,11 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
     rig, folder, out_dir = opened.rig, opened.folder, opened.out_dir
     dry = " (dry run)" if opened.dry_run else ""
     adaptive = " at most, adaptive" if opened.source is not None else ""
-    out.print(
-        f"Rig [bold]{escape(rig.name)}[/]{dry}: {opened.steps_to_do} of {opened.total_steps} "
-        f"lights{adaptive} → {escape(str(out_dir))}"
-    )
+    # "24 of 24 lights" for --lights 24 on a 48-LED dome read as if the dome had 24: a new
+    # session says its count, a resumed one what is left of it
+    todo, total = opened.steps_to_do, opened.total_steps
+    count = f"{todo} lights" if todo == total else f"{todo} of {total} lights left"
+    out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
     resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
     if getattr(rig.lighting, "resume_hint", None):  # a dome whose own count cannot resume
         resume_hint = rig.lighting.resume_hint
@@ -642,8 +643,10 @@ def export_lp(
         err.print(
             f"[yellow]note:[/] its image names are relative to {escape(str(session_dir))}, "
             "and tools (relight, RTIBuilder, rti-rig fit) read them beside the .lp: move "
-            f"{escape(str(out_file))} into {escape(str(session_dir))} to use it (relight-cli "
-            "takes the first .lp of a folder: keep one there)",
+            f"{escape(str(out_file))} into {escape(str(session_dir))} to use it; for relight-cli, "
+            "which reads the first .lp of a folder, move that folder's lights.lp out too ("
+            f"`rti-rig export-lp {escape(str(session_dir))} --out "
+            f"{escape(str(session_dir / 'lights.lp'))}` writes it again)",
             soft_wrap=True,
         )
     out.print(f"{len(done.entries)} lights → {out_file}")

@@ -85,6 +85,16 @@ def test_readme_first_command_dry_run(tmp_path: Path, monkeypatch: pytest.Monkey
 
 
 @pytest.mark.e2e
+def test_the_run_header_says_the_session_s_count_not_n_of_n(tmp_path: Path) -> None:
+    """``--lights 24`` on the 48-LED dome had opened with "24 of 24 lights", which reads as if
+    the dome had 24; a new session says its count, a resumed one what is left of it."""
+    cfg = REPO / "rig_configs" / "simulated_dome.toml"
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "(dry run): 6 lights →" in r.output and " of 6 " not in r.output
+
+
 def test_plan_then_run_then_export(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
     plan = tmp_path / "plan.lp"

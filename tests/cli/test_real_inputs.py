@@ -262,7 +262,12 @@ def test_export_lp_outside_the_session_says_where_its_names_resolve(tmp_path: Pa
     outside = tmp_path / "demo_linear.lp"
     r = runner.invoke(app, ["export-lp", str(session), "--out", str(outside), "--linear"])
     assert r.exit_code == 0, r.output
-    assert "move" in r.output and "relative to" in " ".join(r.output.split())
+    said = " ".join(r.output.split())
+    assert "move" in said and "relative to" in said
+    # the advice for relight-cli (the first .lp of a folder) is not to keep two there, and how
+    # to get lights.lp back: it had said "move it into the session … keep one there"
+    assert "move that folder's lights.lp out too" in said
+    assert f"rti-rig export-lp {session} --out {session / 'lights.lp'}` writes it again" in said
     r = runner.invoke(app, ["fit", str(outside), "--out", str(tmp_path / "f"), "--no-qa"])
     assert r.exit_code == 2
     text = " ".join(r.output.split())
