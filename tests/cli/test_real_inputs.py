@@ -446,3 +446,27 @@ def test_too_many_lights_of_a_replay_are_counted_as_its_images(tmp_path: Path) -
     text = " ".join(r.output.split())
     assert r.exit_code == 2 and "has only 18 images; use --lights 18 or fewer" in text, text
     assert "LEDs" not in text and not (tmp_path / "s").exists()
+
+
+def test_check_of_a_recorded_acquisition_tests_no_lights_that_do_not_exist(
+    tmp_path: Path,
+) -> None:
+    """`rti-rig check ACQ/dirs.lp` had walked the replay rig's "LEDs" (its images) and said
+    "unknown firmware, 18 LEDs … passed: 18 … round trip median 0.00 ms … PASS": a light test
+    of lights that do not exist. It now says what loading the acquisition verified, and an
+    acquisition with a damaged image fails it, naming the image."""
+    r = runner.invoke(app, ["check", str(ACQ / "dirs.lp")])
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
+    assert "replay rig: a recorded acquisition, no device to light, move or open" in said
+    assert "images: 18 listed in dirs.lp, each present beside it" in said
+    assert "402x395" in said and said.endswith("RESULT: PASS")
+    assert "LED" not in said and "round trip" not in said
+    copy = tmp_path / "acq"
+    shutil.copytree(ACQ, copy)
+    first = next(iter(sorted(copy.glob("*.jpg"))))
+    first.write_bytes(first.read_bytes()[:2000])  # cut off, as a card pulled too early
+    r = runner.invoke(app, ["check", str(copy / "dirs.lp")])
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert "damaged JPEG" in said and first.name in said and "Traceback" not in r.output

@@ -49,6 +49,8 @@ def check_rig(req: CheckRequest) -> Any:
             f"--intensity {req.intensity:g}: give the LED drive level as a fraction in (0, 1]"
         )
     loaded = load_rig_config(req.rig_config)
+    if loaded.config.backend == "replay":
+        return ReplayCheck.of(loaded)
     if loaded.config.dome is not None and loaded.config.dome.flash_sync is not None:
         from rti_rig.app.flash_sync import flash_sync_check
 
@@ -104,3 +106,47 @@ class WithCamera:
     def lines(self) -> list[str]:
         *body, result = self.lights.lines()
         return [*body, self.camera[0], result if self.camera[1] else "RESULT: FAIL"]
+
+
+@dataclass(frozen=True)
+class ReplayCheck:
+    """``check`` of a recorded acquisition (``rti-rig check ACQ/dirs.lp``): what loading it as a
+    rig verified, its images, and nothing more.
+
+    Why: the replay rig's "LEDs" are images, so the dome walk had reported "unknown firmware,
+    18 LEDs … passed: 18 … round trip median 0.00 ms … PASS" — a light test of lights that do
+    not exist. What can be checked of an acquisition is checked when it loads (every image
+    listed present beside the .lp, no damaged JPEG, every image readable, one size and one
+    kind), so a load that succeeds is the pass, said as such."""
+
+    count: int
+    width: int
+    height: int
+    lp_name: str
+    notes: tuple[str, ...]
+
+    @classmethod
+    def of(cls, loaded: Any) -> ReplayCheck:
+        from rti_rig.app.config import dome_led_directions
+
+        cam = loaded.config.camera
+        return cls(
+            count=len(dome_led_directions(loaded)[0]),
+            width=int(cam.width),
+            height=int(cam.height),
+            lp_name=Path(loaded.path).name,
+            notes=tuple(loaded.notes),
+        )
+
+    @property
+    def ok(self) -> bool:
+        return True
+
+    def lines(self) -> list[str]:
+        return [
+            "replay rig: a recorded acquisition, no device to light, move or open",
+            f"images: {self.count} listed in {self.lp_name}, each present beside it, "
+            f"undamaged and readable, all {self.width}x{self.height} of one kind",
+            *(f"note: {n}" for n in self.notes),
+            "RESULT: PASS",
+        ]
