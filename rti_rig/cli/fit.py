@@ -37,6 +37,19 @@ def print_verdict(session: Path | None) -> None:
             "[yellow]QA verdict skipped (Ctrl-C):[/] the session is complete; "
             f"rti-rig fit {escape(str(session))} --out FOLDER gives the verdict"
         )
+    except VerdictTerminated:  # SIGTERM: said as Ctrl-C is, then the exit a SIGTERM asks for
+        err.print(
+            "[yellow]QA verdict skipped (SIGTERM):[/] the session is complete; "
+            f"rti-rig fit {escape(str(session))} --out FOLDER gives the verdict"
+        )
+        raise typer.Exit(code=143) from None
+
+
+class VerdictTerminated(BaseException):
+    """A SIGTERM while ``run`` computes its QA verdict (raised by the run's handler for that
+    phase): the session is complete, so it is said like a Ctrl-C there; it had ended the
+    process silently (exit 143), which read like a failed session. A BaseException, as
+    KeyboardInterrupt is, so that no ``except Exception`` on the way swallows it."""
 
 
 @app.command()

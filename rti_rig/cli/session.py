@@ -247,7 +247,25 @@ def run(
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
 
-            print_verdict(opened.out_dir)
+            with _verdict_terminable():
+                print_verdict(opened.out_dir)
+
+
+@contextmanager
+def _verdict_terminable() -> Iterator[None]:
+    """A SIGTERM while the QA verdict is computed raises :class:`~rti_rig.cli.fit.
+    VerdictTerminated`, which the verdict says as it says a Ctrl-C (the session is complete)
+    before exiting 143; it had ended the process with no word."""
+    from rti_rig.cli.fit import VerdictTerminated
+
+    def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        raise VerdictTerminated
+
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 @contextmanager

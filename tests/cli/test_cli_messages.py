@@ -147,6 +147,40 @@ def test_a_late_sigusr1_does_not_end_the_run_before_its_verdict(tmp_path: Path) 
     assert "SIGUSR1 ignored" in said and "QA verdict:" in said, said
 
 
+def test_a_sigterm_during_the_verdict_says_the_session_is_complete(tmp_path: Path) -> None:
+    """SIGTERM (a service manager, ``timeout``) while the QA verdict is computed had ended the
+    process silently with exit 143: a complete session read as a failed one. It is said as a
+    Ctrl-C there is, and the exit is still a SIGTERM's (143); SIGTERM's handler is back after."""
+    import subprocess
+    import sys
+
+    script = (
+        "import os, signal, sys\n"
+        "import rti_rig.app.usecases.fit as fit\n"
+        "def late(session):\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    raise AssertionError('the SIGTERM should have stopped the verdict')\n"
+        "fit.verdict_for_session = late\n"
+        "from rti_rig.cli import app\n"
+        "try:\n"
+        "    app(sys.argv[1:], prog_name='rti-rig')\n"
+        "finally:\n"
+        "    print('handler restored:', signal.getsignal(signal.SIGTERM) is signal.SIG_DFL)\n"
+    )
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "6"]
+    proc = subprocess.run(
+        [sys.executable, "-c", script, *args], capture_output=True, text=True, timeout=300
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 143, (proc.returncode, said)
+    assert "6 image(s) in the session" in said
+    assert "QA verdict skipped (SIGTERM): the session is complete" in said, said
+    assert f"rti-rig fit {out} --out FOLDER gives the verdict" in said
+    assert "handler restored: True" in said and "Traceback" not in said
+
+
 def test_a_session_cancelled_before_its_first_image_offers_no_resume(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
