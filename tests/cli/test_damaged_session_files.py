@@ -201,3 +201,25 @@ def test_reshoot_lost_does_not_vouch_for_what_it_cannot_check(
     assert "image_006 cannot be checked (journal.jsonl line 6 unreadable)" in text
     r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
     assert r.exit_code != 0 and "image_006" in said(r), said(r)  # lights.lp lists it: named
+
+
+def test_a_missing_manifest_is_said_by_fit(session: Path, tmp_path: Path) -> None:
+    """A session that lost its manifest.json had been fitted, and judged "good", without a
+    word (run --resume refuses the folder as "not an rti-rig session folder"). fit still fits
+    it from lights.lp — its images are vouched for by the journal — and says what is missing."""
+    s = _copy(session, tmp_path)
+    (s / "manifest.json").unlink()
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert f"note: {s} is a session folder without its manifest.json: fitted from" in text
+    assert "cannot be resumed; restore the manifest from a copy of the session" in text
+    # a folder of images and an .lp that never was a session (no journal) gets no such note
+    plain = tmp_path / "plain"
+    plain.mkdir()
+    for f in s.glob("image_*.jpg"):
+        shutil.copy(f, plain / f.name)
+    shutil.copy(s / "lights.lp", plain / "lights.lp")
+    r = runner.invoke(app, ["fit", str(plain), "--out", str(tmp_path / "fit2")])
+    assert r.exit_code == 0, r.output
+    assert "manifest.json" not in said(r)

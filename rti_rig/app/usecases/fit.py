@@ -46,7 +46,7 @@ from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
 from rti_rig.runtime.disowned import refuse_if_disowned
-from rti_rig.runtime.session import JOURNAL, LP_NAME
+from rti_rig.runtime.session import JOURNAL, LP_NAME, MANIFEST
 
 #: What ``--model`` accepts besides the registered model names.
 AUTO = "auto"
@@ -248,6 +248,15 @@ def acquisition_files(
                 )
             raise FitInputError(f"{source} holds no .lp file: not a session folder")
         lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]
+        if notes is not None and (source / JOURNAL).is_file() and not (source / MANIFEST).is_file():
+            # a session (it has a journal) that lost its manifest had been fitted, and judged
+            # "good", without a word: what it records (the rig, the plan, the exposure, the
+            # lights' calibration) is gone, and run --resume refuses the folder
+            notes.append(
+                f"{source} is a session folder without its {MANIFEST}: fitted from its "
+                f"{lp.name}, but its record of the rig, plan and exposure is missing and it "
+                "cannot be resumed; restore the manifest from a copy of the session"
+            )
     elif source.suffix.lower() == ".lp" and source.is_file():
         lp = source
     else:
