@@ -223,3 +223,12 @@ def test_a_missing_manifest_is_said_by_fit(session: Path, tmp_path: Path) -> Non
     r = runner.invoke(app, ["fit", str(plain), "--out", str(tmp_path / "fit2")])
     assert r.exit_code == 0, r.output
     assert "manifest.json" not in said(r)
+
+
+def test_fit_of_a_path_that_does_not_exist_says_so(tmp_path: Path) -> None:
+    """A typo in fit's source had been told "give a session folder or an .lp file", as if the
+    path were of the wrong kind."""
+    r = runner.invoke(app, ["fit", str(tmp_path / "sesion"), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 2, r.output
+    assert f"{tmp_path / 'sesion'} does not exist" in said(r)
+    assert not (tmp_path / "fit").exists()

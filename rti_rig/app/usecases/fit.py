@@ -259,6 +259,8 @@ def acquisition_files(
             )
     elif source.suffix.lower() == ".lp" and source.is_file():
         lp = source
+    elif not source.exists():  # a typo had been told to "give a session folder or an .lp"
+        raise FitInputError(f"{source} does not exist: give a session folder or an .lp file")
     else:
         raise FitInputError(f"{source}: give a session folder or an .lp file")
     refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
