@@ -154,6 +154,10 @@ def fit(
                 if item.verdict:
                     line += f"; QA verdict: {item.verdict}"
                 out.print(escape(line))
+                said = [("note", t) for t in item.notes] + [("warning", t) for t in item.warnings]
+                for kind, text in said:
+                    line = f"  [yellow]{kind}:[/] {escape(text)}"
+                    err.print(line, highlight=False, soft_wrap=True)
             if any(i.status.startswith("failed") for i in items):
                 raise typer.Exit(code=2)
             return

@@ -519,3 +519,24 @@ def test_fit_refuses_a_cfa_mosaic_session_by_name(tmp_path: Path) -> None:
     assert "image_001.tif is a CFA mosaic" in said and 'decode.mode = "demosaic"' in said
     assert "Traceback" not in r.output
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_batch_says_each_session_s_notes_and_warnings(tmp_path: Path) -> None:
+    """``fit S1 S2 --out ROOT`` had printed one line per session and dropped what ``fit S``
+    says of it: here a 5-light session's "fit.ptm not written" (a PTM needs 6)."""
+    from conftest import CONFIGS
+
+    sessions = []
+    for name, n in (("five", "5"), ("six", "6")):
+        s = tmp_path / name
+        cfg = str(CONFIGS / "simulated_dome.toml")
+        r = runner.invoke(app, ["run", cfg, "--out", str(s), "--lights", n, "--no-verdict"])
+        assert r.exit_code == 0, r.output
+        sessions.append(str(s))
+    r = runner.invoke(app, ["fit", *sessions, "--out", str(tmp_path / "batch"), "--no-qa"])
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
+    five, six = said.index(f"{sessions[0]}: done"), said.index(f"{sessions[1]}: done")
+    warning = said.index("warning: fit.ptm not written: a PTM needs at least 6 lights, there are 5")
+    assert five < warning < six  # under its own session
+    assert said.count("fit.ptm not written") == 1

@@ -776,6 +776,10 @@ class BatchItem:
     out_dir: Path
     status: str  # "done", "skipped (finished earlier)", or "failed: ..."
     verdict: str | None = None
+    #: the fit's notes and warnings, as a single fit prints them (a batch had dropped them:
+    #: "fit.ptm not written" for a 5-light session was said by fit S, not by fit S1 S2)
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
 
 def batch_out_dir(root: Path, source: Path) -> Path:
@@ -858,4 +862,11 @@ def fit_one(
         shutil.rmtree(partial, ignore_errors=True)
         if not final.exists():
             raise
-    return BatchItem(source, final, "done", result.qa.verdict if result.qa is not None else None)
+    return BatchItem(
+        source,
+        final,
+        "done",
+        result.qa.verdict if result.qa is not None else None,
+        tuple(result.notes),
+        tuple(result.warnings),
+    )
