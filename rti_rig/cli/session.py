@@ -385,8 +385,8 @@ def _paused_lights(rig) -> str:  # type: ignore[no-untyped-def]
     from rti_rig.app.usecases.safe_state import lights_state
     from rti_rig.runtime.lighting import ArmLighting
 
-    if isinstance(rig.lighting, ArmLighting):
-        return "lamp off"
+    if isinstance(rig.lighting, ArmLighting):  # no lamp reports back: what was asked, no more
+        return "lamp off requested after the last image"
     return lights_state(rig)
 
 

@@ -290,7 +290,7 @@ def test_a_cancelled_session_says_what_is_known_of_the_lights(
         ("emulated_elexol.toml", "this firmware never acknowledges"),
         ("emulated_dome.toml", "all-off sent and acknowledged by the dome: lights are off"),
         ("simulated_dome.toml", "lights were switched off"),
-        ("virtual_arm.toml", "lamp off"),
+        ("virtual_arm.toml", "lamp off requested after the last image"),
     ],
 )
 def test_a_paused_session_says_what_is_known_of_the_lights(
