@@ -221,6 +221,56 @@ def test_a_session_another_process_is_writing_is_not_resumed_under_it(tmp_path: 
     assert "4 of 8 images verified" in said(r), said(r)
 
 
+@pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="POSIX flock")
+def test_a_resume_that_fails_to_open_releases_the_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A resume refused after its reopen (the rig's check failed) or opened and closed without
+    running had kept the folder's lock for as long as the calling process lived: every other
+    process was told the session is "in use by another rti-rig process"."""
+    import sys
+
+    from rti_rig.app.usecases import session as usecase
+
+    cfg = write_config(tmp_path, SMALL_DOME)
+    rig = build_rig(load_rig_config(cfg))
+    cancel = CancelToken()
+
+    def stop_after_four(e) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(e, StepCompleted) and e.index == 3:
+            cancel.cancel()
+
+    out = tmp_path / "s"
+    run_session(
+        rig,
+        plan_uniform(rig.geometry, LIGHTS),
+        SessionFolder.create(out, LIGHTS),
+        cancel=cancel,
+        on_event=stop_after_four,
+    )
+    probe = [
+        sys.executable,
+        "-c",
+        "import fcntl, os, sys\n"
+        "fd = os.open(sys.argv[1], os.O_RDONLY)\n"
+        "fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)\n",
+        str(out),
+    ]
+
+    def failing_check(loaded, schedule):  # type: ignore[no-untyped-def]
+        raise SessionError("the rig's check failed")
+
+    with monkeypatch.context() as m:
+        m.setattr(usecase, "checked_rig", failing_check)
+        with pytest.raises(SessionError):
+            usecase.open_resumed_session(usecase.ResumeRequest(out, cfg))
+    assert subprocess.run(probe, capture_output=True).returncode == 0
+
+    opened = usecase.open_resumed_session(usecase.ResumeRequest(out, cfg))
+    opened.close()  # opened, never run
+    assert subprocess.run(probe, capture_output=True).returncode == 0
+
+
 def test_free_disk_is_checked_before_anything_moves(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

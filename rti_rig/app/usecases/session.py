@@ -146,7 +146,12 @@ class OpenedSession:
         return self.total_steps - self.steps_done_before
 
     def close(self) -> None:
-        self.rig.close()
+        from rti_rig.runtime.session import unlock_session
+
+        try:
+            self.rig.close()
+        finally:
+            unlock_session(self.folder.root)  # a resume's lock, also for a run never started
 
     def __enter__(self) -> OpenedSession:
         return self
@@ -574,6 +579,18 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
 
         check_done = refuse_broken_run(Path(req.session_dir), planned_steps(manifest))
     folder = SessionFolder.reopen(req.session_dir, check_done, req.reshoot_lost)
+    try:
+        return _opened_resume(req, loaded, folder, identity, diffs, on_note)
+    except BaseException:
+        # the folder's lock (taken by the reopen) goes with the run that did not start: a
+        # process that stays (a test, a program calling this) had kept every other one out
+        from rti_rig.runtime.session import unlock_session
+
+        unlock_session(folder.root)
+        raise
+
+
+def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: ignore[no-untyped-def]
     folder.rig_identity = identity
     folder.rig_change = diffs or None
     folder.input_notes = list(loaded.notes)  # recorded in this run's entry of the manifest
