@@ -243,7 +243,10 @@ def _refuse_non_lp_text(content: list[tuple[int, str]], source: str) -> None:
                 "UTF-8 or ASCII text, or copy it again from where it was written",
             )
     first_no, first = content[0]
-    if first.startswith("{"):
+    tokens = first.split()
+    # an image named '{001}.jpg' on a count-less file's first line is a light, not JSON
+    light = len(tokens) >= 4 and all(_is_number(t) for t in tokens[1:4])
+    if first.startswith("{") and not light:
         raise LpFormatError(
             source,
             first_no,

@@ -335,6 +335,17 @@ def test_relight_json_dome_is_refused_as_json() -> None:
     assert str(info.value).startswith("my.dome, line 1: this is a JSON file, not an .lp")
 
 
+def test_a_countless_lp_whose_first_image_name_begins_with_a_brace_is_read() -> None:
+    """The JSON refusal looks at what the first line is: a count-less .lp whose first image is
+    named '{001}.jpg' is a light, read as before (it had been refused as "a JSON file"), and a
+    one-line JSON is still refused as JSON."""
+    text = "{001}.jpg 0.6 0 0.8\n{002}.jpg 0 0.6 0.8\n"
+    assert [e.name for e in parse_lp(text, "braces.lp")] == ["{001}.jpg", "{002}.jpg"]
+    with pytest.raises(LpFormatError) as info:
+        parse_lp('{"directions": [[0.1, 0.2, 0.97]]}\n', "my.dome")
+    assert "this is a JSON file, not an .lp" in str(info.value)
+
+
 def test_cceh_skeleton_without_names_is_refused_saying_so() -> None:
     """cceh/rti's lp-builder.py writes a dome's lights as bare ``x y z`` lines, no count and no
     names (``dome1.lp``, the "skeleton" its image-filer.py fills with names): there is no image
