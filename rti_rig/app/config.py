@@ -384,7 +384,7 @@ def quoted_value(raw: Any, value: Any, loc: tuple[Any, ...] = ()) -> tuple[str, 
     100`` — is refused already. The walk compares the file's tree with the validated one, so it
     needs no list of numeric keys and reaches every table and array."""
     if isinstance(raw, str):
-        return (_key_of(loc), raw, value) if isinstance(value, bool | int | float) else None
+        return (_key_of(loc), raw, value) if _reads_as(raw, value) else None
     if isinstance(raw, dict):
         for k, sub_raw in raw.items():
             if isinstance(value, BaseModel) and k in type(value).model_fields:
@@ -402,6 +402,25 @@ def quoted_value(raw: Any, value: Any, loc: tuple[Any, ...] = ()) -> tuple[str, 
             if hit is not None:
                 return hit
     return None
+
+
+#: the texts pydantic's lax mode reads as a truth value
+_TRUTH_WORDS = frozenset(["true", "false", "yes", "no", "on", "off", "t", "f", "y", "n", "1", "0"])
+
+
+def _reads_as(text: str, value: Any) -> bool:
+    """Whether ``text`` is ``value`` written in quotes: a truth value's word, or the number
+    itself. A value that came from elsewhere (``[dome.serial] baudrate`` is the protocol's, so a
+    ``protocol.baudrate = "fast"`` beside it met a number) is no quoted number: saying "write it
+    without the quotes" of 'fast' was untrue."""
+    if isinstance(value, bool):
+        return text.strip().lower() in _TRUTH_WORDS
+    if isinstance(value, int | float):
+        try:
+            return float(text) == float(value)
+        except ValueError:
+            return False
+    return False
 
 
 def refuse_quoted_value(path: str | Path, raw: Any, value: Any, loc: tuple[Any, ...] = ()) -> None:

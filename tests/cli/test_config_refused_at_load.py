@@ -302,3 +302,24 @@ def test_a_quoted_truth_value_in_the_camera_device_table_is_refused(tmp_path: Pa
 def test_every_shipped_config_has_no_quoted_number() -> None:
     for cfg in sorted(CONFIGS.glob("*.toml")):
         load_rig_config(cfg)  # raises on a quoted number
+
+
+def test_text_that_is_no_number_is_not_called_a_quoted_number(tmp_path: Path) -> None:
+    """The protocol's baud rate is [dome.serial]'s where that gives one: a
+    ``protocol.baudrate = "fast"`` beside it met a number in the validated description and was
+    refused as "'fast' is text in quotes, not a number: write it without the quotes", which is
+    untrue ('fast' unquoted is no TOML). Only text that reads as the value is a quoted value."""
+    cfg = edited(
+        tmp_path,
+        "emulated_rtipy.toml",
+        "[dome.serial]\n",
+        "[dome.serial]\nbaudrate = 57600\n",
+    )
+    text = cfg.read_text(encoding="utf-8").replace(
+        "led_count = 8 ", 'baudrate = "fast"\nled_count = 8 ', 1
+    )
+    cfg.write_text(text, encoding="utf-8")
+    try:
+        load_rig_config(cfg)
+    except ConfigError as exc:
+        assert "text in quotes" not in exc.message, exc.message
