@@ -367,6 +367,10 @@ class SessionFolder:
         except OSError as exc:
             raise SessionWriteError(self.root, exc) from None
         lock_session(self.root)  # two runs given the same new --out: the second stops here
+        # ... and one that was checked before another run in the same --out began and finished
+        # (it took its images while this one's rig was opening): what that left is no image-less
+        # leftover to clear; its journal, lights.lp and manifest had been replaced by this one's
+        self.check_new(self.root)
         # an image-less session left here before (see check_new): its files go
         for name in (JOURNAL, LP_NAME):
             with contextlib.suppress(FileNotFoundError):

@@ -271,6 +271,27 @@ def test_a_resume_that_fails_to_open_releases_the_folder(
     assert subprocess.run(probe, capture_output=True).returncode == 0
 
 
+def test_a_new_session_does_not_begin_over_one_that_finished_while_it_opened(
+    tmp_path: Path,
+) -> None:
+    """Two runs given the same new --out, the second's rig slower to open: the first's
+    check, begin and finish all came between the second's check and its begin. The second
+    then deleted the first's journal.jsonl and lights.lp and wrote its manifest over the
+    first's (the lock had been released with the first's finish). It is refused at its begin,
+    and the first session is as it was."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    late = SessionFolder.create(out, LIGHTS)  # checked while the folder did not exist
+    rig = build_rig(load_rig_config(cfg))
+    schedule = plan_uniform(rig.geometry, LIGHTS)
+    run_session(rig, schedule, SessionFolder.create(out, LIGHTS))
+    records = ("manifest.json", "journal.jsonl")
+    before = (digests(out), {n: (out / n).read_bytes() for n in records})
+    with pytest.raises(SessionError, match="not empty"):
+        run_session(build_rig(load_rig_config(cfg)), schedule, late)
+    assert (digests(out), {n: (out / n).read_bytes() for n in records}) == before
+
+
 def test_free_disk_is_checked_before_anything_moves(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
