@@ -155,94 +155,97 @@ def run(
         open_resumed_session,
     )
 
-    try:
-        if resume is not None:
-            given = [
-                flag
-                for flag, value in (
-                    ("--out", out_dir is not None),
-                    ("--plan", plan is not None),
-                    ("--lights", lights is not None),
-                    ("--adaptive", adaptive),
-                    ("--until-error", until_error is not None),
-                    ("--min-lights", min_lights is not None),
-                    ("--auto-exposure", auto_exposure),
-                    ("--min-elevation-deg", min_elevation_deg != 0.0),
-                    ("--max-elevation-deg", max_elevation_deg != 90.0),
-                )
-                if value
-            ]
-            if given:
-                raise RtiRigError(
-                    "--resume continues a session as it began (its lights, stopping rule and "
-                    f"exposure are in its manifest): drop {', '.join(given)}"
-                )
-            opened = open_resumed_session(
-                ResumeRequest(
-                    resume,
-                    rig_config,
-                    max_saturated=max_saturated,
-                    accept_rig_change=accept_rig_change,
-                    objective=objective,
-                    reshoot_lost=reshoot_lost,
-                ),
-                print_note,
-            )
-        else:
-            if rig_config is None or out_dir is None:
-                raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
-            if accept_rig_change:
-                raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
-            if reshoot_lost:
-                raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
-            opened = open_new_session(
-                NewSessionRequest(
-                    rig_config,
-                    out_dir,
-                    lights=lights,
-                    plan=plan,
-                    min_elevation_deg=min_elevation_deg,
-                    max_elevation_deg=max_elevation_deg,
-                    auto_exposure=auto_exposure,
-                    max_saturated=max_saturated,
-                    adaptive=adaptive,
-                    until_error_deg=until_error,
-                    objective=objective,
-                    min_lights=min_lights,
-                ),
-                print_note,
-            )
-    except RtiRigError as exc:
-        _print_failures(getattr(exc, "teardown_failures", None))  # metering's
-        state = getattr(exc, "lights_state", None)
-        if state is not None:  # metering failed: it had lit the rig; nothing was written yet
-            err.print(
-                f"{_sentence(state)}; nothing was captured or written to {out_dir}.",
-                markup=False,
-            )
-        raise fail(exc) from None
-    except KeyboardInterrupt as exc:
-        # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
-        # had been 130 with no word at all
-        if resume is not None:
-            said = (
-                f"Stopped (Ctrl-C) before the session went on: no new image was captured; "
-                f"continue it with rti-rig run --resume {resume}"
-            )
-        else:
-            said = (
-                "Stopped (Ctrl-C) before the first image: nothing was captured or written to "
-                f"{out_dir}"
-            )
-        _print_failures(getattr(exc, "teardown_failures", None))
-        if auto_exposure:
-            said += (
-                "; metering, if it had begun, attempted an all-off on its way out: check the "
-                "rig's lights"
-            )
-        err.print(f"[yellow]{escape(said)}.[/]")
-        raise typer.Exit(code=130) from None
+    # SIGUSR1 said to be ignored from here, not only once the capture is over: one that came
+    # while the rig opened (an emulator starting, metering with the rig lit) had ended the
+    # process at once, exit 138, no word and no all-off
     with _late_pause_ignored():
+        try:
+            if resume is not None:
+                given = [
+                    flag
+                    for flag, value in (
+                        ("--out", out_dir is not None),
+                        ("--plan", plan is not None),
+                        ("--lights", lights is not None),
+                        ("--adaptive", adaptive),
+                        ("--until-error", until_error is not None),
+                        ("--min-lights", min_lights is not None),
+                        ("--auto-exposure", auto_exposure),
+                        ("--min-elevation-deg", min_elevation_deg != 0.0),
+                        ("--max-elevation-deg", max_elevation_deg != 90.0),
+                    )
+                    if value
+                ]
+                if given:
+                    raise RtiRigError(
+                        "--resume continues a session as it began (its lights, stopping rule and "
+                        f"exposure are in its manifest): drop {', '.join(given)}"
+                    )
+                opened = open_resumed_session(
+                    ResumeRequest(
+                        resume,
+                        rig_config,
+                        max_saturated=max_saturated,
+                        accept_rig_change=accept_rig_change,
+                        objective=objective,
+                        reshoot_lost=reshoot_lost,
+                    ),
+                    print_note,
+                )
+            else:
+                if rig_config is None or out_dir is None:
+                    raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
+                if accept_rig_change:
+                    raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
+                if reshoot_lost:
+                    raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
+                opened = open_new_session(
+                    NewSessionRequest(
+                        rig_config,
+                        out_dir,
+                        lights=lights,
+                        plan=plan,
+                        min_elevation_deg=min_elevation_deg,
+                        max_elevation_deg=max_elevation_deg,
+                        auto_exposure=auto_exposure,
+                        max_saturated=max_saturated,
+                        adaptive=adaptive,
+                        until_error_deg=until_error,
+                        objective=objective,
+                        min_lights=min_lights,
+                    ),
+                    print_note,
+                )
+        except RtiRigError as exc:
+            _print_failures(getattr(exc, "teardown_failures", None))  # metering's
+            state = getattr(exc, "lights_state", None)
+            if state is not None:  # metering failed: it had lit the rig; nothing was written yet
+                err.print(
+                    f"{_sentence(state)}; nothing was captured or written to {out_dir}.",
+                    markup=False,
+                )
+            raise fail(exc) from None
+        except KeyboardInterrupt as exc:
+            # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
+            # had been 130 with no word at all
+            if resume is not None:
+                said = (
+                    f"Stopped (Ctrl-C) before the session went on: no new image was captured; "
+                    f"continue it with rti-rig run --resume {resume}"
+                )
+            else:
+                said = (
+                    "Stopped (Ctrl-C) before the first image: nothing was captured or written to "
+                    f"{out_dir}"
+                )
+            _print_failures(getattr(exc, "teardown_failures", None))
+            if auto_exposure:
+                said += (
+                    "; metering, if it had begun, attempted an all-off on its way out: check the "
+                    "rig's lights"
+                )
+            err.print(f"[yellow]{escape(said)}.[/]")
+            raise typer.Exit(code=130) from None
         _execute(opened)
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict

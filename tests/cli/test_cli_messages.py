@@ -147,6 +147,38 @@ def test_a_late_sigusr1_does_not_end_the_run_before_its_verdict(tmp_path: Path) 
     assert "SIGUSR1 ignored" in said and "QA verdict:" in said, said
 
 
+@pytest.mark.skipif(not hasattr(__import__("signal"), "SIGUSR1"), reason="no SIGUSR1")
+def test_an_early_sigusr1_does_not_end_the_run_while_the_rig_opens(tmp_path: Path) -> None:
+    """SIGUSR1 (pause) that arrives while the rig opens (an emulator starting, metering with
+    the rig lit) met Python's default action: exit 138, no word, no all-off. It is ignored
+    there too, and said to be, and the session runs."""
+    import subprocess
+    import sys
+
+    script = (
+        "import os, signal, sys\n"
+        "import rti_rig.app.usecases.session as session\n"
+        "real = session.open_new_session\n"
+        "def early(*a, **k):\n"
+        "    os.kill(os.getpid(), signal.SIGUSR1)\n"
+        "    return real(*a, **k)\n"
+        "session.open_new_session = early\n"
+        "from rti_rig.cli import app\n"
+        "app(sys.argv[1:], prog_name='rti-rig')\n"
+    )
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    args = ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6", "--no-verdict"]
+    proc = subprocess.run(
+        [sys.executable, "-c", script, *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 0, (proc.returncode, said)
+    assert "SIGUSR1 ignored" in said and "6 image(s) in the session" in said, said
+
+
 def test_a_sigterm_during_the_verdict_says_the_session_is_complete(tmp_path: Path) -> None:
     """SIGTERM (a service manager, ``timeout``) while the QA verdict is computed had ended the
     process silently with exit 143: a complete session read as a failed one. It is said as a
