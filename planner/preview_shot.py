@@ -97,6 +97,8 @@ def preview_schedule(
                 ang = angle_between_deg(geometry.directions[paper], wanted)
                 led, off = int(paper[np.argmin(ang)]), float(ang.min())
                 which = "the nearest in the paper's {:g}–{:g}° band".format(*PAPER_BAND_DEG)
+                if (lo, hi) != tuple(PAPER_BAND_DEG):  # only the part inside the band asked for
+                    which = f"the nearest at {lo:g}–{hi:g}° (the paper's band within yours)"
         d = geometry.directions[led]
         if off > SNAP_TOLERANCE_DEG:
             got_az, got_el = (float(v) for v in az_el_from_direction(d))

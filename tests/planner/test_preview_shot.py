@@ -91,6 +91,14 @@ def test_a_preview_keeps_to_the_elevation_band_it_is_given() -> None:
     # the paper's band is preferred where it is part of the band, not where it is its edge
     # ("far", at 45° across the dome, is not taken under the 45° ceiling)
     assert preview_schedule(dome, band=(45.0, 90.0))[0].steps[0].label == "paper"
+    # where the band cuts into the paper's, the note names the part searched, not 45–60°
+    cut = DomeGeometry(direction_from_az_el([150.0, 135.0], [54.0, 40.0]), ("at 54", "at 40"))
+    schedule, notes = preview_schedule(cut, band=(0.0, 55.0))
+    assert schedule.steps[0].label == "at 54"
+    assert notes == [
+        "no LED at az 135°, el 50°: the nearest at 45–55° (the paper's band within yours), "
+        "at 54 (az 150.0°, el 54.0°), is 10.0° away"
+    ]
     assert preview_schedule(dome, band=(30.0, 45.0))[0].steps[0].label == "low"
     # a light asked for in the band: the nearest LED in the band, not the nearest overall
     schedule, notes = preview_schedule(dome, (135.0, 46.0), band=(0.0, 46.0))
