@@ -115,35 +115,50 @@ def test_a_late_ctrl_c_does_not_cut_the_summary(
     assert signal.getsignal(signal.SIGINT) is before  # the handlers before are back
 
 
-@pytest.mark.skipif(not hasattr(__import__("signal"), "SIGUSR1"), reason="no SIGUSR1")
-def test_a_late_sigusr1_does_not_end_the_run_before_its_verdict(tmp_path: Path) -> None:
-    """SIGUSR1 (pause) that arrives once the capture is over, while the QA verdict is computed,
-    had met Python's default action: the process ended at once with exit 138 and no word, the
-    verdict unsaid. It is ignored there, and said to be; the handlers before are back after."""
+def _run_signalled(
+    tmp_path: Path, module: str, function: str, signal_name: str, then: str, *extra: str
+) -> tuple[int, str, Path]:
+    """``rti-rig run`` of 6 lights on the simulated dome in a process of its own, where
+    ``module.function`` first sends the process ``signal_name``, then ``then`` (a statement:
+    ``return real(*a, **k)`` to go on). Exit code, what it said (and whether SIGTERM's handler
+    was the default again at the end), the session folder."""
     import subprocess
     import sys
 
     script = (
         "import os, signal, sys\n"
-        "import rti_rig.app.usecases.fit as fit\n"
-        "real = fit.verdict_for_session\n"
-        "def late(session):\n"
-        "    os.kill(os.getpid(), signal.SIGUSR1)\n"
-        "    return real(session)\n"
-        "fit.verdict_for_session = late\n"
+        f"import {module} as target\n"
+        f"real = target.{function}\n"
+        "def signalled(*a, **k):\n"
+        f"    os.kill(os.getpid(), signal.{signal_name})\n"
+        f"    {then}\n"
+        f"target.{function} = signalled\n"
         "from rti_rig.cli import app\n"
-        "app(sys.argv[1:], prog_name='rti-rig')\n"
+        "try:\n"
+        "    app(sys.argv[1:], prog_name='rti-rig')\n"
+        "finally:\n"
+        "    default = signal.getsignal(signal.SIGTERM) is signal.SIG_DFL\n"
+        "    print('SIGTERM handler restored:', default)\n"
     )
     cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
-    args = ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6"]
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "6", *extra]
     proc = subprocess.run(
-        [sys.executable, "-c", script, *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
+        [sys.executable, "-c", script, *args], capture_output=True, text=True, timeout=300
     )
-    said = " ".join((proc.stdout + proc.stderr).split())
-    assert proc.returncode == 0, (proc.returncode, said)
+    return proc.returncode, " ".join((proc.stdout + proc.stderr).split()), out
+
+
+@pytest.mark.skipif(not hasattr(__import__("signal"), "SIGUSR1"), reason="no SIGUSR1")
+def test_a_late_sigusr1_does_not_end_the_run_before_its_verdict(tmp_path: Path) -> None:
+    """SIGUSR1 (pause) that arrives once the capture is over, while the QA verdict is computed,
+    had met Python's default action: the process ended at once with exit 138 and no word, the
+    verdict unsaid. It is ignored there, and said to be; the handlers before are back after."""
+    code, said, _ = _run_signalled(
+        tmp_path, "rti_rig.app.usecases.fit", "verdict_for_session", "SIGUSR1",
+        "return real(*a, **k)",
+    )  # fmt: skip
+    assert code == 0, (code, said)
     assert "SIGUSR1 ignored" in said and "QA verdict:" in said, said
 
 
@@ -152,30 +167,11 @@ def test_an_early_sigusr1_does_not_end_the_run_while_the_rig_opens(tmp_path: Pat
     """SIGUSR1 (pause) that arrives while the rig opens (an emulator starting, metering with
     the rig lit) met Python's default action: exit 138, no word, no all-off. It is ignored
     there too, and said to be, and the session runs."""
-    import subprocess
-    import sys
-
-    script = (
-        "import os, signal, sys\n"
-        "import rti_rig.app.usecases.session as session\n"
-        "real = session.open_new_session\n"
-        "def early(*a, **k):\n"
-        "    os.kill(os.getpid(), signal.SIGUSR1)\n"
-        "    return real(*a, **k)\n"
-        "session.open_new_session = early\n"
-        "from rti_rig.cli import app\n"
-        "app(sys.argv[1:], prog_name='rti-rig')\n"
-    )
-    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
-    args = ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "6", "--no-verdict"]
-    proc = subprocess.run(
-        [sys.executable, "-c", script, *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    said = " ".join((proc.stdout + proc.stderr).split())
-    assert proc.returncode == 0, (proc.returncode, said)
+    code, said, _ = _run_signalled(
+        tmp_path, "rti_rig.app.usecases.session", "open_new_session", "SIGUSR1",
+        "return real(*a, **k)", "--no-verdict",
+    )  # fmt: skip
+    assert code == 0, (code, said)
     assert "SIGUSR1 ignored" in said and "6 image(s) in the session" in said, said
 
 
@@ -183,34 +179,15 @@ def test_a_sigterm_during_the_verdict_says_the_session_is_complete(tmp_path: Pat
     """SIGTERM (a service manager, ``timeout``) while the QA verdict is computed had ended the
     process silently with exit 143: a complete session read as a failed one. It is said as a
     Ctrl-C there is, and the exit is still a SIGTERM's (143); SIGTERM's handler is back after."""
-    import subprocess
-    import sys
-
-    script = (
-        "import os, signal, sys\n"
-        "import rti_rig.app.usecases.fit as fit\n"
-        "def late(session):\n"
-        "    os.kill(os.getpid(), signal.SIGTERM)\n"
-        "    raise AssertionError('the SIGTERM should have stopped the verdict')\n"
-        "fit.verdict_for_session = late\n"
-        "from rti_rig.cli import app\n"
-        "try:\n"
-        "    app(sys.argv[1:], prog_name='rti-rig')\n"
-        "finally:\n"
-        "    print('handler restored:', signal.getsignal(signal.SIGTERM) is signal.SIG_DFL)\n"
-    )
-    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
-    out = tmp_path / "s"
-    args = ["run", str(cfg), "--out", str(out), "--lights", "6"]
-    proc = subprocess.run(
-        [sys.executable, "-c", script, *args], capture_output=True, text=True, timeout=300
-    )
-    said = " ".join((proc.stdout + proc.stderr).split())
-    assert proc.returncode == 143, (proc.returncode, said)
+    code, said, out = _run_signalled(
+        tmp_path, "rti_rig.app.usecases.fit", "verdict_for_session", "SIGTERM",
+        "raise AssertionError('the SIGTERM should have stopped the verdict')",
+    )  # fmt: skip
+    assert code == 143, (code, said)
     assert "6 image(s) in the session" in said
     assert "QA verdict skipped (SIGTERM): the session is complete" in said, said
     assert f"rti-rig fit {out} --out FOLDER gives the verdict" in said
-    assert "handler restored: True" in said and "Traceback" not in said
+    assert "SIGTERM handler restored: True" in said and "Traceback" not in said
 
 
 def test_a_session_cancelled_before_its_first_image_offers_no_resume(

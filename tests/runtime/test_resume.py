@@ -167,14 +167,9 @@ def test_resume_refuses_what_it_cannot_do(tmp_path: Path, reference: tuple[Path,
 
 
 @pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="POSIX flock")
-def test_a_session_another_process_is_writing_is_not_resumed_under_it(tmp_path: Path) -> None:
-    """A second `run --resume` on a session still being captured (it looked stuck; another
-    terminal) had gone ahead: it moved the running session's image in flight to recovered/,
-    shot a step the first process then failed on, and the manifest kept one of the two runs.
-    The folder is locked by the process writing it; the resume is refused and nothing moves."""
-    import shutil
-    import sys
-
+def _cancelled_after_four(tmp_path: Path) -> tuple[Path, Path]:
+    """A session of :data:`LIGHTS` on the small dome cancelled after its fourth image (the
+    folder an interrupted capture leaves, to resume), and its rig config."""
     cfg = write_config(tmp_path, SMALL_DOME)
     rig = build_rig(load_rig_config(cfg))
     cancel = CancelToken()
@@ -184,13 +179,26 @@ def test_a_session_another_process_is_writing_is_not_resumed_under_it(tmp_path: 
             cancel.cancel()
 
     out = tmp_path / "s"
-    run_session(
+    res = run_session(
         rig,
         plan_uniform(rig.geometry, LIGHTS),
         SessionFolder.create(out, LIGHTS),
         cancel=cancel,
         on_event=stop_after_four,
     )
+    assert res.finish_reason is FinishReason.CANCELLED
+    return out, cfg
+
+
+def test_a_session_another_process_is_writing_is_not_resumed_under_it(tmp_path: Path) -> None:
+    """A second `run --resume` on a session still being captured (it looked stuck; another
+    terminal) had gone ahead: it moved the running session's image in flight to recovered/,
+    shot a step the first process then failed on, and the manifest kept one of the two runs.
+    The folder is locked by the process writing it; the resume is refused and nothing moves."""
+    import shutil
+    import sys
+
+    out, _ = _cancelled_after_four(tmp_path)
     # the other process's image in flight: on disk, not journaled yet
     shutil.copy(out / "image_004.jpg", out / "image_005.jpg")
     holder = subprocess.Popen(
@@ -232,22 +240,7 @@ def test_a_resume_that_fails_to_open_releases_the_folder(
 
     from rti_rig.app.usecases import session as usecase
 
-    cfg = write_config(tmp_path, SMALL_DOME)
-    rig = build_rig(load_rig_config(cfg))
-    cancel = CancelToken()
-
-    def stop_after_four(e) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(e, StepCompleted) and e.index == 3:
-            cancel.cancel()
-
-    out = tmp_path / "s"
-    run_session(
-        rig,
-        plan_uniform(rig.geometry, LIGHTS),
-        SessionFolder.create(out, LIGHTS),
-        cancel=cancel,
-        on_event=stop_after_four,
-    )
+    out, cfg = _cancelled_after_four(tmp_path)
     probe = [
         sys.executable,
         "-c",
