@@ -123,12 +123,11 @@ def test_sigterm_is_an_emergency_stop_that_can_be_resumed(
 
 
 @pytest.mark.e2e
-def test_cancelled_session_resumes_and_corrupt_files_are_recaptured(
-    tmp_path: Path, reference: tuple[Path, Path]
-) -> None:
-    cfg, ref = reference
+def _cancelled_after_four(tmp_path: Path) -> tuple[Path, Path]:
+    """A session of :data:`LIGHTS` on the small dome cancelled after its fourth image (the
+    folder an interrupted capture leaves, to resume), and its rig config."""
+    cfg = write_config(tmp_path, SMALL_DOME)
     rig = build_rig(load_rig_config(cfg))
-    schedule = plan_uniform(rig.geometry, LIGHTS)
     cancel = CancelToken()
 
     def stop_after_four(e) -> None:  # type: ignore[no-untyped-def]
@@ -137,9 +136,21 @@ def test_cancelled_session_resumes_and_corrupt_files_are_recaptured(
 
     out = tmp_path / "s"
     res = run_session(
-        rig, schedule, SessionFolder.create(out, LIGHTS), cancel=cancel, on_event=stop_after_four
+        rig,
+        plan_uniform(rig.geometry, LIGHTS),
+        SessionFolder.create(out, LIGHTS),
+        cancel=cancel,
+        on_event=stop_after_four,
     )
     assert res.finish_reason is FinishReason.CANCELLED
+    return out, cfg
+
+
+def test_cancelled_session_resumes_and_corrupt_files_are_recaptured(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    _, ref = reference  # the same SMALL_DOME config, run without interruption
+    out, _ = _cancelled_after_four(tmp_path)
     damaged = out / "image_002.jpg"
     data = bytearray(damaged.read_bytes())
     data[100] ^= 0xFF
@@ -167,29 +178,6 @@ def test_resume_refuses_what_it_cannot_do(tmp_path: Path, reference: tuple[Path,
 
 
 @pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="POSIX flock")
-def _cancelled_after_four(tmp_path: Path) -> tuple[Path, Path]:
-    """A session of :data:`LIGHTS` on the small dome cancelled after its fourth image (the
-    folder an interrupted capture leaves, to resume), and its rig config."""
-    cfg = write_config(tmp_path, SMALL_DOME)
-    rig = build_rig(load_rig_config(cfg))
-    cancel = CancelToken()
-
-    def stop_after_four(e) -> None:  # type: ignore[no-untyped-def]
-        if isinstance(e, StepCompleted) and e.index == 3:
-            cancel.cancel()
-
-    out = tmp_path / "s"
-    res = run_session(
-        rig,
-        plan_uniform(rig.geometry, LIGHTS),
-        SessionFolder.create(out, LIGHTS),
-        cancel=cancel,
-        on_event=stop_after_four,
-    )
-    assert res.finish_reason is FinishReason.CANCELLED
-    return out, cfg
-
-
 def test_a_session_another_process_is_writing_is_not_resumed_under_it(tmp_path: Path) -> None:
     """A second `run --resume` on a session still being captured (it looked stuck; another
     terminal) had gone ahead: it moved the running session's image in flight to recovered/,
