@@ -212,6 +212,35 @@ def holds_no_image(root: Path) -> bool:
     return not (journal.exists() and scan_journal(root).records)
 
 
+def is_session_folder(folder: Path) -> bool:
+    """True if ``folder`` holds a session's own record: its manifest or its journal (a folder
+    with only a ``lights.lp`` is an acquisition any tool may have written, not a session)."""
+    return (folder / MANIFEST).is_file() or (folder / JOURNAL).is_file()
+
+
+def enclosing_session(root: Path) -> Path | None:
+    """The nearest folder above ``root`` that is a session (:func:`is_session_folder`), named
+    as ``root`` was (relative to the working folder when ``root`` is and it lies within it);
+    ``None`` if there is none.
+
+    Why: a new session given an ``--out`` inside a finished one was written there, nested
+    among its images; a copy, a fit or a ``--resume`` of the outer session then carries or
+    stumbles over the inner one. The path is resolved first, so ``S/../T/new`` is not taken
+    for a folder inside ``S`` and a symbolic link into a session is.
+    """
+    resolved = Path(root).resolve()
+    for ancestor in resolved.parents:
+        if is_session_folder(ancestor):
+            if Path(root).is_absolute():
+                return ancestor
+            try:
+                shown = ancestor.relative_to(Path.cwd().resolve())
+            except ValueError:
+                return ancestor
+            return shown if shown.parts else ancestor
+    return None
+
+
 #: session folders this process writes, locked against a second rti-rig process (resolved
 #: path → the folder's open descriptor, whose ``flock`` is the lock)
 _LOCKED: dict[str, int] = {}
@@ -294,6 +323,24 @@ class SessionFolder:
         root = Path(root)
         if root.exists() and not root.is_dir():
             raise SessionError(f"{root} exists and is not a folder: choose another --out")
+        outer = enclosing_session(root)
+        if outer is not None:  # a session written inside another goes wherever that one goes
+            try:
+                finished = (read_manifest(outer).get("runner") or {}).get(
+                    "finish_reason"
+                ) == "completed"
+                resume = f"'rti-rig run --resume {outer}'"
+                what = (
+                    "a finished session"
+                    if finished
+                    else f"an interrupted session (continue it with {resume})"
+                )
+            except SessionError:  # a journal without a manifest, or a damaged manifest
+                what = f"a session folder (it holds rti-rig's {MANIFEST} or {JOURNAL})"
+            raise SessionError(
+                f"--out {root} is inside {outer}, {what}: give an --out outside it, so that "
+                "each session stays a folder of its own"
+            )
         if root.exists() and any(root.iterdir()) and not holds_no_image(root):
             resume = ""  # not a session: no resume to offer
             if (root / MANIFEST).is_file():
