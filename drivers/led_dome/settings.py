@@ -124,6 +124,17 @@ class ThermalSettings(_Strict):
 CodecProfile = Literal["default", "framed", "binary"]
 
 
+def _same_number(a: Any, b: Any) -> bool:
+    """Whether two config values are the same number (``9600`` and ``9600.0``; a quoted one
+    is compared by its text and refused as quoted elsewhere)."""
+    if isinstance(a, bool) or isinstance(b, bool):
+        return False
+    try:
+        return float(a) == float(b)
+    except (TypeError, ValueError):
+        return False
+
+
 class DomeSerialSettings(_Strict):
     """How to reach an LED dome over a serial port, and the policy that keeps it safe."""
 
@@ -187,10 +198,26 @@ class DomeSerialSettings(_Strict):
     @model_validator(mode="before")
     @classmethod
     def _profile_baud(cls, data: Any) -> Any:
-        """A built-in firmware's baud rate unless the config gives one."""
-        if isinstance(data, dict) and "baudrate" not in data:
+        """A built-in firmware's baud rate unless the config gives one.
+
+        The port opens at ``[dome.serial] baudrate`` when it is given; a different
+        ``[dome.serial.protocol] baudrate`` beside it was silently ignored, so a user who set
+        the firmware's rate in the protocol table got a dome that never answered (or the rate
+        they did not mean). Both given and different is refused, naming both keys.
+        """
+        if not isinstance(data, dict):
+            return data
+        over = data.get("protocol") if isinstance(data.get("protocol"), dict) else {}
+        if "baudrate" in data and "baudrate" in over:
+            ours, theirs = data["baudrate"], over["baudrate"]
+            if not _same_number(ours, theirs):
+                raise ValueError(
+                    f"dome.serial.baudrate = {ours!r} and dome.serial.protocol.baudrate = "
+                    f"{theirs!r} disagree, and the port opens at one rate only: give the "
+                    "firmware's baud rate once (remove one of the two keys) or make them equal"
+                )
+        if "baudrate" not in data:
             name = data.get("profile")
-            over = data.get("protocol") if isinstance(data.get("protocol"), dict) else {}
             if isinstance(name, str) and name in described_profiles():
                 data = {**data, "baudrate": over.get("baudrate", builtin_spec(name)["baudrate"])}
             elif name == "custom":

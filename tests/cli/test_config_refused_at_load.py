@@ -323,3 +323,54 @@ def test_text_that_is_no_number_is_not_called_a_quoted_number(tmp_path: Path) ->
         load_rig_config(cfg)
     except ConfigError as exc:
         assert "text in quotes" not in exc.message, exc.message
+
+
+# ------------------------------------------------------- the baud rate given twice
+
+
+def _two_bauds(tmp_path: Path, serial: str, protocol: str, name: str = "rig.toml") -> Path:
+    """emulated_nab_rti_v1.toml (its firmware at 9600) with a baud rate in both tables."""
+    cfg = edited(
+        tmp_path, "emulated_nab_rti_v1.toml", "[dome.serial]\n", f"[dome.serial]\n{serial}\n", name
+    )
+    text = cfg.read_text(encoding="utf-8").replace(
+        "[dome.serial.protocol]\n", f"[dome.serial.protocol]\n{protocol}\n", 1
+    )
+    cfg.write_text(text, encoding="utf-8")
+    return cfg
+
+
+def test_two_different_baud_rates_are_refused_naming_both_keys(tmp_path: Path) -> None:
+    """``[dome.serial] baudrate`` silently won over ``[dome.serial.protocol] baudrate``: the
+    port opened at 115200 to a firmware at 9600, and ``check`` blamed a silent board after a
+    reply timeout. Both given and different is refused as the config loads, before any port."""
+    cfg = _two_bauds(tmp_path, "baudrate = 115200", "baudrate = 9600")
+    with pytest.raises(ConfigError) as err:
+        load_rig_config(cfg)
+    assert str(err.value.path) == str(cfg)
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"{cfg}: key 'dome.serial'" in text
+    assert "dome.serial.baudrate = 115200 and dome.serial.protocol.baudrate = 9600 disagree" in text
+    assert "remove one of the two keys" in text
+    assert "LEDs stepped" not in text and "Traceback" not in text
+
+
+@pytest.mark.parametrize(
+    ("serial", "protocol", "baud"),
+    [
+        ("baudrate = 9600", "baudrate = 9600", 9600),  # equal: accepted
+        ("baudrate = 9600", "baudrate = 9600.0", 9600),  # the same number written otherwise
+        ("", "baudrate = 19200", 19200),  # only the protocol's: it is the port's
+        ("baudrate = 38400", "", 38400),  # only [dome.serial]'s
+        ("", "", 9600),  # neither: the nab-rti-v1 firmware's own
+    ],
+)
+def test_one_baud_rate_or_two_equal_ones_load(
+    tmp_path: Path, serial: str, protocol: str, baud: int
+) -> None:
+    loaded = load_rig_config(_two_bauds(tmp_path, serial, protocol))
+    settings = loaded.config.dome.serial  # type: ignore[union-attr]
+    assert settings.baudrate == baud
+    assert settings.protocol_spec().baudrate == baud
