@@ -11,6 +11,7 @@ object is what the abort protects against; the same rule as an emergency stop).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -25,6 +26,16 @@ from rti_rig.runtime.lighting import attempt_all
 
 #: Largest angle between the asked and the reached direction that passes (degrees).
 TOLERANCE_DEG = 1.0
+
+
+def arm_label(name: str) -> str:
+    """How the check's heading names the arm: its own name when that already says "arm" (the
+    driver's default name is ``arm``, the simulator's ``simulated arm``), else "arm NAME".
+
+    Why: the heading was always "arm NAME", which read "arm arm: 8 poses" on the shipped
+    configs; a name such as ``tablet-rig`` still needs the noun to say what was checked.
+    """
+    return name if "arm" in re.split(r"[^a-z]+", name.lower()) else f"arm {name}"
 
 
 @dataclass(frozen=True)
@@ -67,7 +78,7 @@ class ArmSelfTestReport:
 
     def lines(self) -> list[str]:
         out = [
-            f"arm {self.name}: {len(self.checks)} poses, tolerance {self.tolerance_deg:g}°",
+            f"{arm_label(self.name)}: {len(self.checks)} poses, tolerance {self.tolerance_deg:g}°",
             "  pose               asked az/el       reached az/el     error   move",
         ]
         for c in self.checks:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -59,6 +60,14 @@ class FakeCarrier:
 
     def park(self) -> None:
         self.log.append("park")
+
+
+class RenamedCarrier(FakeCarrier):
+    """The fake carrier under another name."""
+
+    def __init__(self, name: str) -> None:
+        super().__init__()
+        self.name = name  # type: ignore[misc]
 
 
 @pytest.mark.parametrize(
@@ -194,6 +203,26 @@ def test_check_command_on_the_shipped_arm_configs(config: str, tmp_path: Path) -
     assert "RESULT: PASS" in r.output
     assert "8 poses" in r.output and "\nparked\n" in r.output and "NOT parked" not in r.output
     assert r.output.count(" ok\n") == 8
+    # the heading names the arm once ("arm arm: 8 poses" on the Dynamixel configs, whose
+    # driver's arm is named "arm"; "arm simulated arm" on the virtual one)
+    heading = "simulated arm" if config == "virtual_arm.toml" else "arm"
+    assert f"\n{heading}: 8 poses, tolerance 1°\n" in r.output, r.output
+    assert not re.search(r"\b(\w+) \1\b", r.output), r.output  # no word said twice
+
+
+@pytest.mark.parametrize(
+    ("name", "label"),
+    [
+        ("arm", "arm"),
+        ("simulated arm", "simulated arm"),
+        ("left-Arm", "left-Arm"),
+        ("tablet-rig", "arm tablet-rig"),  # a name that does not say what it is gets the noun
+        ("swarm", "arm swarm"),  # ... a word holding "arm" is no arm
+    ],
+)
+def test_the_heading_names_the_arm_with_one_noun(name: str, label: str) -> None:
+    report = arm_self_test(RenamedCarrier(name), ARM, VirtualClock())
+    assert report.lines()[0] == f"{label}: 8 poses, tolerance 1°"
 
 
 @pytest.mark.e2e
