@@ -34,7 +34,7 @@ images to reshoot and why, followed by every check that was not made (:attr:`QAR
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import cv2
@@ -108,6 +108,25 @@ DRIFT_CONFIRM = 0.8
 DRIFT_PX = 1.0
 #: Fewer lit, unshadowed, unsaturated images than this cannot determine a normal.
 MIN_COVERAGE = 3
+#: An uncalibrated dome's LEDs differ light to light (one measured dome: 19–37 % darker to
+#: 18–23 % brighter than its median LED), and so do the gains of its images, by a factor over
+#: the whole image, wherever a rendering of the fit explains them. The session's *light
+#: scatter* is the robust RMS (1.4826 × MAD) of ln gain over the images within
+#: :data:`~rti_rig.reconstruct.qa_directions.MISFIT_LIMIT` of a rendering; from this much on,
+#: the lights themselves differ. Measured on the emulated 48-LED dome, every light, over the
+#: flat, relief, tablet, tilted and painting scenes: 0.000–0.002 with equal LEDs on the matte
+#: ones, 0.018 on the varnished painting; 0.22–0.27 with LEDs drawn at 20 % RMS (0.10 from 8
+#: lights). The glossy coin scatters 0.23 with equal LEDs, but no rendering explains it
+#: (median misfit 0.70): not measured there.
+LIGHT_SCATTER_MIN = 0.05
+#: ... measured on at least this many images (and on at least half of the judged ones).
+LIGHT_SCATTER_MIN_IMAGES = 8
+#: An image brighter than predicted is within the light scatter when it too is a rendering
+#: and its ln gain lies within this many scatters of the median (of 48 normal draws, one lies
+#: beyond 3.5 in about 2 % of sessions): its light's own output can explain it.
+LIGHT_SCATTER_Z = 3.5
+#: The bright-image check's words, found by :meth:`QAReport.explain_bright_by_lights`.
+BRIGHTER = "brighter than the other images predict"
 
 
 @dataclass(frozen=True)
@@ -138,6 +157,14 @@ class ImageCheck:
     #: within :data:`NEIGHBOUR_SPAN_DEG`); NaN where the lights are too far apart, there are
     #: too few lights, or a gain could not be judged.
     neighbour_gain_ratio: float = float("nan")
+    #: How far the image is from the best Lambertian rendering of the fit at any direction and
+    #: brightness (:func:`~rti_rig.reconstruct.qa_directions.relative_misfit`; inf where too
+    #: few pixels are lit): small for an image that is a rendering scaled by its light's output.
+    misfit: float = float("inf")
+    #: True when the session's gains scatter light to light (:data:`LIGHT_SCATTER_MIN`) and
+    #: this image's gain lies within that scatter (:data:`LIGHT_SCATTER_Z`), its image a
+    #: rendering: its light's own output, not the image, can explain its brightness.
+    within_light_scatter: bool = False
 
 
 #: The saturation check's advice (replaced where a session cannot follow it).
@@ -171,6 +198,13 @@ class QAReport:
     #: The verdict's word for images with problems: "reshoot", or what fits a session that
     #: cannot reshoot (a replayed acquisition's images are the recording's: "flawed").
     verdict_word: str = "reshoot"
+    #: The light scatter of the session (:data:`LIGHT_SCATTER_MIN`); NaN where it could not be
+    #: measured (too few images a rendering explains).
+    light_scatter: float = float("nan")
+    #: Said in the verdict for the bright images the lights explain, taken off the reshoot
+    #: list by :meth:`explain_bright_by_lights` (the application knows when the rig's lights
+    #: can differ: an uncalibrated dome); empty otherwise.
+    light_note: str = ""
 
     @property
     def caveats(self) -> list[str]:
@@ -206,12 +240,45 @@ class QAReport:
 
     @property
     def verdict(self) -> str:
-        """``good`` or ``reshoot: name (why); ...``."""
+        """``good`` or ``reshoot: name (why); ...``, and the light note (if any) after it."""
         tail = "".join(f"; {c}" for c in self.caveats)
         if self.good:
-            return "good" + tail
+            head = (
+                f"no image to {self.verdict_word}, but {self.light_note}"
+                if self.light_note
+                else "good"
+            )
+            return head + tail
         parts = [f"{c.name} ({'; '.join(c.problems)})" for c in self.reshoot]
-        return f"{self.verdict_word}: " + ", ".join(parts) + tail
+        light = f"; {self.light_note}" if self.light_note else ""
+        return f"{self.verdict_word}: " + ", ".join(parts) + light + tail
+
+    def bright_within_light_scatter(self) -> list[ImageCheck]:
+        """The images called brighter than predicted whose light's own output can explain it
+        (:attr:`ImageCheck.within_light_scatter`)."""
+        return [
+            c
+            for c in self.images
+            if c.within_light_scatter and any(p.endswith(BRIGHTER) for p in c.problems)
+        ]
+
+    def explain_bright_by_lights(self, note: str) -> QAReport:
+        """This report with the bright-image problem taken off :meth:`bright_within_light_scatter`
+        (their other problems stand) and ``note`` said in the verdict in its place.
+
+        For the application to call where it knows the lights can differ (a dome with no light
+        calibration applied): there a reshoot gives the same image again, since the brightness
+        is its LED's own."""
+        explained = {c.index for c in self.bright_within_light_scatter()}
+        if not explained:
+            return self
+        images = tuple(
+            replace(c, problems=tuple(p for p in c.problems if not p.endswith(BRIGHTER)))
+            if c.index in explained
+            else c
+            for c in self.images
+        )
+        return replace(self, images=images, light_note=note)
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -226,6 +293,8 @@ class QAReport:
             "direction_note": self.direction_note,
             "drift_note": self.drift_note,
             "caveats": self.caveats,
+            "light_scatter": self.light_scatter,
+            "light_note": self.light_note,
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
@@ -466,6 +535,7 @@ def assess(
                 else "; here too few images hold their edges still to tell: none is claimed"
             )
         )
+    light_scatter, within_scatter = _light_scatter(ev.gain, ev.misfit)
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []
@@ -497,7 +567,7 @@ def assess(
         elif (
             np.isfinite(ev.gain[i]) and ev.gain[i] > BRIGHT_GAIN and sat_frac[i] <= SATURATED_LIMIT
         ):
-            problems.append(f"{ev.gain[i]:.1f}× brighter than the other images predict")
+            problems.append(f"{ev.gain[i]:.1f}× {BRIGHTER}")
         if ev.moved[i]:
             dx, dy = ev.drift[i]
             problems.append(
@@ -521,6 +591,8 @@ def assess(
                 direction_judged=bool(ev.direction_judged[i]),
                 gain_judged=bool(np.isfinite(ev.lit_gain[i])),
                 neighbour_gain_ratio=float(ev.neighbour_ratio[i]),
+                misfit=float(ev.misfit[i]),
+                within_light_scatter=bool(within_scatter[i]),
             )
         )
     flagged = {c.index for c in checks if c.problems}
@@ -561,7 +633,26 @@ def assess(
         directions_checked=bool(ev.direction_judged.any()),
         direction_note=ev.direction_note,
         drift_note=drift_note,
+        light_scatter=light_scatter,
     )
+
+
+def _light_scatter(gain: NDArray, misfit: NDArray) -> tuple[float, NDArray[np.bool_]]:
+    """The session's light scatter (:data:`LIGHT_SCATTER_MIN`; NaN where too few images are
+    renderings to measure it) and which images' gains lie within it."""
+    n = len(gain)
+    within = np.zeros(n, bool)
+    judged = np.isfinite(gain) & (gain > 0)
+    rendered = judged & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT)
+    count = int(rendered.sum())
+    if count < LIGHT_SCATTER_MIN_IMAGES or 2 * count < int(judged.sum()):
+        return float("nan"), within
+    log_gain = np.log(np.where(judged, gain, 1.0))
+    centre = float(np.median(log_gain[rendered]))
+    scatter = float(1.4826 * np.median(np.abs(log_gain[rendered] - centre)))
+    if scatter >= LIGHT_SCATTER_MIN:
+        within = rendered & (np.abs(log_gain - centre) <= LIGHT_SCATTER_Z * scatter)
+    return scatter, within
 
 
 @dataclass

@@ -14,6 +14,7 @@ import shlex
 from dataclasses import replace
 from pathlib import Path
 
+from rti_rig.app.usecases.uneven_lights import with_uneven_lights
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import read_lp
 from rti_rig.reconstruct.qa import LESS_EXPOSURE, QAReport
@@ -47,6 +48,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     except RtiRigError:
         manifest = None
     if manifest is not None:
+        qa = with_uneven_lights(qa, manifest)  # a bright image its uncalibrated LED explains
         qa = _with_unfinished(_with_session_kind(qa, manifest), source, manifest)
     lost = files_lost_since_capture(source)
     if not lost:
