@@ -497,13 +497,28 @@ class DomePolicy:
             if problem:
                 raise DeviceError(self.name, f"after a board reset: {problem}", command)
         else:
-            self.clock.sleep(self.settings.retry_backoff_s)
+            self._back_off(self.settings.retry_backoff_s)
+
+    def _back_off(self, seconds: float) -> None:
+        """Wait ``seconds`` for the device: a back-off gives the board (a USB device coming back
+        on the bus, a reply on its way) time on the clock the link really waits on, counted on
+        the rig's. On the rig's simulated clock alone it had passed no time for an emulated
+        dome on a pseudo-terminal, which runs in real time: a USB drop of a second was never
+        recovered in a dry run (every reconnection tried at once, "did not come back"), where
+        the real rig's back-off waits for it."""
+        if seconds <= 0:
+            return
+        link_clock = self._link_clock
+        if link_clock is None:
+            self.clock.sleep(seconds)
+        else:
+            self._counted(lambda: link_clock.sleep(seconds))
 
     def _reconnect(self, command: str) -> None:
         self._quiet_close()
         last = "no attempt made"
         for attempt in range(self.settings.reconnect_attempts):
-            self.clock.sleep(self.settings.reconnect_backoff_s * (2**attempt))
+            self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
             try:
                 info = self._counted(self.link.connect)
             except DomeLinkError as exc:

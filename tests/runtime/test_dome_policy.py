@@ -206,6 +206,34 @@ def test_disconnect_that_does_not_come_back_gives_up():
     assert fw.lit is None
 
 
+def test_reconnection_back_off_passes_on_the_links_own_clock():
+    """An emulated dome on a pty runs in real time while the rig's clock is simulated: the
+    back-off before each reconnection must pass where the board is (the link's clock), or a
+    USB drop of a second is never recovered in a dry run (every attempt made at once), where
+    the real rig's back-off waits for the board to come back. Here a second virtual clock
+    stands for the pty's real time."""
+    link_clock, rig_clock = VirtualClock(), VirtualClock()
+    s = DomeSerialSettings(
+        port="emulated", profile="default", reconnect_attempts=3, reconnect_backoff_s=1.0
+    )
+    fw = firmware_for(
+        s,
+        clock=link_clock,
+        led_count=N_LEDS,
+        faults=FaultPlan((Fault(LIGHT_1, FaultKind.DISCONNECT, delay_s=1.5),)),
+    )
+    dome = build_dome(s, rig_clock, transport=InProcessDomeTransport(fw))
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    before = rig_clock.now()
+    dome.light(1, 1.0)  # away 1.5 s: the first attempt (after 1 s) fails, the second (3 s) not
+    assert fw.lit == (1, 255)
+    assert dome.stats.reconnects == 1
+    # the back-off is the rig's time too (the session time a dry run reports)
+    assert rig_clock.now() - before >= 3.0
+
+
 def test_shutter_is_never_resent():
     dome, fw, _clock = make("default", [Fault(3, FaultKind.DROP_REPLY)])
     dome.connect()
