@@ -49,11 +49,17 @@ class _ReleasingHandler:
     mark set, and every later packet — the teardown's hold, its torque-off — then fails with
     COMM_PORT_BUSY: the stop could not reach the servos. So an exchange that is interrupted
     releases the port as it unwinds, and the next command first discards the status reply the
-    interrupted one may still provoke (it would be read as the next command's answer)."""
+    interrupted one may still provoke (it would be read as the next command's answer).
 
-    def __init__(self, handler: Any, port: Any) -> None:
+    A port that fails under an exchange (the USB adapter unplugged mid-session: pyserial raises
+    ``SerialException``, an ``OSError``) is a :class:`CommunicationError` naming the port, as
+    a port that cannot be opened is: it had reached the user as a Python traceback, and the
+    arm's stop could not tell a lost port from any other bug."""
+
+    def __init__(self, handler: Any, port: Any, device: str = "arm") -> None:
         self._handler = handler
         self._port = port
+        self._device = device
         self._interrupted = False
 
     def __getattr__(self, name: str) -> Any:
@@ -62,10 +68,19 @@ class _ReleasingHandler:
             return attr
 
         def call(*args: Any, **kwargs: Any) -> Any:
-            if self._interrupted:
-                self._recover()
             try:
+                if self._interrupted:
+                    self._recover()
                 return attr(*args, **kwargs)
+            except OSError as exc:  # pyserial's SerialException is one
+                self._port.is_using = False
+                self._interrupted = True
+                raise CommunicationError(
+                    self._device,
+                    f"the port {self._port.getPortName()!r} failed ({exc}): check that the "
+                    "arm's USB adapter (e.g. a U2D2) is still plugged in and the servos "
+                    "powered",
+                ) from exc
             except BaseException:
                 self._port.is_using = False  # whatever the SDK was doing, it is not any more
                 self._interrupted = True
@@ -93,7 +108,7 @@ class DxlBus:
     def __init__(self, port: Any, device: str, packet_handler: Any | None = None) -> None:
         self.port = port
         self.device = device
-        self.ph = _ReleasingHandler(packet_handler or sdk.PacketHandler(2.0), port)
+        self.ph = _ReleasingHandler(packet_handler or sdk.PacketHandler(2.0), port, device)
         #: the line speed the port was opened at (named when a servo does not answer)
         self.baudrate: int | None = None
         #: whether anything that changes a servo's state (a write, an action, a reboot) was

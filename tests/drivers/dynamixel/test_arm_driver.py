@@ -489,3 +489,32 @@ def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothin
     assert "nothing was commanded: the arm could not be connected" in " ".join(report.lines())
     rig = SimpleNamespace(lighting=ArmLighting(never), loaded=SimpleNamespace(config=None))
     assert lights_state(rig) == "nothing was commanded: the arm could not be connected"
+
+
+def test_a_port_lost_mid_session_is_a_named_device_error() -> None:
+    """The arm's USB adapter unplugged under an exchange: pyserial raises SerialException (an
+    OSError) from the SDK's read or write. It had escaped the driver as itself, and the CLI
+    printed a Python traceback instead of the stop's outcome and the resume hint."""
+    import serial
+
+    settings = arm_settings()
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    port = InProcessPort(emu, name="/dev/ttyUSB0")
+    arm = DynamixelArm(settings, port=port, clock=clock)
+    arm.connect()
+
+    def gone(*args: object) -> bytes:
+        raise serial.SerialException(
+            "device reports readiness to read but returned no data (device disconnected or "
+            "multiple access on port?)"
+        )
+
+    port.writePort = gone  # type: ignore[method-assign]
+    port.readPort = gone  # type: ignore[method-assign]
+    with pytest.raises(DynamixelError, match=r"port '/dev/ttyUSB0' failed.*U2D2") as info:
+        arm.move_to(direction_from_az_el(90, 30))
+    assert isinstance(info.value.__cause__, serial.SerialException)
+    # the teardown says what it could not do, by name, whatever the step
+    with pytest.raises(DynamixelError, match=r"stop incomplete.*port '/dev/ttyUSB0' failed"):
+        arm.close()
