@@ -18,7 +18,7 @@ from enum import StrEnum
 from typing import Any, Protocol
 
 from rti_rig.core.devices import Frame
-from rti_rig.core.errors import ScheduleError
+from rti_rig.core.errors import CaptureError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.rig import Rig
@@ -186,6 +186,47 @@ def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
         )
 
 
+def frame_layout(frame: Frame) -> tuple[int, int, bool]:
+    """(height, width, colour) of a frame, as :func:`rti_rig.core.image_files.header_layout`
+    reads them from a session's linear TIFF."""
+    px = frame.pixels
+    return int(px.shape[0]), int(px.shape[1]), px.ndim == 3 and px.shape[2] >= 3
+
+
+def _refuse_other_layout(
+    rig: Rig,
+    folder: SessionFolder,
+    index: int,
+    frame: Frame,
+    got: tuple[int, int, bool],
+    layout: tuple[int, int, bool],
+) -> None:
+    """Stop on a frame whose size or colour differs from the session's images, keeping it.
+
+    A session's images are one set for every fit, relight and RTIBuilder (a resume with another
+    camera size is refused for that reason); such a frame had been written into the session as
+    if nothing were wrong, the run said complete, and only the QA verdict ("images differ in
+    shape") then told of a session that no tool could use."""
+
+    def said(lay: tuple[int, int, bool], by: str = "×") -> str:
+        return f"{lay[1]}{by}{lay[0]} {'colour' if lay[2] else 'grey'}"
+
+    # a TIFF's description is ASCII
+    why = (
+        f"not image {index + 1} of the session: {said(got, 'x')}, the session's are "
+        f"{said(layout, 'x')}"
+    )
+    kept = folder.set_aside(index, frame, why)
+    raise CaptureError(
+        rig.camera.name,
+        f"image {index + 1} came back {said(got)}, but this session's images are "
+        f"{said(layout)}: the camera's image size or format changed during the session (a "
+        "setting changed on the camera, another camera's file in a watched folder). It is not "
+        f"part of the session (kept as {kept}); set the camera back, then continue the session",
+        "capture",
+    )
+
+
 @contextlib.contextmanager
 def _signals_deferred() -> Iterator[None]:
     """Hold SIGINT/SIGTERM while devices are put in their safe state, or while a captured
@@ -284,6 +325,7 @@ def run_session(
     }
     records: list[StepRecord] = []
     end_notes: list[str] = []
+    layout = folder.image_layout()  # the session's image size, once it has an image
     reason = FinishReason.ERROR
     error: str | None = None
     teardown: list[str] = []
@@ -322,6 +364,9 @@ def run_session(
             frame = rig.camera.capture(step_exposure(rig, step))
             t_captured = clock.now()
             rig.lighting.off()
+            got = frame_layout(frame)
+            if layout is not None and got != layout:
+                _refuse_other_layout(rig, folder, i, frame, got, layout)
             if rig.capture_check is not None:  # may keep the image aside and stop the session
                 rig.capture_check(i, frame, actual, folder.root)
             fields = {
@@ -342,6 +387,7 @@ def run_session(
             if source is not None:
                 source.observe(i, frame, record)
             records.append(record)
+            layout = layout or got
             emit(StepCompleted(i, total, record))
         else:
             if rig.end_check is not None:  # e.g. a camera-triggered dome's proof frame

@@ -408,6 +408,30 @@ class SessionFolder:
         """Committed images in the folder (earlier runs' and this one's)."""
         return len(self.committed)
 
+    def image_layout(self) -> tuple[int, int, bool] | None:
+        """(height, width, colour) of the session's images, from the header of its first
+        committed linear TIFF; None before any image (or if that header says nothing)."""
+        from rti_rig.core.image_files import header_layout
+
+        for index in sorted(self.committed):
+            try:
+                return header_layout(self.root / self.committed[index].linear_image)
+            except OSError:
+                return None
+        return None
+
+    def set_aside(self, index: int, frame: Frame, why: str) -> str:
+        """Keep ``frame``, which cannot be one of the session's images, as a linear TIFF under
+        ``recovered/`` (never listed, never deleted); its path relative to the folder."""
+        rel = f"recovered/{_new_stamp(self.root)}/{LINEAR_DIR}/{self.names[index]}.tif"
+        dest = self.root / rel
+        try:
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            write_linear_tiff(dest, frame.pixels, description=why)
+        except OSError as exc:
+            raise SessionWriteError(dest, exc) from None
+        return rel
+
     def _make_folder(self) -> None:
         try:
             (self.root / LINEAR_DIR).mkdir(parents=True, exist_ok=True)

@@ -165,6 +165,54 @@ def test_failing_light_and_failing_teardown_are_reported(tmp_path: Path) -> None
     assert any("port gone" in f for f in runner["teardown_failures"])
 
 
+class ResizingCamera:
+    """Wraps a camera; from capture number ``at`` (0-based) on, its frames are half the size
+    (the camera's image size changed mid-session, or another camera's file was picked up)."""
+
+    def __init__(self, inner, at: int) -> None:  # type: ignore[no-untyped-def]
+        self.inner, self.at, self.n = inner, at, 0
+        self.name = "resizing camera"
+
+    def connect(self) -> None:
+        self.inner.connect()
+
+    def close(self) -> None:
+        self.inner.close()
+
+    def capture(self, exposure_s: float):  # type: ignore[no-untyped-def]
+        import dataclasses
+
+        frame = self.inner.capture(exposure_s)
+        self.n += 1
+        if self.n <= self.at:
+            return frame
+        half = frame.pixels[::2, ::2].copy()
+        return dataclasses.replace(frame, pixels=half)
+
+
+def test_a_frame_of_another_size_stops_the_session_and_is_kept_aside(tmp_path: Path) -> None:
+    """Image 4 of another size had been written into the session as if nothing were wrong:
+    the run said complete, and no tool could use the session (its images differ in shape)."""
+    rig = small_rig(tmp_path)
+    rig.camera = ResizingCamera(rig.camera, 3)
+    schedule = plan_uniform(rig.geometry, 6)
+    out = tmp_path / "s"
+    with pytest.raises(CaptureError, match=r"image 4 came back .*but this session's images are"):
+        run_session(rig, schedule, SessionFolder.create(out, 6))
+    assert_images_intact(out, 3)
+    assert manifest(out)["runner"]["finish_reason"] == "error"
+    assert rig.lighting.source.lit is None  # type: ignore[attr-defined]
+    kept = list((out / "recovered").rglob("image_004.tif"))
+    assert len(kept) == 1  # the frame is not lost, only kept out of the session
+    # a resume on a camera that gives another size than the images on disk stops the same way
+    rig = small_rig(tmp_path)
+    rig.camera = ResizingCamera(rig.camera, 0)
+    folder = SessionFolder.reopen(out)
+    with pytest.raises(CaptureError, match=r"image 4 came back"):
+        run_session(rig, schedule, folder)
+    assert_images_intact(out, 3)
+
+
 def test_validation_happens_before_anything_moves(tmp_path: Path) -> None:
     rig = small_rig(tmp_path)
     good = plan_uniform(rig.geometry, 3)
