@@ -82,7 +82,17 @@ def read_image_file(path: Path, device: str) -> NDArray:
     if suffix in (".tif", ".tiff"):
         import tifffile  # on a TIFF only: `rti-rig plan` imports this module for any preview
 
-        return tifffile.imread(path)
+        try:
+            return tifffile.imread(path)
+        except (ValueError, OSError) as exc:
+            # a TIFF cut short or not a TIFF at all (tifffile raises ValueError, TiffFileError
+            # among them): it had escaped as itself, a Python traceback mid-session
+            raise CaptureError(
+                device,
+                f"cannot read image file {path} ({exc}): is it a complete TIFF (not one still "
+                "being written, or a copy cut short)?",
+                "read",
+            ) from exc
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise CaptureError(device, f"cannot read image file {path}", "read")

@@ -138,6 +138,23 @@ def test_16bit_tiff_accepted_8bit_refused(tmp_path):
         cam.capture(0.5)
 
 
+def test_a_tiff_cut_short_is_a_named_capture_error(tmp_path):
+    """Half a TIFF (a copy cut short, a writer that paused longer than the stability polls):
+    tifffile's ValueError had escaped the camera as itself, a traceback from 'rti-rig run'."""
+    whole = tmp_path / "whole.tif.tmp"
+    tifffile.imwrite(whole, np.full((64, 64, 3), 30000, np.uint16), photometric="rgb")
+    data = whole.read_bytes()
+    whole.unlink()
+
+    def half():
+        (tmp_path / "a.tif").write_bytes(data[: len(data) // 2])
+
+    cam = watch(tmp_path, ScriptedClock({0.1: half}), patterns=("*.tif",))
+    cam.connect()
+    with pytest.raises(CaptureError, match=r"a\.tif.*complete TIFF"):
+        cam.capture(0.5)
+
+
 @pytest.mark.parametrize("suffix", [".tif", ".png"])
 def test_colour_file_arrives_in_rgb_order(tmp_path, suffix):
     """A red 16-bit file is red in the frame, whatever library decodes it: tifffile hands over
