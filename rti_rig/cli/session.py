@@ -246,6 +246,22 @@ def run(
                 )
             err.print(f"[yellow]{escape(said)}.[/]")
             raise typer.Exit(code=130) from None
+        except Exception as exc:  # no part of rti-rig named it: said, not a traceback
+            _print_failures(getattr(exc, "teardown_failures", None))
+            if resume is not None:
+                said = (
+                    "The session did not go on: no new image was captured; continue it with "
+                    f"rti-rig run --resume {resume} once this is fixed"
+                )
+            else:
+                said = f"Nothing was captured or written to {out_dir}"
+            if auto_exposure:
+                said += (
+                    "; metering, if it had begun, attempted an all-off on its way out: check the "
+                    "rig's lights"
+                )
+            err.print(f"{said}.", markup=False)
+            raise _unexpected(exc, "") from None
         _execute(opened)
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
@@ -292,6 +308,18 @@ def _late_pause_ignored() -> Iterator[None]:
     finally:
         if previous is not None:
             signal.signal(usr1, previous)
+
+
+def _unexpected(exc: Exception, report: str) -> typer.Exit:
+    """An exception no part of rti-rig named, said in one line (never a traceback), exit 1."""
+    err.print(
+        f"[bold red]error:[/] unexpected {escape(type(exc).__name__)}: {escape(str(exc))} (a "
+        "fault that rti-rig or one of its device drivers should have named: please report it"
+        f"{escape(', with ' + report) if report else ''})",
+        highlight=False,
+        soft_wrap=True,
+    )
+    return typer.Exit(code=1)
 
 
 def _sentence(text: str) -> str:
@@ -482,6 +510,17 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
             f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False
         )
         raise fail(exc) from None
+    except Exception as exc:
+        # a fault no driver named (an OSError, a library's own exception): the controller has
+        # torn down and kept the images all the same, but this had been a Python traceback,
+        # with nothing said of the lights, of the images kept or of the resume
+        from rti_rig.app.usecases.safe_state import lights_state
+
+        state = lights_state(rig, _print_teardown_failures(folder))
+        err.print(
+            f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False
+        )
+        raise _unexpected(exc, f"{out_dir}/manifest.json") from None
     finally:
         for sig, h in previous.items():
             signal.signal(sig, h)
