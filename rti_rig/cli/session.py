@@ -333,8 +333,24 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
 
     folder, out_dir = opened.folder, opened.out_dir
     if folder.images_kept:
+        whole, listed = folder.lp_listing()
+        if whole:
+            return (
+                f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}. "
+                f"{resume_hint}"
+            )
+        # its write failed (a full disk): "listed in lights.lp" had been said of a lights.lp
+        # that was missing, or listed fewer images than the folder holds
+        state = f"lists only {listed} of them" if listed else "is missing"
+        if getattr(opened.rig.lighting, "resume_hint", None):  # a session that cannot resume
+            remedy = f"'rti-rig export-lp {out_dir} --out FILE.lp' writes one from the journal"
+        else:
+            remedy = "the resume writes it again"
         return (
-            f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}. {resume_hint}"
+            f"{folder.images_kept} image(s) kept in {out_dir}, each journaled with its "
+            f"checksum, but its {LP_NAME} could not be written and {state}: do not open the "
+            f"folder in relight or RTIBuilder before it is whole again ({remedy}). "
+            f"{resume_hint}"
         )
     if opened.resumed:
         return f"No new image was captured. {resume_hint}"

@@ -606,6 +606,20 @@ class SessionFolder:
                 os.truncate(path, size)
             raise SessionWriteError(path, exc) from None
 
+    def lp_listing(self) -> tuple[bool, int]:
+        """Whether ``lights.lp`` lists exactly the committed images in step order (what a
+        stopped session promises), and how many it lists (0: missing or unreadable). A write
+        that failed, on a full disk, leaves it behind the journal."""
+        from rti_rig.core.errors import RtiRigError
+        from rti_rig.core.lp_format import read_lp
+
+        want = [self.committed[i].image for i in sorted(self.committed)]
+        try:
+            have = [e.name for e in read_lp(self.root / LP_NAME)]
+        except (RtiRigError, OSError, ValueError):
+            have = []
+        return have == want, len(have)
+
     def write_lp(self) -> None:
         """Rewrite ``lights.lp`` from every committed step, in step order (atomically)."""
         ordered = [self.committed[i] for i in sorted(self.committed)]

@@ -209,6 +209,28 @@ def test_write_failure_stops_by_name_and_resumes(
     assert digests(out) == digests(ref)
 
 
+@pytest.mark.parametrize(("after", "state"), [(0, "is missing"), (3, "lists only 3 of them")])
+def test_a_stop_does_not_say_listed_in_lights_lp_when_its_write_failed(
+    tmp_path: Path, reference: tuple[Path, Path], after: int, state: str
+) -> None:
+    """The image is committed (its journal line), then lights.lp cannot be rewritten (a full
+    disk): the stop had said "N image(s) kept …, listed in lights.lp" of a lights.lp that was
+    missing, or listed one image fewer than the folder holds."""
+    cfg, ref = reference
+    out = tmp_path / "s"
+    with failing_writes("lp", after=after, errno_code=errno.ENOSPC):
+        r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"{after + 1} image(s) kept in {out}" in text
+    assert "listed in lights.lp" not in text
+    assert f"lights.lp could not be written and {state}" in text
+    assert f"rti-rig run --resume {out}" in text
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref)
+
+
 def test_free_space_is_checked_before_each_image(
     tmp_path: Path, reference: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
