@@ -204,8 +204,8 @@ class OpenCvCamera:
             raise DeviceError(
                 self.name,
                 "the camera delivers 8-bit frames, which are gamma-encoded on nearly every "
-                "camera: set response = \"srgb\" in [camera.device] (or \"linear\" if yours "
-                "is linear), or ask for a 16-bit format (fourcc = \"Y16 \") if it offers one",
+                'camera: set response = "srgb" in [camera.device] (or "linear" if yours '
+                'is linear), or ask for a 16-bit format (fourcc = "Y16 ") if it offers one',
                 "capture",
             )
 

@@ -51,6 +51,27 @@ def _flags_show_no_type() -> None:
 _flags_show_no_type()
 
 
+def reflowed(doc: str) -> str:
+    """``doc`` with the line breaks inside each paragraph made spaces (blank lines still part
+    paragraphs). Why: typer's rich help keeps a docstring's source line breaks, so ``--help``
+    showed sentences broken mid-line ("stops at once (lights" / "off, arm stopped ...") and the
+    command list cut each summary at its first source line."""
+    paragraphs = [" ".join(p.split()) for p in doc.strip().split("\n\n")]
+    return "\n\n".join(p for p in paragraphs if p)
+
+
+def reflow_command_help(typer_app: typer.Typer) -> None:
+    """Give every command of ``typer_app`` whose help is its docstring that docstring reflowed
+    (:func:`reflowed`); an explicit ``help=`` is left as written."""
+    import inspect
+
+    for command in typer_app.registered_commands:
+        if command.help is None and command.callback is not None:
+            doc = inspect.getdoc(command.callback)
+            if doc:
+                command.help = reflowed(doc)
+
+
 def fail(exc: RtiRigError) -> typer.Exit:
     # the message is plain text: "[camera]" or "[dome.serial]" in it must not be read as markup
     err.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)

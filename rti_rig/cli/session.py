@@ -522,9 +522,7 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
         from rti_rig.app.usecases.safe_state import lights_state
 
         state = lights_state(rig, _print_teardown_failures(folder))
-        err.print(
-            f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False
-        )
+        err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
         raise fail(exc) from None
     except Exception as exc:
         # a fault no driver named (an OSError, a library's own exception): the controller has
@@ -533,9 +531,7 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
         from rti_rig.app.usecases.safe_state import lights_state
 
         state = lights_state(rig, _print_teardown_failures(folder))
-        err.print(
-            f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False
-        )
+        err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
         raise _unexpected(exc, f"{out_dir}/manifest.json") from None
     finally:
         for sig, h in previous.items():

@@ -26,6 +26,4 @@ def test_an_arm_points_at_teardown_problems_only_when_there_are_some() -> None:
     rig = build_rig(load_rig_config(REPO / "rig_configs" / "virtual_arm.toml"))
     with rig:
         assert lights_state(rig) == "lamp off and stop were requested"
-        assert lights_state(rig, teardown_failed=True).endswith(
-            "(see the teardown problems above)"
-        )
+        assert lights_state(rig, teardown_failed=True).endswith("(see the teardown problems above)")
