@@ -72,6 +72,7 @@ class LedDomeDriver:
         self.banner: DomeIdentity | None = None
         #: Boot banners seen since connect (initial one included).
         self.banners_seen = 0
+        self._heard = False
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -96,6 +97,7 @@ class LedDomeDriver:
 
     def close(self) -> None:
         self._open = False
+        self._heard = False
         self._rx.clear()
         self.transport.close()
 
@@ -103,6 +105,14 @@ class LedDomeDriver:
     def port_open(self) -> bool:
         """The port is open (a board that resets on open may be booting, and boot lit)."""
         return self._open
+
+    @property
+    def profile_heard(self) -> bool:
+        """Since the port was last opened, the board sent what only a board of this profile
+        sends: its boot banner, or a well-formed reply (a late one included). The policy resends
+        a failed handshake only then: silence or bytes this codec cannot read are what a wrong
+        port, baud rate or profile gives, and resending would only delay that advice."""
+        return self._heard
 
     # ------------------------------------------------------------------ verbs
 
@@ -188,6 +198,7 @@ class LedDomeDriver:
                 raise self._error(
                     f"garbled reply ({reply.reason}): {reply.raw!r}", name, LinkFault.GARBLED, True
                 )
+            self._heard = True  # well-formed in this profile, whatever it says
             if self.codec.has_sequence and reply.seq is not None and reply.seq != seq:
                 traffic_log.debug("%s: dropped a late reply to command %s", self.device, reply.seq)
                 continue
@@ -247,6 +258,8 @@ class LedDomeDriver:
                     LinkFault.RESET,
                     True,
                 )
+            if not isinstance(reply, Garbled):
+                self._heard = True  # a late reply, well-formed in this profile
             traffic_log.debug("%s: dropped stale input %r", self.device, reply)
 
     def _wait_for_banner(self) -> None:
@@ -297,6 +310,7 @@ class LedDomeDriver:
 
     def _saw_banner(self, banner: Banner) -> None:
         self.banners_seen += 1
+        self._heard = True
         if banner.identity is not None:
             self.banner = banner.identity
 

@@ -80,6 +80,7 @@ class ScriptedDomeDriver:
         #: Text heard while waiting after opening (boot banner), for the probe and messages.
         self.boot_text = ""
         self.banners_seen = 0
+        self._heard = False
         #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`),
         #: and when it ends
         self._booted = False
@@ -112,12 +113,22 @@ class ScriptedDomeDriver:
 
     def close(self) -> None:
         self._open = False
+        self._heard = False
         self._rx.clear()
         self.transport.close()
 
     @property
     def port_open(self) -> bool:
         return self._open
+
+    @property
+    def profile_heard(self) -> bool:
+        """Since the port was last opened, the board printed what only this firmware prints:
+        its ready text, its reboot text, or a reply matching the description. The policy resends
+        a failed handshake or init command only then: silence or unmatched text are what a
+        wrong port, baud rate or profile gives, and resending would only delay that advice
+        (and send more bytes to a board of another firmware)."""
+        return self._heard
 
     def hello(self) -> DomeInfo:
         """Handshake (if the firmware has one) and the init commands; the board's state is
@@ -272,6 +283,7 @@ class ScriptedDomeDriver:
                 got = self._rx[0]
                 del self._rx[:1]
                 if got == reply.byte:
+                    self._heard = True
                     return ""
                 raise self._error(
                     f"expected acknowledgement byte 0x{reply.byte:02x}, got 0x{got:02x}",
@@ -287,9 +299,11 @@ class ScriptedDomeDriver:
                 m = wanted.search(text)
                 if m:
                     del self._rx[: len(text[: m.end()].encode("latin-1"))]
+                    self._heard = True
                     return m.group(0)
                 if step is not None and (s := step.search(text)) is not None:
                     del self._rx[: len(text[: s.end()].encode("latin-1"))]
+                    self._heard = True
                     raise self._error(
                         f"the firmware stepped to LED {int(s.group(1)) - self.spec.index_base}, "
                         f"not LED {index} (a missed or double step)",
@@ -316,6 +330,7 @@ class ScriptedDomeDriver:
         spec = self.spec
         if spec.reset_pattern and re.search(spec.reset_pattern, text):
             self.banners_seen += 1
+            self._heard = True
             self._rx.clear()
             self._lit = frozenset()
             self._window_end = self._timed_led = None
@@ -324,6 +339,7 @@ class ScriptedDomeDriver:
                 "the board rebooted (boot banner) before answering", name, LinkFault.RESET
             )
         if spec.error_pattern and (m := re.search(spec.error_pattern, text)):
+            self._heard = True
             self._rx.clear()
             raise self._error(f"the firmware refused: {m.group(0)!r}", name, LinkFault.REJECTED)
 
@@ -348,6 +364,7 @@ class ScriptedDomeDriver:
                 heard += self._rx
                 self._rx.clear()
                 if ready is not None and ready.search(heard.decode("latin-1")):
+                    self._heard = True
                     break
                 remaining = deadline - clock.now()
                 if remaining <= 0:

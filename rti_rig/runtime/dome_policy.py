@@ -205,8 +205,15 @@ class DomePolicy:
 
     def connect(self) -> None:
         try:
-            info = self._counted(self.link.connect)
+            info = self._connect_link()
         except DomeLinkError as exc:
+            # asked before the port is closed (which forgets what the board sent); a firmware
+            # that refused the handshake keeps the advice (another dialect, or the baud rate)
+            spoke = (
+                exc.command != "open port"
+                and exc.fault is not LinkFault.REJECTED
+                and self._board_spoke_profile(exc)
+            )
             if exc.command == "open port" and not self._port_was_open:
                 # Nothing was ever sent: say so, not "all-off failed, lights may be on".
                 self.off_report = OffReport(OffOutcome.NEVER_OPENED, exc.message)
@@ -231,6 +238,16 @@ class DomePolicy:
                     self.name,
                     f"the dome's port could not be opened ({exc.message}); check that the board "
                     "is plugged in and that the rig config's port names it",
+                    exc.command,
+                ) from exc
+            if spoke:
+                # its banner or a reply came through: port, baud rate and profile are right
+                raise DeviceError(
+                    self.name,
+                    f"no handshake with the dome ({exc.message}); the board on this port "
+                    "answers in the rig config's protocol profile (its boot banner or a reply "
+                    "came through), but its handshake did not: check the USB cable and the "
+                    "board's power supply",
                     exc.command,
                 ) from exc
             raise DeviceError(
@@ -283,6 +300,64 @@ class DomePolicy:
                 self.name,
             )
         self._run(self.link.all_off, "all off")  # start from the safe state
+
+    def _connect_link(self) -> DomeInfo:
+        """Open the port and handshake; a handshake (or init command) whose reply was lost,
+        late or garbled, that arrived garbled (a resendable firmware error) or that a reboot
+        cut short is sent again on the open port up to ``retries`` times, as any idempotent
+        command is. It had not been: one reply lost at the start failed the session ("no
+        handshake with the dome … check the port, the baud rate and the protocol profile"),
+        from a board that had just sent its boot banner on that very port.
+
+        Only a board that has spoken the profile since the port opened is sent it again (see
+        :meth:`_board_spoke_profile`): silence or unreadable bytes alone are what a wrong port,
+        baud rate or profile gives, which still fails at once with that advice rather than
+        after ``retries`` more timeouts (and more bytes sent to a board of another protocol)."""
+        try:
+            return self._counted(self.link.connect)
+        except DomeLinkError as first:
+            exc = first
+        attempt = 0
+        while (
+            exc.retryable
+            and attempt < self.settings.retries
+            and getattr(self.link, "port_open", True)
+            and self._board_spoke_profile(exc)
+        ):
+            attempt += 1
+            self.stats.retries += 1
+            self.stats.recovered.append(f"{exc.command}: {exc.fault}")
+            log.warning(
+                "%s: %s failed while connecting (%s, attempt %d): %s",
+                self.name,
+                exc.command,
+                exc.fault,
+                attempt,
+                exc.message,
+            )
+            self._back_off(self.settings.retry_backoff_s)
+            try:
+                return self._counted(self.link.hello)
+            except DomeLinkError as again:
+                exc = again
+        if attempt:
+            raise DomeLinkError(
+                exc.device,
+                f"{exc.message}; gave up after {attempt + 1} attempts",
+                exc.command,
+                exc.fault,
+                retryable=False,
+                code=exc.code,
+            ) from exc
+        raise exc
+
+    def _board_spoke_profile(self, exc: DomeLinkError) -> bool:
+        """Whether the board on the port has shown, since it was opened, that it speaks the
+        link's protocol profile: its boot banner or ready text, a well-formed reply (the link's
+        ``profile_heard``), or the fault itself (a reboot banner, a firmware error reply)."""
+        if exc.fault in (LinkFault.RESET, LinkFault.REJECTED):
+            return True
+        return exc.fault in _NOT_ITS_BOARD and bool(getattr(self.link, "profile_heard", False))
 
     def close(self) -> None:
         """All off (best effort), then release the port. Safe twice and after a failed connect."""

@@ -49,6 +49,25 @@ def test_cli_dry_run_through_the_emulated_dome(tmp_path: Path) -> None:
     assert manifest["rig"]["backend"] == "emulated"
 
 
+@pytest.mark.e2e
+@pytest.mark.pty
+def test_a_dry_run_whose_first_handshake_reply_is_lost_completes(tmp_path: Path) -> None:
+    """The emulated board drops its reply to the very first handshake (after its boot banner):
+    the handshake is sent again and the run completes. It had failed at its start with "no
+    handshake with the dome … check the port, the baud rate and the protocol profile"."""
+    cfg = small_emulated(
+        tmp_path, '\n[emulator]\nfaults = [{at_command = 1, kind = "drop_reply"}]\n'
+    )
+    # a reply timeout no CPU load exhausts on the pty (the dropped reply costs it once)
+    cfg.write_text(cfg.read_text().replace("reply_timeout_s = 0.5", "reply_timeout_s = 2.0"))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    assert r.exit_code == 0, r.output
+    assert "no handshake" not in said(r)
+    assert len(read_lp(out / "lights.lp")) == 4
+    assert wrong_light_steps(cfg, out) == []
+
+
 @pytest.mark.pty
 def test_firmware_really_lit_each_recorded_led(tmp_path: Path) -> None:
     loaded = load_rig_config(small_emulated(tmp_path))
