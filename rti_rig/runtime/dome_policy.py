@@ -231,7 +231,7 @@ class DomePolicy:
                     self._port_was_open = True
                 # A board that answered nothing we understood may still be lit (one sketch
                 # boots with every LED on): send the all-off anyway wherever the port is open.
-                self._attempt_off(f"after the failed connection: {exc.message}")
+                self._attempt_off(f"after the failed connection ({exc.message})")
             self._quiet_close()
             if exc.command == "open port":
                 raise DeviceError(
