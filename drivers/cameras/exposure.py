@@ -13,7 +13,7 @@ camera through a short test series and verifies the prediction with a real shot.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -209,6 +209,40 @@ def meter_exposure(
             target = _backoff(target, frame.exposure_s, backoff, candidates_s)
         break
     return choose_from_series(series, rule)
+
+
+def recheck_exposure(
+    camera: Camera,
+    rule: ExposureRule,
+    exposure_s: float,
+    candidates_s: Sequence[float] | None = None,
+    step_down: float = 4.0,
+    backoff: float = 0.9,
+) -> tuple[ExposureChoice | None, tuple[float, ...]]:
+    """Does ``exposure_s``, chosen at another light, keep within ``rule`` at the current one?
+
+    Why: on a dome whose LEDs differ, the light metered first need not be the brightest, and
+    one shot per further light is the least that tells. Returns a choice and the exposures of
+    the shots taken here. The choice is None when that shot keeps within the rule, headroom
+    included. Where this light is brighter it is the longest exposure up to ``exposure_s`` that
+    keeps within the rule here: predicted from that shot when it is within the limit (a
+    shorter exposure only darkens what was measured), else from a test series from
+    ``step_down`` times shorter (:func:`meter_exposure`, never longer than ``exposure_s``)."""
+    series: list[Frame] = []
+    frame = _shot(camera, exposure_s, series)
+    limit = rule.max_saturated_fraction
+    if (
+        frame.saturated_fraction <= limit
+        and predicted_saturated_fraction(frame, exposure_s, rule.headroom) <= limit
+    ):
+        return None, (frame.exposure_s,)
+    capped = rule.model_copy(update={"max_exposure_s": exposure_s})
+    if frame.saturated_fraction <= limit:
+        return choose_exposure(frame, capped, candidates_s), (frame.exposure_s,)
+    start = _shorter(exposure_s / step_down, capped, candidates_s)
+    choice = meter_exposure(camera, capped, start, candidates_s, step_down, backoff)
+    tested = (frame.exposure_s, *choice.test_exposures_s)
+    return replace(choice, test_exposures_s=tested), tested
 
 
 def _shot(camera: Camera, exposure_s: float, series: list[Frame]) -> Frame:

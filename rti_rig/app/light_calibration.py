@@ -217,8 +217,9 @@ def _refuse_saturated(
     """Refuse a card session with clipped images, naming every one and an exposure to try.
 
     The advice had been "rti-rig run --auto-exposure meters one", also for a session that
-    --auto-exposure had metered: it meters at the nominally brightest LED, and on a card (every
-    pixel at one level) under an uncalibrated dome a brighter LED clipped the whole frame."""
+    --auto-exposure had metered: it meters at the nominally brightest LEDs (one, or up to six on
+    an uncalibrated dome), and on a card (every pixel at one level) under an uncalibrated dome a
+    brighter LED clipped the whole frame."""
     clipped = [s for s in steps if float(s.get("saturated_fraction") or 0.0) > MAX_SATURATED]
     if not clipped:
         return
@@ -228,13 +229,19 @@ def _refuse_saturated(
     )
     exposure = float(exposures.min())
     provenance = (manifest.get("schedule") or {}).get("provenance") or {}
-    metered = isinstance(provenance.get("exposure"), dict)
-    why = (
-        "--auto-exposure metered this session at one LED, and an uncalibrated dome's LEDs "
-        "differ by tens of percent, so a brighter one clipped the card: "
-        if metered
-        else ""
-    )
+    metered = provenance.get("exposure")
+    why = ""
+    if isinstance(metered, dict):
+        # a session --auto-exposure metered at several LEDs (an uncalibrated dome's, since it
+        # recorded lights_metered_at_steps) had been said to be metered "at one LED"
+        lights = metered.get("lights_metered_at_steps")
+        count = len(lights) if isinstance(lights, list) and lights else 1
+        at = "one LED" if count == 1 else f"{count} LEDs"
+        other = "a brighter one" if count == 1 else "a brighter one it did not meter at"
+        why = (
+            f"--auto-exposure metered this session at {at}, and an uncalibrated dome's LEDs "
+            f"differ by tens of percent, so {other} clipped the card: "
+        )
     raise SessionError(
         f"{root}/{worst['linear_image']} (LED {worst['led']}): "
         f"{100 * float(worst['saturated_fraction']):.1f} % of its pixels are saturated "

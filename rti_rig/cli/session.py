@@ -67,7 +67,9 @@ def run(
         typer.Option(
             "--auto-exposure",
             help="Before starting, meter at the brightest planned light (a short test series) "
-            "and fix the exposure that keeps saturated pixels under --max-saturated.",
+            "and fix the exposure that keeps saturated pixels under --max-saturated. On a dome "
+            "with no light calibration applied, whose LEDs may differ, the 6 planned lights a "
+            "level object receives most from are checked (one more test shot each at least).",
         ),
     ] = False,
     max_saturated: Annotated[

@@ -206,6 +206,19 @@ def test_a_clipped_card_metered_by_auto_exposure_is_not_told_to_meter_again(
     assert "2 of 48 images clipped" in text and "image_007.tif (LED 6)" in text, text
     assert "meters one" not in text and "--auto-exposure metered this session" in text, text
     assert f"exposure_s = {exposure / 2:.4g} under [camera]" in text, text
+    assert "at one LED" in text, text
+    # metered at several LEDs (an uncalibrated dome's --auto-exposure): not said "at one LED"
+    edit_manifest(
+        tmp_path / "card",
+        lambda m: m["schedule"]["provenance"]["exposure"].update(
+            lights_metered_at_steps=[45, 46, 44, 47, 43, 48]
+        ),
+    )
+    with pytest.raises(SessionError) as caught:
+        read_card_session(tmp_path / "card")
+    text = str(caught.value)
+    assert "--auto-exposure metered this session at 6 LEDs" in text, text
+    assert "so a brighter one it did not meter at clipped the card" in text, text
 
 
 @pytest.mark.slow

@@ -23,7 +23,7 @@ from rti_rig.runtime.controller import (
     validate_schedule,
 )
 from rti_rig.runtime.rig import Rig
-from rti_rig.runtime.session import SessionFolder
+from rti_rig.runtime.session import SessionFolder, image_names
 
 
 @dataclass(frozen=True)
@@ -264,10 +264,21 @@ def fix_exposure(
 
     On a timed firmware (RTIPy) the metering may choose no exposure longer than the LED's
     self-timed window leaves room for: the camera's ``max_exposure_s`` is lowered to it, with
-    a note (a longer exposure would be refused at its capture on the dome)."""
-    from rti_rig.drivers.cameras.exposure import meter_exposure
+    a note (a longer exposure would be refused at its capture on the dome).
+
+    On a dome whose LEDs were never evened out (:func:`_light_outputs_unknown`) the light
+    nearest the zenith need not be the brightest: metered there alone, 7 of the 48 images of
+    the emulated card dome clipped 56–100 %. There up to ``PROBE_LIGHTS`` of the highest-ranked
+    planned lights are checked, at one test shot each at least, with a note saying so and what
+    it costs before the lights come on."""
+    from rti_rig.drivers.cameras.exposure import meter_exposure, recheck_exposure
     from rti_rig.drivers.cameras.settings import ExposureRule
-    from rti_rig.runtime.exposure_policy import fix_session_exposure
+    from rti_rig.runtime.exposure_policy import (
+        PROBE_LIGHTS,
+        Recheck,
+        fix_session_exposure,
+        metering_steps,
+    )
 
     cam = rig.camera_config
     longest = cam.max_exposure_s
@@ -293,8 +304,17 @@ def fix_exposure(
         shutter = getattr(camera, "available_exposures_s", None)
         return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
 
+    def recheck(camera, exposure_s: float) -> Recheck:  # type: ignore[no-untyped-def]
+        shutter = getattr(camera, "available_exposures_s", None)
+        choice, tested = recheck_exposure(camera, rule, exposure_s, shutter() if shutter else None)
+        return Recheck(tested, choice)
+
+    unknown = _light_outputs_unknown(rig)
+    probes = min(PROBE_LIGHTS, len(metering_steps(schedule, PROBE_LIGHTS))) if unknown else 1
+    if probes > 1:
+        on_note(Note(_probes_said(rig, unknown, probes, limit)))
     try:
-        fixed = fix_session_exposure(rig, schedule, meter)
+        fixed = fix_session_exposure(rig, schedule, meter, recheck if probes > 1 else None, probes)
     except RtiRigError as exc:
         # what metering's teardown established about the lights travels with the error (the
         # user had been told only the error: no word of the lights metering had switched on)
@@ -304,8 +324,57 @@ def fix_exposure(
         exc.lights_state = lights_state(rig, bool(failures))  # type: ignore[attr-defined]
         raise
     chosen = fixed.provenance["exposure"]
-    on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s ({chosen['reason']})"))
+    where = ""
+    if probes > 1:
+        at = chosen["metered_at_step"] - 1
+        led = schedule.steps[at].led
+        which = f" (LED {led})" if led is not None else ""
+        metered = len(chosen["lights_metered_at_steps"])
+        where = (
+            f" at {image_names(len(schedule))[at]}'s light{which}, the brightest of the "
+            f"{metered} metered, after {chosen['metering_shots']} test shots"
+        )
+    on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s{where} ({chosen['reason']})"))
     return fixed
+
+
+def _light_outputs_unknown(rig: Rig) -> str:
+    """Why the lights' outputs may differ from one another (empty if they may not): a dome
+    that is not simulated, with no light calibration applied. A simulated dome's LEDs are
+    equal, a calibrated one's evened out (``intensity_correction``), an arm has one lamp."""
+    from rti_rig.app.config import LoadedRig
+
+    loaded = rig.loaded
+    if not isinstance(loaded, LoadedRig):
+        return ""
+    config = loaded.config
+    if config.kind != "dome" or config.backend == "simulated" or config.dome is None:
+        return ""
+    serial = config.dome.serial
+    if serial is not None and serial.intensity_correction is not None:
+        return ""
+    return (
+        "This dome has no light calibration applied (rti-rig calibrate-lights): its LEDs may "
+        "differ by tens of percent, so the light nearest the zenith need not be the brightest"
+    )
+
+
+def _probes_said(rig: Rig, why: str, probes: int, limit) -> str:  # type: ignore[no-untyped-def]
+    """The note that metering checks more lights, and what that costs: the user waits for
+    shots they did not ask for, so how many and how long is said before the lights come on
+    (a shot's time from the rig's [timing], as the session's estimate takes it)."""
+    timing = rig.loaded.config.timing
+    shot_s = timing.settle_s + timing.readout_s + timing.transfer_s
+    window = (
+        f"; each light also waits out its LED's {limit.window_s:g} s window"
+        if limit is not None
+        else ""
+    )
+    return (
+        f"{why}. Metering checks the {probes} planned lights a level object receives most "
+        f"from: {probes - 1} more test shots than at one light, more where one is brighter "
+        f"(each about {shot_s:.2g} s + the exposure: settle + readout + transfer{window})"
+    )
 
 
 def _timed_limit(rig: Rig):  # type: ignore[no-untyped-def]

@@ -1,0 +1,62 @@
+"""`rti-rig run --auto-exposure` on the shipped emulated dome with uneven LEDs clips no image.
+
+Metered at the one light nearest the zenith, 7 of its 48 images clipped 56–100 % (LEDs 36, 38,
+39, 40, 42, 43 and 47 give more light than the metered LED 44): the exposure chosen there,
+0.134 s, was too long for them. Checked at the 6 highest planned lights, LED 42 shortens it.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tifffile
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+@pytest.mark.slow
+@pytest.mark.pty
+@pytest.mark.e2e
+def test_auto_exposure_on_the_uneven_card_dome_clips_no_image(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "emulated_dome_card.toml"),
+            "--auto-exposure",
+            "--out",
+            str(out),
+            "--no-verdict",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    m = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    chosen = m["schedule"]["provenance"]["exposure"]
+    limit = chosen["rule"]["max_saturated_fraction"]
+    # the images as written: none over the rule's limit (the controller's figure, and the TIFFs')
+    assert len(m["steps"]) == 48
+    over = [
+        (s["image"], s["saturated_fraction"]) for s in m["steps"] if s["saturated_fraction"] > limit
+    ]
+    assert not over, over
+    for s in m["steps"]:
+        px = tifffile.imread(out / s["linear_image"])
+        brightest = px.max(axis=-1) if px.ndim == 3 else px
+        assert float(np.mean(brightest >= np.iinfo(px.dtype).max)) <= limit, s["linear_image"]
+    # what it cost and where the exposure was set: said, and recorded
+    assert len(chosen["lights_metered_at_steps"]) == 6
+    assert chosen["metering_shots"] >= 6
+    assert len(chosen["test_exposures_by_light_s"]) == 6
+    assert {s["exposure_s"] for s in m["steps"]} == {chosen["exposure_s"]}
+    said = " ".join(r.output.split())
+    assert "Metering checks the 6 planned lights a level object receives most from" in said
+    step = chosen["metered_at_step"]
+    assert f"Exposure fixed at {chosen['exposure_s']:.4g} s at image_{step:03d}'s light" in said
