@@ -377,12 +377,27 @@ def _print_failures(failures) -> bool:  # type: ignore[no-untyped-def]
     return bool(failures)
 
 
+def _metering(manifest: dict) -> dict | None:  # type: ignore[type-arg]
+    """The exposure metering's evidence (``schedule.provenance.exposure``) where the session's
+    exposure was metered before it began (``--auto-exposure``), else None."""
+    evidence = ((manifest.get("schedule") or {}).get("provenance") or {}).get("exposure")
+    return evidence if isinstance(evidence, dict) and "metering_shots" in evidence else None
+
+
 def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def]
     """The session's time on the real rig: a resumed session's is the sum of its runs (the
-    manifest's), not this run's alone."""
-    timing = (folder.manifest or {}).get("timing") or {}
+    manifest's), not this run's alone, and a metered one's includes the metering's test shots
+    (their time on the rig's clock, which the manifest's exposure evidence records). It had
+    left them out: 7 test shots, 8.4 s, on the emulated card dome (57.2 s said for 65.6 s)."""
+    manifest = folder.manifest or {}
+    timing = manifest.get("timing") or {}
     runs = int(timing.get("runs") or 1)
-    beside = [f"simulated in {result.wall_time_s:.1f} s"] if dry else []
+    metering = _metering(manifest)
+    metering_s = None if metering is None else metering.get("rig_time_s")
+    wall = result.wall_time_s
+    if metering is not None and runs == 1:  # this run metered: its dry run took that too
+        wall += float(metering.get("wall_time_s") or 0.0)
+    beside = [f"simulated in {wall:.1f} s"] if dry else []
     total = result.rig_time_s
     at_least = ""
     if runs > 1:
@@ -402,7 +417,16 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
                 "images' times"
             )
     over = f" over {runs} runs" if runs > 1 else ""
-    return f"Session time on the real rig: {at_least}{total:.1f} s{over}" + (
+    metered = ""
+    if metering is not None:
+        shots = int(metering["metering_shots"])
+        if metering_s is None:  # metered before its time was recorded (an older session)
+            metered = f", not counting {shots} metering shots"
+        else:
+            total += float(metering_s)
+            metered = f" including {shots} metering shots"
+            beside.insert(1 if runs > 1 else 0, f"metering {float(metering_s):.1f} s")
+    return f"Session time on the real rig: {at_least}{total:.1f} s{over}{metered}" + (
         f" ({', '.join(beside)})" if beside else ""
     )
 

@@ -19,6 +19,7 @@ exposures shot under each.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
@@ -102,6 +103,11 @@ def fix_session_exposure(
     The schedule is validated first (nothing moves for a schedule the rig cannot run), each
     light is switched off after its shots and at the end, and devices are closed so that the
     session starts from a clean connect.
+
+    The evidence records the time metering took on the rig's clock (``rig_time_s``, from the
+    connect to the teardown; on a dry run the simulated rig's) and on the wall
+    (``wall_time_s``): the session's time on the real rig includes it (it had left out the
+    test shots: 7 shots, about 8 s, on the emulated card dome).
     """
     if probes < 1:
         raise ValueError(f"probes must be at least 1, got {probes}")
@@ -116,6 +122,7 @@ def fix_session_exposure(
 
     at = steps[0]
     tested: list[list[float]] = []
+    started, wall_started = rig.clock.now(), time.perf_counter()
     try:
         rig.lighting.connect()
         rig.camera.connect()
@@ -137,6 +144,7 @@ def fix_session_exposure(
         exc.teardown_failures = teardown()  # type: ignore[attr-defined]
         raise
     failures = teardown()
+    rig_time_s, wall_time_s = rig.clock.now() - started, time.perf_counter() - wall_started
     if failures:
         raise DeviceError(
             rig.name,
@@ -152,6 +160,8 @@ def fix_session_exposure(
         "test_exposures_by_light_s": tested,
         # a meter that names no test exposure took one shot at least
         "metering_shots": max(len(tested[0]), 1) + sum(len(t) for t in tested[1:]),
+        "rig_time_s": rig_time_s,
+        "wall_time_s": wall_time_s,
     }
     fixed = replace(
         schedule, steps=steps_fixed, provenance={**schedule.provenance, "exposure": evidence}

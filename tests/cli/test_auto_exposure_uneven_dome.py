@@ -60,3 +60,12 @@ def test_auto_exposure_on_the_uneven_card_dome_clips_no_image(tmp_path: Path) ->
     assert "Metering checks the 6 planned lights a level object receives most from" in said
     step = chosen["metered_at_step"]
     assert f"Exposure fixed at {chosen['exposure_s']:.4g} s at image_{step:03d}'s light" in said
+    # the session's time on the real rig counts the metering's test shots (7, on the simulated
+    # rig's clock: 8.4 s); it had said 57.2 s, the 48 images alone
+    metering_s = chosen["rig_time_s"]
+    assert metering_s > chosen["metering_shots"] * (0.3 + 0.7)  # readout + transfer a shot
+    total = m["timing"]["rig_time_s"] + metering_s
+    assert (
+        f"Session time on the real rig: {total:.1f} s including {chosen['metering_shots']} "
+        f"metering shots (metering {metering_s:.1f} s, simulated in "
+    ) in said
