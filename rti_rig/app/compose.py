@@ -20,15 +20,17 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
     """Build the rig a config describes.
 
     Simulated and emulated rigs run on a virtual clock (a dry run reports the real rig's time
-    without waiting for it); hardware runs on the system clock. Use the rig as a context manager
-    (or call ``close``) to release emulators and ports afterwards.
+    without waiting for it); hardware runs on the system clock. So does, unless ``clock`` is
+    given, an emulated firmware that switches its LEDs on its own clock (RTIPy's self-timed
+    window): see :func:`_build_emulated_firmware_dome`. Use the rig as a context manager (or
+    call ``close``) to release emulators and ports afterwards.
     """
     cfg = loaded.config
     if cfg.backend == "hardware":
         return _build_hardware(loaded, clock or SystemClock())
     if cfg.backend == "replay":
         return _build_replay(loaded, clock or VirtualClock())
-    return _build_simulated(loaded, clock or VirtualClock())
+    return _build_simulated(loaded, clock)
 
 
 #: The simulated scenes are lit so that this exposure fills 3/4 of the sensor's well with a white
@@ -88,8 +90,9 @@ class _FirmwareLight:
         return 0.0 if lit is None else lit[1] / self._max * float(self._power[lit[0]])
 
 
-def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock) -> Rig:
-    """The real dome driver over real pyserial, talking to the firmware emulator on a pty."""
+def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock | None) -> Rig:
+    """The real dome driver over real pyserial, talking to the firmware emulator on a pty
+    (``clock``: the rig's, None for the dry run's own)."""
     from rti_rig.app.dome_factory import build_dome
     from rti_rig.simulator.dome_firmware import (
         Fault,
@@ -104,6 +107,7 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
     serial = cfg.dome.serial
     if serial.is_described:
         return _build_emulated_firmware_dome(loaded, geometry, clock)
+    clock = clock or VirtualClock()
     firmware = firmware_for(
         serial,
         led_count=geometry.count,
@@ -160,8 +164,21 @@ class _BoardLight:
         return 0.0 if self.direction is None else 1.0
 
 
-def _build_emulated_firmware_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock) -> Rig:
-    """The scripted driver over real pyserial, against a real firmware's emulator on a pty."""
+def _build_emulated_firmware_dome(
+    loaded: LoadedRig, geometry: DomeGeometry, clock: Clock | None
+) -> Rig:
+    """The scripted driver over real pyserial, against a real firmware's emulator on a pty.
+
+    The emulator runs in real time (the pty's bytes and the firmware's own waits really pass).
+    Without a ``clock`` of the caller's, the rig runs on a virtual clock, the link's real time
+    counted on it (``DomePolicy``), unless the firmware switches its LEDs on its own clock
+    (``Board.self_timed``: RTIPy's LED goes dark 2 s after it lit). There what is lit when the
+    camera exposes depends on the time the rig spends between two commands (settle, the
+    camera's exposure, readout and transfer), so the whole rig runs on the real clock, the
+    board's: each shot takes its [timing] on it, as on the real dome. On the virtual clock the
+    camera had taken no time on the board's: a dry run metered a series of test shots under
+    one LED window that the real camera outlasts (its later shots dark).
+    """
     from rti_rig.app.dome_factory import build_dome
     from rti_rig.drivers.led_dome.factory import protocol_for
     from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
@@ -180,6 +197,8 @@ def _build_emulated_firmware_dome(loaded: LoadedRig, geometry: DomeGeometry, clo
         ),
         led_map=spec.led_map,
     )
+    if clock is None:
+        clock = SystemClock() if board.self_timed else VirtualClock()
     stack = contextlib.ExitStack()
     link = stack.enter_context(serve_on_pty(board, serial.profile))
     try:
@@ -347,7 +366,7 @@ def _build_replay(loaded: LoadedRig, clock: Clock) -> Rig:
     return Rig(loaded, geometry, DomeLighting(dome, geometry), camera, clock)
 
 
-def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
+def _build_simulated(loaded: LoadedRig, clock: Clock | None) -> Rig:
     from rti_rig.simulator.sim_lights import LightState, SimulatedArm, SimulatedDome
 
     cfg = loaded.config
@@ -356,9 +375,10 @@ def _build_simulated(loaded: LoadedRig, clock: Clock) -> Rig:
         from rti_rig.app.flash_sync import build_flash_sync_rig
 
         assert isinstance(geometry, DomeGeometry)
-        return build_flash_sync_rig(loaded, geometry, clock)
+        return build_flash_sync_rig(loaded, geometry, clock or VirtualClock())
     if cfg.backend == "emulated" and isinstance(geometry, DomeGeometry):
-        return _build_emulated_dome(loaded, geometry, clock)
+        return _build_emulated_dome(loaded, geometry, clock)  # it chooses its dry run's clock
+    clock = clock or VirtualClock()
     if cfg.backend == "emulated":
         assert isinstance(geometry, ArmGeometry)
         return _build_emulated_arm(loaded, geometry, clock)

@@ -15,6 +15,14 @@ need not be the brightest: on the emulated card dome 7 of 48 images metered that
 lit and checked at the chosen exposure (``recheck``, one shot each when they keep within the
 rule), and a brighter one shortens it; the evidence names every light metered and the test
 exposures shot under each.
+
+Where the lights go dark by themselves a fixed time after they light (a timed firmware: RTIPy
+lights an LED for 2 s), a series of test shots under one lighting outlasts it: each shot takes
+settle + exposure + readout + transfer (about 1.1 s on the shipped configs), so the third shot
+of a series was dark, metered as "nothing bright" and the exposure chosen the longest allowed
+(0.95 s where 0.00136 s was right on the emulated RTIPy dome), and the off after the series
+refused ("went dark by itself"). There each test shot is taken under its own lighting
+(``shot_per_lighting``).
 """
 
 from __future__ import annotations
@@ -26,8 +34,9 @@ from typing import Any
 
 import numpy as np
 
+from rti_rig.core.devices import Frame
 from rti_rig.core.errors import DeviceError
-from rti_rig.core.schedule import LightSchedule
+from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.controller import validate_schedule
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
@@ -89,12 +98,41 @@ def brightest_step(schedule: LightSchedule) -> int:
     return metering_steps(schedule, 1)[0]
 
 
+class _LitForEachShot:
+    """The rig's camera, each capture after the first taken under its light lit again.
+
+    Before each shot after the first the light is switched off, lit again and the settle
+    waited, as the session does for each image: on a timed firmware the off waits for the end
+    of the LED's window and refuses a shot that outlasted it, and the light command opens a new
+    window (RTIPy's firmware blocks till its window ends: the new one follows it, never
+    overlaps it). Every other attribute is the camera's (its shutter speeds, its name)."""
+
+    def __init__(self, rig: Rig, step: LightStep) -> None:
+        self._rig = rig
+        self._step = step
+        self._lit_for_next = True  # lit and settled by the caller for the first shot
+
+    def capture(self, exposure_s: float) -> Frame:
+        rig = self._rig
+        if not self._lit_for_next:
+            rig.lighting.off()
+            rig.lighting.set(self._step)
+            rig.clock.sleep(rig.timing.settle_s)
+        self._lit_for_next = False
+        return rig.camera.capture(exposure_s)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._rig.camera, name)
+
+
 def fix_session_exposure(
     rig: Rig,
     schedule: LightSchedule,
     meter: Meter,
     recheck: Rechecker | None = None,
     probes: int = 1,
+    *,
+    shot_per_lighting: bool = False,
 ) -> LightSchedule:
     """Meter at the brightest-ranked planned light, check up to ``probes`` - 1 more with
     ``recheck`` (each may shorten the exposure, never lengthen it), and return the schedule
@@ -103,6 +141,10 @@ def fix_session_exposure(
     The schedule is validated first (nothing moves for a schedule the rig cannot run), each
     light is switched off after its shots and at the end, and devices are closed so that the
     session starts from a clean connect.
+
+    ``shot_per_lighting``: the lights go dark by themselves a fixed time after they light (a
+    timed firmware's window, which holds one capture but not a series), so each test shot is
+    taken under its own lighting (:class:`_LitForEachShot`), as each image of the session is.
 
     The evidence records the time metering took on the rig's clock (``rig_time_s``, from the
     connect to the teardown; on a dry run the simulated rig's) and on the wall
@@ -113,6 +155,9 @@ def fix_session_exposure(
         raise ValueError(f"probes must be at least 1, got {probes}")
     validate_schedule(rig, schedule)
     steps = metering_steps(schedule, probes if recheck is not None else 1)
+
+    def camera_at(step: LightStep) -> Any:
+        return _LitForEachShot(rig, step) if shot_per_lighting else rig.camera
 
     def teardown() -> list[str]:
         # every step of the teardown runs, whatever one device does; what failed is said
@@ -128,13 +173,13 @@ def fix_session_exposure(
         rig.camera.connect()
         rig.lighting.set(schedule.steps[at])
         rig.clock.sleep(rig.timing.settle_s)
-        choice = meter(rig.camera, rig.camera_config.exposure_s)
+        choice = meter(camera_at(schedule.steps[at]), rig.camera_config.exposure_s)
         tested.append([float(t) for t in getattr(choice, "test_exposures_s", ())])
         for j in steps[1:] if recheck is not None else ():
             rig.lighting.off()  # one light at a time: the last one's off before the next lights
             rig.lighting.set(schedule.steps[j])
             rig.clock.sleep(rig.timing.settle_s)
-            found = recheck(rig.camera, float(choice.exposure_s))
+            found = recheck(camera_at(schedule.steps[j]), float(choice.exposure_s))
             tested.append([float(t) for t in found.tested_s])
             if found.choice is not None and found.choice.exposure_s < choice.exposure_s:
                 choice, at = found.choice, j
@@ -160,6 +205,7 @@ def fix_session_exposure(
         "test_exposures_by_light_s": tested,
         # a meter that names no test exposure took one shot at least
         "metering_shots": max(len(tested[0]), 1) + sum(len(t) for t in tested[1:]),
+        "shot_per_lighting": shot_per_lighting,
         "rig_time_s": rig_time_s,
         "wall_time_s": wall_time_s,
     }

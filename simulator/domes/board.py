@@ -57,6 +57,12 @@ class Board:
     boot_s = 0.0
     #: Opening the port resets the board (Arduino DTR auto-reset).
     resets_on_open = True
+    #: The firmware switches its LEDs on its own clock, with no command (RTIPy's LED goes dark
+    #: when its window ends): what is lit when the camera exposes depends on the time the rig
+    #: spends between two commands, so a dry run must spend that time on the board's clock too
+    #: (``rti_rig.app.compose`` then runs the whole rig on it). Elsewhere only commands change
+    #: the LEDs, and the rig's simulated time may pass without the board's.
+    self_timed = False
 
     def __init__(self, clock: Clock | None = None, faults: FaultPlan | None = None) -> None:
         self.clock = clock or SystemClock()

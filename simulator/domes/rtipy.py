@@ -25,6 +25,7 @@ class RtiPyBoard(Board):
     led_count = COLUMNS * ROWS
     baudrate = 9600
     boot_s = 1.6
+    self_timed = True  # ``T,x,y,secs``: the LED goes dark after secs, whatever the host does
 
     def firmware(self) -> Firmware:
         while True:

@@ -22,6 +22,10 @@ class Metered(Exception):
     pass
 
 
+#: Whether each metering asked for a test shot per lighting (a timed firmware's window).
+shot_each: list[bool] = []
+
+
 class FakeRig:
     """What fix_exposure reads of a rig before it meters."""
 
@@ -35,9 +39,11 @@ def _probes(cfg: Path, monkeypatch: pytest.MonkeyPatch, lights: int = 48) -> tup
     import rti_rig.runtime.exposure_policy as policy
 
     asked: list[int] = []
+    shot_each.clear()
 
-    def fake_fix(rig, schedule, meter, recheck, probes):  # type: ignore[no-untyped-def]
+    def fake_fix(rig, schedule, meter, recheck, probes, **how):  # type: ignore[no-untyped-def]
         asked.append(probes if recheck is not None else 1)
+        shot_each.append(how.get("shot_per_lighting", False))
         raise Metered
 
     monkeypatch.setattr(policy, "fix_session_exposure", fake_fix)
@@ -67,12 +73,19 @@ def test_an_uncalibrated_dome_is_metered_at_six_lights_and_told_why(
     assert probes == 3 and "Metering checks the 3 planned lights" in notes[0]
 
 
-def test_a_timed_dome_is_told_each_light_waits_out_its_window(
+def test_a_timed_dome_is_told_each_test_shot_waits_out_a_window_of_its_own(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    """RTIPy's LED goes dark 2 s after it lit, and a test shot takes about 1.1 s: a series
+    under one lighting had its later shots dark. Each shot is lit again (asked of the policy),
+    and the user is told so, and what it costs, before the lights come on."""
     probes, notes = _probes(CONFIGS / "emulated_rtipy.toml", monkeypatch)
-    assert probes == 6
-    assert notes[-1].endswith("; each light also waits out its LED's 2 s window)"), notes
+    assert probes == 6 and shot_each == [True]
+    assert "each test shot is taken under a window of its own" in notes[0], notes
+    assert notes[-1].endswith("; each test shot also waits out an LED window of its own, 2 s)")
+    # a dome whose LEDs stay lit until told: one lighting per light metered
+    _probes(CONFIGS / "emulated_dome_card.toml", monkeypatch)
+    assert shot_each == [False]
 
 
 @pytest.mark.parametrize("config", ["simulated_dome.toml", "virtual_arm.toml", "calibrated"])

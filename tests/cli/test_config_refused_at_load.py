@@ -93,7 +93,7 @@ def test_a_long_exposure_fits_a_window_raised_to_hold_it(tmp_path: Path) -> None
 
 
 def test_auto_exposure_meters_no_longer_than_the_window_holds(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
     """--auto-exposure on an RTIPy dome: the camera's max_exposure_s (30 s by default) is lowered
     to what the window leaves room for, and the user is told; metering never picks more."""
@@ -108,7 +108,7 @@ def test_auto_exposure_meters_no_longer_than_the_window_holds(
     class Metered(Exception):
         pass
 
-    def fake_fix(rig, schedule, meter, *checks):  # type: ignore[no-untyped-def]
+    def fake_fix(rig, schedule, meter, *checks, **how):  # type: ignore[no-untyped-def]
         meter(object(), 0.05)
         raise Metered
 
@@ -132,6 +132,7 @@ def test_auto_exposure_meters_no_longer_than_the_window_holds(
     assert rules and rules[0].max_exposure_s == pytest.approx(0.95)
     assert "Metering chooses no exposure longer than 0.95 s" in notes[0].text
     assert "max_exposure_s = 30 s" in notes[0].text
+    assert "And each test shot is taken under a window of its own" in notes[0].text
     # a dome with no self-timed window keeps the camera's own limit (and, uncalibrated, is
     # metered at several lights: said in a note of its own)
     loaded = load_rig_config(CONFIGS / "emulated_nab_rti_v1.toml")
@@ -140,6 +141,21 @@ def test_auto_exposure_meters_no_longer_than_the_window_holds(
         fix_exposure(FakeRig(), planned(), 0.001, notes.append)  # type: ignore[arg-type]
     assert rules[-1].max_exposure_s == 30.0
     assert not [n for n in notes if "Metering chooses no exposure longer" in n.text]
+    assert not [n for n in notes if "a window of its own" in n.text]
+    # a camera whose own limit the window holds: nothing lowered, the shot per window said
+    text = (CONFIGS / "emulated_rtipy.toml").read_text(encoding="utf-8")
+    path = tmp_path / "rig.toml"
+    path.write_text(text.replace("exposure_s = 0.05", "exposure_s = 0.05\nmax_exposure_s = 0.5"))
+    loaded = load_rig_config(path)
+    notes.clear()
+    with pytest.raises(Metered):
+        fix_exposure(FakeRig(), planned(), 0.001, notes.append)  # type: ignore[arg-type]
+    assert rules[-1].max_exposure_s == 0.5
+    assert notes[0].text.startswith(
+        "Metering: the rtipy firmware lights each LED for 2 s (dome.serial.protocol.light_on_s "
+        "= 2) and then switches it off by itself, so each test shot is taken under a window of "
+        "its own (its LED lit again for it): a window holds one capture, not a series"
+    ), notes[0].text
 
 
 def test_a_plan_step_exposing_past_the_window_is_refused_before_the_port_opens(

@@ -158,3 +158,60 @@ def test_a_stop_or_an_error_while_checking_tears_down_and_says_what_it_could_not
     assert stopped.value.teardown_failures == ["all LEDs off: no reply"]  # type: ignore[attr-defined]
     assert rig.lighting.source.lit is None  # type: ignore[attr-defined]
     assert closed == ["camera"]
+
+
+def test_with_a_shot_per_lighting_each_test_shot_is_lit_again_and_the_time_recorded(
+    tmp_path: Path,
+) -> None:
+    """A timed firmware's LED goes dark by itself a fixed time after it lit (RTIPy: 2 s), and a
+    series of test shots under one lighting outlasts that window (about 1.1 s a shot): the
+    third shot of a series had been dark. With ``shot_per_lighting`` every shot after the
+    first is preceded by the light's off (on such a firmware: its window waited out) and the
+    light lit again, at every light metered; each light's first shot is under the lighting
+    that opened it."""
+    rig, schedule = _rig_and_plan(tmp_path)
+    log = _logged(rig)
+    real_capture = rig.camera.capture
+
+    def capture(exposure_s: float):  # type: ignore[no-untyped-def]
+        log.append(("shot", rig.lighting.source.lit))  # type: ignore[attr-defined]
+        return real_capture(exposure_s)
+
+    rig.camera.capture = capture  # type: ignore[method-assign]
+
+    def meter(camera, start_s: float) -> Choice:  # type: ignore[no-untyped-def]
+        for t in (start_s, start_s / 4, 0.02):
+            camera.capture(t)
+        return Choice(0.02, (start_s, start_s / 4, 0.02))
+
+    def recheck(camera, exposure_s: float) -> Recheck:  # type: ignore[no-untyped-def]
+        camera.capture(exposure_s)
+        camera.capture(exposure_s)
+        return Recheck((exposure_s, exposure_s))
+
+    before = rig.clock.now()
+    fixed = fix_session_exposure(rig, schedule, meter, recheck, 2, shot_per_lighting=True)
+    first, second = (schedule.steps[i].led for i in metering_steps(schedule, 2))
+    assert log == [
+        first,
+        ("shot", first),
+        *(x for _ in range(2) for x in ("off", first, ("shot", first))),
+        "off",
+        second,
+        ("shot", second),
+        "off",
+        second,
+        ("shot", second),
+    ]
+    evidence = fixed.provenance["exposure"]
+    assert evidence["shot_per_lighting"] is True
+    assert evidence["metering_shots"] == 5
+    # the metering's time on the rig's clock: what the session's time line adds
+    assert evidence["rig_time_s"] == pytest.approx(rig.clock.now() - before)
+    assert evidence["rig_time_s"] > 5 * (0.3 + 0.7)  # five shots' readout and transfer at least
+
+    # without it (a dome whose LEDs stay lit until told): one lighting per light, as before
+    log.clear()
+    fixed = fix_session_exposure(rig, schedule, meter, recheck, 2)
+    assert log == [first, *[("shot", first)] * 3, "off", second, *[("shot", second)] * 2]
+    assert fixed.provenance["exposure"]["shot_per_lighting"] is False

@@ -264,7 +264,10 @@ def fix_exposure(
 
     On a timed firmware (RTIPy) the metering may choose no exposure longer than the LED's
     self-timed window leaves room for: the camera's ``max_exposure_s`` is lowered to it, with
-    a note (a longer exposure would be refused at its capture on the dome).
+    a note (a longer exposure would be refused at its capture on the dome). And each test shot
+    is taken under its own lighting (the policy's ``shot_per_lighting``): a window holds one
+    capture, not a series (about 1.1 s per shot on the shipped configs against RTIPy's 2 s),
+    and the later shots of a series under one lighting had been dark.
 
     On a dome whose LEDs were never evened out (:func:`_light_outputs_unknown`) the light
     nearest the zenith need not be the brightest: metered there alone, 7 of the 48 images of
@@ -283,16 +286,24 @@ def fix_exposure(
     cam = rig.camera_config
     longest = cam.max_exposure_s
     limit = _timed_limit(rig)
-    if limit is not None and limit.max_exposure_s < longest:
-        longest = max(limit.max_exposure_s, cam.min_exposure_s)
-        on_note(
-            Note(
-                f"Metering chooses no exposure longer than {longest:.3g} s (not the camera's "
-                f"max_exposure_s = {cam.max_exposure_s:g} s): {limit.window_said()}, and each "
-                "capture (settle + exposure + readout + transfer) must end while its LED is "
-                "lit. For longer exposures raise dome.serial.protocol.light_on_s"
-            )
+    if limit is not None:
+        own = (
+            "each test shot is taken under a window of its own (its LED lit again for it): "
+            "a window holds one capture, not a series"
         )
+        if limit.max_exposure_s < longest:
+            longest = max(limit.max_exposure_s, cam.min_exposure_s)
+            on_note(
+                Note(
+                    f"Metering chooses no exposure longer than {longest:.3g} s (not the "
+                    f"camera's max_exposure_s = {cam.max_exposure_s:g} s): "
+                    f"{limit.window_said()}, and each capture (settle + exposure + readout + "
+                    "transfer) must end while its LED is lit. For longer exposures raise "
+                    f"dome.serial.protocol.light_on_s. And {own}"
+                )
+            )
+        else:
+            on_note(Note(f"Metering: {limit.window_said()}, so {own}"))
     rule = ExposureRule(
         max_saturated_fraction=max_saturated,
         headroom=1.25,  # other planned lights may be a little brighter than the metered one
@@ -314,7 +325,14 @@ def fix_exposure(
     if probes > 1:
         on_note(Note(_probes_said(rig, unknown, probes, limit)))
     try:
-        fixed = fix_session_exposure(rig, schedule, meter, recheck if probes > 1 else None, probes)
+        fixed = fix_session_exposure(
+            rig,
+            schedule,
+            meter,
+            recheck if probes > 1 else None,
+            probes,
+            shot_per_lighting=limit is not None,
+        )
     except RtiRigError as exc:
         # what metering's teardown established about the lights travels with the error (the
         # user had been told only the error: no word of the lights metering had switched on)
@@ -366,7 +384,7 @@ def _probes_said(rig: Rig, why: str, probes: int, limit) -> str:  # type: ignore
     timing = rig.loaded.config.timing
     shot_s = timing.settle_s + timing.readout_s + timing.transfer_s
     window = (
-        f"; each light also waits out its LED's {limit.window_s:g} s window"
+        f"; each test shot also waits out an LED window of its own, {limit.window_s:g} s"
         if limit is not None
         else ""
     )

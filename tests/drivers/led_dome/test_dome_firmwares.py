@@ -5,7 +5,9 @@ pseudo-terminal through real pyserial; the emulator's record of which LEDs were 
 at every capture and at the end. Timeouts on the pty are generous (seconds), and the dry run's
 own clock is virtual, so CPU load cannot exhaust them; the link's real time is added to it
 (what the real rig would spend), so a dry run's reported rig time moves with load by the
-pty's latency (milliseconds), which no test here bounds from above.
+pty's latency (milliseconds), which no test here bounds from above. RTIPy's dry run runs in
+real time (its LEDs go dark on the board's clock, which the camera's time must pass on): at the
+shipped exposure each capture leaves 0.85 s of its 2 s window spare.
 """
 
 from __future__ import annotations
@@ -447,6 +449,33 @@ def test_a_capture_outlasting_a_timed_led_is_refused_naming_the_led() -> None:
         assert info.value.led == 15
         assert board.lit == frozenset()
         dome.close()
+
+
+@pytest.mark.slow  # the rtipy dry run runs in real time: a connect, a window, three shots
+def test_the_emulated_rtipy_window_runs_on_the_time_the_camera_takes() -> None:
+    """A dry run on the emulated RTIPy dome spends the camera's time (exposure + readout +
+    transfer, the config's [timing]: 1.05 s a shot at 0.05 s) on the board's clock, as the real
+    rig does: the LED's 2 s window holds the first two shots of a series under one lighting,
+    and the third, begun 2.2 s after the LED lit, is dark; the off after it refuses the series.
+    The camera had taken its time on the dry run's simulated clock alone, none on the board's:
+    every shot of any series was lit, and metering such a series showed nothing wrong."""
+    from rti_rig.core.dome_link import DomeLedError
+
+    with build_rig(load_rig_config(CONFIGS / "emulated_rtipy.toml")) as rig:
+        board = rig.emulator  # type: ignore[attr-defined]
+        rig.lighting.connect()
+        rig.camera.connect()
+        rig.lighting.set(plan_uniform(rig.geometry, 8).steps[0])
+        rig.clock.sleep(rig.timing.settle_s)
+        frames, lit = [], []
+        for _ in range(3):
+            lit.append(board.lit)  # as the shot begins (its exposure: 0.05 s of it)
+            frames.append(rig.camera.capture(0.05))
+        means = [float(f.pixels.mean()) for f in frames]
+        assert lit[:2] == [frozenset({0})] * 2 and lit[2] == frozenset(), lit
+        assert means[2] * 20 < min(means[:2]), means  # the third: the sensor's noise alone
+        with pytest.raises(DomeLedError, match="LED 0 went dark by itself"):
+            rig.lighting.off()
 
 
 def elexol_with_map(tmp_path: Path, map_text: str, section: str = "Dome main") -> Path:
