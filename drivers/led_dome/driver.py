@@ -122,6 +122,14 @@ class LedDomeDriver:
             raise self._error(
                 "handshake reply carries no identity", "handshake", LinkFault.GARBLED, True
             )
+        damaged = _unprintable_field(echo)
+        if damaged is not None:
+            raise self._error(
+                f"garbled reply (the {damaged} holds a control byte): {echo!r}",
+                "handshake",
+                LinkFault.GARBLED,
+                True,
+            )
         return DomeInfo(echo.firmware_id, echo.version, echo.led_count)
 
     def light(self, index: int, level: int, max_on_ms: int | None = None) -> None:
@@ -323,6 +331,24 @@ class LedDomeDriver:
         code: int | None = None,
     ) -> DomeLinkError:
         return DomeLinkError(self.device, message, command, fault, retryable=retryable, code=code)
+
+
+def _unprintable_field(identity: DomeIdentity) -> str | None:
+    """The identity field (``"firmware name"`` or ``"version"``) holding a control or other
+    non-printable character, if any.
+
+    The framed profile carries no checksum (nor does the default one with ``checksum =
+    false``): a byte damaged on the wire inside the firmware's name still makes a well-formed
+    frame, and the handshake had been accepted with a name such as ``'RTIDOM\\x04-EMU'`` (the
+    emulator's garbled reply), which the log and ``rti-rig check`` then printed as the board's
+    name. No firmware names itself with control bytes, so such a reply is garbled, and resent
+    like any other garbled reply. Damage that leaves printable text cannot be told from a real
+    name without a checksum: that is the profile's stated weakness (docs/protocols/led-dome.md).
+    """
+    for name, value in (("firmware name", identity.firmware_id), ("version", identity.version)):
+        if not value.isprintable():
+            return name
+    return None
 
 
 def _describe_echo(echo: object) -> str:

@@ -17,7 +17,9 @@ from rti_rig.core.devices import DiscreteLightSource
 from rti_rig.core.errors import DeviceError
 from rti_rig.drivers.led_dome import DomeSerialSettings
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
+from rti_rig.drivers.led_dome.codec_framed import FramedCodec
 from rti_rig.drivers.led_dome.driver import LedDomeDriver
+from rti_rig.drivers.led_dome.messages import Ack, AllOff, DomeIdentity, Hello
 from rti_rig.runtime.dome_policy import (
     DomeLedError,
     DomeLinkError,
@@ -307,6 +309,50 @@ def test_wrong_echo_is_caught_and_the_light_resent():
     assert transport.script == []
 
 
+#: Profiles without a checksum, a boot banner in each, and a handshake reply with a damaged
+#: byte in it that still makes a well-formed reply (the framed one is the emulator's garble).
+UNCHECKED = {
+    "framed, name": (
+        FramedCodec(),
+        b"<READY,RTIDOME-EMU,1.0.0,4>",
+        b"<OK,1,9,RTIDOM\x04-EMU,1.0.0,4>",
+    ),
+    "framed, version": (
+        FramedCodec(),
+        b"<READY,RTIDOME-EMU,1.0.0,4>",
+        b"<OK,1,9,RTIDOME-EMU,1.\x7f.0,4>",
+    ),
+    "default without checksum, name": (
+        DefaultCodec(checksum=False),
+        b"READY RTIDOME-EMU 1.0.0 4\n",
+        b"OK 1 ID RTIDOM\x04-EMU 1.0.0 4\n",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(UNCHECKED))
+def test_a_handshake_reply_with_a_control_byte_in_the_identity_is_garbled_and_resent(case):
+    """A profile without a checksum cannot see a damaged byte, but no firmware names itself
+    with control bytes: such a reply is garbled, resent, and the board's real name is what
+    connect keeps. It had been accepted as firmware 'RTIDOM\\x04-EMU'."""
+    codec, banner, damaged = UNCHECKED[case]
+    identity = DomeIdentity("RTIDOME-EMU", "1.0.0", 4)
+    transport = ScriptedTransport(
+        [
+            (codec.encode_command(1, Hello()), damaged),
+            (codec.encode_command(2, Hello()), codec.encode_reply(Ack(2, identity), Hello())),
+            (codec.encode_command(3, AllOff()), codec.encode_reply(Ack(3, AllOff()), AllOff())),
+        ]
+    )
+    transport.open = lambda: setattr(transport, "pending", banner)  # its own profile's banner
+    dome = DomePolicy(LedDomeDriver(transport, codec), VirtualClock())
+    dome.connect()
+    assert dome.info is not None
+    assert (dome.info.firmware_id, dome.info.version) == ("RTIDOME-EMU", "1.0.0")
+    assert dome.stats.recovered == ["handshake: garbled"]
+    assert transport.script == []
+
+
 # ----------------------------------------------------------------------------- thermal
 
 
@@ -450,13 +496,12 @@ LOST_AT_THE_HANDSHAKE = [
     for profile in PROFILES
     for kind in (
         FaultKind.DROP_REPLY,
+        # framed included: it carries no checksum, and its garbled reply (a control byte in
+        # the firmware's name, 'RTIDOM\x04-EMU') had been accepted, damaged name and all
         FaultKind.GARBLE_REPLY,
         FaultKind.GARBLE_COMMAND,
         FaultKind.DELAY_REPLY,
     )
-    # the framed profile carries no checksum: a damaged byte inside the firmware's name
-    # passes unseen, so there is nothing to resend
-    if (profile, kind) != ("framed", FaultKind.GARBLE_REPLY)
 ]
 
 
@@ -469,6 +514,9 @@ def test_a_handshake_whose_reply_is_lost_is_sent_again(profile, kind):
     dome, fw, clock = make(profile, [Fault(1, kind, delay_s=5.0)])
     session(dome, fw, clock)  # every LED lit as asked
     assert dome.stats.retries == 1, dome.stats
+    clean, _, _ = make(profile)
+    clean.connect()
+    assert dome.info == clean.info  # not a damaged name
     assert fw.lit is None
 
 
