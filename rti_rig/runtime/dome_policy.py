@@ -132,6 +132,9 @@ class DomeStats:
     reconnects: int = 0
     rehandshakes: int = 0
     thermal_wait_s: float = 0.0
+    #: ``"<command>: <fault>"`` for each fault met by a command (the connect's handshake
+    #: included) that then got through; a command that failed in the end adds none (its resends
+    #: still count in ``retries``).
     recovered: list[str] = field(default_factory=list)
 
 
@@ -312,12 +315,15 @@ class DomePolicy:
         Only a board that has spoken the profile since the port opened is sent it again (see
         :meth:`_board_spoke_profile`): silence or unreadable bytes alone are what a wrong port,
         baud rate or profile gives, which still fails at once with that advice rather than
-        after ``retries`` more timeouts (and more bytes sent to a board of another protocol)."""
+        after ``retries`` more timeouts (and more bytes sent to a board of another protocol).
+        The faults resent after go to ``stats.recovered`` only once the handshake got through:
+        a connect that gave up had listed each of its resends as recovered."""
         try:
             return self._counted(self.link.connect)
         except DomeLinkError as first:
             exc = first
         attempt = 0
+        resent: list[str] = []
         while (
             exc.retryable
             and attempt < self.settings.retries
@@ -326,7 +332,7 @@ class DomePolicy:
         ):
             attempt += 1
             self.stats.retries += 1
-            self.stats.recovered.append(f"{exc.command}: {exc.fault}")
+            resent.append(f"{exc.command}: {exc.fault}")
             log.warning(
                 "%s: %s failed while connecting (%s, attempt %d): %s",
                 self.name,
@@ -337,9 +343,12 @@ class DomePolicy:
             )
             self._back_off(self.settings.retry_backoff_s)
             try:
-                return self._counted(self.link.hello)
+                info = self._counted(self.link.hello)
             except DomeLinkError as again:
                 exc = again
+            else:
+                self.stats.recovered += resent
+                return info
         if attempt:
             raise DomeLinkError(
                 exc.device,
@@ -491,8 +500,13 @@ class DomePolicy:
         *,
         idempotent: bool = True,
     ) -> T:
-        """Run one exchange with bounded retries, reconnection and the lost-light check."""
+        """Run one exchange with bounded retries, reconnection and the lost-light check.
+
+        The faults resent after go to ``stats.recovered`` once the command got through, not
+        as they are resent: a command that gave up after its resends had been listed as
+        recovered from the very faults that stopped it."""
         attempt = 0
+        resent: list[str] = []
         while True:
             self.stats.commands += 1
             try:
@@ -549,9 +563,10 @@ class DomePolicy:
                 attempt += 1
                 self.stats.retries += 1
                 self._recover(exc, command)
-                self.stats.recovered.append(f"{command}: {fault}")
+                resent.append(f"{command}: {fault}")
             else:
                 self._answered = True
+                self.stats.recovered += resent
                 return result
 
     def _recover(self, exc: DomeLinkError, command: str) -> None:

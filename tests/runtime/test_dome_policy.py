@@ -514,6 +514,7 @@ def test_a_handshake_whose_reply_is_lost_is_sent_again(profile, kind):
     dome, fw, clock = make(profile, [Fault(1, kind, delay_s=5.0)])
     session(dome, fw, clock)  # every LED lit as asked
     assert dome.stats.retries == 1, dome.stats
+    assert len(dome.stats.recovered) == 1 and dome.stats.recovered[0].startswith("handshake: ")
     clean, _, _ = make(profile)
     clean.connect()
     assert dome.info == clean.info  # not a damaged name
@@ -528,6 +529,7 @@ def test_a_handshake_never_answered_gives_up_after_the_retries():
     with pytest.raises(DeviceError, match=r"no handshake.*gave up after 3 attempts") as caught:
         dome.connect()
     assert dome.stats.retries == 2
+    assert dome.stats.recovered == []  # resent twice, recovered never: it had listed both
     assert "check the USB cable" in str(caught.value)
     assert "check the port, the baud rate" not in str(caught.value)
 
@@ -573,6 +575,20 @@ def test_a_board_that_never_spoke_the_profile_is_not_sent_the_handshake_again(bo
     assert len(writes) == 2  # the handshake, then the all-off a failed connection sends anyway
     assert "check the port, the baud rate and the protocol profile" in str(caught.value)
     assert "gave up" not in str(caught.value)
+
+
+def test_a_command_that_gives_up_after_its_resends_is_not_listed_as_recovered():
+    """``stats.recovered`` had listed each resend as it was made: a light that failed after
+    two resends was "recovered" twice. Only faults of a command that got through are."""
+    faults = [Fault(n, FaultKind.DROP_REPLY) for n in (LIGHT_1, LIGHT_1 + 1, LIGHT_1 + 2)]
+    dome, _fw, _clock = make("default", faults, retries=2)
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    with pytest.raises(DomeLinkError, match="gave up after 3 attempts"):
+        dome.light(1, 1.0)
+    assert dome.stats.retries == 2
+    assert dome.stats.recovered == []
 
 
 def test_relighting_the_same_led_keeps_counting_its_on_time():
