@@ -203,10 +203,15 @@ class DomePolicy:
         #: (a handshake, or a command that went through): until then a board that does not
         #: answer may be another board, or none, so a give-up names the port, baud and profile.
         self._answered = False
+        #: Whether the board spoke the profile on a port this connect opened and then lost
+        #: (see :meth:`_connect_link`): its port, baud rate and profile are then known right,
+        #: whatever the reopened port gives.
+        self._spoke_before_drop = False
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> None:
+        self._spoke_before_drop = False
         try:
             info = self._connect_link()
         except DomeLinkError as exc:
@@ -215,7 +220,7 @@ class DomePolicy:
             spoke = (
                 exc.command != "open port"
                 and exc.fault is not LinkFault.REJECTED
-                and self._board_spoke_profile(exc)
+                and (self._spoke_before_drop or self._board_spoke_profile(exc))
             )
             if exc.command == "open port" and not self._port_was_open:
                 # Nothing was ever sent: say so, not "all-off failed, lights may be on".
@@ -241,6 +246,16 @@ class DomePolicy:
                     self.name,
                     f"the dome's port could not be opened ({exc.message}); check that the board "
                     "is plugged in and that the rig config's port names it",
+                    exc.command,
+                ) from exc
+            if exc.fault is LinkFault.DISCONNECTED:
+                # the port opened, then vanished: a USB event, which no port name, baud rate
+                # or profile gives (that advice had sent users to a config that was right)
+                raise DeviceError(
+                    self.name,
+                    f"the dome's port was lost during the {exc.command} ({exc.message}): the "
+                    "USB link dropped; check the USB cable, the USB hub and the board's power "
+                    "supply, then connect again",
                     exc.command,
                 ) from exc
             if spoke:
@@ -305,6 +320,82 @@ class DomePolicy:
         self._run(self.link.all_off, "all off")  # start from the safe state
 
     def _connect_link(self) -> DomeInfo:
+        """Open the port and handshake (see :meth:`_open_and_handshake` for the resends); a port
+        that vanishes after it opened (a USB drop during the boot wait, the handshake or an init
+        command) is reopened by path, as a drop mid-session is.
+
+        Before, such a drop failed the session at its start with "no handshake with the dome …
+        check the port, the baud rate and the protocol profile": wrong advice for a port that
+        was there and then was not. It is reopened only if the board spoke the profile before
+        the drop (its banner, ready text or a well-formed reply): then the port is the dome's
+        and a reconnection is what the session would do a minute later. A board heard from
+        nothing before its port vanished (one that browns out its USB port as it boots lit
+        drops off at every opening) is not reopened: connect says the port was lost at once.
+
+        Up to ``reconnect_attempts`` reopenings (none if it is 0), with the back-off doubling
+        from ``reconnect_backoff_s`` on the link's clock; one whose port came back but whose
+        handshake failed otherwise ends the attempts with that failure. ``stats.recovered``
+        gets the faults this connect met only if its handshake got through in the end."""
+        recovered: list[str] = []
+        try:
+            info = self._open_and_handshake(recovered)
+        except DomeLinkError as exc:
+            if not (
+                _lost_after_opening(exc)
+                and getattr(self.link, "profile_heard", False)
+                and self.settings.reconnect_attempts > 0
+            ):
+                raise
+            info = self._reopen_after_drop(exc, recovered)
+        self.stats.recovered += recovered
+        return info
+
+    def _reopen_after_drop(self, drop: DomeLinkError, recovered: list[str]) -> DomeInfo:
+        """Reopen the port a connect lost after the board had spoken the profile on it (see
+        :meth:`_connect_link`); the info of the handshake that got through."""
+        self._spoke_before_drop = True
+        self.stats.retries += 1  # the handshake is sent again, on the reopened port
+        recovered.append(f"{drop.command}: {drop.fault}")
+        log.warning(
+            "%s: the port was lost during the %s (%s); reopening it",
+            self.name,
+            drop.command,
+            drop.message,
+        )
+        last = drop
+        for attempt in range(self.settings.reconnect_attempts):
+            self._quiet_close()
+            self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
+            try:
+                info = self._open_and_handshake(recovered)
+            except DomeLinkError as exc:
+                if exc.command == "open port" or _lost_after_opening(exc):
+                    # not back yet, or gone again: the next attempt waits longer
+                    log.warning("%s: reconnection %d failed: %s", self.name, attempt + 1, exc)
+                    last = exc
+                    continue
+                raise DomeLinkError(  # back, but the handshake failed otherwise: say both
+                    exc.device,
+                    f"{exc.message} (after the port was lost during the {drop.command} and "
+                    "reopened)",
+                    exc.command,
+                    exc.fault,
+                    retryable=False,
+                    code=exc.code,
+                ) from exc
+            self.stats.reconnects += 1
+            return info
+        n = self.settings.reconnect_attempts
+        raise DomeLinkError(
+            drop.device,
+            f"{drop.message}; it did not come back after {n} reconnection "
+            f"attempt{'s' if n != 1 else ''} ({last.message})",
+            drop.command,  # not "open port": the port was open and the handshake sent
+            LinkFault.DISCONNECTED,
+            retryable=False,
+        ) from last
+
+    def _open_and_handshake(self, recovered: list[str]) -> DomeInfo:
         """Open the port and handshake; a handshake (or init command) whose reply was lost,
         late or garbled, that arrived garbled (a resendable firmware error) or that a reboot
         cut short is sent again on the open port up to ``retries`` times, as any idempotent
@@ -316,14 +407,13 @@ class DomePolicy:
         :meth:`_board_spoke_profile`): silence or unreadable bytes alone are what a wrong port,
         baud rate or profile gives, which still fails at once with that advice rather than
         after ``retries`` more timeouts (and more bytes sent to a board of another protocol).
-        The faults resent after go to ``stats.recovered`` only once the handshake got through:
-        a connect that gave up had listed each of its resends as recovered."""
+        Each fault resent after is added to ``recovered``, which the caller counts only once
+        the handshake got through; a lost port is raised as it is (:meth:`_connect_link`)."""
         try:
             return self._counted(self.link.connect)
         except DomeLinkError as first:
             exc = first
         attempt = 0
-        resent: list[str] = []
         while (
             exc.retryable
             and attempt < self.settings.retries
@@ -332,7 +422,7 @@ class DomePolicy:
         ):
             attempt += 1
             self.stats.retries += 1
-            resent.append(f"{exc.command}: {exc.fault}")
+            recovered.append(f"{exc.command}: {exc.fault}")
             log.warning(
                 "%s: %s failed while connecting (%s, attempt %d): %s",
                 self.name,
@@ -343,13 +433,10 @@ class DomePolicy:
             )
             self._back_off(self.settings.retry_backoff_s)
             try:
-                info = self._counted(self.link.hello)
+                return self._counted(self.link.hello)
             except DomeLinkError as again:
                 exc = again
-            else:
-                self.stats.recovered += resent
-                return info
-        if attempt:
+        if attempt and exc.fault is not LinkFault.DISCONNECTED:
             raise DomeLinkError(
                 exc.device,
                 f"{exc.message}; gave up after {attempt + 1} attempts",
@@ -738,6 +825,11 @@ class DomePolicy:
 
 #: Faults of a board that may not be the one the profile describes (or no board at all).
 _NOT_ITS_BOARD = (LinkFault.TIMEOUT, LinkFault.GARBLED, LinkFault.MISMATCH)
+
+
+def _lost_after_opening(exc: DomeLinkError) -> bool:
+    """The port opened, then vanished (a USB drop): not a port that could not be opened."""
+    return exc.fault is LinkFault.DISCONNECTED and exc.command != "open port"
 
 
 def _failed_off(exc: DomeLinkError) -> OffReport:

@@ -577,6 +577,82 @@ def test_a_board_that_never_spoke_the_profile_is_not_sent_the_handshake_again(bo
     assert "gave up" not in str(caught.value)
 
 
+@pytest.mark.parametrize("profile", PROFILES)
+def test_a_usb_drop_during_the_handshake_is_reconnected_and_the_session_completes(profile):
+    """The board sent its banner, then its port vanished as the handshake went out (a USB
+    drop): the port is reopened by path, as mid-session. It had failed the session at its
+    start with "no handshake with the dome … check the port, the baud rate and the protocol
+    profile", of a port that had just opened and a board that had just spoken the profile."""
+    dome, fw, clock = make(profile, [Fault(1, FaultKind.DISCONNECT, delay_s=0.5)])
+    session(dome, fw, clock)  # every LED lit as asked
+    assert dome.stats.reconnects == 1
+    assert dome.stats.recovered == ["handshake: disconnected"]
+    assert dome.link.transport.opens == 2
+    assert fw.lit is None
+
+
+def test_a_usb_drop_during_the_handshake_that_does_not_come_back_names_the_usb_link():
+    """Bounded by reconnect_attempts, and the message says what happened (the port was lost),
+    not to check a port name, baud rate and profile that were right."""
+    dome, _fw, _clock = make(
+        "default", [Fault(1, FaultKind.DISCONNECT, delay_s=1000.0)], reconnect_attempts=3
+    )
+    with pytest.raises(DeviceError) as caught:
+        dome.connect()
+    msg = str(caught.value)
+    assert "port was lost during the handshake" in msg
+    assert "did not come back after 3 reconnection attempts" in msg
+    assert "check the USB cable, the USB hub and the board's power supply" in msg
+    assert "check the port, the baud rate" not in msg
+    assert dome.stats.recovered == []
+    assert dome.link.transport.opens == 1  # the three reopenings found no port
+    assert not dome.off_report.lights_known_off  # honest: the all-off could not be sent
+
+
+def test_a_usb_drop_before_the_board_spoke_is_named_but_not_reconnected():
+    """A board without auto-reset has said nothing before its handshake: its port vanishing
+    then is still a USB drop, not a wrong port, baud rate or profile, and the message says so.
+    It is not reopened (a board that browns out its USB port as it boots would drop again)."""
+    dome, _fw, _clock = make("default", [Fault(1, FaultKind.DISCONNECT, delay_s=0.5)], banner=False)
+    with pytest.raises(DeviceError) as caught:
+        dome.connect()
+    msg = str(caught.value)
+    assert "port was lost during the handshake" in msg and "check the USB cable" in msg
+    assert "check the port, the baud rate" not in msg
+    assert dome.stats.reconnects == 0 and dome.stats.recovered == []
+    assert dome.link.transport.opens == 1
+
+
+def test_a_board_that_comes_back_silent_after_a_drop_at_connect_keeps_the_usb_advice():
+    """It spoke the profile before its port vanished, so port, baud rate and profile are
+    right whatever the reopened port gives: the advice is the USB cable and the power."""
+    clock = VirtualClock()
+    s = DomeSerialSettings(port="emulated", profile="default")
+    fw = firmware_for(
+        s,
+        clock=clock,
+        led_count=N_LEDS,
+        boot_delay_s=0.2,
+        faults=FaultPlan((Fault(1, FaultKind.DISCONNECT, delay_s=0.5),)),
+    )
+
+    class SilentOnceBack(InProcessDomeTransport):
+        def open(self) -> None:
+            if self.opens:  # back on the bus, but the board says nothing
+                fw.banner_on_boot = False
+                fw.faults = FaultPlan(tuple(Fault(n, FaultKind.DROP_REPLY) for n in range(2, 9)))
+            super().open()
+
+    dome = build_dome(s, clock, transport=SilentOnceBack(fw))
+    with pytest.raises(DeviceError) as caught:
+        dome.connect()
+    msg = str(caught.value)
+    assert "after the port was lost during the handshake and reopened" in msg
+    assert "check the USB cable" in msg
+    assert "check the port, the baud rate" not in msg
+    assert dome.stats.recovered == []
+
+
 def test_a_command_that_gives_up_after_its_resends_is_not_listed_as_recovered():
     """``stats.recovered`` had listed each resend as it was made: a light that failed after
     two resends was "recovered" twice. Only faults of a command that got through are."""

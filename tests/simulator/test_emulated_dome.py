@@ -68,6 +68,47 @@ def test_a_dry_run_whose_first_handshake_reply_is_lost_completes(tmp_path: Path)
     assert wrong_light_steps(cfg, out) == []
 
 
+@pytest.mark.e2e
+@pytest.mark.pty
+def test_a_dry_run_whose_board_drops_off_the_usb_at_the_handshake_completes(
+    tmp_path: Path,
+) -> None:
+    """The emulated board sends its banner, then its pty vanishes as the first handshake
+    arrives (a USB drop; back 0.3 s later behind the same path): the port is reopened and the
+    run completes. It had failed at its start with "no handshake with the dome … check the
+    port, the baud rate and the protocol profile", through real pyserial's own errors."""
+    cfg = small_emulated(
+        tmp_path,
+        '\n[emulator]\nfaults = [{at_command = 1, kind = "disconnect", delay_s = 0.3}]\n',
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    assert r.exit_code == 0, r.output
+    assert "no handshake" not in said(r) and "port was lost" not in said(r)
+    assert len(read_lp(out / "lights.lp")) == 4
+    assert wrong_light_steps(cfg, out) == []
+
+
+@pytest.mark.e2e
+@pytest.mark.pty
+def test_a_check_whose_board_drops_off_for_good_at_the_handshake_names_the_usb_link(
+    tmp_path: Path,
+) -> None:
+    """Gone for good: the check fails saying the port was lost during the handshake and to
+    check the USB cable, hub and power, not the port, baud rate and profile it had said."""
+    cfg = small_emulated(
+        tmp_path,
+        '\n[emulator]\nfaults = [{at_command = 1, kind = "disconnect", delay_s = 60.0}]\n',
+    )
+    cfg.write_text(cfg.read_text().replace("reconnect_attempts = 3", "reconnect_attempts = 1"))
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "port was lost during the handshake" in text
+    assert "check the USB cable, the USB hub and the board's power supply" in text
+    assert "check the port, the baud rate" not in text
+
+
 @pytest.mark.pty
 def test_firmware_really_lit_each_recorded_led(tmp_path: Path) -> None:
     loaded = load_rig_config(small_emulated(tmp_path))

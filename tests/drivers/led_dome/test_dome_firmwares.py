@@ -245,6 +245,23 @@ def test_a_lost_reply_to_the_init_all_off_is_resent_and_the_session_completes(
     assert len(read_lp(out / "lights.lp")) == 8
 
 
+def test_a_usb_drop_at_the_init_all_off_is_reconnected_and_the_session_completes(
+    tmp_path: Path,
+) -> None:
+    """The nab sketch's port vanishes as the connect's init all-off (command 1, after its ready
+    text) arrives, and comes back 0.3 s later: the port is reopened and the run completes. It
+    had failed at its start with "no handshake with the dome … check the port, the baud rate
+    and the protocol profile"."""
+    cfg = with_faults(
+        "nab-rti-v1", tmp_path, 'faults = [{at_command = 1, kind = "disconnect", delay_s = 0.3}]\n'
+    )
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])
+    assert r.exit_code == 0, r.output
+    assert "no handshake" not in said(r) and "port was lost" not in said(r)
+    assert len(read_lp(out / "lights.lp")) == 8
+
+
 def test_board_reset_mid_session_stops_naming_the_led_keeps_images_and_ends_dark(
     tmp_path: Path,
 ) -> None:
