@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import hashlib
+import re
 import tempfile
 import time
 from collections import Counter
@@ -54,6 +55,8 @@ from rti_rig.testing.kill_hooks import popen_session
 from rti_rig.testing.verify import wrong_light_steps
 
 REPO = Path(__file__).resolve().parent.parent
+#: The report's section of docs/reliability.md, between markers of this name.
+SECTION = "fault_campaign"
 IN_PROCESS = ("camera-failure", "light-failure")
 SERVO = ("servo-overload", "servo-overheating", "servo-corrupt-crc", "servo-silence")
 SERIAL = (
@@ -533,12 +536,26 @@ def main() -> None:
     text = report(result, args.sessions, args.seed, time.perf_counter() - t0, groups)
     print(text)
     if out is not None:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        old = out.read_text() if out.exists() else ""
-        # the dome firmwares' campaign (benchmarks.firmware_fault_campaign) owns its own section
-        keep = old[old.find("<!-- BEGIN firmware_faults -->") :] if "firmware_faults" in old else ""
-        out.write_text(text.rstrip() + ("\n\n" + keep if keep else "\n"))
+        write_report(text, out)
         print(f"report → {out}")
+
+
+def write_report(text: str, out: Path) -> None:
+    """Put the report between its markers in ``out``, leaving the rest of the file as it is.
+
+    It had kept only the dome firmwares' section (from its marker on) and replaced everything
+    before it: the "Emulators on a pty under CPU load" section between the two was deleted by
+    every ``--write``. A file without the markers gets the report on top of what it holds."""
+    begin, end = f"<!-- BEGIN {SECTION} -->", f"<!-- END {SECTION} -->"
+    block = f"{begin}\n{text.strip()}\n{end}"
+    old = out.read_text() if out.exists() else ""
+    pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.DOTALL)
+    if pattern.search(old):
+        new = pattern.sub(lambda _m: block, old)
+    else:
+        new = block + ("\n\n" + old.lstrip() if old.strip() else "")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(new.rstrip() + "\n")
 
 
 if __name__ == "__main__":

@@ -8,9 +8,13 @@ complete. Checked: the committed images survive unchanged, the folder ends compl
 consistent, every image is explained best by its recorded LED (the wrong-light check), and the
 emulator's record shows every LED off at the end of every run (``dark at end``).
 
-    python -m benchmarks.firmware_fault_campaign [--sessions 24] [--seed 1] [--write]
+    python -m benchmarks.firmware_fault_campaign [--sessions 24] [--seed 1] [--at-connect] [--write]
 
-``--write`` puts the figures in their section of docs/reliability.md.
+``--write`` puts the figures in their section of docs/reliability.md. The fault is drawn after
+the connect (from command 4: the connect's commands and the first all-off come before) unless
+``--at-connect``, which draws it at commands 1-3 only, the connect's handshake or init
+commands and its first all-offs, where a session had failed at its start; its figures have a
+section of their own.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.fault_campaign import committed_files
+from benchmarks.fault_campaign import committed_files, first_finish_reason
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.core.errors import RtiRigError
@@ -48,6 +52,9 @@ CONFIGS = {
 KINDS = ("drop_reply", "garble_reply", "delay_reply", "reset", "disconnect")
 LIGHTS = 6
 SECTION = "firmware_faults"
+#: Commands the fault is drawn from: after the connect, or at it (``--at-connect``).
+AFTER_CONNECT = (4, 4 + 2 * LIGHTS)
+AT_CONNECT = (1, 4)
 
 
 def make_config(folder: Path, profile: str, fault: tuple[int, str] | None) -> Path:
@@ -81,8 +88,9 @@ def run_once(cfg: Path, out: Path, resume: bool) -> bool:
         return not board.lit
 
 
-def campaign(sessions: int, seed: int) -> dict:
+def campaign(sessions: int, seed: int, at_connect: bool = False) -> dict:
     rng = np.random.default_rng(seed)
+    low, high = AT_CONNECT if at_connect else AFTER_CONNECT
     stats: Counter[str] = Counter()
     per_kind: Counter[str] = Counter()
     profiles = list(CONFIGS)
@@ -91,11 +99,14 @@ def campaign(sessions: int, seed: int) -> dict:
         for i in range(sessions):
             profile = profiles[i % len(profiles)]
             kind = str(rng.choice(KINDS))
-            at = int(rng.integers(4, 4 + 2 * LIGHTS))  # 1-3 connect and the first all-off
+            at = int(rng.integers(low, high))  # 1-3: the connect and the first all-off
             out = tmpdir / f"s{i:03d}"
             dark = run_once(make_config(tmpdir, profile, (at, kind)), out, resume=False)
             per_kind[kind] += 1
-            first = read_manifest(out)["runner"].get("finish_reason")
+            # a run that failed at connect wrote nothing (the folder is begun once the rig
+            # answers): stopped with its error, and run again from nothing below
+            first = first_finish_reason(out)
+            stats["stopped_at_connect"] += int(not (out / "manifest.json").exists())
             stats["recovered_in_session"] += int(first == "completed")
             stats["stopped_with_named_error"] += int(first == "error")
             stats["runs"] += 1
@@ -103,13 +114,16 @@ def campaign(sessions: int, seed: int) -> dict:
             snapshots: dict[str, str] = {}
             clean = make_config(tmpdir, profile, None)
             resumes = 0
-            while read_manifest(out)["runner"].get("finish_reason") != "completed":
-                snapshots.update(committed_files(out))
+            while first_finish_reason(out) != "completed":
                 if resumes >= 5:
                     stats["abandoned"] += 1
                     break
                 resumes += 1
                 stats["runs"] += 1
+                if not (out / "manifest.json").exists():
+                    stats["dark_at_end"] += int(run_once(clean, out, resume=False))
+                    continue
+                snapshots.update(committed_files(out))
                 stats["dark_at_end"] += int(run_once(clean, out, resume=True))
             m = read_manifest(out)
             complete = m["runner"].get("finish_reason") == "completed" and len(m["steps"]) == LIGHTS
@@ -132,12 +146,16 @@ def campaign(sessions: int, seed: int) -> dict:
     return {"stats": dict(stats), "faults": dict(per_kind)}
 
 
-def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
+def report(result: dict, sessions: int, seed: int, seconds: float, at_connect: bool = False) -> str:
     s, f = result["stats"], result["faults"]
     rows = [
         ("sessions (one firmware fault each)", s.get("sessions", 0)),
         ("recovered inside the session (retry, reconnect)", s.get("recovered_in_session", 0)),
         ("stopped with a named error, then resumed", s.get("stopped_with_named_error", 0)),
+        (
+            "of which stopped at connect, before anything was written (run again from nothing)",
+            s.get("stopped_at_connect", 0),
+        ),
         ("sessions completed", s.get("sessions_completed", 0)),
         ("images checked", s.get("images_checked", 0)),
         ("images lost or changed", s.get("images_lost", 0)),
@@ -146,14 +164,17 @@ def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
         ("runs whose emulator record ends with every LED off", s.get("dark_at_end", 0)),
     ]
     kinds = ", ".join(f"{k} {v}" for k, v in sorted(f.items()))
+    low, high = AT_CONNECT if at_connect else AFTER_CONNECT
     return "\n".join(
         [
-            "## Real-firmware dome profiles under faults",
+            "## Real-firmware dome profiles under faults" + (" at connect" if at_connect else ""),
             "",
             f"Command: `python -m benchmarks.firmware_fault_campaign --sessions {sessions} "
-            f"--seed {seed} --write` ({seconds:.0f} s). Profiles in turn: "
+            f"--seed {seed}{' --at-connect' if at_connect else ''} --write` ({seconds:.0f} s). "
+            "Profiles in turn: "
             + ", ".join(CONFIGS)
-            + f"; {LIGHTS} lights each; faults: {kinds}.",
+            + f"; {LIGHTS} lights each; the fault at a command drawn from {low} to {high - 1}; "
+            f"faults: {kinds}.",
             "",
             "| | count |",
             "|---|---|",
@@ -162,8 +183,8 @@ def report(result: dict, sessions: int, seed: int, seconds: float) -> str:
     )
 
 
-def write_section(text: str, path: Path) -> None:
-    begin, end = f"<!-- BEGIN {SECTION} -->", f"<!-- END {SECTION} -->"
+def write_section(text: str, path: Path, section: str = SECTION) -> None:
+    begin, end = f"<!-- BEGIN {section} -->", f"<!-- END {section} -->"
     block = f"{begin}\n{text}\n{end}"
     old = path.read_text() if path.exists() else ""
     pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.DOTALL)
@@ -177,14 +198,20 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--sessions", type=int, default=24)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument(
+        "--at-connect",
+        action="store_true",
+        help="draw each fault at commands 1-3 (the connect) rather than after it",
+    )
     ap.add_argument("--write", action="store_true")
     args = ap.parse_args()
     t0 = time.perf_counter()
-    result = campaign(args.sessions, args.seed)
-    text = report(result, args.sessions, args.seed, time.perf_counter() - t0)
+    result = campaign(args.sessions, args.seed, args.at_connect)
+    text = report(result, args.sessions, args.seed, time.perf_counter() - t0, args.at_connect)
     print(text)
     if args.write:
-        write_section(text, REPO / "docs" / "reliability.md")
+        section = f"{SECTION}_at_connect" if args.at_connect else SECTION
+        write_section(text, REPO / "docs" / "reliability.md", section)
 
 
 if __name__ == "__main__":

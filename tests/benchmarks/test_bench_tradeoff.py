@@ -112,3 +112,29 @@ def test_fault_campaign_writes_its_report_only_when_asked(
     monkeypatch.setattr(sys, "argv", ["fault_campaign", "--sessions", "0", "--write"])
     fc.main()
     assert (tmp_path / "docs" / "reliability.md").is_file()
+
+
+def test_fault_campaign_writes_only_its_own_section(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/reliability.md holds other sections between the campaign's and the dome
+    firmwares' ("Emulators on a pty under CPU load"): a --write had deleted them, keeping
+    only what followed the firmwares' marker."""
+    import sys
+
+    import benchmarks.fault_campaign as fc
+
+    docs = tmp_path / "docs" / "reliability.md"
+    docs.parent.mkdir()
+    docs.write_text(
+        "<!-- BEGIN fault_campaign -->\nold figures\n<!-- END fault_campaign -->\n\n"
+        "## Emulators on a pty under CPU load\n\nkept\n\n"
+        "<!-- BEGIN firmware_faults -->\nfirmware figures\n<!-- END firmware_faults -->\n"
+    )
+    monkeypatch.setattr(fc, "REPO", tmp_path)
+    monkeypatch.setattr(sys, "argv", ["fault_campaign", "--sessions", "0", "--write"])
+    fc.main()
+    text = docs.read_text()
+    assert "old figures" not in text and "# Reliability: fault campaign" in text
+    assert "## Emulators on a pty under CPU load\n\nkept\n" in text
+    assert "firmware figures" in text
