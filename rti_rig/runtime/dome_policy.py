@@ -694,12 +694,16 @@ class DomePolicy:
     def _reconnect(self, command: str) -> None:
         self._quiet_close()
         last = "no attempt made"
+        port_came_back = False  # whether the last attempt opened the port (its handshake failed)
         for attempt in range(self.settings.reconnect_attempts):
             self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
             try:
                 info = self._counted(self.link.connect)
             except DomeLinkError as exc:
                 last = exc.message
+                port_came_back = exc.command != "open port" and exc.fault is not (
+                    LinkFault.DISCONNECTED
+                )
                 self._quiet_close()
                 continue
             problem = self._check_identity(info)
@@ -708,11 +712,19 @@ class DomePolicy:
                 raise DeviceError(self.name, f"after reconnecting: {problem}", command)
             self.stats.reconnects += 1
             return
+        # "did not come back" only of a port that did not: one that reopened but whose board
+        # did not answer its handshake is said so (the board, not the USB link, is in question)
+        tries = self.settings.reconnect_attempts
+        attempts = f"{tries} reconnection attempt{'' if tries == 1 else 's'}"
+        outcome = (
+            f"its port came back but the board did not answer its handshake after {attempts}"
+            if port_came_back
+            else f"did not come back after {attempts}"
+        )
         raise DomeLinkError(
             self.name,
-            f"the dome dropped off and did not come back after "
-            f"{self.settings.reconnect_attempts} reconnection attempts ({last}); check the USB "
-            "cable and the dome's power",
+            f"the dome dropped off and {outcome} ({last}); check the USB cable and the dome's "
+            "power",
             command,
             LinkFault.DISCONNECTED,
             retryable=False,

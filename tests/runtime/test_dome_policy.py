@@ -868,3 +868,23 @@ def test_a_real_time_rig_never_sleeps_for_the_link_again():
 
     dome = DomePolicy(_TimedLink(VirtualClock()), SystemClock())
     assert dome._link_clock is None  # a hardware rig's clock is real: nothing to add
+
+
+def test_a_port_that_comes_back_to_a_silent_board_is_not_said_never_to_have_come_back():
+    """Mid-session, a USB drop whose port reopens but whose board then never answers its
+    handshake: the give-up says the port came back and the board did not answer (the board is in
+    question, not the USB link), where it had said the dome "did not come back"."""
+    silent = [Fault(n, FaultKind.DROP_REPLY) for n in range(LIGHT_1 + 1, LIGHT_1 + 20)]
+    dome, _fw, _clock = make(
+        "default",
+        [Fault(LIGHT_1, FaultKind.DISCONNECT, delay_s=0.5), *silent],
+        reconnect_attempts=1,
+    )
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    with pytest.raises(DomeLinkError) as info:
+        dome.light(1, 1.0)
+    msg = str(info.value)
+    assert "its port came back but the board did not answer its handshake after 1 " in msg, msg
+    assert "reconnection attempt (" in msg and "did not come back" not in msg, msg
