@@ -597,6 +597,19 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
         err.print(f"[yellow]note:[/] {escape(str(note))}")
     for failure in result.teardown_failures:
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
+    if result.finish_reason is not FinishReason.CANCELLED and getattr(
+        rig.loaded.config, "backend", None
+    ) in ("hardware", "emulated"):
+        from rti_rig.app.usecases.safe_state import lights_state
+
+        # a finished session on a rig with devices says what its teardown established, as a
+        # stop does (it had said nothing: the user took the object out not told whether the
+        # dome had acknowledged its all-off, or that a firmware with none switches itself off)
+        out.print(
+            _sentence(lights_state(rig, bool(result.teardown_failures))) + ".",
+            markup=False,
+            highlight=False,
+        )
     adaptive_result = opened.extra.get("adaptive_result")
     if adaptive_result is not None:
         from rti_rig.app.usecases.adaptive import estimate_phrase, few_lights_note

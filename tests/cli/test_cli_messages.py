@@ -397,3 +397,45 @@ def test_an_arm_that_could_not_be_connected_is_not_said_to_be_stopped(tmp_path: 
     assert "Nothing was commanded: the arm could not be connected" in said
     assert "Lamp off and stop were requested" not in said
     assert "U2D2" in said and not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("config", "sentence"),
+    [
+        ("emulated_dome.toml", "All-off sent and acknowledged by the dome: lights are off."),
+        ("emulated_elexol.toml", "this firmware never acknowledges"),
+        ("simulated_arm.toml", "Lamp off and stop were requested."),
+    ],
+)
+def test_a_finished_session_on_a_rig_with_devices_says_what_is_known_of_the_lights(
+    tmp_path: Path, config: str, sentence: str
+) -> None:
+    """A finished run had said nothing of the lights (only a stop or an error did): the user
+    took the object out not told whether the dome had acknowledged its all-off. It now says
+    what the teardown established, in the words a stop uses, and no more."""
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / config
+    r = runner.invoke(
+        app,
+        ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "4", "--no-verdict"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    tail = said[said.index("Session time on the real rig") :]
+    assert sentence in tail, said
+    if "never acknowledges" in sentence:
+        assert "lights are off" not in said, said
+
+
+def test_a_dry_run_of_a_simulated_dome_claims_nothing_of_lights_it_does_not_have(
+    tmp_path: Path,
+) -> None:
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    r = runner.invoke(
+        app,
+        ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "4", "--no-verdict"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "lights are off" not in said and "switched off" not in said, said
