@@ -362,34 +362,23 @@ class DomePolicy:
             drop.command,
             drop.message,
         )
-        last = drop
-        for attempt in range(self.settings.reconnect_attempts):
-            self._quiet_close()
-            self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
-            try:
-                info = self._open_and_handshake(recovered)
-            except DomeLinkError as exc:
-                if exc.command == "open port" or _lost_after_opening(exc):
-                    # not back yet, or gone again: the next attempt waits longer
-                    log.warning("%s: reconnection %d failed: %s", self.name, attempt + 1, exc)
-                    last = exc
-                    continue
-                raise DomeLinkError(  # back, but the handshake failed otherwise: say both
-                    exc.device,
-                    f"{exc.message} (after the port was lost during the {drop.command} and "
-                    "reopened)",
-                    exc.command,
-                    exc.fault,
-                    retryable=False,
-                    code=exc.code,
-                ) from exc
-            self.stats.reconnects += 1
+        info, last, came_back = self._reopen(recovered, end_when_back=True)
+        if info is not None:
             return info
+        if came_back and last is not None:
+            raise DomeLinkError(  # back, but the handshake failed otherwise: say both
+                last.device,
+                f"{last.message} (after the port was lost during the {drop.command} and reopened)",
+                last.command,
+                last.fault,
+                retryable=False,
+                code=last.code,
+            ) from last
         n = self.settings.reconnect_attempts
         raise DomeLinkError(
             drop.device,
             f"{drop.message}; it did not come back after {n} reconnection "
-            f"attempt{'s' if n != 1 else ''} ({last.message})",
+            f"attempt{'s' if n != 1 else ''} ({(last or drop).message})",
             drop.command,  # not "open port": the port was open and the handshake sent
             LinkFault.DISCONNECTED,
             retryable=False,
@@ -692,25 +681,15 @@ class DomePolicy:
             self._counted(lambda: link_clock.sleep(seconds))
 
     def _reconnect(self, command: str) -> None:
-        self._quiet_close()
-        last = "no attempt made"
-        port_came_back = False  # whether the last attempt opened the port (its handshake failed)
-        for attempt in range(self.settings.reconnect_attempts):
-            self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
-            try:
-                info = self._counted(self.link.connect)
-            except DomeLinkError as exc:
-                last = exc.message
-                port_came_back = exc.command != "open port" and exc.fault is not (
-                    LinkFault.DISCONNECTED
-                )
-                self._quiet_close()
-                continue
+        """Reopen the port a session lost (a USB drop) and check it is the same dome."""
+        recovered: list[str] = []
+        info, last, came_back = self._reopen(recovered, end_when_back=False)
+        if info is not None:
             problem = self._check_identity(info)
             if problem:
                 self._quiet_close()
                 raise DeviceError(self.name, f"after reconnecting: {problem}", command)
-            self.stats.reconnects += 1
+            self.stats.recovered += recovered
             return
         # "did not come back" only of a port that did not: one that reopened but whose board
         # did not answer its handshake is said so (the board, not the USB link, is in question)
@@ -718,17 +697,52 @@ class DomePolicy:
         attempts = f"{tries} reconnection attempt{'' if tries == 1 else 's'}"
         outcome = (
             f"its port came back but the board did not answer its handshake after {attempts}"
-            if port_came_back
+            if came_back
             else f"did not come back after {attempts}"
         )
+        said = last.message if last is not None else "no attempt made"
         raise DomeLinkError(
             self.name,
-            f"the dome dropped off and {outcome} ({last}); check the USB cable and the dome's "
+            f"the dome dropped off and {outcome} ({said}); check the USB cable and the dome's "
             "power",
             command,
             LinkFault.DISCONNECTED,
             retryable=False,
         )
+
+    def _reopen(
+        self, recovered: list[str], *, end_when_back: bool
+    ) -> tuple[DomeInfo | None, DomeLinkError | None, bool]:
+        """Close the port and open it again by path, up to ``reconnect_attempts`` times, the
+        back-off doubling from ``reconnect_backoff_s`` on the link's clock; each opening
+        handshakes as a connect does (:meth:`_open_and_handshake`: a lost reply is resent once
+        the board has spoken the profile, its faults added to ``recovered``).
+
+        One loop for a drop at the connect and a drop mid-session (they had been two copies,
+        and the session's did not resend a lost handshake reply on the reopened port: one lost
+        reply cost a whole reconnection attempt). Returns the info of the handshake that got
+        through (``stats.reconnects`` counted), else None, the last failure and whether its port
+        had come back. ``end_when_back``: stop at the first port that came back but whose
+        handshake failed otherwise (a connect: that board's answer is then what is in
+        question), rather than trying again (mid-session: a board may still be booting)."""
+        last: DomeLinkError | None = None
+        came_back = False
+        for attempt in range(self.settings.reconnect_attempts):
+            self._quiet_close()
+            self._back_off(self.settings.reconnect_backoff_s * (2**attempt))
+            try:
+                info = self._open_and_handshake(recovered)
+            except DomeLinkError as exc:
+                last = exc
+                came_back = not (exc.command == "open port" or _lost_after_opening(exc))
+                log.warning("%s: reconnection %d failed: %s", self.name, attempt + 1, exc)
+                if came_back and end_when_back:
+                    return None, exc, True
+                continue
+            self.stats.reconnects += 1
+            return info, None, False
+        self._quiet_close()
+        return None, last, came_back
 
     def _check_identity(self, info: DomeInfo) -> str | None:
         s = self.settings

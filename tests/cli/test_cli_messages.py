@@ -399,6 +399,19 @@ def test_an_arm_that_could_not_be_connected_is_not_said_to_be_stopped(tmp_path: 
     assert "U2D2" in said and not out.exists()
 
 
+def _finished_run(tmp_path: Path, config: str) -> str:
+    """A 4-light run of a shipped config to its end (no verdict), its output on one line."""
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / config
+    r = runner.invoke(
+        app,
+        ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "4", "--no-verdict"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    return said
+
+
 @pytest.mark.parametrize(
     ("config", "sentence"),
     [
@@ -413,14 +426,7 @@ def test_a_finished_session_on_a_rig_with_devices_says_what_is_known_of_the_ligh
     """A finished run had said nothing of the lights (only a stop or an error did): the user
     took the object out not told whether the dome had acknowledged its all-off. It now says
     what the teardown established, in the words a stop uses, and no more."""
-    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / config
-    r = runner.invoke(
-        app,
-        ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "4", "--no-verdict"],
-        terminal_width=400,
-    )
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    said = _finished_run(tmp_path, config)
     tail = said[said.index("Session time on the real rig") :]
     assert sentence in tail, said
     if "never acknowledges" in sentence:
@@ -430,12 +436,5 @@ def test_a_finished_session_on_a_rig_with_devices_says_what_is_known_of_the_ligh
 def test_a_dry_run_of_a_simulated_dome_claims_nothing_of_lights_it_does_not_have(
     tmp_path: Path,
 ) -> None:
-    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
-    r = runner.invoke(
-        app,
-        ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "4", "--no-verdict"],
-        terminal_width=400,
-    )
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    said = _finished_run(tmp_path, "simulated_dome.toml")
     assert "lights are off" not in said and "switched off" not in said, said

@@ -888,3 +888,26 @@ def test_a_port_that_comes_back_to_a_silent_board_is_not_said_never_to_have_come
     msg = str(info.value)
     assert "its port came back but the board did not answer its handshake after 1 " in msg, msg
     assert "reconnection attempt (" in msg and "did not come back" not in msg, msg
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+def test_a_reconnection_mid_session_resends_a_handshake_whose_reply_was_lost(profile):
+    """The reopened port's handshake is resent as a connect's is (the board's banner came
+    through): one lost reply had cost the whole reconnection attempt, here the only one."""
+    dome, fw, _clock = make(
+        profile,
+        [
+            Fault(LIGHT_1, FaultKind.DISCONNECT, delay_s=0.5),
+            Fault(LIGHT_1 + 1, FaultKind.DROP_REPLY),
+        ],
+        reconnect_attempts=1,
+    )
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    dome.light(1, 1.0)
+    assert fw.lit is not None and fw.lit[0] == 1
+    assert dome.stats.reconnects == 1
+    assert "handshake: timeout" in dome.stats.recovered, dome.stats.recovered
+    dome.all_off()
+    assert fw.lit is None
