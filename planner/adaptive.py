@@ -161,6 +161,10 @@ class Decision:
     #: the next decision keeps as its incumbent); the evidence records the floor the band
     #: really applied and its ceiling (:func:`applied_floor`), never a floor below the band
     band: tuple[float, float] | None = None
+    #: the floor the evidence names the design by where the floors' designs were grouped
+    #: (:func:`_merged_floors`: one layout offered under several floors); None: as the band
+    #: applied it
+    design_label: float | None = None
 
     def evidence(self) -> dict[str, object]:
         out: dict[str, object] = {
@@ -175,7 +179,11 @@ class Decision:
         if self.design_floor == FITTED_KEY:  # not a floor (FITTED_DESIGN)
             out["design"] = "fitted"
         elif self.design_floor is not None:
-            out["design_floor_deg"] = applied_floor(self.design_floor, self.band)
+            out["design_floor_deg"] = (
+                self.design_label
+                if self.design_label is not None
+                else applied_floor(self.design_floor, self.band)
+            )
             if _ceiling(self.band) is not None:
                 out["design_ceiling_deg"] = _ceiling(self.band)
         if self.objective is not None:
@@ -454,27 +462,94 @@ def _ceiling(band: tuple[float, float] | None) -> float | None:
 
 
 def _merged_floors(
-    floors: tuple[float, ...], band: tuple[float, float] | None
+    floors: tuple[float, ...],
+    band: tuple[float, float] | None,
+    lowest_deg: float | None = None,
 ) -> dict[float, list[float]]:
-    """The floors (keys of the designs) grouped by :func:`applied_floor`: the floors of each
-    group are one design in ``band`` (the fitted key on its own)."""
-    groups: dict[float, list[float]] = {}
+    """The floors (keys of the designs) that are one layout, grouped under the floor the
+    evidence names them by: floors the band applies alike (:func:`applied_floor`), and floors
+    at or below ``lowest_deg``, the elevation of the rig's lowest candidate light — every
+    candidate is above each of them, so :func:`homogeneous_completion` makes them one layout
+    (on a dome whose lowest LEDs are at 10° the designs above 0° and 10°, which the evidence
+    had listed twice with equal scores). A group is named by its highest applied floor: every
+    light of the layout lies above it. The fitted key stays on its own.
+
+    Floors whose designs merely *happen* to be the same lights late in a session (one light
+    left, the same for every floor) stay apart: they are different designs that agree on what
+    is left, and the session's own design keeps its name."""
+    low = "below the lowest light"
+    members: dict[object, list[float]] = {}
     for f in sorted(floors):
-        groups.setdefault(applied_floor(f, band), []).append(f)
-    return groups
+        if f == FITTED_KEY:
+            key: object = f
+        elif lowest_deg is not None and f <= lowest_deg + 1e-9:
+            key = low
+        else:
+            key = applied_floor(f, band)
+        members.setdefault(key, []).append(f)
+    # the candidates are cut to the band, so a floor above the lowest light applies above the
+    # band's floor too: the labels of the groups are distinct
+    return {
+        (f if f == FITTED_KEY else max(applied_floor(g, band) for g in group)): group
+        for group in members.values()
+        for f in group[:1]
+    }
+
+
+def _lowest_deg(candidates: NDArray[np.float64]) -> float | None:
+    """The elevation (°) of the lowest candidate light (None: no candidate)."""
+    if len(candidates) == 0:
+        return None
+    return float(np.degrees(np.arcsin(np.clip(np.min(candidates[:, 2]), -1.0, 1.0))))
+
+
+def _same_lights(a: NDArray[np.intp] | None, b: NDArray[np.intp] | None) -> bool:
+    """Whether two designs are the same lights (in any order)."""
+    if a is None or b is None:
+        return False
+    return bool(np.array_equal(np.sort(a), np.sort(b)))
+
+
+def _label_of(
+    f: float, band: tuple[float, float] | None, groups: dict[float, list[float]]
+) -> float:
+    """The floor the evidence names design ``f`` by (its group's, :func:`_merged_floors`)."""
+    for label, group in groups.items():
+        if f in group:
+            return label
+    return applied_floor(f, band)
 
 
 def _recorded_scores(
-    scores: dict[float, Any], band: tuple[float, float] | None, best: float
+    scores: dict[float, Any], groups: dict[float, list[float]], best: float
 ) -> dict[str, Any]:
-    """The designs' scores as the evidence records them: one entry per design, keyed by the
-    floor the band applied (:func:`applied_floor`), so that designs which are one layout in the
-    band are named once (they score alike: the same lights; the taken design's own score where
-    it is among them)."""
+    """The designs' scores as the evidence records them: one entry per layout, keyed by the
+    floor it is named by (:func:`_merged_floors`), so that designs which are one layout are
+    named once (they score alike: the same lights; the taken design's own score where it is
+    among them)."""
     out: dict[str, Any] = {}
-    for a, group in _merged_floors(tuple(scores), band).items():
+    for a, group in groups.items():
         out[_label(a)] = scores[best] if best in group else scores[group[0]]
     return out
+
+
+def _scored_once(
+    designs: dict[float, NDArray[np.intp]], score: Callable[[list[NDArray[np.intp]]], list[Any]]
+) -> dict[float, Any]:
+    """``score`` (a list of designs → their scores) run on each distinct layout once, its
+    score given to every key whose design is that layout: two floors whose designs are the
+    same lights would be simulated alike (each light's noise is seeded from its direction),
+    so the second simulation was time spent on nothing."""
+    first: list[float] = []
+    alias: dict[float, float] = {}
+    for f, c in designs.items():
+        twin = next((g for g in first if _same_lights(designs[g], c)), None)
+        if twin is None:
+            first.append(f)
+            twin = f
+        alias[f] = twin
+    got = dict(zip(first, score([designs[f] for f in first]), strict=True))
+    return {f: got[alias[f]] for f in designs}
 
 
 def design_error_deg(
@@ -683,16 +758,25 @@ def choose_in_design(
         fitted = _fitted_relight(model, state, candidates, available, designs, n_total)
         if fitted is not None:
             designs[FITTED_KEY] = fitted
-        full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
         held, shared = shared_held_out(candidates, available, list(designs.values()))
-        psnr = simulate_relight_designs(model, full, held, relight, relight_basis(n_total))
+        held_of = {id(c): h for c, h in zip(designs.values(), held, strict=True)}
+        psnr = _scored_once(
+            designs,
+            lambda ds: simulate_relight_designs(
+                model,
+                [np.concatenate([state.lights, candidates[c]]) for c in ds],
+                [held_of[id(c)] for c in ds],
+                relight,
+                relight_basis(n_total),
+            ),
+        )
         return _relight_decision(
             state,
             candidates,
             available,
             n_total,
             designs,
-            dict(zip(designs, psnr, strict=True)),
+            psnr,
             {f for f, h in zip(designs, held, strict=True) if len(h) == 0},
             default_floor if incumbent is None or incumbent not in designs else incumbent,
             now,
@@ -710,8 +794,12 @@ def choose_in_design(
         )
     if model is not None and designs:  # bias-aware: each design simulated on this object
         assert fit is not None
-        full = [np.concatenate([state.lights, candidates[c]]) for c in designs.values()]
-        scores = dict(zip(designs, simulate_designs(model, full, fit), strict=True))
+        scores = _scored_once(
+            designs,
+            lambda ds: simulate_designs(
+                model, [np.concatenate([state.lights, candidates[c]]) for c in ds], fit
+            ),
+        )
     if model is not None:
         margin = SIM_MARGIN if margin is None else margin
     if not designs:
@@ -738,7 +826,8 @@ def choose_in_design(
         scale=scale,
         keep=keep,
     )
-    design = {k: round(v, 4) for k, v in _recorded_scores(scores, band, best).items()}
+    groups = _merged_floors(tuple(scores), band, _lowest_deg(candidates))
+    design = {k: round(v, 4) for k, v in _recorded_scores(scores, groups, best).items()}
     if model is None:  # the bound's scores are estimates already (scaled)
         after = f"bound: {scores[best]:.3g}° estimated after all {n_total}"
     elif model.noise_slope == 0.0:  # the scores rank; scaled, the estimate --until-error uses
@@ -758,12 +847,13 @@ def choose_in_design(
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"{_design_name(best, n_total, band, tuple(scores))} ({after}; {_by_floor(band)}: "
+        f"{_design_name(best, n_total, band, groups)} ({after}; {_by_floor(band)}: "
         f"{design}); within it, the largest predicted drop per second ({k} captured)",
         design_floor=best,
         objective="normals",
         design_scores=design,
         band=band,
+        design_label=_label_of(best, band, groups),
     )
 
 
@@ -793,7 +883,7 @@ def _design_name(
     f: float,
     n_total: int,
     band: tuple[float, float] | None = None,
-    floors: tuple[float, ...] = (),
+    groups: dict[float, list[float]] | None = None,
     objective: str = "normals",
 ) -> str:
     """A design's name in a decision's reason: the fitted design by what it minimises (for
@@ -804,22 +894,25 @@ def _design_name(
                 f"design of {n_total} lights of least expected relighting error on the fitted model"
             )
         return f"design of {n_total} lights of least expected error on the fitted surface"
-    return f"homogeneous design of {n_total} lights {_floor_words(f, band, floors)}"
+    return f"homogeneous design of {n_total} lights {_floor_words(f, band, groups or {})}"
 
 
-def _floor_words(f: float, band: tuple[float, float] | None, floors: tuple[float, ...]) -> str:
+def _floor_words(
+    f: float, band: tuple[float, float] | None, groups: dict[float, list[float]]
+) -> str:
     """Where the design of floor ``f`` lies in ``band``: ``above 20°``, or ``between 30° and
     45°`` under a ceiling; where the band's floor is what bounds it, said so, with the floors
-    (of ``floors``, every design offered) whose designs are this one layout."""
-    a, top = applied_floor(f, band), _ceiling(band)
+    whose designs are this one layout (``groups``, :func:`_merged_floors`)."""
+    a, top = _label_of(f, band, groups), _ceiling(band)
     words = f"between {a:g}° and {top:g}°" if top is not None else f"above {a:g}°"
     why = []
     if band is not None and a > 0.0 and a == float(band[0]):
         why.append("the band's floor")
-    same = _merged_floors(floors, band).get(a, [f])
+    same = groups.get(a, [f])
     if len(same) > 1:
         named = ", ".join(f"{g:g}°" for g in same[:-1]) + f" and {same[-1]:g}°"
-        why.append(f"the designs above {named} are this one layout in the band")
+        where = " in the band" if band is not None and a == float(band[0]) else ""
+        why.append(f"the designs above {named} are this one layout{where}")
     return words + (f" ({'; '.join(why)})" if why else "")
 
 
@@ -907,7 +1000,8 @@ def _relight_decision(
     mask[designs[best]] = True
     d = choose_next(state, candidates, mask & available, **choose)
     recorded = {f: None if f in unjudged else round(v, 3) for f, v in psnr.items()}
-    by_floor: dict[str, float | None] = _recorded_scores(recorded, band, best)
+    groups = _merged_floors(tuple(psnr), band, _lowest_deg(candidates))
+    by_floor: dict[str, float | None] = _recorded_scores(recorded, groups, best)
     judged = (
         "no light of the rig is left out of it, so there is nothing to judge its relighting on"
         if best in unjudged
@@ -919,13 +1013,14 @@ def _relight_decision(
         now,
         d.predicted_error_deg,
         d.runner_up,
-        f"{_design_name(best, n_total, band, tuple(psnr), 'relight')} ({judged}; "
+        f"{_design_name(best, n_total, band, groups, 'relight')} ({judged}; "
         f"{_by_floor(band)}: {by_floor}); within it, the largest predicted drop of the normal "
         f"error per second ({len(state.lights)} captured)",
         design_floor=best,
         objective="relight",
         design_scores=by_floor,
         band=band,
+        design_label=_label_of(best, band, groups),
     )
 
 

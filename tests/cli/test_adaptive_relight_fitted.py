@@ -41,7 +41,8 @@ def test_a_relight_session_on_the_shipped_dome_scores_the_fitted_design(tmp_path
     assert len(adaptive) == 2
     for d in adaptive:
         scores = d["design_psnr_db"]
-        assert set(scores) == {"0", "10", "20", "30", "fitted"}
+        # the designs above 0° and 10° are one layout on this dome (its lowest LEDs at 10°)
+        assert set(scores) == {"10", "20", "30", "fitted"}
         assert 5.0 < scores["fitted"] < 100.0
 
 

@@ -187,13 +187,16 @@ def test_within_a_band_each_design_is_named_by_the_floor_the_band_applied() -> N
             st, cand, available, 9, default_floor=10.0, margin=margin, band=(20.0, 45.0)
         )
         assert (named.candidate, named.design_floor) == (plain.candidate, plain.design_floor)
-        assert set(plain.evidence()["design_error_deg"]) == {"0", "10", "20", "30"}
+        # without the band's words the same lights are still one layout (their designs are
+        # the same lights: :func:`_merged_floors`), named by its highest floor
+        assert set(plain.evidence()["design_error_deg"]) == {"20", "30"}
         ev = named.evidence()
         assert set(ev["design_error_deg"]) == {"20", "30"}  # one entry per layout
         assert ev["design_floor_deg"] == max(plain.design_floor, 20.0)
+        assert plain.evidence()["design_floor_deg"] == ev["design_floor_deg"]
         assert ev["design_ceiling_deg"] == 45.0
         assert ev["design_error_deg"][f"{ev['design_floor_deg']:g}"] == pytest.approx(
-            plain.evidence()["design_error_deg"][f"{plain.design_floor:g}"]
+            plain.evidence()["design_error_deg"][f"{plain.evidence()['design_floor_deg']:g}"]
         )
         assert f"between {ev['design_floor_deg']:g}° and 45°" in named.reason
         assert "by floor, each up to the 45° ceiling" in named.reason

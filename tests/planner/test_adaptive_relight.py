@@ -243,3 +243,53 @@ def test_a_lobe_no_camera_could_show_is_relit_as_a_camera_records_it(
     assert min(clipped) > 10.0 and max(brightest) <= 1.0
     monkeypatch.setattr(adaptive_relight, "SATURATION", None)
     assert min(simulate_relight_designs(model, full, held, relight_fit, "ptm")) < 0.0
+
+
+@pytest.mark.parametrize("objective", ["normals", "relight"])
+def test_designs_that_are_the_same_lights_are_simulated_and_listed_once(
+    objective: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On a dome whose lowest lights are at 10° (the shipped simulated dome's are), the
+    designs above 0° and 10° are the same lights: each decision simulated that layout twice
+    and listed it twice in the evidence with equal scores ("0" and "10"). Each distinct layout
+    is now simulated once and listed once, named by the floor all its lights lie above; the
+    choice is the one the duplicate-scoring build made (the same scores, the same ties)."""
+    import rti_rig.planner.adaptive as adaptive
+    import rti_rig.planner.adaptive_relight as adaptive_relight
+
+    monkeypatch.setattr(adaptive, "FITTED_DESIGN", False)
+    monkeypatch.setattr(adaptive_relight, "RELIGHT_FITTED_DESIGN", False)
+    cand = fibonacci_cap(120, 10.0, 90.0)  # no light below 10°
+    avail = np.ones(len(cand), dtype=bool)
+    comps = {f: homogeneous_completion(cand, avail, np.zeros((0, 3)), 9, f) for f in DESIGN_FLOORS}
+    assert np.array_equal(comps[0.0], comps[10.0]) and not np.array_equal(comps[10], comps[20])
+    seen: list[int] = []
+    inner = (
+        adaptive.simulate_designs if objective == "normals" else adaptive.simulate_relight_designs
+    )
+    name = "simulate_designs" if objective == "normals" else "simulate_relight_designs"
+
+    def counted(model, designs, *args, **kwargs):  # type: ignore[no-untyped-def]
+        seen.append(len(designs))
+        return inner(model, designs, *args, **kwargs)
+
+    monkeypatch.setattr(adaptive, name, counted)
+    kw = dict(fit=robust_fit, default_floor=0.0, objective=objective, relight=relight_fit)
+    d = choose_in_design(_state_of(grazing_shadow_object(0)), cand, avail, 9, **kw)
+    assert seen == [3]  # 0°/10° (one layout), 20°, 30°
+    ev = d.evidence()
+    scores = ev["design_error_deg" if objective == "normals" else "design_psnr_db"]
+    assert set(scores) == {"10", "20", "30"}
+    assert "0" not in scores
+    if d.design_floor in (0.0, 10.0):
+        assert ev["design_floor_deg"] == 10.0
+        assert "above 10° (the designs above 0° and 10° are this one layout)" in d.reason
+    # the duplicate-scoring build's choice: every design simulated as it was
+    monkeypatch.setattr(adaptive, name, inner)
+    monkeypatch.setattr(
+        adaptive,
+        "_scored_once",
+        lambda ds, score: dict(zip(ds, score(list(ds.values())), strict=True)),
+    )
+    old = choose_in_design(_state_of(grazing_shadow_object(0)), cand, avail, 9, **kw)
+    assert (old.candidate, old.design_floor) == (d.candidate, d.design_floor)
