@@ -10,6 +10,7 @@ import contextlib
 import hashlib
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -219,6 +220,30 @@ def read_jpeg_rgb(path: Path) -> NDArray[np.uint8]:
     return img[..., ::-1] if img.ndim == 3 else img
 
 
+def tiff_is_planar(page: Any) -> bool:
+    """Whether a TIFF page stores its colour samples as separate planes (PlanarConfiguration
+    2, Photoshop's "Per Channel" pixel order), which tifffile returns samples first."""
+    return int(page.planarconfig) == 2 and int(page.samplesperpixel) > 1
+
+
+def tiff_samples_last(pixels: NDArray[Any], planar: bool) -> NDArray[Any]:
+    """A TIFF's pixels as (H, W) or (H, W, samples) whatever its planar configuration: a
+    planar RGB TIFF decodes to (3, H, W), which had been taken for an image 3 pixels high
+    (the replay rig stopped at its first capture, the fit at its export)."""
+    if planar and pixels.ndim == 3:
+        return np.ascontiguousarray(np.moveaxis(pixels, 0, -1))
+    return pixels
+
+
+def colour_or_grey(pixels: NDArray[Any]) -> NDArray[Any]:
+    """(H, W, 3) colour or (H, W) grey from an RGB-ordered image with any extra samples: an
+    alpha channel (RGBA, or grey + alpha) carries no light and is dropped, as
+    :func:`header_layout` counts such images (3 samples or more: colour)."""
+    if pixels.ndim != 3 or pixels.shape[2] == 3:
+        return pixels
+    return pixels[..., :3] if pixels.shape[2] > 3 else pixels[..., 0]
+
+
 def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     """A recorded image as stored: 8-bit (JPEG, 8-bit PNG/TIFF) or 16-bit (TIFF, PNG), RGB
     order, shape (H, W) or (H, W, 3); refused with the file's name if it cannot be read."""
@@ -227,12 +252,13 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         import tifffile
 
         try:
-            img = tifffile.imread(p)
+            with tifffile.TiffFile(p) as tif:
+                img = tiff_samples_last(tif.asarray(), tiff_is_planar(tif.pages[0]))
         except Exception as exc:  # tifffile raises many kinds; the user needs the file's name
             raise SessionError(f"cannot read image {p}: {exc}") from None
         if img.dtype not in (np.uint8, np.uint16) or img.ndim not in (2, 3):
             raise SessionError(f"image {p}: {img.dtype} {img.shape} is not 8/16-bit grey or RGB")
-        return img[..., :3] if img.ndim == 3 else img
+        return colour_or_grey(img)
     import cv2
 
     if not p.is_file():  # said here, before OpenCV prints its own warning line about it

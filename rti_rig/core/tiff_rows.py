@@ -5,7 +5,9 @@ zlib-compressed in strips). A fit streams through bands of rows of all images; d
 frames would hold the acquisition in memory. :class:`TiffRows` reads only the rows asked for
 (uncompressed: straight from their byte offsets) or decodes only the strips that cover them
 (zlib: keeping the last strip, since bands rarely align with strips), and otherwise falls back
-to reading the image whole — correct for any TIFF, lean for the ones rti-rig writes.
+to reading the image whole — correct for any TIFF, lean for the ones rti-rig writes. Whatever
+the file's layout, the rows are (W, 3) colour or (W,) grey: planar TIFFs (Photoshop's "Per
+Channel" order) are interleaved and an alpha sample is dropped, as the replay rig reads them.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import tifffile
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import ImageFileError
+from rti_rig.core.image_files import colour_or_grey, tiff_is_planar, tiff_samples_last
 
 #: TIFF compression codes decoded strip by strip here: none, Adobe deflate, deflate.
 _STRIPPED = {1: "none", 8: "zlib", 32946: "zlib"}
@@ -43,7 +46,16 @@ class TiffRows:
     def _read_header(self) -> None:
         with tifffile.TiffFile(self.path) as tf:
             page = tf.pages[0]
-            self.shape: tuple[int, ...] = tuple(int(x) for x in page.shape)
+            stored = tuple(int(x) for x in page.shape)
+            self._planar = tiff_is_planar(page) and len(stored) == 3
+            if self._planar:  # separate planes: (samples, H, W) as stored
+                stored = (*stored[1:], stored[0])
+            #: colour or grey (an alpha sample dropped, planes interleaved): what a fit needs;
+            #: such a TIFF is read whole, as rows cannot be taken from it in place
+            self._reshaped = self._planar or (len(stored) == 3 and stored[2] != 3)
+            self.shape: tuple[int, ...] = stored
+            if len(stored) == 3 and stored[2] != 3:
+                self.shape = stored[:2] + ((3,) if stored[2] > 3 else ())
             self.dtype = np.dtype(page.dtype)
             self.ndim = len(self.shape)
             #: the first page's ImageDescription ("" when none): what the writer said the
@@ -54,6 +66,7 @@ class TiffRows:
                 comp in _STRIPPED
                 and int(page.predictor) == 1
                 and int(page.planarconfig) == 1
+                and not self._reshaped
                 and not page.is_tiled
                 and self.dtype.itemsize in (1, 2)
                 and tf.byteorder == "<"
@@ -127,7 +140,8 @@ class TiffRows:
         if not self._lean or not isinstance(key, slice):
             if self._full is None:
                 try:
-                    self._full = tifffile.imread(self.path)
+                    full = tiff_samples_last(tifffile.imread(self.path), self._planar)
+                    self._full = np.ascontiguousarray(colour_or_grey(full))
                 except MemoryError:
                     raise
                 except Exception as exc:  # damaged data, a codec this install lacks, …

@@ -278,3 +278,40 @@ def test_a_fit_records_its_own_warnings_not_the_process_s(
     said = json.loads((out / "fit.json").read_text(encoding="utf-8"))["warnings"]
     assert any("overflow while fitting" in w for w in said), said
     assert not any("unclosed file" in w or "deprecated" in w for w in said), said
+
+
+def _rgba(px: np.ndarray) -> np.ndarray:
+    return np.dstack([px, np.full(px.shape[:2], 65535, np.uint16)])
+
+
+@pytest.mark.parametrize("layout", ["planar tiff", "rgba tiff", "rgba png"])
+def test_planar_and_alpha_images_fit_exactly_like_the_session(
+    inputs: dict[str, Path], tmp_path: Path, layout: str
+) -> None:
+    """A planar TIFF (Photoshop's "Per Channel" order) decodes samples first, (3, H, W), and an
+    RGBA image has a fourth sample: both had gone through the whole fit to stop at its export
+    ("export needs grey or RGB coefficients, got (6, 1, 96, 112)"), and RGBA PNGs were read
+    alpha first. The alpha carries no light: dropped, as the replay rig drops it."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    entries = []
+    for e in read_lp(inputs["tiff"] / "lights.lp"):
+        stem = Path(e.name).stem
+        px = tifffile.imread(inputs["tiff"] / "linear" / f"{stem}.tif")
+        if layout == "planar tiff":
+            name = f"{stem}.tif"
+            tifffile.imwrite(
+                acq / name, np.moveaxis(px, -1, 0), photometric="rgb", planarconfig="separate"
+            )
+        elif layout == "rgba tiff":
+            name = f"{stem}.tif"
+            tifffile.imwrite(acq / name, _rgba(px), photometric="rgb", extrasamples=["unassalpha"])
+        else:
+            name = f"{stem}.png"
+            cv2.imwrite(str(acq / name), _rgba(px)[..., [2, 1, 0, 3]])
+        entries.append(LpEntry(name, e.direction))
+    write_lp(acq / "acquisition.lp", entries)
+    n_ref, a_ref = _fit(inputs["tiff"], tmp_path / "ref")
+    n_got, a_got = _fit(acq / "acquisition.lp", tmp_path / "out")
+    np.testing.assert_array_equal(n_got, n_ref)
+    np.testing.assert_array_equal(a_got, a_ref)

@@ -291,3 +291,37 @@ def test_an_rtibuilder_project_replays_and_fits_with_its_absolute_windows_names(
         app, ["run", str(lp), "--out", str(tmp_path / "p"), "--plan", str(plan), "--no-verdict"]
     )
     assert r.exit_code == 0, r.output
+
+
+@pytest.mark.parametrize("layout", ["planar", "rgba"])
+def test_replay_of_planar_or_alpha_tiffs_gives_their_rgb_pixels(
+    tmp_path: Path, layout: str
+) -> None:
+    """A planar TIFF (Photoshop's "Per Channel" order) had been read as (3, H, 3): the session
+    stopped at its first capture saying the first image was not the first image's size. An
+    alpha sample carries no light: the frame is the RGB pixels."""
+    import tifffile
+
+    rng = np.random.default_rng(3)
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    sources = []
+    lines = ["4"]
+    for i, (x, y, z) in enumerate([(0.5, 0, 0.866), (0, 0.5, 0.866), (-0.5, 0, 0.866), (0, 0, 1)]):
+        px = rng.integers(0, 65535, (24, 32, 3), dtype=np.uint16)
+        if layout == "planar":
+            stored, extra = np.moveaxis(px, -1, 0), {"planarconfig": "separate"}
+        else:
+            alpha = np.full((24, 32, 1), 65535, np.uint16)
+            stored, extra = np.concatenate([px, alpha], axis=2), {"extrasamples": ["unassalpha"]}
+        tifffile.imwrite(acq / f"img{i}.tif", stored, photometric="rgb", **extra)
+        sources.append(px)
+        lines.append(f"img{i}.tif {x} {y} {z}")
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    steps = _journal(out)
+    assert len(steps) == 4
+    for step in steps:
+        assert np.array_equal(read_linear_tiff(out / step["linear_image"]), sources[step["led"]])

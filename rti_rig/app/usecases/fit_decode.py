@@ -26,8 +26,9 @@ import numpy as np
 
 def imread_rgb(path: Path, into: np.ndarray | None = None) -> np.ndarray | None:
     """The image at ``path`` as OpenCV reads it unchanged (8- or 16-bit, grey or colour), with
-    3-channel images in RGB order; None when it cannot be decoded. Decoded into ``into`` when
-    that buffer has the image's shape and type (else into a new array)."""
+    colour images in RGB order and an alpha channel dropped; None when it cannot be decoded.
+    Decoded into ``into`` when that buffer has the image's shape and type (else into a new
+    array)."""
     img = imread_into(path, into) if into is not None else _imread(path)
     if img is None:
         return None
@@ -35,7 +36,10 @@ def imread_rgb(path: Path, into: np.ndarray | None = None) -> np.ndarray | None:
         # BGR to RGB in place: a reversed copy would hold each image twice while it is written
         return cv2.cvtColor(img, cv2.COLOR_BGR2RGB, dst=img)
     if img.ndim == 3:
-        return np.ascontiguousarray(img[..., ::-1])
+        # BGRA (or grey + alpha): the alpha sample carries no light and is dropped, as the
+        # replay rig reads such images (reversed whole, RGBA had become ARGB, four channels
+        # the fit only refused at its export)
+        return np.ascontiguousarray(img[..., 2::-1] if img.shape[2] >= 3 else img[..., 0])
     return img
 
 
