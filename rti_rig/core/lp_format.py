@@ -374,11 +374,13 @@ def parse_lp(
         # rounding noise is no news; vectors of length 3 may be lamp positions read as
         # directions, which is worth a line (they are normalised either way)
         lengths = [n for _, n in off_unit]
+        shortest, longest = f"{min(lengths):.3g}", f"{max(lengths):.3g}"
+        # one length when they all print alike: a file scaled by 3 had been told "length 3–3"
+        span = shortest if shortest == longest else f"{shortest}–{longest}"
         notes.append(
             f"{source}, line {off_unit[0][0]}"
             + (f" and {len(off_unit) - 1} more" if len(off_unit) > 1 else "")
-            + f": light vector length {min(lengths):.3g}"
-            + (f"–{max(lengths):.3g}" if len(off_unit) > 1 else "")
+            + f": light vector length {span}"
             + ", not 1; read as directions (normalised). If the file gives lamp positions "
             "rather than directions, they are only right for a distant lamp"
         )

@@ -421,3 +421,20 @@ def test_nul_bytes_are_refused_saying_why(tmp_path: Path) -> None:
     cut.write_bytes(b"2\na_1.jpg 0 0 1\na_2.jpg 0 0.6 0.8\n" + b"\x00" * 64)
     with pytest.raises(LpFormatError, match=r"cut\.lp, line 4: the line holds NUL bytes"):
         read_lp(cut)
+
+
+def test_vectors_all_of_one_length_are_told_that_length_not_a_range(tmp_path: Path) -> None:
+    """Positions written 3 units out (every line): the note had said "length 3–3"."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    lp = tmp_path / "lamps.lp"
+    lp.write_text("3\na_1.jpg 0 0 3\na_2.jpg 0 3 0.0001\na_3.jpg 3 0 0.0001\n")
+    r = CliRunner().invoke(
+        app, ["plan", "--rig", str(lp), "--lights", "3", "--out", str(tmp_path / "p.lp")]
+    )
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "line 2 and 2 more: light vector length 3, not 1" in text, text
+    assert "3–3" not in text
