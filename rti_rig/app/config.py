@@ -901,7 +901,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     """
     from rti_rig.core.errors import SessionError
     from rti_rig.core.image_files import header_layout, jpeg_truncation, read_image_any
-    from rti_rig.core.lp_format import image_paths, is_absolute_name
+    from rti_rig.core.lp_format import case_hint, image_paths, is_absolute_name
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -926,7 +926,8 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
                 "beside its folder"
                 if any(is_absolute_name(m) for m in missing)
                 else ""
-            ),
+            )
+            + case_hint([paths[m] for m in missing]),
         )
     damaged = [
         f"{e.name}: {why}" for e in entries if (why := jpeg_truncation(paths[e.name])) is not None

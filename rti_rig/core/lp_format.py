@@ -165,6 +165,45 @@ def image_paths(lp_path: Path, entries: Sequence[LpEntry]) -> list[Path]:
     return paths
 
 
+def case_hint(missing: Sequence[Path]) -> str:
+    """What to say of images not found whose folder holds a file of the same name in another
+    case (``image01.JPG`` listed, ``image01.jpg`` there): "" when none does.
+
+    Windows and macOS find such a file, so an `.lp` written there reads there; Linux tells
+    the two names apart (and a FAT card mounted with ``shortname=lower`` shows a camera's
+    ``IMG_0001.JPG`` as ``img_0001.jpg``). The file is not read in its place — which of two
+    names differing only in case is meant is not ours to guess — but named, since "missing"
+    of a file the user sees in the folder is no help."""
+    listings: dict[Path, dict[str, list[str]]] = {}
+    twins: list[str] = []
+    for path in missing:
+        folder = path.parent
+        if folder not in listings:
+            by_case: dict[str, list[str]] = {}
+            with contextlib.suppress(OSError):
+                for child in folder.iterdir():
+                    by_case.setdefault(child.name.casefold(), []).append(child.name)
+            listings[folder] = by_case
+        found = listings[folder].get(path.name.casefold(), [])
+        if found:
+            twins.append(f"{path.name} -> {found[0]}")
+    if not twins:
+        return ""
+    why = (
+        ": Windows and macOS ignore the case of file names, this system does not; rename the "
+        "files or correct the names in the .lp"
+    )
+    if len(missing) == 1:
+        return (
+            f"; {twins[0].split(' -> ')[1]} is there, the same name in other upper/lower case{why}"
+        )
+    more = f" and {len(twins) - 3} more" if len(twins) > 3 else ""
+    return (
+        f"; {len(twins)} of them differ only in upper/lower case from a file there "
+        f"({', '.join(twins[:3])}{more}){why}"
+    )
+
+
 def _check_name(name: str, source: str, lineno: int) -> None:
     """Reject relative names that would resolve outside the `.lp` file's own folder (an
     absolute name is a tool's path on its own machine: see :func:`image_path`)."""

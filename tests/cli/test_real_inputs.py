@@ -470,3 +470,23 @@ def test_check_of_a_recorded_acquisition_tests_no_lights_that_do_not_exist(
     assert r.exit_code == 2, r.output
     said = " ".join(r.output.split())
     assert "damaged JPEG" in said and first.name in said and "Traceback" not in r.output
+
+
+def test_image_names_differing_only_in_case_are_named_with_their_file(tmp_path: Path) -> None:
+    """An .lp written on Windows or macOS lists IMAGE01.JPG where the folder, copied to Linux,
+    holds image01.jpg: `run` and `fit` had said only "missing", of files the user sees there."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = (ACQ / "dirs.lp").read_text().splitlines()[1:7]
+    for line in lines:
+        shutil.copy(ACQ / line.split()[0], acq / line.split()[0])
+    upper = [line.replace(".jpg", ".JPG") for line in lines]
+    (acq / "dirs.lp").write_text("\r\n".join(["6", *upper]) + "\r\n")
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "6 of 6 image(s) missing" in said, said
+    assert "6 of them differ only in upper/lower case" in said
+    assert "image01.JPG -> image01.jpg" in said and "rename the files" in said
+    r = runner.invoke(app, ["fit", str(acq / "dirs.lp"), "--out", str(tmp_path / "f")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "image01.jpg is there, the same name in other" in said, said

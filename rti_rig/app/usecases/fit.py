@@ -36,7 +36,13 @@ from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, jpeg_truncation
-from rti_rig.core.lp_format import directions_of, image_file_name, image_paths, read_lp
+from rti_rig.core.lp_format import (
+    case_hint,
+    directions_of,
+    image_file_name,
+    image_paths,
+    read_lp,
+)
 from rti_rig.core.out_folders import ensure_writable_folder
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
@@ -104,7 +110,7 @@ def read_image(path: Path) -> Any:
     taken as sRGB and linearised on read). The lazy Dask stack reads its chunks through this,
     in the process that computes them."""
     if not path.is_file():
-        raise FitInputError(f"image {path} listed in the .lp is missing")
+        raise FitInputError(f"image {path} listed in the .lp is missing{case_hint([path])}")
     if path.suffix.lower() in (".tif", ".tiff"):
         rows = TiffRows(path)  # read a band at a time, never whole
         _check_tiff_type(path, rows)
@@ -183,7 +189,7 @@ def _open_frames(paths: list[Path], label: str) -> list[Any]:
         if not path.is_file():
             raise FitInputError(
                 f"image {path} listed in {label} is missing (an .lp's image names are read "
-                "relative to its own folder)"
+                f"relative to its own folder){case_hint([path])}"
             )
         if path.suffix.lower() in (".tif", ".tiff"):
             rows = TiffRows(path)
