@@ -927,7 +927,12 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
                 if any(is_absolute_name(m) for m in missing)
                 else ""
             )
-            + case_hint([paths[m] for m in missing]),
+            + (
+                case_hint([paths[m] for m in missing])
+                # what to do, as the damaged and unreadable images below are told
+                or "; copy them where their names point, or remove their lines from the .lp "
+                "to replay the others"
+            ),
         )
     damaged = [
         f"{e.name}: {why}" for e in entries if (why := jpeg_truncation(paths[e.name])) is not None

@@ -206,6 +206,8 @@ def test_an_acquisition_with_missing_images_is_refused_before_anything_runs(
     assert r.exit_code == 2
     text = " ".join(r.output.split())
     assert "1 of 18 image(s) missing" in text and "image05.jpg" in text
+    # and what to do, as for a damaged or unreadable image
+    assert "copy them where their names point, or remove their lines from the .lp" in text
     assert not (tmp_path / "s").exists()
 
 
