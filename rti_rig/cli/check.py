@@ -50,14 +50,21 @@ def stop_on_signals() -> Iterator[None]:
 
 @app.command()
 def check(
-    rig_config: Annotated[Path, typer.Argument(help="Rig config TOML to check.")],
+    rig_config: Annotated[
+        Path,
+        typer.Argument(
+            help="Rig config TOML to check, or a recorded acquisition's .lp (its images are "
+            "checked: present, undamaged, readable, of one size and kind)."
+        ),
+    ],
     intensity: Annotated[
         float, typer.Option("--intensity", help="LED drive level for the walk, in (0, 1].")
     ] = 0.2,
 ) -> None:
     """Self-test the rig: a dome lights each LED in turn and reports what answered; an arm
     visits poses spanning its band (checking where it really got to), flashes the lamp at each
-    and parks; then the camera is opened and released (no image taken)."""
+    and parks; then the camera is opened and released (no image taken). A recorded
+    acquisition's .lp (a replay rig) has no device: its images are checked instead."""
     from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
     from rti_rig.runtime.controller import EmergencyStop
 

@@ -26,7 +26,9 @@ def run(
     rig_config: Annotated[
         Path | None,
         typer.Argument(
-            help="Rig config TOML (see rig_configs/), e.g. rig_configs/simulated_dome.toml. "
+            help="Rig config TOML (see rig_configs/), e.g. rig_configs/simulated_dome.toml, "
+            "or a recorded acquisition's .lp with its images beside it, replayed as a rig "
+            "(docs/adaptive.md, 'The replay rig'). "
             "Optional with --resume (the session's own config is used)."
         ),
     ] = None,
@@ -635,7 +637,12 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
 @app.command()
 def preview(
     rig_config: Annotated[
-        Path, typer.Argument(help="Rig config TOML, e.g. rig_configs/simulated_dome.toml.")
+        Path,
+        typer.Argument(
+            help="Rig config TOML, e.g. rig_configs/simulated_dome.toml, or a recorded "
+            "acquisition's .lp with its images beside it (the preview is its image nearest "
+            "the light asked)."
+        ),
     ],
     out_dir: Annotated[
         Path, typer.Option("--out", help="New or empty folder to write the one-image session.")

@@ -64,3 +64,13 @@ def test_paragraphs_stay_apart() -> None:
     assert reflowed("One line\n    and its end.\n\nA second\nparagraph.") == (
         "One line and its end.\n\nA second paragraph."
     )
+
+
+@pytest.mark.parametrize("command", ["run", "check", "preview"])
+def test_commands_taking_a_rig_say_a_recorded_acquisitions_lp_is_one(command: str) -> None:
+    """`run`, `check` and `preview` take an acquisition's .lp as a rig (the replay rig), but
+    their help had said only "Rig config TOML" (and `check`'s that a dome lights its LEDs)."""
+    r = runner.invoke(app, [command, "--help"], terminal_width=200)
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.replace("│", " ").split())
+    assert "or a recorded acquisition's .lp" in text, text
