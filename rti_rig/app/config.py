@@ -551,6 +551,18 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     path = Path(path)
     if path.suffix.lower() == ".lp":
         return load_replay_rig(path)
+    if path.is_dir():  # an acquisition's folder, given for its .lp: say which file to give
+        lps = sorted(p.name for p in path.glob("*") if p.suffix.lower() == ".lp")
+        raise ConfigError(
+            path,
+            None,
+            "is a folder: give a rig config (.toml) or a recorded acquisition's .lp"
+            + (
+                f" (this folder holds {', '.join(lps[:3])}{' ...' if len(lps) > 3 else ''})"
+                if lps
+                else ""
+            ),
+        )
     try:
         raw_bytes = path.read_bytes()
     except OSError as exc:

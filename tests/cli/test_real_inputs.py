@@ -490,3 +490,13 @@ def test_image_names_differing_only_in_case_are_named_with_their_file(tmp_path: 
     r = runner.invoke(app, ["fit", str(acq / "dirs.lp"), "--out", str(tmp_path / "f")])
     said = " ".join(r.output.split())
     assert r.exit_code == 2 and "image01.jpg is there, the same name in other" in said, said
+
+
+def test_an_acquisitions_folder_given_as_the_rig_names_its_lp(tmp_path: Path) -> None:
+    """`rti-rig run ACQ --out S` (the folder, not its .lp) had said "cannot read the file: Is
+    a directory"."""
+    r = runner.invoke(app, ["run", str(ACQ), "--out", str(tmp_path / "s")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "is a folder: give a rig config (.toml) or a recorded acquisition's .lp" in said
+    assert "(this folder holds dirs.lp)" in said and "Traceback" not in r.output
