@@ -327,3 +327,21 @@ def test_replay_of_planar_or_alpha_tiffs_gives_their_rgb_pixels(
     assert len(steps) == 4
     for step in steps:
         assert np.array_equal(read_linear_tiff(out / step["linear_image"]), sources[step["led"]])
+
+
+def test_a_resume_whose_acquisition_moved_asks_for_its_lp_not_a_toml(tmp_path: Path) -> None:
+    """The replayed acquisition moved after the session: the resume had asked for
+    "rti-rig run RIG.toml --resume S", a rig config the user never had."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    out = tmp_path / "s"
+    r = runner.invoke(
+        app, ["run", str(acq / "dirs.lp"), "--out", str(out), "--lights", "3", "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output
+    acq.rename(tmp_path / "moved")
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "the recorded acquisition it replayed" in said and "is not there any more" in said
+    assert f"give it: rti-rig run ACQ/dirs.lp --resume {out}" in said and "RIG.toml" not in said

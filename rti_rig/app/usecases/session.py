@@ -644,11 +644,15 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         )
     config_path = req.rig_config or Path(rig_entry["config_path"])
     if req.rig_config is None and not config_path.is_file():
+        # a replay rig is an acquisition's .lp, moved with its images: ask for that, not a TOML
+        replay = config_path.suffix.lower() == ".lp"
+        what = "recorded acquisition it replayed" if replay else "rig config it was shot with"
+        give = f"ACQ/{config_path.name}" if replay else "RIG.toml"
         raise RtiRigError(
-            f"{req.session_dir}: the rig config it was shot with, {config_path}, is not there "
-            "any more (moved or renamed?); give it: rti-rig run RIG.toml --resume "
-            f"{req.session_dir} (the session's manifest keeps a copy of the config it began "
-            "with, and a resume checks the rig against it)"
+            f"{req.session_dir}: the {what}, {config_path}, is not there any more (moved or "
+            f"renamed?); give it: rti-rig run {give} --resume {req.session_dir} (the "
+            "session's manifest keeps a copy of the rig it began with, and a resume checks "
+            "the rig against it)"
         )
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
