@@ -912,7 +912,12 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     take.
     """
     from rti_rig.core.errors import SessionError
-    from rti_rig.core.image_files import header_layout, jpeg_truncation, read_image_any
+    from rti_rig.core.image_files import (
+        header_layout,
+        jpeg_truncation,
+        read_image_any,
+        tiff_sample_problem,
+    )
     from rti_rig.core.lp_format import case_hint, image_paths, is_absolute_name
 
     lp_path = Path(lp_path).resolve()
@@ -963,8 +968,13 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     # format), which is what a capture would do
     layouts: dict[str, tuple[int, int, bool]] = {}
     unreadable: list[str] = []
+    unsupported: list[str] = []
     for e in entries:
         path = paths[e.name]
+        problem = tiff_sample_problem(path)  # a float TIFF has a header like any other
+        if problem is not None:
+            unsupported.append(problem)
+            continue
         layout = header_layout(path)
         if layout is None:
             try:
@@ -981,6 +991,14 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             f"{len(unreadable)} of {len(entries)} image(s) beside it cannot be read "
             f"({'; '.join(unreadable[:5])}{' ...' if len(unreadable) > 5 else ''}); copy them "
             "again from the camera or card, or list only the others",
+        )
+    if unsupported:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{len(unsupported)} of {len(entries)} image(s) beside it hold pixels a replay "
+            f"cannot give as a frame ({'; '.join(unsupported[:3])}"
+            f"{' ...' if len(unsupported) > 3 else ''}), or list only the others",
         )
     height, width, colour = layouts[entries[0].name]
     odd = [f"{n} is {w}x{h}" for n, (h, w, _) in layouts.items() if (h, w) != (height, width)]

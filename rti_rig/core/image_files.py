@@ -244,6 +244,38 @@ def colour_or_grey(pixels: NDArray[Any]) -> NDArray[Any]:
     return pixels[..., :3] if pixels.shape[2] > 3 else pixels[..., 0]
 
 
+def _not_8_or_16_bit(path: Path, dtype: Any, shape: tuple[int, ...]) -> str:
+    return (
+        f"image {path}: {np.dtype(dtype)} {tuple(shape)} is not 8/16-bit grey or RGB; save it "
+        "again as an 8-bit (sRGB) or 16-bit (linear) TIFF of one image"
+    )
+
+
+def tiff_sample_problem(path: Path) -> str | None:
+    """Why :func:`read_image_any` would refuse a TIFF that reads — float or 32-bit samples (an
+    HDR export), a stack of pages — told from its header, without decoding the pixels; None
+    when it would read it, or when the file is no TIFF or is damaged (its decoder says why).
+
+    :func:`header_layout` gives such a file a size like any other: the replay rig's check
+    before a session had passed it ("undamaged and readable") and the session stopped at its
+    image part-way, telling the user to resume into the same stop."""
+    p = Path(path)
+    with open(p, "rb") as fh:
+        if fh.read(4) not in (b"II*\x00", b"MM\x00*"):
+            return None
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(p) as tif:
+            dtype = tif.pages[0].dtype
+            shape = tuple(int(n) for n in tif.series[0].shape)
+    except Exception:  # tifffile raises many kinds; the decoder names the problem later
+        return None
+    if dtype is None or (np.dtype(dtype) in (np.uint8, np.uint16) and len(shape) in (2, 3)):
+        return None
+    return _not_8_or_16_bit(p, dtype, shape)
+
+
 def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     """A recorded image as stored: 8-bit (JPEG, 8-bit PNG/TIFF) or 16-bit (TIFF, PNG), RGB
     order, shape (H, W) or (H, W, 3); refused with the file's name if it cannot be read."""
@@ -257,7 +289,7 @@ def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
         except Exception as exc:  # tifffile raises many kinds; the user needs the file's name
             raise SessionError(f"cannot read image {p}: {exc}") from None
         if img.dtype not in (np.uint8, np.uint16) or img.ndim not in (2, 3):
-            raise SessionError(f"image {p}: {img.dtype} {img.shape} is not 8/16-bit grey or RGB")
+            raise SessionError(_not_8_or_16_bit(p, img.dtype, img.shape))
         return colour_or_grey(img)
     import cv2
 

@@ -345,3 +345,38 @@ def test_a_resume_whose_acquisition_moved_asks_for_its_lp_not_a_toml(tmp_path: P
     assert r.exit_code == 2, said
     assert "the recorded acquisition it replayed" in said and "is not there any more" in said
     assert f"give it: rti-rig run ACQ/dirs.lp --resume {out}" in said and "RIG.toml" not in said
+
+
+@pytest.mark.parametrize("kind", ["float", "stack"])
+def test_a_tiff_a_replay_cannot_give_is_refused_before_anything_runs(
+    tmp_path: Path, kind: str
+) -> None:
+    """A float TIFF (an HDR export) or a stack of pages has a header like any other: `check`
+    had passed it ("undamaged and readable") and `run` stopped at it part-way, telling the user
+    to resume into the same stop."""
+    import tifffile
+
+    rng = np.random.default_rng(5)
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = ["4"]
+    for i, (x, y, z) in enumerate([(0.5, 0, 0.866), (0, 0.5, 0.866), (-0.5, 0, 0.866), (0, 0, 1)]):
+        px = rng.integers(0, 65535, (24, 32, 3), dtype=np.uint16)
+        if i == 2:  # the third image only: the session would have captured two
+            odd = px.astype(np.float32) / 65535 if kind == "float" else np.stack([px, px])
+            tifffile.imwrite(acq / f"img{i}.tif", odd, photometric="rgb")
+        else:
+            tifffile.imwrite(acq / f"img{i}.tif", px, photometric="rgb")
+        lines.append(f"img{i}.tif {x} {y} {z}")
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
+    for args in (
+        ["check", str(acq / "dirs.lp")],
+        ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")],
+    ):
+        r = runner.invoke(app, args)
+        said = " ".join(r.output.split())
+        assert r.exit_code == 2, said
+        assert "1 of 4 image(s) beside it hold pixels a replay cannot give" in said, said
+        assert "img2.tif" in said and "is not 8/16-bit grey or RGB; save it again as" in said
+        assert "PASS" not in said and "Traceback" not in r.output
+    assert not (tmp_path / "s").exists()
