@@ -914,7 +914,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     from rti_rig.core.errors import SessionError
     from rti_rig.core.image_files import (
         header_layout,
-        jpeg_truncation,
+        image_truncation,
         read_image_any,
         tiff_sample_problem,
     )
@@ -951,14 +951,19 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
                 "to replay the others"
             ),
         )
-    damaged = [
-        f"{e.name}: {why}" for e in entries if (why := jpeg_truncation(paths[e.name])) is not None
-    ]
-    if damaged:  # OpenCV would decode them with their missing part grey, and say nothing
+    why_cut = {e.name: image_truncation(paths[e.name]) for e in entries}
+    damaged = [f"{name}: {why}" for name, why in why_cut.items() if why is not None]
+    if damaged:  # OpenCV would decode a JPEG with its missing part grey, and say nothing
+        jpegs = all(
+            paths[name].suffix.lower() in (".jpg", ".jpeg")
+            for name, why in why_cut.items()
+            if why is not None
+        )
         raise ConfigError(
             lp_path,
             None,
-            f"{len(damaged)} of {len(entries)} image(s) beside it are damaged JPEGs "
+            f"{len(damaged)} of {len(entries)} image(s) beside it are damaged "
+            f"{'JPEGs' if jpegs else 'images'} "
             f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
             "from the camera or card",
         )

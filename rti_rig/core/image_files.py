@@ -158,6 +158,43 @@ def jpeg_truncation(path: Path) -> str | None:
     return "it ends inside its header (cut short)"
 
 
+#: The chunk every whole PNG ends with (length 0, type IEND, its CRC).
+_PNG_END = b"\x00\x00\x00\x00IEND\xaeB`\x82"
+
+
+def image_truncation(path: Path) -> str | None:
+    """Why the JPEG, PNG or TIFF at ``path`` is cut short, or None when it is whole (or of
+    another kind): read from its ends and header, without decoding the pixels.
+
+    A PNG or TIFF cut short by a full card or an interrupted copy keeps a whole header, so
+    :func:`header_layout` gives it a size; the replay rig's check before a session had passed
+    it ("undamaged and readable") and the session stopped at its image part-way. A whole PNG
+    ends with its IEND chunk; a whole TIFF holds every strip or tile its first page lists."""
+    p = Path(path)
+    with open(p, "rb") as fh:
+        head = fh.read(8)
+        if head.startswith(b"\x89PNG\r\n\x1a\n"):
+            size = fh.seek(0, os.SEEK_END)
+            fh.seek(max(0, size - 4096))
+            if b"IEND" not in fh.read():  # the last chunk; writers may pad after it
+                return "it ends before its IEND chunk (cut short)"
+            return None
+    if head[:4] in (b"II*\x00", b"MM\x00*"):
+        import tifffile
+
+        try:
+            with tifffile.TiffFile(p) as tif:
+                page = tif.pages[0]
+                ends = [o + n for o, n in zip(page.dataoffsets, page.databytecounts, strict=False)]
+                size = tif.filehandle.size
+        except Exception:  # tifffile raises many kinds; the decoder names the problem later
+            return None
+        if ends and max(ends) > size:
+            return f"its image data runs {max(ends) - size} bytes past its end (cut short)"
+        return None
+    return jpeg_truncation(p)
+
+
 def header_layout(path: Path) -> tuple[int, int, bool] | None:
     """(height, width, colour) from the file's header alone (JPEG frame header, PNG IHDR, TIFF
     first page), without decoding the pixels; ``colour`` as :func:`read_image_any` would

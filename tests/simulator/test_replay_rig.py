@@ -380,3 +380,41 @@ def test_a_tiff_a_replay_cannot_give_is_refused_before_anything_runs(
         assert "img2.tif" in said and "is not 8/16-bit grey or RGB; save it again as" in said
         assert "PASS" not in said and "Traceback" not in r.output
     assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("suffix", [".png", ".tif"])
+def test_a_png_or_tiff_cut_short_is_refused_before_anything_runs(
+    tmp_path: Path, suffix: str
+) -> None:
+    """A PNG or TIFF cut short (a full card, an interrupted copy) keeps a whole header: `check`
+    had said PASS ("undamaged and readable") and `run` stopped at it part-way, as it stops on a
+    cut-short JPEG no more."""
+    import cv2
+    import tifffile
+
+    rng = np.random.default_rng(7)
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = ["4"]
+    for i, (x, y, z) in enumerate([(0.5, 0, 0.866), (0, 0.5, 0.866), (-0.5, 0, 0.866), (0, 0, 1)]):
+        px = rng.integers(0, 65535, (24, 32, 3), dtype=np.uint16)
+        path = acq / f"img{i}{suffix}"
+        if suffix == ".png":
+            cv2.imwrite(str(path), px)
+        else:
+            tifffile.imwrite(path, px, photometric="rgb")
+        lines.append(f"{path.name} {x} {y} {z}")
+    victim = acq / f"img2{suffix}"
+    victim.write_bytes(victim.read_bytes()[:2000])
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
+    for args in (
+        ["check", str(acq / "dirs.lp")],
+        ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")],
+    ):
+        r = runner.invoke(app, args)
+        said = " ".join(r.output.split())
+        assert r.exit_code == 2, said
+        assert "1 of 4 image(s) beside it are damaged images" in said, said
+        assert f"img2{suffix}: " in said and "(cut short)" in said and "copy them again" in said
+        assert "PASS" not in said and "Traceback" not in r.output
+    assert not (tmp_path / "s").exists()
