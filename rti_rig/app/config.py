@@ -8,6 +8,7 @@ drives it; building devices from it happens in :mod:`rti_rig.app.compose` (the c
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import tomllib
@@ -546,6 +547,29 @@ def _with_led_map_path(data: dict[str, Any], folder: Path) -> dict[str, Any]:
     return {**data, "dome": {**dome, "serial": resolved}}  # type: ignore[dict-item]
 
 
+def _not_toml_hint(raw: bytes) -> str:
+    """What a file that is no TOML was given as a rig instead, where that can be told: an image
+    of an acquisition (``run ACQ/image01.jpg``), or an acquisition's light list saved under
+    another suffix (``lights.txt``), which a rig is read as only when it ends in ``.lp``.
+    Both had been told only the TOML parser's complaint ("codec can't decode byte 0xff",
+    "Expected '=' after a key")."""
+    if raw.startswith((b"\xff\xd8", b"\x89PNG", b"II*\x00", b"MM\x00*")):
+        return (
+            "; this is an image: give the rig config (.toml) or the recorded acquisition's .lp "
+            "that lists the images"
+        )
+    with contextlib.suppress(LpFormatError):
+        from rti_rig.core.lp_format import parse_lp
+
+        text = raw.decode("utf-8-sig", errors="replace")
+        if len(parse_lp(text)) >= 1:
+            return (
+                "; it reads as an .lp light list: a recorded acquisition is replayed from a "
+                "file named *.lp (rename or copy it to end in .lp)"
+            )
+    return ""
+
+
 def load_rig_config(path: Path | str) -> LoadedRig:
     """Read and validate a rig config TOML file (or an acquisition's `.lp`: a replay rig)."""
     path = Path(path)
@@ -570,7 +594,7 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     try:
         data = tomllib.loads(raw_bytes.decode("utf-8-sig"))  # a BOM (Notepad) is no error
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ConfigError(path, None, f"not valid TOML: {exc}") from None
+        raise ConfigError(path, None, f"not valid TOML: {exc}{_not_toml_hint(raw_bytes)}") from None
     data, settings, correction_bytes = _with_correction_file(data, path)
     settings = _with_led_map_path(settings, path.parent)
     config = parse_rig_config(settings, str(path))

@@ -500,3 +500,25 @@ def test_an_acquisitions_folder_given_as_the_rig_names_its_lp(tmp_path: Path) ->
     assert r.exit_code == 2, said
     assert "is a folder: give a rig config (.toml) or a recorded acquisition's .lp" in said
     assert "(this folder holds dirs.lp)" in said and "Traceback" not in r.output
+
+
+def test_an_image_or_a_light_list_named_txt_given_as_the_rig_says_what_it_is(
+    tmp_path: Path,
+) -> None:
+    """`run ACQ/image01.jpg` had said only "not valid TOML: 'utf-8' codec can't decode byte
+    0xff", and an acquisition's light list saved as lights.txt "Expected '=' after a key"."""
+    r = runner.invoke(app, ["run", str(ACQ / "image01.jpg"), "--out", str(tmp_path / "s")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "this is an image: give the rig config (.toml) or" in said, said
+    txt = tmp_path / "lights.txt"
+    shutil.copy(ACQ / "dirs.lp", txt)
+    r = runner.invoke(app, ["run", str(txt), "--out", str(tmp_path / "s")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "it reads as an .lp light list" in said, said
+    assert "rename or copy it to end in .lp" in said and not (tmp_path / "s").exists()
+    toml = tmp_path / "bad.toml"
+    toml.write_text('name = "x"\nkind =\n')
+    r = runner.invoke(app, ["check", str(toml)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and "not valid TOML" in said and "this is an image" not in said, said
+    assert ".lp light list" not in said
