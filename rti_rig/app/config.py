@@ -24,7 +24,12 @@ from rti_rig.app.flash_sync import FlashSyncSettings, SyncFaultConfig
 from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.lp_format import read_lp
-from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
+from rti_rig.core.rig_geometry import (
+    COINCIDENT_LED_DEG,
+    ArmGeometry,
+    DomeGeometry,
+    coincident_leds,
+)
 from rti_rig.drivers.dynamixel.settings import ArmSettings
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 
@@ -951,6 +956,20 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
         raise LpFormatError(lp_path, None, f"cannot read: {exc.strerror or exc}") from None
     notes: list[str] = []
     entries = read_lp(lp_path, upper_hemisphere=True, notes=notes)
+    pair = coincident_leds([e.direction for e in entries])
+    if pair is not None:
+        # said before the images are read, in a replay's words: the dome check below had
+        # said "key 'dome.lp_file'" (a key of a config the user never wrote) and "a dome's
+        # calibration lists each LED once"
+        i, j = pair
+        raise ConfigError(
+            lp_path,
+            None,
+            f"lights {i + 1} ({entries[i].name}) and {j + 1} ({entries[j].name}) share one "
+            f"direction (within {COINCIDENT_LED_DEG}°): a replay fires the acquisition's "
+            "lights by direction, each once; remove one of the two lines (its image is then "
+            "left out) to replay the others",
+        )
     paths = dict(zip((e.name for e in entries), image_paths(lp_path, entries), strict=True))
     missing = [e.name for e in entries if not paths[e.name].is_file()]
     if missing:

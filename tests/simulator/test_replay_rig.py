@@ -418,3 +418,20 @@ def test_a_png_or_tiff_cut_short_is_refused_before_anything_runs(
         assert f"img2{suffix}: " in said and "(cut short)" in said and "copy them again" in said
         assert "PASS" not in said and "Traceback" not in r.output
     assert not (tmp_path / "s").exists()
+
+
+def test_an_acquisition_repeating_a_light_is_refused_in_a_replays_words(tmp_path: Path) -> None:
+    """Two images shot under one light (a repeated reference shot): the refusal had named
+    "key 'dome.lp_file'", a key of a rig config the user never wrote."""
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    lines = (acq / "dirs.lp").read_text().splitlines()
+    shutil.copy(acq / "image01.jpg", acq / "image01b.jpg")
+    again = "image01b.jpg " + " ".join(lines[1].split()[1:])
+    (acq / "dirs.lp").write_text("\n".join([str(len(lines)), *lines[1:], again]) + "\n")
+    r = runner.invoke(app, ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "lights 1 (image01.jpg) and 19 (image01b.jpg) share one direction" in said, said
+    assert "remove one of the two lines" in said and "dome.lp_file" not in said
+    assert not (tmp_path / "s").exists()
