@@ -315,3 +315,28 @@ def test_planar_and_alpha_images_fit_exactly_like_the_session(
     n_got, a_got = _fit(acq / "acquisition.lp", tmp_path / "out")
     np.testing.assert_array_equal(n_got, n_ref)
     np.testing.assert_array_equal(a_got, a_ref)
+
+
+def test_a_png_cut_short_is_named_damaged_with_what_to_do(
+    inputs: dict[str, Path], tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A PNG cut short (a full card, an interrupted copy) had been told only "cannot read
+    image X", after libpng's own "Read Error" line."""
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    entries = []
+    for e in read_lp(inputs["tiff"] / "lights.lp"):
+        stem = Path(e.name).stem
+        px = tifffile.imread(inputs["tiff"] / "linear" / f"{stem}.tif")
+        cv2.imwrite(str(acq / f"{stem}.png"), px[..., ::-1])
+        entries.append(LpEntry(f"{stem}.png", e.direction))
+    write_lp(acq / "acquisition.lp", entries)
+    victim = acq / entries[2].name
+    victim.write_bytes(victim.read_bytes()[:3000])
+    capfd.readouterr()
+    r = runner.invoke(app, ["fit", str(acq / "acquisition.lp"), "--out", str(tmp_path / "o"), *FIT])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert f"{victim.name} is a damaged PNG: it ends before its IEND chunk (cut short)" in said
+    assert "copy it again from the camera or card" in said
+    assert "libpng" not in capfd.readouterr().err

@@ -35,7 +35,7 @@ from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, jpeg_truncation
+from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation
 from rti_rig.core.lp_format import (
     case_hint,
     directions_of,
@@ -155,14 +155,19 @@ def _decode(path: Path, into: np.ndarray | None = None) -> np.ndarray:
     if path.suffix.lower() in (".tif", ".tiff"):
         img = np.asarray(TiffRows(path)[:])
     else:
-        why = jpeg_truncation(path) if path.is_file() else None
-        if why is not None:  # OpenCV would decode it anyway, the missing part grey
+        why = image_truncation(path) if path.is_file() else None
+        if why is not None:  # OpenCV would decode a JPEG anyway, the missing part grey
+            # (a PNG cut short had been told only "cannot read image", after libpng's own line)
+            kind = "PNG" if path.suffix.lower() == ".png" else "JPEG"
             raise FitInputError(
-                f"image {path} is a damaged JPEG: {why}; copy it again from the camera or card"
+                f"image {path} is a damaged {kind}: {why}; copy it again from the camera or card"
             )
         decoded = imread_rgb(path, into)
         if decoded is None:
-            raise FitInputError(f"cannot read image {path}")
+            raise FitInputError(
+                f"cannot read image {path} (not a JPEG or PNG OpenCV decodes); save it again "
+                "as JPEG, PNG or TIFF, or leave it out of the .lp"
+            )
         img = decoded
     if img.dtype not in (np.uint8, np.uint16):
         raise FitInputError(f"{path}: expected 8- or 16-bit images, got {img.dtype}")
