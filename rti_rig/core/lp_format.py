@@ -219,11 +219,31 @@ def _check_name(name: str, source: str, lineno: int) -> None:
             )
 
 
-def _parse_float(token: str, source: str, lineno: int, axis: str) -> float:
+#: A spreadsheet's CSV export of a light list: fields split by ',' or ';' (with or without
+#: spaces after them), four or more of them on the line.
+_CSV_FIELDS = re.compile(r"\s*[,;]\s*|\s+")
+
+
+def _csv_hint(line: str) -> str:
+    """What to say of a line whose fields are split by ',' or ';' (Excel's "Save as CSV", in
+    locales whose decimal separator is ',' with ';'): "" for any other line. Such lines had
+    been refused as one field, or with "use '.' as the decimal separator" of a file whose
+    decimals were '.' already and whose commas split the fields."""
+    if not re.search(r"[,;]", line) or len([f for f in _CSV_FIELDS.split(line) if f]) < 4:
+        return ""
+    return (
+        " (fields separated by ',' or ';': a spreadsheet's CSV export? an .lp separates the "
+        "image name and x y z with spaces or tabs, and writes decimals with '.')"
+    )
+
+
+def _parse_float(token: str, source: str, lineno: int, axis: str, line: str = "") -> float:
     try:
         value = float(token)
     except ValueError:
-        hint = " (use '.' as the decimal separator)" if "," in token else ""
+        hint = _csv_hint(line) if token.endswith((",", ";")) or ";" in token else ""
+        if not hint and "," in token:
+            hint = " (use '.' as the decimal separator)"
         raise LpFormatError(
             source, lineno, f"{axis} component {token!r} is not a number{hint}"
         ) from None
@@ -337,7 +357,15 @@ def parse_lp(
             declared = int(first_tokens[0])
         except ValueError:
             raise LpFormatError(
-                source, first_no, f"count line {first!r} is not a whole number"
+                source,
+                first_no,
+                f"count line {first!r} is not a whole number"
+                + (
+                    " (a spreadsheet's column headings? an .lp has none: a count line, then "
+                    "'image-name x y z' per image, separated by spaces or tabs)"
+                    if _csv_hint(first)
+                    else ""
+                ),
             ) from None
         if declared <= 0:
             raise LpFormatError(source, first_no, f"count {declared} must be positive")
@@ -362,13 +390,13 @@ def parse_lp(
             raise LpFormatError(
                 source,
                 lineno,
-                f"expected 'name x y z', found {len(tokens)} field(s): {line!r}",
+                f"expected 'name x y z', found {len(tokens)} field(s): {line!r}" + _csv_hint(line),
             )
         # Like relight: the last three fields are the vector, the rest is the name.
         name = " ".join(tokens[:-3])
         _refuse_extra_columns(tokens, line, source, lineno)
         x, y, z = (
-            _parse_float(t, source, lineno, axis)
+            _parse_float(t, source, lineno, axis, line)
             for t, axis in zip(tokens[-3:], "xyz", strict=True)
         )
         norm = math.sqrt(x * x + y * y + z * z)

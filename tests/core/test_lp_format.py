@@ -438,3 +438,38 @@ def test_vectors_all_of_one_length_are_told_that_length_not_a_range(tmp_path: Pa
     text = " ".join(r.output.split())
     assert "line 2 and 2 more: light vector length 3, not 1" in text, text
     assert "3–3" not in text
+
+
+@pytest.mark.parametrize(
+    ("text", "says"),
+    [
+        ("3\nimg01.jpg,0.205,-0.237,0.949\n", "line 2: expected 'name x y z', found 1 field(s)"),
+        ("3\r\nimg01.jpg;0,205;-0,237;0,949\r\n", "line 2: expected 'name x y z', found 1"),
+        # '.' decimals, ', ' between fields: it had been told to use '.' as the decimal separator
+        ("3\nimg01.jpg, 0.205, -0.237, 0.949\n", "line 2: x component '0.205,' is not a number"),
+        ("name,x,y,z\nimg01.jpg,0.205,-0.237,0.949\n", "line 1: count line 'name,x,y,z'"),
+    ],
+)
+def test_a_spreadsheets_csv_export_is_refused_saying_so(
+    tmp_path: Path, text: str, says: str
+) -> None:
+    """Light lists edited in a spreadsheet and saved as CSV (',' or, where ',' is the decimal
+    separator, ';'): refused with the line and what an .lp separates its fields with."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    lp = tmp_path / "lights.lp"
+    lp.write_bytes(text.encode())
+    r = CliRunner().invoke(
+        app, ["plan", "--rig", str(lp), "--lights", "3", "--out", str(tmp_path / "p.lp")]
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2 and says in said, said
+    assert "spreadsheet" in said and "spaces or tabs" in said
+    assert "use '.' as the decimal separator" not in said
+
+
+def test_decimal_commas_between_spaces_still_get_the_decimal_hint() -> None:
+    with pytest.raises(LpFormatError, match=r"use '\.' as the decimal separator"):
+        parse_lp("1\nimg01.jpg 0,205 -0,237 0,949\n", "x.lp")
