@@ -522,3 +522,17 @@ def test_an_image_or_a_light_list_named_txt_given_as_the_rig_says_what_it_is(
     said = " ".join(r.output.split())
     assert r.exit_code == 2 and "not valid TOML" in said and "this is an image" not in said, said
     assert ".lp light list" not in said
+
+
+def test_too_many_lights_of_a_replay_in_a_band_are_counted_as_its_images(tmp_path: Path) -> None:
+    """With an elevation band it had said "the dome has only 8 LEDs at or above 50°
+    elevation" of an acquisition of images."""
+    r = runner.invoke(
+        app,
+        ["run", str(ACQ / "dirs.lp"), "--out", str(tmp_path / "s"), "--lights", "12",
+         "--min-elevation-deg", "50"],
+    )  # fmt: skip
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert "has only 8 images at or above 50° elevation; use --lights 8 or fewer" in text, text
+    assert "LEDs" not in text and not (tmp_path / "s").exists()

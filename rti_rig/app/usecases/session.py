@@ -467,11 +467,25 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     check_light_count(n)
     if (few := too_few_to_fit(n)) is not None:
         on_note(few)
-    if loaded.config.backend == "replay" and n > geometry.count:  # its "LEDs" are images
-        raise RtiRigError(
-            f"--lights {n}: the acquisition {loaded.path} has only {geometry.count} images; "
-            f"use --lights {geometry.count} or fewer"
-        )
+    if loaded.config.backend == "replay":  # its "LEDs" are images, in the band or not
+        # (with --min/--max-elevation-deg the planner's refusal had said "the dome has only
+        # 8 LEDs at or above 50° elevation" of an acquisition's images)
+        from rti_rig.core.geometry import az_el_from_direction
+        from rti_rig.planner.uniform import band_text
+
+        lo, hi = req.min_elevation_deg, req.max_elevation_deg
+        _, el = az_el_from_direction(geometry.directions)
+        inside = int(((el >= lo - 1e-9) & (el <= hi + 1e-9)).sum())
+        if n > inside:
+            band = band_text(lo, hi)
+            fewer = [f"use --lights {inside} or fewer"] if inside else []
+            if band:
+                fewer.append("widen --min-elevation-deg / --max-elevation-deg")
+            asked = f"--lights {n}" if req.lights is not None else f"{n} lights (every image)"
+            raise RtiRigError(
+                f"{asked}: the acquisition {loaded.path} has only {inside} images{band}; "
+                + " or ".join(fewer)
+            )
     return plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )
