@@ -32,8 +32,11 @@ def schedule_from_lp(
     if isinstance(geometry, ArmGeometry):
         for i, (e, d) in enumerate(zip(entries, dirs, strict=True)):
             reason = geometry.unreachable_reason(d)
-            if reason:
-                raise ScheduleError(f"{source}, light {i + 1} ({e.name}): {reason}")
+            if reason:  # what to do, as a dome's refusal says it (it had said only why)
+                raise ScheduleError(
+                    f"{source}, light {i + 1} ({e.name}): {reason}; the plan was made for "
+                    "another rig — replan with --rig for this arm"
+                )
         return LightSchedule.from_directions(
             dirs, labels=[e.name for e in entries], method="plan", provenance=prov
         )
