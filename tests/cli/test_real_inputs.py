@@ -536,3 +536,26 @@ def test_too_many_lights_of_a_replay_in_a_band_are_counted_as_its_images(tmp_pat
     assert r.exit_code == 2, text
     assert "has only 8 images at or above 50° elevation; use --lights 8 or fewer" in text, text
     assert "LEDs" not in text and not (tmp_path / "s").exists()
+
+
+def test_check_of_an_rtibuilder_project_says_where_its_images_were_found(
+    tmp_path: Path,
+) -> None:
+    """An RTIBuilder project keeps its .lp in assembly-files/ and its images in jpeg-exports/:
+    `check` had said they were "each present beside it"."""
+    project = tmp_path / "proj"
+    (project / "assembly-files").mkdir(parents=True)
+    (project / "jpeg-exports").mkdir()
+    lines = (ACQ / "dirs.lp").read_text().splitlines()[1:]
+    listed = []
+    for line in lines:
+        name, *xyz = line.split()
+        shutil.copy(ACQ / name, project / "jpeg-exports" / name)
+        listed.append(f"H:\\RTI_Data\\proj\\jpeg-exports\\{name} {' '.join(xyz)}")
+    lp = project / "assembly-files" / "proj.lp"
+    lp.write_text("\r\n".join([str(len(listed)), *listed]) + "\r\n")
+    r = runner.invoke(app, ["check", str(lp)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "images: 18 listed in proj.lp, each present in ../jpeg-exports (from the .lp's" in said
+    assert "beside it" not in said and said.endswith("RESULT: PASS")

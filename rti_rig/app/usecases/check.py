@@ -8,6 +8,7 @@ happens.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -124,18 +125,31 @@ class ReplayCheck:
     height: int
     lp_name: str
     notes: tuple[str, ...]
+    #: where the images were found: "beside it", or the folders, relative to the .lp's
+    where: str = "beside it"
 
     @classmethod
     def of(cls, loaded: Any) -> ReplayCheck:
         from rti_rig.app.config import dome_led_directions
+        from rti_rig.core.lp_format import image_paths, read_lp
 
         cam = loaded.config.camera
+        lp = Path(loaded.path)
+        # said as found: an RTIBuilder project's images are in ../jpeg-exports, a name may
+        # hold a folder; "each present beside it" had been said of those too
+        folders = sorted({p.parent for p in image_paths(lp, read_lp(lp, upper_hemisphere=True))})
+        where = "beside it"
+        if folders != [lp.parent]:
+            shown = [os.path.relpath(f, lp.parent) for f in folders[:3]]
+            more = " ..." if len(folders) > 3 else ""
+            where = f"in {', '.join(shown)}{more} (from the .lp's folder)"
         return cls(
             count=len(dome_led_directions(loaded)[0]),
             width=int(cam.width),
             height=int(cam.height),
-            lp_name=Path(loaded.path).name,
+            lp_name=lp.name,
             notes=tuple(loaded.notes),
+            where=where,
         )
 
     @property
@@ -145,7 +159,7 @@ class ReplayCheck:
     def lines(self) -> list[str]:
         return [
             "replay rig: a recorded acquisition, no device to light, move or open",
-            f"images: {self.count} listed in {self.lp_name}, each present beside it, "
+            f"images: {self.count} listed in {self.lp_name}, each present {self.where}, "
             f"undamaged and readable, all {self.width}x{self.height} of one kind",
             *(f"note: {n}" for n in self.notes),
             "RESULT: PASS",
