@@ -158,10 +158,6 @@ def jpeg_truncation(path: Path) -> str | None:
     return "it ends inside its header (cut short)"
 
 
-#: The chunk every whole PNG ends with (length 0, type IEND, its CRC).
-_PNG_END = b"\x00\x00\x00\x00IEND\xaeB`\x82"
-
-
 def image_truncation(path: Path) -> str | None:
     """Why the JPEG, PNG or TIFF at ``path`` is cut short, or None when it is whole (or of
     another kind): read from its ends and header, without decoding the pixels.
@@ -282,6 +278,7 @@ def colour_or_grey(pixels: NDArray[Any]) -> NDArray[Any]:
 
 
 def _not_8_or_16_bit(path: Path, dtype: Any, shape: tuple[int, ...]) -> str:
+    """The refusal of an image whose pixels no frame holds, with what to give instead."""
     return (
         f"image {path}: {np.dtype(dtype)} {tuple(shape)} is not 8/16-bit grey or RGB; save it "
         "again as an 8-bit (sRGB) or 16-bit (linear) TIFF of one image"
