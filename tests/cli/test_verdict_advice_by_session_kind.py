@@ -56,3 +56,21 @@ def test_a_planned_session_keeps_the_advice(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     text = said(r)
     assert "reshoot with less exposure" in text and "cannot reshoot" not in text
+
+
+@pytest.mark.parametrize("lights", [1, 2])
+def test_a_test_shot_of_too_few_lights_is_told_what_run_can_do(tmp_path: Path, lights: int) -> None:
+    """A session of 1 or 2 lights has no normal map to judge: the verdict's refusal had been
+    the fit's own, ending "choose a lower-order model", an option run does not have. It says
+    how many lights the verdict needs and the run option that gives them; the run succeeds."""
+    out = tmp_path / "s"
+    dome = CONFIGS / "simulated_dome.toml"
+    r = runner.invoke(app, ["run", str(dome), "--out", str(out), "--lights", str(lights)])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "lower-order model" not in text
+    assert (
+        f"QA verdict unavailable: the verdict's normal map needs at least 3 lights and this "
+        f"session has {lights}; run with --lights 3 or more" in text
+    )
+    assert len(list(out.glob("image_*.jpg"))) == lights

@@ -775,9 +775,24 @@ def _qa_row(c: ImageCheck) -> str:
     )
 
 
+#: The fewest lights the QA verdict is given for: its normal map is photometric stereo's, three
+#: coefficients per pixel.
+VERDICT_MIN_LIGHTS = 3
+
+
 def verdict_for_session(session: Path) -> str:
-    """The QA verdict line of a session folder (for ``rti-rig run``'s last line)."""
+    """The QA verdict line of a session folder (for ``rti-rig run``'s last line).
+
+    A session of fewer than :data:`VERDICT_MIN_LIGHTS` lights (a test shot of one or two) is
+    refused in the run's words: the fit's own refusal ended "choose a lower-order model", an
+    option ``run`` does not have."""
     frames, lights, names, _ = load_acquisition(session)
+    if len(lights) < VERDICT_MIN_LIGHTS:
+        raise RtiRigError(
+            f"the verdict's normal map needs at least {VERDICT_MIN_LIGHTS} lights and this "
+            f"session has {len(lights)}; run with --lights {VERDICT_MIN_LIGHTS} or more for "
+            "an RTI the verdict can judge (the images taken are kept)"
+        )
     return with_lost_files(assess(frames, lights, names), session).verdict
 
 
