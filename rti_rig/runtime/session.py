@@ -1048,7 +1048,36 @@ def _prepare_resume(
         raise SessionWriteError(root / LINEAR_DIR, exc) from None
     if repair:
         recovered.append(f"recovered/{stamp}/journal-rejected.txt")
+    moved_lp = _relist_verified(root, done, stamp)
+    if moved_lp is not None:
+        recovered.append(moved_lp)
     return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
+
+
+def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str | None:
+    """Make ``lights.lp`` list exactly the verified steps, once the others were set aside.
+
+    Why here, before the rig opens: the run rewrites it only from its first commit (or its
+    finish, once begun). A resume that set an image aside and then stopped before that — a
+    Ctrl-C or a dome that did not answer while the rig opened — had left ``lights.lp`` listing
+    the image it had just moved to ``recovered/``; relight, pairing the `.lp`'s lines with the
+    JPEGs by order, then gave every later image the wrong light. With no verified step left,
+    the stale ``lights.lp`` is moved to ``recovered/`` (never deleted); its path is returned.
+    """
+    path = root / LP_NAME
+    ordered = [done[i] for i in sorted(done)]
+    if ordered:
+        write_lp_atomic(path, [LpEntry(r.image, r.actual_direction) for r in ordered])
+        return None
+    if not path.is_file():
+        return None
+    dest = root / "recovered" / stamp / LP_NAME
+    try:
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        os.replace(path, dest)
+    except OSError as exc:
+        raise SessionWriteError(dest, exc) from None
+    return dest.relative_to(root).as_posix()
 
 
 def lost_image_advice(root: Path, adaptive: bool) -> str:

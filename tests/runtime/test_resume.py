@@ -351,3 +351,36 @@ def test_arm_session_killed_mid_move_resumes_identically(
     assert r.exit_code == 0, r.output
     assert digests(out) == digests(ref)
     assert steps_of(out) == steps_of(ref)
+
+
+def _listed(folder: Path) -> list[str]:
+    """The image names ``lights.lp`` lists (empty if there is none)."""
+    lp = folder / "lights.lp"
+    if not lp.exists():
+        return []
+    return [line.split()[0] for line in lp.read_text().splitlines()[1:]]
+
+
+@pytest.mark.parametrize("damaged", [("image_002.jpg",), tuple(f"image_00{i}.jpg" for i in "1234")])
+def test_a_resume_stopped_before_its_first_image_leaves_lights_lp_listing_the_images_on_disk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, damaged: tuple[str, ...]
+) -> None:
+    """The resume sets an unverified image aside in recovered/ before the rig opens; stopped
+    then (here a full disk, as well a Ctrl-C or a dome that did not answer), lights.lp had
+    still listed the image it had moved: relight pairs the .lp's lines with the JPEGs in order,
+    so every later image got the wrong light. It lists exactly the JPEGs in the folder; with
+    none left, it goes to recovered/ too."""
+    import shutil
+
+    out, _ = _cancelled_after_four(tmp_path)
+    for name in damaged:
+        (out / name).write_bytes(b"a copy cut short")
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=1_000_000))
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "not enough free disk space" in said(r), said(r)
+    on_disk = sorted(p.name for p in out.glob("image_*.jpg"))
+    assert _listed(out) == on_disk
+    if not on_disk:
+        assert list((out / "recovered").rglob("lights.lp"))  # set aside, never deleted
