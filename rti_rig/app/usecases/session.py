@@ -581,8 +581,8 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         if loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
             on_note(
                 Note(
-                    f"{config_path} has changed since the session began; the remaining steps "
-                    "are checked against it before anything moves.",
+                    f"{_config_differs(config_path, manifest)}; the remaining steps are checked "
+                    "against it before anything moves.",
                     "warning",
                 )
             )
@@ -626,12 +626,37 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     elif loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
         on_note(
             Note(
-                f"{config_path} has been edited since the session began, in nothing the images "
-                "depend on (kind, lights, camera, exposure, decoding are the same).",
+                f"{_config_differs(config_path, manifest)}, in nothing the images depend on "
+                "(kind, lights, camera, exposure, decoding are the same).",
                 "warning",
             )
         )
     return identity, diffs
+
+
+def _config_differs(config_path: Path, manifest: dict[str, Any]) -> str:
+    """How ``config_path`` came to differ from the config the session began with.
+
+    Why: a resume given another file than the session's (``rti-rig run OTHER.toml --resume
+    DIR``, a second dome's config, a copy) had been told that this file "has been edited since
+    the session began": a claim about a file nobody had touched, which sends the user looking
+    for an edit instead of at the choice of config. The file the session last ran with is named.
+    """
+    last = (manifest.get("rig") or {}).get("config_path")
+    if last and not _same_file(Path(config_path), Path(last)):
+        return (
+            f"{config_path} is not the rig config this session last ran with ({last}), and "
+            "differs from the one it began with"
+        )
+    return f"{config_path} has been edited since the session began"
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file (the recorded one may be gone: then by path)."""
+    try:
+        return a.samefile(b)
+    except OSError:
+        return a.resolve() == b.resolve()
 
 
 def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
