@@ -242,9 +242,11 @@ class DomeSerialSettings(_Strict):
             self.protocol_spec()  # refuse a bad description now, naming its key
         for other in ("default", "framed", "binary"):
             if other != self.profile and getattr(self, other) is not None:
+                # the table is a sub-table of [dome.serial]: "[dome.framed]" had been named,
+                # a table no config has (and one the loader refuses as an unknown key)
                 raise ValueError(
                     f"options for the '{other}' profile are given but profile = "
-                    f"'{self.profile}'; remove [dome.{other}] or set profile = '{other}'"
+                    f"'{self.profile}'; remove [dome.serial.{other}] or set profile = '{other}'"
                 )
         if self.profile == "binary" and self.max_level > 255:
             raise ValueError("the binary profile carries the level in one byte: max_level ≤ 255")

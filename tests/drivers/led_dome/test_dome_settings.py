@@ -118,3 +118,25 @@ def test_example_dome_lp_is_a_safe_profile_48_led_hemisphere():
     ring_of = np.digitize(elevation, [17.5, 32.5, 47.5, 62.5])
     assert np.bincount(ring_of).tolist() == [12, 12, 10, 8, 6]
     assert (np.diff(ring_of) >= 0).all()
+
+
+def test_another_profiles_options_name_the_table_they_are_in(tmp_path: Path) -> None:
+    """The example config copied and set to a firmware's profile (as `rti-rig probe` prints it)
+    keeps its [dome.serial.framed] table: the refusal told the user to remove "[dome.framed]",
+    a table that is not in the file (and one the loader refuses as an unknown key)."""
+    import shutil
+
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    configs = REPO / "rig_configs"
+    shutil.copy(configs / "example_dome_48.lp", tmp_path)
+    text = (configs / "example_dome_48.toml").read_text()
+    cfg = tmp_path / "my_dome.toml"
+    cfg.write_text(text.replace('profile = "framed"', 'profile = "minirti"'))
+    r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "my_dome.toml: key 'dome.serial'" in said, said
+    assert "remove [dome.serial.framed] or set profile = 'framed'" in said, said
