@@ -27,6 +27,8 @@ class ProbeRequest:
 class ProbeResult:
     port: str
     profile: str | None = None
+    #: The baud rate the firmware answered at (with ``profile``).
+    baudrate: int | None = None
     #: What each probe heard (probe description → text), in the order tried.
     heard: list[tuple[str, str]] = field(default_factory=list)
     lights: str = "nothing was lit by the probe"
@@ -35,11 +37,11 @@ class ProbeResult:
     def config_lines(self) -> list[str]:
         if self.profile is None:
             return []
-        return [
-            "[dome.serial]",
-            f'port = "{self.port}"',
-            f'profile = "{self.profile}"',
-        ]
+        # the rate it answered at is said too: a config copied from the example (or the
+        # guide) keeps its "baudrate = 115200", which overrides the profile's own rate, and
+        # a 9600-baud firmware then failed its check with no word of the rate that works
+        rate = [f"baudrate = {self.baudrate}"] if self.baudrate is not None else []
+        return ["[dome.serial]", f'port = "{self.port}"', f'profile = "{self.profile}"', *rate]
 
     def lines(self) -> list[str]:
         out = []
@@ -94,7 +96,7 @@ def _listen(t: SerialTransport, seconds: float) -> bytes:
 
 def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     """The Nab sketch answered: it boots with every LED on, so switch them off before leaving."""
-    result.profile = "nab-rti-v1"
+    result.profile, result.baudrate = "nab-rti-v1", 9600
     off = _exchange(result.port, 9600, wait, b"<0>", 0.6)
     result.heard.append(("all off <0>", off))
     result.lights = (
@@ -117,18 +119,18 @@ def probe(request: ProbeRequest) -> ProbeResult:
         text = _exchange(port, 115200, wait, b"", 0)
         result.heard.append(("listen at 115200 baud", text))
         if "Reflectance Transformation Imager Serial Interface" in text:
-            result.profile = "nichlock"
+            result.profile, result.baudrate = "nichlock", 115200
             result.lights = "the firmware boots with every LED off; nothing was sent"
             return result
         text = _exchange(port, 38400, 0.2, b"?", 0.5)
         result.heard.append(("'?' at 38400 baud", text))
         if "USB I/O 24R1" in text:
-            result.profile = "elexol-24r1"
+            result.profile, result.baudrate = "elexol-24r1", 38400
             return result
         text = _exchange(port, 115200, wait, b"m", 0.5)
         result.heard.append(("'m' (free RAM) at 115200 baud", text))
         if "RAM bytes remaining" in text or "Reflectance Transformation Imager" in text:
-            result.profile = "nichlock"
+            result.profile, result.baudrate = "nichlock", 115200
             result.lights = "the firmware boots with every LED off; nothing that lights was sent"
             return result
         text = _exchange(port, 9600, wait, b"<9>", 0.6)
@@ -138,13 +140,13 @@ def probe(request: ProbeRequest) -> ProbeResult:
         text = _exchange(port, 9600, 1.6, b"\x42" + bytes(8), 0.5)
         result.heard.append(("0x42 + empty mask at 9600 baud", text))
         if text.endswith("\x01"):
-            result.profile = "minirti"
+            result.profile, result.baudrate = "minirti", 9600
             result.lights = "the probe sent an all-off mask, acknowledged"
             return result
         text = _exchange(port, 9600, wait, b"T,0,0,0", 1.8)
         result.heard.append(("'T,0,0,0' at 9600 baud", text))
         if "I received: T,0,0,0 the instructionByte was: T" in text:
-            result.profile = "rtipy"
+            result.profile, result.baudrate = "rtipy", 9600
             result.lights = "LED (0, 0) was asked for zero seconds: it stays dark"
             return result
         result.lights = "nothing that lights an LED was sent"

@@ -26,6 +26,7 @@ from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.lp_format import read_lp
+from rti_rig.drivers.led_dome.dome_profiles import builtin_spec
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.planner.uniform import plan_uniform
 from rti_rig.runtime.controller import run_session
@@ -73,6 +74,9 @@ def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
         r = runner.invoke(app, ["probe", link.port])
         assert r.exit_code == 0, r.output
         assert f'profile = "{profile}"' in r.output
+        # the rate it answered at, which a config copied from the example (baudrate = 115200)
+        # must be given: the printed lines had left it out
+        assert f"baudrate = {builtin_spec(profile)['baudrate']}" in r.output, r.output
         assert eventually(lambda: board.lit == frozenset())
 
 
