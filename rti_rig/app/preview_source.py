@@ -18,6 +18,7 @@ a session's) or belong to another acquisition. Two records that disagree are an 
 
 from __future__ import annotations
 
+import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -61,7 +62,8 @@ def _finished_steps(root: Path) -> list[dict[str, Any]]:
     if not steps:
         raise ScheduleError(
             f"{root}: the session has no finished images, so its lights are not recorded yet; "
-            f"if it was interrupted, finish it with 'rti-rig run --resume {root}' (or shoot the "
+            "if it was interrupted, finish it with rti-rig run --resume "
+            f"{shlex.quote(str(root))} (or shoot the "
             "preview again), or give the light with --preview-light AZ,EL"
         )
     return steps

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 from typing import Annotated
 
@@ -35,12 +36,12 @@ def print_verdict(session: Path | None) -> None:
     except KeyboardInterrupt:  # the session is complete: only the advice is cut short
         err.print(
             "[yellow]QA verdict skipped (Ctrl-C):[/] the session is complete; "
-            f"rti-rig fit {escape(str(session))} --out FOLDER gives the verdict"
+            f"rti-rig fit {escape(shlex.quote(str(session)))} --out FOLDER gives the verdict"
         )
     except VerdictTerminated:  # SIGTERM: said as Ctrl-C is, then the exit a SIGTERM asks for
         err.print(
             "[yellow]QA verdict skipped (SIGTERM):[/] the session is complete; "
-            f"rti-rig fit {escape(str(session))} --out FOLDER gives the verdict"
+            f"rti-rig fit {escape(shlex.quote(str(session)))} --out FOLDER gives the verdict"
         )
         raise typer.Exit(code=143) from None
 

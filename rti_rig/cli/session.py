@@ -235,7 +235,7 @@ def run(
             if resume is not None:
                 said = (
                     f"Stopped (Ctrl-C) before the session went on: no new image was captured; "
-                    f"continue it with rti-rig run --resume {resume}"
+                    f"continue it with rti-rig run --resume {_arg(resume)}"
                 )
             else:
                 said = (
@@ -255,7 +255,7 @@ def run(
             if resume is not None:
                 said = (
                     "The session did not go on: no new image was captured; continue it with "
-                    f"rti-rig run --resume {resume} once this is fixed"
+                    f"rti-rig run --resume {_arg(resume)} once this is fixed"
                 )
             else:
                 said = f"Nothing was captured or written to {out_dir}"
@@ -326,6 +326,13 @@ def _unexpected(exc: Exception, report: str) -> typer.Exit:
     return typer.Exit(code=1)
 
 
+def _arg(path: Path | str) -> str:
+    """``path`` as one shell word, for a command the user is told to run: a session folder
+    with a space in its name ("Object 12 recto") had been printed bare, so the resume hint
+    pasted into a shell ran ``--resume Object`` with "12" and "recto" as other arguments."""
+    return shlex.quote(str(path))
+
+
 def _sentence(text: str) -> str:
     """``text`` with its first letter a capital (a state clause printed as a sentence)."""
     return text[:1].upper() + text[1:]
@@ -347,7 +354,9 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         # that was missing, or listed fewer images than the folder holds
         state = f"lists only {listed} of them" if listed else "is missing"
         if getattr(opened.rig.lighting, "resume_hint", None):  # a session that cannot resume
-            remedy = f"'rti-rig export-lp {out_dir} --out FILE.lp' writes one from the journal"
+            remedy = (
+                f"`rti-rig export-lp {_arg(out_dir)} --out FILE.lp` writes one from the journal"
+            )
         else:
             remedy = "the resume writes it again"
         return (
@@ -508,7 +517,7 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
     todo, total = opened.steps_to_do, opened.total_steps
     count = f"{todo} lights" if todo == total else f"{todo} of {total} lights left"
     out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
-    resume_hint = f"Continue with: rti-rig run --resume {out_dir}"
+    resume_hint = f"Continue with: rti-rig run --resume {_arg(out_dir)}"
     if getattr(rig.lighting, "resume_hint", None):  # a dome whose own count cannot resume
         resume_hint = rig.lighting.resume_hint
     try:
@@ -763,8 +772,8 @@ def export_lp(
             "and tools (relight, RTIBuilder, rti-rig fit) read them beside the .lp: move "
             f"{escape(str(out_file))} into {escape(str(session_dir))} to use it; for relight-cli, "
             "which reads the first .lp of a folder, move that folder's lights.lp out too ("
-            f"`rti-rig export-lp {escape(str(session_dir))} --out "
-            f"{escape(str(session_dir / 'lights.lp'))}` writes it again)",
+            f"`rti-rig export-lp {escape(_arg(session_dir))} --out "
+            f"{escape(_arg(session_dir / 'lights.lp'))}` writes it again)",
             soft_wrap=True,
         )
     out.print(f"{len(done.entries)} lights → {out_file}")

@@ -273,7 +273,7 @@ def lock_session(root: Path) -> None:
         raise SessionError(
             f"{root} is in use by another rti-rig process (a session is being captured or "
             "resumed in it): let it finish, or stop it (Ctrl-C in its terminal), then "
-            f"continue with: rti-rig run --resume {root}"
+            f"continue with: rti-rig run --resume {shlex.quote(str(root))}"
         ) from None
     except OSError:  # a filesystem without flock (some network mounts): no lock, as before
         os.close(fd)
@@ -329,7 +329,7 @@ class SessionFolder:
                 finished = (read_manifest(outer).get("runner") or {}).get(
                     "finish_reason"
                 ) == "completed"
-                resume = f"'rti-rig run --resume {outer}'"
+                resume = f"rti-rig run --resume {shlex.quote(str(outer))}"
                 what = (
                     "a finished session"
                     if finished
@@ -351,10 +351,11 @@ class SessionFolder:
                 except SessionError:
                     finished = False
                 resume = (
-                    f" (it holds a finished session: fit it with 'rti-rig fit {root} --out DIR')"
+                    " (it holds a finished session: fit it with rti-rig fit "
+                    f"{shlex.quote(str(root))} --out DIR)"
                     if finished
                     else ", or continue the interrupted session in it with "
-                    f"'rti-rig run --resume {root}'"
+                    f"rti-rig run --resume {shlex.quote(str(root))}"
                 )
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "

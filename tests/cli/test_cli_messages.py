@@ -438,3 +438,41 @@ def test_a_dry_run_of_a_simulated_dome_claims_nothing_of_lights_it_does_not_have
 ) -> None:
     said = _finished_run(tmp_path, "simulated_dome.toml")
     assert "lights are off" not in said and "switched off" not in said, said
+
+
+def test_the_resume_hint_runs_as_printed_for_a_folder_with_spaces(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A museum's session folders are named after the object ("object 12 recto"). The hint
+    after a Ctrl-C printed the folder bare: pasted into a shell, "rti-rig run --resume
+    .../object 12 recto" resumed a folder "object" with "12" and "recto" as stray arguments.
+    The command as printed (split as a shell splits it) continues the session."""
+    import os
+    import shlex
+    import signal
+
+    from conftest import SMALL_DOME, write_config
+
+    from rti_rig.simulator.sim_lights import SimulatedDome
+
+    real, lit = SimulatedDome.light, []
+
+    def ctrl_c_at_the_third_light(self, *a, **k):  # type: ignore[no-untyped-def]
+        lit.append(1)
+        if len(lit) == 3:
+            os.kill(os.getpid(), signal.SIGINT)  # stops after this image
+        return real(self, *a, **k)
+
+    out = tmp_path / "object 12 recto"
+    cfg = write_config(tmp_path, SMALL_DOME)
+    with monkeypatch.context() as m:
+        m.setattr(SimulatedDome, "light", ctrl_c_at_the_third_light)
+        r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "6"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    hint = said.split("Continue with: ", 1)[1]
+    argv = shlex.split(hint)
+    assert argv[:3] == ["rti-rig", "run", "--resume"] and argv[3] == str(out), argv
+    r = runner.invoke(app, [*argv[1:], "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "6 image(s) in the session" in " ".join(r.output.split())

@@ -77,8 +77,7 @@ def test_an_interrupted_session_says_how_to_continue_it(
     with pytest.raises(SessionError) as refused:
         SessionFolder.check_new(Path("S/a/b"))
     assert str(refused.value).startswith(
-        "--out S/a/b is inside S, an interrupted session (continue it with "
-        "'rti-rig run --resume S')"
+        "--out S/a/b is inside S, an interrupted session (continue it with rti-rig run --resume S)"
     )
 
 

@@ -7,6 +7,7 @@ CLI only parses its options into a request, calls these functions and prints wha
 
 from __future__ import annotations
 
+import shlex
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -602,7 +603,8 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             "or gain reads as a brighter or darker light, another size or decoding as another "
             "picture), and fit, relight and RTIBuilder take a session's images as one set. "
             "That cannot be accepted into this session, even with --accept-rig-change: set it "
-            f"back to continue (rti-rig run --resume {session_dir} with the session's own "
+            f"back to continue (rti-rig run --resume {shlex.quote(str(session_dir))} with the "
+            "session's own "
             "config), or start a new session with the new settings"
         )
     if recorded.get("kind") != identity.get("kind"):
@@ -617,7 +619,8 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             f"{config_path} does not describe the rig this session began on ("
             + "; ".join(diffs)
             + "): its images would not match the ones already taken. Resume with the "
-            f"session's own config (rti-rig run --resume {session_dir}), or, if the change "
+            f"session's own config (rti-rig run --resume {shlex.quote(str(session_dir))}), or, "
+            "if the change "
             "is deliberate (a repaired LED, recalibrated light positions), add "
             "--accept-rig-change to record it"
         )
