@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import shlex
 import signal
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -158,68 +159,72 @@ def run(
         open_new_session,
         open_resumed_session,
     )
+    from rti_rig.runtime.controller import EmergencyStop
 
     # SIGUSR1 said to be ignored from here, not only once the capture is over: one that came
     # while the rig opened (an emulator starting, metering with the rig lit) had ended the
     # process at once, exit 138, no word and no all-off
     with _late_pause_ignored():
         try:
-            if resume is not None:
-                given = [
-                    flag
-                    for flag, value in (
-                        ("--out", out_dir is not None),
-                        ("--plan", plan is not None),
-                        ("--lights", lights is not None),
-                        ("--adaptive", adaptive),
-                        ("--until-error", until_error is not None),
-                        ("--min-lights", min_lights is not None),
-                        ("--auto-exposure", auto_exposure),
-                        ("--min-elevation-deg", min_elevation_deg != 0.0),
-                        ("--max-elevation-deg", max_elevation_deg != 90.0),
+            with _terminable_while_opening():
+                if resume is not None:
+                    given = [
+                        flag
+                        for flag, value in (
+                            ("--out", out_dir is not None),
+                            ("--plan", plan is not None),
+                            ("--lights", lights is not None),
+                            ("--adaptive", adaptive),
+                            ("--until-error", until_error is not None),
+                            ("--min-lights", min_lights is not None),
+                            ("--auto-exposure", auto_exposure),
+                            ("--min-elevation-deg", min_elevation_deg != 0.0),
+                            ("--max-elevation-deg", max_elevation_deg != 90.0),
+                        )
+                        if value
+                    ]
+                    if given:
+                        raise RtiRigError(
+                            "--resume continues a session as it began (its lights, stopping rule "
+                            f"and exposure are in its manifest): drop {', '.join(given)}"
+                        )
+                    opened = open_resumed_session(
+                        ResumeRequest(
+                            resume,
+                            rig_config,
+                            max_saturated=max_saturated,
+                            accept_rig_change=accept_rig_change,
+                            objective=objective,
+                            reshoot_lost=reshoot_lost,
+                        ),
+                        print_note,
                     )
-                    if value
-                ]
-                if given:
-                    raise RtiRigError(
-                        "--resume continues a session as it began (its lights, stopping rule and "
-                        f"exposure are in its manifest): drop {', '.join(given)}"
+                else:
+                    if rig_config is None or out_dir is None:
+                        raise RtiRigError(
+                            "give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)"
+                        )
+                    if accept_rig_change:
+                        raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
+                    if reshoot_lost:
+                        raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
+                    opened = open_new_session(
+                        NewSessionRequest(
+                            rig_config,
+                            out_dir,
+                            lights=lights,
+                            plan=plan,
+                            min_elevation_deg=min_elevation_deg,
+                            max_elevation_deg=max_elevation_deg,
+                            auto_exposure=auto_exposure,
+                            max_saturated=max_saturated,
+                            adaptive=adaptive,
+                            until_error_deg=until_error,
+                            objective=objective,
+                            min_lights=min_lights,
+                        ),
+                        print_note,
                     )
-                opened = open_resumed_session(
-                    ResumeRequest(
-                        resume,
-                        rig_config,
-                        max_saturated=max_saturated,
-                        accept_rig_change=accept_rig_change,
-                        objective=objective,
-                        reshoot_lost=reshoot_lost,
-                    ),
-                    print_note,
-                )
-            else:
-                if rig_config is None or out_dir is None:
-                    raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
-                if accept_rig_change:
-                    raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
-                if reshoot_lost:
-                    raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
-                opened = open_new_session(
-                    NewSessionRequest(
-                        rig_config,
-                        out_dir,
-                        lights=lights,
-                        plan=plan,
-                        min_elevation_deg=min_elevation_deg,
-                        max_elevation_deg=max_elevation_deg,
-                        auto_exposure=auto_exposure,
-                        max_saturated=max_saturated,
-                        adaptive=adaptive,
-                        until_error_deg=until_error,
-                        objective=objective,
-                        min_lights=min_lights,
-                    ),
-                    print_note,
-                )
         except RtiRigError as exc:
             _print_failures(getattr(exc, "teardown_failures", None))  # metering's
             state = getattr(exc, "lights_state", None)
@@ -229,27 +234,31 @@ def run(
                     markup=False,
                 )
             raise fail(exc) from None
-        except KeyboardInterrupt as exc:
+        except (KeyboardInterrupt, EmergencyStop) as exc:
             # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
-            # had been 130 with no word at all
+            # had been 130 with no word at all (a SIGTERM's 143, with no all-off either)
+            why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
             if resume is not None:
                 said = (
-                    f"Stopped (Ctrl-C) before the session went on: no new image was captured; "
+                    f"Stopped ({why}) before the session went on: no new image was captured; "
                     f"continue it with rti-rig run --resume {_arg(resume)}"
                 )
             else:
                 said = (
-                    "Stopped (Ctrl-C) before the first image: nothing was captured or written to "
+                    f"Stopped ({why}) before the first image: nothing was captured or written to "
                     f"{out_dir}"
                 )
             _print_failures(getattr(exc, "teardown_failures", None))
-            if auto_exposure:
+            state = getattr(exc, "lights_state", None)
+            if state is not None:  # stopped while metering: what its teardown established
+                said += f"; metering was stopped, and then: {state}"
+            elif auto_exposure:
                 said += (
                     "; metering, if it had begun, attempted an all-off on its way out: check the "
                     "rig's lights"
                 )
             err.print(f"[yellow]{escape(said)}.[/]")
-            raise typer.Exit(code=130) from None
+            raise typer.Exit(code=stop_exit_code(why)) from None
         except Exception as exc:  # no part of rti-rig named it: said, not a traceback
             _print_failures(getattr(exc, "teardown_failures", None))
             if resume is not None:
@@ -272,6 +281,32 @@ def run(
 
             with _verdict_terminable():
                 print_verdict(opened.out_dir)
+
+
+@contextmanager
+def _terminable_while_opening() -> Iterator[None]:
+    """A SIGTERM while the session opens raises :class:`~rti_rig.runtime.controller.
+    EmergencyStop`, which the opening's own teardown (metering's all-off, the rig's close)
+    answers as it answers a Ctrl-C; the command then says so and exits 143.
+
+    Why: SIGTERM (a service manager, ``timeout``, a lab's scheduler) while an emulator started,
+    a dome handshook or metering had an LED lit met the default action: the process ended at
+    once, exit 143, no word and no all-off, though ``run --help`` promises "SIGTERM stops at
+    once (lights off ...)". The capture installs its own handler (:func:`_run_and_report`)."""
+    from rti_rig.runtime.controller import EmergencyStop
+
+    if threading.current_thread() is not threading.main_thread():
+        yield  # signal handlers can only be set from the main thread
+        return
+
+    def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        raise EmergencyStop("SIGTERM")
+
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 @contextmanager

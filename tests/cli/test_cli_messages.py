@@ -476,3 +476,23 @@ def test_the_resume_hint_runs_as_printed_for_a_folder_with_spaces(
     r = runner.invoke(app, [*argv[1:], "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert "6 image(s) in the session" in " ".join(r.output.split())
+
+
+def test_a_sigterm_while_metering_switches_the_lights_off_and_says_so(tmp_path: Path) -> None:
+    """SIGTERM (a service manager, ``timeout``) while `--auto-exposure` metered, with an LED
+    lit, met Python's default action: exit 143, no word, no all-off, though `run --help`
+    promises that SIGTERM stops at once with the lights off. Metering's teardown runs, what it
+    established is said, nothing is written, and SIGTERM's handler is back after."""
+    code, said, out = _run_signalled(
+        tmp_path, "rti_rig.drivers.cameras.exposure", "meter_exposure", "SIGTERM",
+        "raise AssertionError('the SIGTERM should have stopped the metering')",
+        "--auto-exposure",
+    )  # fmt: skip
+    assert code == 143, (code, said)
+    assert (
+        f"Stopped (SIGTERM) before the first image: nothing was captured or written to {out}"
+        in said
+    )
+    assert "metering was stopped, and then: lights were switched off" in said, said
+    assert "SIGTERM handler restored: True" in said and "Traceback" not in said, said
+    assert not out.exists()

@@ -17,6 +17,7 @@ from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.runtime.controller import (
     CancelToken,
+    EmergencyStop,
     Event,
     FinishReason,
     SessionResult,
@@ -334,9 +335,10 @@ def fix_exposure(
             probes,
             shot_per_lighting=limit is not None,
         )
-    except RtiRigError as exc:
-        # what metering's teardown established about the lights travels with the error (the
-        # user had been told only the error: no word of the lights metering had switched on)
+    except (RtiRigError, KeyboardInterrupt, EmergencyStop) as exc:
+        # what metering's teardown established about the lights travels with the error, or
+        # with the stop (Ctrl-C, SIGTERM) (the user had been told only the error: no word of
+        # the lights metering had switched on)
         from rti_rig.app.usecases.safe_state import lights_state
 
         failures = getattr(exc, "teardown_failures", None)
