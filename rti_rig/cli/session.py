@@ -248,17 +248,7 @@ def run(
                     f"Stopped ({why}) before the first image: nothing was captured or written to "
                     f"{out_dir}"
                 )
-            _print_failures(getattr(exc, "teardown_failures", None))
-            state = getattr(exc, "lights_state", None)
-            if state is not None:  # stopped while metering: what its teardown established
-                said += f"; metering was stopped, and then: {state}"
-            elif auto_exposure:
-                said += (
-                    "; metering, if it had begun, attempted an all-off on its way out: check the "
-                    "rig's lights"
-                )
-            err.print(f"[yellow]{escape(said)}.[/]")
-            raise typer.Exit(code=stop_exit_code(why)) from None
+            raise _stopped_while_opening(exc, why, said, auto_exposure) from None
         except Exception as exc:  # no part of rti-rig named it: said, not a traceback
             _print_failures(getattr(exc, "teardown_failures", None))
             if resume is not None:
@@ -281,6 +271,24 @@ def run(
 
             with _verdict_terminable():
                 print_verdict(opened.out_dir)
+
+
+def _stopped_while_opening(
+    exc: BaseException, why: str, said: str, auto_exposure: bool
+) -> typer.Exit:
+    """Say a stop (Ctrl-C, SIGTERM) that came while the session opened, and what metering's
+    teardown established of the lights if it was metering; the exit a stop by ``why`` asks."""
+    _print_failures(getattr(exc, "teardown_failures", None))
+    state = getattr(exc, "lights_state", None)
+    if state is not None:  # stopped while metering: what its teardown established
+        said += f"; metering was stopped, and then: {state}"
+    elif auto_exposure:
+        said += (
+            "; metering, if it had begun, attempted an all-off on its way out: check the rig's "
+            "lights"
+        )
+    err.print(f"[yellow]{escape(said)}.[/]")
+    return typer.Exit(code=stop_exit_code(why))
 
 
 @contextmanager
@@ -735,22 +743,35 @@ def preview(
     its linear image with that light (no --preview-light needed).
     """
     from rti_rig.app.usecases.session import PreviewRequest, open_preview_session
+    from rti_rig.runtime.controller import EmergencyStop
 
     try:
-        opened = open_preview_session(
-            PreviewRequest(
-                rig_config,
-                out_dir,
-                parse_az_el(light, "--light"),
-                auto_exposure=auto_exposure,
-                max_saturated=max_saturated,
-                min_elevation_deg=min_elevation_deg,
-                max_elevation_deg=max_elevation_deg,
-            ),
-            print_note,
-        )
+        with _terminable_while_opening():
+            opened = open_preview_session(
+                PreviewRequest(
+                    rig_config,
+                    out_dir,
+                    parse_az_el(light, "--light"),
+                    auto_exposure=auto_exposure,
+                    max_saturated=max_saturated,
+                    min_elevation_deg=min_elevation_deg,
+                    max_elevation_deg=max_elevation_deg,
+                ),
+                print_note,
+            )
     except RtiRigError as exc:
+        state = getattr(exc, "lights_state", None)
+        if state is not None:  # metering failed: it had lit the rig; nothing was written yet
+            err.print(
+                f"{_sentence(state)}; nothing was captured or written to {out_dir}.", markup=False
+            )
         raise fail(exc) from None
+    except (KeyboardInterrupt, EmergencyStop) as exc:
+        # metering for the preview lights the rig: a Ctrl-C had said only "rti-rig: stopped",
+        # a SIGTERM nothing at all (and sent no all-off)
+        why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
+        said = f"Stopped ({why}) before the preview image: nothing was captured or written to "
+        raise _stopped_while_opening(exc, why, f"{said}{out_dir}", auto_exposure) from None
     _execute(opened)
     # the band given here is the one to plan in: said in the command to copy
     band = "".join(

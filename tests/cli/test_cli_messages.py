@@ -496,3 +496,42 @@ def test_a_sigterm_while_metering_switches_the_lights_off_and_says_so(tmp_path: 
     assert "metering was stopped, and then: lights were switched off" in said, said
     assert "SIGTERM handler restored: True" in said and "Traceback" not in said, said
     assert not out.exists()
+
+
+@pytest.mark.parametrize("signal_name, code", [("SIGTERM", 143), ("SIGINT", 130)])
+def test_a_stop_while_the_preview_meters_switches_the_lights_off_and_says_so(
+    tmp_path: Path, signal_name: str, code: int
+) -> None:
+    """`preview --auto-exposure` lights the rig to meter. A SIGTERM there had ended the process
+    at once (exit 143, no word, no all-off), a Ctrl-C said only "rti-rig: stopped (Ctrl-C)":
+    neither said anything of the lights. Both now stop through metering's teardown and say
+    what it established."""
+    import subprocess
+    import sys
+
+    script = (
+        "import os, signal, sys\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "import rti_rig.drivers.cameras.exposure as target\n"
+        "def signalled(*a, **k):\n"
+        f"    os.kill(os.getpid(), signal.{signal_name})\n"
+        "    raise AssertionError('the signal should have stopped the metering')\n"
+        "target.meter_exposure = signalled\n"
+        "from rti_rig.launch import main\n"
+        "sys.argv[0] = 'rti-rig'\n"
+        "main()\n"
+    )
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "simulated_dome.toml"
+    out = tmp_path / "p"
+    proc = subprocess.run(
+        [sys.executable, "-c", script, "preview", str(cfg), "--out", str(out), "--auto-exposure"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    why = "SIGTERM" if signal_name == "SIGTERM" else "Ctrl-C"
+    assert proc.returncode == code, (proc.returncode, said)
+    assert f"Stopped ({why}) before the preview image: nothing was captured" in said, said
+    assert "metering was stopped, and then: lights were switched off" in said, said
+    assert "Traceback" not in said and not out.exists()
