@@ -37,7 +37,7 @@ import numpy as np
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import DeviceError
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.controller import validate_schedule
+from rti_rig.runtime.controller import _signals_deferred, validate_schedule
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
 
@@ -160,10 +160,15 @@ def fix_session_exposure(
         return _LitForEachShot(rig, step) if shot_per_lighting else rig.camera
 
     def teardown() -> list[str]:
-        # every step of the teardown runs, whatever one device does; what failed is said
-        return rig.lighting.safe() + attempt_all(
-            [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
-        )
+        # every step of the teardown runs, whatever one device does; what failed is said. A
+        # Ctrl-C or SIGTERM is held until it is done (as the capture's teardown holds them):
+        # a second Ctrl-C ("stop at once") had cut the all-off short with an LED lit, and the
+        # dome's last all-off, the one between two metered lights, was then reported as the
+        # state of the lights ("acknowledged by the dome: lights are off")
+        with _signals_deferred():
+            return rig.lighting.safe() + attempt_all(
+                [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
+            )
 
     at = steps[0]
     tested: list[list[float]] = []

@@ -110,3 +110,70 @@ def test_a_stop_during_metering_carries_what_the_teardown_could_not_do(tmp_path:
     with pytest.raises(KeyboardInterrupt) as stopped:
         fix_session_exposure(rig, schedule, meter)
     assert stopped.value.teardown_failures == ["all LEDs off: no reply"]  # type: ignore[attr-defined]
+
+
+#: ``rti-rig run`` in a process of its own, on an emulated dome whose board is recorded: Ctrl-C
+#: while metering the second light, and a second Ctrl-C ("stop at once") as metering's teardown
+#: begins; the LEDs the board has lit are printed at the end.
+_DOUBLE_CTRL_C = """
+import os, signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+import rti_rig.simulator.domes as domes
+boards, board_for = [], domes.board_for
+def recorded(*a, **k):
+    boards.append(board_for(*a, **k))
+    return boards[-1]
+domes.board_for = recorded
+import rti_rig.drivers.cameras.exposure as exposure
+recheck = exposure.recheck_exposure
+def ctrl_c(*a, **k):
+    os.kill(os.getpid(), signal.SIGINT)
+    return recheck(*a, **k)
+exposure.recheck_exposure = ctrl_c
+from rti_rig.runtime.lighting import DomeLighting
+safe = DomeLighting.safe
+def ctrl_c_again(self, *a, **k):
+    os.kill(os.getpid(), signal.SIGINT)
+    return safe(self, *a, **k)
+DomeLighting.safe = ctrl_c_again
+from rti_rig.launch import main
+sys.argv = ["rti-rig", *sys.argv[1:]]
+try:
+    main()
+finally:
+    print("LIT at exit:", [sorted(b.lit) for b in boards], flush=True)
+"""
+
+
+@pytest.mark.pty
+@pytest.mark.skipif(__import__("sys").platform != "linux", reason="pty semantics on Linux")
+def test_a_second_ctrl_c_does_not_cut_meterings_all_off_short(tmp_path: Path) -> None:
+    """Ctrl-C twice while `--auto-exposure` metered on an uncalibrated dome (six lights, an
+    all-off between two): the second cut metering's all-off short, left an LED lit, and the
+    all-off between two metered lights was then said of the lights ("acknowledged by the dome:
+    lights are off"). The second stop is held until the teardown is done."""
+    import subprocess
+    import sys
+
+    cfg = Path(__file__).resolve().parents[2] / "rig_configs" / "emulated_nichlock.toml"
+    out = tmp_path / "s"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            _DOUBLE_CTRL_C,
+            "run",
+            str(cfg),
+            "--out",
+            str(out),
+            "--auto-exposure",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 130, said
+    assert "LIT at exit: [[]]" in said, said  # the emulated board: every LED dark
+    assert "metering was stopped, and then: all-off sent and acknowledged" in said, said
+    assert not out.exists()
