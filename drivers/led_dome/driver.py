@@ -18,6 +18,8 @@ import logging
 from rti_rig.core.dome_link import DomeInfo, DomeLinkError, LinkFault
 from rti_rig.drivers.led_dome.codec_base import DomeCodec
 from rti_rig.drivers.led_dome.messages import (
+    ERR_LED_FAULT,
+    ERR_THERMAL,
     ERROR_CODES,
     TRANSIENT_ERROR_CODES,
     Ack,
@@ -37,6 +39,15 @@ from rti_rig.drivers.led_dome.messages import (
     error_text,
 )
 from rti_rig.drivers.led_dome.transport import Transport, TransportError
+
+#: What to do about a definitive refusal, said with it. A dead LED stopped a session with only
+#: "LED fault (open circuit ...)" and the session's "Continue with: rti-rig run --resume": a
+#: resume lights the same LED again and stops on it again.
+_REMEDY = {
+    ERR_LED_FAULT: "; the LED or its wiring needs repair: until then a session that lights it, "
+    "or its resume, stops there again",
+    ERR_THERMAL: "; let the LED cool before it is lit again",
+}
 
 #: Every byte to and from the dome goes through this logger (DEBUG, hex).
 traffic_log = logging.getLogger("rti_rig.dome.traffic")
@@ -216,7 +227,8 @@ class LedDomeDriver:
                         f"unknown error code {reply.code}", name, LinkFault.GARBLED, True
                     )
                 raise self._error(
-                    f"firmware error {reply.code}: {error_text(reply.code)}",
+                    f"firmware error {reply.code}: {error_text(reply.code)}"
+                    + _REMEDY.get(reply.code, ""),
                     name,
                     LinkFault.REJECTED,
                     reply.code in TRANSIENT_ERROR_CODES,

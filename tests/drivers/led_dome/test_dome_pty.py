@@ -249,3 +249,31 @@ def test_dry_run_against_the_emulator_in_another_process():
     # Terminated, it still removes the pty's temporary folder rather than leave it in /tmp.
     assert proc.returncode == 0
     assert not Path(port).parent.exists()
+
+
+def test_a_dead_led_that_stops_a_session_says_to_repair_it_before_the_resume(
+    tmp_path: Path,
+) -> None:
+    """A session on the emulated dome stops at its dead LED, and offers "Continue with: rti-rig
+    run --resume": the refusal had said only "LED fault (open circuit: the LED draws no
+    current)", and a resume lights the same LED and stops on it again. It says the LED needs
+    repair first."""
+    import shutil
+
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    configs = Path(__file__).resolve().parents[3] / "rig_configs"
+    shutil.copy(configs / "example_dome_48.lp", tmp_path)
+    cfg = tmp_path / "dome.toml"
+    cfg.write_text((configs / "emulated_dome.toml").read_text() + "\n[emulator]\ndead_leds = [2]\n")
+    r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "LED 2 refused" in said and "LED fault" in said, said
+    repair = (
+        "the LED or its wiring needs repair: until then a session that lights it, or its "
+        "resume, stops there again"
+    )
+    assert repair in said, said
