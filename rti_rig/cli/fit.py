@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import shlex
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -51,6 +55,56 @@ class VerdictTerminated(BaseException):
     phase): the session is complete, so it is said like a Ctrl-C there; it had ended the
     process silently (exit 143), which read like a failed session. A BaseException, as
     KeyboardInterrupt is, so that no ``except Exception`` on the way swallows it."""
+
+
+class FitStopped(BaseException):
+    """A SIGTERM during ``fit`` (raised by its handler): a BaseException, as KeyboardInterrupt
+    is, so that the fit's own clean-up (outputs written so far removed, a batch's partial
+    folder discarded) runs on the way out and no ``except Exception`` swallows it."""
+
+
+@contextmanager
+def _stoppable() -> Iterator[None]:
+    """SIGTERM stops a fit as Ctrl-C does: through its clean-up.
+
+    Why: without a handler a SIGTERM (``timeout``, a scheduler, a service manager) ended the
+    process at once, silently, exit 143, leaving half-written outputs (``fit.ptm.part``, a
+    normal map without its QA) in --out, and the same command run again was refused: "not
+    empty"."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # signal handlers can only be set from the main thread
+        return
+
+    def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        raise FitStopped()
+
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _stopped(why: str, out_dir: Path, batch: bool, written: bool) -> typer.Exit:
+    """Say what a stopped fit left (``written``: the stop came after every output was
+    written, while they were being reported), and the exit a shell expects for that signal."""
+    from rti_rig.cli.app import stop_exit_code
+
+    if written:
+        said = f"Stopped ({why}) after the fit had written its outputs to {out_dir}"
+    elif batch:
+        said = (
+            f"Stopped ({why}): the sessions finished are kept in {out_dir}, the one being "
+            "fitted was discarded; run the same command again to fit the rest (finished ones "
+            "are skipped)"
+        )
+    else:
+        said = (
+            f"Stopped ({why}) before the fit finished: nothing it wrote was left in {out_dir}; "
+            "run the same command again"
+        )
+    err.print(f"[yellow]{escape(said)}.[/]")
+    return typer.Exit(code=stop_exit_code(why))
 
 
 @app.command()
@@ -108,14 +162,52 @@ def fit(
     ] = None,
 ) -> None:
     """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
-    from rti_rig.app.usecases.fit import FitRequest, run_batch, run_fit
     from rti_rig.app.usecases.fit_memory import use_one_heap
-    from rti_rig.reconstruct.registry import model_spec
 
     # One malloc heap for this process, before any decode or reader thread starts: it is
     # process-wide and permanent, so the command (one fit or one batch per process) sets it,
     # not the use case, which a Dask worker or a test process also runs (fit_memory).
     use_one_heap()
+
+    written: list[bool] = []  # set once every output is written (what a stop then says)
+    try:
+        with _stoppable():
+            _fit_command(
+                written,
+                sources,
+                out_dir,
+                model,
+                no_qa,
+                no_ptm,
+                no_hsh,
+                no_normals,
+                export_encoding,
+                hsh_order,
+                scheduler,
+            )
+    except KeyboardInterrupt:
+        raise _stopped("Ctrl-C", out_dir, len(sources) > 1, bool(written)) from None
+    except FitStopped:
+        raise _stopped("SIGTERM", out_dir, len(sources) > 1, bool(written)) from None
+
+
+def _fit_command(  # type: ignore[no-untyped-def]
+    written: list[bool],
+    sources: list[Path],
+    out_dir: Path,
+    model: str,
+    no_qa: bool,
+    no_ptm: bool,
+    no_hsh: bool,
+    no_normals: bool,
+    export_encoding: str,
+    hsh_order: int | None,
+    scheduler: str | None,
+) -> None:
+    """The body of :func:`fit`, run under its stop handling (``written`` gets True once every
+    output is written)."""
+    from rti_rig.app.usecases.fit import FitRequest, run_batch, run_fit
+    from rti_rig.reconstruct.registry import model_spec
 
     try:
         if export_encoding not in ("srgb", "linear"):
@@ -150,6 +242,7 @@ def fit(
                 from rti_rig.app.usecases.fit_dask import run_batch_dask
 
                 items = run_batch_dask(sources, out_dir, request, scheduler)
+            written.append(True)
             for item in items:
                 line = f"{item.source}: {item.status}"
                 if item.verdict:
@@ -168,6 +261,7 @@ def fit(
             from rti_rig.app.usecases.fit_dask import run_fit_dask
 
             result = run_fit_dask(request, scheduler)
+        written.append(True)
     except RtiRigError as exc:
         raise fail(exc) from None
     print_notes(result.notes)
