@@ -146,7 +146,8 @@ def run(
         bool, typer.Option("--no-verdict", help="Do not print the QA verdict at the end.")
     ] = False,
 ) -> None:
-    """Run a capture session (a dry run when the config's backend is 'simulated').
+    """Run a capture session: a dry run on a simulated or emulated rig or a recorded
+    acquisition's .lp, the real rig otherwise.
 
     Ctrl-C once stops after the current image; Ctrl-C twice or SIGTERM stops at once (lights
     off, arm stopped, and parked if the config says park_on_emergency_stop = true); SIGUSR1
