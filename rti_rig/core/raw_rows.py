@@ -65,6 +65,11 @@ class RawRows:
         self._row_bytes = int(np.prod(self.shape[1:])) * self._stored.itemsize
         self._float_luts: dict[float, NDArray[np.float32]] = {}
 
+    @property
+    def stored(self) -> np.dtype[Any]:
+        """The pixels' type as stored (uint8 for an 8-bit image ``dtype`` reads as linear)."""
+        return self._stored
+
     def __len__(self) -> int:
         return self.shape[0]
 

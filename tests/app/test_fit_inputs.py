@@ -340,3 +340,29 @@ def test_a_png_cut_short_is_named_damaged_with_what_to_do(
     assert f"{victim.name} is a damaged PNG: it ends before its IEND chunk (cut short)" in said
     assert "copy it again from the camera or card" in said
     assert "libpng" not in capfd.readouterr().err
+
+
+def test_an_acquisition_mixing_8_and_16_bit_images_is_fitted_with_a_note(tmp_path: Path) -> None:
+    """8-bit images are decoded as sRGB and 16-bit ones taken as linear (both documented); an
+    acquisition mixing them (a 16-bit export beside JPEGs) was fitted without a word, though a
+    gamma-encoded 16-bit export is then fitted wrongly. It is fitted, and said; an acquisition
+    of one kind gets no such note."""
+    from rti_rig.app.usecases.fit import load_acquisition
+
+    src = Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay"
+    acq = tmp_path / "acq"
+    shutil.copytree(src, acq)
+    notes: list[str] = []
+    load_acquisition(acq / "dirs.lp", notes)
+    assert not any("mixes" in n for n in notes)
+    lp = (acq / "dirs.lp").read_text()
+    first = lp.splitlines()[1].split()[0]  # image01.jpg
+    rgb = cv2.imread(str(acq / first))[..., ::-1]
+    write_linear_tiff(acq / "image01.tif", rgb.astype(np.uint16) * 257)  # a 16-bit export
+    (acq / "dirs.lp").write_text(lp.replace(first, "image01.tif"))
+    notes = []
+    load_acquisition(acq / "dirs.lp", notes)
+    mixed = [n for n in notes if "mixes" in n]
+    assert len(mixed) == 1, notes
+    assert "17 8-bit image(s), decoded as sRGB, with 1 16-bit one(s), taken as linear" in mixed[0]
+    assert "image01.tif" in mixed[0] and "export every image of the acquisition alike" in mixed[0]

@@ -307,7 +307,32 @@ def load_acquisition(
     shapes = {f.shape for f in frames}
     if len(shapes) != 1:
         raise FitInputError(f"images of {lp} differ in shape: {sorted(shapes)}")
+    if notes is not None and not any(p.parent.name == "linear" for p in paths):
+        # (a session's linear/ with stand-ins is said by acquisition_files)
+        notes.extend(_mixed_depth_note(lp, frames, paths))
     return frames, lights, names, f"{len(frames)} images from {lp}"
+
+
+def _mixed_depth_note(lp: Path, frames: list[Any], paths: list[Path]) -> list[str]:
+    """A note when an acquisition mixes 8-bit images (decoded as sRGB) with 16-bit ones (taken
+    as linear, as sessions write them): one 16-bit export that is gamma-encoded, not linear,
+    beside JPEGs would be fitted several times too bright in its mid-tones, silently. Both
+    readings are the documented ones, so the files are fitted; the user is told to check."""
+    eight = [p.name for f, p in zip(frames, paths, strict=True) if _stored_8_bit(f)]
+    if not eight or len(eight) == len(paths):
+        return []
+    sixteen = [p.name for f, p in zip(frames, paths, strict=True) if not _stored_8_bit(f)]
+    shown = ", ".join(sixteen[:3]) + (" ..." if len(sixteen) > 3 else "")
+    return [
+        f"{lp} mixes {len(eight)} 8-bit image(s), decoded as sRGB, with {len(sixteen)} 16-bit "
+        f"one(s), taken as linear ({shown}): if the 16-bit files are gamma-encoded exports, "
+        "not linear data, they are fitted wrongly; export every image of the acquisition alike"
+    ]
+
+
+def _stored_8_bit(frame: Any) -> bool:
+    """Whether a frame of :func:`_open_frames` holds 8-bit (sRGB-encoded) pixels."""
+    return bool(getattr(frame, "stored", np.dtype(frame.dtype)) == np.uint8)
 
 
 def _save_png(path: Path, rgb: np.ndarray) -> Path:
