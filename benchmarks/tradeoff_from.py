@@ -35,6 +35,7 @@ import time
 from collections.abc import Callable
 from itertools import pairwise
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -64,12 +65,12 @@ def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarra
     choice of fit.rti's order, which `rti-rig fit` makes on colour pixels with the saturated
     ones left out (a grey mean hides a channel at its top code)."""
     from rti_rig.core.image_files import read_image_any
-    from rti_rig.core.lp_format import image_path, read_lp
+    from rti_rig.core.lp_format import read_lp
 
     entries = read_lp(lp, upper_hemisphere=True)
     images, colour = [], []
-    for e in entries:
-        img = read_image_any(image_path(lp.parent, e.name))
+    for path in _image_files(lp, entries):
+        img = read_image_any(path)
         x = img.astype(np.float32) / (255.0 if img.dtype == np.uint8 else 65535.0)
         if img.dtype == np.uint8:  # sRGB decoding
             x = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
@@ -83,6 +84,31 @@ def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarra
         colour.append(x.astype(np.float32))
     dirs = np.array([e.direction for e in entries])
     return np.stack(images), np.stack(colour), dirs, [e.name for e in entries]
+
+
+def _image_files(lp: Path, entries: list[Any]) -> list[Path]:
+    """The image file of every line of ``lp``, all checked to exist before minutes of work.
+
+    Why: a missing image had been met while reading, as "cannot read image …image01.JPG:
+    there is no such file", without the ``.lp`` it was listed in or, where the folder holds
+    ``image01.jpg``, the case of the name as the reason (what ``run`` and ``fit`` say)."""
+    from rti_rig.core.errors import LpFormatError
+    from rti_rig.core.lp_format import case_hint, image_paths
+
+    paths = image_paths(lp, entries)
+    missing = [p for p in paths if not p.is_file()]
+    if missing:
+        shown = ", ".join(p.name for p in missing[:5]) + (" ..." if len(missing) > 5 else "")
+        raise LpFormatError(
+            lp,
+            None,
+            f"{len(missing)} of {len(entries)} image(s) it lists are missing ({shown})"
+            + (
+                case_hint(missing)
+                or "; copy them where their names point, or remove their lines from the .lp"
+            ),
+        )
+    return paths
 
 
 def held_out_lights(dirs: np.ndarray, seed: int = 0) -> np.ndarray:

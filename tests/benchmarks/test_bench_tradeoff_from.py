@@ -174,3 +174,29 @@ def test_the_summary_and_the_plots_name_the_same_best_floor_even_one_short_of_a_
     text = summarise_from(rows, 1.0, "test", ["a.jpg", "b.jpg", "c.jpg"])
     assert "(30°, hindsight)" in text
     assert "no layout: too few lights above 30°" in text
+
+
+@pytest.mark.parametrize(
+    ("listed", "hint"),
+    [("image01.JPG", "image01.jpg is there"), ("gone.jpg", "copy them where their names point")],
+)
+def test_a_missing_image_is_named_with_its_lp_and_what_to_do(
+    tmp_path: Path, listed: str, hint: str
+) -> None:
+    """A missing image (or one listed in another case than the file: ``image01.JPG`` for
+    ``image01.jpg``) had been told "cannot read image …: there is no such file", without the
+    .lp or the reason, after the other images were read: it is named with the .lp, the count
+    and what to do, as run and fit say it, before anything is written."""
+    import shutil
+
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ.parent, acq)
+    lp = acq / "dirs.lp"
+    lp.write_text(lp.read_text().replace("image01.jpg", listed, 1))
+    out = tmp_path / "o"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out)])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, r.output
+    assert f"{lp}: 1 of 18 image(s) it lists are missing ({listed})" in text
+    assert hint in text
+    assert not out.exists() or not any(out.iterdir())
