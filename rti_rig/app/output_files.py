@@ -5,8 +5,21 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
+from rti_rig.app.config import LoadedRig
 from rti_rig.core.errors import RtiRigError
 from rti_rig.runtime.session import MANIFEST
+
+
+def rig_inputs(rig: Path, loaded: LoadedRig) -> dict[str, Path | None]:
+    """The files a loaded rig config makes a command read: the config itself and a dome's LED
+    calibration ``.lp`` (its ``lp_file``). Why: an ``--out --force`` onto that ``.lp`` had
+    replaced the dome's LED directions with the command's output (a light calibration's
+    TOML), and every later command on that rig was refused at load."""
+    inputs: dict[str, Path | None] = {"RIG": rig}
+    dome = loaded.config.dome
+    if dome is not None and dome.lp_file:
+        inputs["rig's LED calibration (lp_file)"] = loaded.folder / dome.lp_file
+    return inputs
 
 
 def check_output_file(

@@ -22,7 +22,7 @@ from rti_rig.app.light_calibration import (
     card_spread_deg,
     read_card_session,
 )
-from rti_rig.app.output_files import check_output_file
+from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
@@ -84,7 +84,7 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             "replaced, even with --force, which replaces only a file named by --out); give "
             "--out to write the calibration elsewhere"
         )
-    check_output_file(target, req.force, {"RIG": req.rig_config})
+    check_output_file(target, req.force, rig_inputs(req.rig_config, loaded))
     spread = 0.0 if req.not_flat_ok else card_spread_deg(card)
     if spread > MAX_CARD_SPREAD_DEG:
         # an object's session had been "calibrated" into a correction the user was told to
