@@ -116,7 +116,9 @@ def preview_schedule(
         schedule = LightSchedule.from_directions([wanted], method="preview", provenance=prov)
     _, got = az_el_from_direction(schedule.steps[0].direction)
     lo, hi = PREVIEW_BAND_DEG
-    if not lo <= float(got) <= hi:
+    # with the tolerance of the band checks above: an arm sent to 30° reads back 29.99...°
+    # from its direction, and had been told "at 30° elevation: outside 30–70°"
+    if not lo - 1e-9 <= float(got) <= hi + 1e-9:
         notes.append(
             f"the preview light is at {float(got):.0f}° elevation: outside {lo:g}–{hi:g}°, "
             "its shading says little about the relief (the paper shoots at 45–60°)"

@@ -353,3 +353,28 @@ def test_the_rig_is_closed_whatever_interrupts_the_start(
     with pytest.raises(KeyboardInterrupt):
         uc._open_new(loaded, [], tmp_path / "new", False, 0.001, uc._ignore)  # type: ignore[arg-type]
     assert rig.closed
+
+
+def test_an_arm_preview_at_the_edge_of_the_shading_band_is_not_called_outside_it(
+    tmp_path: Path,
+) -> None:
+    """`preview virtual_arm.toml --max-elevation-deg 30` shoots at 30°, which the direction
+    reads back as 29.99...°: the note had said "at 30° elevation: outside 30–70°". A preview
+    really outside the band (25°) is still noted."""
+    cfg = write_config(
+        tmp_path,
+        (REPO / "rig_configs" / "virtual_arm.toml")
+        .read_text()
+        .replace("width = 512", "width = 48")
+        .replace("height = 512", "height = 48"),
+    )
+    r = runner.invoke(
+        app, ["preview", str(cfg), "--out", str(tmp_path / "p30"), "--max-elevation-deg", "30"]
+    )
+    assert r.exit_code == 0, r.output
+    assert "says little about the relief" not in said(r)
+    r = runner.invoke(
+        app, ["preview", str(cfg), "--out", str(tmp_path / "p25"), "--max-elevation-deg", "25"]
+    )
+    assert r.exit_code == 0, r.output
+    assert "the preview light is at 25° elevation: outside 30–70°" in said(r)
