@@ -80,8 +80,10 @@ def calibrate_lights(
     ] = False,
 ) -> None:
     """Measure each LED's light from a card session and write the intensity correction that
-    evens the dome out (every LED dimmed to the weakest one's light), for [dome.serial]
+    evens the dome out (every LED dimmed to the weakest one's light), for \\[dome.serial]
     intensity_correction_file in the rig config."""
+    # the backslash above keeps typer's rich help from reading "[dome.serial]" as markup and
+    # dropping it (tests/cli/test_help_markup.py)
 
     import numpy as np
 

@@ -88,7 +88,8 @@ def plan(
             help="Image noise proportional to the signal, as a fraction (normals objective): "
             "0.05 models 8-bit JPEG captures on a dome without LED intensity calibration "
             "(docs/research/planner.md); 0 models additive noise only. Default: the rig config's "
-            "[camera] signal_noise (0 if absent, and for a bare .lp).",
+            # escaped: rich help reads a bare [camera] as markup and drops it
+            "\\[camera] signal_noise (0 if absent, and for a bare .lp).",
         ),
     ] = None,
     material: Annotated[
