@@ -11,14 +11,26 @@ from rti_rig.runtime.session import MANIFEST
 
 
 def rig_inputs(rig: Path, loaded: LoadedRig) -> dict[str, Path | None]:
-    """The files a loaded rig config makes a command read: the config itself and a dome's LED
-    calibration ``.lp`` (its ``lp_file``). Why: an ``--out --force`` onto that ``.lp`` had
-    replaced the dome's LED directions with the command's output (a light calibration's
-    TOML), and every later command on that rig was refused at load."""
+    """The files a loaded rig config makes a command read: the config itself, a dome's LED
+    calibration ``.lp`` (``lp_file``), its LED intensity correction
+    (``intensity_correction_file``) and its LED map (``led_map_file``). Why: an ``--out
+    --force`` onto one of them had replaced it with the command's output (a light
+    calibration's TOML over the LED ``.lp``, a plan over the intensity correction), after
+    which every command on that rig was refused at load."""
     inputs: dict[str, Path | None] = {"RIG": rig}
     dome = loaded.config.dome
-    if dome is not None and dome.lp_file:
+    if dome is None:
+        return inputs
+    if dome.lp_file:
         inputs["rig's LED calibration (lp_file)"] = loaded.folder / dome.lp_file
+    serial = (loaded.raw.get("dome") or {}).get("serial") or {}
+    name = serial.get("intensity_correction_file")
+    if isinstance(name, str) and name:  # relative to the config's real folder, as it is read
+        inputs["rig's LED intensity correction (intensity_correction_file)"] = (
+            Path(loaded.path).resolve().parent / name
+        )
+    if dome.serial is not None and dome.serial.led_map_file:
+        inputs["rig's LED map (led_map_file)"] = Path(dome.serial.led_map_file)
     return inputs
 
 

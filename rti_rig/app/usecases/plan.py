@@ -14,7 +14,7 @@ from pathlib import Path
 
 from rti_rig.app.compose import arm_order_for, read_preview_image
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
-from rti_rig.app.output_files import check_output_file
+from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.app.preview_source import resolve_preview
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import direction_from_az_el
@@ -102,14 +102,15 @@ def _signal_noise(req: PlanLightsRequest, loaded: LoadedRig | None, objective: s
 
 
 def _check_outputs(req: PlanLightsRequest, loaded: LoadedRig | None) -> None:
+    # the rig's own files (its LED .lp, intensity correction, LED map) are inputs too
+    rig_files = {} if loaded is None else rig_inputs(req.rig, loaded)
+    rig_files.pop("RIG", None)  # named "rig file" here
     inputs: dict[str, Path | None] = {
         "preview": req.preview,
         "rig file": req.rig,
         "depth model": req.depth_model,
+        **rig_files,
     }
-    if loaded is not None and loaded.config.dome is not None and loaded.config.dome.lp_file:
-        # the dome's LED calibration is an input too
-        inputs["rig's LED calibration (lp_file)"] = loaded.folder / loaded.config.dome.lp_file
     check_output_file(req.out_file, req.force, inputs)
     if req.figure is not None:
         from rti_rig.app.plan_figure import check_figure_path  # matplotlib only when asked
