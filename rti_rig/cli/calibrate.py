@@ -114,8 +114,13 @@ def calibrate_lights(
     measured = np.flatnonzero(cal.measured)
     elevation = np.degrees(np.arcsin(np.clip(geometry.directions[measured] @ normal, -1, 1)))
     lowest = float(elevation.min())
-    weak, strong = int(np.argmin(cal.output)), int(np.argmax(cal.output))
+    weak = int(np.argmin(cal.output))  # the LED the correction evens out to
+    # the extremes this session measured: with a correction in force an LED it did not shoot
+    # is assumed at its old figure, and had been named as if measured ("is still 0.74 to 1.57
+    # (LED 38)" from a card session of 12 LEDs without LED 38)
+    low, high = (int(measured[f(cal.output[measured])]) for f in (np.argmin, np.argmax))
     names = geometry.names
+    each = "each LED" if cal.measured.all() else "each measured LED"
 
     def led(i: int) -> str:
         """An LED as the dome names it and as the session shot it (the image to open)."""
@@ -140,16 +145,17 @@ def calibrate_lights(
             + (" — the dome is even." if cal.shot_spread < even_enough else ".")
         )
         out.print(
-            f"Each LED's own light, without the correction, is still {cal.output[weak]:.2f} "
-            f"({escape(led(weak))}) to {cal.output[strong]:.2f} "
-            f"({escape(led(strong))}) of the median; the new correction "
+            f"{each[0].upper()}{each[1:]}'s own light, without the correction, is still "
+            f"{cal.output[low]:.2f} "
+            f"({escape(led(low))}) to {cal.output[high]:.2f} "
+            f"({escape(led(high))}) of the median; the new correction "
             f"differs from the one in force by at most {100 * change:.1f} %."
         )
     else:
         out.print(
-            f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; each LED's own light "
-            f"from {cal.output[weak]:.2f} ({escape(led(weak))}) to "
-            f"{cal.output[strong]:.2f} ({escape(led(strong))}) of the median."
+            f"Lights as shot: spread {100 * cal.shot_spread:.1f} % RMS; {each}'s own light "
+            f"from {cal.output[low]:.2f} ({escape(led(low))}) to "
+            f"{cal.output[high]:.2f} ({escape(led(high))}) of the median."
         )
     out.print(
         f"Evened out, every LED gives {cal.evened_light:.2f} of the median LED's light "
