@@ -178,6 +178,13 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     )
     if light_note and report.preview_light_source == "given":
         report.preview_light_source = light_note
+    if req.signal_noise and not report.signal_noise:
+        # as --material's note says (planner.make_plan): an option given and silently unused
+        # had read as if the plan modelled the JPEG noise
+        report.notes.append(
+            f"--signal-noise {req.signal_noise:g} is not used: no surface was modelled "
+            f"({method} needs none)"
+        )
     if bare_lp:
         # the acquisition's own names, written as the .lp profile allows (no whitespace): a
         # name with spaces (RTIBuilder's 'H:\\RTI Data\\...' paths) had stopped the plan with a
