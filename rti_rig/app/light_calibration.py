@@ -302,6 +302,31 @@ def _work_image(pixels: NDArray[Any]) -> NDArray[np.float32]:
     return (small.mean(axis=2) if small.ndim == 3 else small).astype(np.float32)
 
 
+#: The fewest measured LEDs the gain estimate takes (:func:`estimate_light_gains`).
+MIN_MEASURED_LEDS = 4
+
+
+def _check_enough_above(
+    card: CardSession, card_normal: Sequence[float], min_elevation_deg: float
+) -> None:
+    """Refuse, naming ``--min-elevation-deg``, a floor that leaves too few LEDs to measure.
+
+    Why: the gain estimate's own refusal ("only 0 lights light the card at shading >= 0.985:
+    need 4; is the card's normal right?") pointed at the card's normal when the floor the user
+    gave was the cause."""
+    normal = np.asarray(card_normal, dtype=np.float64)
+    normal = normal / np.linalg.norm(normal)
+    above = np.degrees(np.arcsin(np.clip(card.directions @ normal, -1.0, 1.0)))
+    usable = int((above >= min_elevation_deg - 1e-9).sum())
+    if usable < MIN_MEASURED_LEDS:
+        raise ReconstructionError(
+            f"{card.root}: only {usable} of its {len(above)} LEDs are at or above "
+            f"--min-elevation-deg {min_elevation_deg:g} above the card (the highest at "
+            f"{float(above.max()):.1f}°), and measuring needs at least {MIN_MEASURED_LEDS}: "
+            "lower --min-elevation-deg (default 5)"
+        )
+
+
 def calibrate_dome(
     card: CardSession,
     led_count: int,
@@ -327,6 +352,7 @@ def calibrate_dome(
         )
     if not 0.0 < min_elevation_deg < 90.0:
         raise ReconstructionError(f"min_elevation_deg must be in (0, 90), got {min_elevation_deg}")
+    _check_enough_above(card, card_normal, min_elevation_deg)
     gains = estimate_light_gains(
         card.images,
         card.directions,
