@@ -32,6 +32,20 @@ def _parse_normal(text: str) -> tuple[float, float, float]:
     return (x / norm, y / norm, z / norm)
 
 
+def _how_to_set(raw: dict) -> str:  # type: ignore[type-arg]
+    """How the calibration line goes into the rig config: added, or replacing the correction
+    the config already names. Why: a config with a correction was told to "add" the line, and
+    a second ``intensity_correction_file`` under ``[dome.serial]`` is refused as invalid TOML
+    ("Cannot overwrite a value"); ``intensity_correction`` and the file may not be given
+    together either."""
+    serial = (raw.get("dome") or {}).get("serial") or {}
+    if "intensity_correction_file" in serial:
+        return "replace its intensity_correction_file line under"
+    if "intensity_correction" in serial:
+        return "replace its intensity_correction = [...] with this line under"
+    return "add under"
+
+
 @app.command("calibrate-lights")
 def calibrate_lights(
     card_session: Annotated[
@@ -189,7 +203,8 @@ def calibrate_lights(
         )
     else:
         out.print(
-            f"To use it, add under {escape('[dome.serial]')} in {escape(str(rig_config))}:",
+            f"To use it, {_how_to_set(loaded.raw)} {escape('[dome.serial]')} in "
+            f"{escape(str(rig_config))}:",
             highlight=False,
         )
     # the line to paste, on its own and never wrapped (a wrapped line pastes as two)
