@@ -364,6 +364,10 @@ def write_csv(rows: list[Row], path: Path) -> Path:
     return path
 
 
+#: The naive uniform series' name when floor 0° is also the scene's best floor (one line).
+NAIVE_IS_BEST = "uniform (floor 0°, also the best here)"
+
+
 def _series(rows: list[Row], scene: str) -> dict[str, list[Row]]:
     """Rows per plotted series: naive uniform, uniform at the scene's best floor, planners."""
     floor = best_floor(rows, scene)
@@ -375,7 +379,7 @@ def _series(rows: list[Row], scene: str) -> dict[str, list[Row]]:
             # when floor 0° is also the best floor, one line says so (two lines drawn on top
             # of each other had hidden the first under the second)
             if r.floor_deg == 0.0:
-                label = "uniform" if floor != 0.0 else "uniform (floor 0°, also the best here)"
+                label = "uniform" if floor != 0.0 else NAIVE_IS_BEST
                 out.setdefault(label, []).append(r)
             elif r.floor_deg == floor:
                 out.setdefault(f"uniform, floor {floor:g}°", []).append(r)
@@ -469,18 +473,19 @@ def _verdicts(scene: str, series: dict[str, list[Row]], counts: list[int]) -> li
     def at(name: str, n: int) -> Row | None:
         return next((r for r in series.get(name, []) if r.n == n), None)
 
-    floor_name = next((k for k in series if k.startswith("uniform, floor")), "uniform")
+    # the naive series is named for what it is when floor 0° is also the best: every
+    # comparison below had looked for "uniform", found nothing, and said "never worse" and
+    # "never beats" of comparisons it had not made
+    naive = NAIVE_IS_BEST if NAIVE_IS_BEST in series else "uniform"
+    floor_name = next((k for k in series if k.startswith("uniform, floor")), naive)
     out = []
-    km = [
-        n
-        for n in counts
-        if (a := at("kmeans (normals)", n))
-        and (b := at("uniform", n))
-        and a.normal_mean_deg < b.normal_mean_deg
-    ]
-    if not km:
+    pairs = {n: (a, b) for n in counts if (a := at("kmeans (normals)", n)) and (b := at(naive, n))}
+    km = [n for n, (a, b) in pairs.items() if a.normal_mean_deg < b.normal_mean_deg]
+    if not pairs:
+        verdict = "was not compared with naive uniform (no N with both)"
+    elif not km:
         verdict = "never beats naive uniform on normals"
-    elif len(km) == len(counts):
+    elif len(km) == len(pairs):
         verdict = "beats naive uniform on normals at every N"
     else:
         verdict = f"beats naive uniform on normals only at N = {', '.join(map(str, km))}"
@@ -492,16 +497,21 @@ def _verdicts(scene: str, series: dict[str, list[Row]], counts: list[int]) -> li
         name = f"optimal ({objective})"
         worse = []
         gains = []
+        compared = 0
         for n in counts:
             a, b = at(name, n), at(floor_name, n)
             if a is None or b is None:
                 continue
+            compared += 1
             va, vb = getattr(a, key), getattr(b, key)
             if not better(va, vb) and not np.isclose(va, vb, rtol=1e-3):
                 worse.append(n)
             if n <= 10:
                 gains.append(vb - va if key == "normal_mean_deg" else va - vb)
         unit = "°" if key == "normal_mean_deg" else " dB"
+        if not compared:
+            out.append(f"  - optimal/{objective} vs {floor_name}: not compared (no N with both).")
+            continue
         out.append(
             f"  - optimal/{objective} vs {floor_name} on {key}: "
             + (f"worse at N = {', '.join(map(str, worse))}" if worse else "never worse")

@@ -138,3 +138,48 @@ def test_fault_campaign_writes_only_its_own_section(
     assert "old figures" not in text and "# Reliability: fault campaign" in text
     assert "## Emulators on a pty under CPU load\n\nkept\n" in text
     assert "firmware figures" in text
+
+
+def _row(method: str, objective: str, n: int, floor: float, deg: float, db: float):  # type: ignore[no-untyped-def]
+    from benchmarks.tradeoff import Row
+
+    return Row(
+        "painting", method, objective, n, floor, deg, deg, 1.0, "ptm", db, 0.9, 1.0, 1.0, 0.0
+    )
+
+
+def test_the_verdicts_compare_with_naive_uniform_when_floor_0_is_also_the_best() -> None:
+    """With floor 0° the scene's best, the naive series is named "uniform (floor 0°, also the
+    best here)"; the verdicts had looked for "uniform", compared nothing, and said "never
+    worse" of an optimal plan 4 dB worse in their own table (bench tradeoff --quick,
+    painting). Here optimal loses on relighting at both N and k-means beats uniform at N = 8."""
+    from benchmarks.tradeoff import _series, _verdicts
+
+    rows = []
+    for n in (6, 8):
+        rows += [
+            _row("uniform", "normals", n, 0.0, 1.0, 33.5),
+            _row("uniform", "normals", n, 20.0, 2.0, 30.0),  # a worse floor: 0° is the best
+            _row("optimal", "normals", n, 0.0, 0.9, 33.0),
+            _row("optimal", "relight", n, 0.0, 1.2, 29.5),
+            _row("kmeans", "normals", n, 0.0, 1.1 if n == 6 else 0.95, 30.0),
+        ]
+    series = _series(rows, "painting")
+    assert "uniform (floor 0°, also the best here)" in series and "uniform" not in series
+    text = "\n".join(_verdicts("painting", series, [6, 8]))
+    assert "beats naive uniform on normals only at N = 8" in text
+    assert "optimal/relight vs uniform (floor 0°, also the best here) on relight_psnr_db: " in text
+    assert "worse at N = 6, 8" in text
+    assert (
+        "optimal/normals vs uniform (floor 0°, also the best here) on normal_mean_deg: never worse"
+        in text
+    )
+    assert "mean gain at N ≤ 10: -4.00 dB" in text
+
+
+def test_a_verdict_with_nothing_to_compare_says_so() -> None:
+    from benchmarks.tradeoff import _verdicts
+
+    text = "\n".join(_verdicts("painting", {}, [6, 8]))
+    assert "never" not in text
+    assert "was not compared with naive uniform" in text and "not compared (no N with both)" in text
