@@ -76,9 +76,13 @@ def run(
         ),
     ] = False,
     max_saturated: Annotated[
-        float,
-        typer.Option("--max-saturated", help="Largest fraction of saturated pixels allowed."),
-    ] = 0.001,
+        float | None,
+        typer.Option(
+            "--max-saturated",
+            help="With --auto-exposure: the largest fraction of saturated pixels its metering "
+            "allows (default 0.001, 0.1 %).",
+        ),
+    ] = None,
     resume: Annotated[
         Path | None,
         typer.Option(
@@ -179,6 +183,7 @@ def run(
                             ("--until-error", until_error is not None),
                             ("--min-lights", min_lights is not None),
                             ("--auto-exposure", auto_exposure),
+                            ("--max-saturated", max_saturated is not None),
                             ("--min-elevation-deg", min_elevation_deg != 0.0),
                             ("--max-elevation-deg", max_elevation_deg != 90.0),
                         )
@@ -193,7 +198,6 @@ def run(
                         ResumeRequest(
                             resume,
                             rig_config,
-                            max_saturated=max_saturated,
                             accept_rig_change=accept_rig_change,
                             objective=objective,
                             reshoot_lost=reshoot_lost,
@@ -209,6 +213,7 @@ def run(
                         raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
                     if reshoot_lost:
                         raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
+                    refuse_unmetered_limit(max_saturated, auto_exposure)
                     opened = open_new_session(
                         NewSessionRequest(
                             rig_config,
@@ -218,7 +223,7 @@ def run(
                             min_elevation_deg=min_elevation_deg,
                             max_elevation_deg=max_elevation_deg,
                             auto_exposure=auto_exposure,
-                            max_saturated=max_saturated,
+                            **_metering_limit(max_saturated),
                             adaptive=adaptive,
                             until_error_deg=until_error,
                             objective=objective,
@@ -272,6 +277,23 @@ def run(
 
             with _verdict_terminable():
                 print_verdict(opened.out_dir)
+
+
+def _metering_limit(max_saturated: float | None) -> dict[str, float]:
+    """The request's ``max_saturated`` where the option was given (else its default)."""
+    return {} if max_saturated is None else {"max_saturated": max_saturated}
+
+
+def refuse_unmetered_limit(max_saturated: float | None, auto_exposure: bool) -> None:
+    """``--max-saturated`` without ``--auto-exposure`` is refused: only metering reads it, so
+    it had been accepted and ignored, the config's exposure used as it is (an option that
+    does nothing must not look as if it did)."""
+    if max_saturated is not None and not auto_exposure:
+        raise RtiRigError(
+            f"--max-saturated {max_saturated:g} sets how much --auto-exposure's metering lets "
+            "clip; without --auto-exposure the config's exposure is used as it is: add "
+            "--auto-exposure, or drop --max-saturated"
+        )
 
 
 def _stopped_while_opening(
@@ -734,9 +756,13 @@ def preview(
         ),
     ] = False,
     max_saturated: Annotated[
-        float,
-        typer.Option("--max-saturated", help="Largest fraction of saturated pixels allowed."),
-    ] = 0.001,
+        float | None,
+        typer.Option(
+            "--max-saturated",
+            help="With --auto-exposure: the largest fraction of saturated pixels its metering "
+            "allows (default 0.001, 0.1 %).",
+        ),
+    ] = None,
 ) -> None:
     """Shoot the planner's preview: one image under one light, as a session of one image.
 
@@ -747,6 +773,7 @@ def preview(
     from rti_rig.runtime.controller import EmergencyStop
 
     try:
+        refuse_unmetered_limit(max_saturated, auto_exposure)
         with _terminable_while_opening():
             opened = open_preview_session(
                 PreviewRequest(
@@ -754,7 +781,7 @@ def preview(
                     out_dir,
                     parse_az_el(light, "--light"),
                     auto_exposure=auto_exposure,
-                    max_saturated=max_saturated,
+                    **_metering_limit(max_saturated),
                     min_elevation_deg=min_elevation_deg,
                     max_elevation_deg=max_elevation_deg,
                 ),

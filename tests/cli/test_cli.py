@@ -144,6 +144,15 @@ def test_plan_on_bare_lp_keeps_original_names(tmp_path: Path) -> None:
         (["export-lp", "{cfg}", "--out", "{tmp}/x.lp"], "is a file: give the session folder"),
         (["run", "{cfg}", "--out", "{tmp}/s", "--plan", "{tmp}/under.lp"], "under.lp, line 2"),
         (["run", "{cfg}", "--out", "{tmp}/s", "--auto-exposure", "--max-saturated", "2"], "[0, 1)"),
+        # only metering reads it: accepted and ignored without --auto-exposure until 2026-11-29
+        (
+            ["run", "{cfg}", "--out", "{tmp}/s", "--max-saturated", "0.01"],
+            "--max-saturated 0.01 sets how much --auto-exposure's metering lets clip",
+        ),
+        (
+            ["preview", "{cfg}", "--out", "{tmp}/s", "--max-saturated", "0.01"],
+            "add --auto-exposure, or drop --max-saturated",
+        ),
         (["run", "{cfg}", "--out", "{tmp}/s", "--min-elevation-deg", "95"], "in [0, 90)"),
         (["check", "{cfg}", "--intensity", "1.5"], "--intensity 1.5: give the LED drive level"),
         (["check", "{cfg}", "--intensity", "0"], "fraction in (0, 1]"),
