@@ -817,6 +817,30 @@ def preview(
         markup=False,
         soft_wrap=True,
     )
+    metered = _metered_apart(opened) if auto_exposure else None
+    if metered is not None:
+        out.print(
+            f"Then: rti-rig run {shlex.quote(str(rig_config))} --plan plan.lp --out SESSION "
+            f"--auto-exposure (this preview was metered at {metered[0]:.4g} s; without "
+            f"--auto-exposure the run uses the config's exposure_s = {metered[1]:g} s)",
+            highlight=False,
+            markup=False,
+            soft_wrap=True,
+        )
+
+
+def _metered_apart(opened) -> tuple[float, float] | None:  # type: ignore[no-untyped-def]
+    """(the exposure the preview was metered at, the config's) when they differ by more than
+    1 %: the run a plan leads to uses the config's exposure unless it meters again, and the
+    preview's metering is not carried over (a plan holds lights, not an exposure). Said after
+    a metered preview: on the emulated dome a run at the config's 0.05 s after a preview
+    metered at 0.0074 s had clipped, and its verdict said reshoot."""
+    steps = opened.schedule.steps
+    chosen = steps[0].exposure_s if steps else None
+    config = opened.rig.camera_config.exposure_s
+    if chosen is None or abs(chosen - config) <= 0.01 * config:
+        return None
+    return float(chosen), float(config)
 
 
 @app.command("export-lp")
