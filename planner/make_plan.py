@@ -262,8 +262,9 @@ def check_plan_options(
     if n < MIN_PLAN_LIGHTS:
         raise ScheduleError(
             f"--lights {n}: plan at least {MIN_PLAN_LIGHTS} lights; fewer cannot determine a "
-            "surface normal (photometric stereo needs 3, a PTM 6, an HSH fit.rti 4), so no "
-            "planner can do better than another (a 2-light plan read 90° expected error)"
+            "surface normal (photometric stereo needs 3, a PTM 6, the fit.rti rti-rig fit "
+            "writes 5), so no planner can do better than another (a 2-light plan read 90° "
+            "expected error)"
         )
     if n > MAX_LIGHTS:
         raise ScheduleError(
