@@ -581,7 +581,8 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
     # "24 of 24 lights" for --lights 24 on a 48-LED dome read as if the dome had 24: a new
     # session says its count, a resumed one what is left of it
     todo, total = opened.steps_to_do, opened.total_steps
-    count = f"{todo} lights" if todo == total else f"{todo} of {total} lights left"
+    noun = "light" if todo == 1 else "lights"
+    count = f"{todo} {noun}" if todo == total else f"{todo} of {total} {noun} left"
     out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
     resume_hint = f"Continue with: rti-rig run --resume {_arg(out_dir)}"
     if getattr(rig.lighting, "resume_hint", None):  # a dome whose own count cannot resume

@@ -39,3 +39,4 @@ def test_an_unmetered_preview_adds_nothing(tmp_path: Path) -> None:
     r = runner.invoke(app, ["preview", str(DOME), "--out", str(tmp_path / "p")])
     assert r.exit_code == 0, r.output
     assert "Plan from it:" in said(r) and "--auto-exposure" not in said(r)
+    assert "(dry run): 1 light →" in said(r)  # it had said "1 lights"
