@@ -451,8 +451,8 @@ def assess(
         for i in np.flatnonzero(edge_moved):
             crop_arr[i] = move_back(crop_arr[i], float(edge_dev[i, 0]), float(edge_dev[i, 1]))
 
-    def evidence_of(fit: Any) -> _Evidence:
-        ev = _evidence(crop_arr, crop_sat, fit, lt, dark_level, names)
+    def evidence_of(fit: Any, still: NDArray[np.bool_] | None = None) -> _Evidence:
+        ev = _evidence(crop_arr, crop_sat, fit, lt, dark_level, names, still)
         for i in np.flatnonzero(edge_moved):
             ev.moved[i] = True
             ev.drift_judged[i] = True
@@ -518,6 +518,21 @@ def assess(
     drift_note = ""
     if not edges_trusted and poor_fit > MISFIT_LIMIT:
         noise = still_spread_px(edge_dev)
+        unclaimed = np.array(
+            [
+                bool(ev.moved[i]) and not _edges_agree(ev.drift[i], edge_dev[i], noise)
+                for i in range(n)
+            ],
+            dtype=bool,
+        )
+        if unclaimed.any():
+            # Their images had been moved back by that unclaimed shift before their brightness
+            # was judged: moved 113-125 px on a 256 px crop, the warp's black fill made the
+            # emulated coin's two brightest images "misfired or dim: 0% of the brightness of
+            # the images of its 4 nearest lights". Judge them again as captured.
+            ev = evidence_of(ps, still=unclaimed)
+            finite = np.isfinite(ev.misfit)
+            poor_fit = float(np.median(ev.misfit[finite])) if finite.any() else float("inf")
         for i in range(n):
             if ev.moved[i] and not _edges_agree(ev.drift[i], edge_dev[i], noise):
                 ev.moved[i] = False
@@ -687,8 +702,11 @@ def _evidence(
     lt: NDArray,
     dark: float,
     names: Sequence[str],
+    still: NDArray[np.bool_] | None = None,
 ) -> _Evidence:
-    """Every image judged against one fit ``ps``."""
+    """Every image judged against one fit ``ps``. Images in ``still`` are judged as captured,
+    never moved back by a shift against the fit: one the verdict does not claim (see
+    :func:`assess`) must not have its brightness measured on a copy moved by it."""
     n = crop_arr.shape[0]
     valid = ps.valid
     rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
@@ -720,7 +738,7 @@ def _evidence(
         drift_judged[i] = lit_frac >= DRIFT_MIN_LIT
         compare = valid & (shade > 0.2) & ~crop_sat[i]
         img = raw
-        if drift_judged[i] and np.hypot(dx, dy) > DRIFT_PX:
+        if drift_judged[i] and np.hypot(dx, dy) > DRIFT_PX and not (still is not None and still[i]):
             moved[i], img = _confirmed_shift(pred, raw, dx, dy, compare)
         images.append(img)
         drift.append((dx, -dy))  # x right, y up (DESIGN.md)
