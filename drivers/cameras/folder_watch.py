@@ -7,6 +7,14 @@ Files present at ``connect`` are ignored; each file is used once; a file counts 
 size has stopped changing (the writer may still be copying it). Optionally an injected
 ``trigger(exposure_s)`` fires the shutter (e.g. the dome driver's shutter-line command).
 
+"Used once" is by the file, not only by its name: many tethering programs save under one name
+and rename afterwards (``capt0000.CR2`` → ``IMG_0001.CR2``, or a hidden ``.IMG_0001.CR2``
+temporary → ``IMG_0001.CR2``). A rename keeps the file's device, inode, size and modification
+time, so a file with the identity of one already seen is not a new shot; taken by name alone it
+had been the *next* light's image, every later image one light off. Hidden files (a leading
+dot) are the temporaries of such programs and of sync tools (rsync's ``.name.XXXXXX``), never a
+finished shot, and are not looked at.
+
 Safe state: nothing to release (no device handle); ``close`` forgets the seen files.
 """
 
@@ -61,6 +69,16 @@ def is_raw_file(path: Path) -> bool:
     return path.suffix.lower() in RAW_SUFFIXES
 
 
+def _identity(path: Path) -> tuple[int, int, int, int] | None:
+    """(device, inode, size, mtime in ns) of ``path``, or None if it is gone: what a rename
+    keeps, so a used file that reappears under another name is recognised."""
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
 class FolderWatchCamera:
     """Implements the ``Camera`` protocol by waiting for new files in a folder."""
 
@@ -75,6 +93,10 @@ class FolderWatchCamera:
         self._clock = clock or SystemClock()
         self._trigger = trigger
         self._seen: set[str] | None = None
+        #: (device, inode, size, mtime) of every file seen: a renamed one keeps all four
+        self._seen_ids: set[tuple[int, int, int, int]] = set()
+        #: names of used files that reappeared as another file (reported at a timeout)
+        self._reused_names: set[str] = set()
 
     def connect(self) -> None:
         folder = self.settings.folder
@@ -85,10 +107,14 @@ class FolderWatchCamera:
                 "folder; create it or fix 'folder' in the rig config",
                 "connect",
             )
-        self._seen = {p.name for p in self._matching()}
+        present = self._matching()
+        self._seen = {p.name for p in present}
+        self._seen_ids = {i for i in map(_identity, present) if i is not None}
+        self._reused_names = set()
 
     def close(self) -> None:
         self._seen = None
+        self._seen_ids = set()
 
     def __enter__(self) -> FolderWatchCamera:
         self.connect()
@@ -101,6 +127,8 @@ class FolderWatchCamera:
         found: dict[str, Path] = {}
         for pattern in self.settings.patterns:
             for p in self.settings.folder.glob(pattern):
+                if p.name.startswith("."):  # a tethering or sync tool's temporary
+                    continue
                 if p.is_file():
                     found[p.name] = p
         return list(found.values())
@@ -108,12 +136,16 @@ class FolderWatchCamera:
     def _new_files(self, seen: set[str]) -> list[Path]:
         new = []
         for p in self._matching():
+            ident = _identity(p)
+            if ident is None:  # removed between glob and stat
+                continue
             if p.name in seen:
+                if ident[:2] not in {i[:2] for i in self._seen_ids}:  # another file
+                    self._reused_names.add(p.name)
                 continue
-            try:
-                new.append((p.stat().st_mtime_ns, p.name, p))
-            except FileNotFoundError:  # removed between glob and stat
+            if ident in self._seen_ids:  # a file already seen, renamed
                 continue
+            new.append((ident[3], p.name, p))
         return [p for _, _, p in sorted(new)]
 
     def wait_for_file(self) -> Path:
@@ -138,14 +170,26 @@ class FolderWatchCamera:
                     stable = 1 if size > 0 else 0
                 last = (path.name, size)
                 if stable >= s.stable_polls:
-                    self._seen.add(path.name)
-                    return path
+                    ident = _identity(path)
+                    if ident is not None:
+                        self._seen.add(path.name)
+                        self._seen_ids.add(ident)
+                        return path
             if self._clock.now() - start >= s.timeout_s:
                 growing = f"; {last[0]} appeared but was still being written" if last else ""
+                reused = ""
+                if self._reused_names:
+                    names = ", ".join(sorted(self._reused_names))
+                    reused = (
+                        f"; {names} appeared again as another file, but a name is used once "
+                        "(an earlier shot had it): have the tethering program give every shot "
+                        "its own file name"
+                    )
                 raise CaptureError(
                     self.name,
                     f"no new file matching {list(s.patterns)} in {s.folder} within "
-                    f"{s.timeout_s:g} s{growing}: is the camera firing and saving there?",
+                    f"{s.timeout_s:g} s{growing}{reused}: is the camera firing and saving "
+                    "there?",
                     "wait for file",
                 )
             self._clock.sleep(s.poll_interval_s)

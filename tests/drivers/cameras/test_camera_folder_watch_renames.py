@@ -1,0 +1,103 @@
+"""Folder watch: a tethering program that saves under one name and renames afterwards.
+
+Many do (``capt0000.CR2`` → ``IMG_0001.CR2``, or a hidden ``.IMG_0001.CR2`` temporary →
+``IMG_0001.CR2``). Taken by name alone, the renamed file had been a new file: the next light's
+image was the previous light's picture, and every later image one light off, with no error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rti_rig.core.clock import VirtualClock
+from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
+from rti_rig.drivers.cameras.settings import FolderWatchSettings
+
+
+class ScriptedClock(VirtualClock):
+    """Virtual time; runs ``actions[t]`` once virtual time reaches ``t`` (a file appearing...)."""
+
+    def __init__(self, actions):
+        super().__init__()
+        self.actions = sorted(actions.items())
+
+    def sleep(self, seconds):
+        super().sleep(seconds)
+        while self.actions and self.actions[0][0] <= self.now():
+            self.actions.pop(0)[1]()
+
+
+def dng(path, level):
+    mosaic = linear_to_mosaic(np.full((32, 32), level), "RGGB", 256, 4095)
+    return write_dng(path, mosaic, black_level=256, white_level=4095, exposure_s=0.5, iso=100)
+
+
+def level_of(frame) -> float:
+    return float(np.mean(frame.pixels) / frame.white_level)
+
+
+def camera(tmp_path, actions, **kw):
+    settings = FolderWatchSettings(
+        folder=tmp_path, timeout_s=4.0, poll_interval_s=0.125, patterns=("*.DNG",), **kw
+    )
+    cam = FolderWatchCamera(settings, clock=ScriptedClock(actions))
+    cam.connect()
+    return cam
+
+
+def test_a_file_renamed_after_it_was_taken_is_not_the_next_shot(tmp_path):
+    # shot 1 saved as capt0000.DNG, renamed once written; shot 2 saved as IMG_0002.DNG
+    actions = {
+        0.25: lambda: dng(tmp_path / "capt0000.DNG", 0.2),
+        1.0: lambda: (tmp_path / "capt0000.DNG").rename(tmp_path / "IMG_0001.DNG"),
+        2.0: lambda: dng(tmp_path / "IMG_0002.DNG", 0.6),
+    }
+    cam = camera(tmp_path, actions)
+    first = cam.capture(0.5)
+    assert level_of(first) == pytest.approx(0.2, abs=1e-3)
+    second = cam.capture(0.5)
+    assert second.metadata["originals"][0]["name"] == "IMG_0002.DNG"
+    assert level_of(second) == pytest.approx(0.6, abs=1e-3)
+
+
+def test_a_hidden_temporary_is_not_taken_its_final_name_is(tmp_path):
+    def save_hidden(name, level):
+        dng(tmp_path / f".{name}", level)
+
+    actions = {
+        0.25: lambda: save_hidden("IMG_0001.DNG", 0.2),
+        1.0: lambda: (tmp_path / ".IMG_0001.DNG").rename(tmp_path / "IMG_0001.DNG"),
+        2.0: lambda: save_hidden("IMG_0002.DNG", 0.6),
+        3.0: lambda: (tmp_path / ".IMG_0002.DNG").rename(tmp_path / "IMG_0002.DNG"),
+    }
+    cam = camera(tmp_path, actions)
+    first = cam.capture(0.5)
+    assert first.metadata["originals"][0]["name"] == "IMG_0001.DNG"
+    assert level_of(first) == pytest.approx(0.2, abs=1e-3)
+    second = cam.capture(0.5)
+    assert second.metadata["originals"][0]["name"] == "IMG_0002.DNG"
+    assert level_of(second) == pytest.approx(0.6, abs=1e-3)
+
+
+def test_a_file_present_at_connect_and_renamed_is_not_a_shot(tmp_path):
+    dng(tmp_path / "old.DNG", 0.9)
+    cam = camera(tmp_path, {0.25: lambda: (tmp_path / "old.DNG").rename(tmp_path / "X.DNG")})
+    with pytest.raises(CaptureError, match="no new file"):
+        cam.capture(0.5)
+
+
+def test_a_name_used_again_by_another_file_is_refused_and_said_so(tmp_path):
+    # every shot saved as capt0000.DNG, the previous one renamed first: the second capt0000 is
+    # never taken (a name is used once), and the timeout says why
+    actions = {
+        0.25: lambda: dng(tmp_path / "capt0000.DNG", 0.2),
+        1.0: lambda: (tmp_path / "capt0000.DNG").rename(tmp_path / "IMG_0001.DNG"),
+        1.5: lambda: dng(tmp_path / "capt0000.DNG", 0.6),
+    }
+    cam = camera(tmp_path, actions)
+    cam.capture(0.5)
+    with pytest.raises(CaptureError, match=r"capt0000\.DNG appeared again.*its own file name"):
+        cam.capture(0.5)
