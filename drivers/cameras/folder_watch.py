@@ -15,6 +15,11 @@ had been the *next* light's image, every later image one light off. Hidden files
 dot) are the temporaries of such programs and of sync tools (rsync's ``.name.XXXXXX``), never a
 finished shot, and are not looked at.
 
+One shot may give two files (a camera set to RAW+JPEG: ``IMG_0001.CR2`` and ``IMG_0001.JPG``).
+When both match ``patterns``, the RAW is the shot's image and a file with the stem of a file
+already taken is never another shot (it had been the next light's image, the lights one off
+from there on).
+
 Safe state: nothing to release (no device handle); ``close`` forgets the seen files.
 """
 
@@ -97,6 +102,8 @@ class FolderWatchCamera:
         self._seen_ids: set[tuple[int, int, int, int]] = set()
         #: names of used files that reappeared as another file (reported at a timeout)
         self._reused_names: set[str] = set()
+        #: stems of the files taken: a later file with one is the same shot's other file
+        self._taken_stems: set[str] = set()
 
     def connect(self) -> None:
         folder = self.settings.folder
@@ -111,6 +118,7 @@ class FolderWatchCamera:
         self._seen = {p.name for p in present}
         self._seen_ids = {i for i in map(_identity, present) if i is not None}
         self._reused_names = set()
+        self._taken_stems = set()
 
     def close(self) -> None:
         self._seen = None
@@ -145,6 +153,8 @@ class FolderWatchCamera:
                 continue
             if ident in self._seen_ids:  # a file already seen, renamed
                 continue
+            if p.stem in self._taken_stems:  # the other file of a RAW+JPEG shot already taken
+                continue
             new.append((ident[3], p.name, p))
         return [p for _, _, p in sorted(new)]
 
@@ -160,6 +170,8 @@ class FolderWatchCamera:
             new = self._new_files(self._seen)
             if new:
                 path = new[0]
+                if not is_raw_file(path):  # RAW+JPEG: the RAW is the shot's image
+                    path = next((p for p in new if p.stem == path.stem and is_raw_file(p)), path)
                 try:
                     size = path.stat().st_size
                 except FileNotFoundError:
@@ -174,6 +186,7 @@ class FolderWatchCamera:
                     if ident is not None:
                         self._seen.add(path.name)
                         self._seen_ids.add(ident)
+                        self._taken_stems.add(path.stem)
                         return path
             if self._clock.now() - start >= s.timeout_s:
                 growing = f"; {last[0]} appeared but was still being written" if last else ""

@@ -3,6 +3,7 @@
 Many do (``capt0000.CR2`` → ``IMG_0001.CR2``, or a hidden ``.IMG_0001.CR2`` temporary →
 ``IMG_0001.CR2``). Taken by name alone, the renamed file had been a new file: the next light's
 image was the previous light's picture, and every later image one light off, with no error.
+The same happened to the JPEG of a RAW+JPEG shot when the patterns matched both.
 """
 
 from __future__ import annotations
@@ -39,9 +40,9 @@ def level_of(frame) -> float:
     return float(np.mean(frame.pixels) / frame.white_level)
 
 
-def camera(tmp_path, actions, **kw):
+def camera(tmp_path, actions, patterns=("*.DNG",), **kw):
     settings = FolderWatchSettings(
-        folder=tmp_path, timeout_s=4.0, poll_interval_s=0.125, patterns=("*.DNG",), **kw
+        folder=tmp_path, timeout_s=4.0, poll_interval_s=0.125, patterns=patterns, **kw
     )
     cam = FolderWatchCamera(settings, clock=ScriptedClock(actions))
     cam.connect()
@@ -101,3 +102,43 @@ def test_a_name_used_again_by_another_file_is_refused_and_said_so(tmp_path):
     cam.capture(0.5)
     with pytest.raises(CaptureError, match=r"capt0000\.DNG appeared again.*its own file name"):
         cam.capture(0.5)
+
+
+def jpeg(path, level):
+    import cv2
+
+    code = round(255 * level ** (1 / 2.2))
+    assert cv2.imwrite(str(path), np.full((32, 32, 3), code, np.uint8))
+
+
+@pytest.mark.parametrize("jpeg_first", [False, True])
+def test_raw_plus_jpeg_is_one_shot_and_its_raw_the_image(tmp_path, jpeg_first):
+    """A camera set to RAW+JPEG, both matched: the JPEG had been the next light's image."""
+
+    def shot(n, level):
+        if jpeg_first:
+            jpeg(tmp_path / f"IMG_000{n}.JPG", level)
+        dng(tmp_path / f"IMG_000{n}.DNG", level)
+        if not jpeg_first:
+            jpeg(tmp_path / f"IMG_000{n}.JPG", level)
+
+    actions = {0.25: lambda: shot(1, 0.2), 2.0: lambda: shot(2, 0.6)}
+    cam = camera(tmp_path, actions, ("*.DNG", "*.JPG"), eight_bit_response="srgb")
+    first, second = cam.capture(0.5), cam.capture(0.5)
+    assert [f.metadata["originals"][0]["name"] for f in (first, second)] == [
+        "IMG_0001.DNG",
+        "IMG_0002.DNG",
+    ]
+    assert level_of(second) == pytest.approx(0.6, abs=1e-3)
+
+
+def test_the_jpeg_of_a_raw_shot_arriving_late_is_not_the_next_shot(tmp_path):
+    actions = {
+        0.25: lambda: dng(tmp_path / "IMG_0001.DNG", 0.2),
+        1.0: lambda: jpeg(tmp_path / "IMG_0001.JPG", 0.2),  # after the RAW was taken
+        2.0: lambda: dng(tmp_path / "IMG_0002.DNG", 0.6),
+    }
+    cam = camera(tmp_path, actions, ("*.DNG", "*.JPG"), eight_bit_response="srgb")
+    cam.capture(0.5)
+    second = cam.capture(0.5)
+    assert second.metadata["originals"][0]["name"] == "IMG_0002.DNG"
