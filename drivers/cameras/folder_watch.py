@@ -35,7 +35,7 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.drivers.cameras.image_io import read_image_file, to_linear_uint16
-from rti_rig.drivers.cameras.raw_decode import decode_raw, exposure_stats
+from rti_rig.drivers.cameras.raw_decode import DECODER, decode_raw, exposure_stats
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
 
 RAW_SUFFIXES = {
@@ -228,7 +228,7 @@ class FolderWatchCamera:
                 f"{exc.message}; the trigger was not confirmed either ({unconfirmed})",
                 "wait for file",
             ) from exc
-        frame = self._decode(path, exposure_s, started)
+        frame = self._decode_complete(path, exposure_s, started)
         if unconfirmed is not None:
             frame.metadata["trigger_unconfirmed"] = unconfirmed
             frame.metadata.setdefault("notices", [])
@@ -237,6 +237,43 @@ class FolderWatchCamera:
                 "the trigger's confirmation was lost but the camera's file arrived",
             ]
         return frame
+
+    def _decode_complete(self, path: Path, exposure_s: float, started: float) -> Frame:
+        """Decode ``path``; one that will not decode gets ``timeout_s`` to change and is tried
+        again once its size is steady for ``stable_polls`` polls.
+
+        Why: a steady size only means the writer paused (a network share, a Wi-Fi upload, a
+        program writing in chunks). Half a file had stopped the session at once, a shot lost
+        for a pause longer than the stability polls, though the rest of it was on its way.
+        """
+        s = self.settings
+        deadline = self._clock.now() + s.timeout_s
+        while True:
+            tried = _identity(path)
+            try:
+                return self._decode(path, exposure_s, started)
+            except CaptureError as exc:
+                # the decoders' own refusals: LibRaw's, or a TIFF/PNG that would not read (not
+                # this camera's, of a whole file: 8-bit data, a wrong exposure)
+                if exc.device != DECODER and exc.command != "read":
+                    raise
+                failure = exc
+            last, stable = tried, 0
+            while True:
+                if self._clock.now() >= deadline:
+                    raise CaptureError(
+                        self.name,
+                        f"{failure.message}; {path.name} did not change within "
+                        f"{s.timeout_s:g} s after that (if the program saving it pauses while "
+                        "writing, raise stable_polls or poll_interval_s)",
+                        "decode",
+                    ) from failure
+                self._clock.sleep(s.poll_interval_s)
+                now = _identity(path)
+                stable = stable + 1 if now == last else 1
+                last = now
+                if now is not None and now != tried and stable >= s.stable_polls:
+                    break
 
     def _decode(self, path: Path, exposure_s: float, started: float) -> Frame:
         s = self.settings

@@ -142,3 +142,46 @@ def test_the_jpeg_of_a_raw_shot_arriving_late_is_not_the_next_shot(tmp_path):
     cam.capture(0.5)
     second = cam.capture(0.5)
     assert second.metadata["originals"][0]["name"] == "IMG_0002.DNG"
+
+
+@pytest.mark.parametrize("suffix", [".DNG", ".tif"])
+def test_a_writer_that_pauses_longer_than_the_polls_still_gives_the_shot(tmp_path, suffix):
+    """Half a file, steady for the stability polls (the writer paused), then the rest: it had
+    stopped the session with a decode error, the shot lost though the file was on its way."""
+    import tifffile
+
+    whole = tmp_path / "whole.bin"
+    if suffix == ".DNG":
+        dng(whole, 0.4)
+    else:
+        tifffile.imwrite(whole, np.full((32, 32, 3), 26214, np.uint16), photometric="rgb")
+    data = whole.read_bytes()
+    whole.unlink()
+    target = tmp_path / f"IMG_0001{suffix}"
+    actions = {
+        0.25: lambda: target.write_bytes(data[: len(data) // 2]),
+        2.0: lambda: target.write_bytes(data),
+    }
+    cam = camera(tmp_path, actions, (f"*{suffix}",))
+    frame = cam.capture(0.5)
+    assert level_of(frame) == pytest.approx(0.4, abs=1e-3)
+
+
+def test_a_file_that_stays_cut_short_is_an_error_naming_it_and_what_to_raise(tmp_path):
+    whole = tmp_path / "whole.bin"
+    dng(whole, 0.4)
+    data = whole.read_bytes()
+    whole.unlink()
+    actions = {0.25: lambda: (tmp_path / "IMG_0001.DNG").write_bytes(data[: len(data) // 2])}
+    cam = camera(tmp_path, actions)
+    with pytest.raises(
+        CaptureError, match=r"IMG_0001\.DNG did not change within 4 s.*stable_polls"
+    ):
+        cam.capture(0.5)
+
+
+def test_an_eight_bit_file_is_refused_at_once_not_waited_on(tmp_path):
+    cam = camera(tmp_path, {0.25: lambda: jpeg(tmp_path / "IMG_0001.JPG", 0.2)}, ("*.JPG",))
+    with pytest.raises(CaptureError, match="8-bit"):
+        cam.capture(0.5)
+    assert cam._clock.now() < 1.0
