@@ -65,5 +65,6 @@ register_camera_kind(
         "folder_watch",
         FolderWatchSettings,
         lambda s, c: FolderWatchCamera(s, clock=c.clock, trigger=c.trigger),
+        sets_exposure=False,
     )
 )

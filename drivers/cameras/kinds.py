@@ -42,6 +42,10 @@ class CameraKind:
     name: str
     settings: type[BaseModel]
     build: Callable[[Any, CameraContext], Camera]
+    #: Whether the driver sets the exposure it is asked for. A camera that only delivers files
+    #: (a watched folder: the camera or its own program sets the shutter) cannot be metered:
+    #: ``--auto-exposure`` is refused for it instead of asking for exposures it cannot take.
+    sets_exposure: bool = True
 
 
 _KINDS: dict[str, CameraKind] = {}

@@ -429,6 +429,8 @@ def _open_new(
             "--auto-exposure cannot meter a replayed acquisition: its camera returns the "
             "recorded images whatever the exposure; drop --auto-exposure",
         )
+    if auto_exposure:
+        refuse_unmeterable_camera(loaded)
     identity = rig_identity(loaded)
     rig = checked_rig(loaded, schedule)
     try:
@@ -440,6 +442,32 @@ def _open_new(
         rig.close()
         raise
     return OpenedSession(rig, schedule, folder, Path(out_dir))
+
+
+def refuse_unmeterable_camera(loaded) -> None:  # type: ignore[no-untyped-def]
+    """``--auto-exposure`` on a camera that does not set its exposure is refused before the
+    rig opens.
+
+    Why: a watched folder only receives what the camera (set by hand or by its own program)
+    shot. Metering asked it for test exposures it could not take, fired the camera for them,
+    and stopped at the second with "set the camera to manual at the session exposure", an
+    exposure the metering was still looking for.
+    """
+    from rti_rig.app.config import camera_device_settings
+    from rti_rig.drivers.cameras.kinds import camera_kind
+
+    if loaded.config.camera.device is None:
+        return
+    kind = camera_kind(getattr(camera_device_settings(loaded), "kind", None))
+    if kind is not None and not kind.sets_exposure:
+        raise ConfigError(
+            loaded.path,
+            "camera.device.kind",
+            f"--auto-exposure cannot meter a '{kind.name}' camera: rti-rig does not set its "
+            "exposure (the camera or its own program does), so it cannot take test shots at "
+            "other exposures. Drop --auto-exposure, set the camera's shutter by hand and "
+            "[camera] exposure_s to the same value",
+        )
 
 
 def new_session_schedule(  # type: ignore[no-untyped-def]
