@@ -78,6 +78,9 @@ class Body:
     busy_after_shot: int = 0  # the next N captures after a shot answer -110 first
     card_free_shots: int = 1000
     jpeg_first: bool = False  # RAW+JPEG: capture() returns the JPEG, the RAW comes by event
+    #: RAW+JPEG: the second file is announced only after this many quiet event waits (a body
+    #: still writing its JPEG); a shot taken before then finds the announcement pending
+    second_file_quiet_waits: int = 0
     powered: bool = True
     off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
     shots: int = 0
@@ -86,6 +89,7 @@ class Body:
     deleted: list[str] = field(default_factory=list)
     calls: list[str] = field(default_factory=list)
     _events: list[tuple[int, object]] = field(default_factory=list)
+    _late: list[list] = field(default_factory=list)  # type: ignore[type-arg]
     _busy: int = 0
     _counter: int = 0
 
@@ -197,6 +201,9 @@ def make_module(body: Body) -> types.ModuleType:
             if body._busy:
                 body._busy -= 1
                 raise GPhoto2Error(-110)
+            # the files a previous shot was still writing are announced by now
+            body._events.extend(event for _, event in body._late)
+            body._late.clear()
             store = body.store()
             if store is body.card and body.card_free_shots <= 0:
                 raise GPhoto2Error(-115)
@@ -218,7 +225,11 @@ def make_module(body: Body) -> types.ModuleType:
                 files.sort(key=lambda n: not n.endswith(".JPG"))
             folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"
             for name in files if body.announce_first else files[1:]:
-                body._events.append((GP_EVENT_FILE_ADDED, CameraFilePath(folder, name)))
+                event = (GP_EVENT_FILE_ADDED, CameraFilePath(folder, name))
+                if name != files[0] and body.second_file_quiet_waits:
+                    body._late.append([body.second_file_quiet_waits, event])
+                else:
+                    body._events.append(event)
             if body.capture_complete_event:
                 body._events.append((GP_EVENT_CAPTURE_COMPLETE, None))
             return CameraFilePath(folder, files[0])
@@ -227,6 +238,10 @@ def make_module(body: Body) -> types.ModuleType:
             body.check("wait_for_event")
             if body._events:
                 return body._events.pop(0)
+            if body._late:
+                body._late[0][0] -= 1
+                if body._late[0][0] < 0:
+                    return body._late.pop(0)[1]
             return GP_EVENT_TIMEOUT, None
 
         def file_get(self, folder: str, name: str, kind: int) -> CameraFile:

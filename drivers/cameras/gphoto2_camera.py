@@ -129,6 +129,8 @@ class Gphoto2Camera:
         self._shutter_label: str | None = None
         self._count = 0
         self._staging_tmp: Path | None = None
+        #: stems of the camera files of the shots taken so far (a late announcement is theirs)
+        self._earlier_stems: set[str] = set()
         self.retries_used = 0
         self.camera_model: str | None = None
 
@@ -332,7 +334,9 @@ class Gphoto2Camera:
         t_capture = self._clock.now()
         path = self._call("capture", lambda: cam.capture(gp.GP_CAPTURE_IMAGE))
         files = [(str(path.folder), str(path.name))]
-        files.extend(self._more_files(files))
+        more, late = self._more_files(files)
+        files.extend(more)
+        self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
         raw_files = [f for f in files if is_raw_file(Path(f[1]))]
         if not raw_files:
@@ -361,6 +365,15 @@ class Gphoto2Camera:
         iso = _number(s.iso) or decoded.gain
         metadata = dict(decoded.metadata)
         camera_path = {n: f"{f.rstrip('/')}/{n}" for f, n in files}
+        notices = list(metadata.get("notices") or [])
+        if s.keep_jpeg and not jpeg:
+            notices.append(
+                f"keep_jpeg is set but the camera announced no JPEG within event_timeout_s = "
+                f"{s.event_timeout_s:g} s: set image_format to its RAW+JPEG value, raise "
+                "event_timeout_s, or set keep_jpeg = false"
+            )
+        if notices:
+            metadata["notices"] = notices
         metadata.update(
             {
                 "camera": self.name,
@@ -375,6 +388,7 @@ class Gphoto2Camera:
                 # journal): a wrapped or repeated camera counter can never overwrite a shot
                 "originals": [{"path": str(p), "name": camera_path[n]} for n, p in saved.items()],
                 "jpeg_file": jpeg[0] if jpeg else None,
+                "late_camera_files": [f"{f.rstrip('/')}/{n}" for f, n in late],
                 "capture_started_s": t_capture,
                 "capture_finished_s": self._clock.now(),
             }
@@ -398,23 +412,44 @@ class Gphoto2Camera:
             self._staging_tmp = Path(tempfile.mkdtemp(prefix=f"rti-rig-{self.name}-"))
         return self._staging_tmp
 
-    def _more_files(self, files: list[tuple[str, str]]) -> list[tuple[str, str]]:
-        """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet."""
+    def _more_files(
+        self, files: list[tuple[str, str]]
+    ) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+        """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet
+        with what this shot needs: its RAW, and its JPEG too with ``keep_jpeg`` (for at most
+        ``event_timeout_s``). Returns (this shot's other files, files of an earlier shot).
+
+        Why both rules: a body still writing its JPEG announces it after a quiet spell. Quiet
+        with the RAW in hand had ended the wait, and the late announcement was collected at
+        the next shot as that shot's file (``raw/image_002.jpg`` was shot 1's JPEG). A file
+        with the stem of an earlier shot's file (``IMG_0001.JPG`` after ``IMG_0001.CR2``) and
+        not this shot's is the earlier shot's, never this one's. (Stems alone do not pair
+        files: libgphoto2 may number each object of a RAM capture, ``capt0000.jpg`` and
+        ``capt0001.nef``; a body naming every shot alike keeps the old rule.)
+        """
         gp = self._gp
         wait_ms = 200
         budget_ms = self.settings.event_timeout_s * 1000
+        stem = Path(files[0][1]).stem
         more: list[tuple[str, str]] = []
+        late: list[tuple[str, str]] = []
         while budget_ms > 0:
             event, data = self._call("wait_for_event", lambda: self._cam.wait_for_event(wait_ms))
             if event == gp.GP_EVENT_FILE_ADDED:
                 item = (str(data.folder), str(data.name))
-                if item not in files and item not in more:  # some bodies re-announce the first
-                    more.append(item)
+                if item in files or item in more or item in late:
+                    continue  # some bodies re-announce the first
+                earlier = Path(item[1]).stem in self._earlier_stems
+                (late if earlier and Path(item[1]).stem != stem else more).append(item)
             elif event == gp.GP_EVENT_TIMEOUT:
                 budget_ms -= wait_ms
-                if any(is_raw_file(Path(n)) for _, n in files + more):
+                names = [Path(n) for _, n in files + more]
+                have_raw = any(is_raw_file(n) for n in names)
+                have_jpeg = any(not is_raw_file(n) for n in names)
+                if have_raw and (have_jpeg or not self.settings.keep_jpeg):
                     break
-        return more
+        self._earlier_stems.update(Path(n).stem for _, n in files + more)
+        return more, late
 
     def _delete(self, files: list[tuple[str, str]]) -> None:
         if not self.settings.delete_from_camera:
