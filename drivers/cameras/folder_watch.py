@@ -13,7 +13,9 @@ temporary → ``IMG_0001.CR2``). A rename keeps the file's device, inode, size a
 time, so a file with the identity of one already seen is not a new shot; taken by name alone it
 had been the *next* light's image, every later image one light off. Hidden files (a leading
 dot) are the temporaries of such programs and of sync tools (rsync's ``.name.XXXXXX``), never a
-finished shot, and are not looked at.
+finished shot, and are not looked at. With a trigger, a file already there when the shutter is
+pulsed (a duplicate, a test shot, an extra frame of the last pulse) is set aside and named in the
+frame's notices, never taken as the pulse's picture.
 
 One shot may give two files (a camera set to RAW+JPEG: ``IMG_0001.CR2`` and ``IMG_0001.JPG``).
 When both match ``patterns``, the RAW is the shot's image and a file with the stem of a file
@@ -213,7 +215,17 @@ class FolderWatchCamera:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
         started = self._clock.now()
         unconfirmed: str | None = None
+        stray: list[str] = []
         if self._trigger is not None:
+            # a file already there before the pulse is not the pulse's picture (a duplicate, a
+            # test shot, a second frame of the last pulse): taken as the oldest new file it had
+            # been this light's image, and every later image one light off
+            for p in self._new_files(self._seen):
+                ident = _identity(p)
+                self._seen.add(p.name)
+                if ident is not None:
+                    self._seen_ids.add(ident)
+                stray.append(p.name)
             try:
                 self._trigger(exposure_s)
             except TriggerUnconfirmed as exc:
@@ -229,6 +241,14 @@ class FolderWatchCamera:
                 "wait for file",
             ) from exc
         frame = self._decode_complete(path, exposure_s, started)
+        if stray:
+            frame.metadata["stray_files"] = stray
+            frame.metadata["notices"] = [
+                *(frame.metadata.get("notices") or []),
+                f"{len(stray)} file(s) came into the watched folder before this shot's trigger "
+                f"and were not used: {', '.join(stray)} (a duplicate or a shot no light "
+                "asked for)",
+            ]
         if unconfirmed is not None:
             frame.metadata["trigger_unconfirmed"] = unconfirmed
             frame.metadata.setdefault("notices", [])

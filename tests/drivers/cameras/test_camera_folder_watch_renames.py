@@ -185,3 +185,31 @@ def test_an_eight_bit_file_is_refused_at_once_not_waited_on(tmp_path):
     with pytest.raises(CaptureError, match="8-bit"):
         cam.capture(0.5)
     assert cam._clock.now() < 1.0
+
+
+def test_a_file_there_before_the_pulse_is_not_the_pulses_picture(tmp_path):
+    """An extra file (a duplicate copy, a test shot) had been taken as the next light's image,
+    every later image one light off. With a trigger, the pulse's picture comes after it."""
+    shots = iter([0.2, 0.4, 0.6])
+    count = iter(range(1, 4))
+
+    def pulse(exposure_s):
+        n, level = next(count), next(shots)
+        dng(tmp_path / f"IMG_000{n}.DNG", level)
+        if n == 1:
+            dng(tmp_path / "IMG_0001_copy.DNG", level)  # a second file for one shot
+
+    settings = FolderWatchSettings(
+        folder=tmp_path, timeout_s=4.0, poll_interval_s=0.125, patterns=("*.DNG",)
+    )
+    cam = FolderWatchCamera(settings, clock=VirtualClock(), trigger=pulse)
+    cam.connect()
+    frames = [cam.capture(0.5) for _ in range(3)]
+    assert [f.metadata["originals"][0]["name"] for f in frames] == [
+        "IMG_0001.DNG",
+        "IMG_0002.DNG",
+        "IMG_0003.DNG",
+    ]
+    assert [round(level_of(f), 2) for f in frames] == [0.2, 0.4, 0.6]
+    assert frames[1].metadata["stray_files"] == ["IMG_0001_copy.DNG"]
+    assert any("IMG_0001_copy.DNG" in n for n in frames[1].metadata["notices"])
