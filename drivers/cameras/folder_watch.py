@@ -102,6 +102,8 @@ class FolderWatchCamera:
         self._seen: set[str] | None = None
         #: (device, inode, size, mtime) of every file seen: a renamed one keeps all four
         self._seen_ids: set[tuple[int, int, int, int]] = set()
+        #: (device, inode) of the same files: a set, as a folder may hold thousands of them
+        self._seen_inodes: set[tuple[int, int]] = set()
         #: names of used files that reappeared as another file (reported at a timeout)
         self._reused_names: set[str] = set()
         #: stems of the files taken: a later file with one is the same shot's other file
@@ -119,12 +121,14 @@ class FolderWatchCamera:
         present = self._matching()
         self._seen = {p.name for p in present}
         self._seen_ids = {i for i in map(_identity, present) if i is not None}
+        self._seen_inodes = {i[:2] for i in self._seen_ids}
         self._reused_names = set()
         self._taken_stems = set()
 
     def close(self) -> None:
         self._seen = None
         self._seen_ids = set()
+        self._seen_inodes = set()
 
     def __enter__(self) -> FolderWatchCamera:
         self.connect()
@@ -143,6 +147,14 @@ class FolderWatchCamera:
                     found[p.name] = p
         return list(found.values())
 
+    def _mark_seen(self, name: str, ident: tuple[int, int, int, int] | None) -> None:
+        """``name`` (and the file it is, if it still exists) is used: never taken again."""
+        assert self._seen is not None
+        self._seen.add(name)
+        if ident is not None:
+            self._seen_ids.add(ident)
+            self._seen_inodes.add(ident[:2])
+
     def _new_files(self, seen: set[str]) -> list[Path]:
         new = []
         for p in self._matching():
@@ -150,7 +162,7 @@ class FolderWatchCamera:
             if ident is None:  # removed between glob and stat
                 continue
             if p.name in seen:
-                if ident[:2] not in {i[:2] for i in self._seen_ids}:  # another file
+                if ident[:2] not in self._seen_inodes:  # another file
                     self._reused_names.add(p.name)
                 continue
             if ident in self._seen_ids:  # a file already seen, renamed
@@ -186,8 +198,7 @@ class FolderWatchCamera:
                 if stable >= s.stable_polls:
                     ident = _identity(path)
                     if ident is not None:
-                        self._seen.add(path.name)
-                        self._seen_ids.add(ident)
+                        self._mark_seen(path.name, ident)
                         self._taken_stems.add(path.stem)
                         return path
             if self._clock.now() - start >= s.timeout_s:
@@ -221,10 +232,7 @@ class FolderWatchCamera:
             # test shot, a second frame of the last pulse): taken as the oldest new file it had
             # been this light's image, and every later image one light off
             for p in self._new_files(self._seen):
-                ident = _identity(p)
-                self._seen.add(p.name)
-                if ident is not None:
-                    self._seen_ids.add(ident)
+                self._mark_seen(p.name, _identity(p))
                 stray.append(p.name)
             try:
                 self._trigger(exposure_s)
