@@ -21,6 +21,17 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note, stop_exit_code
 from rti_rig.core.errors import RtiRigError
 
+#: ``--max-saturated`` of ``run`` and ``preview``: None when not given (only metering reads it,
+#: so it is refused without ``--auto-exposure``: :func:`refuse_unmetered_limit`).
+MaxSaturatedOption = Annotated[
+    float | None,
+    typer.Option(
+        "--max-saturated",
+        help="With --auto-exposure: the largest fraction of saturated pixels its metering "
+        "allows (default 0.001, 0.1 %).",
+    ),
+]
+
 
 @app.command()
 def run(
@@ -75,14 +86,7 @@ def run(
             "level object receives most from are checked (one more test shot each at least).",
         ),
     ] = False,
-    max_saturated: Annotated[
-        float | None,
-        typer.Option(
-            "--max-saturated",
-            help="With --auto-exposure: the largest fraction of saturated pixels its metering "
-            "allows (default 0.001, 0.1 %).",
-        ),
-    ] = None,
+    max_saturated: MaxSaturatedOption = None,
     resume: Annotated[
         Path | None,
         typer.Option(
@@ -756,14 +760,7 @@ def preview(
             help="Meter first (a short test series) so the preview is not saturated.",
         ),
     ] = False,
-    max_saturated: Annotated[
-        float | None,
-        typer.Option(
-            "--max-saturated",
-            help="With --auto-exposure: the largest fraction of saturated pixels its metering "
-            "allows (default 0.001, 0.1 %).",
-        ),
-    ] = None,
+    max_saturated: MaxSaturatedOption = None,
 ) -> None:
     """Shoot the planner's preview: one image under one light, as a session of one image.
 

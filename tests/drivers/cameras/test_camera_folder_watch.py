@@ -8,6 +8,7 @@ import time
 import numpy as np
 import pytest
 import tifffile
+from scripted_clock import ScriptedClock
 
 from rti_rig.core.clock import SystemClock, VirtualClock
 from rti_rig.core.devices import Camera
@@ -15,19 +16,6 @@ from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
 from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
-
-
-class ScriptedClock(VirtualClock):
-    """Virtual time; runs ``actions[t]`` once virtual time reaches ``t`` (a file appearing...)."""
-
-    def __init__(self, actions):
-        super().__init__()
-        self.actions = sorted(actions.items())
-
-    def sleep(self, seconds):
-        super().sleep(seconds)
-        while self.actions and self.actions[0][0] <= self.now():
-            self.actions.pop(0)[1]()
 
 
 def dng(path, level=0.3, exposure_s=0.5):

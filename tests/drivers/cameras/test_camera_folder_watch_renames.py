@@ -10,25 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scripted_clock import ScriptedClock
 
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.errors import CaptureError
 from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
 from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
-
-
-class ScriptedClock(VirtualClock):
-    """Virtual time; runs ``actions[t]`` once virtual time reaches ``t`` (a file appearing...)."""
-
-    def __init__(self, actions):
-        super().__init__()
-        self.actions = sorted(actions.items())
-
-    def sleep(self, seconds):
-        super().sleep(seconds)
-        while self.actions and self.actions[0][0] <= self.now():
-            self.actions.pop(0)[1]()
 
 
 def dng(path, level):
