@@ -534,12 +534,12 @@ def _recorded_scores(
 
 
 def _scored_once(
-    designs: dict[float, NDArray[np.intp]], score: Callable[[list[NDArray[np.intp]]], list[Any]]
+    designs: dict[float, NDArray[np.intp]], score: Callable[[list[float]], list[Any]]
 ) -> dict[float, Any]:
-    """``score`` (a list of designs → their scores) run on each distinct layout once, its
-    score given to every key whose design is that layout: two floors whose designs are the
-    same lights would be simulated alike (each light's noise is seeded from its direction),
-    so the second simulation was time spent on nothing."""
+    """``score`` (keys of ``designs`` → their designs' scores) run on each distinct layout
+    once, its score given to every key whose design is that layout: two floors whose designs
+    are the same lights would be simulated alike (each light's noise is seeded from its
+    direction), so the second simulation was time spent on nothing."""
     first: list[float] = []
     alias: dict[float, float] = {}
     for f, c in designs.items():
@@ -548,7 +548,7 @@ def _scored_once(
             first.append(f)
             twin = f
         alias[f] = twin
-    got = dict(zip(first, score([designs[f] for f in first]), strict=True))
+    got = dict(zip(first, score(first), strict=True))
     return {f: got[alias[f]] for f in designs}
 
 
@@ -759,13 +759,13 @@ def choose_in_design(
         if fitted is not None:
             designs[FITTED_KEY] = fitted
         held, shared = shared_held_out(candidates, available, list(designs.values()))
-        held_of = {id(c): h for c, h in zip(designs.values(), held, strict=True)}
+        held_by = dict(zip(designs, held, strict=True))
         psnr = _scored_once(
             designs,
-            lambda ds: simulate_relight_designs(
+            lambda keys: simulate_relight_designs(
                 model,
-                [np.concatenate([state.lights, candidates[c]]) for c in ds],
-                [held_of[id(c)] for c in ds],
+                [np.concatenate([state.lights, candidates[designs[k]]]) for k in keys],
+                [held_by[k] for k in keys],
                 relight,
                 relight_basis(n_total),
             ),
@@ -796,8 +796,8 @@ def choose_in_design(
         assert fit is not None
         scores = _scored_once(
             designs,
-            lambda ds: simulate_designs(
-                model, [np.concatenate([state.lights, candidates[c]]) for c in ds], fit
+            lambda keys: simulate_designs(
+                model, [np.concatenate([state.lights, candidates[designs[k]]]) for k in keys], fit
             ),
         )
     if model is not None:

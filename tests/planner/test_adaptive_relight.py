@@ -289,7 +289,7 @@ def test_designs_that_are_the_same_lights_are_simulated_and_listed_once(
     monkeypatch.setattr(
         adaptive,
         "_scored_once",
-        lambda ds, score: dict(zip(ds, score(list(ds.values())), strict=True)),
+        lambda ds, score: dict(zip(ds, score(list(ds)), strict=True)),
     )
     old = choose_in_design(_state_of(grazing_shadow_object(0)), cand, avail, 9, **kw)
     assert (old.candidate, old.design_floor) == (d.candidate, d.design_floor)
