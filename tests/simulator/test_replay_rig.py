@@ -347,6 +347,38 @@ def test_a_resume_whose_acquisition_moved_asks_for_its_lp_not_a_toml(tmp_path: P
     assert f"give it: rti-rig run ACQ/dirs.lp --resume {out}" in said and "RIG.toml" not in said
 
 
+#: The four lights of the small acquisitions the refusals below are built on.
+FOUR_LIGHTS = [(0.5, 0, 0.866), (0, 0.5, 0.866), (-0.5, 0, 0.866), (0, 0, 1)]
+
+
+def _four_images(acq: Path, seed: int, write) -> None:  # type: ignore[no-untyped-def]
+    """A 4-light acquisition in ``acq``: ``write(i, pixels)`` saves image ``i`` (16-bit RGB
+    noise) and returns its file name; dirs.lp lists them."""
+    rng = np.random.default_rng(seed)
+    acq.mkdir()
+    lines = ["4"]
+    for i, (x, y, z) in enumerate(FOUR_LIGHTS):
+        name = write(i, rng.integers(0, 65535, (24, 32, 3), dtype=np.uint16))
+        lines.append(f"{name} {x} {y} {z}")
+    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
+
+
+def _refused_by_check_and_run(tmp_path: Path, acq: Path, *fragments: str) -> None:
+    """`check` and `run` of ``acq/dirs.lp`` both refuse it (exit 2, every fragment said, no
+    PASS, no traceback), and no session folder is made."""
+    for args in (
+        ["check", str(acq / "dirs.lp")],
+        ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")],
+    ):
+        r = runner.invoke(app, args)
+        said = " ".join(r.output.split())
+        assert r.exit_code == 2, said
+        for fragment in fragments:
+            assert fragment in said, said
+        assert "PASS" not in said and "Traceback" not in r.output
+    assert not (tmp_path / "s").exists()
+
+
 @pytest.mark.parametrize("kind", ["float", "stack"])
 def test_a_tiff_a_replay_cannot_give_is_refused_before_anything_runs(
     tmp_path: Path, kind: str
@@ -356,30 +388,24 @@ def test_a_tiff_a_replay_cannot_give_is_refused_before_anything_runs(
     to resume into the same stop."""
     import tifffile
 
-    rng = np.random.default_rng(5)
     acq = tmp_path / "acq"
-    acq.mkdir()
-    lines = ["4"]
-    for i, (x, y, z) in enumerate([(0.5, 0, 0.866), (0, 0.5, 0.866), (-0.5, 0, 0.866), (0, 0, 1)]):
-        px = rng.integers(0, 65535, (24, 32, 3), dtype=np.uint16)
+
+    def write(i: int, px: np.ndarray) -> str:
         if i == 2:  # the third image only: the session would have captured two
             odd = px.astype(np.float32) / 65535 if kind == "float" else np.stack([px, px])
             tifffile.imwrite(acq / f"img{i}.tif", odd, photometric="rgb")
         else:
             tifffile.imwrite(acq / f"img{i}.tif", px, photometric="rgb")
-        lines.append(f"img{i}.tif {x} {y} {z}")
-    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
-    for args in (
-        ["check", str(acq / "dirs.lp")],
-        ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")],
-    ):
-        r = runner.invoke(app, args)
-        said = " ".join(r.output.split())
-        assert r.exit_code == 2, said
-        assert "1 of 4 image(s) beside it hold pixels a replay cannot give" in said, said
-        assert "img2.tif" in said and "is not 8/16-bit grey or RGB; save it again as" in said
-        assert "PASS" not in said and "Traceback" not in r.output
-    assert not (tmp_path / "s").exists()
+        return f"img{i}.tif"
+
+    _four_images(acq, 5, write)
+    _refused_by_check_and_run(
+        tmp_path,
+        acq,
+        "1 of 4 image(s) beside it hold pixels a replay cannot give",
+        "img2.tif",
+        "is not 8/16-bit grey or RGB; save it again as",
+    )
 
 
 @pytest.mark.parametrize("suffix", [".png", ".tif"])
@@ -392,32 +418,27 @@ def test_a_png_or_tiff_cut_short_is_refused_before_anything_runs(
     import cv2
     import tifffile
 
-    rng = np.random.default_rng(7)
     acq = tmp_path / "acq"
-    acq.mkdir()
-    lines = ["4"]
-    for i, (x, y, z) in enumerate([(0.5, 0, 0.866), (0, 0.5, 0.866), (-0.5, 0, 0.866), (0, 0, 1)]):
-        px = rng.integers(0, 65535, (24, 32, 3), dtype=np.uint16)
+
+    def write(i: int, px: np.ndarray) -> str:
         path = acq / f"img{i}{suffix}"
         if suffix == ".png":
             cv2.imwrite(str(path), px)
         else:
             tifffile.imwrite(path, px, photometric="rgb")
-        lines.append(f"{path.name} {x} {y} {z}")
+        return path.name
+
+    _four_images(acq, 7, write)
     victim = acq / f"img2{suffix}"
     victim.write_bytes(victim.read_bytes()[:2000])
-    (acq / "dirs.lp").write_text("\n".join(lines) + "\n")
-    for args in (
-        ["check", str(acq / "dirs.lp")],
-        ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")],
-    ):
-        r = runner.invoke(app, args)
-        said = " ".join(r.output.split())
-        assert r.exit_code == 2, said
-        assert "1 of 4 image(s) beside it are damaged images" in said, said
-        assert f"img2{suffix}: " in said and "(cut short)" in said and "copy them again" in said
-        assert "PASS" not in said and "Traceback" not in r.output
-    assert not (tmp_path / "s").exists()
+    _refused_by_check_and_run(
+        tmp_path,
+        acq,
+        "1 of 4 image(s) beside it are damaged images",
+        f"img2{suffix}: ",
+        "(cut short)",
+        "copy them again",
+    )
 
 
 def test_an_acquisition_repeating_a_light_is_refused_in_a_replays_words(tmp_path: Path) -> None:
