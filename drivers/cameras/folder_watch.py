@@ -22,12 +22,18 @@ When both match ``patterns``, the RAW is the shot's image and a file with the st
 already taken is never another shot (it had been the next light's image, the lights one off
 from there on).
 
+The LED need not wait for the file: with a trigger it goes off ``shutter_lag_s`` plus the
+exposure after the pulse (see ``expose``), without one once the file has come; the transfer and
+the decode then happen in the dark. Held lit until the image was in hand, a RAW arriving over
+Wi-Fi 9 s after the pulse ran into the dome's ``max_on_s`` = 8 s and the good shot was lost.
+
 Safe state: nothing to release (no device handle); ``close`` forgets the seen files.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -86,6 +92,17 @@ def _identity(path: Path) -> tuple[int, int, int, int] | None:
     return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
 
 
+@dataclass
+class _Pending:
+    """An exposure fired (or waited for) by ``expose`` whose frame ``collect`` has not given."""
+
+    exposure_s: float
+    started: float
+    path: Path | None = None
+    stray: list[str] = field(default_factory=list)
+    unconfirmed: str | None = None
+
+
 class FolderWatchCamera:
     """Implements the ``Camera`` protocol by waiting for new files in a folder."""
 
@@ -108,6 +125,7 @@ class FolderWatchCamera:
         self._reused_names: set[str] = set()
         #: stems of the files taken: a later file with one is the same shot's other file
         self._taken_stems: set[str] = set()
+        self._pending: _Pending | None = None
 
     def connect(self) -> None:
         folder = self.settings.folder
@@ -127,6 +145,7 @@ class FolderWatchCamera:
 
     def close(self) -> None:
         self._seen = None
+        self._pending = None
         self._seen_ids = set()
         self._seen_inodes = set()
 
@@ -222,46 +241,68 @@ class FolderWatchCamera:
 
     def capture(self, exposure_s: float) -> Frame:
         """Fire the trigger (if any), wait for the file, decode it to a linear frame."""
+        self.expose(exposure_s)
+        return self.collect()
+
+    def expose(self, exposure_s: float) -> float | None:
+        """Fire the trigger and return when the exposure has surely ended: ``shutter_lag_s``
+        plus ``exposure_s`` after the pulse was confirmed. Without a trigger nothing says when
+        someone else fires, so this waits for the file, whose arrival proves the exposure over.
+
+        The light can then go off while the file crosses the tether or Wi-Fi link (seconds for
+        a RAW), rather than stay lit into the dome's ``max_on_s``.
+        """
         if self._seen is None:
             raise CaptureError(self.name, "not connected; call connect() first", "capture")
-        started = self._clock.now()
-        unconfirmed: str | None = None
-        stray: list[str] = []
-        if self._trigger is not None:
-            # a file already there before the pulse is not the pulse's picture (a duplicate, a
-            # test shot, a second frame of the last pulse): taken as the oldest new file it had
-            # been this light's image, and every later image one light off
-            for p in self._new_files(self._seen):
-                self._mark_seen(p.name, _identity(p))
-                stray.append(p.name)
-            try:
-                self._trigger(exposure_s)
-            except TriggerUnconfirmed as exc:
-                unconfirmed = str(exc)
+        pending = _Pending(exposure_s, started=self._clock.now())
+        self._pending = None
+        if self._trigger is None:
+            pending.path = self.wait_for_file()
+            self._pending = pending
+            return self._clock.now()
+        # a file already there before the pulse is not the pulse's picture (a duplicate, a test
+        # shot, a second frame of the last pulse): taken as the oldest new file it had been
+        # this light's image, and every later image one light off
+        for p in self._new_files(self._seen):
+            self._mark_seen(p.name, _identity(p))
+            pending.stray.append(p.name)
         try:
-            path = self.wait_for_file()
-        except CaptureError as exc:
-            if unconfirmed is None:
-                raise
-            raise CaptureError(
-                self.name,
-                f"{exc.message}; the trigger was not confirmed either ({unconfirmed})",
-                "wait for file",
-            ) from exc
-        frame = self._decode_complete(path, exposure_s, started)
-        if stray:
-            frame.metadata["stray_files"] = stray
+            self._trigger(exposure_s)
+        except TriggerUnconfirmed as exc:
+            pending.unconfirmed = str(exc)
+        self._pending = pending
+        return self._clock.now() + self.settings.shutter_lag_s + exposure_s
+
+    def collect(self) -> Frame:
+        """The file of the last ``expose`` (waited for if it has not come yet), decoded."""
+        pending, self._pending = self._pending, None
+        if pending is None:
+            raise CaptureError(self.name, "collect() without expose() before it", "capture")
+        path = pending.path
+        if path is None:
+            try:
+                path = self.wait_for_file()
+            except CaptureError as exc:
+                if pending.unconfirmed is None:
+                    raise
+                raise CaptureError(
+                    self.name,
+                    f"{exc.message}; the trigger was not confirmed either ({pending.unconfirmed})",
+                    "wait for file",
+                ) from exc
+        frame = self._decode_complete(path, pending.exposure_s, pending.started)
+        if pending.stray:
+            frame.metadata["stray_files"] = pending.stray
             frame.metadata["notices"] = [
                 *(frame.metadata.get("notices") or []),
-                f"{len(stray)} file(s) came into the watched folder before this shot's trigger "
-                f"and were not used: {', '.join(stray)} (a duplicate or a shot no light "
-                "asked for)",
+                f"{len(pending.stray)} file(s) came into the watched folder before this shot's "
+                f"trigger and were not used: {', '.join(pending.stray)} (a duplicate or a shot "
+                "no light asked for)",
             ]
-        if unconfirmed is not None:
-            frame.metadata["trigger_unconfirmed"] = unconfirmed
-            frame.metadata.setdefault("notices", [])
+        if pending.unconfirmed is not None:
+            frame.metadata["trigger_unconfirmed"] = pending.unconfirmed
             frame.metadata["notices"] = [
-                *frame.metadata["notices"],
+                *(frame.metadata.get("notices") or []),
                 "the trigger's confirmation was lost but the camera's file arrived",
             ]
         return frame

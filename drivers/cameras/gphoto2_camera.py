@@ -131,6 +131,9 @@ class Gphoto2Camera:
         self._staging_tmp: Path | None = None
         #: stems of the camera files of the shots taken so far (a late announcement is theirs)
         self._earlier_stems: set[str] = set()
+        #: (camera path, requested and set exposure, shutter label, start) of an exposure whose
+        #: files ``collect`` has not downloaded yet
+        self._pending: tuple[Any, float, float, str, float] | None = None
         self.retries_used = 0
         self.camera_model: str | None = None
 
@@ -217,6 +220,7 @@ class Gphoto2Camera:
         """End the camera session. Safe twice and after a failed connect."""
         cam, self._cam = self._cam, None
         self._shutter_label = None
+        self._pending = None
         if cam is not None:
             # the camera may already be gone; there is nothing else to release
             with contextlib.suppress(Exception):
@@ -313,6 +317,16 @@ class Gphoto2Camera:
     # -- capture ---------------------------------------------------------------------------
     def capture(self, exposure_s: float) -> Frame:
         """Set the shutter, fire, download the RAW (and JPEG), decode it to linear data."""
+        self.expose(exposure_s)
+        return self.collect()
+
+    def expose(self, exposure_s: float) -> float | None:
+        """Set the shutter and fire; return once the camera reports the image taken.
+
+        libgphoto2's capture returns when the camera has the picture (its file is named), so
+        the exposure is over: the light may go off before the download and the RAW decode,
+        which take seconds for a 24-megapixel RAW over USB.
+        """
         if self._cam is None:
             raise CaptureError(
                 self.name, "camera is not connected; call connect() first", "capture"
@@ -332,7 +346,20 @@ class Gphoto2Camera:
             self._set_config_values({s.shutter_config: (label, "shutter_config")})
             self._shutter_label = label
         t_capture = self._clock.now()
+        self._pending = None
         path = self._call("capture", lambda: cam.capture(gp.GP_CAPTURE_IMAGE))
+        self._pending = (path, exposure_s, secs, label, t_capture)
+        return self._clock.now()
+
+    def collect(self) -> Frame:
+        """Download the last ``expose``'s RAW (and JPEG) and decode it to linear data."""
+        pending, self._pending = self._pending, None
+        if pending is None or self._cam is None:
+            raise CaptureError(self.name, "collect() without expose() before it", "capture")
+        path, exposure_s, secs, label, t_capture = pending
+        s = self.settings
+        gp = self._gp
+        cam = self._cam
         files = [(str(path.folder), str(path.name))]
         more, late = self._more_files(files)
         files.extend(more)

@@ -215,6 +215,15 @@ class FolderWatchSettings(_Strict):
     )
     patterns: tuple[str, ...] = ("*.dng", "*.DNG")
     timeout_s: float = Field(10.0, gt=0.0)
+    shutter_lag_s: float = Field(
+        0.5,
+        ge=0.0,
+        le=10.0,
+        description="with trigger = 'dome_shutter': the longest time from the release pulse "
+        "to the start of the exposure (the camera's shutter lag, autofocus off). The LED stays "
+        "lit this long plus the exposure after the pulse, then goes off while the file is "
+        "awaited; set the camera's own shutter to [camera] exposure_s",
+    )
     poll_interval_s: float = Field(0.05, gt=0.0)
     stable_polls: int = Field(2, ge=1)
     exposure_tolerance: float | None = Field(

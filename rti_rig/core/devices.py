@@ -120,3 +120,23 @@ class Camera(Protocol):
     def close(self) -> None: ...
 
     def capture(self, exposure_s: float) -> Frame: ...
+
+
+@runtime_checkable
+class ExposingCamera(Protocol):
+    """A camera whose exposure is over well before its image is in hand, in two calls.
+
+    Why: a DSLR's download and RAW decode, or a tethered file's transfer over USB or Wi-Fi,
+    take seconds after the shutter has closed. Held lit through them, an LED cast several times
+    the light the image needs on the object (a light dose a conservator counts) and ran into
+    the dome's thermal limit ``max_on_s``, which stopped the session and lost a good shot.
+
+    ``expose`` fires the shutter and returns the time (on the rig's clock) by which the exposure
+    has surely ended, or None when the camera cannot tell (then the light stays on until
+    ``collect`` returns). ``collect`` returns the frame of that exposure. The controller
+    switches the light off in between; ``capture`` is the two in one call.
+    """
+
+    def expose(self, exposure_s: float) -> float | None: ...
+
+    def collect(self) -> Frame: ...

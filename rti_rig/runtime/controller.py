@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, Protocol
 
-from rti_rig.core.devices import Frame
+from rti_rig.core.devices import ExposingCamera, Frame
 from rti_rig.core.errors import CaptureError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
@@ -157,6 +157,31 @@ class StepSource(Protocol):
 
 def step_exposure(rig: Rig, step: LightStep) -> float:
     return step.exposure_s if step.exposure_s is not None else rig.camera_config.exposure_s
+
+
+def shoot_lit(rig: Rig, exposure_s: float) -> Frame:
+    """Capture one frame under the light that is on, and switch the light off.
+
+    A camera that can say when its exposure is over (an :class:`ExposingCamera`: a DSLR that
+    downloads and decodes, a tethered file still on its way) has the light switched off then,
+    not after the image is in hand: seconds less of light on the object per image, and no shot
+    lost to ``max_on_s`` while a file crossed a slow link. The frame is collected after that.
+    """
+    camera = rig.camera
+    if not isinstance(camera, ExposingCamera):
+        frame = camera.capture(exposure_s)
+        rig.lighting.off()
+        return frame
+    ended = camera.expose(exposure_s)
+    if ended is None:  # the camera cannot tell: the light stays on until the image is in
+        frame = camera.collect()
+        rig.lighting.off()
+        return frame
+    wait = ended - rig.clock.now()
+    if wait > 0:
+        rig.clock.sleep(wait)
+    rig.lighting.off()
+    return camera.collect()
 
 
 def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
@@ -361,9 +386,8 @@ def run_session(
             t_lit = clock.now()
             clock.sleep(rig.timing.settle_s)
             t_settled = clock.now()
-            frame = rig.camera.capture(step_exposure(rig, step))
+            frame = shoot_lit(rig, step_exposure(rig, step))
             t_captured = clock.now()
-            rig.lighting.off()
             got = frame_layout(frame)
             if layout is not None and got != layout:
                 _refuse_other_layout(rig, folder, i, frame, got, layout)
@@ -394,12 +418,7 @@ def run_session(
                 last = schedule.steps[-1] if source is None else None
                 exposure = cam.exposure_s if last is None else step_exposure(rig, last)
 
-                def shoot(exposure: float = exposure) -> Frame:
-                    frame = rig.camera.capture(exposure)
-                    rig.lighting.off()
-                    return frame
-
-                end_notes = list(rig.end_check(shoot, folder.root))
+                end_notes = list(rig.end_check(lambda e=exposure: shoot_lit(rig, e), folder.root))
             reason = FinishReason.COMPLETED
     except KeyboardInterrupt:
         reason, error = FinishReason.INTERRUPTED, "interrupted by the user (Ctrl-C)"

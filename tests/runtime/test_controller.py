@@ -405,3 +405,67 @@ def test_an_emergency_stop_during_an_image_s_commit_leaves_it_listed(
         bystander.set()
     assert manifest(out)["runner"]["finish_reason"] == "emergency-stop"
     assert_images_intact(out, 4)
+
+
+class ExposingWrapper:
+    """Wraps a camera as an ``ExposingCamera`` whose exposure is over ``ends_after_s`` after it
+    fires (None: it cannot tell); records, with the rig's clock, what happens when."""
+
+    def __init__(self, inner, clock, ends_after_s, log) -> None:  # type: ignore[no-untyped-def]
+        self.inner, self.clock, self.ends_after_s, self.log = inner, clock, ends_after_s, log
+        self.name = "exposing camera"
+        self._exposure: float | None = None
+
+    def connect(self) -> None:
+        self.inner.connect()
+
+    def close(self) -> None:
+        self.inner.close()
+
+    def capture(self, exposure_s: float):  # type: ignore[no-untyped-def]
+        raise AssertionError("an ExposingCamera is driven through expose() and collect()")
+
+    def expose(self, exposure_s: float) -> float | None:
+        self.log.append(("expose", self.clock.now()))
+        self._exposure = exposure_s
+        if self.ends_after_s is None:
+            return None
+        return self.clock.now() + self.ends_after_s
+
+    def collect(self):  # type: ignore[no-untyped-def]
+        self.log.append(("collect", self.clock.now()))
+        assert self._exposure is not None
+        return self.inner.capture(self._exposure)
+
+
+@pytest.mark.parametrize("ends_after_s", [0.8, None])
+def test_the_light_goes_off_when_the_camera_says_its_exposure_is_over(
+    tmp_path: Path, ends_after_s: float | None
+) -> None:
+    """A DSLR's download and decode, a tethered file's transfer, happened with the LED lit: the
+    object got seconds more light per image and a slow file ran into the thermal limit. Now
+    the light goes off at the end the camera gives, before the frame is collected; a camera
+    that cannot tell keeps it on until the frame is in."""
+    rig = small_rig(tmp_path)
+    log: list[tuple[str, float]] = []
+    rig.camera = ExposingWrapper(rig.camera, rig.clock, ends_after_s, log)
+    lighting_off = rig.lighting.off
+
+    def off() -> None:
+        log.append(("off", rig.clock.now()))
+        lighting_off()
+
+    rig.lighting.off = off  # type: ignore[method-assign]
+    result = run_session(
+        rig, plan_uniform(rig.geometry, 3), SessionFolder.create(tmp_path / "s", 3)
+    )
+    assert result.finish_reason is FinishReason.COMPLETED
+    assert log[0][0] == "off" and len(log) == 1 + 3 * 3  # the session's opening all-off first
+    steps = [log[i : i + 3] for i in range(1, len(log), 3)]
+    for step in steps:
+        names = [name for name, _ in step]
+        if ends_after_s is None:
+            assert names == ["expose", "collect", "off"]
+        else:
+            assert names == ["expose", "off", "collect"]
+            assert step[1][1] - step[0][1] == pytest.approx(ends_after_s)

@@ -206,3 +206,35 @@ def test_trigger_unconfirmed_and_no_file_is_an_error_naming_both(tmp_path):
     cam.connect()
     with pytest.raises(CaptureError, match=r"no new file.*not confirmed either.*no reply"):
         cam.capture(0.5)
+
+
+def test_a_triggered_exposure_ends_shutter_lag_plus_exposure_after_the_pulse(tmp_path):
+    """With the dome's release line, the exposure is over ``shutter_lag_s`` + exposure after
+    the pulse: ``expose`` says so without waiting for the file, which ``collect`` awaits (it
+    may take seconds over Wi-Fi; the LED need not stay on for that)."""
+    from rti_rig.core.devices import ExposingCamera
+
+    clock = ScriptedClock({4.0: lambda: dng(tmp_path / "IMG_0001.dng")})  # the file comes late
+    fired: list[float] = []
+    cam = FolderWatchCamera(
+        FolderWatchSettings(folder=tmp_path, shutter_lag_s=0.3),
+        clock=clock,
+        trigger=lambda e: fired.append(clock.now()),
+    )
+    assert isinstance(cam, ExposingCamera)
+    cam.connect()
+    ended = cam.expose(0.5)
+    assert len(fired) == 1 and ended == pytest.approx(fired[0] + 0.3 + 0.5)
+    f = cam.collect()
+    assert f.metadata["source_file"].endswith("IMG_0001.dng")
+    assert clock.now() >= 4.0 > ended + 2.0
+
+
+def test_an_untriggered_exposure_is_over_once_its_file_has_come(tmp_path):
+    """Someone else fires the camera: only the file's arrival says the exposure is over."""
+    clock = ScriptedClock({2.0: lambda: dng(tmp_path / "IMG_0001.dng")})
+    cam = watch(tmp_path, clock)
+    cam.connect()
+    ended = cam.expose(0.5)
+    assert ended is not None and ended >= 2.0
+    assert cam.collect().metadata["source_file"].endswith("IMG_0001.dng")

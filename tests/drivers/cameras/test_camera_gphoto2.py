@@ -234,3 +234,22 @@ def test_nearest_shutter_in_stops():
     table = [(1 / 125, "1/125"), (1 / 60, "1/60"), (1 / 30, "1/30")]
     assert nearest_shutter(0.016, table)[1] == "1/60"
     assert nearest_shutter(0.03, table)[1] == "1/30"
+
+
+def test_expose_returns_once_the_shot_is_taken_and_collect_downloads_it(tmp_path):
+    """The download and the RAW decode (seconds for 24 megapixels) had happened inside one
+    capture call, with the dome's LED lit: now ``expose`` ends at the shot, so the controller
+    switches the light off before ``collect`` downloads it."""
+    from rti_rig.core.devices import ExposingCamera
+
+    body = dslr()
+    with camera(body, tmp_path) as cam:
+        assert isinstance(cam, ExposingCamera)
+        ended = cam.expose(1 / 125)
+        assert ended is not None
+        assert "capture" in body.calls and "file_get" not in body.calls
+        assert not list(tmp_path.glob("cap*"))
+        f = cam.collect()
+        assert body.calls.count("file_get") == 1 and f.exposure_s == pytest.approx(1 / 125)
+        with pytest.raises(CaptureError, match=r"collect\(\) without expose"):
+            cam.collect()  # one frame per exposure
