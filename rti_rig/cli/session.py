@@ -275,12 +275,13 @@ def run(
                 )
             err.print(f"{said}.", markup=False)
             raise _unexpected(exc, "") from None
-        _execute(opened)
+        unsafe = _execute(opened)
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
 
             with _verdict_terminable():
                 print_verdict(opened.out_dir)
+        _refuse_unsafe_end(unsafe)
 
 
 def _metering_limit(max_saturated: float | None) -> dict[str, float]:
@@ -512,18 +513,36 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
     )
 
 
-def _execute(opened) -> None:  # type: ignore[no-untyped-def]
+def _execute(opened) -> bool:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on.
+    True when the session completed but its teardown failed (see :func:`_refuse_unsafe_end`).
 
     The handlers in place before are back only once the summary is printed: a second Ctrl-C
     meant as "stop at once", arriving just after the session stopped on the first, had cut
     the summary and its resume hint off (exit 130, no word)."""
     previous = {sig: signal.getsignal(sig) for sig in _HANDLED}
     try:
-        _run_and_report(opened)
+        return _run_and_report(opened)
     finally:
         for sig, h in previous.items():
             signal.signal(sig, h)
+
+
+def _refuse_unsafe_end(unsafe: bool) -> None:
+    """Exit 1 after a complete session whose teardown failed or left the lights unsure.
+
+    Why: the images are all there, but the rig was not brought to a known safe state (a final
+    all-off not sent or unanswered, a lamp or stop refused). The run had exited 0, so a script
+    chaining ``run && fit`` or a lab's batch took it for a clean end while the dome might be
+    lit.
+    """
+    if unsafe:
+        err.print(
+            "[red]The session is complete, but the rig was not brought to a known safe state "
+            "(above):[/] make it safe by hand (switch the dome or lamp off) before taking the "
+            "object out."
+        )
+        raise typer.Exit(code=1)
 
 
 _HANDLED = (signal.SIGINT, signal.SIGTERM) + (
@@ -544,7 +563,7 @@ def _paused_lights(rig) -> str:  # type: ignore[no-untyped-def]
     return lights_state(rig)
 
 
-def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
+def _run_and_report(opened) -> bool:  # type: ignore[no-untyped-def]
     from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
         CancelToken,
@@ -712,6 +731,9 @@ def _run_and_report(opened) -> None:  # type: ignore[no-untyped-def]
             f"{escape(lights)} {resume_hint}"
         )
         raise typer.Exit(code=130)
+    from rti_rig.app.usecases.safe_state import safe_state_unsure
+
+    return bool(result.teardown_failures) or safe_state_unsure(rig)
 
 
 @app.command()
@@ -798,7 +820,7 @@ def preview(
         why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
         said = f"Stopped ({why}) before the preview image: nothing was captured or written to "
         raise _stopped_while_opening(exc, why, f"{said}{out_dir}", auto_exposure) from None
-    _execute(opened)
+    unsafe = _execute(opened)
     # the band given here is the one to plan in: said in the command to copy
     band = "".join(
         f" {flag} {value:g}"
@@ -825,6 +847,7 @@ def preview(
             markup=False,
             soft_wrap=True,
         )
+    _refuse_unsafe_end(unsafe)
 
 
 def _metered_apart(opened) -> tuple[float, float] | None:  # type: ignore[no-untyped-def]

@@ -7,6 +7,7 @@ sent), an arm that its lamp-off was requested.
 
 from __future__ import annotations
 
+from rti_rig.core.dome_link import OffOutcome
 from rti_rig.runtime.arm_check import not_connected_sentence
 from rti_rig.runtime.dome_policy import lights_state_sentence
 from rti_rig.runtime.lighting import DomeLighting
@@ -31,4 +32,22 @@ def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-
         return unreached
     return "lamp off and stop were requested" + (
         " (see the teardown problems above)" if teardown_failed else ""
+    )
+
+
+def safe_state_unsure(rig) -> bool:  # type: ignore[no-untyped-def]
+    """True when the rig's lights are not known to be safe after its teardown: the dome's last
+    all-off was not sent or went unconfirmed (what :func:`lights_state` then tells the user to
+    deal with by hand). A firmware that never acknowledges, or switches itself off, is as safe
+    as it can be said to be; a simulated dome has nothing to be unsure of."""
+    lighting = rig.lighting
+    if not isinstance(lighting, DomeLighting):
+        return False
+    report = getattr(lighting.source, "off_report", None)
+    if report is None:
+        return hasattr(lighting.source, "off_report")  # a real dome that sent no all-off
+    return report.outcome in (
+        OffOutcome.SENT_UNCONFIRMED,
+        OffOutcome.NOT_SENT,
+        OffOutcome.NEVER_OPENED,
     )
