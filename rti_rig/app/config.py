@@ -472,6 +472,26 @@ def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
 CALIBRATION_FORMAT = "rti-rig-light-calibration/1"
 
 
+#: The key under which a loaded rig's raw ``[dome.serial]`` (and so a session's manifest)
+#: records which LEDs its calibration file measured (the others were assumed median).
+MEASURED_KEY = "intensity_correction_measured"
+
+
+def read_measured_leds(path: Path, count: int) -> list[bool] | None:
+    """The ``measured`` flags of a calibration file (one per LED), or None if it has none of
+    that length (an older or hand-made file): what is not said is not claimed."""
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None
+    measured = data.get("measured")
+    if not isinstance(measured, list) or len(measured) != count:
+        return None
+    if not all(isinstance(m, bool) for m in measured):
+        return None
+    return list(measured)
+
+
 def read_correction_file(path: Path, rig_name: str) -> list[float]:
     """The ``intensity_correction`` list of a calibration file, checked against the rig.
 
@@ -505,6 +525,22 @@ def read_correction_file(path: Path, rig_name: str) -> list[float]:
     return [float(v) for v in corr]
 
 
+def calibration_coverage(loaded: LoadedRig) -> tuple[int, int] | None:
+    """(LEDs measured, LEDs) of the light calibration file the rig config names, or None when
+    it names none or the file does not say (a correction typed into the config).
+
+    Why: a card session of 12 of a dome's 48 LEDs gives a correction that assumes the other 36
+    median; they are not evened out, and metering at one light, as on a dome evened out, had
+    clipped 5 of 48 images of a matte card 67–100 %.
+    """
+    dome = loaded.raw.get("dome")
+    serial = dome.get("serial") if isinstance(dome, dict) else None
+    measured = serial.get(MEASURED_KEY) if isinstance(serial, dict) else None
+    if not isinstance(measured, list):
+        return None
+    return sum(bool(m) for m in measured), len(measured)
+
+
 def _with_correction_file(
     data: dict[str, Any], path: Path
 ) -> tuple[dict[str, Any], dict[str, Any], bytes]:
@@ -533,7 +569,12 @@ def _with_correction_file(
     except ValueError as exc:
         raise ConfigError(path, key, str(exc)) from None
     recorded = {**serial, "intensity_correction": values}
-    settings = {k: v for k, v in recorded.items() if k != "intensity_correction_file"}
+    measured = read_measured_leds(file, len(values))
+    if measured is not None:  # which LEDs it evens out, for metering and the QA verdict
+        recorded[MEASURED_KEY] = measured
+    settings = {
+        k: v for k, v in recorded.items() if k not in ("intensity_correction_file", MEASURED_KEY)
+    }
     return (
         {**data, "dome": {**dome, "serial": recorded}},  # type: ignore[dict-item]
         {**data, "dome": {**dome, "serial": settings}},  # type: ignore[dict-item]

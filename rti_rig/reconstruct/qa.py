@@ -262,14 +262,17 @@ class QAReport:
             if c.within_light_scatter and any(p.endswith(BRIGHTER) for p in c.problems)
         ]
 
-    def explain_bright_by_lights(self, note: str) -> QAReport:
+    def explain_bright_by_lights(self, note: str, only: set[int] | None = None) -> QAReport:
         """This report with the bright-image problem taken off :meth:`bright_within_light_scatter`
-        (their other problems stand) and ``note`` said in the verdict in its place.
+        (their other problems stand; ``only``: of those images, by index) and ``note`` said in
+        the verdict in its place.
 
         For the application to call where it knows the lights can differ (a dome with no light
-        calibration applied): there a reshoot gives the same image again, since the brightness
-        is its LED's own."""
+        calibration applied, or LEDs a calibration did not measure): there a reshoot gives the
+        same image again, since the brightness is its LED's own."""
         explained = {c.index for c in self.bright_within_light_scatter()}
+        if only is not None:
+            explained &= only
         if not explained:
             return self
         images = tuple(

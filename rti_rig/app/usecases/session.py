@@ -373,7 +373,18 @@ def _light_outputs_unknown(rig: Rig) -> str:
         return ""
     serial = config.dome.serial
     if serial is not None and serial.intensity_correction is not None:
-        return ""
+        from rti_rig.app.config import calibration_coverage
+
+        coverage = calibration_coverage(loaded)
+        if coverage is None or coverage[0] == coverage[1]:
+            return ""
+        measured, count = coverage
+        return (
+            f"This dome's light calibration measured {measured} of its {count} LEDs (the "
+            "others were assumed to give the median light; calibrate a card shot under every "
+            "LED to even them out): they may differ by tens of percent, so the light nearest "
+            "the zenith need not be the brightest"
+        )
     return (
         "This dome has no light calibration applied (rti-rig calibrate-lights): its LEDs may "
         "differ by tens of percent, so the light nearest the zenith need not be the brightest"
