@@ -323,3 +323,18 @@ def test_a_run_stopped_before_its_proof_is_not_used(tmp_path: Path, rigs) -> Non
     assert truth(rig)[29] == 30  # the fault was real: from the bounce on, one LED ahead
     assert len(read_lp(out / "lights.lp")) == 40  # …and those images are listed in lights.lp
     assert_disowned_session_is_not_used(tmp_path, out, "did not pass it")
+
+
+def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None:
+    """A complete session had been told "--resume cannot be used with a camera-triggered dome:
+    the dome's own count no longer matches", as if something had interrupted it."""
+    out = tmp_path / "s"
+    assert (
+        runner.invoke(app, ["run", str(SHIPPED), "--out", str(out), "--no-verdict"]).exit_code == 0
+    )
+    for extra in ([], ["--reshoot-lost"]):
+        result = runner.invoke(app, ["run", "--resume", str(out), *extra])
+        assert result.exit_code == 2, result.output
+        text = " ".join(result.output.split())
+        assert "this session already completed all 60 steps; nothing to resume" in text
+        assert "cannot be used" not in text

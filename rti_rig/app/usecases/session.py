@@ -740,8 +740,18 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
     loaded = load_rig_config(config_path)
     for note in loaded.notes:
         on_note(Note(note, "warning"))
-    from rti_rig.app.flash_sync import refuse_options
+    from rti_rig.app.flash_sync import flash_sync_of, refuse_options
 
+    runner = manifest.get("runner") or {}
+    if flash_sync_of(loaded) is not None and runner.get("finish_reason") == "completed":
+        # a finished session had been told only that a camera-triggered dome cannot resume
+        # (so the user looked for what had interrupted it): it is complete, and says so
+        raise RtiRigError(
+            f"{req.session_dir}: this session already completed all "
+            f"{runner.get('steps_planned', len(manifest.get('steps') or []))} steps; nothing "
+            "to resume (a camera-triggered dome cannot reshoot single images either: to shoot "
+            "again, long-press the dome's start button, then rti-rig run CONFIG --out NEWDIR)"
+        )
     refuse_options(loaded, **{"--resume": True})
     identity, diffs = check_resume_rig(
         manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
