@@ -37,7 +37,8 @@ import numpy as np
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import DeviceError
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.controller import _signals_deferred, validate_schedule
+from rti_rig.runtime.controller import validate_schedule
+from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
 
@@ -165,7 +166,7 @@ def fix_session_exposure(
         # a second Ctrl-C ("stop at once") had cut the all-off short with an LED lit, and the
         # dome's last all-off, the one between two metered lights, was then reported as the
         # state of the lights ("acknowledged by the dome: lights are off")
-        with _signals_deferred():
+        with signals_deferred():
             return rig.lighting.safe() + attempt_all(
                 [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
             )

@@ -48,6 +48,7 @@ from rti_rig.core.image_files import (
     write_srgb_jpeg,
 )
 from rti_rig.core.lp_format import LpEntry, format_lp
+from rti_rig.runtime.deferred_signals import signals_deferred
 
 MANIFEST = "manifest.json"
 JOURNAL = "journal.jsonl"
@@ -1016,42 +1017,46 @@ def _prepare_resume(
     stamp = _new_stamp(root)
     if check_done is not None:
         check_done(done)
-    repair = _repair_journal(root, scan, stamp) if scan.needs_repair else []
-    keep = {name for rec in done.values() for name in rec.sha256}
-    recovered: list[str] = []
-    leftovers = [
-        *root.glob("image_*"),
-        *(root / LINEAR_DIR).glob("image_*"),
-        *(root / RAW_DIR).glob("image_*"),
-        *(p for p in (root / RAW_INCOMING).glob("*") if p.is_file()),
-    ]
-    for path in sorted(leftovers):
-        rel = path.relative_to(root).as_posix()
-        if rel in keep:
-            continue
-        dest = root / "recovered" / stamp / rel
+    # the journal's repair, the moves and the relisting are one change of the folder: a
+    # Ctrl-C or SIGTERM among them (acted on once they are done) had left lights.lp listing
+    # an image already moved to recovered/, which relight then paired with another light
+    with signals_deferred():
+        repair = _repair_journal(root, scan, stamp) if scan.needs_repair else []
+        keep = {name for rec in done.values() for name in rec.sha256}
+        recovered: list[str] = []
+        leftovers = [
+            *root.glob("image_*"),
+            *(root / LINEAR_DIR).glob("image_*"),
+            *(root / RAW_DIR).glob("image_*"),
+            *(p for p in (root / RAW_INCOMING).glob("*") if p.is_file()),
+        ]
+        for path in sorted(leftovers):
+            rel = path.relative_to(root).as_posix()
+            if rel in keep:
+                continue
+            dest = root / "recovered" / stamp / rel
+            try:
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(path, dest)
+            except OSError as exc:
+                raise SessionWriteError(dest, exc) from None
+            recovered.append(dest.relative_to(root).as_posix())
+        for partial in [
+            *root.glob(".*.partial"),
+            *(root / LINEAR_DIR).glob(".*.partial"),
+            *(root / RAW_DIR).glob(".*.partial"),
+            *root.glob(".*.tmp"),
+        ]:
+            partial.unlink()
         try:
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(path, dest)
+            (root / LINEAR_DIR).mkdir(exist_ok=True)
         except OSError as exc:
-            raise SessionWriteError(dest, exc) from None
-        recovered.append(dest.relative_to(root).as_posix())
-    for partial in [
-        *root.glob(".*.partial"),
-        *(root / LINEAR_DIR).glob(".*.partial"),
-        *(root / RAW_DIR).glob(".*.partial"),
-        *root.glob(".*.tmp"),
-    ]:
-        partial.unlink()
-    try:
-        (root / LINEAR_DIR).mkdir(exist_ok=True)
-    except OSError as exc:
-        raise SessionWriteError(root / LINEAR_DIR, exc) from None
-    if repair:
-        recovered.append(f"recovered/{stamp}/journal-rejected.txt")
-    moved_lp = _relist_verified(root, done, stamp)
-    if moved_lp is not None:
-        recovered.append(moved_lp)
+            raise SessionWriteError(root / LINEAR_DIR, exc) from None
+        if repair:
+            recovered.append(f"recovered/{stamp}/journal-rejected.txt")
+        moved_lp = _relist_verified(root, done, stamp)
+        if moved_lp is not None:
+            recovered.append(moved_lp)
     return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
 
 

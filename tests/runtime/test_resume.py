@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import signal
 import subprocess
 import time
@@ -384,3 +385,35 @@ def test_a_resume_stopped_before_its_first_image_leaves_lights_lp_listing_the_im
     assert _listed(out) == on_disk
     if not on_disk:
         assert list((out / "recovered").rglob("lights.lp"))  # set aside, never deleted
+
+
+def test_a_ctrl_c_while_a_resume_sets_images_aside_leaves_lights_lp_listing_the_images_on_disk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C that came while the resume moved an unverified image to recovered/ stopped it
+    before lights.lp was relisted: the `.lp` listed the image just moved, and relight paired
+    every later image with the wrong light. The moves and the relisting now finish first; the
+    Ctrl-C is acted on after them (the run says it stopped, exit 130)."""
+    import signal
+
+    import rti_rig.runtime.session as session_module
+
+    out, _ = _cancelled_after_four(tmp_path)
+    (out / "image_002.jpg").write_bytes(b"a copy cut short")
+    real_replace = os.replace
+    calls: list[str] = []
+
+    def replace_then_ctrl_c(src, dst):  # type: ignore[no-untyped-def]
+        real_replace(src, dst)
+        calls.append(str(src))
+        if len(calls) == 1:
+            signal.raise_signal(signal.SIGINT)
+
+    monkeypatch.setattr(session_module.os, "replace", replace_then_ctrl_c)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert calls, "the resume set nothing aside"
+    assert r.exit_code == 130, r.output
+    assert "Ctrl-C" in said(r)
+    on_disk = sorted(p.name for p in out.glob("image_*.jpg"))
+    assert "image_002.jpg" not in on_disk
+    assert _listed(out) == on_disk

@@ -1,0 +1,72 @@
+"""SIGINT and SIGTERM held while a short block that must not be cut runs, then acted on.
+
+Why a module of its own: the controller holds them while devices go safe and while an image is
+committed, metering while its lights go off, and a resume while it sets unverified images aside
+and relists ``lights.lp`` (a stop in between had left the `.lp` listing a moved image).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+from typing import Any
+
+
+@contextlib.contextmanager
+def signals_deferred() -> Iterator[None]:
+    """Hold SIGINT/SIGTERM while devices are put in their safe state, or while a captured
+    image is committed (its files and journal line).
+
+    An emergency-stop handler raising in the middle of teardown could leave a light on, and in
+    the middle of a commit an image that ``lights.lp`` does not list; the signals are delivered
+    (and acted on) as soon as the block is done. Held at the level of Python's handlers, not
+    the thread's signal mask: a signal sent to the process is delivered to any thread that does
+    not block it (BLAS, the progress bar, an emulator's), and Python then runs the handler in
+    the main thread all the same — a mask in the main thread alone had held nothing.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield  # handlers can only be set from the main thread, where they run
+        return
+    pending: list[tuple[int, Any]] = []
+    raised: list[BaseException] = []  # by a pending signal's handler as a handler was swapped
+
+    def hold(signum: int, frame: Any) -> None:
+        pending.append((signum, frame))
+
+    installed: dict[int, Any] = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(sig) is None:  # set outside Python: it could not be put back
+            continue
+        installed[sig] = _swap_handler(sig, hold, raised)
+    try:  # a stop that came as the hold was set (in ``raised``) acts after the block too
+        yield
+    finally:
+        for sig, handler in installed.items():
+            _swap_handler(sig, handler, raised)
+        for signum, frame in pending:  # delivered now, as they would have been
+            handler = installed.get(signum)
+            if handler is None:
+                continue
+            if callable(handler):
+                try:
+                    handler(signum, frame)
+                except BaseException as exc:
+                    raised.append(exc)
+            elif handler != signal.SIG_IGN:  # the default action: raised again, now unheld
+                signal.raise_signal(signum)
+        if raised:
+            raise raised[0]
+
+
+def _swap_handler(sig: int, handler: Any, raised: list[BaseException]) -> Any:
+    """``signal.signal(sig, handler)``, made to happen: Python first runs the handlers of any
+    signal already pending, and one that raises (the CLI's emergency stop) would skip the swap
+    and leave a hold half set or half undone. Its exception is kept in ``raised``, the swap
+    tried again."""
+    while True:
+        try:
+            return signal.signal(sig, handler)
+        except BaseException as exc:
+            raised.append(exc)
