@@ -102,6 +102,13 @@ class ArmLighting:
     ``park_after_session`` is off; after an emergency stop it stays where it stopped unless
     ``park_on_emergency`` is on, because moving a just-stopped arm near an object is what an
     emergency stop is meant to prevent.
+
+    Whatever the policy, an arm whose own move or lamp failed (a servo fault such as an
+    overload — "the arm is blocked" —, a move timeout, a servo that stopped answering), or whose
+    stop did not hold every joint, is not parked: the park is a move sent to both joints, and
+    it had driven the healthy joint round while the faulty one hung limp (the self-test,
+    :mod:`rti_rig.runtime.arm_check`, already kept this rule). The teardown says why it was
+    not parked.
     """
 
     def __init__(
@@ -114,8 +121,11 @@ class ArmLighting:
         self.name = carrier.name
         self.park_after_session = park_after_session
         self.park_on_emergency = park_on_emergency
+        #: the arm's own failure since the last connect (a move or the lamp): no park after it
+        self.arm_failure: Exception | None = None
 
     def connect(self) -> None:
+        self.arm_failure = None
         self.carrier.connect()
 
     def close(self) -> None:
@@ -125,21 +135,34 @@ class ArmLighting:
         return self.carrier.unreachable_reason(np.asarray(step.direction))
 
     def set(self, step: LightStep) -> ActualLight:
-        reached = self.carrier.move_to(np.asarray(step.direction))
-        self.carrier.lamp(True)
+        try:
+            reached = self.carrier.move_to(np.asarray(step.direction))
+            self.carrier.lamp(True)
+        except Exception as exc:  # the arm's own failure: remembered so that it is not parked
+            self.arm_failure = exc
+            raise
         return ActualLight((float(reached[0]), float(reached[1]), float(reached[2])))
 
     def off(self) -> None:
         self.carrier.lamp(False)
 
     def safe(self, emergency: bool = False) -> list[str]:
-        actions: list[tuple[str, object]] = [
-            ("lamp off", lambda: self.carrier.lamp(False)),
-            ("stop", self.carrier.stop),
-        ]
-        if self.park_on_emergency if emergency else self.park_after_session:
-            actions.append(("park", self.carrier.park))
-        return attempt_all(actions)
+        failures = attempt_all(
+            [("lamp off", lambda: self.carrier.lamp(False)), ("stop", self.carrier.stop)]
+        )
+        if not (self.park_on_emergency if emergency else self.park_after_session):
+            return failures
+        stop_failed = any(f.startswith("stop: ") for f in failures)
+        if self.arm_failure is not None or stop_failed:
+            why = "own move failed" if self.arm_failure is not None else "stop failed"
+            return [
+                *failures,
+                f"park: not attempted because the arm's {why}: parking is a move of both "
+                "joints, and a faulty or blocked arm must not be driven near the object; it "
+                "was left where it stopped. Clear the fault (its error says how), then park "
+                "it with 'rti-rig check'",
+            ]
+        return failures + attempt_all([("park", self.carrier.park)])
 
 
 def attempt_all(actions: list[tuple[str, object]]) -> list[str]:
