@@ -65,6 +65,9 @@ FACTORY_REGISTERS = (
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
 DEFAULT_FIRMWARE = 46
+#: The control-table items the emulator names (``control_table``), each written whole or not
+#: at all (Data Length Error otherwise): a Write may span several of them.
+ITEMS = tuple(r for r in vars(ct).values() if isinstance(r, ct.Register))
 #: Drive Mode (address 10) bit 3 and the firmware that brought it (ROBOTIS e-manual, X series).
 TORQUE_ON_BY_GOAL_UPDATE = 0x08
 TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE = 45
@@ -284,7 +287,18 @@ class EmulatedServo:
         return 0, bytes(self.table[address : address + length])
 
     def write(self, address: int, data: bytes) -> int:
-        """Apply a Write; returns the error number (0 = ok)."""
+        """Apply a Write; returns the error number (0 = ok).
+
+        A Write sets consecutive bytes from its start address, so one packet may cover several
+        items (Profile Acceleration, Profile Velocity and Goal Position, 108..119, say); an item
+        it covers only in part is refused with a Data Length Error, which the e-manual defines
+        as "Attempt to write Data that is shorter than the data length of the corresponding
+        Address (ex: when you attempt to only use 2 bytes of a item that has been defined as 4
+        bytes)" (Protocol 2.0, Status Packet, Error; ROBOTIS-GIT/emanual
+        docs/en/dxl/protocol2.md @ 01179568a085cfc99bdad6e880e43fa871bd318a). Every check runs
+        before any byte is written: a refused Write changes nothing. (The emulator had refused
+        any Write that did not hold the Goal Position alone, and accepted half of any other
+        item: it modelled the packets our driver sends, not the servo.)"""
         end = address + len(data)
         if not data or end > ct.TABLE_SIZE:
             return p2.ERR_DATA_LENGTH
@@ -293,18 +307,62 @@ class EmulatedServo:
                 return p2.ERR_ACCESS
         if address < ct.EEPROM_END and self.torque_on:
             return p2.ERR_ACCESS
-        goal = ct.GOAL_POSITION
-        if address <= goal.address < end:
-            if (address, len(data)) != (goal.address, goal.size):
+        for reg in ITEMS:
+            covers_some = address < reg.address + reg.size and end > reg.address
+            if covers_some and not address <= reg.address <= reg.address + reg.size <= end:
                 return p2.ERR_DATA_LENGTH
-            value = p2.to_signed(int.from_bytes(data, "little"), 4)
+
+        def covered(reg: ct.Register) -> bytes | None:
+            """The bytes this Write gives ``reg``, if it covers it."""
+            if address <= reg.address and reg.address + reg.size <= end:
+                return data[reg.address - address : reg.address - address + reg.size]
+            return None
+
+        goal_bytes = covered(ct.GOAL_POSITION)
+        goal: int | None = None
+        if goal_bytes is not None:
+            goal = p2.to_signed(int.from_bytes(goal_bytes, "little"), 4)
             if self.get(ct.OPERATING_MODE) == ct.OperatingMode.POSITION:
                 lo, hi = self.get(ct.MIN_POSITION_LIMIT), self.get(ct.MAX_POSITION_LIMIT)
             else:
                 lo, hi = -ct.EXTENDED_TICK_LIMIT, ct.EXTENDED_TICK_LIMIT
-            if not lo <= value <= hi:
+            if not lo <= goal <= hi:
                 return p2.ERR_DATA_LIMIT
-            self.table[address:end] = data
+        torque_bytes = covered(ct.TORQUE_ENABLE)
+        if torque_bytes is not None and torque_bytes[0] and self._shut_down:
+            return p2.ERR_RESULT_FAIL  # after a shutdown only a reboot re-enables torque
+        pv_bytes = covered(ct.PROFILE_VELOCITY)
+        time_based = self.get(ct.DRIVE_MODE) & ct.DRIVE_MODE_TIME_BASED_PROFILE
+        # e-manual, Velocity Limit(44): "maximum velocity of Goal Velocity(104) and Profile
+        # Velocity(112)"; the control-table include adds "Values for Goal Velocity and
+        # Profile Velocity cannot be set to values exceeding the Velocity Limit ... Data
+        # Limit Error" (ROBOTIS-GIT/emanual _includes/en/dxl/control_table/velocity_limit.md
+        # @ 9344769ede3e0f19f4e4d876e3e80639f3188ae9, an include with Y-series branches; the
+        # X pages' own include, control_table_vellimit.md, says only "maximum velocity").
+        # Refused or capped on an X-series servo is NOT verified (a dynamixel-workbench
+        # issue, #207, reads as capped): refusing is modelled, the stricter case, and the
+        # driver checks the limit before writing, so it meets neither
+        if (
+            pv_bytes is not None
+            and not time_based
+            and int.from_bytes(pv_bytes, "little") > self.get(ct.VELOCITY_LIMIT)
+        ):
+            return p2.ERR_DATA_LIMIT
+        # every check passed: the Write takes effect
+        if torque_bytes is not None:
+            if not torque_bytes[0]:
+                self._freeze()
+            elif not self.torque_on:
+                # modelled: torque-on holds the present position (goal := present). Not
+                # verified against the e-manual; the driver writes goal := present first anyway
+                self._freeze()
+                self._set(ct.GOAL_POSITION, round(self.position()))
+        mode_before = self.get(ct.OPERATING_MODE)
+        self.table[address:end] = data
+        if self.get(ct.OPERATING_MODE) != mode_before:
+            self._set(ct.PROFILE_VELOCITY, 0)
+            self._set(ct.PROFILE_ACCELERATION, 0)
+        if goal is not None:
             if (
                 not self.torque_on
                 and not self._shut_down
@@ -314,42 +372,7 @@ class EmulatedServo:
                 # e-manual, Drive Mode bit 3 "Torque On by Goal Update" (firmware 45+): a goal
                 # written while Torque Enable is 0 switches torque on, and the servo moves to it
                 self.table[ct.TORQUE_ENABLE.address] = 1
-            self._start_move(value)
-            return 0
-        if address <= ct.TORQUE_ENABLE.address < end:
-            on = data[ct.TORQUE_ENABLE.address - address]
-            if on and self._shut_down:
-                return p2.ERR_RESULT_FAIL  # after a shutdown only a reboot re-enables torque
-            if not on:
-                self._freeze()
-            elif not self.torque_on:
-                # modelled: torque-on holds the present position (goal := present). Not
-                # verified against the e-manual; the driver writes goal := present first anyway
-                self._freeze()
-                self._set(ct.GOAL_POSITION, round(self.position()))
-        pv = ct.PROFILE_VELOCITY
-        if (
-            address <= pv.address
-            and pv.address + pv.size <= end
-            and not self.get(ct.DRIVE_MODE) & ct.DRIVE_MODE_TIME_BASED_PROFILE
-        ):
-            # e-manual, Velocity Limit(44): "maximum velocity of Goal Velocity(104) and Profile
-            # Velocity(112)"; the control-table include adds "Values for Goal Velocity and
-            # Profile Velocity cannot be set to values exceeding the Velocity Limit ... Data
-            # Limit Error" (ROBOTIS-GIT/emanual _includes/en/dxl/control_table/velocity_limit.md
-            # @ 9344769ede3e0f19f4e4d876e3e80639f3188ae9, an include with Y-series branches; the
-            # X pages' own include, control_table_vellimit.md, says only "maximum velocity").
-            # Refused or capped on an X-series servo is NOT verified (a dynamixel-workbench
-            # issue, #207, reads as capped): refusing is modelled, the stricter case, and the
-            # driver checks the limit before writing, so it meets neither
-            value = int.from_bytes(data[pv.address - address : pv.address - address + 4], "little")
-            if value > self.get(ct.VELOCITY_LIMIT):
-                return p2.ERR_DATA_LIMIT
-        mode_before = self.get(ct.OPERATING_MODE)
-        self.table[address:end] = data
-        if self.get(ct.OPERATING_MODE) != mode_before:
-            self._set(ct.PROFILE_VELOCITY, 0)
-            self._set(ct.PROFILE_ACCELERATION, 0)
+            self._start_move(goal)  # with the profile this Write may have set too
         return 0
 
     def _start_move(self, goal: int) -> None:

@@ -348,3 +348,41 @@ def test_a_fault_outside_the_shutdown_setting_alerts_but_leaves_torque_on() -> N
     assert info.value.torque_on is False and "limp" in str(info.value)
     bus.reboot(2)
     bus.write(2, ct.TORQUE_ENABLE, 1)  # a reboot lifts the shutdown
+
+
+def test_one_write_may_set_several_items_but_never_part_of_one() -> None:
+    """e-manual, Protocol 2.0: a Write sets consecutive bytes from its address, so one packet
+    may carry Profile Acceleration, Profile Velocity and Goal Position (108..119) and the servo
+    moves with that profile; writing only part of an item is a Data Length Error ("only use 2
+    bytes of a item that has been defined as 4 bytes"), and a refused Write changes nothing.
+    The emulator had refused the first (modelled only on the packets our driver sends) and
+    accepted the second."""
+    clock = VirtualClock()
+    emu = two_servos(clock)
+    port = InProcessPort(emu)
+    assert port.openPort() and port.setBaudRate(57600)
+    ph = sdk.PacketHandler(2.0)
+    assert ph.write1ByteTxRx(port, 1, ct.TORQUE_ENABLE.address, 1) == (sdk.COMM_SUCCESS, 0)
+    block = [*(20).to_bytes(4, "little"), *(40).to_bytes(4, "little")]
+    block += list((3000).to_bytes(4, "little"))
+    assert ph.writeTxRx(port, 1, ct.PROFILE_ACCELERATION.address, 12, block) == (
+        sdk.COMM_SUCCESS,
+        0,
+    )
+    assert ph.read4ByteTxRx(port, 1, ct.PROFILE_VELOCITY.address)[0] == 40
+    assert emu.servos[1].is_moving()
+    clock.sleep(60.0)
+    assert ph.read4ByteTxRx(port, 1, ct.PRESENT_POSITION.address)[0] == 3000
+    # two bytes of the 4-byte Profile Velocity: refused, nothing written
+    assert ph.writeTxRx(port, 1, ct.PROFILE_VELOCITY.address, 2, [7, 0]) == (
+        sdk.COMM_SUCCESS,
+        0x05,
+    )
+    # a Write from Profile Velocity's third byte into Goal Position: refused as a whole
+    assert ph.writeTxRx(port, 1, ct.PROFILE_VELOCITY.address + 2, 6, [0, 0, 0, 8, 0, 0]) == (
+        sdk.COMM_SUCCESS,
+        0x05,
+    )
+    assert ph.read4ByteTxRx(port, 1, ct.PROFILE_VELOCITY.address)[0] == 40
+    assert ph.read4ByteTxRx(port, 1, ct.GOAL_POSITION.address)[0] == 3000
+    assert not emu.servos[1].is_moving()
