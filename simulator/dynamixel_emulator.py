@@ -65,6 +65,9 @@ FACTORY_REGISTERS = (
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
 DEFAULT_FIRMWARE = 46
+#: Largest deviation from Goal Position (ticks) at which Moving Status says In-Position: the
+#: e-manual's "predefined value" is not published for the X series, so this is an assumption.
+IN_POSITION_TICKS = 1
 #: The control-table items the emulator names (``control_table``), each written whole or not
 #: at all (Data Length Error otherwise): a Write may span several of them.
 ITEMS = tuple(r for r in vars(ct).values() if isinstance(r, ct.Register))
@@ -218,11 +221,21 @@ class EmulatedServo:
     def _refresh(self) -> None:
         now = self.clock.now()
         moving = self._profile.moving(now)
-        self._set(ct.PRESENT_POSITION, round(self._profile.position(now)))
+        present = round(self._profile.position(now))
+        self._set(ct.PRESENT_POSITION, present)
         units = self._profile.velocity(now) / (ct.RPM_PER_VELOCITY_UNIT / 60 * ct.TICKS_PER_REV)
         self._set(ct.PRESENT_VELOCITY, round(units))
         self._set(ct.MOVING, 1 if moving else 0)
-        self._set(ct.MOVING_STATUS, 0x02 if moving else 0x01)
+        # e-manual, Moving Status (123): bit 1 "Profile Ongoing", bit 0 "In-Position: Whether
+        # or not the DYNAMIXEL has arrived to the desired Goal Position(116)", set "when the
+        # positional deviation is smaller than a predefined value" (ROBOTIS-GIT/emanual
+        # _includes/en/dxl/x/moving_status.md @ 53247968642942cbbdb3fb52e47d5aef4269267a). A
+        # servo stopped short of its goal (shut down by a fault mid-move, torque switched off)
+        # has not arrived: In-Position had been set whenever no profile ran. The predefined
+        # deviation is not published for the X series: IN_POSITION_TICKS is assumed. The
+        # velocity-profile bits (4-5) are not modelled.
+        arrived = not moving and abs(present - self.get(ct.GOAL_POSITION)) <= IN_POSITION_TICKS
+        self._set(ct.MOVING_STATUS, (0x02 if moving else 0) | (0x01 if arrived else 0))
         self._set(ct.REALTIME_TICK, int(now * 1000) % 32768)
 
     def _freeze(self) -> None:

@@ -386,3 +386,36 @@ def test_one_write_may_set_several_items_but_never_part_of_one() -> None:
     assert ph.read4ByteTxRx(port, 1, ct.PROFILE_VELOCITY.address)[0] == 40
     assert ph.read4ByteTxRx(port, 1, ct.GOAL_POSITION.address)[0] == 3000
     assert not emu.servos[1].is_moving()
+
+
+def test_in_position_means_arrived_at_the_goal_not_merely_stopped() -> None:
+    """e-manual, Moving Status (123) bit 0 In-Position: "whether or not the DYNAMIXEL has
+    arrived to the desired Goal Position". A servo shut down by an overload mid-move stops
+    short of its goal: it is not in position (the emulator had said it was, as soon as no
+    profile ran); once it holds a goal it has reached, it is."""
+    clock = VirtualClock()
+    emu = two_servos(clock)
+    port = InProcessPort(emu)
+    assert port.openPort() and port.setBaudRate(57600)
+    ph = sdk.PacketHandler(2.0)
+
+    def moving_status() -> int:
+        value, result, _error = ph.read1ByteTxRx(port, 1, ct.MOVING_STATUS.address)
+        assert result == sdk.COMM_SUCCESS
+        return value
+
+    assert ph.write1ByteTxRx(port, 1, ct.TORQUE_ENABLE.address, 1)[0] == sdk.COMM_SUCCESS
+    assert moving_status() & 0x03 == 0x01  # holding where it is: arrived
+    assert ph.write4ByteTxRx(port, 1, ct.PROFILE_VELOCITY.address, 40)[0] == sdk.COMM_SUCCESS
+    assert ph.write4ByteTxRx(port, 1, ct.GOAL_POSITION.address, 3000)[0] == sdk.COMM_SUCCESS
+    clock.sleep(0.2)
+    assert moving_status() & 0x03 == 0x02  # profile ongoing, not arrived
+    emu.inject_hardware_error(1, ct.HardwareFault.OVERLOAD)  # factory Shutdown selects it
+    clock.sleep(30.0)
+    present = ph.read4ByteTxRx(port, 1, ct.PRESENT_POSITION.address)[0]
+    assert 2048 < present < 3000
+    assert moving_status() & 0x03 == 0x00  # stopped short: neither moving nor in position
+    emu.servos[1].reboot()
+    assert ph.write1ByteTxRx(port, 1, ct.TORQUE_ENABLE.address, 1)[0] == sdk.COMM_SUCCESS
+    clock.sleep(1.0)
+    assert moving_status() & 0x03 == 0x01  # torque-on holds the present position: arrived
