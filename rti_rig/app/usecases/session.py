@@ -659,11 +659,10 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         raise RigChangedError(
             f"{config_path} does not describe the rig this session began on ("
             + "; ".join(diffs)
-            + "): its images would not match the ones already taken. Resume with the "
-            f"session's own config (rti-rig run --resume {shlex.quote(str(session_dir))}), or, "
-            "if the change "
-            "is deliberate (a repaired LED, recalibrated light positions), add "
-            "--accept-rig-change to record it"
+            + "): its images would not match the ones already taken. "
+            + _back_to_own_config(config_path, manifest, session_dir)
+            + ", or, if the change is deliberate (a repaired LED, recalibrated light "
+            "positions), add --accept-rig-change to record it"
         )
     if diffs:
         on_note(Note("rig change accepted and recorded: " + "; ".join(diffs), "warning"))
@@ -676,6 +675,29 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             )
         )
     return identity, diffs
+
+
+def _back_to_own_config(
+    config_path: Path, manifest: dict[str, Any], session_dir: Path | str
+) -> str:
+    """How to get back to the rig the session began on (a sentence, no final stop).
+
+    Why: the advice was always "Resume with the session's own config (rti-rig run --resume
+    DIR)", also when the file refused *was* the session's own, edited in place since (an arm's
+    keep-out cone widened between two runs): that command loads the same edited file and is
+    refused again. Then the file must be set back, and the manifest holds what it said."""
+    last = (manifest.get("rig") or {}).get("config_path")
+    if last and _same_file(Path(config_path), Path(last)):
+        where = Path(session_dir) / "manifest.json"
+        return (
+            "It is this session's own config, edited since the session began: set it back "
+            f"to continue (the config the session began with is recorded in {where}, under "
+            "rig.config)"
+        )
+    return (
+        "Resume with the session's own config (rti-rig run --resume "
+        f"{shlex.quote(str(session_dir))})"
+    )
 
 
 def _config_differs(config_path: Path, manifest: dict[str, Any]) -> str:
