@@ -345,12 +345,14 @@ def run_session(
             }
             # the lights are off; an emergency stop raised between the files' rename and the
             # journal line left an image on disk that lights.lp did not list: the commit of a
-            # captured image is finished first (a fraction of a second), then the stop acts
+            # captured image is finished first (a fraction of a second), then the stop acts.
+            # The record is counted inside the hold too: a stop that acted before the count
+            # left the manifest's steps_done_this_run one short of the images this run wrote
             with signals_deferred():
                 record = folder.write_step(i, frame, fields)
+                records.append(record)
             if source is not None:
                 source.observe(i, frame, record)
-            records.append(record)
             layout = layout or got
             emit(StepCompleted(i, total, record))
         else:

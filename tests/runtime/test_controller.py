@@ -403,8 +403,11 @@ def test_an_emergency_stop_during_an_image_s_commit_leaves_it_listed(
     finally:
         signal.signal(signal.SIGTERM, previous)
         bystander.set()
-    assert manifest(out)["runner"]["finish_reason"] == "emergency-stop"
+    runner = manifest(out)["runner"]
+    assert runner["finish_reason"] == "emergency-stop"
     assert_images_intact(out, 4)
+    # counted as done in this run too (the stop acted before the count: 3 of 4 were said)
+    assert runner["steps_done_this_run"] == runner["steps_done"] == 4
 
 
 class ExposingWrapper:
