@@ -312,8 +312,19 @@ class DynamixelArm:
         self.park()
 
     def lamp(self, on: bool) -> None:
+        """Switch the lamp (with ``lamp = "servo_led"``: the LED register of its servo).
+
+        Switching it off is done by a Write the servo carries out even while it reports a
+        hardware fault: the Alert bit of its reply says the servo has a problem, not that the
+        Write failed (an error number would; ROBOTIS e-manual, Protocol 2.0, Status Packet,
+        Error). So the Alert does not fail the lamp-off — it had, and a session stopped by an
+        overload on the lamp's servo reported "lamp off" as failed with the lamp off, and kept
+        calling it on. The fault itself is reported by the move or stop that meets it.
+        Switching on still refuses a servo in fault."""
         if self.settings.lamp == "servo_led" and self._connected:
-            self._bus.write(int(self.settings.lamp_servo_id), ct.LED, 1 if on else 0)
+            self._bus.write(
+                int(self.settings.lamp_servo_id), ct.LED, 1 if on else 0, check_alert=bool(on)
+            )
         self._lamp_on = bool(on)
 
     @property

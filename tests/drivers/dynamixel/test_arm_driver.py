@@ -518,3 +518,18 @@ def test_a_port_lost_mid_session_is_a_named_device_error() -> None:
     # the teardown says what it could not do, by name, whatever the step
     with pytest.raises(DynamixelError, match=r"stop incomplete.*port '/dev/ttyUSB0' failed"):
         arm.close()
+
+
+def test_the_lamp_goes_off_on_a_servo_that_reports_a_fault() -> None:
+    """A servo in fault still carries out a Write (the Alert bit is no error number): the
+    servo_led lamp's off is done, and said so (it was reported as failed, and the lamp kept
+    as on); switching it on again is refused."""
+    arm, emu, _ = make_arm(lamp="servo_led", lamp_servo_id=2)
+    arm.connect()
+    arm.lamp(True)
+    emu.inject_hardware_error(2, ct.HardwareFault.OVERLOAD)
+    arm.lamp(False)
+    assert emu.servos[2].get(ct.LED) == 0 and not arm.lamp_is_on
+    with pytest.raises(HardwareFaultError, match="overload"):
+        arm.lamp(True)
+    assert not arm.lamp_is_on
