@@ -414,6 +414,10 @@ class DynamixelArm:
         and may drop under gravity, which is why ``stop`` (hold) is the normal safe stop."""
         self._emergency_stopped = True
         self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
+        if self.settings.lamp == "servo_led":
+            # the lamp hangs on a servo's LED output: it goes off only by a write (the lamp
+            # had been recorded as off with the LED still lit); broadcast, no reply to wait for
+            self._bus.broadcast_write(ct.LED, 0)
         self._lamp_on = False
 
     def reboot(self) -> None:

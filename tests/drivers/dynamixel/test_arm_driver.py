@@ -257,7 +257,7 @@ def test_emergency_stop_and_lamp_on_servo_led() -> None:
     assert emu.servos[2].get(ct.LED) == 1
     arm.emergency_stop()
     assert not emu.servos[1].torque_on and not emu.servos[2].torque_on
-    assert not arm.lamp_is_on
+    assert not arm.lamp_is_on and emu.servos[2].get(ct.LED) == 0  # said off, and off
 
 
 def test_settings_errors_name_the_problem() -> None:
