@@ -2,7 +2,8 @@
 
 Never "lights are off" unless that was established: a dome reports the outcome of its last
 all-off (acknowledged, sent to a firmware that never acknowledges, sent but unconfirmed, not
-sent), an arm that its lamp-off was requested.
+sent), an arm that its lamp-off was requested — or, for a real arm whose lamp is not on the
+servo bus (``lamp = "software"``), that nothing switched it.
 """
 
 from __future__ import annotations
@@ -27,12 +28,21 @@ def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-
         if hasattr(source, "off_report"):
             return lights_state_sentence(source)
         return "lights were switched off"  # a simulated dome: its state is the simulation's
-    unreached = not_connected_sentence(getattr(lighting, "carrier", None))
+    carrier = getattr(lighting, "carrier", None)
+    unreached = not_connected_sentence(carrier)
     if unreached is not None:
         return unreached
-    return "lamp off and stop were requested" + (
-        " (see the teardown problems above)" if teardown_failed else ""
-    )
+    after = " (see the teardown problems above)" if teardown_failed else ""
+    lamp = getattr(getattr(carrier, "settings", None), "lamp", None)
+    if lamp == "software" and getattr(rig.loaded.config, "backend", None) == "hardware":
+        # the lamp's own switch is outside the servo bus: its "off" is a flag in the driver,
+        # and "lamp off ... requested" had told a user at a real arm that it was switched
+        return (
+            'stop was requested; the lamp is not switched by rti-rig (lamp = "software" in '
+            "[arm.dynamixel]: its switch is outside the servo bus), so switch it off yourself"
+            + after
+        )
+    return "lamp off and stop were requested" + after
 
 
 def safe_state_unsure(rig) -> bool:  # type: ignore[no-untyped-def]
