@@ -186,6 +186,9 @@ class EmulatedServo:
         self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
         self._registered: tuple[int, bytes] | None = None
         self._shut_down = False
+        #: the writable RAM area (Torque Enable .. Goal Position) as at power-on, restored by a
+        #: Reboot (:meth:`reboot`)
+        self._ram_at_power_on = bytes(self.table[ct.EEPROM_END : ct.REALTIME_TICK.address])
         self.set_input_voltage(
             f.recommended_supply_decivolts if supply_decivolts is None else supply_decivolts
         )
@@ -283,11 +286,26 @@ class EmulatedServo:
             self.inject_hardware_error(ct.HardwareFault.INPUT_VOLTAGE)
 
     def reboot(self) -> None:
+        """A restart, as at power-on: the RAM area back to its initial values, EEPROM kept.
+
+        e-manual, X-series control table, Area: "Data in the RAM Area is reset to initial
+        values when the power is reset"; the Shutdown notes give the S/W REBOOT (the Reboot
+        instruction) beside turning the power off and on (ROBOTIS-GIT/emanual
+        _includes/en/dxl/x/control_table.md @ add0d1dabec2202f8ae9848b7eda8e98f9a44b0f,
+        shutdown.md @ 048ec0de57bc856b9f127ef854243fb44c86d428). So Profile Velocity and
+        Acceleration, LED, Status Return Level, a registered instruction and the Hardware Error
+        Status go back to their initial values, not only the error and torque (a reboot had
+        kept the session's profile and the LED: a driver that relied on them after a reboot
+        would have passed here and failed on a servo). The initial Goal Position is not given
+        ("-"): the present position is modelled, as for a torque-on. A supply still outside
+        the voltage limits raises its error again."""
         self._shut_down = False
         self._freeze()
-        self.table[ct.HARDWARE_ERROR_STATUS.address] = 0
-        self.table[ct.TORQUE_ENABLE.address] = 0
-        self.table[ct.LED.address] = 0
+        self.table[ct.EEPROM_END : ct.REALTIME_TICK.address] = self._ram_at_power_on
+        self._set(ct.GOAL_POSITION, round(self.position()))
+        self._registered = None
+        # a supply still outside the limits is met again by the restarted servo
+        self.set_input_voltage(self.get(ct.PRESENT_INPUT_VOLTAGE))
 
     # -- instructions -----------------------------------------------------------------------
     def status_error(self, number: int = 0) -> int:

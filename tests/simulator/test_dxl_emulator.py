@@ -419,3 +419,35 @@ def test_in_position_means_arrived_at_the_goal_not_merely_stopped() -> None:
     assert ph.write1ByteTxRx(port, 1, ct.TORQUE_ENABLE.address, 1)[0] == sdk.COMM_SUCCESS
     clock.sleep(1.0)
     assert moving_status() & 0x03 == 0x01  # torque-on holds the present position: arrived
+
+
+def test_a_reboot_restores_the_ram_area_as_at_power_on() -> None:
+    """e-manual: RAM is reset to its initial values when the power is reset, and the Reboot
+    instruction is the software form of that. The emulator's reboot had cleared only the
+    hardware error, torque and LED, keeping the profile a driver had written."""
+    clock = VirtualClock()
+    emu = two_servos(clock)
+    port = InProcessPort(emu)
+    assert port.openPort() and port.setBaudRate(57600)
+    ph = sdk.PacketHandler(2.0)
+    for reg, value in (
+        (ct.PROFILE_VELOCITY, 50),
+        (ct.PROFILE_ACCELERATION, 20),
+        (ct.LED, 1),
+        (ct.TORQUE_ENABLE, 1),
+    ):
+        write = {1: ph.write1ByteTxRx, 4: ph.write4ByteTxRx}[reg.size]
+        assert write(port, 1, reg.address, value) == (sdk.COMM_SUCCESS, 0)
+    assert ph.regWriteTxRx(port, 1, ct.LED.address, 1, [0]) == (sdk.COMM_SUCCESS, 0)
+    emu.inject_hardware_error(1, ct.HardwareFault.OVERHEATING)
+    assert ph.reboot(port, 1) == (sdk.COMM_SUCCESS, 0)
+    servo = emu.servos[1]
+    assert servo.get(ct.PROFILE_VELOCITY) == 0 and servo.get(ct.PROFILE_ACCELERATION) == 0
+    assert servo.get(ct.LED) == 0 and not servo.torque_on and servo.hardware_error == 0
+    assert servo.get(ct.STATUS_RETURN_LEVEL) == 2  # the model's initial value
+    assert servo.get(ct.REGISTERED_INSTRUCTION) == 0
+    assert servo.get(ct.GOAL_POSITION) == round(servo.position())
+    assert servo.get(ct.MIN_POSITION_LIMIT) == 0  # EEPROM kept
+    emu.set_input_voltage(1, 200)  # 20 V: above the XL430's 14 V limit, and still there
+    assert ph.reboot(port, 1)[0] == sdk.COMM_SUCCESS
+    assert servo.hardware_error == ct.HardwareFault.INPUT_VOLTAGE
