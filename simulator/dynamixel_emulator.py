@@ -186,6 +186,8 @@ class EmulatedServo:
         self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
         self._registered: tuple[int, bytes] | None = None
         self._shut_down = False
+        #: the other axes of the same body (a 2XL430's second id): see :meth:`write`
+        self.other_axes: list[EmulatedServo] = []
         #: the writable RAM area (Torque Enable .. Goal Position) as at power-on, restored by a
         #: Reboot (:meth:`reboot`)
         self._ram_at_power_on = bytes(self.table[ct.EEPROM_END : ct.REALTIME_TICK.address])
@@ -336,7 +338,11 @@ class EmulatedServo:
         for lo, hi in READ_ONLY:
             if address < hi and end > lo:
                 return p2.ERR_ACCESS
-        if address < ct.EEPROM_END and self.torque_on:
+        if address < ct.EEPROM_END and (
+            self.torque_on or any(axis.torque_on for axis in self.other_axes)
+        ):
+            # a two-axis body (2XL430) locks its EEPROM while either axis has torque on
+            # (ct.DUAL_AXIS_MODELS: "for all axis are set to '0'")
             return p2.ERR_ACCESS
         for reg in ITEMS:
             covers_some = address < reg.address + reg.size and end > reg.address
@@ -688,6 +694,9 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
                 present_ticks=ticks if at_park else 2048,
             )
         )
+    dual = [s for s in servos if s.get(ct.MODEL_NUMBER) in ct.DUAL_AXIS_MODELS]
+    if len(dual) == 2:  # both joints on one two-axis servo (a 2XL430 pan-tilt)
+        dual[0].other_axes, dual[1].other_axes = [dual[1]], [dual[0]]
     return DynamixelBusEmulator(servos, clock)
 
 

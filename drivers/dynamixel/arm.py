@@ -191,7 +191,18 @@ class DynamixelArm:
                 sid,
             )
         log.info("%s: servo %d position limits %s -> %s", self.name, sid, have, (lo, hi))
-        self._bus.write(sid, ct.TORQUE_ENABLE, 0)  # EEPROM is writable only with torque off
+        # EEPROM is writable only with torque off; on a two-axis servo (2XL430) only with both
+        # axes' torque off: the arm's other axis of that model is taken to be its sibling (a
+        # 2XL430 pan-tilt). With the other axis still holding from an earlier session (torque
+        # policy "hold"), changing the limits in the config had failed the connect on a bare
+        # "access error"
+        off = [sid]
+        if joint.model_number in ct.DUAL_AXIS_MODELS:
+            off = [
+                j.servo_id for j in self.settings.joints if j.model_number in ct.DUAL_AXIS_MODELS
+            ]
+        for servo_id in off:
+            self._bus.write(servo_id, ct.TORQUE_ENABLE, 0)
         self._bus.write(sid, ct.MIN_POSITION_LIMIT, lo)
         self._bus.write(sid, ct.MAX_POSITION_LIMIT, hi)
         again = (

@@ -96,6 +96,13 @@ MODEL_NAMES = {
     1200: "XL330-M288",
 }
 
+#: Models with two axes in one body, each axis a servo id of its own: their EEPROM can be
+#: written only with the torque of *every* axis off ("Data in the EEPROM Area can only be
+#: modified when Torque Enable(64) for all axis are set to '0'", ROBOTIS e-manual, X-series
+#: control table, Area, 2XL430-W250 branch: ROBOTIS-GIT/emanual
+#: _includes/en/dxl/x/control_table.md @ add0d1dabec2202f8ae9848b7eda8e98f9a44b0f).
+DUAL_AXIS_MODELS = frozenset({1090})
+
 TICKS_PER_REV = 4096
 DEG_PER_TICK = 360.0 / TICKS_PER_REV
 MAX_TICK = TICKS_PER_REV - 1

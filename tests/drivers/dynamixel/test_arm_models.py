@@ -127,3 +127,31 @@ def test_a_second_joints_profile_velocity_above_its_limit_fails_connect_before_a
     assert not arm.commanded
     for servo in emu.servos.values():
         assert servo.get(ct.MIN_POSITION_LIMIT) == 0 and servo.get(ct.MAX_POSITION_LIMIT) == 4095
+
+
+def test_new_limits_on_a_2xl430_held_from_an_earlier_session_are_written() -> None:
+    """A 2XL430-W250 pan-tilt (two axes, one body) locks its EEPROM while *either* axis has
+    torque on (e-manual, control table Area, 2XL430 branch). The arm left holding by the last
+    session (torque policy "hold"), and the config's azimuth limits then changed: the connect
+    switched off the azimuth axis alone and failed on "access error" writing the new limits."""
+    arm, emu, clock = make_arm(1090)
+    arm.connect()
+    arm.close()
+    assert all(s.torque_on for s in emu.servos.values())  # holding, as "hold" says
+    wider = dict(model_number=1090, profile_velocity_rpm=20.0, min_deg=-160.0)
+    settings = arm_settings(azimuth=wider, elevation=dict(model_number=1090))
+    again = DynamixelArm(settings, InProcessPort(emu), clock)
+    with again:
+        again.move_to(direction_from_az_el(-150, 40))
+    assert emu.servos[1].get(ct.MIN_POSITION_LIMIT) == settings.azimuth.tick_limits[0]
+
+
+def test_the_emulated_2xl430_locks_its_eeprom_while_either_axis_holds() -> None:
+    arm, emu, _clock = make_arm(1090)
+    arm.connect()
+    emu.servos[1].table[ct.TORQUE_ENABLE.address] = 0  # one axis off, the other holding
+    assert emu.servos[1].write(ct.MIN_POSITION_LIMIT.address, (100).to_bytes(4, "little")) == 7
+    arm, emu, _clock = make_arm(1060)  # two XL430s: two bodies, each its own lock
+    arm.connect()
+    emu.servos[1].table[ct.TORQUE_ENABLE.address] = 0
+    assert emu.servos[1].write(ct.MIN_POSITION_LIMIT.address, (100).to_bytes(4, "little")) == 0
