@@ -183,7 +183,44 @@ class ArmSettings(BaseModel):
                 f"park pose (azimuth {self.park_azimuth_deg}, elevation "
                 f"{self.park_elevation_deg}) is not safe: {reason}"
             )
+        self._check_move_timeout()
         return self
+
+    def _check_move_timeout(self) -> None:
+        """``move_timeout_s`` at least the longest move the arm can be sent on.
+
+        A move not in position within ``move_timeout_s`` fails the session ("check for an
+        obstruction"), so a timeout shorter than the arm's own longest move — a joint across
+        its whole range at its profile — fails every session that asks for it, after images
+        were taken (a 2 rpm azimuth with the shipped 20 s timeout: a swing from -165 deg to 165
+        deg took 27 s, and the session stopped there). The profile is the X-series trapezoid
+        (:func:`rti_rig.core.arm_motion.joint_move_time_s`) with the quantised register
+        values; the elevation range is the reachable one (below the keep-out cone)."""
+        from rti_rig.core.arm_motion import joint_move_time_s
+
+        top = min(self.elevation.max_deg, 90.0 - self.keep_out_half_angle_deg)
+        spans = (
+            ("azimuth", self.azimuth, self.azimuth.min_deg, self.azimuth.max_deg),
+            ("elevation", self.elevation, self.elevation.min_deg, top),
+        )
+        role, joint, lo, hi = max(
+            spans,
+            key=lambda j: joint_move_time_s(
+                j[3] - j[2], j[1].joint_velocity_deg_s, j[1].joint_acceleration_deg_s2
+            ),
+        )
+        longest = joint_move_time_s(
+            hi - lo, joint.joint_velocity_deg_s, joint.joint_acceleration_deg_s2
+        )
+        if self.move_timeout_s < longest:
+            raise ValueError(
+                f"move_timeout_s = {self.move_timeout_s:g} s is shorter than this arm's "
+                f"longest move: the {role} joint across its range ({lo:g}..{hi:g} deg) at "
+                f"profile_velocity_rpm = {joint.profile_velocity_rpm:g} takes {longest:.1f} s, "
+                "so a session that asks for it would stop there with a timeout; raise "
+                f"move_timeout_s to {math.ceil(1.5 * longest)} or more, or raise that joint's "
+                "profile_velocity_rpm"
+            )
 
     @property
     def servo_ids(self) -> tuple[int, int]:

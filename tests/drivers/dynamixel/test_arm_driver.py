@@ -242,12 +242,25 @@ def test_a_stop_holds_an_arm_found_inside_the_keep_out_cone() -> None:
 
 
 def test_stalled_move_times_out_and_stops() -> None:
-    arm, emu, clock = make_arm(move_timeout_s=1.0)
+    # a short timeout needs a short arm: the config refuses one below its longest move
+    arm, emu, clock = make_arm(move_timeout_s=2.0, azimuth=dict(min_deg=-20.0, max_deg=20.0))
     arm.connect()
     emu.servos[2].table[ct.TORQUE_ENABLE.address] = 0  # stalls: goal accepted, no motion
     with pytest.raises(MoveTimeoutError, match="not in position"):
         arm.move_to(direction_from_az_el(0, 60))
-    assert clock.now() < 2.0
+    assert clock.now() < 3.0
+
+
+def test_a_timeout_shorter_than_the_arm_s_longest_move_is_refused() -> None:
+    """A 2 rpm azimuth across -170..170 deg takes about 28 s: with a 20 s timeout, a session
+    that asked for that swing stopped there, after its first images ("not in position after
+    20.0 s ... check for an obstruction")."""
+    with pytest.raises(ValidationError, match=r"move_timeout_s = 20 s is shorter") as info:
+        arm_settings(move_timeout_s=20.0, azimuth=dict(profile_velocity_rpm=2.0))
+    said = str(info.value)
+    assert "azimuth joint across its range (-170..170 deg)" in said
+    assert "raise move_timeout_s to 42 or more" in said
+    arm_settings(move_timeout_s=30.0, azimuth=dict(profile_velocity_rpm=2.0))  # enough
 
 
 def test_emergency_stop_and_lamp_on_servo_led() -> None:
