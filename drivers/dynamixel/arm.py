@@ -109,7 +109,7 @@ class DynamixelArm:
                 dev,
                 f"model number {model} ({ct.MODEL_NAMES.get(model, 'unknown')}) but the config "
                 f"expects {joint.model_number} ({ct.MODEL_NAMES[joint.model_number]}); fix "
-                "model_number or the servo id",
+                f"model_number or servo_id in [arm.dynamixel.{self._role(joint)}]",
                 "connect",
                 sid,
             )
@@ -148,6 +148,11 @@ class DynamixelArm:
                 )
         self._check_velocity_limit(joint)
 
+    def _role(self, joint) -> str:  # type: ignore[no-untyped-def]
+        """The joint's table in the rig config (``azimuth`` or ``elevation``): an error about a
+        setting names where to change it (it had named only the servo id)."""
+        return "azimuth" if joint is self.settings.azimuth else "elevation"
+
     def _check_velocity_limit(self, joint) -> None:
         """The profile velocity within the servo's Velocity Limit (44), checked before any write.
 
@@ -162,7 +167,8 @@ class DynamixelArm:
         if joint.velocity_units > limit:
             raise ConfigMismatchError(
                 self.name,
-                f"profile_velocity_rpm = {joint.profile_velocity_rpm:g} (register value "
+                f"[arm.dynamixel.{self._role(joint)}] profile_velocity_rpm = "
+                f"{joint.profile_velocity_rpm:g} (register value "
                 f"{joint.velocity_units}) exceeds the servo's Velocity Limit {limit} "
                 f"({limit * ct.RPM_PER_VELOCITY_UNIT:.1f} rpm, "
                 f"{ct.MODEL_NAMES.get(joint.model_number, 'this model')}); lower "

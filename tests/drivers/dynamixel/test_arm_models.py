@@ -122,11 +122,23 @@ def test_a_second_joints_profile_velocity_above_its_limit_fails_connect_before_a
     clock = VirtualClock()
     emu = emulator_for_arm(settings, clock)
     arm = DynamixelArm(settings, InProcessPort(emu), clock)
-    with pytest.raises(ConfigMismatchError, match="profile_velocity_rpm"):
+    with pytest.raises(ConfigMismatchError, match="profile_velocity_rpm") as info:
         arm.connect()
+    # the config table to change is named, not only the servo id
+    assert "[arm.dynamixel.elevation] profile_velocity_rpm = 40" in str(info.value)
     assert not arm.commanded
     for servo in emu.servos.values():
         assert servo.get(ct.MIN_POSITION_LIMIT) == 0 and servo.get(ct.MAX_POSITION_LIMIT) == 4095
+
+
+def test_a_servo_of_another_model_is_named_with_the_config_table_to_fix() -> None:
+    settings = arm_settings(elevation=dict(model_number=1020))
+    clock = VirtualClock()
+    emu = emulator_for_arm(arm_settings(), clock)  # two XL430s on the bus
+    arm = DynamixelArm(settings, InProcessPort(emu), clock)
+    with pytest.raises(ConfigMismatchError, match="model number 1060") as info:
+        arm.connect()
+    assert "fix model_number or servo_id in [arm.dynamixel.elevation]" in str(info.value)
 
 
 def test_new_limits_on_a_2xl430_held_from_an_earlier_session_are_written() -> None:
