@@ -147,12 +147,11 @@ class ArmLighting:
         self.carrier.lamp(False)
 
     def safe(self, emergency: bool = False) -> list[str]:
-        failures = attempt_all(
-            [("lamp off", lambda: self.carrier.lamp(False)), ("stop", self.carrier.stop)]
-        )
+        failures = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
+        stop_failed = attempt_all([("stop", self.carrier.stop)])
+        failures += stop_failed
         if not (self.park_on_emergency if emergency else self.park_after_session):
             return failures
-        stop_failed = any(f.startswith("stop: ") for f in failures)
         if self.arm_failure is not None or stop_failed:
             why = "own move failed" if self.arm_failure is not None else "stop failed"
             return [

@@ -94,3 +94,30 @@ def test_a_session_failed_by_the_camera_still_parks_the_arm(tmp_path: Path) -> N
     ticks = tuple(round(v) for v in emulator.joint_positions().values())
     park = arm.kin.ticks_of_pose(0.0, 10.0)
     assert max(abs(a - b) for a, b in zip(ticks, park, strict=True)) <= 2
+
+
+def test_an_arm_whose_stop_failed_is_not_parked_either(tmp_path: Path) -> None:
+    """The session fails on the camera, and the elevation servo has stopped answering: the
+    stop cannot hold it, so the park (a move of both joints) is not sent."""
+    rig = emulated_arm_rig(tmp_path)
+    emulator, real_capture, shots, mark = rig.emulator, rig.camera.capture, [0], []
+
+    def capture(exposure_s: float):  # type: ignore[no-untyped-def]
+        shots[0] += 1
+        if shots[0] == 3:
+            emulator.silent_ids.add(rig.loaded.config.arm.dynamixel.elevation.servo_id)
+            mark.append(len(emulator.goal_log))
+            raise CaptureError(rig.camera.name, "card full", "capture")
+        return real_capture(exposure_s)
+
+    rig.camera.capture = capture  # type: ignore[method-assign]
+    out = tmp_path / "s"
+    with rig, pytest.raises(CaptureError):
+        run_session(rig, plan_uniform(rig.geometry, 8), SessionFolder.create(out, 8))
+    arm = rig.lighting.carrier  # type: ignore[attr-defined]
+    park = dict(zip(arm.settings.servo_ids, arm.kin.ticks_of_pose(0.0, 10.0), strict=True))
+    after = emulator.goal_log[mark[0] :]
+    assert not [g for g in after if park[g[0]] == g[1]], f"park goals sent: {after}"
+    runner = json.loads((out / "manifest.json").read_text())["runner"]
+    said = [f for f in runner["teardown_failures"] if f.startswith("park:")]
+    assert len(said) == 1 and "because the arm's stop failed" in said[0]
