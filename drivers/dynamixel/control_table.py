@@ -137,13 +137,25 @@ class HardwareFault(IntEnum):
     OVERLOAD = 0x20
 
 
+#: What to do about each fault; :class:`~rti_rig.drivers.dynamixel.faults.HardwareFaultError`
+#: follows it with :data:`REBOOT_HOW`.
 FAULT_ADVICE = {
     HardwareFault.INPUT_VOLTAGE: "check the power supply voltage against the servo's limits",
     HardwareFault.OVERHEATING: "let the servo cool down and reduce its load or duty cycle",
-    HardwareFault.MOTOR_ENCODER: "the encoder failed; check the servo, then reboot it",
-    HardwareFault.ELECTRICAL_SHOCK: "check wiring and power; then reboot the servo",
-    HardwareFault.OVERLOAD: "the arm is blocked or overloaded; clear the obstruction, then reboot",
+    HardwareFault.MOTOR_ENCODER: "the encoder failed; check the servo",
+    HardwareFault.ELECTRICAL_SHOCK: "check wiring and power",
+    HardwareFault.OVERLOAD: "the arm is blocked or overloaded; clear the obstruction",
 }
+#: How a user restarts a servo to clear its fault — rti-rig has no reboot command, and
+#: refuses to connect to a servo reporting one: the e-manual's H/W REBOOT (power off and on)
+#: or S/W REBOOT (the Reboot instruction, e.g. from Dynamixel Wizard 2.0; ROBOTIS-GIT/emanual
+#: _includes/en/dxl/x/shutdown.md @ 048ec0de). The advice had said "then reboot" for some
+#: faults and nothing for others: an overheated servo, told only to cool down, was refused
+#: again once cool, its fault still latched.
+REBOOT_HOW = (
+    "then switch the servos' power off and on (or send Reboot from Dynamixel Wizard 2.0) to "
+    "clear it"
+)
 
 
 def decode_hardware_error(status: int) -> list[HardwareFault]:

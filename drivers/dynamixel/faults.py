@@ -68,8 +68,8 @@ class HardwareFaultError(DynamixelError):
         )
         super().__init__(
             device,
-            f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}. "
-            + torque_statement(torque_on),
+            f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}; "
+            f"{ct.REBOOT_HOW}. " + torque_statement(torque_on),
             command,
             servo_id,
         )

@@ -247,6 +247,9 @@ def test_injected_hardware_error_surfaces_by_name(fault, name) -> None:
         bus.write(2, ct.LED, 1)
     assert info.value.fault_names == [name] and info.value.servo_id == 2
     assert name.split("_")[0] in str(info.value).lower() and "reboot" in str(info.value)
+    # how to reboot, as a user can (rti-rig has no reboot command; the fault stays latched):
+    # an overheated servo had only been told to cool down, and was refused again once cool
+    assert "; then switch the servos' power off and on" in str(info.value)
     bus.reboot(2)
     bus.write(2, ct.LED, 1)  # cleared
 
