@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
+from rti_rig.core.rig_geometry import LIMIT_SLACK_DEG
 from rti_rig.drivers.dynamixel import control_table as ct
 
 if TYPE_CHECKING:  # annotations only: settings validates a park pose with these kinematics
@@ -51,12 +52,15 @@ class ArmKinematics:
         """Why a joint pose is unsafe, or None."""
         s = self.settings
         az, el = s.azimuth, s.elevation
-        if not az.min_deg - EPS_DEG <= azimuth_deg <= az.max_deg + EPS_DEG:
+        # a pose a rounding hair past a limit is on it (LIMIT_SLACK_DEG): its ticks are rounded
+        # onto the limit's own tick (ticks_of_pose), and the tick gate below stays exact
+        slack = LIMIT_SLACK_DEG
+        if not az.min_deg - slack <= azimuth_deg <= az.max_deg + slack:
             return f"azimuth joint {azimuth_deg:.3f} deg outside {az.min_deg}..{az.max_deg}"
-        if not el.min_deg - EPS_DEG <= elevation_deg <= el.max_deg + EPS_DEG:
+        if not el.min_deg - slack <= elevation_deg <= el.max_deg + slack:
             return f"elevation {elevation_deg:.3f} deg outside {el.min_deg}..{el.max_deg}"
         limit = 90.0 - s.keep_out_half_angle_deg
-        if elevation_deg > limit + EPS_DEG:
+        if elevation_deg > limit + slack:
             return (
                 f"elevation {elevation_deg:.3f} deg is inside the "
                 f"{s.keep_out_half_angle_deg} deg keep-out cone around the camera "
@@ -89,6 +93,7 @@ class ArmKinematics:
         are clamped onto the limit (which is inside the safe range). Anything further out is
         left alone for the gate to refuse."""
         out = []
+        cone = 90.0 - self.settings.keep_out_half_angle_deg
         for joint, deg in (
             (self.settings.azimuth, azimuth_deg),
             (self.settings.elevation, elevation_deg),
@@ -100,6 +105,18 @@ class ArmKinematics:
                 t = lo
             elif raw <= hi + 1.0 and t > hi:
                 t = hi
+            # a pose on the keep-out cone's edge rounds to the tick outside the cone, not the one
+            # a fraction of a tick inside it (which the gate refuses)
+            edge = joint is self.settings.elevation and deg <= cone + LIMIT_SLACK_DEG
+            if edge and ticks_to_joint(joint, t) > cone + EPS_DEG:
+                t = next(
+                    (
+                        a
+                        for a in (math.floor(raw), math.ceil(raw))
+                        if lo <= a <= hi and ticks_to_joint(joint, a) <= cone + EPS_DEG
+                    ),
+                    t,
+                )
             out.append(int(t))
         return out[0], out[1]
 
@@ -123,7 +140,7 @@ class ArmKinematics:
         return [
             azimuth_deg + 360.0 * k
             for k in range(k0, k1 + 1)
-            if j.min_deg - EPS_DEG <= azimuth_deg + 360.0 * k <= j.max_deg + EPS_DEG
+            if j.min_deg - LIMIT_SLACK_DEG <= azimuth_deg + 360.0 * k <= j.max_deg + LIMIT_SLACK_DEG
         ]
 
     def solve(

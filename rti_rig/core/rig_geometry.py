@@ -66,6 +66,14 @@ class DomeGeometry:
         return i, float(ang[i])
 
 
+#: How far past an arm's limit (degrees) a direction may lie and count as on it: an `.lp`
+#: keeps six decimals, which put a light planned exactly on a limit up to ~1e-4° either side
+#: (a plan at the 15° keep-out edge was refused as "15.00° from the camera axis, inside the
+#: 15° keep-out cone … made for another rig"). Far below a servo tick (0.088°): the driver
+#: rounds such a pose onto the limit's own tick, and its tick gate stays exact.
+LIMIT_SLACK_DEG = 1e-3
+
+
 @dataclass(frozen=True)
 class ArmGeometry:
     """An arm's reachable band of light directions and its parking pose."""
@@ -89,18 +97,22 @@ class ArmGeometry:
         _, el = az_el_from_direction(d)
         el = float(el)
         off_axis = float(angle_between_deg(d, (0.0, 0.0, 1.0)))
-        if off_axis < self.keep_out_half_angle_deg - 1e-9:
+        if off_axis < self.keep_out_half_angle_deg - LIMIT_SLACK_DEG:
             return (
                 f"direction is {off_axis:.2f}° from the camera axis, inside the "
                 f"{self.keep_out_half_angle_deg:g}° keep-out cone"
             )
-        if el < self.min_elevation_deg - 1e-9:
+        if el < self.min_elevation_deg - LIMIT_SLACK_DEG:
             return f"elevation {el:.2f}° is below the arm's minimum {self.min_elevation_deg:g}°"
-        if el > self.max_elevation_deg + 1e-9:
+        if el > self.max_elevation_deg + LIMIT_SLACK_DEG:
             return f"elevation {el:.2f}° is above the arm's maximum {self.max_elevation_deg:g}°"
         az = float(az_el_from_direction(d)[0])
         az = az - 360.0 if az > 180.0 else az
-        if not self.min_azimuth_deg - 1e-9 <= az <= self.max_azimuth_deg + 1e-9:
+        if (
+            not self.min_azimuth_deg - LIMIT_SLACK_DEG
+            <= az
+            <= self.max_azimuth_deg + LIMIT_SLACK_DEG
+        ):
             return (
                 f"azimuth {az:.2f}° is outside the arm's range "
                 f"[{self.min_azimuth_deg:g}°, {self.max_azimuth_deg:g}°]"
@@ -115,11 +127,11 @@ class ArmGeometry:
         off_axis = angle_between_deg(d, np.array([0.0, 0.0, 1.0]))
         az = np.where(az > 180.0, az - 360.0, az)
         return (
-            (off_axis >= self.keep_out_half_angle_deg - 1e-9)
-            & (el >= self.min_elevation_deg - 1e-9)
-            & (el <= self.max_elevation_deg + 1e-9)
-            & (az >= self.min_azimuth_deg - 1e-9)
-            & (az <= self.max_azimuth_deg + 1e-9)
+            (off_axis >= self.keep_out_half_angle_deg - LIMIT_SLACK_DEG)
+            & (el >= self.min_elevation_deg - LIMIT_SLACK_DEG)
+            & (el <= self.max_elevation_deg + LIMIT_SLACK_DEG)
+            & (az >= self.min_azimuth_deg - LIMIT_SLACK_DEG)
+            & (az <= self.max_azimuth_deg + LIMIT_SLACK_DEG)
         )
 
     def elevation_band(self, min_elevation_deg: float = 0.0) -> tuple[float, float]:

@@ -190,3 +190,33 @@ def test_direction_on_a_degree_limit_is_reachable_from_either_side() -> None:
         pose, reason = kin.solve(d, ref)
         assert reason is None and pose is not None
         assert kin.ticks_reason(*kin.ticks_of_pose(*pose)) is None
+
+
+@pytest.mark.parametrize("half_angle", [15.0, 14.95, 14.99])
+def test_a_light_on_the_keep_out_edge_as_an_lp_writes_it_is_reachable(half_angle: float) -> None:
+    """A light planned exactly on the cone's edge, read back from an `.lp`'s six decimals, lies
+    up to ~1e-4° either side of it: it was refused ("inside the keep-out cone"), and where the
+    edge's tick rounded up into the cone the gate refused it too. It is now on the edge: its
+    ticks are the nearest outside the cone, which the exact gate passes; a light 0.01° inside
+    the cone is still refused."""
+    cfg = ArmSettings(
+        port="emulated",
+        azimuth=dict(
+            servo_id=1, model_number=1060, zero_offset_ticks=2048, min_deg=-170.0, max_deg=170.0
+        ),
+        elevation=dict(
+            servo_id=2, model_number=1060, zero_offset_ticks=1024, min_deg=0.0, max_deg=90.0
+        ),
+        keep_out_half_angle_deg=half_angle,
+        park_elevation_deg=10.0,
+    )
+    kin = ArmKinematics(cfg)
+    edge = 90.0 - half_angle
+    for az in (0.0, 37.0, -120.0):
+        on_edge = np.round(direction_from_az_el(az, edge), 6)  # as an .lp stores it
+        pose, reason = kin.solve(on_edge)
+        assert reason is None and pose is not None, reason
+        el_ticks = kin.ticks_of_pose(*pose)[1]
+        assert kin.ticks_reason(*kin.ticks_of_pose(*pose)) is None
+        assert (el_ticks - 1024) * DPT <= edge + 1e-9
+        assert kin.solve(direction_from_az_el(az, edge + 0.01))[1] is not None
