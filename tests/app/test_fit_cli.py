@@ -367,6 +367,47 @@ def test_batch_fit_is_resumable(clean, tmp_path: Path) -> None:
     assert r.exit_code == 0 and r.output.count("(finished earlier)") == 2
 
 
+def test_a_batch_given_the_current_folder_fits_it(
+    clean, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``fit . OTHER --out OUT`` from inside a session: ``.`` has no name of its own, and its
+    output had been ``OUT/.`` (``OUT`` itself, which exists once the batch begins), so the
+    session was reported "skipped (finished earlier)" and never fitted."""
+    import shutil
+
+    here = tmp_path / "coin"
+    shutil.copytree(clean[0], here)
+    other = tmp_path / "tablet"
+    shutil.copytree(clean[0], other)
+    out = tmp_path / "batch"
+    monkeypatch.chdir(here)
+    args = ["fit", ".", "../tablet", "--out", str(out), "--model", "ps", "--no-qa"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    assert "finished earlier" not in r.output and r.output.count(": done") == 2
+    assert (out / "coin" / "normals.npy").is_file() and (out / "tablet" / "fit.json").is_file()
+    r = runner.invoke(app, args)  # and a second run finds both finished, by the same names
+    assert r.exit_code == 0 and r.output.count("(finished earlier)") == 2
+
+
+def test_a_batch_whose_sessions_share_a_folder_name_names_them(clean, tmp_path: Path) -> None:
+    """Two days' sessions both named ``coin``: refused before anything is fitted, naming both
+    sources, the output folder they would share and what to do (it had said only "two
+    sources would write to the same folder: ['coin']")."""
+    import shutil
+
+    first, second = tmp_path / "day1" / "coin", tmp_path / "day2" / "coin"
+    shutil.copytree(clean[0], first)
+    shutil.copytree(clean[0], second)
+    out = tmp_path / "batch"
+    r = runner.invoke(app, ["fit", str(first), str(second), "--out", str(out), "--no-qa"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, r.output
+    assert str(first) in said and str(second) in said and str(out / "coin") in said
+    assert "separate batches" in said and "rename" in said
+    assert not out.exists()
+
+
 def test_qa_verdict_does_not_depend_on_the_order_images_are_listed(tmp_path: Path) -> None:
     """The consensus search draws images at random (seeded): drawn by their position in the
     listing, nine swapped pairs were named correctly in one order and not in others (14 of

@@ -837,9 +837,20 @@ def batch_out_dir(root: Path, source: Path) -> Path:
     """Where a batch writes one source: ``root/<session folder name>``, or for an ``.lp`` file
     ``root/<its folder>-<its stem>``: acquisitions of a backlog often all name their file
     ``dirs.lp`` (one folder per object), and the name must not depend on the rest of the batch
-    (a resumed batch finds what it finished by this name)."""
+    (a resumed batch finds what it finished by this name).
+
+    A folder's name is taken from its absolute path: ``.`` (the folder one is in) and ``..``
+    have no name of their own, and ``root / "."`` is ``root`` itself, which exists once the
+    batch begins, so ``fit . OTHER --out OUT`` had reported the current session "skipped
+    (finished earlier)" without fitting it (``..`` named ``OUT/..``, likewise skipped)."""
     if source.is_dir():
-        return root / source.name
+        name = Path(os.path.abspath(source)).name
+        if not name:
+            raise FitInputError(
+                f"{source}: the root of a file system is no session folder; give the session's "
+                "own folder"
+            )
+        return root / name
     folder = source.resolve().parent.name
     return root / (f"{folder}-{source.stem}" if folder else source.stem)
 
@@ -863,10 +874,22 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     import glob
     import shutil
 
-    names = [batch_out_dir(root, s).name for s in sources]
-    dupes = {n for n in names if names.count(n) > 1}
-    if dupes:
-        raise FitInputError(f"two sources would write to the same folder: {sorted(dupes)}")
+    by_name: dict[str, list[Path]] = {}
+    for s in sources:
+        by_name.setdefault(batch_out_dir(root, s).name, []).append(s)
+    clashes = {n: ss for n, ss in by_name.items() if len(ss) > 1}
+    if clashes:
+        # which sources, and what to do: it had said only "two sources would write to the same
+        # folder: ['coin']", of two days' sessions both named coin (or one given twice)
+        said = "; ".join(
+            f"{', '.join(map(str, ss))} -> {root / n}" for n, ss in sorted(clashes.items())
+        )
+        raise FitInputError(
+            f"sources would write to the same output folder ({said}): a batch names each "
+            "output after its session folder (an .lp's after its folder and stem); give each "
+            "source once, and fit sessions whose folders share a name in separate batches "
+            "(another --out) or rename one of the folders"
+        )
     try:
         root.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
