@@ -886,7 +886,8 @@ def export_lp(
     if done.left_out:
         err.print(
             f"[yellow]note:[/] left out, missing or changed since they were captured: "
-            f"{escape(', '.join(done.left_out))}",
+            f"{escape(', '.join(done.left_out))}"
+            + (f"; {escape(done.renamed)}" if done.renamed else ""),
             soft_wrap=True,
         )
     if done.unchecked:

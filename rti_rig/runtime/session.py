@@ -33,7 +33,7 @@ import shlex
 import shutil
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -977,8 +977,10 @@ def _prepare_resume(
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
         latest = _latest_records(scan.records)
-        lost = {i: _lost_files(root, rec) for i, rec in latest.items()}
+        renamed = renamed_jpegs(root, scan.records)
+        lost = {i: _lost_files(root, rec, renamed) for i, rec in latest.items()}
         lost = {i: gone for i, gone in lost.items() if gone}
+        moved = f"; {renamed_note(renamed)}" if renamed else ""
         if manifest.get("adaptive") and finished < total:  # an adaptive session that stopped
             stop = (manifest["adaptive"].get("result") or {}).get("stop") or {}
             raise SessionError(
@@ -995,6 +997,10 @@ def _prepare_resume(
                     f"be checked ({why}): restore {MANIFEST if MANIFEST in why else JOURNAL} "
                     "from a backup copy of the folder, then run this again"
                 )
+            if renamed:
+                raise SessionError(
+                    f"{root}: nothing to reshoot: this session completed all {total} steps" + moved
+                )
             raise SessionError(
                 f"{root}: nothing to reshoot: this session completed all {total} steps and "
                 "every image is as captured (each JPEG matches its journaled checksum, each "
@@ -1004,6 +1010,7 @@ def _prepare_resume(
             raise SessionError(
                 f"{root}: this session already completed all {total} steps"
                 + _lost_note(root, latest, lost, adaptive=bool(manifest.get("adaptive")))
+                + moved
             )
         # the lost steps are reshot; the others stand as they are, verified or not
         done = {i: _to_record(rec) for i, rec in latest.items() if i not in lost}
@@ -1165,17 +1172,22 @@ def read_manifest(root: Path) -> dict[str, Any]:
     return data
 
 
-def _lost_files(root: Path, rec: dict[str, Any]) -> list[str]:
+def _lost_files(
+    root: Path, rec: dict[str, Any], renamed: Mapping[str, str] | None = None
+) -> list[str]:
     """The image files of one journaled step gone or changed since capture: its JPEG against
     its checksum (what relight and RTIBuilder read), its linear TIFF for its presence (a fit
     reads every pixel anyway; hashing gigabytes for a verdict would not do). RAW originals
-    are not counted: archiving them elsewhere is normal, and the images stand without them."""
+    are not counted: archiving them elsewhere is normal, and the images stand without them.
+    A JPEG in ``renamed`` (:func:`renamed_jpegs`) is not lost: it is there, under another name."""
     lost = []
     for name, digest in rec["sha256"].items():
         if name not in (rec.get("image"), rec.get("linear_image")):
             continue
         path = root / name
         if not path.is_file():
+            if renamed and name in renamed:
+                continue
             lost.append(f"{name} missing")
         elif name == rec.get("image") and _sha256(path) != digest:
             lost.append(f"{name} changed")
@@ -1185,7 +1197,8 @@ def _lost_files(root: Path, rec: dict[str, Any]) -> list[str]:
 def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
     """Per image (its base name, ``image_010``) of a session, its JPEG or linear TIFF gone or
     changed since capture (:func:`_lost_files`): what the QA verdict names and what
-    ``run --resume --reshoot-lost`` reshoots, one criterion for both. Empty for a folder
+    ``run --resume --reshoot-lost`` reshoots, one criterion for both. A JPEG that is in the
+    folder under another name (:func:`renamed_jpegs`) is not lost. Empty for a folder
     without a journal (an ``.lp`` acquisition is no session)."""
     root = Path(root)
     if not (root / JOURNAL).is_file() or not (root / MANIFEST).is_file():
@@ -1196,11 +1209,25 @@ def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
         return {}
     lost: dict[str, list[str]] = {}
     records = scan_journal(root, image_names(total) if total else None).records
+    renamed = renamed_jpegs(root, records)
     for rec in _latest_records(records).values():
-        gone = _lost_files(root, rec)
+        gone = _lost_files(root, rec, renamed)
         if gone:
             lost[Path(rec["image"]).stem] = gone
     return lost
+
+
+def renamed_since_capture(root: Path) -> dict[str, str]:
+    """:func:`renamed_jpegs` of session ``root`` from its journal (empty for a folder that is
+    no session, as :func:`files_lost_since_capture`)."""
+    root = Path(root)
+    if not (root / JOURNAL).is_file() or not (root / MANIFEST).is_file():
+        return {}
+    try:
+        total = planned_steps(read_manifest(root))
+    except SessionError:
+        return {}
+    return renamed_jpegs(root, scan_journal(root, image_names(total) if total else None).records)
 
 
 def unchecked_images(root: Path) -> tuple[list[str], str]:
@@ -1284,6 +1311,61 @@ def _latest_records(records: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
     return {rec["index"]: rec for rec in records}
 
 
+def renamed_jpegs(root: Path, records: list[dict[str, Any]]) -> dict[str, str]:
+    """The session's JPEGs missing under their journaled names that are in the folder under
+    another name with the same bytes: ``{journaled name: name found}``.
+
+    Why: a folder whose images were renamed one by one (``coin17_001.jpg`` for
+    ``image_001.jpg``, a collection's own numbering) had every image called missing: ``fit``'s
+    verdict advised reshooting them all, ``--reshoot-lost`` would have, and ``export-lp``
+    found "none of the 12 journaled image(s) on disk", of files that were all there. Only the
+    folder's JPEGs that no journal record names are read, and only when a journaled JPEG is
+    missing: a session as written, or one that lost a file, costs no hashing.
+    """
+    root = Path(root)
+    wanted: dict[str, str] = {}  # checksum -> journaled name, of the JPEGs not on disk
+    for rec in _latest_records(records).values():
+        name = rec.get("image")
+        digest = rec["sha256"].get(name) if name else None
+        if digest and not (root / name).is_file():
+            wanted.setdefault(digest, name)
+    if not wanted:
+        return {}
+    journaled = {rec.get("image") for rec in records}
+    found: dict[str, str] = {}
+    try:
+        candidates = sorted(root.iterdir())
+    except OSError:
+        return {}
+    for path in candidates:
+        if (
+            path.suffix.lower() not in (".jpg", ".jpeg")
+            or path.name in journaled
+            or path.name.startswith(".")
+            or not path.is_file()
+        ):
+            continue
+        name = wanted.get(_sha256(path) or "")
+        if name is not None and name not in found:
+            found[name] = path.name
+    return found
+
+
+def renamed_note(renamed: Mapping[str, str]) -> str:
+    """What to say of :func:`renamed_jpegs`: which file is which, and what to do."""
+    if not renamed:
+        return ""
+    pairs = [f"{name} as {there}" for name, there in sorted(renamed.items())]
+    shown = ", ".join(pairs[:5]) + (f" and {len(pairs) - 5} more" if len(pairs) > 5 else "")
+    one = len(pairs) == 1
+    return (
+        f"{shown} {'is' if one else 'are'} in the folder under another name, the same bytes "
+        f"as captured: give {'it' if one else 'them'} back {'its' if one else 'their'} "
+        f"session name{'' if one else 's'} ({LP_NAME}, RTIBuilder and rti-rig find the images "
+        f"by those names); {'it needs' if one else 'they need'} no reshooting"
+    )
+
+
 def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], list[str]]:
     """`.lp` entries of a session from its verified journal, and the images left out.
 
@@ -1308,9 +1390,11 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
     left_out = sorted({r[key] for r in records if r["index"] not in done})
     if not done:
+        renamed = renamed_jpegs(root, records) if not linear else {}
         raise SessionError(
             f"{root}: none of the {len(left_out)} journaled image(s) is on disk as captured "
             "(missing or changed), so there is no .lp to export"
+            + (f"; {renamed_note(renamed)}" if renamed else "")
         )
     entries = [LpEntry(getattr(done[i], key), done[i].actual_direction) for i in sorted(done)]
     return entries, left_out

@@ -413,6 +413,40 @@ def test_an_image_lost_since_capture_is_named_by_qa_and_reshot_on_request(
     assert kept["image_003.tif"] == tif and len(kept["image_006.jpg"]) == 2000
 
 
+def test_images_renamed_in_the_folder_are_named_as_renamed_not_lost(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A finished session whose JPEGs a user renamed to the collection's numbering
+    (``coin17_001.jpg`` for ``image_001.jpg``): every image had been called missing — the
+    verdict said reshoot them all, ``--reshoot-lost`` would have, ``export-lp`` found "none of
+    the 8 journaled image(s) on disk". Each is named with its new name and the advice is to
+    give it back its name; one really deleted is still lost, and said so."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    for jpg in sorted(done.glob("image_*.jpg")):
+        jpg.rename(done / f"coin17_{jpg.name.removeprefix('image_')}")
+    (done / "coin17_008.jpg").unlink()  # this one is really gone
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 2, r.output
+    assert "image_001.jpg as coin17_001.jpg" in said(r) and "need no reshooting" in said(r)
+    assert "image_008.jpg as" not in said(r)
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert verdict.startswith("reshoot: image_008 (image_008.jpg missing since capture"), verdict
+    assert "image_001 (" not in verdict and "image_002.jpg as coin17_002.jpg" in verdict
+    before = {p: p.read_bytes() for p in done.rglob("*") if p.is_file()}
+    r = runner.invoke(app, ["run", "--resume", str(done)])
+    assert r.exit_code == 2 and "image_008" in said(r) and "as coin17_003.jpg" in said(r)
+    assert {p: p.read_bytes() for p in done.rglob("*") if p.is_file()} == before
+    # put back under its name, one is listed again; the others are still named as renamed
+    (done / "coin17_003.jpg").rename(done / "image_003.jpg")
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "y.lp")])
+    assert r.exit_code == 0, r.output
+    assert [e.name for e in read_lp(tmp_path / "y.lp")] == ["image_003.jpg"]
+    assert "image_004.jpg as coin17_004.jpg" in said(r)
+
+
 def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tiff(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

@@ -12,7 +12,12 @@ from pathlib import Path
 from rti_rig.app.output_files import check_output_file
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
-from rti_rig.runtime.session import session_lp_report, unchecked_images
+from rti_rig.runtime.session import (
+    renamed_note,
+    renamed_since_capture,
+    session_lp_report,
+    unchecked_images,
+)
 
 
 @dataclass(frozen=True)
@@ -35,6 +40,8 @@ class ExportedLp:
     #: Images no readable journal record vouches for (not in the file), and why.
     unchecked: list[str] = field(default_factory=list)
     unchecked_why: str = ""
+    #: What to say of left-out JPEGs that are in the folder under another name ("" if none).
+    renamed: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -44,4 +51,7 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     write_lp(req.out_file, entries)
     outside = Path(req.out_file).resolve().parent != Path(req.session_dir).resolve()
     unchecked, why = unchecked_images(req.session_dir)
-    return ExportedLp(list(entries), list(left_out), outside, unchecked, why)
+    # a left-out JPEG renamed in the folder is named with its new name: "missing" of a file
+    # that is there had read as one to reshoot
+    renamed = renamed_since_capture(req.session_dir) if left_out and not req.linear else {}
+    return ExportedLp(list(entries), list(left_out), outside, unchecked, why, renamed_note(renamed))

@@ -27,6 +27,8 @@ from rti_rig.runtime.session import (
     lost_image_advice,
     planned_steps,
     read_manifest,
+    renamed_note,
+    renamed_since_capture,
     scan_journal,
     unchecked_images,
 )
@@ -50,6 +52,10 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     if manifest is not None:
         qa = with_uneven_lights(qa, manifest)  # a bright image its uncalibrated LED explains
         qa = _with_unfinished(_with_session_kind(qa, manifest), source, manifest)
+    renamed = renamed_since_capture(source)
+    if renamed:  # there, under another name: said, and not called lost (nothing to reshoot)
+        note = renamed_note(renamed)
+        qa = replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
