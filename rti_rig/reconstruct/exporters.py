@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import json
 import mmap
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -217,6 +218,17 @@ def write_hsh_rti(path: Path, coefficients: NDArray[Any]) -> Path:
     return writer.close()
 
 
+def relight_listing_order(image_names: Sequence[str]) -> list[int]:
+    """Indices of ``image_names`` (file names) in the order relight lists a folder's images.
+
+    relightlab's ``Project::scanDir`` (cnr-isti-vclab/relight ``src/project.cpp``) lists the
+    folder's ``*.jpg`` with a ``QDir``, whose default sort is ``Name | IgnoreCase``: by the
+    lower-cased file name (the name itself breaking ties); its ``DomePanel::loadDome``
+    (``relightlab/domepanel.cpp``) then gives image ``i`` the dome's direction ``i``.
+    """
+    return sorted(range(len(image_names)), key=lambda i: (image_names[i].lower(), image_names[i]))
+
+
 def write_relight_dome(
     path: Path,
     directions: ArrayLike,
@@ -224,9 +236,24 @@ def write_relight_dome(
     diameter_cm: float | None = None,
     image_width_cm: float | None = None,
     label: str = "",
+    image_names: Sequence[str] | None = None,
 ) -> Path:
-    """relight's ``.dome`` JSON for these light ``directions`` (N, 3), z up, y to image top."""
+    """relight's ``.dome`` JSON for these light ``directions`` (N, 3), z up, y to image top.
+
+    With ``image_names`` (the file name of each direction's image), the directions are written
+    in :func:`relight_listing_order`: relight pairs a dome's directions with the images by
+    position only, so an acquisition listed in another order (``img1.jpg`` … ``img10.jpg``
+    in shooting order, which relight lists ``img1``, ``img10``, ``img11``, …, ``img2``) had
+    been given the wrong lights in relight without a word, where its ``.lp`` (paired by name)
+    gave the right ones.
+    """
     d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    if image_names is not None:
+        if len(image_names) != len(d):
+            raise ReconstructionError(
+                f"{len(image_names)} image names for {len(d)} light directions"
+            )
+        d = d[relight_listing_order(image_names)]
     diameter = float(diameter_cm) if diameter_cm else 0.0
     doc: dict[str, Any] = {
         "label": label,

@@ -344,6 +344,45 @@ def test_fit_from_a_bare_lp_with_its_images_beside_it(clean, tmp_path: Path) -> 
     assert float(np.median(_angles(np.load(out / "normals.npy"), truth))) < 3.0
 
 
+def test_lights_dome_pairs_each_image_with_its_light_as_relight_lists_them(
+    clean, tmp_path: Path
+) -> None:
+    """relight applies a ``.dome`` by position: relightlab's ``Project::scanDir``
+    (cnr-isti-vclab/relight ``src/project.cpp``) lists the folder's images with a ``QDir``
+    (default sort ``Name | IgnoreCase``) and ``DomePanel::loadDome``
+    (``relightlab/domepanel.cpp``) gives image ``i`` direction ``i`` of ``Dome::fromJson``
+    (``src/dome.cpp``: ``directions`` as ``{"x", "y", "z"}`` objects). An acquisition whose
+    ``.lp`` lists ``img1.jpg`` … ``img10.jpg`` … in shooting order (relight lists ``img1``,
+    ``img10``, ``img11``, …, ``img2``) had its lights.dome written in the ``.lp``'s order, so
+    relight gave most images another image's light."""
+    import shutil
+
+    from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+    session = clean[0]
+    folder = tmp_path / "acq"
+    (folder / "linear").mkdir(parents=True)
+    entries = []
+    for k, e in enumerate(read_lp(session / "lights.lp"), start=1):
+        shutil.copy(
+            session / "linear" / f"{Path(e.name).stem}.tif", folder / "linear" / f"Img{k}.tif"
+        )
+        entries.append(LpEntry(f"Img{k}.jpg", e.direction))
+    assert len(entries) >= 12  # so that name order is not shooting order
+    write_lp(folder / "dirs.lp", entries)
+    out = tmp_path / "out"
+    lean = ["--no-qa", "--no-ptm", "--no-hsh", "--model", "ps"]
+    r = runner.invoke(app, ["fit", str(folder / "dirs.lp"), "--out", str(out), *lean])
+    assert r.exit_code == 0, r.output
+    dome = json.loads((out / "lights.dome").read_text(encoding="utf-8"))
+    got = np.array([[d["x"], d["y"], d["z"]] for d in dome["directions"]])
+    light_of = {e.name: np.array(e.direction) for e in entries}
+    listed = sorted(light_of, key=str.lower)  # QDir's Name | IgnoreCase
+    assert listed[:3] == ["Img1.jpg", "Img10.jpg", "Img11.jpg"]
+    expected = np.array([light_of[name] for name in listed])
+    np.testing.assert_allclose(got, expected, atol=1e-6)
+
+
 def test_batch_fit_is_resumable(clean, tmp_path: Path) -> None:
     import shutil
 

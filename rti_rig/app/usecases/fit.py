@@ -297,6 +297,13 @@ def acquisition_files(
     return lp, lights, paths, names
 
 
+def listed_image_files(source: Path) -> list[str]:
+    """The file name of each image of an acquisition, in its ``.lp``'s order (the order of
+    the fit's lights): what relight lists in the images' folder."""
+    lp, _, _, _ = acquisition_files(source)
+    return [image_file_name(e.name) for e in read_lp(lp, upper_hemisphere=True)]
+
+
 def load_acquisition(
     source: Path, notes: list[str] | None = None
 ) -> tuple[list[Any], np.ndarray, list[str], str]:
@@ -411,7 +418,12 @@ def _fit_into(  # type: ignore[no-untyped-def]
     result.warnings = [str(w.message) for w in fit_warnings(caught)] + result.warnings
     result.notes = notes
     result.files.append(
-        exporters.write_relight_dome(out / "lights.dome", lights, label=str(req.source))
+        exporters.write_relight_dome(
+            out / "lights.dome",
+            lights,
+            label=str(req.source),
+            image_names=listed_image_files(req.source),
+        )
     )
     release_free_memory()  # the fit's bands and PNG buffers, before QA reads the images again
     if req.qa:
