@@ -906,4 +906,6 @@ def export_lp(
             f"{escape(_arg(session_dir / 'lights.lp'))}` writes it again)",
             soft_wrap=True,
         )
-    out.print(f"{len(done.entries)} lights → {out_file}")
+    # escaped: a file in a folder named 'coin [draft]' had been said as 'coin .lp' (rich read
+    # '[draft]' as markup)
+    out.print(f"{len(done.entries)} lights → {escape(str(out_file))}")

@@ -277,6 +277,21 @@ def test_export_lp_outside_the_session_says_where_its_names_resolve(tmp_path: Pa
     assert r.exit_code == 0 and "move" not in r.output, r.output
 
 
+def test_export_lp_says_a_path_with_brackets_as_it_is(tmp_path: Path) -> None:
+    """A lab's folder named 'coin [draft]': export-lp's last line had said the file it wrote
+    as '.../x .lp' (the terminal library read '[draft]' as a style tag and dropped it)."""
+    cfg = REPO / "rig_configs" / "simulated_dome.toml"
+    session = tmp_path / "coin [draft]"
+    args = ["run", str(cfg), "--out", str(session), "--lights", "4", "--no-verdict"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    out = session / "x [draft].lp"
+    r = runner.invoke(app, ["export-lp", str(session), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert f"4 lights → {out}" in " ".join(r.output.split()), r.output
+    assert out.is_file()
+
+
 def test_a_misspelt_camera_device_key_is_named_like_any_other(tmp_path: Path) -> None:
     """docs/guide.md: a misspelt key is refused with the file and the key. Under
     [camera.device] the message was pydantic's "Extra inputs are not permitted"."""
