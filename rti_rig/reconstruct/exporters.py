@@ -11,7 +11,10 @@ Formats, as published (no code copied):
   the light's projection with ``v`` up — the DESIGN.md frame.
 * **HSH ``.rti``** (RTIViewer's format: its ``Hsh::loadData``, the ``.rti`` branch; relight's
   ``LRti::loadHSH`` in cnr-isti-vclab/relight ``src/legacy_rti.cpp``; CHI's Java HSH viewer
-  ``org.thadeus.rtiviewer.RTI``): comment lines starting ``#`` (the first is ``#HSH1.2``), the
+  ``org.thadeus.rtiviewer.RTI``; JedMills' RTIViewer ``RTIParser``): header lines ending in
+  CRLF, as the HSH fitter RTIBuilder runs writes them (JedMills' parser counts 2 bytes per line
+  end to find the data; the others read to the LF): comment lines starting ``#`` (the first
+  is ``#HSH1.2``), the
   file type ``3`` (HSH), ``width height 3``, ``terms basis_type element_size`` (we write
   ``2 1``: the basis type is ignored by readers, one byte per element), then ``terms``
   little-endian float32 scales and ``terms`` biases, then bytes: scanlines **from the top
@@ -147,9 +150,12 @@ class RtiWriter:
         self.terms = self.lo.size
         if self.terms not in (4, 9, 16):
             raise ReconstructionError(f"HSH has 4, 9 or 16 terms, got {self.terms}")
-        header = (
-            f"#HSH1.2\n#written by rti-rig\n3\n{self.width} {self.height} 3\n{self.terms} 2 1\n"
-        ).encode("ascii")
+        # CRLF, as the HSH fitter RTIBuilder runs writes it (HshCore::hsh_save): JedMills'
+        # RTIViewer (src/ptmCreation/RTIParser.java, getHeaderData) finds the scales at the sum
+        # of each header line's length + 2, so LF-only lines had it read every scale, bias and
+        # coefficient from a few bytes too far; readers that scan to LF take CRLF alike
+        lines = ["#HSH1.2", "#written by rti-rig", "3", f"{self.width} {self.height} 3"]
+        header = "".join(f"{line}\r\n" for line in [*lines, f"{self.terms} 2 1"]).encode("ascii")
         self._tmp = path.with_name(path.name + ".part")
         self._fh = open(self._tmp, "wb")  # noqa: SIM115 - open across bands, closed by close()
         self._fh.write(header)

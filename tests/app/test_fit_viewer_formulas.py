@@ -122,7 +122,7 @@ def relight_ptm_as_rtiviewer(coef: np.ndarray, light: np.ndarray) -> np.ndarray:
 def read_rti_as_rtiviewer(path: Path) -> np.ndarray:
     """(H, W, 3, terms) float coefficients, row 0 = the top row shown."""
     data = path.read_bytes()
-    assert data.startswith(b"#HSH1.2\n")  # what relight's LRti::load looks for
+    assert data.startswith(b"#HSH1.2\r\n")  # relight's LRti::load compares its first 7 bytes
     lines, pos = _header_lines(data, 3, skip_comments=True)
     assert int(lines[0]) == 3  # HSH
     w, h, colours = (int(v) for v in lines[1].split())
@@ -133,6 +133,48 @@ def read_rti_as_rtiviewer(path: Path) -> np.ndarray:
     body = np.frombuffer(data, np.uint8, offset=pos + 8 * terms)
     assert body.size == h * w * 3 * terms
     return body.reshape(h, w, 3, terms) / 255.0 * scale + bias
+
+
+def read_rti_as_jedmills_rtiviewer(path: Path) -> np.ndarray:
+    """(H, W, 3, terms) as JedMills' RTIViewer reads an HSH ``.rti`` (JedMills/RTIViewer
+    ``src/ptmCreation/RTIParser.java``): ``getHeaderData`` reads lines with a
+    ``BufferedReader`` (a line ends at LF, CR or CRLF) and takes the data to start at the sum
+    of ``line.length() + 2`` over the lines up to the first that is no comment, then two more;
+    ``getTexelDataHSH`` skips that many bytes and reads the little-endian scales and biases,
+    then the bytes. Only files whose header lines end in CRLF (as the HSH fitter RTIBuilder
+    runs writes them) are read where they are."""
+    text = path.read_bytes().decode("latin-1")
+    lines = iter(re.split(r"\r\n|\r|\n", text))
+    line = next(lines)
+    start = len(line) + 2
+    while line.startswith("#"):
+        line = next(lines)
+        start += len(line) + 2
+    first, second = next(lines), next(lines)
+    start += len(first) + 2 + len(second) + 2
+    w, h, _ = (int(v) for v in first.split())
+    terms = int(second.split()[0])
+    data = path.read_bytes()
+    scale = np.frombuffer(data, "<f4", terms, start).astype(np.float64)
+    bias = np.frombuffer(data, "<f4", terms, start + 4 * terms).astype(np.float64)
+    body = np.frombuffer(data, np.uint8, h * w * 3 * terms, start + 8 * terms)
+    return body.reshape(h, w, 3, terms) / 255.0 * scale + bias
+
+
+def test_fit_rti_reads_alike_in_jedmills_rtiviewer_and_in_rtiviewer(shot) -> None:
+    """JedMills' RTIViewer finds an HSH file's data by counting 2 bytes per header line end;
+    fit.rti's header lines had ended in LF alone, so it read every scale, bias and
+    coefficient from 5 bytes too far (garbage), where RTIViewer, relight and CHI's viewer,
+    reading to the LF, read it right. With CRLF, as RTIBuilder's HSH fitter writes them, all
+    read the same coefficients."""
+    _, fitted = shot
+    data = (fitted / "fit.rti").read_bytes()
+    header = data[: data.index(b" 2 1\r\n") + len(b" 2 1\r\n")]
+    assert header.count(b"\n") == header.count(b"\r\n") == 5  # every header line ends in CRLF
+    np.testing.assert_array_equal(
+        read_rti_as_jedmills_rtiviewer(fitted / "fit.rti"),
+        read_rti_as_rtiviewer(fitted / "fit.rti"),
+    )
 
 
 def rtiviewer_hsh_weights(light: np.ndarray, terms: int) -> np.ndarray:
