@@ -351,3 +351,8 @@ def test_a_16_term_rti_says_that_relight_reads_hsh_only_to_9_terms(shot, tmp_pat
     said = " ".join(r.output.split())
     assert "fit.rti: hsh3" in said and "--hsh-order 2" in said.split("fit.rti: hsh3", 1)[1]
     assert "relight" in json.loads((out / "fit.json").read_text())["rti"]
+    # webGLRtiMaker (jcupitt/webRTIViewer webGLRTIMaker-src/rti.h: 9-entry scale, bias and
+    # plane arrays) and JedMills' RTIViewer (src/ptmCreation/RTIParser.java: terms 0-8) read
+    # 9 terms at most either: a 16-term file for the web viewer had been sent without a word
+    rti = json.loads((out / "fit.json").read_text())["rti"]
+    assert "webGLRtiMaker" in rti and "JedMills" in rti, rti

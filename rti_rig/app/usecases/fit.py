@@ -460,7 +460,10 @@ PTM_MEASURED_FROM = 8
 #: The highest HSH order relight reads from an ``.rti``: its ``convertRTI`` (src/cli/
 #: convert_rti.cpp, through ``LRti``'s 9-entry HSH plane order in src/legacy_rti.cpp) and its
 #: viewer's ``Rti::lightWeightsHsh`` (src/rti.cpp, 9 weights) know 4 or 9 terms, and its
-#: converter back to ``.rti`` refuses any other plane count. RTIViewer reads 16.
+#: converter back to ``.rti`` refuses any other plane count. RTIViewer reads 16. So do not
+#: the web viewer's converter webGLRtiMaker (its ``Hsh`` keeps 9 scales, biases and planes:
+#: jcupitt/webRTIViewer ``webGLRTIMaker-src/rti.h``; 16 overrun them) and JedMills'
+#: RTIViewer (``src/ptmCreation/RTIParser.java`` keeps terms 0-8 and drops the rest).
 RELIGHT_HSH_ORDER = 2
 
 #: Pixel sample shared by model choice, quantisation ranges and the reference level: one
@@ -556,8 +559,9 @@ def _fit_all(
         if order > RELIGHT_HSH_ORDER:  # said on fit.rti's own line: information, not a fault
             rti_why += (
                 f" ({(order + 1) ** 2} terms: RTIViewer views them; relight's .rti converter "
-                f"and viewer know HSH of 4 or 9 terms only, so for relight fit again with "
-                f"--hsh-order {RELIGHT_HSH_ORDER}, or fit the images with relight-cli)"
+                "and viewer, webGLRtiMaker (the WebRTIViewer's converter) and JedMills' "
+                "RTIViewer know HSH of 4 or 9 terms only, so for relight or the web fit again "
+                f"with --hsh-order {RELIGHT_HSH_ORDER}, or fit the images with relight-cli)"
             )
     elif req.write_hsh:
         skipped.append(
