@@ -153,9 +153,11 @@ def plan(
     print_notes(planned.notes)
     for line in planned.report.lines():
         out.print(line, highlight=False, markup=False)
-    out.print(
+    out.print(  # the path as it is: a folder named "coin [draft]" is no markup
         f"Planned {len(planned.schedule)} lights ({planned.method}, {planned.objective}) → "
-        f"{out_file}"
+        f"{out_file}",
+        markup=False,
+        highlight=False,
     )
     if figure is not None:
         # after the report: a map that cannot be drawn must not hide a plan that was written

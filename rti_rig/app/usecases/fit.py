@@ -342,11 +342,6 @@ def _stored_8_bit(frame: Any) -> bool:
     return bool(getattr(frame, "stored", np.dtype(frame.dtype)) == np.uint8)
 
 
-def _save_png(path: Path, rgb: np.ndarray) -> Path:
-    cv2.imwrite(str(path), rgb[..., ::-1] if rgb.ndim == 3 else rgb)
-    return path
-
-
 #: How the bands of a fit are computed: given the stack, the plan and the row tiles, yield each
 #: tile with its :class:`BandFit` (any order). :func:`local_bands` by default; the Dask runner
 #: of :mod:`rti_rig.app.usecases.fit_dask` computes them on a scheduler.
@@ -758,7 +753,13 @@ def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
         cv2.COLORMAP_VIRIDIS,
     )
     cov_img[qa.coverage < 3] = (0, 0, 255)
-    cv2.imwrite(str(out / "qa_coverage.png"), cov_img)
+    if not cv2.imwrite(str(out / "qa_coverage.png"), cov_img):
+        # OpenCV says a failed write only by its return value: unchecked, qa.html showed a
+        # map that was never written (a full disk, a folder that turned read-only)
+        raise RtiRigError(
+            f"could not write {out / 'qa_coverage.png'}: check the free space and that the "
+            "folder is writable, then fit again"
+        )
     (out / "qa.json").write_text(json.dumps(qa.to_json(), indent=1) + "\n", encoding="utf-8")
     rows = "\n".join(_qa_row(c) for c in qa.images)
     normals = '<img src="normals.png" width="320">' if (out / "normals.png").exists() else ""
