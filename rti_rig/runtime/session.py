@@ -17,9 +17,11 @@ Layout (opens directly in relight-cli's folder mode, which takes the first ``*.l
 Nothing already captured is ever overwritten: a folder holding images is refused, and image
 writes refuse existing files. Nothing is created on disk until :meth:`SessionFolder.begin`
 (called once the rig is connected), and ``lights.lp`` is rewritten atomically after every
-committed image, so a killed session opens in relight at once. Other writers (a camera's RAW
-originals, say) may add their own sub-folders: only ``image_*`` files and the files above are
-the session store's.
+committed image, so a killed session opens in relight at once — except after a kill (SIGKILL,
+a power cut) in the fraction of a second between an image's files and its journal line: that
+image is then on disk but not in ``lights.lp``, and relight-cli refuses the folder for the
+count; ``run --resume`` sets it aside. Other writers (a camera's RAW originals, say) may add
+their own sub-folders: only ``image_*`` files and the files above are the session store's.
 """
 
 from __future__ import annotations
