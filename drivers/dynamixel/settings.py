@@ -154,10 +154,20 @@ class ArmSettings(BaseModel):
     @field_validator("baudrate")
     @classmethod
     def _baud(cls, v: int) -> int:
+        usable = [b for b in ct.BAUD_CODES.values() if b in SDK_BAUDRATES]
         if v not in SDK_BAUDRATES:
             raise ValueError(
                 f"baudrate {v} is not accepted by dynamixel_sdk; use one of "
-                f"{', '.join(map(str, SDK_BAUDRATES))}"
+                f"{', '.join(map(str, usable))} (the rate the servos are set to)"
+            )
+        if v not in ct.BAUD_CODES.values():
+            # the SDK opens the port at it, but no X-series servo can be set to it (Baud Rate,
+            # address 8, codes 0–7): the arm had only failed at connect, "no servo answered"
+            raise ValueError(
+                f"baudrate {v}: no Dynamixel X-series servo runs at it (Baud Rate codes 0–7 "
+                f"give {', '.join(map(str, ct.BAUD_CODES.values()))}); set the rate the servos "
+                f"are set to, one of {', '.join(map(str, usable))} (Dynamixel Wizard 2.0 shows "
+                "it)"
             )
         return v
 

@@ -29,3 +29,17 @@ def test_check_on_the_wrong_baud_rate_names_it(tmp_path: Path) -> None:
         .exit_code
         == 0
     )
+
+
+def test_a_baud_rate_no_x_series_servo_runs_at_is_refused_at_load(tmp_path: Path) -> None:
+    """38400 opens the port (dynamixel_sdk accepts it) but no X-series servo can be set to it:
+    the arm had only failed at connect ("no servo answered"); now the config is refused by key,
+    with the rates a servo can run at."""
+    text = (REPO / "rig_configs" / "simulated_arm.toml").read_text()
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace("baudrate = 57600", "baudrate = 38400"))
+    r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "arm.dynamixel.baudrate" in said and "no Dynamixel X-series servo runs at it" in said
+    assert "57600, 115200, 1000000" in said
