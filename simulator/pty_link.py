@@ -4,8 +4,12 @@ A thread owns the master side of an ``os.openpty()`` pair; the host opens the sl
 stable symlink (like ``/dev/serial/by-id/...``) with ordinary pyserial. The helper emulates what
 matters about a USB serial board:
 
-* **auto-reset on open**: when the slave gets opened (the master stops reporting a hang-up), the
-  device's ``on_port_opened()`` runs, so an Arduino-like board reboots and sends its banner;
+* **auto-reset on open**: whenever the slave gets opened, the device's ``on_port_opened()``
+  runs, so an Arduino-like board reboots and sends its banner. On Linux every open is seen
+  (inotify on the slave's device node), also a close and reopen within microseconds, as a
+  program that probes a port several times does: the master's hang-up, the only sign
+  elsewhere, is missed when the reopen comes before the server thread polls, and the board then
+  did not reset where a real one does (DTR drops on close and rises on open);
 * **USB drop**: when the device asks for it (``take_disconnect()``), the pty is torn down (the
   host's next read or write fails as on a real unplug) and a fresh one appears behind the same
   symlink after the requested time, so the host can reconnect by path;
@@ -17,10 +21,12 @@ Shutdown is bounded: the thread polls with a short timeout and is joined with a 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import fcntl
 import os
 import select
 import struct
+import sys
 import tempfile
 import termios
 import threading
@@ -30,6 +36,69 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
+
+#: inotify event bits (``<sys/inotify.h>``).
+_IN_CLOSE_WRITE, _IN_CLOSE_NOWRITE, _IN_OPEN = 0x08, 0x10, 0x20
+_IN_EVENT = struct.Struct("iIII")  # wd, mask, cookie, len (a name of len bytes follows)
+
+
+class _OpenWatch:
+    """Opens and closes of one device node, seen through inotify (Linux); see the module doc.
+
+    ``available`` is False where inotify is not (another OS, a libc without it): the server
+    then falls back on the master's hang-up, which misses a quick close and reopen.
+    """
+
+    def __init__(self) -> None:
+        self.fd = -1
+        self.wd = -1
+        self._libc = None
+        if not sys.platform.startswith("linux"):
+            return
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            fd = libc.inotify_init1(os.O_NONBLOCK | os.O_CLOEXEC)
+        except (OSError, AttributeError):
+            return
+        if fd >= 0:
+            self._libc, self.fd = libc, fd
+
+    @property
+    def available(self) -> bool:
+        return self.fd >= 0
+
+    def watch(self, path: str) -> None:
+        """Watch ``path`` from now on (events of an earlier node are ignored)."""
+        if self._libc is None:
+            return
+        mask = _IN_OPEN | _IN_CLOSE_WRITE | _IN_CLOSE_NOWRITE
+        self.wd = self._libc.inotify_add_watch(self.fd, os.fsencode(path), mask)
+
+    def events(self) -> list[bool]:
+        """The opens (True) and closes (False) of the watched node since the last call."""
+        if self.fd < 0:
+            return []
+        try:
+            data = os.read(self.fd, 4096)
+        except (BlockingIOError, InterruptedError):
+            return []
+        out = []
+        offset = 0
+        while offset + _IN_EVENT.size <= len(data):
+            wd, mask, _cookie, length = _IN_EVENT.unpack_from(data, offset)
+            offset += _IN_EVENT.size + length
+            if wd != self.wd:
+                continue  # a node replaced after a USB drop
+            if mask & _IN_OPEN:
+                out.append(True)
+            if mask & (_IN_CLOSE_WRITE | _IN_CLOSE_NOWRITE):
+                out.append(False)
+        return out
+
+    def close(self) -> None:
+        if self.fd >= 0:
+            os.close(self.fd)
+            self.fd = -1
 
 
 class TimedOutput(Protocol):
@@ -108,6 +177,8 @@ class _Server:
         self.pending: list[TimedOutput] = []
         self.errors: list[BaseException] = []
         self.iterations = 0  # loops run (wait_delivered waits for the next ones)
+        self.watch = _OpenWatch()
+        self.openers = 0  # programs holding the slave open (counted when ``watch`` works)
 
     def new_pty(self) -> None:
         master, slave = os.openpty()
@@ -119,8 +190,10 @@ class _Server:
             tmp.unlink()
         tmp.symlink_to(target)
         tmp.replace(self.link_path)
+        self.watch.watch(target)  # after the slave fd above is closed: only the host's opens
         old, self.master = self.master, master
         self.opened = False
+        self.openers = 0
         self.pending.clear()
         if old >= 0:
             os.close(old)
@@ -134,6 +207,7 @@ class _Server:
             if self.master >= 0:
                 os.close(self.master)
                 self.master = -1
+            self.watch.close()
 
     def _loop(self) -> None:
         poller = select.poll()
@@ -146,17 +220,35 @@ class _Server:
                         poller.unregister(registered)
                 poller.register(self.master, select.POLLIN)
                 registered = self.master
+                if self.watch.available:
+                    with contextlib.suppress(KeyError, ValueError):
+                        poller.register(self.watch.fd, select.POLLIN)
             events = poller.poll(self._poll_ms())
-            hup = any(ev & select.POLLHUP for _, ev in events)
+            hup = any(fd == self.master and ev & select.POLLHUP for fd, ev in events)
+            if self.watch.available:
+                # every open is a reset, however soon after a close (see the module doc); the
+                # events were queued by the host's open() before it could write anything
+                for opened in self.watch.events():
+                    if opened:
+                        self.openers += 1
+                        if self.openers == 1:
+                            self.opened = True
+                            self.pending.clear()  # a close unseen by the hang-up: output lost
+                            self.pending += self.device.on_port_opened()
+                    else:
+                        self.openers = max(0, self.openers - 1)
+                        if self.openers == 0:
+                            self.opened = False
+                            self.pending.clear()
             if hup:
-                if self.opened:
+                if self.opened and not self.watch.available:
                     self.opened = False
                     self.pending.clear()  # nobody listens: output is lost, as on a real board
                 time.sleep(0.002)
-            elif not self.opened:
+            elif not self.opened and not self.watch.available:
                 self.opened = True
                 self.pending += self.device.on_port_opened()
-            if any(ev & select.POLLIN for _, ev in events) and not hup:
+            if any(fd == self.master and ev & select.POLLIN for fd, ev in events) and not hup:
                 try:
                     data = os.read(self.master, 4096)
                 except OSError:

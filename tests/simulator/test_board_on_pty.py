@@ -1,0 +1,64 @@
+"""Real-firmware emulators served on a pty behave as the boards do at the port, whatever the host.
+
+Each test opens the pty with real pyserial, as a host program does. Waits are bounded reads of
+seconds, never timing asserts, so CPU load cannot fail them.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import pytest
+import serial
+
+from rti_rig.simulator.domes import board_for
+from rti_rig.simulator.pty_link import serve_on_pty
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+#: The last line of the Nab sketch's boot banner (``setup()`` of the "RTI v1.0" sketch).
+NAB_BANNER_END = b"<6> Single photo\r\n===================\r\n"
+
+
+def read_until(port: serial.Serial, end: bytes, timeout_s: float = 10.0) -> bytes:
+    """What the board sent up to and including ``end`` (or all it sent within the bound)."""
+    heard = bytearray()
+    deadline = time.monotonic() + timeout_s
+    while end not in heard and time.monotonic() < deadline:
+        heard += port.read(max(1, port.in_waiting))
+    return bytes(heard)
+
+
+def boots(board) -> int:  # type: ignore[no-untyped-def]
+    return sum(1 for _, what in board.events if what == "boot")
+
+
+def test_a_quick_close_and_reopen_resets_the_board_again() -> None:
+    """An Arduino resets at every open (DTR), however soon after a close: the emulator too.
+
+    ``rti-rig probe`` closes the port and opens it again at once for its next question. The
+    server had seen only the first open (it looked for the master's hang-up, which a reopen
+    within microseconds never shows), so the board went on where it was: the Nab sketch booted
+    once for two opens, and RTIPy's reply to one probe reached the next one.
+    """
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        port = serial.Serial(link.port, 9600, timeout=0.1)
+        assert read_until(port, NAB_BANNER_END).endswith(NAB_BANNER_END)
+        # The server thread is held in the board (its lock) while the port is closed and
+        # opened again: the reopen then surely comes before the server polls, as it does when
+        # the CPU is busy or the host is quick, so the test does not depend on the scheduler.
+        with board._lock:
+            time.sleep(0.2)  # the server reaches the board's lock and waits there
+            port.close()
+            port = serial.Serial(link.port, 9600, timeout=0.1)
+        with port:
+            second = read_until(port, NAB_BANNER_END)
+        assert b"RTI-Dome intialized" in second, second
+        assert boots(board) == 2
+        # and it booted lit again, as the sketch's setup() does at every reset
+        assert board.lit == frozenset(range(64))
