@@ -57,6 +57,10 @@ class Board:
     boot_s = 0.0
     #: Opening the port resets the board (Arduino DTR auto-reset).
     resets_on_open = True
+    #: The board's serial port is the microcontroller's own USB (CDC ACM, e.g. an ATmega32u4):
+    #: no UART lies between host and firmware, so the host's baud rate is a setting nobody
+    #: reads and any rate works. Behind a USB-serial chip (FTDI, 16U2) both UARTs must agree.
+    native_usb = False
     #: The firmware switches its LEDs on its own clock, with no command (RTIPy's LED goes dark
     #: when its window ends): what is lit when the camera exposes depends on the time the rig
     #: spends between two commands, so a dry run must spend that time on the board's clock too
@@ -207,6 +211,8 @@ class Board:
     # ------------------------------------------------------------------ internals
 
     def _baud_mismatch(self) -> bool:
+        if self.native_usb:
+            return False
         return self.host_baud is not None and self.host_baud != self.baudrate
 
     def _lit_off_unpowered(self) -> None:

@@ -5,7 +5,10 @@ non-digits, reads digits, stops at a non-digit it leaves in the buffer or after 
 timeout, 0 if no digit came); ``M`` clears the shift registers (all off), shifts in LED n's bit
 on driver n / 8 (none when n / 8 is not 0..3), latches it, then waits 100 ms, pulses the camera
 line 100 ms, waits 100 ms; ``A`` runs the whole 32-LED sequence (not emulated). No replies. The
-ATmega32u4 has native USB: opening the port does not reset it.
+board is an ATmega32u4 (the sketch drives ``LED_BUILTIN_TX``, which only the 32u4 boards
+define, and uses pins 0 and 1, the UART's, as outputs while ``Serial`` still works): its
+``Serial`` is native USB, so opening the port does not reset it and the host's baud rate is
+not used (``Serial.begin(9600)`` sets nothing on a USB CDC port): any rate reaches the sketch.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ class RtiDomeBoard(Board):
     baudrate = 9600
     boot_s = 0.0
     resets_on_open = False
+    native_usb = True
 
     def firmware(self) -> Firmware:
         while True:

@@ -62,3 +62,42 @@ def test_a_quick_close_and_reopen_resets_the_board_again() -> None:
         assert boots(board) == 2
         # and it booted lit again, as the sketch's setup() does at every reset
         assert board.lit == frozenset(range(64))
+
+
+def eventually(predicate, timeout_s: float = 10.0) -> bool:  # type: ignore[no-untyped-def]
+    """True once ``predicate()`` is (bounded): the pty hands bytes over when the CPU allows."""
+    end = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > end:
+            return False
+        time.sleep(0.005)
+    return True
+
+
+def test_a_native_usb_board_works_at_any_baud_rate() -> None:
+    """hadrian2/RTI_Dome runs on an ATmega32u4 (``ATMEGA_code.txt`` drives ``LED_BUILTIN_TX``,
+    a 32u4 board's pin, and uses the UART's pins 0 and 1 as outputs): its ``Serial`` is USB
+    CDC, where ``Serial.begin(9600)`` sets no rate, so a host at 115200 still reaches it. The
+    emulator had garbled every byte at a rate other than 9600, as for a board behind a UART."""
+    board = board_for("rti-dome-m")
+    with (
+        serve_on_pty(board, "rti-dome") as link,
+        serial.Serial(link.port, 115200, timeout=0.1) as port,
+    ):
+        port.write(b"M5")
+        assert eventually(lambda: board.lit == frozenset({5})), board.timeline
+
+
+def test_a_board_behind_a_uart_still_hears_garbage_at_another_rate() -> None:
+    """The Nab sketch's Uno talks through its USB-serial chip's UART at 9600 (``Serial.begin``):
+    at 115200 its banner is unreadable and ``<3,5>`` lights nothing."""
+    board = board_for("nab-rti-v1")
+    with (
+        serve_on_pty(board, "nab") as link,
+        serial.Serial(link.port, 115200, timeout=0.1) as port,
+    ):
+        heard = read_until(port, NAB_BANNER_END, timeout_s=3.0)
+        assert b"RTI-Dome" not in heard
+        port.write(b"<0><3,5>")
+        time.sleep(0.5)
+    assert board.lit != frozenset({5})
