@@ -1,12 +1,15 @@
 """The "RTI v1.0" sketch (Sjors H. Nab, 2024) as its source behaves, on an Arduino that resets.
 
 Facts from the sketch: ``setup()`` calls ``lightsOn()`` (so **every LED lights at boot**) and
-prints a banner; commands are framed ``<`` … ``>`` into a 32-byte buffer, split on commas and
-read with ``atoi``; ``lightsOff()`` and ``lightsOn()`` first switch UV off (printing
-``<UV Turned off.>``); ``singleLED`` switches all off first, then lights row N / 8, column N % 8;
-the shutter holds its pin 50 ms, waits 500 ms, then answers; unknown codes answer
-``<INCORRECT FUNCTION CALL: n>``. ``println`` ends lines with CR LF. The Uno-class board sits
-~1.6 s in its bootloader after the port opens.
+prints a banner; commands are framed ``<`` … ``>`` into a 32-byte buffer, split with ``strtok``
+on commas (which skips empty fields: ``<3,,7>`` is ``<3,7>``) and read with ``atoi``;
+``lightsOff()`` and ``lightsOn()`` first switch UV off (printing ``<UV Turned off.>``);
+``singleLED`` switches all off first, then lights row N / 8, column N % 8; the shutter holds its
+pin 50 ms, waits 500 ms, then answers; unknown codes answer ``<INCORRECT FUNCTION CALL: n>``.
+``<4,ms>`` (``uvPhoto``) shoots one frame under the UV LEDs and ``<5,ms>`` (``rti``) runs the
+sketch's own 64-LED capture, one shutter per LED; both block for their whole run and end with
+``lightsOn()``: **every LED lit** again. ``println`` ends lines with CR LF. The Uno-class board
+sits ~1.6 s in its bootloader after the port opens.
 """
 
 from __future__ import annotations
@@ -57,8 +60,8 @@ class NabRtiV1Board(Board):
                 receiving, buf = True, ""
 
     def _call(self, data: str) -> Firmware:
-        fields = data.split(",")
-        code = atoi(fields[0]) if fields and fields[0] else 0
+        fields = [f for f in data.split(",") if f]  # strtok: empty fields are skipped
+        code = atoi(fields[0]) if fields else 0
         arg = atoi(fields[1]) if len(fields) > 1 else 0
         if code == 0:
             self._lights_off()
@@ -73,10 +76,12 @@ class NabRtiV1Board(Board):
             y, x = c_div(arg, 8), c_mod(arg, 8)
             self.set_lit({y * 8 + x} if 0 <= arg < 64 else set())  # outside: pins undefined
             self.println(f"<Single LED turned on, number: {arg}, row: {y}, column: {x}>")
+        elif code == 4:
+            yield from self._uv_photo(arg)
+        elif code == 5:
+            yield from self._rti(arg)
         elif code == 6:
             yield from self._shutter()
-        elif code in (4, 5):
-            self.println("<not emulated>")  # UVF photo / firmware-run capture: not used by hosts
         else:
             self.println(f"<INCORRECT FUNCTION CALL: {code}>")
 
@@ -85,6 +90,41 @@ class NabRtiV1Board(Board):
         yield Sleep(0.05)
         yield Sleep(0.5)
         self.println("<Shutter triggered.>")
+
+    def _uv_photo(self, exposure_ms: int) -> Firmware:
+        """``uvPhoto``: one frame under the UV LEDs, then every white LED lit again."""
+        self.println("===================")
+        self.println("<Initialising UVF photograph>")
+        self._lights_off()
+        self._lights_off()  # uvOn() switches all off once more before the UV pin
+        self.uv = True
+        self.println("<UV Turned on.>")
+        yield from self._shutter()
+        yield Sleep(_delay_s(exposure_ms))
+        self.uv = False
+        self.println("<UV Turned off.>")
+        self._lights_on()
+        self.println("<UVF Photograph taken>")
+        self.println("===================")
+
+    def _rti(self, exposure_ms: int) -> Firmware:
+        """``rti``: the sketch's own capture, row by row, a shutter and ``exposure_ms`` per LED."""
+        expected = c_div(exposure_ms, 1000) * 63 + 500 * 63 // 1000  # the sketch's int arithmetic
+        self._lights_off()
+        self.println("===================")
+        self.println("<RTI Capture Initialised>")
+        minutes, seconds = c_div(expected, 60), c_mod(expected, 60)
+        self.println(f"<Time to completion: {minutes} minutes and {seconds} seconds>")
+        for y in range(8):
+            self.println(f"<Completion: {100 // 8 * y}%>")
+            for x in range(8):
+                self.set_lit({y * 8 + x})
+                yield from self._shutter()
+                yield Sleep(_delay_s(exposure_ms))
+                self.set_lit(set())
+        self._lights_on()
+        self.println("<RTI Capture Completed>")
+        self.println("===================")
 
     def _lights_on(self) -> None:
         self.uv = False
@@ -97,3 +137,8 @@ class NabRtiV1Board(Board):
         self.println("<UV Turned off.>")
         self.set_lit(set())
         self.println("<All lights turned off.>")
+
+
+def _delay_s(ms: int) -> float:
+    """``delay(ms)`` of an ``int``: a negative one becomes a huge ``unsigned long``, as in C."""
+    return (ms % 2**32) / 1000.0
