@@ -398,18 +398,28 @@ def main(argv: list[str] | None = None) -> int:
 
     Run as ``python -m rti_rig.simulator.dome_firmware``.
 
-    Prints the port path, so that a rig config (or ``rti-rig check``) can be pointed at it for a
-    dry run through the real driver and real pyserial.
+    Prints the port path, so that a rig config (or ``rti-rig check``, or ``rti-rig probe``) can
+    be pointed at it for a dry run through the real driver and real pyserial. ``--profile``
+    names one of the project's own protocols (``default``, ``framed``, ``binary``) or a real
+    firmware whose emulator ``rti_rig.simulator.domes`` holds (``nab-rti-v1`` …): that one has
+    the firmware's own LED count, baud rate and boot, so ``--leds``, ``--dead`` and
+    ``--boot-delay-s`` do not apply to it.
     """
     import argparse
     import signal
-    import time
+
+    from rti_rig.simulator.domes import SERIAL_FIRMWARES
 
     parser = argparse.ArgumentParser(description=main.__doc__)
-    parser.add_argument("--profile", choices=["default", "framed", "binary"], default="default")
-    parser.add_argument("--leds", type=int, default=48)
+    parser.add_argument(
+        "--profile",
+        choices=["default", "framed", "binary", *SERIAL_FIRMWARES],
+        default="default",
+        help="one of the project's own protocols, or a real firmware (docs/domes.md)",
+    )
+    parser.add_argument("--leds", type=int, default=None, help="LED count (default 48)")
     parser.add_argument("--dead", type=int, nargs="*", default=[], help="dead LED indices")
-    parser.add_argument("--boot-delay-s", type=float, default=0.5)
+    parser.add_argument("--boot-delay-s", type=float, default=None, help="default 0.5")
     parser.add_argument(
         "--fault",
         action="append",
@@ -423,26 +433,54 @@ def main(argv: list[str] | None = None) -> int:
     for spec in args.fault:
         at, _, kind = spec.partition(":")
         faults.append(Fault(int(at), FaultKind(kind)))
-    settings = DomeSerialSettings(port="pty", profile=args.profile)
-    firmware = firmware_for(
-        settings,
-        led_count=args.leds,
-        dead_leds=frozenset(args.dead),
-        boot_delay_s=args.boot_delay_s,
-        faults=FaultPlan(tuple(faults)),
-    )
     # SIGTERM (what a test harness or service manager sends) ends like Ctrl-C, so the pty's
     # temporary folder is removed instead of left behind in /tmp.
     signal.signal(signal.SIGTERM, signal.default_int_handler)
+    if args.profile in SERIAL_FIRMWARES:
+        options = (("--leds", args.leds), ("--boot-delay-s", args.boot_delay_s))
+        given = [option for option, value in options if value is not None]
+        given += ["--dead"] if args.dead else []
+        if given:
+            parser.error(
+                f"{', '.join(given)}: the {args.profile} firmware's emulator has the firmware's "
+                "own LED count and boot; these options are for default, framed and binary"
+            )
+        from rti_rig.simulator.domes import board_for
+
+        board = board_for(args.profile, faults=FaultPlan(tuple(faults)))
+        with serve_on_pty(board, args.profile) as link:
+            print(
+                f"emulated {args.profile} firmware ({board.led_count} LEDs, "
+                f"{board.baudrate} baud) on {link.port}",
+                flush=True,
+            )
+            _serve_until_stopped(link, args.seconds)
+        return 0
+    leds = 48 if args.leds is None else args.leds
+    settings = DomeSerialSettings(port="pty", profile=args.profile)
+    firmware = firmware_for(
+        settings,
+        led_count=leds,
+        dead_leds=frozenset(args.dead),
+        boot_delay_s=0.5 if args.boot_delay_s is None else args.boot_delay_s,
+        faults=FaultPlan(tuple(faults)),
+    )
     with emulated_dome_on_pty(firmware) as link:
-        print(f"emulated {args.profile} dome with {args.leds} LEDs on {link.port}", flush=True)
-        deadline = None if args.seconds is None else time.monotonic() + args.seconds
-        try:
-            while link.alive and (deadline is None or time.monotonic() < deadline):
-                time.sleep(0.1)
-        except KeyboardInterrupt:
-            pass
+        print(f"emulated {args.profile} dome with {leds} LEDs on {link.port}", flush=True)
+        _serve_until_stopped(link, args.seconds)
     return 0
+
+
+def _serve_until_stopped(link: PtyLink, seconds: float | None) -> None:
+    """Wait while ``link`` serves, until Ctrl-C (or SIGTERM) or ``seconds`` have passed."""
+    import time
+
+    deadline = None if seconds is None else time.monotonic() + seconds
+    try:
+        while link.alive and (deadline is None or time.monotonic() < deadline):
+            time.sleep(0.1)
+    except KeyboardInterrupt:
+        pass
 
 
 if __name__ == "__main__":

@@ -10,6 +10,9 @@ from rti_rig.core.clock import Clock
 from rti_rig.simulator.dome_firmware import FaultPlan
 from rti_rig.simulator.domes.board import Board
 
+#: The built-in firmware profiles with a serial emulator here (``board_for`` serves each).
+SERIAL_FIRMWARES = ("nab-rti-v1", "rtipy", "minirti", "elexol-24r1", "rti-dome-m", "nichlock")
+
 
 def board_for(
     profile: str,

@@ -81,6 +81,31 @@ def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
 
 
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
+def test_a_firmware_served_in_another_process_can_be_probed() -> None:
+    """``python -m rti_rig.simulator.dome_firmware --profile nab-rti-v1`` serves the sketch's
+    emulator, so ``rti-rig probe`` can be rehearsed as docs/domes.md shows; the server had
+    offered only the project's own protocols (default, framed, binary)."""
+    import subprocess
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rti_rig.simulator.dome_firmware", "--profile", "nab-rti-v1"],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        assert line.startswith("emulated nab-rti-v1 firmware (64 LEDs, 9600 baud) on "), line
+        r = runner.invoke(app, ["probe", line.split()[-1]])
+        assert r.exit_code == 0, r.output
+        assert 'profile = "nab-rti-v1"' in r.output and "baudrate = 9600" in r.output
+        assert "all-off sent and acknowledged" in said(r)
+    finally:
+        proc.terminate()  # the process this test started, by its own handle
+        proc.wait(timeout=10)
+
+
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 def test_probe_says_plainly_when_nothing_known_answers() -> None:
     board = board_for("rti-dome-m")  # never answers anything
     with serve_on_pty(board, "silent") as link:
