@@ -30,6 +30,36 @@ def policy_settings(settings: DomeSerialSettings) -> DomePolicySettings:
         confirm_with_query=settings.confirm_with_query,
         expected_led_count=settings.expected_led_count,
         shutter_pulse_ms=settings.shutter_pulse_ms,
+        link_hint=baudrate_hint(settings),
+    )
+
+
+def baudrate_hint(settings: DomeSerialSettings) -> str:
+    """What to say of the port's baud rate when a built-in firmware's board answered nothing.
+
+    A ``[dome.serial] baudrate`` overrides the profile's own, and one left from the example
+    config (115200) on a 9600-baud sketch gave only "check the port, the baud rate and the
+    protocol profile", naming neither the key nor the rate the firmware talks at.
+    """
+    from rti_rig.drivers.led_dome.dome_profiles import (
+        any_baudrate,
+        builtin_spec,
+        described_profiles,
+    )
+
+    name = settings.profile
+    if name not in described_profiles() or any_baudrate(name):
+        return ""
+    own = int(builtin_spec(name)["baudrate"])
+    if settings.baudrate == own:
+        return ""
+    key = "dome.serial.baudrate"
+    if settings.protocol is not None and "baudrate" in settings.protocol:
+        key = "dome.serial.protocol.baudrate"
+    return (
+        f"the port opened at {key} = {settings.baudrate}, but the {name} firmware as "
+        f"published talks at {own} baud: unless it was changed, remove that key or set it to "
+        f"{own}"
     )
 
 

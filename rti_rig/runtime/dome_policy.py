@@ -151,6 +151,10 @@ class DomePolicySettings:
     confirm_with_query: bool = False
     expected_led_count: int | None = None
     shutter_pulse_ms: int = 50
+    #: Said after "check the port, the baud rate and the protocol profile" when nothing on the
+    #: port answered: what the rig config's rate is against the firmware's own, if they differ
+    #: (a baudrate left from the example config, 115200, on a 9600-baud sketch).
+    link_hint: str = ""
 
 
 @dataclass(frozen=True)
@@ -271,7 +275,8 @@ class DomePolicy:
             raise DeviceError(
                 self.name,
                 f"no handshake with the dome ({exc.message}); check the port, the baud rate and "
-                "the protocol profile in the rig config, and that the board is powered",
+                f"the protocol profile in the rig config, and that the board is powered"
+                f"{self._link_hint()}",
                 exc.command,
             ) from exc
         except BaseException:
@@ -626,7 +631,7 @@ class DomePolicy:
                         why += (
                             "; nothing on this port has answered yet: check the port, the baud "
                             "rate and the protocol profile in the rig config, and that the "
-                            "board is powered"
+                            f"board is powered{self._link_hint()}"
                         )
                     raise DomeLinkError(
                         self.name,
@@ -811,6 +816,11 @@ class DomePolicy:
             self._counted(finish)
         except DomeLinkError as exc:
             log.warning("%s: waiting for the board to boot failed: %s", self.name, exc)
+
+    def _link_hint(self) -> str:
+        """``settings.link_hint`` as the end of an advice sentence ("" when there is none)."""
+        hint = self.settings.link_hint
+        return f" ({hint})" if hint else ""
 
     def _attempt_off(self, when: str) -> None:
         """One all-off, whatever state the link is in; record what it established."""

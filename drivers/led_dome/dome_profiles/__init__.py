@@ -41,6 +41,15 @@ def builtin_spec(name: str) -> dict[str, Any]:
     return _deep_copy(module.SPEC)
 
 
+def any_baudrate(name: str) -> bool:
+    """True where built-in firmware ``name`` runs on a board whose own USB is its serial port
+    (its module's ``ANY_BAUDRATE``): the host's baud rate is not used there."""
+    if name not in _MODULES:
+        return False
+    module = importlib.import_module(f"{__name__}.{_MODULES[name]}")
+    return bool(getattr(module, "ANY_BAUDRATE", False))
+
+
 def max_led_count(name: str) -> int | None:
     """The most LEDs built-in firmware ``name`` can address (its module's ``MAX_LED_COUNT``), or
     None where no fixed maximum is known (an LED map decides, or ``custom``)."""

@@ -11,6 +11,10 @@ USB) does not reset when the port opens.
 #: Four shift-register drivers of 8 outputs (``M<n>`` selects none past 31).
 MAX_LED_COUNT = 32
 
+#: An ATmega32u4 (the sketch drives ``LED_BUILTIN_TX``): ``Serial`` is its own USB, where
+#: ``Serial.begin(9600)`` sets no rate, so any host baud rate reaches the sketch.
+ANY_BAUDRATE = True
+
 SPEC = {
     "name": "rti-dome-m",
     "led_count": MAX_LED_COUNT,

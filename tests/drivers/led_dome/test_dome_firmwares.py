@@ -106,6 +106,37 @@ def test_a_firmware_served_in_another_process_can_be_probed() -> None:
 
 
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
+def test_a_baudrate_left_from_the_example_is_named_when_the_sketch_does_not_answer(
+    tmp_path: Path,
+) -> None:
+    """``baudrate = 115200`` (the example config's) on the 9600-baud Nab sketch: the check had
+    said only "check the port, the baud rate and the protocol profile", naming neither the key
+    nor the rate the firmware talks at (docs/domes.md warns of this very mistake)."""
+    text = (CONFIGS / CONFIG["nab-rti-v1"]).read_text()
+    text = text.replace('profile = "nab-rti-v1"', 'profile = "nab-rti-v1"\nbaudrate = 115200')
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text)
+    r = runner.invoke(app, ["check", str(rig)])
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "dome.serial.baudrate = 115200" in text and "talks at 9600 baud" in text, text
+    assert "remove that key or set it to 9600" in text
+
+
+def test_the_baudrate_hint_is_said_only_where_the_rate_matters() -> None:
+    from rti_rig.app.dome_factory import baudrate_hint
+
+    def hint(**kw: object) -> str:
+        return baudrate_hint(DomeSerialSettings(port="x", **kw))  # type: ignore[arg-type]
+
+    assert hint(profile="nab-rti-v1") == ""  # the profile's own rate
+    assert hint(profile="rti-dome-m", baudrate=115200) == ""  # native USB: any rate works
+    assert hint(profile="framed", baudrate=9600) == ""  # the project's own: no published rate
+    said_ = hint(profile="rtipy", protocol={"baudrate": 19200})
+    assert "dome.serial.protocol.baudrate = 19200" in said_ and "at 9600 baud" in said_
+
+
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 def test_probe_says_plainly_when_nothing_known_answers() -> None:
     board = board_for("rti-dome-m")  # never answers anything
     with serve_on_pty(board, "silent") as link:
