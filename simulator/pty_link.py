@@ -53,6 +53,7 @@ class _OpenWatch:
         self.fd = -1
         self.wd = -1
         self._libc = None
+        self._failed = False  # a node could not be watched: fall back on the hang-up
         if not sys.platform.startswith("linux"):
             return
         try:
@@ -65,7 +66,7 @@ class _OpenWatch:
 
     @property
     def available(self) -> bool:
-        return self.fd >= 0
+        return self.fd >= 0 and not self._failed
 
     def watch(self, path: str) -> None:
         """Watch ``path`` from now on (events of an earlier node are ignored)."""
@@ -73,9 +74,13 @@ class _OpenWatch:
             return
         mask = _IN_OPEN | _IN_CLOSE_WRITE | _IN_CLOSE_NOWRITE
         self.wd = self._libc.inotify_add_watch(self.fd, os.fsencode(path), mask)
+        self._failed = self.wd < 0
 
     def events(self) -> list[bool]:
-        """The opens (True) and closes (False) of the watched node since the last call."""
+        """The opens (True) and closes (False) of the watched node since the last call.
+
+        Read whenever the descriptor is open, also after a failed watch: events left unread
+        would keep it ready, and the server's poll would spin."""
         if self.fd < 0:
             return []
         try:
@@ -220,15 +225,16 @@ class _Server:
                         poller.unregister(registered)
                 poller.register(self.master, select.POLLIN)
                 registered = self.master
-                if self.watch.available:
+                if self.watch.fd >= 0:
                     with contextlib.suppress(KeyError, ValueError):
                         poller.register(self.watch.fd, select.POLLIN)
             events = poller.poll(self._poll_ms())
             hup = any(fd == self.master and ev & select.POLLHUP for fd, ev in events)
+            seen = self.watch.events()
             if self.watch.available:
                 # every open is a reset, however soon after a close (see the module doc); the
                 # events were queued by the host's open() before it could write anything
-                for opened in self.watch.events():
+                for opened in seen:
                     if opened:
                         self.openers += 1
                         if self.openers == 1:

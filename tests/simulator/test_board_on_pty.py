@@ -101,3 +101,20 @@ def test_a_board_behind_a_uart_still_hears_garbage_at_another_rate() -> None:
         port.write(b"<0><3,5>")
         time.sleep(0.5)
     assert board.lit != frozenset({5})
+
+
+def test_a_node_that_cannot_be_watched_falls_back_on_the_hang_up(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Where inotify cannot watch the pty's node, an open is still seen (by the master's
+    hang-up ending), so the board still boots when the host opens the port."""
+    from rti_rig.simulator import pty_link
+
+    def refused(self, path: str) -> None:  # type: ignore[no-untyped-def]
+        self.wd, self._failed = -1, True
+
+    monkeypatch.setattr(pty_link._OpenWatch, "watch", refused)
+    board = board_for("nab-rti-v1")
+    with (
+        serve_on_pty(board, "nab") as link,
+        serial.Serial(link.port, 9600, timeout=0.1) as port,
+    ):
+        assert read_until(port, NAB_BANNER_END).endswith(NAB_BANNER_END)
