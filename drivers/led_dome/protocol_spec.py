@@ -171,8 +171,13 @@ class ProtocolSpec(_Strict):
                 raise ValueError("stepping = true needs all_off (it rewinds to the first LED)")
         if self.led_map is not None:
             if len(self.led_map) < self.led_count:
+                # said with what to do: the bare count had left a user with 30 LEDs on an
+                # Elexol board (24 outputs, one LED each by default) guessing
+                rows = len(self.led_map)
                 raise ValueError(
-                    f"the LED map has {len(self.led_map)} rows for led_count = {self.led_count}"
+                    f"the LED map has {rows} rows for led_count = {self.led_count}: each LED "
+                    f"needs its row (the outputs that light it), so give led_count = {rows} or "
+                    "fewer, or an led_map_file (with led_map_section) that has a row per LED"
                 )
             if any(not 0 <= b <= 255 for row in self.led_map for b in row):
                 raise ValueError("LED map values must be bytes (0..255)")

@@ -585,6 +585,20 @@ def test_a_bad_led_map_file_is_refused_at_load_naming_file_and_line(tmp_path: Pa
     assert "maps.txt:2" in said(r) and "led_map_file" in said(r)
 
 
+def test_more_leds_than_the_elexol_map_has_rows_says_what_to_do(tmp_path: Path) -> None:
+    """30 LEDs on the default map (24 outputs, one LED each) had been refused with only "the LED
+    map has 24 rows for led_count = 30"."""
+    text = (CONFIGS / "emulated_elexol.toml").read_text()
+    text = text.replace("count = 12", "count = 30").replace("led_count = 12", "led_count = 30")
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text(text)
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2
+    text = said(r)
+    assert "the LED map has 24 rows for led_count = 30" in text
+    assert "give led_count = 24 or fewer, or an led_map_file" in text
+
+
 @pytest.mark.parametrize("kind", ["garble_reply", "drop_reply"])
 def test_a_stepping_dome_rewinds_after_a_doubtful_step_and_labels_every_image_right(
     kind: str, tmp_path: Path
