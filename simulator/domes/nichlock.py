@@ -7,7 +7,9 @@ then a ``>`` prompt follows; ``0`` lights the next LED (``LED number: N; on pin 
 ``!Please disable newlines!``; other keys ``Did nothing; that key is not assigned to a
 command.``. Past LED 191 ``0`` returns before the prompt. The Arduino Mega resets when the port
 opens; the banner ends with ``For help, press 'h'`` and the prompt. Scans, menus and the touch
-screen are not emulated.
+screen are not emulated. The baud rate is the one stored in EEPROM (``setup()`` reads it;
+the ``a`` settings menu offers 300, 2400, 9600, 19200 and 115200, ``DEFAULT_BAUD_RATE`` in
+``headers.h`` is 115200): ``baudrate`` gives a board set otherwise.
 """
 
 from __future__ import annotations
@@ -22,6 +24,10 @@ class NichlockBoard(Board):
     led_count = N_LEDS
     baudrate = 115200
     boot_s = 1.0
+
+    def __init__(self, baudrate: int = 115200, **kw: object) -> None:
+        self.baudrate = baudrate  # the rate stored in the board's EEPROM
+        super().__init__(**kw)  # type: ignore[arg-type]
 
     def firmware(self) -> Firmware:
         self.count = 0

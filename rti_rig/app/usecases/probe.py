@@ -107,6 +107,30 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     return result
 
 
+#: What nichlock/rti's firmware prints, at whatever rate its EEPROM holds: its banner, the free
+#: RAM (``m``) and its answer to a key it does not know (``arduino-program/src/main.cpp``).
+_NICHLOCK_SAYS = (
+    "Reflectance Transformation Imager Serial Interface",
+    "RAM bytes remaining",
+    "Did nothing; that key is not assigned",
+)
+
+
+def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
+    """Name nichlock's firmware if ``text`` (heard at ``baud``) is its; True if it was.
+
+    Checked after every probe, not only at 115200: its rate is stored in EEPROM (9600 on a
+    board set so), and a 9600-baud board that was not recognised went on to RTIPy's
+    ``T,0,0,0``, whose three ``0`` step it to its third LED, left lit under the words "nothing
+    that lights an LED was sent".
+    """
+    if not any(words in text for words in _NICHLOCK_SAYS):
+        return False
+    result.profile, result.baudrate = "nichlock", baud
+    result.lights = "the firmware boots with every LED off; nothing that lights was sent"
+    return True
+
+
 def probe(request: ProbeRequest) -> ProbeResult:
     """Try the known firmwares on ``request.port``; see the module docstring for the order."""
     result = ProbeResult(request.port)
@@ -116,11 +140,11 @@ def probe(request: ProbeRequest) -> ProbeResult:
         result.heard.append(("listen at 9600 baud", text))
         if "RTI-Dome intialized" in text or "<All lights turned on.>" in text:
             return _nab_found(result, wait)
+        if _nichlock_found(result, text, 9600):
+            return result
         text = _exchange(port, 115200, wait, b"", 0)
         result.heard.append(("listen at 115200 baud", text))
-        if "Reflectance Transformation Imager Serial Interface" in text:
-            result.profile, result.baudrate = "nichlock", 115200
-            result.lights = "the firmware boots with every LED off; nothing was sent"
+        if _nichlock_found(result, text, 115200):
             return result
         text = _exchange(port, 38400, 0.2, b"?", 0.5)
         result.heard.append(("'?' at 38400 baud", text))
@@ -129,16 +153,18 @@ def probe(request: ProbeRequest) -> ProbeResult:
             return result
         text = _exchange(port, 115200, wait, b"m", 0.5)
         result.heard.append(("'m' (free RAM) at 115200 baud", text))
-        if "RAM bytes remaining" in text or "Reflectance Transformation Imager" in text:
-            result.profile, result.baudrate = "nichlock", 115200
-            result.lights = "the firmware boots with every LED off; nothing that lights was sent"
+        if _nichlock_found(result, text, 115200):
             return result
         text = _exchange(port, 9600, wait, b"<9>", 0.6)
         result.heard.append(("'<9>' (an unknown code) at 9600 baud", text))
         if "<INCORRECT FUNCTION CALL: 9>" in text or "RTI-Dome intialized" in text:
             return _nab_found(result, wait)
+        if _nichlock_found(result, text, 9600):
+            return result
         text = _exchange(port, 9600, 1.6, b"\x42" + bytes(8), 0.5)
         result.heard.append(("0x42 + empty mask at 9600 baud", text))
+        if _nichlock_found(result, text, 9600):
+            return result
         if text.endswith("\x01"):
             result.profile, result.baudrate = "minirti", 9600
             result.lights = "the probe sent an all-off mask, acknowledged"

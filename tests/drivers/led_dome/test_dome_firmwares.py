@@ -137,6 +137,23 @@ def test_the_baudrate_hint_is_said_only_where_the_rate_matters() -> None:
 
 
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
+def test_probe_finds_a_nichlock_board_at_9600_without_lighting_it() -> None:
+    """nichlock/rti keeps its baud rate in EEPROM (its settings menu offers 9600). Such a board
+    was not recognised (only 115200 was), so the probe went on to RTIPy's ``T,0,0,0``: its
+    three ``0`` stepped the dome to LED 2, left lit, and the probe said "nothing that lights an
+    LED was sent"."""
+    from rti_rig.simulator.domes.nichlock import NichlockBoard
+
+    board = NichlockBoard(baudrate=9600)
+    with serve_on_pty(board, "nichlock") as link:
+        r = runner.invoke(app, ["probe", link.port])
+        assert r.exit_code == 0, r.output
+        assert 'profile = "nichlock"' in r.output and "baudrate = 9600" in r.output
+        time.sleep(0.5)  # anything still on its way has reached the board
+        assert all(lit == frozenset() for _, lit in board.timeline), board.timeline
+
+
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 def test_probe_says_plainly_when_nothing_known_answers() -> None:
     board = board_for("rti-dome-m")  # never answers anything
     with serve_on_pty(board, "silent") as link:
