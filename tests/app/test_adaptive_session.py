@@ -264,6 +264,29 @@ def test_adaptive_on_an_arm_counts_move_time(tmp_path: Path) -> None:
         np.testing.assert_allclose(s["planned_direction"], s["actual_direction"], atol=0.02)
 
 
+def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> None:
+    """``--adaptive`` without ``--lights`` is capped at the config's ``default_lights``, the
+    default ``--lights`` documents (it had shot 100 lights, the cap meant for
+    ``--until-error`` alone, on an arm whose config says 24); ``--until-error`` alone keeps
+    the larger cap, its N being unknown."""
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    assert "default_lights = 24" in text
+    cfg = write_config(tmp_path, text.replace("default_lights = 24", "default_lights = 6"))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--adaptive"])
+    assert r.exit_code == 0, r.output
+    assert "6 lights at most, adaptive" in said(r)
+    assert len(journal(out)) == 6
+    assert manifest(out)["adaptive"]["max_lights"] == 6
+    assert "reached its maximum of 6 lights" in said(r)
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases.adaptive import ARM_MAX_LIGHTS, default_max_lights
+
+    loaded = load_rig_config(cfg)
+    assert default_max_lights(loaded, 2.0) is None  # --until-error alone: up to ARM_MAX_LIGHTS
+    assert ARM_MAX_LIGHTS > 6
+
+
 def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
     acq = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
     out = tmp_path / "s"

@@ -668,6 +668,21 @@ def dome_start(
     return [int(full[i]) for i in pick]
 
 
+def default_max_lights(loaded, until_error_deg: float | None) -> int | None:  # type: ignore[no-untyped-def]
+    """The maximum of an adaptive session given neither ``--lights`` nor ``--until-error``:
+    the rig config's ``default_lights``, as ``--lights`` documents its default and a planned
+    run uses it (an arm's 24; a dome's ``default_lights`` if set). None — every light the rig
+    offers, on an arm :data:`ARM_MAX_LIGHTS` — with ``--until-error``, whose N is unknown, and
+    on a dome without ``default_lights``. ``--adaptive`` alone on an arm had shot 100 lights,
+    four times the 24 its config and ``--lights``'s help promise."""
+    if until_error_deg is not None:
+        return None
+    cfg = loaded.config
+    section = cfg.arm if cfg.arm is not None else cfg.dome
+    default = getattr(section, "default_lights", None)
+    return None if default is None else int(default)
+
+
 def adaptive_plan(  # type: ignore[no-untyped-def]
     rig,
     lights: int | None,
@@ -675,11 +690,14 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     design: bool | None = None,
     objective: str = "normals",
     band: tuple[float, float] = _FULL_BAND,
+    default_max: int | None = None,
 ) -> AdaptivePlan:
     """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
     homogeneous starting layout of ``start_lights``; with ``lights`` given (``design`` not
     False) the rest is chosen as a design of that many lights, starting from the objective's
-    default floor.
+    default floor. Without ``lights``, the session's maximum is ``default_max`` (the rig
+    config's ``default_lights``, :func:`default_max_lights`) where given, else every light
+    the rig offers (an arm: :data:`ARM_MAX_LIGHTS`), never more than the candidates.
 
     ``band`` (``--min/--max-elevation-deg``): only the lights between these elevations are
     candidates, so every light of the session — the start, each decision, each design — is in
@@ -704,6 +722,8 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
         ok = [rig.lighting.problem(LightStep(tuple(d))) is None for d in dirs]
         dirs, leds = dirs[np.asarray(ok, dtype=bool)], None
         cap = ARM_MAX_LIGHTS
+    if default_max is not None:
+        cap = min(cap, default_max)
     max_lights = min(lights if lights is not None else cap, len(dirs))
     k0 = min(start_lights, max_lights)
     n_design = max_lights if (lights is not None and design is not False) else None
@@ -1035,7 +1055,13 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:
-        plan = adaptive_plan(rig, lights, objective=objective, band=band)
+        plan = adaptive_plan(
+            rig,
+            lights,
+            objective=objective,
+            band=band,
+            default_max=None if lights is not None else default_max_lights(loaded, until_error_deg),
+        )
         if not isinstance(geometry, DomeGeometry):  # an arm's reachable lights need the rig's
             _check_lights_within(lights, len(plan.candidates), band)  # own rules
             if min_lights is not None:
