@@ -152,6 +152,15 @@ class StepSource(Protocol):
 
     def observe(self, index: int, frame: Frame, record: StepRecord) -> None: ...
 
+    def conclude(self) -> dict[str, Any]:
+        """How the source ended (for an adaptive session: lights used, final estimate, why it
+        stopped), asked once its last step is done and *before* the session counts as
+        completed: it is recorded under ``adaptive.result`` in the same manifest write that
+        says so. Computed afterwards, a stop during it (the estimate takes a fraction of a
+        second) had left a session marked completed without its result, which no resume
+        could add."""
+        ...
+
 
 def step_exposure(rig: Rig, step: LightStep) -> float:
     return step.exposure_s if step.exposure_s is not None else rig.camera_config.exposure_s
@@ -294,6 +303,8 @@ def run_session(
     reason = FinishReason.ERROR
     error: str | None = None
     teardown: list[str] = []
+    #: the source's conclusion (``StepSource.conclude``), once it has one
+    concluded: dict[str, Any] | None = None
     rig_t0, wall_t0 = clock.now(), time.perf_counter()
     try:
         rig.bind_session(folder.root)
@@ -315,6 +326,7 @@ def run_session(
             else:
                 decided = source.next_step(i)
                 if decided is None:  # the source says the session is done
+                    concluded = source.conclude()
                     reason = FinishReason.COMPLETED
                     break
                 step, decision = decided
@@ -356,6 +368,8 @@ def run_session(
             layout = layout or got
             emit(StepCompleted(i, total, record))
         else:
+            if source is not None:  # run to its maximum: never asked for the step past it
+                concluded = source.conclude()
             if rig.end_check is not None:  # e.g. a camera-triggered dome's proof frame
                 last = schedule.steps[-1] if source is None else None
                 exposure = cam.exposure_s if last is None else step_exposure(rig, last)
@@ -403,6 +417,7 @@ def run_session(
                         **({"end_check": end_notes} if rig.end_check is not None else {}),
                     },
                     timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
+                    source_result=concluded if reason is FinishReason.COMPLETED else None,
                 )
             except SessionWriteError as exc:
                 if error is None:  # nothing else went wrong: this is the session's failure

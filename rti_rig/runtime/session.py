@@ -633,22 +633,34 @@ class SessionFolder:
             )
 
     def finish(
-        self, records: list[StepRecord], runner: dict[str, Any], timing: dict[str, Any]
+        self,
+        records: list[StepRecord],
+        runner: dict[str, Any],
+        timing: dict[str, Any],
+        source_result: dict[str, Any] | None = None,
     ) -> None:
-        """Write the `.lp` from what actually ran (all runs, in step order), then the manifest.
+        """Write the `.lp` from what actually ran (all runs, in step order), then the manifest
+        (with ``source_result``, an adaptive session's outcome, under ``adaptive.result``: in
+        the one write that says the session completed, so that no stop can fall between them).
 
         Does nothing for a session that never began (nothing was created on disk).
         """
         try:
-            self._finish(records, runner, timing)
+            self._finish(records, runner, timing, source_result)
         finally:
             unlock_session(self.root)
 
     def _finish(
-        self, records: list[StepRecord], runner: dict[str, Any], timing: dict[str, Any]
+        self,
+        records: list[StepRecord],
+        runner: dict[str, Any],
+        timing: dict[str, Any],
+        source_result: dict[str, Any] | None = None,
     ) -> None:
         if not self.begun:
             return
+        if source_result is not None:
+            self.manifest.setdefault("adaptive", {})["result"] = source_result
         for r in records:
             self.committed.setdefault(r.index, r)
         # a stop that came between a journal line and its return (a signal during the fsync)

@@ -264,6 +264,58 @@ def test_adaptive_on_an_arm_counts_move_time(tmp_path: Path) -> None:
         np.testing.assert_allclose(s["planned_direction"], s["actual_direction"], atol=0.02)
 
 
+def test_a_stop_while_the_outcome_is_concluded_leaves_a_session_the_resume_finishes(
+    tmp_path: Path,
+) -> None:
+    """The outcome (final estimate, why it stopped) is concluded before the session counts as
+    completed, and recorded in the same manifest write. It had been computed after the
+    controller marked the session completed: a SIGTERM in that fraction of a second left a
+    manifest saying completed with no ``adaptive.result``, the CLI saying "Continue with:
+    rti-rig run --resume", and the resume refusing ("already completed all 10 steps")."""
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases.adaptive import open_adaptive_session
+    from rti_rig.runtime.controller import EmergencyStop, run_session
+
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 6, None)
+
+    def signalled() -> dict:  # the SIGTERM arrives while the final estimate is computed
+        raise EmergencyStop("SIGTERM")
+
+    source.chooser.conclude = signalled
+    with rig, pytest.raises(EmergencyStop):
+        run_session(rig, schedule, folder, source=source)
+    m = manifest(out)
+    assert m["runner"]["finish_reason"] == "emergency-stop"
+    assert "result" not in m["adaptive"] and len(journal(out)) == 6
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "Adaptive: 6 lights; stopped: reached its maximum of 6 lights" in said(r)
+    m = manifest(out)
+    assert m["runner"]["finish_reason"] == "completed"
+    assert m["adaptive"]["result"]["lights_used"] == 6
+
+
+def test_a_completed_session_s_outcome_is_in_the_controller_s_own_manifest_write(
+    tmp_path: Path,
+) -> None:
+    """run_session alone (no CLI, no use case after it) leaves the outcome in the manifest."""
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.usecases.adaptive import open_adaptive_session
+    from rti_rig.runtime.controller import run_session
+
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    rig, schedule, folder, source = open_adaptive_session(load_rig_config(cfg), out, 6, 1000.0)
+    with rig:
+        run_session(rig, schedule, folder, source=source)
+    m = manifest(out)
+    assert m["runner"]["finish_reason"] == "completed"
+    assert m["adaptive"]["result"]["target_claimed"] is True
+    assert m["adaptive"]["result"] == source.conclude()
+
+
 def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> None:
     """``--adaptive`` without ``--lights`` is capped at the config's ``default_lights``, the
     default ``--lights`` documents (it had shot 100 lights, the cap meant for

@@ -787,6 +787,7 @@ class AdaptiveSteps:
             band=plan.band,
         )
         self._pending: dict[int, int] = {}
+        self._outcome: dict[str, Any] | None = None
 
     @property
     def total(self) -> int:
@@ -857,17 +858,11 @@ class AdaptiveSteps:
             self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
 
     def conclude(self) -> dict[str, Any]:
-        return self.chooser.conclude()
-
-
-def record_result(folder_root: Path, result: dict[str, Any]) -> None:
-    """Add the adaptive run's outcome (lights used, final estimate, why it stopped) to the
-    manifest, after the controller has written it."""
-    from rti_rig.runtime.session import MANIFEST, _write_json_atomic, read_manifest
-
-    manifest = read_manifest(folder_root)
-    manifest.setdefault("adaptive", {})["result"] = result
-    _write_json_atomic(Path(folder_root) / MANIFEST, manifest)
+        """The outcome (``AdaptiveChooser.conclude``), computed once: the controller asks for
+        it before the session completes and records it; the CLI's summary reads it again."""
+        if self._outcome is None:
+            self._outcome = self.chooser.conclude()
+        return self._outcome
 
 
 def estimate_phrase(result: dict[str, Any]) -> str:

@@ -867,10 +867,7 @@ def run_opened_session(
             source=opened.source,
         )
     if opened.source is not None and result.finish_reason is FinishReason.COMPLETED:
-        from rti_rig.app.usecases.adaptive import record_result
-
-        # the adaptive run's outcome (lights used, final estimate, why it stopped)
-        outcome = opened.source.conclude()
-        record_result(opened.out_dir, outcome)
-        opened.extra["adaptive_result"] = outcome
+        # the adaptive run's outcome (lights used, final estimate, why it stopped), concluded
+        # before the session completed and recorded by the controller in the same write
+        opened.extra["adaptive_result"] = opened.source.conclude()
     return result
