@@ -135,6 +135,53 @@ def test_a_resumed_session_whose_images_changed_is_refused(
     assert "step 6 was decided differently" in said(r)
 
 
+def test_a_resume_on_an_accepted_rig_change_it_cannot_repeat_says_so(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """Recalibrated light positions accepted with --accept-rig-change, on which the steps
+    taken are no longer decided as they were: the refusal names the accepted change (it had
+    blamed "another rig config, software version or image on disk", and the note before it
+    said the change was recorded, though nothing was), and the folder is left as it was."""
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        open_new_session,
+        run_opened_session,
+    )
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    cfg, _ = uninterrupted
+    out = tmp_path / "cut"
+    # through the use case, as `run` does: it records the rig's identity, which a resume on
+    # another config is checked against (the bare ``interrupted`` helper records none)
+    opened = open_new_session(NewSessionRequest(cfg, out, lights=8, adaptive=True))
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 5:
+            cancel.cancel()
+
+    run_opened_session(opened, cancel, on_event)
+    assert len(journal(out)) == 6
+    before = folder_bytes(out)
+    text = cfg.read_text()
+    assert "elevation_deg = 20.0" in text and "elevation_deg = 50.0" in text
+    moved = write_config(
+        tmp_path,
+        text.replace("elevation_deg = 20.0", "elevation_deg = 20.2").replace(
+            "elevation_deg = 50.0", "elevation_deg = 50.2"
+        ),
+        "recalibrated.toml",
+    )
+    r = runner.invoke(app, ["run", str(moved), "--resume", str(out), "--accept-rig-change"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "accepted and recorded" not in text
+    assert "rig change accepted (recorded in the manifest once the session goes on)" in text
+    assert "the rig change accepted with --accept-rig-change (light positions" in text
+    assert "Nothing was recorded or captured" in text
+    assert folder_bytes(out) == before
+
+
 @pytest.mark.parametrize("damage", ["deleted", "one byte changed"])
 def test_a_resume_with_an_earlier_image_gone_is_refused_before_the_folder_changes(
     uninterrupted: tuple[Path, Path], tmp_path: Path, damage: str

@@ -849,6 +849,18 @@ class AdaptiveSteps:
                 else tuple(float(c) for c in self.plan.candidates[candidate])
             )
             if planned is None or not np.allclose(planned, rec.planned_direction, atol=1e-9):
+                changed = getattr(folder, "rig_change", None)
+                if changed:  # the user just accepted it: say it is why, not "another config"
+                    raise RtiRigError(
+                        f"{folder.root}: the rig change accepted with --accept-rig-change ("
+                        + "; ".join(changed)
+                        + ") changes the lights this adaptive session chooses among, and a "
+                        "resume re-decides every step already taken: on this rig step "
+                        f"{i + 1} is not decided as it was (another light, or its LED at the "
+                        "new position). Nothing was recorded or captured. Resume with the "
+                        f"session's own config (rti-rig run --resume {folder.root}), or start "
+                        "a new session on the changed rig"
+                    )
                 raise RtiRigError(
                     f"{folder.root}: step {i + 1} was decided differently when the session "
                     "began (another rig config, software version or image on disk); it cannot "

@@ -665,7 +665,16 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             "positions), add --accept-rig-change to record it"
         )
     if diffs:
-        on_note(Note("rig change accepted and recorded: " + "; ".join(diffs), "warning"))
+        # recorded in the manifest when the session goes on: a resume refused after this (a
+        # remaining step the changed rig cannot run, an adaptive step it would decide
+        # otherwise) records nothing, and the note had said "recorded" all the same
+        on_note(
+            Note(
+                "rig change accepted (recorded in the manifest once the session goes on): "
+                + "; ".join(diffs),
+                "warning",
+            )
+        )
     elif loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
         on_note(
             Note(
