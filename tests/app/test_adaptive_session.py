@@ -288,6 +288,52 @@ def test_bad_requests_are_refused_before_anything_moves(
     assert not (tmp_path / "s").exists()
 
 
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--adaptive"],
+        ["--adaptive", "--lights", "4"],
+        ["--adaptive", "--lights", "5"],
+        ["--until-error", "2", "--lights", "4"],
+    ],
+)
+def test_a_rig_with_no_light_beyond_the_start_refuses_adaptive_with_one_remedy(
+    tmp_path: Path, args: list[str]
+) -> None:
+    """On a 4-LED dome ``--lights 4`` was refused with "give at least 5" and ``--lights 5``
+    with "give at most 4", a circle; ``--adaptive`` alone ran the 4 lights, labelled adaptive,
+    with no decision made. Now one refusal says there is nothing to choose and what to run."""
+    text = SMALL_DOME.replace(
+        """rings = [
+  { elevation_deg = 20.0, count = 8 },
+  { elevation_deg = 50.0, count = 4, azimuth_offset_deg = 45.0 },
+]""",
+        "rings = [{ elevation_deg = 40.0, count = 4 }]",
+    )
+    assert text != SMALL_DOME
+    cfg = write_config(tmp_path, text)
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), *args])
+    assert r.exit_code == 2, r.output
+    assert "this rig offers 4 lights" in said(r) and "none left to choose" in said(r)
+    assert f"rti-rig run {cfg} --out DIR" in said(r)
+    assert not (tmp_path / "s").exists()
+
+
+def test_until_error_alone_on_a_rig_of_few_lights_still_judges_them(tmp_path: Path) -> None:
+    """--until-error alone is kept there: its estimate says whether the lights reach it."""
+    text = SMALL_DOME.replace(
+        """rings = [
+  { elevation_deg = 20.0, count = 8 },
+  { elevation_deg = 50.0, count = 4, azimuth_offset_deg = 45.0 },
+]""",
+        "rings = [{ elevation_deg = 40.0, count = 4 }]",
+    )
+    cfg = write_config(tmp_path, text)
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--until-error", "90"])
+    assert r.exit_code == 0, r.output
+    assert "Adaptive: 4 lights; stopped:" in said(r)
+
+
 def test_adaptive_on_an_arm_counts_move_time(tmp_path: Path) -> None:
     out = tmp_path / "s"
     r = runner.invoke(

@@ -20,6 +20,7 @@ uninterrupted session would have.
 
 from __future__ import annotations
 
+import shlex
 import time
 import warnings
 from collections.abc import Callable
@@ -1021,6 +1022,31 @@ def _check_lights_within(
         )
 
 
+def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
+    loaded,
+    offered: int,
+    lights: int | None,
+    until_error_deg: float | None,
+    band: tuple[float, float] = _FULL_BAND,
+) -> None:
+    """Refuse ``--adaptive`` (or ``--lights N`` with it) on a rig offering no more lights than
+    the starting layout: there is nothing left to choose. ``--lights 4`` was refused with "give
+    at least 5" and ``--lights 5`` with "give at most 4", sending the user round in a circle,
+    while ``--adaptive`` alone ran the lights as a planned run would, labelled adaptive.
+    ``--until-error`` alone is kept: its estimate still says whether these lights reach the
+    target."""
+    if offered > START_LIGHTS or (lights is None and until_error_deg is not None):
+        return
+    widen = " (or widen --min/--max-elevation-deg)" if tuple(band) != _FULL_BAND else ""
+    noun = "light" if offered == 1 else "lights"
+    raise RtiRigError(
+        f"this rig offers {offered} {noun}{_band_words(band)}, and an adaptive session starts "
+        f"from {START_LIGHTS} and chooses the next ones: there is none left to choose. Shoot "
+        f"them all with a planned run: rti-rig run {shlex.quote(str(loaded.path))} --out DIR"
+        f"{widen}"
+    )
+
+
 def open_adaptive_session(  # type: ignore[no-untyped-def]
     loaded,
     out_dir: Path,
@@ -1042,6 +1068,13 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
 
     if until_error_deg is not None and not (np.isfinite(until_error_deg) and until_error_deg > 0):
         raise RtiRigError(f"--until-error {until_error_deg:g}: give a positive angle in degrees")
+    from rti_rig.app.config import rig_geometry
+
+    geometry = rig_geometry(loaded)
+    offered: int | None = None
+    if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
+        offered = len(candidates_for(geometry, band[0], max_elevation_deg=band[1]).directions)
+        _refuse_nothing_to_choose(loaded, offered, lights, until_error_deg, band)
     if lights is not None and lights < START_LIGHTS + 1:
         asked = "--until-error … " if until_error_deg is not None else "--adaptive "
         raise RtiRigError(
@@ -1050,11 +1083,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         )
     check_objective(objective, lights, until_error_deg)
     check_min_lights(min_lights, lights, until_error_deg)
-    from rti_rig.app.config import rig_geometry
-
-    geometry = rig_geometry(loaded)
-    if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
-        offered = len(candidates_for(geometry, band[0], max_elevation_deg=band[1]).directions)
+    if offered is not None:
         _check_lights_within(lights, offered, band)
         if min_lights is not None:
             _check_min_within(min_lights, offered, band)
