@@ -334,6 +334,37 @@ def test_until_error_alone_on_a_rig_of_few_lights_still_judges_them(tmp_path: Pa
     assert "Adaptive: 4 lights; stopped:" in said(r)
 
 
+@pytest.mark.parametrize(
+    ("rig", "fragment"),
+    [
+        ("tests/data/neuralrti_replay/dirs.lp", "cannot meter a replayed acquisition"),
+        ("rig_configs/example_dome_48_folder_watch.toml", "cannot meter a 'folder_watch' camera"),
+    ],
+)
+def test_adaptive_auto_exposure_on_a_rig_no_run_can_meter_says_why(
+    tmp_path: Path, rig: str, fragment: str
+) -> None:
+    """--adaptive --auto-exposure advised metering with a planned run, which these rigs refuse
+    (a replay's images do not change with the exposure; a watched folder's camera is not set
+    by rti-rig): the reason that holds for every run is given instead."""
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(REPO / rig),
+            "--out",
+            str(tmp_path / "s"),
+            "--adaptive",
+            "--lights",
+            "6",
+            "--auto-exposure",
+        ],
+    )
+    assert r.exit_code == 2, r.output
+    assert fragment in said(r) and "Meter once with a planned run" not in said(r)
+    assert not (tmp_path / "s").exists()
+
+
 def test_adaptive_on_an_arm_counts_move_time(tmp_path: Path) -> None:
     out = tmp_path / "s"
     r = runner.invoke(

@@ -431,17 +431,8 @@ def _open_new(
     from rti_rig.app.rig_identity import rig_identity
 
     SessionFolder.check_new(out_dir)
-    if auto_exposure and loaded.config.backend == "replay":
-        # the recorded images come back whatever the exposure: metering them would "fix" an
-        # exposure that changes nothing (a claim nothing established)
-        raise ConfigError(
-            loaded.path,
-            None,
-            "--auto-exposure cannot meter a replayed acquisition: its camera returns the "
-            "recorded images whatever the exposure; drop --auto-exposure",
-        )
     if auto_exposure:
-        refuse_unmeterable_camera(loaded)
+        refuse_unmeterable_rig(loaded)
     identity = rig_identity(loaded)
     rig = checked_rig(loaded, schedule)
     try:
@@ -453,6 +444,24 @@ def _open_new(
         rig.close()
         raise
     return OpenedSession(rig, schedule, folder, Path(out_dir))
+
+
+def refuse_unmeterable_rig(loaded) -> None:  # type: ignore[no-untyped-def]
+    """``--auto-exposure`` on a rig whose exposure metering cannot change: a replayed
+    acquisition, or a camera rti-rig does not set the exposure of
+    (:func:`refuse_unmeterable_camera`). Asked by a planned run, and first by an adaptive one,
+    whose own refusal advises metering with a planned run: on these rigs that advice led to
+    the refusal below."""
+    if loaded.config.backend == "replay":
+        # the recorded images come back whatever the exposure: metering them would "fix" an
+        # exposure that changes nothing (a claim nothing established)
+        raise ConfigError(
+            loaded.path,
+            None,
+            "--auto-exposure cannot meter a replayed acquisition: its camera returns the "
+            "recorded images whatever the exposure; drop --auto-exposure",
+        )
+    refuse_unmeterable_camera(loaded)
 
 
 def refuse_unmeterable_camera(loaded) -> None:  # type: ignore[no-untyped-def]
@@ -542,6 +551,7 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     if req.plan is not None:
         raise RtiRigError("--adaptive chooses its own lights: drop --plan")
     if req.auto_exposure:
+        refuse_unmeterable_rig(loaded)  # no planned run meters these either: say so first
         raise RtiRigError(
             "--adaptive cannot meter the exposure: its lights are chosen as the images "
             "arrive, so there is no brightest planned light to meter at. Meter once with a "
