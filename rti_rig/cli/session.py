@@ -217,7 +217,9 @@ def run(
                         raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
                     if reshoot_lost:
                         raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
-                    refuse_unmetered_limit(max_saturated, auto_exposure)
+                    refuse_unmetered_limit(
+                        max_saturated, auto_exposure, adaptive or until_error is not None
+                    )
                     opened = open_new_session(
                         NewSessionRequest(
                             rig_config,
@@ -289,11 +291,20 @@ def _metering_limit(max_saturated: float | None) -> dict[str, float]:
     return {} if max_saturated is None else {"max_saturated": max_saturated}
 
 
-def refuse_unmetered_limit(max_saturated: float | None, auto_exposure: bool) -> None:
+def refuse_unmetered_limit(
+    max_saturated: float | None, auto_exposure: bool, adaptive: bool = False
+) -> None:
     """``--max-saturated`` without ``--auto-exposure`` is refused: only metering reads it, so
     it had been accepted and ignored, the config's exposure used as it is (an option that
-    does nothing must not look as if it did)."""
+    does nothing must not look as if it did). In an adaptive session (``adaptive``), which
+    cannot meter, the remedy is to drop it: "add --auto-exposure" led to a second refusal."""
     if max_saturated is not None and not auto_exposure:
+        if adaptive:
+            raise RtiRigError(
+                f"--max-saturated {max_saturated:g} sets how much --auto-exposure's metering "
+                "lets clip, and an adaptive session cannot meter (its lights are chosen as the "
+                "images arrive): the config's exposure is used as it is; drop --max-saturated"
+            )
         raise RtiRigError(
             f"--max-saturated {max_saturated:g} sets how much --auto-exposure's metering lets "
             "clip; without --auto-exposure the config's exposure is used as it is: add "

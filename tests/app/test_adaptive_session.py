@@ -277,6 +277,16 @@ def test_until_error_stops_when_the_estimate_is_reached(
             ["--adaptive", "--lights", "6", "--auto-exposure"],
             "--adaptive cannot meter the exposure",
         ),
+        # it said "add --auto-exposure", which an adaptive session then refused
+        (
+            ["--adaptive", "--lights", "6", "--max-saturated", "0.01"],
+            "an adaptive session cannot meter (its lights are chosen as the images arrive): the "
+            "config's exposure is used as it is; drop --max-saturated",
+        ),
+        (
+            ["--until-error", "2", "--max-saturated", "0.01"],
+            "an adaptive session cannot meter",
+        ),
     ],
 )
 def test_bad_requests_are_refused_before_anything_moves(
