@@ -473,6 +473,39 @@ def test_adaptive_alone_on_an_arm_shoots_its_default_lights(tmp_path: Path) -> N
     assert ARM_MAX_LIGHTS > 6
 
 
+def test_a_resume_on_a_faster_arm_names_the_times_that_changed(tmp_path: Path) -> None:
+    """An arm's decisions weigh each light's move time; a resume whose config speeds the arm
+    up (which the rig identity rightly ignores: the images do not change) decides a step
+    otherwise and is refused. It said "another rig config, software version or image on
+    disk ... start a new session"; it now names the times and that putting them back
+    continues the session (which it does)."""
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    assert "speed_deg_s = 60.0" in text and "acceleration_deg_s2 = 120.0" in text
+    cfg = write_config(
+        tmp_path, text.replace("width = 512", "width = 96").replace("height = 512", "height = 96")
+    )
+    out = tmp_path / "s"
+    interrupted(cfg, out, after_step=5, lights=9)
+    before = folder_bytes(out)
+    fast = write_config(
+        tmp_path,
+        cfg.read_text()
+        .replace("speed_deg_s = 60.0", "speed_deg_s = 6000.0")
+        .replace("acceleration_deg_s2 = 120.0", "acceleration_deg_s2 = 12000.0"),
+        "fast.toml",
+    )
+    r = runner.invoke(app, ["run", str(fast), "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "an adaptive session weighs each light by the time it costs" in text
+    assert "arm moves, the longest from the last light" in text
+    assert "Put those settings back as the session began to continue it" in text
+    assert folder_bytes(out) == before
+    r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)])  # put back: it goes on
+    assert r.exit_code == 0, r.output
+    assert len(journal(out)) == 9
+
+
 def test_adaptive_on_a_replayed_real_acquisition(tmp_path: Path) -> None:
     acq = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
     out = tmp_path / "s"

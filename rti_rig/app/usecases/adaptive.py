@@ -766,9 +766,11 @@ class AdaptiveSteps:
         self.min_lights = min_lights
         self.objective = objective
         move: MoveTimes | None = None
+        self._park = None
         if isinstance(rig.geometry, ArmGeometry):
             settings = _arm_motion_settings(rig.loaded)
             park = rig.geometry.park_direction
+            self._park = park
 
             def move(current):  # type: ignore[no-untyped-def]
                 here = park if current is None else current
@@ -789,6 +791,7 @@ class AdaptiveSteps:
         )
         self._pending: dict[int, int] = {}
         self._outcome: dict[str, Any] | None = None
+        self._move = move  # for a refused resume's words (:meth:`_timing_differences`)
 
     @property
     def total(self) -> int:
@@ -862,6 +865,16 @@ class AdaptiveSteps:
                         f"session's own config (rti-rig run --resume {folder.root}), or start "
                         "a new session on the changed rig"
                     )
+                timing = self._timing_differences(folder)
+                if timing:  # the config's times changed: restoring them continues the session
+                    raise RtiRigError(
+                        f"{folder.root}: step {i + 1} is not decided as it was: an adaptive "
+                        "session weighs each light by the time it costs (the capture and, on an "
+                        "arm, the move to it), and the rig config now gives other times ("
+                        + "; ".join(timing)
+                        + "). Nothing was recorded or captured. Put those settings back as the "
+                        "session began to continue it, or start a new session"
+                    )
                 raise RtiRigError(
                     f"{folder.root}: step {i + 1} was decided differently when the session "
                     "began (another rig config, software version or image on disk); it cannot "
@@ -869,6 +882,45 @@ class AdaptiveSteps:
                 )
             pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
             self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
+
+    def _timing_differences(self, folder) -> list[str]:  # type: ignore[no-untyped-def]
+        """On an arm, the times a decision weighs (capture, moves) that differ between the rig
+        config the session last ran with (its manifest) and this one, in words; empty if they
+        agree, on a dome, or if they cannot be told. The rig identity leaves timing and motion
+        out (they do not change the images), so a resume on a slowed arm got as far as
+        re-deciding its steps and was refused as "another rig config", with "start a new
+        session" as the remedy, where putting the speed back continues it."""
+        from rti_rig.app.config import parse_rig_config
+
+        recorded = (folder.manifest.get("rig") or {}).get("config")
+        if self._move is None or not isinstance(recorded, dict):
+            # a dome's lights all cost one capture time: a time per second ranks them alike,
+            # so another time cannot be why a dome's step is decided otherwise
+            return []
+        try:
+            then = parse_rig_config(recorded, "manifest.json")
+        except Exception:  # a manifest of another build: nothing to say beyond the refusal
+            return []
+        out: list[str] = []
+        t = then.timing
+        capture_then = t.light_switch_s + t.settle_s + then.camera.exposure_s + t.readout_s
+        capture_then += t.transfer_s
+        capture_now = self.chooser.capture_s
+        if not np.isclose(capture_then, capture_now, rtol=1e-9, atol=1e-12):
+            out.append(f"time per capture {capture_then:.2f} s → {capture_now:.2f} s: [timing]")
+        if then.arm is not None:
+            settings = _arm_motion_settings(SimpleNamespace(config=then))
+            # as the decision saw it: from the last light, or from the park
+            here = self.chooser.lights[-1] if self.chooser.lights else None
+            now = self._move(here)
+            start = here if here is not None else self._park
+            before = np.array([move_time_s(start, d, settings) for d in self.plan.candidates])
+            if now is not None and not np.allclose(before, now, rtol=1e-9, atol=1e-12):
+                out.append(
+                    f"arm moves, the longest from the last light {before.max():.1f} s → "
+                    f"{now.max():.1f} s: [arm] speed, acceleration or settle time"
+                )
+        return out
 
     def conclude(self) -> dict[str, Any]:
         """The outcome (``AdaptiveChooser.conclude``), computed once: the controller asks for
