@@ -182,6 +182,26 @@ def test_a_resume_on_an_accepted_rig_change_it_cannot_repeat_says_so(
     assert folder_bytes(out) == before
 
 
+def test_a_resume_on_a_rig_with_another_number_of_lights_says_what_to_do(
+    uninterrupted: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """A dome with an LED fewer, accepted with --accept-rig-change: the refusal said only "it
+    cannot continue as it began"; it now says why and what to do, and nothing moved."""
+    cfg, _ = uninterrupted
+    out = tmp_path / "cut"
+    interrupted(cfg, out, after_step=5)
+    before = folder_bytes(out)
+    text = cfg.read_text()
+    assert "count = 4," in text
+    fewer = write_config(tmp_path, text.replace("count = 4,", "count = 3,"), "fewer.toml")
+    r = runner.invoke(app, ["run", str(fewer), "--resume", str(out), "--accept-rig-change"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "the rig now offers 11 candidate lights, the session began with 12" in text
+    assert f"Resume with the session's own config (rti-rig run --resume {out})" in text
+    assert folder_bytes(out) == before
+
+
 @pytest.mark.parametrize("damage", ["deleted", "one byte changed"])
 def test_a_resume_with_an_earlier_image_gone_is_refused_before_the_folder_changes(
     uninterrupted: tuple[Path, Path], tmp_path: Path, damage: str

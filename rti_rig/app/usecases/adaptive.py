@@ -1281,9 +1281,15 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
         ),
     )
     if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
+        # what to do, not only what is wrong (it had ended "it cannot continue as it began",
+        # after a note that the rig change was accepted)
         raise RtiRigError(
             f"{folder.root}: the rig now offers {len(plan.candidates)} candidate lights, the "
-            f"session began with {header['candidates']}: it cannot continue as it began"
+            f"session began with {header['candidates']}: an adaptive session chooses among the "
+            "rig's lights, and a resume re-decides every step already taken among them, so it "
+            "cannot continue as it began. Nothing was recorded or captured. Resume with the "
+            f"session's own config (rti-rig run --resume {folder.root}), or start a new session "
+            "on the changed rig"
         )
     # the stop's factor the session began with (its target means the same to the end)
     source = AdaptiveSteps(
