@@ -765,6 +765,7 @@ def _evidence(
             resid.append(np.zeros(0))
         usable = vflat & ~crop_sat[i].ravel()
         flat_img = img.ravel().astype(np.float64)
+        usable = usable & (flat_img > dark)  # cast shadows: no light reaches them to judge
         sols[i], lit_px = _best_direction(flat_img, bflat, usable, lt[i])
         misfit[i] = relative_misfit(bflat, flat_img, sols[i], lit_px)
     nb_ratio = neighbour_ratio(gain, lt)
