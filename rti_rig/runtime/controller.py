@@ -363,10 +363,12 @@ def run_session(
             with signals_deferred():
                 record = folder.write_step(i, frame, fields)
                 records.append(record)
+                # said inside the hold too: a stop acting before it left the progress bar one
+                # short of the images kept ("4/10", then "5 image(s) in the session")
+                emit(StepCompleted(i, total, record))
             if source is not None:
                 source.observe(i, frame, record)
             layout = layout or got
-            emit(StepCompleted(i, total, record))
         else:
             if source is not None:  # run to its maximum: never asked for the step past it
                 concluded = source.conclude()

@@ -398,11 +398,24 @@ def test_an_emergency_stop_during_an_image_s_commit_leaves_it_listed(
     try:
         rig = small_rig(tmp_path)
         out = tmp_path / "s"
+        completed: list[int] = []
+
+        def on_event(event):  # type: ignore[no-untyped-def]
+            if isinstance(event, StepCompleted):
+                completed.append(event.index)
+
         with pytest.raises(EmergencyStop):
-            run_session(rig, plan_uniform(rig.geometry, 8), SessionFolder.create(out, 8))
+            run_session(
+                rig,
+                plan_uniform(rig.geometry, 8),
+                SessionFolder.create(out, 8),
+                on_event=on_event,
+            )
     finally:
         signal.signal(signal.SIGTERM, previous)
         bystander.set()
+    # the progress shown counts every image kept (it had been one short: "3/8", 4 kept)
+    assert completed == [0, 1, 2, 3]
     runner = manifest(out)["runner"]
     assert runner["finish_reason"] == "emergency-stop"
     assert_images_intact(out, 4)
