@@ -627,11 +627,20 @@ class DomePolicy:
                             if attempt
                             else ""
                         )
-                    if not self._answered and fault in _NOT_ITS_BOARD:
+                    if not self._answered and fault is LinkFault.TIMEOUT:
                         why += (
                             "; nothing on this port has answered yet: check the port, the baud "
                             "rate and the protocol profile in the rig config, and that the "
                             f"board is powered{self._link_hint()}"
+                        )
+                    elif not self._answered and fault in _NOT_ITS_BOARD:
+                        # bytes came back (a banner, another firmware's replies): a board is
+                        # there and talks, which "nothing has answered" had denied
+                        why += (
+                            "; a board on this port sends bytes, but none this rig config's "
+                            "protocol profile understands: check the profile (rti-rig probe "
+                            "PORT names the firmware it finds) and the baud rate"
+                            + self._link_hint()
                         )
                     raise DomeLinkError(
                         self.name,

@@ -243,6 +243,22 @@ def test_a_profile_without_a_handshake_whose_board_never_answers_names_port_baud
     assert "the baud rate and the protocol profile" in text
 
 
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_board_that_talks_another_protocol_is_not_said_to_be_silent(tmp_path: Path) -> None:
+    """The miniRTI profile on a Nab sketch board: the board sends its banner and replies, which
+    the profile cannot read. It had been told "nothing on this port has answered yet", sending
+    the user to the cable and the power supply of a board that was talking."""
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        cfg = _hardware(tmp_path, "emulated_minirti.toml", link.port)
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "nothing on this port has answered" not in text
+    assert "a board on this port sends bytes, but none this rig config's protocol profile" in text
+    assert "rti-rig probe PORT" in text
+
+
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 @pytest.mark.parametrize("profile", list(CONFIG))
 def test_session_of_8_lights_has_the_scheduled_led_lit_at_every_capture(
