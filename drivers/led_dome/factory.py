@@ -14,7 +14,7 @@ from pathlib import Path
 from rti_rig.core.errors import ConfigError
 from rti_rig.drivers.led_dome.driver import LedDomeDriver
 from rti_rig.drivers.led_dome.profiles import make_codec
-from rti_rig.drivers.led_dome.protocol_spec import ProtocolSpec, parse_led_map
+from rti_rig.drivers.led_dome.protocol_spec import MissingSection, ProtocolSpec, parse_led_map
 from rti_rig.drivers.led_dome.scripted import ScriptedDomeDriver
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.drivers.led_dome.transport import SerialTransport, Transport
@@ -34,6 +34,8 @@ def protocol_for(settings: DomeSerialSettings) -> ProtocolSpec:
         try:
             led_map = parse_led_map(text, settings.led_map_section, str(path))
             return settings.protocol_spec(led_map)
+        except MissingSection:
+            raise  # the rig config's led_map_section is at fault: its loader names that key
         except ValueError as exc:
             raise ConfigError(str(path), "dome.serial.led_map_file", str(exc)) from None
     return settings.protocol_spec()

@@ -268,6 +268,11 @@ class ProtocolSpec(_Strict):
         return re.compile(render_pattern(pattern, v))
 
 
+class MissingSection(ValueError):
+    """The map file is fine but has no section of the name asked for: the fault is in the rig
+    config's ``led_map_section``, not in the file (a typo there had been named as the file's)."""
+
+
 def parse_led_map(text: str, section: str | None, source: str) -> tuple[tuple[int, ...], ...]:
     """LED rows from an rtiacquire-style map file: ``** name **`` sections of hex triples.
 
@@ -301,5 +306,5 @@ def parse_led_map(text: str, section: str | None, source: str) -> tuple[tuple[in
         raise ValueError(f"{source}: no '** name **' section")
     name = section or next(iter(maps))
     if name not in maps:
-        raise ValueError(f"{source}: no section '{name}' (sections: {', '.join(maps)})")
+        raise MissingSection(f"{source} has no section '{name}' (sections: {', '.join(maps)})")
     return tuple(maps[name])

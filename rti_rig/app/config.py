@@ -647,8 +647,12 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     serial_cfg = config.dome.serial if config.dome is not None else None
     if serial_cfg is not None and serial_cfg.led_map_file is not None:  # refuse a bad map now
         from rti_rig.drivers.led_dome.factory import protocol_for
+        from rti_rig.drivers.led_dome.protocol_spec import MissingSection
 
-        protocol_for(serial_cfg)
+        try:
+            protocol_for(serial_cfg)
+        except MissingSection as exc:  # the config's section name, not the map file, is wrong
+            raise ConfigError(path, "dome.serial.led_map_section", str(exc)) from None
     loaded = LoadedRig(
         config=config,
         path=str(path.resolve()),

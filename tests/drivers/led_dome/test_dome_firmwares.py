@@ -618,6 +618,18 @@ def test_a_bad_led_map_file_is_refused_at_load_naming_file_and_line(tmp_path: Pa
     assert "maps.txt:2" in said(r) and "led_map_file" in said(r)
 
 
+def test_a_misspelt_led_map_section_is_named_as_the_config_key(tmp_path: Path) -> None:
+    """A section name the map file lacks was refused under led_map_file, as if the file were
+    wrong; the fault is the rig config's led_map_section."""
+    data = Path(__file__).resolve().parents[2] / "data" / "domes" / "led-maps.txt"
+    cfg = elexol_with_map(tmp_path, data.read_text(), section="Dome mian")
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 2
+    text = said(r)
+    assert "rig.toml" in text and "dome.serial.led_map_section" in text
+    assert "no section 'Dome mian'" in text and "Dome main" in text
+
+
 def test_more_leds_than_the_elexol_map_has_rows_says_what_to_do(tmp_path: Path) -> None:
     """30 LEDs on the default map (24 outputs, one LED each) had been refused with only "the LED
     map has 24 rows for led_count = 30"."""
