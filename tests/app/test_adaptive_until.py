@@ -284,3 +284,16 @@ def test_the_stops_reason_and_the_final_line_print_one_upper_estimate_alike() ->
     shown = re.search(r"upper estimate ([\d.]+)°", line)
     assert shown is not None and f"upper estimate {shown.group(1)}°" in reason
     assert f"estimate {fake.stop_terms(est)['estimated_error_deg']:.2f}°" in reason
+
+
+def test_a_relight_session_s_upper_estimate_is_not_tied_to_until_error() -> None:
+    """A relight session's last line said "(×1.95: what --until-error would be compared with)",
+    though --until-error is refused with --objective relight."""
+    from rti_rig.app.usecases.adaptive import estimate_phrase
+
+    terms = {"estimated_error_deg": 2.0, "upper_error_deg": 3.9, "upper_factor": 1.95}
+    assert estimate_phrase({**terms, "objective": "relight"}).endswith("3.90° (×1.95)")
+    normals = estimate_phrase({**terms, "objective": "normals"})
+    assert normals.endswith("what --until-error would be compared with)")
+    until = estimate_phrase({**terms, "until_error_deg": 4.0})
+    assert until.endswith("what --until-error is compared with)")

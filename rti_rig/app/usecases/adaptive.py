@@ -941,12 +941,13 @@ def estimate_phrase(result: dict[str, Any]) -> str:
     text = f"estimated mean normal error {est:.2f}°"
     if up is not None:
         factor = result.get("upper_factor", up / est if est else 0)
-        role = (
-            "what --until-error is compared with"
-            if result.get("until_error_deg") is not None
-            else "what --until-error would be compared with"
-        )
-        text += f", upper estimate {up:.2f}° (×{factor:g}: {role})"
+        if result.get("until_error_deg") is not None:
+            role = ": what --until-error is compared with"
+        elif result.get("objective", "normals") == "normals":
+            role = ": what --until-error would be compared with"
+        else:  # --until-error goes with normals only: a relight session is never compared
+            role = ""
+        text += f", upper estimate {up:.2f}° (×{factor:g}{role})"
     return text
 
 
