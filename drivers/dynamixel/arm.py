@@ -250,8 +250,8 @@ class DynamixelArm:
         first (``ArmLighting.safe``), after an emergency stop or a failed self-test it must not
         (the arm may be stopped against an obstruction). So ``close`` never parks; call
         ``park()`` before it when that is wanted. Safe to call twice and after a failed
-        ``connect``. Errors during teardown are logged and the first one is re-raised after the
-        port has been closed."""
+        ``connect``. The first error during teardown is re-raised after the port has been
+        closed; any later one is logged."""
         if not self._connected:
             self._bus.close()
             return
@@ -263,8 +263,10 @@ class DynamixelArm:
             try:
                 step()
             except Exception as exc:  # keep tearing down
-                log.error("%s: teardown step failed: %s", self.name, exc)
-                first = first or exc
+                if first is None:
+                    first = exc  # raised below, and said by whoever called close
+                else:  # only logged: said once, not a second time beside the raised one
+                    log.error("%s: teardown step failed: %s", self.name, exc)
         self._connected = False
         self._bus.close()
         if first is not None:

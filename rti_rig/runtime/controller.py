@@ -259,6 +259,19 @@ def _refuse_other_layout(
     )
 
 
+def _teardown_failure(label: str, exc: Exception, earlier: list[str]) -> str:
+    """``label: what failed``, or a pointer to the earlier failure it repeats word for word.
+
+    Why: a device's ``close`` retries its own safe state (an arm stops again), so one servo
+    fault was printed in full for the stop and again for the close, a paragraph each."""
+    text = str(exc)
+    for failure in earlier:
+        first, _, said = failure.partition(": ")
+        if said == text:
+            return f"{label}: failed as '{first}' above"
+    return f"{label}: {text}"
+
+
 def run_session(
     rig: Rig,
     schedule: LightSchedule,
@@ -403,7 +416,7 @@ def run_session(
                 try:
                     close()
                 except Exception as exc:  # keep tearing down whatever fails
-                    teardown.append(f"{label}: {exc}")
+                    teardown.append(_teardown_failure(label, exc, teardown))
             rig_time = clock.now() - rig_t0
             wall_time = time.perf_counter() - wall_t0
             try:

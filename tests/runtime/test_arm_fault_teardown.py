@@ -75,6 +75,9 @@ def test_an_arm_fault_mid_move_is_not_followed_by_a_park(tmp_path: Path) -> None
     runner = json.loads((out / "manifest.json").read_text())["runner"]
     said = [f for f in runner["teardown_failures"] if f.startswith("park:")]
     assert len(said) == 1 and "not attempted" in said[0] and "own move failed" in said[0]
+    # the close's retry of the stop failed alike: pointed to, not a second paragraph of it
+    assert "light close: failed as 'stop' above" in runner["teardown_failures"]
+    assert sum("Hardware Error Status" in f for f in runner["teardown_failures"]) == 1
 
 
 def test_a_session_failed_by_the_camera_still_parks_the_arm(tmp_path: Path) -> None:
