@@ -80,6 +80,12 @@ MIN_DIRECTION_IMAGES = 5
 MAX_ROUNDS = 4
 #: An image below this gain at its bright end had no light at all (a black frame).
 NO_LIGHT_GAIN = 0.1
+#: An acquisition whose every image keeps its brightest pixels (99th percentile) below this
+#: fraction of full scale had no light: the gain above is judged against the other images,
+#: and one black throughout (a lens cap, lights that never fired) had been called "good". Not
+#: judged image by image: metered for a glossy coin's glint, the emulated dome's low lights
+#: reach only 0.13-0.15 % of full scale, lit as they should be.
+NO_SIGNAL_FRACTION = 0.002
 #: A light is dim too when its image's median gain is at most this fraction of the median
 #: gain of its :data:`NEIGHBOUR_COUNT` nearest lights' images: the Lambertian prediction
 #: misjudges a glossy object's brightness light by light (bright-end gains of 0.8-5.4 on the
@@ -432,6 +438,14 @@ def assess(
         del a, g, m
     small = np.stack(small_list)
     small_sat = np.stack(small_sat_list)
+    peak = (
+        np.percentile(small.reshape(n, -1), 99.0, axis=1) / saturation
+        if np.isfinite(saturation) and saturation > 0
+        else np.full(n, np.nan)  # float data: no full scale to measure against
+    )
+    # one black image among lit ones is judged against the others (its gain); when all are,
+    # there is nothing to judge against, and the acquisition is black throughout
+    all_black = bool(np.all(peak < NO_SIGNAL_FRACTION))
     ref = float(np.percentile(small, 99.0)) or 1.0
     dark = DARK_FRACTION * ref
     dark_frac = (small < dark).mean(axis=(1, 2))
@@ -586,6 +600,13 @@ def assess(
             np.isfinite(ev.gain[i]) and ev.gain[i] > BRIGHT_GAIN and sat_frac[i] <= SATURATED_LIMIT
         ):
             problems.append(f"{ev.gain[i]:.1f}× {BRIGHTER}")
+        if all_black and not any(p.startswith("misfired") for p in problems):
+            problems = [p for p in problems if not p.endswith(BRIGHTER)]  # of nothing
+            problems.append(
+                f"misfired, no light: its brightest pixels reach {peak[i]:.2%} of full scale, "
+                "as every image's do (a lens cap, lights that never fired, or an exposure far "
+                "too short)"
+            )
         if ev.moved[i]:
             dx, dy = ev.drift[i]
             problems.append(

@@ -1,0 +1,33 @@
+"""An acquisition black throughout is not "good".
+
+Every image black (a lens cap left on, lights that never fired) had been called "QA verdict:
+good", with only "brightness not judged … (too few pixels lit)": each image's brightness is
+judged against what the other images predict, and black against black predicts black.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp, write_lp
+
+REPO = Path(__file__).resolve().parents[2]
+ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+
+
+def test_a_black_acquisition_is_called_so(tmp_path: Path) -> None:
+    entries = read_lp(ACQ)
+    for e in entries:
+        cv2.imwrite(str(tmp_path / e.name), np.zeros((64, 64, 3), np.uint8))
+    lp = tmp_path / "dirs.lp"
+    write_lp(lp, entries)
+    r = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-ptm"])
+    said = " ".join(r.output.split())
+    assert "QA verdict: good" not in said, said
+    assert said.count("misfired, no light") == len(entries)
+    assert "as every image's do (a lens cap, lights that never fired" in said
