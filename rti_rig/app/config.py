@@ -707,7 +707,35 @@ def load_rig_config(path: Path | str) -> LoadedRig:
                 "'dome_shutter' needs a dome (its camera-release line fires the camera); on an "
                 "arm rig let the camera fire itself (trigger = 'none')",
             )
+        note = _untriggered_wait_note(loaded, cam)
+        if note:
+            loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
     return loaded
+
+
+def _untriggered_wait_note(rig: LoadedRig, cam: Any) -> str:
+    """Said when a dome's LED may have to stay lit longer than it is allowed while a camera
+    fired by someone else is awaited ("" otherwise).
+
+    With ``trigger = 'none'`` nothing tells rti-rig when the camera fires, so the LED stays on
+    until the file comes (with ``'dome_shutter'`` it goes off after the exposure). A file later
+    than ``max_on_s`` then stops the session at the thermal limit, with advice about settle and
+    exposure that does not name the wait.
+    """
+    serial = rig.config.dome.serial if rig.config.dome is not None else None
+    if serial is None or getattr(cam, "kind", None) != "folder_watch" or cam.trigger != "none":
+        return ""
+    lit_for = serial.thermal.max_on_s - rig.config.timing.settle_s
+    if cam.timeout_s <= lit_for:
+        return ""
+    return (
+        f"{rig.path}: camera.device.timeout_s = {cam.timeout_s:g} s is longer than an LED may "
+        f"stay lit ([dome.serial.thermal] max_on_s = {serial.thermal.max_on_s:g} s, less "
+        f"settle_s): with trigger = 'none' the LED stays on until the file comes, so a file "
+        f"later than {lit_for:g} s stops the session at the thermal limit. Lower timeout_s, or "
+        "let the dome fire the camera (trigger = 'dome_shutter': its LED goes off after the "
+        "exposure, and the file may take timeout_s)"
+    )
 
 
 def _layout_said(dome: DomeConfig, count: int) -> str:

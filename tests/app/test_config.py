@@ -179,3 +179,27 @@ def test_a_camera_setting_given_as_a_number_says_how_to_write_it(tmp_path: Path)
         camera_device_settings(load_rig_config(path))
     assert info.value.key == "camera.device.iso"
     assert 'got 100: write it in quotes, "100"' in info.value.message
+
+
+@pytest.mark.parametrize(
+    ("trigger", "timeout", "said"),
+    [("none", 15.0, True), ("none", 7.0, False), ("dome_shutter", 15.0, False)],
+)
+def test_a_camera_awaited_longer_than_an_led_may_stay_lit_is_noted(
+    tmp_path: Path, trigger: str, timeout: float, said: bool
+) -> None:
+    """With trigger = 'none' the LED stays lit until the file comes: a timeout_s beyond
+    max_on_s let a late file stop the session at the thermal limit, with advice about settle
+    and exposure only. Now the config says so when it is loaded (shown by run)."""
+    import shutil
+
+    shutil.copy(REPO / "rig_configs" / "example_dome_48.lp", tmp_path / "example_dome_48.lp")
+    text = (REPO / "rig_configs" / "example_dome_48_folder_watch.toml").read_text()
+    assert 'trigger = "dome_shutter"' in text and "timeout_s = 15.0" in text
+    text = text.replace('trigger = "dome_shutter"', f'trigger = "{trigger}"')
+    cfg = tmp_path / "fw.toml"
+    cfg.write_text(text.replace("timeout_s = 15.0", f"timeout_s = {timeout}"))
+    notes = " ".join(load_rig_config(cfg).notes)
+    assert ("stops the session at the thermal limit" in notes) is said
+    if said:
+        assert "camera.device.timeout_s = 15 s" in notes and "max_on_s = 8 s" in notes
