@@ -456,3 +456,39 @@ def test_an_acquisition_repeating_a_light_is_refused_in_a_replays_words(tmp_path
     assert "lights 1 (image01.jpg) and 19 (image01b.jpg) share one direction" in said, said
     assert "remove one of the two lines" in said and "dome.lp_file" not in said
     assert not (tmp_path / "s").exists()
+
+
+def test_a_resume_on_an_acquisition_whose_images_changed_is_refused(tmp_path: Path) -> None:
+    """An image of the replayed acquisition replaced between the interruption and the resume
+    had been mixed in without a word: the resume's images came from another acquisition than
+    the first part's. Refused, nothing changed; with the original put back it continues."""
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        open_new_session,
+        run_opened_session,
+    )
+    from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+
+    acq = tmp_path / "acq"
+    shutil.copytree(ACQ, acq)
+    out = tmp_path / "s"
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 2:
+            cancel.cancel()
+
+    opened = open_new_session(NewSessionRequest(acq / "dirs.lp", out, lights=8))
+    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    before = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
+    last = read_lp(acq / "dirs.lp")[-1].name
+    shutil.copy(acq / read_lp(acq / "dirs.lp")[0].name, acq / last)  # an image replaced
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert "are not the ones this session began with" in said and "Put the original" in said
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before
+    shutil.copy(ACQ / last, acq / last)  # put back
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(out / "lights.lp")) == 8

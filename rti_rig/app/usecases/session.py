@@ -644,6 +644,15 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         {k: recorded[k] for k in IMAGE_KEYS if k in recorded},
         {k: identity.get(k) for k in IMAGE_KEYS if k in recorded},
     )
+    if image_diffs == ["recorded images: changed"]:
+        # a replayed acquisition is a rig whose camera returns its files: they are its images
+        raise RigChangedError(
+            f"the images of {config_path} are not the ones this session began with (one was "
+            "edited, replaced or re-exported since): the session's first images and the ones "
+            "a resume would take would come from two different acquisitions. Put the original "
+            f"files back to continue (rti-rig run --resume {shlex.quote(str(session_dir))}), "
+            "or start a new session from the acquisition as it is now"
+        )
     if recorded.get("kind") == identity.get("kind") and image_diffs:
         # accepted, a new exposure had gone into the fit as a brighter light: normals 5.5° off
         # on average, with a "good" verdict; nothing downstream corrects for it
