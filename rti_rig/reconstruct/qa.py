@@ -11,7 +11,8 @@ Run before the object leaves the dome. The checks (all on linear images):
 
   - **gain** ``image / prediction``; its :data:`DIM_PERCENTILE` percentile below
     :data:`DIM_GAIN` means a misfired or dim light, below :data:`NO_LIGHT_GAIN` no light (a
-    black frame); shadows lower the median, not the bright end;
+    black frame); shadows lower the median, not the bright end; a dark image is not judged
+    where its light is at or below the object's mean surface (its relief's own shadows);
   - **best direction**: the light direction that explains the image best (least squares of the
     image on ``rho n`` over its lit pixels). Far from the recorded direction means a wrong
     light (a swapped entry of the ``.lp``, a wrong LED); the report names the recorded light
@@ -171,6 +172,10 @@ class ImageCheck:
     #: this image's gain lies within that scatter (:data:`LIGHT_SCATTER_Z`), its image a
     #: rendering: its light's own output, not the image, can explain its brightness.
     within_light_scatter: bool = False
+    #: True when its light lies at or below the object's mean surface (the crop's mean fitted
+    #: normal) and its image was dark where the fit said it would be lit: the object's own
+    #: relief can shadow all it reaches, so its brightness is not judged (``gain_judged``).
+    dark_below_surface: bool = False
 
 
 #: The saturation check's advice (replaced where a session cannot follow it).
@@ -224,9 +229,9 @@ class QAReport:
         for label, attr in (("shift", "drift_judged"), ("brightness", "gain_judged")):
             if attr == "drift_judged" and self.drift_note:
                 continue
-            skipped = [
-                c.name for c in self.images if not getattr(c, attr) and c.index not in flagged
-            ]
+            unjudged = [c for c in self.images if not getattr(c, attr) and c.index not in flagged]
+            below = [c.name for c in unjudged if attr == "gain_judged" and c.dark_below_surface]
+            skipped = [c.name for c in unjudged if c.name not in below]
             if skipped:
                 why = (
                     f"its light reaches less than {DRIFT_MIN_LIT:.0%} of the object"
@@ -234,6 +239,12 @@ class QAReport:
                     else "too few pixels lit"
                 )
                 out.append(f"{label} not judged on {_names(skipped)} ({why})")
+            if below:
+                out.append(
+                    f"{label} not judged on {_names(below)} (dark, but its light is at or below "
+                    "the object's mean surface, where the object's own relief can shadow all it "
+                    "reaches: a misfire cannot be told from that; check the LED fired)"
+                )
         return out
 
     @property
@@ -632,6 +643,7 @@ def assess(
                 neighbour_gain_ratio=float(ev.neighbour_ratio[i]),
                 misfit=float(ev.misfit[i]),
                 within_light_scatter=bool(within_scatter[i]),
+                dark_below_surface=bool(ev.dark_below_surface[i]),
             )
         )
     flagged = {c.index for c in checks if c.problems}
@@ -717,6 +729,8 @@ class _Evidence:
     most_disagree: bool = False
     #: Median gain over its nearest lights' (NaN where not compared): :func:`neighbour_ratio`.
     neighbour_ratio: NDArray = field(default_factory=lambda: np.zeros(0))
+    #: Dark images whose light lies at or below the object's mean surface: not judged dim.
+    dark_below_surface: NDArray = field(default_factory=lambda: np.zeros(0, bool))
 
 
 def _evidence(
@@ -789,7 +803,17 @@ def _evidence(
         usable = usable & (flat_img > dark)  # cast shadows: no light reaches them to judge
         sols[i], lit_px = _best_direction(flat_img, bflat, usable, lt[i])
         misfit[i] = relative_misfit(bflat, flat_img, sols[i], lit_px)
+    # A light at or below the object's mean surface reaches only slopes turned towards it on
+    # a surface turned away, past that surface's own horizon: its cast shadows, which the fit
+    # does not model, can black every pixel it reaches. There a dark image is no evidence of
+    # a misfire (a bright one is still evidence it fired): its brightness is not judged.
+    mean_n = ps.normals[valid].astype(np.float64).mean(axis=0) if valid.any() else np.zeros(3)
+    below = (lt @ mean_n) <= 0.0 if np.any(mean_n) else np.zeros(n, bool)
+    unjudged = below & np.isfinite(lit_gain) & (lit_gain < DIM_GAIN)
+    gain[unjudged] = lit_gain[unjudged] = np.nan
     nb_ratio = neighbour_ratio(gain, lt)
+    nb_dark = below & np.isfinite(nb_ratio) & (nb_ratio <= NEIGHBOUR_DIM_RATIO)
+    gain[nb_dark] = lit_gain[nb_dark] = nb_ratio[nb_dark] = np.nan
     dim = (np.isfinite(lit_gain) & (lit_gain < DIM_GAIN)) | (
         np.isfinite(nb_ratio) & (nb_ratio <= NEIGHBOUR_DIM_RATIO)
     )
@@ -902,6 +926,7 @@ def _evidence(
         misfit,
         most_disagree,
         nb_ratio,
+        unjudged | nb_dark,
     )
 
 

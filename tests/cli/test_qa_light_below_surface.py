@@ -1,0 +1,65 @@
+"""A light below the object's mean surface leaves a dark image that is no misfire.
+
+On the virtual arm's tilted relief (256 px, 12 lights between 5° and 20° elevation, every one
+fired where it was recorded) the verdict said "reshoot: image_004 (misfired, no light: 0% of
+the brightness …)": that light sits below the plane the relief is carved in, the fit predicts
+it on a few slopes turned towards it (0.4 % of the object), and the plane's own horizon
+shadows them all. The dark image is now left unjudged, and said so; a real misfire of a light
+above the surface is still named.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
+
+runner = CliRunner()
+
+
+@pytest.mark.slow  # a 12-light session and a refit of it
+def test_a_light_below_the_tilted_surface_is_not_called_misfired(tmp_path: Path) -> None:
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    assert "width = 512\nheight = 512" in text and 'name = "relief"' in text
+    text = text.replace("width = 512\nheight = 512", "width = 256\nheight = 256")
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace('name = "relief"', 'name = "tilted"'))
+    session = tmp_path / "s"
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(cfg),
+            "--out",
+            str(session),
+            "--lights",
+            "12",
+            "--min-elevation-deg",
+            "5",
+            "--max-elevation-deg",
+            "20",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
+    assert "QA verdict: good" in said, said
+    assert "misfired" not in said, said
+    # the check not made is said, with why and what to do
+    assert "brightness not judged on image_004 (dark, but its light is at or below" in said
+    assert "check the LED fired" in said
+
+    # a real misfire of a light above the surface (image_001 lights the whole plane) is named
+    tif = session / "linear" / "image_001.tif"
+    black = np.full_like(read_linear_tiff(tif), 2)
+    tif.unlink()
+    write_linear_tiff(tif, black)
+    r = runner.invoke(app, ["fit", str(session), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    said = " ".join(r.output.split())
+    assert "reshoot: image_001 (misfired, no light" in said, said
