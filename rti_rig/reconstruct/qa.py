@@ -64,7 +64,9 @@ SATURATED_LIMIT = 0.01
 DARK_FRACTION = 0.02
 #: An image darker than its prediction by this factor (median ratio) is dim or misfired.
 DIM_GAIN = 0.6
-#: An image brighter than its prediction by this factor is flagged (wrong light or exposure).
+#: An image brighter than its prediction by this factor is flagged (wrong light or exposure),
+#: where it is within :data:`~rti_rig.reconstruct.qa_directions.MISFIT_LIMIT` of a Lambertian
+#: rendering: a glossy object's highlights are brighter than any with its light right.
 BRIGHT_GAIN = 1.6
 #: A best direction further than this from the recorded one (degrees) is a wrong light.
 WRONG_LIGHT_DEG = 8.0
@@ -245,6 +247,19 @@ class QAReport:
                     "the object's mean surface, where the object's own relief can shadow all it "
                     "reaches: a misfire cannot be told from that; check the LED fired)"
                 )
+        glossy = [
+            c.name
+            for c in self.images
+            if _bright(c.gain, c.saturated_fraction)
+            and not c.misfit <= MISFIT_LIMIT
+            and c.index not in flagged
+        ]
+        if glossy:
+            out.append(
+                f"brighter than predicted, not judged on {_names(glossy)}: further than "
+                f"{MISFIT_LIMIT:.0%} from any Lambertian rendering of the fit (gloss), whose "
+                "highlights are brighter than the prediction with a right light and exposure"
+            )
         return out
 
     @property
@@ -318,6 +333,12 @@ class QAReport:
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
+
+
+def _bright(gain: float, saturated_fraction: float) -> bool:
+    """Brighter than predicted by more than :data:`BRIGHT_GAIN`, and not clipped beyond
+    :data:`SATURATED_LIMIT` (the saturation check names that)."""
+    return bool(np.isfinite(gain) and gain > BRIGHT_GAIN and saturated_fraction <= SATURATED_LIMIT)
 
 
 def _names(names: list[str]) -> str:
@@ -607,9 +628,10 @@ def assess(
                 f"(the images that agree do to a median {ev.typical:.1f}°), closest to the "
                 f"light recorded for {names[int(ev.near[i])]} (swapped?)"
             )
-        elif (
-            np.isfinite(ev.gain[i]) and ev.gain[i] > BRIGHT_GAIN and sat_frac[i] <= SATURATED_LIMIT
-        ):
+        elif _bright(float(ev.gain[i]), float(sat_frac[i])) and ev.misfit[i] <= MISFIT_LIMIT:
+            # brighter than the Lambertian prediction is a fault (a stray flash, an exposure)
+            # only where the image is a rendering at all: a glossy object's highlight makes it
+            # brighter with its light and exposure right (said in the caveats instead)
             problems.append(f"{ev.gain[i]:.1f}× {BRIGHTER}")
         if all_black and not any(p.startswith("misfired") for p in problems):
             problems = [p for p in problems if not p.endswith(BRIGHTER)]  # of nothing
