@@ -93,6 +93,72 @@ def test_a_worker_that_cannot_read_the_images_exits_2_naming_the_cluster(
     assert "same paths" in r.output and "Traceback" not in r.output
 
 
+def _scheduler_gone(*args, **kwargs):
+    """What a task's result raises on the client once the scheduler has gone away: Dask
+    cancels every future of the client (``FutureCancelledError``, reason
+    ``scheduler-connection-lost``), not an ``OSError``."""
+    from distributed.client import FutureCancelledError
+
+    raise FutureCancelledError("task", "scheduler-connection-lost", "Client lost the connection.")
+
+
+def test_a_lost_scheduler_mid_fit_is_said_so(tmp_path: Path, monkeypatch) -> None:
+    """It had said "a band of the fit failed … Check the workers' logs (memory limit?)"."""
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    monkeypatch.setattr(fit_dask, "fit_band_recording", _scheduler_gone)
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        r = runner.invoke(
+            app, ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
+        )
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert f"lost the Dask scheduler at '{address}' while fitting" in said, said
+    assert "memory limit" not in said and "run the same command" in said
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_lost_scheduler_mid_batch_keeps_and_names_the_finished_sessions(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """A session can finish on its worker while the client waits for another's result; Dask
+    then cancels its future with the rest. Every session had been reported "failed on the Dask
+    cluster: FutureCancelledError", the finished one too, and no word of resuming."""
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    for name in ("s1", "s2"):
+        make_session(tmp_path / name, size=(24, 32))
+    real = fit_dask.fit_one
+
+    def finishes_then_loses_the_scheduler(source, root, template, bands=None):  # type: ignore[no-untyped-def]
+        if source.name == "s1":
+            real(source, root, template)
+        _scheduler_gone()
+
+    monkeypatch.setattr(fit_dask, "fit_one", finishes_then_loses_the_scheduler)
+    out = tmp_path / "o"
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        args = ["fit", str(tmp_path / "s1"), str(tmp_path / "s2"), "--out", str(out)]
+        r = runner.invoke(app, [*args, "--no-qa", "--scheduler", address])
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert f"lost the Dask scheduler at '{address}' during the batch" in said, said
+    assert f"1 of 2 sessions are finished in {out.resolve()} ({tmp_path / 's1'})" in said
+    assert "run the same command" in said and "s1: failed" not in said
+    assert (out / "s1" / "fit.json").exists() and not (out / "s2").exists()
+
+
 def _cli(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [*RTI_RIG, *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=900

@@ -24,6 +24,7 @@ Dask is imported only here, and this module only when ``--scheduler`` is given.
 
 from __future__ import annotations
 
+import logging
 import os
 import socket
 import threading
@@ -64,6 +65,10 @@ CONNECT_TIMEOUT_S = 20.0
 WORKERS_TIMEOUT_S = 60.0
 #: Bands in flight per worker thread (bounds the results waiting to be written).
 BANDS_IN_FLIGHT_PER_THREAD = 2
+
+#: The reason Dask gives the futures it cancels when the client loses the scheduler
+#: (``FutureCancelledError.reason``): a lost scheduler surfaces so, not as an ``OSError``.
+SCHEDULER_LOST = "scheduler-connection-lost"
 
 SHARED_PATHS = (
     "every Dask worker must see the session's files at the same paths as this machine "
@@ -116,7 +121,30 @@ def scheduler_client(address: str) -> Iterator[Any]:
             ) from None
         yield client
     finally:
+        _close_quietly(client)
+
+
+def _close_quietly(client: Any) -> None:
+    """Close ``client`` without Dask's log lines reaching the user.
+
+    Why: closing a client that has lost its scheduler cancels its reconnection attempt, which
+    Dask logs as an ERROR with a full traceback (``CancelledError`` in ``_reconnect``) on
+    stderr, after the error this command reports in its own words."""
+    from distributed.utils import silence_logging_cmgr
+
+    with silence_logging_cmgr(logging.CRITICAL):
         client.close()
+
+
+def scheduler_lost(client: Any, exc: BaseException) -> bool:
+    """Whether ``exc``, raised by a future's result, means the scheduler went away: Dask then
+    cancels every future of the client (even finished ones whose result was not fetched yet)
+    with the reason :data:`SCHEDULER_LOST`; an ``OSError`` may come from a connection cut
+    mid-transfer. A lost scheduler had been reported as a failed band ("check the workers'
+    logs (memory limit?)"), and in a batch as every session failed, finished ones too."""
+    if isinstance(exc, OSError) or getattr(exc, "reason", None) == SCHEDULER_LOST:
+        return True
+    return str(getattr(client, "status", "running")) in ("connecting", "closing", "closed")
 
 
 def dask_bands(client: Any, address: str, source: Path) -> BandRunner:
@@ -204,13 +232,16 @@ def _on_cluster(
                     f"a worker of the Dask cluster at {address!r} could not read the images: "
                     f"{exc}. Note: {SHARED_PATHS}."
                 ) from None
-            except OSError as exc:  # the scheduler went away mid-fit
-                raise SchedulerError(
-                    f"lost the Dask scheduler at {address!r} while fitting: {exc}"
-                ) from None
             except RtiRigError:
                 raise  # a named error of the fit itself, raised on the worker
             except Exception as exc:  # e.g. KilledWorker: a worker died on this band
+                if scheduler_lost(client, exc):
+                    raise SchedulerError(
+                        f"lost the Dask scheduler at {address!r} while fitting (it stopped or "
+                        "the network to it failed); nothing of this fit was kept in --out: "
+                        "start the scheduler again (`dask scheduler`, workers with `dask "
+                        f"worker {address}`) and run the same command"
+                    ) from None
                 raise SchedulerError(
                     f"a band of the fit failed on the Dask cluster at {address!r}: "
                     f"{type(exc).__name__}: {exc}. Check the workers' logs (memory limit?) and "
@@ -255,6 +286,27 @@ def _fit_one_task(source: Path, root: Path, template: FitRequest, threads: int |
         return fit_one(source, root, template)
 
 
+def _batch_lost(
+    scheduler: str, sources: list[Path], given: dict[Path, Path], root: Path
+) -> SchedulerError:
+    """The error of a batch whose scheduler went away: which sessions are finished in
+    ``root`` (a session can finish on its worker while the client waits for another's result,
+    so it is told by its folder, not by its future, which Dask cancels with the rest)."""
+    finished = [given[s] for s in sources if batch_out_dir(root, s).exists()]
+    kept = (
+        f"{len(finished)} of {len(sources)} sessions are finished in {root} "
+        f"({', '.join(map(str, finished))}) and are kept"
+        if finished
+        else f"no session is finished in {root} yet"
+    )
+    return SchedulerError(
+        f"lost the Dask scheduler at {scheduler!r} during the batch (it stopped or the network "
+        f"to it failed): {kept}. Start the scheduler again (`dask scheduler`, workers with "
+        f"`dask worker {scheduler}`) and run the same command to fit the rest: finished "
+        "sessions are skipped, partial ones redone"
+    )
+
+
 def run_batch_dask(
     sources: list[Path], root: Path, template: FitRequest, scheduler: str = THREADS
 ) -> list[BatchItem]:
@@ -280,12 +332,9 @@ def run_batch_dask(
                 continue
             try:
                 items.append(futures[s].result())
-            except OSError as exc:
-                raise SchedulerError(
-                    f"lost the Dask scheduler at {scheduler!r} during the batch: {exc}; "
-                    "rerun the same command to resume (finished sessions are kept)"
-                ) from None
             except Exception as exc:  # e.g. KilledWorker: this session failed, the batch goes on
+                if scheduler_lost(client, exc):
+                    raise _batch_lost(scheduler, sources, given, root) from None
                 status = f"failed on the Dask cluster: {type(exc).__name__}: {exc}"
                 items.append(BatchItem(s, batch_out_dir(root, s), status))
         return [replace(item, source=given[item.source]) for item in items]
