@@ -85,13 +85,27 @@ def _stoppable() -> Iterator[None]:
         signal.signal(signal.SIGTERM, previous)
 
 
-def _stopped(why: str, out_dir: Path, batch: bool, written: bool) -> typer.Exit:
+def _stopped(
+    why: str, out_dir: Path, batch: bool, written: bool, cluster: bool = False
+) -> typer.Exit:
     """Say what a stopped fit left (``written``: the stop came after every output was
-    written, while they were being reported), and the exit a shell expects for that signal."""
+    written, while they were being reported; ``cluster``: a batch whose sessions are tasks on
+    Dask workers), and the exit a shell expects for that signal."""
     from rti_rig.cli.app import stop_exit_code
 
     if written:
         said = f"Stopped ({why}) after the fit had written its outputs to {out_dir}"
+    elif batch and cluster:
+        # Dask cannot interrupt a task a worker is running: a session already started goes on
+        # there and is renamed into place when it finishes. "The one being fitted was
+        # discarded" had been said, and the sessions appeared in --out minutes later.
+        said = (
+            f"Stopped ({why}): the sessions finished are kept in {out_dir}; those already "
+            "running on the Dask workers cannot be stopped from here and go on there, each "
+            f"appearing in {out_dir} when it finishes (the ones not yet started were "
+            "cancelled); run the same command again to fit the rest (finished ones are "
+            "skipped)"
+        )
     elif batch:
         said = (
             f"Stopped ({why}): the sessions finished are kept in {out_dir}, the one being "
@@ -170,6 +184,7 @@ def fit(
     use_one_heap()
 
     written: list[bool] = []  # set once every output is written (what a stop then says)
+    cluster = scheduler not in (None, "threads")  # the fit_dask.THREADS value, not imported
     try:
         with _stoppable():
             _fit_command(
@@ -186,9 +201,9 @@ def fit(
                 scheduler,
             )
     except KeyboardInterrupt:
-        raise _stopped("Ctrl-C", out_dir, len(sources) > 1, bool(written)) from None
+        raise _stopped("Ctrl-C", out_dir, len(sources) > 1, bool(written), cluster) from None
     except FitStopped:
-        raise _stopped("SIGTERM", out_dir, len(sources) > 1, bool(written)) from None
+        raise _stopped("SIGTERM", out_dir, len(sources) > 1, bool(written), cluster) from None
 
 
 def _fit_command(  # type: ignore[no-untyped-def]

@@ -101,3 +101,44 @@ def test_a_stopped_batch_keeps_the_sessions_it_finished(
     assert r.exit_code == 143, r.output
     assert "Stopped (SIGTERM): the sessions finished are kept in" in said(r)
     assert sorted(p.name for p in root.iterdir()) == ["a-dirs"]  # no partial folder left
+
+
+def test_a_stopped_cluster_batch_does_not_claim_its_running_sessions_discarded(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On a Dask cluster a session already running on a worker is not stopped by the client's
+    SIGTERM (Dask does not interrupt a running task): it goes on and is renamed into place.
+    "The one being fitted was discarded" had been said, and the session appeared later."""
+    import time
+
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    a = tmp_path / "a"
+    shutil.copytree(ACQ.parent, a)
+    real = fit_dask.fit_one
+
+    def stopped_then_fitted(*args, **kwargs):  # type: ignore[no-untyped-def]
+        os.kill(os.getpid(), signal.SIGTERM)  # the client (this process's main thread) stops
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fit_dask, "fit_one", stopped_then_fitted)
+    root = tmp_path / "fits"
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        args = ["fit", str(a / "dirs.lp"), str(ACQ), "--out", str(root), "--no-qa"]
+        r = runner.invoke(app, [*args, "--scheduler", cluster.scheduler_address])
+        assert r.exit_code == 143, r.output
+        assert "discarded" not in said(r), r.output
+        assert "already running on the Dask workers cannot be stopped from here" in said(r)
+
+        def landed() -> list[Path]:  # the session the worker was running (either one)
+            return [p for p in root.iterdir() if not p.name.startswith(".")]
+
+        for _ in range(2400):  # what is said: the running session goes on and lands
+            if landed():
+                break
+            time.sleep(0.25)
+        assert [(p / "fit.ptm").is_file() for p in landed()] == [True]
