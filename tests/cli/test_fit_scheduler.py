@@ -159,6 +159,33 @@ def test_a_lost_scheduler_mid_batch_keeps_and_names_the_finished_sessions(
     assert (out / "s1" / "fit.json").exists() and not (out / "s2").exists()
 
 
+def test_a_cluster_batch_names_outputs_and_refuses_twice_given_sources_as_without_dask(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """Sources had been resolved before naming their outputs: a symlinked session folder was
+    fitted into OUT/<the link's target> (OUT/<the link> without Dask: a rerun either way
+    fitted it again), and one session given as s1 and ./s1 was merged into one fit silently
+    where the batch without Dask refuses it."""
+    from distributed import LocalCluster
+
+    make_session(tmp_path / "sessions" / "s1", size=(24, 32))
+    (tmp_path / "coin_day2").symlink_to(tmp_path / "sessions" / "s1")
+    monkeypatch.chdir(tmp_path)
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        batch = ["fit", "coin_day2", "sessions/s1", "--no-qa", "--model", "ps"]
+        r = runner.invoke(app, [*batch, "--out", "o", "--scheduler", address])
+        assert r.exit_code == 0, r.output
+        assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["coin_day2", "s1"]
+        twice = ["fit", "sessions/s1", "./sessions/s1", "--no-qa", "--out", "o2"]
+        r = runner.invoke(app, [*twice, "--scheduler", address])
+    assert r.exit_code == 2, r.output
+    assert "sources would write to the same output folder" in " ".join(r.output.split())
+    assert not (tmp_path / "o2" / "s1").exists()
+
+
 def _cli(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [*RTI_RIG, *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=900

@@ -287,12 +287,12 @@ def _fit_one_task(source: Path, root: Path, template: FitRequest, threads: int |
 
 
 def _batch_lost(
-    scheduler: str, sources: list[Path], given: dict[Path, Path], root: Path
+    scheduler: str, sources: list[Path], given: list[tuple[Path, Path]], root: Path
 ) -> SchedulerError:
     """The error of a batch whose scheduler went away: which sessions are finished in
     ``root`` (a session can finish on its worker while the client waits for another's result,
     so it is told by its folder, not by its future, which Dask cancels with the rest)."""
-    finished = [given[s] for s in sources if batch_out_dir(root, s).exists()]
+    finished = [g for s, g in given if batch_out_dir(root, s).exists()]
     kept = (
         f"{len(finished)} of {len(sources)} sessions are finished in {root} "
         f"({', '.join(map(str, finished))}) and are kept"
@@ -316,11 +316,16 @@ def run_batch_dask(
     if scheduler == THREADS:
         plan_batch(sources, root)
         return [fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources]
-    given = dict(zip([s.resolve() for s in sources], sources, strict=True))
-    sources = list(given)  # absolute: workers do not share this process's working directory
+    # Absolute, as workers do not share this process's working directory, but not resolved:
+    # ``resolve()`` followed a symlinked session folder, so its output was named after the
+    # link's target (OUT/s1 for sess/coin_day2 -> s1, OUT/coin_day2 without Dask, so a rerun
+    # either way fitted it again), and two spellings of one session (sess/s1, ./sess/s1) were
+    # merged into one fit silently where the batch without Dask refuses them.
+    given = list(zip([Path(os.path.abspath(s)) for s in sources], sources, strict=True))
+    sources = [a for a, _ in given]
     root = root.resolve()
     with scheduler_client(scheduler) as client:
-        todo = set(plan_batch(sources, root))
+        todo = set(plan_batch(sources, root))  # refuses a source given twice, as without Dask
         threads = blas_threads()
         futures = {
             s: client.submit(_fit_one_task, s, root, template, threads, pure=False) for s in todo
@@ -337,4 +342,4 @@ def run_batch_dask(
                     raise _batch_lost(scheduler, sources, given, root) from None
                 status = f"failed on the Dask cluster: {type(exc).__name__}: {exc}"
                 items.append(BatchItem(s, batch_out_dir(root, s), status))
-        return [replace(item, source=given[item.source]) for item in items]
+        return [replace(item, source=g) for item, (_, g) in zip(items, given, strict=True)]
