@@ -186,6 +186,27 @@ def test_a_cluster_batch_names_outputs_and_refuses_twice_given_sources_as_withou
     assert not (tmp_path / "o2" / "s1").exists()
 
 
+def test_a_cluster_batch_source_missing_here_too_is_not_blamed_on_the_workers(
+    tmp_path: Path,
+) -> None:
+    """A mistyped source had been sent to a worker and reported "does not exist on worker host
+    HOST: every Dask worker must see the session's files at the same paths", a wrong lead."""
+    from distributed import LocalCluster
+
+    make_session(tmp_path / "s1", size=(24, 32))
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        args = ["fit", str(tmp_path / "s1"), str(tmp_path / "s2"), "--no-qa", "--model", "ps"]
+        r = runner.invoke(
+            app, [*args, "--out", str(tmp_path / "o"), "--scheduler", cluster.scheduler_address]
+        )
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert f"{tmp_path / 's2'}: failed: {tmp_path / 's2'} does not exist: give a session" in said
+    assert "worker host" not in said and f"{tmp_path / 's1'}: done" in said
+
+
 def _cli(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [*RTI_RIG, *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=900

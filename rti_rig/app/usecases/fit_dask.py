@@ -327,11 +327,19 @@ def run_batch_dask(
     with scheduler_client(scheduler) as client:
         todo = set(plan_batch(sources, root))  # refuses a source given twice, as without Dask
         threads = blas_threads()
+        # A source missing here too is the user's typo, not the workers' filesystem: it is
+        # refused here in the words of the batch without Dask ("does not exist: give a session
+        # folder or an .lp file"); it had been sent and blamed on the workers' shared paths.
         futures = {
-            s: client.submit(_fit_one_task, s, root, template, threads, pure=False) for s in todo
+            s: client.submit(_fit_one_task, s, root, template, threads, pure=False)
+            for s in todo
+            if s.exists()
         }
         items = []
         for s in sources:
+            if s in todo and s not in futures:
+                items.append(fit_one(s, root, template))  # fails at once, naming the path
+                continue
             if s not in futures:
                 items.append(BatchItem(s, batch_out_dir(root, s), "skipped (finished earlier)"))
                 continue
