@@ -142,3 +142,28 @@ def test_eight_bit_images_beside_a_bare_lp_give_the_same_bytes(session: Path, tm
     r = runner.invoke(app, [*base, "--out", str(tmp_path / "threads"), "--scheduler", "threads"])
     assert r.exit_code == 0, r.output
     same_files(tmp_path / "plain", tmp_path / "threads")
+
+
+def test_a_killed_attempts_partial_folder_goes_once_the_session_is_finished(
+    session: Path, tmp_path: Path
+) -> None:
+    """A Dask worker killed mid-session cannot remove its attempt's partial folder; the retry
+    finished the session, and the dead attempt's folder (hundreds of MB of a large session)
+    had stayed in --out after a successful batch, never removed (finished sessions are
+    skipped). Another session's partial folder whose name begins alike is left alone."""
+    from rti_rig.app.usecases.fit import FitRequest, fit_one
+
+    root = tmp_path / "batch"
+    dead = root / f".{session.name}.555-dead0000.partial"  # the killed worker's attempt
+    other = root / f".{session.name}.x.777-live0000.partial"  # session "s.x", being fitted
+    for folder in (dead, other):
+        folder.mkdir(parents=True)
+        (folder / "normals.npy").write_bytes(b"half")
+    item = fit_one(session, root, FitRequest(session, root, model="ps", qa=False))
+    assert item.status == "done", item.status
+    assert not dead.exists() and (other / "normals.npy").exists()
+    # and a later run removes one left beside a finished session
+    dead.mkdir()
+    args = ["fit", str(session), str(tmp_path / "nope"), "--out", str(root), "--no-qa"]
+    r = runner.invoke(app, args)
+    assert "(finished earlier)" in r.output and not dead.exists(), r.output

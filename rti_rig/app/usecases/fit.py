@@ -885,10 +885,22 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
     return [fit_one(source, root, template) for source in sources]
 
 
+def partial_folders(root: Path, name: str) -> list[Path]:
+    """The partial folders of the session whose output is ``root/name`` (``.NAME.PID-ID.partial``,
+    or ``.NAME.partial`` of older runs). Matched exactly, not by a glob: ``.s1.*partial`` also
+    matched session ``s1.x``'s ``.s1.x.PID-ID.partial``, which a batch may be fitting."""
+    import re
+
+    pattern = re.compile(rf"\.{re.escape(name)}(\.[^.]*)?\.partial")
+    try:
+        return [p for p in root.iterdir() if pattern.fullmatch(p.name) and p.is_dir()]
+    except OSError:  # no root yet: nothing partial
+        return []
+
+
 def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     """The sources of a batch still to fit (their output folder does not exist), after removing
     the partial folders a killed run left for them. Refuses two sources with one output name."""
-    import glob
     import shutil
 
     by_name: dict[str, list[Path]] = {}
@@ -917,11 +929,12 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     todo = []
     for source in sources:
         final = batch_out_dir(root, source)
-        if final.exists():
-            continue
-        for partial in root.glob(f".{glob.escape(final.name)}.*partial"):
+        # a finished session's too: a Dask worker killed mid-session leaves its attempt's
+        # partial folder while the retry finishes the session (see fit_one)
+        for partial in partial_folders(root, final.name):
             shutil.rmtree(partial, ignore_errors=True)
-        todo.append(source)
+        if not final.exists():
+            todo.append(source)
     return todo
 
 
@@ -953,6 +966,12 @@ def fit_one(
         shutil.rmtree(partial, ignore_errors=True)
         if not final.exists():
             raise
+    # Earlier attempts' partial folders: a Dask worker killed mid-session cannot remove its
+    # own, and the retry that finished the session had left it in --out (hundreds of MB of a
+    # large session, a successful batch, never removed: later runs skip finished sessions).
+    # An attempt still running elsewhere then fails on its worker; the session is finished.
+    for stale in partial_folders(root, final.name):
+        shutil.rmtree(stale, ignore_errors=True)
     return BatchItem(
         source,
         final,
