@@ -1215,14 +1215,10 @@ def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
     folder under another name (:func:`renamed_jpegs`) is not lost. Empty for a folder
     without a journal (an ``.lp`` acquisition is no session)."""
     root = Path(root)
-    if not (root / JOURNAL).is_file() or not (root / MANIFEST).is_file():
-        return {}
-    try:
-        total = planned_steps(read_manifest(root))
-    except SessionError:
+    records = _journal_records(root)
+    if records is None:
         return {}
     lost: dict[str, list[str]] = {}
-    records = scan_journal(root, image_names(total) if total else None).records
     renamed = renamed_jpegs(root, records)
     for rec in _latest_records(records).values():
         gone = _lost_files(root, rec, renamed)
@@ -1235,13 +1231,20 @@ def renamed_since_capture(root: Path) -> dict[str, str]:
     """:func:`renamed_jpegs` of session ``root`` from its journal (empty for a folder that is
     no session, as :func:`files_lost_since_capture`)."""
     root = Path(root)
+    records = _journal_records(root)
+    return {} if records is None else renamed_jpegs(root, records)
+
+
+def _journal_records(root: Path) -> list[dict[str, Any]] | None:
+    """The journal's records of session ``root``, or None for a folder that is no session (no
+    journal or manifest, or a manifest that cannot be read)."""
     if not (root / JOURNAL).is_file() or not (root / MANIFEST).is_file():
-        return {}
+        return None
     try:
         total = planned_steps(read_manifest(root))
     except SessionError:
-        return {}
-    return renamed_jpegs(root, scan_journal(root, image_names(total) if total else None).records)
+        return None
+    return scan_journal(root, image_names(total) if total else None).records
 
 
 def unchecked_images(root: Path) -> tuple[list[str], str]:

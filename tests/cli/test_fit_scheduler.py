@@ -75,22 +75,28 @@ def _unreadable(path: Path):
 def test_a_worker_that_cannot_read_the_images_exits_2_naming_the_cluster(
     tmp_path: Path, monkeypatch
 ) -> None:
-    from distributed import LocalCluster
 
     from rti_rig.app.usecases import fit_dask
 
     session = make_session(tmp_path / "s", size=(24, 32))[0]
     monkeypatch.setattr(fit_dask, "read_image", _unreadable)  # what the workers open with
+    r, address = _fit_on_one_worker(session, tmp_path / "o")
+    assert r.exit_code == 2, r.output
+    assert address in r.output and "could not read the images" in r.output
+    assert "same paths" in r.output and "Traceback" not in r.output
+
+
+def _fit_on_one_worker(session: Path, out: Path):  # type: ignore[no-untyped-def]
+    """``rti-rig fit SESSION --out OUT --scheduler ADDR`` on an in-process cluster of one
+    single-threaded worker; the result and the scheduler's address."""
+    from distributed import LocalCluster
+
     with LocalCluster(
         n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
     ) as cluster:
         address = cluster.scheduler_address
-        r = runner.invoke(
-            app, ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
-        )
-    assert r.exit_code == 2, r.output
-    assert address in r.output and "could not read the images" in r.output
-    assert "same paths" in r.output and "Traceback" not in r.output
+        r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--scheduler", address])
+    return r, address
 
 
 def _scheduler_gone(*args, **kwargs):
@@ -104,19 +110,12 @@ def _scheduler_gone(*args, **kwargs):
 
 def test_a_lost_scheduler_mid_fit_is_said_so(tmp_path: Path, monkeypatch) -> None:
     """It had said "a band of the fit failed … Check the workers' logs (memory limit?)"."""
-    from distributed import LocalCluster
 
     from rti_rig.app.usecases import fit_dask
 
     session = make_session(tmp_path / "s", size=(24, 32))[0]
     monkeypatch.setattr(fit_dask, "fit_band_recording", _scheduler_gone)
-    with LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
-    ) as cluster:
-        address = cluster.scheduler_address
-        r = runner.invoke(
-            app, ["fit", str(session), "--out", str(tmp_path / "o"), "--scheduler", address]
-        )
+    r, address = _fit_on_one_worker(session, tmp_path / "o")
     assert r.exit_code == 2, r.output
     said = " ".join(r.output.split())
     assert f"lost the Dask scheduler at '{address}' while fitting" in said, said
