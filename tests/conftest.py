@@ -35,6 +35,16 @@ def write_config(tmp_path: Path, text: str, name: str = "rig.toml") -> Path:
     return p
 
 
+def virtual_arm_variant(tmp_path: Path, scene: str, side: int | None = None) -> Path:
+    """The shipped virtual arm (512 px, the relief) with another simulated scene and, if
+    given, square frames of ``side`` px: what the QA tests run correct sessions on."""
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    assert "width = 512\nheight = 512" in text and 'name = "relief"' in text
+    if side is not None:
+        text = text.replace("width = 512\nheight = 512", f"width = {side}\nheight = {side}")
+    return write_config(tmp_path, text.replace('name = "relief"', f'name = "{scene}"'), "arm.toml")
+
+
 SMALL_DOME = """
 name = "small"
 kind = "dome"

@@ -1055,13 +1055,7 @@ def _prepare_resume(
             rel = path.relative_to(root).as_posix()
             if rel in keep:
                 continue
-            dest = root / "recovered" / stamp / rel
-            try:
-                dest.parent.mkdir(parents=True, exist_ok=True)
-                os.replace(path, dest)
-            except OSError as exc:
-                raise SessionWriteError(dest, exc) from None
-            recovered.append(dest.relative_to(root).as_posix())
+            recovered.append(_set_aside(root, path, stamp))
         for partial in [
             *root.glob(".*.partial"),
             *(root / LINEAR_DIR).glob(".*.partial"),
@@ -1098,7 +1092,13 @@ def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str
         return None
     if not path.is_file():
         return None
-    dest = root / "recovered" / stamp / LP_NAME
+    return _set_aside(root, path, stamp)
+
+
+def _set_aside(root: Path, path: Path, stamp: str) -> str:
+    """Move ``path`` (inside session ``root``) to ``recovered/STAMP/`` under the same relative
+    path, never deleting anything; returns where it went, relative to ``root``."""
+    dest = root / "recovered" / stamp / path.relative_to(root)
     try:
         dest.parent.mkdir(parents=True, exist_ok=True)
         os.replace(path, dest)

@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import virtual_arm_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -22,10 +22,7 @@ from rti_rig.cli import app
 
 @pytest.mark.slow  # a 12-light session of 512 × 512 frames and its verdict
 def test_a_glossy_coins_highlight_is_not_called_too_bright(tmp_path: Path) -> None:
-    text = (CONFIGS / "virtual_arm.toml").read_text()
-    assert "width = 512\nheight = 512" in text and 'name = "relief"' in text
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace('name = "relief"', 'name = "coin"'))
+    cfg = virtual_arm_variant(tmp_path, "coin")
     r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "12"])
     assert r.exit_code == 0, r.output
     said = " ".join(r.output.split())

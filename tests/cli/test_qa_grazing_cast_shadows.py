@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import virtual_arm_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -21,11 +21,7 @@ from rti_rig.cli import app
 
 @pytest.mark.slow  # a 24-light session of 1024 × 1024 frames and its verdict
 def test_a_correct_arm_session_of_large_frames_is_good(tmp_path: Path) -> None:
-    text = (CONFIGS / "virtual_arm.toml").read_text()
-    assert "width = 512\nheight = 512" in text and 'name = "relief"' in text
-    text = text.replace("width = 512\nheight = 512", "width = 1024\nheight = 1024")
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace('name = "relief"', 'name = "tablet"'))
+    cfg = virtual_arm_variant(tmp_path, "tablet", 1024)
     r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "24"])
     assert r.exit_code == 0, r.output
     said = " ".join(r.output.split())

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from conftest import virtual_arm_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -25,11 +25,7 @@ runner = CliRunner()
 
 @pytest.mark.slow  # a 12-light session and a refit of it
 def test_a_light_below_the_tilted_surface_is_not_called_misfired(tmp_path: Path) -> None:
-    text = (CONFIGS / "virtual_arm.toml").read_text()
-    assert "width = 512\nheight = 512" in text and 'name = "relief"' in text
-    text = text.replace("width = 512\nheight = 512", "width = 256\nheight = 256")
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace('name = "relief"', 'name = "tilted"'))
+    cfg = virtual_arm_variant(tmp_path, "tilted", 256)
     session = tmp_path / "s"
     r = runner.invoke(
         app,

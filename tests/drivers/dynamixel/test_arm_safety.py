@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from dxl_support import arm_settings
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -199,18 +200,7 @@ def test_a_light_on_the_keep_out_edge_as_an_lp_writes_it_is_reachable(half_angle
     edge's tick rounded up into the cone the gate refused it too. It is now on the edge: its
     ticks are the nearest outside the cone, which the exact gate passes; a light 0.01° inside
     the cone is still refused."""
-    cfg = ArmSettings(
-        port="emulated",
-        azimuth=dict(
-            servo_id=1, model_number=1060, zero_offset_ticks=2048, min_deg=-170.0, max_deg=170.0
-        ),
-        elevation=dict(
-            servo_id=2, model_number=1060, zero_offset_ticks=1024, min_deg=0.0, max_deg=90.0
-        ),
-        keep_out_half_angle_deg=half_angle,
-        park_elevation_deg=10.0,
-    )
-    kin = ArmKinematics(cfg)
+    kin = ArmKinematics(arm_settings(keep_out_half_angle_deg=half_angle, park_elevation_deg=10.0))
     edge = 90.0 - half_angle
     for az in (0.0, 37.0, -120.0):
         on_edge = np.round(direction_from_az_el(az, edge), 6)  # as an .lp stores it
