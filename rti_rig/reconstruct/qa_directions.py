@@ -35,6 +35,24 @@ def relative_misfit(b: NDArray, img: NDArray, s: NDArray, lit: NDArray[np.bool_]
     return float(np.median(np.abs(img[lit] - pred)) / scale)
 
 
+def recorded_misfit(b: NDArray, img: NDArray, usable: NDArray[np.bool_], light: NDArray) -> float:
+    """:func:`relative_misfit` of the image's best rendering under its *recorded* light, its
+    brightness free: how well the recorded direction explains the image, to compare with how
+    well the best direction does. Their ratio says how far off the recorded light is in what
+    the image can show, where the angle alone cannot: on a near-flat varnished painting a
+    direction 12° off renders the image within 10 % as well as the best one, on a tablet's
+    relief a direction 25° off renders it 7× worse."""
+    d = np.asarray(light, dtype=np.float64)
+    lit = usable & ((b @ d) > 0.05 * np.linalg.norm(b, axis=-1))
+    if lit.sum() < 10:
+        return float("inf")
+    shade = b[lit] @ d
+    power = float(shade @ shade)
+    if power <= 0:
+        return float("inf")
+    return relative_misfit(b, img, d * float(shade @ img[lit]) / power, lit)
+
+
 #: Draws of the consensus search (seeded: a verdict is reproducible).
 CONSENSUS_DRAWS = 300
 #: Images per draw.
