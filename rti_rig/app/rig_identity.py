@@ -6,6 +6,12 @@ other and with the `.lp`. The identity lists what changes the images — the rig
 backend, where its lights can be, the LEDs' intensity correction, the camera's size, exposure,
 gain and RAW decoding, and (for a dry run) the simulated scene — and nothing that does not (a
 serial port's name, timing, parking policy), so a rig moved to another USB port resumes.
+
+A dome's light positions are compared as positions, not as a digest: a re-measured dome whose
+``.lp`` differs from the session's by what six decimals cannot tell apart (the precision an
+``.lp`` is written with) is the same rig, and one whose LEDs really moved is named by how many
+moved and by how much (a digest of rounded positions had called both "changed", and could not
+say which).
 """
 
 from __future__ import annotations
@@ -13,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +44,12 @@ LABELS = {
 }
 
 
+#: The largest angle (rad) between a light's recorded and current position that is rounding
+#: noise, not a change: two writings of one direction at the six decimals of an ``.lp`` differ
+#: by at most 1e-6 in each component (under 2e-6 rad once renormalised); a re-measured LED
+#: that really moved does so by a tenth of a degree or more (1.7e-3 rad).
+POSITION_TOLERANCE_RAD = 5e-6
+
 #: The keys that change what the images are, not where the light comes from: a session cannot
 #: take images that differ in them, accepted or not (nothing downstream corrects for them).
 IMAGE_KEYS = ("camera_size", "exposure_s", "gain", "camera_device", "decode", "recorded_images")
@@ -57,6 +70,10 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
         ident["light_positions"] = _digest(
             [[round(float(x), 5) for x in d] for d in geometry.directions]
         )
+        # the positions themselves, as the session's decisions saw them (the digest stays for
+        # sessions recorded before): compared with a tolerance, a change named by LED
+        # (:func:`_moved_lights`), and an adaptive resume decides on them (:func:`same_rig`)
+        ident["light_directions"] = [[float(x) for x in d] for d in geometry.directions]
         serial = cfg.dome.serial if cfg.dome else None
         corr = getattr(serial, "intensity_correction", None)
         ident["intensity_correction"] = None if corr is None else _digest(list(corr))
@@ -114,6 +131,14 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
             continue  # a dome and an arm differ in these by nature: the kind says it all
         if key == "recorded_images" and old is None:
             continue  # a session begun before the images were part of the identity
+        if key == "light_directions":
+            continue  # said under "light positions"
+        if key == "light_positions":
+            moved = _moved_lights(before.get("light_directions"), now.get("light_directions"))
+            if moved is not None:  # both sides hold the positions: compared, not digested
+                if moved:
+                    out.append(moved)
+                continue
         label = LABELS.get(key, key)
         if key in ("light_positions", "intensity_correction", "decode", "scene", "recorded_images"):
             out.append(f"{label}: changed" if old and new else f"{label}: {old} → {new}")
@@ -126,6 +151,48 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
         else:
             out.append(f"{label}: {_show(old)} → {_show(new)}")
     return out
+
+
+def same_rig(recorded: dict[str, Any], identity: dict[str, Any]) -> dict[str, Any]:
+    """``identity`` (a rig that differs from ``recorded`` in nothing
+    :func:`identity_differences` names), with the light positions ``recorded`` holds: those
+    of a re-measured ``.lp`` that differ by rounding alone are the same lights, and the
+    session keeps the positions it began with. An adaptive session's decisions are made on
+    them (a symmetric dome's ties between equally good LEDs are broken by the last digit,
+    so rounding noise had chosen another starting LED and the resume was refused)."""
+    if "light_directions" in recorded and "light_directions" in identity:
+        for key in ("light_positions", "light_directions"):
+            identity = {**identity, key: recorded[key]}
+    return identity
+
+
+def _moved_lights(before: Any, now: Any) -> str | None:
+    """How the lights moved between two identities' ``light_directions``, in words; ``""``
+    when none moved beyond :data:`POSITION_TOLERANCE_RAD` (rounding noise: the same rig);
+    None when it cannot be told (a side without positions, or another number of lights,
+    which the ``lights`` key names)."""
+    if not isinstance(before, list) or not isinstance(now, list) or len(before) != len(now):
+        return None
+    angles = []
+    for a, b in zip(before, now, strict=True):
+        dot = sum(float(x) * float(y) for x, y in zip(a, b, strict=True))
+        na = math.sqrt(sum(float(x) ** 2 for x in a))
+        nb = math.sqrt(sum(float(y) ** 2 for y in b))
+        # atan2 of |a×b| and a·b: exact for the tiny angles rounding gives (acos is not)
+        cross = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+        angles.append(math.atan2(math.sqrt(sum(c * c for c in cross)), dot) if na and nb else 0.0)
+    moved = [i for i, t in enumerate(angles) if t > POSITION_TOLERANCE_RAD]
+    if not moved:
+        return ""
+    worst = max(moved, key=lambda i: angles[i])
+    return (
+        f"light positions: {len(moved)} of {len(angles)} LEDs moved, by up to "
+        f"{math.degrees(angles[worst]):.2f}° (LED index {worst})"
+    )
 
 
 def _show(value: Any) -> str:

@@ -135,13 +135,13 @@ def test_a_resumed_session_whose_images_changed_is_refused(
     assert "step 6 was decided differently" in said(r)
 
 
-def test_a_resume_on_an_accepted_rig_change_it_cannot_repeat_says_so(
+def test_a_resume_on_an_accepted_rig_change_keeps_the_steps_taken_and_goes_on(
     uninterrupted: tuple[Path, Path], tmp_path: Path
 ) -> None:
-    """Recalibrated light positions accepted with --accept-rig-change, on which the steps
-    taken are no longer decided as they were: the refusal names the accepted change (it had
-    blamed "another rig config, software version or image on disk", and the note before it
-    said the change was recorded, though nothing was), and the folder is left as it was."""
+    """Recalibrated light positions accepted with --accept-rig-change: the steps taken were
+    decided on the rig as it was, so they are kept as recorded, and the rest is decided on the
+    rig as it is (every such resume had been refused at step 1, "not decided as it was"); the
+    change is recorded in the run (tests/app/test_adaptive_recalibrated.py: an `.lp`)."""
     from rti_rig.app.usecases.session import (
         NewSessionRequest,
         open_new_session,
@@ -172,14 +172,15 @@ def test_a_resume_on_an_accepted_rig_change_it_cannot_repeat_says_so(
         ),
         "recalibrated.toml",
     )
+    shot = [s["led"] for s in journal(out)]
     r = runner.invoke(app, ["run", str(moved), "--resume", str(out), "--accept-rig-change"])
-    assert r.exit_code == 2, r.output
-    text = said(r)
-    assert "accepted and recorded" not in text
-    assert "rig change accepted (recorded in the manifest once the session goes on)" in text
-    assert "the rig change accepted with --accept-rig-change (light positions" in text
-    assert "Nothing was recorded or captured" in text
-    assert folder_bytes(out) == before
+    assert r.exit_code == 0, r.output
+    assert "rig change accepted (recorded in the manifest once the session goes on)" in said(r)
+    steps = journal(out)
+    assert len(steps) == 8 and [s["led"] for s in steps[:6]] == shot
+    assert len({s["led"] for s in steps}) == 8
+    assert "LEDs moved, by up to 0.20°" in str(manifest(out)["runs"][-1]["rig_change"])
+    assert before.keys() <= folder_bytes(out).keys()
 
 
 def test_a_resume_on_a_rig_with_another_number_of_lights_says_what_to_do(

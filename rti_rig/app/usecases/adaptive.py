@@ -692,6 +692,7 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     objective: str = "normals",
     band: tuple[float, float] = _FULL_BAND,
     default_max: int | None = None,
+    positions: NDArray[np.float64] | None = None,
 ) -> AdaptivePlan:
     """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
     homogeneous starting layout of ``start_lights``; with ``lights`` given (``design`` not
@@ -703,12 +704,18 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     ``band`` (``--min/--max-elevation-deg``): only the lights between these elevations are
     candidates, so every light of the session — the start, each decision, each design — is in
     it (a gilded object's highlights kept off the camera by a 45° ceiling). The rig is seen as
-    that band alone: a dome as its LEDs in the band, an arm with its band cut at the ceiling."""
+    that band alone: a dome as its LEDs in the band, an arm with its band cut at the ceiling.
+
+    ``positions`` (a dome's, one per LED): the LED positions to decide on instead of the
+    rig's — on a resume, those the session recorded, which the rig's differ from by rounding
+    alone (:func:`rig_identity.same_rig`)."""
     from rti_rig.planner import adaptive
     from rti_rig.planner.uniform import arm_below
 
     lo, hi = band
     geometry = rig.geometry
+    if positions is not None and isinstance(geometry, DomeGeometry):
+        geometry = DomeGeometry(np.asarray(positions, dtype=np.float64), geometry.names)
     if isinstance(geometry, DomeGeometry):
         cands = candidates_for(geometry, lo, max_elevation_deg=hi)
         dirs, leds = cands.directions, cands.leds
@@ -841,30 +848,28 @@ class AdaptiveSteps:
     def replay(self, folder) -> None:  # type: ignore[no-untyped-def]
         """Show the chooser the steps already on disk (``--resume``), in index order, and check
         that each would be decided again as it was (else the session cannot continue as it
-        began)."""
+        began).
+
+        A step is decided again as it was when the same light is chosen: on a dome the same
+        LED at its position to within :data:`rig_identity.POSITION_TOLERANCE_RAD` (a
+        re-measured ``.lp`` that differs by rounding is the same rig; they had been compared
+        at 1e-9, so such a session could never continue). After ``--accept-rig-change`` the
+        steps already taken were decided on the rig as it was, which this one no longer is:
+        each is checked against what was recorded (its light, on this rig, and its image,
+        which the reopen verified) and not against a decision on the changed rig (which had
+        refused every such resume); the chooser is told each light where it really was, and
+        decides the remaining steps on the rig as it is now."""
         done = folder.done
         refuse_broken_run(Path(folder.root), folder.total_steps)(done)
+        other_rig = _decided_on_another_rig(folder, len(done))
         for i in range(len(done)):
             rec = done[i]
+            # decided on this rig in every case: the chooser's state (the design it is in)
+            # grows from its own decisions on the images so far
             candidate, _ = self.chooser.decide(i)
-            planned = (
-                None
-                if candidate is None
-                else tuple(float(c) for c in self.plan.candidates[candidate])
-            )
-            if planned is None or not np.allclose(planned, rec.planned_direction, atol=1e-9):
-                changed = getattr(folder, "rig_change", None)
-                if changed:  # the user just accepted it: say it is why, not "another config"
-                    raise RtiRigError(
-                        f"{folder.root}: the rig change accepted with --accept-rig-change ("
-                        + "; ".join(changed)
-                        + ") changes the lights this adaptive session chooses among, and a "
-                        "resume re-decides every step already taken: on this rig step "
-                        f"{i + 1} is not decided as it was (another light, or its LED at the "
-                        "new position). Nothing was recorded or captured. Resume with the "
-                        f"session's own config (rti-rig run --resume {folder.root}), or start "
-                        "a new session on the changed rig"
-                    )
+            if i < other_rig:
+                candidate = self._recorded_candidate(folder, i, rec)
+            elif candidate is None or not self._same_light(candidate, rec):
                 timing = self._timing_differences(folder)
                 if timing:  # the config's times changed: restoring them continues the session
                     raise RtiRigError(
@@ -882,6 +887,53 @@ class AdaptiveSteps:
                 )
             pixels = read_linear_tiff(Path(folder.root) / rec.linear_image)
             self.chooser.observe(candidate, np.asarray(rec.actual_direction), small_grey(pixels))
+        if other_rig:
+            self._keep_start_unused(folder, len(done))
+
+    def _same_light(self, candidate: int, rec) -> bool:  # type: ignore[no-untyped-def]
+        """Whether ``candidate`` is the light step ``rec`` recorded: the same LED (a dome) at
+        the same position to within rounding."""
+        from rti_rig.app.rig_identity import POSITION_TOLERANCE_RAD
+
+        if self.plan.leds is not None and int(self.plan.leds[candidate]) != rec.led:
+            return False
+        return _angle_rad(self.plan.candidates[candidate], rec.planned_direction) <= (
+            POSITION_TOLERANCE_RAD
+        )
+
+    def _recorded_candidate(self, folder, i: int, rec) -> int:  # type: ignore[no-untyped-def]
+        """The candidate of the light step ``i`` recorded, on the changed rig: a dome's LED by
+        its index, an arm's direction by the nearest candidate. Refused when a dome's LED is no
+        longer among the lights (its band), naming it."""
+        if self.plan.leds is None:
+            d = np.asarray(rec.planned_direction, dtype=np.float64)
+            return int(np.argmax(self.plan.candidates @ d))
+        where = np.flatnonzero(self.plan.leds == rec.led)
+        if where.size == 0:
+            raise RtiRigError(
+                f"{folder.root}: step {i + 1} was shot with LED index {rec.led}, which the "
+                "changed rig accepted with --accept-rig-change no longer offers this session "
+                "(outside its elevation band, or gone). Nothing was recorded or captured. "
+                f"Resume with the session's own config (rti-rig run --resume {folder.root}), "
+                "or start a new session on the changed rig"
+            )
+        return int(where[0])
+
+    def _keep_start_unused(self, folder, done: int) -> None:  # type: ignore[no-untyped-def]
+        """Refuse a resume within the starting layout whose remaining starting lights, on the
+        changed rig, include one already shot (the start is placed on the rig's positions, so
+        a real move can place it on other LEDs): the session would shoot it twice."""
+        rest = self.chooser.start[done:]
+        twice = sorted(set(rest) & set(self.chooser.used))
+        if twice:
+            raise RtiRigError(
+                f"{folder.root}: on the changed rig accepted with --accept-rig-change the "
+                "starting layout is other LEDs, and one of its remaining lights was already "
+                "shot (LED index "
+                + ", ".join(str(self._step(c).led) for c in twice)
+                + "). Nothing was recorded or captured. Resume with the session's own config "
+                f"(rti-rig run --resume {folder.root}), or start a new session on the changed rig"
+            )
 
     def _timing_differences(self, folder) -> list[str]:  # type: ignore[no-untyped-def]
         """On an arm, the times a decision weighs (capture, moves) that differ between the rig
@@ -928,6 +980,25 @@ class AdaptiveSteps:
         if self._outcome is None:
             self._outcome = self.chooser.conclude()
         return self._outcome
+
+
+def _decided_on_another_rig(folder, done: int) -> int:  # type: ignore[no-untyped-def]
+    """How many of the steps already taken were decided on a rig other than this one: all of
+    them when this resume accepts a change (``--accept-rig-change``), else those taken before
+    the last resume that accepted one (its run records ``rig_change`` and the steps it found
+    done), else none."""
+    if getattr(folder, "rig_change", None):
+        return done
+    runs = (getattr(folder, "manifest", None) or {}).get("runs") or []
+    changed = [int(r.get("resumed_with_steps_done") or 0) for r in runs if r.get("rig_change")]
+    return min(max(changed, default=0), done)
+
+
+def _angle_rad(a: Any, b: Any) -> float:
+    """The angle (rad) between two directions, exact for the tiny angles of rounding."""
+    u = np.asarray(a, dtype=np.float64)
+    v = np.asarray(b, dtype=np.float64)
+    return float(np.arctan2(np.linalg.norm(np.cross(u, v)), float(u @ v)))
 
 
 def estimate_phrase(result: dict[str, Any]) -> str:
@@ -1263,6 +1334,18 @@ def refuse_broken_run(root: Path, total_steps: int) -> Callable[[dict[int, Any]]
     return check
 
 
+def _recorded_positions(rig, folder) -> NDArray[np.float64] | None:  # type: ignore[no-untyped-def]
+    """A dome's LED positions as the session recorded them (its rig identity, kept by the
+    resume where the rig's differ by rounding alone), or None: an arm, a session recorded
+    before the positions were, or another number of LEDs."""
+    recorded = getattr(folder, "rig_identity", None) or {}
+    dirs = recorded.get("light_directions")
+    if not isinstance(rig.geometry, DomeGeometry) or not isinstance(dirs, list):
+        return None
+    arr = np.asarray(dirs, dtype=np.float64)
+    return arr if arr.shape == rig.geometry.directions.shape else None
+
+
 def resume_adaptive_source(rig, folder, objective: str | None = None) -> AdaptiveSteps:  # type: ignore[no-untyped-def]
     """The step source of an interrupted adaptive session, brought up to its last step
     (``objective``: the one the user asks for, if any — it must be the session's own)."""
@@ -1280,6 +1363,7 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
             float(header.get("min_elevation_deg", _FULL_BAND[0])),
             float(header.get("max_elevation_deg", _FULL_BAND[1])),
         ),
+        positions=_recorded_positions(rig, folder),
     )
     if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
         # what to do, not only what is wrong (it had ended "it cannot continue as it began",

@@ -625,7 +625,12 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
 
     Refuses (:class:`RigChangedError`, listing what differs) unless ``accept_change``.
     """
-    from rti_rig.app.rig_identity import IMAGE_KEYS, identity_differences, rig_identity
+    from rti_rig.app.rig_identity import (
+        IMAGE_KEYS,
+        identity_differences,
+        rig_identity,
+        same_rig,
+    )
 
     identity = rig_identity(loaded)
     recorded = (manifest.get("rig") or {}).get("identity")
@@ -702,6 +707,8 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
                 "warning",
             )
         )
+    if not diffs:  # the same rig: its positions as the session recorded them (rounding aside)
+        identity = same_rig(recorded, identity)
     return identity, diffs
 
 
