@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib
 
+from rti_rig.app.usecases import adaptive as usecase
 from rti_rig.app.usecases.adaptive_constants import (
     DECISION_MODULES,
     RESTORED_ON_RESUME,
@@ -13,16 +14,24 @@ from rti_rig.app.usecases.adaptive_constants import (
 )
 from rti_rig.planner import adaptive_until
 
+#: the module each exempt name belongs to (a resume takes its value from the session)
+OWNERS = {
+    "UPPER_FACTOR": adaptive_until,
+    "UPPER_QUANTILE": adaptive_until,
+    "RING_SPAN_DEG": usecase,
+}
+
 
 def test_only_the_stop_factor_and_its_quantile_are_defined_under_the_exempt_names() -> None:
     """A decision module that defined its own UPPER_FACTOR (say, a bound for a design) would be
     exempt from the resume check by name: every module that holds one of these names must hold
-    the stop module's very object (an import of it)."""
+    its owner's very object (an import of it)."""
+    assert set(OWNERS) == RESTORED_ON_RESUME
     for name in DECISION_MODULES:
         module = importlib.import_module(name)
         for key in RESTORED_ON_RESUME:
             if hasattr(module, key):
-                assert getattr(module, key) is getattr(adaptive_until, key), f"{name}.{key}"
+                assert getattr(module, key) is getattr(OWNERS[key], key), f"{name}.{key}"
 
 
 def test_the_exempt_names_are_exempt_under_any_module_and_nothing_else_is() -> None:

@@ -648,25 +648,83 @@ def _floor_for(geometry: DomeGeometry, n: int, floor_deg: float = START_FLOOR_DE
     return float(min(floor_deg, el[min(n, len(el)) - 1]))
 
 
+#: The elevation span (°) within which the lights a start is taken from are one ring: there the
+#: starting layout's elevations cannot spread it, and its azimuths must (:func:`_ring_start`).
+#: A resume takes the session's own (``adaptive_constants.RESTORED_ON_RESUME``): one begun
+#: before it existed (none recorded) resumes without it, as it began, and is not refused.
+RING_SPAN_DEG = 2.0
+
+
 def dome_start(
     geometry: DomeGeometry,
     k: int,
     n_total: int | None,
     objective: str = "normals",
     above_floor: bool | None = None,
+    band: tuple[float, float] | None = None,
+    ring_span_deg: float | None = RING_SPAN_DEG,
 ) -> list[int]:
     """LED indices of a dome's starting layout of ``k``: with ``n_total`` known, the ``k`` of
     the homogeneous layout of ``n_total`` (at the objective's default floor) closest to a
     homogeneous layout of ``k`` — so that the default design is that layout exactly
-    (``above_floor``: as ``start_subset``'s, for the benchmarks' variants)."""
+    (``above_floor``: as ``start_subset``'s, for the benchmarks' variants).
+
+    ``band`` (an elevation band the session was cut to; None or every elevation: none): where
+    the lights the start is taken from are one ring (within :data:`RING_SPAN_DEG`), the start
+    is spread evenly round it (:func:`_ring_start`). The homogeneous layouts place their
+    lights by a golden-angle spiral whose elevations spread them; on one ring only its
+    azimuths are left, and four of them fall within 137.5° (`--adaptive --lights 5
+    --min-elevation-deg 60` on `simulated_dome.toml` started at 0°, 60°, 120° and 300°,
+    three on one side and none within 180° of 210°). ``ring_span_deg`` None: never (a session
+    begun before the rule, resumed as it began)."""
+    banded = band is not None and tuple(band) != _FULL_BAND and ring_span_deg is not None
     if n_total is None or n_total <= k:
+        if banded and _one_ring(geometry.directions, ring_span_deg):
+            return _ring_start(geometry.directions, k)
         return [int(i) for i in select_uniform_leds(geometry, k, _floor_for(geometry, k))]
     from rti_rig.planner import adaptive
 
     floor = _floor_for(geometry, n_total, adaptive.default_floor_for(objective))
     full = select_uniform_leds(geometry, n_total, floor)
+    if banded and _one_ring(geometry.directions[full], ring_span_deg):
+        return sorted(int(full[i]) for i in _ring_start(geometry.directions[full], k))
     pick = start_subset(geometry.directions[full], k, objective=objective, above_floor=above_floor)
     return [int(full[i]) for i in pick]
+
+
+def _elevations_deg(dirs: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.degrees(np.arcsin(np.clip(dirs[:, 2], -1.0, 1.0)))
+
+
+def _one_ring(dirs: NDArray[np.float64], span_deg: float | None) -> bool:
+    """Whether the lights ``dirs`` lie within ``span_deg`` of elevation (None: never)."""
+    el = _elevations_deg(dirs)
+    return span_deg is not None and bool(el.max() - el.min() <= span_deg)
+
+
+def _ring_start(dirs: NDArray[np.float64], k: int) -> list[int]:
+    """Indices of ``k`` of the ring of lights ``dirs`` matched one-to-one (least total angle)
+    to ``k`` directions evenly spaced round it (every 360°/k, at its mean elevation), the
+    target turned in steps of a 24th of that spacing to fit the ring's own LEDs best (the
+    first best on a tie)."""
+    from scipy.optimize import linear_sum_assignment
+
+    if k >= len(dirs):
+        return list(range(len(dirs)))
+    el = np.radians(float(_elevations_deg(dirs).mean()))
+    best: tuple[float, list[int]] | None = None
+    for offset in np.arange(24) / 24.0:
+        az = 2.0 * np.pi * (np.arange(k) + offset) / k
+        target = np.stack(
+            [np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.full(k, np.sin(el))], axis=1
+        )
+        cost = np.arccos(np.clip(target @ dirs.T, -1.0, 1.0))
+        rows, cols = linear_sum_assignment(cost)
+        total = float(cost[rows, cols].sum())
+        if best is None or total < best[0] - 1e-9:
+            best = (total, sorted(int(c) for c in cols))
+    assert best is not None
+    return best[1]
 
 
 def default_max_lights(loaded, until_error_deg: float | None) -> int | None:  # type: ignore[no-untyped-def]
@@ -693,6 +751,7 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     band: tuple[float, float] = _FULL_BAND,
     default_max: int | None = None,
     positions: NDArray[np.float64] | None = None,
+    ring_span_deg: float | None = RING_SPAN_DEG,
 ) -> AdaptivePlan:
     """Candidates the rig can really run (each checked by the rig's own lighting rules) and a
     homogeneous starting layout of ``start_lights``; with ``lights`` given (``design`` not
@@ -708,7 +767,8 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
 
     ``positions`` (a dome's, one per LED): the LED positions to decide on instead of the
     rig's — on a resume, those the session recorded, which the rig's differ from by rounding
-    alone (:func:`rig_identity.same_rig`)."""
+    alone (:func:`rig_identity.same_rig`). ``ring_span_deg``: as :func:`dome_start`'s (a
+    resume passes the session's own)."""
     from rti_rig.planner import adaptive
     from rti_rig.planner.uniform import arm_below
 
@@ -736,7 +796,9 @@ def adaptive_plan(  # type: ignore[no-untyped-def]
     k0 = min(start_lights, max_lights)
     n_design = max_lights if (lights is not None and design is not False) else None
     if isinstance(geometry, DomeGeometry):
-        start = dome_start(sub, k0, n_design, objective)
+        start = dome_start(
+            sub, k0, n_design, objective, band=(float(lo), float(hi)), ring_span_deg=ring_span_deg
+        )
     else:
         from rti_rig.planner.objectives import Candidates
 
@@ -1364,6 +1426,8 @@ def resume_adaptive_source(rig, folder, objective: str | None = None) -> Adaptiv
             float(header.get("max_elevation_deg", _FULL_BAND[1])),
         ),
         positions=_recorded_positions(rig, folder),
+        # the session's own (none recorded: begun before the rule, resumed without it)
+        ring_span_deg=(header.get("constants") or {}).get("app.usecases.adaptive.RING_SPAN_DEG"),
     )
     if plan.max_lights != header["max_lights"] or len(plan.candidates) != header["candidates"]:
         # what to do, not only what is wrong (it had ended "it cannot continue as it began",
