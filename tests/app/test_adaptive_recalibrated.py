@@ -128,6 +128,10 @@ def test_a_dome_whose_leds_moved_is_refused_by_how_much_and_continues_once_accep
     assert r.exit_code == 2, r.output
     assert "light positions: 12 of 12 LEDs moved, by up to 0.30°" in said(r)
     assert "add --accept-rig-change" in said(r)
+    # the config is untouched: what to put back is the .lp it reads (it had been told to set
+    # the config back, from a recorded copy that holds no position)
+    assert "The config itself is as the session began; the light calibration it reads" in said(r)
+    assert "dome.lp" in said(r) and "edited since" not in said(r)
 
     from rti_rig.app.usecases.session import (
         ResumeRequest,

@@ -684,7 +684,10 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
             f"{config_path} does not describe the rig this session began on ("
             + "; ".join(diffs)
             + "): its images would not match the ones already taken. "
-            + _back_to_own_config(config_path, manifest, session_dir)
+            + (
+                _read_file_changed(loaded, manifest)
+                or _back_to_own_config(config_path, manifest, session_dir)
+            )
             + ", or, if the change is deliberate (a repaired LED, recalibrated light "
             "positions), add --accept-rig-change to record it"
         )
@@ -710,6 +713,26 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     if not diffs:  # the same rig: its positions as the session recorded them (rounding aside)
         identity = same_rig(recorded, identity)
     return identity, diffs
+
+
+def _read_file_changed(loaded, manifest: dict[str, Any]) -> str | None:  # type: ignore[no-untyped-def]
+    """What to set back when the config is byte for byte the one the session last ran with
+    (with its intensity correction file) and the change is in the light calibration ``.lp``
+    it reads (a sentence, no final stop); None otherwise.
+
+    Why: a dome re-measured since (a new ``lp_file``) had been told that its config was
+    "edited since the session began: set it back … (recorded … under rig.config)", about a
+    file nobody had touched and whose recorded copy holds no position."""
+    if loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
+        return None
+    dome = loaded.config.dome
+    if dome is None or dome.layout != "lp" or not dome.lp_file:
+        return None
+    lp = (loaded.folder / dome.lp_file).resolve()
+    return (
+        f"The config itself is as the session began; the light calibration it reads, {lp}, is "
+        "not: put the .lp the session began with back to continue"
+    )
 
 
 def _back_to_own_config(
