@@ -1229,8 +1229,23 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
         f"this rig offers {offered} {noun}{_band_words(band)}, and an adaptive session starts "
         f"from {START_LIGHTS} and chooses the next ones: there is none left to choose. Shoot "
         f"them all with a planned run: rti-rig run {shlex.quote(str(loaded.path))} --out DIR"
-        f"{widen}"
+        f"{_band_options(band, offered)}{widen}"
     )
+
+
+def _band_options(band: tuple[float, float], offered: int) -> str:
+    """The planned run's options that keep to ``band`` and take its ``offered`` lights (nothing
+    for every elevation). The advice had been the bare `rti-rig run RIG --out DIR`: every LED
+    of the dome, the ones the band was asked to keep out (above a gilded object's ceiling)
+    too."""
+    if tuple(band) == _FULL_BAND:
+        return ""
+    out = f" --lights {offered}"
+    if band[0] != _FULL_BAND[0]:
+        out += f" --min-elevation-deg {band[0]:g}"
+    if band[1] != _FULL_BAND[1]:
+        out += f" --max-elevation-deg {band[1]:g}"
+    return out
 
 
 def open_adaptive_session(  # type: ignore[no-untyped-def]
