@@ -34,3 +34,26 @@ def test_the_advised_planned_run_keeps_to_the_band(tmp_path: Path) -> None:
     steps = journal(tmp_path / "planned")
     assert len(steps) == 4
     assert all(math.degrees(math.asin(s["actual_direction"][2])) > 45 for s in steps)
+
+
+def test_the_advised_metering_run_keeps_to_the_band(tmp_path: Path) -> None:
+    """`--auto-exposure` with `--adaptive --max-elevation-deg 45` (a gilded object): the
+    metering run advised had been `--lights 6` over every elevation, metering under (and
+    firing) lights above the ceiling that the session will never fire."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(cfg),
+            "--out",
+            str(tmp_path / "s"),
+            *("--adaptive", "--lights", "6", "--max-elevation-deg", "30", "--auto-exposure"),
+        ],
+    )
+    assert r.exit_code == 2, r.output
+    assert f"rti-rig run {cfg} --out TEST --lights 6 --max-elevation-deg 30 --auto-exposure" in (
+        said(r)
+    )
+    assert "then run this command again without --auto-exposure" in said(r)
+    assert not (tmp_path / "s").exists()

@@ -542,6 +542,31 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     )
 
 
+def _metering_options(req: NewSessionRequest, loaded) -> str:  # type: ignore[no-untyped-def]
+    """The lights of the planned run an adaptive session is advised to meter with: 6 (fewer
+    where a dome's band holds fewer) in the session's band. Why: the advice had been `--lights
+    6` over every elevation, which meters under lights the session will never fire and fires
+    them (above a gilded object's 45° ceiling, the highlight the band keeps out)."""
+    from rti_rig.app.config import rig_geometry
+    from rti_rig.core.rig_geometry import DomeGeometry
+
+    lo, hi = req.min_elevation_deg, req.max_elevation_deg
+    lights = 6
+    geometry = rig_geometry(loaded)
+    if isinstance(geometry, DomeGeometry):
+        import numpy as np
+
+        el = np.degrees(np.arcsin(np.clip(geometry.directions[:, 2], -1.0, 1.0)))
+        inside = int(((el >= lo - 1e-9) & (el <= hi + 1e-9)).sum())
+        lights = max(1, min(lights, inside))
+    out = f"--lights {lights}"
+    if lo != 0.0:
+        out += f" --min-elevation-deg {lo:g}"
+    if hi != 90.0:
+        out += f" --max-elevation-deg {hi:g}"
+    return out
+
+
 def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ignore[no-untyped-def]
     """A new adaptive session: the starting layout, the step source and the folder."""
     from rti_rig.app.rig_identity import rig_identity
@@ -550,18 +575,19 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
 
     if req.plan is not None:
         raise RtiRigError("--adaptive chooses its own lights: drop --plan")
+    # every light of the session is chosen in the band (it had been refused: the adaptive
+    # loop chose among every light the rig can run)
+    check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     if req.auto_exposure:
         refuse_unmeterable_rig(loaded)  # no planned run meters these either: say so first
         raise RtiRigError(
             "--adaptive cannot meter the exposure: its lights are chosen as the images "
             "arrive, so there is no brightest planned light to meter at. Meter once with a "
-            f"planned run (rti-rig run {req.rig_config} --out TEST --lights 6 --auto-exposure "
-            "prints 'Exposure fixed at T s'), set camera.exposure_s = T in the rig config, then "
-            "run --adaptive; drop --auto-exposure"
+            f"planned run (rti-rig run {shlex.quote(str(req.rig_config))} --out TEST "
+            f"{_metering_options(req, loaded)} --auto-exposure prints 'Exposure fixed at T s'), "
+            "set camera.exposure_s = T in the rig config, then run this command again without "
+            "--auto-exposure"
         )
-    # every light of the session is chosen in the band (it had been refused: the adaptive
-    # loop chose among every light the rig can run)
-    check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     if req.lights is not None:
         check_light_count(req.lights)
     identity = rig_identity(loaded)
