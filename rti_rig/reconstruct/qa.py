@@ -87,6 +87,9 @@ WRONG_LIGHT_SPREAD = 3.0
 #: light explains the image within 0.94-1.36× as well; swapped lights on the same painting
 #: and on the tablet read 1.77-26× (simulated dome and arm sessions, 7 swaps injected).
 WRONG_LIGHT_MISFIT_RATIO = 1.5
+#: An image clipped over more than this fraction of the object's pixels has no light
+#: direction to judge (it is told to reshoot with less exposure in any case).
+CLIPPED_DIRECTION_LIMIT = 0.5
 #: Light directions are judged only when the fitted normals spread at least this much (degrees,
 #: the smallest axis of their second moment): a flat card leaves the azimuth undetermined.
 MIN_NORMAL_SPREAD_DEG = 2.0
@@ -701,6 +704,7 @@ def assess(
         "min_normal_spread_deg": MIN_NORMAL_SPREAD_DEG,
         "wrong_light_spread": WRONG_LIGHT_SPREAD,
         "wrong_light_misfit_ratio": WRONG_LIGHT_MISFIT_RATIO,
+        "clipped_direction_limit": CLIPPED_DIRECTION_LIMIT,
         "drift_px": DRIFT_PX,
         "drift_min_lit": DRIFT_MIN_LIT,
         "drift_confirm": DRIFT_CONFIRM,
@@ -863,7 +867,12 @@ def _evidence(
     dead = np.isfinite(lit_gain) & (lit_gain < NO_LIGHT_GAIN)
     # a wrong light can look dim (its recorded light predicts a brighter image): only a frame
     # with no light at all has no direction to judge
-    cand = ~dead & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT) & np.isfinite(err)
+    # an image clipped over most of the object keeps only the pixels its light barely
+    # reaches: its best direction is fitted on those and means nothing (96-100 % clipped, the
+    # tablet's images had been told "wrong light: … 9-22° … (swapped?)" beside "saturated")
+    clipped = np.array([float(crop_sat[i][valid].mean()) if valid.any() else 0.0 for i in range(n)])
+    blinded = ~dead & (clipped > CLIPPED_DIRECTION_LIMIT)
+    cand = ~dead & ~blinded & np.isfinite(misfit) & (misfit <= MISFIT_LIMIT) & np.isfinite(err)
     nv = ps.normals[valid].astype(np.float64)
     moment = nv.T @ nv / max(len(nv), 1)
     spread_deg = float(np.degrees(np.arcsin(np.sqrt(max(np.linalg.eigvalsh(moment)[0], 0.0)))))
@@ -945,12 +954,23 @@ def _evidence(
                 mv = _confirmed_shift(pred_best, crop_arr[i], dx, dy, valid & ~crop_sat[i])[0]
             moved[i] = mv
             drift[i] = (dx, -dy)
-        skipped = [i for i in range(n) if not cand[i] and not dead[i]]
+        skipped = [i for i in range(n) if not cand[i] and not dead[i] and not blinded[i]]
         if skipped and judged.any():
             note = (
                 f"light direction not checked on {_names([names[i] for i in skipped])} "
                 f"(further than {MISFIT_LIMIT:.0%} from any Lambertian rendering of the fit: "
                 "grazing light, gloss or clipping)"
+            )
+        if blinded.any() and judged.any():
+            note = "; ".join(
+                part
+                for part in (
+                    note,
+                    "light direction not checked on "
+                    f"{_names([names[i] for i in np.flatnonzero(blinded)])} (more than "
+                    f"{CLIPPED_DIRECTION_LIMIT:.0%} of the object clipped)",
+                )
+                if part
             )
         if explained.any():
             lo, hi = (f"{v:.0f}" for v in (err[explained].min(), err[explained].max()))
@@ -962,7 +982,7 @@ def _evidence(
                     f"{lo if lo == hi else f'{lo}-{hi}'}° from the recorded light, but the "
                     "recorded light renders the image within "
                     f"{WRONG_LIGHT_MISFIT_RATIO:g}× as well (this object places its lights no "
-                    "finer: gloss or shadows pull the direction); not called wrong",
+                    "finer: gloss, shadows or clipping pull the direction); not called wrong",
                 )
                 if part
             )

@@ -620,3 +620,25 @@ def test_a_batch_says_each_session_s_notes_and_warnings(tmp_path: Path) -> None:
     warning = said.index("warning: fit.ptm not written: a PTM needs at least 6 lights, there are 5")
     assert five < warning < six  # under its own session
     assert said.count("fit.ptm not written") == 1
+
+
+#: Twelve lights in rings from 10° to 70° (the simulated dome's 12-light plan's elevations).
+TWELVE = _rings(((10, 2, 0), (25, 3, 45), (40, 3, 108), (55, 3, 22), (70, 1, 60)))
+
+
+@pytest.mark.parametrize("k", [2, 8, 10])
+def test_an_image_clipped_throughout_is_not_called_a_wrong_light(tmp_path: Path, k: int) -> None:
+    # 96-100 % clipped, its best direction was fitted on the few pixels its light barely
+    # reaches: "saturated … ; wrong light: lit from 9-22° away … (swapped?)"
+    session, _, _ = make_session(tmp_path / "s", lights=TWELVE, saturate=k)
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    qa = json.loads((out / "qa.json").read_text())
+    name = f"image_{k + 1:03d}"
+    assert set(qa["reshoot"]) == {name}, qa["verdict"]
+    assert "saturated" in qa["verdict"] and "wrong light" not in qa["verdict"], qa["verdict"]
+    assert (
+        f"light direction not checked on {name} (more than 50% of the object clipped)"
+        in (qa["verdict"])
+    )
