@@ -1165,9 +1165,16 @@ def check_min_lights(
     if min_lights is None:
         return
     if until_error_deg is None:
+        # what the session does without it is said for what the user gave (an advice naming
+        # --lights to a user who gave none had read as an option they had given)
+        without = (
+            f"with --lights {lights} alone the session shoots {lights} lights"
+            if lights is not None
+            else "add --until-error DEG (the target the stop claims), or leave --min-lights out"
+        )
         raise RtiRigError(
             f"--min-lights {min_lights} goes with --until-error (it is the fewest lights the "
-            "stop may claim the target at); with --lights N alone the session shoots N lights"
+            f"stop may claim the target at); {without}"
         )
     if min_lights < 1:
         raise RtiRigError(f"--min-lights {min_lights}: give a positive number of lights")
