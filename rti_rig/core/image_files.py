@@ -121,6 +121,36 @@ def write_srgb_jpeg(path: Path, srgb8: NDArray[np.uint8], quality: int = 95) -> 
     return _atomic_write(path, enc.tobytes())
 
 
+def pixels_sha256(pixels: NDArray[Any]) -> str:
+    """SHA-256 of an image's pixels, independent of the file that holds them: its shape, its
+    sample type and its samples in row order, little-endian.
+
+    Why, besides the file's own checksum: a linear TIFF re-saved by another tool with the same
+    pixels (a tag added, recompressed) differs byte for byte, yet what a fit reads is
+    unchanged; an edit saved over it changes the pixels. The pixel checksum tells the two
+    apart (:func:`tiff_pixels_sha256` reads a file's back)."""
+    arr = np.ascontiguousarray(pixels)
+    if arr.dtype.byteorder == ">" or (arr.dtype.byteorder == "=" and not _LITTLE):
+        arr = arr.astype(arr.dtype.newbyteorder("<"))
+    h = hashlib.sha256(f"{arr.shape}|{arr.dtype.kind}{arr.dtype.itemsize}|".encode())
+    h.update(memoryview(arr.reshape(-1).view(np.uint8)))  # the GIL is released while hashing
+    return h.hexdigest()
+
+
+_LITTLE = np.little_endian
+
+
+def tiff_pixels_sha256(path: Path) -> str | None:
+    """:func:`pixels_sha256` of the first image of the TIFF at ``path`` (None if it cannot be
+    decoded: damaged, cut short, or no TIFF at all)."""
+    import tifffile
+
+    try:
+        return pixels_sha256(tifffile.imread(path))
+    except Exception:  # tifffile raises many kinds for a damaged file; None says "unreadable"
+        return None
+
+
 def read_linear_tiff(path: Path) -> NDArray[np.uint16]:
     import tifffile
 

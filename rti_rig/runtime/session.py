@@ -36,6 +36,7 @@ import shutil
 import sys
 import time
 from collections.abc import Callable, Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -46,6 +47,8 @@ from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import (
     MOSAIC_TIFF_LABEL,
     linear_to_srgb8,
+    pixels_sha256,
+    tiff_pixels_sha256,
     write_linear_tiff,
     write_srgb_jpeg,
 )
@@ -82,6 +85,10 @@ class StepRecord:
     saturated_fraction: float
     black_fraction: float
     sha256: dict[str, str] = field(default_factory=dict)
+    #: linear TIFF → :func:`~rti_rig.core.image_files.pixels_sha256` of its pixels: a TIFF whose
+    #: bytes differ from ``sha256`` but whose pixels match was re-saved, not edited (empty in
+    #: sessions written before 2026-11-29: their TIFFs are checked by their bytes alone)
+    pixels_sha256: dict[str, str] = field(default_factory=dict)
     #: session file → the camera's (or watched folder's) own name for it
     originals: dict[str, str] = field(default_factory=dict)
     #: how the linear image was made from the RAW file (mode, CFA pattern, black/white levels
@@ -534,11 +541,19 @@ class SessionFolder:
             sha = {name: digest for name, (digest, _) in originals.items()}
             current = self.root / tif
             description = _tiff_description(decode)
-            sha[tif] = write_linear_tiff(current, frame.pixels, description=description)
-            current = self.root / jpg
-            sha[jpg] = write_srgb_jpeg(current, linear_to_srgb8(frame.pixels, frame.white_level))
+            # the pixels' checksum is taken while the files are encoded and written (hashing
+            # releases the GIL): about 0.4 s of CPU for a 24 MP frame, overlapped, not added
+            with ThreadPoolExecutor(max_workers=1) as pool:
+                pixel_digest = pool.submit(pixels_sha256, frame.pixels)
+                sha[tif] = write_linear_tiff(current, frame.pixels, description=description)
+                current = self.root / jpg
+                srgb8 = linear_to_srgb8(frame.pixels, frame.white_level)
+                sha[jpg] = write_srgb_jpeg(current, srgb8)
+                pixel_sums = {tif: pixel_digest.result()}
         except OSError as exc:
             raise SessionWriteError(current, exc) from None
+        for name in (tif, jpg, *originals):  # this process need not read them back to trust them
+            _remember_digest(self.root / name, sha[name])
         record = StepRecord(
             index=index,
             image=jpg,
@@ -548,6 +563,7 @@ class SessionFolder:
             black_fraction=frame.black_fraction,
             write_wall_s=time.perf_counter() - t0,
             sha256=sha,
+            pixels_sha256=pixel_sums,
             originals={name: source for name, (_, source) in originals.items()},
             decode=decode,
             notices=[str(n) for n in frame.metadata.get("notices") or []],
@@ -870,11 +886,45 @@ def _tiff_description(decode: dict[str, Any]) -> str | None:
     )
 
 
+#: checksums this process wrote or computed, by resolved path, with the file's identity then
+#: (device, inode, size, modification and change times in ns): a session's last verdict had
+#: read back every file the run had just written, seconds per image at 24 MP
+_KNOWN_DIGESTS: dict[str, tuple[tuple[int, int, int, int, int], str]] = {}
+
+
+def _identity(st: os.stat_result) -> tuple[int, int, int, int, int]:
+    """What changes whenever a file's content may have (its ctime moves on any write, rename
+    or ``utime``, and no tool can set it back)."""
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+
+
+def _remember_digest(path: Path, digest: str) -> None:
+    """Record ``digest`` as the checksum of ``path`` as it is now (see :data:`_KNOWN_DIGESTS`)."""
+    with contextlib.suppress(OSError):
+        _KNOWN_DIGESTS[str(Path(path).resolve())] = (_identity(path.stat()), digest)
+
+
 def _sha256(path: Path) -> str | None:
+    """SHA-256 of the file at ``path`` (None if it is not a file), read in chunks; a file this
+    process wrote or hashed and that has not changed since is not read again."""
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
+        st = path.stat()
+        key = str(path.resolve())
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    known = _KNOWN_DIGESTS.get(key)
+    if known is not None and known[0] == _identity(st):
+        return known[1]
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for chunk in iter(lambda: fh.read(1 << 22), b""):
+                h.update(chunk)
     except (FileNotFoundError, IsADirectoryError):
         return None
+    digest = h.hexdigest()
+    _KNOWN_DIGESTS[key] = (_identity(st), digest)
+    return digest
 
 
 def verified_steps(
@@ -1017,8 +1067,8 @@ def _prepare_resume(
                 )
             raise SessionError(
                 f"{root}: nothing to reshoot: this session completed all {total} steps and "
-                "every image is as captured (each JPEG matches its journaled checksum, each "
-                "linear TIFF is there)"
+                "every image is as captured (each JPEG and linear TIFF matches its journaled "
+                "checksum)"
             )
         if not lost or manifest.get("adaptive") or not reshoot_lost:
             raise SessionError(
@@ -1189,11 +1239,14 @@ def read_manifest(root: Path) -> dict[str, Any]:
 def _lost_files(
     root: Path, rec: dict[str, Any], renamed: Mapping[str, str] | None = None
 ) -> list[str]:
-    """The image files of one journaled step gone or changed since capture: its JPEG against
-    its checksum (what relight and RTIBuilder read), its linear TIFF for its presence (a fit
-    reads every pixel anyway; hashing gigabytes for a verdict would not do). RAW originals
-    are not counted: archiving them elsewhere is normal, and the images stand without them.
-    A JPEG in ``renamed`` (:func:`renamed_jpegs`) is not lost: it is there, under another name."""
+    """The image files of one journaled step gone or changed since capture: its JPEG (what
+    relight and RTIBuilder read) and its linear TIFF (what ``fit`` reads) against their
+    journaled checksums. A TIFF whose bytes differ but whose pixels match the journaled pixel
+    checksum was re-saved by another tool (a tag added, recompressed), not changed: what a fit
+    reads is as captured. A session journaled before pixel checksums has only the bytes', so
+    there any difference counts (:func:`tiff_check_note` says so). RAW originals are not
+    counted: archiving them elsewhere is normal, and the images stand without them. A JPEG in
+    ``renamed`` (:func:`renamed_jpegs`) is not lost: it is there, under another name."""
     lost = []
     for name, digest in rec["sha256"].items():
         if name not in (rec.get("image"), rec.get("linear_image")):
@@ -1203,9 +1256,48 @@ def _lost_files(
             if renamed and name in renamed:
                 continue
             lost.append(f"{name} missing")
-        elif name == rec.get("image") and _sha256(path) != digest:
+        elif _sha256(path) != digest:
+            pixels = (rec.get("pixels_sha256") or {}).get(name)
+            resaved = pixels is not None and name == rec.get("linear_image")
+            if resaved and tiff_pixels_sha256(path) == pixels:
+                continue  # re-saved with the very pixels captured
             lost.append(f"{name} changed")
     return lost
+
+
+def checksum_session_files(root: Path, stop: Callable[[], bool] | None = None) -> None:
+    """Read and checksum the JPEG and linear TIFF of every journaled step of session ``root``
+    (nothing for a folder that is no session), so that :func:`files_lost_since_capture`
+    finds their checksums known (:data:`_KNOWN_DIGESTS`) unless they change meanwhile.
+
+    Why: checking every TIFF reads the whole session once more (14 GB for 100 images of
+    24 MP); a fit runs this alongside its own work rather than after it. ``stop`` is asked
+    between files (a fit that failed or was interrupted does not wait for the rest)."""
+    root = Path(root)
+    if root.name == LP_NAME and not root.is_dir():  # a session's lights.lp given for it
+        root = root.parent
+    records = _journal_records(root)
+    for rec in _latest_records(records or []).values():
+        for name in (rec["image"], rec["linear_image"]):
+            if stop is not None and stop():
+                return
+            _sha256(root / name)
+
+
+def tiff_check_note(root: Path) -> str:
+    """What to say, once, of a session journaled before linear TIFFs had pixel checksums:
+    their bytes are checked, so a TIFF re-saved by another tool with unchanged pixels is
+    named as changed (empty for a newer session, or a folder that is no session)."""
+    records = _journal_records(Path(root))
+    if not records:
+        return ""
+    if all((r.get("pixels_sha256") or {}).get(r["linear_image"]) for r in records):
+        return ""
+    return (
+        f"{JOURNAL} predates pixel checksums (rti-rig before 2026-11-29): each linear TIFF is "
+        "checked by its bytes alone, so one re-saved by another tool with the same pixels is "
+        "named as changed too; compare it with a backup copy before reshooting it"
+    )
 
 
 def files_lost_since_capture(root: Path) -> dict[str, list[str]]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import hashlib
+import io
 import json
 import os
 import signal
@@ -476,6 +477,66 @@ def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tif
     assert r.exit_code == 2, r.output
     assert "nothing to reshoot" in said(r) and "missing or changed" not in said(r), said(r)
     assert {p: p.read_bytes() for p in done.rglob("*") if p.is_file()} == before
+
+
+def test_a_linear_tiff_edited_since_capture_is_named_and_reshot_on_request(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A colleague opened linear/image_005.tif in an editor, touched a few pixels and saved it:
+    `fit` fitted the edited pixels and said "good" (only the JPEGs were checked against their
+    checksums, the TIFFs for their presence). Now the verdict names the TIFF, --reshoot-lost
+    reshoots exactly that step (the edited file set aside, never deleted), while a TIFF
+    re-saved with the very pixels captured still counts as intact (its pixel checksum)."""
+    import tifffile
+
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    edited = done / "linear" / "image_005.tif"
+    pixels = tifffile.imread(edited)
+    pixels[10:14, 10:14] = 0  # a retouch: small enough that the QA's pixel checks cannot see it
+    tifffile.imwrite(edited, pixels, photometric="rgb")
+    resaved = done / "linear" / "image_002.tif"
+    tifffile.imwrite(resaved, tifffile.imread(resaved), photometric="rgb", description="DAM tag")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert verdict.startswith("reshoot: image_005 (linear/image_005.tif changed since capture")
+    assert "image_002" not in verdict, verdict
+    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
+    assert r.exit_code == 0, r.output
+    assert "7 of 8 images verified" in said(r) and "QA verdict: good" in said(r), said(r)
+    kept = {p.name: p.read_bytes() for p in (done / "recovered").rglob("image_*")}
+    assert set(kept) == {"image_005.tif", "image_005.jpg"}
+    assert tifffile.imread(io.BytesIO(kept["image_005.tif"]))[10, 10].tolist() == [0, 0, 0]
+
+
+def test_a_session_journaled_before_pixel_checksums_is_checked_by_bytes_and_says_so(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A session written before the TIFFs' pixel checksums (its journal has only the files'):
+    still fitted and checked, its edited TIFF named, with one note saying why a mere re-save
+    would be named too (not once per image, and no refusal)."""
+    import tifffile
+
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    records = [json.loads(line) for line in (done / "journal.jsonl").read_text().splitlines()]
+    for rec in records:
+        rec.pop("pixels_sha256", None)
+    (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit0"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    qa = json.loads((tmp_path / "fit0" / "qa.json").read_text())
+    assert qa["verdict"] == "good" and "predates" not in json.dumps(qa)
+    for name in ("image_003.tif", "image_007.tif"):
+        tif = done / "linear" / name
+        tifffile.imwrite(tif, tifffile.imread(tif) // 2, photometric="rgb")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    out = said(r)
+    assert "linear/image_003.tif changed since capture" in out
+    assert "linear/image_007.tif changed since capture" in out
+    assert out.count("predates pixel checksums") == 1, out
 
 
 def test_a_session_without_its_lights_lp_is_told_how_to_rebuild_it(

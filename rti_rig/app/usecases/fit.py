@@ -10,6 +10,7 @@ The stack is never held, as floats or otherwise; one streamed pass computes ever
 
 from __future__ import annotations
 
+import contextlib
 import html
 import json
 import math
@@ -19,7 +20,7 @@ import threading
 import time
 import warnings
 from collections.abc import Callable, Iterator
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -52,7 +53,7 @@ from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
 from rti_rig.runtime.disowned import refuse_if_disowned
-from rti_rig.runtime.session import JOURNAL, LP_NAME, MANIFEST
+from rti_rig.runtime.session import JOURNAL, LP_NAME, MANIFEST, checksum_session_files
 
 #: What ``--model`` accepts besides the registered model names.
 AUTO = "auto"
@@ -393,19 +394,37 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     out = req.out_dir
     created = not out.exists()
     prepare_out_dir(out)
+    # the QA checks every captured file against its journaled checksum: hashed while the fit
+    # works (hashing releases the GIL), not after it
+    pool, stop = ThreadPoolExecutor(max_workers=1), threading.Event()
+    checksums = (
+        pool.submit(checksum_session_files, Path(req.source), stop.is_set) if req.qa else None
+    )
     try:
-        result = _fit_into(req, out, frames, lights, names, what, notes, bands)
+        result = _fit_into(req, out, frames, lights, names, what, notes, bands, checksums)
     except BaseException:
+        stop.set()  # a failed or interrupted fit does not wait for the checksums
         _discard_outputs(out, created)  # ``out`` was new or empty: what is in it is this run's
         raise
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
     result.seconds = time.perf_counter() - t0
     return result
 
 
 def _fit_into(  # type: ignore[no-untyped-def]
-    req: FitRequest, out: Path, frames, lights, names, what: str, notes: list[str], bands
+    req: FitRequest,
+    out: Path,
+    frames,
+    lights,
+    names,
+    what: str,
+    notes: list[str],
+    bands,
+    checksums: Future[None] | None = None,
 ) -> FitResult:
-    """Every output of :func:`run_fit` written into the prepared ``out``."""
+    """Every output of :func:`run_fit` written into the prepared ``out`` (``checksums``: the
+    session's files being checksummed meanwhile, awaited before the QA)."""
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -422,6 +441,9 @@ def _fit_into(  # type: ignore[no-untyped-def]
     )
     release_free_memory()  # the fit's bands and PNG buffers, before QA reads the images again
     if req.qa:
+        if checksums is not None:
+            with contextlib.suppress(Exception):  # the QA's own check says what went wrong
+                checksums.result()
         try:
             result.qa = with_lost_files(assess(frames, lights, names), req.source)
         except ReconstructionError as exc:  # e.g. too few or coplanar lights for PS

@@ -20,6 +20,7 @@ from rti_rig.core.lp_format import read_lp
 from rti_rig.reconstruct.qa import LESS_EXPOSURE, QAReport
 from rti_rig.runtime.session import (
     JOURNAL,
+    LINEAR_DIR,
     LP_NAME,
     MANIFEST,
     files_lost_since_capture,
@@ -30,13 +31,15 @@ from rti_rig.runtime.session import (
     renamed_note,
     renamed_since_capture,
     scan_journal,
+    tiff_check_note,
     unchecked_images,
 )
 
 
 def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     """``qa`` with a problem added to each image of session ``source`` whose JPEG or linear
-    TIFF is gone or changed since capture, a caveat naming the images no journal record
+    TIFF is gone or changed since capture (checked against the journal's checksums: a TIFF
+    edited after capture changes what a fit reads), a caveat naming the images no journal record
     vouches for, and advice a replayed or adaptive session can follow (unchanged for an
     ``.lp`` acquisition, which has no journal)."""
     source = Path(source)
@@ -59,6 +62,12 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
+    if any(
+        g.startswith(f"{LINEAR_DIR}/") and g.endswith(" changed") for v in lost.values() for g in v
+    ):
+        old = tiff_check_note(source)  # a session journaled before pixel checksums: said once
+        if old:
+            qa = replace(qa, session_note=f"{qa.session_note}; {old}" if qa.session_note else old)
     todo = lost_image_advice(source, bool(read_manifest(source).get("adaptive")))
     listed = _listed(source / LP_NAME)
     images = []
