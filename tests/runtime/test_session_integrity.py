@@ -539,6 +539,30 @@ def test_a_session_journaled_before_pixel_checksums_is_checked_by_bytes_and_says
     assert out.count("predates pixel checksums") == 1, out
 
 
+def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """Both files of two steps deleted by hand: the fit stopped at the first with "image
+    .../image_004.jpg listed in .../lights.lp is missing (an .lp's image names are read relative
+    to its own folder)", neither naming the other nor what a session can do. Now it names both
+    and the ways out, and the .lp it points to fits the images that remain."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    for stem in ("image_004", "image_006"):
+        (done / f"{stem}.jpg").unlink()
+        (done / "linear" / f"{stem}.tif").unlink()
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 2, r.output
+    out = said(r)
+    assert "2 image(s) its lights.lp lists are gone" in out and "(image_004, image_006)" in out
+    assert f"rti-rig run --resume {done} --reshoot-lost" in out
+    rest = done / "rest.lp"
+    assert f"rti-rig export-lp {done} --out {rest}" in out
+    assert runner.invoke(app, ["export-lp", str(done), "--out", str(rest)]).exit_code == 0
+    r = runner.invoke(app, ["fit", str(rest), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+
+
 def test_a_session_without_its_lights_lp_is_told_how_to_rebuild_it(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

@@ -53,7 +53,16 @@ from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
 from rti_rig.reconstruct.stack import ImageStack
 from rti_rig.runtime.disowned import refuse_if_disowned
-from rti_rig.runtime.session import JOURNAL, LP_NAME, MANIFEST, checksum_session_files
+from rti_rig.runtime.session import (
+    JOURNAL,
+    LP_NAME,
+    MANIFEST,
+    checksum_session_files,
+    lost_image_advice,
+    read_manifest,
+    renamed_note,
+    renamed_since_capture,
+)
 
 #: What ``--model`` accepts besides the registered model names.
 AUTO = "auto"
@@ -286,6 +295,8 @@ def acquisition_files(
         names.append(stem)
         if not linear.is_file():
             stand_ins.append(e.name)
+    if (lp.parent / JOURNAL).is_file():
+        _refuse_lost_images(lp, [p for p in paths if not p.is_file()])
     if notes is not None and stand_ins and len(stand_ins) < len(entries):
         # a session's linear/ lacks some TIFFs: their 8-bit files are read instead, said (the
         # fit had mixed lossy 8-bit data into a linear one without a word)
@@ -296,6 +307,35 @@ def acquisition_files(
             "16-bit data; restore the TIFFs from a copy for a fully linear fit"
         )
     return lp, lights, paths, names
+
+
+def _refuse_lost_images(lp: Path, missing: list[Path]) -> None:
+    """Refuse a session whose ``lp`` lists images with neither their linear TIFF nor the file
+    listed on disk, naming them all with what to do.
+
+    Why: such a fit stopped at the first one with "image S/image_004.jpg listed in
+    S/lights.lp is missing (an .lp's image names are read relative to its own folder)", which
+    named neither the others nor the session's own ways out (a copy, ``--reshoot-lost``, or
+    an ``.lp`` of the images that remain from the journal)."""
+    if not missing:
+        return
+    root = lp.parent
+    try:
+        adaptive = bool(read_manifest(root).get("adaptive"))
+    except RtiRigError:
+        adaptive = False
+    shown = ", ".join(p.stem for p in missing[:8]) + (" …" if len(missing) > 8 else "")
+    renamed = renamed_since_capture(root)
+    moved = f" ({renamed_note(renamed)})" if renamed else ""
+    folder = shlex.quote(str(root))
+    verb = "is" if len(missing) == 1 else "are"
+    rest = shlex.quote(str(root / "rest.lp"))
+    raise FitInputError(
+        f"{root}: {len(missing)} image(s) its {lp.name} lists {verb} gone, neither the JPEG "
+        f"nor the linear TIFF on disk ({shown}){moved}: {lost_image_advice(root, adaptive)}; "
+        "or fit the images that remain, listed from the session's journal: rti-rig export-lp "
+        f"{folder} --out {rest}, then rti-rig fit {rest} --out DIR"
+    )
 
 
 def listed_image_files(source: Path) -> list[str]:
