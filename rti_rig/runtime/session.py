@@ -1266,9 +1266,10 @@ def _lost_files(
 
 
 def checksum_session_files(root: Path, stop: Callable[[], bool] | None = None) -> None:
-    """Read and checksum the JPEG and linear TIFF of every journaled step of session ``root``
-    (nothing for a folder that is no session), so that :func:`files_lost_since_capture`
-    finds their checksums known (:data:`_KNOWN_DIGESTS`) unless they change meanwhile.
+    """Read and checksum the files of every journaled step of session ``root`` (nothing for a
+    folder that is no session), so that :func:`files_lost_since_capture` and
+    :func:`originals_changed_since_capture` find their checksums known
+    (:data:`_KNOWN_DIGESTS`) unless they change meanwhile.
 
     Why: checking every TIFF reads the whole session once more (14 GB for 100 images of
     24 MP); a fit runs this alongside its own work rather than after it. ``stop`` is asked
@@ -1278,7 +1279,7 @@ def checksum_session_files(root: Path, stop: Callable[[], bool] | None = None) -
         root = root.parent
     records = _journal_records(root)
     for rec in _latest_records(records or []).values():
-        for name in (rec["image"], rec["linear_image"]):
+        for name in rec["sha256"]:  # the step's JPEG, linear TIFF and kept originals
             if stop is not None and stop():
                 return
             _sha256(root / name)
@@ -1317,6 +1318,25 @@ def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
         if gone:
             lost[Path(rec["image"]).stem] = gone
     return lost
+
+
+def originals_changed_since_capture(root: Path) -> list[str]:
+    """The camera originals a session keeps (``raw/…``, a RAW or a RAW+JPEG pair's files) that
+    are on disk but differ from their journaled checksums.
+
+    Why: a DNG opened in a raw editor that writes its metadata into the file, or an original
+    replaced by a sync tool, is no longer the camera's file the session vouches for, and
+    nothing said so. One that is gone is not named (archiving originals elsewhere is normal),
+    and neither counts as lost: the session's JPEG and linear TIFF stand without it."""
+    root = Path(root)
+    changed = []
+    for rec in _latest_records(_journal_records(root) or []).values():
+        own = (rec.get("image"), rec.get("linear_image"))
+        for name, digest in rec["sha256"].items():
+            path = root / name
+            if name not in own and path.is_file() and _sha256(path) != digest:
+                changed.append(name)
+    return sorted(changed)
 
 
 def renamed_since_capture(root: Path) -> dict[str, str]:

@@ -563,6 +563,36 @@ def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out
     assert r.exit_code == 0, r.output
 
 
+def test_a_camera_original_changed_since_capture_is_named_not_reshot(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A kept DNG into which a raw editor wrote its metadata: no longer the camera's file,
+    and nothing said so (originals were not checked at all once the session finished). Now
+    the verdict's note names it and says what to do; the images stand (no reshoot), and an
+    original archived elsewhere (gone) is still not named."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    records = [json.loads(line) for line in (done / "journal.jsonl").read_text().splitlines()]
+    (done / "raw").mkdir()
+    for rec in records:  # as a DSLR session's: each step keeps the camera's file
+        raw = f"raw/{Path(rec['image']).stem}.dng"
+        body = f"camera file {rec['index']}".encode()
+        (done / raw).write_bytes(body)
+        rec["sha256"][raw] = hashlib.sha256(body).hexdigest()
+        rec.setdefault("originals", {})[raw] = f"IMG_{rec['index']:04d}.DNG"
+    (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    (done / "raw" / "image_002.dng").unlink()  # archived elsewhere
+    (done / "raw" / "image_005.dng").write_bytes(b"camera file 4 + XMP written by an editor")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert verdict.startswith("good; raw/image_005.dng changed since capture"), verdict
+    assert "restore the original from a backup copy" in verdict
+    assert "image_002.dng" not in verdict and "reshoot" not in verdict
+    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
+    assert r.exit_code == 2 and "nothing to reshoot" in said(r), r.output
+
+
 def test_a_session_without_its_lights_lp_is_told_how_to_rebuild_it(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

@@ -26,6 +26,7 @@ from rti_rig.runtime.session import (
     files_lost_since_capture,
     image_names,
     lost_image_advice,
+    originals_changed_since_capture,
     planned_steps,
     read_manifest,
     renamed_note,
@@ -58,6 +59,17 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     renamed = renamed_since_capture(source)
     if renamed:  # there, under another name: said, and not called lost (nothing to reshoot)
         note = renamed_note(renamed)
+        qa = replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
+    originals = originals_changed_since_capture(source)
+    if originals:  # the camera's files, no longer as captured: said, not reshot
+        shown = ", ".join(originals[:5]) + (
+            f" and {len(originals) - 5} more" if len(originals) > 5 else ""
+        )
+        note = (
+            f"{shown} changed since capture (not the camera's original any more: a raw editor "
+            "that writes into the file, or a copy over it); the JPEGs and linear TIFFs do not "
+            "depend on it: restore the original from a backup copy of the folder"
+        )
         qa = replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
     lost = files_lost_since_capture(source)
     if not lost:
