@@ -593,6 +593,24 @@ def test_a_camera_original_changed_since_capture_is_named_not_reshot(
     assert r.exit_code == 2 and "nothing to reshoot" in said(r), r.output
 
 
+def test_a_session_copied_without_its_linear_folder_says_its_jpegs_stood_in(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A session copied without linear/ (left behind to save space): the fit read the 8-bit
+    JPEGs for every image without a word (the stand-in note was for a session missing some
+    TIFFs, not all), while a session journals a linear TIFF for each."""
+    import shutil
+
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    shutil.rmtree(done / "linear")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert f"{LIGHTS} of {LIGHTS} image(s) have no linear/ TIFF and were read" in said(r)
+    notes = json.loads((tmp_path / "fit" / "fit.json").read_text())["input_notes"]
+    assert any("read from their 8-bit file instead" in n for n in notes), notes
+
+
 def test_a_session_without_its_lights_lp_is_told_how_to_rebuild_it(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

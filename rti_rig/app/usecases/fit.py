@@ -297,14 +297,17 @@ def acquisition_files(
             stand_ins.append(e.name)
     if (lp.parent / JOURNAL).is_file():
         _refuse_lost_images(lp, [p for p in paths if not p.is_file()])
-    if notes is not None and stand_ins and len(stand_ins) < len(entries):
+    session = (lp.parent / JOURNAL).is_file()  # it wrote a linear TIFF for every image
+    if notes is not None and stand_ins and (len(stand_ins) < len(entries) or session):
         # a session's linear/ lacks some TIFFs: their 8-bit files are read instead, said (the
-        # fit had mixed lossy 8-bit data into a linear one without a word)
+        # fit had mixed lossy 8-bit data into a linear one without a word; and a session whose
+        # linear/ was not copied with it was fitted from its JPEGs alone without one either)
         shown = ", ".join(stand_ins[:5]) + (" ..." if len(stand_ins) > 5 else "")
+        beside = " beside linear 16-bit data" if len(stand_ins) < len(entries) else ""
         notes.append(
             f"{len(stand_ins)} of {len(entries)} image(s) have no linear/ TIFF and were read "
-            f"from their 8-bit file instead ({shown}): lossy, sRGB-decoded data beside linear "
-            "16-bit data; restore the TIFFs from a copy for a fully linear fit"
+            f"from their 8-bit file instead ({shown}): lossy, sRGB-decoded data{beside}; "
+            "restore the TIFFs from a copy for a fully linear fit"
         )
     return lp, lights, paths, names
 
