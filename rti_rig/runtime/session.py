@@ -205,6 +205,12 @@ def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
 _NO_IMAGE_FILES = {MANIFEST, JOURNAL, LP_NAME}
 
 
+#: Files an operating system's file browser leaves in any folder it shows (macOS Finder,
+#: Windows Explorer): a folder made for a session and opened there holds one before any image,
+#: and had been refused as "not empty"
+_FOLDER_METADATA = {".DS_Store", "Thumbs.db", "desktop.ini", ".directory"}
+
+
 def holds_no_image(root: Path) -> bool:
     """True if ``root`` holds nothing but an image-less session's own files."""
     for path in root.rglob("*"):
@@ -215,6 +221,8 @@ def holds_no_image(root: Path) -> bool:
             continue
         name = rel.as_posix()
         if name.startswith(".") and name.endswith((".tmp", ".partial")):
+            continue
+        if path.name in _FOLDER_METADATA:
             continue
         if name not in _NO_IMAGE_FILES:
             return False

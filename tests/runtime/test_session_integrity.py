@@ -681,6 +681,28 @@ def test_a_folder_holding_no_image_may_be_reused(
     assert digests(out) == digests(ref)
 
 
+def test_a_new_folder_a_file_browser_opened_is_not_refused_as_not_empty(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A folder made for the session in Finder or Explorer holds .DS_Store or Thumbs.db before
+    any image: `run --out` had refused it ("not empty: refusing to write a session over
+    existing files"). They are left as they are; any other file still refuses the folder."""
+    cfg, ref = reference
+    out = tmp_path / "s"
+    out.mkdir()
+    (out / ".DS_Store").write_bytes(b"\0\0\0\1Bud1")
+    (out / "Thumbs.db").write_bytes(b"thumbs")
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 0, r.output
+    assert digests(out) == digests(ref) and (out / ".DS_Store").is_file()
+    other = tmp_path / "t"
+    other.mkdir()
+    (other / ".DS_Store").write_bytes(b"x")
+    (other / "notes.txt").write_text("object 17")
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(other), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2 and "is not empty" in said(r), r.output
+
+
 # 7. Counts and caps before any layout is built -------------------------------------------------
 
 
