@@ -1092,6 +1092,7 @@ def _prepare_resume(
                 f"{root}: --reshoot-lost is for a session that completed; this one did not, and "
                 "its resume reshoots whatever it cannot verify anyway: drop --reshoot-lost"
             )
+        _refuse_lost_journal(root, names)
         done = verified_steps(root, scan.records)
     stamp = _new_stamp(root)
     if check_done is not None:
@@ -1131,6 +1132,37 @@ def _prepare_resume(
         if moved_lp is not None:
             recovered.append(moved_lp)
     return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
+
+
+def _refuse_lost_journal(root: Path, names: list[str]) -> None:
+    """Refuse to resume an interrupted session whose journal is gone while images of its later
+    steps are on disk, before anything moves.
+
+    Why: its resume had moved every image to ``recovered/`` ("0 of 16 images verified on disk,
+    25 unverified file(s) moved to recovered/") and shot them all again, never saying that the
+    journal was missing (deleted by hand, or left behind by a copy). A step begins only once the
+    previous one's journal line is on disk, so files of a step after the first prove there was
+    a journal; files of the first step alone are a kill before the first line, which a resume
+    sets aside and reshoots as ever."""
+    if (root / JOURNAL).exists():
+        return
+    first = names[0] if names else ""
+    later = sorted(
+        p.stem
+        for folder in (root, root / LINEAR_DIR, root / RAW_DIR)
+        for p in folder.glob("image_*")
+        if p.is_file() and p.stem != first and not p.stem.startswith(f"{first}_")
+    )
+    if not later:
+        return
+    count = len({stem.split("_")[1] for stem in later} | {first.split("_")[1]})
+    raise SessionError(
+        f"{root}: {JOURNAL} is missing, so none of the images on disk (about {count} steps) "
+        "can be verified as captured with its light: restore "
+        f"{JOURNAL} from a backup copy of the folder (or from where it was moved), then run "
+        f"rti-rig run --resume {shlex.quote(str(root))} again; if it is lost for good, shoot "
+        "the session again with another --out (nothing in this folder was changed)"
+    )
 
 
 def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str | None:

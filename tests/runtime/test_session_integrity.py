@@ -263,6 +263,36 @@ def test_free_space_is_checked_before_each_image(
 # 4. Junk journal lines -------------------------------------------------------------------------
 
 
+def test_a_resume_without_its_journal_is_refused_before_anything_moves(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """An interrupted session whose journal.jsonl was moved away by hand: its resume had moved
+    every image to recovered/ ("0 of 8 images verified") and shot them all again without
+    saying why. Now it is refused, naming the journal and what to do, the folder unchanged;
+    with the journal back the resume keeps every image. A kill before the first journal line
+    (files of the first step only) is still resumed as ever."""
+    cfg, ref = reference
+    out = tmp_path / "s"
+    cancelled_after(cfg, out, 3)
+    (out / "journal.jsonl").rename(tmp_path / "journal.jsonl")
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "journal.jsonl is missing" in said(r) and "restore journal.jsonl" in said(r)
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    (tmp_path / "journal.jsonl").rename(out / "journal.jsonl")
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0 and "3 of 8 images verified" in said(r), r.output
+    assert digests(out) == digests(ref)
+    # files of the first step only, and no journal: a kill before its line, resumed as ever
+    first = tmp_path / "first"
+    cancelled_after(cfg, first, 1)
+    (first / "journal.jsonl").unlink()
+    r = runner.invoke(app, ["run", "--resume", str(first)])
+    assert r.exit_code == 0 and "0 of 8 images verified" in said(r), r.output
+    assert digests(first) == digests(ref)
+
+
 @pytest.mark.parametrize(
     "junk",
     [
