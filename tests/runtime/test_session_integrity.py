@@ -584,11 +584,13 @@ def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out
     r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 2, r.output
     out = said(r)
-    assert "2 image(s) its lights.lp lists are gone" in out and "(image_004, image_006)" in out
+    assert "2 image(s) its lights.lp lists cannot be read as captured" in out
+    assert "(image_004: neither its JPEG nor its linear TIFF on disk; image_006: neither" in out
     assert f"rti-rig run --resume {done} --reshoot-lost" in out
     rest = done / "rest.lp"
-    assert f"rti-rig export-lp {done} --out {rest}" in out
-    assert runner.invoke(app, ["export-lp", str(done), "--out", str(rest)]).exit_code == 0
+    assert f"rti-rig export-lp {done} --linear --out {rest}" in out
+    r = runner.invoke(app, ["export-lp", str(done), "--linear", "--out", str(rest)])
+    assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["fit", str(rest), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 0, r.output
 
@@ -621,6 +623,30 @@ def test_a_camera_original_changed_since_capture_is_named_not_reshot(
     assert "image_002.dng" not in verdict and "reshoot" not in verdict
     r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
     assert r.exit_code == 2 and "nothing to reshoot" in said(r), r.output
+
+
+def test_a_fit_of_a_session_with_a_tiff_cut_short_names_it_before_fitting(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """linear/image_007.tif cut short by an interrupted copy: the fit stopped part-way at a
+    short read, told to "leave it out of the .lp" (of a session, whose lights.lp it rewrites).
+    Now it is refused before fitting with the session's ways out, and the .lp of the rest it
+    names (the TIFFs as captured; a JPEG-listing .lp would have read the cut TIFF again) fits."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    tif = done / "linear" / "image_007.tif"
+    tif.write_bytes(tif.read_bytes()[:5000])
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 2, r.output
+    out = said(r)
+    assert "(linear/image_007.tif: its image data runs" in out and "cut short" in out, out
+    assert f"rti-rig run --resume {done} --reshoot-lost" in out
+    assert not (tmp_path / "fit").exists()
+    rest = done / "rest.lp"
+    r = runner.invoke(app, ["export-lp", str(done), "--linear", "--out", str(rest)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["fit", str(rest), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
 
 
 def test_a_session_copied_without_its_linear_folder_says_its_jpegs_stood_in(

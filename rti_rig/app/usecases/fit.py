@@ -296,7 +296,11 @@ def acquisition_files(
         if not linear.is_file():
             stand_ins.append(e.name)
     if (lp.parent / JOURNAL).is_file():
-        _refuse_lost_images(lp, [p for p in paths if not p.is_file()])
+        # gone, or cut short (a copy interrupted): the fit had stopped part-way at the first
+        # short read, told to "leave it out of the .lp" of a session whose .lp it rewrites
+        damaged = [(p, "gone") for p in paths if not p.is_file()]
+        damaged += [(p, why) for p in paths if p.is_file() and (why := image_truncation(p))]
+        _refuse_lost_images(lp, damaged)
     session = (lp.parent / JOURNAL).is_file()  # it wrote a linear TIFF for every image
     if notes is not None and stand_ins and (len(stand_ins) < len(entries) or session):
         # a session's linear/ lacks some TIFFs: their 8-bit files are read instead, said (the
@@ -312,32 +316,39 @@ def acquisition_files(
     return lp, lights, paths, names
 
 
-def _refuse_lost_images(lp: Path, missing: list[Path]) -> None:
-    """Refuse a session whose ``lp`` lists images with neither their linear TIFF nor the file
-    listed on disk, naming them all with what to do.
+def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:
+    """Refuse a session whose ``lp`` lists images that are gone (neither their linear TIFF nor
+    the file listed on disk) or whose file to be read is cut short, naming them all with what
+    to do.
 
     Why: such a fit stopped at the first one with "image S/image_004.jpg listed in
-    S/lights.lp is missing (an .lp's image names are read relative to its own folder)", which
-    named neither the others nor the session's own ways out (a copy, ``--reshoot-lost``, or
-    an ``.lp`` of the images that remain from the journal)."""
-    if not missing:
+    S/lights.lp is missing (an .lp's image names are read relative to its own folder)", or
+    part-way through at a short read, which named neither the others nor the session's own
+    ways out (a copy, ``--reshoot-lost``, or an ``.lp`` of the images that remain from the
+    journal)."""
+    if not damaged:
         return
     root = lp.parent
     try:
         adaptive = bool(read_manifest(root).get("adaptive"))
     except RtiRigError:
         adaptive = False
-    shown = ", ".join(p.stem for p in missing[:8]) + (" …" if len(missing) > 8 else "")
+
+    def one(path: Path, why: str) -> str:
+        if why == "gone":
+            return f"{path.stem}: neither its JPEG nor its linear TIFF on disk"
+        return f"{path.relative_to(root).as_posix()}: {why}"
+
+    shown = "; ".join(one(p, why) for p, why in damaged[:8]) + (" …" if len(damaged) > 8 else "")
     renamed = renamed_since_capture(root)
     moved = f" ({renamed_note(renamed)})" if renamed else ""
     folder = shlex.quote(str(root))
-    verb = "is" if len(missing) == 1 else "are"
     rest = shlex.quote(str(root / "rest.lp"))
     raise FitInputError(
-        f"{root}: {len(missing)} image(s) its {lp.name} lists {verb} gone, neither the JPEG "
-        f"nor the linear TIFF on disk ({shown}){moved}: {lost_image_advice(root, adaptive)}; "
-        "or fit the images that remain, listed from the session's journal: rti-rig export-lp "
-        f"{folder} --out {rest}, then rti-rig fit {rest} --out DIR"
+        f"{root}: {len(damaged)} image(s) its {lp.name} lists cannot be read as captured "
+        f"({shown}){moved}: {lost_image_advice(root, adaptive)}; or fit the images that "
+        "remain, listed from the session's journal: rti-rig export-lp "
+        f"{folder} --linear --out {rest}, then rti-rig fit {rest} --out DIR"
     )
 
 
