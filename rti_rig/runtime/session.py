@@ -1481,42 +1481,48 @@ def _latest_records(records: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
 
 
 def renamed_jpegs(root: Path, records: list[dict[str, Any]]) -> dict[str, str]:
-    """The session's JPEGs missing under their journaled names that are in the folder under
-    another name with the same bytes: ``{journaled name: name found}``.
+    """The session's JPEGs and linear TIFFs missing under their journaled names that are in
+    their folder under another name with the same bytes: ``{journaled name: name found}``
+    (both relative to the session, ``linear/image_003.tif`` → ``linear/coin17_003.tif``).
 
     Why: a folder whose images were renamed one by one (``coin17_001.jpg`` for
     ``image_001.jpg``, a collection's own numbering) had every image called missing: ``fit``'s
     verdict advised reshooting them all, ``--reshoot-lost`` would have, and ``export-lp``
-    found "none of the 12 journaled image(s) on disk", of files that were all there. Only the
-    folder's JPEGs that no journal record names are read, and only when a journaled JPEG is
-    missing: a session as written, or one that lost a file, costs no hashing.
+    found "none of the 12 journaled image(s) on disk", of files that were all there; the
+    TIFFs renamed the same way in ``linear/`` were still called missing, and reshot. Only the
+    files of a folder that no journal record names are read, and only when a journaled file of
+    that folder is missing: a session as written, or one that lost a file, costs no hashing.
     """
     root = Path(root)
-    wanted: dict[str, str] = {}  # checksum -> journaled name, of the JPEGs not on disk
-    for rec in _latest_records(records).values():
-        name = rec.get("image")
-        digest = rec["sha256"].get(name) if name else None
-        if digest and not (root / name).is_file():
-            wanted.setdefault(digest, name)
-    if not wanted:
-        return {}
-    journaled = {rec.get("image") for rec in records}
     found: dict[str, str] = {}
-    try:
-        candidates = sorted(root.iterdir())
-    except OSError:
-        return {}
-    for path in candidates:
-        if (
-            path.suffix.lower() not in (".jpg", ".jpeg")
-            or path.name in journaled
-            or path.name.startswith(".")
-            or not path.is_file()
-        ):
+    kinds = (("image", "", (".jpg", ".jpeg")), ("linear_image", LINEAR_DIR, (".tif", ".tiff")))
+    for key, sub, suffixes in kinds:
+        wanted: dict[str, str] = {}  # checksum -> journaled name, of the files not on disk
+        for rec in _latest_records(records).values():
+            name = rec.get(key)
+            digest = rec["sha256"].get(name) if name else None
+            if digest and not (root / name).is_file():
+                wanted.setdefault(digest, name)
+        if not wanted:
             continue
-        name = wanted.get(_sha256(path) or "")
-        if name is not None and name not in found:
-            found[name] = path.name
+        journaled = {rec.get(key) for rec in records}
+        folder = root / sub if sub else root
+        try:
+            candidates = sorted(folder.iterdir())
+        except OSError:
+            continue
+        for path in candidates:
+            rel = path.relative_to(root).as_posix()
+            if (
+                path.suffix.lower() not in suffixes
+                or rel in journaled
+                or path.name.startswith(".")
+                or not path.is_file()
+            ):
+                continue
+            name = wanted.get(_sha256(path) or "")
+            if name is not None and name not in found:
+                found[name] = rel
     return found
 
 
@@ -1559,7 +1565,11 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
     left_out = sorted({r[key] for r in records if r["index"] not in done})
     if not done:
-        renamed = renamed_jpegs(root, records) if not linear else {}
+        renamed = {  # of the kind of file the .lp lists
+            name: there
+            for name, there in renamed_jpegs(root, records).items()
+            if name.startswith(f"{LINEAR_DIR}/") == linear
+        }
         raise SessionError(
             f"{root}: none of the {len(left_out)} journaled image(s) is on disk as captured "
             "(missing or changed), so there is no .lp to export"

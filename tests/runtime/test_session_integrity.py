@@ -478,6 +478,34 @@ def test_images_renamed_in_the_folder_are_named_as_renamed_not_lost(
     assert "image_004.jpg as coin17_004.jpg" in said(r)
 
 
+def test_tiffs_renamed_in_linear_are_named_as_renamed_not_lost(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """The TIFFs renamed in linear/ to a collection's numbering, like their JPEGs: only the
+    JPEGs were looked for under other names, so the TIFFs were called missing, the verdict
+    said "reshoot" and --reshoot-lost reshot them, setting files that were there aside. Now
+    they are named as renamed, nothing is reshot, and a fit says to give the names back."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    (done / "linear" / "image_005.tif").rename(done / "linear" / "coin17_005.tif")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert verdict.startswith("good") and "reshoot" not in verdict.split(";")[0], verdict
+    assert "linear/image_005.tif as linear/coin17_005.tif" in verdict
+    (done / "image_003.jpg").rename(done / "coin17_003.jpg")
+    (done / "linear" / "image_003.tif").rename(done / "linear" / "coin17_003.tif")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit2"), "--model", "ps"])
+    assert r.exit_code == 2, r.output
+    assert "lists are not under their session names" in said(r), said(r)
+    assert "linear/image_003.tif as linear/coin17_003.tif" in said(r)
+    assert "--reshoot-lost" not in said(r)
+    before = {p: p.read_bytes() for p in done.rglob("*") if p.is_file()}
+    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
+    assert r.exit_code == 2 and "nothing to reshoot" in said(r), r.output
+    assert {p: p.read_bytes() for p in done.rglob("*") if p.is_file()} == before
+
+
 def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tiff(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

@@ -342,6 +342,12 @@ def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:
     shown = "; ".join(one(p, why) for p, why in damaged[:8]) + (" …" if len(damaged) > 8 else "")
     renamed = renamed_since_capture(root)
     moved = f" ({renamed_note(renamed)})" if renamed else ""
+    there = {Path(name).stem for name in renamed}
+    if all(why == "gone" and path.stem in there for path, why in damaged):
+        raise FitInputError(  # all there, under other names: nothing to restore or reshoot
+            f"{root}: {len(damaged)} image(s) its {lp.name} lists are not under their session "
+            f"names: {renamed_note(renamed)}; then run this again"
+        )
     folder = shlex.quote(str(root))
     rest = shlex.quote(str(root / "rest.lp"))
     raise FitInputError(
