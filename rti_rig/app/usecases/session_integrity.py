@@ -82,19 +82,32 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             qa = replace(qa, session_note=f"{qa.session_note}; {old}" if qa.session_note else old)
     todo = lost_image_advice(source, bool(read_manifest(source).get("adaptive")))
     listed = _listed(source / LP_NAME)
+    relisted = [n for n, g in lost.items() if f"{n}.jpg" in listed and f"{n}.jpg missing" in g]
+    relight = (
+        f"{LP_NAME} still lists {'it' if len(relisted) == 1 else 'them'}, so relight (which "
+        "pairs the .lp's lines with the JPEGs in order) gives every later image the wrong light"
+    )
+    once = len(lost) > 1  # the advice said once, not after each of (say) 48 images
     images = []
     for check in qa.images:
         gone = lost.get(check.name)
         if gone:
             problem = f"{', '.join(gone)} since capture"
-            if f"{check.name}.jpg" in listed and f"{check.name}.jpg missing" in gone:
-                problem += (
-                    f"; {LP_NAME} still lists it, so relight (which pairs the .lp's lines with "
-                    "the JPEGs in order) gives every later image the wrong light"
-                )
-            check = replace(check, problems=(*check.problems, f"{problem}; {todo}"))
+            if not once:
+                problem += f"; {relight}" if check.name in relisted else ""
+                problem += f"; {todo}"
+            check = replace(check, problems=(*check.problems, problem))
         images.append(check)
-    return replace(qa, images=tuple(images))
+    qa = replace(qa, images=tuple(images))
+    if once:
+        shown = ", ".join(sorted(lost)[:8]) + (
+            f" and {len(lost) - 8} more" if len(lost) > 8 else ""
+        )
+        note = f"{len(lost)} images missing or changed since capture ({shown}): {todo}"
+        if relisted:
+            note += f"; {relight} ({', '.join(relisted[:8])}{' …' if len(relisted) > 8 else ''})"
+        qa = replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
+    return qa
 
 
 def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignore[type-arg]
