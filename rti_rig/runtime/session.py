@@ -1257,6 +1257,20 @@ def read_manifest(root: Path) -> dict[str, Any]:
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
+        if (Path(root) / JOURNAL).is_file():
+            # a session that lost its manifest (deleted, or left out of a copy): "not an rti-rig
+            # session folder" had been said of a folder of its images and journal
+            fit = (
+                f", but its images can still be fitted: rti-rig fit {shlex.quote(str(root))} "
+                "--out DIR"
+                if (Path(root) / LP_NAME).is_file()
+                else ""
+            )
+            raise SessionError(
+                f"{root} is a session folder without its {MANIFEST} (its {JOURNAL} is there): "
+                f"restore {MANIFEST} from a backup copy of the folder; without it the session "
+                f"cannot be resumed (its schedule and rig are recorded there){fit}"
+            ) from None
         raise SessionError(
             f"{root} has no {MANIFEST}: it is not an rti-rig session folder"
         ) from None

@@ -214,6 +214,11 @@ def test_a_missing_manifest_is_said_by_fit(session: Path, tmp_path: Path) -> Non
     text = said(r)
     assert f"note: {s} is a session folder without its manifest.json: fitted from" in text
     assert "cannot be resumed; restore the manifest from a copy of the session" in text
+    # and run --resume says the same of it (it had called it "not an rti-rig session folder")
+    r = runner.invoke(app, ["run", "--resume", str(s)])
+    assert r.exit_code == 2, r.output
+    assert f"{s} is a session folder without its manifest.json" in said(r), said(r)
+    assert "restore manifest.json from a backup copy" in said(r)
     # a folder of images and an .lp that never was a session (no journal) gets no such note
     plain = tmp_path / "plain"
     plain.mkdir()
