@@ -935,6 +935,21 @@ def _sha256(path: Path) -> str | None:
     return digest
 
 
+def _as_captured(root: Path, rec: dict[str, Any], name: str, digest: str | None) -> bool:
+    """Whether file ``name`` of journal record ``rec`` is on disk as captured: its bytes match
+    ``digest``, or (its linear TIFF) its pixels match the journaled pixel checksum, re-saved
+    by another tool without a change to what a fit reads. One criterion for the QA verdict,
+    ``--reshoot-lost``, a resume and ``export-lp`` (``export-lp --linear`` had left out a
+    TIFF the verdict called intact)."""
+    path = root / name
+    if _sha256(path) == digest:
+        return True
+    pixels = (rec.get("pixels_sha256") or {}).get(name)
+    if pixels is None or name != rec.get("linear_image") or not path.is_file():
+        return False
+    return tiff_pixels_sha256(path) == pixels
+
+
 def verified_steps(
     root: Path, records: list[dict[str, Any]], only: str | None = None
 ) -> dict[int, StepRecord]:
@@ -948,7 +963,7 @@ def verified_steps(
         sums = entry["sha256"]
         if only is not None:
             sums = {entry[only]: sums.get(entry[only])}
-        if all(_sha256(Path(root) / name) == digest for name, digest in sums.items()):
+        if all(_as_captured(Path(root), entry, name, digest) for name, digest in sums.items()):
             done[idx] = _to_record(entry)
         else:
             done.pop(idx, None)
@@ -1310,11 +1325,7 @@ def _lost_files(
             if renamed and name in renamed:
                 continue
             lost.append(f"{name} missing")
-        elif _sha256(path) != digest:
-            pixels = (rec.get("pixels_sha256") or {}).get(name)
-            resaved = pixels is not None and name == rec.get("linear_image")
-            if resaved and tiff_pixels_sha256(path) == pixels:
-                continue  # re-saved with the very pixels captured
+        elif not _as_captured(root, rec, name, digest):
             lost.append(f"{name} changed")
     return lost
 

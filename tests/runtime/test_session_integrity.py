@@ -563,6 +563,11 @@ def test_a_linear_tiff_edited_since_capture_is_named_and_reshot_on_request(
     verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
     assert verdict.startswith("reshoot: image_005 (linear/image_005.tif changed since capture")
     assert "image_002" not in verdict, verdict
+    # export-lp --linear judges them alike (it had left the re-saved TIFF out too)
+    r = runner.invoke(app, ["export-lp", str(done), "--linear", "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 0, r.output
+    names = [e.name for e in read_lp(tmp_path / "x.lp")]
+    assert "linear/image_002.tif" in names and "linear/image_005.tif" not in names, names
     r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
     assert r.exit_code == 0, r.output
     assert "7 of 8 images verified" in said(r) and "QA verdict: good" in said(r), said(r)
