@@ -16,8 +16,16 @@ from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
 from rti_rig.simulator.sim_lights import LightState
+from rti_rig.simulator.sim_scene import row_bands
+
+#: Poisson counts are kept as float32, exact up to here; anything above reads full well anyway.
+_COUNT_CAP = float(2**24)
+_WHITE = 65535
 
 #: A renderer maps (light direction or None, intensity) to linear radiance (H, W, 3) in [0, ~1].
+#: One that also has ``shape`` and ``rows(direction, intensity, start, stop)`` (the relief's
+#: :class:`~rti_rig.simulator.sim_scene.ReliefRenderer`) is pulled band by band, so the camera
+#: never holds the whole float64 radiance; the returned arrays are only read, never modified.
 Renderer = Callable[[NDArray[np.float64] | None, float], NDArray[np.float64]]
 
 
@@ -84,27 +92,72 @@ class SimulatedCamera:
         if not exposure_s > 0:
             raise CaptureError(self.name, f"exposure must be positive, got {exposure_s}", "capture")
         t0 = self._clock.now()
-        radiance = self._render(self._state.direction, self._state.intensity) + self._ambient
-        electrons = radiance * (self._e_per_radiance_s * exposure_s)
         rng = np.random.default_rng(self._noise_key(exposure_s))
         self._count += 1
-        if self._noise:
-            electrons = rng.poisson(np.clip(electrons, 0.0, None)).astype(np.float64)
-            electrons += rng.normal(0.0, self._read_noise, electrons.shape)
-        electrons = np.clip(electrons, 0.0, self._full_well)
+        out = self._expose(exposure_s, rng)
         self._clock.sleep(exposure_s + self._readout_s + self._transfer_s)
         if self._raw:
-            return self._through_raw(electrons / self._full_well, exposure_s, t0)
-        white = 65535
-        pixels = np.round(electrons * (white / self._full_well)).astype(np.uint16)
+            return self._through_raw(out, exposure_s, t0)
         return Frame(
-            pixels=pixels,
+            pixels=out,
             exposure_s=exposure_s,
             gain=1.0,
-            white_level=white,
+            white_level=_WHITE,
             timestamp_s=t0,
             metadata={"source": "simulated", "capture_index": self._count - 1},
         )
+
+    def _expose(self, exposure_s: float, rng: np.random.Generator) -> NDArray[np.generic]:
+        """The sensor's output (uint16 codes, or linear float in [0, 1] for ``raw``), a band of
+        rows at a time.
+
+        Why bands: whole-image float64 temporaries of a 24 MP frame are 0.6 GB each, and the
+        sensor chain made half a dozen. Every pixel still goes through the same arithmetic,
+        and the generator draws the same numbers in the same order (all the Poisson draws,
+        then all the read-noise draws, each in row order), so the image is bit for bit the one
+        a whole-image pass gives. Only the Poisson counts are kept between the two passes, as
+        float32 capped at 2**24 (exact below the cap; a count that high is clipped to the full
+        well whatever read noise is added).
+        """
+        band_of = getattr(self._render, "rows", None)
+        if band_of is None:
+            whole = self._render(self._state.direction, self._state.intensity)
+            shape = whole.shape
+
+            def band(start: int, stop: int) -> NDArray[np.float64]:
+                return whole[start:stop]
+        else:
+            shape = tuple(self._render.shape)  # type: ignore[attr-defined]
+            direction, intensity = self._state.direction, self._state.intensity
+
+            def band(start: int, stop: int) -> NDArray[np.float64]:
+                return band_of(direction, intensity, start, stop)  # type: ignore[no-any-return]
+
+        scale = self._e_per_radiance_s * exposure_s
+        out = np.empty(shape, dtype=np.float64 if self._raw else np.uint16)
+        bands = row_bands(shape[0], shape[1] if len(shape) > 1 else 1)
+        counts = np.empty(shape, dtype=np.float32) if self._noise else None
+        for a, b in bands:
+            electrons = (band(a, b) + self._ambient) * scale
+            if counts is None:
+                self._finish(electrons, out[a:b])
+            else:
+                drawn = rng.poisson(np.clip(electrons, 0.0, None))
+                counts[a:b] = np.minimum(drawn, _COUNT_CAP)
+        if counts is not None:
+            for a, b in bands:
+                electrons = counts[a:b].astype(np.float64)
+                electrons += rng.normal(0.0, self._read_noise, electrons.shape)
+                self._finish(electrons, out[a:b])
+        return out
+
+    def _finish(self, electrons: NDArray[np.float64], out: NDArray[np.generic]) -> None:
+        """Clip ``electrons`` to the well and write the band's output codes into ``out``."""
+        electrons = np.clip(electrons, 0.0, self._full_well)
+        if self._raw:
+            out[...] = electrons / self._full_well
+        else:
+            out[...] = np.round(electrons * (_WHITE / self._full_well)).astype(np.uint16)
 
     def _through_raw(self, linear: NDArray[np.float64], exposure_s: float, t0: float) -> Frame:
         """Deliver the frame as a DSLR would: Bayer mosaic → DNG → the real rawpy decode path."""
