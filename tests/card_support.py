@@ -3,6 +3,7 @@ and a session shot on it through the CLI."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +29,8 @@ def card_rig(tmp_path: Path, serial_extra: str = "", name: str = "card.toml") ->
     text = text.replace(
         'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
     )
-    text = text.replace('name = "coin"', 'name = "flat"')
+    text = re.sub(r'(?m)^name = "tablet"', 'name = "flat"', text)
+    assert 'name = "flat"' in text
     text = text.replace('profile = "default"\n', f'profile = "default"\n{serial_extra}')
     power = ", ".join(f"{p:g}" for p in TRUE_POWER)
     return write_config(tmp_path, text + f"\n[emulator]\nled_power = [{power}]\n", name)

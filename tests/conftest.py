@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -43,6 +44,18 @@ def virtual_arm_variant(tmp_path: Path, scene: str, side: int | None = None) -> 
     if side is not None:
         text = text.replace("width = 512\nheight = 512", f"width = {side}\nheight = {side}")
     return write_config(tmp_path, text.replace('name = "relief"', f'name = "{scene}"'), "arm.toml")
+
+
+def coin_dome(folder: Path, exposure_s: float = 0.05) -> Path:
+    """The shipped emulated dome (48 LEDs, real driver over a pty) shooting the polished coin at
+    ``exposure_s``, as emulated_dome.toml did until its scene became the matte tablet: at 0.05 s
+    the coin's face clips under the high LEDs (the case the QA tests below are about)."""
+    text = (CONFIGS / "emulated_dome.toml").read_text()
+    assert "exposure_s = 0.05\n" in text and re.search(r'(?m)^name = "tablet"', text)
+    text = re.sub(r'(?m)^name = "tablet"', 'name = "coin"', text)
+    text = text.replace("exposure_s = 0.05\n", f"exposure_s = {exposure_s}\n")
+    text = text.replace('"example_dome_48.lp"', f'"{(CONFIGS / "example_dome_48.lp").as_posix()}"')
+    return write_config(folder, text, "coin_dome.toml")
 
 
 SMALL_DOME = """

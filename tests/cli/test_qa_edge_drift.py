@@ -18,6 +18,7 @@ import cv2
 import numpy as np
 import pytest
 import tifffile
+from conftest import coin_dome
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -60,8 +61,9 @@ def relief(tmp_path_factory: pytest.TempPathFactory) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def coin(tmp_path_factory: pytest.TempPathFactory) -> np.ndarray:
-    out = tmp_path_factory.mktemp("coin") / "s"
-    _run(out, REPO / "rig_configs" / "emulated_dome.toml", "--no-verdict")
+    folder = tmp_path_factory.mktemp("coin")
+    _run(folder / "s", coin_dome(folder), "--no-verdict")
+    out = folder / "s"
     return _grey(out)
 
 
@@ -112,14 +114,7 @@ def test_the_glossy_coin_s_edges_give_sane_shifts_and_show_a_move(coin) -> None:
 def test_a_dark_glossy_session_that_held_still_is_not_called_moved(tmp_path: Path) -> None:
     """The emulated dome's coin at a tenth of its exposure: nothing moved, and on this object
     no move of a few pixels can be measured, which the verdict says — not "moved" by 84 px."""
-    text = (REPO / "rig_configs" / "emulated_dome.toml").read_text()
-    assert 'lp_file = "example_dome_48.lp"' in text and "exposure_s = 0.05" in text
-    lp = (REPO / "rig_configs" / "example_dome_48.lp").as_posix()
-    text = text.replace('"example_dome_48.lp"', f'"{lp}"').replace(
-        "exposure_s = 0.05", "exposure_s = 0.005"
-    )
-    config = tmp_path / "dark_coin.toml"
-    config.write_text(text)
+    config = coin_dome(tmp_path, exposure_s=0.005)
     session = tmp_path / "s"
     said = _run(session, config)
     assert "QA verdict" in said and "moved" not in said, said

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from conftest import coin_dome
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -23,7 +24,7 @@ runner = CliRunner()
 
 
 def test_the_metered_coin_has_no_image_called_dim_by_an_unclaimed_shift(tmp_path: Path) -> None:
-    config = REPO / "rig_configs" / "emulated_dome.toml"
+    config = coin_dome(tmp_path)
     r = runner.invoke(app, ["run", str(config), "--out", str(tmp_path / "s"), "--auto-exposure"])
     assert r.exit_code == 0, r.output
     text = " ".join(r.output.split())

@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, coin_dome
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -37,7 +37,7 @@ def test_a_replayed_acquisition_is_not_told_to_reshoot_with_less_exposure(tmp_pa
 
 @pytest.mark.pty
 def test_an_adaptive_session_is_not_told_to_reshoot_one_image(tmp_path: Path) -> None:
-    cfg = CONFIGS / "emulated_dome.toml"  # a polished coin at a fixed 0.05 s: the top clips
+    cfg = coin_dome(tmp_path)  # a polished coin at a fixed 0.05 s: the top clips
     r = runner.invoke(
         app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--adaptive", "--lights", "9"]
     )
@@ -51,7 +51,7 @@ def test_an_adaptive_session_is_not_told_to_reshoot_one_image(tmp_path: Path) ->
 
 @pytest.mark.pty
 def test_a_planned_session_keeps_the_advice(tmp_path: Path) -> None:
-    cfg = CONFIGS / "emulated_dome.toml"
+    cfg = coin_dome(tmp_path)
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--lights", "48"])
     assert r.exit_code == 0, r.output
     text = said(r)
