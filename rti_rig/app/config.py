@@ -188,6 +188,14 @@ class SceneConfig(_Strict):
             raise ValueError(
                 f"unknown scene {self.name!r}; choose relief, {', '.join(SCENE_NAMES)}"
             )
+        if self.name == "relief" and self.light_distance_mm is not None:
+            # the relief is rendered under directional lights only: a lamp distance given for
+            # it was silently dropped, and the dry run claimed point lamps it never rendered
+            raise ValueError(
+                "light_distance_mm has no effect on the relief scene, which is lit by "
+                "directional lights only: remove light_distance_mm, or choose a library scene "
+                f"for point lamps ({', '.join(SCENE_NAMES)})"
+            )
         return self
 
     name: str = "relief"
