@@ -338,6 +338,18 @@ class RigConfig(_Strict):
                 "they need kind = 'dome' and backend = 'emulated' (the real driver applies the "
                 "intensity correction that evens them out)"
             )
+        if (
+            self.scene.raw
+            and self.backend != "hardware"
+            and (self.camera.width % 2 or self.camera.height % 2)
+        ):
+            # refused here, not at the first capture: the mosaic encoder raised an unexplained
+            # ValueError once the session had started
+            raise ValueError(
+                "scene.raw = true delivers each frame through a 2x2 Bayer mosaic (a DNG), which "
+                f"needs an even camera width and height; got {self.camera.width} x "
+                f"{self.camera.height}: make both even, as a real sensor's are"
+            )
         if self.backend == "hardware" and self.camera.device is None:
             raise ValueError(
                 "backend 'hardware' needs a [camera.device] table naming the camera driver "
