@@ -37,6 +37,10 @@ KNOWN_PASSES = frozenset({"shadows", "specular"})
 DEFAULT_PIXEL_SIZE_MM = 0.05
 
 
+#: The smallest image side a library scene is built at (its shapes scale with the image).
+MIN_SIZE_PX = 8
+
+
 class SceneError(RtiRigError, ValueError):
     """A scene cannot be built: unknown name, bad size, or an unreadable map file."""
 
@@ -499,8 +503,11 @@ def make_scene(
     """Build the named library scene at the given size; same (name, size, seed) → same scene."""
     if name not in _BUILDERS:
         raise SceneError(f"unknown scene '{name}'; choose one of: {', '.join(SCENE_NAMES)}")
-    if int(height_px) < 8 or int(width_px) < 8:
-        raise SceneError(f"scene '{name}': size {height_px}x{width_px} too small (min 8x8)")
+    if int(height_px) < MIN_SIZE_PX or int(width_px) < MIN_SIZE_PX:
+        raise SceneError(
+            f"scene '{name}': size {height_px}x{width_px} too small "
+            f"(min {MIN_SIZE_PX}x{MIN_SIZE_PX})"
+        )
     if not pixel_size_mm > 0:
         raise SceneError(f"scene '{name}': pixel_size_mm must be > 0, got {pixel_size_mm}")
     return _BUILDERS[name](int(height_px), int(width_px), int(seed), float(pixel_size_mm))

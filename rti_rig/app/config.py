@@ -338,6 +338,19 @@ class RigConfig(_Strict):
                 "they need kind = 'dome' and backend = 'emulated' (the real driver applies the "
                 "intensity correction that evens them out)"
             )
+        if self.backend in ("simulated", "emulated"):
+            from rti_rig.simulator.scenes import MIN_SIZE_PX
+
+            # the relief's normals need two pixels a side (central differences); the library
+            # scenes MIN_SIZE_PX. A smaller frame failed at the first capture, the relief's with
+            # an unexplained numpy ValueError after the session folder was made
+            least = 2 if self.scene.name == "relief" else MIN_SIZE_PX
+            if min(self.camera.width, self.camera.height) < least:
+                raise ValueError(
+                    f"camera.width x camera.height = {self.camera.width} x "
+                    f"{self.camera.height} px is too small for the simulated scene "
+                    f"'{self.scene.name}': it needs at least {least} x {least} px"
+                )
         if (
             self.scene.raw
             and self.backend != "hardware"
