@@ -430,9 +430,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seconds", type=float, default=None, help="stop after this long")
     args = parser.parse_args(argv)
     faults = []
+    kinds = ", ".join(k.value for k in FaultKind)
     for spec in args.fault:
         at, _, kind = spec.partition(":")
-        faults.append(Fault(int(at), FaultKind(kind)))
+        try:
+            faults.append(Fault(int(at), FaultKind(kind)))
+        except ValueError:
+            parser.error(
+                f"--fault {spec}: give K:KIND, K a command number (1 = the first), KIND "
+                f"one of {kinds}"
+            )
     # SIGTERM (what a test harness or service manager sends) ends like Ctrl-C, so the pty's
     # temporary folder is removed instead of left behind in /tmp.
     signal.signal(signal.SIGTERM, signal.default_int_handler)
@@ -446,7 +453,14 @@ def main(argv: list[str] | None = None) -> int:
                 "own LED count and boot; these options are for default, framed and binary"
             )
         from rti_rig.simulator.domes import board_for
+        from rti_rig.simulator.domes.board import BOARD_FAULT_KINDS
 
+        other = sorted({f.kind.value for f in faults} - {k.value for k in BOARD_FAULT_KINDS})
+        if other:
+            parser.error(
+                f"--fault {', '.join(other)}: the {args.profile} firmware's emulator does not "
+                f"emulate it; it emulates {', '.join(k.value for k in BOARD_FAULT_KINDS)}"
+            )
         board = board_for(args.profile, faults=FaultPlan(tuple(faults)))
         with serve_on_pty(board, args.profile) as link:
             print(
@@ -484,4 +498,10 @@ def _serve_until_stopped(link: PtyLink, seconds: float | None) -> None:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    # Run the main of the module as imported, not of this ``__main__`` copy: the boards of
+    # ``rti_rig.simulator.domes`` test a fault's kind against the imported module's FaultKind,
+    # so faults built from this copy's (another class of the same name) were never applied:
+    # ``--profile nichlock --fault 3:reset`` served a board that never reset.
+    from rti_rig.simulator.dome_firmware import main as _imported_main
+
+    raise SystemExit(_imported_main())

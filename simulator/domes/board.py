@@ -30,6 +30,17 @@ from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan, Output,
 
 RX_BUFFER = 64
 
+#: The faults a board applies (:meth:`Board.begin_command`); a firmware's emulator has no
+#: other (a command damaged on the way in, a reset after the reply are the project's own
+#: protocols' emulator's), so asking one of it for another is refused, not silently ignored.
+BOARD_FAULT_KINDS = (
+    FaultKind.DROP_REPLY,
+    FaultKind.GARBLE_REPLY,
+    FaultKind.DELAY_REPLY,
+    FaultKind.RESET,
+    FaultKind.DISCONNECT,
+)
+
 
 @dataclass(frozen=True)
 class Sleep:

@@ -712,3 +712,58 @@ def test_check_fails_a_dome_whose_camera_does_not_connect(tmp_path: Path) -> Non
     assert "passed: 12, failed: 0" in text  # the lights were fine
     assert "camera: FAILED to connect" in text and str(tmp_path / "v9") in text
     assert r.output.rstrip().splitlines()[-1] == "RESULT: FAIL"
+
+
+NICHLOCK = ("--profile", "nichlock")
+
+
+@pytest.mark.slow  # a firmware served in another process, read over a real pty
+def test_a_fault_asked_of_a_served_firmware_happens() -> None:
+    """``python -m rti_rig.simulator.dome_firmware --profile nichlock --fault 1:reset``: the
+    board resets as its first command arrives. Run as ``-m``, the module's faults were built
+    from its ``__main__`` copy, whose FaultKind the boards never matched: every ``--fault`` on
+    a real firmware's emulator was silently ignored (the board answered ``m`` as if asked)."""
+    import subprocess
+
+    import serial
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rti_rig.simulator.dome_firmware", *NICHLOCK, "--fault", "1:reset"],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        port = serial.Serial(proc.stdout.readline().split()[-1], 115200, timeout=0.1)
+        banner = b"For help, press 'h'\n>"
+
+        def read_until(end: bytes) -> bytes:
+            got = b""
+            deadline = time.monotonic() + 20.0
+            while end not in got and time.monotonic() < deadline:
+                got += port.read(256)
+            return got
+
+        assert banner in read_until(banner)
+        port.write(b"m")  # command 1: the board resets instead of answering
+        again = read_until(banner)
+        port.close()
+        assert b"Reflectance Transformation Imager Serial Interface" in again, again
+        assert b"RAM bytes remaining" not in again
+    finally:
+        proc.terminate()  # the process this test started, by its own handle
+        proc.wait(timeout=10)
+
+
+def test_a_fault_a_firmware_emulator_does_not_emulate_is_refused(capsys) -> None:  # type: ignore[no-untyped-def]
+    """A kind the boards do not apply (a garbled command) had been accepted and ignored."""
+    from rti_rig.simulator.dome_firmware import main
+
+    with pytest.raises(SystemExit) as stopped:
+        main(["--profile", "nichlock", "--fault", "2:garble_command", "--seconds", "0.1"])
+    assert stopped.value.code == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "--fault garble_command: the nichlock firmware's emulator does not emulate it" in err
+    with pytest.raises(SystemExit):
+        main(["--profile", "nichlock", "--fault", "reset"])
+    assert "give K:KIND" in capsys.readouterr().err
