@@ -84,6 +84,7 @@ class LedDomeDriver:
         #: Boot banners seen since connect (initial one included).
         self.banners_seen = 0
         self._heard = False
+        self._bytes_heard = False
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -109,6 +110,7 @@ class LedDomeDriver:
     def close(self) -> None:
         self._open = False
         self._heard = False
+        self._bytes_heard = False
         self._rx.clear()
         self.transport.close()
 
@@ -124,6 +126,15 @@ class LedDomeDriver:
         a failed handshake only then: silence or bytes this codec cannot read are what a wrong
         port, baud rate or profile gives, and resending would only delay that advice."""
         return self._heard
+
+    @property
+    def bytes_heard(self) -> bool:
+        """Any byte at all came from the port since it was last opened (readable or not). A
+        port silent so far may hold a board whose first reply was lost (a USB-serial adapter
+        dropping bytes at the open, a board without a boot banner still booting): the policy
+        sends its handshake once more then (it lights nothing), where bytes no profile reads
+        are already another board's answer."""
+        return self._bytes_heard
 
     # ------------------------------------------------------------------ verbs
 
@@ -314,6 +325,7 @@ class LedDomeDriver:
 
     def _feed(self, data: bytes) -> None:
         if data:
+            self._bytes_heard = True
             traffic_log.debug("%s << %s", self.device, data.hex(" "))
             self._rx.extend(data)
 

@@ -81,6 +81,7 @@ class ScriptedDomeDriver:
         self.boot_text = ""
         self.banners_seen = 0
         self._heard = False
+        self._bytes_heard = False
         #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`),
         #: and when it ends
         self._booted = False
@@ -114,6 +115,7 @@ class ScriptedDomeDriver:
     def close(self) -> None:
         self._open = False
         self._heard = False
+        self._bytes_heard = False
         self._rx.clear()
         self.transport.close()
 
@@ -129,6 +131,15 @@ class ScriptedDomeDriver:
         wrong port, baud rate or profile gives, and resending would only delay that advice
         (and send more bytes to a board of another firmware)."""
         return self._heard
+
+    @property
+    def bytes_heard(self) -> bool:
+        """Any byte at all came from the port since it was last opened (readable or not). A
+        port silent so far may hold a board whose first reply was lost (a USB-serial adapter
+        dropping bytes at the open, a board without a boot banner still booting): the policy
+        sends its handshake once more then (it lights nothing), where bytes no profile reads
+        are already another board's answer."""
+        return self._bytes_heard
 
     def hello(self) -> DomeInfo:
         """Handshake (if the firmware has one) and the init commands; the board's state is
@@ -379,6 +390,7 @@ class ScriptedDomeDriver:
 
     def _feed(self, data: bytes) -> None:
         if data:
+            self._bytes_heard = True
             traffic_log.debug("%s << %s", self.device, data.hex(" "))
             self._rx.extend(data)
 

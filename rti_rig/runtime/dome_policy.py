@@ -397,10 +397,12 @@ class DomePolicy:
         handshake with the dome … check the port, the baud rate and the protocol profile"),
         from a board that had just sent its boot banner on that very port.
 
-        Only a board that has spoken the profile since the port opened is sent it again (see
-        :meth:`_board_spoke_profile`): silence or unreadable bytes alone are what a wrong port,
-        baud rate or profile gives, which still fails at once with that advice rather than
-        after ``retries`` more timeouts (and more bytes sent to a board of another protocol).
+        Up to ``retries`` times only to a board that has spoken the profile since the port
+        opened (see :meth:`_board_spoke_profile`): unreadable bytes are what a wrong baud rate
+        or profile gives, which still fails at once with that advice (and sends no more bytes
+        to a board of another protocol). A port wholly silent since it opened is sent it once
+        more (:meth:`_port_silent`): a board without a boot banner whose first reply was lost
+        had failed its connect there, where a wrong port now costs one more reply timeout.
         Each fault resent after is added to ``recovered``, which the caller counts only once
         the handshake got through; a lost port is raised as it is (:meth:`_connect_link`)."""
         try:
@@ -412,7 +414,7 @@ class DomePolicy:
             exc.retryable
             and attempt < self.settings.retries
             and getattr(self.link, "port_open", True)
-            and self._board_spoke_profile(exc)
+            and (self._board_spoke_profile(exc) or (attempt == 0 and self._port_silent(exc)))
         ):
             attempt += 1
             self.stats.retries += 1
@@ -440,6 +442,18 @@ class DomePolicy:
                 code=exc.code,
             ) from exc
         raise exc
+
+    def _port_silent(self, exc: DomeLinkError) -> bool:
+        """The handshake timed out on a port that has sent no byte at all since it opened.
+
+        That is a wrong or empty port, or a board whose first reply was lost: one without a
+        boot banner (an Elexol board, a board whose auto-reset is off) behind a USB-serial
+        adapter that drops bytes at the open, or still booting after the open's reset. Nothing
+        tells them apart, so the handshake is sent once more (never more): it lights nothing
+        (a handshake or init command is a query or an all-off, sent again after every reboot
+        anyway), and a wrong port costs one more reply timeout before its advice. A board that
+        sent bytes this profile cannot read is not resent to (another firmware's board)."""
+        return exc.fault is LinkFault.TIMEOUT and not getattr(self.link, "bytes_heard", True)
 
     def _board_spoke_profile(self, exc: DomeLinkError) -> bool:
         """Whether the board on the port has shown, since it was opened, that it speaks the

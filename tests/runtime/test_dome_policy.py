@@ -538,20 +538,11 @@ NEVER_SPOKE_THE_PROFILE = {
     # a board of another protocol (its banner and replies unreadable to the default codec)
     "framed board": ("framed", True, ()),
     "binary board": ("binary", True, ()),
-    # nothing on the port answers at all
-    "silent": ("default", False, range(1, 10)),
-    # a board without auto-reset sends no banner: nothing shows its profile before the
-    # handshake, so its lost first reply is not resent (the limit of telling them apart)
-    "no banner, first reply lost": ("default", False, (1,)),
 }
 
 
-@pytest.mark.parametrize("board", list(NEVER_SPOKE_THE_PROFILE))
-def test_a_board_that_never_spoke_the_profile_is_not_sent_the_handshake_again(board):
-    """A wrong port, baud rate or profile gives silence or bytes the codec cannot read. Sending
-    the handshake again would only delay the advice by ``retries`` reply timeouts (and send
-    more bytes to a board of another protocol): it fails at the first handshake, as it did."""
-    speaks, banner, dropped = NEVER_SPOKE_THE_PROFILE[board]
+def _recorded_dome(speaks: str, banner: bool, dropped) -> tuple:  # type: ignore[no-untyped-def]
+    """A dome on an in-process port that records what the host wrote."""
     clock = VirtualClock()
     fw = firmware_for(
         DomeSerialSettings(port="emulated", profile=speaks),
@@ -569,12 +560,46 @@ def test_a_board_that_never_spoke_the_profile_is_not_sent_the_handshake_again(bo
             super().write(data)
 
     dome = build_dome(DomeSerialSettings(port="emulated"), clock, transport=Recording(fw))
+    return dome, fw, writes
+
+
+@pytest.mark.parametrize("board", list(NEVER_SPOKE_THE_PROFILE))
+def test_a_board_that_never_spoke_the_profile_is_not_sent_the_handshake_again(board):
+    """A wrong baud rate or profile gives bytes the codec cannot read. Sending the handshake
+    again would only delay the advice by ``retries`` reply timeouts (and send more bytes to a
+    board of another protocol): it fails at the first handshake, as it did."""
+    dome, _fw, writes = _recorded_dome(*NEVER_SPOKE_THE_PROFILE[board])
     with pytest.raises(DeviceError, match="no handshake") as caught:
         dome.connect()
     assert dome.stats.retries == 0
     assert len(writes) == 2  # the handshake, then the all-off a failed connection sends anyway
     assert "check the port, the baud rate and the protocol profile" in str(caught.value)
     assert "gave up" not in str(caught.value)
+
+
+def test_a_silent_port_is_sent_the_handshake_once_more_then_given_the_port_advice():
+    """Nothing on the port answers at all: one more handshake (it lights nothing), never the
+    ``retries`` a board that spoke the profile gets, then the port, baud rate and profile."""
+    dome, _fw, writes = _recorded_dome("default", False, range(1, 10))
+    with pytest.raises(DeviceError, match="no handshake") as caught:
+        dome.connect()
+    assert dome.stats.retries == 1
+    assert len(writes) == 3  # the handshake twice, then the all-off
+    assert all(b" ID*" in w for w in writes[:2])  # a handshake each (a new sequence number)
+    assert "gave up after 2 attempts" in str(caught.value)
+    assert "check the port, the baud rate and the protocol profile" in str(caught.value)
+
+
+def test_a_board_without_a_banner_whose_first_reply_is_lost_is_connected():
+    """A board without auto-reset sends no banner, so nothing shows its profile before the
+    handshake; its first reply lost (a USB-serial adapter dropping bytes at the open) had
+    failed the connect with advice to check a port, baud rate and profile that were right."""
+    dome, fw, writes = _recorded_dome("default", False, (1,))
+    dome.connect()
+    assert dome.info is not None and dome.info.led_count == N_LEDS
+    assert dome.stats.retries == 1 and dome.stats.recovered == ["handshake: timeout"]
+    assert all(b" ID*" in w for w in writes[:2])  # a handshake each (a new sequence number)
+    assert fw.lit is None
 
 
 @pytest.mark.parametrize("profile", PROFILES)

@@ -767,3 +767,15 @@ def test_a_fault_a_firmware_emulator_does_not_emulate_is_refused(capsys) -> None
     with pytest.raises(SystemExit):
         main(["--profile", "nichlock", "--fault", "reset"])
     assert "give K:KIND" in capsys.readouterr().err
+
+
+def test_an_elexol_board_whose_first_reply_is_lost_is_checked(tmp_path: Path) -> None:
+    """The Elexol board sends no banner (nothing resets it when the port opens), so nothing had
+    shown it there before its ``?``: the answer lost (a USB-serial adapter dropping bytes at
+    the open) failed the check with "no handshake … check the port, the baud rate and the
+    protocol profile". ``?`` lights nothing, so it is asked once more."""
+    cfg = with_faults("elexol-24r1", tmp_path, 'faults = [{at_command = 1, kind = "drop_reply"}]\n')
+    r = runner.invoke(app, ["check", str(cfg)])
+    assert r.exit_code == 0, r.output
+    assert "no handshake" not in said(r)
+    assert "RESULT: SENT, NOT VERIFIED" in said(r) and "1 retries" in said(r)
