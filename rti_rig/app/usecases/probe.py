@@ -62,7 +62,8 @@ class ProbeResult:
             out.append(
                 "No known dome firmware answered. Domes that never answer (hadrian2/RTI_Dome) "
                 'cannot be identified by probing: set profile = "rti-dome-m" yourself, or '
-                "describe the firmware (docs/domes.md)."
+                "describe the firmware (docs/domes.md). A nichlock board set to 300 baud in its "
+                'settings menu is not listened for: profile = "nichlock" with baudrate = 300.'
             )
         else:
             out.append(f"Found: {self.profile}. Rig-config lines to use:")
@@ -116,6 +117,11 @@ _NICHLOCK_SAYS = (
 )
 
 
+#: The rates besides 9600 and 115200 that nichlock's settings menu offers and the probe listens
+#: at (its fifth, 300 baud, would need seconds for the banner alone: not tried).
+NICHLOCK_OTHER_RATES = (19200, 2400)
+
+
 def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
     """Name nichlock's firmware if ``text`` (heard at ``baud``) is its; True if it was.
 
@@ -146,6 +152,14 @@ def probe(request: ProbeRequest) -> ProbeResult:
         result.heard.append(("listen at 115200 baud", text))
         if _nichlock_found(result, text, 115200):
             return result
+        # nichlock's settings menu (``a``, ``2``) stores 19200 or 2400 too, taken at its next
+        # boot: listened for before anything is sent, since bytes at another rate reach such a
+        # board as keys of its menus (a board set so had been "No known dome firmware")
+        for rate in NICHLOCK_OTHER_RATES:
+            text = _exchange(port, rate, wait, b"", 0)
+            result.heard.append((f"listen at {rate} baud", text))
+            if _nichlock_found(result, text, rate):
+                return result
         text = _exchange(port, 38400, 0.2, b"?", 0.5)
         result.heard.append(("'?' at 38400 baud", text))
         if "USB I/O 24R1" in text:

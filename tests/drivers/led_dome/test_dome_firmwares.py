@@ -154,6 +154,22 @@ def test_probe_finds_a_nichlock_board_at_9600_without_lighting_it() -> None:
 
 
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
+def test_probe_finds_a_nichlock_board_set_to_19200_in_its_menu() -> None:
+    """nichlock's settings menu (``a``, ``2``) offers 19200 and 2400 too; a board set so was
+    "No known dome firmware answered" (only 9600 and 115200 were listened at), and every later
+    probe's bytes reached it as keys of its menus."""
+    from rti_rig.simulator.domes.nichlock import NichlockBoard
+
+    board = NichlockBoard(baudrate=19200)
+    with serve_on_pty(board, "nichlock") as link:
+        r = runner.invoke(app, ["probe", link.port])
+        assert r.exit_code == 0, r.output
+        assert 'profile = "nichlock"' in r.output and "baudrate = 19200" in r.output
+        assert b"?" not in board.heard and b"m" not in board.heard  # found by listening
+        assert all(lit == frozenset() for _, lit in board.timeline), board.timeline
+
+
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 def test_probe_says_plainly_when_nothing_known_answers() -> None:
     board = board_for("rti-dome-m")  # never answers anything
     with serve_on_pty(board, "silent") as link:
