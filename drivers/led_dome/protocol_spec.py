@@ -117,6 +117,10 @@ class ProtocolSpec(_Strict):
     reset_pattern: str | None = None
     #: Text (regex) whose appearance means the firmware refused the command.
     error_pattern: str | None = None
+    #: Text (regex) whose appearance means the firmware waits for a person, not a command
+    #: (a menu, a calibration), and what to tell the user to do about it.
+    waiting_pattern: str | None = None
+    waiting_advice: str = ""
     #: Timed LEDs: the firmware lights for this long, blocks, then switches the LED off.
     light_on_s: float | None = Field(None, gt=0, le=600)
     #: Stepping firmware: ``light`` steps to the next LED and its reply names the LED lit
@@ -130,7 +134,7 @@ class ProtocolSpec(_Strict):
     #: A line for the docs and the probe (what the firmware is, where it comes from).
     note: str = ""
 
-    @field_validator("reset_pattern", "error_pattern", "ready_pattern")
+    @field_validator("reset_pattern", "error_pattern", "ready_pattern", "waiting_pattern")
     @classmethod
     def _regex(cls, value: str | None) -> str | None:
         if value is not None:

@@ -349,6 +349,16 @@ class ScriptedDomeDriver:
             raise self._error(
                 "the board rebooted (boot banner) before answering", name, LinkFault.RESET
             )
+        if spec.waiting_pattern and (m := re.search(spec.waiting_pattern, text)):
+            self._heard = True
+            self._rx.clear()
+            advice = f": {spec.waiting_advice}" if spec.waiting_advice else ""
+            raise self._error(
+                f"the firmware is not at its command prompt: it waits for a person "
+                f"({m.group(0).strip()!r}){advice}",
+                name,
+                LinkFault.WAITING,
+            )
         if spec.error_pattern and (m := re.search(spec.error_pattern, text)):
             self._heard = True
             self._rx.clear()
@@ -395,5 +405,5 @@ class ScriptedDomeDriver:
             self._rx.extend(data)
 
     def _error(self, message: str, command: str, fault: LinkFault) -> DomeLinkError:
-        retryable = fault not in (LinkFault.REJECTED,)
+        retryable = fault not in (LinkFault.REJECTED, LinkFault.WAITING)
         return DomeLinkError(self.device, message, command, fault, retryable=retryable)

@@ -24,6 +24,9 @@ class LinkFault(StrEnum):
     RESET = "reset"  # an unexpected boot banner: the board rebooted
     DISCONNECTED = "disconnected"  # the port went away (USB drop) or is not open
     REJECTED = "rejected"  # the firmware answered ERR
+    #: The firmware waits for a person, not a command (a menu, a touch-screen calibration): no
+    #: resend helps (each would be one more key into it), and no LED is at fault.
+    WAITING = "waiting"
 
 
 class DomeLinkError(DeviceError):

@@ -9,7 +9,9 @@ step is a named error). Baud rate from EEPROM, 115200 on a fresh board: ``header
 ``DEFAULT_BAUD_RATE 115200`` and its settings menu lists "115200 (Default)"; the comment in
 ``setup()`` that says 9600 is stale. A board whose EEPROM was set otherwise needs ``baudrate``
 in the rig config. Arduino Mega: resets when the port opens and prints a banner ending with
-``For help, press 'h'`` and the prompt.
+``For help, press 'h'`` and the prompt, unless its touch screen is uncalibrated: then the boot
+waits in the calibration, which answers each key ``Recieved: <key>`` (the firmware's spelling);
+that is said as such, with what to do.
 """
 
 #: The Arduino Mega sketch steps through 192 LEDs.
@@ -36,5 +38,16 @@ SPEC = {
     },
     "reset_pattern": r"Reflectance Transformation Imager Serial Interface",
     "error_pattern": r"Did nothing; that key is not assigned",
+    # calTouch (displayCtrl.cpp) answers every key but c and s so, and nothing else does: the
+    # board boots into it while its touch screen is uncalibrated, and the display's settings
+    # page starts it too. rti-rig does not send 'c' itself: at the prompt that key starts the
+    # firmware's column test, which waits for two keys and then lights LEDs.
+    "waiting_pattern": r"Recieved: [^\r\n]*\r\n",
+    "waiting_advice": (
+        "the dome is in its touch-screen calibration (an uncalibrated screen holds every boot "
+        "there); tap the two red circles on its display, or press 'c' in a serial terminal "
+        "(115200 baud unless changed) to skip it this once, or 's' to stop it for good; then "
+        "run again"
+    ),
     "note": "nichlock/rti Arduino Mega shield: step next/all-off, position verified",
 }

@@ -795,3 +795,24 @@ def test_an_elexol_board_whose_first_reply_is_lost_is_checked(tmp_path: Path) ->
     assert r.exit_code == 0, r.output
     assert "no handshake" not in said(r)
     assert "RESULT: SENT, NOT VERIFIED" in said(r) and "1 retries" in said(r)
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_nichlock_board_held_in_its_touch_calibration_is_said_so(tmp_path: Path) -> None:
+    """An uncalibrated touch screen holds nichlock's boot in ``calTouch``, which answers each
+    key ``Recieved: x``. The check had said "a board on this port sends bytes, but none this
+    rig config's protocol profile understands: check the profile (rti-rig probe …)", and the
+    probe then named this very profile; the all-off was resent into the calibration."""
+    from rti_rig.simulator.domes.nichlock import NichlockBoard
+
+    board = NichlockBoard(touch_calibrated=False)
+    with serve_on_pty(board, "nichlock") as link:
+        cfg = _hardware(tmp_path, "emulated_nichlock.toml", link.port)
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+        assert eventually(lambda: board.heard.count(b"x") == 2)  # its own, and the closing one
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "the dome is in its touch-screen calibration" in text
+    assert "tap the two red circles on its display" in text
+    assert "check the profile" not in text and "lights are off" not in text
+    assert board.heard == b"xx"  # not resent: each would be one more key into the calibration
