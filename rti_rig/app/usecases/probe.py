@@ -33,6 +33,8 @@ class ProbeResult:
     heard: list[tuple[str, str]] = field(default_factory=list)
     lights: str = "nothing was lit by the probe"
     error: str | None = None
+    #: What else the firmware showed that the user must act on before a check (or None).
+    note: str | None = None
 
     def config_lines(self) -> list[str]:
         if self.profile is None:
@@ -69,6 +71,8 @@ class ProbeResult:
             out.append(f"Found: {self.profile}. Rig-config lines to use:")
             out += ["  " + line for line in self.config_lines()]
         out.append(f"Lights: {self.lights}")
+        if self.note:
+            out.append(f"Note: {self.note}")
         return out
 
 
@@ -134,6 +138,14 @@ def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
         return False
     result.profile, result.baudrate = "nichlock", baud
     result.lights = "the firmware boots with every LED off; nothing that lights was sent"
+    if "Starting Calibration" in text and "For help, press 'h'" not in text:
+        # beginDisplay holds the boot in calTouch while the touch screen is uncalibrated: a
+        # check then meets the calibration, not the prompt (it says so too)
+        result.note = (
+            "its boot waits in its touch-screen calibration (the screen is not calibrated): "
+            "tap the two red circles on its display, or press 'c' in a serial terminal to skip "
+            "it this once ('s' to stop it for good), before rti-rig check"
+        )
     return True
 
 

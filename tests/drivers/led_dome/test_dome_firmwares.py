@@ -170,6 +170,22 @@ def test_probe_finds_a_nichlock_board_set_to_19200_in_its_menu() -> None:
 
 
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
+def test_probe_says_a_nichlock_board_waits_in_its_touch_calibration() -> None:
+    """Its boot printed "Starting Calibration.." and never its prompt; the probe said only
+    "Found: nichlock", and the check that followed met the calibration."""
+    from rti_rig.simulator.domes.nichlock import NichlockBoard
+
+    board = NichlockBoard(touch_calibrated=False)
+    with serve_on_pty(board, "nichlock") as link:
+        r = runner.invoke(app, ["probe", link.port])
+    assert r.exit_code == 0, r.output
+    assert 'profile = "nichlock"' in r.output
+    text = said(r)
+    assert "Note: its boot waits in its touch-screen calibration" in text
+    assert "tap the two red circles on its display" in text
+
+
+@pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 def test_probe_says_plainly_when_nothing_known_answers() -> None:
     board = board_for("rti-dome-m")  # never answers anything
     with serve_on_pty(board, "silent") as link:
