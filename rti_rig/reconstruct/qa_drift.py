@@ -48,6 +48,8 @@ called moved by 2 px. Not kept.)
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
 from numpy.typing import NDArray
@@ -129,13 +131,20 @@ def _spectrum(img: NDArray[np.float64], window: NDArray[np.float64]) -> NDArray[
     return np.fft.rfft2(img * window)
 
 
+def _correlation(
+    ref_spectrum: NDArray[np.complex128], img: NDArray[np.float64], window: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The phase correlation surface of ``img`` against the reference, no shift at its centre."""
+    cross = np.conj(ref_spectrum) * _spectrum(img, window)
+    cross /= np.maximum(np.abs(cross), 1e-30)
+    return np.fft.fftshift(np.fft.irfft2(cross, s=img.shape))
+
+
 def _peak_near_zero(
     ref_spectrum: NDArray[np.complex128], img: NDArray[np.float64], window: NDArray[np.float64]
 ) -> tuple[tuple[float, float], float]:
     """:func:`local_phase_correlation` with the reference's spectrum computed once a round."""
-    cross = np.conj(ref_spectrum) * _spectrum(img, window)
-    cross /= np.maximum(np.abs(cross), 1e-30)
-    corr = np.fft.fftshift(np.fft.irfft2(cross, s=img.shape))
+    corr = _correlation(ref_spectrum, img, window)
     h, w = corr.shape
     cy, cx = h // 2, w // 2
     r = min(MAX_SHIFT_PX, cy - 3, cx - 3)
@@ -186,6 +195,126 @@ def measure_drift(
     out = np.full((n, 2), np.nan)
     out[measured] = shifts[measured]
     return out, response
+
+
+#: A step (one move part-way through the session) is looked for only with at least this many
+#: images whose edges can be placed on each side of it.
+STEP_MIN_IMAGES = 3
+#: ... and is a move when the two sides' median edge images lie further apart than this
+#: (pixels): the per-image judgement's :data:`~rti_rig.reconstruct.qa.DRIFT_PX`.
+STEP_PX = 1.0
+
+
+@dataclass(frozen=True)
+class Step:
+    """The object or the camera moved once, between images ``first - 1`` and ``first``
+    (0-based, capture order), by ``shift`` (image axes, x right, y down): the images from
+    ``first`` on against the images before it."""
+
+    first: int
+    shift: tuple[float, float]
+
+
+def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | None:
+    """A move part-way through the session (a step in the per-image shifts), or None.
+
+    Why: when the object moves for a good part of a session (from image 25 of 48, or 7 of 12)
+    every reference the per-image checks use is a blend of the two positions. The median edge
+    image of :func:`measure_drift` is half one and half the other, each image's peak against it
+    is a double one whose centroid is refused (or lands half-way), and the fit blends the two
+    as well: a move of (1, 2) px from image 25 of 48 was named on 10 of its 24 images, one of
+    (2, 0) px from image 7 of 12 on none ("good"). Two positions are plain in the *integer*
+    peaks against that median, though (0 before the move, the move after it, on the emulated
+    dome's 48 images), and the capture order says they form two runs.
+
+    So: the whole-pixel peak of each image's edges against the session's median edge image;
+    the split of the capture order into a before and an after that separates those peaks best
+    (the largest between-group sum of squares, each side at least :data:`STEP_MIN_IMAGES`
+    placed images); then the two sides' own median edge images, each made at one position and
+    over many lights (a light's own shading edges average out), correlated against each other
+    (sub-pixel, :func:`local_phase_correlation`). It is a move when they lie more than
+    :data:`STEP_PX` apart, the after side moved back by it agrees with the before side better
+    than as it is (:func:`_confirmed` logic), and the split's peaks agree with that shift.
+    """
+    n = crops.shape[0]
+    edges = [edge_image(c) if usable[i] else None for i, c in enumerate(crops)]
+    have = [i for i in range(n) if edges[i] is not None]
+    if len(have) < 2 * STEP_MIN_IMAGES:
+        return None
+    window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
+
+    def median_of(images: list[int]) -> NDArray[np.float64]:
+        return np.median(np.stack([edges[i] for i in images]), axis=0).astype(np.float64)
+
+    def peaks_against(ref: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Each image's whole-pixel peak against ``ref`` (NaN: none within the search)."""
+        out = np.full((n, 2), np.nan)
+        ref_spectrum = _spectrum(ref, window)
+        h, w = ref.shape
+        cy, cx = h // 2, w // 2
+        r = min(MAX_SHIFT_PX, cy - 3, cx - 3)
+        if r < 2:
+            return out
+        for i in have:
+            corr = _correlation(ref_spectrum, edges[i].astype(np.float64), window)
+            near = corr[cy - r : cy + r + 1, cx - r : cx + r + 1]
+            iy, ix = np.unravel_index(int(np.argmax(near)), near.shape)
+            if near[iy, ix] >= MIN_RESPONSE and 0 < iy < 2 * r and 0 < ix < 2 * r:
+                out[i] = (ix - r, iy - r)
+        return out
+
+    def best_split(peaks: NDArray[np.float64]) -> int | None:
+        """The first image after the split of the capture order that separates the placed
+        peaks best (largest between-group sum of squares)."""
+        placed = np.flatnonzero(np.isfinite(peaks[:, 0]))
+        p, m = peaks[placed], placed.size
+        best, split = 0.0, -1
+        for k in range(STEP_MIN_IMAGES, m - STEP_MIN_IMAGES + 1):
+            gap = p[:k].mean(axis=0) - p[k:].mean(axis=0)
+            score = float(gap @ gap) * k * (m - k) / m
+            if score > best:
+                best, split = score, k
+        return int(placed[split]) if split >= 0 else None
+
+    # a first split from the peaks against the blended median, then (twice) from the peaks
+    # against the median of the images before it: made at one position, it places the
+    # images after a move at the move
+    first = best_split(peaks_against(median_of(have)))
+    peaks = np.full((n, 2), np.nan)
+    for _ in range(2):
+        if first is None:
+            return None
+        before = [i for i in have if i < first]
+        if len(before) < STEP_MIN_IMAGES or len(have) - len(before) < STEP_MIN_IMAGES:
+            return None
+        peaks = peaks_against(median_of(before))
+        first = best_split(peaks)
+    if first is None:
+        return None
+    before = [i for i in have if i < first]
+    after = [i for i in have if i >= first]
+    if len(before) < STEP_MIN_IMAGES or len(after) < STEP_MIN_IMAGES:
+        return None
+    ref_a, ref_b = median_of(before), median_of(after)
+    (dx, dy), response = local_phase_correlation(ref_a, ref_b, window)
+    if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
+        return None
+    as_is, moved_back = _agreement(ref_a, ref_b, dx, dy)
+    if not moved_back > as_is:
+        return None
+    # the images, one by one, must sit where the step says: those after it at the move, those
+    # before at none (two groups of lights whose shading edges differ would not)
+    tol = max(1.0, 0.5 * float(np.hypot(dx, dy)))
+    pa, pb = peaks[before], peaks[after]
+    pa, pb = pa[np.isfinite(pa[:, 0])], pb[np.isfinite(pb[:, 0])]
+    if len(pa) < STEP_MIN_IMAGES or len(pb) < STEP_MIN_IMAGES:
+        return None
+    if (
+        np.hypot(*np.median(pa, axis=0)) > tol
+        or np.hypot(*(np.median(pb, axis=0) - (dx, dy))) > tol
+    ):
+        return None
+    return Step(first, (float(dx), float(dy)))
 
 
 #: The edge shifts are trusted when their robust spread about the session's median is at
