@@ -200,6 +200,8 @@ def measure_drift(
 #: A step (one move part-way through the session) is looked for only with at least this many
 #: images whose edges can be placed on each side of it.
 STEP_MIN_IMAGES = 3
+#: ... and when at least this share of the images on each side sit where the step says.
+STEP_AGREE = 0.75
 #: ... and is a move when the two sides' median edge images lie further apart than this
 #: (pixels): the per-image judgement's :data:`~rti_rig.reconstruct.qa.DRIFT_PX`.
 STEP_PX = 1.0
@@ -276,25 +278,62 @@ def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | N
                 best, split = score, k
         return int(placed[split]) if split >= 0 else None
 
-    # a first split from the peaks against the blended median, then (twice) from the peaks
-    # against the median of the images before it: made at one position, it places the
-    # images after a move at the move
-    first = best_split(peaks_against(median_of(have)))
-    peaks = np.full((n, 2), np.nan)
-    for _ in range(2):
+    def moved_labels(ref: NDArray[np.float64], dx: float, dy: float) -> NDArray[np.float64]:
+        """1 where an image's edges moved back by ``(dx, dy)`` agree with ``ref`` better than
+        as they are, 0 where worse, NaN where not measured."""
+        out = np.full(n, np.nan)
+        for i in have:
+            as_is, back = _agreement(ref, edges[i], dx, dy)
+            if np.isfinite(as_is) and np.isfinite(back):
+                out[i] = float(back > as_is)
+        return out
+
+    def label_split(labels: NDArray[np.float64]) -> int | None:
+        """The first image after the split that the labels agree with most."""
+        known = np.flatnonzero(np.isfinite(labels))
+        lab, m = labels[known], known.size
+        best, split = -1.0, -1
+        for k in range(STEP_MIN_IMAGES, m - STEP_MIN_IMAGES + 1):
+            agree = float((lab[:k] == 0).sum() + (lab[k:] == 1).sum())
+            if agree > best:
+                best, split = agree, k
+        return int(known[split]) if split >= 0 else None
+
+    def sides(first: int | None) -> tuple[list[int], list[int]] | None:
         if first is None:
             return None
         before = [i for i in have if i < first]
-        if len(before) < STEP_MIN_IMAGES or len(have) - len(before) < STEP_MIN_IMAGES:
+        after = [i for i in have if i >= first]
+        if len(before) < STEP_MIN_IMAGES or len(after) < STEP_MIN_IMAGES:
             return None
-        peaks = peaks_against(median_of(before))
-        first = best_split(peaks)
-    if first is None:
+        return before, after
+
+    # A first split from the whole-pixel peaks against the blended median; then the shift
+    # between the two sides' medians, and each image labelled by whether its edges moved back
+    # by that shift agree better with the before side's (a hypothesis test, no peak to find:
+    # an image under a grazing or weak light places no peak, but still tells which of two
+    # known positions it is at); the split the labels agree with most, twice.
+    first = best_split(peaks_against(median_of(have)))
+    labels = np.full(n, np.nan)
+    dx = dy = float("nan")
+    for _ in range(3):
+        split = sides(first)
+        if split is None:
+            return None
+        before, after = split
+        ref_a = median_of(before)
+        (dx, dy), response = local_phase_correlation(ref_a, median_of(after), window)
+        if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
+            return None
+        labels = moved_labels(ref_a, dx, dy)
+        refined = label_split(labels)
+        if refined == first:
+            break
+        first = refined
+    split = sides(first)
+    if split is None:
         return None
-    before = [i for i in have if i < first]
-    after = [i for i in have if i >= first]
-    if len(before) < STEP_MIN_IMAGES or len(after) < STEP_MIN_IMAGES:
-        return None
+    before, after = split
     ref_a, ref_b = median_of(before), median_of(after)
     (dx, dy), response = local_phase_correlation(ref_a, ref_b, window)
     if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
@@ -302,17 +341,15 @@ def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | N
     as_is, moved_back = _agreement(ref_a, ref_b, dx, dy)
     if not moved_back > as_is:
         return None
-    # the images, one by one, must sit where the step says: those after it at the move, those
-    # before at none (two groups of lights whose shading edges differ would not)
-    tol = max(1.0, 0.5 * float(np.hypot(dx, dy)))
-    pa, pb = peaks[before], peaks[after]
-    pa, pb = pa[np.isfinite(pa[:, 0])], pb[np.isfinite(pb[:, 0])]
-    if len(pa) < STEP_MIN_IMAGES or len(pb) < STEP_MIN_IMAGES:
+    # the images, one by one, must sit where the step says: most of those after it at the
+    # move, most of those before at none (two groups of lights whose shading edges differ
+    # would not)
+    labels = moved_labels(ref_a, dx, dy)
+    la, lb = labels[before], labels[after]
+    la, lb = la[np.isfinite(la)], lb[np.isfinite(lb)]
+    if la.size < STEP_MIN_IMAGES or lb.size < STEP_MIN_IMAGES:
         return None
-    if (
-        np.hypot(*np.median(pa, axis=0)) > tol
-        or np.hypot(*(np.median(pb, axis=0) - (dx, dy))) > tol
-    ):
+    if la.mean() > 1 - STEP_AGREE or lb.mean() < STEP_AGREE:
         return None
     return Step(first, (float(dx), float(dy)))
 
