@@ -36,7 +36,7 @@ import shutil
 import sys
 import time
 from collections.abc import Callable, Mapping
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -203,6 +203,18 @@ def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
 #: Files a session folder that holds no image may contain (left by a session that stopped
 #: before its first image): such a folder may be reused for a new session.
 _NO_IMAGE_FILES = {MANIFEST, JOURNAL, LP_NAME}
+
+
+_HASH_POOL: ThreadPoolExecutor | None = None
+
+
+def _hash_pool() -> ThreadPoolExecutor:
+    """The one thread that checksums a step's pixels while its files are written (made on
+    first use and kept: a session writes hundreds of steps, each had started a thread)."""
+    global _HASH_POOL
+    if _HASH_POOL is None:
+        _HASH_POOL = ThreadPoolExecutor(max_workers=1, thread_name_prefix="pixel-sha256")
+    return _HASH_POOL
 
 
 #: Files an operating system's file browser leaves in any folder it shows (macOS Finder,
@@ -551,13 +563,15 @@ class SessionFolder:
             description = _tiff_description(decode)
             # the pixels' checksum is taken while the files are encoded and written (hashing
             # releases the GIL): about 0.4 s of CPU for a 24 MP frame, overlapped, not added
-            with ThreadPoolExecutor(max_workers=1) as pool:
-                pixel_digest = pool.submit(pixels_sha256, frame.pixels)
+            pixel_digest = _hash_pool().submit(pixels_sha256, frame.pixels)
+            try:
                 sha[tif] = write_linear_tiff(current, frame.pixels, description=description)
                 current = self.root / jpg
                 srgb8 = linear_to_srgb8(frame.pixels, frame.white_level)
                 sha[jpg] = write_srgb_jpeg(current, srgb8)
-                pixel_sums = {tif: pixel_digest.result()}
+            finally:
+                wait((pixel_digest,))  # the frame's hash ends before the step does
+            pixel_sums = {tif: pixel_digest.result()}
         except OSError as exc:
             raise SessionWriteError(current, exc) from None
         for name in (tif, jpg, *originals):  # this process need not read them back to trust them
