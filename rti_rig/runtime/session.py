@@ -34,6 +34,7 @@ import platform
 import shlex
 import shutil
 import sys
+import threading
 import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor, wait
@@ -910,8 +911,22 @@ def _tiff_description(decode: dict[str, Any]) -> str | None:
 
 #: checksums this process wrote or computed, by resolved path, with the file's identity then
 #: (device, inode, size, modification and change times in ns): a session's last verdict had
-#: read back every file the run had just written, seconds per image at 24 MP
+#: read back every file the run had just written, seconds per image at 24 MP. At most
+#: :data:`_KNOWN_LIMIT` are kept, the oldest given up first (a long-lived process, such as a
+#: GUI that runs session after session, had kept one for every file it ever wrote or read)
 _KNOWN_DIGESTS: dict[str, tuple[tuple[int, int, int, int, int], str]] = {}
+_KNOWN_LIMIT = 1 << 16  # files: a few sessions' worth, some 15 MB at most
+_KNOWN_LOCK = threading.Lock()  # a fit checksums its session on a thread of its own
+
+
+def _know(key: str, identity: tuple[int, int, int, int, int], digest: str) -> None:
+    """Keep ``digest`` of the file at resolved path ``key`` with its ``identity``, within
+    :data:`_KNOWN_LIMIT`."""
+    with _KNOWN_LOCK:
+        _KNOWN_DIGESTS.pop(key, None)  # to the newest end
+        _KNOWN_DIGESTS[key] = (identity, digest)
+        while len(_KNOWN_DIGESTS) > _KNOWN_LIMIT:
+            del _KNOWN_DIGESTS[next(iter(_KNOWN_DIGESTS))]
 
 
 def _identity(st: os.stat_result) -> tuple[int, int, int, int, int]:
@@ -923,7 +938,7 @@ def _identity(st: os.stat_result) -> tuple[int, int, int, int, int]:
 def _remember_digest(path: Path, digest: str) -> None:
     """Record ``digest`` as the checksum of ``path`` as it is now (see :data:`_KNOWN_DIGESTS`)."""
     with contextlib.suppress(OSError):
-        _KNOWN_DIGESTS[str(Path(path).resolve())] = (_identity(path.stat()), digest)
+        _know(str(Path(path).resolve()), _identity(path.stat()), digest)
 
 
 def _sha256(path: Path) -> str | None:
@@ -945,7 +960,7 @@ def _sha256(path: Path) -> str | None:
     except (FileNotFoundError, IsADirectoryError):
         return None
     digest = h.hexdigest()
-    _KNOWN_DIGESTS[key] = (_identity(st), digest)
+    _know(key, _identity(st), digest)
     return digest
 
 
