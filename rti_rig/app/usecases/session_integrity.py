@@ -59,7 +59,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     renamed = renamed_since_capture(source)
     if renamed:  # there, under another name: said, and not called lost (nothing to reshoot)
         note = renamed_note(renamed)
-        qa = replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
+        qa = _noted(qa, note)
     originals = originals_changed_since_capture(source)
     if originals:  # the camera's files, no longer as captured: said, not reshot
         shown = ", ".join(originals[:5]) + (
@@ -70,7 +70,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             "that writes into the file, or a copy over it); the JPEGs and linear TIFFs do not "
             "depend on it: restore the original from a backup copy of the folder"
         )
-        qa = replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
+        qa = _noted(qa, note)
     lost = files_lost_since_capture(source)
     if not lost:
         return qa
@@ -79,7 +79,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     ):
         old = tiff_check_note(source)  # a session journaled before pixel checksums: said once
         if old:
-            qa = replace(qa, session_note=f"{qa.session_note}; {old}" if qa.session_note else old)
+            qa = _noted(qa, old)
     todo = lost_image_advice(source, bool(read_manifest(source).get("adaptive")))
     listed = _listed(source / LP_NAME)
     relisted = [n for n, g in lost.items() if f"{n}.jpg" in listed and f"{n}.jpg missing" in g]
@@ -106,8 +106,13 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         note = f"{len(lost)} images missing or changed since capture ({shown}): {todo}"
         if relisted:
             note += f"; {relight} ({', '.join(relisted[:8])}{' …' if len(relisted) > 8 else ''})"
-        qa = replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
+        qa = _noted(qa, note)
     return qa
+
+
+def _noted(qa: QAReport, note: str) -> QAReport:
+    """``qa`` with ``note`` added to its session note."""
+    return replace(qa, session_note=f"{qa.session_note}; {note}" if qa.session_note else note)
 
 
 def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignore[type-arg]
@@ -168,8 +173,7 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
         f"the session is not finished ({taken} {of} images; {how}): this verdict judges the "
         f"images taken so far; continue it with rti-rig run --resume {shlex.quote(str(source))}"
     )
-    joined = f"{qa.session_note}; {note}" if qa.session_note else note
-    return replace(qa, session_note=joined)
+    return _noted(qa, note)
 
 
 def _with_unchecked(qa: QAReport, source: Path) -> QAReport:
