@@ -295,13 +295,13 @@ def acquisition_files(
         names.append(stem)
         if not linear.is_file():
             stand_ins.append(e.name)
-    if (lp.parent / JOURNAL).is_file():
+    session = (lp.parent / JOURNAL).is_file()  # it wrote a linear TIFF for every image
+    if session:
         # gone, or cut short (a copy interrupted): the fit had stopped part-way at the first
         # short read, told to "leave it out of the .lp" of a session whose .lp it rewrites
         damaged = [(p, "gone") for p in paths if not p.is_file()]
         damaged += [(p, why) for p in paths if p.is_file() and (why := image_truncation(p))]
         _refuse_lost_images(lp, damaged)
-    session = (lp.parent / JOURNAL).is_file()  # it wrote a linear TIFF for every image
     if notes is not None and stand_ins and (len(stand_ins) < len(entries) or session):
         # a session's linear/ lacks some TIFFs: their 8-bit files are read instead, said (the
         # fit had mixed lossy 8-bit data into a linear one without a word; and a session whose
