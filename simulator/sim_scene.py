@@ -108,10 +108,13 @@ class ReliefRenderer:
         """Radiance of image rows ``start:stop``."""
         if direction is None:
             return np.zeros((stop - start, *self.shape[1:]))
-        normals = _normals_rows(self._height, start, stop)
-        cos = np.clip(normals @ np.asarray(direction, dtype=np.float64), 0.0, None)
-        albedo = self._base[self._iy[start:stop]][:, self._ix]
-        return albedo * (intensity * cos)[..., None]
+        band = HeightFieldScene(
+            "relief",
+            self._height[start:stop],
+            _normals_rows(self._height, start, stop),
+            self._base[self._iy[start:stop]][:, self._ix],
+        )
+        return lambert_radiance(band, direction, intensity)
 
     def __call__(
         self, direction: NDArray[np.float64] | None, intensity: float
