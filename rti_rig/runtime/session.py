@@ -1534,7 +1534,9 @@ def _latest_records(records: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
     return {rec["index"]: rec for rec in records}
 
 
-def renamed_jpegs(root: Path, records: list[dict[str, Any]]) -> dict[str, str]:
+def renamed_jpegs(
+    root: Path, records: list[dict[str, Any]], only: str | None = None
+) -> dict[str, str]:
     """The session's JPEGs and linear TIFFs missing under their journaled names that are in
     their folder under another name with the same bytes: ``{journaled name: name found}``
     (both relative to the session, ``linear/image_003.tif`` → ``linear/coin17_003.tif``).
@@ -1546,11 +1548,14 @@ def renamed_jpegs(root: Path, records: list[dict[str, Any]]) -> dict[str, str]:
     TIFFs renamed the same way in ``linear/`` were still called missing, and reshot. Only the
     files of a folder that no journal record names are read, and only when a journaled file of
     that folder is missing: a session as written, or one that lost a file, costs no hashing.
+    ``only`` (``"image"`` or ``"linear_image"``) looks for that kind of file alone.
     """
     root = Path(root)
     found: dict[str, str] = {}
     kinds = (("image", "", (".jpg", ".jpeg")), ("linear_image", LINEAR_DIR, (".tif", ".tiff")))
     for key, sub, suffixes in kinds:
+        if only is not None and key != only:
+            continue
         wanted: dict[str, str] = {}  # checksum -> journaled name, of the files not on disk
         for rec in _latest_records(records).values():
             name = rec.get(key)
@@ -1619,11 +1624,7 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
     left_out = sorted({r[key] for r in records if r["index"] not in done})
     if not done:
-        renamed = {  # of the kind of file the .lp lists
-            name: there
-            for name, there in renamed_jpegs(root, records).items()
-            if name.startswith(f"{LINEAR_DIR}/") == linear
-        }
+        renamed = renamed_jpegs(root, records, only=key)  # of the kind of file the .lp lists
         raise SessionError(
             f"{root}: none of the {len(left_out)} journaled image(s) is on disk as captured "
             "(missing or changed), so there is no .lp to export"
