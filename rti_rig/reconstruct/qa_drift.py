@@ -312,39 +312,28 @@ def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | N
     # between the two sides' medians, and each image labelled by whether its edges moved back
     # by that shift agree better with the before side's (a hypothesis test, no peak to find:
     # an image under a grazing or weak light places no peak, but still tells which of two
-    # known positions it is at); the split the labels agree with most, twice.
+    # known positions it is at); the split the labels agree with most, up to three times.
     first = best_split(peaks_against(median_of(have)))
-    labels = np.full(n, np.nan)
-    dx = dy = float("nan")
-    for _ in range(3):
+    for rnd in range(4):  # three refinements; the split they end on is judged below
         split = sides(first)
         if split is None:
             return None
         before, after = split
-        ref_a = median_of(before)
-        (dx, dy), response = local_phase_correlation(ref_a, median_of(after), window)
+        ref_a, ref_b = median_of(before), median_of(after)
+        (dx, dy), response = local_phase_correlation(ref_a, ref_b, window)
         if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
             return None
         labels = moved_labels(ref_a, dx, dy)
-        refined = label_split(labels)
+        refined = label_split(labels) if rnd < 3 else first
         if refined == first:
             break
         first = refined
-    split = sides(first)
-    if split is None:
-        return None
-    before, after = split
-    ref_a, ref_b = median_of(before), median_of(after)
-    (dx, dy), response = local_phase_correlation(ref_a, ref_b, window)
-    if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
-        return None
     as_is, moved_back = _agreement(ref_a, ref_b, dx, dy)
     if not moved_back > as_is:
         return None
     # the images, one by one, must sit where the step says: most of those after it at the
     # move, most of those before at none (two groups of lights whose shading edges differ
     # would not)
-    labels = moved_labels(ref_a, dx, dy)
     la, lb = labels[before], labels[after]
     la, lb = la[np.isfinite(la)], lb[np.isfinite(lb)]
     if la.size < STEP_MIN_IMAGES or lb.size < STEP_MIN_IMAGES:
