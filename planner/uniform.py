@@ -28,6 +28,17 @@ def band_text(min_elevation_deg: float, max_elevation_deg: float) -> str:
     return f" at or above {min_elevation_deg:g}° elevation" if min_elevation_deg > 0 else ""
 
 
+def band_run_options(lights: int, min_elevation_deg: float, max_elevation_deg: float) -> str:
+    """``--lights N`` and the ``--min/--max-elevation-deg`` (those not at their defaults) of a
+    planned run that keeps to a band: the advice of a refusal that sends the user to one."""
+    out = f"--lights {lights}"
+    if min_elevation_deg != 0.0:
+        out += f" --min-elevation-deg {min_elevation_deg:g}"
+    if max_elevation_deg != 90.0:
+        out += f" --max-elevation-deg {max_elevation_deg:g}"
+    return out
+
+
 def select_uniform_leds(
     dome: DomeGeometry,
     n: int,

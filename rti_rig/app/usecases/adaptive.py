@@ -62,7 +62,7 @@ from rti_rig.planner.adaptive_bias import simulate_error_deg
 from rti_rig.planner.adaptive_relight import OBJECTIVES
 from rti_rig.planner.adaptive_until import choose_until, reaches_target, upper_error_deg
 from rti_rig.planner.objectives import candidates_for, snap_unique
-from rti_rig.planner.uniform import select_uniform_leds
+from rti_rig.planner.uniform import band_run_options, select_uniform_leds
 
 #: Width (px) of the grey copies the decisions are fitted on (a 24-MP image is shrunk once).
 FIT_PX = 128
@@ -1232,27 +1232,15 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
         return
     widen = " (or widen --min/--max-elevation-deg)" if tuple(band) != _FULL_BAND else ""
     noun = "light" if offered == 1 else "lights"
+    # the band's lights (the bare `rti-rig run RIG --out DIR` fires every LED, those the band
+    # keeps out above a gilded object's ceiling too)
+    in_band = "" if tuple(band) == _FULL_BAND else " " + band_run_options(offered, *band)
     raise RtiRigError(
         f"this rig offers {offered} {noun}{_band_words(band)}, and an adaptive session starts "
         f"from {START_LIGHTS} and chooses the next ones: there is none left to choose. Shoot "
         f"them all with a planned run: rti-rig run {shlex.quote(str(loaded.path))} --out DIR"
-        f"{_band_options(band, offered)}{widen}"
+        f"{in_band}{widen}"
     )
-
-
-def _band_options(band: tuple[float, float], offered: int) -> str:
-    """The planned run's options that keep to ``band`` and take its ``offered`` lights (nothing
-    for every elevation). The advice had been the bare `rti-rig run RIG --out DIR`: every LED
-    of the dome, the ones the band was asked to keep out (above a gilded object's ceiling)
-    too."""
-    if tuple(band) == _FULL_BAND:
-        return ""
-    out = f" --lights {offered}"
-    if band[0] != _FULL_BAND[0]:
-        out += f" --min-elevation-deg {band[0]:g}"
-    if band[1] != _FULL_BAND[1]:
-        out += f" --max-elevation-deg {band[1]:g}"
-    return out
 
 
 def open_adaptive_session(  # type: ignore[no-untyped-def]

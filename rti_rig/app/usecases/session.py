@@ -549,22 +549,18 @@ def _metering_options(req: NewSessionRequest, loaded) -> str:  # type: ignore[no
     them (above a gilded object's 45° ceiling, the highlight the band keeps out)."""
     from rti_rig.app.config import rig_geometry
     from rti_rig.core.rig_geometry import DomeGeometry
+    from rti_rig.planner.uniform import band_run_options
 
     lo, hi = req.min_elevation_deg, req.max_elevation_deg
     lights = 6
     geometry = rig_geometry(loaded)
     if isinstance(geometry, DomeGeometry):
-        import numpy as np
+        from rti_rig.core.geometry import az_el_from_direction
 
-        el = np.degrees(np.arcsin(np.clip(geometry.directions[:, 2], -1.0, 1.0)))
+        _, el = az_el_from_direction(geometry.directions)  # as the planner bands its LEDs
         inside = int(((el >= lo - 1e-9) & (el <= hi + 1e-9)).sum())
         lights = max(1, min(lights, inside))
-    out = f"--lights {lights}"
-    if lo != 0.0:
-        out += f" --min-elevation-deg {lo:g}"
-    if hi != 90.0:
-        out += f" --max-elevation-deg {hi:g}"
-    return out
+    return band_run_options(lights, lo, hi)
 
 
 def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ignore[no-untyped-def]
