@@ -19,11 +19,13 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from rti_rig.app.config import LoadedRig, rig_geometry
+from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 
 #: How each identity key is named in a refusal.
@@ -173,25 +175,15 @@ def _moved_lights(before: Any, now: Any) -> str | None:
     which the ``lights`` key names)."""
     if not isinstance(before, list) or not isinstance(now, list) or len(before) != len(now):
         return None
-    angles = []
-    for a, b in zip(before, now, strict=True):
-        dot = sum(float(x) * float(y) for x, y in zip(a, b, strict=True))
-        na = math.sqrt(sum(float(x) ** 2 for x in a))
-        nb = math.sqrt(sum(float(y) ** 2 for y in b))
-        # atan2 of |a×b| and a·b: exact for the tiny angles rounding gives (acos is not)
-        cross = [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-        angles.append(math.atan2(math.sqrt(sum(c * c for c in cross)), dot) if na and nb else 0.0)
-    moved = [i for i, t in enumerate(angles) if t > POSITION_TOLERANCE_RAD]
+    # exact for the tiny angles rounding gives (an acos is not)
+    angles = angle_between_deg(np.asarray(before, dtype=float), np.asarray(now, dtype=float))
+    moved = [i for i, t in enumerate(angles) if t > np.degrees(POSITION_TOLERANCE_RAD)]
     if not moved:
         return ""
     worst = max(moved, key=lambda i: angles[i])
     return (
         f"light positions: {len(moved)} of {len(angles)} LEDs moved, by up to "
-        f"{math.degrees(angles[worst]):.2f}° (LED index {worst})"
+        f"{angles[worst]:.2f}° (LED index {worst})"
     )
 
 

@@ -42,6 +42,7 @@ from rti_rig.app.usecases.adaptive_constants import (
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule, LightStep
@@ -959,9 +960,8 @@ class AdaptiveSteps:
 
         if self.plan.leds is not None and int(self.plan.leds[candidate]) != rec.led:
             return False
-        return _angle_rad(self.plan.candidates[candidate], rec.planned_direction) <= (
-            POSITION_TOLERANCE_RAD
-        )
+        angle = angle_between_deg(self.plan.candidates[candidate], rec.planned_direction)
+        return float(np.radians(angle)) <= POSITION_TOLERANCE_RAD
 
     def _recorded_candidate(self, folder, i: int, rec) -> int:  # type: ignore[no-untyped-def]
         """The candidate of the light step ``i`` recorded, on the changed rig: a dome's LED by
@@ -1054,13 +1054,6 @@ def _decided_on_another_rig(folder, done: int) -> int:  # type: ignore[no-untype
     runs = (getattr(folder, "manifest", None) or {}).get("runs") or []
     changed = [int(r.get("resumed_with_steps_done") or 0) for r in runs if r.get("rig_change")]
     return min(max(changed, default=0), done)
-
-
-def _angle_rad(a: Any, b: Any) -> float:
-    """The angle (rad) between two directions, exact for the tiny angles of rounding."""
-    u = np.asarray(a, dtype=np.float64)
-    v = np.asarray(b, dtype=np.float64)
-    return float(np.arctan2(np.linalg.norm(np.cross(u, v)), float(u @ v)))
 
 
 def estimate_phrase(result: dict[str, Any]) -> str:
