@@ -1140,9 +1140,9 @@ def _evidence(
                     note,
                     f"{_names([names[i] for i in np.flatnonzero(explained)])}: best direction "
                     f"{lo if lo == hi else f'{lo}-{hi}'}° from the recorded light, but the "
-                    "recorded light renders the image within "
-                    f"{WRONG_LIGHT_MISFIT_RATIO:g}× as well (this object places its lights no "
-                    "finer: gloss, shadows or clipping pull the direction); not called wrong",
+                    "recorded light explains the image nearly as well (its misfit within "
+                    f"{WRONG_LIGHT_MISFIT_RATIO:g}× the best direction's: on this object gloss, "
+                    "shadows or clipping pull the best direction); not called wrong",
                 )
                 if part
             )
