@@ -502,9 +502,9 @@ def _confirmed_shift(
 
 def _confirmed_step(
     crop_arr: NDArray, lt: NDArray, lit: NDArray[np.bool_], saturation: float | None
-) -> Step | None:
+) -> tuple[Step, NDArray, Any] | None:
     """A move part-way through the session (:func:`~rti_rig.reconstruct.qa_drift.find_step`)
-    that the fit confirms, or None.
+    that the fit confirms, with the images from it on moved back and the fit of those, or None.
 
     The edges alone are not enough: an object whose shading edges move with the light (the
     virtual arm's 512 px tablet) has two groups of lights whose median edges lie a pixel apart
@@ -521,19 +521,18 @@ def _confirmed_step(
         moved[i] = move_back(moved[i], *step.shift)
     pad = int(np.ceil(max(abs(v) for v in step.shift))) + 1
     try:
-        as_is = _step_residual(crop_arr, lt, step.first, pad, saturation)
-        undone = _step_residual(moved, lt, step.first, pad, saturation)
+        fit_as_is = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=saturation)
+        fit_undone = fit_photometric_stereo(moved, lt, robust=True, saturation=saturation)
     except ReconstructionError:
         return None
-    return step if undone <= DRIFT_CONFIRM * as_is else None
+    as_is = _step_residual(crop_arr, fit_as_is, lt, step.first, pad)
+    undone = _step_residual(moved, fit_undone, lt, step.first, pad)
+    return (step, moved, fit_undone) if undone <= DRIFT_CONFIRM * as_is else None
 
 
-def _step_residual(
-    stack: NDArray, lt: NDArray, first: int, pad: int, saturation: float | None
-) -> float:
-    """Median relative residual, against a robust fit of ``stack``, of the images from
-    ``first`` on (over the lit pixels at least ``pad`` from the border)."""
-    ps = fit_photometric_stereo(stack, lt, robust=True, saturation=saturation)
+def _step_residual(stack: NDArray, ps: Any, lt: NDArray, first: int, pad: int) -> float:
+    """Median relative residual, against ``ps`` (a robust fit of ``stack``), of the images
+    from ``first`` on (over the lit pixels at least ``pad`` from the border)."""
     rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
     inner = ps.valid.copy()
     inner[:pad], inner[-pad:], inner[:, :pad], inner[:, -pad:] = False, False, False, False
@@ -642,20 +641,22 @@ def assess(
     # A move part-way through (a step in capture order) blends every reference below: found
     # first, from the two sides' own edges, and confirmed by the fit; its images are moved
     # back before anything else is measured, and the images from it on are the ones moved.
-    step = _confirmed_step(crop_arr, lt, lit_images, sat_level)
+    found = _confirmed_step(crop_arr, lt, lit_images, sat_level)
+    step: Step | None = None
+    step_fit: Any = None  # the fit of crop_arr as it now is (the step undone)
     step_moved = np.zeros(n, bool)
     step_shift = np.zeros(2)
-    if step is not None:
+    if found is not None:
+        step, crop_arr, step_fit = found
         step_moved[step.first :] = True
         step_shift = np.array(step.shift)
-        crop_arr = crop_arr.copy()
-        for i in range(step.first, n):
-            crop_arr[i] = move_back(crop_arr[i], *step.shift)
     edge_shift, _ = measure_drift(crop_arr, lit_images)
     edges_trusted, edge_dev = edge_shifts_trusted(edge_shift)
     edge_moved = np.zeros(n, bool)
     if edges_trusted:
         edge_moved = np.isfinite(edge_dev[:, 0]) & (np.hypot(*edge_dev.T) > DRIFT_PX)
+        if edge_moved.any():
+            step_fit = None  # crop_arr changes below
         crop_arr = crop_arr.copy()
         for i in np.flatnonzero(edge_moved):
             crop_arr[i] = move_back(crop_arr[i], float(edge_dev[i, 0]), float(edge_dev[i, 1]))
@@ -678,7 +679,11 @@ def assess(
     # first fit that found any, from the half of the images that best fit any light (the most
     # self-consistent), then from every image not flagged, until the set stops changing.
     keep = np.ones(n, bool)
-    ps = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
+    ps = (
+        step_fit
+        if step_fit is not None
+        else fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
+    )
     ev = evidence_of(ps)
     before = (ps, ev)  # the fit and evidence a refit replaced
     for rnd in range(MAX_ROUNDS):
