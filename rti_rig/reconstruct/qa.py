@@ -969,11 +969,11 @@ def _evidence(
     resid: list[NDArray] = []
     sols = np.zeros((n, 3))
     misfit = np.full(n, np.inf)
-    misfit_recorded = np.full(n, np.inf)
     drift: list[tuple[float, float]] = []
     moved = np.zeros(n, bool)
     drift_judged = np.zeros(n, bool)
     images = []
+    usables = []  # the pixels each image's direction is judged on
     for i in range(n):
         raw = crop_arr[i]
         shade = ps.normals @ lt[i].astype(np.float32)
@@ -1010,7 +1010,7 @@ def _evidence(
         usable = usable & (flat_img > dark)  # cast shadows: no light reaches them to judge
         sols[i], lit_px = _best_direction(flat_img, bflat, usable, lt[i])
         misfit[i] = relative_misfit(bflat, flat_img, sols[i], lit_px)
-        misfit_recorded[i] = recorded_misfit(bflat, flat_img, usable, lt[i])
+        usables.append(usable)
     # A light at or below the object's mean surface reaches only slopes turned towards it on
     # a surface turned away, past that surface's own horizon: its cast shadows, which the fit
     # does not model, can black every pixel it reaches. There a dark image is no evidence of
@@ -1075,6 +1075,10 @@ def _evidence(
         # pointing away is a wrong light only where the recorded light renders the image
         # clearly worse than the best direction does: else the angle is the object's
         # (gloss pulls a high light's best direction low), not the light's
+        misfit_recorded = np.full(n, np.inf)
+        for i in np.flatnonzero(off):  # only an image pointing away needs it
+            flat = images[i].ravel().astype(np.float64)
+            misfit_recorded[i] = recorded_misfit(bflat, flat, usables[i], lt[i])
         explained = off & (misfit_recorded <= WRONG_LIGHT_MISFIT_RATIO * misfit)
         wrong = off & ~explained
         if off.sum() > (cand & ~off).sum():
