@@ -1131,29 +1131,21 @@ def _evidence(
                 "grazing light, gloss or clipping)"
             )
         if blinded.any() and judged.any():
-            note = "; ".join(
-                part
-                for part in (
-                    note,
-                    "light direction not checked on "
-                    f"{_names([names[i] for i in np.flatnonzero(blinded)])} (more than "
-                    f"{CLIPPED_DIRECTION_LIMIT:.0%} of the object clipped)",
-                )
-                if part
+            note = _and_note(
+                note,
+                "light direction not checked on "
+                f"{_names([names[i] for i in np.flatnonzero(blinded)])} (more than "
+                f"{CLIPPED_DIRECTION_LIMIT:.0%} of the object clipped)",
             )
         if explained.any():
             lo, hi = (f"{v:.0f}" for v in (err[explained].min(), err[explained].max()))
-            note = "; ".join(
-                part
-                for part in (
-                    note,
-                    f"{_names([names[i] for i in np.flatnonzero(explained)])}: best direction "
-                    f"{lo if lo == hi else f'{lo}-{hi}'}° from the recorded light, but the "
-                    "recorded light explains the image nearly as well (its misfit within "
-                    f"{WRONG_LIGHT_MISFIT_RATIO:g}× the best direction's: on this object gloss, "
-                    "shadows or clipping pull the best direction); not called wrong",
-                )
-                if part
+            note = _and_note(
+                note,
+                f"{_names([names[i] for i in np.flatnonzero(explained)])}: best direction "
+                f"{lo if lo == hi else f'{lo}-{hi}'}° from the recorded light, but the "
+                "recorded light explains the image nearly as well (its misfit within "
+                f"{WRONG_LIGHT_MISFIT_RATIO:g}× the best direction's: on this object gloss, "
+                "shadows or clipping pull the best direction); not called wrong",
             )
     return _Evidence(
         gain,
@@ -1176,6 +1168,11 @@ def _evidence(
         nb_ratio,
         unjudged | nb_dark,
     )
+
+
+def _and_note(note: str, more: str) -> str:
+    """``more`` said after ``note`` (if any)."""
+    return f"{note}; {more}" if note else more
 
 
 def neighbour_ratio(gain: NDArray, lt: NDArray) -> NDArray:
