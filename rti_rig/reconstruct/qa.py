@@ -85,13 +85,14 @@ WRONG_LIGHT_SPREAD = 3.0
 #: than this many times its best rendering at any direction
 #: (:func:`~rti_rig.reconstruct.qa_directions.recorded_misfit`): how well a light can be
 #: placed depends on the object. A varnished painting's highlights pull the best direction
-#: of a high light 8-21° low (the simulated painting, every light right: 4 of 6 correct
-#: sessions at 256-512 px were told to reshoot "wrong light … swapped?"), yet its recorded
+#: of a high light 8-22° low (the simulated painting, every light right: 4 of 7 correct
+#: sessions at 256-1024 px were told to reshoot "wrong light … swapped?"), yet its recorded
 #: light explains the image within 0.94-1.36× as well; swapped lights on the same painting
 #: and on the tablet read 1.77-26× (simulated dome and arm sessions, 7 swaps injected).
 WRONG_LIGHT_MISFIT_RATIO = 1.5
-#: An image clipped over more than this fraction of the object's pixels has no light
-#: direction to judge (it is told to reshoot with less exposure in any case).
+#: An image clipped over more than this fraction of the pixels the per-image checks judge
+#: (the crop's object pixels) has no light direction to judge: what is left unclipped is
+#: what its light barely reaches.
 CLIPPED_DIRECTION_LIMIT = 0.5
 #: Light directions are judged only when the fitted normals spread at least this much (degrees,
 #: the smallest axis of their second moment): a flat card leaves the azimuth undetermined.
@@ -818,8 +819,9 @@ def assess(
             first = names[step.first]
             problems.append(
                 f"{MOVED_FROM} {first} on: shifted ({dx:+.1f}, {dy:+.1f}) px "
-                f"against the images before it; reshoot from {first} on, or align those "
-                "images to the earlier ones before fitting"
+                "against the images before it; reshoot the whole session (reshooting from "
+                f"{first} on keeps two positions unless the object is put back exactly), or "
+                "align those images to the earlier ones before fitting"
             )
         elif ev.moved[i]:
             dx, dy = ev.drift[i]
@@ -1135,7 +1137,7 @@ def _evidence(
                 note,
                 "light direction not checked on "
                 f"{_names([names[i] for i in np.flatnonzero(blinded)])} (more than "
-                f"{CLIPPED_DIRECTION_LIMIT:.0%} of the object clipped)",
+                f"{CLIPPED_DIRECTION_LIMIT:.0%} of the pixels judged clipped)",
             )
         if explained.any():
             lo, hi = (f"{v:.0f}" for v in (err[explained].min(), err[explained].max()))

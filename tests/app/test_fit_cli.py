@@ -639,6 +639,6 @@ def test_an_image_clipped_throughout_is_not_called_a_wrong_light(tmp_path: Path,
     assert set(qa["reshoot"]) == {name}, qa["verdict"]
     assert "saturated" in qa["verdict"] and "wrong light" not in qa["verdict"], qa["verdict"]
     assert (
-        f"light direction not checked on {name} (more than 50% of the object clipped)"
+        f"light direction not checked on {name} (more than 50% of the pixels judged clipped)"
         in (qa["verdict"])
     )
