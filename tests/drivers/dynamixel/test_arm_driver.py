@@ -378,19 +378,22 @@ def test_settings_from_a_rig_toml_table() -> None:
 
 
 def test_the_documented_rig_config_validates_and_dry_runs() -> None:
-    """The TOML in docs/protocols/dynamixel-arm.md is the proposed simulated_arm.toml."""
-    import re
+    """docs/protocols/dynamixel-arm.md points to the shipped simulated_arm.toml as the complete
+    example of the arm's tables: its ``[arm.dynamixel]`` table is ``ArmSettings`` as is, its
+    top-level ``backend`` and ``[arm] transport`` are what the doc says, and it drives the
+    emulated servos."""
     import tomllib
     from pathlib import Path
 
     from rti_rig.drivers.dynamixel.settings import ArmSettings
 
-    doc = Path(__file__).resolve().parents[3] / "docs" / "protocols" / "dynamixel-arm.md"
-    block = re.search(r"```toml\n(.*?)```", doc.read_text(encoding="utf-8"), re.DOTALL)
-    assert block is not None
-    table = tomllib.loads(block.group(1))["arm"]
-    assert (table.pop("backend"), table.pop("transport")) == ("emulated", "pty")
-    settings = ArmSettings.model_validate(table)
+    repo = Path(__file__).resolve().parents[3]
+    doc = (repo / "docs" / "protocols" / "dynamixel-arm.md").read_text(encoding="utf-8")
+    for said in ("[arm.dynamixel]", "rig_configs/simulated_arm.toml", 'backend = "emulated"'):
+        assert said in doc, said
+    config = tomllib.loads((repo / "rig_configs" / "simulated_arm.toml").read_text())
+    assert (config["backend"], config["arm"]["transport"]) == ("emulated", "pty")
+    settings = ArmSettings.model_validate(config["arm"]["dynamixel"])
     clock = VirtualClock()
     emu = emulator_for_arm(settings, clock)
     with DynamixelArm(settings, InProcessPort(emu), clock) as arm:
