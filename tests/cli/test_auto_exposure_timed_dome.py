@@ -90,10 +90,11 @@ def test_metering_on_the_timed_rtipy_dome_shoots_each_test_shot_under_a_lit_led(
     assert [t for t, _ in shots[:n]] == [
         t for ts in chosen["test_exposures_by_light_s"] for t in ts
     ]
-    # so no dark shot chose the exposure: far below the longest the window allows (0.95 s, which
-    # a dark shot had chosen), and the images at it keep within the rule
+    # so no dark shot chose the exposure: well below the longest the window allows (0.95 s, which
+    # a dark shot had chosen; the matte tablet meters at about 0.08 s), and the images at it keep
+    # within the rule
     assert chosen["shot_per_lighting"] is True
-    assert chosen["exposure_s"] < chosen["rule"]["max_exposure_s"] / 100
+    assert chosen["exposure_s"] < chosen["rule"]["max_exposure_s"] / 4
     limit = chosen["rule"]["max_saturated_fraction"]
     assert [s["saturated_fraction"] <= limit for s in m["steps"]] == [True] * 3
     assert "each test shot is taken under a window of its own" in said

@@ -231,13 +231,17 @@ def test_a_black_frame_in_a_real_acquisition_is_a_misfire_by_name(tmp_path: Path
 
 
 def test_a_clean_emulated_dome_dry_run_reports_no_move(tmp_path: Path) -> None:
-    """The emulated domes image a glossy coin on 48 px, which the QA's Lambertian prediction
-    explains poorly: the phase correlation then peaked 13-24 px away, and every dry run was
-    called "object or camera moved". A shift now counts only if undoing it explains the
-    image better. The verdict still asks to reshoot image_012, and rightly: its light is at
-    76° elevation, near the camera axis, and the coin's specular face is clipped white at the
-    config's fixed exposure (0.05 s): 21% of its 8-bit pixels are 255 in some channel."""
-    cfg = REPO / "rig_configs" / "emulated_elexol.toml"
+    """The emulated domes imaged a glossy coin on 48 px (their scene until 2026-11-29; the
+    test keeps it), which the QA's Lambertian prediction explains poorly: the phase
+    correlation then peaked 13-24 px away, and every dry run was called "object or camera
+    moved". A shift now counts only if undoing it explains the image better. The verdict
+    still asks to reshoot image_012, and rightly: its light is at 76° elevation, near the
+    camera axis, and the coin's specular face is clipped white at the config's fixed
+    exposure (0.05 s): 21% of its 8-bit pixels are 255 in some channel."""
+    text = (REPO / "rig_configs" / "emulated_elexol.toml").read_text(encoding="utf-8")
+    assert '\nname = "tablet"\n' in text
+    cfg = tmp_path / "elexol_coin.toml"
+    cfg.write_text(text.replace('\nname = "tablet"\n', '\nname = "coin"\n'), encoding="utf-8")
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "12"])
     assert r.exit_code == 0, r.output
