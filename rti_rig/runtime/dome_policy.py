@@ -211,21 +211,31 @@ class DomePolicy:
         #: (see :meth:`_connect_link`): its port, baud rate and profile are then known right,
         #: whatever the reopened port gives.
         self._spoke_before_drop = False
+        #: How far the last :meth:`connect` got, for a report that must not claim more (or
+        #: less) than was established: ``"not opened"``, ``"opened"`` (the board said nothing
+        #: this profile reads), ``"answered"`` (it spoke the profile, but the handshake failed)
+        #: ``"connected"`` (handshake through, but the all-off that starts from the safe state
+        #: failed) or ``"ready"`` (connected and switched off). None: no connect attempted.
+        self.reached: str | None = None
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> None:
         self._spoke_before_drop = False
+        self.reached = "not opened"
         try:
             info = self._connect_link()
         except DomeLinkError as exc:
             # asked before the port is closed (which forgets what the board sent); a firmware
             # that refused the handshake keeps the advice (another dialect, or the baud rate)
-            spoke = (
-                exc.command != "open port"
-                and exc.fault is not LinkFault.REJECTED
-                and (self._spoke_before_drop or self._board_spoke_profile(exc))
+            answered = exc.command != "open port" and (
+                self._spoke_before_drop or self._board_spoke_profile(exc)
             )
+            spoke = answered and exc.fault is not LinkFault.REJECTED
+            if answered:
+                self.reached = "answered"
+            elif exc.command != "open port":
+                self.reached = "opened"
             if exc.command == "open port" and not self._port_was_open:
                 # Nothing was ever sent: say so, not "all-off failed, lights may be on".
                 self.off_report = OffReport(OffOutcome.NEVER_OPENED, exc.message)
@@ -287,6 +297,7 @@ class DomePolicy:
             try:
                 if getattr(self.link, "port_open", True):
                     self._port_was_open = True
+                    self.reached = "opened"
                     # what stands if a further signal cuts the attempt short (the attempt
                     # replaces it with what it established)
                     self.off_report = OffReport(
@@ -298,6 +309,16 @@ class DomePolicy:
                 self._quiet_close()
             raise
         self._port_was_open = True
+        # a firmware without a handshake has shown nothing yet (its first reply will), unless
+        # its boot text or an init command's reply came through: then "nothing on this port
+        # has answered yet: check the port, the baud rate and the profile" is false (the Nab
+        # sketch's banner and acknowledged init all-off had been followed by that advice when
+        # the next all-off's reply was lost)
+        answered = bool(getattr(self.link, "identifies_itself", True)) or bool(
+            getattr(self.link, "profile_heard", False)
+        )
+        # the handshake, if any, got through; is it the rig config's dome?
+        self.reached = "answered" if answered else "opened"
         problem = self._check_identity(info)
         if problem:
             self._attempt_off("after the identity check failed")
@@ -305,8 +326,10 @@ class DomePolicy:
             raise DeviceError(self.name, problem, "handshake")
         self.info = info
         self._lit = None
-        # a firmware without a handshake has shown nothing yet (its first reply will)
-        self._answered = bool(getattr(self.link, "identifies_itself", True))
+        # "connected" only of a board that answered (a miniRTI board at a wrong baud rate
+        # answers nothing, and its all-off failing is then no sign it was reached)
+        self.reached = "connected" if answered else "opened"
+        self._answered = answered
         log.info(
             "%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version, info.led_count
         )
@@ -323,6 +346,7 @@ class DomePolicy:
                 self.name,
             )
         self._run(self.link.all_off, "all off")  # start from the safe state
+        self.reached = "ready"
 
     def _connect_link(self) -> DomeInfo:
         """Open the port and handshake (see :meth:`_open_and_handshake` for the resends); a port
@@ -937,6 +961,8 @@ class SelfTestReport:
     #: Whether the firmware answers a light command: if not, a step "passes" when it was sent
     #: without error, and only a person watching the dome knows whether the LED lit.
     light_confirmed: bool = True
+    #: How far the connect got (:attr:`DomePolicy.reached`); None: not a dome policy.
+    reached: str | None = None
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -962,7 +988,12 @@ class SelfTestReport:
             if self.firmware
             else "unknown firmware"
         )
-        if self.aborted and self.firmware is None and not self.led_count and not self.checks:
+        if self.aborted and not self.checks and self.reached in _REACHED:
+            # the port opened: say how far the connect got, not "not reached" (a board whose
+            # banner and init all-off came through, then whose next all-off's reply was lost,
+            # had been reported "not reached")
+            out = [f"{self.name}: {_REACHED[self.reached]}; no LED stepped (see ABORTED below)"]
+        elif self.aborted and self.firmware is None and not self.led_count and not self.checks:
             # never reached: "unknown firmware, 0 LEDs" and "LEDs stepped: 0" had read as a
             # dome that answered with no LEDs (the config's 48 were never asked about)
             out = [f"{self.name}: not reached, no LED stepped (see ABORTED below)"]
@@ -1001,6 +1032,20 @@ class SelfTestReport:
         else:
             out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
+
+
+#: What each stage of :attr:`DomePolicy.reached` established, as the check's first line says it.
+_REACHED = {
+    "opened": "port opened, but nothing came back that its protocol profile reads",
+    "answered": (
+        "port opened and the board answered in its protocol profile, but the connection did "
+        "not complete"
+    ),
+    "connected": (
+        "connected (the board answered in its protocol profile), but the all-off that starts "
+        "the walk from the safe state failed"
+    ),
+}
 
 
 def self_test(
@@ -1047,6 +1092,8 @@ def self_test(
     except DeviceError as exc:
         report.aborted = str(exc)
     finally:
+        if isinstance(source, DomePolicy):
+            report.reached = source.reached  # before close() forgets the connection
         try:
             source.close()
         except DeviceError as exc:

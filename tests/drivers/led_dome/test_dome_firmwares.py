@@ -832,3 +832,38 @@ def test_a_nichlock_board_held_in_its_touch_calibration_is_said_so(tmp_path: Pat
     assert "tap the two red circles on its display" in text
     assert "check the profile" not in text and "lights are off" not in text
     assert board.heard == b"xx"  # not resent: each would be one more key into the calibration
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_check_whose_board_answered_before_its_all_off_failed_says_what_was_reached(
+    tmp_path: Path,
+) -> None:
+    """The Nab sketch's banner came through and it acknowledged the init all-off; then the reply
+    to the connect's all-off was lost. The check had said "not reached" and "nothing on this
+    port has answered yet: check the port, the baud rate and the protocol profile", of a board
+    that had just answered in its profile."""
+    cfg = with_faults("nab-rti-v1", tmp_path, 'faults = [{at_command = 2, kind = "drop_reply"}]\n')
+    cfg.write_text(cfg.read_text().replace("retries = 2", "retries = 0"))
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "not reached" not in text and "nothing on this port has answered" not in text, text
+    assert "connected (the board answered in its protocol profile), but the all-off" in text
+    assert "no LED stepped" in text and "RESULT: FAIL" in text
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_check_whose_board_never_answered_is_not_said_to_be_connected(tmp_path: Path) -> None:
+    """miniRTI has no handshake: its connect ends in an all-off whose ack is the first word
+    heard. At a wrong baud rate none comes; that is a port that opened, not a dome reached."""
+    board = board_for("minirti")
+    with serve_on_pty(board, "minirti") as link:
+        cfg = _hardware(tmp_path, "emulated_minirti.toml", link.port)
+        text = cfg.read_text().replace('profile = "minirti"', 'profile = "minirti"\nretries = 0')
+        cfg.write_text(text.replace("retries = 2", "baudrate = 57600"))
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "connected" not in text.replace("camera: folder-camera connected", ""), text
+    assert "port opened, but nothing came back that its protocol profile reads" in text
+    assert "nothing on this port has answered yet" in text
