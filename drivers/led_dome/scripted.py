@@ -101,7 +101,38 @@ class ScriptedDomeDriver:
         self._boot_deadline = self.transport.clock.now() + self.spec.boot_wait_s
         self._wait_boot()
         self._booted = True
+        self._refuse_foreign_banner()
         return self.hello()
+
+    def _refuse_foreign_banner(self) -> None:
+        """Refuse, before sending a byte, a board whose boot text is another built-in
+        firmware's banner (and not this profile's ready text).
+
+        Why: the profile's commands are other keys to that firmware. The nab-rti-v1 profile on a
+        nichlock board sent ``<0>``, whose ``0`` stepped the board to LED 0, then the all-off
+        after the failed connect stepped it to LED 1, and the user was told to check the port,
+        the baud rate and the profile of a board that had printed its name."""
+        if self._heard or not self.boot_text:
+            return
+        from rti_rig.drivers.led_dome.dome_profiles import builtin_spec, described_profiles
+
+        own = {self.spec.reset_pattern, self.spec.ready_pattern}
+        for name in described_profiles():
+            if name == self.spec.name:
+                continue
+            other = builtin_spec(name)
+            for key in ("reset_pattern", "ready_pattern"):
+                pattern = other.get(key)
+                if pattern and pattern not in own and re.search(pattern, self.boot_text):
+                    raise self._error(
+                        f"the board on this port printed the boot banner of the {name} "
+                        f"firmware, not the {self.spec.name} one, so nothing was sent to it "
+                        f"(this profile's commands are other keys to that firmware, which may "
+                        f'light its LEDs): set profile = "{name}" in [dome.serial] '
+                        "(rti-rig probe PORT confirms it)",
+                        "wait after opening",
+                        LinkFault.FOREIGN,
+                    )
 
     def finish_boot(self) -> None:
         """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same
@@ -405,5 +436,5 @@ class ScriptedDomeDriver:
             self._rx.extend(data)
 
     def _error(self, message: str, command: str, fault: LinkFault) -> DomeLinkError:
-        retryable = fault not in (LinkFault.REJECTED, LinkFault.WAITING)
+        retryable = fault not in (LinkFault.REJECTED, LinkFault.WAITING, LinkFault.FOREIGN)
         return DomeLinkError(self.device, message, command, fault, retryable=retryable)

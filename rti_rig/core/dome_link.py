@@ -27,6 +27,10 @@ class LinkFault(StrEnum):
     #: The firmware waits for a person, not a command (a menu, a touch-screen calibration): no
     #: resend helps (each would be one more key into it), and no LED is at fault.
     WAITING = "waiting"
+    #: The board printed another known firmware's boot banner: it is not the profile's board,
+    #: and the profile's commands (its all-off included) would be other keys to it (the Nab
+    #: sketch's ``<0>`` steps a nichlock board to its next LED), so nothing is sent to it.
+    FOREIGN = "foreign"
 
 
 class DomeLinkError(DeviceError):

@@ -248,6 +248,14 @@ class DomePolicy:
                 # Open before (metering, then the session) and switched off with an
                 # established all-off since: nothing was sent after it, so that still holds.
                 pass
+            elif exc.fault is LinkFault.FOREIGN:
+                # another firmware's board: this profile's all-off is other keys to it
+                self._port_was_open = True
+                self.off_report = OffReport(
+                    OffOutcome.NOT_SENT,
+                    "the board on the port runs another firmware, to which this profile's "
+                    "all-off is other commands",
+                )
             else:
                 if exc.command != "open port":
                     self._port_was_open = True
@@ -262,6 +270,8 @@ class DomePolicy:
                     "is plugged in and that the rig config's port names it",
                     exc.command,
                 ) from exc
+            if exc.fault is LinkFault.FOREIGN:
+                raise DeviceError(exc.device, exc.message, exc.command) from exc
             if exc.fault is LinkFault.DISCONNECTED:
                 # the port opened, then vanished: a USB event, which no port name, baud rate
                 # or profile gives (that advice had sent users to a config that was right)

@@ -867,3 +867,27 @@ def test_a_check_whose_board_never_answered_is_not_said_to_be_connected(tmp_path
     assert "connected" not in text.replace("camera: folder-camera connected", ""), text
     assert "port opened, but nothing came back that its protocol profile reads" in text
     assert "nothing on this port has answered yet" in text
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_profile_forced_onto_another_firmwares_board_is_refused_before_sending(
+    tmp_path: Path,
+) -> None:
+    """The nab-rti-v1 profile (at the board's baud rate) on a nichlock board, whose boot banner
+    names it: the Nab init ``<0>`` stepped the board to LED 0, the all-off after the failed
+    connect to LED 1, and the user was told to check the port, the baud rate and the profile.
+    Now nothing is sent, the firmware is named and the lights' state is said as unknown."""
+    from rti_rig.simulator.domes.nichlock import NichlockBoard
+
+    board = NichlockBoard()
+    with serve_on_pty(board, "nichlock") as link:
+        cfg = _hardware(tmp_path, "emulated_nab_rti_v1.toml", link.port)
+        cfg.write_text(cfg.read_text().replace("retries = 2", "retries = 2\nbaudrate = 115200"))
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "printed the boot banner of the nichlock firmware" in text, text
+    assert 'set profile = "nichlock"' in text and "nothing was sent to it" in text
+    assert "all-off could NOT be sent" in text and "lights are off" not in text
+    assert bytes(board.heard) == b""
+    assert all(not lit for _, lit in board.timeline)
