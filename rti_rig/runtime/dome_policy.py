@@ -356,6 +356,14 @@ class DomePolicy:
                 self.name,
             )
         self._run(self.link.all_off, "all off")  # start from the safe state
+        if (
+            getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED)
+            is not OffOutcome.ACKNOWLEDGED
+        ):
+            # an all-off nothing answers (RTIPy's wait for its window, Elexol's unanswered
+            # bytes) shows no board: RTIPy's profile at a wrong baud rate had lost its port,
+            # baud and profile advice at the first light's garbled reply
+            self._answered = answered
         self.reached = "ready"
 
     def _connect_link(self) -> DomeInfo:

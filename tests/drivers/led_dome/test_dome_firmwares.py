@@ -891,3 +891,21 @@ def test_a_profile_forced_onto_another_firmwares_board_is_refused_before_sending
     assert "all-off could NOT be sent" in text and "lights are off" not in text
     assert bytes(board.heard) == b""
     assert all(not lit for _, lit in board.timeline)
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_timed_firmware_at_a_wrong_baud_rate_gets_the_port_baud_profile_advice(
+    tmp_path: Path,
+) -> None:
+    """RTIPy's profile has no all-off to send: the connect's "all-off" is a wait, which had
+    counted as the board answering, so the first light's garbled reply (a wrong baud rate)
+    ended the check with "gave up after 3 attempts" and no word of the baud rate."""
+    board = board_for("rtipy")
+    with serve_on_pty(board, "rtipy") as link:
+        cfg = _hardware(tmp_path, "emulated_rtipy.toml", link.port)
+        cfg.write_text(cfg.read_text().replace("retries = 2", "retries = 0\nbaudrate = 57600", 1))
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "none this rig config's protocol profile understands" in text, text
+    assert "dome.serial.baudrate = 57600" in text and "set it to 9600" in text
