@@ -102,12 +102,27 @@ def _listen(t: SerialTransport, seconds: float) -> bytes:
 def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     """The Nab sketch answered: it boots with every LED on, so switch them off before leaving."""
     result.profile, result.baudrate = "nab-rti-v1", 9600
-    off = _exchange(result.port, 9600, wait, b"<0>", 0.6)
-    result.heard.append(("all off <0>", off))
+    t = SerialTransport(result.port, 9600)
+    t.open()
+    off = ""
+    try:
+        _listen(t, wait)  # the board resets as the port opens: its bootloader, then its banner
+        # sent again on the same open port if unanswered (reopening it would reset the board,
+        # which lights every LED again): one lost reply, or a <0> the board missed, had ended
+        # the probe with "NOT acknowledged: check the dome", where a session resends it
+        for what, listen_s in (("all off <0>", 0.6), ("all off <0> again", 1.2)):
+            t.write(b"<0>")
+            off = _listen(t, listen_s).decode("latin-1")
+            result.heard.append((what, off))
+            if "<All lights turned off.>" in off:
+                break
+    finally:
+        t.close()
     result.lights = (
         "the sketch boots with every LED on; all-off sent and acknowledged"
         if "<All lights turned off.>" in off
-        else "the sketch boots with every LED on; all-off sent but NOT acknowledged: check the dome"
+        else "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
+        "the dome"
     )
     return result
 

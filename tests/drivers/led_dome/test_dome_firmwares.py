@@ -80,6 +80,24 @@ def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
         assert eventually(lambda: board.lit == frozenset())
 
 
+@pytest.mark.slow  # real firmware timing over a pty
+def test_probe_sends_the_nab_all_off_again_when_its_reply_is_lost() -> None:
+    """The Nab sketch boots fully lit; the probe's ``<0>`` is its only way dark. One lost reply
+    had ended the probe "all-off sent but NOT acknowledged: check the dome" (and a ``<0>`` the
+    board missed left it lit): it is sent again on the same open port (reopening would reset
+    the board, lit again)."""
+    from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
+
+    board = board_for("nab-rti-v1", faults=FaultPlan((Fault(1, FaultKind.DROP_REPLY),)))
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = runner.invoke(app, ["probe", link.port], terminal_width=400)
+        assert eventually(lambda: board.lit == frozenset())
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "all-off sent and acknowledged" in text and "NOT acknowledged" not in text, text
+    assert board.commands == 2
+
+
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 def test_a_firmware_served_in_another_process_can_be_probed() -> None:
     """``python -m rti_rig.simulator.dome_firmware --profile nab-rti-v1`` serves the sketch's
