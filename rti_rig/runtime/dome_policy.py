@@ -217,6 +217,13 @@ class DomePolicy:
         #: ``"connected"`` (handshake through, but the all-off that starts from the safe state
         #: failed) or ``"ready"`` (connected and switched off). None: no connect attempted.
         self.reached: str | None = None
+        #: The reconnect window (s) of the last reconnection that gave up on a port that did not
+        #: come back (None: none gave up), and, once a later one (the closing all-off's) got the
+        #: dome back after all, that window: the error said "did not come back" and the lights
+        #: line then "acknowledged", which read as a contradiction, not as a USB link away for
+        #: longer than the reconnect window.
+        self._gave_up_after_s: float | None = None
+        self.came_back_after_give_up: float | None = None
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -760,24 +767,45 @@ class DomePolicy:
                 self._quiet_close()
                 raise DeviceError(self.name, f"after reconnecting: {problem}", command)
             self.stats.recovered += recovered
+            if self._gave_up_after_s is not None:
+                self.came_back_after_give_up = self._gave_up_after_s
             return
         # "did not come back" only of a port that did not: one that reopened but whose board
         # did not answer its handshake is said so (the board, not the USB link, is in question)
         tries = self.settings.reconnect_attempts
         attempts = f"{tries} reconnection attempt{'' if tries == 1 else 's'}"
-        outcome = (
-            f"its port came back but the board did not answer its handshake after {attempts}"
-            if came_back
-            else f"did not come back after {attempts}"
-        )
         said = last.message if last is not None else "no attempt made"
+        if came_back:
+            outcome = (
+                f"its port came back but the board did not answer its handshake after "
+                f"{attempts} ({said}); check the USB cable and the dome's power"
+            )
+        else:
+            window = self.reconnect_window_s()
+            self._gave_up_after_s = window
+            outcome = (
+                f"did not come back within {attempts} over {window:.1f} s ({said}); check the "
+                f"USB cable, the hub and the dome's power, or {self._window_keys()}"
+            )
         raise DomeLinkError(
             self.name,
-            f"the dome dropped off and {outcome} ({said}); check the USB cable and the dome's "
-            "power",
+            f"the dome dropped off and {outcome}",
             command,
             LinkFault.DISCONNECTED,
             retryable=False,
+        )
+
+    def reconnect_window_s(self) -> float:
+        """Seconds of back-off over which a lost port is tried again before giving up."""
+        s = self.settings
+        return s.reconnect_backoff_s * (2**s.reconnect_attempts - 1)
+
+    def _window_keys(self) -> str:
+        s = self.settings
+        return (
+            f"raise reconnect_attempts (now {s.reconnect_attempts}) or reconnect_backoff_s (now "
+            f"{s.reconnect_backoff_s:g} s, doubled at each attempt) in [dome.serial] if it drops "
+            "off for longer"
         )
 
     def _reopen(
@@ -945,7 +973,15 @@ def lights_state_sentence(source: object) -> str:
     report = getattr(source, "off_report", None)
     if report is None:
         return "no all-off was attempted (the dome was never reached): check the dome's lights"
-    return str(report.sentence())
+    sentence = str(report.sentence())
+    window = getattr(source, "came_back_after_give_up", None)
+    if window is not None:
+        sentence += (
+            f" (the dome came back after the reconnection gave up: its USB link was away longer "
+            f"than the {window:.1f} s of reconnection attempts; check the USB cable, the hub and "
+            f"the dome's power, or {source._window_keys()})"  # type: ignore[attr-defined]
+        )
+    return sentence
 
 
 # ----------------------------------------------------------------------------- self test

@@ -27,6 +27,7 @@ from rti_rig.runtime.dome_policy import (
     LinkFault,
     ThermalGuard,
     ThermalLimits,
+    lights_state_sentence,
     self_test,
 )
 from rti_rig.simulator.dome_firmware import (
@@ -202,7 +203,7 @@ def test_disconnect_that_does_not_come_back_gives_up():
     dome.connect()
     dome.light(0, 1.0)
     dome.all_off()
-    with pytest.raises(DomeLinkError, match="did not come back after 3 reconnection") as info:
+    with pytest.raises(DomeLinkError, match="did not come back within 3 reconnection") as info:
         dome.light(1, 1.0)
     assert "light LED 1" in str(info.value)
     assert fw.lit is None
@@ -613,6 +614,29 @@ def test_a_usb_drop_during_the_handshake_is_reconnected_and_the_session_complete
     assert dome.stats.reconnects == 1
     assert dome.stats.recovered == ["handshake: disconnected"]
     assert dome.link.transport.opens == 2
+    assert fw.lit is None
+
+
+def test_a_drop_longer_than_the_reconnect_window_says_so_when_the_dome_comes_back_later():
+    """The light's reconnection gave up after its 7 s of attempts; the port came back at 9 s,
+    and the closing all-off reconnected and was acknowledged. The user had read "did not come
+    back" above "all-off sent and acknowledged": a contradiction, with no word of the window."""
+    dome, fw, _clock = make(
+        "default", [Fault(LIGHT_1, FaultKind.DISCONNECT, delay_s=9.0)], reconnect_attempts=3
+    )
+    dome.connect()
+    dome.light(0, 1.0)
+    dome.all_off()
+    with pytest.raises(DomeLinkError) as info:
+        dome.light(1, 1.0)
+    msg = str(info.value)
+    assert "did not come back within 3 reconnection attempts over 7.0 s" in msg, msg
+    assert "raise reconnect_attempts (now 3) or reconnect_backoff_s (now 1 s" in msg
+    dome.close()
+    said = lights_state_sentence(dome)
+    assert said.startswith("all-off sent and acknowledged by the dome: lights are off"), said
+    assert "the dome came back after the reconnection gave up" in said
+    assert "away longer than the 7.0 s of reconnection attempts" in said
     assert fw.lit is None
 
 
