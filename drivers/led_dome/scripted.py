@@ -112,10 +112,12 @@ class ScriptedDomeDriver:
         nichlock board sent ``<0>``, whose ``0`` stepped the board to LED 0, then the all-off
         after the failed connect stepped it to LED 1, and the user was told to check the port,
         the baud rate and the profile of a board that had printed its name."""
-        if self._heard or not self.boot_text:
-            return
         from rti_rig.drivers.led_dome.dome_profiles import builtin_spec, described_profiles
 
+        if self._heard or not self.boot_text or self.spec.name not in described_profiles():
+            # a custom description may be of a modified sketch that keeps another firmware's
+            # banner: only the built-in profiles, whose firmwares are known, are refused so
+            return
         own = {self.spec.reset_pattern, self.spec.ready_pattern}
         for name in described_profiles():
             if name == self.spec.name:

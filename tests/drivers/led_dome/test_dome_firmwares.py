@@ -927,3 +927,22 @@ def test_a_timed_firmware_at_a_wrong_baud_rate_gets_the_port_baud_profile_advice
     text = said(r)
     assert "none this rig config's protocol profile understands" in text, text
     assert "dome.serial.baudrate = 57600" in text and "set it to 9600" in text
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_custom_description_of_a_sketch_keeping_a_known_banner_is_not_refused() -> None:
+    """Only the built-in profiles refuse another built-in firmware's banner: a custom
+    description may be of a modified Nab sketch that still prints the Nab banner."""
+    from rti_rig.drivers.led_dome.factory import build_driver
+
+    spec = builtin_spec("nab-rti-v1")
+    spec["name"] = "my-nab"
+    del spec["ready_pattern"], spec["reset_pattern"]
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        driver = build_driver(DomeSerialSettings(port=link.port, profile="custom", protocol=spec))
+        try:
+            assert driver.connect().firmware_id == "my-nab"
+        finally:
+            driver.close()
+    assert board.commands == 1  # its init all-off went through
