@@ -1369,7 +1369,7 @@ def checksum_session_files(root: Path, stop: Callable[[], bool] | None = None) -
     24 MP); a fit runs this alongside its own work rather than after it. ``stop`` is asked
     between files (a fit that failed or was interrupted does not wait for the rest)."""
     root = Path(root)
-    if root.name == LP_NAME and not root.is_dir():  # a session's lights.lp given for it
+    if root.suffix.lower() == ".lp" and root.is_file():  # an .lp of the session given for it
         root = root.parent
     records = _journal_records(root)
     for rec in _latest_records(records or []).values():

@@ -576,6 +576,33 @@ def test_a_linear_tiff_edited_since_capture_is_named_and_reshot_on_request(
     assert tifffile.imread(io.BytesIO(kept["image_005.tif"]))[10, 10].tolist() == [0, 0, 0]
 
 
+def test_an_lp_of_the_users_own_in_a_session_is_checked_for_the_images_it_lists(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """`rti-rig fit S/mine.lp` (an .lp the user exported or edited beside the session's
+    images) had no integrity check at all: a TIFF edited since capture was fitted and judged
+    "good". Its images are now checked as lights.lp's are, and only those: an image it leaves
+    out (lost, and left out on purpose) is not held against it."""
+    import tifffile
+
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    edited = done / "linear" / "image_005.tif"
+    pixels = tifffile.imread(edited)
+    pixels[10:14, 10:14] = 0
+    tifffile.imwrite(edited, pixels, photometric="rgb")
+    (done / "image_003.jpg").unlink()
+    lines = (done / "lights.lp").read_text().splitlines()
+    kept = [line for line in lines[1:] if not line.startswith("image_003")]
+    (done / "mine.lp").write_text("\n".join([str(len(kept)), *kept]) + "\n")
+    out = tmp_path / "fit"
+    r = runner.invoke(app, ["fit", str(done / "mine.lp"), "--out", str(out), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((out / "qa.json").read_text())["verdict"]
+    assert verdict.startswith("reshoot: image_005 (linear/image_005.tif changed since capture")
+    assert "image_003" not in verdict, verdict
+
+
 def test_a_session_journaled_before_pixel_checksums_is_checked_by_bytes_and_says_so(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

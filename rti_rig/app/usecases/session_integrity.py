@@ -13,6 +13,7 @@ from __future__ import annotations
 import shlex
 from dataclasses import replace
 from pathlib import Path
+from typing import TypeVar
 
 from rti_rig.app.usecases.uneven_lights import with_uneven_lights
 from rti_rig.core.errors import RtiRigError
@@ -36,19 +37,28 @@ from rti_rig.runtime.session import (
     unchecked_images,
 )
 
+V = TypeVar("V")
+
 
 def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     """``qa`` with a problem added to each image of session ``source`` whose JPEG or linear
     TIFF is gone or changed since capture (checked against the journal's checksums: a TIFF
     edited after capture changes what a fit reads), a caveat naming the images no journal record
     vouches for, and advice a replayed or adaptive session can follow (unchanged for an
-    ``.lp`` acquisition, which has no journal)."""
+    ``.lp`` acquisition, which has no journal). ``source`` is a session folder, its
+    ``lights.lp``, or another ``.lp`` in it: then only the images that ``.lp`` lists (the
+    ones fitted and judged) are named."""
     source = Path(source)
+    lp = source / LP_NAME
+    fitted: set[str] | None = None  # the images judged, when not every one of the session's
     if not source.is_dir():
-        if source.name != LP_NAME:  # an .lp of its own, not a session's lights.lp
-            return qa
-        source = source.parent
-    qa = _with_unchecked(qa, source)
+        lp, source = source, source.parent
+        if lp.name != LP_NAME:
+            # an .lp of the user's own beside a session's images (exported, edited, a subset):
+            # its images are checked as lights.lp's are, and only those (it had been fitted
+            # without a check: an edited TIFF was judged "good")
+            fitted = {c.name for c in qa.images}
+    qa = _with_unchecked(qa, source, fitted)
     try:
         manifest = read_manifest(source)  # once, for what the session's kind and end allow
     except RtiRigError:
@@ -56,11 +66,13 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     if manifest is not None:
         qa = with_uneven_lights(qa, manifest)  # a bright image its uncalibrated LED explains
         qa = _with_unfinished(_with_session_kind(qa, manifest), source, manifest)
-    renamed = renamed_since_capture(source)
+    renamed = _only(renamed_since_capture(source), fitted)
     if renamed:  # there, under another name: said, and not called lost (nothing to reshoot)
         note = renamed_note(renamed)
         qa = _noted(qa, note)
-    originals = originals_changed_since_capture(source)
+    originals = [
+        n for n in originals_changed_since_capture(source) if fitted is None or _stem(n) in fitted
+    ]
     if originals:  # the camera's files, no longer as captured: said, not reshot
         shown = ", ".join(originals[:5]) + (
             f" and {len(originals) - 5} more" if len(originals) > 5 else ""
@@ -71,7 +83,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             "depend on it: restore the original from a backup copy of the folder"
         )
         qa = _noted(qa, note)
-    lost = files_lost_since_capture(source)
+    lost = _only(files_lost_since_capture(source), fitted)
     if not lost:
         return qa
     if any(
@@ -81,10 +93,10 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         if old:
             qa = _noted(qa, old)
     todo = lost_image_advice(source, bool(read_manifest(source).get("adaptive")))
-    listed = _listed(source / LP_NAME)
+    listed = _listed(lp)
     relisted = [n for n, g in lost.items() if f"{n}.jpg" in listed and f"{n}.jpg missing" in g]
     relight = (
-        f"{LP_NAME} still lists {'it' if len(relisted) == 1 else 'them'}, so relight (which "
+        f"{lp.name} still lists {'it' if len(relisted) == 1 else 'them'}, so relight (which "
         "pairs the .lp's lines with the JPEGs in order) gives every later image the wrong light"
     )
     once = len(lost) > 1  # the advice said once, not after each of (say) 48 images
@@ -176,9 +188,25 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     return _noted(qa, note)
 
 
-def _with_unchecked(qa: QAReport, source: Path) -> QAReport:
-    """``qa`` with a caveat naming the images no readable journal record vouches for."""
+def _only(found: dict[str, V], fitted: set[str] | None) -> dict[str, V]:
+    """The entries of ``found`` (keyed by an image's base name, or a file name relative to the
+    session) that concern an image of ``fitted`` (all of them when ``fitted`` is None)."""
+    if fitted is None:
+        return found
+    return {k: v for k, v in found.items() if _stem(k) in fitted}
+
+
+def _stem(name: str) -> str:
+    """The image base name of a session file name (``linear/image_003.tif`` → ``image_003``)."""
+    return Path(name).stem
+
+
+def _with_unchecked(qa: QAReport, source: Path, fitted: set[str] | None = None) -> QAReport:
+    """``qa`` with a caveat naming the images no readable journal record vouches for (of
+    ``fitted`` alone when given)."""
     unchecked, why = unchecked_images(source)
+    if fitted is not None:
+        unchecked = [n for n in unchecked if n in fitted]
     if not unchecked:
         return qa
     shown = ", ".join(unchecked[:8]) + (
