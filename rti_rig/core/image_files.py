@@ -153,9 +153,16 @@ def pixels_sha256(pixels: NDArray[Any]) -> str:
     arr = np.ascontiguousarray(pixels)
     if arr.dtype.byteorder == ">" or (arr.dtype.byteorder == "=" and not _LITTLE):
         arr = arr.astype(arr.dtype.newbyteorder("<"))
-    h = hashlib.sha256(f"{arr.shape}|{arr.dtype.kind}{arr.dtype.itemsize}|".encode())
+    h = pixels_hasher(arr.shape, arr.dtype)
     h.update(memoryview(arr.reshape(-1).view(np.uint8)))  # the GIL is released while hashing
     return h.hexdigest()
+
+
+def pixels_hasher(shape: tuple[int, ...], dtype: np.dtype[Any]) -> Any:
+    """The SHA-256 of :func:`pixels_sha256` before any sample: fed an image's little-endian
+    samples in row order, a band at a time, it gives that checksum (how a reader that goes
+    through every row anyway takes it without reading the file again)."""
+    return hashlib.sha256(f"{tuple(shape)}|{dtype.kind}{dtype.itemsize}|".encode())
 
 
 _LITTLE = np.little_endian

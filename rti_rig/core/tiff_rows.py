@@ -13,6 +13,7 @@ Channel" order) are interleaved and an alpha sample is dropped, as the replay ri
 from __future__ import annotations
 
 import os
+import threading
 import zlib
 from pathlib import Path
 from typing import Any
@@ -22,7 +23,12 @@ import tifffile
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import ImageFileError
-from rti_rig.core.image_files import colour_or_grey, tiff_is_planar, tiff_samples_last
+from rti_rig.core.image_files import (
+    colour_or_grey,
+    pixels_hasher,
+    tiff_is_planar,
+    tiff_samples_last,
+)
 
 #: TIFF compression codes decoded strip by strip here: none, Adobe deflate, deflate.
 _STRIPPED = {1: "none", 8: "zlib", 32946: "zlib"}
@@ -42,6 +48,16 @@ class TiffRows:
         self._full: NDArray[Any] | None = None
         self._cache: dict[int, NDArray[Any]] = {}
         self._row_shape = self.shape[1:]
+        #: (the file's stat when its last row was read, :func:`pixels_sha256` of its pixels),
+        #: once a pass of reads from the first row to the last, in order, found the file
+        #: unchanged throughout; None until then. Why: a fit goes through every row anyway, and
+        #: the session's integrity check then needs no second read of the file
+        #: (:func:`rti_rig.runtime.session.remember_pixel_digest`).
+        self.pixel_digest: tuple[os.stat_result, str] | None = None
+        self._hash_lock = threading.Lock()
+        self._hash: Any = None  # the checksum of rows 0.._hashed_to of the pass under way
+        self._hashed_to = 0
+        self._hash_start: tuple[int, ...] = ()
 
     def _read_header(self) -> None:
         with tifffile.TiffFile(self.path) as tf:
@@ -150,20 +166,58 @@ class TiffRows:
         start, stop, step = key.indices(self.shape[0])
         if step != 1 or stop <= start:
             return self[:][key] if step != 1 else np.empty((0, *self._row_shape), self.dtype)
+        self._hash_begin(start)
         if not self._compressed:
-            return self._raw_rows(start, stop)
-        rps = self._rows_per_strip
-        parts = []
-        for k in range(start // rps, (stop - 1) // rps + 1):
-            strip = self._strip(k)
-            lo = max(start - k * rps, 0)
-            hi = min(stop - k * rps, strip.shape[0])
-            parts.append(strip[lo:hi])
-        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+            rows = self._raw_rows(start, stop)
+        else:
+            rps = self._rows_per_strip
+            parts = []
+            for k in range(start // rps, (stop - 1) // rps + 1):
+                strip = self._strip(k)
+                lo = max(start - k * rps, 0)
+                hi = min(stop - k * rps, strip.shape[0])
+                parts.append(strip[lo:hi])
+            rows = parts[0] if len(parts) == 1 else np.concatenate(parts)
+        self._hash_rows(start, stop, rows)
+        return rows
+
+    def _hash_begin(self, start: int) -> None:
+        """Before rows from ``start`` are read: a read of the first row starts a pass whose
+        pixel checksum is taken on the way (unless one was taken already)."""
+        if start != 0 or self.pixel_digest is not None:
+            return
+        with self._hash_lock:
+            self._hash = pixels_hasher(self.shape, self.dtype)
+            self._hashed_to = 0
+            self._hash_start = _identity(os.stat(self.path))
+
+    def _hash_rows(self, start: int, stop: int, rows: NDArray[Any]) -> None:
+        """Rows ``start``..``stop`` just read, added to the pass's checksum when they follow
+        the last rows added (any other order ends the pass without a checksum); the last row
+        gives :attr:`pixel_digest` if the file did not change meanwhile."""
+        with self._hash_lock:
+            if self._hash is None:
+                return
+            if start != self._hashed_to:
+                self._hash = None
+                return
+            self._hash.update(memoryview(np.ascontiguousarray(rows).reshape(-1).view(np.uint8)))
+            self._hashed_to = stop
+            if stop < self.shape[0]:
+                return
+            digest, self._hash = self._hash.hexdigest(), None
+            st = os.stat(self.path)
+            if _identity(st) == self._hash_start:  # no write, rename or utime while read
+                self.pixel_digest = (st, digest)
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> NDArray[Any]:
         full = self[0 : self.shape[0]]
         return full.astype(dtype) if dtype is not None else np.array(full)
+
+
+def _identity(st: os.stat_result) -> tuple[int, ...]:
+    """What changes whenever a file's content may have (its ctime moves on any write)."""
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 def _unreadable(path: Path, exc: BaseException) -> ImageFileError:

@@ -36,7 +36,7 @@ import shutil
 import sys
 import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
@@ -941,6 +941,30 @@ def _remember_digest(path: Path, digest: str) -> None:
         _know(str(Path(path).resolve()), _identity(path.stat()), digest)
 
 
+def remember_pixel_digest(path: Path, st: os.stat_result, digest: str) -> None:
+    """Record ``digest``, the :func:`pixels_sha256` of the TIFF at ``path`` as it was when
+    ``st`` was taken (read whole by this process: a fit's pass through its rows), so that the
+    check of a session's linear TIFF need not read it again (:func:`_as_captured`)."""
+    with contextlib.suppress(OSError):
+        _know(_PIXELS + str(Path(path).resolve()), _identity(st), digest)
+
+
+#: the key prefix of a pixel checksum in :data:`_KNOWN_DIGESTS` (a file's own has none)
+_PIXELS = "pixels:"
+
+
+def _known_pixels(path: Path) -> str | None:
+    """The pixel checksum :func:`remember_pixel_digest` holds for ``path`` as it is now (None
+    when none, or when the file changed since it was taken)."""
+    try:
+        st = path.stat()
+        key = _PIXELS + str(path.resolve())
+    except OSError:
+        return None
+    known = _KNOWN_DIGESTS.get(key)
+    return known[1] if known is not None and known[0] == _identity(st) else None
+
+
 def _sha256(path: Path) -> str | None:
     """SHA-256 of the file at ``path`` (None if it is not a file), read in chunks; a file this
     process wrote or hashed and that has not changed since is not read again."""
@@ -971,9 +995,11 @@ def _as_captured(root: Path, rec: dict[str, Any], name: str, digest: str | None)
     ``--reshoot-lost``, a resume and ``export-lp`` (``export-lp --linear`` had left out a
     TIFF the verdict called intact)."""
     path = root / name
+    pixels = (rec.get("pixels_sha256") or {}).get(name)
+    if pixels is not None and name == rec.get("linear_image") and _known_pixels(path) == pixels:
+        return True  # this process read the very pixels captured (a fit, as it went through)
     if _sha256(path) == digest:
         return True
-    pixels = (rec.get("pixels_sha256") or {}).get(name)
     if pixels is None or name != rec.get("linear_image") or not path.is_file():
         return False
     return tiff_pixels_sha256(path) == pixels
@@ -1359,7 +1385,9 @@ def _lost_files(
     return lost
 
 
-def checksum_session_files(root: Path, stop: Callable[[], bool] | None = None) -> None:
+def checksum_session_files(
+    root: Path, stop: Callable[[], bool] | None = None, read_by_caller: Collection[Path] = ()
+) -> None:
     """Read and checksum the files of every journaled step of session ``root`` (nothing for a
     folder that is no session), so that :func:`files_lost_since_capture` and
     :func:`originals_changed_since_capture` find their checksums known
@@ -1367,15 +1395,22 @@ def checksum_session_files(root: Path, stop: Callable[[], bool] | None = None) -
 
     Why: checking every TIFF reads the whole session once more (14 GB for 100 images of
     24 MP); a fit runs this alongside its own work rather than after it. ``stop`` is asked
-    between files (a fit that failed or was interrupted does not wait for the rest)."""
+    between files (a fit that failed or was interrupted does not wait for the rest).
+    ``read_by_caller``: linear TIFFs the caller reads whole itself, taking their pixel checksum on
+    the way (:func:`remember_pixel_digest`): not read here too (24 MP TIFFs had been read twice
+    by a fit, once to fit and once to checksum)."""
     root = Path(root)
+    skipped = {Path(p).resolve() for p in read_by_caller}
     if root.suffix.lower() == ".lp" and root.is_file():  # an .lp of the session given for it
         root = root.parent
     records = _journal_records(root)
     for rec in _latest_records(records or []).values():
+        pixels = rec.get("pixels_sha256") or {}
         for name in rec["sha256"]:  # the step's JPEG, linear TIFF and kept originals
             if stop is not None and stop():
                 return
+            if pixels.get(name) and (root / name).resolve() in skipped:
+                continue  # its pixel checksum is taken as the caller reads it
             _sha256(root / name)
 
 

@@ -60,6 +60,7 @@ from rti_rig.runtime.session import (
     checksum_session_files,
     lost_image_advice,
     read_manifest,
+    remember_pixel_digest,
     renamed_note,
     renamed_since_capture,
 )
@@ -455,10 +456,14 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     created = not out.exists()
     prepare_out_dir(out)
     # the QA checks every captured file against its journaled checksum: hashed while the fit
-    # works (hashing releases the GIL), not after it
+    # works (hashing releases the GIL), not after it; a TIFF the fit reads in place gets its
+    # pixel checksum from the fit's own pass through its rows, not from a second read
     pool, stop = ThreadPoolExecutor(max_workers=1), threading.Event()
+    in_place = [f.path for f in frames if isinstance(f, TiffRows)]
     checksums = (
-        pool.submit(checksum_session_files, Path(req.source), stop.is_set) if req.qa else None
+        pool.submit(checksum_session_files, Path(req.source), stop.is_set, in_place)
+        if req.qa
+        else None
     )
     try:
         result = _fit_into(req, out, frames, lights, names, what, notes, bands, checksums)
@@ -505,7 +510,9 @@ def _fit_into(  # type: ignore[no-untyped-def]
             with contextlib.suppress(Exception):  # the QA's own check says what went wrong
                 checksums.result()
         try:
-            result.qa = with_lost_files(assess(frames, lights, names), req.source)
+            qa = assess(frames, lights, names)  # every row of every frame: checksummed too
+            _remember_pixels(frames)
+            result.qa = with_lost_files(qa, req.source)
         except ReconstructionError as exc:  # e.g. too few or coplanar lights for PS
             result.warnings.append(f"QA not possible: {exc}")
         else:
@@ -917,7 +924,18 @@ def verdict_for_session(session: Path) -> str:
             f"session has {len(lights)}; run with --lights {VERDICT_MIN_LIGHTS} or more for "
             "an RTI the verdict can judge (the images taken are kept)"
         )
-    return with_lost_files(assess(frames, lights, names), session).verdict
+    qa = assess(frames, lights, names)
+    _remember_pixels(frames)
+    return with_lost_files(qa, session).verdict
+
+
+def _remember_pixels(frames: list[Any]) -> None:
+    """Hand the integrity check the pixel checksums the TIFFs of ``frames`` took as they were
+    read through (:attr:`TiffRows.pixel_digest`): it then reads none of them again."""
+    for frame in frames:
+        got = getattr(frame, "pixel_digest", None) if isinstance(frame, TiffRows) else None
+        if got is not None:
+            remember_pixel_digest(frame.path, *got)
 
 
 @dataclass(frozen=True)
