@@ -1496,7 +1496,8 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
     journal gone, a line damaged, a last line cut short) cannot be checked, and a verdict that
     said "good" without saying so claimed what it had not established. Returns the image base
     names (``image_006``) and the reason; ``([], "")`` for a folder that is no session, or whose
-    journal vouches for every image on disk."""
+    journal vouches for every image on disk. The image a session stopped while saving
+    (:func:`stopped_while_committing`) is not among them: no record of it was ever lost."""
     root = Path(root)
     if not (root / MANIFEST).exists():
         return [], ""
@@ -1522,6 +1523,8 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
     if runner.get("finish_reason") == "completed":  # every step it took was captured
         expected |= set(names[: int(runner.get("steps_done") or total)])
     unchecked = [n for n in names if n in expected and n not in recorded]
+    stopped = _stopped_while_committing(manifest, scan.records, names, unchecked)
+    unchecked = [n for n in unchecked if n != stopped]
     if not unchecked:
         return [], ""
     if not (root / JOURNAL).is_file():
@@ -1537,6 +1540,55 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
             parts.append(f"the last line of {JOURNAL} was cut short")
         why = "; ".join(parts) or f"no record of them in {JOURNAL}"
     return unchecked, why
+
+
+def _stopped_while_committing(
+    manifest: dict[str, Any],
+    records: list[dict[str, Any]],
+    names: list[str],
+    unrecorded: list[str],
+) -> str | None:
+    """The image of ``unrecorded`` (on disk, no journal record) that a session stopped while
+    committing, or None.
+
+    A session killed (or powered off) after an image's files were written and before its
+    journal line leaves that one image on disk unjournaled: the step right after the last one
+    recorded, in a session that did not complete. It was never part of the session (its
+    lights.lp does not list it, a fit leaves it out, a resume sets it aside and shoots it
+    again); nothing is lost from the journal, whose restoring from a backup the verdict had
+    advised. Two or more such images past the last record, or one further on, are what a
+    damaged journal leaves (and so is an unrecorded image before it)."""
+    if (manifest.get("runner") or {}).get("finish_reason") == "completed":
+        return None
+    last = max((int(r["index"]) for r in records), default=-1)
+    beyond = [n for n in unrecorded if names.index(n) > last]
+    return beyond[0] if beyond == names[last + 1 : last + 2] else None
+
+
+def stopped_while_committing(root: Path) -> str | None:
+    """:func:`_stopped_while_committing` of session ``root`` (None for a folder that is no
+    session, or whose manifest cannot be read)."""
+    root = Path(root)
+    if not (root / MANIFEST).is_file():
+        return None
+    try:
+        manifest = read_manifest(root)
+    except SessionError:
+        return None
+    total = planned_steps(manifest)
+    if not total:
+        return None
+    names = image_names(total)
+    present = {
+        p.stem
+        for folder in (root, root / LINEAR_DIR)
+        for p in folder.glob("image_*")
+        if p.is_file()
+    }
+    records = scan_journal(root, names).records
+    recorded = {Path(r["image"]).stem for r in records}
+    unrecorded = [n for n in names if n in present and n not in recorded]
+    return _stopped_while_committing(manifest, records, names, unrecorded)
 
 
 def journal_rig_time(root: Path) -> float:

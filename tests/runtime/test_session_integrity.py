@@ -347,6 +347,36 @@ def test_killed_session_has_its_lp_and_exports(
     assert read_lp(tmp_path / "k.lp") == ref_lp[:3]
 
 
+def test_an_image_killed_before_its_journal_line_is_said_to_be_no_part_of_the_session(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A kill after image_007's files were written and before its journal line: fit's verdict
+    had named image_007 "not checked against its capture checksum" and advised restoring
+    journal.jsonl from a backup, of a journal that had lost nothing. It now says what the
+    file is (no part of the session, not fitted) and what a resume does with it; a line
+    really lost from the journal is still said to be."""
+    from rti_rig.testing.kill_hooks import popen_session
+
+    cfg, _ = reference
+    out = tmp_path / "s"
+    proc = popen_session("before_journal", 6, cfg, out, LIGHTS)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    assert (out / "image_007.jpg").is_file()
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "image_007 is on disk without a journal record" in verdict, verdict
+    assert "restore journal.jsonl" not in verdict and "not checked" not in verdict, verdict
+    lines = (out / "journal.jsonl").read_text().splitlines(keepends=True)
+    (out / "journal.jsonl").write_text("".join(lines[:2] + lines[3:]))  # image_003's lost
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit2"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit2" / "qa.json").read_text())["verdict"]
+    assert "image_003 not checked against its capture checksum" in verdict, verdict
+    assert "image_007 is on disk without a journal record" in verdict, verdict
+
+
 def test_a_resume_after_a_kill_says_its_time_is_a_lower_bound(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

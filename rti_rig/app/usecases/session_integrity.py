@@ -33,6 +33,7 @@ from rti_rig.runtime.session import (
     renamed_note,
     renamed_since_capture,
     scan_journal,
+    stopped_while_committing,
     tiff_check_note,
     unchecked_images,
 )
@@ -58,7 +59,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             # its images are checked as lights.lp's are, and only those (it had been fitted
             # without a check: an edited TIFF was judged "good")
             fitted = {c.name for c in qa.images}
-    qa = _with_unchecked(qa, source, fitted)
+    qa = _with_stopped_while_committing(_with_unchecked(qa, source, fitted), source)
     try:
         manifest = read_manifest(source)  # once, for what the session's kind and end allow
     except RtiRigError:
@@ -184,6 +185,32 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     note = (
         f"the session is not finished ({taken} {of} images; {how}): this verdict judges the "
         f"images taken so far; continue it with rti-rig run --resume {shlex.quote(str(source))}"
+    )
+    return _noted(qa, note)
+
+
+def _with_stopped_while_committing(qa: QAReport, source: Path) -> QAReport:
+    """``qa`` with a word on the image session ``source`` stopped while saving (on disk, no
+    journal record: :func:`stopped_while_committing`).
+
+    Why: it had been named among the images whose journal record was lost, with "restore
+    journal.jsonl from a backup copy" as the advice, of a journal that had lost nothing."""
+    stopped = stopped_while_committing(source)
+    if stopped is None:
+        return qa
+    folder = shlex.quote(str(source))
+    if stopped in {c.name for c in qa.images}:  # an .lp of the user's own listed it
+        note = (
+            f"{stopped} was fitted, but the session stopped while saving it, before its journal "
+            "record: neither its files nor its light were ever recorded as captured; leave it "
+            f"out of the .lp, or let rti-rig run --resume {folder} capture it again"
+        )
+        joined = f"{qa.integrity_note}; {note}" if qa.integrity_note else note
+        return replace(qa, integrity_note=joined)
+    note = (
+        f"{stopped} is on disk without a journal record: the session stopped while saving it, "
+        f"so it is no part of the session (not in {LP_NAME}, not fitted); rti-rig run --resume "
+        f"{folder} sets it aside in recovered/ (never deleted) and captures that step again"
     )
     return _noted(qa, note)
 
