@@ -12,7 +12,7 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
@@ -175,7 +175,7 @@ def run(
     # process at once, exit 138, no word and no all-off
     with _late_pause_ignored():
         try:
-            with _terminable_while_opening():
+            with _terminable_while_opening() as handover:
                 if resume is not None:
                     given = [
                         flag
@@ -237,6 +237,7 @@ def run(
                         ),
                         print_note,
                     )
+                handover.hold()  # a SIGTERM from here on: the capture stops at once
         except RtiRigError as exc:
             _print_failures(getattr(exc, "teardown_failures", None))  # metering's
             state = getattr(exc, "lights_state", None)
@@ -277,7 +278,7 @@ def run(
                 )
             err.print(f"{said}.", markup=False)
             raise _unexpected(exc, "") from None
-        unsafe = _execute(opened)
+        unsafe = _execute(opened, handover)
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
 
@@ -350,10 +351,35 @@ def _terminable_while_opening() -> Iterator[None]:
         raise EmergencyStop("SIGTERM")
 
     previous = signal.signal(signal.SIGTERM, terminated)
+    handover = HandOver(previous)
     try:
-        yield
+        yield handover
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        if not handover.holding:
+            signal.signal(signal.SIGTERM, previous)
+
+
+class HandOver:
+    """A SIGTERM between the session's opening and its capture: held (recorded), not acted
+    on, until the capture's own handler is in place, which then stops the session before its
+    first image, the rig closed.
+
+    Why: the opening's handler was taken away before the capture's was set, and a SIGTERM in
+    between met the default action: the process ended at once, exit 143, with no word (a
+    resume had just set unverified files aside in recovered/) and the rig never closed."""
+
+    def __init__(self, original: Any = signal.SIG_DFL) -> None:
+        #: the SIGTERM handler before the opening's (what the capture puts back at its end)
+        self.original = original
+        self.holding = False
+        self.held: list[int] = []
+
+    def hold(self) -> None:
+        """From now on a SIGTERM is recorded, for the capture to act on (main thread only)."""
+        if threading.current_thread() is not threading.main_thread():
+            return
+        signal.signal(signal.SIGTERM, lambda signum, frame: self.held.append(signum))
+        self.holding = True
 
 
 @contextmanager
@@ -524,7 +550,7 @@ def _time_line(folder, result, dry: bool) -> str:  # type: ignore[no-untyped-def
     )
 
 
-def _execute(opened) -> bool:  # type: ignore[no-untyped-def]
+def _execute(opened, handover: HandOver | None = None) -> bool:  # type: ignore[no-untyped-def]
     """Run with a progress bar and signal handling; print what happened and how to go on.
     True when the session completed but its teardown failed (see :func:`_refuse_unsafe_end`).
 
@@ -532,11 +558,34 @@ def _execute(opened) -> bool:  # type: ignore[no-untyped-def]
     meant as "stop at once", arriving just after the session stopped on the first, had cut
     the summary and its resume hint off (exit 130, no word)."""
     previous = {sig: signal.getsignal(sig) for sig in _HANDLED}
+    handover = handover or HandOver(previous[signal.SIGTERM])
+    previous[signal.SIGTERM] = handover.original  # not the hand-over's hold
     try:
-        return _run_and_report(opened)
+        return _run_and_report(opened, handover)
     finally:
         for sig, h in previous.items():
             signal.signal(sig, h)
+
+
+def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-untyped-def]
+    """Close a session stopped after it opened and before its capture began, say so as a stop
+    while opening is said, and give the exit a stop by ``why`` asks (the capture's own
+    teardown never ran: the rig is closed here)."""
+    try:
+        opened.close()
+    except Exception as exc:  # closing what the opening opened: said, never a traceback
+        err.print(f"[yellow]Closing the rig failed:[/] {escape(str(exc))}")
+    if opened.resumed:
+        said = (
+            f"Stopped ({why}) before the session went on: no new image was captured; continue "
+            f"it with rti-rig run --resume {_arg(opened.out_dir)}"
+        )
+    else:
+        said = f"Stopped ({why}) before the first image: nothing was captured"
+        if not opened.folder.begun:
+            said += f" or written to {opened.out_dir}"
+    err.print(f"[yellow]{escape(said)}.[/]")
+    return typer.Exit(code=stop_exit_code(why))
 
 
 def _refuse_unsafe_end(unsafe: bool) -> None:
@@ -574,7 +623,7 @@ def _paused_lights(rig) -> str:  # type: ignore[no-untyped-def]
     return lights_state(rig)
 
 
-def _run_and_report(opened) -> bool:  # type: ignore[no-untyped-def]
+def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-untyped-def]
     from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
         CancelToken,
@@ -605,10 +654,13 @@ def _run_and_report(opened) -> bool:  # type: ignore[no-untyped-def]
             cancel.pause()
             err.print("[yellow]Pausing after this image; SIGUSR1 again resumes.[/]")
 
-    handlers = {signal.SIGINT: on_sigint, signal.SIGTERM: on_sigterm}
+    handlers = {signal.SIGINT: on_sigint}
     if hasattr(signal, "SIGUSR1"):
         handlers[signal.SIGUSR1] = on_sigusr1
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
+    # SIGTERM stays held (the hand-over's) until the try below, which answers it
+    previous[signal.SIGTERM] = handover.original
+    started = False  # whether the capture (which tears the rig down itself) has begun
     rig, folder, out_dir = opened.rig, opened.folder, opened.out_dir
     dry = " (dry run)" if opened.dry_run else ""
     adaptive = " at most, adaptive" if opened.source is not None else ""
@@ -622,6 +674,9 @@ def _run_and_report(opened) -> bool:  # type: ignore[no-untyped-def]
     if getattr(rig.lighting, "resume_hint", None):  # a dome whose own count cannot resume
         resume_hint = rig.lighting.resume_hint
     try:
+        signal.signal(signal.SIGTERM, on_sigterm)
+        if handover.held:  # a SIGTERM while the capture took over from the opening
+            raise EmergencyStop("SIGTERM")
         with Progress(
             TextColumn("[progress.description]{task.description}"),
             BarColumn(),
@@ -646,9 +701,13 @@ def _run_and_report(opened) -> bool:  # type: ignore[no-untyped-def]
                 elif isinstance(event, StepStarted):  # after a pause: capturing again
                     progress.update(task, description="capturing")
 
+            started = True
             result = run_opened_session(opened, cancel, on_event)
     except EmergencyStop as exc:
         from rti_rig.app.usecases.safe_state import lights_state
+
+        if not started:  # before the capture began: nothing was lit or written by it
+            raise _stopped_before_capture(opened, str(exc)) from None
 
         failed = _print_teardown_failures(folder)
         err.print(
@@ -805,7 +864,7 @@ def preview(
 
     try:
         refuse_unmetered_limit(max_saturated, auto_exposure)
-        with _terminable_while_opening():
+        with _terminable_while_opening() as handover:
             opened = open_preview_session(
                 PreviewRequest(
                     rig_config,
@@ -818,6 +877,7 @@ def preview(
                 ),
                 print_note,
             )
+            handover.hold()  # a SIGTERM from here on: the capture stops at once
     except RtiRigError as exc:
         state = getattr(exc, "lights_state", None)
         if state is not None:  # metering failed: it had lit the rig; nothing was written yet
@@ -831,7 +891,7 @@ def preview(
         why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
         said = f"Stopped ({why}) before the preview image: nothing was captured or written to "
         raise _stopped_while_opening(exc, why, f"{said}{out_dir}", auto_exposure) from None
-    unsafe = _execute(opened)
+    unsafe = _execute(opened, handover)
     # the band given here is the one to plan in: said in the command to copy
     band = "".join(
         f" {flag} {value:g}"
