@@ -20,6 +20,7 @@ times the exposure it needed under the median LED), which is reported.
 from __future__ import annotations
 
 import math
+import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -149,10 +150,13 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     planned = manifest["schedule"]["steps"]
     finish = (manifest.get("runner") or {}).get("finish_reason")
     if finish != "completed" or len(steps) != len(planned):
+        # counted from the journal: the manifest lists a run's steps only once it finishes, so
+        # a killed card session had been said to hold "0 of 48 images" with 20 on disk
+        taken = len({r["index"] for r in scan_journal(root, image_names(len(planned))).records})
         raise SessionError(
             f"{root}: the card session did not finish ({finish or 'no finish recorded'}, "
-            f"{len(steps)} of {len(planned)} images): continue it with rti-rig run --resume "
-            f"{root}, or shoot the card again"
+            f"{max(taken, len(steps))} of {len(planned)} images): continue it with rti-rig run "
+            f"--resume {shlex.quote(str(root))}, or shoot the card again"
         )
     shot_with = {run.get("config_sha256") for run in manifest.get("runs") or []}
     shot_with.discard(None)

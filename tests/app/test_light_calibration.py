@@ -385,11 +385,23 @@ def test_resumed_unfinished_or_malformed_card_sessions_are_refused(tmp_path: Pat
         with pytest.raises(SessionError, match=match):
             read_card_session(card)
 
+    journal = (card / "journal.jsonl").read_text().splitlines(keepends=True)
+    (card / "journal.jsonl").write_text("".join(journal[:20]))  # as a stop after 20 leaves it
+
     def cancelled(m):  # type: ignore[no-untyped-def]
         m["runner"]["finish_reason"] = "cancelled"
         m["steps"] = m["steps"][:20]
 
     refused(cancelled, r"did not finish \(cancelled, 20 of 48 images\)")
+
+    def killed(m):  # type: ignore[no-untyped-def]
+        # a kill: the manifest as the run began (its steps are written when a run finishes);
+        # the journal holds the 20 images taken ("0 of 48 images" had been said)
+        m["runner"] = {"state": "running", "finish_reason": None}
+        m["steps"] = []
+
+    refused(killed, r"did not finish \(no finish recorded, 20 of 48 images\)")
+    (card / "journal.jsonl").write_text("".join(journal))
 
     def resumed_with_another_calibration(m):  # type: ignore[no-untyped-def]
         m["runs"].append({**m["runs"][0], "config_sha256": "0" * 64})
