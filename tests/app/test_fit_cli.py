@@ -642,3 +642,25 @@ def test_an_image_clipped_throughout_is_not_called_a_wrong_light(tmp_path: Path,
         f"light direction not checked on {name} (more than 50% of the pixels judged clipped)"
         in (qa["verdict"])
     )
+
+
+def test_an_out_folder_a_killed_fit_left_is_named_as_such(tmp_path: Path) -> None:
+    """A fit killed outright (SIGKILL, an out-of-memory kill: no clean-up can run) left its
+    --out holding normals.npy and fit.ptm.part; the same command was then refused as merely
+    "not empty". It now says whose files they are and what to do; a folder of other files is
+    still refused as not empty."""
+    session, _, _ = make_session(tmp_path / "s", lights=dome_lights()[:12], size=(48, 64))
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "normals.npy").write_bytes(b"\x93NUMPY")
+    (out / "fit.ptm.part").write_bytes(b"PTM_1.2\n")
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, r.output
+    assert "holds the outputs of a fit that did not finish (fit.ptm.part, normals.npy" in said
+    assert "delete that folder, or those files, and run this again" in said
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine")
+    r = runner.invoke(app, ["fit", str(session), "--out", str(other)])
+    assert r.exit_code == 2 and "is not empty" in " ".join(r.output.split()), r.output

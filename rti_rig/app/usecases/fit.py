@@ -416,6 +416,14 @@ def prepare_out_dir(out: Path) -> None:
         raise FitInputError(f"--out {out} exists and is not a folder: choose another --out")
     try:
         if out.exists() and any(out.iterdir()):
+            unfinished = _unfinished_fit(out)
+            if unfinished:
+                raise FitInputError(
+                    f"{out} holds the outputs of a fit that did not finish ({unfinished}; its "
+                    "fit.json, written last, is missing): the fit was killed, or the machine "
+                    "stopped (out of memory?); delete that folder, or those files, and run this "
+                    "again, or choose another --out"
+                )
             raise FitInputError(f"{out} is not empty: fit writes into a new or empty folder")
     except OSError as exc:
         raise FitInputError(f"--out {out}: cannot read it ({exc.strerror or exc})") from None
@@ -423,6 +431,25 @@ def prepare_out_dir(out: Path) -> None:
         ensure_writable_folder(out)
     except RtiRigError as exc:
         raise FitInputError(str(exc)) from None
+
+
+#: Files a fit writes before its fit.json (written last): one of them without a fit.json is
+#: what a fit killed outright (SIGKILL, an out-of-memory kill, a power cut) left.
+_FIT_OUTPUTS = ("normals.npy", "albedo.npy", "fit.ptm", "fit.rti", "lights.dome", "qa.json")
+
+
+def _unfinished_fit(out: Path) -> str:
+    """The files of a fit that did not finish in folder ``out`` (``""`` when none).
+
+    Why: a fit killed outright cannot clean up after itself, and its ``--out`` (gigabytes of
+    ``*.part`` and ``.npy`` files at 24 MP) was then refused as merely "not empty", which did
+    not say whose files they were or whether they could go."""
+    if (out / "fit.json").exists():
+        return ""
+    found = sorted(
+        p.name for p in out.iterdir() if p.name.endswith(".part") or p.name in _FIT_OUTPUTS
+    )
+    return ", ".join(found[:6]) + (" …" if len(found) > 6 else "")
 
 
 def _discard_outputs(out: Path, created: bool) -> None:
