@@ -237,7 +237,7 @@ def run(
                         ),
                         print_note,
                     )
-                handover.hold()  # a SIGTERM from here on: the capture stops at once
+                handover.hold()  # a stop from here on: the capture answers it
         except RtiRigError as exc:
             _print_failures(getattr(exc, "teardown_failures", None))  # metering's
             state = getattr(exc, "lights_state", None)
@@ -344,14 +344,14 @@ def _terminable_while_opening() -> Iterator[None]:
     from rti_rig.runtime.controller import EmergencyStop
 
     if threading.current_thread() is not threading.main_thread():
-        yield  # signal handlers can only be set from the main thread
+        yield HandOver()  # signal handlers can only be set from the main thread
         return
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
         raise EmergencyStop("SIGTERM")
 
     previous = signal.signal(signal.SIGTERM, terminated)
-    handover = HandOver(previous)
+    handover = HandOver({signal.SIGTERM: previous})
     try:
         yield handover
     finally:
@@ -360,26 +360,36 @@ def _terminable_while_opening() -> Iterator[None]:
 
 
 class HandOver:
-    """A SIGTERM between the session's opening and its capture: held (recorded), not acted
-    on, until the capture's own handler is in place, which then stops the session before its
-    first image, the rig closed.
+    """A SIGTERM or Ctrl-C between the session's opening and its capture: held (recorded),
+    not acted on, until the capture's own handlers are in place; the capture then stops the
+    session before its first image, the rig closed, and says so.
 
-    Why: the opening's handler was taken away before the capture's was set, and a SIGTERM in
-    between met the default action: the process ended at once, exit 143, with no word (a
-    resume had just set unverified files aside in recovered/) and the rig never closed."""
+    Why: the opening's handler was taken away before the capture's were set, and a signal in
+    between met the default action: SIGTERM ended the process at once (exit 143), Ctrl-C with
+    exit 130, both with no word (a resume had just set unverified files aside in recovered/)
+    and the rig never closed."""
 
-    def __init__(self, original: Any = signal.SIG_DFL) -> None:
-        #: the SIGTERM handler before the opening's (what the capture puts back at its end)
-        self.original = original
+    def __init__(self, originals: dict[int, Any] | None = None) -> None:
+        #: the handlers before the opening's, by signal (what the capture puts back at its end)
+        self.originals: dict[int, Any] = dict(originals or {})
         self.holding = False
         self.held: list[int] = []
 
     def hold(self) -> None:
-        """From now on a SIGTERM is recorded, for the capture to act on (main thread only)."""
+        """From now on SIGTERM and SIGINT are recorded, for the capture to act on (main
+        thread only)."""
         if threading.current_thread() is not threading.main_thread():
             return
-        signal.signal(signal.SIGTERM, lambda signum, frame: self.held.append(signum))
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            before = signal.signal(sig, lambda signum, frame: self.held.append(signum))
+            self.originals.setdefault(sig, before)
         self.holding = True
+
+    def why(self) -> str:
+        """How the held stop is named ("" when none came)."""
+        if signal.SIGTERM in self.held:
+            return "SIGTERM"
+        return "Ctrl-C" if self.held else ""
 
 
 @contextmanager
@@ -558,8 +568,8 @@ def _execute(opened, handover: HandOver | None = None) -> bool:  # type: ignore[
     meant as "stop at once", arriving just after the session stopped on the first, had cut
     the summary and its resume hint off (exit 130, no word)."""
     previous = {sig: signal.getsignal(sig) for sig in _HANDLED}
-    handover = handover or HandOver(previous[signal.SIGTERM])
-    previous[signal.SIGTERM] = handover.original  # not the hand-over's hold
+    handover = handover or HandOver()
+    previous.update(handover.originals)  # not the hand-over's holds
     try:
         return _run_and_report(opened, handover)
     finally:
@@ -659,7 +669,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         handlers[signal.SIGUSR1] = on_sigusr1
     previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
     # SIGTERM stays held (the hand-over's) until the try below, which answers it
-    previous[signal.SIGTERM] = handover.original
+    previous[signal.SIGTERM] = signal.getsignal(signal.SIGTERM)
+    previous.update(handover.originals)  # not the hand-over's holds
     started = False  # whether the capture (which tears the rig down itself) has begun
     rig, folder, out_dir = opened.rig, opened.folder, opened.out_dir
     dry = " (dry run)" if opened.dry_run else ""
@@ -675,8 +686,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         resume_hint = rig.lighting.resume_hint
     try:
         signal.signal(signal.SIGTERM, on_sigterm)
-        if handover.held:  # a SIGTERM while the capture took over from the opening
-            raise EmergencyStop("SIGTERM")
+        if handover.held:  # a SIGTERM or Ctrl-C while the capture took over from the opening
+            raise EmergencyStop(handover.why())
         with Progress(
             TextColumn("[progress.description]{task.description}"),
             BarColumn(),
@@ -877,7 +888,7 @@ def preview(
                 ),
                 print_note,
             )
-            handover.hold()  # a SIGTERM from here on: the capture stops at once
+            handover.hold()  # a stop from here on: the capture answers it
     except RtiRigError as exc:
         state = getattr(exc, "lights_state", None)
         if state is not None:  # metering failed: it had lit the rig; nothing was written yet
