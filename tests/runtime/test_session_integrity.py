@@ -633,6 +633,36 @@ def test_an_lp_of_the_users_own_in_a_session_is_checked_for_the_images_it_lists(
     assert "image_003" not in verdict, verdict
 
 
+def test_an_image_lost_and_left_out_of_the_lp_fitted_is_still_named(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """image_003.jpg deleted, lights.lp written again from the journal (export-lp leaves the
+    lost image out): `fit S` judged the 7 images listed and said "good", of a session that
+    lost one. The lost image is now named, as not fitted; and a session folder without its
+    lights.lp, fitted from another .lp in it, is said to be."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    (done / "image_003.jpg").unlink()
+    (done / "linear" / "image_003.tif").unlink()
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 0, r.output
+    (done / "lights.lp").unlink()
+    (tmp_path / "x.lp").rename(done / "rest.lp")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert f"{done} is a session folder without its lights.lp: fitted from its rest.lp" in said(r)
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "1 image missing or changed since capture (image_003; image_003 not in rest.lp, so" in (
+        verdict
+    ), verdict
+    (done / "rest.lp").rename(done / "lights.lp")
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit2"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert "without its lights.lp" not in said(r)
+    verdict = json.loads((tmp_path / "fit2" / "qa.json").read_text())["verdict"]
+    assert "image_003 not in lights.lp, so not fitted" in verdict, verdict
+
+
 def test_a_session_journaled_before_pixel_checksums_is_checked_by_bytes_and_says_so(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

@@ -270,6 +270,15 @@ def acquisition_files(
                 )
             raise FitInputError(f"{source} holds no .lp file: not a session folder")
         lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]
+        if notes is not None and lp.name != LP_NAME and (source / JOURNAL).is_file():
+            # a session that lost its lights.lp had been fitted from another .lp in it (one
+            # the user exported: a subset, say) without a word
+            notes.append(
+                f"{source} is a session folder without its {LP_NAME}: fitted from its "
+                f"{lp.name}; rebuild {LP_NAME} from the session's journal with: rti-rig "
+                f"export-lp {shlex.quote(str(source))} --out "
+                f"{shlex.quote(str(source / LP_NAME))}"
+            )
         if notes is not None and (source / JOURNAL).is_file() and not (source / MANIFEST).is_file():
             # a session (it has a journal) that lost its manifest had been fitted, and judged
             # "good", without a word: what it records (the rig, the plan, the exposure, the

@@ -51,6 +51,8 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     ones fitted and judged) are named."""
     source = Path(source)
     lp = source / LP_NAME
+    if source.is_dir() and not lp.is_file():  # the .lp a fit of the folder reads instead
+        lp = next(iter(sorted(source.glob("*.lp"))), lp)
     fitted: set[str] | None = None  # the images judged, when not every one of the session's
     if not source.is_dir():
         lp, source = source, source.parent
@@ -100,7 +102,10 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         f"{lp.name} still lists {'it' if len(relisted) == 1 else 'them'}, so relight (which "
         "pairs the .lp's lines with the JPEGs in order) gives every later image the wrong light"
     )
-    once = len(lost) > 1  # the advice said once, not after each of (say) 48 images
+    # an image lost that the .lp fitted does not list (a lights.lp written again without it)
+    # is said too: it had gone unsaid, the verdict "good", of a session no longer whole
+    unlisted = [n for n in sorted(lost) if n not in {c.name for c in qa.images}]
+    once = len(lost) > 1 or bool(unlisted)  # the advice said once, not after each of 48 images
     images = []
     for check in qa.images:
         gone = lost.get(check.name)
@@ -116,7 +121,11 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         shown = ", ".join(sorted(lost)[:8]) + (
             f" and {len(lost) - 8} more" if len(lost) > 8 else ""
         )
-        note = f"{len(lost)} images missing or changed since capture ({shown}): {todo}"
+        if unlisted:
+            shown += f"; {', '.join(unlisted[:8])}{' …' if len(unlisted) > 8 else ''} not in "
+            shown += f"{lp.name}, so not fitted"
+        plural = "images" if len(lost) > 1 else "image"
+        note = f"{len(lost)} {plural} missing or changed since capture ({shown}): {todo}"
         if relisted:
             note += f"; {relight} ({', '.join(relisted[:8])}{' …' if len(relisted) > 8 else ''})"
         qa = _noted(qa, note)
