@@ -1216,15 +1216,10 @@ def _refuse_lost_journal(root: Path, names: list[str]) -> None:
     sets aside and reshoots as ever."""
     if (root / JOURNAL).exists():
         return
-    first = names[0] if names else ""
-    later = sorted(
-        p.stem
-        for folder in (root, root / LINEAR_DIR, root / RAW_DIR)
-        for p in folder.glob("image_*")
-        if p.is_file() and p.stem != first and not p.stem.startswith(f"{first}_")
-    )
+    later = _files_after_first_step(root, names)
     if not later:
         return
+    first = names[0] if names else ""
     count = len({stem.split("_")[1] for stem in later} | {first.split("_")[1]})
     raise SessionError(
         f"{root}: {JOURNAL} is missing, so none of the images on disk (about {count} steps) "
@@ -1233,6 +1228,36 @@ def _refuse_lost_journal(root: Path, names: list[str]) -> None:
         f"rti-rig run --resume {shlex.quote(str(root))} again; if it is lost for good, shoot "
         "the session again with another --out (nothing in this folder was changed)"
     )
+
+
+def _files_after_first_step(root: Path, names: list[str]) -> list[str]:
+    """The base names of image files on disk of any step after the first (``image_002``,
+    ``image_003_raw``…): what proves a session had a journal (a step begins only once the
+    previous one's journal line is on disk)."""
+    first = names[0] if names else ""
+    return sorted(
+        p.stem
+        for folder in (root, root / LINEAR_DIR, root / RAW_DIR)
+        for p in folder.glob("image_*")
+        if p.is_file() and p.stem != first and not p.stem.startswith(f"{first}_")
+    )
+
+
+def stopped_before_first_record(root: Path) -> bool:
+    """Whether session ``root`` (its manifest readable) has no journal because it never wrote
+    one: stopped (killed, a power cut) before its first image was journaled, with at most that
+    first image's files on disk (which a resume sets aside and shoots again).
+
+    Why: such a folder had been called "not a session folder" by ``fit``, and ``export-lp``
+    advised restoring a journal.jsonl from a backup, of a journal that never existed."""
+    root = Path(root)
+    if (root / JOURNAL).exists():
+        return False
+    try:
+        total = planned_steps(read_manifest(root))
+    except SessionError:
+        return False
+    return bool(total) and not _files_after_first_step(root, image_names(total))
 
 
 def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str | None:
@@ -1703,6 +1728,13 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     key = "linear_image" if linear else "image"
     done = verified_steps(root, records, only=key)  # the file the .lp names, as captured
     if not records:
+        if stopped_before_first_record(root):
+            raise SessionError(
+                f"{root}: the session stopped before its first image was recorded in its "
+                f"{JOURNAL}, so there is no .lp to export; continue it with rti-rig run --resume "
+                f"{shlex.quote(str(root))} (a first image's files left on disk are set aside in "
+                "recovered/ and shot again)"
+            )
         if not (Path(root) / JOURNAL).is_file():
             raise SessionError(
                 f"{root}: {JOURNAL} is missing, so no image can be verified as captured with "

@@ -377,6 +377,36 @@ def test_an_image_killed_before_its_journal_line_is_said_to_be_no_part_of_the_se
     assert "image_007 is on disk without a journal record" in verdict, verdict
 
 
+def test_a_session_killed_before_its_first_record_is_told_to_resume_not_restore(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """Killed after image_001's TIFF was written, before any journal line: `fit` had called
+    the folder "not a session folder" and `export-lp` advised restoring journal.jsonl from a
+    backup, of a journal that never existed. Both now say it stopped before its first record
+    and to resume. A session that lost both its lights.lp and its journal is not called "not
+    a session folder" either."""
+    from rti_rig.testing.kill_hooks import popen_session
+
+    cfg, ref = reference
+    out = tmp_path / "s"
+    proc = popen_session("between_files", 0, cfg, out, LIGHTS)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    assert (out / "linear" / "image_001.tif").is_file() and not (out / "journal.jsonl").exists()
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 2 and "stopped before its first image was recorded" in said(r), r.output
+    assert f"rti-rig run --resume {out}" in said(r)
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 2 and "stopped before its first image was recorded" in said(r), r.output
+    assert "backup" not in said(r)
+    done = copied(ref, tmp_path)
+    (done / "journal.jsonl").unlink()
+    (done / "lights.lp").unlink()
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit2")])
+    assert r.exit_code == 2, r.output
+    assert "a session folder without its lights.lp and journal.jsonl" in said(r), r.output
+
+
 def test_a_resume_after_a_kill_says_its_time_is_a_lower_bound(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:

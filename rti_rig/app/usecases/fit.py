@@ -63,6 +63,7 @@ from rti_rig.runtime.session import (
     remember_pixel_digest,
     renamed_note,
     renamed_since_capture,
+    stopped_before_first_record,
 )
 
 #: What ``--model`` accepts besides the registered model names.
@@ -267,6 +268,18 @@ def acquisition_files(
                     f"{source} is a session folder without its {LP_NAME}; rebuild it from the "
                     f"session's journal with: rti-rig export-lp {shlex.quote(str(source))} "
                     f"--out {shlex.quote(str(source / LP_NAME))}"
+                )
+            if stopped_before_first_record(source):  # a session killed before its first record
+                raise FitInputError(
+                    f"{source} is a session that stopped before its first image was recorded: "
+                    f"there is nothing to fit yet; continue it with rti-rig run --resume "
+                    f"{shlex.quote(str(source))}"
+                )
+            if (source / MANIFEST).is_file():  # its journal and lights.lp both gone
+                raise FitInputError(
+                    f"{source} is a session folder without its {LP_NAME} and {JOURNAL}: its "
+                    "images cannot be paired with their lights or verified as captured; restore "
+                    "both from a backup copy of the folder"
                 )
             raise FitInputError(f"{source} holds no .lp file: not a session folder")
         lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]
