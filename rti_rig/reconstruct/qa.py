@@ -55,9 +55,9 @@ from rti_rig.reconstruct.qa_drift import (
     MAX_SHIFT_PX,
     Step,
     edge_shifts_trusted,
-    find_step,
     measure_drift,
     move_back,
+    step_candidates,
     still_spread_px,
 )
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
@@ -539,8 +539,9 @@ def _confirmed_shift(
 def _confirmed_step(
     crop_arr: NDArray, lt: NDArray, lit: NDArray[np.bool_], saturation: float | None
 ) -> tuple[Step, NDArray, Any] | None:
-    """A move part-way through the session (:func:`~rti_rig.reconstruct.qa_drift.find_step`)
-    that the fit confirms, with the images from it on moved back and the fit of those, or None.
+    """A move part-way through the session (the first of
+    :func:`~rti_rig.reconstruct.qa_drift.step_candidates` the fit confirms), with the images
+    from it on moved back and the fit of those, or None.
 
     The edges alone are not enough: an object whose shading edges move with the light (the
     virtual arm's 512 px tablet) has two groups of lights whose median edges lie a pixel apart
@@ -549,21 +550,23 @@ def _confirmed_step(
     photometric-stereo fit at least :data:`DRIFT_CONFIRM` better (median relative residual)
     than as captured. Measured on the emulated sessions: 0.50-0.61 for moves of 1.4-3 px from
     image 4 or 7 of 12 and 25 of 48; 1.01-1.26 for the tablet's two still sessions."""
-    step = find_step(crop_arr, lit)
-    if step is None:
-        return None
-    moved = crop_arr.copy()
-    for i in range(step.first, len(crop_arr)):
-        moved[i] = move_back(moved[i], *step.shift)
-    pad = int(np.ceil(max(abs(v) for v in step.shift))) + 1
-    try:
-        fit_as_is = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=saturation)
-        fit_undone = fit_photometric_stereo(moved, lt, robust=True, saturation=saturation)
-    except ReconstructionError:
-        return None
-    as_is = _step_residual(crop_arr, fit_as_is, lt, step.first, pad)
-    undone = _step_residual(moved, fit_undone, lt, step.first, pad)
-    return (step, moved, fit_undone) if undone <= DRIFT_CONFIRM * as_is else None
+    fit_as_is: Any = None
+    for step in step_candidates(crop_arr, lit):  # the next when the fit refuses one
+        moved = crop_arr.copy()
+        for i in range(step.first, len(crop_arr)):
+            moved[i] = move_back(moved[i], *step.shift)
+        pad = int(np.ceil(max(abs(v) for v in step.shift))) + 1
+        try:
+            if fit_as_is is None:
+                fit_as_is = fit_photometric_stereo(crop_arr, lt, robust=True, saturation=saturation)
+            fit_undone = fit_photometric_stereo(moved, lt, robust=True, saturation=saturation)
+        except ReconstructionError:
+            return None
+        as_is = _step_residual(crop_arr, fit_as_is, lt, step.first, pad)
+        undone = _step_residual(moved, fit_undone, lt, step.first, pad)
+        if undone <= DRIFT_CONFIRM * as_is:
+            return step, moved, fit_undone
+    return None
 
 
 def _step_residual(stack: NDArray, ps: Any, lt: NDArray, first: int, pad: int) -> float:

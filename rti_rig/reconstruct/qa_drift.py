@@ -48,6 +48,7 @@ called moved by 2 px. Not kept.)
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import cv2
@@ -218,7 +219,13 @@ class Step:
 
 
 def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | None:
-    """A move part-way through the session (a step in the per-image shifts), or None.
+    """The first of :func:`step_candidates`, or None."""
+    return next(step_candidates(crops, usable), None)
+
+
+def step_candidates(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Iterator[Step]:
+    """Moves part-way through the session (a step in the per-image shifts) the edges bear
+    out, most likely first, each with a different first image (none: none found).
 
     Why: when the object moves for a good part of a session (from image 25 of 48, or 7 of 12)
     every reference the per-image checks use is a blend of the two positions. The median edge
@@ -237,12 +244,21 @@ def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | N
     (sub-pixel, :func:`local_phase_correlation`). It is a move when they lie more than
     :data:`STEP_PX` apart, the after side moved back by it agrees with the before side better
     than as it is (:func:`_confirmed` logic), and the split's peaks agree with that shift.
+
+    The first split comes from the peaks against the median of every image; then from the
+    peaks against the median of the first half of the images, then of the second half. When
+    the move falls half-way, the median of all holds both positions equally and every peak
+    against it sits at 0 (no split: the painting moved (1, 2) px from image 7 of 12 was named
+    on two scattered images, neither of them moved); a half that lies on one side of the move
+    holds that position alone, and the other side's peaks stand off it by the move. A caller
+    that confirms a candidate another way (:func:`~rti_rig.reconstruct.qa._confirmed_step`)
+    takes the next when one is refused.
     """
     n = crops.shape[0]
     edges = [edge_image(c) if usable[i] else None for i, c in enumerate(crops)]
     have = [i for i in range(n) if edges[i] is not None]
     if len(have) < 2 * STEP_MIN_IMAGES:
-        return None
+        return
     window = cv2.createHanningWindow((crops.shape[2], crops.shape[1]), cv2.CV_64F)
 
     def median_of(images: list[int]) -> NDArray[np.float64]:
@@ -308,39 +324,55 @@ def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | N
             return None
         return before, after
 
-    # A first split from the whole-pixel peaks against the blended median; then the shift
-    # between the two sides' medians, and each image labelled by whether its edges moved back
-    # by that shift agree better with the before side's (a hypothesis test, no peak to find:
-    # an image under a grazing or weak light places no peak, but still tells which of two
-    # known positions it is at); the split the labels agree with most, up to three times.
-    first = best_split(peaks_against(median_of(have)))
-    for rnd in range(4):  # three refinements; the split they end on is judged below
-        split = sides(first)
-        if split is None:
+    def judged(first: int | None) -> Step | None:
+        """The step the split before ``first`` refines to, if the images bear it out."""
+        # The shift between the two sides' medians, and each image labelled by whether its
+        # edges moved back by that shift agree better with the before side's (a hypothesis
+        # test, no peak to find: an image under a grazing or weak light places no peak, but
+        # still tells which of two known positions it is at); the split the labels agree
+        # with most, up to three times.
+        for rnd in range(4):  # three refinements; the split they end on is judged below
+            split = sides(first)
+            if split is None:
+                return None
+            before, after = split
+            ref_a, ref_b = median_of(before), median_of(after)
+            (dx, dy), response = local_phase_correlation(ref_a, ref_b, window)
+            if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
+                return None
+            labels = moved_labels(ref_a, dx, dy)
+            refined = label_split(labels) if rnd < 3 else first
+            if refined == first:
+                break
+            first = refined
+        as_is, moved_back = _agreement(ref_a, ref_b, dx, dy)
+        if not moved_back > as_is:
             return None
-        before, after = split
-        ref_a, ref_b = median_of(before), median_of(after)
-        (dx, dy), response = local_phase_correlation(ref_a, ref_b, window)
-        if not np.isfinite(dx) or response < MIN_RESPONSE or np.hypot(dx, dy) <= STEP_PX:
+        # the images, one by one, must sit where the step says: most of those after it at
+        # the move, most of those before at none (two groups of lights whose shading edges
+        # differ would not)
+        la, lb = labels[before], labels[after]
+        la, lb = la[np.isfinite(la)], lb[np.isfinite(lb)]
+        if la.size < STEP_MIN_IMAGES or lb.size < STEP_MIN_IMAGES:
             return None
-        labels = moved_labels(ref_a, dx, dy)
-        refined = label_split(labels) if rnd < 3 else first
-        if refined == first:
-            break
-        first = refined
-    as_is, moved_back = _agreement(ref_a, ref_b, dx, dy)
-    if not moved_back > as_is:
-        return None
-    # the images, one by one, must sit where the step says: most of those after it at the
-    # move, most of those before at none (two groups of lights whose shading edges differ
-    # would not)
-    la, lb = labels[before], labels[after]
-    la, lb = la[np.isfinite(la)], lb[np.isfinite(lb)]
-    if la.size < STEP_MIN_IMAGES or lb.size < STEP_MIN_IMAGES:
-        return None
-    if la.mean() > 1 - STEP_AGREE or lb.mean() < STEP_AGREE:
-        return None
-    return Step(first, (float(dx), float(dy)))
+        if la.mean() > 1 - STEP_AGREE or lb.mean() < STEP_AGREE:
+            return None
+        assert first is not None  # sides() refused None
+        return Step(first, (float(dx), float(dy)))
+
+    # The first split, from the whole-pixel peaks against the median of every image; failing
+    # that, against the median of the first half of the images, then of the second half
+    # (the seeds): a move between a quarter and three quarters of the way through
+    # leaves one half at one position, whose median holds that position's edges alone.
+    half = len(have) // 2
+    seen: set[int] = set()
+    for seed in (have, have[:half], have[half:]):
+        if len(seed) < STEP_MIN_IMAGES:
+            continue
+        step = judged(best_split(peaks_against(median_of(seed))))
+        if step is not None and step.first not in seen:
+            seen.add(step.first)
+            yield step
 
 
 #: The edge shifts are trusted when their robust spread about the session's median is at
