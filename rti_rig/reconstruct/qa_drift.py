@@ -415,3 +415,60 @@ def still_spread_px(dev: NDArray[np.float64]) -> float:
 def move_back(img: NDArray, dx: float, dy: float) -> NDArray:
     """The image moved back by its measured shift (edges reflected)."""
     return _move(img, -dx, -dy)
+
+
+#: A change point needs at least this many measured images on each side: fewer, and the
+#: per-image check against a fit made mostly of the other side names them itself.
+CHANGE_MIN_BLOCK = 3
+#: A change point is a candidate when its two blocks' median shifts differ by this many
+#: standard errors (robust, from the blocks' own spread) ...
+CHANGE_Z = 4.0
+#: ... and by at least this much (pixels). The fit blends the two positions, so each block
+#: reads only part of the move against it. Candidates are confirmed by a refit
+#: (:func:`~rti_rig.reconstruct.qa._moved_block`).
+CHANGE_MIN_PX = 0.5
+
+
+def change_point(
+    shifts: NDArray[np.float64], judged: NDArray[np.bool_]
+) -> tuple[int, NDArray[np.float64], float] | None:
+    """Where per-image shifts (N, 2) of a session, in capture order, split into an earlier and
+    a later block whose median shifts differ by more than their noise: the first image of the
+    later block, the later block's median shift minus the earlier's, and that difference in
+    robust standard errors. None when no split passes :data:`CHANGE_Z` and
+    :data:`CHANGE_MIN_PX` (``judged`` False, or a NaN shift: not used; each block needs
+    :data:`CHANGE_MIN_BLOCK` used images).
+
+    Why: where the edges move with the light (the virtual arm's 256 px tablet) the edge-based
+    :func:`step_candidates` cannot tell a move from a change of lights, but the shifts of the
+    images against a fit can: a fit that blends two positions leaves every image a pixel or
+    so off the blend, no single image beyond the per-image threshold, and the images split
+    plainly into two clusters in capture order. The noise is each block's spread about its
+    own median (1.4826 × MAD, pooled), so a session whose grazing images wander by ±0.7 px
+    is not split by them."""
+    ok = judged & np.all(np.isfinite(shifts), axis=1)
+    idx = np.flatnonzero(ok)
+    m = idx.size
+    if m < 2 * CHANGE_MIN_BLOCK:
+        return None
+    s = shifts[idx]
+    # the split that best explains the shifts as two still positions (least summed distance
+    # to each block's median: one image that wanders does not pull the split to it)
+    cost = [
+        float(np.hypot(*(s[:c] - np.median(s[:c], axis=0)).T).sum())
+        + float(np.hypot(*(s[c:] - np.median(s[c:], axis=0)).T).sum())
+        for c in range(CHANGE_MIN_BLOCK, m - CHANGE_MIN_BLOCK + 1)
+    ]
+    cut = CHANGE_MIN_BLOCK + int(np.argmin(cost))
+    a, b = s[:cut], s[cut:]
+    ma, mb = np.median(a, axis=0), np.median(b, axis=0)
+    diff = mb - ma
+    dev = np.concatenate([np.hypot(*(a - ma).T), np.hypot(*(b - mb).T)])
+    # 2-D distances of normal noise (Rayleigh): their median is 1.1774 sigma per axis; the
+    # floor keeps blocks of near-identical shifts from an infinite z
+    sigma = max(float(np.median(dev)) / 1.1774, 0.02)
+    se = 1.2533 * sigma * np.sqrt(1.0 / cut + 1.0 / (m - cut))  # of a median
+    size = float(np.hypot(*diff))
+    if size < CHANGE_MIN_PX or size < CHANGE_Z * se:
+        return None
+    return int(idx[cut]), diff, size / se
