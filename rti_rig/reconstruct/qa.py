@@ -538,6 +538,19 @@ def _confirmed_shift(
     return False, raw
 
 
+#: Where the fit leaves the images after a step this far from its prediction (median relative
+#: residual, as captured and with the step undone alike), its confirmation of the step is no
+#: evidence either way and the edges' step stands on its own (:func:`_confirmed_step`): the
+#: fit explains the object no better than the QA's
+#: :data:`~rti_rig.reconstruct.qa_directions.MISFIT_LIMIT` at either position. Measured on the
+#: emulated sessions with a 1-2 px move undone: 0.004-0.026 on the matte scenes (tablet,
+#: tilted, relief, painting; 0.006-0.08 as captured), 0.11-0.31 on the glossy coin and the
+#: industrial part, whose residual moved by -13 % to +6 % (a (2, 0) px move from image 13 of
+#: 24 on either had been called good: the step was found by the edges, from the right image,
+#: and refused by the fit).
+STEP_FIT_NO_EVIDENCE = 0.1
+
+
 def _confirmed_step(
     crop_arr: NDArray, lt: NDArray, lit: NDArray[np.bool_], saturation: float | None
 ) -> tuple[Step, NDArray, Any] | None:
@@ -551,7 +564,10 @@ def _confirmed_step(
     images agree with one another: the images from the step on, moved back, are explained by a
     photometric-stereo fit at least :data:`DRIFT_CONFIRM` better (median relative residual)
     than as captured. Measured on the emulated sessions: 0.50-0.61 for moves of 1.4-3 px from
-    image 4 or 7 of 12 and 25 of 48; 1.01-1.26 for the tablet's two still sessions."""
+    image 4 or 7 of 12 and 25 of 48; 1.01-1.26 for the tablet's two still sessions. Where the
+    fit explains those images poorly (:data:`STEP_FIT_NO_EVIDENCE`: gloss, an object the
+    Lambertian fit cannot render) it confirms nothing, and the edges' step is taken as found:
+    on the emulated coin and industrial part no still session yields an edges' step."""
     fit_as_is: Any = None
     for step in step_candidates(crop_arr, lit):  # the next when the fit refuses one
         moved = crop_arr.copy()
@@ -566,7 +582,7 @@ def _confirmed_step(
             return None
         as_is = _step_residual(crop_arr, fit_as_is, lt, step.first, pad)
         undone = _step_residual(moved, fit_undone, lt, step.first, pad)
-        if undone <= DRIFT_CONFIRM * as_is:
+        if undone <= DRIFT_CONFIRM * as_is or min(as_is, undone) > STEP_FIT_NO_EVIDENCE:
             return step, moved, fit_undone
     return None
 

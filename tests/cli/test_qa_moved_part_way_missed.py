@@ -9,7 +9,10 @@ Found by an injection sweep over correct simulated sessions (every case below wa
   0, so no split was proposed (now also from the median of each half of the session);
 * the virtual arm's 256 px tablet, 24 lights, moved (2, 2) px from image 12: its shading
   edges move with the light, so no edges' step holds (now the shifts against the fit, split
-  in capture order and confirmed by a refit from one side: qa._moved_block).
+  in capture order and confirmed by a refit from one side: qa._moved_block);
+* the glossy coin and the industrial part, moved (2, 0) px: the edges' step was found, from
+  the right image, and refused by the fit, which explains neither object well enough to
+  confirm anything (qa.STEP_FIT_NO_EVIDENCE).
 """
 
 from __future__ import annotations
@@ -40,6 +43,8 @@ def _dome_variant(folder: Path, scene: str) -> Path:
 CASES = {
     "painting": ("dome", "painting", None, 12, 7, 1, 2),
     "tablet": ("arm", "tablet", 256, 24, 12, 2, 2),
+    "coin": ("arm", "coin", None, 24, 13, 2, 0),
+    "industrial": ("dome", "industrial", None, 12, 5, 2, 0),
 }
 
 
