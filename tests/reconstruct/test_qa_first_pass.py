@@ -54,3 +54,12 @@ def test_a_float_frame_with_a_nan_channel_still_counts_its_clipped_one() -> None
     np.testing.assert_array_equal(small_sat, want[2])
     finite = np.isfinite(want[1])
     np.testing.assert_allclose(small[finite], want[1][finite], rtol=1e-6)
+
+
+def test_a_frame_with_nothing_clipped_marks_no_reduced_pixel() -> None:
+    a = np.random.default_rng(4).integers(0, 60000, size=(120, 90, 3), dtype=np.uint16)
+    frac, small, small_sat = _reduced(a, 65535.0, (45, 60))
+    want = _by_definition(a, 65535.0, (45, 60))
+    assert frac == want[0] == 0.0
+    assert small_sat.dtype == np.bool_ and small_sat.shape == small.shape == want[2].shape
+    assert not small_sat.any()
