@@ -826,6 +826,14 @@ def assess(
                 if np.isfinite(shown)
                 else "; here too few images hold their edges still to tell: none is claimed"
             )
+            + (
+                # the step's own evidence (_confirmed_step): on such an object the edges of
+                # the images on either side of it, the fit confirming nothing either way
+                "; a move part-way through is claimed from the edges of the images before "
+                "and after it"
+                if step is not None
+                else ""
+            )
         )
     if step is None and not edges_trusted and not drift_note:
         # No step the edges bear out, on an object whose edges move with the light: the

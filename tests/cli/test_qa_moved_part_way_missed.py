@@ -86,6 +86,11 @@ def test_the_move_is_named_from_its_first_image(case, tmp_path: Path) -> None:  
     assert moved == [f"image_{i:03d}" for i in range(first, lights + 1)], qa["verdict"]
     shift = next(c for c in qa["images"] if c["name"] == name)["drift_px"]
     np.testing.assert_allclose(shift, [dx, -dy], atol=0.75)  # x right, y up
+    # where the fit explains the object poorly its note says how the move was claimed (it
+    # said a shift is claimed only where the fit and the edges agree, beside a move the fit
+    # had not confirmed)
+    if "show it alike" in qa["drift_note"]:
+        assert "a move part-way through is claimed from the edges" in qa["drift_note"]
 
 
 def test_the_session_held_still_is_not_called_moved(case, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
