@@ -35,7 +35,7 @@ error per scene and target.
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b] [--seed S]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
 [--floors F,F] [--default-floor F] [--relight-default-floor F] [--relief-gain]
-[--no-fitted-design] [--fitted-margin M]
+[--no-fitted-design] [--fitted-margin M] [--heldout-score select|1se|mean|minimax]
 [--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight-fitted-design]
 [--relight-basis B]
 [--no-relight] [--cache FILE] [--min-elevation-deg F] [--max-elevation-deg C]
@@ -692,6 +692,10 @@ def configure_planner(args: argparse.Namespace) -> None:
         import rti_rig.planner.adaptive_bias as bias
 
         bias.FIT_RELIEF_GAIN = True
+    if args.heldout_score:
+        from benchmarks.adaptive_heldout import install
+
+        install(args.heldout_score)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -766,6 +770,13 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="fit the relief's depth to the captured shadows (planner.adaptive_relief; off in "
         "what ships)",
+    )
+    ap.add_argument(
+        "--heldout-score",
+        default=None,
+        choices=("select", "1se", "mean", "minimax"),
+        help="score the normals objective's designs on variants of the object model judged "
+        "on held-out captured images (benchmarks.adaptive_heldout; not shipped)",
     )
     ap.add_argument(
         "--no-until", action="store_true", help="skip the --until-error rows (faster to iterate)"
@@ -966,6 +977,7 @@ def main(argv: list[str] | None = None) -> str:
                 else ""
             )
             + (" --relief-gain" if args.relief_gain else "")
+            + (f" --heldout-score {args.heldout_score}" if args.heldout_score else "")
             + (" --no-fitted-design" if args.no_fitted_design else "")
             + (f" --fitted-pixels {args.fitted_pixels}" if args.fitted_pixels is not None else "")
             + (f" --relight-basis {args.relight_basis}" if args.relight_basis else "")

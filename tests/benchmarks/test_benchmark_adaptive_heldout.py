@@ -1,0 +1,79 @@
+"""``benchmarks.adaptive_heldout``: object-model variants judged on held-out captured images,
+and ``benchmarks.adaptive --heldout-score`` scoring the chooser's designs by them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks import adaptive, adaptive_heldout
+from rti_rig.core.geometry import fibonacci_cap
+from rti_rig.planner.adaptive import SurfaceState, object_model
+
+
+def _matte_state(k: int = 8, side: int = 24, noise: float = 0.003) -> SurfaceState:
+    """A matte, gently rippled Lambertian surface under ``k`` lights, as the chooser sees it."""
+    rows, cols = np.mgrid[0:side, 0:side]
+    rows, cols = rows.ravel(), cols.ravel()
+    n = np.c_[0.15 * np.sin(cols / 4.0), 0.1 * np.cos(rows / 5.0), np.ones(rows.size)]
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    albedo = np.full(rows.size, 0.6)
+    lights = fibonacci_cap(k, 25.0)
+    rng = np.random.default_rng(3)
+    clean = (albedo[:, None] * np.clip(n @ lights.T, 0.0, None)).T
+    obs = (clean + rng.normal(0.0, noise, clean.shape)).astype(np.float32)
+    return SurfaceState(
+        normals=n,
+        albedo=albedo,
+        noise=np.full(rows.size, noise),
+        lit=(n @ lights.T) > 0,
+        lights=lights,
+        obs=obs,
+        valid=np.ones(rows.size, dtype=bool),
+        dark=0.01,
+        noise_floor=0.001,
+        rows=rows,
+        cols=cols,
+        height=np.zeros((side, side)),
+    )
+
+
+def test_held_out_images_favour_the_matte_variant_of_a_matte_object() -> None:
+    state = _matte_state()
+    model = object_model(state)
+    assert model is not None
+    vs = adaptive_heldout.variants(model)
+    assert set(vs) == set(adaptive_heldout.VARIANTS)
+    losses = adaptive_heldout.heldout_losses(state, model, vs)
+    assert all(v.size == len(state.lights) for v in losses.values())
+    assert losses["matte"].mean() < losses["glossy"].mean()
+
+
+def test_heldout_score_replaces_the_chooser_s_design_score(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``--heldout-score mean``: the chooser's designs are scored by the mean over the variants
+    of the simulated robust fit; without the option the planner is left as it ships."""
+    import rti_rig.planner.adaptive as planner
+    from rti_rig.app.usecases.adaptive import robust_fit
+    from rti_rig.planner.adaptive_bias import simulate_designs
+
+    monkeypatch.setattr(planner, "object_model", planner.object_model)
+    monkeypatch.setattr(planner, "simulate_designs", planner.simulate_designs)
+    shipped = planner.simulate_designs
+    adaptive.configure_planner(adaptive.build_parser().parse_args([]))
+    assert planner.simulate_designs is shipped
+    adaptive.configure_planner(adaptive.build_parser().parse_args(["--heldout-score", "mean"]))
+    assert planner.simulate_designs is not shipped
+    state = _matte_state()
+    model = planner.object_model(state)
+    designs = [fibonacci_cap(9, f) for f in (10.0, 30.0)]
+    got = planner.simulate_designs(model, designs, robust_fit)
+    want = np.mean(
+        [
+            simulate_designs(m, designs, robust_fit)
+            for m in adaptive_heldout.variants(model).values()
+        ],
+        axis=0,
+    )
+    assert np.allclose(got, want)
