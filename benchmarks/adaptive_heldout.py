@@ -27,7 +27,12 @@ than on its own renderings. This probe measures it at the first decision (the sh
   (Spearman, and the regret of the criterion's best design) of the criterion's scores with the
   designs' true errors, per decision.
 
-Run: ``python -m benchmarks.adaptive_heldout [--draws K] [--scenes a,b] [--ns 6,9]``.
+``--all-decisions``: instead, at every decision of the shipped chooser's sessions, each
+criterion's rank correlation and regret over the designs offered (the session follows what
+ships).
+
+Run: ``python -m benchmarks.adaptive_heldout [--draws K] [--scenes a,b] [--ns 6,9] [--seed S]
+[--all-decisions]``.
 Prints a table per cell and the mean rank correlations; writes nothing.
 """
 
@@ -51,7 +56,7 @@ from benchmarks.adaptive_reach import (
     _score_floors,
     _start_state,
 )
-from rti_rig.app.usecases.adaptive import dome_start, robust_fit
+from rti_rig.app.usecases.adaptive import dome_start, robust_fit, sample_pixels
 from rti_rig.planner import adaptive
 from rti_rig.planner import adaptive_optimal as ao
 from rti_rig.planner.adaptive import object_model
@@ -64,6 +69,9 @@ from rti_rig.planner.adaptive_bias import (
 
 VARIANTS = ("fitted", "no-shadow", "relief2", "glossy", "matte", "smooth")
 CRITERIA = ("shipped", "select", "1se", "mean", "minimax")
+#: and, in the first-decision probe only, ``truth-pred``: the variant that best predicts the
+#: *true* images of every light not shot (a perfect variant selector; benchmark-only)
+PROBE_CRITERIA = (*CRITERIA, "truth-pred")
 #: neighbours a ``smooth`` normal is averaged over (sampled pixels, image distance)
 SMOOTH_K = 16
 #: the robust loss's scale, noise units
@@ -138,6 +146,42 @@ def heldout_losses(state, model: ObjectModel, vs: dict[str, ObjectModel]) -> dic
     return {name: np.array(x) for name, x in out.items()}
 
 
+def truly_predicting(
+    dirs: NDArray, model: ObjectModel, vs: dict[str, ObjectModel], truth: NDArray, shot: list[int]
+) -> str:
+    """The variant whose renderings best predict the *true* sampled observations ``truth``
+    (L, P) of every light (``dirs`` (L, 3)) not ``shot`` (the same robust loss in the model's
+    noise units as :func:`heldout_losses`): what a perfect selector of variants by prediction
+    would pick."""
+    rest = np.setdiff1d(np.arange(len(truth)), shot)
+    dirs = np.asarray(dirs)[rest]
+    pix = np.arange(len(model.normals))
+    truth = truth[:, sample_columns(model, truth.shape[1])]
+    best, name = np.inf, "fitted"
+    for v, m in vs.items():
+        pred = _render(_fresh(m), dirs, pix)  # (L', P)
+        sd = np.asarray(model.noise_sd(pred), dtype=np.float64) + 0.0 * pred
+        z = (truth[rest] - pred) / np.maximum(sd, 1e-9)
+        loss = float(np.mean(np.log1p((z / LOSS_C) ** 2)))
+        if loss < best:
+            best, name = loss, v
+    return name
+
+
+def sample_columns(model: ObjectModel, samples: int) -> NDArray[np.intp]:
+    """The columns of the chooser's pixel sample (``sample_pixels``, ``samples`` of them) that
+    the model's pixels are: the state keeps only the pixels not dark under every light shot."""
+    from rti_rig.app.usecases.adaptive import sample_index
+
+    assert model.relief is not None
+    height, rows, cols = model.relief
+    h, w = height.shape
+    flat = sample_index(h * w)
+    assert flat.size == samples
+    where = {int(f): j for j, f in enumerate(flat)}
+    return np.array([where[int(r) * w + int(c)] for r, c in zip(rows, cols, strict=True)])
+
+
 def criteria_scores(
     sims: dict[str, list[float]], losses: dict[str, NDArray]
 ) -> tuple[dict[str, list[float]], str]:
@@ -165,7 +209,7 @@ def criteria_scores(
 
 def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 0) -> str:
     rows = []
-    rho_all: dict[str, list[float]] = {c: [] for c in CRITERIA}
+    rho_all: dict[str, list[float]] = {c: [] for c in PROBE_CRITERIA}
     cells_of: list = []  # type: ignore[type-arg]
     for _, scene, data, rng in _scenes(scenes, seed):
         cand = data.candidate_dirs
@@ -176,6 +220,7 @@ def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 
         rho: dict[tuple[int, str], list[float]] = {}
         for _ in range(draws):
             keep, sub = _draw_lights(rng, len(cand), cand)
+            g_sample = sample_pixels(grey[keep]).astype(np.float64)  # (L, P): every light
             for n in adaptive_ns(ns):
                 _score_floors(res, n, keep, sub, err)
             for n in ns:
@@ -198,7 +243,10 @@ def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 
                 sims = {v: simulate_designs(m, lights, robust_fit) for v, m in vs.items()}
                 losses = heldout_losses(state, model, vs)
                 crit, best_v = criteria_scores(sims, losses)
+                truly = truly_predicting(cand[keep], model, vs, g_sample, list(st))
+                crit["truth-pred"] = sims[truly]
                 favoured.setdefault(n, []).append(best_v)
+                favoured.setdefault(-n, []).append(truly)
                 res.setdefault((n, "best design"), []).append(min(true))
                 for v in vs:
                     pick = adaptive._switch(dict(zip(keys, sims[v], strict=True)), 10.0, 0.1, None)
@@ -232,9 +280,12 @@ def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 
             crit_cells = [
                 f"{cell(c)} (ρ {np.mean(rho[(n, c)]):+.2f}, regret "
                 f"{np.mean(res[(n, f'regret {c}')]):.2f})"
-                for c in CRITERIA
+                for c in PROBE_CRITERIA
             ]
-            fav = ",".join(f"{v}:{favoured[n].count(v)}" for v in VARIANTS if v in favoured[n])
+            fav = "; ".join(
+                ",".join(f"{v}:{favoured[m].count(v)}" for v in VARIANTS if v in favoured[m])
+                for m in (n, -n)
+            )
             rows.append(
                 f"| {scene} | {n} | {tuned:g}°: {bar:.3g} | {cell('best design')} | "
                 + " | ".join(crit_cells)
@@ -245,13 +296,13 @@ def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 
         print(f"{scene} done", flush=True)
     head = (
         "| scene | N | bar | best design | "
-        + " | ".join(CRITERIA)
-        + " | per variant (its own score) | favoured |\n|"
-        + "---|" * (5 + len(CRITERIA))
+        + " | ".join(PROBE_CRITERIA)
+        + " | per variant (its own score) | favoured (held-out; truly best-predicting) |\n|"
+        + "---|" * (6 + len(PROBE_CRITERIA))
     )
     summary = ", ".join(f"{c} {np.mean(v):+.3f}" for c, v in rho_all.items())
     excess = []
-    for label in [*CRITERIA, *(f"v {v}" for v in VARIANTS)]:
+    for label in [*PROBE_CRITERIA, *(f"v {v}" for v in VARIANTS)]:
         total, above = 0.0, []
         for scene, res in cells_of:
             tuned = min(
@@ -278,6 +329,79 @@ def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 
         + "\n\nΣ relative excess over the bar of the design taken at the first decision (with the "
         "chooser's 10 % margin from the default floor), and the cells above the bar (means, "
         "not paired verdicts):\n" + "\n".join(f"* {x}" for x in excess)
+    )
+
+
+def decisions_probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 0) -> str:
+    """At *every* decision of the shipped chooser's sessions (not only the first): each
+    criterion's rank correlation with the designs' true errors and the regret of its best
+    design. The session follows what ships; the criteria only rank the designs it was offered
+    (the floors' completions of the lights shot so far and the fitted design)."""
+    from rti_rig.app.usecases.adaptive import AdaptiveChooser
+
+    rows = []
+    pooled: dict[str, list[float]] = {}
+    for _, scene, data, rng in _scenes(scenes, seed):
+        cand = data.candidate_dirs
+        grey = data.candidate_images.mean(axis=-1)
+        err = _layout_error(data)
+        got: dict[tuple[int, str], list[float]] = {}
+        for _ in range(draws):
+            keep, sub = _draw_lights(rng, len(cand), cand)
+            dirs, g = cand[keep], grey[keep]
+            for n in ns:
+                st = list(dome_start(sub, adaptive.START_LIGHTS, n))
+                chooser = AdaptiveChooser(dirs, st, n, None, design_lights=n)
+                shot: list[int] = []
+                for i in range(n):
+                    if i >= adaptive.START_LIGHTS:
+                        state = chooser.state()
+                        model = object_model(state)
+                        assert model is not None
+                        avail = np.ones(len(keep), dtype=bool)
+                        avail[shot] = False
+                        comps = [
+                            adaptive.homogeneous_completion(dirs, avail, dirs[shot], n, f)
+                            for f in FLOORS
+                        ]
+                        comps = [c for c in comps if c is not None and c.size]
+                        fitted = ao.pinned_optimal_design(state, dirs, np.asarray(shot), comps)
+                        designs = [*comps, fitted]
+                        lights = [np.concatenate([dirs[shot], dirs[c]]) for c in designs]
+                        true = [err(keep[np.r_[shot, c]]) for c in designs]
+                        vs = variants(model)
+                        sims = {v: simulate_designs(m, lights, robust_fit) for v, m in vs.items()}
+                        crit, _ = criteria_scores(sims, heldout_losses(state, model, vs))
+                        crit.update({f"variant {v}": s for v, s in sims.items()})
+                        for c, sc in crit.items():
+                            r = spearmanr(sc, true).statistic
+                            r = 0.0 if not np.isfinite(r) else float(r)
+                            got.setdefault((n, c), []).append(r)
+                            got.setdefault((n, f"regret {c}"), []).append(
+                                true[int(np.argmin(sc))] / min(true) - 1.0
+                            )
+                            pooled.setdefault(c, []).append(r)
+                    c, _ = chooser.decide(i)
+                    assert c is not None
+                    chooser.observe(c, dirs[c], g[c])
+                    shot.append(int(c))
+        for n in ns:
+            cells = [
+                f"{np.mean(got[(n, c)]):+.2f} / {np.mean(got[(n, f'regret {c}')]):.2f}"
+                for c in CRITERIA
+            ]
+            rows.append(
+                f"| {scene} | {n} | {len(got[(n, 'shipped')])} | " + " | ".join(cells) + " |"
+            )
+        print(f"{scene} done", flush=True)
+    head = (
+        "| scene | N | decisions | " + " | ".join(CRITERIA) + " |\n|" + "---|" * (3 + len(CRITERIA))
+    )
+    summary = ", ".join(f"{c} {np.mean(v):+.3f}" for c, v in pooled.items())
+    return (
+        "Every decision of the shipped chooser's sessions: mean Spearman ρ of each criterion's "
+        "design scores with the designs' true errors / mean regret of its best design\n\n"
+        f"{head}\n" + "\n".join(rows) + f"\n\nmean ρ over every decision: {summary}"
     )
 
 
@@ -323,9 +447,15 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument("--scenes", default="")
     ap.add_argument("--ns", default="6,9,12,18")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument(
+        "--all-decisions",
+        action="store_true",
+        help="instead: the rank correlations at every decision of the shipped chooser's sessions",
+    )
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    md = probe(
+    fn = decisions_probe if args.all_decisions else probe
+    md = fn(
         args.draws,
         tuple(x for x in args.scenes.split(",") if x),
         tuple(int(x) for x in args.ns.split(",")),

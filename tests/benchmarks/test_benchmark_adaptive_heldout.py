@@ -77,3 +77,18 @@ def test_heldout_score_replaces_the_chooser_s_design_score(
         axis=0,
     )
     assert np.allclose(got, want)
+
+
+def test_the_truly_predicting_variant_of_a_matte_object_is_not_the_glossy_one() -> None:
+    """``truth-pred``: the variant whose renderings best predict the true images of the lights
+    not shot (here noise-free Lambertian ones) — never the one given a lobe the object lacks."""
+    state = _matte_state()
+    model = object_model(state)
+    assert model is not None
+    dirs = fibonacci_cap(40, 10.0)
+    n, albedo = state.normals, state.albedo
+    truth = (albedo[:, None] * np.clip(n @ dirs.T, 0.0, None)).T  # (L, P), the sample's order
+    cols = adaptive_heldout.sample_columns(model, truth.shape[1])
+    assert np.array_equal(cols, np.arange(truth.shape[1]))
+    vs = adaptive_heldout.variants(model)
+    assert adaptive_heldout.truly_predicting(dirs, model, vs, truth, [0, 1]) != "glossy"
