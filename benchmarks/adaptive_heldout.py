@@ -21,7 +21,9 @@ than on its own renderings. This probe measures it at the first decision (the sh
   design): ``shipped`` (the simulated robust fit on ``fitted``), ``select`` (on the variant
   the held-out images favour), ``1se`` (the mean over the variants within one standard error —
   across held-out images, paired — of the favoured one), ``mean`` (over every variant),
-  ``minimax`` (the worst variant);
+  ``minimax`` (the worst variant); and, benchmark-only, ``truth-pred`` (on the variant whose
+  renderings best predict the *true* images of every light not shot: what a perfect selector
+  of variants by prediction would use — does predicting better rank designs better?);
 * each criterion's design taken as the chooser takes it (the default floor kept unless another
   is 10 % better, ``planner.adaptive._switch``), its true error, and the **rank correlation**
   (Spearman, and the regret of the criterion's best design) of the criterion's scores with the
@@ -31,9 +33,13 @@ than on its own renderings. This probe measures it at the first decision (the sh
 criterion's rank correlation and regret over the designs offered (the session follows what
 ships).
 
+``python -m benchmarks.adaptive --heldout-score select|1se|mean|minimax`` runs the chooser
+itself with its designs scored so (:func:`install`), every decision.
+
 Run: ``python -m benchmarks.adaptive_heldout [--draws K] [--scenes a,b] [--ns 6,9] [--seed S]
-[--all-decisions]``.
-Prints a table per cell and the mean rank correlations; writes nothing.
+[--all-decisions]`` (all scenes and N, 8 draws: about 3–9 min on 2 loaded cores;
+``--all-decisions`` on 3 scenes at 6 and 9 lights about 5 min). Prints a table per cell and
+the mean rank correlations; writes nothing.
 """
 
 from __future__ import annotations
