@@ -35,7 +35,7 @@ error per scene and target.
 Run: ``python -m benchmarks.adaptive [--sim-draws K] [--real-draws K] [--scenes a,b] [--seed S]
 [--ns 6,9] [--no-until] [--start default|hedge-all|hedge-20|hedge-10|shared-3]
 [--floors F,F] [--default-floor F] [--relight-default-floor F] [--relief-gain]
-[--no-fitted-design] [--fitted-margin M] [--heldout-score select|1se|mean|minimax]
+[--no-fitted-design] [--fitted-margin M] [--heldout-score select|1se|mean|minimax|variant-NAME]
 [--fitted-seeds F,F] [--sim-margin M] [--fitted-pixels K] [--no-relight-fitted-design]
 [--relight-basis B]
 [--no-relight] [--cache FILE] [--min-elevation-deg F] [--max-elevation-deg C]
@@ -774,9 +774,16 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument(
         "--heldout-score",
         default=None,
-        choices=("select", "1se", "mean", "minimax"),
+        choices=(
+            "select",
+            "1se",
+            "mean",
+            "minimax",
+            *(f"variant-{v}" for v in ("no-shadow", "relief2", "glossy", "matte", "smooth")),
+        ),
         help="score the normals objective's designs on variants of the object model judged "
-        "on held-out captured images (benchmarks.adaptive_heldout; not shipped)",
+        "on held-out captured images, or on one variant (variant-NAME) "
+        "(benchmarks.adaptive_heldout; not shipped)",
     )
     ap.add_argument(
         "--no-until", action="store_true", help="skip the --until-error rows (faster to iterate)"

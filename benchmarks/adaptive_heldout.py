@@ -413,12 +413,15 @@ def decisions_probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], se
 
 def install(criterion: str) -> None:
     """Make the chooser (``planner.adaptive.choose_in_design``, normals objective) score its
-    designs by ``criterion`` (one of :data:`CRITERIA` but ``shipped``) instead of the simulated
+    designs by ``criterion`` (one of :data:`CRITERIA` but ``shipped``, or ``variant-NAME``: one
+    variant of :data:`VARIANTS`, without held-out evidence) instead of the simulated
     robust fit on the object model as fitted: ``benchmarks.adaptive --heldout-score``. The
     state each decision's model is fitted from is kept (the held-out losses need its images).
     A benchmark's monkeypatch, not a planner change."""
-    if criterion not in CRITERIA[1:]:
-        raise SystemExit(f"--heldout-score: one of {', '.join(CRITERIA[1:])}")
+    fixed = criterion.removeprefix("variant-")
+    if criterion not in CRITERIA[1:] and not (criterion != fixed and fixed in VARIANTS):
+        choices = [*CRITERIA[1:], *(f"variant-{v}" for v in VARIANTS[1:])]
+        raise SystemExit(f"--heldout-score: one of {', '.join(choices)}")
     import rti_rig.planner.adaptive as planner
 
     last: list = []  # type: ignore[type-arg]
@@ -429,6 +432,8 @@ def install(criterion: str) -> None:
         return fit_model(state)
 
     def scored(model, designs, fit, *a, **kw):  # type: ignore[no-untyped-def]
+        if criterion != fixed:  # one variant, no held-out evidence
+            return simulate_designs(variants(model)[fixed], designs, fit, *a, **kw)
         state = last[0]
         vs = variants(model)
         sims = {v: simulate_designs(m, designs, fit, *a, **kw) for v, m in vs.items()}

@@ -92,3 +92,24 @@ def test_the_truly_predicting_variant_of_a_matte_object_is_not_the_glossy_one() 
     assert np.array_equal(cols, np.arange(truth.shape[1]))
     vs = adaptive_heldout.variants(model)
     assert adaptive_heldout.truly_predicting(dirs, model, vs, truth, [0, 1]) != "glossy"
+
+
+def test_heldout_score_variant_scores_on_that_variant_alone(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``--heldout-score variant-smooth``: the designs scored on the smooth variant only; an
+    unknown name is refused."""
+    import rti_rig.planner.adaptive as planner
+    from rti_rig.app.usecases.adaptive import robust_fit
+    from rti_rig.planner.adaptive_bias import simulate_designs
+
+    monkeypatch.setattr(planner, "object_model", planner.object_model)
+    monkeypatch.setattr(planner, "simulate_designs", planner.simulate_designs)
+    adaptive_heldout.install("variant-smooth")
+    model = planner.object_model(_matte_state())
+    designs = [fibonacci_cap(9, f) for f in (10.0, 30.0)]
+    got = planner.simulate_designs(model, designs, robust_fit)
+    want = simulate_designs(adaptive_heldout.variants(model)["smooth"], designs, robust_fit)
+    assert np.allclose(got, want)
+    with pytest.raises(SystemExit, match="one of"):
+        adaptive_heldout.install("variant-shiny")
