@@ -57,6 +57,7 @@ from scipy.stats import spearmanr
 from benchmarks.adaptive_reach import (
     FLOORS,
     _draw_lights,
+    _floor_completions,
     _layout_error,
     _scenes,
     _score_floors,
@@ -231,12 +232,7 @@ def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 
                 _score_floors(res, n, keep, sub, err)
             for n in ns:
                 st = np.asarray(dome_start(sub, adaptive.START_LIGHTS, n))
-                avail = np.ones(len(keep), dtype=bool)
-                avail[st] = False
-                comps = [
-                    adaptive.homogeneous_completion(cand[keep], avail, cand[keep][st], n, f)
-                    for f in FLOORS
-                ]
+                _, comps = _floor_completions(cand[keep], st, n)
                 state = _start_state(cand[keep], grey[keep], list(st), n)
                 model = object_model(state)
                 assert model is not None
@@ -364,12 +360,7 @@ def decisions_probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], se
                         state = chooser.state()
                         model = object_model(state)
                         assert model is not None
-                        avail = np.ones(len(keep), dtype=bool)
-                        avail[shot] = False
-                        comps = [
-                            adaptive.homogeneous_completion(dirs, avail, dirs[shot], n, f)
-                            for f in FLOORS
-                        ]
+                        _, comps = _floor_completions(dirs, shot, n)
                         comps = [c for c in comps if c is not None and c.size]
                         fitted = ao.pinned_optimal_design(state, dirs, np.asarray(shot), comps)
                         designs = [*comps, fitted]

@@ -151,6 +151,15 @@ def _draw_lights(
     return keep, DomeGeometry(cand[keep], tuple(f"c{i:03d}" for i in keep))
 
 
+def _floor_completions(dirs, start, n: int, floors=FLOORS):  # type: ignore[no-untyped-def]
+    """The lights not in ``start`` (indices into ``dirs``, a mask) and the completions of
+    ``start`` to each floor's homogeneous layout of ``n`` (None where a floor has none), as a
+    session completes its start."""
+    avail = np.ones(len(dirs), dtype=bool)
+    avail[start] = False
+    return avail, [adaptive.homogeneous_completion(dirs, avail, dirs[start], n, f) for f in floors]
+
+
 def _score_floors(res, n: int, keep, sub: DomeGeometry, err) -> None:  # type: ignore[no-untyped-def]
     """The homogeneous layouts of ``n`` lights above each shipped floor, scored into ``res``."""
     for f in FLOORS:
@@ -394,17 +403,12 @@ def families(
             for n in NS:
                 _score_floors(res, n, keep, sub, err)
                 st = dome_start(sub, adaptive.START_LIGHTS, n)
-                avail = np.ones(len(keep), dtype=bool)
-                avail[st] = False
-                for f in FLOORS + EXTRA_FLOORS:
-                    comp = adaptive.homogeneous_completion(cand[keep], avail, cand[keep][st], n, f)
+                avail, every = _floor_completions(cand[keep], st, n, FLOORS + EXTRA_FLOORS)
+                for f, comp in zip(FLOORS + EXTRA_FLOORS, every, strict=True):
                     e = np.inf if comp is None else err(keep[np.r_[st, comp]])
                     res.setdefault((n, f"comp {f:g}"), []).append(e)
                 state = _start_state(cand[keep], grey[keep], list(st), n)
-                comps = [
-                    adaptive.homogeneous_completion(cand[keep], avail, cand[keep][st], n, f)
-                    for f in FLOORS
-                ]
+                comps = every[: len(FLOORS)]
                 free = pinned_optimal_design(state, cand[keep], np.asarray(st), comps)
                 res.setdefault((n, "fitted"), []).append(err(keep[np.r_[st, free]]))
                 opt = planned_leds(data.preview, sub, n, light)
@@ -511,12 +515,7 @@ def truth_surface(
             for n in NS:
                 _score_floors(res, n, keep, sub, err)
                 st = np.asarray(dome_start(sub, adaptive.START_LIGHTS, n))
-                avail = np.ones(len(keep), dtype=bool)
-                avail[st] = False
-                comps = [
-                    adaptive.homogeneous_completion(cand[keep], avail, cand[keep][st], n, f)
-                    for f in FLOORS
-                ]
+                avail, comps = _floor_completions(cand[keep], st, n)
                 state = _start_state(cand[keep], grey[keep], list(st), n)
                 fitted = ao.state_sample(ao._subsample(state, TRUTH_PIXELS), cand[keep])
                 everything = np.ones(len(keep), dtype=bool)
