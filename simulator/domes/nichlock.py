@@ -30,7 +30,7 @@ calibration waits for its serial key), the display's patterns and profiles, the 
 
 from __future__ import annotations
 
-from collections.abc import Generator
+from collections.abc import Generator, Iterable
 from dataclasses import dataclass, field
 
 from rti_rig.simulator.domes.board import Board, Firmware, Read, Sleep
@@ -205,6 +205,17 @@ class NichlockBoard(Board):
         """``while (!Serial.available()) {}`` then ``Serial.read()``: waits however long."""
         return chr((yield Read()) or 0)
 
+    def _choice(self, lines: Iterable[str]) -> Generator[Sleep | Read, int | None, str | None]:
+        """A menu's lines printed and its key read; None for ``c``, which every menu of the
+        sketch answers with "Cancelled" before returning to the LED commands."""
+        for line in lines:
+            self.println(line)
+        pick = yield from self._key()
+        if pick == "c":
+            self.println("Cancelled")
+            return None
+        return pick
+
     # ------------------------------------------------------------------ menus
 
     def _settings(self) -> Generator[Sleep | Read, int | None, bool]:
@@ -214,31 +225,29 @@ class NichlockBoard(Board):
             "Entered settings. Select one of the following options, or use 'c' to cancel. "
             "Settings requiring a restart are marked with '*'."
         )
-        for line in (
-            "1. Reset Specific Settings",
-            "2. Serial Baud Rate*",
-            "3. Change Channel/Color Names",
-            "4. Verbose Serial",
-            "5. Default Channel/Color",
-        ):
-            self.println(line)
-        pick = yield from self._key()
-        if pick == "c":
-            self.println("Cancelled")
+        pick = yield from self._choice(
+            (
+                "1. Reset Specific Settings",
+                "2. Serial Baud Rate*",
+                "3. Change Channel/Color Names",
+                "4. Verbose Serial",
+                "5. Default Channel/Color",
+            )
+        )
+        if pick is None:
             return False
         if pick == "1":
             self.println("SELECTED: Reset Specific Settings.")
             self.println("Enter the setting you would like to reset.")
-            for line in (
-                "1. Serial Baud Rate*",
-                "2. Display Calibration*",
-                "3. ALL Channel/Color Names",
-                "*=Restart required.",
-            ):
-                self.println(line)
-            pick = yield from self._key()
-            if pick == "c":
-                self.println("Cancelled")
+            pick = yield from self._choice(
+                (
+                    "1. Serial Baud Rate*",
+                    "2. Display Calibration*",
+                    "3. ALL Channel/Color Names",
+                    "*=Restart required.",
+                )
+            )
+            if pick is None:
                 return False
             if pick == "1":
                 rom.baud = DEFAULT_BAUD_RATE
@@ -263,11 +272,11 @@ class NichlockBoard(Board):
         elif pick == "2":
             self.println("SELECTED: Serial Baud Rate")
             self.println("Select the baud rate you would like to use:")
-            for key, rate in BAUD_CHOICES.items():
-                self.println(f"{key}. {rate}" + (" (Default)" if key == "5" else ""))
-            pick = yield from self._key()
-            if pick == "c":
-                self.println("Cancelled")
+            pick = yield from self._choice(
+                f"{key}. {rate}" + (" (Default)" if key == "5" else "")
+                for key, rate in BAUD_CHOICES.items()
+            )
+            if pick is None:
                 return False
             rate = BAUD_CHOICES.get(pick, rom.baud)  # another key stores the rate in use
             rom.baud = rate
@@ -275,11 +284,8 @@ class NichlockBoard(Board):
         elif pick == "3":
             self.println("SELECTED: Change Channel/Color Names")
             self.println("Choose which Channel/Color name you would like to change: ")
-            for channel in range(3):
-                self.println(f"{channel + 1}. {self._name(channel)}")
-            which = yield from self._key()
-            if which == "c":
-                self.println("Cancelled")
+            which = yield from self._choice(f"{c + 1}. {self._name(c)}" for c in range(3))
+            if which is None:
                 return False
             self.print("Enter the name you would like to change it to (press '\\' to finish): ")
             name = ""
@@ -306,11 +312,8 @@ class NichlockBoard(Board):
             self.println(
                 "Enter the channel/color you would like as the default when using the display"
             )
-            for channel in range(3):
-                self.println(f"{channel + 1}. {self._name(channel)}")
-            pick = yield from self._key()
-            if pick == "c":
-                self.println("Cancelled")
+            pick = yield from self._choice(f"{c + 1}. {self._name(c)}" for c in range(3))
+            if pick is None:
                 return False
             if pick in ("1", "2", "3"):
                 rom.default_channel = int(pick)
