@@ -167,11 +167,8 @@ class ScriptedDomeDriver:
 
     @property
     def bytes_heard(self) -> bool:
-        """Any byte at all came from the port since it was last opened (readable or not). A
-        port silent so far may hold a board whose first reply was lost (a USB-serial adapter
-        dropping bytes at the open, a board without a boot banner still booting): the policy
-        sends its handshake once more then (it lights nothing), where bytes no profile reads
-        are already another board's answer."""
+        """Any byte at all came from the port since it was last opened, as
+        :attr:`~rti_rig.drivers.led_dome.driver.LedDomeDriver.bytes_heard` (why the policy asks)."""
         return self._bytes_heard
 
     def hello(self) -> DomeInfo:

@@ -740,12 +740,8 @@ def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out
     assert "2 image(s) its lights.lp lists cannot be read as captured" in out
     assert "(image_004: neither its JPEG nor its linear TIFF on disk; image_006: neither" in out
     assert f"rti-rig run --resume {done} --reshoot-lost" in out
-    rest = done / "rest.lp"
-    assert f"rti-rig export-lp {done} --linear --out {rest}" in out
-    r = runner.invoke(app, ["export-lp", str(done), "--linear", "--out", str(rest)])
-    assert r.exit_code == 0, r.output
-    r = runner.invoke(app, ["fit", str(rest), "--out", str(tmp_path / "fit"), "--model", "ps"])
-    assert r.exit_code == 0, r.output
+    assert f"rti-rig export-lp {done} --linear --out {done / 'rest.lp'}" in out
+    _fit_the_rest(done, tmp_path / "fit")
 
 
 def test_a_camera_original_changed_since_capture_is_named_not_reshot(
@@ -795,11 +791,7 @@ def test_a_fit_of_a_session_with_a_tiff_cut_short_names_it_before_fitting(
     assert "(linear/image_007.tif: its image data runs" in out and "cut short" in out, out
     assert f"rti-rig run --resume {done} --reshoot-lost" in out
     assert not (tmp_path / "fit").exists()
-    rest = done / "rest.lp"
-    r = runner.invoke(app, ["export-lp", str(done), "--linear", "--out", str(rest)])
-    assert r.exit_code == 0, r.output
-    r = runner.invoke(app, ["fit", str(rest), "--out", str(tmp_path / "fit"), "--model", "ps"])
-    assert r.exit_code == 0, r.output
+    _fit_the_rest(done, tmp_path / "fit")
 
 
 def test_a_session_copied_without_its_linear_folder_says_its_jpegs_stood_in(
@@ -970,3 +962,13 @@ def test_the_journal_time_counts_a_killed_run_of_one_image() -> None:
     assert rig_time_of_records(one_run) == pytest.approx(3.0)
     killed_after_one = [rec(0.0), rec(0.0), rec(1.0)]  # run 1: one image; run 2: two
     assert rig_time_of_records(killed_after_one) == pytest.approx(1.0 + 2.0)
+
+
+def _fit_the_rest(done: Path, out: Path) -> None:
+    """The way out a refused session is given: ``export-lp --linear`` of the images still
+    intact into ``rest.lp``, then ``fit`` of that, which must succeed."""
+    rest = done / "rest.lp"
+    r = runner.invoke(app, ["export-lp", str(done), "--linear", "--out", str(rest)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["fit", str(rest), "--out", str(out), "--model", "ps"])
+    assert r.exit_code == 0, r.output
