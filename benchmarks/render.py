@@ -45,7 +45,7 @@ def run(size: int = 1000, n_lights: int = 100, dome_mm: float = 400.0) -> str:
         peak = tracemalloc.get_traced_memory()[1] / 1e6
         tracemalloc.stop()
         diffuse = _time_lights(lambda lg: render_radiance(scene, lg, passes=()), lights)
-        shadows = _time_lights(lambda lg: lt.visibility(scene, prep, lg), lights)
+        shadows = _time_lights(lambda lg: lt.visibility(prep, lg), lights)
         spec = _time_lights(lambda lg: render_radiance(scene, lg, passes={"specular"}), lights)
         med = statistics.median
         rows.append(

@@ -24,6 +24,7 @@ default (``passes=None``) exactly those the scene declares.
 
 from __future__ import annotations
 
+import copy
 import math
 import weakref
 from collections.abc import Iterable
@@ -107,22 +108,41 @@ class PreparedScene:
     def __init__(self, scene: Scene) -> None:
         f32 = np.float32
         self.shape = scene.shape
-        n = scene.normals.astype(f32)
-        self.nx, self.ny, self.nz = (np.ascontiguousarray(n[..., k]) for k in range(3))
+        self.nx, self.ny, self.nz = (
+            np.ascontiguousarray(scene.normals[..., k], dtype=f32) for k in range(3)
+        )
         self.albedo = scene.albedo.astype(f32)
         self.height = scene.height.astype(f32)
         self.f0 = scene.specular_albedo.astype(f32)
-        alpha = scene.roughness.astype(np.float64) ** 2
-        self.alpha2 = (alpha**2).astype(f32)
-        # View half of the Smith-GGX visibility: 1 / (n·v + sqrt(α² + (1-α²)(n·v)²)), v = +z.
-        nz = scene.normals[..., 2]
-        self.vis_view = (1.0 / (nz + np.sqrt(alpha**2 + (1 - alpha**2) * nz**2))).astype(f32)
+        self.alpha2 = np.empty(self.shape, f32)
+        self.vis_view = np.empty(self.shape, f32)
+        # In bands of rows: the float64 terms are elementwise, so each pixel is as from whole
+        # planes, without half a dozen frame-sized float64 temporaries (1.1 GB at 24 MP).
+        step = max(1, (1 << 18) // max(self.shape[1], 1))
+        for a in range(0, self.shape[0], step):
+            alpha = scene.roughness[a : a + step].astype(np.float64) ** 2
+            self.alpha2[a : a + step] = alpha**2
+            # View half of the Smith-GGX visibility: 1 / (n·v + sqrt(α² + (1-α²)(n·v)²)), v = +z.
+            nz = scene.normals[a : a + step, :, 2]
+            self.vis_view[a : a + step] = 1.0 / (nz + np.sqrt(alpha**2 + (1 - alpha**2) * nz**2))
         rows, cols = self.shape
         px = scene.pixel_size_mm
         self.pixel_size_mm = px
         self.x_mm = ((np.arange(cols) - (cols - 1) / 2.0) * px).astype(f32)[None, :]
         self.y_mm = (((rows - 1) / 2.0 - np.arange(rows)) * px).astype(f32)[:, None]
         self.z_mm = (scene.height * px).astype(f32)
+
+    def band(self, start: int, stop: int) -> PreparedScene:
+        """The same scene restricted to image rows ``start:stop`` (views, no copies), for
+        shading a band of rows at a time: every per-pixel array is sliced, the per-column
+        coordinates are shared. Shading is elementwise, so a band's pixels come out exactly
+        as in the whole image."""
+        part = copy.copy(self)
+        for key in ("nx", "ny", "nz", "albedo", "height", "f0", "alpha2", "vis_view", "z_mm"):
+            setattr(part, key, getattr(self, key)[start:stop])
+        part.y_mm = self.y_mm[start:stop]
+        part.shape = (stop - start, self.shape[1])
+        return part
 
 
 _CACHE: weakref.WeakKeyDictionary[Scene, PreparedScene] = weakref.WeakKeyDictionary()
@@ -166,8 +186,8 @@ def _geometry(prep: PreparedScene, light: Light) -> tuple[tuple, NDArray[np.floa
     return (lx, ly, lz), irradiance
 
 
-def visibility(scene: Scene, prep: PreparedScene, light: Light) -> NDArray[np.float32]:
-    """Cast-shadow visibility (H, W) in [0, 1] of the scene from ``light``."""
+def visibility(prep: PreparedScene, light: Light) -> NDArray[np.float32]:
+    """Cast-shadow visibility (H, W) in [0, 1] of the prepared scene from ``light``."""
     if isinstance(light, DirectionalLight):
         return directional_visibility(prep.height, light.direction)
     rows, cols = prep.shape
@@ -188,17 +208,34 @@ def render_radiance(
     """
     chosen = resolve_passes(scene, passes)
     prep = prepare(scene)
+    vis = visibility(prep, light) if "shadows" in chosen else None
+    return shade(prep, light, chosen, vis)
+
+
+def shade(
+    prep: PreparedScene,
+    light: Light,
+    chosen: frozenset[str],
+    vis: NDArray[np.float32] | None,
+) -> NDArray[np.float32]:
+    """π × radiance of ``prep`` (a whole scene or a :meth:`PreparedScene.band` of it) with
+    the cast-shadow visibility ``vis`` of the same pixels (None: no shadow pass).
+
+    Why apart from :func:`render_radiance`: the shadow sweep needs the whole height field,
+    but the shading does not, so a large frame can take its visibility once and be shaded
+    a band of rows at a time (:class:`~rti_rig.simulator.sim_scene.LibraryRenderer`).
+    """
     (lx, ly, lz), irradiance = _geometry(prep, light)
     cos_i = prep.nx * lx
     cos_i += prep.ny * ly
     cos_i += prep.nz * lz
     np.maximum(cos_i, 0.0, out=cos_i)
-    shade = cos_i * irradiance  # E·cos θ, W/m² on the surface
-    if "shadows" in chosen:
-        shade *= visibility(scene, prep, light)
-    out = prep.albedo * shade[..., None]
+    lit = cos_i * irradiance  # E·cos θ, W/m² on the surface
+    if vis is not None:
+        lit *= vis
+    out = prep.albedo * lit[..., None]
     if "specular" in chosen:
-        out += specular_term(prep, (lx, ly, lz), cos_i) * (shade[..., None])
+        out += specular_term(prep, (lx, ly, lz), cos_i) * (lit[..., None])
     return out
 
 

@@ -35,6 +35,10 @@ from numpy.typing import ArrayLike, NDArray
 #: from interpolation on surfaces lit at nearly their own slope (where shading is ~0 anyway).
 BIAS_PX = 0.02
 
+#: Cells of a sweep's resampled grid processed at a time (rays are independent): a few MB of
+#: temporaries each, where whole grids of a 24 MP frame took GB.
+SWEEP_CELLS = 1 << 20
+
 #: Above this elevation tangent (about 89.994°) no height field with finite slopes casts a
 #: shadow longer than 1e-4 of its relief; treated as the zenith.
 ZENITH_TAN = 1e4
@@ -86,17 +90,27 @@ def directional_visibility(
         borderMode=cv2.BORDER_CONSTANT,
         borderValue=0,
     )
-    a = np.arange(n_a, dtype=np.float32) - np.float32(ea)
-    g = hs - a * np.float32(tan_el)
-    g[inside == 0] = -np.inf
-    # Highest occluder strictly nearer the light: reversed cumulative max, shifted by one.
-    occ = np.empty_like(g)
-    occ[:, -1] = -np.inf
-    np.maximum.accumulate(g[:, :0:-1], axis=1, out=occ[:, -2::-1])
-    lit = (g >= occ - np.float32(bias_px)).astype(np.float32)
-    # Cells outside the image hold no surface; call them lit so that interpolating back does not
-    # darken the border pixels (a level plane must come out fully lit, to the last pixel).
-    lit[inside == 0] = 1.0
+    slope = (np.arange(n_a, dtype=np.float32) - np.float32(ea)) * np.float32(tan_el)
+    lit = np.empty((n_b, n_a), np.float32)
+    # Lines a block at a time (each row of the grid is one line towards the light, swept on
+    # its own: the same cells as from the whole grid, with a few MB of temporaries).
+    step = max(1, SWEEP_CELLS // n_a)
+    for b in range(0, n_b, step):
+        out = inside[b : b + step] == 0
+        g = hs[b : b + step] - slope
+        g[out] = -np.inf
+        # Highest occluder strictly nearer the light: reversed cumulative max, shifted by one.
+        occ = np.empty_like(g)
+        occ[:, -1] = -np.inf
+        np.maximum.accumulate(g[:, :0:-1], axis=1, out=occ[:, -2::-1])
+        occ -= np.float32(bias_px)
+        block = lit[b : b + step]
+        np.greater_equal(g, occ, out=block, casting="unsafe")
+        # Cells outside the image hold no surface; call them lit so that interpolating back
+        # does not darken the border pixels (a level plane must come out fully lit).
+        block[out] = 1.0
+        del out, g, occ
+    del hs, inside
     # Back to the image: sample the lit grid at each pixel's (a_idx, b_idx).
     back = np.array(
         [[dc, dr, ea - cc * dc - cr * dr], [pc, pr, eb - cc * pc - cr * pr]], dtype=np.float64
@@ -149,22 +163,36 @@ def point_visibility(
     phi = np.linspace(phi0, phi1, n_phi)
     rho = rho_min + np.arange(n_rho, dtype=np.float64)
     rho32 = rho.astype(np.float32)[None, :]
-    # Offsets from the foot point in float32 (sub-1e-3 px error), then shifted in place.
-    map_c = np.cos(phi).astype(np.float32)[:, None] * rho32
-    map_c += np.float32(fc)
-    map_r = np.sin(phi).astype(np.float32)[:, None] * rho32
-    map_r += np.float32(fr)
-    hs = cv2.remap(h, map_c, map_r, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-    inside = (map_c >= -0.5) & (map_c <= cols - 0.5) & (map_r >= -0.5) & (map_r <= rows - 0.5)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sigma = (np.float32(zl) - hs) / rho32  # tangent of the depression angle from the light
+    cos32 = np.cos(phi).astype(np.float32)[:, None]
+    sin32 = np.sin(phi).astype(np.float32)[:, None]
     near = rho32 < 0.5  # (almost) under the light: the ray is vertical, nothing occludes
-    occluder = np.where(inside & ~near, sigma, np.float32(np.inf))
-    occ = np.minimum.accumulate(occluder, axis=1)
-    occ = np.concatenate([np.full((n_phi, 1), np.inf, np.float32), occ[:, :-1]], axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lit = (sigma <= occ + np.float32(bias_px) / np.maximum(rho32, np.float32(0.5))) | near
-    lit = lit.astype(np.float32)
+    lit = np.empty((n_phi, n_rho), np.float32)
+    # Rays a block at a time: each ray (a row of the polar grid) is resampled and swept on its
+    # own, so a block's rows come out exactly as from the whole grid, whose float32 planes at
+    # 24 MP (about 10⁸ cells under a lamp at the dome's radius) had reached 4 GB.
+    step = max(1, SWEEP_CELLS // n_rho)
+    for a in range(0, n_phi, step):
+        # Offsets from the foot point in float32 (sub-1e-3 px error), then shifted in place.
+        map_c = cos32[a : a + step] * rho32
+        map_c += np.float32(fc)
+        map_r = sin32[a : a + step] * rho32
+        map_r += np.float32(fr)
+        hs = cv2.remap(h, map_c, map_r, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        inside = (map_c >= -0.5) & (map_c <= cols - 0.5) & (map_r >= -0.5)
+        inside &= map_r <= rows - 0.5
+        del map_c, map_r
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sigma = (np.float32(zl) - hs) / rho32  # tangent of the depression angle
+        occluder = np.where(inside & ~near, sigma, np.float32(np.inf))
+        del hs, inside
+        occ = np.empty_like(occluder)
+        occ[:, 0] = np.inf
+        np.minimum.accumulate(occluder[:, :-1], axis=1, out=occ[:, 1:])
+        del occluder
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rows_lit = sigma <= occ + np.float32(bias_px) / np.maximum(rho32, np.float32(0.5))
+        lit[a : a + step] = rows_lit | near
+        del sigma, occ, rows_lit
     # Back to the image.
     pc_ = (np.arange(cols, dtype=np.float64) - fc).astype(np.float32)[None, :]
     pr_ = (np.arange(rows, dtype=np.float64) - fr).astype(np.float32)[:, None]

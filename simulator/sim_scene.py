@@ -151,15 +151,80 @@ def renderer_for(
     if name == "relief":
         return ReliefRenderer(height_px, width_px, seed)
 
-    from rti_rig.simulator.light_transport import light_at, render_radiance
-    from rti_rig.simulator.scenes import make_scene
+    return LibraryRenderer(name, height_px, width_px, seed, light_distance_mm)
 
-    library = make_scene(name, height_px, width_px, seed=seed)
 
-    def render(direction, intensity):  # type: ignore[no-untyped-def]
+class LibraryRenderer:
+    """A library scene (:mod:`rti_rig.simulator.scenes`) under one light, with the passes it
+    declares, rendered a band of rows at a time.
+
+    Why: at 24 MP a whole-image render held the scene's float64 planes (2 GB), their float32
+    copies and a dozen whole-frame temporaries, near 9 GB for one light. The renderer keeps
+    only the float32 copies the shading reads (:class:`PreparedScene`, about 1.3 GB at 24 MP);
+    the cast-shadow sweep, which needs the whole height field, runs once per light and its
+    visibility (4 bytes a pixel) is kept while that light's bands are pulled. Every pixel is
+    computed exactly as in :func:`render_radiance` on the whole scene (tested).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        height_px: int,
+        width_px: int,
+        seed: int = 0,
+        light_distance_mm: float | None = None,
+    ) -> None:
+        from rti_rig.simulator.light_transport import PreparedScene
+        from rti_rig.simulator.scenes import make_scene
+
+        scene = make_scene(name, height_px, width_px, seed=seed)
+        self._prep = PreparedScene(scene)
+        self._passes = scene.passes
+        self._distance = light_distance_mm
+        self.shape = (height_px, width_px, 3)
+        self._vis_key: tuple[tuple[float, ...], float] | None = None
+        self._vis: NDArray[np.float32] | None = None
+
+    def _light(self, direction: NDArray[np.float64], intensity: float):  # type: ignore[no-untyped-def]
+        from rti_rig.simulator.light_transport import light_at
+
+        return light_at(direction, self._distance, irradiance=float(intensity))
+
+    def _visibility(self, light, key: tuple[tuple[float, ...], float]):  # type: ignore[no-untyped-def]
+        """The light's whole-frame cast-shadow visibility, swept once per light."""
+        from rti_rig.simulator.light_transport import visibility
+
+        if "shadows" not in self._passes:
+            return None
+        if self._vis_key != key:
+            self._vis = None  # the previous light's, released before the sweep
+            self._vis = visibility(self._prep, light)
+            self._vis_key = key
+        return self._vis
+
+    def rows(
+        self, direction: NDArray[np.float64] | None, intensity: float, start: int, stop: int
+    ) -> NDArray[np.float64]:
+        """Radiance (float64) of image rows ``start:stop``."""
+        from rti_rig.simulator.light_transport import shade
+
         if direction is None or intensity <= 0:
-            return np.zeros(library.albedo.shape, dtype=np.float64)
-        light = light_at(direction, light_distance_mm, irradiance=float(intensity))
-        return render_radiance(library, light).astype(np.float64)
+            return np.zeros((stop - start, *self.shape[1:]))
+        light = self._light(direction, intensity)
+        key = (tuple(float(c) for c in np.ravel(direction)), float(intensity))
+        vis = self._visibility(light, key)
+        band = shade(
+            self._prep.band(start, stop),
+            light,
+            self._passes,
+            None if vis is None else vis[start:stop],
+        )
+        return band.astype(np.float64)
 
-    return render
+    def __call__(
+        self, direction: NDArray[np.float64] | None, intensity: float
+    ) -> NDArray[np.float64]:
+        out = np.empty(self.shape)
+        for start, stop in row_bands(*self.shape[:2]):
+            out[start:stop] = self.rows(direction, intensity, start, stop)
+        return out
