@@ -89,7 +89,28 @@ def _normals_rows(height: NDArray[np.float64], start: int, stop: int) -> NDArray
     return normals_from_height(height[lo:hi])[start - lo : stop - lo]
 
 
-class ReliefRenderer:
+class BandedRenderer:
+    """A renderer that computes an image a band of rows at a time (``rows``); called, it
+    assembles the whole image from its bands (the wrong-light check and tests want whole
+    images; the simulated camera pulls the bands itself)."""
+
+    shape: tuple[int, int, int]
+
+    def rows(
+        self, direction: NDArray[np.float64] | None, intensity: float, start: int, stop: int
+    ) -> NDArray[np.float64]:
+        raise NotImplementedError
+
+    def __call__(
+        self, direction: NDArray[np.float64] | None, intensity: float
+    ) -> NDArray[np.float64]:
+        out = np.empty(self.shape)
+        for start, stop in row_bands(*self.shape[:2]):
+            out[start:stop] = self.rows(direction, intensity, start, stop)
+        return out
+
+
+class ReliefRenderer(BandedRenderer):
     """The relief scene under a directional light, rendered a band of rows at a time.
 
     Holds only the height field (8 bytes a pixel); normals and albedo are made per band, so a
@@ -115,14 +136,6 @@ class ReliefRenderer:
             self._base[self._iy[start:stop]][:, self._ix],
         )
         return lambert_radiance(band, direction, intensity)
-
-    def __call__(
-        self, direction: NDArray[np.float64] | None, intensity: float
-    ) -> NDArray[np.float64]:
-        out = np.empty(self.shape)
-        for start, stop in row_bands(*self.shape[:2]):
-            out[start:stop] = self.rows(direction, intensity, start, stop)
-        return out
 
 
 def lambert_radiance(
@@ -154,7 +167,7 @@ def renderer_for(
     return LibraryRenderer(name, height_px, width_px, seed, light_distance_mm)
 
 
-class LibraryRenderer:
+class LibraryRenderer(BandedRenderer):
     """A library scene (:mod:`rti_rig.simulator.scenes`) under one light, with the passes it
     declares, rendered a band of rows at a time.
 
@@ -220,11 +233,3 @@ class LibraryRenderer:
             None if vis is None else vis[start:stop],
         )
         return band.astype(np.float64)
-
-    def __call__(
-        self, direction: NDArray[np.float64] | None, intensity: float
-    ) -> NDArray[np.float64]:
-        out = np.empty(self.shape)
-        for start, stop in row_bands(*self.shape[:2]):
-            out[start:stop] = self.rows(direction, intensity, start, stop)
-        return out
