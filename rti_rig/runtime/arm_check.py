@@ -65,6 +65,9 @@ class ArmSelfTestReport:
     elapsed_s: float = 0.0
     #: what may be said of an arm whose connect failed (:func:`not_connected_sentence`)
     not_connected: str | None = None
+    #: whether the teardown's stop succeeded (every joint held): only then is the arm said to
+    #: have been stopped
+    stopped: bool = True
 
     @property
     def ok(self) -> bool:
@@ -99,6 +102,13 @@ class ArmSelfTestReport:
             # no stop or hold to speak of (it had said "stopped where it was" of an arm whose
             # port could not even be opened)
             out.append(f"ABORTED: {self.aborted} ({self.not_connected})")
+        elif self.aborted and not self.stopped:
+            # the stop failed (a servo that does not answer, one that shut down): "stopped
+            # where it was" had been said above the teardown's "it may still be moving"
+            out.append(
+                f"ABORTED: {self.aborted} (not parked; the stop did not hold every joint: "
+                "see the teardown below)"
+            )
         elif self.aborted:
             out.append(
                 f"ABORTED: {self.aborted} (not parked: the arm was stopped where it was"
@@ -210,12 +220,29 @@ def arm_self_test(
         exc.self_test_report = report  # type: ignore[attr-defined]
         raise
     finally:
-        report.teardown_failures = attempt_all(
+        failures = attempt_all(
             [
                 ("lamp off", lambda: carrier.lamp(False)),
                 ("stop", carrier.stop),
                 ("close", carrier.close),
             ]
         )
+        report.stopped = not any(f.startswith("stop: ") for f in failures)
+        report.teardown_failures = _point_back(failures)
         report.elapsed_s = clock.now() - started
     return report
+
+
+def _point_back(failures: list[str]) -> list[str]:
+    """Teardown failures, one that repeats an earlier one word for word replaced by a pointer
+    to it (``close: failed as 'stop' above``).
+
+    Why: the driver's ``close`` stops the arm again, so one servo fault had been printed in
+    full twice, a paragraph for the stop and the same paragraph for the close (``rti-rig run``
+    already pointed back: :func:`rti_rig.runtime.controller._teardown_failure`)."""
+    out: list[str] = []
+    for failure in failures:
+        label, _, text = failure.partition(": ")
+        first = next((f.partition(": ")[0] for f in out if f.partition(": ")[2] == text), None)
+        out.append(f"{label}: failed as '{first}' above" if first is not None else failure)
+    return out

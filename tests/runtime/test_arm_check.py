@@ -229,3 +229,40 @@ def test_the_heading_names_the_arm_with_one_noun(name: str, label: str) -> None:
 def test_check_command_fails_on_a_missing_config(tmp_path: Path) -> None:
     r = runner.invoke(app, ["check", str(tmp_path / "nope.toml")])
     assert r.exit_code != 0
+
+
+@pytest.mark.e2e
+def test_an_arm_whose_stop_failed_is_not_said_to_have_been_stopped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`rti-rig check` on the emulated arm (real driver and SDK, in-process) whose azimuth servo
+    stops answering at the third pose: the teardown's stop cannot hold that joint, which may
+    still be moving. The abort line had said "the arm was stopped where it was" above the
+    teardown's "it may still be moving", and the close's repeat of the stop's failure was a
+    second copy of the same paragraph."""
+    from rti_rig.app import compose
+    from rti_rig.app.usecases import check
+
+    def build_rig(loaded, clock=None):  # type: ignore[no-untyped-def]
+        rig = compose.build_rig(loaded, clock)
+        carrier, emulator, moves = rig.lighting.carrier, rig.emulator, []  # type: ignore[attr-defined]
+        real_move = carrier.move_to
+
+        def move_to(direction: np.ndarray) -> np.ndarray:
+            moves.append(direction)
+            if len(moves) == 3:
+                emulator.silent_ids.add(loaded.config.arm.dynamixel.azimuth.servo_id)
+            return real_move(direction)
+
+        carrier.move_to = move_to
+        return rig
+
+    monkeypatch.setattr(check, "build_rig", build_rig)
+    r = runner.invoke(app, ["check", str(inprocess_arm_config(tmp_path))])
+    said = " ".join(r.output.split())
+    assert "RESULT: FAIL" in said and "NOT parked" in said
+    assert "it may still be moving" in said  # the teardown's stop, as the driver said it
+    assert "stopped where it was" not in said, said
+    assert "the stop did not hold every joint" in said
+    assert said.count("it may still be moving") == 1, said
+    assert "teardown FAILED: close: failed as 'stop' above" in said
