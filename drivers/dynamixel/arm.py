@@ -35,7 +35,12 @@ from rti_rig.drivers.dynamixel.faults import (
     SafetyViolation,
     UnreachableError,
 )
-from rti_rig.drivers.dynamixel.kinematics import ArmKinematics, as_direction, clamp_ticks
+from rti_rig.drivers.dynamixel.kinematics import (
+    ArmKinematics,
+    as_direction,
+    clamp_ticks,
+    ticks_to_joint,
+)
 from rti_rig.drivers.dynamixel.settings import ArmSettings
 
 log = logging.getLogger("rti_rig.dynamixel.arm")
@@ -496,15 +501,58 @@ class DynamixelArm:
             if close and not moving:
                 return self.kin.direction_of_ticks(*present)
             if self.clock.now() - start > s.move_timeout_s:
+                late = [
+                    (joint, p, g)
+                    for joint, p, g in zip(s.joints, present, goal, strict=True)
+                    if abs(p - g) > s.in_position_tolerance_ticks
+                ]
+                said = self._not_in_position(late)  # before the stop's hold rewrites goals
                 try:
                     self.stop()
                 except Exception as exc:  # report the timeout, not the failed stop
                     log.error("%s: stop after timeout failed: %s", self.name, exc)
                 raise MoveTimeoutError(
                     self.name,
-                    f"not in position after {s.move_timeout_s} s: goal {goal}, present "
-                    f"{tuple(present)} ticks (tolerance {s.in_position_tolerance_ticks}); check "
-                    "for an obstruction, the load, or raise move_timeout_s",
+                    f"not in position after {s.move_timeout_s:g} s: {said} (goal {goal}, "
+                    f"present {tuple(present)} ticks, tolerance "
+                    f"{s.in_position_tolerance_ticks})",
                     command,
+                    late[0][0].servo_id if len(late) == 1 else None,
                 )
             self.clock.sleep(s.poll_interval_s)
+
+    def _not_in_position(self, late: list[tuple[Any, int, int]]) -> str:
+        """Which joints a timed-out move left short, where, and why as far as can be read.
+
+        Why: the timeout had given the two joints' ticks only, with "check for an obstruction"
+        whatever happened: a user could not tell which servo stayed behind, nor that its
+        torque was off — a servo restarts with torque off after a dip in its supply (RAM
+        reset to its initial values, no Hardware Error left to read: ROBOTIS e-manual,
+        X-series control table, RAM area), which no obstruction explains. Torque Enable is
+        read for each joint left short (best effort)."""
+        if not late:  # every joint close but one still reporting Moving
+            return "the joints are within tolerance but still report moving; raise move_timeout_s"
+        parts = []
+        for joint, p, g in late:
+            at = ticks_to_joint(joint, p)
+            to = ticks_to_joint(joint, g)
+            who = (  # one joint: the error's "servo N:" prefix names its servo already
+                f"the {self._role(joint)} joint"
+                if len(late) == 1
+                else f"servo {joint.servo_id} ({self._role(joint)})"
+            )
+            text = f"{who} was at {at:.1f} deg, goal {to:.1f} deg"
+            try:
+                torque = self._bus.read(joint.servo_id, ct.TORQUE_ENABLE, check_alert=False)
+            except DynamixelError:
+                torque = None
+            if torque == 0:
+                text += (
+                    ": its torque is off (a servo restarts with torque off after a dip in its "
+                    "supply, so check that the supply carries both servos moving at once; or "
+                    "another program switched it off); the joint is limp"
+                )
+            else:
+                text += ": check for an obstruction or a load too heavy for it"
+            parts.append(text)
+        return "; ".join(parts)

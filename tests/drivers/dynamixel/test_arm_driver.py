@@ -251,6 +251,36 @@ def test_stalled_move_times_out_and_stops() -> None:
     assert clock.now() < 3.0
 
 
+def test_a_move_timeout_names_the_joint_left_short_and_a_torque_found_off() -> None:
+    """A servo that restarted (a dip in its supply: RAM back to its initial values, torque
+    off, no Hardware Error left) takes the next goal and does not move. The timeout had said
+    "goal (a, b), present (c, d) ticks; check for an obstruction": not which servo stayed
+    behind, nor that its torque was off."""
+    arm, emu, _ = make_arm()
+    arm.connect()
+    arm.move_to(direction_from_az_el(0, 20))
+    emu.servos[2].reboot()  # the elevation servo restarts between two moves
+    with pytest.raises(MoveTimeoutError) as info:
+        arm.move_to(direction_from_az_el(0, 60))
+    said = str(info.value)
+    assert info.value.servo_id == 2
+    assert "servo 2: not in position" in said and "the elevation joint was at 20.0 deg" in said
+    assert "goal 60.0 deg" in said and "its torque is off" in said and "supply" in said
+    assert "obstruction" not in said
+
+
+def test_a_blocked_joint_s_timeout_names_it_and_the_obstruction() -> None:
+    arm, emu, _ = make_arm()
+    arm.connect()
+    emu.servos[1]._start_move = lambda goal: None  # type: ignore[method-assign]  # blocked
+    with pytest.raises(MoveTimeoutError) as info:
+        arm.move_to(direction_from_az_el(90, 10))
+    said = str(info.value)
+    assert info.value.servo_id == 1
+    assert "the azimuth joint was at 0.0 deg, goal 90.0 deg" in said and "obstruction" in said
+    assert "torque is off" not in said
+
+
 def test_a_timeout_shorter_than_the_arm_s_longest_move_is_refused() -> None:
     """A 2 rpm azimuth across -170..170 deg takes about 28 s: with a 20 s timeout, a session
     that asked for that swing stopped there, after its first images ("not in position after
