@@ -235,7 +235,8 @@ class DynamixelArm:
                 raise SafetyViolation(
                     self.name,
                     f"present position {t} is outside the configured range {lo}..{hi}; move the "
-                    "arm by hand into its range (torque is off) or fix zero_offset_ticks",
+                    f"arm by hand into its range {self._torque_for_hands()} or fix "
+                    "zero_offset_ticks",
                     "connect",
                     joint.servo_id,
                 )
@@ -244,9 +245,38 @@ class DynamixelArm:
             raise SafetyViolation(
                 self.name,
                 f"the arm is not in a safe pose ({reason}); move it "
-                "by hand out of the keep-out cone (torque is off)",
+                f"by hand out of the keep-out cone {self._torque_for_hands()}",
                 "connect",
             )
+
+    def _torque_for_hands(self) -> str:
+        """What the servos' torque is, as read, for a user told to move the arm by hand.
+
+        Why read: the refusal had said "(torque is off)" as a fact. With ``torque_policy =
+        "hold"`` the servos keep holding after a session or check ends, and they still do when
+        the next connect refuses the pose (a wider keep-out cone in the config, say): a user
+        told the torque was off pushed against servos holding under torque. And ``home`` runs
+        this check on a connected arm, torque on."""
+        on, unknown = [], []
+        for joint in self.settings.joints:
+            try:
+                if self._bus.read(joint.servo_id, ct.TORQUE_ENABLE, check_alert=False):
+                    on.append(joint)
+            except DynamixelError:
+                unknown.append(joint)
+        if on:
+            held = ", ".join(f"servo {j.servo_id} ({self._role(j)})" for j in on)
+            return (
+                f"(its torque is ON, as read: {held} still holding, e.g. since an earlier "
+                "session with torque_policy = 'hold'; switch the servos' power off and on, "
+                "which starts them with torque off, supporting the arm so that it cannot drop "
+                "onto the object, then move it)"
+            )
+        if unknown:
+            return (
+                "(whether its torque is off could not be read: switch the servos' power off first)"
+            )
+        return "(its torque is off, as read)"
 
     def close(self) -> None:
         """Lamp off, motion stopped (torque policy applied), port released — the arm is not moved.

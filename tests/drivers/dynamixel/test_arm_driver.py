@@ -130,6 +130,31 @@ def test_arm_outside_limits_at_power_up_is_refused() -> None:
     assert not emu.servos[2].torque_on and emu.goal_log == []
 
 
+def test_a_pose_refused_at_connect_says_the_torque_as_read() -> None:
+    """An arm left holding by a session with torque_policy = "hold" (its servos keep their
+    torque after close), then connected with a wider keep-out cone: its pose is refused, and
+    the user told to move it by hand. That had said "(torque is off)" of servos holding
+    under torque."""
+    arm, emu, clock = make_arm(keep_out_half_angle_deg=5.0)
+    arm.connect()
+    arm.move_to(direction_from_az_el(0.0, 80.0))
+    arm.close()  # "hold": torque stays on
+    assert emu.servos[1].torque_on and emu.servos[2].torque_on
+    wider = DynamixelArm(arm_settings(keep_out_half_angle_deg=15.0), InProcessPort(emu), clock)
+    with pytest.raises(SafetyViolation, match="keep-out cone") as info:
+        wider.connect()
+    said = str(info.value)
+    assert "torque is off" not in said
+    assert "its torque is ON, as read: servo 1 (azimuth), servo 2 (elevation)" in said
+    assert "power off and on" in said
+    # a fresh arm powered up inside the cone: its torque is off, and read so
+    arm, emu, _ = make_arm()
+    in_cone = arm.kin.ticks_of_pose(0.0, 80.0)[1]
+    emu.servos[2]._profile.start = emu.servos[2]._profile.goal = float(in_cone)
+    with pytest.raises(SafetyViolation, match=r"\(its torque is off, as read\)"):
+        arm.connect()
+
+
 def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
     arm, emu, clock = make_arm()
     arm.connect()
