@@ -28,6 +28,7 @@ from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.bus import DxlBus
 from rti_rig.drivers.dynamixel.faults import (
+    CommunicationError,
     ConfigMismatchError,
     DynamixelError,
     HardwareFaultError,
@@ -108,7 +109,10 @@ class DynamixelArm:
 
     def _check_servo(self, joint) -> None:
         sid, dev = joint.servo_id, self.name
-        model = self._bus.ping(sid)
+        try:
+            model = self._bus.ping(sid)
+        except CommunicationError as exc:
+            raise self._unanswered(joint, exc) from exc
         if model != joint.model_number:
             raise ConfigMismatchError(
                 dev,
@@ -152,6 +156,57 @@ class DynamixelArm:
                     sid,
                 )
         self._check_velocity_limit(joint)
+
+    def _unanswered(self, joint, exc: CommunicationError) -> CommunicationError:  # type: ignore[no-untyped-def]
+        """A configured servo that does not answer its ping, with what does answer on the bus.
+
+        Why: the error had been the SDK's "There is no status packet!" with "check power,
+        cabling, id and baud rate" whatever the cause. A broadcast Ping (read-only) tells the
+        causes apart: other servos answering at this baud rate mean a wrong ``servo_id`` (the
+        answering ids and models are named, with the config key to set); none answering means
+        power, cabling, the baud rate or the servos' protocol (a servo set to Protocol 1.0,
+        Protocol Type = 1 at address 13, does not answer Protocol 2.0 packets: ROBOTIS
+        e-manual, X-series control table)."""
+        found = self._bus.scan()
+        if not found:
+            if found is None:
+                return exc
+            return CommunicationError(
+                self.name,
+                f"no reply to its ping (COMM_RX_TIMEOUT), and no servo at all answers a "
+                f"broadcast ping at {self.settings.baudrate} baud: check the servos' power and "
+                "cabling, "
+                f"[arm.dynamixel] baudrate (X-series servos ship at 57600; Dynamixel Wizard "
+                "2.0 scans every rate) and that the servos speak Protocol 2.0 (Protocol Type, "
+                "address 13)",
+                exc.command,
+                joint.servo_id,
+            )
+        if joint.servo_id in found:
+            return exc  # it answers a broadcast: a flaky line, said as the SDK said it
+        role = self._role(joint)
+        others = {j.servo_id: self._role(j) for j in self.settings.joints if j is not joint}
+        spare = {i: m for i, m in found.items() if i not in others}
+        if not spare:  # only the arm's other joint answers
+            seen = ", ".join(f"servo {i} (the {others[i]} joint)" for i in sorted(found))
+            message = (
+                f"no servo with id {joint.servo_id} answers at {self.settings.baudrate} baud, "
+                f"while {seen} does: check the {role} servo's cable and the chain between "
+                f"the servos, then its id and baud rate (Dynamixel Wizard 2.0) against "
+                f"[arm.dynamixel.{role}] servo_id"
+            )
+        else:
+            answering = ", ".join(
+                f"{i} ({ct.MODEL_NAMES.get(m, f'model {m}')})" for i, m in sorted(spare.items())
+            )
+            one = len(spare) == 1
+            message = (
+                f"no servo with id {joint.servo_id} answers at {self.settings.baudrate} baud, "
+                f"but {'servo' if one else 'servos'} {answering} {'does' if one else 'do'}: "
+                f"set servo_id in [arm.dynamixel.{role}] to the id of the {role} servo "
+                "(Dynamixel Wizard 2.0 shows and changes ids; no two servos may share one)"
+            )
+        return CommunicationError(self.name, message, exc.command, joint.servo_id)
 
     def _role(self, joint) -> str:  # type: ignore[no-untyped-def]
         """The joint's table in the rig config (``azimuth`` or ``elevation``): an error about a

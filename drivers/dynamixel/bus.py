@@ -218,6 +218,19 @@ class DxlBus:
         self._check(result, error, dxl_id, "ping", alert=False)
         return int(model)
 
+    def scan(self) -> dict[int, int] | None:
+        """``{id: model number}`` of every servo answering a broadcast Ping at this baud rate
+        (``None``: the scan itself failed). Read-only, for naming what is on the bus when a
+        configured servo does not answer; answers that arrive damaged are left out."""
+        try:
+            found, result = self.ph.broadcastPing(self.port)
+        except DynamixelError:
+            return None
+        log.debug("%s: broadcast ping -> %s (%d)", self.device, found, result)
+        if result not in (sdk.COMM_SUCCESS, sdk.COMM_RX_TIMEOUT, sdk.COMM_RX_CORRUPT):
+            return None
+        return {int(i): int(v[0]) for i, v in (found or {}).items()}
+
     def read(self, dxl_id: int, reg: ct.Register, check_alert: bool = True) -> int:
         command = f"read {reg.name}"
         fn = {1: self.ph.read1ByteTxRx, 2: self.ph.read2ByteTxRx, 4: self.ph.read4ByteTxRx}

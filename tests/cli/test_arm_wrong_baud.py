@@ -21,7 +21,9 @@ def test_check_on_the_wrong_baud_rate_names_it(tmp_path: Path) -> None:
     said = " ".join(r.output.split())
     assert r.exit_code != 0, said
     assert "servo 1" in said and "at 1000000 baud" in said, said
-    assert "baud rate: X-series servos ship at 57600" in said
+    # no servo at all answers a broadcast ping there: the baud rate is named with its key
+    assert "no servo at all answers a broadcast ping at 1000000 baud" in said
+    assert "[arm.dynamixel] baudrate (X-series servos ship at 57600" in said
     assert "Traceback" not in said
     assert (
         CliRunner()

@@ -155,6 +155,37 @@ def test_a_pose_refused_at_connect_says_the_torque_as_read() -> None:
         arm.connect()
 
 
+def test_a_servo_that_does_not_answer_is_told_from_what_the_bus_answers() -> None:
+    """A configured servo silent at connect. The error had been the SDK's "There is no status
+    packet!" with "check power, cabling, id and baud rate" whatever the cause; a broadcast Ping
+    (read-only) now tells a wrong id from an unplugged servo and from a wrong baud rate."""
+    clock = VirtualClock()
+    emu = emulator_for_arm(arm_settings(), clock)  # servos 1 and 2 on the bus
+    wrong_id = DynamixelArm(arm_settings(elevation=dict(servo_id=3)), InProcessPort(emu), clock)
+    with pytest.raises(DynamixelError) as info:
+        wrong_id.connect()
+    said = str(info.value)
+    assert "no servo with id 3 answers at 57600 baud, but servo 2 (XL430-W250) does" in said
+    assert "set servo_id in [arm.dynamixel.elevation]" in said and info.value.servo_id == 3
+    assert not wrong_id.commanded
+
+    emu.silent_ids.add(2)  # the elevation servo unplugged: only the azimuth answers
+    arm = DynamixelArm(arm_settings(), InProcessPort(emu), clock)
+    with pytest.raises(DynamixelError) as info:
+        arm.connect()
+    said = str(info.value)
+    assert "while servo 1 (the azimuth joint) does" in said
+    assert "check the elevation servo's cable" in said and "set servo_id" not in said
+
+    emu.silent_ids.clear()
+    wrong_baud = DynamixelArm(arm_settings(baudrate=1_000_000), InProcessPort(emu), clock)
+    with pytest.raises(DynamixelError) as info:
+        wrong_baud.connect()
+    said = str(info.value)
+    assert "no servo at all answers a broadcast ping at 1000000 baud" in said
+    assert "[arm.dynamixel] baudrate" in said and "Protocol 2.0" in said
+
+
 def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
     arm, emu, clock = make_arm()
     arm.connect()
