@@ -12,7 +12,8 @@ Status Return Level, the Alert bit, motion under Profile Velocity/Acceleration (
 *emulator time* read from an injected clock, so a dry run with a ``VirtualClock`` never waits)
 and fault injection: hardware errors (Alert in every status; torque off and motion frozen only
 for the errors the Shutdown register selects, as the e-manual says), corrupted CRC on replies,
-and silent (disconnected) servos. A Hardware Error Status bit stays set until a Reboot (not
+and silent (disconnected) servos; a servo at another baud rate, or switched to Protocol 1.0
+(Protocol Type 13 = 1), answers nothing. A Hardware Error Status bit stays set until a Reboot (not
 verified for a non-shutdown error whose cause has passed).
 
 Deliberate simplifications: a new goal during a move restarts the profile from the present
@@ -74,6 +75,8 @@ ITEMS = tuple(r for r in vars(ct).values() if isinstance(r, ct.Register))
 #: Drive Mode (address 10) bit 3 and the firmware that brought it (ROBOTIS e-manual, X series).
 TORQUE_ON_BY_GOAL_UPDATE = 0x08
 TORQUE_ON_BY_GOAL_UPDATE_FIRMWARE = 45
+#: Protocol Type (address 13) of a servo that speaks Protocol 2.0 (1: Protocol 1.0 only)
+PROTOCOL_2 = 2
 
 
 def _ticks_per_s(velocity_units: int) -> float:
@@ -488,11 +491,18 @@ class DynamixelBusEmulator:
     def receive(self, data: bytes) -> bytes:
         """Feed instruction bytes; return the status bytes the servos send back."""
         with self._lock:
+            # a servo whose Protocol Type (13) is not 2 speaks Protocol 1.0 only (ROBOTIS
+            # e-manual, Protocol Compatibility Table: "X-series can switch DYNAMIXEL Protocol
+            # 2.0 into DYNAMIXEL Protocol 1.0 ... Protocol Type(13)") and does not answer these
+            # packets: it had answered them, so a servo set to 1.0 passed `check` here
             self._deaf = self.silent_ids | {
                 i
                 for i, servo in self.servos.items()
-                if self.host_baud is not None
-                and ct.BAUD_CODES.get(servo.get(ct.BAUD_RATE)) != self.host_baud
+                if (
+                    self.host_baud is not None
+                    and ct.BAUD_CODES.get(servo.get(ct.BAUD_RATE)) != self.host_baud
+                )
+                or servo.get(ct.PROTOCOL_TYPE) != PROTOCOL_2
             }
             self._parser.feed(bytes(data))
             out = bytearray()

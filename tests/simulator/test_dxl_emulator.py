@@ -454,3 +454,17 @@ def test_a_reboot_restores_the_ram_area_as_at_power_on() -> None:
     emu.set_input_voltage(1, 200)  # 20 V: above the XL430's 14 V limit, and still there
     assert ph.reboot(port, 1)[0] == sdk.COMM_SUCCESS
     assert servo.hardware_error == ct.HardwareFault.INPUT_VOLTAGE
+
+
+def test_a_servo_switched_to_protocol_1_does_not_answer_protocol_2() -> None:
+    """An X-series servo whose Protocol Type (13) is 1 speaks Protocol 1.0 only (e-manual,
+    Protocol Compatibility Table). The emulator had answered it in 2.0 all the same, so a
+    servo left in 1.0 by another controller passed a dry run that fails on the rig."""
+    emu = two_servos(VirtualClock())
+    bus = DxlBus(InProcessPort(emu), "arm")
+    bus.open(57600)
+    bus.write(2, ct.PROTOCOL_TYPE, 1)  # EEPROM, torque off: accepted, answered in 2.0
+    with pytest.raises(CommunicationError, match="COMM_RX_TIMEOUT"):
+        bus.ping(2)
+    assert bus.scan() == {1: 1060}  # nor does it answer a broadcast ping
+    assert bus.ping(1) == 1060
