@@ -23,6 +23,7 @@ from __future__ import annotations
 import types
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 GP_CAPTURE_IMAGE = 0
 GP_FILE_TYPE_NORMAL = 1
@@ -81,6 +82,13 @@ class Body:
     #: RAW+JPEG: the second file is announced only after this many quiet event waits (a body
     #: still writing its JPEG); a shot taken before then finds the announcement pending
     second_file_quiet_waits: int = 0
+    #: a body that reports a property change (GP_EVENT_UNKNOWN "PTP Property d105 changed")
+    #: every ``chatter_s`` of ``chatter_clock`` time whenever it has nothing else to say, as
+    #: Canon bodies do (python-gphoto2 #50); at most ``chatter_limit`` times, so that a driver
+    #: that never stops listening fails a test instead of hanging it
+    chatter_s: float = 0.0
+    chatter_clock: Any = None
+    chatter_limit: int = 10_000
     powered: bool = True
     off_at_shot: int | None = None  # switched off when asked for this shot (1-based)
     shots: int = 0
@@ -242,6 +250,12 @@ def make_module(body: Body) -> types.ModuleType:
                 body._late[0][0] -= 1
                 if body._late[0][0] < 0:
                     return body._late.pop(0)[1]
+            if body.chatter_s:
+                body.chatter_limit -= 1
+                if body.chatter_limit < 0:
+                    raise AssertionError("the driver never stopped waiting for events")
+                body.chatter_clock.sleep(body.chatter_s)
+                return GP_EVENT_UNKNOWN, "PTP Property d105 changed"
             return GP_EVENT_TIMEOUT, None
 
         def file_get(self, folder: str, name: str, kind: int) -> CameraFile:

@@ -456,20 +456,34 @@ class Gphoto2Camera:
         """
         gp = self._gp
         wait_ms = 200
-        budget_ms = self.settings.event_timeout_s * 1000
+        budget_s = self.settings.event_timeout_s
         stem = Path(files[0][1]).stem
         more: list[tuple[str, str]] = []
         late: list[tuple[str, str]] = []
-        while budget_ms > 0:
+        # Time is counted on the clock for every event, and "quiet" is time with no file
+        # announced, whatever else the body reports. Only timeouts had been counted: a body
+        # that reports a property change every few milliseconds (GP_EVENT_UNKNOWN "PTP
+        # Property d105 changed", python-gphoto2 #50) never let the wait end, and the
+        # session hung at its first image; a wait_for_event that blocks longer than asked
+        # (libgphoto2 #151: about 1.2 s before a FILE_ADDED) is counted as it took.
+        spent_s = quiet_s = 0.0
+        while spent_s < budget_s:
+            started = self._clock.now()
             event, data = self._call("wait_for_event", lambda: self._cam.wait_for_event(wait_ms))
+            took = self._clock.now() - started
+            if event == gp.GP_EVENT_TIMEOUT:
+                took = max(took, wait_ms / 1000)  # a clock that does not see the wait
+            spent_s += took
             if event == gp.GP_EVENT_FILE_ADDED:
+                quiet_s = 0.0
                 item = (str(data.folder), str(data.name))
                 if item in files or item in more or item in late:
                     continue  # some bodies re-announce the first
                 earlier = Path(item[1]).stem in self._earlier_stems
                 (late if earlier and Path(item[1]).stem != stem else more).append(item)
-            elif event == gp.GP_EVENT_TIMEOUT:
-                budget_ms -= wait_ms
+                continue
+            quiet_s += took
+            if quiet_s >= wait_ms / 1000:
                 names = [Path(n) for _, n in files + more]
                 have_raw = any(is_raw_file(n) for n in names)
                 have_jpeg = any(not is_raw_file(n) for n in names)

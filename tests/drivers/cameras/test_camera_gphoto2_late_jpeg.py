@@ -73,3 +73,30 @@ def test_bodies_naming_every_shot_alike_keep_their_files(tmp_path):
         first, second = cam.capture(1 / 60), cam.capture(1 / 60)
     assert kept(first) == kept(second) == ["/capt0000.CR2", "/capt0000.JPG"]
     assert second.metadata["late_camera_files"] == []
+
+
+def test_a_body_that_keeps_reporting_property_changes_does_not_hold_a_shot(tmp_path):
+    """A body that reports a property change every 20 ms when it has nothing else to say
+    (GP_EVENT_UNKNOWN, as Canon bodies do): only GP_EVENT_TIMEOUT had counted as waiting or
+    as quiet, so the wait for a shot's files never ended and the session hung at its first
+    image. Now quiet is time with no file announced, and event_timeout_s bounds the wait."""
+    clock = VirtualClock()
+    body = Body(render=render, chatter_s=0.02, chatter_clock=clock)
+    cam = Gphoto2Camera(
+        Gphoto2CameraSettings(image_format="RAW"),
+        output_dir=tmp_path,
+        clock=clock,
+        gp_module=make_module(body),
+    )
+    with cam:
+        first, second = cam.capture(1 / 60), cam.capture(1 / 60)
+        assert kept(first) == ["/IMG_0001.CR2"] and kept(second) == ["/IMG_0002.CR2"]
+        assert clock.now() < 1.0  # each shot's wait ended after a quiet 200 ms
+    # a JPEG that never comes: waited for event_timeout_s, not for ever
+    body = Body(render=render, chatter_s=0.02, chatter_clock=clock)
+    settings = Gphoto2CameraSettings(image_format="RAW", keep_jpeg=True, event_timeout_s=1.0)
+    with Gphoto2Camera(settings, tmp_path, clock, make_module(body)) as cam:
+        start = clock.now()
+        frame = cam.capture(1 / 60)
+    assert 1.0 <= clock.now() - start < 1.1
+    assert any("no JPEG" in n for n in frame.metadata["notices"])
