@@ -154,12 +154,19 @@ class ArmLighting:
             return failures
         if self.arm_failure is not None or stop_failed:
             why = "own move failed" if self.arm_failure is not None else "stop failed"
+            # "left where it stopped" only of a stop that held every joint: one that did not
+            # answer may still be moving to its last goal (the stop's failure above says so)
+            left = (
+                "it was left as the failed stop above describes, not moved again"
+                if stop_failed
+                else "it was left where it stopped"
+            )
             return [
                 *failures,
                 f"park: not attempted because the arm's {why}: parking is a move of both "
-                "joints, and a faulty or blocked arm must not be driven near the object; it "
-                "was left where it stopped. Clear the fault (its error says how), then park "
-                "it with 'rti-rig check'",
+                f"joints, and a faulty or blocked arm must not be driven near the object; "
+                f"{left}. Clear the fault (its error says how), then park it with "
+                "'rti-rig check'",
             ]
         return failures + attempt_all([("park", self.carrier.park)])
 

@@ -124,3 +124,5 @@ def test_an_arm_whose_stop_failed_is_not_parked_either(tmp_path: Path) -> None:
     runner = json.loads((out / "manifest.json").read_text())["runner"]
     said = [f for f in runner["teardown_failures"] if f.startswith("park:")]
     assert len(said) == 1 and "because the arm's stop failed" in said[0]
+    # the elevation joint did not answer the stop: it is not said to have stopped
+    assert "left where it stopped" not in said[0] and "failed stop above" in said[0]
