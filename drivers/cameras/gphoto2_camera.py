@@ -336,12 +336,7 @@ class Gphoto2Camera:
         cam = self._cam
         secs, label, err = nearest_shutter(exposure_s, self._shutters)
         if err > s.shutter_tolerance:
-            raise CaptureError(
-                self.name,
-                f"exposure {exposure_s:g} s is not offered (nearest '{label}' = {secs:g} s); "
-                "choose one of available_exposures_s()",
-                "set shutter",
-            )
+            raise CaptureError(self.name, self._not_offered(exposure_s, secs, label), "set shutter")
         if label != self._shutter_label:
             self._set_config_values({s.shutter_config: (label, "shutter_config")})
             self._shutter_label = label
@@ -350,6 +345,23 @@ class Gphoto2Camera:
         path = self._call("capture", lambda: cam.capture(gp.GP_CAPTURE_IMAGE))
         self._pending = (path, exposure_s, secs, label, t_capture)
         return self._clock.now()
+
+    def _not_offered(self, exposure_s: float, secs: float, label: str) -> str:
+        """Why an exposure cannot be shot, with the offered speeds either side and the keys
+        to change. It had said "choose one of available_exposures_s()", a Python method,
+        to a user whose exposure comes from the rig config's [camera] exposure_s."""
+        below = [(t, lab) for t, lab in self._shutters if t < exposure_s]
+        above = [(t, lab) for t, lab in self._shutters if t > exposure_s]
+        near = [f"{t:g} s ('{lab}')" for t, lab in (below[-1:] + above[:1])]
+        return (
+            f"exposure {exposure_s:g} s is not a shutter speed this camera offers (nearest "
+            f"'{label}' = {secs:g} s, {abs(secs - exposure_s) / exposure_s:.0%} off; "
+            f"shutter_tolerance = {self.settings.shutter_tolerance:g}): set [camera] "
+            f"exposure_s in the rig config to one it offers, {' or '.join(near)}, or raise "
+            "shutter_tolerance in [camera.device] to shoot the nearest; the camera offers "
+            f"'{self._shutters[0][1]}' to '{self._shutters[-1][1]}' in its own steps (its "
+            "1/3 or 1/2 stop setting)"
+        )
 
     def collect(self) -> Frame:
         """Download the last ``expose``'s RAW (and JPEG) and decode it to linear data."""

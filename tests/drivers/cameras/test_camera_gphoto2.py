@@ -203,8 +203,15 @@ def test_value_not_offered_and_value_not_latched(tmp_path):
 
 
 def test_exposure_not_offered_is_refused(tmp_path):
-    with camera(dslr(), tmp_path) as cam, pytest.raises(CaptureError, match="not offered"):
+    """Refused naming the speeds either side and the config keys to change: it had said
+    "choose one of available_exposures_s()", a Python method, to a CLI user."""
+    with camera(dslr(), tmp_path) as cam, pytest.raises(CaptureError) as info:
         cam.capture(0.1)  # between 1/8 and 1/15
+    said = str(info.value)
+    assert "not a shutter speed this camera offers" in said
+    assert "0.0666667 s ('1/15') or 0.125 s ('1/8')" in said
+    assert "[camera] exposure_s" in said and "shutter_tolerance" in said
+    assert "available_exposures_s" not in said
 
 
 def test_unknown_config_name_points_to_list_config(tmp_path):
