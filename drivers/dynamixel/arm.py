@@ -80,6 +80,15 @@ class DynamixelArm:
         servo holding under torque, so a stop may not say that nothing was commanded."""
         return bool(self._bus.commanded)
 
+    @property
+    def driven(self) -> bool:
+        """Whether anything that could leave a servo driven was ever sent (any write but a
+        Torque Enable = 0 or an EEPROM write: a first connect rewrites the position limits
+        that way, torque off, before it checks the pose). A connect that failed after those
+        writes only left no servo driven by this driver; its stop may say so rather than
+        "a servo may be holding under torque" beside a refusal that read the torque off."""
+        return bool(self._bus.driven)
+
     # -- lifecycle --------------------------------------------------------------------------
     def connect(self) -> None:
         """Open the port, check the servos against the config, set profiles, torque on."""

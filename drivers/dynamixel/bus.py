@@ -114,6 +114,10 @@ class DxlBus:
         #: whether anything that changes a servo's state (a write, an action, a reboot) was
         #: ever sent: until then a stop may say nothing was commanded
         self.commanded = False
+        #: whether anything that could leave a servo driven was ever sent: any command but a
+        #: Torque Enable = 0 or an EEPROM write (which a servo takes only with its torque off,
+        #: the limits a first connect writes): until then no servo was driven by this bus
+        self.driven = False
 
     # -- port -------------------------------------------------------------------------------
     def open(self, baudrate: int) -> None:
@@ -270,8 +274,14 @@ class DxlBus:
             )
         return bytes(data), int(error)
 
-    def write(self, dxl_id: int, reg: ct.Register, value: int, check_alert: bool = True) -> None:
+    def _commanding(self, reg: ct.Register | None = None, value: int | None = None) -> None:
+        """Record a command going out (:attr:`commanded`, :attr:`driven`)."""
         self.commanded = True
+        if reg is None or not (reg.eeprom or (reg is ct.TORQUE_ENABLE and value == 0)):
+            self.driven = True
+
+    def write(self, dxl_id: int, reg: ct.Register, value: int, check_alert: bool = True) -> None:
+        self._commanding(reg, value)
         command = f"write {reg.name} = {value}"
         raw = value & ((1 << (8 * reg.size)) - 1)
         fn = {1: self.ph.write1ByteTxRx, 2: self.ph.write2ByteTxRx, 4: self.ph.write4ByteTxRx}
@@ -284,7 +294,7 @@ class DxlBus:
 
         Without the drain, the status the servo sends back is read as the answer to the next
         command (SDK pitfall; ROBOTIS PR #646)."""
-        self.commanded = True
+        self._commanding(reg, value)
         raw = value & ((1 << (8 * reg.size)) - 1)
         data = list(raw.to_bytes(reg.size, "little"))
         result = self.ph.writeTxOnly(self.port, dxl_id, reg.address, reg.size, data)
@@ -304,7 +314,7 @@ class DxlBus:
 
     def sync_write(self, reg: ct.Register, values: Mapping[int, int]) -> None:
         """Same register on several servos in one broadcast packet (no reply to wait for)."""
-        self.commanded = True
+        self._commanding()
         group = sdk.GroupSyncWrite(self.port, self.ph, reg.address, reg.size)
         for dxl_id, value in values.items():
             raw = int(value) & ((1 << (8 * reg.size)) - 1)
@@ -318,7 +328,7 @@ class DxlBus:
 
     def broadcast_write(self, reg: ct.Register, value: int) -> None:
         """Write to every servo at once; broadcast writes get no status, so none is left over."""
-        self.commanded = True
+        self._commanding(reg, value)
         raw = value & ((1 << (8 * reg.size)) - 1)
         data = list(raw.to_bytes(reg.size, "little"))
         result = self.ph.writeTxOnly(self.port, p2.BROADCAST_ID, reg.address, reg.size, data)
@@ -330,13 +340,13 @@ class DxlBus:
 
     def action(self) -> None:
         """Action to the broadcast id: unicast Action leaves a stale reply (SDK pitfall)."""
-        self.commanded = True
+        self._commanding()
         result = self.ph.action(self.port, p2.BROADCAST_ID)
         if result != sdk.COMM_SUCCESS:
             raise CommunicationError(self.device, comm_text(self.ph, result), "action")
 
     def reboot(self, dxl_id: int) -> None:
-        self.commanded = True
+        self._commanding()
         result, error = self.ph.reboot(self.port, dxl_id)
         log.debug("%s: reboot %d (%d, %d)", self.device, dxl_id, result, error)
         self._check(result, error, dxl_id, "reboot", alert=False)

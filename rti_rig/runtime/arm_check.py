@@ -127,12 +127,21 @@ class ArmSelfTestReport:
 def not_connected_sentence(carrier: object, connected: bool | None = None) -> str | None:
     """What may truthfully be said of an arm whose connect never completed (None: it did;
     ``connected``: known by the caller, else the carrier's ``ever_connected``). Nothing was
-    commanded if nothing was ever written to a servo; a connect that failed after a write
-    (limits, profiles, a goal, torque on) may have left a servo holding under torque."""
+    commanded if nothing was ever written to a servo; nothing driven if only torque-off and
+    EEPROM writes went out (:attr:`DynamixelArm.driven`); a connect that failed after another
+    write (profiles, a goal, torque on) may have left a servo holding under torque."""
     if getattr(carrier, "ever_connected", True) if connected is None else connected:
         return None
     if getattr(carrier, "commanded", True) is False:
         return "nothing was commanded: the arm could not be connected"
+    if getattr(carrier, "driven", True) is False:
+        # only torque-off and EEPROM writes went out (the position limits a first connect
+        # writes): "a servo may be holding under torque" had been said beside a refusal that
+        # had just read every servo's torque off
+        return (
+            "the arm could not be connected; rti-rig switched no servo's torque on (it only "
+            "switched torque off to write servo settings)"
+        )
     return (
         "the arm's connection failed part-way, after settings were written to its servos: a "
         "servo may be holding its position under torque; switch the arm's power off before "

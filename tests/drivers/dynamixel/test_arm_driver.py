@@ -593,6 +593,26 @@ def test_a_connect_that_fails_after_writing_is_not_said_to_have_commanded_nothin
     assert lights_state(rig) == "nothing was commanded: the arm could not be connected"
 
 
+def test_a_connect_refused_after_writing_only_limits_is_not_said_to_hold_under_torque() -> None:
+    """Fresh servos (factory limits 0..4095) powered up inside the keep-out cone: the connect
+    writes the config's limits (torque off, EEPROM), then refuses the pose, saying the torque
+    reads off. The check then added "a servo may be holding its position under torque; switch
+    the arm's power off", which no write had made so."""
+    from rti_rig.core.rig_geometry import ArmGeometry
+    from rti_rig.runtime.arm_check import arm_self_test
+
+    arm, emu, clock = make_arm()
+    in_cone = arm.kin.ticks_of_pose(0.0, 80.0)[1]
+    emu.servos[2]._profile.start = emu.servos[2]._profile.goal = float(in_cone)
+    geometry = ArmGeometry(5.0, 70.0, 15.0, 0.0, 10.0, -170.0, 170.0)
+    report = arm_self_test(arm, geometry, clock)
+    text = " ".join(" ".join(report.lines()).split())
+    assert emu.servos[2].get(ct.MAX_POSITION_LIMIT) == arm.settings.elevation.tick_limits[1]
+    assert not emu.servos[1].torque_on and not emu.servos[2].torque_on
+    assert "(its torque is off, as read)" in text
+    assert "under torque" not in text and "switched no servo's torque on" in text
+
+
 def test_a_port_lost_mid_session_is_a_named_device_error() -> None:
     """The arm's USB adapter unplugged under an exchange: pyserial raises SerialException (an
     OSError) from the SDK's read or write. It had escaped the driver as itself, and the CLI
