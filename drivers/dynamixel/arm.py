@@ -304,7 +304,7 @@ class DynamixelArm:
                     "connect",
                     joint.servo_id,
                 )
-        reason = self.kin.ticks_reason(*ticks)
+        reason = self.kin.ticks_reason(*ticks, what="position")
         if reason:
             raise SafetyViolation(
                 self.name,

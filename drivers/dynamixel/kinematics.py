@@ -68,8 +68,14 @@ class ArmKinematics:
             )
         return None
 
-    def ticks_reason(self, azimuth_ticks: int, elevation_ticks: int) -> str | None:
-        """THE safety gate: why these Goal Position values must not be sent, or None."""
+    def ticks_reason(
+        self, azimuth_ticks: int, elevation_ticks: int, what: str = "goal"
+    ) -> str | None:
+        """THE safety gate: why these Goal Position values must not be sent, or None.
+
+        ``what`` names the ticks in the reason: ``"goal"``, or ``"position"`` for a pose read
+        from the servos (connect's check had called the arm's present pose a "goal", as if
+        rti-rig had tried to send it there)."""
         s = self.settings
         for name, joint, t in (
             ("azimuth", s.azimuth, azimuth_ticks),
@@ -77,12 +83,12 @@ class ArmKinematics:
         ):
             lo, hi = joint.tick_limits
             if not lo <= t <= hi:
-                return f"{name} servo {joint.servo_id} goal {t} ticks outside limits {lo}..{hi}"
+                return f"{name} servo {joint.servo_id} {what} {t} ticks outside limits {lo}..{hi}"
         el_deg = ticks_to_joint(s.elevation, elevation_ticks)
         limit = 90.0 - s.keep_out_half_angle_deg
         if el_deg > limit + EPS_DEG:
             return (
-                f"elevation goal {elevation_ticks} ticks = {el_deg:.3f} deg enters the "
+                f"elevation {what} {elevation_ticks} ticks = {el_deg:.3f} deg enters the "
                 f"keep-out cone (max {limit:.3f} deg)"
             )
         return None

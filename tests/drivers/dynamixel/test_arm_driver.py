@@ -611,6 +611,8 @@ def test_a_connect_refused_after_writing_only_limits_is_not_said_to_hold_under_t
     assert not emu.servos[1].torque_on and not emu.servos[2].torque_on
     assert "(its torque is off, as read)" in text
     assert "under torque" not in text and "switched no servo's torque on" in text
+    # the pose read from the servos is no goal: nothing was sent
+    assert "elevation position 1934 ticks = 79.980 deg" in text and "goal" not in text
 
 
 def test_a_port_lost_mid_session_is_a_named_device_error() -> None:
