@@ -334,9 +334,10 @@ class Gphoto2Camera:
         s = self.settings
         gp = self._gp
         cam = self._cam
-        secs, label, err = nearest_shutter(exposure_s, self._shutters)
-        if err > s.shutter_tolerance:
-            raise CaptureError(self.name, self._not_offered(exposure_s, secs, label), "set shutter")
+        problem = self.exposure_problem(exposure_s)
+        if problem is not None:
+            raise CaptureError(self.name, problem, "set shutter")
+        secs, label, _ = nearest_shutter(exposure_s, self._shutters)
         if label != self._shutter_label:
             self._set_config_values({s.shutter_config: (label, "shutter_config")})
             self._shutter_label = label
@@ -345,6 +346,16 @@ class Gphoto2Camera:
         path = self._call("capture", lambda: cam.capture(gp.GP_CAPTURE_IMAGE))
         self._pending = (path, exposure_s, secs, label, t_capture)
         return self._clock.now()
+
+    def exposure_problem(self, exposure_s: float) -> str | None:
+        """Why ``exposure_s`` cannot be shot on this camera (None: it can), once connected.
+
+        For ``rti-rig check``: a session's exposure that the camera does not offer had passed
+        the check and failed the session's first capture, with its light already on."""
+        secs, label, err = nearest_shutter(exposure_s, self._shutters)
+        if err <= self.settings.shutter_tolerance:
+            return None
+        return self._not_offered(exposure_s, secs, label)
 
     def _not_offered(self, exposure_s: float, secs: float, label: str) -> str:
         """Why an exposure cannot be shot, with the offered speeds either side and the keys

@@ -84,12 +84,29 @@ def camera_line(rig, why_no_image: str = "") -> tuple[str, bool]:  # type: ignor
     first capture (gphoto2 not installed, no camera found)."""
     try:
         rig.camera.connect()
+        problem = _exposure_problem(rig)
     except RtiRigError as exc:
         return f"camera: FAILED to connect: {exc}", False
     finally:
         rig.camera.close()
     why = f": {why_no_image}" if why_no_image else ""
+    if problem is not None:
+        return (
+            f"camera: {rig.camera.name} connected (no image taken{why}), but FAILED: {problem}",
+            False,
+        )
     return f"camera: {rig.camera.name} connected (no image taken{why})", True
+
+
+def _exposure_problem(rig) -> str | None:  # type: ignore[no-untyped-def]
+    """Why the config's ``[camera] exposure_s`` cannot be shot on the connected camera, if its
+    driver can tell (a DSLR offers a fixed list of shutter speeds): such a session failed at
+    its first capture, its light already on, after a check that had passed."""
+    judge = getattr(rig.camera, "exposure_problem", None)
+    if not callable(judge):
+        return None
+    said = judge(float(rig.camera_config.exposure_s))
+    return None if said is None else str(said)
 
 
 @dataclass(frozen=True)

@@ -286,3 +286,24 @@ def test_dslr_busy_after_every_shot_is_retried_and_the_session_completes(body, t
     assert result.exit_code == 0, result.output
     check_images(out)
     assert body.shots == 4 and body.calls.count("capture") == 4 + 3
+
+
+#: A body in 1/3-stop steps around 1/10 s: it offers no 1/8 s (the shipped example's 0.125 s).
+NO_EIGHTH = ["bulb", "30", "1", "1/4", "1/10", "1/13", "1/15", "1/30", "1/60"]
+
+
+def test_check_fails_a_session_exposure_the_camera_does_not_offer(body, tmp_path):
+    """`rti-rig check` had passed the shipped DSLR config on a body without 1/8 s, and the
+    session then failed at its first capture, its LED lit, telling the user to "choose one of
+    available_exposures_s()"."""
+    body.choices["shutterspeed"] = NO_EIGHTH
+    result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
+    said = " ".join(result.output.split())
+    assert result.exit_code != 0 and "RESULT: FAIL" in said, result.output
+    assert "camera: dslr connected (no image taken), but FAILED" in said
+    assert "exposure 0.125 s is not a shutter speed this camera offers" in said
+    assert "0.1 s ('1/10') or 0.25 s ('1/4')" in said and "[camera] exposure_s" in said
+    assert body.shots == 0
+    body.choices["shutterspeed"] = [*NO_EIGHTH, "1/8"]
+    result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
+    assert result.exit_code == 0 and "RESULT: PASS" in result.output, result.output
