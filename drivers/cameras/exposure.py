@@ -175,18 +175,20 @@ def meter_exposure(
     retaken ``step_down`` times shorter; a predicted exposure that fails verification is
     shortened by ``backoff`` (or to the next shorter candidate) towards the preview's. At most
     ``rule.max_attempts`` shots are taken; if none verifies, the longest good shot is chosen.
+
+    With ``candidates_s``, a ``start_exposure_s`` the camera does not offer starts the series
+    at the offered exposure nearest it in stops, within the rule's range. It had raised a
+    ValueError: ``rti-rig run --auto-exposure`` on a DSLR without the config's exposure in its
+    shutter list (0.125 s on a body in 1/2-stop steps) stopped before its first test shot with
+    "unexpected ValueError … please report it", although metering exists to choose the
+    exposure from the camera's own list.
     """
     if step_down <= 1:
         raise ValueError("step_down must exceed 1")
     if not 0 < backoff < 1:
         raise ValueError("backoff must lie in (0, 1)")
-    if candidates_s is not None and not any(
-        np.isclose(start_exposure_s, c, rtol=1e-9) for c in candidates_s
-    ):
-        raise ValueError(
-            f"start exposure {start_exposure_s:g} s is not one of the camera's "
-            "exposures (candidates_s)"
-        )
+    if candidates_s is not None:
+        start_exposure_s = _nearest_offered(start_exposure_s, rule, candidates_s)
     series: list[Frame] = []
     frame = _shot(camera, start_exposure_s, series)
     while True:
@@ -251,6 +253,15 @@ def _shot(camera: Camera, exposure_s: float, series: list[Frame]) -> Frame:
         raise CaptureError(camera.name, "frame has no exposure time; cannot meter", "meter")
     series.append(frame)
     return frame
+
+
+def _nearest_offered(exposure_s: float, rule: ExposureRule, candidates_s: Sequence[float]) -> float:
+    """The candidate nearest ``exposure_s`` in stops, preferring those in the rule's range."""
+    offered = [float(c) for c in candidates_s if c > 0]
+    if not offered:
+        raise ValueError("candidates_s holds no exposure")
+    ranged = [c for c in offered if rule.min_exposure_s <= c <= rule.max_exposure_s] or offered
+    return min(ranged, key=lambda c: abs(np.log(c / exposure_s)))
 
 
 def _shorter(target: float, rule: ExposureRule, candidates_s: Sequence[float] | None) -> float:

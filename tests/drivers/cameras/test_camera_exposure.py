@@ -145,10 +145,22 @@ def test_meter_exposure_with_camera_shutter_list(tmp_path):
 def test_meter_exposure_validates_its_arguments():
     cam = RawRoundTripCamera("sim", lambda t: np.full((32, 32, 3), t))
     cam.connect()
-    with pytest.raises(ValueError, match="not one of the camera's exposures"):
-        meter_exposure(cam, ExposureRule(), 0.1, [1 / 60, 1 / 30])
     with pytest.raises(ValueError, match="backoff"):
         meter_exposure(cam, ExposureRule(), 0.1, backoff=1.5)
+
+
+def test_meter_exposure_starts_at_the_offered_exposure_nearest_the_asked_one():
+    """A start the camera does not offer (the config's 0.125 s on a body without 1/8 s) had
+    raised a ValueError, which `rti-rig run --auto-exposure` printed as "unexpected ValueError
+    ... please report it" before its first test shot."""
+    radiance = np.linspace(0.0, 10.0, 48 * 64 * 3).reshape(48, 64, 3)
+    cam = RawRoundTripCamera("sim", lambda t: radiance * t)
+    cam.connect()
+    shutters = [1 / 250, 1 / 125, 1 / 60, 1 / 30, 1 / 15, 1 / 10, 1 / 4]  # no 1/8
+    choice = meter_exposure(cam, ExposureRule(max_saturated_fraction=0.01), 0.125, shutters)
+    assert choice.test_exposures_s[0] == 1 / 10  # the nearest in stops
+    assert choice.satisfied and choice.exposure_s == 1 / 10  # the top 1% at 0.99 of full scale
+    assert all(t in shutters for t in choice.test_exposures_s)
 
 
 def test_meter_exposure_gives_up_when_even_the_shortest_shot_saturates():
