@@ -48,6 +48,15 @@ GP_ERROR_HINTS = {
 GONE_CODES = frozenset({-7, -10, -52, -105})
 
 
+#: Settings keys whose camera setting is named by another key (the camera's own name for it).
+NAME_KEYS = {
+    "iso": "iso_config",
+    "aperture": "aperture_config",
+    "image_format": "image_format_config",
+    "shutter_config": "shutter_config",
+}
+
+
 class CameraGoneError(CaptureError):
     """The camera stopped answering mid-session (switched off, unplugged, powered down).
 
@@ -235,14 +244,26 @@ class Gphoto2Camera:
 
     # -- configuration ---------------------------------------------------------------------
     def _widget(self, config: Any, name: str, key: str) -> Any:
+        """The camera's setting ``name``, asked for by the settings key ``key``.
+
+        A missing setting names the key that holds its *name* (``image_format_config`` for
+        ``image_format``): it had said "set 'image_format' to this camera's name for it",
+        sending the user to put a setting's name where its value goes."""
         gp = self._gp
         try:
             return config.get_child_by_name(name)
         except gp.GPhoto2Error as exc:
+            name_key = NAME_KEYS.get(key)
+            fix = (
+                f'set {name_key} = "..." in [camera.device] to this camera\'s name for it'
+                if name_key is not None
+                else f"this camera cannot take {key}"
+            )
             raise DeviceError(
                 self.name,
-                f"camera has no setting '{name}': set '{key}' to this camera's name for it "
-                "(list them with `gphoto2 --list-config`)",
+                f"camera has no setting '{name}' (asked for by {key}): {fix}; `gphoto2 "
+                "--list-config` lists the names it has (Nikon bodies name the aperture "
+                "'f-number')",
                 f"get {name}",
             ) from exc
 

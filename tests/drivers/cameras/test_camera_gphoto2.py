@@ -220,6 +220,26 @@ def test_unknown_config_name_points_to_list_config(tmp_path):
 
 
 @pytest.mark.parametrize(
+    ("setting", "key", "name_key"),
+    [
+        ("imageformat", "image_format", "image_format_config"),
+        ("aperture", "aperture", "aperture_config"),
+        ("iso", "iso", "iso_config"),
+    ],
+)
+def test_a_missing_setting_names_the_key_that_holds_its_name(tmp_path, setting, key, name_key):
+    """A body whose setting has another name (a Nikon's): the error had said "set
+    'image_format' to this camera's name for it", the key of the value, not of the name."""
+    body = dslr()
+    del body.config[setting]
+    with pytest.raises(DeviceError) as info:
+        camera(body, tmp_path, iso="100", aperture="8").connect()
+    said = str(info.value)
+    assert f"camera has no setting '{setting}' (asked for by {key})" in said
+    assert f"set {name_key} = " in said and f"set '{key}' to" not in said
+
+
+@pytest.mark.parametrize(
     ("label", "secs"),
     [
         ("1/125", 1 / 125),
