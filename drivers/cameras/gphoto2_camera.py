@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import math
 import re
+import shutil
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -226,10 +227,19 @@ class Gphoto2Camera:
             raise
 
     def close(self) -> None:
-        """End the camera session. Safe twice and after a failed connect."""
+        """End the camera session and remove the private staging folder. Safe twice and after
+        a failed connect.
+
+        The private folder holds only shots taken with no session bound (the metering series
+        of ``run --auto-exposure`` or ``preview``, decoded already): it had been left in the
+        system's temporary directory, a 20-30 MB RAW per test shot for ever, after every
+        metered session."""
         cam, self._cam = self._cam, None
         self._shutter_label = None
         self._pending = None
+        staging, self._staging_tmp = self._staging_tmp, None
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
         if cam is not None:
             # the camera may already be gone; there is nothing else to release
             with contextlib.suppress(Exception):

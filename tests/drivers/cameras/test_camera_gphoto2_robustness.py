@@ -7,6 +7,7 @@ wraps or repeats names, RAM vs card capture targets, RAW+JPEG delivered as two f
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -176,6 +177,9 @@ def test_metering_shots_before_the_session_exists_go_to_a_private_folder(tmp_pat
         f = cam.capture(1 / 60)
     staged = f.metadata["originals"][0]["path"]
     assert "rti-rig-dslr-" in staged and tmp_path.as_posix() not in staged
+    # ... and go with the camera's close: a metered session had left each test shot's RAW in
+    # the temporary directory for ever
+    assert not Path(staged).parent.exists()
 
 
 def test_mosaic_sessions_are_labelled_in_tiff_journal_and_manifest(tmp_path):
