@@ -125,6 +125,9 @@ class FolderWatchCamera:
         self._reused_names: set[str] = set()
         #: stems of the files taken: a later file with one is the same shot's other file
         self._taken_stems: set[str] = set()
+        #: every file name in the folder at connect (a timeout names the new ones that no
+        #: pattern matches)
+        self._at_connect: set[str] = set()
         self._pending: _Pending | None = None
 
     def connect(self) -> None:
@@ -137,6 +140,7 @@ class FolderWatchCamera:
                 "connect",
             )
         present = self._matching()
+        self._at_connect = set(self._visible_names())
         self._seen = {p.name for p in present}
         self._seen_ids = {i for i in map(_identity, present) if i is not None}
         self._seen_inodes = {i[:2] for i in self._seen_ids}
@@ -165,6 +169,42 @@ class FolderWatchCamera:
                 if p.is_file():
                     found[p.name] = p
         return list(found.values())
+
+    def _visible_names(self) -> list[str]:
+        """Names of the files in the folder, hidden temporaries left out."""
+        try:
+            return [
+                p.name
+                for p in self.settings.folder.iterdir()
+                if not p.name.startswith(".") and p.is_file()
+            ]
+        except OSError:
+            return []
+
+    def _unmatched_said(self) -> str:
+        """The files that came since connect but match no pattern, said with the fix.
+
+        Why: a camera saving ``_DSC0001.ARW`` into a folder watched for ``*.CR2`` (the guide's
+        example) timed out with "is the camera firing and saving there?" while it was doing
+        just that; the patterns are case-sensitive too (``*.cr2`` does not match
+        ``IMG_0001.CR2``)."""
+        patterns = self.settings.patterns
+        names = sorted(
+            n
+            for n in self._visible_names()
+            if n not in self._at_connect and not any(Path(n).match(p) for p in patterns)
+        )
+        if not names:
+            return ""
+        shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+        suffixes = sorted({f"*{Path(n).suffix}" for n in names if Path(n).suffix})
+        add = f" (e.g. {', '.join(repr(x) for x in suffixes)})" if suffixes else ""
+        return (
+            f"; {shown} came into the folder but no pattern matches "
+            f"{'them' if len(names) > 1 else 'it'} (patterns are case-sensitive): add "
+            f"{'their' if len(names) > 1 else 'its'} pattern{add} to patterns in "
+            "[camera.device]"
+        )
 
     def _mark_seen(self, name: str, ident: tuple[int, int, int, int] | None) -> None:
         """``name`` (and the file it is, if it still exists) is used: never taken again."""
@@ -230,11 +270,12 @@ class FolderWatchCamera:
                         "(an earlier shot had it): have the tethering program give every shot "
                         "its own file name"
                     )
+                unmatched = self._unmatched_said()
+                ask = "" if unmatched else ": is the camera firing and saving there?"
                 raise CaptureError(
                     self.name,
                     f"no new file matching {list(s.patterns)} in {s.folder} within "
-                    f"{s.timeout_s:g} s{growing}{reused}: is the camera firing and saving "
-                    "there?",
+                    f"{s.timeout_s:g} s{growing}{reused}{unmatched}{ask}",
                     "wait for file",
                 )
             self._clock.sleep(s.poll_interval_s)

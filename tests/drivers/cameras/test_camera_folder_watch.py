@@ -41,6 +41,29 @@ def test_timeout_without_real_waiting(tmp_path):
     assert clock.now() == pytest.approx(10.0)
 
 
+def test_a_timeout_names_the_new_files_no_pattern_matches(tmp_path):
+    """A camera saving ``_DSC0001.ARW`` into a folder watched for ``*.CR2`` (the guide's
+    example), or ``IMG_0001.CR2`` for ``*.cr2``: the timeout had asked "is the camera firing
+    and saving there?" while it was doing just that."""
+    (tmp_path / "notes.txt").write_text("here before the session")
+    clock = ScriptedClock({0.5: lambda: dng(tmp_path / "_DSC0001.ARW")})
+    cam = watch(tmp_path, clock, patterns=("*.CR2", "*.cr2"), timeout_s=2.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "_DSC0001.ARW came into the folder but no pattern matches it" in said
+    assert "'*.ARW'" in said and "patterns in [camera.device]" in said
+    assert "notes.txt" not in said and "is the camera firing" not in said
+    # nothing came at all: the question stands
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    cam = watch(empty, VirtualClock(), patterns=("*.CR2",), timeout_s=1.0)
+    cam.connect()
+    with pytest.raises(CaptureError, match="is the camera firing and saving there"):
+        cam.capture(0.5)
+
+
 def test_timeout_on_the_system_clock_is_bounded(tmp_path):
     cam = watch(tmp_path, SystemClock(), timeout_s=0.2, poll_interval_s=0.02)
     cam.connect()
