@@ -127,7 +127,8 @@ class Body:
         return [(self.model, self.port)] if self.detected is None else list(self.detected)
 
     def store(self) -> dict[str, bytes]:
-        return self.ram if self.config["capturetarget"] == "Internal RAM" else self.card
+        # a body without the setting (not every make has it in libgphoto2) shoots to its card
+        return self.ram if self.config.get("capturetarget") == "Internal RAM" else self.card
 
 
 class _Widget:

@@ -264,11 +264,13 @@ class Gphoto2Camera:
             return config.get_child_by_name(name)
         except gp.GPhoto2Error as exc:
             name_key = NAME_KEYS.get(key)
-            fix = (
-                f'set {name_key} = "..." in [camera.device] to this camera\'s name for it'
-                if name_key is not None
-                else f"this camera cannot take {key}"
-            )
+            leave = f'{key} = "" to leave it as the camera has it'
+            if name_key is None:  # capture_target: no other name to give it
+                fix = f"in [camera.device] set {leave}"
+            else:
+                fix = f'in [camera.device] set {name_key} = "..." to this camera\'s name for it'
+                if key != name_key:
+                    fix += f", or {leave}"
             raise DeviceError(
                 self.name,
                 f"camera has no setting '{name}' (asked for by {key}): {fix}; `gphoto2 "

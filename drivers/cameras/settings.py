@@ -196,6 +196,16 @@ class Gphoto2CameraSettings(_Strict):
     )
     decode: RawDecodeSettings = RawDecodeSettings()
 
+    @field_validator("iso", "aperture", "image_format", "capture_target", mode="before")
+    @classmethod
+    def _empty_is_leave(cls, v: object) -> object:
+        """``""`` leaves the camera's own setting alone (what ``None`` means here).
+
+        TOML has no null, so a rig config could not say "leave it": a body without a
+        'capturetarget' setting (one libgphoto2 offers only on some makes) could not be used
+        at all, the default "Internal RAM" being asked of it at every connect."""
+        return None if v == "" else v
+
 
 class FolderWatchSettings(_Strict):
     """A camera fired by someone else (the dome's shutter line, a vendor program).

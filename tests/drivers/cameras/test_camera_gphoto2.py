@@ -280,3 +280,18 @@ def test_expose_returns_once_the_shot_is_taken_and_collect_downloads_it(tmp_path
         assert body.calls.count("file_get") == 1 and f.exposure_s == pytest.approx(1 / 125)
         with pytest.raises(CaptureError, match=r"collect\(\) without expose"):
             cam.collect()  # one frame per exposure
+
+
+def test_a_body_without_capturetarget_can_be_left_alone_with_an_empty_value(tmp_path):
+    """libgphoto2 offers 'capturetarget' on some makes only. The default "Internal RAM" was
+    asked of such a body at every connect, and TOML has no null to say "leave it": the body
+    could not be used at all. capture_target = "" now leaves the camera's own setting."""
+    body = dslr()
+    del body.config["capturetarget"]
+    with pytest.raises(DeviceError) as info:
+        camera(body, tmp_path).connect()
+    assert 'in [camera.device] set capture_target = "" to leave it' in str(info.value)
+    assert Gphoto2CameraSettings(capture_target="", iso="").capture_target is None
+    with camera(body, tmp_path, capture_target="") as cam:
+        frame = cam.capture(1 / 60)
+    assert frame.metadata["camera_files"] == ["/store_00020001/DCIM/100CANON/IMG_0001.DNG"]
