@@ -310,13 +310,25 @@ class QAReport:
                 else "good"
             )
             return head + tail
+        # A move part-way through is one fault of every image from it on: said once, as a
+        # range, whatever else some of those images have. Each image's other problems are
+        # said on their own (a saturated image in the range had been given the move's whole
+        # advice again, and a run of 48 cut into pieces around it).
+        carriers: dict[str, list[ImageCheck]] = {}
+        for c in self.reshoot:
+            for p in c.problems:
+                if p.startswith(MOVED_FROM):
+                    carriers.setdefault(p, []).append(c)
+        ranged = {p: run for p, run in carriers.items() if len(run) >= 3}
         parts = []
-        for run in _runs(self.reshoot):
-            why = "; ".join(run[0].problems)
-            if len(run) < 3 or MOVED_FROM not in why:
-                parts.extend(f"{c.name} ({why})" for c in run)
-            else:  # a move from one image on: said once, not 24 times
-                parts.append(f"{run[0].name} ... {run[-1].name} ({len(run)} images: {why})")
+        for c in self.reshoot:
+            for p in c.problems:
+                if p in ranged and ranged[p][0] is c:
+                    run = ranged[p]
+                    parts.append(f"{run[0].name} ... {run[-1].name} ({len(run)} images: {p})")
+            rest = [p for p in c.problems if p not in ranged]
+            if rest:
+                parts.append(f"{c.name} ({'; '.join(rest)})")
         light = f"; {self.light_note}" if self.light_note else ""
         return f"{self.verdict_word}: " + ", ".join(parts) + light + tail
 
@@ -369,17 +381,6 @@ class QAReport:
             "thresholds": self.thresholds,
             "images": [asdict(c) for c in self.images],
         }
-
-
-def _runs(checks: list[ImageCheck]) -> list[list[ImageCheck]]:
-    """``checks`` in runs of consecutive images with the same problems."""
-    runs: list[list[ImageCheck]] = []
-    for c in checks:
-        if runs and runs[-1][-1].index == c.index - 1 and runs[-1][-1].problems == c.problems:
-            runs[-1].append(c)
-        else:
-            runs.append([c])
-    return runs
 
 
 def _bright(gain: float, saturated_fraction: float) -> bool:
