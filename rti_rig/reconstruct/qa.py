@@ -624,9 +624,86 @@ def _confirmed_step(
             return None
         as_is = _step_residual(crop_arr, fit_as_is, lt, step.first, pad)
         undone = _step_residual(moved, fit_undone, lt, step.first, pad)
-        if undone <= DRIFT_CONFIRM * as_is or min(as_is, undone) > STEP_FIT_NO_EVIDENCE:
+        if undone <= DRIFT_CONFIRM * as_is:
+            return _placed_by_fit(crop_arr, lt, step, moved, fit_undone, saturation)
+        if min(as_is, undone) > STEP_FIT_NO_EVIDENCE:
             return step, moved, fit_undone
     return None
+
+
+#: How many images :func:`_placed_by_fit` may move a confirmed step's first image by.
+STEP_PLACEMENT_MAX = 3
+
+
+def _placed_by_fit(
+    crop_arr: NDArray,
+    lt: NDArray,
+    step: Step,
+    moved: NDArray,
+    fit_undone: Any,
+    saturation: float | None,
+) -> tuple[Step, NDArray, Any]:
+    """A step the fit confirmed, its first image placed by the fit: the images at its border
+    judged one by one against the fit of the step undone (:func:`_fit_side`), the step's first
+    image moved while the image there says the other position (at most
+    :data:`STEP_PLACEMENT_MAX` images), and the images moved back and refitted if it moved.
+
+    Why: the edges place the step by whether each image's edge image agrees better with the
+    images before it as it is or moved back, and an image whose light shows few edges answers
+    that by a hair. On the virtual arm's 256 px industrial part moved (1, 2) px from image 25
+    of 48, image 24 (its edges 0.45 as it is, 0.50 moved back) put the move at image 24: the
+    verdict named an image that never moved. Against the fit the same image reads 2.5 times
+    closer as it is (image 25: 3.3 times closer moved back)."""
+    n = len(crop_arr)
+
+    def side(i: int) -> int:
+        return _fit_side(crop_arr[i], fit_undone, lt[i], step.shift, saturation)
+
+    first = step.first
+    for _ in range(STEP_PLACEMENT_MAX):
+        if first < n - 1 and side(first) < 0:
+            first += 1
+        elif first > 1 and side(first - 1) > 0:
+            first -= 1
+        else:
+            break
+    if first == step.first:
+        return step, moved, fit_undone
+    placed = Step(first, step.shift)
+    moved_again = crop_arr.copy()
+    for i in range(first, n):
+        moved_again[i] = move_back(moved_again[i], *step.shift)
+    try:
+        refit = fit_photometric_stereo(moved_again, lt, robust=True, saturation=saturation)
+    except ReconstructionError:  # the edges' placement stands
+        return step, moved, fit_undone
+    return placed, moved_again, refit
+
+
+def _fit_side(
+    img: NDArray, ps: Any, light: NDArray, shift: tuple[float, float], saturation: float | None
+) -> int:
+    """Which position of a step ``img`` is at, by the fit ``ps`` of the step undone: 1 moved
+    (moved back by ``shift`` it is closer to its prediction by :data:`DRIFT_CONFIRM`), -1
+    where the session began (as it is, closer by as much), 0 undecided (or too few pixels
+    lit). Median absolute residual over the lit, unclipped pixels away from the border."""
+    rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
+    pred = rho * np.maximum(ps.normals @ np.asarray(light, dtype=np.float32), 0.0)
+    mask = ps.valid & (pred > 0.02 * float(pred.max()))
+    if saturation is not None:
+        mask &= img < saturation
+    pad = int(np.ceil(max(abs(v) for v in shift))) + 1
+    mask[:pad], mask[-pad:], mask[:, :pad], mask[:, -pad:] = False, False, False, False
+    if mask.sum() < 10:
+        return 0
+    back = move_back(img, *shift)
+    as_is = float(np.median(np.abs(img[mask] - pred[mask])))
+    moved_back = float(np.median(np.abs(back[mask] - pred[mask])))
+    if moved_back <= DRIFT_CONFIRM * as_is:
+        return 1
+    if as_is <= DRIFT_CONFIRM * moved_back:
+        return -1
+    return 0
 
 
 def _step_residual(stack: NDArray, ps: Any, lt: NDArray, first: int, pad: int) -> float:
