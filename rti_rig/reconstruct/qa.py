@@ -528,8 +528,9 @@ def _best_direction(
     the cost on a 384 px crop."""
     if reach is None:
         reach = 0.05 * np.linalg.norm(b, axis=-1)
-    # only the usable pixels can be lit: select them once (the same rows, in the same order)
-    bu, iu, ru = b[use], img[use], reach[use]
+    # only the usable pixels can be lit: select them once (np.compress: the rows b[use] gives,
+    # in the same order, at a third of the cost)
+    bu, iu, ru = np.compress(use, b, axis=0), img[use], reach[use]
     d = np.asarray(start, dtype=np.float64)
     sol = d * 0.0
     lit_u = np.zeros(len(bu), bool)
@@ -537,7 +538,7 @@ def _best_direction(
         lit_u = (bu @ d) > ru
         if lit_u.sum() < 10:
             break
-        sol = _least_squares3(bu[lit_u], iu[lit_u])
+        sol = _least_squares3(np.compress(lit_u, bu, axis=0), iu[lit_u])
         norm = np.linalg.norm(sol)
         if norm <= 0:
             break

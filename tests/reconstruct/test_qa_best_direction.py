@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from rti_rig.reconstruct.qa import _best_direction
+from rti_rig.reconstruct.qa_directions import relative_misfit
 
 
 def _by_definition(img, b, use, start):  # type: ignore[no-untyped-def]
@@ -68,3 +69,15 @@ def test_too_few_usable_pixels_give_no_direction_as_before() -> None:
     want_sol, want_lit = _by_definition(b @ light, b, use, light)
     np.testing.assert_array_equal(lit, want_lit)
     np.testing.assert_array_equal(sol, want_sol)
+
+
+def test_the_misfit_is_the_one_it_replaced() -> None:
+    """relative_misfit selects its rows with np.compress (a third of the cost of b[lit])."""
+    rng = np.random.default_rng(9)
+    b = _normals(rng, 5000, 30.0) * (0.3 + rng.random(5000))[:, None]
+    s = np.array([0.2, 0.1, 0.8])
+    img = b @ s + rng.normal(0.0, 0.02, 5000)
+    lit = rng.random(5000) > 0.3
+    pred = b[lit] @ s
+    want = float(np.median(np.abs(img[lit] - pred)) / np.median(np.abs(pred)))
+    assert relative_misfit(b, img, s, lit) == want
