@@ -93,19 +93,26 @@ def consensus_images(
         gram = b @ b.T
         if np.linalg.cond(gram) > 1e6:
             continue
-        sol = np.linalg.solve(gram, b @ sample[idx][:, lit].T).T  # best vector per image
+        obs = sample[idx][:, lit]
+        sol = np.linalg.solve(gram, b @ obs.T).T  # best vector per image
         unit = sol / np.maximum(np.linalg.norm(sol, axis=1, keepdims=True), 1e-12)
         cos = np.sum(unit * lights[idx], axis=1)
+        near = cos >= np.cos(np.radians(agree_deg))
+        if near.sum() <= best_count:
+            continue  # at most these agree: no larger set can come of this draw
         # and explained as well as the drawn images are: an image of the object elsewhere
-        # (moved) is not, whatever its light
-        pred = sol @ b
-        obs = sample[idx][:, lit]
-        misfit = np.median(np.abs(obs - pred), axis=1) / np.maximum(
+        # (moved) is not, whatever its light. Measured only on the images the verdict reads
+        # (those near their light, and the drawn ones for the scale): each image's misfit is
+        # its own row's medians, the same whichever other rows are measured
+        drawn = np.isin(idx, pick)
+        rows = near | drawn
+        pred = sol[rows] @ b
+        misfit = np.full(len(idx), np.inf)
+        misfit[rows] = np.median(np.abs(obs[rows] - pred), axis=1) / np.maximum(
             np.median(np.abs(pred), axis=1), 1e-12
         )
-        drawn = np.isin(idx, pick)
         ok_fit = misfit <= 2.0 * float(np.median(misfit[drawn])) + 0.01
-        agree = (cos >= np.cos(np.radians(agree_deg))) & ok_fit
+        agree = near & ok_fit
         if agree.sum() > best_count:
             best_count = int(agree.sum())
             best = np.zeros(n, bool)
