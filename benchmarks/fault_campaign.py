@@ -198,8 +198,9 @@ def run_in_process(
         run_opened_session(opened, cancel, on_event)
 
 
-def run_killed_resume(out: Path, at_light: int) -> tuple[int, bytes]:
-    """``rti-rig run --resume OUT`` in a child process, SIGKILLed before light ``at_light``."""
+def run_killed_resume(out: Path, at_light: int, *flags: str) -> tuple[int, bytes]:
+    """``rti-rig run --resume OUT`` (with ``flags``) in a child process, SIGKILLed before light
+    ``at_light``."""
     import os
     import subprocess
     import sys
@@ -207,7 +208,7 @@ def run_killed_resume(out: Path, at_light: int) -> tuple[int, bytes]:
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     argv = [sys.executable, "-m", "rti_rig.testing.kill_hooks", "before_light", str(at_light)]
     proc = subprocess.run(
-        [*argv, "run", "--resume", str(out)], env=env, capture_output=True, timeout=300
+        [*argv, "run", "--resume", str(out), *flags], env=env, capture_output=True, timeout=300
     )
     return proc.returncode, proc.stderr
 
@@ -283,7 +284,9 @@ def session_fault(
             if journal.exists() and journal.stat().st_size:
                 data = journal.read_bytes()
                 journal.write_bytes(data[: -int(rng.integers(1, min(60, len(data)) + 1))])
-            code, stderr = run_killed_resume(out, int(rng.integers(0, 3)))
+            # a cut into a committed line (the manifest lists its step) is damage, not a kill's
+            # torn append: refused without the flag, rebuilt from the manifest with it
+            code, stderr = run_killed_resume(out, int(rng.integers(0, 3)), "--rebuild-journal")
             faults["torn-journal-cut"] += 1
             faults["resume-killed"] += int(code == -9)
             if b"Traceback" in stderr:
@@ -495,8 +498,8 @@ further in-process fault.
   other kind of rig, half the image width, or another exposure); the resume must be refused
   without touching the folder, and the session's own rig then finishes it.
 - `torn-journal-killed-resumes`: the session is stopped, then 1–3 times in a row the journal's
-  tail is cut by 1–60 bytes and `rti-rig run --resume` is SIGKILLed before one of its first
-  lights (`torn-journal-cut`, `resume-killed` count each link of the chain).
+  tail is cut by 1–60 bytes and `rti-rig run --resume --rebuild-journal` is SIGKILLed before one
+  of its first lights (`torn-journal-cut`, `resume-killed` count each link of the chain).
 - `junk-journal-line`: a line that is not a record (`42`, `[]`, `null`, a record without its
   checksum, half a record…) is inserted anywhere in the journal of a stopped session.
 - `disk-full-*`: the n-th write to one kind of session file fails as a full disk (`ENOSPC`), a

@@ -114,6 +114,16 @@ def run(
             "deleted.",
         ),
     ] = False,
+    rebuild_journal: Annotated[
+        bool,
+        typer.Option(
+            "--rebuild-journal",
+            help="With --resume on a session whose journal.jsonl is lost or damaged: rebuild it "
+            "from manifest.json, taking back only the images whose files match the manifest's "
+            "checksums and whose light is the manifest's; the old journal and every other image "
+            "file are set aside in recovered/, never deleted.",
+        ),
+    ] = False,
     adaptive: Annotated[
         bool,
         typer.Option(
@@ -205,6 +215,7 @@ def run(
                             accept_rig_change=accept_rig_change,
                             objective=objective,
                             reshoot_lost=reshoot_lost,
+                            rebuild_journal=rebuild_journal,
                         ),
                         print_note,
                     )
@@ -217,6 +228,8 @@ def run(
                         raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
                     if reshoot_lost:
                         raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
+                    if rebuild_journal:
+                        raise RtiRigError("--rebuild-journal goes with --resume SESSION_DIR only")
                     refuse_unmetered_limit(
                         max_saturated, auto_exposure, adaptive or until_error is not None
                     )

@@ -13,6 +13,8 @@ Layout (opens directly in relight-cli's folder mode, which takes the first ``*.l
       journal.jsonl          one line per completed step, flushed to disk as it happens
       manifest.json          rig config, schedule, per-step timings, versions, finish reason
       recovered/STAMP/...    what a resume set aside: unverified images, rejected journal lines
+                             (``--rebuild-journal``: the damaged journal, and the images the
+                             manifest does not vouch for under ``unproven/``, ``not-in-manifest/``)
 
 Nothing already captured is ever overwritten: a folder holding images is refused, and image
 writes refuse existing files. Nothing is created on disk until :meth:`SessionFolder.begin`
@@ -416,15 +418,17 @@ class SessionFolder:
         root: Path,
         check_done: Callable[[dict[int, StepRecord]], None] | None = None,
         reshoot_lost: bool = False,
+        rebuild_journal: bool = False,
     ) -> SessionFolder:
         """Open an interrupted session to capture the steps it has not done yet.
 
         What is on disk is verified against the journal's checksums first, and the journal is
         repaired; see :func:`prepare_resume` (``check_done`` may refuse the verified steps
         before anything in the folder changes; ``reshoot_lost`` reopens a completed session to
-        reshoot what was lost since capture).
+        reshoot what was lost since capture; ``rebuild_journal`` rebuilds a journal that lost
+        records from the manifest's).
         """
-        state = prepare_resume(Path(root), check_done, reshoot_lost)
+        state = prepare_resume(Path(root), check_done, reshoot_lost, rebuild_journal)
         folder = cls(Path(root), planned_steps(state.manifest))
         folder.manifest = state.manifest
         folder.resume = state
@@ -506,6 +510,8 @@ class SessionFolder:
             run["recovered_files"] = self.resume.recovered
             if self.resume.journal_repair:
                 run["journal_repair"] = self.resume.journal_repair
+            if self.resume.journal_rebuild:
+                run["journal_rebuild"] = self.resume.journal_rebuild
             if self.rig_change:
                 run["rig_change"] = self.rig_change
             if self.rig_identity is not None:
@@ -766,6 +772,9 @@ class ResumeState:
     recovered: list[str]
     #: what was done to the journal before appending to it (torn tail, rejected lines)
     journal_repair: list[str] = field(default_factory=list)
+    #: what ``--rebuild-journal`` did: the journal rebuilt from the manifest, what it took back,
+    #: where the old journal and every file the manifest does not vouch for were set aside
+    journal_rebuild: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -1070,6 +1079,7 @@ def prepare_resume(
     root: Path,
     check_done: Callable[[dict[int, StepRecord]], None] | None = None,
     reshoot_lost: bool = False,
+    rebuild_journal: bool = False,
 ) -> ResumeState:
     """:func:`_prepare_resume` with the folder locked (:func:`lock_session`) before anything in
     it is read or moved: held for the resumed run, released if the resume is refused."""
@@ -1078,7 +1088,7 @@ def prepare_resume(
     if root.is_dir():
         lock_session(root)
     try:
-        return _prepare_resume(root, check_done, reshoot_lost)
+        return _prepare_resume(root, check_done, reshoot_lost, rebuild_journal)
     except BaseException:
         if not held:
             unlock_session(root)
@@ -1089,6 +1099,7 @@ def _prepare_resume(
     root: Path,
     check_done: Callable[[dict[int, StepRecord]], None] | None = None,
     reshoot_lost: bool = False,
+    rebuild_journal: bool = False,
 ) -> ResumeState:
     """Verify an interrupted session, repair its journal and set aside what is not committed.
 
@@ -1107,6 +1118,10 @@ def _prepare_resume(
     cut short between the TIFF and the JPEG, a checksum mismatch) are *moved* to
     ``recovered/``, never deleted; half-written temporary files are removed (they never were
     an image).
+
+    A journal that lost records the manifest holds (deleted, cut short, overwritten) is
+    refused, naming ``rebuild_journal``; with it the journal is rebuilt from what the files
+    prove (:func:`_provable_steps`, :func:`_rebuild_journal`).
     """
     root = Path(root)
     manifest = read_manifest(root)
@@ -1116,6 +1131,17 @@ def _prepare_resume(
     runner = manifest.get("runner") or {}
     names = image_names(total)
     scan = scan_journal(root, names)
+    if rebuild_journal and (reshoot_lost or runner.get("finish_reason") == "completed"):
+        raise SessionError(
+            f"{root}: --rebuild-journal is for a session that did not finish; this one "
+            + (
+                "completed (its QA verdict, rti-rig fit, names what cannot be checked)"
+                if runner.get("finish_reason") == "completed"
+                else "is reshot with --reshoot-lost, which needs its journal as it is"
+            )
+            + ": drop --rebuild-journal"
+        )
+    rebuilt: dict[int, dict[str, Any]] | None = None  # the manifest's records taken back
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
         latest = _latest_records(scan.records)
@@ -1162,8 +1188,15 @@ def _prepare_resume(
                 f"{root}: --reshoot-lost is for a session that completed; this one did not, and "
                 "its resume reshoots whatever it cannot verify anyway: drop --reshoot-lost"
             )
-        _refuse_lost_journal(root, names)
-        done = verified_steps(root, scan.records)
+        unjournaled = _unjournaled_steps(root, manifest, scan, names)
+        if rebuild_journal and unjournaled:
+            rebuilt = _provable_steps(root, manifest, names)
+            done = {i: _to_record(e) for i, e in rebuilt.items()}
+        else:
+            if unjournaled:
+                _refuse_unjournaled(root, scan, names, unjournaled)
+            _refuse_lost_journal(root, names)
+            done = verified_steps(root, scan.records)
     stamp = _new_stamp(root)
     if check_done is not None:
         check_done(done)
@@ -1171,9 +1204,18 @@ def _prepare_resume(
     # Ctrl-C or SIGTERM among them (acted on once they are done) had left lights.lp listing
     # an image already moved to recovered/, which relight then paired with another light
     with signals_deferred():
-        repair = _repair_journal(root, scan, stamp) if scan.needs_repair else []
-        keep = {name for rec in done.values() for name in rec.sha256}
         recovered: list[str] = []
+        rebuild: list[str] = []
+        if rebuilt is not None:
+            rebuild, moved_aside = _rebuild_journal(root, manifest, rebuilt, names, stamp)
+            recovered.extend(moved_aside)
+        elif rebuild_journal:
+            rebuild = [
+                f"{JOURNAL} already holds a record of every image {MANIFEST} lists as captured: "
+                "nothing rebuilt (the resume goes on as without --rebuild-journal)"
+            ]
+        repair = _repair_journal(root, scan, stamp) if scan.needs_repair and not rebuilt else []
+        keep = {name for rec in done.values() for name in rec.sha256}
         leftovers = [
             *root.glob("image_*"),
             *(root / LINEAR_DIR).glob("image_*"),
@@ -1201,7 +1243,194 @@ def _prepare_resume(
         moved_lp = _relist_verified(root, done, stamp)
         if moved_lp is not None:
             recovered.append(moved_lp)
-    return ResumeState(manifest=manifest, done=done, recovered=recovered, journal_repair=repair)
+    return ResumeState(
+        manifest=manifest,
+        done=done,
+        recovered=recovered,
+        journal_repair=repair,
+        journal_rebuild=rebuild,
+    )
+
+
+def _manifest_records(manifest: dict[str, Any], names: list[str]) -> dict[int, dict[str, Any]]:
+    """The step records the manifest holds (written when a run of the session ended, also by
+    Ctrl-C, SIGTERM or an error: each with the checksums its journal line held), well-formed
+    ones only, by step."""
+    steps = manifest.get("steps")
+    if not isinstance(steps, list):
+        return {}
+    return {e["index"]: e for e in steps if _record_problem(e, names) is None}
+
+
+def _unjournaled_steps(
+    root: Path, manifest: dict[str, Any], scan: JournalScan, names: list[str]
+) -> list[int]:
+    """The steps the manifest records as captured, whose files are on disk as its checksums
+    say, and of which the journal holds no record: what a journal deleted, cut short or
+    overwritten has lost (a journal line torn by a kill is never that: the step it was
+    committing is in no manifest, which only a run's end writes)."""
+    journaled = {r["index"] for r in scan.records}
+    return sorted(
+        i
+        for i, entry in _manifest_records(manifest, names).items()
+        if i not in journaled and verified_steps(root, [entry])
+    )
+
+
+def rebuildable_journal(root: Path) -> bool:
+    """Whether ``run --resume ROOT --rebuild-journal`` would take back images of session
+    ``root``: it did not finish, and its journal lost records its manifest holds of images
+    still on disk as captured (False for a folder that is no session)."""
+    root = Path(root)
+    try:
+        manifest = read_manifest(root)
+    except SessionError:
+        return False
+    total = planned_steps(manifest)
+    if not total or (manifest.get("runner") or {}).get("finish_reason") == "completed":
+        return False
+    names = image_names(total)
+    try:
+        scan = scan_journal(root, names)
+    except SessionError:
+        return False
+    return bool(_unjournaled_steps(root, manifest, scan, names))
+
+
+def _refuse_unjournaled(
+    root: Path, scan: JournalScan, names: list[str], unjournaled: list[int]
+) -> None:
+    """Refuse a resume that would set aside and reshoot images the manifest proves were
+    captured, because the journal lost their records; nothing in the folder changes.
+
+    Why: a journal cut short was read as a line torn by a kill ("never committed") and one
+    overwritten as junk, and the resume moved every image they had lost to ``recovered/`` and
+    shot them again, though ``manifest.json`` held each one's checksums and light; a missing
+    journal was refused with no way on but a backup."""
+    if not (root / JOURNAL).exists():
+        what = f"{JOURNAL} is missing"
+    else:
+        parts = []
+        if scan.rejected:
+            parts.append(f"{len(scan.rejected)} unreadable line(s)")
+        if scan.torn.strip():
+            parts.append("its last line cut short")
+        what = f"{JOURNAL} is damaged ({', '.join(parts) or 'records missing'})"
+    shown = ", ".join(names[i] for i in unjournaled[:8]) + (" …" if len(unjournaled) > 8 else "")
+    folder = shlex.quote(str(root))
+    raise SessionError(
+        f"{root}: {what}: it holds no record of {len(unjournaled)} image(s) that {MANIFEST} "
+        f"lists as captured, with files on disk as its checksums say ({shown}); a resume "
+        "would set them aside and shoot them again (nothing in this folder was changed): "
+        f"restore {JOURNAL} from a backup copy of the folder and resume again, or rebuild it "
+        f"from the manifest: rti-rig run --resume {folder} --rebuild-journal (it takes back "
+        "only the images whose files match the manifest's checksums and light, and sets the "
+        "old journal and anything else aside in recovered/, never deleted)"
+    )
+
+
+def _light_as_recorded(manifest: dict[str, Any], entry: dict[str, Any]) -> bool:
+    """Whether the light of the manifest's record ``entry`` is the one the manifest's schedule
+    gives its step (the same LED, the same planned direction): a record moved to another step
+    or edited by hand is not taken back. An adaptive session's steps have no scheduled light
+    (each was chosen from the images before it): the resume decides each again and refuses
+    one decided otherwise (:meth:`~rti_rig.app.usecases.adaptive.AdaptiveSteps.replay`); its
+    record must hold that decision."""
+    if manifest.get("adaptive"):
+        return isinstance(entry.get("decision"), dict)
+    steps = (manifest.get("schedule") or {}).get("steps")
+    i = entry["index"]
+    if not isinstance(steps, list) or not 0 <= i < len(steps) or not isinstance(steps[i], dict):
+        return False
+    step = steps[i]
+    if step.get("led") != entry.get("led"):
+        return False
+    try:
+        planned = [float(x) for x in step.get("direction") or ()]
+        recorded = [float(x) for x in entry["planned_direction"]]
+    except (TypeError, ValueError):
+        return False
+    if len(planned) != 3 or len(recorded) != 3:
+        return False
+    return all(abs(a - b) <= 1e-9 for a, b in zip(planned, recorded, strict=True))
+
+
+def _provable_steps(
+    root: Path, manifest: dict[str, Any], names: list[str]
+) -> dict[int, dict[str, Any]]:
+    """The manifest's records whose files are on disk as its checksums say (bytes, or a linear
+    TIFF's pixels) and whose light is the one the manifest gives the step: all a rebuilt
+    journal may hold. Nothing in the folder changes."""
+    return {
+        i: e
+        for i, e in _manifest_records(manifest, names).items()
+        if _light_as_recorded(manifest, e) and verified_steps(root, [e])
+    }
+
+
+def _rebuild_journal(
+    root: Path,
+    manifest: dict[str, Any],
+    taken: dict[int, dict[str, Any]],
+    names: list[str],
+    stamp: str,
+) -> tuple[list[str], list[str]]:
+    """Rebuild the journal from ``taken`` (:func:`_provable_steps`): the old journal is moved
+    to ``recovered/STAMP/journal-damaged.jsonl``, every image file no taken record vouches for
+    to ``recovered/STAMP/not-in-manifest/`` (the manifest does not list its step) or
+    ``recovered/STAMP/unproven/`` (listed, but its file or light is not as the manifest says),
+    never deleted; then the journal is written with the taken records, as their lines were.
+    Returns what was done (said, and recorded in the manifest's run) and the paths set aside."""
+    notes: list[str] = []
+    moved: list[str] = []
+    aside = root / "recovered" / stamp
+    journal = root / JOURNAL
+    if journal.exists():
+        dest = aside / "journal-damaged.jsonl"
+        try:
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(journal, dest)
+        except OSError as exc:
+            raise SessionWriteError(dest, exc) from None
+        # said, and recorded in the run's journal_rebuild, but no image: not counted with them
+        notes.append(f"the damaged {JOURNAL} was kept as {dest.relative_to(root).as_posix()}")
+    keep = {name for e in taken.values() for name in e["sha256"]}
+    listed = _manifest_records(manifest, names)
+    steps_of = {n: i for i, n in enumerate(names)}
+    files = [
+        *root.glob("image_*"),
+        *(root / LINEAR_DIR).glob("image_*"),
+        *(root / RAW_DIR).glob("image_*"),
+    ]
+    for path in sorted(p for p in files if p.is_file()):
+        rel = path.relative_to(root).as_posix()
+        if rel in keep:
+            continue
+        step = steps_of.get("_".join(path.stem.split("_")[:2]))  # image_003_2.nef: step 3
+        why = "unproven" if step is not None and step in listed else "not-in-manifest"
+        dest = aside / why / rel
+        try:
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(path, dest)
+        except OSError as exc:
+            raise SessionWriteError(dest, exc) from None
+        moved.append(dest.relative_to(root).as_posix())
+        said = (
+            f"its step is in {MANIFEST}, but not all its files (or its light) are as recorded there"
+            if why == "unproven"
+            else f"{MANIFEST} does not list its step, so nothing proves its light"
+        )
+        notes.append(f"{rel} set aside as {moved[-1]}: {said}")
+    lines = b"".join(json.dumps(taken[i]).encode("utf-8") + b"\n" for i in sorted(taken))
+    _write_bytes_atomic(journal, lines)
+    shown = ", ".join(names[i] for i in sorted(taken)[:8]) + (" …" if len(taken) > 8 else "")
+    notes.insert(
+        0,
+        f"{JOURNAL} rebuilt from {MANIFEST}: {len(taken)} image(s) taken back"
+        + (f" ({shown})" if taken else "")
+        + ", each file matching the manifest's checksum and its light the manifest's",
+    )
+    return notes, moved
 
 
 def _refuse_lost_journal(root: Path, names: list[str]) -> None:
@@ -1226,7 +1455,9 @@ def _refuse_lost_journal(root: Path, names: list[str]) -> None:
         "can be verified as captured with its light: restore "
         f"{JOURNAL} from a backup copy of the folder (or from where it was moved), then run "
         f"rti-rig run --resume {shlex.quote(str(root))} again; if it is lost for good, shoot "
-        "the session again with another --out (nothing in this folder was changed)"
+        "the session again with another --out (nothing in this folder was changed; "
+        f"--rebuild-journal cannot help either: {MANIFEST} vouches for none of these images, "
+        "as a session killed before any run of it ended records none)"
     )
 
 

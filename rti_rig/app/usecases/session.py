@@ -94,6 +94,9 @@ class ResumeRequest:
     #: A session that completed: reshoot the images lost or changed since capture (the QA
     #: verdict names them), with the object where it was.
     reshoot_lost: bool = False
+    #: A session whose journal lost records (deleted, cut short, overwritten): rebuild it from
+    #: the manifest's records whose files and lights are as recorded (the rest set aside).
+    rebuild_journal: bool = False
 
 
 @dataclass(frozen=True)
@@ -864,7 +867,9 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
         from rti_rig.runtime.session import planned_steps
 
         check_done = refuse_broken_run(Path(req.session_dir), planned_steps(manifest))
-    folder = SessionFolder.reopen(req.session_dir, check_done, req.reshoot_lost)
+    folder = SessionFolder.reopen(
+        req.session_dir, check_done, req.reshoot_lost, req.rebuild_journal
+    )
     try:
         return _opened_resume(req, loaded, folder, identity, diffs, on_note)
     except BaseException:
@@ -892,6 +897,8 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     )
     for line in resume.journal_repair if resume else []:
         on_note(Note(f"{line}: set aside in recovered/, not appended onto", "warning"))
+    for line in resume.journal_rebuild if resume else []:
+        on_note(Note(line, "warning"))
     rig = checked_rig(loaded, schedule)
     source = None
     if "adaptive" in folder.manifest:

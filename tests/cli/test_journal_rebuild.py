@@ -1,0 +1,205 @@
+"""``run --resume --rebuild-journal``: a session whose journal was lost or damaged.
+
+A stopped session's manifest holds every committed image's record (checksums, light). Its
+resume had refused a missing journal with no way on but a backup, and had read a journal cut
+short or overwritten as torn or junk lines: every image they had lost was moved to recovered/
+and shot again. The resume now refuses, naming ``--rebuild-journal``; with it the journal is
+rebuilt from the images whose files and lights the manifest proves, anything else set aside
+(never deleted) under a name that says why, and the session continues as an uninterrupted
+one would have gone.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import SMALL_DOME, interrupted, said, write_config
+from typer.testing import CliRunner
+
+from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
+from rti_rig.cli import app
+from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+
+runner = CliRunner()
+LIGHTS = 8
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes() for p in folder.rglob("*") if p.is_file()
+    }
+
+
+def _images(folder: Path) -> dict[str, str]:
+    files = [*folder.glob("image_*.jpg"), *(folder / "linear").glob("*.tif"), folder / "lights.lp"]
+    return {
+        p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest() for p in files
+    }
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, Path]:
+    """(the rig config, an uninterrupted session, the same session stopped after 4 images)."""
+    base = tmp_path_factory.mktemp("rebuild")
+    cfg = write_config(base, SMALL_DOME)
+    ref = base / "uninterrupted"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(ref), "--lights", str(LIGHTS)])
+    assert r.exit_code == 0, r.output
+    stopped = base / "stopped"
+    cancel = CancelToken()
+
+    def on_event(e) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(e, StepCompleted) and e.index == 3:
+            cancel.cancel()
+
+    opened = open_new_session(NewSessionRequest(cfg, stopped, lights=LIGHTS))
+    assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    return cfg, ref, stopped
+
+
+def _damaged(made: tuple[Path, Path, Path], tmp_path: Path, how: str) -> Path:
+    out = tmp_path / "s"
+    shutil.copytree(made[2], out)
+    journal = out / "journal.jsonl"
+    data = journal.read_bytes()
+    if how == "deleted":
+        journal.unlink()
+    elif how == "truncated":
+        journal.write_bytes(data[: len(data) // 2])  # mid-line: records 3 and 4 gone
+    elif how == "garbage":
+        journal.write_bytes(bytes(range(256)) * 8 + b"\x00\n{not json\n")
+    return out
+
+
+@pytest.mark.parametrize("how", ["deleted", "truncated", "garbage"])
+def test_a_lost_or_damaged_journal_is_refused_then_rebuilt(
+    made: tuple[Path, Path, Path], tmp_path: Path, how: str
+) -> None:
+    _, ref, _ = made
+    out = _damaged(made, tmp_path, how)
+    old_journal = (out / "journal.jsonl").read_bytes() if how != "deleted" else None
+    before = _files(out)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "lists as captured" in said(r) and f"--resume {out} --rebuild-journal" in said(r)
+    assert _files(out) == before  # refused: nothing moved, nothing reshot
+
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert "4 of 8 images verified" in said(r), r.output
+    assert "journal.jsonl rebuilt from manifest.json: 4 image(s) taken back" in said(r)
+    assert _images(out) == _images(ref)  # as if never interrupted
+    for name, data in before.items():  # every captured file kept, unchanged
+        if name.startswith("image_") or name.startswith("linear/"):
+            assert (out / name).read_bytes() == data, name
+    kept = list((out / "recovered").rglob("journal-damaged.jsonl"))
+    if old_journal is None:
+        assert not kept
+    else:  # the broken journal kept aside, byte for byte, and said
+        assert [p.read_bytes() for p in kept] == [old_journal]
+        assert "journal-damaged.jsonl" in said(r)
+    rebuild = json.loads((out / "manifest.json").read_text())["runs"][-1]["journal_rebuild"]
+    assert rebuild and "rebuilt" in rebuild[0]
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "not checked" not in said(r) and "QA verdict: good" in said(r)
+
+
+def test_an_image_edited_after_the_manifest_is_not_taken_back(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    _, ref, _ = made
+    out = _damaged(made, tmp_path, "deleted")
+    edited = bytearray((out / "image_002.jpg").read_bytes())
+    edited[-10] ^= 1
+    (out / "image_002.jpg").write_bytes(bytes(edited))
+    tif = (out / "linear" / "image_002.tif").read_bytes()
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert "3 image(s) taken back (image_001, image_003, image_004)" in said(r)
+    (aside,) = (out / "recovered").glob("*/unproven/image_002.jpg")
+    assert aside.read_bytes() == bytes(edited)  # set aside as it was, never deleted
+    assert aside.parent.joinpath("linear", "image_002.tif").read_bytes() == tif
+    assert "image_002.jpg set aside as" in said(r)
+    assert _images(out) == _images(ref)  # reshot, under the manifest's light
+
+
+def test_an_image_the_manifest_does_not_list_is_set_aside(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    _, ref, _ = made
+    out = _damaged(made, tmp_path, "garbage")
+    extra = (out / "image_004.jpg").read_bytes()
+    (out / "image_005.jpg").write_bytes(extra)  # a copy dropped in: which light? none proves it
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    (aside,) = (out / "recovered").glob("*/not-in-manifest/image_005.jpg")
+    assert aside.read_bytes() == extra
+    assert "does not list its step" in said(r)
+    assert _images(out) == _images(ref)
+
+
+def test_a_record_given_another_light_is_not_taken_back(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """A manifest record whose light is not its step's (edited by hand) proves nothing."""
+    _, ref, _ = made
+    out = _damaged(made, tmp_path, "deleted")
+    manifest = json.loads((out / "manifest.json").read_text())
+    manifest["steps"][2]["led"] = manifest["schedule"]["steps"][3]["led"]
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert "3 image(s) taken back (image_001, image_002, image_004)" in said(r)
+    assert list((out / "recovered").glob("*/unproven/image_003.jpg"))
+    assert _images(out) == _images(ref)
+
+
+def test_the_flag_goes_with_an_unfinished_session_only(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    cfg, ref, _ = made
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "n"), "--rebuild-journal"])
+    assert r.exit_code == 2 and "goes with --resume" in said(r), r.output
+    done = tmp_path / "done"
+    shutil.copytree(ref, done)
+    r = runner.invoke(app, ["run", "--resume", str(done), "--rebuild-journal"])
+    assert r.exit_code == 2 and "completed" in said(r) and "drop --rebuild-journal" in said(r)
+    # a whole journal: nothing to rebuild, and said; the resume goes on as ever
+    out = tmp_path / "whole"
+    shutil.copytree(made[2], out)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0 and "nothing rebuilt" in said(r), r.output
+    assert _images(out) == _images(ref)
+
+
+def test_an_adaptive_session_continues_as_it_would_have(tmp_path: Path) -> None:
+    """Its records in the manifest hold each decision: the rebuilt journal replays them, and
+    the resume decides each again (a step decided otherwise would be refused)."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    plain, lost = tmp_path / "plain", tmp_path / "lost"
+    interrupted(cfg, plain, 3)
+    shutil.copytree(plain, lost)
+    (lost / "journal.jsonl").unlink()
+    r = runner.invoke(app, ["run", "--resume", str(lost)])
+    assert r.exit_code == 2 and "--rebuild-journal" in said(r), r.output
+    r = runner.invoke(app, ["run", "--resume", str(lost), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["run", "--resume", str(plain)])
+    assert r.exit_code == 0, r.output
+    assert _images(lost) == _images(plain)
+
+
+def test_the_verdict_of_a_session_without_its_journal_names_the_rebuild(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """fit's verdict had advised a backup alone, of a session its manifest can vouch for."""
+    out = _damaged(made, tmp_path, "truncated")
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "not checked against their capture checksums" in said(r)
+    assert f"rti-rig run --resume {out} --rebuild-journal" in said(r)
