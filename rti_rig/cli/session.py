@@ -183,7 +183,7 @@ def run(
     # SIGUSR1 said to be ignored from here, not only once the capture is over: one that came
     # while the rig opened (an emulator starting, metering with the rig lit) had ended the
     # process at once, exit 138, no word and no all-off
-    with _late_pause_ignored():
+    with _late_pause_ignored(), _late_term_held() as late_term:
         try:
             with _terminable_while_opening() as handover:
                 if resume is not None:
@@ -292,6 +292,15 @@ def run(
             err.print(f"{said}.", markup=False)
             raise _unexpected(exc, "") from None
         unsafe = _execute(opened, handover)
+        if late_term:  # the summary is out; the verdict, not computed, is fit's to give
+            _refuse_unsafe_end(unsafe, exit_code=None)
+            err.print(
+                "[yellow]Stopped (SIGTERM) once the session had ended: it is complete; its QA "
+                "verdict was not computed:[/] rti-rig fit "
+                f"{escape(_arg(opened.out_dir))} --out FOLDER gives it",
+                soft_wrap=True,
+            )
+            raise typer.Exit(code=143)
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
 
@@ -418,6 +427,35 @@ def _verdict_terminable() -> Iterator[None]:
     previous = signal.signal(signal.SIGTERM, terminated)
     try:
         yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextmanager
+def _late_term_held() -> Iterator[list[int]]:
+    """A SIGTERM once the capture is over, while its summary prints, recorded (in the list
+    yielded) rather than acted on at once; a second one ends the process as the default would.
+
+    Why: the capture's handlers were undone before its summary printed, and a SIGTERM then (a
+    scheduler's ``timeout``) met the default action: exit 143 with no word of the images kept,
+    the session's time, the lights' state or how to get the QA verdict, of a session that had
+    completed. The summary takes milliseconds; ``run`` then says the verdict was not computed
+    and which command gives it, and exits 143. This is the handler every later restore puts
+    back (installed before the opening's), so it holds from the capture's end to the run's."""
+    held: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield held
+        return
+
+    def late(signum, frame) -> None:  # type: ignore[no-untyped-def]
+        if held:  # asked twice: stop now (a summary that hangs must not outlive a stop)
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            signal.raise_signal(signal.SIGTERM)
+        held.append(signum)
+
+    previous = signal.signal(signal.SIGTERM, late)
+    try:
+        yield held
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -611,8 +649,9 @@ def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-
     return typer.Exit(code=stop_exit_code(why))
 
 
-def _refuse_unsafe_end(unsafe: bool) -> None:
-    """Exit 1 after a complete session whose teardown failed or left the lights unsure.
+def _refuse_unsafe_end(unsafe: bool, exit_code: int | None = 1) -> None:
+    """Exit 1 after a complete session whose teardown failed or left the lights unsure (said,
+    with no exit, when ``exit_code`` is None: a stop that comes with its own exit).
 
     Why: the images are all there, but the rig was not brought to a known safe state (a final
     all-off not sent or unanswered, a lamp or stop refused). The run had exited 0, so a script
@@ -625,7 +664,8 @@ def _refuse_unsafe_end(unsafe: bool) -> None:
             "(above):[/] make it safe by hand (switch the dome or lamp off) before taking the "
             "object out."
         )
-        raise typer.Exit(code=1)
+        if exit_code is not None:
+            raise typer.Exit(code=exit_code)
 
 
 _HANDLED = (signal.SIGINT, signal.SIGTERM) + (
