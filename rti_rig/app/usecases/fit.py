@@ -282,7 +282,23 @@ def acquisition_files(
                     "both from a backup copy of the folder"
                 )
             raise FitInputError(f"{source} holds no .lp file: not a session folder")
-        lp = source / "lights.lp" if (source / "lights.lp").is_file() else lps[0]
+        if not (source / LP_NAME).is_file() and len(lps) > 1:
+            # the first in name order had been fitted, said only of a session: a folder with
+            # dirs.lp and a_subset.lp was fitted from the 4 lights of the subset, "good"
+            shown = ", ".join(p.name for p in lps[:6]) + (" …" if len(lps) > 6 else "")
+            rebuild = (
+                f"; or rebuild the session's own {LP_NAME} from its journal with: rti-rig "
+                f"export-lp {shlex.quote(str(source))} --out "
+                f"{shlex.quote(str(source / LP_NAME))}"
+                if (source / JOURNAL).is_file()
+                else ""
+            )
+            raise FitInputError(
+                f"{source} holds {len(lps)} .lp files and no {LP_NAME} ({shown}): which one "
+                "lists its lights cannot be told; fit the one you mean, e.g. rti-rig fit "
+                f"{shlex.quote(str(lps[0]))} --out DIR{rebuild}"
+            )
+        lp = source / LP_NAME if (source / LP_NAME).is_file() else lps[0]
         if notes is not None and lp.name != LP_NAME and (source / JOURNAL).is_file():
             # a session that lost its lights.lp had been fitted from another .lp in it (one
             # the user exported: a subset, say) without a word
