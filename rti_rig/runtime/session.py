@@ -1818,7 +1818,14 @@ def _stopped_while_committing(
         return None
     last = max((int(r["index"]) for r in records), default=-1)
     beyond = [n for n in unrecorded if names.index(n) > last]
-    return beyond[0] if beyond == names[last + 1 : last + 2] else None
+    if beyond != names[last + 1 : last + 2]:
+        return None
+    # a step the manifest records was committed (only a run's end writes them there): its
+    # journal line was lost since, not cut by a stop, and the verdict had said "neither its
+    # files nor its light were ever recorded as captured" of an image the manifest vouches for
+    if last + 1 in _manifest_records(manifest, names):
+        return None
+    return beyond[0]
 
 
 def stopped_while_committing(root: Path) -> str | None:

@@ -203,3 +203,20 @@ def test_the_verdict_of_a_session_without_its_journal_names_the_rebuild(
     assert r.exit_code == 0, r.output
     assert "not checked against their capture checksums" in said(r)
     assert f"rti-rig run --resume {out} --rebuild-journal" in said(r)
+
+
+def test_a_committed_line_cut_short_is_not_called_a_stop_while_saving(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """The journal's last line cut short, of an image the manifest records: the verdict had
+    said the session "stopped while saving it ... neither its files nor its light were ever
+    recorded as captured", and pointed to a resume (now refused) to shoot it again."""
+    out = tmp_path / "s"
+    shutil.copytree(made[2], out)
+    journal = out / "journal.jsonl"
+    journal.write_bytes(journal.read_bytes()[:-30])
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "stopped while saving" not in said(r)
+    assert "image_004 not checked against its capture checksum" in said(r)
+    assert f"rti-rig run --resume {out} --rebuild-journal" in said(r)
