@@ -220,3 +220,14 @@ def test_a_committed_line_cut_short_is_not_called_a_stop_while_saving(
     assert "stopped while saving" not in said(r)
     assert "image_004 not checked against its capture checksum" in said(r)
     assert f"rti-rig run --resume {out} --rebuild-journal" in said(r)
+
+
+def test_the_verdict_counts_the_images_the_manifest_records(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """A stopped session without its journal: "not finished (0 of 8 images …)" had been said
+    of 4 images on disk, fitted and judged, that the manifest records."""
+    out = _damaged(made, tmp_path, "deleted")
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "the session is not finished (4 of 8 images" in said(r), r.output

@@ -185,7 +185,15 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     if reason == "completed":
         return qa
     total = planned_steps(manifest)
-    taken = len({r["index"] for r in scan_journal(source, image_names(total)).records})
+    # the journal's steps and those the manifest records (a lost journal had made it "0 of 8
+    # images" of a session with 4 on disk, fitted and judged)
+    steps = manifest.get("steps")
+    recorded = {
+        s["index"]
+        for s in (steps if isinstance(steps, list) else [])
+        if isinstance(s, dict) and isinstance(s.get("index"), int)
+    }
+    taken = len({r["index"] for r in scan_journal(source, image_names(total)).records} | recorded)
     how = (
         _ENDED.get(reason or "", f"it ended: {reason}")
         if reason
