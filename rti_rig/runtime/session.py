@@ -1360,10 +1360,28 @@ def _provable_steps(
 ) -> dict[int, dict[str, Any]]:
     """The manifest's records whose files are on disk as its checksums say (bytes, or a linear
     TIFF's pixels) and whose light is the one the manifest gives the step: all a rebuilt
-    journal may hold. Nothing in the folder changes."""
+    journal may hold. Nothing in the folder changes.
+
+    An adaptive session whose record of an image on disk holds no decision is refused: the
+    resume could not decide that step again as it was, nor the lights after it."""
+    listed = _manifest_records(manifest, names)
+    if manifest.get("adaptive"):
+        undecided = [
+            names[i]
+            for i, e in sorted(listed.items())
+            if not isinstance(e.get("decision"), dict) and verified_steps(root, [e])
+        ]
+        if undecided:
+            raise SessionError(
+                f"{root}: {MANIFEST} records {', '.join(undecided[:8])} without the adaptive "
+                "decision that chose its light, so a rebuilt journal could not prove the "
+                "session continues as it began; nothing in this folder was changed: restore "
+                f"{JOURNAL} from a backup copy of the folder, or start a new session with "
+                "another --out"
+            )
     return {
         i: e
-        for i, e in _manifest_records(manifest, names).items()
+        for i, e in listed.items()
         if _light_as_recorded(manifest, e) and verified_steps(root, [e])
     }
 

@@ -231,3 +231,19 @@ def test_the_verdict_counts_the_images_the_manifest_records(
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 0, r.output
     assert "the session is not finished (4 of 8 images" in said(r), r.output
+
+
+def test_an_adaptive_record_without_its_decision_is_refused(tmp_path: Path) -> None:
+    """What cannot be proven is not guessed: a record with no decision cannot be decided again."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    interrupted(cfg, out, 3)
+    (out / "journal.jsonl").unlink()
+    manifest = json.loads((out / "manifest.json").read_text())
+    manifest["steps"][1]["decision"] = None
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    before = _files(out)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 2, r.output
+    assert "image_002 without the adaptive decision" in said(r)
+    assert _files(out) == before
