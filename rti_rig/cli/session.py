@@ -1013,6 +1013,7 @@ def export_lp(
     for every image on disk as captured (an interrupted session's too)."""
     from rti_rig.app.usecases.export import ExportLpRequest
     from rti_rig.app.usecases.export import export_lp as write_session_lp
+    from rti_rig.runtime.session import JOURNAL
 
     try:
         done = write_session_lp(ExportLpRequest(session_dir, out_file, linear, force))
@@ -1028,7 +1029,12 @@ def export_lp(
     if done.unchecked:
         err.print(
             f"[yellow]note:[/] left out, not verifiable as captured "
-            f"({escape(done.unchecked_why)}): {escape(', '.join(done.unchecked))}",
+            f"({escape(done.unchecked_why)}): {escape(', '.join(done.unchecked))}"
+            + (
+                f"; restore {JOURNAL} from a backup copy{escape(done.rebuild)}"
+                if done.rebuild
+                else ""
+            ),
             soft_wrap=True,
         )
     if done.outside_session:

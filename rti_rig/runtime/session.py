@@ -1297,6 +1297,18 @@ def rebuildable_journal(root: Path) -> bool:
     return bool(_unjournaled_steps(root, manifest, scan, names))
 
 
+def rebuild_advice(root: Path) -> str:
+    """ ", or rebuild it …" naming ``run --resume ROOT --rebuild-journal`` where it would take
+    images back (:func:`rebuildable_journal`), else "": said where a lost journal is named
+    (export-lp had advised a backup alone, of a session its manifest can vouch for)."""
+    if not rebuildable_journal(root):
+        return ""
+    return (
+        f", or rebuild it from {MANIFEST}'s records: rti-rig run --resume "
+        f"{shlex.quote(str(root))} --rebuild-journal"
+    )
+
+
 def _refuse_unjournaled(
     root: Path, scan: JournalScan, names: list[str], unjournaled: list[int]
 ) -> None:
@@ -1995,6 +2007,7 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
             raise SessionError(
                 f"{root}: {JOURNAL} is missing, so no image can be verified as captured with "
                 f"its light: restore {JOURNAL} from a backup copy of the folder"
+                + rebuild_advice(root)
             )
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
     left_out = sorted({r[key] for r in records if r["index"] not in done})

@@ -247,3 +247,19 @@ def test_an_adaptive_record_without_its_decision_is_refused(tmp_path: Path) -> N
     assert r.exit_code == 2, r.output
     assert "image_002 without the adaptive decision" in said(r)
     assert _files(out) == before
+
+
+@pytest.mark.parametrize("how", ["deleted", "truncated"])
+def test_export_lp_names_the_rebuild(
+    made: tuple[Path, Path, Path], tmp_path: Path, how: str
+) -> None:
+    """export-lp had advised a backup alone, of a session its manifest can vouch for."""
+    out = _damaged(made, tmp_path, how)
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
+    assert f"rti-rig run --resume {out} --rebuild-journal" in said(r), r.output
+    # a finished session cannot be resumed: not offered
+    done = tmp_path / "done"
+    shutil.copytree(made[1], done)
+    (done / "journal.jsonl").unlink()
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "y.lp")])
+    assert r.exit_code == 2 and "--rebuild-journal" not in said(r), r.output

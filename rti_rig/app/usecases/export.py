@@ -13,6 +13,7 @@ from rti_rig.app.output_files import check_output_file
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
+    rebuild_advice,
     renamed_note,
     renamed_since_capture,
     session_lp_report,
@@ -40,6 +41,8 @@ class ExportedLp:
     #: Images no readable journal record vouches for (not in the file), and why.
     unchecked: list[str] = field(default_factory=list)
     unchecked_why: str = ""
+    #: ", or rebuild it …": how to take the unchecked images back ("" if it cannot)
+    rebuild: str = ""
     #: What to say of left-out JPEGs that are in the folder under another name ("" if none).
     renamed: str = ""
 
@@ -54,4 +57,13 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     # a left-out JPEG renamed in the folder is named with its new name: "missing" of a file
     # that is there had read as one to reshoot
     renamed = renamed_since_capture(req.session_dir) if left_out and not req.linear else {}
-    return ExportedLp(list(entries), list(left_out), outside, unchecked, why, renamed_note(renamed))
+    rebuild = rebuild_advice(req.session_dir) if unchecked else ""
+    return ExportedLp(
+        list(entries),
+        list(left_out),
+        outside,
+        unchecked,
+        why,
+        rebuild=rebuild,
+        renamed=renamed_note(renamed),
+    )

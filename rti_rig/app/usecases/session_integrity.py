@@ -30,7 +30,7 @@ from rti_rig.runtime.session import (
     originals_changed_since_capture,
     planned_steps,
     read_manifest,
-    rebuildable_journal,
+    rebuild_advice,
     renamed_note,
     renamed_since_capture,
     scan_journal,
@@ -263,11 +263,8 @@ def _with_unchecked(qa: QAReport, source: Path, fitted: set[str] | None = None) 
         f"unseen; restore {MANIFEST if MANIFEST in why else JOURNAL} from a backup copy of the "
         "folder"
     )
-    if MANIFEST not in why and rebuildable_journal(source):  # the resume's other way on
-        note += (
-            f", or rebuild it from {MANIFEST}'s records: rti-rig run --resume "
-            f"{shlex.quote(str(source))} --rebuild-journal"
-        )
+    if MANIFEST not in why:  # the resume's other way on, where it would take images back
+        note += rebuild_advice(source)
     return replace(qa, integrity_note=note)
 
 
