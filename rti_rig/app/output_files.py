@@ -7,7 +7,7 @@ from pathlib import Path
 
 from rti_rig.app.config import LoadedRig
 from rti_rig.core.errors import RtiRigError
-from rti_rig.runtime.session import MANIFEST
+from rti_rig.runtime.session import LP_NAME, MANIFEST
 
 
 def rig_inputs(rig: Path, loaded: LoadedRig) -> dict[str, Path | None]:
@@ -57,9 +57,26 @@ def check_output_file(
             )
     for folder in out_file.resolve().parents:
         if (folder / MANIFEST).is_file():
+            if _own_lp(out_file, folder):
+                break  # the user's own .lp beside the images (no capture): --force replaces it
             raise RtiRigError(
                 f"{option} {out_file} would replace a file of the session in {folder}; a "
                 "session's files are never overwritten: write it elsewhere"
             )
     if not force:
         raise RtiRigError(f"{option} {out_file} exists; use --force to replace it")
+
+
+def _own_lp(out_file: Path, session: Path) -> bool:
+    """Whether ``out_file`` is an ``.lp`` of the user's own at the top of ``session`` (one
+    ``export-lp`` or ``plan`` wrote there), not one of the files the session keeps.
+
+    Why: the guide has an exported ``.lp`` put in the session folder (tools read its image
+    names beside it), and ``export-lp --out S/linear.lp --force`` after a resume was refused
+    ("a session's files are never overwritten"), though ``--force`` says it overwrites and the
+    file holds nothing captured; ``lights.lp``, which the session writes, stays refused."""
+    return (
+        out_file.suffix.lower() == ".lp"
+        and out_file.name != LP_NAME
+        and out_file.resolve().parent == session
+    )

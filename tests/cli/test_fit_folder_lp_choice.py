@@ -67,3 +67,27 @@ def test_a_session_without_its_lights_lp_and_two_others_names_the_rebuild(
     assert r.exit_code == 2, r.output
     assert "(all.lp, first4.lp)" in said(r)
     assert f"rti-rig export-lp {s} --out {s / 'lights.lp'}" in said(r)
+
+
+def test_export_lp_force_replaces_the_users_own_lp_in_the_session(
+    session: Path, tmp_path: Path
+) -> None:
+    """The guide puts an exported .lp in the session folder (tools read its names beside it);
+    exporting it again with --force had been refused as "a file of the session", though
+    --force says it overwrites. The session's own files stay refused."""
+    s = tmp_path / "s"
+    shutil.copytree(session, s)
+    mine = s / "linear.lp"
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(mine), "--linear"])
+    assert r.exit_code == 0, r.output
+    mine.write_text("2\nimage_001.jpg 0 0 1\nimage_002.jpg 0 1 0\n")  # stale
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(mine), "--linear"])
+    assert r.exit_code == 2 and "--force" in said(r), r.output
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(mine), "--linear", "--force"])
+    assert r.exit_code == 0, r.output
+    assert mine.read_text().startswith("8\nlinear/image_001.tif")
+    for own in ("lights.lp", "manifest.json", "journal.jsonl", "image_001.jpg"):
+        before = (s / own).read_bytes()
+        r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / own), "--force"])
+        assert r.exit_code == 2 and "never overwritten" in said(r), (own, r.output)
+        assert (s / own).read_bytes() == before
