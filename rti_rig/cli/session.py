@@ -926,63 +926,74 @@ def preview(
     from rti_rig.app.usecases.session import PreviewRequest, open_preview_session
     from rti_rig.runtime.controller import EmergencyStop
 
-    try:
-        refuse_unmetered_limit(max_saturated, auto_exposure)
-        with _terminable_while_opening() as handover:
-            opened = open_preview_session(
-                PreviewRequest(
-                    rig_config,
-                    out_dir,
-                    parse_az_el(light, "--light"),
-                    auto_exposure=auto_exposure,
-                    **_metering_limit(max_saturated),
-                    min_elevation_deg=min_elevation_deg,
-                    max_elevation_deg=max_elevation_deg,
-                ),
-                print_note,
+    # a SIGTERM once the capture is over: the summary and the plan hint finish first
+    with _late_term_held() as late_term:
+        try:
+            refuse_unmetered_limit(max_saturated, auto_exposure)
+            with _terminable_while_opening() as handover:
+                opened = open_preview_session(
+                    PreviewRequest(
+                        rig_config,
+                        out_dir,
+                        parse_az_el(light, "--light"),
+                        auto_exposure=auto_exposure,
+                        **_metering_limit(max_saturated),
+                        min_elevation_deg=min_elevation_deg,
+                        max_elevation_deg=max_elevation_deg,
+                    ),
+                    print_note,
+                )
+                handover.hold()  # a stop from here on: the capture answers it
+        except RtiRigError as exc:
+            state = getattr(exc, "lights_state", None)
+            if state is not None:  # metering failed: it had lit the rig; nothing was written yet
+                err.print(
+                    f"{_sentence(state)}; nothing was captured or written to {out_dir}.",
+                    markup=False,
+                )
+            raise fail(exc) from None
+        except (KeyboardInterrupt, EmergencyStop) as exc:
+            # metering for the preview lights the rig: a Ctrl-C had said only "rti-rig: stopped",
+            # a SIGTERM nothing at all (and sent no all-off)
+            why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
+            said = f"Stopped ({why}) before the preview image: nothing was captured or written to "
+            raise _stopped_while_opening(exc, why, f"{said}{out_dir}", auto_exposure) from None
+        unsafe = _execute(opened, handover)
+        # the band given here is the one to plan in: said in the command to copy
+        band = "".join(
+            f" {flag} {value:g}"
+            for flag, value, given in (
+                ("--min-elevation-deg", min_elevation_deg, min_elevation_deg != 0.0),
+                ("--max-elevation-deg", max_elevation_deg, max_elevation_deg != 90.0),
             )
-            handover.hold()  # a stop from here on: the capture answers it
-    except RtiRigError as exc:
-        state = getattr(exc, "lights_state", None)
-        if state is not None:  # metering failed: it had lit the rig; nothing was written yet
-            err.print(
-                f"{_sentence(state)}; nothing was captured or written to {out_dir}.", markup=False
-            )
-        raise fail(exc) from None
-    except (KeyboardInterrupt, EmergencyStop) as exc:
-        # metering for the preview lights the rig: a Ctrl-C had said only "rti-rig: stopped",
-        # a SIGTERM nothing at all (and sent no all-off)
-        why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
-        said = f"Stopped ({why}) before the preview image: nothing was captured or written to "
-        raise _stopped_while_opening(exc, why, f"{said}{out_dir}", auto_exposure) from None
-    unsafe = _execute(opened, handover)
-    # the band given here is the one to plan in: said in the command to copy
-    band = "".join(
-        f" {flag} {value:g}"
-        for flag, value, given in (
-            ("--min-elevation-deg", min_elevation_deg, min_elevation_deg != 0.0),
-            ("--max-elevation-deg", max_elevation_deg, max_elevation_deg != 90.0),
+            if given
         )
-        if given
-    )
-    out.print(
-        f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
-        f"{shlex.quote(str(rig_config))} --lights N{band} --out plan.lp",
-        highlight=False,
-        markup=False,
-        soft_wrap=True,
-    )
-    metered = _metered_apart(opened) if auto_exposure else None
-    if metered is not None:
         out.print(
-            f"Then: rti-rig run {shlex.quote(str(rig_config))} --plan plan.lp --out SESSION "
-            f"--auto-exposure (this preview was metered at {metered[0]:.4g} s; without "
-            f"--auto-exposure the run uses the config's exposure_s = {metered[1]:g} s)",
+            f"Plan from it: rti-rig plan {shlex.quote(str(out_dir))} --rig "
+            f"{shlex.quote(str(rig_config))} --lights N{band} --out plan.lp",
             highlight=False,
             markup=False,
             soft_wrap=True,
         )
-    _refuse_unsafe_end(unsafe)
+        metered = _metered_apart(opened) if auto_exposure else None
+        if metered is not None:
+            out.print(
+                f"Then: rti-rig run {shlex.quote(str(rig_config))} --plan plan.lp --out SESSION "
+                f"--auto-exposure (this preview was metered at {metered[0]:.4g} s; without "
+                f"--auto-exposure the run uses the config's exposure_s = {metered[1]:g} s)",
+                highlight=False,
+                markup=False,
+                soft_wrap=True,
+            )
+        if late_term:  # the preview and its summary are out; the run's word on the stop
+            _refuse_unsafe_end(unsafe, exit_code=None)
+            err.print(
+                "[yellow]Stopped (SIGTERM) once the preview was taken: it is complete in "
+                f"{escape(_arg(out_dir))}[/] (plan from it as above)",
+                soft_wrap=True,
+            )
+            raise typer.Exit(code=143)
+        _refuse_unsafe_end(unsafe)
 
 
 def _metered_apart(opened) -> tuple[float, float] | None:  # type: ignore[no-untyped-def]

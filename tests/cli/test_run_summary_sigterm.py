@@ -53,3 +53,21 @@ def test_a_sigterm_during_the_summary_keeps_it_and_says_how_to_get_the_verdict(
     assert "QA verdict was not computed" in said and f"rti-rig fit {out} --out FOLDER" in said
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["runner"]["finish_reason"] == "completed"
+
+
+def test_a_sigterm_during_the_preview_summary_keeps_the_plan_hint(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    hook = tmp_path / "hook.py"
+    hook.write_text(HOOK)
+    out = tmp_path / "p"
+    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"}
+    proc = subprocess.run(
+        [sys.executable, str(hook), "preview", str(cfg), "--out", str(out)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 143, said
+    assert f"Plan from it: rti-rig plan {out}" in said and "Stopped (SIGTERM)" in said
