@@ -314,6 +314,41 @@ def lock_session(root: Path) -> None:
     _LOCKED[key] = fd
 
 
+def refuse_if_in_use(root: Path, what: str) -> None:
+    """Refuse to read session ``root`` for ``what`` ("fit", "export-lp") while another process
+    holds it (:func:`lock_session`: a run or resume capturing into it).
+
+    Why: ``fit`` of a session still being captured read its ``lights.lp`` and its images at
+    different moments: "error: 40 image names for 33 light directions", or a verdict of a part
+    of the session that advised a ``--resume`` the running capture would refuse. A shared
+    ``flock`` is tried and released at once; a folder this process holds is not in use by
+    another (``run``'s own verdict), and one that cannot be locked (not POSIX, some network
+    mounts) is read as before."""
+    try:
+        import fcntl
+    except ImportError:
+        return
+    key = str(Path(root).resolve())
+    if key in _LOCKED or not (Path(root) / MANIFEST).is_file():
+        return
+    try:
+        fd = os.open(key, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise SessionError(
+            f"{root} is being captured by another rti-rig process right now (its images and "
+            f"{LP_NAME} change as it goes): {what} it once that run has ended (or stop it with "
+            "Ctrl-C in its terminal)"
+        ) from None
+    except OSError:
+        return
+    finally:
+        os.close(fd)  # releases the shared lock, if it was taken
+
+
 def unlock_session(root: Path) -> None:
     """Release :func:`lock_session`'s hold on ``root`` (nothing if it is not held)."""
     fd = _LOCKED.pop(str(Path(root).resolve()), None)

@@ -14,6 +14,7 @@ from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
     rebuild_advice,
+    refuse_if_in_use,
     renamed_note,
     renamed_since_capture,
     session_lp_report,
@@ -49,6 +50,7 @@ class ExportedLp:
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
     refuse_if_disowned(req.session_dir)
+    refuse_if_in_use(req.session_dir, "export its .lp")
     entries, left_out = session_lp_report(req.session_dir, linear=req.linear)
     check_output_file(req.out_file, req.force, {})
     write_lp(req.out_file, entries)
