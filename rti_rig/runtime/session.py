@@ -1249,7 +1249,7 @@ def _prepare_resume(
                 f"{JOURNAL} already holds a record of every image {MANIFEST} lists as captured: "
                 "nothing rebuilt (the resume goes on as without --rebuild-journal)"
             ]
-        repair = _repair_journal(root, scan, stamp) if scan.needs_repair and not rebuilt else []
+        repair = _repair_journal(root, scan, stamp) if scan.needs_repair and rebuilt is None else []
         keep = {name for rec in done.values() for name in rec.sha256}
         leftovers = [
             *root.glob("image_*"),
@@ -1333,9 +1333,10 @@ def rebuildable_journal(root: Path) -> bool:
 
 
 def rebuild_advice(root: Path) -> str:
-    """ ", or rebuild it …" naming ``run --resume ROOT --rebuild-journal`` where it would take
-    images back (:func:`rebuildable_journal`), else "": said where a lost journal is named
-    (export-lp had advised a backup alone, of a session its manifest can vouch for)."""
+    """The words that name ``run --resume ROOT --rebuild-journal`` (to follow the advice to
+    restore the journal from a backup) where it would take images back
+    (:func:`rebuildable_journal`), else "": said where a lost journal is named (export-lp had
+    advised a backup alone, of a session its manifest can vouch for)."""
     if not rebuildable_journal(root):
         return ""
     return (

@@ -263,3 +263,23 @@ def test_export_lp_names_the_rebuild(
     (done / "journal.jsonl").unlink()
     r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "y.lp")])
     assert r.exit_code == 2 and "--rebuild-journal" not in said(r), r.output
+
+
+def test_a_rebuild_that_takes_nothing_back_keeps_no_old_line(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """Every record the manifest holds given another light: nothing is taken back, and the
+    rebuilt journal stays empty (the damaged one's surviving lines had been written back over
+    it, records of images just set aside)."""
+    _, ref, _ = made
+    out = _damaged(made, tmp_path, "truncated")
+    manifest = json.loads((out / "manifest.json").read_text())
+    for step in manifest["steps"]:
+        step["led"] = -1
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert "0 image(s) taken back" in said(r)
+    lines = (out / "journal.jsonl").read_text().splitlines()
+    assert [json.loads(line)["index"] for line in lines] == list(range(8))
+    assert _images(out) == _images(ref)
