@@ -91,3 +91,26 @@ def test_export_lp_force_replaces_the_users_own_lp_in_the_session(
         r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / own), "--force"])
         assert r.exit_code == 2 and "never overwritten" in said(r), (own, r.output)
         assert (s / own).read_bytes() == before
+
+
+def test_a_lights_lp_edited_since_capture_is_named_against_the_journal(
+    session: Path, tmp_path: Path
+) -> None:
+    """Two lines' directions swapped in lights.lp: the verdict blamed the images ("reshoot:
+    image_002 (wrong light …)"), which were as captured; the journal holds the lights that
+    fired, and it is the .lp that is now named, with how to write it again."""
+    s = tmp_path / "s"
+    shutil.copytree(session, s)
+    lines = (s / "lights.lp").read_text().splitlines()
+    a, b = lines[2].split(), lines[5].split()
+    lines[2], lines[5] = " ".join([a[0], *b[1:]]), " ".join([b[0], *a[1:]])
+    (s / "lights.lp").write_text("\n".join(lines) + "\n")
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "lights.lp gives image_002, image_005 another light than the journal" in said(r)
+    assert f"rti-rig export-lp {s} --out {s / 'lights.lp'}" in said(r)
+    (s / "lights.lp").rename(tmp_path / "edited.lp")
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(s / "lights.lp")])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit2")])
+    assert r.exit_code == 0 and "another light than the journal" not in said(r), r.output

@@ -10,10 +10,13 @@ JPEGs in order) gave every later image the wrong light. The journal says what wa
 
 from __future__ import annotations
 
+import math
 import shlex
 from dataclasses import replace
 from pathlib import Path
 from typing import TypeVar
+
+import numpy as np
 
 from rti_rig.app.usecases.uneven_lights import with_uneven_lights
 from rti_rig.core.errors import RtiRigError
@@ -67,6 +70,8 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         manifest = read_manifest(source)  # once, for what the session's kind and end allow
     except RtiRigError:
         manifest = None
+    if manifest is not None:
+        qa = _with_relabelled(qa, lp, source, manifest)
     if manifest is not None:
         qa = with_uneven_lights(qa, manifest)  # a bright image its uncalibrated LED explains
         qa = _with_unfinished(_with_session_kind(qa, manifest), source, manifest)
@@ -131,6 +136,54 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             note += f"; {relight} ({', '.join(relisted[:8])}{' …' if len(relisted) > 8 else ''})"
         qa = _noted(qa, note)
     return qa
+
+
+#: How far (radians) an .lp's light may be from the journal's and still be the same one: the
+#: .lp's six decimals round a direction by about 1e-6 rad.
+_SAME_LIGHT_RAD = 1e-4
+
+
+def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QAReport:  # type: ignore[type-arg]
+    """``qa`` with a note naming the images the fitted ``lp`` gives another light than the one
+    the journal records as fired (the ``.lp`` edited since capture, or lines swapped).
+
+    Why: lights.lp with two lines' directions swapped by hand was fitted as it was, and the
+    verdict said "reshoot: image_002 (wrong light …)": the images were as captured, and the
+    journal held the lights that really fired; it is the ``.lp`` to write again."""
+    try:
+        entries = read_lp(lp)
+        total = planned_steps(manifest)
+        records = scan_journal(source, image_names(total) if total else None).records
+    except (OSError, RtiRigError, ValueError):
+        return qa
+    fired: dict[str, np.ndarray] = {}
+    for rec in records:  # a later record of a step (a reshot image) replaces an earlier one
+        d = np.asarray(rec["actual_direction"], dtype=np.float64)
+        for name in (rec["image"], rec["linear_image"]):
+            fired[name] = d
+    differ = []
+    for e in entries:
+        d = fired.get(e.name)
+        if d is None:
+            continue
+        a = np.asarray(e.direction, dtype=np.float64)
+        cos = float(a @ d) / max(float(np.linalg.norm(a) * np.linalg.norm(d)), 1e-12)
+        if math.acos(min(1.0, max(-1.0, cos))) > _SAME_LIGHT_RAD:
+            differ.append(Path(e.name).stem)
+    if not differ:
+        return qa
+    shown = ", ".join(differ[:8]) + (f" and {len(differ) - 8} more" if len(differ) > 8 else "")
+    folder = shlex.quote(str(source))
+    note = (
+        f"{lp.name} gives {shown} another light than the journal records as fired (the .lp "
+        "edited since capture?): the fit paired "
+        f"{'it' if len(differ) == 1 else 'them'} with {lp.name}'s, and relight would too; "
+        f"move {lp.name} aside and write it again from the journal: rti-rig export-lp {folder} "
+        f"--out {shlex.quote(str(source / lp.name))}"
+        + (" --linear" if any(e.name.startswith(f"{LINEAR_DIR}/") for e in entries) else "")
+    )
+    joined = f"{qa.integrity_note}; {note}" if qa.integrity_note else note
+    return replace(qa, integrity_note=joined)
 
 
 def _noted(qa: QAReport, note: str) -> QAReport:
