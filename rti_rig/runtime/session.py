@@ -1496,6 +1496,15 @@ def _rebuild_journal(
         + (f" ({shown})" if taken else "")
         + ", each file matching the manifest's checksum and its light the manifest's",
     )
+    # said on disk too, beside what was set aside: a stop before the run records it in the
+    # manifest (the rig not answering, a Ctrl-C while it opens) had left recovered/ unexplained
+    report = aside / "journal-rebuild.txt"
+    try:
+        aside.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SessionWriteError(aside, exc) from None
+    _write_bytes_atomic(report, "".join(f"{n}\n" for n in notes).encode("utf-8"))
+    notes.append(f"what was done is written in {report.relative_to(root).as_posix()}")
     return notes, moved
 
 

@@ -104,6 +104,9 @@ def test_a_lost_or_damaged_journal_is_refused_then_rebuilt(
         assert "journal-damaged.jsonl" in said(r)
     rebuild = json.loads((out / "manifest.json").read_text())["runs"][-1]["journal_rebuild"]
     assert rebuild and "rebuilt" in rebuild[0]
+    # and on disk beside what was set aside, whatever stops the run before the manifest
+    (report,) = (out / "recovered").rglob("journal-rebuild.txt")
+    assert report.read_text().startswith("journal.jsonl rebuilt from manifest.json: 4 image(s)")
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 0, r.output
     assert "not checked" not in said(r) and "QA verdict: good" in said(r)
