@@ -114,3 +114,16 @@ def test_a_lights_lp_edited_since_capture_is_named_against_the_journal(
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit2")])
     assert r.exit_code == 0 and "another light than the journal" not in said(r), r.output
+
+
+def test_a_lights_lp_out_of_name_order_is_named_for_relight(session: Path, tmp_path: Path) -> None:
+    """lights.lp's lines reversed by hand: the fit pairs by name and said "good", but relight
+    pairs the lines with the JPEGs in name order, every image under another's light."""
+    s = tmp_path / "s"
+    shutil.copytree(session, s)
+    count, *lines = (s / "lights.lp").read_text().splitlines()
+    (s / "lights.lp").write_text("\n".join([count, *reversed(lines)]) + "\n")
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "lights.lp lists the images out of their name order" in said(r)
+    assert f"rti-rig export-lp {s} --out {s / 'lights.lp'}" in said(r)

@@ -170,18 +170,32 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
         cos = float(a @ d) / max(float(np.linalg.norm(a) * np.linalg.norm(d)), 1e-12)
         if math.acos(min(1.0, max(-1.0, cos))) > _SAME_LIGHT_RAD:
             differ.append(Path(e.name).stem)
-    if not differ:
+    listed = [e.name for e in entries]
+    # relight pairs lights.lp's lines with the folder's JPEGs in name order (a fit pairs by
+    # name): lines reordered by hand had been judged "good", every image relit wrongly
+    reordered = lp.name == LP_NAME and listed != sorted(listed)
+    if not differ and not reordered:
         return qa
-    shown = ", ".join(differ[:8]) + (f" and {len(differ) - 8} more" if len(differ) > 8 else "")
     folder = shlex.quote(str(source))
-    note = (
-        f"{lp.name} gives {shown} another light than the journal records as fired (the .lp "
-        "edited since capture?): the fit paired "
-        f"{'it' if len(differ) == 1 else 'them'} with {lp.name}'s, and relight would too; "
+    again = (
         f"move {lp.name} aside and write it again from the journal: rti-rig export-lp {folder} "
         f"--out {shlex.quote(str(source / lp.name))}"
         + (" --linear" if any(e.name.startswith(f"{LINEAR_DIR}/") for e in entries) else "")
     )
+    if differ:
+        shown = ", ".join(differ[:8]) + (f" and {len(differ) - 8} more" if len(differ) > 8 else "")
+        note = (
+            f"{lp.name} gives {shown} another light than the journal records as fired (the .lp "
+            "edited since capture?): the fit paired "
+            f"{'it' if len(differ) == 1 else 'them'} with {lp.name}'s, and relight would too; "
+            + again
+        )
+    else:
+        note = (
+            f"{lp.name} lists the images out of their name order (edited since capture?): the "
+            "fit paired each with its own line, but relight pairs the lines with the folder's "
+            f"JPEGs in name order, so it would give them the wrong lights; {again}"
+        )
     joined = f"{qa.integrity_note}; {note}" if qa.integrity_note else note
     return replace(qa, integrity_note=joined)
 
