@@ -127,3 +127,16 @@ def test_a_lights_lp_out_of_name_order_is_named_for_relight(session: Path, tmp_p
     assert r.exit_code == 0, r.output
     assert "lights.lp lists the images out of their name order" in said(r)
     assert f"rti-rig export-lp {s} --out {s / 'lights.lp'}" in said(r)
+
+
+def test_a_captured_image_left_out_of_lights_lp_is_named(session: Path, tmp_path: Path) -> None:
+    """A line deleted from lights.lp by hand: 7 images fitted, "good", of a session of 8 on
+    disk (relight pairs 7 lines with 8 JPEGs)."""
+    s = tmp_path / "s"
+    shutil.copytree(session, s)
+    lines = (s / "lights.lp").read_text().splitlines()
+    del lines[4]
+    (s / "lights.lp").write_text("\n".join(["7", *lines[1:]]) + "\n")
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    assert "lights.lp does not list image_004, captured and on disk" in said(r)

@@ -174,7 +174,22 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
     # relight pairs lights.lp's lines with the folder's JPEGs in name order (a fit pairs by
     # name): lines reordered by hand had been judged "good", every image relit wrongly
     reordered = lp.name == LP_NAME and listed != sorted(listed)
-    if not differ and not reordered:
+    # a captured image on disk the session's lights.lp leaves out (a line deleted by hand):
+    # not fitted, judged "good", and relight pairs 7 lines with 8 JPEGs
+    # (one lost or changed since capture is named by the lost-files note, with what to do)
+    latest = {rec["index"]: rec for rec in records}
+    unlisted: list[str] = []
+    if lp.name == LP_NAME:
+        candidates = [
+            Path(rec["image"]).stem
+            for rec in latest.values()
+            if rec["image"] not in listed
+            and rec["linear_image"] not in listed
+            and (source / rec["image"]).is_file()
+        ]
+        lost = files_lost_since_capture(source) if candidates else {}
+        unlisted = sorted(n for n in candidates if n not in lost)
+    if not differ and not reordered and not unlisted:
         return qa
     folder = shlex.quote(str(source))
     again = (
@@ -189,6 +204,14 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
             "edited since capture?): the fit paired "
             f"{'it' if len(differ) == 1 else 'them'} with {lp.name}'s, and relight would too; "
             + again
+        )
+    elif unlisted:
+        shown = ", ".join(unlisted[:8]) + (" …" if len(unlisted) > 8 else "")
+        note = (
+            f"{lp.name} does not list {shown}, captured and on disk (the .lp edited since "
+            f"capture?): {'it was' if len(unlisted) == 1 else 'they were'} not fitted, and "
+            "relight, which pairs the .lp's lines with the folder's JPEGs in name order, would "
+            f"give every later image the wrong light; {again}"
         )
     else:
         note = (
