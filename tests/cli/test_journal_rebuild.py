@@ -234,6 +234,8 @@ def test_the_verdict_counts_the_images_the_manifest_records(
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 0, r.output
     assert "the session is not finished (4 of 8 images" in said(r), r.output
+    # the continuation it names is one that is not refused
+    assert f"continue it with rti-rig run --resume {out} --rebuild-journal" in said(r)
 
 
 def test_an_adaptive_record_without_its_decision_is_refused(tmp_path: Path) -> None:

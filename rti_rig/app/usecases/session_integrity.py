@@ -293,6 +293,8 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     note = (
         f"the session is not finished ({taken} {of} images; {how}): this verdict judges the "
         f"images taken so far; continue it with rti-rig run --resume {shlex.quote(str(source))}"
+        # a plain resume of a journal that lost records the manifest holds is refused
+        + (" --rebuild-journal (or once its journal is restored)" if rebuild_advice(source) else "")
     )
     return _noted(qa, note)
 
