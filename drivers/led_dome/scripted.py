@@ -30,6 +30,9 @@ traffic_log = logging.getLogger("rti_rig.dome.traffic")
 
 #: Extra seconds the host allows past the end of a timed LED's on-window.
 TIMED_MARGIN_S = 0.05
+#: Characters of the text heard since the port opened that are kept to look for a banner in
+#: (the longest built-in banner, nichlock's, is under 1 kB).
+HEARD_KEPT = 4096
 
 
 class ScriptedDomeDriver:
@@ -45,6 +48,7 @@ class ScriptedDomeDriver:
     ) -> None:
         self.transport = transport
         self.spec = spec
+        self._device_name = device
         #: Floor under every reply timeout (``reply_timeout_s`` of the serial settings).
         self.min_reply_timeout_s = min_reply_timeout_s
         self.device = f"{device} ({transport.name}, {spec.name} profile)"
@@ -82,10 +86,18 @@ class ScriptedDomeDriver:
         self.banners_seen = 0
         self._heard = False
         self._bytes_heard = False
+        #: The text heard since the port opened (its last :data:`HEARD_KEPT` characters), where
+        #: another firmware's banner is looked for: a byte-acknowledged profile reads a banner
+        #: one byte at a time, and a stale one is dropped before each command.
+        self._heard_text = ""
         #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`),
         #: and when it ends
         self._booted = False
         self._boot_deadline = 0.0
+        #: The built-in firmware whose boot banner the board printed, when it is not this
+        #: profile's (:attr:`LinkFault.FOREIGN`): only its own all-off is sent to it from then
+        #: on (:meth:`switch_off_foreign`), none of this profile's commands. None: none seen.
+        self.foreign_firmware: str | None = None
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -97,6 +109,7 @@ class ScriptedDomeDriver:
             raise self._error(str(exc), "open port", LinkFault.DISCONNECTED) from exc
         self._open = True
         self._booted = False
+        self.foreign_firmware = None
         self._rx.clear()
         self._boot_deadline = self.transport.clock.now() + self.spec.boot_wait_s
         self._wait_boot()
@@ -112,12 +125,29 @@ class ScriptedDomeDriver:
         nichlock board sent ``<0>``, whose ``0`` stepped the board to LED 0, then the all-off
         after the failed connect stepped it to LED 1, and the user was told to check the port,
         the baud rate and the profile of a board that had printed its name."""
+        name = self._foreign_banner(self.boot_text)
+        if name is None:
+            return
+        self.foreign_firmware = name
+        raise self._error(
+            f"the board on this port printed the boot banner of the {name} firmware, not the "
+            f"{self.spec.name} one, so none of this profile's commands was sent to it (they are "
+            f"other keys to that firmware, which may light its LEDs); only that firmware's own "
+            f"all-off is sent, to switch off what it lit (the lights line says what it "
+            f'established): set profile = "{name}" in [dome.serial] (rti-rig probe PORT '
+            "confirms it)",
+            "wait after opening",
+            LinkFault.FOREIGN,
+        )
+
+    def _foreign_banner(self, text: str) -> str | None:
+        """The built-in firmware other than this profile's whose boot banner ``text`` holds,
+        or None. Only a built-in profile's board is judged so: a custom description may be of a
+        modified sketch that keeps another firmware's banner."""
         from rti_rig.drivers.led_dome.dome_profiles import builtin_spec, described_profiles
 
-        if self._heard or not self.boot_text or self.spec.name not in described_profiles():
-            # a custom description may be of a modified sketch that keeps another firmware's
-            # banner: only the built-in profiles, whose firmwares are known, are refused so
-            return
+        if self._heard or not text or self.spec.name not in described_profiles():
+            return None
         own = {self.spec.reset_pattern, self.spec.ready_pattern}
         for name in described_profiles():
             if name == self.spec.name:
@@ -125,16 +155,56 @@ class ScriptedDomeDriver:
             other = builtin_spec(name)
             for key in ("reset_pattern", "ready_pattern"):
                 pattern = other.get(key)
-                if pattern and pattern not in own and re.search(pattern, self.boot_text):
-                    raise self._error(
-                        f"the board on this port printed the boot banner of the {name} "
-                        f"firmware, not the {self.spec.name} one, so nothing was sent to it "
-                        f"(this profile's commands are other keys to that firmware, which may "
-                        f'light its LEDs): set profile = "{name}" in [dome.serial] '
-                        "(rti-rig probe PORT confirms it)",
-                        "wait after opening",
-                        LinkFault.FOREIGN,
-                    )
+                if pattern and pattern not in own and re.search(pattern, text):
+                    return str(name)
+        return None
+
+    def switch_off_foreign(self) -> OffOutcome:
+        """Send the all-off of the built-in firmware whose banner the board printed
+        (:attr:`foreign_firmware`), and nothing else; wait for its acknowledgement where that
+        firmware gives one. Returns what it established; a :class:`DomeLinkError` (naming that
+        firmware) if it could not be sent or was not acknowledged.
+
+        Why: the Nab sketch boots with every LED on. A board refused for its banner was left
+        lit, told to be switched off at its supply, when its own all-off (``<0>``), which the
+        board had just announced it understands, switches it off and says so. Its banner came
+        through at this port's baud rate, so its all-off is sent at that rate too."""
+        from rti_rig.drivers.led_dome.dome_profiles import builtin_spec
+        from rti_rig.drivers.led_dome.protocol_spec import ProtocolSpec
+
+        name = self.foreign_firmware
+        if name is None:
+            raise self._error(
+                "no other firmware's banner was heard on this port", "all off", LinkFault.REJECTED
+            )
+        theirs = ScriptedDomeDriver(
+            self.transport,
+            ProtocolSpec.model_validate(builtin_spec(name)),
+            device=self._device_name,
+            min_reply_timeout_s=self.min_reply_timeout_s,
+        )
+        if not self._open:
+            raise theirs._error("port not open", "all off", LinkFault.DISCONNECTED)
+        theirs._open = theirs._booted = True
+        try:
+            self._switch_off_as(theirs)
+        finally:
+            self._open = theirs._open
+        return theirs.off_outcome
+
+    def _switch_off_as(self, theirs: ScriptedDomeDriver) -> None:
+        """``theirs.all_off()`` once the banner ``theirs`` firmware is printing has ended."""
+        # the rest of its banner first (up to its ready text): what is sent before is lost
+        # while it still prints, and its banner would read as a reboot to its all-off
+        self._rx.clear()
+        theirs._heard_text = self._heard_text
+        ready = theirs.spec.ready_pattern
+        if ready and not re.search(ready, self._heard_text):
+            theirs._wait_ready(
+                self.transport.clock.now() + theirs.spec.boot_wait_s, self._heard_text
+            )
+        theirs._rx.clear()
+        theirs.all_off()
 
     def finish_boot(self) -> None:
         """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same
@@ -149,6 +219,7 @@ class ScriptedDomeDriver:
         self._open = False
         self._heard = False
         self._bytes_heard = False
+        self._heard_text = ""
         self._rx.clear()
         self.transport.close()
 
@@ -433,6 +504,7 @@ class ScriptedDomeDriver:
             self._bytes_heard = True
             traffic_log.debug("%s << %s", self.device, data.hex(" "))
             self._rx.extend(data)
+            self._heard_text = (self._heard_text + data.decode("latin-1"))[-HEARD_KEPT:]
 
     def _error(self, message: str, command: str, fault: LinkFault) -> DomeLinkError:
         retryable = fault not in (LinkFault.REJECTED, LinkFault.WAITING, LinkFault.FOREIGN)

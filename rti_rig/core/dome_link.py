@@ -29,7 +29,9 @@ class LinkFault(StrEnum):
     WAITING = "waiting"
     #: The board printed another known firmware's boot banner: it is not the profile's board,
     #: and the profile's commands (its all-off included) would be other keys to it (the Nab
-    #: sketch's ``<0>`` steps a nichlock board to its next LED), so nothing is sent to it.
+    #: sketch's ``<0>`` steps a nichlock board to its next LED), so none is sent to it. A link
+    #: that can offers ``switch_off_foreign()``: that firmware's own all-off, and nothing else
+    #: (the Nab sketch boots with every LED on).
     FOREIGN = "foreign"
 
 

@@ -256,13 +256,10 @@ class DomePolicy:
                 # established all-off since: nothing was sent after it, so that still holds.
                 pass
             elif exc.fault is LinkFault.FOREIGN:
-                # another firmware's board: this profile's all-off is other keys to it
+                # another firmware's board: this profile's all-off is other keys to it, that
+                # firmware's own all-off is not (a Nab board boots with every LED on)
                 self._port_was_open = True
-                self.off_report = OffReport(
-                    OffOutcome.NOT_SENT,
-                    "the board on the port runs another firmware, to which this profile's "
-                    "all-off is other commands",
-                )
+                self._switch_off_foreign("after the board was refused")
             else:
                 if exc.command != "open port":
                     self._port_was_open = True
@@ -920,6 +917,9 @@ class DomePolicy:
         try:
             self._counted(self.link.all_off)
         except DomeLinkError as exc:
+            if exc.fault is LinkFault.FOREIGN:
+                self._switch_off_foreign(when)
+                return
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = _failed_off(exc)
         except DeviceError as exc:
@@ -929,6 +929,37 @@ class DomePolicy:
             self.off_report = OffReport(
                 getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED), when
             )
+
+    def _switch_off_foreign(self, when: str) -> None:
+        """Send the all-off of the firmware whose banner the board printed (the link's
+        ``switch_off_foreign``: that all-off alone, acknowledged where that firmware
+        acknowledges), never this profile's; record what it established.
+
+        Why (a decision of the project's owners, hardware safety first): a Nab board, which
+        boots with every LED on, refused for its banner under another profile had been left
+        lit ("all-off could NOT be sent … switch the dome off at its power supply"), when the
+        all-off of the firmware it had just named switches it off. A link that cannot send
+        another firmware's all-off leaves the lights as unknown, as before."""
+        switch = getattr(self.link, "switch_off_foreign", None)
+        if switch is None:
+            self.off_report = OffReport(
+                OffOutcome.NOT_SENT,
+                "the board on the port runs another firmware, to which this profile's all-off "
+                "is other commands",
+            )
+            return
+        firmware = getattr(self.link, "foreign_firmware", None) or "other"
+        try:
+            outcome = self._counted(switch)
+        except DomeLinkError as exc:
+            log.warning(
+                "%s: the %s firmware's all-off %s failed: %s", self.name, firmware, when, exc
+            )
+            self.off_report = _failed_off(exc)
+            return
+        self.off_report = OffReport(
+            outcome, f"the {firmware} firmware's own all-off, whose banner the board printed"
+        )
 
     def _require_connected(self, command: str) -> DomeInfo:
         if self.info is None:

@@ -894,7 +894,8 @@ def test_a_profile_forced_onto_another_firmwares_board_is_refused_before_sending
     """The nab-rti-v1 profile (at the board's baud rate) on a nichlock board, whose boot banner
     names it: the Nab init ``<0>`` stepped the board to LED 0, the all-off after the failed
     connect to LED 1, and the user was told to check the port, the baud rate and the profile.
-    Now nothing is sent, the firmware is named and the lights' state is said as unknown."""
+    Now none of the profile's commands is sent, the firmware is named, and nichlock's own
+    all-off (``x``) alone is sent and its acknowledgement said."""
     from rti_rig.simulator.domes.nichlock import NichlockBoard
 
     board = NichlockBoard()
@@ -905,10 +906,38 @@ def test_a_profile_forced_onto_another_firmwares_board_is_refused_before_sending
     assert r.exit_code == 1, r.output
     text = said(r)
     assert "printed the boot banner of the nichlock firmware" in text, text
-    assert 'set profile = "nichlock"' in text and "nothing was sent to it" in text
-    assert "all-off could NOT be sent" in text and "lights are off" not in text
-    assert bytes(board.heard) == b""
+    assert 'set profile = "nichlock"' in text
+    assert "none of this profile's commands was sent to it" in text
+    assert "lights: all-off sent and acknowledged by the dome: lights are off" in text, text
+    assert bytes(board.heard) == b"x"
     assert all(not lit for _, lit in board.timeline)
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+@pytest.mark.parametrize("profile", ["rtipy"])
+def test_a_board_refused_for_the_nab_banner_is_switched_off_by_the_nab_all_off(
+    tmp_path: Path, profile: str
+) -> None:
+    """The Nab sketch boots with every LED on. Under another 9600-baud profile its banner
+    refused it, and it was left lit ("all-off could NOT be sent … switch the dome off at its
+    power supply"). Now the sketch's own all-off, ``<0>``, alone is sent, and its
+    acknowledgement is what the lights line says; the profile to set is named."""
+    board = board_for("nab-rti-v1")
+    shipped = {"rtipy": "emulated_rtipy.toml", "minirti": "emulated_minirti.toml"}
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        cfg = _hardware(tmp_path, shipped.get(profile, "emulated_rti_dome.toml"), link.port)
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+        assert eventually(lambda: board.lit == frozenset())
+    assert r.exit_code == 1, r.output
+    text = said(r)
+    assert "printed the boot banner of the nab-rti-v1 firmware" in text, text
+    assert 'set profile = "nab-rti-v1"' in text
+    assert "lights: all-off sent and acknowledged by the dome: lights are off" in text, text
+    assert "Traceback" not in text
+    # nothing of the refused profile's reached the sketch: what it read is its own all-off
+    heard = bytes(board.heard)
+    assert heard.endswith(b"<0>"), heard
+    assert b"<" not in heard[: -len(b"<0>")], heard
 
 
 @pytest.mark.slow  # real firmware timing over a pty
