@@ -402,8 +402,9 @@ def main(argv: list[str] | None = None) -> int:
     be pointed at it for a dry run through the real driver and real pyserial. ``--profile``
     names one of the project's own protocols (``default``, ``framed``, ``binary``) or a real
     firmware whose emulator ``rti_rig.simulator.domes`` holds (``nab-rti-v1`` …): that one has
-    the firmware's own LED count, baud rate and boot, so ``--leds``, ``--dead`` and
-    ``--boot-delay-s`` do not apply to it.
+    the firmware's own LED count and baud rate, so ``--leds`` and ``--dead`` do not apply to it;
+    ``--boot-delay-s`` sets its time in the bootloader after a reset (a slow or older
+    bootloader: the banner then comes later than the profile's boot wait).
     """
     import argparse
     import signal
@@ -419,7 +420,13 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--leds", type=int, default=None, help="LED count (default 48)")
     parser.add_argument("--dead", type=int, nargs="*", default=[], help="dead LED indices")
-    parser.add_argument("--boot-delay-s", type=float, default=None, help="default 0.5")
+    parser.add_argument(
+        "--boot-delay-s",
+        type=float,
+        default=None,
+        help="seconds from power-on or reset to the firmware's start (default 0.5; a real "
+        "firmware's emulator: its board's own bootloader time)",
+    )
     parser.add_argument(
         "--fault",
         action="append",
@@ -444,14 +451,15 @@ def main(argv: list[str] | None = None) -> int:
     # temporary folder is removed instead of left behind in /tmp.
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     if args.profile in SERIAL_FIRMWARES:
-        options = (("--leds", args.leds), ("--boot-delay-s", args.boot_delay_s))
-        given = [option for option, value in options if value is not None]
+        given = ["--leds"] if args.leds is not None else []
         given += ["--dead"] if args.dead else []
         if given:
             parser.error(
                 f"{', '.join(given)}: the {args.profile} firmware's emulator has the firmware's "
-                "own LED count and boot; these options are for default, framed and binary"
+                "own LEDs; these options are for default, framed and binary"
             )
+        if args.boot_delay_s is not None and not 0 <= args.boot_delay_s <= 60:
+            parser.error(f"--boot-delay-s {args.boot_delay_s:g}: give 0 to 60 seconds")
         from rti_rig.simulator.domes import board_for
         from rti_rig.simulator.domes.board import BOARD_FAULT_KINDS
 
@@ -462,6 +470,8 @@ def main(argv: list[str] | None = None) -> int:
                 f"emulate it; it emulates {', '.join(k.value for k in BOARD_FAULT_KINDS)}"
             )
         board = board_for(args.profile, faults=FaultPlan(tuple(faults)))
+        if args.boot_delay_s is not None:
+            board.boot_s = args.boot_delay_s  # an instance's, not the firmware class's
         with serve_on_pty(board, args.profile) as link:
             print(
                 f"emulated {args.profile} firmware ({board.led_count} LEDs, "

@@ -819,6 +819,29 @@ def test_a_fault_a_firmware_emulator_does_not_emulate_is_refused(capsys) -> None
     assert "give K:KIND" in capsys.readouterr().err
 
 
+def test_a_served_firmware_boots_as_slowly_as_asked(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``--boot-delay-s`` sets a real firmware's bootloader time (an older or slower bootloader,
+    whose banner comes after the profile's boot wait), so that case can be rehearsed through
+    ``rti-rig probe``/``check``; it had been refused for every real firmware's emulator."""
+    import contextlib
+
+    from rti_rig.simulator import dome_firmware
+
+    served = []
+
+    @contextlib.contextmanager
+    def serve(board, name):  # type: ignore[no-untyped-def]
+        served.append(board)
+        yield type("Link", (), {"port": "/dev/null", "alive": False})()
+
+    monkeypatch.setattr(dome_firmware, "serve_on_pty", serve)
+    assert dome_firmware.main(["--profile", "nab-rti-v1", "--boot-delay-s", "7"]) == 0
+    assert served[0].boot_s == 7.0
+    assert board_for("nab-rti-v1").boot_s == 1.6  # the firmware's own, untouched
+    with pytest.raises(SystemExit):
+        dome_firmware.main(["--profile", "nab-rti-v1", "--leds", "8"])
+
+
 def test_an_elexol_board_whose_first_reply_is_lost_is_checked(tmp_path: Path) -> None:
     """The Elexol board sends no banner (nothing resets it when the port opens), so nothing had
     shown it there before its ``?``: the answer lost (a USB-serial adapter dropping bytes at
