@@ -20,6 +20,7 @@ Like :class:`LedDomeDriver` it never retries: the runtime's ``DomePolicy`` decid
 from __future__ import annotations
 
 import logging
+import math
 import re
 
 from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
@@ -93,11 +94,19 @@ class ScriptedDomeDriver:
         #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`),
         #: and when it ends
         self._booted = False
+        self._opened_at = 0.0
         self._boot_deadline = 0.0
+        #: the wait after opening heard something (a banner, bootloader noise): a banner later
+        #: than that is a reboot, not a late first boot
+        self._boot_heard = False
         #: The built-in firmware whose boot banner the board printed, when it is not this
         #: profile's (:attr:`LinkFault.FOREIGN`): only its own all-off is sent to it from then
         #: on (:meth:`switch_off_foreign`), none of this profile's commands. None: none seen.
         self.foreign_firmware: str | None = None
+        #: What that firmware's all-off established once it went through (nothing is sent to
+        #: the board after it, so it holds until the port is opened again).
+        self._foreign_off: OffOutcome | None = None
+        self._foreign_cache: list[tuple[str, str]] | None = None
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -108,12 +117,15 @@ class ScriptedDomeDriver:
         except TransportError as exc:
             raise self._error(str(exc), "open port", LinkFault.DISCONNECTED) from exc
         self._open = True
-        self._booted = False
+        self._booted = self._boot_heard = False
         self.foreign_firmware = None
+        self._foreign_off = None
         self._rx.clear()
-        self._boot_deadline = self.transport.clock.now() + self.spec.boot_wait_s
+        self._opened_at = self.transport.clock.now()
+        self._boot_deadline = self._opened_at + self.spec.boot_wait_s
         self._wait_boot()
         self._booted = True
+        self._boot_heard = bool(self.boot_text.strip())
         self._refuse_foreign_banner()
         return self.hello()
 
@@ -144,20 +156,31 @@ class ScriptedDomeDriver:
         """The built-in firmware other than this profile's whose boot banner ``text`` holds,
         or None. Only a built-in profile's board is judged so: a custom description may be of a
         modified sketch that keeps another firmware's banner."""
-        from rti_rig.drivers.led_dome.dome_profiles import builtin_spec, described_profiles
-
-        if self._heard or not text or self.spec.name not in described_profiles():
+        if self._heard or not text:
             return None
-        own = {self.spec.reset_pattern, self.spec.ready_pattern}
-        for name in described_profiles():
-            if name == self.spec.name:
-                continue
-            other = builtin_spec(name)
-            for key in ("reset_pattern", "ready_pattern"):
-                pattern = other.get(key)
-                if pattern and pattern not in own and re.search(pattern, text):
-                    return str(name)
+        for name, pattern in self._foreign_patterns():
+            if re.search(pattern, text):
+                return name
         return None
+
+    def _foreign_patterns(self) -> list[tuple[str, str]]:
+        """(firmware, banner pattern) of each other built-in firmware (none for a description
+        that is not a built-in profile), read once: they are looked for in every reply."""
+        if self._foreign_cache is None:
+            from rti_rig.drivers.led_dome.dome_profiles import builtin_spec, described_profiles
+
+            self._foreign_cache = []
+            if self.spec.name in described_profiles():
+                own = {self.spec.reset_pattern, self.spec.ready_pattern}
+                for name in described_profiles():
+                    if name == self.spec.name:
+                        continue
+                    other = builtin_spec(name)
+                    for key in ("reset_pattern", "ready_pattern"):
+                        pattern = other.get(key)
+                        if pattern and pattern not in own:
+                            self._foreign_cache.append((str(name), str(pattern)))
+        return self._foreign_cache
 
     def switch_off_foreign(self) -> OffOutcome:
         """Send the all-off of the built-in firmware whose banner the board printed
@@ -177,6 +200,8 @@ class ScriptedDomeDriver:
             raise self._error(
                 "no other firmware's banner was heard on this port", "all off", LinkFault.REJECTED
             )
+        if self._foreign_off is not None:
+            return self._foreign_off  # nothing was sent to the board since: it still holds
         theirs = ScriptedDomeDriver(
             self.transport,
             ProtocolSpec.model_validate(builtin_spec(name)),
@@ -190,7 +215,8 @@ class ScriptedDomeDriver:
             self._switch_off_as(theirs)
         finally:
             self._open = theirs._open
-        return theirs.off_outcome
+        self._foreign_off = theirs.off_outcome
+        return self._foreign_off
 
     def _switch_off_as(self, theirs: ScriptedDomeDriver) -> None:
         """``theirs.all_off()`` once the banner ``theirs`` firmware is printing has ended."""
@@ -214,6 +240,7 @@ class ScriptedDomeDriver:
         if self._open and not self._booted:
             self._wait_ready(self._boot_deadline, "")
             self._booted = True
+            self._boot_heard = bool(self.boot_text.strip())
 
     def close(self) -> None:
         self._open = False
@@ -241,6 +268,21 @@ class ScriptedDomeDriver:
         """Any byte at all came from the port since it was last opened, as
         :attr:`~rti_rig.drivers.led_dome.driver.LedDomeDriver.bytes_heard` (why the policy asks)."""
         return self._bytes_heard
+
+    @property
+    def silence_hint(self) -> str:
+        """The end of a failed connect's advice when the port sent no byte since it opened but
+        this profile's board prints a boot banner at every opening: a board slower to boot than
+        the boot wait (an older bootloader) stays silent through it, then prints its banner
+        (and the Nab sketch lights every LED) after the connect gave up. "" otherwise."""
+        spec = self.spec
+        if self._bytes_heard or spec.ready_pattern is None or spec.reset_pattern is None:
+            return ""
+        return (
+            f"; the {spec.name} board prints a boot banner each time its port opens, and none "
+            f"came within the profile's boot wait (boot_wait_s = {spec.boot_wait_s:g} s): if "
+            "the board is slow to boot, raise boot_wait_s in [dome.serial.protocol]"
+        )
 
     def hello(self) -> DomeInfo:
         """Handshake (if the firmware has one) and the init commands; the board's state is
@@ -354,6 +396,14 @@ class ScriptedDomeDriver:
     ) -> str:
         if not self._open:
             raise self._error("port not open (connect first)", name, LinkFault.DISCONNECTED)
+        if self.foreign_firmware is not None:
+            raise self._error(
+                f"the board on this port runs the {self.foreign_firmware} firmware (it printed "
+                f"its boot banner), so none of this profile's commands is sent to it: set "
+                f'profile = "{self.foreign_firmware}" in [dome.serial]',
+                name,
+                LinkFault.FOREIGN,
+            )
         clock = self.transport.clock
         try:
             self._drain_stale(name)
@@ -424,6 +474,19 @@ class ScriptedDomeDriver:
                     )
             remaining = deadline - clock.now()
             if remaining <= 0:
+                if text.strip() and self._banner_may_be_coming():
+                    # unmatched text from a board silent through its boot wait, on a profile
+                    # whose board prints a banner: read on to its end (up to a boot wait) to
+                    # tell a late banner (above) from a reply this profile cannot read
+                    self._rx.clear()
+                    self._wait_ready(clock.now() + self.spec.boot_wait_s, text)
+                    ready_seen, self._heard = self._heard, False  # the banner's first sight
+                    try:
+                        self._check_reset_or_error(self.boot_text, name)
+                    finally:
+                        self._boot_heard = True  # once only: what follows is judged as replies
+                    self._heard = ready_seen
+                    text = self.boot_text
                 if text.strip():
                     self._rx.clear()
                     raise self._error(
@@ -440,13 +503,48 @@ class ScriptedDomeDriver:
 
     def _check_reset_or_error(self, text: str, name: str) -> None:
         spec = self.spec
+        other = self._foreign_banner(self._heard_text)
+        if other is not None:
+            # a banner later than the boot wait (a slow bootloader, or a profile without one:
+            # rti-dome-m waits for none) had been dropped as stale input, or read a byte at a
+            # time as replies: a Nab board, lit from its boot, was then said "most likely off"
+            self.foreign_firmware = other
+            self._rx.clear()
+            after = self.transport.clock.now() - self._opened_at
+            raise self._error(
+                f"the board on this port printed the boot banner of the {other} firmware, not "
+                f"the {spec.name} one, {after:.1f} s after the port opened (after this "
+                f"profile's boot wait of {spec.boot_wait_s:g} s), so commands of this profile "
+                f"had reached it before; none is sent from now on, only that firmware's own "
+                f"all-off, to switch off what it lit (the lights line says what it "
+                f'established): set profile = "{other}" in [dome.serial] (rti-rig probe PORT '
+                "confirms it)",
+                name,
+                LinkFault.FOREIGN,
+            )
         if spec.reset_pattern and re.search(spec.reset_pattern, text):
+            # the first banner since the port opened, after a boot wait that heard nothing
+            late = not self._heard and not self._boot_heard
             self.banners_seen += 1
             self._heard = True
             self._rx.clear()
             self._lit = frozenset()
             self._window_end = self._timed_led = None
+            after = self.transport.clock.now() - self._opened_at
             self._wait_ready(self.transport.clock.now() + spec.boot_wait_s, text)
+            if late:
+                # a slow bootloader: the banner had been reported as a reboot, or (cut at a
+                # reply's deadline) as an unreadable reply with "check the port, the baud
+                # rate and the profile", and the Nab sketch, lit at its boot, was left lit
+                raise self._error(
+                    f"the board printed its boot banner only {after:.1f} s after the port "
+                    f"opened, past this profile's boot wait (boot_wait_s = {spec.boot_wait_s:g}"
+                    f" s), so what was sent before was lost: a bootloader slower than the "
+                    f"{spec.name} firmware's usual one (set boot_wait_s = "
+                    f"{math.ceil(after) + 1} in [dome.serial.protocol]), or a reboot",
+                    name,
+                    LinkFault.RESET,
+                )
             raise self._error(
                 "the board rebooted (boot banner) before answering", name, LinkFault.RESET
             )
@@ -464,6 +562,17 @@ class ScriptedDomeDriver:
             self._heard = True
             self._rx.clear()
             raise self._error(f"the firmware refused: {m.group(0)!r}", name, LinkFault.REJECTED)
+
+    def _banner_may_be_coming(self) -> bool:
+        """Nothing this profile prints has been heard since the port opened, the boot wait
+        heard nothing, and this profile's board prints a boot banner: text now may be a banner
+        later than the boot wait (an older or slower bootloader)."""
+        return (
+            not self._heard
+            and not self._boot_heard
+            and self.spec.ready_pattern is not None
+            and self.spec.reset_pattern is not None
+        )
 
     def _drain_stale(self, name: str) -> None:
         self._feed(self.transport.read(0.0))

@@ -239,6 +239,8 @@ class DomePolicy:
                 self._spoke_before_drop or self._board_spoke_profile(exc)
             )
             spoke = answered and exc.fault is not LinkFault.REJECTED
+            # a board that prints a banner at every opening, and none came (a slow bootloader)
+            silent_boot = str(getattr(self.link, "silence_hint", ""))
             if answered:
                 self.reached = "answered"
             elif exc.command != "open port":
@@ -300,7 +302,7 @@ class DomePolicy:
                 self.name,
                 f"no handshake with the dome ({exc.message}); check the port, the baud rate and "
                 f"the protocol profile in the rig config, and that the board is powered"
-                f"{self._link_hint()}",
+                f"{self._link_hint()}{silent_boot}",
                 exc.command,
             ) from exc
         except BaseException:
@@ -591,7 +593,10 @@ class DomePolicy:
             self._run(self.link.all_off, "all off")
         except DomeLinkError as exc:
             self._lit = None
-            self.off_report = _failed_off(exc)
+            if exc.fault is LinkFault.FOREIGN:
+                self._switch_off_foreign("in place of this profile's all-off")
+            else:
+                self.off_report = _failed_off(exc)
             raise
         self.off_report = OffReport(getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED))
         self._check_on_time("all off")

@@ -297,7 +297,8 @@ def test_a_profile_without_a_handshake_whose_board_never_answers_names_port_baud
 def test_a_board_that_talks_another_protocol_is_not_said_to_be_silent(tmp_path: Path) -> None:
     """The miniRTI profile on a Nab sketch board: the board sends its banner and replies, which
     the profile cannot read. It had been told "nothing on this port has answered yet", sending
-    the user to the cable and the power supply of a board that was talking."""
+    the user to the cable and the power supply of a board that was talking. Its banner, later
+    than the profile's 1.5 s boot wait, now names the firmware that talks."""
     board = board_for("nab-rti-v1")
     with serve_on_pty(board, "nab-rti-v1") as link:
         cfg = _hardware(tmp_path, "emulated_minirti.toml", link.port)
@@ -305,7 +306,7 @@ def test_a_board_that_talks_another_protocol_is_not_said_to_be_silent(tmp_path: 
     assert r.exit_code == 1, r.output
     text = said(r)
     assert "nothing on this port has answered" not in text
-    assert "a board on this port sends bytes, but none this rig config's protocol profile" in text
+    assert "printed the boot banner of the nab-rti-v1 firmware, not the minirti one" in text
     assert "rti-rig probe PORT" in text
 
 
@@ -937,7 +938,7 @@ def test_a_profile_forced_onto_another_firmwares_board_is_refused_before_sending
 
 
 @pytest.mark.slow  # real firmware timing over a pty
-@pytest.mark.parametrize("profile", ["rtipy"])
+@pytest.mark.parametrize("profile", ["rtipy", "minirti", "rti-dome-m"])
 def test_a_board_refused_for_the_nab_banner_is_switched_off_by_the_nab_all_off(
     tmp_path: Path, profile: str
 ) -> None:
@@ -957,10 +958,54 @@ def test_a_board_refused_for_the_nab_banner_is_switched_off_by_the_nab_all_off(
     assert 'set profile = "nab-rti-v1"' in text
     assert "lights: all-off sent and acknowledged by the dome: lights are off" in text, text
     assert "Traceback" not in text
-    # nothing of the refused profile's reached the sketch: what it read is its own all-off
+    # the sketch read one command, its own all-off: a banner later than the profile's boot
+    # wait (minirti waits 1.5 s, rti-dome-m none, the sketch's bootloader 1.6 s) had been read
+    # a byte at a time as acks, or dropped as stale input and the board said "most likely off"
     heard = bytes(board.heard)
-    assert heard.endswith(b"<0>"), heard
-    assert b"<" not in heard[: -len(b"<0>")], heard
+    assert heard.endswith(b"<0>") and heard.count(b"<") == 1, heard
+
+
+@pytest.mark.slow  # real firmware timing over a pty, and a board 5 s in its bootloader
+def test_a_banner_later_than_the_boot_wait_is_a_late_boot_and_the_board_is_switched_off(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A Nab board whose bootloader takes 5 s (the profile waits 4 s): the init ``<0>`` went
+    into the bootloader, the banner then read as a reboot or, cut at a reply's deadline, as an
+    unreadable reply ("check the port, the baud rate and the protocol profile"), and the board,
+    lit at its boot, was said "may still be on". Now the init is sent again after the banner,
+    and the late boot is said with the key to raise."""
+    board = board_for("nab-rti-v1")
+    board.boot_s = 5.0
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        cfg = _hardware(tmp_path, "emulated_nab_rti_v1.toml", link.port)
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+        assert eventually(lambda: board.lit == frozenset())
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert "RESULT: PASS" in text and "lights are off" in text, text
+    warned = " ".join(caplog.text.split())  # what the check warns on stderr as it recovers
+    assert "printed its boot banner only" in warned and "boot_wait_s = 4 s" in warned, warned
+    assert "set boot_wait_s = " in warned and "[dome.serial.protocol]" in warned
+    assert "rebooted" not in warned and "check the port" not in warned
+
+
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_board_silent_through_the_connect_names_its_boot_wait(tmp_path: Path) -> None:
+    """A Nab board still in its bootloader when the connect gave up: the advice was the port,
+    the baud rate and the profile alone, where the board prints a banner at every opening and
+    none came; the boot wait is named too (the lights are said unknown: it boots lit)."""
+    board = board_for("nab-rti-v1")
+    board.boot_s = 30.0
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        cfg = _hardware(tmp_path, "emulated_nab_rti_v1.toml", link.port)
+        text = cfg.read_text().replace("reply_timeout_s = 3.0", "reply_timeout_s = 0.5")
+        cfg.write_text(text.replace("led_count = 12", "led_count = 12\nboot_wait_s = 0.5"))
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert "prints a boot banner each time its port opens, and none came" in text, text
+    assert "boot_wait_s = 0.5 s" in text and "raise boot_wait_s in [dome.serial.protocol]" in text
+    assert "lights may still be on" in text
 
 
 @pytest.mark.slow  # real firmware timing over a pty
