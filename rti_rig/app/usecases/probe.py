@@ -216,7 +216,15 @@ def probe(request: ProbeRequest) -> ProbeResult:
             result.profile, result.baudrate = "rtipy", 9600
             result.lights = "LED (0, 0) was asked for zero seconds: it stays dark"
             return result
-        result.lights = "nothing that lights an LED was sent"
+        # a board that resets at every opening and is still in its bootloader when each
+        # listen ends is heard by no probe; the Nab sketch then lights every LED as it boots,
+        # after the probe had said only that nothing lighting was sent
+        result.lights = (
+            f"nothing that lights an LED was sent; but a board that resets when its port opens "
+            f"(an Arduino) and takes longer than the {wait:g} s each probe listens to boot "
+            "answers none of them, and lights whatever its firmware lights at boot once the "
+            "probe has closed the port (the Nab sketch: every LED): look at the dome"
+        )
     except TransportError as exc:
         result.error = str(exc)
         if result.profile == "nab-rti-v1":

@@ -965,6 +965,24 @@ def test_a_board_refused_for_the_nab_banner_is_switched_off_by_the_nab_all_off(
     assert heard.endswith(b"<0>") and heard.count(b"<") == 1, heard
 
 
+@pytest.mark.slow  # every probe, each listening 2.6 s after the port opens
+def test_a_probe_that_heard_nothing_says_a_slow_booting_board_may_light_after_it(
+    tmp_path: Path,
+) -> None:
+    """A Nab board whose bootloader outlasts each probe's listen answers none (each opening
+    resets it), then lights every LED as it boots once the probe has closed the port: the probe
+    had said only "nothing that lights an LED was sent"."""
+    board = board_for("nab-rti-v1")
+    board.boot_s = 30.0
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = runner.invoke(app, ["probe", link.port], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert "No known dome firmware answered" in text
+    assert "takes longer than the 2.6 s each probe listens to boot" in text, text
+    assert "(the Nab sketch: every LED): look at the dome" in text
+
+
 @pytest.mark.slow  # real firmware timing over a pty, and a board 5 s in its bootloader
 def test_a_banner_later_than_the_boot_wait_is_a_late_boot_and_the_board_is_switched_off(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
