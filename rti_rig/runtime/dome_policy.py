@@ -671,14 +671,23 @@ class DomePolicy:
                     lost = self._lit
                     self._lit = None
                     self.guard.record(lost.index, lost.since, self.clock.now())
-                    self._recover(exc, command)
+                    back = self._recover(exc, command)
                     what = "rebooted" if fault is LinkFault.RESET else "dropped off the USB bus"
+                    # "off again" only once the handshake after the reboot went through: a
+                    # board that rebooted again there (the Nab sketch boots lit) had been said
+                    # off while every LED was on
+                    state = (
+                        "the dome is off again"
+                        if back
+                        else "its handshake after the reboot failed too, so whether the dome "
+                        "is lit is unknown until the closing all-off (see the lights line)"
+                    )
                     raise DomeLedError(
                         self.name,
                         lost.index,
                         f"the board {what} while LED {lost.index} was meant to be lit (found "
                         f"during '{command}'): the image taken under LED {lost.index} may have "
-                        "had no light; the dome is off again, repeat that capture",
+                        f"had no light; {state}; repeat that capture",
                         command,
                     ) from exc
                 if not exc.retryable or not idempotent or attempt >= self.settings.retries:
@@ -724,8 +733,10 @@ class DomePolicy:
                 self.stats.recovered += resent
                 return result
 
-    def _recover(self, exc: DomeLinkError, command: str) -> None:
-        """Bring the link back after ``exc`` so that the command can be sent again."""
+    def _recover(self, exc: DomeLinkError, command: str) -> bool:
+        """Bring the link back after ``exc`` so that the command can be sent again. False when
+        the handshake after a reboot failed (what the board then has lit is unknown), True
+        otherwise (a failed reconnection raises)."""
         if exc.fault is LinkFault.DISCONNECTED:
             self._reconnect(command)
         elif exc.fault is LinkFault.RESET:
@@ -735,14 +746,16 @@ class DomePolicy:
             except DomeLinkError as again:
                 if again.fault is LinkFault.DISCONNECTED:
                     self._reconnect(command)
-                else:  # the resend that follows is bounded by the retry count anyway
-                    log.warning("%s: handshake after a reset failed: %s", self.name, again)
-                return
+                    return True
+                # the resend that follows is bounded by the retry count anyway
+                log.warning("%s: handshake after a reset failed: %s", self.name, again)
+                return False
             problem = self._check_identity(info)
             if problem:
                 raise DeviceError(self.name, f"after a board reset: {problem}", command)
         else:
             self._back_off(self.settings.retry_backoff_s)
+        return True
 
     def _back_off(self, seconds: float) -> None:
         """Wait ``seconds`` for the device: a back-off gives the board (a USB device coming back

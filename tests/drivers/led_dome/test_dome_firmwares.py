@@ -422,6 +422,24 @@ def test_board_reset_mid_session_stops_naming_the_led_keeps_images_and_ends_dark
     assert "rebooted" in r_text
 
 
+def test_a_board_that_reboots_again_at_its_rehandshake_is_not_said_off(tmp_path: Path) -> None:
+    """The Nab sketch reboots (lit) while LED 1 is lit, and again at the init all-off of the
+    handshake after it: the error said "the dome is off again" of a board with every LED on.
+    It says the state is unknown until the closing all-off, which the lights line reports."""
+    cfg = with_faults(
+        "nab-rti-v1",
+        tmp_path,
+        'faults = [{at_command = 6, kind = "reset"}, {at_command = 7, kind = "reset"}]\n',
+    )
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert "the board rebooted while LED 1 was meant to be lit" in text, text
+    assert "the dome is off again" not in text
+    assert "whether the dome is lit is unknown until the closing all-off" in text
+    assert "lights: all-off sent and acknowledged by the dome: lights are off" in text
+
+
 def test_port_gone_for_good_is_a_named_error_and_says_lights_unknown(tmp_path: Path) -> None:
     cfg = with_faults(
         "nab-rti-v1", tmp_path, 'faults = [{at_command = 6, kind = "disconnect", delay_s = 60}]\n'
