@@ -701,15 +701,18 @@ class DomePolicy:
                             if attempt
                             else ""
                         )
-                    if not self._answered and fault is LinkFault.TIMEOUT:
+                    talked = bool(getattr(self.link, "bytes_heard", False))
+                    if not self._answered and fault is LinkFault.TIMEOUT and not talked:
                         why += (
                             "; nothing on this port has answered yet: check the port, the baud "
                             "rate and the protocol profile in the rig config, and that the "
                             f"board is powered{self._link_hint()}"
                         )
                     elif not self._answered and fault in _NOT_ITS_BOARD:
-                        # bytes came back (a banner, another firmware's replies): a board is
-                        # there and talks, which "nothing has answered" had denied
+                        # bytes came back (a banner, another firmware's replies, a banner at
+                        # another baud rate before a reply timed out): a board is there and
+                        # talks, which "nothing has answered … and that the board is powered"
+                        # had denied
                         why += (
                             "; a board on this port sends bytes, but none this rig config's "
                             "protocol profile understands: check the profile (rti-rig probe "

@@ -310,6 +310,25 @@ def test_a_board_that_talks_another_protocol_is_not_said_to_be_silent(tmp_path: 
     assert "rti-rig probe PORT" in text
 
 
+@pytest.mark.slow  # real firmware timing over a pty
+def test_a_board_whose_banner_came_at_another_baud_rate_is_not_said_to_be_silent(
+    tmp_path: Path,
+) -> None:
+    """The nichlock profile (115200 baud) on the 9600-baud Nab sketch: its banner arrives as
+    unreadable bytes, then the all-off's reply times out. That had been said "nothing on this
+    port has answered yet: check … that the board is powered", of a board that was talking."""
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        cfg = _hardware(tmp_path, "emulated_nichlock.toml", link.port)
+        cfg.write_text(cfg.read_text().replace("reply_timeout_s = 3.0", "reply_timeout_s = 0.5"))
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert "nothing on this port has answered" not in text, text
+    assert "a board on this port sends bytes, but none this rig config's protocol" in text
+    assert "lights may still be on" in text  # the sketch boots lit; nothing it reads was sent
+
+
 @pytest.mark.slow  # real firmware timing over a pty: seconds per firmware
 @pytest.mark.parametrize("profile", list(CONFIG))
 def test_session_of_8_lights_has_the_scheduled_led_lit_at_every_capture(
