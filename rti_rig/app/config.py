@@ -324,6 +324,18 @@ class RigConfig(_Strict):
                 f"backend '{self.backend}' drives the dome over serial: add a [dome.serial] "
                 "table (port, profile; see docs/protocols/led-dome.md)"
             )
+        serial = self.dome.serial if self.kind == "dome" and self.dome is not None else None
+        if self.backend == "emulated" and serial is not None and serial.port != "emulated":
+            # the dry run serves its own emulator and replaces the port: a config copied from a
+            # shipped emulated one with the dome's real port set, as its header said to, ran a
+            # whole check against the emulator ("PASS") and never opened the dome's port
+            raise ValueError(
+                f"[dome.serial] port = {serial.port!r} with backend = 'emulated': an emulated "
+                "dry run serves its own emulator of the dome on a pseudo-terminal and never "
+                "opens that port, so the dome on it would not be reached; to drive it, set "
+                "backend = 'hardware' (with a [camera.device]); for the dry run, set "
+                "port = 'emulated'"
+            )
         if self.backend != "simulated" and self.kind == "arm" and self.arm.dynamixel is None:  # type: ignore[union-attr]
             raise ValueError(
                 f"backend '{self.backend}' drives the arm's servos: add an [arm.dynamixel] "
