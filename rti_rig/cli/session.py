@@ -253,13 +253,7 @@ def run(
                 handover.hold()  # a stop from here on: the capture answers it
         except RtiRigError as exc:
             _print_failures(getattr(exc, "teardown_failures", None))  # metering's
-            state = getattr(exc, "lights_state", None)
-            if state is not None:  # metering failed: it had lit the rig; nothing was written yet
-                err.print(
-                    f"{_sentence(state)}; nothing was captured or written to {out_dir}.",
-                    markup=False,
-                )
-            raise fail(exc) from None
+            raise _opening_failed(exc, out_dir) from None
         except (KeyboardInterrupt, EmergencyStop) as exc:
             # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
             # had been 130 with no word at all (a SIGTERM's 143, with no all-off either)
@@ -333,6 +327,17 @@ def refuse_unmetered_limit(
             "clip; without --auto-exposure the config's exposure is used as it is: add "
             "--auto-exposure, or drop --max-saturated"
         )
+
+
+def _opening_failed(exc: RtiRigError, out_dir: Path) -> typer.Exit:
+    """The exit for an error while the rig opened (before any image): where metering had lit
+    the rig, the lights' state is said first, with nothing captured or written."""
+    state = getattr(exc, "lights_state", None)
+    if state is not None:
+        err.print(
+            f"{_sentence(state)}; nothing was captured or written to {out_dir}.", markup=False
+        )
+    return fail(exc)
 
 
 def _stopped_while_opening(
@@ -945,13 +950,7 @@ def preview(
                 )
                 handover.hold()  # a stop from here on: the capture answers it
         except RtiRigError as exc:
-            state = getattr(exc, "lights_state", None)
-            if state is not None:  # metering failed: it had lit the rig; nothing was written yet
-                err.print(
-                    f"{_sentence(state)}; nothing was captured or written to {out_dir}.",
-                    markup=False,
-                )
-            raise fail(exc) from None
+            raise _opening_failed(exc, out_dir) from None
         except (KeyboardInterrupt, EmergencyStop) as exc:
             # metering for the preview lights the rig: a Ctrl-C had said only "rti-rig: stopped",
             # a SIGTERM nothing at all (and sent no all-off)

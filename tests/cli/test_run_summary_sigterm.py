@@ -32,23 +32,29 @@ app()
 """
 
 
-def test_a_sigterm_during_the_summary_keeps_it_and_says_how_to_get_the_verdict(
-    tmp_path: Path,
-) -> None:
-    cfg = write_config(tmp_path, SMALL_DOME)
+def _run_signalled(tmp_path: Path, *args: str) -> tuple[int, str]:
+    """rti-rig ``args`` on a small simulated dome, signalled as its summary prints: the exit
+    code and what it said, whitespace folded."""
     hook = tmp_path / "hook.py"
     hook.write_text(HOOK)
-    out = tmp_path / "s"
     env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"}
     proc = subprocess.run(
-        [sys.executable, str(hook), "run", str(cfg), "--out", str(out), "--lights", "8"],
+        [sys.executable, str(hook), *args],
         env=env,
         capture_output=True,
         text=True,
         timeout=300,
     )
-    said = " ".join((proc.stdout + proc.stderr).split())
-    assert proc.returncode == 143, said
+    return proc.returncode, " ".join((proc.stdout + proc.stderr).split())
+
+
+def test_a_sigterm_during_the_summary_keeps_it_and_says_how_to_get_the_verdict(
+    tmp_path: Path,
+) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    code, said = _run_signalled(tmp_path, "run", str(cfg), "--out", str(out), "--lights", "8")
+    assert code == 143, said
     assert "8 image(s) in the session" in said and "Session time on the real rig" in said
     assert "QA verdict was not computed" in said and f"rti-rig fit {out} --out FOLDER" in said
     manifest = json.loads((out / "manifest.json").read_text())
@@ -57,17 +63,7 @@ def test_a_sigterm_during_the_summary_keeps_it_and_says_how_to_get_the_verdict(
 
 def test_a_sigterm_during_the_preview_summary_keeps_the_plan_hint(tmp_path: Path) -> None:
     cfg = write_config(tmp_path, SMALL_DOME)
-    hook = tmp_path / "hook.py"
-    hook.write_text(HOOK)
     out = tmp_path / "p"
-    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"}
-    proc = subprocess.run(
-        [sys.executable, str(hook), "preview", str(cfg), "--out", str(out)],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    said = " ".join((proc.stdout + proc.stderr).split())
-    assert proc.returncode == 143, said
+    code, said = _run_signalled(tmp_path, "preview", str(cfg), "--out", str(out))
+    assert code == 143, said
     assert f"Plan from it: rti-rig plan {out}" in said and "Stopped (SIGTERM)" in said

@@ -219,8 +219,12 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
             "fit paired each with its own line, but relight pairs the lines with the folder's "
             f"JPEGs in name order, so it would give them the wrong lights; {again}"
         )
-    joined = f"{qa.integrity_note}; {note}" if qa.integrity_note else note
-    return replace(qa, integrity_note=joined)
+    return _integrity_noted(qa, note)
+
+
+def _integrity_noted(qa: QAReport, note: str) -> QAReport:
+    """``qa`` with ``note`` added to its integrity note."""
+    return replace(qa, integrity_note=f"{qa.integrity_note}; {note}" if qa.integrity_note else note)
 
 
 def _noted(qa: QAReport, note: str) -> QAReport:
@@ -315,8 +319,7 @@ def _with_stopped_while_committing(qa: QAReport, source: Path) -> QAReport:
             "record: neither its files nor its light were ever recorded as captured; leave it "
             f"out of the .lp, or let rti-rig run --resume {folder} capture it again"
         )
-        joined = f"{qa.integrity_note}; {note}" if qa.integrity_note else note
-        return replace(qa, integrity_note=joined)
+        return _integrity_noted(qa, note)
     note = (
         f"{stopped} is on disk without a journal record: the session stopped while saving it, "
         f"so it is no part of the session (not in {LP_NAME}, not fitted); rti-rig run --resume "
