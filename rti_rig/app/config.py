@@ -282,6 +282,29 @@ class RigConfig(_Strict):
     scene: SceneConfig = SceneConfig()
     emulator: EmulatorConfig = EmulatorConfig()
 
+    def _refuse_real_port_when_emulated(self) -> None:
+        """Refuse a real port in an emulated dry run's config, naming the key.
+
+        The dry run serves its own emulator (the dome's firmware, the arm's servos) and
+        replaces the port: a config copied from a shipped emulated one with the device's real
+        port set, as its header said to, ran a whole check against the emulator ("PASS") and
+        never opened the port, so the device on it was never reached."""
+        if self.backend != "emulated":
+            return
+        if self.kind == "dome" and self.dome is not None and self.dome.serial is not None:
+            key, port, device = "[dome.serial]", self.dome.serial.port, "the dome"
+        elif self.kind == "arm" and self.arm is not None and self.arm.dynamixel is not None:
+            key, port, device = "[arm.dynamixel]", self.arm.dynamixel.port, "the arm's servos"
+        else:
+            return
+        if port != "emulated":
+            raise ValueError(
+                f"{key} port = {port!r} with backend = 'emulated': an emulated dry run serves "
+                f"its own emulator of {device} and never opens that port, so {device} on it "
+                "would not be reached; to drive it, set backend = 'hardware' (with a "
+                "[camera.device]); for the dry run, set port = 'emulated'"
+            )
+
     @model_validator(mode="after")
     def _kind_has_its_table(self) -> RigConfig:
         if self.kind == "dome" and self.dome is None:
@@ -324,18 +347,7 @@ class RigConfig(_Strict):
                 f"backend '{self.backend}' drives the dome over serial: add a [dome.serial] "
                 "table (port, profile; see docs/protocols/led-dome.md)"
             )
-        serial = self.dome.serial if self.kind == "dome" and self.dome is not None else None
-        if self.backend == "emulated" and serial is not None and serial.port != "emulated":
-            # the dry run serves its own emulator and replaces the port: a config copied from a
-            # shipped emulated one with the dome's real port set, as its header said to, ran a
-            # whole check against the emulator ("PASS") and never opened the dome's port
-            raise ValueError(
-                f"[dome.serial] port = {serial.port!r} with backend = 'emulated': an emulated "
-                "dry run serves its own emulator of the dome on a pseudo-terminal and never "
-                "opens that port, so the dome on it would not be reached; to drive it, set "
-                "backend = 'hardware' (with a [camera.device]); for the dry run, set "
-                "port = 'emulated'"
-            )
+        self._refuse_real_port_when_emulated()
         if self.backend != "simulated" and self.kind == "arm" and self.arm.dynamixel is None:  # type: ignore[union-attr]
             raise ValueError(
                 f"backend '{self.backend}' drives the arm's servos: add an [arm.dynamixel] "

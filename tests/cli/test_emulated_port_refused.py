@@ -1,8 +1,10 @@
-"""An emulated dome config with a real port set is refused, naming the key and what to set.
+"""An emulated dome or arm config with a real port set is refused, naming the key and what to set.
 
 The shipped ``emulated_*.toml`` of the real firmwares said "Only [dome.serial] differs on the
 real dome: set port". A user who did so kept ``backend = "emulated"``: the dry run served its
 own emulator, never opened the port, and ``rti-rig check`` said PASS of a dome it never reached.
+The emulated arm (``simulated_arm.toml``: "on hardware e.g. /dev/ttyUSB0 (U2D2)") did the same:
+a full arm check PASS against the emulated servos, the U2D2's port never opened.
 """
 
 from __future__ import annotations
@@ -26,6 +28,19 @@ def test_a_real_port_under_the_emulated_backend_is_refused(tmp_path: Path, name:
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "[dome.serial] port = '/dev/ttyACM0' with backend = 'emulated'" in said, said
+    assert "never opens that port" in said and "set backend = 'hardware'" in said
+    assert "RESULT" not in said and "Traceback" not in said
+
+
+def test_a_real_port_for_the_emulated_arm_is_refused(tmp_path: Path) -> None:
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    assert 'port = "emulated"' in text and 'backend = "emulated"' in text
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace('port = "emulated"', 'port = "/dev/ttyUSB0"', 1))
+    r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "[arm.dynamixel] port = '/dev/ttyUSB0' with backend = 'emulated'" in said, said
     assert "never opens that port" in said and "set backend = 'hardware'" in said
     assert "RESULT" not in said and "Traceback" not in said
 
