@@ -46,6 +46,24 @@ def virtual_arm_variant(tmp_path: Path, scene: str, side: int | None = None) -> 
     return write_config(tmp_path, text.replace('name = "relief"', f'name = "{scene}"'), "arm.toml")
 
 
+@pytest.fixture(scope="session")
+def arm_tablet_12(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A correct session of the shipped virtual arm on the tablet with 12 lights (read only:
+    the QA tests copy it to move or clip its images): an object whose shading edges move with
+    the light, so two groups of its lights have median edges about a pixel apart."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    root = tmp_path_factory.mktemp("tablet")
+    out = root / "s"
+    config = virtual_arm_variant(root, "tablet")
+    args = ["run", str(config), "--out", str(out), "--lights", "12", "--no-verdict"]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 0, r.output
+    return out
+
+
 def coin_dome(folder: Path, exposure_s: float = 0.05) -> Path:
     """The shipped emulated dome (48 LEDs, real driver over a pty) shooting the polished coin at
     ``exposure_s``, as emulated_dome.toml did until its scene became the matte tablet: at 0.05 s

@@ -18,29 +18,25 @@ from typer.testing import CliRunner
 from rti_rig.cli import app
 
 
-@pytest.mark.parametrize("name", ["emulated_nab_rti_v1.toml", "emulated_dome.toml"])
-def test_a_real_port_under_the_emulated_backend_is_refused(tmp_path: Path, name: str) -> None:
+@pytest.mark.parametrize(
+    ("name", "key", "port"),
+    [
+        ("emulated_nab_rti_v1.toml", "[dome.serial]", "/dev/ttyACM0"),
+        ("emulated_dome.toml", "[dome.serial]", "/dev/ttyACM0"),
+        ("simulated_arm.toml", "[arm.dynamixel]", "/dev/ttyUSB0"),
+    ],
+)
+def test_a_real_port_under_the_emulated_backend_is_refused(
+    tmp_path: Path, name: str, key: str, port: str
+) -> None:
     text = (CONFIGS / name).read_text()
-    assert 'port = "emulated"' in text
-    cfg = tmp_path / "dome.toml"
-    cfg.write_text(text.replace('port = "emulated"', 'port = "/dev/ttyACM0"', 1))
-    r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
-    said = " ".join(r.output.split())
-    assert r.exit_code == 2, said
-    assert "[dome.serial] port = '/dev/ttyACM0' with backend = 'emulated'" in said, said
-    assert "never opens that port" in said and "set backend = 'hardware'" in said
-    assert "RESULT" not in said and "Traceback" not in said
-
-
-def test_a_real_port_for_the_emulated_arm_is_refused(tmp_path: Path) -> None:
-    text = (CONFIGS / "simulated_arm.toml").read_text()
     assert 'port = "emulated"' in text and 'backend = "emulated"' in text
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace('port = "emulated"', 'port = "/dev/ttyUSB0"', 1))
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text(text.replace('port = "emulated"', f'port = "{port}"', 1))
     r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
-    assert "[arm.dynamixel] port = '/dev/ttyUSB0' with backend = 'emulated'" in said, said
+    assert f"{key} port = '{port}' with backend = 'emulated'" in said, said
     assert "never opens that port" in said and "set backend = 'hardware'" in said
     assert "RESULT" not in said and "Traceback" not in said
 

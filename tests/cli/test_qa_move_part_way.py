@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import virtual_arm_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -85,28 +84,17 @@ def test_the_same_session_held_still_is_good(session: Path, tmp_path: Path) -> N
     assert qa["good"], qa["verdict"]
 
 
-@pytest.fixture(scope="module")
-def tablet(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The shipped virtual arm on the tablet with 12 lights: an object whose shading edges
-    move with the light, so two groups of its lights have median edges about a pixel apart."""
-    root = tmp_path_factory.mktemp("tablet")
-    config = virtual_arm_variant(root, "tablet")
-    out = root / "s"
-    args = ["run", str(config), "--out", str(out), "--lights", "12", "--no-verdict"]
-    r = runner.invoke(app, args)
-    assert r.exit_code == 0, r.output
-    return out
-
-
-def test_the_tablet_held_still_is_not_called_moved(tablet: Path, tmp_path: Path) -> None:
-    qa = _verdict(tablet, tmp_path / "f")
+def test_the_tablet_held_still_is_not_called_moved(arm_tablet_12: Path, tmp_path: Path) -> None:
+    qa = _verdict(arm_tablet_12, tmp_path / "f")
     assert "moved" not in qa["verdict"], qa["verdict"]
 
 
-def test_a_move_on_the_tablet_is_named_from_its_first_image(tablet: Path, tmp_path: Path) -> None:
+def test_a_move_on_the_tablet_is_named_from_its_first_image(
+    arm_tablet_12: Path, tmp_path: Path
+) -> None:
     """The first split (from whole-pixel peaks against the blended median) put the move at
     image_010; each image's own test against the two positions puts it at image_007."""
-    moved = _moved_copy(tablet, tmp_path / "moved", 7, 2, 0)
+    moved = _moved_copy(arm_tablet_12, tmp_path / "moved", 7, 2, 0)
     qa = _verdict(moved, tmp_path / "f")
     assert "moved from image_007 on" in qa["verdict"], qa["verdict"]
     assert qa["reshoot"] == [f"image_{i:03d}" for i in range(7, 13)], qa["verdict"]

@@ -20,25 +20,12 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-import pytest
-from conftest import virtual_arm_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
 
 runner = CliRunner()
-
-
-@pytest.fixture(scope="module")
-def tablet(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    root = tmp_path_factory.mktemp("tablet")
-    config = virtual_arm_variant(root, "tablet")
-    out = root / "s"
-    args = ["run", str(config), "--out", str(out), "--lights", "12", "--no-verdict"]
-    r = runner.invoke(app, args)
-    assert r.exit_code == 0, r.output
-    return out
 
 
 def _sha(path: Path) -> str:
@@ -74,9 +61,9 @@ def _changed_copy(session: Path, dst: Path, first: int, dx: int, clipped: int) -
 
 
 def test_the_move_is_said_once_beside_an_image_with_another_problem(
-    tablet: Path, tmp_path: Path
+    arm_tablet_12: Path, tmp_path: Path
 ) -> None:
-    moved = _changed_copy(tablet, tmp_path / "moved", first=7, dx=2, clipped=10)
+    moved = _changed_copy(arm_tablet_12, tmp_path / "moved", first=7, dx=2, clipped=10)
     out = tmp_path / "f"
     r = runner.invoke(app, ["fit", str(moved), "--out", str(out), "--no-ptm", "--no-hsh"])
     assert r.exit_code == 0, r.output
