@@ -119,9 +119,9 @@ def run(
         typer.Option(
             "--rebuild-journal",
             help="With --resume on a session whose journal.jsonl is lost or damaged: rebuild it "
-            "from manifest.json, taking back only the images whose files match the manifest's "
-            "checksums and whose light is the manifest's; the old journal and every other image "
-            "file are set aside in recovered/, never deleted.",
+            "from manifest.json and the journal's intact lines, taking back only the images "
+            "whose files match their recorded checksums and whose light is their step's; the old "
+            "journal and every other image file are set aside in recovered/, never deleted.",
         ),
     ] = False,
     adaptive: Annotated[

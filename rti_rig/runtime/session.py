@@ -1176,7 +1176,7 @@ def _prepare_resume(
             )
             + ": drop --rebuild-journal"
         )
-    rebuilt: dict[int, dict[str, Any]] | None = None  # the manifest's records taken back
+    rebuilt: dict[int, dict[str, Any]] | None = None  # the records taken back
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
         latest = _latest_records(scan.records)
@@ -1225,7 +1225,7 @@ def _prepare_resume(
             )
         unjournaled = _unjournaled_steps(root, manifest, scan, names)
         if rebuild_journal and unjournaled:
-            rebuilt = _provable_steps(root, manifest, names)
+            rebuilt = _provable_steps(root, manifest, names, scan.records)
             done = {i: _to_record(e) for i, e in rebuilt.items()}
         else:
             if unjournaled:
@@ -1242,7 +1242,9 @@ def _prepare_resume(
         recovered: list[str] = []
         rebuild: list[str] = []
         if rebuilt is not None:
-            rebuild, moved_aside = _rebuild_journal(root, manifest, rebuilt, names, stamp)
+            rebuild, moved_aside = _rebuild_journal(
+                root, manifest, rebuilt, names, stamp, scan.records
+            )
             recovered.extend(moved_aside)
         elif rebuild_journal:
             rebuild = [
@@ -1372,8 +1374,9 @@ def _refuse_unjournaled(
         "would set them aside and shoot them again (nothing in this folder was changed): "
         f"restore {JOURNAL} from a backup copy of the folder and resume again, or rebuild it "
         f"from the manifest: rti-rig run --resume {folder} --rebuild-journal (it takes back "
-        "only the images whose files match the manifest's checksums and light, and sets the "
-        "old journal and anything else aside in recovered/, never deleted)"
+        "only the images whose files match the checksums and light the manifest or an intact "
+        "journal line records, and sets the old journal and anything else aside in "
+        "recovered/, never deleted)"
     )
 
 
@@ -1404,11 +1407,21 @@ def _light_as_recorded(manifest: dict[str, Any], entry: dict[str, Any]) -> bool:
 
 
 def _provable_steps(
-    root: Path, manifest: dict[str, Any], names: list[str]
+    root: Path,
+    manifest: dict[str, Any],
+    names: list[str],
+    journaled: list[dict[str, Any]],
 ) -> dict[int, dict[str, Any]]:
-    """The manifest's records whose files are on disk as its checksums say (bytes, or a linear
-    TIFF's pixels) and whose light is the one the manifest gives the step: all a rebuilt
-    journal may hold. Nothing in the folder changes.
+    """The records whose files are on disk as their checksums say (bytes, or a linear TIFF's
+    pixels) and whose light is the one the manifest gives the step: all a rebuilt journal may
+    hold. Nothing in the folder changes.
+
+    A step's record is its last intact line of the damaged journal (``journaled``, well-formed
+    records only) when that proves it, else the manifest's. Why the journal's too: the manifest
+    is written only when a run ends, so the images a run committed before it was killed (SIGKILL,
+    a power cut) are recorded in the journal alone; a rebuild from the manifest alone set them
+    aside and shot them again, though their journal lines held their checksums and lights, the
+    very proof a plain resume takes.
 
     An adaptive session whose record of an image on disk holds no decision is refused: the
     resume could not decide that step again as it was, nor the lights after it."""
@@ -1427,11 +1440,18 @@ def _provable_steps(
                 f"{JOURNAL} from a backup copy of the folder, or start a new session with "
                 "another --out"
             )
-    return {
-        i: e
-        for i, e in listed.items()
-        if _light_as_recorded(manifest, e) and verified_steps(root, [e])
-    }
+    latest = _latest_records(list(journaled))
+    taken: dict[int, dict[str, Any]] = {}
+    for i in sorted(set(listed) | set(latest)):
+        for entry in (latest.get(i), listed.get(i)):
+            if (
+                entry is not None
+                and _light_as_recorded(manifest, entry)
+                and verified_steps(root, [entry])
+            ):
+                taken[i] = entry
+                break
+    return taken
 
 
 def _rebuild_journal(
@@ -1440,13 +1460,15 @@ def _rebuild_journal(
     taken: dict[int, dict[str, Any]],
     names: list[str],
     stamp: str,
+    journaled: list[dict[str, Any]],
 ) -> tuple[list[str], list[str]]:
     """Rebuild the journal from ``taken`` (:func:`_provable_steps`): the old journal is moved
     to ``recovered/STAMP/journal-damaged.jsonl``, every image file no taken record vouches for
-    to ``recovered/STAMP/not-in-manifest/`` (the manifest does not list its step) or
-    ``recovered/STAMP/unproven/`` (listed, but its file or light is not as the manifest says),
-    never deleted; then the journal is written with the taken records, as their lines were.
-    Returns what was done (said, and recorded in the manifest's run) and the paths set aside."""
+    to ``recovered/STAMP/not-in-manifest/`` (neither the manifest nor an intact line of the old
+    journal, ``journaled``, records its step) or ``recovered/STAMP/unproven/`` (recorded, but
+    its file or light is not as recorded), never deleted; then the journal is written with the
+    taken records, as their lines were. Returns what was done (said, and recorded in the
+    manifest's run) and the paths set aside."""
     notes: list[str] = []
     moved: list[str] = []
     aside = root / "recovered" / stamp
@@ -1462,6 +1484,7 @@ def _rebuild_journal(
         notes.append(f"the damaged {JOURNAL} was kept as {dest.relative_to(root).as_posix()}")
     keep = {name for e in taken.values() for name in e["sha256"]}
     listed = _manifest_records(manifest, names)
+    recorded = set(listed) | {e["index"] for e in journaled}
     steps_of = {n: i for i, n in enumerate(names)}
     files = [
         *root.glob("image_*"),
@@ -1473,7 +1496,7 @@ def _rebuild_journal(
         if rel in keep:
             continue
         step = steps_of.get("_".join(path.stem.split("_")[:2]))  # image_003_2.nef: step 3
-        why = "unproven" if step is not None and step in listed else "not-in-manifest"
+        why = "unproven" if step is not None and step in recorded else "not-in-manifest"
         dest = aside / why / rel
         try:
             dest.parent.mkdir(parents=True, exist_ok=True)
@@ -1482,19 +1505,30 @@ def _rebuild_journal(
             raise SessionWriteError(dest, exc) from None
         moved.append(dest.relative_to(root).as_posix())
         said = (
-            f"its step is in {MANIFEST}, but not all its files (or its light) are as recorded there"
+            f"its step is recorded (in {MANIFEST} or an intact line of the old {JOURNAL}), but "
+            "not all its files (or its light) are as recorded there"
             if why == "unproven"
-            else f"{MANIFEST} does not list its step, so nothing proves its light"
+            else f"{MANIFEST} does not list its step, nor does an intact line of the old "
+            f"{JOURNAL}, so nothing proves its light"
         )
         notes.append(f"{rel} set aside as {moved[-1]}: {said}")
     lines = b"".join(json.dumps(taken[i]).encode("utf-8") + b"\n" for i in sorted(taken))
     _write_bytes_atomic(journal, lines)
-    shown = ", ".join(names[i] for i in sorted(taken)[:8]) + (" …" if len(taken) > 8 else "")
+    from_manifest = [i for i in sorted(taken) if listed.get(i) == taken[i]]
+    from_journal = [i for i in sorted(taken) if listed.get(i) != taken[i]]
     notes.insert(
         0,
-        f"{JOURNAL} rebuilt from {MANIFEST}: {len(taken)} image(s) taken back"
-        + (f" ({shown})" if taken else "")
-        + ", each file matching the manifest's checksum and its light the manifest's",
+        f"{JOURNAL} rebuilt from {MANIFEST}: {len(from_manifest)} image(s) taken back"
+        + (f" ({_shown(names, from_manifest)})" if from_manifest else "")
+        + ", each file matching the manifest's checksum and its light the manifest's"
+        + (
+            f"; and {len(from_journal)} from the old {JOURNAL}'s intact lines "
+            f"({_shown(names, from_journal)}), committed after {MANIFEST} was last written (a "
+            "run killed before its end), each file matching its line's checksum and its light "
+            "the one its step was given"
+            if from_journal
+            else ""
+        ),
     )
     # said on disk too, beside what was set aside: a stop before the run records it in the
     # manifest (the rig not answering, a Ctrl-C while it opens) had left recovered/ unexplained
@@ -1506,6 +1540,11 @@ def _rebuild_journal(
     _write_bytes_atomic(report, "".join(f"{n}\n" for n in notes).encode("utf-8"))
     notes.append(f"what was done is written in {report.relative_to(root).as_posix()}")
     return notes, moved
+
+
+def _shown(names: list[str], steps: list[int]) -> str:
+    """The image names of ``steps``, the first 8 of them."""
+    return ", ".join(names[i] for i in steps[:8]) + (" …" if len(steps) > 8 else "")
 
 
 def _refuse_lost_journal(root: Path, names: list[str]) -> None:

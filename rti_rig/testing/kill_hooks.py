@@ -108,21 +108,16 @@ def popen_session(
 ) -> subprocess.Popen[bytes]:
     """Start ``rti-rig run CONFIG --out OUT --lights LIGHTS`` in a child process that dies at
     ``stage`` of step ``k`` (see the module docstring); stdout and stderr are piped."""
+    return popen_argv(stage, k, ["run", str(config), "--out", str(out), "--lights", str(lights)])
+
+
+def popen_argv(stage: str, k: int, cli_args: list[str]) -> subprocess.Popen[bytes]:
+    """Start ``rti-rig CLI_ARGS…`` (``run --resume DIR``, say) in a child process that dies
+    at ``stage`` of step ``k``, counted from this process's first step; stdout and stderr are
+    piped."""
     repo = Path(__file__).resolve().parent.parent
     env = {**os.environ, "PYTHONPATH": str(repo)}
-    argv = [
-        sys.executable,
-        "-m",
-        "rti_rig.testing.kill_hooks",
-        stage,
-        str(k),
-        "run",
-        str(config),
-        "--out",
-        str(out),
-        "--lights",
-        str(lights),
-    ]
+    argv = [sys.executable, "-m", "rti_rig.testing.kill_hooks", stage, str(k), *cli_args]
     return subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 

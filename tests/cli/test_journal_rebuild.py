@@ -23,6 +23,7 @@ from typer.testing import CliRunner
 from rti_rig.app.usecases.session import NewSessionRequest, open_new_session, run_opened_session
 from rti_rig.cli import app
 from rti_rig.runtime.controller import CancelToken, FinishReason, StepCompleted
+from rti_rig.testing.kill_hooks import popen_argv
 
 runner = CliRunner()
 LIGHTS = 8
@@ -282,9 +283,54 @@ def test_a_rebuild_that_takes_nothing_back_keeps_no_old_line(
     for step in manifest["steps"]:
         step["led"] = -1
     (out / "manifest.json").write_text(json.dumps(manifest))
+    # the journal's surviving lines too: they prove nothing either, and must not come back
+    journal = out / "journal.jsonl"
+    *whole, torn = journal.read_bytes().split(b"\n")
+    edited = [json.loads(line) | {"led": -1} for line in whole]
+    assert edited  # the surviving lines are there, to be left out
+    journal.write_bytes(b"".join(json.dumps(e).encode() + b"\n" for e in edited) + torn)
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 0, r.output
     assert "0 image(s) taken back" in said(r)
     lines = (out / "journal.jsonl").read_text().splitlines()
     assert [json.loads(line)["index"] for line in lines] == list(range(8))
+    assert _images(out) == _images(ref)
+
+
+def test_images_journaled_after_the_manifest_are_taken_back(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """A resume killed (SIGKILL) after committing three images: their journal lines hold their
+    checksums and lights, the manifest (written only when a run ends) does not. A line of the
+    journal is then overwritten (a sync tool), so the resume is refused and the rebuild named.
+    The rebuild had taken back only the manifest's images and set the three aside, then shot
+    them again; the journal's intact lines prove them as a plain resume would."""
+    _, ref, _ = made
+    out = tmp_path / "s"
+    shutil.copytree(made[2], out)
+    kill = popen_argv("before_journal", 3, ["run", "--resume", str(out)])
+    assert kill.wait(timeout=300) == -9, kill.communicate()
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().split(b"\n")
+    assert [json.loads(line)["index"] for line in lines if line] == list(range(7))
+    assert len(json.loads((out / "manifest.json").read_text())["steps"]) == 4
+    lines[3] = b"\x00" * len(lines[3])  # image_004's line, which the manifest records
+    journal.write_bytes(b"\n".join(lines))
+    kept = {n: (out / n).stat().st_ino for n in ("image_005.jpg", "linear/image_007.tif")}
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2 and "--rebuild-journal" in said(r), r.output
+
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert "7 of 8 images verified" in said(r), r.output
+    assert "and 3 from the old journal.jsonl's intact lines (image_005, image_006, image_007)" in (
+        said(r)
+    )
+    # only the image the kill left uncommitted was set aside; the three were never moved
+    aside = sorted(p.relative_to(out) for p in (out / "recovered").rglob("image_*"))
+    assert [p.parts[2:] for p in aside] == [
+        ("not-in-manifest", "image_008.jpg"),
+        ("not-in-manifest", "linear", "image_008.tif"),
+    ]
+    assert {n: (out / n).stat().st_ino for n in kept} == kept
     assert _images(out) == _images(ref)
