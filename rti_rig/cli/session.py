@@ -121,7 +121,8 @@ def run(
             help="With --resume on a session whose journal.jsonl is lost or damaged: rebuild it "
             "from manifest.json and the journal's intact lines, taking back only the images "
             "whose files match their recorded checksums and whose light is their step's; the old "
-            "journal and every other image file are set aside in recovered/, never deleted.",
+            "journal and every other image file are set aside in recovered/, never deleted. A "
+            "completed session is rebuilt without the rig, once every image is proven.",
         ),
     ] = False,
     adaptive: Annotated[
@@ -180,6 +181,40 @@ def run(
     )
     from rti_rig.runtime.controller import EmergencyStop
 
+    if resume is not None:
+        given = [
+            flag
+            for flag, value in (
+                ("--out", out_dir is not None),
+                ("--plan", plan is not None),
+                ("--lights", lights is not None),
+                ("--adaptive", adaptive),
+                ("--until-error", until_error is not None),
+                ("--min-lights", min_lights is not None),
+                ("--auto-exposure", auto_exposure),
+                ("--max-saturated", max_saturated is not None),
+                ("--min-elevation-deg", min_elevation_deg != 0.0),
+                ("--max-elevation-deg", max_elevation_deg != 90.0),
+            )
+            if value
+        ]
+        if given:
+            raise fail(
+                RtiRigError(
+                    "--resume continues a session as it began (its lights, stopping rule "
+                    f"and exposure are in its manifest): drop {', '.join(given)}"
+                )
+            )
+        resume_request = ResumeRequest(
+            resume,
+            rig_config,
+            accept_rig_change=accept_rig_change,
+            objective=objective,
+            reshoot_lost=reshoot_lost,
+            rebuild_journal=rebuild_journal,
+        )
+        if _rebuilt_finished(resume_request):  # a completed session: no rig, nothing to shoot
+            return
     # SIGUSR1 said to be ignored from here, not only once the capture is over: one that came
     # while the rig opened (an emulator starting, metering with the rig lit) had ended the
     # process at once, exit 138, no word and no all-off
@@ -187,38 +222,7 @@ def run(
         try:
             with _terminable_while_opening() as handover:
                 if resume is not None:
-                    given = [
-                        flag
-                        for flag, value in (
-                            ("--out", out_dir is not None),
-                            ("--plan", plan is not None),
-                            ("--lights", lights is not None),
-                            ("--adaptive", adaptive),
-                            ("--until-error", until_error is not None),
-                            ("--min-lights", min_lights is not None),
-                            ("--auto-exposure", auto_exposure),
-                            ("--max-saturated", max_saturated is not None),
-                            ("--min-elevation-deg", min_elevation_deg != 0.0),
-                            ("--max-elevation-deg", max_elevation_deg != 90.0),
-                        )
-                        if value
-                    ]
-                    if given:
-                        raise RtiRigError(
-                            "--resume continues a session as it began (its lights, stopping rule "
-                            f"and exposure are in its manifest): drop {', '.join(given)}"
-                        )
-                    opened = open_resumed_session(
-                        ResumeRequest(
-                            resume,
-                            rig_config,
-                            accept_rig_change=accept_rig_change,
-                            objective=objective,
-                            reshoot_lost=reshoot_lost,
-                            rebuild_journal=rebuild_journal,
-                        ),
-                        print_note,
-                    )
+                    opened = open_resumed_session(resume_request, print_note)
                 else:
                     if rig_config is None or out_dir is None:
                         raise RtiRigError(
@@ -301,6 +305,57 @@ def run(
             with _verdict_terminable():
                 print_verdict(opened.out_dir)
         _refuse_unsafe_end(unsafe)
+
+
+def _rebuilt_finished(req: Any) -> bool:
+    """``run --resume DIR --rebuild-journal`` of a session that completed: its journal rebuilt
+    with no rig opened (:func:`~rti_rig.app.usecases.session.rebuild_finished_session`), what
+    was done said, and the next command named. False when the request is no such rebuild (the
+    resume goes on as ever).
+
+    Why: a completed session whose journal was lost (a copy that skipped it) was refused ("for a
+    session that did not finish"), with no way to make it whole again. A Ctrl-C or SIGTERM
+    while the images are checked leaves the folder as it was; one while the journal is written
+    is acted on once it is, and said so."""
+    from rti_rig.app.usecases.session import Note, rebuild_finished_session
+    from rti_rig.runtime.controller import EmergencyStop
+    from rti_rig.runtime.session import JOURNAL
+
+    folder = _arg(req.session_dir)
+    try:
+        with _terminable_while_opening():
+            notes = rebuild_finished_session(req)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    except (KeyboardInterrupt, EmergencyStop) as exc:
+        why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
+        done = getattr(exc, "journal_rebuild", None)
+        if done:
+            for line in done:
+                print_note(Note(line, "warning"))
+            said = (
+                f"Stopped ({why}) once {JOURNAL} was rebuilt: the session is whole again; "
+                f"rti-rig fit {folder} --out FOLDER fits it and gives its QA verdict"
+            )
+        else:
+            said = (
+                f"Stopped ({why}) before {JOURNAL} was rebuilt: nothing in {folder} was "
+                f"changed; run rti-rig run --resume {folder} --rebuild-journal again"
+            )
+        err.print(f"[yellow]{escape(said)}.[/]")
+        raise typer.Exit(code=stop_exit_code(why)) from None
+    if notes is None:
+        return False
+    for line in notes:
+        print_note(Note(line, "warning"))
+    out.print(
+        f"{req.session_dir}: {JOURNAL} rebuilt; the session is complete and whole again (no "
+        f"rig was opened, nothing was shot). Next: rti-rig fit {folder} --out FOLDER fits it "
+        "and gives its QA verdict",
+        highlight=False,
+        markup=False,
+    )
+    return True
 
 
 def _metering_limit(max_saturated: float | None) -> dict[str, float]:

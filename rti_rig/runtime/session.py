@@ -1166,15 +1166,17 @@ def _prepare_resume(
     runner = manifest.get("runner") or {}
     names = image_names(total)
     scan = scan_journal(root, names)
-    if rebuild_journal and (reshoot_lost or runner.get("finish_reason") == "completed"):
+    if rebuild_journal and reshoot_lost:
         raise SessionError(
-            f"{root}: --rebuild-journal is for a session that did not finish; this one "
-            + (
-                "completed (its QA verdict, rti-rig fit, names what cannot be checked)"
-                if runner.get("finish_reason") == "completed"
-                else "is reshot with --reshoot-lost, which needs its journal as it is"
-            )
-            + ": drop --rebuild-journal"
+            f"{root}: --rebuild-journal and --reshoot-lost go one at a time: rebuild the "
+            "journal first, then reshoot what the rebuilt journal finds lost (--reshoot-lost "
+            "needs a journal to know what was captured): drop --reshoot-lost"
+        )
+    if rebuild_journal and runner.get("finish_reason") == "completed":
+        raise SessionError(
+            f"{root}: this session completed: nothing is captured to rebuild its journal, "
+            "which rebuild_finished_journal does without the rig (rti-rig run --resume "
+            f"{shlex.quote(str(root))} --rebuild-journal)"
         )
     rebuilt: dict[int, dict[str, Any]] | None = None  # the records taken back
     if runner.get("finish_reason") == "completed":
@@ -1317,21 +1319,122 @@ def _unjournaled_steps(
 def rebuildable_journal(root: Path) -> bool:
     """Whether ``run --resume ROOT --rebuild-journal`` would take back images of session
     ``root``: it did not finish, and its journal lost records its manifest holds of images
-    still on disk as captured (False for a folder that is no session)."""
+    still on disk as captured; or it completed, its journal lost or damaged, and every image
+    it captured is proven (:func:`rebuild_finished_journal`). False for a folder that is no
+    session."""
     root = Path(root)
     try:
         manifest = read_manifest(root)
     except SessionError:
         return False
     total = planned_steps(manifest)
-    if not total or (manifest.get("runner") or {}).get("finish_reason") == "completed":
+    if not total:
         return False
     names = image_names(total)
     try:
         scan = scan_journal(root, names)
+        if (manifest.get("runner") or {}).get("finish_reason") == "completed":
+            return _finished_rebuild(root, manifest, names, scan)[1] == []
     except SessionError:
         return False
     return bool(_unjournaled_steps(root, manifest, scan, names))
+
+
+def _finished_steps(manifest: dict[str, Any], total: int) -> range:
+    """The steps a completed session captured: all of its schedule's, or as many as an
+    adaptive one took before its stopping rule ended it."""
+    done = (manifest.get("runner") or {}).get("steps_done")
+    if manifest.get("adaptive") and isinstance(done, int) and not isinstance(done, bool):
+        return range(min(done, total))
+    return range(total)
+
+
+def _finished_rebuild(
+    root: Path, manifest: dict[str, Any], names: list[str], scan: JournalScan
+) -> tuple[dict[int, dict[str, Any]], list[str] | None]:
+    """What a completed session's journal would be rebuilt from (:func:`_provable_steps`), and
+    why each captured image that nothing proves is not (None: the journal is whole, nothing to
+    rebuild). Nothing in the folder changes."""
+    steps = _finished_steps(manifest, len(names))
+    journaled = {r["index"] for r in scan.records}
+    if (root / JOURNAL).exists() and not scan.needs_repair and set(steps) <= journaled:
+        return {}, None
+    taken = _provable_steps(root, manifest, names, scan.records)
+    listed = _manifest_records(manifest, names)
+    latest = _latest_records(scan.records)
+    unproven = []
+    for i in steps:
+        if i in taken:
+            continue
+        records = [e for e in (latest.get(i), listed.get(i)) if e is not None]
+        if not records:
+            why = f"neither {MANIFEST} nor an intact line of {JOURNAL} records it"
+        elif not any(_light_as_recorded(manifest, e) for e in records):
+            why = "its recorded light is not the one its step was given"
+        else:
+            gone = sorted(
+                name
+                for e in records
+                for name, digest in e["sha256"].items()
+                if not _as_captured(root, e, name, digest)
+            )
+            why = f"{', '.join(dict.fromkeys(gone))} missing or changed since capture"
+        unproven.append(f"{names[i]} ({why})")
+    return taken, unproven
+
+
+def rebuild_finished_journal(root: Path) -> list[str]:
+    """Rebuild the journal of a session that **completed** from what proves each image (its
+    manifest's records, an intact line of the damaged journal: :func:`_provable_steps`), with
+    no rig: nothing is captured. Returns what was done, as :func:`_rebuild_journal` says it.
+
+    Refused, naming each image and why, unless every image the session captured is proven;
+    nothing in the folder changes then. Why: a completed session whose journal was lost (a copy
+    to a NAS or a sync tool that skipped it) could not be made whole: ``--rebuild-journal`` was
+    refused as "for a session that did not finish", export-lp refused the session, and its
+    verdict could check no image against its capture checksum; its manifest holds every record
+    the journal did."""
+    root = Path(root)
+    held = str(root.resolve()) in _LOCKED
+    lock_session(root)
+    try:
+        manifest = read_manifest(root)
+        runner = manifest.get("runner") or {}
+        if runner.get("finish_reason") != "completed":
+            raise SessionError(f"{root}: this session did not complete: resume it instead")
+        names = image_names(planned_steps(manifest))
+        scan = scan_journal(root, names)
+        taken, unproven = _finished_rebuild(root, manifest, names, scan)
+        folder = shlex.quote(str(root))
+        if unproven is None:
+            raise SessionError(
+                f"{root}: this session completed and its {JOURNAL} holds a record of every "
+                f"image it captured: nothing to rebuild; drop --rebuild-journal (the QA verdict "
+                f"of rti-rig fit {folder} --out DIR names any image changed since capture)"
+            )
+        if unproven:
+            shown = "; ".join(unproven[:8]) + (" …" if len(unproven) > 8 else "")
+            raise SessionError(
+                f"{root}: {JOURNAL} cannot be rebuilt: {len(unproven)} of the session's images "
+                f"cannot be proven as captured: {shown}; nothing in this folder was changed: "
+                f"restore {JOURNAL} (or those files) from a backup copy of the folder, then run "
+                f"this again; meanwhile rti-rig fit {folder} --out DIR fits the session as it "
+                "is, its verdict naming the images it cannot check"
+            )
+        notes: list[str] = []
+        try:
+            with signals_deferred():  # the journal, the moves and lights.lp: one change
+                stamp = _new_stamp(root)
+                notes, _moved = _rebuild_journal(root, manifest, taken, names, stamp, scan.records)
+                _relist_verified(root, {i: _to_record(e) for i, e in taken.items()}, stamp)
+        except BaseException as exc:
+            if notes:  # a stop held while the folder changed, acted on once it had: said so
+                exc.journal_rebuild = notes  # type: ignore[attr-defined]
+            raise
+        return notes
+    finally:
+        if not held:
+            unlock_session(root)
 
 
 def rebuild_advice(root: Path) -> str:

@@ -263,10 +263,14 @@ def test_export_lp_names_the_rebuild(
     out = _damaged(made, tmp_path, how)
     r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
     assert f"rti-rig run --resume {out} --rebuild-journal" in said(r), r.output
-    # a finished session cannot be resumed: not offered
+    # a finished session's journal is rebuilt too (no rig opened): offered
     done = tmp_path / "done"
     shutil.copytree(made[1], done)
     (done / "journal.jsonl").unlink()
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "y.lp")])
+    assert r.exit_code == 2 and f"rti-rig run --resume {done} --rebuild-journal" in said(r)
+    # but not where the rebuild would be refused: an image it cannot prove
+    (done / "image_002.jpg").unlink()
     r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "y.lp")])
     assert r.exit_code == 2 and "--rebuild-journal" not in said(r), r.output
 
@@ -334,3 +338,111 @@ def test_images_journaled_after_the_manifest_are_taken_back(
     ]
     assert {n: (out / n).stat().st_ino for n in kept} == kept
     assert _images(out) == _images(ref)
+
+
+def _no_rig(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Fail the test if a rig config is loaded (a completed session's rebuild shoots nothing)."""
+
+    def refused(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise AssertionError("a rig config was loaded")
+
+    monkeypatch.setattr("rti_rig.app.config.load_rig_config", refused)
+
+
+def test_a_completed_session_whose_journal_is_lost_is_made_whole(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A finished session copied to a NAS without its journal: the rebuild had been refused
+    ("for a session that did not finish"), export-lp refused the folder and fit could check no
+    image. Its manifest holds every record the journal did: the journal comes back as it was,
+    with no rig opened."""
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    (out / "journal.jsonl").unlink()
+    _no_rig(monkeypatch)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert "journal.jsonl rebuilt from manifest.json: 8 image(s) taken back" in said(r)
+    assert "whole again" in said(r) and f"rti-rig fit {out} --out FOLDER" in said(r)
+    assert (out / "journal.jsonl").read_bytes() == (ref / "journal.jsonl").read_bytes()
+    assert _images(out) == _images(ref)
+    (report,) = (out / "recovered").rglob("journal-rebuild.txt")
+    assert "8 image(s) taken back" in report.read_text()
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "x.lp").read_bytes() == (ref / "lights.lp").read_bytes()
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 2 and "nothing to rebuild" in said(r), r.output
+
+
+def test_a_completed_session_with_an_image_it_cannot_prove_is_refused_untouched(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    (out / "journal.jsonl").unlink()
+    (out / "image_003.jpg").unlink()
+    before = _files(out)
+    _no_rig(monkeypatch)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 2, r.output
+    assert "image_003 (image_003.jpg missing or changed since capture)" in said(r)
+    assert "restore journal.jsonl (or those files) from a backup copy" in said(r)
+    assert _files(out) == before
+
+
+def test_a_stop_while_a_completed_session_is_rebuilt_says_what_it_left(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C while the images are checked: nothing changed, and the same command again; one
+    held while the journal is written acts once it is: the session is whole, and fit next."""
+    import rti_rig.runtime.session as session
+
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    (out / "journal.jsonl").unlink()
+    before = _files(out)
+    real_provable, real_relist = session._provable_steps, session._relist_verified
+
+    def stopped(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(session, "_provable_steps", stopped)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 130, r.output
+    assert "before journal.jsonl was rebuilt: nothing in" in said(r)
+    assert f"rti-rig run --resume {out} --rebuild-journal again" in said(r)
+    assert _files(out) == before
+
+    monkeypatch.setattr(session, "_provable_steps", real_provable)
+
+    def relisted_then_stopped(*args, **kwargs):  # type: ignore[no-untyped-def]
+        real_relist(*args, **kwargs)
+        raise KeyboardInterrupt  # a Ctrl-C held by the block, acted on at its end
+
+    monkeypatch.setattr(session, "_relist_verified", relisted_then_stopped)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 130, r.output
+    assert "once journal.jsonl was rebuilt: the session is whole again" in said(r)
+    assert (out / "journal.jsonl").read_bytes() == (ref / "journal.jsonl").read_bytes()
+
+
+def test_a_completed_adaptive_session_is_rebuilt_to_where_it_stopped(tmp_path: Path) -> None:
+    """An adaptive session completes below its maximum: the steps it took are all proven."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "a"
+    r = runner.invoke(
+        app, ["run", str(cfg), "--out", str(out), "--lights", "8", "--until-error", "60"]
+    )
+    assert r.exit_code == 0, r.output
+    journal = (out / "journal.jsonl").read_bytes()
+    taken = len(journal.splitlines())
+    assert taken < 8  # stopped by its rule, below its maximum
+    (out / "journal.jsonl").unlink()
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert f"{taken} image(s) taken back" in said(r)
+    assert (out / "journal.jsonl").read_bytes() == journal

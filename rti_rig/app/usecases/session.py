@@ -808,6 +808,25 @@ def _same_file(a: Path, b: Path) -> bool:
         return a.resolve() == b.resolve()
 
 
+def rebuild_finished_session(req: ResumeRequest) -> list[str] | None:
+    """``--rebuild-journal`` of a session that completed: its journal rebuilt from what proves
+    each image (:func:`~rti_rig.runtime.session.rebuild_finished_journal`), no rig opened,
+    since nothing is left to capture; returns what was done. None when the request is no such
+    rebuild (the session did not complete, or no rebuild was asked): the resume goes on.
+
+    Why not through :func:`open_resumed_session`: a completed session's resume is refused (and
+    a camera-triggered dome's, or a rig config moved since, could not even open), and a lost
+    journal of a finished session had no way back at all."""
+    from rti_rig.runtime.session import read_manifest, rebuild_finished_journal
+
+    if not req.rebuild_journal or req.reshoot_lost:
+        return None
+    manifest = read_manifest(req.session_dir)
+    if (manifest.get("runner") or {}).get("finish_reason") != "completed":
+        return None
+    return rebuild_finished_journal(Path(req.session_dir))
+
+
 def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
     """Check the rig against the session, verify and repair the session on disk, open the
     rig and check the remaining steps on it.
