@@ -1337,6 +1337,8 @@ def rebuildable_journal(root: Path) -> bool:
             return _finished_rebuild(root, manifest, names, scan)[1] == []
     except SessionError:
         return False
+    if unresumable(root) is not None:  # a resume, which the rebuild goes with, is refused
+        return False
     return bool(_unjournaled_steps(root, manifest, scan, names))
 
 
@@ -1740,9 +1742,38 @@ def _set_aside(root: Path, path: Path, stamp: str) -> str:
     return dest.relative_to(root).as_posix()
 
 
+def unresumable(root: Path) -> str | None:
+    """What to do instead of ``run --resume`` for session ``root`` if no resume can continue
+    it or reshoot its images (None when one can, or when ``root`` is no session): one shot on
+    a camera-triggered dome, whose own count went on since (its resume, ``--reshoot-lost``
+    and an unfinished session's ``--rebuild-journal`` are refused before anything moves).
+
+    Why: the QA verdict, export-lp and fit advised ``run --resume`` (with
+    ``--rebuild-journal`` or ``--reshoot-lost``) for such sessions, commands that are refused
+    for them. Read from the rig config the manifest records (``dome.flash_sync``)."""
+    try:
+        manifest = read_manifest(Path(root))
+    except SessionError:
+        return None
+    rig = manifest.get("rig") or {}
+    dome = (rig.get("config") or {}).get("dome") if isinstance(rig, dict) else None
+    sync = dome.get("flash_sync") if isinstance(dome, dict) else None
+    if not isinstance(sync, dict):
+        return None
+    config = shlex.quote(str(rig.get("config_path") or "CONFIG"))
+    return (
+        f"a camera-triggered dome ({sync.get('firmware', 'flash-stepped')}) cannot continue a "
+        "session or reshoot single images (its own count went on): long-press its start "
+        f"button to rewind it, then shoot the session again: rti-rig run {config} --out NEWDIR"
+    )
+
+
 def lost_image_advice(root: Path, adaptive: bool) -> str:
     """What to do about images of a finished session lost since capture (the QA verdict and
     a refused resume say the same)."""
+    instead = unresumable(root)
+    if instead is not None:  # --reshoot-lost is refused for it
+        return f"put the originals back from a copy; {instead}"
     if adaptive:
         return (
             "put the originals back from a copy (an adaptive session cannot reshoot one image: "
@@ -2184,11 +2215,16 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     done = verified_steps(root, records, only=key)  # the file the .lp names, as captured
     if not records:
         if stopped_before_first_record(root):
+            instead = unresumable(root)
             raise SessionError(
                 f"{root}: the session stopped before its first image was recorded in its "
-                f"{JOURNAL}, so there is no .lp to export; continue it with rti-rig run --resume "
-                f"{shlex.quote(str(root))} (a first image's files left on disk are set aside in "
-                "recovered/ and shot again)"
+                f"{JOURNAL}, so there is no .lp to export; "
+                + (
+                    instead
+                    if instead is not None
+                    else f"continue it with rti-rig run --resume {shlex.quote(str(root))} (a "
+                    "first image's files left on disk are set aside in recovered/ and shot again)"
+                )
             )
         if not (Path(root) / JOURNAL).is_file():
             raise SessionError(

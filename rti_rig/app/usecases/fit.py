@@ -65,6 +65,7 @@ from rti_rig.runtime.session import (
     renamed_note,
     renamed_since_capture,
     stopped_before_first_record,
+    unresumable,
 )
 
 #: What ``--model`` accepts besides the registered model names.
@@ -272,10 +273,15 @@ def acquisition_files(
                     f"--out {shlex.quote(str(source / LP_NAME))}"
                 )
             if stopped_before_first_record(source):  # a session killed before its first record
+                instead = unresumable(source)  # a camera-triggered dome's resume is refused
                 raise FitInputError(
                     f"{source} is a session that stopped before its first image was recorded: "
-                    f"there is nothing to fit yet; continue it with rti-rig run --resume "
-                    f"{shlex.quote(str(source))}"
+                    "there is nothing to fit yet; "
+                    + (
+                        instead
+                        if instead is not None
+                        else f"continue it with rti-rig run --resume {shlex.quote(str(source))}"
+                    )
                 )
             if (source / MANIFEST).is_file():  # its journal and lights.lp both gone
                 raise FitInputError(

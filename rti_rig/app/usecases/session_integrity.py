@@ -40,6 +40,7 @@ from rti_rig.runtime.session import (
     stopped_while_committing,
     tiff_check_note,
     unchecked_images,
+    unresumable,
 )
 
 V = TypeVar("V")
@@ -294,11 +295,21 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
         else ("it stopped without recording why (killed, or a power cut?)")
     )
     of = f"of at most {total}" if manifest.get("adaptive") else f"of {total}"
+    instead = unresumable(source)
     note = (
         f"the session is not finished ({taken} {of} images; {how}): this verdict judges the "
-        f"images taken so far; continue it with rti-rig run --resume {shlex.quote(str(source))}"
-        # a plain resume of a journal that lost records the manifest holds is refused
-        + (" --rebuild-journal (or once its journal is restored)" if rebuild_advice(source) else "")
+        "images taken so far; "
+        + (
+            instead  # its resume is refused: not named
+            if instead is not None
+            else f"continue it with rti-rig run --resume {shlex.quote(str(source))}"
+            # a plain resume of a journal that lost records the manifest holds is refused
+            + (
+                " --rebuild-journal (or once its journal is restored)"
+                if rebuild_advice(source)
+                else ""
+            )
+        )
     )
     return _noted(qa, note)
 
@@ -313,17 +324,27 @@ def _with_stopped_while_committing(qa: QAReport, source: Path) -> QAReport:
     if stopped is None:
         return qa
     folder = shlex.quote(str(source))
+    instead = unresumable(source)  # a resume is refused: not named
     if stopped in {c.name for c in qa.images}:  # an .lp of the user's own listed it
         note = (
             f"{stopped} was fitted, but the session stopped while saving it, before its journal "
             "record: neither its files nor its light were ever recorded as captured; leave it "
-            f"out of the .lp, or let rti-rig run --resume {folder} capture it again"
+            + (
+                "out of the .lp"
+                if instead is not None
+                else f"out of the .lp, or let rti-rig run --resume {folder} capture it again"
+            )
         )
         return _integrity_noted(qa, note)
     note = (
         f"{stopped} is on disk without a journal record: the session stopped while saving it, "
-        f"so it is no part of the session (not in {LP_NAME}, not fitted); rti-rig run --resume "
-        f"{folder} sets it aside in recovered/ (never deleted) and captures that step again"
+        f"so it is no part of the session (not in {LP_NAME}, not fitted); "
+        + (
+            instead
+            if instead is not None
+            else f"rti-rig run --resume {folder} sets it aside in recovered/ (never deleted) and "
+            "captures that step again"
+        )
     )
     return _noted(qa, note)
 
