@@ -1573,7 +1573,12 @@ def _rebuild_journal(
     journal, ``journaled``, records its step) or ``recovered/STAMP/unproven/`` (recorded, but
     its file or light is not as recorded), never deleted; then the journal is written with the
     taken records, as their lines were. Returns what was done (said, and recorded in the
-    manifest's run) and the paths set aside."""
+    manifest's run) and the paths set aside.
+
+    The old journal is copied aside and replaced by the new one in one rename, last: it had been
+    moved aside first, so a kill (SIGKILL, a power cut) before the new one was written left the
+    session with no journal at all, and the next rebuild, reading none, set aside and shot again
+    the images only its intact lines proved."""
     notes: list[str] = []
     moved: list[str] = []
     aside = root / "recovered" / stamp
@@ -1582,7 +1587,7 @@ def _rebuild_journal(
         dest = aside / "journal-damaged.jsonl"
         try:
             dest.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(journal, dest)
+            _copy_whole(journal, dest)
         except OSError as exc:
             raise SessionWriteError(dest, exc) from None
         # said, and recorded in the run's journal_rebuild, but no image: not counted with them

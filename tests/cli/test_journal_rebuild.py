@@ -301,6 +301,23 @@ def test_a_rebuild_that_takes_nothing_back_keeps_no_old_line(
     assert _images(out) == _images(ref)
 
 
+def _killed_after_its_manifest(made: tuple[Path, Path, Path], tmp_path: Path) -> Path:
+    """The stopped session resumed and killed (SIGKILL) once it had committed three more
+    images, which only the journal records; then image_004's line, which the manifest records
+    too, overwritten (a sync tool)."""
+    out = tmp_path / "s"
+    shutil.copytree(made[2], out)
+    kill = popen_argv("before_journal", 3, ["run", "--resume", str(out)])
+    assert kill.wait(timeout=300) == -9, kill.communicate()
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().split(b"\n")
+    assert [json.loads(line)["index"] for line in lines if line] == list(range(7))
+    assert len(json.loads((out / "manifest.json").read_text())["steps"]) == 4
+    lines[3] = b"\x00" * len(lines[3])
+    journal.write_bytes(b"\n".join(lines))
+    return out
+
+
 def test_images_journaled_after_the_manifest_are_taken_back(
     made: tuple[Path, Path, Path], tmp_path: Path
 ) -> None:
@@ -310,16 +327,7 @@ def test_images_journaled_after_the_manifest_are_taken_back(
     The rebuild had taken back only the manifest's images and set the three aside, then shot
     them again; the journal's intact lines prove them as a plain resume would."""
     _, ref, _ = made
-    out = tmp_path / "s"
-    shutil.copytree(made[2], out)
-    kill = popen_argv("before_journal", 3, ["run", "--resume", str(out)])
-    assert kill.wait(timeout=300) == -9, kill.communicate()
-    journal = out / "journal.jsonl"
-    lines = journal.read_bytes().split(b"\n")
-    assert [json.loads(line)["index"] for line in lines if line] == list(range(7))
-    assert len(json.loads((out / "manifest.json").read_text())["steps"]) == 4
-    lines[3] = b"\x00" * len(lines[3])  # image_004's line, which the manifest records
-    journal.write_bytes(b"\n".join(lines))
+    out = _killed_after_its_manifest(made, tmp_path)
     kept = {n: (out / n).stat().st_ino for n in ("image_005.jpg", "linear/image_007.tif")}
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2 and "--rebuild-journal" in said(r), r.output
@@ -446,3 +454,33 @@ def test_a_completed_adaptive_session_is_rebuilt_to_where_it_stopped(tmp_path: P
     assert r.exit_code == 0, r.output
     assert f"{taken} image(s) taken back" in said(r)
     assert (out / "journal.jsonl").read_bytes() == journal
+
+
+def test_a_rebuild_killed_before_its_journal_is_written_keeps_the_old_one(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The old journal had been moved aside first: a kill before the new one was written left
+    no journal, and the next rebuild, reading none, set aside and shot again the three images
+    only its intact lines proved. The process dies here as the new journal is written (no
+    code of the rebuild runs after it, as with SIGKILL)."""
+    import rti_rig.runtime.session as session
+
+    _, ref, _ = made
+    out = _killed_after_its_manifest(made, tmp_path)
+    damaged = (out / "journal.jsonl").read_bytes()
+    real_write = session._write_bytes_atomic
+
+    def killed(path: Path, data: bytes) -> None:
+        if path.name == "journal.jsonl":
+            raise KeyboardInterrupt  # stands for the kill: nothing after it runs
+        real_write(path, data)
+
+    monkeypatch.setattr(session, "_write_bytes_atomic", killed)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 130, r.output
+    assert (out / "journal.jsonl").read_bytes() == damaged
+    monkeypatch.setattr(session, "_write_bytes_atomic", real_write)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert "and 3 from the old journal.jsonl's intact lines" in said(r), r.output
+    assert _images(out) == _images(ref)
