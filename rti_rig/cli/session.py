@@ -265,7 +265,7 @@ def run(
             if resume is not None:
                 said = (
                     f"Stopped ({why}) before the session went on: no new image was captured; "
-                    f"continue it with rti-rig run --resume {_arg(resume)}"
+                    f"continue it with {_resume_command(resume_request)}"
                 )
             else:
                 said = (
@@ -278,7 +278,7 @@ def run(
             if resume is not None:
                 said = (
                     "The session did not go on: no new image was captured; continue it with "
-                    f"rti-rig run --resume {_arg(resume)} once this is fixed"
+                    f"{_resume_command(resume_request)} once this is fixed"
                 )
             else:
                 said = f"Nothing was captured or written to {out_dir}"
@@ -553,6 +553,29 @@ def _unexpected(exc: Exception, report: str) -> typer.Exit:
         soft_wrap=True,
     )
     return typer.Exit(code=1)
+
+
+def _resume_command(req: Any) -> str:
+    """The ``run --resume`` command of ``req`` (a ResumeRequest) to give again, with the rig
+    config and flags it was given.
+
+    Why: a resume stopped before it went on (a Ctrl-C while it checked the images, a rig that
+    did not answer) was told to continue with a plain ``rti-rig run --resume DIR``; for a
+    journal that needs ``--rebuild-journal``, or a completed session's ``--reshoot-lost``, that
+    command is refused, and a rig change not yet accepted would be refused again."""
+    words = ["rti-rig run"]
+    if req.rig_config is not None:
+        words.append(_arg(req.rig_config))
+    words.append(f"--resume {_arg(req.session_dir)}")
+    if req.accept_rig_change:
+        words.append("--accept-rig-change")
+    if req.objective is not None:
+        words.append(f"--objective {_arg(req.objective)}")
+    if req.reshoot_lost:
+        words.append("--reshoot-lost")
+    if req.rebuild_journal:
+        words.append("--rebuild-journal")
+    return " ".join(words)
 
 
 def _arg(path: Path | str) -> str:

@@ -484,3 +484,35 @@ def test_a_rebuild_killed_before_its_journal_is_written_keeps_the_old_one(
     assert r.exit_code == 0, r.output
     assert "and 3 from the old journal.jsonl's intact lines" in said(r), r.output
     assert _images(out) == _images(ref)
+
+
+@pytest.mark.parametrize("flag", ["--rebuild-journal", "--reshoot-lost"])
+def test_a_resume_stopped_before_it_went_on_names_the_command_that_continues_it(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, flag: str
+) -> None:
+    """A Ctrl-C while the rig opened had been told "continue it with rti-rig run --resume
+    DIR": refused for a journal that needs the rebuild, and for a completed session's
+    reshoot. The command named is the one given, which goes on."""
+    import rti_rig.app.usecases.session as usecase
+
+    _, ref, _ = made
+    if flag == "--rebuild-journal":
+        out = _damaged(made, tmp_path, "deleted")
+    else:
+        out = tmp_path / "s"
+        shutil.copytree(ref, out)
+        (out / "image_003.jpg").unlink()
+    real = usecase.checked_rig
+
+    def stopped(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(usecase, "checked_rig", stopped)
+    r = runner.invoke(app, ["run", "--resume", str(out), flag])
+    assert r.exit_code == 130, r.output
+    named = f"continue it with rti-rig run --resume {out} {flag}."
+    assert named in said(r), r.output
+    monkeypatch.setattr(usecase, "checked_rig", real)
+    r = runner.invoke(app, ["run", "--resume", str(out), flag, "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert _images(out) == _images(ref)
