@@ -1179,6 +1179,7 @@ def _prepare_resume(
             f"{shlex.quote(str(root))} --rebuild-journal)"
         )
     rebuilt: dict[int, dict[str, Any]] | None = None  # the records taken back
+    restored: dict[int, dict[str, Any]] = {}  # --reshoot-lost: the manifest's, restored
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
         latest = _latest_records(scan.records)
@@ -1193,6 +1194,10 @@ def _prepare_resume(
                 f"{finished} of at most {total} lights ({stop.get('reason', 'its stopping rule')})"
                 + _lost_note(root, latest, lost, adaptive=True)
             )
+        if reshoot_lost and lost and not manifest.get("adaptive"):
+            # images the journal lost a line of, proven by the manifest: kept, not reshot
+            restored = _restorable(root, manifest, scan, names)
+            latest.update(restored)
         if reshoot_lost and not lost and not manifest.get("adaptive"):
             unchecked, why = unchecked_images(root)
             if unchecked:  # nothing found lost is not nothing lost
@@ -1200,7 +1205,9 @@ def _prepare_resume(
                     f"{root}: --reshoot-lost finds nothing lost among the images it can check, "
                     f"but {', '.join(unchecked[:8])}{' …' if len(unchecked) > 8 else ''} cannot "
                     f"be checked ({why}): restore {MANIFEST if MANIFEST in why else JOURNAL} "
-                    "from a backup copy of the folder, then run this again"
+                    "from a backup copy of the folder"
+                    + ("" if MANIFEST in why else rebuild_advice(root))
+                    + ", then run this again"
                 )
             if renamed:
                 raise SessionError(
@@ -1254,6 +1261,14 @@ def _prepare_resume(
                 "nothing rebuilt (the resume goes on as without --rebuild-journal)"
             ]
         repair = _repair_journal(root, scan, stamp) if scan.needs_repair and rebuilt is None else []
+        if restored:
+            lines = [json.dumps(restored[i]).encode("utf-8") + b"\n" for i in sorted(restored)]
+            _write_bytes_atomic(root / JOURNAL, b"".join([*scan.kept, *lines]))
+            rebuild = [
+                f"{JOURNAL}: {len(restored)} record(s) it had lost restored from {MANIFEST} "
+                f"({_shown(names, sorted(restored))}), each image's files matching the "
+                "manifest's checksums and its light its step's: kept, not reshot"
+            ]
         keep = {name for rec in done.values() for name in rec.sha256}
         leftovers = [
             *root.glob("image_*"),
@@ -1483,6 +1498,32 @@ def _refuse_unjournaled(
         "journal line records, and sets the old journal and anything else aside in "
         "recovered/, never deleted)"
     )
+
+
+def _restorable(
+    root: Path, manifest: dict[str, Any], scan: JournalScan, names: list[str]
+) -> dict[int, dict[str, Any]]:
+    """The manifest's records of a completed session's images that its journal lost a line of
+    (:func:`_unjournaled_steps`: files on disk as the manifest's checksums say), for
+    ``--reshoot-lost`` to keep; refused, nothing moved, if the light of one is not its step's.
+
+    Why: the reshoot keeps the journaled images and shoots every other step, so an intact image
+    whose journal line was overwritten (a sync tool) was set aside and shot again with the one
+    lost ("reshoot exactly those" reshot more, on a rig where the object may have moved); and
+    the rebuild, which needs every image as captured, could not help while one was lost."""
+    listed = _manifest_records(manifest, names)
+    unjournaled = _unjournaled_steps(root, manifest, scan, names)
+    restored = {i: listed[i] for i in unjournaled if _light_as_recorded(manifest, listed[i])}
+    unproven = [i for i in unjournaled if i not in restored]
+    if unproven:
+        raise SessionError(
+            f"{root}: {JOURNAL} holds no record of {_shown(names, unproven)}, and the light "
+            f"{MANIFEST} records for {'it' if len(unproven) == 1 else 'them'} is not the one "
+            "its step was given: --reshoot-lost would set them aside and shoot them again with "
+            "the images lost (nothing in this folder was changed): restore "
+            f"{JOURNAL} from a backup copy of the folder, then run this again"
+        )
+    return restored
 
 
 def _light_as_recorded(manifest: dict[str, Any], entry: dict[str, Any]) -> bool:

@@ -516,3 +516,47 @@ def test_a_resume_stopped_before_it_went_on_names_the_command_that_continues_it(
     r = runner.invoke(app, ["run", "--resume", str(out), flag, "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert _images(out) == _images(ref)
+
+
+def test_reshoot_lost_keeps_an_intact_image_whose_journal_line_was_lost(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """A completed session: image_003's journal line overwritten (a sync tool), image_005.jpg
+    deleted. --reshoot-lost had set image_003 aside and shot it again with image_005 (it keeps
+    only the journaled images); the manifest proves it, so its record is restored and only
+    image_005 is reshot."""
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().split(b"\n")
+    lines[2] = b"\x00" * len(lines[2])
+    journal.write_bytes(b"\n".join(lines))
+    (out / "image_005.jpg").unlink()
+    kept = {n: (out / n).stat().st_ino for n in ("image_003.jpg", "linear/image_003.tif")}
+    r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "1 record(s) it had lost restored from manifest.json (image_003)" in said(r)
+    assert "1 of 8 light" in said(r)
+    assert {n: (out / n).stat().st_ino for n in kept} == kept  # never moved
+    aside = sorted(p.name for p in (out / "recovered").rglob("image_*"))
+    assert aside == ["image_005.tif"]
+    assert _images(out) == _images(ref)
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0 and "not checked" not in said(r), r.output
+
+
+def test_reshoot_lost_with_nothing_lost_names_the_rebuild_of_a_line_it_cannot_check(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """It had advised a backup alone, of a journal line the manifest can restore."""
+    out = tmp_path / "done"
+    shutil.copytree(made[1], out)
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().split(b"\n")
+    lines[2] = b"\x00" * len(lines[2])
+    journal.write_bytes(b"\n".join(lines))
+    r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost"])
+    assert r.exit_code == 2, r.output
+    assert "finds nothing lost" in said(r)
+    assert f"rti-rig run --resume {out} --rebuild-journal, then run this again" in said(r)
