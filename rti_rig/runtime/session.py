@@ -1183,7 +1183,12 @@ def _prepare_resume(
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
         latest = _latest_records(scan.records)
-        renamed = renamed_jpegs(root, scan.records)
+        if reshoot_lost and not manifest.get("adaptive"):
+            # the records the journal lost, from the manifest: an image intact is kept, one
+            # lost is reshot, as if the journal had lost nothing
+            restored = _restorable(root, manifest, scan, names)
+            latest.update(restored)
+        renamed = renamed_jpegs(root, [*scan.records, *restored.values()])
         lost = {i: _lost_files(root, rec, renamed) for i, rec in latest.items()}
         lost = {i: gone for i, gone in lost.items() if gone}
         moved = f"; {renamed_note(renamed)}" if renamed else ""
@@ -1194,10 +1199,6 @@ def _prepare_resume(
                 f"{finished} of at most {total} lights ({stop.get('reason', 'its stopping rule')})"
                 + _lost_note(root, latest, lost, adaptive=True)
             )
-        if reshoot_lost and lost and not manifest.get("adaptive"):
-            # images the journal lost a line of, proven by the manifest: kept, not reshot
-            restored = _restorable(root, manifest, scan, names)
-            latest.update(restored)
         if reshoot_lost and not lost and not manifest.get("adaptive"):
             unchecked, why = unchecked_images(root)
             if unchecked:  # nothing found lost is not nothing lost
@@ -1264,10 +1265,16 @@ def _prepare_resume(
         if restored:
             lines = [json.dumps(restored[i]).encode("utf-8") + b"\n" for i in sorted(restored)]
             _write_bytes_atomic(root / JOURNAL, b"".join([*scan.kept, *lines]))
+            kept = sorted(i for i in restored if i in done)
             rebuild = [
                 f"{JOURNAL}: {len(restored)} record(s) it had lost restored from {MANIFEST} "
-                f"({_shown(names, sorted(restored))}), each image's files matching the "
-                "manifest's checksums and its light its step's: kept, not reshot"
+                f"({_shown(names, sorted(restored))}), each with its step's light; "
+                + (
+                    f"{len(kept)} of those images kept, their files as recorded ("
+                    f"{_shown(names, kept)}), not reshot"
+                    if kept
+                    else "none of those images is as recorded"
+                )
             ]
         keep = {name for rec in done.values() for name in rec.sha256}
         leftovers = [
@@ -1503,18 +1510,22 @@ def _refuse_unjournaled(
 def _restorable(
     root: Path, manifest: dict[str, Any], scan: JournalScan, names: list[str]
 ) -> dict[int, dict[str, Any]]:
-    """The manifest's records of a completed session's images that its journal lost a line of
-    (:func:`_unjournaled_steps`: files on disk as the manifest's checksums say), for
-    ``--reshoot-lost`` to keep; refused, nothing moved, if the light of one is not its step's.
+    """The manifest's records of a completed session's steps its journal lost the line of (its
+    well-formed records only), for ``--reshoot-lost`` to restore: an image whose files are as
+    those checksums say is kept, one lost or changed is reshot. Refused, nothing moved, if the
+    light a record gives is not its step's (nothing then proves which image it is).
 
     Why: the reshoot keeps the journaled images and shoots every other step, so an intact image
     whose journal line was overwritten (a sync tool) was set aside and shot again with the one
-    lost ("reshoot exactly those" reshot more, on a rig where the object may have moved); and
-    the rebuild, which needs every image as captured, could not help while one was lost."""
+    lost ("reshoot exactly those" reshot more, on a rig where the object may have moved); a
+    journal lost whole found nothing to reshoot; and the rebuild, which needs every image as
+    captured, could not help while one was lost."""
+    journaled = {r["index"] for r in scan.records}
     listed = _manifest_records(manifest, names)
-    unjournaled = _unjournaled_steps(root, manifest, scan, names)
-    restored = {i: listed[i] for i in unjournaled if _light_as_recorded(manifest, listed[i])}
-    unproven = [i for i in unjournaled if i not in restored]
+    restored = {
+        i: e for i, e in listed.items() if i not in journaled and _light_as_recorded(manifest, e)
+    }
+    unproven = sorted(i for i in listed if i not in journaled and i not in restored)
     if unproven:
         raise SessionError(
             f"{root}: {JOURNAL} holds no record of {_shown(names, unproven)}, and the light "

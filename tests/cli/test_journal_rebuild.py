@@ -520,7 +520,7 @@ def test_a_resume_stopped_before_it_went_on_names_the_command_that_continues_it(
 
 def test_reshoot_lost_keeps_an_intact_image_whose_journal_line_was_lost(
     made: tuple[Path, Path, Path], tmp_path: Path
-) -> None:
+) -> None:  # see also the journal lost whole, below
     """A completed session: image_003's journal line overwritten (a sync tool), image_005.jpg
     deleted. --reshoot-lost had set image_003 aside and shot it again with image_005 (it keeps
     only the journaled images); the manifest proves it, so its record is restored and only
@@ -537,6 +537,7 @@ def test_reshoot_lost_keeps_an_intact_image_whose_journal_line_was_lost(
     r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert "1 record(s) it had lost restored from manifest.json (image_003)" in said(r)
+    assert "1 of those images kept, their files as recorded (image_003), not reshot" in said(r)
     assert "1 of 8 light" in said(r)
     assert {n: (out / n).stat().st_ino for n in kept} == kept  # never moved
     aside = sorted(p.name for p in (out / "recovered").rglob("image_*"))
@@ -560,3 +561,27 @@ def test_reshoot_lost_with_nothing_lost_names_the_rebuild_of_a_line_it_cannot_ch
     assert r.exit_code == 2, r.output
     assert "finds nothing lost" in said(r)
     assert f"rti-rig run --resume {out} --rebuild-journal, then run this again" in said(r)
+
+
+def test_reshoot_lost_of_a_session_whose_journal_is_lost_reshoots_only_the_lost_image(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """A completed session without its journal and with image_005.jpg deleted: --reshoot-lost
+    had found nothing it could check, and the rebuild (every image as captured) refused for
+    image_005: no way on without a backup. The manifest's records are restored; only
+    image_005 is reshot."""
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    (out / "journal.jsonl").unlink()
+    (out / "image_005.jpg").unlink()
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 2 and "image_005" in said(r), r.output
+    r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "8 record(s) it had lost restored" in said(r) and "7 of those images kept" in said(r)
+    assert sorted(p.name for p in (out / "recovered").rglob("image_*")) == ["image_005.tif"]
+    assert _images(out) == _images(ref)
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0 and "not checked" not in said(r), r.output
+    assert "QA verdict: good" in said(r)
