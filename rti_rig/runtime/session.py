@@ -1356,7 +1356,7 @@ def rebuildable_journal(root: Path) -> bool:
     try:
         scan = scan_journal(root, names)
         if (manifest.get("runner") or {}).get("finish_reason") == "completed":
-            return _finished_rebuild(root, manifest, names, scan)[1] == []
+            return _finished_rebuild(root, manifest, names, scan)[1] == []  # all proven
     except SessionError:
         return False
     if unresumable(root) is not None:  # a resume, which the rebuild goes with, is refused
@@ -1375,18 +1375,20 @@ def _finished_steps(manifest: dict[str, Any], total: int) -> range:
 
 def _finished_rebuild(
     root: Path, manifest: dict[str, Any], names: list[str], scan: JournalScan
-) -> tuple[dict[int, dict[str, Any]], list[str] | None]:
-    """What a completed session's journal would be rebuilt from (:func:`_provable_steps`), and
+) -> tuple[dict[int, dict[str, Any]], list[str] | None, list[str]]:
+    """What a completed session's journal would be rebuilt from (:func:`_provable_steps`),
     why each captured image that nothing proves is not (None: the journal is whole, nothing to
-    rebuild). Nothing in the folder changes."""
+    rebuild), and which of those only have files missing or changed (their record and light
+    are there: ``--reshoot-lost`` can shoot them again). Nothing in the folder changes."""
     steps = _finished_steps(manifest, len(names))
     journaled = {r["index"] for r in scan.records}
     if (root / JOURNAL).exists() and not scan.needs_repair and set(steps) <= journaled:
-        return {}, None
+        return {}, None, []
     taken = _provable_steps(root, manifest, names, scan.records)
     listed = _manifest_records(manifest, names)
     latest = _latest_records(scan.records)
-    unproven = []
+    unproven: list[str] = []
+    lost_only: list[str] = []  # only files missing or changed: --reshoot-lost can redo them
     for i in steps:
         if i in taken:
             continue
@@ -1403,8 +1405,9 @@ def _finished_rebuild(
                 if not _as_captured(root, e, name, digest)
             )
             why = f"{', '.join(dict.fromkeys(gone))} missing or changed since capture"
+            lost_only.append(names[i])
         unproven.append(f"{names[i]} ({why})")
-    return taken, unproven
+    return taken, unproven, lost_only
 
 
 def rebuild_finished_journal(root: Path) -> list[str]:
@@ -1428,7 +1431,7 @@ def rebuild_finished_journal(root: Path) -> list[str]:
             raise SessionError(f"{root}: this session did not complete: resume it instead")
         names = image_names(planned_steps(manifest))
         scan = scan_journal(root, names)
-        taken, unproven = _finished_rebuild(root, manifest, names, scan)
+        taken, unproven, lost_only = _finished_rebuild(root, manifest, names, scan)
         folder = shlex.quote(str(root))
         if unproven is None:
             raise SessionError(
@@ -1438,12 +1441,21 @@ def rebuild_finished_journal(root: Path) -> list[str]:
             )
         if unproven:
             shown = "; ".join(unproven[:8]) + (" …" if len(unproven) > 8 else "")
+            reshoot = (
+                # their records are there: the reshoot restores them and shoots those again
+                f"; or reshoot exactly those, with the object where it was: rti-rig run "
+                f"--resume {folder} --reshoot-lost"
+                if len(lost_only) == len(unproven)
+                and not manifest.get("adaptive")
+                and unresumable(root) is None
+                else ""
+            )
             raise SessionError(
                 f"{root}: {JOURNAL} cannot be rebuilt: {len(unproven)} of the session's images "
                 f"cannot be proven as captured: {shown}; nothing in this folder was changed: "
                 f"restore {JOURNAL} (or those files) from a backup copy of the folder, then run "
-                f"this again; meanwhile rti-rig fit {folder} --out DIR fits the session as it "
-                "is, its verdict naming the images it cannot check"
+                f"this again{reshoot}; meanwhile rti-rig fit {folder} --out DIR fits the "
+                "session as it is, its verdict naming the images it cannot check"
             )
         notes: list[str] = []
         try:

@@ -577,6 +577,8 @@ def test_reshoot_lost_of_a_session_whose_journal_is_lost_reshoots_only_the_lost_
     (out / "image_005.jpg").unlink()
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 2 and "image_005" in said(r), r.output
+    reshoot = f"rti-rig run --resume {out} --reshoot-lost"
+    assert f"or reshoot exactly those, with the object where it was: {reshoot}" in said(r)
     r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert "8 record(s) it had lost restored" in said(r) and "7 of those images kept" in said(r)
