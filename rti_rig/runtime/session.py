@@ -1631,7 +1631,7 @@ def _rebuild_journal(
     stamp: str,
     journaled: list[dict[str, Any]],
 ) -> tuple[list[str], list[str]]:
-    """Rebuild the journal from ``taken`` (:func:`_provable_steps`): the old journal is moved
+    """Rebuild the journal from ``taken`` (:func:`_provable_steps`): the old journal is copied
     to ``recovered/STAMP/journal-damaged.jsonl``, every image file no taken record vouches for
     to ``recovered/STAMP/not-in-manifest/`` (neither the manifest nor an intact line of the old
     journal, ``journaled``, records its step) or ``recovered/STAMP/unproven/`` (recorded, but
