@@ -1477,13 +1477,48 @@ def rebuild_advice(root: Path) -> str:
     """The words that name ``run --resume ROOT --rebuild-journal`` (to follow the advice to
     restore the journal from a backup) where it would take images back
     (:func:`rebuildable_journal`), else "": said where a lost journal is named (export-lp had
-    advised a backup alone, of a session its manifest can vouch for)."""
-    if not rebuildable_journal(root):
+    advised a backup alone, of a session its manifest can vouch for). A completed session whose
+    rebuild is refused only because images are missing or changed since capture is told the
+    reshoot instead, which restores the records the journal lost before it shoots exactly those
+    (the backup alone had been advised)."""
+    folder = shlex.quote(str(root))
+    if rebuildable_journal(root):
+        return (
+            f", or rebuild it from {MANIFEST}'s records: rti-rig run --resume {folder} "
+            "--rebuild-journal"
+        )
+    lost = _lost_beside_a_lost_journal(Path(root))
+    if not lost:
         return ""
     return (
-        f", or rebuild it from {MANIFEST}'s records: rti-rig run --resume "
-        f"{shlex.quote(str(root))} --rebuild-journal"
+        f", or, as {', '.join(lost[:5])}{' …' if len(lost) > 5 else ''} "
+        f"{'is' if len(lost) == 1 else 'are'} missing or changed since capture, reshoot exactly "
+        f"those with the object where it was: rti-rig run --resume {folder} --reshoot-lost (it "
+        f"restores the journal's records from {MANIFEST} first)"
     )
+
+
+def _lost_beside_a_lost_journal(root: Path) -> list[str]:
+    """The images of a completed session that its rebuild refuses only as missing or changed
+    since capture, when ``--reshoot-lost`` could shoot them again (not adaptive, not on a
+    camera-triggered dome); empty otherwise, or when anything else is unproven."""
+    try:
+        manifest = read_manifest(root)
+        total = planned_steps(manifest)
+        if (
+            not total
+            or (manifest.get("runner") or {}).get("finish_reason") != "completed"
+            or manifest.get("adaptive")
+            or unresumable(root) is not None
+        ):
+            return []
+        names = image_names(total)
+        _taken, unproven, lost_only = _finished_rebuild(
+            root, manifest, names, scan_journal(root, names)
+        )
+    except SessionError:
+        return []
+    return lost_only if unproven and len(lost_only) == len(unproven) else []
 
 
 def _refuse_unjournaled(

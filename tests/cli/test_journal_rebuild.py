@@ -579,6 +579,10 @@ def test_reshoot_lost_of_a_session_whose_journal_is_lost_reshoots_only_the_lost_
     assert r.exit_code == 2 and "image_005" in said(r), r.output
     reshoot = f"rti-rig run --resume {out} --reshoot-lost"
     assert f"or reshoot exactly those, with the object where it was: {reshoot}" in said(r)
+    # export-lp says so too (it had named a backup alone)
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 2 and "as image_005 is missing or changed since capture" in said(r)
+    assert f"with the object where it was: {reshoot}" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert "8 record(s) it had lost restored" in said(r) and "7 of those images kept" in said(r)
