@@ -10,12 +10,14 @@ GP_FILE_TYPE_NORMAL)`` → a CameraFile with ``save(path)``, ``file_delete``; er
 -105 unknown model, -110 busy, -115 no space left).
 
 Quirks of real bodies it reproduces (from gphoto/libgphoto2 issue threads, see
-/work/shared/reference/hardware-notes.md §5): "busy" right after a shot, a body switched off or
-unplugged (every call then fails with -7 and autodetect finds nothing), a card that fills up,
-a file counter that wraps (IMG_9999 → IMG_0001) or a RAM target that names every shot the same
-(Nikon's ``capt0000.nef``), RAW+JPEG delivered as two files, the second through a
-FILE_ADDED event (some bodies also announce the first one, and end with CAPTURE_COMPLETE),
-several bodies on the bus, and a setting that does not latch (the mode dial not on M).
+/work/shared/reference/hardware-notes.md §5): "busy" right after a shot (for a number of
+tries, or for a time as a body writing to a slow card is: it takes no picture meanwhile), a
+body switched off or unplugged (every call then fails with -7 and autodetect finds nothing), a
+card that fills up, a file counter that wraps (IMG_9999 → IMG_0001) or a RAM target that
+names every shot the same (Nikon's ``capt0000.nef``), RAW+JPEG delivered as two files, the
+second through a FILE_ADDED event (some bodies also announce the first one, and end with
+CAPTURE_COMPLETE), several bodies on the bus, and a setting that does not latch (the mode dial
+not on M).
 """
 
 from __future__ import annotations
@@ -77,6 +79,10 @@ class Body:
     #: op name → error codes raised by its next calls, in order
     failures: dict[str, list[int]] = field(default_factory=dict)
     busy_after_shot: int = 0  # the next N captures after a shot answer -110 first
+    #: a slow card: every capture answers -110 (and takes no picture) until ``busy_for_s`` of
+    #: ``busy_clock`` time have passed since the last shot (PTP Device Busy, gphoto2 #308)
+    busy_for_s: float = 0.0
+    busy_clock: Any = None
     card_free_shots: int = 1000
     jpeg_first: bool = False  # RAW+JPEG: capture() returns the JPEG, the RAW comes by event
     #: RAW+JPEG: the second file is announced only after this many quiet event waits (a body
@@ -99,6 +105,7 @@ class Body:
     _events: list[tuple[int, object]] = field(default_factory=list)
     _late: list[list] = field(default_factory=list)  # type: ignore[type-arg]
     _busy: int = 0
+    _busy_until: float = float("-inf")
     _counter: int = 0
 
     def switch_off(self) -> None:
@@ -210,6 +217,8 @@ def make_module(body: Body) -> types.ModuleType:
             if body._busy:
                 body._busy -= 1
                 raise GPhoto2Error(-110)
+            if body.busy_for_s and body.busy_clock.now() < body._busy_until:
+                raise GPhoto2Error(-110)
             # the files a previous shot was still writing are announced by now
             body._events.extend(event for _, event in body._late)
             body._late.clear()
@@ -230,6 +239,8 @@ def make_module(body: Body) -> types.ModuleType:
                 body.card_free_shots -= 1
             body.shots += 1
             body._busy = body.busy_after_shot
+            if body.busy_for_s:
+                body._busy_until = body.busy_clock.now() + body.busy_for_s
             if body.jpeg_first:
                 files.sort(key=lambda n: not n.endswith(".JPG"))
             folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"

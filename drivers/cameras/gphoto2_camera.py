@@ -22,12 +22,13 @@ import re
 import shutil
 import tempfile
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
-from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.drivers.cameras.folder_watch import is_raw_file
 from rti_rig.drivers.cameras.raw_decode import decode_raw
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
@@ -40,7 +41,9 @@ GP_ERROR_HINTS = {
     -53: "the USB device is claimed by another program (on desktops gvfs-gphoto2-volume-monitor "
     "or a file manager mounted it): stop that program or unmount the camera",
     -105: "no camera model detected: is it on, connected, and in PC/PTP mode?",
-    -110: "camera busy: still writing the previous file? raise busy_retries or retry_delay_s",
+    -110: "camera busy: still writing the previous file to its card, or hunting focus? raise "
+    "busy_retries or retry_max_delay_s in [camera.device] to wait longer (on a dome its LED is "
+    "switched off while the wait outlasts max_on_s, and lit again for the shot)",
     -115: "the camera's memory card is full: free space on it, or set capture_target = "
     "'Internal RAM' so that shots are only downloaded, never stored on the card",
 }
@@ -144,6 +147,9 @@ class Gphoto2Camera:
         #: (camera path, requested and set exposure, shutter label, start) of an exposure whose
         #: files ``collect`` has not downloaded yet
         self._pending: tuple[Any, float, float, str, float] | None = None
+        #: a busy spell handed back to the caller by ``expose_within`` (its light went off):
+        #: the next ``expose_within`` goes on counting its tries and waits from there
+        self._busy: _BusySpell | None = None
         self.retries_used = 0
         self.camera_model: str | None = None
 
@@ -165,21 +171,34 @@ class Gphoto2Camera:
                     self._clock.sleep(delay)
                     delay = min(delay * s.retry_backoff, s.retry_max_delay_s)
                     continue
-                hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
-                tries = f" after {attempt + 1} attempts" if attempt else ""
-                text = f"gphoto2 error {code} ({exc}){tries}: {hint}"
-                if code in GONE_CODES and self._cam is not None:
-                    raise CameraGoneError(
-                        self.name,
-                        f"the camera stopped answering during '{command}' (switched off, "
-                        f"unplugged or powered down?); {text}. Images already taken are kept: "
-                        "reconnect it, then continue with 'rti-rig run --resume SESSION'",
-                        command,
-                    ) from exc
-                if code == -115:
-                    raise CardFullError(self.name, text, command) from exc
-                raise error(self.name, text, command) from exc
+                raise self._failure(command, exc, attempt + 1, error) from exc
         raise AssertionError("unreachable")  # pragma: no cover
+
+    def _failure(
+        self,
+        command: str,
+        exc: Exception,
+        attempts: int,
+        error: type[DeviceError] = CaptureError,
+        waited_s: float | None = None,
+    ) -> DeviceError:
+        """The error for a gphoto2 call that failed for good, with its code's hint."""
+        code = getattr(exc, "code", None)
+        hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
+        over = f" over {waited_s:g} s" if waited_s else ""
+        tries = f" after {attempts} attempts{over}" if attempts > 1 else ""
+        text = f"gphoto2 error {code} ({exc}){tries}: {hint}"
+        if code in GONE_CODES and self._cam is not None:
+            return CameraGoneError(
+                self.name,
+                f"the camera stopped answering during '{command}' (switched off, "
+                f"unplugged or powered down?); {text}. Images already taken are kept: "
+                "reconnect it, then continue with 'rti-rig run --resume SESSION'",
+                command,
+            )
+        if code == -115:
+            return CardFullError(self.name, text, command)
+        return error(self.name, text, command)
 
     # -- lifecycle -------------------------------------------------------------------------
     def connect(self) -> None:
@@ -237,6 +256,7 @@ class Gphoto2Camera:
         cam, self._cam = self._cam, None
         self._shutter_label = None
         self._pending = None
+        self._busy = None
         staging, self._staging_tmp = self._staging_tmp, None
         if staging is not None:
             shutil.rmtree(staging, ignore_errors=True)
@@ -360,12 +380,26 @@ class Gphoto2Camera:
         the exposure is over: the light may go off before the download and the RAW decode,
         which take seconds for a 24-megapixel RAW over USB.
         """
+        return self.expose_within(exposure_s, None)
+
+    def expose_within(self, exposure_s: float, fire_by: float | None) -> float | None:
+        """``expose``, waiting for a busy camera only while its next try is due by ``fire_by``.
+
+        A camera that answers busy (-110: "I/O in progress", PTP Device Busy) refused the shot
+        and took no picture. Its tries are spaced ``retry_delay_s``, ``retry_backoff`` times
+        longer each time, at most ``retry_max_delay_s``, for ``busy_retries`` retries in all.
+        When the next wait would end after ``fire_by`` (on the clock), :class:`CameraBusyError`
+        is raised at once, with that wait as ``retry_in_s``: the caller's light may not stay
+        lit that long, so the caller switches it off, waits, lights it again and calls this
+        again, which tries at once and goes on counting from where it was (the spell is this
+        camera's until a shot is taken or the tries run out). The whole wait is thus bounded
+        by the retry settings, lit or not; past them the error is a plain ``CaptureError``.
+        """
         if self._cam is None:
             raise CaptureError(
                 self.name, "camera is not connected; call connect() first", "capture"
             )
         s = self.settings
-        gp = self._gp
         cam = self._cam
         problem = self.exposure_problem(exposure_s)
         if problem is not None:
@@ -376,9 +410,40 @@ class Gphoto2Camera:
             self._shutter_label = label
         t_capture = self._clock.now()
         self._pending = None
-        path = self._call("capture", lambda: cam.capture(gp.GP_CAPTURE_IMAGE))
+        path = self._fire(cam, fire_by)
         self._pending = (path, exposure_s, secs, label, t_capture)
         return self._clock.now()
+
+    def _fire(self, cam: Any, fire_by: float | None) -> Any:
+        """Fire the shutter once the camera is not busy; see :meth:`expose_within`."""
+        gp = self._gp
+        s = self.settings
+        spell, self._busy = self._busy or _BusySpell(delay_s=s.retry_delay_s), None
+        while True:
+            try:
+                return cam.capture(gp.GP_CAPTURE_IMAGE)
+            except gp.GPhoto2Error as exc:
+                code = getattr(exc, "code", None)
+                if code not in s.retry_codes or spell.tries >= s.busy_retries:
+                    raise self._failure(
+                        "capture", exc, spell.tries + 1, waited_s=spell.waited_s
+                    ) from exc
+                delay = spell.delay_s
+                spell.tries += 1
+                spell.waited_s += delay
+                spell.delay_s = min(delay * s.retry_backoff, s.retry_max_delay_s)
+                self.retries_used += 1
+                if fire_by is not None and self._clock.now() + delay > fire_by + 1e-9:
+                    self._busy = spell
+                    raise CameraBusyError(
+                        self.name,
+                        f"camera busy (gphoto2 error {code}) {spell.tries} time(s); its next "
+                        f"try is due in {delay:g} s, later than the shot may be fired",
+                        "capture",
+                        retry_in_s=delay,
+                        tries=spell.tries,
+                    ) from exc
+                self._clock.sleep(delay)
 
     def exposure_problem(self, exposure_s: float) -> str | None:
         """Why ``exposure_s`` cannot be shot on this camera (None: it can), once connected.
@@ -556,6 +621,15 @@ class Gphoto2Camera:
             # files in camera RAM may vanish once downloaded
             with contextlib.suppress(gp.GPhoto2Error):
                 self._cam.file_delete(folder, name)
+
+
+@dataclass
+class _BusySpell:
+    """One wait for a busy camera: its tries so far, the time waited, the next wait."""
+
+    delay_s: float
+    tries: int = 0
+    waited_s: float = 0.0
 
 
 def _unused(folder: Path, name: str) -> Path:

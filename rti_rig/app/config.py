@@ -764,50 +764,11 @@ def load_rig_config(path: Path | str) -> LoadedRig:
                 "'dome_shutter' needs a dome (its camera-release line fires the camera); on an "
                 "arm rig let the camera fire itself (trigger = 'none')",
             )
-        for note in (_untriggered_wait_note(loaded, cam), _busy_wait_note(loaded, cam)):
-            if note:
-                loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
+        # a busy DSLR is no note (it had been one until 2026-11-29): the controller switches
+        # the LED off while a busy camera is awaited past max_on_s, and lights it again
+        if note := _untriggered_wait_note(loaded, cam):
+            loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
     return loaded
-
-
-def busy_wait_s(cam: Any) -> float:
-    """The longest a gphoto2 camera's 'busy' retries wait in one call: the waits between
-    ``busy_retries + 1`` attempts, from ``retry_delay_s`` growing by ``retry_backoff`` up to
-    ``retry_max_delay_s`` (as :meth:`Gphoto2Camera._call` waits)."""
-    total, delay = 0.0, float(cam.retry_delay_s)
-    for _ in range(int(cam.busy_retries)):
-        total += delay
-        delay = min(delay * cam.retry_backoff, cam.retry_max_delay_s)
-    return total
-
-
-def _busy_wait_note(rig: LoadedRig, cam: Any) -> str:
-    """Said when a dome's LED may have to stay lit longer than it is allowed while a DSLR
-    answers 'busy' to the shot ("" otherwise).
-
-    The capture is fired with the LED lit, and a body still writing its previous file answers
-    'busy' (-110), which the driver retries with growing waits. The shipped DSLR example's
-    defaults wait up to 11.5 s against max_on_s = 8 s: a camera busy for long stopped the
-    session at the thermal limit with "raise max_on_s or shorten settle and exposure", advice
-    that does not name the wait.
-    """
-    serial = rig.config.dome.serial if rig.config.dome is not None else None
-    if serial is None or getattr(cam, "kind", None) != "gphoto2":
-        return ""
-    wait = busy_wait_s(cam)
-    lit_for = serial.thermal.max_on_s - rig.config.timing.settle_s - rig.config.camera.exposure_s
-    if wait <= lit_for:
-        return ""
-    return (
-        f"{rig.path}: a busy camera is retried for up to {wait:g} s "
-        f"([camera.device] busy_retries = {cam.busy_retries}, retry_delay_s = "
-        f"{cam.retry_delay_s:g}, retry_backoff = {cam.retry_backoff:g}, retry_max_delay_s = "
-        f"{cam.retry_max_delay_s:g}) while its LED is lit, longer than it may stay lit "
-        f"([dome.serial.thermal] max_on_s = {serial.thermal.max_on_s:g} s, less settle_s and "
-        f"exposure_s: {lit_for:g} s): a camera busy that long stops the session at the "
-        "thermal limit. Lower busy_retries or retry_max_delay_s so the retries fit, or raise "
-        "max_on_s if the LEDs allow it"
-    )
 
 
 def _untriggered_wait_note(rig: LoadedRig, cam: Any) -> str:

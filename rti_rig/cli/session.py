@@ -769,12 +769,29 @@ def _paused_lights(rig) -> str:  # type: ignore[no-untyped-def]
     return lights_state(rig)
 
 
+def _light_off_for_camera(event) -> str:  # type: ignore[no-untyped-def]
+    """What the user is told when a step's light goes off while a busy camera is awaited."""
+    light = f"LED {event.led}" if event.led is not None else "the light"
+    off = {
+        "acknowledged": "switched off, acknowledged by the dome",
+        "sent-no-ack": "all-off sent (this firmware never acknowledges)",
+        "self-timed": "going off by itself (this firmware has no all-off)",
+    }.get(event.off or "", "all-off sent")
+    return (
+        f"Image {event.index + 1}: the camera is still busy (writing its previous shot?) and "
+        f"its next try, in {event.wait_s:g} s, would keep {light} (lit {event.lit_s:.1f} s) on "
+        f"past max_on_s = {event.max_on_s:g} s: {off}; it is lit again for the shot after "
+        "that wait."
+    )
+
+
 def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-untyped-def]
     from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
         CancelToken,
         EmergencyStop,
         FinishReason,
+        LightOffForCamera,
         Paused,
         StepCompleted,
         StepStarted,
@@ -847,6 +864,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                     )
                 elif isinstance(event, StepStarted):  # after a pause: capturing again
                     progress.update(task, description="capturing")
+                elif isinstance(event, LightOffForCamera):
+                    # said as it happens: the bar would stand still for the whole wait
+                    err.print(_light_off_for_camera(event), markup=False)
 
             started = True
             result = run_opened_session(opened, cancel, on_event)

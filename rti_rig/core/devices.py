@@ -140,3 +140,22 @@ class ExposingCamera(Protocol):
     def expose(self, exposure_s: float) -> float | None: ...
 
     def collect(self) -> Frame: ...
+
+
+@runtime_checkable
+class BusyAwareCamera(Protocol):
+    """An :class:`ExposingCamera` that can be told by when it must fire.
+
+    Why: a DSLR still writing its previous shot to a slow card answers "busy" and is retried
+    with growing waits; fired with the step's LED lit, those waits had to fit in the time an
+    LED may stay lit (the dome's ``max_on_s``), and a camera busy longer stopped the session.
+    ``expose_within(exposure_s, fire_by)`` waits for a busy camera only while the next try
+    can still be made by ``fire_by`` (on the rig's clock); past it, it raises
+    :class:`rti_rig.core.errors.CameraBusyError` having taken no picture, so that the
+    controller can switch the light off, wait in the dark and light it again for the shot.
+    ``fire_by = None`` waits as ``expose`` does.
+    """
+
+    def expose_within(self, exposure_s: float, fire_by: float | None) -> float | None: ...
+
+    def collect(self) -> Frame: ...

@@ -59,5 +59,31 @@ class CaptureError(DeviceError):
     """The camera did not deliver a usable frame."""
 
 
+class CameraBusyError(CaptureError):
+    """The camera answered busy and took **no** picture, and its next try is due later than
+    the caller allowed it to wait (the time the step's light may stay lit).
+
+    Raised by a :class:`rti_rig.core.devices.BusyAwareCamera` only when asked to fire by a
+    time: the caller switches its light off, waits ``retry_in_s`` in the dark, lights it
+    again and asks once more; the camera keeps counting its tries across these calls, so the
+    whole wait stays bounded by its own retry settings (then it raises a plain
+    :class:`CaptureError`).
+    """
+
+    def __init__(
+        self,
+        device: str,
+        message: str,
+        command: str | None,
+        retry_in_s: float,
+        tries: int,
+    ) -> None:
+        super().__init__(device, message, command)
+        #: how long to wait before the next try (the camera's own back-off)
+        self.retry_in_s = retry_in_s
+        #: how many times it has answered busy so far in this wait
+        self.tries = tries
+
+
 class SessionError(RtiRigError):
     """The session folder cannot be written or read as asked (never overwrites captures)."""

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, Protocol
 
-from rti_rig.core.devices import ExposingCamera, Frame
-from rti_rig.core.errors import CaptureError, ScheduleError
+from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame
+from rti_rig.core.errors import CameraBusyError, CaptureError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.deferred_signals import signals_deferred
@@ -125,7 +125,24 @@ class SessionResult:
     notes: tuple[str, ...] = ()
 
 
-Event = StepStarted | StepCompleted | Paused
+@dataclass(frozen=True)
+class LightOffForCamera:
+    """The step's light was switched off because the camera is still busy and its next try
+    would come after the light's ``max_on_s``; it is lit again after ``wait_s`` (the
+    camera's next try, plus any cool-down the dome's thermal guard asks)."""
+
+    index: int
+    total: int
+    led: int | None
+    lit_s: float
+    #: what the all-off established ("acknowledged", "sent-no-ack"…; None: not known)
+    off: str | None
+    wait_s: float
+    #: how long the light may stay lit (the dome's ``max_on_s``)
+    max_on_s: float
+
+
+Event = StepStarted | StepCompleted | Paused | LightOffForCamera
 
 
 class StepSource(Protocol):
@@ -179,7 +196,12 @@ def shoot_lit(rig: Rig, exposure_s: float) -> Frame:
         frame = camera.capture(exposure_s)
         rig.lighting.off()
         return frame
-    ended = camera.expose(exposure_s)
+    return _finish_shot(rig, camera.expose(exposure_s))
+
+
+def _finish_shot(rig: Rig, ended: float | None) -> Frame:
+    """Light off once the exposure that ``expose`` fired has ended, then collect its frame."""
+    camera: Any = rig.camera
     if ended is None:  # the camera cannot tell: the light stays on until the image is in
         frame = camera.collect()
         rig.lighting.off()
@@ -189,6 +211,75 @@ def shoot_lit(rig: Rig, exposure_s: float) -> Frame:
         rig.clock.sleep(wait)
     rig.lighting.off()
     return camera.collect()
+
+
+def shoot_step(
+    rig: Rig,
+    step: LightStep,
+    exposure_s: float,
+    lit_at: float,
+    on_dark: Callable[[dict[str, Any]], None] | None = None,
+) -> tuple[Frame, list[dict[str, Any]]]:
+    """Capture the image of ``step``, lit at ``lit_at`` and settled, and switch its light off;
+    return the frame and the times its light was switched off and lit again meanwhile.
+
+    A camera that answers busy (a DSLR writing its previous shot to a slow card) is awaited
+    with the light lit only as long as the light may stay lit (the dome's ``max_on_s``, less
+    the exposure and ``timing.readout_s``, from ``lit_at``). Past that the light is switched
+    off (thermal duty first), the camera is awaited in the dark for its next try, and the same
+    light is lit again and settled before the camera is asked again: the image is always the
+    one taken under the lit light, since the camera is only ever fired with it lit, and its
+    light goes off only once the exposure is over or the camera has refused the shot. The
+    whole wait is bounded by the camera's own retry settings (``busy_retries`` and its
+    back-off); a camera still busy then stops the session, which ``--resume`` continues. The
+    dome's thermal guard may add a cool-down before a relight. Until 2026-11-29 a camera busy
+    longer than ``max_on_s`` stopped the session, with advice (raise ``busy_retries``) that
+    then ran into the thermal limit.
+
+    ``on_dark`` is told each time the light goes off (how long it was lit, what the all-off
+    established, how long the camera is awaited), before that wait.
+    """
+    camera = rig.camera
+    limit_of = getattr(rig.lighting, "lit_limit_s", None)
+    limit = limit_of() if limit_of is not None else None
+    if limit is None or not isinstance(camera, BusyAwareCamera):
+        return shoot_lit(rig, exposure_s), []
+    clock = rig.clock
+    relit: list[dict[str, Any]] = []
+    while True:
+        fire_by = lit_at + limit - exposure_s - rig.timing.readout_s
+        try:
+            ended = camera.expose_within(exposure_s, fire_by)
+        except CameraBusyError as busy:
+            off_at = clock.now()
+            rig.lighting.off()  # raises, stopping the session, if the dome did not take it
+            said_of = getattr(rig.lighting, "off_said", None)
+            off_said = said_of() if said_of is not None else None
+            if on_dark is not None:
+                on_dark(
+                    {
+                        "lit_s": off_at - lit_at,
+                        "off": off_said,
+                        "wait_s": busy.retry_in_s,
+                        "max_on_s": limit,
+                    }
+                )
+            clock.sleep(busy.retry_in_s)
+            rig.lighting.set(step)  # the thermal guard may let the LED cool first
+            relit.append(
+                {
+                    # how long the light had been lit, and how long it was dark
+                    "lit_s": off_at - lit_at,
+                    "off": off_said,
+                    "dark_s": clock.now() - off_at,
+                    "camera_busy_tries": busy.tries,
+                    "camera_wait_s": busy.retry_in_s,
+                }
+            )
+            lit_at = clock.now()
+            clock.sleep(rig.timing.settle_s)
+            continue
+        return _finish_shot(rig, ended), relit
 
 
 def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
@@ -351,7 +442,13 @@ def run_session(
             t_lit = clock.now()
             clock.sleep(rig.timing.settle_s)
             t_settled = clock.now()
-            frame = shoot_lit(rig, step_exposure(rig, step))
+            frame, relit = shoot_step(
+                rig,
+                step,
+                step_exposure(rig, step),
+                t_lit,
+                lambda dark, i=i, led=step.led: emit(LightOffForCamera(i, total, led, **dark)),
+            )
             t_captured = clock.now()
             got = frame_layout(frame)
             if layout is not None and got != layout:
@@ -367,6 +464,7 @@ def run_session(
                 "settle_s": t_settled - t_lit,
                 "capture_s": t_captured - t_settled,
                 **({"decision": decision} if decision is not None else {}),
+                **({"relit": relit} if relit else {}),
             }
             # the lights are off; an emergency stop raised between the files' rename and the
             # journal line left an image on disk that lights.lp did not list: the commit of a

@@ -90,6 +90,22 @@ class DomeLighting:
     def off(self) -> None:
         self.source.all_off()
 
+    def lit_limit_s(self) -> float | None:
+        """How long one LED may stay lit (the thermal guard's ``max_on_s``), None when the
+        source sets no limit (a simulated dome).
+
+        The controller switches the LED off while a busy camera is awaited past this, and
+        lights it again for the shot (:func:`rti_rig.runtime.controller.shoot_step`)."""
+        thermal = getattr(getattr(self.source, "settings", None), "thermal", None)
+        return None if thermal is None else float(thermal.max_on_s)
+
+    def off_said(self) -> str | None:
+        """What the last all-off established, as the dome policy recorded it
+        (``"acknowledged"``, ``"sent-no-ack"``, ``"self-timed"``…), None when it keeps no
+        record: a step's journal says what was established, never more."""
+        report = getattr(self.source, "off_report", None)
+        return None if report is None else str(report.outcome)
+
     def safe(self, emergency: bool = False) -> list[str]:
         return attempt_all([("all LEDs off", self.source.all_off)])
 

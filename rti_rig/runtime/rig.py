@@ -33,6 +33,8 @@ class TimingConfig(Protocol):
     """The rig's timing, as the controller waits on it."""
 
     settle_s: float
+    #: from the end of the exposure until the camera reports the image taken
+    readout_s: float
 
 
 class RigConfig(Protocol):

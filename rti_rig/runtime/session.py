@@ -100,6 +100,12 @@ class StepRecord:
     notices: list[str] = field(default_factory=list)
     #: an adaptive session's decision for this step and its evidence (None: a fixed schedule)
     decision: dict[str, Any] | None = None
+    #: each time the step's light was switched off while a busy camera was awaited past the
+    #: time the light may stay lit, and lit again for the shot: how long it had been lit
+    #: (``lit_s``), what the all-off established (``off``: "acknowledged", "sent-no-ack"…),
+    #: how long it was dark (``dark_s``), the camera's busy answers so far
+    #: (``camera_busy_tries``) and the wait for its next try (``camera_wait_s``)
+    relit: list[dict[str, Any]] = field(default_factory=list)
 
 
 def planned_steps(manifest: dict[str, Any]) -> int:
@@ -787,6 +793,14 @@ def session_notices(records: list[StepRecord]) -> list[str]:
     counts: dict[str, int] = {}
     for r in records:
         for n in r.notices:
+            counts[n] = counts.get(n, 0) + 1
+        if r.relit:
+            n = (
+                "the camera was still busy (writing its previous shot?) when its next try "
+                "would have kept the LED lit past max_on_s: the LED was switched off while the "
+                "camera was awaited and lit again for the image (the journal's 'relit' says "
+                "how long, and whether the dome acknowledged each all-off)"
+            )
             counts[n] = counts.get(n, 0) + 1
         if r.decode.get("mode") == "mosaic":
             n = (

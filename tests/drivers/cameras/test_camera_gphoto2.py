@@ -11,7 +11,7 @@ from fake_gphoto2 import SHUTTERS, Body, make_module
 
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.devices import Camera
-from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic
 from rti_rig.drivers.cameras.gphoto2_camera import (
     Gphoto2Camera,
@@ -147,6 +147,56 @@ def test_busy_forever_gives_up_with_a_clear_error(tmp_path):
         pytest.raises(CaptureError, match=r"-110.*after 4 attempts.*busy"),
     ):
         cam.capture(1 / 60)
+
+
+def test_busy_past_fire_by_is_handed_back_without_a_picture_and_counted_on(tmp_path):
+    """A body writing to a slow card answers busy for 9 s after each shot. Told to fire
+    within 1 s (its light may not stay lit longer), the camera waits 0.5 s, then hands the wait
+    back (its next try is due in 1 s) having taken no picture; called again after that wait
+    it goes on with the same tries and back-off, and fires once the body is ready."""
+    clock = VirtualClock()
+    body = dslr(busy_for_s=9.0, busy_clock=clock)
+    with camera(body, tmp_path, clock=clock, busy_retries=6, retry_delay_s=0.5) as cam:
+        cam.capture(1 / 60)  # the first shot: the body is busy for 9 s from now
+        assert body.shots == 1
+        with pytest.raises(CameraBusyError) as busy:
+            cam.expose_within(1 / 60, fire_by=clock.now() + 1.0)
+        assert busy.value.retry_in_s == pytest.approx(1.0) and busy.value.tries == 2
+        assert clock.now() == pytest.approx(0.5)  # waited 0.5 s lit, not the 1 s past fire_by
+        assert body.shots == 1  # no picture while busy
+        waits, wait = [], busy.value.retry_in_s
+        while True:  # the caller's dark waits, each followed by a try at once
+            clock.sleep(wait)
+            waits.append(wait)
+            try:
+                cam.expose_within(1 / 60, fire_by=clock.now() + 1.0)
+                break
+            except CameraBusyError as again:
+                wait = again.retry_in_s
+        assert waits == [1.0, 2.0, 4.0, 4.0]  # the back-off went on across the calls
+        assert body.shots == 2 and clock.now() == pytest.approx(11.5)
+        assert cam.collect().metadata["camera_files"] == ["/IMG_0002.DNG"]
+
+
+def test_busy_handed_back_still_ends_after_busy_retries(tmp_path):
+    """The tries counted across ``expose_within`` calls end at busy_retries: a body that never
+    comes back is an error that says how long it was awaited."""
+    clock = VirtualClock()
+    body = dslr(failures={"capture": [-110] * 20})
+    with camera(body, tmp_path, clock=clock, busy_retries=3, retry_delay_s=1.0) as cam:
+        for _ in range(3):
+            with pytest.raises(CameraBusyError) as busy:
+                cam.expose_within(1 / 60, fire_by=clock.now())
+            clock.sleep(busy.value.retry_in_s)
+        with pytest.raises(CaptureError, match=r"-110.*after 4 attempts over 7 s.*busy") as end:
+            cam.expose_within(1 / 60, fire_by=clock.now())
+        assert not isinstance(end.value, CameraBusyError)
+        assert "busy_retries" in str(end.value) and body.shots == 0
+        # the next shot starts a new wait (the spell ended with the error)
+        body.failures["capture"] = [-110]
+        with pytest.raises(CameraBusyError) as busy:
+            cam.expose_within(1 / 60, fire_by=clock.now())
+        assert busy.value.tries == 1 and busy.value.retry_in_s == 1.0
 
 
 def test_other_errors_are_not_retried(tmp_path):

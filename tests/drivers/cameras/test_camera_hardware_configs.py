@@ -288,6 +288,35 @@ def test_dslr_busy_after_every_shot_is_retried_and_the_session_completes(body, t
     assert body.shots == 4 and body.calls.count("capture") == 4 + 3
 
 
+@pytest.mark.slow
+def test_dslr_busy_past_its_leds_max_on_s_is_awaited_with_the_led_off(body, dome, tmp_path):
+    """A body writing to a slow card answers busy 4 times after a shot: with the shipped
+    config's retries (0.5, 1, 2, 4… s) the fifth try would come 7.7 s after its LED lit,
+    past max_on_s = 8 s less the shot. The LED goes off (acknowledged), the camera is awaited
+    in the dark, the LED is lit again and the image taken under it. Until 2026-11-29 the
+    session stopped there ("raise busy_retries"; raised, the LED then broke max_on_s)."""
+    body.busy_after_shot = 4
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "2")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, result.output
+    check_images(out, 2)  # each image as bright as its own LED: none taken in the dark
+    first, second = journal(out)
+    assert first["relit"] == [] and second["relit"], second
+    assert all(r["off"] == "acknowledged" for r in second["relit"])
+    assert all(r["lit_s"] < 8.0 for r in second["relit"])
+    led = second["led"]
+    assert "Image 2: the camera is still busy" in said and f"keep LED {led} (lit" in said
+    assert "past max_on_s = 8 s: switched off, acknowledged by the dome" in said
+    assert "lit again for the shot" in said
+    assert "the LED was switched off while the camera was awaited" in said
+    assert "[1 of 2 images]" in said
+    # the firmware's own log: the step's LED lit, off, lit again, off; never two at once
+    log = [(e.what, e.index) for e in dome.history if e.what in ("lit", "off")]
+    relit = len(second["relit"])
+    assert log[-2 * (relit + 1) :] == [("lit", led), ("off", led)] * (relit + 1)
+
+
 #: A body in 1/3-stop steps around 1/10 s: it offers no 1/8 s (the shipped example's 0.125 s).
 NO_EIGHTH = ["bulb", "30", "1", "1/4", "1/10", "1/13", "1/15", "1/30", "1/60"]
 

@@ -1,0 +1,150 @@
+"""A DSLR busy longer than its LED may stay lit: the LED goes off, the camera is awaited in the
+dark, the same LED is lit again for the shot (the owners' decision, 2026-11-29).
+
+The rig is the shipped emulated dome (the real dome policy and driver over a pty, on the rig's
+virtual clock) with a 8 s ``max_on_s``, and the real gphoto2 driver on the fake python-gphoto2
+module, whose body writes to a slow card: it answers busy (-110, no picture) for a time after
+each shot. Each image is rendered from what the emulated firmware really has lit when the body
+fires, so an image taken in the dark would show it.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS, write_config
+from dng_spec_writer import dng, mosaic_from_rgb
+from fake_gphoto2 import Body, make_module
+
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
+from rti_rig.core.errors import CaptureError
+from rti_rig.core.image_files import read_linear_tiff
+from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
+from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
+from rti_rig.runtime.controller import FinishReason, run_session
+from rti_rig.runtime.rig import Rig
+from rti_rig.runtime.session import SessionFolder
+
+pytestmark = pytest.mark.pty
+
+H, W = 32, 48
+BLACK, WHITE = (512, 512, 512, 512), 16383
+#: the steps' LEDs: three distinct ones, so that each image's brightness names its LED
+LEDS = (3, 20, 40)
+
+
+def level(led: int | None) -> float:
+    return 0.0 if led is None else 0.3 + 0.01 * led
+
+
+def dome_with_thermal(tmp_path: Path) -> Path:
+    """The shipped emulated dome with the DSLR example's thermal limits (max_on_s = 8 s) and
+    exposure (1/8 s, a shutter speed the body offers)."""
+    text = (CONFIGS / "emulated_dome.toml").read_text()
+    assert "[camera]" in text and "settle_s = 0.1\n" in text and "readout_s = 0.3\n" in text
+    assert "exposure_s = 0.05\n" in text
+    text = text.replace("exposure_s = 0.05\n", "exposure_s = 0.125\n")
+    text = text.replace('"example_dome_48.lp"', f'"{(CONFIGS / "example_dome_48.lp").as_posix()}"')
+    text = text.replace(
+        "[camera]", "[dome.serial.thermal]\nmax_on_s = 8.0\nmax_duty = 0.3\n\n[camera]", 1
+    )
+    return write_config(tmp_path, text, "dome.toml")
+
+
+def dslr_rig(tmp_path: Path, **settings: object) -> tuple[Rig, Body, list]:
+    """The emulated dome with a gphoto2 DSLR on the fake module; returns the rig, the body
+    and the list of what the firmware had lit at each shot the body took."""
+    rig = build_rig(load_rig_config(dome_with_thermal(tmp_path)))
+    firmware = rig.emulator  # type: ignore[attr-defined]
+    lit_at_shots: list = []
+
+    def render(body: Body) -> bytes:
+        lit = firmware.lit
+        lit_at_shots.append(None if lit is None else lit[0])
+        rgb = np.full((H, W, 3), level(None if lit is None else lit[0]))
+        return dng(mosaic_from_rgb(rgb, "RGGB", BLACK, WHITE), "RGGB", BLACK, WHITE)
+
+    body = Body(render=render, busy_clock=rig.clock)
+    camera = Gphoto2Camera(
+        Gphoto2CameraSettings(image_format="RAW", **settings),  # type: ignore[arg-type]
+        output_dir=tmp_path / "staging",
+        clock=rig.clock,
+        gp_module=make_module(body),
+    )
+    rig.camera = camera
+    return rig, body, lit_at_shots
+
+
+def schedule_of(rig: Rig) -> LightSchedule:
+    dirs = rig.geometry.directions
+    steps = tuple(LightStep(tuple(float(x) for x in dirs[i]), led=i) for i in LEDS)
+    return LightSchedule(steps, method="test")
+
+
+def journal(out: Path) -> list[dict]:
+    return [json.loads(x) for x in (out / "journal.jsonl").read_text().splitlines() if x]
+
+
+def test_a_camera_busy_past_max_on_s_is_awaited_in_the_dark_and_shot_relit(tmp_path):
+    """A body busy 9 s after each shot, retried after 1, 2, 4, 4… s: the LED is lit 7.1 s,
+    switched off (acknowledged), dark 4 s, lit again, and the image taken under it. Until
+    2026-11-29 the LED stayed lit through every retry and the session stopped at the thermal
+    guard ("LED 20 stayed on 11.2 s, beyond max_on_s = 8 s")."""
+    rig, body, lit_at_shots = dslr_rig(tmp_path, busy_retries=6, retry_delay_s=1.0)
+    body.busy_for_s = 9.0
+    out = tmp_path / "s"
+    with rig:
+        result = run_session(rig, schedule_of(rig), SessionFolder.create(out, len(LEDS)))
+    assert result.finish_reason is FinishReason.COMPLETED, result.error
+    # every shot the body took, it took under the step's own LED: none in the dark
+    assert lit_at_shots == list(LEDS) and body.shots == 3
+    entries = journal(out)
+    assert entries[0]["relit"] == []  # the body was ready for the first image
+    for e in entries[1:]:
+        (relit,) = e["relit"]
+        assert relit["off"] == "acknowledged"
+        assert 7.0 <= relit["lit_s"] <= 8.0 - 0.125 - 0.3  # within max_on_s, less the shot
+        assert relit["dark_s"] >= 4.0 and relit["camera_wait_s"] == 4.0
+        assert relit["camera_busy_tries"] == 4
+    for e in entries:
+        tif = read_linear_tiff(out / e["linear_image"]) / 65535
+        assert tif.mean() == pytest.approx(level(e["led"]), rel=1e-3)
+    manifest = json.loads((out / "manifest.json").read_text())
+    (note,) = [n for n in manifest["notices"] if "lit again" in n]
+    assert note.endswith("[2 of 3 images]")
+    # the firmware saw each busy step's LED lit, switched off and lit again: one LED at a time
+    history = [(ev.what, ev.index) for ev in rig.emulator.history if ev.what in ("lit", "off")]  # type: ignore[attr-defined]
+    assert history == [
+        ("lit", 3),
+        ("off", 3),
+        ("lit", 20),
+        ("off", 20),
+        ("lit", 20),
+        ("off", 20),
+        ("lit", 40),
+        ("off", 40),
+        ("lit", 40),
+        ("off", 40),
+    ]
+
+
+def test_a_camera_that_never_comes_back_stops_the_session_after_its_retries_lights_off(
+    tmp_path,
+):
+    """The wait is bounded by the camera's retries (1 + 2 + 4 + 4 s here), lit or not: then the
+    session stops, resumable, with the images before kept and every LED off."""
+    rig, body, lit_at_shots = dslr_rig(tmp_path, busy_retries=4, retry_delay_s=1.0)
+    body.busy_for_s = 1e9
+    out = tmp_path / "s"
+    with rig, pytest.raises(CaptureError, match=r"after 5 attempts over 11 s.*busy_retries"):
+        run_session(rig, schedule_of(rig), SessionFolder.create(out, len(LEDS)))
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] == "error"
+    assert [e["index"] for e in journal(out)] == [0]
+    assert lit_at_shots == [3] and body.shots == 1
+    assert rig.emulator.lit is None  # type: ignore[attr-defined]
