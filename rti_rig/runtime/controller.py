@@ -240,16 +240,37 @@ def shoot_step(
     established, how long the camera is awaited), before that wait.
     """
     camera = rig.camera
-    limit_of = getattr(rig.lighting, "lit_limit_s", None)
-    limit = limit_of() if limit_of is not None else None
-    if limit is None or not isinstance(camera, BusyAwareCamera):
+    if lit_limit_s(rig) is None or not isinstance(camera, BusyAwareCamera):
         return shoot_lit(rig, exposure_s), []
+    ended, _, relit = fire_lit(rig, step, exposure_s, lit_at, on_dark)
+    return _finish_shot(rig, ended), relit
+
+
+def lit_limit_s(rig: Rig) -> float | None:
+    """How long the rig's light may stay lit at a time (a dome's ``max_on_s``), or None."""
+    limit_of = getattr(rig.lighting, "lit_limit_s", None)
+    return limit_of() if limit_of is not None else None
+
+
+def fire_lit(
+    rig: Rig,
+    step: LightStep,
+    exposure_s: float,
+    lit_at: float,
+    on_dark: Callable[[dict[str, Any]], None] | None = None,
+) -> tuple[float | None, float, list[dict[str, Any]]]:
+    """Fire a :class:`BusyAwareCamera` under ``step``'s light, lit at ``lit_at`` and settled,
+    by :func:`shoot_step`'s rules; the light is left lit. Returns when the exposure ended (as
+    ``expose`` does), when the light it was taken under was lit, and the relights."""
+    camera = rig.camera
+    assert isinstance(camera, BusyAwareCamera)
+    limit = lit_limit_s(rig)
     clock = rig.clock
     relit: list[dict[str, Any]] = []
     while True:
-        fire_by = lit_at + limit - exposure_s - rig.timing.readout_s
+        fire_by = None if limit is None else lit_at + limit - exposure_s - rig.timing.readout_s
         try:
-            ended = camera.expose_within(exposure_s, fire_by)
+            return camera.expose_within(exposure_s, fire_by), lit_at, relit
         except CameraBusyError as busy:
             off_at = clock.now()
             rig.lighting.off()  # raises, stopping the session, if the dome did not take it
@@ -278,8 +299,6 @@ def shoot_step(
             )
             lit_at = clock.now()
             clock.sleep(rig.timing.settle_s)
-            continue
-        return _finish_shot(rig, ended), relit
 
 
 def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:

@@ -34,10 +34,10 @@ from typing import Any
 
 import numpy as np
 
-from rti_rig.core.devices import Frame
+from rti_rig.core.devices import BusyAwareCamera, Frame
 from rti_rig.core.errors import DeviceError
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.controller import validate_schedule
+from rti_rig.runtime.controller import fire_lit, lit_limit_s, validate_schedule
 from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
@@ -100,17 +100,31 @@ def brightest_step(schedule: LightSchedule) -> int:
 
 
 class _LitForEachShot:
-    """The rig's camera, each capture after the first taken under its light lit again.
+    """The rig's camera for test shots at one light, lit and settled by the caller at
+    ``lit_at``.
 
-    Before each shot after the first the light is switched off, lit again and the settle
-    waited, as the session does for each image: on a timed firmware the off waits for the end
-    of the LED's window and refuses a shot that outlasted it, and the light command opens a new
-    window (RTIPy's firmware blocks till its window ends: the new one follows it, never
-    overlaps it). Every other attribute is the camera's (its shutter speeds, its name)."""
+    With ``relight_each``, before each shot after the first the light is switched off, lit
+    again and the settle waited, as the session does for each image: on a timed firmware the
+    off waits for the end of the LED's window and refuses a shot that outlasted it, and the
+    light command opens a new window (RTIPy's firmware blocks till its window ends: the new
+    one follows it, never overlaps it).
 
-    def __init__(self, rig: Rig, step: LightStep) -> None:
+    A camera that answers busy (a DSLR still writing the previous test shot) is awaited as a
+    session's image is (:func:`rti_rig.runtime.controller.fire_lit`): lit only while its next
+    try fits in the LED's ``max_on_s``, else in the dark, the light lit again for the shot.
+    The retries had all been made with the LED lit: a body busy 10 s stopped ``run
+    --auto-exposure`` at the thermal guard ("LED 28 stayed on 11.7 s, beyond max_on_s = 8
+    s") before the session began.
+
+    Every other attribute is the camera's (its shutter speeds, its name)."""
+
+    def __init__(
+        self, rig: Rig, step: LightStep, lit_at: float, relight_each: bool = False
+    ) -> None:
         self._rig = rig
         self._step = step
+        self._lit_at = lit_at
+        self._relight_each = relight_each
         self._lit_for_next = True  # lit and settled by the caller for the first shot
 
     def capture(self, exposure_s: float) -> Frame:
@@ -118,9 +132,14 @@ class _LitForEachShot:
         if not self._lit_for_next:
             rig.lighting.off()
             rig.lighting.set(self._step)
+            self._lit_at = rig.clock.now()
             rig.clock.sleep(rig.timing.settle_s)
-        self._lit_for_next = False
-        return rig.camera.capture(exposure_s)
+        self._lit_for_next = not self._relight_each
+        camera = rig.camera
+        if lit_limit_s(rig) is None or not isinstance(camera, BusyAwareCamera):
+            return camera.capture(exposure_s)
+        _, self._lit_at, _ = fire_lit(rig, self._step, exposure_s, self._lit_at)
+        return camera.collect()  # the light stays lit for the series' next shot, as before
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._rig.camera, name)
@@ -157,8 +176,8 @@ def fix_session_exposure(
     validate_schedule(rig, schedule)
     steps = metering_steps(schedule, probes if recheck is not None else 1)
 
-    def camera_at(step: LightStep) -> Any:
-        return _LitForEachShot(rig, step) if shot_per_lighting else rig.camera
+    def camera_at(step: LightStep, lit_at: float) -> Any:
+        return _LitForEachShot(rig, step, lit_at, relight_each=shot_per_lighting)
 
     def teardown() -> list[str]:
         # every step of the teardown runs, whatever one device does; what failed is said. A
@@ -178,14 +197,16 @@ def fix_session_exposure(
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.set(schedule.steps[at])
+        lit_at = rig.clock.now()
         rig.clock.sleep(rig.timing.settle_s)
-        choice = meter(camera_at(schedule.steps[at]), rig.camera_config.exposure_s)
+        choice = meter(camera_at(schedule.steps[at], lit_at), rig.camera_config.exposure_s)
         tested.append([float(t) for t in getattr(choice, "test_exposures_s", ())])
         for j in steps[1:] if recheck is not None else ():
             rig.lighting.off()  # one light at a time: the last one's off before the next lights
             rig.lighting.set(schedule.steps[j])
+            lit_at = rig.clock.now()
             rig.clock.sleep(rig.timing.settle_s)
-            found = recheck(camera_at(schedule.steps[j]), float(choice.exposure_s))
+            found = recheck(camera_at(schedule.steps[j], lit_at), float(choice.exposure_s))
             tested.append([float(t) for t in found.tested_s])
             if found.choice is not None and found.choice.exposure_s < choice.exposure_s:
                 choice, at = found.choice, j

@@ -24,9 +24,11 @@ from rti_rig.app.config import load_rig_config
 from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.schedule import LightSchedule, LightStep
+from rti_rig.drivers.cameras.exposure import meter_exposure, recheck_exposure
 from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
-from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
+from rti_rig.drivers.cameras.settings import ExposureRule, Gphoto2CameraSettings
 from rti_rig.runtime.controller import FinishReason, run_session
+from rti_rig.runtime.exposure_policy import Recheck, fix_session_exposure
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import SessionFolder
 
@@ -147,4 +149,38 @@ def test_a_camera_that_never_comes_back_stops_the_session_after_its_retries_ligh
     assert manifest["runner"]["finish_reason"] == "error"
     assert [e["index"] for e in journal(out)] == [0]
     assert lit_at_shots == [3] and body.shots == 1
+    assert rig.emulator.lit is None  # type: ignore[attr-defined]
+
+
+def test_metering_a_busy_camera_waits_in_the_dark_never_past_max_on_s(tmp_path):
+    """``run --auto-exposure``'s test shots at three lights, on the body busy 9 s after each:
+    each shot is awaited as a session's image is, the LED off while the camera's next try
+    would keep it lit past max_on_s. The retries had all been made with the LED lit, and
+    metering stopped at the thermal guard before the session began ("LED 20 stayed on
+    11.1 s, beyond max_on_s = 8 s")."""
+    rig, body, lit_at_shots = dslr_rig(tmp_path, busy_retries=6, retry_delay_s=1.0)
+    body.busy_for_s = 9.0
+    rule = ExposureRule(headroom=1.25, min_exposure_s=1 / 250, max_exposure_s=1.0)
+
+    def meter(camera, start_s):  # type: ignore[no-untyped-def]
+        return meter_exposure(camera, rule, start_s, camera.available_exposures_s())
+
+    def recheck(camera, exposure_s):  # type: ignore[no-untyped-def]
+        choice, tested = recheck_exposure(camera, rule, exposure_s, camera.available_exposures_s())
+        return Recheck(tested, choice)
+
+    with rig:
+        fixed = fix_session_exposure(rig, schedule_of(rig), meter, recheck, probes=3)
+    evidence = fixed.provenance["exposure"]
+    order = [LEDS[i - 1] for i in evidence["lights_metered_at_steps"]]  # brightest first
+    assert sorted(order) == sorted(LEDS)
+    # every test shot was taken under a lit LED of the metered lights, none in the dark
+    assert body.shots == evidence["metering_shots"] == len(lit_at_shots) >= 3
+    assert None not in lit_at_shots and set(lit_at_shots) == set(LEDS)
+    # the body was busy at the second and third lights metered: lit, off, lit again
+    lit_count = {led: 0 for led in LEDS}
+    for ev in rig.emulator.history:  # type: ignore[attr-defined]
+        if ev.what == "lit":
+            lit_count[ev.index] += 1
+    assert lit_count[order[0]] == 1 and min(lit_count[led] for led in order[1:]) >= 2
     assert rig.emulator.lit is None  # type: ignore[attr-defined]
