@@ -777,11 +777,16 @@ def _light_off_for_camera(event) -> str:  # type: ignore[no-untyped-def]
         "sent-no-ack": "all-off sent (this firmware never acknowledges)",
         "self-timed": "going off by itself (this firmware has no all-off)",
     }.get(event.off or "", "all-off sent")
+    cool = (
+        f" and {event.cool_s:.1f} s more for its duty limit (max_duty) to let it light again"
+        if event.cool_s >= 0.05
+        else ""
+    )
     return (
         f"Image {event.index + 1}: the camera is still busy (writing its previous shot?) and "
         f"its next try, in {event.wait_s:g} s, would keep {light} (lit {event.lit_s:.1f} s) on "
         f"past max_on_s = {event.max_on_s:g} s: {off}; it is lit again for the shot after "
-        "that wait."
+        f"that wait{cool}."
     )
 
 

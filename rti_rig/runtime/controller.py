@@ -129,7 +129,7 @@ class SessionResult:
 class LightOffForCamera:
     """The step's light was switched off because the camera is still busy and its next try
     would come after the light's ``max_on_s``; it is lit again after ``wait_s`` (the
-    camera's next try, plus any cool-down the dome's thermal guard asks)."""
+    camera's next try) and ``cool_s`` (the cool-down the dome's duty limit asks)."""
 
     index: int
     total: int
@@ -138,6 +138,8 @@ class LightOffForCamera:
     #: what the all-off established ("acknowledged", "sent-no-ack"…; None: not known)
     off: str | None
     wait_s: float
+    #: how long the light must cool after that wait before its duty limit lets it light
+    cool_s: float
     #: how long the light may stay lit (the dome's ``max_on_s``)
     max_on_s: float
 
@@ -277,11 +279,15 @@ def fire_lit(
             said_of = getattr(rig.lighting, "off_said", None)
             off_said = said_of() if said_of is not None else None
             if on_dark is not None:
+                cool_of = getattr(rig.lighting, "cool_down_s", None)
+                after = clock.now() + busy.retry_in_s
+                cool_s = cool_of(step, after) if cool_of is not None else 0.0
                 on_dark(
                     {
                         "lit_s": off_at - lit_at,
                         "off": off_said,
                         "wait_s": busy.retry_in_s,
+                        "cool_s": cool_s,
                         "max_on_s": limit,
                     }
                 )

@@ -99,6 +99,16 @@ class DomeLighting:
         thermal = getattr(getattr(self.source, "settings", None), "thermal", None)
         return None if thermal is None else float(thermal.max_on_s)
 
+    def cool_down_s(self, step: LightStep, at: float) -> float:
+        """How long after ``at`` (on the rig's clock) the step's LED must still cool before
+        its duty limit lets it light again (0: it may light at ``at``), as the dome's thermal
+        guard will wait in ``set``: said to the user before a wait in the dark, which that
+        cool-down lengthens."""
+        guard = getattr(self.source, "guard", None)
+        if guard is None or step.led is None:
+            return 0.0
+        return max(0.0, float(guard.earliest_start(step.led, at)) - at)
+
     def off_said(self) -> str | None:
         """What the last all-off established, as the dome policy recorded it
         (``"acknowledged"``, ``"sent-no-ack"``, ``"self-timed"``…), None when it keeps no

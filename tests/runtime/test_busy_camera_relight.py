@@ -21,13 +21,14 @@ from fake_gphoto2 import Body, make_module
 
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
+from rti_rig.cli.session import _light_off_for_camera
 from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.drivers.cameras.exposure import meter_exposure, recheck_exposure
 from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
 from rti_rig.drivers.cameras.settings import ExposureRule, Gphoto2CameraSettings
-from rti_rig.runtime.controller import FinishReason, run_session
+from rti_rig.runtime.controller import FinishReason, LightOffForCamera, run_session
 from rti_rig.runtime.exposure_policy import Recheck, fix_session_exposure
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import SessionFolder
@@ -44,7 +45,7 @@ def level(led: int | None) -> float:
     return 0.0 if led is None else 0.3 + 0.01 * led
 
 
-def dome_with_thermal(tmp_path: Path) -> Path:
+def dome_with_thermal(tmp_path: Path, max_duty: float = 0.3) -> Path:
     """The shipped emulated dome with the DSLR example's thermal limits (max_on_s = 8 s) and
     exposure (1/8 s, a shutter speed the body offers)."""
     text = (CONFIGS / "emulated_dome.toml").read_text()
@@ -53,15 +54,15 @@ def dome_with_thermal(tmp_path: Path) -> Path:
     text = text.replace("exposure_s = 0.05\n", "exposure_s = 0.125\n")
     text = text.replace('"example_dome_48.lp"', f'"{(CONFIGS / "example_dome_48.lp").as_posix()}"')
     text = text.replace(
-        "[camera]", "[dome.serial.thermal]\nmax_on_s = 8.0\nmax_duty = 0.3\n\n[camera]", 1
+        "[camera]", f"[dome.serial.thermal]\nmax_on_s = 8.0\nmax_duty = {max_duty}\n\n[camera]", 1
     )
     return write_config(tmp_path, text, "dome.toml")
 
 
-def dslr_rig(tmp_path: Path, **settings: object) -> tuple[Rig, Body, list]:
+def dslr_rig(tmp_path: Path, max_duty: float = 0.3, **settings: object) -> tuple[Rig, Body, list]:
     """The emulated dome with a gphoto2 DSLR on the fake module; returns the rig, the body
     and the list of what the firmware had lit at each shot the body took."""
-    rig = build_rig(load_rig_config(dome_with_thermal(tmp_path)))
+    rig = build_rig(load_rig_config(dome_with_thermal(tmp_path, max_duty)))
     firmware = rig.emulator  # type: ignore[attr-defined]
     lit_at_shots: list = []
 
@@ -184,3 +185,31 @@ def test_metering_a_busy_camera_waits_in_the_dark_never_past_max_on_s(tmp_path):
             lit_count[ev.index] += 1
     assert lit_count[order[0]] == 1 and min(lit_count[led] for led in order[1:]) >= 2
     assert rig.emulator.lit is None  # type: ignore[attr-defined]
+
+
+def test_the_user_is_told_when_the_led_goes_off_and_how_long_it_must_cool(tmp_path):
+    """At max_duty = 0.2 an LED lit 7.1 s may light again only once that on-time has mostly
+    left the 60 s duty window: the wait in the dark is the camera's 4 s and some 56 s of
+    cool-down, which the message says as the LED goes off (it had said only "4 s")."""
+    rig, body, _ = dslr_rig(tmp_path, max_duty=0.2, busy_retries=6, retry_delay_s=1.0)
+    body.busy_for_s = 9.0
+    events: list[LightOffForCamera] = []
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, LightOffForCamera):
+            events.append(event)
+
+    out = tmp_path / "s"
+    with rig:
+        run_session(rig, schedule_of(rig), SessionFolder.create(out, len(LEDS)), on_event=on_event)
+    second = journal(out)[1]
+    (relit,) = second["relit"]
+    first = events[0]
+    assert (first.index, first.led, first.off) == (1, LEDS[1], "acknowledged")
+    assert first.wait_s == 4.0 and first.max_on_s == 8.0
+    assert first.cool_s > 50.0
+    assert relit["dark_s"] == pytest.approx(first.wait_s + first.cool_s, abs=0.5)
+    said = _light_off_for_camera(first)
+    assert "in 4 s, would keep LED 20 (lit 7.1 s) on past max_on_s = 8 s" in said
+    assert "switched off, acknowledged by the dome" in said
+    assert f"and {first.cool_s:.1f} s more for its duty limit (max_duty)" in said
