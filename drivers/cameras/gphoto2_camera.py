@@ -41,9 +41,11 @@ GP_ERROR_HINTS = {
     -53: "the USB device is claimed by another program (on desktops gvfs-gphoto2-volume-monitor "
     "or a file manager mounted it): stop that program or unmount the camera",
     -105: "no camera model detected: is it on, connected, and in PC/PTP mode?",
-    -110: "camera busy: still writing the previous file to its card, or hunting focus? raise "
-    "busy_retries or retry_max_delay_s in [camera.device] to wait longer (on a dome its LED is "
-    "switched off while the wait outlasts max_on_s, and lit again for the shot)",
+    -110: "camera busy: still writing the previous file to its card, or its autofocus could not "
+    "lock (Canon bodies answer a failed focus so, every time: set the lens to MF, focused by "
+    "hand)? For a slow card raise busy_retries or retry_max_delay_s in [camera.device] to wait "
+    "longer (on a dome its LED is switched off while the wait outlasts max_on_s, and lit again "
+    "for the shot)",
     -115: "the camera's memory card is full: free space on it, or set capture_target = "
     "'Internal RAM' so that shots are only downloaded, never stored on the card",
 }
