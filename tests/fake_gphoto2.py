@@ -83,6 +83,9 @@ class Body:
     #: ``busy_clock`` time have passed since the last shot (PTP Device Busy, gphoto2 #308)
     busy_for_s: float = 0.0
     busy_clock: Any = None
+    #: a capture answers busy only after this much ``busy_clock`` time (a Canon body whose
+    #: autofocus fails: "-- long pause --", then PTP Device Busy; libgphoto2 #30, pibooth #246)
+    busy_takes_s: float = 0.0
     card_free_shots: int = 1000
     jpeg_first: bool = False  # RAW+JPEG: capture() returns the JPEG, the RAW comes by event
     #: RAW+JPEG: the second file is announced only after this many quiet event waits (a body
@@ -213,12 +216,17 @@ def make_module(body: Body) -> types.ModuleType:
             if body.off_at_shot is not None and body.shots + 1 == body.off_at_shot:
                 body.off_at_shot = None
                 body.switch_off()
-            body.check("capture")
-            if body._busy:
-                body._busy -= 1
-                raise GPhoto2Error(-110)
-            if body.busy_for_s and body.busy_clock.now() < body._busy_until:
-                raise GPhoto2Error(-110)
+            try:
+                body.check("capture")
+                if body._busy:
+                    body._busy -= 1
+                    raise GPhoto2Error(-110)
+                if body.busy_for_s and body.busy_clock.now() < body._busy_until:
+                    raise GPhoto2Error(-110)
+            except GPhoto2Error as exc:
+                if exc.code == -110 and body.busy_takes_s:
+                    body.busy_clock.sleep(body.busy_takes_s)
+                raise
             # the files a previous shot was still writing are announced by now
             body._events.extend(event for _, event in body._late)
             body._late.clear()

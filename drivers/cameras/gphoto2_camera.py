@@ -422,9 +422,14 @@ class Gphoto2Camera:
         s = self.settings
         spell, self._busy = self._busy or _BusySpell(delay_s=s.retry_delay_s), None
         while True:
+            started = self._clock.now()
             try:
                 return cam.capture(gp.GP_CAPTURE_IMAGE)
             except gp.GPhoto2Error as exc:
+                # a body may answer busy only after a pause (a Canon whose autofocus fails:
+                # "-- long pause --", then PTP Device Busy): the next try may take as long to
+                # answer, with the light lit, so it too must be over by fire_by
+                took = self._clock.now() - started
                 code = getattr(exc, "code", None)
                 if code not in s.retry_codes or spell.tries >= s.busy_retries:
                     raise self._failure(
@@ -435,7 +440,7 @@ class Gphoto2Camera:
                 spell.waited_s += delay
                 spell.delay_s = min(delay * s.retry_backoff, s.retry_max_delay_s)
                 self.retries_used += 1
-                if fire_by is not None and self._clock.now() + delay > fire_by + 1e-9:
+                if fire_by is not None and self._clock.now() + delay + took > fire_by + 1e-9:
                     self._busy = spell
                     raise CameraBusyError(
                         self.name,

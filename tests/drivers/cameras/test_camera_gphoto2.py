@@ -178,6 +178,20 @@ def test_busy_past_fire_by_is_handed_back_without_a_picture_and_counted_on(tmp_p
         assert cam.collect().metadata["camera_files"] == ["/IMG_0002.DNG"]
 
 
+def test_a_busy_answer_that_takes_time_is_counted_before_another_lit_try(tmp_path):
+    """A body whose busy answer comes only after 1.5 s (a Canon whose autofocus fails): with
+    3 s to fire in, a try after the 0.5 s wait would answer at 3.5 s, its light still lit past
+    the time allowed; the wait is handed back at once instead (it had been tried, and the
+    light kept lit until 3.5 s)."""
+    clock = VirtualClock()
+    body = dslr(failures={"capture": [-110] * 3}, busy_takes_s=1.5, busy_clock=clock)
+    with camera(body, tmp_path, clock=clock, busy_retries=5, retry_delay_s=0.5) as cam:
+        with pytest.raises(CameraBusyError) as busy:
+            cam.expose_within(1 / 60, fire_by=3.0)
+        assert clock.now() == pytest.approx(1.5) and busy.value.tries == 1
+        assert busy.value.retry_in_s == 0.5
+
+
 def test_busy_handed_back_still_ends_after_busy_retries(tmp_path):
     """The tries counted across ``expose_within`` calls end at busy_retries: a body that never
     comes back is an error that says how long it was awaited."""
