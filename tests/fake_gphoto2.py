@@ -86,6 +86,9 @@ class Body:
     #: a capture answers busy only after this much ``busy_clock`` time (a Canon body whose
     #: autofocus fails: "-- long pause --", then PTP Device Busy; libgphoto2 #30, pibooth #246)
     busy_takes_s: float = 0.0
+    #: each download takes this much ``download_clock`` time (a 24 MP RAW over USB 2: 2-3 s)
+    download_s: float = 0.0
+    download_clock: Any = None
     card_free_shots: int = 1000
     jpeg_first: bool = False  # RAW+JPEG: capture() returns the JPEG, the RAW comes by event
     #: RAW+JPEG: the second file is announced only after this many quiet event waits (a body
@@ -280,6 +283,8 @@ def make_module(body: Body) -> types.ModuleType:
 
         def file_get(self, folder: str, name: str, kind: int) -> CameraFile:
             body.check("file_get")
+            if body.download_s:
+                body.download_clock.sleep(body.download_s)
             store = body.store()
             if name not in store:
                 raise GPhoto2Error(-108)

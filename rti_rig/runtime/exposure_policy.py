@@ -34,10 +34,10 @@ from typing import Any
 
 import numpy as np
 
-from rti_rig.core.devices import BusyAwareCamera, Frame
+from rti_rig.core.devices import ExposingCamera, Frame
 from rti_rig.core.errors import DeviceError
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.controller import fire_lit, lit_limit_s, validate_schedule
+from rti_rig.runtime.controller import lit_limit_s, shoot_step, validate_schedule
 from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
@@ -109,12 +109,16 @@ class _LitForEachShot:
     light command opens a new window (RTIPy's firmware blocks till its window ends: the new
     one follows it, never overlaps it).
 
-    A camera that answers busy (a DSLR still writing the previous test shot) is awaited as a
-    session's image is (:func:`rti_rig.runtime.controller.fire_lit`): lit only while its next
-    try fits in the LED's ``max_on_s``, else in the dark, the light lit again for the shot.
-    The retries had all been made with the LED lit: a body busy 10 s stopped ``run
-    --auto-exposure`` at the thermal guard ("LED 28 stayed on 11.7 s, beyond max_on_s = 8
-    s") before the session began.
+    On a light with a time limit (a dome's ``max_on_s``), a camera that can say when its
+    exposure is over (a DSLR) takes each test shot as a session's image is taken
+    (:func:`rti_rig.runtime.controller.shoot_step`): a busy camera awaited lit only while its
+    next try fits in ``max_on_s``, else in the dark, the light lit again for the shot; the
+    light off once the exposure is over, the download and decode done in the dark, and the
+    light lit again and settled for the next shot of the series. Until 2026-11-29 a series
+    was shot under one lighting with every download and RAW decode lit, and every busy retry:
+    three test shots of a bright object at a 3 s download each stopped ``run
+    --auto-exposure`` at the thermal guard ("LED 40 stayed on 9.3 s, beyond max_on_s = 8 s;
+    raise max_on_s or shorten settle and exposure"), as did a body busy 10 s.
 
     Every other attribute is the camera's (its shutter speeds, its name)."""
 
@@ -126,20 +130,23 @@ class _LitForEachShot:
         self._lit_at = lit_at
         self._relight_each = relight_each
         self._lit_for_next = True  # lit and settled by the caller for the first shot
+        self._dark = False  # switched off after the last shot (no other all-off needed)
 
     def capture(self, exposure_s: float) -> Frame:
         rig = self._rig
         if not self._lit_for_next:
-            rig.lighting.off()
+            if not self._dark:
+                rig.lighting.off()
             rig.lighting.set(self._step)
             self._lit_at = rig.clock.now()
             rig.clock.sleep(rig.timing.settle_s)
-        self._lit_for_next = not self._relight_each
         camera = rig.camera
-        if lit_limit_s(rig) is None or not isinstance(camera, BusyAwareCamera):
-            return camera.capture(exposure_s)
-        _, self._lit_at, _ = fire_lit(rig, self._step, exposure_s, self._lit_at)
-        return camera.collect()  # the light stays lit for the series' next shot, as before
+        if lit_limit_s(rig) is not None and isinstance(camera, ExposingCamera):
+            self._lit_for_next, self._dark = False, True  # the shot ends with the light off
+            frame, _ = shoot_step(rig, self._step, exposure_s, self._lit_at)
+            return frame
+        self._lit_for_next, self._dark = not self._relight_each, False
+        return camera.capture(exposure_s)
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._rig.camera, name)

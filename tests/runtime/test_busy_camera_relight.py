@@ -26,7 +26,7 @@ from rti_rig.core.errors import CaptureError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.drivers.cameras.exposure import meter_exposure, recheck_exposure
-from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
+from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera, parse_shutter
 from rti_rig.drivers.cameras.settings import ExposureRule, Gphoto2CameraSettings
 from rti_rig.runtime.controller import FinishReason, LightOffForCamera, run_session
 from rti_rig.runtime.exposure_policy import Recheck, fix_session_exposure
@@ -59,7 +59,9 @@ def dome_with_thermal(tmp_path: Path, max_duty: float = 0.3) -> Path:
     return write_config(tmp_path, text, "dome.toml")
 
 
-def dslr_rig(tmp_path: Path, max_duty: float = 0.3, **settings: object) -> tuple[Rig, Body, list]:
+def dslr_rig(
+    tmp_path: Path, max_duty: float = 0.3, brightness: float = 1.0, **settings: object
+) -> tuple[Rig, Body, list]:
     """The emulated dome with a gphoto2 DSLR on the fake module; returns the rig, the body
     and the list of what the firmware had lit at each shot the body took."""
     rig = build_rig(load_rig_config(dome_with_thermal(tmp_path, max_duty)))
@@ -69,7 +71,10 @@ def dslr_rig(tmp_path: Path, max_duty: float = 0.3, **settings: object) -> tuple
     def render(body: Body) -> bytes:
         lit = firmware.lit
         lit_at_shots.append(None if lit is None else lit[0])
-        rgb = np.full((H, W, 3), level(None if lit is None else lit[0]))
+        # as bright as the LED and the shutter make it (x brightness: 1 at 1/8 s)
+        secs = parse_shutter(body.config["shutterspeed"]) or 0.125
+        value = level(None if lit is None else lit[0]) * brightness * secs / 0.125
+        rgb = np.full((H, W, 3), min(value, 1.5))
         return dng(mosaic_from_rgb(rgb, "RGGB", BLACK, WHITE), "RGGB", BLACK, WHITE)
 
     body = Body(render=render, busy_clock=rig.clock)
@@ -213,3 +218,27 @@ def test_the_user_is_told_when_the_led_goes_off_and_how_long_it_must_cool(tmp_pa
     assert "in 4 s, would keep LED 20 (lit 7.1 s) on past max_on_s = 8 s" in said
     assert "switched off, acknowledged by the dome" in said
     assert f"and {first.cool_s:.1f} s more for its duty limit (max_duty)" in said
+
+
+def test_metering_a_bright_object_downloads_each_test_shot_with_the_led_off(tmp_path):
+    """A bright object: the 1/8 s preview clips, so the series at the brightest light takes
+    three shots, each downloaded for 3 s. Each test shot is taken as a session's image is:
+    the LED off once the exposure is over, the download in the dark, the LED lit again for
+    the next shot. The series had been shot under one lighting, every download lit, and
+    metering stopped at the thermal guard ("LED 40 stayed on 9.3 s, beyond max_on_s = 8 s")."""
+    rig, body, lit_at_shots = dslr_rig(tmp_path, brightness=30.0)
+    body.download_s, body.download_clock = 3.0, rig.clock
+    rule = ExposureRule(headroom=1.25, min_exposure_s=1 / 250, max_exposure_s=1.0)
+
+    def meter(camera, start_s):  # type: ignore[no-untyped-def]
+        return meter_exposure(camera, rule, start_s, camera.available_exposures_s())
+
+    with rig:
+        fixed = fix_session_exposure(rig, schedule_of(rig), meter)
+    evidence = fixed.provenance["exposure"]
+    led = LEDS[evidence["metered_at_step"] - 1]
+    assert len(evidence["test_exposures_s"]) >= 3  # a series at one light
+    assert lit_at_shots == [led] * body.shots  # every shot under its LED
+    log = [(e.what, e.index) for e in rig.emulator.history if e.what in ("lit", "off")]  # type: ignore[attr-defined]
+    assert log == [("lit", led), ("off", led)] * body.shots
+    assert fixed.steps[0].exposure_s < 0.125 / 10
