@@ -99,12 +99,12 @@ def journal(out: Path) -> list[dict]:
 
 
 def test_a_camera_busy_past_max_on_s_is_awaited_in_the_dark_and_shot_relit(tmp_path):
-    """A body busy 9 s after each shot, retried after 1, 2, 4, 4… s: the LED is lit 7.1 s,
+    """A body busy 10 s after each shot, retried after 1, 2, 4, 4… s: the LED is lit 7.1 s,
     switched off (acknowledged), dark 4 s, lit again, and the image taken under it. Until
     2026-11-29 the LED stayed lit through every retry and the session stopped at the thermal
     guard ("LED 20 stayed on 11.2 s, beyond max_on_s = 8 s")."""
     rig, body, lit_at_shots = dslr_rig(tmp_path, busy_retries=6, retry_delay_s=1.0)
-    body.busy_for_s = 9.0
+    body.busy_for_s = 10.0
     out = tmp_path / "s"
     with rig:
         result = run_session(rig, schedule_of(rig), SessionFolder.create(out, len(LEDS)))
@@ -197,7 +197,7 @@ def test_the_user_is_told_when_the_led_goes_off_and_how_long_it_must_cool(tmp_pa
     left the 60 s duty window: the wait in the dark is the camera's 4 s and some 56 s of
     cool-down, which the message says as the LED goes off (it had said only "4 s")."""
     rig, body, _ = dslr_rig(tmp_path, max_duty=0.2, busy_retries=6, retry_delay_s=1.0)
-    body.busy_for_s = 9.0
+    body.busy_for_s = 10.0
     events: list[LightOffForCamera] = []
 
     def on_event(event) -> None:  # type: ignore[no-untyped-def]
