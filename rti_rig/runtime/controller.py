@@ -244,7 +244,7 @@ def shoot_step(
     camera = rig.camera
     if lit_limit_s(rig) is None or not isinstance(camera, BusyAwareCamera):
         return shoot_lit(rig, exposure_s), []
-    ended, _, relit = fire_lit(rig, step, exposure_s, lit_at, on_dark)
+    ended, relit = fire_lit(rig, step, exposure_s, lit_at, on_dark)
     return _finish_shot(rig, ended), relit
 
 
@@ -260,10 +260,10 @@ def fire_lit(
     exposure_s: float,
     lit_at: float,
     on_dark: Callable[[dict[str, Any]], None] | None = None,
-) -> tuple[float | None, float, list[dict[str, Any]]]:
+) -> tuple[float | None, list[dict[str, Any]]]:
     """Fire a :class:`BusyAwareCamera` under ``step``'s light, lit at ``lit_at`` and settled,
     by :func:`shoot_step`'s rules; the light is left lit. Returns when the exposure ended (as
-    ``expose`` does), when the light it was taken under was lit, and the relights."""
+    ``expose`` does) and the relights."""
     camera = rig.camera
     assert isinstance(camera, BusyAwareCamera)
     limit = lit_limit_s(rig)
@@ -272,7 +272,7 @@ def fire_lit(
     while True:
         fire_by = None if limit is None else lit_at + limit - exposure_s - rig.timing.readout_s
         try:
-            return camera.expose_within(exposure_s, fire_by), lit_at, relit
+            return camera.expose_within(exposure_s, fire_by), relit
         except CameraBusyError as busy:
             off_at = clock.now()
             rig.lighting.off()  # raises, stopping the session, if the dome did not take it
