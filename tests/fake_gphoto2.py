@@ -86,6 +86,9 @@ class Body:
     #: a capture answers busy only after this much ``busy_clock`` time (a Canon body whose
     #: autofocus fails: "-- long pause --", then PTP Device Busy; libgphoto2 #30, pibooth #246)
     busy_takes_s: float = 0.0
+    #: the body's own time: a capture that fires takes its shutter time on it, as libgphoto2's
+    #: capture returns only once the picture is taken (None: at once, for tests of other things)
+    clock: Any = None
     #: each download takes this much ``download_clock`` time (a 24 MP RAW over USB 2: 2-3 s)
     download_s: float = 0.0
     download_clock: Any = None
@@ -142,6 +145,14 @@ class Body:
     def store(self) -> dict[str, bytes]:
         # a body without the setting (not every make has it in libgphoto2) shoots to its card
         return self.ram if self.config.get("capturetarget") == "Internal RAM" else self.card
+
+
+def shutter_s(label: str) -> float:
+    """Seconds of a shutter label of ``SHUTTERS`` ('1/125', '0.5', '30'; 'bulb': 0)."""
+    if label == "bulb":
+        return 0.0
+    num, _, den = label.partition("/")
+    return float(num) / float(den or 1)
 
 
 class _Widget:
@@ -243,6 +254,8 @@ def make_module(body: Body) -> types.ModuleType:
                 files.append(stem + body.raw_suffix)
             if "JPEG" in fmt:
                 files.append(stem + ".JPG")
+            if body.clock is not None:  # the shutter is open for its time, then the file named
+                body.clock.sleep(shutter_s(body.config["shutterspeed"]))
             raw_data = body.render(body)
             for name in files:
                 store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"

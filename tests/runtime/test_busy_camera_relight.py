@@ -77,7 +77,7 @@ def dslr_rig(
         rgb = np.full((H, W, 3), min(value, 1.5))
         return dng(mosaic_from_rgb(rgb, "RGGB", BLACK, WHITE), "RGGB", BLACK, WHITE)
 
-    body = Body(render=render, busy_clock=rig.clock)
+    body = Body(render=render, busy_clock=rig.clock, clock=rig.clock)
     camera = Gphoto2Camera(
         Gphoto2CameraSettings(image_format="RAW", **settings),  # type: ignore[arg-type]
         output_dir=tmp_path / "staging",

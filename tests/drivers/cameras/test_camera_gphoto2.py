@@ -349,6 +349,19 @@ def test_expose_returns_once_the_shot_is_taken_and_collect_downloads_it(tmp_path
             cam.collect()  # one frame per exposure
 
 
+def test_expose_ends_when_the_body_has_taken_the_picture(tmp_path):
+    """libgphoto2's capture returns once the picture is taken, so a 1/2 s shot ends 1/2 s
+    after it was fired, on the body's clock as on the rig's: the light may go off then and
+    not before. (The fake body had answered at once, whatever the shutter: a test of the
+    light against the exposure saw a 2 s shot end in no time.)"""
+    clock = VirtualClock()
+    body = dslr(clock=clock)
+    with camera(body, tmp_path, clock=clock) as cam:
+        ended = cam.expose(0.5)
+        assert ended == pytest.approx(0.5) and clock.now() == pytest.approx(0.5)
+        assert cam.collect().metadata["capture_started_s"] == 0.0
+
+
 def test_a_body_without_capturetarget_can_be_left_alone_with_an_empty_value(tmp_path):
     """libgphoto2 offers 'capturetarget' on some makes only. The default "Internal RAM" was
     asked of such a body at every connect, and TOML has no null to say "leave it": the body

@@ -74,7 +74,7 @@ def render_for(firmware):
 
 @pytest.fixture
 def body(dome, monkeypatch):
-    b = Body(render=render_for(dome))
+    b = Body(render=render_for(dome), clock=SystemClock())  # each shot takes its shutter time
     monkeypatch.setitem(sys.modules, "gphoto2", make_module(b))
     return b
 
