@@ -242,3 +242,22 @@ def test_metering_a_bright_object_downloads_each_test_shot_with_the_led_off(tmp_
     log = [(e.what, e.index) for e in rig.emulator.history if e.what in ("lit", "off")]  # type: ignore[attr-defined]
     assert log == [("lit", led), ("off", led)] * body.shots
     assert fixed.steps[0].exposure_s < 0.125 / 10
+
+
+def test_metering_a_dark_object_chooses_no_exposure_longer_than_an_led_may_stay_lit(tmp_path):
+    """A dark object under the emulated dome (max_on_s = 8 s, settle 0.1 s, readout 0.3 s):
+    the metering may choose no exposure longer than 7.6 s, so the body's 2 s, not its 30 s,
+    with a note that names max_on_s. It had chosen the camera's max_exposure_s = 30 s and shot
+    it with the LED lit 30 s ("LED 40 stayed on 30.2 s, beyond max_on_s = 8 s")."""
+    from rti_rig.app.usecases.session import fix_exposure
+
+    rig, _, lit_at_shots = dslr_rig(tmp_path, brightness=0.004)
+    notes: list[str] = []
+    with rig:
+        fixed = fix_exposure(rig, schedule_of(rig), 0.001, on_note=lambda n: notes.append(n.text))
+    assert {s.exposure_s for s in fixed.steps} == {2.0}
+    assert None not in lit_at_shots
+    said = " ".join(notes)
+    assert "The exposure, 2 s, is the longest the metering could choose" in said
+    assert "leaves 7.6 s ([dome.serial.thermal] max_on_s = 8 s" in said
+    assert "not the camera's max_exposure_s = 30 s" in said

@@ -309,6 +309,15 @@ def fix_exposure(
             )
         else:
             on_note(Note(f"Metering: {limit.window_said()}, so {own}"))
+    # an LED may stay lit max_on_s at a time (the dome's thermal guard), and a shot (settle,
+    # exposure, readout) must end within it: metering of a dark object had chosen the camera's
+    # max_exposure_s (30 s on the shipped DSLR example) and shot it with the LED lit 30 s
+    # against max_on_s = 8 s (no watchdog on that firmware), the session then refused
+    lit_cap = _lit_exposure_cap(rig)
+    if lit_cap is not None and lit_cap < longest:
+        longest = max(lit_cap, cam.min_exposure_s)
+    else:
+        lit_cap = None
     rule = ExposureRule(
         max_saturated_fraction=max_saturated,
         headroom=1.25,  # other planned lights may be a little brighter than the metered one
@@ -359,7 +368,38 @@ def fix_exposure(
             f"{metered} metered, after {chosen['metering_shots']} test shots"
         )
     on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s{where} ({chosen['reason']})"))
+    if lit_cap is not None and chosen["exposure_s"] >= _next_shorter_s(rig, longest) - 1e-9:
+        serial = rig.loaded.config.dome.serial  # type: ignore[attr-defined]
+        on_note(
+            Note(
+                f"The exposure, {chosen['exposure_s']:.4g} s, is the longest the metering "
+                f"could choose: each shot must end while its LED is lit, which leaves "
+                f"{longest:.3g} s ([dome.serial.thermal] max_on_s = "
+                f"{serial.thermal.max_on_s:g} s, less timing.settle_s and timing.readout_s), "
+                f"not the camera's max_exposure_s = {cam.max_exposure_s:g} s; the images may "
+                "be dark. Raise max_on_s if the LEDs allow it, or the ISO or aperture",
+                level="warning",
+            )
+        )
     return fixed
+
+
+def _lit_exposure_cap(rig: Rig) -> float | None:
+    """The longest exposure a shot can have under an LED lit at most ``max_on_s`` (less the
+    settle before and the readout after it), or None when the light has no time limit."""
+    limit_of = getattr(getattr(rig, "lighting", None), "lit_limit_s", None)
+    limit = limit_of() if limit_of is not None else None
+    if limit is None:
+        return None
+    return limit - rig.timing.settle_s - rig.timing.readout_s
+
+
+def _next_shorter_s(rig: Rig, longest: float) -> float:
+    """The longest shutter speed the camera offers at or under ``longest`` (``longest`` for a
+    camera without a list): the metering chose the cap when it chose that one."""
+    offered = getattr(rig.camera, "available_exposures_s", None)
+    speeds = [t for t in (offered() if offered is not None else []) if t <= longest + 1e-9]
+    return max(speeds) if speeds else longest
 
 
 def _light_outputs_unknown(rig: Rig) -> str:
