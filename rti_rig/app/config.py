@@ -729,6 +729,8 @@ def load_rig_config(path: Path | str) -> LoadedRig:
             limit = timed_exposure_limit(loaded)
             if limit is not None and config.camera.exposure_s > limit.max_exposure_s + 1e-9:
                 raise ConfigError(path, "camera.exposure_s", limit.refusal(config.camera))
+        if serial is not None:
+            _check_exposure_fits_lit(loaded, serial)
         if serial is not None and (problem := serial.check_led_count(len(dirs))):
             key = "dome.serial.expected_led_count"
             if problem.startswith("intensity_correction"):
@@ -769,6 +771,38 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         if note := _untriggered_wait_note(loaded, cam):
             loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
     return loaded
+
+
+def _check_exposure_fits_lit(rig: LoadedRig, serial: Any) -> None:
+    """Refuse a ``[camera] exposure_s`` whose shot cannot end while its LED is lit.
+
+    An LED may stay lit ``[dome.serial.thermal] max_on_s`` at a time, and a shot takes the
+    settle before it and the camera's readout after it: with more, every capture overran the
+    thermal limit and the session stopped at its first image with the LED lit all along
+    ("LED 0 stayed on 2.2 s, beyond max_on_s = 2 s"), after the dome had been opened and lit.
+    """
+    t = rig.config.timing
+    cam = rig.config.camera
+    max_on = serial.thermal.max_on_s
+    room = max_on - t.settle_s - t.readout_s
+    if cam.exposure_s <= room + 1e-9:
+        return
+    total = t.settle_s + cam.exposure_s + t.readout_s
+    shorten = (
+        f"shorten exposure_s to at most {room:.3g} s (or raise the ISO or open the aperture)"
+        if room >= cam.min_exposure_s
+        else "shorten timing.settle_s and the exposure"
+    )
+    raise ConfigError(
+        rig.path,
+        "camera.exposure_s",
+        f"{cam.exposure_s:g} s does not fit: an LED may stay lit at most "
+        f"[dome.serial.thermal] max_on_s = {max_on:g} s, and each shot (timing.settle_s "
+        f"{t.settle_s:g} + camera.exposure_s {cam.exposure_s:g} + timing.readout_s "
+        f"{t.readout_s:g} = {total:.3g} s) must end while its LED is lit; every capture would "
+        f"stop the session at the thermal limit. Either {shorten}, or raise max_on_s if the "
+        "LEDs allow it",
+    )
 
 
 def _untriggered_wait_note(rig: LoadedRig, cam: Any) -> str:

@@ -223,3 +223,30 @@ def test_a_dslr_retried_longer_than_an_led_may_stay_lit_is_no_longer_a_note(
     assert "busy_retries = 20\n" in cfg.read_text()
     notes = " ".join(load_rig_config(cfg).notes)
     assert "busy" not in notes and "thermal limit" not in notes, notes
+
+
+@pytest.mark.parametrize(("exposure", "refused"), [("2.0", True), ("1.3", False)])
+def test_an_exposure_whose_shot_cannot_end_while_its_led_is_lit_is_refused_at_load(
+    tmp_path: Path, exposure: str, refused: bool
+) -> None:
+    """max_on_s = 2 s, settle 0.2 s, readout 0.5 s: a 2 s exposure cannot end while its LED is
+    lit. It was accepted, and `rti-rig run` stopped at its first image with the LED lit all
+    along ("LED 0 stayed on 2.208 s, beyond max_on_s = 2 s")."""
+    import shutil
+
+    shutil.copy(REPO / "rig_configs" / "example_dome_48.lp", tmp_path / "example_dome_48.lp")
+    text = (REPO / "rig_configs" / "example_dome_48.toml").read_text()
+    assert "max_on_s = 8.0\n" in text and "exposure_s = 0.125\n" in text
+    text = text.replace("max_on_s = 8.0\n", "max_on_s = 2.0\n")
+    cfg = tmp_path / "dslr.toml"
+    cfg.write_text(text.replace("exposure_s = 0.125\n", f"exposure_s = {exposure}\n"))
+    if not refused:
+        load_rig_config(cfg)
+        return
+    with pytest.raises(ConfigError) as e:
+        load_rig_config(cfg)
+    assert e.value.key == "camera.exposure_s"
+    said = str(e.value)
+    assert "[dome.serial.thermal] max_on_s = 2 s" in said
+    assert "timing.settle_s 0.2 + camera.exposure_s 2 + timing.readout_s 0.5 = 2.7 s" in said
+    assert "shorten exposure_s to at most 1.3 s" in said
