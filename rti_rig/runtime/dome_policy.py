@@ -217,6 +217,11 @@ class DomePolicy:
         #: ``"connected"`` (handshake through, but the all-off that starts from the safe state
         #: failed) or ``"ready"`` (connected and switched off). None: no connect attempted.
         self.reached: str | None = None
+        #: Whether a lit LED serves an image (a session, a preview, metering), so that an LED
+        #: lost to a reboot or a USB drop is said to have spoilt "the image taken under" it and
+        #: that capture is to be repeated. ``rti-rig check`` takes no image and clears it: its
+        #: lost-LED message had spoken of an image under LED 1 that was never taken.
+        self.lights_images = True
         #: The reconnect window (s) of the last reconnection that gave up on a port that did not
         #: come back (None: none gave up), and, once a later one (the closing all-off's) got the
         #: dome back after all, that window: the error said "did not come back" and the lights
@@ -682,12 +687,22 @@ class DomePolicy:
                         else "its handshake after the reboot failed too, so whether the dome "
                         "is lit is unknown until the closing all-off (see the lights line)"
                     )
+                    if self.lights_images:
+                        lost_what = (
+                            f"the image taken under LED {lost.index} may have had no light; "
+                            f"{state}; repeat that capture"
+                        )
+                    else:
+                        lost_what = (
+                            f"LED {lost.index} went dark with it (this check takes no image); "
+                            f"{state}; a board that {what} by itself points to its power "
+                            "supply or its USB cable: check them, then run the check again"
+                        )
                     raise DomeLedError(
                         self.name,
                         lost.index,
                         f"the board {what} while LED {lost.index} was meant to be lit (found "
-                        f"during '{command}'): the image taken under LED {lost.index} may have "
-                        f"had no light; {state}; repeat that capture",
+                        f"during '{command}'): {lost_what}",
                         command,
                     ) from exc
                 if not exc.retryable or not idempotent or attempt >= self.settings.retries:
@@ -1171,6 +1186,8 @@ def self_test(
     report = SelfTestReport(name=source.name, firmware=None, led_count=0)
     link = getattr(source, "link", None)
     report.light_confirmed = bool(getattr(link, "light_confirmed", True))
+    if isinstance(source, DomePolicy):
+        source.lights_images = False  # an LED lost to a reboot spoils no image here
     try:
         source.connect()
         report.led_count = source.light_count()
