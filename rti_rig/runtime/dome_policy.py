@@ -1084,6 +1084,9 @@ class SelfTestReport:
     light_confirmed: bool = True
     #: How far the connect got (:attr:`DomePolicy.reached`); None: not a dome policy.
     reached: str | None = None
+    #: The built-in firmware whose boot banner the board printed when it is not the profile's
+    #: (the link's ``foreign_firmware``); None: none seen.
+    foreign_firmware: str | None = None
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -1109,7 +1112,29 @@ class SelfTestReport:
             if self.firmware
             else "unknown firmware"
         )
-        if self.aborted and not self.checks and self.reached in _REACHED:
+        if self.foreign_firmware is not None:
+            # another firmware's board: the profile's name and the config's LED count in the
+            # heading ("rti-dome-m, 8 LEDs" over "LEDs stepped: 0") had read as a board that
+            # was identified and counted, and the light commands sent before its banner showed
+            # were other keys to it, not steps of this dome
+            board = (
+                f"{self.firmware.firmware_id} board"
+                if self.firmware
+                else "board of the rig config's profile"
+            )
+            sent = len(self.light_latency_s)
+            out = [
+                f"{self.name}: not a {board}: it printed the boot banner of the "
+                f"{self.foreign_firmware} firmware (see ABORTED below); its LED count is unknown",
+                "no LED stepped"
+                + (
+                    f" ({sent} light command{'s' if sent != 1 else ''} of this profile reached "
+                    "it before its banner showed: other keys to that firmware)"
+                    if sent
+                    else ""
+                ),
+            ]
+        elif self.aborted and not self.checks and self.reached in _REACHED:
             # the port opened: say how far the connect got, not "not reached" (a board whose
             # banner and init all-off came through, then whose next all-off's reply was lost,
             # had been reported "not reached")
@@ -1127,7 +1152,7 @@ class SelfTestReport:
                 + f", failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
             )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
-        if self.light_latency_s:
+        if self.light_latency_s and self.foreign_firmware is None:
             lat = np.asarray(self.light_latency_s) * 1000
             out.append(
                 f"light command round trip: median {np.median(lat):.2f} ms, "
@@ -1217,6 +1242,7 @@ def self_test(
     finally:
         if isinstance(source, DomePolicy):
             report.reached = source.reached  # before close() forgets the connection
+        report.foreign_firmware = getattr(link, "foreign_firmware", None)
         try:
             source.close()
         except DeviceError as exc:

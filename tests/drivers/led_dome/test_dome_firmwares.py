@@ -13,6 +13,7 @@ shipped exposure each capture leaves 0.85 s of its 2 s window spare.
 from __future__ import annotations
 
 import json
+import re
 import sys
 import time
 from pathlib import Path
@@ -1009,6 +1010,13 @@ def test_a_board_refused_for_the_nab_banner_is_switched_off_by_the_nab_all_off(
     assert 'set profile = "nab-rti-v1"' in text
     assert "lights: all-off sent and acknowledged by the dome: lights are off" in text, text
     assert "Traceback" not in text
+    # the heading names the firmware found, not the profile's name and the config's LED count
+    # ("rti-dome-m, 8 LEDs" beside "LEDs stepped: 0" had read as a board identified, counted)
+    assert "banner of the nab-rti-v1 firmware (see ABORTED below); its LED count is unknown" in (
+        text
+    ), text
+    assert not re.search(r", \d+ LEDs$", text, re.M) and "LEDs stepped" not in text, text
+    assert "light command round trip" not in text  # of another firmware's board
     # the sketch read one command, its own all-off: a banner later than the profile's boot
     # wait (minirti waits 1.5 s, rti-dome-m none, the sketch's bootloader 1.6 s) had been read
     # a byte at a time as acks, or dropped as stale input and the board said "most likely off"
