@@ -59,6 +59,8 @@ class ArmSelfTestReport:
     tolerance_deg: float
     park_wanted: bool = True
     checks: list[PoseCheck] = field(default_factory=list)
+    #: how many poses the walk was to visit (:func:`self_test_poses`)
+    planned: int = 0
     parked: bool = False
     aborted: str | None = None
     teardown_failures: list[str] = field(default_factory=list)
@@ -80,10 +82,20 @@ class ArmSelfTestReport:
         )
 
     def lines(self) -> list[str]:
-        out = [
-            f"{arm_label(self.name)}: {len(self.checks)} poses, tolerance {self.tolerance_deg:g}°",
-            "  pose               asked az/el       reached az/el     error   move",
-        ]
+        # the heading says how far the walk got: "arm: 3 poses" had been printed of a walk
+        # stopped at pose 3 of 8, and "arm: 0 poses" with an empty table of one never started
+        label, done = arm_label(self.name), len(self.checks)
+        if not done:
+            out = [f"{label}: no pose visited (see ABORTED below)"]
+        elif done < self.planned:
+            out = [
+                f"{label}: stopped at pose {done} of {self.planned}, "
+                f"tolerance {self.tolerance_deg:g}°"
+            ]
+        else:
+            out = [f"{label}: {done} poses, tolerance {self.tolerance_deg:g}°"]
+        if done:
+            out.append("  pose               asked az/el       reached az/el     error   move")
         for c in self.checks:
             az, el = c.asked_az_el
             if c.reached_az_el is None:
@@ -188,6 +200,7 @@ def arm_self_test(
     started = clock.now()
     report = ArmSelfTestReport(carrier.name, tolerance_deg, park_wanted=park)
     poses = self_test_poses(geometry)
+    report.planned = len(poses)
     # validate every pose before anything connects or moves
     for label, d in poses:
         reason = geometry.unreachable_reason(d) or carrier.unreachable_reason(d)

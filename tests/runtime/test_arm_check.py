@@ -117,6 +117,22 @@ def test_a_device_error_aborts_without_parking_but_makes_the_arm_safe() -> None:
     assert "not parked" in "\n".join(report.lines())
 
 
+def test_the_heading_says_how_far_an_aborted_walk_got() -> None:
+    """A walk stopped by a device error at pose 3 of 8 had been headed "fake arm: 3 poses", as
+    if three were all it was to visit; one whose connect failed, "0 poses" over an empty table."""
+    report = arm_self_test(FakeCarrier(fail_on_move=3), ARM, VirtualClock())
+    planned = len(self_test_poses(ARM))
+    assert report.lines()[0] == f"fake arm: stopped at pose 3 of {planned}, tolerance 1°"
+
+    class NoConnect(FakeCarrier):
+        def connect(self) -> None:
+            raise DeviceError(self.name, "cannot open port 'COM9'")
+
+    lines = arm_self_test(NoConnect(), ARM, VirtualClock()).lines()
+    assert lines[0] == "fake arm: no pose visited (see ABORTED below)", lines
+    assert not any("asked az/el" in line for line in lines)  # no empty table
+
+
 def test_any_other_error_is_reported_too_and_the_arm_made_safe() -> None:
     carrier = FakeCarrier()
 
