@@ -452,7 +452,11 @@ class DynamixelBusEmulator:
     """Several servos on one bus: bytes in, status bytes out (thread-safe).
 
     Fault injection: ``silent_ids`` never answer nor act (a disconnected servo);
-    ``corrupt_next_replies`` damages the CRC of that many upcoming status packets.
+    ``corrupt_next_replies`` damages the CRC of that many upcoming status packets;
+    ``drop_next_replies`` loses that many upcoming status packets on the wire (the servo acted
+    on the instruction, the host hears nothing: the SDK's COMM_RX_TIMEOUT); ``reply_faults``
+    does either to the status of the K-th instruction packet received (1 = the first, any id):
+    ``{K: "drop_reply" | "garble_reply"}``, the rig config's ``[[emulator.faults]]``.
     ``goal_log`` records every Goal Position value that reached the bus, accepted or not.
     """
 
@@ -467,6 +471,10 @@ class DynamixelBusEmulator:
         self.host_baud: int | None = None
         self._deaf: set[int] = set()
         self.corrupt_next_replies = 0
+        self.drop_next_replies = 0
+        self.reply_faults: dict[int, str] = {}
+        #: instruction packets received so far (what ``reply_faults`` counts)
+        self.instructions_received = 0
         self.goal_log: list[tuple[int, int]] = []
         self.instructions: list[p2.Packet] = []
         self._parser = p2.PacketParser()
@@ -513,12 +521,22 @@ class DynamixelBusEmulator:
                         out += self._reply(dxl_id, p2.ERR_CRC)
                     continue
                 self.instructions.append(item)
-                out += self._handle(item)
+                self.instructions_received += 1
+                fault = self.reply_faults.get(self.instructions_received)
+                reply = self._handle(item)
+                if reply and fault == "drop_reply":
+                    reply = b""  # the servo acted; its status was lost on the wire
+                elif reply and fault == "garble_reply":
+                    reply = reply[:-1] + bytes([reply[-1] ^ 0xFF])
+                out += reply
             return bytes(out)
 
     def _reply(self, dxl_id: int, number: int = 0, params: bytes = b"") -> bytes:
         servo = self.servos[dxl_id]
         packet = p2.status_packet(dxl_id, servo.status_error(number), params)
+        if self.drop_next_replies > 0:
+            self.drop_next_replies -= 1
+            return b""
         if self.corrupt_next_replies > 0:
             self.corrupt_next_replies -= 1
             packet = packet[:-1] + bytes([packet[-1] ^ 0xFF])

@@ -7,8 +7,11 @@ Known SDK behaviours handled here:
 * A unicast Action or ``*TxOnly`` leaves the servo's status reply unread, and it corrupts the
   next read -> the arm never sends those; :meth:`DxlBus.write_no_wait` (the only TxOnly here)
   drains the reply, and :meth:`DxlBus.action` always broadcasts (no reply at all).
-* A status packet lost or corrupted on the wire fails one exchange -> reads (ping, read) are
-  idempotent and retried once (:meth:`DxlBus._exchange`); writes are never retried here.
+* A status packet lost or corrupted on the wire fails one exchange (the SDK returns
+  COMM_RX_TIMEOUT or COMM_RX_CORRUPT) -> reads (ping, read) and unicast writes of a value are
+  idempotent (writing the same value again leaves the servo as one write does) and retried
+  once (:meth:`DxlBus._exchange`). A reboot, an action or a clear is not a write of a value
+  and is never retried.
 * Instruction packets go out without byte stuffing -> harmless for servos (they parse by
   length); the emulator parses by length too.
 """
@@ -195,8 +198,10 @@ class DxlBus:
     RETRYABLE = (sdk.COMM_RX_TIMEOUT, sdk.COMM_RX_CORRUPT)
 
     def _exchange(self, call, what: str, dxl_id: int):  # type: ignore[no-untyped-def]
-        """Run an idempotent read ``call`` (returning ``(..., result, error)``), retried once
-        if its status packet was lost or corrupt: reading twice changes nothing on the servo."""
+        """Run an idempotent ``call`` (returning ``(..., result, error)``), retried once if
+        its status packet was lost or corrupt: reading twice changes nothing on the servo, and
+        writing a register's value twice leaves it as writing it once does (Goal Position
+        included: the servo plans its profile to the same goal from where it is)."""
         reply = call()
         if reply[-2] in self.RETRYABLE:
             log.warning(
@@ -285,7 +290,11 @@ class DxlBus:
         command = f"write {reg.name} = {value}"
         raw = value & ((1 << (8 * reg.size)) - 1)
         fn = {1: self.ph.write1ByteTxRx, 2: self.ph.write2ByteTxRx, 4: self.ph.write4ByteTxRx}
-        result, error = fn[reg.size](self.port, dxl_id, reg.address, raw)
+        # retried once when its status is lost or damaged: one lost reply to a lamp or goal
+        # write had ended the session, though the servo had most likely acted on it
+        result, error = self._exchange(
+            lambda: fn[reg.size](self.port, dxl_id, reg.address, raw), command, dxl_id
+        )
         log.debug("%s: id %d %s (%d, %d)", self.device, dxl_id, command, result, error)
         self._check(result, error, dxl_id, command, alert=check_alert)
 

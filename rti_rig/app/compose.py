@@ -258,6 +258,8 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     port, emulator = stack.enter_context(
         emulated_arm_port(settings, clock, transport=arm_cfg.transport)
     )
+    # [[emulator.faults]]: the status of the K-th instruction packet lost or damaged
+    emulator.reply_faults = {f.at_command: f.kind for f in loaded.config.emulator.faults}
     try:
         arm = DynamixelArm(settings, port, clock)
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)

@@ -222,6 +222,12 @@ class EmulatorFault(_Strict):
     delay_s: float = Field(default=1.0, ge=0, le=60)
 
 
+#: The ``[[emulator.faults]]`` kinds the emulated servo bus rehearses: a status packet lost or
+#: damaged on the wire (the servos' faults of their own, overload and the like, are the
+#: emulator's hardware errors).
+ARM_FAULT_KINDS = ("drop_reply", "garble_reply")
+
+
 class EmulatorConfig(_Strict):
     """Faults and flaws of the emulated devices in an ``emulated`` dry run (to rehearse them).
 
@@ -305,6 +311,26 @@ class RigConfig(_Strict):
                 "[camera.device]); for the dry run, set port = 'emulated'"
             )
 
+    def _arm_faults_are_replies(self) -> None:
+        """Refuse, naming the key, an arm's fault the emulated servos cannot rehearse.
+
+        Why: the faults were the dome firmware's alone, and an arm config's were ignored: a
+        rehearsal of a lost status packet ran a clean check ("PASS") and rehearsed nothing."""
+        if self.kind != "arm" or not self.emulator.faults:
+            return
+        for i, fault in enumerate(self.emulator.faults):
+            if self.backend != "emulated" or self.arm is None or self.arm.dynamixel is None:
+                raise ValueError(
+                    f"emulator.faults[{i}]: faults are rehearsed on emulated servos only "
+                    "(backend = 'emulated' with an [arm.dynamixel] table); remove them here"
+                )
+            if fault.kind not in ARM_FAULT_KINDS:
+                raise ValueError(
+                    f"emulator.faults[{i}].kind = {fault.kind!r}: the emulated servo bus "
+                    f"rehearses {' and '.join(ARM_FAULT_KINDS)} (the status packet of "
+                    "the at_command-th instruction packet the servos receive, lost or damaged)"
+                )
+
     @model_validator(mode="after")
     def _kind_has_its_table(self) -> RigConfig:
         if self.kind == "dome" and self.dome is None:
@@ -362,6 +388,7 @@ class RigConfig(_Strict):
                 "they need kind = 'dome' and backend = 'emulated' (the real driver applies the "
                 "intensity correction that evens them out)"
             )
+        self._arm_faults_are_replies()
         if self.backend in ("simulated", "emulated"):
             from rti_rig.simulator.scenes import MIN_SIZE_PX
 

@@ -266,8 +266,14 @@ def test_corrupted_crc_and_silence_are_communication_errors() -> None:
         bus.read(1, ct.PRESENT_POSITION)
     assert bus.read(1, ct.PRESENT_POSITION) == 2048  # next reply is clean
     emu.corrupt_next_replies = 1
+    bus.write(1, ct.LED, 1)  # a write of a value is idempotent: retried once, like a read
+    assert emu.servos[1].get(ct.LED) == 1
+    emu.drop_next_replies = 1  # its status lost on the wire: the servo acted, the host heard
+    bus.write(1, ct.LED, 0)  # nothing (COMM_RX_TIMEOUT); sent again, and the value is there
+    assert emu.servos[1].get(ct.LED) == 0 and emu.drop_next_replies == 0
+    emu.corrupt_next_replies = 2
     with pytest.raises(CommunicationError, match="COMM_RX_CORRUPT"):
-        bus.write(1, ct.LED, 1)  # a write is never retried by the bus
+        bus.write(1, ct.LED, 1)  # damaged twice in a row: a named error
     emu.silent_ids.add(2)
     with pytest.raises(CommunicationError, match="servo 2") as info:
         bus.ping(2)

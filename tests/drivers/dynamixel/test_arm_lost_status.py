@@ -1,0 +1,84 @@
+"""A status packet lost or damaged on the wire, to a write: retried once, through the CLI.
+
+One lost reply to a lamp, goal or settings write had ended a check or a session with
+COMM_RX_TIMEOUT, though the servo had acted on the write; a write of a register's value is
+idempotent, so it is sent once more (as reads were). The shipped arm config rehearses it with
+``[[emulator.faults]]``, which an arm config had silently ignored."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.app.compose import build_rig
+from rti_rig.app.config import load_rig_config
+from rti_rig.cli import app
+from rti_rig.drivers.dynamixel import protocol2 as p2
+
+runner = CliRunner()
+
+
+def _arm_config(tmp_path: Path, faults: str) -> Path:
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    text = text.replace('transport = "pty"', 'transport = "inprocess"')
+    path = tmp_path / "arm.toml"
+    path.write_text(text + "\n[emulator]\n" + faults)
+    return path
+
+
+def _writes(config: Path, upto: int) -> list[int]:
+    """The 1-based numbers of the write instructions among the first ``upto`` the emulated
+    servos receive during a clean check of ``config`` (what a fault's at_command counts)."""
+    clean = config.with_name("clean.toml")
+    clean.write_text(config.read_text().split("\n[emulator]\n")[0])
+    with build_rig(load_rig_config(clean)) as rig:
+        carrier = rig.lighting.carrier  # type: ignore[attr-defined]
+        carrier.connect()
+        carrier.lamp(True)
+        carrier.lamp(False)
+        carrier.close()
+        sent = rig.emulator.instructions  # type: ignore[attr-defined]
+    return [i + 1 for i, pkt in enumerate(sent[:upto]) if pkt.instruction == p2.INST_WRITE]
+
+
+@pytest.mark.parametrize("kind", ["drop_reply", "garble_reply"])
+def test_a_lost_or_damaged_status_to_a_write_is_retried_and_the_check_passes(
+    tmp_path: Path, kind: str
+) -> None:
+    probe = _arm_config(tmp_path, "")
+    writes = _writes(probe, 60)
+    assert len(writes) >= 3, writes
+    # the connect's first write (a settings write), and two later ones (torque, lamp)
+    faults = "".join(
+        f'[[emulator.faults]]\nat_command = {k}\nkind = "{kind}"\n'
+        for k in (writes[0], writes[len(writes) // 2], writes[-1])
+    )
+    cfg = _arm_config(tmp_path, faults)
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 0, r.output
+    assert "RESULT: PASS" in r.output and "COMM_RX" not in r.output, r.output
+
+
+def test_a_write_whose_status_is_lost_twice_is_a_named_error(tmp_path: Path) -> None:
+    """Lost on the retry too: the servo (or its cable) is not answering, said as before."""
+    writes = _writes(_arm_config(tmp_path, ""), 60)
+    first = writes[0]
+    faults = "".join(
+        f'[[emulator.faults]]\nat_command = {k}\nkind = "drop_reply"\n' for k in (first, first + 1)
+    )
+    r = runner.invoke(app, ["check", str(_arm_config(tmp_path, faults))], terminal_width=400)
+    assert r.exit_code == 1, r.output
+    assert "COMM_RX_TIMEOUT" in r.output and "servo 1" in r.output, r.output
+
+
+def test_an_arm_fault_the_servo_bus_cannot_rehearse_is_refused_naming_the_key(
+    tmp_path: Path,
+) -> None:
+    cfg = _arm_config(tmp_path, '[[emulator.faults]]\nat_command = 5\nkind = "reset"\n')
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    assert r.exit_code == 2, r.output
+    assert "emulator.faults[0].kind = 'reset'" in r.output, r.output
+    assert "drop_reply and garble_reply" in r.output
