@@ -66,6 +66,11 @@ FACTORY_REGISTERS = (
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
 DEFAULT_FIRMWARE = 46
+#: Seconds a servo answers nothing after it acknowledged a Reboot instruction, while it
+#: restarts. The e-manual (Protocol 2.0, Reboot) gives the status packet but no restart time;
+#: measured on XC330 servos: the status comes at once, then ~0.4 s of silence
+#: (ROBOTIS-GIT/emanual issue #1698, 2024-09-01), and ROBOTIS's Dynamixel2Arduino waits 3 s.
+RESTART_S = 0.4
 #: Largest deviation from Goal Position (ticks) at which Moving Status says In-Position: the
 #: e-manual's "predefined value" is not published for the X series, so this is an assumption.
 IN_POSITION_TICKS = 1
@@ -189,6 +194,9 @@ class EmulatedServo:
         self._profile = _Profile(present_ticks, present_ticks, clock.now(), 1.0, 1.0)
         self._registered: tuple[int, bytes] | None = None
         self._shut_down = False
+        #: how long a Reboot keeps it silent (:data:`RESTART_S`), and until when it is
+        self.restart_s = RESTART_S
+        self.restarting_until = float("-inf")
         #: the other axes of the same body (a 2XL430's second id): see :meth:`write`
         self.other_axes: list[EmulatedServo] = []
         #: the writable RAM area (Torque Enable .. Goal Position) as at power-on, restored by a
@@ -306,6 +314,8 @@ class EmulatedServo:
         the voltage limits raises its error again."""
         self._shut_down = False
         self._freeze()
+        # it answers nothing while it restarts (the Reboot's own status went out first)
+        self.restarting_until = self.clock.now() + self.restart_s
         self.table[ct.EEPROM_END : ct.REALTIME_TICK.address] = self._ram_at_power_on
         self._set(ct.GOAL_POSITION, round(self.position()))
         self._registered = None
@@ -503,10 +513,12 @@ class DynamixelBusEmulator:
             # e-manual, Protocol Compatibility Table: "X-series can switch DYNAMIXEL Protocol
             # 2.0 into DYNAMIXEL Protocol 1.0 ... Protocol Type(13)") and does not answer these
             # packets: it had answered them, so a servo set to 1.0 passed `check` here
+            now = self.clock.now()
             self._deaf = self.silent_ids | {
                 i
                 for i, servo in self.servos.items()
-                if (
+                if now < servo.restarting_until  # restarting after a Reboot
+                or (
                     self.host_baud is not None
                     and ct.BAUD_CODES.get(servo.get(ct.BAUD_RATE)) != self.host_baud
                 )

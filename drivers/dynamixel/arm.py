@@ -538,13 +538,47 @@ class DynamixelArm:
             self._bus.broadcast_write(ct.LED, 0)
         self._lamp_on = False
 
+    #: Longest wait (s) for a rebooted servo to answer a ping again. The e-manual gives no
+    #: restart time; XC330s answer again after ~0.4 s (ROBOTIS-GIT/emanual issue #1698) and
+    #: ROBOTIS's Dynamixel2Arduino waits 3 s after a Reboot, so 3 s covers what is known.
+    REBOOT_WAIT_S = 3.0
+    #: Pause between two pings while waiting for a rebooted servo.
+    REBOOT_POLL_S = 0.05
+
     def reboot(self) -> None:
-        """Reboot both servos (clears a hardware fault) and reconnect-style re-check them."""
+        """Reboot both servos (clears a hardware fault), wait until each answers again, and
+        reconnect-style re-check them.
+
+        Why the wait: a servo acknowledges the Reboot instruction at once, then answers nothing
+        while it restarts, so the reconnect's first ping, sent straight after, went unanswered
+        on a real servo ("COMM_RX_TIMEOUT … check power, cabling, id and baud rate")."""
         for joint in self.settings.joints:
             self._bus.reboot(joint.servo_id)
         self._connected = False
+        for joint in self.settings.joints:
+            self._wait_restarted(joint)
         self._bus.close()
         self.connect()
+
+    def _wait_restarted(self, joint) -> None:  # type: ignore[no-untyped-def]
+        """Ping ``joint``'s servo until it answers, for at most :attr:`REBOOT_WAIT_S` on the
+        arm's clock; one still silent is a :class:`CommunicationError` naming it."""
+        deadline = self.clock.now() + self.REBOOT_WAIT_S
+        while True:
+            try:
+                self._bus.ping(joint.servo_id)
+                return
+            except CommunicationError as exc:
+                if self.clock.now() >= deadline:
+                    raise CommunicationError(
+                        self.name,
+                        f"the {self._role(joint)} joint's servo answered no ping within "
+                        f"{self.REBOOT_WAIT_S:g} s of its Reboot: switch the servos' power off "
+                        "and on, check its cable, then connect again",
+                        "reboot",
+                        joint.servo_id,
+                    ) from exc
+            self.clock.sleep(self.REBOOT_POLL_S)
 
     # -- internals --------------------------------------------------------------------------
     def _require_connected(self, command: str) -> None:

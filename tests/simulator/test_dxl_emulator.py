@@ -14,6 +14,7 @@ from rti_rig.drivers.dynamixel.faults import (
     ServoStatusError,
 )
 from rti_rig.simulator.dynamixel_emulator import (
+    RESTART_S,
     DynamixelBusEmulator,
     EmulatedServo,
     InProcessPort,
@@ -251,6 +252,7 @@ def test_injected_hardware_error_surfaces_by_name(fault, name) -> None:
     # an overheated servo had only been told to cool down, and was refused again once cool
     assert "; then switch the servos' power off and on" in str(info.value)
     bus.reboot(2)
+    clock.sleep(RESTART_S)  # silent while it restarts
     bus.write(2, ct.LED, 1)  # cleared
 
 
@@ -356,6 +358,7 @@ def test_a_fault_outside_the_shutdown_setting_alerts_but_leaves_torque_on() -> N
         bus.read(2, ct.PRESENT_POSITION)
     assert info.value.torque_on is False and "limp" in str(info.value)
     bus.reboot(2)
+    clock.sleep(RESTART_S)  # silent while it restarts
     bus.write(2, ct.TORQUE_ENABLE, 1)  # a reboot lifts the shutdown
 
 
@@ -425,6 +428,7 @@ def test_in_position_means_arrived_at_the_goal_not_merely_stopped() -> None:
     assert 2048 < present < 3000
     assert moving_status() & 0x03 == 0x00  # stopped short: neither moving nor in position
     emu.servos[1].reboot()
+    clock.sleep(RESTART_S)  # silent while it restarts
     assert ph.write1ByteTxRx(port, 1, ct.TORQUE_ENABLE.address, 1)[0] == sdk.COMM_SUCCESS
     clock.sleep(1.0)
     assert moving_status() & 0x03 == 0x01  # torque-on holds the present position: arrived
@@ -458,6 +462,7 @@ def test_a_reboot_restores_the_ram_area_as_at_power_on() -> None:
     assert servo.get(ct.GOAL_POSITION) == round(servo.position())
     assert servo.get(ct.MIN_POSITION_LIMIT) == 0  # EEPROM kept
     emu.set_input_voltage(1, 200)  # 20 V: above the XL430's 14 V limit, and still there
+    clock.sleep(RESTART_S)  # silent while it restarts
     assert ph.reboot(port, 1)[0] == sdk.COMM_SUCCESS
     assert servo.hardware_error == ct.HardwareFault.INPUT_VOLTAGE
 
