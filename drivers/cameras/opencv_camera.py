@@ -210,6 +210,19 @@ class OpenCvCamera:
             )
 
     # -- capture ---------------------------------------------------------------------------
+    def _ran_out(self) -> str:
+        """For an image sequence: how many files were read, so that a sequence shorter than
+        the session (or a drain that skips files) is told as such, not as a lost device."""
+        s = self.settings
+        if s.backend != "images":
+            return ""
+        return (
+            f": the image sequence {s.device} ended after {self._frames_read} file"
+            f"{'s' if self._frames_read != 1 else ''}; each capture reads "
+            f"{s.frames_to_drain + 1} (drain_frames = {s.frames_to_drain} in [camera.device], "
+            "then one kept)"
+        )
+
     def _require_open(self) -> VideoCaptureLike:
         if self._cap is None:
             raise CaptureError(
@@ -259,18 +272,21 @@ class OpenCvCamera:
         else:
             actual, units, applied = exposure_s, exposure_s / s.exposure_unit_s, False
             gain = float(s.gain or 0.0)
-        for i in range(s.drain_frames):
+        drain = s.frames_to_drain
+        for i in range(drain):
             if not cap.grab():
                 raise CaptureError(
                     self.name,
-                    f"stream ended while draining frame {i + 1} of {s.drain_frames}",
+                    f"stream ended while draining frame {i + 1} of {drain}{self._ran_out()}",
                     "drain",
                 )
-        self._frames_read += s.drain_frames
+            self._frames_read += 1
         ok, image = cap.read()
         if not ok or image is None:
             raise CaptureError(
-                self.name, "no frame delivered (stream ended or device lost)", "read"
+                self.name,
+                "no frame delivered (stream ended or device lost)" + self._ran_out(),
+                "read",
             )
         self._frames_read += 1
         image = np.asarray(image)
@@ -289,7 +305,7 @@ class OpenCvCamera:
             "exposure_units": units,
             "exposure_applied": applied,
             "gain_unit": "v4l2" if applied else "configured",
-            "drained_frames": s.drain_frames,
+            "drained_frames": drain,
             "stream_index": self._frames_read - 1,
             "capture_started_s": started,
             "capture_finished_s": self._clock.now(),

@@ -122,11 +122,12 @@ class OpenCvCameraSettings(_Strict):
     gain: float | None = Field(None, description="CAP_PROP_GAIN to set and verify; None = leave")
     wb_temperature_k: int | None = Field(None, gt=0)
     buffer_size: int = Field(1, ge=1, description="CAP_PROP_BUFFERSIZE requested at connect")
-    drain_frames: int = Field(
-        4,
+    drain_frames: int | None = Field(
+        None,
         ge=0,
         description="frames grabbed and discarded before each capture so the returned frame "
-        "was exposed after the exposure was set (V4L2 queues several buffers)",
+        "was exposed after the exposure was set (V4L2 queues several buffers); unset: 4 on "
+        "v4l2, 0 on an image sequence (one file per capture)",
     )
     exposure_tolerance: float = Field(
         0.02, ge=0.0, description="relative mismatch allowed between set and read-back exposure"
@@ -141,6 +142,16 @@ class OpenCvCameraSettings(_Strict):
     )
     black_level: int = Field(0, ge=0, description="code value subtracted from 16-bit frames")
     white_level: int = Field(65535, gt=0, le=65535, description="saturation code of 16-bit frames")
+
+    @property
+    def frames_to_drain(self) -> int:
+        """``drain_frames``, or its default for the backend: 4 on v4l2 (V4L2 queues buffers
+        filled before the exposure changed), 0 on an image sequence, where each file is one
+        capture. Why: the image sequence had drained 4 files a capture too, so a dry run over
+        one file per light used files 5, 10, … and ran out after a fifth of its lights."""
+        if self.drain_frames is not None:
+            return self.drain_frames
+        return 4 if self.backend == "v4l2" else 0
 
     @field_validator("fourcc")
     @classmethod

@@ -48,6 +48,21 @@ def test_image_sequence_16bit_frames_come_back_unchanged_after_draining(tmp_path
     cam.close()  # safe twice
 
 
+def test_an_image_sequence_reads_one_file_a_capture_and_says_when_it_runs_out(tmp_path):
+    """An image sequence has no queue of stale buffers: a dry run over one file per light had
+    drained 4 files a capture by default (files 4, 9, …), ending after a fifth of its lights
+    with "stream ended while draining frame 3 of 4"."""
+    pattern = write_sequence(tmp_path, [1000, 2000, 3000])
+    with images_camera(pattern) as cam:
+        got = [int(cam.capture(0.01).pixels[0, 0]) for _ in range(3)]
+        assert got == [1000, 2000, 3000]
+        with pytest.raises(CaptureError) as info:
+            cam.capture(0.01)
+    said = str(info.value)
+    assert "ended after 3 files" in said and "each capture reads 1" in said, said
+    assert OpenCvCameraSettings(backend="v4l2").frames_to_drain == 4  # a camera still drains
+
+
 def test_image_sequence_black_level_and_white_level(tmp_path):
     pattern = write_sequence(tmp_path, [100, 4095])
     cam = images_camera(pattern, drain_frames=0, black_level=64, white_level=4095)
