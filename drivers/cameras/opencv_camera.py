@@ -31,6 +31,9 @@ from rti_rig.drivers.cameras.raw_decode import exposure_stats
 from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 
 RAW_GREY_FOURCCS = {"Y16 ", "Y10 ", "Y12 "}
+#: Buffers OpenCV's V4L2 backend queues unless CAP_PROP_BUFFERSIZE changes it
+#: (DEFAULT_V4L_BUFFERS in modules/videoio/src/cap_v4l.cpp).
+OPENCV_V4L_DEFAULT_BUFFERS = 4
 
 
 class VideoCaptureLike(Protocol):
@@ -73,6 +76,9 @@ class OpenCvCamera:
         self._factory: CaptureFactory = capture_factory or cv2.VideoCapture
         self._cap: VideoCaptureLike | None = None
         self._frames_read = 0
+        #: frames each capture drains: ``frames_to_drain``, raised at connect to the buffers
+        #: the driver really queues when ``drain_frames`` is left unset
+        self._drain = settings.frames_to_drain
         self.connection_info: dict[str, Any] = {}
 
     # -- lifecycle -------------------------------------------------------------------------
@@ -164,6 +170,7 @@ class OpenCvCamera:
             if got in RAW_GREY_FOURCCS:
                 self._set_verified(cap, cv2.CAP_PROP_CONVERT_RGB, 0, "convert_rgb")
         info["buffer_size_set"] = bool(cap.set(cv2.CAP_PROP_BUFFERSIZE, s.buffer_size))
+        self._drain = self._drain_for_queue(cap, info)
         if s.toggle_auto_exposure:
             cap.set(cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_auto)
         self._set_verified(
@@ -196,6 +203,39 @@ class OpenCvCamera:
                 self._refuse_unset_response(np.asarray(frame))
         self.connection_info = info
 
+    def _drain_for_queue(self, cap: VideoCaptureLike, info: dict[str, Any]) -> int:
+        """Frames to drain so that none exposed before an exposure change is kept: at least
+        the buffers the driver queues.
+
+        Why: a driver that refuses the buffer-size request (``set`` returns False) keeps its
+        own queue, OpenCV's V4L2 default of 4 buffers or more, and ``get`` reports it; a drain
+        shorter than that returned a frame exposed at the previous light's exposure, while the
+        metadata said ``drained_frames = 4`` as if it were fresh. An unset ``drain_frames``
+        follows the queue; a set one shorter than it is refused, naming the key."""
+        s = self.settings
+        asked = s.buffer_size if info["buffer_size_set"] else None
+        got = cap.get(cv2.CAP_PROP_BUFFERSIZE)
+        queued = asked or (int(got) if got >= 1 else OPENCV_V4L_DEFAULT_BUFFERS)
+        info["buffers_queued"] = queued
+        drain = s.frames_to_drain
+        if drain >= queued:
+            return drain
+        refused = (
+            ""
+            if info["buffer_size_set"]
+            else f"the driver refused buffer_size = {s.buffer_size} (CAP_PROP_BUFFERSIZE) and "
+        )
+        if s.drain_frames is None:
+            return queued
+        raise DeviceError(
+            self.name,
+            f"{refused}{queued} buffer{' is' if queued == 1 else 's are'} queued, so "
+            f"drain_frames = {s.drain_frames} in [camera.device] would keep a frame exposed "
+            f"before the exposure changed: set drain_frames = {queued} or more, or remove it "
+            "(unset, it follows the queue)",
+            "set buffer_size",
+        )
+
     def _refuse_unset_response(self, image: np.ndarray) -> None:
         """An 8-bit frame with no ``response`` configured is refused, not taken as linear: such
         frames are gamma-encoded on nearly every camera, and read as linear they bias every
@@ -219,7 +259,7 @@ class OpenCvCamera:
         return (
             f": the image sequence {s.device} ended after {self._frames_read} file"
             f"{'s' if self._frames_read != 1 else ''}; each capture reads "
-            f"{s.frames_to_drain + 1} (drain_frames = {s.frames_to_drain} in [camera.device], "
+            f"{self._drain + 1} (drain_frames = {self._drain} in [camera.device], "
             "then one kept)"
         )
 
@@ -272,7 +312,7 @@ class OpenCvCamera:
         else:
             actual, units, applied = exposure_s, exposure_s / s.exposure_unit_s, False
             gain = float(s.gain or 0.0)
-        drain = s.frames_to_drain
+        drain = self._drain
         for i in range(drain):
             if not cap.grab():
                 raise CaptureError(

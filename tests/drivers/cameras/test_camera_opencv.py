@@ -134,6 +134,8 @@ class FakeV4l2:
             cv2.CAP_PROP_AUTO_WB: 1.0 if has_awb else 0.0,
             cv2.CAP_PROP_FRAME_WIDTH: 640.0,
             cv2.CAP_PROP_FRAME_HEIGHT: 480.0,
+            # OpenCV's V4L2 backend reports its own buffer count, the request refused below
+            cv2.CAP_PROP_BUFFERSIZE: float(buffers),
         }
         # buffers already filled at the old exposure
         self.queue = deque(self._frame() for _ in range(buffers))
@@ -220,11 +222,31 @@ def test_v4l2_capture_sets_exposure_in_100us_units_and_drains_stale_buffers():
 
 
 def test_without_draining_the_frame_is_stale():
-    # Shows why draining exists: the same fake without it returns the old exposure's frame.
+    # Shows why draining exists: the same fake without it returns the old exposure's frame
+    # (a drain shorter than the queue is refused at connect: below)
     fake = FakeV4l2()
-    with v4l2_camera(fake, drain_frames=0) as cam:
+    cam = v4l2_camera(fake, drain_frames=0)
+    cam._drain_for_queue = lambda cap, info: 0  # type: ignore[method-assign]
+    with cam:
         f = cam.capture(0.01)
     assert np.all(f.pixels == 156)
+
+
+def test_a_refused_buffer_size_is_drained_in_full_or_a_short_drain_refused():
+    """The driver refuses the one-buffer request and keeps 6 queued: 4 drained frames left a
+    frame of the previous exposure, delivered as fresh ("drained_frames": 4). Unset, the drain
+    follows the queue; set shorter than it, the connect is refused naming the key."""
+    fake = FakeV4l2(buffers=6)
+    with v4l2_camera(fake) as cam:
+        f = cam.capture(0.01)
+    assert np.all(f.pixels == 100), f.pixels  # exposed after the change
+    assert f.metadata["drained_frames"] == 6 and f.metadata["buffers_queued"] == 6
+    assert f.metadata["buffer_size_set"] is False
+    with pytest.raises(DeviceError) as info:
+        v4l2_camera(FakeV4l2(buffers=6), drain_frames=4).connect()
+    said = str(info.value)
+    assert "refused buffer_size = 1" in said and "6 buffers are queued" in said, said
+    assert "drain_frames = 4 in [camera.device]" in said and "drain_frames = 6 or more" in said
 
 
 def test_v4l2_size_is_set_before_the_pixel_format():
