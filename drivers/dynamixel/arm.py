@@ -131,6 +131,7 @@ class DynamixelArm:
                 "connect",
                 sid,
             )
+        self._check_status_return_level(joint)
         status = self._bus.read(sid, ct.HARDWARE_ERROR_STATUS, check_alert=False)
         if status:
             raise self._bus.hardware_fault(sid, "connect", status)
@@ -165,6 +166,42 @@ class DynamixelArm:
                     sid,
                 )
         self._check_velocity_limit(joint)
+
+    def _check_status_return_level(self, joint) -> None:  # type: ignore[no-untyped-def]
+        """Refuse, before any write, a servo whose Status Return Level (68) is below 2.
+
+        Why: the driver confirms every write by its status packet, and a servo set to level 1
+        by another program (it saves bus time) answers pings and reads but no write. Its first
+        write (torque off for the position limits) then timed out with "COMM_RX_TIMEOUT …
+        check power, cabling, id and baud rate", of a servo that had just answered. Level 0
+        (ping only) leaves even this read unanswered, which is said as such. The register is
+        in the RAM area, 2 at power-on (ROBOTIS e-manual, X-series control table)."""
+        sid, role = joint.servo_id, self._role(joint)
+        fix = (
+            "it is 2 at power-on (RAM area): switch the servos' power off and on, or set "
+            "Status Return Level (address 68) to 2 with Dynamixel Wizard 2.0"
+        )
+        try:
+            level = self._bus.read(sid, ct.STATUS_RETURN_LEVEL, check_alert=False)
+        except CommunicationError as exc:
+            if "COMM_RX_TIMEOUT" not in exc.message:
+                raise
+            raise CommunicationError(
+                self.name,
+                f"the {role} joint's servo answers its ping but no read: its Status Return "
+                f"Level (address 68) is most likely 0 (answer pings only); {fix}",
+                exc.command,
+                sid,
+            ) from exc
+        if level < 2:
+            raise ConfigMismatchError(
+                self.name,
+                f"Status Return Level (address 68) is {level}: the {role} joint's servo "
+                "answers pings and reads but no write, so no command could be confirmed; "
+                f"{fix}",
+                "connect",
+                sid,
+            )
 
     def _unanswered(self, joint, exc: CommunicationError) -> CommunicationError:  # type: ignore[no-untyped-def]
         """A configured servo that does not answer its ping, with what does answer on the bus.

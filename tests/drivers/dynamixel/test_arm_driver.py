@@ -459,6 +459,24 @@ def test_a_servo_that_does_not_come_back_from_a_reboot_is_named() -> None:
     assert clock.now() - started < 4.0  # bounded
 
 
+@pytest.mark.parametrize("level", [0, 1])
+def test_a_servo_that_answers_no_write_is_refused_before_any_write(level: int) -> None:
+    """A servo left at Status Return Level 1 by another program answers pings and reads but
+    no write: the connect's first write (torque off) timed out with "check power, cabling, id
+    and baud rate"; at level 0 its first read did. Both are named, before anything is
+    written."""
+    arm, emu, _ = make_arm()
+    emu.servos[2].table[ct.STATUS_RETURN_LEVEL.address] = level
+    with pytest.raises(DynamixelError) as info:
+        arm.connect()
+    said = str(info.value)
+    assert info.value.servo_id == 2 and "elevation joint's servo" in said, said
+    assert "Status Return Level (address 68)" in said and "power off and on" in said
+    assert (f"is {level}:" if level else "is most likely 0") in said
+    assert "cabling" not in said
+    assert not arm.commanded  # refused before any write
+
+
 def test_settings_from_a_rig_toml_table() -> None:
     import tomllib
 
