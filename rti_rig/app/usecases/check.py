@@ -68,13 +68,27 @@ def check_rig(req: CheckRequest) -> Any:
                     rig.clock,
                     park=rig.lighting.park_after_session,
                 )
-                return WithCamera(lights, camera_line(rig))
+                return WithCamera(lights, camera_line(rig), _lamp_notes(rig))
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
             report = getattr(exc, "self_test_report", None)
             failures = tuple(str(f) for f in getattr(report, "teardown_failures", None) or ())
             raise CheckStopped(str(exc), lights_state(rig, bool(failures)), failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
+
+
+def _lamp_notes(rig) -> tuple[str, ...]:  # type: ignore[no-untyped-def]
+    """What the arm check says of a lamp it cannot switch: a real arm's lamp whose switch is
+    outside the servo bus (``lamp = "software"``, the default). The check is said to flash the
+    lamp at each pose, and a user watching a lamp that never lit was told nothing of why."""
+    lamp = getattr(getattr(rig.lighting.carrier, "settings", None), "lamp", None)
+    if lamp != "software" or rig.loaded.config.backend != "hardware":
+        return ()
+    return (
+        'lamp: not switched by rti-rig (lamp = "software" in [arm.dynamixel]: its switch is '
+        "outside the servo bus), so no flash reached it at any pose; set lamp = "
+        '"servo_led" and lamp_servo_id if it hangs on a servo\'s LED output',
+    )
 
 
 def camera_line(rig, why_no_image: str = "") -> tuple[str, bool]:  # type: ignore[no-untyped-def]
@@ -116,6 +130,8 @@ class WithCamera:
 
     lights: Any
     camera: tuple[str, bool]
+    #: lines said after the lights' own (what the check could not do with them)
+    notes: tuple[str, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -123,7 +139,12 @@ class WithCamera:
 
     def lines(self) -> list[str]:
         *body, result = self.lights.lines()
-        return [*body, self.camera[0], result if self.camera[1] else "RESULT: FAIL"]
+        return [
+            *body,
+            *self.notes,
+            self.camera[0],
+            result if self.camera[1] else "RESULT: FAIL",
+        ]
 
 
 @dataclass(frozen=True)
