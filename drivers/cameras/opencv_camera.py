@@ -176,10 +176,17 @@ class OpenCvCamera:
         self._set_verified(
             cap, cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_manual, "auto_exposure (manual)"
         )
-        # Mono sensors have no white balance control: absent is fine, stuck on is not.
-        if not cap.set(cv2.CAP_PROP_AUTO_WB, 0) and cap.get(cv2.CAP_PROP_AUTO_WB) == 1:
+        # Mono sensors have no white balance control: absent is fine, stuck on is not. Read
+        # back whatever set returned: a driver that says yes and leaves auto white balance on
+        # had passed, and each light's colour was then balanced differently.
+        accepted = cap.set(cv2.CAP_PROP_AUTO_WB, 0)
+        if cap.get(cv2.CAP_PROP_AUTO_WB) == 1:
             raise DeviceError(
-                self.name, "camera refused to turn auto white balance off", "set auto_wb"
+                self.name,
+                f"camera did not turn auto white balance off (set returned {accepted}, reads "
+                f"back 1); try `v4l2-ctl -d {s.device} -c white_balance_automatic=0` (older "
+                "kernels: white_balance_temperature_auto=0)",
+                "set auto_wb",
             )
         info["auto_wb"] = cap.get(cv2.CAP_PROP_AUTO_WB)
         if s.wb_temperature_k is not None:

@@ -115,6 +115,7 @@ class FakeV4l2:
         manual_latches=True,
         exposure_latches=True,
         has_awb=False,
+        awb_latches=True,
         opened=True,
         buffers=4,
     ):
@@ -122,6 +123,7 @@ class FakeV4l2:
         self.manual_latches = manual_latches
         self.exposure_latches = exposure_latches
         self.has_awb = has_awb
+        self.awb_latches = awb_latches
         self.opened = opened
         self.released = False
         self.log: list[tuple[int, float]] = []
@@ -164,8 +166,9 @@ class FakeV4l2:
         if prop == cv2.CAP_PROP_AUTO_WB:
             if not self.has_awb:
                 return False
-            self.props[prop] = float(value)
-            return True
+            if self.awb_latches:
+                self.props[prop] = float(value)
+            return True  # claims success either way
         if prop == cv2.CAP_PROP_BUFFERSIZE:
             return False
         if prop in self.props:
@@ -208,6 +211,16 @@ def test_v4l2_connect_sets_y16_manual_exposure_and_awb_off_verifying_each():
     assert fake.props[cv2.CAP_PROP_GAIN] == 8
     assert props.index(cv2.CAP_PROP_FOURCC) < props.index(cv2.CAP_PROP_AUTO_EXPOSURE)
     assert cam.connection_info["fourcc"] == "Y16 "
+
+
+def test_auto_white_balance_that_stays_on_is_refused_though_set_said_yes():
+    """The driver says yes to auto white balance off and leaves it on: only a refused set had
+    been read back, so the connect passed and each light's colour was balanced anew."""
+    with pytest.raises(DeviceError) as info:
+        v4l2_camera(FakeV4l2(has_awb=True, awb_latches=False)).connect()
+    said = str(info.value)
+    assert "did not turn auto white balance off (set returned True, reads back 1)" in said
+    assert "white_balance_automatic=0" in said
 
 
 def test_v4l2_capture_sets_exposure_in_100us_units_and_drains_stale_buffers():
