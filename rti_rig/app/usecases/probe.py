@@ -77,7 +77,12 @@ class ProbeResult:
 
 
 def _exchange(port: str, baud: int, wait_s: float, send: bytes, listen_s: float) -> str:
-    """Open at ``baud``, wait ``wait_s`` (collecting the banner), send, listen; all text heard."""
+    """Open at ``baud``, wait ``wait_s`` (collecting the banner), send, listen; all text heard.
+
+    A probe met by silence is sent once more on the same open port (every probe is harmless
+    to the firmwares known, and none resets a board when it is repeated): one reply lost on
+    the line, an Elexol board's ``USB I/O 24R1`` to ``?``, had made the probe say that no
+    known firmware answered, where a session's driver resends the same command."""
     t = SerialTransport(port, baud)
     t.open()
     try:
@@ -85,7 +90,11 @@ def _exchange(port: str, baud: int, wait_s: float, send: bytes, listen_s: float)
         heard += _listen(t, wait_s)
         if send:
             t.write(send)
-            heard += _listen(t, listen_s)
+            answer = _listen(t, listen_s)
+            if not answer:
+                t.write(send)
+                answer = _listen(t, listen_s)
+            heard += answer
         return heard.decode("latin-1")
     finally:
         t.close()

@@ -82,6 +82,21 @@ def test_probe_names_the_firmware_and_leaves_it_dark(profile: str) -> None:
 
 
 @pytest.mark.slow  # real firmware timing over a pty
+def test_probe_asks_again_when_a_reply_is_lost_and_finds_the_elexol_board() -> None:
+    """docs/domes.md's own rehearsal: the Elexol board's answer to the first ``?`` is lost.
+    The probe had gone on to the other firmwares and said "No known dome firmware answered";
+    a probe met by silence is sent once more on the same open port, as the driver resends."""
+    from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
+
+    board = board_for("elexol-24r1", faults=FaultPlan((Fault(1, FaultKind.DROP_REPLY),)))
+    with serve_on_pty(board, "elexol-24r1") as link:
+        r = runner.invoke(app, ["probe", link.port], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 0, text
+    assert 'profile = "elexol-24r1"' in text and "No known dome firmware" not in text, text
+
+
+@pytest.mark.slow  # real firmware timing over a pty
 def test_probe_sends_the_nab_all_off_again_when_its_reply_is_lost() -> None:
     """The Nab sketch boots fully lit; the probe's ``<0>`` is its only way dark. One lost reply
     had ended the probe "all-off sent but NOT acknowledged: check the dome" (and a ``<0>`` the
