@@ -69,7 +69,8 @@ DEFAULT_FIRMWARE = 46
 #: Seconds a servo answers nothing after it acknowledged a Reboot instruction, while it
 #: restarts. The e-manual (Protocol 2.0, Reboot) gives the status packet but no restart time;
 #: measured on XC330 servos: the status comes at once, then ~0.4 s of silence
-#: (ROBOTIS-GIT/emanual issue #1698, 2024-09-01), and ROBOTIS's Dynamixel2Arduino waits 3 s.
+#: (ROBOTIS-GIT/emanual issue #1698, 2024-09-01, which also reports ROBOTIS's Arduino code
+#: waiting 3 s).
 RESTART_S = 0.4
 #: Largest deviation from Goal Position (ticks) at which Moving Status says In-Position: the
 #: e-manual's "predefined value" is not published for the X series, so this is an assumption.

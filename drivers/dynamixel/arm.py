@@ -576,8 +576,8 @@ class DynamixelArm:
         self._lamp_on = False
 
     #: Longest wait (s) for a rebooted servo to answer a ping again. The e-manual gives no
-    #: restart time; XC330s answer again after ~0.4 s (ROBOTIS-GIT/emanual issue #1698) and
-    #: ROBOTIS's Dynamixel2Arduino waits 3 s after a Reboot, so 3 s covers what is known.
+    #: restart time; XC330s answer again after ~0.4 s, and ROBOTIS's Arduino code is reported
+    #: to wait 3 s after a Reboot (ROBOTIS-GIT/emanual issue #1698), so 3 s covers both.
     REBOOT_WAIT_S = 3.0
     #: Pause between two pings while waiting for a rebooted servo.
     REBOOT_POLL_S = 0.05
