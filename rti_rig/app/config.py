@@ -207,7 +207,9 @@ class SceneConfig(_Strict):
 
 
 class EmulatorFault(_Strict):
-    """One byte-level fault of the emulated dome firmware, at its n-th command (1-based)."""
+    """One byte-level fault of the emulated dome firmware, at its n-th command (1-based), or
+    of the emulated servo bus, at its n-th instruction packet (``drop_reply`` and
+    ``garble_reply`` only: :data:`ARM_FAULT_KINDS`)."""
 
     at_command: int = Field(gt=0)
     kind: Literal[
