@@ -263,11 +263,15 @@ class OpenCvCamera:
         s = self.settings
         if s.backend != "images":
             return ""
+        how = (
+            f" (drain_frames = {self._drain} in [camera.device], then one kept)"
+            if s.drain_frames is not None
+            else ""
+        )
         return (
             f": the image sequence {s.device} ended after {self._frames_read} file"
             f"{'s' if self._frames_read != 1 else ''}; each capture reads "
-            f"{self._drain + 1} (drain_frames = {self._drain} in [camera.device], "
-            "then one kept)"
+            f"{self._drain + 1}{how}"
         )
 
     def _require_open(self) -> VideoCaptureLike:
