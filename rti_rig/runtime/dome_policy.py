@@ -1250,4 +1250,5 @@ def self_test(
         report.elapsed_s = clock.now() - started
         if isinstance(source, DomePolicy):
             report.lights_state = lights_state_sentence(source)
+            source.lights_images = True  # a session on the same dome takes images again
     return report
