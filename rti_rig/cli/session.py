@@ -590,6 +590,19 @@ def _sentence(text: str) -> str:
     return text[:1].upper() + text[1:]
 
 
+def _cannot_resume(rig) -> str | None:  # type: ignore[no-untyped-def]
+    """What is said instead of "continue with --resume" of a session this rig cannot resume
+    (None: it can): a camera-triggered dome, whose own count went on, or an image-sequence
+    camera, read from its first file again by every run (a stopped dry run had been told to
+    resume, and the resume gave the remaining lights the pictures of the first ones)."""
+    from rti_rig.runtime.session import image_sequence_restarts
+
+    if getattr(rig.lighting, "resume_hint", None):
+        return str(rig.lighting.resume_hint)
+    why = image_sequence_restarts(rig.loaded.config.camera.device, _arg(rig.loaded.path))
+    return None if why is None else f"It cannot be resumed: {why}."
+
+
 def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
     """What a stopped session left on disk and how to go on (never a resume hint for nothing)."""
     from rti_rig.runtime.session import LP_NAME, holds_no_image
@@ -605,7 +618,7 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         # its write failed (a full disk): "listed in lights.lp" had been said of a lights.lp
         # that was missing, or listed fewer images than the folder holds
         state = f"lists only {listed} of them" if listed else "is missing"
-        if getattr(opened.rig.lighting, "resume_hint", None):  # a session that cannot resume
+        if _cannot_resume(opened.rig):
             remedy = (
                 f"`rti-rig export-lp {_arg(out_dir)} --out FILE.lp` writes one from the journal"
             )
@@ -839,9 +852,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     noun = "light" if todo == 1 else "lights"
     count = f"{todo} {noun}" if todo == total else f"{todo} of {total} {noun} left"
     out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
-    resume_hint = f"Continue with: rti-rig run --resume {_arg(out_dir)}"
-    if getattr(rig.lighting, "resume_hint", None):  # a dome whose own count cannot resume
-        resume_hint = rig.lighting.resume_hint
+    resume_hint = _cannot_resume(rig) or f"Continue with: rti-rig run --resume {_arg(out_dir)}"
     try:
         signal.signal(signal.SIGTERM, on_sigterm)
         if handover.held:  # a SIGTERM or Ctrl-C while the capture took over from the opening

@@ -1864,7 +1864,8 @@ def unresumable(root: Path) -> str | None:
     """What to do instead of ``run --resume`` for session ``root`` if no resume can continue
     it or reshoot its images (None when one can, or when ``root`` is no session): one shot on
     a camera-triggered dome, whose own count went on since (its resume, ``--reshoot-lost``
-    and an unfinished session's ``--rebuild-journal`` are refused before anything moves).
+    and an unfinished session's ``--rebuild-journal`` are refused before anything moves), or
+    with an image-sequence camera (:func:`image_sequence_restarts`).
 
     Why: the QA verdict, export-lp and fit advised ``run --resume`` (with
     ``--rebuild-journal`` or ``--reshoot-lost``) for such sessions, commands that are refused
@@ -1874,15 +1875,42 @@ def unresumable(root: Path) -> str | None:
     except SessionError:
         return None
     rig = manifest.get("rig") or {}
-    dome = (rig.get("config") or {}).get("dome") if isinstance(rig, dict) else None
+    config_of = (rig.get("config") or {}) if isinstance(rig, dict) else {}
+    dome = config_of.get("dome")
     sync = dome.get("flash_sync") if isinstance(dome, dict) else None
-    if not isinstance(sync, dict):
-        return None
     config = shlex.quote(str(rig.get("config_path") or "CONFIG"))
+    if not isinstance(sync, dict):
+        camera = config_of.get("camera")
+        device = camera.get("device") if isinstance(camera, dict) else None
+        return image_sequence_restarts(device, config)
     return (
         f"a camera-triggered dome ({sync.get('firmware', 'flash-stepped')}) cannot continue a "
         "session or reshoot single images (its own count went on): long-press its start "
         f"button to rewind it, then shoot the session again: rti-rig run {config} --out NEWDIR"
+    )
+
+
+def image_sequence_restarts(device: object, config: str) -> str | None:
+    """Why a session cannot be resumed, nor single images reshot, if its camera (the
+    ``[camera.device]`` table ``device`` of rig config ``config``) is an image sequence
+    (``backend = "images"``), with what to do instead; None for any other camera.
+
+    Why: an image sequence is opened at its first file by every run, so a resume gave the
+    lights still to shoot the files of the lights already shot (image_006 held f_000's
+    picture), recorded as lit by LEDs that never lit them, and the verdict then blamed dim
+    or bright images. Which file belongs to which light is not known to the camera (metering
+    shots and retries read files too), so nothing can say where to start again."""
+    if not isinstance(device, dict):
+        return None
+    if device.get("kind") != "opencv" or device.get("backend") != "images":
+        return None
+    return (
+        "its camera is an image sequence ([camera.device] backend = 'images', device = "
+        f"{device.get('device')!r}), which every run reads from its first file again, so it "
+        "cannot continue a session or reshoot single images: a resume would give the lights "
+        "still to shoot the pictures of the lights already shot. Shoot the dry run again into "
+        f"a new folder: rti-rig run {config} --out NEWDIR (to rehearse on recorded images "
+        "paired with their lights, a resumable replay rig: rti-rig run ACQ/dirs.lp --out DIR)"
     )
 
 

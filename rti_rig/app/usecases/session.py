@@ -917,6 +917,7 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
             "again, long-press the dome's start button, then rti-rig run CONFIG --out NEWDIR)"
         )
     refuse_options(loaded, **{"--resume": True})
+    _refuse_image_sequence_resume(loaded, Path(req.session_dir))
     identity, diffs = check_resume_rig(
         manifest, loaded, config_path, req.accept_rig_change, on_note, req.session_dir
     )
@@ -938,6 +939,17 @@ def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> Ope
 
         unlock_session(folder.root)
         raise
+
+
+def _refuse_image_sequence_resume(loaded: Any, root: Path) -> None:
+    """Refuse, before the folder is touched, to resume a session with images whose camera is
+    an image sequence (:func:`rti_rig.runtime.session.image_sequence_restarts`)."""
+    from rti_rig.runtime.session import holds_no_image, image_sequence_restarts
+
+    why = image_sequence_restarts(loaded.config.camera.device, shlex.quote(str(loaded.path)))
+    if why is None or holds_no_image(root):
+        return  # nothing shot yet: the sequence's first file is the first image's
+    raise RtiRigError(f"{root}: this session cannot be resumed (nothing was changed): {why}")
 
 
 def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: ignore[no-untyped-def]

@@ -1,0 +1,94 @@
+"""A dry run whose camera is an image sequence (`[camera.device] backend = "images"`) cannot be
+resumed: the sequence is read from its first file again on every run, so the resumed lights
+were given the files of the lights already shot (image_006 held f_000's picture), labelled as
+lit by LEDs that never lit them. The resume is refused before anything in the folder changes.
+
+Through `rti-rig run` on the shipped hardware dome example, its camera swapped for an image
+sequence and its port redirected to the dome firmware emulator on a pty.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import serial
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.app.config import load_rig_config
+from rti_rig.cli import app
+from rti_rig.core.clock import SystemClock
+from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+
+pytestmark = [pytest.mark.pty, pytest.mark.e2e]
+
+runner = CliRunner()
+SOURCE = CONFIGS / "example_dome_48.toml"
+
+
+def _config(tmp: Path, frames: Path) -> Path:
+    """The shipped hardware example with an image sequence for its camera."""
+    text = SOURCE.read_text()
+    head, rest = text.split("[camera.device]", 1)
+    tail = rest[rest.index("[timing]") :]
+    head = head.replace("width = 6000", "width = 32").replace("height = 4000", "height = 24")
+    device = (
+        '[camera.device]\nkind = "opencv"\nbackend = "images"\nresponse = "srgb"\n'
+        f'device = "{frames}/f_%03d.png"\n\n'
+    )
+    shutil.copy(CONFIGS / "example_dome_48.lp", tmp / "example_dome_48.lp")
+    path = tmp / "sequence_dome.toml"
+    path.write_text(head + device + tail)
+    return path
+
+
+@pytest.fixture
+def dome(monkeypatch):
+    settings = load_rig_config(SOURCE).config.dome.serial
+    firmware = firmware_for(settings, led_count=48, clock=SystemClock())
+    real = serial.serial_for_url
+    with emulated_dome_on_pty(firmware) as link:
+
+        def redirect(url, *args, **kwargs):  # type: ignore[no-untyped-def]
+            return real(link.port if url == settings.port else url, *args, **kwargs)
+
+        monkeypatch.setattr(serial, "serial_for_url", redirect)
+        yield firmware
+
+
+def test_a_session_shot_from_an_image_sequence_is_not_resumed(dome, tmp_path: Path) -> None:
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i in range(5):  # five files for eight lights: the sequence runs out at the sixth
+        cv2.imwrite(str(frames / f"f_{i:03d}.png"), np.full((24, 32, 3), 40 + 30 * i, np.uint8))
+    config = _config(tmp_path, frames)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(config), "--out", str(out), "--lights", "8"])
+    assert r.exit_code != 0, r.output
+    stopped = " ".join(r.output.split())
+    assert "--resume" not in stopped, stopped  # it had said "Continue with: rti-rig run --resume"
+    assert "It cannot be resumed: its camera is an image sequence" in stopped, stopped
+    assert sorted(p.name for p in out.glob("image_*.jpg"))[-1:] == ["image_005.jpg"], r.output
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    verdict = " ".join(r.output.split())
+    assert "the session is not finished" in verdict, verdict
+    assert "--resume" not in verdict, verdict  # it had said "continue it with rti-rig run --resume"
+    assert "its camera is an image sequence" in verdict, verdict
+    shutil.rmtree(tmp_path / "fit", ignore_errors=True)
+    for i in range(5, 8):  # the user adds the files the run lacked, then resumes
+        cv2.imwrite(str(frames / f"f_{i:03d}.png"), np.full((24, 32, 3), 200, np.uint8))
+    before = sorted((p.relative_to(out), p.read_bytes()) for p in out.rglob("*") if p.is_file())
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 2, r.output
+    said = " ".join(r.output.split())
+    assert "image sequence" in said and "backend = 'images'" in said, said
+    assert "this session cannot be resumed (nothing was changed)" in said, said
+    assert "from its first file" in said, said
+    assert f"rti-rig run {config} --out NEWDIR" in said, said
+    assert "Traceback" not in r.output
+    after = sorted((p.relative_to(out), p.read_bytes()) for p in out.rglob("*") if p.is_file())
+    assert after == before  # refused before the folder was touched
