@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from hypothesis import HealthCheck, settings
@@ -18,6 +21,29 @@ settings.load_profile("rti-rig")
 
 REPO = Path(__file__).resolve().parent.parent
 CONFIGS = REPO / "rig_configs"
+
+
+@contextlib.contextmanager
+def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterator[Any]:
+    """The dome firmware a hardware config names (48 LEDs), emulated on a pty, the config's
+    port redirected there: everything above ``serial.serial_for_url`` is the real stack, as
+    a user's command builds it from the file. Yields the emulated firmware (its history)."""
+    import serial
+
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.core.clock import SystemClock
+    from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
+
+    serial_settings = load_rig_config(config).config.dome.serial
+    firmware = firmware_for(serial_settings, led_count=48, clock=SystemClock())
+    real = serial.serial_for_url
+    with emulated_dome_on_pty(firmware) as link:
+
+        def redirect(url, *args, **kwargs):  # type: ignore[no-untyped-def]
+            return real(link.port if url == serial_settings.port else url, *args, **kwargs)
+
+        monkeypatch.setattr(serial, "serial_for_url", redirect)
+        yield firmware
 
 
 @pytest.fixture

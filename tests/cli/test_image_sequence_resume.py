@@ -15,14 +15,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-import serial
-from conftest import CONFIGS
+from conftest import CONFIGS, shipped_dome_on_pty
 from typer.testing import CliRunner
 
-from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
-from rti_rig.core.clock import SystemClock
-from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 
 pytestmark = [pytest.mark.pty, pytest.mark.e2e]
 
@@ -47,16 +43,8 @@ def _config(tmp: Path, frames: Path) -> Path:
 
 
 @pytest.fixture
-def dome(monkeypatch):
-    settings = load_rig_config(SOURCE).config.dome.serial
-    firmware = firmware_for(settings, led_count=48, clock=SystemClock())
-    real = serial.serial_for_url
-    with emulated_dome_on_pty(firmware) as link:
-
-        def redirect(url, *args, **kwargs):  # type: ignore[no-untyped-def]
-            return real(link.port if url == settings.port else url, *args, **kwargs)
-
-        monkeypatch.setattr(serial, "serial_for_url", redirect)
+def dome(monkeypatch):  # type: ignore[no-untyped-def]
+    with shipped_dome_on_pty(monkeypatch, SOURCE) as firmware:
         yield firmware
 
 

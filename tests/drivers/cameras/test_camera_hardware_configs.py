@@ -17,17 +17,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import serial
-from conftest import CONFIGS
+from conftest import CONFIGS, shipped_dome_on_pty
 from dng_spec_writer import dng, mosaic_from_rgb, srgb8
 from fake_gphoto2 import Body, make_module
 from typer.testing import CliRunner
 
-from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.core.clock import SystemClock
 from rti_rig.core.image_files import read_jpeg_rgb, read_linear_tiff
-from rti_rig.simulator.dome_firmware import emulated_dome_on_pty, firmware_for
 
 pytestmark = [pytest.mark.pty, pytest.mark.e2e]
 
@@ -47,17 +44,7 @@ def patch_level(led: int | None) -> float:
 @pytest.fixture
 def dome(monkeypatch, request):
     """The shipped config's dome firmware on a pty; its configured port is redirected there."""
-    path = getattr(request, "param", DSLR_CONFIG)
-    settings = load_rig_config(path).config.dome.serial
-    firmware = firmware_for(settings, led_count=48, clock=SystemClock())
-    real = serial.serial_for_url
-
-    with emulated_dome_on_pty(firmware) as link:
-
-        def redirect(url, *args, **kwargs):
-            return real(link.port if url == settings.port else url, *args, **kwargs)
-
-        monkeypatch.setattr(serial, "serial_for_url", redirect)
+    with shipped_dome_on_pty(monkeypatch, getattr(request, "param", DSLR_CONFIG)) as firmware:
         yield firmware
 
 
