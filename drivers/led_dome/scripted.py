@@ -255,6 +255,16 @@ class ScriptedDomeDriver:
         return self._open
 
     @property
+    def light_window_s(self) -> float | None:
+        """How long a lit LED stays lit before the firmware switches it off by itself (a
+        timed firmware's window, RTIPy's ``T,x,y,secs``), None when it stays lit until told.
+
+        The policy's lit limit is the shorter of this and ``max_on_s``: a busy camera awaited
+        up to ``max_on_s`` under RTIPy had fired after its LED had gone dark by itself."""
+        window = self.spec.window_s
+        return None if window is None else float(window)
+
+    @property
     def profile_heard(self) -> bool:
         """Since the port was last opened, the board printed what only this firmware prints:
         its ready text, its reboot text, or a reply matching the description. The policy resends

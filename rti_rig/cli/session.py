@@ -795,11 +795,12 @@ def _light_off_for_camera(event) -> str:  # type: ignore[no-untyped-def]
         if event.cool_s >= 0.05
         else ""
     )
+    # the limit said is what sets it: max_on_s, or a timed firmware's own window (RTIPy)
+    limit = event.limit or f"max_on_s = {event.max_on_s:g} s"
     return (
         f"Image {event.index + 1}: the camera is still busy (writing its previous shot?) and "
         f"its next try, in {event.wait_s:g} s, would keep {light} (lit {event.lit_s:.1f} s) on "
-        f"past max_on_s = {event.max_on_s:g} s: {off}; it is lit again for the shot after "
-        f"that wait{cool}."
+        f"past {limit}: {off}; it is lit again for the shot after that wait{cool}."
     )
 
 

@@ -82,6 +82,8 @@ class DomeLink(Protocol):
     echoes_light: bool
     #: Highest PWM level the firmware takes.
     max_level: int
+    # Optional: ``light_window_s`` (float | None), how long the firmware keeps an LED lit
+    # before it switches it off by itself (a timed firmware); read with ``getattr``.
 
     def connect(self) -> DomeInfo:
         """Open the port, wait for the ready banner, handshake."""

@@ -140,8 +140,12 @@ class LightOffForCamera:
     wait_s: float
     #: how long the light must cool after that wait before its duty limit lets it light
     cool_s: float
-    #: how long the light may stay lit (the dome's ``max_on_s``)
+    #: how long the light may stay lit (the dome's ``max_on_s``, or a timed firmware's
+    #: shorter window)
     max_on_s: float
+    #: what sets that limit, as a message names it ("max_on_s = 8 s", or the timed
+    #: firmware's window: RTIPy's LED goes dark by itself after ``light_on_s``)
+    limit: str = ""
 
 
 Event = StepStarted | StepCompleted | Paused | LightOffForCamera
@@ -226,12 +230,15 @@ def shoot_step(
     return the frame and the times its light was switched off and lit again meanwhile.
 
     A camera that answers busy (a DSLR writing its previous shot to a slow card) is awaited
-    with the light lit only as long as the light may stay lit (the dome's ``max_on_s``, less
-    the exposure and ``timing.readout_s``, from ``lit_at``). Past that the light is switched
-    off (thermal duty first), the camera is awaited in the dark for its next try, and the same
-    light is lit again and settled before the camera is asked again: the image is always the
-    one taken under the lit light, since the camera is only ever fired with it lit, and its
-    light goes off only once the exposure is over or the camera has refused the shot. The
+    with the light lit only as long as the light may stay lit (the dome's ``max_on_s``, or a
+    timed firmware's shorter window, RTIPy's ``light_on_s``, after which its LED is dark
+    whatever the host does; less the exposure and ``timing.readout_s``, from ``lit_at``).
+    Past that the light is switched off (thermal duty first; a timed firmware is left to
+    switch it off), the camera is awaited in the dark for its next try, and the same light is
+    lit again (on RTIPy a new timed command) and settled before the camera is asked again:
+    the image is always the one taken under the lit light, since the camera is only ever
+    fired with it lit, and its light goes off only once the exposure is over or the camera
+    has refused the shot. The
     whole wait is bounded by the camera's own retry settings (``busy_retries`` and its
     back-off); a camera still busy then stops the session, which ``--resume`` continues. The
     dome's thermal guard may add a cool-down before a relight. Until 2026-11-29 a camera busy
@@ -252,6 +259,14 @@ def lit_limit_s(rig: Rig) -> float | None:
     """How long the rig's light may stay lit at a time (a dome's ``max_on_s``), or None."""
     limit_of = getattr(rig.lighting, "lit_limit_s", None)
     return limit_of() if limit_of is not None else None
+
+
+def lit_limit_said(rig: Rig) -> str:
+    """What sets :func:`lit_limit_s`, as a message names it (``max_on_s = 8 s``)."""
+    said_of = getattr(rig.lighting, "lit_limit_said", None)
+    if said_of is not None:
+        return str(said_of())
+    return f"max_on_s = {lit_limit_s(rig):g} s"
 
 
 def fire_lit(
@@ -289,6 +304,7 @@ def fire_lit(
                         "wait_s": busy.retry_in_s,
                         "cool_s": cool_s,
                         "max_on_s": limit,
+                        "limit": lit_limit_said(rig),
                     }
                 )
             clock.sleep(busy.retry_in_s)

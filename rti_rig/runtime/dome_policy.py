@@ -615,6 +615,28 @@ class DomePolicy:
         ms = self.settings.shutter_pulse_ms if pulse_ms is None else int(pulse_ms)
         self._run(lambda: self.link.shutter(ms), f"shutter pulse {ms} ms", idempotent=False)
 
+    def lit_limit_s(self) -> float:
+        """How long one LED may stay lit at a time: ``max_on_s``, or the firmware's own window
+        where it switches the LED off by itself sooner (RTIPy lights for ``light_on_s`` whole
+        seconds). A busy camera awaited for ``max_on_s`` under RTIPy had been fired after its
+        LED had gone dark by itself, and the all-off then refused the image late."""
+        limit = self.settings.thermal.max_on_s
+        window = getattr(self.link, "light_window_s", None)
+        return limit if window is None else min(limit, float(window))
+
+    def lit_limit_said(self) -> str:
+        """What sets :meth:`lit_limit_s`, for a message: ``max_on_s = 8 s``, or the timed
+        firmware's window (``the 2 s the rtipy firmware keeps it lit (light_on_s)``)."""
+        limit = self.settings.thermal.max_on_s
+        window = getattr(self.link, "light_window_s", None)
+        if window is None or window >= limit:
+            return f"max_on_s = {limit:g} s"
+        firmware = getattr(getattr(self.link, "spec", None), "name", None) or "dome's"
+        return (
+            f"the {float(window):g} s the {firmware} firmware keeps it lit before switching it "
+            "off by itself (light_on_s)"
+        )
+
     def lit_state(self) -> tuple[int | None, int]:
         """What the firmware itself says is lit (index or None, level)."""
         self._require_connected("query")

@@ -91,13 +91,24 @@ class DomeLighting:
         self.source.all_off()
 
     def lit_limit_s(self) -> float | None:
-        """How long one LED may stay lit (the thermal guard's ``max_on_s``), None when the
-        source sets no limit (a simulated dome).
+        """How long one LED may stay lit (the thermal guard's ``max_on_s``, or a timed
+        firmware's shorter window: the LED is dark after it whatever the host does), None
+        when the source sets no limit (a simulated dome).
 
         The controller switches the LED off while a busy camera is awaited past this, and
         lights it again for the shot (:func:`rti_rig.runtime.controller.shoot_step`)."""
+        own = getattr(self.source, "lit_limit_s", None)
+        if own is not None:
+            return float(own())
         thermal = getattr(getattr(self.source, "settings", None), "thermal", None)
         return None if thermal is None else float(thermal.max_on_s)
+
+    def lit_limit_said(self) -> str:
+        """What sets :meth:`lit_limit_s`, as a message names it (``max_on_s = 8 s``)."""
+        own = getattr(self.source, "lit_limit_said", None)
+        if own is not None:
+            return str(own())
+        return f"max_on_s = {self.lit_limit_s():g} s"
 
     def cool_down_s(self, step: LightStep, at: float) -> float:
         """How long after ``at`` (on the rig's clock) the step's LED must still cool before

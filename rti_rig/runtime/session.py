@@ -797,9 +797,10 @@ def session_notices(records: list[StepRecord]) -> list[str]:
         if r.relit:
             n = (
                 "the camera was still busy (writing its previous shot?) when its next try "
-                "would have kept the LED lit past max_on_s: the LED was switched off while the "
-                "camera was awaited and lit again for the image (the journal's 'relit' says "
-                "how long, and whether the dome acknowledged each all-off)"
+                "would have kept the LED lit past the time it may stay lit (max_on_s, or a "
+                "timed firmware's own light_on_s): the LED was switched off while the camera "
+                "was awaited and lit again for the image (the journal's 'relit' says how long, "
+                "and whether the dome acknowledged each all-off)"
             )
             counts[n] = counts.get(n, 0) + 1
         if r.decode.get("mode") == "mosaic":
