@@ -802,35 +802,72 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     return loaded
 
 
+#: ``[camera.device]`` kinds whose driver says when its exposure is over (an
+#: ``ExposingCamera``): the controller switches the LED off then, before the download.
+EXPOSING_CAMERA_KINDS = frozenset({"gphoto2", "folder_watch"})
+
+
+def lit_per_shot(rig: LoadedRig) -> tuple[float, bool]:
+    """(seconds an LED stays lit for one shot besides its exposure, whether that counts the
+    transfer).
+
+    The settle before the exposure and the readout after it always; and the transfer too for
+    a camera that cannot say when its exposure is over (a dry run's simulated camera, an OpenCV
+    camera): the LED goes off only once its frame is in hand. Without the transfer the check
+    below had passed a dry-run config whose every capture overran max_on_s ("LED 0 stayed on
+    1.153 s, beyond max_on_s = 0.46 s"), found after the dome was opened and lit."""
+    t = rig.config.timing
+    device = rig.config.camera.device or {}
+    held = device.get("kind") not in EXPOSING_CAMERA_KINDS
+    return t.settle_s + t.readout_s + (t.transfer_s if held else 0.0), held
+
+
+def shot_said(rig: LoadedRig, exposure_key: str, exposure_s: float) -> tuple[float, str]:
+    """(seconds an LED stays lit for a shot of ``exposure_s``, the sum said with its keys:
+    ``timing.settle_s 0.2 + camera.exposure_s 2 + timing.readout_s 0.5 = 2.7 s``)."""
+    t = rig.config.timing
+    fixed, held = lit_per_shot(rig)
+    total = fixed + exposure_s
+    text = (
+        f"timing.settle_s {t.settle_s:g} + {exposure_key} {exposure_s:g} + timing.readout_s "
+        f"{t.readout_s:g}"
+    )
+    if held:
+        text += (
+            f" + timing.transfer_s {t.transfer_s:g} (this camera cannot say when its exposure "
+            "is over, so its LED stays lit until the frame is in)"
+        )
+    return total, f"{text} = {total:.3g} s"
+
+
 def _check_exposure_fits_lit(rig: LoadedRig, serial: Any) -> None:
     """Refuse a ``[camera] exposure_s`` whose shot cannot end while its LED is lit.
 
     An LED may stay lit ``[dome.serial.thermal] max_on_s`` at a time, and a shot takes the
-    settle before it and the camera's readout after it: with more, every capture overran the
-    thermal limit and the session stopped at its first image with the LED lit all along
-    ("LED 0 stayed on 2.2 s, beyond max_on_s = 2 s"), after the dome had been opened and lit.
+    settle before it and the camera's readout after it (:func:`lit_per_shot`): with more, every
+    capture overran the thermal limit and the session stopped at its first image with the LED
+    lit all along ("LED 0 stayed on 2.2 s, beyond max_on_s = 2 s"), after the dome had been
+    opened and lit.
     """
-    t = rig.config.timing
     cam = rig.config.camera
     max_on = serial.thermal.max_on_s
-    room = max_on - t.settle_s - t.readout_s
+    fixed, _ = lit_per_shot(rig)
+    room = max_on - fixed
     if cam.exposure_s <= room + 1e-9:
         return
-    total = t.settle_s + cam.exposure_s + t.readout_s
+    _, said = shot_said(rig, "camera.exposure_s", cam.exposure_s)
     shorten = (
         f"shorten exposure_s to at most {room:.3g} s (or raise the ISO or open the aperture)"
         if room >= cam.min_exposure_s
-        else "shorten timing.settle_s and the exposure"
+        else "shorten the [timing] keys and the exposure"
     )
     raise ConfigError(
         rig.path,
         "camera.exposure_s",
         f"{cam.exposure_s:g} s does not fit: an LED may stay lit at most "
-        f"[dome.serial.thermal] max_on_s = {max_on:g} s, and each shot (timing.settle_s "
-        f"{t.settle_s:g} + camera.exposure_s {cam.exposure_s:g} + timing.readout_s "
-        f"{t.readout_s:g} = {total:.3g} s) must end while its LED is lit; every capture would "
-        f"stop the session at the thermal limit. Either {shorten}, or raise max_on_s if the "
-        "LEDs allow it",
+        f"[dome.serial.thermal] max_on_s = {max_on:g} s, and each shot ({said}) must end while "
+        f"its LED is lit; every capture would stop the session at the thermal limit. Either "
+        f"{shorten}, or raise max_on_s if the LEDs allow it",
     )
 
 
