@@ -7,6 +7,7 @@ CLI only parses its options into a request, calls these functions and prints wha
 
 from __future__ import annotations
 
+import math
 import shlex
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -262,6 +263,48 @@ def _check_timed_window(loaded, schedule: LightSchedule) -> None:  # type: ignor
         )
 
 
+def _check_steps_fit_lit(  # type: ignore[no-untyped-def]
+    loaded, schedule: LightSchedule, done: frozenset[int] = frozenset()
+) -> None:
+    """Refuse the steps' own exposures (a metered session's, resumed) whose shot cannot end
+    while its LED is lit, ``[dome.serial.thermal] max_on_s``, before the port opens.
+
+    Why: the config's exposure_s is checked when it loads, the steps' were not. A session
+    metered at 0.084 s and resumed after max_on_s was lowered to 1.17 s opened the dome, lit
+    LED 21 and stopped at the thermal guard ("LED 21 stayed on 1.186 s, beyond max_on_s =
+    1.17 s; the firmware watchdog switched it off"), then said to resume, which did the same.
+    """
+    from rti_rig.app.config import lit_per_shot, shot_said
+    from rti_rig.core.errors import ScheduleError
+
+    dome = loaded.config.dome
+    serial = dome.serial if dome is not None else None
+    if serial is None:
+        return
+    max_on = serial.thermal.max_on_s
+    fixed, _ = lit_per_shot(loaded)
+    over = [
+        (i, step)
+        for i, step in enumerate(schedule.steps)
+        if i not in done and step.exposure_s is not None and fixed + step.exposure_s > max_on + 1e-9
+    ]
+    if not over:
+        return
+    i, step = over[0]
+    led = f" (LED {step.led})" if step.led is not None else ""
+    _, said = shot_said(loaded, "its exposure_s", round(step.exposure_s or 0.0, 6))
+    need = math.ceil((fixed + max(s.exposure_s or 0.0 for _, s in over)) * 100) / 100
+    steps = ", ".join(str(j + 1) for j, _ in over[:10]) + (" ..." if len(over) > 10 else "")
+    raise ScheduleError(
+        f"{len(over)} step(s) to shoot expose too long for an LED that may stay lit at most "
+        f"[dome.serial.thermal] max_on_s = {max_on:g} s ({loaded.path}): step {i + 1}{led}, "
+        f"{said}, would run into the thermal limit (step(s) {steps}); nothing has moved. A "
+        "step's exposure_s is the schedule's own (fixed when the session began, by "
+        "--auto-exposure), which the session's images share: raise max_on_s to at least "
+        f"{need:g} s if the LEDs allow it, or shorten the [timing] keys"
+    )
+
+
 def fix_exposure(
     rig: Rig, schedule: LightSchedule, max_saturated: float, on_note: NoteSink = _ignore
 ) -> LightSchedule:
@@ -477,6 +520,7 @@ def _open_new(
     if auto_exposure:
         refuse_unmeterable_rig(loaded)
     identity = rig_identity(loaded)
+    _check_steps_fit_lit(loaded, schedule)
     rig = checked_rig(loaded, schedule)
     try:
         if auto_exposure:
@@ -970,6 +1014,8 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         on_note(Note(f"{line}: set aside in recovered/, not appended onto", "warning"))
     for line in resume.journal_rebuild if resume else []:
         on_note(Note(line, "warning"))
+    # the steps still to shoot, at their own exposures, before the port opens
+    _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
     rig = checked_rig(loaded, schedule)
     source = None
     if "adaptive" in folder.manifest:
