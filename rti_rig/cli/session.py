@@ -168,10 +168,10 @@ def run(
     """Run a capture session: a dry run on a simulated or emulated rig or a recorded
     acquisition's .lp, the real rig otherwise.
 
-    Ctrl-C once stops after the current image; Ctrl-C twice or SIGTERM stops at once (lights
-    off, arm stopped, and parked if the config says park_on_emergency_stop = true); SIGUSR1
-    pauses or resumes between images. An interrupted session can be
-    continued with --resume.
+    Ctrl-C once stops after the current image (before it, its light left off, while a busy
+    camera is awaited in the dark); Ctrl-C twice or SIGTERM stops at once (lights off, arm
+    stopped, and parked if the config says park_on_emergency_stop = true); SIGUSR1 pauses or
+    resumes between images. An interrupted session can be continued with --resume.
     """
     from rti_rig.app.usecases.session import (
         NewSessionRequest,

@@ -93,6 +93,20 @@ class CancelToken:
             time.sleep(poll_s)
 
 
+class StepAbandoned(Exception):
+    """The run was cancelled (Ctrl-C) while a busy camera was awaited with the step's light
+    off: the step is left untaken, to be shot by a resume, rather than lit again for it.
+
+    Why: the cancel is acted on between steps, and that wait (the camera's next try, then any
+    cool-down the dome's duty limit asks, up to a minute) ended with the light lit again and
+    the shot taken before the run stopped; a user who pressed Ctrl-C waited for a shot they
+    had asked not to take."""
+
+
+#: How often a wait in the dark looks at the cancel (seconds of the rig's clock).
+DARK_POLL_S = 0.1
+
+
 @dataclass(frozen=True)
 class Paused:
     index: int
@@ -225,6 +239,7 @@ def shoot_step(
     exposure_s: float,
     lit_at: float,
     on_dark: Callable[[dict[str, Any]], None] | None = None,
+    cancelled: Callable[[], bool] | None = None,
 ) -> tuple[Frame, list[dict[str, Any]]]:
     """Capture the image of ``step``, lit at ``lit_at`` and settled, and switch its light off;
     return the frame and the times its light was switched off and lit again meanwhile.
@@ -246,12 +261,14 @@ def shoot_step(
     then ran into the thermal limit.
 
     ``on_dark`` is told each time the light goes off (how long it was lit, what the all-off
-    established, how long the camera is awaited), before that wait.
+    established, how long the camera is awaited), before that wait. ``cancelled`` is asked
+    through each wait in the dark: once it says so the step is abandoned with its light off
+    (:class:`StepAbandoned`), never lit again for it.
     """
     camera = rig.camera
     if lit_limit_s(rig) is None or not isinstance(camera, BusyAwareCamera):
         return shoot_lit(rig, exposure_s), []
-    ended, relit = fire_lit(rig, step, exposure_s, lit_at, on_dark)
+    ended, relit = fire_lit(rig, step, exposure_s, lit_at, on_dark, cancelled)
     return _finish_shot(rig, ended), relit
 
 
@@ -275,10 +292,12 @@ def fire_lit(
     exposure_s: float,
     lit_at: float,
     on_dark: Callable[[dict[str, Any]], None] | None = None,
+    cancelled: Callable[[], bool] | None = None,
 ) -> tuple[float | None, list[dict[str, Any]]]:
     """Fire a :class:`BusyAwareCamera` under ``step``'s light, lit at ``lit_at`` and settled,
     by :func:`shoot_step`'s rules; the light is left lit. Returns when the exposure ended (as
-    ``expose`` does) and the relights."""
+    ``expose`` does) and the relights; raises :class:`StepAbandoned`, the light off, when
+    ``cancelled`` says so during a wait in the dark."""
     camera = rig.camera
     assert isinstance(camera, BusyAwareCamera)
     limit = lit_limit_s(rig)
@@ -307,7 +326,12 @@ def fire_lit(
                         "limit": lit_limit_said(rig),
                     }
                 )
-            clock.sleep(busy.retry_in_s)
+            _wait_dark(rig, clock.now() + busy.retry_in_s, cancelled)
+            cool_of = getattr(rig.lighting, "cool_down_s", None)
+            if cool_of is not None and cancelled is not None:
+                # the cool-down the thermal guard would wait in ``set``, waited here where a
+                # cancel is seen (it may be a minute)
+                _wait_dark(rig, clock.now() + cool_of(step, clock.now()), cancelled)
             rig.lighting.set(step)  # the thermal guard may let the LED cool first
             relit.append(
                 {
@@ -321,6 +345,19 @@ def fire_lit(
             )
             lit_at = clock.now()
             clock.sleep(rig.timing.settle_s)
+
+
+def _wait_dark(rig: Rig, until: float, cancelled: Callable[[], bool] | None) -> None:
+    """Wait on the rig's clock until ``until``, the light off; raise :class:`StepAbandoned` as
+    soon as ``cancelled`` says so (looked at every :data:`DARK_POLL_S`)."""
+    clock = rig.clock
+    while True:
+        if cancelled is not None and cancelled():
+            raise StepAbandoned("cancelled while the camera was awaited with the light off")
+        left = until - clock.now()
+        if left <= 0:
+            return
+        clock.sleep(left if cancelled is None else min(left, DARK_POLL_S))
 
 
 def validate_schedule(rig: Rig, schedule: LightSchedule) -> None:
@@ -483,13 +520,24 @@ def run_session(
             t_lit = clock.now()
             clock.sleep(rig.timing.settle_s)
             t_settled = clock.now()
-            frame, relit = shoot_step(
-                rig,
-                step,
-                step_exposure(rig, step),
-                t_lit,
-                lambda dark, i=i, led=step.led: emit(LightOffForCamera(i, total, led, **dark)),
-            )
+            try:
+                frame, relit = shoot_step(
+                    rig,
+                    step,
+                    step_exposure(rig, step),
+                    t_lit,
+                    lambda dark, i=i, led=step.led: emit(LightOffForCamera(i, total, led, **dark)),
+                    lambda: cancel.cancelled,
+                )
+            except StepAbandoned:
+                # the light is off and nothing of this step was recorded: the resume takes it
+                end_notes.append(
+                    f"image {i + 1} was not taken: the run was cancelled while its camera was "
+                    "still busy and awaited with its light off, so its light was not lit again "
+                    "for it; a resume takes it first"
+                )
+                reason = FinishReason.CANCELLED
+                break
             t_captured = clock.now()
             got = frame_layout(frame)
             if layout is not None and got != layout:

@@ -261,3 +261,87 @@ def test_metering_a_dark_object_chooses_no_exposure_longer_than_an_led_may_stay_
     assert "The exposure, 2 s, is the longest the metering could choose" in said
     assert "leaves 7.6 s ([dome.serial.thermal] max_on_s = 8 s" in said
     assert "not the camera's max_exposure_s = 30 s" in said
+
+
+def test_a_cancel_while_the_camera_is_awaited_in_the_dark_stops_there_its_led_left_off(
+    tmp_path,
+):
+    """Ctrl-C (the run's cancel) as the LED goes off for a busy camera, at max_duty = 0.2: the
+    wait ahead is the camera's 4 s and some 56 s of cool-down. The run had waited it all, lit
+    the LED again and taken the shot before stopping; it now stops there, the LED left off,
+    the step not recorded (a resume takes it), and says so."""
+    from rti_rig.runtime.controller import CancelToken
+
+    rig, body, lit_at_shots = dslr_rig(tmp_path, max_duty=0.2, busy_retries=6, retry_delay_s=1.0)
+    body.busy_for_s = 10.0
+    cancel = CancelToken()
+    dark: list[LightOffForCamera] = []
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, LightOffForCamera):
+            dark.append(event)
+            cancel.cancel()  # what the Ctrl-C handler does
+
+    out = tmp_path / "s"
+    with rig:
+        result = run_session(
+            rig,
+            schedule_of(rig),
+            SessionFolder.create(out, len(LEDS)),
+            cancel=cancel,
+            on_event=on_event,
+        )
+    assert result.finish_reason is FinishReason.CANCELLED, result.error
+    (event,) = dark
+    assert event.index == 1 and event.cool_s > 50.0
+    # one picture, the first step's; the second step's LED lit once, switched off, never again
+    assert lit_at_shots == [LEDS[0]] and body.shots == 1
+    history = [(ev.what, ev.index) for ev in rig.emulator.history if ev.what in ("lit", "off")]  # type: ignore[attr-defined]
+    assert history == [("lit", LEDS[0]), ("off", LEDS[0]), ("lit", LEDS[1]), ("off", LEDS[1])]
+    assert rig.emulator.lit is None  # type: ignore[attr-defined]
+    assert [e["index"] for e in journal(out)] == [0]
+    (note,) = result.notes
+    assert note.startswith("image 2 was not taken: the run was cancelled while its camera")
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] == "cancelled"
+
+
+def test_a_cancel_during_the_cool_down_before_a_relight_stops_there(tmp_path):
+    """The cancel comes after the camera's wait, in the cool-down the duty limit asks before
+    the LED may light again (the thermal guard had waited it inside the relight, deaf to it)."""
+    from rti_rig.runtime.controller import CancelToken
+
+    rig, body, lit_at_shots = dslr_rig(tmp_path, max_duty=0.2, busy_retries=6, retry_delay_s=1.0)
+    body.busy_for_s = 10.0
+    cancel = CancelToken()
+    dark: list[float] = []
+    clock = rig.clock
+    real_sleep = clock.sleep
+
+    def sleep(seconds: float) -> None:
+        real_sleep(seconds)
+        # 10 s of rig time into the dark: past the camera's 4 s, inside the cool-down
+        if dark and clock.now() > dark[0] + 10.0:
+            cancel.cancel()
+
+    clock.sleep = sleep  # type: ignore[method-assign]
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, LightOffForCamera):
+            dark.append(clock.now())
+
+    out = tmp_path / "s"
+    with rig:
+        result = run_session(
+            rig,
+            schedule_of(rig),
+            SessionFolder.create(out, len(LEDS)),
+            cancel=cancel,
+            on_event=on_event,
+        )
+    assert result.finish_reason is FinishReason.CANCELLED
+    assert lit_at_shots == [LEDS[0]] and body.shots == 1
+    lit = [ev.index for ev in rig.emulator.history if ev.what == "lit"]  # type: ignore[attr-defined]
+    assert lit == [LEDS[0], LEDS[1]]  # never lit again for the abandoned step
+    assert clock.now() < dark[0] + 10.0 + 1.0  # stopped within a poll of the cancel, not ~56 s
+    assert [e["index"] for e in journal(out)] == [0]

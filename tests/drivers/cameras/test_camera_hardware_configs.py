@@ -323,3 +323,42 @@ def test_check_fails_a_session_exposure_the_camera_does_not_offer(body, tmp_path
     body.choices["shutterspeed"] = [*NO_EIGHTH, "1/8"]
     result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
     assert result.exit_code == 0 and "RESULT: PASS" in result.output, result.output
+
+
+@pytest.mark.slow
+def test_ctrl_c_while_a_busy_dslr_is_awaited_in_the_dark_stops_there_and_resumes(
+    body, dome, tmp_path, monkeypatch
+):
+    """Ctrl-C as image 2's LED goes off for a body still busy: the run had waited for the
+    camera, lit the LED again and taken the shot before stopping (with a cool-down, up to a
+    minute). It stops there now: the LED left off, image 2 not recorded, said, and the resume
+    takes it. The signal is sent from inside the process as the LED goes off (no timing)."""
+    import os
+    import signal
+
+    import rti_rig.cli.session as cli_session
+
+    body.busy_after_shot = 4
+    real_said = cli_session._light_off_for_camera
+
+    def ctrl_c_as_the_led_goes_off(event):  # type: ignore[no-untyped-def]
+        os.kill(os.getpid(), signal.SIGINT)
+        return real_said(event)
+
+    monkeypatch.setattr(cli_session, "_light_off_for_camera", ctrl_c_as_the_led_goes_off)
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "3")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 130, result.output
+    assert [e["index"] for e in journal(out)] == [0] and body.shots == 1
+    led = json.loads((out / "manifest.json").read_text())["schedule"]["steps"][1]["led"]
+    log = [(e.what, e.index) for e in dome.history if e.what in ("lit", "off")]
+    assert log[-2:] == [("lit", led), ("off", led)] and dome.lit is None
+    assert "image 2 was not taken: the run was cancelled while its camera was still busy" in said
+    assert "acknowledged by the dome: lights are off" in said
+    assert f"Continue with: rti-rig run --resume {out}" in said
+
+    monkeypatch.setattr(cli_session, "_light_off_for_camera", real_said)
+    result = run("--resume", str(out))
+    assert result.exit_code == 0, result.output
+    check_images(out, 3)  # each image as bright as its own LED: none taken in the dark
