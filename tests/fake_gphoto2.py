@@ -11,9 +11,10 @@ GP_FILE_TYPE_NORMAL)`` → a CameraFile with ``save(path)``, ``file_delete``; er
 
 Quirks of real bodies it reproduces (from gphoto/libgphoto2 issue threads, see
 /work/shared/reference/hardware-notes.md §5): "busy" right after a shot (for a number of
-tries, or for a time as a body writing to a slow card is: it takes no picture meanwhile), a
-body switched off or unplugged (every call then fails with -7 and autodetect finds nothing), a
-card that fills up, a file counter that wraps (IMG_9999 → IMG_0001) or a RAM target that
+tries, or for a time as a body writing to a slow card is: it takes no picture meanwhile; or,
+pibooth #466, busy yet the picture taken, its file announced by event at once or at the next
+shot), a body switched off or unplugged (every call then fails with -7 and autodetect finds
+nothing), a card that fills up, a file counter that wraps (IMG_9999 → IMG_0001) or a RAM target that
 names every shot the same (Nikon's ``capt0000.nef``), RAW+JPEG delivered as two files, the
 second through a FILE_ADDED event (some bodies also announce the first one, and end with
 CAPTURE_COMPLETE), several bodies on the bus, and a setting that does not latch (the mode dial
@@ -79,6 +80,14 @@ class Body:
     #: op name → error codes raised by its next calls, in order
     failures: dict[str, list[int]] = field(default_factory=dict)
     busy_after_shot: int = 0  # the next N captures after a shot answer -110 first
+    #: of those busy answers, the next N took the picture all the same (the shutter fired, the
+    #: file is written and announced by a FILE_ADDED event, yet capture answered -110), as
+    #: bodies do whose release times out while the shot goes on (pibooth #466)
+    busy_yet_shot: int = 0
+    #: such a picture is announced only once the next shot is taken (a body still writing it)
+    stray_announced_late: bool = False
+    #: the camera file names of the pictures taken behind a busy answer
+    stray_files: list[str] = field(default_factory=list)
     #: a slow card: every capture answers -110 (and takes no picture) until ``busy_for_s`` of
     #: ``busy_clock`` time have passed since the last shot (PTP Device Busy, gphoto2 #308)
     busy_for_s: float = 0.0
@@ -200,6 +209,41 @@ def make_module(body: Body) -> types.ModuleType:
             with open(target, "wb") as fh:
                 fh.write(self._data)
 
+    def take_picture(announce_all: bool = False) -> CameraFilePath:
+        """The shutter fires: the files are written and announced (``announce_all``: all
+        of them by event, for a picture whose capture answered busy)."""
+        store = body.store()
+        fmt = body.config["imageformat"]
+        stem = body.next_stem()
+        files = []
+        if "RAW" in fmt:
+            files.append(stem + body.raw_suffix)
+        if "JPEG" in fmt:
+            files.append(stem + ".JPG")
+        if body.clock is not None:  # the shutter is open for its time, then the file named
+            body.clock.sleep(shutter_s(body.config["shutterspeed"]))
+        raw_data = body.render(body)
+        for name in files:
+            store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"
+        if store is body.card:
+            body.card_free_shots -= 1
+        body.shots += 1
+        body._busy = body.busy_after_shot
+        if body.busy_for_s:
+            body._busy_until = body.busy_clock.now() + body.busy_for_s
+        if body.jpeg_first:
+            files.sort(key=lambda n: not n.endswith(".JPG"))
+        folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"
+        for name in files if body.announce_first or announce_all else files[1:]:
+            event = (GP_EVENT_FILE_ADDED, CameraFilePath(folder, name))
+            if name != files[0] and body.second_file_quiet_waits:
+                body._late.append([body.second_file_quiet_waits, event])
+            else:
+                body._events.append(event)
+        if body.capture_complete_event:
+            body._events.append((GP_EVENT_CAPTURE_COMPLETE, None))
+        return CameraFilePath(folder, files[0])
+
     class Camera:
         @staticmethod
         def autodetect() -> list[tuple[str, str]]:
@@ -234,6 +278,16 @@ def make_module(body: Body) -> types.ModuleType:
                 body.check("capture")
                 if body._busy:
                     body._busy -= 1
+                    if body.busy_yet_shot:
+                        body.busy_yet_shot -= 1
+                        still_busy = body._busy
+                        stray = take_picture(announce_all=True)
+                        body._busy = still_busy  # it goes on answering busy as it was
+                        body.stray_files.append(stray.name)
+                        if body.stray_announced_late:  # held back until the next shot
+                            held = [e for e in body._events if e[1] is not None]
+                            body._events[:] = [e for e in body._events if e not in held]
+                            body._late.extend([10**9, e] for e in held)
                     raise GPhoto2Error(-110)
                 if body.busy_for_s and body.busy_clock.now() < body._busy_until:
                     raise GPhoto2Error(-110)
@@ -247,36 +301,7 @@ def make_module(body: Body) -> types.ModuleType:
             store = body.store()
             if store is body.card and body.card_free_shots <= 0:
                 raise GPhoto2Error(-115)
-            fmt = body.config["imageformat"]
-            stem = body.next_stem()
-            files = []
-            if "RAW" in fmt:
-                files.append(stem + body.raw_suffix)
-            if "JPEG" in fmt:
-                files.append(stem + ".JPG")
-            if body.clock is not None:  # the shutter is open for its time, then the file named
-                body.clock.sleep(shutter_s(body.config["shutterspeed"]))
-            raw_data = body.render(body)
-            for name in files:
-                store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"
-            if store is body.card:
-                body.card_free_shots -= 1
-            body.shots += 1
-            body._busy = body.busy_after_shot
-            if body.busy_for_s:
-                body._busy_until = body.busy_clock.now() + body.busy_for_s
-            if body.jpeg_first:
-                files.sort(key=lambda n: not n.endswith(".JPG"))
-            folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"
-            for name in files if body.announce_first else files[1:]:
-                event = (GP_EVENT_FILE_ADDED, CameraFilePath(folder, name))
-                if name != files[0] and body.second_file_quiet_waits:
-                    body._late.append([body.second_file_quiet_waits, event])
-                else:
-                    body._events.append(event)
-            if body.capture_complete_event:
-                body._events.append((GP_EVENT_CAPTURE_COMPLETE, None))
-            return CameraFilePath(folder, files[0])
+            return take_picture()
 
         def wait_for_event(self, timeout_ms: int) -> tuple[int, object]:
             body.check("wait_for_event")

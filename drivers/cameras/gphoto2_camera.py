@@ -489,7 +489,7 @@ class Gphoto2Camera:
         gp = self._gp
         cam = self._cam
         files = [(str(path.folder), str(path.name))]
-        more, late = self._more_files(files)
+        more, late, strays = self._more_files(files)
         files.extend(more)
         self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
@@ -513,7 +513,17 @@ class Gphoto2Camera:
             )
             camera_file.save(str(target))
             saved[name] = target
-        self._delete(files)
+        # pictures the body took behind a busy answer: downloaded too (nothing captured is
+        # lost), handed over as strays, never as this shot's files
+        stray_saved: list[dict[str, str]] = []
+        for folder, name in strays:
+            target = _unused(staging, f"stray{self._count:04d}_{name}")
+            camera_file = self._call(
+                "download", lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL)
+            )
+            camera_file.save(str(target))
+            stray_saved.append({"path": str(target), "name": f"{folder.rstrip('/')}/{name}"})
+        self._delete(files + strays)
         raw_path = saved[raw_files[0][1]]
         decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
         jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
@@ -521,6 +531,14 @@ class Gphoto2Camera:
         metadata = dict(decoded.metadata)
         camera_path = {n: f"{f.rstrip('/')}/{n}" for f, n in files}
         notices = list(metadata.get("notices") or [])
+        if stray_saved:
+            notices.append(
+                "the camera delivered a picture besides the shot's own file(s): one it took "
+                "while answering busy (its capture refused, yet its shutter fired), at a moment "
+                "rti-rig did not choose, so under a light it cannot vouch for; it is kept "
+                "aside in strays/ (the step's 'strays' in the journal), never as an image of "
+                "the session"
+            )
         if s.keep_jpeg and not jpeg:
             notices.append(
                 f"keep_jpeg is set but the camera announced no JPEG within event_timeout_s = "
@@ -544,6 +562,8 @@ class Gphoto2Camera:
                 "originals": [{"path": str(p), "name": camera_path[n]} for n, p in saved.items()],
                 "jpeg_file": jpeg[0] if jpeg else None,
                 "late_camera_files": [f"{f.rstrip('/')}/{n}" for f, n in late],
+                # taken behind a busy answer (see _more_files): the session keeps them aside
+                "stray_originals": stray_saved,
                 "capture_started_s": t_capture,
                 "capture_finished_s": self._clock.now(),
             }
@@ -569,10 +589,19 @@ class Gphoto2Camera:
 
     def _more_files(
         self, files: list[tuple[str, str]]
-    ) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    ) -> tuple[list[tuple[str, str]], list[tuple[str, str]], list[tuple[str, str]]]:
         """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet
         with what this shot needs: its RAW, and its JPEG too with ``keep_jpeg`` (for at most
-        ``event_timeout_s``). Returns (this shot's other files, files of an earlier shot).
+        ``event_timeout_s``). Returns (this shot's other files, files of an earlier shot,
+        strays).
+
+        A stray is a picture the body took while answering busy: its capture failed (-110),
+        yet the shutter fired and the file was written and announced (pibooth #466). One shot
+        gives one RAW, so a RAW announced once the shot has its own is another picture's, and
+        so is any file of that picture's stem. It had been kept as another of this shot's
+        originals (``raw/image_003_2.cr2``, a picture taken under an earlier step's light,
+        recorded under this one's); it is handed over apart, so that nothing captured is lost
+        and nothing is recorded under a light it was not taken under.
 
         Why both rules: a body still writing its JPEG announces it after a quiet spell. Quiet
         with the RAW in hand had ended the wait, and the late announcement was collected at
@@ -588,6 +617,7 @@ class Gphoto2Camera:
         stem = Path(files[0][1]).stem
         more: list[tuple[str, str]] = []
         late: list[tuple[str, str]] = []
+        strays: list[tuple[str, str]] = []
         # Time is counted on the clock for every event, and "quiet" is time with no file
         # announced, whatever else the body reports. Only timeouts had been counted: a body
         # that reports a property change every few milliseconds (GP_EVENT_UNKNOWN "PTP
@@ -605,10 +635,18 @@ class Gphoto2Camera:
             if event == gp.GP_EVENT_FILE_ADDED:
                 quiet_s = 0.0
                 item = (str(data.folder), str(data.name))
-                if item in files or item in more or item in late:
+                if item in files or item in more or item in late or item in strays:
                     continue  # some bodies re-announce the first
-                earlier = Path(item[1]).stem in self._earlier_stems
-                (late if earlier and Path(item[1]).stem != stem else more).append(item)
+                name = Path(item[1])
+                earlier = name.stem in self._earlier_stems
+                if earlier and name.stem != stem:
+                    late.append(item)
+                elif name.stem in {Path(n).stem for _, n in strays} or (
+                    is_raw_file(name) and any(is_raw_file(Path(n)) for _, n in files + more)
+                ):
+                    strays.append(item)
+                else:
+                    more.append(item)
                 continue
             quiet_s += took
             if quiet_s >= wait_ms / 1000:
@@ -617,8 +655,8 @@ class Gphoto2Camera:
                 have_jpeg = any(not is_raw_file(n) for n in names)
                 if have_raw and (have_jpeg or not self.settings.keep_jpeg):
                     break
-        self._earlier_stems.update(Path(n).stem for _, n in files + more)
-        return more, late
+        self._earlier_stems.update(Path(n).stem for _, n in files + more + strays)
+        return more, late, strays
 
     def _delete(self, files: list[tuple[str, str]]) -> None:
         if not self.settings.delete_from_camera:

@@ -12,6 +12,10 @@ Layout (opens directly in relight-cli's folder mode, which takes the first ``*.l
       lights.lp              one line per image, from the light that actually fired
       journal.jsonl          one line per completed step, flushed to disk as it happens
       manifest.json          rig config, schedule, per-step timings, versions, finish reason
+      strays/image_002-IMG_0002.CR2
+                             a picture the camera delivered with a step's but not of it (a
+                             DSLR that answered busy yet took one): kept, in the step's
+                             ``strays``, never one of the session's images
       recovered/STAMP/...    what a resume set aside: unverified images, rejected journal lines
                              (``--rebuild-journal``: the damaged journal, and the images the
                              manifest does not vouch for under ``unproven/``, ``not-in-manifest/``)
@@ -106,6 +110,15 @@ class StepRecord:
     #: how long it was dark (``dark_s``), the camera's busy answers so far
     #: (``camera_busy_tries``) and the wait for its next try (``camera_wait_s``)
     relit: list[dict[str, Any]] = field(default_factory=list)
+    #: pictures the camera delivered with this step's but not of it (a DSLR that answered busy
+    #: yet took a picture): session file under ``strays/`` → {``camera_file``, ``sha256``};
+    #: never one of the session's images, listed nowhere else
+    strays: dict[str, dict[str, str]] = field(default_factory=dict)
+
+
+#: Where a step's strays are kept (see ``StepRecord.strays``): apart from ``raw/``, whose
+#: ``image_*`` files are a step's own.
+STRAY_DIR = "strays"
 
 
 def planned_steps(manifest: dict[str, Any]) -> int:
@@ -599,6 +612,7 @@ class SessionFolder:
         decode = dict(frame.metadata.get("decode") or {})
         listed = frame.metadata.get("originals") or []
         originals = self._keep_originals(base, listed)  # names the file if a write fails
+        strays = self._keep_strays(base, frame.metadata.get("stray_originals") or [])
         current = self.root / tif
         try:
             for item, rel in zip(listed, originals, strict=True):
@@ -637,6 +651,7 @@ class SessionFolder:
             originals={name: source for name, (_, source) in originals.items()},
             decode=decode,
             notices=[str(n) for n in frame.metadata.get("notices") or []],
+            strays=strays,
             **record_fields,
         )
         self._append_journal(json.dumps(asdict(record)) + "\n")
@@ -680,6 +695,35 @@ class SessionFolder:
             except OSError as exc:
                 raise SessionWriteError(dest, exc) from None
             kept[rel] = (digest, str(item.get("name") or src.name))
+        return kept
+
+    def _keep_strays(self, base: str, strays: list[dict[str, Any]]) -> dict[str, dict[str, str]]:
+        """Put the pictures a camera delivered besides the step's own (see
+        ``StepRecord.strays``) under ``strays/``, named after the step they came with and the
+        camera's own name (``strays/image_003-IMG_0002.CR2``): kept, never one of the step's
+        files. Returns {session name: {camera_file, sha256}}."""
+        kept: dict[str, dict[str, str]] = {}
+        root = self.root.resolve()
+        for item in strays:
+            src = Path(item["path"])
+            camera_name = str(item.get("name") or src.name)
+            stem, suffix = Path(camera_name).stem, Path(camera_name).suffix
+            rel = f"{STRAY_DIR}/{base}-{stem}{suffix}"
+            n = 2
+            while rel in kept or (self.root / rel).exists():  # never over a kept picture
+                rel = f"{STRAY_DIR}/{base}-{stem}_{n}{suffix}"
+                n += 1
+            dest = self.root / rel
+            try:
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                if src.resolve().is_relative_to(root):
+                    digest = _fsync_sha256(src)
+                    os.replace(src, dest)
+                else:
+                    digest = _copy_whole(src, dest)
+            except OSError as exc:
+                raise SessionWriteError(dest, exc) from None
+            kept[rel] = {"camera_file": camera_name, "sha256": digest}
         return kept
 
     def _append_journal(self, line: str) -> None:

@@ -9,6 +9,7 @@ everything above ``serial.serial_for_url`` is the real stack).
 
 from __future__ import annotations
 
+import hashlib
 import json
 import sys
 import threading
@@ -362,3 +363,38 @@ def test_ctrl_c_while_a_busy_dslr_is_awaited_in_the_dark_stops_there_and_resumes
     result = run("--resume", str(out))
     assert result.exit_code == 0, result.output
     check_images(out, 3)  # each image as bright as its own LED: none taken in the dark
+
+
+@pytest.mark.parametrize("announced_late", [False, True])
+def test_a_picture_taken_behind_a_busy_answer_is_kept_aside_never_as_an_images_file(
+    body, tmp_path, announced_late
+):
+    """A body answers busy once after a shot, yet takes the picture (its release timed out
+    while the shot went on, pibooth #466): IMG_0002 is written and announced by event, at once
+    or only at the next shot. The session had kept it as a second original of image 2
+    (``raw/image_002_2.cr2``, listed in the journal as image 2's camera file), without a word.
+    It is now downloaded (nothing captured is lost) and kept in ``strays/``, named as such, in
+    the step's ``strays``, never among its originals, and the summary says so."""
+    body.busy_after_shot = 1
+    body.busy_yet_shot = 1
+    body.stray_announced_late = announced_late
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "3")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, result.output
+    check_images(out, 3)  # each image's one original, as bright as its own LED
+    assert body.stray_files == ["IMG_0002.CR2"] and body.shots == 4
+    entries = journal(out)
+    names = [next(iter(e["originals"].values())) for e in entries]
+    assert names == ["/IMG_0001.CR2", "/IMG_0003.CR2", "/IMG_0004.CR2"]
+    assert sorted(p.name for p in (out / "raw").glob("*.cr2")) == [
+        f"image_00{i}.cr2" for i in (1, 2, 3)
+    ]
+    (stray,) = [(e["index"], s) for e in entries for s in e["strays"].items()]
+    index, (rel, kept) = stray
+    assert index == 1 and rel == "strays/image_002-IMG_0002.CR2"
+    assert kept["camera_file"] == "/IMG_0002.CR2"
+    data = (out / rel).read_bytes()
+    assert hashlib.sha256(data).hexdigest() == kept["sha256"]
+    assert "it took while answering busy" in said and "kept aside in strays/" in said
+    assert not body.ram  # downloaded and gone from the camera, as every shot
