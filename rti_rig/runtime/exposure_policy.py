@@ -183,8 +183,14 @@ def fix_session_exposure(
     validate_schedule(rig, schedule)
     steps = metering_steps(schedule, probes if recheck is not None else 1)
 
+    # a light with a time limit (a dome's max_on_s) holds one shot, not a series, for a camera
+    # that holds it lit until its frame is in (a dry run's simulated camera, an OpenCV one):
+    # a series under one lighting had overrun it ("LED 41 stayed on 2.235 s, beyond max_on_s
+    # = 1.16 s"), each shot alone fitting (a DSLR's shots end dark, see _LitForEachShot)
+    relight_each = shot_per_lighting or lit_limit_s(rig) is not None
+
     def camera_at(step: LightStep, lit_at: float) -> Any:
-        return _LitForEachShot(rig, step, lit_at, relight_each=shot_per_lighting)
+        return _LitForEachShot(rig, step, lit_at, relight_each=relight_each)
 
     def teardown() -> list[str]:
         # every step of the teardown runs, whatever one device does; what failed is said. A
