@@ -811,15 +811,20 @@ def lit_per_shot(rig: LoadedRig) -> tuple[float, bool]:
     """(seconds an LED stays lit for one shot besides its exposure, whether that counts the
     transfer).
 
-    The settle before the exposure and the readout after it always; and the transfer too for
-    a camera that cannot say when its exposure is over (a dry run's simulated camera, an OpenCV
-    camera): the LED goes off only once its frame is in hand. Without the transfer the check
-    below had passed a dry-run config whose every capture overran max_on_s ("LED 0 stayed on
-    1.153 s, beyond max_on_s = 0.46 s"), found after the dome was opened and lit."""
+    The settle before the exposure and the readout after it always; and the transfer and the
+    all-off's time too for a camera that cannot say when its exposure is over (a dry run's
+    simulated camera, an OpenCV camera): the LED goes off only once its frame is in hand.
+    Without the transfer the check below had passed a dry-run config whose every capture
+    overran max_on_s ("LED 0 stayed on 1.153 s, beyond max_on_s = 0.46 s"), found after the
+    dome was opened and lit."""
     t = rig.config.timing
     device = rig.config.camera.device or {}
     held = device.get("kind") not in EXPOSING_CAMERA_KINDS
-    return t.settle_s + t.readout_s + (t.transfer_s if held else 0.0), held
+    # held: the LED goes off only with the all-off sent after the frame, which takes its own
+    # time (timing.light_switch_s); a camera that says when its exposure is over has the
+    # readout after it as margin
+    after = t.transfer_s + t.light_switch_s if held else 0.0
+    return t.settle_s + t.readout_s + after, held
 
 
 def shot_said(rig: LoadedRig, exposure_key: str, exposure_s: float) -> tuple[float, str]:
@@ -834,8 +839,9 @@ def shot_said(rig: LoadedRig, exposure_key: str, exposure_s: float) -> tuple[flo
     )
     if held:
         text += (
-            f" + timing.transfer_s {t.transfer_s:g} (this camera cannot say when its exposure "
-            "is over, so its LED stays lit until the frame is in)"
+            f" + timing.transfer_s {t.transfer_s:g} + timing.light_switch_s "
+            f"{t.light_switch_s:g} (this camera cannot say when its exposure is over, so its "
+            "LED stays lit until the frame is in and the all-off is through)"
         )
     return total, f"{text} = {total:.3g} s"
 

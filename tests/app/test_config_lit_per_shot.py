@@ -22,8 +22,8 @@ from rti_rig.cli import app
 
 
 def emulated_dome(tmp_path: Path, max_on_s: float) -> Path:
-    """The shipped emulated dome (settle 0.1, exposure 0.05, readout 0.3, transfer 0.7 s: a
-    shot holds its LED 1.15 s) with a thermal limit."""
+    """The shipped emulated dome (settle 0.1, exposure 0.05, readout 0.3, transfer 0.7 s, and
+    the all-off's 0.02 s: a shot holds its LED 1.17 s) with a thermal limit."""
     text = (CONFIGS / "emulated_dome.toml").read_text()
     for line in ("settle_s = 0.1\n", "readout_s = 0.3\n", "transfer_s = 0.7\n"):
         assert line in text
@@ -45,14 +45,15 @@ def test_a_shot_held_lit_through_its_transfer_past_max_on_s_is_refused_at_load(
     assert "[dome.serial.thermal] max_on_s = 1 s" in said
     assert (
         "timing.settle_s 0.1 + camera.exposure_s 0.05 + timing.readout_s 0.3 + "
-        "timing.transfer_s 0.7 (this camera cannot say when its exposure is over" in said
+        "timing.transfer_s 0.7 + timing.light_switch_s 0.02 (this camera cannot say when its "
+        "exposure is over" in said
     )
-    assert "= 1.15 s" in said
+    assert "= 1.17 s" in said
 
 
 def test_a_shot_that_fits_with_its_transfer_runs_to_the_end(tmp_path: Path) -> None:
     """The limit the check now sets is the one the run meets: at max_on_s = 1.2 s every image
-    is taken (its LED lit 1.15 s each)."""
+    is taken (its LED lit about 1.15 s each, the all-off's time on top)."""
     out = tmp_path / "s"
     args = ["run", str(emulated_dome(tmp_path, 1.2)), "--out", str(out), "--lights", "3"]
     result = CliRunner().invoke(app, [*args, "--no-verdict"])

@@ -64,3 +64,27 @@ def test_metering_takes_each_test_shot_under_its_own_lighting_within_max_on_s(
     lit = [ev.index for ev in metering.history if ev.what == "lit"]
     assert len(lit) >= shots > len(set(lit))  # a series at one light, one lighting a shot
     assert not [ev for ev in metering.history if ev.what == "watchdog"]
+
+
+def test_metering_a_dim_dome_chooses_no_exposure_its_held_shot_cannot_fit(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """Every LED at 5 % of its output: metering goes to the longest exposure it may choose.
+    That had left settle and readout only (1.6 s at max_on_s = 2 s), and the test shot, which
+    holds its LED through the transfer too, stopped at the thermal guard ("LED 41 stayed on
+    2.691 s, beyond max_on_s = 2 s"). The cap now leaves the transfer and the all-off's time
+    (timing.light_switch_s, 0.3 s here: room for the pty's own time under any load) too."""
+    config = emulated_dome(tmp_path, 2.0, led_power=0.05)
+    text = config.read_text()
+    assert "light_switch_s = 0.02\n" in text
+    config.write_text(text.replace("light_switch_s = 0.02\n", "light_switch_s = 0.3\n"))
+    out = tmp_path / "s"
+    args = [str(config), "--out", str(out), "--lights", "6", "--auto-exposure", "--no-verdict"]
+    result = CliRunner().invoke(app, ["run", *args])
+    text = said(result)
+    assert result.exit_code == 0, text
+    steps = json.loads((out / "manifest.json").read_text())["schedule"]["steps"]
+    (exposure,) = {s["exposure_s"] for s in steps}
+    assert exposure <= 2.0 - 0.1 - 0.3 - 0.7 - 0.3 + 1e-9
+    assert "is the longest the metering could choose" in text
+    assert "less timing.settle_s, readout_s, transfer_s and light_switch_s" in text

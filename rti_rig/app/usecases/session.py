@@ -413,12 +413,18 @@ def fix_exposure(
     on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s{where} ({chosen['reason']})"))
     if lit_cap is not None and chosen["exposure_s"] >= _next_shorter_s(rig, longest) - 1e-9:
         serial = rig.loaded.config.dome.serial  # type: ignore[attr-defined]
+        less = (
+            "timing.settle_s, readout_s, transfer_s and light_switch_s: this camera holds its "
+            "LED lit until its frame is in"
+            if _held_after_s(rig)
+            else "timing.settle_s and timing.readout_s"
+        )
         on_note(
             Note(
                 f"The exposure, {chosen['exposure_s']:.4g} s, is the longest the metering "
                 f"could choose: each shot must end while its LED is lit, which leaves "
                 f"{longest:.3g} s ([dome.serial.thermal] max_on_s = "
-                f"{serial.thermal.max_on_s:g} s, less timing.settle_s and timing.readout_s), "
+                f"{serial.thermal.max_on_s:g} s, less {less}), "
                 f"not the camera's max_exposure_s = {cam.max_exposure_s:g} s; the images may "
                 "be dark. Raise max_on_s if the LEDs allow it, or the ISO or aperture",
                 level="warning",
@@ -429,12 +435,31 @@ def fix_exposure(
 
 def _lit_exposure_cap(rig: Rig) -> float | None:
     """The longest exposure a shot can have under an LED lit at most ``max_on_s`` (less the
-    settle before and the readout after it), or None when the light has no time limit."""
+    settle before and the readout after it, and for a camera that holds its LED lit until its
+    frame is in the transfer and the all-off's own time), or None when the light has no time
+    limit.
+
+    Why: metering a dry run's simulated camera on a dome with max_on_s = 2 s (LEDs dim) chose
+    the exposure that left settle and readout only, whose test shot then held its LED through
+    the transfer too, and stopped at the thermal guard before the session began ("LED 41
+    stayed on 2.691 s, beyond max_on_s = 2 s")."""
     limit_of = getattr(getattr(rig, "lighting", None), "lit_limit_s", None)
     limit = limit_of() if limit_of is not None else None
     if limit is None:
         return None
-    return limit - rig.timing.settle_s - rig.timing.readout_s
+    return limit - rig.timing.settle_s - rig.timing.readout_s - _held_after_s(rig)
+
+
+def _held_after_s(rig: Rig) -> float:
+    """How long past its readout a shot holds its LED lit: nothing for a camera that says when
+    its exposure is over (an ``ExposingCamera``: the LED goes off then, the readout its
+    margin), else the transfer and the all-off's own time (``timing.light_switch_s``), as
+    :func:`rti_rig.app.config.lit_per_shot` counts it."""
+    from rti_rig.core.devices import ExposingCamera
+
+    if isinstance(rig.camera, ExposingCamera):
+        return 0.0
+    return rig.timing.transfer_s + rig.timing.light_switch_s
 
 
 def _next_shorter_s(rig: Rig, longest: float) -> float:
