@@ -183,11 +183,19 @@ class Gphoto2Camera:
         attempts: int,
         error: type[DeviceError] = CaptureError,
         waited_s: float | None = None,
+        spent_s: float | None = None,
     ) -> DeviceError:
-        """The error for a gphoto2 call that failed for good, with its code's hint."""
+        """The error for a gphoto2 call that failed for good, with its code's hint.
+
+        ``spent_s``: the time from the first try to the last, said when it is longer than the
+        waits between tries (``waited_s``) by the time the tries themselves took, the light's
+        relights and cool-downs: a body busy through relights and a minute's cool-down had been
+        said to have been tried "over 15.5 s" after some 75 s."""
         code = getattr(exc, "code", None)
         hint = GP_ERROR_HINTS.get(code, "see `gphoto2 --debug` output")
         over = f" over {waited_s:g} s" if waited_s else ""
+        if waited_s and spent_s is not None and spent_s > waited_s + 1.0:
+            over = f" over {spent_s:.0f} s ({waited_s:g} s of them the waits between tries)"
         tries = f" after {attempts} attempts{over}" if attempts > 1 else ""
         text = f"gphoto2 error {code} ({exc}){tries}: {hint}"
         if code in GONE_CODES and self._cam is not None:
@@ -420,7 +428,8 @@ class Gphoto2Camera:
         """Fire the shutter once the camera is not busy; see :meth:`expose_within`."""
         gp = self._gp
         s = self.settings
-        spell, self._busy = self._busy or _BusySpell(delay_s=s.retry_delay_s), None
+        now = self._clock.now()
+        spell, self._busy = self._busy or _BusySpell(s.retry_delay_s, first_try_at=now), None
         while True:
             started = self._clock.now()
             try:
@@ -433,7 +442,11 @@ class Gphoto2Camera:
                 code = getattr(exc, "code", None)
                 if code not in s.retry_codes or spell.tries >= s.busy_retries:
                     raise self._failure(
-                        "capture", exc, spell.tries + 1, waited_s=spell.waited_s
+                        "capture",
+                        exc,
+                        spell.tries + 1,
+                        waited_s=spell.waited_s,
+                        spent_s=self._clock.now() - spell.first_try_at,
                     ) from exc
                 delay = spell.delay_s
                 spell.tries += 1
@@ -675,6 +688,8 @@ class _BusySpell:
     delay_s: float
     tries: int = 0
     waited_s: float = 0.0
+    #: when its first try was made (on the camera's clock)
+    first_try_at: float = 0.0
 
 
 def _unused(folder: Path, name: str) -> Path:

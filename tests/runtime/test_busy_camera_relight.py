@@ -345,3 +345,22 @@ def test_a_cancel_during_the_cool_down_before_a_relight_stops_there(tmp_path):
     assert lit == [LEDS[0], LEDS[1]]  # never lit again for the abandoned step
     assert clock.now() < dark[0] + 10.0 + 1.0  # stopped within a poll of the cancel, not ~56 s
     assert [e["index"] for e in journal(out)] == [0]
+
+
+def test_a_camera_that_never_comes_back_is_said_to_have_been_tried_for_as_long_as_it_was(
+    tmp_path,
+):
+    """At max_duty = 0.2 the relight waits some 56 s of cool-down: the camera's five tries
+    span about a minute, of which 11 s are the waits between them. The error had said "after
+    5 attempts over 11 s" of a stop a minute after the first try."""
+    import re
+
+    rig, body, _ = dslr_rig(tmp_path, max_duty=0.2, busy_retries=4, retry_delay_s=1.0)
+    body.busy_for_s = 1e9
+    out = tmp_path / "s"
+    with rig, pytest.raises(CaptureError) as e:
+        run_session(rig, schedule_of(rig), SessionFolder.create(out, len(LEDS)))
+    said = str(e.value)
+    m = re.search(r"after 5 attempts over (\d+) s \(11 s of them the waits between tries\)", said)
+    assert m is not None, said
+    assert 60 <= int(m.group(1)) <= 70  # 7.1 s lit, 4 s dark, ~56 s cool-down, the settle
