@@ -788,7 +788,7 @@ def _light_off_for_camera(event) -> str:  # type: ignore[no-untyped-def]
     off = {
         "acknowledged": "switched off, acknowledged by the dome",
         "sent-no-ack": "all-off sent (this firmware never acknowledges)",
-        "self-timed": "going off by itself (this firmware has no all-off)",
+        "self-timed": "gone dark by itself at the end of its window (this firmware has no all-off)",
     }.get(event.off or "", "all-off sent")
     cool = (
         f" and {event.cool_s:.1f} s more for its duty limit (max_duty) to let it light again"

@@ -125,7 +125,7 @@ def test_a_busy_camera_on_rtipy_is_awaited_in_the_dark_and_shot_under_a_new_wind
     assert (
         f"would keep LED {leds[1]} (lit" in said
         and "past the 2 s the rtipy firmware keeps it lit before switching it off by itself "
-        "(light_on_s): going off by itself"
+        "(light_on_s): gone dark by itself at the end of its window"
         in said
     ), said
     # the board's own record: the second LED lit again (a new timed command) for each relight,
