@@ -1201,9 +1201,10 @@ def _prepare_resume(
     refuses (by raising) leaves the folder exactly as it was.
 
     A session that **completed** is refused, unless ``reshoot_lost``: then exactly the steps
-    whose JPEG or linear TIFF is gone or changed since capture (:func:`_lost_files`, what the
-    QA verdict names) are reshot; every other step stands as it is (a TIFF rewritten, a RAW
-    original archived elsewhere, are not reasons to reshoot a finished session).
+    whose JPEG or linear TIFF is gone or changed since capture, or whose kept RAW original is
+    gone (:func:`_lost_files`, what the QA verdict names) are reshot, their files set aside;
+    every other step stands as it is (a TIFF re-saved with its pixels unchanged is no reason
+    to reshoot a finished session).
 
     A step counts as done when its journal line is a well-formed record and every file it names
     is on disk with the journaled checksum. Journal lines that are not records (a torn last
@@ -2063,14 +2064,21 @@ def _lost_files(
     journaled checksums. A TIFF whose bytes differ but whose pixels match the journaled pixel
     checksum was re-saved by another tool (a tag added, recompressed), not changed: what a fit
     reads is as captured. A session journaled before pixel checksums has only the bytes', so
-    there any difference counts (:func:`tiff_check_note` says so). RAW originals are not
-    counted: archiving them elsewhere is normal, and the images stand without them. A JPEG in
-    ``renamed`` (:func:`renamed_jpegs`) is not lost: it is there, under another name."""
+    there any difference counts (:func:`tiff_check_note` says so). A kept camera original
+    (``raw/…``) that is gone is lost too: the RAW is the original capture (the JPEG and TIFF
+    are developed from it), and a resume and ``--rebuild-journal`` already called a step
+    without it unproven, while this called it "no reason to reshoot" (its developed images
+    may still be fitted: :func:`originals_lost` tells them apart). One that is there but
+    changed is named by :func:`originals_changed_since_capture`, to restore from a copy. A
+    JPEG in ``renamed`` (:func:`renamed_jpegs`) is not lost: it is there, under another
+    name."""
     lost = []
     for name, digest in rec["sha256"].items():
-        if name not in (rec.get("image"), rec.get("linear_image")):
-            continue
         path = root / name
+        if name not in (rec.get("image"), rec.get("linear_image")):
+            if not path.is_file():  # a camera original
+                lost.append(f"{name} missing")
+            continue
         if not path.is_file():
             if renamed and name in renamed:
                 continue
@@ -2127,10 +2135,10 @@ def tiff_check_note(root: Path) -> str:
 
 def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
     """Per image (its base name, ``image_010``) of a session, its JPEG or linear TIFF gone or
-    changed since capture (:func:`_lost_files`): what the QA verdict names and what
-    ``run --resume --reshoot-lost`` reshoots, one criterion for both. A JPEG that is in the
-    folder under another name (:func:`renamed_jpegs`) is not lost. Empty for a folder
-    without a journal (an ``.lp`` acquisition is no session)."""
+    changed since capture, or its kept camera original gone (:func:`_lost_files`): what the
+    QA verdict names and what ``run --resume --reshoot-lost`` reshoots, one criterion for
+    both. A JPEG that is in the folder under another name (:func:`renamed_jpegs`) is not
+    lost. Empty for a folder without a journal (an ``.lp`` acquisition is no session)."""
     root = Path(root)
     records = _journal_records(root)
     if records is None:
@@ -2144,14 +2152,21 @@ def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
     return lost
 
 
+def originals_lost(gone: list[str]) -> bool:
+    """Whether the files of one image :func:`_lost_files` names (``gone``) are all kept camera
+    originals (``raw/…``): the original capture is lost, yet the developed JPEG and linear
+    TIFF are as captured, so a fit still used them (said, with the reshoot that gets the
+    original back)."""
+    return bool(gone) and all(g.startswith(f"{RAW_DIR}/") for g in gone)
+
+
 def originals_changed_since_capture(root: Path) -> list[str]:
     """The camera originals a session keeps (``raw/…``, a RAW or a RAW+JPEG pair's files) that
     are on disk but differ from their journaled checksums.
 
     Why: a DNG opened in a raw editor that writes its metadata into the file, or an original
     replaced by a sync tool, is no longer the camera's file the session vouches for, and
-    nothing said so. One that is gone is not named (archiving originals elsewhere is normal),
-    and neither counts as lost: the session's JPEG and linear TIFF stand without it."""
+    nothing said so. One that is gone is lost, named by :func:`files_lost_since_capture`."""
     root = Path(root)
     changed = []
     for rec in _latest_records(_journal_records(root) or []).values():

@@ -578,25 +578,16 @@ def test_tiffs_renamed_in_linear_are_named_as_renamed_not_lost(
     assert {p: p.read_bytes() for p in done.rglob("*") if p.is_file()} == before
 
 
-def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tiff(
+def test_a_finished_session_is_not_reshot_for_a_rewritten_tiff(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:
-    """RAW originals moved to an archive, a TIFF rewritten by another tool: the images stand,
-    the verdict is good, and --reshoot-lost finds nothing to reshoot (a review found both made
-    a completed session reshoot every image, its intact files moved aside)."""
+    """A TIFF rewritten by another tool with the very pixels captured: the images stand, the
+    verdict is good, and --reshoot-lost finds nothing to reshoot (a review found it made a
+    completed session reshoot every image, its intact files moved aside)."""
     import tifffile
 
     _, ref = reference
     done = copied(ref, tmp_path)
-    lines = (done / "journal.jsonl").read_text().splitlines()
-    records = [json.loads(line) for line in lines]
-    for rec in records:  # as a DSLR session's: each step's RAW original, since archived
-        raw = f"raw/{Path(rec['image']).stem}.cr2"
-        rec["sha256"][raw] = "0" * 64
-        # the camera's own name, as a DSLR session journals it (without it the record is no
-        # step record, and the verdict had been "good" only because nothing was checked)
-        rec.setdefault("originals", {})[raw] = f"/store_00010001/DCIM/IMG_{rec['index']:04d}.CR2"
-    (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
     tif = done / "linear" / "image_004.tif"
     tifffile.imwrite(tif, tifffile.imread(tif), description="re-saved")
     r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
@@ -607,6 +598,63 @@ def test_a_finished_session_is_not_reshot_for_an_archived_raw_or_a_rewritten_tif
     assert r.exit_code == 2, r.output
     assert "nothing to reshoot" in said(r) and "missing or changed" not in said(r), said(r)
     assert {p: p.read_bytes() for p in done.rglob("*") if p.is_file()} == before
+
+
+def _with_raw_originals(done: Path) -> dict[str, bytes]:
+    """Session ``done`` made a DSLR session's: each step keeps the camera's file under raw/,
+    its checksum and camera name in the journal and the manifest's records. Returns them."""
+    records = [json.loads(line) for line in (done / "journal.jsonl").read_text().splitlines()]
+    (done / "raw").mkdir()
+    bodies = {}
+    for rec in records:
+        raw = f"raw/{Path(rec['image']).stem}.dng"
+        body = f"camera file {rec['index']}".encode()
+        (done / raw).write_bytes(body)
+        bodies[raw] = body
+        rec["sha256"][raw] = hashlib.sha256(body).hexdigest()
+        rec.setdefault("originals", {})[raw] = f"IMG_{rec['index']:04d}.DNG"
+    (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    m = manifest(done)
+    by_step = {r["index"]: r for r in records}
+    m["steps"] = [by_step.get(s["index"], s) for s in m["steps"]]
+    (done / "manifest.json").write_text(json.dumps(m))
+    return bodies
+
+
+def test_a_missing_raw_original_is_a_lost_image_said_alike_and_reshot_on_request(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """The RAW is the original capture: raw/image_003.dng gone from a finished session. The
+    verdict had said "good" and --reshoot-lost "nothing to reshoot", while a rebuild of its
+    journal called the image unproven and advised --reshoot-lost, which then refused. Now the
+    verdict names the RAW as lost (its developed images fitted), a plain resume names it,
+    and --reshoot-lost shoots exactly that step again, its developed files set aside."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    _with_raw_originals(done)
+    (done / "raw" / "image_003.dng").unlink()
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert verdict.startswith(
+        "reshoot: image_003 (raw/image_003.dng missing since capture: the "
+        "camera's original capture is lost, its developed JPEG and linear "
+        "TIFF are as captured and were fitted"
+    ), verdict
+    assert f"rti-rig run --resume {done} --reshoot-lost" in verdict
+    r = runner.invoke(app, ["run", "--resume", str(done)])
+    assert r.exit_code == 2 and "missing or changed since capture (image_003)" in said(r), r.output
+    jpeg = (done / "image_003.jpg").read_bytes()
+    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
+    assert r.exit_code == 0, r.output
+    (aside,) = (done / "recovered").iterdir()
+    assert (aside / "image_003.jpg").read_bytes() == jpeg  # set aside, not overwritten
+    assert sorted(p.relative_to(aside).as_posix() for p in aside.rglob("*") if p.is_file()) == [
+        "image_003.jpg",
+        "linear/image_003.tif",
+    ]
+    journal = [json.loads(line) for line in (done / "journal.jsonl").read_text().splitlines()]
+    assert [e["index"] for e in journal] == [*range(LIGHTS), 2]
 
 
 def test_a_linear_tiff_edited_since_capture_is_named_and_reshot_on_request(
@@ -758,27 +806,17 @@ def test_a_camera_original_changed_since_capture_is_named_not_reshot(
 ) -> None:
     """A kept DNG into which a raw editor wrote its metadata: no longer the camera's file,
     and nothing said so (originals were not checked at all once the session finished). Now
-    the verdict's note names it and says what to do; the images stand (no reshoot), and an
-    original archived elsewhere (gone) is still not named."""
+    the verdict's note names it and says what to do; the images stand (no reshoot)."""
     _, ref = reference
     done = copied(ref, tmp_path)
-    records = [json.loads(line) for line in (done / "journal.jsonl").read_text().splitlines()]
-    (done / "raw").mkdir()
-    for rec in records:  # as a DSLR session's: each step keeps the camera's file
-        raw = f"raw/{Path(rec['image']).stem}.dng"
-        body = f"camera file {rec['index']}".encode()
-        (done / raw).write_bytes(body)
-        rec["sha256"][raw] = hashlib.sha256(body).hexdigest()
-        rec.setdefault("originals", {})[raw] = f"IMG_{rec['index']:04d}.DNG"
-    (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
-    (done / "raw" / "image_002.dng").unlink()  # archived elsewhere
+    _with_raw_originals(done)
     (done / "raw" / "image_005.dng").write_bytes(b"camera file 4 + XMP written by an editor")
     r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 0, r.output
     verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
     assert verdict.startswith("good; raw/image_005.dng changed since capture"), verdict
     assert "restore the original from a backup copy" in verdict
-    assert "image_002.dng" not in verdict and "reshoot" not in verdict
+    assert "reshoot" not in verdict
     r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
     assert r.exit_code == 2 and "nothing to reshoot" in said(r), r.output
 

@@ -31,6 +31,7 @@ from rti_rig.runtime.session import (
     image_names,
     lost_image_advice,
     originals_changed_since_capture,
+    originals_lost,
     planned_steps,
     read_manifest,
     rebuild_advice,
@@ -117,7 +118,7 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     for check in qa.images:
         gone = lost.get(check.name)
         if gone:
-            problem = f"{', '.join(gone)} since capture"
+            problem = f"{', '.join(gone)} since capture" + _developed_stand(gone)
             if not once:
                 problem += f"; {relight}" if check.name in relisted else ""
                 problem += f"; {todo}"
@@ -132,11 +133,30 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
             shown += f"; {', '.join(unlisted[:8])}{' …' if len(unlisted) > 8 else ''} not in "
             shown += f"{lp.name}, so not fitted"
         plural = "images" if len(lost) > 1 else "image"
+        raws = sorted(n for n, g in lost.items() if originals_lost(g))
+        if raws:  # the camera's originals: lost, though what was fitted of them stands
+            shown += (
+                f"; of {', '.join(raws[:8])}{' …' if len(raws) > 8 else ''} the RAW original is "
+                "lost, the developed JPEG and linear TIFF are as captured and were fitted"
+            )
         note = f"{len(lost)} {plural} missing or changed since capture ({shown}): {todo}"
         if relisted:
             note += f"; {relight} ({', '.join(relisted[:8])}{' …' if len(relisted) > 8 else ''})"
         qa = _noted(qa, note)
     return qa
+
+
+def _developed_stand(gone: list[str]) -> str:
+    """What to add to an image's lost files ``gone`` when only its camera originals are lost:
+    the RAW is the original capture, so the image is lost, but its developed JPEG and linear
+    TIFF are as captured and were fitted (the verdict had called a missing RAW no reason to
+    reshoot while a resume and a rebuild called the step unproven)."""
+    if not originals_lost(gone):
+        return ""
+    return (
+        ": the camera's original capture is lost, its developed JPEG and linear TIFF are as "
+        "captured and were fitted"
+    )
 
 
 #: How far (radians) an .lp's light may be from the journal's and still be the same one: the
