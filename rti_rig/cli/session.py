@@ -122,7 +122,8 @@ def run(
             "from manifest.json and the journal's intact lines, taking back only the images "
             "whose files match their recorded checksums and whose light is their step's; the old "
             "journal and every other image file are set aside in recovered/, never deleted. A "
-            "completed session is rebuilt without the rig, once every image is proven.",
+            "completed session is rebuilt without the rig: an image whose files alone are not "
+            "as recorded is recorded as lost (its files set aside), for --reshoot-lost.",
         ),
     ] = False,
     adaptive: Annotated[
@@ -317,7 +318,11 @@ def _rebuilt_finished(req: Any) -> bool:
     session that did not finish"), with no way to make it whole again. A Ctrl-C or SIGTERM
     while the images are checked leaves the folder as it was; one while the journal is written
     is acted on once it is, and said so."""
-    from rti_rig.app.usecases.session import Note, rebuild_finished_session
+    from rti_rig.app.usecases.session import (
+        Note,
+        lost_since_capture_advice,
+        rebuild_finished_session,
+    )
     from rti_rig.runtime.controller import EmergencyStop
     from rti_rig.runtime.session import JOURNAL
 
@@ -333,9 +338,12 @@ def _rebuilt_finished(req: Any) -> bool:
         if done:
             for line in done:
                 print_note(Note(line, "warning"))
-            said = (
-                f"Stopped ({why}) once {JOURNAL} was rebuilt: the session is whole again; "
-                f"rti-rig fit {folder} --out FOLDER fits it and gives its QA verdict"
+            lost = lost_since_capture_advice(req.session_dir)
+            said = f"Stopped ({why}) once {JOURNAL} was rebuilt: " + (
+                f"the session is whole again; rti-rig fit {folder} --out FOLDER fits it "
+                "and gives its QA verdict"
+                if lost is None
+                else f"{lost}; meanwhile rti-rig fit {folder} --out FOLDER fits the rest"
             )
         else:
             said = (
@@ -348,6 +356,16 @@ def _rebuilt_finished(req: Any) -> bool:
         return False
     for line in notes:
         print_note(Note(line, "warning"))
+    lost = lost_since_capture_advice(req.session_dir)
+    if lost is not None:  # recorded as lost: said with the command that reshoots it
+        out.print(
+            f"{req.session_dir}: {JOURNAL} rebuilt from every image it could prove (no rig "
+            f"was opened, nothing was shot), but the session is not whole: {lost}; meanwhile "
+            f"rti-rig fit {folder} --out FOLDER fits it, its QA verdict naming what is lost",
+            highlight=False,
+            markup=False,
+        )
+        return True
     out.print(
         f"{req.session_dir}: {JOURNAL} rebuilt; the session is complete and whole again (no "
         f"rig was opened, nothing was shot). Next: rti-rig fit {folder} --out FOLDER fits it "

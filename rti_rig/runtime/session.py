@@ -1416,7 +1416,10 @@ def rebuildable_journal(root: Path) -> bool:
     try:
         scan = scan_journal(root, names)
         if (manifest.get("runner") or {}).get("finish_reason") == "completed":
-            return _finished_rebuild(root, manifest, names, scan)[1] == []  # all proven
+            # every image proven, or recorded with its light, its files alone lost (the
+            # rebuild records it as lost, for --reshoot-lost)
+            _taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
+            return unproven is not None and len(lost) == len(unproven)
     except SessionError:
         return False
     if unresumable(root) is not None:  # a resume, which the rebuild goes with, is refused
@@ -1435,11 +1438,12 @@ def _finished_steps(manifest: dict[str, Any], total: int) -> range:
 
 def _finished_rebuild(
     root: Path, manifest: dict[str, Any], names: list[str], scan: JournalScan
-) -> tuple[dict[int, dict[str, Any]], list[str] | None, list[str]]:
+) -> tuple[dict[int, dict[str, Any]], list[str] | None, dict[int, dict[str, Any]]]:
     """What a completed session's journal would be rebuilt from (:func:`_provable_steps`),
     why each captured image that nothing proves is not (None: the journal is whole, nothing to
-    rebuild), and which of those only have files missing or changed (their record and light
-    are there: ``--reshoot-lost`` can shoot them again). Nothing in the folder changes."""
+    rebuild), and, by step, the record of each of those that only has files missing or changed
+    (its record and light are there: the rebuild records it as lost, and ``--reshoot-lost``
+    can shoot it again). Nothing in the folder changes."""
     steps = _finished_steps(manifest, len(names))
     journaled = {r["index"] for r in scan.records}
     if (root / JOURNAL).exists() and not scan.needs_repair and set(steps) <= journaled:
@@ -1448,14 +1452,15 @@ def _finished_rebuild(
     listed = _manifest_records(manifest, names)
     latest = _latest_records(scan.records)
     unproven: list[str] = []
-    lost_only: list[str] = []  # only files missing or changed: --reshoot-lost can redo them
+    lost_only: dict[int, dict[str, Any]] = {}  # only files missing or changed
     for i in steps:
         if i in taken:
             continue
         records = [e for e in (latest.get(i), listed.get(i)) if e is not None]
+        lit = [e for e in records if _light_as_recorded(manifest, e)]
         if not records:
             why = f"neither {MANIFEST} nor an intact line of {JOURNAL} records it"
-        elif not any(_light_as_recorded(manifest, e) for e in records):
+        elif not lit:
             why = "its recorded light is not the one its step was given"
         else:
             gone = sorted(
@@ -1465,7 +1470,7 @@ def _finished_rebuild(
                 if not _as_captured(root, e, name, digest)
             )
             why = f"{', '.join(dict.fromkeys(gone))} missing or changed since capture"
-            lost_only.append(names[i])
+            lost_only[i] = lit[0]  # the journal's line, else the manifest's
         unproven.append(f"{names[i]} ({why})")
     return taken, unproven, lost_only
 
@@ -1475,12 +1480,19 @@ def rebuild_finished_journal(root: Path) -> list[str]:
     manifest's records, an intact line of the damaged journal: :func:`_provable_steps`), with
     no rig: nothing is captured. Returns what was done, as :func:`_rebuild_journal` says it.
 
-    Refused, naming each image and why, unless every image the session captured is proven;
-    nothing in the folder changes then. Why: a completed session whose journal was lost (a copy
-    to a NAS or a sync tool that skipped it) could not be made whole: ``--rebuild-journal`` was
-    refused as "for a session that did not finish", export-lp refused the session, and its
-    verdict could check no image against its capture checksum; its manifest holds every record
-    the journal did."""
+    An image whose record and light are there but whose files are not all as captured (a JPEG
+    edited, a RAW original gone) is recorded as captured and lost: its record goes back into
+    the journal, its files that are not as recorded are set aside in ``recovered/`` (never
+    deleted), and the QA verdict and ``--reshoot-lost`` then see it as lost, as with the
+    journal intact. Why: one such image had refused the whole rebuild, and every image that
+    was provable stayed unproven until a backup was found.
+
+    Refused, naming each image and why, if an image the session captured has no record with its
+    step's light; nothing in the folder changes then. Why: a completed session whose journal
+    was lost (a copy to a NAS or a sync tool that skipped it) could not be made whole:
+    ``--rebuild-journal`` was refused as "for a session that did not finish", export-lp refused
+    the session, and its verdict could check no image against its capture checksum; its
+    manifest holds every record the journal did."""
     root = Path(root)
     held = str(root.resolve()) in _LOCKED
     lock_session(root)
@@ -1491,7 +1503,7 @@ def rebuild_finished_journal(root: Path) -> list[str]:
             raise SessionError(f"{root}: this session did not complete: resume it instead")
         names = image_names(planned_steps(manifest))
         scan = scan_journal(root, names)
-        taken, unproven, lost_only = _finished_rebuild(root, manifest, names, scan)
+        taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
         folder = shlex.quote(str(root))
         if unproven is None:
             raise SessionError(
@@ -1499,30 +1511,27 @@ def rebuild_finished_journal(root: Path) -> list[str]:
                 f"image it captured: nothing to rebuild; drop --rebuild-journal (the QA verdict "
                 f"of rti-rig fit {folder} --out DIR names any image changed since capture)"
             )
-        if unproven:
+        if len(lost) < len(unproven):
             shown = "; ".join(unproven[:8]) + (" …" if len(unproven) > 8 else "")
-            reshoot = (
-                # their records are there: the reshoot restores them and shoots those again
-                f"; or reshoot exactly those, with the object where it was: rti-rig run "
-                f"--resume {folder} --reshoot-lost"
-                if len(lost_only) == len(unproven)
-                and not manifest.get("adaptive")
-                and unresumable(root) is None
-                else ""
-            )
             raise SessionError(
                 f"{root}: {JOURNAL} cannot be rebuilt: {len(unproven)} of the session's images "
                 f"cannot be proven as captured: {shown}; nothing in this folder was changed: "
                 f"restore {JOURNAL} (or those files) from a backup copy of the folder, then run "
-                f"this again{reshoot}; meanwhile rti-rig fit {folder} --out DIR fits the "
+                f"this again; meanwhile rti-rig fit {folder} --out DIR fits the "
                 "session as it is, its verdict naming the images it cannot check"
             )
         notes: list[str] = []
         try:
             with signals_deferred():  # the journal, the moves and lights.lp: one change
                 stamp = _new_stamp(root)
-                notes, _moved = _rebuild_journal(root, manifest, taken, names, stamp, scan.records)
-                _relist_verified(root, {i: _to_record(e) for i, e in taken.items()}, stamp)
+                notes, _moved = _rebuild_journal(
+                    root, manifest, taken, names, stamp, scan.records, lost
+                )
+                # lights.lp lists what is on disk as captured: a lost image is not listed
+                # (relight pairs its lines with the JPEGs in order)
+                _relist_verified(
+                    root, verified_steps(root, [*taken.values(), *lost.values()], "image"), stamp
+                )
         except BaseException as exc:
             if notes:  # a stop held while the folder changed, acted on once it had: said so
                 exc.journal_rebuild = notes  # type: ignore[attr-defined]
@@ -1537,25 +1546,27 @@ def rebuild_advice(root: Path) -> str:
     """The words that name ``run --resume ROOT --rebuild-journal`` (to follow the advice to
     restore the journal from a backup) where it would take images back
     (:func:`rebuildable_journal`), else "": said where a lost journal is named (export-lp had
-    advised a backup alone, of a session its manifest can vouch for). A completed session whose
-    rebuild is refused only because images are missing or changed since capture is told the
-    reshoot instead, which restores the records the journal lost before it shoots exactly those
-    (the backup alone had been advised)."""
+    advised a backup alone, of a session its manifest can vouch for). A completed session with
+    images missing or changed since capture is told the reshoot too, which restores the records
+    the journal lost before it shoots exactly those (the backup alone had been advised), beside
+    the rebuild, which records them as lost without the rig."""
     folder = shlex.quote(str(root))
+    lost = _lost_beside_a_lost_journal(Path(root))
+    if lost:
+        return (
+            f", or, as {', '.join(lost[:5])}{' …' if len(lost) > 5 else ''} "
+            f"{'is' if len(lost) == 1 else 'are'} missing or changed since capture, reshoot "
+            f"exactly those with the object where it was: rti-rig run --resume {folder} "
+            f"--reshoot-lost (it restores the journal's records from {MANIFEST} first; "
+            f"without the rig, rti-rig run --resume {folder} --rebuild-journal rebuilds the "
+            f"journal and records {'it' if len(lost) == 1 else 'them'} as lost)"
+        )
     if rebuildable_journal(root):
         return (
             f", or rebuild it from {MANIFEST}'s records: rti-rig run --resume {folder} "
             "--rebuild-journal"
         )
-    lost = _lost_beside_a_lost_journal(Path(root))
-    if not lost:
-        return ""
-    return (
-        f", or, as {', '.join(lost[:5])}{' …' if len(lost) > 5 else ''} "
-        f"{'is' if len(lost) == 1 else 'are'} missing or changed since capture, reshoot exactly "
-        f"those with the object where it was: rti-rig run --resume {folder} --reshoot-lost (it "
-        f"restores the journal's records from {MANIFEST} first)"
-    )
+    return ""
 
 
 def _lost_beside_a_lost_journal(root: Path) -> list[str]:
@@ -1573,12 +1584,10 @@ def _lost_beside_a_lost_journal(root: Path) -> list[str]:
         ):
             return []
         names = image_names(total)
-        _taken, unproven, lost_only = _finished_rebuild(
-            root, manifest, names, scan_journal(root, names)
-        )
+        _taken, unproven, lost = _finished_rebuild(root, manifest, names, scan_journal(root, names))
     except SessionError:
         return []
-    return lost_only if unproven and len(lost_only) == len(unproven) else []
+    return [names[i] for i in sorted(lost)] if unproven and len(lost) == len(unproven) else []
 
 
 def _refuse_unjournaled(
@@ -1725,8 +1734,12 @@ def _rebuild_journal(
     names: list[str],
     stamp: str,
     journaled: list[dict[str, Any]],
+    lost: Mapping[int, dict[str, Any]] | None = None,
 ) -> tuple[list[str], list[str]]:
-    """Rebuild the journal from ``taken`` (:func:`_provable_steps`): the old journal is copied
+    """Rebuild the journal from ``taken`` (:func:`_provable_steps`) and the records of a
+    completed session's images recorded as lost (``lost``: their light as recorded, their
+    files not all as captured; those files are set aside as unproven, the others stay where
+    they are, as with the journal intact): the old journal is copied
     to ``recovered/STAMP/journal-damaged.jsonl``, every image file no taken record vouches for
     to ``recovered/STAMP/not-in-manifest/`` (neither the manifest nor an intact line of the old
     journal, ``journaled``, records its step) or ``recovered/STAMP/unproven/`` (recorded, but
@@ -1751,7 +1764,14 @@ def _rebuild_journal(
             raise SessionWriteError(dest, exc) from None
         # said, and recorded in the run's journal_rebuild, but no image: not counted with them
         notes.append(f"the damaged {JOURNAL} was kept as {dest.relative_to(root).as_posix()}")
+    lost = dict(lost or {})
     keep = {name for e in taken.values() for name in e["sha256"]}
+    keep |= {
+        name
+        for e in lost.values()
+        for name, digest in e["sha256"].items()
+        if _as_captured(root, e, name, digest)
+    }
     listed = _manifest_records(manifest, names)
     recorded = set(listed) | {e["index"] for e in journaled}
     steps_of = {n: i for i, n in enumerate(names)}
@@ -1781,7 +1801,8 @@ def _rebuild_journal(
             f"{JOURNAL}, so nothing proves its light"
         )
         notes.append(f"{rel} set aside as {moved[-1]}: {said}")
-    lines = b"".join(json.dumps(taken[i]).encode("utf-8") + b"\n" for i in sorted(taken))
+    written = {**lost, **taken}
+    lines = b"".join(json.dumps(written[i]).encode("utf-8") + b"\n" for i in sorted(written))
     _write_bytes_atomic(journal, lines)
     from_manifest = [i for i in sorted(taken) if listed.get(i) == taken[i]]
     from_journal = [i for i in sorted(taken) if listed.get(i) != taken[i]]
@@ -1799,6 +1820,22 @@ def _rebuild_journal(
             else ""
         ),
     )
+    if lost:
+        gone = {
+            i: [n for n, d in e["sha256"].items() if not _as_captured(root, e, n, d)]
+            for i, e in lost.items()
+        }
+        notes.insert(
+            1,
+            f"{len(lost)} image(s) recorded as captured and lost ("
+            + "; ".join(
+                f"{names[i]}: {', '.join(gone[i]) or 'its files'} not as captured"
+                for i in sorted(lost)[:8]
+            )
+            + (" …" if len(lost) > 8 else "")
+            + "): each one's record and light are back in the journal, its files that are not "
+            "as recorded set aside, the others left in place",
+        )
     # said on disk too, beside what was set aside: a stop before the run records it in the
     # manifest (the rig not answering, a Ctrl-C while it opens) had left recovered/ unexplained
     report = aside / "journal-rebuild.txt"

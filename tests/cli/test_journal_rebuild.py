@@ -269,10 +269,12 @@ def test_export_lp_names_the_rebuild(
     (done / "journal.jsonl").unlink()
     r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "y.lp")])
     assert r.exit_code == 2 and f"rti-rig run --resume {done} --rebuild-journal" in said(r)
-    # but not where the rebuild would be refused: an image it cannot prove
+    # with an image lost too: the reshoot that makes it whole, and the rebuild that records
+    # it as lost without the rig
     (done / "image_002.jpg").unlink()
     r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "y.lp")])
-    assert r.exit_code == 2 and "--rebuild-journal" not in said(r), r.output
+    assert r.exit_code == 2 and f"rti-rig run --resume {done} --reshoot-lost" in said(r)
+    assert f"{done} --rebuild-journal rebuilds the journal and records it as lost" in said(r)
 
 
 def test_a_rebuild_that_takes_nothing_back_keeps_no_old_line(
@@ -384,21 +386,63 @@ def test_a_completed_session_whose_journal_is_lost_is_made_whole(
     assert r.exit_code == 2 and "nothing to rebuild" in said(r), r.output
 
 
-def test_a_completed_session_with_an_image_it_cannot_prove_is_refused_untouched(
+def test_a_completed_session_with_a_record_given_another_light_is_refused_untouched(
     made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    """A record whose light is not its step's proves nothing, not even which image was lost:
+    the rebuild is refused, nothing moved."""
     _, ref, _ = made
     out = tmp_path / "done"
     shutil.copytree(ref, out)
     (out / "journal.jsonl").unlink()
-    (out / "image_003.jpg").unlink()
+    manifest = json.loads((out / "manifest.json").read_text())
+    manifest["steps"][2]["led"] = manifest["schedule"]["steps"][3]["led"]
+    (out / "manifest.json").write_text(json.dumps(manifest))
     before = _files(out)
     _no_rig(monkeypatch)
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 2, r.output
-    assert "image_003 (image_003.jpg missing or changed since capture)" in said(r)
+    assert "image_003 (its recorded light is not the one its step was given)" in said(r)
     assert "restore journal.jsonl (or those files) from a backup copy" in said(r)
     assert _files(out) == before
+
+
+def test_a_completed_session_with_an_image_it_cannot_prove_is_rebuilt_then_made_whole(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Journal lost and image_003.jpg corrupted: the rebuild had been refused whole for that
+    one image, every provable image left unproven. Now the journal is rebuilt from every proven
+    image, image_003 recorded as lost (its changed JPEG set aside, never deleted) with the one
+    command that reshoots it; fit says what is lost, and --reshoot-lost makes it whole."""
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    (out / "journal.jsonl").unlink()
+    corrupted = (out / "image_003.jpg").read_bytes()[:-100] + b"\0" * 100
+    (out / "image_003.jpg").write_bytes(corrupted)
+    with monkeypatch.context() as m:
+        _no_rig(m)
+        r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    reshoot = f"rti-rig run --resume {out} --reshoot-lost"
+    assert "7 image(s) taken back" in said(r), r.output
+    assert "1 image(s) recorded as captured and lost (image_003: image_003.jpg" in said(r)
+    assert "but the session is not whole: 1 image(s) lost since capture (image_003" in said(r)
+    assert reshoot in said(r) and "whole again" not in said(r)
+    (aside,) = (out / "recovered").rglob("unproven/image_003.jpg")
+    assert aside.read_bytes() == corrupted
+    # the journal holds all 8 records, as captured
+    assert (out / "journal.jsonl").read_bytes() == (ref / "journal.jsonl").read_bytes()
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert "image_003" in said(r) and reshoot in said(r) and "not checked" not in said(r)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert aside.read_bytes() == corrupted  # never overwritten
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit2"), "--model", "ps"])
+    assert r.exit_code == 0 and "QA verdict: good" in said(r), r.output
+    assert "missing or changed" not in said(r)
+    assert _images(out) == _images(ref)
 
 
 def test_a_stop_while_a_completed_session_is_rebuilt_says_what_it_left(
@@ -575,11 +619,8 @@ def test_reshoot_lost_of_a_session_whose_journal_is_lost_reshoots_only_the_lost_
     shutil.copytree(ref, out)
     (out / "journal.jsonl").unlink()
     (out / "image_005.jpg").unlink()
-    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
-    assert r.exit_code == 2 and "image_005" in said(r), r.output
     reshoot = f"rti-rig run --resume {out} --reshoot-lost"
-    assert f"or reshoot exactly those, with the object where it was: {reshoot}" in said(r)
-    # export-lp says so too (it had named a backup alone)
+    # export-lp names the reshoot (it had named a backup alone)
     r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
     assert r.exit_code == 2 and "as image_005 is missing or changed since capture" in said(r)
     assert f"with the object where it was: {reshoot}" in said(r), r.output

@@ -1019,3 +1019,32 @@ def _fit_the_rest(done: Path, out: Path) -> None:
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["fit", str(rest), "--out", str(out), "--model", "ps"])
     assert r.exit_code == 0, r.output
+
+
+def test_a_missing_raw_beside_a_lost_journal_is_rebuilt_as_lost_and_its_image_still_fitted(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """Journal lost and raw/image_006.dng gone from a finished DSLR session: the rebuild had
+    refused the whole journal for it. Now every image is taken back, image_006 recorded as
+    lost with its JPEG and TIFF left in place (still listed and fitted), and the verdict and
+    the rebuild name the reshoot that gets the original back."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    _with_raw_originals(done)
+    journal = (done / "journal.jsonl").read_bytes()
+    (done / "journal.jsonl").unlink()
+    (done / "raw" / "image_006.dng").unlink()
+    lp = (done / "lights.lp").read_bytes()
+    r = runner.invoke(app, ["run", "--resume", str(done), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    reshoot = f"rti-rig run --resume {done} --reshoot-lost"
+    assert "lost since capture (image_006: raw/image_006.dng missing)" in said(r), r.output
+    assert reshoot in said(r)
+    assert (done / "journal.jsonl").read_bytes() == journal
+    assert (done / "lights.lp").read_bytes() == lp  # its developed image stays listed
+    assert not list((done / "recovered").rglob("image_*"))  # nothing else was set aside
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert verdict.startswith("reshoot: image_006 (raw/image_006.dng missing since capture: the")
+    assert reshoot in verdict
