@@ -127,6 +127,43 @@ def committed_files(root: Path) -> dict[str, str]:
     return out
 
 
+def note_committed(root: Path, seen: dict[int, set[str]]) -> None:
+    """Add to ``seen`` (step → its records) each record the journal of session ``root`` holds
+    now (well-formed ones, as resume reads them), as its canonical JSON: a later capture of a
+    step has another record (its rig time at least), even where the simulated image has the
+    same bytes."""
+    import json
+
+    if not (root / "journal.jsonl").exists():
+        return
+    for entry in scan_journal(root).records:
+        seen.setdefault(entry["index"], set()).add(json.dumps(entry, sort_keys=True))
+
+
+def reshoots(root: Path, seen: dict[int, set[str]]) -> tuple[int, int]:
+    """What session ``root``'s runs set aside and shot again, at its end: (images set aside,
+    committed images shot again).
+
+    An image set aside is one step's files moved to ``recovered/`` by one resume (each resume
+    has its own ``recovered/STAMP/``). A committed image shot again is a step with more than one
+    record among those committed (:func:`note_committed`, whenever it was called) and the final
+    journal's: its committed capture was replaced by a later one. Why: "images lost" compares
+    the final files with those committed, and on the simulated rigs a step shot again has the
+    same bytes, so an image set aside and shot again went unseen. (Whether a set-aside file was
+    committed cannot be told by its bytes, for the same reason.)"""
+    import json
+
+    recovered = root / "recovered"
+    set_aside = {
+        (path.relative_to(recovered).parts[0], "_".join(path.stem.split("_")[:2]))
+        for path in (recovered.rglob("image_*") if recovered.is_dir() else ())
+        if path.is_file()
+    }
+    final = {e["index"]: json.dumps(e, sort_keys=True) for e in scan_journal(root).records}
+    again = sum(1 for i, records in seen.items() if len(records | {final.get(i, "")} - {""}) > 1)
+    return len(set_aside), again
+
+
 def first_finish_reason(out: Path) -> str | None:
     """How the first run ended; ``"error"`` if it stopped before writing anything (a rig that
     fails at connect leaves nothing on disk)."""
@@ -239,8 +276,10 @@ def session_fault(
     stats: Counter,
     faults: Counter,
     tracebacks: Tracebacks,
+    seen: dict[int, set[str]],
 ) -> Path:
-    """Play one of the :data:`SESSION` faults on a new session; returns its config."""
+    """Play one of the :data:`SESSION` faults on a new session; returns its config. The
+    records committed before the fault damages the journal are noted in ``seen``."""
     kind = "dome" if rng.random() < 0.6 else "arm"
     cfg = make_config(tmpdir, kind, seed_i)
     if fault_kind.startswith("disk-full-"):
@@ -258,6 +297,7 @@ def session_fault(
     run_in_process(cfg, out, n, None, False, tracebacks, cancel_after=max(1, k))
     if not (out / "manifest.json").exists():
         return cfg
+    note_committed(out, seen)
     if fault_kind == "rig-changed-at-resume":
         changed = other_rig(tmpdir, cfg, kind, seed_i, rng)
         before = sorted(p.as_posix() for p in out.rglob("*"))
@@ -281,6 +321,7 @@ def session_fault(
     elif fault_kind == "torn-journal-killed-resumes":
         journal = out / "journal.jsonl"
         for _ in range(int(rng.integers(1, 4))):  # a chain of interrupted resumes
+            note_committed(out, seen)  # what the last killed resume committed, before the cut
             if journal.exists() and journal.stat().st_size:
                 data = journal.read_bytes()
                 journal.write_bytes(data[: -int(rng.integers(1, min(60, len(data)) + 1))])
@@ -315,6 +356,7 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
     kinds = tuple(k for g in groups for k in GROUPS[g])
     faults: Counter[str] = Counter()
     stats: Counter[str] = Counter()
+    reshot: dict[str, Counter[str]] = {}  # per fault kind: what was set aside and shot again
     tracebacks = Tracebacks()
     with tempfile.TemporaryDirectory() as tmp:
         tmpdir = Path(tmp)
@@ -322,6 +364,7 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
             n = int(rng.integers(6, 17))
             out = tmpdir / f"session_{i:04d}"
             fault_kind = str(rng.choice(kinds))
+            seen: dict[int, set[str]] = {}  # step → its journal records, as committed
             k = int(rng.integers(0, n))
             seed_i = int(rng.integers(0, 1000))
             if fault_kind in SERIAL:
@@ -346,7 +389,7 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                 stats["servo_faults_stopped_with_error"] += int(first == "error")
             elif fault_kind in SESSION:
                 cfg = session_fault(
-                    fault_kind, tmpdir, out, n, k, seed_i, rng, stats, faults, tracebacks
+                    fault_kind, tmpdir, out, n, k, seed_i, rng, stats, faults, tracebacks, seen
                 )
             else:
                 cfg = make_config(tmpdir, "dome" if rng.random() < 0.6 else "arm", seed_i)
@@ -369,6 +412,7 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                     run_in_process(cfg, out, n, None, False, tracebacks)
                     continue
                 snapshots.update(committed_files(out))
+                note_committed(out, seen)
                 m = read_manifest(out)
                 if m["runner"].get("finish_reason") == "completed":
                     break
@@ -398,6 +442,11 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
                 or hashlib.sha256((out / name).read_bytes()).hexdigest() != digest
             )
             stats["images_lost"] += lost
+            aside, again = reshoots(out, seen)
+            stats["images_set_aside"] += aside
+            stats["committed_images_shot_again"] += again
+            row = reshot.setdefault(fault_kind, Counter())
+            row.update(sessions=1, set_aside=aside, shot_again=again)
             stats["wrong_light_images"] += len(wrong_light_steps(cfg, out))
             stats["images_checked"] += len(m["steps"])
             if (i + 1) % 20 == 0:
@@ -405,7 +454,11 @@ def campaign(sessions: int, seed: int, groups: tuple[str, ...] = tuple(GROUPS)) 
     stats["tracebacks"] = len(tracebacks.seen)
     for line in tracebacks.seen[:10]:
         print(f"traceback: {line}", flush=True)
-    return {"stats": dict(stats), "faults": dict(faults)}
+    return {
+        "stats": dict(stats),
+        "faults": dict(faults),
+        "reshoots": {k: dict(v) for k, v in sorted(reshot.items())},
+    }
 
 
 def report(
@@ -455,9 +508,21 @@ def report(
             "sessions_restarted_from_nothing",
         ),
         ("SIGKILL faults that failed to kill", "kills_that_did_not_kill"),
+        (
+            "images set aside in `recovered/` (one step's files moved by one resume, kept)",
+            "images_set_aside",
+        ),
+        (
+            "committed images shot again (the step's final record is a later capture)",
+            "committed_images_shot_again",
+        ),
     ]
     figures = "\n".join(f"| {label} | {s.get(key, 0)} |" for label, key in labels)
     rows = "\n".join(f"| {k} | {v} |" for k, v in sorted(f.items()))
+    reshot = "\n".join(
+        f"| {k} | {r.get('sessions', 0)} | {r.get('set_aside', 0)} | {r.get('shot_again', 0)} |"
+        for k, r in sorted(result.get("reshoots", {}).items())
+    )
     faults_opt = "" if set(groups) == set(GROUPS) else f" --faults {','.join(groups)}"
     command = (
         f"python -m benchmarks.fault_campaign --sessions {sessions} --seed {seed}{faults_opt} "
@@ -481,6 +546,16 @@ further in-process fault.
 | kind | count |
 |---|---|
 {rows}
+
+## Images set aside and shot again, by the session's first fault
+
+"Images lost" compares each session's final files with the images committed before its
+faults; a step set aside and shot again is not lost (its files are kept in `recovered/`, and on
+the simulated rigs the new capture has the same bytes), so it is counted here.
+
+| first fault | sessions | images set aside | committed images shot again |
+|---|---|---|---|
+{reshot}
 
 - `camera-failure`: the camera raises a capture error (no frame) at the step.
 - `light-failure`: the dome's `light` command or the arm's move fails at the step.
