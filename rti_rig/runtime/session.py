@@ -2309,7 +2309,10 @@ def _stopped_while_committing(
         return None
     last = max((int(r["index"]) for r in records), default=-1)
     beyond = [n for n in unrecorded if names.index(n) > last]
-    if beyond != names[last + 1 : last + 2]:
+    # none beyond the last record: every step is recorded (a completed session whose
+    # --reshoot-lost was killed while saving the image it shot again, its step recorded by the
+    # capture it replaces), and fit and export-lp had died on an IndexError
+    if not beyond or beyond != names[last + 1 : last + 2]:
         return None
     # a step the manifest records was committed (only a run's end writes them there): its
     # journal line was lost since, not cut by a stop, and the verdict had said "neither its

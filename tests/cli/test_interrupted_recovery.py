@@ -1,0 +1,61 @@
+"""Recovery commands interrupted part-way: ``run --resume --reshoot-lost`` and
+``--rebuild-journal`` killed, then fit, export-lp and a resume; every image survives, and
+every message names the session, what happened and a next command that is not refused."""
+
+from __future__ import annotations
+
+import hashlib
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import SMALL_DOME, said, write_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.testing.kill_hooks import popen_argv
+
+runner = CliRunner()
+LIGHTS = 6
+
+
+def _images(folder: Path) -> dict[str, str]:
+    files = [*folder.glob("image_*.jpg"), *(folder / "linear").glob("*.tif"), folder / "lights.lp"]
+    return {
+        p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest() for p in files
+    }
+
+
+@pytest.fixture(scope="module")
+def ref(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    base = tmp_path_factory.mktemp("ref")
+    cfg = write_config(base, SMALL_DOME)
+    out = base / "done"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def test_a_reshoot_killed_while_saving_is_fitted_exported_and_resumed(
+    ref: Path, tmp_path: Path
+) -> None:
+    """--reshoot-lost of image_003 SIGKILLed between its TIFF and its JPEG: fit and export-lp
+    of the folder died on an IndexError (every step recorded, the session no longer
+    completed). Now both work, and the resume they name makes the session whole."""
+    out = tmp_path / "s"
+    shutil.copytree(ref, out)
+    damaged = (out / "image_003.jpg").read_bytes() + b"x"
+    (out / "image_003.jpg").write_bytes(damaged)
+    proc = popen_argv("between_files", 0, ["run", "--resume", str(out), "--reshoot-lost"])
+    proc.communicate(timeout=300)
+    assert proc.returncode == -9
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert "image_003" in said(r) and f"rti-rig run --resume {out}" in said(r), r.output
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 0 and "image_003.jpg" in said(r), r.output
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert _images(out) == _images(ref)
+    kept = [p.read_bytes() for p in (out / "recovered").rglob("image_003.jpg")]
+    assert kept == [damaged]  # set aside, never deleted nor overwritten
