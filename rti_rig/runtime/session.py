@@ -2008,6 +2008,19 @@ def lost_image_advice(root: Path, adaptive: bool) -> str:
             "put the originals back from a copy (an adaptive session cannot reshoot one image: "
             "the lights after it were chosen from it), or start a new session with another --out"
         )
+    try:
+        finished = (read_manifest(root).get("runner") or {}).get("finish_reason")
+    except SessionError:
+        finished = None
+    if finished != "completed":
+        # a session not finished (a --reshoot-lost killed part-way, say): --reshoot-lost is
+        # refused for it, and its plain resume sets aside and shoots again what it cannot
+        # verify (the advice had named --reshoot-lost, which then said to drop it)
+        return (
+            "put the originals back from a copy, or let its resume set them aside and shoot "
+            f"them again, with the object where it was: rti-rig run --resume "
+            f"{shlex.quote(str(root))}"
+        )
     return (
         "put the originals back from a copy, or reshoot exactly those, with the object where "
         f"it was: rti-rig run --resume {shlex.quote(str(root))} --reshoot-lost"

@@ -41,7 +41,8 @@ def test_a_reshoot_killed_while_saving_is_fitted_exported_and_resumed(
 ) -> None:
     """--reshoot-lost of image_003 SIGKILLed between its TIFF and its JPEG: fit and export-lp
     of the folder died on an IndexError (every step recorded, the session no longer
-    completed). Now both work, and the resume they name makes the session whole."""
+    completed), and the verdict advised --reshoot-lost, which is refused for a session not
+    finished. Now both work, the advice is the plain resume, and it makes the session whole."""
     out = tmp_path / "s"
     shutil.copytree(ref, out)
     damaged = (out / "image_003.jpg").read_bytes() + b"x"
@@ -52,6 +53,7 @@ def test_a_reshoot_killed_while_saving_is_fitted_exported_and_resumed(
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 0, r.output
     assert "image_003" in said(r) and f"rti-rig run --resume {out}" in said(r), r.output
+    assert "--reshoot-lost" not in said(r)  # refused for a session not finished
     r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
     assert r.exit_code == 0 and "image_003.jpg" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
