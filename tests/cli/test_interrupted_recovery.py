@@ -61,3 +61,22 @@ def test_a_reshoot_killed_while_saving_is_fitted_exported_and_resumed(
     assert _images(out) == _images(ref)
     kept = [p.read_bytes() for p in (out / "recovered").rglob("image_003.jpg")]
     assert kept == [damaged]  # set aside, never deleted nor overwritten
+
+
+def test_the_reshoot_says_where_it_set_the_files_aside_without_calling_them_unverified(
+    ref: Path, tmp_path: Path
+) -> None:
+    """--reshoot-lost of image_002 (its JPEG changed, its TIFF as captured): "2 unverified
+    file(s) moved to recovered/" had been said of a TIFF whose checksum matched, in a folder
+    whose recovered/ may hold earlier resumes' files too."""
+    out = tmp_path / "s"
+    shutil.copytree(ref, out)
+    (out / "image_002.jpg").write_bytes((out / "image_002.jpg").read_bytes() + b"x")
+    r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    (stamp,) = (out / "recovered").iterdir()
+    assert (
+        f"2 file(s) of the images to reshoot set aside in recovered/{stamp.name}/ (never "
+        "deleted)" in said(r)
+    ), r.output
+    assert "unverified" not in said(r)

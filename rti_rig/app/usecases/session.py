@@ -1053,10 +1053,19 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     done = len(folder.done)
     resume = folder.resume
     recovered = resume.recovered if resume else []
+    # where they went, said: the folder of this resume, not recovered/ at large (which may hold
+    # earlier resumes' too); with --reshoot-lost they are the files of the images to shoot
+    # again, which had been called "unverified" though their checksums may well match
+    where = ", ".join(sorted({"/".join(Path(p).parts[:2]) for p in recovered}))
+    moved = (
+        f", {len(recovered)} file(s) of the images to reshoot set aside in {where}/ (never deleted)"
+        if req.reshoot_lost
+        else f", {len(recovered)} unverified file(s) moved to {where}/"
+    )
     on_note(
         Note(
             f"Resuming {req.session_dir}: {done} of {folder.total_steps} images verified on disk"
-            + (f", {len(recovered)} unverified file(s) moved to recovered/" if recovered else "")
+            + (moved if recovered else "")
         )
     )
     for line in resume.journal_repair if resume else []:
