@@ -632,3 +632,31 @@ def test_reshoot_lost_of_a_session_whose_journal_is_lost_reshoots_only_the_lost_
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 0 and "not checked" not in said(r), r.output
     assert "QA verdict: good" in said(r)
+
+
+def test_a_stop_held_while_a_rebuild_records_an_image_lost_says_it_is_not_whole(
+    made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C held while the journal of a completed session with image_004.jpg deleted is
+    rebuilt: acted on once it is; "the session is whole again" must not be said, but what
+    is lost and the reshoot that gets it back."""
+    import rti_rig.runtime.session as session
+
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    (out / "journal.jsonl").unlink()
+    (out / "image_004.jpg").unlink()
+    real_relist = session._relist_verified
+
+    def relisted_then_stopped(*args, **kwargs):  # type: ignore[no-untyped-def]
+        real_relist(*args, **kwargs)
+        raise KeyboardInterrupt  # a Ctrl-C held by the block, acted on at its end
+
+    monkeypatch.setattr(session, "_relist_verified", relisted_then_stopped)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 130, r.output
+    assert "whole again" not in said(r), r.output
+    assert "once journal.jsonl was rebuilt: 1 image(s) lost since capture (image_004" in said(r)
+    assert f"rti-rig run --resume {out} --reshoot-lost" in said(r)
+    assert (out / "journal.jsonl").read_bytes() == (ref / "journal.jsonl").read_bytes()
