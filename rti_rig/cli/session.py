@@ -1169,6 +1169,8 @@ def export_lp(
             + (f"; {escape(done.renamed)}" if done.renamed else ""),
             soft_wrap=True,
         )
+    if done.raw_lost:
+        err.print(f"[yellow]note:[/] {escape(done.raw_lost)}", soft_wrap=True)
     if done.unchecked:
         err.print(
             f"[yellow]note:[/] left out, not verifiable as captured "

@@ -1048,3 +1048,23 @@ def test_a_missing_raw_beside_a_lost_journal_is_rebuilt_as_lost_and_its_image_st
     verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
     assert verdict.startswith("reshoot: image_006 (raw/image_006.dng missing since capture: the")
     assert reshoot in verdict
+
+
+def test_export_lp_lists_an_image_whose_raw_is_lost_and_says_the_original_is_lost(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """export-lp of a finished DSLR session without raw/image_002.dng said nothing of it, while
+    the verdict names the image lost: its JPEG is listed (as captured), and the lost original
+    named with the reshoot that gets it back."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    _with_raw_originals(done)
+    (done / "raw" / "image_002.dng").unlink()
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(done / "x.lp")])
+    assert r.exit_code == 0, r.output
+    assert [e.name for e in read_lp(done / "x.lp")] == [e.name for e in read_lp(ref / "lights.lp")]
+    assert (
+        "raw/image_002.dng missing since capture: the camera's original capture of image_002 "
+        "is lost (the developed image is as captured, and listed)" in said(r)
+    ), r.output
+    assert f"rti-rig run --resume {done} --reshoot-lost" in said(r)

@@ -13,6 +13,10 @@ from rti_rig.app.output_files import check_output_file
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
+    files_lost_since_capture,
+    lost_image_advice,
+    originals_lost,
+    read_manifest,
     rebuild_advice,
     refuse_if_in_use,
     renamed_note,
@@ -46,6 +50,8 @@ class ExportedLp:
     rebuild: str = ""
     #: What to say of left-out JPEGs that are in the folder under another name ("" if none).
     renamed: str = ""
+    #: What to say of listed images whose kept RAW original is lost ("" if none).
+    raw_lost: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -68,4 +74,27 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         why,
         rebuild=rebuild,
         renamed=renamed_note(renamed),
+        raw_lost=_raw_lost(Path(req.session_dir), {Path(e.name).stem for e in entries}),
+    )
+
+
+def _raw_lost(root: Path, listed: set[str]) -> str:
+    """What to say of the images ``listed`` whose camera originals alone are lost: the RAW is
+    the original capture, so the image is lost, though its developed file is as captured and
+    listed. Why: export-lp said nothing of it, while the QA verdict names it and
+    ``--reshoot-lost`` shoots it again."""
+    lost = sorted(
+        (n, g)
+        for n, g in files_lost_since_capture(root).items()
+        if n in listed and originals_lost(g)
+    )
+    if not lost:
+        return ""
+    files = ", ".join(f for _, g in lost[:8] for f in g) + (" …" if len(lost) > 8 else "")
+    adaptive = bool(read_manifest(root).get("adaptive"))
+    return (
+        f"{files} since capture: the camera's original capture of "
+        f"{', '.join(n for n, _ in lost[:8])} is lost (the developed "
+        f"{'image is' if len(lost) == 1 else 'images are'} as captured, and listed); "
+        + lost_image_advice(root, adaptive)
     )
