@@ -1289,9 +1289,14 @@ def _prepare_resume(
         done = {i: _to_record(rec) for i, rec in latest.items() if i not in lost}
     else:
         if reshoot_lost:
+            # the command named: after a --reshoot-lost stopped part-way, the user's next try
+            # is the same command again, and "drop --reshoot-lost" left the rest to guess
             raise SessionError(
-                f"{root}: --reshoot-lost is for a session that completed; this one did not, and "
-                "its resume reshoots whatever it cannot verify anyway: drop --reshoot-lost"
+                f"{root}: --reshoot-lost is for a session that completed; this one did not "
+                f"({_ENDED_AS.get(runner.get('finish_reason'), 'its last run did not finish')}), "
+                "and its resume sets aside and shoots again whatever it cannot verify anyway "
+                "(nothing in this folder was changed): continue it with rti-rig run --resume "
+                f"{shlex.quote(str(root))}"
             )
         unjournaled = _unjournaled_steps(root, manifest, scan, names)
         if rebuild_journal and unjournaled:
@@ -1371,6 +1376,19 @@ def _prepare_resume(
         journal_repair=repair,
         journal_rebuild=rebuild,
     )
+
+
+#: How a run that did not finish ended, by the manifest's finish_reason (for a refusal).
+_ENDED_AS = {
+    "cancelled": "its last run was stopped by Ctrl-C",
+    "interrupted": "its last run was interrupted",
+    "error": "its last run stopped on an error",
+    "emergency-stop": "its last run was stopped by an emergency stop",
+    "write-failed": "its last run could not write a file",
+    "no-space": "its last run found the disk full",
+    "crashed": "its last run stopped without finishing",
+    None: "its last run was killed before recording how it ended",
+}
 
 
 def _manifest_records(manifest: dict[str, Any], names: list[str]) -> dict[int, dict[str, Any]]:

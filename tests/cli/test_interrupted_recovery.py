@@ -80,3 +80,26 @@ def test_the_reshoot_says_where_it_set_the_files_aside_without_calling_them_unve
         "deleted)" in said(r)
     ), r.output
     assert "unverified" not in said(r)
+
+
+def test_the_reshoot_again_after_it_was_killed_names_the_resume_that_continues(
+    ref: Path, tmp_path: Path
+) -> None:
+    """The same --reshoot-lost again after it was SIGKILLed before its light: refused with
+    "drop --reshoot-lost", the command left to guess. Now it says how the last run ended and
+    names the resume; nothing in the folder changes, and that resume makes it whole."""
+    out = tmp_path / "s"
+    shutil.copytree(ref, out)
+    (out / "image_005.jpg").write_bytes((out / "image_005.jpg").read_bytes() + b"x")
+    proc = popen_argv("before_light", 0, ["run", "--resume", str(out), "--reshoot-lost"])
+    proc.communicate(timeout=300)
+    assert proc.returncode == -9
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost"])
+    assert r.exit_code == 2, r.output
+    assert "its last run was killed before recording how it ended" in said(r), r.output
+    assert said(r).endswith(f"continue it with rti-rig run --resume {out}"), r.output
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert _images(out) == _images(ref)
