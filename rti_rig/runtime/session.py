@@ -1798,6 +1798,13 @@ def _rebuild_journal(
         *(root / LINEAR_DIR).glob("image_*"),
         *(root / RAW_DIR).glob("image_*"),
     ]
+    latest = _latest_records(list(journaled))
+    unproven_why: dict[int, str] = {}  # said before anything moves (a move makes a file missing)
+    for path in files:
+        step = steps_of.get("_".join(path.stem.split("_")[:2]))
+        if step is None or step in unproven_why or step in taken:
+            continue
+        unproven_why[step] = _why_unproven(root, manifest, latest.get(step), listed.get(step))
     for path in sorted(p for p in files if p.is_file()):
         rel = path.relative_to(root).as_posix()
         if rel in keep:
@@ -1813,8 +1820,8 @@ def _rebuild_journal(
         moved.append(dest.relative_to(root).as_posix())
         said = (
             f"its step is recorded (in {MANIFEST} or an intact line of the old {JOURNAL}), but "
-            "not all its files (or its light) are as recorded there"
-            if why == "unproven"
+            + (unproven_why.get(step) or "not all its files (or its light) are as recorded there")
+            if why == "unproven" and step is not None
             else f"{MANIFEST} does not list its step, nor does an intact line of the old "
             f"{JOURNAL}, so nothing proves its light"
         )
@@ -1864,6 +1871,35 @@ def _rebuild_journal(
     _write_bytes_atomic(report, "".join(f"{n}\n" for n in notes).encode("utf-8"))
     notes.append(f"what was done is written in {report.relative_to(root).as_posix()}")
     return notes, moved
+
+
+def _why_unproven(
+    root: Path,
+    manifest: dict[str, Any],
+    journaled: dict[str, Any] | None,
+    listed: dict[str, Any] | None,
+) -> str | None:
+    """Why a recorded step's image is not proven (its record from an intact journal line,
+    ``journaled``, or the manifest's, ``listed``): its light, or the files of it missing or
+    changed since capture, named (a RAW original too: the original capture). None when
+    neither records it.
+
+    Why: the rebuild said "not all its files (or its light) are as recorded" of a step whose
+    RAW original alone was missing, not naming what was lost."""
+    records = [e for e in (journaled, listed) if e is not None]
+    if not records:
+        return None
+    lit = [e for e in records if _light_as_recorded(manifest, e)]
+    if not lit:
+        return "its recorded light is not the one its step was given"
+    gone = [
+        f"{name} {'changed' if (root / name).is_file() else 'missing'}"
+        for name, digest in lit[0]["sha256"].items()
+        if not _as_captured(root, lit[0], name, digest)
+    ]
+    if not gone:
+        return None
+    return f"{', '.join(gone)} since capture"
 
 
 def _shown(names: list[str], steps: list[int]) -> str:

@@ -1068,3 +1068,24 @@ def test_export_lp_lists_an_image_whose_raw_is_lost_and_says_the_original_is_los
         "is lost (the developed image is as captured, and listed)" in said(r)
     ), r.output
     assert f"rti-rig run --resume {done} --reshoot-lost" in said(r)
+
+
+def test_a_rebuild_names_the_missing_raw_that_leaves_an_image_unproven(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """A stopped DSLR session without its journal and without raw/image_002.dng: the rebuild
+    set image_002's JPEG and TIFF aside saying "not all its files (or its light) are as
+    recorded there". Now it names the lost original; the resume shoots the step again."""
+    cfg, ref = reference
+    out = tmp_path / "s"
+    cancelled_after(cfg, out, 4)
+    _with_raw_originals(out)
+    (out / "raw" / "image_002.dng").unlink()
+    (out / "journal.jsonl").unlink()
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "image_002.jpg set aside as recovered/" in said(
+        r
+    ) and "but raw/image_002.dng missing since capture" in said(r), r.output
+    assert "not all its files" not in said(r)
+    assert digests(out) == digests(ref)
