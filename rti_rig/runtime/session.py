@@ -1524,10 +1524,21 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
         folder = shlex.quote(str(root))
         if unproven is None:
+            # what is lost, named with what gets it back: the user who reached for the rebuild
+            # had been sent to a fit to find out
+            lost = files_lost_since_capture(root)
+            shown = "; ".join(f"{n}: {', '.join(g)}" for n, g in sorted(lost.items())[:8])
             raise SessionError(
                 f"{root}: this session completed and its {JOURNAL} holds a record of every "
-                f"image it captured: nothing to rebuild; drop --rebuild-journal (the QA verdict "
-                f"of rti-rig fit {folder} --out DIR names any image changed since capture)"
+                "image it captured: nothing to rebuild; drop --rebuild-journal"
+                + (
+                    f"; but {len(lost)} image(s) are lost since capture ({shown}"
+                    f"{' …' if len(lost) > 8 else ''}): "
+                    + lost_image_advice(root, bool(manifest.get("adaptive")))
+                    if lost
+                    else f" (the QA verdict of rti-rig fit {folder} --out DIR names any image "
+                    "changed since capture)"
+                )
             )
         if len(lost) < len(unproven):
             shown = "; ".join(unproven[:8]) + (" …" if len(unproven) > 8 else "")

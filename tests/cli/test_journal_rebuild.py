@@ -660,3 +660,21 @@ def test_a_stop_held_while_a_rebuild_records_an_image_lost_says_it_is_not_whole(
     assert "once journal.jsonl was rebuilt: 1 image(s) lost since capture (image_004" in said(r)
     assert f"rti-rig run --resume {out} --reshoot-lost" in said(r)
     assert (out / "journal.jsonl").read_bytes() == (ref / "journal.jsonl").read_bytes()
+
+
+def test_a_rebuild_of_a_whole_journal_names_the_image_lost_and_its_reshoot(
+    made: tuple[Path, Path, Path], tmp_path: Path
+) -> None:
+    """A completed session with its journal intact and image_006.jpg deleted: a user reaching
+    for --rebuild-journal was told "nothing to rebuild" and sent to a fit to find out what was
+    wrong. Now what is lost is named with the reshoot; nothing changes."""
+    _, ref, _ = made
+    out = tmp_path / "done"
+    shutil.copytree(ref, out)
+    (out / "image_006.jpg").unlink()
+    before = _files(out)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    assert r.exit_code == 2 and "nothing to rebuild" in said(r), r.output
+    assert "1 image(s) are lost since capture (image_006: image_006.jpg missing)" in said(r)
+    assert said(r).endswith(f"rti-rig run --resume {out} --reshoot-lost"), r.output
+    assert _files(out) == before
