@@ -1166,7 +1166,8 @@ def export_lp(
         err.print(
             f"[yellow]note:[/] left out, missing or changed since they were captured: "
             f"{escape(', '.join(done.left_out))}"
-            + (f"; {escape(done.renamed)}" if done.renamed else ""),
+            + (f"; {escape(done.renamed)}" if done.renamed else "")
+            + (f"; {escape(done.left_out_advice)}" if done.left_out_advice else ""),
             soft_wrap=True,
         )
     if done.raw_lost:

@@ -1089,3 +1089,20 @@ def test_a_rebuild_names_the_missing_raw_that_leaves_an_image_unproven(
     ) and "but raw/image_002.dng missing since capture" in said(r), r.output
     assert "not all its files" not in said(r)
     assert digests(out) == digests(ref)
+
+
+def test_export_lp_names_the_reshoot_of_the_images_it_leaves_out(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """export-lp of a finished session with image_003.jpg deleted left it out and named it,
+    but not what gets it back (the verdict names the reshoot)."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    (done / "image_003.jpg").unlink()
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(done / "x.lp")])
+    assert r.exit_code == 0, r.output
+    assert (
+        "left out, missing or changed since they were captured: image_003.jpg; put the "
+        f"originals back from a copy, or reshoot exactly those, with the object where it was: "
+        f"rti-rig run --resume {done} --reshoot-lost" in said(r)
+    ), r.output

@@ -52,6 +52,9 @@ class ExportedLp:
     renamed: str = ""
     #: What to say of listed images whose kept RAW original is lost ("" if none).
     raw_lost: str = ""
+    #: What to do about the images left out as missing or changed ("" if none, or if every
+    #: one is in the folder under another name).
+    left_out_advice: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -75,6 +78,15 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         rebuild=rebuild,
         renamed=renamed_note(renamed),
         raw_lost=_raw_lost(Path(req.session_dir), {Path(e.name).stem for e in entries}),
+        # the images left out named with what gets them back, as the verdict does (the note
+        # named them alone)
+        left_out_advice=(
+            lost_image_advice(
+                Path(req.session_dir), bool(read_manifest(req.session_dir).get("adaptive"))
+            )
+            if len(left_out) > len(renamed)
+            else ""
+        ),
     )
 
 
