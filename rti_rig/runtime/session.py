@@ -1526,16 +1526,16 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         if unproven is None:
             # what is lost, named with what gets it back: the user who reached for the rebuild
             # had been sent to a fit to find out
-            lost = files_lost_since_capture(root)
-            shown = "; ".join(f"{n}: {', '.join(g)}" for n, g in sorted(lost.items())[:8])
+            gone = files_lost_since_capture(root)
+            shown = "; ".join(f"{n}: {', '.join(g)}" for n, g in sorted(gone.items())[:8])
             raise SessionError(
                 f"{root}: this session completed and its {JOURNAL} holds a record of every "
                 "image it captured: nothing to rebuild; drop --rebuild-journal"
                 + (
-                    f"; but {len(lost)} image(s) are lost since capture ({shown}"
-                    f"{' …' if len(lost) > 8 else ''}): "
+                    f"; but {len(gone)} image(s) are lost since capture ({shown}"
+                    f"{' …' if len(gone) > 8 else ''}): "
                     + lost_image_advice(root, bool(manifest.get("adaptive")))
-                    if lost
+                    if gone
                     else f" (the QA verdict of rti-rig fit {folder} --out DIR names any image "
                     "changed since capture)"
                 )
@@ -1810,12 +1810,12 @@ def _rebuild_journal(
         *(root / RAW_DIR).glob("image_*"),
     ]
     latest = _latest_records(list(journaled))
-    unproven_why: dict[int, str] = {}  # said before anything moves (a move makes a file missing)
-    for path in files:
-        step = steps_of.get("_".join(path.stem.split("_")[:2]))
-        if step is None or step in unproven_why or step in taken:
-            continue
-        unproven_why[step] = _why_unproven(root, manifest, latest.get(step), listed.get(step))
+    # said before anything moves (a move makes a file missing)
+    unproven_why: dict[int, str | None] = {
+        step: _why_unproven(root, manifest, latest.get(step), listed.get(step))
+        for step in {steps_of.get("_".join(p.stem.split("_")[:2])) for p in files} | set(lost)
+        if step is not None and step not in taken
+    }
     for path in sorted(p for p in files if p.is_file()):
         rel = path.relative_to(root).as_posix()
         if rel in keep:
@@ -1856,16 +1856,12 @@ def _rebuild_journal(
             else ""
         ),
     )
-    if lost:
-        gone = {
-            i: [n for n, d in e["sha256"].items() if not _as_captured(root, e, n, d)]
-            for i, e in lost.items()
-        }
+    if lost:  # what each lost, as found before anything moved
         notes.insert(
             1,
             f"{len(lost)} image(s) recorded as captured and lost ("
             + "; ".join(
-                f"{names[i]}: {', '.join(gone[i]) or 'its files'} not as captured"
+                f"{names[i]}: {unproven_why.get(i) or 'its files not as captured'}"
                 for i in sorted(lost)[:8]
             )
             + (" …" if len(lost) > 8 else "")

@@ -426,7 +426,10 @@ def test_a_completed_session_with_an_image_it_cannot_prove_is_rebuilt_then_made_
     assert r.exit_code == 0, r.output
     reshoot = f"rti-rig run --resume {out} --reshoot-lost"
     assert "7 image(s) taken back" in said(r), r.output
-    assert "1 image(s) recorded as captured and lost (image_003: image_003.jpg" in said(r)
+    assert (
+        "1 image(s) recorded as captured and lost (image_003: image_003.jpg changed since"
+        in said(r)
+    )
     assert "but the session is not whole: 1 image(s) lost since capture (image_003" in said(r)
     assert reshoot in said(r) and "whole again" not in said(r)
     (aside,) = (out / "recovered").rglob("unproven/image_003.jpg")
