@@ -103,3 +103,22 @@ def test_the_reshoot_again_after_it_was_killed_names_the_resume_that_continues(
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert _images(out) == _images(ref)
+
+
+def test_the_verdict_of_a_reshoot_stopped_part_way_counts_the_image_lost(
+    ref: Path, tmp_path: Path
+) -> None:
+    """A --reshoot-lost SIGKILLed before its light: the verdict said "the session is not
+    finished (6 of 6 images; …)", which read as a contradiction; now it says one is lost."""
+    out = tmp_path / "s"
+    shutil.copytree(ref, out)
+    (out / "image_004.jpg").write_bytes((out / "image_004.jpg").read_bytes() + b"x")
+    proc = popen_argv("before_light", 0, ["run", "--resume", str(out), "--reshoot-lost"])
+    proc.communicate(timeout=300)
+    assert proc.returncode == -9
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    assert (
+        f"the session is not finished ({LIGHTS} of {LIGHTS} images, 1 of them lost since; it "
+        "stopped without recording why" in said(r)
+    ), r.output

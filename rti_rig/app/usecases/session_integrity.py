@@ -315,10 +315,14 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
         else ("it stopped without recording why (killed, or a power cut?)")
     )
     of = f"of at most {total}" if manifest.get("adaptive") else f"of {total}"
+    # of the images taken, those lost since: "12 of 12 images" of a session not finished (a
+    # --reshoot-lost stopped part-way) had read as a contradiction
+    lost = len(files_lost_since_capture(source))
+    since = f", {lost} of them lost since" if lost else ""
     instead = unresumable(source)
     note = (
-        f"the session is not finished ({taken} {of} images; {how}): this verdict judges the "
-        "images taken so far; "
+        f"the session is not finished ({taken} {of} images{since}; {how}): this verdict judges "
+        "the images taken so far; "
         + (
             instead  # its resume is refused: not named
             if instead is not None
