@@ -54,6 +54,7 @@ def build_driver(
             protocol_for(settings),
             device=name,
             min_reply_timeout_s=settings.reply_timeout_s,
+            led_count_source=settings.led_count_source(),
         )
     return LedDomeDriver(
         port,

@@ -46,9 +46,15 @@ class ScriptedDomeDriver:
         *,
         device: str = "dome",
         min_reply_timeout_s: float = 0.0,
+        led_count_source: str | None = None,
     ) -> None:
         self.transport = transport
         self.spec = spec
+        #: Where ``spec.led_count`` came from (the rig config's key, the LED map, the profile's
+        #: default): the firmware never says, so a check names this instead.
+        self.led_count_source = (
+            led_count_source or f"the {spec.name} protocol description (led_count)"
+        )
         self._device_name = device
         #: Floor under every reply timeout (``reply_timeout_s`` of the serial settings).
         self.min_reply_timeout_s = min_reply_timeout_s
@@ -308,7 +314,7 @@ class ScriptedDomeDriver:
             self.spec.name,
             "",
             self.spec.led_count,
-            led_count_source=f"the {self.spec.name} protocol description (led_count)",
+            led_count_source=self.led_count_source,
         )
 
     # ------------------------------------------------------------------ verbs

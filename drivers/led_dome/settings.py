@@ -280,6 +280,19 @@ class DomeSerialSettings(_Strict):
             msg = first["msg"].removeprefix("Value error, ")
             raise ValueError(f"protocol.{where}: {msg}" if where else f"protocol: {msg}") from None
 
+    def led_count_source(self) -> str:
+        """Where a firmware profile's LED count comes from, as a check or error should say it.
+
+        None of the described firmwares reports how many LEDs it has, so the count is never
+        the board's word: it is the rig config's ``led_count``, its LED map's rows, or the
+        built-in profile's own default. Saying which keeps a check from reading as if the
+        board had counted its LEDs."""
+        if self.led_map_file is not None:
+            return "the rows of the LED map file (dome.serial.led_map_file)"
+        if self.protocol is not None and "led_count" in self.protocol:
+            return "the rig config (dome.serial.protocol.led_count)"
+        return f"the {self.profile} profile's own count (no led_count in [dome.serial.protocol])"
+
     @property
     def is_described(self) -> bool:
         """True for firmware profiles (driven from a protocol description, not a codec)."""

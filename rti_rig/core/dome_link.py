@@ -71,6 +71,16 @@ class DomeInfo:
             return f"the firmware reports {self.led_count} LEDs"
         return f"{self.led_count_source} gives {self.led_count} LEDs (the firmware reports none)"
 
+    def led_count_heading(self) -> str:
+        """``N LEDs`` for a heading, with where the count came from when the firmware did not
+        report it: a bare "nab-rti-v1, 12 LEDs" read as a count the board had established."""
+        if self.led_count_source is None:
+            return f"{self.led_count} LEDs"
+        return (
+            f"{self.led_count} LEDs per {self.led_count_source}; this firmware does not "
+            "report its count"
+        )
+
 
 class DomeLink(Protocol):
     """The verbs of a dome driver (one exchange each; errors are :class:`DomeLinkError`)."""

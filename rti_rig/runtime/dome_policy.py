@@ -1166,7 +1166,14 @@ class SelfTestReport:
             # dome that answered with no LEDs (the config's 48 were never asked about)
             out = [f"{self.name}: not reached, no LED stepped (see ABORTED below)"]
         else:
-            out = [f"{self.name}: {' '.join(fw.split())}, {self.led_count} LEDs"]
+            # a firmware that reports no count: say whose count it is (the config's), never
+            # as if the board had said it
+            count = (
+                self.firmware.led_count_heading()
+                if self.firmware is not None and self.firmware.led_count == self.led_count
+                else f"{self.led_count} LEDs"
+            )
+            out = [f"{self.name}: {' '.join(fw.split())}, {count}"]
             passed = sum(c.ok for c in self.checks)
             out.append(
                 f"LEDs stepped: {len(self.checks)}, "
