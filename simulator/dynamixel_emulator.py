@@ -779,23 +779,113 @@ def emulated_arm_port(
         server.stop()
 
 
-def main() -> None:  # pragma: no cover - manual tool
-    """Serve two XL430s (ids 1, 2) on a pty until Ctrl-C, in real time (SystemClock)."""
-    from rti_rig.core.clock import SystemClock
+#: The rig config whose arm the manual tool emulates when none is given (shipped, installed).
+MANUAL_DEFAULT_CONFIG = "simulated_arm.toml"
+
+
+def arm_settings_of(config: str | None) -> tuple[Any, str]:
+    """``(ArmSettings, where)`` of a rig config's ``[arm.dynamixel]`` table (default: the
+    shipped ``simulated_arm.toml``); a ``ValueError`` names the file and what is wrong."""
+    import tomllib
+    from importlib import resources
+    from pathlib import Path
+
+    from pydantic import ValidationError
+
+    from rti_rig.drivers.dynamixel.settings import ArmSettings
+
+    if config is None:
+        path = Path(str(resources.files("rti_rig.rig_configs").joinpath(MANUAL_DEFAULT_CONFIG)))
+    else:
+        path = Path(config)
+    try:
+        table = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read it as a rig config: {exc}") from None
+    arm = table.get("arm", {}).get("dynamixel")
+    if not isinstance(arm, dict):
+        raise ValueError(f"{path}: no [arm.dynamixel] table: give a servo-arm rig config")
+    try:
+        return ArmSettings.model_validate(arm), str(path)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise ValueError(f"{path}: key 'arm.dynamixel.{where}': {first['msg']}") from None
+
+
+@contextlib.contextmanager
+def served_arm(settings: Any, clock: Clock) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
+    """``(server, emulator)``: the servos of ``settings`` (ids, models, modes) resting at its
+    park pose, served on a pty for any client (the manual tool; a plain SDK ``PortHandler``).
+
+    The tool had served two XL430s at 2048 ticks each: on the shipped arm's geometry
+    (elevation zero at 1024 ticks) that is 90° elevation, inside every keep-out cone, so a
+    ``check`` pointed at it was refused at once ("the arm is not in a safe pose … move it by
+    hand"). The park pose is, by validation, reachable and outside the cone."""
     from rti_rig.simulator.dynamixel_pty import PtyServoServer
 
-    clock = SystemClock()
-    emulator = DynamixelBusEmulator(
-        [EmulatedServo(1, 1060, clock), EmulatedServo(2, 1060, clock)], clock
-    )
+    emulator = emulator_for_arm(settings, clock)
     with PtyServoServer(emulator) as server:
-        print(f"emulated XL430 ids 1, 2 on {server.device_path}; Ctrl-C to stop", flush=True)
+        yield server, emulator
+
+
+def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual tool
+    """Serve a rig config's arm servos (default: rig_configs/simulated_arm.toml) on a pty,
+    resting at its park pose, in real time until Ctrl-C.
+
+    Run as ``python -m rti_rig.simulator.dynamixel_emulator [--config RIG.toml]``, then point a
+    copy of that config at the printed port (``backend = "hardware"``, ``[arm.dynamixel] port``,
+    a ``[camera.device]``) and run ``rti-rig check`` on it (docs/protocols/dynamixel-arm.md)."""
+    import argparse
+    import signal
+
+    from rti_rig.core.clock import SystemClock
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument(
+        "--config",
+        default=None,
+        help=f"a servo-arm rig config whose [arm.dynamixel] servos to emulate (default: the "
+        f"shipped {MANUAL_DEFAULT_CONFIG})",
+    )
+    parser.add_argument("--seconds", type=float, default=None, help="stop after this long")
+    args = parser.parse_args(argv)
+    try:
+        settings, where = arm_settings_of(args.config)
+    except ValueError as exc:
+        parser.error(str(exc))
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # remove the pty on SIGTERM too
+    with served_arm(settings, SystemClock()) as (server, _):
+        ids = ", ".join(
+            f"{j.servo_id} ({name}, model {j.model_number})"
+            for name, j in (("azimuth", settings.azimuth), ("elevation", settings.elevation))
+        )
+        print(
+            f"emulated servos {ids} at 57600 baud (a new servo's factory rate), resting at the "
+            f"park pose of {where} (azimuth {settings.park_azimuth_deg:g}°, elevation "
+            f"{settings.park_elevation_deg:g}°), on {server.device_path}",
+            flush=True,
+        )
+        print(
+            f'In a copy of that config set backend = "hardware", [arm.dynamixel] port = '
+            f'"{server.device_path}" and a [camera.device], then: rti-rig check COPY.toml. '
+            "Ctrl-C stops the servos.",
+            flush=True,
+        )
+        if settings.baudrate != 57600:
+            print(
+                f"Note: the config's [arm.dynamixel] baudrate = {settings.baudrate}, but these "
+                "servos talk at 57600 as shipped: the check will find none, as on a real bus",
+                flush=True,
+            )
         try:
-            while True:
-                time.sleep(1.0)
+            end = None if args.seconds is None else time.monotonic() + args.seconds
+            while end is None or time.monotonic() < end:
+                time.sleep(0.2)
         except KeyboardInterrupt:
             pass
+    return 0
 
 
 if __name__ == "__main__":  # pragma: no cover
-    main()
+    raise SystemExit(main())
