@@ -39,6 +39,13 @@ def test_a_dome_gone_at_the_final_all_off_fails_the_run(
         + f'\n[emulator]\nfaults = [{{at_command = {command}, kind = "disconnect", '
         "delay_s = 60.0}]\n"
     )
+    # one short reconnection attempt, the config's keys (the shipped 7.5 s of attempts, for a
+    # real replug, had made each gone port cost the test 7.5 s, twice)
+    cfg.write_text(
+        cfg.read_text()
+        .replace("reconnect_attempts = 4", "reconnect_attempts = 1")
+        .replace("reconnect_backoff_s = 0.5", "reconnect_backoff_s = 0.05")
+    )
     out = tmp_path / "s"
     args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
     r = CliRunner().invoke(app, args, terminal_width=400)

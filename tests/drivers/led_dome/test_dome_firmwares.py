@@ -493,10 +493,18 @@ def test_port_gone_for_good_is_a_named_error_and_says_lights_unknown(tmp_path: P
     cfg = with_faults(
         "nab-rti-v1", tmp_path, 'faults = [{at_command = 6, kind = "disconnect", delay_s = 60}]\n'
     )
+    # the shipped 4 attempts from 0.5 s (7.5 s, for a real replug) are the config's keys: a
+    # port gone for good is gone for good in one short attempt too (two windows had cost 15 s)
+    cfg.write_text(
+        cfg.read_text()
+        .replace("reconnect_attempts = 4", "reconnect_attempts = 1")
+        .replace("reconnect_backoff_s = 0.5", "reconnect_backoff_s = 0.05")
+    )
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "8"])
     assert r.exit_code == 2, r.output
     text = said(r)
+    assert "did not come back within 1 reconnection attempt" in text, text
     assert "lights are off" not in text
     assert "could NOT be sent" in text or "not acknowledged" in text
 
