@@ -291,7 +291,15 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
         from rti_rig.app.dome_factory import build_dome
 
         assert cfg.dome is not None and cfg.dome.serial is not None
-        dome = build_dome(cfg.dome.serial, clock, directions=geometry.directions, name="dome")
+        # the port in the name: every line about the dome (check's heading, an ABORTED or
+        # stopped session's error) then says which port was opened; "dome" alone had left a
+        # user with two boards plugged in no way to tell the wrong port from a silent board
+        dome = build_dome(
+            cfg.dome.serial,
+            clock,
+            directions=geometry.directions,
+            name=f"dome on {cfg.dome.serial.port}",
+        )
         camera = build_camera(
             camera_settings, clock=clock, trigger=_camera_trigger(camera_settings, dome)
         )

@@ -8,12 +8,17 @@ board, though the 12 was the rig config's ``[dome.serial.protocol] led_count``.
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
 from conftest import CONFIGS
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.dome_link import DomeInfo
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.simulator.domes import board_for
+from rti_rig.simulator.pty_link import serve_on_pty
 
 runner = CliRunner()
 
@@ -44,3 +49,24 @@ def test_a_firmware_that_reports_its_count_keeps_a_bare_heading() -> None:
     assert DomeInfo("rti-rig-dome", "1.2", 48).led_count_heading() == "48 LEDs"
     said = DomeInfo("minirti", "", 12, "the rig config (x)").led_count_heading()
     assert said == "12 LEDs per the rig config (x); this firmware does not report its count"
+
+
+@pytest.mark.pty
+def test_a_hardware_dome_is_named_with_the_port_it_opened(tmp_path: Path) -> None:
+    """A real dome's check said "dome: elexol-24r1, 12 LEDs" and, when it failed, "ABORTED:
+    dome during 'handshake': … check the port": which port was opened was said nowhere (the
+    emulated configs' "dome on /tmp/…" had it), so a user with two boards plugged in could not
+    tell a wrong port from a silent board."""
+    board = board_for("elexol-24r1")
+    with serve_on_pty(board, "elexol-24r1") as link:
+        text = (CONFIGS / "emulated_elexol.toml").read_text()
+        text = text.replace('backend = "emulated"', 'backend = "hardware"')
+        text = text.replace('port = "emulated"', f'port = "{link.port}"')
+        (tmp_path / "tether").mkdir()
+        device = f'[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
+        cfg = tmp_path / "dome.toml"
+        cfg.write_text(text[: text.index("[timing]")] + device + text[text.index("[timing]") :])
+        r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert f"dome on {link.port}: elexol-24r1, 12 LEDs per the rig config" in said, said

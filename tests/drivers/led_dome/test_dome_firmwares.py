@@ -808,7 +808,10 @@ def test_a_check_whose_port_never_opened_does_not_report_a_dome_of_0_leds() -> N
     text = " ".join(r.output.split())
     assert r.exit_code == 1 and "RESULT: FAIL" in text, text
     assert "0 LEDs" not in text and "LEDs stepped: 0" not in text, text
-    assert "dome: not reached, no LED stepped" in text and "port could not be opened" in text
+    assert (
+        "dome on /dev/serial/by-id/usb-Arduino_Mega_2560-if00: not reached, no LED stepped" in text
+    ), text
+    assert "port could not be opened" in text
 
 
 @pytest.mark.slow  # rti-dome-m blocks 1.5 s per command over a real pty
