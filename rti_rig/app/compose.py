@@ -311,7 +311,10 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
 
         assert cfg.arm is not None and cfg.arm.dynamixel is not None
         settings = cfg.arm.dynamixel
-        arm = DynamixelArm(settings, dynamixel_sdk.PortHandler(settings.port), clock)
+        # the port in the name, as a hardware dome's: "arm during 'ping': servo 3: no servo
+        # with id 3 answers at 57600 baud" had named no port, on a bench with two adapters
+        named = settings.model_copy(update={"name": f"{settings.name} on {settings.port}"})
+        arm = DynamixelArm(named, dynamixel_sdk.PortHandler(settings.port), clock)
         camera = build_camera(camera_settings, clock=clock)
         rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock)
     rig.session_hooks.append(_session_hook(camera))

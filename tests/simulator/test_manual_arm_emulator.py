@@ -10,13 +10,17 @@ emulator. It now serves a rig config's servos at that config's park pose.
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from conftest import CONFIGS
+from typer.testing import CliRunner
 
-from rti_rig.core.clock import VirtualClock
+from rti_rig.cli import app
+from rti_rig.core.clock import SystemClock, VirtualClock
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
 from rti_rig.drivers.dynamixel.kinematics import ArmKinematics
 from rti_rig.simulator.dynamixel_emulator import arm_settings_of, served_arm
@@ -61,3 +65,33 @@ def test_the_tool_says_where_the_servos_rest_and_what_to_set() -> None:
     assert out.returncode == 0, out.stderr
     assert "resting at the park pose of" in out.stdout and "elevation 10°" in out.stdout
     assert 'backend = "hardware", [arm.dynamixel] port = "' in out.stdout
+
+
+def test_a_hardware_arm_is_named_with_its_port(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A real arm's check said "ABORTED: arm during 'ping': servo 3: no servo with id 3
+    answers at 57600 baud …": no port, on a bench where a dome's and an arm's adapters sit side
+    by side. The arm is now "arm on PORT" in every line, as a hardware dome is."""
+    import dynamixel_sdk
+
+    settings, where = arm_settings_of(None)
+    with served_arm(settings, SystemClock()) as (server, _):
+        port = server.device_path
+        # the SDK's port on the pty, with the server's causal reply timeouts (no wall-time
+        # window for a loaded machine to miss)
+        monkeypatch.setattr(dynamixel_sdk, "PortHandler", lambda _path: server.port_handler())
+        text = Path(where).read_text()
+        text = text.replace('backend = "emulated"', 'backend = "hardware"')
+        text = text.replace('transport = "pty"', "")
+        text = re.sub(r'port = "emulated".*', f'port = "{port}"', text)
+        text = text.replace("servo_id = 2", "servo_id = 3")  # the elevation servo's id is wrong
+        (tmp_path / "tether").mkdir()
+        text += f'\n[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
+        cfg = tmp_path / "arm.toml"
+        cfg.write_text(text)
+        r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1, said
+    assert f"arm on {port}: no pose visited" in said, said
+    assert f"ABORTED: arm on {port} during 'ping': servo 3: no servo with id 3" in said, said
