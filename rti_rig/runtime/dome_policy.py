@@ -1109,6 +1109,10 @@ class SelfTestReport:
     #: The built-in firmware whose boot banner the board printed when it is not the profile's
     #: (the link's ``foreign_firmware``); None: none seen.
     foreign_firmware: str | None = None
+    #: How many of ``stats.recovered`` the connect itself recovered from: the walk's own come
+    #: after (a banner later than the boot wait, at the port's opening, is the connect's: a
+    #: slow bootloader, not a board that rebooted by itself during the walk).
+    recovered_at_connect: int = 0
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -1193,6 +1197,7 @@ class SelfTestReport:
                 f"recovery: {s.retries} retries, {s.reconnects} reconnects, "
                 f"{s.rehandshakes} re-handshakes"
             )
+            out += _recovered_board_faults(s.recovered[self.recovered_at_connect :])
         if self.aborted:
             out.append(f"ABORTED: {self.aborted}")
         if self.lights_state:
@@ -1207,6 +1212,28 @@ class SelfTestReport:
         else:
             out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
+
+
+def _recovered_board_faults(recovered: list[str]) -> list[str]:
+    """A line for a board that rebooted or dropped off the USB bus during the check's walk (after
+    the connect) and was recovered from (the walk went on).
+
+    Why: a reboot at an all-off (no LED meant lit) was recovered and the check ended "RESULT:
+    PASS" with only "1 re-handshakes" to show for it, where a reboot while an LED was lit
+    failed the check saying to look at the power supply and the USB cable: a board that
+    reboots or drops off by itself will do so in a session too, and stop it there."""
+    what = {"reset": "rebooted", "disconnected": "dropped off the USB bus"}
+    seen: dict[str, list[str]] = {}
+    for entry in recovered:
+        command, _, fault = entry.rpartition(": ")
+        if fault in what:
+            seen.setdefault(what[fault], []).append(command)
+    return [
+        f"the board {event} during the check (at {', '.join(map(repr, commands))}) and the "
+        "check went on; a board that does so by itself points to its power supply or its USB "
+        "cable: check them (in a session, one that comes while an LED is lit stops the run)"
+        for event, commands in seen.items()
+    ]
 
 
 #: What each stage of :attr:`DomePolicy.reached` established, as the check's first line says it.
@@ -1248,6 +1275,7 @@ def self_test(
         if isinstance(source, DomePolicy):
             report.firmware = source.info
             report.stats = source.stats
+            report.recovered_at_connect = len(source.stats.recovered)
         order = list(range(report.led_count)) if leds is None else list(leds)
         report.planned = len(order)
         for i in order:

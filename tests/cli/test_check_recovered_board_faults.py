@@ -1,0 +1,71 @@
+"""`rti-rig check` says so when the board rebooted during the walk and was recovered from.
+
+A Nab board that rebooted instead of taking a light command (no LED lit at that moment: the
+check re-handshakes and resends) ended "RESULT: PASS" with "recovery: 1 retries, 0 reconnects,
+1 re-handshakes" as the only trace, where a reboot while an LED was lit failed the check saying
+to look at the power supply and the USB cable. A board that reboots by itself does it in a
+session too.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+
+def test_a_reboot_the_check_recovered_from_is_said(tmp_path: Path) -> None:
+    cfg = tmp_path / "rig.toml"
+    # commands 1-4: the init and connect all-offs, LED 0 and its all-off; 5 is LED 1's light
+    cfg.write_text(
+        (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
+        + '\n[[emulator.faults]]\nat_command = 5\nkind = "reset"\n'
+    )
+    r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert "1 re-handshakes" in said, said
+    assert "the board rebooted during the check (at 'light LED 1" in said, said
+    assert "points to its power supply or its USB cable" in said
+
+
+def test_only_reboots_and_usb_drops_are_named() -> None:
+    from rti_rig.runtime.dome_policy import _recovered_board_faults
+
+    assert _recovered_board_faults(["light LED 3 at level 1: timeout"]) == []
+    lines = _recovered_board_faults(["all off: disconnected", "all off: reset", "hello: reset"])
+    assert len(lines) == 2
+    assert lines[0].startswith("the board dropped off the USB bus during the check (at 'all off')")
+    assert lines[1].startswith("the board rebooted during the check (at 'all off', 'hello')")
+
+
+def test_a_banner_later_than_the_boot_wait_is_not_called_a_reboot(tmp_path: Path) -> None:
+    """A board whose bootloader outlasts the profile's boot wait prints its banner after the
+    first command: the connect resends it, and its warning names boot_wait_s. It is no board
+    rebooting by itself, which the line had said of it (power supply, USB cable)."""
+    from rti_rig.simulator.domes import board_for
+    from rti_rig.simulator.pty_link import serve_on_pty
+
+    board = board_for("nab-rti-v1")
+    board.boot_s = 5.0  # the profile waits 4 s
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        text = (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
+        text = text.replace('backend = "emulated"', 'backend = "hardware"')
+        text = text.replace('port = "emulated"', f'port = "{link.port}"')
+        (tmp_path / "tether").mkdir()
+        device = f'[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
+        cfg = tmp_path / "dome.toml"
+        cfg.write_text(text[: text.index("[timing]")] + device + text[text.index("[timing]") :])
+        r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert "LEDs stepped: 12, passed: 12" in said, said
+    assert "rebooted during the check" not in said, said
