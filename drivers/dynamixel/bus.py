@@ -141,7 +141,39 @@ class DxlBus:
                 f"port {self.port.getPortName()!r} refused baud rate {baudrate}",
                 "open",
             )
+        self._lock_exclusively()
         self.baudrate = baudrate
+
+    def _lock_exclusively(self) -> None:
+        """Hold the port's lock (``flock``, as pyserial's ``exclusive=True`` and the dome's
+        transport take it), or close it again and say that another program holds it.
+
+        Why: the SDK opens the port unlocked, so a second ``rti-rig check`` or ``run`` on the
+        arm's port while one ran opened it too; the two shared the servos' replies (the second
+        failed with "COMM_RX_TIMEOUT … check power, cabling, id and baud rate"), and one that
+        got its pings answered would have written position limits (torque off) and goals to
+        an arm the other was moving."""
+        ser = getattr(self.port, "ser", None)
+        fileno = getattr(ser, "fileno", None)
+        if fileno is None:
+            return  # an in-process stand-in (no file), or a platform without one
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not POSIX
+            return
+        try:
+            fcntl.flock(fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            name = self.port.getPortName()
+            self.port.closePort()
+            raise CommunicationError(
+                self.device,
+                f"port {name!r} is locked by another program (another rti-rig check or run "
+                "on this arm): nothing was sent; let it finish or stop it, then try again",
+                "open",
+            ) from None
+        except OSError:
+            return  # a device that cannot be locked (flock unsupported): as before
 
     def close(self) -> None:
         if getattr(self.port, "is_open", False):
