@@ -63,6 +63,7 @@ def check(
 ) -> None:
     """Self-test the rig: a dome lights each LED in turn and reports what answered; an arm
     visits poses spanning its band (checking where it really got to), flashes the lamp at each
+    if it hangs on a servo's LED output (lamp = "servo_led"; a "software" lamp is not switched)
     and parks; then the camera is opened and released (no image taken). A recorded
     acquisition's .lp (a replay rig) has no device: its images are checked instead."""
     from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
