@@ -38,7 +38,7 @@ from rti_rig.drivers.led_dome.messages import (
     describe,
     error_text,
 )
-from rti_rig.drivers.led_dome.transport import Transport, TransportError
+from rti_rig.drivers.led_dome.transport import PortHeldError, Transport, TransportError
 
 #: What to do about a definitive refusal, said with it. A dead LED stopped a session with only
 #: "LED fault (open circuit ...)" and the session's "Continue with: rti-rig run --resume": a
@@ -94,7 +94,9 @@ class LedDomeDriver:
         try:
             self.transport.open()
         except TransportError as exc:
-            raise self._error(str(exc), "open port", LinkFault.DISCONNECTED, True) from exc
+            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED, True)
+            error.port_held = isinstance(exc, PortHeldError)
+            raise error from exc
         self._open = True
         self._rx.clear()
         self._wait_for_banner()

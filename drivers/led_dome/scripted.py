@@ -25,7 +25,7 @@ import re
 
 from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
 from rti_rig.drivers.led_dome.protocol_spec import CommandSpec, ProtocolSpec
-from rti_rig.drivers.led_dome.transport import Transport, TransportError
+from rti_rig.drivers.led_dome.transport import PortHeldError, Transport, TransportError
 
 traffic_log = logging.getLogger("rti_rig.dome.traffic")
 
@@ -121,7 +121,9 @@ class ScriptedDomeDriver:
         try:
             self.transport.open()
         except TransportError as exc:
-            raise self._error(str(exc), "open port", LinkFault.DISCONNECTED) from exc
+            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED)
+            error.port_held = isinstance(exc, PortHeldError)
+            raise error from exc
         self._open = True
         self._booted = self._boot_heard = False
         self.foreign_firmware = None

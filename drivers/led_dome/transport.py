@@ -35,6 +35,10 @@ class TransportError(Exception):
     """The port is gone (unplugged, closed under us) or cannot be opened."""
 
 
+class PortHeldError(TransportError):
+    """The port exists but another program holds its lock (another rti-rig on this dome)."""
+
+
 class Transport(Protocol):
     """A byte pipe to the board. Opened by :meth:`open`, never in the constructor."""
 
@@ -96,7 +100,8 @@ class SerialTransport:
                 why = os.strerror(errno)
             else:
                 why = str(exc)
-            raise TransportError(f"cannot open serial port {self.port}: {why}") from exc
+            error = PortHeldError if "exclusively lock" in str(exc) else TransportError
+            raise error(f"cannot open serial port {self.port}: {why}") from exc
         self._timeout = 0
 
     def close(self) -> None:

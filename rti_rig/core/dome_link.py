@@ -47,11 +47,15 @@ class DomeLinkError(DeviceError):
         *,
         retryable: bool,
         code: int | None = None,
+        port_held: bool = False,
     ) -> None:
         super().__init__(device, message, command)
         self.fault = fault
         self.retryable = retryable
         self.code = code
+        #: The port could not be opened because another program holds its lock (another
+        #: rti-rig check or run on this dome): nothing about the board is known or wrong.
+        self.port_held = port_held
 
 
 @dataclass(frozen=True)
@@ -139,6 +143,9 @@ class OffReport:
 
     outcome: OffOutcome
     detail: str = ""
+    #: NEVER_OPENED because another program holds the port: the lights are that program's
+    #: (switching the dome off at its supply would cut a session that runs).
+    port_held: bool = False
 
     @property
     def lights_known_off(self) -> bool:
@@ -164,8 +171,12 @@ class OffReport:
                 "its power supply"
             ),
             OffOutcome.NEVER_OPENED: (
-                f"the dome's port could not be opened{why}, so this run lit nothing and could "
-                "not send an all-off either; if the dome is lit from an earlier run, switch it "
-                "off at its power supply"
+                f"the dome's port is held by another program{why}, so this run lit nothing "
+                "and sent nothing: the lights are that program's (another rti-rig check or run "
+                "switches them off when it ends)"
+                if self.port_held
+                else f"the dome's port could not be opened{why}, so this run lit nothing and "
+                "could not send an all-off either; if the dome is lit from an earlier run, "
+                "switch it off at its power supply"
             ),
         }[self.outcome]

@@ -252,7 +252,9 @@ class DomePolicy:
                 self.reached = "opened"
             if exc.command == "open port" and not self._port_was_open:
                 # Nothing was ever sent: say so, not "all-off failed, lights may be on".
-                self.off_report = OffReport(OffOutcome.NEVER_OPENED, exc.message)
+                self.off_report = OffReport(
+                    OffOutcome.NEVER_OPENED, exc.message, port_held=exc.port_held
+                )
             elif (
                 exc.command == "open port"
                 and self._lit is None
@@ -274,6 +276,17 @@ class DomePolicy:
                 # boots with every LED on): send the all-off anyway wherever the port is open.
                 self._attempt_off(f"after the failed connection ({exc.message})")
             self._quiet_close()
+            if exc.command == "open port" and exc.port_held:
+                # the board is there and may be lit by the program using it: "check that the
+                # board is plugged in" beside "switch it off at its power supply" had sent a
+                # user to cut the power under a session that ran
+                raise DeviceError(
+                    self.name,
+                    f"the dome's port is held by another program ({exc.message}): if another "
+                    "rti-rig check or run is using this dome, let it finish or stop it with "
+                    "Ctrl-C (it switches the lights off itself), then try again",
+                    exc.command,
+                ) from exc
             if exc.command == "open port":
                 raise DeviceError(
                     self.name,
