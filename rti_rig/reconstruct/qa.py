@@ -263,6 +263,11 @@ class QAReport:
     #: The verdict's word for images with problems: "reshoot", or what fits a session that
     #: cannot reshoot (a replayed acquisition's images are the recording's: "flawed").
     verdict_word: str = "reshoot"
+    #: Images of the session lost since capture that the fitted ``.lp`` does not list, so no
+    #: check above saw them (set by the application). The session is not whole whatever the
+    #: fitted images show: a rebuilt journal that set a changed JPEG aside had left the verdict
+    #: "good; 1 image missing or changed since capture …".
+    lost_unfitted: tuple[str, ...] = ()
     #: The light scatter of the session (:data:`LIGHT_SCATTER_MIN`); NaN where it could not be
     #: measured (too few images a rendering explains).
     light_scatter: float = float("nan")
@@ -338,12 +343,16 @@ class QAReport:
 
     @property
     def good(self) -> bool:
-        return not self.reshoot
+        return not self.reshoot and not self.lost_unfitted
 
     @property
     def verdict(self) -> str:
         """``good`` or ``reshoot: name (why); ...``, and the light note (if any) after it."""
         tail = "".join(f"; {c}" for c in self.caveats)
+        # an image lost and not fitted is said first, its what-to-do in the caveats' note
+        lost = [f"{n} (lost since capture, not fitted)" for n in self.lost_unfitted]
+        if not self.reshoot and lost:
+            return f"{self.verdict_word}: " + ", ".join(lost) + tail
         if self.good:
             head = (
                 f"no image to {self.verdict_word}, but {self.light_note}"
@@ -371,7 +380,7 @@ class QAReport:
             if rest:
                 parts.append(f"{c.name} ({'; '.join(rest)})")
         light = f"; {self.light_note}" if self.light_note else ""
-        return f"{self.verdict_word}: " + ", ".join(parts) + light + tail
+        return f"{self.verdict_word}: " + ", ".join(parts + lost) + light + tail
 
     def bright_within_light_scatter(self) -> list[ImageCheck]:
         """The images called brighter than predicted whose light's own output can explain it
@@ -407,7 +416,7 @@ class QAReport:
         return {
             "verdict": self.verdict,
             "good": self.good,
-            "reshoot": [c.name for c in self.reshoot],
+            "reshoot": [c.name for c in self.reshoot] + list(self.lost_unfitted),
             "expected_normal_error_deg": self.expected_normal_error_deg,
             "noise_sigma": self.noise_sigma,
             "undercovered_fraction": self.undercovered_fraction,

@@ -439,6 +439,11 @@ def test_a_completed_session_with_an_image_it_cannot_prove_is_rebuilt_then_made_
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 0, r.output
     assert "image_003" in said(r) and reshoot in said(r) and "not checked" not in said(r)
+    # a lost image lights.lp no longer lists is still a session not whole: never "good"
+    # (the verdict had read "good; 1 image missing or changed since capture …")
+    assert "QA verdict: reshoot: image_003 (lost since capture, not fitted)" in said(r)
+    qa = json.loads((tmp_path / "fit" / "qa.json").read_text())
+    assert qa["good"] is False and qa["reshoot"] == ["image_003"], qa["verdict"]
     r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert aside.read_bytes() == corrupted  # never overwritten

@@ -143,6 +143,8 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
         if relisted:
             note += f"; {relight} ({', '.join(relisted[:8])}{' …' if len(relisted) > 8 else ''})"
         qa = _noted(qa, note)
+    if unlisted:
+        qa = replace(qa, lost_unfitted=tuple(unlisted))
     return qa
 
 
