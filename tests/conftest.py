@@ -72,6 +72,46 @@ def virtual_arm_variant(tmp_path: Path, scene: str, side: int | None = None) -> 
     return write_config(tmp_path, text.replace('name = "relief"', f'name = "{scene}"'), "arm.toml")
 
 
+def emulated_dome_as_hardware(tmp_path: Path, shipped: str, port: str) -> Path:
+    """The shipped emulated dome config ``shipped`` as a user's hardware copy of it: its board
+    on ``port`` (an emulator served on a pty) and a watched-folder camera, as a real dome with
+    a tethered camera is configured."""
+    text = (CONFIGS / shipped).read_text()
+    assert 'backend = "emulated"' in text and 'port = "emulated"' in text, shipped
+    text = text.replace('backend = "emulated"', 'backend = "hardware"')
+    text = text.replace('port = "emulated"', f'port = "{port}"')
+    (tmp_path / "tether").mkdir()
+    device = f'[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
+    at = text.index("[timing]")
+    return write_config(tmp_path, text[:at] + device + text[at:], "dome.toml")
+
+
+def dome_variant(tmp_path: Path, scene: str, side: int) -> Path:
+    """The shipped simulated dome with another simulated scene and square frames of ``side``
+    px: what the QA tests run correct sessions of the dome on."""
+    text = (CONFIGS / "simulated_dome.toml").read_text()
+    text, n_w = re.subn(r"(?m)^width = \d+", f"width = {side}", text)
+    text, n_h = re.subn(r"(?m)^height = \d+", f"height = {side}", text)
+    text, n_s = re.subn(r'(?ms)(\[scene\].*?^name = )"[^"]*"', rf'\g<1>"{scene}"', text)
+    assert (n_w, n_h, n_s) == (1, 1, 1), "simulated_dome.toml no longer has one width/height/scene"
+    return write_config(tmp_path, text, f"{scene}_{side}.toml")
+
+
+def dome_session(tmp_path: Path, scene: str, side: int, lights: int) -> Path:
+    """A session of :func:`dome_variant` shot through the CLI, without its verdict."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    out = tmp_path / "s"
+    config = dome_variant(tmp_path, scene, side)
+    r = CliRunner().invoke(
+        app, ["run", str(config), "--out", str(out), "--lights", str(lights), "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output
+    return out
+
+
 @pytest.fixture(scope="session")
 def arm_tablet_12(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A correct session of the shipped virtual arm on the tablet with 12 lights (read only:

@@ -349,10 +349,8 @@ class QAReport:
     def verdict(self) -> str:
         """``good`` or ``reshoot: name (why); ...``, and the light note (if any) after it."""
         tail = "".join(f"; {c}" for c in self.caveats)
-        # an image lost and not fitted is said first, its what-to-do in the caveats' note
+        # an image lost and not fitted is named with the others, its what-to-do in the caveats
         lost = [f"{n} (lost since capture, not fitted)" for n in self.lost_unfitted]
-        if not self.reshoot and lost:
-            return f"{self.verdict_word}: " + ", ".join(lost) + tail
         if self.good:
             head = (
                 f"no image to {self.verdict_word}, but {self.light_note}"

@@ -253,12 +253,11 @@ def shoot_step(
     lit again (on RTIPy a new timed command) and settled before the camera is asked again:
     the image is always the one taken under the lit light, since the camera is only ever
     fired with it lit, and its light goes off only once the exposure is over or the camera
-    has refused the shot. The
-    whole wait is bounded by the camera's own retry settings (``busy_retries`` and its
-    back-off); a camera still busy then stops the session, which ``--resume`` continues. The
-    dome's thermal guard may add a cool-down before a relight. Until 2026-11-29 a camera busy
-    longer than ``max_on_s`` stopped the session, with advice (raise ``busy_retries``) that
-    then ran into the thermal limit.
+    has refused the shot. The whole wait is bounded by the camera's own retry settings
+    (``busy_retries`` and its back-off); a camera still busy then stops the session, which
+    ``--resume`` continues. The dome's thermal guard may add a cool-down before a relight.
+    Until 2026-11-29 a camera busy longer than ``max_on_s`` stopped the session, with advice
+    (raise ``busy_retries``) that then ran into the thermal limit.
 
     ``on_dark`` is told each time the light goes off (how long it was lit, what the all-off
     established, how long the camera is awaited), before that wait. ``cancelled`` is asked

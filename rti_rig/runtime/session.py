@@ -682,19 +682,7 @@ class SessionFolder:
             dest = self.root / rel
             if dest.exists():
                 raise SessionError(f"{dest} already exists: refusing to overwrite a captured file")
-            try:
-                dest.parent.mkdir(parents=True, exist_ok=True)
-                if src.resolve().is_relative_to(root):
-                    # a download staged in raw/.incoming may be the only copy (the camera may
-                    # have deleted its own): checksummed where it lies, then renamed in one
-                    # step, so at every moment it is whole under one of its two names
-                    digest = _fsync_sha256(src)
-                    os.replace(src, dest)
-                else:
-                    digest = _copy_whole(src, dest)
-            except OSError as exc:
-                raise SessionWriteError(dest, exc) from None
-            kept[rel] = (digest, str(item.get("name") or src.name))
+            kept[rel] = (_take_whole(src, dest, root), str(item.get("name") or src.name))
         return kept
 
     def _keep_strays(self, base: str, strays: list[dict[str, Any]]) -> dict[str, dict[str, str]]:
@@ -713,16 +701,7 @@ class SessionFolder:
             while rel in kept or (self.root / rel).exists():  # never over a kept picture
                 rel = f"{STRAY_DIR}/{base}-{stem}_{n}{suffix}"
                 n += 1
-            dest = self.root / rel
-            try:
-                dest.parent.mkdir(parents=True, exist_ok=True)
-                if src.resolve().is_relative_to(root):
-                    digest = _fsync_sha256(src)
-                    os.replace(src, dest)
-                else:
-                    digest = _copy_whole(src, dest)
-            except OSError as exc:
-                raise SessionWriteError(dest, exc) from None
+            digest = _take_whole(src, self.root / rel, root)
             kept[rel] = {"camera_file": camera_name, "sha256": digest}
         return kept
 
@@ -970,6 +949,24 @@ def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
         scan.records.append(entry)
         scan.kept.append(raw + b"\n")
     return scan
+
+
+def _take_whole(src: Path, dest: Path, root: Path) -> str:
+    """Put the camera's file ``src`` at ``dest`` whole and return its SHA-256.
+
+    A download staged inside the session (``root``, e.g. raw/.incoming) may be the only copy
+    (the camera may have deleted its own): it is checksummed where it lies, then renamed in one
+    step, so at every moment it is whole under one of its two names; one from elsewhere is
+    copied whole. An OSError is the session's write error, naming ``dest``."""
+    try:
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        if src.resolve().is_relative_to(root):
+            digest = _fsync_sha256(src)
+            os.replace(src, dest)
+            return digest
+        return _copy_whole(src, dest)
+    except OSError as exc:
+        raise SessionWriteError(dest, exc) from None
 
 
 def _copy_whole(src: Path, dest: Path) -> str:

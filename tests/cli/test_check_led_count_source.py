@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, emulated_dome_as_hardware
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -59,13 +59,7 @@ def test_a_hardware_dome_is_named_with_the_port_it_opened(tmp_path: Path) -> Non
     tell a wrong port from a silent board."""
     board = board_for("elexol-24r1")
     with serve_on_pty(board, "elexol-24r1") as link:
-        text = (CONFIGS / "emulated_elexol.toml").read_text()
-        text = text.replace('backend = "emulated"', 'backend = "hardware"')
-        text = text.replace('port = "emulated"', f'port = "{link.port}"')
-        (tmp_path / "tether").mkdir()
-        device = f'[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
-        cfg = tmp_path / "dome.toml"
-        cfg.write_text(text[: text.index("[timing]")] + device + text[text.index("[timing]") :])
+        cfg = emulated_dome_as_hardware(tmp_path, "emulated_elexol.toml", link.port)
         r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said

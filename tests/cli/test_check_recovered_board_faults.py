@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, emulated_dome_as_hardware
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -58,13 +58,7 @@ def test_a_banner_later_than_the_boot_wait_is_not_called_a_reboot(tmp_path: Path
     board = board_for("nab-rti-v1")
     board.boot_s = 5.0  # the profile waits 4 s
     with serve_on_pty(board, "nab-rti-v1") as link:
-        text = (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
-        text = text.replace('backend = "emulated"', 'backend = "hardware"')
-        text = text.replace('port = "emulated"', f'port = "{link.port}"')
-        (tmp_path / "tether").mkdir()
-        device = f'[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
-        cfg = tmp_path / "dome.toml"
-        cfg.write_text(text[: text.index("[timing]")] + device + text[text.index("[timing]") :])
+        cfg = emulated_dome_as_hardware(tmp_path, "emulated_nab_rti_v1.toml", link.port)
         r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())
     assert "LEDs stepped: 12, passed: 12" in said, said

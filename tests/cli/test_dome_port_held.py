@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 import serial
-from conftest import CONFIGS
+from conftest import emulated_dome_as_hardware
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -29,13 +29,7 @@ pytestmark = [
 def test_a_check_on_a_port_another_program_holds_says_to_wait_for_it(tmp_path: Path) -> None:
     board = board_for("elexol-24r1")
     with serve_on_pty(board, "elexol-24r1") as link:
-        text = (CONFIGS / "emulated_elexol.toml").read_text()
-        text = text.replace('backend = "emulated"', 'backend = "hardware"')
-        text = text.replace('port = "emulated"', f'port = "{link.port}"')
-        (tmp_path / "tether").mkdir()
-        device = f'[camera.device]\nkind = "folder_watch"\nfolder = "{tmp_path / "tether"}"\n'
-        cfg = tmp_path / "dome.toml"
-        cfg.write_text(text[: text.index("[timing]")] + device + text[text.index("[timing]") :])
+        cfg = emulated_dome_as_hardware(tmp_path, "emulated_elexol.toml", link.port)
         holder = serial.Serial(link.port, 38400, timeout=0, exclusive=True)  # the other program
         try:
             r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)

@@ -11,18 +11,17 @@ predict), image_022 (1.7× brighter …)".
 from __future__ import annotations
 
 import json
-import re
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
 
-REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 BRIGHTER = "brighter than the other images predict"
 
@@ -38,17 +37,7 @@ def _fit(session: Path, out: Path) -> tuple[str, dict]:  # type: ignore[type-arg
 @pytest.mark.slow
 @pytest.mark.e2e
 def test_a_ring_of_glossy_images_is_not_called_brighter(tmp_path: Path) -> None:
-    text = (REPO / "rig_configs" / "simulated_dome.toml").read_text()
-    text = re.sub(r"(?m)^width = \d+", "width = 512", text)
-    text = re.sub(r"(?m)^height = \d+", "height = 512", text)
-    text = re.sub(r'(?ms)(\[scene\].*?^name = )"[^"]*"', r'\g<1>"industrial"', text)
-    config = tmp_path / "industrial.toml"
-    config.write_text(text)
-    session = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(config), "--out", str(session), "--lights", "24", "--no-verdict"]
-    )
-    assert r.exit_code == 0, r.output
+    session = dome_session(tmp_path, "industrial", 512, 24)
 
     said, qa = _fit(session, tmp_path / "fit")
     by_name = {im["name"]: im for im in qa["images"]}

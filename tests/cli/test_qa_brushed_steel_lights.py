@@ -17,28 +17,18 @@ import re
 from pathlib import Path
 
 import pytest
+from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 
-REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 
 
 @pytest.mark.slow
 @pytest.mark.e2e
 def test_a_correct_brushed_steel_session_has_no_light_called_wrong(tmp_path: Path) -> None:
-    text = (REPO / "rig_configs" / "simulated_dome.toml").read_text()
-    text = re.sub(r"(?m)^width = \d+", "width = 1024", text)
-    text = re.sub(r"(?m)^height = \d+", "height = 1024", text)
-    text = re.sub(r'(?ms)(\[scene\].*?^name = )"[^"]*"', r'\g<1>"industrial"', text)
-    config = tmp_path / "industrial.toml"
-    config.write_text(text)
-    session = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(config), "--out", str(session), "--lights", "24", "--no-verdict"]
-    )
-    assert r.exit_code == 0, r.output
+    session = dome_session(tmp_path, "industrial", 1024, 24)
     out = tmp_path / "fit"
     r = runner.invoke(
         app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh", "--no-normals"]

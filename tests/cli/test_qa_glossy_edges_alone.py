@@ -11,36 +11,23 @@ still named, and the verdict says which shift it cannot judge.
 from __future__ import annotations
 
 import json
-import re
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
 
-REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
 def coin(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    tmp = tmp_path_factory.mktemp("coin")
-    text = (REPO / "rig_configs" / "simulated_dome.toml").read_text()
-    text = re.sub(r"(?m)^width = \d+", "width = 1024", text)
-    text = re.sub(r"(?m)^height = \d+", "height = 1024", text)
-    text = re.sub(r'(?ms)(\[scene\].*?^name = )"[^"]*"', r'\g<1>"coin"', text)
-    config = tmp / "coin.toml"
-    config.write_text(text)
-    out = tmp / "s"
-    r = runner.invoke(
-        app, ["run", str(config), "--out", str(out), "--lights", "12", "--no-verdict"]
-    )
-    assert r.exit_code == 0, r.output
-    return out
+    return dome_session(tmp_path_factory.mktemp("coin"), "coin", 1024, 12)
 
 
 def _qa(session: Path, out: Path) -> dict:  # type: ignore[type-arg]

@@ -12,35 +12,24 @@ candidate that explains them best is taken.
 from __future__ import annotations
 
 import json
-import re
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
 
-REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 
 
 @pytest.mark.slow
 @pytest.mark.e2e
 def test_a_tablet_moved_from_image_7_is_said_moved_from_image_7(tmp_path: Path) -> None:
-    text = (REPO / "rig_configs" / "simulated_dome.toml").read_text()
-    text = re.sub(r"(?m)^width = \d+", "width = 256", text)
-    text = re.sub(r"(?m)^height = \d+", "height = 256", text)
-    text = re.sub(r'(?ms)(\[scene\].*?^name = )"[^"]*"', r'\g<1>"tablet"', text)
-    config = tmp_path / "tablet.toml"
-    config.write_text(text)
-    session = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(config), "--out", str(session), "--lights", "12", "--no-verdict"]
-    )
-    assert r.exit_code == 0, r.output
+    session = dome_session(tmp_path, "tablet", 256, 12)
     moved = tmp_path / "moved"
     shutil.copytree(session, moved)
     for name in ("journal.jsonl", "manifest.json"):  # the pixels change after capture

@@ -14,36 +14,20 @@ its first image on (tests/cli/test_qa_move_part_way.py).
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import pytest
+from conftest import dome_session
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 
-REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
-
-
-def _config(tmp: Path, scene: str, size: int) -> Path:
-    text = (REPO / "rig_configs" / "simulated_dome.toml").read_text()
-    text = re.sub(r"(?m)^width = \d+", f"width = {size}", text)
-    text = re.sub(r"(?m)^height = \d+", f"height = {size}", text)
-    text = re.sub(r'(?ms)(\[scene\].*?^name = )"[^"]*"', rf'\g<1>"{scene}"', text)
-    out = tmp / f"{scene}_{size}.toml"
-    out.write_text(text)
-    return out
 
 
 @pytest.mark.slow
 def test_a_still_tablet_at_1024_px_is_good(tmp_path: Path) -> None:
-    config = _config(tmp_path, "tablet", 1024)
-    session = tmp_path / "s"
-    r = runner.invoke(
-        app, ["run", str(config), "--out", str(session), "--lights", "24", "--no-verdict"]
-    )
-    assert r.exit_code == 0, r.output
+    session = dome_session(tmp_path, "tablet", 1024, 24)
     out = tmp_path / "fit"
     r = runner.invoke(
         app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh", "--no-normals"]

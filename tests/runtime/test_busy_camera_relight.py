@@ -263,6 +263,18 @@ def test_metering_a_dark_object_chooses_no_exposure_longer_than_an_led_may_stay_
     assert "not the camera's max_exposure_s = 30 s" in said
 
 
+def _run_cancellable(rig, out, cancel, on_event):  # type: ignore[no-untyped-def]
+    """The session of ``rig``'s schedule into ``out``, with ``cancel`` and ``on_event``."""
+    with rig:
+        return run_session(
+            rig,
+            schedule_of(rig),
+            SessionFolder.create(out, len(LEDS)),
+            cancel=cancel,
+            on_event=on_event,
+        )
+
+
 def test_a_cancel_while_the_camera_is_awaited_in_the_dark_stops_there_its_led_left_off(
     tmp_path,
 ):
@@ -283,14 +295,7 @@ def test_a_cancel_while_the_camera_is_awaited_in_the_dark_stops_there_its_led_le
             cancel.cancel()  # what the Ctrl-C handler does
 
     out = tmp_path / "s"
-    with rig:
-        result = run_session(
-            rig,
-            schedule_of(rig),
-            SessionFolder.create(out, len(LEDS)),
-            cancel=cancel,
-            on_event=on_event,
-        )
+    result = _run_cancellable(rig, out, cancel, on_event)
     assert result.finish_reason is FinishReason.CANCELLED, result.error
     (event,) = dark
     assert event.index == 1 and event.cool_s > 50.0
@@ -331,14 +336,7 @@ def test_a_cancel_during_the_cool_down_before_a_relight_stops_there(tmp_path):
             dark.append(clock.now())
 
     out = tmp_path / "s"
-    with rig:
-        result = run_session(
-            rig,
-            schedule_of(rig),
-            SessionFolder.create(out, len(LEDS)),
-            cancel=cancel,
-            on_event=on_event,
-        )
+    result = _run_cancellable(rig, out, cancel, on_event)
     assert result.finish_reason is FinishReason.CANCELLED
     assert lit_at_shots == [LEDS[0]] and body.shots == 1
     lit = [ev.index for ev in rig.emulator.history if ev.what == "lit"]  # type: ignore[attr-defined]
