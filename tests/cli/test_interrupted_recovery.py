@@ -72,14 +72,20 @@ def test_the_reshoot_says_where_it_set_the_files_aside_without_calling_them_unve
     out = tmp_path / "s"
     shutil.copytree(ref, out)
     (out / "image_002.jpg").write_bytes((out / "image_002.jpg").read_bytes() + b"x")
+    with (out / "journal.jsonl").open("a") as journal:  # a torn line, set aside there too
+        journal.write('{"index": 3, "imag')
     r = runner.invoke(app, ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"])
     assert r.exit_code == 0, r.output
     (stamp,) = (out / "recovered").iterdir()
+    assert (stamp / "journal-rejected.txt").is_file()
     assert (
         f"2 file(s) of the images to reshoot set aside in recovered/{stamp.name}/ (never "
         "deleted)" in said(r)
     ), r.output
     assert "unverified" not in said(r)
+    # the count is of the images' files set aside, whatever else the resume put there
+    aside = [p for p in stamp.rglob("*") if p.is_file() and p.name.startswith("image_")]
+    assert len(aside) == 2, sorted(p.name for p in stamp.rglob("*"))
 
 
 def test_the_reshoot_again_after_it_was_killed_names_the_resume_that_continues(

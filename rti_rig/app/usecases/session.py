@@ -1057,8 +1057,11 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     # earlier resumes' too); with --reshoot-lost they are the files of the images to shoot
     # again, which had been called "unverified" though their checksums may well match
     where = ", ".join(sorted({"/".join(Path(p).parts[:2]) for p in recovered}))
+    # the rejected journal lines and a lights.lp written again are set aside there too, but
+    # they are not files of the images to reshoot (they had been counted as such)
+    images = [p for p in recovered if Path(p).suffix.lower() not in (".txt", ".lp")]
     moved = (
-        f", {len(recovered)} file(s) of the images to reshoot set aside in {where}/ (never deleted)"
+        f", {len(images)} file(s) of the images to reshoot set aside in {where}/ (never deleted)"
         if req.reshoot_lost
         else f", {len(recovered)} unverified file(s) moved to {where}/"
     )
