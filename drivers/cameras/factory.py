@@ -58,6 +58,7 @@ register_camera_kind(
         lambda s, c: Gphoto2Camera(
             s, output_dir=c.output_dir, clock=c.clock, gp_module=c.gp_module
         ),
+        says_exposure_end=True,
     )
 )
 register_camera_kind(
@@ -66,5 +67,6 @@ register_camera_kind(
         FolderWatchSettings,
         lambda s, c: FolderWatchCamera(s, clock=c.clock, trigger=c.trigger),
         sets_exposure=False,
+        says_exposure_end=True,
     )
 )

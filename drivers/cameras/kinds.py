@@ -46,6 +46,12 @@ class CameraKind:
     #: (a watched folder: the camera or its own program sets the shutter) cannot be metered:
     #: ``--auto-exposure`` is refused for it instead of asking for exposures it cannot take.
     sets_exposure: bool = True
+    #: Whether its driver says when its exposure is over (an
+    #: :class:`~rti_rig.core.devices.ExposingCamera`): the controller switches the LED off
+    #: then, before the download. One that cannot say holds its LED lit until its frame is in,
+    #: which the config's check against ``max_on_s`` counts (a list of kind names there had
+    #: been a second answer to this, beside the controller's own look at the driver).
+    says_exposure_end: bool = False
 
 
 _KINDS: dict[str, CameraKind] = {}

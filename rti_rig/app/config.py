@@ -802,11 +802,6 @@ def load_rig_config(path: Path | str) -> LoadedRig:
     return loaded
 
 
-#: ``[camera.device]`` kinds whose driver says when its exposure is over (an
-#: ``ExposingCamera``): the controller switches the LED off then, before the download.
-EXPOSING_CAMERA_KINDS = frozenset({"gphoto2", "folder_watch"})
-
-
 def lit_per_shot(rig: LoadedRig) -> tuple[float, bool]:
     """(seconds an LED stays lit for one shot besides its exposure, whether that counts the
     transfer).
@@ -817,9 +812,11 @@ def lit_per_shot(rig: LoadedRig) -> tuple[float, bool]:
     Without the transfer the check below had passed a dry-run config whose every capture
     overran max_on_s ("LED 0 stayed on 1.153 s, beyond max_on_s = 0.46 s"), found after the
     dome was opened and lit."""
+    from rti_rig.drivers.cameras.kinds import camera_kind
+
     t = rig.config.timing
-    device = rig.config.camera.device or {}
-    held = device.get("kind") not in EXPOSING_CAMERA_KINDS
+    kind = camera_kind((rig.config.camera.device or {}).get("kind"))
+    held = kind is None or not kind.says_exposure_end  # a dry run's simulated camera: held
     # held: the LED goes off only with the all-off sent after the frame, which takes its own
     # time (timing.light_switch_s); a camera that says when its exposure is over has the
     # readout after it as margin

@@ -311,8 +311,8 @@ def fire_lit(
             rig.lighting.off()  # raises, stopping the session, if the dome did not take it
             said_of = getattr(rig.lighting, "off_said", None)
             off_said = said_of() if said_of is not None else None
+            cool_of = getattr(rig.lighting, "cool_down_s", None)
             if on_dark is not None:
-                cool_of = getattr(rig.lighting, "cool_down_s", None)
                 after = clock.now() + busy.retry_in_s
                 cool_s = cool_of(step, after) if cool_of is not None else 0.0
                 on_dark(
@@ -326,8 +326,7 @@ def fire_lit(
                     }
                 )
             _wait_dark(rig, clock.now() + busy.retry_in_s, cancelled)
-            cool_of = getattr(rig.lighting, "cool_down_s", None)
-            if cool_of is not None and cancelled is not None:
+            if cool_of is not None:
                 # the cool-down the thermal guard would wait in ``set``, waited here where a
                 # cancel is seen (it may be a minute)
                 _wait_dark(rig, clock.now() + cool_of(step, clock.now()), cancelled)

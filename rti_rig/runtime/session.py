@@ -1290,7 +1290,7 @@ def _prepare_resume(
             # is the same command again, and "drop --reshoot-lost" left the rest to guess
             raise SessionError(
                 f"{root}: --reshoot-lost is for a session that completed; this one did not "
-                f"({_ENDED_AS.get(runner.get('finish_reason'), 'its last run did not finish')}), "
+                f"({_ended_as(runner.get('finish_reason'))}), "
                 "and its resume sets aside and shoots again whatever it cannot verify anyway "
                 "(nothing in this folder was changed): continue it with rti-rig run --resume "
                 f"{shlex.quote(str(root))}"
@@ -1376,16 +1376,25 @@ def _prepare_resume(
 
 
 #: How a run that did not finish ended, by the manifest's finish_reason (for a refusal).
-_ENDED_AS = {
-    "cancelled": "its last run was stopped by Ctrl-C",
-    "interrupted": "its last run was interrupted",
-    "error": "its last run stopped on an error",
-    "emergency-stop": "its last run was stopped by an emergency stop",
-    "write-failed": "its last run could not write a file",
-    "no-space": "its last run found the disk full",
-    "crashed": "its last run stopped without finishing",
-    None: "its last run was killed before recording how it ended",
+#: How a session's last run ended, by its manifest's ``finish_reason``, as messages say it
+#: (the verdict of a session not finished and a refused ``--reshoot-lost`` say it alike).
+RUN_ENDED = {
+    "cancelled": "stopped by Ctrl-C",
+    "interrupted": "interrupted",
+    "error": "stopped by an error",
+    "emergency-stop": "stopped by an emergency stop",
+    "write-failed": "a file could not be written",
+    "no-space": "the disk was full",
+    "crashed": "the program stopped without finishing it",
 }
+
+
+def _ended_as(reason: object) -> str:
+    """``its last run …`` for :data:`RUN_ENDED`'s ``reason`` (None: killed before saying)."""
+    if reason is None:
+        return "its last run was killed before recording how it ended"
+    said = RUN_ENDED.get(reason) if isinstance(reason, str) else None
+    return f"its last run: {said}" if said else "its last run did not finish"
 
 
 def _manifest_records(manifest: dict[str, Any], names: list[str]) -> dict[int, dict[str, Any]]:

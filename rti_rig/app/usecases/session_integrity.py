@@ -27,6 +27,7 @@ from rti_rig.runtime.session import (
     LINEAR_DIR,
     LP_NAME,
     MANIFEST,
+    RUN_ENDED,
     files_lost_since_capture,
     image_names,
     lost_image_advice,
@@ -283,17 +284,6 @@ def _with_session_kind(qa: QAReport, manifest: dict) -> QAReport:  # type: ignor
 
 
 #: How a session that did not finish ended, as the manifest's finish_reason records it.
-_ENDED = {
-    "cancelled": "stopped by Ctrl-C",
-    "interrupted": "interrupted",
-    "error": "stopped by an error",
-    "emergency-stop": "stopped by an emergency stop",
-    "write-failed": "a file could not be written",
-    "no-space": "the disk was full",
-    "crashed": "the program stopped without finishing it",
-}
-
-
 def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  # type: ignore[type-arg]
     """``qa`` with a caveat for a session that did not finish: its verdict judges the images
     taken so far, and a "good" there had read as a session to fit and archive."""
@@ -312,7 +302,7 @@ def _with_unfinished(qa: QAReport, source: Path, manifest: dict) -> QAReport:  #
     }
     taken = len({r["index"] for r in scan_journal(source, image_names(total)).records} | recorded)
     how = (
-        _ENDED.get(reason or "", f"it ended: {reason}")
+        RUN_ENDED.get(reason or "", f"it ended: {reason}")
         if reason
         else ("it stopped without recording why (killed, or a power cut?)")
     )

@@ -45,6 +45,21 @@ def test_the_built_in_kinds_are_registered():
     assert kinds.camera_kind_names()[:3] == ("opencv", "gphoto2", "folder_watch")
 
 
+def test_a_kind_says_its_exposure_end_exactly_when_its_driver_does():
+    """The config's max_on_s check counts the transfer for a camera that holds its LED lit
+    until its frame is in; the controller switches the LED off early only for an
+    ExposingCamera. The two answers must agree for every built-in kind."""
+    from rti_rig.core.devices import ExposingCamera
+    from rti_rig.drivers.cameras.folder_watch import FolderWatchCamera
+    from rti_rig.drivers.cameras.gphoto2_camera import Gphoto2Camera
+    from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera
+
+    drivers = {"opencv": OpenCvCamera, "gphoto2": Gphoto2Camera, "folder_watch": FolderWatchCamera}
+    for name, driver in drivers.items():
+        kind = kinds.camera_kind(name)
+        assert kind is not None and kind.says_exposure_end == issubclass(driver, ExposingCamera)
+
+
 def test_an_unknown_kind_names_the_key_and_the_known_kinds():
     with pytest.raises(ValidationError) as info:
         parse_camera_settings({"kind": "webcam"})
