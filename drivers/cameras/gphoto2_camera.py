@@ -33,6 +33,11 @@ from rti_rig.drivers.cameras.folder_watch import is_raw_file
 from rti_rig.drivers.cameras.raw_decode import decode_raw
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
+#: libgphoto2's name for an object of a capture kept in the camera's RAM when the body gives
+#: none (``capt0000.jpg``, ``capt0001.nef``): numbered per object, so a shot's RAW and JPEG do
+#: not share a stem there, as a card's files (``IMG_0003.CR2``, ``IMG_0003.JPG``) do.
+_RAM_CAPTURE_NAME = re.compile(r"capt\d+", re.IGNORECASE)
+
 T = TypeVar("T")
 
 GP_ERROR_HINTS = {
@@ -620,14 +625,20 @@ class Gphoto2Camera:
         with the RAW in hand had ended the wait, and the late announcement was collected at
         the next shot as that shot's file (``raw/image_002.jpg`` was shot 1's JPEG). A file
         with the stem of an earlier shot's file (``IMG_0001.JPG`` after ``IMG_0001.CR2``) and
-        not this shot's is the earlier shot's, never this one's. (Stems alone do not pair
-        files: libgphoto2 may number each object of a RAM capture, ``capt0000.jpg`` and
-        ``capt0001.nef``; a body naming every shot alike keeps the old rule.)
+        not this shot's is the earlier shot's, never this one's. Any other file of another
+        stem is a stray, whichever of its files comes first. (Stems do not pair files where
+        libgphoto2 numbers each object of a RAM capture, ``capt0000.jpg`` and
+        ``capt0001.nef`` (:data:`_RAM_CAPTURE_NAME`); there, and for a body naming every shot
+        alike, only the one-RAW rule above tells a stray.)
         """
         gp = self._gp
         wait_ms = 200
         budget_s = self.settings.event_timeout_s
         stem = Path(files[0][1]).stem
+        # a card's names pair a shot's files by stem (IMG_0003.CR2, IMG_0003.JPG): a file of
+        # another stem is another picture's, whichever comes first (a stray's JPEG or RAW
+        # announced before this shot's RAW had been kept as this shot's)
+        by_stem = _RAM_CAPTURE_NAME.fullmatch(stem) is None
         more: list[tuple[str, str]] = []
         late: list[tuple[str, str]] = []
         strays: list[tuple[str, str]] = []
@@ -654,8 +665,10 @@ class Gphoto2Camera:
                 earlier = name.stem in self._earlier_stems
                 if earlier and name.stem != stem:
                     late.append(item)
-                elif name.stem in {Path(n).stem for _, n in strays} or (
-                    is_raw_file(name) and any(is_raw_file(Path(n)) for _, n in files + more)
+                elif (
+                    (by_stem and name.stem != stem)
+                    or name.stem in {Path(n).stem for _, n in strays}
+                    or (is_raw_file(name) and any(is_raw_file(Path(n)) for _, n in files + more))
                 ):
                     strays.append(item)
                 else:

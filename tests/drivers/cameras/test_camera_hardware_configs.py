@@ -398,3 +398,33 @@ def test_a_picture_taken_behind_a_busy_answer_is_kept_aside_never_as_an_images_f
     assert hashlib.sha256(data).hexdigest() == kept["sha256"]
     assert "it took while answering busy" in said and "kept aside in strays/" in said
     assert not body.ram  # downloaded and gone from the camera, as every shot
+
+
+def test_a_raw_and_jpeg_picture_taken_behind_a_busy_answer_is_kept_aside_whole(body, tmp_path):
+    """RAW+JPEG, the capture's own path the JPEG (the RAW comes by event): the picture a busy
+    answer took (IMG_0002.JPG, then IMG_0002.CR2) is announced before the retried shot's RAW.
+    Its JPEG had been kept as image 2's, its RAW as image 2's original and image 2's own RAW
+    set aside as the stray: a picture whose exposure the LED may not have covered, recorded as
+    the step's. A body naming a shot's files with one stem pairs them by it."""
+    text = DSLR_CONFIG.read_text().replace(
+        'image_format = "RAW"', 'image_format = "RAW + Large Fine JPEG"\nkeep_jpeg = true'
+    )
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "raw_jpeg.toml"
+    config.write_text(text)
+    body.jpeg_first = True
+    body.busy_after_shot = 1
+    body.busy_yet_shot = 1
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "3")
+    assert result.exit_code == 0, result.output
+    assert body.shots == 4
+    entries = journal(out)
+    stems = [sorted({Path(n).stem for n in e["originals"].values()}) for e in entries]
+    assert stems == [["IMG_0001"], ["IMG_0003"], ["IMG_0004"]], entries
+    assert [len(e["originals"]) for e in entries] == [2, 2, 2]
+    strays = {s: kept["camera_file"] for e in entries for s, kept in e["strays"].items()}
+    assert sorted(strays.values()) == ["/IMG_0002.CR2", "/IMG_0002.JPG"], strays
+    assert all((out / s).is_file() for s in strays)
