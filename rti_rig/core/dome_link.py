@@ -172,8 +172,8 @@ class OffReport:
             ),
             OffOutcome.NEVER_OPENED: (
                 f"the dome's port is held by another program{why}, so this run lit nothing "
-                "and sent nothing: the lights are that program's (another rti-rig check or run "
-                "switches them off when it ends)"
+                "and sent nothing: the lights are that program's (if it is another rti-rig "
+                "check or run, it switches them off when it ends)"
                 if self.port_held
                 else f"the dome's port could not be opened{why}, so this run lit nothing and "
                 "could not send an all-off either; if the dome is lit from an earlier run, "
