@@ -1471,7 +1471,7 @@ def _finished_rebuild(
     steps = _finished_steps(manifest, len(names))
     journaled = {r["index"] for r in scan.records}
     if (root / JOURNAL).exists() and not scan.needs_repair and set(steps) <= journaled:
-        return {}, None, []
+        return {}, None, {}
     taken = _provable_steps(root, manifest, names, scan.records)
     listed = _manifest_records(manifest, names)
     latest = _latest_records(scan.records)
