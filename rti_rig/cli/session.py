@@ -318,13 +318,9 @@ def _rebuilt_finished(req: Any) -> bool:
     session that did not finish"), with no way to make it whole again. A Ctrl-C or SIGTERM
     while the images are checked leaves the folder as it was; one while the journal is written
     is acted on once it is, and said so."""
-    from rti_rig.app.usecases.session import (
-        Note,
-        lost_since_capture_advice,
-        rebuild_finished_session,
-    )
+    from rti_rig.app.usecases.session import Note, rebuild_finished_session
     from rti_rig.runtime.controller import EmergencyStop
-    from rti_rig.runtime.session import JOURNAL
+    from rti_rig.runtime.session import JOURNAL, lost_since_capture_said
 
     folder = _arg(req.session_dir)
     try:
@@ -338,7 +334,7 @@ def _rebuilt_finished(req: Any) -> bool:
         if done:
             for line in done:
                 print_note(Note(line, "warning"))
-            lost = lost_since_capture_advice(req.session_dir)
+            lost = lost_since_capture_said(req.session_dir)
             said = f"Stopped ({why}) once {JOURNAL} was rebuilt: " + (
                 f"the session is whole again; rti-rig fit {folder} --out FOLDER fits it "
                 "and gives its QA verdict"
@@ -356,7 +352,7 @@ def _rebuilt_finished(req: Any) -> bool:
         return False
     for line in notes:
         print_note(Note(line, "warning"))
-    lost = lost_since_capture_advice(req.session_dir)
+    lost = lost_since_capture_said(req.session_dir)
     if lost is not None:  # recorded as lost: said with the command that reshoots it
         out.print(
             f"{req.session_dir}: {JOURNAL} rebuilt from every image it could prove (no rig "

@@ -1532,15 +1532,12 @@ def rebuild_finished_journal(root: Path) -> list[str]:
         if unproven is None:
             # what is lost, named with what gets it back: the user who reached for the rebuild
             # had been sent to a fit to find out
-            gone = files_lost_since_capture(root)
-            shown = "; ".join(f"{n}: {', '.join(g)}" for n, g in sorted(gone.items())[:8])
+            gone = lost_since_capture_said(root, manifest)
             raise SessionError(
                 f"{root}: this session completed and its {JOURNAL} holds a record of every "
                 "image it captured: nothing to rebuild; drop --rebuild-journal"
                 + (
-                    f"; but {len(gone)} image(s) are lost since capture ({shown}"
-                    f"{' …' if len(gone) > 8 else ''}): "
-                    + lost_image_advice(root, bool(manifest.get("adaptive")))
+                    f"; but {gone}"
                     if gone
                     else f" (the QA verdict of rti-rig fit {folder} --out DIR names any image "
                     "changed since capture)"
@@ -2091,6 +2088,26 @@ def lost_image_advice(root: Path, adaptive: bool) -> str:
     return (
         "put the originals back from a copy, or reshoot exactly those, with the object where "
         f"it was: rti-rig run --resume {shlex.quote(str(root))} --reshoot-lost"
+    )
+
+
+def lost_since_capture_said(root: Path, manifest: dict[str, Any] | None = None) -> str | None:
+    """``N image(s) lost since capture (image_003: image_003.jpg changed; …): <what gets them
+    back>`` for session ``root`` once its journal says what was captured; None when nothing
+    is lost. ``manifest``: the session's, when the caller holds it.
+
+    Why: a completed session's rebuild that recorded an image as lost (its file changed, set
+    aside) must not end with "the session is complete and whole again", and a rebuild refused
+    as needless names what is lost all the same; both say it in these words."""
+    root = Path(root)
+    lost = files_lost_since_capture(root)
+    if not lost:
+        return None
+    adaptive = bool((manifest if manifest is not None else read_manifest(root)).get("adaptive"))
+    shown = "; ".join(f"{n}: {', '.join(g)}" for n, g in sorted(lost.items())[:8])
+    more = " …" if len(lost) > 8 else ""
+    return f"{len(lost)} image(s) lost since capture ({shown}{more}): " + lost_image_advice(
+        root, adaptive
     )
 
 

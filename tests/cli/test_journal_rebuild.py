@@ -683,6 +683,6 @@ def test_a_rebuild_of_a_whole_journal_names_the_image_lost_and_its_reshoot(
     before = _files(out)
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 2 and "nothing to rebuild" in said(r), r.output
-    assert "1 image(s) are lost since capture (image_006: image_006.jpg missing)" in said(r)
+    assert "1 image(s) lost since capture (image_006: image_006.jpg missing)" in said(r)
     assert said(r).endswith(f"rti-rig run --resume {out} --reshoot-lost"), r.output
     assert _files(out) == before

@@ -936,30 +936,6 @@ def rebuild_finished_session(req: ResumeRequest) -> list[str] | None:
     return rebuild_finished_journal(Path(req.session_dir))
 
 
-def lost_since_capture_advice(root: Path) -> str | None:
-    """What session ``root`` lost since capture and the command that gets it back, once its
-    journal says what was captured (after ``--rebuild-journal``); None when nothing is lost.
-
-    Why: a completed session's rebuild that recorded an image as lost (its file changed, set
-    aside) must not end with "the session is complete and whole again"."""
-    from rti_rig.runtime.session import (
-        files_lost_since_capture,
-        lost_image_advice,
-        read_manifest,
-    )
-
-    lost = files_lost_since_capture(Path(root))
-    if not lost:
-        return None
-    adaptive = bool(read_manifest(Path(root)).get("adaptive"))
-    shown = "; ".join(f"{n}: {', '.join(g)}" for n, g in sorted(lost.items())[:8]) + (
-        " …" if len(lost) > 8 else ""
-    )
-    return f"{len(lost)} image(s) lost since capture ({shown}): " + lost_image_advice(
-        Path(root), adaptive
-    )
-
-
 def open_resumed_session(req: ResumeRequest, on_note: NoteSink = _ignore) -> OpenedSession:
     """Check the rig against the session, verify and repair the session on disk, open the
     rig and check the remaining steps on it.
