@@ -1490,14 +1490,11 @@ def _evidence(
                 "lights (gloss, shadows or clipping), or most recorded lights are wrong (the "
                 ".lp of another session?)"
             )
-            judged = np.zeros(n, bool)
-            wrong = np.zeros(n, bool)
-            explained = np.zeros(n, bool)
-            typical = float("nan")
             most_disagree = True
         if not most_disagree:
             object_typical = RAYLEIGH_MEDIAN_PER_Q25 * float(np.percentile(err[cand], 25.0))
-        if not most_disagree and object_typical >= object_error_limit:
+        object_unjudgeable = not most_disagree and object_typical >= object_error_limit
+        if object_unjudgeable:
             # The "typical" above is the median of the errors within WRONG_LIGHT_DEG alone, so
             # its limit never passed 24°: on the brushed steel of the simulated industrial
             # part (1024 px, 24 lights, every light right) half the judged images point 13° or
@@ -1511,6 +1508,7 @@ def _evidence(
                 "lights (gloss, shadows or clipping), too far to tell a wrong light (a swap "
                 "of neighbouring lights) from the object's own error"
             )
+        if most_disagree or object_unjudgeable:  # no direction judged: said in the note
             judged = np.zeros(n, bool)
             wrong = np.zeros(n, bool)
             explained = np.zeros(n, bool)

@@ -453,6 +453,18 @@ def test_a_completed_session_with_an_image_it_cannot_prove_is_rebuilt_then_made_
     assert _images(out) == _images(ref)
 
 
+def _ctrl_c_once_relisted(monkeypatch: pytest.MonkeyPatch, real_relist) -> None:  # type: ignore[no-untyped-def]
+    """A Ctrl-C arriving while the rebuilt journal is written: held by the block, acted on
+    at its end (once ``_relist_verified`` has run)."""
+    import rti_rig.runtime.session as session
+
+    def relisted_then_stopped(*args, **kwargs):  # type: ignore[no-untyped-def]
+        real_relist(*args, **kwargs)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(session, "_relist_verified", relisted_then_stopped)
+
+
 def test_a_stop_while_a_completed_session_is_rebuilt_says_what_it_left(
     made: tuple[Path, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -479,11 +491,7 @@ def test_a_stop_while_a_completed_session_is_rebuilt_says_what_it_left(
 
     monkeypatch.setattr(session, "_provable_steps", real_provable)
 
-    def relisted_then_stopped(*args, **kwargs):  # type: ignore[no-untyped-def]
-        real_relist(*args, **kwargs)
-        raise KeyboardInterrupt  # a Ctrl-C held by the block, acted on at its end
-
-    monkeypatch.setattr(session, "_relist_verified", relisted_then_stopped)
+    _ctrl_c_once_relisted(monkeypatch, real_relist)
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 130, r.output
     assert "once journal.jsonl was rebuilt: the session is whole again" in said(r)
@@ -657,11 +665,7 @@ def test_a_stop_held_while_a_rebuild_records_an_image_lost_says_it_is_not_whole(
     (out / "image_004.jpg").unlink()
     real_relist = session._relist_verified
 
-    def relisted_then_stopped(*args, **kwargs):  # type: ignore[no-untyped-def]
-        real_relist(*args, **kwargs)
-        raise KeyboardInterrupt  # a Ctrl-C held by the block, acted on at its end
-
-    monkeypatch.setattr(session, "_relist_verified", relisted_then_stopped)
+    _ctrl_c_once_relisted(monkeypatch, real_relist)
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
     assert r.exit_code == 130, r.output
     assert "whole again" not in said(r), r.output
