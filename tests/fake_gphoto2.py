@@ -10,15 +10,15 @@ GP_FILE_TYPE_NORMAL)`` → a CameraFile with ``save(path)``, ``file_delete``; er
 -105 unknown model, -110 busy, -115 no space left).
 
 Quirks of real bodies it reproduces (from gphoto/libgphoto2 issue threads, see
-/work/shared/reference/hardware-notes.md §5): "busy" right after a shot (for a number of
-tries, or for a time as a body writing to a slow card is: it takes no picture meanwhile; or,
-pibooth #466, busy yet the picture taken, its file announced by event at once or at the next
-shot), a body switched off or unplugged (every call then fails with -7 and autodetect finds
-nothing), a card that fills up, a file counter that wraps (IMG_9999 → IMG_0001) or a RAM target that
-names every shot the same (Nikon's ``capt0000.nef``), RAW+JPEG delivered as two files, the
-second through a FILE_ADDED event (some bodies also announce the first one, and end with
-CAPTURE_COMPLETE), several bodies on the bus, and a setting that does not latch (the mode dial
-not on M).
+/work/shared/reference/hardware-notes.md §5): "busy" right after a shot (for a number of tries,
+or for a time as a body writing to a slow card is: it takes no picture meanwhile; or, pibooth
+#466, busy yet the picture taken, its file announced by event at once, at the next shot or
+never: ``folder_list_files`` then shows it on the card), a body switched off or unplugged
+(every call then fails with -7 and autodetect finds nothing), a card that fills up, a file
+counter that wraps (IMG_9999 → IMG_0001) or a RAM target that names every shot the same
+(Nikon's ``capt0000.nef``), RAW+JPEG delivered as two files, the second through a FILE_ADDED
+event (some bodies also announce the first one, and end with CAPTURE_COMPLETE), several bodies
+on the bus, and a setting that does not latch (the mode dial not on M).
 """
 
 from __future__ import annotations
@@ -86,6 +86,9 @@ class Body:
     busy_yet_shot: int = 0
     #: such a picture is announced only once the next shot is taken (a body still writing it)
     stray_announced_late: bool = False
+    #: such a picture is never announced at all (no FILE_ADDED event, ever): on a card it is
+    #: only seen by listing the folder; in the camera's RAM it is lost
+    stray_never_announced: bool = False
     #: the camera file names of the pictures taken behind a busy answer
     stray_files: list[str] = field(default_factory=list)
     #: a slow card: every capture answers -110 (and takes no picture) until ``busy_for_s`` of
@@ -284,7 +287,9 @@ def make_module(body: Body) -> types.ModuleType:
                         stray = take_picture(announce_all=True)
                         body._busy = still_busy  # it goes on answering busy as it was
                         body.stray_files.append(stray.name)
-                        if body.stray_announced_late:  # held back until the next shot
+                        if body.stray_never_announced:
+                            body._events[:] = [e for e in body._events if e[1] is None]
+                        elif body.stray_announced_late:  # held back until the next shot
                             held = [e for e in body._events if e[1] is not None]
                             body._events[:] = [e for e in body._events if e not in held]
                             body._late.extend([10**9, e] for e in held)
@@ -327,6 +332,13 @@ def make_module(body: Body) -> types.ModuleType:
             if name not in store:
                 raise GPhoto2Error(-108)
             return CameraFile(store[name])
+
+        def folder_list_files(self, folder: str) -> list[tuple[str, None]]:
+            """python-gphoto2's CameraList of (name, value) pairs: the files in ``folder``."""
+            body.check("folder_list_files")
+            card = "/store_00020001/DCIM/100CANON"
+            store = body.card if folder.rstrip("/") == card else body.ram if folder == "/" else {}
+            return [(name, None) for name in sorted(store)]
 
         def file_delete(self, folder: str, name: str) -> None:
             body.check("file_delete")

@@ -157,6 +157,13 @@ class Gphoto2Camera:
         #: a busy spell handed back to the caller by ``expose_within`` (its light went off):
         #: the next ``expose_within`` goes on counting its tries and waits from there
         self._busy: _BusySpell | None = None
+        #: whether the shot ``_fire`` took last came after busy answers (a picture may have
+        #: been taken behind one and never announced: ``collect`` then lists the card folder)
+        self._fired_after_busy = False
+        #: card folder → the names listed there after the last shot in it (what was on the
+        #: card before any busy spell that follows): listed once per folder, then again only
+        #: after a busy spell, so a body that is never busy costs one listing a session
+        self._card_seen: dict[str, set[str]] = {}
         self.retries_used = 0
         self.camera_model: str | None = None
 
@@ -272,6 +279,7 @@ class Gphoto2Camera:
         self._shutter_label = None
         self._pending = None
         self._busy = None
+        self._card_seen = {}
         staging, self._staging_tmp = self._staging_tmp, None
         if staging is not None:
             shutil.rmtree(staging, ignore_errors=True)
@@ -438,7 +446,9 @@ class Gphoto2Camera:
         while True:
             started = self._clock.now()
             try:
-                return cam.capture(gp.GP_CAPTURE_IMAGE)
+                path = cam.capture(gp.GP_CAPTURE_IMAGE)
+                self._fired_after_busy = spell.tries > 0
+                return path
             except gp.GPhoto2Error as exc:
                 # a body may answer busy only after a pause (a Canon whose autofocus fails:
                 # "-- long pause --", then PTP Device Busy): the next try may take as long to
@@ -509,6 +519,7 @@ class Gphoto2Camera:
         files = [(str(path.folder), str(path.name))]
         more, late, strays = self._more_files(files)
         files.extend(more)
+        strays.extend(self._unannounced(str(path.folder), files + late + strays))
         self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
         raw_files = [f for f in files if is_raw_file(Path(f[1]))]
@@ -542,6 +553,7 @@ class Gphoto2Camera:
             camera_file.save(str(target))
             stray_saved.append({"path": str(target), "name": f"{folder.rstrip('/')}/{name}"})
         self._delete(files + strays)
+        self._note_card(str(path.folder), files + strays)
         raw_path = saved[raw_files[0][1]]
         decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
         jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
@@ -683,6 +695,58 @@ class Gphoto2Camera:
                     break
         self._earlier_stems.update(Path(n).stem for _, n in files + more + strays)
         return more, late, strays
+
+    def _list_folder(self, folder: str) -> set[str] | None:
+        """The file names in a camera folder, or None where it cannot be listed (a RAM
+        capture's folder on some bodies): one listing, never retried."""
+        try:
+            return {str(name) for name, _ in self._cam.folder_list_files(folder)}
+        except self._gp.GPhoto2Error:
+            return None
+
+    def _unannounced(self, folder: str, known: list[tuple[str, str]]) -> list[tuple[str, str]]:
+        """Pictures the body took behind a busy answer and never announced (no FILE_ADDED
+        event, ever), found on its card: the files in the shot's folder that were not there
+        after the last shot in it and are not files this shot's events named.
+
+        Looked for only when the shot came after busy answers (a body that is never busy
+        costs one listing of its folder a session, in :meth:`_note_card`). Such a picture
+        had stayed on the card unseen, the session saying nothing of it. In the camera's
+        RAM (``capture_target = "Internal RAM"``) an unannounced picture has no file to list
+        and cannot be seen at all; nor can one taken before the first listing of a folder
+        (a busy spell before the session's first shot in it)."""
+        if not self._fired_after_busy or self.settings.capture_target == "Internal RAM":
+            return []
+        before = self._card_seen.get(folder)
+        if before is None:
+            return []
+        now = self._list_folder(folder)
+        if now is None:
+            return []
+        named = {n for f, n in known if f.rstrip("/") == folder.rstrip("/")}
+        found = [(folder, n) for n in sorted(now - before - named)]
+        self._card_seen[folder] = now
+        self._earlier_stems.update(Path(n).stem for _, n in found)
+        return found
+
+    def _note_card(self, folder: str, taken: list[tuple[str, str]]) -> None:
+        """Remember what the shot's card folder holds once its files are downloaded (and
+        deleted): the "before" of the next busy spell's listing. Listed the first time a
+        folder is seen; after that only the shot's own files are added (when they stay on
+        the card), and a busy spell's listing (:meth:`_unannounced`) replaces it."""
+        if self.settings.capture_target == "Internal RAM":
+            return
+        seen = self._card_seen.get(folder)
+        if seen is None:
+            listed = self._list_folder(folder)
+            if listed is None:
+                return
+            seen = listed
+        if self.settings.delete_from_camera:
+            seen = seen - {n for _, n in taken}
+        else:
+            seen = seen | {n for _, n in taken}
+        self._card_seen[folder] = seen
 
     def _delete(self, files: list[tuple[str, str]]) -> None:
         if not self.settings.delete_from_camera:

@@ -428,3 +428,46 @@ def test_a_raw_and_jpeg_picture_taken_behind_a_busy_answer_is_kept_aside_whole(b
     strays = {s: kept["camera_file"] for e in entries for s, kept in e["strays"].items()}
     assert sorted(strays.values()) == ["/IMG_0002.CR2", "/IMG_0002.JPG"], strays
     assert all((out / s).is_file() for s in strays)
+
+
+def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(body, tmp_path):
+    """A body answers busy once after a shot yet takes the picture, and never announces it (no
+    FILE_ADDED event, ever). Capturing to the card, the picture had stayed there unseen, the
+    session saying nothing. The card folder is listed after the busy spell: IMG_0002 is found,
+    downloaded into strays/ and recorded in image 2's strays, never as an image; a file on the
+    card before the session is left alone; a body never busy costs one listing a session."""
+    text = DSLR_CONFIG.read_text().replace(
+        'capture_target = "Internal RAM"', 'capture_target = "Memory card"'
+    )
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "card.toml"
+    config.write_text(text)
+    body.card["IMG_0999.CR2"] = b"the owner's earlier picture"
+    body.busy_after_shot = 1
+    body.busy_yet_shot = 1
+    body.stray_never_announced = True
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "3")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, result.output
+    check_images(out, 3)
+    assert body.stray_files == ["IMG_0002.CR2"] and body.shots == 4
+    entries = journal(out)
+    names = [Path(next(iter(e["originals"].values()))).name for e in entries]
+    assert names == ["IMG_0001.CR2", "IMG_0003.CR2", "IMG_0004.CR2"]
+    strays = [(e["index"], s, kept) for e in entries for s, kept in e["strays"].items()]
+    assert [(i, s) for i, s, _ in strays] == [(1, "strays/image_002-IMG_0002.CR2")]
+    assert strays[0][2]["camera_file"].endswith("/IMG_0002.CR2")
+    assert "it took while answering busy" in said
+    assert sorted(body.card) == ["IMG_0999.CR2"]  # the stray downloaded and deleted
+
+    # a body that is never busy: its folder listed once, nothing taken as a stray
+    body.busy_after_shot = body.busy_yet_shot = 0
+    body.calls.clear()
+    result = run(str(config), "--out", str(tmp_path / "t"), "--lights", "3")
+    assert result.exit_code == 0, result.output
+    assert body.calls.count("folder_list_files") == 1
+    assert all(not e["strays"] for e in journal(tmp_path / "t"))
+    assert sorted(body.card) == ["IMG_0999.CR2"]
