@@ -34,6 +34,12 @@ RAW_GREY_FOURCCS = {"Y16 ", "Y10 ", "Y12 "}
 #: Buffers OpenCV's V4L2 backend queues unless CAP_PROP_BUFFERSIZE changes it
 #: (DEFAULT_V4L_BUFFERS in modules/videoio/src/cap_v4l.cpp).
 OPENCV_V4L_DEFAULT_BUFFERS = 4
+#: Freshly exposed frames discarded after the queued ones, whatever the queue: the frame in
+#: flight when the drain began (its exposure may have begun before the light was settled)
+#: and two more while the sensor latches a new exposure at a frame boundary (UVC sensors take
+#: one frame or more: realsense #11228 reports up to 5 on one body, so ``drain_frames`` can
+#: ask for more). A one-buffer queue with the default 4 drained has always discarded 3.
+FRESH_FRAMES_DISCARDED = 3
 
 
 class VideoCaptureLike(Protocol):
@@ -211,35 +217,42 @@ class OpenCvCamera:
         self.connection_info = info
 
     def _drain_for_queue(self, cap: VideoCaptureLike, info: dict[str, Any]) -> int:
-        """Frames to drain so that none exposed before an exposure change is kept: at least
-        the buffers the driver queues.
+        """Frames to drain so that none exposed before the light settled or the exposure
+        changed is kept: the buffers the driver queues, then freshly exposed frames.
 
         Why: a driver that refuses the buffer-size request (``set`` returns False) keeps its
         own queue, OpenCV's V4L2 default of 4 buffers or more, and ``get`` reports it; a drain
         shorter than that returned a frame exposed at the previous light's exposure, while the
-        metadata said ``drained_frames = 4`` as if it were fresh. An unset ``drain_frames``
-        follows the queue; a set one shorter than it is refused, naming the key."""
+        metadata said ``drained_frames = 4`` as if it were fresh. Draining just the queue is
+        not enough either: the next frame is the one in flight as the drain began (uvcvideo
+        fills a re-queued buffer from the next frame start, whose exposure began before), and a
+        sensor latches a new exposure a frame or more late. A drain of exactly the queue had
+        kept that frame, or the one after it, on a 4-buffer queue: the new light's image at
+        the previous step's exposure. An unset ``drain_frames`` drains the queue and
+        :data:`FRESH_FRAMES_DISCARDED` more (as a one-buffer queue with 4 drained always did);
+        a set one that would keep the in-flight frame is refused, naming the key."""
         s = self.settings
         asked = s.buffer_size if info["buffer_size_set"] else None
         got = cap.get(cv2.CAP_PROP_BUFFERSIZE)
         queued = asked or (int(got) if got >= 1 else OPENCV_V4L_DEFAULT_BUFFERS)
         info["buffers_queued"] = queued
         drain = s.frames_to_drain
-        if drain >= queued:
+        if s.drain_frames is None:
+            return max(drain, queued + FRESH_FRAMES_DISCARDED)
+        if drain > queued:
             return drain
         refused = (
             ""
             if info["buffer_size_set"]
             else f"the driver refused buffer_size = {s.buffer_size} (CAP_PROP_BUFFERSIZE) and "
         )
-        if s.drain_frames is None:
-            return queued
         raise DeviceError(
             self.name,
             f"{refused}{queued} buffer{' is' if queued == 1 else 's are'} queued, so "
             f"drain_frames = {s.drain_frames} in [camera.device] would keep a frame exposed "
-            f"before the exposure changed: set drain_frames = {queued} or more, or remove it "
-            "(unset, it follows the queue)",
+            f"before the exposure changed or the light settled (the one in flight): set "
+            f"drain_frames = {queued + 1} or more ({queued + FRESH_FRAMES_DISCARDED} leaves the "
+            "sensor time to latch a new exposure), or remove it (unset, it follows the queue)",
             "set buffer_size",
         )
 

@@ -126,8 +126,9 @@ class OpenCvCameraSettings(_Strict):
         None,
         ge=0,
         description="frames grabbed and discarded before each capture so the returned frame "
-        "was exposed after the exposure was set (V4L2 queues several buffers); unset: 4 on "
-        "v4l2, 0 on an image sequence (one file per capture)",
+        "was exposed after the exposure was set (V4L2 queues several buffers); unset: the "
+        "queued buffers and 3 fresh frames (at least 4) on v4l2, 0 on an image sequence (one "
+        "file per capture)",
     )
     exposure_tolerance: float = Field(
         0.02, ge=0.0, description="relative mismatch allowed between set and read-back exposure"

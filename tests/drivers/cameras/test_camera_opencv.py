@@ -253,13 +253,16 @@ def test_a_refused_buffer_size_is_drained_in_full_or_a_short_drain_refused():
     with v4l2_camera(fake) as cam:
         f = cam.capture(0.01)
     assert np.all(f.pixels == 100), f.pixels  # exposed after the change
-    assert f.metadata["drained_frames"] == 6 and f.metadata["buffers_queued"] == 6
+    # the 6 queued, then the frame in flight and two while the sensor latches the exposure
+    assert f.metadata["drained_frames"] == 9 and f.metadata["buffers_queued"] == 6
     assert f.metadata["buffer_size_set"] is False
     with pytest.raises(DeviceError) as info:
         v4l2_camera(FakeV4l2(buffers=6), drain_frames=4).connect()
     said = str(info.value)
     assert "refused buffer_size = 1" in said and "6 buffers are queued" in said, said
-    assert "drain_frames = 4 in [camera.device]" in said and "drain_frames = 6 or more" in said
+    assert "drain_frames = 4 in [camera.device]" in said and "drain_frames = 7 or more" in said
+    with pytest.raises(DeviceError, match="drain_frames = 7 or more"):  # the queue alone
+        v4l2_camera(FakeV4l2(buffers=6), drain_frames=6).connect()
 
 
 def test_v4l2_size_is_set_before_the_pixel_format():

@@ -1,0 +1,207 @@
+"""A UVC camera streaming as a real one does, behind OpenCV's V4L2 backend, on a virtual clock.
+
+Modelled on the published behaviour, not on our driver:
+
+* OpenCV's ``cap_v4l.cpp``: the first ``grab`` queues every buffer and starts the stream
+  (``VIDIOC_STREAMON``); each ``grab`` gives the buffer it handed out last back to the driver
+  (``VIDIOC_QBUF``), then takes the oldest filled one (``VIDIOC_DQBUF``), waiting for one if
+  none is filled; ``read`` is ``grab`` then retrieve. ``CAP_PROP_BUFFERSIZE`` is the number
+  of buffers (4 by default); a driver may refuse another count.
+* The camera exposes frames continuously at its frame rate whether or not the host reads
+  them; uvcvideo fills a buffer only from the start of a frame (it waits for the frame-ID bit
+  to toggle, so a buffer queued mid-frame gets the next frame), and a frame that finds no
+  queued buffer is dropped: a full queue holds the *oldest* frames.
+* A rolling shutter: row ``r`` of frame ``k`` is read out at ``k·P + r·R/H`` (``P`` the frame
+  period, ``R`` the readout time) after an exposure of ``e`` seconds ending then; the frame is
+  delivered once its last row is read. A new exposure value takes effect ``latency_frames``
+  frame periods after it is set (sensors latch it at a frame boundary).
+
+Each row's value is ``scale`` × the light integrated over that row's own exposure, so a frame
+exposed partly under another light (or partly dark) shows it row by row.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from rti_rig.core.clock import VirtualClock
+
+
+@dataclass
+class _Buffer:
+    state: str = "queued"  # queued (the driver's), filling, done, held (the application's)
+    queued_at: float = 0.0
+    frame: int | None = None
+    done_at: float = 0.0
+
+
+class LightHistory:
+    """The light on the object as a function of time (piecewise constant), on ``clock``."""
+
+    def __init__(self, clock: VirtualClock) -> None:
+        self.clock = clock
+        self.changes: list[tuple[float, float]] = [(-math.inf, 0.0)]
+
+    def set(self, level: float) -> None:
+        self.changes.append((self.clock.now(), level))
+
+    def integral(self, t0: float, t1: float) -> float:
+        total = 0.0
+        for i, (start, level) in enumerate(self.changes):
+            end = self.changes[i + 1][0] if i + 1 < len(self.changes) else math.inf
+            lo, hi = max(start, t0), min(end, t1)
+            if hi > lo:
+                total += level * (hi - lo)
+        return total
+
+
+class BufferedUvcStream:
+    """``cv2.VideoCapture(device, CAP_V4L2)`` on a Y16 UVC camera (see the module docstring)."""
+
+    def __init__(
+        self,
+        light: LightHistory,
+        *,
+        fps: float = 10.0,
+        readout_s: float = 0.05,
+        rows: int = 8,
+        cols: int = 4,
+        buffers: int = 4,
+        buffer_size_accepted: bool = True,
+        latency_frames: int = 1,
+        scale: float = 100_000.0,
+        exposure_units: float = 100.0,
+    ) -> None:
+        self.light = light
+        self.clock = light.clock
+        self.period = 1.0 / fps
+        self.readout_s = readout_s
+        self.rows, self.cols = rows, cols
+        self.accept_buffer_size = buffer_size_accepted
+        self.latency_frames = latency_frames
+        self.scale = scale
+        self.buffers = [_Buffer() for _ in range(buffers)]
+        self.streaming_from: float | None = None
+        self.next_frame = 0
+        self.held: _Buffer | None = None
+        #: (time set, exposure units): the exposure control's history
+        self.exposures: list[tuple[float, float]] = [(-math.inf, exposure_units)]
+        self.props = {
+            cv2.CAP_PROP_FOURCC: float(cv2.VideoWriter_fourcc(*"Y16 ")),
+            cv2.CAP_PROP_CONVERT_RGB: 1.0,
+            cv2.CAP_PROP_AUTO_EXPOSURE: 3.0,
+            cv2.CAP_PROP_EXPOSURE: exposure_units,
+            cv2.CAP_PROP_GAIN: 0.0,
+            cv2.CAP_PROP_AUTO_WB: 0.0,
+            cv2.CAP_PROP_FRAME_WIDTH: float(cols),
+            cv2.CAP_PROP_FRAME_HEIGHT: float(rows),
+            cv2.CAP_PROP_BUFFERSIZE: float(buffers),
+            cv2.CAP_PROP_FPS: fps,
+        }
+        #: every frame handed to the application: (frame number, its rows' exposure windows)
+        self.delivered: list[tuple[int, list[tuple[float, float]]]] = []
+
+    # -- the camera and the driver ---------------------------------------------------------
+    def _exposure_s(self, k: int) -> float:
+        """The exposure frame ``k`` was taken at: the value set ``latency_frames`` periods
+        before the frame period its exposure began in."""
+        latch = (k - 1 - self.latency_frames) * self.period
+        units = [u for t, u in self.exposures if t <= latch][-1]
+        return min(units * 1e-4, self.period)
+
+    def _row_windows(self, k: int) -> list[tuple[float, float]]:
+        e = self._exposure_s(k)
+        t0 = self.streaming_from or 0.0
+        return [
+            (
+                t0 + k * self.period + r * self.readout_s / self.rows - e,
+                t0 + k * self.period + r * self.readout_s / self.rows,
+            )
+            for r in range(self.rows)
+        ]
+
+    def _run_until(self, now: float) -> None:
+        """Frames whose readout began by ``now`` go into a buffer queued before they began,
+        or are dropped; buffers whose frame is read out by ``now`` are done."""
+        assert self.streaming_from is not None
+        while self.streaming_from + self.next_frame * self.period <= now:
+            k = self.next_frame
+            start = self.streaming_from + k * self.period
+            free = [b for b in self.buffers if b.state == "queued" and b.queued_at <= start]
+            if free:
+                b = min(free, key=lambda b: b.queued_at)
+                b.state, b.frame, b.done_at = "filling", k, start + self.readout_s
+            self.next_frame += 1
+        for b in self.buffers:
+            if b.state == "filling" and b.done_at <= now:
+                b.state = "done"
+
+    def _dequeue(self) -> _Buffer:
+        while True:
+            now = self.clock.now()
+            self._run_until(now)
+            done = [b for b in self.buffers if b.state == "done"]
+            if done:
+                b = min(done, key=lambda b: b.done_at)
+                b.state = "held"
+                return b
+            pending = [b.done_at for b in self.buffers if b.state == "filling"]
+            assert self.streaming_from is not None
+            next_start = self.streaming_from + self.next_frame * self.period
+            self.clock.sleep(max(min([*pending, next_start]) - now, 1e-9))
+
+    def _pixels(self, k: int) -> np.ndarray:
+        rows = [self.scale * self.light.integral(a, b) for a, b in self._row_windows(k)]
+        col = np.clip(np.round(rows), 0, 65535).astype(np.uint16)
+        return np.repeat(col[:, None], self.cols, axis=1)
+
+    # -- VideoCapture ----------------------------------------------------------------------
+    def isOpened(self) -> bool:
+        return True
+
+    def set(self, prop: int, value: float) -> bool:
+        if prop == cv2.CAP_PROP_BUFFERSIZE:
+            if not self.accept_buffer_size:
+                return False
+            self.buffers = [_Buffer() for _ in range(int(value))]
+            self.props[prop] = float(value)
+            return True
+        if prop == cv2.CAP_PROP_EXPOSURE:
+            if self.props[cv2.CAP_PROP_AUTO_EXPOSURE] != 1:
+                return True
+            self.exposures.append((self.clock.now(), float(value)))
+        if prop == cv2.CAP_PROP_FOURCC and value != self.props[prop]:
+            return True  # Y16 only
+        if prop in self.props:
+            self.props[prop] = float(value)
+            return True
+        return False
+
+    def get(self, prop: int) -> float:
+        return self.props.get(prop, -1.0)
+
+    def grab(self) -> bool:
+        now = self.clock.now()
+        if self.streaming_from is None:  # the first grab queues every buffer, STREAMON
+            self.streaming_from = now
+            for b in self.buffers:
+                b.state, b.queued_at = "queued", now
+        if self.held is not None:  # VIDIOC_QBUF of the buffer handed out last
+            self._run_until(now)
+            self.held.state, self.held.queued_at, self.held.frame = "queued", now, None
+        self.held = self._dequeue()
+        return True
+
+    def read(self) -> tuple[bool, np.ndarray]:
+        self.grab()
+        assert self.held is not None and self.held.frame is not None
+        k = self.held.frame
+        self.delivered.append((k, self._row_windows(k)))
+        return True, self._pixels(k)
+
+    def release(self) -> None:
+        self.streaming_from = None
