@@ -555,7 +555,10 @@ class Gphoto2Camera:
         self._delete(files + strays)
         self._note_card(str(path.folder), files + strays)
         raw_path = saved[raw_files[0][1]]
-        decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
+        try:
+            decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
+        except CaptureError as exc:
+            raise self._undecoded(raw_path, raw_files[0][1], exc) from exc
         jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
         iso = _number(s.iso) or decoded.gain
         metadata = dict(decoded.metadata)
@@ -605,6 +608,24 @@ class Gphoto2Camera:
             white_level=decoded.white_level,
             timestamp_s=t_capture,
             metadata=metadata,
+        )
+
+    def _undecoded(self, raw_path: Path, camera_name: str, exc: CaptureError) -> CaptureError:
+        """The error for a downloaded RAW that would not decode: the camera's file and where
+        its only copy is kept (it is gone from the camera once downloaded).
+
+        Why: the error named ``raw/.incoming/cap0002_IMG_0002.RAF`` only, a folder a resume
+        empties into ``recovered/``, and said nothing of the camera's copy, already deleted:
+        an owner who looked for the shot on the card found nothing."""
+        where = str(raw_path)
+        if self.output_dir is not None and self.output_dir.name == ".incoming":
+            where += " (a resume moves it to the session's recovered/ folder, never deleting it)"
+        return CaptureError(
+            self.name,
+            f"the camera's file {camera_name} would not decode; it is kept at {where}, the "
+            f"camera's copy {'deleted' if self.settings.delete_from_camera else 'kept'}. "
+            + exc.message.removeprefix(f"{raw_path}: "),
+            "decode",
         )
 
     def _staging_dir(self) -> Path:

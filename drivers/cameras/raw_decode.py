@@ -362,6 +362,19 @@ def decode_raw(
                 else [int(v) for v in per_channel_white]
             )
             other = raw.other
+    except rawpy.LibRawFileUnsupportedError as exc:
+        # a body newer than the bundled LibRaw (a new Canon CR3 or Fujifilm RAF, say) gives
+        # this, a truncated download a data or I/O error: "is it a complete download?" had
+        # sent the owner of a new camera looking for a cable fault
+        raise CaptureError(
+            DECODER,
+            f"{name}: LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy "
+            f"{rawpy.__version__}) does not read this file's format ({exc}): a camera newer "
+            "than this LibRaw, or a file that is no RAW. Update rawpy (pip install -U rawpy), "
+            "or shoot a format it reads (DNG where the camera offers it, or convert the files "
+            "with a DNG converter and watch a folder of DNGs)",
+            "decode",
+        ) from exc
     except rawpy.LibRawError as exc:
         raise CaptureError(
             DECODER,

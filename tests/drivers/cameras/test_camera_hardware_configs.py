@@ -471,3 +471,24 @@ def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(b
     assert body.calls.count("folder_list_files") == 1
     assert all(not e["strays"] for e in journal(tmp_path / "t"))
     assert sorted(body.card) == ["IMG_0999.CR2"]
+
+
+def test_a_raw_libraw_cannot_read_names_the_file_what_to_do_and_keeps_it(body, tmp_path):
+    """A body newer than the bundled LibRaw: its second RAW is a format LibRaw does not know.
+    The run had stopped with "…/raw/.incoming/cap0002_IMG_0002.RAF: LibRaw cannot decode this
+    file …; is it a complete RAW/DNG download?": no word of a format too new, of what to do,
+    or that the camera's copy was already deleted and this is the only one."""
+    good = body.render
+    unknown = b"FUJIFILMCCD-RAW 0201" + bytes(4000)
+    body.render = lambda b: unknown if b.shots >= 1 else good(b)
+    body.raw_suffix = ".RAF"
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "3")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, result.output
+    assert "the camera's file IMG_0002.RAF would not decode" in said
+    assert "does not read this file's format" in said and "pip install -U rawpy" in said
+    assert "the camera's copy deleted" in said and "recovered/" in said
+    kept = out / "raw" / ".incoming" / "cap0002_IMG_0002.RAF"
+    assert f"kept at {kept}" in said and kept.read_bytes() == unknown
+    assert [e["index"] for e in journal(out)] == [0]
