@@ -50,7 +50,10 @@ class Body:
     model: str = "Canon EOS 600D"
     port: str = "usb:001,005"
     raw_suffix: str = ".CR2"
-    naming: str = "counter"  # or "repeat" (every shot capt0000.*, as Nikon RAM targets do)
+    #: "counter" (IMG_0001.CR2 and .JPG), "repeat" (every shot capt0000.*), or "object" (one
+    #: number per object, capt0000.jpg then capt0001.cr2, as libgphoto2's ptp2 names the
+    #: objects of a capture kept in the camera's RAM: its Nikon capture counts ``capcnt++``)
+    naming: str = "counter"
     counter_start: int = 1
     counter_wrap: int = 9999
     config: dict[str, str] = field(
@@ -128,6 +131,7 @@ class Body:
     _busy: int = 0
     _busy_until: float = float("-inf")
     _counter: int = 0
+    _objects: int = 0
 
     def switch_off(self) -> None:
         """Switched off or unplugged: every call fails, nothing is detected."""
@@ -226,6 +230,13 @@ def make_module(body: Body) -> types.ModuleType:
         if body.clock is not None:  # the shutter is open for its time, then the file named
             body.clock.sleep(shutter_s(body.config["shutterspeed"]))
         raw_data = body.render(body)
+        if body.jpeg_first:
+            files.sort(key=lambda n: not n.endswith(".JPG"))
+        if body.naming == "object":  # libgphoto2's RAM names: one number per object, in order
+            files = [
+                f"capt{body._objects + i:04d}{n[n.rindex('.') :]}" for i, n in enumerate(files)
+            ]
+            body._objects += len(files)
         for name in files:
             store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"
         if store is body.card:
@@ -234,8 +245,6 @@ def make_module(body: Body) -> types.ModuleType:
         body._busy = body.busy_after_shot
         if body.busy_for_s:
             body._busy_until = body.busy_clock.now() + body.busy_for_s
-        if body.jpeg_first:
-            files.sort(key=lambda n: not n.endswith(".JPG"))
         folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"
         for name in files if body.announce_first or announce_all else files[1:]:
             event = (GP_EVENT_FILE_ADDED, CameraFilePath(folder, name))

@@ -36,7 +36,7 @@ from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 #: libgphoto2's name for an object of a capture kept in the camera's RAM when the body gives
 #: none (``capt0000.jpg``, ``capt0001.nef``): numbered per object, so a shot's RAW and JPEG do
 #: not share a stem there, as a card's files (``IMG_0003.CR2``, ``IMG_0003.JPG``) do.
-_RAM_CAPTURE_NAME = re.compile(r"capt\d+", re.IGNORECASE)
+_RAM_CAPTURE_NAME = re.compile(r"capt(\d+)", re.IGNORECASE)
 
 T = TypeVar("T")
 
@@ -517,8 +517,7 @@ class Gphoto2Camera:
         gp = self._gp
         cam = self._cam
         files = [(str(path.folder), str(path.name))]
-        more, late, strays = self._more_files(files)
-        files.extend(more)
+        files, late, strays = self._more_files(files)
         strays.extend(self._unannounced(str(path.folder), files + late + strays))
         self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
@@ -643,8 +642,8 @@ class Gphoto2Camera:
     ) -> tuple[list[tuple[str, str]], list[tuple[str, str]], list[tuple[str, str]]]:
         """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet
         with what this shot needs: its RAW, and its JPEG too with ``keep_jpeg`` (for at most
-        ``event_timeout_s``). Returns (this shot's other files, files of an earlier shot,
-        strays).
+        ``event_timeout_s``). Returns (this shot's files, the capture's own path among them
+        unless it was a stray's, files of an earlier shot, strays).
 
         A stray is a picture the body took while answering busy: its capture failed (-110),
         yet the shutter fired and the file was written and announced (pibooth #466). One shot
@@ -662,7 +661,8 @@ class Gphoto2Camera:
         stem is a stray, whichever of its files comes first. (Stems do not pair files where
         libgphoto2 numbers each object of a RAM capture, ``capt0000.jpg`` and
         ``capt0001.nef`` (:data:`_RAM_CAPTURE_NAME`); there, and for a body naming every shot
-        alike, only the one-RAW rule above tells a stray.)
+        alike, only the one-RAW rule above tells a stray, and with two RAWs numbered apart the
+        last picture is the shot's: :func:`_last_picture`.)
         """
         gp = self._gp
         wait_ms = 200
@@ -715,7 +715,12 @@ class Gphoto2Camera:
                 if have_raw and (have_jpeg or not self.settings.keep_jpeg):
                     break
         self._earlier_stems.update(Path(n).stem for _, n in files + more + strays)
-        return more, late, strays
+        own = files + more
+        if not by_stem:
+            split = _last_picture(own + strays, returned=files[0])
+            if split is not None:
+                own, strays = split
+        return own, late, strays
 
     def _list_folder(self, folder: str) -> set[str] | None:
         """The file names in a camera folder, or None where it cannot be listed (a RAM
@@ -777,6 +782,40 @@ class Gphoto2Camera:
             # files in camera RAM may vanish once downloaded
             with contextlib.suppress(gp.GPhoto2Error):
                 self._cam.file_delete(folder, name)
+
+
+def _ram_number(name: str) -> int | None:
+    """The object number of a libgphoto2 RAM capture name (``capt0003.cr2`` → 3), else None."""
+    m = _RAM_CAPTURE_NAME.fullmatch(Path(name).stem)
+    return int(m.group(1)) if m else None
+
+
+def _last_picture(
+    files: list[tuple[str, str]], returned: tuple[str, str]
+) -> tuple[list[tuple[str, str]], list[tuple[str, str]]] | None:
+    """(the shot's files, the strays) among a RAM capture's numbered files holding two RAWs
+    or more, or None where numbers cannot order them (a body naming every shot alike).
+
+    libgphoto2 numbers each object of a RAM capture as it sees it (``capt%04d``, a counter
+    per object: camlibs/ptp2 ``capcnt++``), and a body announces its objects as it creates
+    them, so a picture taken behind a busy answer, taken before the shot that succeeded, has
+    the lower numbers: the shot's RAW is the highest-numbered one, and its JPEG the object
+    next to it on the side the body puts its JPEG (before the RAW when the capture returned a
+    JPEG, after it when it returned the RAW). The first RAW had been taken as the shot's: on
+    a body returning the JPEG of RAW+JPEG, the stray's RAW, announced before the shot's own,
+    was kept as the image (and the stray's JPEG as a second JPEG of the step), the shot's own
+    RAW set aside as the stray."""
+    numbers = [_ram_number(n) for _, n in files]
+    raws = [f for f in files if is_raw_file(Path(f[1]))]
+    if len(raws) < 2 or None in numbers or len(set(numbers)) != len(numbers):
+        return None
+    raw = max(raws, key=lambda f: _ram_number(f[1]) or 0)
+    n = _ram_number(raw[1]) or 0
+    jpeg_number = n - 1 if not is_raw_file(Path(returned[1])) else n + 1
+    own = [raw] + [
+        f for f in files if not is_raw_file(Path(f[1])) and _ram_number(f[1]) == jpeg_number
+    ]
+    return own, [f for f in files if f not in own]
 
 
 @dataclass

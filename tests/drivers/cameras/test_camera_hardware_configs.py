@@ -492,3 +492,43 @@ def test_a_raw_libraw_cannot_read_names_the_file_what_to_do_and_keeps_it(body, t
     kept = out / "raw" / ".incoming" / "cap0002_IMG_0002.RAF"
     assert f"kept at {kept}" in said and kept.read_bytes() == unknown
     assert [e["index"] for e in journal(out)] == [0]
+
+
+@pytest.mark.parametrize("jpeg_first", [True, False], ids=["jpeg-returned", "raw-returned"])
+def test_a_ram_capture_numbered_per_object_keeps_the_last_picture_as_the_shot(
+    body, tmp_path, jpeg_first
+):
+    """RAW+JPEG into the camera's RAM, libgphoto2 naming each object ``captNNNN`` with one
+    number per object (capt0002.JPG, capt0003.CR2 …): a picture a busy answer took is
+    announced before the retried shot's own files. With the capture returning the JPEG, the
+    stray's RAW (capt0003), the first RAW to come, had been kept as image 2 and the stray's
+    JPEG as a second JPEG of the step (``raw/image_002_2.jpg``), image 2's own RAW (capt0005)
+    set aside as the stray. Objects are numbered as they come and the stray was taken first:
+    the shot is the last picture, its JPEG the object next to its RAW."""
+    text = DSLR_CONFIG.read_text().replace(
+        'image_format = "RAW"', 'image_format = "RAW + Large Fine JPEG"\nkeep_jpeg = true'
+    )
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "raw_jpeg.toml"
+    config.write_text(text)
+    body.naming = "object"
+    body.jpeg_first = jpeg_first
+    body.busy_after_shot = 1
+    body.busy_yet_shot = 1
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "3")
+    assert result.exit_code == 0, result.output
+    entries = journal(out)
+    first, second = ("JPG", "CR2") if jpeg_first else ("CR2", "JPG")
+    files = [sorted(Path(n).name for n in e["originals"].values()) for e in entries]
+    assert files == [
+        sorted([f"capt0000.{first}", f"capt0001.{second}"]),
+        sorted([f"capt0004.{first}", f"capt0005.{second}"]),
+        sorted([f"capt0006.{first}", f"capt0007.{second}"]),
+    ], files
+    strays = sorted(Path(k["camera_file"]).name for e in entries for k in e["strays"].values())
+    assert strays == sorted([f"capt0002.{first}", f"capt0003.{second}"])
+    raws = [k for e in entries for k in e["originals"] if k.endswith(".cr2")]
+    assert raws == [f"raw/image_00{i}.cr2" for i in (1, 2, 3)]
