@@ -72,6 +72,7 @@ class BufferedUvcStream:
         cols: int = 4,
         buffers: int = 4,
         buffer_size_accepted: bool = True,
+        min_buffers: int = 1,
         latency_frames: int = 1,
         scale: float = 100_000.0,
         exposure_units: float = 100.0,
@@ -82,6 +83,8 @@ class BufferedUvcStream:
         self.readout_s = readout_s
         self.rows, self.cols = rows, cols
         self.accept_buffer_size = buffer_size_accepted
+        #: VIDIOC_REQBUFS may allocate more buffers than asked; OpenCV then reports those
+        self.min_buffers = min_buffers
         self.latency_frames = latency_frames
         self.scale = scale
         self.buffers = [_Buffer() for _ in range(buffers)]
@@ -167,8 +170,9 @@ class BufferedUvcStream:
         if prop == cv2.CAP_PROP_BUFFERSIZE:
             if not self.accept_buffer_size:
                 return False
-            self.buffers = [_Buffer() for _ in range(int(value))]
-            self.props[prop] = float(value)
+            count = max(int(value), self.min_buffers)
+            self.buffers = [_Buffer() for _ in range(count)]
+            self.props[prop] = float(count)
             return True
         if prop == cv2.CAP_PROP_EXPOSURE:
             if self.props[cv2.CAP_PROP_AUTO_EXPOSURE] != 1:

@@ -234,7 +234,9 @@ class OpenCvCamera:
         s = self.settings
         asked = s.buffer_size if info["buffer_size_set"] else None
         got = cap.get(cv2.CAP_PROP_BUFFERSIZE)
-        queued = asked or (int(got) if got >= 1 else OPENCV_V4L_DEFAULT_BUFFERS)
+        # OpenCV reports the buffers the driver allocated (VIDIOC_REQBUFS may give more than
+        # asked): an accepted request for 1 had been trusted over a read-back of 3
+        queued = max(asked or 0, int(got)) if got >= 1 else asked or OPENCV_V4L_DEFAULT_BUFFERS
         info["buffers_queued"] = queued
         drain = s.frames_to_drain
         if s.drain_frames is None:

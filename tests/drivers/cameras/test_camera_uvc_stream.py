@@ -50,20 +50,28 @@ def shoot(stream: BufferedUvcStream, settle_s: float, **settings: object) -> lis
 
 
 @pytest.mark.parametrize(
-    "buffers, accepted, latency",
-    [(1, True, 1), (4, False, 1), (6, False, 2), (1, True, 2)],
-    ids=["one-buffer", "refused-4-queued", "refused-6-queued-slow-latch", "one-buffer-slow-latch"],
+    "buffers, accepted, latency, min_buffers",
+    [(1, True, 1, 1), (4, False, 1, 1), (6, False, 2, 1), (1, True, 2, 1), (1, True, 2, 3)],
+    ids=[
+        "one-buffer",
+        "refused-4-queued",
+        "refused-6-queued-slow-latch",
+        "one-buffer-slow-latch",
+        "one-asked-three-allocated",
+    ],
 )
-def test_every_frame_is_exposed_wholly_under_its_own_light(buffers, accepted, latency):
+def test_every_frame_is_exposed_wholly_under_its_own_light(buffers, accepted, latency, min_buffers):
     """A driver that refuses the one-buffer request keeps its queue (OpenCV's default 4): the
     drain emptied the queue and kept the first frame read after it, the one in flight as the
     light settled (its exposure began before the light came on) and, the new exposure latched
-    a frame late, shot at the previous step's exposure."""
+    a frame late, shot at the previous step's exposure. A driver that accepts one buffer and
+    allocates three (OpenCV reports them) had been drained as if it queued one."""
     stream = BufferedUvcStream(
         LightHistory(VirtualClock()),
         buffers=buffers,
         buffer_size_accepted=accepted,
         latency_frames=latency,
+        min_buffers=min_buffers,
     )
     frames = shoot(stream, settle_s=0.0)
     assert len(stream.delivered) == len(STEPS)
