@@ -642,8 +642,8 @@ class Gphoto2Camera:
     ) -> tuple[list[tuple[str, str]], list[tuple[str, str]], list[tuple[str, str]]]:
         """Collect FILE_ADDED events (the second file of RAW+JPEG) until the camera goes quiet
         with what this shot needs: its RAW, and its JPEG too with ``keep_jpeg`` (for at most
-        ``event_timeout_s``). Returns (this shot's files, the capture's own path among them
-        unless it was a stray's, files of an earlier shot, strays).
+        ``event_timeout_s``). Returns (this shot's files, which hold the capture's own path
+        unless that was a stray's; files of an earlier shot; strays).
 
         A stray is a picture the body took while answering busy: its capture failed (-110),
         yet the shutter fired and the file was written and announced (pibooth #466). One shot
