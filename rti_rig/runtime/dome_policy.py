@@ -229,10 +229,25 @@ class DomePolicy:
         #: longer than the reconnect window.
         self._gave_up_after_s: float | None = None
         self.came_back_after_give_up: float | None = None
+        #: The port was kept open, switched off, by :meth:`hold` for the next :meth:`connect`
+        #: (metering, then the session), which then reuses it instead of reopening it.
+        self._held = False
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> None:
+        if self._held:
+            self._held = False
+            if self.info is not None and getattr(self.link, "port_open", True):
+                # the port :meth:`hold` kept: reopening it would reset a board that resets on
+                # open (an Uno-class board), and the Nab sketch boots with every LED lit until
+                # the all-off; the all-off (recovered as any command's) confirms the board
+                # is still there and off
+                self._run(self.link.all_off, "all off")
+                self.off_report = OffReport(
+                    getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED)
+                )
+                return
         self._spoke_before_drop = False
         self.reached = "not opened"
         try:
@@ -529,8 +544,28 @@ class DomePolicy:
             return True
         return exc.fault in _NOT_ITS_BOARD and bool(getattr(self.link, "profile_heard", False))
 
+    def hold(self) -> None:
+        """All off, and keep the port open for the next :meth:`connect` (metering, then the
+        session), which reuses it; :meth:`close` releases it as ever.
+
+        Why: ``run --auto-exposure`` closed the port after metering and opened it again for
+        the session. An Uno-class board resets at every opening, and the Nab sketch boots
+        with every LED lit until the all-off: one more spell of full light on the object
+        (light dose matters to pigments, dyes and paper), and one more boot wait. An all-off
+        that fails raises as :meth:`all_off` does, and the port is then closed."""
+        try:
+            self.all_off()
+        except BaseException:
+            self.close()
+            raise
+        if self.info is not None and getattr(self.link, "port_open", True):
+            self._held = True
+        else:
+            self.close()
+
     def close(self) -> None:
         """All off (best effort), then release the port. Safe twice and after a failed connect."""
+        self._held = False
         if self.info is not None:
             try:
                 self.all_off()

@@ -167,7 +167,9 @@ def fix_session_exposure(
 
     The schedule is validated first (nothing moves for a schedule the rig cannot run), each
     light is switched off after its shots and at the end, and devices are closed so that the
-    session starts from a clean connect.
+    session starts from a clean connect, except a dome's port, which a lighting that can
+    (``hold``) keeps open, switched off: reopening it resets an Uno-class board, and the Nab
+    sketch boots with every LED lit until the session's all-off. A failed metering closes all.
 
     ``shot_per_lighting``: the lights go dark by themselves a fixed time after they light (a
     timed firmware's window, which holds one capture but not a series), so each test shot is
@@ -192,15 +194,22 @@ def fix_session_exposure(
     def camera_at(step: LightStep, lit_at: float) -> Any:
         return _LitForEachShot(rig, step, lit_at, relight_each=relight_each)
 
-    def teardown() -> list[str]:
+    def teardown(keep_lights: bool = False) -> list[str]:
         # every step of the teardown runs, whatever one device does; what failed is said. A
         # Ctrl-C or SIGTERM is held until it is done (as the capture's teardown holds them):
         # a second Ctrl-C ("stop at once") had cut the all-off short with an LED lit, and the
         # dome's last all-off, the one between two metered lights, was then reported as the
         # state of the lights ("acknowledged by the dome: lights are off")
         with signals_deferred():
-            return rig.lighting.safe() + attempt_all(
-                [("camera close", rig.camera.close), ("lights close", rig.lighting.close)]
+            failures = rig.lighting.safe()
+            # a dome kept open (hold) only once its all-off went through: one that failed is
+            # closed, and the error says so
+            hold = getattr(rig.lighting, "hold", None) if keep_lights and not failures else None
+            return failures + attempt_all(
+                [
+                    ("camera close", rig.camera.close),
+                    ("lights close", hold or rig.lighting.close),
+                ]
             )
 
     at = steps[0]
@@ -228,7 +237,7 @@ def fix_session_exposure(
         # (it had been dropped, and the user told an all-off was sent)
         exc.teardown_failures = teardown()  # type: ignore[attr-defined]
         raise
-    failures = teardown()
+    failures = teardown(keep_lights=True)
     rig_time_s, wall_time_s = rig.clock.now() - started, time.perf_counter() - wall_started
     if failures:
         raise DeviceError(

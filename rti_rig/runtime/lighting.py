@@ -68,6 +68,15 @@ class DomeLighting:
     def close(self) -> None:
         self.source.close()
 
+    def hold(self) -> None:
+        """Lights off, the dome's port kept open for the next :meth:`connect` where its driver
+        can (a board that resets on open boots lit: the Nab sketch), closed otherwise."""
+        hold = getattr(self.source, "hold", None)
+        if hold is None:
+            self.source.close()
+        else:
+            hold()
+
     def problem(self, step: LightStep) -> str | None:
         if step.led is None:
             return "a dome step must name an LED (snap the plan to the dome's LEDs)"
