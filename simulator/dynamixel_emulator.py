@@ -814,9 +814,16 @@ def arm_settings_of(config: str | None) -> tuple[Any, str]:
 
 
 @contextlib.contextmanager
-def served_arm(settings: Any, clock: Clock) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
+def served_arm(
+    settings: Any, clock: Clock, baudrate: int = 57600
+) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
     """``(server, emulator)``: the servos of ``settings`` (ids, models, modes) resting at its
     park pose, served on a pty for any client (the manual tool; a plain SDK ``PortHandler``).
+
+    ``baudrate``: the rate the servos are set to (their Baud Rate (8), factory 57600 on the
+    X series); they answer only a host at that rate, as real servos do (ROBOTIS e-manual,
+    Baud Rate: the host and the servo must use the same rate). The tool had always served
+    57600, so a bus a user had set to 1 Mbps could not be rehearsed.
 
     The tool had served two XL430s at 2048 ticks each: on the shipped arm's geometry
     (elevation zero at 1024 ticks) that is 90° elevation, inside every keep-out cone, so a
@@ -824,7 +831,15 @@ def served_arm(settings: Any, clock: Clock) -> Iterator[tuple[Any, DynamixelBusE
     hand"). The park pose is, by validation, reachable and outside the cone."""
     from rti_rig.simulator.dynamixel_pty import PtyServoServer
 
+    codes = {rate: code for code, rate in ct.BAUD_CODES.items()}
+    if baudrate not in codes:
+        raise ValueError(
+            f"baud rate {baudrate}: an X-series servo's Baud Rate (8) is one of "
+            + ", ".join(str(r) for r in codes)
+        )
     emulator = emulator_for_arm(settings, clock)
+    for servo in emulator.servos.values():
+        servo._set(ct.BAUD_RATE, codes[baudrate])
     with PtyServoServer(emulator) as server:
         yield server, emulator
 
@@ -849,19 +864,32 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
         f"shipped {MANUAL_DEFAULT_CONFIG})",
     )
     parser.add_argument("--seconds", type=float, default=None, help="stop after this long")
+    parser.add_argument(
+        "--baud",
+        type=int,
+        default=57600,
+        help="the baud rate the servos are set to (default 57600, the X series' factory rate); "
+        "they answer only at it",
+    )
     args = parser.parse_args(argv)
+    if args.baud not in ct.BAUD_CODES.values():
+        parser.error(
+            f"--baud {args.baud}: an X-series servo runs at one of "
+            + ", ".join(str(r) for r in ct.BAUD_CODES.values())
+        )
     try:
         settings, where = arm_settings_of(args.config)
     except ValueError as exc:
         parser.error(str(exc))
     signal.signal(signal.SIGTERM, signal.default_int_handler)  # remove the pty on SIGTERM too
-    with served_arm(settings, SystemClock()) as (server, _):
+    factory = " (a new servo's factory rate)" if args.baud == 57600 else ""
+    with served_arm(settings, SystemClock(), args.baud) as (server, _):
         ids = ", ".join(
             f"{j.servo_id} ({name}, model {j.model_number})"
             for name, j in (("azimuth", settings.azimuth), ("elevation", settings.elevation))
         )
         print(
-            f"emulated servos {ids} at 57600 baud (a new servo's factory rate), resting at the "
+            f"emulated servos {ids} at {args.baud} baud{factory}, resting at the "
             f"park pose of {where} (azimuth {settings.park_azimuth_deg:g}°, elevation "
             f"{settings.park_elevation_deg:g}°), on {server.device_path}",
             flush=True,
@@ -872,10 +900,11 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
             "Ctrl-C stops the servos.",
             flush=True,
         )
-        if settings.baudrate != 57600:
+        if settings.baudrate != args.baud:
             print(
                 f"Note: the config's [arm.dynamixel] baudrate = {settings.baudrate}, but these "
-                "servos talk at 57600 as shipped: the check will find none, as on a real bus",
+                f"servos talk at {args.baud}: none answers at {settings.baudrate}, as on a "
+                "real bus",
                 flush=True,
             )
         try:
