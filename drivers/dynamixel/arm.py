@@ -46,6 +46,11 @@ from rti_rig.drivers.dynamixel.settings import ArmSettings
 
 log = logging.getLogger("rti_rig.dynamixel.arm")
 
+#: The X-series Baud Rate values (ROBOTIS e-manual, Baud Rate (8)) a silent bus is scanned at,
+#: most likely first: the factory 57600, then the 1 Mbps of many older Protocol 1.0 servos and
+#: of users who raise it, then the rest; 9600 last, its broadcast Ping waiting about 4.4 s.
+_RATES_TO_TRY = (57600, 1_000_000, 115200, 2_000_000, 3_000_000, 4_000_000, 4_500_000, 9600)
+
 
 class DynamixelArm:
     """Two-axis light arm (azimuth + elevation) on Dynamixel Protocol 2.0 servos.
@@ -217,14 +222,18 @@ class DynamixelArm:
         if not found:
             if found is None:
                 return exc
+            elsewhere = self._bus.scan_rates(_RATES_TO_TRY)
+            if elsewhere is not None:
+                return self._at_other_rate(joint, exc, *elsewhere)
+            tried = ", ".join(str(r) for r in _RATES_TO_TRY if r != self.settings.baudrate)
             return CommunicationError(
                 self.name,
                 f"no reply to its ping (COMM_RX_TIMEOUT), and no servo at all answers a "
-                f"broadcast ping at {self.settings.baudrate} baud: check the servos' power and "
-                "cabling, "
-                f"[arm.dynamixel] baudrate (X-series servos ship at 57600; Dynamixel Wizard "
-                "2.0 scans every rate) and that the servos speak Protocol 2.0 (Protocol Type, "
-                "address 13)",
+                f"broadcast ping on {self._bus.port.getPortName()!r} at "
+                f"{self.settings.baudrate} baud (the [arm.dynamixel] baudrate), nor at "
+                f"{tried}: check the servos' power and cabling, and that the servos speak "
+                "Protocol 2.0 (Protocol Type, address 13; a servo set to Protocol 1.0, as "
+                "AX and MX servos ship, answers none of these pings)",
                 exc.command,
                 joint.servo_id,
             )
@@ -253,6 +262,27 @@ class DynamixelArm:
                 "(Dynamixel Wizard 2.0 shows and changes ids; no two servos may share one)"
             )
         return CommunicationError(self.name, message, exc.command, joint.servo_id)
+
+    def _at_other_rate(  # type: ignore[no-untyped-def]
+        self, joint, exc: CommunicationError, rate: int, found: dict[int, int]
+    ) -> CommunicationError:
+        """Servos silent at the configured baud rate that answer at another: that rate, the
+        servos and the key to set (the message had left the user to scan every rate with
+        Dynamixel Wizard 2.0)."""
+        answering = ", ".join(
+            f"{i} ({ct.MODEL_NAMES.get(m, f'model {m}')})" for i, m in sorted(found.items())
+        )
+        one = len(found) == 1
+        return CommunicationError(
+            self.name,
+            f"no reply to its ping (COMM_RX_TIMEOUT) on {self._bus.port.getPortName()!r} at "
+            f"{self.settings.baudrate} baud (the [arm.dynamixel] baudrate), but "
+            f"{'servo' if one else 'servos'} {answering} {'answers' if one else 'answer'} "
+            f"a broadcast ping at {rate} baud: set baudrate = {rate} in [arm.dynamixel] (or "
+            "set the servos' Baud Rate, address 8, with Dynamixel Wizard 2.0)",
+            exc.command,
+            joint.servo_id,
+        )
 
     def _role(self, joint) -> str:  # type: ignore[no-untyped-def]
         """The joint's table in the rig config (``azimuth`` or ``elevation``): an error about a

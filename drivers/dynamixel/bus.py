@@ -19,7 +19,7 @@ Known SDK behaviours handled here:
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import dynamixel_sdk as sdk
@@ -271,6 +271,41 @@ class DxlBus:
         if result not in (sdk.COMM_SUCCESS, sdk.COMM_RX_TIMEOUT, sdk.COMM_RX_CORRUPT):
             return None
         return {int(i): int(v[0]) for i, v in (found or {}).items()}
+
+    def scan_rates(self, rates: Iterable[int]) -> tuple[int, dict[int, int]] | None:
+        """The first of ``rates`` at which servos answer a broadcast Ping, with ``{id: model
+        number}``; None if none answers at any (or the adapter takes none of them). The port
+        is set back to the rate it was opened at, and locked again, whatever happens.
+
+        Read-only (a Ping changes nothing on a servo), as Dynamixel Wizard 2.0's scan: for
+        naming the rate a bus silent at the configured one answers at (X-series servos ship
+        at 57600, and a user may have set another, ROBOTIS e-manual, Baud Rate (8)). A
+        broadcast Ping waits its whole window (about 0.8 s at 1 Mbps, 4.4 s at 9600 baud), so
+        the rates are tried in the order given and the scan stops at the first that answers."""
+        configured = self.baudrate
+        if configured is None:
+            return None
+        try:
+            for rate in rates:
+                if rate == configured:
+                    continue
+                try:
+                    if not self.port.setBaudRate(rate):
+                        continue
+                except Exception:  # an adapter (or pty) that cannot run at this rate
+                    continue
+                found = self.scan()
+                if found:
+                    return rate, found
+            return None
+        finally:
+            try:
+                self.port.setBaudRate(configured)  # the SDK reopens the port: lock it again
+                self._lock_exclusively()
+            except Exception as exc:  # the caller's error says what the bus gave
+                log.warning(
+                    "%s: could not set the port back to %d baud: %s", self.device, configured, exc
+                )
 
     def read(self, dxl_id: int, reg: ct.Register, check_alert: bool = True) -> int:
         command = f"read {reg.name}"

@@ -183,8 +183,18 @@ def test_a_servo_that_does_not_answer_is_told_from_what_the_bus_answers() -> Non
     with pytest.raises(DynamixelError) as info:
         wrong_baud.connect()
     said = str(info.value)
-    assert "no servo at all answers a broadcast ping at 1000000 baud" in said
-    assert "[arm.dynamixel] baudrate" in said and "Protocol 2.0" in said
+    # the servos answer at their factory 57600: that rate is named, with the key to set
+    assert "at 1000000 baud (the [arm.dynamixel] baudrate), but servos 1 (XL430-W250)" in said
+    assert "set baudrate = 57600 in [arm.dynamixel]" in said
+    assert emu.host_baud == 1_000_000  # the port is back at the configured rate
+    assert not wrong_baud.commanded
+
+    emu.silent_ids.update({1, 2})  # nothing answers at any rate: power, cabling, protocol
+    with pytest.raises(DynamixelError) as info:
+        wrong_baud.connect()
+    said = str(info.value)
+    assert "no servo at all answers a broadcast ping" in said and "at 1000000 baud" in said
+    assert "nor at 57600, 115200" in said and "Protocol 2.0" in said
 
 
 def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
