@@ -66,6 +66,15 @@ FACTORY_REGISTERS = (
 #: Read-only address ranges [start, end) of the X-series table.
 READ_ONLY = ((0, 7), (69, 71), (120, 148))
 DEFAULT_FIRMWARE = 46
+
+#: A servo's own errors by the name ``[[emulator.faults]]`` gives them: their bits of Hardware
+#: Error Status (70) (ROBOTIS e-manual, X-series control table).
+HARDWARE_FAULT_BITS = {
+    "overload": ct.HardwareFault.OVERLOAD,
+    "overheating": ct.HardwareFault.OVERHEATING,
+    "input_voltage": ct.HardwareFault.INPUT_VOLTAGE,
+    "electrical_shock": ct.HardwareFault.ELECTRICAL_SHOCK,
+}
 #: Seconds a servo answers nothing after it acknowledged a Reboot instruction, while it
 #: restarts. The e-manual (Protocol 2.0, Reboot) gives the status packet but no restart time;
 #: measured on XC330 servos: the status comes at once, then ~0.4 s of silence
@@ -467,7 +476,11 @@ class DynamixelBusEmulator:
     ``drop_next_replies`` loses that many upcoming status packets on the wire (the servo acted
     on the instruction, the host hears nothing: the SDK's COMM_RX_TIMEOUT); ``reply_faults``
     does either to the status of the K-th instruction packet received (1 = the first, any id):
-    ``{K: "drop_reply" | "garble_reply"}``, the rig config's ``[[emulator.faults]]``.
+    ``{K: "drop_reply" | "garble_reply"}``, the rig config's ``[[emulator.faults]]``;
+    ``hardware_faults`` raises a servo's own error as the K-th instruction packet arrives:
+    ``{K: (servo id, "overload" | "overheating" | "input_voltage" | "electrical_shock")}``
+    (:meth:`EmulatedServo.inject_hardware_error`: the Alert bit until a Reboot, torque off
+    for the faults the servo's Shutdown selects).
     ``goal_log`` records every Goal Position value that reached the bus, accepted or not.
     """
 
@@ -484,6 +497,7 @@ class DynamixelBusEmulator:
         self.corrupt_next_replies = 0
         self.drop_next_replies = 0
         self.reply_faults: dict[int, str] = {}
+        self.hardware_faults: dict[int, tuple[int, str]] = {}
         #: instruction packets received so far (what ``reply_faults`` counts)
         self.instructions_received = 0
         self.goal_log: list[tuple[int, int]] = []
@@ -535,6 +549,13 @@ class DynamixelBusEmulator:
                     continue
                 self.instructions.append(item)
                 self.instructions_received += 1
+                raised = self.hardware_faults.get(self.instructions_received)
+                if raised is not None and raised[0] in self.servos:
+                    # the servo's own error, as it meets it (an overload under load): its
+                    # bit, the Alert flag from this status on, torque off if Shutdown says
+                    self.servos[raised[0]].inject_hardware_error(
+                        int(HARDWARE_FAULT_BITS[raised[1]])
+                    )
                 fault = self.reply_faults.get(self.instructions_received)
                 reply = self._handle(item)
                 if reply and fault == "drop_reply":

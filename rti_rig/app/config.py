@@ -208,8 +208,9 @@ class SceneConfig(_Strict):
 
 class EmulatorFault(_Strict):
     """One byte-level fault of the emulated dome firmware, at its n-th command (1-based), or
-    of the emulated servo bus, at its n-th instruction packet (``drop_reply`` and
-    ``garble_reply`` only: :data:`ARM_FAULT_KINDS`)."""
+    of the emulated servo bus, at its n-th instruction packet (:data:`ARM_FAULT_KINDS`): a
+    status packet lost or damaged, or a servo's own hardware error
+    (:data:`ARM_HARDWARE_FAULTS`, raised on ``servo_id`` as that packet arrives)."""
 
     at_command: int = Field(gt=0)
     kind: Literal[
@@ -220,14 +221,34 @@ class EmulatorFault(_Strict):
         "disconnect",
         "reset",
         "reset_after_reply",
+        "overload",
+        "overheating",
+        "input_voltage",
+        "electrical_shock",
     ]
     delay_s: float = Field(default=1.0, ge=0, le=60)
+    #: The servo a hardware error (``overload`` …) is raised on; arm faults only.
+    servo_id: int | None = Field(default=None, ge=0, le=252)
 
 
 #: The ``[[emulator.faults]]`` kinds the emulated servo bus rehearses: a status packet lost or
 #: damaged on the wire (the servos' faults of their own, overload and the like, are the
 #: emulator's hardware errors).
-ARM_FAULT_KINDS = ("drop_reply", "garble_reply")
+ARM_FAULT_KINDS = (
+    "drop_reply",
+    "garble_reply",
+    "overload",
+    "overheating",
+    "input_voltage",
+    "electrical_shock",
+)
+
+#: The ``[[emulator.faults]]`` kinds that are a servo's own hardware error (a bit of its
+#: Hardware Error Status (70), ROBOTIS e-manual), raised on ``servo_id``: the servo sets the
+#: Alert bit of every status packet and, for the faults its Shutdown (63) selects, switches
+#: its torque off (the arm sags) until a reboot. Without them a servo's overload could not be
+#: rehearsed through ``run`` or ``check`` at all.
+ARM_HARDWARE_FAULTS = ("overload", "overheating", "input_voltage", "electrical_shock")
 
 
 class EmulatorConfig(_Strict):
@@ -318,7 +339,18 @@ class RigConfig(_Strict):
 
         Why: the faults were the dome firmware's alone, and an arm config's were ignored: a
         rehearsal of a lost status packet ran a clean check ("PASS") and rehearsed nothing."""
-        if self.kind != "arm" or not self.emulator.faults:
+        if self.kind != "arm":
+            for i, fault in enumerate(self.emulator.faults):
+                if fault.kind in ARM_HARDWARE_FAULTS or fault.servo_id is not None:
+                    raise ValueError(
+                        f"emulator.faults[{i}]: {fault.kind}"
+                        f"{' with servo_id' if fault.servo_id is not None else ''} is a "
+                        "servo's fault, rehearsed on an emulated arm; a dome's firmware "
+                        "rehearses drop_reply, garble_reply, garble_command, delay_reply, "
+                        "disconnect, reset and reset_after_reply"
+                    )
+            return
+        if not self.emulator.faults:
             return
         for i, fault in enumerate(self.emulator.faults):
             if self.backend != "emulated" or self.arm is None or self.arm.dynamixel is None:
@@ -329,8 +361,22 @@ class RigConfig(_Strict):
             if fault.kind not in ARM_FAULT_KINDS:
                 raise ValueError(
                     f"emulator.faults[{i}].kind = {fault.kind!r}: the emulated servo bus "
-                    f"rehearses {' and '.join(ARM_FAULT_KINDS)} (the status packet of "
-                    "the at_command-th instruction packet the servos receive, lost or damaged)"
+                    f"rehearses {', '.join(ARM_FAULT_KINDS[:2])} (the status packet of "
+                    "the at_command-th instruction packet the servos receive, lost or "
+                    f"damaged) and {', '.join(ARM_HARDWARE_FAULTS)} (a servo's hardware "
+                    "error, on servo_id, as that packet arrives)"
+                )
+            ids = [j.servo_id for j in (self.arm.dynamixel.azimuth, self.arm.dynamixel.elevation)]
+            if fault.kind in ARM_HARDWARE_FAULTS and fault.servo_id not in ids:
+                raise ValueError(
+                    f"emulator.faults[{i}].servo_id = {fault.servo_id}: a {fault.kind} is "
+                    "raised on one of the arm's servos; set servo_id to "
+                    + " or ".join(str(i) for i in ids)
+                )
+            if fault.kind not in ARM_HARDWARE_FAULTS and fault.servo_id is not None:
+                raise ValueError(
+                    f"emulator.faults[{i}].servo_id: a {fault.kind} loses the status packet "
+                    "of whichever servo answers; remove servo_id"
                 )
 
     @model_validator(mode="after")

@@ -81,4 +81,4 @@ def test_an_arm_fault_the_servo_bus_cannot_rehearse_is_refused_naming_the_key(
     r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     assert r.exit_code == 2, r.output
     assert "emulator.faults[0].kind = 'reset'" in r.output, r.output
-    assert "drop_reply and garble_reply" in r.output
+    assert "drop_reply, garble_reply" in r.output and "overload" in r.output

@@ -1,0 +1,77 @@
+"""A servo's own hardware error is rehearsed on an emulated arm through ``[[emulator.faults]]``.
+
+A real X-series servo that overloads sets its Hardware Error Status bit, flags the Alert bit
+in every status packet and, for the faults its Shutdown (63) selects (overload on the XL430),
+switches its torque off until a reboot (ROBOTIS e-manual): the arm sags. The emulator could
+raise it, but nothing at the front door could: an arm config's faults were only lost or
+damaged replies, so ``run`` and ``check`` on a servo that overloads mid-move could not be
+rehearsed (an ``overload`` fault was refused at load).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+import rti_rig.app.compose as compose
+import rti_rig.app.usecases.check as check_usecase
+from rti_rig.cli import app
+from rti_rig.drivers.dynamixel import control_table as ct
+
+runner = CliRunner()
+
+FAULT = '\n[[emulator.faults]]\nat_command = 60\nkind = "overload"\nservo_id = 2\n'
+
+
+def _config(tmp_path: Path, extra: str = FAULT) -> Path:
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    text = text.replace('transport = "pty"', 'transport = "inprocess"')
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text + extra)
+    return cfg
+
+
+def test_check_on_a_servo_that_overloads_stops_names_it_and_leaves_it_unparked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    emulators: list = []  # type: ignore[type-arg]
+    real_build = compose.build_rig
+
+    def build(*args, **kwargs):  # type: ignore[no-untyped-def]
+        rig = real_build(*args, **kwargs)
+        emulators.append(rig.emulator)
+        return rig
+
+    monkeypatch.setattr(compose, "build_rig", build)
+    monkeypatch.setattr(check_usecase, "build_rig", build)  # imported by name there
+    r = runner.invoke(app, ["check", str(_config(tmp_path))], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1, said
+    assert "Traceback" not in said
+    assert "servo 2: hardware fault overload (Hardware Error Status 0x20)" in said, said
+    assert "send Reboot from Dynamixel Wizard 2.0" in said
+    assert "NOT parked" in said and "RESULT: FAIL" in said
+    (emu,) = emulators
+    servo = emu.servos[2]
+    # the servo as a real one: shut down (torque off), its error latched until a reboot
+    assert servo.get(ct.TORQUE_ENABLE) == 0 and servo.shut_down
+    assert servo.get(ct.HARDWARE_ERROR_STATUS) & ct.HardwareFault.OVERLOAD
+
+
+def test_a_hardware_fault_needs_one_of_the_arms_servos_and_is_refused_on_a_dome(
+    tmp_path: Path,
+) -> None:
+    wrong = FAULT.replace("servo_id = 2", "servo_id = 7")
+    r = runner.invoke(app, ["check", str(_config(tmp_path, wrong))], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "emulator.faults[0].servo_id = 7" in said and "set servo_id to 1 or 2" in said
+    dome = tmp_path / "dome.toml"
+    dome.write_text((CONFIGS / "emulated_nab_rti_v1.toml").read_text() + FAULT)
+    r = runner.invoke(app, ["check", str(dome)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "overload with servo_id is a servo's fault" in said
