@@ -113,6 +113,10 @@ class ScriptedDomeDriver:
         #: the board after it, so it holds until the port is opened again).
         self._foreign_off: OffOutcome | None = None
         self._foreign_cache: list[tuple[str, str]] | None = None
+        #: What a boot banner later than the profile's boot wait said (a slow bootloader, and
+        #: the ``boot_wait_s`` to set), kept for the report the user reads: as a warning on
+        #: stderr alone it was missed beside ``check``'s "RESULT: PASS". None: none so far.
+        self.slow_boot_advice: str | None = None
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -554,15 +558,14 @@ class ScriptedDomeDriver:
                 # a slow bootloader: the banner had been reported as a reboot, or (cut at a
                 # reply's deadline) as an unreadable reply with "check the port, the baud
                 # rate and the profile", and the Nab sketch, lit at its boot, was left lit
-                raise self._error(
+                self.slow_boot_advice = (
                     f"the board printed its boot banner only {after:.1f} s after the port "
                     f"opened, past this profile's boot wait (boot_wait_s = {spec.boot_wait_s:g}"
                     f" s), so what was sent before was lost: a bootloader slower than the "
                     f"{spec.name} firmware's usual one (set boot_wait_s = "
-                    f"{math.ceil(after) + 1} in [dome.serial.protocol]), or a reboot",
-                    name,
-                    LinkFault.RESET,
+                    f"{math.ceil(after) + 1} in [dome.serial.protocol]), or a reboot"
                 )
+                raise self._error(self.slow_boot_advice, name, LinkFault.RESET)
             raise self._error(
                 "the board rebooted (boot banner) before answering", name, LinkFault.RESET
             )

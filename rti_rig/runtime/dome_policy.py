@@ -1161,6 +1161,10 @@ class SelfTestReport:
     #: after (a banner later than the boot wait, at the port's opening, is the connect's: a
     #: slow bootloader, not a board that rebooted by itself during the walk).
     recovered_at_connect: int = 0
+    #: A boot banner later than the profile's boot wait (the link's ``slow_boot_advice``: a
+    #: slow bootloader and the ``boot_wait_s`` to set), said in the report: it had reached
+    #: stderr alone, beside a "RESULT: PASS" that a user reads as nothing to change.
+    slow_boot: str | None = None
 
     @property
     def failed(self) -> list[LedCheck]:
@@ -1246,6 +1250,11 @@ class SelfTestReport:
                 f"{s.rehandshakes} re-handshakes"
             )
             out += _recovered_board_faults(s.recovered[self.recovered_at_connect :])
+        if self.slow_boot:
+            out.append(
+                f"slow boot: {self.slow_boot}; the commands were sent again after the banner "
+                "and the check went on, but each session on this board meets the same wait"
+            )
         if self.aborted:
             out.append(f"ABORTED: {self.aborted}")
         if self.lights_state:
@@ -1348,6 +1357,9 @@ def self_test(
         if isinstance(source, DomePolicy):
             report.reached = source.reached  # before close() forgets the connection
         report.foreign_firmware = getattr(link, "foreign_firmware", None)
+        slow = getattr(link, "slow_boot_advice", None)
+        if isinstance(slow, str) and slow not in (report.aborted or ""):
+            report.slow_boot = slow  # recovered from; one that ended the check is its error
         try:
             source.close()
         except DeviceError as exc:

@@ -51,7 +51,10 @@ def test_only_reboots_and_usb_drops_are_named() -> None:
 def test_a_banner_later_than_the_boot_wait_is_not_called_a_reboot(tmp_path: Path) -> None:
     """A board whose bootloader outlasts the profile's boot wait prints its banner after the
     first command: the connect resends it, and its warning names boot_wait_s. It is no board
-    rebooting by itself, which the line had said of it (power supply, USB cable)."""
+    rebooting by itself, which the line had said of it (power supply, USB cable).
+
+    Its advice is in the report, above the result: it had reached stderr alone, beside a
+    "RESULT: PASS" a user reads as nothing to change."""
     from rti_rig.simulator.domes import board_for
     from rti_rig.simulator.pty_link import serve_on_pty
 
@@ -63,3 +66,6 @@ def test_a_banner_later_than_the_boot_wait_is_not_called_a_reboot(tmp_path: Path
     said = " ".join(r.output.split())
     assert "LEDs stepped: 12, passed: 12" in said, said
     assert "rebooted during the check" not in said, said
+    # CliRunner mixes stderr into output: the report's own line is what is looked for
+    assert "slow boot: the board printed its boot banner only" in said, said
+    assert "set boot_wait_s = 7 in [dome.serial.protocol]" in said
