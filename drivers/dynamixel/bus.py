@@ -121,6 +121,9 @@ class DxlBus:
         #: Torque Enable = 0 or an EEPROM write (which a servo takes only with its torque off,
         #: the limits a first connect writes): until then no servo was driven by this bus
         self.driven = False
+        #: ids that have answered on this port since it opened: one of them silent later was
+        #: reached at this id and baud rate, so its silence is its cable or power, not those
+        self.answered: set[int] = set()
 
     # -- port -------------------------------------------------------------------------------
     def open(self, baudrate: int) -> None:
@@ -176,6 +179,7 @@ class DxlBus:
             return  # a device that cannot be locked (flock unsupported): as before
 
     def close(self) -> None:
+        self.answered.clear()
         if getattr(self.port, "is_open", False):
             self.port.closePort()
 
@@ -183,6 +187,18 @@ class DxlBus:
     def _check(self, result: int, error: int, dxl_id: int, command: str, alert: bool = True):
         if result != sdk.COMM_SUCCESS:
             at = f" at {self.baudrate} baud" if self.baudrate else ""
+            if result == sdk.COMM_RX_TIMEOUT and dxl_id in self.answered:
+                # it answered at this id and rate before: "check id and baud rate" had sent a
+                # user whose cable came out mid-session to a config that was right
+                raise CommunicationError(
+                    self.device,
+                    f"{comm_text(self.ph, result)}{at}: it had answered on "
+                    f"{self.port.getPortName()!r} and has stopped answering: its cable, "
+                    "the chain of cables to it, or the servos' power supply was lost; check "
+                    "them (the id and baud rate were right)",
+                    command,
+                    dxl_id,
+                )
             raise CommunicationError(
                 self.device,
                 f"{comm_text(self.ph, result)}{at} (check power, cabling, id and baud rate: "
@@ -190,6 +206,7 @@ class DxlBus:
                 command,
                 dxl_id,
             )
+        self.answered.add(dxl_id)
         if error & 0x7F:
             raise ServoStatusError(
                 self.device, dxl_id, error, command, f"servo answered {p2.describe_error(error)}"
@@ -321,10 +338,9 @@ class DxlBus:
         """Raw bytes of ``length`` registers from ``address`` and the status ERR byte.
 
         Hardware alerts are *not* raised here; the caller decides (it may want the data)."""
+        command = f"read {_span_name(address, length)}"
         data, result, error = self._exchange(
-            lambda: self.ph.readTxRx(self.port, dxl_id, address, length),
-            f"read {address}+{length}",
-            dxl_id,
+            lambda: self.ph.readTxRx(self.port, dxl_id, address, length), command, dxl_id
         )
         log.debug(
             "%s: id %d read %d+%d -> %s (%d, %d)",
@@ -336,13 +352,10 @@ class DxlBus:
             result,
             error,
         )
-        self._check(result, error, dxl_id, f"read {address}+{length}", alert=False)
+        self._check(result, error, dxl_id, command, alert=False)
         if len(data) != length:
             raise CommunicationError(
-                self.device,
-                f"short reply: {len(data)} of {length} bytes",
-                f"read {address}+{length}",
-                dxl_id,
+                self.device, f"short reply: {len(data)} of {length} bytes", command, dxl_id
             )
         return bytes(data), int(error)
 
@@ -426,3 +439,15 @@ class DxlBus:
         result, error = self.ph.reboot(self.port, dxl_id)
         log.debug("%s: reboot %d (%d, %d)", self.device, dxl_id, result, error)
         self._check(result, error, dxl_id, "reboot", alert=False)
+
+
+def _span_name(address: int, length: int) -> str:
+    """``Moving..Present Position`` for a block read of the control table, as an error names
+    the command (it had said ``read 122+14``, which a user cannot look up); the addresses
+    when no register starts and ends the span."""
+    items = [r for r in vars(ct).values() if isinstance(r, ct.Register)]
+    first = next((r for r in items if r.address == address), None)
+    last = next((r for r in items if r.address + r.size == address + length), None)
+    if first is None or last is None:
+        return f"{address}+{length}"
+    return first.name if first is last else f"{first.name}..{last.name}"
