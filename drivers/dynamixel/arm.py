@@ -222,16 +222,23 @@ class DynamixelArm:
         if not found:
             if found is None:
                 return exc
-            elsewhere = self._bus.scan_rates(_RATES_TO_TRY)
+            log.warning(
+                "%s: no servo answers at %d baud; looking for them at the other X-series rates "
+                "(a broadcast ping each, read-only: up to about 10 s)",
+                self.name,
+                self.settings.baudrate,
+            )
+            rates: list[int] = []
+            elsewhere = self._bus.scan_rates(_RATES_TO_TRY, rates)
             if elsewhere is not None:
                 return self._at_other_rate(joint, exc, *elsewhere)
-            tried = ", ".join(str(r) for r in _RATES_TO_TRY if r != self.settings.baudrate)
+            tried = f", nor at {', '.join(map(str, rates))}" if rates else ""
             return CommunicationError(
                 self.name,
                 f"no reply to its ping (COMM_RX_TIMEOUT), and no servo at all answers a "
                 f"broadcast ping on {self._bus.port.getPortName()!r} at "
-                f"{self.settings.baudrate} baud (the [arm.dynamixel] baudrate), nor at "
-                f"{tried}: check the servos' power and cabling, and that the servos speak "
+                f"{self.settings.baudrate} baud (the [arm.dynamixel] baudrate){tried}: check "
+                "the servos' power and cabling, and that the servos speak "
                 "Protocol 2.0 (Protocol Type, address 13; a servo set to Protocol 1.0, as "
                 "AX and MX servos ship, answers none of these pings)",
                 exc.command,

@@ -289,10 +289,13 @@ class DxlBus:
             return None
         return {int(i): int(v[0]) for i, v in (found or {}).items()}
 
-    def scan_rates(self, rates: Iterable[int]) -> tuple[int, dict[int, int]] | None:
+    def scan_rates(
+        self, rates: Iterable[int], tried: list[int] | None = None
+    ) -> tuple[int, dict[int, int]] | None:
         """The first of ``rates`` at which servos answer a broadcast Ping, with ``{id: model
-        number}``; None if none answers at any (or the adapter takes none of them). The port
-        is set back to the rate it was opened at, and locked again, whatever happens.
+        number}``; None if none answers at any (or the adapter takes none of them). Each rate
+        the port was set to is appended to ``tried`` (one the adapter refuses is not). The
+        port is set back to the rate it was opened at, and locked again, whatever happens.
 
         Read-only (a Ping changes nothing on a servo), as Dynamixel Wizard 2.0's scan: for
         naming the rate a bus silent at the configured one answers at (X-series servos ship
@@ -311,6 +314,8 @@ class DxlBus:
                         continue
                 except Exception:  # an adapter (or pty) that cannot run at this rate
                     continue
+                if tried is not None:
+                    tried.append(rate)
                 found = self.scan()
                 if found:
                     return rate, found
