@@ -251,6 +251,21 @@ class DynamixelArm:
         spare = {i: m for i, m in found.items() if i not in others}
         if not spare:  # only the arm's other joint answers
             seen = ", ".join(f"servo {i} (the {others[i]} joint)" for i in sorted(found))
+            # this one set to another rate than the other joint (a servo replaced, or its
+            # rate changed alone), read-only as the scan at connect: it had been told to
+            # check its cable first, with no word of the rate that answers
+            elsewhere = self._bus.scan_rates(_RATES_TO_TRY)
+            if elsewhere is not None and joint.servo_id in elsewhere[1]:
+                rate = elsewhere[0]
+                return CommunicationError(
+                    self.name,
+                    f"no reply at {self.settings.baudrate} baud (the [arm.dynamixel] "
+                    f"baudrate), while {seen} does; the {role} servo answers at {rate} baud: "
+                    "the servos on one bus must share one rate, so set its Baud Rate "
+                    f"(address 8) to {self.settings.baudrate} with Dynamixel Wizard 2.0",
+                    exc.command,
+                    joint.servo_id,
+                )
             message = (
                 f"no servo with id {joint.servo_id} answers at {self.settings.baudrate} baud, "
                 f"while {seen} does: check the {role} servo's cable and the chain between "

@@ -197,6 +197,22 @@ def test_a_servo_that_does_not_answer_is_told_from_what_the_bus_answers() -> Non
     assert "nor at 57600, 115200" in said and "Protocol 2.0" in said
 
 
+def test_one_servo_at_another_rate_than_the_other_is_named_with_its_rate() -> None:
+    """The elevation servo set to 1 Mbps (replaced, or its rate changed alone) beside an
+    azimuth at 57600: it had been told to check its cable first, with no word of a rate."""
+    clock = VirtualClock()
+    emu = emulator_for_arm(arm_settings(), clock)
+    emu.servos[2]._set(ct.BAUD_RATE, 3)  # 1 Mbps (e-manual, Baud Rate (8): value 3)
+    arm = DynamixelArm(arm_settings(), InProcessPort(emu), clock)
+    with pytest.raises(DynamixelError) as info:
+        arm.connect()
+    said = str(info.value)
+    assert info.value.servo_id == 2
+    assert "while servo 1 (the azimuth joint) does; the elevation servo answers at 1000000" in said
+    assert "set its Baud Rate (address 8) to 57600" in said
+    assert emu.host_baud == 57600 and not arm.commanded
+
+
 def test_fault_during_move_is_named_and_teardown_still_runs() -> None:
     arm, emu, clock = make_arm()
     arm.connect()
