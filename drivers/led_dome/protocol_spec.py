@@ -131,6 +131,10 @@ class ProtocolSpec(_Strict):
     #: Wait after opening until this text (regex) has arrived (the end of the boot banner),
     #: at most ``boot_wait_s``; without it the whole ``boot_wait_s`` is waited.
     ready_pattern: str | None = None
+    #: The firmware lights every LED as it boots (the Nab sketch's ``setup()`` calls
+    #: ``lightsOn()``) and its board resets when the port opens: an all-off that did not get
+    #: through after an opening leaves the dome fully lit, which the lights line then says.
+    boots_lit: bool = False
     #: A line for the docs and the probe (what the firmware is, where it comes from).
     note: str = ""
 

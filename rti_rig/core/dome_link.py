@@ -146,12 +146,26 @@ class OffReport:
     #: NEVER_OPENED because another program holds the port: the lights are that program's
     #: (switching the dome off at its supply would cut a session that runs).
     port_held: bool = False
+    #: The firmware that lights every LED as its board boots, when this all-off failed right
+    #: after the port opened (which resets such a board): "lights may still be on" understated
+    #: a dome that, if it is that board, is fully lit. None: not such a case.
+    boots_lit: str | None = None
 
     @property
     def lights_known_off(self) -> bool:
         return self.outcome in (OffOutcome.ACKNOWLEDGED, OffOutcome.SELF_TIMED)
 
     def sentence(self) -> str:
+        said = self._sentence()
+        if self.boots_lit and self.outcome in (OffOutcome.SENT_UNCONFIRMED, OffOutcome.NOT_SENT):
+            said += (
+                f"; the {self.boots_lit} firmware lights every LED as its board boots, and "
+                "opening the port resets the board: if this is that board, every LED is on "
+                "now; switch the dome off at its power supply"
+            )
+        return said
+
+    def _sentence(self) -> str:
         why = f" ({self.detail})" if self.detail else ""
         return {
             OffOutcome.ACKNOWLEDGED: "all-off sent and acknowledged by the dome: lights are off",

@@ -27,7 +27,7 @@ import logging
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TypeVar
 
 import numpy as np
@@ -289,7 +289,7 @@ class DomePolicy:
                     self._port_was_open = True
                 # A board that answered nothing we understood may still be lit (one sketch
                 # boots with every LED on): send the all-off anyway wherever the port is open.
-                self._attempt_off(f"after the failed connection ({exc.message})")
+                self._attempt_off(f"after the failed connection ({exc.message})", after_open=True)
             self._quiet_close()
             if exc.command == "open port" and exc.port_held:
                 # the board is there and may be lit by the program using it: "check that the
@@ -353,7 +353,7 @@ class DomePolicy:
                         OffOutcome.NOT_SENT, "a further stop cut the all-off short"
                     )
                     self._finish_boot()
-                    self._attempt_off("after the connection was interrupted")
+                    self._attempt_off("after the connection was interrupted", after_open=True)
             finally:
                 self._quiet_close()
             raise
@@ -1018,8 +1018,18 @@ class DomePolicy:
         hint = self.settings.link_hint
         return f" ({hint})" if hint else ""
 
-    def _attempt_off(self, when: str) -> None:
-        """One all-off, whatever state the link is in; record what it established."""
+    def _attempt_off(self, when: str, after_open: bool = False) -> None:
+        """One all-off, whatever state the link is in; record what it established.
+
+        ``after_open``: the port was opened by the connect that failed, which resets a board
+        that resets on open; on a firmware that boots lit (``boots_lit``, the Nab sketch) a
+        failed all-off then leaves every LED on if the board is that one, and is said so."""
+        spec = getattr(self.link, "spec", None)
+        lit_at_boot = (
+            str(getattr(spec, "name", ""))
+            if after_open and getattr(spec, "boots_lit", False)
+            else None
+        )
         try:
             self._counted(self.link.all_off)
         except DomeLinkError as exc:
@@ -1027,10 +1037,12 @@ class DomePolicy:
                 self._switch_off_foreign(when)
                 return
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
-            self.off_report = _failed_off(exc)
+            self.off_report = replace(_failed_off(exc), boots_lit=lit_at_boot)
         except DeviceError as exc:
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
-            self.off_report = OffReport(OffOutcome.SENT_UNCONFIRMED, str(exc))
+            self.off_report = OffReport(
+                OffOutcome.SENT_UNCONFIRMED, str(exc), boots_lit=lit_at_boot
+            )
         else:
             self.off_report = OffReport(
                 getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED), when

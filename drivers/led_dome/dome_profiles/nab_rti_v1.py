@@ -36,5 +36,6 @@ SPEC = {
     },
     "reset_pattern": r"RTI-Dome intialized",
     "error_pattern": r"<INCORRECT FUNCTION CALL: -?\d+>",
+    "boots_lit": True,
     "note": "RTI v1.0 sketch by Sjors H. Nab (2024); boots with every LED on",
 }
