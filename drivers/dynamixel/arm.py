@@ -674,6 +674,39 @@ class DynamixelArm:
         if not self._connected:
             raise DynamixelError(self.name, "not connected; call connect() first", command)
 
+    def check_held(self, command: str = "check held after the capture") -> None:
+        """Raise unless every joint still holds the goal it reached, fault-free: read after a
+        capture, before its image is kept under the direction read before it.
+
+        Why: a servo that overloaded while the shutter was open (ROBOTIS e-manual, Shutdown
+        (63): torque off; Hardware Error Status (70) and the Alert bit of every status packet
+        set until a reboot) leaves a limp joint, and the arm sags; the image had been kept and
+        listed in lights.lp under the direction read before the capture, the fault found only
+        at the next move. A fault is raised as :class:`HardwareFaultError` (servo, fault, how
+        to clear it); a joint moved off its goal by more than ``in_position_tolerance_ticks``
+        (a sag, a bump) as a :class:`DynamixelError` naming the joint and how far."""
+        self._require_connected(command)
+        s = self.settings
+        for joint, goal in zip(s.joints, self._goal or (None, None), strict=True):
+            data, error = self._bus.read_block(
+                joint.servo_id, ct.STATUS_BLOCK_START, ct.STATUS_BLOCK_LENGTH
+            )
+            if error & p2.ERR_ALERT:
+                raise self._bus.hardware_fault(joint.servo_id, command)
+            off = ct.PRESENT_POSITION.address - ct.STATUS_BLOCK_START
+            present = p2.to_signed(int.from_bytes(data[off : off + 4], "little"), 4)
+            if goal is not None and abs(present - goal) > s.in_position_tolerance_ticks:
+                raise DynamixelError(
+                    self.name,
+                    f"the {self._role(joint)} joint moved during the capture: at "
+                    f"{ticks_to_joint(joint, present):.2f}° where it had reached "
+                    f"{ticks_to_joint(joint, goal):.2f}° (more than in_position_tolerance_ticks "
+                    f"= {s.in_position_tolerance_ticks}): the image was not kept; check for a "
+                    "bump or a joint that slips",
+                    command,
+                    joint.servo_id,
+                )
+
     def joint_ticks(self) -> tuple[int, int]:
         """Present Position of (azimuth, elevation), signed."""
         return tuple(

@@ -537,6 +537,12 @@ def run_session(
                 reason = FinishReason.CANCELLED
                 break
             t_captured = clock.now()
+            # an arm whose servo faulted (or that moved) during the exposure: the image is not
+            # kept under the direction read before it; the error stops the run, a resume
+            # retakes this step
+            held = getattr(rig.lighting, "check_held", None)
+            if held is not None:
+                held()
             got = frame_layout(frame)
             if layout is not None and got != layout:
                 _refuse_other_layout(rig, folder, i, frame, got, layout)

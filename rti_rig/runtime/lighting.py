@@ -192,6 +192,20 @@ class ArmLighting:
     def off(self) -> None:
         self.carrier.lamp(False)
 
+    def check_held(self) -> None:
+        """After a capture: raise unless the arm still holds the direction it reached, with
+        no servo fault (a carrier that cannot tell does nothing). The image is then not kept:
+        a servo that overloaded during the exposure went limp and the arm may have sagged,
+        and the image had been kept under the direction read before it."""
+        check = getattr(self.carrier, "check_held", None)
+        if check is None:
+            return
+        try:
+            check()
+        except Exception as exc:  # the arm's own failure: no park after it
+            self.arm_failure = exc
+            raise
+
     def safe(self, emergency: bool = False) -> list[str]:
         failures = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
         stop_failed = attempt_all([("stop", self.carrier.stop)])

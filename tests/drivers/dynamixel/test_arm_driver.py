@@ -729,3 +729,22 @@ def test_the_lamp_goes_off_on_a_servo_that_reports_a_fault() -> None:
     with pytest.raises(HardwareFaultError, match="overload"):
         arm.lamp(True)
     assert not arm.lamp_is_on
+
+
+def test_check_held_after_a_capture_names_a_joint_that_moved_or_faulted() -> None:
+    """Read after each capture (the controller keeps no image under a direction the arm no
+    longer holds): a joint off its goal (a sag, a bump) and a servo fault are both named."""
+    import numpy as np
+
+    arm, emu, _clock = make_arm()
+    arm.connect()
+    arm.move_to(np.array([0.0, 0.5, 0.8]))
+    arm.check_held()  # where it was left: nothing to say
+    goal = arm.joint_ticks()[1]
+    emu.servos[2]._profile.start = emu.servos[2]._profile.goal = float(goal - 40)  # sagged
+    with pytest.raises(DynamixelError, match="the elevation joint moved during the capture"):
+        arm.check_held()
+    emu.servos[2]._profile.start = emu.servos[2]._profile.goal = float(goal)
+    emu.servos[1].inject_hardware_error(ct.HardwareFault.OVERHEATING)
+    with pytest.raises(DynamixelError, match="servo 1: hardware fault overheating"):
+        arm.check_held()
