@@ -177,6 +177,9 @@ class OpenCvCamera:
                 self._set_verified(cap, cv2.CAP_PROP_CONVERT_RGB, 0, "convert_rgb")
         info["buffer_size_set"] = bool(cap.set(cv2.CAP_PROP_BUFFERSIZE, s.buffer_size))
         self._drain = self._drain_for_queue(cap, info)
+        fps = cap.get(cv2.CAP_PROP_FPS)
+        if fps > 0:  # some drivers report none (0): the capture's time is then not known
+            info["fps"] = float(fps)
         if s.toggle_auto_exposure:
             cap.set(cv2.CAP_PROP_AUTO_EXPOSURE, s.auto_exposure_auto)
         self._set_verified(
@@ -257,6 +260,37 @@ class OpenCvCamera:
             "sensor time to latch a new exposure), or remove it (unset, it follows the queue)",
             "set buffer_size",
         )
+
+    def capture_time_s(self, exposure_s: float) -> tuple[float, str] | None:
+        """The longest a ``capture`` of ``exposure_s`` reads frames for, and how that is
+        counted, once connected; None on an image sequence or a camera reporting no frame rate.
+
+        Why: the capture drains ``self._drain`` frames and keeps one, all with the LED lit.
+        Queued frames may be read at once, but a queue the camera has not refilled since the
+        last capture (the settle is shorter than the queue at the frame rate) is waited for a
+        frame period a frame; each period is at least the exposure (a UVC sensor exposing
+        longer than its frame period slows its stream). Counted as every frame read waited
+        for, the worst case: the lit-time check made from the config alone counted only the
+        exposure, and a 5 fps camera whose driver refused the one-buffer request held its LED
+        1.6 s a capture past a ``max_on_s`` the check had passed."""
+        fps = self.connection_info.get("fps")
+        if self._cap is None or self.settings.backend != "v4l2" or not fps:
+            return None
+        period = max(1.0 / fps, exposure_s)
+        frames = self._drain + 1
+        queued = self.connection_info.get("buffers_queued")
+        if self.settings.drain_frames is None and queued is not None:
+            how = (
+                f"drain_frames unset: the {queued} buffer{'s' if queued != 1 else ''} the "
+                f"driver queues and {self._drain - queued} fresh"
+            )
+        else:
+            how = f"drain_frames = {self._drain}"
+        said = (
+            f"{frames} frames at {fps:g} fps, {period:.3g} s each ({how}, then the one kept) "
+            f"= {frames * period:.3g} s"
+        )
+        return frames * period, said
 
     def _refuse_unset_response(self, image: np.ndarray) -> None:
         """An 8-bit frame with no ``response`` configured is refused, not taken as linear: such

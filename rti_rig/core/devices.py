@@ -143,6 +143,25 @@ class ExposingCamera(Protocol):
 
 
 @runtime_checkable
+class FramePacedCamera(Protocol):
+    """A camera whose capture reads frames off a stream, at its frame rate, with the light lit.
+
+    Why: a UVC camera streams continuously and queues frames exposed before the light settled
+    or the exposure changed; a capture discards them (the queue and a few fresh frames) before
+    it keeps one, all with the LED lit. At 5 fps with a 4-buffer queue that is 8 frames, 1.6 s:
+    a config whose settle + exposure + readout + transfer fitted ``max_on_s`` then stopped at
+    the thermal limit with the object lit. ``capture_time_s(exposure_s)`` says, once the
+    camera is connected (frame rate and queue known), the longest a capture of ``exposure_s``
+    reads frames for and how that is counted (a phrase for a message), or None when the camera
+    cannot tell (no frame rate reported).
+    """
+
+    name: str
+
+    def capture_time_s(self, exposure_s: float) -> tuple[float, str] | None: ...
+
+
+@runtime_checkable
 class BusyAwareCamera(Protocol):
     """An :class:`ExposingCamera` that can be told by when it must fire.
 

@@ -9,13 +9,13 @@ and writes the session's `.lp` and manifest from the images already on disk.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, Protocol
 
-from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame
-from rti_rig.core.errors import CameraBusyError, CaptureError, ScheduleError
+from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame, FramePacedCamera
+from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.deferred_signals import signals_deferred
@@ -285,6 +285,50 @@ def lit_limit_said(rig: Rig) -> str:
     return f"max_on_s = {lit_limit_s(rig):g} s"
 
 
+def check_capture_fits_lit(rig: Rig, exposures_s: Iterable[float], before: str) -> None:
+    """Refuse, before anything is lit, a camera whose capture holds its light lit longer than
+    the light may stay lit (a dome's ``max_on_s``), once the camera is connected.
+
+    Why: the config's check (``rti_rig.app.config.lit_per_shot``) counts settle + exposure +
+    readout + transfer + the all-off; a UVC camera (a :class:`FramePacedCamera`) reads the
+    frames it drains and the one it keeps with the LED lit, which only the connected camera
+    can count (its frame rate and queue). A 5 fps camera whose driver refused the one-buffer
+    request passed the check and stopped at the first image with the object lit ("LED 0 stayed
+    on 1.555 s, beyond max_on_s = 1 s; raise max_on_s or shorten settle and exposure"). The
+    step's lit time is the config's sum with the exposure replaced by the frames read.
+    ``before`` says what was not done ("nothing was lit").
+    """
+    camera = rig.camera
+    limit = lit_limit_s(rig)
+    exposures = list(exposures_s)
+    if limit is None or not exposures or not isinstance(camera, FramePacedCamera):
+        return
+    exposure = max(exposures)  # a frame period is at least the exposure: the longest is worst
+    counted = camera.capture_time_s(exposure)
+    if counted is None:
+        return
+    capture_s, said = counted
+    t = rig.timing
+    transfer = float(getattr(t, "transfer_s", 0.0))
+    switch = float(getattr(t, "light_switch_s", 0.0))
+    total = t.settle_s + capture_s + t.readout_s + transfer + switch
+    if total <= limit + 1e-9:
+        return
+    where = getattr(getattr(rig, "loaded", None), "path", None)
+    raise DeviceError(
+        camera.name,
+        f"a capture at {exposure:g} s reads {said} with its LED lit, so each step's LED stays "
+        f"lit timing.settle_s {t.settle_s:g} + {capture_s:.3g} s + timing.readout_s "
+        f"{t.readout_s:g} + timing.transfer_s {transfer:g} + timing.light_switch_s {switch:g} "
+        f"= {total:.3g} s, beyond {lit_limit_said(rig)}"
+        f"{f' ({where})' if where else ''}: every capture would stop at the thermal limit with "
+        f"the object lit; {before}. Give the camera a higher frame rate, let its driver queue "
+        "fewer buffers (buffer_size in [camera.device]; drain_frames if the sensor latches a "
+        "new exposure at once), or raise max_on_s if the LEDs allow it",
+        "check lit time",
+    )
+
+
 def fire_lit(
     rig: Rig,
     step: LightStep,
@@ -491,6 +535,11 @@ def run_session(
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()
+        planned = [
+            *(step_exposure(rig, schedule.steps[i]) for i in todo if source is None),
+            *((cam.exposure_s, *(s.exposure_s or 0.0 for s in schedule.steps)) if source else ()),
+        ]
+        check_capture_fits_lit(rig, planned, "nothing was lit or written")
         # only now, with the rig known to answer, is anything written to disk
         folder.begin(header)
         for i in todo:

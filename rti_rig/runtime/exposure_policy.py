@@ -37,7 +37,12 @@ import numpy as np
 from rti_rig.core.devices import ExposingCamera, Frame
 from rti_rig.core.errors import DeviceError
 from rti_rig.core.schedule import LightSchedule, LightStep
-from rti_rig.runtime.controller import lit_limit_s, shoot_step, validate_schedule
+from rti_rig.runtime.controller import (
+    check_capture_fits_lit,
+    lit_limit_s,
+    shoot_step,
+    validate_schedule,
+)
 from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.lighting import attempt_all
 from rti_rig.runtime.rig import Rig
@@ -218,6 +223,9 @@ def fix_session_exposure(
     try:
         rig.lighting.connect()
         rig.camera.connect()
+        # the metering's first shot, the shortest it starts from: a UVC camera's drain that
+        # does not fit the light's limit then would stop it at the thermal limit, lit
+        check_capture_fits_lit(rig, [rig.camera_config.exposure_s], "nothing was lit")
         rig.lighting.set(schedule.steps[at])
         lit_at = rig.clock.now()
         rig.clock.sleep(rig.timing.settle_s)

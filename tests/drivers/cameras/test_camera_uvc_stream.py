@@ -4,12 +4,17 @@ wholly under its own light and at its own exposure."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from types import SimpleNamespace
 
+import cv2
 import pytest
+from conftest import CONFIGS, shipped_dome_on_pty
 from fake_uvc import BufferedUvcStream, LightHistory
+from typer.testing import CliRunner
 
-from rti_rig.core.clock import VirtualClock
+from rti_rig.cli import app
+from rti_rig.core.clock import SystemClock, VirtualClock
 from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera
 from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 from rti_rig.runtime.controller import shoot_lit
@@ -84,3 +89,59 @@ def test_every_frame_is_exposed_wholly_under_its_own_light(buffers, accepted, la
         expected = round(stream.scale * level * exposure)
         assert abs(frame.pixels.astype(int) - expected).max() <= 1, (frame.pixels[:, 0], expected)
         assert frame.exposure_s == pytest.approx(exposure)
+
+
+def _uvc_dome_config(tmp_path: Path) -> Path:
+    """The shipped 48-LED dome with a UVC camera, LEDs that may stay lit 1 s at a time: the
+    config's own check passes (settle 0.1 + exposure 0.05 + readout 0.05 + transfer 0.05 +
+    all-off 0.02 = 0.27 s)."""
+    text = (CONFIGS / "example_dome_48.toml").read_text()
+    text = text.replace('"example_dome_48.lp"', f'"{CONFIGS / "example_dome_48.lp"}"')
+    text = text.replace("max_on_s = 8.0", "max_on_s = 1.0")
+    text = text.replace("exposure_s = 0.125", "exposure_s = 0.05")
+    text = text.replace("width = 6000\nheight = 4000", "width = 4\nheight = 8")
+    text = text[: text.index("[camera.device]")] + (
+        '[camera.device]\nkind = "opencv"\ndevice = 0\n\n[timing]\nlight_switch_s = 0.02\n'
+        "settle_s = 0.1\nreadout_s = 0.05\ntransfer_s = 0.05\n"
+    )
+    cfg = tmp_path / "uvc_dome.toml"
+    cfg.write_text(text)
+    return cfg
+
+
+@pytest.mark.pty
+@pytest.mark.parametrize("fps, fits", [(5.0, False), (30.0, True)], ids=["5fps", "30fps"])
+def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
+    tmp_path, monkeypatch, fps, fits
+):
+    """`rti-rig run` on a dome whose LEDs may stay lit 1 s, with a 5 fps UVC camera whose
+    driver refused the one-buffer request (4 queued): each capture reads 8 frames (the queue,
+    3 fresh, the one kept), 1.6 s with the LED lit. The config's check counted the exposure
+    only, and the run lit LED 0 and stopped at the thermal guard ("LED 0 stayed on 1.555 s,
+    beyond max_on_s = 1 s; raise max_on_s or shorten settle and exposure"). Now it is refused
+    once the camera is connected, before any LED, naming the camera, the keys and figures; a
+    30 fps camera (8 frames, 0.27 s) runs."""
+    cfg = _uvc_dome_config(tmp_path)
+    stream = BufferedUvcStream(
+        LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
+        fps=fps,
+        buffers=4,
+        buffer_size_accepted=False,
+    )
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    said = " ".join(r.output.split())
+    lit = [e for e in firmware.history if e.what == "lit"]
+    if fits:
+        assert r.exit_code == 0, said
+        assert len(lit) == 4
+        return
+    assert r.exit_code == 2, said
+    assert not lit, lit  # no LED was lit
+    assert "uvc-camera" in said and "8 frames at 5 fps, 0.2 s each" in said, said
+    assert "the 4 buffers the driver queues and 3 fresh" in said, said
+    assert "= 1.82 s, beyond max_on_s = 1 s" in said and str(cfg) in said.replace(" ", ""), said
+    assert "timing.settle_s 0.1" in said and "nothing was lit" in said, said
+    assert "Traceback" not in said and not list(out.glob("*.jpg"))
