@@ -43,7 +43,12 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.drivers.cameras.image_io import read_image_file, to_linear_uint16
-from rti_rig.drivers.cameras.raw_decode import DECODER, decode_raw, exposure_stats
+from rti_rig.drivers.cameras.raw_decode import (
+    DECODER,
+    UnsupportedRawError,
+    decode_raw,
+    exposure_stats,
+)
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
 
 RAW_SUFFIXES = {
@@ -90,6 +95,21 @@ def _identity(path: Path) -> tuple[int, int, int, int] | None:
     except FileNotFoundError:
         return None
     return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
+def _has_header(path: Path) -> bool:
+    """Whether ``path``'s first bytes are written (not all zero).
+
+    Why: a program copying onto a network share (Windows over SMB) may set a file's full size
+    first and fill it afterwards; such a file's size is steady at once, and LibRaw reads its
+    zeros as no known format. Only a file whose header is there is known to be in a format
+    LibRaw does not read."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(16)
+    except OSError:
+        return False
+    return any(head)
 
 
 @dataclass
@@ -367,6 +387,15 @@ class FolderWatchCamera:
                 # this camera's, of a whole file: 8-bit data, a wrong exposure)
                 if exc.device != DECODER and exc.command != "read":
                     raise
+                if isinstance(exc, UnsupportedRawError) and _has_header(path):
+                    raise CaptureError(
+                        self.name,
+                        f"{exc.message}. The file is whole (its size steady over "
+                        f"{s.stable_polls} polls, its header written), so waiting will not "
+                        f"help; it is left in {s.folder}, and no image was recorded for this "
+                        "light",
+                        "decode",
+                    ) from exc
                 failure = exc
             last, stable = tried, 0
             while True:

@@ -28,6 +28,17 @@ from rti_rig.core.errors import CaptureError
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
 DECODER = "raw-decode"
+
+
+class UnsupportedRawError(CaptureError):
+    """LibRaw does not read this file's format (a body newer than it, or no RAW at all).
+
+    Why a class of its own: a complete file in such a format will never decode, however
+    long it is waited for, unlike a file cut short (LibRaw's I/O and data errors); a watched
+    folder had waited ``timeout_s`` for it to change and then advised raising
+    ``stable_polls``."""
+
+
 _COLOR_NAMES = "RGBG"
 
 
@@ -366,7 +377,7 @@ def decode_raw(
         # a body newer than the bundled LibRaw (a new Canon CR3 or Fujifilm RAF, say) gives
         # this, a truncated download a data or I/O error: "is it a complete download?" had
         # sent the owner of a new camera looking for a cable fault
-        raise CaptureError(
+        raise UnsupportedRawError(
             DECODER,
             f"{name}: LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy "
             f"{rawpy.__version__}) does not read this file's format ({exc}): a camera newer "

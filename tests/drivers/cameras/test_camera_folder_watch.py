@@ -261,3 +261,49 @@ def test_an_untriggered_exposure_is_over_once_its_file_has_come(tmp_path):
     ended = cam.expose(0.5)
     assert ended is not None and ended >= 2.0
     assert cam.collect().metadata["source_file"].endswith("IMG_0001.dng")
+
+
+def test_a_whole_file_libraw_does_not_read_is_said_at_once_naming_it(tmp_path):
+    """A tethering program saving a RAW in a format LibRaw does not read (a body newer than
+    it): the file is whole and will never decode. The camera had waited ``timeout_s`` for it
+    to change and then advised raising stable_polls or poll_interval_s."""
+    clock = ScriptedClock(
+        {
+            0.5: lambda: (tmp_path / "IMG_0001.CR2").write_bytes(
+                b"\x89NEWRAW" + bytes(range(256)) * 64
+            )
+        }
+    )
+    cam = watch(tmp_path, clock, patterns=("*.CR2",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "IMG_0001.CR2" in said and "does not read this file's format" in said
+    assert "pip install -U rawpy" in said and str(tmp_path) in said
+    assert "waiting will not help" in said and "stable_polls or poll_interval_s" not in said
+    assert clock.now() < 5.0  # not the 30 s timeout
+    assert (tmp_path / "IMG_0001.CR2").exists()  # left where the program saved it
+
+
+def test_a_file_sized_before_it_is_written_is_waited_for(tmp_path):
+    """A program copying onto a network share may set the file's full size first (zeros) and
+    fill it afterwards: LibRaw reads the zeros as no known format, but the file is not whole
+    yet, so it is waited for and decoded once written."""
+    whole = tmp_path / "whole.dng"
+    dng(whole, level=0.3)
+    data = whole.read_bytes()
+    whole.unlink()
+    target = tmp_path / "shots"
+    target.mkdir()
+    clock = ScriptedClock(
+        {
+            0.5: lambda: (target / "IMG_0001.dng").write_bytes(bytes(len(data))),
+            3.0: lambda: (target / "IMG_0001.dng").write_bytes(data),
+        }
+    )
+    cam = watch(target, clock, timeout_s=10.0, poll_interval_s=0.25)
+    cam.connect()
+    frame = cam.capture(0.5)
+    assert frame.metadata["originals"][0]["name"] == "IMG_0001.dng"
+    assert frame.pixels.mean() > 0

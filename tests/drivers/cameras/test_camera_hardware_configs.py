@@ -532,3 +532,42 @@ def test_a_ram_capture_numbered_per_object_keeps_the_last_picture_as_the_shot(
     assert strays == sorted([f"capt0002.{first}", f"capt0003.{second}"])
     raws = [k for e in entries for k in e["originals"] if k.endswith(".cr2")]
     assert raws == [f"raw/image_00{i}.cr2" for i in (1, 2, 3)]
+
+
+@pytest.mark.parametrize("dome", [WATCH_CONFIG], indirect=True)
+def test_folder_watch_of_a_raw_libraw_does_not_read_says_so_at_once(dome, tmp_path, monkeypatch):
+    """The tethering program saves a whole RAW in a format LibRaw does not read (a body newer
+    than it): `rti-rig run` had waited timeout_s (15 s on the example) for the file to change,
+    then advised raising stable_polls or poll_interval_s. Now the error names the file, the
+    folder it is left in and what to do, at once."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    watched = tmp_path / "Pictures" / "rti-tether"
+    watched.mkdir(parents=True)
+    stop = threading.Event()
+
+    def tethering_program() -> None:
+        seen = 0
+        while not stop.is_set():
+            pulses = [e for e in list(dome.history) if e.what == "shutter"]
+            for _ in pulses[seen:]:
+                seen += 1
+                (watched / f"IMG_{seen:04d}.CR2").write_bytes(
+                    b"\x89NEWRAW" + bytes(range(256)) * 64
+                )
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=tethering_program, daemon=True)
+    thread.start()
+    try:
+        out = tmp_path / "s"
+        result = run(str(WATCH_CONFIG), "--out", str(out), "--lights", "4")
+    finally:
+        stop.set()
+        thread.join(2)
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert "IMG_0001.CR2" in said and "does not read this file's format" in said, said
+    assert "pip install -U rawpy" in said and "waiting will not help" in said, said
+    assert "it is left in" in said and "rti-tether" in said, said
+    assert "stable_polls or poll_interval_s" not in said, said
+    assert sum(e.what == "shutter" for e in dome.history) == 1
