@@ -164,6 +164,8 @@ class Gphoto2Camera:
         #: card before any busy spell that follows): listed once per folder, then again only
         #: after a busy spell, so a body that is never busy costs one listing a session
         self._card_seen: dict[str, set[str]] = {}
+        #: files this session downloaded and left on the card (``delete_from_camera = false``)
+        self._left_on_card = 0
         self.retries_used = 0
         self.camera_model: str | None = None
 
@@ -219,7 +221,7 @@ class Gphoto2Camera:
                 command,
             )
         if code == -115:
-            return CardFullError(self.name, text, command)
+            return CardFullError(self.name, text + self._card_filled_by_copies(), command)
         return error(self.name, text, command)
 
     # -- lifecycle -------------------------------------------------------------------------
@@ -774,8 +776,27 @@ class Gphoto2Camera:
             seen = seen | {n for _, n in taken}
         self._card_seen[folder] = seen
 
+    def _card_filled_by_copies(self) -> str:
+        """Said with a full card when the session keeps its shots' copies there ("" else).
+
+        Why: with ``delete_from_camera = false`` every downloaded shot stays on the card, so
+        the session itself fills it; the card-full error had said only to free the card or
+        capture to RAM, not that the kept copies (and the key keeping them) were the cause."""
+        s = self.settings
+        if s.delete_from_camera or s.capture_target == "Internal RAM":
+            return ""
+        left = self._left_on_card
+        return (
+            f"; delete_from_camera = false in [camera.device] keeps each shot's copy on the "
+            f"card ({left} file{'s' if left != 1 else ''} this session downloaded are still "
+            "on it), which is what fills it: set delete_from_camera = true (each shot is "
+            "deleted there only once it is in the session's raw/), or free the card, then "
+            "continue with 'rti-rig run --resume SESSION'"
+        )
+
     def _delete(self, files: list[tuple[str, str]]) -> None:
         if not self.settings.delete_from_camera:
+            self._left_on_card += len(files)
             return
         gp = self._gp
         for folder, name in files:

@@ -571,3 +571,29 @@ def test_folder_watch_of_a_raw_libraw_does_not_read_says_so_at_once(dome, tmp_pa
     assert "it is left in" in said and "rti-tether" in said, said
     assert "stable_polls or poll_interval_s" not in said, said
     assert sum(e.what == "shutter" for e in dome.history) == 1
+
+
+def test_a_card_filled_by_the_kept_copies_says_so_naming_the_key(body, tmp_path):
+    """Capturing to the card with delete_from_camera = false, each shot's copy stays on the
+    card and fills it: the card-full error had said "free space on it, or set capture_target =
+    'Internal RAM'", not that the session's own kept copies were what filled it, nor the key
+    that keeps them."""
+    text = DSLR_CONFIG.read_text().replace(
+        'capture_target = "Internal RAM"',
+        'capture_target = "Memory card"\ndelete_from_camera = false',
+    )
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "card.toml"
+    config.write_text(text)
+    body.card_free_shots = 2
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert len(journal(out)) == 2 and len(body.card) == 2  # both kept, on the card and here
+    assert "card is full" in said, said
+    assert "delete_from_camera = false" in said, said
+    assert "2 files this session downloaded are still on it" in said, said
+    assert "--resume" in said, said
