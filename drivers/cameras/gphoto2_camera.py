@@ -545,16 +545,33 @@ class Gphoto2Camera:
             saved[name] = target
         # pictures the body took behind a busy answer: downloaded too (nothing captured is
         # lost), handed over as strays, never as this shot's files
-        stray_saved: list[dict[str, str]] = []
+        stray_saved: list[dict[str, Any]] = []
+        # with no session bound (run --auto-exposure's metering, preview) the downloads go to
+        # a private folder deleted at close: a stray is then left on the card, where it is the
+        # only copy kept (it had been deleted there and with the folder, without a word)
+        left_on_card = self.output_dir is None and s.capture_target != "Internal RAM"
         for folder, name in strays:
             target = _unused(staging, f"stray{self._count:04d}_{name}")
             camera_file = self._call(
                 "download", lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL)
             )
             camera_file.save(str(target))
-            stray_saved.append({"path": str(target), "name": f"{folder.rstrip('/')}/{name}"})
-        self._delete(files + strays)
-        self._note_card(str(path.folder), files + strays)
+            stray_saved.append(
+                {
+                    "path": str(target),
+                    "name": f"{folder.rstrip('/')}/{name}",
+                    "left_on_card": left_on_card,
+                }
+            )
+        if left_on_card:
+            self._delete(files)
+            self._note_card(str(path.folder), files)
+            seen = self._card_seen.get(str(path.folder))
+            if seen is not None:  # on the card now: never found again as a new picture
+                seen |= {n for _, n in strays}
+        else:
+            self._delete(files + strays)
+            self._note_card(str(path.folder), files + strays)
         raw_path = saved[raw_files[0][1]]
         try:
             decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)

@@ -128,9 +128,18 @@ class _LitForEachShot:
     Every other attribute is the camera's (its shutter speeds, its name)."""
 
     def __init__(
-        self, rig: Rig, step: LightStep, lit_at: float, relight_each: bool = False
+        self,
+        rig: Rig,
+        step: LightStep,
+        lit_at: float,
+        relight_each: bool = False,
+        strays: list[dict[str, Any]] | None = None,
     ) -> None:
         self._rig = rig
+        #: pictures the camera delivered besides its test shots (``stray_originals``: taken
+        #: behind a busy answer), said by the caller: a test shot is no session image, but a
+        #: picture of the object had vanished with the metering's private folder unsaid
+        self._strays = strays if strays is not None else []
         self._step = step
         self._lit_at = lit_at
         self._relight_each = relight_each
@@ -149,9 +158,17 @@ class _LitForEachShot:
         if lit_limit_s(rig) is not None and isinstance(camera, ExposingCamera):
             self._lit_for_next, self._dark = False, True  # the shot ends with the light off
             frame, _ = shoot_step(rig, self._step, exposure_s, self._lit_at)
-            return frame
-        self._lit_for_next, self._dark = not self._relight_each, False
-        return camera.capture(exposure_s)
+        else:
+            self._lit_for_next, self._dark = not self._relight_each, False
+            frame = camera.capture(exposure_s)
+        for stray in frame.metadata.get("stray_originals") or []:
+            self._strays.append(
+                {
+                    "camera_file": str(stray.get("name") or stray.get("path")),
+                    "kept": "on the camera's card" if stray.get("left_on_card") else "not kept",
+                }
+            )
+        return frame
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._rig.camera, name)
@@ -196,8 +213,10 @@ def fix_session_exposure(
     # = 1.16 s"), each shot alone fitting (a DSLR's shots end dark, see _LitForEachShot)
     relight_each = shot_per_lighting or lit_limit_s(rig) is not None
 
+    strays: list[dict[str, Any]] = []
+
     def camera_at(step: LightStep, lit_at: float) -> Any:
-        return _LitForEachShot(rig, step, lit_at, relight_each=relight_each)
+        return _LitForEachShot(rig, step, lit_at, relight_each=relight_each, strays=strays)
 
     def teardown(keep_lights: bool = False) -> list[str]:
         # every step of the teardown runs, whatever one device does; what failed is said. A
@@ -263,6 +282,7 @@ def fix_session_exposure(
         # a meter that names no test exposure took one shot at least
         "metering_shots": max(len(tested[0]), 1) + sum(len(t) for t in tested[1:]),
         "shot_per_lighting": shot_per_lighting,
+        **({"metering_strays": strays} if strays else {}),
         "rig_time_s": rig_time_s,
         "wall_time_s": wall_time_s,
     }

@@ -411,6 +411,8 @@ def fix_exposure(
             f"{metered} metered, after {chosen['metering_shots']} test shots"
         )
     on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s{where} ({chosen['reason']})"))
+    if strays := chosen.get("metering_strays"):
+        on_note(Note(_metering_strays_said(strays)))
     if lit_cap is not None and chosen["exposure_s"] >= _next_shorter_s(rig, longest) - 1e-9:
         serial = rig.loaded.config.dome.serial  # type: ignore[attr-defined]
         less = (
@@ -448,6 +450,30 @@ def _lit_exposure_cap(rig: Rig) -> float | None:
     if limit is None:
         return None
     return limit - rig.timing.settle_s - rig.timing.readout_s - _held_after_s(rig)
+
+
+def _metering_strays_said(strays: list[dict[str, Any]]) -> str:
+    """What the run says of pictures the camera delivered besides the metering's test shots.
+
+    Why: a picture a body took behind a busy answer during ``--auto-exposure`` is no session
+    image (a moment and a light rti-rig did not choose), but it is a picture of the object:
+    it had vanished with the metering's private download folder, and from the card, unsaid."""
+    n = len(strays)
+    where = {"not kept": "not kept", "on the camera's card": "left on the camera's card"}
+    names = ", ".join(f"{s['camera_file']} ({where.get(s['kept'], s['kept'])})" for s in strays)
+    lost = any(s["kept"] == "not kept" for s in strays)
+    return (
+        f"Metering: the camera delivered {n} picture{'s' if n != 1 else ''} besides its test "
+        f"shots, taken while it answered busy: {names}. A metering shot is no session image, "
+        "and such a picture was taken at a moment rti-rig did not choose, under a light it "
+        "cannot vouch for"
+        + (
+            "; a RAM capture keeps no copy once the metering ends (capture_target = 'Memory "
+            "card' leaves such a picture on the card)"
+            if lost
+            else ""
+        )
+    )
 
 
 def _held_after_s(rig: Rig) -> float:

@@ -597,3 +597,38 @@ def test_a_card_filled_by_the_kept_copies_says_so_naming_the_key(body, tmp_path)
     assert "delete_from_camera = false" in said, said
     assert "2 files this session downloaded are still on it" in said, said
     assert "--resume" in said, said
+
+
+@pytest.mark.parametrize("target", ["Memory card", "Internal RAM"])
+def test_a_picture_taken_behind_a_busy_answer_while_metering_is_said_and_kept_on_the_card(
+    body, tmp_path, target
+):
+    """`run --auto-exposure`: the body answers busy after a test shot yet takes the picture.
+    Metering shots are not session images, but that picture, of the object under some light,
+    had been downloaded into the metering's private folder and deleted with it (and from the
+    card) without a word. Now the run says so, and on a card it is left there."""
+    text = DSLR_CONFIG.read_text().replace(
+        'capture_target = "Internal RAM"', f'capture_target = "{target}"'
+    )
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "meter.toml"
+    config.write_text(text)
+    body.busy_after_shot = 1
+    body.busy_yet_shot = 1
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "3", "--auto-exposure")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, said
+    assert body.stray_files == ["IMG_0002.CR2"], body.stray_files
+    assert "Metering: the camera delivered 1 picture besides its test shots" in said, said
+    assert "IMG_0002.CR2" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    (kept,) = manifest["schedule"]["provenance"]["exposure"]["metering_strays"]
+    assert kept["camera_file"].endswith("IMG_0002.CR2")
+    if target == "Memory card":
+        assert "left on the camera's card" in said, said
+        assert "IMG_0002.CR2" in body.card and kept["kept"] == "on the camera's card"
+    else:
+        assert "not kept" in said, said
