@@ -27,11 +27,17 @@ exposure after the pulse (see ``expose``), without one once the file has come; t
 the decode then happen in the dark. Held lit until the image was in hand, a RAW arriving over
 Wi-Fi 9 s after the pulse ran into the dome's ``max_on_s`` = 8 s and the good shot was lost.
 
+Once the rig is bound to a session, a taken file is copied into the session's
+``raw/.incoming`` before it is decoded, and that copy is decoded and kept: the folder belongs
+to another program, which may move its files out (an auto import) or rename them meanwhile.
+
 Safe state: nothing to release (no device handle); ``close`` forgets the seen files.
 """
 
 from __future__ import annotations
 
+import os
+import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -149,6 +155,9 @@ class FolderWatchCamera:
         #: pattern matches)
         self._at_connect: set[str] = set()
         self._pending: _Pending | None = None
+        #: where a taken file is copied before it is decoded: the session's ``raw/.incoming``,
+        #: set when the rig is bound to a session (None: decoded where it lies)
+        self.output_dir: Path | None = None
 
     def connect(self) -> None:
         folder = self.settings.folder
@@ -380,17 +389,21 @@ class FolderWatchCamera:
         deadline = self._clock.now() + s.timeout_s
         while True:
             tried = _identity(path)
+            held = self._hold(path)
             try:
-                return self._decode(path, exposure_s, started)
+                return self._decode(held, exposure_s, started, path)
             except CaptureError as exc:
+                if held != path and _identity(path) is not None:
+                    held.unlink(missing_ok=True)  # the folder's file stays; the copy is no use
                 # the decoders' own refusals: LibRaw's, or a TIFF/PNG that would not read (not
                 # this camera's, of a whole file: 8-bit data, a wrong exposure)
                 if exc.device != DECODER and exc.command != "read":
                     raise
+                message = exc.message.replace(str(held), str(path))
                 if isinstance(exc, UnsupportedRawError) and _has_header(path):
                     raise CaptureError(
                         self.name,
-                        f"{exc.message}. The file is whole (its size steady over "
+                        f"{message}. The file is whole (its size steady over "
                         f"{s.stable_polls} polls, its header written), so waiting will not "
                         f"help; it is left in {s.folder}, and no image was recorded for this "
                         "light",
@@ -402,7 +415,7 @@ class FolderWatchCamera:
                 if self._clock.now() >= deadline:
                     raise CaptureError(
                         self.name,
-                        f"{failure.message}; {path.name} did not change within "
+                        f"{message}; {path.name} did not change within "
                         f"{s.timeout_s:g} s after that (if the program saving it pauses while "
                         "writing, raise stable_polls or poll_interval_s)",
                         "decode",
@@ -414,8 +427,50 @@ class FolderWatchCamera:
                 if now is not None and now != tried and stable >= s.stable_polls:
                     break
 
-    def _decode(self, path: Path, exposure_s: float, started: float) -> Frame:
+    def _hold(self, path: Path) -> Path:
+        """Copy the file taken from the watched folder into the session (``output_dir``, its
+        ``raw/.incoming``) and return the copy, which is decoded and kept; ``path`` itself
+        when no session is bound.
+
+        Why: the folder belongs to another program, and many move its files out (Lightroom's
+        auto import, a sync tool) or rename them. The file had been decoded where it lay and
+        copied at the step's commit, by then gone: the session stopped with "cannot write
+        raw/image_001.dng: No such file or directory", as if the disk had failed, and the
+        bytes kept need not have been the bytes decoded."""
+        if self.output_dir is None:
+            return path
+        self.output_dir.mkdir(parents=True, exist_ok=True)
+        dest, n = self.output_dir / path.name, 2
+        while dest.exists():
+            dest, n = self.output_dir / f"{path.stem}_{n}{path.suffix}", n + 1
+        tmp = dest.with_name(f".{dest.name}.partial")
+        try:
+            shutil.copyfile(path, tmp)
+            os.replace(tmp, dest)
+        except OSError as exc:
+            tmp.unlink(missing_ok=True)
+            gone = isinstance(exc, FileNotFoundError)
+            raise CaptureError(
+                self.name,
+                f"{path.name} came into {self.settings.folder} and was taken as this light's "
+                + (
+                    "image, but it was moved or deleted before rti-rig could copy it: another "
+                    "program takes files out of the folder (an auto import?); have it copy "
+                    "them, or point it at another folder"
+                    if gone
+                    else f"image, but it could not be copied into {self.output_dir} ({exc})"
+                )
+                + "; no image was recorded for this light",
+                "copy",
+            ) from exc
+        return dest
+
+    def _decode(
+        self, path: Path, exposure_s: float, started: float, watched: Path | None = None
+    ) -> Frame:
+        """Decode ``path`` (the session's copy of ``watched``, the folder's file)."""
         s = self.settings
+        watched = watched or path
         if is_raw_file(path):
             decoded = decode_raw(path, s.decode, timestamp_s=started)
             pixels, white = decoded.pixels, decoded.white_level
@@ -453,7 +508,8 @@ class FolderWatchCamera:
                 "camera": self.name,
                 # the session copies the file under raw/ with its own name (the watched
                 # folder belongs to another program)
-                "originals": [{"path": str(path), "name": path.name}],
+                "originals": [{"path": str(path), "name": watched.name}],
+                "watched_file": str(watched),
                 "exposure_requested_s": exposure_s,
                 "exposure_source": "file" if file_exposure else "requested",
                 "capture_started_s": started,

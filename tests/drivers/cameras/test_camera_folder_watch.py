@@ -307,3 +307,22 @@ def test_a_file_sized_before_it_is_written_is_waited_for(tmp_path):
     frame = cam.capture(0.5)
     assert frame.metadata["originals"][0]["name"] == "IMG_0001.dng"
     assert frame.pixels.mean() > 0
+
+
+def test_a_file_moved_away_before_it_is_copied_is_named_with_what_to_do(tmp_path):
+    """Bound to a session, a taken file is copied in before it is decoded; one another program
+    moved out of the folder first (an auto import) is said as such, not as a disk failure."""
+    watched, incoming = tmp_path / "w", tmp_path / "s" / "raw" / ".incoming"
+    watched.mkdir()
+    cam = watch(watched, VirtualClock(), timeout_s=5.0)
+    cam.output_dir = incoming
+    cam.connect()
+    dng(watched / "IMG_0001.dng")
+    path = cam.wait_for_file()
+    path.rename(tmp_path / "IMG_0001.dng")  # imported elsewhere
+    with pytest.raises(CaptureError) as info:
+        cam._decode_complete(path, 0.5, 0.0)
+    said = str(info.value)
+    assert "IMG_0001.dng came into" in said and "moved or deleted before rti-rig" in said
+    assert "no image was recorded for this light" in said
+    assert not list(incoming.iterdir())

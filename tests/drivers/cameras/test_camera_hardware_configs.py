@@ -632,3 +632,60 @@ def test_a_picture_taken_behind_a_busy_answer_while_metering_is_said_and_kept_on
         assert "IMG_0002.CR2" in body.card and kept["kept"] == "on the camera's card"
     else:
         assert "not kept" in said, said
+
+
+@pytest.mark.parametrize("dome", [WATCH_CONFIG], indirect=True)
+def test_folder_watch_keeps_the_shot_another_program_moves_out_of_the_folder(
+    dome, tmp_path, monkeypatch
+):
+    """Lightroom's auto import (or a sync tool) moves each file out of the watched folder
+    seconds after it comes, while rti-rig decodes it. The file had been decoded where it lay
+    and copied at the step's commit, by then gone: `rti-rig run` stopped with "cannot write
+    raw/image_001.dng: No such file or directory", as if the disk had failed. The taken file
+    is now copied into the session first, and that copy is decoded and kept."""
+    import shutil
+
+    import rti_rig.drivers.cameras.folder_watch as folder_watch
+
+    monkeypatch.setenv("HOME", str(tmp_path))
+    watched = tmp_path / "Pictures" / "rti-tether"
+    watched.mkdir(parents=True)
+    library = tmp_path / "library"
+    library.mkdir()
+    real_decode = folder_watch.decode_raw
+
+    def decoded_while_imported(path, *args, **kwargs):  # type: ignore[no-untyped-def]
+        frame = real_decode(path, *args, **kwargs)
+        name = Path(path).name
+        shutil.move(watched / name, library / name)  # the auto import takes it meanwhile
+        return frame
+
+    monkeypatch.setattr(folder_watch, "decode_raw", decoded_while_imported)
+    render = render_for(dome)
+    stop = threading.Event()
+
+    def tethering_program() -> None:
+        seen = 0
+        while not stop.is_set():
+            pulses = [e for e in list(dome.history) if e.what == "shutter"]
+            for _ in pulses[seen:]:
+                seen += 1
+                (watched / f"_DSC{seen:04d}.DNG").write_bytes(render())
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=tethering_program, daemon=True)
+    thread.start()
+    try:
+        out = tmp_path / "s"
+        result = run(str(WATCH_CONFIG), "--out", str(out), "--lights", "4")
+    finally:
+        stop.set()
+        thread.join(2)
+    assert result.exit_code == 0, result.output
+    check_images(out)
+    names = [next(iter(e["originals"].values())) for e in journal(out)]
+    assert names == [f"_DSC{i:04d}.DNG" for i in range(1, 5)]
+    for i in range(1, 5):  # the session's copy is the camera's file, byte for byte
+        kept = (out / "raw" / f"image_{i:03d}.dng").read_bytes()
+        assert kept == (library / f"_DSC{i:04d}.DNG").read_bytes()
+    assert not any((out / "raw" / ".incoming").iterdir())
