@@ -301,6 +301,14 @@ class FolderWatchCamera:
                     )
                 unmatched = self._unmatched_said()
                 ask = "" if unmatched else ": is the camera firing and saving there?"
+                if not s.folder.is_dir():
+                    # a network share that dropped, a card reader unplugged: the question
+                    # about the camera had sent the user to check a camera that was firing
+                    ask = (
+                        "; the folder is no longer there or cannot be reached (a network "
+                        "share disconnected or unmounted, a disk unplugged?): reconnect it, "
+                        "then continue with 'rti-rig run --resume SESSION'"
+                    )
                 raise CaptureError(
                     self.name,
                     f"no new file matching {list(s.patterns)} in {s.folder} within "

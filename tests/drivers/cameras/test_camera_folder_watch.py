@@ -326,3 +326,19 @@ def test_a_file_moved_away_before_it_is_copied_is_named_with_what_to_do(tmp_path
     assert "IMG_0001.dng came into" in said and "moved or deleted before rti-rig" in said
     assert "no image was recorded for this light" in said
     assert not list(incoming.iterdir())
+
+
+def test_a_folder_that_went_away_is_said_at_the_timeout(tmp_path):
+    """The watched folder on a network share that disconnects mid-session: the timeout had
+    asked "is the camera firing and saving there?" of a camera that was."""
+    share = tmp_path / "share"
+    share.mkdir()
+    clock = ScriptedClock({0.5: lambda: share.rmdir()})
+    cam = watch(share, clock, timeout_s=3.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert str(share) in said and "no longer there or cannot be reached" in said
+    assert "network share" in said and "--resume" in said
+    assert "is the camera firing" not in said
