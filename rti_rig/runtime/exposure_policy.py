@@ -148,6 +148,11 @@ class _LitForEachShot:
 
     def capture(self, exposure_s: float) -> Frame:
         rig = self._rig
+        # a longer test exposure is a longer frame period for a UVC camera, whose capture
+        # reads several frames lit: refused before its light is lit again, not at the guard
+        check_capture_fits_lit(
+            rig, [exposure_s], f"the metering stopped before its test shot at {exposure_s:g} s"
+        )
         if not self._lit_for_next:
             if not self._dark:
                 rig.lighting.off()

@@ -145,3 +145,34 @@ def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
     assert "= 1.82 s, beyond max_on_s = 1 s" in said and str(cfg) in said.replace(" ", ""), said
     assert "timing.settle_s 0.1" in said and "nothing was lit" in said, said
     assert "Traceback" not in said and not list(out.glob("*.jpg"))
+
+
+@pytest.mark.pty
+def test_a_uvc_metering_shot_too_long_for_max_on_s_is_refused_before_it_is_lit(
+    tmp_path, monkeypatch
+):
+    """`run --auto-exposure` with a 30 fps UVC camera (8 frames a capture) on LEDs that may
+    stay lit 1 s: a dark object is metered towards the longest exposure the config's lit-time
+    sum allows (0.78 s), a capture that reads 8 frames of at least 0.78 s each (a UVC camera
+    exposing longer than its frame period slows its stream) with the LED lit. The metering had
+    lit its lights for 5 test shots up to 0.78 s and only the session then refused the
+    exposure; that test shot is now refused before its light is lit, naming the figures."""
+    cfg = _uvc_dome_config(tmp_path)
+    stream = BufferedUvcStream(
+        LightHistory(SystemClock()),  # type: ignore[arg-type]  # no light reaches it: dark
+        fps=30.0,
+        buffers=4,
+        buffer_size_accepted=False,
+    )
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(
+            app, ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
+        )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "metering stopped before its test shot at" in said, said
+    assert "beyond max_on_s = 1 s" in said and "uvc-camera" in said, said
+    assert [e.what for e in firmware.history].count("lit") == 1  # the 0.05 s preview only
+    assert "stayed on" not in said, said
