@@ -371,11 +371,20 @@ class FolderWatchCamera:
         frame = self._decode_complete(path, pending.exposure_s, pending.started)
         if pending.stray:
             frame.metadata["stray_files"] = pending.stray
+            kept = self._hold_strays(pending.stray)
+            if kept:
+                frame.metadata["stray_originals"] = kept
+            where = (
+                ""
+                if not kept
+                else f"; {'it is' if len(kept) == 1 else f'{len(kept)} are'} kept aside in the "
+                "session's strays/ (the step's 'strays' in the journal), never as an image"
+            )
             frame.metadata["notices"] = [
                 *(frame.metadata.get("notices") or []),
                 f"{len(pending.stray)} file(s) came into the watched folder before this shot's "
                 f"trigger and were not used: {', '.join(pending.stray)} (a duplicate or a shot "
-                "no light asked for)",
+                f"no light asked for){where}",
             ]
         if pending.unconfirmed is not None:
             frame.metadata["trigger_unconfirmed"] = pending.unconfirmed
@@ -384,6 +393,26 @@ class FolderWatchCamera:
                 "the trigger's confirmation was lost but the camera's file arrived",
             ]
         return frame
+
+    def _hold_strays(self, names: list[str]) -> list[dict[str, str]]:
+        """Copy the files set aside before a pulse into the session, as the session's
+        ``stray_originals`` (kept in ``strays/``, recorded in the step's ``strays``); those
+        gone from the folder meanwhile are left out. Done once the shot is collected, its
+        light off (a copy before the pulse had kept the LED lit for it).
+
+        Why: such a file is a picture of the object, at a moment and under a light rti-rig
+        cannot vouch for: never an image, but kept, as a DSLR's stray is; it had been named in
+        a notice only, and the session held no copy of it."""
+        if self.output_dir is None:
+            return []
+        kept = []
+        for name in names:
+            try:
+                copy = self._hold(self.settings.folder / name)
+            except CaptureError:
+                continue  # moved out of the folder meanwhile: named in the notice all the same
+            kept.append({"path": str(copy), "name": name})
+        return kept
 
     def _decode_complete(self, path: Path, exposure_s: float, started: float) -> Frame:
         """Decode ``path``; one that will not decode gets ``timeout_s`` to change and is tried

@@ -689,3 +689,54 @@ def test_folder_watch_keeps_the_shot_another_program_moves_out_of_the_folder(
         kept = (out / "raw" / f"image_{i:03d}.dng").read_bytes()
         assert kept == (library / f"_DSC{i:04d}.DNG").read_bytes()
     assert not any((out / "raw" / ".incoming").iterdir())
+
+
+@pytest.mark.parametrize("dome", [WATCH_CONFIG], indirect=True)
+def test_folder_watch_keeps_a_file_set_aside_before_a_pulse_in_strays(dome, tmp_path, monkeypatch):
+    """A file that came into the watched folder besides the shot's (a test shot the owner
+    took, a duplicate) is set aside at the next pulse, never that light's image. It had been
+    named in a notice only, the session holding no copy; now it is kept in strays/ and
+    recorded in the step's strays with its checksum, as a DSLR's stray is."""
+    import os
+
+    monkeypatch.setenv("HOME", str(tmp_path))
+    watched = tmp_path / "Pictures" / "rti-tether"
+    watched.mkdir(parents=True)
+    render = render_for(dome)
+    stop = threading.Event()
+
+    def tethering_program() -> None:
+        seen = 0
+        while not stop.is_set():
+            pulses = [e for e in list(dome.history) if e.what == "shutter"]
+            for _ in pulses[seen:]:
+                seen += 1
+                shot = watched / f"_DSC{seen:04d}.DNG"
+                shot.write_bytes(render())
+                if seen == 1:  # the owner's test shot, saved after the first shot's file
+                    extra = watched / "_DSC9000.DNG"
+                    extra.write_bytes(b"II*\0 the owner's test shot")
+                    later = shot.stat().st_mtime_ns + 10**9
+                    os.utime(extra, ns=(later, later))
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=tethering_program, daemon=True)
+    thread.start()
+    try:
+        out = tmp_path / "s"
+        result = run(str(WATCH_CONFIG), "--out", str(out), "--lights", "4")
+    finally:
+        stop.set()
+        thread.join(2)
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, said
+    check_images(out)
+    entries = journal(out)
+    names = [next(iter(e["originals"].values())) for e in entries]
+    assert names == [f"_DSC{i:04d}.DNG" for i in range(1, 5)]
+    strays = {s: kept for e in entries for s, kept in e["strays"].items()}
+    assert list(strays) == ["strays/image_002-_DSC9000.DNG"], strays
+    kept = (out / "strays" / "image_002-_DSC9000.DNG").read_bytes()
+    assert kept == b"II*\0 the owner's test shot"
+    assert strays["strays/image_002-_DSC9000.DNG"]["camera_file"] == "_DSC9000.DNG"
+    assert "_DSC9000.DNG" in said and "strays/" in said, said
