@@ -36,6 +36,7 @@ Safe state: nothing to release (no device handle); ``close`` forgets the seen fi
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 from collections.abc import Callable
@@ -394,6 +395,16 @@ class FolderWatchCamera:
             ]
         return frame
 
+    def _drop_copy(self, held: Path) -> None:
+        """Delete a copy :meth:`_hold` made, and the folders it made for it if they are left
+        empty (``raw/.incoming``, ``raw/``): a session whose first file would not decode
+        then holds no camera file, and the run says it may be used again (an empty ``raw/``
+        had it say "holds files of the camera … Continue with: rti-rig run --resume")."""
+        held.unlink(missing_ok=True)
+        for folder in (held.parent, held.parent.parent):
+            with contextlib.suppress(OSError):  # not empty: another file is kept there
+                folder.rmdir()
+
     def _hold_strays(self, names: list[str]) -> list[dict[str, str]]:
         """Copy the files set aside before a pulse into the session, as the session's
         ``stray_originals`` (kept in ``strays/``, recorded in the step's ``strays``); those
@@ -431,7 +442,7 @@ class FolderWatchCamera:
                 return self._decode(held, exposure_s, started, path)
             except CaptureError as exc:
                 if held != path and _identity(path) is not None:
-                    held.unlink(missing_ok=True)  # the folder's file stays; the copy is no use
+                    self._drop_copy(held)  # the folder's file stays; the copy is no use
                 # the decoders' own refusals: LibRaw's, or a TIFF/PNG that would not read (not
                 # this camera's, of a whole file: 8-bit data, a wrong exposure)
                 if exc.device != DECODER and exc.command != "read":

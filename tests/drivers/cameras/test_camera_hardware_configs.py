@@ -571,6 +571,9 @@ def test_folder_watch_of_a_raw_libraw_does_not_read_says_so_at_once(dome, tmp_pa
     assert "it is left in" in said and "rti-tether" in said, said
     assert "stable_polls or poll_interval_s" not in said, said
     assert sum(e.what == "shutter" for e in dome.history) == 1
+    # the session's copy of the file is dropped with the folders made for it: nothing kept
+    assert "may be used again" in said and "--resume" not in said, said
+    assert (watched / "IMG_0001.CR2").is_file()
 
 
 def test_a_card_filled_by_the_kept_copies_says_so_naming_the_key(body, tmp_path):
