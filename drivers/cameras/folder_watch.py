@@ -528,10 +528,20 @@ class FolderWatchCamera:
         else:
             image = read_image_file(path, self.name)
             if image.dtype == np.uint8 and s.eight_bit_response == "refuse":
+                raw = [x for x in s.patterns if Path(x).suffix.lower() in RAW_SUFFIXES]
+                # patterns matching RAWs too: a camera saving RAW+JPEG whose JPEG came first
+                # and was whole before its RAW appeared (being told to "save RAW" it already
+                # did, the owner had nothing to change)
+                fix = (
+                    f"patterns {list(s.patterns)} match RAW files too: a camera saving RAW+JPEG "
+                    f"may write its JPEG first, so match only the RAW (keep {raw} in patterns "
+                    "in [camera.device])"
+                    if raw
+                    else "save RAW or 16-bit TIFF, or set eight_bit_response = 'srgb'"
+                )
                 raise CaptureError(
                     self.name,
-                    f"{path.name} is 8-bit (gamma-encoded), not linear data: save RAW or 16-bit "
-                    "TIFF, or set eight_bit_response = 'srgb'",
+                    f"{path.name} is 8-bit (gamma-encoded), not linear data: {fix}",
                     "decode",
                 )
             response = "linear" if s.eight_bit_response == "refuse" else s.eight_bit_response

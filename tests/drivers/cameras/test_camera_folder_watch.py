@@ -342,3 +342,36 @@ def test_a_folder_that_went_away_is_said_at_the_timeout(tmp_path):
     assert str(share) in said and "no longer there or cannot be reached" in said
     assert "network share" in said and "--resume" in said
     assert "is the camera firing" not in said
+
+
+def test_a_raw_plus_jpeg_camera_whose_jpeg_comes_first_is_told_to_match_the_raw(tmp_path):
+    """Patterns matching a RAW+JPEG camera's two files, its JPEG whole before its RAW appears:
+    the JPEG is taken (8-bit), and the refusal had said "save RAW or 16-bit TIFF" to an owner
+    whose camera saves RAW; it now says to match only the RAW, naming the patterns."""
+    import cv2
+
+    clock = ScriptedClock(
+        {
+            0.5: lambda: cv2.imwrite(
+                str(tmp_path / "IMG_0001.JPG"), np.full((32, 32, 3), 100, np.uint8)
+            ),
+            1.0: lambda: dng(tmp_path / "IMG_0001.CR2"),
+        }
+    )
+    cam = watch(tmp_path, clock, patterns=("*.CR2", "*.JPG"))
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "IMG_0001.JPG is 8-bit" in said and "match only the RAW" in said
+    assert "keep ['*.CR2'] in patterns" in said and "save RAW" not in said
+    # a folder watched for JPEGs alone: the advice stands
+    only = tmp_path / "jpeg"
+    only.mkdir()
+    clock = ScriptedClock(
+        {0.5: lambda: cv2.imwrite(str(only / "a.jpg"), np.full((32, 32, 3), 9, np.uint8))}
+    )
+    cam = watch(only, clock, patterns=("*.jpg",))
+    cam.connect()
+    with pytest.raises(CaptureError, match="save RAW or 16-bit TIFF"):
+        cam.capture(0.5)
