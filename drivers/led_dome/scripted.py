@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import math
 import re
+from typing import Any
 
 from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
 from rti_rig.drivers.led_dome.protocol_spec import CommandSpec, ProtocolSpec
@@ -243,6 +244,57 @@ class ScriptedDomeDriver:
             )
         theirs._rx.clear()
         theirs.all_off()
+
+    @property
+    def published_baudrate(self) -> int | None:
+        """The baud rate this built-in profile's firmware talks at as published, when the port
+        is set to another (a ``baudrate`` left from the example config); None when it is not,
+        when the description is not a built-in profile, or the transport has no baud rate (an
+        in-process emulator)."""
+        from rti_rig.drivers.led_dome.dome_profiles import (
+            any_baudrate,
+            builtin_spec,
+            described_profiles,
+        )
+
+        name = self.spec.name
+        port_rate = getattr(self.transport, "baudrate", None)
+        if name not in described_profiles() or any_baudrate(name) or port_rate is None:
+            return None
+        own = int(builtin_spec(name)["baudrate"])
+        return None if own == int(port_rate) else own
+
+    def switch_off_at_published_rate(self) -> OffOutcome:
+        """Reopen the port at :attr:`published_baudrate`, wait for the board to boot and send
+        this profile's all-off there; the port is closed again and set back to its rate.
+        Returns what the all-off established; a :class:`DomeLinkError` if it was not
+        acknowledged (or the port could not be reopened).
+
+        Why: the Nab sketch lights every LED in ``setup()``, and its Uno-class board resets when
+        the port opens. At a wrong baud rate the all-off after the failed connect is garbage to
+        it, and the board was left lit whole. Reopening resets it once more (lit for its boot),
+        and its all-off at the rate its firmware is published with then switches it off, and is
+        acknowledged, if the board is that firmware's at that rate."""
+        rate = self.published_baudrate
+        if rate is None:
+            raise self._error(
+                "the port is already at this firmware's published baud rate",
+                "all off",
+                LinkFault.REJECTED,
+            )
+        transport: Any = self.transport
+        spec, port_rate = self.spec, transport.baudrate
+        self.close()
+        transport.baudrate = rate
+        self.spec = spec.model_copy(update={"baudrate": rate})
+        try:
+            self.connect()  # the boot wait, then the init (the Nab sketch's is its all-off)
+            self.all_off()
+        finally:
+            self.close()
+            transport.baudrate = port_rate
+            self.spec = spec
+        return self.off_outcome
 
     def finish_boot(self) -> None:
         """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same

@@ -150,12 +150,18 @@ class OffReport:
     #: after the port opened (which resets such a board): "lights may still be on" understated
     #: a dome that, if it is that board, is fully lit. None: not such a case.
     boots_lit: str | None = None
+    #: The baud rate (the firmware's published one) the port was reopened at to send the
+    #: all-off again, after the one at the configured rate went unanswered on a firmware that
+    #: boots lit; ``outcome`` is then what that second all-off established. None: no reopening.
+    reopened_at: int | None = None
 
     @property
     def lights_known_off(self) -> bool:
         return self.outcome in (OffOutcome.ACKNOWLEDGED, OffOutcome.SELF_TIMED)
 
     def sentence(self) -> str:
+        if self.reopened_at is not None:
+            return self._reopened_sentence()
         said = self._sentence()
         if self.boots_lit and self.outcome in (OffOutcome.SENT_UNCONFIRMED, OffOutcome.NOT_SENT):
             said += (
@@ -164,6 +170,24 @@ class OffReport:
                 "now; switch the dome off at its power supply"
             )
         return said
+
+    def _reopened_sentence(self) -> str:
+        """What two all-offs established: the one at the configured rate, unanswered, and the
+        one after reopening at the firmware's published rate (which reset the board again)."""
+        firmware = self.boots_lit or "profile's"
+        said = (
+            "all-off sent at the configured baud rate but not acknowledged; the port was then "
+            f"reopened at {self.reopened_at} baud, the {firmware} firmware's published rate "
+            "(which resets the board: every LED lit while it booted), and its all-off sent "
+            "there"
+        )
+        if self.outcome is OffOutcome.ACKNOWLEDGED:
+            return f"{said} was acknowledged: lights are off"
+        why = f" ({self.detail})" if self.detail else ""
+        return (
+            f"{said} was not acknowledged either{why}: if this is a {firmware} board, every LED "
+            "is on now; switch the dome off at its power supply"
+        )
 
     def _sentence(self) -> str:
         why = f" ({self.detail})" if self.detail else ""

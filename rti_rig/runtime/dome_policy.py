@@ -289,7 +289,11 @@ class DomePolicy:
                     self._port_was_open = True
                 # A board that answered nothing we understood may still be lit (one sketch
                 # boots with every LED on): send the all-off anyway wherever the port is open.
-                self._attempt_off(f"after the failed connection ({exc.message})", after_open=True)
+                self._attempt_off(
+                    f"after the failed connection ({exc.message})",
+                    after_open=True,
+                    at_published_rate=not answered,
+                )
             self._quiet_close()
             if exc.command == "open port" and exc.port_held:
                 # the board is there and may be lit by the program using it: "check that the
@@ -335,7 +339,7 @@ class DomePolicy:
                 self.name,
                 f"no handshake with the dome ({exc.message}); check the port, the baud rate and "
                 f"the protocol profile in the rig config, and that the board is powered"
-                f"{self._link_hint()}{silent_boot}",
+                f"{self._link_hint()}{silent_boot}{self._reopened_hint()}",
                 exc.command,
             ) from exc
         except BaseException:
@@ -1018,12 +1022,34 @@ class DomePolicy:
         hint = self.settings.link_hint
         return f" ({hint})" if hint else ""
 
-    def _attempt_off(self, when: str, after_open: bool = False) -> None:
+    def _reopened_hint(self) -> str:
+        """The end of a failed connect's advice when the all-off after it reached the board
+        only at the firmware's published baud rate: then that rate is established, not guessed."""
+        report = self.off_report
+        if report is None or report.reopened_at is None:
+            return ""
+        if report.outcome is not OffOutcome.ACKNOWLEDGED:
+            return ""
+        return (
+            f"; reopened at {report.reopened_at} baud to switch it off, the board acknowledged "
+            f"its all-off there: it talks at {report.reopened_at} baud"
+        )
+
+    def _attempt_off(
+        self, when: str, after_open: bool = False, *, at_published_rate: bool = False
+    ) -> None:
         """One all-off, whatever state the link is in; record what it established.
 
         ``after_open``: the port was opened by the connect that failed, which resets a board
         that resets on open; on a firmware that boots lit (``boots_lit``, the Nab sketch) a
-        failed all-off then leaves every LED on if the board is that one, and is said so."""
+        failed all-off then leaves every LED on if the board is that one, and is said so.
+
+        ``at_published_rate`` (a failed connect where the board spoke nothing of its profile):
+        on such a firmware, an all-off that went unanswered at a port rate other than the
+        firmware's published one is sent again after reopening the port at that rate (the
+        link's ``switch_off_at_published_rate``). At the wrong rate the all-off is garbage to the
+        board, which the opening had lit whole: it was left so, the user told to cut its power.
+        The reopening resets the board once more (lit while it boots), then switches it off."""
         spec = getattr(self.link, "spec", None)
         lit_at_boot = (
             str(getattr(spec, "name", ""))
@@ -1038,6 +1064,8 @@ class DomePolicy:
                 return
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = replace(_failed_off(exc), boots_lit=lit_at_boot)
+            if at_published_rate and lit_at_boot and exc.fault is not LinkFault.DISCONNECTED:
+                self._switch_off_at_published_rate(lit_at_boot)
         except DeviceError as exc:
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = OffReport(
@@ -1047,6 +1075,27 @@ class DomePolicy:
             self.off_report = OffReport(
                 getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED), when
             )
+
+    def _switch_off_at_published_rate(self, firmware: str) -> None:
+        """See :meth:`_attempt_off`; records what the second all-off established."""
+        rate = getattr(self.link, "published_baudrate", None)
+        switch = getattr(self.link, "switch_off_at_published_rate", None)
+        if rate is None or switch is None:
+            return
+        log.warning(
+            "%s: reopening the port at %d baud, the %s firmware's published rate, to switch the "
+            "board off (it boots with every LED lit)",
+            self.name,
+            rate,
+            firmware,
+        )
+        try:
+            outcome = self._counted(switch)
+        except DomeLinkError as exc:
+            log.warning("%s: all off at %d baud failed: %s", self.name, rate, exc)
+            self.off_report = replace(_failed_off(exc), boots_lit=firmware, reopened_at=rate)
+            return
+        self.off_report = OffReport(outcome, boots_lit=firmware, reopened_at=rate)
 
     def _switch_off_foreign(self, when: str) -> None:
         """Send the all-off of the firmware whose banner the board printed (the link's

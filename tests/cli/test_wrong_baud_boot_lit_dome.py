@@ -1,11 +1,13 @@
-"""A Nab board that the connect's all-off did not reach is said to be fully lit, if it is one.
+"""A Nab board at a wrong baud rate is switched off at its firmware's published rate.
 
 The Nab sketch lights every LED in ``setup()``, and its Uno-class board resets when the port
 opens. At a wrong ``baudrate`` (115200 left from the example config) nothing the host sends
-reaches the sketch: the check's lights line said "lights may still be on; check the dome" of
-a dome the opening had just lit whole. It now says that this firmware lights every LED at
-boot, that opening the port resets the board, and to switch the dome off at its supply. The
-emulator's record is the truth: every LED is lit at the end.
+reaches the sketch, and the all-off after the failed connect is garbage to it: the board was
+left lit whole, the user told to switch it off at its supply. The port is now reopened at the
+firmware's published rate (9600; the board resets again, lit while it boots) and its all-off
+sent there: the report says it was acknowledged and that the board talks at 9600. A board that
+answers at neither rate (a sketch changed to another rate) is still said to be lit whole. The
+emulator's record is the truth.
 """
 
 from __future__ import annotations
@@ -28,14 +30,13 @@ pytestmark = [
 ]
 
 
-def test_a_nab_board_at_a_wrong_baud_rate_is_said_to_be_lit_whole(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def _check(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, board_baud: int) -> tuple:  # type: ignore[type-arg]
     boards: list = []  # type: ignore[type-arg]
     real_build = compose.build_rig
 
     def build(*args, **kwargs):  # type: ignore[no-untyped-def]
         rig = real_build(*args, **kwargs)
+        rig.emulator.baudrate = board_baud  # the rate the sketch was built with
         boards.append(rig.emulator)
         return rig
 
@@ -47,9 +48,30 @@ def test_a_nab_board_at_a_wrong_baud_rate_is_said_to_be_lit_whole(
         text.replace('profile = "nab-rti-v1"', 'profile = "nab-rti-v1"\nbaudrate = 115200')
     )
     r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
-    said = " ".join(r.output.split())
-    assert r.exit_code == 1, said
-    assert "the nab-rti-v1 firmware lights every LED as its board boots" in said, said
-    assert "switch the dome off at its power supply" in said
     (board,) = boards
+    return r.exit_code, " ".join(r.output.split()), board
+
+
+def test_a_nab_board_at_a_wrong_baud_rate_is_switched_off_at_its_published_rate(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    code, said, board = _check(tmp_path, monkeypatch, 9600)
+    assert code == 1, said
+    assert "reopened at 9600 baud, the nab-rti-v1 firmware's published rate" in said, said
+    assert "its all-off sent there was acknowledged: lights are off" in said
+    assert "the board acknowledged its all-off there: it talks at 9600 baud" in said
+    assert "power supply" not in said
+    # the truth: booted twice (lit whole each time), and dark at the end
+    assert [what for _, what in board.events].count("boot") == 2
+    assert board.lit == frozenset()
+
+
+def test_a_board_silent_at_both_rates_is_still_said_to_be_lit_whole(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    code, said, board = _check(tmp_path, monkeypatch, 19200)
+    assert code == 1, said
+    assert "reopened at 9600 baud" in said and "was not acknowledged either" in said, said
+    assert "every LED is on now; switch the dome off at its power supply" in said
+    assert "it talks at 9600" not in said
     assert len(board.lit) > 1  # the truth: the board is lit whole
