@@ -70,6 +70,10 @@ class ArmSelfTestReport:
     #: whether the teardown's stop succeeded (every joint held): only then is the arm said to
     #: have been stopped
     stopped: bool = True
+    #: the device's own words of the error that aborted the walk (its fault and what to do),
+    #: said in full once, under ABORTED: the failed pose's row and a teardown that met the
+    #: same fault point back to it (one overload's paragraph had been printed three times)
+    aborted_detail: str | None = None
 
     @property
     def ok(self) -> bool:
@@ -99,7 +103,8 @@ class ArmSelfTestReport:
         for c in self.checks:
             az, el = c.asked_az_el
             if c.reached_az_el is None:
-                out.append(f"  {c.label:18s} {az:7.2f}°/{el:5.2f}°  FAIL {c.message}")
+                said = "see ABORTED below" if c.message == self.aborted else c.message
+                out.append(f"  {c.label:18s} {az:7.2f}°/{el:5.2f}°  FAIL {said}")
                 continue
             raz, rel = c.reached_az_el
             verdict = "ok" if c.ok else f"FAIL {c.message}"
@@ -126,7 +131,7 @@ class ArmSelfTestReport:
                 f"ABORTED: {self.aborted} (not parked: the arm was stopped where it was"
                 + ("; see the teardown below)" if self.teardown_failures else ")")
             )
-        out.extend(f"teardown FAILED: {f}" for f in self.teardown_failures)
+        out.extend(f"teardown FAILED: {self._said_once(f)}" for f in self.teardown_failures)
         if self.parked:
             out.append("parked")
         else:
@@ -134,6 +139,15 @@ class ArmSelfTestReport:
         out.append(f"elapsed {self.elapsed_s:.1f} s on the rig's clock")
         out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
+
+    def _said_once(self, text: str) -> str:
+        """``text`` with the aborting error's explanation, said in full under ABORTED,
+        shortened to its first clause (the fault itself) and a pointer back."""
+        detail = self.aborted_detail
+        if not detail or len(detail) < 60 or detail not in text:
+            return text
+        head = detail.split(";", 1)[0]
+        return text.replace(detail, f"{head} (as under ABORTED above)")
 
 
 def not_connected_sentence(carrier: object, connected: bool | None = None) -> str | None:
@@ -237,6 +251,7 @@ def arm_self_test(
             str(exc) if isinstance(exc, RtiRigError) else f"{type(exc).__name__}: {exc}"
         )
         report.not_connected = not_connected_sentence(carrier, connected)
+        report.aborted_detail = getattr(exc, "message", None)
     except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
         report.aborted = f"stopped ({exc})"
         exc.self_test_report = report  # type: ignore[attr-defined]

@@ -54,6 +54,11 @@ def test_check_on_a_servo_that_overloads_stops_names_it_and_leaves_it_unparked(
     assert "servo 2: hardware fault overload (Hardware Error Status 0x20)" in said, said
     assert "send Reboot from Dynamixel Wizard 2.0" in said
     assert "NOT parked" in said and "RESULT: FAIL" in said
+    # the fault's paragraph is said once (it was printed three times: the pose's row, ABORTED
+    # and the teardown's stop), and the teardown still says what it met
+    assert said.count("clear the obstruction") == 1, said
+    assert said.count("servo 2: hardware fault overload") == 2  # ABORTED, then the pointer
+    assert "(as under ABORTED above)" in said and "(the arm may sag)" in said
     (emu,) = emulators
     servo = emu.servos[2]
     # the servo as a real one: shut down (torque off), its error latched until a reboot
