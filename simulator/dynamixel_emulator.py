@@ -836,7 +836,10 @@ def arm_settings_of(config: str | None) -> tuple[Any, str]:
 
 @contextlib.contextmanager
 def served_arm(
-    settings: Any, clock: Clock, baudrate: int = 57600
+    settings: Any,
+    clock: Clock,
+    baudrate: int = 57600,
+    faults: Iterable[tuple[int, str, int | None]] = (),
 ) -> Iterator[tuple[Any, DynamixelBusEmulator]]:
     """``(server, emulator)``: the servos of ``settings`` (ids, models, modes) resting at its
     park pose, served on a pty for any client (the manual tool; a plain SDK ``PortHandler``).
@@ -845,6 +848,10 @@ def served_arm(
     X series); they answer only a host at that rate, as real servos do (ROBOTIS e-manual,
     Baud Rate: the host and the servo must use the same rate). The tool had always served
     57600, so a bus a user had set to 1 Mbps could not be rehearsed.
+
+    ``faults``: ``(K, kind, servo id or None)``, as a rig config's ``[[emulator.faults]]``
+    (:func:`parse_tool_fault`): the status of the K-th instruction packet lost or damaged, or
+    a servo's own hardware error raised as it arrives.
 
     The tool had served two XL430s at 2048 ticks each: on the shipped arm's geometry
     (elevation zero at 1024 ticks) that is 90° elevation, inside every keep-out cone, so a
@@ -861,8 +868,49 @@ def served_arm(
     emulator = emulator_for_arm(settings, clock)
     for servo in emulator.servos.values():
         servo._set(ct.BAUD_RATE, codes[baudrate])
+    for at, kind, dxl_id in faults:
+        if kind in HARDWARE_FAULT_BITS:
+            emulator.hardware_faults[at] = (int(dxl_id or 0), kind)
+        else:
+            emulator.reply_faults[at] = kind
     with PtyServoServer(emulator) as server:
         yield server, emulator
+
+
+#: What the manual tool's ``--fault`` takes, as a rig config's ``[[emulator.faults]]`` on an
+#: arm: a status packet lost or damaged, or a servo's own hardware error.
+TOOL_FAULT_KINDS = ("drop_reply", "garble_reply", *HARDWARE_FAULT_BITS)
+
+
+def parse_tool_fault(spec: str, servo_ids: Iterable[int]) -> tuple[int, str, int | None]:
+    """``K:KIND`` (a status lost or damaged) or ``K:KIND:ID`` (servo ID's hardware error) as
+    ``(K, kind, id or None)``; a ValueError that says what to give otherwise.
+
+    Why: the dome firmware tool took ``--fault`` and this one did not, so a servo's overload
+    could be rehearsed through a rig config's ``[[emulator.faults]]`` but not on the served
+    pty a user points a hardware config at."""
+    ids = sorted(servo_ids)
+    parts = spec.split(":")
+    usage = (
+        f"--fault {spec}: give K:KIND or, for a servo's hardware error, K:KIND:ID (K the "
+        f"instruction packet, 1 = the first; KIND one of {', '.join(TOOL_FAULT_KINDS)}; ID "
+        f"one of {', '.join(map(str, ids))})"
+    )
+    if len(parts) not in (2, 3) or parts[1] not in TOOL_FAULT_KINDS:
+        raise ValueError(usage)
+    try:
+        at = int(parts[0])
+        dxl_id = int(parts[2]) if len(parts) == 3 else None
+    except ValueError:
+        raise ValueError(usage) from None
+    kind = parts[1]
+    if at < 1:
+        raise ValueError(usage)
+    if kind in HARDWARE_FAULT_BITS and dxl_id not in ids:
+        raise ValueError(f"{usage}: {kind} is a servo's own error, so it needs the servo's id")
+    if kind not in HARDWARE_FAULT_BITS and dxl_id is not None:
+        raise ValueError(f"{usage}: {kind} is the bus's, not a servo's: give no id")
+    return at, kind, dxl_id
 
 
 def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual tool
@@ -892,6 +940,16 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
         help="the baud rate the servos are set to (default 57600, the X series' factory rate); "
         "they answer only at it",
     )
+    parser.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="K:KIND[:ID]",
+        help="as [[emulator.faults]]: at the K-th instruction packet, the status lost or "
+        "damaged (drop_reply, garble_reply) or servo ID's hardware error (overload, "
+        "overheating, input_voltage, electrical_shock: the Alert bit until a Reboot, torque "
+        "off where its Shutdown selects it); repeatable",
+    )
     args = parser.parse_args(argv)
     if args.baud not in ct.BAUD_CODES.values():
         parser.error(
@@ -902,9 +960,14 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
         settings, where = arm_settings_of(args.config)
     except ValueError as exc:
         parser.error(str(exc))
+    ids = (settings.azimuth.servo_id, settings.elevation.servo_id)
+    try:
+        faults = [parse_tool_fault(spec, ids) for spec in args.fault]
+    except ValueError as exc:
+        parser.error(str(exc))
     signal.signal(signal.SIGTERM, signal.default_int_handler)  # remove the pty on SIGTERM too
     factory = " (a new servo's factory rate)" if args.baud == 57600 else ""
-    with served_arm(settings, SystemClock(), args.baud) as (server, _):
+    with served_arm(settings, SystemClock(), args.baud, faults) as (server, _):
         ids = ", ".join(
             f"{j.servo_id} ({name}, model {j.model_number})"
             for name, j in (("azimuth", settings.azimuth), ("elevation", settings.elevation))
@@ -921,6 +984,9 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
             "Ctrl-C stops the servos.",
             flush=True,
         )
+        for at, kind, dxl_id in faults:
+            whose = f"servo {dxl_id}'s {kind}" if dxl_id is not None else f"{kind} (its status)"
+            print(f"Fault: {whose} at instruction packet {at}", flush=True)
         if settings.baudrate != args.baud:
             print(
                 f"Note: the config's [arm.dynamixel] baudrate = {settings.baudrate}, but these "

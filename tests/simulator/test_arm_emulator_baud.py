@@ -50,3 +50,38 @@ def test_the_tool_says_the_rate_it_serves_and_refuses_one_no_servo_runs_at() -> 
     assert "baudrate = 57600, but these servos talk at 1000000" in out.stdout
     bad = subprocess.run([*run, "--baud", "38400"], capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and "--baud 38400" in bad.stderr
+
+
+def test_the_tool_raises_a_servos_hardware_error_as_emulator_faults_does() -> None:
+    """``--fault K:KIND[:ID]``, as ``[[emulator.faults]]``: the dome firmware tool took one and
+    this one did not, so an overload could not be rehearsed on the served pty."""
+    from rti_rig.drivers.dynamixel import control_table as ct
+    from rti_rig.simulator.dynamixel_emulator import parse_tool_fault
+
+    settings, _ = arm_settings_of(None)
+    fault = parse_tool_fault("2:overload:2", (1, 2))
+    assert fault == (2, "overload", 2)
+    with served_arm(settings, VirtualClock(), 57600, [fault]) as (server, emulator):
+        bus = DxlBus(server.port_handler(), "arm on A")
+        bus.open(57600)
+        try:
+            assert bus.ping(2) == 1060  # packet 1: all well
+            bus.ping(1)  # packet 2: servo 2 overloads as it arrives
+            status = bus.read(2, ct.HARDWARE_ERROR_STATUS, check_alert=False)
+        finally:
+            bus.close()
+    assert status & ct.HardwareFault.OVERLOAD
+    assert emulator.servos[2].get(ct.TORQUE_ENABLE) == 0  # the XL430 shuts down for it
+    run = [sys.executable, "-m", "rti_rig.simulator.dynamixel_emulator", "--seconds", "0"]
+    out = subprocess.run(
+        [*run, "--fault", "60:overload:2", "--fault", "3:drop_reply"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.returncode == 0, out.stderr
+    assert "Fault: servo 2's overload at instruction packet 60" in out.stdout
+    bad = subprocess.run(
+        [*run, "--fault", "60:overload"], capture_output=True, text=True, timeout=120
+    )
+    assert bad.returncode == 2 and "needs the servo's id" in bad.stderr
