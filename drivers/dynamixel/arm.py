@@ -18,6 +18,7 @@ limits only.
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -50,6 +51,55 @@ log = logging.getLogger("rti_rig.dynamixel.arm")
 #: most likely first: the factory 57600, then the 1 Mbps of many older Protocol 1.0 servos and
 #: of users who raise it, then the rest; 9600 last, its broadcast Ping waiting about 4.4 s.
 _RATES_TO_TRY = (57600, 1_000_000, 115200, 2_000_000, 3_000_000, 4_000_000, 4_500_000, 9600)
+
+
+@dataclass(frozen=True)
+class RebootOutcome:
+    """What :meth:`DynamixelArm.reboot_faulted` established of one joint's servo."""
+
+    role: str
+    servo_id: int
+    #: Hardware Error Status as read before (0: no fault, nothing done)
+    status_before: int
+    rebooted: bool
+    #: Hardware Error Status read back after the reboot (None: not rebooted)
+    status_after: int | None = None
+    #: Torque Enable as read (after the reboot; before it for one left alone)
+    torque_on: bool = False
+
+    @property
+    def cleared(self) -> bool:
+        """No fault is left on this servo (none was there, or the reboot cleared it)."""
+        return self.status_before == 0 or (self.rebooted and self.status_after == 0)
+
+    def sentence(self) -> str:
+        who = f"servo {self.servo_id} ({self.role})"
+        if not self.status_before:
+            return f"{who}: no hardware fault (Hardware Error Status 0x00): not rebooted"
+        faults = _fault_names(self.status_before)
+        if not self.rebooted:
+            return (
+                f"{who}: hardware fault {faults} (0x{self.status_before:02X}) but its torque "
+                "is on (it still holds its joint): NOT rebooted, as a reboot switches torque "
+                "off and the joint would drop; support the arm, then switch the servos' power "
+                "off and on"
+            )
+        assert self.status_after is not None
+        if self.status_after:
+            return (
+                f"{who}: hardware fault {faults} (0x{self.status_before:02X}); rebooted, but "
+                f"it is still set (Hardware Error Status 0x{self.status_after:02X}): its cause "
+                "remains (see the advice rti-rig check gives for it)"
+            )
+        return (
+            f"{who}: hardware fault {faults} (0x{self.status_before:02X}); rebooted, Hardware "
+            "Error Status read back 0x00, torque "
+            + ("ON as read (unexpected)" if self.torque_on else "off (the joint is limp)")
+        )
+
+
+def _fault_names(status: int) -> str:
+    return ", ".join(f.name.lower().replace("_", " ") for f in ct.decode_hardware_error(status))
 
 
 class DynamixelArm:
@@ -648,6 +698,47 @@ class DynamixelArm:
             self._wait_restarted(joint)
         self._bus.close()
         self.connect()
+
+    def reboot_faulted(self) -> list[RebootOutcome]:
+        """Reboot only the servos whose Hardware Error Status is set and whose torque is off,
+        wait until each answers again, and read its status and torque back; nothing else is
+        written and no torque is switched on (the port is closed again: a ``connect``, through
+        every check, is what drives the arm next). One per joint, in the config's order.
+
+        Why: no command cleared a servo's fault (overload …), though its Reboot instruction
+        does (ROBOTIS e-manual, Shutdown (63): "REBOOT is the only method to reset Torque
+        Enable(64) to '1' after the shutdown"); users were sent to a power cycle or Dynamixel
+        Wizard. A faulted servo whose torque is still on (an input-voltage error the XL430's
+        Shutdown does not select) is not rebooted: a reboot switches its torque off, and the
+        joint it holds would drop."""
+        if self._connected:
+            raise DynamixelError(
+                self.name, "the arm is connected: close it before rebooting", "reboot faulted"
+            )
+        self._bus.open(self.settings.baudrate)
+        out: list[RebootOutcome] = []
+        try:
+            for joint in self.settings.joints:
+                sid, role = joint.servo_id, self._role(joint)
+                try:
+                    self._bus.ping(sid)
+                except CommunicationError as exc:
+                    raise self._unanswered(joint, exc) from exc
+                status = self._bus.read(sid, ct.HARDWARE_ERROR_STATUS, check_alert=False)
+                if not status:
+                    out.append(RebootOutcome(role, sid, 0, rebooted=False))
+                    continue
+                if self._bus.read(sid, ct.TORQUE_ENABLE, check_alert=False):
+                    out.append(RebootOutcome(role, sid, status, rebooted=False, torque_on=True))
+                    continue
+                self._bus.reboot(sid)
+                self._wait_restarted(joint)
+                after = self._bus.read(sid, ct.HARDWARE_ERROR_STATUS, check_alert=False)
+                torque = bool(self._bus.read(sid, ct.TORQUE_ENABLE, check_alert=False))
+                out.append(RebootOutcome(role, sid, status, True, after, torque))
+        finally:
+            self._bus.close()
+        return out
 
     def _wait_restarted(self, joint) -> None:  # type: ignore[no-untyped-def]
         """Ping ``joint``'s servo until it answers, for at most :attr:`REBOOT_WAIT_S` on the

@@ -153,8 +153,8 @@ FAULT_ADVICE = {
 #: faults and nothing for others: an overheated servo, told only to cool down, was refused
 #: again once cool, its fault still latched.
 REBOOT_HOW = (
-    "then switch the servos' power off and on (or send Reboot from Dynamixel Wizard 2.0) to "
-    "clear it"
+    "then run rti-rig check RIG.toml --reboot-faulted (it reboots the faulted servos whose "
+    "torque is off, and nothing moves), or switch the servos' power off and on, to clear it"
 )
 
 

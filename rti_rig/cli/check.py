@@ -60,6 +60,15 @@ def check(
     intensity: Annotated[
         float, typer.Option("--intensity", help="LED drive level for the walk, in (0, 1].")
     ] = 0.2,
+    reboot_faulted: Annotated[
+        bool,
+        typer.Option(
+            "--reboot-faulted",
+            help="Instead of the walk: reboot the arm's servos whose Hardware Error Status is "
+            "set (overload …) and whose torque is off, and read their status back. Nothing "
+            "moves and no torque is switched on; run check again afterwards.",
+        ),
+    ] = False,
 ) -> None:
     """Self-test the rig: a dome lights each LED in turn and reports what answered; an arm
     visits poses spanning its band (checking where it really got to), flashes the lamp at each
@@ -69,6 +78,9 @@ def check(
     from rti_rig.app.usecases.check import CheckRequest, CheckStopped, check_rig
     from rti_rig.runtime.controller import EmergencyStop
 
+    if reboot_faulted:
+        _reboot_faulted(rig_config)
+        return
     try:
         with stop_on_signals():
             out.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
@@ -85,6 +97,22 @@ def check(
         raise fail(exc) from None
     for line in report.lines():
         out.print(line, highlight=False, markup=False)  # a message may quote [a.table]
+    if not report.ok:
+        raise typer.Exit(code=1)
+
+
+def _reboot_faulted(rig_config: Path) -> None:
+    """``check --reboot-faulted``: print what the reboot established; exit 1 if a fault is
+    left."""
+    from rti_rig.app.usecases.check import reboot_faulted
+
+    out.print(f"Rebooting the faulted servos of {escape(str(rig_config))} (torque stays off)…")
+    try:
+        report = reboot_faulted(rig_config)
+    except RtiRigError as exc:
+        raise fail(exc) from None
+    for line in report.lines():
+        out.print(line, highlight=False, markup=False)
     if not report.ok:
         raise typer.Exit(code=1)
 

@@ -248,9 +248,10 @@ def test_injected_hardware_error_surfaces_by_name(fault, name) -> None:
         bus.write(2, ct.LED, 1)
     assert info.value.fault_names == [name] and info.value.servo_id == 2
     assert name.split("_")[0] in str(info.value).lower() and "reboot" in str(info.value)
-    # how to reboot, as a user can (rti-rig has no reboot command; the fault stays latched):
-    # an overheated servo had only been told to cool down, and was refused again once cool
-    assert "; then switch the servos' power off and on" in str(info.value)
+    # how to reboot, as a user can (the fault stays latched): an overheated servo had only
+    # been told to cool down, and was refused again once cool
+    assert "; then run rti-rig check RIG.toml --reboot-faulted" in str(info.value)
+    assert "or switch the servos' power off and on" in str(info.value)
     bus.reboot(2)
     clock.sleep(RESTART_S)  # silent while it restarts
     bus.write(2, ct.LED, 1)  # cleared

@@ -77,6 +77,51 @@ def check_rig(req: CheckRequest) -> Any:
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
 
 
+@dataclass(frozen=True)
+class RebootReport:
+    """What ``check --reboot-faulted`` established, servo by servo (``.lines()``, ``.ok``)."""
+
+    outcomes: tuple[Any, ...]
+    rig_config: Path
+
+    @property
+    def ok(self) -> bool:
+        return all(o.cleared for o in self.outcomes)
+
+    def lines(self) -> list[str]:
+        out = [o.sentence() for o in self.outcomes]
+        if not any(o.rebooted for o in self.outcomes):
+            out.append("nothing rebooted; no torque was switched on or off")
+        else:
+            out.append(
+                "no torque was switched on: the rebooted joints are limp until a check or run "
+                f"connects the arm (rti-rig check {self.rig_config} next, with the arm clear)"
+            )
+        out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
+        return out
+
+
+def reboot_faulted(rig_config: Path) -> RebootReport:
+    """Reboot the arm's servos whose Hardware Error Status is set (torque off), and read their
+    status back: nothing moves, and no torque is switched on (see
+    ``DynamixelArm.reboot_faulted``). Refused on a rig that has no Dynamixel arm."""
+    loaded = load_rig_config(rig_config)
+    if loaded.config.arm is None or loaded.config.backend not in ("emulated", "hardware"):
+        raise RtiRigError(
+            f"{rig_config}: --reboot-faulted reboots a Dynamixel arm's faulted servos; this rig "
+            "config has none (a dome, a simulated or a replay rig)"
+        )
+    with build_rig(loaded) as rig:
+        carrier = getattr(rig.lighting, "carrier", None)
+        reboot = getattr(carrier, "reboot_faulted", None)
+        if reboot is None:
+            raise RtiRigError(
+                f"{rig_config}: --reboot-faulted needs an arm on Dynamixel servos; this rig's "
+                "arm has none"
+            )
+        return RebootReport(tuple(reboot()), rig_config)
+
+
 def _lamp_notes(rig) -> tuple[str, ...]:  # type: ignore[no-untyped-def]
     """What the arm check says of a lamp it cannot switch: a real arm's lamp whose switch is
     outside the servo bus (``lamp = "software"``, the default). The check is said to flash the

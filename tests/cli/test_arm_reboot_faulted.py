@@ -1,0 +1,84 @@
+"""``rti-rig check RIG.toml --reboot-faulted`` clears a servo's hardware error, and nothing else.
+
+A servo that overloads latches its Hardware Error Status and (on the XL430, whose Shutdown
+selects overload) switches its torque off until a Reboot (ROBOTIS e-manual, Shutdown (63)).
+The driver had a ``reboot()``, but no command reached it: users were sent to a power cycle or
+Dynamixel Wizard. The option reboots only the faulted servos whose torque is off, reads their
+status back and says what it established; it writes no goal and switches no torque on, so the
+arm does not move: a later ``check`` or ``run`` connects it through every check.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+import rti_rig.app.compose as compose
+import rti_rig.app.usecases.check as check_usecase
+from rti_rig.cli import app
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel import protocol2 as p2
+
+runner = CliRunner()
+
+# the elevation servo overloads as the first instruction packet arrives (the arm already
+# faulted when rti-rig opens the port, as after a session that stopped on it)
+FAULT = '\n[[emulator.faults]]\nat_command = 1\nkind = "overload"\nservo_id = 2\n'
+
+
+def _config(tmp_path: Path) -> Path:
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace('transport = "pty"', 'transport = "inprocess"') + FAULT)
+    return cfg
+
+
+def test_reboot_faulted_clears_the_faulted_servo_only_and_moves_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    emulators: list = []  # type: ignore[type-arg]
+    real_build = compose.build_rig
+
+    def build(*args, **kwargs):  # type: ignore[no-untyped-def]
+        rig = real_build(*args, **kwargs)
+        emulators.append(rig.emulator)
+        return rig
+
+    monkeypatch.setattr(compose, "build_rig", build)
+    monkeypatch.setattr(check_usecase, "build_rig", build)
+    cfg = _config(tmp_path)
+    r = runner.invoke(app, ["check", str(cfg), "--reboot-faulted"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "Traceback" not in said
+    assert "servo 1 (azimuth): no hardware fault (Hardware Error Status 0x00): not rebooted" in (
+        said
+    )
+    assert (
+        "servo 2 (elevation): hardware fault overload (0x20); rebooted, Hardware Error Status "
+        "read back 0x00, torque off" in said
+    ), said
+    assert "RESULT: PASS" in said
+    (emu,) = emulators
+    # the truth: servo 2 alone was rebooted, its error cleared; nothing moved or was driven
+    reboots = [p.dxl_id for p in emu.instructions if p.instruction == p2.INST_REBOOT]
+    assert reboots == [2]
+    assert emu.servos[2].get(ct.HARDWARE_ERROR_STATUS) == 0
+    assert all(s.get(ct.TORQUE_ENABLE) == 0 for s in emu.servos.values())
+    assert emu.goal_log == []
+    writes = [p for p in emu.instructions if p.instruction == p2.INST_WRITE]
+    assert writes == []
+
+
+def test_reboot_faulted_is_refused_on_a_rig_without_dynamixel_servos() -> None:
+    r = runner.invoke(
+        app,
+        ["check", str(CONFIGS / "emulated_nab_rti_v1.toml"), "--reboot-faulted"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "--reboot-faulted reboots a Dynamixel arm's faulted servos" in said
