@@ -209,6 +209,11 @@ class EmulatedServo:
         self.restarting_until = float("-inf")
         #: the other axes of the same body (a 2XL430's second id): see :meth:`write`
         self.other_axes: list[EmulatedServo] = []
+        #: Where a joint carrying a load falls to once its torque goes off (ticks; None: it
+        #: stays where it is, as an unloaded joint does), and how fast (ticks/s): see
+        #: :meth:`_go_limp`. Set on the arm's elevation joint by :func:`emulator_for_arm`.
+        self.sag_to: float | None = None
+        self.sag_ticks_per_s = 0.0
         #: the writable RAM area (Torque Enable .. Goal Position) as at power-on, restored by a
         #: Reboot (:meth:`reboot`)
         self._ram_at_power_on = bytes(self.table[ct.EEPROM_END : ct.REALTIME_TICK.address])
@@ -269,6 +274,22 @@ class EmulatedServo:
         p = self._profile.position(now)
         self._profile = _Profile(p, p, now, 1.0, 1.0)
 
+    def _go_limp(self) -> None:
+        """Torque just went off: a loaded joint (:attr:`sag_to`) falls towards its rest at
+        :attr:`sag_ticks_per_s`, from where it is; an unloaded one stays put.
+
+        Why: a servo whose torque is off is back-driven by its load (ROBOTIS e-manual, Torque
+        Enable (64): with torque off the horn turns freely by an external force), and the
+        emulated arm had frozen where it was, so a sag under an overload (Shutdown (63): torque
+        off) was never seen through ``run``. The fall is modelled at a constant rate (gear
+        friction, no inertia), an assumption, not a measurement."""
+        self._freeze()
+        if self.sag_to is None or self.sag_ticks_per_s <= 0:
+            return
+        now = self.clock.now()
+        p = self._profile.position(now)
+        self._profile = _Profile(p, self.sag_to, now, self.sag_ticks_per_s, math.inf)
+
     # -- faults -----------------------------------------------------------------------------
     @property
     def shut_down(self) -> bool:
@@ -293,8 +314,11 @@ class EmulatedServo:
         self.table[ct.HARDWARE_ERROR_STATUS.address] |= bits
         if bits & self.get(ct.SHUTDOWN):
             self._shut_down = True
+            was_on = self.torque_on
             self._freeze()
             self.table[ct.TORQUE_ENABLE.address] = 0
+            if was_on:
+                self._go_limp()
 
     def set_input_voltage(self, decivolts: int) -> None:
         """The supply the servo sees (Present Input Voltage, 0.1 V).
@@ -323,7 +347,9 @@ class EmulatedServo:
         ("-"): the present position is modelled, as for a torque-on. A supply still outside
         the voltage limits raises its error again."""
         self._shut_down = False
-        self._freeze()
+        was_on = self.torque_on
+        if was_on:
+            self._freeze()  # a limp joint's motion is its load's: a reboot does not stop it
         # it answers nothing while it restarts (the Reboot's own status went out first)
         self.restarting_until = self.clock.now() + self.restart_s
         self.table[ct.EEPROM_END : ct.REALTIME_TICK.address] = self._ram_at_power_on
@@ -331,6 +357,8 @@ class EmulatedServo:
         self._registered = None
         # a supply still outside the limits is met again by the restarted servo
         self.set_input_voltage(self.get(ct.PRESENT_INPUT_VOLTAGE))
+        if was_on and not self.torque_on:
+            self._go_limp()  # a reboot under torque drops the joint it held
 
     # -- instructions -----------------------------------------------------------------------
     def status_error(self, number: int = 0) -> int:
@@ -409,9 +437,11 @@ class EmulatedServo:
         ):
             return p2.ERR_DATA_LIMIT
         # every check passed: the Write takes effect
+        limp = torque_bytes is not None and not torque_bytes[0] and self.torque_on
         if torque_bytes is not None:
             if not torque_bytes[0]:
-                self._freeze()
+                if self.torque_on:  # a limp joint's motion is its load's: not stopped here
+                    self._freeze()
             elif not self.torque_on:
                 # modelled: torque-on holds the present position (goal := present). Not
                 # verified against the e-manual; the driver writes goal := present first anyway
@@ -419,6 +449,8 @@ class EmulatedServo:
                 self._set(ct.GOAL_POSITION, round(self.position()))
         mode_before = self.get(ct.OPERATING_MODE)
         self.table[address:end] = data
+        if limp:
+            self._go_limp()
         if self.get(ct.OPERATING_MODE) != mode_before:
             self._set(ct.PROFILE_VELOCITY, 0)
             self._set(ct.PROFILE_ACCELERATION, 0)
@@ -733,6 +765,14 @@ class InProcessPort:
         return not self._rx
 
 
+#: How fast the emulated arm's elevation joint falls once its torque goes off (degrees of
+#: joint per second). Assumed, not measured: a lamp of a few hundred grams on a 0.45 m arm
+#: loads an XL430 near its stall torque (about 1.4 N·m at 12 V), so a back-driven joint falls
+#: in seconds, held back by its gear train's friction; the session's check after a capture
+#: is what meets it, and any rate of degrees per second is well past every tolerance.
+SAG_DEG_PER_S = 10.0
+
+
 def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> DynamixelBusEmulator:
     """Servos matching an ``ArmSettings`` (ids, models, modes), resting at the park pose.
 
@@ -756,6 +796,15 @@ def emulator_for_arm(settings: Any, clock: Clock, at_park: bool = True) -> Dynam
                 present_ticks=ticks if at_park else 2048,
             )
         )
+    # the elevation joint carries the lamp: with its torque off it falls to its lower limit
+    # (the lamp on its stop) at SAG_DEG_PER_S, an assumption (see EmulatedServo._go_limp)
+    elevation = servos[1]
+    elevation.sag_to = float(
+        kin.ticks_of_pose(settings.park_azimuth_deg, settings.elevation.min_deg)[1]
+    )
+    elevation.sag_ticks_per_s = (
+        SAG_DEG_PER_S * ct.TICKS_PER_REV / 360.0 * settings.elevation.gear_ratio
+    )
     dual = [s for s in servos if s.get(ct.MODEL_NUMBER) in ct.DUAL_AXIS_MODELS]
     if len(dual) == 2:  # both joints on one two-axis servo (a 2XL430 pan-tilt)
         dual[0].other_axes, dual[1].other_axes = [dual[1]], [dual[0]]

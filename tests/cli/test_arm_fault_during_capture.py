@@ -25,18 +25,21 @@ def test_a_servo_that_overloads_during_an_exposure_loses_that_image_not_its_dire
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     real_build = compose.build_rig
+    emulators: list = []  # type: ignore[type-arg]
+    held: list[float] = []
 
     def build(*args, **kwargs):  # type: ignore[no-untyped-def]
         rig = real_build(*args, **kwargs)
         emu, real_capture = rig.emulator, rig.camera.capture
+        emulators.append(emu)
         shots = []
 
         def capture(exposure_s: float):  # type: ignore[no-untyped-def]
-            frame = real_capture(exposure_s)
             shots.append(exposure_s)
-            if len(shots) == 3:  # the elevation servo overloads while image 3 exposes
+            if len(shots) == 3:  # the elevation servo overloads as image 3 starts exposing
                 emu.inject_hardware_error(2, ct.HardwareFault.OVERLOAD)
-            return frame
+                held.append(emu.servos[2].position())
+            return real_capture(exposure_s)
 
         rig.camera.capture = capture
         return rig
@@ -56,3 +59,9 @@ def test_a_servo_that_overloads_during_an_exposure_loses_that_image_not_its_dire
     assert sorted(p.name for p in out.glob("image_*.jpg")) == ["image_001.jpg", "image_002.jpg"]
     steps = [json.loads(line) for line in (out / "journal.jsonl").read_text().splitlines()]
     assert len(steps) == 2
+    # the truth: the shut-down elevation servo is limp and its loaded joint has fallen from
+    # the goal it held for image 3 towards its lower stop (the emulated arm had frozen there)
+    (emu,) = emulators
+    servo = emu.servos[2]
+    assert servo.get(ct.TORQUE_ENABLE) == 0
+    assert servo.position() < held[0] - 4, (servo.position(), held)

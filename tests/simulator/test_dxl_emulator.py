@@ -480,3 +480,35 @@ def test_a_servo_switched_to_protocol_1_does_not_answer_protocol_2() -> None:
         bus.ping(2)
     assert bus.scan() == {1: 1060}  # nor does it answer a broadcast ping
     assert bus.ping(1) == 1060
+
+
+def test_the_arms_loaded_elevation_joint_falls_to_its_stop_once_its_torque_goes_off() -> None:
+    """A servo with its torque off is back-driven by its load; the emulated arm had frozen
+    where it was, so a sag under an overload was never seen through ``run``. The elevation
+    joint now falls to its lower limit at SAG_DEG_PER_S (an assumption); the azimuth joint,
+    which carries no load against gravity, stays; a joint never driven stays at rest."""
+    from rti_rig.simulator.dynamixel_emulator import (
+        SAG_DEG_PER_S,
+        arm_settings_of,
+        emulator_for_arm,
+    )
+
+    settings, _ = arm_settings_of(None)
+    clock = VirtualClock()
+    emu = emulator_for_arm(settings, clock)
+    azimuth, elevation = emu.servos[1], emu.servos[2]
+    rest = elevation.position()
+    clock.sleep(5.0)
+    assert elevation.position() == rest  # resting at park, never driven: not moved
+    for servo in (azimuth, elevation):
+        servo.table[ct.TORQUE_ENABLE.address] = 1
+    held = elevation.position()
+    emu.inject_hardware_error(2, ct.HardwareFault.OVERLOAD)  # shuts down: torque off
+    emu.inject_hardware_error(1, ct.HardwareFault.OVERLOAD)
+    clock.sleep(0.5)
+    per_s = SAG_DEG_PER_S * ct.TICKS_PER_REV / 360.0
+    assert elevation.position() == pytest.approx(held - 0.5 * per_s)
+    assert azimuth.position() == pytest.approx(azimuth.get(ct.GOAL_POSITION))
+    clock.sleep(60.0)
+    stop = settings.elevation.zero_offset_ticks  # 0 deg, the lower limit of the shipped arm
+    assert elevation.position() == pytest.approx(stop)
