@@ -127,6 +127,9 @@ class DynamixelArm:
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal: tuple[int, int] | None = None
+        #: The ticks read when the last move ended in position: the pose whose direction the
+        #: capture that follows is recorded under, which :meth:`check_held` compares with.
+        self._reached: tuple[int, int] | None = None
 
     @property
     def commanded(self) -> bool:
@@ -766,19 +769,31 @@ class DynamixelArm:
             raise DynamixelError(self.name, "not connected; call connect() first", command)
 
     def check_held(self, command: str = "check held after the capture") -> None:
-        """Raise unless every joint still holds the goal it reached, fault-free: read after a
-        capture, before its image is kept under the direction read before it.
+        """Raise unless every joint still holds, fault-free, the pose read when its move ended
+        (the pose the capture is recorded under): read after a capture, before its image is
+        kept under the direction read before it.
 
         Why: a servo that overloaded while the shutter was open (ROBOTIS e-manual, Shutdown
         (63): torque off; Hardware Error Status (70) and the Alert bit of every status packet
         set until a reboot) leaves a limp joint, and the arm sags; the image had been kept and
         listed in lights.lp under the direction read before the capture, the fault found only
         at the next move. A fault is raised as :class:`HardwareFaultError` (servo, fault, how
-        to clear it); a joint moved off its goal by more than ``in_position_tolerance_ticks``
-        (a sag, a bump) as a :class:`DynamixelError` naming the joint and how far."""
+        to clear it); a joint moved by more than ``in_position_tolerance_ticks`` (a sag, a
+        bump) as a :class:`DynamixelError` naming the joint and how far.
+
+        Measured from the pose reached, not from the goal: a servo holding a load settles off
+        its goal (the XL430's Position I Gain (82) is 0 at the factory, so its position loop
+        keeps a steady-state error under a steady load; ROBOTIS-GIT/emanual
+        docs/en/dxl/x/xl430-w250.md @ 00a4b781d5a52e9b62599ea084cabc11e33b3b46: Position I Gain
+        initial 0, P 640), up to the move's tolerance, and may
+        creep a tick or two more; measured from the goal, an arm that settled 3 ticks short and
+        crept 2 was stopped mid-session as "moved" (5 > 4) though the recorded direction was
+        off by 2 ticks. The same tolerance bounds both: how far the recorded direction may be
+        from where the lamp really was."""
         self._require_connected(command)
         s = self.settings
-        for joint, goal in zip(s.joints, self._goal or (None, None), strict=True):
+        reference = self._reached or self._goal or (None, None)
+        for joint, held in zip(s.joints, reference, strict=True):
             data, error = self._bus.read_block(
                 joint.servo_id, ct.STATUS_BLOCK_START, ct.STATUS_BLOCK_LENGTH
             )
@@ -786,12 +801,12 @@ class DynamixelArm:
                 raise self._bus.hardware_fault(joint.servo_id, command)
             off = ct.PRESENT_POSITION.address - ct.STATUS_BLOCK_START
             present = p2.to_signed(int.from_bytes(data[off : off + 4], "little"), 4)
-            if goal is not None and abs(present - goal) > s.in_position_tolerance_ticks:
+            if held is not None and abs(present - held) > s.in_position_tolerance_ticks:
                 raise DynamixelError(
                     self.name,
                     f"the {self._role(joint)} joint moved during the capture: at "
                     f"{ticks_to_joint(joint, present):.2f}° where it had reached "
-                    f"{ticks_to_joint(joint, goal):.2f}° (more than in_position_tolerance_ticks "
+                    f"{ticks_to_joint(joint, held):.2f}° (more than in_position_tolerance_ticks "
                     f"= {s.in_position_tolerance_ticks}): the image was not kept; check for a "
                     "bump or a joint that slips",
                     command,
@@ -815,6 +830,7 @@ class DynamixelArm:
         ids = self.settings.servo_ids
         self._bus.sync_write(ct.GOAL_POSITION, dict(zip(ids, goal, strict=True)))
         self._goal = goal
+        self._reached = None  # until this goal is reached
 
     def _move_ticks(self, goal: tuple[int, int], command: str) -> NDArray[np.float64]:
         self._require_connected(command)
@@ -840,6 +856,7 @@ class DynamixelArm:
                 for p, g in zip(present, goal, strict=True)
             )
             if close and not moving:
+                self._reached = (present[0], present[1])
                 return self.kin.direction_of_ticks(*present)
             if self.clock.now() - start > s.move_timeout_s:
                 late = [
