@@ -749,7 +749,7 @@ class DynamixelArm:
         deadline = self.clock.now() + self.REBOOT_WAIT_S
         while True:
             try:
-                self._bus.ping(joint.servo_id)
+                self._bus.ping(joint.servo_id, once=True)  # this loop is the retry
                 return
             except CommunicationError as exc:
                 if self.clock.now() >= deadline:

@@ -267,11 +267,20 @@ class DxlBus:
         return reply
 
     # -- commands ---------------------------------------------------------------------------
-    def ping(self, dxl_id: int) -> int:
-        """Model number of servo ``dxl_id`` (raises if it does not answer)."""
-        model, result, error = self._exchange(
-            lambda: self.ph.ping(self.port, dxl_id), "ping", dxl_id
-        )
+    def ping(self, dxl_id: int, *, once: bool = False) -> int:
+        """Model number of servo ``dxl_id`` (raises if it does not answer).
+
+        ``once``: no retry (nor its warning) after a lost reply, for a caller that pings in a
+        loop of its own (waiting for a rebooted servo, silent while it restarts: each ping had
+        warned "retrying once", nine lines for one reboot)."""
+        if once:
+            model, result, error = self.ph.ping(self.port, dxl_id)
+            if result == sdk.COMM_RX_TIMEOUT:
+                self.drain_reply()  # a late reply must not answer a later command
+        else:
+            model, result, error = self._exchange(
+                lambda: self.ph.ping(self.port, dxl_id), "ping", dxl_id
+            )
         log.debug("%s: ping %d -> model %s (%d, %d)", self.device, dxl_id, model, result, error)
         self._check(result, error, dxl_id, "ping", alert=False)
         return int(model)

@@ -37,7 +37,7 @@ def _config(tmp_path: Path) -> Path:
 
 
 def test_reboot_faulted_clears_the_faulted_servo_only_and_moves_nothing(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     emulators: list = []  # type: ignore[type-arg]
     real_build = compose.build_rig
@@ -62,6 +62,8 @@ def test_reboot_faulted_clears_the_faulted_servo_only_and_moves_nothing(
         "read back 0x00, torque off" in said
     ), said
     assert "RESULT: PASS" in said
+    # waiting for the rebooted servo is one wait, not a warning per unanswered ping
+    assert not [r for r in caplog.records if "retrying once" in r.getMessage()]
     (emu,) = emulators
     # the truth: servo 2 alone was rebooted, its error cleared; nothing moved or was driven
     reboots = [p.dxl_id for p in emu.instructions if p.instruction == p2.INST_REBOOT]
