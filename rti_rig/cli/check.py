@@ -106,7 +106,7 @@ def _reboot_faulted(rig_config: Path) -> None:
     left."""
     from rti_rig.app.usecases.check import reboot_faulted
 
-    out.print(f"Rebooting the faulted servos of {escape(str(rig_config))} (torque stays off)…")
+    out.print(f"Looking for faulted servos on {escape(str(rig_config))}'s arm (nothing moves)…")
     try:
         report = reboot_faulted(rig_config)
     except RtiRigError as exc:
