@@ -11,6 +11,9 @@ Layout (opens directly in relight-cli's folder mode, which takes the first ``*.l
                              keep both files
       lights.lp              one line per image, from the light that actually fired
       journal.jsonl          one line per completed step, flushed to disk as it happens
+      records/image_001.json the same record of each committed step, one file per step,
+                             written atomically right after its journal line: what proves
+                             the step if that line is later damaged (see :func:`scan_journal`)
       manifest.json          rig config, schedule, per-step timings, versions, finish reason
       strays/image_002-IMG_0002.CR2
                              a picture the camera delivered with a step's but not of it (a
@@ -67,6 +70,8 @@ JOURNAL = "journal.jsonl"
 LP_NAME = "lights.lp"
 LINEAR_DIR = "linear"
 RAW_DIR = "raw"
+#: One file per committed step holding its journal record (see :meth:`SessionFolder.write_step`)
+RECORDS_DIR = "records"
 #: Where a DSLR downloads before the step is committed (files left here by a crash are moved to
 #: recovered/ on resume, never used as a step's image and never deleted).
 RAW_INCOMING = f"{RAW_DIR}/.incoming"
@@ -185,6 +190,15 @@ def _write_bytes_atomic(path: Path, data: bytes) -> None:
         with contextlib.suppress(OSError):
             tmp.unlink(missing_ok=True)
         raise SessionWriteError(path, exc) from None
+
+
+def _fsync_dir(path: Path) -> None:
+    """Make a folder's entries (a file just renamed into it) durable across a power loss."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _write_json_atomic(path: Path, data: dict[str, Any]) -> None:
@@ -654,10 +668,36 @@ class SessionFolder:
             strays=strays,
             **record_fields,
         )
-        self._append_journal(json.dumps(asdict(record)) + "\n")
+        line = json.dumps(asdict(record)) + "\n"
+        self._append_journal(line)
         self.committed[index] = record
+        self._write_step_record(base, line)
         self.write_lp()
         return record
+
+    def _write_step_record(self, base: str, line: str) -> None:
+        """Keep the step's record, just journaled, in ``records/BASE.json`` too (atomically,
+        fsynced, the folder entry made durable).
+
+        Why: the journal is one file appended to; a line damaged later (a cut tail, a sync tool,
+        a power loss that tears the file) left nothing proving a step a killed run had committed
+        (the manifest lists a run's steps only when the run ends), and the resume set its
+        image aside and shot it again, after the object may have been taken away. A record
+        file is never appended to, so no later write can tear it; :func:`scan_journal` takes it
+        as the step's record when the journal holds none that matches."""
+        folder = self.root / RECORDS_DIR
+        try:
+            new = not folder.is_dir()
+            folder.mkdir(exist_ok=True)
+            if new:
+                _fsync_dir(self.root)
+        except OSError as exc:
+            raise SessionWriteError(folder, exc) from None
+        _write_bytes_atomic(folder / f"{base}.json", line.encode("utf-8"))
+        try:
+            _fsync_dir(folder)
+        except OSError as exc:
+            raise SessionWriteError(folder, exc) from None
 
     def _keep_originals(
         self, base: str, originals: list[dict[str, Any]]
@@ -856,17 +896,20 @@ class JournalScan:
 
     ``kept`` holds the raw bytes of the good lines (each ending in a newline), ``rejected``
     the line numbers, texts and reasons of the others, ``torn`` a last line with no newline
-    (the process died while appending it: never committed).
+    (the process died while appending it, or the file's tail was cut), ``mended`` the step
+    record files (``records/BASE.json``) taken as records the journal lacks: appended to
+    ``records`` and ``kept``, so a repair writes them back into the journal.
     """
 
     records: list[dict[str, Any]] = field(default_factory=list)
     kept: list[bytes] = field(default_factory=list)
     rejected: list[tuple[int, str, str]] = field(default_factory=list)
     torn: bytes = b""
+    mended: list[str] = field(default_factory=list)
 
     @property
     def needs_repair(self) -> bool:
-        return bool(self.rejected or self.torn)
+        return bool(self.rejected or self.torn or self.mended)
 
 
 _REQUIRED = {
@@ -948,7 +991,40 @@ def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
             continue
         scan.records.append(entry)
         scan.kept.append(raw + b"\n")
+    _mend_from_step_records(Path(root), names, scan)
     return scan
+
+
+def _mend_from_step_records(root: Path, names: list[str] | None, scan: JournalScan) -> None:
+    """Add to ``scan`` the step record files (``records/BASE.json``, written at each commit)
+    of the steps the journal holds no intact record of, whose files are on disk as they say.
+
+    One rule for every reader (resume, ``--rebuild-journal``, fit's verdict, export-lp): a
+    step is proven by its journal record, or, when its line is lost or damaged, by its record
+    file, with its files matching the checksums. Why: a journal whose line of a committed
+    step was damaged (the tail cut after a kill) proved nothing of it, and the resume shot it
+    again. The journal's record, when it has one, decides alone (a record file never
+    overrides it). A record file whose files are not as it says (set aside, changed since) is
+    passed over: the step is then unproven, as before. Sessions from before these files have
+    none, and read as they always did."""
+    folder = root / RECORDS_DIR
+    if not folder.is_dir():
+        return
+    journaled = {r["index"] for r in scan.records}
+    for path in sorted(folder.glob("image_*.json")):
+        try:
+            raw = path.read_bytes().strip()
+            entry = json.loads(raw.decode("utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            continue
+        if _record_problem(entry, names) is not None or entry["image"] != f"{path.stem}.jpg":
+            continue
+        if entry["index"] in journaled or not verified_steps(root, [entry]):
+            continue
+        scan.records.append(entry)
+        scan.kept.append(raw + b"\n")
+        scan.mended.append(path.relative_to(root).as_posix())
+        journaled.add(entry["index"])
 
 
 def _take_whole(src: Path, dest: Path, root: Path) -> str:
@@ -1137,14 +1213,30 @@ def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[str]:
     for lineno, text, reason in scan.rejected:
         notes.append(f"journal line {lineno}: {reason}")
         report.append(f"# line {lineno}: {reason}\n{text}\n")
-    if scan.torn:
+    cut = scan.torn.strip()
+    if cut and any(line.startswith(cut) for line in scan.kept[len(scan.kept) - len(scan.mended) :]):
+        # the cut line of a step its record file proves: committed, its record written back
+        notes.append(f"journal: a last line cut to {len(scan.torn)} byte(s)")
+        report.append(
+            "# last line cut short (the step's record file holds it whole, written back)\n"
+            f"{scan.torn.decode('utf-8', 'replace')}\n"
+        )
+    elif scan.torn:
         notes.append(f"journal: a torn last line of {len(scan.torn)} byte(s) (never committed)")
         report.append(
             "# torn last line (no newline: the process died while writing it; never "
             f"committed)\n{scan.torn.decode('utf-8', 'replace')}\n"
         )
+    for rel in scan.mended:
+        notes.append(
+            f"journal: the record of {Path(rel).stem}, which it had lost, written back from "
+            f"{rel} (its files are as that record says: the image is kept, not shot again)"
+        )
     dest = root / "recovered" / stamp / "journal-rejected.txt"
     try:
+        if not report:  # only records written back: nothing to set aside
+            _write_bytes_atomic(root / JOURNAL, b"".join(scan.kept))
+            return notes
         dest.parent.mkdir(parents=True, exist_ok=True)
         with open(dest, "a", encoding="utf-8") as fh:
             fh.write("".join(report))
@@ -1355,13 +1447,14 @@ def _prepare_resume(
             *(root / LINEAR_DIR).glob(".*.partial"),
             *(root / RAW_DIR).glob(".*.partial"),
             *root.glob(".*.tmp"),
+            *(root / RECORDS_DIR).glob(".*.tmp"),
         ]:
             partial.unlink()
         try:
             (root / LINEAR_DIR).mkdir(exist_ok=True)
         except OSError as exc:
             raise SessionWriteError(root / LINEAR_DIR, exc) from None
-        if repair:
+        if repair and (root / "recovered" / stamp / "journal-rejected.txt").is_file():
             recovered.append(f"recovered/{stamp}/journal-rejected.txt")
         moved_lp = _relist_verified(root, done, stamp)
         if moved_lp is not None:
@@ -2384,6 +2477,46 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
             parts.append(f"the last line of {JOURNAL} was cut short")
         why = "; ".join(parts) or f"no record of them in {JOURNAL}"
     return unchecked, why
+
+
+def journal_mend_note(root: Path) -> str | None:
+    """What to say of the images whose journal line is lost or damaged but whose step record
+    file (``records/BASE.json``) proves them as captured: checked against that file, and the
+    command that writes their records back into the journal. None when there are none.
+
+    Why: those images are checked (a verdict may call them good), yet the journal is damaged;
+    said, with the mend, so a copy of the folder is not taken for whole as it is."""
+    root = Path(root)
+    try:
+        manifest = read_manifest(root)
+    except SessionError:
+        return None
+    total = planned_steps(manifest)
+    if not total:
+        return None
+    scan = scan_journal(root, image_names(total))
+    if not scan.mended:
+        return None
+    stems = [Path(rel).stem for rel in scan.mended]
+    parts = []
+    if scan.rejected:
+        lines = ", ".join(str(n) for n, _, _ in scan.rejected)
+        parts.append(f"line{'s' if len(scan.rejected) > 1 else ''} {lines} unreadable")
+    if scan.torn.strip():
+        parts.append("its last line cut short")
+    why = ", ".join(parts) or "records missing"
+    completed = (manifest.get("runner") or {}).get("finish_reason") == "completed"
+    mend = f"rti-rig run --resume {shlex.quote(str(root))}" + (
+        " --rebuild-journal" if completed else ""
+    )
+    one = len(stems) == 1
+    shown = ", ".join(stems[:8]) + (" …" if len(stems) > 8 else "")
+    return (
+        f"{JOURNAL} is damaged ({why}) and holds no record of {shown}: "
+        f"{'it was' if one else 'they were'} checked against {'its' if one else 'their'} "
+        f"step record file{'' if one else 's'} ({RECORDS_DIR}/) instead, as captured; "
+        f"{mend} writes {'it' if one else 'them'} back into {JOURNAL}"
+    )
 
 
 def _stopped_while_committing(

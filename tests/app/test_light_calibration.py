@@ -259,6 +259,7 @@ def test_a_card_image_changed_since_capture_is_refused_not_measured(tmp_path: Pa
     journal = card / "journal.jsonl"
     lines = journal.read_text().splitlines(keepends=True)
     journal.write_text("".join(lines[:3]) + "{not json\n" + "".join(lines[4:]))
+    (card / "records" / "image_004.json").unlink()  # its step record file lost too
     with pytest.raises(SessionError, match=r"image_004.tif \(LED 3\) has no readable record"):
         read_card_session(card)
 
@@ -387,6 +388,10 @@ def test_resumed_unfinished_or_malformed_card_sessions_are_refused(tmp_path: Pat
 
     journal = (card / "journal.jsonl").read_text().splitlines(keepends=True)
     (card / "journal.jsonl").write_text("".join(journal[:20]))  # as a stop after 20 leaves it
+    records = card / "records"
+    later = {p: p.read_bytes() for p in sorted(records.glob("image_*.json"))[20:]}
+    for p in later:  # ... with no step record file of a later image either
+        p.unlink()
 
     def cancelled(m):  # type: ignore[no-untyped-def]
         m["runner"]["finish_reason"] = "cancelled"
@@ -402,6 +407,8 @@ def test_resumed_unfinished_or_malformed_card_sessions_are_refused(tmp_path: Pat
 
     refused(killed, r"did not finish \(no finish recorded, 20 of 48 images\)")
     (card / "journal.jsonl").write_text("".join(journal))
+    for p, data in later.items():
+        p.write_bytes(data)
 
     def resumed_with_another_calibration(m):  # type: ignore[no-untyped-def]
         m["runs"].append({**m["runs"][0], "config_sha256": "0" * 64})

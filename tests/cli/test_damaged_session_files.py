@@ -86,10 +86,41 @@ def test_a_missing_journal_is_said_by_the_verdict_and_export_lp(
     assert r.exit_code != 0 and "journal.jsonl is missing" in said(r), r.output
 
 
+def test_a_damaged_journal_line_proven_by_its_record_file_is_checked_and_said(
+    session: Path, tmp_path: Path
+) -> None:
+    """Its step record file (records/image_006.json) proves image_006: checked against it,
+    fitted and listed, and the verdict says the journal is damaged and what mends it."""
+    s = _copy(session, tmp_path)
+    journal = s / "journal.jsonl"
+    lines = journal.read_text().splitlines(keepends=True)
+    journal.write_text("".join(lines[:5]) + lines[5][:40] + "\n" + "".join(lines[6:]))
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "not checked" not in verdict, verdict
+    assert (
+        "journal.jsonl is damaged (line 6 unreadable) and holds no record of image_006: it was "
+        "checked against its step record file (records/) instead, as captured; "
+        f"rti-rig run --resume {s} --rebuild-journal writes it back into journal.jsonl"
+    ) in verdict, verdict
+    r = runner.invoke(app, ["export-lp", str(s), "--out", str(tmp_path / "a.lp")])
+    assert r.exit_code == 0, r.output
+    assert "image_006" in (tmp_path / "a.lp").read_text()
+    r = runner.invoke(app, ["run", "--resume", str(s), "--rebuild-journal"])
+    assert r.exit_code == 0, r.output
+    assert [json.loads(x)["index"] for x in journal.read_text().splitlines()] == list(range(12))
+    r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit2")])
+    verdict = json.loads((tmp_path / "fit2" / "qa.json").read_text())["verdict"]
+    assert r.exit_code == 0 and verdict == "good", verdict
+
+
 def test_a_damaged_journal_line_is_said_by_the_verdict_and_export_lp(
     session: Path, tmp_path: Path
 ) -> None:
+    """Without its step record file (a session written before them, or the file lost too)."""
     s = _copy(session, tmp_path)
+    (s / "records" / "image_006.json").unlink()
     journal = s / "journal.jsonl"
     lines = journal.read_text().splitlines(keepends=True)
     journal.write_text("".join(lines[:5]) + lines[5][:40] + "\n" + "".join(lines[6:]))

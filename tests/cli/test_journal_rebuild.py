@@ -44,7 +44,12 @@ def _images(folder: Path) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def made(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, Path]:
-    """(the rig config, an uninterrupted session, the same session stopped after 4 images)."""
+    """(the rig config, an uninterrupted session, the same session stopped after 4 images).
+
+    Both sessions' step record files (``records/``) are removed, as in a session
+    written before them: with them, a plain resume writes a lost line back from its step's
+    file (tests/runtime/test_step_records.py), and what these tests exercise is the proof
+    that is left without them, the manifest."""
     base = tmp_path_factory.mktemp("rebuild")
     cfg = write_config(base, SMALL_DOME)
     ref = base / "uninterrupted"
@@ -59,6 +64,8 @@ def made(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, Path]:
 
     opened = open_new_session(NewSessionRequest(cfg, stopped, lights=LIGHTS))
     assert run_opened_session(opened, cancel, on_event).finish_reason is FinishReason.CANCELLED
+    for session in (ref, stopped):
+        shutil.rmtree(session / "records")
     return cfg, ref, stopped
 
 

@@ -379,6 +379,7 @@ def test_an_image_killed_before_its_journal_line_is_said_to_be_no_part_of_the_se
     assert "restore journal.jsonl" not in verdict and "not checked" not in verdict, verdict
     lines = (out / "journal.jsonl").read_text().splitlines(keepends=True)
     (out / "journal.jsonl").write_text("".join(lines[:2] + lines[3:]))  # image_003's lost
+    (out / "records" / "image_003.json").unlink()  # with its step record file
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit2"), "--model", "ps"])
     assert r.exit_code == 0, r.output
     verdict = json.loads((tmp_path / "fit2" / "qa.json").read_text())["verdict"]

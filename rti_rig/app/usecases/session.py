@@ -1065,7 +1065,9 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     moved = (
         f", {len(images)} file(s) of the images to reshoot set aside in {where}/ (never deleted)"
         if req.reshoot_lost
-        else f", {len(recovered)} unverified file(s) moved to {where}/"
+        else f", {len(images)} unverified file(s) moved to {where}/"
+        if images
+        else f" (what it set aside is in {where}/)"
     )
     on_note(
         Note(
@@ -1074,7 +1076,10 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         )
     )
     for line in resume.journal_repair if resume else []:
-        on_note(Note(f"{line}: set aside in recovered/, not appended onto", "warning"))
+        # a record written back from its step's record file is kept, not set aside
+        kept = "written back from" in line
+        said = line if kept else f"{line}: set aside in recovered/, not appended onto"
+        on_note(Note(said, "warning"))
     for line in resume.journal_rebuild if resume else []:
         on_note(Note(line, "warning"))
     # the steps still to shoot, at their own exposures, before the port opens

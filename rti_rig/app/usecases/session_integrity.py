@@ -30,6 +30,7 @@ from rti_rig.runtime.session import (
     RUN_ENDED,
     files_lost_since_capture,
     image_names,
+    journal_mend_note,
     lost_image_advice,
     originals_changed_since_capture,
     originals_lost,
@@ -381,6 +382,9 @@ def _stem(name: str) -> str:
 def _with_unchecked(qa: QAReport, source: Path, fitted: set[str] | None = None) -> QAReport:
     """``qa`` with a caveat naming the images no readable journal record vouches for (of
     ``fitted`` alone when given)."""
+    mended = journal_mend_note(source)
+    if mended:  # checked, but against the step record files: the journal is to be mended
+        qa = _noted(qa, mended)
     unchecked, why = unchecked_images(source)
     if fitted is not None:
         unchecked = [n for n in unchecked if n in fitted]

@@ -1,0 +1,100 @@
+"""A committed step stays proven when its journal line is damaged later: each commit also
+writes the step's record to ``records/BASE.json``, which a resume takes back into the journal.
+
+Before, a run killed after committing a step whose journal line was then cut (the tail of
+``journal.jsonl`` torn) left nothing proving the step (the manifest lists a run's steps only
+when it ends): the resume set the image aside and shot it again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import signal
+from pathlib import Path
+
+import pytest
+from conftest import SMALL_DOME, write_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.testing.kill_hooks import popen_session
+
+runner = CliRunner()
+LIGHTS = 8
+
+
+def said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+def _sha(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _killed_after_three(tmp_path: Path) -> Path:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    proc = popen_session("before_light", 3, cfg, out, LIGHTS)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.parametrize("flags", [[], ["--rebuild-journal"]])
+def test_a_committed_step_whose_journal_line_was_cut_is_kept_not_shot_again(
+    tmp_path: Path, flags: list[str]
+) -> None:
+    out = _killed_after_three(tmp_path)
+    assert sorted(p.name for p in (out / "records").iterdir()) == [
+        "image_001.json",
+        "image_002.json",
+        "image_003.json",
+    ]
+    third = {p: _sha(out / p) for p in ("image_003.jpg", "linear/image_003.tif")}
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().splitlines(keepends=True)
+    assert len(lines) == 3
+    journal.write_bytes(b"".join(lines[:2]) + lines[2][:-25])  # image_003's line torn
+
+    r = runner.invoke(app, ["run", "--resume", str(out), *flags])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "3 of 8 images verified" in text, text
+    assert "written back from records/image_003.json" in text, text
+    # the image is the one captured, never set aside
+    assert {p: _sha(out / p) for p in third} == third
+    moved = [p.name for p in (out / "recovered").rglob("*") if p.is_file()]
+    assert moved == ["journal-rejected.txt"], moved
+    # the journal is mended: image_003's record, once, then the steps shot after it
+    records = [json.loads(x) for x in journal.read_text().splitlines()]
+    assert [r["index"] for r in records] == list(range(LIGHTS))
+    assert records[2]["sha256"]["image_003.jpg"] == third["image_003.jpg"]
+    # the resume shot only the steps never committed
+    m = json.loads((out / "manifest.json").read_text())
+    assert m["runs"][-1]["resumed_with_steps_done"] == 3
+    assert len(list((out / "records").glob("image_*.json"))) == LIGHTS
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_record_file_whose_image_was_changed_proves_nothing(tmp_path: Path) -> None:
+    """The record file is proof only with its files as captured: an image changed since
+    (and its journal line cut) is set aside and shot again, as before."""
+    out = _killed_after_three(tmp_path)
+    (out / "image_003.jpg").write_bytes(b"edited")
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().splitlines(keepends=True)
+    journal.write_bytes(b"".join(lines[:2]) + lines[2][:-25])
+
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "2 of 8 images verified" in said(r), said(r)
+    kept = {p.relative_to(out / "recovered").parts[1:] for p in (out / "recovered").rglob("*.*")}
+    assert ("image_003.jpg",) in kept, kept
+    assert next((out / "recovered").rglob("image_003.jpg")).read_bytes() == b"edited"
+    # the journal and the record file now hold the new capture's record
+    new = json.loads((out / "records" / "image_003.json").read_text())
+    assert new["sha256"]["image_003.jpg"] == _sha(out / "image_003.jpg")
