@@ -110,8 +110,8 @@ def run(
             "--reshoot-lost",
             help="With --resume on a session that completed: reshoot exactly the images whose "
             "JPEG or linear TIFF was lost or changed since capture, or whose RAW original "
-            "(raw/) was lost (the QA verdict names them), with the object where it was; their "
-            "files are set aside in recovered/, never deleted.",
+            "(raw/) was lost or changed (the QA verdict names them), with the object where it "
+            "was; their files are set aside in recovered/, never deleted.",
         ),
     ] = False,
     rebuild_journal: Annotated[

@@ -580,6 +580,8 @@ class SessionFolder:
                 run["journal_repair"] = self.resume.journal_repair
             if self.resume.journal_rebuild:
                 run["journal_rebuild"] = self.resume.journal_rebuild
+            if self.resume.lost_since_capture:
+                run["lost_since_capture"] = self.resume.lost_since_capture
             if self.rig_change:
                 run["rig_change"] = self.rig_change
             if self.rig_identity is not None:
@@ -888,6 +890,10 @@ class ResumeState:
     #: what ``--rebuild-journal`` did: the journal rebuilt from the manifest, what it took back,
     #: where the old journal and every file the manifest does not vouch for were set aside
     journal_rebuild: list[str] = field(default_factory=list)
+    #: a session not finished: its committed images whose files are missing or changed since
+    #: capture, set aside to be shot again, said as the verdict says them
+    #: (:func:`lost_since_capture_said`'s words: ``image_005: raw/image_005.dng changed``)
+    lost_since_capture: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -1328,6 +1334,7 @@ def _prepare_resume(
             f"{shlex.quote(str(root))} --rebuild-journal)"
         )
     rebuilt: dict[int, dict[str, Any]] | None = None  # the records taken back
+    lost_now: list[str] = []  # a session not finished: committed images lost since capture
     restored: dict[int, dict[str, Any]] = {}  # --reshoot-lost: the manifest's, restored
     if runner.get("finish_reason") == "completed":
         finished = runner.get("steps_done", total)
@@ -1396,6 +1403,13 @@ def _prepare_resume(
                 _refuse_unjournaled(root, scan, names, unjournaled)
             _refuse_lost_journal(root, names)
             done = verified_steps(root, scan.records)
+        latest = _latest_records(scan.records)
+        renamed = renamed_jpegs(root, scan.records)
+        lost_now = [
+            f"{names[i]}: {', '.join(gone)}"
+            for i, rec in sorted(latest.items())
+            if i not in done and (gone := _lost_files(root, rec, renamed))
+        ]
     stamp = _new_stamp(root)
     if check_done is not None:
         check_done(done)
@@ -1465,6 +1479,7 @@ def _prepare_resume(
         recovered=recovered,
         journal_repair=repair,
         journal_rebuild=rebuild,
+        lost_since_capture=lost_now,
     )
 
 
@@ -2296,15 +2311,20 @@ def _lost_files(
     are developed from it), and a resume and ``--rebuild-journal`` already called a step
     without it unproven, while this called it "no reason to reshoot" (its developed images
     may still be fitted: :func:`originals_lost` tells them apart). One that is there but
-    changed is named by :func:`originals_changed_since_capture`, to restore from a copy. A
-    JPEG in ``renamed`` (:func:`renamed_jpegs`) is not lost: it is there, under another
-    name."""
+    changed (a raw editor that writes its metadata into the DNG, a copy over it) is lost
+    alike: the captured original is no longer there. Why: it had been "good" in the verdict
+    (restore it from a backup, no reshoot) and "nothing to reshoot" to ``--reshoot-lost``,
+    while a resume of a session not finished set its step aside and shot it again and a
+    completed session's ``--rebuild-journal`` recorded it as lost. A JPEG in ``renamed``
+    (:func:`renamed_jpegs`) is not lost: it is there, under another name."""
     lost = []
     for name, digest in rec["sha256"].items():
         path = root / name
-        if name not in (rec.get("image"), rec.get("linear_image")):
-            if not path.is_file():  # a camera original
+        if name not in (rec.get("image"), rec.get("linear_image")):  # a camera original
+            if not path.is_file():
                 lost.append(f"{name} missing")
+            elif not _as_captured(root, rec, name, digest):
+                lost.append(f"{name} changed")
             continue
         if not path.is_file():
             if renamed and name in renamed:
@@ -2319,8 +2339,8 @@ def checksum_session_files(
     root: Path, stop: Callable[[], bool] | None = None, read_by_caller: Collection[Path] = ()
 ) -> None:
     """Read and checksum the files of every journaled step of session ``root`` (nothing for a
-    folder that is no session), so that :func:`files_lost_since_capture` and
-    :func:`originals_changed_since_capture` find their checksums known
+    folder that is no session), so that :func:`files_lost_since_capture` finds
+    their checksums known
     (:data:`_KNOWN_DIGESTS`) unless they change meanwhile.
 
     Why: checking every TIFF reads the whole session once more (14 GB for 100 images of
@@ -2385,24 +2405,6 @@ def originals_lost(gone: list[str]) -> bool:
     TIFF are as captured, so a fit still used them (said, with the reshoot that gets the
     original back)."""
     return bool(gone) and all(g.startswith(f"{RAW_DIR}/") for g in gone)
-
-
-def originals_changed_since_capture(root: Path) -> list[str]:
-    """The camera originals a session keeps (``raw/…``, a RAW or a RAW+JPEG pair's files) that
-    are on disk but differ from their journaled checksums.
-
-    Why: a DNG opened in a raw editor that writes its metadata into the file, or an original
-    replaced by a sync tool, is no longer the camera's file the session vouches for, and
-    nothing said so. One that is gone is lost, named by :func:`files_lost_since_capture`."""
-    root = Path(root)
-    changed = []
-    for rec in _latest_records(_journal_records(root) or []).values():
-        own = (rec.get("image"), rec.get("linear_image"))
-        for name, digest in rec["sha256"].items():
-            path = root / name
-            if name not in own and path.is_file() and _sha256(path) != digest:
-                changed.append(name)
-    return sorted(changed)
 
 
 def renamed_since_capture(root: Path) -> dict[str, str]:

@@ -802,24 +802,71 @@ def test_a_fit_of_a_session_whose_images_are_gone_names_them_all_and_the_way_out
     _fit_the_rest(done, tmp_path / "fit")
 
 
-def test_a_camera_original_changed_since_capture_is_named_not_reshot(
+def test_a_camera_original_changed_since_capture_is_lost_said_alike_and_reshot_on_request(
     tmp_path: Path, reference: tuple[Path, Path]
 ) -> None:
-    """A kept DNG into which a raw editor wrote its metadata: no longer the camera's file,
-    and nothing said so (originals were not checked at all once the session finished). Now
-    the verdict's note names it and says what to do; the images stand (no reshoot)."""
+    """A kept DNG into which a raw editor wrote its metadata: the captured original is no
+    longer there. The verdict had called it "good" (restore it from a backup, no reshoot) and
+    --reshoot-lost "nothing to reshoot", while a rebuilt journal recorded it as lost and a
+    resume of a session not finished shot it again. Now every path calls it lost in the same
+    words, with the same remedies, and --reshoot-lost shoots it again, its files kept."""
     _, ref = reference
     done = copied(ref, tmp_path)
     _with_raw_originals(done)
-    (done / "raw" / "image_005.dng").write_bytes(b"camera file 4 + XMP written by an editor")
+    edited = b"camera file 4 + XMP written by an editor"
+    (done / "raw" / "image_005.dng").write_bytes(edited)
+    words = (
+        "image_005 (raw/image_005.dng changed since capture: the camera's original capture is "
+        "lost, its developed JPEG and linear TIFF are as captured and were fitted; put the "
+        "originals back from a copy, or reshoot exactly those, with the object where it was: "
+        f"rti-rig run --resume {done} --reshoot-lost"
+    )
     r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 0, r.output
     verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
-    assert verdict.startswith("good; raw/image_005.dng changed since capture"), verdict
-    assert "restore the original from a backup copy" in verdict
-    assert "reshoot" not in verdict
-    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
-    assert r.exit_code == 2 and "nothing to reshoot" in said(r), r.output
+    assert verdict.startswith(f"reshoot: {words}"), verdict
+    r = runner.invoke(app, ["export-lp", str(done), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 0, r.output
+    assert "raw/image_005.dng changed since capture: the camera's original capture" in said(r)
+    r = runner.invoke(app, ["run", "--resume", str(done)])
+    assert r.exit_code == 2 and "missing or changed since capture (image_005)" in said(r), r.output
+    assert f"rti-rig run --resume {done} --reshoot-lost" in said(r)
+    r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "1 of 8 light" in said(r)
+    (aside,) = (done / "recovered").iterdir()
+    assert (aside / "raw" / "image_005.dng").read_bytes() == edited  # set aside, never deleted
+
+
+def test_a_camera_original_changed_in_a_session_not_finished_is_said_and_shot_again(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """The resume of a session not finished shoots again what it cannot verify (the object is
+    still in place): it had said only "N unverified file(s) moved" of a DNG a raw editor had
+    written into. It now names it in the verdict's words, kept in recovered/."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    _with_raw_originals(done)
+    m = manifest(done)
+    m["runner"]["finish_reason"] = "cancelled"
+    (done / "manifest.json").write_text(json.dumps(m))
+    edited = b"camera file 2 + XMP written by an editor"
+    (done / "raw" / "image_003.dng").write_bytes(edited)
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert "image_003 (raw/image_003.dng changed since capture: the camera's original" in verdict
+    assert "or let its resume set them aside and shoot them again, with the object" in verdict
+    r = runner.invoke(app, ["run", "--resume", str(done), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert (
+        "1 image(s) lost since capture (image_003: raw/image_003.dng changed): what was "
+        "captured is no longer there; what is left of them set aside in recovered/"
+    ) in said(r), said(r)
+    (aside,) = (done / "recovered").iterdir()
+    assert (aside / "raw" / "image_003.dng").read_bytes() == edited
+    assert manifest(done)["runs"][-1]["lost_since_capture"] == [
+        "image_003: raw/image_003.dng changed"
+    ]
 
 
 def test_a_fit_of_a_session_with_a_tiff_cut_short_names_it_before_fitting(

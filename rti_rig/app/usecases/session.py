@@ -1082,6 +1082,19 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         on_note(Note(said, "warning"))
     for line in resume.journal_rebuild if resume else []:
         on_note(Note(line, "warning"))
+    lost = resume.lost_since_capture if resume else []
+    if lost:
+        # in the verdict's words, with what this resume does about them: it had said only "N
+        # unverified file(s) moved", of a RAW a raw editor had written into, say
+        shown = "; ".join(lost[:8]) + (" …" if len(lost) > 8 else "")
+        aside = f"what is left of them set aside in {where}/ (never deleted), " if where else ""
+        on_note(
+            Note(
+                f"{len(lost)} image(s) lost since capture ({shown}): what was captured is no "
+                f"longer there; {aside}shot again now, with the object where it was",
+                "warning",
+            )
+        )
     # the steps still to shoot, at their own exposures, before the port opens
     _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
     rig = checked_rig(loaded, schedule)

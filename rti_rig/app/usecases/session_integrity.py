@@ -32,7 +32,6 @@ from rti_rig.runtime.session import (
     image_names,
     journal_mend_note,
     lost_image_advice,
-    originals_changed_since_capture,
     originals_lost,
     planned_steps,
     read_manifest,
@@ -82,19 +81,6 @@ def with_lost_files(qa: QAReport, source: Path) -> QAReport:
     renamed = _only(renamed_since_capture(source), fitted)
     if renamed:  # there, under another name: said, and not called lost (nothing to reshoot)
         note = renamed_note(renamed)
-        qa = _noted(qa, note)
-    originals = [
-        n for n in originals_changed_since_capture(source) if fitted is None or _stem(n) in fitted
-    ]
-    if originals:  # the camera's files, no longer as captured: said, not reshot
-        shown = ", ".join(originals[:5]) + (
-            f" and {len(originals) - 5} more" if len(originals) > 5 else ""
-        )
-        note = (
-            f"{shown} changed since capture (not the camera's original any more: a raw editor "
-            "that writes into the file, or a copy over it); the JPEGs and linear TIFFs do not "
-            "depend on it: restore the original from a backup copy of the folder"
-        )
         qa = _noted(qa, note)
     lost = _only(files_lost_since_capture(source), fitted)
     if not lost:
