@@ -11,6 +11,7 @@ The stack is never held, as floats or otherwise; one streamed pass computes ever
 from __future__ import annotations
 
 import contextlib
+import errno
 import html
 import json
 import math
@@ -74,6 +75,46 @@ AUTO = "auto"
 
 class FitInputError(RtiRigError):
     """The session or .lp cannot be read for fitting."""
+
+
+class FitOutputError(RtiRigError):
+    """The fit's outputs could not be written (a full disk, a file-size limit, a read-only or
+    failing disk): named, with the folder left as it was found and the command to run again."""
+
+
+#: Errors that say the output could not be written, whichever file the OS names (a file
+#: object's truncate names none).
+_WRITE_ERRNOS = {errno.ENOSPC, errno.EFBIG, errno.EROFS, errno.EDQUOT}
+
+
+def _output_write_failed(exc: OSError, out: Path) -> bool:
+    """Whether ``exc`` is a failure to write the fit's outputs in ``out`` (not to read the
+    session's images, which is said where they are read)."""
+    if exc.errno in _WRITE_ERRNOS:
+        return True
+    name = exc.filename
+    return bool(name) and Path(str(name)).resolve().is_relative_to(out.resolve())
+
+
+def _output_error(exc: OSError, req: FitRequest, out: Path, created: bool) -> FitOutputError:
+    """What a fit that could not write its outputs says: what failed, that nothing was kept
+    and the session is unchanged, and the command to run again. Why: a full disk (or a
+    file-size limit) met while the fit's files were written reached the user as a Python
+    traceback ending in ``OSError: [Errno 27] File too large``."""
+    code = errno.errorcode.get(exc.errno or 0, "")
+    reason = f"{exc.strerror or exc}{f' ({code})' if code else ''}"
+    where = f" ({exc.filename})" if exc.filename else ""
+    left = "removed" if created else "emptied again"
+    remedy = {
+        errno.EFBIG: "raise the file-size limit (ulimit -f)",
+        errno.EROFS: "choose an --out on a disk you can write to",
+    }.get(exc.errno or 0, "free space on that disk, or choose an --out on another")
+    return FitOutputError(
+        f"{req.source}: the fit could not write its outputs in {out}{where}: {reason}; "
+        f"nothing of it was kept ({out} {left}) and the session is unchanged: {remedy}, "
+        f"then run again: rti-rig fit {shlex.quote(str(req.source))} --out "
+        f"{shlex.quote(str(out))}"
+    )
 
 
 @dataclass(frozen=True)
@@ -540,9 +581,11 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     )
     try:
         result = _fit_into(req, out, frames, lights, names, what, notes, bands, checksums)
-    except BaseException:
+    except BaseException as exc:
         stop.set()  # a failed or interrupted fit does not wait for the checksums
         _discard_outputs(out, created)  # ``out`` was new or empty: what is in it is this run's
+        if isinstance(exc, OSError) and _output_write_failed(exc, out):
+            raise _output_error(exc, req, out, created) from None
         raise
     finally:
         pool.shutdown(wait=False, cancel_futures=True)
