@@ -686,7 +686,7 @@ class SessionFolder:
         (the manifest lists a run's steps only when the run ends), and the resume set its
         image aside and shot it again, after the object may have been taken away. A record
         file is never appended to, so no later write can tear it; :func:`scan_journal` takes it
-        as the step's record when the journal holds none that matches."""
+        as the step's record when the journal holds no intact record of the step."""
         folder = self.root / RECORDS_DIR
         try:
             new = not folder.is_dir()
