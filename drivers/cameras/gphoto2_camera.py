@@ -21,7 +21,7 @@ import math
 import re
 import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
@@ -520,7 +520,7 @@ class Gphoto2Camera:
         cam = self._cam
         files = [(str(path.folder), str(path.name))]
         files, late, strays = self._more_files(files)
-        strays.extend(self._unannounced(str(path.folder), files + late + strays))
+        strays.extend(self._unannounced(str(path.folder), files + late + strays, strays))
         self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
         raw_files = [f for f in files if is_raw_file(Path(f[1]))]
@@ -565,13 +565,13 @@ class Gphoto2Camera:
             )
         if left_on_card:
             self._delete(files)
-            self._note_card(str(path.folder), files)
+            self._note_card(str(path.folder), files + late)
             seen = self._card_seen.get(str(path.folder))
             if seen is not None:  # on the card now: never found again as a new picture
                 seen |= {n for _, n in strays}
         else:
             self._delete(files + strays)
-            self._note_card(str(path.folder), files + strays)
+            self._note_card(str(path.folder), files + strays + late)
         raw_path = saved[raw_files[0][1]]
         try:
             decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
@@ -749,7 +749,12 @@ class Gphoto2Camera:
         except self._gp.GPhoto2Error:
             return None
 
-    def _unannounced(self, folder: str, known: list[tuple[str, str]]) -> list[tuple[str, str]]:
+    def _unannounced(
+        self,
+        folder: str,
+        known: list[tuple[str, str]],
+        strays_known: Sequence[tuple[str, str]] = (),
+    ) -> list[tuple[str, str]]:
         """Pictures the body took behind a busy answer and never announced (no FILE_ADDED
         event, ever), found on its card: the files in the shot's folder that were not there
         after the last shot in it and are not files this shot's events named.
@@ -769,7 +774,13 @@ class Gphoto2Camera:
         if now is None:
             return []
         named = {n for f, n in known if f.rstrip("/") == folder.rstrip("/")}
-        found = [(folder, n) for n in sorted(now - before - named)]
+        # a card pairs a shot's files by stem: a file of this shot's stem or an earlier
+        # shot's (its JPEG still being written, announced late or never) is no stray; the
+        # shot's own JPEG had been downloaded into strays/ as "taken while answering busy"
+        # on every step after a busy answer (RAW+JPEG, keep_jpeg off)
+        ours = self._earlier_stems | {Path(n).stem for _, n in known}
+        ours -= {Path(n).stem for _, n in strays_known}  # a stray's other file is a stray
+        found = [(folder, n) for n in sorted(now - before - named) if Path(n).stem not in ours]
         self._card_seen[folder] = now
         self._earlier_stems.update(Path(n).stem for _, n in found)
         return found

@@ -473,6 +473,39 @@ def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(b
     assert sorted(body.card) == ["IMG_0999.CR2"]
 
 
+@pytest.mark.parametrize("delete", [True, False])
+def test_a_shots_own_jpeg_written_late_is_no_stray_after_a_busy_answer(body, tmp_path, delete):
+    """A RAW+JPEG body capturing to its card answers busy once before each shot, taking no
+    picture, and writes each shot's JPEG after the RAW's quiet spell (announced only at the
+    next shot). The listing after the busy spell found that JPEG on the card and took it for
+    a picture "taken while answering busy": images 2-4 each had their own JPEG downloaded into
+    strays/ and the run said the body took pictures it never took. A card pairs a shot's files
+    by stem: a file of a shot's own stem is no stray."""
+    text = DSLR_CONFIG.read_text().replace(
+        'capture_target = "Internal RAM"', 'capture_target = "Memory card"'
+    )
+    text = text.replace(
+        'image_format = "RAW"',
+        'image_format = "RAW + Large Fine JPEG"'
+        + ("" if delete else "\ndelete_from_camera = false"),
+    )
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "card.toml"
+    config.write_text(text)
+    body.busy_after_shot = 1  # busy once after each shot, no picture taken behind it
+    body.second_file_quiet_waits = 10**6  # each JPEG announced only at the next shot
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "4")
+    assert result.exit_code == 0, result.output
+    check_images(out, 4)
+    assert body.shots == 4
+    assert [s for e in journal(out) for s in e["strays"]] == []
+    assert "while answering busy" not in " ".join(result.output.split())
+    assert not (out / "strays").exists()
+
+
 def test_a_raw_libraw_cannot_read_names_the_file_what_to_do_and_keeps_it(body, tmp_path):
     """A body newer than the bundled LibRaw: its second RAW is a format LibRaw does not know.
     The run had stopped with "…/raw/.incoming/cap0002_IMG_0002.RAF: LibRaw cannot decode this
