@@ -81,6 +81,9 @@ RAW_SUFFIXES = {
     ".x3f",
 }
 
+#: 8-bit formats a camera saves beside its RAW (RAW+JPEG): never a linear image
+JPEG_SUFFIXES = {".jpg", ".jpeg"}
+
 
 class TriggerUnconfirmed(Exception):
     """The trigger was sent but its confirmation was lost (e.g. the dome's reply to a shutter
@@ -217,7 +220,12 @@ class FolderWatchCamera:
         Why: a camera saving ``_DSC0001.ARW`` into a folder watched for ``*.CR2`` (the guide's
         example) timed out with "is the camera firing and saving there?" while it was doing
         just that; the patterns are case-sensitive too (``*.cr2`` does not match
-        ``IMG_0001.CR2``)."""
+        ``IMG_0001.CR2``).
+
+        A JPEG in a folder watched for RAWs is a RAW+JPEG shot whose RAW has not come (late,
+        or not saved), never a pattern to add: an 8-bit JPEG is refused as an image, and the
+        advice to add ``'*.JPG'`` had sent an owner whose RAW was merely late to a pattern
+        that could only stop the next run at its first JPEG."""
         patterns = self.settings.patterns
         names = sorted(
             n
@@ -226,15 +234,35 @@ class FolderWatchCamera:
         )
         if not names:
             return ""
-        shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
-        suffixes = sorted({f"*{Path(n).suffix}" for n in names if Path(n).suffix})
-        add = f" (e.g. {', '.join(repr(x) for x in suffixes)})" if suffixes else ""
-        return (
-            f"; {shown} came into the folder but no pattern matches "
-            f"{'them' if len(names) > 1 else 'it'} (patterns are case-sensitive): add "
-            f"{'their' if len(names) > 1 else 'its'} pattern{add} to patterns in "
-            "[camera.device]"
+        raw_patterns = [x for x in patterns if Path(x).suffix.lower() in RAW_SUFFIXES]
+        jpegs = (
+            [n for n in names if Path(n).suffix.lower() in JPEG_SUFFIXES] if raw_patterns else []
         )
+        names = [n for n in names if n not in jpegs]
+        said = ""
+        if names:
+            shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+            suffixes = sorted({f"*{Path(n).suffix}" for n in names if Path(n).suffix})
+            add = f" (e.g. {', '.join(repr(x) for x in suffixes)})" if suffixes else ""
+            said = (
+                f"; {shown} came into the folder but no pattern matches "
+                f"{'them' if len(names) > 1 else 'it'} (patterns are case-sensitive): add "
+                f"{'their' if len(names) > 1 else 'its'} pattern{add} to patterns in "
+                "[camera.device]"
+            )
+        # a JPEG whose RAW is there under a name no pattern matches is said by that RAW above
+        stems = {Path(n).stem for n in names}
+        alone = [n for n in jpegs if Path(n).stem not in stems]
+        if alone:
+            shown = ", ".join(alone[:3]) + (f" and {len(alone) - 3} more" if len(alone) > 3 else "")
+            said += (
+                f"; {shown} came into the folder but not {'their' if len(alone) > 1 else 'its'} "
+                f"RAW (patterns {raw_patterns}): if the camera saves RAW+JPEG, its RAW is late "
+                "(raise timeout_s in [camera.device] if the link is slow, e.g. Wi-Fi) or was "
+                "saved elsewhere (the card only?); if it saves JPEG only, set it to RAW or "
+                "RAW+JPEG (an 8-bit JPEG is not linear data: do not add its pattern)"
+            )
+        return said
 
     def _mark_seen(self, name: str, ident: tuple[int, int, int, int] | None) -> None:
         """``name`` (and the file it is, if it still exists) is used: never taken again."""

@@ -375,3 +375,34 @@ def test_a_raw_plus_jpeg_camera_whose_jpeg_comes_first_is_told_to_match_the_raw(
     cam.connect()
     with pytest.raises(CaptureError, match="save RAW or 16-bit TIFF"):
         cam.capture(0.5)
+
+
+def test_a_jpeg_whose_raw_is_late_is_not_advised_as_a_pattern_to_add(tmp_path):
+    """A RAW+JPEG camera watched for its RAW alone, the RAW late at the timeout: the timeout
+    had advised adding '*.JPG' to patterns (whose 8-bit data is refused as an image); it now
+    says the RAW has not come, to raise timeout_s or set the camera to save RAW."""
+    import cv2
+
+    def jpeg(name):
+        cv2.imwrite(str(tmp_path / name), np.full((8, 8, 3), 9, np.uint8))
+
+    clock = ScriptedClock({0.5: lambda: jpeg("IMG_0001.JPG")})
+    cam = watch(tmp_path, clock, patterns=("*.CR2",), timeout_s=2.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "IMG_0001.JPG came into the folder but not its RAW" in said
+    assert "raise timeout_s" in said and "'*.JPG'" not in said
+    assert "add its pattern (e.g." not in said
+    # its RAW came under a name no pattern matches (a case mismatch): that RAW's pattern is said
+    other = tmp_path / "case"
+    other.mkdir()
+    clock = ScriptedClock({0.5: lambda: (jpeg("case/IMG_0002.JPG"), dng(other / "IMG_0002.cr2"))})
+    cam = watch(other, clock, patterns=("*.CR2",), timeout_s=2.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "IMG_0002.cr2 came into the folder but no pattern matches it" in said
+    assert "'*.cr2'" in said and "'*.JPG'" not in said and "not its RAW" not in said
