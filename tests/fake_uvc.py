@@ -11,6 +11,11 @@ Modelled on the published behaviour, not on our driver:
   them; uvcvideo fills a buffer only from the start of a frame (it waits for the frame-ID bit
   to toggle, so a buffer queued mid-frame gets the next frame), and a frame that finds no
   queued buffer is dropped: a full queue holds the *oldest* frames.
+* In manual exposure the frame rate stays constant (UVC auto-exposure priority off, its
+  default; Microsoft's KSPROPERTY_CAMERACONTROL_AUTO_EXPOSURE_PRIORITY: "if the frame rate is
+  30 fps, the exposure time cannot exceed 33 ms"): a longer exposure is clamped to the frame
+  period, and ``exposure_absolute`` still reads back as set. ``CAP_PROP_FPS`` sets the frame
+  rate (VIDIOC_S_PARM: the nearest the camera offers) and reads back the one in use.
 * A rolling shutter: row ``r`` of frame ``k`` is read out at ``k·P + r·R/H`` (``P`` the frame
   period, ``R`` the readout time) after an exposure of ``e`` seconds ending then; the frame is
   delivered once its last row is read. A new exposure value takes effect ``latency_frames``
@@ -76,9 +81,13 @@ class BufferedUvcStream:
         latency_frames: int = 1,
         scale: float = 100_000.0,
         exposure_units: float = 100.0,
+        frame_rates: tuple[float, ...] | None = None,
     ) -> None:
         self.light = light
         self.clock = light.clock
+        #: the frame rates the camera offers for its format and size (VIDIOC_ENUM_FRAMEINTERVALS);
+        #: VIDIOC_S_PARM picks the nearest, and CAP_PROP_FPS then reads that one back
+        self.frame_rates = frame_rates or (fps,)
         self.period = 1.0 / fps
         self.readout_s = readout_s
         self.rows, self.cols = rows, cols
@@ -112,8 +121,11 @@ class BufferedUvcStream:
     def _exposure_s(self, k: int) -> float:
         """The exposure frame ``k`` was taken at: the value set ``latency_frames`` periods
         before the frame period its exposure began in."""
-        latch = (k - 1 - self.latency_frames) * self.period
+        t0 = self.streaming_from or 0.0  # frame k is read out from t0 + k·P (the clock's)
+        latch = t0 + (k - 1 - self.latency_frames) * self.period
         units = [u for t, u in self.exposures if t <= latch][-1]
+        # manual exposure keeps the frame rate (auto-exposure priority is off): a longer
+        # exposure is clamped to the frame period, while exposure_absolute reads back as set
         return min(units * 1e-4, self.period)
 
     def _row_windows(self, k: int) -> list[tuple[float, float]]:
@@ -173,6 +185,12 @@ class BufferedUvcStream:
             count = max(int(value), self.min_buffers)
             self.buffers = [_Buffer() for _ in range(count)]
             self.props[prop] = float(count)
+            return True
+        if prop == cv2.CAP_PROP_FPS:
+            if self.streaming_from is not None:
+                return False  # not modelled: the driver sets it at connect, before streaming
+            rate = min(self.frame_rates, key=lambda r: abs(r - value))
+            self.period, self.props[prop] = 1.0 / rate, float(rate)
             return True
         if prop == cv2.CAP_PROP_EXPOSURE:
             if self.props[cv2.CAP_PROP_AUTO_EXPOSURE] != 1:

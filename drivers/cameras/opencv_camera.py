@@ -17,6 +17,7 @@ dry runs and tests through the same read/drain/convert path, without camera cont
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any, Protocol
 
@@ -175,6 +176,19 @@ class OpenCvCamera:
             info["fourcc"] = got
             if got in RAW_GREY_FOURCCS:
                 self._set_verified(cap, cv2.CAP_PROP_CONVERT_RGB, 0, "convert_rgb")
+        if s.fps is not None:
+            # before the buffers: OpenCV restarts the stream for a new frame interval
+            accepted = cap.set(cv2.CAP_PROP_FPS, s.fps)
+            got = cap.get(cv2.CAP_PROP_FPS)
+            if got <= 0 or abs(got - s.fps) > 0.01 * s.fps:
+                raise DeviceError(
+                    self.name,
+                    f"camera did not take fps = {s.fps:g} in [camera.device] (set returned "
+                    f"{accepted}, reads back {got:g}): choose a frame rate it offers for this "
+                    f"format and size (`v4l2-ctl -d {s.device} --list-formats-ext`), or remove "
+                    "fps",
+                    "set fps",
+                )
         info["buffer_size_set"] = bool(cap.set(cv2.CAP_PROP_BUFFERSIZE, s.buffer_size))
         self._drain = self._drain_for_queue(cap, info)
         fps = cap.get(cv2.CAP_PROP_FPS)
@@ -268,8 +282,9 @@ class OpenCvCamera:
         Why: the capture drains ``self._drain`` frames and keeps one, all with the LED lit.
         Queued frames may be read at once, but a queue the camera has not refilled since the
         last capture (the settle is shorter than the queue at the frame rate) is waited for a
-        frame period a frame; each period is at least the exposure (a UVC sensor exposing
-        longer than its frame period slows its stream). Counted as every frame read waited
+        frame period a frame; each period is counted as at least the exposure (the worst case;
+        :meth:`refuse_exposure` refuses a longer exposure, which a UVC camera in manual exposure
+        clamps to the period). Counted as every frame read waited
         for, the worst case: the lit-time check made from the config alone counted only the
         exposure, and a 5 fps camera whose driver refused the one-buffer request held its LED
         1.6 s a capture past a ``max_on_s`` the check had passed."""
@@ -291,6 +306,41 @@ class OpenCvCamera:
             f"= {frames * period:.3g} s"
         )
         return frames * period, said
+
+    def refuse_exposure(self, exposure_s: float, before: str) -> None:
+        """Refuse an exposure longer than the frame period the connected camera reports.
+
+        Why: in manual exposure a UVC camera keeps its frame rate (auto-exposure priority,
+        which may slow the stream, applies to auto modes only and is off by default), so a
+        sensor asked for 0.05 s at 30 fps exposes 1/30 s, while ``exposure_absolute`` reads
+        back 500 units as set. The read-back check passed, the session recorded 0.05 s and
+        every image was a third darker than recorded, unsaid. The frame interval
+        (``CAP_PROP_FPS``, VIDIOC_G_PARM) is what bounds the exposure. Nothing is checked on an
+        image sequence or a camera reporting no frame rate. ``before`` says what was not done
+        ("nothing was lit")."""
+        fps = self.connection_info.get("fps")
+        if self._cap is None or self.settings.backend != "v4l2" or not fps:
+            return
+        period = 1.0 / fps
+        if exposure_s <= period * (1 + 1e-6):
+            return
+        slowest = math.floor(1.0 / exposure_s * 1000) / 1000
+        set_fps = (
+            "set"
+            if self.settings.fps is None
+            else f"lower fps = {self.settings.fps:g} in [camera.device] to"
+        )
+        raise DeviceError(
+            self.name,
+            f"exposure {exposure_s:g} s is longer than the frame period {period:.4g} s of the "
+            f"camera's {fps:g} fps (CAP_PROP_FPS): in manual exposure a UVC camera keeps its "
+            "frame rate and exposes at most one period, while its exposure reads back as set, "
+            f"so each image would be darker than recorded; {before}. {set_fps.capitalize()} "
+            f"fps = {slowest:g} or lower in [camera.device] if the camera offers it "
+            f"(`v4l2-ctl -d {self.settings.device} --list-formats-ext`), or shorten the "
+            f"exposure to at most {period:.4g} s ([camera] exposure_s, max_exposure_s)",
+            "check exposure",
+        )
 
     def _refuse_unset_response(self, image: np.ndarray) -> None:
         """An 8-bit frame with no ``response`` configured is refused, not taken as linear: such
@@ -366,6 +416,10 @@ class OpenCvCamera:
             )
         started = self._clock.now()
         if s.backend == "v4l2":
+            try:  # a caller that did not check before lighting: refused before any frame
+                self.refuse_exposure(exposure_s, "no frame was read")
+            except DeviceError as exc:
+                raise CaptureError(self.name, exc.message, "set exposure") from exc
             actual, units = self._apply_exposure(cap, exposure_s)
             gain = float(cap.get(cv2.CAP_PROP_GAIN))
             applied = True

@@ -122,6 +122,14 @@ class OpenCvCameraSettings(_Strict):
     gain: float | None = Field(None, description="CAP_PROP_GAIN to set and verify; None = leave")
     wb_temperature_k: int | None = Field(None, gt=0)
     buffer_size: int = Field(1, ge=1, description="CAP_PROP_BUFFERSIZE requested at connect")
+    fps: float | None = Field(
+        None,
+        gt=0.0,
+        description="CAP_PROP_FPS set and verified at connect; None = the camera's. In manual "
+        "exposure a UVC camera keeps its frame rate and clamps a longer exposure to the frame "
+        "period (its exposure still reads back as set): an exposure longer than 1/fps is "
+        "refused, so lower fps for longer ones",
+    )
     drain_frames: int | None = Field(
         None,
         ge=0,

@@ -301,6 +301,18 @@ def check_capture_fits_lit(rig: Rig, exposures_s: Iterable[float], before: str) 
     camera = rig.camera
     limit = lit_limit_s(rig)
     exposures = list(exposures_s)
+    _check_capture_lit_time(rig, camera, limit, exposures, before)
+    # a UVC camera exposes at most a frame period however long it is asked (its exposure
+    # reads back as set): refused here too, with no lit-time limit, before anything lights
+    refuse = getattr(camera, "refuse_exposure", None)
+    if refuse is not None and exposures:
+        refuse(max(exposures), before)
+
+
+def _check_capture_lit_time(
+    rig: Rig, camera: object, limit: float | None, exposures: list[float], before: str
+) -> None:
+    """The lit-time half of :func:`check_capture_fits_lit`."""
     if limit is None or not exposures or not isinstance(camera, FramePacedCamera):
         return
     exposure = max(exposures)  # a frame period is at least the exposure: the longest is worst

@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.clock import SystemClock, VirtualClock
+from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.drivers.cameras.opencv_camera import OpenCvCamera
 from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 from rti_rig.runtime.controller import shoot_lit
@@ -110,7 +111,7 @@ def _uvc_dome_config(tmp_path: Path) -> Path:
 
 
 @pytest.mark.pty
-@pytest.mark.parametrize("fps, fits", [(5.0, False), (30.0, True)], ids=["5fps", "30fps"])
+@pytest.mark.parametrize("fps, fits", [(5.0, False), (20.0, True)], ids=["5fps", "20fps"])
 def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
     tmp_path, monkeypatch, fps, fits
 ):
@@ -120,7 +121,7 @@ def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
     only, and the run lit LED 0 and stopped at the thermal guard ("LED 0 stayed on 1.555 s,
     beyond max_on_s = 1 s; raise max_on_s or shorten settle and exposure"). Now it is refused
     once the camera is connected, before any LED, naming the camera, the keys and figures; a
-    30 fps camera (8 frames, 0.27 s) runs."""
+    20 fps camera (8 frames, 0.4 s) runs."""
     cfg = _uvc_dome_config(tmp_path)
     stream = BufferedUvcStream(
         LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
@@ -151,7 +152,7 @@ def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
 def test_a_uvc_metering_shot_too_long_for_max_on_s_is_refused_before_it_is_lit(
     tmp_path, monkeypatch
 ):
-    """`run --auto-exposure` with a 30 fps UVC camera (8 frames a capture) on LEDs that may
+    """`run --auto-exposure` with a 20 fps UVC camera (8 frames a capture) on LEDs that may
     stay lit 1 s: a dark object is metered towards the longest exposure the config's lit-time
     sum allows (0.78 s), a capture that reads 8 frames of at least 0.78 s each (a UVC camera
     exposing longer than its frame period slows its stream) with the LED lit. The metering had
@@ -160,7 +161,7 @@ def test_a_uvc_metering_shot_too_long_for_max_on_s_is_refused_before_it_is_lit(
     cfg = _uvc_dome_config(tmp_path)
     stream = BufferedUvcStream(
         LightHistory(SystemClock()),  # type: ignore[arg-type]  # no light reaches it: dark
-        fps=30.0,
+        fps=20.0,
         buffers=4,
         buffer_size_accepted=False,
     )
@@ -176,3 +177,74 @@ def test_a_uvc_metering_shot_too_long_for_max_on_s_is_refused_before_it_is_lit(
     assert "beyond max_on_s = 1 s" in said and "uvc-camera" in said, said
     assert [e.what for e in firmware.history].count("lit") == 1  # the 0.05 s preview only
     assert "stayed on" not in said, said
+
+
+@pytest.mark.pty
+def test_a_uvc_exposure_longer_than_the_frame_period_is_refused_before_any_led_lights(
+    tmp_path, monkeypatch
+):
+    """`rti-rig run` at exposure_s = 0.05 s with a 30 fps UVC camera: in manual exposure the
+    camera keeps its frame rate and exposes 1/30 s, while exposure_absolute reads back 500
+    units as set. The run recorded 0.05 s for images exposed 0.033 s; it is now refused once
+    the camera is connected, before any LED, naming the camera, the keys and the frame rate to
+    set. With fps = 20 in [camera.device] (offered by the camera) it runs, each kept frame
+    exposed the 0.05 s recorded."""
+    cfg = _uvc_dome_config(tmp_path)
+    stream = BufferedUvcStream(
+        LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
+        fps=30.0,
+        frame_rates=(30.0, 20.0, 15.0),
+    )
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--no-verdict"]
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, args)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert not [e for e in firmware.history if e.what == "lit"]
+    assert "uvc-camera" in said and "exposure 0.05 s is longer than the frame period" in said
+    assert "30 fps" in said and "fps = 20 or lower in [camera.device]" in said, said
+    assert "[camera] exposure_s" in said and "nothing was lit" in said, said
+    assert "Traceback" not in said and not out.exists()
+
+    cfg.write_text(cfg.read_text().replace('kind = "opencv"\n', 'kind = "opencv"\nfps = 20\n'))
+    stream = BufferedUvcStream(
+        LightHistory(SystemClock()),  # type: ignore[arg-type]
+        fps=30.0,
+        frame_rates=(30.0, 20.0, 15.0),
+    )
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, args)
+    assert r.exit_code == 0, r.output
+    assert len([e for e in firmware.history if e.what == "lit"]) == 4
+    kept = stream.delivered[-4:]
+    assert all(b - a == pytest.approx(0.05) for _, rows in kept for a, b in rows), kept
+
+
+def test_a_frame_rate_the_camera_does_not_offer_is_refused_at_connect_naming_the_key():
+    stream = BufferedUvcStream(LightHistory(VirtualClock()), fps=30.0, frame_rates=(30.0, 15.0))
+    cam = OpenCvCamera(
+        OpenCvCameraSettings(device=0, fps=20.0),
+        clock=stream.clock,
+        capture_factory=lambda dev, api: stream,
+    )
+    with pytest.raises(DeviceError) as info:
+        cam.connect()
+    said = str(info.value)
+    assert "fps = 20 in [camera.device]" in said and "reads back 15" in said
+    assert "--list-formats-ext" in said
+
+
+def test_a_capture_not_checked_before_lighting_is_refused_before_a_frame_is_read():
+    """A caller that did not check (a script driving the camera): refused before any frame,
+    never recorded at an exposure the sensor did not take."""
+    stream = BufferedUvcStream(LightHistory(VirtualClock()), fps=30.0)
+    cam = OpenCvCamera(
+        OpenCvCameraSettings(device=0), clock=stream.clock, capture_factory=lambda d, a: stream
+    )
+    with cam, pytest.raises(CaptureError, match="longer than the frame period"):
+        cam.capture(0.05)
+    assert not stream.delivered
+    with cam:
+        assert cam.capture(0.03).exposure_s == pytest.approx(0.03)
