@@ -31,6 +31,7 @@ CFA_CODES: dict[str, tuple[int, int, int, int]] = {
 MIN_SIDE = 22
 
 TAG_MAKE = 271
+TAG_DATE_TIME = 306
 TAG_MODEL = 272
 TAG_CFA_REPEAT = 33421
 TAG_CFA_PATTERN = 33422
@@ -61,12 +62,15 @@ def dng_bytes(
     make: str = "rti-rig",
     model: str = "simulated",
     as_shot_neutral: tuple[float, float, float] | None = None,
+    date_time: str | None = None,
 ) -> bytes:
     """Encode a Bayer mosaic (uint16, H×W, even sizes) as an uncompressed DNG and return bytes.
 
     ``mosaic`` holds raw code values *including* the black offset, as a sensor delivers them.
     ``black_level`` is one value, or four for the 2×2 positions row by row (written with
-    BlackLevelRepeatDim, as cameras with per-channel black levels do).
+    BlackLevelRepeatDim, as cameras with per-channel black levels do). ``date_time``
+    ("YYYY:MM:DD HH:MM:SS", the camera's clock, whole seconds) is written as IFD0's DateTime,
+    which LibRaw reads as the capture time (rawpy's ``other.timestamp``).
     """
     arr = np.asarray(mosaic)
     if arr.dtype != np.uint16 or arr.ndim != 2:
@@ -111,6 +115,8 @@ def dng_bytes(
         for v in as_shot_neutral:
             flat.extend(_rational(v, 10_000))
         tags.append((TAG_AS_SHOT_NEUTRAL, "2I", 3, tuple(flat), True))
+    if date_time is not None:
+        tags.append((TAG_DATE_TIME, "s", 0, date_time, True))
     buf = io.BytesIO()
     tifffile.imwrite(buf, arr, photometric=tifffile.PHOTOMETRIC.CFA, extratags=tags, metadata=None)
     return buf.getvalue()

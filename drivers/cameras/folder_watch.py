@@ -27,6 +27,19 @@ exposure after the pulse (see ``expose``), without one once the file has come; t
 the decode then happen in the dark. Held lit until the image was in hand, a RAW arriving over
 Wi-Fi 9 s after the pulse ran into the dome's ``max_on_s`` = 8 s and the good shot was lost.
 
+With a trigger, a file's own capture time (LibRaw's timestamp: EXIF DateTimeOriginal or the
+TIFF DateTime, whole seconds on the camera's clock) is checked against the pulses: the first
+image after ``connect`` anchors the camera clock to its pulse, and each later file must have
+been shot as long after the last image as its pulse came after that image's pulse, within
+:data:`CAPTURE_TIME_RESOLUTION_S` plus ``shutter_lag_s``. A file out of step (a pulse's file
+that came after the run had stopped at the timeout and was resumed, or a second frame) is set
+aside in ``strays/`` and the pulse's own file waited for; one that fits the set-aside file as
+the next pulse's proves the last image was a late file of an earlier pulse, said in a notice.
+Only differences of the camera clock are used (its offset, time zone and setting are free; its
+drift over a session is taken as negligible). What this cannot check: the first image after a
+``connect`` (no anchor yet), and files without a capture time (8-bit or 16-bit TIFF/PNG, a
+RAW LibRaw finds no time in).
+
 Once the rig is bound to a session, a taken file is copied into the session's
 ``raw/.incoming`` before it is decoded, and that copy is decoded and kept: the folder belongs
 to another program, which may move its files out (an auto import) or rename them meanwhile.
@@ -81,6 +94,13 @@ RAW_SUFFIXES = {
     ".x3f",
 }
 
+#: A capture time's resolution: EXIF DateTimeOriginal is whole seconds, and LibRaw's timestamp
+#: (rawpy's ``other.timestamp``) keeps no SubSecTimeOriginal; a difference of two such times is
+#: off by less than this
+CAPTURE_TIME_RESOLUTION_S = 1.0
+#: files out of step with the pulses set aside for one pulse before the run is stopped
+MAX_OUT_OF_STEP = 3
+
 #: 8-bit formats a camera saves beside its RAW (RAW+JPEG): never a linear image
 JPEG_SUFFIXES = {".jpg", ".jpeg"}
 
@@ -107,6 +127,26 @@ def _identity(path: Path) -> tuple[int, int, int, int] | None:
     return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
 
 
+def capture_time(path: Path) -> float | None:
+    """The capture time LibRaw reads in ``path`` (EXIF DateTimeOriginal, or the TIFF DateTime),
+    in seconds on the camera's clock (only differences are meaningful), or None when the file
+    is no RAW, LibRaw cannot open it or it holds no time (LibRaw then gives the epoch)."""
+    if not is_raw_file(path):
+        return None
+    try:
+        import rawpy
+
+        with rawpy.imread(str(path)) as raw:
+            stamp = raw.other.timestamp
+    except Exception:  # no evidence: the file's own decode says what is wrong with it
+        return None
+    try:
+        value = stamp.timestamp()
+    except (OverflowError, OSError, ValueError, AttributeError):
+        return None
+    return None if stamp.year <= 1970 else float(value)
+
+
 def _has_header(path: Path) -> bool:
     """Whether ``path``'s first bytes are written (not all zero).
 
@@ -131,6 +171,10 @@ class _Pending:
     path: Path | None = None
     stray: list[str] = field(default_factory=list)
     unconfirmed: str | None = None
+    #: when the trigger returned (the rig's clock): the pulse a file's capture time must fit
+    pulsed_at: float | None = None
+    #: files that came after the pulse but were shot out of step with it, said in notices
+    out_of_step: list[str] = field(default_factory=list)
 
 
 class FolderWatchCamera:
@@ -159,6 +203,12 @@ class FolderWatchCamera:
         #: pattern matches)
         self._at_connect: set[str] = set()
         self._pending: _Pending | None = None
+        #: (capture time, pulse time) of the last image whose file had a capture time: the
+        #: camera clock's anchor to the pulses
+        self._anchor: tuple[float, float] | None = None
+        #: (capture time, the pulse before) of the last file set aside as out of step: a late
+        #: file of the previous pulse, if the next file fits it
+        self._orphan: tuple[float, float] | None = None
         #: where a taken file is copied before it is decoded: the session's ``raw/.incoming``,
         #: set when the rig is bound to a session (None: decoded where it lies)
         self.output_dir: Path | None = None
@@ -179,6 +229,8 @@ class FolderWatchCamera:
         self._seen_inodes = {i[:2] for i in self._seen_ids}
         self._reused_names = set()
         self._taken_stems = set()
+        self._anchor = None
+        self._orphan = None
 
     def close(self) -> None:
         self._seen = None
@@ -377,6 +429,7 @@ class FolderWatchCamera:
             self._trigger(exposure_s)
         except TriggerUnconfirmed as exc:
             pending.unconfirmed = str(exc)
+        pending.pulsed_at = self._clock.now()
         self._pending = pending
         return self._clock.now() + self.settings.shutter_lag_s + exposure_s
 
@@ -386,18 +439,12 @@ class FolderWatchCamera:
         if pending is None:
             raise CaptureError(self.name, "collect() without expose() before it", "capture")
         path = pending.path
+        notes: list[str] = []
         if path is None:
-            try:
-                path = self.wait_for_file()
-            except CaptureError as exc:
-                if pending.unconfirmed is None:
-                    raise
-                raise CaptureError(
-                    self.name,
-                    f"{exc.message}; the trigger was not confirmed either ({pending.unconfirmed})",
-                    "wait for file",
-                ) from exc
+            path, notes = self._await_pulse_file(pending)
         frame = self._decode_complete(path, pending.exposure_s, pending.started)
+        if notes:
+            frame.metadata["notices"] = [*(frame.metadata.get("notices") or []), *notes]
         if pending.stray:
             frame.metadata["stray_files"] = pending.stray
             kept = self._hold_strays(pending.stray)
@@ -409,11 +456,24 @@ class FolderWatchCamera:
                 else f"; {'it is' if len(kept) == 1 else f'{len(kept)} are'} kept aside in the "
                 "session's strays/ (the step's 'strays' in the journal), never as an image"
             )
+            before = [n for n in pending.stray if n not in pending.out_of_step]
+            said = []
+            if before:
+                said.append(
+                    f"{len(before)} file(s) came into the watched folder before this shot's "
+                    f"trigger and were not used: {', '.join(before)} (a duplicate or a shot "
+                    "no light asked for)"
+                )
+            if pending.out_of_step:
+                said.append(
+                    f"{len(pending.out_of_step)} file(s) came after this shot's trigger but "
+                    f"were shot out of step with it and not used: "
+                    f"{', '.join(pending.out_of_step)} (their capture times fit no pulse of "
+                    "this run: a late file of an earlier pulse, or a shot no light asked for)"
+                )
             frame.metadata["notices"] = [
                 *(frame.metadata.get("notices") or []),
-                f"{len(pending.stray)} file(s) came into the watched folder before this shot's "
-                f"trigger and were not used: {', '.join(pending.stray)} (a duplicate or a shot "
-                f"no light asked for){where}",
+                *(f"{x}{where}" for x in said),
             ]
         if pending.unconfirmed is not None:
             frame.metadata["trigger_unconfirmed"] = pending.unconfirmed
@@ -422,6 +482,74 @@ class FolderWatchCamera:
                 "the trigger's confirmation was lost but the camera's file arrived",
             ]
         return frame
+
+    def _await_pulse_file(self, pending: _Pending) -> tuple[Path, list[str]]:
+        """The file of ``pending``'s pulse: the next new file whose capture time fits the
+        pulse (see the module docstring); those out of step are set aside as strays.
+
+        Why: a file that came after the run stopped at ``timeout_s`` and was resumed was taken
+        as the resumed pulse's image (its light right), but that pulse's own file then came
+        after the next pulse and was taken for the next light, and so on: every later image
+        recorded under a light it was not taken under."""
+        while True:
+            try:
+                path = self.wait_for_file()
+            except CaptureError as exc:
+                said = exc.message
+                if pending.out_of_step:
+                    said += (
+                        f"; {', '.join(pending.out_of_step)} came after the pulse but "
+                        f"{'were' if len(pending.out_of_step) > 1 else 'was'} shot out of step "
+                        "with it (a late file of an earlier pulse?) and set aside in strays/"
+                    )
+                if pending.unconfirmed is not None:
+                    said += f"; the trigger was not confirmed either ({pending.unconfirmed})"
+                if said == exc.message:
+                    raise
+                raise CaptureError(self.name, said, "wait for file") from exc
+            taken = capture_time(path)
+            if pending.pulsed_at is None or taken is None:
+                return path, []
+            placed = self._place(taken, pending.pulsed_at)
+            if placed is not None:
+                return path, placed
+            pending.stray.append(path.name)
+            pending.out_of_step.append(path.name)
+            if len(pending.out_of_step) > MAX_OUT_OF_STEP:
+                raise CaptureError(
+                    self.name,
+                    f"{', '.join(pending.out_of_step)} came into {self.settings.folder} after "
+                    "this light's pulse, but none was shot in step with the pulses (its capture "
+                    "time against the last image's, within "
+                    f"{CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s:g} s: "
+                    "shutter_lag_s plus the 1 s of EXIF times): is the camera's clock being "
+                    "set meanwhile, or another camera saving there? They are kept in strays/; "
+                    "no image was recorded for this light",
+                    "check capture time",
+                )
+
+    def _place(self, taken: float, pulsed_at: float) -> list[str] | None:
+        """Whether a file shot at ``taken`` (camera clock) is the file of the pulse at
+        ``pulsed_at`` (rig clock): the notices to give it if so, None if it is out of step
+        (then remembered as a possible late file of the previous pulse)."""
+        tol = CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s
+        anchor, orphan = self._anchor, self._orphan
+        notes: list[str] = []
+        if anchor is not None and abs((taken - anchor[0]) - (pulsed_at - anchor[1])) > tol:
+            if orphan is None or abs((taken - orphan[0]) - (pulsed_at - orphan[1])) > tol:
+                self._orphan = (taken, anchor[1])
+                return None
+            # the set-aside file was the previous pulse's: the last image was an earlier one's
+            early = orphan[0] - anchor[0]
+            notes.append(
+                "the previous image's file was shot "
+                f"{early:.0f} s before the file of its pulse, which came only after the next "
+                "pulse and is kept in strays/: it was a late file of an earlier pulse (one the "
+                "run stopped waiting for before a resume?); check that the object and the light "
+                "were the same then"
+            )
+        self._anchor, self._orphan = (taken, pulsed_at), None
+        return notes
 
     def _drop_copy(self, held: Path) -> None:
         """Delete a copy :meth:`_hold` made, and the folders it made for it if they are left

@@ -8,6 +8,8 @@ The same happened to the JPEG of a RAW+JPEG shot when the patterns matched both.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scripted_clock import ScriptedClock
@@ -201,3 +203,88 @@ def test_a_file_there_before_the_pulse_is_not_the_pulses_picture(tmp_path):
     assert [round(level_of(f), 2) for f in frames] == [0.2, 0.4, 0.6]
     assert frames[1].metadata["stray_files"] == ["IMG_0001_copy.DNG"]
     assert any("IMG_0001_copy.DNG" in n for n in frames[1].metadata["notices"])
+
+
+class _Body:
+    """A camera fired by the dome's shutter line, its tethering program saving each shot's DNG
+    ``delays[n]`` s after the n-th pulse (on the test's clock), stamped with the camera clock's
+    DateTime (whole seconds, ``offset_s`` from the rig's clock: another time zone)."""
+
+    def __init__(self, folder, delays, offset_s=3600.0 * 5 + 17.4):
+        self.folder, self.delays, self.offset_s = folder, list(delays), offset_s
+        self.clock = ScriptedClock({})
+        self.pulses: list[float] = []
+
+    def pulse(self, exposure_s: float) -> None:
+        import datetime
+
+        n, at = len(self.pulses) + 1, self.clock.now()
+        self.pulses.append(at)
+        stamp = datetime.datetime(2026, 11, 30, 9, 0, 0) + datetime.timedelta(
+            seconds=at + self.offset_s
+        )
+        mosaic = linear_to_mosaic(np.full((32, 32), 0.1 * n), "RGGB", 256, 4095)
+
+        def save() -> None:
+            write_dng(
+                self.folder / f"IMG_{n:04d}.DNG",
+                mosaic,
+                black_level=256,
+                white_level=4095,
+                exposure_s=exposure_s,
+                date_time=stamp.strftime("%Y:%m:%d %H:%M:%S"),
+            )
+
+        self.clock.actions = sorted([*self.clock.actions, (at + self.delays[n - 1], save)])
+
+
+def test_a_file_late_past_a_stopped_run_does_not_put_the_resumed_images_one_light_off(tmp_path):
+    """Pulse 2's file comes 20 s late, after the run stopped at timeout_s = 15 s; the resume
+    pulses light 2 again, 10 s later, and the late file comes after that pulse: taken for light
+    2 (its light). The resumed pulse's own file comes after the next pulse and had been taken
+    for light 3, every later image one light off. Its capture time (17 s after the image
+    before, the pulses 3.25 s apart) now sets it aside in strays, and light 3 gets its own
+    file, which fits it as the next pulse's."""
+    # n-th pulse's file delay: 1 s, then pulse 2's 20 s (past the timeout), then the resumed
+    # run's: pulse 3 (light 2 again) 4 s, after the late file; pulses 4 and 5 (lights 3, 4) 1.5 s
+    body = _Body(tmp_path, [1.0, 20.0, 4.0, 1.5, 1.5])
+    settings = FolderWatchSettings(
+        folder=tmp_path, timeout_s=15.0, poll_interval_s=0.125, shutter_lag_s=0.25
+    )
+
+    def camera() -> FolderWatchCamera:
+        return FolderWatchCamera(settings, clock=body.clock, trigger=body.pulse)
+
+    first = camera()
+    first.connect()
+    assert first.capture(0.5).metadata["watched_file"].endswith("IMG_0001.DNG")
+    with pytest.raises(CaptureError, match="within 15 s"):
+        first.capture(0.5)  # light 2: the run stops
+    first.close()
+    body.clock.sleep(2.0)  # the user resumes: pulse 2's file is still on its way
+    resumed = camera()
+    resumed.connect()
+    got = []
+    for _ in range(3):  # lights 2, 3, 4
+        frame = resumed.capture(0.5)
+        got.append((Path(frame.metadata["watched_file"]).name, frame.metadata.get("notices")))
+    names = [n for n, _ in got]
+    # light 2: the late file (a shot of light 2); light 3: pulse 4's; light 4: pulse 5's
+    assert names == ["IMG_0002.DNG", "IMG_0004.DNG", "IMG_0005.DNG"], got
+    said = " ".join(got[1][1] or [])
+    assert "IMG_0003.DNG" in said and "shot out of step" in said, said
+    assert "late file of an earlier pulse" in said, said
+    assert not got[0][1] and not got[2][1], got
+
+
+def test_files_in_step_with_the_pulses_are_all_taken_whatever_the_camera_clock(tmp_path):
+    """Files coming up to a few seconds late, the camera clock hours off: every one taken."""
+    body = _Body(tmp_path, [3.0, 0.2, 4.0, 1.0], offset_s=-7 * 3600 + 0.9)
+    cam = FolderWatchCamera(
+        FolderWatchSettings(folder=tmp_path, timeout_s=10.0, poll_interval_s=0.125),
+        clock=body.clock,
+        trigger=body.pulse,
+    )
+    cam.connect()
+    names = [Path(cam.capture(0.5).metadata["watched_file"]).name for _ in range(4)]
+    assert names == [f"IMG_{n:04d}.DNG" for n in range(1, 5)]
