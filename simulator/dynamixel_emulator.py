@@ -529,7 +529,7 @@ class DynamixelBusEmulator:
         self.corrupt_next_replies = 0
         self.drop_next_replies = 0
         self.reply_faults: dict[int, str] = {}
-        self.hardware_faults: dict[int, tuple[int, str]] = {}
+        self.hardware_faults: dict[int, list[tuple[int, str]]] = {}
         #: instruction packets received so far (what ``reply_faults`` counts)
         self.instructions_received = 0
         self.goal_log: list[tuple[int, int]] = []
@@ -581,13 +581,11 @@ class DynamixelBusEmulator:
                     continue
                 self.instructions.append(item)
                 self.instructions_received += 1
-                raised = self.hardware_faults.get(self.instructions_received)
-                if raised is not None and raised[0] in self.servos:
-                    # the servo's own error, as it meets it (an overload under load): its
-                    # bit, the Alert flag from this status on, torque off if Shutdown says
-                    self.servos[raised[0]].inject_hardware_error(
-                        int(HARDWARE_FAULT_BITS[raised[1]])
-                    )
+                for dxl_id, kind in self.hardware_faults.get(self.instructions_received, ()):
+                    if dxl_id in self.servos:
+                        # the servo's own error, as it meets it (an overload under load): its
+                        # bit, the Alert flag from this status on, torque off if Shutdown says
+                        self.servos[dxl_id].inject_hardware_error(int(HARDWARE_FAULT_BITS[kind]))
                 fault = self.reply_faults.get(self.instructions_received)
                 reply = self._handle(item)
                 if reply and fault == "drop_reply":
@@ -596,6 +594,17 @@ class DynamixelBusEmulator:
                     reply = reply[:-1] + bytes([reply[-1] ^ 0xFF])
                 out += reply
             return bytes(out)
+
+    def add_fault(self, at: int, kind: str, servo_id: int | None = None) -> None:
+        """Rehearse a fault at the ``at``-th instruction packet: a status lost or damaged
+        (``drop_reply``, ``garble_reply``) or servo ``servo_id``'s hardware error (a key of
+        :data:`HARDWARE_FAULT_BITS`). One place for a config's ``[[emulator.faults]]`` and the
+        manual tool's ``--fault``; several servos' errors at one packet are all raised (they
+        had been kept by packet, the last one alone)."""
+        if kind in HARDWARE_FAULT_BITS:
+            self.hardware_faults.setdefault(at, []).append((int(servo_id or 0), kind))
+        else:
+            self.reply_faults[at] = kind
 
     def _reply(self, dxl_id: int, number: int = 0, params: bytes = b"") -> bytes:
         servo = self.servos[dxl_id]
@@ -918,10 +927,7 @@ def served_arm(
     for servo in emulator.servos.values():
         servo._set(ct.BAUD_RATE, codes[baudrate])
     for at, kind, dxl_id in faults:
-        if kind in HARDWARE_FAULT_BITS:
-            emulator.hardware_faults[at] = (int(dxl_id or 0), kind)
-        else:
-            emulator.reply_faults[at] = kind
+        emulator.add_fault(at, kind, dxl_id)
     with PtyServoServer(emulator) as server:
         yield server, emulator
 

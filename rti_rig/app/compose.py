@@ -260,17 +260,8 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     )
     # [[emulator.faults]]: the status of the K-th instruction packet lost or damaged, or a
     # servo's hardware error (overload …) raised as that packet arrives
-    from rti_rig.app.config import ARM_HARDWARE_FAULTS
-
-    faults = loaded.config.emulator.faults
-    emulator.reply_faults = {
-        f.at_command: f.kind for f in faults if f.kind not in ARM_HARDWARE_FAULTS
-    }
-    emulator.hardware_faults = {
-        f.at_command: (int(f.servo_id or 0), f.kind)
-        for f in faults
-        if f.kind in ARM_HARDWARE_FAULTS
-    }
+    for f in loaded.config.emulator.faults:
+        emulator.add_fault(f.at_command, f.kind, f.servo_id)
     try:
         arm = DynamixelArm(settings, port, clock)
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)

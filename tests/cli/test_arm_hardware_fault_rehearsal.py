@@ -80,3 +80,38 @@ def test_a_hardware_fault_needs_one_of_the_arms_servos_and_is_refused_on_a_dome(
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "overload with servo_id is a servo's fault" in said
+
+
+def test_two_servos_faulting_at_one_packet_are_both_rehearsed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two ``[[emulator.faults]]`` at the same packet, one per servo (a supply sag overloads
+    both joints at once): both servos latch their errors. The emulator kept its hardware
+    faults by packet, one each, so the first was dropped without a word and only servo 2
+    faulted."""
+    emulators: list = []  # type: ignore[type-arg]
+    real_build = compose.build_rig
+
+    def build(*args, **kwargs):  # type: ignore[no-untyped-def]
+        rig = real_build(*args, **kwargs)
+        emulators.append(rig.emulator)
+        return rig
+
+    monkeypatch.setattr(compose, "build_rig", build)
+    monkeypatch.setattr(check_usecase, "build_rig", build)
+    both = FAULT.replace("servo_id = 2", "servo_id = 1") + FAULT
+    r = runner.invoke(app, ["check", str(_config(tmp_path, both))], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "Traceback" not in said, said
+    (emu,) = emulators
+    for dxl_id in (1, 2):
+        assert emu.servos[dxl_id].get(ct.HARDWARE_ERROR_STATUS) & ct.HardwareFault.OVERLOAD
+
+
+def test_the_configs_hardware_fault_kinds_are_the_emulators() -> None:
+    """The kinds a config accepts as a servo's hardware error are those the emulator raises
+    (two lists, in two layers: a kind added to one alone would be refused or never raised)."""
+    from rti_rig.app.config import ARM_HARDWARE_FAULTS
+    from rti_rig.simulator.dynamixel_emulator import HARDWARE_FAULT_BITS
+
+    assert set(ARM_HARDWARE_FAULTS) == set(HARDWARE_FAULT_BITS)
