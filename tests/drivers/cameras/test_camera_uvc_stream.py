@@ -92,13 +92,13 @@ def test_every_frame_is_exposed_wholly_under_its_own_light(buffers, accepted, la
         assert frame.exposure_s == pytest.approx(exposure)
 
 
-def _uvc_dome_config(tmp_path: Path) -> Path:
+def _uvc_dome_config(tmp_path: Path, max_on_s: float = 1.0) -> Path:
     """The shipped 48-LED dome with a UVC camera, LEDs that may stay lit 1 s at a time: the
     config's own check passes (settle 0.1 + exposure 0.05 + readout 0.05 + transfer 0.05 +
     all-off 0.02 = 0.27 s)."""
     text = (CONFIGS / "example_dome_48.toml").read_text()
     text = text.replace('"example_dome_48.lp"', f'"{CONFIGS / "example_dome_48.lp"}"')
-    text = text.replace("max_on_s = 8.0", "max_on_s = 1.0")
+    text = text.replace("max_on_s = 8.0", f"max_on_s = {max_on_s}")
     text = text.replace("exposure_s = 0.125", "exposure_s = 0.05")
     text = text.replace("width = 6000\nheight = 4000", "width = 4\nheight = 8")
     text = text[: text.index("[camera.device]")] + (
@@ -121,8 +121,10 @@ def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
     only, and the run lit LED 0 and stopped at the thermal guard ("LED 0 stayed on 1.555 s,
     beyond max_on_s = 1 s; raise max_on_s or shorten settle and exposure"). Now it is refused
     once the camera is connected, before any LED, naming the camera, the keys and figures; a
-    20 fps camera (8 frames, 0.4 s) runs."""
-    cfg = _uvc_dome_config(tmp_path)
+    20 fps camera (8 frames, 0.4 s) runs. The LEDs may stay lit 1.5 s here, not 1 s: the
+    20 fps run is timed on the real clock of a pty session (0.62 s lit a step), and a loaded
+    machine must keep inside the guard."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
     stream = BufferedUvcStream(
         LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
         fps=fps,
@@ -143,7 +145,7 @@ def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
     assert not lit, lit  # no LED was lit
     assert "uvc-camera" in said and "8 frames at 5 fps, 0.2 s each" in said, said
     assert "the 4 buffers the driver queues and 3 fresh" in said, said
-    assert "= 1.82 s, beyond max_on_s = 1 s" in said and str(cfg) in said.replace(" ", ""), said
+    assert "= 1.82 s, beyond max_on_s = 1.5 s" in said and str(cfg) in said.replace(" ", ""), said
     assert "timing.settle_s 0.1" in said and "nothing was lit" in said, said
     assert "Traceback" not in said and not list(out.glob("*.jpg"))
 
