@@ -912,6 +912,8 @@ class JournalScan:
     rejected: list[tuple[int, str, str]] = field(default_factory=list)
     torn: bytes = b""
     mended: list[str] = field(default_factory=list)
+    #: the journal file is not there at all (every record in ``records`` is a record file's)
+    missing: bool = False
 
     @property
     def needs_repair(self) -> bool:
@@ -978,6 +980,10 @@ def scan_journal(root: Path, names: list[str] | None = None) -> JournalScan:
     try:
         data = path.read_bytes()
     except FileNotFoundError:
+        # a journal deleted outright loses no step its record file proves (each verified
+        # against its files): it had been refused as lost for good, records/ holding them all
+        scan.missing = True
+        _mend_from_step_records(Path(root), names, scan)
         return scan
     except OSError as exc:
         raise SessionError(f"cannot read {path}: {exc.strerror or exc}") from None
@@ -1233,7 +1239,15 @@ def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[str]:
             "# torn last line (no newline: the process died while writing it; never "
             f"committed)\n{scan.torn.decode('utf-8', 'replace')}\n"
         )
-    for rel in scan.mended:
+    if scan.missing and scan.mended:
+        stems = [Path(rel).stem for rel in scan.mended]
+        notes.append(
+            f"{JOURNAL} was missing: rebuilt from {len(stems)} step record file(s) in "
+            f"{RECORDS_DIR}/ ({', '.join(stems[:8])}{' …' if len(stems) > 8 else ''}), each "
+            "taken only with its files on disk as its checksums say: those images are kept, "
+            "not shot again"
+        )
+    for rel in [] if scan.missing else scan.mended:
         notes.append(
             f"journal: the record of {Path(rel).stem}, which it had lost, written back from "
             f"{rel} (its files are as that record says: the image is kept, not shot again)"
@@ -1395,13 +1409,15 @@ def _prepare_resume(
                 f"{shlex.quote(str(root))}"
             )
         unjournaled = _unjournaled_steps(root, manifest, scan, names)
-        if rebuild_journal and unjournaled:
+        if rebuild_journal and (unjournaled or scan.missing):
+            # a journal gone: rebuilt from what proves each step (the manifest's records, the
+            # step record files), the rest set aside, as asked
             rebuilt = _provable_steps(root, manifest, names, scan.records)
             done = {i: _to_record(e) for i, e in rebuilt.items()}
         else:
             if unjournaled:
                 _refuse_unjournaled(root, scan, names, unjournaled)
-            _refuse_lost_journal(root, names)
+            _refuse_lost_journal(root, names, scan)
             done = verified_steps(root, scan.records)
         latest = _latest_records(scan.records)
         renamed = renamed_jpegs(root, scan.records)
@@ -1421,10 +1437,10 @@ def _prepare_resume(
         rebuild: list[str] = []
         if rebuilt is not None:
             rebuild, moved_aside = _rebuild_journal(
-                root, manifest, rebuilt, names, stamp, scan.records
+                root, manifest, rebuilt, names, stamp, scan.records, from_records=scan.missing
             )
             recovered.extend(moved_aside)
-        elif rebuild_journal:
+        elif rebuild_journal and not scan.mended:  # a rebuild from records/: said by repair
             rebuild = [
                 f"{JOURNAL} already holds a record of every image {MANIFEST} lists as captured: "
                 "nothing rebuilt (the resume goes on as without --rebuild-journal)"
@@ -1875,6 +1891,7 @@ def _rebuild_journal(
     stamp: str,
     journaled: list[dict[str, Any]],
     lost: Mapping[int, dict[str, Any]] | None = None,
+    from_records: bool = False,
 ) -> tuple[list[str], list[str]]:
     """Rebuild the journal from ``taken`` (:func:`_provable_steps`) and the records of a
     completed session's images recorded as lost (``lost``: their light as recorded, their
@@ -1890,7 +1907,10 @@ def _rebuild_journal(
     The old journal is copied aside and replaced by the new one in one rename, last: it had been
     moved aside first, so a kill (SIGKILL, a power cut) before the new one was written left the
     session with no journal at all, and the next rebuild, reading none, set aside and shot again
-    the images only its intact lines proved."""
+    the images only its intact lines proved.
+
+    ``from_records``: the journal was missing, so the records ``journaled`` holds are the step
+    record files' (``records/``), each verified against its files, and are said to be."""
     notes: list[str] = []
     moved: list[str] = []
     aside = root / "recovered" / stamp
@@ -1959,10 +1979,15 @@ def _rebuild_journal(
         + (f" ({_shown(names, from_manifest)})" if from_manifest else "")
         + ", each file matching the manifest's checksum and its light the manifest's"
         + (
-            f"; and {len(from_journal)} from the old {JOURNAL}'s intact lines "
-            f"({_shown(names, from_journal)}), committed after {MANIFEST} was last written (a "
-            "run killed before its end), each file matching its line's checksum and its light "
-            "the one its step was given"
+            f"; and {len(from_journal)} from "
+            + (
+                f"their step record files in {RECORDS_DIR}/ ({JOURNAL} was missing)"
+                if from_records
+                else f"the old {JOURNAL}'s intact lines"
+            )
+            + f" ({_shown(names, from_journal)}), committed after {MANIFEST} was last written "
+            "(a run killed before its end), each file matching its record's checksum and its "
+            "light the one its step was given"
             if from_journal
             else ""
         ),
@@ -2025,7 +2050,7 @@ def _shown(names: list[str], steps: list[int]) -> str:
     return ", ".join(names[i] for i in steps[:8]) + (" …" if len(steps) > 8 else "")
 
 
-def _refuse_lost_journal(root: Path, names: list[str]) -> None:
+def _refuse_lost_journal(root: Path, names: list[str], scan: JournalScan) -> None:
     """Refuse to resume an interrupted session whose journal is gone while images of its later
     steps are on disk, before anything moves.
 
@@ -2034,12 +2059,40 @@ def _refuse_lost_journal(root: Path, names: list[str]) -> None:
     journal was missing (deleted by hand, or left behind by a copy). A step begins only once the
     previous one's journal line is on disk, so files of a step after the first prove there was
     a journal; files of the first step alone are a kill before the first line, which a resume
-    sets aside and reshoots as ever."""
+    sets aside and reshoots as ever.
+
+    The step record files (``records/``) that ``scan`` took in the journal's place prove their
+    steps; files of the step after the last of them are the step a kill cut short, set aside
+    and reshot as ever. Files of any other step are still refused: a record file of theirs is
+    gone or no longer matches them, and only the journal's backup could vouch for them."""
     if (root / JOURNAL).exists():
         return
-    later = _files_after_first_step(root, names)
+    proven = {int(r["index"]) for r in scan.records}
+    if proven:  # the steps proven, and the one after the last of them (cut short by a kill)
+        proven.add(min(max(proven) + 1, len(names) - 1))
+    allowed = {names[i] for i in proven}
+    later = [
+        stem
+        for stem in _files_after_first_step(root, names)
+        if not any(stem == n or stem.startswith(f"{n}_") for n in allowed)
+    ]
     if not later:
         return
+    if proven:
+        bases = sorted(
+            {n for n in names for stem in later if stem == n or stem.startswith(f"{n}_")}
+        )
+        shown = ", ".join(bases[:8]) + (" …" if len(bases) > 8 else "")
+        raise SessionError(
+            f"{root}: {JOURNAL} is missing; the step record files in {RECORDS_DIR}/ prove "
+            f"{len(scan.records)} image(s) as captured, but not {shown}, whose record files "
+            "are gone or no longer match them: restore "
+            f"{JOURNAL} (or {RECORDS_DIR}/) from a backup copy of the folder, then run "
+            f"rti-rig run --resume {shlex.quote(str(root))} again; if it is lost for good, "
+            "rti-rig run --resume "
+            f"{shlex.quote(str(root))} --rebuild-journal sets them aside in recovered/ (never "
+            "deleted) and shoots them again (nothing in this folder was changed)"
+        )
     first = names[0] if names else ""
     count = len({stem.split("_")[1] for stem in later} | {first.split("_")[1]})
     raise SessionError(
@@ -2507,6 +2560,7 @@ def journal_mend_note(root: Path) -> str | None:
     if scan.torn.strip():
         parts.append("its last line cut short")
     why = ", ".join(parts) or "records missing"
+    state = "is missing, so it" if scan.missing else f"is damaged ({why}) and"
     completed = (manifest.get("runner") or {}).get("finish_reason") == "completed"
     mend = f"rti-rig run --resume {shlex.quote(str(root))}" + (
         " --rebuild-journal" if completed else ""
@@ -2514,7 +2568,7 @@ def journal_mend_note(root: Path) -> str | None:
     one = len(stems) == 1
     shown = ", ".join(stems[:8]) + (" …" if len(stems) > 8 else "")
     return (
-        f"{JOURNAL} is damaged ({why}) and holds no record of {shown}: "
+        f"{JOURNAL} {state} holds no record of {shown}: "
         f"{'it was' if one else 'they were'} checked against {'its' if one else 'their'} "
         f"step record file{'' if one else 's'} ({RECORDS_DIR}/) instead, as captured; "
         f"{mend} writes {'it' if one else 'them'} back into {JOURNAL}"

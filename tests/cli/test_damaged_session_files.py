@@ -77,6 +77,7 @@ def test_a_missing_journal_is_said_by_the_verdict_and_export_lp(
     jpeg = s / "image_004.jpg"
     jpeg.write_bytes(jpeg.read_bytes()[:-200] + b"\x00" * 200)  # changed since capture
     (s / "journal.jsonl").unlink()
+    shutil.rmtree(s / "records")  # and its step record files: the manifest alone
     r = runner.invoke(app, ["fit", str(s), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 0, r.output
     qa = json.loads((tmp_path / "fit" / "qa.json").read_text())

@@ -196,6 +196,7 @@ def test_an_adaptive_session_continues_as_it_would_have(tmp_path: Path) -> None:
     interrupted(cfg, plain, 3)
     shutil.copytree(plain, lost)
     (lost / "journal.jsonl").unlink()
+    shutil.rmtree(lost / "records")  # and its step record files: the manifest alone
     r = runner.invoke(app, ["run", "--resume", str(lost)])
     assert r.exit_code == 2 and "--rebuild-journal" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(lost), "--rebuild-journal"])
@@ -252,6 +253,7 @@ def test_an_adaptive_record_without_its_decision_is_refused(tmp_path: Path) -> N
     out = tmp_path / "s"
     interrupted(cfg, out, 3)
     (out / "journal.jsonl").unlink()
+    shutil.rmtree(out / "records")  # and its step record files: the manifest alone
     manifest = json.loads((out / "manifest.json").read_text())
     manifest["steps"][1]["decision"] = None
     (out / "manifest.json").write_text(json.dumps(manifest))

@@ -68,6 +68,7 @@ def test_a_stopped_session_without_its_journal_is_not_sent_to_a_resume(
     out = tmp_path / "s"
     shutil.copytree(shot[1], out)
     (out / "journal.jsonl").unlink()
+    shutil.rmtree(out / "records")  # and its step record files: the manifest alone
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
     assert r.exit_code == 0, r.output
     assert "the session is not finished (5 of 60 images" in said(r)
@@ -89,6 +90,7 @@ def test_a_finished_session_without_its_journal_is_rebuilt_as_advised(
     out = tmp_path / "s"
     shutil.copytree(shot[0], out)
     (out / "journal.jsonl").unlink()
+    shutil.rmtree(out / "records")  # and its step record files: the manifest alone
     r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
     assert f"rti-rig run --resume {out} --rebuild-journal" in said(r), r.output
     r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])

@@ -13,6 +13,7 @@ import hashlib
 import io
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -279,12 +280,16 @@ def test_a_resume_without_its_journal_is_refused_before_anything_moves(
     out = tmp_path / "s"
     cancelled_after(cfg, out, 3)
     (out / "journal.jsonl").rename(tmp_path / "journal.jsonl")
+    # and its step record files (a session from before them; one with them is rebuilt from
+    # them: tests/runtime/test_step_records.py)
+    (out / "records").rename(tmp_path / "records")
     before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 2, r.output
     assert "journal.jsonl is missing" in said(r) and "restore journal.jsonl" in said(r)
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
     (tmp_path / "journal.jsonl").rename(out / "journal.jsonl")
+    (tmp_path / "records").rename(out / "records")
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0 and "3 of 8 images verified" in said(r), r.output
     assert digests(out) == digests(ref)
@@ -292,6 +297,7 @@ def test_a_resume_without_its_journal_is_refused_before_anything_moves(
     first = tmp_path / "first"
     cancelled_after(cfg, first, 1)
     (first / "journal.jsonl").unlink()
+    shutil.rmtree(first / "records")  # as a kill before the first commit leaves them: none
     killed = manifest(first)  # as a kill leaves it: the manifest begin wrote, with no step
     killed.update(steps=[], runner={"state": "running", "finish_reason": None})
     (first / "manifest.json").write_text(json.dumps(killed))
@@ -615,6 +621,10 @@ def _with_raw_originals(done: Path) -> dict[str, bytes]:
         rec["sha256"][raw] = hashlib.sha256(body).hexdigest()
         rec.setdefault("originals", {})[raw] = f"IMG_{rec['index']:04d}.DNG"
     (done / "journal.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    for rec in records:  # each step's record file holds its journal line, as at capture
+        step_file = done / "records" / f"{Path(rec['image']).stem}.json"
+        if step_file.parent.is_dir():
+            step_file.write_text(json.dumps(rec) + "\n")
     m = manifest(done)
     by_step = {r["index"]: r for r in records}
     m["steps"] = [by_step.get(s["index"], s) for s in m["steps"]]

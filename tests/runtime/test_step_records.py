@@ -98,3 +98,55 @@ def test_a_record_file_whose_image_was_changed_proves_nothing(tmp_path: Path) ->
     # the journal and the record file now hold the new capture's record
     new = json.loads((out / "records" / "image_003.json").read_text())
     assert new["sha256"]["image_003.jpg"] == _sha(out / "image_003.jpg")
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+@pytest.mark.parametrize("flags", [[], ["--rebuild-journal"]])
+def test_a_deleted_journal_is_rebuilt_from_the_step_record_files(
+    tmp_path: Path, flags: list[str]
+) -> None:
+    """A journal deleted outright, records/ holding every committed step's record: the resume
+    rebuilds it from them, each verified against its files (it had been refused, saying
+    ``--rebuild-journal`` cannot help, though every step was proven)."""
+    out = _killed_after_three(tmp_path)
+    kept = {p: _sha(out / p) for p in ("image_002.jpg", "image_003.jpg")}
+    (out / "journal.jsonl").unlink()
+
+    r = runner.invoke(app, ["run", "--resume", str(out), *flags])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "3 of 8 images verified" in text, text
+    if flags:  # the rebuild asked for says where each image's proof came from
+        assert "3 from their step record files in records/ (journal.jsonl was missing)" in text
+    else:
+        assert "journal.jsonl was missing: rebuilt from 3 step record file(s) in records/" in text
+        assert not (out / "recovered").exists()
+    assert "nothing rebuilt" not in text and "set aside in recovered/" not in text, text
+    assert {p: _sha(out / p) for p in kept} == kept
+    records = [json.loads(x) for x in (out / "journal.jsonl").read_text().splitlines()]
+    assert [r["index"] for r in records] == list(range(LIGHTS))
+    assert (
+        json.loads((out / "manifest.json").read_text())["runs"][-1]["resumed_with_steps_done"] == 3
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_deleted_journal_whose_record_file_no_longer_matches_is_still_refused(
+    tmp_path: Path,
+) -> None:
+    """A record file is proof only with its files as captured: image_002 changed, the journal
+    deleted, nothing vouches for image_002 while image_003 was committed after it: refused,
+    the folder unchanged, the fit's verdict saying the journal is missing."""
+    out = _killed_after_three(tmp_path)
+    (out / "journal.jsonl").unlink()
+    (out / "image_002.jpg").write_bytes(b"edited")
+    before = sorted(p.relative_to(out).as_posix() for p in out.rglob("*"))
+
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code != 0
+    text = said(r)
+    assert "journal.jsonl is missing" in text and "image_002" in text, text
+    assert "records/" in text, text
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before

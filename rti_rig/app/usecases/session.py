@@ -1077,7 +1077,7 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
     )
     for line in resume.journal_repair if resume else []:
         # a record written back from its step's record file is kept, not set aside
-        kept = "written back from" in line
+        kept = "written back from" in line or "was missing: rebuilt from" in line
         said = line if kept else f"{line}: set aside in recovered/, not appended onto"
         on_note(Note(said, "warning"))
     for line in resume.journal_rebuild if resume else []:
