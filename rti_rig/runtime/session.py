@@ -2241,8 +2241,16 @@ def lost_image_advice(root: Path, adaptive: bool) -> str:
         # a session not finished (a --reshoot-lost killed part-way, say): --reshoot-lost is
         # refused for it, and its plain resume sets aside and shoots again what it cannot
         # verify (the advice had named --reshoot-lost, which then said to drop it)
+        aside = _set_aside_as_captured(root)
+        where = (
+            f" ({', '.join(aside[:4])}{' …' if len(aside) > 4 else ''} "
+            f"{'is' if len(aside) == 1 else 'are'} as captured, set aside by a resume; any "
+            "other from a copy)"
+            if aside
+            else " from a copy"
+        )
         return (
-            "put the originals back from a copy, or let its resume set them aside and shoot "
+            f"put the originals back{where}, or let its resume set them aside and shoot "
             f"them again, with the object where it was: rti-rig run --resume "
             f"{shlex.quote(str(root))}"
         )
@@ -2250,6 +2258,31 @@ def lost_image_advice(root: Path, adaptive: bool) -> str:
         "put the originals back from a copy, or reshoot exactly those, with the object where "
         f"it was: rti-rig run --resume {shlex.quote(str(root))} --reshoot-lost"
     )
+
+
+def _set_aside_as_captured(root: Path) -> list[str]:
+    """The files of images lost since capture that a resume (a ``--reshoot-lost`` stopped
+    part-way: a full disk, a kill) set aside in ``recovered/`` and that are still as captured
+    (their journaled checksum): where to put them back from.
+
+    Why: the verdict said only "put the originals back from a copy" of a session whose intact
+    linear TIFF sat in recovered/, set aside by the resume a full disk then stopped."""
+    records = _journal_records(root)
+    if not records:
+        return []
+    renamed = renamed_jpegs(root, records)
+    found: list[str] = []
+    for rec in _latest_records(records).values():
+        if not _lost_files(root, rec, renamed):
+            continue
+        for name, digest in rec["sha256"].items():
+            if _as_captured(root, rec, name, digest):
+                continue
+            for stamp in sorted((root / "recovered").glob("*"), reverse=True):  # latest first
+                if (stamp / name).is_file() and _as_captured(stamp, rec, name, digest):
+                    found.append((stamp / name).relative_to(root).as_posix())
+                    break
+    return found
 
 
 def lost_since_capture_said(root: Path, manifest: dict[str, Any] | None = None) -> str | None:

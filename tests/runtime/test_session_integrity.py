@@ -1164,3 +1164,25 @@ def test_export_lp_names_the_reshoot_of_the_images_it_leaves_out(
         f"originals back from a copy, or reshoot exactly those, with the object where it was: "
         f"rti-rig run --resume {done} --reshoot-lost" in said(r)
     ), r.output
+
+
+def test_a_full_disk_during_reshoot_lost_points_the_verdict_at_what_it_set_aside(
+    tmp_path: Path, reference: tuple[Path, Path]
+) -> None:
+    """image_003.jpg deleted, then --reshoot-lost stopped by a full disk after it set the
+    intact TIFF aside: the verdict said only "put the originals back from a copy". Now it
+    names the file set aside, as captured, in recovered/."""
+    _, ref = reference
+    done = copied(ref, tmp_path)
+    (done / "image_003.jpg").unlink()
+    with failing_writes("tiff", after=0, errno_code=errno.ENOSPC):
+        r = runner.invoke(app, ["run", "--resume", str(done), "--reshoot-lost"])
+    assert "cannot write" in said(r), r.output
+    aside = [p.relative_to(done).as_posix() for p in (done / "recovered").rglob("*.tif")]
+    assert len(aside) == 1 and aside[0].endswith("/linear/image_003.tif"), aside
+    r = runner.invoke(app, ["fit", str(done), "--out", str(tmp_path / "fit"), "--model", "ps"])
+    assert r.exit_code == 0, r.output
+    verdict = json.loads((tmp_path / "fit" / "qa.json").read_text())["verdict"]
+    assert f"put the originals back ({aside[0]} is as captured, set aside by a resume" in (
+        " ".join(verdict.split())
+    ), verdict
