@@ -617,6 +617,37 @@ def _cannot_resume(rig) -> str | None:  # type: ignore[no-untyped-def]
     return None if why is None else f"It cannot be resumed: {why}."
 
 
+def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore[no-untyped-def]
+    """A file the capture could not write, said as the run's last line with what happened to
+    the images and the next command; any other error as it is.
+
+    Why: a full disk on a step's record file ended the run with a bare ``error: cannot write
+    …/records/image_003.json``, as if the image were lost, though its journal line (the
+    commit) was on disk; the resume command was said only lines above it."""
+    from rti_rig.runtime.session import RECORDS_DIR, SessionWriteError
+
+    kept = opened.folder.images_kept
+    if not isinstance(exc, SessionWriteError) or _cannot_resume(opened.rig) or not kept:
+        return exc  # nothing kept: the folder may be used again, as said above
+    if exc.path.parent.name == RECORDS_DIR:
+        what = (
+            f"{exc.path.stem} is kept all the same (its journal line, the commit, was written "
+            "first)"
+        )
+    else:
+        what = f"{kept} image(s) are kept"
+    if exc.errno_name in ("ENOSPC", "EFBIG", "EDQUOT"):
+        fix = "free space on that disk (or lift the file-size limit or quota)"
+    elif exc.errno_name == "EROFS":
+        fix = "make that disk writable again"
+    else:
+        fix = "check that disk"
+    return RtiRigError(
+        f"{exc}: the session stopped there; {what}; {fix}, then continue with rti-rig run "
+        f"--resume {_arg(opened.out_dir)}"
+    )
+
+
 def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
     """What a stopped session left on disk and how to go on (never a resume hint for nothing)."""
     from rti_rig.runtime.session import LP_NAME, holds_no_image
@@ -918,7 +949,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
 
         state = lights_state(rig, _print_teardown_failures(folder))
         err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
-        raise fail(exc) from None
+        raise fail(_write_failed_said(exc, opened)) from None
     except Exception as exc:
         # a fault no driver named (an OSError, a library's own exception): the controller has
         # torn down and kept the images all the same, but this had been a Python traceback,

@@ -1186,3 +1186,26 @@ def test_a_full_disk_during_reshoot_lost_points_the_verdict_at_what_it_set_aside
     assert f"put the originals back ({aside[0]} is as captured, set aside by a resume" in (
         " ".join(verdict.split())
     ), verdict
+
+
+def test_a_full_disk_on_a_step_record_file_ends_with_what_happened_and_the_resume(
+    tmp_path: Path, reference: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The run's last line had been a bare "error: cannot write …/records/image_002.json": it
+    now says the image is kept (its journal line was written first) and the command that
+    continues, and that command completes the session."""
+    cfg, ref = reference
+    out = tmp_path / "s"
+    # a step's record file (records/.image_NNN.json.tmp), the manifest's (.manifest.json.tmp)
+    # too: its begin and image_001's record file are written, image_002's is not
+    monkeypatch.setitem(WRITE_POINTS, "record", (".json.tmp",))
+    with failing_writes("record", after=2, errno_code=errno.ENOSPC):
+        r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2, r.output
+    last = " ".join(r.output.strip().splitlines()[-1].split())
+    assert last.startswith(f"error: cannot write {out}/records/image_002.json"), r.output
+    assert "image_002 is kept all the same" in said(r), r.output
+    assert said(r).endswith(f"then continue with rti-rig run --resume {out}"), r.output
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    assert r.exit_code == 0 and "2 of 8 images verified" in said(r), r.output
+    assert digests(out) == digests(ref)
