@@ -633,8 +633,11 @@ class SessionFolder:
         try:
             for item, rel in zip(listed, originals, strict=True):
                 if decode.get("source_file") == str(item["path"]):
-                    # where the decoded RAW is kept now, and the camera's own name for it
+                    # where the decoded RAW is kept now, and the camera's (or the watched
+                    # folder's) own name for it; source_file names the kept file too: it had
+                    # named the staged download (raw/.incoming/cap0001_…), gone once moved
                     decode["raw_file"] = rel
+                    decode["source_file"] = rel
                     decode["camera_file"] = originals[rel][1]
             sha = {name: digest for name, (digest, _) in originals.items()}
             current = self.root / tif

@@ -150,3 +150,53 @@ def test_a_deleted_journal_whose_record_file_no_longer_matches_is_still_refused(
     assert "journal.jsonl is missing" in text and "image_002" in text, text
     assert "records/" in text, text
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*")) == before
+
+
+def test_the_decoded_raw_is_named_where_it_is_kept_not_where_it_was_staged(
+    tmp_path: Path,
+) -> None:
+    """decode.source_file in the journal, the record file and the manifest had named the
+    staged download (raw/.incoming/cap0001_IMG_0001.CR2), gone once the commit moved it to
+    raw/image_001.cr2: it now names the kept file, the camera's own name kept beside it."""
+    import numpy as np
+
+    from rti_rig.core.devices import Frame
+    from rti_rig.runtime.session import RAW_INCOMING, SessionFolder
+
+    folder = SessionFolder.create(tmp_path / "s", 1)
+    folder.begin({"rig": {}, "schedule": {"steps": [{}]}})
+    staged = folder.root / RAW_INCOMING / "cap0001_IMG_0001.CR2"
+    staged.parent.mkdir(parents=True)
+    staged.write_bytes(b"raw bytes")
+    frame = Frame(
+        pixels=np.full((4, 4, 3), 1000, np.uint16),
+        exposure_s=0.1,
+        gain=100.0,
+        white_level=65535,
+        timestamp_s=0.0,
+        metadata={
+            "originals": [{"path": str(staged), "name": "/IMG_0001.CR2"}],
+            "decode": {"mode": "half", "source_file": str(staged)},
+        },
+    )
+    fields = {
+        "planned_direction": (0.0, 0.0, 1.0),
+        "actual_direction": (0.0, 0.0, 1.0),
+        "led": 0,
+        "rig_start_s": 0.0,
+        "light_s": 0.0,
+        "settle_s": 0.0,
+        "capture_s": 0.0,
+    }
+    rec = folder.write_step(0, frame, fields)
+    folder.finish([rec], {"finish_reason": "completed"}, {})
+    manifest = json.loads((folder.root / "manifest.json").read_text())
+    for decode in (
+        rec.decode,
+        json.loads((folder.root / "journal.jsonl").read_text())["decode"],
+        json.loads((folder.root / "records" / "image_001.json").read_text())["decode"],
+        manifest["steps"][0]["decode"],
+    ):
+        assert decode["source_file"] == decode["raw_file"] == "raw/image_001.cr2", decode
+        assert (folder.root / decode["source_file"]).read_bytes() == b"raw bytes"
+        assert decode["camera_file"] == "/IMG_0001.CR2"
