@@ -36,6 +36,7 @@ their own sub-folders: only ``image_*`` files and the files above are the sessio
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
 import os
@@ -192,11 +193,29 @@ def _write_bytes_atomic(path: Path, data: bytes) -> None:
         raise SessionWriteError(path, exc) from None
 
 
+#: What a file system that cannot fsync a folder answers (some network and FUSE mounts):
+#: the entries are then as durable as that file system makes them, and nothing more can be
+#: done (PostgreSQL's fsync_fname ignores exactly these for folders).
+_DIR_FSYNC_UNSUPPORTED = {errno.EINVAL, errno.EBADF, errno.ENOTSUP, errno.EOPNOTSUPP}
+
+
 def _fsync_dir(path: Path) -> None:
-    """Make a folder's entries (a file just renamed into it) durable across a power loss."""
-    fd = os.open(path, os.O_RDONLY)
+    """Make a folder's entries (a file just renamed into it) durable across a power loss.
+
+    A file system that does not fsync folders is let be: the step's journal line, the commit,
+    is already written, and stopping every run on such a disk (as this did) keeps nothing
+    more."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError as exc:
+        if exc.errno in _DIR_FSYNC_UNSUPPORTED:
+            return
+        raise
     try:
         os.fsync(fd)
+    except OSError as exc:
+        if exc.errno not in _DIR_FSYNC_UNSUPPORTED:
+            raise
     finally:
         os.close(fd)
 
@@ -2603,11 +2622,19 @@ def journal_mend_note(root: Path) -> str | None:
     )
     one = len(stems) == 1
     shown = ", ".join(stems[:8]) + (" …" if len(stems) > 8 else "")
+    # an unfinished session's resume captures the images still to take as well (lights on,
+    # an arm moving): said, so a user who wants only the journal mended is not surprised
+    left = total - len({int(r["index"]) for r in scan.records})
+    also = (
+        f", and goes on to capture the {left} image{'s' if left != 1 else ''} still to take"
+        if not completed and left > 0
+        else ""
+    )
     return (
         f"{JOURNAL} {state} holds no record of {shown}: "
         f"{'it was' if one else 'they were'} checked against {'its' if one else 'their'} "
         f"step record file{'' if one else 's'} ({RECORDS_DIR}/) instead, as captured; "
-        f"{mend} writes {'it' if one else 'them'} back into {JOURNAL}"
+        f"{mend} writes {'it' if one else 'them'} back into {JOURNAL}{also}"
     )
 
 

@@ -200,3 +200,59 @@ def test_the_decoded_raw_is_named_where_it_is_kept_not_where_it_was_staged(
         assert decode["source_file"] == decode["raw_file"] == "raw/image_001.cr2", decode
         assert (folder.root / decode["source_file"]).read_bytes() == b"raw bytes"
         assert decode["camera_file"] == "/IMG_0001.CR2"
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_the_verdicts_mend_for_an_unfinished_session_says_it_also_captures(
+    tmp_path: Path,
+) -> None:
+    """The verdict of a session killed after 5 of 8 images, its fifth journal line cut, named
+    `rti-rig run --resume S` as what writes the record back into the journal, and nothing
+    more: that resume also lights the dome for the 3 images still to take. Said now."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    proc = popen_session("before_light", 5, cfg, out, LIGHTS)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().splitlines(keepends=True)
+    assert len(lines) == 5
+    journal.write_bytes(b"".join(lines[:4]) + lines[4][:-25])
+    r = runner.invoke(
+        app,
+        ["fit", str(out), "--out", str(tmp_path / "f"), "--no-ptm", "--no-hsh", "--no-normals"],
+    )
+    text = said(r)
+    assert "writes it back into journal.jsonl, and goes on to capture the 3 images" in text, text
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_disk_that_cannot_fsync_a_folder_still_runs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Some network and FUSE file systems answer EINVAL to an fsync of a folder. The step
+    record's folder fsync turned that into a write failure after the step's journal line was
+    written: every run on such a disk stopped at image 1, its summary and manifest
+    disagreeing on the images kept. The folder's entries are let be as durable as the file
+    system makes them."""
+    import errno
+    import os
+    import stat
+
+    real_fsync = os.fsync
+
+    def fsync(fd: int) -> None:
+        if stat.S_ISDIR(os.fstat(fd).st_mode):
+            raise OSError(errno.EINVAL, os.strerror(errno.EINVAL))
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    assert r.exit_code == 0, said(r)
+    assert sorted(p.name for p in (out / "records").iterdir()) == [
+        f"image_00{i}.json" for i in range(1, 5)
+    ]
