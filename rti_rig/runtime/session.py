@@ -1037,14 +1037,15 @@ def _mend_from_step_records(root: Path, names: list[str] | None, scan: JournalSc
     step is proven by its journal record, or, when its line is lost or damaged, by its record
     file, with its files matching the checksums. Why: a journal whose line of a committed
     step was damaged (the tail cut after a kill) proved nothing of it, and the resume shot it
-    again. The journal's record, when it has one, decides alone (a record file never
-    overrides it). A record file whose files are not as it says (set aside, changed since) is
-    passed over: the step is then unproven, as before. Sessions from before these files have
-    none, and read as they always did."""
+    again. The journal's latest record of a step decides when its files match it; the record
+    file is taken over it only when they do not and the record file's do (a step shot again,
+    its new line cut). A record file whose files are not as it says (set aside, changed since)
+    is passed over: the step is then unproven, as before. Sessions from before these files
+    have none, and read as they always did."""
     folder = root / RECORDS_DIR
     if not folder.is_dir():
         return
-    journaled = {r["index"] for r in scan.records}
+    latest = _latest_records(scan.records)
     for path in sorted(folder.glob("image_*.json")):
         try:
             raw = path.read_bytes().strip()
@@ -1053,12 +1054,21 @@ def _mend_from_step_records(root: Path, names: list[str] | None, scan: JournalSc
             continue
         if _record_problem(entry, names) is not None or entry["image"] != f"{path.stem}.jpg":
             continue
-        if entry["index"] in journaled or not verified_steps(root, [entry]):
+        journaled = latest.get(entry["index"])
+        if journaled == entry:
+            continue  # the journal holds this very record: nothing to mend, nothing hashed
+        if journaled is not None and verified_steps(root, [journaled]):
+            continue  # the journal's latest record proves the step: it decides
+        if not verified_steps(root, [entry]):
             continue
+        # no record of the step in the journal, or only an earlier one its files no longer
+        # match (a step shot again whose new line was cut: the old record had won, failed its
+        # checksums, and the step was shot once more): the record file, written after the
+        # journal line of the latest commit, proves it
         scan.records.append(entry)
         scan.kept.append(raw + b"\n")
         scan.mended.append(path.relative_to(root).as_posix())
-        journaled.add(entry["index"])
+        latest[entry["index"]] = entry
 
 
 def _take_whole(src: Path, dest: Path, root: Path) -> str:

@@ -256,3 +256,38 @@ def test_a_disk_that_cannot_fsync_a_folder_still_runs(
     assert sorted(p.name for p in (out / "records").iterdir()) == [
         f"image_00{i}.json" for i in range(1, 5)
     ]
+
+
+@pytest.mark.slow
+def test_a_step_shot_again_whose_new_journal_line_was_cut_is_proven_by_its_record_file(
+    tmp_path: Path,
+) -> None:
+    """A step shot again (a resume that set its image aside, or `--reshoot-lost`) has two
+    journal records, the earlier first; a run killed after that commit, its new line then
+    cut, leaves the earlier record as the journal's latest. That record had decided alone:
+    its checksums no longer match the image on disk, so the step was unproven and shot once
+    more, although records/image_003.json holds the new record whole and the files match it.
+    The record file is taken over a journal record its files do not match (and only then:
+    one the files match still decides)."""
+    from rti_rig.runtime.session import image_names, scan_journal, verified_steps
+
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    assert r.exit_code == 0, said(r)
+    journal = out / "journal.jsonl"
+    lines = journal.read_bytes().splitlines(keepends=True)
+    earlier = json.loads(lines[2])
+    earlier["sha256"] = {k: "0" * 64 for k in earlier["sha256"]}  # a capture since replaced
+    journal.write_bytes(
+        lines[0] + lines[1] + (json.dumps(earlier) + "\n").encode() + lines[3] + lines[2][:-30]
+    )
+    scan = scan_journal(out, image_names(4))
+    assert scan.mended == ["records/image_003.json"]
+    assert sorted(verified_steps(out, scan.records)) == [0, 1, 2, 3]
+
+    # the journal's own latest record, matching the files, decides: no record file taken
+    journal.write_bytes(b"".join(lines))
+    (out / "records" / "image_003.json").write_text(json.dumps(earlier) + "\n")
+    scan = scan_journal(out, image_names(4))
+    assert scan.mended == [] and sorted(verified_steps(out, scan.records)) == [0, 1, 2, 3]
