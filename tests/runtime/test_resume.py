@@ -395,6 +395,7 @@ def test_a_ctrl_c_while_a_resume_sets_images_aside_leaves_lights_lp_listing_the_
     every later image with the wrong light. The moves and the relisting now finish first; the
     Ctrl-C is acted on after them (the run says it stopped, exit 130)."""
     import signal
+    import threading
 
     import rti_rig.runtime.session as session_module
 
@@ -405,6 +406,13 @@ def test_a_ctrl_c_while_a_resume_sets_images_aside_leaves_lights_lp_listing_the_
 
     def replace_then_ctrl_c(src, dst):  # type: ignore[no-untyped-def]
         real_replace(src, dst)
+        # os.replace is patched process-wide: only the resume's own move of a file of this
+        # session, in the main thread, is the moment meant (a writer thread's or another
+        # test's leftover thread's atomic write had raised the Ctrl-C elsewhere)
+        if threading.current_thread() is not threading.main_thread() or not str(src).startswith(
+            str(out)
+        ):
+            return
         calls.append(str(src))
         if len(calls) == 1:
             signal.raise_signal(signal.SIGINT)
