@@ -62,6 +62,16 @@ def write_config(tmp_path: Path, text: str, name: str = "rig.toml") -> Path:
     return p
 
 
+def inprocess_arm_config(tmp_path: Path, extra: str = "") -> Path:
+    """simulated_arm.toml with its servos emulated in-process (the real driver and SDK packet
+    code without a pty thread: the fastest path), ``extra`` appended (``[[emulator.faults]]``)."""
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    assert 'transport = "pty"' in text
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text.replace('transport = "pty"', 'transport = "inprocess"') + extra)
+    return cfg
+
+
 def virtual_arm_variant(tmp_path: Path, scene: str, side: int | None = None) -> Path:
     """The shipped virtual arm (512 px, the relief) with another simulated scene and, if
     given, square frames of ``side`` px: what the QA tests run correct sessions on."""

@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import inprocess_arm_config
 from typer.testing import CliRunner
 
 import rti_rig.app.compose as compose
@@ -45,9 +45,7 @@ def test_a_servo_that_overloads_during_an_exposure_loses_that_image_not_its_dire
         return rig
 
     monkeypatch.setattr(compose, "build_rig", build)
-    text = (CONFIGS / "simulated_arm.toml").read_text()
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace('transport = "pty"', 'transport = "inprocess"'))
+    cfg = inprocess_arm_config(tmp_path)
     out = tmp_path / "s"
     r = CliRunner().invoke(
         app, ["run", str(cfg), "--out", str(out), "--lights", "6"], terminal_width=400

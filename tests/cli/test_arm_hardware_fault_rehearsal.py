@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, inprocess_arm_config
 from typer.testing import CliRunner
 
 import rti_rig.app.compose as compose
@@ -27,11 +27,7 @@ FAULT = '\n[[emulator.faults]]\nat_command = 60\nkind = "overload"\nservo_id = 2
 
 
 def _config(tmp_path: Path, extra: str = FAULT) -> Path:
-    text = (CONFIGS / "simulated_arm.toml").read_text()
-    text = text.replace('transport = "pty"', 'transport = "inprocess"')
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text + extra)
-    return cfg
+    return inprocess_arm_config(tmp_path, extra)
 
 
 def test_check_on_a_servo_that_overloads_stops_names_it_and_leaves_it_unparked(

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import inprocess_arm_config
 from typer.testing import CliRunner
 
 import rti_rig.app.compose as compose
@@ -40,9 +40,7 @@ def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, creep: int) -> tuple[i
         return rig
 
     monkeypatch.setattr(compose, "build_rig", build)
-    text = (CONFIGS / "simulated_arm.toml").read_text()
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace('transport = "pty"', 'transport = "inprocess"'))
+    cfg = inprocess_arm_config(tmp_path)
     out = tmp_path / "s"
     r = CliRunner().invoke(
         app, ["run", str(cfg), "--out", str(out), "--lights", "4"], terminal_width=400

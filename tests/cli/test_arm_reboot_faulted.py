@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, inprocess_arm_config
 from typer.testing import CliRunner
 
 import rti_rig.app.compose as compose
@@ -30,10 +30,7 @@ FAULT = '\n[[emulator.faults]]\nat_command = 1\nkind = "overload"\nservo_id = 2\
 
 
 def _config(tmp_path: Path) -> Path:
-    text = (CONFIGS / "simulated_arm.toml").read_text()
-    cfg = tmp_path / "arm.toml"
-    cfg.write_text(text.replace('transport = "pty"', 'transport = "inprocess"') + FAULT)
-    return cfg
+    return inprocess_arm_config(tmp_path, FAULT)
 
 
 def test_reboot_faulted_clears_the_faulted_servo_only_and_moves_nothing(

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, inprocess_arm_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -189,16 +189,6 @@ def test_a_refused_pose_stops_the_test_before_anything_connects() -> None:
     assert not report.ok
     assert "refused before moving" in (report.aborted or "")
     assert carrier.log == []
-
-
-def inprocess_arm_config(tmp_path: Path) -> Path:
-    """simulated_arm.toml with the servos emulated in-process: the real driver and SDK packet
-    code without a pty thread (the fastest path)."""
-    text = (CONFIGS / "simulated_arm.toml").read_text()
-    assert 'transport = "pty"' in text
-    out = tmp_path / "arm.toml"
-    out.write_text(text.replace('transport = "pty"', 'transport = "inprocess"'))
-    return out
 
 
 @pytest.mark.e2e
