@@ -1701,6 +1701,11 @@ def _reliable_gains(
 _GAIN_FIELDS = ("gain", "lit_gain", "reliable_gain", "neighbour_ratio")
 
 
+#: Images called dim judged again beside the others scaled back (:func:`_dim_rejudged`), the
+#: nearest to right first: each costs one robust fit of the crop.
+MAX_DIM_REJUDGED = 4
+
+
 def _dim_rejudged(
     ev: _Evidence,
     crop_arr: NDArray,
@@ -1724,7 +1729,12 @@ def _dim_rejudged(
     (:data:`NO_LIGHT_GAIN`) has nothing to scale and stays out."""
     out = ev
     scale = np.where(np.isfinite(ev.lit_gain), ev.lit_gain, 0.0)
-    for i in np.flatnonzero(ev.dim):
+    # one robust fit of the crop per image judged again (seconds each with many lights): the
+    # few nearest to right are the ones a neighbour's dim light can have dragged down, so at
+    # most MAX_DIM_REJUDGED of them, the brightest first, however many lights a weak ring
+    # or a failing supply dims
+    dim = np.flatnonzero(ev.dim)
+    for i in dim[np.argsort(-scale[dim], kind="stable")][:MAX_DIM_REJUDGED]:
         others = ev.dim.copy()
         others[i] = False
         lit = others & (scale >= NO_LIGHT_GAIN)
