@@ -54,6 +54,7 @@ import os
 import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from datetime import UTC
 from pathlib import Path
 from typing import Any
 
@@ -131,20 +132,32 @@ def capture_time(path: Path) -> float | None:
     """The capture time LibRaw reads in ``path`` (EXIF DateTimeOriginal, or the TIFF DateTime),
     in seconds on the camera's clock (only differences are meaningful), or None when the file
     is no RAW, LibRaw cannot open it or it holds no time (LibRaw then gives the epoch)."""
+    return _read_capture_time(path)[1]
+
+
+def _read_capture_time(path: Path) -> tuple[bool, float | None]:
+    """(whether waiting cannot change the answer, the capture time or None).
+
+    False for a RAW LibRaw cannot open yet (a file still being written: "Unexpected end of
+    file"); True for one it opened (with or without a time), a format it does not read, or no
+    RAW. The time is the camera's wall clock read as UTC: EXIF carries no time zone, and read
+    in the computer's zone two shots across its daylight-saving change came out an hour apart,
+    every later file then out of step."""
     if not is_raw_file(path):
-        return None
+        return True, None
     try:
         import rawpy
 
         with rawpy.imread(str(path)) as raw:
             stamp = raw.other.timestamp
-    except Exception:  # no evidence: the file's own decode says what is wrong with it
-        return None
+    except Exception as exc:  # no evidence yet, or none: the file's own decode says why
+        unsupported = type(exc).__name__ == "LibRawFileUnsupportedError"
+        return unsupported, None
     try:
-        value = stamp.timestamp()
+        value = stamp.replace(tzinfo=UTC).timestamp()
     except (OverflowError, OSError, ValueError, AttributeError):
-        return None
-    return None if stamp.year <= 1970 else float(value)
+        return True, None
+    return True, (None if stamp.year <= 1970 else float(value))
 
 
 def _has_header(path: Path) -> bool:
@@ -171,8 +184,11 @@ class _Pending:
     path: Path | None = None
     stray: list[str] = field(default_factory=list)
     unconfirmed: str | None = None
-    #: when the trigger returned (the rig's clock): the pulse a file's capture time must fit
+    #: when the trigger was called (the rig's clock): the pulse a file's capture time must fit
     pulsed_at: float | None = None
+    #: how long the trigger took to return: the pulse lies within it (a lost reply makes it a
+    #: whole reply timeout, and the pulse had been dated at its end)
+    pulse_window_s: float = 0.0
     #: files that came after the pulse but were shot out of step with it, said in notices
     out_of_step: list[str] = field(default_factory=list)
 
@@ -205,10 +221,10 @@ class FolderWatchCamera:
         self._pending: _Pending | None = None
         #: (capture time, pulse time) of the last image whose file had a capture time: the
         #: camera clock's anchor to the pulses
-        self._anchor: tuple[float, float] | None = None
+        self._anchor: tuple[float, float, float] | None = None
         #: (capture time, the pulse before) of the last file set aside as out of step: a late
         #: file of the previous pulse, if the next file fits it
-        self._orphan: tuple[float, float] | None = None
+        self._orphan: tuple[float, float, float] | None = None
         #: where a taken file is copied before it is decoded: the session's ``raw/.incoming``,
         #: set when the rig is bound to a session (None: decoded where it lies)
         self.output_dir: Path | None = None
@@ -425,11 +441,13 @@ class FolderWatchCamera:
         for p in self._new_files(self._seen):
             self._mark_seen(p.name, _identity(p))
             pending.stray.append(p.name)
+        sent = self._clock.now()
         try:
             self._trigger(exposure_s)
         except TriggerUnconfirmed as exc:
             pending.unconfirmed = str(exc)
-        pending.pulsed_at = self._clock.now()
+        pending.pulsed_at = sent
+        pending.pulse_window_s = self._clock.now() - sent
         self._pending = pending
         return self._clock.now() + self.settings.shutter_lag_s + exposure_s
 
@@ -500,17 +518,20 @@ class FolderWatchCamera:
                     said += (
                         f"; {', '.join(pending.out_of_step)} came after the pulse but "
                         f"{'were' if len(pending.out_of_step) > 1 else 'was'} shot out of step "
-                        "with it (a late file of an earlier pulse?) and set aside in strays/"
+                        "with it (a late file of an earlier pulse?), not used, and left in "
+                        f"{self.settings.folder}"
                     )
                 if pending.unconfirmed is not None:
                     said += f"; the trigger was not confirmed either ({pending.unconfirmed})"
                 if said == exc.message:
                     raise
                 raise CaptureError(self.name, said, "wait for file") from exc
-            taken = capture_time(path)
-            if pending.pulsed_at is None or taken is None:
+            if pending.pulsed_at is None:
                 return path, []
-            placed = self._place(taken, pending.pulsed_at)
+            taken = self._whole_capture_time(path)
+            if taken is None:
+                return path, []
+            placed = self._place(taken, pending.pulsed_at, pending.pulse_window_s)
             if placed is not None:
                 return path, placed
             pending.stray.append(path.name)
@@ -523,21 +544,52 @@ class FolderWatchCamera:
                     "time against the last image's, within "
                     f"{CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s:g} s: "
                     "shutter_lag_s plus the 1 s of EXIF times): is the camera's clock being "
-                    "set meanwhile, or another camera saving there? They are kept in strays/; "
-                    "no image was recorded for this light",
+                    "set meanwhile, or another camera saving there? They are left in "
+                    f"{self.settings.folder}; no image was recorded for this light",
                     "check capture time",
                 )
 
-    def _place(self, taken: float, pulsed_at: float) -> list[str] | None:
+    def _whole_capture_time(self, path: Path) -> float | None:
+        """The capture time of ``path`` once LibRaw can open it: a file still being written
+        (a network share, a Wi-Fi upload pausing) is given ``timeout_s`` to change and settle,
+        as its decode is. None where it holds no time, or still cannot be opened then (its
+        decode then says why).
+
+        Why: read as it first came, half a file gave no time, and a late file of an earlier
+        pulse was taken for this light unchecked: the very case the check is for."""
+        s = self.settings
+        deadline = self._clock.now() + s.timeout_s
+        while True:
+            final, taken = _read_capture_time(path)
+            if final or taken is not None:
+                return taken
+            tried, stable = _identity(path), 0
+            last = tried
+            while True:
+                if self._clock.now() >= deadline:
+                    return None
+                self._clock.sleep(s.poll_interval_s)
+                now = _identity(path)
+                stable = stable + 1 if now == last else 1
+                last = now
+                if now is not None and now != tried and stable >= s.stable_polls:
+                    break
+
+    def _place(self, taken: float, pulsed_at: float, window_s: float = 0.0) -> list[str] | None:
         """Whether a file shot at ``taken`` (camera clock) is the file of the pulse at
         ``pulsed_at`` (rig clock): the notices to give it if so, None if it is out of step
         (then remembered as a possible late file of the previous pulse)."""
-        tol = CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s
+        base = CAPTURE_TIME_RESOLUTION_S + self.settings.shutter_lag_s + window_s
         anchor, orphan = self._anchor, self._orphan
         notes: list[str] = []
-        if anchor is not None and abs((taken - anchor[0]) - (pulsed_at - anchor[1])) > tol:
-            if orphan is None or abs((taken - orphan[0]) - (pulsed_at - orphan[1])) > tol:
-                self._orphan = (taken, anchor[1])
+        # each pulse is known to within the time its trigger took to return
+        if anchor is not None and abs((taken - anchor[0]) - (pulsed_at - anchor[1])) > (
+            base + anchor[2]
+        ):
+            if orphan is None or abs((taken - orphan[0]) - (pulsed_at - orphan[1])) > (
+                base + orphan[2]
+            ):
+                self._orphan = (taken, anchor[1], anchor[2])
                 return None
             # the set-aside file was the previous pulse's: the last image was an earlier one's
             early = orphan[0] - anchor[0]
@@ -548,7 +600,7 @@ class FolderWatchCamera:
                 "run stopped waiting for before a resume?); check that the object and the light "
                 "were the same then"
             )
-        self._anchor, self._orphan = (taken, pulsed_at), None
+        self._anchor, self._orphan = (taken, pulsed_at, window_s), None
         return notes
 
     def _drop_copy(self, held: Path) -> None:

@@ -288,3 +288,101 @@ def test_files_in_step_with_the_pulses_are_all_taken_whatever_the_camera_clock(t
     cam.connect()
     names = [Path(cam.capture(0.5).metadata["watched_file"]).name for _ in range(4)]
     assert names == [f"IMG_{n:04d}.DNG" for n in range(1, 5)]
+
+
+def test_a_pulse_whose_confirmation_was_lost_keeps_its_own_file(tmp_path):
+    """Pulse 2's reply is lost: the trigger returns a whole reply timeout (1 s) after the real
+    pulse. The pulse had been dated when the trigger returned, so its own file (camera clock
+    at .05 s) read 1 s out of step and was set aside, the run stopping with "a late file of an
+    earlier pulse?". The pulse is now dated within the trigger's call."""
+    from rti_rig.drivers.cameras.folder_watch import TriggerUnconfirmed
+
+    body = _Body(tmp_path, [0.5, 0.5, 0.5], offset_s=0.05)
+
+    def pulse(exposure_s: float) -> None:
+        body.pulse(exposure_s)
+        if len(body.pulses) == 2:
+            body.clock.sleep(1.0)
+            raise TriggerUnconfirmed("dome: no reply within 1 s")
+
+    settings = FolderWatchSettings(folder=tmp_path, timeout_s=5.0, poll_interval_s=0.125)
+    cam = FolderWatchCamera(settings, clock=body.clock, trigger=pulse)
+    cam.connect()
+    assert cam.capture(0.1).metadata["watched_file"].endswith("IMG_0001.DNG")
+    body.clock.sleep(2.9 - (body.clock.now() - body.pulses[0]))
+    second = cam.capture(0.1)
+    assert second.metadata["watched_file"].endswith("IMG_0002.DNG")
+    assert any("confirmation was lost" in n for n in second.metadata.get("notices") or [])
+
+
+def test_a_late_file_still_being_written_is_checked_once_whole(tmp_path):
+    """A file shot 30 s out of step comes half written 0.3 s after pulse 2 (a network share
+    pausing), then whole 1 s later; pulse 2's own file comes 2.5 s after its pulse. Half a
+    file gave LibRaw no capture time and the file was taken for light 2 unchecked. Its time is
+    now read once it is whole: it is set aside and light 2 gets its own file."""
+    import datetime
+
+    body = _Body(tmp_path, [0.5, 2.5, 0.5], offset_s=0.0)
+    stale = tmp_path.parent / "stale.dng"
+    stamp = datetime.datetime(2026, 11, 30, 9, 0, 0) - datetime.timedelta(seconds=30)
+    write_dng(
+        stale,
+        linear_to_mosaic(np.full((64, 64), 0.9), "RGGB", 256, 4095),
+        black_level=256,
+        white_level=4095,
+        exposure_s=0.1,
+        date_time=stamp.strftime("%Y:%m:%d %H:%M:%S"),
+    )
+    data = stale.read_bytes()
+    late = tmp_path / "IMG_0000.DNG"
+
+    def pulse(exposure_s: float) -> None:
+        body.pulse(exposure_s)
+        if len(body.pulses) == 2:
+            at = body.clock.now()
+            body.clock.actions = sorted(
+                [
+                    *body.clock.actions,
+                    (at + 0.3, lambda: late.write_bytes(data[: len(data) // 2])),
+                    (at + 1.3, lambda: late.write_bytes(data)),
+                ],
+                key=lambda a: a[0],
+            )
+
+    settings = FolderWatchSettings(folder=tmp_path, timeout_s=5.0, poll_interval_s=0.125)
+    cam = FolderWatchCamera(settings, clock=body.clock, trigger=pulse)
+    cam.connect()
+    cam.capture(0.1)
+    body.clock.sleep(3.0)
+    second = cam.capture(0.1)
+    assert second.metadata["watched_file"].endswith("IMG_0002.DNG"), second.metadata
+
+
+def test_a_capture_time_does_not_jump_at_the_computers_daylight_saving_change(
+    tmp_path, monkeypatch
+):
+    """EXIF times carry no time zone; read in the computer's zone, two shots 3 s apart across
+    its daylight-saving change (America/New_York, 2026-11-01 02:00) came out 3603 s apart, and
+    every later file was set aside as out of step. They are the camera's wall clock."""
+    import time
+
+    from rti_rig.drivers.cameras.folder_watch import capture_time
+
+    monkeypatch.setenv("TZ", "America/New_York")
+    time.tzset()
+    try:
+        times = []
+        for name, stamp in (("a.DNG", "2026:11:01 01:59:58"), ("b.DNG", "2026:11:01 02:00:01")):
+            write_dng(
+                tmp_path / name,
+                linear_to_mosaic(np.full((32, 32), 0.5), "RGGB", 256, 4095),
+                black_level=256,
+                white_level=4095,
+                exposure_s=0.1,
+                date_time=stamp,
+            )
+            times.append(capture_time(tmp_path / name))
+    finally:
+        monkeypatch.delenv("TZ")
+        time.tzset()
+    assert times[1] - times[0] == pytest.approx(3.0)
