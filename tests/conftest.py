@@ -72,6 +72,26 @@ def inprocess_arm_config(tmp_path: Path, extra: str = "") -> Path:
     return cfg
 
 
+def emulators_built_by_check(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
+    """The emulators of the rigs ``rti-rig check`` builds from here on (``build_rig`` wrapped
+    where compose and the check use case import it): what a test reads the servos' state
+    from after the command."""
+    import rti_rig.app.compose as compose
+    import rti_rig.app.usecases.check as check_usecase
+
+    emulators: list[Any] = []
+    real_build = compose.build_rig
+
+    def build(*args: Any, **kwargs: Any) -> Any:
+        rig = real_build(*args, **kwargs)
+        emulators.append(rig.emulator)
+        return rig
+
+    monkeypatch.setattr(compose, "build_rig", build)
+    monkeypatch.setattr(check_usecase, "build_rig", build)  # imported by name there
+    return emulators
+
+
 def virtual_arm_variant(tmp_path: Path, scene: str, side: int | None = None) -> Path:
     """The shipped virtual arm (512 px, the relief) with another simulated scene and, if
     given, square frames of ``side`` px: what the QA tests run correct sessions on."""

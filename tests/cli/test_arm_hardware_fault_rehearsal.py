@@ -13,11 +13,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, inprocess_arm_config
+from conftest import CONFIGS, emulators_built_by_check, inprocess_arm_config
 from typer.testing import CliRunner
 
-import rti_rig.app.compose as compose
-import rti_rig.app.usecases.check as check_usecase
 from rti_rig.cli import app
 from rti_rig.drivers.dynamixel import control_table as ct
 
@@ -33,16 +31,7 @@ def _config(tmp_path: Path, extra: str = FAULT) -> Path:
 def test_check_on_a_servo_that_overloads_stops_names_it_and_leaves_it_unparked(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    emulators: list = []  # type: ignore[type-arg]
-    real_build = compose.build_rig
-
-    def build(*args, **kwargs):  # type: ignore[no-untyped-def]
-        rig = real_build(*args, **kwargs)
-        emulators.append(rig.emulator)
-        return rig
-
-    monkeypatch.setattr(compose, "build_rig", build)
-    monkeypatch.setattr(check_usecase, "build_rig", build)  # imported by name there
+    emulators = emulators_built_by_check(monkeypatch)
     r = runner.invoke(app, ["check", str(_config(tmp_path))], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 1, said
@@ -85,16 +74,7 @@ def test_two_servos_faulting_at_one_packet_are_both_rehearsed(
     both joints at once): both servos latch their errors. The emulator kept its hardware
     faults by packet, one each, so the first was dropped without a word and only servo 2
     faulted."""
-    emulators: list = []  # type: ignore[type-arg]
-    real_build = compose.build_rig
-
-    def build(*args, **kwargs):  # type: ignore[no-untyped-def]
-        rig = real_build(*args, **kwargs)
-        emulators.append(rig.emulator)
-        return rig
-
-    monkeypatch.setattr(compose, "build_rig", build)
-    monkeypatch.setattr(check_usecase, "build_rig", build)
+    emulators = emulators_built_by_check(monkeypatch)
     both = FAULT.replace("servo_id = 2", "servo_id = 1") + FAULT
     r = runner.invoke(app, ["check", str(_config(tmp_path, both))], terminal_width=400)
     said = " ".join(r.output.split())

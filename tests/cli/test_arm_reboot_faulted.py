@@ -13,11 +13,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, inprocess_arm_config
+from conftest import CONFIGS, emulators_built_by_check, inprocess_arm_config
 from typer.testing import CliRunner
 
-import rti_rig.app.compose as compose
-import rti_rig.app.usecases.check as check_usecase
 from rti_rig.cli import app
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
@@ -36,16 +34,7 @@ def _config(tmp_path: Path) -> Path:
 def test_reboot_faulted_clears_the_faulted_servo_only_and_moves_nothing(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
-    emulators: list = []  # type: ignore[type-arg]
-    real_build = compose.build_rig
-
-    def build(*args, **kwargs):  # type: ignore[no-untyped-def]
-        rig = real_build(*args, **kwargs)
-        emulators.append(rig.emulator)
-        return rig
-
-    monkeypatch.setattr(compose, "build_rig", build)
-    monkeypatch.setattr(check_usecase, "build_rig", build)
+    emulators = emulators_built_by_check(monkeypatch)
     cfg = _config(tmp_path)
     r = runner.invoke(app, ["check", str(cfg), "--reboot-faulted"], terminal_width=400)
     said = " ".join(r.output.split())
