@@ -23,7 +23,11 @@ than on its own renderings. This probe measures it at the first decision (the sh
   across held-out images, paired — of the favoured one), ``mean`` (over every variant),
   ``minimax`` (the worst variant); and, benchmark-only, ``truth-pred`` (on the variant whose
   renderings best predict the *true* images of every light not shot: what a perfect selector
-  of variants by prediction would use — does predicting better rank designs better?);
+  of variants by prediction would use — does predicting better rank designs better?), and
+  ``bar-regret`` (2026-11-30, issue 28): per variant also the four *full* homogeneous layouts
+  of N (floors 0/10/20/30, not completions of the lights shot: the bar as that variant sees
+  it) are simulated, and a design scores ``max_v simerr_v(d) / min_f simerr_v(H_f)``, its
+  worst predicted loss against the bar (:func:`bar_regret`);
 * each criterion's design taken as the chooser takes it (the default floor kept unless another
   is 10 % better, ``planner.adaptive._switch``), its true error, and the **rank correlation**
   (Spearman, and the regret of the criterion's best design) of the criterion's scores with the
@@ -77,8 +81,10 @@ from rti_rig.planner.adaptive_bias import (
 VARIANTS = ("fitted", "no-shadow", "relief2", "glossy", "matte", "smooth")
 CRITERIA = ("shipped", "select", "1se", "mean", "minimax")
 #: and, in the first-decision probe only, ``truth-pred``: the variant that best predicts the
-#: *true* images of every light not shot (a perfect variant selector; benchmark-only)
-PROBE_CRITERIA = (*CRITERIA, "truth-pred")
+#: *true* images of every light not shot (a perfect variant selector; benchmark-only), and
+#: ``bar-regret``: the worst, over the variants, of a design's simulated error over the best of
+#: that variant's own *full* homogeneous layouts (:func:`bar_regret`)
+PROBE_CRITERIA = (*CRITERIA, "truth-pred", "bar-regret")
 #: neighbours a ``smooth`` normal is averaged over (sampled pixels, image distance)
 SMOOTH_K = 16
 #: the robust loss's scale, noise units
@@ -214,6 +220,32 @@ def criteria_scores(
     }, best
 
 
+def full_homogeneous(dirs: NDArray, n: int) -> list[NDArray]:
+    """The full homogeneous layouts of ``n`` of the candidates ``dirs`` (K, 3), one per shipped
+    floor (:data:`FLOORS`; a floor with too few candidates left out), as light sets (n, 3): the
+    bar's layouts, not completions of the lights shot (``homogeneous_completion`` with none
+    used, which matches the ideal layout to the candidates as ``select_uniform_leds`` does)."""
+    free = np.ones(len(dirs), dtype=bool)
+    out = []
+    for f in FLOORS:
+        idx = adaptive.homogeneous_completion(dirs, free, np.zeros((0, 3)), n, f)
+        if idx is not None and idx.size == n:
+            out.append(np.asarray(dirs)[idx])
+    return out
+
+
+def bar_regret(sims: dict[str, list[float]], bars: dict[str, list[float]]) -> list[float]:
+    """Per design: ``max_v sims[v][d] / min(bars[v])``, the worst over the variants of the
+    design's simulated error relative to the best homogeneous layout *as that variant sees it*.
+
+    Why: raw ``minimax`` is ruled by the hardest variant (its errors are the largest whatever
+    the design); dividing by each variant's own bar removes its overall difficulty and scores
+    the design by its worst predicted loss against the bar the issue sets (the hindsight-tuned
+    homogeneous layout). Below 1: every variant predicts the design beats its best layout."""
+    ratio = [np.asarray(sims[v], dtype=np.float64) / max(min(bars[v]), 1e-12) for v in sims]
+    return [float(x) for x in np.max(ratio, axis=0)]
+
+
 def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 0) -> str:
     rows = []
     rho_all: dict[str, list[float]] = {c: [] for c in PROBE_CRITERIA}
@@ -247,6 +279,9 @@ def probe(draws: int, scenes: tuple[str, ...], ns: tuple[int, ...], seed: int = 
                 crit, best_v = criteria_scores(sims, losses)
                 truly = truly_predicting(cand[keep], model, vs, g_sample, list(st))
                 crit["truth-pred"] = sims[truly]
+                homs = full_homogeneous(cand[keep], n)
+                bars = {v: simulate_designs(m, homs, robust_fit) for v, m in vs.items()}
+                crit["bar-regret"] = bar_regret(sims, bars)
                 favoured.setdefault(n, []).append(best_v)
                 favoured.setdefault(-n, []).append(truly)
                 res.setdefault((n, "best design"), []).append(min(true))

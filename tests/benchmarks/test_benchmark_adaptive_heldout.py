@@ -113,3 +113,29 @@ def test_heldout_score_variant_scores_on_that_variant_alone(
     assert np.allclose(got, want)
     with pytest.raises(SystemExit, match="one of"):
         adaptive_heldout.install("variant-shiny")
+
+
+def test_bar_regret_divides_each_variant_by_its_own_best_layout() -> None:
+    """Design 0 is at the bar for both variants; design 1 is twice variant a's bar. Raw
+    ``minimax`` is ruled by the hard variant b (errors 10 against 9) and prefers design 1; the
+    bar regret prefers design 0 (worst ratio 1 against 2)."""
+    sims = {"a": [2.0, 4.0], "b": [10.0, 9.0]}
+    bars = {"a": [3.0, 2.0, 5.0], "b": [12.0, 10.0]}
+    assert adaptive_heldout.bar_regret(sims, bars) == pytest.approx([1.0, 2.0])
+    raw = np.max([sims["a"], sims["b"]], axis=0)
+    assert int(np.argmin(raw)) == 1
+
+
+def test_full_homogeneous_layouts_are_the_bar_s_layouts() -> None:
+    """One layout of N per shipped floor, the candidates ``select_uniform_leds`` takes (the
+    bar's layouts), whatever lights a session has shot."""
+    from rti_rig.core.rig_geometry import DomeGeometry
+    from rti_rig.planner.uniform import select_uniform_leds
+
+    dirs = fibonacci_cap(60, 0.0)
+    dome = DomeGeometry(dirs, tuple(f"c{i:02d}" for i in range(len(dirs))))
+    homs = adaptive_heldout.full_homogeneous(dirs, 9)
+    assert len(homs) == len(adaptive_heldout.FLOORS)
+    for f, h in zip(adaptive_heldout.FLOORS, homs, strict=True):
+        want = dirs[select_uniform_leds(dome, 9, f)]
+        assert sorted(map(tuple, np.round(h, 9))) == sorted(map(tuple, np.round(want, 9)))
