@@ -41,7 +41,8 @@ ships).
 itself with its designs scored so (:func:`install`), every decision.
 
 Run: ``python -m benchmarks.adaptive_heldout [--draws K] [--scenes a,b] [--ns 6,9] [--seed S]
-[--all-decisions]`` (all scenes and N, 8 draws: about 3–9 min on 2 loaded cores;
+[--all-decisions]`` (all scenes and N, 8 draws: about 11 min on 2 loaded cores with
+``bar-regret``'s layouts, 3–9 min before;
 ``--all-decisions`` on 3 scenes at 6 and 9 lights about 5 min). Prints a table per cell and
 the mean rank correlations; writes nothing.
 """
