@@ -206,6 +206,7 @@ class _Server:
     def run(self) -> None:
         try:
             self._loop()
+            self._reset_by_late_opens()
         except BaseException as exc:  # reported to the test through PtyLink.errors
             self.errors.append(exc)
         finally:
@@ -271,6 +272,14 @@ class _Server:
                 self._unplug(down)
                 continue
             self._flush_due()
+
+    def _reset_by_late_opens(self) -> None:
+        """An open of the port the loop had not read when the server was asked to stop still
+        resets the board (its DTR rose as the port opened): a host that opened and closed the
+        port just before its rig closed (a stop inside pyserial's open) had left the emulated
+        Nab board dark where the real one, reset, boots with every LED lit."""
+        if self.watch.available and any(self.watch.events()):
+            self.device.on_port_opened()
 
     def _poll_ms(self) -> int:
         if not self.pending:

@@ -118,24 +118,13 @@ class ScriptedDomeDriver:
         #: the ``boot_wait_s`` to set), kept for the report the user reads: as a warning on
         #: stderr alone it was missed beside ``check``'s "RESULT: PASS". None: none so far.
         self.slow_boot_advice: str | None = None
+        #: A stop came while the port was being opened (see :meth:`reopen_port`).
+        self.open_cut_short = False
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> DomeInfo:
-        self.close()
-        try:
-            self.transport.open()
-        except TransportError as exc:
-            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED)
-            error.port_held = isinstance(exc, PortHeldError)
-            raise error from exc
-        self._open = True
-        self._booted = self._boot_heard = False
-        self.foreign_firmware = None
-        self._foreign_off = None
-        self._rx.clear()
-        self._opened_at = self.transport.clock.now()
-        self._boot_deadline = self._opened_at + self.spec.boot_wait_s
+        self.reopen_port()
         self._wait_boot()
         self._booted = True
         self._boot_heard = bool(self.boot_text.strip())
@@ -295,6 +284,37 @@ class ScriptedDomeDriver:
             transport.baudrate = port_rate
             self.spec = spec
         return self.off_outcome
+
+    def reopen_port(self) -> None:
+        """Open the port (closing it first) and start the boot wait, without waiting it out:
+        the first step of :meth:`connect`, and what a stop that cut that step short calls to
+        get the port back for the all-off (then :meth:`finish_boot`).
+
+        :attr:`open_cut_short` is true from before the system opens the port until this link
+        counts it open: a stop in between (inside pyserial's open, which closes the port again
+        as the stop goes through it) left a port that was never open here, so no all-off was
+        sent, while the opening had reset a board that resets on open, and the Nab sketch
+        boots with every LED lit."""
+        self.close()
+        self.open_cut_short = True
+        self._booted = self._boot_heard = False
+        self.foreign_firmware = None
+        self._foreign_off = None
+        # the boot wait is counted from before the opening: a stop just after it then finds
+        # the deadline of this opening, not an earlier one's (its all-off would be lost in the
+        # bootloader)
+        self._opened_at = self.transport.clock.now()
+        self._boot_deadline = self._opened_at + self.spec.boot_wait_s
+        try:
+            self.transport.open()
+        except TransportError as exc:
+            self.open_cut_short = False  # the system refused it: nothing was opened or reset
+            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED)
+            error.port_held = isinstance(exc, PortHeldError)
+            raise error from exc
+        self._open = True
+        self._rx.clear()
+        self.open_cut_short = False
 
     def finish_boot(self) -> None:
         """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same

@@ -137,6 +137,10 @@ class OffOutcome(StrEnum):
     NEVER_OPENED = "never-opened"  # the port could not be opened: this run sent nothing at all
 
 
+#: The end of a lights sentence that sends the user to the dome's supply.
+_CUT_SUPPLY = "; switch the dome off at its power supply"
+
+
 @dataclass(frozen=True)
 class OffReport:
     """The honest state of the lights after the last all-off attempt (what a user is told)."""
@@ -164,6 +168,7 @@ class OffReport:
             return self._reopened_sentence()
         said = self._sentence()
         if self.boots_lit and self.outcome in (OffOutcome.SENT_UNCONFIRMED, OffOutcome.NOT_SENT):
+            said = said.removesuffix(_CUT_SUPPLY)  # said once, at the end of what follows
             said += (
                 f"; the {self.boots_lit} firmware lights every LED as its board boots, and "
                 "opening the port resets the board: if this is that board, every LED is on "

@@ -348,13 +348,17 @@ class DomePolicy:
             # sent before the stop goes on (it had been told "the dome was never reached"
             # with every LED of a board that boots lit still on)
             try:
+                if getattr(self.link, "open_cut_short", False):
+                    self._reopen_cut_short_port()
                 if getattr(self.link, "port_open", True):
                     self._port_was_open = True
                     self.reached = "opened"
                     # what stands if a further signal cuts the attempt short (the attempt
                     # replaces it with what it established)
                     self.off_report = OffReport(
-                        OffOutcome.NOT_SENT, "a further stop cut the all-off short"
+                        OffOutcome.NOT_SENT,
+                        "a further stop cut the all-off short",
+                        boots_lit=self._lit_at_boot(),
                     )
                     self._finish_boot()
                     self._attempt_off("after the connection was interrupted", after_open=True)
@@ -1005,6 +1009,37 @@ class DomePolicy:
         finally:
             self.clock.sleep(max(0.0, self._link_clock.now() - t0))
 
+    def _reopen_cut_short_port(self) -> None:
+        """Open the port again after a stop cut its opening short, so that the all-off can be
+        sent (the caller sends it once the board has booted).
+
+        Why: a Ctrl-C inside pyserial's open (which closes the port as the stop goes through)
+        left a port this link never had open: no all-off was sent and the user was told "the
+        dome was never reached", while the opening had reset the board, and the Nab sketch
+        boots with every LED lit. Reopening resets such a board once more (lit while it
+        boots), then its all-off switches it off, acknowledged where the firmware does. If the
+        port does not open again, the lights line says the all-off was not sent."""
+        self._port_was_open = True  # the system opened it: a board that resets on open did
+        self.reached = "opened"
+        self.off_report = OffReport(
+            OffOutcome.NOT_SENT,
+            "the stop came while the port was being opened, and it was not opened again",
+            boots_lit=self._lit_at_boot(),
+        )
+        log.warning("%s: reopening the port a stop cut short, to send the all-off", self.name)
+        try:
+            self._counted(self.link.reopen_port)  # type: ignore[attr-defined]
+        except DomeLinkError as exc:
+            log.warning("%s: the port did not open again: %s", self.name, exc)
+            self.off_report = replace(
+                self.off_report, detail=f"the port did not open again after the stop: {exc}"
+            )
+
+    def _lit_at_boot(self) -> str | None:
+        """The firmware's name if it lights every LED as its board boots (the Nab sketch)."""
+        spec = getattr(self.link, "spec", None)
+        return str(getattr(spec, "name", "")) if getattr(spec, "boots_lit", False) else None
+
     def _finish_boot(self) -> None:
         """Let a board the stop caught in its bootloader finish booting (to the end of the
         profile's boot wait begun when the port opened) before the all-off, which would be lost
@@ -1050,12 +1085,7 @@ class DomePolicy:
         link's ``switch_off_at_published_rate``). At the wrong rate the all-off is garbage to the
         board, which the opening had lit whole: it was left so, the user told to cut its power.
         The reopening resets the board once more (lit while it boots), then switches it off."""
-        spec = getattr(self.link, "spec", None)
-        lit_at_boot = (
-            str(getattr(spec, "name", ""))
-            if after_open and getattr(spec, "boots_lit", False)
-            else None
-        )
+        lit_at_boot = self._lit_at_boot() if after_open else None
         try:
             self._counted(self.link.all_off)
         except DomeLinkError as exc:

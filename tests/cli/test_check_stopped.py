@@ -12,6 +12,7 @@ import threading
 from pathlib import Path
 
 import pytest
+from conftest import emulators_built_by_check
 
 REPO = Path(__file__).resolve().parents[2]
 #: the CLI with the dome's third ``light`` holding (its LED lit) until a signal ends it
@@ -99,3 +100,45 @@ def test_a_stopped_arm_check_says_what_its_teardown_could_not_do(
     assert r.exit_code == 143, said
     assert "teardown problem: lamp off" in said and "no answer to lamp off" in said, said
     assert said.index("teardown problem") < said.index("Check stopped (SIGTERM)")
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_ctrl_c_inside_the_opening_of_the_nab_port_still_switches_the_board_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Ctrl-C while pyserial opens the dome's port (after the system opened it, which resets
+    the board; pyserial closes it again as the stop goes through): the port is opened again and
+    the all-off sent once the board has booted. No all-off had been sent, the user told "the
+    dome was never reached", and the Nab sketch, reset by the opening, stood with every LED lit.
+    The Ctrl-C is a real SIGINT through the check's handler, raised at that point (no race)."""
+    import serial
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    real_open = serial.serial_for_url
+    stops: list[int] = []
+
+    def opened(*args, **kwargs):  # type: ignore[no-untyped-def]
+        port = real_open(*args, **kwargs)
+        if not stops:  # the user's one Ctrl-C, in the first opening
+            stops.append(signal.SIGINT)
+            try:
+                signal.raise_signal(signal.SIGINT)
+            except BaseException:
+                port.close()  # as pyserial's own open does when a stop goes through it
+                raise
+        return port
+
+    monkeypatch.setattr(serial, "serial_for_url", opened)
+    emulators = emulators_built_by_check(monkeypatch)
+    cfg = REPO / "rig_configs" / "emulated_nab_rti_v1.toml"
+    r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert stops and r.exit_code == 130, said
+    assert "Traceback" not in said
+    assert "never reached" not in said, said
+    assert "Check stopped (Ctrl-C): all-off sent and acknowledged by the dome" in said, said
+    (board,) = emulators
+    assert any(what == "boot" for _, what in board.events)  # the opening did reset it
+    assert board.lit == frozenset()  # booted lit, then switched off

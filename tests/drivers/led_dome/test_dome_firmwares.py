@@ -1146,3 +1146,39 @@ def test_a_custom_description_of_a_sketch_keeping_a_known_banner_is_not_refused(
         finally:
             driver.close()
     assert board.commands == 1  # its init all-off went through
+
+
+def test_a_stop_inside_the_opening_whose_port_will_not_reopen_says_the_board_is_lit() -> None:
+    """A stop inside the port's opening (which reset the board), and the port then does not
+    open again for the all-off: the lights line says the Nab board, which boots with every LED
+    lit, is lit and to cut its supply (it had said "the dome was never reached")."""
+    from rti_rig.app.dome_factory import build_dome
+    from rti_rig.core.clock import VirtualClock
+    from rti_rig.core.dome_link import OffOutcome
+    from rti_rig.drivers.led_dome.transport import TransportError
+    from rti_rig.runtime.controller import EmergencyStop
+
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab") as link:
+        dome = build_dome(DomeSerialSettings(port=link.port, profile="nab-rti-v1"), VirtualClock())
+        transport = dome.link.transport
+        real_open, opens = transport.open, []
+
+        def open_port():  # type: ignore[no-untyped-def]
+            opens.append(1)
+            if len(opens) > 1:
+                raise TransportError(f"cannot open serial port {link.port}: No such device")
+            real_open()
+            transport.close()  # as pyserial closes the port when a stop goes through its open
+            raise EmergencyStop("SIGTERM")
+
+        transport.open = open_port
+        with pytest.raises(EmergencyStop):
+            dome.connect()
+        assert len(opens) == 2  # the port was tried again for the all-off
+        report = dome.off_report
+        assert report is not None and report.outcome is OffOutcome.NOT_SENT
+        said = report.sentence()
+        assert "every LED is on now; switch the dome off at its power supply" in said, said
+        assert said.count("power supply") == 1, said
+        assert "never reached" not in said
