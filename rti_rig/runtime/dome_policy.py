@@ -1084,7 +1084,9 @@ class DomePolicy:
         firmware's published one is sent again after reopening the port at that rate (the
         link's ``switch_off_at_published_rate``). At the wrong rate the all-off is garbage to the
         board, which the opening had lit whole: it was left so, the user told to cut its power.
-        The reopening resets the board once more (lit while it boots), then switches it off."""
+        The reopening resets the board once more (lit while it boots), then switches it off.
+        A port that sent no byte at all since it opened is not reopened (see
+        :meth:`_not_reopened_silent`)."""
         lit_at_boot = self._lit_at_boot() if after_open else None
         try:
             self._counted(self.link.all_off)
@@ -1095,7 +1097,10 @@ class DomePolicy:
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = replace(_failed_off(exc), boots_lit=lit_at_boot)
             if at_published_rate and lit_at_boot and exc.fault is not LinkFault.DISCONNECTED:
-                self._switch_off_at_published_rate(lit_at_boot)
+                if getattr(self.link, "bytes_heard", True):
+                    self._switch_off_at_published_rate(lit_at_boot)
+                else:
+                    self._not_reopened_silent(lit_at_boot)
         except DeviceError as exc:
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = OffReport(
@@ -1105,6 +1110,29 @@ class DomePolicy:
             self.off_report = OffReport(
                 getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED), when
             )
+
+    def _not_reopened_silent(self, firmware: str) -> None:
+        """Record why a port wholly silent since it opened is not reopened at the firmware's
+        published rate (see :meth:`_attempt_off`).
+
+        Why: a board of a firmware that boots lit prints its banner at every opening (the Nab
+        sketch's ``setup()``), and at a wrong baud rate that banner still comes, as garbled
+        bytes; a port that sent not one byte through the boot wait, the resent handshake and
+        the all-off had no such board booting on it. Reopening it cost a second boot wait and
+        reply timeout (7 s with the Nab profile) for an all-off nothing could receive."""
+        rate = getattr(self.link, "published_baudrate", None)
+        if rate is None or self.off_report is None:
+            return
+        report = self.off_report
+        self.off_report = replace(
+            report,
+            detail=(
+                f"{report.detail}; not reopened at {rate} baud, the {firmware} firmware's "
+                "published rate: not one byte came from the port since it opened, where that "
+                "firmware's board prints its boot banner at every opening, garbled at a wrong "
+                "baud rate"
+            ),
+        )
 
     def _switch_off_at_published_rate(self, firmware: str) -> None:
         """See :meth:`_attempt_off`; records what the second all-off established."""

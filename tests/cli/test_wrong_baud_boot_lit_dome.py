@@ -75,3 +75,44 @@ def test_a_board_silent_at_both_rates_is_still_said_to_be_lit_whole(
     assert "every LED is on now; switch the dome off at its power supply" in said
     assert "it talks at 9600" not in said
     assert len(board.lit) > 1  # the truth: the board is lit whole
+
+
+def test_a_port_silent_at_the_wrong_rate_is_not_reopened_at_the_published_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The wrong port and the wrong rate: nothing at all answers on the port (no board prints
+    a banner, garbled or not). It is not reopened at 9600 for a second boot wait and reply
+    timeout (7 s more with the Nab profile) for an all-off nothing receives; the lights line
+    says why, and still says what a lit Nab board would need."""
+    import os
+    import tty
+
+    from conftest import emulated_dome_as_hardware
+
+    from rti_rig.drivers.led_dome.transport import SerialTransport
+
+    master, slave = os.openpty()  # a port with nothing behind it: it reads what it is sent
+    tty.setraw(slave)
+    port = os.ttyname(slave)
+    os.close(slave)
+    opened_at: list[int] = []
+    real_open = SerialTransport.open
+
+    def counted(self):  # type: ignore[no-untyped-def]
+        opened_at.append(self.baudrate)
+        real_open(self)
+
+    monkeypatch.setattr(SerialTransport, "open", counted)
+    cfg = emulated_dome_as_hardware(tmp_path, "emulated_nab_rti_v1.toml", port)
+    text = cfg.read_text().replace("reply_timeout_s = 3.0", "reply_timeout_s = 0.5")
+    text = text.replace('profile = "nab-rti-v1"', 'profile = "nab-rti-v1"\nbaudrate = 115200')
+    cfg.write_text(text.replace("led_count = 12", "led_count = 12\nboot_wait_s = 0.5"))
+    try:
+        r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    finally:
+        os.close(master)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1, said
+    assert opened_at == [115200], opened_at  # once, at the configured rate
+    assert "not reopened at 9600 baud" in said and "not one byte came from the port" in said
+    assert "switch the dome off at its power supply" in said, said
