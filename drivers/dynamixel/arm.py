@@ -126,6 +126,9 @@ class DynamixelArm:
         self.ever_connected = False
         self._lamp_on = False
         self._emergency_stopped = False
+        #: ``release_on_close`` switched the torque off at the last close (see
+        #: :meth:`torque_release_note`).
+        self.torque_released = False
         self._goal: tuple[int, int] | None = None
         #: The ticks read when the last move ended in position: the pose whose direction the
         #: capture that follows is recorded under, which :meth:`check_held` compares with.
@@ -170,6 +173,7 @@ class DynamixelArm:
             self._bus.close()
             raise
         self._connected = self.ever_connected = True
+        self.torque_released = False
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is
@@ -529,12 +533,38 @@ class DynamixelArm:
             <= self.PARKED_TICKS
         ):
             self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
+            self.torque_released = True
         else:
             log.warning(
                 "%s: not at the park pose, so torque stays on (release_on_close releases only "
                 "when parked, where the arm cannot drop onto the object)",
                 self.name,
             )
+
+    def torque_release_note(self) -> str | None:
+        """What a user must know of an arm whose last close released its torque at the park
+        pose (None when it did not): the park pose is not held.
+
+        Why: the check said "parked" and no more, while the limp elevation joint, back-driven
+        by the lamp's weight, may sink from the park pose towards its lower stop (the emulator
+        models a 10 °/s fall); a user leaving the lamp over the object took "parked" for a
+        pose the arm keeps."""
+        if not self.torque_released:
+            return None
+        s = self.settings
+        low = s.elevation.min_deg
+        said = (
+            'torque then released (torque_policy = "release_on_close"): the joints are limp '
+            "and hold no pose"
+        )
+        if s.park_elevation_deg <= low:
+            return f"{said}; the lamp rests at its lower limit ({low:g}° elevation)"
+        return (
+            f"{said}: the lamp's weight may lower the elevation joint from "
+            f"{s.park_elevation_deg:g}° towards its lower limit ({low:g}°) or its stop; to "
+            f'keep it where it parked, set torque_policy = "hold", or park it where it '
+            f"rests (park_elevation_deg = {low:g} in [arm.dynamixel])"
+        )
 
     def __enter__(self) -> DynamixelArm:
         self.connect()

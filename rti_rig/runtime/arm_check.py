@@ -74,6 +74,9 @@ class ArmSelfTestReport:
     #: said in full once, under ABORTED: the failed pose's row and a teardown that met the
     #: same fault point back to it (one overload's paragraph had been printed three times)
     aborted_detail: str | None = None
+    #: what the carrier says of a park it does not hold (its torque released at the close),
+    #: said with "parked"; None: nothing to add
+    release_note: str | None = None
 
     @property
     def ok(self) -> bool:
@@ -133,7 +136,7 @@ class ArmSelfTestReport:
             )
         out.extend(f"teardown FAILED: {self._said_once(f)}" for f in self.teardown_failures)
         if self.parked:
-            out.append("parked")
+            out.append("parked" + (f"; {self.release_note}" if self.release_note else ""))
         else:
             out.append("NOT parked" + ("" if self.park_wanted else " (park_after_session is off)"))
         out.append(f"elapsed {self.elapsed_s:.1f} s on the rig's clock")
@@ -265,6 +268,8 @@ def arm_self_test(
             ]
         )
         report.stopped = not any(f.startswith("stop: ") for f in failures)
+        note = getattr(carrier, "torque_release_note", None)
+        report.release_note = note() if callable(note) else None
         report.teardown_failures = _point_back(failures)
         report.elapsed_s = clock.now() - started
     return report
