@@ -45,6 +45,7 @@ from rti_rig.core.dome_link import (
     OffReport,
 )
 from rti_rig.core.errors import DeviceError
+from rti_rig.runtime.deferred_signals import signals_deferred
 
 log = logging.getLogger("rti_rig.dome")
 
@@ -348,20 +349,8 @@ class DomePolicy:
             # sent before the stop goes on (it had been told "the dome was never reached"
             # with every LED of a board that boots lit still on)
             try:
-                if getattr(self.link, "open_cut_short", False):
-                    self._reopen_cut_short_port()
-                if getattr(self.link, "port_open", True):
-                    self._port_was_open = True
-                    self.reached = "opened"
-                    # what stands if a further signal cuts the attempt short (the attempt
-                    # replaces it with what it established)
-                    self.off_report = OffReport(
-                        OffOutcome.NOT_SENT,
-                        "a further stop cut the all-off short",
-                        boots_lit=self._lit_at_boot(),
-                    )
-                    self._finish_boot()
-                    self._attempt_off("after the connection was interrupted", after_open=True)
+                with signals_deferred():
+                    self._switch_off_after_stop()
             finally:
                 self._quiet_close()
             raise
@@ -1008,6 +997,29 @@ class DomePolicy:
             return op()
         finally:
             self.clock.sleep(max(0.0, self._link_clock.now() - t0))
+
+    def _switch_off_after_stop(self) -> None:
+        """The all-off after a stop cut :meth:`connect` short, once the board has booted (the
+        port opened again first if the stop cut its opening short). Run with further signals
+        held (see :meth:`connect`): a second Ctrl-C during its boot wait, the usual answer to a
+        command that does not stop at once, had cut it short and left the Nab board, which
+        boots lit, with every LED on; the signal acts once the all-off is through."""
+        if getattr(self.link, "open_cut_short", False):
+            self._reopen_cut_short_port()
+        if not getattr(self.link, "port_open", True):
+            return
+        self._port_was_open = True
+        self.reached = "opened"
+        # what stands if the attempt is cut short all the same (an error that is no signal);
+        # the attempt replaces it with what it established
+        self.off_report = OffReport(
+            OffOutcome.NOT_SENT,
+            "a further stop cut the all-off short",
+            boots_lit=self._lit_at_boot(),
+        )
+        log.warning("%s: stopped while connecting: switching the dome off first", self.name)
+        self._finish_boot()
+        self._attempt_off("after the connection was interrupted", after_open=True)
 
     def _reopen_cut_short_port(self) -> None:
         """Open the port again after a stop cut its opening short, so that the all-off can be
