@@ -78,11 +78,18 @@ class RebootOutcome:
             return f"{who}: no hardware fault (Hardware Error Status 0x00): not rebooted"
         faults = _fault_names(self.status_before)
         if not self.rebooted:
+            # its cause first: a power cycle alone, on the supply that faulted it (an input-
+            # voltage error is the one the XL430's Shutdown leaves torque on for), faults it
+            # again; the advice had been "switch the power off and on" alone
+            cause = "; ".join(
+                ct.FAULT_ADVICE[f] for f in ct.decode_hardware_error(self.status_before)
+            )
             return (
                 f"{who}: hardware fault {faults} (0x{self.status_before:02X}) but its torque "
                 "is on (it still holds its joint): NOT rebooted, as a reboot switches torque "
-                "off and the joint would drop; support the arm, then switch the servos' power "
-                "off and on"
+                f"off and the joint would drop; {cause}, then support the arm and switch the "
+                "servos' power off and on (that clears the fault, and the joint goes limp), "
+                "then run rti-rig check"
             )
         assert self.status_after is not None
         if self.status_after:

@@ -70,3 +70,40 @@ def test_reboot_faulted_is_refused_on_a_rig_without_dynamixel_servos() -> None:
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "--reboot-faulted reboots a Dynamixel arm's faulted servos" in said
+
+
+def test_a_faulted_servo_whose_torque_is_on_is_left_alone_and_the_user_told_what_to_do(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An input-voltage error, which the XL430's Shutdown (0x34) does not select: the servo
+    keeps its torque on and holds its joint. A Reboot resets its RAM, torque included (ROBOTIS
+    e-manual, Reboot; Torque Enable (64) is RAM), and the loaded elevation joint would drop: it
+    is skipped, and the report says which servo, why, the fault's cause to fix first (a power
+    cycle alone on the supply that faulted it faults it again) and what to do then."""
+    from rti_rig.drivers.dynamixel.arm import DynamixelArm
+
+    emulators = emulators_built_by_check(monkeypatch)
+    real_reboot = DynamixelArm.reboot_faulted
+
+    def reboot_faulted(self):  # type: ignore[no-untyped-def]
+        servo = emulators[0].servos[2]  # as a session left it: torque on, then the fault
+        servo._set(ct.TORQUE_ENABLE, 1)
+        servo._set(ct.HARDWARE_ERROR_STATUS, int(ct.HardwareFault.INPUT_VOLTAGE))
+        return real_reboot(self)
+
+    monkeypatch.setattr(DynamixelArm, "reboot_faulted", reboot_faulted)
+    cfg = inprocess_arm_config(tmp_path)
+    r = runner.invoke(app, ["check", str(cfg), "--reboot-faulted"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1, said
+    assert (
+        "servo 2 (elevation): hardware fault input voltage (0x01) but its torque is on (it "
+        "still holds its joint): NOT rebooted, as a reboot switches torque off and the joint "
+        "would drop; check the power supply voltage against the servo's limits, then support "
+        "the arm and switch the servos' power off and on" in said
+    ), said
+    assert "nothing rebooted; no torque was switched on or off" in said
+    assert "RESULT: FAIL" in said
+    (emu,) = emulators  # the truth: no Reboot sent, the joint still held
+    assert not [p for p in emu.instructions if p.instruction == p2.INST_REBOOT]
+    assert emu.servos[2].get(ct.TORQUE_ENABLE) == 1
