@@ -27,8 +27,9 @@ exposure after the pulse (see ``expose``), without one once the file has come; t
 the decode then happen in the dark. Held lit until the image was in hand, a RAW arriving over
 Wi-Fi 9 s after the pulse ran into the dome's ``max_on_s`` = 8 s and the good shot was lost.
 
-With a trigger, a file's own capture time (LibRaw's timestamp: EXIF DateTimeOriginal or the
-TIFF DateTime, whole seconds on the camera's clock) is checked against the pulses: the first
+With a trigger, a file's own capture time (a RAW's LibRaw timestamp: EXIF DateTimeOriginal or
+the TIFF DateTime; a TIFF's EXIF DateTimeOriginal; whole seconds on the camera's clock) is
+checked against the pulses: the first
 image after ``connect`` anchors the camera clock to its pulse, and each later file must have
 been shot as long after the last image as its pulse came after that image's pulse, within
 :data:`CAPTURE_TIME_RESOLUTION_S` plus ``shutter_lag_s``. A file out of step (a pulse's file
@@ -36,9 +37,11 @@ that came after the run had stopped at the timeout and was resumed, or a second 
 aside in ``strays/`` and the pulse's own file waited for; one that fits the set-aside file as
 the next pulse's proves the last image was a late file of an earlier pulse, said in a notice.
 Only differences of the camera clock are used (its offset, time zone and setting are free; its
-drift over a session is taken as negligible). What this cannot check: the first image after a
-``connect`` (no anchor yet), and files without a capture time (8-bit or 16-bit TIFF/PNG, a
-RAW LibRaw finds no time in).
+drift over a session is taken as negligible). The first image after a resume is checked against
+the camera clock an earlier run learned against the computer's wall clock (kept in the
+session, :class:`_LearnedClock`): a file shot before the resume connected is set aside. What
+this cannot check: the first image of a new session (no clock learned yet), and files without
+a capture time (PNG, a TIFF or RAW without one), which say so in a notice.
 
 Once the rig is bound to a session, a taken file is copied into the session's
 ``raw/.incoming`` before it is decoded, and that copy is decoded and kept: the folder belongs
@@ -50,11 +53,13 @@ Safe state: nothing to release (no device handle); ``close`` forgets the seen fi
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import shutil
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from datetime import UTC
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -102,8 +107,62 @@ CAPTURE_TIME_RESOLUTION_S = 1.0
 #: files out of step with the pulses set aside for one pulse before the run is stopped
 MAX_OUT_OF_STEP = 3
 
+#: TIFF names: their capture time is read with tifffile (EXIF DateTimeOriginal)
+TIFF_SUFFIXES = {".tif", ".tiff"}
+
 #: 8-bit formats a camera saves beside its RAW (RAW+JPEG): never a linear image
 JPEG_SUFFIXES = {".jpg", ".jpeg"}
+
+
+#: how fast a camera's clock may drift from the computer's, as a fraction of the time between
+#: the run that learned it and a resume (100 ppm: quartz clocks keep within a few tens, and
+#: this leaves room for the computer's own time corrections)
+CLOCK_DRIFT = 1e-4
+#: where a session keeps the camera clock learned (in its ``raw/``, beside ``.incoming``)
+CLOCK_FILE = ".folder_watch_clock.json"
+
+#: said for a file whose capture time cannot be read (one constant text: the session summary
+#: counts the images it concerns)
+NO_CAPTURE_TIME = (
+    "the watched folder's file holds no capture time (no EXIF DateTimeOriginal: a PNG, or a "
+    "TIFF or RAW saved without it), so it was not checked against the shutter pulses: a late "
+    "or extra file in the folder would have been taken as this light's image unseen"
+)
+
+
+@dataclass(frozen=True)
+class _LearnedClock:
+    """The camera's clock against the computer's wall clock, learned from an image in step
+    with its pulse: ``offset_s`` = capture time − the pulse's wall time, at ``wall_s``, the
+    pulse dated within ``window_s``. Kept in the session so a resume can check its first file.
+
+    Why: within a run, each file is checked against the image before it; the first image
+    after a connect had nothing to be checked against, so a file shot before a resume (the
+    late file of the pulse the stopped run waited for) was taken as the resumed light's
+    image."""
+
+    offset_s: float
+    wall_s: float
+    window_s: float
+
+    @classmethod
+    def load(cls, path: Path | None) -> _LearnedClock | None:
+        """The clock kept at ``path``; None when there is none or it cannot be read (the
+        first file is then unchecked, as in a new session)."""
+        if path is None:
+            return None
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+            return cls(float(data["offset_s"]), float(data["wall_s"]), float(data["window_s"]))
+        except (OSError, ValueError, TypeError, KeyError):
+            return None
+
+    def save(self, path: Path) -> None:
+        """Write atomically; a failure is left unsaid (a resume then checks less, no worse)."""
+        tmp = path.with_name(f"{path.name}.partial")
+        with contextlib.suppress(OSError):
+            tmp.write_text(json.dumps(self.__dict__), encoding="utf-8")
+            os.replace(tmp, path)
 
 
 class TriggerUnconfirmed(Exception):
@@ -129,9 +188,10 @@ def _identity(path: Path) -> tuple[int, int, int, int] | None:
 
 
 def capture_time(path: Path) -> float | None:
-    """The capture time LibRaw reads in ``path`` (EXIF DateTimeOriginal, or the TIFF DateTime),
-    in seconds on the camera's clock (only differences are meaningful), or None when the file
-    is no RAW, LibRaw cannot open it or it holds no time (LibRaw then gives the epoch)."""
+    """The capture time of ``path``, in seconds on the camera's clock (only differences are
+    meaningful): a RAW's as LibRaw reads it (EXIF DateTimeOriginal, or the TIFF DateTime), a
+    TIFF's EXIF DateTimeOriginal; None when LibRaw or tifffile cannot open the file, it holds
+    no time (LibRaw then gives the epoch) or it is neither (a PNG: OpenCV reads no EXIF)."""
     return _read_capture_time(path)[1]
 
 
@@ -143,6 +203,8 @@ def _read_capture_time(path: Path) -> tuple[bool, float | None]:
     RAW. The time is the camera's wall clock read as UTC: EXIF carries no time zone, and read
     in the computer's zone two shots across its daylight-saving change came out an hour apart,
     every later file then out of step."""
+    if path.suffix.lower() in TIFF_SUFFIXES:
+        return _tiff_capture_time(path)
     if not is_raw_file(path):
         return True, None
     try:
@@ -158,6 +220,37 @@ def _read_capture_time(path: Path) -> tuple[bool, float | None]:
     except (OverflowError, OSError, ValueError, AttributeError):
         return True, None
     return True, (None if stamp.year <= 1970 else float(value))
+
+
+def _tiff_capture_time(path: Path) -> tuple[bool, float | None]:
+    """:func:`_read_capture_time` of a TIFF: its EXIF DateTimeOriginal (the EXIF IFD, where
+    tethering programs and raw converters keep the shot's time), as the camera's wall clock.
+
+    Why: a TIFF had no capture time at all, so a late or extra TIFF was never checked against
+    the pulses. IFD0's DateTime is not used: it is when the file was written (the export), which
+    trails the shot by a varying transfer time, and would set in-step files aside. False (wait)
+    while tifffile cannot read the file yet (one still being written)."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tif:
+            exif = tif.pages.first.tags.get("ExifTag")
+            stamp = exif.value.get("DateTimeOriginal") if exif is not None else None
+    except Exception:  # not whole yet, or no TIFF: its decode says which
+        return False, None
+    return True, _exif_time(stamp)
+
+
+def _exif_time(stamp: object) -> float | None:
+    """An EXIF "YYYY:MM:DD HH:MM:SS" as seconds, the camera's wall clock read as UTC (see
+    :func:`_read_capture_time`); None when it is blank or malformed."""
+    if not isinstance(stamp, str):
+        return None
+    try:
+        when = datetime.strptime(stamp.strip().rstrip("\x00")[:19], "%Y:%m:%d %H:%M:%S")
+    except ValueError:
+        return None
+    return when.replace(tzinfo=UTC).timestamp() if when.year > 1970 else None
 
 
 def _has_header(path: Path) -> bool:
@@ -191,6 +284,14 @@ class _Pending:
     pulse_window_s: float = 0.0
     #: files that came after the pulse but were shot out of step with it, said in notices
     out_of_step: list[str] = field(default_factory=list)
+    #: when the trigger was called on the computer's wall clock (what a resume's check of its
+    #: first file is learned against: the rig clock starts again with each run)
+    pulsed_wall: float | None = None
+    #: of ``out_of_step``, those shot before this run connected (by the camera clock an earlier
+    #: run of the session learned): name -> how many seconds before
+    before_connect: dict[str, float] = field(default_factory=dict)
+    #: the capture time of the file taken, in step with the pulse (None: not checked)
+    taken: float | None = None
 
 
 class FolderWatchCamera:
@@ -201,8 +302,16 @@ class FolderWatchCamera:
         settings: FolderWatchSettings,
         clock: Clock | None = None,
         trigger: Callable[[float], None] | None = None,
+        wall: Callable[[], float] = time.time,
     ) -> None:
         self.settings = settings
+        #: the computer's wall clock (seconds since the epoch): the camera clock learned
+        #: against it holds from one run of a session to the next, the rig clock does not
+        self._wall = wall
+        #: the computer's wall clock at ``connect``
+        self._connected_wall: float | None = None
+        #: the camera clock as an earlier run of the session learned it, read at connect
+        self._learned: _LearnedClock | None = None
         self.name = settings.name
         self._clock = clock or SystemClock()
         self._trigger = trigger
@@ -247,6 +356,8 @@ class FolderWatchCamera:
         self._taken_stems = set()
         self._anchor = None
         self._orphan = None
+        self._connected_wall = self._wall()
+        self._learned = _LearnedClock.load(self._clock_file())
 
     def close(self) -> None:
         self._seen = None
@@ -441,12 +552,12 @@ class FolderWatchCamera:
         for p in self._new_files(self._seen):
             self._mark_seen(p.name, _identity(p))
             pending.stray.append(p.name)
-        sent = self._clock.now()
+        sent, wall = self._clock.now(), self._wall()
         try:
             self._trigger(exposure_s)
         except TriggerUnconfirmed as exc:
             pending.unconfirmed = str(exc)
-        pending.pulsed_at = sent
+        pending.pulsed_at, pending.pulsed_wall = sent, wall
         pending.pulse_window_s = self._clock.now() - sent
         self._pending = pending
         return self._clock.now() + self.settings.shutter_lag_s + exposure_s
@@ -461,6 +572,7 @@ class FolderWatchCamera:
         if path is None:
             path, notes = self._await_pulse_file(pending)
         frame = self._decode_complete(path, pending.exposure_s, pending.started)
+        self._learn_clock(pending)
         if notes:
             frame.metadata["notices"] = [*(frame.metadata.get("notices") or []), *notes]
         if pending.stray:
@@ -488,6 +600,7 @@ class FolderWatchCamera:
                     f"were shot out of step with it and not used: "
                     f"{', '.join(pending.out_of_step)} (their capture times fit no pulse of "
                     "this run: a late file of an earlier pulse, or a shot no light asked for)"
+                    + self._before_connect_said(pending)
                 )
             frame.metadata["notices"] = [
                 *(frame.metadata.get("notices") or []),
@@ -521,6 +634,7 @@ class FolderWatchCamera:
                         "with it (a late file of an earlier pulse?), not used, and left in "
                         f"{self.settings.folder}"
                     )
+                    said += self._before_connect_said(pending)
                 if pending.unconfirmed is not None:
                     said += f"; the trigger was not confirmed either ({pending.unconfirmed})"
                 if said == exc.message:
@@ -530,12 +644,18 @@ class FolderWatchCamera:
                 return path, []
             taken = self._whole_capture_time(path)
             if taken is None:
-                return path, []
-            placed = self._place(taken, pending.pulsed_at, pending.pulse_window_s)
+                return path, [NO_CAPTURE_TIME]
+            early = self._shot_before_connect(taken, pending.pulse_window_s)
+            placed = None
+            if early is None:
+                placed = self._place(taken, pending.pulsed_at, pending.pulse_window_s)
             if placed is not None:
+                pending.taken = taken  # learned once the file is decoded (see collect)
                 return path, placed
             pending.stray.append(path.name)
             pending.out_of_step.append(path.name)
+            if early is not None:
+                pending.before_connect[path.name] = early
             if len(pending.out_of_step) > MAX_OUT_OF_STEP:
                 raise CaptureError(
                     self.name,
@@ -602,6 +722,60 @@ class FolderWatchCamera:
             )
         self._anchor, self._orphan = (taken, pulsed_at, window_s), None
         return notes
+
+    def _before_connect_said(self, pending: _Pending) -> str:
+        """The files of ``pending`` refused as shot before this run connected, said with how
+        the camera clock was known and what to do if it was set since."""
+        if not pending.before_connect:
+            return ""
+        shown = ", ".join(f"{n} {s:.0f} s" for n, s in pending.before_connect.items())
+        return (
+            f"; shot before this run connected ({shown} before, by the camera clock the "
+            "session's earlier run learned): files of the stopped run, not of this light. If "
+            "the camera's clock was set back since, delete "
+            f"{self._clock_file()} and resume again (the first image is then unchecked)"
+        )
+
+    def _clock_file(self) -> Path | None:
+        """Where the session keeps the camera clock learned: its ``raw/`` folder (the parent
+        of ``output_dir``, ``raw/.incoming``); None when no session is bound."""
+        return None if self.output_dir is None else self.output_dir.parent / CLOCK_FILE
+
+    def _learn_clock(self, pending: _Pending) -> None:
+        """Keep the camera clock of an image in step with its pulse, for a resume: once its
+        file is decoded, so a session whose first file is refused holds nothing of it (its
+        ``raw/`` folder, made for the clock, had made it a session to resume)."""
+        where = self._clock_file()
+        if where is None or pending.pulsed_wall is None or pending.taken is None:
+            return
+        learned = _LearnedClock(
+            pending.taken - pending.pulsed_wall, pending.pulsed_wall, pending.pulse_window_s
+        )
+        with contextlib.suppress(OSError):
+            where.parent.mkdir(parents=True, exist_ok=True)
+            learned.save(where)
+
+    def _shot_before_connect(self, taken: float, window_s: float) -> float | None:
+        """How many seconds before this run connected a first file was shot, by the camera
+        clock an earlier run of the session learned; None when it may be this run's (or there
+        is no such clock, or the run has an image to check its files against already).
+
+        Only a file shot before the connect is refused: a later one may be the pulse's. The
+        allowance is the EXIF second, the shutter lag, both pulses' trigger times and a drift
+        of :data:`CLOCK_DRIFT` over the time since the clock was learned; a file of the stopped
+        run was shot at least ``timeout_s`` (the wait that stopped it) before the resume."""
+        learned, connected = self._learned, self._connected_wall
+        if self._anchor is not None or learned is None or connected is None:
+            return None
+        allowance = (
+            CAPTURE_TIME_RESOLUTION_S
+            + self.settings.shutter_lag_s
+            + window_s
+            + learned.window_s
+            + CLOCK_DRIFT * abs(connected - learned.wall_s)
+        )
+        early = connected - (taken - learned.offset_s)
+        return early if early > allowance else None
 
     def _drop_copy(self, held: Path) -> None:
         """Delete a copy :meth:`_hold` made, and the folders it made for it if they are left

@@ -205,15 +205,36 @@ def test_a_file_there_before_the_pulse_is_not_the_pulses_picture(tmp_path):
     assert any("IMG_0001_copy.DNG" in n for n in frames[1].metadata["notices"])
 
 
+#: 2026-11-30 09:00:00 UTC, the day the _Body's camera clock counts from
+WALL_AT_ZERO = 1796029200.0
+
+
+def exif_tiff(path, level, stamp):
+    """A 16-bit grey TIFF with EXIF DateTimeOriginal ``stamp`` (a datetime) in its EXIF IFD,
+    as tethering programs and raw converters write it (Pillow writes the EXIF IFD)."""
+    from PIL import Image, TiffImagePlugin
+
+    ifd = TiffImagePlugin.ImageFileDirectory_v2()
+    ifd[0x8769] = {0x9003: stamp.strftime("%Y:%m:%d %H:%M:%S")}
+    image = Image.fromarray(np.full((32, 32), round(65535 * level), np.uint16))
+    image.save(path, tiffinfo=ifd)
+
+
 class _Body:
     """A camera fired by the dome's shutter line, its tethering program saving each shot's DNG
     ``delays[n]`` s after the n-th pulse (on the test's clock), stamped with the camera clock's
     DateTime (whole seconds, ``offset_s`` from the rig's clock: another time zone)."""
 
-    def __init__(self, folder, delays, offset_s=3600.0 * 5 + 17.4):
+    def __init__(self, folder, delays, offset_s=3600.0 * 5 + 17.4, tiff=False):
         self.folder, self.delays, self.offset_s = folder, list(delays), offset_s
         self.clock = ScriptedClock({})
         self.pulses: list[float] = []
+        #: save 16-bit TIFFs with EXIF DateTimeOriginal (as a tethering program exports them)
+        self.tiff = tiff
+
+    def wall(self) -> float:
+        """The computer's wall clock: the test's clock, counted from 2026-11-30 09:00 UTC."""
+        return WALL_AT_ZERO + self.clock.now()
 
     def pulse(self, exposure_s: float) -> None:
         import datetime
@@ -226,6 +247,9 @@ class _Body:
         mosaic = linear_to_mosaic(np.full((32, 32), 0.1 * n), "RGGB", 256, 4095)
 
         def save() -> None:
+            if self.tiff:
+                exif_tiff(self.folder / f"IMG_{n:04d}.tif", 0.1 * n, stamp)
+                return
             write_dng(
                 self.folder / f"IMG_{n:04d}.DNG",
                 mosaic,
@@ -386,3 +410,139 @@ def test_a_capture_time_does_not_jump_at_the_computers_daylight_saving_change(
         monkeypatch.delenv("TZ")
         time.tzset()
     assert times[1] - times[0] == pytest.approx(3.0)
+
+
+def _stopped_and_resumed(tmp_path, session):
+    """The stopped-run scenario of the test above, with the camera bound to ``session`` (or
+    not): pulse 2's file is 20 s late, the run stops at timeout_s = 15 s, the user resumes 2 s
+    later; the late file then comes before the resumed pulse's own file. The names taken for
+    lights 2, 3, 4 after the resume, and their notices."""
+    body = _Body(tmp_path, [1.0, 20.0, 4.0, 1.5, 1.5])
+    settings = FolderWatchSettings(
+        folder=tmp_path, timeout_s=15.0, poll_interval_s=0.125, shutter_lag_s=0.25
+    )
+
+    def camera() -> FolderWatchCamera:
+        cam = FolderWatchCamera(settings, clock=body.clock, trigger=body.pulse, wall=body.wall)
+        cam.output_dir = None if session is None else session / "raw" / ".incoming"
+        return cam
+
+    first = camera()
+    first.connect()
+    first.capture(0.5)
+    with pytest.raises(CaptureError, match="within 15 s"):
+        first.capture(0.5)
+    first.close()
+    body.clock.sleep(2.0)
+    resumed = camera()
+    resumed.connect()
+    got = []
+    for _ in range(3):
+        frame = resumed.capture(0.5)
+        got.append((Path(frame.metadata["watched_file"]).name, frame.metadata.get("notices")))
+    return got
+
+
+def test_a_resumes_first_file_shot_before_it_connected_is_set_aside(tmp_path):
+    """The first image after a connect had no earlier image to be checked against: the late
+    file of the pulse the stopped run waited for, shot 17 s before the resume, was taken as the
+    resumed light's image. The camera clock learned in the first run (kept in the session's
+    raw/) now dates it before the resume: it is set aside and the resumed pulse's own file
+    taken; every image after it is its own pulse's."""
+    tether, session = tmp_path / "tether", tmp_path / "session"
+    tether.mkdir()
+    got = _stopped_and_resumed(tether, session)
+    assert [n for n, _ in got] == ["IMG_0003.DNG", "IMG_0004.DNG", "IMG_0005.DNG"], got
+    said = " ".join(got[0][1] or [])
+    assert "IMG_0002.DNG" in said and "shot before this run connected" in said, said
+    assert not got[1][1] and not got[2][1], got
+    assert (session / "raw" / ".folder_watch_clock.json").is_file()
+
+
+def test_a_resume_hours_later_takes_its_own_files_despite_clock_drift(tmp_path):
+    """A clean resume 8 hours after the first run, the camera clock having drifted 2 s behind
+    the computer's meanwhile (70 ppm): its first file is not refused."""
+    session = tmp_path / "session"
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    body = _Body(tether, [0.5] * 4, offset_s=0.3)
+    settings = FolderWatchSettings(folder=tether, timeout_s=5.0, poll_interval_s=0.125)
+
+    def camera() -> FolderWatchCamera:
+        cam = FolderWatchCamera(settings, clock=body.clock, trigger=body.pulse, wall=body.wall)
+        cam.output_dir = session / "raw" / ".incoming"
+        cam.connect()
+        return cam
+
+    first = camera()
+    first.capture(0.1)
+    first.capture(0.1)
+    first.close()
+    body.clock.sleep(8 * 3600.0)
+    body.offset_s -= 2.0
+    resumed = camera()
+    names = [Path(resumed.capture(0.1).metadata["watched_file"]).name for _ in range(2)]
+    assert names == ["IMG_0003.DNG", "IMG_0004.DNG"]
+
+
+def test_a_tiffs_exif_capture_time_is_checked_against_the_pulses(tmp_path):
+    """A TIFF's EXIF DateTimeOriginal is its capture time: a TIFF shot 30 s out of step that
+    comes after pulse 2, before pulse 2's own file, had been taken for light 2 (a TIFF had no
+    capture time at all). It is set aside and light 2 gets its own file."""
+    import datetime
+
+    body = _Body(tmp_path, [0.5, 2.5, 0.5], offset_s=0.0, tiff=True)
+    stale = datetime.datetime(2026, 11, 30, 9, 0, 0) - datetime.timedelta(seconds=30)
+
+    def pulse(exposure_s: float) -> None:
+        body.pulse(exposure_s)
+        if len(body.pulses) == 2:
+            late = (body.clock.now() + 0.5, lambda: exif_tiff(tmp_path / "OLD.tif", 0.9, stale))
+            body.clock.actions = sorted([*body.clock.actions, late], key=lambda a: a[0])
+
+    settings = FolderWatchSettings(
+        folder=tmp_path, timeout_s=5.0, poll_interval_s=0.125, patterns=("*.tif",)
+    )
+    cam = FolderWatchCamera(settings, clock=body.clock, trigger=pulse)
+    cam.connect()
+    cam.capture(0.1)
+    body.clock.sleep(3.0)
+    second = cam.capture(0.1)
+    assert second.metadata["watched_file"].endswith("IMG_0002.tif"), second.metadata
+    assert second.metadata["stray_files"] == ["OLD.tif"]
+
+
+def test_a_file_with_no_capture_time_is_said_to_be_unchecked(tmp_path):
+    """A PNG (OpenCV reads no EXIF) or a TIFF without DateTimeOriginal cannot be checked
+    against the pulses: the image says so, in one text the session summary counts, rather
+    than pass for checked."""
+    import cv2
+
+    def pulse(exposure_s: float) -> None:
+        cv2.imwrite(str(tmp_path / "IMG_0001.png"), np.full((32, 32), 30000, np.uint16))
+
+    settings = FolderWatchSettings(
+        folder=tmp_path, timeout_s=5.0, poll_interval_s=0.125, patterns=("*.png",)
+    )
+    cam = FolderWatchCamera(settings, clock=VirtualClock(), trigger=pulse)
+    cam.connect()
+    notices = cam.capture(0.1).metadata.get("notices") or []
+    assert any("holds no capture time" in n and "not checked" in n for n in notices), notices
+
+
+def test_a_refused_first_file_leaves_no_camera_clock_in_the_session(tmp_path):
+    """The camera clock is kept in the session's raw/ only once an image's file is decoded: a
+    first file refused (exposed 0.5 s where 0.1 s was asked) leaves no raw/ folder, so the
+    session still holds nothing and may be used again."""
+    session, tether = tmp_path / "session", tmp_path / "tether"
+    tether.mkdir()
+    body = _Body(tether, [0.5], offset_s=0.0)
+    settings = FolderWatchSettings(folder=tether, timeout_s=5.0, poll_interval_s=0.125)
+    cam = FolderWatchCamera(
+        settings, clock=body.clock, trigger=lambda _: body.pulse(0.5), wall=body.wall
+    )
+    cam.output_dir = session / "raw" / ".incoming"
+    cam.connect()
+    with pytest.raises(CaptureError, match="set the camera to manual"):
+        cam.capture(0.1)
+    assert not (session / "raw").exists()

@@ -776,3 +776,86 @@ def test_folder_watch_keeps_a_file_set_aside_before_a_pulse_in_strays(dome, tmp_
     assert kept == b"II*\0 the owner's test shot"
     assert strays["strays/image_002-_DSC9000.DNG"]["camera_file"] == "_DSC9000.DNG"
     assert "_DSC9000.DNG" in said and "strays/" in said, said
+
+
+def _watch_config_waiting(tmp_path: Path, timeout_s: float) -> Path:
+    """The shipped folder-watch example, its wait for a file shortened to ``timeout_s`` (so a
+    run stops at a late file in seconds), beside a copy of its .lp."""
+    folder = tmp_path / "config"
+    folder.mkdir()
+    lp = WATCH_CONFIG.with_name("example_dome_48.lp")
+    (folder / lp.name).write_bytes(lp.read_bytes())
+    cfg = folder / WATCH_CONFIG.name
+    text = WATCH_CONFIG.read_text().replace("timeout_s = 15.0", f"timeout_s = {timeout_s}")
+    assert f"timeout_s = {timeout_s}" in text
+    cfg.write_text(text)
+    return cfg
+
+
+def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypatch):
+    """Pulse 2's file is late: the run stops at timeout_s. After `run --resume`, that file
+    comes into the folder just before the resumed pulse's own one. It was taken as the
+    resumed light's image (the first image after a connect was never checked), a picture
+    shot before the stop. The camera clock the first run learned now dates it before the
+    resume: it is kept in strays/ and image 2 is the resumed pulse's own file."""
+    import datetime
+    import os
+
+    from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+
+    monkeypatch.setenv("HOME", str(tmp_path))
+    watched = tmp_path / "Pictures" / "rti-tether"
+    watched.mkdir(parents=True)
+    cfg = _watch_config_waiting(tmp_path, 3.0)
+    stop = threading.Event()
+    mosaic = linear_to_mosaic(np.full((32, 32), 0.3), "RGGB", 256, 4095)
+
+    def save(name: str, stamp: datetime.datetime, mtime_ns: int | None = None) -> None:
+        path = watched / name
+        write_dng(
+            path,
+            mosaic,
+            black_level=256,
+            white_level=4095,
+            exposure_s=0.125,
+            date_time=stamp.strftime("%Y:%m:%d %H:%M:%S"),
+        )
+        if mtime_ns is not None:
+            os.utime(path, ns=(mtime_ns, mtime_ns))
+
+    with shipped_dome_on_pty(monkeypatch, cfg) as dome:
+
+        def tethering_program() -> None:
+            seen, late = 0, None
+            while not stop.is_set():
+                pulses = [e for e in list(dome.history) if e.what == "shutter"]
+                for _ in pulses[seen:]:
+                    seen += 1
+                    # the camera's clock: UTC wall time, as a camera set to UTC keeps it
+                    now = datetime.datetime.now(datetime.UTC).replace(tzinfo=None)
+                    if seen == 2:
+                        late = now  # shot, but its file is on its way past the timeout
+                        continue
+                    if seen == 3 and late is not None:  # the late file, just before this one
+                        save("_DSC0002.DNG", late, time.time_ns() - 10**9)
+                    save(f"_DSC{seen:04d}.DNG", now)
+                time.sleep(0.01)
+
+        thread = threading.Thread(target=tethering_program, daemon=True)
+        thread.start()
+        try:
+            out = tmp_path / "s"
+            first = run(str(cfg), "--out", str(out), "--lights", "3")
+            resumed = run("--resume", str(out))
+        finally:
+            stop.set()
+            thread.join(2)
+    assert first.exit_code != 0 and "within 3 s" in first.output, first.output
+    said = " ".join(resumed.output.split())
+    assert resumed.exit_code == 0, said
+    entries = journal(out)
+    names = [next(iter(e["originals"].values())) for e in entries]
+    assert names == ["_DSC0001.DNG", "_DSC0003.DNG", "_DSC0004.DNG"], names
+    strays = {s: kept for e in entries for s, kept in e["strays"].items()}
+    assert [kept["camera_file"] for kept in strays.values()] == ["_DSC0002.DNG"], strays
+    assert "shot before this run connected" in said, said
