@@ -133,6 +133,11 @@ class Body:
     _counter: int = 0
     _objects: int = 0
 
+    def still_writing(self, tries: int) -> None:
+        """The body is still writing a picture taken before the session (the owner's last
+        test shot): its next ``tries`` captures answer busy, as after a shot."""
+        self._busy = tries
+
     def switch_off(self) -> None:
         """Switched off or unplugged: every call fails, nothing is detected."""
         self.powered = False
@@ -348,6 +353,18 @@ def make_module(body: Body) -> types.ModuleType:
             card = "/store_00020001/DCIM/100CANON"
             store = body.card if folder.rstrip("/") == card else body.ram if folder == "/" else {}
             return [(name, None) for name in sorted(store)]
+
+        def folder_list_folders(self, folder: str) -> list[tuple[str, None]]:
+            """python-gphoto2's CameraList of (name, value) pairs: the folders in ``folder``;
+            as libgphoto2's PTP driver shows a card, its storage at the top, then DCIM."""
+            body.check("folder_list_folders")
+            tree = {
+                "": "store_00020001",
+                "/store_00020001": "DCIM",
+                "/store_00020001/DCIM": "100CANON",
+            }
+            sub = tree.get(folder.rstrip("/"))
+            return [] if sub is None else [(sub, None)]
 
         def file_delete(self, folder: str, name: str) -> None:
             body.check("file_delete")

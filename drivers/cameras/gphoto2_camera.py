@@ -58,6 +58,10 @@ GP_ERROR_HINTS = {
 #: auto power-off): -7 I/O error, -10 timeout, -52 USB device not found, -105 model not found.
 GONE_CODES = frozenset({-7, -10, -52, -105})
 
+#: card folders walked at connect at most (``/``, a storage, ``DCIM``, ``100CANON`` … are four):
+#: a card of more is left to be listed at the session's first shot in a folder, as before
+MAX_CARD_FOLDERS = 64
+
 
 #: Settings keys whose camera setting is named by another key (the camera's own name for it).
 NAME_KEYS = {
@@ -164,6 +168,9 @@ class Gphoto2Camera:
         #: card before any busy spell that follows): listed once per folder, then again only
         #: after a busy spell, so a body that is never busy costs one listing a session
         self._card_seen: dict[str, set[str]] = {}
+        #: every card folder there was at connect (None: not walked, or not wholly): a folder
+        #: not among them was made since, so every file in it is new
+        self._card_folders: set[str] | None = None
         #: files this session downloaded and left on the card (``delete_from_camera = false``)
         self._left_on_card = 0
         self.retries_used = 0
@@ -265,6 +272,7 @@ class Gphoto2Camera:
         self.camera_model = model
         try:
             self._configure()
+            self._list_card()
         except BaseException:
             self.close()
             raise
@@ -282,6 +290,7 @@ class Gphoto2Camera:
         self._pending = None
         self._busy = None
         self._card_seen = {}
+        self._card_folders = None
         staging, self._staging_tmp = self._staging_tmp, None
         if staging is not None:
             shutil.rmtree(staging, ignore_errors=True)
@@ -763,11 +772,14 @@ class Gphoto2Camera:
         costs one listing of its folder a session, in :meth:`_note_card`). Such a picture
         had stayed on the card unseen, the session saying nothing of it. In the camera's
         RAM (``capture_target = "Internal RAM"``) an unannounced picture has no file to list
-        and cannot be seen at all; nor can one taken before the first listing of a folder
-        (a busy spell before the session's first shot in it)."""
+        and cannot be seen at all; nor can one in a folder that was on the card at connect but
+        not listed then (see :meth:`_list_card`) before the session's first shot in it."""
         if not self._fired_after_busy or self.settings.capture_target == "Internal RAM":
             return []
         before = self._card_seen.get(folder)
+        if before is None and self._card_folders is not None:
+            # not on the card at connect: the body made it since, for this session's shots
+            before = set() if folder.rstrip("/") not in self._card_folders else None
         if before is None:
             return []
         now = self._list_folder(folder)
@@ -784,6 +796,39 @@ class Gphoto2Camera:
         self._card_seen[folder] = now
         self._earlier_stems.update(Path(n).stem for _, n in found)
         return found
+
+    def _list_card(self) -> None:
+        """At connect, when shooting to the card: walk its folders and list the files of each
+        innermost one (``DCIM/100CANON``): the "before" of the session's first shot in it.
+
+        Why: a card folder was first listed after the session's first shot in it, so a
+        picture the body took behind a busy answer before that shot (a body still writing
+        the owner's last picture as the session began) was taken for a file that had always
+        been there, and stayed on the card unseen. A folder made after connect (the body
+        opening ``101CANON``) holds only new files. The walk stops at
+        :data:`MAX_CARD_FOLDERS` (a card of many folders; the first shot's listing then
+        serves, as before); a body that cannot list folders is left as before. A body
+        never busy pays for it instead of its first shot's listing: one listing a session."""
+        if self.settings.capture_target == "Internal RAM":
+            return
+        folders: set[str] = set()
+        todo = ["/"]
+        while todo:
+            if len(folders) >= MAX_CARD_FOLDERS:
+                return
+            folder = todo.pop()
+            try:
+                subs = [str(n) for n, _ in self._cam.folder_list_folders(folder)]
+            except self._gp.GPhoto2Error:
+                return
+            folders.add(folder)
+            todo.extend(f"{folder.rstrip('/')}/{n}" for n in subs)
+            if not subs and folder != "/":
+                listed = self._list_folder(folder)
+                if listed is None:
+                    return
+                self._card_seen[folder] = listed
+        self._card_folders = folders
 
     def _note_card(self, folder: str, taken: list[tuple[str, str]]) -> None:
         """Remember what the shot's card folder holds once its files are downloaded (and

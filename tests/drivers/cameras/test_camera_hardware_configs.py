@@ -430,12 +430,8 @@ def test_a_raw_and_jpeg_picture_taken_behind_a_busy_answer_is_kept_aside_whole(b
     assert all((out / s).is_file() for s in strays)
 
 
-def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(body, tmp_path):
-    """A body answers busy once after a shot yet takes the picture, and never announces it (no
-    FILE_ADDED event, ever). Capturing to the card, the picture had stayed there unseen, the
-    session saying nothing. The card folder is listed after the busy spell: IMG_0002 is found,
-    downloaded into strays/ and recorded in image 2's strays, never as an image; a file on the
-    card before the session is left alone; a body never busy costs one listing a session."""
+def card_config(tmp_path: Path) -> Path:
+    """The shipped DSLR example capturing to the camera's card, written into ``tmp_path``."""
     text = DSLR_CONFIG.read_text().replace(
         'capture_target = "Internal RAM"', 'capture_target = "Memory card"'
     )
@@ -444,6 +440,43 @@ def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(b
     )
     config = tmp_path / "card.toml"
     config.write_text(text)
+    return config
+
+
+def test_a_picture_taken_behind_a_busy_answer_before_the_first_shot_is_found_on_the_card(
+    body, tmp_path
+):
+    """The body is still writing the owner's last picture as the session starts: its first
+    capture answers busy yet takes a picture it never announces. The card folder was first
+    listed after the session's first shot, so that picture was taken for one always there and
+    stayed on the card unseen. The card is now listed at connect: it is found, kept in
+    strays/ and recorded in image 1's strays; the owner's earlier picture is left alone."""
+    config = card_config(tmp_path)
+    body.card["IMG_0999.CR2"] = b"the owner's earlier picture"
+    body.still_writing(1)
+    body.busy_yet_shot = 1
+    body.stray_never_announced = True
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "2")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, said
+    assert body.stray_files == ["IMG_0001.CR2"] and body.shots == 3
+    entries = journal(out)
+    names = [Path(next(iter(e["originals"].values()))).name for e in entries]
+    assert names == ["IMG_0002.CR2", "IMG_0003.CR2"]
+    strays = [(e["index"], s) for e in entries for s in e["strays"]]
+    assert strays == [(0, "strays/image_001-IMG_0001.CR2")], strays
+    assert "it took while answering busy" in said
+    assert sorted(body.card) == ["IMG_0999.CR2"]
+
+
+def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(body, tmp_path):
+    """A body answers busy once after a shot yet takes the picture, and never announces it (no
+    FILE_ADDED event, ever). Capturing to the card, the picture had stayed there unseen, the
+    session saying nothing. The card folder is listed after the busy spell: IMG_0002 is found,
+    downloaded into strays/ and recorded in image 2's strays, never as an image; a file on the
+    card before the session is left alone; a body never busy costs one listing a session."""
+    config = card_config(tmp_path)
     body.card["IMG_0999.CR2"] = b"the owner's earlier picture"
     body.busy_after_shot = 1
     body.busy_yet_shot = 1
@@ -465,6 +498,7 @@ def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(b
 
     # a body that is never busy: its folder listed once, nothing taken as a stray
     body.busy_after_shot = body.busy_yet_shot = 0
+    body.still_writing(0)  # done with the last run's last shot (it was busy once after each)
     body.calls.clear()
     result = run(str(config), "--out", str(tmp_path / "t"), "--lights", "3")
     assert result.exit_code == 0, result.output
