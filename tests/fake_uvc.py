@@ -226,4 +226,12 @@ class BufferedUvcStream:
         return True, self._pixels(k)
 
     def release(self) -> None:
+        """STREAMOFF and the buffers freed (OpenCV's release: VIDIOC_STREAMOFF, then
+        VIDIOC_REQBUFS with count 0): a reopened stream starts again at its first frame, into
+        buffers of its own. The frame count had carried on from the last stream, so a reopened
+        camera's first frame came that many periods after STREAMON (1.5 s after a metering's
+        30 frames at 20 fps)."""
         self.streaming_from = None
+        self.next_frame = 0
+        self.held = None
+        self.buffers = [_Buffer() for _ in self.buffers]

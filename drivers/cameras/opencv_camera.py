@@ -307,6 +307,34 @@ class OpenCvCamera:
         )
         return frames * period, said
 
+    def longest_exposure_s(self) -> tuple[float, str] | None:
+        """The longest exposure the connected camera can take, and what bounds it (a phrase
+        naming the keys to change), or None before ``connect``.
+
+        Why: ``run --auto-exposure`` meters within ``[camera]``'s range, fixed from the config
+        before the camera is open; a dark object was metered past the frame period (1/fps,
+        known only once connected) or ``[camera.device] max_exposure_s``, and the run stopped
+        at the metering's own test shot, told to shorten an exposure the user never chose."""
+        if self._cap is None:
+            return None
+        s = self.settings
+        fps = self.connection_info.get("fps") if s.backend == "v4l2" else None
+        bound = (
+            s.max_exposure_s,
+            f"max_exposure_s = {s.max_exposure_s:g} s in [camera.device] (the range it refuses "
+            "exposures outside)",
+        )
+        if fps and 1.0 / fps < bound[0]:
+            lower = "set" if s.fps is None else f"lower fps = {s.fps:g} in [camera.device] to"
+            bound = (
+                1.0 / fps,
+                f"the frame period {1.0 / fps:.4g} s of the camera's {fps:g} fps "
+                "(CAP_PROP_FPS): in manual exposure a UVC camera exposes at most one period; "
+                f"for longer exposures {lower} a lower fps in [camera.device] if the camera "
+                f"offers one (`v4l2-ctl -d {s.device} --list-formats-ext`)",
+            )
+        return bound
+
     def refuse_exposure(self, exposure_s: float, before: str) -> None:
         """Refuse an exposure longer than the frame period the connected camera reports.
 

@@ -368,13 +368,28 @@ def fix_exposure(
         max_exposure_s=longest,
     )
 
+    #: what the connected camera bounds the exposure by, where it is shorter than the rule's
+    camera_cap: list[tuple[float, str]] = []
+
+    def camera_rule(camera) -> ExposureRule:  # type: ignore[no-untyped-def]
+        # the camera is connected by now: its own longest exposure (a UVC camera's frame
+        # period) is known, which the config's range, fixed before it opened, is not
+        bound = getattr(camera, "longest_exposure_s", None)
+        found = bound() if bound is not None else None
+        if found is None or found[0] >= rule.max_exposure_s:
+            return rule
+        camera_cap[:] = [found]
+        return rule.model_copy(update={"max_exposure_s": max(found[0], rule.min_exposure_s)})
+
     def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
         shutter = getattr(camera, "available_exposures_s", None)
-        return meter_exposure(camera, rule, start_s, shutter() if shutter else None)
+        return meter_exposure(camera, camera_rule(camera), start_s, shutter() if shutter else None)
 
     def recheck(camera, exposure_s: float) -> Recheck:  # type: ignore[no-untyped-def]
         shutter = getattr(camera, "available_exposures_s", None)
-        choice, tested = recheck_exposure(camera, rule, exposure_s, shutter() if shutter else None)
+        choice, tested = recheck_exposure(
+            camera, camera_rule(camera), exposure_s, shutter() if shutter else None
+        )
         return Recheck(tested, choice)
 
     unknown = _light_outputs_unknown(rig)
@@ -413,7 +428,18 @@ def fix_exposure(
     on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s{where} ({chosen['reason']})"))
     if strays := chosen.get("metering_strays"):
         on_note(Note(_metering_strays_said(strays)))
-    if lit_cap is not None and chosen["exposure_s"] >= _next_shorter_s(rig, longest) - 1e-9:
+    if camera_cap and chosen["exposure_s"] >= camera_cap[0][0] * (1 - 1e-6):
+        bound = camera_cap[0][1]
+        on_note(
+            Note(
+                f"The exposure, {chosen['exposure_s']:.4g} s, is the longest the camera "
+                f"{rig.camera.name} can take, not the {longest:.3g} s the config allows "
+                f"([camera] max_exposure_s, the LED's lit time): {bound}. The images may be "
+                "dark; raise the gain or the light",
+                level="warning",
+            )
+        )
+    elif lit_cap is not None and chosen["exposure_s"] >= _next_shorter_s(rig, longest) - 1e-9:
         serial = rig.loaded.config.dome.serial  # type: ignore[attr-defined]
         less = (
             "timing.settle_s, readout_s, transfer_s and light_switch_s: this camera holds its "

@@ -4,6 +4,7 @@ wholly under its own light and at its own exposure."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -151,16 +152,19 @@ def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
 
 
 @pytest.mark.pty
-def test_a_uvc_metering_shot_too_long_for_max_on_s_is_refused_before_it_is_lit(
-    tmp_path, monkeypatch
+@pytest.mark.parametrize("max_on_s", [1.5, 8.0], ids=["lit-limit-1.5s", "lit-limit-8s"])
+def test_a_uvc_metering_chooses_no_exposure_past_the_cameras_frame_period(
+    tmp_path, monkeypatch, max_on_s
 ):
-    """`run --auto-exposure` with a 20 fps UVC camera (8 frames a capture) on LEDs that may
-    stay lit 1 s: a dark object is metered towards the longest exposure the config's lit-time
-    sum allows (0.78 s), a capture that reads 8 frames of at least 0.78 s each (a UVC camera
-    exposing longer than its frame period slows its stream) with the LED lit. The metering had
-    lit its lights for 5 test shots up to 0.78 s and only the session then refused the
-    exposure; that test shot is now refused before its light is lit, naming the figures."""
-    cfg = _uvc_dome_config(tmp_path)
+    """`run --auto-exposure` with a 20 fps UVC camera (period 0.05 s) and a dark object: the
+    metering's range came from the config alone, fixed before the camera was open, so it
+    reached for the longest exposure the LEDs' lit time allows (0.78 s at max_on_s = 1 s,
+    7.7 s at 8 s), and the run stopped at its own test shot, telling the user to shorten an
+    exposure they never chose ("metering stopped before its test shot at …: … beyond max_on_s"
+    or "… is longer than the frame period"). Once the camera is connected its frame period
+    bounds the metering: the exposure is fixed at 0.05 s, a warning names the camera, the
+    frame rate and the key to lower, and the session runs, each LED lit within max_on_s."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=max_on_s)
     stream = BufferedUvcStream(
         LightHistory(SystemClock()),  # type: ignore[arg-type]  # no light reaches it: dark
         fps=20.0,
@@ -169,16 +173,26 @@ def test_a_uvc_metering_shot_too_long_for_max_on_s_is_refused_before_it_is_lit(
     )
     monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
     out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        r = CliRunner().invoke(
-            app, ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
-        )
+        r = CliRunner().invoke(app, [*args, "--no-verdict"])
     said = " ".join(r.output.split())
-    assert r.exit_code == 2, said
-    assert "metering stopped before its test shot at" in said, said
-    assert "beyond max_on_s = 1 s" in said and "uvc-camera" in said, said
-    assert [e.what for e in firmware.history].count("lit") == 1  # the 0.05 s preview only
-    assert "stayed on" not in said, said
+    assert r.exit_code == 0, said
+    assert "Exposure fixed at 0.05 s" in said, said
+    assert "longest the camera uvc-camera can take" in said, said
+    assert "20 fps (CAP_PROP_FPS)" in said and "lower fps in [camera.device]" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert all(s["exposure_s"] == pytest.approx(0.05) for s in manifest["steps"])
+    assert (
+        max(
+            t
+            for shots in manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
+            for t in shots
+        )
+        <= 0.05 + 1e-9
+    )
+    assert "Traceback" not in said and "stayed on" not in said, said
+    assert len([e for e in firmware.history if e.what == "lit"]) >= 4 + 4
 
 
 @pytest.mark.pty
