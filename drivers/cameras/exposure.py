@@ -12,7 +12,7 @@ camera through a short test series and verifies the prediction with a real shot.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -168,6 +168,7 @@ def meter_exposure(
     candidates_s: Sequence[float] | None = None,
     step_down: float = 4.0,
     backoff: float = 0.9,
+    quantise: Callable[[float], float] | None = None,
 ) -> ExposureChoice:
     """Short test series at the current light: preview, predict, verify with a real shot.
 
@@ -182,7 +183,12 @@ def meter_exposure(
     shutter list (0.125 s on a body in 1/2-stop steps) stopped before its first test shot with
     "unexpected ValueError … please report it", although metering exists to choose the
     exposure from the camera's own list.
+
+    ``quantise`` (see :class:`_Quantised`) rounds each requested exposure down to one the
+    camera takes exactly; the choice is then always a shot's own exposure.
     """
+    if quantise is not None:
+        camera = _Quantised(camera, quantise)
     if step_down <= 1:
         raise ValueError("step_down must exceed 1")
     if not 0 < backoff < 1:
@@ -220,6 +226,7 @@ def recheck_exposure(
     candidates_s: Sequence[float] | None = None,
     step_down: float = 4.0,
     backoff: float = 0.9,
+    quantise: Callable[[float], float] | None = None,
 ) -> tuple[ExposureChoice | None, tuple[float, ...]]:
     """Does ``exposure_s``, chosen at another light, keep within ``rule`` at the current one?
 
@@ -229,7 +236,10 @@ def recheck_exposure(
     included. Where this light is brighter it is the longest exposure up to ``exposure_s`` that
     keeps within the rule here: predicted from that shot when it is within the limit (a
     shorter exposure only darkens what was measured), else from a test series from
-    ``step_down`` times shorter (:func:`meter_exposure`, never longer than ``exposure_s``)."""
+    ``step_down`` times shorter (:func:`meter_exposure`, never longer than ``exposure_s``).
+    ``quantise`` as for :func:`meter_exposure`; a predicted choice is rounded down by it too."""
+    if quantise is not None:
+        camera = _Quantised(camera, quantise)
     series: list[Frame] = []
     frame = _shot(camera, exposure_s, series)
     limit = rule.max_saturated_fraction
@@ -240,11 +250,36 @@ def recheck_exposure(
         return None, (frame.exposure_s,)
     capped = rule.model_copy(update={"max_exposure_s": exposure_s})
     if frame.saturated_fraction <= limit:
-        return choose_exposure(frame, capped, candidates_s), (frame.exposure_s,)
+        choice = choose_exposure(frame, capped, candidates_s)
+        if quantise is not None:  # shorter than predicted: never more saturated
+            choice = replace(choice, exposure_s=quantise(choice.exposure_s))
+        return choice, (frame.exposure_s,)
     start = _shorter(exposure_s / step_down, capped, candidates_s)
     choice = meter_exposure(camera, capped, start, candidates_s, step_down, backoff)
     tested = (frame.exposure_s, *choice.test_exposures_s)
     return replace(choice, test_exposures_s=tested), tested
+
+
+class _Quantised:
+    """``camera`` asked only for exposures it takes exactly: each request rounded down by
+    ``quantise`` (e.g. a UVC camera's whole ``exposure_unit_s`` steps).
+
+    Why: the metering solves for any exposure in its range and steps a saturated preview down
+    4 times at a time (0.05 s, 0.0125 s, 0.0031 s, 0.00078 s): a UVC camera set in 100 µs
+    units refuses one more than ``exposure_tolerance`` from a whole unit, and a bright object
+    stopped ``run --auto-exposure`` with "exposure 0.000775 s is not a whole number of
+    0.0001 s units …; choose a representable exposure", an exposure the user never chose.
+    Rounded down, a shot never saturates more than the one asked for."""
+
+    def __init__(self, camera: Camera, quantise: Callable[[float], float]) -> None:
+        self._camera, self._quantise = camera, quantise
+        self.name = camera.name
+
+    def capture(self, exposure_s: float) -> Frame:
+        return self._camera.capture(self._quantise(exposure_s))
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._camera, name)
 
 
 def _shot(camera: Camera, exposure_s: float, series: list[Frame]) -> Frame:

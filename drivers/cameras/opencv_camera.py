@@ -307,6 +307,16 @@ class OpenCvCamera:
         )
         return frames * period, said
 
+    def representable_exposure_s(self, exposure_s: float) -> float:
+        """The longest exposure at or under ``exposure_s`` the camera takes exactly: whole
+        ``exposure_unit_s`` steps, one at least (any value on an image sequence, which has no
+        controls). What ``run --auto-exposure`` asks for, so that a metered exposure is never
+        refused as "not a whole number of units"."""
+        if self.settings.backend != "v4l2":
+            return exposure_s
+        unit = self.settings.exposure_unit_s
+        return max(1, math.floor(exposure_s / unit + 1e-9)) * unit
+
     def longest_exposure_s(self) -> tuple[float, str] | None:
         """The longest exposure the connected camera can take, and what bounds it (a phrase
         naming the keys to change), or None before ``connect``.

@@ -381,14 +381,27 @@ def fix_exposure(
         camera_cap[:] = [found]
         return rule.model_copy(update={"max_exposure_s": max(found[0], rule.min_exposure_s)})
 
+    # a camera taking exposures in steps (a UVC camera's exposure_unit_s) is asked for those
     def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
         shutter = getattr(camera, "available_exposures_s", None)
-        return meter_exposure(camera, camera_rule(camera), start_s, shutter() if shutter else None)
+        steps = getattr(camera, "representable_exposure_s", None)
+        return meter_exposure(
+            camera,
+            camera_rule(camera),
+            start_s,
+            shutter() if shutter else None,
+            quantise=steps,
+        )
 
     def recheck(camera, exposure_s: float) -> Recheck:  # type: ignore[no-untyped-def]
         shutter = getattr(camera, "available_exposures_s", None)
+        steps = getattr(camera, "representable_exposure_s", None)
         choice, tested = recheck_exposure(
-            camera, camera_rule(camera), exposure_s, shutter() if shutter else None
+            camera,
+            camera_rule(camera),
+            exposure_s,
+            shutter() if shutter else None,
+            quantise=steps,
         )
         return Recheck(tested, choice)
 

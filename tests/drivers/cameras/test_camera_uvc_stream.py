@@ -196,6 +196,35 @@ def test_a_uvc_metering_chooses_no_exposure_past_the_cameras_frame_period(
 
 
 @pytest.mark.pty
+def test_a_uvc_metering_asks_only_for_exposures_in_the_cameras_units(tmp_path, monkeypatch):
+    """`run --auto-exposure` on a bright object with a UVC camera set in 100 µs units: the
+    metering stepped its saturated preview down 4 times at a time (0.05, 0.0125, 0.0031 s)
+    and asked for 0.000775 s, which the camera refuses as "not a whole number of 0.0001 s
+    units …; choose a representable exposure": the run stopped, the user told to choose an
+    exposure they never chose. Each test exposure is now rounded down to whole units, and
+    the session's exposure is one of them."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    light = LightHistory(SystemClock())  # type: ignore[arg-type]
+    light.set(1.0)  # bright whatever LED is lit: 0.05 s saturates 76 times over
+    stream = BufferedUvcStream(light, fps=20.0, scale=1e8)
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, [*args, "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "whole number" not in said and "Traceback" not in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    evidence = manifest["schedule"]["provenance"]["exposure"]
+    shot = [t for shots in evidence["test_exposures_by_light_s"] for t in shots]
+    chosen = [s["exposure_s"] for s in manifest["steps"]]
+    for t in [*shot, *chosen]:
+        assert t / 1e-4 == pytest.approx(round(t / 1e-4), abs=1e-6), (t, shot, chosen)
+    assert chosen[0] == pytest.approx(0.0005), said  # 0.0006 s × headroom 1.25 would clip
+
+
+@pytest.mark.pty
 def test_a_uvc_exposure_longer_than_the_frame_period_is_refused_before_any_led_lights(
     tmp_path, monkeypatch
 ):
