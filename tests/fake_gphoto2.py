@@ -108,6 +108,9 @@ class Body:
     download_s: float = 0.0
     download_clock: Any = None
     card_free_shots: int = 1000
+    #: a freshly formatted card: its DCIM holds no ``100CANON`` until the body writes its
+    #: first picture there (a body makes its folder with its first file)
+    card_formatted: bool = False
     jpeg_first: bool = False  # RAW+JPEG: capture() returns the JPEG, the RAW comes by event
     #: RAW+JPEG: the second file is announced only after this many quiet event waits (a body
     #: still writing its JPEG); a shot taken before then finds the announcement pending
@@ -246,6 +249,7 @@ def make_module(body: Body) -> types.ModuleType:
             store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"
         if store is body.card:
             body.card_free_shots -= 1
+            body.card_formatted = False
         body.shots += 1
         body._busy = body.busy_after_shot
         if body.busy_for_s:
@@ -364,6 +368,8 @@ def make_module(body: Body) -> types.ModuleType:
                 "/store_00020001/DCIM": "100CANON",
             }
             sub = tree.get(folder.rstrip("/"))
+            if sub == "100CANON" and body.card_formatted:
+                sub = None
             return [] if sub is None else [(sub, None)]
 
         def file_delete(self, folder: str, name: str) -> None:
