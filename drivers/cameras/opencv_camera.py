@@ -345,6 +345,16 @@ class OpenCvCamera:
             )
         return bound
 
+    def exposure_problem(self, exposure_s: float) -> str | None:
+        """Why ``exposure_s`` cannot be shot on the connected camera (None: it can), for
+        ``rti-rig check``: what :meth:`refuse_exposure` would refuse before a session lights
+        anything (a check had passed such a config)."""
+        try:
+            self.refuse_exposure(exposure_s, "a session would stop before its first image")
+        except DeviceError as exc:
+            return exc.message
+        return None
+
     def refuse_exposure(self, exposure_s: float, before: str) -> None:
         """Refuse an exposure longer than the frame period the connected camera reports.
 
@@ -356,8 +366,17 @@ class OpenCvCamera:
         (``CAP_PROP_FPS``, VIDIOC_G_PARM) is what bounds the exposure. Nothing is checked on an
         image sequence or a camera reporting no frame rate. ``before`` says what was not done
         ("nothing was lit")."""
+        if self._cap is None or self.settings.backend != "v4l2":
+            return
+        not_whole = self._not_whole_units(exposure_s)
+        if not_whole is not None:
+            raise DeviceError(
+                self.name,
+                f"{not_whole}; {before}. Set [camera] exposure_s to one of those",
+                "check exposure",
+            )
         fps = self.connection_info.get("fps")
-        if self._cap is None or self.settings.backend != "v4l2" or not fps:
+        if not fps:
             return
         period = 1.0 / fps
         if exposure_s <= period * (1 + 1e-6):
@@ -418,18 +437,32 @@ class OpenCvCamera:
             )
         return self._cap
 
+    def _not_whole_units(self, exposure_s: float) -> str | None:
+        """Why the camera cannot take ``exposure_s`` (not within ``exposure_tolerance`` of a
+        whole number of ``exposure_unit_s``), naming the exposures either side; None if it can.
+
+        Why: found only at the capture, with the first step's LED lit, and said as "choose a
+        representable exposure", naming neither the key nor the exposures that are."""
+        s = self.settings
+        units = max(1, round(exposure_s / s.exposure_unit_s))
+        if abs(units * s.exposure_unit_s - exposure_s) <= s.exposure_tolerance * exposure_s:
+            return None
+        lower = max(1, math.floor(exposure_s / s.exposure_unit_s)) * s.exposure_unit_s
+        return (
+            f"exposure {exposure_s:g} s is not a whole number of the camera's "
+            f"{s.exposure_unit_s:g} s exposure units (exposure_unit_s in [camera.device]; "
+            f"V4L2 exposure_absolute), within exposure_tolerance = {s.exposure_tolerance:g}: "
+            f"the nearest it takes are {lower:g} s and {lower + s.exposure_unit_s:g} s"
+        )
+
     def _apply_exposure(self, cap: VideoCaptureLike, exposure_s: float) -> tuple[float, float]:
         """Set the exposure, verify it reads back; returns (actual_s, units)."""
         s = self.settings
         units = max(1, round(exposure_s / s.exposure_unit_s))
         actual = units * s.exposure_unit_s
-        if abs(actual - exposure_s) > s.exposure_tolerance * exposure_s:
-            raise CaptureError(
-                self.name,
-                f"exposure {exposure_s:g} s is not a whole number of {s.exposure_unit_s:g} s "
-                f"units (nearest {actual:g} s); choose a representable exposure",
-                "set exposure",
-            )
+        not_whole = self._not_whole_units(exposure_s)
+        if not_whole is not None:
+            raise CaptureError(self.name, not_whole, "set exposure")
         accepted = cap.set(cv2.CAP_PROP_EXPOSURE, units)
         got = cap.get(cv2.CAP_PROP_EXPOSURE)
         if not accepted or abs(got - units) > max(0.5, s.exposure_tolerance * units):

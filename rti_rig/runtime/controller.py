@@ -303,10 +303,11 @@ def check_capture_fits_lit(rig: Rig, exposures_s: Iterable[float], before: str) 
     exposures = list(exposures_s)
     _check_capture_lit_time(rig, camera, limit, exposures, before)
     # a UVC camera exposes at most a frame period however long it is asked (its exposure
-    # reads back as set): refused here too, with no lit-time limit, before anything lights
+    # reads back as set), and only whole exposure units: refused here too, with no lit-time
+    # limit, before anything lights (the longest first: the frame period is its to fail)
     refuse = getattr(camera, "refuse_exposure", None)
-    if refuse is not None and exposures:
-        refuse(max(exposures), before)
+    for exposure in sorted(set(exposures), reverse=True) if refuse is not None else ():
+        refuse(exposure, before)
 
 
 def _check_capture_lit_time(

@@ -267,6 +267,36 @@ def test_a_uvc_exposure_longer_than_the_frame_period_is_refused_before_any_led_l
     assert all(b - a == pytest.approx(0.05) for _, rows in kept for a, b in rows), kept
 
 
+@pytest.mark.pty
+def test_an_exposure_not_in_the_cameras_units_is_refused_before_any_led_lights(
+    tmp_path, monkeypatch
+):
+    """`[camera] exposure_s = 0.00125` on a UVC camera set in 100 µs units (12.5 units, 4 %
+    from the nearest whole one, past exposure_tolerance = 2 %): `rti-rig check` passed, and
+    `rti-rig run` lit LED 0 and stopped at its first capture with "choose a representable
+    exposure", naming neither the key nor an exposure the camera takes. Both now refuse it
+    before any LED lights, naming [camera] exposure_s and 0.0012 s and 0.0013 s."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    cfg.write_text(cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.00125\n", 1))
+    stream = BufferedUvcStream(LightHistory(SystemClock()), fps=20.0)  # type: ignore[arg-type]
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert not [e for e in firmware.history if e.what == "lit"], said
+    assert "exposure 0.00125 s is not a whole number" in said, said
+    assert "0.0012 s and 0.0013 s" in said and "[camera] exposure_s" in said, said
+    assert "nothing was lit" in said and "Traceback" not in said, said
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0 and "RESULT: FAIL" in said, said
+    assert "camera: uvc-camera connected (no image taken), but FAILED" in said, said
+    assert "0.0012 s and 0.0013 s" in said, said
+
+
 def test_a_frame_rate_the_camera_does_not_offer_is_refused_at_connect_naming_the_key():
     stream = BufferedUvcStream(LightHistory(VirtualClock()), fps=30.0, frame_rates=(30.0, 15.0))
     cam = OpenCvCamera(
