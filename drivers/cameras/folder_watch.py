@@ -732,7 +732,7 @@ class FolderWatchCamera:
         return (
             f"; shot before this run connected ({shown} before, by the camera clock the "
             "session's earlier run learned): files of the stopped run, not of this light. If "
-            "the camera's clock was set back since, delete "
+            "the camera's clock was set back since (or another camera now saves there), delete "
             f"{self._clock_file()} and resume again (the first image is then unchecked)"
         )
 

@@ -546,3 +546,32 @@ def test_a_refused_first_file_leaves_no_camera_clock_in_the_session(tmp_path):
     with pytest.raises(CaptureError, match="set the camera to manual"):
         cam.capture(0.1)
     assert not (session / "raw").exists()
+
+
+def test_a_camera_clock_set_back_between_runs_is_said_with_the_way_out(tmp_path):
+    """The owner set the camera's clock back an hour between the stop and the resume: every
+    file now looks shot before the resume. The stop says so, naming the session's clock file
+    to delete; deleted, the next resume takes its files (its first image unchecked)."""
+    session, tether = tmp_path / "session", tmp_path / "tether"
+    tether.mkdir()
+    body = _Body(tether, [0.5] * 4, offset_s=0.0)
+    settings = FolderWatchSettings(folder=tether, timeout_s=3.0, poll_interval_s=0.125)
+
+    def camera() -> FolderWatchCamera:
+        cam = FolderWatchCamera(settings, clock=body.clock, trigger=body.pulse, wall=body.wall)
+        cam.output_dir = session / "raw" / ".incoming"
+        cam.connect()
+        return cam
+
+    camera().capture(0.1)
+    body.clock.sleep(60.0)
+    body.offset_s -= 3600.0
+    with pytest.raises(CaptureError) as info:
+        camera().capture(0.1)
+    said = info.value.message
+    clock_file = session / "raw" / ".folder_watch_clock.json"
+    assert "IMG_0002.DNG" in said and "shot before this run connected" in said, said
+    assert "set back" in said and str(clock_file) in said, said
+    clock_file.unlink()
+    frame = camera().capture(0.1)
+    assert frame.metadata["watched_file"].endswith("IMG_0003.DNG")
