@@ -82,8 +82,12 @@ class BufferedUvcStream:
         scale: float = 100_000.0,
         exposure_units: float = 100.0,
         frame_rates: tuple[float, ...] | None = None,
+        start_latency_s: float = 0.0,
     ) -> None:
         self.light = light
+        #: the first frame's readout begins this long after STREAMON (OpenCV #25688: "the
+        #: first grab on a camera video stream is consistently several hundreds of ms long")
+        self.start_latency_s = start_latency_s
         self.clock = light.clock
         #: the frame rates the camera offers for its format and size (VIDIOC_ENUM_FRAMEINTERVALS);
         #: VIDIOC_S_PARM picks the nearest, and CAP_PROP_FPS then reads that one back
@@ -209,7 +213,7 @@ class BufferedUvcStream:
     def grab(self) -> bool:
         now = self.clock.now()
         if self.streaming_from is None:  # the first grab queues every buffer, STREAMON
-            self.streaming_from = now
+            self.streaming_from = now + self.start_latency_s
             for b in self.buffers:
                 b.state, b.queued_at = "queued", now
         if self.held is not None:  # VIDIOC_QBUF of the buffer handed out last

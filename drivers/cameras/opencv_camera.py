@@ -231,7 +231,29 @@ class OpenCvCamera:
             ok, frame = cap.read()
             if ok and frame is not None:
                 self._refuse_unset_response(np.asarray(frame))
+        else:
+            self._start_stream(cap)
         self.connection_info = info
+
+    def _start_stream(self, cap: VideoCaptureLike) -> None:
+        """Start the stream at connect, with one frame read and discarded, in the dark.
+
+        Why: OpenCV starts a V4L2 stream (VIDIOC_STREAMON) at the first ``grab``, and a
+        camera's first frame comes hundreds of milliseconds to a second after it (OpenCV issue
+        #25688: "the first grab on a camera video stream is consistently several hundreds of
+        milliseconds long"; linuxpy #13: about 1 s). A 16-bit stream was started by the
+        session's first capture, its LED lit, a wait no lit-time check counts (it counts frame
+        periods): on LEDs allowed 1.5 s it ran into the thermal guard at image 1. A camera
+        that gives no frame at all is now said at connect, not with a light on."""
+        if not cap.grab():
+            raise DeviceError(
+                self.name,
+                "the camera opened but delivered no frame: check the cable and that no other "
+                f"program streams from it (`v4l2-ctl -d {self.settings.device} --stream-mmap "
+                "--stream-count=1`)",
+                "start stream",
+            )
+        self._frames_read += 1
 
     def _drain_for_queue(self, cap: VideoCaptureLike, info: dict[str, Any]) -> int:
         """Frames to drain so that none exposed before the light settled or the exposure

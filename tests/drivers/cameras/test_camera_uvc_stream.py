@@ -297,6 +297,29 @@ def test_an_exposure_not_in_the_cameras_units_is_refused_before_any_led_lights(
     assert "0.0012 s and 0.0013 s" in said, said
 
 
+@pytest.mark.pty
+def test_a_uvc_streams_start_up_is_waited_for_at_connect_not_under_a_lit_led(tmp_path, monkeypatch):
+    """A UVC camera whose first frame comes 1.2 s after the stream starts (OpenCV #25688:
+    hundreds of ms on Logitech webcams; about 1 s in linuxpy #13). A 16-bit stream was started
+    by the session's first capture, with LED 0 lit, and the run stopped at the thermal guard
+    ("LED 0 stayed on …, beyond max_on_s = 1.5 s"). The stream is now started at connect, in
+    the dark: every LED is lit about 0.6 s."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    stream = BufferedUvcStream(
+        LightHistory(SystemClock()),  # type: ignore[arg-type]
+        fps=20.0,
+        start_latency_s=1.2,
+    )
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--no-verdict"]
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, args)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert len([e for e in firmware.history if e.what == "lit"]) == 4, said
+
+
 def test_a_frame_rate_the_camera_does_not_offer_is_refused_at_connect_naming_the_key():
     stream = BufferedUvcStream(LightHistory(VirtualClock()), fps=30.0, frame_rates=(30.0, 15.0))
     cam = OpenCvCamera(
