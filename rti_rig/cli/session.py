@@ -632,7 +632,7 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     if exc.path.parent.name == RECORDS_DIR:
         what = (
             f"{exc.path.stem} is kept all the same (its journal line, the commit, was written "
-            "first)"
+            "in spite of it)"
         )
     else:
         what = f"{kept} image(s) are kept"

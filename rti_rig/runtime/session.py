@@ -202,9 +202,9 @@ _DIR_FSYNC_UNSUPPORTED = {errno.EINVAL, errno.EBADF, errno.ENOTSUP, errno.EOPNOT
 def _fsync_dir(path: Path) -> None:
     """Make a folder's entries (a file just renamed into it) durable across a power loss.
 
-    A file system that does not fsync folders is let be: the step's journal line, the commit,
-    is already written, and stopping every run on such a disk (as this did) keeps nothing
-    more."""
+    A file system that does not fsync folders is let be: the step's files are fsynced and its
+    journal line, the commit, is fsynced too; stopping every run on such a disk (as this did)
+    keeps nothing more."""
     try:
         fd = os.open(path, os.O_RDONLY)
     except OSError as exc:
@@ -693,15 +693,28 @@ class SessionFolder:
             **record_fields,
         )
         line = json.dumps(asdict(record)) + "\n"
+        # the record file before the journal line: a kill between the two had left a step
+        # whose line was written with no record file, unprovable once the journal was later
+        # cut or lost. A record file with no line is taken by the resume only with its files
+        # as it says (:func:`_mend_from_step_records`), as a line would be. A record file that
+        # cannot be written does not keep the step from its commit: the line is written, then
+        # that failure is raised
+        try:
+            self._write_step_record(base, line)
+        except SessionWriteError as exc:
+            record_failed: SessionWriteError | None = exc
+        else:
+            record_failed = None
         self._append_journal(line)
         self.committed[index] = record
-        self._write_step_record(base, line)
+        if record_failed is not None:
+            raise record_failed
         self.write_lp()
         return record
 
     def _write_step_record(self, base: str, line: str) -> None:
-        """Keep the step's record, just journaled, in ``records/BASE.json`` too (atomically,
-        fsynced, the folder entry made durable).
+        """Keep the step's record, about to be journaled, in ``records/BASE.json`` too
+        (atomically, fsynced, the folder entry made durable).
 
         Why: the journal is one file appended to; a line damaged later (a cut tail, a sync tool,
         a power loss that tears the file) left nothing proving a step a killed run had committed
@@ -1063,8 +1076,9 @@ def _mend_from_step_records(root: Path, names: list[str] | None, scan: JournalSc
             continue
         # no record of the step in the journal, or only an earlier one its files no longer
         # match (a step shot again whose new line was cut: the old record had won, failed its
-        # checksums, and the step was shot once more): the record file, written after the
-        # journal line of the latest commit, proves it
+        # checksums, and the step was shot once more): the record file, written just before
+        # the journal line of the latest commit (a kill between the two leaves it with no
+        # line), proves it
         scan.records.append(entry)
         scan.kept.append(raw + b"\n")
         scan.mended.append(path.relative_to(root).as_posix())
@@ -1281,7 +1295,7 @@ def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[str]:
         )
     for rel in [] if scan.missing else scan.mended:
         notes.append(
-            f"journal: the record of {Path(rel).stem}, which it had lost, written back from "
+            f"journal: the record of {Path(rel).stem}, which it lacked, written back from "
             f"{rel} (its files are as that record says: the image is kept, not shot again)"
         )
     dest = root / "recovered" / stamp / "journal-rejected.txt"

@@ -8,8 +8,10 @@ runs the ``rti-rig`` command line with the remaining arguments::
 
 Stages: ``before_light``, ``after_light``, ``during_capture``, ``during_write`` (half a TIFF in
 its temporary file), ``between_files`` (TIFF renamed, JPEG not written), ``before_journal`` (both
-files complete, journal line not written), and ``stall`` (no kill: capture K blocks for up to
-60 s of real time, so that another process can signal the run at a known step).
+files complete, journal line not written), ``after_record`` (the step's record file
+``records/BASE.json`` written, its journal line not), ``after_journal`` (the journal line
+written, nothing after it), and ``stall`` (no kill: capture K blocks for up to 60 s of real
+time, so that another process can signal the run at a known step).
 """
 
 from __future__ import annotations
@@ -28,6 +30,8 @@ STAGES = (
     "during_write",
     "between_files",
     "before_journal",
+    "after_record",
+    "after_journal",
     "stall",
 )
 
@@ -41,7 +45,7 @@ def install(stage: str, k: int) -> None:
 
     if stage not in STAGES:
         raise SystemExit(f"unknown stage {stage!r}; choose from {', '.join(STAGES)}")
-    counts = {"light": 0, "capture": 0, "write": 0, "journal": 0}
+    counts = {"light": 0, "capture": 0, "write": 0, "journal": 0, "record": 0, "line": 0}
 
     def die() -> None:
         os.kill(os.getpid(), signal.SIGKILL)
@@ -51,6 +55,8 @@ def install(stage: str, k: int) -> None:
     real_capture = sim_camera.SimulatedCamera.capture
     real_write = image_files._atomic_write
     real_asdict = session.asdict
+    real_record = session.SessionFolder._write_step_record
+    real_append = session.SessionFolder._append_journal
 
     def lit(call, *args):  # type: ignore[no-untyped-def]
         if stage == "before_light" and counts["light"] == k:
@@ -96,6 +102,18 @@ def install(stage: str, k: int) -> None:
             counts["journal"] += 1
         return real_asdict(obj)
 
+    def after(call, stage_here: str, count: str):  # type: ignore[no-untyped-def]
+        def write(self, *args):  # type: ignore[no-untyped-def]
+            call(self, *args)
+            if stage == stage_here and counts[count] == k:
+                die()
+            counts[count] += 1
+
+        return write
+
+    folder = session.SessionFolder
+    folder._write_step_record = after(real_record, "after_record", "record")  # type: ignore[method-assign]
+    folder._append_journal = after(real_append, "after_journal", "line")  # type: ignore[method-assign]
     sim_lights.SimulatedDome.light = light  # type: ignore[method-assign]
     sim_lights.SimulatedArm.move_to = move_to  # type: ignore[method-assign]
     sim_camera.SimulatedCamera.capture = capture  # type: ignore[method-assign]

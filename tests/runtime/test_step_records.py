@@ -291,3 +291,64 @@ def test_a_step_shot_again_whose_new_journal_line_was_cut_is_proven_by_its_recor
     (out / "records" / "image_003.json").write_text(json.dumps(earlier) + "\n")
     scan = scan_journal(out, image_names(4))
     assert scan.mended == [] and sorted(verified_steps(out, scan.records)) == [0, 1, 2, 3]
+
+
+def _killed(tmp_path: Path, stage: str, k: int) -> Path:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    proc = popen_session(stage, k, cfg, out, LIGHTS)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, stderr.decode()
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_kill_right_after_a_journal_line_leaves_its_record_file_to_prove_it(
+    tmp_path: Path,
+) -> None:
+    """The record file had been written after the journal line: a kill between the two left
+    image_004 committed with no record file, and once its line was cut the resume called the
+    line "never committed", set the image aside and shot it again. The record file is now
+    written first, so a committed line always has one."""
+    out = _killed(tmp_path, "after_journal", 3)
+    assert (out / "records" / "image_004.json").is_file()
+    fourth = {p: _sha(out / p) for p in ("image_004.jpg", "linear/image_004.tif")}
+    journal = out / "journal.jsonl"
+    journal.write_bytes(journal.read_bytes()[:-30])  # image_004's line cut
+
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "4 of 8 images verified" in text, text
+    assert "written back from records/image_004.json" in text, text
+    assert "never committed" not in text, text
+    assert {p: _sha(out / p) for p in fourth} == fourth
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_record_file_with_no_journal_line_keeps_its_image_only_as_captured(
+    tmp_path: Path,
+) -> None:
+    """A kill between the record file and the journal line: the image is whole and its
+    record says so, so the resume takes it back into the journal (not shot again); the same
+    kill with the image changed since is set aside and shot again, as any unproven image."""
+    out = _killed(tmp_path, "after_record", 3)
+    journal = out / "journal.jsonl"
+    assert len(journal.read_bytes().splitlines()) == 3
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "4 of 8 images verified" in said(r), said(r)
+    records = [json.loads(x) for x in journal.read_text().splitlines()]
+    assert [r["index"] for r in records] == list(range(LIGHTS))
+
+    (tmp_path / "b").mkdir()
+    changed = _killed(tmp_path / "b", "after_record", 3)
+    (changed / "image_004.jpg").write_bytes(b"edited")
+    r = runner.invoke(app, ["run", "--resume", str(changed), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "3 of 8 images verified" in said(r), said(r)
+    assert next((changed / "recovered").rglob("image_004.jpg")).read_bytes() == b"edited"
+    new = json.loads((changed / "records" / "image_004.json").read_text())
+    assert new["sha256"]["image_004.jpg"] == _sha(changed / "image_004.jpg")
