@@ -596,7 +596,7 @@ class SessionFolder:
             run["resumed_with_steps_done"] = len(self.resume.done)
             run["recovered_files"] = self.resume.recovered
             if self.resume.journal_repair:
-                run["journal_repair"] = self.resume.journal_repair
+                run["journal_repair"] = [note.text for note in self.resume.journal_repair]
             if self.resume.journal_rebuild:
                 run["journal_rebuild"] = self.resume.journal_rebuild
             if self.resume.lost_since_capture:
@@ -913,6 +913,26 @@ def session_notices(records: list[StepRecord]) -> list[str]:
     return [f"{n} [{c} of {total} images]" for n, c in counts.items()]
 
 
+@dataclass(frozen=True)
+class RepairNote:
+    """One thing a resume did to the journal before appending to it, in words, and whether
+    it set bytes of the journal aside (to ``recovered/STAMP/journal-rejected.txt``) or only
+    took records back into it.
+
+    Why a field: the resume's message had told the two apart by the note's wording (a note
+    holding "written back from" was a record kept), and a rejected line's reason quotes the
+    line itself (its ``image``), so a damaged line could read as a record kept and its
+    setting aside go unsaid. The manifest keeps the words only (``journal_repair``: a list of
+    strings, as in sessions written before this field)."""
+
+    text: str
+    #: the note's bytes were taken out of the journal and kept in recovered/, not appended onto
+    set_aside: bool
+
+    def __str__(self) -> str:
+        return self.text
+
+
 @dataclass
 class ResumeState:
     """What an interrupted session folder holds, verified."""
@@ -920,8 +940,9 @@ class ResumeState:
     manifest: dict[str, Any]
     done: dict[int, StepRecord]
     recovered: list[str]
-    #: what was done to the journal before appending to it (torn tail, rejected lines)
-    journal_repair: list[str] = field(default_factory=list)
+    #: what was done to the journal before appending to it (torn tail, rejected lines,
+    #: records written back from their record files)
+    journal_repair: list[RepairNote] = field(default_factory=list)
     #: what ``--rebuild-journal`` did: the journal rebuilt from the manifest, what it took back,
     #: where the old journal and every file the manifest does not vouch for were set aside
     journal_rebuild: list[str] = field(default_factory=list)
@@ -1259,28 +1280,35 @@ def verified_steps(
     return done
 
 
-def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[str]:
+def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[RepairNote]:
     """Set aside what is not a record, then rewrite the journal with the records only.
 
     The torn tail and every rejected line go, with the reason, to
     ``recovered/STAMP/journal-rejected.txt``; the journal is then replaced atomically by its
     good lines, so the next record is never appended onto a torn one.
     """
-    notes: list[str] = []
+    notes: list[RepairNote] = []
     report = []
     for lineno, text, reason in scan.rejected:
-        notes.append(f"journal line {lineno}: {reason}")
+        notes.append(RepairNote(f"journal line {lineno}: {reason}", set_aside=True))
         report.append(f"# line {lineno}: {reason}\n{text}\n")
     cut = scan.torn.strip()
     if cut and any(line.startswith(cut) for line in scan.kept[len(scan.kept) - len(scan.mended) :]):
         # the cut line of a step its record file proves: committed, its record written back
-        notes.append(f"journal: a last line cut to {len(scan.torn)} byte(s)")
+        notes.append(
+            RepairNote(f"journal: a last line cut to {len(scan.torn)} byte(s)", set_aside=True)
+        )
         report.append(
             "# last line cut short (the step's record file holds it whole, written back)\n"
             f"{scan.torn.decode('utf-8', 'replace')}\n"
         )
     elif scan.torn:
-        notes.append(f"journal: a torn last line of {len(scan.torn)} byte(s) (never committed)")
+        notes.append(
+            RepairNote(
+                f"journal: a torn last line of {len(scan.torn)} byte(s) (never committed)",
+                set_aside=True,
+            )
+        )
         report.append(
             "# torn last line (no newline: the process died while writing it; never "
             f"committed)\n{scan.torn.decode('utf-8', 'replace')}\n"
@@ -1288,15 +1316,21 @@ def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[str]:
     if scan.missing and scan.mended:
         stems = [Path(rel).stem for rel in scan.mended]
         notes.append(
-            f"{JOURNAL} was missing: rebuilt from {len(stems)} step record file(s) in "
-            f"{RECORDS_DIR}/ ({', '.join(stems[:8])}{' …' if len(stems) > 8 else ''}), each "
-            "taken only with its files on disk as its checksums say: those images are kept, "
-            "not shot again"
+            RepairNote(
+                f"{JOURNAL} was missing: rebuilt from {len(stems)} step record file(s) in "
+                f"{RECORDS_DIR}/ ({', '.join(stems[:8])}{' …' if len(stems) > 8 else ''}), "
+                "each taken only with its files on disk as its checksums say: those images "
+                "are kept, not shot again",
+                set_aside=False,
+            )
         )
     for rel in [] if scan.missing else scan.mended:
         notes.append(
-            f"journal: the record of {Path(rel).stem}, which it lacked, written back from "
-            f"{rel} (its files are as that record says: the image is kept, not shot again)"
+            RepairNote(
+                f"journal: the record of {Path(rel).stem}, which it lacked, written back from "
+                f"{rel} (its files are as that record says: the image is kept, not shot again)",
+                set_aside=False,
+            )
         )
     dest = root / "recovered" / stamp / "journal-rejected.txt"
     try:

@@ -352,3 +352,33 @@ def test_a_record_file_with_no_journal_line_keeps_its_image_only_as_captured(
     assert next((changed / "recovered").rglob("image_004.jpg")).read_bytes() == b"edited"
     new = json.loads((changed / "records" / "image_004.json").read_text())
     assert new["sha256"]["image_004.jpg"] == _sha(changed / "image_004.jpg")
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_rejected_line_is_said_set_aside_whatever_its_own_text_says(tmp_path: Path) -> None:
+    """The resume had told a record written back from a rejected line by the note's words
+    ("written back from" in it), and a rejected line's reason quotes the line's own image
+    name: a damaged line naming "written back from.jpg" was set aside without a word of it.
+    Each note now carries whether it set something aside; the manifest keeps the words."""
+    out = _killed_after_three(tmp_path)
+    journal = out / "journal.jsonl"
+    lines = journal.read_text().splitlines()
+    damaged = json.loads(lines[2])
+    damaged["image"] = "written back from.jpg"
+    lines[2] = json.dumps(damaged)
+    journal.write_text("\n".join(lines) + "\n")
+
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "3 of 8 images verified" in text, text
+    assert (
+        "journal line 3: image 'written back from.jpg' does not fit step 3 of the schedule: "
+        "set aside in recovered/, not appended onto" in text
+    ), text
+    # the record written back says so, with nothing set aside
+    assert "not shot again): set aside" not in text, text
+    run = json.loads((out / "manifest.json").read_text())["runs"][-1]
+    assert all(isinstance(n, str) for n in run["journal_repair"]), run["journal_repair"]
+    assert run["journal_repair"][0].startswith("journal line 3: image 'written back from.jpg'")

@@ -1114,11 +1114,10 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
             + (moved if recovered else "")
         )
     )
-    for line in resume.journal_repair if resume else []:
+    for note in resume.journal_repair if resume else []:
         # a record written back from its step's record file is kept, not set aside
-        kept = "written back from" in line or "was missing: rebuilt from" in line
-        said = line if kept else f"{line}: set aside in recovered/, not appended onto"
-        on_note(Note(said, "warning"))
+        aside = ": set aside in recovered/, not appended onto" if note.set_aside else ""
+        on_note(Note(f"{note.text}{aside}", "warning"))
     for line in resume.journal_rebuild if resume else []:
         on_note(Note(line, "warning"))
     lost = resume.lost_since_capture if resume else []
