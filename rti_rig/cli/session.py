@@ -9,8 +9,9 @@ from __future__ import annotations
 import shlex
 import signal
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -180,7 +181,6 @@ def run(
         open_new_session,
         open_resumed_session,
     )
-    from rti_rig.runtime.controller import EmergencyStop
 
     if resume is not None:
         given = [
@@ -216,80 +216,65 @@ def run(
         )
         if _rebuilt_finished(resume_request):  # a completed session: no rig, nothing to shoot
             return
+
     # SIGUSR1 said to be ignored from here, not only once the capture is over: one that came
     # while the rig opened (an emulator starting, metering with the rig lit) had ended the
     # process at once, exit 138, no word and no all-off
+    def open_new() -> Any:
+        if rig_config is None or out_dir is None:
+            raise RtiRigError("give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)")
+        if accept_rig_change:
+            raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
+        if reshoot_lost:
+            raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
+        if rebuild_journal:
+            raise RtiRigError("--rebuild-journal goes with --resume SESSION_DIR only")
+        refuse_unmetered_limit(max_saturated, auto_exposure, adaptive or until_error is not None)
+        return open_new_session(
+            NewSessionRequest(
+                rig_config,
+                out_dir,
+                lights=lights,
+                plan=plan,
+                min_elevation_deg=min_elevation_deg,
+                max_elevation_deg=max_elevation_deg,
+                auto_exposure=auto_exposure,
+                **_metering_limit(max_saturated),
+                adaptive=adaptive,
+                until_error_deg=until_error,
+                objective=objective,
+                min_lights=min_lights,
+            ),
+            print_note,
+        )
+
+    if resume is not None:
+        opening = _Opening(
+            lambda: open_resumed_session(resume_request, print_note),
+            out_dir,
+            auto_exposure,
+            stopped=lambda why: (
+                f"Stopped ({why}) before the session went on: no new image was captured; "
+                f"continue it with {_resume_command(resume_request)}"
+            ),
+            not_opened=(
+                "The session did not go on: no new image was captured; continue it with "
+                f"{_resume_command(resume_request)} once this is fixed"
+            ),
+        )
+    else:
+        opening = _Opening(
+            open_new,
+            out_dir,
+            auto_exposure,
+            stopped=lambda why: (
+                f"Stopped ({why}) before the first image: nothing was captured or written to "
+                f"{out_dir}"
+            ),
+            not_opened=f"Nothing was captured or written to {out_dir}",
+        )
     with _late_pause_ignored(), _late_term_held() as late_term:
-        try:
-            with _terminable_while_opening() as handover:
-                if resume is not None:
-                    opened = open_resumed_session(resume_request, print_note)
-                else:
-                    if rig_config is None or out_dir is None:
-                        raise RtiRigError(
-                            "give a RIG_CONFIG and --out DIR (or --resume SESSION_DIR)"
-                        )
-                    if accept_rig_change:
-                        raise RtiRigError("--accept-rig-change goes with --resume SESSION_DIR only")
-                    if reshoot_lost:
-                        raise RtiRigError("--reshoot-lost goes with --resume SESSION_DIR only")
-                    if rebuild_journal:
-                        raise RtiRigError("--rebuild-journal goes with --resume SESSION_DIR only")
-                    refuse_unmetered_limit(
-                        max_saturated, auto_exposure, adaptive or until_error is not None
-                    )
-                    opened = open_new_session(
-                        NewSessionRequest(
-                            rig_config,
-                            out_dir,
-                            lights=lights,
-                            plan=plan,
-                            min_elevation_deg=min_elevation_deg,
-                            max_elevation_deg=max_elevation_deg,
-                            auto_exposure=auto_exposure,
-                            **_metering_limit(max_saturated),
-                            adaptive=adaptive,
-                            until_error_deg=until_error,
-                            objective=objective,
-                            min_lights=min_lights,
-                        ),
-                        print_note,
-                    )
-                handover.hold()  # a stop from here on: the capture answers it
-        except RtiRigError as exc:
-            _print_failures(getattr(exc, "teardown_failures", None))  # metering's
-            raise _opening_failed(exc, out_dir) from None
-        except (KeyboardInterrupt, EmergencyStop) as exc:
-            # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
-            # had been 130 with no word at all (a SIGTERM's 143, with no all-off either)
-            why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
-            if resume is not None:
-                said = (
-                    f"Stopped ({why}) before the session went on: no new image was captured; "
-                    f"continue it with {_resume_command(resume_request)}"
-                )
-            else:
-                said = (
-                    f"Stopped ({why}) before the first image: nothing was captured or written to "
-                    f"{out_dir}"
-                )
-            raise _stopped_while_opening(exc, why, said, auto_exposure) from None
-        except Exception as exc:  # no part of rti-rig named it: said, not a traceback
-            _print_failures(getattr(exc, "teardown_failures", None))
-            if resume is not None:
-                said = (
-                    "The session did not go on: no new image was captured; continue it with "
-                    f"{_resume_command(resume_request)} once this is fixed"
-                )
-            else:
-                said = f"Nothing was captured or written to {out_dir}"
-            if auto_exposure:
-                said += (
-                    "; metering, if it had begun, attempted an all-off on its way out: check the "
-                    "rig's lights"
-                )
-            err.print(f"{said}.", markup=False)
-            raise _unexpected(exc, "") from None
+        opened, handover = _open_for_capture(opening)
         unsafe = _execute(opened, handover)
         if late_term:  # the summary is out; the verdict, not computed, is fit's to give
             _refuse_unsafe_end(unsafe, exit_code=None)
@@ -398,7 +383,7 @@ def refuse_unmetered_limit(
         )
 
 
-def _opening_failed(exc: RtiRigError, out_dir: Path) -> typer.Exit:
+def _opening_failed(exc: RtiRigError, out_dir: Path | None) -> typer.Exit:
     """The exit for an error while the rig opened (before any image): where metering had lit
     the rig, the lights' state is said first, with nothing captured or written."""
     state = getattr(exc, "lights_state", None)
@@ -425,6 +410,55 @@ def _stopped_while_opening(
         )
     err.print(f"[yellow]{escape(said)}.[/]")
     return typer.Exit(code=stop_exit_code(why))
+
+
+@dataclass(frozen=True)
+class _Opening:
+    """How ``run`` or ``preview`` opens its session (``open``, which returns it) and what it
+    says when the opening does not end in a session: ``stopped(why)`` for a Ctrl-C or SIGTERM,
+    ``not_opened`` for a fault no part of rti-rig named."""
+
+    open: Callable[[], Any]
+    out_dir: Path | None
+    auto_exposure: bool
+    stopped: Callable[[str], str]
+    not_opened: str
+
+
+def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
+    """Open the session with a SIGTERM answered as a stop, then hold stops for the capture;
+    whatever ends the opening instead is said (metering's teardown failures and the lights'
+    state with it) and becomes the command's exit, never a traceback.
+
+    One place for ``run`` and ``preview``: they had two copies of this, and the preview's
+    lacked two of the run's answers (an unnamed fault while it opened reached the user as a
+    traceback, and metering's teardown failures went unsaid on an error)."""
+    from rti_rig.runtime.controller import EmergencyStop
+
+    try:
+        with _terminable_while_opening() as handover:
+            opened = opening.open()
+            handover.hold()  # a stop from here on: the capture answers it
+    except RtiRigError as exc:
+        _print_failures(getattr(exc, "teardown_failures", None))  # metering's
+        raise _opening_failed(exc, opening.out_dir) from None
+    except (KeyboardInterrupt, EmergencyStop) as exc:
+        # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
+        # had been 130 with no word at all (a SIGTERM's 143, with no all-off either)
+        why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
+        said = opening.stopped(why)
+        raise _stopped_while_opening(exc, why, said, opening.auto_exposure) from None
+    except Exception as exc:  # no part of rti-rig named it: said, not a traceback
+        _print_failures(getattr(exc, "teardown_failures", None))
+        said = opening.not_opened
+        if opening.auto_exposure:
+            said += (
+                "; metering, if it had begun, attempted an all-off on its way out: check the "
+                "rig's lights"
+            )
+        err.print(f"{said}.", markup=False)
+        raise _unexpected(exc, "") from None
+    return opened, handover
 
 
 @contextmanager
@@ -1089,34 +1123,37 @@ def preview(
     its linear image with that light (no --preview-light needed).
     """
     from rti_rig.app.usecases.session import PreviewRequest, open_preview_session
-    from rti_rig.runtime.controller import EmergencyStop
 
+    def open_preview() -> Any:
+        refuse_unmetered_limit(max_saturated, auto_exposure)
+        return open_preview_session(
+            PreviewRequest(
+                rig_config,
+                out_dir,
+                parse_az_el(light, "--light"),
+                auto_exposure=auto_exposure,
+                **_metering_limit(max_saturated),
+                min_elevation_deg=min_elevation_deg,
+                max_elevation_deg=max_elevation_deg,
+            ),
+            print_note,
+        )
+
+    # metering for the preview lights the rig: a Ctrl-C had said only "rti-rig: stopped", a
+    # SIGTERM nothing at all (and sent no all-off)
+    opening = _Opening(
+        open_preview,
+        out_dir,
+        auto_exposure,
+        stopped=lambda why: (
+            f"Stopped ({why}) before the preview image: nothing was captured or written to "
+            f"{out_dir}"
+        ),
+        not_opened=f"Nothing was captured or written to {out_dir}",
+    )
     # a SIGTERM once the capture is over: the summary and the plan hint finish first
     with _late_term_held() as late_term:
-        try:
-            refuse_unmetered_limit(max_saturated, auto_exposure)
-            with _terminable_while_opening() as handover:
-                opened = open_preview_session(
-                    PreviewRequest(
-                        rig_config,
-                        out_dir,
-                        parse_az_el(light, "--light"),
-                        auto_exposure=auto_exposure,
-                        **_metering_limit(max_saturated),
-                        min_elevation_deg=min_elevation_deg,
-                        max_elevation_deg=max_elevation_deg,
-                    ),
-                    print_note,
-                )
-                handover.hold()  # a stop from here on: the capture answers it
-        except RtiRigError as exc:
-            raise _opening_failed(exc, out_dir) from None
-        except (KeyboardInterrupt, EmergencyStop) as exc:
-            # metering for the preview lights the rig: a Ctrl-C had said only "rti-rig: stopped",
-            # a SIGTERM nothing at all (and sent no all-off)
-            why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
-            said = f"Stopped ({why}) before the preview image: nothing was captured or written to "
-            raise _stopped_while_opening(exc, why, f"{said}{out_dir}", auto_exposure) from None
+        opened, handover = _open_for_capture(opening)
         unsafe = _execute(opened, handover)
         # the band given here is the one to plan in: said in the command to copy
         band = "".join(

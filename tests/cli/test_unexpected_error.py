@@ -74,3 +74,23 @@ def test_an_unnamed_fault_while_the_session_opens_is_said_too(
     assert isinstance(r.exception, SystemExit) and r.exit_code == 1, r.output
     assert "unexpected _Unnamed: no rig today" in said
     assert f"Nothing was captured or written to {out}" in said
+
+
+def test_an_unnamed_fault_while_the_preview_opens_is_said_too(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`preview` opened its session through its own copy of `run`'s opening, without the
+    answer to a fault no part of rti-rig named: it reached the user as a traceback."""
+    import rti_rig.app.compose as compose
+
+    def build(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise _Unnamed("no rig today")
+
+    monkeypatch.setattr(compose, "build_rig", build)
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "p"
+    r = runner.invoke(app, ["preview", str(cfg), "--out", str(out)])
+    said = " ".join(r.output.split())
+    assert isinstance(r.exception, SystemExit) and r.exit_code == 1, (r.exception, r.output)
+    assert "unexpected _Unnamed: no rig today" in said, said
+    assert f"Nothing was captured or written to {out}" in said, said
