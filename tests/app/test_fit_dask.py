@@ -3,6 +3,7 @@ single-process fit, the batch resumable, unreadable images on a worker refused c
 
 from __future__ import annotations
 
+import logging
 import shutil
 import sys
 from pathlib import Path
@@ -167,3 +168,100 @@ def test_a_killed_attempts_partial_folder_goes_once_the_session_is_finished(
     args = ["fit", str(session), str(tmp_path / "nope"), "--out", str(root), "--no-qa"]
     r = runner.invoke(app, args)
     assert "(finished earlier)" in r.output and not dead.exists(), r.output
+
+
+class _Records(logging.Handler):
+    """The records that reach the handlers of Dask's client logger (what a user sees)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.texts: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.texts.append(record.getMessage())
+
+
+def _fetches_failing(cluster, times: int) -> dict[str, int]:  # type: ignore[no-untyped-def]
+    """The in-process worker's answer to a fetch of a result fails ``times`` times (a worker
+    lost with its results, or one the scheduler cannot connect to), then serves it."""
+    (worker,) = cluster.workers.values()
+    serve, calls = worker.handlers["get_data"], {"n": 0}
+
+    async def get_data(comm, **kwargs):  # type: ignore[no-untyped-def]
+        calls["n"] += 1  # Dask hands the handler its comm by the parameter's name
+        if calls["n"] <= times:
+            raise OSError("connection reset by peer")
+        return await serve(comm, **kwargs)
+
+    worker.handlers["get_data"] = get_data
+    return calls
+
+
+@pytest.fixture
+def client_log():  # type: ignore[no-untyped-def]
+    handler = _Records()
+    logger = logging.getLogger("distributed.client")
+    logger.addHandler(handler)
+    yield handler.texts
+    logger.removeHandler(handler)
+
+
+def test_a_result_fetched_again_after_a_failed_fetch_says_nothing(
+    session: Path, tmp_path: Path, client_log: list[str]
+) -> None:
+    """Dask fetches a result again when a fetch fails (its worker lost, say): the fit is the
+    same, and the user's stderr had a WARNING "Couldn't gather 1 keys, rescheduling …" of a
+    run that went well."""
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+    from rti_rig.app.usecases.fit import FitRequest, run_fit
+
+    run_fit(FitRequest(session, tmp_path / "plain", model="ps", qa=False))
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        calls = _fetches_failing(cluster, 1)
+        req = FitRequest(session, tmp_path / "dask", model="ps", qa=False)
+        fit_dask.run_fit_dask(req, cluster.scheduler_address)
+    assert calls["n"] >= 2  # the fetch did fail once
+    same_files(tmp_path / "plain", tmp_path / "dask")
+    assert not [t for t in client_log if "Couldn't gather" in t], client_log
+
+
+def test_a_result_that_can_never_be_fetched_is_a_named_error(
+    session: Path, tmp_path: Path, client_log: list[str]
+) -> None:
+    """A worker whose results cannot be fetched (one the scheduler cannot connect to): Dask
+    retried for ever, hundreds of "Couldn't gather" warnings a second, and the fit never
+    ended. It stops after a few tries, saying what to check."""
+    import threading
+
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+    from rti_rig.app.usecases.fit import FitRequest
+
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        _fetches_failing(cluster, 10**9)
+        address = cluster.scheduler_address
+        req = FitRequest(session, tmp_path / "out", model="ps", qa=False)
+        caught: list[BaseException] = []
+
+        def fit() -> None:
+            try:
+                fit_dask.run_fit_dask(req, address)
+            except BaseException as exc:  # handed to the test's thread
+                caught.append(exc)
+
+        worker = threading.Thread(target=fit, daemon=True)
+        worker.start()
+        worker.join(timeout=120)  # a bound on a hang, not a timing: it ends in about a second
+        assert not worker.is_alive(), f"the fit still waits ({len(client_log)} log lines)"
+    assert len(caught) == 1 and isinstance(caught[0], fit_dask.SchedulerError), caught
+    text = str(caught[0])
+    assert address in text and "could not be fetched" in text and "--contact-address" in text
+    assert not [t for t in client_log if "Couldn't gather" in t], client_log[:3]
+    assert not list((tmp_path / "out").rglob("*.part"))

@@ -70,6 +70,15 @@ BANDS_IN_FLIGHT_PER_THREAD = 2
 #: (``FutureCancelledError.reason``): a lost scheduler surfaces so, not as an ``OSError``.
 SCHEDULER_LOST = "scheduler-connection-lost"
 
+#: The reason given to the future of a band (or a batch's session) whose result could not be
+#: fetched from the worker that holds it, cancelled by :class:`_GatherWatch`.
+GATHER_FAILED = "rti-rig-result-unreachable"
+#: Failed fetches of one result before the fit stops. Dask retries a failed fetch at once and
+#: for ever, logging "Couldn't gather N keys, rescheduling" each time (hundreds a second with
+#: a worker that answers the scheduler but not a fetch): one or two are a worker lost and its
+#: work done again elsewhere, more a worker whose results cannot be reached.
+GATHER_TRIES = 5
+
 SHARED_PATHS = (
     "every Dask worker must see the session's files at the same paths as this machine "
     "(a shared filesystem mounted at the same place)"
@@ -79,6 +88,68 @@ SHARED_PATHS = (
 class SchedulerError(RtiRigError):
     """The Dask scheduler cannot be used: unreachable, no workers, or workers that cannot read
     the images."""
+
+
+class _GatherWatch(logging.Filter):
+    """Keeps Dask's "Couldn't gather … rescheduling" warnings from the user, and stops a fetch
+    that keeps failing.
+
+    Why: a result the client could not fetch (its worker lost, or a worker the scheduler
+    cannot connect to: a firewall, an address only its own host can reach) is retried by Dask
+    at once and without end, each try a WARNING line on this command's stderr. A worker lost
+    once is Dask's own recovery (the band is computed again, the outputs the same): a normal
+    run's stderr got that noise. A result that can never be fetched held the fit for ever,
+    stderr flooding. After :data:`GATHER_TRIES` failures of one result its future is
+    cancelled with the reason :data:`GATHER_FAILED`, which the waiting code says by name."""
+
+    def __init__(self, client: Any) -> None:
+        super().__init__()
+        self.client = client
+        self.failures: dict[Any, int] = {}
+        self.futures: dict[Any, Any] = {}
+
+    def track(self, future: Any) -> Any:
+        """Watch ``future``'s fetches (returns it)."""
+        self.futures[future.key] = future
+        return future
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if not str(record.msg).startswith("Couldn't gather"):
+            return True
+        args = record.args if isinstance(record.args, tuple) else ()
+        for key in args[1] if len(args) == 2 else ():
+            n = self.failures[key] = self.failures.get(key, 0) + 1
+            future = self.futures.get(key)
+            if n == GATHER_TRIES and future is not None:  # on the client's loop: no waiting
+                self.client.loop.add_callback(
+                    lambda f=future: self.client.cancel(
+                        [f], asynchronous=True, reason=GATHER_FAILED
+                    )
+                )
+        return False
+
+
+@contextmanager
+def _gathers_watched(client: Any) -> Iterator[_GatherWatch]:
+    """:class:`_GatherWatch` on the Dask client's logger for the length of the block."""
+    watch = _GatherWatch(client)
+    logger = logging.getLogger("distributed.client")
+    logger.addFilter(watch)
+    try:
+        yield watch
+    finally:
+        logger.removeFilter(watch)
+
+
+def _unreachable(address: str, what: str, kept: str) -> str:
+    """What is said of a result that could not be fetched :data:`GATHER_TRIES` times."""
+    return (
+        f"the Dask cluster at {address!r} computed {what} but its result could not be fetched "
+        f"from the worker holding it ({GATHER_TRIES} tries): every worker's own address must "
+        "be reachable from the scheduler and from this machine (a firewall, or a worker "
+        "listening on an address only its host can reach: see `dask worker --listen-address` "
+        f"and `--contact-address`); {kept}"
+    )
 
 
 @contextmanager
@@ -213,49 +284,58 @@ def _on_cluster(
     pending = iter(range(len(tasks)))
     outstanding: dict[Any, tuple[Any, int]] = {}
 
-    def submit_next() -> Any:
+    def submit_next(watch: _GatherWatch) -> Any:
         i = next(pending, None)
         if i is None:
             return None
-        future = client.compute(tasks[i])
+        future = watch.track(client.compute(tasks[i]))
         outstanding[future.key] = (future, i)
         return future
 
-    first = [f for f in (submit_next() for _ in range(window)) if f is not None]
-    running = as_completed(first, loop=client.loop)
-    try:
-        for future in running:
-            try:
-                fitted = future.result()
-            except ImageReadError as exc:
-                raise SchedulerError(
-                    f"a worker of the Dask cluster at {address!r} could not read the images: "
-                    f"{exc}. Note: {SHARED_PATHS}."
-                ) from None
-            except RtiRigError:
-                raise  # a named error of the fit itself, raised on the worker
-            except Exception as exc:  # e.g. KilledWorker: a worker died on this band
-                if scheduler_lost(client, exc):
+    with _gathers_watched(client) as watch:
+        first = [f for f in (submit_next(watch) for _ in range(window)) if f is not None]
+        running = as_completed(first, loop=client.loop)
+        try:
+            for future in running:
+                try:
+                    fitted = future.result()
+                except ImageReadError as exc:
                     raise SchedulerError(
-                        f"lost the Dask scheduler at {address!r} while fitting (it stopped or "
-                        "the network to it failed); nothing of this fit was kept in --out: "
-                        "start the scheduler again (`dask scheduler`, workers with `dask "
-                        f"worker {address}`) and run the same command"
+                        f"a worker of the Dask cluster at {address!r} could not read the "
+                        f"images: {exc}. Note: {SHARED_PATHS}."
                     ) from None
-                raise SchedulerError(
-                    f"a band of the fit failed on the Dask cluster at {address!r}: "
-                    f"{type(exc).__name__}: {exc}. Check the workers' logs (memory limit?) and "
-                    "run again; finished outputs are not kept for a single-session fit"
-                ) from None
-            yield tiles[outstanding.pop(future.key)[1]], fitted
-            future.release()
-            following = submit_next()
-            if following is not None:
-                running.add(following)
-    finally:  # the caller stopped early or failed: cancel what is left
-        running.clear()
-        if outstanding:
-            client.cancel([f for f, _ in outstanding.values()])
+                except RtiRigError:
+                    raise  # a named error of the fit itself, raised on the worker
+                except Exception as exc:  # e.g. KilledWorker: a worker died on this band
+                    raise _band_failed(client, address, exc) from None
+                yield tiles[outstanding.pop(future.key)[1]], fitted
+                future.release()
+                following = submit_next(watch)
+                if following is not None:
+                    running.add(following)
+        finally:  # the caller stopped early or failed: cancel what is left
+            running.clear()
+            if outstanding:
+                client.cancel([f for f, _ in outstanding.values()])
+
+
+def _band_failed(client: Any, address: str, exc: BaseException) -> SchedulerError:
+    """The error of a band whose future failed (a lost scheduler, or a result that could not
+    be fetched, said as such)."""
+    if getattr(exc, "reason", None) == GATHER_FAILED:
+        kept = "nothing of this fit was kept in --out"
+        return SchedulerError(_unreachable(address, "a band of the fit", kept))
+    if scheduler_lost(client, exc):
+        return SchedulerError(
+            f"lost the Dask scheduler at {address!r} while fitting (it stopped or the network "
+            "to it failed); nothing of this fit was kept in --out: start the scheduler again "
+            f"(`dask scheduler`, workers with `dask worker {address}`) and run the same command"
+        )
+    return SchedulerError(
+        f"a band of the fit failed on the Dask cluster at {address!r}: "
+        f"{type(exc).__name__}: {exc}. Check the workers' logs (memory limit?) and run again; "
+        "finished outputs are not kept for a single-session fit"
+    )
 
 
 def run_fit_dask(req: FitRequest, scheduler: str = THREADS) -> FitResult:
@@ -330,24 +410,45 @@ def run_batch_dask(
         # A source missing here too is the user's typo, not the workers' filesystem: it is
         # refused here in the words of the batch without Dask ("does not exist: give a session
         # folder or an .lp file"); it had been sent and blamed on the workers' shared paths.
-        futures = {
-            s: client.submit(_fit_one_task, s, root, template, threads, pure=False)
-            for s in todo
-            if s.exists()
-        }
-        items = []
-        for s in sources:
-            if s in todo and s not in futures:
-                items.append(fit_one(s, root, template))  # fails at once, naming the path
-                continue
-            if s not in futures:
-                items.append(BatchItem(s, batch_out_dir(root, s), "skipped (finished earlier)"))
-                continue
-            try:
-                items.append(futures[s].result())
-            except Exception as exc:  # e.g. KilledWorker: this session failed, the batch goes on
-                if scheduler_lost(client, exc):
-                    raise _batch_lost(scheduler, sources, given, root) from None
-                status = f"failed on the Dask cluster: {type(exc).__name__}: {exc}"
-                items.append(BatchItem(s, batch_out_dir(root, s), status))
+        with _gathers_watched(client) as watch:
+            futures = {
+                s: watch.track(client.submit(_fit_one_task, s, root, template, threads, pure=False))
+                for s in todo
+                if s.exists()
+            }
+            items = _batch_results(client, scheduler, sources, given, root, template, todo, futures)
         return [replace(item, source=g) for item, (_, g) in zip(items, given, strict=True)]
+
+
+def _batch_results(
+    client: Any,
+    scheduler: str,
+    sources: list[Path],
+    given: list[tuple[Path, Path]],
+    root: Path,
+    template: FitRequest,
+    todo: set[Path],
+    futures: dict[Path, Any],
+) -> list[BatchItem]:
+    """Each session's item of a batch on a cluster, in the order given, as its task ends."""
+    items = []
+    for s in sources:
+        if s in todo and s not in futures:
+            items.append(fit_one(s, root, template))  # fails at once, naming the path
+            continue
+        if s not in futures:
+            items.append(BatchItem(s, batch_out_dir(root, s), "skipped (finished earlier)"))
+            continue
+        try:
+            items.append(futures[s].result())
+        except Exception as exc:  # e.g. KilledWorker: this session failed, the batch goes on
+            if getattr(exc, "reason", None) == GATHER_FAILED:
+                kept = "run the same command again once it is (a finished session is skipped)"
+                status = f"failed: {_unreachable(scheduler, 'the session', kept)}"
+                items.append(BatchItem(s, batch_out_dir(root, s), status))
+                continue
+            if scheduler_lost(client, exc):
+                raise _batch_lost(scheduler, sources, given, root) from None
+            status = f"failed on the Dask cluster: {type(exc).__name__}: {exc}"
+            items.append(BatchItem(s, batch_out_dir(root, s), status))
+    return items
