@@ -74,6 +74,8 @@ KILLS = (
     "sigkill-during-write",
     "sigkill-between-files",
     "sigkill-before-journal",
+    "sigkill-after-record",
+    "sigkill-after-journal",
 )
 #: What a user or a disk does to a session (issue #30).
 SESSION = (
@@ -563,8 +565,9 @@ the simulated rigs the new capture has the same bytes), so it is counted here.
   real pyserial on a pseudo-terminal: a reply dropped, garbled or late, a garbled command, a
   USB disconnect, a board reset before or after acknowledging.
 - `sigkill-*`: the process is killed with SIGKILL (no cleanup at all) before the light, after
-  the capture, half-way through writing the TIFF, between the TIFF and the JPEG, or after both
-  files but before the journal line.
+  the capture, half-way through writing the TIFF, between the TIFF and the JPEG, after both
+  files but before the step's record file, between the record file and the journal line, or
+  right after the journal line.
 
 - `servo-*`: the emulated Dynamixel servos (real SDK, in-process port) report overload or
   overheating in their Hardware Error Status, corrupt their status packets' CRC, or fall silent,
