@@ -12,8 +12,9 @@ Layout (opens directly in relight-cli's folder mode, which takes the first ``*.l
       lights.lp              one line per image, from the light that actually fired
       journal.jsonl          one line per completed step, flushed to disk as it happens
       records/image_001.json the same record of each committed step, one file per step,
-                             written atomically right after its journal line: what proves
-                             the step if that line is later damaged (see :func:`scan_journal`)
+                             written atomically right before its journal line: what proves
+                             the step if that line is damaged later or was never written
+                             (see :func:`scan_journal`)
       manifest.json          rig config, schedule, per-step timings, versions, finish reason
       strays/image_002-IMG_0002.CR2
                              a picture the camera delivered with a step's but not of it (a
@@ -636,7 +637,10 @@ class SessionFolder:
         """Write one captured frame (linear TIFF, then sRGB JPEG), then journal it.
 
         The journal line is the commit point: a step is done only once its line is on disk, and
-        its checksums prove the files are the ones written. ``lights.lp`` is then rewritten
+        its checksums prove the files are the ones written. The step's record file
+        (``records/BASE.json``) is written just before it, so that no committed step is ever
+        without one; a record file whose line never came (a kill between the two) proves the
+        step on a resume only with its files as it says. ``lights.lp`` is then rewritten
         from every committed step. A write that fails (no space, read-only, I/O error) raises
         :class:`SessionWriteError` naming the file, with no temporary file left behind and the
         journal as it was.
