@@ -265,3 +265,39 @@ def test_a_result_that_can_never_be_fetched_is_a_named_error(
     assert address in text and "could not be fetched" in text and "--contact-address" in text
     assert not [t for t in client_log if "Couldn't gather" in t], client_log[:3]
     assert not list((tmp_path / "out").rglob("*.part"))
+
+
+def test_a_batch_session_whose_result_can_never_be_fetched_fails_by_name(
+    session: Path, tmp_path: Path, client_log: list[str]
+) -> None:
+    """In a batch the session whose result cannot be fetched fails with the same words and
+    the batch ends (its `.result()` had waited for ever too)."""
+    import threading
+
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+    from rti_rig.app.usecases.fit import FitRequest
+
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        _fetches_failing(cluster, 10**9)
+        address = cluster.scheduler_address
+        root = tmp_path / "batch"
+        template = FitRequest(session, root, model="ps", qa=False)
+        items: list = []
+        batch = threading.Thread(
+            target=lambda: items.extend(
+                fit_dask.run_batch_dask([session], root, template, address)
+            ),
+            daemon=True,
+        )
+        batch.start()
+        batch.join(timeout=120)  # a bound on a hang, not a timing
+        assert not batch.is_alive(), "the batch still waits"
+    (item,) = items
+    assert item.status.startswith("failed: the Dask cluster") and "could not be fetched" in (
+        item.status
+    ), item.status
+    assert not [t for t in client_log if "Couldn't gather" in t], client_log[:3]
