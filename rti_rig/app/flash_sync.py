@@ -429,10 +429,10 @@ def flash_sync_check(loaded) -> FlashSyncCheckReport:  # type: ignore[no-untyped
     """Build the rig (the order is checked against the firmware), open and release the camera
     without shooting (a shot would step the dome), and say what cannot be tested."""
     from rti_rig.app.compose import build_rig
-    from rti_rig.app.usecases.check import camera_line
+    from rti_rig.app.usecases.check import camera_line, config_note_lines
 
     with build_rig(loaded) as rig:
         assert isinstance(rig.geometry, DomeGeometry)
-        lines = check_lines(loaded, rig.geometry)
+        lines = [*check_lines(loaded, rig.geometry), *config_note_lines(loaded)]
         camera, ok = camera_line(rig, "it would step the dome")
     return FlashSyncCheckReport([*lines, camera], ok)

@@ -60,7 +60,7 @@ def check_rig(req: CheckRequest) -> Any:
         try:
             if isinstance(rig.lighting, DomeLighting):
                 lights = self_test(rig.lighting.source, rig.clock, intensity=req.intensity)
-                return WithCamera(lights, camera_line(rig))
+                return WithCamera(lights, camera_line(rig), config_note_lines(loaded))
             if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
                 lights = arm_self_test(
                     rig.lighting.carrier,
@@ -68,7 +68,8 @@ def check_rig(req: CheckRequest) -> Any:
                     rig.clock,
                     park=rig.lighting.park_after_session,
                 )
-                return WithCamera(lights, camera_line(rig), _lamp_notes(rig))
+                notes = (*config_note_lines(loaded), *_lamp_notes(rig))
+                return WithCamera(lights, camera_line(rig), notes)
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
             report = getattr(exc, "self_test_report", None)
@@ -120,6 +121,16 @@ def reboot_faulted(rig_config: Path) -> RebootReport:
                 "arm has none"
             )
         return RebootReport(tuple(reboot()), rig_config)
+
+
+def config_note_lines(loaded: Any) -> tuple[str, ...]:
+    """What loading the rig config tolerated or warns of (a calibration `.lp` light clamped to
+    the horizon, a count line that disagrees, a watched folder's wait longer than an LED may
+    stay lit), as the check's ``note:`` lines.
+
+    Why: ``run`` and ``plan`` print these notes, and ``check`` — the step before a dome's first
+    session — had dropped them, passing a config whose calibration file it had had to mend."""
+    return tuple(f"note: {n}" for n in loaded.notes)
 
 
 def _lamp_notes(rig) -> tuple[str, ...]:  # type: ignore[no-untyped-def]
@@ -244,6 +255,6 @@ class ReplayCheck:
             "replay rig: a recorded acquisition, no device to light, move or open",
             f"images: {self.count} listed in {self.lp_name}, each present {self.where}, "
             f"undamaged and readable, all {self.width}x{self.height} of one kind",
-            *(f"note: {n}" for n in self.notes),
+            *config_note_lines(self),
             "RESULT: PASS",
         ]
