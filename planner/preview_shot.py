@@ -112,7 +112,17 @@ def preview_schedule(
     else:
         reason = geometry.unreachable_reason(wanted)
         if reason:
-            raise ScheduleError(f"preview light az {az:g}°, el {el:g}°: {reason}")
+            # named as the user gave it, with what to do: the bare limit had left them to
+            # guess that --light was the thing to change
+            if az_el_deg is not None:
+                asked, todo = f"--light {az:g},{el:g}", "give a --light AZ,EL the arm can reach"
+            else:
+                asked = f"the default preview light (az {az:g}°, el {el:g}°)"
+                todo = (
+                    "give --light AZ,EL the arm can reach, or an elevation band "
+                    "(--min-elevation-deg / --max-elevation-deg) within its reach"
+                )
+            raise ScheduleError(f"{asked}: the arm cannot go there ({reason}); {todo}")
         schedule = LightSchedule.from_directions([wanted], method="preview", provenance=prov)
     _, got = az_el_from_direction(schedule.steps[0].direction)
     lo, hi = PREVIEW_BAND_DEG

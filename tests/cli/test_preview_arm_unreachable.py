@@ -1,0 +1,42 @@
+"""`rti-rig preview` on an arm, asked for a light the arm cannot reach, names what to change.
+
+Found by a front-door audit: `rti-rig preview rig_configs/virtual_arm.toml --light 0,90` said
+only "preview light az 0°, el 90°: direction is 0.00° from the camera axis, inside the 10°
+keep-out cone" — neither the option that put it there nor what to do; a dome's light outside the
+band asked for names `--light` and says to give one within the band.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def _refusal(tmp_path: Path, *args: str) -> str:
+    out = tmp_path / "preview"
+    r = runner.invoke(app, ["preview", str(CONFIGS / "virtual_arm.toml"), "--out", str(out), *args])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert "Traceback" not in text
+    assert not out.exists() or not any(out.iterdir())  # nothing shot, nothing written
+    return text
+
+
+def test_a_light_inside_the_keep_out_cone_names_the_option_and_the_remedy(tmp_path: Path) -> None:
+    text = _refusal(tmp_path, "--light", "0,90")
+    assert "--light 0,90: the arm cannot go there" in text, text
+    assert "inside the 10° keep-out cone" in text
+    assert "give a --light AZ,EL the arm can reach" in text
+
+
+def test_a_default_light_pushed_out_of_reach_by_the_band_says_so(tmp_path: Path) -> None:
+    # the default light's elevation is clamped into the band asked for: 85°, past the arm's 80°
+    text = _refusal(tmp_path, "--min-elevation-deg", "85")
+    assert "the default preview light (az 135°, el 85°): the arm cannot go there" in text, text
+    assert "--min-elevation-deg / --max-elevation-deg" in text
