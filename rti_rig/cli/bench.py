@@ -103,8 +103,17 @@ def bench_tradeoff(
 
 def _acquisition_lp(given: Path) -> Path:
     """The ``.lp`` of ``--from``: the file, or a folder's only ``.lp`` (a session's lights.lp),
-    as ``rti-rig fit`` takes a folder ("Is a directory" had been the answer)."""
+    as ``rti-rig fit`` takes a folder ("Is a directory" had been the answer).
+
+    A file not named ``.lp`` is refused by name, as ``fit`` and ``run`` refuse it: read as an
+    ``.lp``, an image had been told its "line 1 holds NUL bytes" (save it again as UTF-8 text)
+    and a rig config "line 4: expected 'name x y z'"."""
     if not given.is_dir():
+        if given.exists() and given.suffix.lower() != ".lp":
+            raise RtiRigError(
+                f"--from {given}: not an .lp file; give the .lp that lists the acquisition's "
+                "images, with the images beside it (or a session folder: its lights.lp)"
+            )
         return given
     found = sorted(given.glob("*.lp"))
     if len(found) == 1:

@@ -150,3 +150,22 @@ def test_tradeoff_from_a_folder_takes_its_only_lp(tmp_path: Path) -> None:
         (tmp_path / name).write_text("1\nx.jpg 0 0 1\n")
     with pytest.raises(RtiRigError, match=r"2 \.lp files \(a\.lp, b\.lp\)"):
         _acquisition_lp(tmp_path)
+
+
+def test_tradeoff_from_a_file_that_is_not_an_lp_names_what_to_give(tmp_path: Path) -> None:
+    """Found by a front-door audit: `--from` an acquisition's image was told its "line 1 holds
+    NUL bytes … save it again as UTF-8", and `--from` a rig config "line 4: expected 'name x y
+    z'"; `fit` and `run` name an .lp as what they want."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    image = ACQ.parent / "image01.jpg"
+    for given in (image, REPO / "rig_configs" / "simulated_dome.toml"):
+        r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(given)])
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2, text
+        assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+        assert f"--from {given}: not an .lp file" in text, text
+        assert "give the .lp that lists the acquisition's images" in text
+        assert "NUL" not in text and "expected 'name x y z'" not in text
