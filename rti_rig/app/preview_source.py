@@ -103,6 +103,24 @@ def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any]]:
     return found
 
 
+def _refuse_a_rig_as_preview(path: Path) -> None:
+    """A rig config or an ``.lp`` given where the preview goes (``rti-rig plan RIG.toml``, the
+    ``--rig`` forgotten) is said to be one, with where it belongs: it had been told only
+    "cannot read this file as an image (JPEG, PNG or TIFF)"."""
+    suffix = path.suffix.lower()
+    if suffix == ".toml":
+        raise ScheduleError(
+            f"{path} is a rig config, not a preview image: give it as --rig {path} "
+            "(rti-rig plan [PREVIEW] --rig RIG.toml; without a preview, uniform, or optimal "
+            "for a level surface)"
+        )
+    if suffix == ".lp":
+        raise ScheduleError(
+            f"{path} is an .lp light list, not a preview image: give it as --rig {path} (a "
+            "dome with exactly those lights), and as PREVIEW one of the images it lists"
+        )
+
+
 def resolve_preview(
     path: Path, rig_lp: RigLp | None = None, light_given: bool = False
 ) -> PreviewSource:
@@ -129,6 +147,7 @@ def resolve_preview(
         where = f"the session {path.resolve().name}"
         light = _lit_from_above(steps[0]["actual_direction"], where, image)
         return PreviewSource(image, light, f"recorded by {where}")
+    _refuse_a_rig_as_preview(path)
     found = _records(path, rig_lp) if path.is_file() and not light_given else []
     if not found:
         return PreviewSource(path)
