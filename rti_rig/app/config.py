@@ -23,7 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from rti_rig.app.flash_sync import FlashSyncSettings, SyncFaultConfig
 from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
-from rti_rig.core.lp_format import read_lp
+from rti_rig.core.lp_format import looks_like_image, read_lp
 from rti_rig.core.rig_geometry import (
     COINCIDENT_LED_DEG,
     ArmGeometry,
@@ -731,7 +731,7 @@ def _not_toml_hint(raw: bytes) -> str:
     another suffix (``lights.txt``), which a rig is read as only when it ends in ``.lp``.
     Both had been told only the TOML parser's complaint ("codec can't decode byte 0xff",
     "Expected '=' after a key")."""
-    if raw.startswith((b"\xff\xd8", b"\x89PNG", b"II*\x00", b"MM\x00*")):
+    if looks_like_image(raw):
         return (
             "; this is an image: give the rig config (.toml) or the recorded acquisition's .lp "
             "that lists the images"

@@ -459,16 +459,39 @@ def parse_lp(
     return entries
 
 
+#: The first bytes of the image files an acquisition holds: JPEG, PNG, TIFF (either order).
+IMAGE_MAGIC = (b"\xff\xd8", b"\x89PNG", b"II*\x00", b"MM\x00*")
+
+
+def looks_like_image(raw: bytes) -> bool:
+    """Whether ``raw`` starts as a JPEG, PNG or TIFF file does."""
+    return raw.startswith(IMAGE_MAGIC)
+
+
 def read_lp(
     path: Path | str, upper_hemisphere: bool = False, notes: list[str] | None = None
 ) -> list[LpEntry]:
     """Read an `.lp` file tolerantly; errors and ``notes`` name the file and line (see
-    :func:`parse_lp`)."""
+    :func:`parse_lp`).
+
+    A folder, an image or a TOML file given where an `.lp` goes (``run --plan``, ``bench
+    tradeoff --from``) is said to be one: they had been told "cannot read: Is a directory",
+    "line 1: the line holds NUL bytes … save it again as UTF-8" and "line 4: expected 'name x
+    y z'"."""
     path = Path(path)
+    wanted = "give the .lp light list (a count line, then 'name x y z' per image)"
+    if path.is_dir():
+        raise LpFormatError(path, None, f"is a folder, not an .lp file: {wanted}")
     try:
         raw = path.read_bytes()
     except OSError as exc:
         raise LpFormatError(path, None, f"cannot read: {exc.strerror or exc}") from None
+    if looks_like_image(raw):
+        raise LpFormatError(path, None, f"this is an image, not an .lp file: {wanted}")
+    if path.suffix.lower() == ".toml":
+        raise LpFormatError(
+            path, None, f"this is a TOML file (a rig config?), not an .lp: {wanted}"
+        )
     return parse_lp(_decode(raw), str(path), upper_hemisphere, notes)
 
 
