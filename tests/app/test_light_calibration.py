@@ -279,7 +279,7 @@ def test_cli_refusals_name_what_is_wrong(tmp_path: Path) -> None:
 
     other = write_config(tmp_path, cfg.read_text().replace("emulated-dome-48", "other"), "o.toml")
     assert "was shot on rig 'emulated-dome-48', not 'other'" in calibrate(rig=other)
-    assert "simulated backend" in calibrate(rig=CONFIGS / "simulated_dome.toml")
+    assert "a simulated dome's LEDs are exact" in calibrate(rig=CONFIGS / "simulated_dome.toml")
     no_level = cfg.read_text().replace('profile = "default"', 'profile = "framed"')
     no_level += "\n[dome.serial.framed]\nsend_level = false\n"
     assert "cannot dim an LED" in calibrate(rig=write_config(tmp_path, no_level, "nl.toml"))

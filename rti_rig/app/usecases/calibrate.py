@@ -57,10 +57,20 @@ class CalibrationWritten:
 def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
     serial = loaded.config.dome.serial if loaded.config.dome else None
     if serial is None:
-        raise RtiRigError(
-            f"{req.rig_config}: rig '{loaded.config.name}' has no [dome.serial]: only a serial "
-            "dome can dim its LEDs (the simulated backend's are exact)"
-        )
+        # why it has none, said as it is: an arm's or a camera-triggered dome's had been told
+        # "the simulated backend's are exact", true only of a simulated dome
+        rig = f"{req.rig_config}: rig '{loaded.config.name}'"
+        if loaded.config.kind != "dome":
+            raise RtiRigError(
+                f"{rig} is an arm: calibrate-lights evens out the LEDs of a dome driven over a "
+                "serial link ([dome.serial]); an arm's lamp is one light, with nothing to even out"
+            )
+        if loaded.config.backend == "simulated":
+            why = "a simulated dome's LEDs are exact, with nothing to even out"
+        else:
+            why = "only a dome driven over a serial link can dim its LEDs"
+        raise RtiRigError(f"{rig} has no [dome.serial]: {why}")
+
     from rti_rig.drivers.led_dome.profiles import make_codec
 
     if not make_codec(serial).has_level:
