@@ -377,29 +377,38 @@ def refuse_if_in_use(root: Path, what: str) -> None:
     ``flock`` is tried and released at once; a folder this process holds is not in use by
     another (``run``'s own verdict), and one that cannot be locked (not POSIX, some network
     mounts) is read as before."""
-    try:
-        import fcntl
-    except ImportError:
-        return
-    key = str(Path(root).resolve())
-    if key in _LOCKED or not (Path(root) / MANIFEST).is_file():
-        return
-    try:
-        fd = os.open(key, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-    except BlockingIOError:
+    if in_use_by_another(root):
         raise SessionError(
             f"{root} is being captured by another rti-rig process right now (its images and "
             f"{LP_NAME} change as it goes): {what} it once that run has ended (or stop it with "
             "Ctrl-C in its terminal)"
-        ) from None
+        )
+
+
+def in_use_by_another(root: Path) -> bool:
+    """Whether another process holds session ``root`` (:func:`lock_session`), tried with a
+    shared ``flock`` released at once; ``False`` where that cannot be known (not POSIX, a
+    folder that cannot be locked) or this process holds it."""
+    try:
+        import fcntl
+    except ImportError:
+        return False
+    key = str(Path(root).resolve())
+    if key in _LOCKED or not (Path(root) / MANIFEST).is_file():
+        return False
+    try:
+        fd = os.open(key, os.O_RDONLY)
     except OSError:
-        return
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True
+    except OSError:
+        return False
     finally:
         os.close(fd)  # releases the shared lock, if it was taken
+    return False
 
 
 def unlock_session(root: Path) -> None:
@@ -478,6 +487,8 @@ class SessionFolder:
                     else ", or continue the interrupted session in it with "
                     f"rti-rig run --resume {shlex.quote(str(root))}"
                 )
+                if not finished and in_use_by_another(root):  # running, not interrupted
+                    resume = " (another rti-rig process is capturing a session in it right now)"
             raise SessionError(
                 f"{root} is not empty: refusing to write a session over existing files; "
                 f"choose a new --out folder{resume}"
