@@ -735,11 +735,17 @@ def _fit_all(
             )
         reason_line = f"{model_name}: chosen by --model"
     normal_source = _normal_source(model_name)
+    skipped: list[str] = []  # said, never silently left out
+    write_normals = req.write_normals
+    if write_normals and normal_source == "ptm":
+        normal_source, why = ptm_normal_source(lights)
+        write_normals = bool(normal_source)
+        if why:
+            skipped.append(why)
 
     # linear models to export, their solve matrices (warnings issued once, here)
     order, rti_why = rti_order(stack, lights, req, model_name, choice)
     linear: dict[str, np.ndarray] = {}
-    skipped: list[str] = []  # said, never silently left out
     if req.write_ptm and n >= 6:
         linear["ptm"] = design_matrix("ptm", lights)
         if n < PTM_MEASURED_FROM:  # written, but the user should know what it is worth
@@ -794,7 +800,7 @@ def _fit_all(
             lo, hi = exporters.coefficient_ranges(w @ obs, margin=0.5, scale=kind.display_scale)
             writers[key] = kind(out / name, stack.width, stack.height, lo, hi)
 
-        if not req.write_normals:  # the models kept only for normals are not fitted
+        if not write_normals:  # the models kept only for normals are not fitted
             normal_source = ""
             linear = {k: v for k, v in linear.items() if k in exported}
         # the last use of the sample: when nothing above read it, it is streamed, never held
@@ -803,7 +809,7 @@ def _fit_all(
         stack.forget_samples()  # planned: the sample is not needed while the bands are fitted
         release_free_memory()
         h, wd = stack.height, stack.width
-        if req.write_normals:
+        if write_normals:
             normals = MapFile(out / "normals.npy", (h, wd, 3))
             albedo_shape = (h, wd) if stack.grey else (h, wd, stack.channels)
             albedo = MapFile(out / "albedo.npy", albedo_shape)
@@ -920,6 +926,36 @@ def _normal_source(model_name: str) -> str:
     and ``--model robust-ps`` or ``--model ps`` asks for one.
     """
     return NORMALS_BY_MODEL.get(model_name, "ps-robust")
+
+
+def ptm_normal_source(lights: np.ndarray) -> tuple[str, str]:
+    """The normal maps' estimator when the PTM would give them, and what to tell the user.
+
+    The PTM's Lambertian reading is only as good as the PTM: on lights its 6 terms cannot
+    separate (one ring, where ``l_u^2 + l_v^2`` is constant; lights at the horizon; one
+    direction repeated) the ridge-regularised PTM is biased and its reading was 22-71° off on a
+    matte sphere, written as if sound. There robust photometric stereo is used if the lights
+    condition Lambert's 3 terms (0.14° on the same ring), else no normal maps are written.
+    """
+    from rti_rig.core.rti_bases import design_matrix
+    from rti_rig.reconstruct.solve import solve_matrix
+
+    _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
+    if not ptm.regularised:
+        return "ptm", ""
+    _, ps = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
+    cond = f"condition number {ptm.condition_number:.3g} over the hemisphere"
+    if not ps.regularised:
+        return "ps-robust", (
+            f"normals from robust photometric stereo, not the PTM: the PTM is ridge-regularised "
+            f"on these lights ({cond}), and its normals would be biased"
+        )
+    return "", (
+        f"normals.png/.npy and albedo not written: these lights condition neither the PTM "
+        f"({cond}) nor photometric stereo (condition number {ps.condition_number:.3g}): lights "
+        "at the horizon, at one azimuth or in one direction give no normals; add "
+        "lights at other elevations and azimuths"
+    )
 
 
 def _usable_sample(stack: ImageStack) -> np.ndarray:

@@ -1,0 +1,51 @@
+"""Normals are not read from a PTM its lights cannot determine.
+
+On one ring of lights ``l_u^2 + l_v^2`` is constant, at the horizon or one direction repeated
+the PTM's terms are not separable either: the PTM is ridge-regularised and its Lambertian
+reading had been written as the normal map, 22° off on a matte object on a ring (71° on one
+repeated direction), said only as "relighting ... not trustworthy". Photometric stereo is fine
+on a ring; on the other sets nothing gives normals, and none are written.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from tests.fit_sessions import _rings, make_session
+
+
+def _fit(session: Path, out: Path, model: str) -> str:
+    r = CliRunner().invoke(
+        app, ["fit", str(session), "--out", str(out), "--model", model, "--no-qa"]
+    )
+    assert r.exit_code == 0, r.output
+    return " ".join(r.output.split())
+
+
+def _error_deg(out: Path, truth: np.ndarray) -> float:
+    n = np.load(out / "normals.npy")
+    return float(np.degrees(np.arccos(np.clip((n * truth).sum(-1), -1, 1))).mean())
+
+
+def test_a_ring_gets_photometric_stereo_normals(tmp_path: Path) -> None:
+    session, _, truth = make_session(
+        tmp_path / "s", scene="tablet", size=(48, 48), lights=_rings(((35, 12, 0),))
+    )
+    said = _fit(session, tmp_path / "f", "ptm")
+    assert "normals from robust photometric stereo, not the PTM" in said
+    assert json.loads((tmp_path / "f" / "fit.json").read_text())["normals_from"] == "ps-robust"
+    assert _error_deg(tmp_path / "f", truth) < 5.0
+
+
+def test_one_direction_repeated_writes_no_normals(tmp_path: Path) -> None:
+    lights = np.repeat(_rings(((40, 1, 30),)), 8, axis=0)
+    session, _, _ = make_session(tmp_path / "s", scene="tablet", size=(32, 32), lights=lights)
+    said = _fit(session, tmp_path / "f", "ptm")
+    assert "normals.png/.npy and albedo not written" in said
+    assert not (tmp_path / "f" / "normals.npy").exists()
+    assert (tmp_path / "f" / "fit.ptm").exists()
