@@ -399,7 +399,7 @@ def parse_lp(
             _parse_float(t, source, lineno, axis, line)
             for t, axis in zip(tokens[-3:], "xyz", strict=True)
         )
-        norm = math.sqrt(x * x + y * y + z * z)
+        norm = math.hypot(x, y, z)  # no overflow: 1e308 squared is inf, and x / inf is 0
         if norm < MIN_NORM:
             # relight's saveLP writes '0 0 0' for an image whose light its sphere did not find
             # (it warns "Missing N light directions" and saves all the same): say so

@@ -473,3 +473,12 @@ def test_a_spreadsheets_csv_export_is_refused_saying_so(
 def test_decimal_commas_between_spaces_still_get_the_decimal_hint() -> None:
     with pytest.raises(LpFormatError, match=r"use '\.' as the decimal separator"):
         parse_lp("1\nimg01.jpg 0,205 -0,237 0,949\n", "x.lp")
+
+
+def test_a_huge_finite_vector_is_read_as_its_direction() -> None:
+    # its length had been computed as sqrt(x*x + ...), infinite for 1e308: read as (0, 0, 0),
+    # the fit then refused "light 5 has length 0.0000" naming neither file nor line
+    notes: list[str] = []
+    (e,) = parse_lp("1\na.jpg 1e308 0 1e308\n", "x.lp", notes=notes)
+    assert e.direction == pytest.approx((2**-0.5, 0.0, 2**-0.5))
+    assert "x.lp, line 2" in " ".join(notes)
