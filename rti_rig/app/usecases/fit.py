@@ -38,6 +38,7 @@ from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation
+from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
     case_hint,
     directions_of,
@@ -1011,7 +1012,7 @@ def write_qa_report(out: Path, qa: QAReport, result: FitResult) -> list[Path]:
             f"could not write {out / 'qa_coverage.png'}: check the free space and that the "
             "folder is writable, then fit again"
         )
-    (out / "qa.json").write_text(json.dumps(qa.to_json(), indent=1) + "\n", encoding="utf-8")
+    (out / "qa.json").write_text(strict_dumps(qa.to_json(), indent=1) + "\n", encoding="utf-8")
     rows = "\n".join(_qa_row(c) for c in qa.images)
     normals = '<img src="normals.png" width="320">' if (out / "normals.png").exists() else ""
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>rti-rig QA</title>
