@@ -49,3 +49,23 @@ def test_one_direction_repeated_writes_no_normals(tmp_path: Path) -> None:
     assert "normals.png/.npy and albedo not written" in said
     assert not (tmp_path / "f" / "normals.npy").exists()
     assert (tmp_path / "f" / "fit.ptm").exists()
+
+
+def test_an_hsh_fit_on_one_azimuth_is_written_without_normals(tmp_path: Path) -> None:
+    # it had been refused whole ("ill-conditioned for photometric stereo"), its normals being
+    # robust PS's; the relighting file is written regularised, as a PTM's is
+    lights = np.array(
+        [
+            (np.cos(e) * np.cos(0.5), np.cos(e) * np.sin(0.5), np.sin(e))
+            for e in np.radians(np.linspace(10, 80, 10))
+        ]
+    )
+    session, _, _ = make_session(tmp_path / "s", size=(32, 32), lights=lights)
+    said = _fit(session, tmp_path / "f", "hsh2")
+    assert "normals.png/.npy and albedo not written" in said
+    assert (tmp_path / "f" / "fit.rti").exists()
+    assert not (tmp_path / "f" / "normals.npy").exists()
+    r = CliRunner().invoke(
+        app, ["fit", str(session), "--out", str(tmp_path / "ps"), "--model", "robust-ps"]
+    )
+    assert r.exit_code == 2 and "ill-conditioned for photometric stereo" in r.output

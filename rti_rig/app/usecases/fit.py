@@ -748,8 +748,9 @@ def _fit_all(
     normal_source = _normal_source(model_name)
     skipped: list[str] = []  # said, never silently left out
     write_normals = req.write_normals
-    if write_normals and normal_source == "ptm":
-        normal_source, why = ptm_normal_source(lights)
+    if write_normals and normal_source in ("ptm", "ps-robust") and model_name != "ps-robust":
+        # the normals a relighting model brings along: robust PS is asked for by name
+        normal_source, why = conditioned_normal_source(normal_source, lights)
         write_normals = bool(normal_source)
         if why:
             skipped.append(why)
@@ -939,33 +940,40 @@ def _normal_source(model_name: str) -> str:
     return NORMALS_BY_MODEL.get(model_name, "ps-robust")
 
 
-def ptm_normal_source(lights: np.ndarray) -> tuple[str, str]:
-    """The normal maps' estimator when the PTM would give them, and what to tell the user.
+def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str]:
+    """The normal maps' estimator in place of ``source`` (``"ptm"`` or ``"ps-robust"``, the
+    estimators a relighting model brings along), and what to tell the user.
 
     The PTM's Lambertian reading is only as good as the PTM: on lights its 6 terms cannot
     separate (one ring, where ``l_u^2 + l_v^2`` is constant; lights at the horizon; one
     direction repeated) the ridge-regularised PTM is biased and its reading was 22-71° off on a
     matte sphere, written as if sound. There robust photometric stereo is used if the lights
-    condition Lambert's 3 terms (0.14° on the same ring), else no normal maps are written.
+    condition Lambert's 3 terms (0.14° on the same ring). Where they do not, no normal maps are
+    written and the relighting files are, regularised as always: a PTM fit had written 71°-off
+    normals, an HSH fit had been refused whole for its normals. ``--model ps`` or ``lambert``
+    asks for normals by name and is refused instead.
     """
     from rti_rig.core.rti_bases import design_matrix
     from rti_rig.reconstruct.solve import solve_matrix
 
-    _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
-    if not ptm.regularised:
-        return "ptm", ""
     _, ps = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
-    cond = f"condition number {ptm.condition_number:.3g} over the hemisphere"
-    if not ps.regularised:
-        return "ps-robust", (
-            f"normals from robust photometric stereo, not the PTM: the PTM is ridge-regularised "
-            f"on these lights ({cond}), and its normals would be biased"
-        )
+    if source == "ptm":
+        _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
+        if not ptm.regularised:
+            return "ptm", ""
+        if not ps.regularised:
+            return "ps-robust", (
+                "normals from robust photometric stereo, not the PTM: the PTM is "
+                f"ridge-regularised on these lights (condition number "
+                f"{ptm.condition_number:.3g} over the hemisphere), and its normals would be biased"
+            )
+    elif not ps.regularised:
+        return source, ""
     return "", (
-        f"normals.png/.npy and albedo not written: these lights condition neither the PTM "
-        f"({cond}) nor photometric stereo (condition number {ps.condition_number:.3g}): lights "
-        "at the horizon, at one azimuth or in one direction give no normals; add "
-        "lights at other elevations and azimuths"
+        "normals.png/.npy and albedo not written: these lights do not condition photometric "
+        f"stereo (condition number {ps.condition_number:.3g} over the hemisphere, limit "
+        f"{ps.cond_limit:g}): lights at the horizon, at one azimuth or in one direction give no "
+        "normals; add lights at other elevations and azimuths"
     )
 
 
