@@ -176,6 +176,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             arm_order=arm_order,
         )
     )
+    refuse_undetermined(schedule, req)
     if light_note and report.preview_light_source == "given":
         report.preview_light_source = light_note
     if req.signal_noise and not report.signal_noise:
@@ -197,6 +198,34 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
     )
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
+
+
+def refuse_undetermined(schedule: LightSchedule, req: PlanLightsRequest) -> None:
+    """Refuse a plan whose lights cannot determine a surface normal, before it is written.
+
+    Every planner picks among the rig's lights in the elevation band; where those all lie in
+    one plane (a ring at the horizon, one azimuth) any choice is coplanar. Such a plan had been
+    written with "expected RMS normal error 90.00" as its only sign, for ``rti-rig fit`` to
+    refuse its photometric stereo after the session was shot. Judged as the fit judges it
+    (:func:`rti_rig.reconstruct.solve.solve_matrix`, the condition number over the hemisphere).
+    """
+    import numpy as np
+
+    from rti_rig.core.rti_bases import design_matrix
+    from rti_rig.reconstruct.solve import solve_matrix
+
+    lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
+    _, report = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
+    if report.regularised:
+        band = f"{req.min_elevation_deg:g}°..{req.max_elevation_deg:g}°"
+        raise RtiRigError(
+            f"the {len(lights)} planned lights cannot determine a surface normal: they lie "
+            f"(nearly) in one plane (condition number {report.condition_number:.3g} over the "
+            f"hemisphere, limit {report.cond_limit:g}), and rti-rig fit would refuse them "
+            f"(lights of {req.rig} between {band} elevation all at the horizon or at one "
+            "azimuth leave no other choice). Use a rig with lights at several elevations and "
+            "azimuths, or widen --min-elevation-deg / --max-elevation-deg; nothing was written"
+        )
 
 
 def _lp_labels(labels: list[str]) -> list[str]:

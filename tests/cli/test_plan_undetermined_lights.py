@@ -1,0 +1,34 @@
+"""A plan whose lights cannot determine a normal is refused, not written.
+
+A bare .lp rig with its lights on one ring at the horizon: every choice of lights is coplanar.
+`rti-rig plan` had written the plan with "expected RMS normal error 90.00" as its only sign,
+and `rti-rig fit` refused the session shot from it ("ill-conditioned for photometric stereo").
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.lp_format import LpEntry, write_lp
+
+
+@pytest.mark.parametrize("method", ["optimal", "uniform"])
+def test_a_horizon_ring_rig_gets_no_plan(tmp_path: Path, method: str) -> None:
+    az = np.radians(np.arange(20) * 18.0)
+    rig = tmp_path / "ring.lp"
+    write_lp(
+        rig, [LpEntry(f"led_{k:02d}.jpg", (np.cos(a), np.sin(a), 0.0)) for k, a in enumerate(az)]
+    )
+    out = tmp_path / "plan.lp"
+    r = CliRunner().invoke(
+        app, ["plan", "--rig", str(rig), "--lights", "12", "--method", method, "--out", str(out)]
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "the 12 planned lights cannot determine a surface normal" in said
+    assert not out.exists()
