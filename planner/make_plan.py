@@ -112,7 +112,9 @@ def _uniform_layouts(
     for f in floors:
         try:
             if isinstance(geometry, DomeGeometry):
-                leds = select_uniform_leds(geometry, n, f, max_elevation_deg=ceiling)
+                leds = select_uniform_leds(
+                    geometry, n, f, max_elevation_deg=ceiling, fewest=MIN_PLAN_LIGHTS
+                )
                 out.append((f"uniform ≥{f:g}°", geometry.directions[leds], leds))
             else:
                 out.append((f"uniform ≥{f:g}°", geometry.homogeneous(n, f), None))

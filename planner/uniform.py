@@ -45,6 +45,7 @@ def select_uniform_leds(
     min_elevation_deg: float = 0.0,
     azimuth_offset_deg: float = 0.0,
     max_elevation_deg: float = 90.0,
+    fewest: int = 1,
 ) -> NDArray[np.intp]:
     """Indices (ascending) of ``n`` LEDs spread evenly between ``min_elevation_deg`` and
     ``max_elevation_deg``.
@@ -60,10 +61,14 @@ def select_uniform_leds(
     candidates = np.flatnonzero((el >= min_elevation_deg - 1e-9) & (el <= max_elevation_deg + 1e-9))
     if n > len(candidates):
         band = band_text(min_elevation_deg, max_elevation_deg)
-        fewer = f"use --lights {len(candidates)} or fewer" if len(candidates) else ""
+        # ``fewest``: the smallest --lights the caller takes (a plan's 3: "use --lights 1 or
+        # fewer" had been advised where --lights 1 is refused)
+        fewer = f"use --lights {len(candidates)} or fewer" if len(candidates) >= fewest else ""
         if max_elevation_deg < 90.0 or min_elevation_deg > 0:
             widen = "widen --min-elevation-deg / --max-elevation-deg"
             fewer = f"{fewer} or {widen}" if fewer else widen
+        if not fewer:  # no fewer lights will do and there is no band to widen
+            fewer = f"a plan needs at least {fewest} lights: use a rig with more"
         raise ScheduleError(
             f"asked for {n} lights but the dome has only {len(candidates)} LEDs{band}; {fewer}"
         )
