@@ -9,6 +9,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
@@ -125,6 +126,21 @@ def dome_variant(tmp_path: Path, scene: str, side: int) -> Path:
     text, n_s = re.subn(r'(?ms)(\[scene\].*?^name = )"[^"]*"', rf'\g<1>"{scene}"', text)
     assert (n_w, n_h, n_s) == (1, 1, 1), "simulated_dome.toml no longer has one width/height/scene"
     return write_config(tmp_path, text, f"{scene}_{side}.toml")
+
+
+def moved_session_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
+    """A copy of ``session`` whose images from ``first`` (1-based) on are shifted by
+    ``(dx, dy)`` px (x right, y down): the object nudged once, part-way through."""
+    import shutil
+
+    from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
+
+    shutil.copytree(session, dst)
+    for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
+        img = read_linear_tiff(f)
+        f.unlink()
+        write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
+    return dst
 
 
 def dome_session(tmp_path: Path, scene: str, side: int, lights: int) -> Path:

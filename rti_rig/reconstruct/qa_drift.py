@@ -216,6 +216,15 @@ class Step:
 
     first: int
     shift: tuple[float, float]
+    #: The share of the images whose edges were placed that sit where the step says (those
+    #: before it at the first position, those from it on at the second): how well the edges
+    #: alone bear this split out, what tells candidates apart where no fit can
+    #: (:func:`~rti_rig.reconstruct.qa._confirmed_step`).
+    agreement: float = 1.0
+    #: Where the move may have begun as early as this image (0-based, before ``first``): the
+    #: edges bear out splits from here to ``first`` alike and no fit tells them apart. None:
+    #: placed at ``first``.
+    earliest: int | None = None
 
 
 def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | None:
@@ -358,7 +367,8 @@ def step_candidates(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> It
         if la.mean() > 1 - STEP_AGREE or lb.mean() < STEP_AGREE:
             return None
         assert first is not None  # sides() refused None
-        return Step(first, (float(dx), float(dy)))
+        agreement = float(((la == 0).sum() + (lb == 1).sum()) / (la.size + lb.size))
+        return Step(first, (float(dx), float(dy)), agreement)
 
     # The first split, from the whole-pixel peaks against the median of every image; failing
     # that, against the median of the first half of the images, then of the second half

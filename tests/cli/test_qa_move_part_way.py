@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import moved_session_copy
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
 
 REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
@@ -42,18 +42,7 @@ def _verdict(session: Path, out: Path) -> dict:  # type: ignore[type-arg]
     return json.loads((out / "qa.json").read_text())
 
 
-def _moved_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
-    """A copy of ``session`` whose images from ``first`` (1-based) on are shifted by
-    ``(dx, dy)`` px (x right, y down): the object nudged once, part-way through."""
-    import shutil
-
-    shutil.copytree(session, dst)
-    files = sorted((dst / "linear").glob("image_*.tif"))
-    for f in files[first - 1 :]:
-        img = read_linear_tiff(f)
-        f.unlink()
-        write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
-    return dst
+_moved_copy = moved_session_copy
 
 
 @pytest.mark.parametrize(

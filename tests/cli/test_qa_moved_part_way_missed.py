@@ -20,16 +20,14 @@ Found by an injection sweep over correct simulated sessions (every case below wa
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import virtual_arm_variant, write_config
+from conftest import moved_session_copy, virtual_arm_variant, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
 
 REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
@@ -73,14 +71,7 @@ def _qa(session: Path, out: Path) -> dict:  # type: ignore[type-arg]
     return json.loads((out / "qa.json").read_text())
 
 
-def _moved_copy(session: Path, dst: Path, first: int, dx: int, dy: int) -> Path:
-    """``session`` with its images from ``first`` (1-based) on shifted by ``(dx, dy)`` px."""
-    shutil.copytree(session, dst)
-    for f in sorted((dst / "linear").glob("image_*.tif"))[first - 1 :]:
-        img = read_linear_tiff(f)
-        f.unlink()
-        write_linear_tiff(f, np.roll(img, (dy, dx), axis=(0, 1)))
-    return dst
+_moved_copy = moved_session_copy
 
 
 def test_the_move_is_named_from_its_first_image(case, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
