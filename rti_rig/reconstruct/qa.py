@@ -50,6 +50,7 @@ from rti_rig.reconstruct.qa_directions import (
     consensus_images,
     recorded_misfit,
     relative_misfit,
+    swapped_pairs,
 )
 from rti_rig.reconstruct.qa_drift import (
     CHANGE_MIN_BLOCK,
@@ -1239,6 +1240,12 @@ def assess(
                     f"{what}: {ev.neighbour_ratio[i]:.0%} of the brightness of the images of "
                     f"its {NEIGHBOUR_COUNT} nearest lights (against the same prediction)"
                 )
+        elif wrong_i and np.isfinite(ev.swap_ratio[i]):
+            problems.append(
+                f"wrong light: rendered {ev.swap_ratio[i]:.1f}× closer under the light "
+                f"recorded for {names[int(ev.near[i])]} than under its own, as that image is "
+                "under this one's (swapped?)"
+            )
         elif wrong_i:
             problems.append(
                 f"wrong light: lit from {ev.err[i]:.0f}° away from its recorded direction "
@@ -1403,6 +1410,9 @@ class _Evidence:
     object_typical: float = float("nan")
     #: Each image's gain on the pixels the fit explains (:func:`_reliable_gains`).
     reliable_gain: NDArray = field(default_factory=lambda: np.zeros(0))
+    #: Of an image called wrong as one of a swapped pair (:func:`swapped_pairs`): how many times
+    #: closer the other's recorded light renders it than its own; NaN otherwise.
+    swap_ratio: NDArray = field(default_factory=lambda: np.zeros(0))
 
 
 def _evidence(
@@ -1658,6 +1668,39 @@ def _evidence(
                 f"{WRONG_LIGHT_MISFIT_RATIO:g}× the best direction's: on this object gloss, "
                 "shadows or clipping pull the best direction); not called wrong",
             )
+    swap_ratio = np.full(n, np.nan)
+    if not judged.any() and spread_deg >= MIN_NORMAL_SPREAD_DEG:
+        # no direction judged by its angle: a swapped pair may still be plain (swapped_pairs)
+        raws = [crop_arr[i].ravel() for i in range(n)]
+        usable_raw = [vflat & ~crop_sat[i].ravel() & (raws[i] > dark) for i in range(n)]
+        pairs = swapped_pairs(
+            bflat,
+            raws,
+            usable_raw,
+            lt,
+            ~dead & ~blinded & np.isfinite(misfit),
+            best,
+            misfit,
+            WRONG_LIGHT_MISFIT_RATIO,
+        )
+        for i, j, r_i, r_j in pairs:
+            for a, other, r in ((i, j, r_i), (j, i, r_j)):
+                wrong[a] = judged[a] = True
+                near[a], swap_ratio[a] = other, r
+                # its shift is measured against the light that lit it, as a wrong light's
+                pred = rho * np.maximum(ps.normals @ lt[other].astype(np.float32), 0.0)
+                dx, dy = drift_of(pred, crop_arr[a])
+                mv = bool(drift_judged[a] and np.hypot(dx, dy) > DRIFT_PX)
+                if mv:
+                    mv = _confirmed_shift(pred, crop_arr[a], dx, dy, valid & ~crop_sat[a])[0]
+                moved[a], drift[a] = mv, (dx, -dy)
+        if pairs:
+            note = _and_note(
+                note,
+                "a swapped pair is still named where each image is rendered clearly closer "
+                f"(over {WRONG_LIGHT_MISFIT_RATIO:g}×) under the other's recorded light than "
+                "under its own",
+            )
     return _Evidence(
         gain,
         lit_gain,
@@ -1680,6 +1723,7 @@ def _evidence(
         unjudged | nb_dark,
         object_typical,
         rel_gain,
+        swap_ratio,
     )
 
 

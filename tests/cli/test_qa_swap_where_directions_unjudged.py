@@ -1,0 +1,65 @@
+"""Two swapped images are named as a swap even on an object whose light directions cannot be
+judged by their angle, and not as the object moving.
+
+Found by a truth-table campaign: the simulated dome's industrial part (brushed steel), 24
+lights, images 2 and 3 swapped (two 10° lights 144° apart): at 1024 px the verdict said the
+object moved from image_005 on by (-1.1, -8.3) px (a block of four images whose shifts against
+the fit wander, split off by qa._moved_block), at 512 px it named neither image. Its images
+point too far from their lights to judge any by its angle; each swapped image is rendered
+4-8× closer under the other's recorded light than under its own (qa_directions.swapped_pairs).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import dome_session
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def _qa(session: Path, out: Path) -> dict:  # type: ignore[type-arg]
+    r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh"])
+    assert r.exit_code == 0, r.output
+    assert "QA verdict:" in " ".join(r.output.split()), r.output
+    return json.loads((out / "qa.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def industrial(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return dome_session(tmp_path_factory.mktemp("industrial"), "industrial", 512, 24)
+
+
+def _wrong(qa: dict) -> dict[str, str]:  # type: ignore[type-arg]
+    return {
+        c["name"]: p for c in qa["images"] for p in c["problems"] if p.startswith("wrong light")
+    }
+
+
+def test_a_swapped_pair_is_said_as_a_swap(industrial: Path, tmp_path: Path) -> None:
+    session = tmp_path / "swapped"
+    shutil.copytree(industrial, session)
+    a, b = session / "linear" / "image_002.tif", session / "linear" / "image_003.tif"
+    a.rename(session / "x.tif")
+    b.rename(a)
+    (session / "x.tif").rename(b)
+    qa = _qa(session, tmp_path / "f")
+    verdict = qa["verdict"]
+    wrong = _wrong(qa)
+    assert sorted(wrong) == ["image_002", "image_003"], verdict
+    assert "recorded for image_003" in wrong["image_002"], verdict
+    assert "recorded for image_002" in wrong["image_003"], verdict
+    assert all("(swapped?)" in p for p in wrong.values()), verdict
+    assert "moved" not in verdict, verdict
+
+
+def test_the_correct_session_has_no_swap(industrial: Path, tmp_path: Path) -> None:
+    qa = _qa(industrial, tmp_path / "f")
+    assert not _wrong(qa), qa["verdict"]
+    assert "swapped" not in qa["verdict"], qa["verdict"]
