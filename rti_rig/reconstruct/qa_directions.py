@@ -175,13 +175,16 @@ def swapped_pairs(
     scored = []
     for a, i in enumerate(suspects):
         for j in suspects[a + 1 :]:
+            # first the directions (a dot product each), then the renderings (a pass over the
+            # crop each): most pairs of a correct session fail the first
+            crossed = lights[j] @ best[i] > lights[i] @ best[i]
+            if not (crossed and lights[i] @ best[j] > lights[j] @ best[j]):
+                continue
             m_ij, s_ij = recorded_rendering(b, images[i], usables[i], lights[j])
             m_ji, s_ji = recorded_rendering(b, images[j], usables[j], lights[i])
             # a swap exchanges directions, not LED output or exposure
             level = all(1 / SWAP_LEVEL_SPAN <= v <= SWAP_LEVEL_SPAN for v in (s_ij, s_ji))
-            crossed = lights[j] @ best[i] > lights[i] @ best[i]
-            crossed &= lights[i] @ best[j] > lights[j] @ best[j]
-            if level and crossed and own[i] > ratio * m_ij and own[j] > ratio * m_ji:
+            if level and own[i] > ratio * m_ij and own[j] > ratio * m_ji:
                 gain = (own[i] + own[j]) / (m_ij + m_ji)
                 scored.append((gain, i, j, own[i] / m_ij, own[j] / m_ji))
     taken: set[int] = set()
