@@ -28,6 +28,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import TypeVar
 
 import numpy as np
@@ -266,36 +267,7 @@ class DomePolicy:
                 self.reached = "answered"
             elif exc.command != "open port":
                 self.reached = "opened"
-            if exc.command == "open port" and not self._port_was_open:
-                # Nothing was ever sent: say so, not "all-off failed, lights may be on".
-                self.off_report = OffReport(
-                    OffOutcome.NEVER_OPENED, exc.message, port_held=exc.port_held
-                )
-            elif (
-                exc.command == "open port"
-                and self._lit is None
-                and self.off_report is not None
-                and self.off_report.lights_known_off
-            ):
-                # Open before (metering, then the session) and switched off with an
-                # established all-off since: nothing was sent after it, so that still holds.
-                pass
-            elif exc.fault is LinkFault.FOREIGN:
-                # another firmware's board: this profile's all-off is other keys to it, that
-                # firmware's own all-off is not (a Nab board boots with every LED on)
-                self._port_was_open = True
-                self._switch_off_foreign("after the board was refused")
-            else:
-                if exc.command != "open port":
-                    self._port_was_open = True
-                # A board that answered nothing we understood may still be lit (one sketch
-                # boots with every LED on): send the all-off anyway wherever the port is open.
-                self._attempt_off(
-                    f"after the failed connection ({exc.message})",
-                    after_open=True,
-                    at_published_rate=not answered,
-                )
-            self._quiet_close()
+            self._switch_off_then_close(partial(self._off_after_failed_connect, exc, answered))
             if exc.command == "open port" and exc.port_held:
                 # the board is there and may be lit by the program using it: "check that the
                 # board is plugged in" beside "switch it off at its power supply" had sent a
@@ -348,11 +320,7 @@ class DomePolicy:
             # the handshake: the port is open and a board may boot lit, so the all-off is
             # sent before the stop goes on (it had been told "the dome was never reached"
             # with every LED of a board that boots lit still on)
-            try:
-                with signals_deferred():
-                    self._switch_off_after_stop()
-            finally:
-                self._quiet_close()
+            self._switch_off_then_close(self._switch_off_after_stop)
             raise
         self._port_was_open = True
         # a firmware without a handshake has shown nothing yet (its first reply will), unless
@@ -367,8 +335,9 @@ class DomePolicy:
         self.reached = "answered" if answered else "opened"
         problem = self._check_identity(info)
         if problem:
-            self._attempt_off("after the identity check failed")
-            self._quiet_close()
+            self._switch_off_then_close(
+                lambda: self._attempt_off("after the identity check failed")
+            )
             raise DeviceError(self.name, problem, "handshake")
         self.info = info
         self._lit = None
@@ -401,6 +370,39 @@ class DomePolicy:
             # baud and profile advice at the first light's garbled reply
             self._answered = answered
         self.reached = "ready"
+
+    def _off_after_failed_connect(self, exc: DomeLinkError, answered: bool) -> None:
+        """The all-off after a connect that failed with ``exc`` (``answered``: the board spoke
+        its profile), or what stands without one; run by :meth:`_switch_off_then_close`."""
+        if exc.command == "open port" and not self._port_was_open:
+            # Nothing was ever sent: say so, not "all-off failed, lights may be on".
+            self.off_report = OffReport(
+                OffOutcome.NEVER_OPENED, exc.message, port_held=exc.port_held
+            )
+        elif (
+            exc.command == "open port"
+            and self._lit is None
+            and self.off_report is not None
+            and self.off_report.lights_known_off
+        ):
+            # Open before (metering, then the session) and switched off with an
+            # established all-off since: nothing was sent after it, so that still holds.
+            pass
+        elif exc.fault is LinkFault.FOREIGN:
+            # another firmware's board: this profile's all-off is other keys to it, that
+            # firmware's own all-off is not (a Nab board boots with every LED on)
+            self._port_was_open = True
+            self._switch_off_foreign("after the board was refused")
+        else:
+            if exc.command != "open port":
+                self._port_was_open = True
+            # A board that answered nothing we understood may still be lit (one sketch
+            # boots with every LED on): send the all-off anyway wherever the port is open.
+            self._attempt_off(
+                f"after the failed connection ({exc.message})",
+                after_open=True,
+                at_published_rate=not answered,
+            )
 
     def _connect_link(self) -> DomeInfo:
         """Open the port and handshake (see :meth:`_open_and_handshake` for the resends); a port
@@ -997,6 +999,22 @@ class DomePolicy:
             return op()
         finally:
             self.clock.sleep(max(0.0, self._link_clock.now() - t0))
+
+    def _switch_off_then_close(self, switch_off: Callable[[], None]) -> None:
+        """``switch_off()`` with further SIGINT/SIGTERM held until it is through, then the port
+        closed, whatever happened.
+
+        Why: an all-off after a connect that failed or was stopped may first reopen the port
+        (at the firmware's published rate, or after a stop inside the opening), which resets a
+        board that resets on open, and the Nab sketch then boots with every LED lit. A Ctrl-C
+        during that boot wait (about 7 s with the Nab profile) had cut the all-off short and
+        left the board, reset by our own reopen, lit whole; the signal now acts once the
+        all-off is through."""
+        try:
+            with signals_deferred():
+                switch_off()
+        finally:
+            self._quiet_close()
 
     def _switch_off_after_stop(self) -> None:
         """The all-off after a stop cut :meth:`connect` short, once the board has booted (the

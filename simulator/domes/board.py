@@ -171,6 +171,18 @@ class Board:
             self._advance(self.clock.now())
             return self._lit
 
+    def lit_once_booted(self) -> frozenset[int]:
+        """LEDs lit once a boot under way is over (the firmware run to the end of its
+        bootloader, or up to now if later), with nothing more sent to it.
+
+        Why: a board still in its bootloader has every pin low, so :attr:`lit` reads empty
+        for a Nab board that a late opening reset and nobody switched off: it lights every LED
+        in ``setup()`` the moment it leaves the bootloader. What a test of "the dome was left
+        dark" must read, once the host has closed the port."""
+        with self._lock:
+            self._advance(max(self.clock.now(), self._boot_until))
+            return self._lit
+
     def lit_at(self, t: float) -> frozenset[int]:
         with self._lock:
             state = frozenset[int]()

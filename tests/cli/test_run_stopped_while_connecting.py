@@ -48,3 +48,53 @@ def test_a_second_ctrl_c_while_the_interrupted_connect_switches_off_waits_for_it
     (board,) = emulators
     assert any(what == "boot" for _, what in board.events)
     assert board.lit == frozenset()  # the truth: booted lit, then switched off
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_ctrl_c_while_a_failed_connect_reopens_at_the_published_rate_waits_for_its_all_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``baudrate = 115200`` on the Nab board (9600): the connect fails, and the port is reopened
+    at 9600 to send the all-off, which resets the board (lit whole while it boots). One Ctrl-C
+    as that reopening opens the port had cut the all-off short: exit 130, the board reset by
+    our own reopen and never switched off, the user told to cut its supply. The Ctrl-C is now
+    held until the all-off is through, then acted on. A real SIGINT, raised at that point."""
+    from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1
+    from rti_rig.drivers.led_dome.transport import SerialTransport
+    from rti_rig.simulator.domes.nab_rti_v1 import NabRtiV1Board
+
+    emulators = emulators_built_by_check(monkeypatch)
+    real_open = SerialTransport.open
+    stops: list[int] = []
+
+    def open_port(self):  # type: ignore[no-untyped-def]
+        real_open(self)
+        if self.baudrate == 9600 and not stops:  # the reopening at the published rate
+            stops.append(signal.SIGINT)
+            signal.raise_signal(signal.SIGINT)
+
+    monkeypatch.setattr(SerialTransport, "open", open_port)
+    text = (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
+    text = text.replace('profile = "nab-rti-v1"', 'profile = "nab-rti-v1"\nbaudrate = 115200')
+    # short waits, so that the test is (each boot and wait is spent twice, in real time): a
+    # quicker bootloader than the Uno's 1.6 s, a boot wait past it and the banner, and the
+    # all-off's reply timeout (1 s in the profile) at 0.5 s, where a booted board at the right
+    # rate answers within 30 ms and one at the wrong rate never does
+    monkeypatch.setattr(NabRtiV1Board, "boot_s", 0.4)
+    monkeypatch.setitem(nab_rti_v1.ALL_OFF["reply"], "timeout_s", 0.5)
+    text = text.replace("reply_timeout_s = 3.0", "reply_timeout_s = 0.5")
+    text = text.replace("led_count = 12", "led_count = 12\nboot_wait_s = 0.9")
+    cfg = tmp_path / "rig.toml"
+    cfg.write_text(text)
+    out = tmp_path / "session"
+    r = CliRunner().invoke(
+        app, ["run", str(cfg), "--auto-exposure", "--out", str(out)], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert stops and r.exit_code == 130, said
+    assert "Traceback" not in said
+    assert "reopened at 9600 baud" in said and "was acknowledged: lights are off" in said, said
+    assert "power supply" not in said, said
+    (board,) = emulators
+    assert [what for _, what in board.events].count("boot") == 2  # our reopen reset it
+    assert board.lit_once_booted() == frozenset()  # booted lit, then switched off
