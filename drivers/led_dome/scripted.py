@@ -300,11 +300,9 @@ class ScriptedDomeDriver:
         self._booted = self._boot_heard = False
         self.foreign_firmware = None
         self._foreign_off = None
-        # the boot wait is counted from before the opening: a stop just after it then finds
-        # the deadline of this opening, not an earlier one's (its all-off would be lost in the
-        # bootloader)
-        self._opened_at = self.transport.clock.now()
-        self._boot_deadline = self._opened_at + self.spec.boot_wait_s
+        # counted from before the opening too: a stop inside it then finds the deadline of
+        # this opening, not an earlier one's (its all-off would be lost in the bootloader)
+        self._start_boot_wait()
         try:
             self.transport.open()
         except TransportError as exc:
@@ -315,6 +313,15 @@ class ScriptedDomeDriver:
         self._open = True
         self._rx.clear()
         self.open_cut_short = False
+        # and again once open: the board resets as the open completes, and a slow open (a USB
+        # adapter that takes its time) had eaten into the boot wait, the first bytes then sent
+        # into the bootloader
+        self._start_boot_wait()
+
+    def _start_boot_wait(self) -> None:
+        """Count the profile's boot wait (and the slow-boot measure) from now."""
+        self._opened_at = self.transport.clock.now()
+        self._boot_deadline = self._opened_at + self.spec.boot_wait_s
 
     def finish_boot(self) -> None:
         """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same
