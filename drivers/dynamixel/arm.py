@@ -76,7 +76,9 @@ class RebootOutcome:
         who = f"servo {self.servo_id} ({self.role})"
         if not self.status_before:
             return f"{who}: no hardware fault (Hardware Error Status 0x00): not rebooted"
-        faults = _fault_names(self.status_before)
+        # " overload" etc.; nothing for a status with only bits the e-manual names no fault
+        # for (0x02): "hardware fault  (0x02)" had been said
+        faults = f" {_fault_names(self.status_before)}".rstrip()
         if not self.rebooted:
             # its cause first: a power cycle alone, on the supply that faulted it (an input-
             # voltage error is the one the XL430's Shutdown leaves torque on for), faults it
@@ -84,8 +86,9 @@ class RebootOutcome:
             cause = "; ".join(
                 ct.FAULT_ADVICE[f] for f in ct.decode_hardware_error(self.status_before)
             )
+            cause = cause or "fix the fault's cause"  # no named fault: no advice of its own
             return (
-                f"{who}: hardware fault {faults} (0x{self.status_before:02X}) but its torque "
+                f"{who}: hardware fault{faults} (0x{self.status_before:02X}) but its torque "
                 "is on (it still holds its joint): NOT rebooted, as a reboot switches torque "
                 f"off and the joint would drop; {cause}, then support the arm and switch the "
                 "servos' power off and on (that clears the fault, and the joint goes limp), "
@@ -94,12 +97,12 @@ class RebootOutcome:
         assert self.status_after is not None
         if self.status_after:
             return (
-                f"{who}: hardware fault {faults} (0x{self.status_before:02X}); rebooted, but "
+                f"{who}: hardware fault{faults} (0x{self.status_before:02X}); rebooted, but "
                 f"it is still set (Hardware Error Status 0x{self.status_after:02X}): its cause "
                 "remains (see the advice rti-rig check gives for it)"
             )
         return (
-            f"{who}: hardware fault {faults} (0x{self.status_before:02X}); rebooted, Hardware "
+            f"{who}: hardware fault{faults} (0x{self.status_before:02X}); rebooted, Hardware "
             "Error Status read back 0x00, torque "
             + ("ON as read (unexpected)" if self.torque_on else "off (the joint is limp)")
         )
