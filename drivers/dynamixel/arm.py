@@ -136,9 +136,12 @@ class DynamixelArm:
         self.ever_connected = False
         self._lamp_on = False
         self._emergency_stopped = False
-        #: ``release_on_close`` switched the torque off at the last close (see
+        #: ``release_on_close`` sent the torque-off at the last close (see
         #: :meth:`torque_release_note`).
         self.torque_released = False
+        #: Torque Enable as read back after that torque-off: the servos still holding, and
+        #: those that did not answer the read (both empty: every servo read back off).
+        self._torque_after_release: tuple[list[Any], list[Any]] = ([], [])
         self._goal: tuple[int, int] | None = None
         #: The ticks read when the last move ended in position: the pose whose direction the
         #: capture that follows is recorded under, which :meth:`check_held` compares with.
@@ -184,6 +187,7 @@ class DynamixelArm:
             raise
         self._connected = self.ever_connected = True
         self.torque_released = False
+        self._torque_after_release = ([], [])
         self._lamp_on = False
         self._emergency_stopped = False
         self._goal = self.joint_ticks()  # multi-turn choices start from where the arm is
@@ -477,15 +481,9 @@ class DynamixelArm:
         the next connect refuses the pose (a wider keep-out cone in the config, say): a user
         told the torque was off pushed against servos holding under torque. And ``home`` runs
         this check on a connected arm, torque on."""
-        on, unknown = [], []
-        for joint in self.settings.joints:
-            try:
-                if self._bus.read(joint.servo_id, ct.TORQUE_ENABLE, check_alert=False):
-                    on.append(joint)
-            except DynamixelError:
-                unknown.append(joint)
+        on, unknown = self._torque_as_read()
         if on:
-            held = ", ".join(f"servo {j.servo_id} ({self._role(j)})" for j in on)
+            held = self._servos_named(on)
             return (
                 f"(its torque is ON, as read: {held} still holding, e.g. since an earlier "
                 "session with torque_policy = 'hold'; switch the servos' power off and on, "
@@ -497,6 +495,20 @@ class DynamixelArm:
                 "(whether its torque is off could not be read: switch the servos' power off first)"
             )
         return "(its torque is off, as read)"
+
+    def _torque_as_read(self) -> tuple[list[Any], list[Any]]:
+        """The joints whose servo reads Torque Enable on, and those whose read failed."""
+        on, unknown = [], []
+        for joint in self.settings.joints:
+            try:
+                if self._bus.read(joint.servo_id, ct.TORQUE_ENABLE, check_alert=False):
+                    on.append(joint)
+            except DynamixelError:
+                unknown.append(joint)
+        return on, unknown
+
+    def _servos_named(self, joints: list[Any]) -> str:
+        return ", ".join(f"servo {j.servo_id} ({self._role(j)})" for j in joints)
 
     def close(self) -> None:
         """Lamp off, motion stopped (torque policy applied), port released — the arm is not moved.
@@ -544,6 +556,8 @@ class DynamixelArm:
         ):
             self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
             self.torque_released = True
+            # a broadcast write gets no status reply: whether each servo let go is read back
+            self._torque_after_release = self._torque_as_read()
         else:
             log.warning(
                 "%s: not at the park pose, so torque stays on (release_on_close releases only "
@@ -552,28 +566,39 @@ class DynamixelArm:
             )
 
     def torque_release_note(self) -> str | None:
-        """What a user must know of an arm whose last close released its torque at the park
-        pose (None when it did not): the park pose is not held.
+        """What a user must know of an arm whose last close sent its torque-off at the park
+        pose (None when it did not): the park pose is not held, and whether each servo was
+        read back limp.
 
         Why: the check said "parked" and no more, while the limp elevation joint, back-driven
-        by the lamp's weight, may sink from the park pose towards its lower stop (the emulator
-        models a 10 °/s fall); a user leaving the lamp over the object took "parked" for a
-        pose the arm keeps."""
+        by the lamp's weight, may sink from the park pose; how far is the arm's mechanics (its
+        min_deg is a software limit, which a limp joint does not keep: it falls to a mechanical
+        stop, if the arm has one). And the torque-off is a broadcast write, which no servo
+        answers: "the joints are limp" is said only of servos that read Torque Enable 0."""
         if not self.torque_released:
             return None
         s = self.settings
-        low = s.elevation.min_deg
+        on, unknown = self._torque_after_release
+        policy = 'torque_policy = "release_on_close"'
+        if on:
+            return (
+                f"torque-off sent ({policy}), but Torque Enable reads back ON from "
+                f"{self._servos_named(on)}: that joint still holds (the torque-off, a "
+                "broadcast no servo answers, did not reach it); to release it, support the "
+                "arm and switch the servos' power off and on"
+            )
         said = (
-            'torque then released (torque_policy = "release_on_close"): the joints are limp '
-            "and hold no pose"
+            f"torque-off sent ({policy}), Torque Enable not read back from "
+            f"{self._servos_named(unknown)}: the joints may be limp and may hold no pose"
+            if unknown
+            else f"torque then released ({policy}, read back off on each servo): the joints "
+            "are limp and hold no pose"
         )
-        if s.park_elevation_deg <= low:
-            return f"{said}; the lamp rests at its lower limit ({low:g}° elevation)"
         return (
-            f"{said}: the lamp's weight may lower the elevation joint from "
-            f"{s.park_elevation_deg:g}° towards its lower limit ({low:g}°) or its stop; to "
-            f'keep it where it parked, set torque_policy = "hold", or park it where it '
-            f"rests (park_elevation_deg = {low:g} in [arm.dynamixel])"
+            f"{said}; the lamp's weight may lower the elevation joint from its park pose "
+            f"({s.park_elevation_deg:g}°), past its lower limit (min_deg = "
+            f"{s.elevation.min_deg:g}°, a software limit a limp joint does not keep), until the "
+            'arm meets a mechanical stop; to keep it where it parked, set torque_policy = "hold"'
         )
 
     def __enter__(self) -> DynamixelArm:
