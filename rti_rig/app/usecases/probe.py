@@ -66,9 +66,10 @@ class ProbeResult:
                 'cannot be identified by probing: set profile = "rti-dome-m" yourself, or '
                 "describe the firmware (docs/domes.md). A nichlock board set to 300 baud in its "
                 'settings menu is not listened for: profile = "nichlock" with baudrate = 300. '
-                "A servo arm's port (Dynamixel servos) answers none of these probes either: "
-                "servos answer only their own packets, which probe does not send (their bytes "
-                "could be commands to a dome); for an arm, run rti-rig check on its rig config."
+                "If this is a servo arm's port (Dynamixel servos), silence is all probe can "
+                "hear there: servos answer only their own packets, which probe does not send "
+                "(their bytes could be commands to a dome); for an arm, run rti-rig check on "
+                "its rig config."
             )
         else:
             out.append(f"Found: {self.profile}. Rig-config lines to use:")
