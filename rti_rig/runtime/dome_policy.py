@@ -1148,8 +1148,11 @@ class DomePolicy:
         Why: a board of a firmware that boots lit prints its banner at every opening (the Nab
         sketch's ``setup()``), and at a wrong baud rate that banner still comes, as garbled
         bytes; a port that sent not one byte through the boot wait, the resent handshake and
-        the all-off had no such board booting on it. Reopening it cost a second boot wait and
-        reply timeout (7 s with the Nab profile) for an all-off nothing could receive."""
+        the all-off had no such board booting on it within the boot wait. Reopening it cost a
+        second boot wait and reply timeout (7 s with the Nab profile) for an all-off that would
+        reach nothing booted in time. It is said as the connect's advice (the link's
+        ``silence_hint``) says it: a board slower to boot than the wait is silent through it
+        too (the lights line had said no board was there, beside that advice)."""
         rate = getattr(self.link, "published_baudrate", None)
         if rate is None or self.off_report is None:
             return
@@ -1158,9 +1161,10 @@ class DomePolicy:
             report,
             detail=(
                 f"{report.detail}; not reopened at {rate} baud, the {firmware} firmware's "
-                "published rate: not one byte came from the port since it opened, where that "
-                "firmware's board prints its boot banner at every opening, garbled at a wrong "
-                "baud rate"
+                "published rate: not one byte came from the port since it opened, and that "
+                "firmware's board prints its boot banner at every opening (garbled at a wrong "
+                "baud rate), so none booted within the boot wait: this is another port, or a "
+                "board slower to boot than boot_wait_s (see the connect's advice)"
             ),
         )
 

@@ -115,4 +115,7 @@ def test_a_port_silent_at_the_wrong_rate_is_not_reopened_at_the_published_one(
     assert r.exit_code == 1, said
     assert opened_at == [115200], opened_at  # once, at the configured rate
     assert "not reopened at 9600 baud" in said and "not one byte came from the port" in said
+    # the lights line and the connect's advice agree: a slow bootloader is silent too
+    assert "a board slower to boot than boot_wait_s (see the connect's advice)" in said, said
+    assert "if the board is slow to boot, raise boot_wait_s" in said, said
     assert "switch the dome off at its power supply" in said, said
