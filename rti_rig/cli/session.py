@@ -172,8 +172,11 @@ def run(
 
     Ctrl-C once stops after the current image (before it, its light left off, while a busy
     camera is awaited in the dark); Ctrl-C twice or SIGTERM stops at once (lights off, arm
-    stopped, and parked if the config says park_on_emergency_stop = true); SIGUSR1 pauses or
-    resumes between images. An interrupted session can be continued with --resume.
+    stopped, and parked if the config says park_on_emergency_stop = true). A stop while the
+    dome connects first switches the dome off, once its board has booted (a few seconds; a
+    further Ctrl-C waits for it): opening its port may have reset a board that boots lit.
+    SIGUSR1 pauses or resumes between images. An interrupted session can be continued with
+    --resume.
     """
     from rti_rig.app.usecases.session import (
         NewSessionRequest,

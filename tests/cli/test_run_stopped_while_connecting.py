@@ -98,3 +98,13 @@ def test_a_ctrl_c_while_a_failed_connect_reopens_at_the_published_rate_waits_for
     (board,) = emulators
     assert [what for _, what in board.events].count("boot") == 2  # our reopen reset it
     assert board.lit_once_booted() == frozenset()  # booted lit, then switched off
+
+
+def test_run_help_says_a_stop_while_connecting_first_switches_the_dome_off() -> None:
+    """``--help`` had said only "Ctrl-C twice or SIGTERM stops at once", while a stop during the
+    dome's connect waits for the all-off (docs/domes.md)."""
+    r = CliRunner().invoke(app, ["run", "--help"], terminal_width=400)
+    said = " ".join(r.output.replace("│", " ").split())
+    assert r.exit_code == 0, said
+    assert "A stop while the dome connects first switches the dome off" in said, said
+    assert "a further Ctrl-C waits for it" in said, said
