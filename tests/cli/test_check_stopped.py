@@ -141,4 +141,4 @@ def test_a_ctrl_c_inside_the_opening_of_the_nab_port_still_switches_the_board_of
     assert "Check stopped (Ctrl-C): all-off sent and acknowledged by the dome" in said, said
     (board,) = emulators
     assert any(what == "boot" for _, what in board.events)  # the opening did reset it
-    assert board.lit == frozenset()  # booted lit, then switched off
+    assert board.lit_once_booted() == frozenset()  # booted lit, then switched off

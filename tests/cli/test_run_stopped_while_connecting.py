@@ -47,7 +47,7 @@ def test_a_second_ctrl_c_while_the_interrupted_connect_switches_off_waits_for_it
     assert "power supply" not in said
     (board,) = emulators
     assert any(what == "boot" for _, what in board.events)
-    assert board.lit == frozenset()  # the truth: booted lit, then switched off
+    assert board.lit_once_booted() == frozenset()  # the truth: booted lit, then switched off
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")

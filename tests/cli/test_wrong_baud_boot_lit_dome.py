@@ -63,7 +63,7 @@ def test_a_nab_board_at_a_wrong_baud_rate_is_switched_off_at_its_published_rate(
     assert "power supply" not in said
     # the truth: booted twice (lit whole each time), and dark at the end
     assert [what for _, what in board.events].count("boot") == 2
-    assert board.lit == frozenset()
+    assert board.lit_once_booted() == frozenset()
 
 
 def test_a_board_silent_at_both_rates_is_still_said_to_be_lit_whole(

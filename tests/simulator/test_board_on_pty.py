@@ -118,3 +118,27 @@ def test_a_node_that_cannot_be_watched_falls_back_on_the_hang_up(monkeypatch) ->
         serial.Serial(link.port, 9600, timeout=0.1) as port,
     ):
         assert read_until(port, NAB_BANNER_END).endswith(NAB_BANNER_END)
+
+
+def test_an_open_unread_when_the_server_stops_still_resets_the_board(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """A host that opened and closed the port just before the emulator was stopped (a stop
+    inside pyserial's open, the rig then closed): the open, not yet read by the server's loop,
+    still resets the board, as DTR rising resets a real one. The Nab board then boots with every
+    LED lit; read once its bootloader is over (``lit`` reads empty while it is in it, as for a
+    board that was never opened). The server is stopped before it runs, so the open is unread."""
+    import os
+    import threading
+
+    from rti_rig.simulator.pty_link import _Server
+
+    board = board_for("nab-rti-v1")
+    stop = threading.Event()
+    stop.set()
+    server = _Server(board, tmp_path / "tty-nab", stop)
+    server.new_pty()
+    assert server.watch.available  # inotify, on Linux: every open is seen
+    fd = os.open(tmp_path / "tty-nab", os.O_RDWR | os.O_NOCTTY)  # the host's open and close
+    os.close(fd)
+    server.run()  # the loop ends at once: the open was never read by it
+    assert boots(board) == 1
+    assert board.lit_once_booted() == frozenset(range(board.led_count))  # never sent the all-off
