@@ -736,7 +736,9 @@ class DynamixelArm:
         """Torque off on every servo now (one broadcast packet, no reply to wait for).
 
         Use when the bus may be unreliable or the arm is hitting something: the arm goes limp
-        and may drop under gravity, which is why ``stop`` (hold) is the normal safe stop."""
+        and may drop under gravity, which is why ``stop`` (hold) is the normal safe stop. A
+        broadcast gets no status reply, so limp is what was sent, not what was read back: a
+        lost packet leaves a joint held (``release_on_close`` reads Torque Enable back)."""
         self._emergency_stopped = True
         self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
         if self.settings.lamp == "servo_led":
