@@ -627,11 +627,22 @@ def run_session(
             # The record is counted inside the hold too: a stop that acted before the count
             # left the manifest's steps_done_this_run one short of the images this run wrote
             with signals_deferred():
-                record = folder.write_step(i, frame, fields)
+                late: SessionWriteError | None = None
+                try:
+                    record = folder.write_step(i, frame, fields)
+                except SessionWriteError as exc:
+                    # its journal line or lights.lp failed after its record file, the commit:
+                    # the step is kept, and had gone uncounted (progress 2/8, the manifest's
+                    # steps_done_this_run 2, "3 image(s) kept")
+                    if exc.committed is None:
+                        raise
+                    record, late = exc.committed, exc
                 records.append(record)
                 # said inside the hold too: a stop acting before it left the progress bar one
                 # short of the images kept ("4/10", then "5 image(s) in the session")
                 emit(StepCompleted(i, total, record))
+                if late is not None:
+                    raise late
             if source is not None:
                 source.observe(i, frame, record)
             layout = layout or got

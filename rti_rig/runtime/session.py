@@ -172,6 +172,9 @@ class SessionWriteError(SessionError):
         import errno as _errno
 
         self.path = Path(path)
+        #: the step this write came after the commit of (its journal line or ``lights.lp``
+        #: failed once its record file was on disk): kept, and to be counted as such
+        self.committed: StepRecord | None = None
         self.errno_name = _errno.errorcode.get(exc.errno or 0, "") if exc.errno else ""
         reason = exc.strerror or str(exc)
         code = f" ({self.errno_name})" if self.errno_name else ""
@@ -647,14 +650,14 @@ class SessionFolder:
     def write_step(self, index: int, frame: Frame, record_fields: dict[str, Any]) -> StepRecord:
         """Write one captured frame (linear TIFF, then sRGB JPEG), then journal it.
 
-        The journal line is the commit point: a step is done only once its line is on disk, and
-        its checksums prove the files are the ones written. The step's record file
-        (``records/BASE.json``) is written just before it, so that no committed step is ever
-        without one; a record file whose line never came (a kill between the two) proves the
-        step on a resume only with its files as it says. ``lights.lp`` is then rewritten
-        from every committed step. A write that fails (no space, read-only, I/O error) raises
+        A step is committed once its record file (``records/BASE.json``) is on disk and its
+        files match the checksums in it; its journal line follows, and a resume writes a
+        missing line back from the record file. Only if the record file cannot be written does
+        the journal line alone commit the step. ``lights.lp`` is then rewritten from every
+        committed step. A write that fails (no space, read-only, I/O error) raises
         :class:`SessionWriteError` naming the file, with no temporary file left behind and the
-        journal as it was.
+        journal as it was; if the step was committed before the failure, the error's
+        ``committed`` holds its record, so that the run counts it as the folder does.
         """
         t0 = time.perf_counter()
         base = self.names[index]
@@ -710,21 +713,28 @@ class SessionFolder:
         line = json.dumps(asdict(record)) + "\n"
         # the record file before the journal line: a kill between the two had left a step
         # whose line was written with no record file, unprovable once the journal was later
-        # cut or lost. A record file with no line is taken by the resume only with its files
-        # as it says (:func:`_mend_from_step_records`), as a line would be. A record file that
-        # cannot be written does not keep the step from its commit: the line is written, then
-        # that failure is raised
+        # cut or lost. The record file on disk commits the step (the resume takes it with its
+        # files as it says, :func:`_mend_from_step_records`, and writes its line back); a
+        # record file that cannot be written leaves the commit to the journal line
         try:
             self._write_step_record(base, line)
         except SessionWriteError as exc:
             record_failed: SessionWriteError | None = exc
         else:
             record_failed = None
-        self._append_journal(line)
-        self.committed[index] = record
-        if record_failed is not None:
-            raise record_failed
-        self.write_lp()
+            self.committed[index] = record
+        try:
+            self._append_journal(line)
+            self.committed[index] = record
+            if record_failed is not None:
+                raise record_failed
+            self.write_lp()
+        except SessionWriteError as exc:
+            # a journal line (or lights.lp) that failed after the record file: the step is
+            # kept all the same, and had gone uncounted (progress 2/8 of 3 images kept)
+            if self.committed.get(index) is record:
+                exc.committed = record
+            raise
         return record
 
     def _write_step_record(self, base: str, line: str) -> None:
@@ -864,8 +874,9 @@ class SessionFolder:
             self.manifest.setdefault("adaptive", {})["result"] = source_result
         for r in records:
             self.committed.setdefault(r.index, r)
-        # a stop that came between a journal line and its return (a signal during the fsync)
-        # still leaves a committed step: the journal is the commit point, so it is read back
+        # a stop that came between a step's commit and its return (a signal during the
+        # fsync) still leaves a committed step: its record file (or, if that failed, its
+        # journal line) is the commit, so both are read back as a resume reads them
         with contextlib.suppress(SessionError):
             late = [
                 e

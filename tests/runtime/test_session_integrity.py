@@ -1209,3 +1209,22 @@ def test_a_full_disk_on_a_step_record_file_ends_with_what_happened_and_the_resum
     r = runner.invoke(app, ["run", "--resume", str(out)])
     assert r.exit_code == 0 and "2 of 8 images verified" in said(r), r.output
     assert digests(out) == digests(ref)
+
+
+@pytest.mark.parametrize("point", ["journal", "lp"])
+def test_a_write_failing_after_the_record_file_counts_the_step_it_kept(
+    tmp_path: Path, reference: tuple[Path, Path], point: str
+) -> None:
+    """A step is committed once its record file is on disk: a full disk on its journal line
+    (or lights.lp) after it had left the step uncounted by the run (progress 2/8, the
+    manifest's steps_done_this_run 2) though lights.lp, steps_done and the stop said 3."""
+    cfg, _ = reference
+    out = tmp_path / "s"
+    with failing_writes(point, after=2, errno_code=errno.ENOSPC):
+        r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2, r.output
+    assert "3/8" in r.output and "2/8" not in r.output, r.output
+    assert "3 image(s) kept" in said(r), r.output
+    run = manifest(out)["runner"]
+    assert run["steps_done_this_run"] == run["steps_done"] == 3, run
+    assert len(manifest(out)["steps"]) == 3
