@@ -28,7 +28,8 @@ import logging
 import os
 import socket
 import threading
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager
 from dataclasses import replace
@@ -78,6 +79,16 @@ GATHER_FAILED = "rti-rig-result-unreachable"
 #: a worker that answers the scheduler but not a fetch): one or two are a worker lost and its
 #: work done again elsewhere, more a worker whose results cannot be reached.
 GATHER_TRIES = 5
+#: ... and the least time (seconds) since that result's first failed fetch. Tries alone end
+#: too soon: a refused or reset fetch fails 5 times in about half a second, so a network
+#: blip of under a second, which Dask rides through, had ended the fit.
+GATHER_PATIENCE_S = 60.0
+
+
+def _now() -> float:
+    """The clock the fetch watch measures :data:`GATHER_PATIENCE_S` by (a test scripts it)."""
+    return time.monotonic()
+
 
 SHARED_PATHS = (
     "every Dask worker must see the session's files at the same paths as this machine "
@@ -99,13 +110,19 @@ class _GatherWatch(logging.Filter):
     at once and without end, each try a WARNING line on this command's stderr. A worker lost
     once is Dask's own recovery (the band is computed again, the outputs the same): a normal
     run's stderr got that noise. A result that can never be fetched held the fit for ever,
-    stderr flooding. After :data:`GATHER_TRIES` failures of one result its future is
-    cancelled with the reason :data:`GATHER_FAILED`, which the waiting code says by name."""
+    stderr flooding. After :data:`GATHER_TRIES` failures of one result, the last at least
+    :data:`GATHER_PATIENCE_S` after its first, its future is cancelled with the reason
+    :data:`GATHER_FAILED`, which the waiting code says by name. A fetch of a result it does
+    not watch (another fit's in this process) is let through, not hidden: the other fit's
+    watch, which sees a record only if this one lets it pass, counts it."""
 
-    def __init__(self, client: Any) -> None:
+    def __init__(self, client: Any, clock: Callable[[], float] | None = None) -> None:
         super().__init__()
         self.client = client
+        self.clock = clock or _now
         self.failures: dict[Any, int] = {}
+        self.first_failed: dict[Any, float] = {}
+        self.cancelled: set[Any] = set()
         self.futures: dict[Any, Any] = {}
 
     def track(self, future: Any) -> Any:
@@ -117,11 +134,17 @@ class _GatherWatch(logging.Filter):
         if not str(record.msg).startswith("Couldn't gather"):
             return True
         args = record.args if isinstance(record.args, tuple) else ()
-        for key in args[1] if len(args) == 2 else ():
+        mine = [key for key in (args[1] if len(args) == 2 else ()) if key in self.futures]
+        if not mine:
+            return True  # not a result of this fit: not ours to count, nor to hide
+        now = self.clock()
+        for key in mine:
             n = self.failures[key] = self.failures.get(key, 0) + 1
-            future = self.futures.get(key)
-            if n == GATHER_TRIES and future is not None:  # on the client's loop: no waiting
-                self.client.loop.add_callback(
+            since = now - self.first_failed.setdefault(key, now)
+            if n >= GATHER_TRIES and since >= GATHER_PATIENCE_S and key not in self.cancelled:
+                self.cancelled.add(key)
+                future = self.futures[key]
+                self.client.loop.add_callback(  # on the client's loop: no waiting
                     lambda f=future: self.client.cancel(
                         [f], asynchronous=True, reason=GATHER_FAILED
                     )
@@ -145,7 +168,8 @@ def _unreachable(address: str, what: str, kept: str) -> str:
     """What is said of a result that could not be fetched :data:`GATHER_TRIES` times."""
     return (
         f"the Dask cluster at {address!r} computed {what} but its result could not be fetched "
-        f"from the worker holding it ({GATHER_TRIES} tries): every worker's own address must "
+        f"from the worker holding it ({GATHER_TRIES} tries over {GATHER_PATIENCE_S:.0f} s): "
+        "every worker's own address must "
         "be reachable from the scheduler and from this machine (a firewall, or a worker "
         "listening on an address only its host can reach: see `dask worker --listen-address` "
         f"and `--contact-address`); {kept}"
@@ -443,9 +467,16 @@ def _batch_results(
             items.append(futures[s].result())
         except Exception as exc:  # e.g. KilledWorker: this session failed, the batch goes on
             if getattr(exc, "reason", None) == GATHER_FAILED:
-                kept = "run the same command again once it is (a finished session is skipped)"
-                status = f"failed: {_unreachable(scheduler, 'the session', kept)}"
-                items.append(BatchItem(s, batch_out_dir(root, s), status))
+                out = batch_out_dir(root, s)
+                if out.exists():  # its fit ended on the worker: a rerun skips it as finished
+                    status = (
+                        "finished on its worker; its report could not be fetched (its "
+                        f"outputs are in {out})"
+                    )
+                else:
+                    kept = "run the same command again once it is (a finished session is skipped)"
+                    status = f"failed: {_unreachable(scheduler, 'the session', kept)}"
+                items.append(BatchItem(s, out, status))
                 continue
             if scheduler_lost(client, exc):
                 raise _batch_lost(scheduler, sources, given, root) from None
