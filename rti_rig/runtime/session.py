@@ -1132,6 +1132,24 @@ def _mend_from_step_records(root: Path, names: list[str] | None, scan: JournalSc
         latest[entry["index"]] = entry
 
 
+def stopped_before_journal_line(scan: JournalScan) -> str | None:
+    """The image (``image_004``) whose record file proves its step but whose journal line the
+    run never wrote: killed (or stopped by a full disk) between the two writes, its step
+    committed. That is the one step ``scan`` takes from a record file, just after the
+    journal's last line (the first step, when no journal was ever written), with nothing
+    else wrong with the journal. None otherwise.
+
+    Why: nothing told such a folder from a damaged one. fit's verdict called it "damaged
+    (records missing)" and "lights.lp does not list image_004 … (the .lp edited since
+    capture?)"; a resume said "journal.jsonl was missing" of a journal never written."""
+    if len(scan.mended) != 1 or scan.rejected or scan.torn:
+        return None
+    *intact, last = scan.records  # a record file's record is appended after the journal's
+    after = max((int(r["index"]) for r in intact), default=-1) + 1
+    stem = Path(scan.mended[0]).stem
+    return stem if int(last["index"]) == after and last["image"] == f"{stem}.jpg" else None
+
+
 def _take_whole(src: Path, dest: Path, root: Path) -> str:
     """Put the camera's file ``src`` at ``dest`` whole and return its SHA-256.
 
@@ -1339,7 +1357,18 @@ def _repair_journal(root: Path, scan: JournalScan, stamp: str) -> list[RepairNot
             "# torn last line (no newline: the process died while writing it; never "
             f"committed)\n{scan.torn.decode('utf-8', 'replace')}\n"
         )
-    if scan.missing and scan.mended:
+    unwritten = stopped_before_journal_line(scan)
+    if scan.missing and unwritten is not None:
+        # no journal because none was begun: "was missing" had read as a file lost
+        notes.append(
+            RepairNote(
+                f"the run stopped before its first journal line: {JOURNAL} begun from "
+                f"{scan.mended[0]} ({unwritten}'s files are as it says: the image is kept, "
+                "not shot again)",
+                set_aside=False,
+            )
+        )
+    elif scan.missing and scan.mended:
         stems = [Path(rel).stem for rel in scan.mended]
         notes.append(
             RepairNote(
@@ -2228,7 +2257,10 @@ def _files_after_first_step(root: Path, names: list[str]) -> list[str]:
 def stopped_before_first_record(root: Path) -> bool:
     """Whether session ``root`` (its manifest readable) has no journal because it never wrote
     one: stopped (killed, a power cut) before its first image was journaled, with at most that
-    first image's files on disk (which a resume sets aside and shoots again).
+    first image's files on disk and no record file proving it (files a resume sets aside
+    and shoots again). A first step whose record file is on disk, its files as it says, is
+    committed: the run stopped before its first journal line, not before its first record
+    (:func:`stopped_before_journal_line`).
 
     Why: such a folder had been called "not a session folder" by ``fit``, and ``export-lp``
     advised restoring a journal.jsonl from a backup, of a journal that never existed."""
@@ -2239,7 +2271,25 @@ def stopped_before_first_record(root: Path) -> bool:
         total = planned_steps(read_manifest(root))
     except SessionError:
         return False
-    return bool(total) and not _files_after_first_step(root, image_names(total))
+    if not total:
+        return False
+    names = image_names(total)
+    return not _files_after_first_step(root, names) and not scan_journal(root, names).records
+
+
+def stopped_before_first_journal_line(root: Path) -> str | None:
+    """The first image of session ``root`` when its run stopped after that image's record
+    file and before any journal line (:func:`stopped_before_journal_line`), else None: its
+    step is committed, but no ``journal.jsonl`` or ``lights.lp`` lists it yet."""
+    root = Path(root)
+    if (root / JOURNAL).exists():
+        return None
+    try:
+        total = planned_steps(read_manifest(root))
+    except SessionError:
+        return None
+    scan = scan_journal(root, image_names(total)) if total else None
+    return stopped_before_journal_line(scan) if scan is not None and scan.missing else None
 
 
 def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str | None:
@@ -2691,6 +2741,9 @@ def journal_mend_note(root: Path) -> str | None:
     scan = scan_journal(root, image_names(total))
     if not scan.mended:
         return None
+    unwritten = stopped_before_journal_line(scan)
+    if unwritten is not None:  # not damage: "damaged (records missing)" had been said of it
+        return _unwritten_line_note(root, unwritten)
     stems = [Path(rel).stem for rel in scan.mended]
     parts = []
     if scan.rejected:
@@ -2719,6 +2772,24 @@ def journal_mend_note(root: Path) -> str | None:
         f"{'it was' if one else 'they were'} checked against {'its' if one else 'their'} "
         f"step record file{'' if one else 's'} ({RECORDS_DIR}/) instead, as captured; "
         f"{mend} writes {'it' if one else 'them'} back into {JOURNAL}{also}"
+    )
+
+
+def _unwritten_line_note(root: Path, stem: str) -> str:
+    """What fit's verdict says of ``stem``, committed by its record file, whose journal line
+    the run never wrote (:func:`stopped_before_journal_line`): where it stopped, whether the
+    fit could use the image (only if ``lights.lp`` lists it), and the command that mends it."""
+    from rti_rig.core.errors import RtiRigError
+    from rti_rig.core.lp_format import read_lp
+
+    try:
+        listed = f"{stem}.jpg" in {e.name for e in read_lp(root / LP_NAME)}
+    except (RtiRigError, OSError, ValueError):
+        listed = False
+    fitted = "" if listed else f" (kept, but not yet in {LP_NAME}, so not fitted)"
+    return (
+        f"the run stopped after {stem}'s record file, before its journal line{fitted}; "
+        f"rti-rig run --resume {shlex.quote(str(root))} writes it back"
     )
 
 
@@ -2902,7 +2973,8 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
                     instead
                     if instead is not None
                     else f"continue it with rti-rig run --resume {shlex.quote(str(root))} (a "
-                    "first image's files left on disk are set aside in recovered/ and shot again)"
+                    "first image's files left on disk without its record file are set aside in "
+                    "recovered/ and shot again)"
                 )
             )
         if not (Path(root) / JOURNAL).is_file():

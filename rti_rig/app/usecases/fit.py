@@ -66,6 +66,7 @@ from rti_rig.runtime.session import (
     remember_pixel_digest,
     renamed_note,
     renamed_since_capture,
+    stopped_before_first_journal_line,
     stopped_before_first_record,
     unresumable,
 )
@@ -314,11 +315,20 @@ def acquisition_files(
                     f"session's journal with: rti-rig export-lp {shlex.quote(str(source))} "
                     f"--out {shlex.quote(str(source / LP_NAME))}"
                 )
-            if stopped_before_first_record(source):  # a session killed before its first record
+            first = stopped_before_first_journal_line(source)
+            if first is not None or stopped_before_first_record(source):
+                # killed before its first record; or after it, before its first journal line
+                # (its image committed: "nothing recorded" had been said of it)
                 instead = unresumable(source)  # a camera-triggered dome's resume is refused
+                what = (
+                    "stopped before its first image was recorded: there is nothing to fit yet"
+                    if first is None
+                    else f"stopped before its first journal line: {first} is kept (its record "
+                    f"file proves it), but no {LP_NAME} lists it yet, and one image is too few "
+                    "to fit"
+                )
                 raise FitInputError(
-                    f"{source} is a session that stopped before its first image was recorded: "
-                    "there is nothing to fit yet; "
+                    f"{source} is a session that {what}; "
                     + (
                         instead
                         if instead is not None

@@ -164,9 +164,13 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
     try:
         entries = read_lp(lp)
         total = planned_steps(manifest)
-        records = scan_journal(source, image_names(total) if total else None).records
+        scan = scan_journal(source, image_names(total) if total else None)
     except (OSError, RtiRigError, ValueError):
         return qa
+    records = scan.records
+    # a step its record file proves, its journal line (and lights.lp's) never written: not an
+    # .lp edited since capture, but a run stopped between the two (said by journal_mend_note)
+    proven = {Path(rel).stem for rel in scan.mended}
     fired: dict[str, np.ndarray] = {}
     for rec in records:  # a later record of a step (a reshot image) replaces an earlier one
         d = np.asarray(rec["actual_direction"], dtype=np.float64)
@@ -197,6 +201,7 @@ def _with_relabelled(qa: QAReport, lp: Path, source: Path, manifest: dict) -> QA
             if rec["image"] not in listed
             and rec["linear_image"] not in listed
             and (source / rec["image"]).is_file()
+            and Path(rec["image"]).stem not in proven
         ]
         lost = files_lost_since_capture(source) if candidates else {}
         unlisted = sorted(n for n in candidates if n not in lost)
