@@ -139,9 +139,20 @@ def popen_argv(stage: str, k: int, cli_args: list[str]) -> subprocess.Popen[byte
     return subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
+USAGE = (
+    "usage: python -m rti_rig.testing.kill_hooks STAGE K RTI-RIG-ARGS…\n"
+    "  runs `rti-rig RTI-RIG-ARGS…` (e.g. run RIG.toml --out DIR --lights 8) and SIGKILLs it at\n"
+    "  STAGE of its step K (0-based); STAGE is one of: " + ", ".join(STAGES)
+)
+
+
 def main(argv: list[str]) -> None:
+    """Install the hooks, then run the command line; a usage line (exit 1) for ``--help`` or
+    arguments it cannot take (it had ended in a ValueError traceback)."""
     from rti_rig.cli import app
 
+    if len(argv) < 3 or argv[0] in ("-h", "--help") or not argv[1].isdigit():
+        raise SystemExit(USAGE)
     stage, k, *cli_args = argv
     install(stage, int(k))
     app(cli_args)

@@ -425,3 +425,13 @@ def test_a_ctrl_c_while_a_resume_sets_images_aside_leaves_lights_lp_listing_the_
     on_disk = sorted(p.name for p in out.glob("image_*.jpg"))
     assert "image_002.jpg" not in on_disk
     assert _listed(out) == on_disk
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["after_record"], ["after_record", "x", "run"]])
+def test_kill_hooks_without_its_arguments_says_its_usage(argv: list[str]) -> None:
+    """`python -m rti_rig.testing.kill_hooks --help` had ended in a ValueError traceback."""
+    from rti_rig.testing.kill_hooks import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert str(stop.value.code).startswith("usage: python -m rti_rig.testing.kill_hooks STAGE K")
