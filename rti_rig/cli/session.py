@@ -256,7 +256,7 @@ def run(
             lambda: open_resumed_session(resume_request, print_note),
             out_dir,
             auto_exposure,
-            stopped=lambda why: (
+            stopped=lambda why, _exc: (
                 f"Stopped ({why}) before the session went on: no new image was captured; "
                 f"continue it with {_resume_command(resume_request)}"
             ),
@@ -270,7 +270,7 @@ def run(
             open_new,
             out_dir,
             auto_exposure,
-            stopped=lambda why: (
+            stopped=lambda why, _exc: (
                 f"Stopped ({why}) before the first image: nothing was captured or written to "
                 f"{out_dir}"
             ),
@@ -307,35 +307,42 @@ def _rebuilt_finished(req: Any) -> bool:
     while the images are checked leaves the folder as it was; one while the journal is written
     is acted on once it is, and said so."""
     from rti_rig.app.usecases.session import Note, rebuild_finished_session
-    from rti_rig.runtime.controller import EmergencyStop
     from rti_rig.runtime.session import JOURNAL, lost_since_capture_said
 
     folder = _arg(req.session_dir)
-    try:
-        with _terminable_while_opening():
-            notes = rebuild_finished_session(req)
-    except RtiRigError as exc:
-        raise fail(exc) from None
-    except (KeyboardInterrupt, EmergencyStop) as exc:
-        why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
+
+    def stopped(why: str, exc: BaseException) -> str:
         done = getattr(exc, "journal_rebuild", None)
-        if done:
-            for line in done:
-                print_note(Note(line, "warning"))
-            lost = lost_since_capture_said(req.session_dir)
-            said = f"Stopped ({why}) once {JOURNAL} was rebuilt: " + (
-                f"the session is whole again; rti-rig fit {folder} --out FOLDER fits it "
-                "and gives its QA verdict"
-                if lost is None
-                else f"{lost}; meanwhile rti-rig fit {folder} --out FOLDER fits the rest"
-            )
-        else:
-            said = (
+        if not done:
+            return (
                 f"Stopped ({why}) before {JOURNAL} was rebuilt: nothing in {folder} was "
                 f"changed; run rti-rig run --resume {folder} --rebuild-journal again"
             )
-        err.print(f"[yellow]{escape(said)}.[/]")
-        raise typer.Exit(code=stop_exit_code(why)) from None
+        for line in done:
+            print_note(Note(line, "warning"))
+        lost = lost_since_capture_said(req.session_dir)
+        return f"Stopped ({why}) once {JOURNAL} was rebuilt: " + (
+            f"the session is whole again; rti-rig fit {folder} --out FOLDER fits it "
+            "and gives its QA verdict"
+            if lost is None
+            else f"{lost}; meanwhile rti-rig fit {folder} --out FOLDER fits the rest"
+        )
+
+    # the opening's answers, shared with run and preview: this third copy had lacked the one
+    # to a fault no part of rti-rig named, which reached the user as a traceback
+    notes, _ = _open_for_capture(
+        _Opening(
+            lambda: rebuild_finished_session(req),
+            req.session_dir,
+            False,
+            stopped,
+            not_opened=(
+                f"The rebuild of {JOURNAL} in {folder} stopped on that fault; run rti-rig run "
+                f"--resume {folder} --rebuild-journal again once it is fixed"
+            ),
+            capture=False,
+        )
+    )
     if notes is None:
         return False
     for line in notes:
@@ -418,14 +425,17 @@ def _stopped_while_opening(
 @dataclass(frozen=True)
 class _Opening:
     """How ``run`` or ``preview`` opens its session (``open``, which returns it) and what it
-    says when the opening does not end in a session: ``stopped(why)`` for a Ctrl-C or SIGTERM,
-    ``not_opened`` for a fault no part of rti-rig named."""
+    says when the opening does not end in a session: ``stopped(why, exc)`` for a Ctrl-C or
+    SIGTERM, ``not_opened`` for a fault no part of rti-rig named. ``capture``: a capture
+    follows, which answers a stop from the end of the opening on (False for the rebuild of a
+    finished session's journal: nothing follows it to answer one)."""
 
     open: Callable[[], Any]
     out_dir: Path | None
     auto_exposure: bool
-    stopped: Callable[[str], str]
+    stopped: Callable[[str, BaseException], str]
     not_opened: str
+    capture: bool = True
 
 
 def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
@@ -441,7 +451,8 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
     try:
         with _terminable_while_opening() as handover:
             opened = opening.open()
-            handover.hold()  # a stop from here on: the capture answers it
+            if opening.capture:
+                handover.hold()  # a stop from here on: the capture answers it
     except RtiRigError as exc:
         _print_failures(getattr(exc, "teardown_failures", None))  # metering's
         raise _opening_failed(exc, opening.out_dir) from None
@@ -449,7 +460,7 @@ def _open_for_capture(opening: _Opening) -> tuple[Any, HandOver]:
         # while the rig opens (an emulator starting, a dome's handshake, metering): the exit
         # had been 130 with no word at all (a SIGTERM's 143, with no all-off either)
         why = "Ctrl-C" if isinstance(exc, KeyboardInterrupt) else str(exc)
-        said = opening.stopped(why)
+        said = opening.stopped(why, exc)
         raise _stopped_while_opening(exc, why, said, opening.auto_exposure) from None
     except Exception as exc:  # no part of rti-rig named it: said, not a traceback
         _print_failures(getattr(exc, "teardown_failures", None))
@@ -1148,7 +1159,7 @@ def preview(
         open_preview,
         out_dir,
         auto_exposure,
-        stopped=lambda why: (
+        stopped=lambda why, _exc: (
             f"Stopped ({why}) before the preview image: nothing was captured or written to "
             f"{out_dir}"
         ),

@@ -94,3 +94,26 @@ def test_an_unnamed_fault_while_the_preview_opens_is_said_too(
     assert isinstance(r.exception, SystemExit) and r.exit_code == 1, (r.exception, r.output)
     assert "unexpected _Unnamed: no rig today" in said, said
     assert f"Nothing was captured or written to {out}" in said, said
+
+
+def test_an_unnamed_fault_while_a_finished_sessions_journal_is_rebuilt_is_said_too(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`run --resume DIR --rebuild-journal` of a completed session opened through a third copy
+    of the opening code, without the answer to a fault no part of rti-rig named: it reached
+    the user as a traceback."""
+    import rti_rig.app.usecases.session as usecase
+
+    cfg = write_config(tmp_path, SMALL_DOME)
+    out = tmp_path / "s"
+    assert runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "3"]).exit_code == 0
+
+    def rebuild(*args, **kwargs):  # type: ignore[no-untyped-def]
+        raise _Unnamed("no journal today")
+
+    monkeypatch.setattr(usecase, "rebuild_finished_session", rebuild)
+    r = runner.invoke(app, ["run", "--resume", str(out), "--rebuild-journal"])
+    said = " ".join(r.output.split())
+    assert isinstance(r.exception, SystemExit) and r.exit_code == 1, (r.exception, r.output)
+    assert "unexpected _Unnamed: no journal today" in said, said
+    assert f"--resume {out} --rebuild-journal again once it is fixed" in said, said
