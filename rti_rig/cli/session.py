@@ -670,8 +670,9 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
     the images and the next command; any other error as it is.
 
     Why: a full disk on a step's record file ended the run with a bare ``error: cannot write
-    …/records/image_003.json``, as if the image were lost, though its journal line (the
-    commit) was on disk; the resume command was said only lines above it."""
+    …/records/image_003.json``, as if the image were lost, though its journal line (which
+    commits a step whose record file cannot be written) was on disk; the resume command was
+    said only lines above it."""
     from rti_rig.runtime.session import RECORDS_DIR, SessionWriteError
 
     kept = opened.folder.images_kept
@@ -679,8 +680,8 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
         return exc  # nothing kept: the folder may be used again, as said above
     if exc.path.parent.name == RECORDS_DIR:
         what = (
-            f"{exc.path.stem} is kept all the same (its journal line, the commit, was written "
-            "in spite of it)"
+            f"{exc.path.stem} is kept all the same (its journal line, which commits it in "
+            "place of that file, was written)"
         )
     else:
         what = f"{kept} image(s) are kept"

@@ -206,9 +206,9 @@ _DIR_FSYNC_UNSUPPORTED = {errno.EINVAL, errno.EBADF, errno.ENOTSUP, errno.EOPNOT
 def _fsync_dir(path: Path) -> None:
     """Make a folder's entries (a file just renamed into it) durable across a power loss.
 
-    A file system that does not fsync folders is let be: the step's files are fsynced and its
-    journal line, the commit, is fsynced too; stopping every run on such a disk (as this did)
-    keeps nothing more."""
+    A file system that does not fsync folders is let be: the step's files, its record file
+    (the commit) and its journal line are each fsynced; stopping every run on such a disk (as
+    this did) keeps nothing more."""
     try:
         fd = os.open(path, os.O_RDONLY)
     except OSError as exc:

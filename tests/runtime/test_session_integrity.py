@@ -1192,8 +1192,8 @@ def test_a_full_disk_on_a_step_record_file_ends_with_what_happened_and_the_resum
     tmp_path: Path, reference: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The run's last line had been a bare "error: cannot write …/records/image_002.json": it
-    now says the image is kept (its journal line, the commit, is written in spite of it) and
-    the command that continues, and that command completes the session."""
+    now says the image is kept (its journal line, which commits it in place of that file, is
+    written) and the command that continues, and that command completes the session."""
     cfg, ref = reference
     out = tmp_path / "s"
     # a step's record file (records/.image_NNN.json.tmp), the manifest's (.manifest.json.tmp)
