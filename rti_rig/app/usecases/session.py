@@ -378,7 +378,10 @@ def fix_exposure(
         found = bound() if bound is not None else None
         if found is None or found[0] >= rule.max_exposure_s:
             return rule
-        camera_cap[:] = [found]
+        # kept as the longest exposure the camera takes exactly (whole exposure_unit_s): at
+        # 30 fps 1/30 s is 333 units, 0.0333 s, which the warning's check never reached
+        steps = getattr(camera, "representable_exposure_s", None)
+        camera_cap[:] = [(steps(found[0]) if steps else found[0], found[1])]
         return rule.model_copy(update={"max_exposure_s": max(found[0], rule.min_exposure_s)})
 
     # a camera taking exposures in steps (a UVC camera's exposure_unit_s) is asked for those

@@ -346,3 +346,25 @@ def test_a_capture_not_checked_before_lighting_is_refused_before_a_frame_is_read
     assert not stream.delivered
     with cam:
         assert cam.capture(0.03).exposure_s == pytest.approx(0.03)
+
+
+@pytest.mark.pty
+def test_a_uvc_metering_at_30fps_warns_at_the_longest_whole_units_exposure(tmp_path, monkeypatch):
+    """`run --auto-exposure` with a 30 fps UVC camera in 100 µs units and a dark object: the
+    longest exposure it takes is 333 units, 0.0333 s, just under the frame period 1/30 s. The
+    warning compared the chosen exposure with 1/30 s itself, which whole units never reach, so
+    it never fired and the dark object was shot dark unsaid; it now compares with the longest
+    exposure in whole units."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    cfg.write_text(cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.02\n", 1))
+    stream = BufferedUvcStream(LightHistory(SystemClock()), fps=30.0)  # type: ignore[arg-type]
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, [*args, "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "Exposure fixed at 0.0333 s" in said, said
+    assert "longest the camera uvc-camera can take" in said, said
+    assert "30 fps (CAP_PROP_FPS)" in said and "Traceback" not in said, said
