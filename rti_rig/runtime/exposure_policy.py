@@ -249,11 +249,17 @@ def fix_session_exposure(
         rig.camera.connect()
         # the metering's first shot, the shortest it starts from: a UVC camera's drain that
         # does not fit the light's limit then would stop it at the thermal limit, lit
-        check_capture_fits_lit(rig, [rig.camera_config.exposure_s], "nothing was lit")
+        # [camera] exposure_s is only where the metering starts, rounded down to what the
+        # camera takes exactly (whole exposure_unit_s): refusing 0.00125 s as "not a whole
+        # number" of 0.0001 s stopped a run whose metering never asks for it
+        steps_of = getattr(rig.camera, "representable_exposure_s", None)
+        start = rig.camera_config.exposure_s
+        start = steps_of(start) if steps_of is not None else start
+        check_capture_fits_lit(rig, [start], "nothing was lit")
         rig.lighting.set(schedule.steps[at])
         lit_at = rig.clock.now()
         rig.clock.sleep(rig.timing.settle_s)
-        choice = meter(camera_at(schedule.steps[at], lit_at), rig.camera_config.exposure_s)
+        choice = meter(camera_at(schedule.steps[at], lit_at), start)
         tested.append([float(t) for t in getattr(choice, "test_exposures_s", ())])
         for j in steps[1:] if recheck is not None else ():
             rig.lighting.off()  # one light at a time: the last one's off before the next lights

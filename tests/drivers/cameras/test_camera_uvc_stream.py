@@ -368,3 +368,29 @@ def test_a_uvc_metering_at_30fps_warns_at_the_longest_whole_units_exposure(tmp_p
     assert "Exposure fixed at 0.0333 s" in said, said
     assert "longest the camera uvc-camera can take" in said, said
     assert "30 fps (CAP_PROP_FPS)" in said and "Traceback" not in said, said
+
+
+@pytest.mark.pty
+def test_a_configured_exposure_not_in_units_is_only_a_start_for_auto_exposure(
+    tmp_path, monkeypatch
+):
+    """`[camera] exposure_s = 0.00125` (12.5 units of 100 µs) with `run --auto-exposure`: the
+    metering replaces it and asks only for whole units, yet the run refused it before any
+    LED lit ("not a whole number"). It is now the metering's start, rounded down to 0.0012 s;
+    without --auto-exposure it is still refused (the test above)."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    cfg.write_text(cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.00125\n", 1))
+    light = LightHistory(SystemClock())  # type: ignore[arg-type]
+    light.set(1.0)
+    stream = BufferedUvcStream(light, fps=20.0, scale=1e6)
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, [*args, "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "whole number" not in said and "Traceback" not in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    shot = manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
+    assert shot[0][0] == pytest.approx(0.0012), shot
