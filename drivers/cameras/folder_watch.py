@@ -56,6 +56,7 @@ import contextlib
 import json
 import os
 import shutil
+import socket
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -144,6 +145,12 @@ class _LearnedClock:
     offset_s: float
     wall_s: float
     window_s: float
+    #: the pulse on the computer's monotonic clock, which no NTP step or clock setting moves
+    #: (None: not known, a clock file of an older version or a rig clock that is not it)
+    mono_s: float | None = None
+    #: the computer and boot it was learned on (:func:`computer_id`): the monotonic clock
+    #: holds only within one boot of one computer
+    computer: str | None = None
 
     @classmethod
     def load(cls, path: Path | None) -> _LearnedClock | None:
@@ -153,8 +160,15 @@ class _LearnedClock:
             return None
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
-            return cls(float(data["offset_s"]), float(data["wall_s"]), float(data["window_s"]))
-        except (OSError, ValueError, TypeError, KeyError):
+            mono = data.get("mono_s")
+            return cls(
+                float(data["offset_s"]),
+                float(data["wall_s"]),
+                float(data["window_s"]),
+                None if mono is None else float(mono),
+                None if data.get("computer") is None else str(data["computer"]),
+            )
+        except (OSError, ValueError, TypeError, KeyError, AttributeError):
             return None
 
     def save(self, path: Path) -> None:
@@ -163,6 +177,26 @@ class _LearnedClock:
         with contextlib.suppress(OSError):
             tmp.write_text(json.dumps(self.__dict__), encoding="utf-8")
             os.replace(tmp, path)
+
+
+def computer_id() -> str:
+    """This computer and its boot: the host name and, where the system says it (Linux), the
+    boot id. Two runs with the same id share one monotonic clock."""
+    try:
+        boot = Path("/proc/sys/kernel/random/boot_id").read_text(encoding="ascii").strip()
+    except OSError:
+        boot = ""
+    return f"{socket.gethostname()} {boot}".strip()
+
+
+#: the first image of a resume whose earlier run's camera clock cannot be compared with this
+#: run's (another computer, or the same after a restart): said, not refused
+RESUME_UNCHECKED = (
+    "this run is on another computer, or the computer restarted, since the session's earlier "
+    "run learned the camera clock: the computer's clock may differ from that run's, so the "
+    "first image was not checked for a file shot before this run (a late file of the stopped "
+    "run); the images after it are checked against it"
+)
 
 
 class TriggerUnconfirmed(Exception):
@@ -287,6 +321,8 @@ class _Pending:
     #: when the trigger was called on the computer's wall clock (what a resume's check of its
     #: first file is learned against: the rig clock starts again with each run)
     pulsed_wall: float | None = None
+    #: when the trigger was called on the computer's monotonic clock (None: not known)
+    pulsed_mono: float | None = None
     #: of ``out_of_step``, those shot before this run connected (by the camera clock an earlier
     #: run of the session learned): name -> how many seconds before
     before_connect: dict[str, float] = field(default_factory=dict)
@@ -303,17 +339,28 @@ class FolderWatchCamera:
         clock: Clock | None = None,
         trigger: Callable[[float], None] | None = None,
         wall: Callable[[], float] = time.time,
+        monotonic: Callable[[], float] | None = None,
+        computer: Callable[[], str] = computer_id,
     ) -> None:
         self.settings = settings
         #: the computer's wall clock (seconds since the epoch): the camera clock learned
         #: against it holds from one run of a session to the next, the rig clock does not
         self._wall = wall
-        #: the computer's wall clock at ``connect``
+        self._clock = clock or SystemClock()
+        #: the computer's monotonic clock, which measures how far its wall clock was moved
+        #: between two runs of one boot (an NTP step): the rig's clock when it is the system's
+        self._monotonic = monotonic or (
+            time.monotonic if isinstance(self._clock, SystemClock) else None
+        )
+        self._computer = computer
+        #: the connect on the wall clock of the run that learned the camera clock (this run's
+        #: wall clock less the step the monotonic clock shows it was moved by since)
         self._connected_wall: float | None = None
+        #: the first image is said unchecked: the learned clock's computer is not this one
+        self._resume_unchecked = False
         #: the camera clock as an earlier run of the session learned it, read at connect
         self._learned: _LearnedClock | None = None
         self.name = settings.name
-        self._clock = clock or SystemClock()
         self._trigger = trigger
         self._seen: set[str] | None = None
         #: (device, inode, size, mtime) of every file seen: a renamed one keeps all four
@@ -356,8 +403,8 @@ class FolderWatchCamera:
         self._taken_stems = set()
         self._anchor = None
         self._orphan = None
-        self._connected_wall = self._wall()
         self._learned = _LearnedClock.load(self._clock_file())
+        self._connected_wall, self._resume_unchecked = self._connect_on_learned_wall()
 
     def close(self) -> None:
         self._seen = None
@@ -553,11 +600,12 @@ class FolderWatchCamera:
             self._mark_seen(p.name, _identity(p))
             pending.stray.append(p.name)
         sent, wall = self._clock.now(), self._wall()
+        mono = None if self._monotonic is None else self._monotonic()
         try:
             self._trigger(exposure_s)
         except TriggerUnconfirmed as exc:
             pending.unconfirmed = str(exc)
-        pending.pulsed_at, pending.pulsed_wall = sent, wall
+        pending.pulsed_at, pending.pulsed_wall, pending.pulsed_mono = sent, wall, mono
         pending.pulse_window_s = self._clock.now() - sent
         self._pending = pending
         return self._clock.now() + self.settings.shutter_lag_s + exposure_s
@@ -651,6 +699,9 @@ class FolderWatchCamera:
                 placed = self._place(taken, pending.pulsed_at, pending.pulse_window_s)
             if placed is not None:
                 pending.taken = taken  # learned once the file is decoded (see collect)
+                if self._resume_unchecked:
+                    self._resume_unchecked = False
+                    placed = [*placed, RESUME_UNCHECKED]
                 return path, placed
             pending.stray.append(path.name)
             pending.out_of_step.append(path.name)
@@ -732,7 +783,8 @@ class FolderWatchCamera:
         return (
             f"; shot before this run connected ({shown} before, by the camera clock the "
             "session's earlier run learned): files of the stopped run, not of this light. If "
-            "the camera's clock was set back since (or another camera now saves there), delete "
+            "the camera's clock was set back since, the computer's clock set forward in a way "
+            "its monotonic clock does not show, or another camera now saves there, delete "
             f"{self._clock_file()} and resume again (the first image is then unchecked)"
         )
 
@@ -749,11 +801,36 @@ class FolderWatchCamera:
         if where is None or pending.pulsed_wall is None or pending.taken is None:
             return
         learned = _LearnedClock(
-            pending.taken - pending.pulsed_wall, pending.pulsed_wall, pending.pulse_window_s
+            pending.taken - pending.pulsed_wall,
+            pending.pulsed_wall,
+            pending.pulse_window_s,
+            pending.pulsed_mono,
+            self._computer(),
         )
         with contextlib.suppress(OSError):
             where.parent.mkdir(parents=True, exist_ok=True)
             learned.save(where)
+
+    def _connect_on_learned_wall(self) -> tuple[float | None, bool]:
+        """This connect on the wall clock of the run that learned the camera clock, and
+        whether the first image is to be said unchecked (None, True: the clocks cannot be
+        compared).
+
+        Why: the computer's wall clock was taken to be the one the camera clock was learned
+        against. A resume after an NTP step of a clock that ran fast, or on another computer
+        whose clock is ahead, dated every good file before the connect: each was refused and
+        the run stopped, blaming the camera's clock. On the same boot the monotonic clock says
+        how far the wall clock was moved and it is taken off; on another computer or boot
+        nothing can, and the first file is said unchecked rather than refused."""
+        learned, now = self._learned, self._wall()
+        if learned is None or learned.mono_s is None:
+            return now, False  # an older session's clock, or a rig clock not the monotonic
+        if learned.computer != self._computer():
+            return None, True
+        mono = None if self._monotonic is None else self._monotonic()
+        if mono is None or mono < learned.mono_s:  # no monotonic clock, or a restart
+            return None, True
+        return learned.wall_s + (mono - learned.mono_s), False
 
     def _shot_before_connect(self, taken: float, window_s: float) -> float | None:
         """How many seconds before this run connected a first file was shot, by the camera

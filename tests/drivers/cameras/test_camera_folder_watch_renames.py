@@ -572,6 +572,60 @@ def test_a_camera_clock_set_back_between_runs_is_said_with_the_way_out(tmp_path)
     clock_file = session / "raw" / ".folder_watch_clock.json"
     assert "IMG_0002.DNG" in said and "shot before this run connected" in said, said
     assert "set back" in said and str(clock_file) in said, said
+    assert "the computer's clock set forward" in said, said
     clock_file.unlink()
     frame = camera().capture(0.1)
     assert frame.metadata["watched_file"].endswith("IMG_0003.DNG")
+
+
+def _resumed_after(tmp_path, wall_step_s, computer_after="this-computer"):
+    """A session whose first run took one image, resumed a minute later after the computer's
+    wall clock was moved ``wall_step_s`` (its monotonic clock, the rig's, not), on the computer
+    ``computer_after``: the resumed camera and the session's clock file."""
+    session, tether = tmp_path / "session", tmp_path / "tether"
+    tether.mkdir()
+    body = _Body(tether, [0.5] * 4, offset_s=0.0)
+    settings = FolderWatchSettings(folder=tether, timeout_s=3.0, poll_interval_s=0.125)
+    step = [0.0]
+
+    def camera(computer: str) -> FolderWatchCamera:
+        cam = FolderWatchCamera(
+            settings,
+            clock=body.clock,
+            trigger=body.pulse,
+            wall=lambda: body.wall() + step[0],
+            monotonic=body.clock.now,
+            computer=lambda: computer,
+        )
+        cam.output_dir = session / "raw" / ".incoming"
+        cam.connect()
+        return cam
+
+    camera("this-computer").capture(0.1)
+    body.clock.sleep(60.0)
+    step[0] = wall_step_s
+    return camera(computer_after)
+
+
+def test_a_resume_after_the_computers_clock_was_stepped_takes_its_own_file(tmp_path):
+    """The computer's clock ran 2 min fast in the first run and NTP stepped it back before the
+    resume (seen from the camera's clock: the computer is now 2 min behind, wall time -120 s):
+    the resumed pulse's own file was dated 2 min before the connect, refused with every file
+    after it, and the run stopped blaming the camera's clock. The monotonic clock of the same
+    boot shows the step, which is taken off: the file is the image, with no notice."""
+    frame = _resumed_after(tmp_path, wall_step_s=+120.0).capture(0.1)
+    assert frame.metadata["watched_file"].endswith("IMG_0002.DNG"), frame.metadata
+    assert not frame.metadata.get("stray_files") and not frame.metadata.get("notices")
+
+
+def test_a_resume_on_another_computer_says_its_first_image_unchecked(tmp_path):
+    """Resumed on another computer whose clock is 2 min ahead: its wall clock cannot be
+    compared with the first run's, which had every good file refused as shot before the
+    connect. The first file is taken, saying it was not checked; the next is checked."""
+    cam = _resumed_after(tmp_path, wall_step_s=+120.0, computer_after="other-computer")
+    first = cam.capture(0.1)
+    assert first.metadata["watched_file"].endswith("IMG_0002.DNG"), first.metadata
+    assert any("another computer" in n for n in first.metadata.get("notices") or [])
+    second = cam.capture(0.1)
+    assert second.metadata["watched_file"].endswith("IMG_0003.DNG")
+    assert not second.metadata.get("notices")
