@@ -846,8 +846,9 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
     monkeypatch.setenv("HOME", str(tmp_path))
     watched = tmp_path / "Pictures" / "rti-tether"
     watched.mkdir(parents=True)
-    # the late file is then 4 s and more older than the resume: well past the check's 1.5 s
-    cfg = _watch_config_waiting(tmp_path, 4.0)
+    # the late file's EXIF time is set 30 s back (shot, say, before a long stop): past the
+    # check's allowance whatever the tethering thread's lag, with a short wait for its file
+    cfg = _watch_config_waiting(tmp_path, 1.5)
     stop = threading.Event()
     mosaic = linear_to_mosaic(np.full((32, 32), 0.3), "RGGB", 256, 4095)
 
@@ -875,7 +876,8 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
                     # the camera's clock: UTC wall time, as a camera set to UTC keeps it
                     now = datetime.datetime.now(datetime.UTC).replace(tzinfo=None)
                     if seen == 2:
-                        late = now  # shot, but its file is on its way past the timeout
+                        # shot, but its file is on its way past the timeout
+                        late = now - datetime.timedelta(seconds=30)
                         continue
                     if seen == 3 and late is not None:  # the late file, just before this one
                         save("_DSC0002.DNG", late, time.time_ns() - 10**9)
@@ -891,7 +893,7 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
         finally:
             stop.set()
             thread.join(2)
-    assert first.exit_code != 0 and "within 4 s" in first.output, first.output
+    assert first.exit_code != 0 and "within 1.5 s" in first.output, first.output
     said = " ".join(resumed.output.split())
     assert resumed.exit_code == 0, said
     entries = journal(out)
