@@ -263,16 +263,35 @@ def _tiff_capture_time(path: Path) -> tuple[bool, float | None]:
     Why: a TIFF had no capture time at all, so a late or extra TIFF was never checked against
     the pulses. IFD0's DateTime is not used: it is when the file was written (the export), which
     trails the shot by a varying transfer time, and would set in-step files aside. False (wait)
-    while tifffile cannot read the file yet (one still being written)."""
+    while tifffile cannot read a file that begins as a TIFF (one still being written); True
+    for one whose first bytes are written and are no TIFF's: it never will be one, and had
+    cost ``timeout_s`` before its notice said it held no capture time."""
     import tifffile
 
     try:
         with tifffile.TiffFile(path) as tif:
-            exif = tif.pages.first.tags.get("ExifTag")
+            # pages[0], not pages.first: newer than the tifffile pyproject.toml allows
+            exif = tif.pages[0].tags.get("ExifTag")
             stamp = exif.value.get("DateTimeOriginal") if exif is not None else None
-    except Exception:  # not whole yet, or no TIFF: its decode says which
-        return False, None
+    except Exception:  # not whole yet, or no TIFF: its first bytes say which
+        return _not_a_tiff(path), None
     return True, _exif_time(stamp)
+
+
+#: the first bytes of a TIFF (little- and big-endian) and a BigTIFF
+TIFF_MAGIC = (b"II*\0", b"MM\0*", b"II+\0", b"MM\0+")
+
+
+def _not_a_tiff(path: Path) -> bool:
+    """Whether ``path``'s first four bytes are written and are no TIFF's: a file waiting
+    cannot make readable (one still being written begins with its header, or zeros on a
+    network share that sets the size first)."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(4)
+    except OSError:
+        return False
+    return len(head) == 4 and any(head) and head not in TIFF_MAGIC
 
 
 def _exif_time(stamp: object) -> float | None:

@@ -629,3 +629,26 @@ def test_a_resume_on_another_computer_says_its_first_image_unchecked(tmp_path):
     second = cam.capture(0.1)
     assert second.metadata["watched_file"].endswith("IMG_0003.DNG")
     assert not second.metadata.get("notices")
+
+
+def test_a_tiff_that_can_never_be_read_is_not_waited_for_as_one_being_written(tmp_path):
+    """Any tifffile error was taken as a TIFF still being written: a file named .tif that is
+    no TIFF (its first bytes written, no TIFF's) cost timeout_s before its capture time was
+    given up. It is now final at once; a TIFF cut short (its header there) is still waited
+    for."""
+    import tifffile
+
+    from rti_rig.drivers.cameras.folder_watch import _read_capture_time
+
+    junk = tmp_path / "junk.tif"
+    junk.write_bytes(b"JFIF this is a JPEG saved as .tif" * 4)
+    assert _read_capture_time(junk) == (True, None)
+    whole = tmp_path / "whole.tif"
+    tifffile.imwrite(whole, np.zeros((64, 64), np.uint16))
+    half = tmp_path / "half.tif"
+    half.write_bytes(whole.read_bytes()[:16])
+    assert _read_capture_time(half) == (False, None)
+    zeros = tmp_path / "zeros.tif"
+    zeros.write_bytes(bytes(4096))  # a network share sets the size first, fills it later
+    assert _read_capture_time(zeros) == (False, None)
+    assert _read_capture_time(whole) == (True, None)  # whole, no EXIF DateTimeOriginal
