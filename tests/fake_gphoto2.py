@@ -108,9 +108,15 @@ class Body:
     download_s: float = 0.0
     download_clock: Any = None
     card_free_shots: int = 1000
-    #: a freshly formatted card: its DCIM holds no ``100CANON`` until the body writes its
-    #: first picture there (a body makes its folder with its first file)
-    card_formatted: bool = False
+    #: the card folder the body saves in, ``DCIM/<n>CANON``: a DCF body opens the next one
+    #: when its file number passes 9999 (DCF, JEITA CP-3461: file numbers 0001-9999 in
+    #: folders 100-999; Canon's manuals: "when the file number reaches 9999 a new folder is
+    #: created"), with ``folder_rollover``; the files of the folders before it stay there
+    card_folder: int = 100
+    folder_rollover: bool = False
+    #: the last file number the body used before the session (its counter, kept across cards)
+    last_file_number: int | None = None
+    older_folders: dict[str, dict[str, bytes]] = field(default_factory=dict)
     jpeg_first: bool = False  # RAW+JPEG: capture() returns the JPEG, the RAW comes by event
     #: RAW+JPEG: the second file is announced only after this many quiet event waits (a body
     #: still writing its JPEG); a shot taken before then finds the announcement pending
@@ -161,7 +167,16 @@ class Body:
             return "capt0000"
         n = (self.counter_start - 1 + self._counter) % self.counter_wrap + 1
         self._counter += 1
+        if self.folder_rollover and self.last_file_number is not None:
+            if n <= self.last_file_number:  # past 9999: the next folder, its files from 0001
+                self.older_folders[self.card_dir()] = self.card
+                self.card, self.card_folder = {}, self.card_folder + 1
+            self.last_file_number = n
         return f"IMG_{n:04d}"
+
+    def card_dir(self) -> str:
+        """The card folder the body saves in, as libgphoto2's PTP driver names it."""
+        return f"/store_00020001/DCIM/{self.card_folder}CANON"
 
     def bus(self) -> list[tuple[str, str]]:
         return [(self.model, self.port)] if self.detected is None else list(self.detected)
@@ -227,9 +242,9 @@ def make_module(body: Body) -> types.ModuleType:
     def take_picture(announce_all: bool = False) -> CameraFilePath:
         """The shutter fires: the files are written and announced (``announce_all``: all
         of them by event, for a picture whose capture answered busy)."""
+        stem = body.next_stem()  # first: it may open the card's next folder
         store = body.store()
         fmt = body.config["imageformat"]
-        stem = body.next_stem()
         files = []
         if "RAW" in fmt:
             files.append(stem + body.raw_suffix)
@@ -249,12 +264,11 @@ def make_module(body: Body) -> types.ModuleType:
             store[name] = raw_data if not name.endswith(".JPG") else b"\xff\xd8\xff\xd9"
         if store is body.card:
             body.card_free_shots -= 1
-            body.card_formatted = False
         body.shots += 1
         body._busy = body.busy_after_shot
         if body.busy_for_s:
             body._busy_until = body.busy_clock.now() + body.busy_for_s
-        folder = "/store_00020001/DCIM/100CANON" if store is body.card else "/"
+        folder = body.card_dir() if store is body.card else "/"
         for name in files if body.announce_first or announce_all else files[1:]:
             event = (GP_EVENT_FILE_ADDED, CameraFilePath(folder, name))
             if name != files[0] and body.second_file_quiet_waits:
@@ -354,23 +368,20 @@ def make_module(body: Body) -> types.ModuleType:
         def folder_list_files(self, folder: str) -> list[tuple[str, None]]:
             """python-gphoto2's CameraList of (name, value) pairs: the files in ``folder``."""
             body.check("folder_list_files")
-            card = "/store_00020001/DCIM/100CANON"
-            store = body.card if folder.rstrip("/") == card else body.ram if folder == "/" else {}
+            folder = folder.rstrip("/") or "/"
+            store = body.older_folders.get(folder, {})
+            store = body.card if folder == body.card_dir() else store
+            store = body.ram if folder == "/" else store
             return [(name, None) for name in sorted(store)]
 
         def folder_list_folders(self, folder: str) -> list[tuple[str, None]]:
             """python-gphoto2's CameraList of (name, value) pairs: the folders in ``folder``;
             as libgphoto2's PTP driver shows a card, its storage at the top, then DCIM."""
             body.check("folder_list_folders")
-            tree = {
-                "": "store_00020001",
-                "/store_00020001": "DCIM",
-                "/store_00020001/DCIM": "100CANON",
-            }
-            sub = tree.get(folder.rstrip("/"))
-            if sub == "100CANON" and body.card_formatted:
-                sub = None
-            return [] if sub is None else [(sub, None)]
+            dcim = [f.rsplit("/", 1)[1] for f in [*body.older_folders, body.card_dir()]]
+            tree = {"": ["store_00020001"], "/store_00020001": ["DCIM"]}
+            tree["/store_00020001/DCIM"] = dcim
+            return [(sub, None) for sub in tree.get(folder.rstrip("/"), [])]
 
         def file_delete(self, folder: str, name: str) -> None:
             body.check("file_delete")

@@ -443,22 +443,22 @@ def card_config(tmp_path: Path) -> Path:
     return config
 
 
-@pytest.mark.parametrize("formatted", [False, True], ids=["card-in-use", "card-formatted"])
+@pytest.mark.parametrize("rollover", [False, True], ids=["card-in-use", "card-next-folder"])
 def test_a_picture_taken_behind_a_busy_answer_before_the_first_shot_is_found_on_the_card(
-    body, tmp_path, formatted
+    body, tmp_path, rollover
 ):
     """The body is still writing the owner's last picture as the session starts: its first
     capture answers busy yet takes a picture it never announces. The card folder was first
     listed after the session's first shot, so that picture was taken for one always there and
     stayed on the card unseen. The card is now listed at connect: it is found, kept in
-    strays/ and recorded in image 1's strays; the owner's earlier picture is left alone. On a
-    freshly formatted card the body makes its folder with that picture: a folder not there at
-    connect holds only new files."""
+    strays/ and recorded in image 1's strays; the owner's earlier picture is left alone. When
+    the owner's picture was file 9999, the body opens the next folder (101CANON) with that
+    picture (DCF numbering): a folder not there at connect holds only new files."""
     config = card_config(tmp_path)
-    if formatted:
-        body.card_formatted = True
-    else:
-        body.card["IMG_0999.CR2"] = b"the owner's earlier picture"
+    body.card["IMG_0999.CR2"] = b"the owner's earlier picture"
+    if rollover:
+        body.folder_rollover, body.last_file_number = True, 9999
+        body.card = {"IMG_9999.CR2": b"the owner's earlier picture"}
     body.still_writing(1)
     body.busy_yet_shot = 1
     body.stray_never_announced = True
@@ -473,7 +473,11 @@ def test_a_picture_taken_behind_a_busy_answer_before_the_first_shot_is_found_on_
     strays = [(e["index"], s) for e in entries for s in e["strays"]]
     assert strays == [(0, "strays/image_001-IMG_0001.CR2")], strays
     assert "it took while answering busy" in said
-    assert sorted(body.card) == ([] if formatted else ["IMG_0999.CR2"])
+    if rollover:  # the session's shots were downloaded and deleted from 101CANON
+        assert body.card_dir().endswith("101CANON") and not body.card, body.card
+        assert list(body.older_folders["/store_00020001/DCIM/100CANON"]) == ["IMG_9999.CR2"]
+    else:
+        assert sorted(body.card) == ["IMG_0999.CR2"]
 
 
 def test_a_picture_a_busy_answer_took_and_never_announced_is_found_on_the_card(body, tmp_path):
