@@ -779,7 +779,9 @@ class Gphoto2Camera:
         before = self._card_seen.get(folder)
         if before is None and self._card_folders is not None:
             # not on the card at connect: the body made it since, for this session's shots
-            before = set() if folder.rstrip("/") not in self._card_folders else None
+            # the walk keeps "/" for the root, which rstrip("/") makes "": the root of a
+            # body saving there had been taken for a folder made since, its files for strays
+            before = set() if (folder.rstrip("/") or "/") not in self._card_folders else None
         if before is None:
             return []
         now = self._list_folder(folder)

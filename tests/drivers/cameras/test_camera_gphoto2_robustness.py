@@ -202,3 +202,20 @@ def test_mosaic_sessions_are_labelled_in_tiff_journal_and_manifest(tmp_path):
     assert any("CFA mosaics" in n for n in manifest["notices"])
     assert manifest["steps"][0]["decode"]["mode"] == "mosaic"
     assert src.exists()  # a watched folder's file is copied, never taken away
+
+
+def test_a_body_saving_at_the_root_is_not_taken_for_a_folder_made_since_connect(tmp_path):
+    """A body left to its own target (no capture_target set) that keeps its shots in RAM,
+    at "/": the connect's walk stores "/" as a folder there, but a busy spell compared "" (the
+    root with its "/" stripped), took the root for a folder the body made since and every
+    file in it for a picture the busy answer took: the owner's earlier one was downloaded as
+    this session's stray. The root is the root."""
+    body = Body(render=render)
+    body.config["capturetarget"] = "Internal RAM"
+    body.ram["capt9999.jpg"] = b"\xff\xd8 the owner's picture, still in the body's RAM"
+    body.still_writing(1)  # the first shot comes after a busy answer: its folder is looked at
+    with camera(body, tmp_path, capture_target=None) as cam:
+        frame = cam.capture(1 / 60)
+    assert cam.retries_used == 1
+    assert not frame.metadata.get("stray_files"), frame.metadata
+    assert "capt9999.jpg" in body.ram
