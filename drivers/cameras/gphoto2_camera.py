@@ -58,9 +58,14 @@ GP_ERROR_HINTS = {
 #: auto power-off): -7 I/O error, -10 timeout, -52 USB device not found, -105 model not found.
 GONE_CODES = frozenset({-7, -10, -52, -105})
 
-#: card folders walked at connect at most (``/``, a storage, ``DCIM``, ``100CANON`` … are four):
-#: a card of more is left to be listed at the session's first shot in a folder, as before
+#: card folders walked before a session at most (``/``, a storage, ``DCIM``, ``100CANON`` …
+#: are four): a card of more is left to be listed at the session's first shot in a folder
 MAX_CARD_FOLDERS = 64
+#: files listed before a session at most, and seconds (the rig's clock) spent listing: a
+#: Nikon-type body fetches each file's info as libgphoto2 lists it (gphoto2 issue #204: some
+#: 6 minutes for 2,700 files); the walk stops before another folder once either is passed
+MAX_CARD_FILES = 2000
+MAX_CARD_WALK_S = 30.0
 
 
 #: Settings keys whose camera setting is named by another key (the camera's own name for it).
@@ -272,7 +277,6 @@ class Gphoto2Camera:
         self.camera_model = model
         try:
             self._configure()
-            self._list_card()
         except BaseException:
             self.close()
             raise
@@ -773,7 +777,7 @@ class Gphoto2Camera:
         had stayed on the card unseen, the session saying nothing of it. In the camera's
         RAM (``capture_target = "Internal RAM"``) an unannounced picture has no file to list
         and cannot be seen at all; nor can one in a folder that was on the card at connect but
-        not listed then (see :meth:`_list_card`) before the session's first shot in it."""
+        not listed then (see :meth:`list_card`) before the session's first shot in it."""
         if not self._fired_after_busy or self.settings.capture_target == "Internal RAM":
             return []
         before = self._card_seen.get(folder)
@@ -799,24 +803,42 @@ class Gphoto2Camera:
         self._earlier_stems.update(Path(n).stem for _, n in found)
         return found
 
-    def _list_card(self) -> None:
-        """At connect, when shooting to the card: walk its folders and list the files of each
-        innermost one (``DCIM/100CANON``): the "before" of the session's first shot in it.
+    def list_card(self, say: Callable[[str], None]) -> None:
+        """Before a capture session's first shot (``run``, not ``check`` or ``preview``), when
+        shooting to the card: walk its folders and list the files of each innermost one
+        (``DCIM/100CANON``), the "before" of the session's first shot in it; ``say`` is told
+        before the walk, and when it stopped short.
 
         Why: a card folder was first listed after the session's first shot in it, so a
         picture the body took behind a busy answer before that shot (a body still writing
         the owner's last picture as the session began) was taken for a file that had always
-        been there, and stayed on the card unseen. A folder made after connect (the body
-        opening ``101CANON``) holds only new files. The walk stops at
-        :data:`MAX_CARD_FOLDERS` (a card of many folders; the first shot's listing then
-        serves, as before); a body that cannot list folders is left as before. A body
-        never busy pays for it instead of its first shot's listing: one listing a session."""
-        if self.settings.capture_target == "Internal RAM":
+        been there, and stayed on the card unseen. A folder made since (the body opening
+        ``101CANON``) holds only new files. The walk had been done at every connect, unsaid
+        and unbounded but for its folders: minutes on a full card of a body that reads each
+        file's info to list it, in ``check`` and ``preview`` too. It stops before another
+        folder past :data:`MAX_CARD_FOLDERS`, :data:`MAX_CARD_FILES` or
+        :data:`MAX_CARD_WALK_S` (the first shot's listing then serves, as before)."""
+        if self._cam is None or self.settings.capture_target == "Internal RAM":
             return
+        say(
+            f"Listing the camera's card ({self.name}), to tell a picture the camera takes "
+            "before the first shot from those already there (a full card may take a while)…"
+        )
         folders: set[str] = set()
-        todo = ["/"]
+        todo, files, started = ["/"], 0, self._clock.now()
         while todo:
-            if len(folders) >= MAX_CARD_FOLDERS:
+            spent = self._clock.now() - started
+            if (
+                len(folders) >= MAX_CARD_FOLDERS
+                or files >= MAX_CARD_FILES
+                or (spent >= MAX_CARD_WALK_S)
+            ):
+                say(
+                    f"Stopped listing the camera's card after {len(folders)} folders, "
+                    f"{files} files, {spent:.0f} s: the check for a picture the camera takes "
+                    "behind a busy answer before the session's first shot is off (after "
+                    "each shot it is made as before); a card with fewer files lists faster"
+                )
                 return
             folder = todo.pop()
             try:
@@ -830,6 +852,7 @@ class Gphoto2Camera:
                 if listed is None:
                     return
                 self._card_seen[folder] = listed
+                files += len(listed)
         self._card_folders = folders
 
     def _note_card(self, folder: str, taken: list[tuple[str, str]]) -> None:

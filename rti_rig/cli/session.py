@@ -902,6 +902,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     from rti_rig.app.usecases.session import run_opened_session
     from rti_rig.runtime.controller import (
         CancelToken,
+        DeviceSays,
         EmergencyStop,
         FinishReason,
         LightOffForCamera,
@@ -978,6 +979,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                 elif isinstance(event, LightOffForCamera):
                     # said as it happens: the bar would stand still for the whole wait
                     err.print(_light_off_for_camera(event), markup=False)
+                elif isinstance(event, DeviceSays):
+                    err.print(event.text, markup=False)
 
             started = True
             result = run_opened_session(opened, cancel, on_event)

@@ -162,7 +162,16 @@ class LightOffForCamera:
     limit: str = ""
 
 
-Event = StepStarted | StepCompleted | Paused | LightOffForCamera
+@dataclass(frozen=True)
+class DeviceSays:
+    """A device's word on what it is doing before the first step, said as it happens (a
+    DSLR listing its card, which may take minutes on a full card, had been silent)."""
+
+    device: str
+    text: str
+
+
+Event = StepStarted | StepCompleted | Paused | LightOffForCamera | DeviceSays
 
 
 class StepSource(Protocol):
@@ -504,8 +513,12 @@ def run_session(
     cancel: CancelToken | None = None,
     on_event: Callable[[Event], None] | None = None,
     source: StepSource | None = None,
+    list_card: bool = True,
 ) -> SessionResult:
     """Run ``schedule`` on ``rig`` into ``folder``; see the module docstring for the guarantees.
+
+    ``list_card``: whether a card camera lists its card before the first shot (not for a
+    preview's one image).
 
     With ``source`` the steps are the source's decisions, step by step (adaptive acquisition);
     ``schedule`` is then the starting layout recorded in the manifest, checked like any other.
@@ -548,6 +561,12 @@ def run_session(
         rig.lighting.connect()
         rig.camera.connect()
         rig.lighting.off()
+        # a card camera lists its card, to tell a picture taken before the first shot (only
+        # a capture session does: `check` and `preview` never wait for it)
+        walk = getattr(rig.camera, "list_card", None) if list_card else None
+        if walk is not None:
+            name = str(getattr(rig.camera, "name", "camera"))
+            walk(lambda text: emit(DeviceSays(name, text)))
         planned = [
             *(step_exposure(rig, schedule.steps[i]) for i in todo if source is None),
             *((cam.exposure_s, *(s.exposure_s or 0.0 for s in schedule.steps)) if source else ()),

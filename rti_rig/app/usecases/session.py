@@ -132,6 +132,9 @@ class OpenedSession:
     #: An adaptive session's step source (:mod:`rti_rig.app.usecases.adaptive`); None: the
     #: schedule is run as it is.
     source: Any = None
+    #: whether a card camera lists its card before the first shot (a capture session, `run`;
+    #: not the one-image session of `preview`, which had waited minutes on a full card)
+    list_card: bool = True
 
     @property
     def dry_run(self) -> bool:
@@ -1170,7 +1173,9 @@ def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> Op
     )
     for note in notes:
         on_note(Note(note, "warning"))
-    return _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+    opened = _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
+    opened.list_card = False
+    return opened
 
 
 def run_opened_session(
@@ -1191,6 +1196,7 @@ def run_opened_session(
             cancel=cancel,
             on_event=on_event,
             source=opened.source,
+            list_card=opened.list_card,
         )
     if opened.source is not None and result.finish_reason is FinishReason.COMPLETED:
         # the adaptive run's outcome (lights used, final estimate, why it stopped), concluded

@@ -215,7 +215,36 @@ def test_a_body_saving_at_the_root_is_not_taken_for_a_folder_made_since_connect(
     body.ram["capt9999.jpg"] = b"\xff\xd8 the owner's picture, still in the body's RAM"
     body.still_writing(1)  # the first shot comes after a busy answer: its folder is looked at
     with camera(body, tmp_path, capture_target=None) as cam:
+        cam.list_card(lambda _: None)  # as a capture session does before its first shot
         frame = cam.capture(1 / 60)
     assert cam.retries_used == 1
     assert not frame.metadata.get("stray_files"), frame.metadata
     assert "capt9999.jpg" in body.ram
+
+
+@pytest.mark.parametrize(
+    "full, said",
+    [
+        (dict(folders=5, files=600, s_per_file=0.0), "after 8 folders, 2400 files, 0 s"),
+        (dict(folders=2, files=300, s_per_file=0.13), "after 5 folders, 300 files, 39 s"),
+    ],
+    ids=["many-files", "slow-listing"],
+)
+def test_the_card_walk_before_a_session_is_said_and_bounded(tmp_path, full, said):
+    """A full card on a body that lists slowly (a Nikon-type body fetches each file's info:
+    gphoto2 issue #204, some 6 minutes for 2,700 files) had been walked at every connect,
+    unsaid, bounded by its folders only. The walk now says it starts, and stops before
+    another folder once 2,000 files are listed or 30 s spent, saying that the check before
+    the first shot is off."""
+    clock = VirtualClock()
+    body = Body(render=render, list_s_per_file=full["s_per_file"], list_clock=clock)
+    for n in range(full["folders"]):
+        names = {f"DSC_{n * 1000 + i:04d}.NEF": b"" for i in range(full["files"])}
+        body.older_folders[f"/store_00020001/DCIM/{100 + n}CANON"] = names
+    body.card_folder = 100 + full["folders"]
+    heard: list[str] = []
+    with camera(body, tmp_path, clock, capture_target="Memory card") as cam:
+        assert "folder_list_folders" not in body.calls  # not at connect
+        cam.list_card(heard.append)
+    assert "Listing the camera's card" in heard[0], heard
+    assert len(heard) == 2 and said in heard[1] and "is off" in heard[1], heard

@@ -443,6 +443,24 @@ def card_config(tmp_path: Path) -> Path:
     return config
 
 
+def test_the_card_is_listed_for_a_run_only_and_said(body, tmp_path):
+    """The card walk had been done at every connect, unsaid: minutes on a full card of a
+    Nikon-type body (gphoto2 issue #204), in `check` and `preview` too, which never look for
+    a picture taken before a session's first shot. `check` and `preview` no longer list the
+    card; `run` says it does before it does."""
+    config = card_config(tmp_path)
+    result = CliRunner().invoke(app, ["check", str(config)])
+    assert result.exit_code == 0 and "RESULT: PASS" in result.output, result.output
+    result = CliRunner().invoke(app, ["preview", str(config), "--out", str(tmp_path / "p")])
+    assert result.exit_code == 0, result.output
+    assert "folder_list_folders" not in body.calls and body.shots == 1, body.calls
+    result = run(str(config), "--out", str(tmp_path / "s"), "--lights", "2")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0, said
+    assert "Listing the camera's card (dslr)" in said, said
+    assert "folder_list_folders" in body.calls
+
+
 @pytest.mark.parametrize("rollover", [False, True], ids=["card-in-use", "card-next-folder"])
 def test_a_picture_taken_behind_a_busy_answer_before_the_first_shot_is_found_on_the_card(
     body, tmp_path, rollover
