@@ -53,6 +53,7 @@ Safe state: nothing to release (no device handle); ``close`` forgets the seen fi
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 import shutil
@@ -180,13 +181,24 @@ class _LearnedClock:
 
 
 def computer_id() -> str:
-    """This computer and its boot: the host name and, where the system says it (Linux), the
-    boot id. Two runs with the same id share one monotonic clock."""
+    """This computer and its boot: a digest of the host name and, where the system says it
+    (Linux), the boot id (a digest: the session, shared with others, names no host). Two runs
+    with the same id share one monotonic clock."""
     try:
         boot = Path("/proc/sys/kernel/random/boot_id").read_text(encoding="ascii").strip()
     except OSError:
         boot = ""
-    return f"{socket.gethostname()} {boot}".strip()
+    return hashlib.sha256(f"{socket.gethostname()} {boot}".encode()).hexdigest()[:16]
+
+
+def since_boot() -> float:
+    """The computer's clock since it booted, which no NTP step or clock setting moves and
+    which counts a suspend (Linux's CLOCK_BOOTTIME; ``time.monotonic`` elsewhere, which
+    counts one on Windows and macOS). A suspend not counted (Linux's CLOCK_MONOTONIC) would
+    be taken for a wall clock set forward, and a late file of a run stopped before a laptop
+    slept would pass for the resumed light's."""
+    boottime = getattr(time, "CLOCK_BOOTTIME", None)
+    return time.monotonic() if boottime is None else time.clock_gettime(boottime)
 
 
 #: the first image of a resume whose earlier run's camera clock cannot be compared with this
@@ -366,10 +378,11 @@ class FolderWatchCamera:
         #: against it holds from one run of a session to the next, the rig clock does not
         self._wall = wall
         self._clock = clock or SystemClock()
-        #: the computer's monotonic clock, which measures how far its wall clock was moved
-        #: between two runs of one boot (an NTP step): the rig's clock when it is the system's
+        #: the computer's clock since boot (:func:`since_boot`), which measures how far its
+        #: wall clock was moved between two runs of one boot (an NTP step); None (no
+        #: correction) when the rig's clock is a virtual one, whose times are no computer's
         self._monotonic = monotonic or (
-            time.monotonic if isinstance(self._clock, SystemClock) else None
+            since_boot if isinstance(self._clock, SystemClock) else None
         )
         self._computer = computer
         #: the connect on the wall clock of the run that learned the camera clock (this run's
@@ -803,7 +816,7 @@ class FolderWatchCamera:
             f"; shot before this run connected ({shown} before, by the camera clock the "
             "session's earlier run learned): files of the stopped run, not of this light. If "
             "the camera's clock was set back since, the computer's clock set forward in a way "
-            "its monotonic clock does not show, or another camera now saves there, delete "
+            "its clock since boot does not show, or another camera now saves there, delete "
             f"{self._clock_file()} and resume again (the first image is then unchecked)"
         )
 
