@@ -151,6 +151,18 @@ def test_a_uvc_drain_longer_than_max_on_s_is_refused_before_any_led_lights(
     assert "Traceback" not in said and not list(out.glob("*.jpg"))
 
 
+def _metered_run(tmp_path, monkeypatch, cfg, stream):  # type: ignore[no-untyped-def]
+    """`rti-rig run CFG --lights 4 --auto-exposure` on the shipped dome's emulator, the UVC
+    camera being STREAM: the exit code, the output on one line, the session folder and the
+    firmware's history (what it lit), for the metering tests below."""
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, [*args, "--no-verdict"])
+    return r.exit_code, " ".join(r.output.split()), out, firmware.history
+
+
 @pytest.mark.pty
 @pytest.mark.parametrize("max_on_s", [1.5, 8.0], ids=["lit-limit-1.5s", "lit-limit-8s"])
 def test_a_uvc_metering_chooses_no_exposure_past_the_cameras_frame_period(
@@ -171,13 +183,8 @@ def test_a_uvc_metering_chooses_no_exposure_past_the_cameras_frame_period(
         buffers=4,
         buffer_size_accepted=False,
     )
-    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
-    out = tmp_path / "s"
-    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        r = CliRunner().invoke(app, [*args, "--no-verdict"])
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    code, said, out, history = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
     assert "Exposure fixed at 0.05 s" in said, said
     assert "longest the camera uvc-camera can take" in said, said
     assert "20 fps (CAP_PROP_FPS)" in said and "lower fps in [camera.device]" in said, said
@@ -192,7 +199,7 @@ def test_a_uvc_metering_chooses_no_exposure_past_the_cameras_frame_period(
         <= 0.05 + 1e-9
     )
     assert "Traceback" not in said and "stayed on" not in said, said
-    assert len([e for e in firmware.history if e.what == "lit"]) >= 4 + 4
+    assert len([e for e in history if e.what == "lit"]) >= 4 + 4
 
 
 @pytest.mark.pty
@@ -207,13 +214,8 @@ def test_a_uvc_metering_asks_only_for_exposures_in_the_cameras_units(tmp_path, m
     light = LightHistory(SystemClock())  # type: ignore[arg-type]
     light.set(1.0)  # bright whatever LED is lit: 0.05 s saturates 76 times over
     stream = BufferedUvcStream(light, fps=20.0, scale=1e8)
-    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
-    out = tmp_path / "s"
-    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
-    with shipped_dome_on_pty(monkeypatch, cfg):
-        r = CliRunner().invoke(app, [*args, "--no-verdict"])
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    code, said, out, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
     assert "whole number" not in said and "Traceback" not in said, said
     manifest = json.loads((out / "manifest.json").read_text())
     evidence = manifest["schedule"]["provenance"]["exposure"]
@@ -358,13 +360,8 @@ def test_a_uvc_metering_at_30fps_warns_at_the_longest_whole_units_exposure(tmp_p
     cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
     cfg.write_text(cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.02\n", 1))
     stream = BufferedUvcStream(LightHistory(SystemClock()), fps=30.0)  # type: ignore[arg-type]
-    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
-    out = tmp_path / "s"
-    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
-    with shipped_dome_on_pty(monkeypatch, cfg):
-        r = CliRunner().invoke(app, [*args, "--no-verdict"])
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    code, said, _, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
     assert "Exposure fixed at 0.0333 s" in said, said
     assert "longest the camera uvc-camera can take" in said, said
     assert "30 fps (CAP_PROP_FPS)" in said and "Traceback" not in said, said
@@ -383,13 +380,8 @@ def test_a_configured_exposure_not_in_units_is_only_a_start_for_auto_exposure(
     light = LightHistory(SystemClock())  # type: ignore[arg-type]
     light.set(1.0)
     stream = BufferedUvcStream(light, fps=20.0, scale=1e6)
-    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
-    out = tmp_path / "s"
-    args = ["run", str(cfg), "--out", str(out), "--lights", "4", "--auto-exposure"]
-    with shipped_dome_on_pty(monkeypatch, cfg):
-        r = CliRunner().invoke(app, [*args, "--no-verdict"])
-    said = " ".join(r.output.split())
-    assert r.exit_code == 0, said
+    code, said, out, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
     assert "whole number" not in said and "Traceback" not in said, said
     manifest = json.loads((out / "manifest.json").read_text())
     shot = manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
