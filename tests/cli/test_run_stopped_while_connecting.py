@@ -76,14 +76,16 @@ def test_a_ctrl_c_while_a_failed_connect_reopens_at_the_published_rate_waits_for
     monkeypatch.setattr(SerialTransport, "open", open_port)
     text = (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
     text = text.replace('profile = "nab-rti-v1"', 'profile = "nab-rti-v1"\nbaudrate = 115200')
-    # short waits, so that the test is (each boot and wait is spent twice, in real time): a
-    # quicker bootloader than the Uno's 1.6 s, a boot wait past it and the banner, and the
-    # all-off's reply timeout (1 s in the profile) at 0.5 s, where a booted board at the right
-    # rate answers within 30 ms and one at the wrong rate never does
+    # shorter waits than the real ones (each boot and wait is spent twice, in real time), each
+    # with a margin of about 1 s over what it waits for, so that a loaded machine's stalled
+    # emulator thread still answers in time: a quicker bootloader than the Uno's 1.6 s, a boot
+    # wait 1.2 s past it and the banner, and the all-off's reply timeout (1 s in the profile)
+    # kept at 1 s, where a booted board at the right rate answers within 30 ms and one at the
+    # wrong rate never does
     monkeypatch.setattr(NabRtiV1Board, "boot_s", 0.4)
-    monkeypatch.setitem(nab_rti_v1.ALL_OFF["reply"], "timeout_s", 0.5)
-    text = text.replace("reply_timeout_s = 3.0", "reply_timeout_s = 0.5")
-    text = text.replace("led_count = 12", "led_count = 12\nboot_wait_s = 0.9")
+    monkeypatch.setitem(nab_rti_v1.ALL_OFF["reply"], "timeout_s", 1.0)
+    text = text.replace("reply_timeout_s = 3.0", "reply_timeout_s = 1.0")
+    text = text.replace("led_count = 12", "led_count = 12\nboot_wait_s = 1.6")
     cfg = tmp_path / "rig.toml"
     cfg.write_text(text)
     out = tmp_path / "session"
