@@ -32,3 +32,27 @@ def test_a_horizon_ring_rig_gets_no_plan(tmp_path: Path, method: str) -> None:
     assert r.exit_code == 2, said
     assert "the 12 planned lights cannot determine a surface normal" in said
     assert not out.exists()
+
+
+def _ring(el_deg: float, n: int) -> list[tuple[float, float, float]]:
+    e, az = np.radians(el_deg), np.radians(np.arange(n) * 360.0 / n)
+    return [(np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)) for a in az]
+
+
+def test_lights_bunched_at_the_zenith_are_named_so_without_a_band_to_widen(
+    tmp_path: Path,
+) -> None:
+    """Rings at 89.2° and 89.6° had been told "all at the horizon or at one azimuth" and to
+    widen a band that was already 0..90°."""
+    rig = tmp_path / "cap.lp"
+    lights = _ring(89.2, 12) + _ring(89.6, 8)
+    write_lp(rig, [LpEntry(f"led_{k:02d}.jpg", d) for k, d in enumerate(lights)])
+    out = tmp_path / "plan.lp"
+    r = CliRunner().invoke(
+        app, ["plan", "--rig", str(rig), "--lights", "12", "--method", "uniform", "--out", str(out)]
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "bunched at the zenith" in said
+    assert "widen" not in said and "at the horizon or at one azimuth" not in said
+    assert not out.exists()

@@ -12,8 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from rti_rig.app.compose import arm_order_for, read_preview_image
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
+from rti_rig.app.normals_determined import FIT_WITHOUT_NORMALS, undetermined_normals
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.app.preview_source import resolve_preview
 from rti_rig.core.errors import RtiRigError
@@ -204,28 +207,28 @@ def refuse_undetermined(schedule: LightSchedule, req: PlanLightsRequest) -> None
     """Refuse a plan whose lights cannot determine a surface normal, before it is written.
 
     Every planner picks among the rig's lights in the elevation band; where those all lie in
-    one plane (a ring at the horizon, one azimuth) any choice is coplanar. Such a plan had been
-    written with "expected RMS normal error 90.00" as its only sign, for ``rti-rig fit`` to
-    refuse its photometric stereo after the session was shot. Judged as the fit judges it
-    (:func:`rti_rig.reconstruct.solve.solve_matrix`, the condition number over the hemisphere).
+    one plane (a ring at the horizon, one azimuth) or bunch at the zenith, any choice does. Such
+    a plan had been written with "expected RMS normal error 90.00" as its only sign, for
+    ``rti-rig fit`` to refuse its photometric stereo after the session was shot. "Widen the
+    band" is offered only where a band was given: a rig whose rings sit at 89.2° and 89.6° had
+    been told to widen the 0..90° band it already had.
     """
-    import numpy as np
-
-    from rti_rig.core.rti_bases import design_matrix
-    from rti_rig.reconstruct.solve import solve_matrix
-
     lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
-    _, report = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
-    if report.regularised:
-        band = f"{req.min_elevation_deg:g}°..{req.max_elevation_deg:g}°"
-        raise RtiRigError(
-            f"the {len(lights)} planned lights cannot determine a surface normal: they lie "
-            f"(nearly) in one plane (condition number {report.condition_number:.3g} over the "
-            f"hemisphere, limit {report.cond_limit:g}), and rti-rig fit would refuse them "
-            f"(lights of {req.rig} between {band} elevation all at the horizon or at one "
-            "azimuth leave no other choice). Use a rig with lights at several elevations and "
-            "azimuths, or widen --min-elevation-deg / --max-elevation-deg; nothing was written"
-        )
+    reason = undetermined_normals(lights, "planned lights")
+    if reason is None:
+        return
+    narrowed = req.min_elevation_deg > 0.0 or req.max_elevation_deg < 90.0
+    band = f"{req.min_elevation_deg:g}°..{req.max_elevation_deg:g}°"
+    widen = (
+        f", or widen --min-elevation-deg / --max-elevation-deg (the band {band} was given)"
+        if narrowed
+        else ""
+    )
+    raise RtiRigError(
+        f"{reason}; {FIT_WITHOUT_NORMALS}. The lights of {req.rig} between {band} "
+        "elevation leave no other choice: use a rig with lights at several elevations and "
+        f"azimuths{widen}; nothing was written"
+    )
 
 
 def _lp_labels(labels: list[str]) -> list[str]:
