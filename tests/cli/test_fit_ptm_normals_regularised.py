@@ -32,6 +32,16 @@ def _error_deg(out: Path, truth: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip((n * truth).sum(-1), -1, 1))).mean())
 
 
+def _one_azimuth() -> np.ndarray:
+    """10 lights at azimuth 28.6°, elevations 10-80°: in one plane through the object."""
+    return np.array(
+        [
+            (np.cos(e) * np.cos(0.5), np.cos(e) * np.sin(0.5), np.sin(e))
+            for e in np.radians(np.linspace(10, 80, 10))
+        ]
+    )
+
+
 def test_a_ring_gets_photometric_stereo_normals(tmp_path: Path) -> None:
     session, _, truth = make_session(
         tmp_path / "s", scene="tablet", size=(48, 48), lights=_rings(((35, 12, 0),))
@@ -54,13 +64,7 @@ def test_one_direction_repeated_writes_no_normals(tmp_path: Path) -> None:
 def test_an_hsh_fit_on_one_azimuth_is_written_without_normals(tmp_path: Path) -> None:
     # it had been refused whole ("ill-conditioned for photometric stereo"), its normals being
     # robust PS's; the relighting file is written regularised, as a PTM's is
-    lights = np.array(
-        [
-            (np.cos(e) * np.cos(0.5), np.cos(e) * np.sin(0.5), np.sin(e))
-            for e in np.radians(np.linspace(10, 80, 10))
-        ]
-    )
-    session, _, _ = make_session(tmp_path / "s", size=(32, 32), lights=lights)
+    session, _, _ = make_session(tmp_path / "s", size=(32, 32), lights=_one_azimuth())
     said = _fit(session, tmp_path / "f", "hsh2")
     assert "normals.png/.npy and albedo not written" in said
     assert (tmp_path / "f" / "fit.rti").exists()
@@ -69,3 +73,15 @@ def test_an_hsh_fit_on_one_azimuth_is_written_without_normals(tmp_path: Path) ->
         app, ["fit", str(session), "--out", str(tmp_path / "ps"), "--model", "robust-ps"]
     )
     assert r.exit_code == 2 and "ill-conditioned for photometric stereo" in r.output
+
+
+def test_auto_on_one_azimuth_names_the_cli_way_out(tmp_path: Path) -> None:
+    # auto chooses Lambert on these lights and was refused with "(from Python,
+    # ill_conditioned='regularise' fits it regularised)", advice a CLI user cannot follow
+    session, _, _ = make_session(tmp_path / "s", size=(32, 32), lights=_one_azimuth())
+    r = CliRunner().invoke(app, ["fit", str(session), "--out", str(tmp_path / "f"), "--no-qa"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "--model auto chose lambert" in said
+    assert "--model hsh2 or --model ptm write the relighting files" in said
+    assert "from Python" not in said

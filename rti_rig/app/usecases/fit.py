@@ -764,6 +764,8 @@ def _fit_all(
         write_normals = bool(normal_source)
         if why:
             skipped.append(why)
+    elif model_name in ("ps", "lambert", "ps-robust"):  # normals are the model: none, no fit
+        _refuse_undetermined_normals(req, model_name, lights)
 
     # linear models to export, their solve matrices (warnings issued once, here)
     order, rti_why = rti_order(stack, lights, req, model_name, choice)
@@ -948,6 +950,29 @@ def _normal_source(model_name: str) -> str:
     and ``--model robust-ps`` or ``--model ps`` asks for one.
     """
     return NORMALS_BY_MODEL.get(model_name, "ps-robust")
+
+
+def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.ndarray) -> None:
+    """Refuse, naming the CLI way out, a fit whose model is photometric stereo (``--model
+    ps``, ``lambert``, ``robust-ps``, or ``auto`` choosing Lambert) on lights that cannot give
+    normals.
+
+    The solver's own refusal advised "(from Python, ill_conditioned='regularise' fits it
+    regularised)", which a CLI user cannot act on; ``auto`` chooses Lambert on lights at one
+    azimuth, so its fit was refused whole where ``--model hsh2`` or ``ptm`` writes the
+    relighting files without normals.
+    """
+    from rti_rig.app.normals_determined import undetermined_normals
+
+    reason = undetermined_normals(lights, "lights of this session")
+    if reason is None:
+        return
+    asked = f"--model auto chose {model_name}" if req.model == AUTO else f"--model {req.model}"
+    raise FitInputError(
+        f"{asked}, photometric stereo, but {reason}: ill-conditioned for photometric stereo. "
+        "--model hsh2 or --model ptm write the relighting files (fit.rti, fit.ptm) without "
+        "normal maps; for normals, capture again with lights at several elevations and azimuths"
+    )
 
 
 def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str]:
