@@ -944,6 +944,12 @@ def _angle(a: NDArray, b: NDArray) -> float:
     return float(np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b)), float(np.dot(a, b)))))
 
 
+#: The narrowest image side the QA can judge: its shift check correlates images under a
+#: Hanning window, which OpenCV refuses on a side of 1 px (a 1×1 image ended ``rti-rig fit``
+#: in a ``cv2.error`` traceback after every output was written, and ``run``'s verdict too).
+QA_MIN_SIDE = 2
+
+
 def assess(
     frames: Sequence[ArrayLike],
     lights: ArrayLike,
@@ -952,11 +958,17 @@ def assess(
     saturation: float | None = None,
 ) -> QAReport:
     """Check an acquisition: ``frames`` (N arrays or row-readable array-likes (H, W[, C]),
-    uint16 or float), ``lights``. Frames are read one at a time."""
+    uint16 or float), ``lights``. Frames are read one at a time. Images narrower than
+    :data:`QA_MIN_SIDE` either way are refused (:class:`ReconstructionError`)."""
     n = len(frames)
     lt = validate_lights(lights, n)
     first = frames[0]
     h, w = int(first.shape[0]), int(first.shape[1])
+    if min(h, w) < QA_MIN_SIDE:  # refused here, so no caller meets OpenCV's error instead
+        raise ReconstructionError(
+            f"the images are {w}×{h} px, and the QA compares them by their edges, which needs "
+            f"at least {QA_MIN_SIDE} px each way"
+        )
     if saturation is None:
         dt = np.dtype(first.dtype)
         saturation = float(np.iinfo(dt).max) if np.issubdtype(dt, np.integer) else float("inf")

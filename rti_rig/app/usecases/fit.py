@@ -632,12 +632,7 @@ def _fit_into(  # type: ignore[no-untyped-def]
         )
     )
     release_free_memory()  # the fit's bands and PNG buffers, before QA reads the images again
-    if req.qa and min(stack.height, stack.width) < QA_MIN_SIDE:
-        result.warnings.append(
-            f"QA not possible: the images are {stack.width}×{stack.height} px, and the QA "
-            f"compares them by their edges, which needs at least {QA_MIN_SIDE} px each way"
-        )
-    elif req.qa:
+    if req.qa:
         if checksums is not None:
             with contextlib.suppress(Exception):  # the QA's own check says what went wrong
                 checksums.result()
@@ -645,7 +640,7 @@ def _fit_into(  # type: ignore[no-untyped-def]
             qa = assess(frames, lights, names)  # every row of every frame: checksummed too
             _remember_pixels(frames)
             result.qa = with_lost_files(qa, req.source)
-        except ReconstructionError as exc:  # e.g. too few or coplanar lights for PS
+        except ReconstructionError as exc:  # e.g. coplanar lights for PS, 1-px images
             result.warnings.append(f"QA not possible: {exc}")
         else:
             result.files += write_qa_report(out, result.qa, result)
@@ -681,11 +676,6 @@ PTM_MEASURED_FROM = 8
 #: jcupitt/webRTIViewer ``webGLRTIMaker-src/rti.h``; 16 overrun them) and JedMills'
 #: RTIViewer (``src/ptmCreation/RTIParser.java`` keeps terms 0-8 and drops the rest).
 RELIGHT_HSH_ORDER = 2
-
-#: The narrowest image side the QA can judge: its shift check correlates images under a
-#: Hanning window, which OpenCV refuses on a side of 1 px (a 1×1 image ended the fit in a
-#: traceback after every output was written).
-QA_MIN_SIDE = 2
 
 #: Pixel sample shared by model choice, quantisation ranges and the reference level: one
 #: decode pass of the files for all three.
