@@ -466,6 +466,8 @@ class SessionFolder:
                 what = (
                     "a finished session"
                     if finished
+                    else "a session another rti-rig process is capturing into right now"
+                    if in_use_by_another(outer)  # running, not interrupted: no resume to offer
                     else f"an interrupted session (continue it with {resume})"
                 )
             except SessionError:  # a journal without a manifest, or a damaged manifest

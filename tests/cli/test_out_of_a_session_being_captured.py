@@ -31,7 +31,8 @@ HOLD = (
 )
 
 
-def test_a_session_being_captured_is_said_to_be_so(tmp_path: Path) -> None:
+def _run_while_captured(tmp_path: Path, out: str) -> str:
+    """``rti-rig run --out S/out`` while another process holds S as a running capture does."""
     config = str(CONFIGS / "virtual_arm.toml")
     session = tmp_path / "s"
     r = runner.invoke(app, ["run", config, "--out", str(session), "--lights", "3", "--no-verdict"])
@@ -48,12 +49,25 @@ def test_a_session_being_captured_is_said_to_be_so(tmp_path: Path) -> None:
     )
     try:
         assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
-        r = runner.invoke(app, ["run", config, "--out", str(session), "--lights", "3"])
+        r = runner.invoke(app, ["run", config, "--out", str(session / out), "--lights", "3"])
     finally:
         assert holder.stdin is not None
         holder.stdin.close()
         holder.wait(timeout=60)
     text = " ".join(r.output.split())
     assert r.exit_code == 2, text
+    return text
+
+
+def test_a_session_being_captured_is_said_to_be_so(tmp_path: Path) -> None:
+    text = _run_while_captured(tmp_path, ".")
     assert "another rti-rig process is capturing a session in it right now" in text, text
+    assert "interrupted" not in text and "--resume" not in text
+
+
+def test_a_folder_inside_a_session_being_captured_is_said_to_be_so(tmp_path: Path) -> None:
+    # --out S/sub had been told S is "an interrupted session (continue it with rti-rig run
+    # --resume S)", a resume the running capture refuses
+    text = _run_while_captured(tmp_path, "sub")
+    assert "another rti-rig process is capturing into right now" in text, text
     assert "interrupted" not in text and "--resume" not in text
