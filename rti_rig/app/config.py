@@ -23,7 +23,8 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from rti_rig.app.flash_sync import FlashSyncSettings, SyncFaultConfig
 from rti_rig.core.errors import ConfigError, LpFormatError
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
-from rti_rig.core.lp_format import looks_like_image, read_lp
+from rti_rig.core.image_files import looks_like_image
+from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import (
     COINCIDENT_LED_DEG,
     ArmGeometry,

@@ -18,6 +18,20 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import SessionError
 
+#: The first bytes of the image files an acquisition holds: JPEG, PNG, TIFF (either byte
+#: order; DNG and most camera RAW are TIFF too). One list for the header reads here and for
+#: the readers that refuse an image given where text goes (:func:`looks_like_image`).
+JPEG_MAGIC = b"\xff\xd8"
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+TIFF_MAGIC = (b"II*\x00", b"MM\x00*")
+
+
+def looks_like_image(raw: bytes) -> bool:
+    """Whether ``raw`` starts as a JPEG, PNG or TIFF file does (an .lp or a rig config given
+    an image is refused as one, not as text with NUL bytes)."""
+    return raw.startswith((JPEG_MAGIC, PNG_MAGIC, *TIFF_MAGIC))
+
+
 #: How a linear TIFF's ImageDescription begins when its pixels are a CFA mosaic (one colour per
 #: photosite, ``decode.mode = "mosaic"``): the session writes it, and readers that need a
 #: picture (``rti-rig fit``) refuse such a file by it rather than fit a checkerboard.
@@ -195,7 +209,7 @@ def jpeg_truncation(path: Path) -> str | None:
     (a data byte FF is followed by 00 or a restart marker); the header segments before the
     first scan (EXIF, whose thumbnail has its own FF D9) are skipped by their lengths."""
     data = Path(path).read_bytes()
-    if not data.startswith(b"\xff\xd8"):
+    if not data.startswith(JPEG_MAGIC):
         return None
     pos = 2
     while pos + 4 <= len(data):
@@ -227,13 +241,13 @@ def image_truncation(path: Path) -> str | None:
     p = Path(path)
     with open(p, "rb") as fh:
         head = fh.read(8)
-        if head.startswith(b"\x89PNG\r\n\x1a\n"):
+        if head.startswith(PNG_MAGIC):
             size = fh.seek(0, os.SEEK_END)
             fh.seek(max(0, size - 4096))
             if b"IEND" not in fh.read():  # the last chunk; writers may pad after it
                 return "it ends before its IEND chunk (cut short)"
             return None
-    if head[:4] in (b"II*\x00", b"MM\x00*"):
+    if head[:4] in TIFF_MAGIC:
         import tifffile
 
         try:
@@ -257,11 +271,11 @@ def header_layout(path: Path) -> tuple[int, int, bool] | None:
     p = Path(path)
     with open(p, "rb") as fh:
         head = fh.read(64 * 1024)
-    if head.startswith(b"\x89PNG\r\n\x1a\n") and head[12:16] == b"IHDR" and len(head) >= 26:
+    if head.startswith(PNG_MAGIC) and head[12:16] == b"IHDR" and len(head) >= 26:
         # colour type 0 grey, 4 grey + alpha; 2 RGB, 3 palette (decoded to RGB), 6 RGBA
         colour = head[25] not in (0, 4)
         return int.from_bytes(head[20:24], "big"), int.from_bytes(head[16:20], "big"), colour
-    if head[:4] in (b"II*\x00", b"MM\x00*"):
+    if head[:4] in TIFF_MAGIC:
         import tifffile
 
         try:
@@ -270,7 +284,7 @@ def header_layout(path: Path) -> tuple[int, int, bool] | None:
                 return int(page.imagelength), int(page.imagewidth), page.samplesperpixel >= 3
         except Exception:  # tifffile raises many kinds; the decoder names the problem later
             return None
-    if not head.startswith(b"\xff\xd8"):
+    if not head.startswith(JPEG_MAGIC):
         return None
     data = head if len(head) < 64 * 1024 else p.read_bytes()
     pos = 2
@@ -353,7 +367,7 @@ def tiff_sample_problem(path: Path) -> str | None:
     image part-way, telling the user to resume into the same stop."""
     p = Path(path)
     with open(p, "rb") as fh:
-        if fh.read(4) not in (b"II*\x00", b"MM\x00*"):
+        if fh.read(4) not in TIFF_MAGIC:
             return None
     import tifffile
 

@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import LpFormatError
+from rti_rig.core.image_files import looks_like_image
 
 #: relight refuses files with more lights than this.
 MAX_LIGHTS = 1000
@@ -457,15 +458,6 @@ def parse_lp(
             f"{len(entries)}; the {len(entries)} listed lights are used"
         )
     return entries
-
-
-#: The first bytes of the image files an acquisition holds: JPEG, PNG, TIFF (either order).
-IMAGE_MAGIC = (b"\xff\xd8", b"\x89PNG", b"II*\x00", b"MM\x00*")
-
-
-def looks_like_image(raw: bytes) -> bool:
-    """Whether ``raw`` starts as a JPEG, PNG or TIFF file does."""
-    return raw.startswith(IMAGE_MAGIC)
 
 
 def read_lp(
