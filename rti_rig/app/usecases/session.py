@@ -695,7 +695,14 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         check_light_count(len(entries))
         if (few := too_few_to_fit(len(entries))) is not None:
             on_note(few)
-        return schedule_from_lp(entries, geometry, str(req.plan))
+        schedule = schedule_from_lp(entries, geometry, str(req.plan))
+        _refuse_undetermined(
+            schedule,
+            f"lights of --plan {req.plan}",
+            "plan them with rti-rig plan (it refuses such lights) or give a plan with lights "
+            "at several elevations and azimuths",
+        )
+        return schedule
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
     check_light_count(n)
@@ -720,9 +727,42 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
                 f"{asked}: the acquisition {loaded.path} has only {inside} images{band}; "
                 + " or ".join(fewer)
             )
-    return plan_uniform(
+    schedule = plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )
+    band = req.min_elevation_deg > 0.0 or req.max_elevation_deg < 90.0
+    _refuse_undetermined(
+        schedule,
+        "lights asked for with --lights"
+        if req.lights is not None
+        else "lights run takes by default",
+        "widen --min-elevation-deg / --max-elevation-deg, or use a rig with lights at several "
+        "elevations and azimuths"
+        if band
+        else "use a rig with lights at several elevations and azimuths",
+    )
+    return schedule
+
+
+def _refuse_undetermined(schedule: LightSchedule, what: str, advice: str) -> None:
+    """Refuse, before the rig is opened, a session whose lights cannot determine a normal.
+
+    Only ``rti-rig plan`` refused lights in one plane (or bunched at the zenith): ``run
+    --lights N`` in a band that leaves only such lights, or ``run --plan`` of a hand-made .lp,
+    captured the session without a word, and ``rti-rig fit`` then wrote no normals from it.
+    Judged as the plan and the fit judge it (:func:`undetermined_normals`).
+    """
+    import numpy as np
+
+    from rti_rig.app.normals_determined import FIT_WITHOUT_NORMALS, undetermined_normals
+
+    lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
+    reason = undetermined_normals(lights, what)
+    if reason is not None:
+        raise RtiRigError(
+            f"{reason}; {FIT_WITHOUT_NORMALS}. {advice[0].upper()}{advice[1:]}; "
+            "nothing was lit or moved"
+        )
 
 
 def _metering_options(req: NewSessionRequest, loaded) -> str:  # type: ignore[no-untyped-def]
