@@ -54,15 +54,20 @@ def angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.degrees(np.arccos(np.clip(np.sum(a * b, axis=-1), -1.0, 1.0)))
 
 
-def row(scene: str, n: int, seed: int = 0) -> str:
-    """One table row: auto's model, robust PS and least-squares errors (mean °)."""
+def render(scene: str, lights: np.ndarray, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """(images (N, H, W[, C]) float32 with the noise, true normals) of a simulated scene."""
     sc = make_scene(scene, SIZE[0], SIZE[1], seed=seed)
-    lights = rings(LAYOUTS[n])
     images = np.stack([render_radiance(sc, DirectionalLight(tuple(d))) for d in lights])
     rng = np.random.default_rng(seed)
     images = images / np.percentile(images, 99.5) * 0.8
     images = np.clip(images + rng.normal(0.0, NOISE, images.shape), 0.0, 1.0).astype(np.float32)
-    truth = np.asarray(sc.normals)
+    return images, np.asarray(sc.normals)
+
+
+def row(scene: str, n: int, seed: int = 0) -> str:
+    """One table row: auto's model, robust PS and least-squares errors (mean °)."""
+    lights = rings(LAYOUTS[n])
+    images, truth = render(scene, lights, seed)
     chosen = select_model(images, lights).model
     robust = fit_photometric_stereo(images, lights, robust=True)
     ls = fit_photometric_stereo(images, lights, robust=False)

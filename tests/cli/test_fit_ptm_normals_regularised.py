@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+from conftest import REPO
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -85,3 +86,36 @@ def test_auto_on_one_azimuth_names_the_cli_way_out(tmp_path: Path) -> None:
     assert "--model auto chose lambert" in said
     assert "--model hsh2 or --model ptm write the relighting files" in said
     assert "from Python" not in said
+
+
+def test_a_ptm_over_its_noise_gain_limit_gives_no_ptm_normals(tmp_path: Path) -> None:
+    # lights on one side only: the PTM is not regularised (condition 40) but amplifies noise
+    # 15.2x (limit 10); its Lambertian reading had been written as the normal map, 25° off
+    side = np.array(
+        [
+            (np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e))
+            for e in np.radians((20, 45, 70))
+            for a in np.radians(np.linspace(0, 90, 6))
+        ]
+    )
+    session, _, truth = make_session(tmp_path / "s", size=(48, 48), lights=side)
+    said = _fit(session, tmp_path / "f", "ptm")
+    assert "normals from robust photometric stereo, not the PTM" in said
+    assert "noise gain 15.2, limit 10" in said
+    assert json.loads((tmp_path / "f" / "fit.json").read_text())["normals_from"] == "ps-robust"
+    assert _error_deg(tmp_path / "f", truth) < 2.0
+    assert (tmp_path / "f" / "fit.ptm").exists()
+
+
+def test_real_light_sets_keep_the_ptm_normals() -> None:
+    # the shipped dome and the recorded acquisitions: noise gains 0.45-2.0, left as they were
+    from rti_rig.app.usecases.fit import conditioned_normal_source
+    from rti_rig.core.lp_format import read_lp
+
+    for lp in (
+        "rig_configs/example_dome_48.lp",
+        "tests/data/neuralrti/dirs.lp",
+        "tests/data/neuralrti_replay/dirs.lp",
+    ):
+        lights = np.array([e.direction for e in read_lp(REPO / lp, upper_hemisphere=True)])
+        assert conditioned_normal_source("ptm", lights) == ("ptm", ""), lp

@@ -972,25 +972,35 @@ def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str
     The PTM's Lambertian reading is only as good as the PTM: on lights its 6 terms cannot
     separate (one ring, where ``l_u^2 + l_v^2`` is constant; lights at the horizon; one
     direction repeated) the ridge-regularised PTM is biased and its reading was 22-71° off on a
-    matte sphere, written as if sound. There robust photometric stereo is used if the lights
-    condition Lambert's 3 terms (0.14° on the same ring). Where they do not, no normal maps are
+    matte sphere, written as if sound. So is a PTM not regularised but over the noise-gain
+    limit (lights on one side only, azimuth 0-90° at 20/45/70°: condition 40, noise gain 15.2;
+    its normals were 25° off on the tablet, 57° on the coin); real light sets have gains
+    0.45-2.0. There robust photometric stereo is used if the lights condition Lambert's 3 terms
+    (0.14° on the same ring; 0.09° on the tablet lit from one side). Lambert would be better on
+    glossy metal lit from one ring and worse on a tilted object's shadows (docs/
+    reconstruction.md, "No normals from a PTM"). Where they do not, no normal maps are
     written and the relighting files are, regularised as always: a PTM fit had written 71°-off
     normals, an HSH fit had been refused whole for its normals. ``--model ps`` or ``lambert``
     asks for normals by name and is refused instead.
     """
     from rti_rig.core.rti_bases import design_matrix
-    from rti_rig.reconstruct.solve import solve_matrix
+    from rti_rig.reconstruct.solve import NOISE_GAIN_LIMIT, solve_matrix
 
     _, ps = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
     if source == "ptm":
         _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
-        if not ptm.regularised:
+        if ptm.trusted:  # neither regularised nor over the noise-gain limit
             return "ptm", ""
+        why = (
+            f"ridge-regularised on these lights (condition number {ptm.condition_number:.3g} "
+            "over the hemisphere), and its normals would be biased"
+            if ptm.regularised
+            else f"ill-conditioned on these lights (noise gain {ptm.noise_gain:.3g}, limit "
+            f"{NOISE_GAIN_LIMIT:g}), and its normals would be far off"
+        )
         if not ps.regularised:
             return "ps-robust", (
-                "normals from robust photometric stereo, not the PTM: the PTM is "
-                f"ridge-regularised on these lights (condition number "
-                f"{ptm.condition_number:.3g} over the hemisphere), and its normals would be biased"
+                f"normals from robust photometric stereo, not the PTM: the PTM is {why}"
             )
     elif not ps.regularised:
         return source, ""
