@@ -54,8 +54,8 @@ def row(scene: str, name: str, seed: int = 0) -> str:
 
 def main(argv: list[str] | None = None) -> str:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--write", action="store_true")
-    ap.parse_args(argv)
+    ap.add_argument("--write", action="store_true", help="write the table into docs/")
+    args = ap.parse_args(argv)
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -73,7 +73,8 @@ def main(argv: list[str] | None = None) -> str:
         ]
     )
     print(md)
-    write_section("ptm_normals_fallback", md, DOC)
+    if args.write:
+        write_section("ptm_normals_fallback", md, DOC)
     return md
 
 
