@@ -58,6 +58,7 @@ import json
 import os
 import shutil
 import socket
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -193,21 +194,42 @@ def computer_id() -> str:
 
 def since_boot() -> float:
     """The computer's clock since it booted, which no NTP step or clock setting moves and
-    which counts a suspend (Linux's CLOCK_BOOTTIME; ``time.monotonic`` elsewhere, which
-    counts one on Windows and macOS). A suspend not counted (Linux's CLOCK_MONOTONIC) would
-    be taken for a wall clock set forward, and a late file of a run stopped before a laptop
-    slept would pass for the resumed light's."""
-    boottime = getattr(time, "CLOCK_BOOTTIME", None)
-    return time.monotonic() if boottime is None else time.clock_gettime(boottime)
+    which counts a suspend: Linux's CLOCK_BOOTTIME; on macOS CLOCK_MONOTONIC, which Apple's
+    clock_gettime(3) says "will continue to increment while the system is asleep"
+    (``time.monotonic`` there is mach_absolute_time, which stops during sleep);
+    ``time.monotonic`` elsewhere (Windows: whether it counts a sleep depends on the Python
+    version, so it is not relied on). A suspend not counted would be taken for a wall clock
+    set forward, and a late file of a run stopped before a laptop slept would pass for the
+    resumed light's: :meth:`FolderWatchCamera._connect_on_learned_wall` therefore also
+    checks this clock against the wall clock. A clock the system refuses (an old kernel, a
+    sandbox: OSError) falls back to ``time.monotonic``."""
+    which = (
+        getattr(time, "CLOCK_MONOTONIC", None)
+        if sys.platform == "darwin"
+        else getattr(time, "CLOCK_BOOTTIME", None)
+    )
+    if which is not None:
+        with contextlib.suppress(OSError):
+            return time.clock_gettime(which)
+    return time.monotonic()
 
 
-#: the first image of a resume whose earlier run's camera clock cannot be compared with this
-#: run's (another computer, or the same after a restart): said, not refused
-RESUME_UNCHECKED = (
-    "this run is on another computer, or the computer restarted, since the session's earlier "
-    "run learned the camera clock: the computer's clock may differ from that run's, so the "
-    "first image was not checked for a file shot before this run (a late file of the stopped "
-    "run); the images after it are checked against it"
+#: how far this computer's wall clock may be from the one the camera clock was learned
+#: against when nothing measures it (another computer, a restart, or a clock since boot
+#: that disagrees with the wall clock by more): NTP keeps two computers within a second and a
+#: hand-set clock within minutes, while a late file of a run stopped the day before is hours
+#: older. A resume's first file shot more than this before the connect is refused.
+WALL_ALLOWANCE_S = 600.0
+
+#: the first image of a resume whose connect could be dated only by this computer's wall
+#: clock: said, with what the check could not catch
+RESUME_WALL_CHECKED = (
+    "this run is on another computer, or the computer restarted (or its clock since boot "
+    "disagrees with its wall clock), since the session's earlier run learned the camera "
+    "clock: the first image was checked against this computer's clock only to within "
+    f"{WALL_ALLOWANCE_S / 60:.0f} min, so a late file of the stopped run shot less than that "
+    "before this run connected would not have been caught; the images after it are checked "
+    "against it"
 )
 
 
@@ -388,8 +410,11 @@ class FolderWatchCamera:
         #: the connect on the wall clock of the run that learned the camera clock (this run's
         #: wall clock less the step the monotonic clock shows it was moved by since)
         self._connected_wall: float | None = None
-        #: the first image is said unchecked: the learned clock's computer is not this one
-        self._resume_unchecked = False
+        #: added to the first file's allowance: :data:`WALL_ALLOWANCE_S` when the connect is
+        #: dated by this computer's wall clock alone
+        self._wall_allowance_s = 0.0
+        #: said on the first image (:data:`RESUME_WALL_CHECKED`), None: nothing to say
+        self._resume_said: str | None = None
         #: the camera clock as an earlier run of the session learned it, read at connect
         self._learned: _LearnedClock | None = None
         self.name = settings.name
@@ -436,7 +461,8 @@ class FolderWatchCamera:
         self._anchor = None
         self._orphan = None
         self._learned = _LearnedClock.load(self._clock_file())
-        self._connected_wall, self._resume_unchecked = self._connect_on_learned_wall()
+        self._connected_wall, self._wall_allowance_s = self._connect_on_learned_wall()
+        self._resume_said = RESUME_WALL_CHECKED if self._wall_allowance_s else None
 
     def close(self) -> None:
         self._seen = None
@@ -731,9 +757,8 @@ class FolderWatchCamera:
                 placed = self._place(taken, pending.pulsed_at, pending.pulse_window_s)
             if placed is not None:
                 pending.taken = taken  # learned once the file is decoded (see collect)
-                if self._resume_unchecked:
-                    self._resume_unchecked = False
-                    placed = [*placed, RESUME_UNCHECKED]
+                if self._resume_said is not None:
+                    placed, self._resume_said = [*placed, self._resume_said], None
                 return path, placed
             pending.stray.append(path.name)
             pending.out_of_step.append(path.name)
@@ -843,26 +868,29 @@ class FolderWatchCamera:
             where.parent.mkdir(parents=True, exist_ok=True)
             learned.save(where)
 
-    def _connect_on_learned_wall(self) -> tuple[float | None, bool]:
-        """This connect on the wall clock of the run that learned the camera clock, and
-        whether the first image is to be said unchecked (None, True: the clocks cannot be
-        compared).
+    def _connect_on_learned_wall(self) -> tuple[float | None, float]:
+        """This connect on the wall clock of the run that learned the camera clock, and the
+        allowance to add for not knowing it better (0, or :data:`WALL_ALLOWANCE_S`).
 
         Why: the computer's wall clock was taken to be the one the camera clock was learned
-        against. A resume after an NTP step of a clock that ran fast, or on another computer
-        whose clock is ahead, dated every good file before the connect: each was refused and
-        the run stopped, blaming the camera's clock. On the same boot the monotonic clock says
-        how far the wall clock was moved and it is taken off; on another computer or boot
-        nothing can, and the first file is said unchecked rather than refused."""
+        against. A resume after an NTP step forward of a clock that ran slow, or on another
+        computer whose clock is behind, dated every good file before the connect: each was
+        refused and the run stopped, blaming the camera's clock. On the same boot the clock
+        since boot says how far the wall clock was moved and it is taken off. On another
+        computer or boot (on Linux every restart: "stopped tonight, resumed tomorrow") it was
+        not checked at all, and a late file of the stopped run, days old, became the resumed
+        light's image: it is now checked against this computer's wall clock within
+        :data:`WALL_ALLOWANCE_S`, as it is when the clock since boot and the wall clock moved
+        apart by more than that since (a sleep the clock since boot did not count)."""
         learned, now = self._learned, self._wall()
         if learned is None or learned.mono_s is None:
-            return now, False  # an older session's clock, or a rig clock not the monotonic
-        if learned.computer != self._computer():
-            return None, True
+            return now, 0.0  # an older session's clock, or a rig clock not the monotonic
         mono = None if self._monotonic is None else self._monotonic()
-        if mono is None or mono < learned.mono_s:  # no monotonic clock, or a restart
-            return None, True
-        return learned.wall_s + (mono - learned.mono_s), False
+        if learned.computer == self._computer() and mono is not None and mono >= learned.mono_s:
+            moved = (now - learned.wall_s) - (mono - learned.mono_s)
+            if abs(moved) <= WALL_ALLOWANCE_S:
+                return now - moved, 0.0
+        return now, WALL_ALLOWANCE_S
 
     def _shot_before_connect(self, taken: float, window_s: float) -> float | None:
         """How many seconds before this run connected a first file was shot, by the camera
@@ -871,8 +899,11 @@ class FolderWatchCamera:
 
         Only a file shot before the connect is refused: a later one may be the pulse's. The
         allowance is the EXIF second, the shutter lag, both pulses' trigger times and a drift
-        of :data:`CLOCK_DRIFT` over the time since the clock was learned; a file of the stopped
-        run was shot at least ``timeout_s`` (the wait that stopped it) before the resume."""
+        of :data:`CLOCK_DRIFT` over the time since the clock was learned, and
+        :data:`WALL_ALLOWANCE_S` when the connect is dated by this computer's wall clock
+        alone. A file the stopped run waited for was shot ``timeout_s`` before it stopped, so
+        it is caught only if the resume came long enough after: not when ``timeout_s`` is
+        within the allowance, nor, on another computer or boot, within ten minutes."""
         learned, connected = self._learned, self._connected_wall
         if self._anchor is not None or learned is None or connected is None:
             return None
@@ -882,6 +913,7 @@ class FolderWatchCamera:
             + window_s
             + learned.window_s
             + CLOCK_DRIFT * abs(connected - learned.wall_s)
+            + self._wall_allowance_s
         )
         early = connected - (taken - learned.offset_s)
         return early if early > allowance else None

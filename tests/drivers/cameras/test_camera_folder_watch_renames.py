@@ -608,11 +608,11 @@ def _resumed_after(tmp_path, wall_step_s, computer_after="this-computer"):
 
 
 def test_a_resume_after_the_computers_clock_was_stepped_takes_its_own_file(tmp_path):
-    """The computer's clock ran 2 min fast in the first run and NTP stepped it back before the
-    resume (seen from the camera's clock: the computer is now 2 min behind, wall time -120 s):
-    the resumed pulse's own file was dated 2 min before the connect, refused with every file
-    after it, and the run stopped blaming the camera's clock. The monotonic clock of the same
-    boot shows the step, which is taken off: the file is the image, with no notice."""
+    """The computer's clock ran 2 min slow in the first run and NTP stepped it forward before
+    the resume (wall time +120 s against the clock since boot): the connect was dated 2 min
+    late, the resumed pulse's own file looked shot 2 min before it and was refused with every
+    file after it, and the run stopped blaming the camera's clock. The clock since boot of the
+    same boot shows the step, which is taken off: the file is the image, with no notice."""
     frame = _resumed_after(tmp_path, wall_step_s=+120.0).capture(0.1)
     assert frame.metadata["watched_file"].endswith("IMG_0002.DNG"), frame.metadata
     assert not frame.metadata.get("stray_files") and not frame.metadata.get("notices")
@@ -629,6 +629,97 @@ def test_a_resume_on_another_computer_says_its_first_image_unchecked(tmp_path):
     second = cam.capture(0.1)
     assert second.metadata["watched_file"].endswith("IMG_0003.DNG")
     assert not second.metadata.get("notices")
+
+
+def _late_file_after_a_next_day_resume(tmp_path, computer_after, boot_s):
+    """The owner stops the run (Ctrl-C) while pulse 2's file is on its way and resumes 16 h
+    later (the computer off overnight, or asleep); the stopped run's file reaches the folder
+    only after the resume connects (a Wi-Fi camera's upload queue draining), 2 s before the
+    resumed pulse's own file. The resume runs on ``computer_after`` (another boot id after a
+    restart), its clock since boot showing ``boot_s`` since pulse 2 (a restart starts it
+    again; a sleep it does not count leaves it short). The first image after the resume."""
+    session, tether = tmp_path / "session", tmp_path / "tether"
+    tether.mkdir()
+    day = 16 * 3600.0
+    body = _Body(tether, [1.0, day + 30.0, 4.0], offset_s=0.0)
+    settings = FolderWatchSettings(folder=tether, timeout_s=15.0, poll_interval_s=0.125)
+    lost = [0.0]
+
+    def camera(computer: str) -> FolderWatchCamera:
+        cam = FolderWatchCamera(
+            settings,
+            clock=body.clock,
+            trigger=body.pulse,
+            wall=body.wall,
+            monotonic=lambda: body.clock.now() - lost[0],
+            computer=lambda: computer,
+        )
+        cam.output_dir = session / "raw" / ".incoming"
+        cam.connect()
+        return cam
+
+    first = camera("this-computer")
+    first.capture(0.1)
+    first.expose(0.1)
+    first.close()  # Ctrl-C while its file is awaited
+    body.clock.sleep(body.pulses[1] + day + 28.0 - body.clock.now())
+    lost[0] = body.clock.now() - body.pulses[1] - boot_s
+    return camera(computer_after).capture(0.1)
+
+
+def test_a_late_file_after_a_restart_and_a_next_day_resume_is_set_aside(tmp_path):
+    """After a restart (on Linux a new boot id) the clock since boot cannot date the connect:
+    the first file was said unchecked and the stopped run's late file, 16 h old, became the
+    resumed light's image. It is now checked against this computer's wall clock within
+    10 min: set aside, and the resumed pulse's own file taken, saying how far it was checked."""
+    frame = _late_file_after_a_next_day_resume(tmp_path, "this-computer-rebooted", 60.0)
+    assert frame.metadata["watched_file"].endswith("IMG_0003.DNG"), frame.metadata
+    assert frame.metadata["stray_files"] == ["IMG_0002.DNG"], frame.metadata
+    said = " ".join(frame.metadata.get("notices") or [])
+    assert "IMG_0002.DNG" in said and "shot before this run connected" in said, said
+    assert "only to within 10 min" in said, said
+
+
+def test_a_sleep_the_clock_since_boot_did_not_count_does_not_pass_a_late_file(tmp_path):
+    """Same computer and boot, but a clock since boot that stopped during a 16 h sleep (as
+    ``time.monotonic`` does on macOS): it showed 0.5 s since pulse 2, the wall clock seemed set
+    forward 16 h and was taken back, the connect was dated just after the Ctrl-C, and the
+    stopped run's late file passed. A clock since boot and a wall clock more than 10 min apart
+    are not trusted: the wall clock dates the connect, and the file is set aside."""
+    frame = _late_file_after_a_next_day_resume(tmp_path, "this-computer", 0.5)
+    assert frame.metadata["watched_file"].endswith("IMG_0003.DNG"), frame.metadata
+    assert frame.metadata["stray_files"] == ["IMG_0002.DNG"], frame.metadata
+
+
+def test_the_clock_since_boot_counts_a_sleep_where_the_system_can_and_survives_a_refusal(
+    monkeypatch,
+):
+    """macOS's ``time.monotonic`` stops during sleep; its CLOCK_MONOTONIC counts it (Apple's
+    clock_gettime(3)). A clock_gettime the system refuses (an old kernel, a sandbox) raised
+    out of the connect; it falls back to ``time.monotonic``."""
+    import time
+
+    from rti_rig.drivers.cameras import folder_watch
+
+    asked = []
+
+    def clock_gettime(which):
+        asked.append(which)
+        return 7.0
+
+    monkeypatch.setattr(folder_watch.time, "clock_gettime", clock_gettime)
+    monkeypatch.setattr(folder_watch.time, "CLOCK_MONOTONIC", 6, raising=False)
+    monkeypatch.setattr(folder_watch.sys, "platform", "darwin")
+    assert folder_watch.since_boot() == 7.0 and asked == [6]
+
+    def refused(which):
+        raise OSError(22, "Invalid argument")
+
+    monkeypatch.setattr(folder_watch.time, "clock_gettime", refused)
+    monkeypatch.setattr(folder_watch.time, "monotonic", lambda: 42.0)
+    monkeypatch.setattr(folder_watch.sys, "platform", "linux")
+    monkeypatch.setattr(time, "CLOCK_BOOTTIME", 7, raising=False)
+    assert folder_watch.since_boot() == 42.0
 
 
 def test_a_tiff_that_can_never_be_read_is_not_waited_for_as_one_being_written(tmp_path):

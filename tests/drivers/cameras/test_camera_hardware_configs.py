@@ -854,12 +854,15 @@ def _watch_config_waiting(tmp_path: Path, timeout_s: float) -> Path:
     return cfg
 
 
-def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypatch):
+@pytest.mark.parametrize("restarted", [False, True], ids=["same-boot", "after-a-restart"])
+def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypatch, restarted):
     """Pulse 2's file is late: the run stops at timeout_s. After `run --resume`, that file
     comes into the folder just before the resumed pulse's own one. It was taken as the
     resumed light's image (the first image after a connect was never checked), a picture
     shot before the stop. The camera clock the first run learned now dates it before the
-    resume: it is kept in strays/ and image 2 is the resumed pulse's own file."""
+    resume: it is kept in strays/ and image 2 is the resumed pulse's own file. After a
+    restart (the clock file's computer and boot id another), the file, shot the day before,
+    was taken unchecked; it is now checked against the computer's wall clock within 10 min."""
     import datetime
     import os
 
@@ -899,7 +902,7 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
                     now = datetime.datetime.now(datetime.UTC).replace(tzinfo=None)
                     if seen == 2:
                         # shot, but its file is on its way past the timeout
-                        late = now - datetime.timedelta(seconds=30)
+                        late = now - datetime.timedelta(seconds=86400 if restarted else 30)
                         continue
                     if seen == 3 and late is not None:  # the late file, just before this one
                         save("_DSC0002.DNG", late, time.time_ns() - 10**9)
@@ -911,6 +914,10 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
         try:
             out = tmp_path / "s"
             first = run(str(cfg), "--out", str(out), "--lights", "3")
+            if restarted:  # as the clock file of the same session written before a restart
+                clock_file = out / "raw" / ".folder_watch_clock.json"
+                learned = json.loads(clock_file.read_text())
+                clock_file.write_text(json.dumps({**learned, "computer": "before-restart"}))
             resumed = run("--resume", str(out))
         finally:
             stop.set()
@@ -924,3 +931,4 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
     strays = {s: kept for e in entries for s, kept in e["strays"].items()}
     assert [kept["camera_file"] for kept in strays.values()] == ["_DSC0002.DNG"], strays
     assert "shot before this run connected" in said, said
+    assert ("only to within 10 min" in said) is restarted, said
