@@ -844,8 +844,9 @@ def load_rig_config(path: Path | str) -> LoadedRig:
             )
         # a busy DSLR is no note (it had been one until 2026-11-29): the controller switches
         # the LED off while a busy camera is awaited past max_on_s, and lights it again
-        if note := _untriggered_wait_note(loaded, cam):
-            loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
+        for note in (_untriggered_wait_note(loaded, cam), _resume_check_note(loaded, cam)):
+            if note:
+                loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
     return loaded
 
 
@@ -943,6 +944,35 @@ def _untriggered_wait_note(rig: LoadedRig, cam: Any) -> str:
         f"later than {lit_for:g} s stops the session at the thermal limit. Lower timeout_s, or "
         "let the dome fire the camera (trigger = 'dome_shutter': its LED goes off after the "
         "exposure, and the file may take timeout_s)"
+    )
+
+
+def _resume_check_note(rig: LoadedRig, cam: Any) -> str:
+    """Said when a dome-fired folder-watch camera's ``timeout_s`` is within the allowance of
+    its capture-time check ("" otherwise).
+
+    A resume's first file is refused only when it was shot more than that allowance (the 1 s
+    of EXIF times, ``shutter_lag_s`` and the pulses' trigger times, at least the shutter pulse)
+    before the resume connected; the file the stopped run waited for was shot ``timeout_s``
+    before the stop. The docs had said such a file is always caught: with a wait this short a
+    quick resume takes it as the resumed light's image.
+    """
+    serial = rig.config.dome.serial if rig.config.dome is not None else None
+    if getattr(cam, "kind", None) != "folder_watch" or cam.trigger != "dome_shutter":
+        return ""
+    from rti_rig.drivers.cameras.folder_watch import CAPTURE_TIME_RESOLUTION_S
+
+    pulse_s = 0.0 if serial is None else serial.shutter_pulse_ms / 1000
+    allowance = CAPTURE_TIME_RESOLUTION_S + cam.shutter_lag_s + 2 * pulse_s
+    if cam.timeout_s > allowance:
+        return ""
+    return (
+        f"{rig.path}: camera.device.timeout_s = {cam.timeout_s:g} s is within the allowance of "
+        f"the capture-time check ({allowance:g} s: 1 s of EXIF times, camera.device."
+        f"shutter_lag_s = {cam.shutter_lag_s:g} s and two shutter pulses): a late file of a "
+        "run stopped at timeout_s and quickly resumed cannot be told from the resumed light's "
+        "own and may be taken as its image. Raise timeout_s well above it (a RAW over Wi-Fi "
+        "may need 15 s), or wait that long before resuming"
     )
 
 
