@@ -330,10 +330,12 @@ class OpenCvCamera:
         return frames * period, said
 
     def representable_exposure_s(self, exposure_s: float) -> float:
-        """The longest exposure at or under ``exposure_s`` the camera takes exactly: whole
-        ``exposure_unit_s`` steps, one at least (any value on an image sequence, which has no
-        controls). What ``run --auto-exposure`` asks for, so that a metered exposure is never
-        refused as "not a whole number of units"."""
+        """An exposure the camera takes exactly, in whole ``exposure_unit_s`` steps: the
+        longest at or under ``exposure_s``, but never under one step, so an ``exposure_s``
+        shorter than one unit gives one unit, longer than asked (the shortest the camera
+        takes); any value on an image sequence, which has no controls. What ``run
+        --auto-exposure`` asks for, so that a metered exposure is never refused as "not a
+        whole number of units"."""
         if self.settings.backend != "v4l2":
             return exposure_s
         unit = self.settings.exposure_unit_s
