@@ -841,7 +841,9 @@ class FolderWatchCamera:
             f"; shot before this run connected ({shown} before, by the camera clock the "
             "session's earlier run learned): files of the stopped run, not of this light. If "
             "the camera's clock was set back since, the computer's clock set forward in a way "
-            "its clock since boot does not show, or another camera now saves there, delete "
+            "its clock since boot does not show (or, on another computer or after a restart, "
+            f"more than {WALL_ALLOWANCE_S / 60:.0f} min ahead of the earlier run's), or another "
+            "camera now saves there, delete "
             f"{self._clock_file()} and resume again (the first image is then unchecked)"
         )
 
@@ -880,15 +882,19 @@ class FolderWatchCamera:
         computer or boot (on Linux every restart: "stopped tonight, resumed tomorrow") it was
         not checked at all, and a late file of the stopped run, days old, became the resumed
         light's image: it is now checked against this computer's wall clock within
-        :data:`WALL_ALLOWANCE_S`, as it is when the clock since boot and the wall clock moved
-        apart by more than that since (a sleep the clock since boot did not count)."""
+        :data:`WALL_ALLOWANCE_S`, as it is when the wall clock moved ahead of the clock since
+        boot by more than that since (a sleep the clock since boot did not count, or a step
+        forward that large: the two cannot be told apart)."""
         learned, now = self._learned, self._wall()
         if learned is None or learned.mono_s is None:
             return now, 0.0  # an older session's clock, or a rig clock not the monotonic
         mono = None if self._monotonic is None else self._monotonic()
         if learned.computer == self._computer() and mono is not None and mono >= learned.mono_s:
             moved = (now - learned.wall_s) - (mono - learned.mono_s)
-            if abs(moved) <= WALL_ALLOWANCE_S:
+            # a sleep not counted only ever looks like a step forward: a step back, however
+            # large, is measured (dated by the wall clock, a late file would look that much
+            # younger)
+            if moved <= WALL_ALLOWANCE_S:
                 return now - moved, 0.0
         return now, WALL_ALLOWANCE_S
 

@@ -631,26 +631,28 @@ def test_a_resume_on_another_computer_says_its_first_image_unchecked(tmp_path):
     assert not second.metadata.get("notices")
 
 
-def _late_file_after_a_next_day_resume(tmp_path, computer_after, boot_s):
+def _late_file_after_a_next_day_resume(
+    tmp_path, computer_after, boot_s=None, after_s=16 * 3600.0, wall_step_s=0.0
+):
     """The owner stops the run (Ctrl-C) while pulse 2's file is on its way and resumes 16 h
-    later (the computer off overnight, or asleep); the stopped run's file reaches the folder
-    only after the resume connects (a Wi-Fi camera's upload queue draining), 2 s before the
-    resumed pulse's own file. The resume runs on ``computer_after`` (another boot id after a
-    restart), its clock since boot showing ``boot_s`` since pulse 2 (a restart starts it
-    again; a sleep it does not count leaves it short). The first image after the resume."""
+    later (``after_s``: the computer off overnight, or asleep); the stopped run's file reaches
+    the folder only after the resume connects (a Wi-Fi camera's upload queue draining), 2 s
+    before the resumed pulse's own file. The resume runs on ``computer_after`` (another boot id
+    after a restart), its clock since boot showing ``boot_s`` since pulse 2 (a restart starts
+    it again; a sleep it does not count leaves it short; None: all of it), its wall clock
+    moved ``wall_step_s``. The first image after the resume."""
     session, tether = tmp_path / "session", tmp_path / "tether"
     tether.mkdir()
-    day = 16 * 3600.0
-    body = _Body(tether, [1.0, day + 30.0, 4.0], offset_s=0.0)
+    body = _Body(tether, [1.0, after_s + 30.0, 4.0], offset_s=0.0)
     settings = FolderWatchSettings(folder=tether, timeout_s=15.0, poll_interval_s=0.125)
-    lost = [0.0]
+    lost, step = [0.0], [0.0]
 
     def camera(computer: str) -> FolderWatchCamera:
         cam = FolderWatchCamera(
             settings,
             clock=body.clock,
             trigger=body.pulse,
-            wall=body.wall,
+            wall=lambda: body.wall() + step[0],
             monotonic=lambda: body.clock.now() - lost[0],
             computer=lambda: computer,
         )
@@ -662,8 +664,9 @@ def _late_file_after_a_next_day_resume(tmp_path, computer_after, boot_s):
     first.capture(0.1)
     first.expose(0.1)
     first.close()  # Ctrl-C while its file is awaited
-    body.clock.sleep(body.pulses[1] + day + 28.0 - body.clock.now())
-    lost[0] = body.clock.now() - body.pulses[1] - boot_s
+    body.clock.sleep(body.pulses[1] + after_s + 28.0 - body.clock.now())
+    lost[0] = 0.0 if boot_s is None else body.clock.now() - body.pulses[1] - boot_s
+    step[0] = wall_step_s
     return camera(computer_after).capture(0.1)
 
 
@@ -689,6 +692,19 @@ def test_a_sleep_the_clock_since_boot_did_not_count_does_not_pass_a_late_file(tm
     frame = _late_file_after_a_next_day_resume(tmp_path, "this-computer", 0.5)
     assert frame.metadata["watched_file"].endswith("IMG_0003.DNG"), frame.metadata
     assert frame.metadata["stray_files"] == ["IMG_0002.DNG"], frame.metadata
+
+
+def test_a_clock_stepped_back_over_10_min_is_still_measured_by_the_clock_since_boot(tmp_path):
+    """The computer's clock ran an hour fast and NTP stepped it back between a Ctrl-C and a
+    resume a minute later. Only a step forward can be a sleep the clock since boot did not
+    count; a step back dated by the wall clock alone would make the stopped run's late file
+    look an hour younger and pass. It is measured and taken off: the file is set aside."""
+    frame = _late_file_after_a_next_day_resume(
+        tmp_path, "this-computer", after_s=60.0, wall_step_s=-3600.0
+    )
+    assert frame.metadata["watched_file"].endswith("IMG_0003.DNG"), frame.metadata
+    assert frame.metadata["stray_files"] == ["IMG_0002.DNG"], frame.metadata
+    assert "only to within" not in " ".join(frame.metadata.get("notices") or [])
 
 
 def test_the_clock_since_boot_counts_a_sleep_where_the_system_can_and_survives_a_refusal(
