@@ -948,14 +948,16 @@ def _untriggered_wait_note(rig: LoadedRig, cam: Any) -> str:
 
 
 def _resume_check_note(rig: LoadedRig, cam: Any) -> str:
-    """Said when a dome-fired folder-watch camera's ``timeout_s`` is within the allowance of
-    its capture-time check ("" otherwise).
+    """Said when a dome-fired folder-watch camera's ``timeout_s`` is too short for its
+    capture-time check to tell a stopped run's late file from a quick resume's own ("" if not).
 
-    A resume's first file is refused only when it was shot more than that allowance (the 1 s
-    of EXIF times, ``shutter_lag_s`` and the pulses' trigger times, at least the shutter pulse)
-    before the resume connected; the file the stopped run waited for was shot ``timeout_s``
-    before the stop. The docs had said such a file is always caught: with a wait this short a
-    quick resume takes it as the resumed light's image.
+    A resume's first file is refused only when it was shot more than the check's allowance
+    (the 1 s of EXIF times, ``shutter_lag_s`` and the pulses' trigger times, at least the
+    shutter pulse) before the resume connected, and its shot is itself known only to within
+    that allowance; the file the stopped run waited for was shot ``timeout_s`` before the
+    stop. So it is surely caught only when ``timeout_s`` is over twice the allowance. The docs
+    had said such a file is always caught: with a shorter wait a quick resume may take it as
+    the resumed light's image.
     """
     serial = rig.config.dome.serial if rig.config.dome is not None else None
     if getattr(cam, "kind", None) != "folder_watch" or cam.trigger != "dome_shutter":
@@ -964,15 +966,16 @@ def _resume_check_note(rig: LoadedRig, cam: Any) -> str:
 
     pulse_s = 0.0 if serial is None else serial.shutter_pulse_ms / 1000
     allowance = CAPTURE_TIME_RESOLUTION_S + cam.shutter_lag_s + 2 * pulse_s
-    if cam.timeout_s > allowance:
+    if cam.timeout_s > 2 * allowance:
         return ""
     return (
-        f"{rig.path}: camera.device.timeout_s = {cam.timeout_s:g} s is within the allowance of "
-        f"the capture-time check ({allowance:g} s: 1 s of EXIF times, camera.device."
-        f"shutter_lag_s = {cam.shutter_lag_s:g} s and two shutter pulses): a late file of a "
-        "run stopped at timeout_s and quickly resumed cannot be told from the resumed light's "
-        "own and may be taken as its image. Raise timeout_s well above it (a RAW over Wi-Fi "
-        "may need 15 s), or wait that long before resuming"
+        f"{rig.path}: camera.device.timeout_s = {cam.timeout_s:g} s is not over twice the "
+        f"allowance of the capture-time check ({allowance:g} s: 1 s of EXIF times, "
+        f"camera.device.shutter_lag_s = {cam.shutter_lag_s:g} s and two shutter pulses): a "
+        "late file of a run stopped at timeout_s and quickly resumed may not be told from the "
+        f"resumed light's own and be taken as its image. Raise timeout_s over "
+        f"{2 * allowance:g} s (a RAW over Wi-Fi may need 15 s), or wait that long before "
+        "resuming"
     )
 
 
