@@ -215,8 +215,8 @@ def since_boot() -> float:
 
 
 #: how far this computer's wall clock may be from the one the camera clock was learned
-#: against when nothing measures it (another computer, a restart, or a clock since boot
-#: that disagrees with the wall clock by more): NTP keeps two computers within a second and a
+#: against when nothing measures it (another computer, a restart, or a wall clock moved
+#: ahead of the clock since boot by more): NTP keeps two computers within a second and a
 #: hand-set clock within minutes, while a late file of a run stopped the day before is hours
 #: older. A resume's first file shot more than this before the connect is refused.
 WALL_ALLOWANCE_S = 600.0
@@ -908,8 +908,9 @@ class FolderWatchCamera:
         of :data:`CLOCK_DRIFT` over the time since the clock was learned, and
         :data:`WALL_ALLOWANCE_S` when the connect is dated by this computer's wall clock
         alone. A file the stopped run waited for was shot ``timeout_s`` before it stopped, so
-        it is caught only if the resume came long enough after: not when ``timeout_s`` is
-        within the allowance, nor, on another computer or boot, within ten minutes."""
+        it is surely caught only when ``timeout_s`` is over twice the allowance (its shot is
+        known only to within it), and, on another computer or boot, when it was shot over ten
+        minutes before the resume."""
         learned, connected = self._learned, self._connected_wall
         if self._anchor is not None or learned is None or connected is None:
             return None
