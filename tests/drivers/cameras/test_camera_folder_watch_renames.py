@@ -585,26 +585,36 @@ def _resumed_after(tmp_path, wall_step_s, computer_after="this-computer"):
     session, tether = tmp_path / "session", tmp_path / "tether"
     tether.mkdir()
     body = _Body(tether, [0.5] * 4, offset_s=0.0)
-    settings = FolderWatchSettings(folder=tether, timeout_s=3.0, poll_interval_s=0.125)
-    step = [0.0]
-
-    def camera(computer: str) -> FolderWatchCamera:
-        cam = FolderWatchCamera(
-            settings,
-            clock=body.clock,
-            trigger=body.pulse,
-            wall=lambda: body.wall() + step[0],
-            monotonic=body.clock.now,
-            computer=lambda: computer,
-        )
-        cam.output_dir = session / "raw" / ".incoming"
-        cam.connect()
-        return cam
-
+    camera = _ComputerClocks(body, 3.0, session)
     camera("this-computer").capture(0.1)
     body.clock.sleep(60.0)
-    step[0] = wall_step_s
+    camera.step_s = wall_step_s
     return camera(computer_after)
+
+
+class _ComputerClocks:
+    """Makes the session's folder-watch cameras on ``body``'s clock, on a named computer: its
+    wall clock ``step_s`` off the test's, its clock since boot ``lost_s`` behind the rig's."""
+
+    def __init__(self, body, timeout_s, session):
+        self.body, self.session, self.step_s, self.lost_s = body, session, 0.0, 0.0
+        self.settings = FolderWatchSettings(
+            folder=body.folder, timeout_s=timeout_s, poll_interval_s=0.125
+        )
+
+    def __call__(self, computer: str) -> FolderWatchCamera:
+        body = self.body
+        cam = FolderWatchCamera(
+            self.settings,
+            clock=body.clock,
+            trigger=body.pulse,
+            wall=lambda: body.wall() + self.step_s,
+            monotonic=lambda: body.clock.now() - self.lost_s,
+            computer=lambda: computer,
+        )
+        cam.output_dir = self.session / "raw" / ".incoming"
+        cam.connect()
+        return cam
 
 
 def test_a_resume_after_the_computers_clock_was_stepped_takes_its_own_file(tmp_path):
@@ -646,29 +656,14 @@ def _late_file_after_a_next_day_resume(
     session, tether = tmp_path / "session", tmp_path / "tether"
     tether.mkdir()
     body = _Body(tether, [1.0, after_s + 30.0, 4.0], offset_s=0.0)
-    settings = FolderWatchSettings(folder=tether, timeout_s=15.0, poll_interval_s=0.125)
-    lost, step = [0.0], [0.0]
-
-    def camera(computer: str) -> FolderWatchCamera:
-        cam = FolderWatchCamera(
-            settings,
-            clock=body.clock,
-            trigger=body.pulse,
-            wall=lambda: body.wall() + step[0],
-            monotonic=lambda: body.clock.now() - lost[0],
-            computer=lambda: computer,
-        )
-        cam.output_dir = session / "raw" / ".incoming"
-        cam.connect()
-        return cam
-
+    camera = _ComputerClocks(body, 15.0, session)
     first = camera("this-computer")
     first.capture(0.1)
     first.expose(0.1)
     first.close()  # Ctrl-C while its file is awaited
     body.clock.sleep(body.pulses[1] + after_s + 28.0 - body.clock.now())
-    lost[0] = 0.0 if boot_s is None else body.clock.now() - body.pulses[1] - boot_s
-    step[0] = wall_step_s
+    camera.lost_s = 0.0 if boot_s is None else body.clock.now() - body.pulses[1] - boot_s
+    camera.step_s = wall_step_s
     return camera(computer_after).capture(0.1)
 
 
@@ -689,8 +684,9 @@ def test_a_sleep_the_clock_since_boot_did_not_count_does_not_pass_a_late_file(tm
     """Same computer and boot, but a clock since boot that stopped during a 16 h sleep (as
     ``time.monotonic`` does on macOS): it showed 0.5 s since pulse 2, the wall clock seemed set
     forward 16 h and was taken back, the connect was dated just after the Ctrl-C, and the
-    stopped run's late file passed. A clock since boot and a wall clock more than 10 min apart
-    are not trusted: the wall clock dates the connect, and the file is set aside."""
+    stopped run's late file passed. A wall clock moved more than 10 min ahead of the clock
+    since boot is not corrected by it: the wall clock dates the connect, and the file is set
+    aside."""
     frame = _late_file_after_a_next_day_resume(tmp_path, "this-computer", 0.5)
     assert frame.metadata["watched_file"].endswith("IMG_0003.DNG"), frame.metadata
     assert frame.metadata["stray_files"] == ["IMG_0002.DNG"], frame.metadata
