@@ -71,6 +71,7 @@ import numpy as np
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
+from rti_rig.core.image_files import TIFF_MAGIC
 from rti_rig.drivers.cameras.image_io import read_image_file, to_linear_uint16
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
@@ -310,10 +311,6 @@ def _tiff_capture_time(path: Path) -> tuple[bool, float | None]:
     except Exception:  # not whole yet, or no TIFF: its first bytes say which
         return _not_a_tiff(path), None
     return True, _exif_time(stamp)
-
-
-#: the first bytes of a TIFF (little- and big-endian) and a BigTIFF
-TIFF_MAGIC = (b"II*\0", b"MM\0*", b"II+\0", b"MM\0+")
 
 
 def _not_a_tiff(path: Path) -> bool:

@@ -23,7 +23,8 @@ from rti_rig.core.errors import SessionError
 #: the readers that refuse an image given where text goes (:func:`looks_like_image`).
 JPEG_MAGIC = b"\xff\xd8"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-TIFF_MAGIC = (b"II*\x00", b"MM\x00*")
+#: a TIFF's first bytes, little- and big-endian, then a BigTIFF's (tifffile reads both)
+TIFF_MAGIC = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
 
 
 def looks_like_image(raw: bytes) -> bool:
