@@ -2,19 +2,53 @@
 
 ``rti-rig plan`` refused lights in one plane, but ``rti-rig run`` captured such a session
 silently and ``rti-rig fit`` then refused its normals with advice only a Python caller could
-follow. One judgement, the fit's own, is shared so that all three agree on which lights give
-no normals and say the same CLI way out.
+follow. One judgement, the fit's own, and one refusal are shared so that all three agree on
+which lights give no normals and say the same CLI way out.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from rti_rig.core.errors import RtiRigError
+
 #: What ``rti-rig fit`` does with lights that give no normals, as a CLI user can act on it.
 FIT_WITHOUT_NORMALS = (
-    "rti-rig fit would write no normal maps from them (--model auto, ps and lambert refuse "
-    "them; --model hsh2 or --model ptm write the relighting files without normals)"
+    "rti-rig fit would write no normal maps from them (--model ps, lambert and robust-ps refuse "
+    "them; --model auto, which then chooses among the PTM and HSH, hsh2 and ptm write the "
+    "relighting files fit.ptm and fit.rti only, ridge-regularised: along the direction the "
+    "lights do not span, their relighting is a guess)"
 )
+
+
+def _layout(lights: np.ndarray) -> str:
+    """How ``lights`` (N×3, judged ill-conditioned) fail to span the three directions.
+
+    Read off the singular vectors of the Lambert matrix (the lights themselves: the
+    hemisphere scaling of :func:`~rti_rig.reconstruct.solve.solve_matrix` is the same for its
+    3 columns, so these are the vectors it judges): lights closer to one line than to one plane
+    (``s2² < s1·s3``) are bunched about the strongest direction; else they lie in the plane
+    whose normal is the weakest. Why: every refusal had said "one plane through the object, or
+    bunched at the zenith", leaving the user to guess which of the two to mend.
+    """
+    _, s, vt = np.linalg.svd(lights, full_matrices=False)
+    if s[1] ** 2 < s[0] * s[2]:
+        strong = vt[0] * np.sign(vt[0][2] or 1.0)
+        el = float(np.degrees(np.arcsin(np.clip(strong[2], -1.0, 1.0))))
+        if el >= 80.0:
+            return "they are bunched at the zenith"
+        az = float(np.degrees(np.arctan2(strong[1], strong[0]))) % 360.0
+        return f"they are bunched about one direction (azimuth {az:.0f}°, elevation {el:.0f}°)"
+    normal = vt[2]
+    if abs(normal[2]) > np.cos(np.radians(10.0)):
+        return "they lie (nearly) in one plane through the object: the horizon"
+    if abs(normal[2]) < np.sin(np.radians(10.0)):
+        az = float(np.degrees(np.arctan2(normal[1], normal[0])) + 90.0) % 180.0
+        return (
+            "they lie (nearly) in one upright plane through the object: lights at one "
+            f"azimuth ({az:.0f}° or {az + 180.0:.0f}°)"
+        )
+    return "they lie (nearly) in one tilted plane through the object"
 
 
 def undetermined_normals(lights: np.ndarray, what: str = "lights") -> str | None:
@@ -35,7 +69,37 @@ def undetermined_normals(lights: np.ndarray, what: str = "lights") -> str | None
     if not report.regularised:
         return None
     return (
-        f"the {len(lights)} {what} cannot determine a surface normal: they lie (nearly) in one "
-        f"plane through the object, or are bunched at the zenith (condition number "
-        f"{report.condition_number:.3g} over the hemisphere, limit {report.cond_limit:g})"
+        f"the {len(lights)} {what} cannot determine a surface normal: {_layout(lights)} "
+        f"(condition number {report.condition_number:.3g} over the hemisphere, limit "
+        f"{report.cond_limit:g})"
     )
+
+
+def band_advice(min_elevation_deg: float, max_elevation_deg: float) -> str:
+    """The way out of lights a rig's elevation band leaves undetermined: another rig, and
+    widening the band only where one was given (:func:`~rti_rig.planner.uniform.band_text`).
+
+    Why: a rig whose rings sit at 89.2° and 89.6° had been told to widen the 0..90° band it
+    already had.
+    """
+    from rti_rig.planner.uniform import band_text
+
+    advice = "use a rig with lights at several elevations and azimuths"
+    band = band_text(min_elevation_deg, max_elevation_deg)
+    if band:
+        advice += f", or widen --min-elevation-deg / --max-elevation-deg (lights{band} were asked)"
+    return advice
+
+
+def refuse_undetermined(lights: np.ndarray, what: str, advice: str, nothing_done: str) -> None:
+    """Refuse, before anything is written, lit or moved, lights that cannot determine a normal.
+
+    ``what`` names the lights, ``advice`` is the way out ("use a rig ..."), ``nothing_done``
+    what was left undone ("nothing was written"). One refusal for ``rti-rig plan`` and ``rti-rig
+    run``: each had its own copy of it, and each worked out "was a band given" itself.
+    """
+    reason = undetermined_normals(lights, what)
+    if reason is not None:
+        raise RtiRigError(
+            f"{reason}; {FIT_WITHOUT_NORMALS}. {advice[0].upper()}{advice[1:]}; {nothing_done}"
+        )

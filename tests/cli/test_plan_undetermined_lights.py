@@ -1,4 +1,4 @@
-"""A plan whose lights cannot determine a normal is refused, not written.
+"""A plan whose lights cannot determine a normal is refused, not written, naming the case.
 
 A bare .lp rig with its lights on one ring at the horizon: every choice of lights is coplanar.
 `rti-rig plan` had written the plan with "expected RMS normal error 90.00" as its only sign,
@@ -31,6 +31,8 @@ def test_a_horizon_ring_rig_gets_no_plan(tmp_path: Path, method: str) -> None:
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "the 12 planned lights cannot determine a surface normal" in said
+    assert "in one plane through the object: the horizon" in said
+    assert "bunched" not in said
     assert not out.exists()
 
 
@@ -42,8 +44,9 @@ def _ring(el_deg: float, n: int) -> list[tuple[float, float, float]]:
 def test_lights_bunched_at_the_zenith_are_named_so_without_a_band_to_widen(
     tmp_path: Path,
 ) -> None:
-    """Rings at 89.2° and 89.6° had been told "all at the horizon or at one azimuth" and to
-    widen a band that was already 0..90°."""
+    """Rings at 89.2° and 89.6° had been told to widen a band that was already 0..90°, and
+    every refusal said "one plane through the object, or bunched at the zenith": which of the
+    two is now named from the Lambert matrix's singular vectors."""
     rig = tmp_path / "cap.lp"
     lights = _ring(89.2, 12) + _ring(89.6, 8)
     write_lp(rig, [LpEntry(f"led_{k:02d}.jpg", d) for k, d in enumerate(lights)])
@@ -53,6 +56,6 @@ def test_lights_bunched_at_the_zenith_are_named_so_without_a_band_to_widen(
     )
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
-    assert "bunched at the zenith" in said
-    assert "widen" not in said and "at the horizon or at one azimuth" not in said
+    assert "they are bunched at the zenith" in said
+    assert "widen" not in said and "plane" not in said
     assert not out.exists()

@@ -31,7 +31,7 @@ def _refused(args: list[str], out: Path) -> str:
     assert r.exit_code == 2, said
     assert not out.exists()  # no session folder: nothing was captured
     assert "nothing was lit or moved" in said
-    assert "--model hsh2 or --model ptm" in said
+    assert "ridge-regularised: along the direction the lights do not span" in said
     return said
 
 
@@ -39,6 +39,7 @@ def test_a_plan_at_one_azimuth_is_refused_before_the_arm_moves(tmp_path: Path) -
     plan = _one_azimuth(tmp_path / "one_az.lp")
     said = _refused([str(CONFIGS / "virtual_arm.toml"), "--plan", str(plan)], tmp_path / "s")
     assert f"the 8 lights of --plan {plan} cannot determine a surface normal" in said
+    assert "lights at one azimuth (0° or 180°)" in said
 
 
 def test_a_replayed_acquisition_at_one_azimuth_is_refused(tmp_path: Path) -> None:

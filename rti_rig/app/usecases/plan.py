@@ -16,7 +16,7 @@ import numpy as np
 
 from rti_rig.app.compose import arm_order_for, read_preview_image
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
-from rti_rig.app.normals_determined import FIT_WITHOUT_NORMALS, undetermined_normals
+from rti_rig.app.normals_determined import band_advice, refuse_undetermined
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.app.preview_source import resolve_preview
 from rti_rig.core.errors import RtiRigError
@@ -179,7 +179,16 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             arm_order=arm_order,
         )
     )
-    refuse_undetermined(schedule, req)
+    # every planner picks among the rig's lights in the band: where those cannot determine a
+    # normal, any choice cannot (the plan had been written, "expected RMS normal error 90.00")
+    refuse_undetermined(
+        np.array([st.direction for st in schedule.steps], dtype=np.float64),
+        "planned lights",
+        f"the lights of {req.rig} between {req.min_elevation_deg:g}°..{req.max_elevation_deg:g}° "
+        "elevation leave no other choice: "
+        + band_advice(req.min_elevation_deg, req.max_elevation_deg),
+        "nothing was written",
+    )
     if light_note and report.preview_light_source == "given":
         report.preview_light_source = light_note
     if req.signal_noise and not report.signal_noise:
@@ -201,34 +210,6 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
     )
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
-
-
-def refuse_undetermined(schedule: LightSchedule, req: PlanLightsRequest) -> None:
-    """Refuse a plan whose lights cannot determine a surface normal, before it is written.
-
-    Every planner picks among the rig's lights in the elevation band; where those all lie in
-    one plane (a ring at the horizon, one azimuth) or bunch at the zenith, any choice does. Such
-    a plan had been written with "expected RMS normal error 90.00" as its only sign, for
-    ``rti-rig fit`` to refuse its photometric stereo after the session was shot. "Widen the
-    band" is offered only where a band was given: a rig whose rings sit at 89.2° and 89.6° had
-    been told to widen the 0..90° band it already had.
-    """
-    lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
-    reason = undetermined_normals(lights, "planned lights")
-    if reason is None:
-        return
-    narrowed = req.min_elevation_deg > 0.0 or req.max_elevation_deg < 90.0
-    band = f"{req.min_elevation_deg:g}°..{req.max_elevation_deg:g}°"
-    widen = (
-        f", or widen --min-elevation-deg / --max-elevation-deg (the band {band} was given)"
-        if narrowed
-        else ""
-    )
-    raise RtiRigError(
-        f"{reason}; {FIT_WITHOUT_NORMALS}. The lights of {req.rig} between {band} "
-        "elevation leave no other choice: use a rig with lights at several elevations and "
-        f"azimuths{widen}; nothing was written"
-    )
 
 
 def _lp_labels(labels: list[str]) -> list[str]:

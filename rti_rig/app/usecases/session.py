@@ -679,6 +679,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     """The schedule a new session runs: the plan's, or a homogeneous layout."""
     from rti_rig.app.compose import arm_order_for
     from rti_rig.app.config import rig_geometry
+    from rti_rig.app.normals_determined import band_advice, refuse_undetermined
     from rti_rig.core.lp_format import read_lp
     from rti_rig.planner.from_lp import schedule_from_lp
     from rti_rig.planner.make_plan import check_elevation_band
@@ -696,11 +697,12 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         if (few := too_few_to_fit(len(entries))) is not None:
             on_note(few)
         schedule = schedule_from_lp(entries, geometry, str(req.plan))
-        _refuse_undetermined(
-            schedule,
+        refuse_undetermined(
+            _directions(schedule),
             f"lights of --plan {req.plan}",
             "plan them with rti-rig plan (it refuses such lights) or give a plan with lights "
             "at several elevations and azimuths",
+            "nothing was lit or moved",
         )
         return schedule
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
@@ -730,39 +732,22 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     schedule = plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )
-    band = req.min_elevation_deg > 0.0 or req.max_elevation_deg < 90.0
-    _refuse_undetermined(
-        schedule,
+    refuse_undetermined(
+        _directions(schedule),
         "lights asked for with --lights"
         if req.lights is not None
         else "lights run takes by default",
-        "widen --min-elevation-deg / --max-elevation-deg, or use a rig with lights at several "
-        "elevations and azimuths"
-        if band
-        else "use a rig with lights at several elevations and azimuths",
+        band_advice(req.min_elevation_deg, req.max_elevation_deg),
+        "nothing was lit or moved",
     )
     return schedule
 
 
-def _refuse_undetermined(schedule: LightSchedule, what: str, advice: str) -> None:
-    """Refuse, before the rig is opened, a session whose lights cannot determine a normal.
-
-    Only ``rti-rig plan`` refused lights in one plane (or bunched at the zenith): ``run
-    --lights N`` in a band that leaves only such lights, or ``run --plan`` of a hand-made .lp,
-    captured the session without a word, and ``rti-rig fit`` then wrote no normals from it.
-    Judged as the plan and the fit judge it (:func:`undetermined_normals`).
-    """
+def _directions(schedule: LightSchedule) -> Any:
+    """The schedule's light directions (N×3), as the fit will read them from lights.lp."""
     import numpy as np
 
-    from rti_rig.app.normals_determined import FIT_WITHOUT_NORMALS, undetermined_normals
-
-    lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
-    reason = undetermined_normals(lights, what)
-    if reason is not None:
-        raise RtiRigError(
-            f"{reason}; {FIT_WITHOUT_NORMALS}. {advice[0].upper()}{advice[1:]}; "
-            "nothing was lit or moved"
-        )
+    return np.array([s.direction for s in schedule.steps], dtype=np.float64)
 
 
 def _metering_options(req: NewSessionRequest, loaded) -> str:  # type: ignore[no-untyped-def]
