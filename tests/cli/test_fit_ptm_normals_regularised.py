@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 from conftest import REPO
 from typer.testing import CliRunner
 
@@ -76,15 +77,31 @@ def test_an_hsh_fit_on_one_azimuth_is_written_without_normals(tmp_path: Path) ->
     assert r.exit_code == 2 and "ill-conditioned for photometric stereo" in r.output
 
 
-def test_auto_on_one_azimuth_names_the_cli_way_out(tmp_path: Path) -> None:
-    # auto chooses Lambert on these lights and was refused with "(from Python,
-    # ill_conditioned='regularise' fits it regularised)", advice a CLI user cannot follow
+@pytest.mark.parametrize("scene", ["tablet", "coin"])
+def test_auto_on_one_azimuth_writes_relighting_files_without_normals(
+    tmp_path: Path, scene: str
+) -> None:
+    # auto had chosen Lambert on the tablet and refused the whole fit (exit 2), but the PTM on
+    # the coin and written its relighting files: the outcome hung on the object, not the lights
+    session, _, _ = make_session(tmp_path / "s", scene=scene, size=(32, 32), lights=_one_azimuth())
+    said = _fit(session, tmp_path / "f", "auto")
+    assert "Lambert left out of the choice" in said
+    assert "lights at one azimuth (29° or 209°)" in said
+    assert "normals.png/.npy and albedo not written" in said
+    fit = json.loads((tmp_path / "f" / "fit.json").read_text())
+    assert fit["model"] != "lambert" and not fit["normals_from"]
+    assert (tmp_path / "f" / "fit.rti").exists()
+    assert not (tmp_path / "f" / "normals.npy").exists()
+
+
+def test_photometric_stereo_by_name_on_one_azimuth_names_the_cli_way_out(tmp_path: Path) -> None:
     session, _, _ = make_session(tmp_path / "s", size=(32, 32), lights=_one_azimuth())
-    r = CliRunner().invoke(app, ["fit", str(session), "--out", str(tmp_path / "f"), "--no-qa"])
+    r = CliRunner().invoke(
+        app, ["fit", str(session), "--out", str(tmp_path / "f"), "--model", "lambert"]
+    )
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
-    assert "--model auto chose lambert" in said
-    assert "--model hsh2 or --model ptm write the relighting files" in said
+    assert "--model auto, --model hsh2 or --model ptm write the relighting files" in said
     assert "from Python" not in said
 
 

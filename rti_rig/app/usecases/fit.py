@@ -719,8 +719,9 @@ def _fit_all(
             "choose a lower order, or leave --hsh-order out"
         )
     if name == AUTO:
+        candidates, left_out = auto_candidates(lights)
         try:
-            choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS)
+            choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS, candidates=candidates)
         except ReconstructionError as exc:
             if n < 3:
                 raise
@@ -733,7 +734,7 @@ def _fit_all(
         files.append(out / "model_choice.md")
         reason_line = (
             f"{choice.model}: lowest order within {choice.tolerance:.0%} of the best held-out "
-            f"error ({choice.best_model}), {choice.holdout}"
+            f"error ({choice.best_model}), {choice.holdout}{left_out}"
         )
     else:
         spec = model_spec(name)
@@ -754,7 +755,7 @@ def _fit_all(
         write_normals = bool(normal_source)
         if why:
             skipped.append(why)
-    elif model_name in ("ps", "lambert", "ps-robust"):  # normals are the model: none, no fit
+    elif model_name in PHOTOMETRIC_STEREO:  # normals are the model: none, no fit
         _refuse_undetermined_normals(req, model_name, lights)
 
     # linear models to export, their solve matrices (warnings issued once, here)
@@ -942,15 +943,41 @@ def _normal_source(model_name: str) -> str:
     return NORMALS_BY_MODEL.get(model_name, "ps-robust")
 
 
+#: The models whose fit is the normal map: on lights that cannot determine a normal there is
+#: nothing to write, and ``auto`` does not choose them.
+PHOTOMETRIC_STEREO = ("ps", "lambert", "ps-robust")
+
+
+def auto_candidates(lights: np.ndarray) -> tuple[tuple[str, ...], str]:
+    """The models ``--model auto`` chooses among on ``lights``, and what to add to its reason.
+
+    Every relighting model, except on lights that cannot determine a normal: there Lambert
+    (photometric stereo) is left out and auto chooses among the PTM and HSH, written
+    ridge-regularised and without normal maps. Why: auto had chosen Lambert on 10 lights at
+    one azimuth on the simulated tablet and refused the whole fit (exit 2), but the PTM on the
+    coin and the industrial part and written their relighting files; which of the two a user
+    got depended on the object, not on the lights.
+    """
+    from rti_rig.app.normals_determined import undetermined_normals
+    from rti_rig.reconstruct.registry import RELIGHT_MODELS
+
+    undetermined = undetermined_normals(lights, "lights of this session")
+    if undetermined is None:
+        return RELIGHT_MODELS, ""
+    kept = tuple(m for m in RELIGHT_MODELS if m not in PHOTOMETRIC_STEREO)
+    return kept, (
+        f"; Lambert left out of the choice: {undetermined}, so only the PTM and HSH, "
+        "ridge-regularised, are written, and no normal maps"
+    )
+
+
 def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.ndarray) -> None:
     """Refuse, naming the CLI way out, a fit whose model is photometric stereo (``--model
-    ps``, ``lambert``, ``robust-ps``, or ``auto`` choosing Lambert) on lights that cannot give
-    normals.
+    ps``, ``lambert`` or ``robust-ps``) on lights that cannot give normals.
 
     The solver's own refusal advised "(from Python, ill_conditioned='regularise' fits it
-    regularised)", which a CLI user cannot act on; ``auto`` chooses Lambert on lights at one
-    azimuth, so its fit was refused whole where ``--model hsh2`` or ``ptm`` writes the
-    relighting files without normals.
+    regularised)", which a CLI user cannot act on. ``auto`` never gets here: on such lights it
+    leaves Lambert out of its choice (:func:`auto_candidates`).
     """
     from rti_rig.app.normals_determined import undetermined_normals
 
@@ -960,8 +987,9 @@ def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.nd
     asked = f"--model auto chose {model_name}" if req.model == AUTO else f"--model {req.model}"
     raise FitInputError(
         f"{asked}, photometric stereo, but {reason}: ill-conditioned for photometric stereo. "
-        "--model hsh2 or --model ptm write the relighting files (fit.rti, fit.ptm) without "
-        "normal maps; for normals, capture again with lights at several elevations and azimuths"
+        "--model auto, --model hsh2 or --model ptm write the relighting files (fit.rti, fit.ptm), "
+        "ridge-regularised, without normal maps; for normals, capture again with lights at "
+        "several elevations and azimuths"
     )
 
 
@@ -976,17 +1004,19 @@ def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str
     limit (lights on one side only, azimuth 0-90° at 20/45/70°: condition 40, noise gain 15.2;
     its normals were 25° off on the tablet, 57° on the coin); real light sets have gains
     0.45-2.0. There robust photometric stereo is used if the lights condition Lambert's 3 terms
-    (0.14° on the same ring; 0.09° on the tablet lit from one side). Lambert would be better on
+    (on the tablet 0.06° on a ring at 35° and 0.16° lit from one side, against the PTM's 12.1° and
+    25.0°: docs/reconstruction.md, the ptm_normals_fallback table). Lambert would be better on
     glossy metal lit from one ring and worse on a tilted object's shadows (docs/
     reconstruction.md, "No normals from a PTM"). Where they do not, no normal maps are
     written and the relighting files are, regularised as always: a PTM fit had written 71°-off
-    normals, an HSH fit had been refused whole for its normals. ``--model ps`` or ``lambert``
-    asks for normals by name and is refused instead.
+    normals, an HSH fit had been refused whole for its normals. ``--model ps``, ``lambert`` or
+    ``robust-ps`` asks for normals by name and is refused instead.
     """
+    from rti_rig.app.normals_determined import undetermined_normals
     from rti_rig.core.rti_bases import design_matrix
     from rti_rig.reconstruct.solve import NOISE_GAIN_LIMIT, solve_matrix
 
-    _, ps = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
+    undetermined = undetermined_normals(lights, "lights of this session")
     if source == "ptm":
         _, ptm = solve_matrix(design_matrix("ptm", lights), "ptm", warn=False)
         if ptm.trusted:  # neither regularised nor over the noise-gain limit
@@ -998,17 +1028,15 @@ def conditioned_normal_source(source: str, lights: np.ndarray) -> tuple[str, str
             else f"ill-conditioned on these lights (noise gain {ptm.noise_gain:.3g}, limit "
             f"{NOISE_GAIN_LIMIT:g}), and its normals would be far off"
         )
-        if not ps.regularised:
+        if undetermined is None:
             return "ps-robust", (
                 f"normals from robust photometric stereo, not the PTM: the PTM is {why}"
             )
-    elif not ps.regularised:
+    elif undetermined is None:
         return source, ""
     return "", (
-        "normals.png/.npy and albedo not written: these lights do not condition photometric "
-        f"stereo (condition number {ps.condition_number:.3g} over the hemisphere, limit "
-        f"{ps.cond_limit:g}): lights at the horizon, at one azimuth or in one direction give no "
-        "normals; add lights at other elevations and azimuths"
+        f"normals.png/.npy and albedo not written: {undetermined}; add lights at other "
+        "elevations and azimuths"
     )
 
 
