@@ -163,6 +163,17 @@ def run(
             "--resume: must be the session's own.",
         ),
     ] = None,
+    allow_no_normals: Annotated[
+        bool,
+        typer.Option(
+            "--allow-no-normals",
+            help="Capture lights that cannot determine a surface normal (all in one plane "
+            "through the object, e.g. one azimuth for raking-light documentation, or bunched "
+            "at the zenith) with a warning, in place of the refusal. rti-rig fit then writes "
+            "no normal maps, and its relighting files are ridge-regularised guesses along the "
+            "direction the lights miss.",
+        ),
+    ] = False,
     no_verdict: Annotated[
         bool, typer.Option("--no-verdict", help="Do not print the QA verdict at the end.")
     ] = False,
@@ -199,6 +210,7 @@ def run(
                 ("--max-saturated", max_saturated is not None),
                 ("--min-elevation-deg", min_elevation_deg != 0.0),
                 ("--max-elevation-deg", max_elevation_deg != 90.0),
+                ("--allow-no-normals", allow_no_normals),
             )
             if value
         ]
@@ -247,6 +259,7 @@ def run(
                 until_error_deg=until_error,
                 objective=objective,
                 min_lights=min_lights,
+                allow_no_normals=allow_no_normals,
             ),
             print_note,
         )

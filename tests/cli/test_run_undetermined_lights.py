@@ -50,3 +50,34 @@ def test_a_replayed_acquisition_at_one_azimuth_is_refused(tmp_path: Path) -> Non
     said = _refused([str(_one_azimuth(acq / "dirs.lp"))], tmp_path / "s")
     assert "the 8 lights run takes by default cannot determine a surface normal" in said
     assert "widen" not in said  # no band was given
+
+
+def test_allow_no_normals_captures_a_one_azimuth_plan_saying_so(tmp_path: Path) -> None:
+    """A deliberate raking-light plan at one azimuth had no way past the refusal."""
+    plan = _one_azimuth(tmp_path / "one_az.lp")
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        [
+            "run",
+            str(CONFIGS / "virtual_arm.toml"),
+            "--plan",
+            str(plan),
+            "--out",
+            str(out),
+            "--no-verdict",
+            "--allow-no-normals",
+        ],
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "captured as asked (--allow-no-normals)" in said
+    assert "along the direction the lights do not span, their relighting is a guess" in said
+    assert len(list(out.glob("image_*.jpg"))) == 8
+    assert "--allow-no-normals" in (out / "manifest.json").read_text(encoding="utf-8")
+
+
+def test_the_refusal_names_the_way_through(tmp_path: Path) -> None:
+    plan = _one_azimuth(tmp_path / "one_az.lp")
+    said = _refused([str(CONFIGS / "virtual_arm.toml"), "--plan", str(plan)], tmp_path / "s")
+    assert "add --allow-no-normals" in said

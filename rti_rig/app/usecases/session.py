@@ -70,6 +70,9 @@ class NewSessionRequest:
     #: Adaptive with ``until_error_deg``: the fewest lights the stop may claim the target at
     #: (None: no minimum; a PTM needs 6, an HSH fit.rti 5).
     min_lights: int | None = None
+    #: Capture lights that cannot determine a normal (one plane, bunched at the zenith) with a
+    #: warning, in place of the refusal: raking-light documentation at one azimuth.
+    allow_no_normals: bool = False
 
     @property
     def is_adaptive(self) -> bool:
@@ -679,7 +682,7 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     """The schedule a new session runs: the plan's, or a homogeneous layout."""
     from rti_rig.app.compose import arm_order_for
     from rti_rig.app.config import rig_geometry
-    from rti_rig.app.normals_determined import band_advice, refuse_undetermined
+    from rti_rig.app.normals_determined import band_advice
     from rti_rig.core.lp_format import read_lp
     from rti_rig.planner.from_lp import schedule_from_lp
     from rti_rig.planner.make_plan import check_elevation_band
@@ -697,12 +700,13 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         if (few := too_few_to_fit(len(entries))) is not None:
             on_note(few)
         schedule = schedule_from_lp(entries, geometry, str(req.plan))
-        refuse_undetermined(
-            _directions(schedule),
+        _check_determined(
+            req,
+            schedule,
             f"lights of --plan {req.plan}",
             "plan them with rti-rig plan (it refuses such lights) or give a plan with lights "
             "at several elevations and azimuths",
-            "nothing was lit or moved",
+            on_note,
         )
         return schedule
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
@@ -732,22 +736,55 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     schedule = plan_uniform(
         geometry, n, req.min_elevation_deg, arm_order_for(loaded), req.max_elevation_deg
     )
-    refuse_undetermined(
-        _directions(schedule),
+    _check_determined(
+        req,
+        schedule,
         "lights asked for with --lights"
         if req.lights is not None
         else "lights run takes by default",
         band_advice(req.min_elevation_deg, req.max_elevation_deg),
-        "nothing was lit or moved",
+        on_note,
     )
     return schedule
 
 
-def _directions(schedule: LightSchedule) -> Any:
-    """The schedule's light directions (N×3), as the fit will read them from lights.lp."""
+def _check_determined(
+    req: NewSessionRequest, schedule: LightSchedule, what: str, advice: str, on_note: NoteSink
+) -> None:
+    """Refuse, before the rig is opened, lights that cannot determine a normal, unless
+    ``--allow-no-normals`` asks for them: then a warning, printed and kept in the manifest.
+
+    Why the way through: a deliberate ``run --plan`` at one azimuth (raking-light
+    documentation) had no way past the refusal. The warning says what ``rti-rig fit`` will
+    make of them: relighting files that are ridge-regularised guesses along the missing
+    direction, and no normal maps.
+    """
     import numpy as np
 
-    return np.array([s.direction for s in schedule.steps], dtype=np.float64)
+    from rti_rig.app.normals_determined import (
+        FIT_WITHOUT_NORMALS,
+        refuse_undetermined,
+        undetermined_normals,
+    )
+
+    lights = np.array([s.direction for s in schedule.steps], dtype=np.float64)
+    if not req.allow_no_normals:
+        refuse_undetermined(
+            lights,
+            what,
+            f"{advice}; or, to capture them all the same (raking-light documentation, no "
+            "normal maps wanted), add --allow-no-normals",
+            "nothing was lit or moved",
+        )
+        return
+    reason = undetermined_normals(lights, what)
+    if reason is not None:
+        on_note(
+            Note(
+                f"{reason}; captured as asked (--allow-no-normals): {FIT_WITHOUT_NORMALS}",
+                "warning",
+            )
+        )
 
 
 def _metering_options(req: NewSessionRequest, loaded) -> str:  # type: ignore[no-untyped-def]
@@ -826,6 +863,11 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
             f"--objective {req.objective} goes with --adaptive (it says what the adaptive "
             "design is chosen for); a planned layout's objective is chosen with `rti-rig plan "
             "--objective`, then run with --plan"
+        )
+    if req.is_adaptive and req.allow_no_normals:
+        raise RtiRigError(
+            "--allow-no-normals goes with --plan or --lights: an adaptive session chooses its "
+            "lights itself; drop --allow-no-normals"
         )
     if req.is_adaptive:
         opened = _open_adaptive(req, loaded)
