@@ -2256,42 +2256,38 @@ def _files_after_first_step(root: Path, names: list[str]) -> list[str]:
     )
 
 
-def stopped_before_first_record(root: Path) -> bool:
-    """Whether session ``root`` (its manifest readable) has no journal because it never wrote
-    one: stopped (killed, a power cut) before its first image was journaled, with at most that
-    first image's files on disk and no record file proving it (files a resume sets aside
-    and shoots again). A first step whose record file is on disk, its files as it says, is
-    committed: the run stopped before its first journal line, not before its first record
-    (:func:`stopped_before_journal_line`).
+#: What :func:`stopped_before_first_journal` says of a session stopped before its first record.
+UNRECORDED = "unrecorded"
+
+
+def stopped_before_first_journal(root: Path) -> str | None:
+    """How session ``root`` (its manifest readable) came to have no journal, or None where it
+    is not one that never wrote one: :data:`UNRECORDED` when it stopped (killed, a power cut)
+    before its first image was journaled, with at most that first image's files on disk and
+    no record file proving it (files a resume sets aside and shoots again); the first image's
+    stem (``image_001``) when it stopped after that image's record file and before any journal
+    line (:func:`stopped_before_journal_line`): its step is committed, but no ``journal.jsonl``
+    or ``lights.lp`` lists it yet.
 
     Why: such a folder had been called "not a session folder" by ``fit``, and ``export-lp``
-    advised restoring a journal.jsonl from a backup, of a journal that never existed."""
+    advised restoring a journal.jsonl from a backup, of a journal that never existed. One
+    function over one :func:`scan_journal`: the two cases had been two functions with one
+    preamble, and ``fit`` read the manifest and scanned the journal twice to tell them apart.
+    """
     root = Path(root)
     if (root / JOURNAL).exists():
-        return False
+        return None
     try:
         total = planned_steps(read_manifest(root))
     except SessionError:
-        return False
+        return None
     if not total:
-        return False
+        return None
     names = image_names(total)
-    return not _files_after_first_step(root, names) and not scan_journal(root, names).records
-
-
-def stopped_before_first_journal_line(root: Path) -> str | None:
-    """The first image of session ``root`` when its run stopped after that image's record
-    file and before any journal line (:func:`stopped_before_journal_line`), else None: its
-    step is committed, but no ``journal.jsonl`` or ``lights.lp`` lists it yet."""
-    root = Path(root)
-    if (root / JOURNAL).exists():
-        return None
-    try:
-        total = planned_steps(read_manifest(root))
-    except SessionError:
-        return None
-    scan = scan_journal(root, image_names(total)) if total else None
-    return stopped_before_journal_line(scan) if scan is not None and scan.missing else None
+    scan = scan_journal(root, names)
+    if not scan.records:
+        return None if _files_after_first_step(root, names) else UNRECORDED
+    return stopped_before_journal_line(scan) if scan.missing else None
 
 
 def _relist_verified(root: Path, done: dict[int, StepRecord], stamp: str) -> str | None:
@@ -2966,7 +2962,7 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     key = "linear_image" if linear else "image"
     done = verified_steps(root, records, only=key)  # the file the .lp names, as captured
     if not records:
-        if stopped_before_first_record(root):
+        if stopped_before_first_journal(root) == UNRECORDED:
             instead = unresumable(root)
             raise SessionError(
                 f"{root}: the session stopped before its first image was recorded in its "

@@ -59,6 +59,7 @@ from rti_rig.runtime.session import (
     JOURNAL,
     LP_NAME,
     MANIFEST,
+    UNRECORDED,
     checksum_session_files,
     lost_image_advice,
     read_manifest,
@@ -66,8 +67,7 @@ from rti_rig.runtime.session import (
     remember_pixel_digest,
     renamed_note,
     renamed_since_capture,
-    stopped_before_first_journal_line,
-    stopped_before_first_record,
+    stopped_before_first_journal,
     unresumable,
 )
 
@@ -315,14 +315,14 @@ def acquisition_files(
                     f"session's journal with: rti-rig export-lp {shlex.quote(str(source))} "
                     f"--out {shlex.quote(str(source / LP_NAME))}"
                 )
-            first = stopped_before_first_journal_line(source)
-            if first is not None or stopped_before_first_record(source):
+            first = stopped_before_first_journal(source)
+            if first is not None:
                 # killed before its first record; or after it, before its first journal line
                 # (its image committed: "nothing recorded" had been said of it)
                 instead = unresumable(source)  # a camera-triggered dome's resume is refused
                 what = (
                     "stopped before its first image was recorded: there is nothing to fit yet"
-                    if first is None
+                    if first == UNRECORDED
                     else f"stopped before its first journal line: {first} is kept (its record "
                     f"file proves it), but no {LP_NAME} lists it yet, and one image is too few "
                     "to fit"
