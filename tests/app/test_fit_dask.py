@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import shutil
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -230,13 +231,22 @@ def test_a_result_fetched_again_after_a_failed_fetch_says_nothing(
 
 
 @pytest.fixture
-def scripted_clock(monkeypatch: pytest.MonkeyPatch) -> None:
+def scripted_clock(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[float]]:
     """The fetch watch's clock, 30 s on at each reading: a result that never comes is given
-    up after its tries without a minute of real waiting."""
+    up after its tries without a minute of real waiting. Its readings are kept: a test that
+    ends without any was not given up by this clock."""
     from rti_rig.app.usecases import fit_dask
 
-    ticks = iter(range(0, 10**9, 30))
-    monkeypatch.setattr(fit_dask, "_now", lambda: float(next(ticks)))
+    readings: list[float] = []
+
+    def clock() -> float:
+        readings.append(30.0 * len(readings))
+        return readings[-1]
+
+    watched = fit_dask._gathers_watched
+    monkeypatch.setattr(fit_dask, "_gathers_watched", lambda client: watched(client, clock))
+    yield readings
+    assert len(readings) >= fit_dask.GATHER_TRIES, readings  # the watch measured by it
 
 
 @pytest.mark.usefixtures("scripted_clock")
@@ -389,8 +399,14 @@ def test_two_fits_in_one_process_each_count_their_own_fetches() -> None:
 
     first_client, second_client = _Client(), _Client()
     logger = logging.getLogger("distributed.client")
-    with _gathers_watched(first_client) as first, _gathers_watched(second_client) as second:
-        first.clock = second.clock = lambda: 1e9 if second.failures else 0.0
+
+    def clock() -> float:  # a minute gone by once the second watch counted a failure
+        return 1e9 if second.failures else 0.0
+
+    with (
+        _gathers_watched(first_client, clock) as first,
+        _gathers_watched(second_client, clock) as second,
+    ):
         second.track(_Future("theirs"))
         for _ in range(GATHER_TRIES + 1):
             logger.filter(_gather_failed("theirs"))

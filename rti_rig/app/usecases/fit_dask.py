@@ -85,11 +85,6 @@ GATHER_TRIES = 5
 GATHER_PATIENCE_S = 60.0
 
 
-def _now() -> float:
-    """The clock the fetch watch measures :data:`GATHER_PATIENCE_S` by (a test scripts it)."""
-    return time.monotonic()
-
-
 SHARED_PATHS = (
     "every Dask worker must see the session's files at the same paths as this machine "
     "(a shared filesystem mounted at the same place)"
@@ -116,10 +111,11 @@ class _GatherWatch(logging.Filter):
     not watch (another fit's in this process) is let through, not hidden: the other fit's
     watch, which sees a record only if this one lets it pass, counts it."""
 
-    def __init__(self, client: Any, clock: Callable[[], float] | None = None) -> None:
+    def __init__(self, client: Any, clock: Callable[[], float] = time.monotonic) -> None:
         super().__init__()
         self.client = client
-        self.clock = clock or _now
+        #: what :data:`GATHER_PATIENCE_S` is measured by (a test gives a scripted one)
+        self.clock = clock
         self.failures: dict[Any, int] = {}
         self.first_failed: dict[Any, float] = {}
         self.cancelled: set[Any] = set()
@@ -153,9 +149,12 @@ class _GatherWatch(logging.Filter):
 
 
 @contextmanager
-def _gathers_watched(client: Any) -> Iterator[_GatherWatch]:
-    """:class:`_GatherWatch` on the Dask client's logger for the length of the block."""
-    watch = _GatherWatch(client)
+def _gathers_watched(
+    client: Any, clock: Callable[[], float] = time.monotonic
+) -> Iterator[_GatherWatch]:
+    """:class:`_GatherWatch` (measuring by ``clock``) on the Dask client's logger for the
+    length of the block."""
+    watch = _GatherWatch(client, clock)
     logger = logging.getLogger("distributed.client")
     logger.addFilter(watch)
     try:
