@@ -136,3 +136,15 @@ def test_real_light_sets_keep_the_ptm_normals() -> None:
     ):
         lights = np.array([e.direction for e in read_lp(REPO / lp, upper_hemisphere=True)])
         assert conditioned_normal_source("ptm", lights) == ("ptm", ""), lp
+
+
+def test_auto_on_four_lights_at_one_azimuth_does_not_advise_photometric_stereo(
+    tmp_path: Path,
+) -> None:
+    # too few for a PTM or HSH with Lambert left out: it advised "--model ps", itself refused
+    session, _, _ = make_session(tmp_path / "s", size=(24, 24), lights=_one_azimuth()[::3])
+    r = CliRunner().invoke(app, ["fit", str(session), "--out", str(tmp_path / "f"), "--no-qa"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "Nor can photometric stereo be fitted" in said
+    assert "--model ps" not in said

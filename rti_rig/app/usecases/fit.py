@@ -719,15 +719,27 @@ def _fit_all(
             "choose a lower order, or leave --hsh-order out"
         )
     if name == AUTO:
-        candidates, left_out = auto_candidates(lights)
+        candidates, undetermined = auto_candidates(lights)
+        left_out = (
+            f"; Lambert left out of the choice: {undetermined}, so only the PTM and HSH, "
+            "ridge-regularised, are written, and no normal maps"
+            if undetermined
+            else ""
+        )
         try:
             choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS, candidates=candidates)
         except ReconstructionError as exc:
             if n < 3:
                 raise
             raise FitInputError(
-                f"--model auto: {exc}. Photometric stereo alone (normals and albedo, no "
-                "relighting model) may still be fitted: --model ps"
+                f"--model auto: {exc}. "
+                + (
+                    f"Nor can photometric stereo be fitted: {undetermined}; capture again "
+                    "with more lights at several elevations and azimuths"
+                    if undetermined
+                    else "Photometric stereo alone (normals and albedo, no relighting model) "
+                    "may still be fitted: --model ps"
+                )
             ) from None
         model_name = choice.model
         (out / "model_choice.md").write_text(choice.to_markdown() + "\n", encoding="utf-8")
@@ -949,7 +961,8 @@ PHOTOMETRIC_STEREO = ("ps", "lambert", "ps-robust")
 
 
 def auto_candidates(lights: np.ndarray) -> tuple[tuple[str, ...], str]:
-    """The models ``--model auto`` chooses among on ``lights``, and what to add to its reason.
+    """The models ``--model auto`` chooses among on ``lights``, and why Lambert is not among
+    them ("" where it is).
 
     Every relighting model, except on lights that cannot determine a normal: there Lambert
     (photometric stereo) is left out and auto chooses among the PTM and HSH, written
@@ -964,11 +977,7 @@ def auto_candidates(lights: np.ndarray) -> tuple[tuple[str, ...], str]:
     undetermined = undetermined_normals(lights, "lights of this session")
     if undetermined is None:
         return RELIGHT_MODELS, ""
-    kept = tuple(m for m in RELIGHT_MODELS if m not in PHOTOMETRIC_STEREO)
-    return kept, (
-        f"; Lambert left out of the choice: {undetermined}, so only the PTM and HSH, "
-        "ridge-regularised, are written, and no normal maps"
-    )
+    return tuple(m for m in RELIGHT_MODELS if m not in PHOTOMETRIC_STEREO), undetermined
 
 
 def _refuse_undetermined_normals(req: FitRequest, model_name: str, lights: np.ndarray) -> None:
