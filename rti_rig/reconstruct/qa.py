@@ -1365,7 +1365,10 @@ def assess(
         sigma,
         thresholds,
         median_direction_error_deg=ev.typical,
-        directions_checked=bool(ev.direction_judged.any()),
+        # by its angle: an image named by the swap check alone (swap_ratio set) is judged by
+        # its rendering, not its angle, and had made qa.json say "checked" beside a null
+        # median and a note saying no direction was
+        directions_checked=bool((ev.direction_judged & ~np.isfinite(ev.swap_ratio)).any()),
         direction_note=ev.direction_note,
         drift_note=drift_note,
         shift_note=shift_note,

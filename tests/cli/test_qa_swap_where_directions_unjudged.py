@@ -57,6 +57,9 @@ def test_a_swapped_pair_is_said_as_a_swap(industrial: Path, tmp_path: Path) -> N
     assert "recorded for image_002" in wrong["image_003"], verdict
     assert all("(swapped?)" in p for p in wrong.values()), verdict
     assert "moved" not in verdict, verdict
+    # qa.json agrees with itself: no direction was judged by its angle, none is claimed
+    assert qa["median_direction_error_deg"] is None, qa
+    assert qa["directions_checked"] is False, qa
 
 
 def test_the_correct_session_has_no_swap(industrial: Path, tmp_path: Path) -> None:
