@@ -744,15 +744,7 @@ def _confirmed_step(
         elif min(as_is, undone) > STEP_FIT_NO_EVIDENCE:
             unjudged.append(step)
     if best is None and unjudged:
-        # The most agreeing. Splits the edges bear out equally are one move placed no closer:
-        # the images from the latest on moved by every one of them, the verdict says from
-        # which image it may have begun (the same coin at 256 px: splits at images 4 and 7,
-        # each with all 12 images where it says).
-        top = max(s.agreement for s in unjudged)
-        tied = sorted((s for s in unjudged if s.agreement == top), key=lambda s: s.first)
-        step = tied[-1]
-        if tied[0].first < step.first:
-            step = replace(step, earliest=tied[0].first)
+        step = _most_agreeing(unjudged, n)
         moved = _moved_from(crop_arr, step)
         try:
             fit_undone = fit_photometric_stereo(moved, lt, robust=True, saturation=saturation)
@@ -768,6 +760,50 @@ def _confirmed_step(
     except ReconstructionError:
         return None
     return _placed_by_fit(crop_arr, lt, step, moved, fit_undone, saturation)
+
+
+def _most_agreeing(unjudged: list[Step], n: int) -> Step:
+    """Of splits the fit cannot weigh, the one the edges bear out most, with the range of
+    images where the move may have begun where they place it no closer.
+
+    Splits the edges bear out alike (within one image of ``n``: a single image read either
+    way is no evidence) are one move placed no closer: the images from the latest on moved
+    by every one of them (the same coin at 256 px: splits at images 4 and 7, each with all
+    12 images where it says; at 512 px 11 and 12 of 12). A split some of whose images sit
+    where it does not say leaves its place open as far as those images (its ``span``): the
+    coin at 256 px, 12 lights, moved (2, 0) px from image 5 gave one split at image 4 and
+    had been told "moved from image_004 on" as if certain."""
+    top = max(s.agreement for s in unjudged)
+    tied = sorted(
+        (s for s in unjudged if s.agreement >= top - 1.0 / n - 1e-9), key=lambda s: s.first
+    )
+    step = tied[-1]
+    lo, hi = tied[0].first, step.first
+    for s in tied:
+        if s.span is not None:
+            lo, hi = min(lo, s.span[0]), max(hi, s.span[1])
+    if (lo, hi) == (step.first, step.first):
+        return step
+    return replace(step, earliest=lo, latest=hi)
+
+
+def _in_open_range(step: Step, i: int) -> bool:
+    """Whether image ``i`` lies where the step's move may have begun but was not placed."""
+    if step.earliest is None or step.latest is None:
+        return False
+    return step.earliest <= i < step.latest
+
+
+def _may_have_moved(step: Step, names: Sequence[str]) -> str:
+    """The problem of an image in the step's open range: it is not known to have moved,
+    nor to have held still, so it is named for the reshoot without a shift claimed."""
+    assert step.earliest is not None and step.latest is not None
+    lo, hi = names[step.earliest], names[step.latest]
+    return (
+        f"may have moved: the object or camera moved between {lo} and {hi}, and the edges "
+        "cannot tell whether before or after this image (the fit explains this object too "
+        "poorly to tell); reshoot the whole session"
+    )
 
 
 def _moved_from(crop_arr: NDArray, step: Step) -> NDArray:
@@ -1280,15 +1316,16 @@ def assess(
                 "as every image's do (a lens cap, lights that never fired, or an exposure far "
                 "too short)"
             )
-        if step_moved[i] and step is not None:
+        if step is not None and _in_open_range(step, i):
+            problems.append(_may_have_moved(step, names))
+        elif step_moved[i] and step is not None:
             dx, dy = step.shift[0], -step.shift[1]  # x right, y up
-            first = names[step.first]
+            first = names[step.first if step.latest is None else step.latest]
             unsure = (
                 ""
                 if step.earliest is None
-                else f", or as early as {names[step.earliest]} (the edges place the move "
-                f"anywhere from {names[step.earliest]} to {first} alike, and the fit explains "
-                "this object too poorly to tell)"
+                else f" (the move began between {names[step.earliest]} and {first}: the edges "
+                "place it no closer, and the fit explains this object too poorly to tell)"
             )
             problems.append(
                 f"{MOVED_FROM} {first} on{unsure}: shifted ({dx:+.1f}, {dy:+.1f}) px "

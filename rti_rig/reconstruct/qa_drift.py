@@ -225,6 +225,14 @@ class Step:
     #: edges bear out splits from here to ``first`` alike and no fit tells them apart. None:
     #: placed at ``first``.
     earliest: int | None = None
+    #: Where the move may have begun as late as this image (0-based, from ``first`` on), set
+    #: with ``earliest``: the images from ``earliest`` up to it may or may not have moved.
+    latest: int | None = None
+    #: The first and the last image the move may have begun at by the images' own labels
+    #: (:func:`step_candidates`): an image before ``first`` read as moved, or one from it on
+    #: read as still, leaves the split's place open that far. ``first`` twice: every image
+    #: sits where the split says.
+    span: tuple[int, int] | None = None
 
 
 def find_step(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> Step | None:
@@ -368,7 +376,10 @@ def step_candidates(crops: NDArray[np.float32], usable: NDArray[np.bool_]) -> It
             return None
         assert first is not None  # sides() refused None
         agreement = float(((la == 0).sum() + (lb == 1).sum()) / (la.size + lb.size))
-        return Step(first, (float(dx), float(dy)), agreement)
+        early = [i for i in before if labels[i] == 1]
+        late = [i + 1 for i in after if labels[i] == 0]
+        span = (min(early, default=first), min(max(late, default=first), n - 1))
+        return Step(first, (float(dx), float(dy)), agreement, span=span)
 
     # The first split, from the whole-pixel peaks against the median of every image; failing
     # that, against the median of the first half of the images, then of the second half

@@ -78,7 +78,11 @@ def test_the_move_is_named_from_its_first_image(case, tmp_path: Path) -> None:  
     session, lights, first, dx, dy = case
     qa = _qa(_moved_copy(session, tmp_path / "moved", first, dx, dy), tmp_path / "f")
     name = f"image_{first:03d}"
-    assert f"moved from {name} on" in qa["verdict"], qa["verdict"]
+    # from its first image, or as a range beginning there where the edges place it no closer
+    # (the industrial part, 12 lights: its 30 % clipped image_012 reads as not moved, so the
+    # split at image_005 is not borne out by every image)
+    v = qa["verdict"]
+    assert f"moved from {name} on" in v or f"moved between {name} and" in v, v
     moved = [c["name"] for c in qa["images"] if any("moved" in p for p in c["problems"])]
     assert moved == [f"image_{i:03d}" for i in range(first, lights + 1)], qa["verdict"]
     shift = next(c for c in qa["images"] if c["name"] == name)["drift_px"]
