@@ -7,6 +7,13 @@ object moved from image_005 on by (-1.1, -8.3) px (a block of four images whose 
 the fit wander, split off by qa._moved_block), at 512 px it named neither image. Its images
 point too far from their lights to judge any by its angle; each swapped image is rendered
 4-8× closer under the other's recorded light than under its own (qa_directions.swapped_pairs).
+
+Margins seen (review, 2026-11-30), for a geometric test "each best direction within the
+object's typical direction error of the other's light": the pair's best directions lie 4.5°
+and 5.5-7.5° from each other's lights at 512 px, but 58.6° and 21.9° at 1024 px, where the
+object's typical error (1.55 × the lower quartile of all images' errors) is 19-21° and the
+check's own object_typical is not computed (NaN). Such a test would lose the 1024 px swap, so
+the pairs are still required only to cross (each best direction nearer the other's light).
 """
 
 from __future__ import annotations
