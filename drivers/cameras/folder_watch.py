@@ -774,6 +774,23 @@ class FolderWatchCamera:
                     "check capture time",
                 )
 
+    def _changed_and_settled(
+        self, path: Path, tried: tuple[int, int, int, int] | None, deadline: float
+    ) -> bool:
+        """Whether ``path`` changed from ``tried`` (its identity when a read of it failed) and
+        then kept one identity for ``stable_polls`` polls before ``deadline``: a file a reader
+        could not use yet is read again only once more of it has come and stopped coming."""
+        s = self.settings
+        last, stable = tried, 0
+        while self._clock.now() < deadline:
+            self._clock.sleep(s.poll_interval_s)
+            now = _identity(path)
+            stable = stable + 1 if now == last else 1
+            last = now
+            if now is not None and now != tried and stable >= s.stable_polls:
+                return True
+        return False
+
     def _whole_capture_time(self, path: Path) -> float | None:
         """The capture time of ``path`` once LibRaw can open it: a file still being written
         (a network share, a Wi-Fi upload pausing) is given ``timeout_s`` to change and settle,
@@ -788,17 +805,8 @@ class FolderWatchCamera:
             final, taken = _read_capture_time(path)
             if final or taken is not None:
                 return taken
-            tried, stable = _identity(path), 0
-            last = tried
-            while True:
-                if self._clock.now() >= deadline:
-                    return None
-                self._clock.sleep(s.poll_interval_s)
-                now = _identity(path)
-                stable = stable + 1 if now == last else 1
-                last = now
-                if now is not None and now != tried and stable >= s.stable_polls:
-                    break
+            if not self._changed_and_settled(path, _identity(path), deadline):
+                return None
 
     def _place(self, taken: float, pulsed_at: float, window_s: float = 0.0) -> list[str] | None:
         """Whether a file shot at ``taken`` (camera clock) is the file of the pulse at
@@ -985,22 +993,14 @@ class FolderWatchCamera:
                         "decode",
                     ) from exc
                 failure = exc
-            last, stable = tried, 0
-            while True:
-                if self._clock.now() >= deadline:
-                    raise CaptureError(
-                        self.name,
-                        f"{message}; {path.name} did not change within "
-                        f"{s.timeout_s:g} s after that (if the program saving it pauses while "
-                        "writing, raise stable_polls or poll_interval_s)",
-                        "decode",
-                    ) from failure
-                self._clock.sleep(s.poll_interval_s)
-                now = _identity(path)
-                stable = stable + 1 if now == last else 1
-                last = now
-                if now is not None and now != tried and stable >= s.stable_polls:
-                    break
+            if not self._changed_and_settled(path, tried, deadline):
+                raise CaptureError(
+                    self.name,
+                    f"{message}; {path.name} did not change within "
+                    f"{s.timeout_s:g} s after that (if the program saving it pauses while "
+                    "writing, raise stable_polls or poll_interval_s)",
+                    "decode",
+                ) from failure
 
     def _hold(self, path: Path) -> Path:
         """Copy the file taken from the watched folder into the session (``output_dir``, its
