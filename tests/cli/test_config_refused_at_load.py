@@ -112,7 +112,7 @@ def test_auto_exposure_meters_no_longer_than_the_window_holds(
         meter(object(), 0.05)
         raise Metered
 
-    monkeypatch.setattr(exposure, "meter_exposure", lambda cam, rule, *a: rules.append(rule))
+    monkeypatch.setattr(exposure, "meter_exposure", lambda cam, rule, *a, **how: rules.append(rule))
     monkeypatch.setattr(policy, "fix_session_exposure", fake_fix)
 
     class FakeRig:
