@@ -115,6 +115,18 @@ def plan(
     force: Annotated[
         bool, typer.Option("--force", help="Overwrite an existing plan file (and --figure).")
     ] = False,
+    allow_no_normals: Annotated[
+        bool,
+        typer.Option(
+            "--allow-no-normals",
+            help="Plan lights that cannot determine a surface normal (all in one plane "
+            "through the object, e.g. one ring of low lights for a relightable PTM/HSH, or "
+            "bunched at the zenith) with a warning, in place of the refusal. rti-rig fit then "
+            "writes no normal maps, and its relighting files are ridge-regularised guesses "
+            "along the direction the lights miss; run the plan with rti-rig run --plan PLAN.lp "
+            "--allow-no-normals.",
+        ),
+    ] = False,
 ) -> None:
     """Plan an ordered set of lights from one preview shot and write it as an .lp file.
 
@@ -146,6 +158,7 @@ def plan(
             material=material,
             figure=figure,
             force=force,
+            allow_no_normals=allow_no_normals,
         )
         planned = plan_lights(request)
     except RtiRigError as exc:

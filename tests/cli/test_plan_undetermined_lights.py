@@ -14,7 +14,7 @@ import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.core.lp_format import LpEntry, write_lp
+from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
 
 
 @pytest.mark.parametrize("method", ["optimal", "uniform"])
@@ -59,3 +59,49 @@ def test_lights_bunched_at_the_zenith_are_named_so_without_a_band_to_widen(
     assert "they are bunched at the zenith" in said
     assert "widen" not in said and "plane" not in said
     assert not out.exists()
+
+
+def _horizon_ring(path: Path) -> Path:
+    az = np.radians(np.arange(20) * 18.0)
+    write_lp(
+        path, [LpEntry(f"led_{k:02d}.jpg", (np.cos(a), np.sin(a), 0.0)) for k, a in enumerate(az)]
+    )
+    return path
+
+
+def test_the_refusal_names_the_way_through(tmp_path: Path) -> None:
+    rig, out = _horizon_ring(tmp_path / "ring.lp"), tmp_path / "plan.lp"
+    r = CliRunner().invoke(app, ["plan", "--rig", str(rig), "--lights", "12", "--out", str(out)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "add --allow-no-normals" in said
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("objective", ["relight", "normals"])
+def test_allow_no_normals_plans_a_horizon_ring_saying_so(tmp_path: Path, objective: str) -> None:
+    """`run` had --allow-no-normals and `plan` had not: a ring of raking lights for a
+    relightable PTM/HSH only could be captured but not planned."""
+    rig, out = _horizon_ring(tmp_path / "ring.lp"), tmp_path / "plan.lp"
+    r = CliRunner().invoke(
+        app,
+        [
+            *("plan", "--rig", str(rig), "--lights", "12", "--objective", objective),
+            *("--out", str(out), "--allow-no-normals"),
+        ],
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "the 12 planned lights cannot determine a surface normal" in said
+    assert "planned as asked (--allow-no-normals)" in said
+    assert "along the direction the lights do not span, their relighting is a guess" in said
+    assert f"rti-rig run --plan {out} --allow-no-normals" in said
+    assert len(read_lp(out)) == 12
+
+
+def test_allow_no_normals_is_silent_where_the_lights_determine_normals(tmp_path: Path) -> None:
+    out = tmp_path / "plan.lp"
+    r = CliRunner().invoke(app, ["plan", "--lights", "12", "--out", str(out), "--allow-no-normals"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "cannot determine" not in said and "--allow-no-normals" not in said

@@ -16,7 +16,12 @@ import numpy as np
 
 from rti_rig.app.compose import arm_order_for, read_preview_image
 from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
-from rti_rig.app.normals_determined import band_advice, refuse_undetermined
+from rti_rig.app.normals_determined import (
+    FIT_WITHOUT_NORMALS,
+    band_advice,
+    refuse_undetermined,
+    undetermined_normals,
+)
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.app.preview_source import resolve_preview
 from rti_rig.core.errors import RtiRigError
@@ -51,6 +56,9 @@ class PlanLightsRequest:
     material: str = "auto"
     figure: Path | None = None
     force: bool = False
+    #: Plan lights that cannot determine a normal (one plane, bunched at the zenith) with a
+    #: warning, in place of the refusal: a ring of low lights for a relightable PTM/HSH only.
+    allow_no_normals: bool = False
 
     @property
     def method_or_default(self) -> str:
@@ -181,14 +189,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     )
     # every planner picks among the rig's lights in the band: where those cannot determine a
     # normal, any choice cannot (the plan had been written, "expected RMS normal error 90.00")
-    refuse_undetermined(
-        np.array([st.direction for st in schedule.steps], dtype=np.float64),
-        "planned lights",
-        f"the lights of {req.rig} between {req.min_elevation_deg:g}°..{req.max_elevation_deg:g}° "
-        "elevation leave no other choice: "
-        + band_advice(req.min_elevation_deg, req.max_elevation_deg),
-        "nothing was written",
-    )
+    _check_determined(req, schedule, notes)
     if light_note and report.preview_light_source == "given":
         report.preview_light_source = light_note
     if req.signal_noise and not report.signal_noise:
@@ -210,6 +211,37 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
     )
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
+
+
+def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: list[str]) -> None:
+    """Refuse, before the plan is written, lights that cannot determine a normal, unless
+    ``allow_no_normals`` asks for them: then a warning among the plan's notes.
+
+    Why the way through: ``rti-rig run`` had ``--allow-no-normals`` and ``plan`` had not, so a
+    conservator who wants only a relightable PTM/HSH from a ring of low lights could capture
+    such lights but not plan them. The warning says what ``rti-rig fit`` will make of them,
+    and that ``run --plan`` asks for the same option (the .lp, an interchange file other RTI
+    tools read, carries no note of it).
+    """
+    lights = np.array([st.direction for st in schedule.steps], dtype=np.float64)
+    if not req.allow_no_normals:
+        refuse_undetermined(
+            lights,
+            "planned lights",
+            f"the lights of {req.rig} between {req.min_elevation_deg:g}°.."
+            f"{req.max_elevation_deg:g}° elevation leave no other choice: "
+            + band_advice(req.min_elevation_deg, req.max_elevation_deg)
+            + "; or, to plan them all the same (relighting only, no normal maps wanted), add "
+            "--allow-no-normals",
+            "nothing was written",
+        )
+        return
+    reason = undetermined_normals(lights, "planned lights")
+    if reason is not None:
+        notes.append(
+            f"{reason}; planned as asked (--allow-no-normals): {FIT_WITHOUT_NORMALS}; run it "
+            f"with rti-rig run --plan {req.out_file} --allow-no-normals"
+        )
 
 
 def _lp_labels(labels: list[str]) -> list[str]:
