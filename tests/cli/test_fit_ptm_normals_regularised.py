@@ -88,10 +88,26 @@ def test_auto_on_one_azimuth_writes_relighting_files_without_normals(
     assert "Lambert left out of the choice" in said
     assert "lights at one azimuth (29° or 209°)" in said
     assert "normals.png/.npy and albedo not written" in said
+    # said once: the Model line and the normals warning had both given the layout in full
+    assert said.count("cannot determine a surface normal: they lie") == 1, said
+    assert said.count("lights at one azimuth (29° or 209°)") == 1, said
     fit = json.loads((tmp_path / "f" / "fit.json").read_text())
     assert fit["model"] != "lambert" and not fit["normals_from"]
     assert (tmp_path / "f" / "fit.rti").exists()
     assert not (tmp_path / "f" / "normals.npy").exists()
+
+
+def test_auto_without_normal_maps_says_why_lambert_was_left_out_once(tmp_path: Path) -> None:
+    # with --no-normals no normals warning gives the reason: the Model line keeps it
+    session, _, _ = make_session(tmp_path / "s", size=(32, 32), lights=_one_azimuth())
+    r = CliRunner().invoke(
+        app,
+        ["fit", str(session), "--out", str(tmp_path / "f"), "--no-qa", "--no-normals"],
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "Lambert left out of the choice: the 10 lights of this session cannot" in said
+    assert said.count("lights at one azimuth (29° or 209°)") == 1, said
 
 
 def test_photometric_stereo_by_name_on_one_azimuth_names_the_cli_way_out(tmp_path: Path) -> None:

@@ -720,12 +720,20 @@ def _fit_all(
         )
     if name == AUTO:
         candidates, undetermined = auto_candidates(lights)
-        left_out = (
-            f"; Lambert left out of the choice: {undetermined}, so only the PTM and HSH, "
-            "ridge-regularised, are written, and no normal maps"
-            if undetermined
-            else ""
-        )
+        left_out = ""
+        if undetermined and req.write_normals:
+            # why, once: the warning that the normal maps are not written gives the lights'
+            # layout and condition number (both lines had, word for word)
+            left_out = (
+                "; Lambert left out of the choice: these lights cannot determine a surface "
+                "normal (the warning below says why), so only the PTM and HSH, "
+                "ridge-regularised, are written, and no normal maps"
+            )
+        elif undetermined:  # --no-normals: no normals warning, so the reason is said here
+            left_out = (
+                f"; Lambert left out of the choice: {undetermined}, so only the PTM and HSH, "
+                "ridge-regularised, are written"
+            )
         try:
             choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS, candidates=candidates)
         except ReconstructionError as exc:
