@@ -139,7 +139,14 @@ def fit(
             help="auto (evidence-based choice), ps, robust-ps, lambert, ptm, hsh1, hsh2, hsh3.",
         ),
     ] = "auto",
-    no_qa: Annotated[bool, typer.Option("--no-qa", help="Skip the QA verdict.")] = False,
+    no_qa: Annotated[
+        bool,
+        typer.Option(
+            "--no-qa",
+            help="Skip the QA verdict (normal maps from images black or saturated throughout "
+            "are still said).",
+        ),
+    ] = False,
     no_ptm: Annotated[bool, typer.Option("--no-ptm", help="Do not write fit.ptm.")] = False,
     no_hsh: Annotated[bool, typer.Option("--no-hsh", help="Do not write fit.rti.")] = False,
     no_normals: Annotated[

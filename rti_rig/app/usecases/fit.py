@@ -20,7 +20,7 @@ import shlex
 import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +35,7 @@ from rti_rig.app.usecases.fit_decode import imread_rgb
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
+from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation
@@ -620,7 +621,7 @@ def _fit_into(  # type: ignore[no-untyped-def]
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = _fit_all(req, stack, lights, out, bands or local_bands)
+        result = _fit_all(req, stack, lights, out, bands or local_bands, names=names)
     result.warnings = [str(w.message) for w in fit_warnings(caught)] + result.warnings
     result.notes = notes
     result.files.append(
@@ -690,7 +691,12 @@ BAND_BUDGET_BYTES = 6 * 1024 * 1024
 
 
 def _fit_all(
-    req: FitRequest, stack: ImageStack, lights: np.ndarray, out: Path, bands: BandRunner
+    req: FitRequest,
+    stack: ImageStack,
+    lights: np.ndarray,
+    out: Path,
+    bands: BandRunner,
+    names: Sequence[str] = (),
 ) -> FitResult:
     """One streamed pass over the acquisition: every output is computed band by band.
 
@@ -838,6 +844,8 @@ def _fit_all(
         if not write_normals:  # the models kept only for normals are not fitted
             normal_source = ""
             linear = {k: v for k, v in linear.items() if k in exported}
+        if write_normals and not req.qa:  # the QA names black and saturated images itself
+            skipped += no_signal_warning(stack, lights, names, SAMPLE_PIXELS)
         # the last use of the sample: when nothing above read it, it is streamed, never held
         ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
         del obs

@@ -1,0 +1,57 @@
+"""Which images hold no signal: black or clipped throughout, judged on a pixel sample.
+
+Why here and not only in the QA: ``rti-rig fit --no-qa`` wrote normal maps from an
+acquisition black throughout (a lens cap, lights that never fired) or saturated throughout
+(an exposure far too long) without a word; a least-squares fit of nothing is still a normal
+map. This check reads only the pixel sample the model choice and the quantisation ranges
+already read (a few hundred thousand values however large the images), so it costs next to
+nothing on a 24-MP session.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: A value below this fraction of full scale is black (the QA's "no light" level: the dimmest
+#: lit images seen, a glossy coin's low lights metered for its glint, reach 0.13-0.15 %).
+BLACK_FRACTION = 0.002
+#: An image with at least this fraction of its sampled values black or clipped holds no signal.
+NO_SIGNAL_SHARE = 0.99
+
+
+@dataclass(frozen=True)
+class NoSignal:
+    """The images that hold no signal, each with what it is (``black``, ``saturated``, or
+    ``black or clipped``: a clipped object on a black ground)."""
+
+    indices: tuple[int, ...]
+    kinds: tuple[str, ...]
+
+
+def images_without_signal(sample: np.ndarray, saturation_level: float | None) -> NoSignal | None:
+    """The images of ``sample`` (N, P, C: a pixel sample of every image, in the stack's
+    scaled units) whose values are almost all black or at ``saturation_level``.
+
+    None where there is no full scale to judge against (float images): "black" means nothing
+    without one, and a state not established is not claimed.
+    """
+    if saturation_level is None or not np.isfinite(saturation_level) or saturation_level <= 0:
+        return None
+    obs = np.asarray(sample).reshape(len(sample), -1)
+    if obs.shape[1] == 0:
+        return None
+    black = (obs < BLACK_FRACTION * saturation_level).mean(axis=1)
+    clipped = (obs >= saturation_level).mean(axis=1)
+    empty = black + clipped >= NO_SIGNAL_SHARE  # NaN (missing) counts as neither
+    indices = tuple(int(i) for i in np.flatnonzero(empty))
+    kinds = tuple(
+        "black"
+        if black[i] >= NO_SIGNAL_SHARE
+        else "saturated"
+        if clipped[i] >= NO_SIGNAL_SHARE
+        else "black or clipped"
+        for i in indices
+    )
+    return NoSignal(indices, kinds)

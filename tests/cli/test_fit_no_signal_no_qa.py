@@ -1,0 +1,79 @@
+"""`rti-rig fit --no-qa` says when its normal maps are from images that hold no signal.
+
+An acquisition black throughout (a lens cap, lights that never fired) or saturated throughout
+(an exposure far too long) had its normal maps written without a word when the QA was left
+out: a least-squares fit of nothing is still a normal map.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp, write_lp
+from tests.fit_sessions import make_session
+
+REPO = Path(__file__).resolve().parents[2]
+ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
+SAID = "the normal maps are from images that hold no signal"
+
+
+def _acquisition(folder: Path, value: int, lit: int = 0) -> tuple[Path, list[str]]:
+    """The replay's 18 lights over flat images of ``value``, its first ``lit`` images its own
+    (real, lit) photographs."""
+    folder.mkdir()
+    entries = read_lp(ACQ)
+    for k, e in enumerate(entries):
+        img = np.full((64, 64, 3), value, np.uint8)
+        if k < lit:
+            img = cv2.resize(cv2.imread(str(ACQ.parent / e.name)), (64, 64))
+        cv2.imwrite(str(folder / e.name), img)
+    write_lp(folder / "dirs.lp", entries)
+    return folder / "dirs.lp", [Path(e.name).stem for e in entries]
+
+
+def _fit(source: Path, out: Path, *extra: str) -> str:
+    r = CliRunner().invoke(app, ["fit", str(source), "--out", str(out), *extra])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    return said
+
+
+@pytest.mark.parametrize(("value", "kind"), [(0, "black"), (255, "saturated")])
+def test_an_acquisition_without_signal_is_said_naming_its_images(
+    tmp_path: Path, value: int, kind: str
+) -> None:
+    lp, stems = _acquisition(tmp_path / "acq", value)
+    said = _fit(lp, tmp_path / "f", "--no-qa")
+    assert (tmp_path / "f" / "normals.npy").exists()  # written, and now said
+    assert said.count(SAID) == 1, said
+    assert "every image (18) is black" in said
+    assert f"{stems[0]} ({kind}), {stems[1]} ({kind})" in said
+    assert "and 6 more" in said  # 12 named of 18
+
+
+def test_images_left_that_cannot_determine_a_normal_are_said(tmp_path: Path) -> None:
+    lp, stems = _acquisition(tmp_path / "acq", 0, lit=2)
+    said = _fit(lp, tmp_path / "f", "--no-qa")
+    assert "16 of the 18 images are black" in said, said
+    assert f"{stems[2]} (black)" in said and f"{stems[0]} (" not in said
+    assert "the 2 others cannot determine a normal by themselves" in said
+
+
+def test_one_misfire_among_lit_images_is_left_to_the_qa(tmp_path: Path) -> None:
+    session, _, _ = make_session(tmp_path / "s", size=(48, 48), black=4)
+    said = _fit(session, tmp_path / "f", "--no-qa")
+    assert SAID not in said
+    assert (tmp_path / "f" / "normals.npy").exists()
+
+
+def test_with_the_qa_it_names_them_itself(tmp_path: Path) -> None:
+    lp, _ = _acquisition(tmp_path / "acq", 0)
+    said = _fit(lp, tmp_path / "f", "--no-ptm")
+    assert SAID not in said  # said once, by the QA
+    assert "misfired, no light" in said
