@@ -1248,7 +1248,8 @@ def export_lp(
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
     """Write the .lp of a session from its verified journal: the lights that actually fired,
-    for every image on disk as captured (an interrupted session's too)."""
+    for every image on disk as captured (an interrupted session's too). A session whose run
+    stopped before adding its last committed image to lights.lp has it added there too."""
     from rti_rig.app.usecases.export import ExportLpRequest
     from rti_rig.app.usecases.export import export_lp as write_session_lp
     from rti_rig.runtime.session import JOURNAL
@@ -1267,6 +1268,8 @@ def export_lp(
         )
     if done.raw_lost:
         err.print(f"[yellow]note:[/] {escape(done.raw_lost)}", soft_wrap=True)
+    if done.relisted:
+        err.print(f"[yellow]note:[/] {escape(done.relisted)}", soft_wrap=True)
     if done.unchecked:
         err.print(
             f"[yellow]note:[/] left out, not verifiable as captured "

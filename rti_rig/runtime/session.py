@@ -2791,6 +2791,71 @@ def _unwritten_line_note(root: Path, stem: str) -> str:
     )
 
 
+def list_unwritten_step(root: Path, scan: JournalScan | None = None) -> str | None:
+    """Make session ``root``'s ``lights.lp`` list the step its run committed by the record file
+    and stopped before journaling (:func:`stopped_before_journal_line`), when ``lights.lp`` is
+    exactly what that run wrote at its previous commit; returns what was done or why it could
+    not be (None when there was nothing to do). ``scan``: the journal's, when the caller holds
+    it (read here otherwise).
+
+    Why: a run writes ``lights.lp`` after the journal line, so a kill between the record file
+    and the line left it one image short of what the session holds: ``export-lp`` (and a
+    resume, which keeps the image) listed it, ``fit`` fitted one image fewer, and relight and
+    RTIBuilder, which read ``lights.lp``, left it out. The rewrite is atomic, under the
+    session's lock, and only completes the run's own listing with the line the run was about
+    to write: a ``lights.lp`` edited by hand, or behind for any other reason, is left as it is
+    (the verdict names it). A session stopped before its first journal line has no
+    ``lights.lp`` to complete (``fit`` says so; the resume writes one)."""
+    root = Path(root)
+    path = root / LP_NAME
+    if not (root / JOURNAL).is_file() or not path.is_file():
+        return None
+    if scan is None:
+        try:
+            total = planned_steps(read_manifest(root))
+            if not total:
+                return None
+            scan = scan_journal(root, image_names(total))
+        except SessionError:
+            return None
+    stem = stopped_before_journal_line(scan)
+    if stem is None or scan.missing:
+        return None
+    *journaled, last = scan.records
+    earlier = [_to_record(r) for _, r in sorted(_latest_records(journaled).items())]
+    before = [LpEntry(r.image, r.actual_direction) for r in earlier]
+    unwritten = _to_record(last)
+    held = str(root.resolve()) in _LOCKED
+    try:
+        lock_session(root)  # a run or resume begun since: its lights.lp is its own
+    except SessionError:
+        return None
+    try:
+        try:
+            if path.read_bytes() != format_lp(before).encode("ascii"):
+                return None  # not the run's own listing: edited since, or behind otherwise
+        except OSError:
+            return None
+        try:
+            write_lp_atomic(path, [*before, LpEntry(unwritten.image, unwritten.actual_direction)])
+        except SessionWriteError as exc:
+            return (
+                f"the run stopped after {stem}'s record file, before its journal line and "
+                f"before {LP_NAME} listed it; {LP_NAME} could not be rewritten to list it ({exc}): "
+                f"it lists {len(before)} of the session's {len(before) + 1} images; rti-rig run "
+                f"--resume {shlex.quote(str(root))} lists it, once the folder can be written"
+            )
+    finally:
+        if not held:
+            unlock_session(root)
+    return (
+        f"{LP_NAME} now lists {stem} too: the run stopped after its record file, before its "
+        f"journal line and before {LP_NAME} listed it; its files are as that record says, so "
+        f"the image is kept, and {LP_NAME} lists the {len(before) + 1} images the session holds "
+        "(rewritten atomically, nothing else changed)"
+    )
+
+
 def _stopped_while_committing(
     manifest: dict[str, Any],
     records: list[dict[str, Any]],

@@ -429,7 +429,8 @@ def _stopped_before_line(tmp_path: Path, n: int) -> Path:
 def test_fit_of_a_run_stopped_between_a_record_file_and_its_line_says_so(tmp_path: Path) -> None:
     """The verdict had said "lights.lp does not list image_004 … (the .lp edited since
     capture?)" and "journal.jsonl is damaged (records missing)" of a run stopped between
-    image_004's record file and its journal line, and counted 4 images of a fit of 3."""
+    image_004's record file and its journal line, and counted 4 images of a fit of 3. The fit
+    now completes lights.lp first (the step is committed), and fits the 4 images."""
     out = _stopped_before_line(tmp_path, 4)
     r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit"), "--model", "ps"])
     assert r.exit_code == 0, r.output
@@ -437,9 +438,10 @@ def test_fit_of_a_run_stopped_between_a_record_file_and_its_line_says_so(tmp_pat
     verdict = " ".join(qa["verdict"].split())
     assert "does not list" not in verdict and "damaged" not in verdict, verdict
     assert (
-        "the run stopped after image_004's record file, before its journal line (kept, but not "
-        f"yet in lights.lp, so not fitted); rti-rig run --resume {out} writes it back"
+        "the run stopped after image_004's record file, before its journal line; rti-rig run "
+        f"--resume {out} writes it back"
     ) in verdict, verdict
+    assert len(qa["images"]) == 4, qa["images"]
 
 
 def test_a_run_stopped_before_its_first_journal_line_tells_one_story(tmp_path: Path) -> None:

@@ -1,7 +1,9 @@
 """Use case: write a session's ``.lp`` from its verified journal (``rti-rig export-lp``).
 
 The lights that actually fired, for every image on disk as it was captured — an interrupted
-session's too; an image missing or changed since is left out and named.
+session's too; an image missing or changed since is left out and named. The session's own
+``lights.lp``, left one image short by a run stopped between a step's record file and its
+journal line, is completed alike (:func:`rti_rig.runtime.session.list_unwritten_step`).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
     files_lost_since_capture,
+    list_unwritten_step,
     lost_image_advice,
     originals_lost,
     read_manifest,
@@ -55,6 +58,9 @@ class ExportedLp:
     #: What to do about the images left out as missing or changed ("" if none, or if every
     #: one is in the folder under another name).
     left_out_advice: str = ""
+    #: What was done to the session's own lights.lp, one image short of what it holds (a run
+    #: stopped between a step's record file and its journal line), or why it could not be.
+    relisted: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -63,6 +69,9 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
     entries, left_out = session_lp_report(req.session_dir, linear=req.linear)
     check_output_file(req.out_file, req.force, {})
     write_lp(req.out_file, entries)
+    # lights.lp one image short of the session (a run stopped between a step's record file
+    # and its journal line): completed once the export is written, so that both list alike
+    relisted = list_unwritten_step(req.session_dir)
     outside = Path(req.out_file).resolve().parent != Path(req.session_dir).resolve()
     unchecked, why = unchecked_images(req.session_dir)
     # a left-out JPEG renamed in the folder is named with its new name: "missing" of a file
@@ -77,6 +86,7 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         why,
         rebuild=rebuild,
         renamed=renamed_note(renamed),
+        relisted=relisted or "",
         raw_lost=_raw_lost(Path(req.session_dir), {Path(e.name).stem for e in entries}),
         # the images left out named with what gets them back, as the verdict does (the note
         # named them alone)

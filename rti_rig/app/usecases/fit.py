@@ -62,6 +62,7 @@ from rti_rig.runtime.session import (
     MANIFEST,
     UNRECORDED,
     checksum_session_files,
+    list_unwritten_step,
     lost_image_advice,
     read_manifest,
     refuse_if_in_use,
@@ -307,6 +308,10 @@ def acquisition_files(
     """The ``.lp`` of a session folder or ``.lp`` source, its lights (N, 3), the image file of
     each light (``linear/<stem>.tif`` when there, else the file the ``.lp`` names) and names."""
     refuse_if_in_use(source if source.is_dir() else source.parent, "fit")
+    if source.is_dir() or source.name == LP_NAME:  # a session's lights.lp, one image short
+        relisted = list_unwritten_step(source if source.is_dir() else source.parent)
+        if relisted is not None and notes is not None:
+            notes.append(relisted)
     if source.is_dir():
         lps = sorted(source.glob("*.lp"))
         if not lps:
