@@ -1683,12 +1683,12 @@ def _unjournaled_steps(
     )
 
 
-def rebuildable_journal(root: Path) -> bool:
+def rebuildable_journal(root: Path, scan: JournalScan | None = None) -> bool:
     """Whether ``run --resume ROOT --rebuild-journal`` would take back images of session
     ``root``: it did not finish, and its journal lost records its manifest holds of images
     still on disk as captured; or it completed, its journal lost or damaged, and every image
     it captured is proven (:func:`rebuild_finished_journal`). False for a folder that is no
-    session."""
+    session. ``scan``: the caller's scan of the journal with the schedule's image names."""
     root = Path(root)
     try:
         manifest = read_manifest(root)
@@ -1699,7 +1699,8 @@ def rebuildable_journal(root: Path) -> bool:
         return False
     names = image_names(total)
     try:
-        scan = scan_journal(root, names)
+        if scan is None:
+            scan = scan_journal(root, names)
         if (manifest.get("runner") or {}).get("finish_reason") == "completed":
             # every image proven, or recorded with its light, its files alone lost (the
             # rebuild records it as lost, for --reshoot-lost)
@@ -1835,16 +1836,17 @@ def rebuild_finished_journal(root: Path) -> list[str]:
             unlock_session(root)
 
 
-def rebuild_advice(root: Path) -> str:
+def rebuild_advice(root: Path, scan: JournalScan | None = None) -> str:
     """The words that name ``run --resume ROOT --rebuild-journal`` (to follow the advice to
     restore the journal from a backup) where it would take images back
     (:func:`rebuildable_journal`), else "": said where a lost journal is named (export-lp had
     advised a backup alone, of a session its manifest can vouch for). A completed session with
     images missing or changed since capture is told the reshoot too, which restores the records
     the journal lost before it shoots exactly those (the backup alone had been advised), beside
-    the rebuild, which records them as lost without the rig."""
+    the rebuild, which records them as lost without the rig. ``scan``: the caller's scan of
+    the journal with the schedule's image names, if it holds one."""
     folder = shlex.quote(str(root))
-    lost = _lost_beside_a_lost_journal(Path(root))
+    lost = _lost_beside_a_lost_journal(Path(root), scan)
     if lost:
         return (
             f", or, as {', '.join(lost[:5])}{' …' if len(lost) > 5 else ''} "
@@ -1854,7 +1856,7 @@ def rebuild_advice(root: Path) -> str:
             f"without the rig, rti-rig run --resume {folder} --rebuild-journal rebuilds the "
             f"journal and records {'it' if len(lost) == 1 else 'them'} as lost)"
         )
-    if rebuildable_journal(root):
+    if rebuildable_journal(root, scan):
         return (
             f", or rebuild it from {MANIFEST}'s records: rti-rig run --resume {folder} "
             "--rebuild-journal"
@@ -1862,7 +1864,7 @@ def rebuild_advice(root: Path) -> str:
     return ""
 
 
-def _lost_beside_a_lost_journal(root: Path) -> list[str]:
+def _lost_beside_a_lost_journal(root: Path, scan: JournalScan | None = None) -> list[str]:
     """The images of a completed session that its rebuild refuses only as missing or changed
     since capture, when ``--reshoot-lost`` could shoot them again (not adaptive, not on a
     camera-triggered dome); empty otherwise, or when anything else is unproven."""
@@ -1877,7 +1879,9 @@ def _lost_beside_a_lost_journal(root: Path) -> list[str]:
         ):
             return []
         names = image_names(total)
-        _taken, unproven, lost = _finished_rebuild(root, manifest, names, scan_journal(root, names))
+        if scan is None:
+            scan = scan_journal(root, names)
+        _taken, unproven, lost = _finished_rebuild(root, manifest, names, scan)
     except SessionError:
         return []
     return [names[i] for i in sorted(lost)] if unproven and len(lost) == len(unproven) else []
@@ -2260,7 +2264,7 @@ def _files_after_first_step(root: Path, names: list[str]) -> list[str]:
 UNRECORDED = "unrecorded"
 
 
-def stopped_before_first_journal(root: Path) -> str | None:
+def stopped_before_first_journal(root: Path, scan: JournalScan | None = None) -> str | None:
     """How session ``root`` (its manifest readable) came to have no journal, or None where it
     is not one that never wrote one: :data:`UNRECORDED` when it stopped (killed, a power cut)
     before its first image was journaled, with at most that first image's files on disk and
@@ -2273,6 +2277,7 @@ def stopped_before_first_journal(root: Path) -> str | None:
     advised restoring a journal.jsonl from a backup, of a journal that never existed. One
     function over one :func:`scan_journal`: the two cases had been two functions with one
     preamble, and ``fit`` read the manifest and scanned the journal twice to tell them apart.
+    ``scan``: the caller's scan of the journal with the schedule's image names, if it holds one.
     """
     root = Path(root)
     if (root / JOURNAL).exists():
@@ -2284,7 +2289,8 @@ def stopped_before_first_journal(root: Path) -> str | None:
     if not total:
         return None
     names = image_names(total)
-    scan = scan_journal(root, names)
+    if scan is None:
+        scan = scan_journal(root, names)
     if not scan.records:
         return None if _files_after_first_step(root, names) else UNRECORDED
     return stopped_before_journal_line(scan) if scan.missing else None
@@ -2376,9 +2382,10 @@ def image_sequence_restarts(device: object, config: str) -> str | None:
     )
 
 
-def lost_image_advice(root: Path, adaptive: bool) -> str:
+def lost_image_advice(root: Path, adaptive: bool, scan: JournalScan | None = None) -> str:
     """What to do about images of a finished session lost since capture (the QA verdict and
-    a refused resume say the same)."""
+    a refused resume say the same). ``scan``: the caller's scan of the journal, if it holds one
+    (:func:`_journal_records`)."""
     instead = unresumable(root)
     if instead is not None:  # --reshoot-lost is refused for it
         return f"put the originals back from a copy; {instead}"
@@ -2395,7 +2402,7 @@ def lost_image_advice(root: Path, adaptive: bool) -> str:
         # a session not finished (a --reshoot-lost killed part-way, say): --reshoot-lost is
         # refused for it, and its plain resume sets aside and shoots again what it cannot
         # verify (the advice had named --reshoot-lost, which then said to drop it)
-        aside = _set_aside_as_captured(root)
+        aside = _set_aside_as_captured(root, scan)
         where = (
             f" ({', '.join(aside[:4])}{' …' if len(aside) > 4 else ''} "
             f"{'is' if len(aside) == 1 else 'are'} as captured, set aside by a resume; any "
@@ -2414,14 +2421,14 @@ def lost_image_advice(root: Path, adaptive: bool) -> str:
     )
 
 
-def _set_aside_as_captured(root: Path) -> list[str]:
+def _set_aside_as_captured(root: Path, scan: JournalScan | None = None) -> list[str]:
     """The files of images lost since capture that a resume (a ``--reshoot-lost`` stopped
     part-way: a full disk, a kill) set aside in ``recovered/`` and that are still as captured
     (their journaled checksum): where to put them back from.
 
     Why: the verdict said only "put the originals back from a copy" of a session whose intact
     linear TIFF sat in recovered/, set aside by the resume a full disk then stopped."""
-    records = _journal_records(root)
+    records = _journal_records(root, scan)
     if not records:
         return []
     renamed = renamed_jpegs(root, records)
@@ -2620,14 +2627,15 @@ def tiff_check_note(root: Path) -> str:
     )
 
 
-def files_lost_since_capture(root: Path) -> dict[str, list[str]]:
+def files_lost_since_capture(root: Path, scan: JournalScan | None = None) -> dict[str, list[str]]:
     """Per image (its base name, ``image_010``) of a session, its JPEG or linear TIFF gone or
     changed since capture, or its kept camera original gone (:func:`_lost_files`): what the
     QA verdict names and what ``run --resume --reshoot-lost`` reshoots, one criterion for
     both. A JPEG that is in the folder under another name (:func:`renamed_jpegs`) is not
-    lost. Empty for a folder without a journal (an ``.lp`` acquisition is no session)."""
+    lost. Empty for a folder without a journal (an ``.lp`` acquisition is no session).
+    ``scan``: the caller's scan of the journal, if it holds one (:func:`_journal_records`)."""
     root = Path(root)
-    records = _journal_records(root)
+    records = _journal_records(root, scan)
     if records is None:
         return {}
     lost: dict[str, list[str]] = {}
@@ -2647,19 +2655,24 @@ def originals_lost(gone: list[str]) -> bool:
     return bool(gone) and all(g.startswith(f"{RAW_DIR}/") for g in gone)
 
 
-def renamed_since_capture(root: Path) -> dict[str, str]:
+def renamed_since_capture(root: Path, scan: JournalScan | None = None) -> dict[str, str]:
     """:func:`renamed_jpegs` of session ``root`` from its journal (empty for a folder that is
-    no session, as :func:`files_lost_since_capture`)."""
+    no session, as :func:`files_lost_since_capture`; ``scan`` as there)."""
     root = Path(root)
-    records = _journal_records(root)
+    records = _journal_records(root, scan)
     return {} if records is None else renamed_jpegs(root, records)
 
 
-def _journal_records(root: Path) -> list[dict[str, Any]] | None:
+def _journal_records(root: Path, scan: JournalScan | None = None) -> list[dict[str, Any]] | None:
     """The journal's records of session ``root``, or None for a folder that is no session (no
-    journal or manifest, or a manifest that cannot be read)."""
+    journal or manifest, or a manifest that cannot be read). ``scan``: the caller's
+    :func:`scan_journal` of it (with the schedule's image names), taken instead of reading the
+    journal again (export-lp had read it three times, each time checking any record file the
+    journal lacks against its images)."""
     if not (root / JOURNAL).is_file() or not (root / MANIFEST).is_file():
         return None
+    if scan is not None:
+        return scan.records
     try:
         total = planned_steps(read_manifest(root))
     except SessionError:
@@ -2667,7 +2680,9 @@ def _journal_records(root: Path) -> list[dict[str, Any]] | None:
     return scan_journal(root, image_names(total) if total else None).records
 
 
-def unchecked_images(root: Path) -> tuple[list[str], str]:
+def unchecked_images(
+    root: Path, scan: JournalScan | None = None, manifest: dict[str, Any] | None = None
+) -> tuple[list[str], str]:
     """Images of a session (on disk, or taken by a session that completed) that no readable
     journal record vouches for, and why.
 
@@ -2676,9 +2691,10 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
     said "good" without saying so claimed what it had not established. Returns the image base
     names (``image_006``) and the reason; ``([], "")`` for a folder that is no session, or whose
     journal vouches for every image on disk. The image a session stopped while saving
-    (:func:`stopped_while_committing`) is not among them: no record of it was ever lost."""
+    (:func:`stopped_while_committing`) is not among them: no record of it was ever lost.
+    ``scan`` and ``manifest``: the caller's, read once (:func:`_journal_records`)."""
     root = Path(root)
-    if not (root / MANIFEST).exists():
+    if manifest is None and not (root / MANIFEST).exists():
         return [], ""
     present = {
         p.stem
@@ -2686,16 +2702,18 @@ def unchecked_images(root: Path) -> tuple[list[str], str]:
         for p in folder.glob("image_*")
         if p.is_file()
     }
-    try:
-        manifest = read_manifest(root)
-    except SessionError:
-        # the journal's records can be matched to image names only through the manifest
-        return sorted(present), f"{MANIFEST} unreadable"
+    if manifest is None:
+        try:
+            manifest = read_manifest(root)
+        except SessionError:
+            # the journal's records can be matched to image names only through the manifest
+            return sorted(present), f"{MANIFEST} unreadable"
     total = planned_steps(manifest)
     if not total:
         return [], ""
     names = image_names(total)
-    scan = scan_journal(root, names)
+    if scan is None:
+        scan = scan_journal(root, names)
     recorded = {Path(r["image"]).stem for r in scan.records}
     expected = set(present)
     runner = manifest.get("runner") or {}
@@ -3011,7 +3029,12 @@ def renamed_note(renamed: Mapping[str, str]) -> str:
     )
 
 
-def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], list[str]]:
+def session_lp_report(
+    root: Path,
+    linear: bool = False,
+    scan: JournalScan | None = None,
+    manifest: dict[str, Any] | None = None,
+) -> tuple[list[LpEntry], list[str]]:
     """`.lp` entries of a session from its verified journal, and the images left out.
 
     Works on a finished session and on an interrupted or killed one alike: a step is listed when
@@ -3019,15 +3042,20 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
     ``linear`` the TIFF) is on disk with its journaled checksum, with the direction that
     actually ran. The second list names journaled files of that kind missing or changed since
     (left out): a damaged JPEG does not drop an intact TIFF from an ``.lp`` of TIFFs.
+    ``scan`` and ``manifest``: the caller's (the scan with the schedule's image names), so
+    that the journal is read once.
     """
-    manifest = read_manifest(root)
+    if manifest is None:
+        manifest = read_manifest(root)
     total = planned_steps(manifest)  # an adaptive session's maximum, not its starting layout
     names = image_names(total) if total else None
-    records = scan_journal(root, names).records
+    if scan is None:
+        scan = scan_journal(root, names)
+    records = scan.records
     key = "linear_image" if linear else "image"
     done = verified_steps(root, records, only=key)  # the file the .lp names, as captured
     if not records:
-        if stopped_before_first_journal(root) == UNRECORDED:
+        if stopped_before_first_journal(root, scan) == UNRECORDED:
             instead = unresumable(root)
             raise SessionError(
                 f"{root}: the session stopped before its first image was recorded in its "
@@ -3044,7 +3072,7 @@ def session_lp_report(root: Path, linear: bool = False) -> tuple[list[LpEntry], 
             raise SessionError(
                 f"{root}: {JOURNAL} is missing, so no image can be verified as captured with "
                 f"its light: restore {JOURNAL} from a backup copy of the folder"
-                + rebuild_advice(root)
+                + rebuild_advice(root, scan)
             )
         raise SessionError(f"{root}: the session recorded no images, so there is no .lp to export")
     left_out = sorted({r[key] for r in records if r["index"] not in done})

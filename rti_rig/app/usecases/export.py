@@ -15,15 +15,19 @@ from rti_rig.app.output_files import check_output_file
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
+    JournalScan,
     files_lost_since_capture,
+    image_names,
     list_unwritten_step,
     lost_image_advice,
     originals_lost,
+    planned_steps,
     read_manifest,
     rebuild_advice,
     refuse_if_in_use,
     renamed_note,
     renamed_since_capture,
+    scan_journal,
     session_lp_report,
     unchecked_images,
 )
@@ -64,20 +68,31 @@ class ExportedLp:
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
+    """Write the session's ``.lp`` and say what it leaves out and why.
+
+    The manifest and the journal are read once, and that one scan serves every question
+    below. Why: each reader scanned the journal again (three times for a session as a kill
+    left it, more with images left out), and each scan checks every record file the journal
+    lacks against its images' checksums."""
     refuse_if_disowned(req.session_dir)
     refuse_if_in_use(req.session_dir, "export its .lp")
-    entries, left_out = session_lp_report(req.session_dir, linear=req.linear)
+    root = Path(req.session_dir)
+    manifest = read_manifest(root)
+    total = planned_steps(manifest)  # an adaptive session's maximum, not its starting layout
+    scan = scan_journal(root, image_names(total) if total else None)
+    entries, left_out = session_lp_report(root, req.linear, scan, manifest)
     check_output_file(req.out_file, req.force, {})
     write_lp(req.out_file, entries)
     # lights.lp one image short of the session (a run stopped between a step's record file
     # and its journal line): completed once the export is written, so that both list alike
-    relisted = list_unwritten_step(req.session_dir)
-    outside = Path(req.out_file).resolve().parent != Path(req.session_dir).resolve()
-    unchecked, why = unchecked_images(req.session_dir)
+    relisted = list_unwritten_step(root, scan)
+    outside = Path(req.out_file).resolve().parent != root.resolve()
+    unchecked, why = unchecked_images(root, scan, manifest)
     # a left-out JPEG renamed in the folder is named with its new name: "missing" of a file
     # that is there had read as one to reshoot
-    renamed = renamed_since_capture(req.session_dir) if left_out and not req.linear else {}
-    rebuild = rebuild_advice(req.session_dir) if unchecked else ""
+    renamed = renamed_since_capture(root, scan) if left_out and not req.linear else {}
+    rebuild = rebuild_advice(root, scan) if unchecked else ""
+    adaptive = bool(manifest.get("adaptive"))
     return ExportedLp(
         list(entries),
         list(left_out),
@@ -87,36 +102,31 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         rebuild=rebuild,
         renamed=renamed_note(renamed),
         relisted=relisted or "",
-        raw_lost=_raw_lost(Path(req.session_dir), {Path(e.name).stem for e in entries}),
+        raw_lost=_raw_lost(root, {Path(e.name).stem for e in entries}, scan, adaptive),
         # the images left out named with what gets them back, as the verdict does (the note
         # named them alone)
         left_out_advice=(
-            lost_image_advice(
-                Path(req.session_dir), bool(read_manifest(req.session_dir).get("adaptive"))
-            )
-            if len(left_out) > len(renamed)
-            else ""
+            lost_image_advice(root, adaptive, scan) if len(left_out) > len(renamed) else ""
         ),
     )
 
 
-def _raw_lost(root: Path, listed: set[str]) -> str:
+def _raw_lost(root: Path, listed: set[str], scan: JournalScan, adaptive: bool) -> str:
     """What to say of the images ``listed`` whose camera originals alone are lost: the RAW is
     the original capture, so the image is lost, though its developed file is as captured and
     listed. Why: export-lp said nothing of it, while the QA verdict names it and
     ``--reshoot-lost`` shoots it again."""
     lost = sorted(
         (n, g)
-        for n, g in files_lost_since_capture(root).items()
+        for n, g in files_lost_since_capture(root, scan).items()
         if n in listed and originals_lost(g)
     )
     if not lost:
         return ""
     files = ", ".join(f for _, g in lost[:8] for f in g) + (" …" if len(lost) > 8 else "")
-    adaptive = bool(read_manifest(root).get("adaptive"))
     return (
         f"{files} since capture: the camera's original capture of "
         f"{', '.join(n for n, _ in lost[:8])} is lost (the developed "
         f"{'image is' if len(lost) == 1 else 'images are'} as captured, and listed); "
-        + lost_image_advice(root, adaptive)
+        + lost_image_advice(root, adaptive, scan)
     )
