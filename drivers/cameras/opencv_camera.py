@@ -341,6 +341,25 @@ class OpenCvCamera:
         unit = self.settings.exposure_unit_s
         return max(1, math.floor(exposure_s / unit + 1e-9)) * unit
 
+    def shortest_exposure_s(self) -> tuple[float, str]:
+        """The shortest exposure the camera takes, and what bounds it (a phrase naming the
+        key): ``[camera.device] min_exposure_s``, rounded up to whole ``exposure_unit_s`` on
+        v4l2.
+
+        Why: ``run --auto-exposure`` metered within ``[camera] min_exposure_s`` alone; a
+        device minimum above it (5 units of 100 µs) had a bright object metered down to a
+        test shot the camera refuses ("outside the configured range"), and the run stopped,
+        told of a range the user never asked the metering to leave."""
+        s = self.settings
+        shortest = s.min_exposure_s
+        if s.backend == "v4l2":
+            unit = s.exposure_unit_s
+            shortest = max(1, math.ceil(shortest / unit - 1e-9)) * unit
+        said = f"min_exposure_s = {s.min_exposure_s:g} s in [camera.device]"
+        if not math.isclose(shortest, s.min_exposure_s, rel_tol=1e-9):
+            said += f", {shortest:g} s in whole {s.exposure_unit_s:g} s units"
+        return shortest, said
+
     def longest_exposure_s(self) -> tuple[float, str] | None:
         """The longest exposure the connected camera can take, and what bounds it (a phrase
         naming the keys to change), or None before ``connect``.

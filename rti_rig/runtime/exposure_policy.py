@@ -80,6 +80,24 @@ class Recheck:
 Rechecker = Callable[[Any, float], Recheck]
 
 
+def exposure_steps(camera: object) -> Callable[[float], float] | None:
+    """The camera's ``representable_exposure_s`` (an exposure it takes exactly, rounded
+    down: a UVC camera's whole ``exposure_unit_s`` steps), or None for a camera that takes
+    any exposure in its range or offers a list of its own (a DSLR's shutter speeds).
+
+    Why one place: the metering asks the camera only for exposures it takes, its start, its
+    test shots and its bound alike; each had looked the method up for itself."""
+    steps = getattr(camera, "representable_exposure_s", None)
+    return steps if callable(steps) else None
+
+
+def representable_s(camera: object, exposure_s: float) -> float:
+    """``exposure_s`` as the camera takes it exactly (:func:`exposure_steps`), unchanged on
+    a camera with no steps."""
+    steps = exposure_steps(camera)
+    return float(steps(exposure_s)) if steps is not None else exposure_s
+
+
 def metering_steps(schedule: LightSchedule, count: int = 1) -> list[int]:
     """Up to ``count`` step indices, one per light, brightest first by the light a level object
     receives from each (its direction's height × the step's intensity; ties keep plan order)."""
@@ -252,9 +270,7 @@ def fix_session_exposure(
         # [camera] exposure_s is only where the metering starts, rounded down to what the
         # camera takes exactly (whole exposure_unit_s): refusing 0.00125 s as "not a whole
         # number" of 0.0001 s stopped a run whose metering never asks for it
-        steps_of = getattr(rig.camera, "representable_exposure_s", None)
-        start = rig.camera_config.exposure_s
-        start = steps_of(start) if steps_of is not None else start
+        start = representable_s(rig.camera, rig.camera_config.exposure_s)
         check_capture_fits_lit(rig, [start], "nothing was lit")
         rig.lighting.set(schedule.steps[at])
         lit_at = rig.clock.now()

@@ -333,8 +333,10 @@ def fix_exposure(
     from rti_rig.runtime.exposure_policy import (
         PROBE_LIGHTS,
         Recheck,
+        exposure_steps,
         fix_session_exposure,
         metering_steps,
+        representable_s,
     )
 
     cam = rig.camera_config
@@ -376,41 +378,55 @@ def fix_exposure(
 
     #: what the connected camera bounds the exposure by, where it is shorter than the rule's
     camera_cap: list[tuple[float, str]] = []
+    #: the shortest exposure the camera takes, where it is longer than the rule's
+    camera_floor: list[tuple[float, str]] = []
 
     def camera_rule(camera) -> ExposureRule:  # type: ignore[no-untyped-def]
-        # the camera is connected by now: its own longest exposure (a UVC camera's frame
-        # period) is known, which the config's range, fixed before it opened, is not
+        # the camera is connected by now: its own range (a UVC camera's frame period, its
+        # [camera.device] min_exposure_s) is known, which the config's [camera] range is not
+        update: dict[str, float] = {}
+        shortest = getattr(camera, "shortest_exposure_s", None)
+        low = shortest() if shortest is not None else None
+        if low is not None and low[0] > rule.min_exposure_s * (1 + 1e-9):
+            # a device minimum above [camera]'s: a bright object had been metered down to a
+            # test shot the camera refuses ("outside the configured range"), stopping the run
+            camera_floor[:] = [low]
+            update["min_exposure_s"] = low[0]
         bound = getattr(camera, "longest_exposure_s", None)
         found = bound() if bound is not None else None
-        if found is None or found[0] >= rule.max_exposure_s:
+        if found is not None and found[0] < rule.max_exposure_s:
+            # kept as the longest exposure the camera takes exactly (whole exposure_unit_s):
+            # at 30 fps 1/30 s is 333 units, 0.0333 s, which the warning's check never reached
+            camera_cap[:] = [(representable_s(camera, found[0]), found[1])]
+            update["max_exposure_s"] = found[0]
+        if not update:
             return rule
-        # kept as the longest exposure the camera takes exactly (whole exposure_unit_s): at
-        # 30 fps 1/30 s is 333 units, 0.0333 s, which the warning's check never reached
-        steps = getattr(camera, "representable_exposure_s", None)
-        camera_cap[:] = [(steps(found[0]) if steps else found[0], found[1])]
-        return rule.model_copy(update={"max_exposure_s": max(found[0], rule.min_exposure_s)})
+        low_s = update.get("min_exposure_s", rule.min_exposure_s)
+        high_s = max(update.get("max_exposure_s", rule.max_exposure_s), low_s)
+        return rule.model_copy(update={"min_exposure_s": low_s, "max_exposure_s": high_s})
 
     # a camera taking exposures in steps (a UVC camera's exposure_unit_s) is asked for those
     def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
         shutter = getattr(camera, "available_exposures_s", None)
-        steps = getattr(camera, "representable_exposure_s", None)
+        ruled = camera_rule(camera)
         return meter_exposure(
             camera,
-            camera_rule(camera),
-            start_s,
+            ruled,
+            # [camera] exposure_s is only where the metering starts: one under the camera's
+            # shortest starts at that (the camera refuses it)
+            max(start_s, ruled.min_exposure_s),
             shutter() if shutter else None,
-            quantise=steps,
+            quantise=exposure_steps(camera),
         )
 
     def recheck(camera, exposure_s: float) -> Recheck:  # type: ignore[no-untyped-def]
         shutter = getattr(camera, "available_exposures_s", None)
-        steps = getattr(camera, "representable_exposure_s", None)
         choice, tested = recheck_exposure(
             camera,
             camera_rule(camera),
             exposure_s,
             shutter() if shutter else None,
-            quantise=steps,
+            quantise=exposure_steps(camera),
         )
         return Recheck(tested, choice)
 
@@ -450,6 +466,23 @@ def fix_exposure(
     on_note(Note(f"Exposure fixed at {chosen['exposure_s']:.4g} s{where} ({chosen['reason']})"))
     if strays := chosen.get("metering_strays"):
         on_note(Note(_metering_strays_said(strays)))
+    floored = camera_floor and chosen["exposure_s"] <= camera_floor[0][0] * (1 + 1e-6)
+    if floored and not chosen.get("satisfied", False):  # bound: it wanted shorter
+        measured = chosen.get("measured_saturated_fraction")
+        saturated = (
+            f"its test shot there saturated {measured:.2%} of pixels (limit {max_saturated:.2%})"
+            if measured is not None
+            else "the images may be saturated"
+        )
+        on_note(
+            Note(
+                f"The exposure, {chosen['exposure_s']:.4g} s, is the shortest the camera "
+                f"{rig.camera.name} can take ({camera_floor[0][1]}), not the "
+                f"{cam.min_exposure_s:g} s [camera] min_exposure_s allows: the metering could "
+                f"go no shorter, and {saturated}. Lower the camera's gain or dim the light",
+                level="warning",
+            )
+        )
     if camera_cap and chosen["exposure_s"] >= camera_cap[0][0] * (1 - 1e-6):
         bound = camera_cap[0][1]
         on_note(

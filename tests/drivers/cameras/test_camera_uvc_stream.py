@@ -386,3 +386,36 @@ def test_a_configured_exposure_not_in_units_is_only_a_start_for_auto_exposure(
     manifest = json.loads((out / "manifest.json").read_text())
     shot = manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
     assert shot[0][0] == pytest.approx(0.0012), shot
+
+
+@pytest.mark.pty
+@pytest.mark.parametrize("start_s", [0.05, 0.0002], ids=["start-above", "start-below-device-min"])
+def test_a_uvc_metering_chooses_no_exposure_under_the_devices_min_exposure_s(
+    tmp_path, monkeypatch, start_s
+):
+    """`run --auto-exposure` on a very bright object with `[camera.device] min_exposure_s =
+    0.00045` above `[camera]`'s 0.0001: the metering's range came from `[camera]` alone, so it
+    stepped a saturated preview down to 0.0001 s, which the camera refuses ("outside the
+    configured range"), and the run stopped; a `[camera] exposure_s` under the device's minimum
+    stopped it at the first test shot. The metering now goes no shorter than the device's
+    minimum in whole units (0.0005 s), starts there if asked to start below it, and a warning
+    names the key that bound it."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    text = cfg.read_text().replace("exposure_s = 0.05\n", f"exposure_s = {start_s}\n", 1)
+    cfg.write_text(text.replace('kind = "opencv"\n', 'kind = "opencv"\nmin_exposure_s = 0.00045\n'))
+    light = LightHistory(SystemClock())  # type: ignore[arg-type]
+    light.set(1.0)
+    stream = BufferedUvcStream(light, fps=20.0, scale=1e9)  # 0.0005 s saturates 7 times over
+    code, said, out, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
+    assert "outside the configured range" not in said and "Traceback" not in said, said
+    assert "Exposure fixed at 0.0005 s" in said, said
+    assert "shortest the camera uvc-camera can take" in said, said
+    assert "min_exposure_s = 0.00045 s in [camera.device], 0.0005 s in whole" in said, said
+    assert "its test shot there saturated 100.00% of pixels (limit 0.10%)" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    evidence = manifest["schedule"]["provenance"]["exposure"]
+    shot = [t for shots in evidence["test_exposures_by_light_s"] for t in shots]
+    assert min(shot) == pytest.approx(0.0005), shot
+    assert all(s["exposure_s"] == pytest.approx(0.0005) for s in manifest["steps"])
+
