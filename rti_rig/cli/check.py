@@ -69,6 +69,17 @@ def check(
             "moves and no torque is switched on; run check again afterwards.",
         ),
     ] = False,
+    auto_exposure: Annotated[
+        bool,
+        typer.Option(
+            "--auto-exposure",
+            help="Check the rig for `run --auto-exposure`: \\[camera] exposure_s is then only "
+            "where the metering starts, judged as the metering takes it (rounded down to a "
+            "UVC camera's whole exposure units; a DSLR starts at its nearest shutter speed), "
+            "and a rig that run refuses to meter (a watched folder, a replay, a "
+            "camera-triggered dome) is refused.",
+        ),
+    ] = False,
 ) -> None:
     """Self-test the rig: a dome lights each LED in turn and reports what answered; an arm
     visits poses spanning its band (checking where it really got to), flashes the lamp at each
@@ -84,7 +95,7 @@ def check(
     try:
         with stop_on_signals():
             out.print(f"Checking {escape(str(rig_config))} (Ctrl-C stops the check at once)…")
-            report = check_rig(CheckRequest(rig_config, intensity))
+            report = check_rig(CheckRequest(rig_config, intensity, auto_exposure))
     except CheckStopped as exc:
         for failure in exc.teardown_failures:
             err.print(f"[red]teardown problem:[/] {escape(failure)}")

@@ -39,3 +39,14 @@ def test_auto_exposure_on_a_watched_folder_is_refused_naming_the_key(
     assert "Drop --auto-exposure" in text and "exposure_s" in text
     # refused before the dome's port was looked for, and nothing written
     assert "open port" not in text and not out.exists()
+
+
+def test_check_auto_exposure_on_a_watched_folder_is_refused_as_run_refuses_it() -> None:
+    """`rti-rig check --auto-exposure` checks the rig for `run --auto-exposure`: a camera that
+    run refuses to meter is refused by the check too, before the dome's port is looked for."""
+    r = runner.invoke(app, ["check", str(WATCH), "--auto-exposure"])
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"{WATCH}: key 'camera.device.kind'" in text
+    assert "--auto-exposure cannot meter a 'folder_watch' camera" in text
+    assert "open port" not in text and "Traceback" not in text

@@ -41,6 +41,9 @@ class CheckRequest:
     rig_config: Path
     #: LED drive level for a dome's walk, in (0, 1].
     intensity: float = 0.2
+    #: check the rig for ``run --auto-exposure``: ``[camera] exposure_s`` is then only the
+    #: metering's start, judged as the metering takes it (see :func:`_exposure_problem`)
+    auto_exposure: bool = False
 
 
 def check_rig(req: CheckRequest) -> Any:
@@ -50,6 +53,13 @@ def check_rig(req: CheckRequest) -> Any:
             f"--intensity {req.intensity:g}: give the LED drive level as a fraction in (0, 1]"
         )
     loaded = load_rig_config(req.rig_config)
+    if req.auto_exposure:
+        # what run --auto-exposure refuses before the rig opens, refused here as there
+        from rti_rig.app.flash_sync import refuse_options
+        from rti_rig.app.usecases.session import refuse_unmeterable_rig
+
+        refuse_unmeterable_rig(loaded)
+        refuse_options(loaded, **{"--auto-exposure": True})
     if loaded.config.backend == "replay":
         return ReplayCheck.of(loaded)
     if loaded.config.dome is not None and loaded.config.dome.flash_sync is not None:
@@ -60,7 +70,8 @@ def check_rig(req: CheckRequest) -> Any:
         try:
             if isinstance(rig.lighting, DomeLighting):
                 lights = self_test(rig.lighting.source, rig.clock, intensity=req.intensity)
-                return WithCamera(lights, camera_line(rig), config_note_lines(loaded))
+                camera = camera_line(rig, auto_exposure=req.auto_exposure)
+                return WithCamera(lights, camera, config_note_lines(loaded))
             if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
                 lights = arm_self_test(
                     rig.lighting.carrier,
@@ -69,7 +80,7 @@ def check_rig(req: CheckRequest) -> Any:
                     park=rig.lighting.park_after_session,
                 )
                 notes = (*config_note_lines(loaded), *_lamp_notes(rig))
-                return WithCamera(lights, camera_line(rig), notes)
+                return WithCamera(lights, camera_line(rig, auto_exposure=req.auto_exposure), notes)
         except EmergencyStop as exc:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
             report = getattr(exc, "self_test_report", None)
@@ -147,14 +158,17 @@ def _lamp_notes(rig) -> tuple[str, ...]:  # type: ignore[no-untyped-def]
     )
 
 
-def camera_line(rig, why_no_image: str = "") -> tuple[str, bool]:  # type: ignore[no-untyped-def]
+def camera_line(  # type: ignore[no-untyped-def]
+    rig, why_no_image: str = "", *, auto_exposure: bool = False
+) -> tuple[str, bool]:
     """Open and release the rig's camera, taking no image (after a lights' walk the lights are
     off; on a camera-triggered dome a shot would step it: ``why_no_image``): the line to print
     and whether it connected. A check had passed a rig whose camera then failed the session's
-    first capture (gphoto2 not installed, no camera found)."""
+    first capture (gphoto2 not installed, no camera found). ``auto_exposure``: the exposure is
+    judged as ``run --auto-exposure`` takes it (:func:`_exposure_problem`)."""
     try:
         rig.camera.connect()
-        problem = _exposure_problem(rig)
+        problem = _exposure_problem(rig, auto_exposure)
     except RtiRigError as exc:
         return f"camera: FAILED to connect: {exc}", False
     finally:
@@ -168,15 +182,48 @@ def camera_line(rig, why_no_image: str = "") -> tuple[str, bool]:  # type: ignor
     return f"camera: {rig.camera.name} connected (no image taken{why})", True
 
 
-def _exposure_problem(rig) -> str | None:  # type: ignore[no-untyped-def]
+def _exposure_problem(rig, auto_exposure: bool = False) -> str | None:  # type: ignore[no-untyped-def]
     """Why the config's ``[camera] exposure_s`` cannot be shot on the connected camera, if its
     driver can tell (a DSLR offers a fixed list of shutter speeds): such a session failed at
-    its first capture, its light already on, after a check that had passed."""
+    its first capture, its light already on, after a check that had passed.
+
+    With ``auto_exposure`` it is judged as ``run --auto-exposure`` takes it, only as the
+    metering's start (:func:`_metering_start_s`). Without, a refusal that run --auto-exposure
+    would not make says so: the check had refused an exposure_s (off a UVC camera's units)
+    that the run the user meant to start took, naming neither the flag nor why."""
     judge = getattr(rig.camera, "exposure_problem", None)
     if not callable(judge):
         return None
-    said = judge(float(rig.camera_config.exposure_s))
-    return None if said is None else str(said)
+    exposure = float(rig.camera_config.exposure_s)
+    start = _metering_start_s(rig.camera, exposure)
+    if auto_exposure:
+        said = judge(start) if start is not None else None
+        return None if said is None else str(said)
+    said = judge(exposure)
+    if said is None:
+        return None
+    if start is None or judge(start) is None:
+        begins = (
+            "at the shutter speed the camera offers nearest it"
+            if start is None
+            else f"at {start:g} s, which the camera takes"
+        )
+        said = (
+            f"{said}. run --auto-exposure would take exposure_s only as its metering's start "
+            f"({begins}): rti-rig check --auto-exposure checks the rig for that"
+        )
+    return str(said)
+
+
+def _metering_start_s(camera, exposure_s: float) -> float | None:  # type: ignore[no-untyped-def]
+    """Where ``run --auto-exposure`` starts metering from ``[camera] exposure_s``: rounded down
+    to an exposure the camera takes exactly (a UVC camera's whole units); None on a camera
+    offering its own list of speeds (a DSLR), whose metering starts at the one nearest it."""
+    from rti_rig.runtime.exposure_policy import representable_s
+
+    if callable(getattr(camera, "available_exposures_s", None)):
+        return None
+    return representable_s(camera, exposure_s)
 
 
 @dataclass(frozen=True)

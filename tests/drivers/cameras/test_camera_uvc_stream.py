@@ -419,3 +419,29 @@ def test_a_uvc_metering_chooses_no_exposure_under_the_devices_min_exposure_s(
     assert min(shot) == pytest.approx(0.0005), shot
     assert all(s["exposure_s"] == pytest.approx(0.0005) for s in manifest["steps"])
 
+
+@pytest.mark.pty
+def test_check_says_an_exposure_not_in_units_is_a_start_for_auto_exposure(tmp_path, monkeypatch):
+    """`[camera] exposure_s = 0.00125` (12.5 units of 100 µs): `run --auto-exposure` takes it
+    as its metering's start (0.0012 s), but `rti-rig check` refused it with no word of that,
+    so a user about to meter was told the rig failed. The refusal now says run
+    --auto-exposure would start at 0.0012 s and names `check --auto-exposure`, which checks
+    the rig for that run and passes it."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    cfg.write_text(cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.00125\n", 1))
+    stream = BufferedUvcStream(LightHistory(SystemClock()), fps=20.0)  # type: ignore[arg-type]
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "0.0012 s and 0.0013 s" in said, said
+    assert "run --auto-exposure would take exposure_s only as its metering's start" in said
+    assert "(at 0.0012 s, which the camera takes)" in said, said
+    assert "rti-rig check --auto-exposure checks the rig for that" in said, said
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["check", str(cfg), "--auto-exposure"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "RESULT: PASS" in said, said
+    assert "camera: uvc-camera connected (no image taken)" in said, said
+    assert "FAILED" not in said and "Traceback" not in said, said
