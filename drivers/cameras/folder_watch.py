@@ -962,7 +962,9 @@ class FolderWatchCamera:
 
     def _decode_complete(self, path: Path, exposure_s: float, started: float) -> Frame:
         """Decode ``path``; one that will not decode gets ``timeout_s`` to change and is tried
-        again once its size is steady for ``stable_polls`` polls.
+        again once its size is steady for ``stable_polls`` polls, unless waiting cannot help:
+        a RAW whose header is written in a format LibRaw does not read, or a file named as a
+        TIFF whose first bytes are written and are no TIFF's (said at once, naming the file).
 
         Why: a steady size only means the writer paused (a network share, a Wi-Fi upload, a
         program writing in chunks). Half a file had stopped the session at once, a shot lost
@@ -990,6 +992,18 @@ class FolderWatchCamera:
                         f"{s.stable_polls} polls, its header written), so waiting will not "
                         f"help; it is left in {s.folder}, and no image was recorded for this "
                         "light",
+                        "decode",
+                    ) from exc
+                if path.suffix.lower() in TIFF_SUFFIXES and _not_a_tiff(path):
+                    # its first bytes are written and no TIFF's, as the capture-time read
+                    # already found: it had still been given timeout_s to change
+                    raise CaptureError(
+                        self.name,
+                        f"{message.split(': is it a complete TIFF')[0]}: {path.name} is no "
+                        "TIFF (its first bytes are written and are not a TIFF header: a "
+                        "damaged file, or another kind saved under a TIFF name), so waiting "
+                        f"will not help; it is left in {s.folder}, and no image was recorded "
+                        "for this light",
                         "decode",
                     ) from exc
                 failure = exc

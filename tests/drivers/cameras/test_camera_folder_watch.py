@@ -406,3 +406,22 @@ def test_a_jpeg_whose_raw_is_late_is_not_advised_as_a_pattern_to_add(tmp_path):
     said = str(info.value)
     assert "IMG_0002.cr2 came into the folder but no pattern matches it" in said
     assert "'*.cr2'" in said and "'*.JPG'" not in said and "not its RAW" not in said
+
+
+def test_a_file_named_tif_that_is_no_tiff_is_said_at_once_naming_it(tmp_path):
+    """A file saved under a .tif name whose first bytes are written and are no TIFF header (a
+    damaged file, a JPEG saved as .tif): its capture-time read gave it up at once, but its
+    decode still waited ``timeout_s`` for it to change and then advised raising stable_polls
+    or poll_interval_s. It is now said at once, naming the file and where it is left."""
+    clock = ScriptedClock(
+        {0.5: lambda: (tmp_path / "IMG_0001.tif").write_bytes(b"JFIF not a TIFF" * 64)}
+    )
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "IMG_0001.tif is no TIFF" in said and "waiting will not help" in said, said
+    assert str(tmp_path) in said and "stable_polls or poll_interval_s" not in said, said
+    assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
+    assert (tmp_path / "IMG_0001.tif").exists()  # left where the program saved it
