@@ -411,6 +411,21 @@ class OpenCvCamera:
         ("nothing was lit")."""
         if self._cap is None or self.settings.backend != "v4l2":
             return
+        s = self.settings
+        if not s.min_exposure_s <= exposure_s <= s.max_exposure_s:
+            # capture refuses it, with the LED already lit (the config's [camera] range may
+            # allow it: the two tables are not compared when the config loads)
+            side = "shorter" if exposure_s < s.min_exposure_s else "longer"
+            key = "min_exposure_s" if side == "shorter" else "max_exposure_s"
+            limit = s.min_exposure_s if side == "shorter" else s.max_exposure_s
+            raise DeviceError(
+                self.name,
+                f"exposure {exposure_s:g} s is {side} than the camera's {key} = {limit:g} s "
+                f"in [camera.device] (the range it refuses exposures outside); {before}. Set "
+                f"[camera] exposure_s within [{s.min_exposure_s:g}, {s.max_exposure_s:g}] s, "
+                f"or change {key} in [camera.device] if the camera can take it",
+                "check exposure",
+            )
         not_whole = self._not_whole_units(exposure_s)
         if not_whole is not None:
             raise DeviceError(

@@ -98,6 +98,19 @@ def representable_s(camera: object, exposure_s: float) -> float:
     return float(steps(exposure_s)) if steps is not None else exposure_s
 
 
+def metering_start_s(camera: object, exposure_s: float) -> float:
+    """Where the metering starts from ``[camera] exposure_s``: rounded down to an exposure the
+    camera takes exactly (:func:`representable_s`), and no shorter than the shortest it takes
+    (a UVC camera's ``shortest_exposure_s``, its ``[camera.device] min_exposure_s``).
+
+    Why: exposure_s is only a start for ``run --auto-exposure``; one under the device's
+    minimum stopped the run at the metering's first test shot. Also what ``rti-rig check
+    --auto-exposure`` judges."""
+    start = representable_s(camera, exposure_s)
+    shortest = getattr(camera, "shortest_exposure_s", None)
+    return max(start, shortest()[0]) if callable(shortest) else start
+
+
 def metering_steps(schedule: LightSchedule, count: int = 1) -> list[int]:
     """Up to ``count`` step indices, one per light, brightest first by the light a level object
     receives from each (its direction's height × the step's intensity; ties keep plan order)."""
@@ -270,7 +283,7 @@ def fix_session_exposure(
         # [camera] exposure_s is only where the metering starts, rounded down to what the
         # camera takes exactly (whole exposure_unit_s): refusing 0.00125 s as "not a whole
         # number" of 0.0001 s stopped a run whose metering never asks for it
-        start = representable_s(rig.camera, rig.camera_config.exposure_s)
+        start = metering_start_s(rig.camera, rig.camera_config.exposure_s)
         check_capture_fits_lit(rig, [start], "nothing was lit")
         rig.lighting.set(schedule.steps[at])
         lit_at = rig.clock.now()

@@ -216,14 +216,14 @@ def _exposure_problem(rig, auto_exposure: bool = False) -> str | None:  # type: 
 
 
 def _metering_start_s(camera, exposure_s: float) -> float | None:  # type: ignore[no-untyped-def]
-    """Where ``run --auto-exposure`` starts metering from ``[camera] exposure_s``: rounded down
-    to an exposure the camera takes exactly (a UVC camera's whole units); None on a camera
-    offering its own list of speeds (a DSLR), whose metering starts at the one nearest it."""
-    from rti_rig.runtime.exposure_policy import representable_s
+    """Where ``run --auto-exposure`` starts metering from ``[camera] exposure_s``
+    (:func:`~rti_rig.runtime.exposure_policy.metering_start_s`); None on a camera offering
+    its own list of speeds (a DSLR), whose metering starts at the one nearest it."""
+    from rti_rig.runtime.exposure_policy import metering_start_s
 
     if callable(getattr(camera, "available_exposures_s", None)):
         return None
-    return representable_s(camera, exposure_s)
+    return metering_start_s(camera, exposure_s)
 
 
 @dataclass(frozen=True)

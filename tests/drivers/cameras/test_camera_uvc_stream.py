@@ -445,3 +445,32 @@ def test_check_says_an_exposure_not_in_units_is_a_start_for_auto_exposure(tmp_pa
     assert r.exit_code == 0 and "RESULT: PASS" in said, said
     assert "camera: uvc-camera connected (no image taken)" in said, said
     assert "FAILED" not in said and "Traceback" not in said, said
+
+
+@pytest.mark.pty
+def test_an_exposure_under_the_devices_min_exposure_s_is_refused_before_any_led_lights(
+    tmp_path, monkeypatch
+):
+    """`[camera] exposure_s = 0.0002` with `[camera.device] min_exposure_s = 0.00045`: the
+    config loads (`[camera]`'s own range allows it), and `rti-rig run` lit LED 0 and stopped
+    at its first capture ("outside the configured range"). It is now refused once the camera
+    is connected, before any LED lights, naming both keys; `rti-rig check` fails it too."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    text = cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.0002\n", 1)
+    cfg.write_text(text.replace('kind = "opencv"\n', 'kind = "opencv"\nmin_exposure_s = 0.00045\n'))
+    stream = BufferedUvcStream(LightHistory(SystemClock()), fps=20.0)  # type: ignore[arg-type]
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    out = tmp_path / "s"
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "4"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert not [e for e in firmware.history if e.what == "lit"], said
+    assert "exposure 0.0002 s is shorter than the camera's min_exposure_s = 0.00045 s" in said
+    assert "[camera] exposure_s" in said and "nothing was lit" in said, said
+    assert "Traceback" not in said, said
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "shorter than the camera's min_exposure_s = 0.00045 s" in said, said
