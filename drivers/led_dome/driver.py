@@ -85,20 +85,18 @@ class LedDomeDriver:
         self.banners_seen = 0
         self._heard = False
         self._bytes_heard = False
+        #: A stop came while the port was being opened (see :meth:`reopen_port`).
+        self.open_cut_short = False
+        #: The wait for the ready banner after the last opening is over (banner or deadline),
+        #: and when that wait ends (see :meth:`finish_boot`).
+        self._booted = False
+        self._boot_deadline = 0.0
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> DomeInfo:
         """Open the port, wait for the ready banner (bounded), then handshake."""
-        self.close()
-        try:
-            self.transport.open()
-        except TransportError as exc:
-            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED, True)
-            error.port_held = isinstance(exc, PortHeldError)
-            raise error from exc
-        self._open = True
-        self._rx.clear()
+        self.reopen_port()
         self._wait_for_banner()
         try:
             return self.hello()
@@ -108,6 +106,44 @@ class LedDomeDriver:
             if exc.fault is not LinkFault.RESET:
                 raise
             return self.hello()
+
+    def reopen_port(self) -> None:
+        """Open the port (closing it first) and start the boot wait, without waiting it out:
+        the first step of :meth:`connect`, and what the policy calls to get the port back for
+        the all-off when a stop cut that step short (then :meth:`finish_boot`).
+
+        :attr:`open_cut_short` is true from before the system opens the port until this link
+        counts it open. Why: a Ctrl-C or SIGTERM in between (inside pyserial's open, which
+        closes the port again as the stop goes through, or just after it) left a port this
+        link never had open, so the policy sent no all-off and said "the dome was never
+        reached" of a board the opening had reset (the line protocol's links were fixed for
+        this; this one had been left out)."""
+        self.close()
+        self.open_cut_short = True
+        self._booted = False
+        # counted from before the opening too: a stop inside it then finds this opening's
+        # deadline, not an earlier one's
+        self._boot_deadline = self.transport.clock.now() + self.ready_timeout_s
+        try:
+            self.transport.open()
+        except TransportError as exc:
+            self.open_cut_short = False  # the system refused it: nothing was opened or reset
+            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED, True)
+            error.port_held = isinstance(exc, PortHeldError)
+            raise error from exc
+        self._open = True
+        self._rx.clear()
+        self.open_cut_short = False
+        # and again once open: the board resets as the open completes
+        self._boot_deadline = self.transport.clock.now() + self.ready_timeout_s
+
+    def finish_boot(self) -> None:
+        """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (up to the
+        ready banner, to the same deadline, not a fresh wait), so that the all-off the policy
+        sends next reaches the firmware: bytes sent to a board still in its bootloader are
+        lost, and the all-off would have been said unacknowledged for nothing."""
+        if self._open and not self._booted:
+            self._wait_for_banner()
 
     def close(self) -> None:
         self._open = False
@@ -296,24 +332,26 @@ class LedDomeDriver:
             traffic_log.debug("%s: dropped stale input %r", self.device, reply)
 
     def _wait_for_banner(self) -> None:
-        """Wait (bounded) for the ready banner; boards without auto-reset send none."""
+        """Wait (bounded, to the deadline set when the port opened) for the ready banner;
+        boards without auto-reset send none."""
         clock = self.transport.clock
-        deadline = clock.now() + self.ready_timeout_s
         while True:
             reply = self._next_reply(None)
             if isinstance(reply, Banner):
                 self._saw_banner(reply)
+                self._booted = True
                 return
             if reply is not None:
                 traffic_log.debug("%s: ignored before the banner: %r", self.device, reply)
                 continue
-            remaining = deadline - clock.now()
+            remaining = self._boot_deadline - clock.now()
             if remaining <= 0:
                 traffic_log.debug(
                     "%s: no ready banner within %g s; handshaking anyway",
                     self.device,
                     self.ready_timeout_s,
                 )
+                self._booted = True
                 return
             try:
                 self._feed(self.transport.read(remaining))
