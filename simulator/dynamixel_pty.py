@@ -34,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import os
 import select
+import sys
 import threading
 import time
 import tty
@@ -279,3 +280,38 @@ class EmulatedLinkPortHandler(dynamixel_sdk.PortHandler):
         with contextlib.suppress(OSError, ValueError):
             select.select([self.ser.fileno()], [], [], HOST_WAIT_S)
         return False
+
+
+#: The manual tool that serves emulated servos on a pty (this module is the link it uses).
+SERVE_TOOL = "python -m rti_rig.simulator.dynamixel_emulator"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Say which tool serves emulated servos: this module is the pty link, not a tool.
+
+    Why: its name reads like the arm's pty emulator, and ``python -m
+    simulator.dynamixel_pty --help`` printed nothing and exited 0, leaving the user with no
+    port and no pointer to the tool that gives one."""
+    import argparse
+
+    parser = argparse.ArgumentParser(
+        prog="python -m rti_rig.simulator.dynamixel_pty",
+        usage=f"{SERVE_TOOL} [--config RIG.toml] [--seconds S] [--baud BAUD] "
+        "[--fault K:KIND[:ID]]  (see its --help)",
+        description="This module is the pseudo-terminal link the emulated servos are served "
+        f"on (a library for the tests and dry runs); it serves nothing by itself. To serve a "
+        f"rig config's arm servos on a pty, run {SERVE_TOOL} (docs/protocols/dynamixel-arm.md).",
+    )
+    # the tool's own options (--config …) given here are not this module's: one answer for all
+    parser.parse_known_args(argv)
+    parser.print_usage(sys.stderr)
+    print(
+        f"this module serves nothing by itself: run {SERVE_TOOL} (with the same options) to "
+        "serve emulated servos",
+        file=sys.stderr,
+    )
+    return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -67,6 +67,34 @@ def test_the_tool_says_where_the_servos_rest_and_what_to_set() -> None:
     assert 'backend = "hardware", [arm.dynamixel] port = "' in out.stdout
 
 
+@pytest.mark.parametrize(
+    "module",
+    ["simulator.dynamixel_pty", "rti_rig.simulator.dynamixel_pty"],
+    ids=["repo", "installed"],
+)
+def test_the_pty_link_module_names_the_tool_that_serves_servos(module: str) -> None:
+    """``python -m simulator.dynamixel_pty --help`` printed nothing: the module is the pty link,
+    and the tool that serves servos on a pty is another. Its help now names that tool, and so
+    does a run without --help (which serves nothing, so it does not exit 0); the named tool
+    exists and answers --help."""
+    repo = CONFIGS.parent
+
+    def run(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [sys.executable, "-m", *args], capture_output=True, text=True, timeout=120, cwd=repo
+        )
+
+    tool = "python -m rti_rig.simulator.dynamixel_emulator"
+    helped = run(module, "--help")
+    assert helped.returncode == 0, helped.stderr
+    assert helped.stdout.startswith(f"usage: {tool} "), helped.stdout
+    bare = run(module, "--config", "rig.toml")
+    assert bare.returncode == 2, bare
+    assert f"serves nothing by itself: run {tool}" in bare.stderr, bare.stderr
+    named = run(tool.removeprefix("python -m ").strip(), "--help")
+    assert named.returncode == 0 and "Serve a rig config's arm servos" in named.stdout, named
+
+
 def test_a_hardware_arm_is_named_with_its_port(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
