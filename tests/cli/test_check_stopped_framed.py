@@ -32,8 +32,11 @@ def _check_said() -> tuple[int, str]:
     return r.exit_code, " ".join(r.output.split())
 
 
-def test_a_ctrl_c_inside_the_opening_of_the_framed_port_still_switches_the_board_off(
-    monkeypatch: pytest.MonkeyPatch,
+@pytest.mark.parametrize(
+    ("sig", "code", "name"), [(signal.SIGINT, 130, "Ctrl-C"), (signal.SIGTERM, 143, "SIGTERM")]
+)
+def test_a_stop_inside_the_opening_of_the_framed_port_still_switches_the_board_off(
+    monkeypatch: pytest.MonkeyPatch, sig: signal.Signals, code: int, name: str
 ) -> None:
     import serial
 
@@ -43,21 +46,21 @@ def test_a_ctrl_c_inside_the_opening_of_the_framed_port_still_switches_the_board
 
         def opened(*args, **kwargs):  # type: ignore[no-untyped-def]
             port = redirected(*args, **kwargs)
-            if not stops:  # the user's one Ctrl-C, in the first opening
-                stops.append(signal.SIGINT)
+            if not stops:  # the user's one stop, in the first opening
+                stops.append(sig)
                 try:
-                    signal.raise_signal(signal.SIGINT)
+                    signal.raise_signal(sig)
                 except BaseException:
                     port.close()  # as pyserial's own open does when a stop goes through it
                     raise
             return port
 
         monkeypatch.setattr(serial, "serial_for_url", opened)
-        code, said = _check_said()
-    assert stops and code == 130, said
+        exit_code, said = _check_said()
+    assert stops and exit_code == code, said
     assert "Traceback" not in said
     assert "never reached" not in said, said
-    assert "Check stopped (Ctrl-C): all-off sent and acknowledged by the dome" in said, said
+    assert f"Check stopped ({name}): all-off sent and acknowledged by the dome" in said, said
     events = [e.what for e in firmware.history]
     assert events.count("boot") == 2, events  # the opening reset it, and so did the reopening
     assert firmware.commands_received >= 1 and "lost while booting" not in events, events
