@@ -87,28 +87,17 @@ def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
 
 def _image_files(lp: Path, entries: list[Any]) -> list[Path]:
-    """The image file of every line of ``lp``, all checked to exist before minutes of work.
+    """The image file of every line of ``lp``, checked as ``run ACQ/dirs.lp`` checks them
+    (found, whole, readable, one size and one kind) before minutes of work.
 
-    Why: a missing image had been met while reading, as "cannot read image …image01.JPG:
-    there is no such file", without the ``.lp`` it was listed in or, where the folder holds
-    ``image01.jpg``, the case of the name as the reason (what ``run`` and ``fit`` say)."""
-    from rti_rig.core.errors import LpFormatError
-    from rti_rig.core.lp_format import case_hint, image_paths
+    Why: only their existence had been checked, so an image of another size was met after
+    every image was read, as "all input arrays must have the same shape" naming no file, or
+    (larger than ``MAX_PX`` wide) was scaled to the others' width in silence and measured."""
+    from rti_rig.core.acquisition_images import check_acquisition_images
 
-    paths = image_paths(lp, entries)
-    missing = [p for p in paths if not p.is_file()]
-    if missing:
-        shown = ", ".join(p.name for p in missing[:5]) + (" ..." if len(missing) > 5 else "")
-        raise LpFormatError(
-            lp,
-            None,
-            f"{len(missing)} of {len(entries)} image(s) it lists are missing ({shown})"
-            + (
-                case_hint(missing)
-                or "; copy them where their names point, or remove their lines from the .lp"
-            ),
-        )
-    return paths
+    return check_acquisition_images(
+        lp, entries, use="measure", pixels="that rti-rig cannot read"
+    ).paths
 
 
 def held_out_lights(dirs: np.ndarray, seed: int = 0) -> np.ndarray:

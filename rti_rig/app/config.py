@@ -1254,14 +1254,7 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
     default dome's (about 1 s a light), so a replayed session reports what a real dome would
     take.
     """
-    from rti_rig.core.errors import SessionError
-    from rti_rig.core.image_files import (
-        header_layout,
-        image_truncation,
-        read_image_any,
-        tiff_sample_problem,
-    )
-    from rti_rig.core.lp_format import case_hint, image_paths, is_absolute_name
+    from rti_rig.core.acquisition_images import check_acquisition_images
 
     lp_path = Path(lp_path).resolve()
     try:
@@ -1284,105 +1277,14 @@ def load_replay_rig(lp_path: Path | str) -> LoadedRig:
             "lights by direction, each once; remove one of the two lines (its image is then "
             "left out) to replay the others",
         )
-    paths = dict(zip((e.name for e in entries), image_paths(lp_path, entries), strict=True))
-    missing = [e.name for e in entries if not paths[e.name].is_file()]
-    if missing:
-        more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
-        shown = ", ".join(missing[:5]) + more
-        raise ConfigError(
-            lp_path,
-            None,
-            f"as a rig, an .lp is a recorded acquisition whose images lie beside it: "
-            f"{len(missing)} of {len(entries)} image(s) missing in {lp_path.parent} ({shown})"
-            + (
-                "; an absolute name (a path on the machine that wrote the .lp) is looked for "
-                "by its file name beside the .lp and in a jpeg-exports folder beside it or "
-                "beside its folder"
-                if any(is_absolute_name(m) for m in missing)
-                else ""
-            )
-            + (
-                case_hint([paths[m] for m in missing])
-                # what to do, as the damaged and unreadable images below are told
-                or "; copy them where their names point, or remove their lines from the .lp "
-                "to replay the others"
-            ),
-        )
-    why_cut = {e.name: image_truncation(paths[e.name]) for e in entries}
-    damaged = [f"{name}: {why}" for name, why in why_cut.items() if why is not None]
-    if damaged:  # OpenCV would decode a JPEG with its missing part grey, and say nothing
-        jpegs = all(
-            paths[name].suffix.lower() in (".jpg", ".jpeg")
-            for name, why in why_cut.items()
-            if why is not None
-        )
-        raise ConfigError(
-            lp_path,
-            None,
-            f"{len(damaged)} of {len(entries)} image(s) beside it are damaged "
-            f"{'JPEGs' if jpegs else 'images'} "
-            f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
-            "from the camera or card",
-        )
-    # one size and one kind (colour or grey) for all, checked now rather than by a capture
-    # that stops the session part-way (and whose resume would stop there again): from the
-    # headers, and by decoding the images whose header does not say (an empty file, another
-    # format), which is what a capture would do
-    layouts: dict[str, tuple[int, int, bool]] = {}
-    unreadable: list[str] = []
-    unsupported: list[str] = []
-    for e in entries:
-        path = paths[e.name]
-        problem = tiff_sample_problem(path)  # a float TIFF has a header like any other
-        if problem is not None:
-            unsupported.append(problem)
-            continue
-        layout = header_layout(path)
-        if layout is None:
-            try:
-                img = read_image_any(path)
-            except SessionError as exc:
-                unreadable.append(str(exc))
-                continue
-            layout = (int(img.shape[0]), int(img.shape[1]), img.ndim == 3)
-        layouts[e.name] = layout
-    if unreadable:
-        raise ConfigError(
-            lp_path,
-            None,
-            f"{len(unreadable)} of {len(entries)} image(s) beside it cannot be read "
-            f"({'; '.join(unreadable[:5])}{' ...' if len(unreadable) > 5 else ''}); copy them "
-            "again from the camera or card, or list only the others",
-        )
-    if unsupported:
-        raise ConfigError(
-            lp_path,
-            None,
-            f"{len(unsupported)} of {len(entries)} image(s) beside it hold pixels a replay "
-            f"cannot give as a frame ({'; '.join(unsupported[:3])}"
-            f"{' ...' if len(unsupported) > 3 else ''}), or list only the others",
-        )
-    height, width, colour = layouts[entries[0].name]
-    odd = [f"{n} is {w}x{h}" for n, (h, w, _) in layouts.items() if (h, w) != (height, width)]
-    if odd:
-        raise ConfigError(
-            lp_path,
-            None,
-            f"the images beside it differ in size: {entries[0].name} is {width}x{height} but "
-            f"{'; '.join(odd[:5])}{' ...' if len(odd) > 5 else ''}; an acquisition has one "
-            "image size (replace or resize those images, or list only the others)",
-        )
-    kind = "colour" if colour else "greyscale"
-    other = [n for n, (_, _, c) in layouts.items() if c != colour]
-    if other:
-        raise ConfigError(
-            lp_path,
-            None,
-            f"the images beside it are not all {kind}: {entries[0].name} is {kind} but "
-            f"{', '.join(other[:5])}{' ...' if len(other) > 5 else ''} "
-            f"{'is' if len(other) == 1 else 'are'} {'greyscale' if colour else 'colour'}; an "
-            "acquisition has one kind of image (convert those images, or list only the others)",
-        )
+    # every image found, whole, readable, of one size and kind, before anything runs (shared
+    # with bench tradeoff --from, which reads the same acquisitions)
+    found = check_acquisition_images(
+        lp_path,
+        entries,
+        lead="as a rig, an .lp is a recorded acquisition whose images lie beside it: ",
+    )
+    width, height = found.width, found.height
     data: dict[str, Any] = {
         "name": f"replay of {lp_path.parent.name}/{lp_path.name}",
         "kind": "dome",

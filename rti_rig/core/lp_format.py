@@ -205,6 +205,52 @@ def case_hint(missing: Sequence[Path]) -> str:
     )
 
 
+def missing_images_advice(
+    names: Sequence[str], paths: Sequence[Path], lp_dir: Path, use: str
+) -> str:
+    """What to say after "N image(s) missing" of the images an `.lp` in ``lp_dir`` lists as
+    ``names``, looked for at ``paths`` (:func:`image_path`): where an absolute name is looked
+    for, and what to do; ``use`` is the verb of what is done with the others ("replay", "fit").
+
+    Why: an absolute name whose file exists at that very path had been called "missing" and
+    the user told to "copy them where their names point", where they already were. It is
+    read beside the `.lp` by design (see :func:`image_path`), so that is said, with the two
+    ways out. One wording for ``run``, ``fit`` and ``bench tradeoff --from``."""
+    absolute = [n for n in names if is_absolute_name(n)]
+    where = (
+        "an absolute name (a path on the machine that wrote the .lp) is looked for by its "
+        "file name beside the .lp and in a jpeg-exports folder beside it or beside its folder"
+    )
+    there = [n for n in absolute if _is_file_at(n)]
+    if there:
+        more = f" and {len(there) - 3} more" if len(there) > 3 else ""
+        which = (
+            ("it exists" if len(names) == 1 else "all of them exist")
+            if len(there) == len(names)
+            else f"{len(there)} of them exist ({', '.join(there[:3])}{more})"
+        )
+        return (
+            f"; {which} at the path the .lp names, but an .lp's images are read beside it: "
+            f"{where}; "
+            f"copy them into {lp_dir}, or write an .lp whose names are relative to its folder"
+        )
+    return ("; " + where if absolute else "") + (
+        case_hint(paths)
+        or f"; copy them where their names point, or remove their lines from the .lp to {use} "
+        "the others"
+    )
+
+
+def _is_file_at(name: str) -> bool:
+    """Whether an absolute image name is a file at that path on this machine (only looked at,
+    never read: an `.lp` does not read files outside its folder)."""
+    path = Path(name)
+    try:
+        return path.is_absolute() and path.is_file()
+    except OSError:
+        return False
+
+
 def _check_name(name: str, source: str, lineno: int) -> None:
     """Reject relative names that would resolve outside the `.lp` file's own folder (an
     absolute name is a tool's path on its own machine: see :func:`image_path`)."""

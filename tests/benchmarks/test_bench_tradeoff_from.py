@@ -197,6 +197,96 @@ def test_a_missing_image_is_named_with_its_lp_and_what_to_do(
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out)])
     text = " ".join(r.output.split())
     assert r.exit_code == 2, r.output
-    assert f"{lp}: 1 of 18 image(s) it lists are missing ({listed})" in text
+    assert f"{lp}: 1 of 18 image(s) missing in {acq} ({listed})" in text
     assert hint in text
     assert not out.exists() or not any(out.iterdir())
+
+
+def _acquisition(folder: Path, count: int = 12) -> Path:
+    """The first ``count`` lights of the real acquisition (402x395 JPEGs: wider than
+    ``MAX_PX``, so the trade-off shrinks them), copied into ``folder``; its ``dirs.lp``."""
+    folder.mkdir()
+    lines = ACQ.read_text().splitlines()[1 : count + 1]
+    for line in lines:
+        name = line.split()[0]
+        (folder / name).write_bytes((ACQ.parent / name).read_bytes())
+    lp = folder / "dirs.lp"
+    lp.write_text(f"{count}\n" + "\n".join(lines) + "\n")
+    return lp
+
+
+@pytest.mark.parametrize(
+    ("damage", "said"),
+    [
+        # shrunk to MAX_PX wide like the others, it had been measured in silence
+        ("300x295", "image05.jpg is 300x295"),
+        ("402x300", "image05.jpg is 402x300"),
+        ("grey", "image05.jpg is greyscale"),
+    ],
+)
+def test_an_image_of_another_size_or_kind_is_refused_by_name_before_any_work(
+    tmp_path: Path, damage: str, said: str
+) -> None:
+    """`bench tradeoff --from` checks the images as `run ACQ/dirs.lp` does: one image of
+    another size had been read with all the others and told "all input arrays must have the
+    same shape" (naming none), or, larger than MAX_PX wide, scaled to fit and measured into a
+    full table of results; a greyscale one among colour ones the same."""
+    import cv2
+
+    lp = _acquisition(tmp_path / "acq")
+    img = cv2.imread(str(lp.parent / "image05.jpg"))
+    if damage == "grey":
+        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    else:
+        w, h = (int(v) for v in damage.split("x"))
+        img = cv2.resize(img, (w, h), interpolation=cv2.INTER_AREA)
+    cv2.imwrite(str(lp.parent / "image05.jpg"), img)
+    out = tmp_path / "o"
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out)])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert text.startswith(f"error: {lp}: the images beside it "), text
+    assert said in text and "list only the others" in text, text
+    assert "Traceback" not in text and "planning" not in text.lower()
+    assert not out.exists() or not any(out.iterdir())
+    # run ACQ/dirs.lp says the same of the same images (one check, shared)
+    ran = CliRunner().invoke(app, ["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"])
+    assert ran.exit_code == 2 and said in " ".join(ran.output.split())
+
+
+def test_absolute_names_whose_files_are_there_are_said_so_by_bench_run_and_fit(
+    tmp_path: Path,
+) -> None:
+    """An .lp naming its images by absolute paths where the files are: they are read beside
+    the .lp (by design), but run, fit and bench had called them "missing" and said "copy them
+    where their names point" (bench, run) or "read relative to its own folder" (fit). All
+    three now say that they are at those paths, and the two ways out, in one wording."""
+    src = _acquisition(tmp_path / "acq")
+    lines = src.read_text().splitlines()
+    elsewhere = tmp_path / "t13"
+    elsewhere.mkdir()
+    lp = elsewhere / "abs.lp"
+    lp.write_text("\n".join([lines[0], *(f"{src.parent}/{line}" for line in lines[1:])]) + "\n")
+    said = (
+        "all of them exist at the path the .lp names, but an .lp's images are read beside it: "
+        "an absolute name (a path on the machine that wrote the .lp) is looked for by its file "
+        f"name beside the .lp and in a jpeg-exports folder beside it or beside its folder; copy "
+        f"them into {elsewhere}, or write an .lp whose names are relative to its folder"
+    )
+    commands = {
+        "bench": ["bench", "tradeoff", "--from", str(lp), "--out", str(tmp_path / "b")],
+        "run": ["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"],
+        "fit": ["fit", str(lp), "--out", str(tmp_path / "f")],
+    }
+    for command, args in commands.items():
+        r = CliRunner().invoke(app, args)
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2, (command, text)
+        assert f"12 of 12 image(s) missing in {elsewhere} ({src.parent}/image01.jpg" in text
+        assert said in text, (command, text)
+        assert "where their names point" not in text and "Traceback" not in text
+    # a name at no such path keeps the old advice (and the note of where it is looked for)
+    lp.write_text(lp.read_text().replace(str(src.parent), "/nowhere/at/all"))
+    r = CliRunner().invoke(app, commands["bench"])
+    text = " ".join(r.output.split())
+    assert "exist at the path" not in text and "copy them where their names point" in text

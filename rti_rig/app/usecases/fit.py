@@ -45,6 +45,8 @@ from rti_rig.core.lp_format import (
     directions_of,
     image_file_name,
     image_paths,
+    is_absolute_name,
+    missing_images_advice,
     read_lp,
 )
 from rti_rig.core.out_folders import ensure_writable_folder
@@ -407,6 +409,8 @@ def acquisition_files(
         damaged = [(p, "gone") for p in paths if not p.is_file()]
         damaged += [(p, why) for p in paths if p.is_file() and (why := image_truncation(p))]
         _refuse_lost_images(lp, damaged)
+    else:
+        _refuse_missing_images(lp, entries, paths)
     if notes is not None and stand_ins and (len(stand_ins) < len(entries) or session):
         # a session's linear/ lacks some TIFFs: their 8-bit files are read instead, said (the
         # fit had mixed lossy 8-bit data into a linear one without a word; and a session whose
@@ -419,6 +423,27 @@ def acquisition_files(
             "restore the TIFFs from a copy for a fully linear fit"
         )
     return lp, lights, paths, names
+
+
+def _refuse_missing_images(lp: Path, entries: list[Any], paths: list[Path]) -> None:
+    """Refuse an ``.lp`` (not a session's) whose images, some named by an absolute path, are
+    not found, naming them all and
+    what to do, in the words ``run`` and ``bench tradeoff --from`` use for the same `.lp`.
+
+    Why: the fit stopped at the first with "image T13/image_001.jpg ... is missing (an .lp's
+    image names are read relative to its own folder)", even where the .lp named it by an
+    absolute path at which the file exists (it is read beside the .lp, by design)."""
+    missing = [(e.name, p) for e, p in zip(entries, paths, strict=True) if not p.is_file()]
+    if not any(is_absolute_name(name) for name, _ in missing):
+        return  # a relative name is said at its read, "read relative to its own folder"
+    more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
+    shown = ", ".join(name for name, _ in missing[:5]) + more
+    raise FitInputError(
+        f"{lp}: {len(missing)} of {len(entries)} image(s) missing in {lp.parent} ({shown})"
+        + missing_images_advice(
+            [name for name, _ in missing], [p for _, p in missing], lp.parent, "fit"
+        )
+    )
 
 
 def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:

@@ -1,0 +1,138 @@
+"""The images of a recorded acquisition (an `.lp` with its images beside it), checked before
+anything is done with them.
+
+Why one module: ``run ACQ/dirs.lp`` (the replay rig) and ``bench tradeoff --from`` read the
+same acquisitions; the trade-off had checked only that the files exist, and so read every
+image before stopping at "all input arrays must have the same shape" (naming no file), or
+scaled one image of another size in silence and printed a full table of results from it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from rti_rig.core.errors import ConfigError, SessionError
+from rti_rig.core.image_files import (
+    header_layout,
+    image_truncation,
+    read_image_any,
+    tiff_sample_problem,
+)
+from rti_rig.core.lp_format import LpEntry, image_paths, missing_images_advice
+
+
+@dataclass(frozen=True)
+class AcquisitionImages:
+    """Where every image of an acquisition is (in the `.lp`'s order), and their one layout."""
+
+    paths: list[Path]
+    height: int
+    width: int
+    colour: bool
+
+
+def check_acquisition_images(
+    lp_path: Path,
+    entries: Sequence[LpEntry],
+    *,
+    lead: str = "",
+    use: str = "replay",
+    pixels: str = "a replay cannot give as a frame",
+) -> AcquisitionImages:
+    """The images ``entries`` (read from ``lp_path``) name, each found, whole, readable, and
+    all of one size and one kind (colour or grey); else a :class:`ConfigError` naming the
+    `.lp`, the images and what to do.
+
+    From the files' headers where they say (decoding only those whose header does not, as a
+    capture or a read would), so that a fault is said before minutes of work, not part-way.
+    ``lead`` opens the message of missing images (the replay says what an `.lp` is as a rig);
+    ``use`` is the verb of what is done with the others ("replay", "measure"); ``pixels``
+    says who cannot read a float or many-paged TIFF."""
+    paths = dict(zip((e.name for e in entries), image_paths(lp_path, entries), strict=True))
+    missing = [e.name for e in entries if not paths[e.name].is_file()]
+    if missing:
+        more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
+        shown = ", ".join(missing[:5]) + more
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{lead}{len(missing)} of {len(entries)} image(s) missing in "
+            f"{Path(lp_path).parent} ({shown})"
+            + missing_images_advice(
+                missing, [paths[m] for m in missing], Path(lp_path).parent, use
+            ),
+        )
+    why_cut = {e.name: image_truncation(paths[e.name]) for e in entries}
+    damaged = [f"{name}: {why}" for name, why in why_cut.items() if why is not None]
+    if damaged:  # OpenCV would decode a JPEG with its missing part grey, and say nothing
+        jpegs = all(
+            paths[name].suffix.lower() in (".jpg", ".jpeg")
+            for name, why in why_cut.items()
+            if why is not None
+        )
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{len(damaged)} of {len(entries)} image(s) beside it are damaged "
+            f"{'JPEGs' if jpegs else 'images'} "
+            f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
+            "from the camera or card",
+        )
+    layouts: dict[str, tuple[int, int, bool]] = {}
+    unreadable: list[str] = []
+    unsupported: list[str] = []
+    for e in entries:
+        path = paths[e.name]
+        problem = tiff_sample_problem(path)  # a float TIFF has a header like any other
+        if problem is not None:
+            unsupported.append(problem)
+            continue
+        layout = header_layout(path)
+        if layout is None:
+            try:
+                img = read_image_any(path)
+            except SessionError as exc:
+                unreadable.append(str(exc))
+                continue
+            layout = (int(img.shape[0]), int(img.shape[1]), img.ndim == 3)
+        layouts[e.name] = layout
+    if unreadable:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{len(unreadable)} of {len(entries)} image(s) beside it cannot be read "
+            f"({'; '.join(unreadable[:5])}{' ...' if len(unreadable) > 5 else ''}); copy them "
+            "again from the camera or card, or list only the others",
+        )
+    if unsupported:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"{len(unsupported)} of {len(entries)} image(s) beside it hold pixels {pixels} "
+            f"({'; '.join(unsupported[:3])}"
+            f"{' ...' if len(unsupported) > 3 else ''}), or list only the others",
+        )
+    height, width, colour = layouts[entries[0].name]
+    odd = [f"{n} is {w}x{h}" for n, (h, w, _) in layouts.items() if (h, w) != (height, width)]
+    if odd:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"the images beside it differ in size: {entries[0].name} is {width}x{height} but "
+            f"{'; '.join(odd[:5])}{' ...' if len(odd) > 5 else ''}; an acquisition has one "
+            "image size (replace or resize those images, or list only the others)",
+        )
+    kind = "colour" if colour else "greyscale"
+    other = [n for n, (_, _, c) in layouts.items() if c != colour]
+    if other:
+        raise ConfigError(
+            lp_path,
+            None,
+            f"the images beside it are not all {kind}: {entries[0].name} is {kind} but "
+            f"{', '.join(other[:5])}{' ...' if len(other) > 5 else ''} "
+            f"{'is' if len(other) == 1 else 'are'} {'greyscale' if colour else 'colour'}; an "
+            "acquisition has one kind of image (convert those images, or list only the others)",
+        )
+    return AcquisitionImages([paths[e.name] for e in entries], height, width, colour)
