@@ -15,7 +15,15 @@ def ensure_writable_folder(folder: Path) -> None:
 
     Why: a command that computes for minutes (a fit, a benchmark) must not find out at the end
     that it cannot write its results; an ``OSError`` there reached users as a traceback.
+
+    A file at ``folder`` (or at a folder above it) is refused as such, as ``export-lp`` names
+    a file given for a folder: ``mkdir`` had been told "cannot write there (File exists: …);
+    choose a folder you can write to", which reads as a permission problem.
     """
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        what = " is a file" if existing == folder else f": {existing} is a file, not a folder"
+        raise RtiRigError(f"--out {folder}{what}: give a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / PROBE_NAME

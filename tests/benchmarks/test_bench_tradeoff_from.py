@@ -290,3 +290,21 @@ def test_absolute_names_whose_files_are_there_are_said_so_by_bench_run_and_fit(
     r = CliRunner().invoke(app, commands["bench"])
     text = " ".join(r.output.split())
     assert "exist at the path" not in text and "copy them where their names point" in text
+
+
+def test_an_out_that_is_a_file_is_refused_as_a_file(tmp_path: Path) -> None:
+    """`--out S_lin.lp` (a file) had been told "cannot write there (File exists: S_lin.lp);
+    choose a folder you can write to", as if it were a matter of permissions."""
+    lp = _acquisition(tmp_path / "acq")
+    a_file = tmp_path / "S_lin.lp"
+    a_file.write_text("12\n")
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp), "--out", str(a_file)])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2 and f"--out {a_file} is a file: give a folder" in text, text
+    assert a_file.read_text() == "12\n"
+    r = CliRunner().invoke(
+        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(a_file / "sub")]
+    )
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert f"--out {a_file / 'sub'}: {a_file} is a file, not a folder: give a folder" in text
