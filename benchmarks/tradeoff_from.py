@@ -86,6 +86,14 @@ def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return np.stack(images), np.stack(colour), dirs, [e.name for e in entries]
 
 
+def check_acquisition(lp: Path) -> None:
+    """Refuse ``lp`` by name, as :func:`load_acquisition_colour` would, without reading the
+    pixels: for the command to say it before it creates its ``--out`` folder."""
+    from rti_rig.core.lp_format import read_lp
+
+    _image_files(lp, read_lp(lp, upper_hemisphere=True))
+
+
 def _image_files(lp: Path, entries: list[Any]) -> list[Path]:
     """The image file of every line of ``lp``, checked as ``run ACQ/dirs.lp`` checks them
     (found, whole, readable, one size and one kind) before minutes of work.

@@ -157,7 +157,7 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
     import time
 
     from benchmarks.tradeoff import TradeoffSettings, plot, run_tradeoff, summarise, write_csv
-    from benchmarks.tradeoff_from import bench_from
+    from benchmarks.tradeoff_from import bench_from, check_acquisition
 
     if from_lp is not None and quick:  # accepted and ignored, it had changed nothing
         raise fail(
@@ -166,6 +166,14 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
                 "your acquisition): drop --quick"
             )
         )
+    if from_lp is not None:
+        # its images before the --out folder is made: a refused acquisition had left an
+        # empty --out folder behind
+        try:
+            from_lp = _acquisition_lp(from_lp)
+            check_acquisition(from_lp)
+        except RtiRigError as exc:
+            raise fail(exc) from None
     if out_dir is not None:  # before minutes of computing, not after
         try:
             _check_out_folder(out_dir, force)
@@ -173,7 +181,6 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
             raise fail(exc) from None
     if from_lp is not None:
         try:
-            from_lp = _acquisition_lp(from_lp)
             text = bench_from(
                 from_lp, out_dir, lambda msg: out.print(msg, highlight=False), force=force
             )
