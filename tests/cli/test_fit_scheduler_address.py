@@ -1,31 +1,133 @@
-"""`rti-rig fit --scheduler` with a malformed address: refused at once, no traceback.
+"""`rti-rig fit --scheduler` with an address it cannot use: refused in words, in bounded time,
+no traceback.
 
-A Client built on 'bogus' raised ValueError (turned into a clear error), but the half-built
-Client then waited 40 s in its __del__ and printed "Exception ignored ... Traceback ...
-TimeoutError" after it.
+A Client built on 'bogus' (or on http://…, a scheme Dask has no transport for) raised
+ValueError (turned into a clear error), but the half-built Client then waited 40 s in its
+__del__ and printed "Exception ignored ... Traceback ... TimeoutError" after it. A port that
+accepts the connection and never answers held the fit for ever: Dask's handshake read its
+reply without the connect timeout.
 """
 
 from __future__ import annotations
 
+import socket
 import subprocess
 import sys
+import threading
+from collections.abc import Iterator
 from pathlib import Path
+
+import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
 RTI_RIG = [sys.executable, "-c", "from rti_rig.cli import main; main()"]
+#: Seconds the CLI waits for the scheduler in these tests (the user's default is 20 s).
+CONNECT_S = 3
+#: ``rti-rig`` with that wait: the module constant set before the CLI runs.
+RTI_RIG_SHORT_WAIT = [
+    sys.executable,
+    "-c",
+    "from rti_rig.app.usecases import fit_dask; "
+    f"fit_dask.CONNECT_TIMEOUT_S = {CONNECT_S}.0; "
+    "from rti_rig.cli import main; main()",
+]
+#: Far above CONNECT_S plus importing Dask on a loaded machine; far below "for ever" (and the
+#: 40 s a half-built Client waited in its __del__ is caught by its traceback on stderr).
+BOUND_S = 150
+
+
+def _fit(command: list[str], scheduler: str, out: Path) -> subprocess.CompletedProcess[str]:
+    """``rti-rig fit ACQ --out OUT --scheduler SCHEDULER --no-qa``, failing the test if it does
+    not end within :data:`BOUND_S`."""
+    args = [*command, "fit", str(ACQ), "--out", str(out), "--scheduler", scheduler, "--no-qa"]
+    try:
+        return subprocess.run(args, capture_output=True, text=True, timeout=BOUND_S)
+    except subprocess.TimeoutExpired as exc:
+        pytest.fail(f"--scheduler {scheduler} still running after {BOUND_S} s: {exc.stderr!r}")
+
+
+def _no_traceback(text: str) -> None:
+    assert "Traceback" not in text and "Exception ignored" not in text, text
 
 
 def test_a_malformed_scheduler_address_is_refused_cleanly(tmp_path: Path) -> None:
     out = tmp_path / "fit"
-    r = subprocess.run(
-        [*RTI_RIG, "fit", str(ACQ), "--out", str(out), "--scheduler", "bogus", "--no-qa"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    r = _fit(RTI_RIG, "bogus", out)
     text = r.stdout + r.stderr
     assert r.returncode == 2, text
-    assert "Traceback" not in text and "Exception ignored" not in text, text
+    _no_traceback(text)
     assert "bogus" in text and "tcp://HOST:8786" in text
+    assert not out.exists()
+
+
+def test_an_address_dask_has_no_transport_for_is_refused_naming_the_accepted_ones(
+    tmp_path: Path,
+) -> None:
+    out = tmp_path / "fit"
+    r = _fit(RTI_RIG, "http://127.0.0.1:8786", out)
+    text = r.stdout + r.stderr
+    assert r.returncode == 2, text
+    _no_traceback(text)
+    assert "'http://127.0.0.1:8786'" in text and "no transport for http://" in text, text
+    assert "tcp://" in text and "inproc://" in text, text  # the schemes it accepts
+    assert "dask worker http" not in text, text  # no advice to start workers on it
+    assert not out.exists()
+
+
+@pytest.fixture
+def silent_port() -> Iterator[int]:
+    """A local port whose server accepts every connection and never sends a byte."""
+    server = socket.create_server(("127.0.0.1", 0))
+    held: list[socket.socket] = []
+
+    def accept() -> None:
+        while True:
+            try:
+                held.append(server.accept()[0])
+            except OSError:  # the listening socket was shut down: the test is over
+                return
+
+    thread = threading.Thread(target=accept, name="silent-scheduler", daemon=True)
+    thread.start()
+    try:
+        yield server.getsockname()[1]
+    finally:
+        server.shutdown(socket.SHUT_RDWR)  # wakes the accept() (Linux)
+        server.close()
+        thread.join(timeout=30)
+        for conn in held:
+            conn.close()
+
+
+def test_a_port_that_accepts_but_never_answers_is_unreachable_within_the_timeout(
+    tmp_path: Path, silent_port: int
+) -> None:
+    address = f"tcp://127.0.0.1:{silent_port}"
+    out = tmp_path / "fit"
+    r = _fit(RTI_RIG_SHORT_WAIT, address, out)
+    text = r.stdout + r.stderr
+    assert r.returncode == 2, text
+    _no_traceback(text)
+    assert f"cannot reach the Dask scheduler at '{address}'" in text, text
+    assert f"within {CONNECT_S} s" in text and "not a Dask scheduler" in text, text
+    assert f"dask worker {address}" in text and "same paths" in text, text
+    assert not out.exists()
+
+
+def test_a_workers_address_is_refused_as_not_a_scheduler(tmp_path: Path) -> None:
+    """A worker answers Dask's handshake too: the Client built on it failed with a TypeError,
+    then hung 40 s in its __del__ and printed a traceback."""
+    from distributed import LocalCluster
+
+    out = tmp_path / "fit"
+    with LocalCluster(
+        n_workers=1, processes=False, protocol="tcp", dashboard_address=None
+    ) as cluster:
+        worker = next(iter(cluster.scheduler_info["workers"]))
+        r = _fit(RTI_RIG_SHORT_WAIT, worker, out)
+    text = r.stdout + r.stderr
+    assert r.returncode == 2, text
+    _no_traceback(text)
+    assert f"'{worker}' answers as a Dask Worker, not a scheduler" in text, text
     assert not out.exists()

@@ -175,19 +175,27 @@ def _unreachable(address: str, what: str, kept: str) -> str:
     )
 
 
-@contextmanager
-def scheduler_client(address: str) -> Iterator[Any]:
-    """A ``distributed.Client`` connected to ``address`` (closed afterwards), or None for
-    :data:`THREADS`. Refuses clearly when the scheduler does not answer or has no workers."""
-    if address == THREADS:
-        yield None
-        return
-    from distributed import Client
+def _unreachable_scheduler(address: str, why: str) -> SchedulerError:
+    """What is said of a scheduler that cannot be connected to (``why``: what happened)."""
+    return SchedulerError(
+        f"cannot reach the Dask scheduler at {address!r} ({why}). "
+        f"Start one with `dask scheduler` and workers with `dask worker {address}` — "
+        f"{SHARED_PATHS} — or leave out --scheduler to fit in this process."
+    )
+
+
+def _checked_address(address: str) -> str:
+    """``address``'s scheme, once Dask can parse the address and has a transport for it.
+
+    Why: a Client built on an address Dask cannot use raised ValueError (said clearly), but the
+    half-built Client then waited 40 s in its ``__del__`` and printed an "Exception ignored …
+    TimeoutError" traceback after the error; an ``http://`` address was also advised as the
+    one to start workers with."""
     from distributed.comm import parse_address
     from distributed.comm.addressing import parse_host_port
+    from distributed.comm.registry import backends, get_backend
 
-    try:  # before a Client exists: one built on a bad address hangs 40 s in its __del__ and
-        # prints an "Exception ignored" traceback after the error
+    try:
         scheme, location = parse_address(address)
         if scheme in ("tcp", "tls", "ws", "wss"):
             parse_host_port(location)
@@ -197,13 +205,84 @@ def scheduler_client(address: str) -> Iterator[Any]:
             f"'{THREADS}' or an address such as tcp://HOST:8786"
         ) from None
     try:
+        get_backend(scheme)  # the transports Dask ships, then any a package registers
+    except (ValueError, ImportError) as exc:
+        known = ", ".join(f"{s}://" for s in sorted(backends))
+        raise SchedulerError(
+            f"--scheduler {address!r} is not a Dask scheduler address: Dask has no transport "
+            f"for {scheme}:// ({type(exc).__name__}), it accepts {known}. Give '{THREADS}' or "
+            "the address `dask scheduler` prints, such as tcp://HOST:8786"
+        ) from None
+    return scheme
+
+
+async def _identity(address: str, timeout: float, connection_args: dict[str, Any]) -> Any:
+    """The scheduler's answer to Dask's ``identity`` request (a connection, its handshake, one
+    request and its reply)."""
+    from distributed.comm import connect
+
+    comm = await connect(address, timeout=timeout, **connection_args)
+    try:
+        await comm.write({"op": "identity", "reply": True})
+        return await comm.read()
+    finally:
+        comm.abort()
+
+
+def _probe(address: str, timeout: float) -> None:
+    """Return once the scheduler at ``address`` answers, within ``timeout`` seconds in all.
+
+    Why: ``Client(address, timeout=…)`` bounds only the TCP connect; Dask's handshake then
+    reads the first reply without a bound, so a port that accepts the connection and never
+    answers (a proxy, a service that is not Dask, a hung scheduler) held ``rti-rig fit`` for
+    ever, and its Ctrl-C left a half-built Client waiting 40 s in ``__del__``. No Client is
+    built before this answers."""
+    import asyncio
+
+    from distributed.security import Security
+
+    args = Security().get_connection_args("client")  # as the Client's own (tls:// from config)
+
+    async def bounded() -> Any:
+        return await asyncio.wait_for(_identity(address, timeout, args), timeout)
+
+    try:
+        identity = asyncio.run(bounded())
+    except TimeoutError:  # asyncio's is the builtin's since 3.11; Dask's own names the address
+        raise _unreachable_scheduler(
+            address,
+            f"no Dask scheduler answered within {timeout:.0f} s: nothing listens there, a "
+            "firewall drops the connection, or what accepts it is not a Dask scheduler",
+        ) from None
+    except Exception as exc:  # refused, reset, a TLS failure, a reply that is not Dask's
+        raise _unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
+    if not (isinstance(identity, dict) and "workers" in identity):
+        # e.g. a worker's or nanny's address: it answers, then the Client built on it failed
+        # with a TypeError and hung 40 s in its __del__, printing a traceback
+        what = identity.get("type", "server") if isinstance(identity, dict) else "server"
+        raise SchedulerError(
+            f"--scheduler {address!r} answers as a Dask {what}, not a scheduler: give the "
+            "address `dask scheduler` prints (the one its workers were started with), such as "
+            "tcp://HOST:8786"
+        )
+
+
+@contextmanager
+def scheduler_client(address: str) -> Iterator[Any]:
+    """A ``distributed.Client`` connected to ``address`` (closed afterwards), or None for
+    :data:`THREADS`. Refuses clearly when the scheduler does not answer within
+    :data:`CONNECT_TIMEOUT_S` or has no workers within :data:`WORKERS_TIMEOUT_S`."""
+    if address == THREADS:
+        yield None
+        return
+    from distributed import Client
+
+    if _checked_address(address) != "inproc":  # in this process: nothing there can hang
+        _probe(address, CONNECT_TIMEOUT_S)
+    try:
         client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
-        raise SchedulerError(
-            f"cannot reach the Dask scheduler at {address!r} ({type(exc).__name__}: {exc}). "
-            f"Start one with `dask scheduler` and workers with `dask worker {address}` — "
-            f"{SHARED_PATHS} — or leave out --scheduler to fit in this process."
-        ) from None
+        raise _unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
     try:
         try:
             client.wait_for_workers(1, timeout=WORKERS_TIMEOUT_S)
