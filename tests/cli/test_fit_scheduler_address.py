@@ -10,6 +10,7 @@ reply without the connect timeout.
 
 from __future__ import annotations
 
+import signal
 import socket
 import subprocess
 import sys
@@ -75,35 +76,47 @@ def test_an_address_dask_has_no_transport_for_is_refused_naming_the_accepted_one
     assert not out.exists()
 
 
-@pytest.fixture
-def silent_port() -> Iterator[int]:
-    """A local port whose server accepts every connection and never sends a byte."""
-    server = socket.create_server(("127.0.0.1", 0))
-    held: list[socket.socket] = []
+class SilentServer:
+    """A local port whose server accepts every connection and never sends a byte; ``accepted``
+    is set once it has accepted one."""
 
-    def accept() -> None:
+    def __init__(self) -> None:
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port: int = self.server.getsockname()[1]
+        self.accepted = threading.Event()
+        self.held: list[socket.socket] = []
+        self.thread = threading.Thread(target=self._accept, name="silent-scheduler", daemon=True)
+        self.thread.start()
+
+    def _accept(self) -> None:
         while True:
             try:
-                held.append(server.accept()[0])
+                self.held.append(self.server.accept()[0])
             except OSError:  # the listening socket was shut down: the test is over
                 return
+            self.accepted.set()
 
-    thread = threading.Thread(target=accept, name="silent-scheduler", daemon=True)
-    thread.start()
-    try:
-        yield server.getsockname()[1]
-    finally:
-        server.shutdown(socket.SHUT_RDWR)  # wakes the accept() (Linux)
-        server.close()
-        thread.join(timeout=30)
-        for conn in held:
+    def close(self) -> None:
+        self.server.shutdown(socket.SHUT_RDWR)  # wakes the accept() (Linux)
+        self.server.close()
+        self.thread.join(timeout=30)
+        for conn in self.held:
             conn.close()
 
 
+@pytest.fixture
+def silent() -> Iterator[SilentServer]:
+    server = SilentServer()
+    try:
+        yield server
+    finally:
+        server.close()
+
+
 def test_a_port_that_accepts_but_never_answers_is_unreachable_within_the_timeout(
-    tmp_path: Path, silent_port: int
+    tmp_path: Path, silent: SilentServer
 ) -> None:
-    address = f"tcp://127.0.0.1:{silent_port}"
+    address = f"tcp://127.0.0.1:{silent.port}"
     out = tmp_path / "fit"
     r = _fit(RTI_RIG_SHORT_WAIT, address, out)
     text = r.stdout + r.stderr
@@ -112,6 +125,31 @@ def test_a_port_that_accepts_but_never_answers_is_unreachable_within_the_timeout
     assert f"cannot reach the Dask scheduler at '{address}'" in text, text
     assert f"within {CONNECT_S} s" in text and "not a Dask scheduler" in text, text
     assert f"dask worker {address}" in text and "same paths" in text, text
+    assert not out.exists()
+
+
+def test_ctrl_c_while_a_silent_port_is_waited_on_exits_at_once_without_a_traceback(
+    tmp_path: Path, silent: SilentServer
+) -> None:
+    """Ctrl-C said "Stopped (Ctrl-C) …", then the half-built Client waited 40 s in its
+    __del__ and printed "Exception ignored … TimeoutError"."""
+    out = tmp_path / "fit"
+    args = ["fit", str(ACQ), "--out", str(out), "--scheduler", f"tcp://127.0.0.1:{silent.port}"]
+    proc = subprocess.Popen(  # the default 20 s wait: Ctrl-C comes first
+        [*RTI_RIG, *args, "--no-qa"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        assert silent.accepted.wait(timeout=BOUND_S), "rti-rig fit never connected"
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=BOUND_S)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    text = stdout + stderr
+    assert proc.returncode == 130, text
+    _no_traceback(text)
+    assert "Stopped (Ctrl-C)" in text, text
     assert not out.exists()
 
 
