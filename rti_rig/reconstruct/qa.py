@@ -24,6 +24,9 @@ Run before the object leaves the dome. The checks (all on linear images):
     sub-pixel), confirmed by the image moved back fitting better: the object or the camera
     moved (judged on images lighting at least :data:`DRIFT_MIN_LIT` of the crop).
 
+* **exposure against its elevation**: the frame's mean level over the images lit from its
+  light's elevation (:mod:`~rti_rig.reconstruct.qa_exposure`): no fit, which on a glossy
+  object of few lights takes a halved or doubled image in.
 * **coverage**: per pixel (on a ≤ :data:`COVERAGE_SIDE` grid) the number of images that light
   it without shadow or saturation; fewer than 3 cannot determine a normal.
 * **expected normal error**: ``(sigma / rho) sqrt(tr(P (L^T L)^-1 P))`` per pixel over its lit
@@ -62,6 +65,12 @@ from rti_rig.reconstruct.qa_drift import (
     move_back,
     step_candidates,
     still_spread_px,
+)
+from rti_rig.reconstruct.qa_exposure import (
+    EXPOSURE_MATE_DEG,
+    EXPOSURE_OFF,
+    exposure_off,
+    exposure_ratios,
 )
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
@@ -206,6 +215,15 @@ LIGHT_SCATTER_Z = 3.5
 MOVED_FROM = "object or camera moved from"
 #: The bright-image check's words, found by :meth:`QAReport.explain_bright_by_lights`.
 BRIGHTER = "brighter than the other images predict"
+#: The exposure check's words (:mod:`~rti_rig.reconstruct.qa_exposure`): "about N× too bright
+#: for its light" is a bright image too, which a dome's uneven LEDs can explain.
+TOO_BRIGHT = "too bright for its light"
+TOO_DARK = "too dark for its light"
+
+
+def _bright_problem(p: str) -> bool:
+    """A problem that says the image is brighter than predicted (either check's words)."""
+    return p.endswith(BRIGHTER) or TOO_BRIGHT in p
 
 
 @dataclass(frozen=True)
@@ -255,6 +273,11 @@ class ImageCheck:
     #: (:data:`RELIABLE_RESIDUAL`); NaN where too few of them are lit. The misfired/dim check
     #: needs it below :data:`DIM_GAIN` too, where measured.
     reliable_gain: float = float("nan")
+    #: The image's mean level over the median of the images lit from within
+    #: :data:`~rti_rig.reconstruct.qa_exposure.EXPOSURE_MATE_DEG` of its elevation
+    #: (:func:`~rti_rig.reconstruct.qa_exposure.exposure_ratios`); NaN where fewer than 2 such
+    #: images, or they disagree among themselves. :data:`EXPOSURE_OFF` either way names it.
+    exposure_ratio: float = float("nan")
 
 
 #: The saturation check's advice (replaced where a session cannot follow it).
@@ -413,7 +436,7 @@ class QAReport:
         return [
             c
             for c in self.images
-            if c.within_light_scatter and any(p.endswith(BRIGHTER) for p in c.problems)
+            if c.within_light_scatter and any(_bright_problem(p) for p in c.problems)
         ]
 
     def explain_bright_by_lights(self, note: str, only: set[int] | None = None) -> QAReport:
@@ -430,7 +453,7 @@ class QAReport:
         if not explained:
             return self
         images = tuple(
-            replace(c, problems=tuple(p for p in c.problems if not p.endswith(BRIGHTER)))
+            replace(c, problems=tuple(p for p in c.problems if not _bright_problem(p)))
             if c.index in explained
             else c
             for c in self.images
@@ -1261,6 +1284,17 @@ def assess(
         ev = _dim_rejudged(ev, crop_arr, lt, keep & ~ev.dim, sat_level, evidence_of)
     light_scatter, within_scatter = _light_scatter(ev.gain, ev.misfit)
     bright_as_mates = _bright_as_its_elevation(ev.gain, lt)
+    # the whole frame's mean level against the images lit from its elevation: a fit of the
+    # session can take a halved or doubled image of a glossy object in (qa_exposure)
+    # (a clipped image's level is a lower bound: no mate, and never "too dark")
+    wrong_judged = ev.wrong & ev.direction_judged
+    clipped = sat_frac > SATURATED_LIMIT
+    exposure, mates = exposure_ratios(
+        small.reshape(n, -1).mean(axis=1, dtype=np.float64),
+        lt,
+        ~ev.dim & ~wrong_judged & ~clipped,
+    )
+    exposure[clipped & (exposure < 1.0)] = np.nan
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []
@@ -1309,6 +1343,14 @@ def assess(
             # only where the image is a rendering at all: a glossy object's highlight makes it
             # brighter with its light and exposure right (said in the caveats instead)
             problems.append(f"{ev.gain[i]:.1f}× {BRIGHTER}")
+        if (
+            exposure_off(exposure[i])
+            and not all_black
+            and not ev.dim[i]
+            and not wrong_i
+            and not any(_bright_problem(p) for p in problems)
+        ):
+            problems.append(_exposure_words(float(exposure[i]), int(mates[i])))
         if all_black and not any(p.startswith("misfired") for p in problems):
             problems = [p for p in problems if not p.endswith(BRIGHTER)]  # of nothing
             problems.append(
@@ -1363,6 +1405,7 @@ def assess(
                     bright_as_mates[i] and _bright(float(ev.gain[i]), float(sat_frac[i]))
                 ),
                 reliable_gain=float(ev.reliable_gain[i]),
+                exposure_ratio=float(exposure[i]),
             )
         )
     flagged = {c.index for c in checks if c.problems}
@@ -1393,6 +1436,8 @@ def assess(
         "neighbour_count": NEIGHBOUR_COUNT,
         "neighbour_span_deg": NEIGHBOUR_SPAN_DEG,
         "min_coverage": MIN_COVERAGE,
+        "exposure_off": EXPOSURE_OFF,
+        "exposure_mate_deg": EXPOSURE_MATE_DEG,
     }
     return QAReport(
         tuple(checks),
@@ -1411,6 +1456,21 @@ def assess(
         shift_note=shift_note,
         light_scatter=light_scatter,
         crop=(rs.start, cs.start, rs.stop - rs.start, cs.stop - cs.start),
+    )
+
+
+def _exposure_words(ratio: float, mates: int) -> str:
+    """What the exposure check says of an image ``ratio`` times as bright as its ``mates``
+    (:func:`~rti_rig.reconstruct.qa_exposure.exposure_ratios`)."""
+    lit = f"the {mates} images lit from within {EXPOSURE_MATE_DEG:.0f}° of its elevation"
+    if ratio > 1.0:
+        return (
+            f"about {ratio:.1f}× {TOO_BRIGHT}: {lit} are that much darker (a stray flash, or "
+            "the exposure changed: auto-exposure left on?)"
+        )
+    return (
+        f"about {1.0 / ratio:.1f}× {TOO_DARK}: {lit} are that much brighter (a flash or LED "
+        "at part power, or the exposure changed: auto-exposure left on?)"
     )
 
 
