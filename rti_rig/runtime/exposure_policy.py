@@ -98,17 +98,43 @@ def representable_s(camera: object, exposure_s: float) -> float:
     return float(steps(exposure_s)) if steps is not None else exposure_s
 
 
-def metering_start_s(camera: object, exposure_s: float) -> float:
-    """Where the metering starts from ``[camera] exposure_s``: rounded down to an exposure the
-    camera takes exactly (:func:`representable_s`), and no shorter than the shortest it takes
-    (a UVC camera's ``shortest_exposure_s``, its ``[camera.device] min_exposure_s``).
+def metering_start(camera: object, exposure_s: float) -> tuple[float, str | None]:
+    """Where the metering starts from ``[camera] exposure_s``, and what was changed to get
+    there (None: nothing but the rounding to the camera's units): rounded down to an exposure
+    the camera takes exactly (:func:`representable_s`), no shorter than the shortest it takes
+    (a UVC camera's ``shortest_exposure_s``, its ``[camera.device] min_exposure_s``) and no
+    longer than the longest (its ``longest_exposure_s``: ``[camera.device] max_exposure_s`` or
+    the frame period, known once connected).
 
     Why: exposure_s is only a start for ``run --auto-exposure``; one under the device's
-    minimum stopped the run at the metering's first test shot. Also what ``rti-rig check
-    --auto-exposure`` judges."""
+    minimum stopped the run at the metering's first test shot, and one over its maximum was
+    refused before any LED lit, while the docs say it "is only where the metering starts".
+    Also what ``rti-rig check --auto-exposure`` judges."""
     start = representable_s(camera, exposure_s)
     shortest = getattr(camera, "shortest_exposure_s", None)
-    return max(start, shortest()[0]) if callable(shortest) else start
+    low = shortest() if callable(shortest) else None
+    longest = getattr(camera, "longest_exposure_s", None)
+    high = longest() if callable(longest) else None
+    if high is not None:
+        cap = representable_s(camera, high[0])
+        if start > cap * (1 + 1e-9):
+            return cap, (
+                f"[camera] exposure_s = {exposure_s:g} s is longer than the camera "
+                f"{getattr(camera, 'name', 'camera')} can take ({high[1]}): the metering "
+                f"started at {cap:g} s instead"
+            )
+    if low is not None and start < low[0] * (1 - 1e-9):
+        return low[0], (
+            f"[camera] exposure_s = {exposure_s:g} s is shorter than the camera "
+            f"{getattr(camera, 'name', 'camera')} can take ({low[1]}): the metering started "
+            f"at {low[0]:g} s instead"
+        )
+    return start, None
+
+
+def metering_start_s(camera: object, exposure_s: float) -> float:
+    """The start of :func:`metering_start` alone (for callers that do not say it)."""
+    return metering_start(camera, exposure_s)[0]
 
 
 def metering_steps(schedule: LightSchedule, count: int = 1) -> list[int]:

@@ -335,6 +335,7 @@ def fix_exposure(
         Recheck,
         exposure_steps,
         fix_session_exposure,
+        metering_start,
         metering_steps,
         representable_s,
     )
@@ -409,12 +410,17 @@ def fix_exposure(
     def meter(camera, start_s: float):  # type: ignore[no-untyped-def]
         shutter = getattr(camera, "available_exposures_s", None)
         ruled = camera_rule(camera)
+        if not callable(shutter):
+            # a start moved into the camera's range is said (it had been refused above it)
+            moved = metering_start(camera, cam.exposure_s)[1]
+            if moved is not None:
+                on_note(Note(moved))
         return meter_exposure(
             camera,
             ruled,
-            # [camera] exposure_s is only where the metering starts: one under the camera's
-            # shortest starts at that (the camera refuses it)
-            max(start_s, ruled.min_exposure_s),
+            # [camera] exposure_s is only where the metering starts: one outside what the
+            # camera takes starts at its nearest end (the camera refuses it)
+            min(max(start_s, ruled.min_exposure_s), ruled.max_exposure_s),
             shutter() if shutter else None,
             quantise=exposure_steps(camera),
         )

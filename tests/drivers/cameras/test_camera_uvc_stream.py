@@ -474,3 +474,37 @@ def test_an_exposure_under_the_devices_min_exposure_s_is_refused_before_any_led_
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and "RESULT: FAIL" in said, said
     assert "shorter than the camera's min_exposure_s = 0.00045 s" in said, said
+
+
+@pytest.mark.pty
+def test_a_metering_start_above_the_devices_max_exposure_s_is_lowered_to_it(tmp_path, monkeypatch):
+    """`run --auto-exposure` with `[camera] exposure_s = 0.05` and `[camera.device]
+    max_exposure_s = 0.02`: exposure_s is only where the metering starts (docs/cameras.md), and
+    a start under the device's minimum was raised to it, but one above its maximum was refused
+    ("longer than the camera's max_exposure_s"), exit 2. The start is now lowered to the
+    device's longest, the run says so, and `rti-rig check --auto-exposure` passes the rig."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    cfg.write_text(
+        cfg.read_text().replace('kind = "opencv"\n', 'kind = "opencv"\nmax_exposure_s = 0.02\n')
+    )
+    light = LightHistory(SystemClock())  # type: ignore[arg-type]
+    light.set(1.0)
+    stream = BufferedUvcStream(light, fps=20.0)
+    code, said, out, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
+    assert "longer than the camera's max_exposure_s" not in said and "Traceback" not in said
+    assert "the metering started at 0.02 s" in said, said
+    assert "max_exposure_s = 0.02 s in [camera.device]" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    shots = manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
+    assert max(t for s in shots for t in s) <= 0.02 + 1e-9, shots
+    assert all(s["exposure_s"] <= 0.02 + 1e-9 for s in manifest["steps"])
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["check", str(cfg), "--auto-exposure"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "RESULT: PASS" in said, said
+    # without --auto-exposure exposure_s is the exposure itself: still refused, naming the key
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "longer than the camera's max_exposure_s = 0.02 s" in said, said
