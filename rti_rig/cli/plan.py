@@ -123,8 +123,8 @@ def plan(
             "through the object, e.g. one ring of low lights for a relightable PTM/HSH, or "
             "bunched at the zenith) with a warning, in place of the refusal. rti-rig fit then "
             "writes no normal maps, and its relighting files are ridge-regularised guesses "
-            "along the direction the lights miss; run the plan with rti-rig run --plan PLAN.lp "
-            "--allow-no-normals.",
+            "along the direction the lights miss; run the plan with rti-rig run RIG.toml --plan "
+            "PLAN.lp --out DIR --allow-no-normals (the warning names your rig and plan).",
         ),
     ] = False,
 ) -> None:

@@ -95,7 +95,8 @@ def test_allow_no_normals_plans_a_horizon_ring_saying_so(tmp_path: Path, objecti
     assert "the 12 planned lights cannot determine a surface normal" in said
     assert "planned as asked (--allow-no-normals)" in said
     assert "along the direction the lights do not span, their relighting is a guess" in said
-    assert f"rti-rig run --plan {out} --allow-no-normals" in said
+    # a bare .lp rig is no config `run` takes: RIG.toml stands for it
+    assert f"rti-rig run RIG.toml --plan {out} --out DIR --allow-no-normals" in said
     assert len(read_lp(out)) == 12
 
 
@@ -105,3 +106,41 @@ def test_allow_no_normals_is_silent_where_the_lights_determine_normals(tmp_path:
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert "cannot determine" not in said and "--allow-no-normals" not in said
+
+
+def test_the_advised_run_command_names_the_rig_and_plan_and_runs(tmp_path: Path) -> None:
+    """The warning advised `rti-rig run --plan PLAN.lp --allow-no-normals`, which `run`
+    refuses ("give a RIG_CONFIG and --out DIR"). It now names the rig config given to `plan`
+    and the plan written, shell-quoted, and the command it gives runs the plan."""
+    import shlex
+
+    from conftest import CONFIGS
+
+    text = (CONFIGS / "simulated_dome.toml").read_text()
+    start, end = text.index("rings = ["), text.index("]\n", text.index("rings = [")) + 2
+    ring = "rings = [{ elevation_deg = 0.0, count = 20, azimuth_offset_deg = 0.0 }]\n"
+    folder = tmp_path / "my rigs"
+    folder.mkdir()
+    rig, plan_file = folder / "raking ring.toml", folder / "raking plan.lp"
+    rig.write_text(text[:start] + ring + text[end:])
+    r = CliRunner().invoke(
+        app,
+        [
+            *("plan", "--rig", str(rig), "--lights", "6", "--objective", "relight"),
+            *("--out", str(plan_file), "--allow-no-normals"),
+        ],
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    advised = said[
+        said.index("rti-rig run ") : said.index("--allow-no-normals", said.index("rti-rig run "))
+        + len("--allow-no-normals")
+    ]
+    assert advised == (
+        f"rti-rig run {shlex.quote(str(rig))} --plan {shlex.quote(str(plan_file))} --out DIR "
+        "--allow-no-normals"
+    ), advised
+    args = [str(tmp_path / "s") if a == "DIR" else a for a in shlex.split(advised)[1:]]
+    r = CliRunner().invoke(app, [*args, "--no-verdict"])
+    assert r.exit_code == 0, " ".join(r.output.split())
+    assert len(read_lp(tmp_path / "s" / "lights.lp")) == 6

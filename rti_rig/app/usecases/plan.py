@@ -9,6 +9,7 @@ meaning "a dome with exactly these lights".
 
 from __future__ import annotations
 
+import shlex
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -240,8 +241,19 @@ def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: li
     if reason is not None:
         notes.append(
             f"{reason}; planned as asked (--allow-no-normals): {FIT_WITHOUT_NORMALS}; run it "
-            f"with rti-rig run --plan {req.out_file} --allow-no-normals"
+            f"with {run_plan_command(req.rig, req.out_file)}"
         )
+
+
+def run_plan_command(rig: Path, plan_file: Path) -> str:
+    """The ``rti-rig run`` command line that runs ``plan_file`` on ``rig`` with
+    ``--allow-no-normals``: the rig config given to ``plan`` (a bare ``.lp`` rig is no config:
+    ``RIG.toml`` stands for the one whose lights it lists), the plan, and ``--out DIR``.
+
+    Why: the advice had been ``rti-rig run --plan PLAN.lp --allow-no-normals``, which ``run``
+    refuses ("give a RIG_CONFIG and --out DIR")."""
+    config = "RIG.toml" if Path(rig).suffix.lower() == ".lp" else shlex.quote(str(rig))
+    return f"rti-rig run {config} --plan {shlex.quote(str(plan_file))} --out DIR --allow-no-normals"
 
 
 def _lp_labels(labels: list[str]) -> list[str]:
