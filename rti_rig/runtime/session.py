@@ -66,6 +66,7 @@ from rti_rig.core.image_files import (
 )
 from rti_rig.core.lp_format import LpEntry, format_lp
 from rti_rig.runtime.deferred_signals import signals_deferred
+from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 
 MANIFEST = "manifest.json"
 JOURNAL = "journal.jsonl"
@@ -2809,21 +2810,17 @@ def _unwritten_line_note(root: Path, stem: str) -> str:
     )
 
 
-def list_unwritten_step(root: Path, scan: JournalScan | None = None) -> str | None:
-    """Make session ``root``'s ``lights.lp`` list the step its run committed by the record file
-    and stopped before journaling (:func:`stopped_before_journal_line`), when ``lights.lp`` is
-    exactly what that run wrote at its previous commit; returns what was done or why it could
-    not be (None when there was nothing to do). ``scan``: the journal's, when the caller holds
-    it (read here otherwise).
+def unwritten_step(
+    root: Path, scan: JournalScan | None = None
+) -> tuple[list[LpEntry], LpEntry, str] | None:
+    """What :func:`list_unwritten_step` would complete, without writing anything: the
+    ``lights.lp`` entries the run wrote at its previous commit, the entry of the step it
+    committed by the record file and stopped before journaling, and that step's stem; None
+    when there is nothing to complete (or ``lights.lp`` is not exactly the run's own listing).
 
-    Why: a run writes ``lights.lp`` after the journal line, so a kill between the record file
-    and the line left it one image short of what the session holds: ``export-lp`` (and a
-    resume, which keeps the image) listed it, ``fit`` fitted one image fewer, and relight and
-    RTIBuilder, which read ``lights.lp``, left it out. The rewrite is atomic, under the
-    session's lock, and only completes the run's own listing with the line the run was about
-    to write: a ``lights.lp`` edited by hand, or behind for any other reason, is left as it is
-    (the verdict names it). A session stopped before its first journal line has no
-    ``lights.lp`` to complete (``fit`` says so; the resume writes one)."""
+    Why: ``fit`` reads the completed listing before it may write anything, and completes the
+    file itself only once all its refusals have passed (it had rewritten ``lights.lp`` of a
+    session it then refused, a disowned one included)."""
     root = Path(root)
     path = root / LP_NAME
     if not (root / JOURNAL).is_file() or not path.is_file():
@@ -2843,34 +2840,64 @@ def list_unwritten_step(root: Path, scan: JournalScan | None = None) -> str | No
     earlier = [_to_record(r) for _, r in sorted(_latest_records(journaled).items())]
     before = [LpEntry(r.image, r.actual_direction) for r in earlier]
     unwritten = _to_record(last)
+    try:
+        if path.read_bytes() != format_lp(before).encode("ascii"):
+            return None  # not the run's own listing: edited since, or behind otherwise
+    except OSError:
+        return None
+    return before, LpEntry(unwritten.image, unwritten.actual_direction), stem
+
+
+def list_unwritten_step(root: Path, scan: JournalScan | None = None) -> str | None:
+    """Make session ``root``'s ``lights.lp`` list the step its run committed by the record file
+    and stopped before journaling (:func:`stopped_before_journal_line`), when ``lights.lp`` is
+    exactly what that run wrote at its previous commit; returns what was done or why it could
+    not be (None when there was nothing to do). ``scan``: the journal's, when the caller holds
+    it (read here otherwise). Call it only once the command's own refusals have passed.
+
+    Why: a run writes ``lights.lp`` after the journal line, so a kill between the record file
+    and the line left it one image short of what the session holds: ``export-lp`` (and a
+    resume, which keeps the image) listed it, ``fit`` fitted one image fewer, and relight and
+    RTIBuilder, which read ``lights.lp``, left it out. The rewrite is atomic, under the
+    session's lock, and only completes the run's own listing with the line the run was about
+    to write: a ``lights.lp`` edited by hand, or behind for any other reason, is left as it is
+    (the verdict names it). A session stopped before its first journal line has no
+    ``lights.lp`` to complete (``fit`` says so; the resume writes one). A disowned session
+    (:data:`rti_rig.runtime.disowned.MARKER`) is never rewritten: nothing in it is used."""
+    root = Path(root)
+    if (root / DISOWNED_MARKER).exists():
+        return None
+    path = root / LP_NAME
+    if unwritten_step(root, scan) is None:
+        return None
     held = str(root.resolve()) in _LOCKED
     try:
         lock_session(root)  # a run or resume begun since: its lights.lp is its own
     except SessionError:
         return None
     try:
-        try:
-            if path.read_bytes() != format_lp(before).encode("ascii"):
-                return None  # not the run's own listing: edited since, or behind otherwise
-        except OSError:
+        pending = unwritten_step(root, scan)  # again, under the lock
+        if pending is None:
             return None
+        before, entry, stem = pending
         try:
-            write_lp_atomic(path, [*before, LpEntry(unwritten.image, unwritten.actual_direction)])
+            write_lp_atomic(path, [*before, entry])
         except SessionWriteError as exc:
             return (
                 f"the run stopped after {stem}'s record file, before its journal line and "
-                f"before {LP_NAME} listed it; {LP_NAME} could not be rewritten to list it ({exc}): "
-                f"it lists {len(before)} of the session's {len(before) + 1} images; rti-rig run "
-                f"--resume {shlex.quote(str(root))} lists it, once the folder can be written"
+                f"before {LP_NAME} listed it; {LP_NAME} could not be rewritten to list it ({exc}) "
+                f"and still lacks {stem}; rti-rig run --resume {shlex.quote(str(root))} lists "
+                "it, once the folder can be written"
             )
     finally:
         if not held:
             unlock_session(root)
+    # nothing more is claimed: an image the session once held may be gone since (the export
+    # says so), so "lists the N images the session holds" had been untrue of it
     return (
-        f"{LP_NAME} now lists {stem} too: the run stopped after its record file, before its "
-        f"journal line and before {LP_NAME} listed it; its files are as that record says, so "
-        f"the image is kept, and {LP_NAME} lists the {len(before) + 1} images the session holds "
-        "(rewritten atomically, nothing else changed)"
+        f"{LP_NAME} now lists {stem} too (rewritten atomically, nothing else changed): the run "
+        f"committed {stem} by its record file and stopped before its journal line and before "
+        f"{LP_NAME} listed it"
     )
 
 

@@ -41,12 +41,15 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
+    LpEntry,
     case_hint,
     directions_of,
+    format_lp,
     image_file_name,
     image_paths,
     is_absolute_name,
     missing_images_advice,
+    parse_lp,
     read_lp,
 )
 from rti_rig.core.out_folders import ensure_writable_folder
@@ -73,6 +76,7 @@ from rti_rig.runtime.session import (
     renamed_since_capture,
     stopped_before_first_journal,
     unresumable,
+    unwritten_step,
 )
 
 #: What ``--model`` accepts besides the registered model names.
@@ -310,10 +314,6 @@ def acquisition_files(
     """The ``.lp`` of a session folder or ``.lp`` source, its lights (N, 3), the image file of
     each light (``linear/<stem>.tif`` when there, else the file the ``.lp`` names) and names."""
     refuse_if_in_use(source if source.is_dir() else source.parent, "fit")
-    if source.is_dir() or source.name == LP_NAME:  # a session's lights.lp, one image short
-        relisted = list_unwritten_step(source if source.is_dir() else source.parent)
-        if relisted is not None and notes is not None:
-            notes.append(relisted)
     if source.is_dir():
         lps = sorted(source.glob("*.lp"))
         if not lps:
@@ -392,7 +392,7 @@ def acquisition_files(
     else:
         raise FitInputError(f"{source}: give a session folder or an .lp file")
     refuse_if_disowned(lp.parent)  # a session whose labels a late slip check disowned
-    entries = read_lp(lp, upper_hemisphere=True, notes=notes)
+    entries = _listed_entries(lp, notes)
     lights = directions_of(entries)
     paths, names, stand_ins = [], [], []
     for e, listed in zip(entries, image_paths(lp, entries), strict=True):
@@ -492,7 +492,44 @@ def listed_image_files(source: Path) -> list[str]:
     """The file name of each image of an acquisition, in its ``.lp``'s order (the order of
     the fit's lights): what relight lists in the images' folder."""
     lp, _, _, _ = acquisition_files(source)
-    return [image_file_name(e.name) for e in read_lp(lp, upper_hemisphere=True)]
+    return [image_file_name(e.name) for e in _listed_entries(lp)]
+
+
+def _listed_entries(lp: Path, notes: list[str] | None = None) -> list[LpEntry]:
+    """The entries of ``lp``; of a session's ``lights.lp`` one image short (a run stopped
+    between a step's record file and its journal line), with that image too, as
+    :func:`complete_session_lp` writes it once the fit has passed its refusals.
+
+    Why: the file had been rewritten before the fit's refusals, a disowned session's and one
+    refused for a non-empty --out included, without a word. The completed listing is read from
+    memory here, and the file left as it is until the fit's outputs are written. A folder that
+    cannot be written is fitted from the file as it is (its verdict says the image is not
+    fitted, which stays true)."""
+    pending = unwritten_step(lp.parent) if lp.name == LP_NAME else None
+    if pending is None or not _writable(lp):
+        return read_lp(lp, upper_hemisphere=True, notes=notes)
+    before, entry, _ = pending
+    return parse_lp(format_lp([*before, entry]), str(lp), upper_hemisphere=True, notes=notes)
+
+
+def _writable(lp: Path) -> bool:
+    """Whether ``lp`` and its folder can be written (the atomic rewrite replaces the file)."""
+    return os.access(lp, os.W_OK) and os.access(lp.parent, os.W_OK)
+
+
+def complete_session_lp(source: Path) -> str | None:
+    """Complete the ``lights.lp`` of session ``source`` (a folder or its ``lights.lp``) that a
+    run stopped between a step's record file and its journal line left one image short; what
+    was done, or None. Called by the fit only once every refusal has passed: never of a
+    disowned session (:func:`list_unwritten_step` leaves those alone too)."""
+    source = Path(source)
+    if source.is_dir():
+        root = source
+    elif source.name == LP_NAME:
+        root = source.parent
+    else:
+        return None
+    return list_unwritten_step(root)
 
 
 def load_acquisition(
@@ -652,6 +689,11 @@ def _fit_into(  # type: ignore[no-untyped-def]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = _fit_all(req, stack, lights, out, bands or local_bands, names=names)
+    # every refusal has passed and the fit's outputs are written: only now is the session's
+    # lights.lp completed (it had been rewritten before them, of refused sessions too)
+    relisted = complete_session_lp(Path(req.source))
+    if relisted is not None:
+        notes.append(relisted)
     result.warnings = [str(w.message) for w in fit_warnings(caught)] + result.warnings
     result.notes = notes
     result.files.append(
