@@ -17,8 +17,14 @@ import numpy as np
 #: A value below this fraction of full scale is black (the QA's "no light" level: the dimmest
 #: lit images seen, a glossy coin's low lights metered for its glint, reach 0.13-0.15 %).
 BLACK_FRACTION = 0.002
-#: An image with at least this fraction of its sampled values black or clipped holds no signal.
-NO_SIGNAL_SHARE = 0.99
+#: An image holds no signal when fewer than this fraction of its sampled values lie between
+#: black and saturation (nor fewer than :data:`SIGNAL_MIN_VALUES`). Why not "99 % black or
+#: clipped": a small object on black velvet, under 1 % of the frame, was called black in
+#: every image. Judged by its brightest values instead, such an image holds signal; a
+#: capped lens's few hot pixels (well under 0.1 %) do not.
+SIGNAL_SHARE = 0.001
+#: The fewest in-range sampled values an image holding signal has, however small the sample.
+SIGNAL_MIN_VALUES = 8
 
 
 @dataclass(frozen=True)
@@ -32,7 +38,9 @@ class NoSignal:
 
 def images_without_signal(sample: np.ndarray, saturation_level: float | None) -> NoSignal | None:
     """The images of ``sample`` (N, P, C: a pixel sample of every image, in the stack's
-    scaled units) whose values are almost all black or at ``saturation_level``.
+    scaled units) with almost no value between black and ``saturation_level``
+    (:data:`SIGNAL_SHARE`): judged by the values that are lit, not by the share that is dark,
+    so a small object on a black ground is signal.
 
     None where there is no full scale to judge against (float images): "black" means nothing
     without one, and a state not established is not claimed.
@@ -42,15 +50,18 @@ def images_without_signal(sample: np.ndarray, saturation_level: float | None) ->
     obs = np.asarray(sample).reshape(len(sample), -1)
     if obs.shape[1] == 0:
         return None
-    black = (obs < BLACK_FRACTION * saturation_level).mean(axis=1)
-    clipped = (obs >= saturation_level).mean(axis=1)
-    empty = black + clipped >= NO_SIGNAL_SHARE  # NaN (missing) counts as neither
+    known = np.isfinite(obs).sum(axis=1)  # NaN (missing) counts as neither black nor signal
+    black = (obs < BLACK_FRACTION * saturation_level).sum(axis=1)
+    clipped = (obs >= saturation_level).sum(axis=1)
+    in_range = known - black - clipped
+    need = np.maximum(SIGNAL_MIN_VALUES, SIGNAL_SHARE * known)
+    empty = (known > 0) & (in_range < need)
     indices = tuple(int(i) for i in np.flatnonzero(empty))
     kinds = tuple(
         "black"
-        if black[i] >= NO_SIGNAL_SHARE
+        if clipped[i] < need[i]
         else "saturated"
-        if clipped[i] >= NO_SIGNAL_SHARE
+        if black[i] < need[i]
         else "black or clipped"
         for i in indices
     )

@@ -77,3 +77,21 @@ def test_with_the_qa_it_names_them_itself(tmp_path: Path) -> None:
     said = _fit(lp, tmp_path / "f", "--no-ptm")
     assert SAID not in said  # said once, by the QA
     assert "misfired, no light" in said
+
+
+def test_a_small_object_on_black_velvet_is_not_called_no_signal(tmp_path: Path) -> None:
+    """An object covering under 1 % of the frame on a black ground: an image had been called
+    black when 99 % of its sampled values were, so every image of such an acquisition was said
+    to hold no signal. Its lit pixels (a 5 x 5 patch of 64 x 64, 0.6 %) are signal."""
+    folder = tmp_path / "acq"
+    folder.mkdir()
+    entries = read_lp(ACQ)
+    for e in entries:
+        img = np.zeros((64, 64, 3), np.uint8)
+        photo = cv2.resize(cv2.imread(str(ACQ.parent / e.name)), (64, 64))
+        img[30:35, 30:35] = np.maximum(photo[30:35, 30:35], 20)  # lit, if dimly
+        cv2.imwrite(str(folder / e.name), img)
+    write_lp(folder / "dirs.lp", entries)
+    said = _fit(folder / "dirs.lp", tmp_path / "f", "--no-qa")
+    assert SAID not in said, said
+    assert (tmp_path / "f" / "normals.npy").exists()
