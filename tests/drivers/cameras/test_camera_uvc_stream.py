@@ -493,6 +493,7 @@ def test_a_metering_start_above_the_devices_max_exposure_s_is_lowered_to_it(tmp_
     code, said, out, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
     assert code == 0, said
     assert "longer than the camera's max_exposure_s" not in said and "Traceback" not in said
+    assert "longer than the camera uvc-camera can take" in said, said
     assert "the metering started at 0.02 s" in said, said
     assert "max_exposure_s = 0.02 s in [camera.device]" in said, said
     manifest = json.loads((out / "manifest.json").read_text())
