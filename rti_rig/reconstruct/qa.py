@@ -137,12 +137,15 @@ MIN_DIRECTION_IMAGES = 5
 MAX_ROUNDS = 4
 #: An image below this gain at its bright end had no light at all (a black frame).
 NO_LIGHT_GAIN = 0.1
-#: An acquisition whose every image keeps its brightest pixels (99th percentile) below this
+#: An acquisition whose every image keeps its brightest pixels (:data:`PEAK_PERCENTILE`) below this
 #: fraction of full scale had no light: the gain above is judged against the other images,
 #: and one black throughout (a lens cap, lights that never fired) had been called "good". Not
 #: judged image by image: metered for a glossy coin's glint, the emulated dome's low lights
 #: reach only 0.13-0.15 % of full scale, lit as they should be.
 NO_SIGNAL_FRACTION = 0.002
+#: The percentile of an image's reduced pixels that is its brightest, judged against
+#: :data:`NO_SIGNAL_FRACTION`.
+PEAK_PERCENTILE = 99.9
 #: A light is dim too when its image's median gain is at most this fraction of the median
 #: gain of its :data:`NEIGHBOUR_COUNT` nearest lights' images: the Lambertian prediction
 #: misjudges a glossy object's brightness light by light (bright-end gains of 0.8-5.4 on the
@@ -1043,7 +1046,9 @@ def assess(
     small = np.stack(small_list)
     small_sat = np.stack(small_sat_list)
     peak = (
-        np.percentile(small.reshape(n, -1), 99.0, axis=1) / saturation
+        # its brightest 0.1 %, not 1 %: a small object on black velvet (under 1 % of the frame)
+        # had every image called "misfired, no light" (as rti_rig.reconstruct.signal_check)
+        np.percentile(small.reshape(n, -1), PEAK_PERCENTILE, axis=1) / saturation
         if np.isfinite(saturation) and saturation > 0
         else np.full(n, np.nan)  # float data: no full scale to measure against
     )

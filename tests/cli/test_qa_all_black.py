@@ -31,3 +31,23 @@ def test_a_black_acquisition_is_called_so(tmp_path: Path) -> None:
     assert "QA verdict: good" not in said, said
     assert said.count("misfired, no light") == len(entries)
     assert "as every image's do (a lens cap, lights that never fired" in said
+
+
+def test_a_small_object_on_black_velvet_is_not_called_black_throughout(tmp_path: Path) -> None:
+    """An object under 1 % of the frame (a 5 x 5 patch of 64 x 64) on a black ground: each
+    image's "brightest pixels" had been its 99th percentile, black, so every image was called
+    "misfired, no light … as every image's do". Its brightest 0.1 % are the object's."""
+    entries = read_lp(ACQ)
+    for e in entries:
+        img = np.zeros((64, 64, 3), np.uint8)
+        photo = cv2.resize(cv2.imread(str(ACQ.parent / e.name)), (64, 64))
+        img[30:35, 30:35] = np.maximum(photo[30:35, 30:35], 20)  # lit, if dimly
+        cv2.imwrite(str(tmp_path / e.name), img)
+    lp = tmp_path / "dirs.lp"
+    write_lp(lp, entries)
+    r = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-ptm"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert "QA verdict" in said, said
+    assert "as every image's do" not in said, said
+    assert said.count("misfired, no light") == 0, said
