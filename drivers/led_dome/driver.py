@@ -229,7 +229,13 @@ class LedDomeDriver:
         if not self._open:
             raise self._error("port not open (connect first)", name, LinkFault.DISCONNECTED, True)
         try:
-            self._drain_stale(name)
+            try:
+                self._drain_stale(name)
+            except DomeLinkError as exc:
+                # found before this command was written (a reboot banner, stale refusal):
+                # nothing of it reached the board, which the policy must not say it did
+                exc.sent = False
+                raise
             self._seq = self.codec.next_seq(self._seq)
             seq = self._seq
             data = self.codec.encode_command(seq, cmd)

@@ -507,7 +507,13 @@ class ScriptedDomeDriver:
             )
         clock = self.transport.clock
         try:
-            self._drain_stale(name)
+            try:
+                self._drain_stale(name)
+            except DomeLinkError as exc:
+                # found before this command was written (a reboot banner, stale refusal):
+                # nothing of it reached the board, which the policy must not say it did
+                exc.sent = False
+                raise
             gap = self._last_end + max(self.spec.min_gap_s, self.spec.frame_silence_s)
             if gap > clock.now():
                 clock.sleep(gap - clock.now())

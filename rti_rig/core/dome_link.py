@@ -48,6 +48,7 @@ class DomeLinkError(DeviceError):
         retryable: bool,
         code: int | None = None,
         port_held: bool = False,
+        sent: bool = True,
     ) -> None:
         super().__init__(device, message, command)
         self.fault = fault
@@ -56,6 +57,11 @@ class DomeLinkError(DeviceError):
         #: The port could not be opened because another program holds its lock (another
         #: rti-rig check or run on this dome): nothing about the board is known or wrong.
         self.port_held = port_held
+        #: Whether the command's bytes may have been written before it failed. False when it
+        #: failed before the write (a reboot banner found waiting, the port not open): an
+        #: all-off that failed so was never sent, and must not be said "sent but not
+        #: acknowledged" (what the lights line had said of it).
+        self.sent = sent
 
 
 @dataclass(frozen=True)

@@ -810,6 +810,7 @@ class DomePolicy:
                         fault,
                         retryable=False,
                         code=exc.code,
+                        sent=exc.sent,
                     ) from exc
                 attempt += 1
                 self.stats.retries += 1
@@ -1103,7 +1104,8 @@ class DomePolicy:
     def _attempt_off(
         self, when: str, after_open: bool = False, *, at_published_rate: bool = False
     ) -> None:
-        """One all-off, whatever state the link is in; record what it established.
+        """One all-off, whatever state the link is in; record what it established. One that
+        met a reboot banner is sent once more (:meth:`_all_off_after_reboot`).
 
         ``after_open``: the port was opened by the connect that failed, which resets a board
         that resets on open; on a firmware that boots lit (``boots_lit``, the Nab sketch) a
@@ -1120,7 +1122,21 @@ class DomePolicy:
         lit_at_boot = self._lit_at_boot() if after_open else None
         try:
             self._counted(self.link.all_off)
-        except DomeLinkError as exc:
+        except DomeLinkError as first:
+            exc = first
+            if exc.fault is LinkFault.RESET and getattr(self.link, "port_open", True):
+                try:
+                    self._all_off_after_reboot(exc, when)
+                except DomeLinkError as again:
+                    exc = again
+                except DeviceError as other:
+                    log.warning("%s: all off %s failed: %s", self.name, when, other)
+                    self.off_report = OffReport(
+                        OffOutcome.SENT_UNCONFIRMED, str(other), boots_lit=lit_at_boot
+                    )
+                    return
+                else:
+                    return
             if exc.fault is LinkFault.FOREIGN:
                 self._switch_off_foreign(when)
                 return
@@ -1140,6 +1156,42 @@ class DomePolicy:
             self.off_report = OffReport(
                 getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED), when
             )
+
+    def _all_off_after_reboot(self, reset: DomeLinkError, when: str) -> None:
+        """The all-off once more after the one that met a reboot banner (found before it was
+        written, or in its reply's place); records what it established, raises what it failed
+        with, said with what happened to the first.
+
+        Why: the banner says the firmware is up again on a port still open, and the reboot
+        decides nothing safe by itself: most firmwares boot dark, but the Nab sketch boots with
+        every LED lit. The single all-off had been given up there, and said "sent but not
+        acknowledged" when it had not even been written; one more, acknowledged where the
+        firmware does, establishes what the reboot left. Only once: a board that keeps
+        rebooting is said so, and sent to its power supply."""
+        first = "was not written" if not reset.sent else "was met by its boot banner"
+        log.warning(
+            "%s: the board rebooted and the all-off %s %s: sending it once more",
+            self.name,
+            when,
+            first,
+        )
+        try:
+            self._counted(self.link.all_off)
+        except DomeLinkError as again:
+            raise DomeLinkError(
+                again.device,
+                f"the board rebooted and the first all-off {first}; the one sent again after "
+                f"its boot banner failed too: {again.message}",
+                again.command,
+                again.fault,
+                retryable=again.retryable,
+                code=again.code,
+                sent=again.sent,
+            ) from again
+        self.off_report = OffReport(
+            getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED),
+            f"{when}, sent again after the board rebooted",
+        )
 
     def _not_reopened_silent(self, firmware: str) -> None:
         """Record why a port wholly silent since it opened is not reopened at the firmware's
@@ -1252,9 +1304,17 @@ def _lost_after_opening(exc: DomeLinkError) -> bool:
 
 
 def _failed_off(exc: DomeLinkError) -> OffReport:
-    """A failed all-off: not sent if the port was gone, else sent but unconfirmed."""
+    """A failed all-off: not sent if the port was gone or it failed before it was written
+    (``exc.sent``: a reboot banner found waiting), else sent but unconfirmed.
+
+    Why: a boot banner found before the all-off was written failed it with a reset fault, and
+    the lights line said "all-off sent but not acknowledged" of bytes never written."""
     if exc.fault is LinkFault.DISCONNECTED:
         return OffReport(OffOutcome.NOT_SENT, exc.message)
+    if not exc.sent:
+        return OffReport(
+            OffOutcome.NOT_SENT, f"{exc.fault}: {exc.message}; it was not written to the port"
+        )
     return OffReport(OffOutcome.SENT_UNCONFIRMED, f"{exc.fault}: {exc.message}")
 
 

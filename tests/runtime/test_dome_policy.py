@@ -960,3 +960,64 @@ def test_a_reconnection_mid_session_resends_a_handshake_whose_reply_was_lost(pro
     assert "handshake: timeout" in dome.stats.recovered, dome.stats.recovered
     dome.all_off()
     assert fw.lit is None
+
+
+#: The shared bytes of the reboot cases below: the connect, and LED 1 refused as dead (the
+#: board then reboots: its banner comes right behind the refusal, before the next command).
+_CONNECT = [
+    (b"1 ID*1C\n", b"OK 1 ID RTIDOME 1.2.0 4*53\n"),
+    (b"2 X*4A\n", b"OK 2 X*6E\n"),
+]
+_BANNER = b"READY RTIDOME 1.2.0 4*20\n"
+_DEAD_THEN_REBOOT = (b"3 L 1 255 10000*4D\n", b"ERR 3 4 LED_1_open_circuit*26\n" + _BANNER)
+
+
+def test_an_all_off_that_meets_a_reboot_banner_before_it_is_written_is_sent_once_more():
+    """The all-off after the refusal finds the banner waiting: nothing of it is written (the
+    script fails any write it does not expect), and the one sent after the banner is what the
+    lights line reports. It had been said "sent but not acknowledged", and not sent again."""
+    transport = ScriptedTransport([*_CONNECT, _DEAD_THEN_REBOOT, (b"4 X*4C\n", b"OK 4 X*68\n")])
+    dome = DomePolicy(LedDomeDriver(transport, DefaultCodec()), VirtualClock())
+    dome.connect()
+    with pytest.raises(DomeLedError):
+        dome.light(1, 1.0)
+    assert transport.script == []
+    assert dome.off_report.lights_known_off, dome.off_report
+    assert lights_state_sentence(dome).startswith("all-off sent and acknowledged")
+
+
+def test_an_all_off_whose_resend_after_a_reboot_fails_too_says_what_each_one_was():
+    """The board reboots again as the resent all-off arrives (a banner in its reply's place):
+    sent, not acknowledged, and the first said never written."""
+    transport = ScriptedTransport([*_CONNECT, _DEAD_THEN_REBOOT, (b"4 X*4C\n", _BANNER)])
+    dome = DomePolicy(LedDomeDriver(transport, DefaultCodec()), VirtualClock())
+    dome.connect()
+    with pytest.raises(DomeLedError):
+        dome.light(1, 1.0)
+    assert transport.script == []
+    said = lights_state_sentence(dome)
+    assert said.startswith("all-off sent but not acknowledged"), said
+    assert "the first all-off was not written" in said, said
+    assert "lights may still be on" in said
+
+
+def test_an_all_off_never_written_for_reboot_banners_is_said_not_sent():
+    """Every attempt of the all-off (and its retries) finds a reboot banner before it is
+    written: "could NOT be sent", never "sent but not acknowledged"."""
+    transport = ScriptedTransport(
+        [
+            *_CONNECT,
+            (b"3 ID*1E\n", b"OK 3 ID RTIDOME 1.2.0 4*51\n" + _BANNER),
+            (b"4 ID*19\n", b"OK 4 ID RTIDOME 1.2.0 4*56\n" + _BANNER),
+        ]
+    )
+    dome = DomePolicy(LedDomeDriver(transport, DefaultCodec()), VirtualClock())
+    dome.connect()
+    transport.pending = _BANNER  # the board rebooted after the connect
+    with pytest.raises(DomeLinkError) as caught:
+        dome.all_off()
+    assert caught.value.fault is LinkFault.RESET and not caught.value.sent
+    assert transport.script == []
+    said = lights_state_sentence(dome)
+    assert said.startswith("all-off could NOT be sent"), said
+    assert "it was not written to the port" in said, said
