@@ -1,6 +1,8 @@
 """`rti-rig check` on the shipped framed-profile dome (``example_dome_48.toml``, its board
 emulated on a pty) stopped by Ctrl-C while the dome connects: the all-off is sent once the
 board has booted, and the line says what it established, as on the line-protocol firmwares.
+A stop inside the port's opening is tested on the default profile too (the shipped
+``emulated_dome.toml``): the same driver runs both profiles, and each is covered.
 
 The framed profile's driver had been left out of that fix: a Ctrl-C inside the port's opening
 (the system had opened it, which resets an Arduino-class board; pyserial closes it again as the
@@ -10,11 +12,15 @@ SIGINTs through the check's handler, raised at those points (no race)."""
 
 from __future__ import annotations
 
+import contextlib
 import signal
 import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
 
 import pytest
-from conftest import CONFIGS, shipped_dome_on_pty
+from conftest import CONFIGS, emulators_built_by_check, shipped_dome_on_pty
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -25,22 +31,40 @@ pytestmark = [
 ]
 
 SHIPPED = CONFIGS / "example_dome_48.toml"
+#: the shipped configs of each profile the dome driver (``LedDomeDriver``) runs: framed (a
+#: hardware config, its board emulated here) and default (served by the dry run's emulator)
+BY_PROFILE = {"framed": SHIPPED, "default": CONFIGS / "emulated_dome.toml"}
 
 
-def _check_said() -> tuple[int, str]:
-    r = CliRunner().invoke(app, ["check", str(SHIPPED)], terminal_width=400)
+def _check_said(config: Path = SHIPPED) -> tuple[int, str]:
+    r = CliRunner().invoke(app, ["check", str(config)], terminal_width=400)
     return r.exit_code, " ".join(r.output.split())
 
 
+@contextlib.contextmanager
+def _emulated_board(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterator[Callable[[], Any]]:
+    """The emulated firmware behind ``config`` (called once the check has run): a hardware
+    config's port redirected to one on a pty, or the dry run's own emulator."""
+    if 'backend = "emulated"' in config.read_text():
+        emulators = emulators_built_by_check(monkeypatch)
+        yield lambda: emulators[-1]
+        return
+    with shipped_dome_on_pty(monkeypatch, config) as firmware:
+        yield lambda: firmware
+
+
+@pytest.mark.parametrize("profile", list(BY_PROFILE))
 @pytest.mark.parametrize(
     ("sig", "code", "name"), [(signal.SIGINT, 130, "Ctrl-C"), (signal.SIGTERM, 143, "SIGTERM")]
 )
-def test_a_stop_inside_the_opening_of_the_framed_port_still_switches_the_board_off(
-    monkeypatch: pytest.MonkeyPatch, sig: signal.Signals, code: int, name: str
+def test_a_stop_inside_the_opening_of_the_dome_port_still_switches_the_board_off(
+    monkeypatch: pytest.MonkeyPatch, sig: signal.Signals, code: int, name: str, profile: str
 ) -> None:
     import serial
 
-    with shipped_dome_on_pty(monkeypatch, SHIPPED) as firmware:
+    config = BY_PROFILE[profile]
+    assert f'profile = "{profile}"' in config.read_text()
+    with _emulated_board(monkeypatch, config) as board:
         redirected = serial.serial_for_url
         stops: list[int] = []
 
@@ -56,7 +80,8 @@ def test_a_stop_inside_the_opening_of_the_framed_port_still_switches_the_board_o
             return port
 
         monkeypatch.setattr(serial, "serial_for_url", opened)
-        exit_code, said = _check_said()
+        exit_code, said = _check_said(config)
+        firmware = board()
     assert stops and exit_code == code, said
     assert "Traceback" not in said
     assert "never reached" not in said, said
