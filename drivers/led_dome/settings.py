@@ -19,6 +19,7 @@ from pydantic import (
     model_validator,
 )
 
+from rti_rig.core.validation_text import error_text, key_of
 from rti_rig.drivers.led_dome.dome_profiles import (
     all_profiles,
     builtin_spec,
@@ -133,6 +134,20 @@ def _same_number(a: Any, b: Any) -> bool:
         return float(a) == float(b)
     except (TypeError, ValueError):
         return False
+
+
+class ProtocolKeyError(ValueError):
+    """A refused key of ``[dome.serial.protocol]``: its place in that table and what is wrong.
+
+    Why a type of its own: the description is checked inside ``[dome.serial]``'s validation, so
+    pydantic would name only ``dome.serial``; the config loader reads ``loc`` to name the full
+    key (``dome.serial.protocol.bogus_key``), worded as every other table words it."""
+
+    def __init__(self, loc: tuple[Any, ...], text: str) -> None:
+        self.loc = loc
+        self.text = text
+        where = key_of(("protocol", *loc))
+        super().__init__(f"{where}: {text}")
 
 
 class DomeSerialSettings(_Strict):
@@ -276,9 +291,7 @@ class DomeSerialSettings(_Strict):
             return ProtocolSpec.model_validate(merged)
         except ValidationError as exc:
             first = exc.errors()[0]
-            where = ".".join(str(p) for p in first["loc"])
-            msg = first["msg"].removeprefix("Value error, ")
-            raise ValueError(f"protocol.{where}: {msg}" if where else f"protocol: {msg}") from None
+            raise ProtocolKeyError(tuple(first["loc"]), error_text(first)) from None
 
     def led_count_source(self) -> str:
         """Where a firmware profile's LED count comes from, as a check or error should say it.

@@ -31,8 +31,10 @@ from rti_rig.core.rig_geometry import (
     DomeGeometry,
     coincident_leds,
 )
+from rti_rig.core.validation_text import error_text as _error_text
+from rti_rig.core.validation_text import key_of as _key_of
 from rti_rig.drivers.dynamixel.settings import ArmSettings
-from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings, ProtocolKeyError
 
 
 class _Strict(BaseModel):
@@ -489,30 +491,6 @@ class LoadedRig(BaseModel):
         return Path(self.path).parent
 
 
-def _key_of(loc: tuple[Any, ...]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += ("." if out else "") + str(part)
-    return out
-
-
-def _error_text(err: Any) -> str:
-    """One pydantic error in a user's words: what is wrong, the value given, and for a number
-    where the driver wants the camera's own text (``iso = 100``), how to write it."""
-    msg = str(err["msg"]).removeprefix("Value error, ")
-    if err["type"] == "extra_forbidden":
-        return "unknown key (check its spelling and the table it is in)"
-    if err["type"] in ("value_error", "missing") or "input" not in err:
-        return msg
-    got = err["input"]
-    if err["type"] == "string_type" and isinstance(got, int | float) and not isinstance(got, bool):
-        return f'{msg} (got {got!r}: write it in quotes, "{got}", as the camera names it)'
-    return f"{msg} (got {got!r})"
-
-
 def quoted_value(raw: Any, value: Any, loc: tuple[Any, ...] = ()) -> tuple[str, str, Any] | None:
     """(key, text, value) of the first value the TOML gave as a string that validation turned
     into a number or a truth value (``exposure_s = "0.05"``, ``checksum = "false"``), else None.
@@ -574,6 +552,16 @@ def refuse_quoted_value(path: str | Path, raw: Any, value: Any, loc: tuple[Any, 
     )
 
 
+def _problem(err: Any) -> tuple[str | None, str]:
+    """(key, text) of one error of the rig config. A refused ``[dome.serial.protocol]`` key is
+    raised inside ``[dome.serial]``'s own check, so pydantic places it at ``dome.serial``; it is
+    named in full here (``dome.serial.protocol.bogus_key``), as every other table's key is."""
+    cause = err.get("ctx", {}).get("error")
+    if isinstance(cause, ProtocolKeyError):
+        return _key_of((*err["loc"], "protocol", *cause.loc)), cause.text
+    return _key_of(err["loc"]) or None, _error_text(err)
+
+
 def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
     """Validate parsed TOML; the first problem becomes a :class:`ConfigError`, and so does a
     number or truth value written in quotes (:func:`quoted_value`)."""
@@ -582,7 +570,7 @@ def parse_rig_config(data: dict[str, Any], path: str) -> RigConfig:
     except ValidationError as exc:
         problems = []
         for err in exc.errors():
-            problems.append((_key_of(err["loc"]) or None, _error_text(err)))
+            problems.append(_problem(err))
         key, msg = problems[0]
         if len(problems) > 1:
             rest = "; ".join(f"'{k}': {m}" if k else m for k, m in problems[1:])
@@ -793,6 +781,12 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         sha256=hashlib.sha256(raw_bytes + correction_bytes).hexdigest(),
         raw=data,
     )
+    return _checked(loaded, path, data)
+
+
+def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
+    """The checks of a loaded config that need it whole (its LEDs, its camera's settings)."""
+    config = loaded.config
     if config.kind == "dome":
         notes: list[str] = []
         dirs, _ = dome_led_directions(loaded, notes)  # fail now, not when the session starts
