@@ -781,7 +781,14 @@ def load_rig_config(path: Path | str) -> LoadedRig:
         sha256=hashlib.sha256(raw_bytes + correction_bytes).hexdigest(),
         raw=data,
     )
-    return _checked(loaded, path, data)
+    try:
+        return _checked(loaded, path, data)
+    except ConfigError as exc:
+        if exc.path != loaded.path:
+            raise
+        # said with the config's path as the user gave it, as every other refusal of it is (a
+        # [camera.device] or dome.lp_file slip had printed the resolved, absolute path)
+        raise ConfigError(path, exc.key, exc.message) from None
 
 
 def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
