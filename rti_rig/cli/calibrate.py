@@ -32,6 +32,19 @@ def _parse_normal(text: str) -> tuple[float, float, float]:
     return (x / norm, y / norm, z / norm)
 
 
+def _check_min_elevation(value: float) -> float:
+    """``--min-elevation-deg`` as given, if it is an elevation strictly between 0° and 90°.
+
+    Why here: the calibration refused it deeper down as ``min_elevation_deg must be in (0,
+    90)``, a name the user never typed, without the default to go back to."""
+    if not 0.0 < value < 90.0:
+        raise RtiRigError(
+            f"--min-elevation-deg {value:g}: give an elevation above 0 and below 90 degrees "
+            "(the default is 5)"
+        )
+    return value
+
+
 def _how_to_set(raw: dict) -> str:  # type: ignore[type-arg]
     """How the calibration line goes into the rig config: added, or replacing the correction
     the config already names. Why: a config with a correction was told to "add" the line, and
@@ -73,7 +86,7 @@ def calibrate_lights(
         typer.Option(
             "--min-elevation-deg",
             help="LEDs lower than this above the card are not measured (grazing light on a "
-            "card is the most sensitive to its tilt and texture).",
+            "card is the most sensitive to its tilt and texture). Degrees, above 0 and below 90.",
         ),
     ] = 5.0,
     force: Annotated[
@@ -110,7 +123,7 @@ def calibrate_lights(
                 rig_config,
                 out_file,
                 _parse_normal(card_normal),
-                min_elevation_deg,
+                _check_min_elevation(min_elevation_deg),
                 force,
                 not_flat_ok,
             )
