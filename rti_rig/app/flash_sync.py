@@ -341,6 +341,8 @@ def refuse_options(loaded, **given: bool) -> None:  # type: ignore[no-untyped-de
     why = {
         "--plan": "the firmware lights its LEDs in its own order; no plan can choose them",
         "--adaptive": "the firmware lights its LEDs in its own order; nothing can choose the next",
+        "--until-error (an adaptive session)": "the firmware lights its LEDs in its own order; "
+        "nothing can choose the next",
         "--auto-exposure": "each metering shot would step the dome to its next LED",
         "--resume": "the dome's own count no longer matches the session's",
         "preview": "a preview shot would step the dome to its next LED",
@@ -406,7 +408,7 @@ def check_new_session(req, loaded) -> None:  # type: ignore[no-untyped-def]
         loaded,
         **{
             "--plan": req.plan is not None,
-            "--adaptive": req.is_adaptive,
+            req.adaptive_option: req.is_adaptive,
             "--auto-exposure": req.auto_exposure,
         },
     )

@@ -78,6 +78,15 @@ class NewSessionRequest:
     def is_adaptive(self) -> bool:
         return self.adaptive or self.until_error_deg is not None
 
+    @property
+    def adaptive_option(self) -> str:
+        """The option that made the session adaptive, as a refusal should name it. Why: a run
+        given only ``--until-error`` was told "--adaptive chooses its own lights", an option
+        the user never typed."""
+        if self.adaptive:
+            return "--adaptive"
+        return "--until-error (an adaptive session)"
+
 
 @dataclass(frozen=True)
 class ResumeRequest:
@@ -854,14 +863,14 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     from rti_rig.planner.make_plan import check_elevation_band
 
     if req.plan is not None:
-        raise RtiRigError("--adaptive chooses its own lights: drop --plan")
+        raise RtiRigError(f"{req.adaptive_option} chooses its own lights: drop --plan")
     # every light of the session is chosen in the band (it had been refused: the adaptive
     # loop chose among every light the rig can run)
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     if req.auto_exposure:
         refuse_unmeterable_rig(loaded)  # no planned run meters these either: say so first
         raise RtiRigError(
-            "--adaptive cannot meter the exposure: its lights are chosen as the images "
+            f"{req.adaptive_option} cannot meter the exposure: its lights are chosen as the images "
             "arrive, so there is no brightest planned light to meter at. Meter once with a "
             f"planned run (rti-rig run {shlex.quote(str(req.rig_config))} --out TEST "
             f"{_metering_options(req, loaded)} --auto-exposure prints 'Exposure fixed at T s'), "
