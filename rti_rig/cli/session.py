@@ -193,7 +193,6 @@ def run(
         NewSessionRequest,
         ResumeRequest,
         open_new_session,
-        open_resumed_session,
     )
 
     if resume is not None:
@@ -266,7 +265,7 @@ def run(
 
     if resume is not None:
         opening = _Opening(
-            lambda: open_resumed_session(resume_request, print_note),
+            lambda: _open_resumed(resume_request, print_note),
             out_dir,
             auto_exposure,
             stopped=lambda why, _exc: (
@@ -698,16 +697,42 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
         )
     else:
         what = f"{kept} image(s) are kept"
-    if exc.errno_name in ("ENOSPC", "EFBIG", "EDQUOT"):
-        fix = "free space on that disk (or lift the file-size limit or quota)"
-    elif exc.errno_name == "EROFS":
-        fix = "make that disk writable again"
-    else:
-        fix = "check that disk"
     return RtiRigError(
-        f"{exc}: the session stopped there; {what}; {fix}, then continue with rti-rig run "
-        f"--resume {_arg(opened.out_dir)}"
+        f"{exc}: the session stopped there; {what}; {_disk_fix(exc.errno_name)}, then continue "
+        f"with rti-rig run --resume {_arg(opened.out_dir)}"
     )
+
+
+def _disk_fix(errno_name: str) -> str:
+    """What to do about a session write the disk refused, by the system's reason."""
+    if errno_name in ("ENOSPC", "EFBIG", "EDQUOT"):
+        return "free space on that disk (or lift the file-size limit or quota)"
+    if errno_name == "EROFS":
+        return (
+            "make that disk writable again (or copy the session folder to a writable disk and "
+            "resume the copy)"
+        )
+    return "check that disk"
+
+
+def _open_resumed(req: Any, on_note: Any) -> Any:
+    """Open ``req`` (a ResumeRequest) for capture; a write the disk refuses while it opens is
+    said with what to do.
+
+    Why: the resume rewrites ``lights.lp`` (and its journal) as it opens, so a session on
+    read-only media (a card or disk mounted read-only, a copy on a DVD) ended with a bare
+    ``cannot write …/lights.lp: Read-only file system (EROFS)``: nothing was lost, but the
+    user was told neither that nor what to do."""
+    from rti_rig.app.usecases.session import open_resumed_session
+    from rti_rig.runtime.session import SessionWriteError
+
+    try:
+        return open_resumed_session(req, on_note)
+    except SessionWriteError as exc:
+        raise RtiRigError(
+            f"{exc}: the session did not go on and nothing captured is lost; "
+            f"{_disk_fix(exc.errno_name)}, then continue with {_resume_command(req)}"
+        ) from None
 
 
 def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def]
