@@ -61,7 +61,11 @@ def check_acquisition_images(
             f"{lead}{len(missing)} of {len(entries)} image(s) missing in "
             f"{Path(lp_path).parent} ({shown})"
             + missing_images_advice(
-                missing, [paths[m] for m in missing], Path(lp_path).parent, use
+                missing,
+                [paths[m] for m in missing],
+                Path(lp_path).parent,
+                use,
+                total=len(entries),
             ),
         )
     why_cut = {e.name: image_truncation(paths[e.name]) for e in entries}

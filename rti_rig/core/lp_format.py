@@ -206,16 +206,23 @@ def case_hint(missing: Sequence[Path]) -> str:
 
 
 def missing_images_advice(
-    names: Sequence[str], paths: Sequence[Path], lp_dir: Path, use: str
+    names: Sequence[str], paths: Sequence[Path], lp_dir: Path, use: str, *, total: int
 ) -> str:
     """What to say after "N image(s) missing" of the images an `.lp` in ``lp_dir`` lists as
     ``names``, looked for at ``paths`` (:func:`image_path`): where an absolute name is looked
-    for, and what to do; ``use`` is the verb of what is done with the others ("replay", "fit").
+    for, and what to do; ``use`` is the verb of what is done with the others ("replay", "fit"),
+    of the ``total`` images the `.lp` lists.
 
     Why: an absolute name whose file exists at that very path had been called "missing" and
     the user told to "copy them where their names point", where they already were. It is
     read beside the `.lp` by design (see :func:`image_path`), so that is said, with the two
-    ways out. One wording for ``run``, ``fit`` and ``bench tradeoff --from``."""
+    ways out. One wording for ``run``, ``fit`` and ``bench tradeoff --from``.
+
+    An absolute name at no such path had been told both that it is looked for beside the
+    `.lp` and to "copy them where their names point" (which leads only to the "exists at the
+    path the .lp names" refusal): it is told to copy them into ``lp_dir``. "Remove their lines
+    from the .lp to fit the others" is offered only when there are others (it had been said
+    with every image missing)."""
     absolute = [n for n in names if is_absolute_name(n)]
     where = (
         "an absolute name (a path on the machine that wrote the .lp) is looked for by its "
@@ -234,10 +241,18 @@ def missing_images_advice(
             f"{where}; "
             f"copy them into {lp_dir}, or write an .lp whose names are relative to its folder"
         )
+    if not absolute:
+        copy = "copy them where their names point"
+    elif len(absolute) == len(names):
+        copy = f"copy them into {lp_dir}"
+    else:  # a relative name may name a subfolder; an absolute one is read by its file name
+        copy = (
+            "copy them where their names point, an absolute name's file by its file name "
+            f"into {lp_dir}"
+        )
+    others = f", or remove their lines from the .lp to {use} the others"
     return ("; " + where if absolute else "") + (
-        case_hint(paths)
-        or f"; copy them where their names point, or remove their lines from the .lp to {use} "
-        "the others"
+        case_hint(paths) or f"; {copy}{others if len(names) < total else ''}"
     )
 
 

@@ -285,11 +285,59 @@ def test_absolute_names_whose_files_are_there_are_said_so_by_bench_run_and_fit(
         assert f"12 of 12 image(s) missing in {elsewhere} ({src.parent}/image01.jpg" in text
         assert said in text, (command, text)
         assert "where their names point" not in text and "Traceback" not in text
-    # a name at no such path keeps the old advice (and the note of where it is looked for)
+    # a name at no such path is told where it is looked for, and to copy it there
     lp.write_text(lp.read_text().replace(str(src.parent), "/nowhere/at/all"))
     r = CliRunner().invoke(app, commands["bench"])
     text = " ".join(r.output.split())
-    assert "exist at the path" not in text and "copy them where their names point" in text
+    assert "exist at the path" not in text and f"copy them into {elsewhere}" in text
+
+
+def test_absolute_names_at_no_such_path_are_told_to_copy_them_beside_the_lp(
+    tmp_path: Path,
+) -> None:
+    """An .lp naming ``/nonexist/x/image01.jpg`` … had been told that an absolute name "is
+    looked for by its file name beside the .lp", then to "copy them where their names point"
+    (which leads only to "exists at the path the .lp names, but … read beside it"), and with
+    every image missing to "remove their lines from the .lp to fit the others", of none.
+    fit and bench tradeoff --from now say to copy them into the .lp's folder, and offer to
+    remove their lines only when other images remain."""
+    src = _acquisition(tmp_path / "acq")
+    lines = src.read_text().splitlines()
+    elsewhere = tmp_path / "t13"
+    elsewhere.mkdir()
+    lp = elsewhere / "abs.lp"
+    lp.write_text("\n".join([lines[0], *(f"/nonexist/x/{line}" for line in lines[1:])]) + "\n")
+    looked_for = (
+        "an absolute name (a path on the machine that wrote the .lp) is looked for by its file "
+        "name beside the .lp and in a jpeg-exports folder beside it or beside its folder"
+    )
+    commands = {
+        "fit": ["fit", str(lp), "--out", str(tmp_path / "f")],
+        "bench": ["bench", "tradeoff", "--from", str(lp), "--out", str(tmp_path / "b")],
+    }
+    for command, args in commands.items():
+        r = CliRunner().invoke(app, args)
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2, (command, text)
+        assert f"12 of 12 image(s) missing in {elsewhere} (/nonexist/x/image01.jpg" in text
+        assert text.endswith(f"{looked_for}; copy them into {elsewhere}"), (command, text)
+        assert "where their names point" not in text and "remove their lines" not in text
+    # one of them missing (the others beside their .lp): its line may be removed, too
+    (src.parent / "image01.jpg").unlink()
+    src.write_text(src.read_text().replace("image01.jpg", "/nonexist/x/image01.jpg", 1))
+    commands = {
+        "fit": ["fit", str(src), "--out", str(tmp_path / "f")],
+        "bench": ["bench", "tradeoff", "--from", str(src), "--out", str(tmp_path / "b")],
+    }
+    for command, verb in (("fit", "fit"), ("bench", "measure")):
+        r = CliRunner().invoke(app, commands[command])
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2, (command, text)
+        assert f"1 of 12 image(s) missing in {src.parent} (/nonexist/x/image01.jpg)" in text
+        assert text.endswith(
+            f"{looked_for}; copy them into {src.parent}, or remove their lines from the .lp "
+            f"to {verb} the others"
+        ), (command, text)
 
 
 def test_an_out_that_is_a_file_is_refused_as_a_file(tmp_path: Path) -> None:

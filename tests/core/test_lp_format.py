@@ -17,6 +17,7 @@ from rti_rig.core.lp_format import (
     image_file_name,
     image_path,
     image_paths,
+    missing_images_advice,
     parse_lp,
     read_lp,
     write_lp,
@@ -482,3 +483,18 @@ def test_a_huge_finite_vector_is_read_as_its_direction() -> None:
     (e,) = parse_lp("1\na.jpg 1e308 0 1e308\n", "x.lp", notes=notes)
     assert e.direction == pytest.approx((2**-0.5, 0.0, 2**-0.5))
     assert "x.lp, line 2" in " ".join(notes)
+
+
+def test_missing_absolute_and_relative_names_are_told_where_each_goes(tmp_path: Path) -> None:
+    """Missing images named both ways: a relative name goes where it points (it may name a
+    subfolder), an absolute one by its file name into the .lp's folder, where it is read; it
+    had been told to "copy them where their names point", the absolute one included."""
+    names = ["sub/image02.jpg", "/nonexist/x/image01.jpg"]
+    paths = [tmp_path / "sub" / "image02.jpg", tmp_path / "image01.jpg"]
+    said = missing_images_advice(names, paths, tmp_path, "fit", total=3)
+    assert said.endswith(
+        "; copy them where their names point, an absolute name's file by its file name into "
+        f"{tmp_path}, or remove their lines from the .lp to fit the others"
+    ), said
+    said = missing_images_advice(names, paths, tmp_path, "fit", total=2)
+    assert "remove their lines" not in said, said

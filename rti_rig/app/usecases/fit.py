@@ -441,7 +441,11 @@ def _refuse_missing_images(lp: Path, entries: list[Any], paths: list[Path]) -> N
     raise FitInputError(
         f"{lp}: {len(missing)} of {len(entries)} image(s) missing in {lp.parent} ({shown})"
         + missing_images_advice(
-            [name for name, _ in missing], [p for _, p in missing], lp.parent, "fit"
+            [name for name, _ in missing],
+            [p for _, p in missing],
+            lp.parent,
+            "fit",
+            total=len(entries),
         )
     )
 
