@@ -10,28 +10,42 @@ from rti_rig.core.errors import RtiRigError
 PROBE_NAME = ".rti-rig-write-test"
 
 
+def _cannot_write_there(folder: Path, exc: OSError) -> RtiRigError:
+    """The refusal of an ``--out`` the system would not let us look into or write to, naming
+    it and the system's reason (one wording for a ``stat`` and a ``mkdir`` that fail)."""
+    where = f": {exc.filename}" if exc.filename else ""
+    return RtiRigError(
+        f"--out {folder}: cannot write there ({exc.strerror or exc}{where}); choose a "
+        "folder you can write to"
+    )
+
+
+def refuse_a_file_in_the_way(folder: Path) -> None:
+    """Refuse ``--out folder`` when ``folder`` (or a folder above it) is a file, by name.
+
+    Why: ``mkdir`` had said "cannot write there (File exists: …); choose a folder you can
+    write to" (and a batch "cannot create the batch folder (File exists)"), which reads as a
+    permission problem. Shared by :func:`ensure_writable_folder` and a fit batch's own folder."""
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        what = " is a file" if existing == folder else f": {existing} is a file, not a folder"
+        raise RtiRigError(f"--out {folder}{what}: give a folder")
+
+
 def ensure_writable_folder(folder: Path) -> None:
     """Create ``folder`` (and its parents) and prove it writable, or refuse by name.
 
     Why: a command that computes for minutes (a fit, a benchmark) must not find out at the end
     that it cannot write its results; an ``OSError`` there reached users as a traceback.
 
-    A file at ``folder`` (or at a folder above it) is refused as such, as ``export-lp`` names
-    a file given for a folder: ``mkdir`` had been told "cannot write there (File exists: …);
-    choose a folder you can write to", which reads as a permission problem.
+    A file at ``folder`` (or at a folder above it) is refused as such
+    (:func:`refuse_a_file_in_the_way`), as ``export-lp`` names a file given for a folder.
     """
-    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
-    if existing is not None and not existing.is_dir():
-        what = " is a file" if existing == folder else f": {existing} is a file, not a folder"
-        raise RtiRigError(f"--out {folder}{what}: give a folder")
+    refuse_a_file_in_the_way(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / PROBE_NAME
         probe.write_bytes(b"")
         probe.unlink()
     except OSError as exc:
-        where = f": {exc.filename}" if exc.filename else ""
-        raise RtiRigError(
-            f"--out {folder}: cannot write there ({exc.strerror or exc}{where}); choose a "
-            "folder you can write to"
-        ) from None
+        raise _cannot_write_there(folder, exc) from None

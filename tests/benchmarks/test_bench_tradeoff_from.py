@@ -356,3 +356,21 @@ def test_an_out_that_is_a_file_is_refused_as_a_file(tmp_path: Path) -> None:
     text = " ".join(r.output.split())
     assert r.exit_code == 2, text
     assert f"--out {a_file / 'sub'}: {a_file} is a file, not a folder: give a folder" in text
+
+
+def test_a_batch_fit_whose_out_is_a_file_is_refused_as_a_file(tmp_path: Path) -> None:
+    """`fit A/dirs.lp B/dirs.lp --out FILE` had been told "cannot create the batch folder
+    (File exists); choose a folder you can write to" (its own mkdir), as if a matter of
+    permissions, where the bench says that --out is a file."""
+    sources = [str(_acquisition(tmp_path / name, 6)) for name in ("a", "b")]
+    a_file = tmp_path / "S_lin.lp"
+    a_file.write_text("12\n")
+    for out, said in (
+        (a_file, f"--out {a_file} is a file: give a folder"),
+        (a_file / "sub", f"--out {a_file / 'sub'}: {a_file} is a file, not a folder: give a"),
+    ):
+        r = CliRunner().invoke(app, ["fit", *sources, "--out", str(out)])
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2 and said in text, text
+        assert "batch folder" not in text
+    assert a_file.read_text() == "12\n"

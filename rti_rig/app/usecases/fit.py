@@ -52,7 +52,7 @@ from rti_rig.core.lp_format import (
     parse_lp,
     read_lp,
 )
-from rti_rig.core.out_folders import ensure_writable_folder
+from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
@@ -1354,6 +1354,10 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
             "source once, and fit sessions whose folders share a name in separate batches "
             "(another --out) or rename one of the folders"
         )
+    # a file given for --out is said to be one (it had been "cannot create the batch folder
+    # (File exists)"), in the words of ensure_writable_folder; its probe file is not written
+    # here, as two batches may plan into one folder at once
+    refuse_a_file_in_the_way(root)
     try:
         root.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
