@@ -10,7 +10,7 @@ from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.out_folders import ensure_writable_folder
+from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
 
 bench_app = typer.Typer(help="Benchmarks on the simulator: the speed/accuracy trade.")
 app.add_typer(bench_app, name="bench")
@@ -138,6 +138,10 @@ def _check_out_folder(out_dir: Path, force: bool) -> None:
     summary.md had been replaced without a word)."""
     from rti_rig.runtime.session import MANIFEST
 
+    # first, as it says a file given for a folder, or a folder the user may not look into
+    # (``--out /root/x`` for another user), by name: the session check below had raised
+    # that PermissionError as a traceback
+    refuse_a_file_in_the_way(out_dir)
     for folder in (out_dir.resolve(), *out_dir.resolve().parents):
         if (folder / MANIFEST).is_file():
             raise RtiRigError(

@@ -25,9 +25,17 @@ def refuse_a_file_in_the_way(folder: Path) -> None:
 
     Why: ``mkdir`` had said "cannot write there (File exists: …); choose a folder you can
     write to" (and a batch "cannot create the batch folder (File exists)"), which reads as a
-    permission problem. Shared by :func:`ensure_writable_folder` and a fit batch's own folder."""
-    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
-    if existing is not None and not existing.is_dir():
+    permission problem. Shared by :func:`ensure_writable_folder` and a fit batch's own folder.
+
+    A folder the user may not look into (``--out /root/x/y`` for another user) makes
+    ``Path.exists`` raise ``PermissionError`` on Python 3.11 rather than say False: that is
+    refused as "cannot write there" too, not let through as a traceback."""
+    try:
+        existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+        is_file = existing is not None and not existing.is_dir()
+    except OSError as exc:
+        raise _cannot_write_there(folder, exc) from None
+    if is_file:
         what = " is a file" if existing == folder else f": {existing} is a file, not a folder"
         raise RtiRigError(f"--out {folder}{what}: give a folder")
 

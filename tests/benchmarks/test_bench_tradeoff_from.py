@@ -374,3 +374,39 @@ def test_a_batch_fit_whose_out_is_a_file_is_refused_as_a_file(tmp_path: Path) ->
         assert r.exit_code == 2 and said in text, text
         assert "batch folder" not in text
     assert a_file.read_text() == "12\n"
+
+
+def test_an_out_the_user_may_not_look_into_is_refused_by_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`--out /root/x/y` for a user who may not look into /root: on Python 3.11 the check of
+    whether it exists raises PermissionError (it does not say False), which had reached the
+    user as a traceback from bench (and from the file check of a fit's batch folder). The
+    tests run as root, whom modes do not stop: ``os.stat`` is made to refuse as for them."""
+    import errno
+    import os
+
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_stat = os.stat
+
+    def stat(path: object, *args: object, **kwargs: object) -> os.stat_result:
+        if str(path).startswith(f"{locked}{os.sep}"):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        return real_stat(path, *args, **kwargs)  # type: ignore[arg-type]
+
+    lp = _acquisition(tmp_path / "acq", 6)
+    other = _acquisition(tmp_path / "acq2", 6)
+    out = locked / "x" / "y"
+    monkeypatch.setattr(os, "stat", stat)
+    for args in (
+        ["bench", "tradeoff", "--from", str(lp), "--out", str(out)],
+        ["fit", str(lp), str(other), "--out", str(out)],
+    ):
+        r = CliRunner().invoke(app, args)
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2, (args[0], text, r.exception)
+        assert f"--out {out}: cannot write there (Permission denied: {out})" in text, text
+        assert "choose a folder you can write to" in text
+    monkeypatch.undo()
+    assert not out.exists()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import errno
+import os
 from pathlib import Path
 
 import pytest
@@ -28,3 +30,26 @@ def test_a_folder_nothing_can_be_created_in_is_refused() -> None:
     # /proc stands in for a read-only card (the tests may run as root, whom modes do not stop)
     with pytest.raises(RtiRigError, match="cannot write there"):
         ensure_writable_folder(Path("/proc/rti-rig-cannot-write-here"))
+
+
+def test_a_folder_the_user_may_not_look_into_is_refused_by_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--out /root/x/y`` of a user who may not look into /root: ``Path.exists`` raises
+    PermissionError on Python 3.11 (it does not say False); it had escaped as a traceback.
+    The tests may run as root, whom modes do not stop: ``os.stat`` refuses as for them."""
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_stat = os.stat
+
+    def stat(path: object, *args: object, **kwargs: object) -> os.stat_result:
+        if str(path).startswith(f"{locked}{os.sep}"):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        return real_stat(path, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(os, "stat", stat)
+    target = locked / "x" / "y"
+    with pytest.raises(RtiRigError, match=r"--out .*/x/y: cannot write there \(Permission denied"):
+        ensure_writable_folder(target)
+    monkeypatch.undo()
+    assert not (locked / "x").exists()
