@@ -381,7 +381,7 @@ def test_an_out_the_user_may_not_look_into_is_refused_by_name(
 ) -> None:
     """`--out /root/x/y` for a user who may not look into /root: on Python 3.11 the check of
     whether it exists raises PermissionError (it does not say False), which had reached the
-    user as a traceback from bench (and from the file check of a fit's batch folder). The
+    user as a traceback from bench, a single fit (and the file check of a fit's batch folder). The
     tests run as root, whom modes do not stop: ``os.stat`` is made to refuse as for them."""
     import errno
     import os
@@ -402,6 +402,7 @@ def test_an_out_the_user_may_not_look_into_is_refused_by_name(
     for args in (
         ["bench", "tradeoff", "--from", str(lp), "--out", str(out)],
         ["fit", str(lp), str(other), "--out", str(out)],
+        ["fit", str(lp), "--out", str(out)],
     ):
         r = CliRunner().invoke(app, args)
         text = " ".join(r.output.split())

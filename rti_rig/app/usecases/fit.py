@@ -52,7 +52,10 @@ from rti_rig.core.lp_format import (
     parse_lp,
     read_lp,
 )
-from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
+from rti_rig.core.out_folders import (
+    ensure_writable_folder,
+    refuse_a_file_in_the_way,
+)
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
 from rti_rig.reconstruct import exporters
@@ -646,6 +649,9 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     left model_choice.md behind, and the corrected command then found --out not empty.
     """
     t0 = time.perf_counter()
+    # a file given for --out, or a folder the user may not look into (Path.exists raises
+    # PermissionError on Python 3.11: a traceback), refused by name before any image is read
+    refuse_a_file_in_the_way(req.out_dir)
     notes: list[str] = []
     frames, lights, names, what = load_acquisition(req.source, notes)
     release_free_memory()  # the decode buffers
