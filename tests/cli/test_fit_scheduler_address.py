@@ -5,7 +5,9 @@ A Client built on 'bogus' (or on http://…, a scheme Dask has no transport for)
 ValueError (turned into a clear error), but the half-built Client then waited 40 s in its
 __del__ and printed "Exception ignored ... Traceback ... TimeoutError" after it. A port that
 accepts the connection and never answers held the fit for ever: Dask's handshake read its
-reply without the connect timeout.
+reply without the connect timeout. An inproc:// address (no other process can reach it) and a
+ucx:// one (its package not installed) were listed as accepted and ended in that traceback or
+were told as an unreachable scheduler; a refused connection waited the full 20 s.
 """
 
 from __future__ import annotations
@@ -71,8 +73,90 @@ def test_an_address_dask_has_no_transport_for_is_refused_naming_the_accepted_one
     assert r.returncode == 2, text
     _no_traceback(text)
     assert "'http://127.0.0.1:8786'" in text and "no transport for http://" in text, text
-    assert "tcp://" in text and "inproc://" in text, text  # the schemes it accepts
+    assert "tcp://" in text and "inproc://" not in text, text  # what reaches another process
     assert "dask worker http" not in text, text  # no advice to start workers on it
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("address", ["inproc://nothing/1/2", "inproc://127.0.0.1/1/1"])
+def test_an_inproc_address_is_refused_as_unreachable_from_another_process(
+    tmp_path: Path, address: str
+) -> None:
+    """An inproc:// address names a scheduler inside one Python process: it was listed as
+    accepted, then the Client built on it waited 40 s and printed "Exception ignored …
+    Traceback … TimeoutError", after advice to start `dask worker inproc://…`."""
+    out = tmp_path / "fit"
+    r = _fit(RTI_RIG, address, out)
+    text = r.stdout + r.stderr
+    assert r.returncode == 2, text
+    _no_traceback(text)
+    assert f"--scheduler '{address}' cannot be reached" in text, text
+    assert "inside one Python process" in text and "tcp://HOST:8786" in text, text
+    assert "dask worker inproc" not in text, text
+    assert not out.exists()
+
+
+def test_an_address_whose_transport_is_not_installed_is_refused_saying_so(
+    tmp_path: Path,
+) -> None:
+    """Dask registers ucx:// without its package: it was listed as accepted, then the Client
+    failed with "TypeError: Can't instantiate abstract class UCXConnector", told as a scheduler
+    that could not be reached (start one with `dask scheduler`)."""
+    try:
+        import distributed_ucxx  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        pytest.skip("distributed-ucxx is installed: ucx:// is usable here")
+    address = "ucx://127.0.0.1:8786"
+    out = tmp_path / "fit"
+    r = _fit(RTI_RIG, address, out)
+    text = r.stdout + r.stderr
+    assert r.returncode == 2, text
+    _no_traceback(text)
+    assert f"--scheduler '{address}' needs Dask's ucx:// transport" in text, text
+    assert "not installed here" in text and "distributed-ucxx" in text, text
+    assert "cannot reach" not in text and "dask worker ucx" not in text, text
+    usable = text.split("this machine has are", 1)[-1].split(". ", 1)[0]
+    assert "tcp://" in usable and "ucx://" not in usable, text  # not offered as usable
+    assert not out.exists()
+
+
+#: ``rti-rig`` waiting far longer for the scheduler than :data:`BOUND_S`: it ends within the
+#: bound only if it does not wait for the timeout.
+RTI_RIG_LONG_WAIT = [
+    sys.executable,
+    "-c",
+    "from rti_rig.app.usecases import fit_dask; "
+    "fit_dask.CONNECT_TIMEOUT_S = 3600.0; "
+    "from rti_rig.cli import main; main()",
+]
+
+
+@pytest.fixture
+def closed_port() -> Iterator[int]:
+    """A local port bound but not listening: a connection to it is refused (Linux), and no
+    other program can take it meanwhile."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        sock.bind(("127.0.0.1", 0))
+        yield sock.getsockname()[1]
+    finally:
+        sock.close()
+
+
+def test_a_refused_connection_is_said_at_once(tmp_path: Path, closed_port: int) -> None:
+    """A port nothing listens on refuses at once, but Dask retried until its 20 s connect
+    timeout and it was told as "Timed out trying to connect"."""
+    address = f"tcp://127.0.0.1:{closed_port}"
+    out = tmp_path / "fit"
+    r = _fit(RTI_RIG_LONG_WAIT, address, out)  # BOUND_S fails it if it waits
+    text = r.stdout + r.stderr
+    assert r.returncode == 2, text
+    _no_traceback(text)
+    assert f"cannot reach the Dask scheduler at '{address}'" in text, text
+    assert f"connection refused: no scheduler listens at 127.0.0.1:{closed_port}" in text, text
+    assert "Timed out" not in text and "`dask scheduler`" in text, text
     assert not out.exists()
 
 

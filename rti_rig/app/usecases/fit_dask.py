@@ -24,6 +24,7 @@ Dask is imported only here, and this module only when ``--scheduler`` is given.
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import os
 import socket
@@ -184,13 +185,46 @@ def _unreachable_scheduler(address: str, why: str) -> SchedulerError:
     )
 
 
+def _usable(scheme: str) -> bool:
+    """Whether Dask's transport for ``scheme`` can open a connection from this process.
+
+    Why: Dask registers ``ucx://`` even without its package (``distributed-ucxx``); a Client
+    built on it failed with "TypeError: Can't instantiate abstract class UCXConnector", told as
+    a scheduler that could not be reached. Getting the connector is what fails, and costs
+    nothing (no connection is opened)."""
+    import warnings
+
+    from distributed.comm.registry import get_backend
+
+    try:
+        with warnings.catch_warnings():  # the deprecated ucx:// warns as it fails
+            warnings.simplefilter("ignore")
+            get_backend(scheme).get_connector()
+    except Exception:  # any failure means the same: not usable here
+        return False
+    return True
+
+
+def _inproc_listening(location: str) -> bool:
+    """Whether ``location`` (of an ``inproc://`` address) names a server living in this
+    process: only then can it be reached (a test's in-process ``LocalCluster``)."""
+    from distributed.comm.inproc import global_manager
+
+    try:
+        return global_manager.get_listener_for(location) is not None
+    except ValueError:  # not ip/pid/n, or another process's pid or host
+        return False
+
+
 def _checked_address(address: str) -> str:
-    """``address``'s scheme, once Dask can parse the address and has a transport for it.
+    """``address``'s scheme, once Dask can parse the address and has a usable transport for it.
 
     Why: a Client built on an address Dask cannot use raised ValueError (said clearly), but the
     half-built Client then waited 40 s in its ``__del__`` and printed an "Exception ignored …
     TimeoutError" traceback after the error; an ``http://`` address was also advised as the
-    one to start workers with."""
+    one to start workers with. So were ``inproc://`` (a scheduler inside one Python process,
+    which no other process can reach: it was listed as accepted and advised for ``dask
+    worker``) and ``ucx://`` (listed as accepted, its package not installed)."""
     from distributed.comm import parse_address
     from distributed.comm.addressing import parse_host_port
     from distributed.comm.registry import backends, get_backend
@@ -204,24 +238,89 @@ def _checked_address(address: str) -> str:
             f"--scheduler {address!r} is not a Dask scheduler address ({exc}): give "
             f"'{THREADS}' or an address such as tcp://HOST:8786"
         ) from None
+    # the transports a scheduler in another process can be reached by, as the user is told
+    usable = ", ".join(f"{s}://" for s in sorted(backends) if s != "inproc" and _usable(s))
+    give = f"Give '{THREADS}' or the address `dask scheduler` prints, such as tcp://HOST:8786"
+    if scheme == "inproc":
+        if _inproc_listening(location):
+            return scheme
+        raise SchedulerError(
+            f"--scheduler {address!r} cannot be reached: an inproc:// address names a "
+            "scheduler inside one Python process, and no other process (this `rti-rig fit` "
+            f"included) can connect to it. {give}, or leave out --scheduler to fit in this "
+            "process"
+        )
     try:
         get_backend(scheme)  # the transports Dask ships, then any a package registers
-    except (ValueError, ImportError) as exc:
-        known = ", ".join(f"{s}://" for s in sorted(backends))
+    except (ValueError, ImportError):
         raise SchedulerError(
             f"--scheduler {address!r} is not a Dask scheduler address: Dask has no transport "
-            f"for {scheme}:// ({type(exc).__name__}), it accepts {known}. Give '{THREADS}' or "
-            "the address `dask scheduler` prints, such as tcp://HOST:8786"
+            f"for {scheme}://, it accepts {usable}. {give}"
         ) from None
+    if not _usable(scheme):
+        hint = " (the distributed-ucxx package)" if scheme == "ucx" else ""
+        raise SchedulerError(
+            f"--scheduler {address!r} needs Dask's {scheme}:// transport, which is not "
+            f"installed here{hint}; the transports this machine has are {usable}. {give}"
+        )
     return scheme
+
+
+class _Refused(Exception):
+    """The scheduler's host refused the connection: nothing listens on that port."""
+
+
+def _refused(exc: BaseException | None) -> bool:
+    """Whether ``exc``, or an exception it was raised from, is a refused connection (Dask's
+    TCP connector raises ``CommClosedError`` from the ``ConnectionRefusedError``)."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, ConnectionRefusedError):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+async def _connect(address: str, timeout: float, connection_args: dict[str, Any]) -> Any:
+    """A Dask comm to ``address``, its handshake done, as ``distributed.comm.connect`` makes.
+
+    Why: Dask's ``connect`` retries a refused connection until its timeout, so a port nothing
+    listens on (a scheduler not started, a wrong port) waited the full 20 s and was told as
+    "Timed out trying to connect". The first try is made here: refused, :class:`_Refused` is
+    raised at once; any other failure (a name not resolved yet, a slow network) is left to
+    Dask's retries."""
+    from distributed.comm import connect, parse_address
+    from distributed.comm.registry import get_backend
+
+    scheme, location = parse_address(address)
+    connector = get_backend(scheme).get_connector()
+    try:  # Dask's own first try is given a fifth of the timeout, as here
+        comm = await asyncio.wait_for(
+            connector.connect(location, deserialize=True, **connection_args), timeout / 5
+        )
+    except (TimeoutError, OSError) as exc:  # CommClosedError is an OSError
+        if _refused(exc):
+            raise _Refused(location) from None
+        return await connect(address, timeout=timeout, **connection_args)
+    # the handshake Dask's connect does once connected (the scheduler reads it first)
+    try:
+        local_info = comm.handshake_info()
+        await comm.write(local_info)
+        comm.remote_info = await comm.read()
+        comm.remote_info["address"] = comm.peer_address
+        comm.local_info = {**local_info, "address": comm.local_address}
+        comm.handshake_options = comm.handshake_configuration(comm.local_info, comm.remote_info)
+    except BaseException:  # a silent or foreign server, or the overall timeout
+        comm.abort()
+        raise
+    return comm
 
 
 async def _identity(address: str, timeout: float, connection_args: dict[str, Any]) -> Any:
     """The scheduler's answer to Dask's ``identity`` request (a connection, its handshake, one
     request and its reply)."""
-    from distributed.comm import connect
-
-    comm = await connect(address, timeout=timeout, **connection_args)
+    comm = await _connect(address, timeout, connection_args)
     try:
         await comm.write({"op": "identity", "reply": True})
         return await comm.read()
@@ -237,8 +336,6 @@ def _probe(address: str, timeout: float) -> None:
     answers (a proxy, a service that is not Dask, a hung scheduler) held ``rti-rig fit`` for
     ever, and its Ctrl-C left a half-built Client waiting 40 s in ``__del__``. No Client is
     built before this answers."""
-    import asyncio
-
     from distributed.security import Security
 
     args = Security().get_connection_args("client")  # as the Client's own (tls:// from config)
@@ -254,7 +351,11 @@ def _probe(address: str, timeout: float) -> None:
             f"no Dask scheduler answered within {timeout:.0f} s: nothing listens there, a "
             "firewall drops the connection, or what accepts it is not a Dask scheduler",
         ) from None
-    except Exception as exc:  # refused, reset, a TLS failure, a reply that is not Dask's
+    except _Refused as refused:
+        raise _unreachable_scheduler(
+            address, f"connection refused: no scheduler listens at {refused}"
+        ) from None
+    except Exception as exc:  # reset, a TLS failure, a reply that is not Dask's
         raise _unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
     if not (isinstance(identity, dict) and "workers" in identity):
         # e.g. a worker's or nanny's address: it answers, then the Client built on it failed
@@ -277,7 +378,7 @@ def scheduler_client(address: str) -> Iterator[Any]:
         return
     from distributed import Client
 
-    if _checked_address(address) != "inproc":  # in this process: nothing there can hang
+    if _checked_address(address) != "inproc":  # one only in this process: nothing can hang
         _probe(address, CONNECT_TIMEOUT_S)
     try:
         client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
