@@ -65,6 +65,7 @@ from rti_rig.core.image_files import (
     write_srgb_jpeg,
 )
 from rti_rig.core.lp_format import LpEntry, format_lp
+from rti_rig.core.out_folders import refuse_a_file_in_the_way
 from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.disowned import MARKER as DISOWNED_MARKER
 
@@ -455,8 +456,9 @@ class SessionFolder:
         first image) may be reused.
         """
         root = Path(root)
-        if root.exists() and not root.is_dir():
-            raise SessionError(f"{root} exists and is not a folder: choose another --out")
+        # a file at --out or above it is named as fit and bench name it (it had been "exists
+        # and is not a folder" here, and "cannot write …: Not a directory" for one under it)
+        refuse_a_file_in_the_way(root)
         outer = enclosing_session(root)
         if outer is not None:  # a session written inside another goes wherever that one goes
             try:
