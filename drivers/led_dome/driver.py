@@ -112,14 +112,17 @@ class LedDomeDriver:
         the first step of :meth:`connect`, and what the policy calls to get the port back for
         the all-off when a stop cut that step short (then :meth:`finish_boot`).
 
-        :attr:`open_cut_short` is true from before the system opens the port until this link
-        counts it open. Why: a Ctrl-C or SIGTERM in between (inside pyserial's open, which
-        closes the port again as the stop goes through, or just after it) left a port this
-        link never had open, so the policy sent no all-off and said "the dome was never
-        reached" of a board the opening had reset (the line protocol's links were fixed for
-        this; this one had been left out)."""
+        :attr:`open_cut_short` is true, for a port whose opening may reset the board (a serial
+        device's, not a URL's: ``SerialTransport.resets_on_open``), from before the system
+        opens the port until this link counts it open. Why: a Ctrl-C or SIGTERM in between
+        (inside pyserial's open, which closes the port again as the stop goes through, or
+        just after it) left a port this link never had open, so the policy sent no all-off
+        and said "the dome was never reached" of a board the opening had reset (the line
+        protocol's links were fixed for this; this one had been left out)."""
         self.close()
-        self.open_cut_short = True
+        # only an opening that may reset the board leaves one to switch off if a stop cuts it
+        # short; a URL port's connect resets nothing (see SerialTransport.resets_on_open)
+        self.open_cut_short = bool(getattr(self.transport, "resets_on_open", True))
         self._booted = False
         # counted from before the opening too: a stop inside it then finds this opening's
         # deadline, not an earlier one's

@@ -290,13 +290,16 @@ class ScriptedDomeDriver:
         the first step of :meth:`connect`, and what a stop that cut that step short calls to
         get the port back for the all-off (then :meth:`finish_boot`).
 
-        :attr:`open_cut_short` is true from before the system opens the port until this link
-        counts it open: a stop in between (inside pyserial's open, which closes the port again
-        as the stop goes through it) left a port that was never open here, so no all-off was
-        sent, while the opening had reset a board that resets on open, and the Nab sketch
-        boots with every LED lit."""
+        :attr:`open_cut_short` is true, for a port whose opening may reset the board (a serial
+        device's, not a URL's: ``SerialTransport.resets_on_open``), from before the system
+        opens the port until this link counts it open: a stop in between (inside pyserial's
+        open, which closes the port again as the stop goes through it) left a port that was
+        never open here, so no all-off was sent, while the opening had reset a board that
+        resets on open, and the Nab sketch boots with every LED lit."""
         self.close()
-        self.open_cut_short = True
+        # only an opening that may reset the board leaves one to switch off if a stop cuts it
+        # short; a URL port's connect resets nothing (see SerialTransport.resets_on_open)
+        self.open_cut_short = bool(getattr(self.transport, "resets_on_open", True))
         self._booted = self._boot_heard = False
         self.foreign_firmware = None
         self._foreign_off = None

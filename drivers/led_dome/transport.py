@@ -76,6 +76,17 @@ class SerialTransport:
         self._ser: serial.SerialBase | None = None
         self._timeout: float | None = None
 
+    @property
+    def resets_on_open(self) -> bool:
+        """Opening this port may reset the board: the system's open of a serial device raises
+        DTR, which resets most Arduino boards. A URL port (``socket://``, ``rfc2217://``,
+        ``loop://`` …) is a network connection or an in-memory loop: connecting toggles no DTR
+        here. Why it is asked: a stop inside the opening of such a port had been taken for one
+        that may have reset the board, and the policy reopened a connection that never
+        completed (a second 5 s connect, signals held) and then said the lights "may still be
+        on" of a dome it had never reached."""
+        return "://" not in self.port
+
     def open(self) -> None:
         if self._ser is not None:
             return

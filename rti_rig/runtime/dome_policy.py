@@ -320,6 +320,7 @@ class DomePolicy:
             # the handshake: the port is open and a board may boot lit, so the all-off is
             # sent before the stop goes on (it had been told "the dome was never reached"
             # with every LED of a board that boots lit still on)
+            self._reopen_cut_short_port()  # not held: a further stop ends a reopening that hangs
             self._switch_off_then_close(self._switch_off_after_stop)
             raise
         self._port_was_open = True
@@ -1019,12 +1020,11 @@ class DomePolicy:
 
     def _switch_off_after_stop(self) -> None:
         """The all-off after a stop cut :meth:`connect` short, once the board has booted (the
-        port opened again first if the stop cut its opening short). Run with further signals
-        held (see :meth:`connect`): a second Ctrl-C during its boot wait, the usual answer to a
-        command that does not stop at once, had cut it short and left the Nab board, which
-        boots lit, with every LED on; the signal acts once the all-off is through."""
-        if getattr(self.link, "open_cut_short", False):
-            self._reopen_cut_short_port()
+        port opened again first, by :meth:`_reopen_cut_short_port`, if the stop cut its opening
+        short). Run with further signals held (see :meth:`connect`): a second Ctrl-C during its
+        boot wait, the usual answer to a command that does not stop at once, had cut it short
+        and left the Nab board, which boots lit, with every LED on; the signal acts once the
+        all-off is through."""
         if not getattr(self.link, "port_open", True):
             return
         self._port_was_open = True
@@ -1049,7 +1049,16 @@ class DomePolicy:
         dome was never reached", while the opening had reset the board, and the Nab sketch
         boots with every LED lit. Reopening resets such a board once more (lit while it
         boots), then its all-off switches it off, acknowledged where the firmware does. If the
-        port does not open again, the lights line says the all-off was not sent."""
+        port does not open again, the lights line says the all-off was not sent.
+
+        Run before the held block, with signals as they are: an opening can hang (a port that
+        does not answer its open), and held signals had made a second Ctrl-C wait it out; a
+        further stop now ends it at once, the port closed and the lights line saying the
+        all-off was not sent. Only an opening that may reset the board (a serial device's, see
+        ``SerialTransport.resets_on_open``) is reopened: the link leaves ``open_cut_short``
+        false for one that resets nothing, such as a URL port's connect."""
+        if not getattr(self.link, "open_cut_short", False):
+            return
         self._port_was_open = True  # the system opened it: a board that resets on open did
         self.reached = "opened"
         self.off_report = OffReport(
@@ -1065,6 +1074,14 @@ class DomePolicy:
             self.off_report = replace(
                 self.off_report, detail=f"the port did not open again after the stop: {exc}"
             )
+        except BaseException:
+            # a further stop while the port was being opened again: it ends here, nothing sent
+            self.off_report = replace(
+                self.off_report,
+                detail="a further stop ended the reopening of the port a stop had cut short",
+            )
+            self._quiet_close()
+            raise
 
     def _lit_at_boot(self) -> str | None:
         """The firmware's name if it lights every LED as its board boots (the Nab sketch)."""

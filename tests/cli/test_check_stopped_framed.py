@@ -4,6 +4,9 @@ board has booted, and the line says what it established, as on the line-protocol
 A stop inside the port's opening is tested on the default profile too (the shipped
 ``emulated_dome.toml``): the same driver runs both profiles, and each is covered.
 
+A stop inside the opening of a URL port (``socket://``), whose connect resets nothing, is not
+followed by a reopening; and a further Ctrl-C ends a reopening of a serial device at once.
+
 The framed profile's driver had been left out of that fix: a Ctrl-C inside the port's opening
 (the system had opened it, which resets an Arduino-class board; pyserial closes it again as the
 stop goes through) sent no all-off and said "the dome was never reached", and a Ctrl-C in the
@@ -14,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import socket
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -120,3 +124,112 @@ def test_a_ctrl_c_in_the_framed_boards_boot_wait_switches_it_off_once_it_has_boo
     events = [e.what for e in firmware.history]
     assert firmware.commands_received >= 1 and "lost while booting" not in events, events
     assert firmware.lit is None
+
+
+@contextlib.contextmanager
+def _listener_that_never_accepts() -> Iterator[tuple[str, int]]:
+    """A TCP listener whose backlog is full and which never accepts: a connect to it hangs
+    (until pyserial's own 5 s timeout), as one to a dome bridge that is not answering does."""
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(0)
+        address = listener.getsockname()
+        queued = [socket.socket() for _ in range(8)]
+        try:
+            for client in queued:
+                client.setblocking(False)
+                client.connect_ex(address)
+            yield address
+        finally:
+            for client in queued:
+                client.close()
+
+
+def test_a_ctrl_c_while_a_socket_port_connects_ends_the_check_without_a_reopening(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """The shipped framed config with its port a ``socket://`` URL to a listener that never
+    accepts. Connecting over TCP toggles no DTR and resets nothing, and this one never
+    completed: the check ends at the Ctrl-C, saying the dome was never reached. It had reopened
+    the port (a second hanging connect, with a further Ctrl-C held), then said "all-off could
+    NOT be sent … lights may still be on" of a dome it never reached."""
+    import serial.urlhandler.protocol_socket as protocol_socket
+
+    with _listener_that_never_accepts() as (host, port):
+        text = SHIPPED.read_text()
+        assert 'profile = "framed"' in text
+        config = tmp_path / SHIPPED.name
+        config.write_text(
+            "\n".join(
+                f'port = "socket://{host}:{port}"' if line.startswith("port = ") else line
+                for line in text.splitlines()
+            )
+        )
+        lp = SHIPPED.with_suffix(".lp")
+        (tmp_path / lp.name).write_bytes(lp.read_bytes())
+        real_connect = protocol_socket.socket.create_connection
+        attempts: list[object] = []
+
+        def connecting(address, *args, **kwargs):  # type: ignore[no-untyped-def]
+            if tuple(address) == (host, port):
+                attempts.append(address)
+                if len(attempts) == 1:  # the user's Ctrl-C while the connect hangs
+                    signal.raise_signal(signal.SIGINT)
+            return real_connect(address, *args, **kwargs)
+
+        monkeypatch.setattr(protocol_socket.socket, "create_connection", connecting)
+        exit_code, said = _check_said(config)
+    assert exit_code == 130, said
+    assert "Traceback" not in said
+    assert len(attempts) == 1, said  # nothing connected again after the stop
+    assert "reopening" not in said, said
+    assert "may still be on" not in said, said
+    assert "Check stopped (Ctrl-C): no all-off was attempted (the dome was never reached)" in (
+        said
+    ), said
+
+
+def test_a_second_sigterm_ends_the_reopening_of_a_port_whose_opening_a_stop_cut_short(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """``rti-rig run`` on the shipped default-profile dome (its emulator on a pty, a serial
+    device): a SIGTERM inside the port's opening, which may have reset the board, reopens the
+    port for the all-off; a second SIGTERM during that reopening (an open that hangs) ends it
+    at once, and the line says the all-off was not sent. The reopening had run with signals
+    held, so nothing could end an open that hung. (``run``, not ``check``: the check's handler
+    answers any further signal during its teardown with "Still stopping" alone, by design.)"""
+    import serial
+
+    emulators = emulators_built_by_check(monkeypatch)
+    redirected = serial.serial_for_url
+    openings: list[int] = []
+
+    def opened(*args, **kwargs):  # type: ignore[no-untyped-def]
+        openings.append(1)
+        if len(openings) == 2:  # the second stop, while the port is being opened again
+            signal.raise_signal(signal.SIGTERM)
+        port = redirected(*args, **kwargs)
+        if len(openings) == 1:  # the first stop, inside the first opening
+            try:
+                signal.raise_signal(signal.SIGTERM)
+            except BaseException:
+                port.close()  # as pyserial's own open does when a stop goes through it
+                raise
+        return port
+
+    monkeypatch.setattr(serial, "serial_for_url", opened)
+    config = BY_PROFILE["default"]
+    r = CliRunner().invoke(
+        app, ["run", str(config), "--out", str(tmp_path / "out")], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 143, said
+    assert "Traceback" not in said
+    assert len(openings) == 2, said
+    assert (
+        "Emergency stop (SIGTERM): all-off could NOT be sent (a further stop ended the "
+        "reopening of the port a stop had cut short)"
+    ) in said, said
+    firmware = emulators[-1]
+    assert [e.what for e in firmware.history].count("boot") == 1  # not opened again
+    assert firmware.commands_received == 0
