@@ -1291,7 +1291,8 @@ def assess(
     bright_as_mates = _bright_as_its_elevation(ev.gain, lt)
     # the whole frame's mean level against the images lit from its elevation: a fit of the
     # session can take a halved or doubled image of a glossy object in (qa_exposure)
-    # (a clipped image's level is a lower bound: no mate, and never "too dark")
+    # (a clipped image's level is a lower bound and its highlight may cover much of the
+    # frame (the real neuralrti_replay's image09, 21 %): no mate, and never judged)
     wrong_judged = ev.wrong & ev.direction_judged
     clipped = sat_frac > SATURATED_LIMIT
     exposure, mates = exposure_ratios(
@@ -1299,7 +1300,7 @@ def assess(
         lt,
         ~ev.dim & ~wrong_judged & ~clipped,
     )
-    exposure[clipped & (exposure < 1.0)] = np.nan
+    exposure[clipped] = np.nan
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []

@@ -16,6 +16,19 @@ px, 12-48 lights; the simulated dome and the virtual arm, whose lights are at ev
 compared per unit of the light's height, 0.93-1.23 there), however glossy, since a highlight
 covers few pixels of the frame. Where
 they do not agree among themselves (a tilted object, lit from one side), nothing is judged.
+
+Two mates that agree are not enough on their own: on a real acquisition
+(``tests/data/neuralrti_replay``) the object is about 3× brighter per unit of light height
+lit from one side (azimuth -50..35°) than from the other, and its 59° image09 had its only
+two mates, 104° and -149° of azimuth, both on the dark side and agreeing, so it was called
+"about 3.6× too bright". An elevation predicts a level only where the session shows that the
+azimuth does not matter: no two other images lit from one elevation disagree, and either two
+images of another elevation agree, one lit from the image's side (within 45° of azimuth) and
+one from a mate's, or the mates are at least 3 surrounding the sky (no gap of 180° in
+azimuth). A ring of 3 (the simulated dome's 12-light coin) is judged by the other rings
+agreeing; the real acquisition's 20° ring disagrees 1.9×, and nothing is judged there.
+Nor is "a highlight covers few pixels" true of a clipped image (image09 had 21 % clipped): the
+QA judges no clipped image by this check, either way (it is named saturated instead).
 """
 
 from __future__ import annotations
@@ -37,6 +50,12 @@ EXPOSURE_MATES_MIN = 2
 #: object's brightness depends on the light's azimuth too (a tilted object), an elevation does
 #: not predict it.
 EXPOSURE_MATE_SPREAD = 1.5
+#: The session shows that the azimuth does not matter between the image and its mates where two
+#: other images lit from one elevation agree, one lit from within this many degrees of the
+#: image's azimuth and the other of a mate's ...
+EXPOSURE_AZIMUTH_DEG = 45.0
+#: ... or where at least this many mates leave no gap of 180° or more between their azimuths.
+EXPOSURE_SURROUND_MIN = 3
 #: Levels are compared per unit of the light's height above the object plane (its direction's
 #: z); a light lower than this (about 3°) is not judged.
 MIN_LZ = 0.05
@@ -48,8 +67,11 @@ def exposure_ratios(
     """Each image's mean ``level`` per unit of its light's height (``lz``) over the median of
     its mates' (per theirs) (the ``usable`` images
     lit from within :data:`EXPOSURE_MATE_DEG` of its light's elevation), and how many mates;
-    NaN where fewer than :data:`EXPOSURE_MATES_MIN` mates, or mates that disagree by more than
-    :data:`EXPOSURE_MATE_SPREAD` among themselves (pure).
+    NaN where fewer than :data:`EXPOSURE_MATES_MIN` mates, where any two other usable images lit
+    from one elevation (its mates among them) disagree by more than
+    :data:`EXPOSURE_MATE_SPREAD`, or where no two other images of one elevation, lit from its
+    side and a mate's (:data:`EXPOSURE_AZIMUTH_DEG`), agree and its mates do not surround it
+    (:func:`_surround`) (pure).
 
     ``usable``: the images fit to stand as a mate (not found dark, wrong or black already:
     one misfire among three images of a ring must not make the other two look bright)."""
@@ -63,17 +85,51 @@ def exposure_ratios(
     # 24 lights: its 6° image read 0.65 of its 8° and 10° mates, 0.99-1.01 per lz)
     level = np.where(lz > MIN_LZ, level / np.maximum(lz, MIN_LZ), np.nan)
     ok = usable & np.isfinite(level) & (level > 0)
+    azimuth = np.degrees(np.arctan2(lt[:, 1], lt[:, 0]))
+    # pairs of usable images lit from one elevation, and those whose levels disagree: the
+    # session's own evidence on whether the azimuth matters (an object brighter lit from one
+    # side, a tilted one, uneven LEDs)
+    same_el = np.abs(elevation[:, None] - elevation[None, :]) <= EXPOSURE_MATE_DEG
+    pair = same_el & ok[:, None] & ok[None, :] & ~np.eye(n, dtype=bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        apart = np.abs(np.log(level[:, None] / level[None, :])) > np.log(EXPOSURE_MATE_SPREAD)
     for i in np.flatnonzero(np.isfinite(level) & (level > 0)):
-        mates = ok & (np.abs(elevation - elevation[i]) <= EXPOSURE_MATE_DEG)
+        mates = ok & same_el[i]
         mates[i] = False
         count[i] = int(mates.sum())
         if count[i] < EXPOSURE_MATES_MIN:
             continue
-        m = level[mates]
-        if m.max() > EXPOSURE_MATE_SPREAD * m.min():
-            continue
-        ratio[i] = float(level[i] / np.median(m))
+        others = pair.copy()
+        others[i, :] = False
+        others[:, i] = False
+        if (others & apart).any():
+            continue  # some elevation's images disagree (its own mates among them)
+        near_i = _azimuth_apart(azimuth, azimuth[i]) <= EXPOSURE_AZIMUTH_DEG
+        near_mate = np.zeros(n, bool)
+        for m in np.flatnonzero(mates):
+            near_mate |= _azimuth_apart(azimuth, azimuth[m]) <= EXPOSURE_AZIMUTH_DEG
+        beyond_mates = others & ~(mates[:, None] & mates[None, :])
+        evidence = beyond_mates & near_i[:, None] & near_mate[None, :]
+        if not evidence.any() and not _surround(azimuth[mates]):
+            continue  # nothing shows its side of the sky and its mates' lit alike
+        ratio[i] = float(level[i] / np.median(level[mates]))
     return ratio, count
+
+
+def _azimuth_apart(azimuth_deg: NDArray, of_deg: float) -> NDArray:
+    """Each azimuth's angle from ``of_deg`` around the circle (0-180°)."""
+    d = np.mod(azimuth_deg - of_deg, 360.0)
+    return np.minimum(d, 360.0 - d)
+
+
+def _surround(azimuth_deg: NDArray) -> bool:
+    """At least :data:`EXPOSURE_SURROUND_MIN` azimuths with no gap of 180° or more between
+    them: mates on every side, whose agreement says the azimuth does not matter."""
+    if len(azimuth_deg) < EXPOSURE_SURROUND_MIN:
+        return False
+    a = np.sort(np.mod(azimuth_deg, 360.0))
+    gaps = np.diff(np.r_[a, a[0] + 360.0])
+    return bool(gaps.max() < 180.0)
 
 
 def exposure_off(ratio: float) -> bool:
