@@ -7,7 +7,8 @@ Run before the object leaves the dome. The checks (all on linear images):
   resolution (at most :data:`CROP` pixels a side, where the object has lit structure:
   :func:`_choose_crop`), refitted without the images found faulty
   (after a first fit that finds any, from the largest set of images that agree among
-  themselves: :func:`~rti_rig.reconstruct.qa_directions.consensus_images`), then per image the
+  themselves: :func:`~rti_rig.reconstruct.qa_directions.consensus_images`; an image whose
+  exposure is off enters them scaled back to its elevation's level), then per image the
   Lambertian prediction ``rho max(0, n . l_i)`` over the pixels its recorded light reaches:
 
   - **gain** ``image / prediction``; its :data:`DIM_PERCENTILE` percentile below
@@ -1119,11 +1120,33 @@ def assess(
     # the rest. So it is refitted without the images found wrong, moved or dark; after a
     # first fit that found any, from the half of the images that best fit any light (the most
     # self-consistent), then from every image not flagged, until the set stops changing.
+    # An image whose whole exposure is off against the images lit from its elevation (no fit
+    # needed: qa_exposure) enters the reference fits scaled back to its mates' level, as a
+    # dim image is judged again (_dim_rejudged): as captured, a doubled image of the shipped
+    # dome's 1024 px coin (12 lights, image_007) tilted the fit until the correct image_002
+    # read "misfired or dim: 33%"; left out, the surface it lit had too few lights and
+    # image_002 read 36%. The image itself is still judged as captured, below. A frame with
+    # next to no light (NO_LIGHT_GAIN) has nothing to scale: its noise is not made an image.
+    level = small.reshape(n, -1).mean(axis=1, dtype=np.float64)
+    clipped = sat_frac > SATURATED_LIMIT
+    early_exposure, _ = exposure_ratios(level, lt, ~clipped)
+    levelled = np.array(
+        [
+            exposure_off(r) and r >= NO_LIGHT_GAIN and not clipped[i]
+            for i, r in enumerate(early_exposure)
+        ],
+        dtype=bool,
+    )
+
+    def fit_stack(arr: NDArray) -> NDArray:
+        """``arr`` as the reference fits take it: the exposure-off images levelled."""
+        return _exposure_levelled(arr, early_exposure, levelled, sat_level)
+
     keep = np.ones(n, bool)
     ps = (
         step_fit
-        if step_fit is not None
-        else fit_photometric_stereo(crop_arr, lt, robust=True, saturation=sat_level)
+        if step_fit is not None and not levelled.any()
+        else fit_photometric_stereo(fit_stack(crop_arr), lt, robust=True, saturation=sat_level)
     )
     ev = evidence_of(ps)
     before = (ps, ev)  # the fit and evidence a refit replaced
@@ -1160,7 +1183,7 @@ def assess(
             break
         try:
             ps_next = fit_photometric_stereo(
-                crop_arr[new_keep], lt[new_keep], robust=True, saturation=sat_level
+                fit_stack(crop_arr)[new_keep], lt[new_keep], robust=True, saturation=sat_level
             )
         except ReconstructionError:  # the remaining lights cannot determine normals
             break
@@ -1180,7 +1203,10 @@ def assess(
         if not np.array_equal(unfaulted, keep) and unfaulted.sum() >= 6:
             try:
                 ps = fit_photometric_stereo(
-                    crop_arr[unfaulted], lt[unfaulted], robust=True, saturation=sat_level
+                    fit_stack(crop_arr)[unfaulted],
+                    lt[unfaulted],
+                    robust=True,
+                    saturation=sat_level,
                 )
                 keep = unfaulted
             except ReconstructionError:
@@ -1286,7 +1312,11 @@ def assess(
             ps, ev, step = block
             step_moved[step.first :] = True
     if int(ev.dim.sum()) >= 2:
-        ev = _dim_rejudged(ev, crop_arr, lt, keep & ~ev.dim, sat_level, evidence_of)
+        # the images called dim as captured: _dim_rejudged scales each back by its own gain
+        # (levelled here as well, a halved one was scaled twice and image_002 read dim again)
+        rejudge_arr = fit_stack(crop_arr)
+        rejudge_arr = np.where(ev.dim[:, None, None], crop_arr, rejudge_arr)
+        ev = _dim_rejudged(ev, rejudge_arr, lt, keep & ~ev.dim, sat_level, evidence_of)
     light_scatter, within_scatter = _light_scatter(ev.gain, ev.misfit)
     bright_as_mates = _bright_as_its_elevation(ev.gain, lt)
     # the whole frame's mean level against the images lit from its elevation: a fit of the
@@ -1294,12 +1324,7 @@ def assess(
     # (a clipped image's level is a lower bound and its highlight may cover much of the
     # frame (the real neuralrti_replay's image09, 21 %): no mate, and never judged)
     wrong_judged = ev.wrong & ev.direction_judged
-    clipped = sat_frac > SATURATED_LIMIT
-    exposure, mates = exposure_ratios(
-        small.reshape(n, -1).mean(axis=1, dtype=np.float64),
-        lt,
-        ~ev.dim & ~wrong_judged & ~clipped,
-    )
+    exposure, mates = exposure_ratios(level, lt, ~ev.dim & ~wrong_judged & ~clipped)
     exposure[clipped] = np.nan
     checks: list[ImageCheck] = []
     for i in range(n):
@@ -1463,6 +1488,26 @@ def assess(
         light_scatter=light_scatter,
         crop=(rs.start, cs.start, rs.stop - rs.start, cs.stop - cs.start),
     )
+
+
+def _exposure_levelled(
+    arr: NDArray, ratio: NDArray, off: NDArray[np.bool_], sat_level: float | None
+) -> NDArray:
+    """``arr`` with each ``off`` image divided by its exposure ``ratio``
+    (:func:`~rti_rig.reconstruct.qa_exposure.exposure_ratios`), its clipped pixels kept at
+    ``sat_level`` (still clipped to the fit); ``arr`` itself where none is off.
+
+    Why: an image whose exposure is off is still a direction. The reference fit of few lights
+    needs it (left out, the surface it lit tilts), but at its captured level it drags the
+    normals towards it and the correct images beside it read dim."""
+    if not off.any():
+        return arr
+    out = arr.copy()
+    for i in np.flatnonzero(off):
+        out[i] = arr[i] / np.float32(ratio[i])
+        if sat_level is not None:
+            out[i][arr[i] >= sat_level] = sat_level
+    return out
 
 
 def _exposure_words(ratio: float, mates: int) -> str:

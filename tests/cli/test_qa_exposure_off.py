@@ -6,7 +6,8 @@ camera would make them, had been "good" apart from the image_012 every session o
 clips: the robust fit of 12 lights took the halved image in (1.01 of its prediction on the
 pixels it explains) and the doubled one is no Lambertian rendering of the glossy coin, so its
 brightness was not judged. Each is now judged against the images lit from its elevation; the
-clean session names no image for its exposure.
+clean session names no image for its exposure. A doubled image no longer gets a correct one
+named beside it: it enters the QA's reference fit scaled back to its mates' level.
 """
 
 from __future__ import annotations
@@ -55,8 +56,10 @@ def _exposure_named(qa: dict) -> dict[str, str]:
     }
 
 
-@pytest.mark.slow  # the coin at 1024 px, 12 lights: three fits of the session
-def test_a_halved_and_a_doubled_image_are_named_on_the_glossy_coin(tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def coin_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shipped simulated dome with its scene set to the coin at 1024 px, 12 lights."""
+    tmp_path = tmp_path_factory.mktemp("coin")
     text = (CONFIGS / "simulated_dome.toml").read_text()
     assert 'name = "relief"' in text and "width = 512" in text and "height = 512" in text
     text = text.replace('name = "relief"', 'name = "coin"')
@@ -66,7 +69,14 @@ def test_a_halved_and_a_doubled_image_are_named_on_the_glossy_coin(tmp_path: Pat
         app, ["run", str(write_config(tmp_path, text)), "--out", str(session), "--lights", "12"]
     )
     assert r.exit_code == 0, r.output
+    return session
 
+
+@pytest.mark.slow  # the coin at 1024 px, 12 lights: three fits of the session
+def test_a_halved_and_a_doubled_image_are_named_on_the_glossy_coin(
+    coin_session: Path, tmp_path: Path
+) -> None:
+    session = coin_session
     clean, _ = _fit(session, tmp_path / "fit_clean")
     assert _exposure_named(clean) == {}, clean["verdict"]
     assert "image_005" not in clean["reshoot"] and "image_009" not in clean["reshoot"]
@@ -88,3 +98,21 @@ def test_a_halved_and_a_doubled_image_are_named_on_the_glossy_coin(tmp_path: Pat
     assert "image_005 (about 1.9× too bright for its light" in said or (
         "image_005 (about 2.0× too bright for its light" in said
     ), said
+
+
+@pytest.mark.slow  # the coin at 1024 px, 12 lights: one fit of the session
+def test_a_doubled_image_does_not_get_a_correct_one_named_dim_beside_it(
+    coin_session: Path, tmp_path: Path
+) -> None:
+    # image_007 (40°) doubled had tilted the reference fit until the correct image_002 (10°,
+    # lighting the same side) read "misfired or dim light: 33%": now image_007 enters the fit
+    # scaled back to its mates' level, and is still named for its exposure
+    doubled, said = _fit(
+        _scaled_copy(coin_session, tmp_path / "doubled", "image_007", 2.0), tmp_path / "f"
+    )
+    named = {c["name"] for c in doubled["images"] if c["problems"]}
+    # image_012 (70°) clips in every session of that rig: named saturated, as on the clean one
+    assert named == {"image_007", "image_012"}, doubled["verdict"]
+    assert list(_exposure_named(doubled)) == ["image_007"], doubled["verdict"]
+    assert doubled["reshoot"] == ["image_007", "image_012"], doubled["verdict"]
+    assert "image_007 (about 1.9× too bright for its light" in said, said
