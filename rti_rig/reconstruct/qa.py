@@ -279,8 +279,10 @@ class ImageCheck:
     reliable_gain: float = float("nan")
     #: The image's mean level over the median of the images lit from within
     #: :data:`~rti_rig.reconstruct.qa_exposure.EXPOSURE_MATE_DEG` of its elevation
-    #: (:func:`~rti_rig.reconstruct.qa_exposure.exposure_ratios`); NaN where fewer than 2 such
-    #: images, or they disagree among themselves. :data:`EXPOSURE_OFF` either way names it.
+    #: (:func:`~rti_rig.reconstruct.qa_exposure.exposure_ratios`); NaN where the session does
+    #: not show that azimuth leaves the level alone there (too few such images, mates that
+    #: disagree, no other elevation's pair to prove it), and for a clipped image.
+    #: :data:`EXPOSURE_OFF` either way names it.
     exposure_ratio: float = float("nan")
 
 
