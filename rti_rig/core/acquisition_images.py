@@ -50,27 +50,62 @@ def check_acquisition_images(
     ``lead`` opens the message of missing images (the replay says what an `.lp` is as a rig);
     ``use`` is the verb of what is done with the others ("replay", "measure"); ``pixels``
     says who cannot read a float or many-paged TIFF."""
-    paths = dict(zip((e.name for e in entries), image_paths(lp_path, entries), strict=True))
-    missing = [e.name for e in entries if not paths[e.name].is_file()]
+    names = [e.name for e in entries]
+    return check_image_files(
+        lp_path,
+        names,
+        image_paths(lp_path, entries),
+        lead=lead,
+        use=use,
+        pixels=pixels,
+    )
+
+
+def check_image_files(
+    lp_path: Path,
+    names: Sequence[str],
+    files: Sequence[Path],
+    *,
+    lead: str = "",
+    use: str = "replay",
+    pixels: str = "a replay cannot give as a frame",
+    headers_only: bool = False,
+) -> AcquisitionImages:
+    """:func:`check_acquisition_images` of the files that will actually be read for the images
+    ``lp_path`` lists as ``names`` (``files[i]`` for ``names[i]``).
+
+    Why split out: ``fit`` reads a ``linear/<stem>.tif`` beside the `.lp` in place of the file
+    it names when there is one; it checks those files, in the words ``run`` and ``bench
+    tradeoff --from`` use (it had stopped at the first missing image, and said a size apart
+    as numpy shapes).
+
+    ``headers_only``: decode nothing, and leave an image that is damaged, of samples ``pixels``
+    names, or whose header does not say its size out of the comparison, to the reader that
+    names its fault (the fit's own read says "cannot be read as a TIFF" where a decode here
+    would say "index 0 out of range"); the size and kind then are 0 and colour when no header
+    says them."""
+    paths = dict(zip(names, files, strict=True))
+    missing = [n for n in names if not paths[n].is_file()]
     if missing:
         more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
         shown = ", ".join(missing[:5]) + more
         raise ConfigError(
             lp_path,
             None,
-            f"{lead}{len(missing)} of {len(entries)} image(s) missing in "
+            f"{lead}{len(missing)} of {len(names)} image(s) missing in "
             f"{Path(lp_path).parent} ({shown})"
             + missing_images_advice(
                 missing,
                 [paths[m] for m in missing],
                 Path(lp_path).parent,
                 use,
-                total=len(entries),
+                total=len(names),
             ),
         )
-    why_cut = {e.name: image_truncation(paths[e.name]) for e in entries}
+    why_cut = {n: image_truncation(paths[n]) for n in names}
     damaged = [f"{name}: {why}" for name, why in why_cut.items() if why is not None]
-    if damaged:  # OpenCV would decode a JPEG with its missing part grey, and say nothing
+    # OpenCV would decode a JPEG with its missing part grey, and say nothing
+    if damaged and not headers_only:
         jpegs = all(
             paths[name].suffix.lower() in (".jpg", ".jpeg")
             for name, why in why_cut.items()
@@ -79,7 +114,7 @@ def check_acquisition_images(
         raise ConfigError(
             lp_path,
             None,
-            f"{len(damaged)} of {len(entries)} image(s) beside it are damaged "
+            f"{len(damaged)} of {len(names)} image(s) beside it are damaged "
             f"{'JPEGs' if jpegs else 'images'} "
             f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
             "from the camera or card",
@@ -87,26 +122,31 @@ def check_acquisition_images(
     layouts: dict[str, tuple[int, int, bool]] = {}
     unreadable: list[str] = []
     unsupported: list[str] = []
-    for e in entries:
-        path = paths[e.name]
+    for n in names:
+        path = paths[n]
+        if why_cut[n] is not None:
+            continue  # (headers_only) said by the reader
         problem = tiff_sample_problem(path)  # a float TIFF has a header like any other
         if problem is not None:
-            unsupported.append(problem)
+            if not headers_only:
+                unsupported.append(problem)
             continue
         layout = header_layout(path)
         if layout is None:
+            if headers_only:
+                continue
             try:
                 img = read_image_any(path)
             except SessionError as exc:
                 unreadable.append(str(exc))
                 continue
             layout = (int(img.shape[0]), int(img.shape[1]), img.ndim == 3)
-        layouts[e.name] = layout
+        layouts[n] = layout
     if unreadable:
         raise ConfigError(
             lp_path,
             None,
-            f"{len(unreadable)} of {len(entries)} image(s) beside it cannot be read "
+            f"{len(unreadable)} of {len(names)} image(s) beside it cannot be read "
             f"({'; '.join(unreadable[:5])}{' ...' if len(unreadable) > 5 else ''}); copy them "
             "again from the camera or card, or list only the others",
         )
@@ -114,17 +154,20 @@ def check_acquisition_images(
         raise ConfigError(
             lp_path,
             None,
-            f"{len(unsupported)} of {len(entries)} image(s) beside it hold pixels {pixels} "
+            f"{len(unsupported)} of {len(names)} image(s) beside it hold pixels {pixels} "
             f"({'; '.join(unsupported[:3])}"
             f"{' ...' if len(unsupported) > 3 else ''}), or list only the others",
         )
-    height, width, colour = layouts[entries[0].name]
+    if not layouts:  # (headers_only) no header said a size
+        return AcquisitionImages([paths[n] for n in names], 0, 0, True)
+    first = next(iter(layouts))  # the first image listed, unless left to its reader
+    height, width, colour = layouts[first]
     odd = [f"{n} is {w}x{h}" for n, (h, w, _) in layouts.items() if (h, w) != (height, width)]
     if odd:
         raise ConfigError(
             lp_path,
             None,
-            f"the images beside it differ in size: {entries[0].name} is {width}x{height} but "
+            f"the images beside it differ in size: {first} is {width}x{height} but "
             f"{'; '.join(odd[:5])}{' ...' if len(odd) > 5 else ''}; an acquisition has one "
             "image size (replace or resize those images, or list only the others)",
         )
@@ -134,9 +177,9 @@ def check_acquisition_images(
         raise ConfigError(
             lp_path,
             None,
-            f"the images beside it are not all {kind}: {entries[0].name} is {kind} but "
+            f"the images beside it are not all {kind}: {first} is {kind} but "
             f"{', '.join(other[:5])}{' ...' if len(other) > 5 else ''} "
             f"{'is' if len(other) == 1 else 'are'} {'greyscale' if colour else 'colour'}; an "
             "acquisition has one kind of image (convert those images, or list only the others)",
         )
-    return AcquisitionImages([paths[e.name] for e in entries], height, width, colour)
+    return AcquisitionImages([paths[n] for n in names], height, width, colour)

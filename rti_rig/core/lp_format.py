@@ -216,7 +216,9 @@ def missing_images_advice(
     Why: an absolute name whose file exists at that very path had been called "missing" and
     the user told to "copy them where their names point", where they already were. It is
     read beside the `.lp` by design (see :func:`image_path`), so that is said, with the two
-    ways out. One wording for ``run``, ``fit`` and ``bench tradeoff --from``.
+    ways out. One wording for ``run``, ``fit`` (of an `.lp`, not a session: a session's lost
+    images are said from its journal) and ``bench tradeoff --from``, all three through
+    :func:`rti_rig.core.acquisition_images.check_image_files`.
 
     An absolute name at no such path had been told both that it is looked for beside the
     `.lp` and to "copy them where their names point" (which leads only to the "exists at the

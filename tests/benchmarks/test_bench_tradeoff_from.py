@@ -252,6 +252,38 @@ def test_an_image_of_another_size_or_kind_is_refused_by_name_before_any_work(
     # run ACQ/dirs.lp says the same of the same images (one check, shared)
     ran = CliRunner().invoke(app, ["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"])
     assert ran.exit_code == 2 and said in " ".join(ran.output.split())
+    # and so does fit of the .lp, before decoding any pixel: it had said numpy's words part-way
+    # ("images of acq/dirs.lp differ: image05.jpg is (295, 300, 3) uint8, ...")
+    fit_out = tmp_path / "f"
+    fitted = CliRunner().invoke(app, ["fit", str(lp), "--out", str(fit_out), "--no-qa"])
+    fit_text = " ".join(fitted.output.split())
+    assert fitted.exit_code == 2, fit_text
+    assert fit_text.startswith(f"error: {lp}: the images beside it "), fit_text
+    assert said in fit_text and "uint8" not in fit_text, fit_text
+
+
+def test_two_missing_relative_names_are_said_alike_by_run_bench_and_fit(tmp_path: Path) -> None:
+    """An .lp (not a session) two of whose images, named relative to it, are gone: run and
+    bench named both in one sentence, but fit stopped at the first ("image acq/image05.jpg
+    listed in acq/dirs.lp is missing ..."), naming neither the other nor the way out."""
+    lp = _acquisition(tmp_path / "acq", count=8)
+    (lp.parent / "image05.jpg").unlink()
+    (lp.parent / "image17.jpg").unlink()
+    said = (
+        f"2 of 8 image(s) missing in {lp.parent} (image05.jpg, image17.jpg); copy them where "
+        "their names point, or remove their lines from the .lp to"
+    )
+    for command, verb in (
+        (["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"], "replay"),
+        (["bench", "tradeoff", "--from", str(lp), "--out", str(tmp_path / "o")], "measure"),
+        (["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"], "fit"),
+    ):
+        r = CliRunner().invoke(app, command)
+        text = " ".join(r.output.split())
+        assert r.exit_code == 2, text
+        assert text.startswith(f"error: {lp}: "), text
+        assert f"{said} {verb} the others" in text, (command[0], text)
+        assert "Traceback" not in text
 
 
 def test_absolute_names_whose_files_are_there_are_said_so_by_bench_run_and_fit(

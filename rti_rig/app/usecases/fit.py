@@ -37,7 +37,8 @@ from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
 from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
-from rti_rig.core.errors import RtiRigError
+from rti_rig.core.acquisition_images import check_image_files
+from rti_rig.core.errors import ConfigError, RtiRigError
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
@@ -47,8 +48,6 @@ from rti_rig.core.lp_format import (
     format_lp,
     image_file_name,
     image_paths,
-    is_absolute_name,
-    missing_images_advice,
     parse_lp,
     read_lp,
 )
@@ -413,7 +412,7 @@ def acquisition_files(
         damaged += [(p, why) for p in paths if p.is_file() and (why := image_truncation(p))]
         _refuse_lost_images(lp, damaged)
     else:
-        _refuse_missing_images(lp, entries, paths)
+        _refuse_unusable_images(lp, entries, paths)
     if notes is not None and stand_ins and (len(stand_ins) < len(entries) or session):
         # a session's linear/ lacks some TIFFs: their 8-bit files are read instead, said (the
         # fit had mixed lossy 8-bit data into a linear one without a word; and a session whose
@@ -428,29 +427,33 @@ def acquisition_files(
     return lp, lights, paths, names
 
 
-def _refuse_missing_images(lp: Path, entries: list[Any], paths: list[Path]) -> None:
-    """Refuse an ``.lp`` (not a session's) whose images, some named by an absolute path, are
-    not found, naming them all and
-    what to do, in the words ``run`` and ``bench tradeoff --from`` use for the same `.lp`.
+def _refuse_unusable_images(lp: Path, entries: list[LpEntry], paths: list[Path]) -> None:
+    """Refuse an ``.lp`` (not a session's) whose images to be read (``paths``: a
+    ``linear/<stem>.tif`` in place of the listed file where there is one) are missing or not
+    all of one size and kind (as their headers say), naming them all and what to do, before any
+    pixel is decoded: in the words ``run`` and ``bench tradeoff --from`` use for the same `.lp`
+    (:func:`check_image_files`).
 
-    Why: the fit stopped at the first with "image T13/image_001.jpg ... is missing (an .lp's
-    image names are read relative to its own folder)", even where the .lp named it by an
-    absolute path at which the file exists (it is read beside the .lp, by design)."""
-    missing = [(e.name, p) for e, p in zip(entries, paths, strict=True) if not p.is_file()]
-    if not any(is_absolute_name(name) for name, _ in missing):
-        return  # a relative name is said at its read, "read relative to its own folder"
-    more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
-    shown = ", ".join(name for name, _ in missing[:5]) + more
-    raise FitInputError(
-        f"{lp}: {len(missing)} of {len(entries)} image(s) missing in {lp.parent} ({shown})"
-        + missing_images_advice(
-            [name for name, _ in missing],
-            [p for _, p in missing],
-            lp.parent,
-            "fit",
-            total=len(entries),
+    Why: the fit stopped at the first missing image of a relative name ("image acq/img_02.png
+    ... is missing"), and said an image of another size part-way, as numpy shapes ("images of
+    acq/a.lp differ: img_05.png is (40, 64, 3) uint8"), where run and bench named them all.
+    From headers only: an image damaged or unreadable is named by the fit's own read of it."""
+    listed = image_paths(lp, entries)
+    # an image read from linear/ is named by that file, the listed name otherwise
+    names = [
+        e.name if p == q else p.relative_to(lp.parent).as_posix()
+        for e, p, q in zip(entries, paths, listed, strict=True)
+    ]
+    try:
+        check_image_files(
+            lp,
+            names,
+            paths,
+            use="fit",
+            headers_only=True,
         )
-    )
+    except ConfigError as exc:
+        raise FitInputError(str(exc)) from None
 
 
 def _refuse_lost_images(lp: Path, damaged: list[tuple[Path, str]]) -> None:
