@@ -2855,7 +2855,9 @@ def list_unwritten_step(root: Path, scan: JournalScan | None = None) -> str | No
     and stopped before journaling (:func:`stopped_before_journal_line`), when ``lights.lp`` is
     exactly what that run wrote at its previous commit; returns what was done or why it could
     not be (None when there was nothing to do). ``scan``: the journal's, when the caller holds
-    it (read here otherwise). Call it only once the command's own refusals have passed.
+    it (read here otherwise); it only spares the lock when there is nothing to do, the decision
+    to write is taken again under the lock from the journal re-read. Call it only once the
+    command's own refusals have passed.
 
     Why: a run writes ``lights.lp`` after the journal line, so a kill between the record file
     and the line left it one image short of what the session holds: ``export-lp`` (and a
@@ -2878,7 +2880,10 @@ def list_unwritten_step(root: Path, scan: JournalScan | None = None) -> str | No
     except SessionError:
         return None
     try:
-        pending = unwritten_step(root, scan)  # again, under the lock
+        # again, under the lock, from the journal and lights.lp as they are now: ``scan`` was
+        # taken before the lock, and a resume that ran in between may have journaled the step
+        # (and written its own lights.lp), which a stale decision would have overwritten
+        pending = unwritten_step(root)
         if pending is None:
             return None
         before, entry, stem = pending

@@ -110,3 +110,37 @@ def test_a_lights_lp_edited_by_hand_is_left_as_it_is(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     assert "now lists" not in said(r), said(r)
     assert lp.read_bytes() == edited
+
+
+@pytest.mark.slow
+@pytest.mark.e2e
+def test_a_resume_that_journals_the_step_before_the_lock_is_not_overwritten(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The decision to complete lights.lp is taken again under the lock from the journal as it
+    is then: a resume that ran between the first look and the lock (here: journaled image_004
+    and wrote its own lights.lp) keeps what it wrote. Before, the journal scan taken before
+    the lock was reused and lights.lp was rewritten from it."""
+    import rti_rig.runtime.session as session_mod
+
+    out = _killed_after_fourth_record(tmp_path)
+    lp = out / "lights.lp"
+    resumed = lp.read_bytes()  # the listing the resume wrote, not yet naming image_004
+    record = (out / "records" / "image_004.json").read_text().strip()
+    real_lock = session_mod.lock_session
+
+    def resume_then_lock(root: Path) -> None:
+        # what a resume run in between leaves: image_004's journal line, and its lights.lp
+        with (out / "journal.jsonl").open("a") as f:
+            f.write(json.dumps(json.loads(record)) + "\n")
+        lp.write_bytes(resumed)
+        real_lock(root)
+
+    monkeypatch.setattr(session_mod, "lock_session", resume_then_lock)
+    r = runner.invoke(app, ["export-lp", str(out), "--out", str(tmp_path / "x.lp")])
+    assert r.exit_code == 0, r.output
+    assert "now lists" not in said(r), said(r)
+    assert lp.read_bytes() == resumed
+    # the line appended is a journal line as the run writes it: read whole, nothing mended
+    scan = session_mod.scan_journal(out, session_mod.image_names(LIGHTS))
+    assert len(scan.records) == 4 and not scan.mended and not scan.rejected, scan
