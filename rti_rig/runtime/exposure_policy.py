@@ -98,43 +98,97 @@ def representable_s(camera: object, exposure_s: float) -> float:
     return float(steps(exposure_s)) if steps is not None else exposure_s
 
 
-def metering_start(camera: object, exposure_s: float) -> tuple[float, str | None]:
-    """Where the metering starts from ``[camera] exposure_s``, and what was changed to get
-    there (None: nothing but the rounding to the camera's units): rounded down to an exposure
-    the camera takes exactly (:func:`representable_s`), no shorter than the shortest it takes
-    (a UVC camera's ``shortest_exposure_s``, its ``[camera.device] min_exposure_s``) and no
-    longer than the longest (its ``longest_exposure_s``: ``[camera.device] max_exposure_s`` or
-    the frame period, known once connected).
+#: one end of the range the metering keeps to, and what sets it (a phrase naming the key)
+Bound = tuple[float, str]
 
-    Why: exposure_s is only a start for ``run --auto-exposure``; one under the device's
-    minimum stopped the run at the metering's first test shot, and one over its maximum was
-    refused before any LED lit, while the docs say it "is only where the metering starts".
-    Also what ``rti-rig check --auto-exposure`` judges."""
-    start = representable_s(camera, exposure_s)
+
+def _at_least_s(camera: object, exposure_s: float) -> float:
+    """The shortest exposure the camera takes exactly at or above ``exposure_s``.
+
+    Only the camera's rounding down (:func:`representable_s`) is known, so the step above is
+    found by probing a growing distance past ``exposure_s``: the first probe that rounds down
+    past the step under ``exposure_s`` lands on the next step (each probe at most doubles the
+    distance, so it cannot skip one)."""
+    under = representable_s(camera, exposure_s)
+    if under >= exposure_s * (1 - 1e-9):
+        return under
+    gap = exposure_s - under
+    for _ in range(64):
+        above = representable_s(camera, exposure_s + gap)
+        if above > under * (1 + 1e-9):
+            return above
+        gap *= 2
+    return exposure_s  # a camera whose rounding never moves up: it takes this one
+
+
+def metering_start(
+    camera: object, exposure_s: float, within: tuple[Bound, Bound] | None = None
+) -> tuple[float, str | None]:
+    """Where the metering starts from ``[camera] exposure_s``, and what was changed to get
+    there (None: nothing but the rounding to the camera's units): an exposure the camera takes
+    exactly (:func:`representable_s`, rounded down, or up where that left the range) inside
+    both the metering's own range ``within`` (``[camera] min_exposure_s`` … ``max_exposure_s``,
+    less what a light's lit time allows; its ends with the phrases that name their keys) and
+    the camera's: no shorter than the shortest it takes (a UVC camera's
+    ``shortest_exposure_s``, its ``[camera.device] min_exposure_s``) and no longer than the
+    longest (its ``longest_exposure_s``: ``[camera.device] max_exposure_s`` or the frame
+    period, known once connected).
+
+    Why one function: ``run --auto-exposure`` starts here, ``rti-rig check --auto-exposure``
+    judges this start, and the note says it. The run had clamped again into ``within``
+    without rounding: with ``[camera] min_exposure_s = exposure_s = 0.00125`` on a camera of
+    0.0001 s units the check judged 0.0012 s while the metering shot 0.00125 s, which the
+    camera cannot take exactly. And exposure_s is only a start: one under the device's
+    minimum had stopped the run at the metering's first test shot, one over its maximum had
+    been refused before any LED lit, while the docs say it "is only where the metering
+    starts". Raises :class:`DeviceError` naming both keys when no exposure the camera takes
+    lies inside both ranges (before anything is lit)."""
+    name = getattr(camera, "name", "camera")
     shortest = getattr(camera, "shortest_exposure_s", None)
-    low = shortest() if callable(shortest) else None
+    low: Bound | None = shortest() if callable(shortest) else None
     longest = getattr(camera, "longest_exposure_s", None)
-    high = longest() if callable(longest) else None
+    high: Bound | None = longest() if callable(longest) else None
     if high is not None:
-        cap = representable_s(camera, high[0])
-        if start > cap * (1 + 1e-9):
-            return cap, (
-                f"[camera] exposure_s = {exposure_s:g} s is longer than the camera "
-                f"{getattr(camera, 'name', 'camera')} can take ({high[1]}): the metering "
-                f"started at {cap:g} s instead"
-            )
-    if low is not None and start < low[0] * (1 - 1e-9):
-        return low[0], (
-            f"[camera] exposure_s = {exposure_s:g} s is shorter than the camera "
-            f"{getattr(camera, 'name', 'camera')} can take ({low[1]}): the metering started "
-            f"at {low[0]:g} s instead"
+        high = (representable_s(camera, high[0]), high[1])
+    floor, cap = low, high
+    if within is not None:
+        if floor is None or within[0][0] > floor[0]:
+            floor = within[0]
+        if cap is None or within[1][0] < cap[0]:
+            cap = within[1]
+    start = exposure_s
+    if cap is not None:
+        start = min(start, cap[0])
+    if floor is not None:
+        start = max(start, floor[0])
+    start = representable_s(camera, start)
+    if floor is not None and start < floor[0] * (1 - 1e-9):
+        start = _at_least_s(camera, floor[0])
+    if cap is not None and start > cap[0] * (1 + 1e-9):
+        raise DeviceError(
+            name,
+            f"no exposure the camera takes exactly lies between {floor[1] if floor else '0'} "
+            f"and {cap[1]}: run --auto-exposure has nowhere to start its metering; lower the "
+            "first or raise the second (nothing was lit)",
+        )
+    if high is not None and exposure_s > high[0] * (1 + 1e-9):
+        return start, (
+            f"[camera] exposure_s = {exposure_s:g} s is longer than the camera {name} can "
+            f"take ({high[1]}): the metering started at {start:g} s instead"
+        )
+    if low is not None and exposure_s < low[0] * (1 - 1e-9):
+        return start, (
+            f"[camera] exposure_s = {exposure_s:g} s is shorter than the camera {name} can "
+            f"take ({low[1]}): the metering started at {start:g} s instead"
         )
     return start, None
 
 
-def metering_start_s(camera: object, exposure_s: float) -> float:
+def metering_start_s(
+    camera: object, exposure_s: float, within: tuple[Bound, Bound] | None = None
+) -> float:
     """The start of :func:`metering_start` alone (for callers that do not say it)."""
-    return metering_start(camera, exposure_s)[0]
+    return metering_start(camera, exposure_s, within)[0]
 
 
 def metering_steps(schedule: LightSchedule, count: int = 1) -> list[int]:
@@ -244,6 +298,7 @@ def fix_session_exposure(
     probes: int = 1,
     *,
     shot_per_lighting: bool = False,
+    within: tuple[Bound, Bound] | None = None,
 ) -> LightSchedule:
     """Meter at the brightest-ranked planned light, check up to ``probes`` - 1 more with
     ``recheck`` (each may shorten the exposure, never lengthen it), and return the schedule
@@ -258,6 +313,9 @@ def fix_session_exposure(
     ``shot_per_lighting``: the lights go dark by themselves a fixed time after they light (a
     timed firmware's window, which holds one capture but not a series), so each test shot is
     taken under its own lighting (:class:`_LitForEachShot`), as each image of the session is.
+
+    ``within``: the metering's own range, its ends with the keys that set them, for its start
+    (:func:`metering_start`), which ``meter`` is given as it is (it had clamped it again).
 
     The evidence records the time metering took on the rig's clock (``rig_time_s``, from the
     connect to the teardown; on a dry run the simulated rig's) and on the wall
@@ -306,10 +364,11 @@ def fix_session_exposure(
         rig.camera.connect()
         # the metering's first shot, the shortest it starts from: a UVC camera's drain that
         # does not fit the light's limit then would stop it at the thermal limit, lit
-        # [camera] exposure_s is only where the metering starts, rounded down to what the
-        # camera takes exactly (whole exposure_unit_s): refusing 0.00125 s as "not a whole
-        # number" of 0.0001 s stopped a run whose metering never asks for it
-        start = metering_start_s(rig.camera, rig.camera_config.exposure_s)
+        # [camera] exposure_s is only where the metering starts, in what the camera takes
+        # exactly (whole exposure_unit_s) inside both ranges (metering_start, decided once
+        # here and judged so by check): refusing 0.00125 s as "not a whole number" of
+        # 0.0001 s stopped a run whose metering never asks for it
+        start = metering_start_s(rig.camera, rig.camera_config.exposure_s, within)
         check_capture_fits_lit(rig, [start], "nothing was lit")
         rig.lighting.set(schedule.steps[at])
         lit_at = rig.clock.now()

@@ -16,7 +16,7 @@ from typing import Any
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.app.usecases.safe_state import lights_state
-from rti_rig.core.errors import RtiRigError
+from rti_rig.core.errors import DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.arm_check import arm_self_test
 from rti_rig.runtime.controller import EmergencyStop
@@ -195,7 +195,13 @@ def _exposure_problem(rig, auto_exposure: bool = False) -> str | None:  # type: 
     if not callable(judge):
         return None
     exposure = float(rig.camera_config.exposure_s)
-    start = _metering_start_s(rig.camera, exposure)
+    try:
+        start = _metering_start_s(rig, exposure)
+    except DeviceError as exc:
+        # no start inside both ranges: run --auto-exposure refuses it before anything lights
+        if auto_exposure:
+            return str(exc)
+        start = None
     if auto_exposure:
         said = judge(start) if start is not None else None
         return None if said is None else str(said)
@@ -215,15 +221,18 @@ def _exposure_problem(rig, auto_exposure: bool = False) -> str | None:  # type: 
     return str(said)
 
 
-def _metering_start_s(camera, exposure_s: float) -> float | None:  # type: ignore[no-untyped-def]
+def _metering_start_s(rig, exposure_s: float) -> float | None:  # type: ignore[no-untyped-def]
     """Where ``run --auto-exposure`` starts metering from ``[camera] exposure_s``
-    (:func:`~rti_rig.runtime.exposure_policy.metering_start_s`); None on a camera offering
-    its own list of speeds (a DSLR), whose metering starts at the one nearest it."""
+    (:func:`~rti_rig.runtime.exposure_policy.metering_start_s`, within the run's own
+    :func:`~rti_rig.app.usecases.session.metering_range`, so the check judges the start the
+    run takes); None on a camera offering its own list of speeds (a DSLR), whose metering
+    starts at the one nearest it. Raises DeviceError when no start fits both ranges."""
+    from rti_rig.app.usecases.session import metering_range
     from rti_rig.runtime.exposure_policy import metering_start_s
 
-    if callable(getattr(camera, "available_exposures_s", None)):
+    if callable(getattr(rig.camera, "available_exposures_s", None)):
         return None
-    return metering_start_s(camera, exposure_s)
+    return metering_start_s(rig.camera, exposure_s, metering_range(rig))
 
 
 @dataclass(frozen=True)

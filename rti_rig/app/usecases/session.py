@@ -379,11 +379,12 @@ def fix_exposure(
         longest = max(lit_cap, cam.min_exposure_s)
     else:
         lit_cap = None
+    within = metering_range(rig)
     rule = ExposureRule(
         max_saturated_fraction=max_saturated,
         headroom=1.25,  # other planned lights may be a little brighter than the metered one
-        min_exposure_s=cam.min_exposure_s,
-        max_exposure_s=longest,
+        min_exposure_s=within[0][0],
+        max_exposure_s=within[1][0],
     )
 
     #: what the connected camera bounds the exposure by, where it is shorter than the rule's
@@ -421,15 +422,16 @@ def fix_exposure(
         ruled = camera_rule(camera)
         if not callable(shutter):
             # a start moved into the camera's range is said (it had been refused above it)
-            moved = metering_start(camera, cam.exposure_s)[1]
+            moved = metering_start(camera, cam.exposure_s, within)[1]
             if moved is not None:
                 on_note(Note(moved))
         return meter_exposure(
             camera,
             ruled,
-            # [camera] exposure_s is only where the metering starts: one outside what the
-            # camera takes starts at its nearest end (the camera refuses it)
-            min(max(start_s, ruled.min_exposure_s), ruled.max_exposure_s),
+            # [camera] exposure_s is only where the metering starts, decided once, inside both
+            # ranges and in the camera's units (metering_start): clamped again here it had
+            # left the camera's units (0.00125 s on a 0.0001 s camera, judged 0.0012 s)
+            start_s,
             shutter() if shutter else None,
             quantise=exposure_steps(camera),
         )
@@ -457,6 +459,7 @@ def fix_exposure(
             recheck if probes > 1 else None,
             probes,
             shot_per_lighting=limit is not None,
+            within=within,
         )
     except (RtiRigError, KeyboardInterrupt, EmergencyStop) as exc:
         # what metering's teardown established about the lights travels with the error, or
@@ -529,6 +532,32 @@ def fix_exposure(
             )
         )
     return fixed
+
+
+def metering_range(rig: Rig) -> tuple[tuple[float, str], tuple[float, str]]:
+    """The range ``run --auto-exposure`` meters within before the camera is connected, each
+    end with the phrase naming its key: ``[camera] min_exposure_s`` … ``max_exposure_s``, the
+    longest lowered to what a timed firmware's window or an LED's ``max_on_s`` allows a shot.
+
+    Why one place: the metering's rule, its start (:func:`~rti_rig.runtime.exposure_policy.
+    metering_start`) and ``rti-rig check --auto-exposure``, which judges that start, keep to
+    the same range."""
+    cam = rig.camera_config
+    low = (cam.min_exposure_s, f"[camera] min_exposure_s = {cam.min_exposure_s:g} s")
+    high = (cam.max_exposure_s, f"[camera] max_exposure_s = {cam.max_exposure_s:g} s")
+    limit = _timed_limit(rig)
+    if limit is not None and limit.max_exposure_s < high[0]:
+        longest = max(limit.max_exposure_s, cam.min_exposure_s)
+        high = (longest, f"{longest:.3g} s ({limit.window_said()})")
+    lit_cap = _lit_exposure_cap(rig)
+    if lit_cap is not None and lit_cap < high[0]:
+        longest = max(lit_cap, cam.min_exposure_s)
+        high = (
+            longest,
+            f"{longest:.3g} s, the longest shot an LED lit at most max_on_s allows after "
+            "timing.settle_s and before timing.readout_s",
+        )
+    return low, high
 
 
 def _lit_exposure_cap(rig: Rig) -> float | None:

@@ -509,3 +509,62 @@ def test_a_metering_start_above_the_devices_max_exposure_s_is_lowered_to_it(tmp_
         r = CliRunner().invoke(app, ["check", str(cfg)])
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and "longer than the camera's max_exposure_s = 0.02 s" in said, said
+
+
+def _min_exposure_at_start(tmp_path: Path, device: str = "") -> Path:
+    """The UVC dome with `[camera] min_exposure_s = exposure_s = 0.00125` (12.5 units of
+    100 µs), and ``device`` added to `[camera.device]`."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    text = cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.00125\n", 1)
+    text = text.replace("min_exposure_s = 0.000125\n", "min_exposure_s = 0.00125\n", 1)
+    cfg.write_text(text.replace('kind = "opencv"\n', f'kind = "opencv"\n{device}'))
+    return cfg
+
+
+@pytest.mark.pty
+def test_the_metering_starts_where_check_judges_in_whole_units_inside_both_ranges(
+    tmp_path, monkeypatch
+):
+    """`[camera] min_exposure_s = exposure_s = 0.00125` on a camera of 0.0001 s units: the
+    start was decided twice, check judging 0.0012 s (the camera's units, not [camera]'s
+    range) and the run clamping again into [camera]'s range unrounded, so the metering's first
+    test shot was 0.00125 s, which the camera cannot take exactly. One decision now: the
+    first whole unit inside both ranges, 0.0013 s, for the run and for check alike."""
+    cfg = _min_exposure_at_start(tmp_path)
+    light = LightHistory(SystemClock())  # type: ignore[arg-type]
+    light.set(1.0)
+    stream = BufferedUvcStream(light, fps=20.0, scale=1e6)
+    code, said, out, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
+    assert "whole number" not in said and "Traceback" not in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    shots = manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
+    assert shots[0][0] == pytest.approx(0.0013), shots
+    assert all(abs(t / 0.0001 - round(t / 0.0001)) < 1e-6 for s in shots for t in s), shots
+    assert min(t for s in shots for t in s) >= 0.00125, shots
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        r = CliRunner().invoke(app, ["check", str(cfg), "--auto-exposure"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "RESULT: PASS" in said, said
+
+
+@pytest.mark.pty
+def test_no_whole_unit_inside_both_ranges_is_refused_naming_both_keys(tmp_path, monkeypatch):
+    """`[camera] min_exposure_s = 0.00125` over `[camera.device] max_exposure_s = 0.0012`: no
+    exposure the camera takes lies in both ranges. `check --auto-exposure` had passed it,
+    judging 0.0012 s (the camera's range alone), and the run started its metering at
+    0.00125 s. Both now refuse it naming both keys, the run before any LED lights."""
+    cfg = _min_exposure_at_start(tmp_path, "max_exposure_s = 0.0012\n")
+    stream = BufferedUvcStream(LightHistory(SystemClock()), fps=20.0)  # type: ignore[arg-type]
+    with monkeypatch.context() as m:
+        m.setattr(cv2, "VideoCapture", lambda device, api: stream)
+        with shipped_dome_on_pty(m, cfg):
+            r = CliRunner().invoke(app, ["check", str(cfg), "--auto-exposure"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "RESULT: FAIL" in said, said
+    keys = ("[camera] min_exposure_s = 0.00125 s", "max_exposure_s = 0.0012 s in [camera.device]")
+    assert all(k in said for k in keys) and "Traceback" not in said, said
+    code, said, out, history = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code != 0 and all(k in said for k in keys), said
+    assert not [e for e in history if e.what == "lit"], said
+    assert "Traceback" not in said and not list(out.glob("*.jpg")), said
