@@ -1,4 +1,5 @@
-"""``export-lp`` reads a session's journal once.
+"""``export-lp`` reads a session's journal once (and once more under the lock where it
+completes the lights.lp of a run stopped between a record file and its journal line).
 
 Before, each of its readers scanned ``journal.jsonl`` again: the listing, the unchecked images,
 the files lost since capture, the renamed ones, the advice (four to six scans of one session),
@@ -50,4 +51,8 @@ def test_export_lp_reads_the_journal_once(tmp_path: Path, monkeypatch: pytest.Mo
     text = said(r)
     assert "4 lights" in text and "left out, missing or changed" in text, text
     assert "image_002.jpg" in text, text
-    assert reads == [str(out / "journal.jsonl")], reads
+    # one scan for everything export-lp says, and one more, under the session's lock, by the
+    # completion of lights.lp this stopped run needs (it must not act on a scan a --resume may
+    # have overtaken: list_unwritten_step); before, four to six
+    assert reads == [str(out / "journal.jsonl")] * 2, reads
+    assert "lights.lp now lists image_005 too" in text, text
