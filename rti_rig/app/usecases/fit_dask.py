@@ -319,6 +319,29 @@ async def _identity(address: str, timeout: float, connection_args: dict[str, Any
         comm.abort()
 
 
+def _run_quietly(main: Any) -> Any:
+    """``asyncio.run(main)``, without asyncio's report of the tasks a stop leaves behind.
+
+    Why: a Ctrl-C that lands while the probe connects cancels the connection's tasks, and one
+    that ends with an exception of its own (a comm closed under it) was printed by
+    ``asyncio.run``'s shutdown as "unhandled exception during asyncio.run() shutdown" with a
+    traceback, after "Stopped (Ctrl-C)". The probe's outcome is what the caller reports."""
+    loop = asyncio.new_event_loop()
+    try:
+        return loop.run_until_complete(main)
+    finally:
+        loop.set_exception_handler(lambda _loop, _context: None)
+        try:
+            left = [task for task in asyncio.all_tasks(loop) if not task.done()]
+            for task in left:
+                task.cancel()
+            if left:
+                loop.run_until_complete(asyncio.gather(*left, return_exceptions=True))
+            loop.run_until_complete(loop.shutdown_asyncgens())
+        finally:
+            loop.close()
+
+
 def _probe(address: str, timeout: float) -> None:
     """Return once the scheduler at ``address`` answers, within ``timeout`` seconds in all.
 
@@ -335,7 +358,7 @@ def _probe(address: str, timeout: float) -> None:
         return await asyncio.wait_for(_identity(address, timeout, args), timeout)
 
     try:
-        identity = asyncio.run(bounded())
+        identity = _run_quietly(bounded())
     except TimeoutError:  # asyncio's is the builtin's since 3.11; Dask's own names the address
         raise _unreachable_scheduler(
             address,
