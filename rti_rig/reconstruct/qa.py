@@ -225,11 +225,6 @@ TOO_BRIGHT = "too bright for its light"
 TOO_DARK = "too dark for its light"
 
 
-def _bright_problem(p: str) -> bool:
-    """A problem that says the image is brighter than predicted (either check's words)."""
-    return p.endswith(BRIGHTER) or TOO_BRIGHT in p
-
-
 @dataclass(frozen=True)
 class ImageCheck:
     """The evidence about one image."""
@@ -284,6 +279,11 @@ class ImageCheck:
     #: disagree, no other elevation's pair to prove it), and for a clipped image.
     #: :data:`EXPOSURE_OFF` either way names it.
     exposure_ratio: float = float("nan")
+    #: Which of ``problems`` says the image is brighter than predicted (the bright-image
+    #: check's or the exposure check's), None when none does. Kept apart so that
+    #: :meth:`QAReport.explain_bright_by_lights` takes that claim off by what it is, not by
+    #: matching its words (a reworded message would have kept a claim the lights explain).
+    bright_problem: str | None = None
 
 
 #: The saturation check's advice (replaced where a session cannot follow it).
@@ -439,11 +439,7 @@ class QAReport:
     def bright_within_light_scatter(self) -> list[ImageCheck]:
         """The images called brighter than predicted whose light's own output can explain it
         (:attr:`ImageCheck.within_light_scatter`)."""
-        return [
-            c
-            for c in self.images
-            if c.within_light_scatter and any(_bright_problem(p) for p in c.problems)
-        ]
+        return [c for c in self.images if c.within_light_scatter and c.bright_problem is not None]
 
     def explain_bright_by_lights(self, note: str, only: set[int] | None = None) -> QAReport:
         """This report with the bright-image problem taken off :meth:`bright_within_light_scatter`
@@ -459,7 +455,11 @@ class QAReport:
         if not explained:
             return self
         images = tuple(
-            replace(c, problems=tuple(p for p in c.problems if not _bright_problem(p)))
+            replace(
+                c,
+                problems=tuple(p for p in c.problems if p != c.bright_problem),
+                bright_problem=None,
+            )
             if c.index in explained
             else c
             for c in self.images
@@ -1256,8 +1256,8 @@ def assess(
         if bar > DRIFT_PX:
             shift_note = (
                 f"a shift of {bar:.1f} px or less not judged: the fit explains this object's "
-                f"images poorly (median misfit {poor_fit:.0%}, limit {MISFIT_LIMIT:.0%}) and "
-                "its highlights' edges move with the light by as much"
+                f"images poorly ({_misfit_said(poor_fit)}) and its highlights' edges move "
+                "with the light by as much"
             )
     drift_note = ""
     if not edges_trusted and poor_fit > MISFIT_LIMIT:
@@ -1288,8 +1288,8 @@ def assess(
                 ev.drift_judged[i] = False
         shown = max(DRIFT_PX, EDGE_NOISE_FACTOR * noise)
         drift_note = (
-            "shift not judged: the fit explains this object's images poorly (median misfit "
-            f"{poor_fit:.0%}, limit {MISFIT_LIMIT:.0%}) and its edges move with the light, so "
+            "shift not judged: the fit explains this object's images poorly "
+            f"({_misfit_said(poor_fit)}) and its edges move with the light, so "
             "a shift is claimed only where the fit and the image's own edges show it alike"
             + (
                 f" (beyond {shown:.1f} px and up to about {MAX_SHIFT_PX - 1} px); a smaller "
@@ -1331,6 +1331,8 @@ def assess(
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []
+        bright_claim: str | None = None  # the one problem that says "brighter", if any
+        misfire_said = False
         if sat_frac[i] > SATURATED_LIMIT:
             problems.append(
                 f"saturated: {sat_frac[i]:.1%} of pixels clipped (limit {SATURATED_LIMIT:.0%}); "
@@ -1340,6 +1342,7 @@ def assess(
         if ev.dim[i] and (not wrong_i or ev.lit_gain[i] < DIM_GAIN * 0.5):
             dead = ev.lit_gain[i] < NO_LIGHT_GAIN
             what = "misfired, no light" if dead else "misfired or dim light"
+            misfire_said = True
             if ev.lit_gain[i] < DIM_GAIN:
                 problems.append(
                     f"{what}: {max(ev.lit_gain[i], 0.0):.0%} of the brightness the other "
@@ -1375,17 +1378,23 @@ def assess(
             # brighter than the Lambertian prediction is a fault (a stray flash, an exposure)
             # only where the image is a rendering at all: a glossy object's highlight makes it
             # brighter with its light and exposure right (said in the caveats instead)
-            problems.append(f"{ev.gain[i]:.1f}× {BRIGHTER}")
+            bright_claim = f"{ev.gain[i]:.1f}× {BRIGHTER}"
+            problems.append(bright_claim)
         if (
             exposure_off(exposure[i])
             and not all_black
             and not ev.dim[i]
             and not wrong_i
-            and not any(_bright_problem(p) for p in problems)
+            and bright_claim is None
         ):
-            problems.append(_exposure_words(float(exposure[i]), int(mates[i])))
-        if all_black and not any(p.startswith("misfired") for p in problems):
-            problems = [p for p in problems if not p.endswith(BRIGHTER)]  # of nothing
+            said = _exposure_words(float(exposure[i]), int(mates[i]))
+            if exposure[i] > 1.0:
+                bright_claim = said  # "too bright for its light": a bright image too
+            problems.append(said)
+        if all_black and not misfire_said:
+            if bright_claim is not None:  # brighter than predicted, of nothing
+                problems.remove(bright_claim)
+                bright_claim = None
             problems.append(
                 f"misfired, no light: its brightest pixels reach {peak[i]:.2%} of full scale, "
                 "as every image's do (a lens cap, lights that never fired, or an exposure far "
@@ -1439,6 +1448,7 @@ def assess(
                 ),
                 reliable_gain=float(ev.reliable_gain[i]),
                 exposure_ratio=float(exposure[i]),
+                bright_problem=bright_claim,
             )
         )
     flagged = {c.index for c in checks if c.problems}
@@ -1510,6 +1520,14 @@ def _exposure_levelled(
         if sat_level is not None:
             out[i][arr[i] >= sat_level] = sat_level
     return out
+
+
+def _misfit_said(poor_fit: float) -> str:
+    """The median misfit as a note gives it; where no image lit enough pixels to measure one
+    (every misfit inf: a saturated or black crop) that, not "median misfit inf%"."""
+    if not np.isfinite(poor_fit):
+        return "no image lights enough of the object to measure how well it fits"
+    return f"median misfit {poor_fit:.0%}, limit {MISFIT_LIMIT:.0%}"
 
 
 def _exposure_words(ratio: float, mates: int) -> str:

@@ -88,3 +88,32 @@ def test_another_problem_of_an_explained_image_still_calls_for_a_reshoot() -> No
     explained = replace(report, images=tuple(images)).explain_bright_by_lights("lights differ")
     assert explained.images[BRIGHT].problems == (moved,)
     assert explained.verdict.startswith(f"reshoot: image_021 ({moved}); lights differ")
+
+
+def test_the_bright_claim_is_taken_off_by_what_it_is_not_by_its_words() -> None:
+    """The application takes the bright claim off an image its light explains. It finds that
+    claim by the check's own record of it (``bright_problem``), so another problem of the image
+    stays and a claim reworded tomorrow still goes (it was found by matching English text)."""
+    from dataclasses import replace
+
+    report = _report(_uneven(1.9))
+    check = report.images[BRIGHT]
+    assert check.bright_problem is not None and check.bright_problem in check.problems
+    assert all(c.bright_problem is None for c in report.images if c.index != BRIGHT)
+    reworded = "1.9x the brightness its neighbours give"
+    other = "object or camera moved: shifted (+3.0, +0.0) px against the others"
+    images = tuple(
+        replace(c, problems=(reworded, other), bright_problem=reworded) if c.index == BRIGHT else c
+        for c in report.images
+    )
+    explained = replace(report, images=images).explain_bright_by_lights("the lights differ")
+    after = explained.images[BRIGHT]
+    assert after.problems == (other,) and after.bright_problem is None
+    assert [c.index for c in explained.reshoot] == [BRIGHT]  # still to reshoot: it moved
+
+
+def test_a_note_on_a_fit_no_image_could_measure_says_so_not_inf_percent() -> None:
+    from rti_rig.reconstruct.qa import _misfit_said
+
+    assert "inf" not in _misfit_said(float("inf"))
+    assert _misfit_said(0.42).startswith("median misfit 42%")
