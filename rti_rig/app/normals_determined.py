@@ -51,13 +51,63 @@ def _layout(lights: np.ndarray) -> str:
     return "they lie (nearly) in one tilted plane through the object"
 
 
+#: Image noise, as a fraction of the brightness of a surface facing the light (its albedo), at
+#: which a light set's normals are judged: 1 %, an 8-bit JPEG's quantisation and shot noise.
+NORMAL_NOISE = 0.01
+#: Largest predicted normal error (standard deviation in degrees, at :data:`NORMAL_NOISE`, for
+#: the worst-placed surface) of lights that can determine a normal. Why 15°: measured
+#: (docs/reconstruction.md, "Which lights determine a normal"), every plan of 3 to 12 lights on
+#: the shipped configs and on the recorded .lp files, with and without an elevation band, gives
+#: 0.4-9.5°; the condition-number limit alone had passed 3-light sets at condition 80-100 whose
+#: normals were 22-38° off (first order) at 1 % noise.
+NORMAL_ERROR_LIMIT_DEG = 15.0
+#: At most this many lights are listed by direction in a refusal (more are counted only).
+_LISTED = 6
+
+
+def predicted_normal_error_deg(lights: np.ndarray, noise: float = NORMAL_NOISE) -> float:
+    """Standard deviation of a Lambertian normal's angle, in degrees, at image noise ``noise``
+    (a fraction of the albedo), for the worst-oriented surface lit by all of ``lights`` (N×3).
+
+    The least-squares fit ``g = (LᵀL)⁻¹Lᵀ I`` of ``g = albedo·n`` has covariance
+    ``noise²·(LᵀL)⁻¹``; only its part across ``n`` turns the normal, so the angle's variance is
+    ``noise²·(trace C − nᵀCn)``, largest where ``n`` is ``C``'s least-variance axis:
+    ``noise²·(1/s₂² + 1/s₃²)`` with ``s`` the singular values of ``L`` (first order, without
+    shadows, which only make it worse). Why this and not the condition number: the condition
+    number is a ratio, blind to how small the weakest direction is against the noise; 3 lights
+    at condition 95 passed while their normals were about 40° off at 1 % noise.
+    """
+    lights = np.asarray(lights, dtype=np.float64).reshape(-1, 3)
+    norms = np.linalg.norm(lights, axis=1, keepdims=True)
+    unit = lights / np.where(norms > 0.0, norms, 1.0)
+    s = np.linalg.svd(unit, compute_uv=False)
+    if len(s) < 3 or s[2] <= s[0] * 1e-12:
+        return float("inf")
+    return float(np.degrees(noise * np.sqrt(1.0 / s[1] ** 2 + 1.0 / s[2] ** 2)))
+
+
+def _listed(lights: np.ndarray) -> str:
+    """The lights' directions as azimuth/elevation, where few enough to read."""
+    if len(lights) > _LISTED:
+        return ""
+    unit = lights / np.linalg.norm(lights, axis=1, keepdims=True).clip(1e-12)
+    az = np.degrees(np.arctan2(unit[:, 1], unit[:, 0])) % 360.0
+    el = np.degrees(np.arcsin(np.clip(unit[:, 2], -1.0, 1.0)))
+    return " at azimuth/elevation " + ", ".join(
+        f"{a:.0f}°/{e:.0f}°" for a, e in zip(az, el, strict=True)
+    )
+
+
 def undetermined_normals(lights: np.ndarray, what: str = "lights") -> str | None:
     """Why ``lights`` (N×3) cannot determine a surface normal, or None where they can.
 
-    Judged as the fit judges Lambert's 3 terms (:func:`rti_rig.reconstruct.solve.solve_matrix`,
-    the condition number over the hemisphere above its limit), so a plan or a capture refused
-    here is one ``rti-rig fit`` would refuse normals for, and no other. ``what`` names them in
-    the text ("planned lights", "lights of this session").
+    Two tests, both needed: the fit's own conditioning of Lambert's 3 terms
+    (:func:`rti_rig.reconstruct.solve.solve_matrix`, the condition number over the hemisphere
+    above its limit, where it would regularise or refuse), and the predicted normal error at
+    :data:`NORMAL_NOISE` above :data:`NORMAL_ERROR_LIMIT_DEG`
+    (:func:`predicted_normal_error_deg`), which judges what the normals are worth. So a plan or
+    a capture refused here is one ``rti-rig fit`` would refuse normals for, and no other.
+    ``what`` names them in the text ("planned lights", "lights of this session").
     """
     from rti_rig.core.rti_bases import design_matrix
     from rti_rig.reconstruct.solve import solve_matrix
@@ -66,12 +116,15 @@ def undetermined_normals(lights: np.ndarray, what: str = "lights") -> str | None
     if len(lights) < 3:  # too few is refused elsewhere, by count
         return None
     _, report = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
-    if not report.regularised:
+    error = predicted_normal_error_deg(lights)
+    if not report.regularised and error <= NORMAL_ERROR_LIMIT_DEG:
         return None
+    shown = f"{error:.3g}°" if np.isfinite(error) else "unbounded"
     return (
-        f"the {len(lights)} {what} cannot determine a surface normal: {_layout(lights)} "
-        f"(condition number {report.condition_number:.3g} over the hemisphere, limit "
-        f"{report.cond_limit:g})"
+        f"the {len(lights)} {what}{_listed(lights)} cannot determine a surface normal: "
+        f"{_layout(lights)} (predicted normal error {shown} at {NORMAL_NOISE:.0%} image "
+        f"noise, limit {NORMAL_ERROR_LIMIT_DEG:g}°; condition number "
+        f"{report.condition_number:.3g} over the hemisphere, limit {report.cond_limit:g})"
     )
 
 

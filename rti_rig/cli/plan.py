@@ -121,9 +121,10 @@ def plan(
             "--allow-no-normals",
             help="Plan lights that cannot determine a surface normal (all in one plane "
             "through the object, e.g. one ring of low lights for a relightable PTM/HSH, or "
-            "bunched at the zenith) with a warning, in place of the refusal. rti-rig fit then "
-            "writes no normal maps, and its relighting files are ridge-regularised guesses "
-            "along the direction the lights miss; run the plan with rti-rig run RIG.toml --plan "
+            "bunched at the zenith, or normals predicted more than 15° off at 1% image noise) "
+            "with a warning, in place of the refusal. rti-rig fit then writes no normal maps, "
+            "and its relighting files are ridge-regularised guesses along the direction the "
+            "lights miss; run the plan with rti-rig run RIG.toml --plan "
             "PLAN.lp --out DIR --allow-no-normals (the warning names your rig and plan).",
         ),
     ] = False,

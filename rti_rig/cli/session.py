@@ -169,9 +169,10 @@ def run(
             "--allow-no-normals",
             help="Capture lights that cannot determine a surface normal (all in one plane "
             "through the object, e.g. one azimuth for raking-light documentation, or bunched "
-            "at the zenith) with a warning, in place of the refusal. rti-rig fit then writes "
-            "no normal maps, and its relighting files are ridge-regularised guesses along the "
-            "direction the lights miss.",
+            "at the zenith, or normals predicted more than 15° off at 1% image noise) with a "
+            "warning, in place of the refusal. rti-rig fit then writes no normal maps, and "
+            "its relighting files are ridge-regularised guesses along the direction the "
+            "lights miss.",
         ),
     ] = False,
     no_verdict: Annotated[
