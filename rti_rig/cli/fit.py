@@ -143,8 +143,8 @@ def fit(
         bool,
         typer.Option(
             "--no-qa",
-            help="Skip the QA verdict (normal maps from images black or saturated throughout "
-            "are still said).",
+            help="Skip the QA verdict (normal maps, fit.ptm or fit.rti from images black or "
+            "saturated throughout are still said).",
         ),
     ] = False,
     no_ptm: Annotated[bool, typer.Option("--no-ptm", help="Do not write fit.ptm.")] = False,

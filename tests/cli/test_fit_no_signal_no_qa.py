@@ -1,4 +1,4 @@
-"""`rti-rig fit --no-qa` says when its normal maps are from images that hold no signal.
+"""`rti-rig fit --no-qa` says when its outputs are from images that hold no signal.
 
 An acquisition black throughout (a lens cap, lights that never fired) or saturated throughout
 (an exposure far too long) had its normal maps written without a word when the QA was left
@@ -20,7 +20,7 @@ from tests.fit_sessions import make_session
 
 REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
-SAID = "the normal maps are from images that hold no signal"
+SAID = "are from images that hold no signal"
 
 
 def _acquisition(folder: Path, value: int, lit: int = 0) -> tuple[Path, list[str]]:
@@ -55,6 +55,27 @@ def test_an_acquisition_without_signal_is_said_naming_its_images(
     assert "every image (18) is black" in said
     assert f"{stems[0]} ({kind}), {stems[1]} ({kind})" in said
     assert "and 6 more" in said  # 12 named of 18
+
+
+@pytest.mark.parametrize(("value", "kind"), [(0, "black"), (255, "saturated")])
+def test_relighting_files_without_normals_are_said_too(
+    tmp_path: Path, value: int, kind: str
+) -> None:
+    # --no-normals --no-qa had written fit.ptm and fit.rti from a black acquisition silently
+    lp, stems = _acquisition(tmp_path / "acq", value)
+    out = tmp_path / "f"
+    said = _fit(lp, out, "--no-qa", "--no-normals")
+    assert (out / "fit.ptm").exists() and not (out / "normals.npy").exists()
+    assert said.count(SAID) == 1, said
+    assert "fit.ptm and fit.rti are from images that hold no signal" in said
+    assert "normal maps" not in said.split(SAID)[0].rsplit("warning:", 1)[-1]
+    assert "every image (18) is black" in said and f"{stems[0]} ({kind})" in said
+
+
+def test_with_normals_every_output_is_named(tmp_path: Path) -> None:
+    lp, _ = _acquisition(tmp_path / "acq", 0)
+    said = _fit(lp, tmp_path / "f", "--no-qa")
+    assert "fit.ptm, fit.rti and the normal maps are from images that hold no signal" in said
 
 
 def test_images_left_that_cannot_determine_a_normal_are_said(tmp_path: Path) -> None:

@@ -929,8 +929,13 @@ def _fit_all(
         if not write_normals:  # the models kept only for normals are not fitted
             normal_source = ""
             linear = {k: v for k, v in linear.items() if k in exported}
-        if write_normals and not req.qa:  # the QA names black and saturated images itself
-            skipped += no_signal_warning(stack, lights, names, SAMPLE_PIXELS)
+        if not req.qa:  # the QA names black and saturated images itself
+            # the relighting files too: --no-normals --no-qa wrote fit.ptm from a black
+            # acquisition without a word
+            made = sorted("fit.ptm" if k == "ptm" else "fit.rti" for k in exported)
+            made += ["the normal maps"] if write_normals else []
+            if made:
+                skipped += no_signal_warning(stack, lights, names, SAMPLE_PIXELS, made)
         # the last use of the sample: when nothing above read it, it is streamed, never held
         ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
         del obs

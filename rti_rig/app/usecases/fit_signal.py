@@ -1,9 +1,10 @@
-"""The warning ``rti-rig fit`` gives where its normal maps rest on images that hold no signal.
+"""The warning ``rti-rig fit`` gives where its outputs rest on images that hold no signal.
 
 Why: with ``--no-qa`` an acquisition black throughout (a lens cap, lights that never fired) or
 saturated throughout (an exposure far too long) had its normal maps written without a word: a
-least-squares fit of nothing is still a normal map. The QA, when it runs, names such images
-itself (so the fit asks for this only with ``--no-qa``).
+least-squares fit of nothing is still a normal map; with ``--no-normals`` too its fit.ptm and
+fit.rti were. The QA, when it runs, names such images itself (so the fit asks for this only
+with ``--no-qa``).
 """
 
 from __future__ import annotations
@@ -19,11 +20,15 @@ NO_SIGNAL_NAMED = 12
 
 
 def no_signal_warning(
-    stack: ImageStack, lights: np.ndarray, names: Sequence[str], sample_pixels: int
+    stack: ImageStack,
+    lights: np.ndarray,
+    names: Sequence[str],
+    sample_pixels: int,
+    outputs: Sequence[str] = ("the normal maps",),
 ) -> list[str]:
-    """A warning where the normal maps rest on images that hold no signal (black or clipped
-    on almost every sampled pixel), naming them; none where the images that do hold signal
-    determine a normal by themselves.
+    """A warning where ``outputs`` (what the fit wrote: "fit.ptm", "fit.rti", "the normal
+    maps") rest on images that hold no signal (black or clipped on almost every sampled pixel),
+    naming them; none where the images that do hold signal determine a normal by themselves.
 
     Judged on the pixel sample of ``sample_pixels`` the model choice and the quantisation
     ranges read anyway (cached; one sampled pass where nothing read it), so it costs next to
@@ -50,8 +55,10 @@ def no_signal_warning(
     else:
         which = f"{len(listed)} of the {stack.n} images are"
         left = f"; the {len(lit)} others cannot determine a normal by themselves"
+    made = list(outputs)
+    said = ", ".join(made[:-1]) + " and " + made[-1] if len(made) > 1 else made[0]
     return [
-        f"the normal maps are from images that hold no signal: {which} black (below "
+        f"{said} are from images that hold no signal: {which} black (below "
         f"{BLACK_FRACTION:.1%} of full scale) or clipped at saturation on almost every sampled "
         f"pixel: {shown}{left}. Check the lens cap, that the lights fire and the exposure, then "
         "capture again (the QA, left out by --no-qa, judges each image)"
