@@ -72,7 +72,11 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.core.image_files import TIFF_MAGIC
-from rti_rig.drivers.cameras.image_io import read_image_file, to_linear_uint16
+from rti_rig.drivers.cameras.image_io import (
+    ImageReadError,
+    read_image_file,
+    to_linear_uint16,
+)
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
     UnsupportedRawError,
@@ -323,6 +327,52 @@ def _not_a_tiff(path: Path) -> bool:
     except OSError:
         return False
     return len(head) == 4 and any(head) and head not in TIFF_MAGIC
+
+
+def _tiff_extent(path: Path) -> tuple[int, int] | None:
+    """Where the piece ``path``'s own TIFF structure names last lies: (start, end) of the
+    strip, tile or IFD that ends furthest into the file; None when tifffile cannot parse its
+    IFDs at all.
+
+    Why: a TIFF that will not decode is either not all written yet (its IFDs name data past
+    its end: a writer that paused, or a copy cut short, which waiting may yet mend) or whole
+    and damaged (everything it names is there and still will not decode: waiting cannot help,
+    and had cost ``timeout_s`` before the stop advised raising stable_polls)."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tif:
+            last = (0, 0)
+            for page in tif.pages:
+                ifd = int(getattr(page, "offset", 0))
+                pieces = [(ifd, ifd + 2)]  # an IFD's entry count, at least
+                pieces += [
+                    (int(o), int(o) + int(n))
+                    for o, n in zip(
+                        getattr(page, "dataoffsets", ()),
+                        getattr(page, "databytecounts", ()),
+                        strict=False,
+                    )
+                ]
+                last = max([last, *pieces], key=lambda piece: piece[1])
+            return last
+    except Exception:  # IFDs that will not parse: nothing is known of the rest
+        return None
+
+
+def _tiff_end_written(path: Path, start: int, end: int, length: int = 64) -> bool:
+    """Whether the last bytes (up to ``length``) of ``path``'s region ``start``–``end`` (the
+    piece its TIFF structure names last) are not all zero.
+
+    Why: a program copying onto a network share may set a file's full size first and fill
+    it afterwards; until then its end reads as zeros, and such a file is not yet known to be
+    damaged however whole its structure looks."""
+    try:
+        with path.open("rb") as f:
+            f.seek(max(start, end - length))
+            return any(f.read(min(length, end - start)))
+    except OSError:
+        return False
 
 
 def _exif_time(stamp: object) -> float | None:
@@ -963,8 +1013,10 @@ class FolderWatchCamera:
     def _decode_complete(self, path: Path, exposure_s: float, started: float) -> Frame:
         """Decode ``path``; one that will not decode gets ``timeout_s`` to change and is tried
         again once its size is steady for ``stable_polls`` polls, unless waiting cannot help:
-        a RAW whose header is written in a format LibRaw does not read, or a file named as a
-        TIFF whose first bytes are written and are no TIFF's (said at once, naming the file).
+        a RAW whose header is written in a format LibRaw does not read, a file named as a
+        TIFF whose first bytes are written and are no TIFF's, or a whole TIFF (every byte its
+        IFDs name written, the last ones not zeros) whose data will not decode: each is said
+        at once, naming the file. Messages are worded here from the decoders' fields.
 
         Why: a steady size only means the writer paused (a network share, a Wi-Fi upload, a
         program writing in chunks). Half a file had stopped the session at once, a shot lost
@@ -984,7 +1036,12 @@ class FolderWatchCamera:
                 # this camera's, of a whole file: 8-bit data, a wrong exposure)
                 if exc.device != DECODER and exc.command != "read":
                     raise
-                message = exc.message.replace(str(held), str(path))
+                if isinstance(exc, ImageReadError):
+                    # worded here from its fields: the folder's file, not the copy read
+                    detail = f" ({exc.reason})" if exc.reason else ""
+                    message = f"cannot read image file {path}{detail}"
+                else:
+                    message = exc.message.replace(str(held), str(path))
                 if isinstance(exc, UnsupportedRawError) and _has_header(path):
                     raise CaptureError(
                         self.name,
@@ -994,18 +1051,44 @@ class FolderWatchCamera:
                         "light",
                         "decode",
                     ) from exc
-                if path.suffix.lower() in TIFF_SUFFIXES and _not_a_tiff(path):
+                tiff = isinstance(exc, ImageReadError) and exc.is_tiff
+                if tiff and _not_a_tiff(path):
                     # its first bytes are written and no TIFF's, as the capture-time read
                     # already found: it had still been given timeout_s to change
                     raise CaptureError(
                         self.name,
-                        f"{message.split(': is it a complete TIFF')[0]}: {path.name} is no "
-                        "TIFF (its first bytes are written and are not a TIFF header: a "
-                        "damaged file, or another kind saved under a TIFF name), so waiting "
-                        f"will not help; it is left in {s.folder}, and no image was recorded "
-                        "for this light",
+                        f"{message}: {path.name} is no TIFF (its first bytes are written and "
+                        "are not a TIFF header: a damaged file, or another kind saved under a "
+                        f"TIFF name), so waiting will not help; it is left in {s.folder}, and "
+                        "no image was recorded for this light",
                         "decode",
                     ) from exc
+                extent = _tiff_extent(path) if tiff else None
+                if (
+                    extent is not None
+                    and tried is not None
+                    and _identity(path) == tried  # the bytes read are the folder's still
+                    and extent[1] <= tried[2]
+                    and _tiff_end_written(path, *extent)
+                ):
+                    # every byte its IFDs name is written, its size steady over the
+                    # stability polls, and it still will not decode: damaged, not half-written
+                    raise CaptureError(
+                        self.name,
+                        f"{message}: {path.name} is a damaged TIFF (its header and the "
+                        f"{extent[1]} bytes its structure names are all written, its size steady "
+                        f"over {s.stable_polls} polls, but its image data will not decode), "
+                        "so waiting will not help; it is left in "
+                        f"{s.folder}, and no image was recorded for this light. Save the shot "
+                        "again from the camera's program, or check the disk or share it is "
+                        "saved on",
+                        "decode",
+                    ) from exc
+                if tiff:
+                    message += (
+                        ": is it a complete TIFF (not one still being written, or a copy cut "
+                        "short)?"
+                    )
                 failure = exc
             if not self._changed_and_settled(path, tried, deadline):
                 raise CaptureError(

@@ -75,24 +75,49 @@ def to_linear_uint16(
     raise ValueError(f"unsupported pixel type {img.dtype}; expected uint8 or uint16")
 
 
+class ImageReadError(CaptureError):
+    """An image file that would not read, with what is known as fields: ``path`` (the file
+    read), ``reason`` (the reader's own words) and ``is_tiff``.
+
+    Why fields: a caller that words the failure its own way (a watched folder naming the
+    folder's file, not the session's copy it read, and whether waiting can help) had cut this
+    function's sentence at a fixed phrase; rewording it would have broken that caller's."""
+
+    def __init__(self, device: str, path: Path, reason: str, *, is_tiff: bool) -> None:
+        self.path = path
+        self.reason = reason
+        self.is_tiff = is_tiff
+        advice = (
+            ": is it a complete TIFF (not one still being written, or a copy cut short)?"
+            if is_tiff
+            else ""
+        )
+        detail = f" ({reason})" if reason else ""
+        super().__init__(device, f"cannot read image file {path}{detail}{advice}", "read")
+
+
 def read_image_file(path: Path, device: str) -> NDArray:
     """Read a non-RAW image file with its bit depth kept, colour in **RGB** order whatever the
-    format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers)."""
+    format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers).
+
+    Raises :class:`ImageReadError` for a file that will not read."""
     suffix = path.suffix.lower()
     if suffix in (".tif", ".tiff"):
         import tifffile  # on a TIFF only: `rti-rig plan` imports this module for any preview
 
         try:
-            return tifffile.imread(path)
-        except (ValueError, OSError) as exc:
+            image = tifffile.imread(path)
+        except (ValueError, OSError, RuntimeError) as exc:
             # a TIFF cut short or not a TIFF at all (tifffile raises ValueError, TiffFileError
-            # among them): it had escaped as itself, a Python traceback mid-session
-            raise CaptureError(
-                device,
-                f"cannot read image file {path} ({exc}): is it a complete TIFF (not one still "
-                "being written, or a copy cut short)?",
-                "read",
-            ) from exc
+            # among them), or compressed data that will not decompress (imagecodecs' errors
+            # are RuntimeErrors): it had escaped as itself, a Python traceback mid-session
+            raise ImageReadError(device, path, str(exc), is_tiff=True) from exc
+        if image.size == 0:  # a damaged IFD tifffile reads past, logging, as no pixels
+            raise ImageReadError(device, path, "it holds no pixels", is_tiff=True)
+        return image
+    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ImageReadError(device, path, "", is_tiff=False)
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise CaptureError(device, f"cannot read image file {path}", "read")

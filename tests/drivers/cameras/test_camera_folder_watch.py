@@ -422,6 +422,80 @@ def test_a_file_named_tif_that_is_no_tiff_is_said_at_once_naming_it(tmp_path):
         cam.capture(0.5)
     said = str(info.value)
     assert "IMG_0001.tif is no TIFF" in said and "waiting will not help" in said, said
+    # worded by the camera from the reader's fields: the file's name and the reader's reason
+    assert f"cannot read image file {tmp_path / 'IMG_0001.tif'} (" in said, said
+    assert "complete TIFF" not in said, said
     assert str(tmp_path) in said and "stable_polls or poll_interval_s" not in said, said
     assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
     assert (tmp_path / "IMG_0001.tif").exists()  # left where the program saved it
+
+
+def _tiff_bytes(tmp_path, compression=None) -> tuple[bytes, int, int]:
+    """A whole 16-bit RGB TIFF's bytes, and its first strip's offset and byte count."""
+    whole = tmp_path / "whole.tif.tmp"
+    tifffile.imwrite(
+        whole, np.full((64, 64, 3), 30000, np.uint16), photometric="rgb", compression=compression
+    )
+    with tifffile.TiffFile(whole) as tif:
+        offset, count = tif.pages[0].dataoffsets[0], tif.pages[0].databytecounts[0]
+    data = whole.read_bytes()
+    whole.unlink()
+    return data, offset, count
+
+
+def test_a_whole_tiff_whose_data_will_not_decode_is_said_at_once_naming_it(tmp_path):
+    """A TIFF whose header and structure are all written, its size steady, but whose
+    compressed data is damaged (a copy gone wrong): its decode waited ``timeout_s`` for it to
+    change, then advised raising stable_polls or poll_interval_s. Nothing more is coming: it
+    is said at once, naming the file, where it is left and what to do."""
+    data, offset, count = _tiff_bytes(tmp_path, compression="zlib")
+    damaged = data[:offset] + bytes(b ^ 0x5A for b in data[offset : offset + count])
+    damaged += data[offset + count :]
+    clock = ScriptedClock({0.5: lambda: (tmp_path / "IMG_0001.tif").write_bytes(damaged)})
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert f"cannot read image file {tmp_path / 'IMG_0001.tif'} (" in said, said
+    assert "IMG_0001.tif is a damaged TIFF" in said and "waiting will not help" in said, said
+    assert f"left in {tmp_path}" in said and "Save the shot again" in said, said
+    assert "stable_polls or poll_interval_s" not in said and ".incoming" not in said, said
+    assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
+    assert (tmp_path / "IMG_0001.tif").exists()
+
+
+def test_a_tiff_whose_writer_pauses_mid_file_is_decoded_once_whole(tmp_path):
+    """Half a TIFF whose structure names data past its end is not called damaged: its writer
+    may have paused (a network share, a Wi-Fi upload) longer than the stability polls, and
+    the rest, when it comes, makes it whole."""
+    data, _, _ = _tiff_bytes(tmp_path, compression="zlib")
+    target = tmp_path / "IMG_0001.tif"
+    clock = ScriptedClock(
+        {
+            0.5: lambda: target.write_bytes(data[: len(data) - 40]),
+            4.0: lambda: target.write_bytes(data),
+        }
+    )
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    frame = cam.capture(0.5)
+    assert np.all(frame.pixels == 30000)
+    assert clock.now() >= 4.0
+
+
+def test_a_tiff_whose_end_is_not_filled_yet_is_waited_for(tmp_path):
+    """A share that sets a file's full size first and fills it later: its header and
+    structure are there, its data still zeros; it is not called damaged, and is decoded once
+    filled."""
+    data, offset, _ = _tiff_bytes(tmp_path, compression="zlib")
+    target = tmp_path / "IMG_0001.tif"
+    clock = ScriptedClock(
+        {
+            0.5: lambda: target.write_bytes(data[:offset] + bytes(len(data) - offset)),
+            4.0: lambda: target.write_bytes(data),
+        }
+    )
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    assert np.all(cam.capture(0.5).pixels == 30000)

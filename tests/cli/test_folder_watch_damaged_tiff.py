@@ -1,0 +1,115 @@
+"""A whole TIFF whose image data is damaged, saved into the watched folder of the shipped
+folder-watch dome (its framed board emulated on a pty, the camera and its tethering program a
+thread that saves a file for each shutter pulse the board saw): ``rti-rig run`` names the file
+at once, with what to do.
+
+Its decode had waited ``timeout_s`` for the file to change, as for one still being written, and
+then advised raising ``stable_polls`` or ``poll_interval_s``: advice that cannot help a file
+whose every byte its TIFF structure names is written and steady.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tifffile
+from conftest import CONFIGS, shipped_dome_on_pty
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+SHIPPED = CONFIGS / "example_dome_48_folder_watch.toml"
+#: long enough that a decode that waits for the file to change is told from one that does not
+#: by what the run says (the waiting one says "did not change within 20 s")
+TIMEOUT_S = 20.0
+
+
+def _damaged_tiff(scratch: Path) -> bytes:
+    """A 16-bit LZW TIFF whose header and structure are whole and whose strip is damaged."""
+    tifffile.imwrite(
+        scratch, np.full((64, 64, 3), 30000, np.uint16), photometric="rgb", compression="lzw"
+    )
+    with tifffile.TiffFile(scratch) as tif:
+        offset, count = tif.pages[0].dataoffsets[0], tif.pages[0].databytecounts[0]
+    data = scratch.read_bytes()
+    scratch.unlink()
+    return (
+        data[:offset]
+        + bytes(b ^ 0x5A for b in data[offset : offset + count])
+        + data[offset + count :]
+    )
+
+
+def _config(tmp_path: Path, tether: Path) -> Path:
+    """The shipped config with its folder set to ``tether``, watched for TIFFs."""
+    text = SHIPPED.read_text(encoding="utf-8")
+    for old, new in [
+        ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
+        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
+        ("timeout_s = 15.0", f"timeout_s = {TIMEOUT_S}"),
+    ]:
+        assert old in text, old
+        text = text.replace(old, new)
+    text = text.replace(
+        text[text.index("patterns = [") : text.index("]\n", text.index("patterns = [")) + 1],
+        'patterns = ["*.tif"]',
+    )
+    cfg = tmp_path / "example_dome_48_folder_watch.toml"
+    cfg.write_text(text, encoding="utf-8")
+    return cfg
+
+
+class Tether(threading.Thread):
+    """The camera and its tethering program: the board's first shutter pulse becomes
+    ``IMG_0001.tif`` in the folder, whole but damaged."""
+
+    def __init__(self, firmware, folder: Path, data: bytes) -> None:  # type: ignore[no-untyped-def]
+        super().__init__(daemon=True)
+        self.firmware, self.folder, self.data = firmware, folder, data
+        self.stop = threading.Event()
+
+    def run(self) -> None:
+        while not self.stop.is_set():
+            if any(e.what == "shutter" for e in list(self.firmware.history)):
+                (self.folder / "IMG_0001.tif").write_bytes(self.data)
+                return
+            self.stop.wait(0.02)
+
+
+def test_run_names_a_damaged_tiff_at_once_with_what_to_do(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    out = tmp_path / "s"
+    cfg = _config(tmp_path, tether)
+    data = _damaged_tiff(tmp_path / "scratch.tif")
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, data)
+        camera.start()
+        try:
+            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            r = CliRunner().invoke(app, args, terminal_width=400)
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+        lit_at_end = firmware.lit_indices()
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said, said
+    assert "IMG_0001.tif is a damaged TIFF" in said and "waiting will not help" in said, said
+    assert f"cannot read image file {tether / 'IMG_0001.tif'} (" in said, said
+    assert ".incoming" not in said, said  # the folder's file is named, not the session's copy
+    assert f"left in {tether}" in said and "Save the shot again" in said, said
+    assert f"did not change within {TIMEOUT_S:g} s" not in said, said
+    assert (tether / "IMG_0001.tif").read_bytes() == data  # left as the program saved it
+    assert lit_at_end == []  # the dome was switched off
