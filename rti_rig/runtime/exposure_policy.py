@@ -27,6 +27,7 @@ refused ("went dark by itself"). There each test shot is taken under its own lig
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -124,8 +125,8 @@ def _at_least_s(camera: object, exposure_s: float) -> float:
 def metering_start(
     camera: object, exposure_s: float, within: tuple[Bound, Bound] | None = None
 ) -> tuple[float, str | None]:
-    """Where the metering starts from ``[camera] exposure_s``, and what was changed to get
-    there (None: nothing but the rounding to the camera's units): an exposure the camera takes
+    """Where the metering starts from ``[camera] exposure_s``, and a note saying why it is
+    not ``exposure_s`` (None when it is): an exposure the camera takes
     exactly (:func:`representable_s`, rounded down, or up where that left the range) inside
     both the metering's own range ``within`` (``[camera] min_exposure_s`` … ``max_exposure_s``,
     less what a light's lit time allows; its ends with the phrases that name their keys) and
@@ -141,8 +142,11 @@ def metering_start(
     camera cannot take exactly. And exposure_s is only a start: one under the device's
     minimum had stopped the run at the metering's first test shot, one over its maximum had
     been refused before any LED lit, while the docs say it "is only where the metering
-    starts". Raises :class:`DeviceError` naming both keys when no exposure the camera takes
-    lies inside both ranges (before anything is lit)."""
+    starts". The note is given whatever moved the start: the camera's range, ``within`` or
+    the camera's units (a start moved by the last two had been taken silently, the user left
+    to think the metering began at exposure_s). Raises :class:`DeviceError` naming both
+    keys when no exposure the camera takes lies inside both ranges (before anything is
+    lit)."""
     name = getattr(camera, "name", "camera")
     shortest = getattr(camera, "shortest_exposure_s", None)
     low: Bound | None = shortest() if callable(shortest) else None
@@ -181,7 +185,23 @@ def metering_start(
             f"[camera] exposure_s = {exposure_s:g} s is shorter than the camera {name} can "
             f"take ({low[1]}): the metering started at {start:g} s instead"
         )
-    return start, None
+    if math.isclose(start, exposure_s, rel_tol=1e-9):
+        return start, None
+    # moved by [camera]'s own range (less what a light's lit time allows) or by the camera's
+    # units: said the same way as a move by the camera's range, or the user is left to think
+    # the metering began at exposure_s
+    if within is not None and exposure_s > within[1][0] * (1 + 1e-9):
+        why = f"is longer than the metering may go ({within[1][1]})"
+    elif within is not None and exposure_s < within[0][0] * (1 - 1e-9):
+        why = f"is shorter than the metering may go ({within[0][1]})"
+    else:
+        why = f"is not an exposure the camera {name} takes exactly (it takes whole units)"
+        under = representable_s(camera, exposure_s)
+        if within is not None and start > under and under < within[0][0] * (1 - 1e-9):
+            why += f" and the one it takes under it is shorter than {within[0][1]}"
+    return start, (
+        f"[camera] exposure_s = {exposure_s:g} s {why}: the metering started at {start:g} s instead"
+    )
 
 
 def metering_start_s(

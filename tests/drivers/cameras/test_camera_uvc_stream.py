@@ -542,10 +542,39 @@ def test_the_metering_starts_where_check_judges_in_whole_units_inside_both_range
     assert shots[0][0] == pytest.approx(0.0013), shots
     assert all(abs(t / 0.0001 - round(t / 0.0001)) < 1e-6 for s in shots for t in s), shots
     assert min(t for s in shots for t in s) >= 0.00125, shots
+    # the start moved by [camera]'s range and the camera's units is said, as one moved by the
+    # camera's own range is (it was taken silently)
+    assert (
+        "[camera] exposure_s = 0.00125 s is not an exposure the camera uvc-camera takes "
+        "exactly (it takes whole units) and the one it takes under it is shorter than "
+        "[camera] min_exposure_s = 0.00125 s: the metering started at 0.0013 s instead"
+    ) in said, said
     with shipped_dome_on_pty(monkeypatch, cfg):
         r = CliRunner().invoke(app, ["check", str(cfg), "--auto-exposure"])
     said = " ".join(r.output.split())
     assert r.exit_code == 0 and "RESULT: PASS" in said, said
+
+
+@pytest.mark.pty
+def test_a_metering_start_rounded_to_the_cameras_units_is_said(tmp_path, monkeypatch):
+    """`run --auto-exposure` with `[camera] exposure_s = 0.00125` (12.5 units of 100 µs):
+    the metering starts at 0.0012 s, the whole unit under it, and the run says so, as it says
+    a start the camera's own range moved; it had said nothing, the user left to think the
+    metering began at exposure_s."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    cfg.write_text(cfg.read_text().replace("exposure_s = 0.05\n", "exposure_s = 0.00125\n", 1))
+    light = LightHistory(SystemClock())  # type: ignore[arg-type]
+    light.set(1.0)
+    stream = BufferedUvcStream(light, fps=20.0, scale=1e6)
+    code, said, out, _ = _metered_run(tmp_path, monkeypatch, cfg, stream)
+    assert code == 0, said
+    assert (
+        "[camera] exposure_s = 0.00125 s is not an exposure the camera uvc-camera takes "
+        "exactly (it takes whole units): the metering started at 0.0012 s instead"
+    ) in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    shots = manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
+    assert shots[0][0] == pytest.approx(0.0012), shots  # where the note says it started
 
 
 @pytest.mark.pty
