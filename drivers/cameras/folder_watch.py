@@ -1064,10 +1064,23 @@ class FolderWatchCamera:
                         "decode",
                     ) from exc
                 extent = _tiff_extent(path) if tiff else None
+                steady = tried is not None and _identity(path) == tried  # still what was read
+                if isinstance(exc, ImageReadError) and exc.no_pixels and steady:
+                    # its IFDs read as naming no image at all (damaged): before, an image of
+                    # no pixels went on to the conversion, whose refusal named only its shape
+                    raise CaptureError(
+                        self.name,
+                        f"{message}: {path.name} is a damaged TIFF (its header is written, "
+                        "but its IFDs name no image data), so waiting will not help; it is "
+                        f"left in {s.folder}, and no image was recorded for this light. Save "
+                        "the shot again from the camera's program, or check the disk or share "
+                        "it is saved on",
+                        "decode",
+                    ) from exc
                 if (
                     extent is not None
                     and tried is not None
-                    and _identity(path) == tried  # the bytes read are the folder's still
+                    and steady
                     and extent[1] <= tried[2]
                     and _tiff_end_written(path, *extent)
                 ):

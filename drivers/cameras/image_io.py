@@ -77,16 +77,20 @@ def to_linear_uint16(
 
 class ImageReadError(CaptureError):
     """An image file that would not read, with what is known as fields: ``path`` (the file
-    read), ``reason`` (the reader's own words) and ``is_tiff``.
+    read), ``reason`` (the reader's own words), ``is_tiff`` and ``no_pixels`` (it read, as an
+    image of no pixels: a TIFF whose IFDs are damaged, which tifffile reads past, logging).
 
     Why fields: a caller that words the failure its own way (a watched folder naming the
     folder's file, not the session's copy it read, and whether waiting can help) had cut this
     function's sentence at a fixed phrase; rewording it would have broken that caller's."""
 
-    def __init__(self, device: str, path: Path, reason: str, *, is_tiff: bool) -> None:
+    def __init__(
+        self, device: str, path: Path, reason: str, *, is_tiff: bool, no_pixels: bool = False
+    ) -> None:
         self.path = path
         self.reason = reason
         self.is_tiff = is_tiff
+        self.no_pixels = no_pixels
         advice = (
             ": is it a complete TIFF (not one still being written, or a copy cut short)?"
             if is_tiff
@@ -113,7 +117,7 @@ def read_image_file(path: Path, device: str) -> NDArray:
             # are RuntimeErrors): it had escaped as itself, a Python traceback mid-session
             raise ImageReadError(device, path, str(exc), is_tiff=True) from exc
         if image.size == 0:  # a damaged IFD tifffile reads past, logging, as no pixels
-            raise ImageReadError(device, path, "it holds no pixels", is_tiff=True)
+            raise ImageReadError(device, path, "it holds no pixels", is_tiff=True, no_pixels=True)
         return image
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:

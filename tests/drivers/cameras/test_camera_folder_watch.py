@@ -499,3 +499,21 @@ def test_a_tiff_whose_end_is_not_filled_yet_is_waited_for(tmp_path):
     cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
     cam.connect()
     assert np.all(cam.capture(0.5).pixels == 30000)
+
+
+def test_a_tiff_whose_ifd_is_damaged_is_said_at_once_naming_it(tmp_path):
+    """A TIFF whose header is written and whose IFD entries are garbage: tifffile reads it,
+    logging, as an image of no pixels. It is named at once as damaged, with what to do (an
+    image of no pixels had been refused naming only its shape, then waited for)."""
+    data, _, _ = _tiff_bytes(tmp_path, compression="zlib")
+    damaged = data[:100] + b"\xff" * 100 + data[200:]
+    clock = ScriptedClock({0.5: lambda: (tmp_path / "IMG_0001.tif").write_bytes(damaged)})
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "IMG_0001.tif is a damaged TIFF" in said and "name no image data" in said, said
+    assert f"left in {tmp_path}" in said and "waiting will not help" in said, said
+    assert "shape" not in said and "stable_polls" not in said, said
+    assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
