@@ -332,7 +332,7 @@ def _not_a_tiff(path: Path) -> bool:
 def _tiff_extent(path: Path) -> tuple[int, int] | None:
     """Where the piece ``path``'s own TIFF structure names last lies: (start, end) of the
     strip, tile or IFD that ends furthest into the file; None when tifffile cannot parse its
-    IFDs at all.
+    IFDs at all, or one names no data (not all written yet, or damaged: not known which).
 
     Why: a TIFF that will not decode is either not all written yet (its IFDs name data past
     its end: a writer that paused, or a copy cut short, which waiting may yet mend) or whole
@@ -345,8 +345,7 @@ def _tiff_extent(path: Path) -> tuple[int, int] | None:
             last = (0, 0)
             for page in tif.pages:
                 ifd = int(getattr(page, "offset", 0))
-                pieces = [(ifd, ifd + 2)]  # an IFD's entry count, at least
-                pieces += [
+                data = [
                     (int(o), int(o) + int(n))
                     for o, n in zip(
                         getattr(page, "dataoffsets", ()),
@@ -354,7 +353,9 @@ def _tiff_extent(path: Path) -> tuple[int, int] | None:
                         strict=False,
                     )
                 ]
-                last = max([last, *pieces], key=lambda piece: piece[1])
+                if not data:  # an IFD naming no data: damaged, or not all written yet
+                    return None
+                last = max([last, (ifd, ifd + 2), *data], key=lambda piece: piece[1])
             return last
     except Exception:  # IFDs that will not parse: nothing is known of the rest
         return None
@@ -1065,7 +1066,14 @@ class FolderWatchCamera:
                     ) from exc
                 extent = _tiff_extent(path) if tiff else None
                 steady = tried is not None and _identity(path) == tried  # still what was read
-                if isinstance(exc, ImageReadError) and exc.no_pixels and steady:
+                if (
+                    isinstance(exc, ImageReadError)
+                    and exc.no_pixels
+                    and steady
+                    and tried is not None
+                    # not a file a share sized first and is still filling (its end zeros)
+                    and _tiff_end_written(path, 0, tried[2])
+                ):
                     # its IFDs read as naming no image at all (damaged): before, an image of
                     # no pixels went on to the conversion, whose refusal named only its shape
                     raise CaptureError(
@@ -1083,6 +1091,7 @@ class FolderWatchCamera:
                     and steady
                     and extent[1] <= tried[2]
                     and _tiff_end_written(path, *extent)
+                    and _tiff_end_written(path, 0, tried[2])
                 ):
                     # every byte its IFDs name is written, its size steady over the
                     # stability polls, and it still will not decode: damaged, not half-written

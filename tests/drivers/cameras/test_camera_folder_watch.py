@@ -517,3 +517,20 @@ def test_a_tiff_whose_ifd_is_damaged_is_said_at_once_naming_it(tmp_path):
     assert f"left in {tmp_path}" in said and "waiting will not help" in said, said
     assert "shape" not in said and "stable_polls" not in said, said
     assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
+
+
+def test_a_tiff_filled_in_place_up_to_its_ifd_is_waited_for(tmp_path):
+    """A share that sets a file's full size first and fills it in order, read when the fill
+    has reached the middle of its IFD: tifffile reads the zero entries past, as an image of no
+    pixels. Its end is still zeros: it is not called damaged, and is decoded once filled."""
+    data, _, _ = _tiff_bytes(tmp_path, compression="zlib")
+    target = tmp_path / "IMG_0001.tif"
+    clock = ScriptedClock(
+        {
+            0.5: lambda: target.write_bytes(data[:40] + bytes(len(data) - 40)),
+            4.0: lambda: target.write_bytes(data),
+        }
+    )
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    assert np.all(cam.capture(0.5).pixels == 30000)
