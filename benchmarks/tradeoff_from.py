@@ -86,12 +86,30 @@ def load_acquisition_colour(lp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return np.stack(images), np.stack(colour), dirs, [e.name for e in entries]
 
 
+def _too_few_lights(lp: Path, count: int) -> str | None:
+    """What is said of an acquisition of ``count`` lights too few for a trade-off, or None."""
+    smallest = MIN_CANDIDATES + MIN_HELD_OUT
+    if count >= smallest:
+        return None
+    return (
+        f"{lp}: {count} lights; at least {smallest} are needed for a trade-off "
+        f"({MIN_CANDIDATES} to plan from and {MIN_HELD_OUT} held out to score relighting)"
+    )
+
+
 def check_acquisition(lp: Path) -> None:
-    """Refuse ``lp`` by name, as :func:`load_acquisition_colour` would, without reading the
-    pixels: for the command to say it before it creates its ``--out`` folder."""
+    """Refuse ``lp`` by name, as :func:`load_acquisition_colour` and
+    :func:`run_tradeoff_from` would, without reading the pixels: for the command to say it
+    before it creates its ``--out`` folder (an acquisition of too few lights had been refused
+    only once read, leaving an empty ``--out`` behind)."""
+    from rti_rig.core.errors import RtiRigError
     from rti_rig.core.lp_format import read_lp
 
-    _image_files(lp, read_lp(lp, upper_hemisphere=True))
+    entries = read_lp(lp, upper_hemisphere=True)
+    _image_files(lp, entries)
+    too_few = _too_few_lights(lp, len(entries))
+    if too_few is not None:
+        raise RtiRigError(too_few)
 
 
 def _image_files(lp: Path, entries: list[Any]) -> list[Path]:
@@ -143,12 +161,9 @@ def run_tradeoff_from(
     from rti_rig.planner.uniform import select_uniform_leds
 
     images, colour, dirs, names = load_acquisition_colour(Path(lp))
-    smallest = MIN_CANDIDATES + MIN_HELD_OUT
-    if len(dirs) < smallest:
-        raise ValueError(
-            f"{lp}: {len(dirs)} lights; at least {smallest} are needed for a trade-off "
-            f"({MIN_CANDIDATES} to plan from and {MIN_HELD_OUT} held out to score relighting)"
-        )
+    too_few = _too_few_lights(lp, len(dirs))
+    if too_few is not None:  # the command says it first (check_acquisition): for other callers
+        raise ValueError(too_few)
     held = held_out_lights(dirs)
     keep = np.setdiff1d(np.arange(len(dirs)), held)  # what every plan chooses among
     dome = DomeGeometry(dirs[keep], tuple(names[i] for i in keep))

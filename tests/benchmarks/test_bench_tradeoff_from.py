@@ -129,6 +129,8 @@ def test_a_best_floor_of_zero_is_one_line_not_two_on_top_of_each_other() -> None
 
 
 def test_tradeoff_from_too_small_an_acquisition_is_refused(tmp_path: Path) -> None:
+    """Refused only once its images were read, after --out had been created: a refused
+    command left an empty folder behind."""
     small = tmp_path / "acq"
     small.mkdir()
     lines = ACQ.read_text().splitlines()[1:10]  # 9 lights: 7 to plan from, 3 held out is 10
@@ -140,6 +142,7 @@ def test_tradeoff_from_too_small_an_acquisition_is_refused(tmp_path: Path) -> No
         app, ["bench", "tradeoff", "--from", str(small / "dirs.lp"), "--out", str(tmp_path / "o")]
     )
     assert r.exit_code == 2 and "at least 10" in r.output and "held out" in r.output
+    assert not (tmp_path / "o").exists()  # refused before --out is made: nothing left behind
 
 
 def test_quick_with_from_is_refused_before_anything_is_written(tmp_path: Path) -> None:
@@ -429,10 +432,11 @@ def test_an_out_the_user_may_not_look_into_is_refused_by_name(
 
     lp = _acquisition(tmp_path / "acq", 6)
     other = _acquisition(tmp_path / "acq2", 6)
+    enough = _acquisition(tmp_path / "acq3")  # bench refuses 6 lights before it sees --out
     out = locked / "x" / "y"
     monkeypatch.setattr(os, "stat", stat)
     for args in (
-        ["bench", "tradeoff", "--from", str(lp), "--out", str(out)],
+        ["bench", "tradeoff", "--from", str(enough), "--out", str(out)],
         ["fit", str(lp), str(other), "--out", str(out)],
         ["fit", str(lp), "--out", str(out)],
     ):
