@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import os
+import tempfile
 from pathlib import Path
 
 from rti_rig.core.errors import RtiRigError
 
-#: A file written and removed to prove the folder writable (permissions, read-only mounts).
-PROBE_NAME = ".rti-rig-write-test"
+#: How the file written and removed to prove the folder writable (permissions, read-only
+#: mounts) is named: this, then a part unique to each probe (:func:`tempfile.mkstemp`).
+PROBE_PREFIX = ".rti-rig-write-test-"
 
 
 def _cannot_write_there(folder: Path, exc: OSError) -> RtiRigError:
@@ -48,12 +51,23 @@ def ensure_writable_folder(folder: Path) -> None:
 
     A file at ``folder`` (or at a folder above it) is refused as such
     (:func:`refuse_a_file_in_the_way`), as ``export-lp`` names a file given for a folder.
+
+    The probe file gets a name no other file has (created exclusively, in the folder itself):
+    a fixed name had replaced, then deleted, a user's file of that name in a folder given with
+    ``--force``, and two commands probing one folder at once could delete each other's probe
+    and fail.
     """
     refuse_a_file_in_the_way(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        probe = folder / PROBE_NAME
-        probe.write_bytes(b"")
-        probe.unlink()
+    except OSError as exc:
+        raise _cannot_write_there(folder, exc) from None
+    try:
+        handle, probe = tempfile.mkstemp(prefix=PROBE_PREFIX, dir=folder)
+    except OSError as exc:  # named by the folder, not by the probe's random name
+        raise _cannot_write_there(folder, OSError(exc.errno, exc.strerror, str(folder))) from None
+    os.close(handle)
+    try:
+        os.unlink(probe)
     except OSError as exc:
         raise _cannot_write_there(folder, exc) from None

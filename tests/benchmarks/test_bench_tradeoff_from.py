@@ -447,3 +447,34 @@ def test_an_out_the_user_may_not_look_into_is_refused_by_name(
         assert "choose a folder you can write to" in text
     monkeypatch.undo()
     assert not out.exists()
+
+
+def test_the_write_probe_leaves_a_users_files_in_out_alone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The probe that proves --out writable was a file of a fixed name, ".rti-rig-write-test":
+    in a folder given with --force, a user's file of that name was replaced, then deleted (and
+    two commands probing one folder at once could delete each other's probe). The trade-off
+    itself is a stand-in: what is checked happens before it, as the command runs."""
+    import benchmarks.tradeoff_from as tradeoff_from
+
+    lp = _acquisition(tmp_path / "acq")
+    out = tmp_path / "o"
+    out.mkdir()
+    mine = {".rti-rig-write-test": "mine\n", ".rti-rig-write-test-x": "also mine\n"}
+    for name, text in mine.items():
+        (out / name).write_text(text)
+    seen: list[list[str]] = []
+
+    def bench_from(lp: Path, out_dir: Path | None, *args: object, **kwargs: object) -> str:
+        assert out_dir is not None
+        seen.append(sorted(p.name for p in out_dir.iterdir()))
+        return "stand-in summary"
+
+    monkeypatch.setattr(tradeoff_from, "bench_from", bench_from)
+    r = CliRunner().invoke(
+        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out), "--force"]
+    )
+    assert r.exit_code == 0 and "stand-in summary" in r.output, r.output
+    assert seen == [sorted(mine)]  # the probe was there and gone before the trade-off ran
+    assert {p.name: p.read_text() for p in out.iterdir()} == mine

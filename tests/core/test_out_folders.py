@@ -9,13 +9,13 @@ from pathlib import Path
 import pytest
 
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.out_folders import PROBE_NAME, ensure_writable_folder
+from rti_rig.core.out_folders import ensure_writable_folder
 
 
 def test_a_new_folder_is_created_and_left_empty(tmp_path: Path) -> None:
     target = tmp_path / "a" / "b"
     ensure_writable_folder(target)
-    assert target.is_dir() and not (target / PROBE_NAME).exists()
+    assert target.is_dir() and not any(target.iterdir())  # the probe file is gone
 
 
 def test_a_folder_under_a_file_is_refused_by_name(tmp_path: Path) -> None:
