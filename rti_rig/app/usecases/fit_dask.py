@@ -32,7 +32,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -270,6 +270,10 @@ class _Refused(Exception):
     """The scheduler's host refused the connection: nothing listens on that port."""
 
 
+class _Unresolved(Exception):
+    """The scheduler's host name does not resolve to an address (``args``: the host, why)."""
+
+
 def _refused(exc: BaseException | None) -> bool:
     """Whether ``exc``, or an exception it was raised from, is a refused connection (Dask's
     TCP connector raises ``CommClosedError`` from the ``ConnectionRefusedError``)."""
@@ -282,24 +286,70 @@ def _refused(exc: BaseException | None) -> bool:
     return False
 
 
+async def _resolve(host: str, port: int, timeout: float) -> None:
+    """Return once ``host`` resolves; raise :class:`_Unresolved` when it does not, or when the
+    resolver has not answered within ``timeout`` seconds.
+
+    Why: Dask's ``connect`` retries a name that does not resolve until its timeout, so a
+    mistyped host waited the full 20 s and was told as "no Dask scheduler answered". The lookup
+    runs in a daemon thread: ``getaddrinfo`` cannot be interrupted, and a resolver that hangs
+    must hold neither this wait beyond ``timeout`` nor the exit of a stopped ``rti-rig fit``
+    (the event loop's own executor is joined at exit)."""
+    loop = asyncio.get_running_loop()
+    answer: asyncio.Future[BaseException | None] = loop.create_future()
+
+    def tell(outcome: BaseException | None) -> None:
+        if not answer.done():
+            answer.set_result(outcome)
+
+    def lookup() -> None:
+        outcome: BaseException | None = None
+        try:
+            socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+        except OSError as exc:  # socket.gaierror, or an OSError of the resolver's
+            outcome = exc
+        with suppress(RuntimeError):  # the loop is closed: the probe was stopped or timed out
+            loop.call_soon_threadsafe(tell, outcome)
+
+    threading.Thread(target=lookup, name="rti-rig-resolve", daemon=True).start()
+    try:
+        failure = await asyncio.wait_for(answer, timeout)
+    except TimeoutError:
+        raise _Unresolved(host, f"the resolver gave no answer within {timeout:.0f} s") from None
+    if failure is not None:
+        why = getattr(failure, "strerror", None) or str(failure)
+        raise _Unresolved(host, why)
+
+
 async def _connect(address: str, timeout: float, connection_args: dict[str, Any]) -> Any:
     """A Dask comm to ``address``, its handshake done (``distributed.comm.connect``), after
-    one plain TCP connection that finds a refused port at once.
+    its host name is resolved and one plain connection finds a refused port at once.
 
-    Why: Dask's ``connect`` retries a refused connection until its timeout, so a port nothing
-    listens on (a scheduler not started, a wrong port) waited the full 20 s and was told as
-    "Timed out trying to connect". A bare TCP connect says it in milliseconds, with nothing of
-    Dask's handshake copied here (a copy would break silently with a Dask upgrade); a scheduler
-    that is there logs it at INFO as a connection closed before its handshake. Not for tls://
-    and wss://, whose listener would log a failed TLS handshake as a warning: those keep Dask's
-    retries. Any other failure (a name not resolved yet, a slow network) is left to Dask."""
+    Why: Dask's ``connect`` retries a refused connection, and a name that does not resolve,
+    until its timeout, so a port nothing listens on (a scheduler not started, a wrong port) or
+    a mistyped host waited the full 20 s and was told as "Timed out trying to connect". A
+    lookup and a bare connect say it in milliseconds, with nothing of Dask's handshake copied
+    here (a copy would break silently with a Dask upgrade); a scheduler that is there logs it
+    at INFO as a connection closed before its handshake. For tls:// and wss:// the same
+    connect also does the TLS handshake, with the context Dask's own connect uses, so that a
+    listener that is there does not log a failed TLS handshake as a warning; a refused port
+    fails before any handshake. Any other failure (a certificate refused, a slow network) is
+    left to Dask, which says it in its own words."""
     from distributed.comm import connect, parse_address, parse_host_port
 
     scheme, location = parse_address(address)
-    if scheme in ("tcp", "ws"):
+    if scheme in ("tcp", "ws", "tls", "wss"):
+        host, port = parse_host_port(location)
+        await _resolve(host, port, timeout / 5)
+        tls: Any = None
+        if scheme == "tls":
+            tls = connection_args.get("ssl_context")  # checked by _tls_settings: a context
+        elif scheme == "wss":  # Dask's wss:// gives tornado None for its default context
+            tls = connection_args.get("ssl_context") or True
         try:
-            host, port = parse_host_port(location)
-            _, writer = await asyncio.wait_for(asyncio.open_connection(host, port), timeout / 5)
+            _, writer = await asyncio.wait_for(
+                asyncio.open_connection(host, port, ssl=tls), timeout / 5
+            )
         except (TimeoutError, OSError, ValueError) as exc:
             if _refused(exc):
                 raise _Refused(location) from None
@@ -345,6 +395,56 @@ def _run_quietly(main: Any) -> Any:
             loop.close()
 
 
+#: Dask's configuration keys a tls:// client needs (its ``Security()`` reads them).
+TLS_KEYS = (
+    "distributed.comm.tls.ca-file",
+    "distributed.comm.tls.client.cert",
+    "distributed.comm.tls.client.key",
+)
+
+
+def _tls_settings(address: str) -> dict[str, Any]:
+    """The connection arguments Dask's ``Client`` will use (``Security()`` from Dask's
+    configuration), refused in words when they cannot serve ``address``.
+
+    Why: a tls:// address without TLS settings was told as "cannot reach the Dask scheduler
+    (TypeError: TLS expects a `ssl_context` argument …)", with advice to start a scheduler,
+    when what is missing is this client's certificate and the CA to check the scheduler's;
+    and a certificate file that cannot be read raised out of here with a traceback."""
+    import ssl
+
+    import dask.config
+    from distributed.security import Security
+
+    how = (
+        f"Dask reads them from its configuration: {', '.join(TLS_KEYS)} (the key may be in "
+        "the certificate file), in a YAML file under ~/.config/dask/ or as the environment "
+        "variables DASK_DISTRIBUTED__COMM__TLS__CA_FILE, "
+        "DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT and DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY"
+    )
+    try:
+        security = Security()
+        args: dict[str, Any] = security.get_connection_args("client")
+    except (OSError, ValueError) as exc:  # ssl.SSLError is an OSError
+        given = {key: dask.config.get(key, None) for key in TLS_KEYS}
+        named = ", ".join(f"{key} = {value!r}" for key, value in given.items() if value)
+        raise SchedulerError(
+            f"--scheduler {address!r}: Dask's TLS settings cannot be used "
+            f"({type(exc).__name__}: {exc}; {named or 'none given'}). Check the files they "
+            f"name; {how}."
+        ) from None
+    if address.startswith("tls://") and not isinstance(args.get("ssl_context"), ssl.SSLContext):
+        given = (security.tls_ca_file, security.tls_client_cert)
+        missing = [key for key, value in zip(TLS_KEYS[:2], given, strict=True) if not value]
+        raise SchedulerError(
+            f"--scheduler {address!r} is a TLS address, and Dask's TLS settings for a client "
+            f"are not given ({' and '.join(missing)} not set): give the CA certificate that "
+            "signed the scheduler's certificate and this client's certificate and key. "
+            f"{how}. Or give the scheduler's tcp:// address if it has one."
+        )
+    return args
+
+
 def _probe(address: str, timeout: float) -> None:
     """Return once the scheduler at ``address`` answers, within ``timeout`` seconds in all.
 
@@ -353,9 +453,7 @@ def _probe(address: str, timeout: float) -> None:
     answers (a proxy, a service that is not Dask, a hung scheduler) held ``rti-rig fit`` for
     ever, and its Ctrl-C left a half-built Client waiting 40 s in ``__del__``. No Client is
     built before this answers."""
-    from distributed.security import Security
-
-    args = Security().get_connection_args("client")  # as the Client's own (tls:// from config)
+    args = _tls_settings(address)
 
     async def bounded() -> Any:
         return await asyncio.wait_for(_identity(address, timeout, args), timeout)
@@ -371,6 +469,13 @@ def _probe(address: str, timeout: float) -> None:
     except _Refused as refused:
         raise _unreachable_scheduler(
             address, f"connection refused: no scheduler listens at {refused}"
+        ) from None
+    except _Unresolved as unresolved:
+        host, why = unresolved.args
+        raise SchedulerError(
+            f"--scheduler {address!r} names the host {host!r}, which does not resolve ({why}): "
+            "check the host name, or give the address `dask scheduler` prints, such as "
+            "tcp://192.0.2.10:8786"
         ) from None
     except Exception as exc:  # reset, a TLS failure, a reply that is not Dask's
         raise _unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
