@@ -414,7 +414,7 @@ class OpenCvCamera:
         s = self.settings
         if not s.min_exposure_s <= exposure_s <= s.max_exposure_s:
             # capture refuses it, with the LED already lit (the config's [camera] range may
-            # allow it: the two tables are not compared when the config loads)
+            # allow it: the config loader refuses only ranges that share no exposure)
             side = "shorter" if exposure_s < s.min_exposure_s else "longer"
             key = "min_exposure_s" if side == "shorter" else "max_exposure_s"
             limit = s.min_exposure_s if side == "shorter" else s.max_exposure_s

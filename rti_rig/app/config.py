@@ -836,6 +836,7 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
         )
     if config.camera.device is not None:
         cam = camera_device_settings(loaded)
+        _check_exposure_ranges(loaded, path, cam)
         if getattr(cam, "trigger", "none") == "dome_shutter" and config.kind != "dome":
             raise ConfigError(
                 path,
@@ -849,6 +850,48 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
             if note:
                 loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
     return loaded
+
+
+def _check_exposure_ranges(loaded: LoadedRig, path: Path, cam: object) -> None:
+    """Refuse a ``[camera]`` exposure range that shares no exposure with the range the camera
+    of ``[camera.device]`` takes (``min_exposure_s`` … ``max_exposure_s`` there, its defaults
+    where not given), naming both keys.
+
+    Why: the two tables were compared only once the camera connected (the metering's start,
+    :func:`rti_rig.runtime.exposure_policy.metering_start`, or the camera's own refusal of
+    the first exposure), so ``rti-rig check`` opened the dome's port and the camera for a
+    config no shot can come from: every exposure is kept inside ``[camera]``'s range, and the
+    camera refuses any outside its own. Said in the connect-time check's words. The frame
+    period and the exposure units, known only once connected, are left to that check."""
+    low = getattr(cam, "min_exposure_s", None)
+    high = getattr(cam, "max_exposure_s", None)
+    if low is None or high is None:  # a camera whose range the config does not give
+        return
+    given = loaded.config.camera.device or {}
+    camera = loaded.config.camera
+
+    def device(key: str, value: float) -> str:
+        default = "" if key in given else " (its default)"
+        return f"{key} = {value:g} s in [camera.device]{default}"
+
+    if camera.min_exposure_s > high * (1 + 1e-9):
+        key = "camera.min_exposure_s"
+        first = f"[camera] min_exposure_s = {camera.min_exposure_s:g} s"
+        second = device("max_exposure_s", high)
+    elif camera.max_exposure_s < low * (1 - 1e-9):
+        key = "camera.max_exposure_s"
+        first = device("min_exposure_s", low)
+        second = f"[camera] max_exposure_s = {camera.max_exposure_s:g} s"
+    else:
+        return
+    raise ConfigError(
+        path,
+        key,
+        f"no exposure the camera takes lies between {first} and {second}: the camera refuses "
+        "any exposure outside [camera.device]'s range, and every exposure (exposure_s, and "
+        "what run --auto-exposure meters) is kept inside [camera]'s; lower the first or raise "
+        "the second",
+    )
 
 
 def lit_per_shot(rig: LoadedRig) -> tuple[float, bool]:

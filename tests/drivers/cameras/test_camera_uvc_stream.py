@@ -579,11 +579,13 @@ def test_a_metering_start_rounded_to_the_cameras_units_is_said(tmp_path, monkeyp
 
 @pytest.mark.pty
 def test_no_whole_unit_inside_both_ranges_is_refused_naming_both_keys(tmp_path, monkeypatch):
-    """`[camera] min_exposure_s = 0.00125` over `[camera.device] max_exposure_s = 0.0012`: no
-    exposure the camera takes lies in both ranges. `check --auto-exposure` had passed it,
-    judging 0.0012 s (the camera's range alone), and the run started its metering at
-    0.00125 s. Both now refuse it naming both keys, the run before any LED lights."""
-    cfg = _min_exposure_at_start(tmp_path, "max_exposure_s = 0.0012\n")
+    """`[camera] min_exposure_s = 0.00125` and `[camera.device] max_exposure_s = 0.00129`
+    share no exposure the camera takes (its units are 0.0001 s). `check --auto-exposure` had
+    passed such a pair, judging 0.0012 s (the camera's range alone), and the run started its
+    metering at 0.00125 s. Both now refuse it naming both keys, the run before any LED
+    lights. (Ranges that do not even meet, 0.00125 over 0.0012, are refused when the config
+    loads: tests/cli/test_config_camera_exposure_ranges.py.)"""
+    cfg = _min_exposure_at_start(tmp_path, "max_exposure_s = 0.00129\n")
     stream = BufferedUvcStream(LightHistory(SystemClock()), fps=20.0)  # type: ignore[arg-type]
     with monkeypatch.context() as m:
         m.setattr(cv2, "VideoCapture", lambda device, api: stream)
@@ -591,7 +593,7 @@ def test_no_whole_unit_inside_both_ranges_is_refused_naming_both_keys(tmp_path, 
             r = CliRunner().invoke(app, ["check", str(cfg), "--auto-exposure"])
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and "RESULT: FAIL" in said, said
-    keys = ("[camera] min_exposure_s = 0.00125 s", "max_exposure_s = 0.0012 s in [camera.device]")
+    keys = ("[camera] min_exposure_s = 0.00125 s", "max_exposure_s = 0.00129 s in [camera.device]")
     assert all(k in said for k in keys) and "Traceback" not in said, said
     code, said, out, history = _metered_run(tmp_path, monkeypatch, cfg, stream)
     assert code != 0 and all(k in said for k in keys), said
