@@ -116,5 +116,27 @@ def stop_exit_code(why: str) -> int:
     return 143 if why == "SIGTERM" else 130
 
 
+#: Libraries whose log records are not for the user's terminal: a command says in words what
+#: they found (a damaged file is named by the image reader), so their records are dropped.
+QUIET_LIBRARY_LOGGERS = ("tifffile",)
+
+
+def quiet_library_logs() -> None:
+    """Give each of :data:`QUIET_LIBRARY_LOGGERS` a handler that drops its records.
+
+    Why: the command line configures no logging, so a library's warning reaches Python's
+    last-resort handler and is printed raw: a TIFF with damaged tags printed nine
+    ``<TiffTag.fromfile> raised TiffFileError(...)`` lines per read, dozens for one ``fit``,
+    around rti-rig's own sentences. A program that configures logging itself still receives
+    the records (they propagate as before)."""
+    import logging
+
+    for name in QUIET_LIBRARY_LOGGERS:
+        logger = logging.getLogger(name)
+        if not any(isinstance(h, logging.NullHandler) for h in logger.handlers):
+            logger.addHandler(logging.NullHandler())
+
+
 def main() -> None:
+    quiet_library_logs()
     app()
