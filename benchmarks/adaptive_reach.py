@@ -40,6 +40,14 @@ and against a search on the session's own simulated score: which part of the gap
 surface fitted from 4 images, which the design criterion (docs/adaptive.md, "The fitted surface
 or the objective?"; 25 min for 8 draws at load 3-4).
 
+``--object-frame``: instead, from the shipped start, the completions homogeneous about the
+object's own mean normal (``benchmarks.adaptive_object_frame``; the median of the object
+model's normals, or with ``--true-normal`` the scene's) beside the shipped designs: their true
+scores, the oracles with and without them, and the design the session's simulated score takes
+with and without them (``--measure relight``: the relight objective's start, designs and score;
+``--seed``: fresh draws). Not shipped: docs/adaptive.md, "Homogeneous about the object's mean
+normal".
+
 Run: ``python -m benchmarks.adaptive_reach [--draws K] [--scenes a,b] [--measure
 normals|relight] [--families [--ceiling coin:9,...]] [--write]`` (about 20 s for 8 draws on 2
 idle cores, ``--measure relight`` with 16 draws 18 min under load 4, ``--families`` 3 min,
@@ -565,6 +573,146 @@ def truth_surface(
     return rows
 
 
+def object_frame(
+    draws: int,
+    scenes: tuple[str, ...] = (),
+    seed: int = 0,
+    measure: str = "normals",
+    true_normal: bool = False,
+) -> list[str]:
+    """Table rows: from the shipped start at the first decision, the homogeneous completions
+    about the object's mean normal (``benchmarks.adaptive_object_frame``, the normal the median
+    of the object model's normals) beside the shipped designs (the floors' completions and
+    the fitted design): their true scores, the oracle with and without them, and the design
+    the session's own score takes (the robust fit simulated on the object model, the default
+    floor kept unless another is ``SIM_MARGIN`` better, as ``choose_in_design`` takes it)
+    with and without them. ``measure`` "relight" scores the layouts by the written fit.rti's
+    PSNR, the start and the simulated choice the relight objective's. ``true_normal``: the
+    layouts about the scene's true median normal instead (what a perfect estimate would give).
+    A last row per scene gives the normal's tilt from the camera axis (median, range over
+    draws and N)."""
+    import rti_rig.planner.adaptive_optimal as ao
+    from benchmarks import adaptive_object_frame as aof
+
+    sign = -1.0 if measure == "relight" else 1.0
+    rows = []
+    for _, scene, data, rng in _scenes(scenes, seed):
+        cand = data.candidate_dirs
+        grey = data.candidate_images.mean(axis=-1)
+        score = _layout_scores(data, measure)
+        res: dict[tuple[int, str], list[float]] = {}
+        tilts: list[float] = []
+        for _ in range(draws):
+            keep, sub = _draw_lights(rng, len(cand), cand)
+            for n in NS:
+                layouts = {f"hom {f:g}": keep[select_uniform_leds(sub, n, f)] for f in FLOORS}
+                objective = "relight" if measure == "relight" else "normals"
+                st = np.asarray(dome_start(sub, adaptive.START_LIGHTS, n, objective))
+                avail, comps = _floor_completions(cand[keep], st, n)
+                state = _start_state(cand[keep], grey[keep], list(st), n)
+                model = object_model(state)
+                normal = aof.mean_normal(data.normals if true_normal else model.normals)
+                tilts.append(aof.tilt_deg(normal))
+                designs = {f: c for f, c in zip(FLOORS, comps, strict=True)}
+                if measure == "relight":
+                    fitted = adaptive._fitted_relight(model, state, cand[keep], avail, designs, n)
+                else:
+                    fitted = ao.pinned_optimal_design(state, cand[keep], st, comps)
+                if fitted is not None:
+                    designs[adaptive.FITTED_KEY] = fitted
+                obj = {}
+                for f in FLOORS:
+                    c = aof.object_frame_completion(cand[keep], avail, cand[keep][st], n, f, normal)
+                    if c is not None and c.size:
+                        obj[100.0 + f] = c
+                every = {**designs, **obj}
+                full = [np.concatenate([cand[keep][st], cand[keep][c]]) for c in every.values()]
+                d0 = adaptive.default_floor_for(objective)
+                if measure == "relight":
+                    pick, pick_obj = (
+                        _relight_pick(model, cand[keep], avail, every, full, n, keys, d0)
+                        for keys in (list(designs), list(every))
+                    )
+                else:
+                    sims = dict(zip(every, simulate_designs(model, full, robust_fit), strict=True))
+                    pick = adaptive._switch(
+                        {k: sims[k] for k in designs}, d0, adaptive.SIM_MARGIN, None
+                    )
+                    pick_obj = adaptive._switch(sims, d0, adaptive.SIM_MARGIN, None)
+                for k, c in every.items():
+                    layouts[f"d {k:g}"] = keep[np.r_[st, c]]
+                got = score(layouts)
+                for k, v in got.items():
+                    res.setdefault((n, k), []).append(v)
+                for k in FLOORS:
+                    res.setdefault((n, f"of {k:g}"), []).append(
+                        got.get(f"d {100.0 + k:g}", sign * np.inf)
+                    )
+                res.setdefault((n, "pick"), []).append(got[f"d {pick:g}"])
+                res.setdefault((n, "pick obj"), []).append(got[f"d {pick_obj:g}"])
+                res.setdefault((n, "took obj"), []).append(float(pick_obj >= 100.0))
+        tuned = adaptive_tuned(res, sign)
+        for n in NS:
+            bar = float(np.mean(res[(n, f"hom {tuned:g}")]))
+
+            def oracle(labels: list[str], n=n, res=res) -> float:  # type: ignore[no-untyped-def]
+                return sign * float(
+                    (sign * np.array([res[(n, x)] for x in labels])).min(axis=0).mean()
+                )
+
+            shipped = [f"d {k:g}" for k in (*FLOORS, adaptive.FITTED_KEY) if (n, f"d {k:g}") in res]
+            objs = [f"of {k:g}" for k in FLOORS]
+            cells = [
+                *(float(np.mean(res[(n, x)])) for x in objs),
+                oracle(shipped),
+                oracle(shipped + objs),
+                float(np.mean(res[(n, "pick")])),
+                float(np.mean(res[(n, "pick obj")])),
+            ]
+            txt = [
+                f"{c:.3g}" + (" **worse**" if sign * c > sign * bar * (1 + 1e-9 * sign) else "")
+                for c in cells
+            ]
+            took = int(np.sum(res[(n, "took obj")]))
+            rows.append(
+                f"| {scene} | {n} | {tuned:g}°: {bar:.3g} | "
+                + " | ".join(txt)
+                + f" | {took}/{draws} |"
+            )
+        print(
+            f"{scene} done; estimated tilt {np.median(tilts):.1f}° "
+            f"({np.min(tilts):.1f}-{np.max(tilts):.1f})",
+            flush=True,
+        )
+        spread = f"{np.median(tilts):.1f}° ({np.min(tilts):.1f}–{np.max(tilts):.1f})"
+        rows.append(f"| {scene} | estimated tilt | {spread} |" + " |" * 9)
+    return rows
+
+
+def _relight_pick(model, dirs, avail, every, full, n, keys, keep_floor):  # type: ignore[no-untyped-def]
+    """The design among ``keys`` the relight objective's simulated score takes (its margin and
+    default, the lights none of them takes held out), as ``choose_in_design`` takes it."""
+    from rti_rig.app.usecases.adaptive import relight_fit
+    from rti_rig.planner.adaptive_relight import (
+        pick_floor,
+        relight_basis,
+        shared_held_out,
+        simulate_relight_designs,
+    )
+
+    order = list(every)
+    held, _ = shared_held_out(dirs, avail, [every[k] for k in keys])
+    got = simulate_relight_designs(
+        model, [full[order.index(k)] for k in keys], held, relight_fit, relight_basis(n)
+    )
+    return pick_floor(dict(zip(keys, got, strict=True)), keep_floor)
+
+
+def adaptive_tuned(res, sign: float) -> float:  # type: ignore[no-untyped-def]
+    """The hindsight-tuned floor: the homogeneous layout best on the mean over N."""
+    return min(FLOORS, key=lambda f: sign * np.mean([np.mean(res[(n, f"hom {f:g}")]) for n in NS]))
+
+
 def _simulated_search(model, dirs, shot, start, score: float, sweeps: int = 2):  # type: ignore[no-untyped-def]
     """Single-light exchanges of the lights not shot (``start``), each replaced by the light
     (any not shot) that lowers the chooser's *simulated* error most (the robust fit simulated
@@ -649,6 +797,23 @@ def main(argv: list[str] | None = None) -> str:
         "with and without its model-bias term (which part of the gap is the fitted surface)",
     )
     ap.add_argument(
+        "--object-frame",
+        action="store_true",
+        help="instead: completions homogeneous about the object's mean normal beside the "
+        "shipped designs (their reach and the session's simulated choice)",
+    )
+    ap.add_argument(
+        "--true-normal",
+        action="store_true",
+        help="with --object-frame: the layouts about the scene's true mean normal",
+    )
+    ap.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="with --object-frame: the draws (0: those of the tables; another: fresh draws)",
+    )
+    ap.add_argument(
         "--measure",
         choices=MEASURES,
         default="normals",
@@ -661,6 +826,8 @@ def main(argv: list[str] | None = None) -> str:
         return _families_main(args, t0)
     if args.truth_surface:
         return _truth_main(args, t0)
+    if args.object_frame:
+        return _object_frame_main(args, t0)
     rows = reach(args.draws, tuple(x for x in args.scenes.split(",") if x), measure=args.measure)
     floors = "/".join(f"{f:g}°" for f in FLOORS)
     starts = list(start_functions())
@@ -794,6 +961,53 @@ def _truth_main(args: argparse.Namespace, t0: float) -> str:
     print(md)
     if args.write:
         write_section("adaptive_reach_truth", md, DOC)
+    return md
+
+
+def _object_frame_main(args: argparse.Namespace, t0: float) -> str:
+    scenes = tuple(x for x in args.scenes.split(",") if x)
+    rows = object_frame(
+        args.draws, scenes, seed=args.seed, measure=args.measure, true_normal=args.true_normal
+    )
+    unit = (
+        "true mean normal error (°)" if args.measure == "normals" else "written fit.rti PSNR (dB)"
+    )
+    md = "\n".join(
+        [
+            _command_line(
+                "--object-frame"
+                + (" --true-normal" if args.true_normal else "")
+                + (f" --seed {args.seed}" if args.seed else "")
+                + ("" if args.measure == "normals" else f" --measure {args.measure}"),
+                args,
+                (),
+                t0,
+            ),
+            "",
+            f"Simulator, {args.draws} paired draws (those of `benchmarks.adaptive`), the shipped "
+            f"start, the design decided at the first decision; {unit}. `obj F`: the start "
+            "completed to the layout homogeneous above F° from the plane whose normal is the "
+            + (
+                "scene's true median normal"
+                if args.true_normal
+                else "median of the object model's normals"
+            )
+            + " (`benchmarks.adaptive_object_frame`; a light shot behind that plane holds no "
+            "place of the layout); oracles (best per draw) of the shipped "
+            "designs (floors' completions and the fitted design) and of those with the `obj` "
+            "ones; `pick`: the design the session's simulated score takes (margin and default "
+            "as `choose_in_design`), without and with the `obj` designs offered, and how often "
+            "it took one. **worse**: worse than the bar (the hindsight-tuned homogeneous layout).",
+            "",
+            "| scene | N | bar | obj 0 | obj 10 | obj 20 | obj 30 | oracle shipped | oracle "
+            "+obj | pick shipped | pick +obj | took obj |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|",
+            *rows,
+        ]
+    )
+    print(md)
+    if args.write:
+        write_section("adaptive_reach_object_frame", md, DOC)
     return md
 
 
