@@ -113,7 +113,9 @@ def test_the_bright_claim_is_taken_off_by_what_it_is_not_by_its_words() -> None:
 
 
 def test_a_note_on_a_fit_no_image_could_measure_says_so_not_inf_percent() -> None:
-    from rti_rig.reconstruct.qa import _misfit_said
+    from rti_rig.reconstruct.qa import MISFIT_LIMIT, _poor_fit_said
 
-    assert "inf" not in _misfit_said(float("inf"))
-    assert _misfit_said(0.42).startswith("median misfit 42%")
+    unmeasured = _poor_fit_said(float("inf"))
+    assert "inf" not in unmeasured and "poorly" not in unmeasured, unmeasured
+    said = _poor_fit_said(0.42)
+    assert said.endswith(f"poorly (median misfit 42%, limit {MISFIT_LIMIT:.0%})"), said
