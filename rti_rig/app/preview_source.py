@@ -29,7 +29,14 @@ import numpy as np
 from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.core.lp_format import LpEntry, image_path
-from rti_rig.runtime.session import LINEAR_DIR, MANIFEST, RAW_DIR, read_manifest
+from rti_rig.runtime.session import (
+    LINEAR_DIR,
+    MANIFEST,
+    RAW_DIR,
+    read_manifest,
+    refuse_if_in_use,
+    scan_journal,
+)
 
 #: A bare `.lp` given as ``--rig``: its path and its entries.
 RigLp = tuple[Path, Sequence[LpEntry]]
@@ -57,16 +64,31 @@ def _session_root(image: Path) -> Path | None:
 
 
 def _finished_steps(root: Path) -> list[dict[str, Any]]:
-    """The steps a session recorded; an error saying what to do when it recorded none."""
+    """The steps a session recorded; an error saying what to do when it recorded none.
+
+    Why the in-use check and the journal count: a session still being captured was said to have
+    "no finished images" and sent to a ``--resume`` the running capture refuses, and one cut off
+    (a run killed, a power cut: its manifest lists its steps only when a run ends) was said to
+    have none while its journal held them. ``fit`` and ``export-lp`` say the first as this does.
+    """
+    refuse_if_in_use(root, "plan from")
     steps = read_manifest(root).get("steps") or []
-    if not steps:
+    if steps:
+        return steps
+    resume = f"rti-rig run --resume {shlex.quote(str(root))}"
+    journaled = len(scan_journal(root).records)
+    if journaled:
         raise ScheduleError(
-            f"{root}: the session has no finished images, so its lights are not recorded yet; "
-            "if it was interrupted, finish it with rti-rig run --resume "
-            f"{shlex.quote(str(root))} (or shoot the "
-            "preview again), or give the light with --preview-light AZ,EL"
+            f"{root}: the session was cut off (a run killed, or a power cut) before its "
+            f"manifest recorded the lights of its {journaled} image"
+            f"{'' if journaled == 1 else 's'}; finish it with {resume} (that records them), "
+            "or give the light with --preview-light AZ,EL"
         )
-    return steps
+    raise ScheduleError(
+        f"{root}: the session has no finished images, so its lights are not recorded yet; "
+        f"if it was interrupted, finish it with {resume} (or shoot the "
+        "preview again), or give the light with --preview-light AZ,EL"
+    )
 
 
 def _lit_from_above(direction: Any, record: str, image: Path) -> tuple[float, float]:

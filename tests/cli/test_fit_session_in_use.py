@@ -1,13 +1,16 @@
-"""``fit`` and ``export-lp`` of a session another rti-rig process is still capturing.
+"""``fit``, ``export-lp`` and ``plan`` of a session another rti-rig process is still capturing.
 
 The fit read the session's lights.lp and its images at different moments while they grew:
 "error: 40 image names for 33 light directions", or a verdict of part of the session that
-advised a ``--resume`` the running capture would refuse. Both are now refused, saying why
-and when to come back; once that run has ended they read the session as ever.
+advised a ``--resume`` the running capture would refuse. ``plan`` from such a session (or one
+of its images) said it had "no finished images" and advised that refused ``--resume`` too. All
+are now refused, saying why and when to come back; once that run has ended they read the
+session as ever.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -17,6 +20,7 @@ from conftest import REPO, SMALL_DOME, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
 
 runner = CliRunner()
 
@@ -60,3 +64,48 @@ def test_a_session_being_captured_is_not_fitted_or_exported(tmp_path: Path) -> N
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["export-lp", str(s), "--out", str(tmp_path / "x.lp")])
     assert r.exit_code == 0, r.output
+
+
+def test_a_session_being_captured_is_not_planned_from(tmp_path: Path) -> None:
+    cfg = write_config(tmp_path, SMALL_DOME)
+    s = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(s), "--lights", "3", "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    # its manifest as a capture under way has it: steps are listed when the run ends
+    manifest = json.loads((s / "manifest.json").read_text())
+    for key in ("finished_at", "timing", "lp_file", "notices"):
+        manifest.pop(key)
+    manifest["runner"] = {"state": "running", "finish_reason": None}
+    manifest["steps"] = []
+    (s / "manifest.json").write_text(json.dumps(manifest))
+    plan = tmp_path / "p.lp"
+    args = ["--rig", str(cfg), "--lights", "6", "--out", str(plan)]
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    holder = subprocess.Popen(
+        [sys.executable, "-c", HOLDER, str(s)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        env=env,
+        text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "locked"
+        for preview in (s, s / "image_002.jpg", s / "linear" / "image_002.tif"):
+            r = runner.invoke(app, ["plan", str(preview), *args])
+            assert r.exit_code == 2, r.output
+            assert "being captured by another rti-rig process" in said(r)
+            assert "plan from it once that run has ended" in said(r)
+            assert "--resume" not in said(r) and "no finished images" not in said(r)
+            assert not plan.exists()
+    finally:
+        assert holder.stdin is not None
+        holder.stdin.close()
+        holder.wait(timeout=60)
+    # the run gone (killed: its manifest still as it began), its journaled images are said
+    r = runner.invoke(app, ["plan", str(s / "image_002.jpg"), *args])
+    assert r.exit_code == 2 and "cut off" in said(r) and "its 3 images" in said(r), r.output
+    assert f"rti-rig run --resume {s}" in said(r) and not plan.exists()
+    assert runner.invoke(app, ["run", "--resume", str(s), "--no-verdict"]).exit_code == 0
+    r = runner.invoke(app, ["plan", str(s / "image_002.jpg"), *args])
+    assert r.exit_code == 0 and "(recorded by the session s)" in r.output, r.output
+    assert len(read_lp(plan)) == 6

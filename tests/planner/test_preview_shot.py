@@ -245,11 +245,30 @@ def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
     shot = tmp_path / "shot"
     assert runner.invoke(app, ["preview", str(cfg), "--out", str(shot)]).exit_code == 0
     manifest = json.loads((shot / "manifest.json").read_text())
-    manifest["steps"] = []  # as a run killed before it finished leaves it
+    # as a run killed before it finished leaves it (its manifest as the run began)
+    for key in ("finished_at", "timing", "lp_file", "notices"):
+        manifest.pop(key)
+    manifest["runner"] = {"state": "running", "finish_reason": None}
+    manifest["steps"] = []
     (shot / "manifest.json").write_text(json.dumps(manifest))
+    # its image is journaled: it had been said to have "no finished images"
     for target in (shot, shot / "linear" / "image_001.tif"):
-        with pytest.raises(ScheduleError, match=r"no finished images.*rti-rig run --resume"):
+        with pytest.raises(
+            ScheduleError, match=r"cut off .* lights of its 1 image; .*rti-rig run --resume"
+        ):
             resolve_preview(target)
+    # killed before its first image was journaled: none is finished
+    kept = {p: p.read_bytes() for p in (shot / "journal.jsonl", *(shot / "records").iterdir())}
+    for p in kept:
+        p.unlink()
+    (shot / "journal.jsonl").write_bytes(b"")
+    with pytest.raises(ScheduleError, match=r"no finished images.*rti-rig run --resume"):
+        resolve_preview(shot)
+    for p, data in kept.items():
+        p.write_bytes(data)
+    # the resume it advises records the light, and plan reads it
+    assert runner.invoke(app, ["run", "--resume", str(shot)]).exit_code == 0
+    assert resolve_preview(shot).light_az_el_deg is not None
     # ... unless the user gives the light: then the image file is all plan needs
     cfg_args = ["--rig", str(cfg), "--lights", "6", "--out", str(tmp_path / "p.lp")]
     image = str(shot / "linear" / "image_001.tif")
