@@ -7,6 +7,7 @@ from pathlib import Path
 
 from rti_rig.app.config import LoadedRig
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.out_folders import ensure_file_writable
 from rti_rig.runtime.session import LP_NAME, MANIFEST
 
 
@@ -42,6 +43,8 @@ def check_output_file(
     ``inputs`` names the files the command reads (``{"PREVIEW": path, ...}``): replacing one of
     them is refused even with ``force``, as is replacing a file inside a session folder —
     nothing already captured is ever overwritten. ``option`` is the flag that named the file.
+    Its folder is proved to take a new file (the file is written as a temporary one renamed
+    over it): a folder that cannot had been found only once the work was done.
     """
     if out_file.is_dir():
         raise RtiRigError(f"{option} {out_file} is a folder: give the name of the file to write")
@@ -49,6 +52,7 @@ def check_output_file(
     if not parent.is_dir():
         raise RtiRigError(f"{option} {out_file}: folder {parent} does not exist; create it first")
     if not out_file.exists():
+        ensure_file_writable(out_file, option)
         return
     for what, path in inputs.items():
         if path is not None and path.exists() and out_file.samefile(path):
@@ -65,6 +69,7 @@ def check_output_file(
             )
     if not force:
         raise RtiRigError(f"{option} {out_file} exists; use --force to replace it")
+    ensure_file_writable(out_file, option)
 
 
 def _own_lp(out_file: Path, session: Path) -> bool:

@@ -13,14 +13,42 @@ from rti_rig.core.errors import RtiRigError
 PROBE_PREFIX = ".rti-rig-write-test-"
 
 
-def _cannot_write_there(folder: Path, exc: OSError) -> RtiRigError:
-    """The refusal of an ``--out`` the system would not let us look into or write to, naming
-    it and the system's reason (one wording for a ``stat`` and a ``mkdir`` that fail)."""
+def _cannot_write_there(folder: Path, exc: OSError, option: str = "--out") -> RtiRigError:
+    """The refusal of an output (``option folder``, or ``option file`` in a folder) the system
+    would not let us look into or write to, naming it and the system's reason (one wording for a
+    ``stat``, a ``mkdir`` and a probe file that fail)."""
     where = f": {exc.filename}" if exc.filename else ""
     return RtiRigError(
-        f"--out {folder}: cannot write there ({exc.strerror or exc}{where}); choose a "
+        f"{option} {folder}: cannot write there ({exc.strerror or exc}{where}); choose a "
         "folder you can write to"
     )
+
+
+def _probe(folder: Path, shown: Path, option: str) -> None:
+    """Create and remove a file of a name no other file has in ``folder``, or refuse
+    ``option shown`` naming ``folder`` (not the probe's random name)."""
+    try:
+        handle, probe = tempfile.mkstemp(prefix=PROBE_PREFIX, dir=folder)
+    except OSError as exc:
+        raise _cannot_write_there(
+            shown, OSError(exc.errno, exc.strerror, str(folder)), option
+        ) from None
+    os.close(handle)
+    try:
+        os.unlink(probe)
+    except OSError as exc:
+        raise _cannot_write_there(shown, exc, option) from None
+
+
+def ensure_file_writable(path: Path, option: str = "--out") -> None:
+    """Prove a file can be created in ``path``'s folder (which exists), or refuse by name.
+
+    Why: ``rti-rig plan --figure /proc/f.png`` (a read-only card, a folder of another user's)
+    was refused only after the plan was computed and written, so the same command run again
+    with a good ``--figure`` needed ``--force``; an output file is written into its folder (a
+    temporary file renamed over it), so the folder is what must take a new file. The probe is
+    made as :func:`ensure_writable_folder` makes it."""
+    _probe(path.parent, path, option)
 
 
 def refuse_a_file_in_the_way(folder: Path) -> None:
@@ -62,12 +90,4 @@ def ensure_writable_folder(folder: Path) -> None:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise _cannot_write_there(folder, exc) from None
-    try:
-        handle, probe = tempfile.mkstemp(prefix=PROBE_PREFIX, dir=folder)
-    except OSError as exc:  # named by the folder, not by the probe's random name
-        raise _cannot_write_there(folder, OSError(exc.errno, exc.strerror, str(folder))) from None
-    os.close(handle)
-    try:
-        os.unlink(probe)
-    except OSError as exc:
-        raise _cannot_write_there(folder, exc) from None
+    _probe(folder, folder, "--out")

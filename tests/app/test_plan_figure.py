@@ -161,6 +161,47 @@ def test_plan_cli_writes_the_map_and_never_overwrites_unasked(tmp_path: Path) ->
 
 
 @pytest.mark.e2e
+def test_plan_cli_refuses_a_map_or_plan_it_cannot_write_before_planning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--figure /proc/f.png`` had been refused only after the plan was written ("the plan
+    itself was written"), so the same command with a good ``--figure`` then needed ``--force``.
+    /proc stands in for a read-only card (the tests may run as root, whom modes do not stop)."""
+    import rti_rig.app.usecases.plan as usecase
+
+    rig = REPO / "rig_configs" / "simulated_dome.toml"
+    base = ["plan", "--rig", str(rig), "--lights", "9"]
+    plan, fig = tmp_path / "p.lp", tmp_path / "p.png"
+    real_plan = usecase.plan
+
+    def not_planned(*_: object, **__: object) -> None:
+        raise AssertionError("planned before the outputs were checked")
+
+    monkeypatch.setattr(usecase, "plan", not_planned)
+    for args, option, bad in (
+        (["--out", str(plan), "--figure", "/proc/rti-rig-cannot-write-here.png"], "--figure", 1),
+        (["--out", "/proc/rti-rig-cannot-write-here.lp", "--figure", str(fig)], "--out", 0),
+    ):
+        r = runner.invoke(app, [*base, *args])
+        flat = " ".join(r.output.split())
+        assert r.exit_code == 2, flat
+        assert f"{option} {args[2 * bad + 1]}: cannot write there" in flat
+        assert "choose a folder you can write to" in flat and "Traceback" not in flat
+        assert not plan.exists() and not fig.exists()
+    # an existing plan given with --force is kept when the map cannot be written either
+    plan.write_text("kept\n")
+    bad_fig = ["--figure", "/proc/rti-rig-cannot-write-here.png", "--force"]
+    r = runner.invoke(app, [*base, "--out", str(plan), *bad_fig])
+    assert r.exit_code == 2 and plan.read_text() == "kept\n", r.output
+    plan.unlink()
+    # the same command with a good map needs no --force: nothing had been written
+    monkeypatch.setattr(usecase, "plan", real_plan)
+    r = runner.invoke(app, [*base, "--out", str(plan), "--figure", str(fig)])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(plan)) == 9 and fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.e2e
 def test_plan_cli_map_shows_the_lights_of_the_plan_file_in_its_order(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
