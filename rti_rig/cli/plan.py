@@ -18,8 +18,9 @@ def plan(
         typer.Argument(
             help="One preview image of the object (8-bit JPEG/PNG/TIFF = sRGB, 16-bit "
             "PNG/TIFF = linear, as 'rti-rig run' writes them; a camera RAW file - DNG, CR2, "
-            "NEF, ARW... - is decoded linearly, its light taken from --preview-light or a "
-            "--rig .lp that lists it), or the session folder "
+            "NEF, ARW... - is decoded linearly, its light taken from --preview-light, the "
+            "rti-rig session it was captured in, or a --rig .lp that lists it), or the "
+            "session folder "
             "'rti-rig preview' wrote. "
             "Needed by 'kmeans'; without it 'optimal' plans for a level surface (matte unless "
             "--material glossy)."

@@ -22,3 +22,14 @@ def test_plan_help_says_which_arms_are_ordered_for_move_time() -> None:
     text = " ".join(r.output.replace("│", " ").split())
     assert "ordered for the least move time of its servos when the config has" in text
     assert "[arm.dynamixel], else nearest neighbour first" in text
+
+
+def test_plan_help_says_where_a_raw_previews_light_comes_from() -> None:
+    # a session's RAW original (raw/image_007.dng) takes its light from the session's record
+    # (rti_rig.app.preview_source); the help named only --preview-light and a --rig .lp
+    r = runner.invoke(app, ["plan", "--help"], terminal_width=200)
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.replace("│", " ").split())
+    assert (
+        "its light taken from --preview-light, the rti-rig session it was captured in, or" in text
+    )
