@@ -239,9 +239,9 @@ def check_plan_options(
 
     Refused, naming the command-line option: an unknown method, objective or material; a signal
     noise the objective does not model; a method that needs a preview without one; a preview's
-    light or depth model without a preview; a depth model that is not a file; an empty elevation
-    band; a light count outside 3..1000 (fewer determine no normal; 1000 is the most an .lp
-    file may list). Callers check early (before reading any image) with ``has_preview``;
+    light or depth model without a preview; a depth model that is a folder or no file; an empty
+    elevation band; a light count outside 3..1000 (fewer determine no normal; 1000 is the most
+    an .lp file may list). Callers check early (before reading any image) with ``has_preview``;
     :func:`plan` checks its request again.
     """
     chosen = get_method(method)
@@ -257,6 +257,11 @@ def check_plan_options(
         raise ScheduleError(
             f"{given} describes a preview shot, but no preview was given: give the preview, "
             f"or drop {given}"
+        )
+    if depth_model is not None and Path(depth_model).is_dir():
+        # "file not found" of a folder that is there read as a typo in its name
+        raise ScheduleError(
+            f"--depth-model {depth_model} is a folder: give the model file in it (.onnx)"
         )
     if depth_model is not None and not Path(depth_model).is_file():
         raise ScheduleError(f"--depth-model {depth_model}: file not found")

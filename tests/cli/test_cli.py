@@ -309,6 +309,7 @@ def test_preview_shot_then_plan_then_run(tmp_path: Path) -> None:
         (["--preview-light", "10,95"], "outside 0..90"),
         (["--objective", "beauty"], "--objective 'beauty' is not known"),
         (["--depth-model", "{tmp}/none.onnx"], "file not found"),
+        (["--depth-model", "{tmp}"], "is a folder: give the model file in it (.onnx)"),
     ],
 )
 def test_plan_option_errors(tmp_path: Path, extra: list[str], fragment: str) -> None:
