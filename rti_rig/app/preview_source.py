@@ -71,7 +71,7 @@ def _finished_steps(root: Path) -> list[dict[str, Any]]:
     (a run killed, a power cut: its manifest lists its steps only when a run ends) was said to
     have none while its journal held them. ``fit`` and ``export-lp`` say the first as this does.
     """
-    refuse_if_in_use(root, "plan from")
+    refuse_if_in_use(root, "plan from it")
     steps = read_manifest(root).get("steps") or []
     if steps:
         return steps

@@ -373,8 +373,9 @@ def lock_session(root: Path) -> None:
 
 
 def refuse_if_in_use(root: Path, what: str) -> None:
-    """Refuse to read session ``root`` for ``what`` ("fit", "export-lp") while another process
-    holds it (:func:`lock_session`: a run or resume capturing into it).
+    """Refuse to read session ``root`` while another process holds it (:func:`lock_session`: a
+    run or resume capturing into it), saying to ``what`` ("fit it", "export its .lp") once that
+    run has ended (a verb alone had read "export its .lp it once that run has ended").
 
     Why: ``fit`` of a session still being captured read its ``lights.lp`` and its images at
     different moments: "error: 40 image names for 33 light directions", or a verdict of a part
@@ -385,7 +386,7 @@ def refuse_if_in_use(root: Path, what: str) -> None:
     if in_use_by_another(root):
         raise SessionError(
             f"{root} is being captured by another rti-rig process right now (its images and "
-            f"{LP_NAME} change as it goes): {what} it once that run has ended (or stop it with "
+            f"{LP_NAME} change as it goes): {what} once that run has ended (or stop it with "
             "Ctrl-C in its terminal)"
         )
 

@@ -53,9 +53,12 @@ def test_a_session_being_captured_is_not_fitted_or_exported(tmp_path: Path) -> N
             r = runner.invoke(app, [*args, "--out", str(tmp_path / "fit")])
             assert r.exit_code == 2, r.output
             assert "being captured by another rti-rig process" in said(r)
+            assert "fit it once that run has ended" in said(r)
             assert not (tmp_path / "fit").exists()
         r = runner.invoke(app, ["export-lp", str(s), "--out", str(tmp_path / "x.lp")])
         assert r.exit_code == 2 and "being captured" in said(r), r.output
+        # it had read "export its .lp it once that run has ended"
+        assert "export its .lp once that run has ended" in said(r), r.output
     finally:
         assert holder.stdin is not None
         holder.stdin.close()

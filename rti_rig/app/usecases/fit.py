@@ -315,7 +315,7 @@ def acquisition_files(
 ) -> tuple[Path, np.ndarray, list[Path], list[str]]:
     """The ``.lp`` of a session folder or ``.lp`` source, its lights (N, 3), the image file of
     each light (``linear/<stem>.tif`` when there, else the file the ``.lp`` names) and names."""
-    refuse_if_in_use(source if source.is_dir() else source.parent, "fit")
+    refuse_if_in_use(source if source.is_dir() else source.parent, "fit it")
     if source.is_dir():
         lps = sorted(source.glob("*.lp"))
         if not lps:
