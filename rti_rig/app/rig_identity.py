@@ -7,11 +7,11 @@ backend, where its lights can be, the LEDs' intensity correction, the camera's s
 gain and RAW decoding, and (for a dry run) the simulated scene — and nothing that does not (a
 serial port's name, timing, parking policy), so a rig moved to another USB port resumes.
 
-A dome's light positions are compared as positions, not as a digest: a re-measured dome whose
-``.lp`` differs from the session's by what six decimals cannot tell apart (the precision an
-``.lp`` is written with) is the same rig, and one whose LEDs really moved is named by how many
-moved and by how much (a digest of rounded positions had called both "changed", and could not
-say which).
+A dome's light positions are compared as positions, not as a digest: a re-measured dome
+whose ``.lp`` differs from the session's by rounding (written again with four decimals or
+more: :data:`POSITION_TOLERANCE_RAD`) is the same rig, and one whose LEDs really moved is
+named by how many moved and by how much (a digest of rounded positions had called both
+"changed", and could not say which).
 """
 
 from __future__ import annotations
@@ -47,10 +47,21 @@ LABELS = {
 
 
 #: The largest angle (rad) between a light's recorded and current position that is rounding
-#: noise, not a change: two writings of one direction at the six decimals of an ``.lp`` differ
-#: by at most 1e-6 in each component (under 2e-6 rad once renormalised); a re-measured LED
-#: that really moved does so by a tenth of a degree or more (1.7e-3 rad).
-POSITION_TOLERANCE_RAD = 5e-6
+#: noise, not a change. Rounding a unit vector's components to d decimals moves it by at most
+#: √3·0.5·10⁻ᵈ rad: 8.7e-7 at the six decimals RTIBuilder, relight and rtiacquire write,
+#: 8.7e-6 at five, 8.7e-5 at four (a calibration saved again with fewer digits, or by a tool
+#: that writes floats short). An LED that really moved does so by a tenth of a degree or more
+#: (1.7e-3 rad). 2e-4 rad (0.011°) accepts any rewrite at four decimals or more with a
+#: margin of two, and stays a ninth of the smallest real move. Three decimals (up to 8.7e-4
+#: rad, 0.05°) is half a real move, too close to tell apart: no known writer uses so few, and
+#: such a refusal says that rounding could explain it (:data:`THREE_DECIMALS_RAD`). It had been
+#: 5e-6 (six decimals only): a calibration written again with five refused the resume,
+#: "moved by up to 0.00°".
+POSITION_TOLERANCE_RAD = 2e-4
+
+#: The most rounding an ``.lp``'s positions to three decimals moves a light (rad): a refusal
+#: within it says so, since an ``.lp`` written with three decimals may be all that changed.
+THREE_DECIMALS_RAD = 3**0.5 * 0.5e-3
 
 #: The keys that change what the images are, not where the light comes from: a session cannot
 #: take images that differ in them, accepted or not (nothing downstream corrects for them).
@@ -181,10 +192,20 @@ def _moved_lights(before: Any, now: Any) -> str | None:
     if not moved:
         return ""
     worst = max(moved, key=lambda i: angles[i])
-    return (
+    text = (
         f"light positions: {len(moved)} of {len(angles)} LEDs moved, by up to "
-        f"{angles[worst]:.2f}° (LED index {worst})"
+        f"{_degrees(float(angles[worst]))} (LED index {worst})"
     )
+    if np.radians(angles[worst]) <= THREE_DECIMALS_RAD:
+        text += ", no more than rounding the .lp to 3 decimals moves a light"
+    return text
+
+
+def _degrees(angle: float) -> str:
+    """``angle`` in degrees with the digits that tell it from zero: two decimals from a tenth
+    of a degree (``0.30°``), two significant digits below (``0.012°``; ``.2f`` had printed a
+    refusal's angle as ``0.00°``)."""
+    return f"{angle:.2f}°" if angle >= 0.1 else f"{angle:.2g}°"
 
 
 def _show(value: Any) -> str:
