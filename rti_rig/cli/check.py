@@ -134,11 +134,30 @@ def probe(
 ) -> None:
     """Identify which known dome firmware answers on PORT (least intrusive probes first; none
     lights an LED, and a dome that boots lit is switched off, or you are told it could not be)
-    and print the rig-config lines to use."""
-    from rti_rig.app.usecases.probe import ProbeRequest
+    and print the rig-config lines to use. Ctrl-C stops the probe after switching off a dome
+    that booted lit, and says what is known of the lights."""
+    from rti_rig.app.usecases.probe import ProbeRequest, ProbeStopped
     from rti_rig.app.usecases.probe import probe as run_probe
+    from rti_rig.runtime.controller import EmergencyStop
 
-    result = run_probe(ProbeRequest(port))
+    try:
+        with stop_on_signals():
+            result = run_probe(ProbeRequest(port))
+    except ProbeStopped as exc:
+        for line in exc.result.heard_lines():
+            out.print(line, highlight=False, markup=False)
+        if exc.result.profile is not None:
+            out.print(f"Found: {exc.result.profile}. Rig-config lines to use:", highlight=False)
+            for line in exc.result.config_lines():
+                out.print("  " + line, highlight=False, markup=False)
+        err.print(
+            f"[red]Probe stopped ({escape(exc.why)}):[/] {escape(exc.result.lights)}.",
+            highlight=False,
+        )
+        raise typer.Exit(code=stop_exit_code(exc.why)) from None
+    except EmergencyStop as exc:  # after the probe returned, before its result was printed
+        err.print(f"[red]Probe stopped ({escape(str(exc))}):[/] look at the dome's lights.")
+        raise typer.Exit(code=stop_exit_code(str(exc))) from None
     for line in result.lines():
         out.print(line, highlight=False, markup=False)
     if result.profile is None:

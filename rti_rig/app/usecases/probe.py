@@ -6,6 +6,13 @@ nichlock's firmware print banners), then ask questions that light nothing (the E
 ``T,0,0,0`` (LED 0 for zero seconds). A firmware identified with its LEDs possibly on (the Nab
 sketch boots fully lit) is sent its all-off before the probe returns. A dome that never answers
 (hadrian2/RTI_Dome) cannot be identified; the result says so, with what was heard.
+
+Ctrl-C or SIGTERM (raised as :class:`EmergencyStop` by the command's handler) stops the probe
+through a teardown, as it stops a check: opening the port at 9600 resets a Nab board, which
+boots with every LED on, so a stop on a port open at 9600 listens out the board's boot on that
+same port (reopening would reset it again) and sends the sketch's all-off if its banner comes;
+a Nab board identified is sent its all-off. :class:`ProbeStopped` then says what is known of
+the lights (it had said only "stopped (Ctrl-C)", a dome lit in full behind it).
 """
 
 from __future__ import annotations
@@ -14,6 +21,7 @@ import time
 from dataclasses import dataclass, field
 
 from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
+from rti_rig.runtime.controller import EmergencyStop
 
 
 @dataclass(frozen=True)
@@ -35,6 +43,8 @@ class ProbeResult:
     error: str | None = None
     #: What else the firmware showed that the user must act on before a check (or None).
     note: str | None = None
+    #: How many times a port opening was attempted (each resets a board like an Arduino).
+    openings: int = 0
 
     def config_lines(self) -> list[str]:
         if self.profile is None:
@@ -45,11 +55,16 @@ class ProbeResult:
         rate = [f"baudrate = {self.baudrate}"] if self.baudrate is not None else []
         return ["[dome.serial]", f'port = "{self.port}"', f'profile = "{self.profile}"', *rate]
 
-    def lines(self) -> list[str]:
+    def heard_lines(self) -> list[str]:
+        """What each probe heard, one line each (the end of a long text)."""
         out = []
         for what, text in self.heard:
             shown = text.strip().replace("\r", "")[-200:] or "(nothing)"
             out.append(f"{what}: {shown!r}")
+        return out
+
+    def lines(self) -> list[str]:
+        out = self.heard_lines()
         if self.error:
             out.append(f"ERROR: {self.error}")
         if self.error and not self.heard:
@@ -80,17 +95,47 @@ class ProbeResult:
         return out
 
 
-def _exchange(port: str, baud: int, wait_s: float, send: bytes, listen_s: float) -> str:
-    """Open at ``baud``, wait ``wait_s`` (collecting the banner), send, listen; all text heard.
+class ProbeStopped(Exception):
+    """The probe was stopped (Ctrl-C, SIGTERM) and its teardown done: ``result`` holds what was
+    heard, the firmware if one was found, and in ``lights`` what is known of the lights."""
+
+    def __init__(self, why: str, result: ProbeResult) -> None:
+        super().__init__(why)
+        self.why, self.result = why, result
+
+
+#: The rate the Nab sketch speaks: a stop on a port open at it listens for the sketch's boot.
+_NAB_BAUD = 9600
+
+#: The lights of a probe stopped before any firmware answered, once it opened the port.
+STOPPED_UNANSWERED = (
+    "the probe was stopped before a firmware answered: nothing that lights an LED was sent, but "
+    "opening the port resets a board like an Arduino, which then lights whatever its firmware "
+    "lights at boot (the Nab sketch: every LED): look at the dome"
+)
+
+#: The Nab sketch's boot banner and its answer to its all-on (either means it booted lit).
+_NAB_SAYS = ("RTI-Dome intialized", "<All lights turned on.>")
+
+
+def _exchange(
+    result: ProbeResult, what: str, baud: int, wait_s: float, send: bytes, listen_s: float
+) -> str:
+    """Open at ``baud``, wait ``wait_s`` (collecting the banner), send, listen; all text heard,
+    also added to ``result.heard`` under ``what``.
 
     A probe met by silence is sent once more on the same open port (every probe is harmless
     to the firmwares known, and none resets a board when it is repeated): one reply lost on
     the line, an Elexol board's ``USB I/O 24R1`` to ``?``, had made the probe say that no
-    known firmware answered, where a session's driver resends the same command."""
-    t = SerialTransport(port, baud)
+    known firmware answered, where a session's driver resends the same command. Stopped
+    (:class:`EmergencyStop`) with the port open, the stop's teardown runs on it
+    (:func:`_stopped_on_open_port`), then :class:`ProbeStopped` is raised."""
+    t = SerialTransport(result.port, baud)
+    result.openings += 1
     t.open()
+    opened = time.monotonic()
+    heard = bytearray()
     try:
-        heard = bytearray()
         heard += _listen(t, wait_s)
         if send:
             t.write(send)
@@ -99,9 +144,40 @@ def _exchange(port: str, baud: int, wait_s: float, send: bytes, listen_s: float)
                 t.write(send)
                 answer = _listen(t, listen_s)
             heard += answer
-        return heard.decode("latin-1")
+    except EmergencyStop as exc:
+        result.heard.append((f"{what} (stopped)", heard.decode("latin-1")))
+        try:
+            _stopped_on_open_port(result, t, baud, opened, wait_s)
+        except TransportError as failed:
+            result.error = str(failed)
+            result.lights = (
+                f"the port failed while the probe stopped ({failed}): the dome's state is not "
+                "known; look at it"
+            )
+        raise ProbeStopped(str(exc), result) from None
     finally:
         t.close()
+    text = heard.decode("latin-1")
+    result.heard.append((what, text))
+    return text
+
+
+def _stopped_on_open_port(
+    result: ProbeResult, t: SerialTransport, baud: int, opened: float, wait_s: float
+) -> None:
+    """The teardown of a probe stopped with ``t`` open at ``baud`` since ``opened``
+    (monotonic): at the Nab sketch's rate, the rest of its boot window (``wait_s``) is listened
+    out on this port, and a sketch that booted, lit, is sent its all-off here (reopening would
+    reset it, lit again). Otherwise nothing that lights was sent, but an opening may have reset
+    a board that boots lit once the probe is gone."""
+    if baud == _NAB_BAUD:
+        text = _listen(t, max(0.0, opened + wait_s - time.monotonic())).decode("latin-1")
+        result.heard.append(("listening out the board's boot", text))
+        if any(words in heard for _, heard in result.heard for words in _NAB_SAYS):
+            result.profile, result.baudrate = "nab-rti-v1", _NAB_BAUD
+            _nab_off(result, t)
+            return
+    result.lights = STOPPED_UNANSWERED
 
 
 def _listen(t: SerialTransport, seconds: float) -> bytes:
@@ -113,31 +189,64 @@ def _listen(t: SerialTransport, seconds: float) -> bytes:
 
 
 def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
-    """The Nab sketch answered: it boots with every LED on, so switch them off before leaving."""
-    result.profile, result.baudrate = "nab-rti-v1", 9600
-    t = SerialTransport(result.port, 9600)
+    """The Nab sketch answered: it boots with every LED on, so switch them off before leaving
+    (also when stopped meanwhile: the all-off is the stop's teardown, then
+    :class:`ProbeStopped`)."""
+    result.profile, result.baudrate = "nab-rti-v1", _NAB_BAUD
+    t = SerialTransport(result.port, _NAB_BAUD)
+    result.openings += 1
     t.open()
-    off = ""
+    opened = time.monotonic()
     try:
-        _listen(t, wait)  # the board resets as the port opens: its bootloader, then its banner
-        # sent again on the same open port if unanswered (reopening it would reset the board,
-        # which lights every LED again): one lost reply, or a <0> the board missed, had ended
-        # the probe with "NOT acknowledged: check the dome", where a session resends it
-        for what, listen_s in (("all off <0>", 0.6), ("all off <0> again", 1.2)):
-            t.write(b"<0>")
-            off = _listen(t, listen_s).decode("latin-1")
-            result.heard.append((what, off))
-            if "<All lights turned off.>" in off:
-                break
+        try:
+            _listen(t, wait)  # the board resets as the port opens: its bootloader, its banner
+        except EmergencyStop as exc:
+            # the teardown: the rest of the boot, so that the all-off reaches a booted board
+            _listen(t, max(0.0, opened + wait - time.monotonic()))
+            _nab_off(result, t)
+            raise ProbeStopped(str(exc), result) from None
+        _nab_off(result, t)
     finally:
         t.close()
+    return result
+
+
+def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
+    """Send the Nab sketch's all-off ``<0>`` on ``t`` (open at 9600, the sketch booted) and
+    say in ``result.lights`` whether it was acknowledged.
+
+    Sent again on the same open port if unanswered (reopening it would reset the board, which
+    lights every LED again): one lost reply, or a <0> the board missed, had ended the probe
+    with "NOT acknowledged: check the dome", where a session resends it. A stop meanwhile is
+    not raised here (the command's handler raises only the first signal, which is what this
+    teardown follows)."""
+    off = ""
+    for what, listen_s in (("all off <0>", 0.6), ("all off <0> again", 1.2)):
+        t.write(b"<0>")
+        off = _listen(t, listen_s).decode("latin-1")
+        result.heard.append((what, off))
+        if "<All lights turned off.>" in off:
+            break
     result.lights = (
         "the sketch boots with every LED on; all-off sent and acknowledged"
         if "<All lights turned off.>" in off
         else "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
         "the dome"
     )
-    return result
+
+
+def _unanswered_lights(wait: float) -> str:
+    """What is known of the lights when no firmware answered: nothing lighting was sent, but
+    an opening resets an Arduino, and a board that boots lit after the last listen is lit."""
+    # a board that resets at every opening and is still in its bootloader when each listen
+    # ends is heard by no probe; the Nab sketch then lights every LED as it boots, after the
+    # probe had said only that nothing lighting was sent
+    return (
+        f"nothing that lights an LED was sent; but a board that resets when its port opens "
+        f"(an Arduino) and takes longer than the {wait:g} s each probe listens to boot "
+        "answers none of them, and lights whatever its firmware lights at boot once the "
+        "probe has closed the port (the Nab sketch: every LED): look at the dome"
+    )
 
 
 #: What nichlock/rti's firmware prints, at whatever rate its EEPROM holds: its banner, the free
@@ -178,66 +287,80 @@ def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
 
 
 def probe(request: ProbeRequest) -> ProbeResult:
-    """Try the known firmwares on ``request.port``; see the module docstring for the order."""
+    """Try the known firmwares on ``request.port``; see the module docstring for the order.
+
+    Raises :class:`ProbeStopped` once a stop (:class:`EmergencyStop`) has had its teardown."""
     result = ProbeResult(request.port)
-    port, wait = request.port, request.listen_s
     try:
-        text = _exchange(port, 9600, wait, b"", 0)
-        result.heard.append(("listen at 9600 baud", text))
+        return _probe(result, request.listen_s)
+    except EmergencyStop as exc:  # stopped with no port open: a port's own is raised there
+        _stopped_between_ports(result, request.listen_s)
+        raise ProbeStopped(str(exc), result) from None
+
+
+def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
+    """The teardown of a probe stopped with no port open (before the first, between two)."""
+    if result.profile == "nab-rti-v1":
+        # identified, lit at its boot, and stopped before its all-off: sent now (the opening
+        # resets it, lit again, so the boot is waited for as the probe waits for it)
+        try:
+            _nab_found(result, wait)
+        except TransportError as exc:
+            result.lights = (
+                f"the sketch boots with every LED on and the all-off could NOT be sent ({exc}): "
+                "the dome may be fully lit; switch it off at its power supply"
+            )
+    elif result.openings:
+        result.lights = STOPPED_UNANSWERED
+    else:
+        result.lights = "nothing was lit by the probe: it never opened the port"
+
+
+def _probe(result: ProbeResult, wait: float) -> ProbeResult:
+    """:func:`probe`'s sequence of probes."""
+    try:
+        text = _exchange(result, "listen at 9600 baud", 9600, wait, b"", 0)
         if "RTI-Dome intialized" in text or "<All lights turned on.>" in text:
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
-        text = _exchange(port, 115200, wait, b"", 0)
-        result.heard.append(("listen at 115200 baud", text))
+        text = _exchange(result, "listen at 115200 baud", 115200, wait, b"", 0)
         if _nichlock_found(result, text, 115200):
             return result
         # nichlock's settings menu (``a``, ``2``) stores 19200 or 2400 too, taken at its next
         # boot: listened for before anything is sent, since bytes at another rate reach such a
         # board as keys of its menus (a board set so had been "No known dome firmware")
         for rate in NICHLOCK_OTHER_RATES:
-            text = _exchange(port, rate, wait, b"", 0)
-            result.heard.append((f"listen at {rate} baud", text))
+            text = _exchange(result, f"listen at {rate} baud", rate, wait, b"", 0)
             if _nichlock_found(result, text, rate):
                 return result
-        text = _exchange(port, 38400, 0.2, b"?", 0.5)
-        result.heard.append(("'?' at 38400 baud", text))
+        text = _exchange(result, "'?' at 38400 baud", 38400, 0.2, b"?", 0.5)
         if "USB I/O 24R1" in text:
             result.profile, result.baudrate = "elexol-24r1", 38400
             return result
-        text = _exchange(port, 115200, wait, b"m", 0.5)
-        result.heard.append(("'m' (free RAM) at 115200 baud", text))
+        text = _exchange(result, "'m' (free RAM) at 115200 baud", 115200, wait, b"m", 0.5)
         if _nichlock_found(result, text, 115200):
             return result
-        text = _exchange(port, 9600, wait, b"<9>", 0.6)
-        result.heard.append(("'<9>' (an unknown code) at 9600 baud", text))
+        text = _exchange(result, "'<9>' (an unknown code) at 9600 baud", 9600, wait, b"<9>", 0.6)
         if "<INCORRECT FUNCTION CALL: 9>" in text or "RTI-Dome intialized" in text:
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
-        text = _exchange(port, 9600, 1.6, b"\x42" + bytes(8), 0.5)
-        result.heard.append(("0x42 + empty mask at 9600 baud", text))
+        text = _exchange(
+            result, "0x42 + empty mask at 9600 baud", 9600, 1.6, b"\x42" + bytes(8), 0.5
+        )
         if _nichlock_found(result, text, 9600):
             return result
         if text.endswith("\x01"):
             result.profile, result.baudrate = "minirti", 9600
             result.lights = "the probe sent an all-off mask, acknowledged"
             return result
-        text = _exchange(port, 9600, wait, b"T,0,0,0", 1.8)
-        result.heard.append(("'T,0,0,0' at 9600 baud", text))
+        text = _exchange(result, "'T,0,0,0' at 9600 baud", 9600, wait, b"T,0,0,0", 1.8)
         if "I received: T,0,0,0 the instructionByte was: T" in text:
             result.profile, result.baudrate = "rtipy", 9600
             result.lights = "LED (0, 0) was asked for zero seconds: it stays dark"
             return result
-        # a board that resets at every opening and is still in its bootloader when each
-        # listen ends is heard by no probe; the Nab sketch then lights every LED as it boots,
-        # after the probe had said only that nothing lighting was sent
-        result.lights = (
-            f"nothing that lights an LED was sent; but a board that resets when its port opens "
-            f"(an Arduino) and takes longer than the {wait:g} s each probe listens to boot "
-            "answers none of them, and lights whatever its firmware lights at boot once the "
-            "probe has closed the port (the Nab sketch: every LED): look at the dome"
-        )
+        result.lights = _unanswered_lights(wait)
     except TransportError as exc:
         result.error = str(exc)
         if result.profile == "nab-rti-v1":

@@ -1,0 +1,84 @@
+"""Ctrl-C during ``rti-rig probe`` on a Nab board: the lights are switched off and said.
+
+Opening the port at 9600 resets the board (Arduino auto-reset), and the Nab sketch lights
+every LED as it boots. A Ctrl-C once the port had opened printed only "rti-rig: stopped
+(Ctrl-C)", and the dome was left fully lit, where ``probe --help`` promises that a dome that
+boots lit is switched off or you are told it could not be. The command runs as its own process
+(a user's Ctrl-C is a SIGINT to it), against the sketch's emulator on a pseudo-terminal; the
+signal is sent once the emulator has seen the port open (its boot), not after a fixed sleep.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rti_rig.simulator.domes import board_for
+from rti_rig.simulator.pty_link import serve_on_pty
+
+pytestmark = [pytest.mark.pty, pytest.mark.e2e]
+
+RTI_RIG = [sys.executable, "-m", "rti_rig"]
+
+
+def _wait_for(predicate, timeout_s: float = 60.0) -> None:  # type: ignore[no-untyped-def]
+    end = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.01)
+
+
+def _probe_stopped_once_the_port_opened(board: Any, name: str, signum: int) -> tuple[int, str]:
+    """``rti-rig probe`` on ``board`` served on a pty, sent ``signum`` once the port opened
+    (the board reset); its exit code and output, its line wrapping undone."""
+    with serve_on_pty(board, name) as link:
+        proc = subprocess.Popen(
+            [*RTI_RIG, "probe", link.port],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            cwd=Path(__file__).resolve().parents[2],
+        )
+        try:
+            _wait_for(lambda: any(what == "boot" for _, what in board.events))
+            proc.send_signal(signum)
+            out, _ = proc.communicate(timeout=120)
+        finally:
+            if proc.poll() is None:
+                proc.kill()  # the process this test started, by its own handle
+                proc.wait(timeout=10)
+    return proc.returncode, " ".join(out.split())
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_once_the_port_opened_switches_the_nab_dome_off_and_says_so(
+    signum: signal.Signals,
+) -> None:
+    board = board_for("nab-rti-v1")
+    # stopped in its bootloader: about to light every LED
+    code, said = _probe_stopped_once_the_port_opened(board, "nab-rti-v1", signum)
+    assert code == (143 if signum == signal.SIGTERM else 130), said
+    why = "SIGTERM" if signum == signal.SIGTERM else "Ctrl-C"
+    assert f"Probe stopped ({why}):" in said, said
+    assert "the sketch boots with every LED on; all-off sent and acknowledged" in said, said
+    assert 'profile = "nab-rti-v1"' in said, said
+    assert "Traceback" not in said, said
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_before_any_firmware_answered_says_the_opening_may_have_lit_a_board() -> None:
+    """A board that never answers (hadrian2/RTI_Dome): nothing lighting was sent, but the port
+    was opened, which resets an Arduino: the stop says so instead of a bare "stopped"."""
+    board = board_for("rti-dome-m")
+    code, said = _probe_stopped_once_the_port_opened(board, "silent", signal.SIGINT)
+    assert code == 130, said
+    assert "Probe stopped (Ctrl-C): the probe was stopped before a firmware answered" in said
+    assert "nothing that lights an LED was sent" in said and "look at the dome" in said, said
+    assert "Found:" not in said and "Traceback" not in said, said
+    assert board.lit_once_booted() == frozenset()
