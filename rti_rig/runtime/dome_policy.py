@@ -1336,9 +1336,15 @@ def _failed_off(exc: DomeLinkError) -> OffReport:
 
 
 def lights_state_sentence(source: object) -> str:
-    """What is known about a light source's lights after it was closed (for messages)."""
+    """What is known about a light source's lights after it was closed (for messages).
+
+    A source that never began a connect (``reached`` None: a refusal of ``--out`` or the disk
+    came first) never opened its port, so nothing can be lit by it: it had been told to "check
+    the dome's lights" beside the refusal."""
     report = getattr(source, "off_report", None)
     if report is None:
+        if getattr(source, "reached", "") is None:
+            return "nothing was lit: the dome's port was never opened"
         return "no all-off was attempted (the dome was never reached): check the dome's lights"
     sentence = str(report.sentence())
     window = getattr(source, "came_back_after_give_up", None)
