@@ -17,6 +17,9 @@ the lights (it had said only "stopped (Ctrl-C)", a dome lit in full behind it).
 
 from __future__ import annotations
 
+import errno
+import os
+import stat
 import time
 from dataclasses import dataclass, field
 
@@ -45,6 +48,9 @@ class ProbeResult:
     note: str | None = None
     #: How many times a port opening was attempted (each resets a board like an Arduino).
     openings: int = 0
+    #: What the port's path is when it is no serial port ("is a regular file" …; None: it
+    #: may be one), said in place of advice to check the dome's cable and power.
+    not_serial: str | None = None
 
     def config_lines(self) -> list[str]:
         if self.profile is None:
@@ -66,8 +72,17 @@ class ProbeResult:
     def lines(self) -> list[str]:
         out = self.heard_lines()
         if self.error:
-            out.append(f"ERROR: {self.error}")
-        if self.error and not self.heard:
+            out.append(f"error: {self.error}")  # as every other command says it
+        if self.error and not self.heard and self.not_serial:
+            # a file, a folder or /dev/null: "check the dome is plugged in" sent a user to the
+            # hardware when the path given was the mistake
+            out.append(
+                f"{self.port} {self.not_serial}: it is not a serial port, so no firmware was "
+                "asked. "
+                "Give the dome's serial port (ls /dev/ttyACM* /dev/ttyUSB* /dev/serial/by-id/; "
+                "on Windows COM3 ...)."
+            )
+        elif self.error and not self.heard:
             # the port never opened: nothing was asked, so nothing can be concluded about a
             # firmware (it had gone on to advise setting a profile for a port that is not there)
             out.append(
@@ -377,4 +392,28 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             )
         else:
             result.lights = "the port could not be used; nothing was sent"
+            result.not_serial = _not_a_serial_port(result.port, str(exc))
     return result
+
+
+def _not_a_serial_port(port: str, error: str) -> str | None:
+    """How ``port``, which failed to open, is no serial port (``"is a regular file"``,
+    ``"is a device but not a terminal"`` …), or None when it may be one (missing, held,
+    a URL, a name the system does not map to a path such as COM3).
+
+    Judged from the path after the failure, never by opening it again: opening a real serial
+    port resets an Arduino. A character device that refused the terminal settings (ENOTTY,
+    "Inappropriate ioctl for device": /dev/null, /dev/zero) is a device but not a serial one."""
+    try:
+        mode = os.stat(port).st_mode
+    except (OSError, ValueError):
+        return None
+    if stat.S_ISREG(mode):
+        return "is a regular file"
+    if stat.S_ISDIR(mode):
+        return "is a folder"
+    if not stat.S_ISCHR(mode):
+        return "is not a device file"
+    if "Inappropriate ioctl" in error or f"({errno.ENOTTY}," in error:
+        return "is a device but not a terminal"
+    return None
