@@ -128,7 +128,9 @@ def fit(
         typer.Argument(
             help="Session folder(s), or .lp file(s) with their images beside them. With more "
             "than one, a resumable batch: each goes to OUT/<session folder name> "
-            "(OUT/<folder>-<stem> for an .lp), finished ones are skipped."
+            "(OUT/<folder>-<stem> for an .lp), finished ones are skipped unless their session "
+            "changed since (resumed, reshot): those are refitted, the earlier fit replaced "
+            "once the new one is complete."
         ),
     ],
     out_dir: Annotated[Path, typer.Option("--out", help="New or empty folder for outputs.")],

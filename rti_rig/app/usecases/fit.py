@@ -32,6 +32,7 @@ from threadpoolctl import threadpool_limits
 
 from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band, fit_warnings
 from rti_rig.app.usecases.fit_decode import imread_rgb
+from rti_rig.app.usecases.fit_inputs import INPUTS_KEY, change_since, inputs_record
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
@@ -542,6 +543,16 @@ def complete_session_lp(source: Path) -> str | None:
     return list_unwritten_step(root)
 
 
+def acquisition_inputs(source: Path) -> dict[str, Any] | None:
+    """The record of what a fit of ``source`` reads (:func:`inputs_record`), or None when it
+    cannot be read as an acquisition (the fit itself says why)."""
+    try:
+        _, lights, paths, names = acquisition_files(source)
+        return inputs_record(lights, paths, names)
+    except (RtiRigError, OSError, ValueError):
+        return None
+
+
 def load_acquisition(
     source: Path, notes: list[str] | None = None
 ) -> tuple[list[Any], np.ndarray, list[str], str]:
@@ -656,6 +667,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     # PermissionError on Python 3.11: a traceback), refused by name before any image is read
     refuse_a_file_in_the_way(req.out_dir)
     notes: list[str] = []
+    inputs = acquisition_inputs(req.source)  # before reading: a later change is a change
     frames, lights, names, what = load_acquisition(req.source, notes)
     release_free_memory()  # the decode buffers
     out = req.out_dir
@@ -672,7 +684,9 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
         else None
     )
     try:
-        result = _fit_into(req, out, frames, lights, names, what, notes, bands, checksums)
+        result = _fit_into(
+            req, out, frames, lights, names, what, notes, bands, checksums, inputs=inputs
+        )
     except BaseException as exc:
         stop.set()  # a failed or interrupted fit does not wait for the checksums
         _discard_outputs(out, created)  # ``out`` was new or empty: what is in it is this run's
@@ -695,9 +709,12 @@ def _fit_into(  # type: ignore[no-untyped-def]
     notes: list[str],
     bands,
     checksums: Future[None] | None = None,
+    *,
+    inputs: dict[str, Any] | None = None,
 ) -> FitResult:
     """Every output of :func:`run_fit` written into the prepared ``out`` (``checksums``: the
-    session's files being checksummed meanwhile, awaited before the QA)."""
+    session's files being checksummed meanwhile, awaited before the QA; ``inputs``: the record
+    of what was read, :func:`acquisition_inputs`, kept in ``fit.json`` for a batch's rerun)."""
     stack = ImageStack(frames)  # uint16, scaled on the fly; saturation at the top code
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -745,6 +762,7 @@ def _fit_into(  # type: ignore[no-untyped-def]
         "input_notes": result.notes,
         "files": [p.name for p in result.files],
         "verdict": result.qa.verdict if result.qa else None,
+        INPUTS_KEY: inputs,
     }
     (out / "fit.json").write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
     result.files.append(out / "fit.json")
@@ -1291,7 +1309,7 @@ def _remember_pixels(frames: list[Any]) -> None:
 class BatchItem:
     source: Path
     out_dir: Path
-    status: str  # "done", "skipped (finished earlier)", or "failed: ..."
+    status: str  # "done", "refitted (...)", "skipped (finished earlier...)", or "failed: ..."
     verdict: str | None = None
     #: the fit's notes and warnings, as a single fit prints them (a batch had dropped them:
     #: "fit.ptm not written" for a 5-light session was said by fit S, not by fit S1 S2)
@@ -1325,8 +1343,10 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
     """Fit several sessions one after another, resumably.
 
     Each goes to :func:`batch_out_dir`, built in a hidden ``.name.*.partial`` folder and renamed
-    when complete: a finished session (its folder exists) is skipped, a killed batch leaves
-    partial folders only, which the next run removes and redoes. A session that fails is
+    when complete: a finished session (its folder exists) is skipped unless its session changed
+    since that fit (:func:`earlier_fit`; refitted then, the earlier fit replaced only once the
+    new one is complete), a killed batch leaves partial folders only, which the next run
+    removes and redoes. A session that fails is
     reported and the batch goes on. (:func:`rti_rig.app.usecases.fit_dask.run_batch_dask` runs
     the same :func:`fit_one` per session as parallel tasks on a Dask cluster.)
     """
@@ -1386,9 +1406,44 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
         # partial folder while the retry finishes the session (see fit_one)
         for partial in partial_folders(root, final.name):
             shutil.rmtree(partial, ignore_errors=True)
-        if not final.exists():
+        if earlier_fit(final, source)[0] is None:
             todo.append(source)
     return todo
+
+
+#: What a batch says of a session whose earlier fit stands.
+FINISHED_EARLIER = "skipped (finished earlier)"
+
+
+def earlier_fit(final: Path, source: Path) -> tuple[str | None, str | None]:
+    """(The status of a session to skip, why it is to be refitted): ``(None, None)`` when
+    ``final`` holds no earlier fit, ``(None, why)`` when its session changed since that fit
+    (its ``fit.json`` records what it was made from, :func:`acquisition_inputs`), ``(status,
+    None)`` when the earlier fit stands.
+
+    Why: only the folder's existence was checked, so a session fitted while interrupted and
+    then continued with ``run --resume`` (or mended with ``--reshoot-lost``) kept its
+    out-of-date fit, reported "skipped (finished earlier)". A fit that records nothing (made
+    before the record was kept) is skipped with a word on how to have it refitted: refitting
+    every such session unasked would redo a whole backlog."""
+    if not final.exists():
+        return None, None
+    try:
+        summary = json.loads((final / "fit.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        summary = None
+    if not isinstance(summary, dict) or summary.get(INPUTS_KEY) is None:
+        return (
+            f"{FINISHED_EARLIER}; its fit.json does not record what it was fitted from, so "
+            f"whether its session changed since cannot be told: delete {final} to fit it again"
+        ), None
+    now = acquisition_inputs(source)
+    if now is None:  # the refit says what is wrong with the source; the earlier fit stays
+        return None, "its session cannot be read as it was when fitted"
+    changed = change_since(summary[INPUTS_KEY], now)
+    if changed is None:
+        return FINISHED_EARLIER, None
+    return None, f"its session changed since the earlier fit: {changed}"
 
 
 def fit_one(
@@ -1405,16 +1460,36 @@ def fit_one(
     from dataclasses import replace
 
     final = batch_out_dir(root, source)
-    if final.exists():
-        return BatchItem(source, final, "skipped (finished earlier)")
-    partial = root / f".{final.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.partial"
+    skipped, outgrown = earlier_fit(final, source)
+    if skipped is not None:
+        return BatchItem(source, final, skipped)
+    attempt = f"{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    partial = root / f".{final.name}.{attempt}.partial"
     try:
         result = run_fit(replace(template, source=source, out_dir=partial), bands)
     except RtiRigError as exc:
         shutil.rmtree(partial, ignore_errors=True)
-        return BatchItem(source, final, f"failed: {exc}")
+        kept = f" (the earlier fit in {final} is kept)" if outgrown and final.exists() else ""
+        return BatchItem(source, final, f"failed: {exc}{kept}")
+    if outgrown is not None and final.exists():
+        # the earlier fit is set aside only now that its successor is complete, under a
+        # partial folder's name (a batch killed between the renames removes it and refits)
+        earlier = root / f".{final.name}.{attempt}-earlier.partial"
+        try:
+            final.rename(earlier)
+        except FileNotFoundError:  # another attempt replaced it meanwhile: rename as below
+            pass
+        else:
+            try:
+                partial.rename(final)
+            except OSError:
+                earlier.rename(final)
+                shutil.rmtree(partial, ignore_errors=True)
+                raise
+            shutil.rmtree(earlier, ignore_errors=True)
     try:
-        partial.rename(final)  # atomic; refused when a finished folder is already there
+        if partial.exists():
+            partial.rename(final)  # atomic; refused when a finished folder is already there
     except OSError:
         shutil.rmtree(partial, ignore_errors=True)
         if not final.exists():
@@ -1428,7 +1503,7 @@ def fit_one(
     return BatchItem(
         source,
         final,
-        "done",
+        "done" if outgrown is None else f"refitted ({outgrown})",
         result.qa.verdict if result.qa is not None else None,
         tuple(result.notes),
         tuple(result.warnings),

@@ -38,12 +38,14 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.fit import (
+    FINISHED_EARLIER,
     BandRunner,
     BatchItem,
     FitRequest,
     FitResult,
     acquisition_files,
     batch_out_dir,
+    earlier_fit,
     fit_one,
     plan_batch,
     read_image,
@@ -762,7 +764,8 @@ def _batch_results(
             items.append(fit_one(s, root, template))  # fails at once, naming the path
             continue
         if s not in futures:
-            items.append(BatchItem(s, batch_out_dir(root, s), "skipped (finished earlier)"))
+            out = batch_out_dir(root, s)
+            items.append(BatchItem(s, out, earlier_fit(out, s)[0] or FINISHED_EARLIER))
             continue
         try:
             items.append(futures[s].result())
