@@ -268,10 +268,9 @@ def check_plan_options(
     check_elevation_band(min_elevation_deg, max_elevation_deg)
     if n < MIN_PLAN_LIGHTS:
         raise ScheduleError(
-            f"--lights {n}: plan at least {MIN_PLAN_LIGHTS} lights; fewer cannot determine a "
-            "surface normal (photometric stereo needs 3, a PTM 6, the fit.rti rti-rig fit "
-            "writes 5), so no planner can do better than another (a 2-light plan read 90° "
-            "expected error)"
+            f"--lights {n}: give at least {MIN_PLAN_LIGHTS} lights to plan; fewer cannot "
+            "determine a surface normal, so no planner can do better than another (a 2-light "
+            "plan read 90° expected error)"
         )
     if n > MAX_LIGHTS:
         raise ScheduleError(

@@ -34,7 +34,14 @@ def plan(
             "(default: the simulated 48-LED dome shipped with rti-rig).",
         ),
     ] = None,
-    lights: Annotated[int, typer.Option("--lights", help="Number of lights to plan.")] = 12,
+    lights: Annotated[
+        int,
+        typer.Option(
+            "--lights",
+            help="Number of lights to plan: at least 3; below 6 a note says what `rti-rig fit` "
+            "will not make of them.",
+        ),
+    ] = 12,
     method: Annotated[
         str | None,
         typer.Option(

@@ -53,7 +53,8 @@ def run(
         typer.Option(
             "--lights",
             help="Number of lights in a homogeneous layout (default: every LED of a dome, "
-            "or the arm's default_lights).",
+            "or the arm's default_lights). At least 1; below 6 a note says, before anything "
+            "lights, what `rti-rig fit` will not make of them (no fit.ptm, fit.rti or fit).",
         ),
     ] = None,
     plan: Annotated[

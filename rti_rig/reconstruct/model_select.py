@@ -85,6 +85,14 @@ class ModelChoice:
         return fit_model(self.model, images, lights, **kwargs)
 
 
+def fewest_images(candidates: Sequence[str] = RELIGHT_MODELS) -> int:
+    """The fewest images :func:`select_model` can fit and check one of ``candidates`` from:
+    the simplest one's coefficients, fitted, plus one light held out (every fold holds out at
+    least one). What a session must shoot for `rti-rig fit`'s default ``--model auto``; run and
+    plan read it here so that their advice cannot drift from the choice itself."""
+    return min(N_COEFFICIENTS[c] for c in candidates) + 1
+
+
 def _folds(n: int, holdout: int | Sequence[int], seed: int) -> tuple[list[np.ndarray], str]:
     if isinstance(holdout, int | np.integer):
         k = int(holdout)
@@ -166,7 +174,7 @@ def select_model(
     fitted = {k: v[0] for k, v in results.items() if v[0] is not None}
     if not fitted:
         simplest = min(results, key=lambda k: N_COEFFICIENTS[k])
-        fewest = N_COEFFICIENTS[simplest] + 1  # one held out at least
+        fewest = fewest_images(list(results))
         plain = f"no candidate model can be fitted from {stack.n} image(s)"
         if stack.n < fewest:
             plain += (

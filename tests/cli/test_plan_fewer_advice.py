@@ -1,7 +1,8 @@
 """A plan refused for too few lights in the band never advises a count a plan refuses.
 
 With one LED at or above the floor, `rti-rig plan` had said "use --lights 1 or fewer", and
-`--lights 1` is refused ("plan at least 3 lights"); a rig of 2 lights was told "use --lights 2".
+`--lights 1` is refused ("give at least 3 lights to plan"); a rig of 2 lights was told "use
+--lights 2".
 """
 
 from __future__ import annotations

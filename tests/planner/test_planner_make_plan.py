@@ -164,10 +164,9 @@ def test_more_lights_than_leds_is_a_clear_error() -> None:
     with pytest.raises(ScheduleError, match="at least 3"):
         make_plan(PREVIEW, DOME, 0, "kmeans")
     # two lights determine no normal: refused by name (a 2-light plan had read 90° expected)
-    with pytest.raises(ScheduleError, match="--lights 2: plan at least 3 lights") as refused:
+    # (what rti-rig fit needs is said by `rti-rig plan`, read from the fit: tests/cli)
+    with pytest.raises(ScheduleError, match="--lights 2: give at least 3 lights to plan"):
         make_plan(PREVIEW, DOME, 2, "optimal")
-    # the fit.rti `rti-rig fit` writes needs 5 lights (it had said "an HSH fit.rti 4")
-    assert "the fit.rti rti-rig fit writes 5" in str(refused.value)
     assert len(make_plan(PREVIEW, DOME, 48, "optimal")) == 48
 
 

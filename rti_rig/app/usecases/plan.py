@@ -25,12 +25,19 @@ from rti_rig.app.normals_determined import (
 )
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.app.preview_source import resolve_preview
+from rti_rig.app.usecases.fit_outlook import fit_minimums, fit_outlook
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
-from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, PlanRequest, check_plan_options, plan
+from rti_rig.planner.make_plan import (
+    DEFAULT_OBJECTIVE,
+    MIN_PLAN_LIGHTS,
+    PlanRequest,
+    check_plan_options,
+    plan,
+)
 from rti_rig.planner.plan_report import PlanReport
 from rti_rig.runtime.session import image_names
 
@@ -136,6 +143,16 @@ def _check_outputs(req: PlanLightsRequest, loaded: LoadedRig | None) -> None:
 def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     """Check, plan and write ``req.out_file``; nothing is read before the options are checked."""
     method, objective = req.method_or_default, req.objective_or_default
+    if req.lights < MIN_PLAN_LIGHTS:
+        least = fit_minimums()
+        raise RtiRigError(
+            f"--lights {req.lights}: give at least {MIN_PLAN_LIGHTS} lights to plan; fewer "
+            f"cannot determine a surface normal (`rti-rig fit` needs {least['ps']} for a "
+            f"normal map with --model ps, {least['auto']} for its default --model auto, a PTM "
+            f"{least['ptm']}, fit.rti {least['rti']}), so no planner can do better than "
+            "another (a 2-light plan read 90° expected error); a test shot of 1 or 2 lights "
+            "needs no plan: rti-rig run RIG --lights 1"
+        )
     check_plan_options(
         method=method,
         objective=objective,
@@ -211,6 +228,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         req.out_file,
         [LpEntry(n, s.direction) for n, s in zip(names, schedule.steps, strict=True)],
     )
+    # what the session it plans gives `rti-rig fit` (run says it again before it shoots)
+    if (outlook := fit_outlook(len(schedule))) is not None:
+        notes.append(outlook)
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
 
 

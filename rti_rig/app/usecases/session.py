@@ -212,7 +212,14 @@ def check_light_count(n: int) -> None:
     from rti_rig.core.lp_format import MAX_LIGHTS
 
     if n < 1:
-        raise RtiRigError(f"--lights {n}: give at least 1 light")
+        from rti_rig.app.usecases.fit_outlook import fit_minimums
+
+        least = fit_minimums()
+        raise RtiRigError(
+            f"--lights {n}: give at least 1 light (1 or 2 make a test shot; `rti-rig fit` "
+            f"needs {least['ps']} for a normal map with --model ps, {least['auto']} for its "
+            f"default --model auto, {least['rti_file']} for fit.ptm and fit.rti)"
+        )
     if n > MAX_LIGHTS:
         raise RtiRigError(
             f"--lights {n}: at most {MAX_LIGHTS} lights per session (the most an .lp file may "
@@ -221,21 +228,14 @@ def check_light_count(n: int) -> None:
 
 
 def too_few_to_fit(n: int) -> Note | None:
-    """A warning for a session of fewer lights than any fit takes: accepted (a test shot of
-    one or two lights is a use), but said before the rig moves, not only by the QA afterwards."""
-    from rti_rig.core.rti_bases import N_COEFFICIENTS
+    """What `rti-rig fit` will not make of a session of ``n`` lights (:func:`fit_outlook`):
+    accepted (a test shot of one or two lights is a use), but said before the rig moves, not
+    only by the QA or the fit afterwards (``--lights 3`` had been silent, its verdict "good",
+    and plain ``fit`` then failed)."""
+    from rti_rig.app.usecases.fit_outlook import fit_outlook
 
-    fewest = N_COEFFICIENTS["lambert"]  # photometric stereo: the fewest coefficients of any fit
-    if n >= fewest:
-        return None
-    return Note(
-        f"{n} light{'s' if n != 1 else ''}: too few for normals or any relighting fit "
-        f"(photometric stereo needs {fewest}, a PTM {N_COEFFICIENTS['ptm']}); the images are "
-        "kept, but "
-        "`rti-rig fit` and the QA verdict will have nothing to fit. Fine for a test shot; for "
-        "an RTI give --lights 6 or more",
-        "warning",
-    )
+    said = fit_outlook(n)
+    return None if said is None else Note(said, "warning")
 
 
 def checked_rig(loaded, schedule: LightSchedule) -> Rig:  # type: ignore[no-untyped-def]
@@ -774,8 +774,6 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
         for note in plan_notes:
             on_note(Note(note, "warning"))
         check_light_count(len(entries))
-        if (few := too_few_to_fit(len(entries))) is not None:
-            on_note(few)
         schedule = schedule_from_lp(entries, geometry, str(req.plan))
         _check_determined(
             req,
@@ -789,8 +787,6 @@ def new_session_schedule(  # type: ignore[no-untyped-def]
     check_elevation_band(req.min_elevation_deg, req.max_elevation_deg)
     n = req.lights if req.lights is not None else default_lights(loaded, geometry)
     check_light_count(n)
-    if (few := too_few_to_fit(n)) is not None:
-        on_note(few)
     if loaded.config.backend == "replay":  # its "LEDs" are images, in the band or not
         # (with --min/--max-elevation-deg the planner's refusal had said "the dome has only
         # 8 LEDs at or above 50° elevation" of an acquisition's images)
@@ -949,6 +945,11 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     if req.is_adaptive:
         opened = _open_adaptive(req, loaded)
         opened.folder.input_notes = list(loaded.notes)
+        # a fixed count (--adaptive --lights N): what the fit will make of it, once the
+        # request has passed its refusals; an --until-error stop is said when it happens
+        fixed = req.lights if req.until_error_deg is None else None
+        if fixed is not None and (few := too_few_to_fit(fixed)) is not None:
+            on_note(few)
         return opened
     plan_notes: list[Note] = []
 
@@ -957,6 +958,9 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
         on_note(note)
 
     schedule = new_session_schedule(req, loaded, keep_note)
+    # said before the rig opens, not recorded among the inputs' notes: not about the inputs
+    if (few := too_few_to_fit(len(schedule))) is not None:
+        on_note(few)
     opened = _open_new(loaded, schedule, req.out_dir, req.auto_exposure, req.max_saturated, on_note)
     opened.folder.input_notes = [*loaded.notes, *(n.text for n in plan_notes)]
     return opened
