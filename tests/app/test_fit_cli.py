@@ -308,7 +308,7 @@ def test_fit_refuses_a_missing_source_and_an_unknown_model(tmp_path: Path, clean
     r = runner.invoke(app, ["fit", str(tmp_path / "nope"), "--out", str(tmp_path / "o")])
     assert r.exit_code == 2 and "session folder or an .lp" in r.output
     r = runner.invoke(app, ["fit", str(clean[0]), "--out", str(tmp_path / "o"), "--model", "x"])
-    assert r.exit_code == 2 and "unknown model" in r.output
+    assert r.exit_code == 2 and "--model 'x' is not known" in r.output
     # the name --help gives is among the names the refusal lists (it gave only ps-robust)
     assert "robust-ps" in " ".join(r.output.split())
 
