@@ -372,6 +372,25 @@ def lock_session(root: Path) -> None:
     _LOCKED[key] = fd
 
 
+def _finished_hint(root: Path, manifest: dict[str, Any]) -> str:
+    """What to do with the finished session in ``root`` that a new one may not overwrite: a
+    preview (``rti-rig preview``'s one image, its schedule's method ``preview``) is planned
+    from, any other session fitted.
+
+    Why: a preview folder given twice to ``preview --out`` had been told "fit it with rti-rig
+    fit", which cannot fit one image; the command that uses a preview is ``plan``, given its
+    rig (the config the preview recorded, as ``preview`` itself advises)."""
+    folder = shlex.quote(str(root))
+    if (manifest.get("schedule") or {}).get("method") == "preview":
+        rig = (manifest.get("rig") or {}).get("config_path")
+        shown = shlex.quote(str(rig)) if isinstance(rig, str) and rig else "RIG.toml"
+        return (
+            f" (it holds a finished preview: plan from it with rti-rig plan {folder} --rig "
+            f"{shown} --lights N --out plan.lp)"
+        )
+    return f" (it holds a finished session: fit it with rti-rig fit {folder} --out DIR)"
+
+
 def refuse_if_in_use(root: Path, what: str) -> None:
     """Refuse to read session ``root`` while another process holds it (:func:`lock_session`: a
     run or resume capturing into it), saying to ``what`` ("fit it", "export its .lp") once that
@@ -484,14 +503,12 @@ class SessionFolder:
             resume = ""  # not a session: no resume to offer
             if (root / MANIFEST).is_file():
                 try:
-                    finished = (read_manifest(root).get("runner") or {}).get(
-                        "finish_reason"
-                    ) == "completed"
+                    manifest = read_manifest(root)
+                    finished = (manifest.get("runner") or {}).get("finish_reason") == "completed"
                 except SessionError:
-                    finished = False
+                    manifest, finished = {}, False
                 resume = (
-                    " (it holds a finished session: fit it with rti-rig fit "
-                    f"{shlex.quote(str(root))} --out DIR)"
+                    _finished_hint(root, manifest)
                     if finished
                     else ", or continue the interrupted session in it with "
                     f"rti-rig run --resume {shlex.quote(str(root))}"
