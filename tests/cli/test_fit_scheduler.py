@@ -11,6 +11,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -267,3 +268,17 @@ def test_a_local_two_worker_cluster_gives_the_single_process_bytes(tmp_path: Pat
             assert got == ref
         r = _cli([*batch, "--scheduler", address], env, tmp_path)
         assert r.returncode == 0 and r.stdout.count("(finished earlier)") == 3, r.stdout
+        # s2's lights recalibrated since: refitted on the cluster, said so; the rest stand
+        from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+
+        entries = read_lp(tmp_path / "s2" / "lights.lp")
+        moved = np.add(entries[0].direction, [0.02, 0.0, 0.0])
+        entries[0] = LpEntry(entries[0].name, tuple(moved / np.linalg.norm(moved)))
+        write_lp(tmp_path / "s2" / "lights.lp", entries)
+        r = _cli([*batch, "--scheduler", address], env, tmp_path)
+        said = " ".join(r.stdout.split())
+        assert r.returncode == 0, r.stdout + r.stderr
+        changed = "its session changed since the earlier fit: its lights changed"
+        assert f"s2: refitted ({changed})" in said
+        assert said.count("(finished earlier)") == 2, said
+        assert sorted(p.name for p in (tmp_path / "batch").iterdir()) == ["s1", "s2", "s3"]
