@@ -161,8 +161,9 @@ def fit(
         bool,
         typer.Option(
             "--no-qa",
-            help="Skip the QA verdict (normal maps, fit.ptm or fit.rti from images black or "
-            "saturated throughout are still said).",
+            help="Skip the QA verdict (still said: fit.ptm or fit.rti where fewer images hold "
+            "signal, not black or saturated throughout, than the model has coefficients; the "
+            "normal maps where those images cannot determine a normal).",
         ),
     ] = False,
     no_ptm: Annotated[bool, typer.Option("--no-ptm", help="Do not write fit.ptm.")] = False,

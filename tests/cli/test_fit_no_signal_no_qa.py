@@ -15,12 +15,13 @@ import pytest
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
-from rti_rig.core.lp_format import read_lp, write_lp
-from tests.fit_sessions import make_session
+from rti_rig.core.lp_format import LpEntry, read_lp, write_lp
+from tests.fit_sessions import dome_lights, make_session
 
 REPO = Path(__file__).resolve().parents[2]
 ACQ = REPO / "tests" / "data" / "neuralrti_replay" / "dirs.lp"
-SAID = "are from images that hold no signal"
+#: "is" or "are": the test that nothing is said must not pass on the verb alone
+SAID = "from images that hold no signal"
 
 
 def _acquisition(folder: Path, value: int, lit: int = 0) -> tuple[Path, list[str]]:
@@ -83,7 +84,61 @@ def test_images_left_that_cannot_determine_a_normal_are_said(tmp_path: Path) -> 
     said = _fit(lp, tmp_path / "f", "--no-qa")
     assert "16 of the 18 images are black" in said, said
     assert f"{stems[2]} (black)" in said and f"{stems[0]} (" not in said
-    assert "the 2 others cannot determine a normal by themselves" in said
+    assert (
+        "the 2 others are fewer than fit.ptm's 6 and fit.rti's 4 coefficients per pixel and "
+        "cannot determine a normal by themselves" in said
+    ), said
+
+
+def _raking() -> np.ndarray:
+    """12 raking lights at azimuths 0° and 180° only, 10°-75° up: relighting documentation
+    whose lights cannot determine a normal (one upright plane through the object)."""
+    out = []
+    for az in np.radians([0.0, 180.0]):
+        for el in np.radians([10.0, 20.0, 30.0, 45.0, 60.0, 75.0]):
+            out.append((np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)))
+    return np.array(out)
+
+
+def test_a_relighting_only_acquisition_with_one_black_image_is_left_to_the_qa(
+    tmp_path: Path,
+) -> None:
+    # its 11 lit images "cannot determine a normal", which fit.ptm and fit.rti never needed:
+    # they had been said to be "from images that hold no signal"
+    session, _, _ = make_session(tmp_path / "s", size=(48, 48), lights=_raking(), black=4)
+    said = _fit(session, tmp_path / "f", "--no-qa")
+    assert (tmp_path / "f" / "fit.ptm").exists() and (tmp_path / "f" / "fit.rti").exists()
+    assert not (tmp_path / "f" / "normals.npy").exists()  # said separately: undetermined
+    assert SAID not in said, said
+
+
+def test_a_relighting_only_acquisition_black_throughout_is_said(tmp_path: Path) -> None:
+    folder = tmp_path / "acq"
+    folder.mkdir()
+    entries = [
+        LpEntry(f"raking_{k:02d}.png", tuple(float(c) for c in d)) for k, d in enumerate(_raking())
+    ]
+    for e in entries:
+        cv2.imwrite(str(folder / e.name), np.zeros((48, 48, 3), np.uint8))
+    write_lp(folder / "dirs.lp", entries)
+    said = _fit(folder / "dirs.lp", tmp_path / "f", "--no-qa")
+    assert said.count(SAID) == 1, said
+    assert "fit.ptm and fit.rti are from images that hold no signal" in said
+    assert "every image (12) is black" in said
+
+
+def test_fewer_lit_images_than_a_ptm_has_coefficients_are_said_naming_fit_ptm(
+    tmp_path: Path,
+) -> None:
+    # 6 lights, one black: the 5 lit ones determine a normal and an order-1 HSH (4 terms)
+    # but not a PTM's 6 coefficients
+    session, _, _ = make_session(tmp_path / "s", size=(48, 48), lights=dome_lights()[::6], black=2)
+    said = _fit(session, tmp_path / "f", "--no-qa", "--hsh-order", "1")
+    assert said.count(SAID) == 1, said
+    assert "fit.ptm is from images that hold no signal: 1 of the 6 images is black" in said
+    assert "image_003 (black); the 5 others are fewer than fit.ptm's 6 coefficients" in said
+    assert "fit.rti" not in said.split(SAID)[0].rsplit("warning:", 1)[-1]
+    assert "normal maps" not in said.split(SAID)[0].rsplit("warning:", 1)[-1]
 
 
 def test_one_misfire_among_lit_images_is_left_to_the_qa(tmp_path: Path) -> None:

@@ -950,10 +950,12 @@ def _fit_all(
         if not req.qa:  # the QA names black and saturated images itself
             # the relighting files too: --no-normals --no-qa wrote fit.ptm from a black
             # acquisition without a word
-            made = sorted("fit.ptm" if k == "ptm" else "fit.rti" for k in exported)
-            made += ["the normal maps"] if write_normals else []
-            if made:
-                skipped += no_signal_warning(stack, lights, names, SAMPLE_PIXELS, made)
+            # each judged by what it needs (a PTM its 6 lit images, the normal maps lights
+            # that determine a normal)
+            written = {("fit.ptm" if k == "ptm" else "fit.rti"): k for k in exported}
+            skipped += no_signal_warning(
+                stack, lights, names, SAMPLE_PIXELS, written, normals=write_normals
+            )
         # the last use of the sample: when nothing above read it, it is streamed, never held
         ref = stack.reference_level(SAMPLE_PIXELS, keep_sample=False)
         del obs

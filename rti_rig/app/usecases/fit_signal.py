@@ -5,11 +5,17 @@ saturated throughout (an exposure far too long) had its normal maps written with
 least-squares fit of nothing is still a normal map; with ``--no-normals`` too its fit.ptm and
 fit.rti were. The QA, when it runs, names such images itself (so the fit asks for this only
 with ``--no-qa``).
+
+Each output is judged by what it needs: the normal maps, images whose lights determine a
+normal; a relighting file, as many images as its model has coefficients. A relighting-only
+acquisition (raking lights at two azimuths) with one black image had been told its fit.ptm
+rested on images without signal because the 11 lit ones "cannot determine a normal", which
+the relighting files never needed.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -17,6 +23,8 @@ from rti_rig.reconstruct.stack import ImageStack
 
 #: Images named in the warning before "and N more".
 NO_SIGNAL_NAMED = 12
+#: How the normal maps are named in the warning.
+NORMAL_MAPS = "the normal maps"
 
 
 def no_signal_warning(
@@ -24,41 +32,72 @@ def no_signal_warning(
     lights: np.ndarray,
     names: Sequence[str],
     sample_pixels: int,
-    outputs: Sequence[str] = ("the normal maps",),
+    relighting: Mapping[str, str] | None = None,
+    normals: bool = True,
 ) -> list[str]:
-    """A warning where ``outputs`` (what the fit wrote: "fit.ptm", "fit.rti", "the normal
-    maps") rest on images that hold no signal (black or clipped on almost every sampled pixel),
-    naming them; none where the images that do hold signal determine a normal by themselves.
+    """A warning where what the fit wrote rests on images that hold no signal (black or
+    clipped on almost every sampled pixel), naming them and the outputs concerned.
+
+    ``relighting`` maps each relighting file written ("fit.ptm", "fit.rti") to its registry
+    model ("ptm", "hsh2"); ``normals`` says whether the normal maps were. Every output is
+    named where every image is empty; otherwise a relighting file only where fewer images hold
+    signal than its model has coefficients (it cannot be fitted from them), and the normal
+    maps only where the images holding signal cannot determine a normal by themselves.
 
     Judged on the pixel sample of ``sample_pixels`` the model choice and the quantisation
     ranges read anyway (cached; one sampled pass where nothing read it), so it costs next to
     nothing however large the images. One black image among lit ones is a misfire the QA
     judges, and the dim low lights of a dome metered for a glint are lit as they should be:
-    neither is said here while the other images determine the normals.
+    neither is said here while the other images suffice for every output.
     """
     from rti_rig.app.normals_determined import undetermined_normals
+    from rti_rig.reconstruct.registry import model_spec
     from rti_rig.reconstruct.signal_check import BLACK_FRACTION, images_without_signal
 
+    relighting = dict(relighting or {})
+    if not relighting and not normals:
+        return []
     sample, _ = stack.pixel_sample(sample_pixels)
     empty = images_without_signal(sample, stack.saturation_level)
     if empty is None or not empty.indices:
         return []
     lit = np.setdiff1d(np.arange(stack.n), empty.indices)
-    if len(lit) >= 3 and undetermined_normals(lights[lit]) is None:
+    everything = len(lit) == 0
+    short = {
+        name: model_spec(key).n_coefficients
+        for name, key in sorted(relighting.items())
+        if everything or len(lit) < model_spec(key).n_coefficients
+    }
+    no_normal = normals and (
+        everything or len(lit) < 3 or undetermined_normals(lights[lit]) is not None
+    )
+    if not short and not no_normal:
         return []
     label = [names[i] if i < len(names) else f"image {i + 1}" for i in range(stack.n)]
     listed = [f"{label[i]} ({kind})" for i, kind in zip(empty.indices, empty.kinds, strict=True)]
     more = len(listed) - NO_SIGNAL_NAMED
     shown = ", ".join(listed[:NO_SIGNAL_NAMED]) + (f" and {more} more" if more > 0 else "")
-    if len(listed) == stack.n:
+    if everything:
         which, left = f"every image ({stack.n}) is", ""
     else:
-        which = f"{len(listed)} of the {stack.n} images are"
-        left = f"; the {len(lit)} others cannot determine a normal by themselves"
-    made = list(outputs)
+        verb = "is" if len(listed) == 1 else "are"
+        which = f"{len(listed)} of the {stack.n} images {verb}"
+        why = []
+        if short:
+            needs = " and ".join(f"{name}'s {count}" for name, count in short.items())
+            why.append(f"fewer than {needs} coefficients per pixel")
+        if no_normal:
+            why.append("cannot determine a normal by themselves")
+        others = "the 1 other" if len(lit) == 1 else f"the {len(lit)} others"
+        verb = "is" if len(lit) == 1 else "are"
+        left = f"; {others} " + " and ".join(
+            w if w.startswith("cannot") else f"{verb} {w}" for w in why
+        )
+    made = [*short, *([NORMAL_MAPS] if no_normal else [])]
     said = ", ".join(made[:-1]) + " and " + made[-1] if len(made) > 1 else made[0]
+    verb = "are" if len(made) > 1 or made[0] == NORMAL_MAPS else "is"
     return [
-        f"{said} are from images that hold no signal: {which} black (below "
+        f"{said} {verb} from images that hold no signal: {which} black (below "
         f"{BLACK_FRACTION:.1%} of full scale) or clipped at saturation on almost every sampled "
         f"pixel: {shown}{left}. Check the lens cap, that the lights fire and the exposure, then "
         "capture again (the QA, left out by --no-qa, judges each image)"
