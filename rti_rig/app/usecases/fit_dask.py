@@ -30,7 +30,7 @@ import os
 import socket
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager, suppress
 from dataclasses import replace
@@ -273,7 +273,20 @@ class _Refused(Exception):
 
 
 class _Unresolved(Exception):
-    """The scheduler's host name does not resolve to an address (``args``: the host, why)."""
+    """The resolver said the scheduler's host name has no address (``args``: the host, why)."""
+
+
+class _LookupFailed(Exception):
+    """The scheduler's host name could not be looked up: the resolver did not answer in time,
+    or failed for a reason of its own, which is not a name that does not exist (``args``: the
+    host, why)."""
+
+
+#: The resolver's answers that a name has no address: said as "does not resolve". Any other
+#: failure (EAI_AGAIN, a nameserver down or slow) says nothing about the name.
+NO_SUCH_NAME = tuple(
+    code for code in (socket.EAI_NONAME, getattr(socket, "EAI_NODATA", None)) if code is not None
+)
 
 
 def _refused(exc: BaseException | None) -> bool:
@@ -288,26 +301,31 @@ def _refused(exc: BaseException | None) -> bool:
     return False
 
 
-async def _resolve(host: str, port: int, timeout: float) -> None:
-    """Return once ``host`` resolves; raise :class:`_Unresolved` when it does not, or when the
-    resolver has not answered within ``timeout`` seconds.
+async def _resolve(host: str, port: int, timeout: float) -> list[str]:
+    """The addresses ``host`` resolves to, in the resolver's order; raise :class:`_Unresolved`
+    when the resolver says it has no address, :class:`_LookupFailed` when it has not answered
+    within ``timeout`` seconds or failed otherwise.
 
     Why: Dask's ``connect`` retries a name that does not resolve until its timeout, so a
     mistyped host waited the full 20 s and was told as "no Dask scheduler answered". The lookup
     runs in a daemon thread: ``getaddrinfo`` cannot be interrupted, and a resolver that hangs
     must hold neither this wait beyond ``timeout`` nor the exit of a stopped ``rti-rig fit``
-    (the event loop's own executor is joined at exit)."""
+    (the event loop's own executor is joined at exit). A slow answer is not a missing name:
+    the lookup had been cut at a fifth of the connect timeout (4 s), under glibc's 5 s per
+    nameserver, so a machine whose first nameserver was down was told that a valid host "does
+    not resolve"."""
     loop = asyncio.get_running_loop()
-    answer: asyncio.Future[BaseException | None] = loop.create_future()
+    answer: asyncio.Future[BaseException | list[str]] = loop.create_future()
 
-    def tell(outcome: BaseException | None) -> None:
+    def tell(outcome: BaseException | list[str]) -> None:
         if not answer.done():
             answer.set_result(outcome)
 
     def lookup() -> None:
-        outcome: BaseException | None = None
+        outcome: BaseException | list[str]
         try:
-            socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+            infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+            outcome = list(dict.fromkeys(str(info[4][0]) for info in infos))
         except OSError as exc:  # socket.gaierror, or an OSError of the resolver's
             outcome = exc
         with suppress(RuntimeError):  # the loop is closed: the probe was stopped or timed out
@@ -315,17 +333,35 @@ async def _resolve(host: str, port: int, timeout: float) -> None:
 
     threading.Thread(target=lookup, name="rti-rig-resolve", daemon=True).start()
     try:
-        failure = await asyncio.wait_for(answer, timeout)
+        outcome = await asyncio.wait_for(answer, timeout)
     except TimeoutError:
-        raise _Unresolved(host, f"the resolver gave no answer within {timeout:.0f} s") from None
-    if failure is not None:
-        why = getattr(failure, "strerror", None) or str(failure)
-        raise _Unresolved(host, why)
+        raise _LookupFailed(host, f"the resolver did not answer within {timeout:.0f} s") from None
+    if isinstance(outcome, BaseException):
+        why = getattr(outcome, "strerror", None) or str(outcome)
+        if isinstance(outcome, socket.gaierror) and outcome.errno in NO_SUCH_NAME:
+            raise _Unresolved(host, why)
+        raise _LookupFailed(host, why)
+    return outcome
 
 
-async def _connect(address: str, timeout: float, connection_args: dict[str, Any]) -> Any:
+def _host_port(address: str) -> tuple[str, int] | None:
+    """The host and port of a tcp://, ws://, tls:// or wss:// ``address``; None for others
+    (inproc://, ucx://: nothing of theirs is looked up or connected to here)."""
+    from distributed.comm import parse_address, parse_host_port
+
+    scheme, location = parse_address(address)
+    if scheme not in ("tcp", "ws", "tls", "wss"):
+        return None
+    host, port = parse_host_port(location)
+    return host, int(port)
+
+
+async def _connect(
+    address: str, timeout: float, connection_args: dict[str, Any], ips: Sequence[str] = ()
+) -> Any:
     """A Dask comm to ``address``, its handshake done (``distributed.comm.connect``), after
-    its host name is resolved and one plain connection finds a refused port at once.
+    plain connections to ``ips`` (its host's addresses, looked up before: see :func:`_probe`)
+    find a refused port at once.
 
     Why: Dask's ``connect`` retries a refused connection, and a name that does not resolve,
     until its timeout, so a port nothing listens on (a scheduler not started, a wrong port) or
@@ -336,34 +372,48 @@ async def _connect(address: str, timeout: float, connection_args: dict[str, Any]
     connect also does the TLS handshake, with the context Dask's own connect uses, so that a
     listener that is there does not log a failed TLS handshake as a warning; a refused port
     fails before any handshake. Any other failure (a certificate refused, a slow network) is
-    left to Dask, which says it in its own words."""
-    from distributed.comm import connect, parse_address, parse_host_port
+    left to Dask, which says it in its own words. The plain connections go to the addresses
+    looked up, not to the name: a slow resolver (a nameserver down, 5 s per lookup) had timed
+    out this step's second lookup, and the port is called refused only where every address
+    refuses (localhost's ::1 may refuse where 127.0.0.1 listens)."""
+    from distributed.comm import connect, parse_address
 
     scheme, location = parse_address(address)
-    if scheme in ("tcp", "ws", "tls", "wss"):
-        host, port = parse_host_port(location)
-        await _resolve(host, port, timeout / 5)
+    host_port = _host_port(address)
+    if host_port is not None and ips:
+        host, port = host_port
         tls: Any = None
         if scheme == "tls":
             tls = connection_args.get("ssl_context")  # checked by _tls_settings: a context
         elif scheme == "wss":  # Dask's wss:// gives tornado None for its default context
             tls = connection_args.get("ssl_context") or True
-        try:
-            _, writer = await asyncio.wait_for(
-                asyncio.open_connection(host, port, ssl=tls), timeout / 5
-            )
-        except (TimeoutError, OSError, ValueError) as exc:
-            if _refused(exc):
-                raise _Refused(location) from None
-        else:
-            writer.close()
+
+        async def every_refused() -> bool:
+            for ip in ips:
+                try:
+                    _, writer = await asyncio.open_connection(
+                        ip, port, ssl=tls, server_hostname=host if tls else None
+                    )
+                except (OSError, ValueError) as exc:
+                    if _refused(exc):
+                        continue
+                    return False
+                writer.close()
+                return False
+            return True
+
+        with suppress(TimeoutError):
+            if await asyncio.wait_for(every_refused(), timeout / 5):
+                raise _Refused(location)
     return await connect(address, timeout=timeout, **connection_args)
 
 
-async def _identity(address: str, timeout: float, connection_args: dict[str, Any]) -> Any:
+async def _identity(
+    address: str, timeout: float, connection_args: dict[str, Any], ips: Sequence[str] = ()
+) -> Any:
     """The scheduler's answer to Dask's ``identity`` request (a connection, its handshake, one
-    request and its reply)."""
-    comm = await _connect(address, timeout, connection_args)
+    request and its reply); ``ips``: its host's addresses (:func:`_connect`)."""
+    comm = await _connect(address, timeout, connection_args, ips)
     try:
         await comm.write({"op": "identity", "reply": True})
         return await comm.read()
@@ -454,11 +504,17 @@ def _probe(address: str, timeout: float) -> None:
     reads the first reply without a bound, so a port that accepts the connection and never
     answers (a proxy, a service that is not Dask, a hung scheduler) held ``rti-rig fit`` for
     ever, and its Ctrl-C left a half-built Client waiting 40 s in ``__del__``. No Client is
-    built before this answers."""
+    built before this answers. The host name is looked up first, with the whole ``timeout``
+    (a slow resolver is not a missing name), and the connection has what is left."""
     args = _tls_settings(address)
 
     async def bounded() -> Any:
-        return await asyncio.wait_for(_identity(address, timeout, args), timeout)
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout
+        host_port = _host_port(address)
+        ips = await _resolve(*host_port, timeout) if host_port is not None else []
+        left = max(deadline - loop.time(), 0.0)
+        return await asyncio.wait_for(_identity(address, timeout, args, ips), left)
 
     try:
         identity = _run_quietly(bounded())
@@ -478,6 +534,13 @@ def _probe(address: str, timeout: float) -> None:
             f"--scheduler {address!r} names the host {host!r}, which does not resolve ({why}): "
             "check the host name, or give the address `dask scheduler` prints, such as "
             "tcp://192.0.2.10:8786"
+        ) from None
+    except _LookupFailed as failed:
+        host, why = failed.args
+        raise SchedulerError(
+            f"--scheduler {address!r}: the host {host!r} could not be looked up ({why}): "
+            "check this machine's network and name servers (/etc/resolv.conf), or give the "
+            "scheduler's IP address, such as tcp://192.0.2.10:8786"
         ) from None
     except Exception as exc:  # reset, a TLS failure, a reply that is not Dask's
         raise _unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
