@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import logging
 
-from rti_rig.core.dome_link import DomeInfo, DomeLinkError, LinkFault
+from rti_rig.core.dome_link import DomeInfo, DomeLinkError, LinkFault, OffOutcome
 from rti_rig.drivers.led_dome.codec_base import DomeCodec
 from rti_rig.drivers.led_dome.messages import (
     ERR_LED_FAULT,
@@ -38,7 +38,8 @@ from rti_rig.drivers.led_dome.messages import (
     describe,
     error_text,
 )
-from rti_rig.drivers.led_dome.transport import PortHeldError, Transport, TransportError
+from rti_rig.drivers.led_dome.port_opening import PortOpening
+from rti_rig.drivers.led_dome.transport import Transport, TransportError
 
 #: What to do about a definitive refusal, said with it. A dead LED stopped a session with only
 #: "LED fault (open circuit ...)" and the session's "Continue with: rti-rig run --resume": a
@@ -53,8 +54,8 @@ _REMEDY = {
 traffic_log = logging.getLogger("rti_rig.dome.traffic")
 
 
-class LedDomeDriver:
-    """Implements :class:`rti_rig.runtime.dome_policy.DomeLink` for one protocol profile."""
+class LedDomeDriver(PortOpening):
+    """Implements :class:`rti_rig.core.dome_link.DomeLink` for one protocol profile."""
 
     def __init__(
         self,
@@ -85,12 +86,18 @@ class LedDomeDriver:
         self.banners_seen = 0
         self._heard = False
         self._bytes_heard = False
-        #: A stop came while the port was being opened (see :meth:`reopen_port`).
+        #: A stop came while the port was being opened (see :meth:`PortOpening.reopen_port`).
         self.open_cut_short = False
         #: The wait for the ready banner after the last opening is over (banner or deadline),
-        #: and when that wait ends (see :meth:`finish_boot`).
+        #: and when that wait ends (see :meth:`finish_boot`, :class:`PortOpening`).
         self._booted = False
         self._boot_deadline = 0.0
+        #: This project's protocols answer ``query`` with the lit LED.
+        self.can_query = True
+        #: The handshake answers with the firmware's identity.
+        self.identifies_itself = True
+        #: Every all-off is acknowledged, or fails.
+        self.off_outcome = OffOutcome.ACKNOWLEDGED
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -107,38 +114,13 @@ class LedDomeDriver:
                 raise
             return self.hello()
 
-    def reopen_port(self) -> None:
-        """Open the port (closing it first) and start the boot wait, without waiting it out:
-        the first step of :meth:`connect`, and what the policy calls to get the port back for
-        the all-off when a stop cut that step short (then :meth:`finish_boot`).
+    def _boot_wait_s(self) -> float:
+        """How long to wait for the ready banner after the port opens (``ready_timeout_s``)."""
+        return self.ready_timeout_s
 
-        :attr:`open_cut_short` is true, for a port whose opening may reset the board (a serial
-        device's, not a URL's: ``SerialTransport.resets_on_open``), from before the system
-        opens the port until this link counts it open. Why: a Ctrl-C or SIGTERM in between
-        (inside pyserial's open, which closes the port again as the stop goes through, or
-        just after it) left a port this link never had open, so the policy sent no all-off
-        and said "the dome was never reached" of a board the opening had reset (the line
-        protocol's links were fixed for this; this one had been left out)."""
-        self.close()
-        # only an opening that may reset the board leaves one to switch off if a stop cuts it
-        # short; a URL port's connect resets nothing (see SerialTransport.resets_on_open)
-        self.open_cut_short = bool(getattr(self.transport, "resets_on_open", True))
-        self._booted = False
-        # counted from before the opening too: a stop inside it then finds this opening's
-        # deadline, not an earlier one's
-        self._boot_deadline = self.transport.clock.now() + self.ready_timeout_s
-        try:
-            self.transport.open()
-        except TransportError as exc:
-            self.open_cut_short = False  # the system refused it: nothing was opened or reset
-            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED, True)
-            error.port_held = isinstance(exc, PortHeldError)
-            raise error from exc
-        self._open = True
-        self._rx.clear()
-        self.open_cut_short = False
-        # and again once open: the board resets as the open completes
-        self._boot_deadline = self.transport.clock.now() + self.ready_timeout_s
+    def _refused(self, exc: TransportError) -> DomeLinkError:
+        """A port the system would not open."""
+        return self._error(str(exc), "open port", LinkFault.DISCONNECTED, True)
 
     def finish_boot(self) -> None:
         """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (up to the
@@ -176,6 +158,29 @@ class LedDomeDriver:
         sends its handshake once more then (it lights nothing), where bytes no profile reads
         are already another board's answer."""
         return self._bytes_heard
+
+    @property
+    def silence_hint(self) -> str:
+        """Nothing to add to a silent port's advice: a board without auto-reset sends no
+        banner, so silence through the ready wait says nothing of a slow boot."""
+        return ""
+
+    @property
+    def light_window_s(self) -> float | None:
+        """None: an LED stays lit until told (the watchdog, where there is one, is a limit the
+        host sets with each light command, not a window of the firmware's own)."""
+        return None
+
+    @property
+    def firmware_name(self) -> str | None:
+        """None: the firmware names itself only in its handshake (:class:`DomeInfo`)."""
+        return None
+
+    @property
+    def boots_lit_firmware(self) -> str | None:
+        """None: no profile of this project's own protocols is described as booting lit (the
+        policy has always taken them so)."""
+        return None
 
     # ------------------------------------------------------------------ verbs
 

@@ -25,8 +25,9 @@ import re
 from typing import Any
 
 from rti_rig.core.dome_link import DomeInfo, DomeLedError, DomeLinkError, LinkFault, OffOutcome
+from rti_rig.drivers.led_dome.port_opening import PortOpening
 from rti_rig.drivers.led_dome.protocol_spec import CommandSpec, ProtocolSpec
-from rti_rig.drivers.led_dome.transport import PortHeldError, Transport, TransportError
+from rti_rig.drivers.led_dome.transport import Transport, TransportError
 
 traffic_log = logging.getLogger("rti_rig.dome.traffic")
 
@@ -37,7 +38,7 @@ TIMED_MARGIN_S = 0.05
 HEARD_KEPT = 4096
 
 
-class ScriptedDomeDriver:
+class ScriptedDomeDriver(PortOpening):
     """Implements :class:`rti_rig.core.dome_link.DomeLink` from a :class:`ProtocolSpec`."""
 
     def __init__(
@@ -99,7 +100,7 @@ class ScriptedDomeDriver:
         #: one byte at a time, and a stale one is dropped before each command.
         self._heard_text = ""
         #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`),
-        #: and when it ends
+        #: and when it ends (:class:`PortOpening`)
         self._booted = False
         self._opened_at = 0.0
         self._boot_deadline = 0.0
@@ -118,7 +119,7 @@ class ScriptedDomeDriver:
         #: the ``boot_wait_s`` to set), kept for the report the user reads: as a warning on
         #: stderr alone it was missed beside ``check``'s "RESULT: PASS". None: none so far.
         self.slow_boot_advice: str | None = None
-        #: A stop came while the port was being opened (see :meth:`reopen_port`).
+        #: A stop came while the port was being opened (see :meth:`PortOpening.reopen_port`).
         self.open_cut_short = False
 
     # ------------------------------------------------------------------ lifecycle
@@ -285,46 +286,20 @@ class ScriptedDomeDriver:
             self.spec = spec
         return self.off_outcome
 
-    def reopen_port(self) -> None:
-        """Open the port (closing it first) and start the boot wait, without waiting it out:
-        the first step of :meth:`connect`, and what a stop that cut that step short calls to
-        get the port back for the all-off (then :meth:`finish_boot`).
-
-        :attr:`open_cut_short` is true, for a port whose opening may reset the board (a serial
-        device's, not a URL's: ``SerialTransport.resets_on_open``), from before the system
-        opens the port until this link counts it open: a stop in between (inside pyserial's
-        open, which closes the port again as the stop goes through it) left a port that was
-        never open here, so no all-off was sent, while the opening had reset a board that
-        resets on open, and the Nab sketch boots with every LED lit."""
-        self.close()
-        # only an opening that may reset the board leaves one to switch off if a stop cuts it
-        # short; a URL port's connect resets nothing (see SerialTransport.resets_on_open)
-        self.open_cut_short = bool(getattr(self.transport, "resets_on_open", True))
-        self._booted = self._boot_heard = False
+    def _forget_board(self) -> None:
+        """At each opening: the boot wait has heard nothing yet, and no other firmware's banner
+        (nor its all-off) holds for the board the opening may have reset."""
+        self._boot_heard = False
         self.foreign_firmware = None
         self._foreign_off = None
-        # counted from before the opening too: a stop inside it then finds the deadline of
-        # this opening, not an earlier one's (its all-off would be lost in the bootloader)
-        self._start_boot_wait()
-        try:
-            self.transport.open()
-        except TransportError as exc:
-            self.open_cut_short = False  # the system refused it: nothing was opened or reset
-            error = self._error(str(exc), "open port", LinkFault.DISCONNECTED)
-            error.port_held = isinstance(exc, PortHeldError)
-            raise error from exc
-        self._open = True
-        self._rx.clear()
-        self.open_cut_short = False
-        # and again once open: the board resets as the open completes, and a slow open (a USB
-        # adapter that takes its time) had eaten into the boot wait, the first bytes then sent
-        # into the bootloader
-        self._start_boot_wait()
 
-    def _start_boot_wait(self) -> None:
-        """Count the profile's boot wait (and the slow-boot measure) from now."""
-        self._opened_at = self.transport.clock.now()
-        self._boot_deadline = self._opened_at + self.spec.boot_wait_s
+    def _boot_wait_s(self) -> float:
+        """The profile's boot wait (``boot_wait_s``)."""
+        return float(self.spec.boot_wait_s)
+
+    def _refused(self, exc: TransportError) -> DomeLinkError:
+        """A port the system would not open."""
+        return self._error(str(exc), "open port", LinkFault.DISCONNECTED)
 
     def finish_boot(self) -> None:
         """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same
@@ -346,7 +321,19 @@ class ScriptedDomeDriver:
 
     @property
     def port_open(self) -> bool:
+        """The port is open (a board that resets on open may be booting, and boot lit)."""
         return self._open
+
+    @property
+    def firmware_name(self) -> str:
+        """The description's firmware name (for messages: the timed window's firmware)."""
+        return self.spec.name
+
+    @property
+    def boots_lit_firmware(self) -> str | None:
+        """The firmware's name when its board lights every LED as it boots (the description's
+        ``boots_lit``: the Nab sketch), else None."""
+        return self.spec.name if self.spec.boots_lit else None
 
     @property
     def light_window_s(self) -> float | None:

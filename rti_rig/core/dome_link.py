@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from rti_rig.core.errors import DeviceError
 
@@ -92,8 +92,13 @@ class DomeInfo:
         )
 
 
+@runtime_checkable
 class DomeLink(Protocol):
-    """The verbs of a dome driver (one exchange each; errors are :class:`DomeLinkError`)."""
+    """The verbs of a dome driver (one exchange each; errors are :class:`DomeLinkError`), and
+    what the policy needs to know of the link to answer a stop or a fault.
+
+    Runtime-checkable so that a test can hold every driver to it (an ``isinstance`` check sees
+    a member missing, not its type)."""
 
     device: str
     #: The light command carries the firmware watchdog time (max on-time).
@@ -102,8 +107,85 @@ class DomeLink(Protocol):
     echoes_light: bool
     #: Highest PWM level the firmware takes.
     max_level: int
-    # Optional: ``light_window_s`` (float | None), how long the firmware keeps an LED lit
-    # before it switches it off by itself (a timed firmware); read with ``getattr``.
+    #: The firmware can say which LED is lit (``query``). Without it and without a light echo,
+    #: only the images can tell a wrong LED, which a connect says.
+    can_query: bool
+    #: Its connect shows the board speaks this profile (a handshake that answers). Else only a
+    #: reply heard since (:attr:`profile_heard`) does: a connect to a firmware that answers
+    #: nothing must not be said to have reached the board.
+    identifies_itself: bool
+    #: What a completed all-off establishes on this firmware (acknowledged, sent with no
+    #: acknowledgement to wait for, or self-timed): the lights line says exactly that.
+    off_outcome: OffOutcome
+    #: A stop came while the port was being opened by :meth:`reopen_port`, on a port whose
+    #: opening may reset the board: the policy then reopens it to send the all-off, because
+    #: the reset may have lit the board (the Nab sketch boots with every LED on).
+    open_cut_short: bool
+
+    # The stop hooks below are what the policy asks after a stop, a failed connect or a lost
+    # reply. They are declared, not looked up with defaults: a link type that lacked one had
+    # silently been given "nothing to do" (no reopening, no all-off after a stop). What only a
+    # described firmware can do stays optional, looked up with ``getattr`` and used where
+    # present: ``published_baudrate`` / ``switch_off_at_published_rate``, ``foreign_firmware``
+    # / ``switch_off_foreign``, ``light_confirmed``, ``slow_boot_advice``.
+
+    @property
+    def port_open(self) -> bool:
+        """The port is open (a board that resets on open may be booting, and boot lit)."""
+        ...
+
+    @property
+    def profile_heard(self) -> bool:
+        """Since the port was last opened, the board sent what only a board of this profile
+        sends: the policy resends a failed handshake only then (silence or unreadable bytes
+        are a wrong port, baud rate or profile, and resending only delays that advice)."""
+        ...
+
+    @property
+    def bytes_heard(self) -> bool:
+        """Any byte at all came from the port since it was last opened: a silent port may hold
+        a board whose first reply was lost (one more handshake), and "nothing has answered:
+        check the port" is said only of a port that sent nothing."""
+        ...
+
+    @property
+    def silence_hint(self) -> str:
+        """The end of a failed connect's advice when the port stayed silent though this
+        firmware prints a boot banner at every opening (a board slower to boot than the boot
+        wait); "" when there is nothing to add."""
+        ...
+
+    @property
+    def light_window_s(self) -> float | None:
+        """How long the firmware keeps an LED lit before it switches it off by itself (a timed
+        firmware), None when it stays lit until told: the lit limit is the shorter of this
+        and ``max_on_s`` (a camera fired after its LED went dark took a dark image)."""
+        ...
+
+    @property
+    def firmware_name(self) -> str | None:
+        """The firmware's name as its protocol description gives it, for messages; None when
+        the link knows it only from the handshake (:class:`DomeInfo`)."""
+        ...
+
+    @property
+    def boots_lit_firmware(self) -> str | None:
+        """The firmware's name when it lights every LED as its board boots (the Nab sketch),
+        else None: an all-off that failed right after an opening (which resets such a board)
+        then leaves a dome that may be fully lit, and the lights line must say so."""
+        ...
+
+    def reopen_port(self) -> None:
+        """Open the port (closing it first) and start the boot wait without waiting it out:
+        the first step of :meth:`connect`, and how the policy gets the port back for the
+        all-off when a stop cut that step short (:attr:`open_cut_short`)."""
+        ...
+
+    def finish_boot(self) -> None:
+        """Wait out the rest of a boot wait a stop cut short (to the same deadline), so that
+        the all-off sent next reaches the firmware and not its bootloader; nothing to do when
+        the wait is over or the port is not open."""
+        ...
 
     def connect(self) -> DomeInfo:
         """Open the port, wait for the ready banner, handshake."""

@@ -240,15 +240,13 @@ class DomePolicy:
     def connect(self) -> None:
         if self._held:
             self._held = False
-            if self.info is not None and getattr(self.link, "port_open", True):
+            if self.info is not None and self.link.port_open:
                 # the port :meth:`hold` kept: reopening it would reset a board that resets on
                 # open (an Uno-class board), and the Nab sketch boots with every LED lit until
                 # the all-off; the all-off (recovered as any command's) confirms the board
                 # is still there and off
                 self._run(self.link.all_off, "all off")
-                self.off_report = OffReport(
-                    getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED)
-                )
+                self.off_report = OffReport(self.link.off_outcome)
                 return
         self._spoke_before_drop = False
         self.reached = "not opened"
@@ -262,7 +260,7 @@ class DomePolicy:
             )
             spoke = answered and exc.fault is not LinkFault.REJECTED
             # a board that prints a banner at every opening, and none came (a slow bootloader)
-            silent_boot = str(getattr(self.link, "silence_hint", ""))
+            silent_boot = self.link.silence_hint
             if answered:
                 self.reached = "answered"
             elif exc.command != "open port":
@@ -329,9 +327,7 @@ class DomePolicy:
         # has answered yet: check the port, the baud rate and the profile" is false (the Nab
         # sketch's banner and acknowledged init all-off had been followed by that advice when
         # the next all-off's reply was lost)
-        answered = bool(getattr(self.link, "identifies_itself", True)) or bool(
-            getattr(self.link, "profile_heard", False)
-        )
+        answered = self.link.identifies_itself or self.link.profile_heard
         # the handshake, if any, got through; is it the rig config's dome?
         self.reached = "answered" if answered else "opened"
         problem = self._check_identity(info)
@@ -349,7 +345,7 @@ class DomePolicy:
         log.info(
             "%s: %s %s with %d LEDs", self.name, info.firmware_id, info.version, info.led_count
         )
-        if not getattr(self.link, "can_query", True) and not self.link.echoes_light:
+        if not self.link.can_query and not self.link.echoes_light:
             log.info(
                 "%s: this firmware does not say which LED it lit; only the images can tell "
                 "(rti-rig's wrong-light check)",
@@ -362,10 +358,7 @@ class DomePolicy:
                 self.name,
             )
         self._run(self.link.all_off, "all off")  # start from the safe state
-        if (
-            getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED)
-            is not OffOutcome.ACKNOWLEDGED
-        ):
+        if self.link.off_outcome is not OffOutcome.ACKNOWLEDGED:
             # an all-off nothing answers (RTIPy's wait for its window, Elexol's unanswered
             # bytes) shows no board: RTIPy's profile at a wrong baud rate had lost its port,
             # baud and profile advice at the first light's garbled reply
@@ -428,7 +421,7 @@ class DomePolicy:
         except DomeLinkError as exc:
             if not (
                 _lost_after_opening(exc)
-                and getattr(self.link, "profile_heard", False)
+                and self.link.profile_heard
                 and self.settings.reconnect_attempts > 0
             ):
                 raise
@@ -494,7 +487,7 @@ class DomePolicy:
         while (
             exc.retryable
             and attempt < self.settings.retries
-            and getattr(self.link, "port_open", True)
+            and self.link.port_open
             and (self._board_spoke_profile(exc) or (attempt == 0 and self._port_silent(exc)))
         ):
             attempt += 1
@@ -534,7 +527,7 @@ class DomePolicy:
         (a handshake or init command is a query or an all-off, sent again after every reboot
         anyway), and a wrong port costs one more reply timeout before its advice. A board that
         sent bytes this profile cannot read is not resent to (another firmware's board)."""
-        return exc.fault is LinkFault.TIMEOUT and not getattr(self.link, "bytes_heard", True)
+        return exc.fault is LinkFault.TIMEOUT and not self.link.bytes_heard
 
     def _board_spoke_profile(self, exc: DomeLinkError) -> bool:
         """Whether the board on the port has shown, since it was opened, that it speaks the
@@ -542,7 +535,7 @@ class DomePolicy:
         ``profile_heard``), or the fault itself (a reboot banner, a firmware error reply)."""
         if exc.fault in (LinkFault.RESET, LinkFault.REJECTED):
             return True
-        return exc.fault in _NOT_ITS_BOARD and bool(getattr(self.link, "profile_heard", False))
+        return exc.fault in _NOT_ITS_BOARD and self.link.profile_heard
 
     def hold(self) -> None:
         """All off, and keep the port open for the next :meth:`connect` (metering, then the
@@ -558,7 +551,7 @@ class DomePolicy:
         except BaseException:
             self.close()
             raise
-        if self.info is not None and getattr(self.link, "port_open", True):
+        if self.info is not None and self.link.port_open:
             self._held = True
         else:
             self.close()
@@ -651,7 +644,7 @@ class DomePolicy:
             else:
                 self.off_report = _failed_off(exc)
             raise
-        self.off_report = OffReport(getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED))
+        self.off_report = OffReport(self.link.off_outcome)
         self._check_on_time("all off")
         if self._lit is not None:
             self.guard.record(self._lit.index, self._lit.since, self.clock.now())
@@ -669,17 +662,17 @@ class DomePolicy:
         seconds). A busy camera awaited for ``max_on_s`` under RTIPy had been fired after its
         LED had gone dark by itself, and the all-off then refused the image late."""
         limit = self.settings.thermal.max_on_s
-        window = getattr(self.link, "light_window_s", None)
+        window = self.link.light_window_s
         return limit if window is None else min(limit, float(window))
 
     def lit_limit_said(self) -> str:
         """What sets :meth:`lit_limit_s`, for a message: ``max_on_s = 8 s``, or the timed
         firmware's window (``the 2 s the rtipy firmware keeps it lit (light_on_s)``)."""
         limit = self.settings.thermal.max_on_s
-        window = getattr(self.link, "light_window_s", None)
+        window = self.link.light_window_s
         if window is None or window >= limit:
             return f"max_on_s = {limit:g} s"
-        firmware = getattr(getattr(self.link, "spec", None), "name", None) or "dome's"
+        firmware = self.link.firmware_name or "dome's"
         return (
             f"the {float(window):g} s the {firmware} firmware keeps it lit before switching it "
             "off by itself (light_on_s)"
@@ -786,7 +779,7 @@ class DomePolicy:
                             if attempt
                             else ""
                         )
-                    talked = bool(getattr(self.link, "bytes_heard", False))
+                    talked = self.link.bytes_heard
                     if not self._answered and fault is LinkFault.TIMEOUT and not talked:
                         why += (
                             "; nothing on this port has answered yet: check the port, the baud "
@@ -1025,7 +1018,7 @@ class DomePolicy:
         boot wait, the usual answer to a command that does not stop at once, had cut it short
         and left the Nab board, which boots lit, with every LED on; the signal acts once the
         all-off is through."""
-        if not getattr(self.link, "port_open", True):
+        if not self.link.port_open:
             return
         self._port_was_open = True
         self.reached = "opened"
@@ -1057,7 +1050,7 @@ class DomePolicy:
         all-off was not sent. Only an opening that may reset the board (a serial device's, see
         ``SerialTransport.resets_on_open``) is reopened: the link leaves ``open_cut_short``
         false for one that resets nothing, such as a URL port's connect."""
-        if not getattr(self.link, "open_cut_short", False):
+        if not self.link.open_cut_short:
             return
         self._port_was_open = True  # the system opened it: a board that resets on open did
         self.reached = "opened"
@@ -1068,7 +1061,7 @@ class DomePolicy:
         )
         log.warning("%s: reopening the port a stop cut short, to send the all-off", self.name)
         try:
-            self._counted(self.link.reopen_port)  # type: ignore[attr-defined]
+            self._counted(self.link.reopen_port)
         except DomeLinkError as exc:
             log.warning("%s: the port did not open again: %s", self.name, exc)
             self.off_report = replace(
@@ -1085,18 +1078,15 @@ class DomePolicy:
 
     def _lit_at_boot(self) -> str | None:
         """The firmware's name if it lights every LED as its board boots (the Nab sketch)."""
-        spec = getattr(self.link, "spec", None)
-        return str(getattr(spec, "name", "")) if getattr(spec, "boots_lit", False) else None
+        return self.link.boots_lit_firmware
 
     def _finish_boot(self) -> None:
         """Let a board the stop caught in its bootloader finish booting (to the end of the
         profile's boot wait begun when the port opened) before the all-off, which would be lost
-        there; a link without a boot wait, or one that fails, goes straight on to the all-off."""
-        finish = getattr(self.link, "finish_boot", None)
-        if finish is None:
-            return
+        there; a link whose boot wait is over returns at once, and one that fails goes straight
+        on to the all-off."""
         try:
-            self._counted(finish)
+            self._counted(self.link.finish_boot)
         except DomeLinkError as exc:
             log.warning("%s: waiting for the board to boot failed: %s", self.name, exc)
 
@@ -1141,7 +1131,7 @@ class DomePolicy:
             self._counted(self.link.all_off)
         except DomeLinkError as first:
             exc = first
-            if exc.fault is LinkFault.RESET and getattr(self.link, "port_open", True):
+            if exc.fault is LinkFault.RESET and self.link.port_open:
                 try:
                     self._all_off_after_reboot(exc, when)
                 except DomeLinkError as again:
@@ -1160,7 +1150,7 @@ class DomePolicy:
             log.warning("%s: all off %s failed: %s", self.name, when, exc)
             self.off_report = replace(_failed_off(exc), boots_lit=lit_at_boot)
             if at_published_rate and lit_at_boot and exc.fault is not LinkFault.DISCONNECTED:
-                if getattr(self.link, "bytes_heard", True):
+                if self.link.bytes_heard:
                     self._switch_off_at_published_rate(lit_at_boot)
                 else:
                     self._not_reopened_silent(lit_at_boot)
@@ -1170,9 +1160,7 @@ class DomePolicy:
                 OffOutcome.SENT_UNCONFIRMED, str(exc), boots_lit=lit_at_boot
             )
         else:
-            self.off_report = OffReport(
-                getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED), when
-            )
+            self.off_report = OffReport(self.link.off_outcome, when)
 
     def _all_off_after_reboot(self, reset: DomeLinkError, when: str) -> None:
         """The all-off once more after the one that met a reboot banner (found before it was
@@ -1206,7 +1194,7 @@ class DomePolicy:
                 sent=again.sent,
             ) from again
         self.off_report = OffReport(
-            getattr(self.link, "off_outcome", OffOutcome.ACKNOWLEDGED),
+            self.link.off_outcome,
             f"{when}, sent again after the board rebooted",
         )
 
@@ -1577,7 +1565,7 @@ def self_test(
                 source.light(i, intensity)
                 report.light_latency_s.append(time.perf_counter() - t0)
                 clock.sleep(settle_s)
-                if isinstance(source, DomePolicy) and getattr(source.link, "can_query", True):
+                if isinstance(source, DomePolicy) and source.link.can_query:
                     lit, _ = source.lit_state()
                     if lit != i:
                         report.checks.append(LedCheck(i, False, f"firmware reports LED {lit} lit"))

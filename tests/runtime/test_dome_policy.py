@@ -14,6 +14,7 @@ import pytest
 from rti_rig.app.dome_factory import build_dome
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.devices import DiscreteLightSource
+from rti_rig.core.dome_link import OffOutcome
 from rti_rig.core.errors import DeviceError
 from rti_rig.drivers.led_dome import DomeSerialSettings
 from rti_rig.drivers.led_dome.codec_default import DefaultCodec
@@ -867,6 +868,24 @@ class _TimedLink:
     can_query = True
     max_level = 255
     device = "timed"
+    # the stop hooks every DomeLink declares, as a link that identifies itself and has no
+    # boot wait answers them
+    identifies_itself = True
+    off_outcome = OffOutcome.ACKNOWLEDGED
+    open_cut_short = False
+    port_open = True
+    profile_heard = False
+    bytes_heard = True
+    silence_hint = ""
+    light_window_s = None
+    firmware_name = None
+    boots_lit_firmware = None
+
+    def reopen_port(self):
+        pass
+
+    def finish_boot(self):
+        pass
 
     def __init__(self, transport_clock):
         from types import SimpleNamespace
