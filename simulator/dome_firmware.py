@@ -44,7 +44,7 @@ from rti_rig.drivers.led_dome.messages import (
 from rti_rig.drivers.led_dome.profiles import make_codec
 from rti_rig.drivers.led_dome.settings import DomeSerialSettings
 from rti_rig.drivers.led_dome.transport import TransportError
-from rti_rig.simulator.pty_link import PtyLink, serve_on_pty
+from rti_rig.simulator.pty_link import PtyLink, serve_on_pty, sigterm_as_ctrl_c
 
 
 class FaultKind(StrEnum):
@@ -407,7 +407,6 @@ def main(argv: list[str] | None = None) -> int:
     bootloader: the banner then comes later than the profile's boot wait).
     """
     import argparse
-    import signal
 
     from rti_rig.simulator.domes import SERIAL_FIRMWARES
 
@@ -447,9 +446,6 @@ def main(argv: list[str] | None = None) -> int:
                 f"--fault {spec}: give K:KIND, K a command number (1 = the first), KIND "
                 f"one of {kinds}"
             )
-    # SIGTERM (what a test harness or service manager sends) ends like Ctrl-C, so the pty's
-    # temporary folder is removed instead of left behind in /tmp.
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
     if args.profile in SERIAL_FIRMWARES:
         given = ["--leds"] if args.leds is not None else []
         given += ["--dead"] if args.dead else []
@@ -472,7 +468,9 @@ def main(argv: list[str] | None = None) -> int:
         board = board_for(args.profile, faults=FaultPlan(tuple(faults)))
         if args.boot_delay_s is not None:
             board.boot_s = args.boot_delay_s  # an instance's, not the firmware class's
-        with serve_on_pty(board, args.profile) as link:
+        # SIGTERM (what a test harness or service manager sends) ends like Ctrl-C while it
+        # serves, so the pty's temporary folder is removed instead of left behind in /tmp
+        with sigterm_as_ctrl_c(), serve_on_pty(board, args.profile) as link:
             print(
                 f"emulated {args.profile} firmware ({board.led_count} LEDs, "
                 f"{board.baudrate} baud) on {link.port}",
@@ -489,7 +487,7 @@ def main(argv: list[str] | None = None) -> int:
         boot_delay_s=0.5 if args.boot_delay_s is None else args.boot_delay_s,
         faults=FaultPlan(tuple(faults)),
     )
-    with emulated_dome_on_pty(firmware) as link:
+    with sigterm_as_ctrl_c(), emulated_dome_on_pty(firmware) as link:
         print(f"emulated {args.profile} dome with {leds} LEDs on {link.port}", flush=True)
         _serve_until_stopped(link, args.seconds)
     return 0

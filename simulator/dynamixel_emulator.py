@@ -976,9 +976,9 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
     copy of that config at the printed port (``backend = "hardware"``, ``[arm.dynamixel] port``,
     a ``[camera.device]``) and run ``rti-rig check`` on it (docs/protocols/dynamixel-arm.md)."""
     import argparse
-    import signal
 
     from rti_rig.core.clock import SystemClock
+    from rti_rig.simulator.pty_link import sigterm_as_ctrl_c
 
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument(
@@ -1020,9 +1020,10 @@ def main(argv: list[str] | None = None) -> int:  # pragma: no cover - manual too
         faults = [parse_tool_fault(spec, ids) for spec in args.fault]
     except ValueError as exc:
         parser.error(str(exc))
-    signal.signal(signal.SIGTERM, signal.default_int_handler)  # remove the pty on SIGTERM too
     factory = " (a new servo's factory rate)" if args.baud == 57600 else ""
-    with served_arm(settings, SystemClock(), args.baud, faults) as (server, _):
+    # remove the pty on SIGTERM too (the handler before is put back when serving ends)
+    with sigterm_as_ctrl_c(), served_arm(settings, SystemClock(), args.baud, faults) as served:
+        server = served[0]
         ids = ", ".join(
             f"{j.servo_id} ({name}, model {j.model_number})"
             for name, j in (("azimuth", settings.azimuth), ("elevation", settings.elevation))

@@ -25,6 +25,7 @@ import ctypes
 import fcntl
 import os
 import select
+import signal
 import struct
 import sys
 import tempfile
@@ -358,3 +359,21 @@ def serve_on_pty(device: PtyDevice, name: str = "dome") -> Iterator[PtyLink]:
                 p.unlink()
         with contextlib.suppress(OSError):
             folder.rmdir()
+
+
+@contextlib.contextmanager
+def sigterm_as_ctrl_c() -> Iterator[None]:
+    """SIGTERM raises KeyboardInterrupt while an emulator's command-line tool serves, so that
+    it ends as Ctrl-C does (the pty's temporary folder removed, not left in /tmp); the handler
+    before is put back when serving ends.
+
+    Why put back: the tools' ``main`` is also called in-process (tests), and the handler it had
+    left made a later SIGTERM to that process a KeyboardInterrupt wherever it landed."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # handlers can only be set from the main thread
+        return
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
