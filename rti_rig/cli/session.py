@@ -944,13 +944,11 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         CancelToken,
         DeviceSays,
         EmergencyStop,
-        FinishReason,
         LightOffForCamera,
         Paused,
         StepCompleted,
         StepStarted,
     )
-    from rti_rig.runtime.session import LP_NAME
 
     cancel = CancelToken()
 
@@ -1054,10 +1052,40 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     finally:
         for sig, h in previous.items():
             signal.signal(sig, h)
-        # the session is over (stopped or done): a late Ctrl-C must not cut the summary
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # the session is over (stopped or done): a late Ctrl-C must not cut the summary
+    with _ctrl_c_ignored():
+        return _summarise(opened, result, resume_hint, dry)
 
+
+@contextmanager
+def _ctrl_c_ignored() -> Iterator[None]:
+    """SIGINT ignored for the block, the handler before put back however it ends (a return,
+    an error, a ``typer.Exit``).
+
+    Why: the summary of a session that is over must not be cut by a late Ctrl-C (a second one
+    meant as "stop at once"), but the ignore had been set and left to the caller to undo:
+    ``run`` called in-process (CliRunner, or anyone calling the app from Python) was one
+    restore away from leaving its caller deaf to Ctrl-C, and every process it started after
+    would inherit the ignored signal."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # handlers can only be set from the main thread
+        return
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        if before is not None:  # None: set outside Python, cannot be put back
+            signal.signal(signal.SIGINT, before)
+
+
+def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ignore[no-untyped-def]
+    """What a session that is over says: its images, time, notes, lights and how to go on;
+    True when it completed but its teardown failed (see :func:`_refuse_unsafe_end`)."""
+    from rti_rig.runtime.controller import FinishReason
     from rti_rig.runtime.disowned import MARKER
+    from rti_rig.runtime.session import LP_NAME
+
+    rig, folder = opened.rig, opened.folder
 
     if result.finish_reason is FinishReason.CANCELLED:
         from rti_rig.app.usecases.safe_state import lights_state
