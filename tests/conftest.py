@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import json
 import re
+import signal
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -45,6 +46,32 @@ def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterat
 
         monkeypatch.setattr(serial, "serial_for_url", redirect)
         yield firmware
+
+
+#: The handlers a test must leave as it found them: a command run in the pytest process
+#: (CliRunner) that left SIGINT ignored made every later subprocess a test started inherit an
+#: ignored Ctrl-C (red in CI only, far from the test that leaked it).
+_WATCHED_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@pytest.fixture(autouse=True)
+def _signal_handlers_left_as_found() -> Iterator[None]:
+    """Fail the test that changes a SIGINT/SIGTERM handler and does not put it back.
+
+    Why: a leaked handler shows up tests later, in whichever test next relies on it (a child
+    process inheriting an ignored Ctrl-C); caught here, the failure names the test that leaked
+    it. The handler is put back first, so one leak does not fail every test after it."""
+    before = {sig: signal.getsignal(sig) for sig in _WATCHED_SIGNALS}
+    yield
+    leaked = []
+    for sig, handler in before.items():
+        now = signal.getsignal(sig)
+        if now != handler:
+            leaked.append(f"{signal.Signals(sig).name}: {handler!r} before, {now!r} after")
+            if handler is not None:  # None: set outside Python, cannot be put back
+                signal.signal(sig, handler)
+    if leaked:
+        pytest.fail("the test left signal handlers changed: " + "; ".join(leaked))
 
 
 @pytest.fixture
