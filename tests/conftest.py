@@ -6,6 +6,7 @@ import contextlib
 import json
 import re
 import signal
+import socket
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -82,6 +83,18 @@ def dome_config_path() -> Path:
 @pytest.fixture
 def arm_config_path() -> Path:
     return CONFIGS / "virtual_arm.toml"
+
+
+@pytest.fixture
+def closed_port() -> Iterator[int]:
+    """A local port bound but not listening: a connection to it is refused (Linux), and no
+    other program can take it meanwhile."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        sock.bind(("127.0.0.1", 0))
+        yield sock.getsockname()[1]
+    finally:
+        sock.close()
 
 
 def write_config(tmp_path: Path, text: str, name: str = "rig.toml") -> Path:

@@ -133,18 +133,6 @@ RTI_RIG_LONG_WAIT = [
 ]
 
 
-@pytest.fixture
-def closed_port() -> Iterator[int]:
-    """A local port bound but not listening: a connection to it is refused (Linux), and no
-    other program can take it meanwhile."""
-    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    try:
-        sock.bind(("127.0.0.1", 0))
-        yield sock.getsockname()[1]
-    finally:
-        sock.close()
-
-
 def test_a_refused_connection_is_said_at_once(tmp_path: Path, closed_port: int) -> None:
     """A port nothing listens on refuses at once, but Dask retried until its 20 s connect
     timeout and it was told as "Timed out trying to connect"."""

@@ -11,10 +11,8 @@ scheduler (TypeError: TLS expects a `ssl_context` …)" with advice to start a s
 from __future__ import annotations
 
 import os
-import socket
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -64,18 +62,6 @@ def _fit(scheduler: str, out: Path, *, tls: bool) -> str:
     assert "Traceback" not in text and "Exception ignored" not in text, text
     assert not out.exists(), text
     return text
-
-
-@pytest.fixture
-def closed_port() -> Iterator[int]:
-    """A local port bound but not listening: a connection to it is refused (Linux), and no
-    other program can take it meanwhile."""
-    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    try:
-        sock.bind(("127.0.0.1", 0))
-        yield sock.getsockname()[1]
-    finally:
-        sock.close()
 
 
 @pytest.mark.parametrize("scheme", ["tcp", "tls"])

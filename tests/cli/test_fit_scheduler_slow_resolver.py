@@ -14,7 +14,7 @@ from __future__ import annotations
 import socket
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -33,18 +33,6 @@ HOST = "scheduler.rti-rig.test"
 SLOW_S = 5.0
 REAL_GETADDRINFO = socket.getaddrinfo
 NOT_RESOLVED = "which does not resolve"
-
-
-@pytest.fixture
-def closed_port() -> Iterator[int]:
-    """A local port bound but not listening: a connection to it is refused (Linux), and no
-    other program can take it meanwhile."""
-    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    try:
-        sock.bind(("127.0.0.1", 0))
-        yield sock.getsockname()[1]
-    finally:
-        sock.close()
 
 
 def _resolver(monkeypatch: pytest.MonkeyPatch, answer: Callable[[Any], list[Any]]) -> list[str]:
