@@ -1255,8 +1255,8 @@ def assess(
             poor_fit = float(np.median(ev.misfit[finite])) if finite.any() else float("inf")
         if bar > DRIFT_PX:
             shift_note = (
-                f"a shift of {bar:.1f} px or less not judged: {_poor_fit_said(poor_fit)} and "
-                "its highlights' edges move with the light by as much"
+                f"a shift of {bar:.1f} px or less not judged: {_poor_fit_said(poor_fit)}, "
+                "and its highlights' edges move with the light by as much"
             )
     drift_note = ""
     if not edges_trusted and poor_fit > MISFIT_LIMIT:
@@ -1287,7 +1287,7 @@ def assess(
                 ev.drift_judged[i] = False
         shown = max(DRIFT_PX, EDGE_NOISE_FACTOR * noise)
         drift_note = (
-            f"shift not judged: {_poor_fit_said(poor_fit)} and its edges move with the light, so "
+            f"shift not judged: {_poor_fit_said(poor_fit)}, and its edges move with the light, so "
             "a shift is claimed only where the fit and the image's own edges show it alike"
             + (
                 f" (beyond {shown:.1f} px and up to about {MAX_SHIFT_PX - 1} px); a smaller "
@@ -1525,7 +1525,7 @@ def _poor_fit_said(poor_fit: float) -> str:
     one was measured; where none was (every misfit inf: a saturated or black crop), that, not
     "median misfit inf%" nor a claim that the fit explains the images poorly."""
     if not np.isfinite(poor_fit):
-        return "no image lights enough of the object to tell how well the fit explains it"
+        return "no image lights enough of the object to tell how well the fit explains its images"
     return (
         "the fit explains this object's images poorly (median misfit "
         f"{poor_fit:.0%}, limit {MISFIT_LIMIT:.0%})"
