@@ -84,6 +84,7 @@ from rti_rig.drivers.cameras.raw_decode import (
     exposure_stats,
 )
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
+from rti_rig.drivers.cameras.tiff_structure import first_ifd
 
 RAW_SUFFIXES = {
     ".dng",
@@ -1016,8 +1017,11 @@ class FolderWatchCamera:
         again once its size is steady for ``stable_polls`` polls, unless waiting cannot help:
         a RAW whose header is written in a format LibRaw does not read, a file named as a
         TIFF whose first bytes are written and are no TIFF's, or a whole TIFF (every byte its
-        IFDs name written, the last ones not zeros) whose data will not decode: each is said
-        at once, naming the file. Messages are worded here from the decoders' fields.
+        IFDs name written, the last ones not zeros) whose data will not decode, or one read as
+        no pixels whose first IFD is all written (:func:`first_ifd`) and names no data, data
+        inside the file or garbage: each is said at once, naming the file. A TIFF whose IFD
+        is not there yet (libtiff writes it last, tifffile zeroed until its data is out) is
+        waited for. Messages are worded here from the decoders' fields.
 
         Why: a steady size only means the writer paused (a network share, a Wi-Fi upload, a
         program writing in chunks). Half a file had stopped the session at once, a shot lost
@@ -1071,15 +1075,22 @@ class FolderWatchCamera:
                     and exc.no_pixels
                     and steady
                     and tried is not None
+                    # its IFD is there (a writer's or a copy's pause leaves it out: libtiff
+                    # writes it last, tifffile's is zeros until its data is out) and names no
+                    # data, data all inside the file, or holds entries no writer writes
+                    and (ifd := first_ifd(path)) is not None
+                    and (extent is None or extent[1] <= tried[2] or ifd.garbled)
                     # not a file a share sized first and is still filling (its end zeros)
                     and _tiff_end_written(path, 0, tried[2])
                 ):
-                    # its IFDs read as naming no image at all (damaged): before, an image of
-                    # no pixels went on to the conversion, whose refusal named only its shape
+                    # its IFD, all written, reads as naming no image at all (damaged): before,
+                    # an image of no pixels went on to the conversion, whose refusal named only
+                    # its shape
                     raise CaptureError(
                         self.name,
-                        f"{message}: {path.name} is a damaged TIFF (its header is written, "
-                        "but its IFDs name no image data), so waiting will not help; it is "
+                        f"{message}: {path.name} is a damaged TIFF (its header and first IFD "
+                        "are written, but its IFDs name no image data that reads), so waiting "
+                        "will not help; it is "
                         f"left in {s.folder}, and no image was recorded for this light. Save "
                         "the shot again from the camera's program, or check the disk or share "
                         "it is saved on",

@@ -8,6 +8,7 @@ explicit response curve: ``"srgb"`` (inverse sRGB) or ``"linear"`` (the user ass
 
 from __future__ import annotations
 
+import struct
 from pathlib import Path
 from typing import Literal
 
@@ -16,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.tiff_structure import header_size
 
 Response = Literal["linear", "srgb"]
 
@@ -78,7 +80,8 @@ def to_linear_uint16(
 class ImageReadError(CaptureError):
     """An image file that would not read, with what is known as fields: ``path`` (the file
     read), ``reason`` (the reader's own words), ``is_tiff`` and ``no_pixels`` (it read, as an
-    image of no pixels: a TIFF whose IFDs are damaged, which tifffile reads past, logging).
+    image of no pixels: a TIFF whose IFD is not written yet or is damaged, which tifffile
+    reads past, logging; only its bytes tell which).
 
     Why fields: a caller that words the failure its own way (a watched folder naming the
     folder's file, not the session's copy it read, and whether waiting can help) had cut this
@@ -100,6 +103,23 @@ class ImageReadError(CaptureError):
         super().__init__(device, f"cannot read image file {path}{detail}{advice}", "read")
 
 
+def _cut_within_header(path: Path) -> str | None:
+    """Why ``path`` (named as a TIFF) ends before its header does, or None when its header is
+    all there (or it begins as no TIFF, or cannot be opened: tifffile then says so).
+
+    Why: a TIFF still being written may hold only its first bytes; tifffile then fails
+    unpacking them with a bare ``struct.error``, which had escaped a capture as a traceback."""
+    try:
+        with path.open("rb") as f:
+            head = f.read(16)
+    except OSError:
+        return None
+    need = header_size(head) if len(head) >= 4 else 8
+    if need is None or len(head) >= need:
+        return None
+    return f"it ends within its {need}-byte header: {len(head)} bytes written"
+
+
 def read_image_file(path: Path, device: str) -> NDArray:
     """Read a non-RAW image file with its bit depth kept, colour in **RGB** order whatever the
     format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers).
@@ -109,9 +129,13 @@ def read_image_file(path: Path, device: str) -> NDArray:
     if suffix in (".tif", ".tiff"):
         import tifffile  # on a TIFF only: `rti-rig plan` imports this module for any preview
 
+        cut = _cut_within_header(path)
+        if cut is not None:
+            # tifffile unpacks a header cut short as itself: a struct.error had escaped
+            raise ImageReadError(device, path, cut, is_tiff=True)
         try:
             image = tifffile.imread(path)
-        except (ValueError, OSError, RuntimeError) as exc:
+        except (ValueError, OSError, RuntimeError, struct.error) as exc:
             # a TIFF cut short or not a TIFF at all (tifffile raises ValueError, TiffFileError
             # among them), or compressed data that will not decompress (imagecodecs' errors
             # are RuntimeErrors): it had escaped as itself, a Python traceback mid-session

@@ -113,3 +113,79 @@ def test_run_names_a_damaged_tiff_at_once_with_what_to_do(
     assert f"did not change within {TIMEOUT_S:g} s" not in said, said
     assert (tether / "IMG_0001.tif").read_bytes() == data  # left as the program saved it
     assert lit_at_end == []  # the dome was switched off
+
+
+class PausedCopy(threading.Thread):
+    """A copy (cp, rsync, SMB, a Wi-Fi upload) of libtiff TIFFs into the folder, of a camera
+    fired by someone else (``trigger = "none"``): once the board's first LED is lit half of
+    ``IMG_0001.tif`` comes (libtiff writes its IFD last,
+    so none of it), and the rest only once the camera waits for it after reading that half
+    (until the run ends otherwise); each later
+    light's file comes whole."""
+
+    def __init__(self, firmware, folder: Path, data: bytes, tried: threading.Event) -> None:  # type: ignore[no-untyped-def]
+        super().__init__(daemon=True)
+        self.firmware, self.folder, self.data, self.tried = firmware, folder, data, tried
+        self.stop = threading.Event()
+
+    def run(self) -> None:
+        saved = 0
+        while not self.stop.is_set():
+            pulses = sum(e.what == "lit" for e in list(self.firmware.history))
+            if pulses > saved:
+                saved += 1
+                target = self.folder / f"IMG_{saved:04d}.tif"
+                if saved == 1:
+                    target.write_bytes(self.data[: len(self.data) // 2])
+                    while not self.tried.wait(0.05):
+                        if self.stop.is_set():
+                            return
+                target.write_bytes(self.data)
+            self.stop.wait(0.02)
+
+
+def test_run_waits_for_a_libtiff_tiff_whose_copy_paused_and_records_it_whole(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Half a TIFF OpenCV (libtiff) wrote, of a camera fired by someone else, its IFD
+    (written last) not yet copied: tifffile reads it as an image of no pixels. ``rti-rig
+    run`` had stopped at once calling it 'a damaged TIFF'; it now waits for the rest and
+    records the shot."""
+    import cv2
+
+    from rti_rig.drivers.cameras import folder_watch
+
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    out = tmp_path / "s"
+    cfg = _config(tmp_path, tether)
+    text = cfg.read_text(encoding="utf-8")
+    assert 'trigger = "dome_shutter"' in text
+    cfg.write_text(text.replace('trigger = "dome_shutter"', 'trigger = "none"'), encoding="utf-8")
+    ok, encoded = cv2.imencode(".tif", np.full((64, 64, 3), 30000, np.uint16))
+    assert ok
+    tried = threading.Event()
+    real = folder_watch.FolderWatchCamera._changed_and_settled
+
+    def waits(self, *args):  # type: ignore[no-untyped-def]
+        tried.set()  # the half file was read, refused and is waited for: the copy may go on
+        return real(self, *args)
+
+    monkeypatch.setattr(folder_watch.FolderWatchCamera, "_changed_and_settled", waits)
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = PausedCopy(firmware, tether, encoded.tobytes(), tried)
+        camera.start()
+        try:
+            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            r = CliRunner().invoke(app, args, terminal_width=400)
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+        lit_at_end = firmware.lit_indices()
+    said = " ".join(r.output.split())
+    assert "damaged" not in said and "Traceback" not in said, said
+    assert tried.is_set(), said  # the half file was read and waited for
+    assert r.exit_code == 0, said
+    assert (out / "raw" / "image_001.tif").read_bytes() == encoded.tobytes()  # whole
+    assert (out / "linear" / "image_002.tif").exists()
+    assert lit_at_end == []

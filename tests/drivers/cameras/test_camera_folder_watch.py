@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import io
 import json
+import struct
 import time
 
+import cv2
 import numpy as np
 import pytest
 import tifffile
@@ -534,3 +537,121 @@ def test_a_tiff_filled_in_place_up_to_its_ifd_is_waited_for(tmp_path):
     cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
     cam.connect()
     assert np.all(cam.capture(0.5).pixels == 30000)
+
+
+class _WriteLog(io.BytesIO):
+    """A file object that records each write a TIFF writer makes, where it makes it."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.writes: list[tuple[int, bytes]] = []
+
+    def write(self, data) -> int:  # type: ignore[override]
+        self.writes.append((self.tell(), bytes(data)))
+        return super().write(data)
+
+
+def _as_written(writes: list[tuple[int, bytes]]) -> list[bytes]:
+    """The file as it stands after each write (a seek past the end leaves zeros, as a file
+    system does): what a reader polling the folder may find."""
+    buf, states = bytearray(), []
+    for at, data in writes:
+        buf.extend(bytes(max(0, at - len(buf))))
+        buf[at : at + len(data)] = data
+        states.append(bytes(buf))
+    return states
+
+
+_PIXELS = np.full((64, 64, 3), 30000, np.uint16)
+
+
+def _tifffile_order(kind: str) -> tuple[list[bytes], bytes]:
+    """tifffile's own writer order (a header naming an IFD at offset 8, that slot zeroed while
+    the data goes out, then the IFD): the states short of whole, and the whole file."""
+    log = _WriteLog()
+    if kind == "multi-page":  # the image and a reduced preview, as a camera program saves
+        with tifffile.TiffWriter(log) as tw:
+            tw.write(_PIXELS, photometric="rgb")
+            tw.write(_PIXELS[::4, ::4], photometric="rgb", subfiletype=1)
+    else:
+        options = {
+            "plain": {},
+            "zlib": {"compression": "zlib"},
+            "tiled": {"tile": (32, 32)},
+            "BigTIFF": {"bigtiff": True},
+        }[kind]
+        tifffile.imwrite(log, _PIXELS, photometric="rgb", **options)
+    whole = log.getvalue()
+    states = _as_written(log.writes)
+    assert states[-1] == whole
+    return [x for x in states if x != whole], whole
+
+
+def _capture_growing(folder, part: bytes, whole: bytes):
+    """Capture a frame whose file holds ``part`` at t=0.5 and ``whole`` at t=4.0."""
+    folder.mkdir()
+    target = folder / "IMG_0001.tif"
+    clock = ScriptedClock(
+        {0.5: lambda: target.write_bytes(part), 4.0: lambda: target.write_bytes(whole)}
+    )
+    cam = watch(folder, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    return cam.capture(0.5), clock
+
+
+@pytest.mark.parametrize("kind", ["plain", "zlib", "tiled", "BigTIFF", "multi-page"])
+def test_a_tiff_in_tifffiles_write_order_is_waited_for_and_decoded_once_whole(tmp_path, kind):
+    """Each state tifffile's writer leaves a TIFF in on its way (its IFD slot zeroed while the
+    data goes out, read as an image of no pixels) is a file still being written, not a
+    damaged one: it is waited for and decoded once whole (it had stopped the session at once
+    as 'a damaged TIFF')."""
+    states, whole = _tifffile_order(kind)
+    assert any(len(x) >= 16 and not any(x[8:16]) for x in states)  # the zeroed IFD slot
+    for n, part in enumerate(states):
+        frame, _ = _capture_growing(tmp_path / f"state{n}", part, whole)
+        assert np.all(frame.pixels == 30000), (n, len(part))
+
+
+def _libtiff_whole() -> bytes:
+    """A whole TIFF as libtiff writes it (OpenCV's imwrite: LZW strips, the IFD last)."""
+    ok, encoded = cv2.imencode(".tif", np.full((256, 320, 3), 30000, np.uint16))
+    assert ok
+    return encoded.tobytes()
+
+
+def test_a_libtiff_tiff_copied_in_halves_is_waited_for_and_decoded_once_whole(tmp_path):
+    """A copy of a libtiff TIFF (cp, rsync, SMB, a Wi-Fi upload) paused half way: its IFD,
+    written last, is not there yet, and tifffile reads it as an image of no pixels. It is
+    waited for and decoded once whole (it had stopped the session at once as 'a damaged
+    TIFF ... its IFDs name no image data')."""
+    whole = _libtiff_whole()
+    frame, clock = _capture_growing(tmp_path / "w", whole[: len(whole) // 2], whole)
+    assert np.all(frame.pixels == 30000)
+    assert clock.now() >= 4.0
+
+
+def test_a_tiff_in_libtiffs_write_order_is_waited_for_and_decoded_once_whole(tmp_path):
+    """libtiff's own order: its header with a first-IFD offset of 0, the strips, the IFD,
+    then the header patched. Each state before the patch is waited for, not called damaged."""
+    whole = _libtiff_whole()
+    (ifd,) = struct.unpack("<I", whole[4:8])
+    unpatched = whole[:4] + bytes(4)
+    states = [unpatched, unpatched + whole[8:ifd], unpatched + whole[8:]]
+    for n, part in enumerate(states):
+        frame, _ = _capture_growing(tmp_path / f"state{n}", part, whole)
+        assert np.all(frame.pixels == 30000), (n, len(part))
+
+
+@pytest.mark.parametrize("bigtiff", [False, True])
+def test_a_tiff_cut_within_its_header_is_waited_for_not_a_traceback(tmp_path, bigtiff):
+    """A TIFF of which only its first 2 to 15 bytes are written: tifffile's header unpack
+    had escaped the capture as 'struct.error: unpack requires a buffer of 4 bytes'. It is a
+    file still being written: waited for, and decoded once whole. A header only (8 bytes of
+    a classic TIFF) is too."""
+    log = _WriteLog()
+    tifffile.imwrite(log, _PIXELS, photometric="rgb", bigtiff=bigtiff)
+    whole = log.getvalue()
+    for n in range(2, 16):
+        frame, clock = _capture_growing(tmp_path / f"cut{n}", whole[:n], whole)
+        assert np.all(frame.pixels == 30000), n
+        assert clock.now() >= 4.0, n

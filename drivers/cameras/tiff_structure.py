@@ -1,0 +1,99 @@
+"""What a TIFF's own bytes prove about whether it is all written (pure reads, no decoding).
+
+Why: a watched folder's TIFF that will not read is either still being written (or copied)
+or damaged, and only the second may stop a session at once. Writers order their bytes
+differently: libtiff (OpenCV, ImageMagick, GIMP, darktable) writes its header with a first-IFD
+offset of 0, then the strips, then the IFD, and patches the header last; tifffile writes its
+header naming an IFD at offset 8, leaves that slot zeroed while the data goes out, then writes
+the IFD. A copy (cp, rsync, SMB, a Wi-Fi upload) that pauses is cut anywhere. Until the IFD is
+there, tifffile reads such a file as an image of no pixels, which had been called damaged.
+Only bytes that are there can prove damage: a header naming an IFD that lies wholly inside
+the file, with a tag count no writer in the middle of its work leaves.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from pathlib import Path
+
+#: (byte order, the version word) -> (header size, IFD tag-count size, entry size, offset size)
+_LAYOUTS = {
+    b"II*\x00": ("<", 8, 2, 12, 4),
+    b"MM\x00*": (">", 8, 2, 12, 4),
+    b"II+\x00": ("<", 16, 8, 20, 8),
+    b"MM\x00+": (">", 16, 8, 20, 8),
+}
+
+#: the data types a TIFF entry may have (TIFF 6.0's 1-12, IFD 13, BigTIFF's 16-18)
+TIFF_TYPES = frozenset({*range(1, 14), 16, 17, 18})
+
+#: more tags than any writer uses: tifffile refuses an IFD with more as "suspicious"
+MAX_TAGS = 4096
+
+
+def header_size(head: bytes) -> int | None:
+    """The size of the header a file beginning with ``head`` has (8 bytes, 16 for BigTIFF);
+    None when ``head`` does not begin with a TIFF signature."""
+    layout = _LAYOUTS.get(bytes(head[:4]))
+    return None if layout is None else layout[1]
+
+
+@dataclass(frozen=True)
+class FirstIfd:
+    """A TIFF's first IFD, all of it inside the file: where it lies and its entries' types."""
+
+    offset: int
+    #: where the IFD ends (its next-IFD offset included)
+    end: int
+    #: the data type of each entry, as written
+    types: tuple[int, ...]
+
+    @property
+    def garbled(self) -> bool:
+        """Whether an entry has a data type no TIFF has: no writer writes one, so the IFD
+        itself is damaged (a zero type is a slot not filled yet, and is not counted)."""
+        return any(t != 0 and t not in TIFF_TYPES for t in self.types)
+
+
+def first_ifd(path: Path) -> FirstIfd | None:
+    """``path``'s first IFD when its header names one (a non-zero offset) lying wholly inside
+    the file with a tag count between 1 and :data:`MAX_TAGS`; None otherwise.
+
+    None for a file that could still be in the middle of being written: a header not all
+    there, libtiff's header whose IFD offset is not patched yet (0), an offset past the end
+    (a copy cut short of a file whose IFD comes last), or tifffile's IFD slot still zeros
+    (a count of 0). None too when the file cannot be read (nothing is known then)."""
+    try:
+        size = path.stat().st_size
+        with path.open("rb") as f:
+            head = f.read(16)
+            layout = _LAYOUTS.get(head[:4])
+            if layout is None:
+                return None
+            order, header, count_size, entry_size, offset_size = layout
+            if len(head) < header:
+                return None
+            if header == 8:
+                (offset,) = struct.unpack(f"{order}I", head[4:8])
+            else:
+                (offset,) = struct.unpack(f"{order}Q", head[8:16])
+            if offset < header or offset + count_size > size:
+                return None
+            f.seek(offset)
+            raw = f.read(count_size)
+            if len(raw) < count_size:
+                return None
+            (count,) = struct.unpack(f"{order}{'H' if count_size == 2 else 'Q'}", raw)
+            end = offset + count_size + count * entry_size + offset_size
+            if not 1 <= count <= MAX_TAGS or end > size:
+                return None
+            entries = f.read(count * entry_size)
+    except OSError:
+        return None
+    if len(entries) < count * entry_size:
+        return None
+    types = tuple(
+        struct.unpack_from(f"{order}H", entries, n * entry_size + 2)[0] for n in range(count)
+    )
+    return FirstIfd(offset, end, types)
