@@ -146,9 +146,6 @@ def read_image_file(path: Path, device: str) -> NDArray:
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise ImageReadError(device, path, "", is_tiff=False)
-    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if img is None:
-        raise CaptureError(device, f"cannot read image file {path}", "read")
     if img.ndim == 3 and img.shape[2] in (3, 4):
         img = np.ascontiguousarray(img[..., 2::-1])  # BGR(A) -> RGB, alpha dropped
     return img

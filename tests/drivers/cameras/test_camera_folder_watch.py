@@ -655,3 +655,22 @@ def test_a_tiff_cut_within_its_header_is_waited_for_not_a_traceback(tmp_path, bi
         frame, clock = _capture_growing(tmp_path / f"cut{n}", whole[:n], whole)
         assert np.all(frame.pixels == 30000), n
         assert clock.now() >= 4.0, n
+
+
+def test_a_png_frame_is_decoded_once(tmp_path, monkeypatch):
+    """A PNG (or JPEG) frame is decoded by OpenCV once (a leftover second imread had decoded
+    each frame twice)."""
+    cv2.imwrite(str(tmp_path / "whole.png"), np.full((32, 32, 3), 30000, np.uint16))
+    decodes = []
+    imread = cv2.imread
+
+    def counting(*args, **kwargs):
+        decodes.append(args[0])
+        return imread(*args, **kwargs)
+
+    monkeypatch.setattr(cv2, "imread", counting)
+    clock = ScriptedClock({0.5: lambda: (tmp_path / "whole.png").rename(tmp_path / "IMG_0001.png")})
+    cam = watch(tmp_path, clock, patterns=("IMG_*.png",), timeout_s=10.0, poll_interval_s=0.25)
+    cam.connect()
+    assert np.all(cam.capture(0.5).pixels == 30000)
+    assert len(decodes) == 1, decodes
