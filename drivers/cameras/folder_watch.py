@@ -84,7 +84,7 @@ from rti_rig.drivers.cameras.raw_decode import (
     exposure_stats,
 )
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
-from rti_rig.drivers.cameras.tiff_structure import first_ifd
+from rti_rig.drivers.cameras.tiff_structure import SAVE_READABLE, first_ifd
 
 RAW_SUFFIXES = {
     ".dng",
@@ -1070,6 +1070,22 @@ class FolderWatchCamera:
                     ) from exc
                 extent = _tiff_extent(path) if tiff else None
                 steady = tried is not None and _identity(path) == tried  # still what was read
+                if (
+                    isinstance(exc, ImageReadError)
+                    and exc.compression is not None
+                    and steady
+                    and first_ifd(path) is not None  # the tag read is in an IFD all written
+                ):
+                    # a compression the reader does not decode is no damage: it had been
+                    # called damaged, with advice to check the disk or share
+                    raise CaptureError(
+                        self.name,
+                        f"{message}: {path.name} is whole (its IFD written, its size steady), "
+                        f"so waiting will not help; it is left in {s.folder}, and no image was "
+                        "recorded for this light. "
+                        f"In the program saving the shots, {SAVE_READABLE}",
+                        "decode",
+                    ) from exc
                 if (
                     isinstance(exc, ImageReadError)
                     and exc.no_pixels

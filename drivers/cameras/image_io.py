@@ -17,7 +17,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import CaptureError
-from rti_rig.drivers.cameras.tiff_structure import header_size
+from rti_rig.drivers.cameras.tiff_structure import (
+    SAVE_READABLE,
+    header_size,
+    unread_compression,
+)
 
 Response = Literal["linear", "srgb"]
 
@@ -79,23 +83,34 @@ def to_linear_uint16(
 
 class ImageReadError(CaptureError):
     """An image file that would not read, with what is known as fields: ``path`` (the file
-    read), ``reason`` (the reader's own words), ``is_tiff`` and ``no_pixels`` (it read, as an
+    read), ``reason`` (the reader's own words), ``is_tiff``, ``no_pixels`` (it read, as an
     image of no pixels: a TIFF whose IFD is not written yet or is damaged, which tifffile
-    reads past, logging; only its bytes tell which).
+    reads past, logging; only its bytes tell which) and ``compression`` (the name of a TIFF
+    compression the reader does not decode, None otherwise).
 
     Why fields: a caller that words the failure its own way (a watched folder naming the
     folder's file, not the session's copy it read, and whether waiting can help) had cut this
     function's sentence at a fixed phrase; rewording it would have broken that caller's."""
 
     def __init__(
-        self, device: str, path: Path, reason: str, *, is_tiff: bool, no_pixels: bool = False
+        self,
+        device: str,
+        path: Path,
+        reason: str,
+        *,
+        is_tiff: bool,
+        no_pixels: bool = False,
+        compression: str | None = None,
     ) -> None:
         self.path = path
         self.reason = reason
         self.is_tiff = is_tiff
         self.no_pixels = no_pixels
+        self.compression = compression
         advice = (
-            ": is it a complete TIFF (not one still being written, or a copy cut short)?"
+            f": {SAVE_READABLE}"
+            if compression
+            else ": is it a complete TIFF (not one still being written, or a copy cut short)?"
             if is_tiff
             else ""
         )
@@ -139,6 +154,12 @@ def read_image_file(path: Path, device: str) -> NDArray:
             # a TIFF cut short or not a TIFF at all (tifffile raises ValueError, TiffFileError
             # among them), or compressed data that will not decompress (imagecodecs' errors
             # are RuntimeErrors): it had escaped as itself, a Python traceback mid-session
+            compression = unread_compression(path, str(exc))
+            if compression is not None:
+                reason = f"it is compressed as {compression}, which the TIFF reader does not decode"
+                raise ImageReadError(
+                    device, path, reason, is_tiff=True, compression=compression
+                ) from exc
             raise ImageReadError(device, path, str(exc), is_tiff=True) from exc
         if image.size == 0:  # a damaged IFD tifffile reads past, logging, as no pixels
             raise ImageReadError(device, path, "it holds no pixels", is_tiff=True, no_pixels=True)

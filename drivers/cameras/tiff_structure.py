@@ -97,3 +97,43 @@ def first_ifd(path: Path) -> FirstIfd | None:
         struct.unpack_from(f"{order}H", entries, n * entry_size + 2)[0] for n in range(count)
     )
     return FirstIfd(offset, end, types)
+
+
+#: TIFF compressions the reader (tifffile with imagecodecs) decodes for a camera's 16-bit
+#: RGB image, and what a program's save dialog calls them (the advice names the first three)
+READ_COMPRESSIONS = {
+    1: "uncompressed",
+    5: "LZW",
+    8: "Deflate (zlib)",
+    32946: "Deflate (zlib)",
+    32773: "PackBits",
+}
+
+#: said to whoever saves a TIFF in a compression the reader does not decode
+SAVE_READABLE = "save TIFFs uncompressed, or with LZW or Deflate (zlib) compression"
+
+
+def unread_compression(path: Path, said: str) -> str | None:
+    """The name and code of ``path``'s first-page compression when it is none the reader
+    decodes and the reader's refusal ``said`` names it ("EER_V0 (TIFF compression 65000)");
+    None otherwise (a readable compression whose data is damaged, or no TIFF to read).
+
+    Why: tifffile refuses such a file with only the code's enum ("COMPRESSION.EER_V0:
+    65000"), and the file had been called damaged, with advice to check the disk or share,
+    while saving it in another compression is all it takes."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tif:
+            code = int(tif.pages[0].compression)
+    except Exception:  # nothing read: not known
+        return None
+    if code in READ_COMPRESSIONS:
+        return None
+    try:
+        name = tifffile.COMPRESSION(code).name
+    except ValueError:
+        name = ""
+    if str(code) not in said and not (name and name in said):
+        return None  # refused for another reason (its data), not for its compression
+    return f"{name} (TIFF compression {code})" if name else f"TIFF compression {code}"

@@ -674,3 +674,47 @@ def test_a_png_frame_is_decoded_once(tmp_path, monkeypatch):
     cam.connect()
     assert np.all(cam.capture(0.5).pixels == 30000)
     assert len(decodes) == 1, decodes
+
+
+def _with_compression_tag(data: bytes, code: int) -> bytes:
+    """``data`` (a little-endian classic TIFF) with its Compression tag set to ``code``."""
+    out = bytearray(data)
+    (ifd,) = struct.unpack("<I", out[4:8])
+    (count,) = struct.unpack("<H", out[ifd : ifd + 2])
+    for n in range(count):
+        entry = ifd + 2 + 12 * n
+        if struct.unpack("<H", out[entry : entry + 2])[0] == 259:
+            out[entry + 8 : entry + 10] = struct.pack("<H", code)
+            return bytes(out)
+    raise AssertionError("no Compression tag")
+
+
+def test_a_tiff_in_a_compression_the_reader_does_not_decode_is_named_with_what_to_save_in(
+    tmp_path,
+):
+    """A whole TIFF whose Compression tag names one the reader does not decode (65000,
+    EER_V0) had been called damaged, with advice to check the disk or share. The compression
+    is named, with the compressions to save in, at once."""
+    data, _, _ = _tiff_bytes(tmp_path)
+    odd = _with_compression_tag(data, 65000)
+    clock = ScriptedClock({0.5: lambda: (tmp_path / "IMG_0001.tif").write_bytes(odd)})
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert "compressed as EER_V0 (TIFF compression 65000)" in said, said
+    assert "uncompressed, or with LZW or Deflate (zlib) compression" in said, said
+    assert "damaged" not in said and "check the disk" not in said, said
+    assert f"left in {tmp_path}" in said and "waiting will not help" in said, said
+    assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
+
+
+@pytest.mark.parametrize("compression", [None, "lzw", "zlib"])
+def test_the_compressions_advised_are_ones_the_reader_decodes(tmp_path, compression):
+    """What a refused compression's advice names (uncompressed, LZW, Deflate) really reads."""
+    data, _, _ = _tiff_bytes(tmp_path, compression=compression)
+    clock = ScriptedClock({0.5: lambda: (tmp_path / "IMG_0001.tif").write_bytes(data)})
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    assert np.all(cam.capture(0.5).pixels == 30000)
