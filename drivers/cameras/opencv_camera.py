@@ -341,6 +341,16 @@ class OpenCvCamera:
         unit = self.settings.exposure_unit_s
         return max(1, math.floor(exposure_s / unit + 1e-9)) * unit
 
+    def exposure_units_said(self) -> str | None:
+        """The key that sets the steps :meth:`representable_exposure_s` takes, with its value
+        (``exposure_unit_s = 0.0001 s in [camera.device]``); None when any exposure is taken.
+
+        Why: a metering start moved to a whole unit was said as "(it takes whole units)",
+        naming neither the unit nor the key that sets it."""
+        if self.settings.backend != "v4l2":
+            return None
+        return f"exposure_unit_s = {self.settings.exposure_unit_s:g} s in [camera.device]"
+
     def shortest_exposure_s(self) -> tuple[float, str]:
         """The shortest exposure the camera takes, and what bounds it (a phrase naming the
         key): ``[camera.device] min_exposure_s``, rounded up to whole ``exposure_unit_s`` on

@@ -175,12 +175,15 @@ def metering_start(
             f"and {cap[1]}: run --auto-exposure has nowhere to start its metering; lower the "
             "first or raise the second (nothing was lit)",
         )
-    if high is not None and exposure_s > high[0] * (1 + 1e-9):
+    # the bound that moved the start is said: above both the camera's longest and [camera]'s
+    # max_exposure_s, the lower of the two (the note had blamed the camera's frame period
+    # while [camera] max_exposure_s had set the start)
+    if high is not None and cap is high and exposure_s > high[0] * (1 + 1e-9):
         return start, (
             f"[camera] exposure_s = {exposure_s:g} s is longer than the camera {name} can "
             f"take ({high[1]}): the metering started at {start:g} s instead"
         )
-    if low is not None and exposure_s < low[0] * (1 - 1e-9):
+    if low is not None and floor is low and exposure_s < low[0] * (1 - 1e-9):
         return start, (
             f"[camera] exposure_s = {exposure_s:g} s is shorter than the camera {name} can "
             f"take ({low[1]}): the metering started at {start:g} s instead"
@@ -195,7 +198,10 @@ def metering_start(
     elif within is not None and exposure_s < within[0][0] * (1 - 1e-9):
         why = f"is shorter than the metering may go ({within[0][1]})"
     else:
-        why = f"is not an exposure the camera {name} takes exactly (it takes whole units)"
+        units = getattr(camera, "exposure_units_said", None)
+        said = units() if callable(units) else None
+        of = f" of {said}" if said else ""
+        why = f"is not an exposure the camera {name} takes exactly (it takes whole units{of})"
         under = representable_s(camera, exposure_s)
         if within is not None and start > under and under < within[0][0] * (1 - 1e-9):
             why += f" and the one it takes under it is shorter than {within[0][1]}"

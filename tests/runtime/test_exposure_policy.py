@@ -13,7 +13,11 @@ from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.cli import app
 from rti_rig.planner.uniform import plan_uniform
-from rti_rig.runtime.exposure_policy import brightest_step, fix_session_exposure
+from rti_rig.runtime.exposure_policy import (
+    brightest_step,
+    fix_session_exposure,
+    metering_start,
+)
 
 runner = CliRunner()
 
@@ -177,3 +181,37 @@ def test_a_second_ctrl_c_does_not_cut_meterings_all_off_short(tmp_path: Path) ->
     assert "LIT at exit: [[]]" in said, said  # the emulated board: every LED dark
     assert "metering was stopped, and then: all-off sent and acknowledged" in said, said
     assert not out.exists()
+
+
+class _FramePeriodCamera:
+    """A camera whose longest exposure is its frame period (a 20 fps UVC camera's 0.05 s)."""
+
+    name = "uvc-camera"
+
+    def longest_exposure_s(self) -> tuple[float, str]:
+        return 0.05, "the frame period at 20 fps, 0.05 s"
+
+
+@pytest.mark.parametrize(
+    "cap",
+    [
+        (0.03, "[camera] max_exposure_s = 0.03 s"),
+        (0.03, "0.03 s, the longest shot an LED lit at most max_on_s allows"),
+    ],
+)
+def test_a_metering_start_above_both_limits_names_the_one_that_set_it(cap) -> None:
+    """``[camera] exposure_s = 0.2`` above both the camera's longest (its frame period,
+    0.05 s) and the metering's own cap (0.03 s): the metering starts at 0.03 s, set by the
+    metering's cap, but the note blamed the frame period. It names what set the start.
+    (``rti-rig run`` refuses an exposure_s above ``[camera] max_exposure_s`` when the config
+    loads; the lit-time cap reaches this the same way.)"""
+    start, note = metering_start(_FramePeriodCamera(), 0.2, ((0.0001, "[camera] min"), cap))
+    assert start == pytest.approx(0.03)
+    assert note == (
+        f"[camera] exposure_s = 0.2 s is longer than the metering may go ({cap[1]}): the "
+        "metering started at 0.03 s instead"
+    ), note
+    # the frame period setting the start is still said as the camera's
+    start, note = metering_start(_FramePeriodCamera(), 0.2, ((0.0001, "[camera] min"), (1, "x")))
+    assert start == pytest.approx(0.05)
+    assert note is not None and "can take (the frame period at 20 fps, 0.05 s)" in note, note

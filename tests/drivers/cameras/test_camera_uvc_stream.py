@@ -546,7 +546,8 @@ def test_the_metering_starts_where_check_judges_in_whole_units_inside_both_range
     # camera's own range is (it was taken silently)
     assert (
         "[camera] exposure_s = 0.00125 s is not an exposure the camera uvc-camera takes "
-        "exactly (it takes whole units) and the one it takes under it is shorter than "
+        "exactly (it takes whole units of exposure_unit_s = 0.0001 s in [camera.device]) and "
+        "the one it takes under it is shorter than "
         "[camera] min_exposure_s = 0.00125 s: the metering started at 0.0013 s instead"
     ) in said, said
     with shipped_dome_on_pty(monkeypatch, cfg):
@@ -570,7 +571,8 @@ def test_a_metering_start_rounded_to_the_cameras_units_is_said(tmp_path, monkeyp
     assert code == 0, said
     assert (
         "[camera] exposure_s = 0.00125 s is not an exposure the camera uvc-camera takes "
-        "exactly (it takes whole units): the metering started at 0.0012 s instead"
+        "exactly (it takes whole units of exposure_unit_s = 0.0001 s in [camera.device]): the "
+        "metering started at 0.0012 s instead"
     ) in said, said
     manifest = json.loads((out / "manifest.json").read_text())
     shots = manifest["schedule"]["provenance"]["exposure"]["test_exposures_by_light_s"]
