@@ -6,9 +6,11 @@ docs/research/planner.md the estimate is 17–59° off). So when the user does n
 ``--preview-light``, the light is taken from what records it, and only from that:
 
 * an rti-rig session folder holding one image (``rti-rig preview`` writes one): its linear
-  image, and the direction that actually fired, from the session's manifest;
+  image, and the direction that actually fired, as the session records it;
 * an image of an rti-rig session (``image_007.jpg``, or ``linear/image_007.tif``): that step's
-  direction, from the manifest;
+  direction, as the session records it: its journal's record when the image is as that
+  record captured it (a session cut off lists in its manifest only the steps of its last
+  finished run), else its manifest's;
 * an image that the bare ``.lp`` given as ``--rig`` lists (a dome's acquisition ``.lp``): its
   line there, the user having named that file.
 
@@ -33,9 +35,12 @@ from rti_rig.runtime.session import (
     LINEAR_DIR,
     MANIFEST,
     RAW_DIR,
+    image_names,
+    planned_steps,
     read_manifest,
     refuse_if_in_use,
     scan_journal,
+    verified_steps,
 )
 
 #: A bare `.lp` given as ``--rig``: its path and its entries.
@@ -63,31 +68,76 @@ def _session_root(image: Path) -> Path | None:
     return next((r for r in roots if (r / MANIFEST).is_file()), None)
 
 
-def _finished_steps(root: Path) -> list[dict[str, Any]]:
-    """The steps a session recorded; an error saying what to do when it recorded none.
+def _files_of(step: dict[str, Any]) -> tuple[str, ...]:
+    """The session files of one step's record: its JPEG, its linear TIFF, the camera's own."""
+    return tuple(
+        n
+        for n in (step.get("image"), step.get("linear_image"), *(step.get("originals") or {}))
+        if n
+    )
 
-    Why the in-use check and the journal count: a session still being captured was said to have
-    "no finished images" and sent to a ``--resume`` the running capture refuses, and one cut off
-    (a run killed, a power cut: its manifest lists its steps only when a run ends) was said to
-    have none while its journal held them. ``fit`` and ``export-lp`` say the first as this does.
+
+def _recorded_steps(
+    root: Path, light_given: bool = False
+) -> tuple[list[dict[str, Any]], dict[int, dict[str, Any]]]:
+    """The steps the session records, one per step in step order, and the journal's latest
+    record of each step it journaled; an error saying what to do when it records none.
+
+    Why the journal: a session's manifest lists its steps only when a run ends, so one cut off
+    (a run killed, a power cut), or a resume of it cut off, holds images its manifest does not
+    list, while its journal (``export-lp`` reads it) records every image with the light that
+    fired. Their lights had been estimated from the image, 25° off, with no word. Why the
+    in-use check: a session still being captured was said to have "no finished images" and
+    sent to a ``--resume`` the running capture refuses; ``fit`` and ``export-lp`` say it as
+    this does.
     """
     refuse_if_in_use(root, "plan from it")
-    steps = read_manifest(root).get("steps") or []
+    manifest = read_manifest(root)
+    total = planned_steps(manifest)
+    journaled = {
+        r["index"]: r for r in scan_journal(root, image_names(total) if total else None).records
+    }
+    steps = {s["index"]: s for s in manifest.get("steps") or [] if isinstance(s, dict)}
+    steps.update((i, r) for i, r in journaled.items() if i not in steps)
     if steps:
-        return steps
+        return [steps[i] for i in sorted(steps)], journaled
     resume = f"rti-rig run --resume {shlex.quote(str(root))}"
-    journaled = len(scan_journal(root).records)
-    if journaled:
+    if light_given:  # the light is given: only an image is missing
         raise ScheduleError(
-            f"{root}: the session was cut off (a run killed, or a power cut) before its "
-            f"manifest recorded the lights of its {journaled} image"
-            f"{'' if journaled == 1 else 's'}; finish it with {resume} (that records them), "
-            "or give the light with --preview-light AZ,EL"
+            f"{root}: the session has no finished images; if it was interrupted, finish it "
+            f"with {resume} (or shoot the preview again)"
         )
     raise ScheduleError(
         f"{root}: the session has no finished images, so its lights are not recorded yet; "
-        f"if it was interrupted, finish it with {resume} (or shoot the "
-        "preview again), or give the light with --preview-light AZ,EL"
+        f"if it was interrupted, finish it with {resume} (or shoot the preview again), or give "
+        "the light with --preview-light AZ,EL"
+    )
+
+
+def _step_light(
+    root: Path, step: dict[str, Any], journaled: dict[int, dict[str, Any]], image: Path
+) -> Any:
+    """The direction that lit ``image`` (a file of ``step``), as the session records it.
+
+    The journal's latest record of the step wins when the image is as that record captured it
+    (a step shot again on a resume is journaled again); else the manifest's step, as before;
+    an image the journal alone records, changed since, is refused: which shot it is, is not
+    known."""
+    latest = journaled.get(step["index"])
+    if latest is None:
+        return step["actual_direction"]
+    target = image.resolve()
+    kind = next(
+        (k for k in ("image", "linear_image") if (root / latest[k]).resolve() == target), None
+    )
+    if verified_steps(root, [latest], only=kind):
+        return latest["actual_direction"]
+    if step is not latest:  # the manifest lists the step
+        return step["actual_direction"]
+    raise ScheduleError(
+        f"{image}: the image is not as the session {root} captured it (changed or replaced "
+        "since; its checksum differs from its journal's), so the light recorded for it may not "
+        "be the one that lit it: give the light with --preview-light AZ,EL"
     )
 
 
@@ -109,12 +159,11 @@ def _records(image: Path, rig_lp: RigLp | None) -> list[tuple[str, str, Any]]:
     found = []
     root = _session_root(image)
     if root is not None:
-        for step in _finished_steps(root):
-            names = (step.get("image"), step.get("linear_image"), *(step.get("originals") or {}))
-            if any(n and (root / n).resolve() == target for n in names):
-                found.append(
-                    (f"the session {root}", f"the session {root.name}", step["actual_direction"])
-                )
+        steps, journaled = _recorded_steps(root)
+        for step in steps:
+            if any((root / n).resolve() == target for n in _files_of(step)):
+                light = _step_light(root, step, journaled, image)
+                found.append((f"the session {root}", f"the session {root.name}", light))
                 break
     if rig_lp is not None:
         lp, entries = rig_lp
@@ -150,8 +199,9 @@ def resolve_preview(
 
     ``rig_lp`` is the bare ``.lp`` given as ``--rig`` with its entries (as the caller already
     read them), if it was one. With ``light_given``
-    (``--preview-light``) no record of a file's light is read, so an unreadable or unfinished
-    one cannot stand in the way of the light the user gave.
+    (``--preview-light``) no record of the light is read (of a session folder, only which
+    image it holds), so an unreadable or unfinished one cannot stand in the way of the light
+    the user gave.
     """
     if path.is_dir():
         if not (path / MANIFEST).is_file():
@@ -159,15 +209,17 @@ def resolve_preview(
                 f"{path} is a folder: give one preview image file, or a session folder from "
                 "'rti-rig preview'"
             )
-        steps = _finished_steps(path)
+        steps, journaled = _recorded_steps(path, light_given)
         if len(steps) != 1:
             raise ScheduleError(
                 f"{path} is a session of {len(steps)} images: give the one to plan from, e.g. "
                 f"{path / steps[0]['linear_image']}"
             )
         image = path / steps[0]["linear_image"]
+        if light_given:  # the user's light stands: the session's record of it is not read
+            return PreviewSource(image)
         where = f"the session {path.resolve().name}"
-        light = _lit_from_above(steps[0]["actual_direction"], where, image)
+        light = _lit_from_above(_step_light(path, steps[0], journaled, image), where, image)
         return PreviewSource(image, light, f"recorded by {where}")
     _refuse_a_rig_as_preview(path)
     found = _records(path, rig_lp) if path.is_file() and not light_given else []

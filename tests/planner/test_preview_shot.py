@@ -251,12 +251,13 @@ def test_an_unfinished_session_says_how_to_finish_it(tmp_path: Path) -> None:
     manifest["runner"] = {"state": "running", "finish_reason": None}
     manifest["steps"] = []
     (shot / "manifest.json").write_text(json.dumps(manifest))
-    # its image is journaled: it had been said to have "no finished images"
+    # its image is journaled, with the light that fired: that is read (it had been said to
+    # have "no finished images", then refused as cut off while the journal held the light)
+    fired = json.loads((shot / "journal.jsonl").read_text().splitlines()[0])["actual_direction"]
     for target in (shot, shot / "linear" / "image_001.tif"):
-        with pytest.raises(
-            ScheduleError, match=r"cut off .* lights of its 1 image; .*rti-rig run --resume"
-        ):
-            resolve_preview(target)
+        src = resolve_preview(target)
+        assert _az_el(direction_from_az_el(*src.light_az_el_deg)) == _az_el(fired)
+        assert src.light_source == "recorded by the session shot"
     # killed before its first image was journaled: none is finished
     kept = {p: p.read_bytes() for p in (shot / "journal.jsonl", *(shot / "records").iterdir())}
     for p in kept:
