@@ -24,20 +24,38 @@ def _cannot_write_there(folder: Path, exc: OSError, option: str = "--out") -> Rt
     )
 
 
+def _probe_refused(shown: Path, option: str, what: str) -> RtiRigError:
+    """The refusal of ``option shown`` whose folder would not take the probe file, saying
+    ``what`` the system refused and why. Why its own wording: the probe's ``OSError`` names the
+    folder as its file, so ``--figure /proc/f.png`` read "cannot write there (No such file or
+    directory: /proc)", as if /proc were missing, when it was the new file in it that was
+    refused."""
+    return RtiRigError(
+        f"{option} {shown}: cannot write there ({what}); choose a folder you can write to"
+    )
+
+
 def _probe(folder: Path, shown: Path, option: str) -> None:
     """Create and remove a file of a name no other file has in ``folder``, or refuse
     ``option shown`` naming ``folder`` (not the probe's random name)."""
     try:
         handle, probe = tempfile.mkstemp(prefix=PROBE_PREFIX, dir=folder)
     except OSError as exc:
-        raise _cannot_write_there(
-            shown, OSError(exc.errno, exc.strerror, str(folder)), option
+        reason = exc.strerror or str(exc)
+        raise _probe_refused(
+            shown, option, f"the system refused a new file in {folder}: {reason}"
         ) from None
     os.close(handle)
     try:
         os.unlink(probe)
     except OSError as exc:
-        raise _cannot_write_there(shown, exc, option) from None
+        reason = exc.strerror or str(exc)
+        raise _probe_refused(
+            shown,
+            option,
+            f"the system refused to remove the test file {probe} it let us create in {folder}: "
+            f"{reason}; remove it yourself",
+        ) from None
 
 
 def ensure_file_writable(path: Path, option: str = "--out") -> None:

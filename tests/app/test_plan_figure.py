@@ -186,6 +186,9 @@ def test_plan_cli_refuses_a_map_or_plan_it_cannot_write_before_planning(
         flat = " ".join(r.output.split())
         assert r.exit_code == 2, flat
         assert f"{option} {args[2 * bad + 1]}: cannot write there" in flat
+        # the folder is named as refusing a new file, not as missing: it had read "(No such
+        # file or directory: /proc)", the probe's reason given as the folder's
+        assert "(the system refused a new file in /proc: No such file or directory)" in flat
         assert "choose a folder you can write to" in flat and "Traceback" not in flat
         assert not plan.exists() and not fig.exists()
     # an existing plan given with --force is kept when the map cannot be written either

@@ -32,6 +32,18 @@ def test_a_folder_nothing_can_be_created_in_is_refused() -> None:
         ensure_writable_folder(Path("/proc/rti-rig-cannot-write-here"))
 
 
+def test_an_existing_folder_refusing_a_new_file_is_not_said_to_be_missing() -> None:
+    """The probe's reason named the folder as its file: "(No such file or directory: /proc)"
+    read as if /proc did not exist. ``ensure_file_writable`` words it the same way (its CLI
+    test: tests/app/test_plan_figure.py)."""
+    with pytest.raises(RtiRigError) as caught:
+        ensure_writable_folder(Path("/proc"))
+    assert str(caught.value) == (
+        "--out /proc: cannot write there (the system refused a new file in /proc: No such file "
+        "or directory); choose a folder you can write to"
+    )
+
+
 def test_a_folder_the_user_may_not_look_into_is_refused_by_name(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
