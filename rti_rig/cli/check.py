@@ -160,5 +160,7 @@ def probe(
         raise typer.Exit(code=stop_exit_code(str(exc))) from None
     for line in result.lines():
         out.print(line, highlight=False, markup=False)
-    if result.profile is None:
+    if result.profile is None or result.error:
+        # a port that failed after the firmware was found (a Nab board whose all-off could
+        # not be sent, possibly fully lit) had exited 0, as a probe that succeeded
         raise typer.Exit(code=1)

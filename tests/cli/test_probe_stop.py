@@ -14,11 +14,13 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
 from rti_rig.simulator.domes import board_for
 from rti_rig.simulator.pty_link import serve_on_pty
 
@@ -37,6 +39,18 @@ def _wait_for(predicate, timeout_s: float = 60.0) -> None:  # type: ignore[no-un
 def _probe_stopped_once_the_port_opened(board: Any, name: str, signum: int) -> tuple[int, str]:
     """``rti-rig probe`` on ``board`` served on a pty, sent ``signum`` once the port opened
     (the board reset); its exit code and output, its line wrapping undone."""
+    return _probe(board, name, signum, lambda: any(what == "boot" for _, what in board.events))
+
+
+def _boots(board: Any) -> int:
+    return sum(what == "boot" for _, what in board.events)
+
+
+def _probe(
+    board: Any, name: str, signum: int | None, when: Callable[[], bool] = lambda: True
+) -> tuple[int, str]:
+    """``rti-rig probe`` on ``board`` served on a pty, sent ``signum`` (if any) once ``when``
+    (a condition the emulator reports) holds; its exit code and output, its wrapping undone."""
     with serve_on_pty(board, name) as link:
         proc = subprocess.Popen(
             [*RTI_RIG, "probe", link.port],
@@ -46,8 +60,9 @@ def _probe_stopped_once_the_port_opened(board: Any, name: str, signum: int) -> t
             cwd=Path(__file__).resolve().parents[2],
         )
         try:
-            _wait_for(lambda: any(what == "boot" for _, what in board.events))
-            proc.send_signal(signum)
+            if signum is not None:
+                _wait_for(when)
+                proc.send_signal(signum)
             out, _ = proc.communicate(timeout=120)
         finally:
             if proc.poll() is None:
@@ -82,3 +97,43 @@ def test_a_stop_before_any_firmware_answered_says_the_opening_may_have_lit_a_boa
     assert "nothing that lights an LED was sent" in said and "look at the dome" in said, said
     assert "Found:" not in said and "Traceback" not in said, said
     assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_during_the_nab_all_off_finishes_it_without_resetting_the_board() -> None:
+    """A Ctrl-C while the probe switches off the Nab board it found (its first ``<0>`` lost, so
+    the probe is waiting on it): the all-off is finished on the port already open. The stop had
+    escaped to the probe's teardown, which opened the port a third time (a reset: every LED lit
+    again) to send the all-off once more."""
+    board = board_for("nab-rti-v1", faults=FaultPlan((Fault(1, FaultKind.DROP_REPLY),)))
+    code, said = _probe(
+        board,
+        "nab-rti-v1",
+        signal.SIGINT,
+        lambda: any(what.startswith("fault drop_reply") for _, what in board.events),
+    )
+    assert code == 130, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert "acknowledged" in said and "Traceback" not in said, said
+    assert _boots(board) == 2, board.events  # the listen, then the all-off's opening: no third
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_then_a_port_failure_in_the_nab_all_off_is_a_stop_not_a_success() -> None:
+    """A Ctrl-C while the found Nab board boots, then the port fails as the all-off is sent (a
+    USB drop): it had ended as a probe that succeeded (exit 0, "Found: nab-rti-v1")."""
+    board = board_for("nab-rti-v1", faults=FaultPlan((Fault(1, FaultKind.DISCONNECT),)))
+    code, said = _probe(board, "nab-rti-v1", signal.SIGINT, lambda: _boots(board) >= 2)
+    assert code == 130, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on and the all-off " in said
+    assert "could NOT be sent" in said and "may be fully lit" in said, said
+    assert "Traceback" not in said, said
+
+
+def test_a_nab_board_whose_all_off_could_not_be_sent_does_not_exit_0() -> None:
+    """No stop: the port fails as the found Nab board is sent its all-off, so the dome may be
+    fully lit; the probe had exited 0 under "Found: nab-rti-v1"."""
+    board = board_for("nab-rti-v1", faults=FaultPlan((Fault(1, FaultKind.DISCONNECT),)))
+    code, said = _probe(board, "nab-rti-v1", None)
+    assert code == 1, said
+    assert "the all-off could NOT be sent" in said and "may be fully lit" in said, said
+    assert "Traceback" not in said, said

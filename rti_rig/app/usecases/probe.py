@@ -195,35 +195,66 @@ def _stopped_on_open_port(
     result.lights = STOPPED_UNANSWERED
 
 
-def _listen(t: SerialTransport, seconds: float) -> bytes:
+def _listen(t: SerialTransport, seconds: float, until: bytes | None = None) -> bytes:
+    """All ``t`` sends for ``seconds``, or until it has sent ``until`` (an acknowledgement:
+    no use listening on, and a stop would only find the probe still listening)."""
     out = bytearray()
     end = time.monotonic() + seconds
     while (left := end - time.monotonic()) > 0:
         out += t.read(min(left, 0.1))
+        if until is not None and until in out:
+            break
     return bytes(out)
 
 
 def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
-    """The Nab sketch answered: it boots with every LED on, so switch them off before leaving
-    (also when stopped meanwhile: the all-off is the stop's teardown, then
-    :class:`ProbeStopped`)."""
+    """The Nab sketch answered: it boots with every LED on, so switch them off before leaving.
+
+    A stop (:class:`EmergencyStop`) meanwhile, in the boot listen or in the all-off itself, is
+    held until the all-off is through on this same open port, then raised as
+    :class:`ProbeStopped`: a stop mid all-off had escaped to the probe's teardown, which opened
+    the port again (a reset: every LED lit once more) to send the all-off a second time. A
+    port that fails after such a stop is said, with the lights, in :class:`ProbeStopped` (it had
+    ended as a probe that succeeded, exit 0, "Found: nab-rti-v1")."""
     result.profile, result.baudrate = "nab-rti-v1", _NAB_BAUD
     t = SerialTransport(result.port, _NAB_BAUD)
     result.openings += 1
     t.open()
     opened = time.monotonic()
+    stop: EmergencyStop | None = None
     try:
         try:
             _listen(t, wait)  # the board resets as the port opens: its bootloader, its banner
         except EmergencyStop as exc:
             # the teardown: the rest of the boot, so that the all-off reaches a booted board
+            stop = exc
             _listen(t, max(0.0, opened + wait - time.monotonic()))
+        try:
             _nab_off(result, t)
-            raise ProbeStopped(str(exc), result) from None
-        _nab_off(result, t)
+        except EmergencyStop as exc:
+            # the first stop came during the all-off (the command's handler raises only the
+            # first): it is finished here, where reopening would reset the board, lit again
+            stop = exc
+            _nab_off(result, t)
+    except TransportError as exc:
+        if stop is None:
+            raise  # the probe's own handler says it (the dome may be lit; exit 1)
+        result.error = str(exc)
+        result.lights = _nab_not_off(exc)
+        raise ProbeStopped(str(stop), result) from None
     finally:
         t.close()
+    if stop is not None:
+        raise ProbeStopped(str(stop), result) from None
     return result
+
+
+def _nab_not_off(exc: TransportError) -> str:
+    """The lights of a Nab board whose all-off could not be sent (it booted, lit)."""
+    return (
+        f"the sketch boots with every LED on and the all-off could NOT be sent ({exc}): the "
+        "dome may be fully lit; switch it off at its power supply"
+    )
 
 
 def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
@@ -232,22 +263,26 @@ def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
 
     Sent again on the same open port if unanswered (reopening it would reset the board, which
     lights every LED again): one lost reply, or a <0> the board missed, had ended the probe
-    with "NOT acknowledged: check the dome", where a session resends it. A stop meanwhile is
-    not raised here (the command's handler raises only the first signal, which is what this
-    teardown follows)."""
+    with "NOT acknowledged: check the dome", where a session resends it. Listening ends at the
+    acknowledgement (it had gone on for the whole window). A stop meanwhile is raised from
+    here: the caller, which holds the open port, finishes the all-off on it."""
     off = ""
     for what, listen_s in (("all off <0>", 0.6), ("all off <0> again", 1.2)):
         t.write(b"<0>")
-        off = _listen(t, listen_s).decode("latin-1")
+        off = _listen(t, listen_s, until=_NAB_OFF_SAYS).decode("latin-1")
         result.heard.append((what, off))
-        if "<All lights turned off.>" in off:
+        if _NAB_OFF_SAYS.decode() in off:
             break
     result.lights = (
         "the sketch boots with every LED on; all-off sent and acknowledged"
-        if "<All lights turned off.>" in off
+        if _NAB_OFF_SAYS.decode() in off
         else "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
         "the dome"
     )
+
+
+#: The Nab sketch's answer to its all-off.
+_NAB_OFF_SAYS = b"<All lights turned off.>"
 
 
 def _unanswered_lights(wait: float) -> str:
@@ -321,10 +356,8 @@ def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
         try:
             _nab_found(result, wait)
         except TransportError as exc:
-            result.lights = (
-                f"the sketch boots with every LED on and the all-off could NOT be sent ({exc}): "
-                "the dome may be fully lit; switch it off at its power supply"
-            )
+            result.error = str(exc)
+            result.lights = _nab_not_off(exc)
     elif result.openings:
         result.lights = STOPPED_UNANSWERED
     else:
