@@ -19,7 +19,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from typer.testing import CliRunner
 
+from rti_rig.app.usecases import probe as probe_usecase
+from rti_rig.cli import app
+from rti_rig.drivers.led_dome.transport import SerialTransport
+from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
 from rti_rig.simulator.domes import board_for
 from rti_rig.simulator.pty_link import serve_on_pty
@@ -137,3 +142,60 @@ def test_a_nab_board_whose_all_off_could_not_be_sent_does_not_exit_0() -> None:
     assert code == 1, said
     assert "the all-off could NOT be sent" in said and "may be fully lit" in said, said
     assert "Traceback" not in said, said
+
+
+def test_a_stop_inside_the_opening_at_9600_reopens_the_port_and_switches_the_nab_dome_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C inside pyserial's open at 9600 (which closes the port as the stop goes
+    through): the opening reset the Nab board, which boots with every LED lit. The probe said
+    "look at the dome" and left it lit; it now opens the port again, as check and run do, and
+    sends the all-off once the sketch's banner comes. The stop is raised where a signal lands,
+    inside the opening (no timing can aim a real signal there)."""
+    real_open = SerialTransport.open
+    stops: list[str] = []
+
+    def open_cut_short(self: SerialTransport) -> None:
+        real_open(self)
+        if not stops:  # the first opening: the system opened it (the board reset), then
+            stops.append(self.port)  # the signal, and pyserial closes the port
+            self.close()
+            raise EmergencyStop("Ctrl-C")
+
+    monkeypatch.setattr(SerialTransport, "open", open_cut_short)
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert stops, "the opening was never cut short"
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_once_the_nab_banner_was_heard_but_not_yet_named_switches_the_dome_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C after the first listen heard the Nab sketch's banner, before the probe named
+    it: it said "stopped before a firmware answered" with the banner among the lines heard,
+    and left the dome lit. The stop is raised where the signal lands, as the switching-off
+    begins (no timing can aim a real signal into that gap)."""
+    real_found = probe_usecase._nab_found
+    calls: list[str | None] = []
+
+    def stopped_first(result: probe_usecase.ProbeResult, wait: float) -> Any:
+        calls.append(result.profile)
+        if len(calls) == 1:
+            raise EmergencyStop("Ctrl-C")
+        return real_found(result, wait)
+
+    monkeypatch.setattr(probe_usecase, "_nab_found", stopped_first)
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert "before a firmware answered" not in said, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert board.lit_once_booted() == frozenset()

@@ -129,8 +129,9 @@ STOPPED_UNANSWERED = (
     "lights at boot (the Nab sketch: every LED): look at the dome"
 )
 
-#: The Nab sketch's boot banner and its answer to its all-on (either means it booted lit).
-_NAB_SAYS = ("RTI-Dome intialized", "<All lights turned on.>")
+#: The Nab sketch's boot banner, its answer to its all-on and to a code it does not know (each
+#: means it booted, lit).
+_NAB_SAYS = ("RTI-Dome intialized", "<All lights turned on.>", "<INCORRECT FUNCTION CALL: ")
 
 
 def _exchange(
@@ -147,7 +148,13 @@ def _exchange(
     (:func:`_stopped_on_open_port`), then :class:`ProbeStopped` is raised."""
     t = SerialTransport(result.port, baud)
     result.openings += 1
-    t.open()
+    try:
+        t.open()
+    except EmergencyStop as exc:
+        # inside pyserial's open, which closes the port as the stop goes through: the opening
+        # may have reset the board all the same (the Nab sketch then boots with every LED on)
+        _stopped_inside_opening(result, t, wait_s)
+        raise ProbeStopped(str(exc), result) from None
     opened = time.monotonic()
     heard = bytearray()
     try:
@@ -188,11 +195,43 @@ def _stopped_on_open_port(
     if baud == _NAB_BAUD:
         text = _listen(t, max(0.0, opened + wait_s - time.monotonic())).decode("latin-1")
         result.heard.append(("listening out the board's boot", text))
-        if any(words in heard for _, heard in result.heard for words in _NAB_SAYS):
+        if _nab_heard(result):
             result.profile, result.baudrate = "nab-rti-v1", _NAB_BAUD
             _nab_off(result, t)
             return
     result.lights = STOPPED_UNANSWERED
+
+
+def _nab_heard(result: ProbeResult) -> bool:
+    """Some probe heard the Nab sketch (its banner, its answer to its all-on or to an unknown
+    code): the board booted, and it boots with every LED on."""
+    return any(words in heard for _, heard in result.heard for words in _NAB_SAYS)
+
+
+def _stopped_inside_opening(result: ProbeResult, cut: SerialTransport, wait_s: float) -> None:
+    """The teardown of a probe stopped inside the opening of ``cut`` (not open: pyserial closes
+    the port as the stop goes through). As ``check`` and ``run`` do after such a stop
+    (``DomePolicy._reopen_cut_short_port``), a port whose opening may reset the board
+    (``resets_on_open``) is opened again, here at the Nab sketch's rate only, and the stop's
+    teardown on an open port (:func:`_stopped_on_open_port`) follows: a Nab board, reset by the
+    opening and lit, had been left so under "look at the dome". A further signal is not raised
+    (the command's handler raises only the first)."""
+    if cut.baudrate != _NAB_BAUD or not cut.resets_on_open:
+        result.lights = STOPPED_UNANSWERED
+        return
+    t = SerialTransport(result.port, _NAB_BAUD)
+    result.openings += 1
+    try:
+        t.open()
+        _stopped_on_open_port(result, t, _NAB_BAUD, time.monotonic(), wait_s)
+    except TransportError as failed:
+        result.error = str(failed)
+        result.lights = (
+            f"the port failed while the probe stopped ({failed}): the dome's state is not "
+            "known; look at it"
+        )
+    finally:
+        t.close()
 
 
 def _listen(t: SerialTransport, seconds: float, until: bytes | None = None) -> bytes:
@@ -350,9 +389,11 @@ def probe(request: ProbeRequest) -> ProbeResult:
 
 def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
     """The teardown of a probe stopped with no port open (before the first, between two)."""
-    if result.profile == "nab-rti-v1":
-        # identified, lit at its boot, and stopped before its all-off: sent now (the opening
-        # resets it, lit again, so the boot is waited for as the probe waits for it)
+    if result.profile == "nab-rti-v1" or (result.profile is None and _nab_heard(result)):
+        # identified (or heard, the stop coming before it was named), lit at its boot, and
+        # stopped before its all-off: sent now (the opening resets it, lit again, so the boot
+        # is waited for as the probe waits for it); "stopped before a firmware answered" had
+        # been said with the banner among the lines heard, the dome left lit
         try:
             _nab_found(result, wait)
         except TransportError as exc:
