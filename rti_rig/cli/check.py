@@ -158,7 +158,13 @@ def probe(
     except EmergencyStop as exc:  # after the probe returned, before its result was printed
         err.print(f"[red]Probe stopped ({escape(str(exc))}):[/] look at the dome's lights.")
         raise typer.Exit(code=stop_exit_code(str(exc))) from None
-    for line in result.lines():
+    for line in result.heard_lines():
+        out.print(line, highlight=False, markup=False)
+    if result.error:
+        # on stderr, unwrapped, as every other command says an error (it had gone to stdout,
+        # wrapped mid-message when piped)
+        err.print(f"[bold red]error:[/] {escape(result.error)}", highlight=False, soft_wrap=True)
+    for line in result.conclusion_lines():
         out.print(line, highlight=False, markup=False)
     if result.profile is None or result.error:
         # a port that failed after the firmware was found (a Nab board whose all-off could

@@ -7,6 +7,8 @@ is. Its error line read "ERROR:" where every other command says "error:".
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -22,7 +24,7 @@ def _path(kind: str, folder: Path) -> Path:
     if kind == "file":
         (folder / "rig.toml").write_text('name = "a config, not a port"\n')
         return folder / "rig.toml"
-    return folder if kind == "folder" else Path("/dev/null")
+    return folder if kind == "folder" else Path(kind)
 
 
 @pytest.mark.parametrize(
@@ -31,6 +33,8 @@ def _path(kind: str, folder: Path) -> Path:
         ("file", "is a regular file"),
         ("folder", "is a folder"),
         ("/dev/null", "is a device but not a terminal"),
+        # its open fails with EINVAL, not ENOTTY: it had been told to check the dome's cable
+        ("/dev/random", "is a device but not a terminal"),
     ],
 )
 def test_a_path_that_is_no_serial_port_is_named_as_such(
@@ -52,3 +56,22 @@ def test_a_missing_port_keeps_the_advice_to_check_its_name_and_the_dome(tmp_path
     assert "error: cannot open serial port" in text and "ERROR" not in text, text
     assert "that the dome is plugged in and powered" in text, text
     assert "is not a serial port" not in text, text
+
+
+def test_the_error_goes_to_stderr_on_one_line(tmp_path: Path) -> None:
+    """Every other command says its error on stderr; probe's went to stdout, and wrapped mid-
+    message in a pipe (a long port path makes it longer than the 80 columns of a pipe)."""
+    port = tmp_path / ("a-long-folder-name-for-a-port-" * 3) / "ttyACM9"
+    r = subprocess.run(
+        [sys.executable, "-m", "rti_rig", "probe", str(port)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=Path(__file__).resolve().parents[2],
+    )
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "error:" not in r.stdout, r.stdout
+    line = next(line for line in r.stderr.splitlines() if line.startswith("error:"))
+    assert line.startswith(f"error: cannot open serial port {port}: "), r.stderr
+    assert line.rstrip().endswith("No such file or directory"), r.stderr
+    assert "Traceback" not in r.stderr, r.stderr

@@ -70,9 +70,15 @@ class ProbeResult:
         return out
 
     def lines(self) -> list[str]:
-        out = self.heard_lines()
-        if self.error:
-            out.append(f"error: {self.error}")  # as every other command says it
+        """What was heard, then :meth:`conclusion_lines` (for stdout; :attr:`error` is not
+        among them: the command says it on stderr between the two, as every other command says
+        its errors)."""
+        return self.heard_lines() + self.conclusion_lines()
+
+    def conclusion_lines(self) -> list[str]:
+        """What the probe concludes: the advice, the firmware and its config lines, the
+        lights."""
+        out: list[str] = []
         if self.error and not self.heard and self.not_serial:
             # a file, a folder or /dev/null: "check the dome is plugged in" sent a user to the
             # hardware when the path given was the mistake
@@ -476,8 +482,10 @@ def _not_a_serial_port(port: str, error: str) -> str | None:
     a URL, a name the system does not map to a path such as COM3).
 
     Judged from the path after the failure, never by opening it again: opening a real serial
-    port resets an Arduino. A character device that refused the terminal settings (ENOTTY,
-    "Inappropriate ioctl for device": /dev/null, /dev/zero) is a device but not a serial one."""
+    port resets an Arduino. A character device that opened but refused the terminal settings
+    is a device but not a serial one, whatever the errno: ENOTTY ("Inappropriate ioctl for
+    device": /dev/null, /dev/zero), EINVAL (/dev/random, which had been told to check that the
+    dome is plugged in). EIO there is a serial port whose device went away as it opened."""
     try:
         mode = os.stat(port).st_mode
     except (OSError, ValueError):
@@ -490,4 +498,11 @@ def _not_a_serial_port(port: str, error: str) -> str | None:
         return "is not a device file"
     if "Inappropriate ioctl" in error or f"({errno.ENOTTY}," in error:
         return "is a device but not a terminal"
+    # pyserial's words when the port opened but its terminal settings could not be read
+    if _TERMINAL_SETTINGS_FAILED in error and f"({errno.EIO}," not in error:
+        return "is a device but not a terminal"
     return None
+
+
+#: pyserial's message when a port opened but ``tcgetattr`` failed on it (POSIX).
+_TERMINAL_SETTINGS_FAILED = "Could not configure port"
