@@ -199,3 +199,29 @@ def test_a_stop_once_the_nab_banner_was_heard_but_not_yet_named_switches_the_dom
     assert "before a firmware answered" not in said, said
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
     assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_as_the_port_closes_after_an_acknowledged_all_off_does_not_reopen_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C as the probe closes the port after the Nab board acknowledged its all-off: the
+    teardown reopened the port (a reset: every LED lit again) to send the all-off once more.
+    The stop is raised where the signal lands, in the closing (too short to aim a signal)."""
+    board = board_for("nab-rti-v1")
+    real_close = SerialTransport.close
+    stops: list[str] = []
+
+    def close_then_stopped(self: SerialTransport) -> None:
+        real_close(self)
+        if not stops and board.commands >= 1:  # the board was sent its all-off
+            stops.append(self.port)
+            raise EmergencyStop("Ctrl-C")
+
+    monkeypatch.setattr(SerialTransport, "close", close_then_stopped)
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130 and stops, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert _boots(board) == 2, board.events
+    assert board.lit_once_booted() == frozenset()

@@ -395,6 +395,10 @@ def probe(request: ProbeRequest) -> ProbeResult:
 
 def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
     """The teardown of a probe stopped with no port open (before the first, between two)."""
+    if any(_NAB_OFF_SAYS.decode() in text for _, text in result.heard):
+        # its all-off was acknowledged, the stop coming as the port closed after it: reopening
+        # would reset the board, lit once more, to switch it off again (``lights`` says it)
+        return
     if result.profile == "nab-rti-v1" or (result.profile is None and _nab_heard(result)):
         # identified (or heard, the stop coming before it was named), lit at its boot, and
         # stopped before its all-off: sent now (the opening resets it, lit again, so the boot
