@@ -186,22 +186,34 @@ def _moved_lights(before: Any, now: Any) -> str | None:
     which the ``lights`` key names)."""
     if not isinstance(before, list) or not isinstance(now, list) or len(before) != len(now):
         return None
-    # exact for the tiny angles rounding gives (an acos is not)
-    angles = angle_between_deg(np.asarray(before, dtype=float), np.asarray(now, dtype=float))
-    moved = [i for i, t in enumerate(angles) if t > np.degrees(POSITION_TOLERANCE_RAD)]
+    moved = moved_lights(before, now)
     if not moved:
         return ""
-    worst = max(moved, key=lambda i: angles[i])
+    worst = max(moved, key=lambda i: moved[i])
     text = (
-        f"light positions: {len(moved)} of {len(angles)} LEDs moved, by up to "
-        f"{_degrees(float(angles[worst]))} (LED index {worst})"
+        f"light positions: {len(moved)} of {len(before)} LEDs moved, by up to "
+        f"{degrees_text(moved[worst])} (LED index {worst})"
     )
-    if np.radians(angles[worst]) <= THREE_DECIMALS_RAD:
+    if np.radians(moved[worst]) <= THREE_DECIMALS_RAD:
         text += ", no more than rounding the .lp to 3 decimals moves a light"
     return text
 
 
-def _degrees(angle: float) -> str:
+def moved_lights(before: Any, now: Any) -> dict[int, float]:
+    """The lights of ``now`` that moved from ``before`` (two equally long sequences of
+    directions) by more than :data:`POSITION_TOLERANCE_RAD`: ``{index: angle in degrees}``.
+
+    Why one function: a resume (:func:`identity_differences`) and a batch fit's refit-on-change
+    record (:mod:`rti_rig.app.usecases.fit_inputs`) must agree on what a moved light is; the
+    fit had compared a digest of positions rounded to 6 decimals, so an ``.lp`` written again
+    with 5 was "changed" there and the same rig here."""
+    # exact for the tiny angles rounding gives (an acos is not)
+    angles = angle_between_deg(np.asarray(before, dtype=float), np.asarray(now, dtype=float))
+    limit = np.degrees(POSITION_TOLERANCE_RAD)
+    return {i: float(t) for i, t in enumerate(np.atleast_1d(angles)) if t > limit}
+
+
+def degrees_text(angle: float) -> str:
     """``angle`` in degrees with the digits that tell it from zero: two decimals from a tenth
     of a degree (``0.30°``), two significant digits below (``0.012°``; ``.2f`` had printed a
     refusal's angle as ``0.00°``)."""

@@ -145,8 +145,9 @@ def fit(
             help="Session folder(s), or .lp file(s) with their images beside them. With more "
             "than one, a resumable batch: each goes to OUT/<session folder name> "
             "(OUT/<folder>-<stem> for an .lp), finished ones are skipped unless their session "
-            "changed since (resumed, reshot): those are refitted, the earlier fit replaced "
-            "once the new one is complete."
+            "changed since (resumed, reshot, lights moved; not a copy without timestamps or "
+            "an .lp rewritten with fewer decimals): those are refitted, the earlier fit "
+            "replaced once the new one is complete."
         ),
     ],
     out_dir: Annotated[Path, typer.Option("--out", help="New or empty folder for outputs.")],
@@ -247,7 +248,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
 ) -> None:
     """The body of :func:`fit`, run under its stop handling (``written`` gets True once every
     output is written)."""
-    from rti_rig.app.usecases.fit import FitRequest, run_batch, run_fit
+    from rti_rig.app.usecases.fit import FitRequest, Outcome, run_batch, run_fit
     from rti_rig.reconstruct.registry import model_spec
 
     try:
@@ -293,7 +294,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
                 for kind, text in said:
                     line = f"  [yellow]{kind}:[/] {escape(text)}"
                     err.print(line, highlight=False, soft_wrap=True)
-            if any(i.status.startswith("failed") for i in items):
+            if any(i.outcome is Outcome.FAILED for i in items):
                 raise typer.Exit(code=2)
             return
         if scheduler is None:

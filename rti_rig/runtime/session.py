@@ -2701,6 +2701,27 @@ def _journal_records(root: Path, scan: JournalScan | None = None) -> list[dict[s
     return scan_journal(root, image_names(total) if total else None).records
 
 
+def journaled_checksums(root: Path) -> dict[str, tuple[str, str | None]] | None:
+    """The sha256 the journal of session ``root`` holds for each file of its steps, from each
+    step's latest record, with its pixels' checksum for a linear TIFF (``{"linear/image_003.tif":
+    (digest, pixels digest), "image_003.jpg": (digest, None), …}``), or None for a folder that
+    is no session. Nothing is hashed: these are the checksums taken at capture.
+
+    Why: a batch fit tells whether a session changed since its earlier fit by them; file sizes
+    and modification times had called a session copied without its timestamps (plain ``cp``,
+    rsync without ``-t``) changed in every image, and refitted a whole backlog."""
+    records = _journal_records(Path(root))
+    if records is None:
+        return None
+    sums: dict[str, tuple[str, str | None]] = {}
+    for rec in _latest_records(records).values():
+        pixels = rec.get("pixels_sha256") or {}
+        for name, digest in rec["sha256"].items():
+            got = pixels.get(name)
+            sums[str(name)] = (str(digest), None if got is None else str(got))
+    return sums
+
+
 def unchecked_images(
     root: Path, scan: JournalScan | None = None, manifest: dict[str, Any] | None = None
 ) -> tuple[list[str], str]:

@@ -278,7 +278,7 @@ def test_a_local_two_worker_cluster_gives_the_single_process_bytes(tmp_path: Pat
         r = _cli([*batch, "--scheduler", address], env, tmp_path)
         said = " ".join(r.stdout.split())
         assert r.returncode == 0, r.stdout + r.stderr
-        changed = "its session changed since the earlier fit: its lights changed"
-        assert f"s2: refitted ({changed})" in said
+        changed = "its session changed since the earlier fit: 1 of 36 lights moved: "
+        assert f"s2: refitted ({changed}{Path(entries[0].name).stem}'s by " in said
         assert said.count("(finished earlier)") == 2, said
         assert sorted(p.name for p in (tmp_path / "batch").iterdir()) == ["s1", "s2", "s3"]

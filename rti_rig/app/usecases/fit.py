@@ -23,6 +23,7 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
+from enum import Enum
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +33,13 @@ from threadpoolctl import threadpool_limits
 
 from rti_rig.app.usecases.fit_bands import BandFit, BandPlan, fit_band, fit_warnings
 from rti_rig.app.usecases.fit_decode import imread_rgb
-from rti_rig.app.usecases.fit_inputs import INPUTS_KEY, change_since, inputs_record
+from rti_rig.app.usecases.fit_inputs import (
+    INPUTS_KEY,
+    as_read,
+    change_since,
+    inputs_record,
+    is_record,
+)
 from rti_rig.app.usecases.fit_maps import MapFile
 from rti_rig.app.usecases.fit_memory import release_free_memory
 from rti_rig.app.usecases.fit_rti_order import hsh_order
@@ -70,6 +77,7 @@ from rti_rig.runtime.session import (
     MANIFEST,
     UNRECORDED,
     checksum_session_files,
+    journaled_checksums,
     list_unwritten_step,
     lost_image_advice,
     read_manifest,
@@ -544,11 +552,19 @@ def complete_session_lp(source: Path) -> str | None:
 
 
 def acquisition_inputs(source: Path) -> dict[str, Any] | None:
-    """The record of what a fit of ``source`` reads (:func:`inputs_record`), or None when it
-    cannot be read as an acquisition (the fit itself says why)."""
+    """The record of what a fit of ``source`` reads (:func:`inputs_record`: its images by the
+    checksums its session's journal holds, if it has one), or None when it cannot be read as an
+    acquisition (the fit itself says why)."""
     try:
-        _, lights, paths, names = acquisition_files(source)
-        return inputs_record(lights, paths, names)
+        lp, lights, paths, names = acquisition_files(source)
+    except (RtiRigError, OSError, ValueError):
+        return None
+    try:
+        journaled = journaled_checksums(lp.parent)
+    except (RtiRigError, OSError):  # a journal that cannot be read: its images by their files
+        journaled = None
+    try:
+        return inputs_record(lights, paths, names, lp.parent, journaled)
     except (RtiRigError, OSError, ValueError):
         return None
 
@@ -747,6 +763,8 @@ def _fit_into(  # type: ignore[no-untyped-def]
             result.warnings.append(f"QA not possible: {exc}")
         else:
             result.files += write_qa_report(out, result.qa, result)
+    if inputs is not None and len(inputs["images"]) == len(frames):
+        inputs = as_read(inputs, [_read_pixels(f) for f in frames])
     summary = {
         "source": str(req.source),
         "read": what,
@@ -1298,6 +1316,12 @@ def verdict_for_session(session: Path) -> str:
     return with_lost_files(qa, session).verdict
 
 
+def _read_pixels(frame: Any) -> str | None:
+    """The pixel checksum a TIFF frame took as the fit read it through, or None."""
+    got = getattr(frame, "pixel_digest", None) if isinstance(frame, TiffRows) else None
+    return None if got is None else str(got[1])
+
+
 def _remember_pixels(frames: list[Any]) -> None:
     """Hand the integrity check the pixel checksums the TIFFs of ``frames`` took as they were
     read through (:attr:`TiffRows.pixel_digest`): it then reads none of them again."""
@@ -1307,16 +1331,38 @@ def _remember_pixels(frames: list[Any]) -> None:
             remember_pixel_digest(frame.path, *got)
 
 
+class Outcome(Enum):
+    """What a batch did with one session; its value begins the words said of it."""
+
+    DONE = "done"
+    SKIPPED = "skipped"  # an earlier fit stands
+    REFITTED = "refitted"  # an earlier fit its session outgrew, replaced
+    FAILED = "failed"
+    #: fitted on a Dask worker whose report could not be fetched: its outputs are there
+    FINISHED = "finished"
+
+
 @dataclass(frozen=True)
 class BatchItem:
+    """One session's result in a batch. Why an enum: the CLI's exit code had been decided by
+    whether the words began with "failed", words that also carry "refitted (…)" and a
+    session's own reasons."""
+
     source: Path
     out_dir: Path
-    status: str  # "done", "refitted (...)", "skipped (finished earlier...)", or "failed: ..."
+    outcome: Outcome
+    #: what follows the outcome's word in :attr:`status` (" (finished earlier)", ": <why>")
+    detail: str = ""
     verdict: str | None = None
     #: the fit's notes and warnings, as a single fit prints them (a batch had dropped them:
     #: "fit.ptm not written" for a 5-light session was said by fit S, not by fit S1 S2)
     notes: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+
+    @property
+    def status(self) -> str:
+        """The words said of the session ("done", "refitted (…)", "failed: …")."""
+        return self.outcome.value + self.detail
 
 
 def batch_out_dir(root: Path, source: Path) -> Path:
@@ -1408,44 +1454,73 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
         # partial folder while the retry finishes the session (see fit_one)
         for partial in partial_folders(root, final.name):
             shutil.rmtree(partial, ignore_errors=True)
-        if earlier_fit(final, source)[0] is None:
+        if not earlier_fit(final, source).stands:
             todo.append(source)
     return todo
 
 
-#: What a batch says of a session whose earlier fit stands.
-FINISHED_EARLIER = "skipped (finished earlier)"
+#: What a batch says of a session whose earlier fit stands, after "skipped".
+FINISHED_EARLIER = " (finished earlier)"
 
 
-def earlier_fit(final: Path, source: Path) -> tuple[str | None, str | None]:
-    """(The status of a session to skip, why it is to be refitted): ``(None, None)`` when
-    ``final`` holds no earlier fit, ``(None, why)`` when its session changed since that fit
-    (its ``fit.json`` records what it was made from, :func:`acquisition_inputs`), ``(status,
-    None)`` when the earlier fit stands.
+@dataclass(frozen=True)
+class EarlierFit:
+    """What a batch finds of a session's earlier fit (:func:`earlier_fit`)."""
+
+    #: its output folder holds an earlier fit
+    found: bool
+    #: why that fit is to be replaced (its session changed since), or None
+    outgrown: str | None = None
+    #: what a skip says after "skipped (finished earlier)"
+    note: str = ""
+
+    @property
+    def stands(self) -> bool:
+        """The earlier fit is kept and the session skipped."""
+        return self.found and self.outgrown is None
+
+    @property
+    def skip_detail(self) -> str:
+        """The words after "skipped" in a batch's line for the session."""
+        return FINISHED_EARLIER + self.note
+
+
+def earlier_fit(final: Path, source: Path) -> EarlierFit:
+    """Whether ``final`` holds an earlier fit of ``source``, and whether it stands: not when
+    its session changed since that fit (its ``fit.json`` records what it was made from,
+    :func:`acquisition_inputs`; ``outgrown`` says how).
 
     Why: only the folder's existence was checked, so a session fitted while interrupted and
     then continued with ``run --resume`` (or mended with ``--reshoot-lost``) kept its
     out-of-date fit, reported "skipped (finished earlier)". A fit that records nothing (made
     before the record was kept) is skipped with a word on how to have it refitted: refitting
-    every such session unasked would redo a whole backlog."""
+    every such session unasked would redo a whole backlog (so is one whose record is in the
+    form kept before the lights were recorded as directions)."""
     if not final.exists():
-        return None, None
+        return EarlierFit(found=False)
     try:
         summary = json.loads((final / "fit.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
         summary = None
-    if not isinstance(summary, dict) or summary.get(INPUTS_KEY) is None:
-        return (
-            f"{FINISHED_EARLIER}; its fit.json does not record what it was fitted from, so "
-            f"whether its session changed since cannot be told: delete {final} to fit it again"
-        ), None
+    if (
+        not isinstance(summary, dict)
+        or summary.get(INPUTS_KEY) is None
+        or (isinstance(summary[INPUTS_KEY], dict) and not is_record(summary[INPUTS_KEY]))
+    ):
+        return EarlierFit(
+            found=True,
+            note=(
+                "; its fit.json does not record what it was fitted from, so whether its "
+                f"session changed since cannot be told: delete {final} to fit it again"
+            ),
+        )
     now = acquisition_inputs(source)
     if now is None:  # the refit says what is wrong with the source; the earlier fit stays
-        return None, "its session cannot be read as it was when fitted"
+        return EarlierFit(True, "its session cannot be read as it was when fitted")
     changed = change_since(summary[INPUTS_KEY], now)
     if changed is None:
-        return FINISHED_EARLIER, None
-    return None, f"its session changed since the earlier fit: {changed}"
+        return EarlierFit(found=True)
+    return EarlierFit(True, f"its session changed since the earlier fit: {changed}")
 
 
 def fit_one(
@@ -1462,9 +1537,10 @@ def fit_one(
     from dataclasses import replace
 
     final = batch_out_dir(root, source)
-    skipped, outgrown = earlier_fit(final, source)
-    if skipped is not None:
-        return BatchItem(source, final, skipped)
+    earlier = earlier_fit(final, source)
+    outgrown = earlier.outgrown
+    if earlier.stands:
+        return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail)
     attempt = f"{os.getpid()}-{uuid.uuid4().hex[:8]}"
     partial = root / f".{final.name}.{attempt}.partial"
     try:
@@ -1472,23 +1548,23 @@ def fit_one(
     except RtiRigError as exc:
         shutil.rmtree(partial, ignore_errors=True)
         kept = f" (the earlier fit in {final} is kept)" if outgrown and final.exists() else ""
-        return BatchItem(source, final, f"failed: {exc}{kept}")
+        return BatchItem(source, final, Outcome.FAILED, f": {exc}{kept}")
     if outgrown is not None and final.exists():
         # the earlier fit is set aside only now that its successor is complete, under a
         # partial folder's name (a batch killed between the renames removes it and refits)
-        earlier = root / f".{final.name}.{attempt}-earlier.partial"
+        set_aside = root / f".{final.name}.{attempt}-earlier.partial"
         try:
-            final.rename(earlier)
+            final.rename(set_aside)
         except FileNotFoundError:  # another attempt replaced it meanwhile: rename as below
             pass
         else:
             try:
                 partial.rename(final)
             except OSError:
-                earlier.rename(final)
+                set_aside.rename(final)
                 shutil.rmtree(partial, ignore_errors=True)
                 raise
-            shutil.rmtree(earlier, ignore_errors=True)
+            shutil.rmtree(set_aside, ignore_errors=True)
     try:
         if partial.exists():
             partial.rename(final)  # atomic; refused when a finished folder is already there
@@ -1505,7 +1581,8 @@ def fit_one(
     return BatchItem(
         source,
         final,
-        "done" if outgrown is None else f"refitted ({outgrown})",
+        Outcome.DONE if outgrown is None else Outcome.REFITTED,
+        "" if outgrown is None else f" ({outgrown})",
         result.qa.verdict if result.qa is not None else None,
         tuple(result.notes),
         tuple(result.warnings),

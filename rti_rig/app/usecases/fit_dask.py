@@ -38,11 +38,11 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.usecases.fit import (
-    FINISHED_EARLIER,
     BandRunner,
     BatchItem,
     FitRequest,
     FitResult,
+    Outcome,
     acquisition_files,
     batch_out_dir,
     earlier_fit,
@@ -749,8 +749,8 @@ def _fit_one_task(source: Path, root: Path, template: FitRequest, threads: int |
         return BatchItem(
             source,
             batch_out_dir(root, source),
-            f"failed: {source} does not exist on worker host {socket.gethostname()}: "
-            f"{SHARED_PATHS}",
+            Outcome.FAILED,
+            f": {source} does not exist on worker host {socket.gethostname()}: {SHARED_PATHS}",
         )
     with _SESSION_LOCK, threadpool_limits(limits=threads, user_api="blas"):
         return fit_one(source, root, template)
@@ -828,7 +828,7 @@ def _batch_results(
             continue
         if s not in futures:
             out = batch_out_dir(root, s)
-            items.append(BatchItem(s, out, earlier_fit(out, s)[0] or FINISHED_EARLIER))
+            items.append(BatchItem(s, out, Outcome.SKIPPED, earlier_fit(out, s).skip_detail))
             continue
         try:
             items.append(futures[s].result())
@@ -836,17 +836,19 @@ def _batch_results(
             if getattr(exc, "reason", None) == GATHER_FAILED:
                 out = batch_out_dir(root, s)
                 if out.exists():  # its fit ended on the worker: a rerun skips it as finished
-                    status = (
-                        "finished on its worker; its report could not be fetched (its "
-                        f"outputs are in {out})"
+                    outcome, detail = (
+                        Outcome.FINISHED,
+                        " on its worker; its report could not be fetched (its outputs are in "
+                        f"{out})",
                     )
                 else:
                     kept = "run the same command again once it is (a finished session is skipped)"
-                    status = f"failed: {_unreachable(scheduler, 'the session', kept)}"
-                items.append(BatchItem(s, out, status))
+                    outcome = Outcome.FAILED
+                    detail = f": {_unreachable(scheduler, 'the session', kept)}"
+                items.append(BatchItem(s, out, outcome, detail))
                 continue
             if scheduler_lost(client, exc):
                 raise _batch_lost(scheduler, sources, given, root) from None
-            status = f"failed on the Dask cluster: {type(exc).__name__}: {exc}"
-            items.append(BatchItem(s, batch_out_dir(root, s), status))
+            detail = f" on the Dask cluster: {type(exc).__name__}: {exc}"
+            items.append(BatchItem(s, batch_out_dir(root, s), Outcome.FAILED, detail))
     return items

@@ -3,51 +3,122 @@
 Why: a batch took any session whose output folder existed for "finished earlier". A session
 fitted while interrupted (11 images), then continued with ``run --resume`` (48 images) or
 mended with ``--reshoot-lost``, kept its out-of-date fit in the batch, reported as done. The
-record is what the fit reads: each image's file (its size and modification time, which a
-resumed or reshot session changes) and the lights, so a batch can tell that an earlier fit no
-longer matches its session and say how.
+record is what the fit reads, so a batch can tell that an earlier fit no longer matches its
+session and say how:
+
+- each image by the checksum its session's journal took at capture (a reshot image has a new
+  one), read from the journal, not hashed again; only an image the journal does not name (a
+  plain ``.lp`` with its images, no journal) by its size and modification time. Sizes and
+  times alone had called a session copied without its timestamps (plain ``cp``, rsync
+  without ``-t``) changed in every image, and refitted a whole backlog;
+  An image whose pixels, as the fit read them, are not those captured (changed on disk
+  since) is recorded by what was read instead (:func:`as_read`): a later reshoot that brings
+  back the captured image then refits it;
+- the lights themselves, compared with the tolerance a resume uses
+  (:func:`rti_rig.app.rig_identity.moved_lights`): a digest of them rounded to 6 decimals
+  had called an ``.lp`` written again with 5 decimals "its lights changed", and could not
+  say which.
 """
 
 from __future__ import annotations
 
-import hashlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from rti_rig.app.rig_identity import degrees_text, moved_lights
+
 #: The key of ``fit.json`` that holds the record.
 INPUTS_KEY = "inputs"
 
+#: The most images or lights a change names before "…".
+_SHOWN = 5
+
 
 def inputs_record(
-    lights: np.ndarray, paths: Sequence[Path], names: Sequence[str]
+    lights: np.ndarray,
+    paths: Sequence[Path],
+    names: Sequence[str],
+    root: Path,
+    journaled: Mapping[str, tuple[str, str | None]] | None,
 ) -> dict[str, Any]:
-    """The record of an acquisition as the fit reads it: each image (name, size in bytes,
-    modification time in ns) in its ``.lp``'s order, and a digest of its lights (to 1e-6, the
-    precision an ``.lp`` is written in). Raises OSError when a file cannot be stat'ed."""
-    images = []
+    """The record of an acquisition as the fit reads it: each image in its ``.lp``'s order,
+    by name and the sha256 ``journaled`` (:func:`rti_rig.runtime.session.journaled_checksums`
+    of session ``root``) holds for its file, or its size in bytes and modification time in ns
+    when none; and its lights' directions. Raises OSError when a file to stat cannot be."""
+    images: list[dict[str, Any]] = []
     for name, path in zip(names, paths, strict=True):
-        st = Path(path).stat()
-        images.append([str(name), int(st.st_size), int(st.st_mtime_ns)])
-    rounded = np.round(np.asarray(lights, dtype=np.float64), 6) + 0.0  # no -0.0
-    return {
-        "images": images,
-        "lights_sha256": hashlib.sha256(rounded.tobytes()).hexdigest(),
-    }
+        sums = None
+        if journaled is not None:
+            try:
+                sums = journaled.get(Path(path).relative_to(root).as_posix())
+            except ValueError:  # an image outside the session folder
+                sums = None
+        if sums is not None:
+            image = {"name": str(name), "sha256": sums[0]}
+            if sums[1] is not None:
+                image["pixels_sha256"] = sums[1]  # what :func:`as_read` compares
+            images.append(image)
+        else:
+            st = Path(path).stat()
+            images.append(
+                {"name": str(name), "size": int(st.st_size), "mtime_ns": int(st.st_mtime_ns)}
+            )
+    directions = [[float(x) for x in d] for d in np.asarray(lights, dtype=np.float64)]
+    return {"images": images, "lights": directions}
+
+
+def as_read(record: dict[str, Any], read_pixels: Sequence[str | None]) -> dict[str, Any]:
+    """``record`` with each image whose pixels the fit read (``read_pixels``, in the record's
+    order: their checksum, None when not taken) differ from the pixels its journal recorded
+    at capture, recorded by what was read rather than by the journal's checksum.
+
+    Why: the journal's checksum says what was captured, not what the fit read; a fit made
+    while an image was damaged, then mended by ``run --resume --reshoot-lost`` (which brings
+    back the same bytes), would have stood, fitted from the damaged image."""
+    images = []
+    for image, got in zip(record["images"], read_pixels, strict=True):
+        captured = image.get("pixels_sha256")
+        if got is not None and captured is not None and got != captured:
+            image = {"name": image["name"], "read_pixels_sha256": got}
+        images.append(image)
+    return {**record, "images": images}
+
+
+def is_record(earlier: Any) -> bool:
+    """Whether ``earlier`` is a record in this form (one kept by a fit before it, a digest of
+    the lights and each image's size and time, is not: its fit is treated as one that records
+    nothing, rather than every such session refitted)."""
+    return isinstance(earlier, dict) and "lights" in earlier
+
+
+def _image_key(image: Any) -> tuple[str, tuple[Any, ...]]:
+    """An image of a record as (name, what identifies its content)."""
+    if "sha256" in image:
+        return str(image["name"]), ("sha256", str(image["sha256"]))
+    if "read_pixels_sha256" in image:  # not as captured when fitted: differs from any capture
+        return str(image["name"]), ("read", str(image["read_pixels_sha256"]))
+    return str(image["name"]), ("stat", int(image["size"]), int(image["mtime_ns"]))
+
+
+def _shown(items: Sequence[str]) -> str:
+    return ", ".join(items[:_SHOWN]) + (" …" if len(items) > _SHOWN else "")
 
 
 def change_since(earlier: Any, now: dict[str, Any]) -> str | None:
     """How the acquisition recorded ``now`` differs from the ``earlier`` record, in words
-    ("11 → 48 images"; "2 of 8 images changed: image_003, image_005"), or None when it
-    matches. An ``earlier`` record that is not one (a damaged ``fit.json``) differs."""
+    ("11 → 48 images"; "2 of 8 images changed: image_003, image_005"; "1 of 8 lights moved:
+    image_004's by 0.20°"), or None when it matches. An ``earlier`` record that cannot be
+    read (a damaged ``fit.json``) differs."""
     try:
-        before = [(str(n), int(s), int(t)) for n, s, t in earlier["images"]]
-        lights_before = str(earlier["lights_sha256"])
+        before = [_image_key(i) for i in earlier["images"]]
+        lights_before = np.asarray(earlier["lights"], dtype=np.float64)
     except (TypeError, KeyError, ValueError):
         return "its fit.json's record of what it was fitted from cannot be read"
-    after = [(str(n), int(s), int(t)) for n, s, t in now["images"]]
+    after = [_image_key(i) for i in now["images"]]
+    lights_now = np.asarray(now["lights"], dtype=np.float64)
     said = []
     if len(before) != len(after):
         said.append(f"{len(before)} → {len(after)} images")
@@ -56,8 +127,11 @@ def change_since(earlier: Any, now: dict[str, Any]) -> str | None:
     else:
         changed = [a[0] for a, b in zip(after, before, strict=True) if a != b]
         if changed:
-            shown = ", ".join(changed[:5]) + (" …" if len(changed) > 5 else "")
-            said.append(f"{len(changed)} of {len(after)} images changed: {shown}")
-    if lights_before != now["lights_sha256"] and len(before) == len(after):
-        said.append("its lights changed")
+            said.append(f"{len(changed)} of {len(after)} images changed: {_shown(changed)}")
+    if len(before) == len(after) and lights_before.shape == lights_now.shape:
+        moved = moved_lights(lights_before, lights_now)
+        if moved:
+            order = sorted(moved, key=lambda i: -moved[i])
+            each = [f"{after[i][0]}'s by {degrees_text(moved[i])}" for i in order]
+            said.append(f"{len(moved)} of {len(after)} lights moved: {_shown(each)}")
     return "; ".join(said) or None
