@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shutil
 from pathlib import Path
 
@@ -117,3 +118,25 @@ def test_a_fit_recording_nothing_comparable_is_skipped_with_a_word(tmp_path: Pat
             f"fitted from, so whether its session changed since cannot be told: delete {fit} to "
             "fit it again"
         ) in said(r), r.output
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_a_plain_lp_without_a_journal_is_still_told_by_its_files_times(tmp_path: Path) -> None:
+    """An .lp with its images beside it has no journal to vouch for them: an image touched
+    since the fit (a re-export over it) is taken for changed, as before."""
+    s, t, fb = fitted(tmp_path)
+    plain = tmp_path / "P"
+    plain.mkdir()
+    shutil.copy(s / "lights.lp", plain / "lights.lp")
+    for jpg in s.glob("image_*.jpg"):
+        shutil.copy(jpg, plain / jpg.name)
+    r = batch(plain, t, out=fb)
+    assert r.exit_code == 0 and f"{plain}: done" in said(r), r.output
+    jpg = sorted(plain.glob("image_*.jpg"))[1]
+    st = jpg.stat()
+    os.utime(jpg, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
+    r = batch(plain, t, out=fb)
+    assert r.exit_code == 0, r.output
+    expected = "refitted (its session changed since the earlier fit: 1 of 6 images changed: "
+    assert f"{plain}: {expected}{jpg.stem})" in said(r), r.output
