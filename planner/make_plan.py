@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from threadpoolctl import threadpool_limits
 
 from rti_rig.core.errors import ScheduleError
+from rti_rig.core.fit_minimums import NORMAL_MIN_LIGHTS
 from rti_rig.core.geometry import az_el_from_direction, fibonacci_cap
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
@@ -218,8 +219,9 @@ class PlanRequest:
 
 
 #: Fewer lights than this determine no surface normal: ``plan`` refuses them by name
-#: (``run --lights N`` may still shoot fewer, e.g. to try a rig out).
-MIN_PLAN_LIGHTS = 3
+#: (``run --lights N`` may still shoot fewer, e.g. to try a rig out). The same figure as the
+#: fit's normal map (``core.fit_minimums``), on purpose: below it no plan beats another.
+MIN_PLAN_LIGHTS = NORMAL_MIN_LIGHTS
 
 
 def check_plan_options(

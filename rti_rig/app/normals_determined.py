@@ -12,6 +12,10 @@ import numpy as np
 
 from rti_rig.core.errors import RtiRigError
 
+# NORMAL_NOISE, NORMAL_ERROR_LIMIT_DEG (why 15°: there) live with the other light minimums, so
+# that the command line's help states them without loading numpy
+from rti_rig.core.fit_minimums import NORMAL_ERROR_LIMIT_DEG, NORMAL_MIN_LIGHTS, NORMAL_NOISE
+
 #: What ``rti-rig fit`` does with lights that give no normals, as a CLI user can act on it.
 FIT_WITHOUT_NORMALS = (
     "rti-rig fit would write no normal maps from them (--model ps, lambert and robust-ps refuse "
@@ -51,16 +55,6 @@ def _layout(lights: np.ndarray) -> str:
     return "they lie (nearly) in one tilted plane through the object"
 
 
-#: Image noise, as a fraction of the brightness of a surface facing the light (its albedo), at
-#: which a light set's normals are judged: 1 %, an 8-bit JPEG's quantisation and shot noise.
-NORMAL_NOISE = 0.01
-#: Largest predicted normal error (standard deviation in degrees, at :data:`NORMAL_NOISE`, for
-#: the worst-placed surface) of lights that can determine a normal. Why 15°: measured
-#: (docs/reconstruction.md, "Which lights determine a normal"), every plan of 3 to 12 lights on
-#: the shipped configs and on the recorded .lp files, with and without an elevation band, gives
-#: 0.4-9.5°; the condition-number limit alone had passed 3-light sets at condition 80-100 whose
-#: normals were 22-38° off (first order) at 1 % noise.
-NORMAL_ERROR_LIMIT_DEG = 15.0
 #: At most this many lights are listed by direction in a refusal (more are counted only).
 _LISTED = 6
 
@@ -113,7 +107,7 @@ def undetermined_normals(lights: np.ndarray, what: str = "lights") -> str | None
     from rti_rig.reconstruct.solve import solve_matrix
 
     lights = np.asarray(lights, dtype=np.float64).reshape(-1, 3)
-    if len(lights) < 3:  # too few is refused elsewhere, by count
+    if len(lights) < NORMAL_MIN_LIGHTS:  # too few is refused elsewhere, by count
         return None
     _, report = solve_matrix(design_matrix("lambert", lights), "lambert", warn=False)
     error = predicted_normal_error_deg(lights)

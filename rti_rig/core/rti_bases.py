@@ -22,10 +22,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-PI = np.pi
+# Coefficient count of each model name understood by :func:`design_matrix`: kept with the
+# other light minimums, numpy-free (the command line's help reads them).
+from rti_rig.core.fit_minimums import N_COEFFICIENTS
 
-#: Coefficient count of each model name understood by :func:`design_matrix`.
-N_COEFFICIENTS = {"lambert": 3, "hsh1": 4, "ptm": 6, "hsh2": 9, "hsh3": 16}
+PI = np.pi
 
 
 def lambert_basis(lights: ArrayLike) -> NDArray[np.float64]:

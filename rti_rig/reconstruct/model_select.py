@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rti_rig.core.fit_minimums import fewest_held_out
 from rti_rig.core.rti_bases import N_COEFFICIENTS, design_matrix
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.linear_model import RelightModel
@@ -89,8 +90,9 @@ def fewest_images(candidates: Sequence[str] = RELIGHT_MODELS) -> int:
     """The fewest images :func:`select_model` can fit and check one of ``candidates`` from:
     the simplest one's coefficients, fitted, plus one light held out (every fold holds out at
     least one). What a session must shoot for `rti-rig fit`'s default ``--model auto``; run and
-    plan read it here so that their advice cannot drift from the choice itself."""
-    return min(N_COEFFICIENTS[c] for c in candidates) + 1
+    plan read it (``core.fit_minimums.FIT_MINIMUMS``) so that their advice cannot drift from
+    the choice itself."""
+    return fewest_held_out(candidates)
 
 
 def _folds(n: int, holdout: int | Sequence[int], seed: int) -> tuple[list[np.ndarray], str]:

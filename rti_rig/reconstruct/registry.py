@@ -15,6 +15,7 @@ from typing import Any
 
 from numpy.typing import ArrayLike
 
+from rti_rig.core.fit_minimums import N_COEFFICIENTS, NORMAL_MIN_LIGHTS
 from rti_rig.reconstruct.hsh import fit_hsh
 from rti_rig.reconstruct.linear_model import RelightModel, fit_lambert
 from rti_rig.reconstruct.photometric_stereo import fit_photometric_stereo
@@ -59,18 +60,28 @@ def model_spec(name: str) -> ModelSpec:
         raise ValueError(f"unknown model '{name}'; known: {', '.join(named)}") from None
 
 
-register(ModelSpec("lambert", 3, fit_lambert, True, "albedo × normal, no shadow handling"))
-register(ModelSpec("hsh1", 4, partial(fit_hsh, order=1), True, "none"))
-register(ModelSpec("ptm", 6, fit_ptm, True, "Lambertian reading of the PTM"))
-register(ModelSpec("hsh2", 9, partial(fit_hsh, order=2), True, "none"))
-register(ModelSpec("hsh3", 16, partial(fit_hsh, order=3), True, "none"))
+# the counts are the core's (N_COEFFICIENTS, NORMAL_MIN_LIGHTS), never restated here
+_N = N_COEFFICIENTS
 register(
-    ModelSpec("ps", 3, partial(fit_photometric_stereo, robust=False), False, "least-squares PS")
+    ModelSpec("lambert", _N["lambert"], fit_lambert, True, "albedo × normal, no shadow handling")
+)
+register(ModelSpec("hsh1", _N["hsh1"], partial(fit_hsh, order=1), True, "none"))
+register(ModelSpec("ptm", _N["ptm"], fit_ptm, True, "Lambertian reading of the PTM"))
+register(ModelSpec("hsh2", _N["hsh2"], partial(fit_hsh, order=2), True, "none"))
+register(ModelSpec("hsh3", _N["hsh3"], partial(fit_hsh, order=3), True, "none"))
+register(
+    ModelSpec(
+        "ps",
+        NORMAL_MIN_LIGHTS,
+        partial(fit_photometric_stereo, robust=False),
+        False,
+        "least-squares PS",
+    )
 )
 register(
     ModelSpec(
         "ps-robust",
-        3,
+        NORMAL_MIN_LIGHTS,
         partial(fit_photometric_stereo, robust=True),
         False,
         "robust PS (shadows, highlights, saturation dropped)",

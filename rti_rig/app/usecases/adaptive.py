@@ -39,6 +39,7 @@ from rti_rig.app.usecases.adaptive_constants import (
     decision_constants,
     describe_differences,
 )
+from rti_rig.core import fit_minimums
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
@@ -1078,11 +1079,11 @@ def estimate_phrase(result: dict[str, Any]) -> str:
 
 
 #: The fewest lights `rti-rig fit` writes each relighting file from (the file, its model, the
-#: lights: a PTM's 6 coefficients; an HSH of order 1 once its held-out error can be measured:
-#: rti_rig.app.usecases.fit_rti_order). Words of a note, never of a decision: a resume does not
-#: compare it (``adaptive_constants.ADVICE_ONLY``).
+#: lights: a PTM's coefficients; an HSH of order 1 once its held-out error can be measured:
+#: rti_rig.app.usecases.fit_rti_order), read from ``core.fit_minimums``. Words of a note, never
+#: of a decision: a resume does not compare it (``adaptive_constants.ADVICE_ONLY``).
 RTI_FILE_LIGHTS = (
-    ("fit.ptm", "a PTM", 6),
+    ("fit.ptm", "a PTM", fit_minimums.FIT_MINIMUMS.ptm),
     ("fit.rti", "an HSH fit", fit_rti_order.HSH_FEWEST_LIGHTS),
 )
 

@@ -47,6 +47,7 @@ from rti_rig.app.usecases.fit_signal import no_signal_warning
 from rti_rig.app.usecases.session_integrity import with_lost_files
 from rti_rig.core.acquisition_images import check_image_files
 from rti_rig.core.errors import ConfigError, RtiRigError
+from rti_rig.core.fit_minimums import FIT_MINIMUMS
 from rti_rig.core.image_files import MOSAIC_TIFF_LABEL, image_truncation
 from rti_rig.core.json_values import strict_dumps
 from rti_rig.core.lp_format import (
@@ -864,7 +865,7 @@ def _fit_all(
         try:
             choice = select_model(stack, lights, max_pixels=SAMPLE_PIXELS, candidates=candidates)
         except ReconstructionError as exc:
-            if n < 3:
+            if n < FIT_MINIMUMS.normal:  # no normal either: the choice's refusal stands
                 raise
             raise FitInputError(
                 f"--model auto: {exc}. "
@@ -908,32 +909,35 @@ def _fit_all(
     # linear models to export, their solve matrices (warnings issued once, here)
     order, rti_why = rti_order(stack, lights, req, model_name, choice)
     linear: dict[str, np.ndarray] = {}
-    if req.write_ptm and n >= 6:
+    if req.write_ptm and n >= FIT_MINIMUMS.ptm:
         linear["ptm"] = design_matrix("ptm", lights)
         if n < PTM_MEASURED_FROM:  # written, but the user should know what it is worth
             skipped.append(
-                f"fit.ptm is written from {n} lights: a PTM's 6 coefficients are fitted with "
-                f"almost nothing to spare and its error on other directions cannot be measured "
+                f"fit.ptm is written from {n} lights: a PTM's {FIT_MINIMUMS.ptm} coefficients "
+                "are fitted with almost nothing to spare and its error on other directions "
+                "cannot be measured "
                 f"below {PTM_MEASURED_FROM} lights (on a real acquisition at 6 lights it relit "
                 "held-out lights 5-6.5 dB below an order-1 HSH: docs/reconstruction.md); prefer "
                 "fit.rti"
             )
     elif req.write_ptm:
-        skipped.append(f"fit.ptm not written: a PTM needs at least 6 lights, there are {n}")
+        skipped.append(
+            f"fit.ptm not written: a PTM needs at least {FIT_MINIMUMS.ptm} lights, there are {n}"
+        )
     if req.write_hsh and order is None:
         skipped.append(rti_why)
-    elif req.write_hsh and n >= (order + 1) ** 2:
+    elif req.write_hsh and n >= FIT_MINIMUMS.hsh(order):
         linear[f"hsh{order}"] = design_matrix(f"hsh{order}", lights)
         if order > RELIGHT_HSH_ORDER:  # said on fit.rti's own line: information, not a fault
             rti_why += (
-                f" ({(order + 1) ** 2} terms: RTIViewer views them; relight's .rti converter "
-                "and viewer, webGLRtiMaker (the WebRTIViewer's converter) and JedMills' "
+                f" ({FIT_MINIMUMS.hsh(order)} terms: RTIViewer views them; relight's .rti "
+                "converter and viewer, webGLRtiMaker (the WebRTIViewer's converter) and JedMills' "
                 "RTIViewer know HSH of 4 or 9 terms only, so for relight or the web fit again "
                 f"with --hsh-order {RELIGHT_HSH_ORDER}, or fit the images with relight-cli)"
             )
     elif req.write_hsh:
         skipped.append(
-            f"fit.rti not written: HSH of order {order} needs at least {(order + 1) ** 2} "
+            f"fit.rti not written: HSH of order {order} needs at least {FIT_MINIMUMS.hsh(order)} "
             f"lights, there are {n}"
         )
     exported = {k for k in linear if k != "lambert"}  # the models written to files
@@ -1294,8 +1298,8 @@ def _qa_row(c: ImageCheck) -> str:
 
 
 #: The fewest lights the QA verdict is given for: its normal map is photometric stereo's, three
-#: coefficients per pixel.
-VERDICT_MIN_LIGHTS = 3
+#: coefficients per pixel (``FitMinimums.normal``).
+VERDICT_MIN_LIGHTS = FIT_MINIMUMS.normal
 
 
 def verdict_for_session(session: Path) -> str:

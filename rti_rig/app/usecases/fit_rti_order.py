@@ -9,9 +9,12 @@ from __future__ import annotations
 
 from typing import Any
 
+from rti_rig.core.fit_minimums import FIT_MINIMUMS
+
 #: The fewest lights an auto fit writes fit.rti from: its 5-fold cross-validation leaves HSH of
-#: order 1 its 4 fitting lights from 5 lights on, so its held-out error is measured from there.
-HSH_FEWEST_LIGHTS = 5
+#: order 1 its 4 fitting lights from 5 lights on, so its held-out error is measured from there
+#: (``FitMinimums.rti``: HSH order 1's coefficients plus one held out).
+HSH_FEWEST_LIGHTS = FIT_MINIMUMS.rti
 
 
 def hsh_order(

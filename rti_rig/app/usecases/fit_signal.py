@@ -19,6 +19,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from rti_rig.core.fit_minimums import NORMAL_MIN_LIGHTS
 from rti_rig.reconstruct.stack import ImageStack
 
 #: Images named in the warning before "and N more".
@@ -69,7 +70,7 @@ def no_signal_warning(
         if everything or len(lit) < model_spec(key).n_coefficients
     }
     no_normal = normals and (
-        everything or len(lit) < 3 or undetermined_normals(lights[lit]) is not None
+        everything or len(lit) < NORMAL_MIN_LIGHTS or undetermined_normals(lights[lit]) is not None
     )
     if not short and not no_normal:
         return []
