@@ -10,6 +10,14 @@ import typer
 from rti_rig.cli.app import app, fail, out, parse_az_el, print_notes
 from rti_rig.core.errors import RtiRigError
 
+# the help's figures (numpy-free): a plan's minimum is the normal's (planner.make_plan)
+from rti_rig.core.fit_minimums import (
+    FIT_MINIMUMS,
+    NORMAL_ERROR_LIMIT_DEG,
+    NORMAL_MIN_LIGHTS,
+    NORMAL_NOISE,
+)
+
 
 @app.command()
 def plan(
@@ -38,8 +46,8 @@ def plan(
         int,
         typer.Option(
             "--lights",
-            help="Number of lights to plan: at least 3; below 6 a note says what `rti-rig fit` "
-            "will not make of them.",
+            help=f"Number of lights to plan: at least {NORMAL_MIN_LIGHTS}; below "
+            f"{FIT_MINIMUMS.rti_file} a note says what `rti-rig fit` will not make of them.",
         ),
     ] = 12,
     method: Annotated[
@@ -129,7 +137,8 @@ def plan(
             "--allow-no-normals",
             help="Plan lights that cannot determine a surface normal (all in one plane "
             "through the object, e.g. one ring of low lights for a relightable PTM/HSH, or "
-            "bunched at the zenith, or normals predicted more than 15° off at 1% image noise) "
+            f"bunched at the zenith, or normals predicted more than {NORMAL_ERROR_LIMIT_DEG:g}° "
+            f"off at {NORMAL_NOISE:.0%} image noise) "
             "with a warning, in place of the refusal. rti-rig fit then writes no normal maps, "
             "and its relighting files are ridge-regularised guesses along the direction the "
             "lights miss; run the plan with rti-rig run RIG.toml --plan "

@@ -22,6 +22,9 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rti_rig.cli.app import app, err, fail, out, parse_az_el, print_note, stop_exit_code
 from rti_rig.core.errors import RtiRigError
 
+# the help's figures (numpy-free)
+from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
+
 #: ``--max-saturated`` of ``run`` and ``preview``: None when not given (only metering reads it,
 #: so it is refused without ``--auto-exposure``: :func:`refuse_unmetered_limit`).
 MaxSaturatedOption = Annotated[
@@ -53,7 +56,8 @@ def run(
         typer.Option(
             "--lights",
             help="Number of lights in a homogeneous layout (default: every LED of a dome, "
-            "or the arm's default_lights). At least 1; below 6 a note says, before anything "
+            "or the arm's default_lights). At least 1; below "
+            f"{FIT_MINIMUMS.rti_file} a note says, before anything "
             "lights, what `rti-rig fit` will not make of them (no fit.ptm, fit.rti or fit).",
         ),
     ] = None,
@@ -170,7 +174,8 @@ def run(
             "--allow-no-normals",
             help="Capture lights that cannot determine a surface normal (all in one plane "
             "through the object, e.g. one azimuth for raking-light documentation, or bunched "
-            "at the zenith, or normals predicted more than 15° off at 1% image noise) with a "
+            f"at the zenith, or normals predicted more than {NORMAL_ERROR_LIMIT_DEG:g}° off at "
+            f"{NORMAL_NOISE:.0%} image noise) with a "
             "warning, in place of the refusal. rti-rig fit then writes no normal maps, and "
             "its relighting files are ridge-regularised guesses along the direction the "
             "lights miss.",

@@ -25,7 +25,7 @@ from rti_rig.app.normals_determined import (
 )
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.app.preview_source import resolve_preview
-from rti_rig.app.usecases.fit_outlook import fit_minimums, fit_outlook
+from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
@@ -144,12 +144,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     """Check, plan and write ``req.out_file``; nothing is read before the options are checked."""
     method, objective = req.method_or_default, req.objective_or_default
     if req.lights < MIN_PLAN_LIGHTS:
-        least = fit_minimums()
         raise RtiRigError(
             f"--lights {req.lights}: give at least {MIN_PLAN_LIGHTS} lights to plan; fewer "
-            f"cannot determine a surface normal (`rti-rig fit` needs {least['ps']} for a "
-            f"normal map with --model ps, {least['auto']} for its default --model auto, a PTM "
-            f"{least['ptm']}, fit.rti {least['rti']}), so no planner can do better than "
+            f"cannot determine a surface normal ({fit_needs()}), so no planner can do better than "
             "another (a 2-light plan read 90° expected error); a test shot of 1 or 2 lights "
             "needs no plan: rti-rig run RIG --lights 1"
         )

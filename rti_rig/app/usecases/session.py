@@ -212,13 +212,10 @@ def check_light_count(n: int) -> None:
     from rti_rig.core.lp_format import MAX_LIGHTS
 
     if n < 1:
-        from rti_rig.app.usecases.fit_outlook import fit_minimums
+        from rti_rig.app.usecases.fit_outlook import fit_needs
 
-        least = fit_minimums()
         raise RtiRigError(
-            f"--lights {n}: give at least 1 light (1 or 2 make a test shot; `rti-rig fit` "
-            f"needs {least['ps']} for a normal map with --model ps, {least['auto']} for its "
-            f"default --model auto, {least['rti_file']} for fit.ptm and fit.rti)"
+            f"--lights {n}: give at least 1 light (1 or 2 make a test shot; {fit_needs()})"
         )
     if n > MAX_LIGHTS:
         raise RtiRigError(
