@@ -73,6 +73,7 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_off,
     exposure_ratios,
 )
+from rti_rig.reconstruct.signal_check import SAMPLE_PIXELS, every_image_black, sample_grid
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
 #: Side of the central crop the per-image checks fit on (full resolution).
@@ -138,14 +139,10 @@ MIN_DIRECTION_IMAGES = 5
 MAX_ROUNDS = 4
 #: An image below this gain at its bright end had no light at all (a black frame).
 NO_LIGHT_GAIN = 0.1
-#: An acquisition whose every image keeps its brightest pixels (:data:`PEAK_PERCENTILE`) below this
-#: fraction of full scale had no light: the gain above is judged against the other images,
-#: and one black throughout (a lens cap, lights that never fired) had been called "good". Not
-#: judged image by image: metered for a glossy coin's glint, the emulated dome's low lights
-#: reach only 0.13-0.15 % of full scale, lit as they should be.
-NO_SIGNAL_FRACTION = 0.002
-#: The percentile of an image's reduced pixels that is its brightest, judged against
-#: :data:`NO_SIGNAL_FRACTION`.
+#: The percentile of an image's reduced pixels that is its brightest: the level a black
+#: acquisition's "misfired, no light" names. Whether it is black throughout is judged by
+#: :func:`~rti_rig.reconstruct.signal_check.every_image_black` (the rule ``fit --no-qa``
+#: warns by), not by this level: the two rules had been written twice and could disagree.
 PEAK_PERCENTILE = 99.9
 #: A light is dim too when its image's median gain is at most this fraction of the median
 #: gain of its :data:`NEIGHBOUR_COUNT` nearest lights' images: the Lambertian prediction
@@ -1040,9 +1037,12 @@ def assess(
     factor = max(1, int(np.ceil(max(h, w) / COVERAGE_SIDE)))
     small_shape = (max(1, w // factor), max(1, h // factor))
     sat_frac = np.zeros(n)
-    small_list, small_sat_list = [], []
+    small_list, small_sat_list, sample_list = [], [], []
+    rows, cols = sample_grid(h, w, SAMPLE_PIXELS)  # the pixels fit --no-qa's check samples
     for f in frames:  # one frame in memory at a time
-        frac, s, s_sat = _reduced(np.asarray(f[0:h]), saturation, small_shape)
+        a = np.asarray(f[0:h])
+        sample_list.append(a[rows[:, None], cols[None, :]].reshape(rows.size * cols.size, -1))
+        frac, s, s_sat = _reduced(a, saturation, small_shape)
         sat_frac[len(small_list)] = frac
         small_list.append(s)
         small_sat_list.append(s_sat)
@@ -1050,14 +1050,20 @@ def assess(
     small_sat = np.stack(small_sat_list)
     peak = (
         # its brightest 0.1 %, not 1 %: a small object on black velvet (under 1 % of the frame)
-        # had every image called "misfired, no light" (as rti_rig.reconstruct.signal_check)
+        # reads as black at its 99th percentile
         np.percentile(small.reshape(n, -1), PEAK_PERCENTILE, axis=1) / saturation
         if np.isfinite(saturation) and saturation > 0
         else np.full(n, np.nan)  # float data: no full scale to measure against
     )
     # one black image among lit ones is judged against the others (its gain); when all are,
-    # there is nothing to judge against, and the acquisition is black throughout
-    all_black = bool(np.all(peak < NO_SIGNAL_FRACTION))
+    # there is nothing to judge against, and the acquisition is black throughout. Judged as
+    # fit --no-qa judges it, on the same sampled pixels in the frames' own units (its stack
+    # scales values and full scale alike), so the two cannot disagree
+    all_black = every_image_black(
+        np.stack(sample_list).astype(np.float32),
+        saturation if np.isfinite(saturation) else None,
+    )
+    del sample_list
     ref = float(np.percentile(small, 99.0)) or 1.0
     dark = DARK_FRACTION * ref
     dark_frac = (small < dark).mean(axis=(1, 2))

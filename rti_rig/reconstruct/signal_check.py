@@ -25,6 +25,35 @@ BLACK_FRACTION = 0.002
 SIGNAL_SHARE = 0.001
 #: The fewest in-range sampled values an image holding signal has, however small the sample.
 SIGNAL_MIN_VALUES = 8
+#: The pixels sampled from each image: the fit's sample (model choice, quantisation ranges,
+#: this check) and the QA's "black throughout", so that both judge the same pixels.
+SAMPLE_PIXELS = 30_000
+
+
+def sample_grid(height: int, width: int, max_pixels: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of the regular grid of at most ``max_pixels`` pixels of a
+    ``height`` x ``width`` image: one grid for the stack's pixel sample and the QA's, so that
+    ``fit --no-qa`` and the QA judge the same pixels."""
+    step = max(1, int(np.ceil(np.sqrt(height * width / max(1, max_pixels)))))
+    rows = np.arange(step // 2, height, step)
+    cols = np.arange(step // 2, width, step)
+    if rows.size == 0:
+        rows = np.array([height // 2])
+    if cols.size == 0:
+        cols = np.array([width // 2])
+    return rows, cols
+
+
+def every_image_black(sample: np.ndarray, saturation_level: float | None) -> bool:
+    """Whether every image of ``sample`` (as :func:`images_without_signal`) holds no signal
+    and is black: the QA's "black throughout" (a lens cap, lights that never fired), judged by
+    the same rule as ``fit --no-qa``'s warning, so that the two cannot disagree."""
+    empty = images_without_signal(sample, saturation_level)
+    return (
+        empty is not None
+        and len(empty.indices) == len(sample) > 0
+        and all(kind == "black" for kind in empty.kinds)
+    )
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.percentile import TopValues, percentile, values_needed
+from rti_rig.reconstruct.signal_check import sample_grid
 
 #: A light may dip this far below the horizon (z) through calibration noise; it is clipped to 0.
 HORIZON_TOLERANCE = 1e-6
@@ -192,15 +193,7 @@ class ImageStack:
 
     def _sample_grid(self, max_pixels: int) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
         """Rows and columns of the regular grid of at most ``max_pixels`` pixels."""
-        total = self.height * self.width
-        step = max(1, int(np.ceil(np.sqrt(total / max(1, max_pixels)))))
-        rows = np.arange(step // 2, self.height, step)
-        cols = np.arange(step // 2, self.width, step)
-        if rows.size == 0:
-            rows = np.array([self.height // 2])
-        if cols.size == 0:
-            cols = np.array([self.width // 2])
-        return rows, cols
+        return sample_grid(self.height, self.width, max_pixels)
 
     def _sample_rows(
         self, rows: NDArray[np.intp], cols: NDArray[np.intp]

@@ -66,7 +66,7 @@ from rti_rig.core.out_folders import (
 )
 from rti_rig.core.raw_rows import DecodedStore, RawRows
 from rti_rig.core.tiff_rows import TiffRows
-from rti_rig.reconstruct import exporters
+from rti_rig.reconstruct import exporters, signal_check
 from rti_rig.reconstruct.errors import ReconstructionError
 from rti_rig.reconstruct.qa import ImageCheck, QAReport, assess
 from rti_rig.reconstruct.registry import model_spec
@@ -801,8 +801,9 @@ PTM_MEASURED_FROM = 8
 RELIGHT_HSH_ORDER = 2
 
 #: Pixel sample shared by model choice, quantisation ranges and the reference level: one
-#: decode pass of the files for all three.
-SAMPLE_PIXELS = 30_000
+#: decode pass of the files for all three, and the no-signal check's, which the QA's "black
+#: throughout" shares.
+SAMPLE_PIXELS = signal_check.SAMPLE_PIXELS
 #: Working-set budget of one band of the stack in the streamed fit (float32 bytes): small, so
 #: that the fit's temporaries (robust PS keeps ~15 arrays of the band's pixels) stay bounded.
 #: Measured at 72 images × 2.5 MP (3 rows a band): 8 MB put the band phase of a normals fit at
