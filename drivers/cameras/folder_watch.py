@@ -71,7 +71,7 @@ import numpy as np
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
-from rti_rig.core.image_files import TIFF_MAGIC
+from rti_rig.core.image_files import TIFF_MAGIC, tiff_extent
 from rti_rig.drivers.cameras.image_io import (
     ImageReadError,
     read_image_file,
@@ -84,7 +84,12 @@ from rti_rig.drivers.cameras.raw_decode import (
     exposure_stats,
 )
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
-from rti_rig.drivers.cameras.tiff_structure import SAVE_READABLE, first_ifd
+from rti_rig.drivers.cameras.tiff_structure import (
+    COMPLETE_TIFF_ADVICE,
+    SAVE_AGAIN,
+    SAVE_READABLE,
+    first_ifd,
+)
 
 RAW_SUFFIXES = {
     ".dng",
@@ -328,38 +333,6 @@ def _not_a_tiff(path: Path) -> bool:
     except OSError:
         return False
     return len(head) == 4 and any(head) and head not in TIFF_MAGIC
-
-
-def _tiff_extent(path: Path) -> tuple[int, int] | None:
-    """Where the piece ``path``'s own TIFF structure names last lies: (start, end) of the
-    strip, tile or IFD that ends furthest into the file; None when tifffile cannot parse its
-    IFDs at all, or one names no data (not all written yet, or damaged: not known which).
-
-    Why: a TIFF that will not decode is either not all written yet (its IFDs name data past
-    its end: a writer that paused, or a copy cut short, which waiting may yet mend) or whole
-    and damaged (everything it names is there and still will not decode: waiting cannot help,
-    and had cost ``timeout_s`` before the stop advised raising stable_polls)."""
-    import tifffile
-
-    try:
-        with tifffile.TiffFile(path) as tif:
-            last = (0, 0)
-            for page in tif.pages:
-                ifd = int(getattr(page, "offset", 0))
-                data = [
-                    (int(o), int(o) + int(n))
-                    for o, n in zip(
-                        getattr(page, "dataoffsets", ()),
-                        getattr(page, "databytecounts", ()),
-                        strict=False,
-                    )
-                ]
-                if not data:  # an IFD naming no data: damaged, or not all written yet
-                    return None
-                last = max([last, (ifd, ifd + 2), *data], key=lambda piece: piece[1])
-            return last
-    except Exception:  # IFDs that will not parse: nothing is known of the rest
-        return None
 
 
 def _tiff_end_written(path: Path, start: int, end: int, length: int = 64) -> bool:
@@ -1012,6 +985,21 @@ class FolderWatchCamera:
             kept.append({"path": str(copy), "name": name})
         return kept
 
+    def _damaged(self, message: str, path: Path, why: str, advice: str = "") -> CaptureError:
+        """The stop for a watched file that will not decode and that waiting will not mend
+        (``why``: what it is, "is a damaged TIFF (…)"), then ``advice`` as a sentence of its
+        own.
+
+        Why one helper: each of these stops says the same of the file (left in the folder, no
+        image recorded for the light), and had been written out once for each kind of file."""
+        return CaptureError(
+            self.name,
+            f"{message}: {path.name} {why}, so waiting will not help; it is left in "
+            f"{self.settings.folder}, and no image was recorded for this light"
+            + (f". {advice}" if advice else ""),
+            "decode",
+        )
+
     def _decode_complete(self, path: Path, exposure_s: float, started: float) -> Frame:
         """Decode ``path``; one that will not decode gets ``timeout_s`` to change and is tried
         again once its size is steady for ``stable_polls`` polls, unless waiting cannot help:
@@ -1060,15 +1048,13 @@ class FolderWatchCamera:
                 if tiff and _not_a_tiff(path):
                     # its first bytes are written and no TIFF's, as the capture-time read
                     # already found: it had still been given timeout_s to change
-                    raise CaptureError(
-                        self.name,
-                        f"{message}: {path.name} is no TIFF (its first bytes are written and "
-                        "are not a TIFF header: a damaged file, or another kind saved under a "
-                        f"TIFF name), so waiting will not help; it is left in {s.folder}, and "
-                        "no image was recorded for this light",
-                        "decode",
+                    raise self._damaged(
+                        message,
+                        path,
+                        "is no TIFF (its first bytes are written and are not a TIFF header: a "
+                        "damaged file, or another kind saved under a TIFF name)",
                     ) from exc
-                extent = _tiff_extent(path) if tiff else None
+                extent = tiff_extent(path) if tiff else None
                 steady = tried is not None and _identity(path) == tried  # still what was read
                 if (
                     isinstance(exc, ImageReadError)
@@ -1078,13 +1064,11 @@ class FolderWatchCamera:
                 ):
                     # a compression the reader does not decode is no damage: it had been
                     # called damaged, with advice to check the disk or share
-                    raise CaptureError(
-                        self.name,
-                        f"{message}: {path.name} is whole (its IFD written, its size steady), "
-                        f"so waiting will not help; it is left in {s.folder}, and no image was "
-                        "recorded for this light. "
+                    raise self._damaged(
+                        message,
+                        path,
+                        "is whole (its IFD written, its size steady)",
                         f"In the program saving the shots, {SAVE_READABLE}",
-                        "decode",
                     ) from exc
                 if (
                     isinstance(exc, ImageReadError)
@@ -1102,15 +1086,12 @@ class FolderWatchCamera:
                     # its IFD, all written, reads as naming no image at all (damaged): before,
                     # an image of no pixels went on to the conversion, whose refusal named only
                     # its shape
-                    raise CaptureError(
-                        self.name,
-                        f"{message}: {path.name} is a damaged TIFF (its header and first IFD "
-                        "are written, but its IFDs name no image data that reads), so waiting "
-                        "will not help; it is "
-                        f"left in {s.folder}, and no image was recorded for this light. Save "
-                        "the shot again from the camera's program, or check the disk or share "
-                        "it is saved on",
-                        "decode",
+                    raise self._damaged(
+                        message,
+                        path,
+                        "is a damaged TIFF (its header and first IFD are written, but its IFDs "
+                        "name no image data that reads)",
+                        SAVE_AGAIN,
                     ) from exc
                 if (
                     extent is not None
@@ -1122,22 +1103,16 @@ class FolderWatchCamera:
                 ):
                     # every byte its IFDs name is written, its size steady over the
                     # stability polls, and it still will not decode: damaged, not half-written
-                    raise CaptureError(
-                        self.name,
-                        f"{message}: {path.name} is a damaged TIFF (its header and the "
-                        f"{extent[1]} bytes its structure names are all written, its size steady "
-                        f"over {s.stable_polls} polls, but its image data will not decode), "
-                        "so waiting will not help; it is left in "
-                        f"{s.folder}, and no image was recorded for this light. Save the shot "
-                        "again from the camera's program, or check the disk or share it is "
-                        "saved on",
-                        "decode",
+                    raise self._damaged(
+                        message,
+                        path,
+                        f"is a damaged TIFF (its header and the {extent[1]} bytes its structure "
+                        f"names are all written, its size steady over {s.stable_polls} polls, "
+                        "but its image data will not decode)",
+                        SAVE_AGAIN,
                     ) from exc
                 if tiff:
-                    message += (
-                        ": is it a complete TIFF (not one still being written, or a copy cut "
-                        "short)?"
-                    )
+                    message += f": {COMPLETE_TIFF_ADVICE}"
                 failure = exc
             if not self._changed_and_settled(path, tried, deadline):
                 raise CaptureError(

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.errors import CaptureError
 from rti_rig.drivers.cameras.tiff_structure import (
+    COMPLETE_TIFF_ADVICE,
     SAVE_READABLE,
     header_size,
     unread_compression,
@@ -108,11 +109,7 @@ class ImageReadError(CaptureError):
         self.no_pixels = no_pixels
         self.compression = compression
         advice = (
-            f": {SAVE_READABLE}"
-            if compression
-            else ": is it a complete TIFF (not one still being written, or a copy cut short)?"
-            if is_tiff
-            else ""
+            f": {SAVE_READABLE}" if compression else f": {COMPLETE_TIFF_ADVICE}" if is_tiff else ""
         )
         detail = f" ({reason})" if reason else ""
         super().__init__(device, f"cannot read image file {path}{detail}{advice}", "read")

@@ -111,6 +111,13 @@ READ_COMPRESSIONS = {
 
 #: said to whoever saves a TIFF in a compression the reader does not decode
 SAVE_READABLE = "save TIFFs uncompressed, or with LZW or Deflate (zlib) compression"
+#: asked of a TIFF that will not read and may yet be incomplete (one reader's refusal, and the
+#: folder watch's while it waits): one wording for both
+COMPLETE_TIFF_ADVICE = "is it a complete TIFF (not one still being written, or a copy cut short)?"
+#: said of a whole TIFF that is damaged: waiting will not mend it, saving it again may
+SAVE_AGAIN = (
+    "Save the shot again from the camera's program, or check the disk or share it is saved on"
+)
 
 
 def unread_compression(path: Path, said: str) -> str | None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
+import itertools
 import os
 from pathlib import Path
 from typing import Any
@@ -249,19 +250,47 @@ def image_truncation(path: Path) -> str | None:
                 return "it ends before its IEND chunk (cut short)"
             return None
     if head[:4] in TIFF_MAGIC:
-        import tifffile
-
-        try:
-            with tifffile.TiffFile(p) as tif:
-                page = tif.pages[0]
-                ends = [o + n for o, n in zip(page.dataoffsets, page.databytecounts, strict=False)]
-                size = tif.filehandle.size
-        except Exception:  # tifffile raises many kinds; the decoder names the problem later
-            return None
-        if ends and max(ends) > size:
-            return f"its image data runs {max(ends) - size} bytes past its end (cut short)"
+        # its first page only: the image read (None, too, where tifffile cannot parse it:
+        # the decoder names the problem later)
+        extent = tiff_extent(p, pages=1)
+        size = p.stat().st_size
+        if extent is not None and extent[1] > size:
+            return f"its image data runs {extent[1] - size} bytes past its end (cut short)"
         return None
     return jpeg_truncation(p)
+
+
+def tiff_extent(path: Path, pages: int | None = None) -> tuple[int, int] | None:
+    """Where the TIFF ``path``'s own structure names last lies: (start, end) of the strip,
+    tile or IFD that ends furthest into the file, over its first ``pages`` pages (None: all);
+    None when tifffile cannot parse its IFDs at all, or one names no data (not all written
+    yet, or damaged: not known which).
+
+    Why one function: whether a TIFF is cut short (:func:`image_truncation`, before a
+    session) and whether a watched folder's TIFF that will not decode is still being written
+    (its IFDs name data past its end) or whole and damaged are the same reading of its IFDs,
+    and had been written twice."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(path) as tif:
+            last = (0, 0)
+            for page in itertools.islice(tif.pages, pages):
+                ifd = int(getattr(page, "offset", 0))
+                data = [
+                    (int(o), int(o) + int(n))
+                    for o, n in zip(
+                        getattr(page, "dataoffsets", ()),
+                        getattr(page, "databytecounts", ()),
+                        strict=False,
+                    )
+                ]
+                if not data:  # an IFD naming no data: damaged, or not all written yet
+                    return None
+                last = max([last, (ifd, ifd + 2), *data], key=lambda piece: piece[1])
+            return last
+    except Exception:  # IFDs that will not parse (tifffile raises many kinds): nothing known
+        return None
 
 
 def header_layout(path: Path) -> tuple[int, int, bool] | None:
