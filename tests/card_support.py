@@ -18,10 +18,6 @@ runner = CliRunner()
 TRUE_POWER = np.round(np.exp(0.2 * np.random.default_rng(7).standard_normal(48)), 3).clip(0.6, 1.4)
 
 
-def said(result) -> str:  # type: ignore[no-untyped-def]
-    return " ".join(result.output.split())
-
-
 def card_rig(tmp_path: Path, serial_extra: str = "", name: str = "card.toml") -> Path:
     """The shipped emulated dome, small frames, shooting the matte plate, with uneven LEDs."""
     text = (CONFIGS / "emulated_dome.toml").read_text()

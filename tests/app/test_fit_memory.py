@@ -16,6 +16,7 @@ import cv2
 import numpy as np
 import pytest
 import tifffile
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -130,7 +131,7 @@ def test_a_broken_jpeg_decoded_into_a_reused_buffer_is_refused_by_name(
     victim.write_bytes(b"\xff\xd8\xff\xe0 not the rest of a JPEG")
     r = runner.invoke(app, ["fit", str(acquisition), "--out", str(tmp_path / "out"), *NORMALS])
     assert r.exit_code == 2, r.output
-    assert victim.name in " ".join(r.output.split())
+    assert victim.name in said(r)
 
 
 def test_decoding_into_a_buffer_gives_what_imread_gives(tmp_path: Path) -> None:

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from card_support import TRUE_POWER, card_rig, said, shoot
-from conftest import CONFIGS, write_config
+from card_support import TRUE_POWER, card_rig, shoot
+from conftest import CONFIGS, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config

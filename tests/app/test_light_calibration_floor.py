@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from card_support import card_rig, said, shoot
+from card_support import card_rig, shoot
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app

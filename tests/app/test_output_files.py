@@ -7,8 +7,8 @@ import shutil
 from pathlib import Path
 
 import pytest
-from card_support import card_rig, said, shoot
-from conftest import CONFIGS
+from card_support import card_rig, shoot
+from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app

@@ -15,8 +15,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from card_support import said
-from conftest import CONFIGS
+from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.app.plan_figure import (
@@ -155,7 +156,7 @@ def test_plan_cli_writes_the_map_and_never_overwrites_unasked(tmp_path: Path) ->
         (tmp_path / "r.png", tmp_path / "r.png", "is the --out plan file"),
     ):
         r = runner.invoke(app, [*base, "--out", str(out), "--figure", str(bad)])
-        flat = " ".join(r.output.split())
+        flat = said(r)
         assert r.exit_code == 2 and why in flat, flat
         assert not out.exists()
 
@@ -183,7 +184,7 @@ def test_plan_cli_refuses_a_map_or_plan_it_cannot_write_before_planning(
         (["--out", "/proc/rti-rig-cannot-write-here.lp", "--figure", str(fig)], "--out", 0),
     ):
         r = runner.invoke(app, [*base, *args])
-        flat = " ".join(r.output.split())
+        flat = said(r)
         assert r.exit_code == 2, flat
         assert f"{option} {args[2 * bad + 1]}: cannot write there" in flat
         # the folder is named as refusing a new file, not as missing: it had read "(No such
@@ -256,7 +257,7 @@ def test_plan_cli_map_failure_keeps_the_plan_and_its_report(
     plan = tmp_path / "p.lp"
     args = ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "9", "--out", str(plan)]
     r = runner.invoke(app, [*args, "--figure", str(tmp_path / "p.png")])
-    flat = " ".join(r.output.split())
+    flat = said(r)
     assert r.exit_code == 2 and "disk full" in flat and "the plan itself was written" in flat
     assert "Planned 9 lights" in flat and len(read_lp(plan)) == 9
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from conftest import CONFIGS
+from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -42,4 +42,4 @@ def test_lights_on_the_keep_out_edge_and_the_azimuth_stops_run(tmp_path: Path) -
     inside = _plan(tmp_path / "inside.lp", [*edge[:4], (10.0, 75.02)])
     r = runner.invoke(app, [*args[:2], "--plan", str(inside), "--out", str(tmp_path / "t")])
     assert r.exit_code == 2, r.output
-    assert "inside the 15° keep-out cone" in " ".join(r.output.split())
+    assert "inside the 15° keep-out cone" in said(r)

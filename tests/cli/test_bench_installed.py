@@ -11,6 +11,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from conftest import said
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -57,7 +59,7 @@ def test_tradeoff_out_that_cannot_be_written_is_refused_before_computing(tmp_pat
     r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out)])
     assert r.exit_code == 2, r.output
     assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
-    text = " ".join(r.output.split())
+    text = said(r)
     assert str(out) in text and "N = 6 done" not in text  # refused before any work
 
 
@@ -82,7 +84,7 @@ def test_tradeoff_refuses_to_replace_a_folder_s_files_without_force(tmp_path: Pa
         r = CliRunner().invoke(
             app, ["bench", "tradeoff", "--from", str(ACQ), "--out", str(out), *force]
         )
-        text = " ".join(r.output.split())
+        text = said(r)
         assert r.exit_code == 2 and expect in text and "N = 6 done" not in text, text
     assert (mine / "summary.md").read_text() == "my notes"
     assert not (session / "sub").exists()
@@ -163,7 +165,7 @@ def test_tradeoff_from_a_file_that_is_not_an_lp_names_what_to_give(tmp_path: Pat
     image = ACQ.parent / "image01.jpg"
     for given in (image, REPO / "rig_configs" / "simulated_dome.toml"):
         r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(given)])
-        text = " ".join(r.output.split())
+        text = said(r)
         assert r.exit_code == 2, text
         assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
         assert f"--from {given}: not an .lp file" in text, text

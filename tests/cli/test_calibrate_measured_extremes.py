@@ -11,8 +11,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from card_support import TRUE_POWER, card_rig, said, shoot
-from conftest import CONFIGS
+from card_support import TRUE_POWER, card_rig, shoot
+from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app

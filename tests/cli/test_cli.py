@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO, SMALL_DOME, write_config
+from conftest import REPO, SMALL_DOME, said, write_config
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -170,7 +170,7 @@ def test_errors_are_one_clear_line(tmp_path: Path, args: list[str], fragment: st
     argv = [a.format(cfg=cfg, tmp=tmp_path) for a in args]
     r = runner.invoke(app, argv)
     assert r.exit_code == 2, r.output
-    assert fragment in " ".join(r.output.split())
+    assert fragment in said(r)
     assert "Traceback" not in r.output
     assert not (tmp_path / "s").exists() and not (tmp_path / "p.lp").exists()
 
@@ -207,7 +207,7 @@ def test_outputs_are_checked_before_work_and_inputs_never_replaced(tmp_path: Pat
     r = runner.invoke(
         app, ["export-lp", str(session), "--out", str(session / "lights.lp"), "--linear", "--force"]
     )
-    assert r.exit_code == 2 and "never overwritten" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "never overwritten" in said(r)
     assert (session / "lights.lp").read_text() == own
     r = plan(session / "lights.lp", "--force")
     assert r.exit_code == 2 and (session / "lights.lp").read_text() == own
@@ -226,7 +226,7 @@ def test_plan_from_another_dome_is_refused(tmp_path: Path) -> None:
     plan.write_text("1\nimage_001.jpg 0.3 0.3 0.905539\n")
     r = runner.invoke(app, ["run", str(cfg), "--out", str(tmp_path / "s"), "--plan", str(plan)])
     assert r.exit_code == 2
-    assert "no LED of this dome within" in " ".join(r.output.split())
+    assert "no LED of this dome within" in said(r)
     assert not (tmp_path / "s").exists()
 
 
@@ -325,7 +325,7 @@ def test_plan_option_errors(tmp_path: Path, extra: list[str], fragment: str) -> 
     ]
     r = runner.invoke(app, args)
     assert r.exit_code == 2, r.output
-    assert fragment in " ".join(r.output.split())
+    assert fragment in said(r)
     r = runner.invoke(
         app,
         [
@@ -368,7 +368,7 @@ def test_plan_optimal_without_a_preview(tmp_path: Path) -> None:
             str(tmp_path / "x.lp"),
         ],
     )
-    assert r.exit_code == 2 and "no preview was given" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "no preview was given" in said(r)
     assert not (tmp_path / "x.lp").exists()
 
 
@@ -383,11 +383,11 @@ def test_plan_signal_noise(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     assert "5 % of the signal" in r.output and len(read_lp(tmp_path / "a.lp")) == 12
     r = runner.invoke(app, [*base, "--signal-noise", "5", "--out", str(tmp_path / "b.lp")])
-    assert r.exit_code == 2 and "--signal-noise must be a fraction" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "--signal-noise must be a fraction" in said(r)
     assert not (tmp_path / "b.lp").exists()
     # checked before the rig and the output file: the option's own error, not "exists"
     r = runner.invoke(app, [*base, "--signal-noise", "-1", "--out", str(tmp_path / "a.lp")])
-    assert r.exit_code == 2 and "--signal-noise must be a fraction" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "--signal-noise must be a fraction" in said(r)
 
 
 def _rig_with_signal_noise(tmp_path: Path, value: str) -> Path:
@@ -406,7 +406,7 @@ def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
     base = ["plan", "--rig", str(rig), "--method", "optimal", "--lights", "12"]
     r = runner.invoke(app, [*base, "--out", str(tmp_path / "a.lp")])
     assert r.exit_code == 0, r.output
-    flat = " ".join(r.output.split())
+    flat = said(r)
     assert "5 % of the signal" in flat
     # where the evidence says it costs, and how to turn the rig's setting off for one plan
     assert "brushed steel from 12 lights" in flat and "give --signal-noise 0" in flat
@@ -414,12 +414,12 @@ def test_plan_takes_signal_noise_from_the_rig_config(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     assert "of the signal" not in r.output
     r = runner.invoke(app, [*base, "--objective", "relight", "--out", str(tmp_path / "c.lp")])
-    flat = " ".join(r.output.split())
+    flat = said(r)
     assert r.exit_code == 2 and "jpeg_dome.toml" in flat and "[camera] signal_noise" in flat
     assert not (tmp_path / "c.lp").exists()
     bad = _rig_with_signal_noise(tmp_path, "1.5")
     r = runner.invoke(app, ["plan", "--rig", str(bad), "--out", str(tmp_path / "d.lp")])
-    flat = " ".join(r.output.split())
+    flat = said(r)
     assert r.exit_code == 2 and "signal_noise" in flat and "jpeg_dome.toml" in flat
 
 
@@ -433,7 +433,7 @@ def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
     tif = session / "linear" / "image_001.tif"
     before = tif.read_bytes()
     r = runner.invoke(app, ["export-lp", str(session), "--out", str(tif), "--force"])
-    assert r.exit_code == 2 and "never overwritten" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "never overwritten" in said(r)
     assert tif.read_bytes() == before
 
     (tmp_path / "domes").mkdir()
@@ -446,7 +446,7 @@ def test_no_file_of_a_session_or_of_the_rig_is_replaced(tmp_path: Path) -> None:
     r = runner.invoke(
         app, ["plan", "--rig", str(lp_cfg), "--lights", "3", "--out", str(lp), "--force"]
     )
-    assert r.exit_code == 2 and "LED calibration" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "LED calibration" in said(r)
     assert lp.read_text() == calibration
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.app.config import load_rig_config
@@ -40,10 +41,6 @@ def _uvc_dome(tmp_path: Path, camera: dict[str, float], device: str) -> Path:
     return path
 
 
-def _said(result) -> str:  # type: ignore[no-untyped-def]
-    return " ".join(result.output.split())
-
-
 def test_a_device_minimum_above_the_camera_maximum_is_refused_by_check(tmp_path: Path) -> None:
     cfg = _uvc_dome(
         tmp_path,
@@ -51,7 +48,7 @@ def test_a_device_minimum_above_the_camera_maximum_is_refused_by_check(tmp_path:
         "min_exposure_s = 0.01",
     )
     r = runner.invoke(app, ["check", str(cfg)])
-    text = _said(r)
+    text = said(r)
     assert r.exit_code == 2, text
     assert f"{cfg}: key 'camera.max_exposure_s': no exposure the camera takes lies between " in text
     assert (
@@ -69,7 +66,7 @@ def test_a_camera_minimum_above_the_devices_default_maximum_is_refused_by_run(
     )
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out)])
-    text = _said(r)
+    text = said(r)
     assert r.exit_code == 2, text
     assert f"{cfg}: key 'camera.min_exposure_s'" in text, text
     assert (

@@ -9,6 +9,7 @@ import errno
 from pathlib import Path
 
 import pytest
+from conftest import said
 from typer.testing import CliRunner
 
 import rti_rig.app.usecases.fit as fit_module
@@ -35,7 +36,7 @@ def test_an_output_the_disk_cannot_hold_is_named_not_a_traceback(
     monkeypatch.setattr(fit_module.exporters, "write_relight_dome", full)
     out = tmp_path / "fit"
     r = runner.invoke(app, ["fit", str(ACQ), "--out", str(out), "--no-ptm", "--no-hsh"])
-    text = " ".join(r.output.split())
+    text = said(r)
     assert r.exit_code == 2, r.output
     assert r.exception is None or isinstance(r.exception, SystemExit), r.exception
     assert f"{ACQ}: the fit could not write its outputs in {out}: the disk says no" in text, text

@@ -14,6 +14,7 @@ import cv2
 import numpy as np
 import pytest
 from conftest import CONFIGS, REPO
+from conftest import said as unwrapped
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -34,8 +35,9 @@ def _cap(elevation_deg: float = 89.0) -> np.ndarray:
 
 
 def _said(args: list[str]) -> tuple[int, str]:
+    """The CLI's exit code for ``args`` and its output unwrapped (:func:`conftest.said`)."""
     r = CliRunner().invoke(app, args)
-    return r.exit_code, " ".join(r.output.split())
+    return r.exit_code, unwrapped(r)
 
 
 def test_the_cap_is_within_the_condition_limit() -> None:

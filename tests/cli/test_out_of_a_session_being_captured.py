@@ -15,7 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conftest import CONFIGS
+from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -54,7 +54,7 @@ def _run_while_captured(tmp_path: Path, out: str) -> str:
         assert holder.stdin is not None
         holder.stdin.close()
         holder.wait(timeout=60)
-    text = " ".join(r.output.split())
+    text = said(r)
     assert r.exit_code == 2, text
     return text
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from conftest import CONFIGS
+from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -22,7 +22,7 @@ runner = CliRunner()
 def _refusal(tmp_path: Path, given: Path) -> str:
     out = tmp_path / "plan.lp"
     r = runner.invoke(app, ["plan", str(given), "--lights", "8", "--out", str(out)])
-    text = " ".join(r.output.split())
+    text = said(r)
     assert r.exit_code == 2, text
     assert "Traceback" not in text and "cannot read this file as an image" not in text
     assert not out.exists()

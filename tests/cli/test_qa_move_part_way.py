@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import moved_session_copy
+from conftest import moved_session_copy, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -37,7 +37,7 @@ def session(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def _verdict(session: Path, out: Path) -> dict:  # type: ignore[type-arg]
     r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh"])
     assert r.exit_code == 0, r.output
-    text = " ".join(r.output.split())
+    text = said(r)
     assert "QA verdict:" in text, text
     return json.loads((out / "qa.json").read_text())
 

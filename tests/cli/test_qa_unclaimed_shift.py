@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from conftest import coin_dome
+from conftest import coin_dome, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -27,7 +27,7 @@ def test_the_metered_coin_has_no_image_called_dim_by_an_unclaimed_shift(tmp_path
     config = coin_dome(tmp_path)
     r = runner.invoke(app, ["run", str(config), "--out", str(tmp_path / "s"), "--auto-exposure"])
     assert r.exit_code == 0, r.output
-    text = " ".join(r.output.split())
+    text = said(r)
     verdict = text[text.index("QA verdict:") :]
     assert "shift not judged" in verdict, verdict  # the shift is still not claimed
     assert "misfired" not in verdict and "0% of the brightness" not in verdict, verdict

@@ -11,6 +11,7 @@ from __future__ import annotations
 import errno
 from pathlib import Path
 
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -35,7 +36,7 @@ def test_a_resume_on_a_read_only_disk_says_nothing_is_lost_and_what_to_do(
     with failing_writes("lp", after=0, errno_code=errno.EROFS) as fault:
         r = runner.invoke(app, ["run", "--resume", str(out)])
     assert fault.failed == 1
-    text = " ".join(r.output.split())
+    text = said(r)
     assert r.exit_code == 2, text
     assert "Traceback" not in text
     assert f"cannot write {out / 'lights.lp'}: Read-only file system (EROFS)" in text

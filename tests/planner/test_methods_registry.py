@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -65,7 +66,7 @@ def test_the_documented_method_plans_through_the_cli(farthest, tmp_path):
     args = ["plan", "--rig", str(DOME), "--lights", "8", "--method", "farthest"]
     r = CliRunner().invoke(app, [*args, "--out", str(out)])
     assert r.exit_code == 0, r.output
-    assert "Planned 8 lights (farthest, normals)" in " ".join(r.output.split())
+    assert "Planned 8 lights (farthest, normals)" in said(r)
     dirs = np.array([e.direction for e in read_lp(out)])
     assert len(dirs) == 8
     # farthest-point sampling spreads the lights: no two closer than the dome's ring spacing

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -194,7 +195,7 @@ def test_plan_cli_keeps_the_plan_below_the_ceiling_and_draws_it(
     r = runner.invoke(
         app, [*args, "--min-elevation-deg", "40", "--max-elevation-deg", "30", "--out", str(plan)]
     )
-    flat = " ".join(r.output.split())
+    flat = said(r)
     assert r.exit_code == 2 and "--max-elevation-deg 30" in flat and "above the floor" in flat
 
 
@@ -279,5 +280,5 @@ def test_run_cli_runs_the_homogeneous_layout_under_the_ceiling(tmp_path: Path) -
     r = runner.invoke(
         app, ["run", str(cfg), "--out", str(tmp_path / "t"), "--max-elevation-deg", "0"]
     )
-    assert r.exit_code == 2 and "above the floor" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "above the floor" in said(r)
     assert not (tmp_path / "t").exists()  # refused before anything was created

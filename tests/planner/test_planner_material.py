@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -160,9 +161,9 @@ def test_cli_material(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     assert "declared glossy" in r.output and len(read_lp(tmp_path / "a.lp")) == 9
     r = runner.invoke(app, [*base, "--material", "shiny", "--out", str(tmp_path / "b.lp")])
-    assert r.exit_code == 2 and "--material 'shiny' is not known" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "--material 'shiny' is not known" in said(r)
     assert not (tmp_path / "b.lp").exists()
     # refused before the rig is read: its own error, not the missing rig's
     missing = ["plan", "--rig", str(tmp_path / "nowhere.toml"), "--material", "shiny"]
     r = runner.invoke(app, [*missing, "--out", str(tmp_path / "c.lp")])
-    assert r.exit_code == 2 and "--material 'shiny' is not known" in " ".join(r.output.split())
+    assert r.exit_code == 2 and "--material 'shiny' is not known" in said(r)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import said
 from threadpoolctl import threadpool_limits
 
 from rti_rig.core.geometry import direction_from_az_el, fibonacci_cap
@@ -283,7 +284,7 @@ def test_cli_plans_a_hundred_arm_lights_from_a_preview(tmp_path) -> None:
     args = ["plan", str(png), "--rig", str(rig), "--lights", "100", "--method", "optimal"]
     r = CliRunner().invoke(app, [*args, "--preview-light", "30,50", "--out", str(out)])
     assert r.exit_code == 0, r.output
-    text = " ".join(r.output.split())
+    text = said(r)
     assert "searched on" in text and "binned pixel rows of 1792" in text
     expected = text.split("expected RMS normal error (degrees): ")[1].split(" searched")[0]
     costs = dict(part.rsplit(" ", 1) for part in expected.split(", "))
