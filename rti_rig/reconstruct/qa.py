@@ -1060,7 +1060,7 @@ def assess(
     # fit --no-qa judges it, on the same sampled pixels in the frames' own units (its stack
     # scales values and full scale alike), so the two cannot disagree
     all_black = every_image_black(
-        np.stack(sample_list).astype(np.float32),
+        np.stack(sample_list),  # in the frames' dtype: no float copy (N x 30 000 x C)
         saturation if np.isfinite(saturation) else None,
     )
     del sample_list
