@@ -325,6 +325,10 @@ class InProcessDomeTransport:
     seen, exactly like a late reply on a real port, but no test ever really sleeps.
     """
 
+    #: Every opening reboots the firmware (:meth:`DomeFirmware.on_port_opened`, an Arduino's
+    #: DTR auto-reset), as a serial device's does.
+    resets_on_open = True
+
     def __init__(self, firmware: DomeFirmware, name: str = "in-process dome") -> None:
         self.firmware = firmware
         self.clock = firmware.clock

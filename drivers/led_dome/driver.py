@@ -86,12 +86,7 @@ class LedDomeDriver(PortOpening):
         self.banners_seen = 0
         self._heard = False
         self._bytes_heard = False
-        #: A stop came while the port was being opened (see :meth:`PortOpening.reopen_port`).
-        self.open_cut_short = False
-        #: The wait for the ready banner after the last opening is over (banner or deadline),
-        #: and when that wait ends (see :meth:`finish_boot`, :class:`PortOpening`).
-        self._booted = False
-        self._boot_deadline = 0.0
+        self._init_opening()
         #: This project's protocols answer ``query`` with the lit LED.
         self.can_query = True
         #: The handshake answers with the firmware's identity.
@@ -122,13 +117,9 @@ class LedDomeDriver(PortOpening):
         """A port the system would not open."""
         return self._error(str(exc), "open port", LinkFault.DISCONNECTED, True)
 
-    def finish_boot(self) -> None:
-        """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (up to the
-        ready banner, to the same deadline, not a fresh wait), so that the all-off the policy
-        sends next reaches the firmware: bytes sent to a board still in its bootloader are
-        lost, and the all-off would have been said unacknowledged for nothing."""
-        if self._open and not self._booted:
-            self._wait_for_banner()
+    def _wait_out_boot(self) -> None:
+        """The rest of the wait for the ready banner (see :meth:`PortOpening.finish_boot`)."""
+        self._wait_for_banner()
 
     def close(self) -> None:
         self._open = False

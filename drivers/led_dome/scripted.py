@@ -99,11 +99,7 @@ class ScriptedDomeDriver(PortOpening):
         #: another firmware's banner is looked for: a byte-acknowledged profile reads a banner
         #: one byte at a time, and a stale one is dropped before each command.
         self._heard_text = ""
-        #: whether the wait after opening the port ran to its end (see :meth:`finish_boot`),
-        #: and when it ends (:class:`PortOpening`)
-        self._booted = False
-        self._opened_at = 0.0
-        self._boot_deadline = 0.0
+        self._init_opening()
         #: the wait after opening heard something (a banner, bootloader noise): a banner later
         #: than that is a reboot, not a late first boot
         self._boot_heard = False
@@ -119,16 +115,13 @@ class ScriptedDomeDriver(PortOpening):
         #: the ``boot_wait_s`` to set), kept for the report the user reads: as a warning on
         #: stderr alone it was missed beside ``check``'s "RESULT: PASS". None: none so far.
         self.slow_boot_advice: str | None = None
-        #: A stop came while the port was being opened (see :meth:`PortOpening.reopen_port`).
-        self.open_cut_short = False
 
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> DomeInfo:
         self.reopen_port()
         self._wait_boot()
-        self._booted = True
-        self._boot_heard = bool(self.boot_text.strip())
+        self._boot_waited()
         self._refuse_foreign_banner()
         return self.hello()
 
@@ -301,15 +294,17 @@ class ScriptedDomeDriver(PortOpening):
         """A port the system would not open."""
         return self._error(str(exc), "open port", LinkFault.DISCONNECTED)
 
-    def finish_boot(self) -> None:
-        """Wait out the rest of the boot wait a stopped :meth:`connect` cut short (to the same
-        deadline, not a fresh wait), so that what is sent next reaches the firmware: bytes sent
-        to a board still in its bootloader are lost (the all-off of a stop there was, and the
-        Nab sketch then lit every LED in ``setup()``)."""
-        if self._open and not self._booted:
-            self._wait_ready(self._boot_deadline, "")
-            self._booted = True
-            self._boot_heard = bool(self.boot_text.strip())
+    def _wait_out_boot(self) -> None:
+        """The rest of the wait after opening (see :meth:`PortOpening.finish_boot`): straight
+        to :meth:`_wait_ready`, not through :meth:`_wait_boot`, which is ``connect``'s own."""
+        self._wait_ready(self._boot_deadline, "")
+        self._boot_waited()
+
+    def _boot_waited(self) -> None:
+        """The wait after opening is over: whether it heard something (a banner later than
+        that is a reboot, not a late first boot)."""
+        self._booted = True
+        self._boot_heard = bool(self.boot_text.strip())
 
     def close(self) -> None:
         self._open = False

@@ -47,6 +47,14 @@ class Transport(Protocol):
     #: The clock :meth:`read` waits on.
     clock: Clock
 
+    @property
+    def resets_on_open(self) -> bool:
+        """Opening this port may reset the board (a serial device's DTR): a stop inside the
+        opening then leaves a board to switch off (see ``PortOpening.reopen_port``). Declared,
+        not looked up with a default: a transport lacking it had silently been taken for one
+        that resets."""
+        ...
+
     def open(self) -> None: ...
 
     def close(self) -> None:

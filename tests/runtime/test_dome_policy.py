@@ -270,6 +270,8 @@ def test_late_reply_is_dropped_not_taken_for_the_next_command():
 class ScriptedTransport:
     """Replays a scripted exchange and fails the test on any unexpected write."""
 
+    resets_on_open = True  # a serial device's port, as the driver takes it
+
     def __init__(self, script):
         self.script = list(script)
         self.clock = VirtualClock()

@@ -20,6 +20,7 @@ class SlowOpeningPort:
 
     name = "slow port"
     baudrate = 9600
+    resets_on_open = True  # an Uno's: its opening resets the board
 
     def __init__(self, clock: VirtualClock, open_s: float) -> None:
         self.clock = clock

@@ -67,3 +67,35 @@ def _link_of(config: Path) -> object:
     """The link behind the dome the composition root builds from ``config`` (nothing opened)."""
     settings = load_rig_config(config).config.dome.serial
     return build_dome(settings, VirtualClock()).link
+
+
+def test_every_transport_declares_whether_its_opening_resets_the_board() -> None:
+    """``reopen_port`` reads ``resets_on_open`` as an attribute: a transport lacking it had
+    been taken, by a ``getattr`` default, for one whose opening resets the board."""
+    from rti_rig.drivers.led_dome.transport import SerialTransport, Transport
+    from rti_rig.simulator.dome_firmware import InProcessDomeTransport
+
+    assert isinstance(vars(Transport).get("resets_on_open"), property)
+    assert SerialTransport("/dev/ttyACM0").resets_on_open is True
+    assert SerialTransport("socket://localhost:1").resets_on_open is False
+    assert InProcessDomeTransport.resets_on_open is True  # its firmware reboots at each opening
+
+
+@pytest.mark.parametrize("hook", ["close", "_boot_wait_s", "_wait_out_boot", "_refused"])
+def test_a_driver_lacking_a_port_opening_hook_cannot_be_built(hook: str) -> None:
+    """The mixin's hooks are abstract: a driver without one fails when built, not when a stop
+    calls it (a ``NotImplementedError`` had surfaced only in the all-off path)."""
+    from rti_rig.drivers.led_dome.port_opening import PortOpening
+
+    hooks = {
+        "close": lambda self: None,
+        "_boot_wait_s": lambda self: 0.0,
+        "_wait_out_boot": lambda self: None,
+        "_refused": lambda self, exc: None,
+    }
+    del hooks[hook]
+    Partial = type("Partial", (PortOpening,), hooks)
+    with pytest.raises(TypeError, match=hook):
+        Partial()
+    Whole = type("Whole", (PortOpening,), {**hooks, hook: lambda self, *a: None})
+    Whole()._init_opening()
