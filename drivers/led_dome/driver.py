@@ -77,6 +77,8 @@ class LedDomeDriver(PortOpening):
         self.max_level = max_level
         self.has_watchdog = codec.has_watchdog
         self.echoes_light = codec.profile != "binary"
+        #: Every light command is answered (an acknowledgement, or the LED's error).
+        self.light_confirmed = True
         self._rx = bytearray()
         self._seq = 0
         self._open = False

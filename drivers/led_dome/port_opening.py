@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 
+from rti_rig.core.clock import Clock
 from rti_rig.core.dome_link import DomeLinkError
 from rti_rig.drivers.led_dome.transport import PortHeldError, Transport, TransportError
 
@@ -35,6 +36,11 @@ class PortOpening(ABC):
     #: When the port was last opened and when its boot wait ends (the transport's clock).
     _opened_at: float
     _boot_deadline: float
+
+    @property
+    def clock(self) -> Clock:
+        """The clock this link's reads wait on: its transport's (``DomeLink.clock``)."""
+        return self.transport.clock
 
     def _init_opening(self) -> None:
         """Set this mixin's state for a link that has opened nothing yet (each driver's

@@ -10,9 +10,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 from rti_rig.core.errors import DeviceError
+
+if TYPE_CHECKING:
+    from rti_rig.core.clock import Clock
 
 
 class LinkFault(StrEnum):
@@ -121,13 +124,25 @@ class DomeLink(Protocol):
     #: opening may reset the board: the policy then reopens it to send the all-off, because
     #: the reset may have lit the board (the Nab sketch boots with every LED on).
     open_cut_short: bool
+    #: The firmware answers a light command (an acknowledgement, or an error for an LED it
+    #: could not light): else a self-test step "passes" only as "sent without error", and
+    #: only a person watching the dome knows whether the LED lit. Declared, not looked up
+    #: with a default: a link lacking it had had its steps reported "passed".
+    light_confirmed: bool
 
     # The stop hooks below are what the policy asks after a stop, a failed connect or a lost
     # reply. They are declared, not looked up with defaults: a link type that lacked one had
     # silently been given "nothing to do" (no reopening, no all-off after a stop). What only a
     # described firmware can do stays optional, looked up with ``getattr`` and used where
     # present: ``published_baudrate`` / ``switch_off_at_published_rate``, ``foreign_firmware``
-    # / ``switch_off_foreign``, ``light_confirmed``, ``slow_boot_advice``.
+    # / ``switch_off_foreign``, ``slow_boot_advice``.
+
+    @property
+    def clock(self) -> Clock:
+        """The clock the link's reads wait on (its transport's): a real port's emulator on a
+        pseudo-terminal answers in real time, which a dry run's simulated rig time must count
+        (see ``DomePolicy``); the rig's own clock when the link waits on that."""
+        ...
 
     @property
     def port_open(self) -> bool:

@@ -882,6 +882,11 @@ class _TimedLink:
     light_window_s = None
     firmware_name = None
     boots_lit_firmware = None
+    light_confirmed = True
+
+    @property
+    def clock(self):
+        return self.transport.clock
 
     def reopen_port(self):
         pass

@@ -45,6 +45,9 @@ def test_the_stop_hooks_are_declared_on_the_protocol() -> None:
     hooks = {"port_open", "open_cut_short", "reopen_port", "finish_boot", "off_outcome"}
     assert hooks <= members, hooks - members
     assert {"connect", "all_off", "light", "device"} <= members
+    # what a self-test step may be said to have established, and the clock the link waits on,
+    # had been read with getattr defaults ("passed"; the rig's own clock)
+    assert {"light_confirmed", "clock"} <= members
 
 
 def test_both_driver_kinds_are_among_the_shipped_configs() -> None:
@@ -61,6 +64,8 @@ def test_every_shipped_dome_link_provides_every_declared_member(config: Path) ->
     assert isinstance(link, DomeLink)
     for name in ("reopen_port", "finish_boot", "connect", "all_off", "close"):
         assert callable(getattr(link, name)), name
+    assert link.clock is link.transport.clock  # type: ignore[attr-defined]
+    assert isinstance(link.light_confirmed, bool)  # type: ignore[attr-defined]
 
 
 def _link_of(config: Path) -> object:
