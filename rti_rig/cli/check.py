@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 import signal
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -15,6 +14,7 @@ from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, stop_exit_code
 from rti_rig.core.errors import RtiRigError
+from rti_rig.runtime.deferred_signals import signal_handlers
 
 
 @contextmanager
@@ -25,9 +25,6 @@ def stop_on_signals() -> Iterator[None]:
     is what switches the lights off (``kill -9`` still ends the process)."""
     from rti_rig.runtime.controller import EmergencyStop
 
-    if threading.current_thread() is not threading.main_thread():
-        yield  # signal handlers can only be set from the main thread
-        return
     phase = "checking"  # then "stopping" (first signal), "done" (handlers being restored)
 
     def on_signal(signum, frame):  # type: ignore[no-untyped-def]
@@ -39,13 +36,11 @@ def stop_on_signals() -> Iterator[None]:
         phase = "stopping"
         raise EmergencyStop("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
 
-    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        phase = "done"
-        for sig, h in previous.items():
-            signal.signal(sig, h)
+    with signal_handlers({signal.SIGINT: on_signal, signal.SIGTERM: on_signal}):
+        try:
+            yield
+        finally:
+            phase = "done"
 
 
 @app.command()

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import shlex
 import signal
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -15,6 +14,7 @@ from rich.markup import escape
 
 from rti_rig.cli.app import app, err, fail, out, print_notes
 from rti_rig.core.errors import RtiRigError
+from rti_rig.runtime.deferred_signals import signal_handlers
 
 #: The --model names, as --help offers them and an unknown name's refusal lists them: one
 #: list, as the refusal (the registry's) had left out ``auto`` and named robust PS
@@ -87,18 +87,12 @@ def _stoppable() -> Iterator[None]:
     process at once, silently, exit 143, leaving half-written outputs (``fit.ptm.part``, a
     normal map without its QA) in --out, and the same command run again was refused: "not
     empty"."""
-    if threading.current_thread() is not threading.main_thread():
-        yield  # signal handlers can only be set from the main thread
-        return
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
         raise FitStopped()
 
-    previous = signal.signal(signal.SIGTERM, terminated)
-    try:
+    with signal_handlers({signal.SIGTERM: terminated}):
         yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 def _stopped(

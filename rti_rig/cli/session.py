@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import shlex
 import signal
-import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -24,6 +23,7 @@ from rti_rig.core.errors import RtiRigError
 
 # the help's figures (numpy-free)
 from rti_rig.core.fit_minimums import FIT_MINIMUMS, NORMAL_ERROR_LIMIT_DEG, NORMAL_NOISE
+from rti_rig.runtime.deferred_signals import handlers_settable, put_back, signal_handlers
 
 #: ``--max-saturated`` of ``run`` and ``preview``: None when not given (only metering reads it,
 #: so it is refused without ``--auto-exposure``: :func:`refuse_unmetered_limit`).
@@ -506,8 +506,8 @@ def _terminable_while_opening() -> Iterator[None]:
     once (lights off ...)". The capture installs its own handler (:func:`_run_and_report`)."""
     from rti_rig.runtime.controller import EmergencyStop
 
-    if threading.current_thread() is not threading.main_thread():
-        yield HandOver()  # signal handlers can only be set from the main thread
+    if not handlers_settable():
+        yield HandOver()
         return
 
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
@@ -519,7 +519,7 @@ def _terminable_while_opening() -> Iterator[None]:
         yield handover
     finally:
         if not handover.holding:
-            signal.signal(signal.SIGTERM, previous)
+            put_back({signal.SIGTERM: previous})
 
 
 class HandOver:
@@ -541,7 +541,7 @@ class HandOver:
     def hold(self) -> None:
         """From now on SIGTERM and SIGINT are recorded, for the capture to act on (main
         thread only)."""
-        if threading.current_thread() is not threading.main_thread():
+        if not handlers_settable():
             return
         for sig in (signal.SIGINT, signal.SIGTERM):
             before = signal.signal(sig, lambda signum, frame: self.held.append(signum))
@@ -584,9 +584,6 @@ def _late_term_held() -> Iterator[list[int]]:
     and which command gives it, and exits 143. This is the handler every later restore puts
     back (installed before the opening's), so it holds from the capture's end to the run's."""
     held: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
-        yield held
-        return
 
     def late(signum, frame) -> None:  # type: ignore[no-untyped-def]
         if held:  # asked twice: stop now (a summary that hangs must not outlive a stop)
@@ -594,11 +591,8 @@ def _late_term_held() -> Iterator[list[int]]:
             signal.raise_signal(signal.SIGTERM)
         held.append(signum)
 
-    previous = signal.signal(signal.SIGTERM, late)
-    try:
+    with signal_handlers({signal.SIGTERM: late}):
         yield held
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 @contextmanager
@@ -1072,15 +1066,8 @@ def _ctrl_c_ignored() -> Iterator[None]:
     ``run`` called in-process (CliRunner, or anyone calling the app from Python) was one
     restore away from leaving its caller deaf to Ctrl-C, and every process it started after
     would inherit the ignored signal."""
-    if threading.current_thread() is not threading.main_thread():
-        yield  # handlers can only be set from the main thread
-        return
-    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
+    with signal_handlers({signal.SIGINT: signal.SIG_IGN}):
         yield
-    finally:
-        if before is not None:  # None: set outside Python, cannot be put back
-            signal.signal(signal.SIGINT, before)
 
 
 def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ignore[no-untyped-def]

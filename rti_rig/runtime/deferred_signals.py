@@ -3,6 +3,10 @@
 Why a module of its own: the controller holds them while devices go safe and while an image is
 committed, metering while its lights go off, and a resume while it sets unverified images aside
 and relists ``lights.lp`` (a stop in between had left the `.lp` listing a moved image).
+
+It also holds :func:`signal_handlers`, the one way the CLI sets handlers for a block: the
+save, install, restore and main-thread check had been written out by hand seven times, and
+two of the copies lacked the check (a handler set off the main thread raises ValueError).
 """
 
 from __future__ import annotations
@@ -10,7 +14,7 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Mapping
 from typing import Any
 
 
@@ -58,6 +62,58 @@ def signals_deferred() -> Iterator[None]:
                 signal.raise_signal(signum)
         if raised:
             raise raised[0]
+
+
+def handlers_settable() -> bool:
+    """Whether this thread may set signal handlers: only the main thread may (Python runs them
+    there; ``signal.signal`` raises ValueError in any other). For the blocks whose handlers
+    :func:`signal_handlers` cannot set (the capture's hand-over), the same check."""
+    return threading.current_thread() is threading.main_thread()
+
+
+#: What ``signal.signal`` accepts: a callable, ``SIG_DFL`` or ``SIG_IGN``.
+Handler = Callable[[int, Any], Any] | int | signal.Handlers
+
+
+@contextlib.contextmanager
+def signal_handlers(wanted: Mapping[int, Handler]) -> Iterator[None]:
+    """Install ``wanted`` (handler by signal) for the block; put back what was there before
+    however it ends (a return, an error, a ``typer.Exit``).
+
+    Off the main thread nothing is installed: Python sets and runs handlers only in the main
+    thread (``signal.signal`` raises ValueError elsewhere), and there the caller's handlers,
+    whatever they are, still apply. A handler that was set outside Python (``getsignal`` says
+    None) cannot be put back, so ``wanted``'s stays, rather than a TypeError at the end of
+    the block. The restore is :func:`put_back`'s.
+    """
+    if not handlers_settable():
+        yield
+        return
+    previous: dict[int, Any] = {}
+    try:  # a handler that raises as the next is installed: those already set are put back
+        for sig, handler in wanted.items():
+            previous[sig] = signal.signal(sig, handler)
+        yield
+    finally:
+        put_back(previous)
+
+
+def put_back(previous: Mapping[int, Any]) -> None:
+    """Set each signal's handler back to ``previous``'s (as ``signal.signal`` or ``getsignal``
+    returned it), main thread only: the restore of :func:`signal_handlers`, and of the blocks
+    it cannot serve (the capture's, which puts back the hand-over's originals).
+
+    Why not ``signal.signal`` in a loop: a None (a handler set outside Python) cannot be put
+    back and raised TypeError, and a pending signal whose handler raises (the CLI's emergency
+    stop) cut the loop short, leaving the rest of the block's handlers in place after it. Here
+    each is swapped (:func:`_swap_handler`); the first such exception is raised once all are
+    back."""
+    raised: list[BaseException] = []
+    for sig, before in previous.items():
+        if before is not None:  # None: set outside Python, cannot be put back
+            _swap_handler(sig, before, raised)
+    if raised:
+        raise raised[0]
 
 
 def _swap_handler(sig: int, handler: Any, raised: list[BaseException]) -> Any:
