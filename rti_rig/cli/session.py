@@ -565,11 +565,8 @@ def _verdict_terminable() -> Iterator[None]:
     def terminated(signum, frame) -> None:  # type: ignore[no-untyped-def]
         raise VerdictTerminated
 
-    previous = signal.signal(signal.SIGTERM, terminated)
-    try:
+    with signal_handlers({signal.SIGTERM: terminated}):
         yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 @contextmanager
@@ -610,12 +607,8 @@ def _late_pause_ignored() -> Iterator[None]:
     def nothing_to_pause(signum, frame) -> None:  # type: ignore[no-untyped-def]
         err.print("[yellow]SIGUSR1 ignored: a session pauses only while it captures.[/]")
 
-    previous = signal.signal(usr1, nothing_to_pause)
-    try:
+    with signal_handlers({usr1: nothing_to_pause}):
         yield
-    finally:
-        if previous is not None:
-            signal.signal(usr1, previous)
 
 
 def _unexpected(exc: Exception, report: str) -> typer.Exit:
@@ -846,15 +839,17 @@ def _execute(opened, handover: HandOver | None = None) -> bool:  # type: ignore[
 
     The handlers in place before are back only once the summary is printed: a second Ctrl-C
     meant as "stop at once", arriving just after the session stopped on the first, had cut
-    the summary and its resume hint off (exit 130, no word)."""
-    previous = {sig: signal.getsignal(sig) for sig in _HANDLED}
+    the summary and its resume hint off (exit 130, no word). Off the main thread none is set,
+    so none is put back (``signal.signal`` would raise ValueError there)."""
     handover = handover or HandOver()
-    previous.update(handover.originals)  # not the hand-over's holds
+    previous: dict[int, Any] = {}
+    if handlers_settable():
+        previous = {sig: signal.getsignal(sig) for sig in _HANDLED}
+        previous.update(handover.originals)  # not the hand-over's holds
     try:
         return _run_and_report(opened, handover)
     finally:
-        for sig, h in previous.items():
-            signal.signal(sig, h)
+        put_back(previous)
 
 
 def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-untyped-def]
@@ -968,13 +963,18 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             cancel.pause()
             err.print("[yellow]Pausing after this image; SIGUSR1 again resumes.[/]")
 
-    handlers = {signal.SIGINT: on_sigint}
-    if hasattr(signal, "SIGUSR1"):
-        handlers[signal.SIGUSR1] = on_sigusr1
-    previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
-    # SIGTERM stays held (the hand-over's) until the try below, which answers it
-    previous[signal.SIGTERM] = signal.getsignal(signal.SIGTERM)
-    previous.update(handover.originals)  # not the hand-over's holds
+    # not signal_handlers(): SIGTERM is set later than the others, and what is put back is the
+    # hand-over's originals, not its holds
+    settable = handlers_settable()  # off the main thread: none set, none put back
+    previous: dict[int, Any] = {}
+    if settable:
+        handlers = {signal.SIGINT: on_sigint}
+        if hasattr(signal, "SIGUSR1"):
+            handlers[signal.SIGUSR1] = on_sigusr1
+        previous = {sig: signal.signal(sig, h) for sig, h in handlers.items()}
+        # SIGTERM stays held (the hand-over's) until the try below, which answers it
+        previous[signal.SIGTERM] = signal.getsignal(signal.SIGTERM)
+        previous.update(handover.originals)  # not the hand-over's holds
     started = False  # whether the capture (which tears the rig down itself) has begun
     rig, folder, out_dir = opened.rig, opened.folder, opened.out_dir
     dry = " (dry run)" if opened.dry_run else ""
@@ -987,7 +987,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
     resume_hint = _cannot_resume(rig) or f"Continue with: rti-rig run --resume {_arg(out_dir)}"
     try:
-        signal.signal(signal.SIGTERM, on_sigterm)
+        if settable:
+            signal.signal(signal.SIGTERM, on_sigterm)
         if handover.held:  # a SIGTERM or Ctrl-C while the capture took over from the opening
             raise EmergencyStop(handover.why())
         with Progress(
@@ -1049,8 +1050,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
         raise _unexpected(exc, f"{out_dir}/manifest.json") from None
     finally:
-        for sig, h in previous.items():
-            signal.signal(sig, h)
+        put_back(previous)
     # the session is over (stopped or done): a late Ctrl-C must not cut the summary
     with _ctrl_c_ignored():
         return _summarise(opened, result, resume_hint, dry)
