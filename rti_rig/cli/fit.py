@@ -242,7 +242,8 @@ def _fit_command(  # type: ignore[no-untyped-def]
 ) -> None:
     """The body of :func:`fit`, run under its stop handling (``written`` gets True once every
     output is written)."""
-    from rti_rig.app.usecases.fit import FitRequest, Outcome, run_batch, run_fit
+    from rti_rig.app.usecases.fit import FitRequest, run_fit
+    from rti_rig.app.usecases.fit_batch import Outcome, run_batch
     from rti_rig.reconstruct.registry import model_spec
 
     try:

@@ -153,7 +153,8 @@ def test_a_killed_attempts_partial_folder_goes_once_the_session_is_finished(
     finished the session, and the dead attempt's folder (hundreds of MB of a large session)
     had stayed in --out after a successful batch, never removed (finished sessions are
     skipped). Another session's partial folder whose name begins alike is left alone."""
-    from rti_rig.app.usecases.fit import FitRequest, fit_one
+    from rti_rig.app.usecases.fit import FitRequest
+    from rti_rig.app.usecases.fit_batch import fit_one
 
     root = tmp_path / "batch"
     dead = root / f".{session.name}.555-dead0000.partial"  # the killed worker's attempt

@@ -9,7 +9,7 @@ Two ways to scale out, both with outputs identical to the single-process fit:
   row bands. Model choice, quantisation ranges, writing the files and QA run here, in the
   process that runs ``rti-rig fit`` (they read a pixel sample and a crop, not the stack).
 * **A batch, sessions as tasks** (``rti-rig fit S1 S2 … --out ROOT --scheduler ADDRESS``):
-  each unfinished session is one task running :func:`rti_rig.app.usecases.fit.fit_one` on a
+  each unfinished session is one task running :func:`rti_rig.app.usecases.fit_batch.fit_one` on a
   worker — the whole single-process fit, into a partial folder renamed when complete — so the
   batch stays resumable: finished sessions are skipped, a killed batch leaves only partial
   folders, which the next run removes and redoes.
@@ -39,15 +39,9 @@ from typing import Any
 
 from rti_rig.app.usecases.fit import (
     BandRunner,
-    BatchItem,
     FitRequest,
     FitResult,
-    Outcome,
     acquisition_files,
-    batch_out_dir,
-    earlier_fit,
-    fit_one,
-    plan_batch,
     read_image,
     run_fit,
 )
@@ -57,6 +51,14 @@ from rti_rig.app.usecases.fit_bands import (
     blas_threads,
     fit_band,
     fit_band_recording,
+)
+from rti_rig.app.usecases.fit_batch import (
+    BatchItem,
+    Outcome,
+    batch_out_dir,
+    earlier_fit,
+    fit_one,
+    plan_batch,
 )
 from rti_rig.core.errors import RtiRigError
 from rti_rig.reconstruct.lazy_stack import ImageReadError, StackSource, lazy_stack
@@ -780,7 +782,7 @@ def _batch_lost(
 def run_batch_dask(
     sources: list[Path], root: Path, template: FitRequest, scheduler: str = THREADS
 ) -> list[BatchItem]:
-    """A resumable batch (see :func:`rti_rig.app.usecases.fit.run_batch`) on Dask: with
+    """A resumable batch (see :func:`rti_rig.app.usecases.fit_batch.run_batch`) on Dask: with
     :data:`THREADS`, sessions one after another with their bands in threads; on a cluster,
     every unfinished session a task of its own (run in parallel across the workers)."""
     if scheduler == THREADS:

@@ -1,0 +1,284 @@
+"""`rti-rig fit` over several sessions: a resumable batch, one output folder per session.
+
+Why a module of its own: the single fit (:mod:`rti_rig.app.usecases.fit`) reads, fits and
+writes one acquisition; the batch decides, per session, whether an earlier fit stands, fits
+the others into partial folders, and swaps a refit in for the fit its session outgrew. The
+Dask runner (:mod:`rti_rig.app.usecases.fit_dask`) runs :func:`fit_one` per session too.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from enum import Enum
+from pathlib import Path
+
+from rti_rig.app.usecases.fit import (
+    BandRunner,
+    FitInputError,
+    FitRequest,
+    acquisition_inputs,
+    run_fit,
+)
+from rti_rig.app.usecases.fit_inputs import INPUTS_KEY, change_since, is_record
+from rti_rig.core.errors import RtiRigError
+from rti_rig.core.out_folders import refuse_a_file_in_the_way
+
+
+class Outcome(Enum):
+    """What a batch did with one session; its value begins the words said of it."""
+
+    DONE = "done"
+    SKIPPED = "skipped"  # an earlier fit stands
+    REFITTED = "refitted"  # an earlier fit its session outgrew, replaced
+    FAILED = "failed"
+    #: fitted on a Dask worker whose report could not be fetched: its outputs are there
+    FINISHED = "finished"
+
+
+@dataclass(frozen=True)
+class BatchItem:
+    """One session's result in a batch. Why an enum: the CLI's exit code had been decided by
+    whether the words began with "failed", words that also carry "refitted (…)" and a
+    session's own reasons."""
+
+    source: Path
+    out_dir: Path
+    outcome: Outcome
+    #: what follows the outcome's word in :attr:`status` (" (finished earlier)", ": <why>")
+    detail: str = ""
+    verdict: str | None = None
+    #: the fit's notes and warnings, as a single fit prints them (a batch had dropped them:
+    #: "fit.ptm not written" for a 5-light session was said by fit S, not by fit S1 S2)
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def status(self) -> str:
+        """The words said of the session ("done", "refitted (…)", "failed: …")."""
+        return self.outcome.value + self.detail
+
+
+def batch_out_dir(root: Path, source: Path) -> Path:
+    """Where a batch writes one source: ``root/<session folder name>``, or for an ``.lp`` file
+    ``root/<its folder>-<its stem>``: acquisitions of a backlog often all name their file
+    ``dirs.lp`` (one folder per object), and the name must not depend on the rest of the batch
+    (a resumed batch finds what it finished by this name).
+
+    A folder's name is taken from its absolute path: ``.`` (the folder one is in) and ``..``
+    have no name of their own, and ``root / "."`` is ``root`` itself, which exists once the
+    batch begins, so ``fit . OTHER --out OUT`` had reported the current session "skipped
+    (finished earlier)" without fitting it (``..`` named ``OUT/..``, likewise skipped)."""
+    if source.is_dir():
+        name = Path(os.path.abspath(source)).name
+        if not name:
+            raise FitInputError(
+                f"{source}: the root of a file system is no session folder; give the session's "
+                "own folder"
+            )
+        return root / name
+    folder = source.resolve().parent.name
+    return root / (f"{folder}-{source.stem}" if folder else source.stem)
+
+
+def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[BatchItem]:
+    """Fit several sessions one after another, resumably.
+
+    Each goes to :func:`batch_out_dir`, built in a hidden ``.name.*.partial`` folder and renamed
+    when complete: a finished session (its folder exists) is skipped unless its session changed
+    since that fit (:func:`earlier_fit`; refitted then, the earlier fit replaced only once the
+    new one is complete), a killed batch leaves partial folders only, which the next run
+    removes and redoes. A session that fails is
+    reported and the batch goes on. (:func:`rti_rig.app.usecases.fit_dask.run_batch_dask` runs
+    the same :func:`fit_one` per session as parallel tasks on a Dask cluster.)
+    """
+    plan_batch(sources, root)
+    return [fit_one(source, root, template) for source in sources]
+
+
+def partial_folders(root: Path, name: str) -> list[Path]:
+    """The partial folders of the session whose output is ``root/name`` (``.NAME.PID-ID.partial``,
+    or ``.NAME.partial`` of older runs). Matched exactly, not by a glob: ``.s1.*partial`` also
+    matched session ``s1.x``'s ``.s1.x.PID-ID.partial``, which a batch may be fitting."""
+    import re
+
+    pattern = re.compile(rf"\.{re.escape(name)}(\.[^.]*)?\.partial")
+    try:
+        return [p for p in root.iterdir() if pattern.fullmatch(p.name) and p.is_dir()]
+    except OSError:  # no root yet: nothing partial
+        return []
+
+
+def plan_batch(sources: list[Path], root: Path) -> list[Path]:
+    """The sources of a batch still to fit (their output folder does not exist), after removing
+    the partial folders a killed run left for them. Refuses two sources with one output name."""
+    import shutil
+
+    by_name: dict[str, list[Path]] = {}
+    for s in sources:
+        by_name.setdefault(batch_out_dir(root, s).name, []).append(s)
+    clashes = {n: ss for n, ss in by_name.items() if len(ss) > 1}
+    if clashes:
+        # which sources, and what to do: it had said only "two sources would write to the same
+        # folder: ['coin']", of two days' sessions both named coin (or one given twice)
+        said = "; ".join(
+            f"{', '.join(map(str, ss))} -> {root / n}" for n, ss in sorted(clashes.items())
+        )
+        raise FitInputError(
+            f"sources would write to the same output folder ({said}): a batch names each "
+            "output after its session folder (an .lp's after its folder and stem); give each "
+            "source once, and fit sessions whose folders share a name in separate batches "
+            "(another --out) or rename one of the folders"
+        )
+    # a file given for --out is said to be one (it had been "cannot create the batch folder
+    # (File exists)"), in the words of ensure_writable_folder; its probe file is not written
+    # here, as two batches may plan into one folder at once
+    refuse_a_file_in_the_way(root)
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FitInputError(
+            f"--out {root}: cannot create the batch folder ({exc.strerror or exc}); choose a "
+            "folder you can write to"
+        ) from None
+    todo = []
+    for source in sources:
+        final = batch_out_dir(root, source)
+        # a finished session's too: a Dask worker killed mid-session leaves its attempt's
+        # partial folder while the retry finishes the session (see fit_one)
+        for partial in partial_folders(root, final.name):
+            shutil.rmtree(partial, ignore_errors=True)
+        if not earlier_fit(final, source).stands:
+            todo.append(source)
+    return todo
+
+
+#: What a batch says of a session whose earlier fit stands, after "skipped".
+FINISHED_EARLIER = " (finished earlier)"
+
+
+@dataclass(frozen=True)
+class EarlierFit:
+    """What a batch finds of a session's earlier fit (:func:`earlier_fit`)."""
+
+    #: its output folder holds an earlier fit
+    found: bool
+    #: why that fit is to be replaced (its session changed since), or None
+    outgrown: str | None = None
+    #: what a skip says after "skipped (finished earlier)"
+    note: str = ""
+
+    @property
+    def stands(self) -> bool:
+        """The earlier fit is kept and the session skipped."""
+        return self.found and self.outgrown is None
+
+    @property
+    def skip_detail(self) -> str:
+        """The words after "skipped" in a batch's line for the session."""
+        return FINISHED_EARLIER + self.note
+
+
+def earlier_fit(final: Path, source: Path) -> EarlierFit:
+    """Whether ``final`` holds an earlier fit of ``source``, and whether it stands: not when
+    its session changed since that fit (its ``fit.json`` records what it was made from,
+    :func:`acquisition_inputs`; ``outgrown`` says how).
+
+    Why: only the folder's existence was checked, so a session fitted while interrupted and
+    then continued with ``run --resume`` (or mended with ``--reshoot-lost``) kept its
+    out-of-date fit, reported "skipped (finished earlier)". A fit that records nothing (made
+    before the record was kept) is skipped with a word on how to have it refitted: refitting
+    every such session unasked would redo a whole backlog (so is one whose record is in the
+    form kept before the lights were recorded as directions)."""
+    if not final.exists():
+        return EarlierFit(found=False)
+    try:
+        summary = json.loads((final / "fit.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        summary = None
+    if (
+        not isinstance(summary, dict)
+        or summary.get(INPUTS_KEY) is None
+        or (isinstance(summary[INPUTS_KEY], dict) and not is_record(summary[INPUTS_KEY]))
+    ):
+        return EarlierFit(
+            found=True,
+            note=(
+                "; its fit.json does not record what it was fitted from, so whether its "
+                f"session changed since cannot be told: delete {final} to fit it again"
+            ),
+        )
+    now = acquisition_inputs(source)
+    if now is None:  # the refit says what is wrong with the source; the earlier fit stays
+        return EarlierFit(True, "its session cannot be read as it was when fitted")
+    changed = change_since(summary[INPUTS_KEY], now)
+    if changed is None:
+        return EarlierFit(found=True)
+    return EarlierFit(True, f"its session changed since the earlier fit: {changed}")
+
+
+def fit_one(
+    source: Path, root: Path, template: FitRequest, bands: BandRunner | None = None
+) -> BatchItem:
+    """One session of a batch: fitted into a partial folder of its own (unique per attempt, so
+    that a retried or orphaned attempt never writes into another's), renamed to
+    :func:`batch_out_dir` when complete. If another attempt finished first, its folder stands
+    and this one's is discarded. Runs in this process or as a task on a Dask worker; ``bands``
+    as for :func:`run_fit`."""
+    import os
+    import shutil
+    import uuid
+    from dataclasses import replace
+
+    final = batch_out_dir(root, source)
+    earlier = earlier_fit(final, source)
+    outgrown = earlier.outgrown
+    if earlier.stands:
+        return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail)
+    attempt = f"{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    partial = root / f".{final.name}.{attempt}.partial"
+    try:
+        result = run_fit(replace(template, source=source, out_dir=partial), bands)
+    except RtiRigError as exc:
+        shutil.rmtree(partial, ignore_errors=True)
+        kept = f" (the earlier fit in {final} is kept)" if outgrown and final.exists() else ""
+        return BatchItem(source, final, Outcome.FAILED, f": {exc}{kept}")
+    if outgrown is not None and final.exists():
+        # the earlier fit is set aside only now that its successor is complete, under a
+        # partial folder's name (a batch killed between the renames removes it and refits)
+        set_aside = root / f".{final.name}.{attempt}-earlier.partial"
+        try:
+            final.rename(set_aside)
+        except FileNotFoundError:  # another attempt replaced it meanwhile: rename as below
+            pass
+        else:
+            try:
+                partial.rename(final)
+            except OSError:
+                set_aside.rename(final)
+                shutil.rmtree(partial, ignore_errors=True)
+                raise
+            shutil.rmtree(set_aside, ignore_errors=True)
+    try:
+        if partial.exists():
+            partial.rename(final)  # atomic; refused when a finished folder is already there
+    except OSError:
+        shutil.rmtree(partial, ignore_errors=True)
+        if not final.exists():
+            raise
+    # Earlier attempts' partial folders: a Dask worker killed mid-session cannot remove its
+    # own, and the retry that finished the session had left it in --out (hundreds of MB of a
+    # large session, a successful batch, never removed: later runs skip finished sessions).
+    # An attempt still running elsewhere then fails on its worker; the session is finished.
+    for stale in partial_folders(root, final.name):
+        shutil.rmtree(stale, ignore_errors=True)
+    return BatchItem(
+        source,
+        final,
+        Outcome.DONE if outgrown is None else Outcome.REFITTED,
+        "" if outgrown is None else f" ({outgrown})",
+        result.qa.verdict if result.qa is not None else None,
+        tuple(result.notes),
+        tuple(result.warnings),
+    )
