@@ -11,7 +11,9 @@ its temporary file), ``between_files`` (TIFF renamed, JPEG not written), ``befor
 files complete, journal line not written), ``after_record`` (the step's record file
 ``records/BASE.json`` written, its journal line not), ``after_journal`` (the journal line
 written, nothing after it), and ``stall`` (no kill: capture K blocks for up to 60 s of real
-time, so that another process can signal the run at a known step).
+time, so that another process can signal the run at a known step). One stage is a batch fit's
+(``fit S1 S2 --out ROOT``), not a run's: ``refit_swap`` dies between the two renames of its
+K-th refit (the earlier fit set aside, the new one not yet in its place).
 """
 
 from __future__ import annotations
@@ -21,7 +23,9 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 STAGES = (
     "before_light",
@@ -33,6 +37,7 @@ STAGES = (
     "after_record",
     "after_journal",
     "stall",
+    "refit_swap",
 )
 
 
@@ -119,6 +124,26 @@ def install(stage: str, k: int) -> None:
     sim_camera.SimulatedCamera.capture = capture  # type: ignore[method-assign]
     image_files._atomic_write = atomic_write
     session.asdict = asdict  # type: ignore[assignment]
+    if stage == "refit_swap":
+        _die_in_refit_swap(k, die)
+
+
+def _die_in_refit_swap(k: int, die: Callable[[], None]) -> None:
+    """Die right after the ``k``-th rename that sets a batch's earlier fit aside."""
+    from rti_rig.app.usecases import fit_batch
+
+    real_rename = Path.rename
+    renamed = [0]
+
+    def rename(self: Path, target: Any) -> Path:
+        result = real_rename(self, target)
+        if Path(target).name.endswith(fit_batch.EARLIER_SUFFIX):
+            if renamed[0] == k:
+                die()
+            renamed[0] += 1
+        return result
+
+    Path.rename = rename  # type: ignore[method-assign]
 
 
 def popen_session(

@@ -147,11 +147,86 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
         final = batch_out_dir(root, source)
         # a finished session's too: a Dask worker killed mid-session leaves its attempt's
         # partial folder while the retry finishes the session (see fit_one)
+        # an interrupted swap's new fit is kept for fit_one to put in place (finish_swap)
+        keep = {_swap_partial(b) for b in earlier_backups(root, final.name)}
+        if final.exists():  # the swap had ended: its backup is an outgrown fit
+            keep = set()
+            for backup in earlier_backups(root, final.name):
+                shutil.rmtree(backup, ignore_errors=True)
         for partial in partial_folders(root, final.name):
-            shutil.rmtree(partial, ignore_errors=True)
+            if partial not in keep:
+                shutil.rmtree(partial, ignore_errors=True)
         if not earlier_fit(final, source).stands:
             todo.append(source)
     return todo
+
+
+def earlier_backups(root: Path, name: str) -> list[Path]:
+    """The earlier fits of session output ``root/name`` that a refit set aside
+    (``.NAME.ATTEMPT.earlier``), oldest first: a refit keeps the fit it replaces under this
+    name until the new one is in place (:func:`fit_one`)."""
+    import re
+
+    pattern = re.compile(rf"\.{re.escape(name)}\.([^.]+)\{EARLIER_SUFFIX}")
+    try:
+        found = [p for p in root.iterdir() if pattern.fullmatch(p.name) and p.is_dir()]
+    except OSError:
+        return []
+
+    def when(p: Path) -> int:
+        try:
+            return p.stat().st_mtime_ns
+        except OSError:  # removed meanwhile by another attempt
+            return 0
+
+    return sorted(found, key=when)
+
+
+#: The ending of the folder a refit keeps the earlier fit in while it swaps the new one in.
+EARLIER_SUFFIX = ".earlier"
+
+
+def _swap_partial(backup: Path) -> Path:
+    """The partial folder of the attempt that set ``backup`` aside (the same ATTEMPT)."""
+    return backup.with_name(backup.name.removesuffix(EARLIER_SUFFIX) + ".partial")
+
+
+def finish_swap(root: Path, final: Path) -> str:
+    """Finish or undo a refit's swap that a kill interrupted, so that ``final`` holds a fit
+    again; what was done, in words (``""`` when there was nothing to do).
+
+    Why: the swap is two renames (the earlier fit aside, the new one in); a batch killed
+    between them had left neither in ``final``, and the next run removed both as partial
+    folders, so a session whose refit then failed had no fit at all. The new fit, complete
+    (its ``fit.json`` is written last), is put in place; otherwise the earlier fit is put
+    back."""
+    import shutil
+
+    backups = earlier_backups(root, final.name)
+    if not backups or final.exists():
+        return ""
+    backup, older = backups[-1], backups[:-1]
+    new = _swap_partial(backup)
+    try:
+        if (new / "fit.json").is_file():
+            new.rename(final)
+            words = (
+                f"a refit of this session was interrupted while it swapped in its new fit: "
+                f"the new fit, complete, was put in place in {final}"
+            )
+        else:
+            backup.rename(final)
+            words = (
+                f"a refit of this session was interrupted before its new fit was complete: "
+                f"the earlier fit was put back in {final}"
+            )
+    except OSError:  # another attempt finished it meanwhile
+        if not final.exists():
+            raise
+        return ""
+    for stale in (*older, backup, new):
+        shutil.rmtree(stale, ignore_errors=True)
+    return words
 
 
 #: What a batch says of a session whose earlier fit stands, after "skipped".
@@ -232,10 +307,12 @@ def fit_one(
     from dataclasses import replace
 
     final = batch_out_dir(root, source)
+    swapped = finish_swap(root, final)
+    said = (swapped,) if swapped else ()
     earlier = earlier_fit(final, source)
     outgrown = earlier.outgrown
     if earlier.stands:
-        return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail)
+        return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail, notes=said)
     attempt = f"{os.getpid()}-{uuid.uuid4().hex[:8]}"
     partial = root / f".{final.name}.{attempt}.partial"
     try:
@@ -243,11 +320,12 @@ def fit_one(
     except RtiRigError as exc:
         shutil.rmtree(partial, ignore_errors=True)
         kept = f" (the earlier fit in {final} is kept)" if outgrown and final.exists() else ""
-        return BatchItem(source, final, Outcome.FAILED, f": {exc}{kept}")
+        return BatchItem(source, final, Outcome.FAILED, f": {exc}{kept}", notes=said)
     if outgrown is not None and final.exists():
         # the earlier fit is set aside only now that its successor is complete, under a
-        # partial folder's name (a batch killed between the renames removes it and refits)
-        set_aside = root / f".{final.name}.{attempt}-earlier.partial"
+        # backup's name: a batch killed between the renames is finished by the next run's
+        # finish_swap (the new fit put in place), never left without a fit
+        set_aside = root / f".{final.name}.{attempt}{EARLIER_SUFFIX}"
         try:
             final.rename(set_aside)
         except FileNotFoundError:  # another attempt replaced it meanwhile: rename as below
@@ -279,6 +357,6 @@ def fit_one(
         Outcome.DONE if outgrown is None else Outcome.REFITTED,
         "" if outgrown is None else f" ({outgrown})",
         result.qa.verdict if result.qa is not None else None,
-        tuple(result.notes),
+        (*said, *result.notes),
         tuple(result.warnings),
     )
