@@ -549,14 +549,17 @@ def complete_session_lp(source: Path) -> str | None:
     return list_unwritten_step(root)
 
 
-def acquisition_inputs(source: Path) -> dict[str, Any] | None:
+def acquisition_inputs(source: Path, files: dict[str, Path] | None = None) -> dict[str, Any] | None:
     """The record of what a fit of ``source`` reads (:func:`inputs_record`: its images by the
     checksums its session's journal holds, if it has one), or None when it cannot be read as an
-    acquisition (the fit itself says why)."""
+    acquisition (the fit itself says why). ``files``, if given, is filled with each image's
+    file by its name in the record (a batch hashes the one whose size or time changed)."""
     try:
         lp, lights, paths, names = acquisition_files(source)
     except (RtiRigError, OSError, ValueError):
         return None
+    if files is not None:
+        files.update((str(n), Path(p)) for n, p in zip(names, paths, strict=True))
     try:
         journaled = journaled_checksums(lp.parent)
     except (RtiRigError, OSError):  # a journal that cannot be read: its images by their files

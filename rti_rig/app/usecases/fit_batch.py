@@ -21,9 +21,16 @@ from rti_rig.app.usecases.fit import (
     acquisition_inputs,
     run_fit,
 )
-from rti_rig.app.usecases.fit_inputs import INPUTS_KEY, change_since, is_record
+from rti_rig.app.usecases.fit_inputs import (
+    INPUTS_KEY,
+    change_since,
+    is_record,
+    journal_lost,
+    judged_by_stat,
+)
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
+from rti_rig.runtime.session import JOURNAL
 
 
 class Outcome(Enum):
@@ -284,13 +291,59 @@ def earlier_fit(final: Path, source: Path) -> EarlierFit:
                 f"session changed since cannot be told: delete {final} to fit it again"
             ),
         )
-    now = acquisition_inputs(source)
+    files: dict[str, Path] = {}
+    now = acquisition_inputs(source, files)
     if now is None:  # the refit says what is wrong with the source; the earlier fit stays
         return EarlierFit(True, "its session cannot be read as it was when fitted")
-    changed = change_since(summary[INPUTS_KEY], now)
+    record = summary[INPUTS_KEY]
+    lost = journal_lost(record, now)
+    if lost and not judged_by_stat(record):
+        return EarlierFit(
+            True,
+            f"{_journal_gone(source)}, and the earlier fit's record names its images by that "
+            "journal's checksums only, so whether they changed cannot be told: refitted",
+        )
+    changed = change_since(record, now, lambda name: _file_sha256(files.get(name)))
+    if lost:
+        how = "judged by its images' sizes and modification times"
+        if changed is None:
+            return EarlierFit(True, note=f"; {_journal_gone(source)}: {how}, which match the fit")
+        return EarlierFit(True, f"{_journal_gone(source)}; {how}: {changed}")
     if changed is None:
         return EarlierFit(found=True)
     return EarlierFit(True, f"its session changed since the earlier fit: {changed}")
+
+
+def _journal_gone(source: Path) -> str:
+    """Words for a session whose journal the earlier fit's record relied on and that is now
+    missing or unreadable, naming the file."""
+    root = source if source.is_dir() else source.parent
+    journal = root / JOURNAL
+    state = "cannot be read" if journal.exists() else "is missing"
+    return f"its session's journal {journal} {state} since the earlier fit"
+
+
+#: Files hashed by this process, by (path, size, mtime_ns): a batch judges each session twice
+#: (plan_batch, then fit_one), and an image whose size or time changed had been read twice.
+_HASHED: dict[tuple[str, int, int], str] = {}
+
+
+def _file_sha256(path: Path | None) -> str | None:
+    """The sha256 of the file at ``path``, read in chunks, or None when it cannot be read; a
+    file this process hashed is not read again while its size and time are unchanged."""
+    import hashlib
+
+    if path is None:
+        return None
+    try:
+        st = path.stat()
+        key = (str(path), st.st_size, st.st_mtime_ns)
+        if key not in _HASHED:
+            with path.open("rb") as fh:
+                _HASHED[key] = hashlib.file_digest(fh, "sha256").hexdigest()
+    except OSError:
+        return None
+    return _HASHED[key]
 
 
 def fit_one(

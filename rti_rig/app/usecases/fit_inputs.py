@@ -22,7 +22,7 @@ session and say how:
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -56,16 +56,17 @@ def inputs_record(
                 sums = journaled.get(Path(path).relative_to(root).as_posix())
             except ValueError:  # an image outside the session folder
                 sums = None
+        st = Path(path).stat()
+        image: dict[str, Any] = {"name": str(name)}
         if sums is not None:
-            image = {"name": str(name), "sha256": sums[0]}
+            image["sha256"] = sums[0]
             if sums[1] is not None:
                 image["pixels_sha256"] = sums[1]  # what :func:`as_read` compares
-            images.append(image)
-        else:
-            st = Path(path).stat()
-            images.append(
-                {"name": str(name), "size": int(st.st_size), "mtime_ns": int(st.st_mtime_ns)}
-            )
+        # kept beside a checksum too: a batch tells an image unchanged since the fit by them
+        # without reading it, and one edited in place (or a session whose journal is lost
+        # since) by them first (:func:`change_since`)
+        image["size"], image["mtime_ns"] = int(st.st_size), int(st.st_mtime_ns)
+        images.append(image)
     directions = [[float(x) for x in d] for d in np.asarray(lights, dtype=np.float64)]
     return {"images": images, "lights": directions}
 
@@ -82,7 +83,8 @@ def as_read(record: dict[str, Any], read_pixels: Sequence[str | None]) -> dict[s
     for image, got in zip(record["images"], read_pixels, strict=True):
         captured = image.get("pixels_sha256")
         if got is not None and captured is not None and got != captured:
-            image = {"name": image["name"], "read_pixels_sha256": got}
+            kept = {k: image[k] for k in ("size", "mtime_ns") if k in image}
+            image = {"name": image["name"], "read_pixels_sha256": got, **kept}
         images.append(image)
     return {**record, "images": images}
 
@@ -94,44 +96,110 @@ def is_record(earlier: Any) -> bool:
     return isinstance(earlier, dict) and "lights" in earlier
 
 
-def _image_key(image: Any) -> tuple[str, tuple[Any, ...]]:
-    """An image of a record as (name, what identifies its content)."""
-    if "sha256" in image:
-        return str(image["name"]), ("sha256", str(image["sha256"]))
-    if "read_pixels_sha256" in image:  # not as captured when fitted: differs from any capture
-        return str(image["name"]), ("read", str(image["read_pixels_sha256"]))
-    return str(image["name"]), ("stat", int(image["size"]), int(image["mtime_ns"]))
+#: Hashes an image of the acquisition now, by its name in the record: the sha256 of its file,
+#: or None when it cannot be read.
+Digest = Callable[[str], "str | None"]
+
+
+def _same_stat(before: Mapping[str, Any], now: Mapping[str, Any]) -> bool:
+    """Whether an image's size and modification time are those ``before`` recorded."""
+    try:
+        return (int(before["size"]), int(before["mtime_ns"])) == (
+            int(now["size"]),
+            int(now["mtime_ns"]),
+        )
+    except (KeyError, TypeError, ValueError):  # a record that kept no size or time
+        return False
+
+
+def _image_change(
+    before: Mapping[str, Any], now: Mapping[str, Any], digest: Digest | None
+) -> str | None:
+    """How one image differs from the fit's record of it: ``"changed"`` (a new capture or other
+    file), ``"edited"`` (its file is no longer what its journal took at capture: edited or
+    damaged in place since the fit), or None when it is the image fitted.
+
+    Size and time first, which cost no read: an image the journal vouches for whose size or
+    time differ is hashed (a copy without timestamps then stands; an image edited in place
+    had stood too, found by the fit's QA only). Without a journal's checksum now (a plain
+    ``.lp``, or a session whose journal is lost since the fit) size and time decide."""
+    if "sha256" in now:
+        if "sha256" in before:
+            if str(before["sha256"]) != str(now["sha256"]):
+                return "changed"
+            if "size" not in before or _same_stat(before, now):
+                return None  # a record without size and time: the journal's word, as before
+            got = digest(str(now["name"])) if digest is not None else None
+            return None if got == str(now["sha256"]) else "edited"
+        if "read_pixels_sha256" in before:  # fitted from an image not as captured
+            return None if _same_stat(before, now) else "changed"
+    return None if _same_stat(before, now) else "changed"
+
+
+def _shown_names(images: Sequence[Mapping[str, Any]]) -> list[str]:
+    return [str(i["name"]) for i in images]
 
 
 def _shown(items: Sequence[str]) -> str:
     return ", ".join(items[:_SHOWN]) + (" …" if len(items) > _SHOWN else "")
 
 
-def change_since(earlier: Any, now: dict[str, Any]) -> str | None:
+def change_since(earlier: Any, now: dict[str, Any], digest: Digest | None = None) -> str | None:
     """How the acquisition recorded ``now`` differs from the ``earlier`` record, in words
-    ("11 → 48 images"; "2 of 8 images changed: image_003, image_005"; "1 of 8 lights moved:
-    image_004's by 0.20°"), or None when it matches. An ``earlier`` record that cannot be
-    read (a damaged ``fit.json``) differs."""
+    ("11 → 48 images"; "2 of 8 images changed: image_003, image_005"; "1 of 8 images changed
+    on disk since its capture …: image_003"; "1 of 8 lights moved: image_004's by 0.20°"), or
+    None when it matches. ``digest`` hashes an image whose size or time changed (see
+    :func:`_image_change`). An ``earlier`` record that cannot be read (a damaged ``fit.json``)
+    differs."""
     try:
-        before = [_image_key(i) for i in earlier["images"]]
+        before = list(earlier["images"])
+        names_before = _shown_names(before)
         lights_before = np.asarray(earlier["lights"], dtype=np.float64)
     except (TypeError, KeyError, ValueError):
         return "its fit.json's record of what it was fitted from cannot be read"
-    after = [_image_key(i) for i in now["images"]]
+    after = list(now["images"])
+    names = _shown_names(after)
     lights_now = np.asarray(now["lights"], dtype=np.float64)
     said = []
     if len(before) != len(after):
         said.append(f"{len(before)} → {len(after)} images")
-    elif [b[0] for b in before] != [a[0] for a in after]:
+    elif names_before != names:
         said.append("its images are not the ones fitted")
     else:
-        changed = [a[0] for a, b in zip(after, before, strict=True) if a != b]
+        kinds = [_image_change(b, a, digest) for b, a in zip(before, after, strict=True)]
+        changed = [n for n, k in zip(names, kinds, strict=True) if k == "changed"]
+        edited = [n for n, k in zip(names, kinds, strict=True) if k == "edited"]
         if changed:
             said.append(f"{len(changed)} of {len(after)} images changed: {_shown(changed)}")
+        if edited:
+            said.append(
+                f"{len(edited)} of {len(after)} images changed on disk since their capture "
+                f"(same name, not the checksum their journal took): {_shown(edited)}"
+            )
     if len(before) == len(after) and lights_before.shape == lights_now.shape:
         moved = moved_lights(lights_before, lights_now)
         if moved:
             order = sorted(moved, key=lambda i: -moved[i])
-            each = [f"{after[i][0]}'s by {degrees_text(moved[i])}" for i in order]
+            each = [f"{names[i]}'s by {degrees_text(moved[i])}" for i in order]
             said.append(f"{len(moved)} of {len(after)} lights moved: {_shown(each)}")
     return "; ".join(said) or None
+
+
+def journal_lost(earlier: Any, now: dict[str, Any]) -> bool:
+    """Whether the ``earlier`` record named images by their journal's checksums and ``now``
+    names none so (the session's journal is gone, or cannot be read, since the fit)."""
+    try:
+        had = any("sha256" in i or "read_pixels_sha256" in i for i in earlier["images"])
+    except (TypeError, KeyError):
+        return False
+    return had and not any("sha256" in i for i in now["images"])
+
+
+def judged_by_stat(earlier: Any) -> bool:
+    """Whether the ``earlier`` record kept each image's size and time (records before they
+    were kept beside a journal's checksum did not: such an image cannot be compared without
+    its journal)."""
+    try:
+        return all("size" in i and "mtime_ns" in i for i in earlier["images"])
+    except (TypeError, KeyError):
+        return False

@@ -1,0 +1,130 @@
+"""A batch tells an image edited in place, and says when the journal it relied on is lost.
+
+An image edited in place (same name, different bytes) kept the checksum its journal took at
+capture, so the batch's record matched and the out-of-date fit stood ("skipped (finished
+earlier)"); only a new fit's QA found it. And a session whose journal was lost since its fit
+was refitted as "6 of 6 images changed", which no image had: the batch compared the journal's
+checksums with sizes and times, and did not say the journal was gone.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import SMALL_DOME, said, write_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def batch(*sources: Path, out: Path):  # type: ignore[no-untyped-def]
+    """``rti-rig fit S... --out OUT`` as a user runs it (PS: any light count from 3 fits)."""
+    args = ["fit", *map(str, sources), "--out", str(out), "--model", "ps", "--no-qa"]
+    return runner.invoke(app, args)
+
+
+def fitted(tmp_path: Path) -> tuple[Path, Path, Path]:
+    """Sessions S and T (6 lights each), fitted by a batch into FB: (S, T, FB)."""
+    cfg = write_config(tmp_path, SMALL_DOME)
+    s, t, fb = tmp_path / "S", tmp_path / "T", tmp_path / "FB"
+    for session in (s, t):
+        r = runner.invoke(app, ["run", str(cfg), "--out", str(session), "--lights", "6"])
+        assert r.exit_code == 0, r.output
+    r = batch(s, t, out=fb)
+    assert r.exit_code == 0 and said(r).count(": done") == 2, r.output
+    return s, t, fb
+
+
+def later(path: Path) -> None:
+    """Give ``path`` a modification time a second after its own (an edit, a ``touch``)."""
+    st = path.stat()
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_an_image_edited_in_place_is_refitted_and_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    s, t, fb = fitted(tmp_path)
+    hashed: list[Path] = []
+    real = hashlib.file_digest
+
+    def counted(fh: Any, digest: Any) -> Any:  # every image file the batch reads to hash it
+        hashed.append(Path(fh.name))
+        return real(fh, digest)
+
+    monkeypatch.setattr(hashlib, "file_digest", counted)
+    r = batch(s, t, out=fb)
+    assert said(r).count("skipped (finished earlier)") == 2, r.output
+    assert hashed == []  # nothing changed in size or time: nothing read
+
+    tif = s / "linear" / "image_003.tif"
+    data = bytearray(tif.read_bytes())
+    data[-100] ^= 0xFF  # same name, same size, other content
+    tif.write_bytes(bytes(data))
+    later(tif)
+    r = batch(s, t, out=fb)
+    assert r.exit_code == 0, r.output
+    assert (
+        f"{s}: refitted (its session changed since the earlier fit: 1 of 6 images changed on "
+        "disk since their capture (same name, not the checksum their journal took): "
+        "image_003)" in said(r)
+    ), r.output
+    assert f"{t}: skipped (finished earlier)" in said(r), r.output
+    assert hashed == [tif]  # only the image whose time changed was read
+
+    r = batch(s, t, out=fb)  # refitted from the image as it now is: it stands
+    assert said(r).count("skipped (finished earlier)") == 2, r.output
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_a_lost_journal_is_said_and_the_images_judged_by_size_and_time(tmp_path: Path) -> None:
+    s, t, fb = fitted(tmp_path)
+    journal = s / "journal.jsonl"
+    shutil.move(journal, tmp_path / "journal.jsonl")
+    r = batch(s, t, out=fb)
+    assert r.exit_code == 0, r.output
+    lost = f"its session's journal {journal} is missing since the earlier fit"
+    assert (
+        f"{s}: skipped (finished earlier); {lost}: judged by its images' sizes and "
+        "modification times, which match the fit" in said(r)
+    ), r.output
+
+    later(s / "linear" / "image_002.tif")
+    r = batch(s, t, out=fb)
+    assert r.exit_code == 0, r.output
+    assert (
+        f"{s}: refitted ({lost}; judged by its images' sizes and modification times: 1 of 6 "
+        "images changed: image_002)" in said(r)
+    ), r.output
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_a_lost_journal_with_a_record_of_checksums_only_is_refitted_saying_so(
+    tmp_path: Path,
+) -> None:
+    s, t, fb = fitted(tmp_path)
+    summary_file = fb / "S" / "fit.json"
+    summary = json.loads(summary_file.read_text(encoding="utf-8"))
+    for image in summary["inputs"]["images"]:  # a record kept before sizes and times were
+        image.pop("size"), image.pop("mtime_ns")
+    summary_file.write_text(json.dumps(summary), encoding="utf-8")
+    (s / "journal.jsonl").unlink()
+    r = batch(s, t, out=fb)
+    assert r.exit_code == 0, r.output
+    assert (
+        f"{s}: refitted (its session's journal {s / 'journal.jsonl'} is missing since the "
+        "earlier fit, and the earlier fit's record names its images by that journal's "
+        "checksums only, so whether they changed cannot be told: refitted)" in said(r)
+    ), r.output
