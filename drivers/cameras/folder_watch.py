@@ -89,6 +89,7 @@ from rti_rig.drivers.cameras.tiff_structure import (
     SAVE_AGAIN,
     SAVE_READABLE,
     first_ifd,
+    ifd_garbage,
 )
 
 RAW_SUFFIXES = {
@@ -310,7 +311,9 @@ def _tiff_capture_time(path: Path) -> tuple[bool, float | None]:
     trails the shot by a varying transfer time, and would set in-step files aside. False (wait)
     while tifffile cannot read a file that begins as a TIFF (one still being written); True
     for one whose first bytes are written and are no TIFF's: it never will be one, and had
-    cost ``timeout_s`` before its notice said it held no capture time."""
+    cost ``timeout_s`` before its notice said it held no capture time. True too for one whose
+    first IFD is garbage no writer on its way leaves (:func:`ifd_garbage`): its decode names
+    it, and the wait here had cost ``timeout_s`` before that."""
     import tifffile
 
     try:
@@ -318,8 +321,8 @@ def _tiff_capture_time(path: Path) -> tuple[bool, float | None]:
             # pages[0], not pages.first: newer than the tifffile pyproject.toml allows
             exif = tif.pages[0].tags.get("ExifTag")
             stamp = exif.value.get("DateTimeOriginal") if exif is not None else None
-    except Exception:  # not whole yet, or no TIFF: its first bytes say which
-        return _not_a_tiff(path), None
+    except Exception:  # not whole yet, no TIFF, or a garbage IFD: its bytes say which
+        return _not_a_tiff(path) or ifd_garbage(path) is not None, None
     return True, _exif_time(stamp)
 
 
@@ -1007,7 +1010,9 @@ class FolderWatchCamera:
         TIFF whose first bytes are written and are no TIFF's, or a whole TIFF (every byte its
         IFDs name written, the last ones not zeros) whose data will not decode, or one read as
         no pixels whose first IFD is all written (:func:`first_ifd`) and names no data, data
-        inside the file or garbage: each is said at once, naming the file. A TIFF whose IFD
+        inside the file or garbage, or one whose first IFD holds what no writer on its way
+        leaves (:func:`ifd_garbage`: a tag count over 4096, an entry of no TIFF type, an
+        offset inside the header): each is said at once, naming the file. A TIFF whose IFD
         is not there yet (libtiff writes it last, tifffile zeroed until its data is out) is
         waited for. Messages are worded here from the decoders' fields.
 
@@ -1091,6 +1096,23 @@ class FolderWatchCamera:
                         path,
                         "is a damaged TIFF (its header and first IFD are written, but its IFDs "
                         "name no image data that reads)",
+                        SAVE_AGAIN,
+                    ) from exc
+                if (
+                    tiff
+                    and steady
+                    and tried is not None
+                    and (garbage := ifd_garbage(path)) is not None
+                    # not a file a share sized first and is still filling (its end zeros)
+                    and _tiff_end_written(path, 0, tried[2])
+                ):
+                    # a header naming an IFD inside the file that holds what no writer on its
+                    # way leaves (its slot zeros, or none named yet): it had been waited for
+                    raise self._damaged(
+                        message,
+                        path,
+                        f"is a damaged TIFF ({garbage}; its size steady over "
+                        f"{s.stable_polls} polls)",
                         SAVE_AGAIN,
                     ) from exc
                 if (

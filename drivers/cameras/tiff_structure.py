@@ -99,6 +99,66 @@ def first_ifd(path: Path) -> FirstIfd | None:
     return FirstIfd(offset, end, types)
 
 
+def ifd_garbage(path: Path) -> str | None:
+    """Why ``path``'s first IFD is garbage no writer on its way leaves, as a phrase ("its
+    first IFD, at byte 8, gives a tag count of 23125 …"); None when it may yet be written, or
+    is not known to be garbage, or the file cannot be read.
+
+    Why: only :func:`first_ifd`'s whole, plausible IFD had been judged, so a TIFF whose header
+    names an IFD inside the file that holds a count over :data:`MAX_TAGS` (tifffile refuses it
+    as "suspicious"), or whose written entries have types no TIFF has, cost ``timeout_s``
+    before it was named. A writer's or a copy's IFD not written yet reads otherwise: libtiff's
+    header names none (0) until the IFD is there, tifffile's slot is zeros (a count of 0), a
+    share that sizes a file first reads zeros where it has not filled, and a copy cut short
+    ends inside an IFD whose count and entries so far are the writer's own. So a non-zero
+    offset inside the header, a count over :data:`MAX_TAGS`, or an entry in the file with a
+    non-zero type no TIFF has is damage. (Whether the file's size is steady and its end
+    written is the caller's to add.)"""
+    try:
+        size = path.stat().st_size
+        with path.open("rb") as f:
+            head = f.read(16)
+            layout = _LAYOUTS.get(head[:4])
+            if layout is None:
+                return None
+            order, header, count_size, entry_size, _ = layout
+            if len(head) < header:
+                return None
+            if header == 8:
+                (offset,) = struct.unpack(f"{order}I", head[4:8])
+            else:
+                (offset,) = struct.unpack(f"{order}Q", head[8:16])
+            if 0 < offset < header:
+                return (
+                    f"its header names its first IFD at byte {offset}, inside the "
+                    f"{header}-byte header"
+                )
+            if offset == 0 or offset + count_size > size:
+                return None  # none named yet (libtiff), or past the end (a copy cut short)
+            f.seek(offset)
+            raw = f.read(count_size)
+            if len(raw) < count_size:
+                return None
+            (count,) = struct.unpack(f"{order}{'H' if count_size == 2 else 'Q'}", raw)
+            if count > MAX_TAGS:
+                return (
+                    f"its first IFD, at byte {offset}, gives a tag count of {count}, more than "
+                    f"any writer writes ({MAX_TAGS}); a writer's IFD not written yet reads 0"
+                )
+            # the entries that are in the file (a copy cut short holds only the first ones)
+            entries = f.read(min(count, (size - offset - count_size) // entry_size) * entry_size)
+    except OSError:
+        return None
+    for n in range(len(entries) // entry_size):
+        (kind,) = struct.unpack_from(f"{order}H", entries, n * entry_size + 2)
+        if kind != 0 and kind not in TIFF_TYPES:
+            return (
+                f"entry {n + 1} of its first IFD, at byte {offset}, has data type {kind}, "
+                "which no TIFF has"
+            )
+    return None
+
+
 #: TIFF compressions the reader (tifffile with imagecodecs) decodes for a camera's 16-bit
 #: RGB image, and what a program's save dialog calls them (the advice names the first three)
 READ_COMPRESSIONS = {

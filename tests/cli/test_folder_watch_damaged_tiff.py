@@ -189,3 +189,50 @@ def test_run_waits_for_a_libtiff_tiff_whose_copy_paused_and_records_it_whole(
     assert (out / "raw" / "image_001.tif").read_bytes() == encoded.tobytes()  # whole
     assert (out / "linear" / "image_002.tif").exists()
     assert lit_at_end == []
+
+
+def _garbage_ifd_tiff(scratch: Path) -> bytes:
+    """A whole 16-bit TIFF whose first IFD's tag count is garbage (bytes XORed, as a copy
+    gone wrong leaves them): its header names the IFD at a byte inside the file."""
+    tifffile.imwrite(scratch, np.full((64, 64, 3), 30000, np.uint16), photometric="rgb")
+    data = scratch.read_bytes()
+    scratch.unlink()
+    ifd = int.from_bytes(data[4:8], "little")
+    assert 8 <= ifd < len(data)
+    return data[:ifd] + bytes(b ^ 0x5A for b in data[ifd : ifd + 2]) + data[ifd + 2 :]
+
+
+def test_run_names_a_tiff_whose_first_ifd_is_garbage_at_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A whole TIFF, its size steady, whose header names a first IFD inside the file that
+    holds a tag count no writer writes (tifffile: "suspicious number of tags"): ``rti-rig
+    run`` had waited ``timeout_s`` (its capture-time read, then its decode), then advised
+    raising stable_polls. A writer on its way leaves that slot zeros (tifffile) or names no
+    IFD yet (libtiff): the file is named at once as damaged, with what to do."""
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    out = tmp_path / "s"
+    cfg = _config(tmp_path, tether)
+    data = _garbage_ifd_tiff(tmp_path / "scratch.tif")
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, data)
+        camera.start()
+        try:
+            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            r = CliRunner().invoke(app, args, terminal_width=400)
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+        lit_at_end = firmware.lit_indices()
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said, said
+    assert "IMG_0001.tif is a damaged TIFF" in said and "waiting will not help" in said, said
+    assert "first IFD" in said and "tag count" in said, said
+    assert f"cannot read image file {tether / 'IMG_0001.tif'} (" in said, said
+    assert f"left in {tether}" in said and "Save the shot again" in said, said
+    assert f"did not change within {TIMEOUT_S:g} s" not in said, said
+    assert "complete TIFF" not in said, said
+    assert (tether / "IMG_0001.tif").read_bytes() == data  # left as the program saved it
+    assert lit_at_end == []  # the dome was switched off

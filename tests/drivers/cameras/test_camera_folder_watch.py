@@ -522,6 +522,72 @@ def test_a_tiff_whose_ifd_is_damaged_is_said_at_once_naming_it(tmp_path):
     assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
 
 
+def _garbage_first_ifd(data: bytes, kind: str) -> bytes:
+    """``data`` (a little-endian classic TIFF) with its first IFD garbage of ``kind``."""
+    (ifd,) = struct.unpack("<I", data[4:8])
+    if kind == "tag count":  # bytes XORed: a count over any writer's
+        return data[:ifd] + bytes(b ^ 0x5A for b in data[ifd : ifd + 2]) + data[ifd + 2 :]
+    if kind == "entry type":  # a plausible count whose IFD would run past the end
+        count = struct.pack("<H", (len(data) - ifd) // 12 + 5)
+        return data[:ifd] + count + data[ifd + 2 : ifd + 4] + b"\x5a\x5a" + data[ifd + 6 :]
+    assert kind == "inside the header"
+    return data[:4] + struct.pack("<I", 2) + data[8:]
+
+
+@pytest.mark.parametrize("kind", ["tag count", "entry type", "inside the header"])
+@pytest.mark.parametrize("trigger", [False, True])
+def test_a_tiff_whose_first_ifd_is_garbage_is_said_at_once_naming_it(tmp_path, kind, trigger):
+    """A whole TIFF, its size steady, whose header names a first IFD inside the file holding
+    what no writer on its way leaves: a tag count over 4096 (tifffile: "suspicious number of
+    tags"), an entry of a type no TIFF has in an IFD that would run past the end, or an
+    offset inside the header. It had been waited for ``timeout_s`` (with a trigger, in its
+    capture-time read and again in its decode), then advice to raise stable_polls. It is
+    named at once as damaged, with where it is left and what to do."""
+    data, _, _ = _tiff_bytes(tmp_path, compression="zlib")
+    damaged = _garbage_first_ifd(data, kind)
+    target = tmp_path / "IMG_0001.tif"
+    clock = ScriptedClock({0.5: lambda: target.write_bytes(damaged)})
+    cam = FolderWatchCamera(
+        FolderWatchSettings(
+            folder=tmp_path, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25
+        ),
+        clock=clock,
+        trigger=(lambda exposure_s: None) if trigger else None,
+    )
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    why = {
+        "tag count": "gives a tag count of",
+        "entry type": "has data type 23130, which no TIFF has",
+        "inside the header": "at byte 2, inside the 8-byte header",
+    }[kind]
+    assert "IMG_0001.tif is a damaged TIFF" in said and why in said, said
+    assert f"left in {tmp_path}" in said and "waiting will not help" in said, said
+    assert "Save the shot again" in said, said
+    assert "stable_polls" not in said and "complete TIFF" not in said, said
+    assert clock.now() < 5.0  # the virtual clock: not the 30 s timeout
+    assert target.read_bytes() == damaged  # left where the program saved it
+
+
+def test_no_state_a_writer_leaves_a_tiff_in_reads_as_a_garbage_ifd(tmp_path):
+    """Every state tifffile's and libtiff's writers, and a copy cut anywhere, leave a TIFF in
+    on its way is not taken for a garbage IFD: they are waited for."""
+    from rti_rig.drivers.cameras.tiff_structure import ifd_garbage
+
+    states = []
+    for kind in ("plain", "zlib", "tiled", "BigTIFF", "multi-page"):
+        part, whole = _tifffile_order(kind)
+        states += part + [whole[:n] for n in range(0, len(whole), 7)]
+    whole = _libtiff_whole()
+    states += [whole[:n] for n in range(0, len(whole), 7)]
+    target = tmp_path / "IMG_0001.tif"
+    for n, state in enumerate(states):
+        target.write_bytes(state)
+        assert ifd_garbage(target) is None, (n, len(state))
+
+
 def test_a_tiff_filled_in_place_up_to_its_ifd_is_waited_for(tmp_path):
     """A share that sets a file's full size first and fills it in order, read when the fill
     has reached the middle of its IFD: tifffile reads the zero entries past, as an image of no
