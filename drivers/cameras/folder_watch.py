@@ -79,6 +79,7 @@ from rti_rig.drivers.cameras.image_io import (
 )
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
+    RawDecodeError,
     UnsupportedRawError,
     decode_raw,
     exposure_stats,
@@ -1038,8 +1039,11 @@ class FolderWatchCamera:
                     # worded here from its fields: the folder's file, not the copy read
                     detail = f" ({exc.reason})" if exc.reason else ""
                     message = f"cannot read image file {path}{detail}"
+                elif isinstance(exc, RawDecodeError):
+                    # worded here from its fields too: LibRaw's own words are left as said
+                    message = exc.about(path)
                 else:
-                    message = exc.message.replace(str(held), str(path))
+                    message = exc.message
                 if isinstance(exc, UnsupportedRawError) and _has_header(path):
                     raise CaptureError(
                         self.name,

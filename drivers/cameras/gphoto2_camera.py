@@ -30,7 +30,7 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.drivers.cameras.folder_watch import is_raw_file
-from rti_rig.drivers.cameras.raw_decode import decode_raw
+from rti_rig.drivers.cameras.raw_decode import RawDecodeError, decode_raw
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
 #: libgphoto2's name for an object of a capture kept in the camera's RAM when the body gives
@@ -655,7 +655,7 @@ class Gphoto2Camera:
             self.name,
             f"the camera's file {camera_name} would not decode; it is kept at {where}, the "
             f"camera's copy {'deleted' if self.settings.delete_from_camera else 'kept'}. "
-            + exc.message.removeprefix(f"{raw_path}: "),
+            + (exc.problem if isinstance(exc, RawDecodeError) else exc.message),
             "decode",
         )
 

@@ -30,7 +30,46 @@ from rti_rig.drivers.cameras.settings import RawDecodeSettings
 DECODER = "raw-decode"
 
 
-class UnsupportedRawError(CaptureError):
+class RawDecodeError(CaptureError):
+    """A RAW file that would not decode, with what is known as fields: ``path`` (the file
+    read, None for bytes), ``problem`` (what is wrong with it and what to do: the sentence
+    after the file's name), ``libraw_error`` (LibRaw's error kind, "LibRawIOError"; None when
+    the refusal is ours) and ``libraw_said`` (LibRaw's own words, as text).
+
+    Why fields: a caller that names another file than the one read (a watched folder's file,
+    of which the session's copy was decoded; a camera's file, downloaded under another name)
+    had rewritten the path inside this message by string replacement, LibRaw's own words
+    included, or cut it off at a fixed prefix. :meth:`about` words it for any file."""
+
+    def __init__(
+        self,
+        path: Path | None,
+        problem: str,
+        *,
+        libraw_error: str | None = None,
+        libraw_said: str | None = None,
+    ) -> None:
+        self.path = path
+        self.problem = problem
+        self.libraw_error = libraw_error
+        self.libraw_said = libraw_said
+        super().__init__(DECODER, self.about("<bytes>" if path is None else path), "decode")
+
+    def about(self, file: Path | str) -> str:
+        """The refusal naming ``file`` as the one that would not decode."""
+        return f"{file}: {self.problem}"
+
+
+def libraw_words(exc: BaseException) -> str:
+    """LibRaw's own words for ``exc`` as text: rawpy raises them as bytes, whose repr
+    ("b'Input/output error'") had reached the user's sentence."""
+    said = exc.args[0] if exc.args else ""
+    if isinstance(said, bytes | bytearray):
+        said = bytes(said).decode("utf-8", "replace")
+    return str(said) or type(exc).__name__
+
+
+class UnsupportedRawError(RawDecodeError):
     """LibRaw does not read this file's format (a body newer than it, or no RAW at all).
 
     Why a class of its own: a complete file in such a format will never decode, however
@@ -354,6 +393,7 @@ def decode_raw(
     """
     settings = settings or RawDecodeSettings()
     name, handle = _source(source)
+    read = None if name == "<bytes>" else Path(name)
     try:
         with rawpy.imread(handle) as raw:
             raw_vis = np.array(raw.raw_image_visible)  # uint16 copy out of LibRaw memory
@@ -377,29 +417,31 @@ def decode_raw(
         # a body newer than the bundled LibRaw (a new Canon CR3 or Fujifilm RAF, say) gives
         # this, a truncated download a data or I/O error: "is it a complete download?" had
         # sent the owner of a new camera looking for a cable fault
+        said = libraw_words(exc)
         raise UnsupportedRawError(
-            DECODER,
-            f"{name}: LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy "
-            f"{rawpy.__version__}) does not read this file's format ({exc}): a camera newer "
+            read,
+            f"LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy "
+            f"{rawpy.__version__}) does not read this file's format ({said}): a camera newer "
             "than this LibRaw, or a file that is no RAW. Update rawpy (pip install -U rawpy), "
             "or shoot a format it reads (DNG where the camera offers it, or convert the files "
             "with a DNG converter and watch a folder of DNGs)",
-            "decode",
+            libraw_error=type(exc).__name__,
+            libraw_said=said,
         ) from exc
     except rawpy.LibRawError as exc:
-        raise CaptureError(
-            DECODER,
-            f"{name}: LibRaw cannot decode this file ({type(exc).__name__}: {exc}); "
+        said = libraw_words(exc)
+        raise RawDecodeError(
+            read,
+            f"LibRaw cannot decode this file ({type(exc).__name__}: {said}); "
             "is it a complete RAW/DNG download?",
-            "decode",
+            libraw_error=type(exc).__name__,
+            libraw_said=said,
         ) from exc
     if raw_vis.ndim != 2:
-        raise CaptureError(DECODER, f"{name}: not a single-plane CFA RAW", "decode")
+        raise RawDecodeError(read, "not a single-plane CFA RAW")
     if white <= int(black_pc.max()):
-        raise CaptureError(
-            DECODER,
-            f"{name}: white level {white} is not above the black levels {black_pc.tolist()}",
-            "decode",
+        raise RawDecodeError(
+            read, f"white level {white} is not above the black levels {black_pc.tolist()}"
         )
     # Uniform black (the usual case) stays scalar: uint16 arithmetic, no index arrays.
     uniform = bool(np.all(black_pc == black_pc[0]))
@@ -422,7 +464,7 @@ def decode_raw(
         try:
             rgb = _colour(raw_vis, colors, black_pc, white, wb, rgb_index, settings.mode)
         except ValueError as exc:
-            raise CaptureError(DECODER, f"{name}: {exc}", "decode") from exc
+            raise RawDecodeError(read, str(exc)) from exc
         if to_srgb is not None:
             rgb = cv2.transform(rgb, to_srgb.astype(np.float32))
         white_level = 65535

@@ -70,17 +70,19 @@ def _config(tmp_path: Path, tether: Path) -> Path:
 
 class Tether(threading.Thread):
     """The camera and its tethering program: the board's first shutter pulse becomes
-    ``IMG_0001.tif`` in the folder, whole but damaged."""
+    ``name`` (``IMG_0001.tif``) in the folder, whole but damaged."""
 
-    def __init__(self, firmware, folder: Path, data: bytes) -> None:  # type: ignore[no-untyped-def]
+    def __init__(  # type: ignore[no-untyped-def]
+        self, firmware, folder: Path, data: bytes, name: str = "IMG_0001.tif"
+    ) -> None:
         super().__init__(daemon=True)
-        self.firmware, self.folder, self.data = firmware, folder, data
+        self.firmware, self.folder, self.data, self.name = firmware, folder, data, name
         self.stop = threading.Event()
 
     def run(self) -> None:
         while not self.stop.is_set():
             if any(e.what == "shutter" for e in list(self.firmware.history)):
-                (self.folder / "IMG_0001.tif").write_bytes(self.data)
+                (self.folder / self.name).write_bytes(self.data)
                 return
             self.stop.wait(0.02)
 
@@ -235,4 +237,52 @@ def test_run_names_a_tiff_whose_first_ifd_is_garbage_at_once(
     assert f"did not change within {TIMEOUT_S:g} s" not in said, said
     assert "complete TIFF" not in said, said
     assert (tether / "IMG_0001.tif").read_bytes() == data  # left as the program saved it
+    assert lit_at_end == []  # the dome was switched off
+
+
+def test_run_names_a_raw_cut_short_with_libraws_words_as_text(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Half a DNG saved into the shipped folder-watch dome's folder, the rest never coming:
+    ``rti-rig run`` names the folder's file (not the session's copy it decoded) and LibRaw's
+    error with its words as text. The sentence had been LibRaw's refusal of the copy with the
+    copy's path replaced inside it, LibRaw's words shown as a Python bytes literal
+    ("(LibRawIOError: b'Input/output error')")."""
+    from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
+
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    out = tmp_path / "s"
+    text = SHIPPED.read_text(encoding="utf-8")
+    for old, new in [
+        ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
+        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
+        ("timeout_s = 15.0", "timeout_s = 1.5"),  # the cut file waited for, then refused
+    ]:
+        assert old in text, old
+        text = text.replace(old, new)
+    cfg = tmp_path / "example_dome_48_folder_watch.toml"
+    cfg.write_text(text, encoding="utf-8")
+    whole = tmp_path / "whole.dng"
+    mosaic = linear_to_mosaic(np.full((32, 32), 0.3), "RGGB", 256, 4095)
+    write_dng(whole, mosaic, black_level=256, white_level=4095, exposure_s=0.5, iso=100)
+    data = whole.read_bytes()[: whole.stat().st_size // 2]
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, data, "IMG_0001.dng")
+        camera.start()
+        try:
+            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            r = CliRunner().invoke(app, args, terminal_width=400)
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+        lit_at_end = firmware.lit_indices()
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said, said
+    assert f"{tether / 'IMG_0001.dng'}: LibRaw cannot decode this file (LibRawIOError: " in said
+    assert "(LibRawIOError: Input/output error)" in said, said
+    assert "b'" not in said and ".incoming" not in said, said
+    assert "IMG_0001.dng did not change within 1.5 s" in said, said
+    assert (tether / "IMG_0001.dng").read_bytes() == data  # left as the program saved it
     assert lit_at_end == []  # the dome was switched off

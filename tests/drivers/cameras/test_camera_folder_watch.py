@@ -289,6 +289,38 @@ def test_a_whole_file_libraw_does_not_read_is_said_at_once_naming_it(tmp_path):
     assert (tmp_path / "IMG_0001.CR2").exists()  # left where the program saved it
 
 
+def test_a_raw_refusal_names_the_folders_file_and_leaves_libraws_words_as_said(
+    tmp_path, monkeypatch
+):
+    """A RAW LibRaw refuses, decoded from the session's copy: the stop names the folder's
+    file, then LibRaw's error kind and its own words, unaltered (LibRaw's data errors name
+    the file it read, the copy). The copy's path had been replaced by string substitution in
+    the whole message, LibRaw's words included, which then named a file LibRaw never read."""
+    import rawpy
+
+    folder = tmp_path / "tether"
+    folder.mkdir()
+    incoming = tmp_path / "s" / "raw" / ".incoming"
+    copy = incoming / "IMG_0001.CR2"
+
+    def refuses(path, *args, **kwargs):  # type: ignore[no-untyped-def]
+        raise rawpy.LibRawDataError(f"{path}: data corrupted at 1234".encode())
+
+    monkeypatch.setattr(rawpy, "imread", refuses)
+    clock = ScriptedClock({0.5: lambda: (folder / "IMG_0001.CR2").write_bytes(b"II*\x00" * 512)})
+    cam = watch(folder, clock, patterns=("*.CR2",), timeout_s=5.0, poll_interval_s=0.25)
+    cam.output_dir = incoming
+    cam.connect()
+    with pytest.raises(CaptureError) as info:
+        cam.capture(0.5)
+    said = str(info.value)
+    assert (
+        f"{folder / 'IMG_0001.CR2'}: LibRaw cannot decode this file (LibRawDataError: "
+        f"{copy}: data corrupted at 1234); is it a complete RAW/DNG download?"
+    ) in said, said
+    assert "b'" not in said, said
+
+
 def test_a_file_sized_before_it_is_written_is_waited_for(tmp_path):
     """A program copying onto a network share may set the file's full size first (zeros) and
     fill it afterwards: LibRaw reads the zeros as no known format, but the file is not whole
