@@ -732,13 +732,21 @@ class DynamixelArm:
         )
         raise DynamixelError(self.name, f"stop incomplete: {said}", "stop") from failed[0][1]
 
-    def emergency_stop(self) -> None:
-        """Torque off on every servo now (one broadcast packet, no reply to wait for).
+    def emergency_stop(self) -> str:
+        """Torque off on every servo now (one broadcast packet, no reply to wait for), then
+        each servo's Torque Enable read back; returns what that established, said as a
+        sentence ("torque off confirmed …" only when every servo read 0).
 
         Use when the bus may be unreliable or the arm is hitting something: the arm goes limp
-        and may drop under gravity, which is why ``stop`` (hold) is the normal safe stop. A
-        broadcast gets no status reply, so limp is what was sent, not what was read back: a
-        lost packet leaves a joint held (``release_on_close`` reads Torque Enable back)."""
+        and may drop under gravity, which is why ``stop`` (hold) is the normal safe stop.
+
+        Why the read-back: a broadcast gets no status packet (ROBOTIS e-manual, Protocol 2.0:
+        only Ping, Sync Read and Bulk Read are answered at the broadcast ID), so a lost packet
+        left a joint held unseen while the stop returned as if the arm were limp. A Read is
+        answered at Status Return Level 1 or 2 (connect requires 2): it is sent after the
+        torque-off, never before it, each bounded by the SDK's packet timeout (tens of ms) and
+        retried once, so an unanswering servo costs well under a second and never hangs the
+        stop; it is then named as not read back, not as limp."""
         self._emergency_stopped = True
         self._bus.broadcast_write(ct.TORQUE_ENABLE, 0)
         if self.settings.lamp == "servo_led":
@@ -746,6 +754,25 @@ class DynamixelArm:
             # had been recorded as off with the LED still lit); broadcast, no reply to wait for
             self._bus.broadcast_write(ct.LED, 0)
         self._lamp_on = False
+        on, unknown = self._torque_as_read()
+        said = ["torque-off sent to every servo (one broadcast, which no servo answers)"]
+        if on:
+            said.append(
+                f"Torque Enable reads back ON from {self._servos_named(on)}: that joint still "
+                "holds (the broadcast did not reach it); switch the servos' power off"
+            )
+        if unknown:
+            said.append(
+                f"Torque Enable not read back from {self._servos_named(unknown)} (no answer): "
+                "it may still hold; switch the servos' power off if it does"
+            )
+        if on or unknown:
+            return "; ".join(said)
+        return (
+            "torque off confirmed: Torque Enable reads back 0 on "
+            f"{self._servos_named(list(self.settings.joints))}; the joints are limp and the "
+            "lamp's weight may lower the arm"
+        )
 
     #: Longest wait (s) for a rebooted servo to answer a ping again. The e-manual gives no
     #: restart time; XC330s answer again after ~0.4 s, and ROBOTIS's Arduino code is reported

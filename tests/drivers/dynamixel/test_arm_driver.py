@@ -388,6 +388,63 @@ def test_emergency_stop_and_lamp_on_servo_led() -> None:
     assert not arm.lamp_is_on and emu.servos[2].get(ct.LED) == 0  # said off, and off
 
 
+def test_an_emergency_stop_says_torque_off_confirmed_only_when_read_back() -> None:
+    """The torque-off is a broadcast, which no servo answers: the stop reads each servo's
+    Torque Enable back and says "torque off confirmed" only when every one reads 0. It had
+    returned nothing, the arm taken for limp whatever reached it."""
+    arm, emu, _ = make_arm()
+    arm.connect()
+    said = arm.emergency_stop()
+    assert not emu.servos[1].torque_on and not emu.servos[2].torque_on
+    assert said.startswith("torque off confirmed"), said
+    assert "servo 1 (azimuth), servo 2 (elevation)" in said, said
+
+
+def test_an_emergency_stop_whose_broadcast_is_lost_names_the_joints_still_held() -> None:
+    """The torque-off packet lost on the line (noise on a long cable): both servos keep their
+    torque on and read it back so; the stop names them as still holding and never says
+    confirmed."""
+    arm, emu, _ = make_arm()
+    arm.connect()
+    port = arm._bus.port
+    deliver = port.writePort
+    # Protocol 2.0: id 0xFE (broadcast), length 6, WRITE (3), address 64 (2 bytes), value 0
+    torque_off = bytes([0xFE, 0x06, 0x00, 0x03, ct.TORQUE_ENABLE.address, 0x00, 0x00])
+
+    def loses_the_torque_off(packet):  # type: ignore[no-untyped-def]
+        if bytes(packet)[4:11] == torque_off:
+            return len(packet)  # sent, never arrives
+        return deliver(packet)
+
+    port.writePort = loses_the_torque_off
+    said = arm.emergency_stop()
+    assert emu.servos[1].torque_on and emu.servos[2].torque_on  # the packet never arrived
+    assert "confirmed" not in said, said
+    assert "reads back ON from servo 1 (azimuth), servo 2 (elevation)" in said, said
+    assert "switch the servos' power off" in said, said
+
+
+@pytest.mark.parametrize("transport", [pytest.param("pty", marks=pytest.mark.pty), "inprocess"])
+def test_an_emergency_stop_with_a_servo_unplugged_says_it_was_not_read_back(
+    transport: str,
+) -> None:
+    """The elevation servo unplugged: its Torque Enable read goes unanswered. The stop
+    returns (the reads are bounded by the SDK's packet timeout, over a real pty too) and says
+    that servo was not read back, never that torque is off."""
+    from rti_rig.simulator.dynamixel_emulator import emulated_arm_port
+
+    settings = arm_settings()
+    clock = VirtualClock()
+    with emulated_arm_port(settings, clock, transport) as (port, emu):
+        arm = DynamixelArm(settings, port, clock)
+        arm.connect()
+        emu.silent_ids.add(2)
+        said = arm.emergency_stop()
+    assert "confirmed" not in said, said
+    assert "not read back from servo 2 (elevation) (no answer)" in said, said
+    assert "servo 1" not in said, said  # read back 0: not named as unknown or held
+
+
 def test_settings_errors_name_the_problem() -> None:
     with pytest.raises(ValidationError, match="keep-out cone"):
         arm_settings(park_elevation_deg=80.0)
