@@ -82,9 +82,11 @@ def signal_handlers(wanted: Mapping[int, Handler]) -> Iterator[None]:
 
     Off the main thread nothing is installed: Python sets and runs handlers only in the main
     thread (``signal.signal`` raises ValueError elsewhere), and there the caller's handlers,
-    whatever they are, still apply. A handler that was set outside Python (``getsignal`` says
-    None) cannot be put back, so ``wanted``'s stays, rather than a TypeError at the end of
-    the block. The restore is :func:`put_back`'s.
+    whatever they are, still apply. A signal whose handler was set outside Python
+    (``getsignal`` says None: a program embedding Python, a preloaded library) is left to
+    that handler, as :func:`signals_deferred` leaves it: it could not be put back, and ours
+    stayed installed after the block (a later SIGTERM swallowed, or raised into the host).
+    The restore is :func:`put_back`'s.
     """
     if not handlers_settable():
         yield
@@ -92,6 +94,8 @@ def signal_handlers(wanted: Mapping[int, Handler]) -> Iterator[None]:
     previous: dict[int, Any] = {}
     try:  # a handler that raises as the next is installed: those already set are put back
         for sig, handler in wanted.items():
+            if signal.getsignal(sig) is None:  # set outside Python: left in charge
+                continue
             previous[sig] = signal.signal(sig, handler)
         yield
     finally:
@@ -107,7 +111,10 @@ def put_back(previous: Mapping[int, Any]) -> None:
     back and raised TypeError, and a pending signal whose handler raises (the CLI's emergency
     stop) cut the loop short, leaving the rest of the block's handlers in place after it. Here
     each is swapped (:func:`_swap_handler`); the first such exception is raised once all are
-    back."""
+    back. Off the main thread nothing is done (``signal.signal`` would raise ValueError there,
+    and the swap's retry would spin on it)."""
+    if not handlers_settable():
+        return
     raised: list[BaseException] = []
     for sig, before in previous.items():
         if before is not None:  # None: set outside Python, cannot be put back
@@ -120,7 +127,10 @@ def _swap_handler(sig: int, handler: Any, raised: list[BaseException]) -> Any:
     """``signal.signal(sig, handler)``, made to happen: Python first runs the handlers of any
     signal already pending, and one that raises (the CLI's emergency stop) would skip the swap
     and leave a hold half set or half undone. Its exception is kept in ``raised``, the swap
-    tried again."""
+    tried again. A handler ``signal.signal`` would refuse is refused before the loop, which
+    would otherwise retry its TypeError for ever."""
+    if not (callable(handler) or handler in (signal.SIG_DFL, signal.SIG_IGN)):
+        raise TypeError(f"signal {sig}: {handler!r} is not a signal handler")
     while True:
         try:
             return signal.signal(sig, handler)

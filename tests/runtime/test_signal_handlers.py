@@ -70,3 +70,53 @@ def test_a_handler_set_outside_python_is_left_rather_than_a_type_error() -> None
     before = signal.getsignal(signal.SIGTERM)
     put_back({signal.SIGTERM: None})
     assert signal.getsignal(signal.SIGTERM) == before
+
+
+def test_put_back_off_the_main_thread_returns_rather_than_retrying_for_ever() -> None:
+    """``signal.signal`` raises ValueError off the main thread; the swap's retry (meant for a
+    pending signal's raising handler) had spun on it for ever."""
+    seen: dict[str, Any] = {}
+
+    def work() -> None:
+        try:
+            put_back({signal.SIGTERM: signal.SIG_DFL})
+            seen["returned"] = True
+        except BaseException as exc:
+            seen["raised"] = exc
+
+    worker = threading.Thread(target=work, daemon=True)
+    worker.start()
+    worker.join(timeout=60)
+    assert not worker.is_alive(), "put_back off the main thread did not return"
+    assert seen == {"returned": True}
+
+
+def test_a_value_signal_signal_refuses_is_raised_not_retried() -> None:
+    with pytest.raises(TypeError, match="not a signal handler"):
+        put_back({signal.SIGTERM: "not a handler"})
+
+
+def test_a_signal_whose_handler_was_set_outside_python_is_left_to_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A host's C handler (``getsignal`` None) stays in charge: ours could not be put back and
+    stayed installed after the block."""
+    import rti_rig.runtime.deferred_signals as deferred
+
+    real_getsignal, real_signal = signal.getsignal, signal.signal
+    installed: list[int] = []
+
+    def getsignal(sig: int) -> Any:
+        return None if sig == signal.SIGTERM else real_getsignal(sig)
+
+    def set_handler(sig: int, handler: Any) -> Any:
+        installed.append(sig)
+        return real_signal(sig, handler)
+
+    monkeypatch.setattr(deferred.signal, "getsignal", getsignal)
+    monkeypatch.setattr(deferred.signal, "signal", set_handler)
+    with signal_handlers({signal.SIGTERM: _mark, signal.SIGINT: signal.SIG_IGN}):
+        pass
+    monkeypatch.undo()
+    assert signal.SIGTERM not in installed
+    assert installed.count(signal.SIGINT) == 2  # set, then put back
