@@ -27,12 +27,24 @@ try:  # pyserial lets termios.error (not an OSError) escape from tcdrain/tcsetat
         OSError,
         termios.error,
     )
+    _TERMIOS_ERROR: type[BaseException] | None = termios.error
 except ImportError:  # pragma: no cover - Windows
     _PORT_ERRORS = (serial.SerialException, OSError)
+    _TERMIOS_ERROR = None
 
 
 class TransportError(Exception):
-    """The port is gone (unplugged, closed under us) or cannot be opened."""
+    """The port is gone (unplugged, closed under us) or cannot be opened.
+
+    ``errno`` is the system's error number behind it, when there is one (the ``OSError`` or
+    ``termios.error`` that pyserial raised or wrapped), so that a caller decides from the number
+    what the failure means (``rti-rig probe``: ENOTTY is a device that is no terminal) rather
+    than from the words of a message, which change with pyserial's version and the locale.
+    """
+
+    def __init__(self, message: str, *, errno: int | None = None) -> None:
+        super().__init__(message)
+        self.errno = errno
 
 
 class PortHeldError(TransportError):
@@ -120,7 +132,9 @@ class SerialTransport:
             else:
                 why = str(exc)
             error = PortHeldError if "exclusively lock" in str(exc) else TransportError
-            raise error(f"cannot open serial port {self.port}: {why}") from exc
+            raise error(
+                f"cannot open serial port {self.port}: {why}", errno=_system_errno(exc)
+            ) from exc
         self._timeout = 0
 
     def close(self) -> None:
@@ -135,7 +149,9 @@ class SerialTransport:
             ser.write(data)
             ser.flush()
         except _PORT_ERRORS as exc:
-            raise TransportError(f"write to {self.port} failed: {exc}") from exc
+            raise TransportError(
+                f"write to {self.port} failed: {exc}", errno=_system_errno(exc)
+            ) from exc
 
     def read(self, timeout_s: float) -> bytes:
         ser = self._require()
@@ -150,9 +166,29 @@ class SerialTransport:
             waiting = ser.in_waiting
             return first + (ser.read(waiting) if waiting else b"")
         except _PORT_ERRORS as exc:
-            raise TransportError(f"read from {self.port} failed: {exc}") from exc
+            raise TransportError(
+                f"read from {self.port} failed: {exc}", errno=_system_errno(exc)
+            ) from exc
 
     def _require(self) -> serial.SerialBase:
         if self._ser is None:
             raise TransportError(f"serial port {self.port} is not open")
         return self._ser
+
+
+def _system_errno(exc: BaseException) -> int | None:
+    """The system's error number behind ``exc``: its own (an ``OSError``, or pyserial's
+    ``SerialException`` built from one), else that of the ``termios.error`` it was raised from
+    (pyserial's "Could not configure port: (25, ...)" keeps the number only in its text and in
+    the exception it was raised while handling); None when the system gave none."""
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen:
+        seen.add(id(cause))
+        number = getattr(cause, "errno", None)
+        if number is None and _TERMIOS_ERROR is not None and isinstance(cause, _TERMIOS_ERROR):
+            number = cause.args[0] if cause.args else None  # termios.error(errno, text)
+        if isinstance(number, int) and number > 0:
+            return number
+        cause = cause.__cause__ or cause.__context__
+    return None

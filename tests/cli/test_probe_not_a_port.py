@@ -75,3 +75,36 @@ def test_the_error_goes_to_stderr_on_one_line(tmp_path: Path) -> None:
     assert line.startswith(f"error: cannot open serial port {port}: "), r.stderr
     assert line.rstrip().endswith("No such file or directory"), r.stderr
     assert "Traceback" not in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("device", ["/dev/null", "/dev/random"])
+def test_a_device_that_is_no_terminal_is_named_whatever_pyserial_words_its_failure(
+    monkeypatch: pytest.MonkeyPatch, device: str
+) -> None:
+    """The probe decides from the system's number for the failure (ENOTTY, EINVAL, carried by
+    the transport's error), not from the words of pyserial's message: it had looked for
+    "Inappropriate ioctl" and "Could not configure port" in the text, so a pyserial that words
+    it otherwise sent the user to check the dome's cable. Here pyserial's open is replaced by
+    one that does what it does (open the device, read its terminal settings, which the system
+    refuses) and says so in other words."""
+    import os
+    import termios
+
+    import serial
+
+    def open_with_other_words(port: str, **_: object) -> None:
+        fd = os.open(port, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+        try:
+            termios.tcgetattr(fd)  # the system's refusal, with its own number
+        except termios.error:
+            raise serial.SerialException(f"port {port} refused its terminal settings") from None
+        finally:
+            os.close(fd)
+        raise AssertionError(f"{port} accepted a terminal's settings")
+
+    monkeypatch.setattr(serial, "serial_for_url", open_with_other_words)
+    r = runner.invoke(app, ["probe", device])
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert f"{device} is a device but not a terminal: it is not a serial port" in text, text
+    assert "plugged in" not in text and "Traceback" not in text, text

@@ -476,20 +476,23 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             )
         else:
             result.lights = "the port could not be used; nothing was sent"
-            result.not_serial = _not_a_serial_port(result.port, str(exc))
+            result.not_serial = _not_a_serial_port(result.port, exc)
     return result
 
 
-def _not_a_serial_port(port: str, error: str) -> str | None:
-    """How ``port``, which failed to open, is no serial port (``"is a regular file"``,
-    ``"is a device but not a terminal"`` …), or None when it may be one (missing, held,
-    a URL, a name the system does not map to a path such as COM3).
+def _not_a_serial_port(port: str, error: TransportError) -> str | None:
+    """How ``port``, which failed to open with ``error``, is no serial port (``"is a regular
+    file"``, ``"is a device but not a terminal"`` …), or None when it may be one (missing,
+    held, a URL, a name the system does not map to a path such as COM3).
 
     Judged from the path after the failure, never by opening it again: opening a real serial
-    port resets an Arduino. A character device that opened but refused the terminal settings
-    is a device but not a serial one, whatever the errno: ENOTTY ("Inappropriate ioctl for
-    device": /dev/null, /dev/zero), EINVAL (/dev/random, which had been told to check that the
-    dome is plugged in). EIO there is a serial port whose device went away as it opened."""
+    port resets an Arduino. A character device that refused the terminal settings is a device
+    but not a serial one; the system's number for the failure (``error.errno``) says so:
+    ENOTTY ("Inappropriate ioctl for device": /dev/null, /dev/zero), EINVAL (/dev/random,
+    which had been told to check that the dome is plugged in). EIO there is a serial port whose
+    device went away as it opened. Decided from the number, not from the message's words (it
+    had looked for "Inappropriate ioctl" and pyserial's "Could not configure port" in the
+    text, which a pyserial release or a translated strerror would change)."""
     try:
         mode = os.stat(port).st_mode
     except (OSError, ValueError):
@@ -500,13 +503,10 @@ def _not_a_serial_port(port: str, error: str) -> str | None:
         return "is a folder"
     if not stat.S_ISCHR(mode):
         return "is not a device file"
-    if "Inappropriate ioctl" in error or f"({errno.ENOTTY}," in error:
-        return "is a device but not a terminal"
-    # pyserial's words when the port opened but its terminal settings could not be read
-    if _TERMINAL_SETTINGS_FAILED in error and f"({errno.EIO}," not in error:
+    if error.errno in _NOT_A_TERMINAL:
         return "is a device but not a terminal"
     return None
 
 
-#: pyserial's message when a port opened but ``tcgetattr`` failed on it (POSIX).
-_TERMINAL_SETTINGS_FAILED = "Could not configure port"
+#: The system's numbers for a character device that refuses a terminal's settings.
+_NOT_A_TERMINAL = frozenset({errno.ENOTTY, errno.EINVAL})

@@ -6,6 +6,7 @@ pyserial's text repeats the port ("could not open port P: [Errno 2] No such file
 
 from __future__ import annotations
 
+import errno
 import os
 import pty
 
@@ -42,3 +43,16 @@ def test_a_missing_port_whose_path_says_lock_is_not_called_held(tmp_path) -> Non
     with pytest.raises(TransportError) as info:
         SerialTransport(port).open()
     assert str(info.value).endswith("No such file or directory")
+
+
+@pytest.mark.parametrize(
+    ("port", "number"), [("/dev/null", errno.ENOTTY), ("/dev/random", errno.EINVAL), ("", 0)]
+)
+def test_the_error_carries_the_systems_number(tmp_path, port: str, number: int) -> None:  # type: ignore[no-untyped-def]
+    """The system's error number rides on the transport's error, also where pyserial kept it
+    only in the ``termios.error`` its own exception was raised from (/dev/null, /dev/random):
+    callers decide from it, not from a message's words (``rti-rig probe``)."""
+    port, number = port or str(tmp_path / "ttyNOPE"), number or errno.ENOENT
+    with pytest.raises(TransportError) as info:
+        SerialTransport(port).open()
+    assert info.value.errno == number, info.value
