@@ -10,6 +10,10 @@ prints a banner, which is why the init sends an all-off straight away. An unknow
 
 ALL_OFF = {"send": "<0>", "reply": {"kind": "pattern", "pattern": r"<All lights turned off\.>"}}
 
+#: What ``lightsOn()`` prints, in ``setup()`` (so at every boot, every LED lit) and after
+#: ``<1>``, ``<4,ms>`` and ``<5,ms>``: heard, it means the board is lit (``rti-rig probe``).
+ALL_ON_REPLY_PATTERN = r"<All lights turned on\.>"
+
 #: The sketch drives an 8×8 matrix: ``<3,N>`` beyond LED 63 addresses no wired pin.
 MAX_LED_COUNT = 64
 

@@ -19,10 +19,12 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import stat
 import time
 from dataclasses import dataclass, field
 
+from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
 from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
 from rti_rig.runtime.controller import EmergencyStop
 
@@ -125,8 +127,27 @@ class ProbeStopped(Exception):
         self.why, self.result = why, result
 
 
+# What the probe knows of the Nab sketch is read from its profile (``nab_rti_v1``), so that
+# a fix there (a rate, a reply's words) reaches the probe too: they had been written out here.
+
+#: The Nab sketch's profile name, as a rig config names it.
+_NAB_NAME: str = nab.SPEC["name"]
+
 #: The rate the Nab sketch speaks: a stop on a port open at it listens for the sketch's boot.
-_NAB_BAUD = 9600
+_NAB_BAUD: int = nab.SPEC["baudrate"]
+
+#: The sketch's all-off command, and its answer.
+_NAB_ALL_OFF: bytes = nab.ALL_OFF["send"].encode("ascii")
+_NAB_OFF_SAYS = re.compile(nab.ALL_OFF["reply"]["pattern"])
+
+#: Its boot banner (printed by ``setup()``, with every LED lit), and its answer to a code it
+#: does not know.
+_NAB_BANNER = re.compile(nab.SPEC["reset_pattern"])
+_NAB_UNKNOWN_CODE = re.compile(nab.SPEC["error_pattern"])
+
+#: The Nab sketch's boot banner, its answer to its all-on (printed at boot too) and to a code
+#: it does not know: each means it booted, lit.
+_NAB_SAYS = (_NAB_BANNER, re.compile(nab.ALL_ON_REPLY_PATTERN), _NAB_UNKNOWN_CODE)
 
 #: The lights of a probe stopped before any firmware answered, once it opened the port.
 STOPPED_UNANSWERED = (
@@ -134,10 +155,6 @@ STOPPED_UNANSWERED = (
     "opening the port resets a board like an Arduino, which then lights whatever its firmware "
     "lights at boot (the Nab sketch: every LED): look at the dome"
 )
-
-#: The Nab sketch's boot banner, its answer to its all-on and to a code it does not know (each
-#: means it booted, lit).
-_NAB_SAYS = ("RTI-Dome intialized", "<All lights turned on.>", "<INCORRECT FUNCTION CALL: ")
 
 
 def _exchange(
@@ -202,7 +219,7 @@ def _stopped_on_open_port(
         text = _listen(t, max(0.0, opened + wait_s - time.monotonic())).decode("latin-1")
         result.heard.append(("listening out the board's boot", text))
         if _nab_heard(result):
-            result.profile, result.baudrate = "nab-rti-v1", _NAB_BAUD
+            result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
             _nab_off(result, t)
             return
     result.lights = STOPPED_UNANSWERED
@@ -211,7 +228,7 @@ def _stopped_on_open_port(
 def _nab_heard(result: ProbeResult) -> bool:
     """Some probe heard the Nab sketch (its banner, its answer to its all-on or to an unknown
     code): the board booted, and it boots with every LED on."""
-    return any(words in heard for _, heard in result.heard for words in _NAB_SAYS)
+    return any(says.search(heard) for _, heard in result.heard for says in _NAB_SAYS)
 
 
 def _stopped_inside_opening(result: ProbeResult, cut: SerialTransport, wait_s: float) -> None:
@@ -240,14 +257,15 @@ def _stopped_inside_opening(result: ProbeResult, cut: SerialTransport, wait_s: f
         t.close()
 
 
-def _listen(t: SerialTransport, seconds: float, until: bytes | None = None) -> bytes:
-    """All ``t`` sends for ``seconds``, or until it has sent ``until`` (an acknowledgement:
-    no use listening on, and a stop would only find the probe still listening)."""
+def _listen(t: SerialTransport, seconds: float, until: re.Pattern[str] | None = None) -> bytes:
+    """All ``t`` sends for ``seconds``, or until what it sent matches ``until`` (an
+    acknowledgement: no use listening on, and a stop would only find the probe still
+    listening)."""
     out = bytearray()
     end = time.monotonic() + seconds
     while (left := end - time.monotonic()) > 0:
         out += t.read(min(left, 0.1))
-        if until is not None and until in out:
+        if until is not None and until.search(out.decode("latin-1")):
             break
     return bytes(out)
 
@@ -261,7 +279,7 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     the port again (a reset: every LED lit once more) to send the all-off a second time. A
     port that fails after such a stop is said, with the lights, in :class:`ProbeStopped` (it had
     ended as a probe that succeeded, exit 0, "Found: nab-rti-v1")."""
-    result.profile, result.baudrate = "nab-rti-v1", _NAB_BAUD
+    result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
     t = SerialTransport(result.port, _NAB_BAUD)
     result.openings += 1
     t.open()
@@ -303,7 +321,7 @@ def _nab_not_off(exc: TransportError) -> str:
 
 
 def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
-    """Send the Nab sketch's all-off ``<0>`` on ``t`` (open at 9600, the sketch booted) and
+    """Send the Nab sketch's all-off ``<0>`` on ``t`` (open at its rate, the sketch booted) and
     say in ``result.lights`` whether it was acknowledged.
 
     Sent again on the same open port if unanswered (reopening it would reset the board, which
@@ -312,22 +330,19 @@ def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
     acknowledgement (it had gone on for the whole window). A stop meanwhile is raised from
     here: the caller, which holds the open port, finishes the all-off on it."""
     off = ""
-    for what, listen_s in (("all off <0>", 0.6), ("all off <0> again", 1.2)):
-        t.write(b"<0>")
+    command = _NAB_ALL_OFF.decode("ascii")
+    for what, listen_s in ((f"all off {command}", 0.6), (f"all off {command} again", 1.2)):
+        t.write(_NAB_ALL_OFF)
         off = _listen(t, listen_s, until=_NAB_OFF_SAYS).decode("latin-1")
         result.heard.append((what, off))
-        if _NAB_OFF_SAYS.decode() in off:
+        if _NAB_OFF_SAYS.search(off):
             break
     result.lights = (
         "the sketch boots with every LED on; all-off sent and acknowledged"
-        if _NAB_OFF_SAYS.decode() in off
+        if _NAB_OFF_SAYS.search(off)
         else "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
         "the dome"
     )
-
-
-#: The Nab sketch's answer to its all-off.
-_NAB_OFF_SAYS = b"<All lights turned off.>"
 
 
 def _unanswered_lights(wait: float) -> str:
@@ -395,11 +410,11 @@ def probe(request: ProbeRequest) -> ProbeResult:
 
 def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
     """The teardown of a probe stopped with no port open (before the first, between two)."""
-    if any(_NAB_OFF_SAYS.decode() in text for _, text in result.heard):
+    if any(_NAB_OFF_SAYS.search(text) for _, text in result.heard):
         # its all-off was acknowledged, the stop coming as the port closed after it: reopening
         # would reset the board, lit once more, to switch it off again (``lights`` says it)
         return
-    if result.profile == "nab-rti-v1" or (result.profile is None and _nab_heard(result)):
+    if result.profile == _NAB_NAME or (result.profile is None and _nab_heard(result)):
         # identified (or heard, the stop coming before it was named), lit at its boot, and
         # stopped before its all-off: sent now (the opening resets it, lit again, so the boot
         # is waited for as the probe waits for it); "stopped before a firmware answered" had
@@ -419,7 +434,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
     """:func:`probe`'s sequence of probes."""
     try:
         text = _exchange(result, "listen at 9600 baud", 9600, wait, b"", 0)
-        if "RTI-Dome intialized" in text or "<All lights turned on.>" in text:
+        if _NAB_BANNER.search(text) or _NAB_SAYS[1].search(text):
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
@@ -440,8 +455,10 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         text = _exchange(result, "'m' (free RAM) at 115200 baud", 115200, wait, b"m", 0.5)
         if _nichlock_found(result, text, 115200):
             return result
-        text = _exchange(result, "'<9>' (an unknown code) at 9600 baud", 9600, wait, b"<9>", 0.6)
-        if "<INCORRECT FUNCTION CALL: 9>" in text or "RTI-Dome intialized" in text:
+        text = _exchange(
+            result, f"'<9>' (an unknown code) at {_NAB_BAUD} baud", _NAB_BAUD, wait, b"<9>", 0.6
+        )
+        if _NAB_UNKNOWN_CODE.search(text) or _NAB_BANNER.search(text):
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
@@ -462,7 +479,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
         result.lights = _unanswered_lights(wait)
     except TransportError as exc:
         result.error = str(exc)
-        if result.profile == "nab-rti-v1":
+        if result.profile == _NAB_NAME:
             # it answered, so it booted, and it boots with every LED on
             result.lights = (
                 "the sketch boots with every LED on and the all-off could NOT be sent: the dome "
