@@ -225,3 +225,57 @@ def test_a_stop_as_the_port_closes_after_an_acknowledged_all_off_does_not_reopen
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
     assert _boots(board) == 2, board.events
     assert board.lit_once_booted() == frozenset()
+
+
+#: A Nab board that takes 3 s to boot (``--boot-delay-s 3`` to the emulator): longer than the
+#: probe's first listen, so the probe goes on to open the port at other rates, each opening a
+#: reset after which the sketch boots at 9600 with every LED lit; within the 4 s the sketch's
+#: profile allows for its boot (``boot_wait_s``).
+SLOW_BOOT_S = 3.0
+
+
+def test_a_stop_inside_an_opening_at_another_rate_reopens_at_9600_and_switches_the_nab_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C inside pyserial's open at 115200: the sketch's board resets at every opening,
+    whatever its rate, and boots at 9600 with every LED lit. The probe reopened only after a
+    stop in a 9600-baud opening: here it said "look at the dome" and left it lit. It now opens
+    the port again at the sketch's rate, listens out its boot and sends the all-off. The stop is
+    raised where a signal lands, inside the opening (no timing can aim a real signal there)."""
+    real_open = SerialTransport.open
+    stops: list[int] = []
+
+    def open_cut_short(self: SerialTransport) -> None:
+        real_open(self)
+        if not stops and self.baudrate == 115200:  # the system opened it (the board reset),
+            stops.append(self.baudrate)  # then the signal, and pyserial closes the port
+            self.close()
+            raise EmergencyStop("Ctrl-C")
+
+    monkeypatch.setattr(SerialTransport, "open", open_cut_short)
+    board = board_for("nab-rti-v1")
+    board.boot_s = SLOW_BOOT_S
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert stops, "the opening at 115200 was never cut short"
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_with_the_port_open_at_another_rate_reopens_at_9600_and_switches_the_nab_off() -> (
+    None
+):
+    """A Ctrl-C while the probe listens at 115200 (its second opening, which reset the slow
+    board): the sketch boots lit at 9600, heard at 115200 as nothing or garbage. The probe said
+    "look at the dome"; it now reopens the port at the sketch's rate and switches it off."""
+    board = board_for("nab-rti-v1")
+    board.boot_s = SLOW_BOOT_S
+    code, said = _probe(board, "nab-rti-v1", signal.SIGINT, lambda: _boots(board) >= 2)
+    assert code == 130, said
+    assert "listen at 115200 baud (stopped)" in said, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
+    assert board.lit_once_booted() == frozenset()

@@ -8,11 +8,13 @@ sketch boots fully lit) is sent its all-off before the probe returns. A dome tha
 (hadrian2/RTI_Dome) cannot be identified; the result says so, with what was heard.
 
 Ctrl-C or SIGTERM (raised as :class:`EmergencyStop` by the command's handler) stops the probe
-through a teardown, as it stops a check: opening the port at 9600 resets a Nab board, which
-boots with every LED on, so a stop on a port open at 9600 listens out the board's boot on that
-same port (reopening would reset it again) and sends the sketch's all-off if its banner comes;
-a Nab board identified is sent its all-off. :class:`ProbeStopped` then says what is known of
-the lights (it had said only "stopped (Ctrl-C)", a dome lit in full behind it).
+through a teardown, as it stops a check: opening the port, at whatever rate, resets a Nab
+board, which boots at 9600 with every LED on, so a stop on a port open at 9600 listens out the
+board's boot on that same port (reopening would reset it again) and sends the sketch's all-off
+if its banner comes; a stop on a port open at another rate, or inside any opening, opens the
+port again at 9600 and does the same; a Nab board identified is sent its all-off.
+:class:`ProbeStopped` then says what is known of the lights (it had said only "stopped
+(Ctrl-C)", a dome lit in full behind it).
 """
 
 from __future__ import annotations
@@ -145,6 +147,9 @@ _NAB_OFF_SAYS = re.compile(nab.ALL_OFF["reply"]["pattern"])
 _NAB_BANNER = re.compile(nab.SPEC["reset_pattern"])
 _NAB_UNKNOWN_CODE = re.compile(nab.SPEC["error_pattern"])
 
+#: The end of its boot banner: the sketch is ready for commands.
+_NAB_READY = re.compile(nab.SPEC["ready_pattern"])
+
 #: The Nab sketch's boot banner, its answer to its all-on (printed at boot too) and to a code
 #: it does not know: each means it booted, lit.
 _NAB_SAYS = (_NAB_BANNER, re.compile(nab.ALL_ON_REPLY_PATTERN), _NAB_UNKNOWN_CODE)
@@ -192,7 +197,7 @@ def _exchange(
     except EmergencyStop as exc:
         result.heard.append((f"{what} (stopped)", heard.decode("latin-1")))
         try:
-            _stopped_on_open_port(result, t, baud, opened, wait_s)
+            _stopped_on_open_port(result, t, baud, opened, wait_s, heard.decode("latin-1"))
         except TransportError as failed:
             result.error = str(failed)
             result.lights = (
@@ -208,21 +213,45 @@ def _exchange(
 
 
 def _stopped_on_open_port(
-    result: ProbeResult, t: SerialTransport, baud: int, opened: float, wait_s: float
+    result: ProbeResult,
+    t: SerialTransport,
+    baud: int,
+    opened: float,
+    wait_s: float,
+    heard: str = "",
 ) -> None:
     """The teardown of a probe stopped with ``t`` open at ``baud`` since ``opened``
-    (monotonic): at the Nab sketch's rate, the rest of its boot window (``wait_s``) is listened
-    out on this port, and a sketch that booted, lit, is sent its all-off here (reopening would
-    reset it, lit again). Otherwise nothing that lights was sent, but an opening may have reset
-    a board that boots lit once the probe is gone."""
+    (monotonic), having heard ``heard`` on it: at the Nab sketch's rate, the rest of its boot
+    window (:func:`_nab_boot_s`) is listened out on this port, until its banner is over, and a
+    sketch that booted, lit, is sent its all-off here (reopening would reset it, lit again).
+
+    At another rate, a port whose opening resets the board is closed and opened again at the
+    sketch's rate (:func:`_reopened_at_nab_rate`): the sketch's board resets at every opening,
+    whatever its rate, and boots at its own rate with every LED lit, heard at this one as
+    nothing or garbage (it had been left so under "look at the dome"). Otherwise nothing that
+    lights was sent, but an opening may have reset a board that boots lit once the probe is
+    gone."""
     if baud == _NAB_BAUD:
-        text = _listen(t, max(0.0, opened + wait_s - time.monotonic())).decode("latin-1")
+        left = 0.0 if _NAB_READY.search(heard) else opened + _nab_boot_s(wait_s) - time.monotonic()
+        text = _listen(t, max(0.0, left), until=_NAB_READY).decode("latin-1")
         result.heard.append(("listening out the board's boot", text))
         if _nab_heard(result):
             result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
             _nab_off(result, t)
             return
+    elif t.resets_on_open:
+        t.close()
+        _reopened_at_nab_rate(result, wait_s)
+        return
     result.lights = STOPPED_UNANSWERED
+
+
+def _nab_boot_s(wait_s: float) -> float:
+    """How long a stop's teardown listens for the Nab sketch's boot after an opening: the
+    probe's own listen, or the boot time the sketch's profile allows (``boot_wait_s``) if
+    longer. A board slower to boot than the probe's listen is not heard by it, but it is lit
+    all the same once it boots, and the teardown is the last chance to switch it off."""
+    return max(wait_s, float(nab.SPEC["boot_wait_s"]))
 
 
 def _nab_heard(result: ProbeResult) -> bool:
@@ -235,13 +264,22 @@ def _stopped_inside_opening(result: ProbeResult, cut: SerialTransport, wait_s: f
     """The teardown of a probe stopped inside the opening of ``cut`` (not open: pyserial closes
     the port as the stop goes through). As ``check`` and ``run`` do after such a stop
     (``DomePolicy._reopen_cut_short_port``), a port whose opening may reset the board
-    (``resets_on_open``) is opened again, here at the Nab sketch's rate only, and the stop's
-    teardown on an open port (:func:`_stopped_on_open_port`) follows: a Nab board, reset by the
-    opening and lit, had been left so under "look at the dome". A further signal is not raised
-    (the command's handler raises only the first)."""
-    if cut.baudrate != _NAB_BAUD or not cut.resets_on_open:
+    (``resets_on_open``) is opened again (:func:`_reopened_at_nab_rate`), at the Nab sketch's
+    rate whatever the rate of the opening cut short: its board resets at every opening, and
+    boots lit at its own rate (only a stop in a 9600-baud opening had reopened it; after one at
+    115200, 19200 or 2400 the dome was left lit under "look at the dome"). A further signal is
+    not raised (the command's handler raises only the first)."""
+    if not cut.resets_on_open:
         result.lights = STOPPED_UNANSWERED
         return
+    _reopened_at_nab_rate(result, wait_s)
+
+
+def _reopened_at_nab_rate(result: ProbeResult, wait_s: float) -> None:
+    """Open the port again at the Nab sketch's rate after a stop (the opening resets the board
+    once more: a Nab board boots lit either way) and do the stop's teardown on it
+    (:func:`_stopped_on_open_port`): its boot listened out, its all-off sent if it is the
+    sketch. A port that fails meanwhile is said in ``result``."""
     t = SerialTransport(result.port, _NAB_BAUD)
     result.openings += 1
     try:
