@@ -7,7 +7,7 @@ import signal
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, NoReturn
 
 import typer
 from rich.markup import escape
@@ -15,6 +15,9 @@ from rich.markup import escape
 from rti_rig.cli.app import app, err, fail, out, stop_exit_code
 from rti_rig.core.errors import RtiRigError
 from rti_rig.runtime.deferred_signals import signal_handlers
+
+if TYPE_CHECKING:
+    from rti_rig.app.usecases.probe import ProbeResult
 
 
 @contextmanager
@@ -123,6 +126,19 @@ def _reboot_faulted(rig_config: Path) -> None:
         raise typer.Exit(code=1)
 
 
+def _probe_stopped(why: str, result: ProbeResult) -> NoReturn:
+    """Say what a stopped probe heard and found and what is known of the lights; exit as a
+    stop does."""
+    for line in result.heard_lines():
+        out.print(line, highlight=False, markup=False)
+    if result.profile is not None:
+        out.print(f"Found: {result.profile}. Rig-config lines to use:", highlight=False)
+        for line in result.config_lines():
+            out.print("  " + line, highlight=False, markup=False)
+    err.print(f"[red]Probe stopped ({escape(why)}):[/] {escape(result.lights)}.", highlight=False)
+    raise typer.Exit(code=stop_exit_code(why)) from None
+
+
 @app.command()
 def probe(
     port: Annotated[str, typer.Argument(help="Serial port of the dome, e.g. /dev/ttyACM0.")],
@@ -131,28 +147,21 @@ def probe(
     lights an LED, and a dome that boots lit is switched off, or you are told it could not be)
     and print the rig-config lines to use. Ctrl-C stops the probe after switching off a dome
     that booted lit, and says what is known of the lights."""
-    from rti_rig.app.usecases.probe import ProbeRequest, ProbeStopped
+    from rti_rig.app.usecases.probe import ProbeRequest, ProbeResult, ProbeStopped
     from rti_rig.app.usecases.probe import probe as run_probe
     from rti_rig.runtime.controller import EmergencyStop
 
+    result = ProbeResult(port)  # filled by the probe: what it established, whenever a stop lands
     try:
         with stop_on_signals():
-            result = run_probe(ProbeRequest(port))
+            run_probe(ProbeRequest(port), result=result)
     except ProbeStopped as exc:
-        for line in exc.result.heard_lines():
-            out.print(line, highlight=False, markup=False)
-        if exc.result.profile is not None:
-            out.print(f"Found: {exc.result.profile}. Rig-config lines to use:", highlight=False)
-            for line in exc.result.config_lines():
-                out.print("  " + line, highlight=False, markup=False)
-        err.print(
-            f"[red]Probe stopped ({escape(exc.why)}):[/] {escape(exc.result.lights)}.",
-            highlight=False,
-        )
-        raise typer.Exit(code=stop_exit_code(exc.why)) from None
-    except EmergencyStop as exc:  # after the probe returned, before its result was printed
-        err.print(f"[red]Probe stopped ({escape(str(exc))}):[/] look at the dome's lights.")
-        raise typer.Exit(code=stop_exit_code(str(exc))) from None
+        _probe_stopped(exc.why, exc.result)
+    except EmergencyStop as exc:
+        # after the probe returned (its teardown done, its lights said in the result), or
+        # before it began (nothing opened): it had said "look at the dome's lights" even after
+        # an all-off the board acknowledged
+        _probe_stopped(str(exc), result)
     for line in result.heard_lines():
         out.print(line, highlight=False, markup=False)
     if result.error:

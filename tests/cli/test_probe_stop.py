@@ -279,3 +279,53 @@ def test_a_stop_with_the_port_open_at_another_rate_reopens_at_9600_and_switches_
     assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
     assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
     assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_after_the_probe_returned_says_the_acknowledged_all_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C after the probe returned, before the command took its result: it said only
+    "look at the dome's lights", after the Nab board had acknowledged its all-off. It now says
+    what the probe established. The stop is raised where the signal lands, as the probe
+    returns (too short a window to aim a real signal at)."""
+    real_probe = probe_usecase.probe
+
+    def then_stopped(request: probe_usecase.ProbeRequest, **kwargs: Any) -> Any:
+        real_probe(request, **kwargs)
+        raise EmergencyStop("Ctrl-C")
+
+    monkeypatch.setattr(probe_usecase, "probe", then_stopped)
+    board = board_for("nab-rti-v1")
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert "Probe stopped (Ctrl-C): the sketch boots with every LED on; all-off sent and " in said
+    assert "look at the dome" not in said, said
+    assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
+    assert _boots(board) == 2, board.events  # no third opening to switch it off again
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_as_the_probe_returns_keeps_what_it_found_of_another_firmware(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C as the probe's sequence returns, having found nichlock's firmware (which boots
+    dark): the teardown said "stopped before a firmware answered … look at the dome". The stop
+    is raised where the signal lands, as the sequence returns."""
+    real_sequence = probe_usecase._probe
+
+    def then_stopped(result: probe_usecase.ProbeResult, wait: float) -> Any:
+        real_sequence(result, wait)
+        raise EmergencyStop("Ctrl-C")
+
+    monkeypatch.setattr(probe_usecase, "_probe", then_stopped)
+    board = board_for("nichlock")
+    with serve_on_pty(board, "nichlock") as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 130, said
+    assert "Probe stopped (Ctrl-C): the firmware boots with every LED off; nothing that " in said
+    assert "before a firmware answered" not in said, said
+    assert 'profile = "nichlock"' in said and "Traceback" not in said, said
+    assert board.lit_once_booted() == frozenset()

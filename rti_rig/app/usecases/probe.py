@@ -434,11 +434,16 @@ def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
     return True
 
 
-def probe(request: ProbeRequest) -> ProbeResult:
+def probe(request: ProbeRequest, result: ProbeResult | None = None) -> ProbeResult:
     """Try the known firmwares on ``request.port``; see the module docstring for the order.
 
+    ``result``, if given (for ``request.port``), is filled as the probe goes and returned: a
+    caller whose stop lands after the probe returned, before it took the result, still has what
+    the probe established of the lights (the command had said only "look at the dome's lights",
+    after an all-off the board had acknowledged).
+
     Raises :class:`ProbeStopped` once a stop (:class:`EmergencyStop`) has had its teardown."""
-    result = ProbeResult(request.port)
+    result = ProbeResult(request.port) if result is None else result
     try:
         return _probe(result, request.listen_s)
     except EmergencyStop as exc:  # stopped with no port open: a port's own is raised there
@@ -462,6 +467,11 @@ def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
         except TransportError as exc:
             result.error = str(exc)
             result.lights = _nab_not_off(exc)
+    elif result.profile is not None or result.error:
+        # the probe had concluded (another firmware found, or the port failed), the stop coming
+        # as it returned: its lights stand ("stopped before a firmware answered … look at the
+        # dome" had replaced a found nichlock board's "boots with every LED off")
+        return
     elif result.openings:
         result.lights = STOPPED_UNANSWERED
     else:
