@@ -150,9 +150,12 @@ _NAB_UNKNOWN_CODE = re.compile(nab.SPEC["error_pattern"])
 #: The end of its boot banner: the sketch is ready for commands.
 _NAB_READY = re.compile(nab.SPEC["ready_pattern"])
 
-#: The Nab sketch's boot banner, its answer to its all-on (printed at boot too) and to a code
-#: it does not know: each means it booted, lit.
-_NAB_SAYS = (_NAB_BANNER, re.compile(nab.ALL_ON_REPLY_PATTERN), _NAB_UNKNOWN_CODE)
+#: Its answer to its all-on, which ``setup()`` prints too, as every LED lights at boot.
+_NAB_ALL_ON = re.compile(nab.ALL_ON_REPLY_PATTERN)
+
+#: The Nab sketch's boot banner, its answer to its all-on and to a code it does not know: each
+#: means it booted, lit.
+_NAB_SAYS = (_NAB_BANNER, _NAB_ALL_ON, _NAB_UNKNOWN_CODE)
 
 #: The lights of a probe stopped before any firmware answered, once it opened the port.
 STOPPED_UNANSWERED = (
@@ -482,7 +485,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
     """:func:`probe`'s sequence of probes."""
     try:
         text = _exchange(result, "listen at 9600 baud", 9600, wait, b"", 0)
-        if _NAB_BANNER.search(text) or _NAB_SAYS[1].search(text):
+        if _NAB_BANNER.search(text) or _NAB_ALL_ON.search(text):
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
