@@ -244,16 +244,15 @@ def test_free_space_is_checked_before_each_image(
 
     cfg, ref = reference
     real = shutil.disk_usage
-    calls = {"n": 0}
+    out = tmp_path / "s"
 
     def usage(path):  # type: ignore[no-untyped-def]
-        calls["n"] += 1
         u = real(path)
-        # the start-up check and three images see room; then the disk is full
-        return u if calls["n"] <= 4 else u._replace(free=1_000_000)
+        # the start-up checks and three images see room; then the disk is full
+        full = out.is_dir() and len(list(out.glob("image_*.jpg"))) >= 3
+        return u._replace(free=1_000_000) if full else u
 
     monkeypatch.setattr(shutil, "disk_usage", usage)
-    out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(out), "--lights", str(LIGHTS)])
     assert r.exit_code == 2, r.output
     assert "not enough free disk space" in said(r) and "--resume" in said(r)

@@ -26,7 +26,12 @@ from rti_rig.runtime.controller import (
     validate_schedule,
 )
 from rti_rig.runtime.rig import Rig
-from rti_rig.runtime.session import SessionFolder, image_names
+from rti_rig.runtime.session import (
+    SessionFolder,
+    check_free_space,
+    estimated_bytes_per_image,
+    image_names,
+)
 
 
 @dataclass(frozen=True)
@@ -674,6 +679,16 @@ def _timed_limit(rig: Rig):  # type: ignore[no-untyped-def]
     return timed_exposure_limit(rig.loaded) if isinstance(rig.loaded, LoadedRig) else None
 
 
+def check_disk_holds(loaded, root: Path, steps: int) -> None:  # type: ignore[no-untyped-def]
+    """Refuse a session whose images the disk under ``root`` cannot hold, before the rig opens.
+
+    Why: the controller checks this too, but only as the capture begins: a full disk had been
+    refused after the rig opened and below a drawn "capturing 0/48" progress bar, as if the
+    capture had started. The controller's own check stays (the disk may fill meanwhile)."""
+    cam = loaded.config.camera
+    check_free_space(root, steps, estimated_bytes_per_image(cam.width, cam.height))
+
+
 def _open_new(
     loaded,  # type: ignore[no-untyped-def]
     schedule: LightSchedule,
@@ -690,6 +705,7 @@ def _open_new(
     from rti_rig.app.rig_identity import rig_identity
 
     SessionFolder.check_new(out_dir)
+    check_disk_holds(loaded, out_dir, len(schedule))
     if auto_exposure:
         refuse_unmeterable_rig(loaded)
     identity = rig_identity(loaded)
@@ -912,6 +928,11 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         (req.min_elevation_deg, req.max_elevation_deg),
     )
     folder.rig_identity = identity
+    try:  # the session's most images, as the controller counts them (its lights are not chosen)
+        check_disk_holds(loaded, req.out_dir, source.total)
+    except BaseException:
+        rig.close()
+        raise
     return OpenedSession(rig, schedule, folder, Path(req.out_dir), source=source)
 
 
@@ -1286,6 +1307,7 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         )
     # the steps still to shoot, at their own exposures, before the port opens
     _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
+    check_disk_holds(loaded, Path(req.session_dir), folder.total_steps - len(folder.done))
     rig = checked_rig(loaded, schedule)
     source = None
     if "adaptive" in folder.manifest:

@@ -1,0 +1,76 @@
+"""A disk that cannot hold the session is refused before the rig opens and before any bar.
+
+``rti-rig run`` (new, adaptive, resumed) and ``rti-rig preview`` on the shipped configs with
+too little free disk under ``--out``: the refusal had come from the controller's start-up
+check, after the rig opened and below a drawn "capturing 0/48" progress bar, as if the
+capture had begun. The free space is faked with ``shutil.disk_usage`` (no real full disk).
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def _disk_full(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=1_000_000))
+
+
+@pytest.mark.parametrize(
+    ("command", "extra"),
+    [
+        ("run", ["rig_configs/simulated_dome.toml"]),
+        ("run", ["rig_configs/emulated_dome.toml"]),
+        ("run", ["rig_configs/simulated_dome.toml", "--adaptive", "--lights", "20"]),
+        ("preview", ["rig_configs/simulated_dome.toml"]),
+    ],
+)
+def test_a_full_disk_is_refused_before_the_capture_bar(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, command: str, extra: list[str]
+) -> None:
+    _disk_full(monkeypatch, tmp_path)
+    out = tmp_path / "s"
+    config = str(CONFIGS.parent / extra[0])
+    r = runner.invoke(app, [command, config, *extra[1:], "--out", str(out)])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "not enough free disk space" in text and "free space or choose another --out" in text
+    assert "capturing" not in text and "0/" not in text, text
+    assert "switched off" not in text and "check the dome's lights" not in text, text
+    assert "Traceback" not in text and not out.exists()
+
+
+def test_a_resume_onto_a_full_disk_is_refused_before_the_capture_bar(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A session stopped by a full disk after two images, resumed while the disk is still
+    full: refused before the rig opens, its images left as they are."""
+    out = tmp_path / "s"
+    real = shutil.disk_usage
+
+    def fills_after_two(path):  # type: ignore[no-untyped-def]
+        usage = real(path)
+        full = out.is_dir() and len(list(out.glob("image_*.jpg"))) >= 2
+        return usage._replace(free=1_000_000) if full else usage
+
+    monkeypatch.setattr(shutil, "disk_usage", fills_after_two)
+    config = str(CONFIGS / "simulated_dome.toml")
+    r = runner.invoke(app, ["run", config, "--out", str(out), "--lights", "4", "--no-verdict"])
+    assert r.exit_code == 2 and "not enough free disk space" in said(r), said(r)
+    kept = sorted(p.name for p in out.glob("image_*.jpg"))
+    assert len(kept) == 2
+    r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "not enough free disk space for 2 image(s)" in text, text
+    assert "capturing" not in text and "Traceback" not in text, text
+    assert sorted(p.name for p in out.glob("image_*.jpg")) == kept
