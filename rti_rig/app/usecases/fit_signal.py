@@ -16,6 +16,7 @@ the relighting files never needed.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -26,6 +27,35 @@ from rti_rig.reconstruct.stack import ImageStack
 NO_SIGNAL_NAMED = 12
 #: How the normal maps are named in the warning.
 NORMAL_MAPS = "the normal maps"
+
+
+@dataclass(frozen=True)
+class Shortfall:
+    """Why the images holding signal cannot make an output, and how it joins "the N others":
+    a complement (``"fewer than ..."``) takes "is"/"are" before it, a verb phrase (``"cannot
+    determine ..."``) stands as it is.
+
+    Why: the grammar had been chosen by the reason's first word (``startswith("cannot")``), so
+    rewording a reason ("can't determine ...", "too few for ...") changed the sentence built
+    ("are can't determine ...")."""
+
+    text: str
+    complement: bool
+
+    def said(self, plural: bool) -> str:
+        """The reason as the predicate of "the N other(s)"."""
+        if not self.complement:
+            return self.text
+        return f"{'are' if plural else 'is'} {self.text}"
+
+
+def others_clause(lit: int, why: Sequence[Shortfall]) -> str:
+    """``"; the N others are ... and cannot ..."``: what the ``lit`` images holding signal
+    fall short of (empty where nothing is said of them)."""
+    if not why:
+        return ""
+    others = "the 1 other" if lit == 1 else f"the {lit} others"
+    return f"; {others} " + " and ".join(w.said(lit != 1) for w in why)
 
 
 def no_signal_warning(
@@ -83,17 +113,13 @@ def no_signal_warning(
     else:
         verb = "is" if len(listed) == 1 else "are"
         which = f"{len(listed)} of the {stack.n} images {verb}"
-        why = []
+        why: list[Shortfall] = []
         if short:
             needs = " and ".join(f"{name}'s {count}" for name, count in short.items())
-            why.append(f"fewer than {needs} coefficients per pixel")
+            why.append(Shortfall(f"fewer than {needs} coefficients per pixel", complement=True))
         if no_normal:
-            why.append("cannot determine a normal by themselves")
-        others = "the 1 other" if len(lit) == 1 else f"the {len(lit)} others"
-        verb = "is" if len(lit) == 1 else "are"
-        left = f"; {others} " + " and ".join(
-            w if w.startswith("cannot") else f"{verb} {w}" for w in why
-        )
+            why.append(Shortfall("cannot determine a normal by themselves", complement=False))
+        left = others_clause(len(lit), why)
     made = [*short, *([NORMAL_MAPS] if no_normal else [])]
     said = ", ".join(made[:-1]) + " and " + made[-1] if len(made) > 1 else made[0]
     verb = "are" if len(made) > 1 or made[0] == NORMAL_MAPS else "is"
