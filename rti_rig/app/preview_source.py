@@ -57,6 +57,9 @@ class PreviewSource:
     image: Path
     light_az_el_deg: tuple[float, float] | None = None
     light_source: str | None = None
+    #: Why no record of the light was found (None where it was, or where it was given):
+    #: what the plan says beside the light it then estimates.
+    unrecorded: str | None = None
 
 
 def _session_root(image: Path) -> Path | None:
@@ -192,6 +195,22 @@ def _refuse_a_rig_as_preview(path: Path) -> None:
         )
 
 
+def _unrecorded(image: Path, rig_lp: RigLp | None) -> str:
+    """Why ``image`` has no record of its light, from what was looked in (module notes).
+
+    Why: an image of a session that records no step with it (a copy, an image whose journal
+    line was never written) had its light estimated with no word of the session at all."""
+    root = _session_root(image)
+    where = []
+    if root is not None:
+        where.append(f"the session {root.name} records no step with {image.name}")
+    if rig_lp is not None:
+        where.append(f"{rig_lp[0].name} (--rig) does not list it")
+    if not where:
+        return "no rti-rig session or --rig .lp records its light"
+    return " and ".join(where)
+
+
 def resolve_preview(
     path: Path, rig_lp: RigLp | None = None, light_given: bool = False
 ) -> PreviewSource:
@@ -224,7 +243,7 @@ def resolve_preview(
     _refuse_a_rig_as_preview(path)
     found = _records(path, rig_lp) if path.is_file() and not light_given else []
     if not found:
-        return PreviewSource(path)
+        return PreviewSource(path, unrecorded=None if light_given else _unrecorded(path, rig_lp))
     (first_where, short, first), *others = found
     for where, _, d in others:
         off = float(angle_between_deg(np.asarray(first), np.asarray(d)))

@@ -179,12 +179,13 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
         geometry = rig_geometry(loaded)
         arm_order = arm_order_for(loaded)
     signal_noise = _signal_noise(req, loaded, objective)
-    az_el, light_note, image = req.preview_light, None, None
+    az_el, light_note, image, unrecorded = req.preview_light, None, None, None
     if req.preview is not None:
         rig_lp = (req.rig, entries) if loaded is None else None
         source = resolve_preview(req.preview, rig_lp, az_el is not None)
         if az_el is None and source.light_az_el_deg is not None:
             az_el, light_note = source.light_az_el_deg, source.light_source
+        unrecorded = source.unrecorded
         image = read_preview_image(source.image)
     schedule, report = plan(
         PlanRequest(
@@ -207,6 +208,8 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     _check_determined(req, schedule, notes)
     if light_note and report.preview_light_source == "given":
         report.preview_light_source = light_note
+    if image is not None and az_el is None and report.preview_light_az_el_deg is not None:
+        report.preview_light_source = estimated_light_said(unrecorded)
     if req.signal_noise and not report.signal_noise:
         # as --material's note says (planner.make_plan): an option given and silently unused
         # had read as if the plan modelled the JPEG noise
@@ -229,6 +232,28 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if (outlook := fit_outlook(len(schedule))) is not None:
         notes.append(outlook)
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
+
+
+#: How far the light estimated from a preview was off the light that fired, where that was
+#: measured: the real icon's 8 previews, docs/research/planner.md. A range seen, not a bound.
+ESTIMATE_OFF_ON_ICON_DEG = (17, 59)
+
+
+def estimated_light_said(unrecorded: str | None) -> str:
+    """How the plan's preview light was had when nothing recorded it and none was given: how it
+    was estimated, why, what is known of its error, and how to give the real one.
+
+    Why: it had been labelled "estimated (Zheng-Chellappa)" and no more, though the estimate
+    is far from the light that fired (17–59° on the icon's previews) and its error on this
+    image is not known; ``--preview-light`` and ``rti-rig preview`` give the light itself."""
+    lo, hi = ESTIMATE_OFF_ON_ICON_DEG
+    why = f", as {unrecorded}" if unrecorded else ""
+    return (
+        f"estimated by Zheng & Chellappa's method from the image's shading{why}: how far off "
+        f"it is here is not known ({lo}–{hi}° on the 8 previews of a real icon, "
+        "docs/research/planner.md); "
+        "--preview-light AZ,EL gives the light that fired"
+    )
 
 
 def _check_determined(req: PlanLightsRequest, schedule: LightSchedule, notes: list[str]) -> None:
