@@ -129,6 +129,7 @@ DASK_MODULES = ("dask", "distributed")
         "rti_rig.cli",
         "rti_rig.app.usecases.fit",
         "rti_rig.app.usecases.fit_dask",
+        "rti_rig.app.usecases.scheduler_probe",
         "rti_rig.reconstruct.lazy_stack",
     ],
 )

@@ -1,0 +1,411 @@
+"""Whether ``rti-rig fit --scheduler ADDRESS`` can use that Dask scheduler, found before any
+``distributed.Client`` is built: the address parsed and its transport usable here, the host
+looked up, Dask's TLS settings loaded, and one bounded connection that asks the scheduler who
+it is.
+
+Why its own module: these checks are about reaching a scheduler, not about fitting; they had
+grown to half of :mod:`rti_rig.app.usecases.fit_dask`, which builds the client on them and
+runs the fit. Dask is imported only inside the functions (this module is imported only when
+``--scheduler`` is given).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+import threading
+from collections.abc import Sequence
+from contextlib import suppress
+from typing import Any
+
+from rti_rig.core.errors import RtiRigError
+
+#: ``--scheduler`` value for Dask's threaded scheduler in this process.
+THREADS = "threads"
+
+SHARED_PATHS = (
+    "every Dask worker must see the session's files at the same paths as this machine "
+    "(a shared filesystem mounted at the same place)"
+)
+
+
+class SchedulerError(RtiRigError):
+    """The Dask scheduler cannot be used: unreachable, no workers, or workers that cannot read
+    the images."""
+
+
+def unreachable_scheduler(address: str, why: str) -> SchedulerError:
+    """What is said of a scheduler that cannot be connected to (``why``: what happened)."""
+    return SchedulerError(
+        f"cannot reach the Dask scheduler at {address!r} ({why}). "
+        f"Start one with `dask scheduler` and workers with `dask worker {address}` — "
+        f"{SHARED_PATHS} — or leave out --scheduler to fit in this process."
+    )
+
+
+def _usable(scheme: str) -> bool:
+    """Whether Dask's transport for ``scheme`` can open a connection from this process.
+
+    Why: Dask registers ``ucx://`` even without its package (``distributed-ucxx``); a Client
+    built on it failed with "TypeError: Can't instantiate abstract class UCXConnector", told as
+    a scheduler that could not be reached. Getting the connector is what fails, and costs
+    nothing (no connection is opened)."""
+    import warnings
+
+    from distributed.comm.registry import get_backend
+
+    try:
+        with warnings.catch_warnings():  # the deprecated ucx:// warns as it fails
+            warnings.simplefilter("ignore")
+            get_backend(scheme).get_connector()
+    except Exception:  # any failure means the same: not usable here
+        return False
+    return True
+
+
+def _inproc_listening(location: str) -> bool:
+    """Whether ``location`` (of an ``inproc://`` address) names a server living in this
+    process: only then can it be reached (a test's in-process ``LocalCluster``)."""
+    from distributed.comm.inproc import global_manager
+
+    try:
+        return global_manager.get_listener_for(location) is not None
+    except ValueError:  # not ip/pid/n, or another process's pid or host
+        return False
+
+
+def checked_address(address: str) -> str:
+    """``address``'s scheme, once Dask can parse the address and has a usable transport for it.
+
+    Why: a Client built on an address Dask cannot use raised ValueError (said clearly), but the
+    half-built Client then waited 40 s in its ``__del__`` and printed an "Exception ignored …
+    TimeoutError" traceback after the error; an ``http://`` address was also advised as the
+    one to start workers with. So were ``inproc://`` (a scheduler inside one Python process,
+    which no other process can reach: it was listed as accepted and advised for ``dask
+    worker``) and ``ucx://`` (listed as accepted, its package not installed)."""
+    from distributed.comm import parse_address
+    from distributed.comm.addressing import parse_host_port
+    from distributed.comm.registry import backends, get_backend
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as exc:
+        raise SchedulerError(
+            f"--scheduler {address!r} is not a Dask scheduler address ({exc}): give "
+            f"'{THREADS}' or an address such as tcp://HOST:8786"
+        ) from None
+    # the transports a scheduler in another process can be reached by, as the user is told
+    usable = ", ".join(f"{s}://" for s in sorted(backends) if s != "inproc" and _usable(s))
+    give = f"Give '{THREADS}' or the address `dask scheduler` prints, such as tcp://HOST:8786"
+    if scheme == "inproc":
+        if _inproc_listening(location):
+            return scheme
+        raise SchedulerError(
+            f"--scheduler {address!r} cannot be reached: an inproc:// address names a "
+            "scheduler inside one Python process, and no other process (this `rti-rig fit` "
+            f"included) can connect to it. {give}, or leave out --scheduler to fit in this "
+            "process"
+        )
+    try:
+        get_backend(scheme)  # the transports Dask ships, then any a package registers
+    except (ValueError, ImportError):
+        raise SchedulerError(
+            f"--scheduler {address!r} is not a Dask scheduler address: Dask has no transport "
+            f"for {scheme}://, it accepts {usable}. {give}"
+        ) from None
+    if not _usable(scheme):
+        hint = " (the distributed-ucxx package)" if scheme == "ucx" else ""
+        raise SchedulerError(
+            f"--scheduler {address!r} needs Dask's {scheme}:// transport, which is not "
+            f"installed here{hint}; the transports this machine has are {usable}. {give}"
+        )
+    return scheme
+
+
+class _Refused(Exception):
+    """The scheduler's host refused the connection: nothing listens on that port."""
+
+
+class _Unresolved(Exception):
+    """The resolver said the scheduler's host name has no address (``args``: the host, why)."""
+
+
+class _LookupFailed(Exception):
+    """The scheduler's host name could not be looked up: the resolver did not answer in time,
+    or failed for a reason of its own, which is not a name that does not exist (``args``: the
+    host, why)."""
+
+
+#: The resolver's answers that a name has no address: said as "does not resolve". Any other
+#: failure (EAI_AGAIN, a nameserver down or slow) says nothing about the name.
+NO_SUCH_NAME = tuple(
+    code for code in (socket.EAI_NONAME, getattr(socket, "EAI_NODATA", None)) if code is not None
+)
+
+
+def _refused(exc: BaseException | None) -> bool:
+    """Whether ``exc``, or an exception it was raised from, is a refused connection (Dask's
+    TCP connector raises ``CommClosedError`` from the ``ConnectionRefusedError``)."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, ConnectionRefusedError):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+async def _resolve(host: str, port: int, timeout: float) -> list[str]:
+    """The addresses ``host`` resolves to, in the resolver's order; raise :class:`_Unresolved`
+    when the resolver says it has no address, :class:`_LookupFailed` when it has not answered
+    within ``timeout`` seconds or failed otherwise.
+
+    Why: Dask's ``connect`` retries a name that does not resolve until its timeout, so a
+    mistyped host waited the full 20 s and was told as "no Dask scheduler answered". The lookup
+    runs in a daemon thread: ``getaddrinfo`` cannot be interrupted, and a resolver that hangs
+    must hold neither this wait beyond ``timeout`` nor the exit of a stopped ``rti-rig fit``
+    (the event loop's own executor is joined at exit). A slow answer is not a missing name:
+    the lookup had been cut at a fifth of the connect timeout (4 s), under glibc's 5 s per
+    nameserver, so a machine whose first nameserver was down was told that a valid host "does
+    not resolve"."""
+    loop = asyncio.get_running_loop()
+    answer: asyncio.Future[BaseException | list[str]] = loop.create_future()
+
+    def tell(outcome: BaseException | list[str]) -> None:
+        if not answer.done():
+            answer.set_result(outcome)
+
+    def lookup() -> None:
+        outcome: BaseException | list[str]
+        try:
+            infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+            outcome = list(dict.fromkeys(str(info[4][0]) for info in infos))
+        except OSError as exc:  # socket.gaierror, or an OSError of the resolver's
+            outcome = exc
+        with suppress(RuntimeError):  # the loop is closed: the probe was stopped or timed out
+            loop.call_soon_threadsafe(tell, outcome)
+
+    threading.Thread(target=lookup, name="rti-rig-resolve", daemon=True).start()
+    try:
+        outcome = await asyncio.wait_for(answer, timeout)
+    except TimeoutError:
+        raise _LookupFailed(host, f"the resolver did not answer within {timeout:.0f} s") from None
+    if isinstance(outcome, BaseException):
+        why = getattr(outcome, "strerror", None) or str(outcome)
+        if isinstance(outcome, socket.gaierror) and outcome.errno in NO_SUCH_NAME:
+            raise _Unresolved(host, why)
+        raise _LookupFailed(host, why)
+    return outcome
+
+
+def _host_port(address: str) -> tuple[str, int] | None:
+    """The host and port of a tcp://, ws://, tls:// or wss:// ``address``; None for others
+    (inproc://, ucx://: nothing of theirs is looked up or connected to here)."""
+    from distributed.comm import parse_address, parse_host_port
+
+    scheme, location = parse_address(address)
+    if scheme not in ("tcp", "ws", "tls", "wss"):
+        return None
+    host, port = parse_host_port(location)
+    return host, int(port)
+
+
+async def _connect(
+    address: str, timeout: float, connection_args: dict[str, Any], ips: Sequence[str] = ()
+) -> Any:
+    """A Dask comm to ``address``, its handshake done (``distributed.comm.connect``), after
+    plain connections to ``ips`` (its host's addresses, looked up before: see :func:`probe`)
+    find a refused port at once.
+
+    Why: Dask's ``connect`` retries a refused connection, and a name that does not resolve,
+    until its timeout, so a port nothing listens on (a scheduler not started, a wrong port) or
+    a mistyped host waited the full 20 s and was told as "Timed out trying to connect". A
+    lookup and a bare connect say it in milliseconds, with nothing of Dask's handshake copied
+    here (a copy would break silently with a Dask upgrade); a scheduler that is there logs it
+    at INFO as a connection closed before its handshake. For tls:// and wss:// the same
+    connect also does the TLS handshake, with the context Dask's own connect uses, so that a
+    listener that is there does not log a failed TLS handshake as a warning; a refused port
+    fails before any handshake. Any other failure (a certificate refused, a slow network) is
+    left to Dask, which says it in its own words. The plain connections go to the addresses
+    looked up, not to the name: a slow resolver (a nameserver down, 5 s per lookup) had timed
+    out this step's second lookup, and the port is called refused only where every address
+    refuses (localhost's ::1 may refuse where 127.0.0.1 listens)."""
+    from distributed.comm import connect, parse_address
+
+    scheme, location = parse_address(address)
+    host_port = _host_port(address)
+    if host_port is not None and ips:
+        host, port = host_port
+        tls: Any = None
+        if scheme == "tls":
+            tls = connection_args.get("ssl_context")  # checked by _tls_settings: a context
+        elif scheme == "wss":  # Dask's wss:// gives tornado None for its default context
+            tls = connection_args.get("ssl_context") or True
+
+        async def every_refused() -> bool:
+            for ip in ips:
+                try:
+                    _, writer = await asyncio.open_connection(
+                        ip, port, ssl=tls, server_hostname=host if tls else None
+                    )
+                except (OSError, ValueError) as exc:
+                    if _refused(exc):
+                        continue
+                    return False
+                writer.close()
+                return False
+            return True
+
+        with suppress(TimeoutError):
+            if await asyncio.wait_for(every_refused(), timeout / 5):
+                raise _Refused(location)
+    return await connect(address, timeout=timeout, **connection_args)
+
+
+async def _identity(
+    address: str, timeout: float, connection_args: dict[str, Any], ips: Sequence[str] = ()
+) -> Any:
+    """The scheduler's answer to Dask's ``identity`` request (a connection, its handshake, one
+    request and its reply); ``ips``: its host's addresses (:func:`_connect`)."""
+    comm = await _connect(address, timeout, connection_args, ips)
+    try:
+        await comm.write({"op": "identity", "reply": True})
+        return await comm.read()
+    finally:
+        comm.abort()
+
+
+def _run_quietly(main: Any) -> Any:
+    """``asyncio.run(main)``, without asyncio's report of the tasks a stop leaves behind.
+
+    Why: a Ctrl-C that lands while the probe connects cancels the connection's tasks, and one
+    that ends with an exception of its own (a comm closed under it) was printed by
+    ``asyncio.run``'s shutdown as "unhandled exception during asyncio.run() shutdown" with a
+    traceback, after "Stopped (Ctrl-C)". And ``asyncio.run`` turns a Ctrl-C into a cancellation
+    of its main task, which the connection under way could outlive: under load the stopped
+    ``rti-rig fit`` then waited on the silent port for good (a test timed out at 150 s). Here
+    the Ctrl-C is raised as it comes, and what it leaves is given one second to end."""
+    loop = asyncio.new_event_loop()
+    try:
+        return loop.run_until_complete(main)
+    finally:
+        loop.set_exception_handler(lambda _loop, _context: None)
+        try:
+            left = [task for task in asyncio.all_tasks(loop) if not task.done()]
+            for task in left:
+                task.cancel()
+            if left:  # bounded: a task that ignores its cancellation must not hold the stop
+                loop.run_until_complete(asyncio.wait(left, timeout=1.0))
+            loop.run_until_complete(loop.shutdown_asyncgens())
+        finally:
+            loop.close()
+
+
+#: Dask's configuration keys a tls:// client needs (its ``Security()`` reads them).
+TLS_KEYS = (
+    "distributed.comm.tls.ca-file",
+    "distributed.comm.tls.client.cert",
+    "distributed.comm.tls.client.key",
+)
+
+
+def _tls_settings(address: str) -> dict[str, Any]:
+    """The connection arguments Dask's ``Client`` will use (``Security()`` from Dask's
+    configuration), refused in words when they cannot serve ``address``.
+
+    Why: a tls:// address without TLS settings was told as "cannot reach the Dask scheduler
+    (TypeError: TLS expects a `ssl_context` argument …)", with advice to start a scheduler,
+    when what is missing is this client's certificate and the CA to check the scheduler's;
+    and a certificate file that cannot be read raised out of here with a traceback."""
+    import ssl
+
+    import dask.config
+    from distributed.security import Security
+
+    how = (
+        f"Dask reads them from its configuration: {', '.join(TLS_KEYS)} (the key may be in "
+        "the certificate file), in a YAML file under ~/.config/dask/ or as the environment "
+        "variables DASK_DISTRIBUTED__COMM__TLS__CA_FILE, "
+        "DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT and DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY"
+    )
+    try:
+        security = Security()
+        args: dict[str, Any] = security.get_connection_args("client")
+    except (OSError, ValueError) as exc:  # ssl.SSLError is an OSError
+        given = {key: dask.config.get(key, None) for key in TLS_KEYS}
+        named = ", ".join(f"{key} = {value!r}" for key, value in given.items() if value)
+        raise SchedulerError(
+            f"--scheduler {address!r}: Dask's TLS settings cannot be used "
+            f"({type(exc).__name__}: {exc}; {named or 'none given'}). Check the files they "
+            f"name; {how}."
+        ) from None
+    if address.startswith("tls://") and not isinstance(args.get("ssl_context"), ssl.SSLContext):
+        given = (security.tls_ca_file, security.tls_client_cert)
+        missing = [key for key, value in zip(TLS_KEYS[:2], given, strict=True) if not value]
+        raise SchedulerError(
+            f"--scheduler {address!r} is a TLS address, and Dask's TLS settings for a client "
+            f"are not given ({' and '.join(missing)} not set): give the CA certificate that "
+            "signed the scheduler's certificate and this client's certificate and key. "
+            f"{how}. Or give the scheduler's tcp:// address if it has one."
+        )
+    return args
+
+
+def probe(address: str, timeout: float) -> None:
+    """Return once the scheduler at ``address`` answers, within ``timeout`` seconds in all.
+
+    Why: ``Client(address, timeout=…)`` bounds only the TCP connect; Dask's handshake then
+    reads the first reply without a bound, so a port that accepts the connection and never
+    answers (a proxy, a service that is not Dask, a hung scheduler) held ``rti-rig fit`` for
+    ever, and its Ctrl-C left a half-built Client waiting 40 s in ``__del__``. No Client is
+    built before this answers. The host name is looked up first, with the whole ``timeout``
+    (a slow resolver is not a missing name), and the connection has what is left."""
+    args = _tls_settings(address)
+
+    async def bounded() -> Any:
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout
+        host_port = _host_port(address)
+        ips = await _resolve(*host_port, timeout) if host_port is not None else []
+        left = max(deadline - loop.time(), 0.0)
+        return await asyncio.wait_for(_identity(address, timeout, args, ips), left)
+
+    try:
+        identity = _run_quietly(bounded())
+    except TimeoutError:  # asyncio's is the builtin's since 3.11; Dask's own names the address
+        raise unreachable_scheduler(
+            address,
+            f"no Dask scheduler answered within {timeout:.0f} s: nothing listens there, a "
+            "firewall drops the connection, or what accepts it is not a Dask scheduler",
+        ) from None
+    except _Refused as refused:
+        raise unreachable_scheduler(
+            address, f"connection refused: no scheduler listens at {refused}"
+        ) from None
+    except _Unresolved as unresolved:
+        host, why = unresolved.args
+        raise SchedulerError(
+            f"--scheduler {address!r} names the host {host!r}, which does not resolve ({why}): "
+            "check the host name, or give the address `dask scheduler` prints, such as "
+            "tcp://192.0.2.10:8786"
+        ) from None
+    except _LookupFailed as failed:
+        host, why = failed.args
+        raise SchedulerError(
+            f"--scheduler {address!r}: the host {host!r} could not be looked up ({why}): "
+            "check this machine's network and name servers (/etc/resolv.conf), or give the "
+            "scheduler's IP address, such as tcp://192.0.2.10:8786"
+        ) from None
+    except Exception as exc:  # reset, a TLS failure, a reply that is not Dask's
+        raise unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
+    if not (isinstance(identity, dict) and "workers" in identity):
+        # e.g. a worker's or nanny's address: it answers, then the Client built on it failed
+        # with a TypeError and hung 40 s in its __del__, printing a traceback
+        what = identity.get("type", "server") if isinstance(identity, dict) else "server"
+        raise SchedulerError(
+            f"--scheduler {address!r} answers as a Dask {what}, not a scheduler: give the "
+            "address `dask scheduler` prints (the one its workers were started with), such as "
+            "tcp://HOST:8786"
+        )
