@@ -635,7 +635,7 @@ class ScriptedDomeDriver(PortOpening):
                     f"{spec.name} firmware's usual one (set boot_wait_s = "
                     f"{math.ceil(after) + 1} in [dome.serial.protocol]), or a reboot"
                 )
-                raise self._error(self.slow_boot_advice, name, LinkFault.RESET)
+                raise self._error(self.slow_boot_advice, name, LinkFault.RESET, slow_boot=True)
             raise self._error(
                 "the board rebooted (boot banner) before answering", name, LinkFault.RESET
             )
@@ -706,6 +706,10 @@ class ScriptedDomeDriver(PortOpening):
             self._rx.extend(data)
             self._heard_text = (self._heard_text + data.decode("latin-1"))[-HEARD_KEPT:]
 
-    def _error(self, message: str, command: str, fault: LinkFault) -> DomeLinkError:
+    def _error(
+        self, message: str, command: str, fault: LinkFault, *, slow_boot: bool = False
+    ) -> DomeLinkError:
         retryable = fault not in (LinkFault.REJECTED, LinkFault.WAITING, LinkFault.FOREIGN)
-        return DomeLinkError(self.device, message, command, fault, retryable=retryable)
+        return DomeLinkError(
+            self.device, message, command, fault, retryable=retryable, slow_boot=slow_boot
+        )

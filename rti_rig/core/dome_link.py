@@ -52,11 +52,19 @@ class DomeLinkError(DeviceError):
         code: int | None = None,
         port_held: bool = False,
         sent: bool = True,
+        slow_boot: bool = False,
     ) -> None:
         super().__init__(device, message, command)
         self.fault = fault
         self.retryable = retryable
         self.code = code
+        #: The fault is a boot banner later than the profile's boot wait (a bootloader slower
+        #: than the firmware's usual one), whose advice the link also keeps as
+        #: ``slow_boot_advice``. A check ended by this error (or by one raised from it) says
+        #: that advice as its error; one that went on says it as a line of its own. Decided by
+        #: this flag, not by finding the advice's words in the error: rewording either
+        #: message had changed which the report said.
+        self.slow_boot = slow_boot
         #: The port could not be opened because another program holds its lock (another
         #: rti-rig check or run on this dome): nothing about the board is known or wrong.
         self.port_held = port_held

@@ -1531,6 +1531,25 @@ _REACHED = {
 }
 
 
+def _ended_by_slow_boot(error: BaseException | None) -> bool:
+    """Whether ``error`` is a slow boot's :class:`DomeLinkError` (``slow_boot`` set), or was
+    raised from one (``raise … from``, the policy's way of restating a link error with its
+    advice added): the check then ended on it and its advice is already the error said.
+
+    Why: this had been decided by looking for the link's advice text inside the error's
+    message, so rewording either (or restating the error without quoting it) changed whether
+    the report said "the check went on" of a check the slow boot had ended. Only explicit
+    causes are followed: an error merely raised while handling a slow boot (``__context__``)
+    is a fault of its own, after which the slow boot's advice is still news."""
+    seen: set[int] = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, DomeLinkError) and error.slow_boot:
+            return True
+        seen.add(id(error))
+        error = error.__cause__
+    return False
+
+
 def self_test(
     source: DiscreteLightSource,
     clock: Clock,
@@ -1546,6 +1565,7 @@ def self_test(
     """
     started = clock.now()
     report = SelfTestReport(name=source.name, firmware=None, led_count=0)
+    ended_by: DeviceError | None = None
     link = source.link if isinstance(source, DomePolicy) else None
     # a source with no link (no firmware to answer) is reported as before: its steps passed
     report.light_confirmed = True if link is None else link.light_confirmed
@@ -1578,12 +1598,13 @@ def self_test(
                 report.checks.append(LedCheck(i, False, str(exc)))
     except DeviceError as exc:
         report.aborted = str(exc)
+        ended_by = exc
     finally:
         if isinstance(source, DomePolicy):
             report.reached = source.reached  # before close() forgets the connection
         report.foreign_firmware = getattr(link, "foreign_firmware", None)
         slow = getattr(link, "slow_boot_advice", None)
-        if isinstance(slow, str) and slow not in (report.aborted or ""):
+        if isinstance(slow, str) and not _ended_by_slow_boot(ended_by):
             report.slow_boot = slow  # recovered from; one that ended the check is its error
         try:
             source.close()

@@ -69,3 +69,50 @@ def test_a_banner_later_than_the_boot_wait_is_not_called_a_reboot(tmp_path: Path
     # CliRunner mixes stderr into output: the report's own line is what is looked for
     assert "slow boot: the board printed its boot banner only" in said, said
     assert "set boot_wait_s = 7 in [dome.serial.protocol]" in said
+
+
+def test_a_late_banner_that_ended_the_check_is_its_error_not_a_slow_boot_line(
+    tmp_path: Path,
+) -> None:
+    """With no resend allowed (retries = 0) the late banner ends the connect: its advice is
+    the check's error, and no "slow boot: … the check went on" line claims a walk that never
+    ran. Which of the two the report says is decided by the link error's ``slow_boot`` flag
+    (and the errors raised from it), not by finding the advice's words in the error."""
+    from rti_rig.simulator.domes import board_for
+    from rti_rig.simulator.pty_link import serve_on_pty
+
+    board = board_for("nab-rti-v1")
+    board.boot_s = 5.0  # the profile waits 4 s
+    with serve_on_pty(board, "nab-rti-v1") as link:
+        cfg = emulated_dome_as_hardware(tmp_path, "emulated_nab_rti_v1.toml", link.port)
+        cfg.write_text(cfg.read_text().replace("retries = 2", "retries = 0"))
+        r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0, said
+    assert "ABORTED:" in said, said
+    aborted = said[said.index("ABORTED:") :]
+    assert "printed its boot banner only" in aborted, said  # the error says the slow boot
+    assert "set boot_wait_s = 7 in [dome.serial.protocol]" in aborted, said
+    assert "slow boot:" not in said and "the check went on" not in said, said
+
+
+def test_only_a_slow_boot_error_or_one_raised_from_it_ended_the_check() -> None:
+    """The decision itself, on errors worded alike: the flag and the explicit cause decide."""
+    from rti_rig.core.dome_link import DomeLinkError, LinkFault
+    from rti_rig.core.errors import DeviceError
+    from rti_rig.runtime.dome_policy import _ended_by_slow_boot
+
+    def link_error(slow: bool) -> DomeLinkError:
+        return DomeLinkError(
+            "dome", "banner late", "hello", LinkFault.RESET, retryable=True, slow_boot=slow
+        )
+
+    slow, other = link_error(True), link_error(False)
+    assert _ended_by_slow_boot(slow) and not _ended_by_slow_boot(other)
+    assert not _ended_by_slow_boot(None)
+    restated = DeviceError("dome", "no handshake with the dome (reworded)", "hello")
+    restated.__cause__ = slow
+    assert _ended_by_slow_boot(restated)
+    after = DeviceError("dome", "banner late", "hello")  # its words, but not raised from it
+    after.__context__ = slow
+    assert not _ended_by_slow_boot(after)
