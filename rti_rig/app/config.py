@@ -22,6 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from rti_rig.app.flash_sync import FlashSyncSettings, SyncFaultConfig
 from rti_rig.core.errors import ConfigError, LpFormatError
+from rti_rig.core.exposure_range import Bound, shared_range
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el, fibonacci_cap
 from rti_rig.core.image_files import looks_like_image
 from rti_rig.core.lp_format import read_lp
@@ -861,8 +862,9 @@ def _check_exposure_ranges(loaded: LoadedRig, path: Path, cam: object) -> None:
     :func:`rti_rig.runtime.exposure_policy.metering_start`, or the camera's own refusal of
     the first exposure), so ``rti-rig check`` opened the dome's port and the camera for a
     config no shot can come from: every exposure is kept inside ``[camera]``'s range, and the
-    camera refuses any outside its own. Said in the connect-time check's words. The frame
-    period and the exposure units, known only once connected, are left to that check."""
+    camera refuses any outside its own. Said in the connect-time check's words, and judged by
+    the same function (:func:`rti_rig.core.exposure_range.shared_range`). The frame period and
+    the exposure units, known only once connected, are left to that check."""
     low = getattr(cam, "min_exposure_s", None)
     high = getattr(cam, "max_exposure_s", None)
     if low is None or high is None:  # a camera whose range the config does not give
@@ -870,24 +872,26 @@ def _check_exposure_ranges(loaded: LoadedRig, path: Path, cam: object) -> None:
     given = loaded.config.camera.device or {}
     camera = loaded.config.camera
 
-    def device(key: str, value: float) -> str:
+    def device(key: str, value: float) -> Bound:
         default = "" if key in given else " (its default)"
-        return f"{key} = {value:g} s in [camera.device]{default}"
+        return value, f"{key} = {value:g} s in [camera.device]{default}"
 
-    if camera.min_exposure_s > high * (1 + 1e-9):
-        key = "camera.min_exposure_s"
-        first = f"[camera] min_exposure_s = {camera.min_exposure_s:g} s"
-        second = device("max_exposure_s", high)
-    elif camera.max_exposure_s < low * (1 - 1e-9):
-        key = "camera.max_exposure_s"
-        first = device("min_exposure_s", low)
-        second = f"[camera] max_exposure_s = {camera.max_exposure_s:g} s"
-    else:
+    shortest = (camera.min_exposure_s, f"[camera] min_exposure_s = {camera.min_exposure_s:g} s")
+    longest = (camera.max_exposure_s, f"[camera] max_exposure_s = {camera.max_exposure_s:g} s")
+    shared = shared_range(
+        (shortest, longest), (device("min_exposure_s", low), device("max_exposure_s", high))
+    )
+    if not shared.empty:
         return
+    assert shared.floor is not None and shared.cap is not None  # what empty means
+    # the ranges are each the right way round, so an empty share has one end of [camera]'s:
+    # its shortest above the device's longest, or its longest below the device's shortest
+    key = "camera.min_exposure_s" if shared.floor is shortest else "camera.max_exposure_s"
     raise ConfigError(
         path,
         key,
-        f"no exposure the camera takes lies between {first} and {second}: the camera refuses "
+        f"no exposure the camera takes lies between {shared.floor[1]} and {shared.cap[1]}: "
+        "the camera refuses "
         "any exposure outside [camera.device]'s range, and every exposure (exposure_s, and "
         "what run --auto-exposure meters) is kept inside [camera]'s; lower the first or raise "
         "the second",

@@ -37,6 +37,7 @@ import numpy as np
 
 from rti_rig.core.devices import ExposingCamera, Frame
 from rti_rig.core.errors import DeviceError
+from rti_rig.core.exposure_range import Bound, longer_than, shared_range
 from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.controller import (
     check_capture_fits_lit,
@@ -99,10 +100,6 @@ def representable_s(camera: object, exposure_s: float) -> float:
     return float(steps(exposure_s)) if steps is not None else exposure_s
 
 
-#: one end of the range the metering keeps to, and what sets it (a phrase naming the key)
-Bound = tuple[float, str]
-
-
 def _at_least_s(camera: object, exposure_s: float) -> float:
     """The shortest exposure the camera takes exactly at or above ``exposure_s``.
 
@@ -154,12 +151,9 @@ def metering_start(
     high: Bound | None = longest() if callable(longest) else None
     if high is not None:
         high = (representable_s(camera, high[0]), high[1])
-    floor, cap = low, high
-    if within is not None:
-        if floor is None or within[0][0] > floor[0]:
-            floor = within[0]
-        if cap is None or within[1][0] < cap[0]:
-            cap = within[1]
+    # the camera's range first: it is the one said on a tie
+    shared = shared_range((low, high), within or (None, None))
+    floor, cap = shared.floor, shared.cap
     start = exposure_s
     if cap is not None:
         start = min(start, cap[0])
@@ -168,7 +162,9 @@ def metering_start(
     start = representable_s(camera, start)
     if floor is not None and start < floor[0] * (1 - 1e-9):
         start = _at_least_s(camera, floor[0])
-    if cap is not None and start > cap[0] * (1 + 1e-9):
+    # no exposure in both ranges (the judgement the config check makes when it loads), or
+    # none the camera takes exactly in what they share
+    if cap is not None and (shared.empty or longer_than(start, cap)):
         raise DeviceError(
             name,
             f"no exposure the camera takes exactly lies between {floor[1] if floor else '0'} "

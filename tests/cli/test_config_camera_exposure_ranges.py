@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from conftest import said
 from typer.testing import CliRunner
 
@@ -85,3 +86,61 @@ def test_ranges_that_meet_are_not_refused_at_load(tmp_path: Path) -> None:
         "min_exposure_s = 0.01",
     )
     assert load_rig_config(cfg).config.camera.max_exposure_s == 0.01
+
+
+class _DeviceRangeCamera:
+    """A connected camera that takes ``[low, high]`` (what the metering's start asks of it)."""
+
+    name = "uvc-camera"
+
+    def __init__(self, low: float, high: float) -> None:
+        self.low, self.high = low, high
+
+    def shortest_exposure_s(self) -> tuple[float, str]:
+        return self.low, f"min_exposure_s = {self.low:g} s in [camera.device]"
+
+    def longest_exposure_s(self) -> tuple[float, str]:
+        return self.high, f"max_exposure_s = {self.high:g} s in [camera.device]"
+
+
+@pytest.mark.parametrize(
+    ("camera_range", "device_range", "shared"),
+    [
+        ((0.000125, 0.005), (0.01, 30.0), False),  # the device's shortest above [camera]'s longest
+        ((3.0, 30.0), (1e-5, 2.0), False),  # [camera]'s shortest above the device's longest
+        ((0.000125, 0.01), (0.01, 30.0), True),  # they meet in one exposure
+        ((0.01, 30.0), (1e-5, 0.01 * (1 - 1e-12)), True),  # they meet, apart in the last bits
+        ((0.001, 0.5), (0.0001, 0.01), True),  # one inside the other
+    ],
+)
+def test_the_config_check_and_the_metering_start_judge_the_ranges_alike(
+    tmp_path: Path,
+    camera_range: tuple[float, float],
+    device_range: tuple[float, float],
+    shared: bool,
+) -> None:
+    """What the config refuses at load, the metering's start refuses once the camera says the
+    same range, and what loads, it starts within: one judgement
+    (:func:`rti_rig.core.exposure_range.shared_range`), not two comparisons that could
+    disagree at an edge."""
+    from rti_rig.core.errors import ConfigError, DeviceError
+    from rti_rig.runtime.exposure_policy import metering_start
+
+    low, high = camera_range
+    cfg = _uvc_dome(
+        tmp_path,
+        {"exposure_s": low, "min_exposure_s": low, "max_exposure_s": high},
+        f"min_exposure_s = {device_range[0]!r}\nmax_exposure_s = {device_range[1]!r}",
+    )
+    try:
+        load_rig_config(cfg)
+        loads = True
+    except ConfigError:
+        loads = False
+    within = ((low, "[camera] min_exposure_s"), (high, "[camera] max_exposure_s"))
+    try:
+        metering_start(_DeviceRangeCamera(*device_range), low, within)
+        starts = True
+    except DeviceError:
+        starts = False
+    assert loads == starts == shared, (loads, starts)
