@@ -105,3 +105,29 @@ def test_tls_settings_that_cannot_be_loaded_name_the_files(tmp_path: Path) -> No
     assert "Dask's TLS settings cannot be used" in text, text
     assert f"distributed.comm.tls.ca-file = '{missing}'" in text, text
     assert not (tmp_path / "fit").exists()
+
+
+@pytest.mark.parametrize("tls", [False, True])
+def test_required_encryption_with_a_tcp_address_says_to_use_tls(
+    tmp_path: Path, closed_port: int, tls: bool
+) -> None:
+    """``distributed.comm.require-encryption`` set and a tcp:// address: Dask refuses the
+    unencrypted transport before connecting. That had been told as "cannot reach the Dask
+    scheduler (RuntimeError: encryption required …)" with advice to start a scheduler; the
+    config's requirement is said, with the tls:// address and the TLS keys to give (with or
+    without them set: a tcp:// address is refused either way)."""
+    env = _env(tls)
+    env["DASK_DISTRIBUTED__COMM__REQUIRE_ENCRYPTION"] = "True"
+    address = f"tcp://127.0.0.1:{closed_port}"
+    args = [*RTI_RIG_LONG_WAIT, "fit", str(ACQ), "--out", str(tmp_path / "fit")]
+    args += ["--scheduler", address, "--no-qa"]
+    r = subprocess.run(args, capture_output=True, text=True, timeout=BOUND_S, env=env)
+    text = " ".join((r.stdout + r.stderr).split())
+    assert r.returncode == 2 and "Traceback" not in text, text
+    assert f"--scheduler '{address}': Dask's configuration requires encryption" in text, text
+    assert "distributed.comm.require-encryption = True" in text, text
+    assert "Give the scheduler's tls:// address" in text, text
+    assert "distributed.comm.tls.ca-file, distributed.comm.tls.client.cert" in text, text
+    assert "DASK_DISTRIBUTED__COMM__REQUIRE_ENCRYPTION" in text, text
+    assert "cannot reach" not in text and "connection refused" not in text, text
+    assert not (tmp_path / "fit").exists()

@@ -311,6 +311,16 @@ TLS_KEYS = (
 )
 
 
+def _encrypted(scheme: str) -> bool:
+    """Whether Dask's connector for ``scheme`` is encrypted, as Dask itself judges it before a
+    connection under ``distributed.comm.require-encryption`` (its ``encrypted`` attribute:
+    False for tcp://, True for tls://). A connector without the attribute (ws://, wss://) is
+    not refused by Dask under that setting, and so not here either."""
+    from distributed.comm.registry import get_backend
+
+    return getattr(get_backend(scheme).get_connector(), "encrypted", None) is not False
+
+
 def _tls_settings(address: str) -> dict[str, Any]:
     """The connection arguments Dask's ``Client`` will use (``Security()`` from Dask's
     configuration), refused in words when they cannot serve ``address``.
@@ -318,10 +328,14 @@ def _tls_settings(address: str) -> dict[str, Any]:
     Why: a tls:// address without TLS settings was told as "cannot reach the Dask scheduler
     (TypeError: TLS expects a `ssl_context` argument …)", with advice to start a scheduler,
     when what is missing is this client's certificate and the CA to check the scheduler's;
-    and a certificate file that cannot be read raised out of here with a traceback."""
+    and a certificate file that cannot be read raised out of here with a traceback. With
+    ``distributed.comm.require-encryption`` set, a tcp:// address was told as "cannot reach
+    the Dask scheduler (RuntimeError: encryption required by Dask configuration …)" with
+    advice to start a scheduler: Dask refuses the unencrypted transport before connecting."""
     import ssl
 
     import dask.config
+    from distributed.comm import parse_address
     from distributed.security import Security
 
     how = (
@@ -341,6 +355,19 @@ def _tls_settings(address: str) -> dict[str, Any]:
             f"({type(exc).__name__}: {exc}; {named or 'none given'}). Check the files they "
             f"name; {how}."
         ) from None
+    scheme, _ = parse_address(address)  # tcp:// where none is given, as Dask's own
+    if args.get("require_encryption") and not _encrypted(scheme):
+        raise SchedulerError(
+            f"--scheduler {address!r}: Dask's configuration requires encryption "
+            f"(distributed.comm.require-encryption = "
+            f"{dask.config.get('distributed.comm.require-encryption', None)!r}), and Dask "
+            f"refuses {scheme}://, which is not encrypted. Give the scheduler's tls:// address "
+            "(a scheduler started with TLS, `dask scheduler --protocol tls` and its "
+            "certificate options) with Dask's TLS settings for a client: the CA certificate "
+            "that signed the scheduler's certificate and this client's certificate and key. "
+            f"{how}. Or, for a scheduler without TLS, unset distributed.comm.require-encryption "
+            "(the environment variable DASK_DISTRIBUTED__COMM__REQUIRE_ENCRYPTION)."
+        )
     if address.startswith("tls://") and not isinstance(args.get("ssl_context"), ssl.SSLContext):
         given = (security.tls_ca_file, security.tls_client_cert)
         missing = [key for key, value in zip(TLS_KEYS[:2], given, strict=True) if not value]
