@@ -128,3 +128,41 @@ def test_a_silent_resolver_is_said_as_one_that_did_not_answer(
     assert (
         f"the host '{HOST}' could not be looked up (the resolver did not answer within 3 s)" in said
     ), said
+
+
+def test_the_scheduler_is_reached_at_the_address_looked_up_not_by_its_name_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A resolver that answers the scheduler's name once, then fails (EAI_AGAIN): the fit
+    reaches the scheduler that is there. Dask's connect had looked the name up again after the
+    probe's lookup, retrying the failing resolver for its whole connect timeout (23 lookups),
+    and the scheduler was told as "no Dask scheduler answered"; a slow resolver cost its delay
+    twice. The scheduler here has no workers: "has no workers" is said only once the Client
+    is connected."""
+    from distributed import LocalCluster
+
+    answered: list[str] = []
+
+    def getaddrinfo(host: Any, port: Any, *args: Any, **kwargs: Any) -> list[Any]:
+        if host != HOST:
+            return REAL_GETADDRINFO(host, port, *args, **kwargs)
+        flags = kwargs.get("flags", args[3] if len(args) > 3 else 0)
+        if flags & socket.AI_NUMERICHOST:  # as the C library answers a name asked so
+            raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+        answered.append(host)
+        if len(answered) > 1:
+            raise socket.gaierror(socket.EAI_AGAIN, "Temporary failure in name resolution")
+        return _loopback(port)
+
+    monkeypatch.setattr(socket, "getaddrinfo", getaddrinfo)
+    monkeypatch.setattr(fit_dask, "CONNECT_TIMEOUT_S", 10.0)
+    monkeypatch.setattr(fit_dask, "WORKERS_TIMEOUT_S", 1.0)
+    with LocalCluster(
+        n_workers=0, processes=False, dashboard_address=None, protocol="tcp://", host="127.0.0.1"
+    ) as cluster:
+        port = cluster.scheduler_address.rsplit(":", 1)[1]
+        said = _fit(tmp_path, f"tcp://{HOST}:{port}")
+    assert f"the Dask scheduler at 'tcp://{HOST}:{port}' has no workers" in said, said
+    assert f"dask worker tcp://{HOST}:{port}" in said, said  # the address given, in advice
+    assert "no Dask scheduler answered" not in said and "could not be looked up" not in said
+    assert answered == [HOST], answered  # looked up once: by the probe

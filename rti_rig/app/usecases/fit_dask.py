@@ -186,10 +186,12 @@ def scheduler_client(address: str) -> Iterator[Any]:
         return
     from distributed import Client
 
+    target, security = address, None
     if checked_address(address) != "inproc":  # one only in this process: nothing can hang
-        probe(address, CONNECT_TIMEOUT_S)
+        reached = probe(address, CONNECT_TIMEOUT_S)  # its host not looked up again by Dask
+        target, security = reached.address, reached.security()
     try:
-        client = Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+        client = Client(target, timeout=CONNECT_TIMEOUT_S, set_as_default=False, security=security)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
         raise unreachable_scheduler(address, f"{type(exc).__name__}: {exc}") from None
     try:

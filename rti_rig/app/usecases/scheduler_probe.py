@@ -16,6 +16,7 @@ import socket
 import threading
 from collections.abc import Sequence
 from contextlib import suppress
+from dataclasses import dataclass
 from typing import Any
 
 from rti_rig.core.errors import RtiRigError
@@ -214,10 +215,10 @@ def _host_port(address: str) -> tuple[str, int] | None:
 
 async def _connect(
     address: str, timeout: float, connection_args: dict[str, Any], ips: Sequence[str] = ()
-) -> Any:
+) -> tuple[Any, Reached]:
     """A Dask comm to ``address``, its handshake done (``distributed.comm.connect``), after
     plain connections to ``ips`` (its host's addresses, looked up before: see :func:`probe`)
-    find a refused port at once.
+    find a refused port at once; and where it was made (:class:`Reached`).
 
     Why: Dask's ``connect`` retries a refused connection, and a name that does not resolve,
     until its timeout, so a port nothing listens on (a scheduler not started, a wrong port) or
@@ -231,11 +232,14 @@ async def _connect(
     left to Dask, which says it in its own words. The plain connections go to the addresses
     looked up, not to the name: a slow resolver (a nameserver down, 5 s per lookup) had timed
     out this step's second lookup, and the port is called refused only where every address
-    refuses (localhost's ::1 may refuse where 127.0.0.1 listens)."""
+    refuses (localhost's ::1 may refuse where 127.0.0.1 listens). Dask's connect goes to the
+    first address that accepted, for tcp:// and tls:// (see :class:`Reached`)."""
     from distributed.comm import connect, parse_address
+    from distributed.comm.addressing import unparse_host_port
 
     scheme, location = parse_address(address)
     host_port = _host_port(address)
+    reached = Reached(address)
     if host_port is not None and ips:
         host, port = host_port
         tls: Any = None
@@ -244,7 +248,8 @@ async def _connect(
         elif scheme == "wss":  # Dask's wss:// gives tornado None for its default context
             tls = connection_args.get("ssl_context") or True
 
-        async def every_refused() -> bool:
+        async def first_accepting() -> tuple[bool, str | None]:
+            """(every address refused, the first that accepted: None if none did)"""
             for ip in ips:
                 try:
                     _, writer = await asyncio.open_connection(
@@ -253,26 +258,33 @@ async def _connect(
                 except (OSError, ValueError) as exc:
                     if _refused(exc):
                         continue
-                    return False
+                    return False, None
                 writer.close()
-                return False
-            return True
+                return False, ip
+            return True, None
 
+        every_refused, accepted = False, None
         with suppress(TimeoutError):
-            if await asyncio.wait_for(every_refused(), timeout / 5):
-                raise _Refused(location)
-    return await connect(address, timeout=timeout, **connection_args)
+            every_refused, accepted = await asyncio.wait_for(first_accepting(), timeout / 5)
+        if every_refused:
+            raise _Refused(location)
+        if accepted is not None and scheme in ("tcp", "tls"):
+            named = host if scheme == "tls" else None
+            reached = Reached(f"{scheme}://{unparse_host_port(accepted, port)}", named)
+            connection_args = reached.connection_args(connection_args)
+    return await connect(reached.address, timeout=timeout, **connection_args), reached
 
 
 async def _identity(
     address: str, timeout: float, connection_args: dict[str, Any], ips: Sequence[str] = ()
-) -> Any:
+) -> tuple[Any, Reached]:
     """The scheduler's answer to Dask's ``identity`` request (a connection, its handshake, one
-    request and its reply); ``ips``: its host's addresses (:func:`_connect`)."""
-    comm = await _connect(address, timeout, connection_args, ips)
+    request and its reply), and where it came from; ``ips``: its host's addresses
+    (:func:`_connect`)."""
+    comm, reached = await _connect(address, timeout, connection_args, ips)
     try:
         await comm.write({"op": "identity", "reply": True})
-        return await comm.read()
+        return await comm.read(), reached
     finally:
         comm.abort()
 
@@ -301,6 +313,50 @@ def _run_quietly(main: Any) -> Any:
             loop.run_until_complete(loop.shutdown_asyncgens())
         finally:
             loop.close()
+
+
+@dataclass(frozen=True)
+class Reached:
+    """Where the probe reached the scheduler: the ``address`` Dask's ``Client`` is to connect
+    to, and for a tls:// one the host name its TLS handshake must still present.
+
+    Why: Dask's connect looks a host name up again, after the probe had resolved it: a slow
+    resolver (a nameserver down, 5 s a lookup) cost its delay twice, and one that answered
+    the probe, then failed, had Dask retry the lookup for the whole connect timeout and the
+    scheduler, which was there, told as "no Dask scheduler answered within 20 s" (23
+    lookups, measured). For tcp:// and tls:// the address is the given one with its host
+    replaced by the address that accepted the probe's connection, so no lookup is made after
+    the probe's; a tls:// connection still presents the host name given
+    (``server_hostname``: SNI, and the certificate's name where Dask checks it). ws:// and
+    wss:// keep the name (their URL, and the Host header a proxy routes by): Dask looks it up
+    again there, within its connect timeout."""
+
+    address: str
+    #: the host name a tls:// connection to :attr:`address` presents; None: the name given
+    server_hostname: str | None = None
+
+    def connection_args(self, args: dict[str, Any]) -> dict[str, Any]:
+        """Dask's connection arguments ``args`` for a connection to :attr:`address`."""
+        if self.server_hostname is None:
+            return args
+        return {**args, "server_hostname": self.server_hostname}
+
+    def security(self) -> Any:
+        """The ``security`` to build the ``Client`` with: None (Dask's configuration, as
+        without) unless a host name must be presented, then Dask's ``Security`` from its
+        configuration giving it too (Dask's own ``Worker`` sets the same key for its
+        scheduler's name)."""
+        if self.server_hostname is None:
+            return None
+        from distributed.security import Security
+
+        name = self.server_hostname
+
+        class _Named(Security):  # type: ignore[misc]
+            def get_connection_args(self, role: str) -> dict[str, Any]:
+                return {**super().get_connection_args(role), "server_hostname": name}
+
+        return _Named()
 
 
 #: Dask's configuration keys a tls:// client needs (its ``Security()`` reads them).
@@ -380,8 +436,9 @@ def _tls_settings(address: str) -> dict[str, Any]:
     return args
 
 
-def probe(address: str, timeout: float) -> None:
-    """Return once the scheduler at ``address`` answers, within ``timeout`` seconds in all.
+def probe(address: str, timeout: float) -> Reached:
+    """Where the scheduler at ``address`` answered, once it has, within ``timeout`` seconds
+    in all (the ``Client`` is to be built on it: :class:`Reached`).
 
     Why: ``Client(address, timeout=…)`` bounds only the TCP connect; Dask's handshake then
     reads the first reply without a bound, so a port that accepts the connection and never
@@ -400,7 +457,7 @@ def probe(address: str, timeout: float) -> None:
         return await asyncio.wait_for(_identity(address, timeout, args, ips), left)
 
     try:
-        identity = _run_quietly(bounded())
+        identity, reached = _run_quietly(bounded())
     except TimeoutError:  # asyncio's is the builtin's since 3.11; Dask's own names the address
         raise unreachable_scheduler(
             address,
@@ -436,3 +493,4 @@ def probe(address: str, timeout: float) -> None:
             "address `dask scheduler` prints (the one its workers were started with), such as "
             "tcp://HOST:8786"
         )
+    return reached
