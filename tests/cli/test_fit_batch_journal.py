@@ -128,3 +128,88 @@ def test_a_lost_journal_with_a_record_of_checksums_only_is_refitted_saying_so(
         "earlier fit, and the earlier fit's record names its images by that journal's "
         "checksums only, so whether they changed cannot be told: refitted)" in said(r)
     ), r.output
+
+
+def counting_reads(monkeypatch: pytest.MonkeyPatch) -> list[Path]:
+    """The files the next batches read whole, to hash or to decode their pixels, each batch
+    as a new ``rti-rig`` process (what this one hashed is forgotten before each)."""
+    import tifffile
+
+    from rti_rig.app.usecases import fit_batch
+
+    read: list[Path] = []
+    real_plan = fit_batch.plan_batch
+
+    def plan(*args: Any, **kwargs: Any) -> Any:  # a batch begins
+        monkeypatch.setattr(fit_batch, "_HASHED", {})
+        return real_plan(*args, **kwargs)
+
+    monkeypatch.setattr(fit_batch, "plan_batch", plan)
+    real_digest, real_imread = hashlib.file_digest, tifffile.imread
+
+    def counted(fh: Any, digest: Any) -> Any:
+        read.append(Path(fh.name))
+        return real_digest(fh, digest)
+
+    def imread(path: Any, *args: Any, **kwargs: Any) -> Any:
+        read.append(Path(path))
+        return real_imread(path, *args, **kwargs)
+
+    monkeypatch.setattr(hashlib, "file_digest", counted)
+    monkeypatch.setattr(tifffile, "imread", imread)
+    return read
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_an_image_resaved_with_its_pixels_then_touched_stands(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A TIFF re-saved with zlib (other bytes, the same pixels) and then touched had been
+    refitted after every touch: "1 of 6 images changed on disk since their capture"."""
+    import tifffile
+
+    s, t, fb = fitted(tmp_path)
+    tif = s / "linear" / "image_002.tif"
+    tifffile.imwrite(tif, tifffile.imread(tif), compression="zlib")
+    for _ in range(2):  # re-saved, then touched, and again: the fit read these very pixels
+        r = batch(s, t, out=fb)
+        assert r.exit_code == 0, r.output
+        assert said(r).count("skipped (finished earlier)") == 2, r.output
+        later(tif)
+    read = counting_reads(monkeypatch)
+    r = batch(s, t, out=fb)
+    assert said(r).count("skipped (finished earlier)") == 2, r.output
+    assert read == [tif]  # its hash is the one recorded for it: its pixels are not decoded
+
+    tifffile.imwrite(tif, tifffile.imread(tif) // 2, compression="zlib")  # an edit
+    r = batch(s, t, out=fb)
+    assert f"{s}: refitted (its session changed since the earlier fit: 1 of 6 images " in (
+        said(r)
+    ), r.output
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_a_session_copied_without_its_times_is_read_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A session copied without its timestamps (``cp -r``) had been read in full on every
+    batch: a hash that confirms an image now brings the fit's record of it up to date."""
+    s, t, fb = fitted(tmp_path)
+    moved = tmp_path / "copy" / "S"
+    shutil.copytree(s, moved, copy_function=shutil.copyfile)  # new modification times
+    shutil.rmtree(s)
+    for image in (moved / "linear").glob("*.tif"):
+        later(image)  # a copy made within the same tick as the session must differ too
+    read = counting_reads(monkeypatch)
+    r = batch(moved, t, out=fb)
+    assert r.exit_code == 0 and said(r).count("skipped (finished earlier)") == 2, r.output
+    assert len(read) == 6, read  # each image read once, to hash it
+    read.clear()
+    summary = json.loads((fb / "S" / "fit.json").read_text(encoding="utf-8"))
+    assert summary["model"] == "ps" and len(summary["inputs"]["images"]) == 6  # kept whole
+    r = batch(moved, t, out=fb)
+    assert said(r).count("skipped (finished earlier)") == 2, r.output
+    assert read == []
+    assert [p.name for p in (fb / "S").iterdir() if p.name.startswith(".")] == []

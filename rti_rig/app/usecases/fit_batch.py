@@ -8,11 +8,13 @@ Dask runner (:mod:`rti_rig.app.usecases.fit_dask`) runs :func:`fit_one` per sess
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
+from typing import Any
 
 from rti_rig.app.usecases.fit import (
     BandRunner,
@@ -24,6 +26,7 @@ from rti_rig.app.usecases.fit import (
 from rti_rig.app.usecases.fit_inputs import (
     INPUTS_KEY,
     change_since,
+    confirmed_update,
     is_record,
     journal_lost,
     judged_by_stat,
@@ -303,7 +306,16 @@ def earlier_fit(final: Path, source: Path) -> EarlierFit:
             f"{_journal_gone(source)}, and the earlier fit's record names its images by that "
             "journal's checksums only, so whether they changed cannot be told: refitted",
         )
-    changed = change_since(record, now, lambda name: _file_sha256(files.get(name)))
+    confirmed: dict[str, dict[str, Any]] = {}
+    changed = change_since(
+        record,
+        now,
+        lambda name: _file_sha256(files.get(name)),
+        lambda name: _tiff_pixels(files.get(name)),
+        confirmed,
+    )
+    if changed is None and confirmed:
+        _keep_record(final / "fit.json", summary, confirmed_update(record, confirmed))
     if lost:
         how = "judged by its images' sizes and modification times"
         if changed is None:
@@ -312,6 +324,39 @@ def earlier_fit(final: Path, source: Path) -> EarlierFit:
     if changed is None:
         return EarlierFit(found=True)
     return EarlierFit(True, f"its session changed since the earlier fit: {changed}")
+
+
+def _keep_record(path: Path, summary: dict[str, Any], record: dict[str, Any]) -> None:
+    """Write ``summary`` with ``record`` as its inputs over ``path`` (a fit's ``fit.json``),
+    atomically: a temporary file in the same folder, then ``os.replace``, so that a kill or a
+    full disk leaves the old ``fit.json`` whole. Not written (the old record stands, and the
+    next batch hashes again) when that fails: a fit folder one may not write to is no
+    error of the batch's."""
+    import tempfile
+
+    text = json.dumps({**summary, INPUTS_KEY: record}, indent=1) + "\n"
+    tmp: str | None = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".fit.json.", suffix=".tmp", dir=path.parent)
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+        tmp = None
+    except OSError:
+        pass
+    finally:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+
+def _tiff_pixels(path: Path | None) -> str | None:
+    """The pixel checksum of the TIFF at ``path`` (None when it is none or cannot be read)."""
+    from rti_rig.core.image_files import tiff_pixels_sha256
+
+    if path is None or path.suffix.lower() not in (".tif", ".tiff"):
+        return None
+    return tiff_pixels_sha256(path)
 
 
 def _journal_gone(source: Path) -> str:

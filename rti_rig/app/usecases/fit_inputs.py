@@ -85,8 +85,21 @@ def as_read(record: dict[str, Any], read_pixels: Sequence[str | None]) -> dict[s
         if got is not None and captured is not None and got != captured:
             kept = {k: image[k] for k in ("size", "mtime_ns") if k in image}
             image = {"name": image["name"], "read_pixels_sha256": got, **kept}
+        elif got is not None and got == captured:
+            # the fit read the captured pixels, whatever file holds them (a TIFF re-saved
+            # with zlib has other bytes): a batch may then confirm a file of other bytes by
+            # its pixels (:func:`_image_change`)
+            image = {**image, PIXELS_AS_CAPTURED: True}
         images.append(image)
     return {**record, "images": images}
+
+
+#: Set on an image of the record whose pixels the fit read and found those captured.
+PIXELS_AS_CAPTURED = "pixels_as_captured"
+#: The sha256 of an image's file as a batch found it holding the pixels the fit read, when
+#: that is not the journal's (a TIFF re-saved with the same pixels): set by a batch
+#: (:func:`confirmed_update`), so that a later ``touch`` or copy of it is not a change.
+READ_SHA256 = "read_sha256"
 
 
 def is_record(earlier: Any) -> bool:
@@ -96,8 +109,9 @@ def is_record(earlier: Any) -> bool:
     return isinstance(earlier, dict) and "lights" in earlier
 
 
-#: Hashes an image of the acquisition now, by its name in the record: the sha256 of its file,
-#: or None when it cannot be read.
+#: Hashes an image of the acquisition now, by its name in the record: the sha256 of its file
+#: (or of its pixels, :func:`rti_rig.core.image_files.tiff_pixels_sha256`), or None when it
+#: cannot be read.
 Digest = Callable[[str], "str | None"]
 
 
@@ -113,7 +127,11 @@ def _same_stat(before: Mapping[str, Any], now: Mapping[str, Any]) -> bool:
 
 
 def _image_change(
-    before: Mapping[str, Any], now: Mapping[str, Any], digest: Digest | None
+    before: Mapping[str, Any],
+    now: Mapping[str, Any],
+    digest: Digest | None,
+    pixels: Digest | None = None,
+    confirmed: dict[str, dict[str, Any]] | None = None,
 ) -> str | None:
     """How one image differs from the fit's record of it: ``"changed"`` (a new capture or other
     file), ``"edited"`` (its file is no longer what its journal took at capture: edited or
@@ -121,16 +139,37 @@ def _image_change(
 
     Size and time first, which cost no read: an image the journal vouches for whose size or
     time differ is hashed (a copy without timestamps then stands; an image edited in place
-    had stood too, found by the fit's QA only). Without a journal's checksum now (a plain
-    ``.lp``, or a session whose journal is lost since the fit) size and time decide."""
+    had stood too, found by the fit's QA only). A hash that matches neither the journal's nor
+    the one a batch recorded for the file the fit read (:data:`READ_SHA256`) is an edit,
+    unless the fit read the captured pixels and the file still holds them (``pixels``: a TIFF
+    re-saved with zlib had been refitted after every ``touch``, "changed since its
+    capture"). An image so confirmed is put in ``confirmed`` by name, with its size, time and
+    file hash now, for the record to be brought up to date (a copied session had been read
+    in full on every batch). Without a journal's checksum now (a plain ``.lp``, or a session
+    whose journal is lost since the fit) size and time decide."""
     if "sha256" in now:
         if "sha256" in before:
             if str(before["sha256"]) != str(now["sha256"]):
                 return "changed"
             if "size" not in before or _same_stat(before, now):
                 return None  # a record without size and time: the journal's word, as before
-            got = digest(str(now["name"])) if digest is not None else None
-            return None if got == str(now["sha256"]) else "edited"
+            name = str(now["name"])
+            got = digest(name) if digest is not None else None
+            if got is None:
+                return "edited"
+            if got not in (str(now["sha256"]), before.get(READ_SHA256)) and not (
+                before.get(PIXELS_AS_CAPTURED) is True
+                and before.get("pixels_sha256") is not None
+                and pixels is not None
+                and pixels(name) == str(before["pixels_sha256"])
+            ):
+                return "edited"
+            if confirmed is not None:
+                update = {"size": now["size"], "mtime_ns": now["mtime_ns"]}
+                if got != str(now["sha256"]):
+                    update[READ_SHA256] = got
+                confirmed[name] = update
+            return None
         if "read_pixels_sha256" in before:  # fitted from an image not as captured
             return None if _same_stat(before, now) else "changed"
     return None if _same_stat(before, now) else "changed"
@@ -144,11 +183,18 @@ def _shown(items: Sequence[str]) -> str:
     return ", ".join(items[:_SHOWN]) + (" …" if len(items) > _SHOWN else "")
 
 
-def change_since(earlier: Any, now: dict[str, Any], digest: Digest | None = None) -> str | None:
+def change_since(
+    earlier: Any,
+    now: dict[str, Any],
+    digest: Digest | None = None,
+    pixels: Digest | None = None,
+    confirmed: dict[str, dict[str, Any]] | None = None,
+) -> str | None:
     """How the acquisition recorded ``now`` differs from the ``earlier`` record, in words
     ("11 → 48 images"; "2 of 8 images changed: image_003, image_005"; "1 of 8 images changed
     on disk since its capture …: image_003"; "1 of 8 lights moved: image_004's by 0.20°"), or
-    None when it matches. ``digest`` hashes an image whose size or time changed (see
+    None when it matches. ``digest`` hashes an image whose size or time changed, ``pixels``
+    hashes its pixels, and ``confirmed`` collects the images a hash confirmed (see
     :func:`_image_change`). An ``earlier`` record that cannot be read (a damaged ``fit.json``)
     differs."""
     try:
@@ -166,7 +212,10 @@ def change_since(earlier: Any, now: dict[str, Any], digest: Digest | None = None
     elif names_before != names:
         said.append("its images are not the ones fitted")
     else:
-        kinds = [_image_change(b, a, digest) for b, a in zip(before, after, strict=True)]
+        kinds = [
+            _image_change(b, a, digest, pixels, confirmed)
+            for b, a in zip(before, after, strict=True)
+        ]
         changed = [n for n, k in zip(names, kinds, strict=True) if k == "changed"]
         edited = [n for n, k in zip(names, kinds, strict=True) if k == "edited"]
         if changed:
@@ -203,3 +252,17 @@ def judged_by_stat(earlier: Any) -> bool:
         return all("size" in i and "mtime_ns" in i for i in earlier["images"])
     except (TypeError, KeyError):
         return False
+
+
+def confirmed_update(
+    earlier: dict[str, Any], confirmed: Mapping[str, Mapping[str, Any]]
+) -> dict[str, Any]:
+    """The ``earlier`` record with the images a batch's hash confirmed (:func:`change_since`'s
+    ``confirmed``) given their size, time and file hash now: the next batch then reads their
+    headers only, not every byte again (a session copied without its timestamps had been read
+    in full on every batch)."""
+    images = []
+    for image in earlier["images"]:
+        update = confirmed.get(str(image.get("name")))
+        images.append(image if update is None else {**image, **update})
+    return {**earlier, "images": images}
