@@ -314,3 +314,14 @@ def never_reached(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]
     assert r.exit_code == 0, r.output
     (out.parent / "said.txt").write_text(said(r))
     return cfg, out
+
+
+def dead_pid() -> int:
+    """The PID of a process that has ended: an attempt folder naming it is a killed run's
+    (a batch leaves the folders of running processes alone, ``fit_batch.owner_gone``)."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-c", "pass"])
+    proc.wait()
+    return proc.pid

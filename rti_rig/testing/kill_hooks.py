@@ -13,7 +13,11 @@ files complete, journal line not written), ``after_record`` (the step's record f
 written, nothing after it), and ``stall`` (no kill: capture K blocks for up to 60 s of real
 time, so that another process can signal the run at a known step). One stage is a batch fit's
 (``fit S1 S2 --out ROOT``), not a run's: ``refit_swap`` dies between the two renames of its
-K-th refit (the earlier fit set aside, the new one not yet in its place).
+K-th refit (the earlier fit set aside, the new one not yet in its place), and ``fit_hold``
+(no kill) holds a batch's K-th session just before it writes its ``fit.json`` into its
+partial folder, for as long as the file the environment's ``RTI_RIG_HOLD`` names exists
+(at most 300 s), having created ``$RTI_RIG_HOLD.reached``: another batch is then run into
+the same ``--out`` at a known moment.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ STAGES = (
     "after_journal",
     "stall",
     "refit_swap",
+    "fit_hold",
 )
 
 
@@ -126,6 +131,28 @@ def install(stage: str, k: int) -> None:
     session.asdict = asdict  # type: ignore[assignment]
     if stage == "refit_swap":
         _die_in_refit_swap(k, die)
+    if stage == "fit_hold":
+        _hold_before_fit_json(k)
+
+
+def _hold_before_fit_json(k: int) -> None:
+    """Hold the ``k``-th ``fit.json`` written into a batch's partial folder while the file
+    ``$RTI_RIG_HOLD`` exists (see the module docstring)."""
+    real_write_text = Path.write_text
+    hold = Path(os.environ["RTI_RIG_HOLD"])
+    seen = [0]
+
+    def write_text(self: Path, *args: Any, **kwargs: Any) -> int:
+        if self.name == "fit.json" and self.parent.name.endswith(".partial"):
+            if seen[0] == k:
+                Path(f"{hold}.reached").touch()
+                deadline = time.monotonic() + 300.0
+                while hold.exists() and time.monotonic() < deadline:
+                    time.sleep(0.05)
+            seen[0] += 1
+        return real_write_text(self, *args, **kwargs)
+
+    Path.write_text = write_text  # type: ignore[method-assign]
 
 
 def _die_in_refit_swap(k: int, die: Callable[[], None]) -> None:

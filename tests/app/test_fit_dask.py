@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import dead_pid
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -105,8 +106,9 @@ def test_the_threads_batch_is_resumable(session: Path, tmp_path: Path) -> None:
     assert r.exit_code == 0 and r.output.count(": done") == 2, r.output
     # a killed run: the second session's folder is gone, a partial one was left behind
     shutil.rmtree(out / "second")
-    (out / ".second.1234-abcd.partial").mkdir()
-    (out / ".second.1234-abcd.partial" / "junk").write_text("x")
+    left = out / f".second.{dead_pid()}-abcd.partial"  # a killed run's
+    left.mkdir()
+    (left / "junk").write_text("x")
     first_bytes = (out / session.name / "normals.npy").read_bytes()
     r = runner.invoke(app, [*args, "--scheduler", "threads"])
     assert r.exit_code == 0, r.output
@@ -157,7 +159,7 @@ def test_a_killed_attempts_partial_folder_goes_once_the_session_is_finished(
     from rti_rig.app.usecases.fit_batch import fit_one
 
     root = tmp_path / "batch"
-    dead = root / f".{session.name}.555-dead0000.partial"  # the killed worker's attempt
+    dead = root / f".{session.name}.{dead_pid()}-dead0000.partial"  # the killed worker's attempt
     other = root / f".{session.name}.x.777-live0000.partial"  # session "s.x", being fitted
     for folder in (dead, other):
         folder.mkdir(parents=True)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import dead_pid
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -246,8 +247,9 @@ def test_a_local_two_worker_cluster_gives_the_single_process_bytes(tmp_path: Pat
         (tmp_path / "batch").mkdir()
         shutil.copytree(tmp_path / "plainbatch" / "s1", tmp_path / "batch" / "s1")
         stamp = (tmp_path / "batch" / "s1" / "normals.npy").stat().st_mtime_ns
-        (tmp_path / "batch" / ".s2.99-dead.partial").mkdir()
-        (tmp_path / "batch" / ".s2.99-dead.partial" / "fit.ptm.part").write_text("x")
+        left = tmp_path / "batch" / f".s2.{dead_pid()}-dead.partial"  # a killed run's
+        left.mkdir()
+        (left / "fit.ptm.part").write_text("x")
         r = _cli([*batch, "--scheduler", address], env, tmp_path)
         assert r.returncode == 0, r.stdout + r.stderr
         assert "s1: skipped (finished earlier)" in r.stdout

@@ -127,12 +127,24 @@ def _output_error(exc: OSError, req: FitRequest, out: Path, created: bool) -> Fi
     remedy = {
         errno.EFBIG: "raise the file-size limit (ulimit -f)",
         errno.EROFS: "choose an --out on a disk you can write to",
+        # a folder gone under the fit is no full disk: two batches given one --out had each
+        # been told to free space when the other removed its partial folder
+        errno.ENOENT: (
+            "its folder was removed while the fit wrote into it (by another run given the "
+            "same --out, or a clean-up); let other runs end"
+        ),
     }.get(exc.errno or 0, "free space on that disk, or choose an --out on another")
+    if out.name.startswith(".") and out.name.endswith(".partial"):
+        # a batch's hidden attempt folder is no --out to give: the batch is run again
+        again = f"run the batch again with --out {shlex.quote(str(out.parent))}"
+    else:
+        again = (
+            f"run again: rti-rig fit {shlex.quote(str(req.source))} --out {shlex.quote(str(out))}"
+        )
     return FitOutputError(
         f"{req.source}: the fit could not write its outputs in {out}{where}: {reason}; "
         f"nothing of it was kept ({out} {left}) and the session is unchanged: {remedy}, "
-        f"then run again: rti-rig fit {shlex.quote(str(req.source))} --out "
-        f"{shlex.quote(str(out))}"
+        f"then {again}"
     )
 
 

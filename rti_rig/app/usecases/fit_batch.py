@@ -120,6 +120,39 @@ def partial_folders(root: Path, name: str) -> list[Path]:
         return []
 
 
+def _owner_pid(folder: Path) -> int | None:
+    """The PID an attempt's folder names (``.NAME.PID-ID.partial`` / ``.earlier``), or None
+    (``.NAME.partial`` of older runs names none)."""
+    import re
+
+    found = re.search(r"\.(\d+)-[^.]*\.(partial|earlier)$", folder.name)
+    return int(found.group(1)) if found else None
+
+
+def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
+    """Whether the process that made attempt folder ``folder`` no longer runs, so that its
+    folder may be removed (``mine_too``: this process's own count as gone, for a batch
+    that begins and fits nothing yet). A folder naming no PID counts as gone.
+
+    Why: two batches given one ``--out`` each removed the other's in-progress partial
+    folder, and both reported a session "failed … No such file or directory". The PID is
+    asked of this host (``os.kill(pid, 0)``): the batch is assumed to run where its
+    ``--out`` was made; a Dask worker on another host sharing the folder is not seen, and
+    its attempt's folder is kept (or, its PID reused here, left for a later run)."""
+    pid = _owner_pid(folder)
+    if pid is None:
+        return True
+    if pid == os.getpid():
+        return mine_too
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # PermissionError: it runs, as another user
+        return False
+    return False
+
+
 def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     """The sources of a batch still to fit (their output folder does not exist), after removing
     the partial folders a killed run left for them. Refuses two sources with one output name."""
@@ -162,9 +195,11 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
         if final.exists():  # the swap had ended: its backup is an outgrown fit
             keep = set()
             for backup in earlier_backups(root, final.name):
-                shutil.rmtree(backup, ignore_errors=True)
+                if owner_gone(backup, mine_too=True):
+                    shutil.rmtree(backup, ignore_errors=True)
         for partial in partial_folders(root, final.name):
-            if partial not in keep:
+            # another batch's attempt, running now into the same --out, is left to it
+            if partial not in keep and owner_gone(partial, mine_too=True):
                 shutil.rmtree(partial, ignore_errors=True)
         if not earlier_fit(final, source).stands:
             todo.append(source)
@@ -238,6 +273,10 @@ def finish_swap(root: Path, final: Path) -> str:
         shutil.rmtree(stale, ignore_errors=True)
     return words
 
+
+#: What a batch says of a session another run into the same --out fitted meanwhile, after
+#: "done".
+DONE_ELSEWHERE = " (by another run into the same --out, meanwhile)"
 
 #: What a batch says of a session whose earlier fit stands, after "skipped".
 FINISHED_EARLIER = " (finished earlier)"
@@ -417,6 +456,10 @@ def fit_one(
         result = run_fit(replace(template, source=source, out_dir=partial), bands)
     except RtiRigError as exc:
         shutil.rmtree(partial, ignore_errors=True)
+        if final.exists() and earlier_fit(final, source).stands:
+            # another run into the same --out finished this session meanwhile (its failure
+            # here, a folder gone under it, is no failure of the session's)
+            return BatchItem(source, final, Outcome.DONE, DONE_ELSEWHERE, notes=said)
         kept = f" (the earlier fit in {final} is kept)" if outgrown and final.exists() else ""
         return BatchItem(source, final, Outcome.FAILED, f": {exc}{kept}", notes=said)
     if outgrown is not None and final.exists():
@@ -446,9 +489,11 @@ def fit_one(
     # Earlier attempts' partial folders: a Dask worker killed mid-session cannot remove its
     # own, and the retry that finished the session had left it in --out (hundreds of MB of a
     # large session, a successful batch, never removed: later runs skip finished sessions).
-    # An attempt still running elsewhere then fails on its worker; the session is finished.
+    # An attempt still running (another batch into the same --out, or a worker of this
+    # host) is left alone: it finds the session finished and discards its own copy.
     for stale in partial_folders(root, final.name):
-        shutil.rmtree(stale, ignore_errors=True)
+        if owner_gone(stale):
+            shutil.rmtree(stale, ignore_errors=True)
     return BatchItem(
         source,
         final,
