@@ -109,3 +109,26 @@ def test_an_incomplete_new_fit_is_undone_and_the_earlier_fit_put_back(tmp_path: 
     assert "the earlier fit was put back" in text, r.output
     assert f"{s}: refitted (its session changed since the earlier fit: 1 of 6 lights" in text
     assert sorted(p.name for p in fb.iterdir()) == ["S", "T"], list(fb.iterdir())
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_an_outgrown_fit_is_not_put_back_for_a_new_fit_the_user_removed(
+    tmp_path: Path,
+) -> None:
+    """Killed after the swap's second rename (the new fit in place, the earlier not yet
+    removed), then the new fit deleted by the user: the outgrown fit had been put back,
+    "interrupted before its new fit was complete"."""
+    import shutil
+
+    s, t, fb = killed_in_the_swap(tmp_path)
+    (new,) = [p for p in fb.iterdir() if p.name.endswith(".partial")]
+    new.rename(fb / "S")  # the rename the kill came before
+    shutil.rmtree(fb / "S")  # the user deletes the new fit
+    r = batch(s, t, out=fb)
+    text = said(r)
+    assert r.exit_code == 0, r.output
+    assert "put back" not in text and "put in place" not in text, r.output
+    assert f"{s}: done" in text, r.output  # fitted afresh, from the session as it is
+    np.testing.assert_allclose(lights_of(fb / "S"), lights_of_lp(s), atol=1e-6)
+    assert sorted(p.name for p in fb.iterdir()) == ["S", "T"], list(fb.iterdir())

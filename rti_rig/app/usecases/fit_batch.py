@@ -243,15 +243,25 @@ def finish_swap(root: Path, final: Path) -> str:
     Why: the swap is two renames (the earlier fit aside, the new one in); a batch killed
     between them had left neither in ``final``, and the next run removed both as partial
     folders, so a session whose refit then failed had no fit at all. The new fit, complete
-    (its ``fit.json`` is written last), is put in place; otherwise the earlier fit is put
-    back."""
+    (its ``fit.json`` is written last), is put in place; otherwise, if the attempt's partial
+    folder is there, the earlier fit is put back. Without it, the swap had ended (the new
+    fit was put in place, and removed since, by the user) and the earlier fit is outgrown:
+    it is removed, not put back (it had been, said "interrupted before its new fit was
+    complete"). A swap whose process still runs (another batch into the same ``--out``) is
+    left to it."""
     import shutil
 
     backups = earlier_backups(root, final.name)
     if not backups or final.exists():
         return ""
     backup, older = backups[-1], backups[:-1]
+    if not owner_gone(backup):
+        return ""
     new = _swap_partial(backup)
+    if not new.is_dir():
+        for stale in (*older, backup):
+            shutil.rmtree(stale, ignore_errors=True)
+        return ""
     try:
         if (new / "fit.json").is_file():
             new.rename(final)
