@@ -90,6 +90,14 @@ def test_images_left_that_cannot_determine_a_normal_are_said(tmp_path: Path) -> 
     ), said
 
 
+def test_one_image_left_that_cannot_determine_a_normal_is_itself(tmp_path: Path) -> None:
+    lp, _ = _acquisition(tmp_path / "acq", 0, lit=1)
+    said = _fit(lp, tmp_path / "f", "--no-qa")
+    assert "17 of the 18 images are black" in said, said
+    assert "the 1 other is fewer than" in said, said
+    assert "and cannot determine a normal by itself." in said, said
+
+
 def _raking() -> np.ndarray:
     """12 raking lights at azimuths 0° and 180° only, 10°-75° up: relighting documentation
     whose lights cannot determine a normal (one upright plane through the object)."""

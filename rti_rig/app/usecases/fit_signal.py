@@ -118,7 +118,9 @@ def no_signal_warning(
             needs = " and ".join(f"{name}'s {count}" for name, count in short.items())
             why.append(Shortfall(f"fewer than {needs} coefficients per pixel", complement=True))
         if no_normal:
-            why.append(Shortfall("cannot determine a normal by themselves", complement=False))
+            # one image left is "itself" ("the 1 other cannot determine a normal by themselves")
+            own = "itself" if len(lit) == 1 else "themselves"
+            why.append(Shortfall(f"cannot determine a normal by {own}", complement=False))
         left = others_clause(len(lit), why)
     made = [*short, *([NORMAL_MAPS] if no_normal else [])]
     said = ", ".join(made[:-1]) + " and " + made[-1] if len(made) > 1 else made[0]
