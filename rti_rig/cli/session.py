@@ -716,12 +716,16 @@ def _open_resumed(req: Any, on_note: Any) -> Any:
     Why: the resume rewrites ``lights.lp`` (and its journal) as it opens, so a session on
     read-only media (a card or disk mounted read-only, a copy on a DVD) ended with a bare
     ``cannot write …/lights.lp: Read-only file system (EROFS)``: nothing was lost, but the
-    user was told neither that nor what to do."""
+    user was told neither that nor what to do. A disk too small for the images left is said
+    with the command to continue with (it had been told to "choose another --out", which a
+    resume refuses)."""
     from rti_rig.app.usecases.session import open_resumed_session
-    from rti_rig.runtime.session import SessionWriteError
+    from rti_rig.runtime.session import NoSpaceError, SessionWriteError
 
     try:
         return open_resumed_session(req, on_note)
+    except NoSpaceError as exc:  # its figures and the images kept, said by the use case
+        raise RtiRigError(f"{exc}; then continue with: {_resume_command(req)}") from None
     except SessionWriteError as exc:
         raise RtiRigError(
             f"{exc}: the session did not go on and nothing captured is lost; "

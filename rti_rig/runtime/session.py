@@ -244,7 +244,20 @@ def estimated_bytes_per_image(width: int, height: int, channels: int = 3) -> int
 
 class NoSpaceError(SessionError):
     """The disk cannot hold the next image(s): checked before the rig starts and before each
-    image, so the session stops cleanly rather than on a write that fails half-way."""
+    image, so the session stops cleanly rather than on a write that fails half-way.
+
+    Carries its figures (``where``, ``steps``, ``need`` and ``free`` in bytes) so that a caller
+    whose advice differs can say it again in its own words: a resume must not be told to
+    "choose another --out", which ``run --resume`` refuses."""
+
+    def __init__(self, message: str, where: Path, steps: int, need: int, free: int) -> None:
+        super().__init__(message)
+        self.where, self.steps, self.need, self.free = where, steps, need, free
+
+    @property
+    def shortfall(self) -> int:
+        """How many bytes must be freed on that disk for the images asked for."""
+        return max(0, self.need - self.free)
 
 
 def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
@@ -257,7 +270,11 @@ def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
     if free < need:
         raise NoSpaceError(
             f"not enough free disk space for {steps} image(s) under {probe}: need about "
-            f"{need / 1e6:.0f} MB, {free / 1e6:.0f} MB free; free space or choose another --out"
+            f"{need / 1e6:.0f} MB, {free / 1e6:.0f} MB free; free space or choose another --out",
+            probe,
+            steps,
+            need,
+            free,
         )
 
 

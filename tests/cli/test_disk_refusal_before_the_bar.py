@@ -8,6 +8,7 @@ capture had begun. The free space is faked with ``shutil.disk_usage`` (no real f
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -49,11 +50,14 @@ def test_a_full_disk_is_refused_before_the_capture_bar(
     assert "Traceback" not in text and not out.exists()
 
 
+@pytest.mark.parametrize("mode", [[], ["--adaptive"]])
 def test_a_resume_onto_a_full_disk_is_refused_before_the_capture_bar(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, mode: list[str]
 ) -> None:
-    """A session stopped by a full disk after two images, resumed while the disk is still
-    full: refused before the rig opens, its images left as they are."""
+    """A session (planned or adaptive) stopped by a full disk after two of six images, resumed
+    while the disk is still full: refused before the rig opens, its images left as they are,
+    in a resume's words. It had said "free space or choose another --out", which ``run
+    --resume S --out X`` refuses, and not that the images taken are kept or how to go on."""
     out = tmp_path / "s"
     real = shutil.disk_usage
 
@@ -64,13 +68,20 @@ def test_a_resume_onto_a_full_disk_is_refused_before_the_capture_bar(
 
     monkeypatch.setattr(shutil, "disk_usage", fills_after_two)
     config = str(CONFIGS / "simulated_dome.toml")
-    r = runner.invoke(app, ["run", config, "--out", str(out), "--lights", "4", "--no-verdict"])
+    r = runner.invoke(
+        app, ["run", config, "--out", str(out), "--lights", "6", *mode, "--no-verdict"]
+    )
     assert r.exit_code == 2 and "not enough free disk space" in said(r), said(r)
     kept = sorted(p.name for p in out.glob("image_*.jpg"))
     assert len(kept) == 2
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
-    text = said(r)
+    text = " ".join(said(r).split())
     assert r.exit_code == 2, text
-    assert "not enough free disk space for 2 image(s)" in text, text
+    assert "2 of 6 images verified on disk" in text, text
+    assert "the 4 image(s) still to shoot need about" in text, text
+    assert re.search(r"free at least \d+ MB there", text), text
+    assert "The 2 image(s) already taken are kept, listed in lights.lp" in text, text
+    assert text.rstrip().endswith(f"then continue with: rti-rig run --resume {out}"), text
+    assert "--out" not in text, text
     assert "capturing" not in text and "Traceback" not in text, text
     assert sorted(p.name for p in out.glob("image_*.jpg")) == kept

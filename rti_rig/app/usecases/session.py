@@ -689,6 +689,36 @@ def check_disk_holds(loaded, root: Path, steps: int) -> None:  # type: ignore[no
     check_free_space(root, steps, estimated_bytes_per_image(cam.width, cam.height))
 
 
+def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  # type: ignore[no-untyped-def]
+    """Refuse a resume whose remaining images the disk cannot hold, in a resume's words.
+
+    Why: the refusal said "free space or choose another --out", and ``run --resume S --out X``
+    is refused ("drop --out"); nor did it say that the images taken are kept or how to go on,
+    which the same disk refusal had said when it came after the rig opened. The caller adds
+    the command to continue with (it knows the options the resume was given)."""
+    from rti_rig.runtime.session import LP_NAME, NoSpaceError
+
+    done = len(folder.done)
+    try:
+        check_disk_holds(loaded, root, folder.total_steps - done)
+    except NoSpaceError as exc:
+        if done:
+            listed = f", listed in {LP_NAME}" if folder.lp_listing()[0] else ""
+            kept = f"The {done} image(s) already taken are kept{listed}"
+        else:
+            kept = "It holds no verified image yet"
+        raise NoSpaceError(
+            f"not enough free disk space to go on with {root}: the {exc.steps} image(s) still "
+            f"to shoot need about {exc.need / 1e6:.0f} MB on the disk holding {exc.where}, "
+            f"{exc.free / 1e6:.0f} MB free; free at least {math.ceil(exc.shortfall / 1e6)} MB "
+            f"there. {kept}",
+            exc.where,
+            exc.steps,
+            exc.need,
+            exc.free,
+        ) from None
+
+
 def _open_new(
     loaded,  # type: ignore[no-untyped-def]
     schedule: LightSchedule,
@@ -1307,7 +1337,7 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         )
     # the steps still to shoot, at their own exposures, before the port opens
     _check_steps_fit_lit(loaded, schedule, frozenset(folder.done))
-    check_disk_holds(loaded, Path(req.session_dir), folder.total_steps - len(folder.done))
+    _check_disk_holds_rest(loaded, folder, Path(req.session_dir))
     rig = checked_rig(loaded, schedule)
     source = None
     if "adaptive" in folder.manifest:
