@@ -27,6 +27,7 @@ from rti_rig.runtime.session import (
     StepRecord,
     check_free_space,
     estimated_bytes_per_image,
+    steps_to_hold,
 )
 
 
@@ -188,6 +189,12 @@ class StepSource(Protocol):
     @property
     def total(self) -> int:
         """The most steps the session may take (the session folder is sized for it)."""
+        ...
+
+    @property
+    def sure_total(self) -> int:
+        """The steps the session is sure to take (``total`` when they are known): the disk is
+        asked to hold these before the capture starts, the rest image by image."""
         ...
 
     def header(self) -> dict[str, Any]:
@@ -531,7 +538,8 @@ def run_session(
     todo = [i for i in range(total) if i not in done]
     cam = rig.camera_config
     per_image = estimated_bytes_per_image(cam.width, cam.height)
-    check_free_space(folder.root, len(todo), per_image)
+    sure = total if source is None else getattr(source, "sure_total", total)
+    check_free_space(folder.root, steps_to_hold(total, len(done), sure), per_image)
     cancel = cancel or CancelToken()
     emit = on_event or (lambda _e: None)
     clock = rig.clock

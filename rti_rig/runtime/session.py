@@ -260,6 +260,19 @@ class NoSpaceError(SessionError):
         return max(0, self.need - self.free)
 
 
+def steps_to_hold(total: int, done: int, sure: int) -> int:
+    """How many images the disk must hold before a session (re)starts: those it is sure to
+    take (``sure`` of ``total``, ``done`` already taken), and at least the next one while any
+    is left.
+
+    Why: an adaptive session stopped by its --until-error target takes an unknown number of
+    images up to ``total``; asking room for ``total`` (48 images, 103.5 MB, for a session that
+    stopped after 4) refused sessions that fit. The rest is checked image by image, and a
+    session stopped by a full disk is kept and can be resumed."""
+    left = max(0, total - done)
+    return min(left, max(1, sure - done)) if left else 0
+
+
 def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
     """Refuse to go on when the disk cannot hold the images still to be captured."""
     probe = Path(root)

@@ -729,6 +729,23 @@ def _ring_start(dirs: NDArray[np.float64], k: int) -> list[int]:
     return best[1]
 
 
+def images_sure(header: dict[str, Any]) -> int:
+    """The images an adaptive session is sure to take, from its header (``AdaptiveSteps.
+    header``, the manifest's ``adaptive``): its ``max_lights`` when the count is known, but
+    with --until-error and no --lights (no design) only its starting lights, or --min-lights
+    if larger — the stop may come at any light after those.
+
+    Why: the disk was asked to hold the session's maximum (on simulated_dome ``--until-error
+    8``: 48 images, 103.5 MB, for a session that stopped after 4, 6.5 MB), refusing sessions
+    that fit; the rest is checked image by image (a session stopped by a full disk is kept
+    and can be resumed)."""
+    total = int(header["max_lights"])
+    if header.get("until_error_deg") is None or header.get("design_lights") is not None:
+        return total
+    least = max(int(header.get("start_lights") or 0), int(header.get("min_lights") or 0))
+    return min(total, least)
+
+
 def default_max_lights(loaded, until_error_deg: float | None) -> int | None:  # type: ignore[no-untyped-def]
     """The maximum of an adaptive session given neither ``--lights`` nor ``--until-error``:
     the rig config's ``default_lights``, as ``--lights`` documents its default and a planned
@@ -867,6 +884,11 @@ class AdaptiveSteps:
     @property
     def total(self) -> int:
         return self.plan.max_lights
+
+    @property
+    def sure_total(self) -> int:
+        """The lights this session is sure to take (:func:`images_sure`)."""
+        return images_sure(self.header())
 
     def start_schedule(self) -> LightSchedule:
         """The starting layout, recorded as the session's schedule in the manifest."""

@@ -696,20 +696,33 @@ def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  
     is refused ("drop --out"); nor did it say that the images taken are kept or how to go on,
     which the same disk refusal had said when it came after the rig opened. The caller adds
     the command to continue with (it knows the options the resume was given)."""
-    from rti_rig.runtime.session import LP_NAME, NoSpaceError
+    from rti_rig.runtime.session import LP_NAME, NoSpaceError, steps_to_hold
 
-    done = len(folder.done)
+    done, total = len(folder.done), folder.total_steps
+    header = folder.manifest.get("adaptive")
+    if header:  # as the controller will count them
+        from rti_rig.app.usecases.adaptive import images_sure
+
+        sure = images_sure(header)
+    else:
+        sure = total
     try:
-        check_disk_holds(loaded, root, folder.total_steps - done)
+        check_disk_holds(loaded, root, steps_to_hold(total, done, sure))
     except NoSpaceError as exc:
         if done:
             listed = f", listed in {LP_NAME}" if folder.lp_listing()[0] else ""
             kept = f"The {done} image(s) already taken are kept{listed}"
         else:
             kept = "It holds no verified image yet"
+        still = (
+            "still to shoot"
+            if sure >= total
+            else "it is still sure to take (its --until-error stop may come at any light after "
+            "them; each is checked for room as it comes)"
+        )
         raise NoSpaceError(
-            f"not enough free disk space to go on with {root}: the {exc.steps} image(s) still "
-            f"to shoot need about {exc.need / 1e6:.0f} MB on the disk holding {exc.where}, "
+            f"not enough free disk space to go on with {root}: the {exc.steps} image(s) "
+            f"{still} need about {exc.need / 1e6:.0f} MB on the disk holding {exc.where}, "
             f"{exc.free / 1e6:.0f} MB free; free at least {math.ceil(exc.shortfall / 1e6)} MB "
             f"there. {kept}",
             exc.where,
@@ -958,8 +971,8 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         (req.min_elevation_deg, req.max_elevation_deg),
     )
     folder.rig_identity = identity
-    try:  # the session's most images, as the controller counts them (its lights are not chosen)
-        check_disk_holds(loaded, req.out_dir, source.total)
+    try:  # the images it is sure to take, as the controller counts them; the rest, image by image
+        check_disk_holds(loaded, req.out_dir, source.sure_total)
     except BaseException:
         rig.close()
         raise
