@@ -25,12 +25,17 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
     window): see :func:`_build_emulated_firmware_dome`. Use the rig as a context manager (or
     call ``close``) to release emulators and ports afterwards.
     """
+    from rti_rig.app.disk_estimate import bytes_per_image
+
     cfg = loaded.config
     if cfg.backend == "hardware":
-        return _build_hardware(loaded, clock or SystemClock())
-    if cfg.backend == "replay":
-        return _build_replay(loaded, clock or VirtualClock())
-    return _build_simulated(loaded, clock)
+        rig = _build_hardware(loaded, clock or SystemClock())
+    elif cfg.backend == "replay":
+        rig = _build_replay(loaded, clock or VirtualClock())
+    else:
+        rig = _build_simulated(loaded, clock)
+    rig.bytes_per_image = bytes_per_image(loaded)  # what the controller's disk checks count
+    return rig
 
 
 #: The simulated scenes are lit so that this exposure fills 3/4 of the sensor's well with a white

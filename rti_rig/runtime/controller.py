@@ -537,7 +537,7 @@ def run_session(
     done = folder.done
     todo = [i for i in range(total) if i not in done]
     cam = rig.camera_config
-    per_image = estimated_bytes_per_image(cam.width, cam.height)
+    per_image = rig.bytes_per_image or estimated_bytes_per_image(cam.width, cam.height)
     sure = total if source is None else getattr(source, "sure_total", total)
     check_free_space(folder.root, steps_to_hold(total, len(done), sure), per_image)
     cancel = cancel or CancelToken()

@@ -81,6 +81,10 @@ class Rig:
     #: frame and the session folder; returns notes for the user, or raises to disown the run
     #: (a camera-triggered dome's end-of-run proof, :class:`rti_rig.runtime.flash_sync.EndCheck`).
     end_check: Callable[..., list[str]] | None = None
+    #: The bound on one image's files on disk, as the composition root reads it from the
+    #: camera config (a RAW camera's decode mode and kept files); None: the controller's own
+    #: full-size RGB bound. The start-up check before the rig opens counts the same.
+    bytes_per_image: int | None = None
 
     def bind_session(self, root: Path) -> None:
         """Tell the devices which session folder this run writes (before ``connect``)."""

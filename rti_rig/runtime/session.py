@@ -236,10 +236,47 @@ def write_lp_atomic(path: Path, entries: list[LpEntry]) -> None:
     _write_bytes_atomic(path, format_lp(entries).encode("ascii"))
 
 
-def estimated_bytes_per_image(width: int, height: int, channels: int = 3) -> int:
-    """A generous upper bound for one step's files: uncompressed 16-bit TIFF plus a JPEG."""
-    pixels = width * height * channels
-    return 2 * pixels + pixels // 2 + 16_384
+#: Bytes a kept camera RAW may take per photosite: 16 bits, uncompressed (a DNG as
+#: ``drivers.cameras.dng_writer`` writes it; a maker's compressed or 14-bit-packed file is less)
+RAW_BYTES_PER_PHOTOSITE = 2
+#: The JPEGs' bound per sample (8-bit, quality 95, 4:4:4: well under half a byte a sample)
+JPEG_BYTES_PER_SAMPLE = 0.5
+
+
+def estimated_bytes_per_image(
+    width: int,
+    height: int,
+    decode_mode: str | None = None,
+    *,
+    kept_raw: bool = False,
+    kept_jpeg: bool = False,
+) -> int:
+    """A generous upper bound for one step's files on disk, for a sensor of ``width`` ×
+    ``height``: the uncompressed 16-bit linear TIFF and our sRGB JPEG of what the camera
+    delivers, plus the camera's own files the session keeps beside them.
+
+    ``decode_mode``: how a RAW camera's file is decoded (``[camera.device.decode] mode``):
+    ``"demosaic"`` or None (frames straight from the camera) give RGB at full size, ``"half"``
+    RGB at half width and height, ``"mosaic"`` one value per photosite. ``kept_raw``: the
+    camera's RAW is kept in the session's ``raw/``; ``kept_jpeg``: the camera's JPEG too
+    (``keep_jpeg``).
+
+    Why: every RAW camera had been allowed 7.5 bytes a pixel (a full-size RGB TIFF and JPEG)
+    whatever it wrote: twice what a ``"half"`` or ``"mosaic"`` session writes (disks that
+    held the session were refused), and in ``"demosaic"`` mode the kept RAW and JPEG were not
+    counted (a disk too small was let through until it filled mid-session)."""
+    if decode_mode == "half":
+        samples = (width // 2) * (height // 2) * 3
+    elif decode_mode == "mosaic":
+        samples = width * height
+    else:
+        samples = width * height * 3
+    total = 2 * samples + int(samples * JPEG_BYTES_PER_SAMPLE) + 16_384
+    if kept_raw:
+        total += RAW_BYTES_PER_PHOTOSITE * width * height + 16_384
+    if kept_jpeg:
+        total += int(width * height * 3 * JPEG_BYTES_PER_SAMPLE) + 16_384
+    return total
 
 
 class NoSpaceError(SessionError):

@@ -29,7 +29,6 @@ from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
     SessionFolder,
     check_free_space,
-    estimated_bytes_per_image,
     image_names,
 )
 
@@ -685,8 +684,9 @@ def check_disk_holds(loaded, root: Path, steps: int) -> None:  # type: ignore[no
     Why: the controller checks this too, but only as the capture begins: a full disk had been
     refused after the rig opened and below a drawn "capturing 0/48" progress bar, as if the
     capture had started. The controller's own check stays (the disk may fill meanwhile)."""
-    cam = loaded.config.camera
-    check_free_space(root, steps, estimated_bytes_per_image(cam.width, cam.height))
+    from rti_rig.app.disk_estimate import bytes_per_image
+
+    check_free_space(root, steps, bytes_per_image(loaded))
 
 
 def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  # type: ignore[no-untyped-def]
