@@ -522,6 +522,7 @@ def _report_preview_facts(preview: NDArray, surface: SurfaceEstimate, report: Pl
         )
     report.preview_light_az_el_deg = (float(az), float(el))
     report.preview_light_source = surface.light_source
+    report.preview_light_why_zenith = surface.light_why_zenith
     report.planning_shape = tuple(surface.image.shape)
     report.relief_scale = surface.fit.scale * relief_trust(surface.fit)
     report.shading_explained_r2 = surface.fit.explained

@@ -24,6 +24,8 @@ class PlanReport:
     planning_shape: tuple[int, ...] | None = None
     preview_light_az_el_deg: tuple[float, float] | None = None
     preview_light_source: str | None = None
+    #: why the zenith was assumed for the preview's light, no direction being had from it
+    preview_light_why_zenith: str | None = None
     relief_source: str | None = None
     relief_scale: float | None = None
     shading_explained_r2: float | None = None

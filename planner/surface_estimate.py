@@ -73,6 +73,9 @@ class SurfaceEstimate:
     nonfinite_repaired: int
     #: normals of the fitted relief before the trust shrinkage (what the paper's k-means sees)
     fitted_normals: NDArray[np.float64] | None = None
+    #: why the zenith was assumed, no light direction being had from the image
+    #: (:attr:`planner.topography.LightEstimate.why_zenith`); None: given or estimated
+    light_why_zenith: str | None = None
 
 
 def relief_trust(fit: ReliefFit) -> float:
@@ -105,11 +108,14 @@ def estimate_surface(
             "the preview is saturated almost everywhere, so its shading is lost; retake it "
             "with a shorter exposure, or plan without a preview (--method optimal or uniform)"
         )
+    why_zenith = None
     if preview_light is not None:
         light, light_source, albedo = given_light(preview_light), "given", None
     else:
         est = estimate_light(image)
         light, light_source, albedo = est.direction, "estimated (Zheng-Chellappa)", None
+        if est.why_zenith is not None:
+            light_source, why_zenith = "assumed (zenith)", est.why_zenith
     if depth_model is not None:
         raw = depth_from_onnx(preview, Path(depth_model), depth_spec, out_shape=image.shape)
         source = f"depth model {Path(depth_model).name}"
@@ -131,6 +137,7 @@ def estimate_surface(
         source,
         bad,
         normals_from_height(fit.scale * height),
+        light_why_zenith=why_zenith,
     )
 
 

@@ -138,6 +138,10 @@ class LightEstimate:
     direction: NDArray[np.float64]
     source: str
     albedo: float
+    #: Why no direction could be read from the image, when the zenith was assumed instead
+    #: (None: estimated). Why kept: the zenith had been reported as "estimated", az 0°, el 90°,
+    #: as if the image had said so.
+    why_zenith: str | None = None
 
 
 def estimate_light(image: NDArray[np.float64]) -> LightEstimate:
@@ -147,15 +151,27 @@ def estimate_light(image: NDArray[np.float64]) -> LightEstimate:
     albedo ``g / pi``, slant ``arccos(4 mu1 / g)``; the tilt is the direction of the mean unit
     image gradient (in the frame of docs/conventions.md: rows run down, so the row derivative
     flips sign).
-    Degenerate images (constant, black) give the zenith: the least committal answer.
+    Where the image gives no direction the zenith is assumed, the least committal answer, and
+    ``why_zenith`` says why: degenerate images (constant, black), shading that varies too
+    little for any slanted light (``4 mu1 / g > 1``: the slant's cosine above 1, clipped), or
+    no gradient to give the tilt.
     """
+    zenith = np.array([0.0, 0.0, 1.0])
     e = image / max(float(image.max()), 1e-12)
     mu1, mu2 = float(e.mean()), float((e * e).mean())
     g2 = 6 * np.pi**2 * mu2 - 48 * mu1**2
     if g2 <= 1e-12 or mu1 <= 0:
-        return LightEstimate(np.array([0.0, 0.0, 1.0]), "estimated", float(image.max()))
+        why = "its shading is uniform or black"
+        return LightEstimate(zenith, "assumed", float(image.max()), why)
     g = np.sqrt(g2)
-    slant = float(np.arccos(np.clip(4 * mu1 / g, -1.0, 1.0)))
+    cos_slant = 4 * mu1 / g
+    if cos_slant > 1.0:
+        why = (
+            f"its shading varies too little for any slanted light (4μ1/g = {cos_slant:.2f} > "
+            "1: Zheng & Chellappa's slant has no solution)"
+        )
+        return LightEstimate(zenith, "assumed", float(g / np.pi * image.max()), why)
+    slant = float(np.arccos(np.clip(cos_slant, -1.0, 1.0)))
     if image.shape[0] > 1 and image.shape[1] > 1:
         gr, gc = np.gradient(e)
     else:
@@ -164,10 +180,9 @@ def estimate_light(image: NDArray[np.float64]) -> LightEstimate:
     mag = np.hypot(gx, gy)
     ok = mag > 1e-9
     if np.count_nonzero(ok) == 0:
-        slant = 0.0
-        tilt = 0.0
-    else:
-        tilt = float(np.arctan2((gy[ok] / mag[ok]).mean(), (gx[ok] / mag[ok]).mean()))
+        why = "it has no shading gradient to give the light's azimuth"
+        return LightEstimate(zenith, "assumed", float(g / np.pi * image.max()), why)
+    tilt = float(np.arctan2((gy[ok] / mag[ok]).mean(), (gx[ok] / mag[ok]).mean()))
     d = np.array([np.cos(tilt) * np.sin(slant), np.sin(tilt) * np.sin(slant), np.cos(slant)])
     return LightEstimate(normalize(d), "estimated", float(g / np.pi * image.max()))
 

@@ -60,3 +60,28 @@ def test_an_image_from_elsewhere_says_nothing_records_its_light(tmp_path: Path) 
 def test_a_given_light_is_said_given_with_no_estimate(tmp_path: Path) -> None:
     text = _plan(tmp_path, IMAGE, "--preview-light", "200,45")
     assert "(given)" in text and "estimated" not in text and "not known" not in text, text
+
+
+def _flat_painting(path: Path) -> Path:
+    """An evenly lit, nearly flat surface: its shading varies too little for Zheng &
+    Chellappa's slant (4μ1/g > 1), whose estimate then falls back to the zenith."""
+    import cv2
+    import numpy as np
+
+    rng = np.random.default_rng(1)
+    grey = 150 + 20 * cv2.GaussianBlur(rng.normal(0, 1, (200, 200)), (0, 0), 4)
+    cv2.imwrite(str(path), np.dstack([grey.clip(0, 255)] * 3).astype(np.uint8))
+    return path
+
+
+@pytest.mark.e2e
+def test_a_zenith_assumed_for_want_of_an_estimate_is_said_assumed(tmp_path: Path) -> None:
+    """It had said "az 0.0°, el 90.0° (estimated by Zheng & Chellappa's method …)", as if the
+    image had shown a light overhead."""
+    text = " ".join(_plan(tmp_path, _flat_painting(tmp_path / "flat.jpg")).split())
+    assert "el 90.0° (the zenith, assumed: no light direction could be estimated" in text, text
+    assert "4μ1/g = " in text and "Zheng & Chellappa's slant has no solution" in text, text
+    assert "as no rti-rig session or --rig .lp records its light" not in text, text
+    assert "no rti-rig session or --rig .lp records its light" in text, text
+    assert "--preview-light AZ,EL gives the light that fired" in text, text
+    assert "estimated by" not in text and UNKNOWN not in text, text

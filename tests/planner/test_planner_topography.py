@@ -61,11 +61,16 @@ def test_light_estimate_on_a_sphere(az: float, el: float, tol: float) -> None:
     image = np.clip(sphere_normals() @ light, 0, None)
     est = estimate_light(image)
     assert float(angle_between_deg(est.direction, light)) < tol
+    if el < 90:
+        assert est.source == "estimated" and est.why_zenith is None
 
 
 def test_light_estimate_degenerate_images_give_zenith() -> None:
+    """Said assumed, with why: the zenith had been reported as "estimated"."""
     for img in (np.zeros((8, 8)), np.ones((8, 8)), np.ones((1, 1))):
-        assert np.allclose(estimate_light(img).direction, (0, 0, 1))
+        est = estimate_light(img)
+        assert np.allclose(est.direction, (0, 0, 1))
+        assert est.source == "assumed" and est.why_zenith, est
 
 
 def test_given_light_is_validated() -> None:

@@ -209,7 +209,12 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if light_note and report.preview_light_source == "given":
         report.preview_light_source = light_note
     if image is not None and az_el is None and report.preview_light_az_el_deg is not None:
-        report.preview_light_source = estimated_light_said(unrecorded)
+        why_zenith = report.preview_light_why_zenith
+        report.preview_light_source = (
+            estimated_light_said(unrecorded)
+            if why_zenith is None
+            else zenith_assumed_said(unrecorded, why_zenith)
+        )
     if req.signal_noise and not report.signal_noise:
         # as --material's note says (planner.make_plan): an option given and silently unused
         # had read as if the plan modelled the JPEG noise
@@ -253,6 +258,21 @@ def estimated_light_said(unrecorded: str | None) -> str:
         f"it is here is not known ({lo}–{hi}° on the 8 previews of a real icon, "
         "docs/research/planner.md); "
         "--preview-light AZ,EL gives the light that fired"
+    )
+
+
+def zenith_assumed_said(unrecorded: str | None, why: str) -> str:
+    """The plan's preview light when no direction could be estimated from the image and the
+    zenith was assumed: that, why, and how to give the real one.
+
+    Why: Zheng & Chellappa's slant has no solution for shading that varies little (a flat,
+    evenly lit painting: ``4μ1/g > 1``), the estimate then falls back to the zenith, and the
+    plan said "az 0.0°, el 90.0° (estimated by Zheng & Chellappa's method …)", as if the image
+    had shown a light overhead."""
+    unknown = f"; {unrecorded}" if unrecorded else ""
+    return (
+        f"the zenith, assumed: no light direction could be estimated from the image, as {why}"
+        f"{unknown}; --preview-light AZ,EL gives the light that fired"
     )
 
 
