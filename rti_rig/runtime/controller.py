@@ -539,7 +539,9 @@ def run_session(
     cam = rig.camera_config
     per_image = rig.bytes_per_image or estimated_bytes_per_image(cam.width, cam.height)
     sure = total if source is None else getattr(source, "sure_total", total)
-    check_free_space(folder.root, steps_to_hold(total, len(done), sure), per_image)
+    check_free_space(
+        folder.root, steps_to_hold(total, len(done), sure), per_image, holds_images=bool(done)
+    )
     cancel = cancel or CancelToken()
     emit = on_event or (lambda _e: None)
     clock = rig.clock
@@ -600,7 +602,7 @@ def run_session(
                     break
                 step, decision = decided
                 validate_schedule(rig, LightSchedule((step,)))  # before this light moves
-            check_free_space(folder.root, 1, per_image)
+            check_free_space(folder.root, 1, per_image, holds_images=folder.images_kept > 0)
             emit(StepStarted(i, total, step))
             t_start = clock.now()
             actual = rig.lighting.set(step)

@@ -40,6 +40,7 @@ import contextlib
 import errno
 import hashlib
 import json
+import math
 import os
 import platform
 import shlex
@@ -310,17 +311,28 @@ def steps_to_hold(total: int, done: int, sure: int) -> int:
     return min(left, max(1, sure - done)) if left else 0
 
 
-def check_free_space(root: Path, steps: int, bytes_per_image: int) -> None:
-    """Refuse to go on when the disk cannot hold the images still to be captured."""
+def check_free_space(
+    root: Path, steps: int, bytes_per_image: int, *, holds_images: bool = False
+) -> None:
+    """Refuse to go on when the disk cannot hold the images still to be captured.
+
+    ``holds_images``: the session under ``root`` already holds images, so it can only go on
+    there: the advice is to free space on that disk, never to "choose another --out" (a new
+    session elsewhere, which a resume refuses)."""
     probe = Path(root)
     while not probe.exists():
         probe = probe.parent
     free = shutil.disk_usage(probe).free
     need = steps * bytes_per_image + 8 * 1024 * 1024
     if free < need:
+        advice = (
+            f"free at least {math.ceil((need - free) / 1e6)} MB on that disk to go on"
+            if holds_images
+            else "free space or choose another --out"
+        )
         raise NoSpaceError(
             f"not enough free disk space for {steps} image(s) under {probe}: need about "
-            f"{need / 1e6:.0f} MB, {free / 1e6:.0f} MB free; free space or choose another --out",
+            f"{need / 1e6:.0f} MB, {free / 1e6:.0f} MB free; {advice}",
             probe,
             steps,
             need,

@@ -72,6 +72,11 @@ def test_a_resume_onto_a_full_disk_is_refused_before_the_capture_bar(
         app, ["run", config, "--out", str(out), "--lights", "6", *mode, "--no-verdict"]
     )
     assert r.exit_code == 2 and "not enough free disk space" in said(r), said(r)
+    # a session with images goes on in its own folder only: "choose another --out" had
+    # followed its "Continue with: rti-rig run --resume S"
+    stopped = " ".join(said(r).split())
+    assert "choose another --out" not in stopped, stopped
+    assert re.search(r"free at least \d+ MB on that disk to go on", stopped), stopped
     kept = sorted(p.name for p in out.glob("image_*.jpg"))
     assert len(kept) == 2
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
