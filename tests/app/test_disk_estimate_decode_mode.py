@@ -110,3 +110,27 @@ def test_a_half_size_session_fits_where_a_demosaiced_one_is_refused(
     assert "not enough free disk space" not in said_by["half"], said_by["half"]
     assert "no-such-port" in said_by["half"], said_by["half"]  # it went on to the dome
     assert f"not enough free disk space for {lights} image(s)" in said_by["demosaic"]
+
+
+def test_the_controller_counts_the_bytes_the_composition_root_gives(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The check before each image counts the rig's own figure (a RAW camera's, by its decode
+    mode), as the start-up check does: it had counted full-size RGB for every camera."""
+    from rti_rig.app.compose import build_rig
+    from rti_rig.app.config import load_rig_config
+    from rti_rig.app.disk_estimate import bytes_per_image
+    from rti_rig.planner.uniform import plan_uniform
+    from rti_rig.runtime.controller import run_session
+    from rti_rig.runtime.session import NoSpaceError, SessionFolder
+
+    loaded = load_rig_config(CONFIGS / "simulated_dome.toml")
+    rig = build_rig(loaded)
+    assert rig.bytes_per_image == bytes_per_image(loaded)
+    rig.bytes_per_image = 100 * estimated_bytes_per_image(512, 512)  # as a huge RAW would be
+    usage = shutil.disk_usage(tmp_path)
+    free = 2 * estimated_bytes_per_image(512, 512) + 8 * 1024 * 1024 + 1_000_000
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=free))
+    schedule = plan_uniform(rig.geometry, 2)
+    with rig, pytest.raises(NoSpaceError, match="for 2 image"):
+        run_session(rig, schedule, SessionFolder.create(tmp_path / "s", 2))
