@@ -98,3 +98,16 @@ def test_a_resumed_until_error_session_asks_room_for_the_rest_of_its_starting_li
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, said(r)
     assert len(list(out.glob("image_*.jpg"))) >= 4
+
+
+def test_a_refused_until_error_session_says_the_rest_is_checked_image_by_image(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _free(monkeypatch, _room_for(3))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", CONFIG, "--out", str(out), "--until-error", "8", "--no-verdict"])
+    text = " ".join(said(r).split())
+    assert r.exit_code == 2, text
+    assert "not enough free disk space for 4 image(s)" in text, text
+    assert "the 4 are the lights it is sure to take; it may take up to 48" in text, text
+    assert "capturing" not in text and not out.exists(), text

@@ -27,6 +27,7 @@ from rti_rig.runtime.controller import (
 )
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
+    NoSpaceError,
     SessionFolder,
     check_free_space,
     image_names,
@@ -696,7 +697,7 @@ def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  
     is refused ("drop --out"); nor did it say that the images taken are kept or how to go on,
     which the same disk refusal had said when it came after the rig opened. The caller adds
     the command to continue with (it knows the options the resume was given)."""
-    from rti_rig.runtime.session import LP_NAME, NoSpaceError, steps_to_hold
+    from rti_rig.runtime.session import LP_NAME, steps_to_hold
 
     done, total = len(folder.done), folder.total_steps
     header = folder.manifest.get("adaptive")
@@ -973,6 +974,18 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     folder.rig_identity = identity
     try:  # the images it is sure to take, as the controller counts them; the rest, image by image
         check_disk_holds(loaded, req.out_dir, source.sure_total)
+    except NoSpaceError as exc:
+        rig.close()
+        if source.sure_total >= source.total:
+            raise
+        raise NoSpaceError(
+            f"{exc} (the {exc.steps} are the lights it is sure to take; it may take up to "
+            f"{source.total}, each checked for room as it comes)",
+            exc.where,
+            exc.steps,
+            exc.need,
+            exc.free,
+        ) from None
     except BaseException:
         rig.close()
         raise
