@@ -75,6 +75,8 @@ class LedDomeDriver(PortOpening):
         self.reply_timeout_s = reply_timeout_s
         self.ready_timeout_s = ready_timeout_s
         self.max_level = max_level
+        #: This project's protocols carry a PWM level, unless framed with send_level = false.
+        self.can_dim = codec.has_level
         self.has_watchdog = codec.has_watchdog
         self.echoes_light = codec.profile != "binary"
         #: Every light command is answered (an acknowledgement, or the LED's error).

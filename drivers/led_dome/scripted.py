@@ -63,6 +63,9 @@ class ScriptedDomeDriver(PortOpening):
         self.device = f"{device} ({transport.name}, {spec.name} profile)"
         self.has_watchdog = False
         self.max_level = 1  # on/off only
+        #: A protocol description has no brightness placeholder: its light command switches an
+        #: LED on (``dome_profiles.no_dimming`` says so of each built-in firmware).
+        self.can_dim = False
         pat = spec.light.reply.pattern or ""
         self.echoes_light = spec.light.reply.kind == "pattern" and (
             "{index}" in pat or ("{row}" in pat and "{col}" in pat)

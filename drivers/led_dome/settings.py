@@ -25,6 +25,7 @@ from rti_rig.drivers.led_dome.dome_profiles import (
     builtin_spec,
     described_profiles,
     merge,
+    no_dimming,
 )
 from rti_rig.drivers.led_dome.protocol_spec import ProtocolSpec
 
@@ -305,6 +306,35 @@ class DomeSerialSettings(_Strict):
         if self.protocol is not None and "led_count" in self.protocol:
             return "the rig config (dome.serial.protocol.led_count)"
         return f"the {self.profile} profile's own count (no led_count in [dome.serial.protocol])"
+
+    def dimming_refusal(self) -> str | None:
+        """Why this link cannot dim an LED, naming the firmware or profile, or None where it can.
+
+        The one answer to "can this dome be dimmed LED by LED" (``calibrate-lights``, an
+        ``intensity_correction`` at config load, the metering's "evened out"): this project's
+        ``default`` and ``binary`` protocols carry a PWM level in every light command, ``framed``
+        does unless ``send_level = false``, and no real firmware described here carries one
+        (:func:`~rti_rig.drivers.led_dome.dome_profiles.no_dimming`)."""
+        if self.profile in ("default", "binary"):
+            return None
+        if self.profile == "framed":
+            if (self.framed or FramedOptions()).send_level:
+                return None
+            return (
+                "the 'framed' profile with send_level = false cannot dim an LED: its light "
+                "frames carry no level, only full intensity"
+            )
+        if self.profile == "custom":
+            return (
+                "a 'custom' firmware described in [dome.serial.protocol] cannot be dimmed: a "
+                "description has no brightness placeholder, its light command switches an LED on"
+            )
+        return f"the {self.profile} firmware cannot dim an LED: {no_dimming(self.profile)}"
+
+    @property
+    def can_dim(self) -> bool:
+        """The link's light command carries a brightness (see :meth:`dimming_refusal`)."""
+        return self.dimming_refusal() is None
 
     @property
     def is_described(self) -> bool:

@@ -807,6 +807,8 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
             limit = timed_exposure_limit(loaded)
             if limit is not None and config.camera.exposure_s > limit.max_exposure_s + 1e-9:
                 raise ConfigError(path, "camera.exposure_s", limit.refusal(config.camera))
+        if serial is not None and serial.intensity_correction is not None:
+            _check_dome_can_dim(path, data, serial)
         if serial is not None:
             _check_exposure_fits_lit(loaded, serial)
         if serial is not None and (problem := serial.check_led_count(len(dirs))):
@@ -851,6 +853,32 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
             if note:
                 loaded = loaded.model_copy(update={"notes": (*loaded.notes, note)})
     return loaded
+
+
+def _check_dome_can_dim(path: Path, data: dict[str, Any], serial: Any) -> None:
+    """Refuse an intensity correction for a link that cannot dim an LED, naming the key, the
+    file and the firmware.
+
+    Why: an on/off firmware (nab-rti-v1 and every other described one) lit each corrected LED
+    at full light; ``check`` said PASS, the images were those of no correction, and metering
+    took the dome for evened out (one light, not the planned six), which can over-expose."""
+    why = serial.dimming_refusal()
+    if why is None:
+        return
+    given = data["dome"]["serial"]
+    if "intensity_correction_file" in given:
+        key = "dome.serial.intensity_correction_file"
+        what = f"the correction in {given['intensity_correction_file']!r}"
+    else:
+        key, what = "dome.serial.intensity_correction", "this correction"
+    raise ConfigError(
+        path,
+        key,
+        f"{why}, so {what} would be ignored (every LED lit at full light). Remove the key; "
+        "a correction needs a link whose light command carries a brightness (the 'default' or "
+        "'binary' profile, or 'framed' with send_level = true). To even out this dome's images "
+        "instead, divide the light gains out of them (rti_rig.reconstruct.apply_light_gains)",
+    )
 
 
 def _check_exposure_ranges(loaded: LoadedRig, path: Path, cam: object) -> None:

@@ -108,7 +108,9 @@ def calibrate_lights(
 ) -> None:
     """Measure each LED's light from a card session and write the intensity correction that
     evens the dome out (every LED dimmed to the weakest one's light), for \\[dome.serial]
-    intensity_correction_file in the rig config."""
+    intensity_correction_file in the rig config. Only a link that can dim an LED takes one
+    (the default and binary profiles, framed with send_level = true): the on/off firmware
+    profiles (nab-rti-v1, rtipy, ...) are refused."""
     # the backslash above keeps typer's rich help from reading "[dome.serial]" as markup and
     # dropping it (tests/cli/test_help_markup.py)
 

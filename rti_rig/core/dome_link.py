@@ -118,6 +118,10 @@ class DomeLink(Protocol):
     echoes_light: bool
     #: Highest PWM level the firmware takes.
     max_level: int
+    #: The light command carries a brightness, so an LED can be dimmed (an intensity
+    #: correction applied). Declared: an on/off firmware's ``max_level`` of 1 had turned every
+    #: corrected level back into full light, without a word.
+    can_dim: bool
     #: The firmware can say which LED is lit (``query``). Without it and without a light echo,
     #: only the images can tell a wrong LED, which a connect says.
     can_query: bool

@@ -238,6 +238,15 @@ class DomePolicy:
     # ------------------------------------------------------------------ lifecycle
 
     def connect(self) -> None:
+        if self.settings.intensity_correction is not None and not self.link.can_dim:
+            # before the port opens (the Nab sketch boots lit): every corrected level of an
+            # on/off link had been lit at full light, as if no correction were given
+            raise DeviceError(
+                self.name,
+                f"{self.link.device} cannot dim an LED, so its intensity_correction would be "
+                "ignored: remove it from [dome.serial]",
+                "connect",
+            )
         if self._held:
             self._held = False
             if self.info is not None and self.link.port_open:

@@ -869,6 +869,7 @@ class _TimedLink:
     echoes_light = True
     can_query = True
     max_level = 255
+    can_dim = True
     device = "timed"
     # the stop hooks every DomeLink declares, as a link that identifies itself and has no
     # boot wait answers them

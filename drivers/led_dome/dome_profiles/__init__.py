@@ -59,6 +59,19 @@ def max_led_count(name: str) -> int | None:
     return getattr(module, "MAX_LED_COUNT", None)
 
 
+def no_dimming(name: str) -> str:
+    """Why built-in firmware ``name`` cannot dim an LED (its module's ``NO_DIMMING``).
+
+    Declared by every module and read without a default, so a new firmware says what its light
+    command can do: the profiles had been asked whether they dim through a codec chosen by
+    elimination, which called every firmware here dimmable, and a light correction for an
+    on/off sketch was accepted and then silently not applied. None of the described firmwares
+    carries a brightness (their light commands switch an LED on), and a protocol description
+    has no placeholder for one."""
+    module = importlib.import_module(f"{__name__}.{_MODULES[name]}")
+    return str(module.NO_DIMMING)
+
+
 def merge(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
     """``override`` laid over ``base`` table by table (the rig config's [dome.serial.protocol])."""
     out = _deep_copy(base)

@@ -8,6 +8,12 @@ acknowledgements. Which outputs light which LED comes from an LED map file (``le
 
 DEFAULT_MAP = [[(1 << (i % 8)) if i // 8 == port else 0 for port in range(3)] for i in range(24)]
 
+#: Can the link dim an LED? No: the board's outputs are relays/IO lines, each on or off.
+NO_DIMMING = (
+    "its port commands (A/B/C + one byte) switch each output on or off "
+    "(one bit each, no brightness)"
+)
+
 SPEC = {
     "name": "elexol-24r1",
     "led_count": 24,

@@ -9,6 +9,12 @@ bytes sent earlier get lost. All off = an all-zero mask.
 #: The 8-byte bitmask carries 64 LEDs.
 MAX_LED_COUNT = 64
 
+#: Can the link dim an LED? No: the one command is an on/off bitmask of the 64 LEDs.
+NO_DIMMING = (
+    "its only command, 0x42 + an 8-byte bitmask, switches each LED on or "
+    "off (one bit each, no brightness)"
+)
+
 SPEC = {
     "name": "minirti",
     "led_count": MAX_LED_COUNT,

@@ -17,6 +17,10 @@ ALL_ON_REPLY_PATTERN = r"<All lights turned on\.>"
 #: The sketch drives an 8×8 matrix: ``<3,N>`` beyond LED 63 addresses no wired pin.
 MAX_LED_COUNT = 64
 
+#: Can the link dim an LED? No: the sketch's only light command, ``<3,N>``, switches LED N
+#: fully on (no brightness field; ``<1>`` is all on, ``<2>`` the UV). Said in refusals.
+NO_DIMMING = "its only light command, <3,N>, switches LED N fully on (it carries no brightness)"
+
 SPEC = {
     "name": "nab-rti-v1",
     "led_count": MAX_LED_COUNT,

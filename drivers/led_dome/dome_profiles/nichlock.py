@@ -17,6 +17,10 @@ that is said as such, with what to do.
 #: The Arduino Mega sketch steps through 192 LEDs.
 MAX_LED_COUNT = 192
 
+#: Can the link dim an LED? No: ``0`` steps to the next LED and lights it; nothing sets a
+#: brightness.
+NO_DIMMING = "it only steps to the next LED (key 0) and lights it; no command carries a brightness"
+
 SPEC = {
     "name": "nichlock",
     "led_count": MAX_LED_COUNT,

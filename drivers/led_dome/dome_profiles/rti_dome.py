@@ -15,6 +15,10 @@ MAX_LED_COUNT = 32
 #: ``Serial.begin(9600)`` sets no rate, so any host baud rate reaches the sketch.
 ANY_BAUDRATE = True
 
+#: Can the link dim an LED? No: ``M<n>`` lights LED n; the serial command carries no
+#: brightness (the drivers' grey-scale is set in the sketch, not by the host).
+NO_DIMMING = "its only light command, M<n>, lights LED n (it carries no brightness)"
+
 SPEC = {
     "name": "rti-dome-m",
     "led_count": MAX_LED_COUNT,

@@ -10,6 +10,13 @@ lights, is ``I received: <command> the instructionByte was: T`` with no line end
 #: The LoLShield's 14 × 9 matrix (``T,x,y``: x 0..13, y 0..8).
 MAX_LED_COUNT = 126
 
+#: Can the link dim an LED? No: ``T,x,y,secs`` lights LED (x, y) fully for whole seconds; the
+#: command has no brightness field. Said in refusals.
+NO_DIMMING = (
+    "its only light command, T,x,y,secs, lights an LED fully for whole "
+    "seconds (it carries no brightness)"
+)
+
 SPEC = {
     "name": "rtipy",
     "led_count": MAX_LED_COUNT,

@@ -71,13 +71,16 @@ def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
             why = "only a dome driven over a serial link can dim its LEDs"
         raise RtiRigError(f"{rig} has no [dome.serial]: {why}")
 
-    from rti_rig.drivers.led_dome.profiles import make_codec
-
-    if not make_codec(serial).has_level:
+    # the link's declared fact, not its codec's: every firmware profile had been given a binary
+    # codec that "carries a level", and an on/off sketch's correction was written and then
+    # silently not applied
+    why = serial.dimming_refusal()
+    if why is not None:
         raise RtiRigError(
-            f"{req.rig_config}: the dome's '{serial.profile}' profile sends no PWM level "
-            "(send_level = false), so it cannot dim an LED; divide the gains out of the "
-            "images instead (rti_rig.reconstruct.apply_light_gains)"
+            f"{req.rig_config}: {why}, so a light correction could not be applied to it. A "
+            "correction needs a link whose light command carries a brightness (the 'default' "
+            "or 'binary' profile, or 'framed' with send_level = true); on this dome, divide the "
+            "gains out of the images instead (rti_rig.reconstruct.apply_light_gains)"
         )
 
 

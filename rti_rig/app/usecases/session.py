@@ -636,6 +636,15 @@ def _light_outputs_unknown(rig: Rig) -> str:
     if config.kind != "dome" or config.backend == "simulated" or config.dome is None:
         return ""
     serial = config.dome.serial
+    if serial is not None and not serial.can_dim:
+        # the link's declared fact, as calibrate-lights and the config loader read it: a
+        # correction on an on/off firmware is not applied, so it evens nothing out, and
+        # calibrate-lights (which it had been sent to) refuses such a dome
+        return (
+            "This dome cannot be evened out with rti-rig calibrate-lights "
+            f"({serial.dimming_refusal()}): its LEDs may differ by tens of percent, so the "
+            "light nearest the zenith need not be the brightest"
+        )
     if serial is not None and serial.intensity_correction is not None:
         from rti_rig.app.config import calibration_coverage
 
