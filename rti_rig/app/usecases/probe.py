@@ -187,16 +187,21 @@ def _exchange(
         _stopped_inside_opening(result, t, wait_s)
         raise ProbeStopped(str(exc), result) from None
     opened = time.monotonic()
+    # the bytes are collected here as they come, not when a listen returns: a stop inside a
+    # listen had lost all it heard (a Nab banner already in, then "stopped before a firmware
+    # answered" and no all-off, the dome left lit)
     heard = bytearray()
     try:
-        heard += _listen(t, wait_s)
+        _listen(t, wait_s, into=heard)
         if send:
             t.write(send)
-            answer = _listen(t, listen_s)
-            if not answer:
+            asked = len(heard)
+            _listen(t, listen_s, into=heard)
+            if len(heard) == asked:
                 t.write(send)
-                answer = _listen(t, listen_s)
-            heard += answer
+                _listen(t, listen_s, into=heard)
+        text = heard.decode("latin-1")
+        result.heard.append((what, text))
     except EmergencyStop as exc:
         result.heard.append((f"{what} (stopped)", heard.decode("latin-1")))
         try:
@@ -208,11 +213,32 @@ def _exchange(
                 "known; look at it"
             )
         raise ProbeStopped(str(exc), result) from None
-    finally:
+    except BaseException:
         t.close()
-    text = heard.decode("latin-1")
-    result.heard.append((what, text))
+        raise
+    try:
+        t.close()
+    except EmergencyStop:
+        # the stop landed in the closing, what was heard kept in ``result.heard``: a firmware
+        # it shows is named before the teardown (:func:`_stopped_between_ports`) decides
+        _another_firmware_found(result, text, baud)
+        raise
     return text
+
+
+def _another_firmware_found(result: ProbeResult, text: str, baud: int) -> bool:
+    """Name a firmware other than the Nab sketch if ``text`` (heard at ``baud``) shows it
+    (nichlock's banner, the Elexol board's answer); True if one was named.
+
+    Asked before a stop's teardown reopens the port to switch a Nab board off: a nichlock board
+    whose banner was heard had been reset once more and told "stopped before a firmware
+    answered"."""
+    if _nichlock_found(result, text, baud):
+        return True
+    if _ELEXOL_SAYS in text:
+        result.profile, result.baudrate = "elexol-24r1", 38400
+        return True
+    return False
 
 
 def _stopped_on_open_port(
@@ -233,12 +259,19 @@ def _stopped_on_open_port(
     whatever its rate, and boots at its own rate with every LED lit, heard at this one as
     nothing or garbage (it had been left so under "look at the dome"). Otherwise nothing that
     lights was sent, but an opening may have reset a board that boots lit once the probe is
-    gone."""
+    gone. A firmware other than the sketch shown in ``heard`` (nichlock's banner) is named and
+    the port is not reopened: it answered, and another opening would only reset it."""
+    if _another_firmware_found(result, heard, baud):
+        return
     if baud == _NAB_BAUD:
-        left = 0.0 if _NAB_READY.search(heard) else opened + _nab_boot_s(wait_s) - time.monotonic()
-        text = _listen(t, max(0.0, left), until=_NAB_READY).decode("latin-1")
+        boot = bytearray(heard.encode("latin-1"))
+        if not _NAB_READY.search(heard):
+            left = opened + _nab_boot_s(wait_s) - time.monotonic()
+            _listen(t, max(0.0, left), until=_NAB_READY, into=boot)
+        text = boot[len(heard) :].decode("latin-1")
         result.heard.append(("listening out the board's boot", text))
-        if _nab_heard(result):
+        whole = boot.decode("latin-1")  # a banner cut in two by the stop is still one banner
+        if _nab_heard(result) or any(says.search(whole) for says in _NAB_SAYS):
             result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
             _nab_off(result, t)
             return
@@ -298,15 +331,29 @@ def _reopened_at_nab_rate(result: ProbeResult, wait_s: float) -> None:
         t.close()
 
 
-def _listen(t: SerialTransport, seconds: float, until: re.Pattern[str] | None = None) -> bytes:
+def _listen(
+    t: SerialTransport,
+    seconds: float,
+    until: re.Pattern[str] | None = None,
+    into: bytearray | None = None,
+) -> bytes:
     """All ``t`` sends for ``seconds``, or until what it sent matches ``until`` (an
     acknowledgement: no use listening on, and a stop would only find the probe still
-    listening)."""
+    listening). ``until`` is matched against ``into`` when it is given (the caller's whole
+    text: a ready line that a stop cut in two is still seen), else against this listen's bytes.
+
+    Each read is also appended to ``into`` as it comes, so that a caller stopped inside the
+    listen (:class:`EmergencyStop` raised from a read) still has what was heard: returned only
+    at the end, a banner already received was lost with the stop."""
     out = bytearray()
     end = time.monotonic() + seconds
     while (left := end - time.monotonic()) > 0:
-        out += t.read(min(left, 0.1))
-        if until is not None and until.search(out.decode("latin-1")):
+        data = t.read(min(left, 0.1))
+        out += data
+        if into is not None:
+            into += data
+        seen = out if into is None else into
+        if until is not None and until.search(seen.decode("latin-1")):
             break
     return bytes(out)
 
@@ -409,6 +456,10 @@ _NICHLOCK_SAYS = (
 )
 
 
+#: What the Elexol 24R1 board answers to ``?``.
+_ELEXOL_SAYS = "USB I/O 24R1"
+
+
 #: The rates besides 9600 and 115200 that nichlock's settings menu offers and the probe listens
 #: at (its fifth, 300 baud, would need seconds for the banner alone: not tried).
 NICHLOCK_OTHER_RATES = (19200, 2400)
@@ -500,7 +551,7 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             if _nichlock_found(result, text, rate):
                 return result
         text = _exchange(result, "'?' at 38400 baud", 38400, 0.2, b"?", 0.5)
-        if "USB I/O 24R1" in text:
+        if _ELEXOL_SAYS in text:
             result.profile, result.baudrate = "elexol-24r1", 38400
             return result
         text = _exchange(result, "'m' (free RAM) at 115200 baud", 115200, wait, b"m", 0.5)

@@ -1,0 +1,120 @@
+"""``rti-rig probe`` keeps what it heard when a stop lands, and switches a lit Nab board off.
+
+A Nab board resets at every opening of its port and boots with every LED lit. What a probe had
+heard was kept only once a listen returned, so a stop inside a listen (or in the closing after
+it) lost a banner already received: the dome was left lit under "stopped before a firmware
+answered". Each test runs the command against the firmware's emulator on a
+pseudo-terminal; a stop is raised where a signal lands (a read, a closing, the gap between two
+ports), which no timing could aim a real signal at.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.drivers.led_dome.transport import SerialTransport
+from rti_rig.runtime.controller import EmergencyStop
+from rti_rig.simulator.domes import board_for
+from rti_rig.simulator.pty_link import serve_on_pty
+
+pytestmark = [pytest.mark.pty, pytest.mark.e2e]
+
+#: The words the stop says of a Nab board switched off.
+SWITCHED_OFF = "the sketch boots with every LED on; all-off sent and acknowledged"
+
+
+def _boots(board: Any) -> int:
+    return sum(what == "boot" for _, what in board.events)
+
+
+def _probe(board: Any, name: str) -> tuple[int, str]:
+    """``rti-rig probe`` on ``board`` served on a pty: its exit code and output, unwrapped."""
+    with serve_on_pty(board, name) as link:
+        r = CliRunner().invoke(app, ["probe", link.port], terminal_width=400)
+    return r.exit_code, " ".join(r.output.split())
+
+
+def _stopped_in_a_read_once_heard(
+    monkeypatch: pytest.MonkeyPatch, baud: int, words: str, why: str = "SIGTERM"
+) -> list[str]:
+    """Raise the stop from the read that follows the one completing ``words`` on a port open at
+    ``baud``: the signal landing in a listen that has already heard them."""
+    real_read = SerialTransport.read
+    heard = bytearray()
+    stops: list[str] = []
+
+    def read_then_stopped(self: SerialTransport, timeout_s: float) -> bytes:
+        if self.baudrate == baud and not stops and words in heard.decode("latin-1"):
+            stops.append(words)
+            raise EmergencyStop(why)
+        data = real_read(self, timeout_s)
+        if self.baudrate == baud and not stops:
+            heard.extend(data)
+        return data
+
+    monkeypatch.setattr(SerialTransport, "read", read_then_stopped)
+    return stops
+
+
+def test_a_stop_in_the_listen_after_the_nab_banner_switches_the_dome_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """SIGTERM in the first listen, after the board booted lit and its whole banner was read:
+    the banner was lost with the stop, the teardown listened for a boot already over, and the
+    dome was left lit (exit 143, "stopped before a firmware answered")."""
+    stops = _stopped_in_a_read_once_heard(monkeypatch, 9600, "<6> Single photo")
+    board = board_for("nab-rti-v1")
+    code, said = _probe(board, "nab-rti-v1")
+    assert stops, "the listen never heard the banner"
+    assert code == 143, said
+    assert "before a firmware answered" not in said, said
+    assert f"Probe stopped (SIGTERM): {SWITCHED_OFF}" in said, said
+    assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
+    assert _boots(board) == 1, board.events  # switched off on the port it had open
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_as_the_first_port_closes_keeps_the_nab_banner_it_heard(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C in the closing of the first port, whose listen heard the Nab banner: the text
+    was dropped, so the lines heard and the teardown knew nothing of the sketch."""
+    real_close = SerialTransport.close
+    stops: list[str] = []
+
+    def close_then_stopped(self: SerialTransport) -> None:
+        real_close(self)
+        if not stops:
+            stops.append(self.port)
+            raise EmergencyStop("Ctrl-C")
+
+    monkeypatch.setattr(SerialTransport, "close", close_then_stopped)
+    board = board_for("nab-rti-v1")
+    code, said = _probe(board, "nab-rti-v1")
+    assert code == 130 and stops, said
+    assert "listen at 9600 baud: '" in said and "Single photo" in said, said
+    assert f"Probe stopped (Ctrl-C): {SWITCHED_OFF}" in said, said
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_after_nichlocks_banner_at_115200_names_it_and_does_not_reset_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C in the listen at 115200 after nichlock's board printed its banner: the port was
+    opened a third time at 9600 (a reset) to look for a Nab board, and the stop said "stopped
+    before a firmware answered"."""
+    stops = _stopped_in_a_read_once_heard(
+        monkeypatch, 115200, "Reflectance Transformation Imager Serial Interface", "Ctrl-C"
+    )
+    board = board_for("nichlock")
+    code, said = _probe(board, "nichlock")
+    assert stops, "the listen at 115200 never heard the banner"
+    assert code == 130, said
+    assert "before a firmware answered" not in said, said
+    assert "Probe stopped (Ctrl-C): the firmware boots with every LED off" in said, said
+    assert 'profile = "nichlock"' in said and "baudrate = 115200" in said, said
+    assert _boots(board) == 2, board.events  # 9600, then 115200: not reset a third time
