@@ -144,9 +144,9 @@ def probe(
     port: Annotated[str, typer.Argument(help="Serial port of the dome, e.g. /dev/ttyACM0.")],
 ) -> None:
     """Identify which known dome firmware answers on PORT (least intrusive probes first; none
-    lights an LED, and a dome that boots lit is switched off, or you are told it could not be)
-    and print the rig-config lines to use. Ctrl-C stops the probe after switching off a dome
-    that booted lit, and says what is known of the lights."""
+    lights an LED, and a dome that boots lit is switched off, or you are told it could not be
+    and the probe exits 1) and print the rig-config lines to use. Ctrl-C stops the probe after
+    switching off a dome that booted lit, and says what is known of the lights."""
     from rti_rig.app.usecases.probe import ProbeRequest, ProbeResult, ProbeStopped
     from rti_rig.app.usecases.probe import probe as run_probe
     from rti_rig.runtime.controller import EmergencyStop

@@ -3,9 +3,10 @@
 A Nab board resets at every opening of its port and boots with every LED lit. What a probe had
 heard was kept only once a listen returned, so a stop inside a listen (or in the closing after
 it) lost a banner already received: the dome was left lit under "stopped before a firmware
-answered". Each test runs the command against the firmware's emulator on a
-pseudo-terminal; a stop is raised where a signal lands (a read, a closing, the gap between two
-ports), which no timing could aim a real signal at.
+answered". A board booting in 3.3 to 4 s (its profile allows 4 s) was sent its all-off while
+still in its bootloader. Each test runs the command against the firmware's emulator on a
+pseudo-terminal; a stop is raised where a signal lands (a read, a closing), which no timing
+could aim a real signal at.
 """
 
 from __future__ import annotations
@@ -15,9 +16,11 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
+from rti_rig.app.usecases import probe as probe_usecase
 from rti_rig.cli import app
 from rti_rig.drivers.led_dome.transport import SerialTransport
 from rti_rig.runtime.controller import EmergencyStop
+from rti_rig.simulator.dome_firmware import Fault, FaultKind, FaultPlan
 from rti_rig.simulator.domes import board_for
 from rti_rig.simulator.pty_link import serve_on_pty
 
@@ -25,6 +28,10 @@ pytestmark = [pytest.mark.pty, pytest.mark.e2e]
 
 #: The words the stop says of a Nab board switched off.
 SWITCHED_OFF = "the sketch boots with every LED on; all-off sent and acknowledged"
+
+#: A Nab board slow to boot: later than the probe's 2.6 s listen and its two all-offs sent
+#: 0.6 s apart, within the 4 s its profile allows (``boot_wait_s``).
+SLOW_BOOT_S = 3.5
 
 
 def _boots(board: Any) -> int:
@@ -101,6 +108,53 @@ def test_a_stop_as_the_first_port_closes_keeps_the_nab_banner_it_heard(
     assert board.lit_once_booted() == frozenset()
 
 
+def test_a_nab_board_slow_to_boot_is_switched_off_once_its_banner_is_over() -> None:
+    """A board that boots in 3.5 s: its all-off went after a fixed 2.6 s and again 0.6 s later,
+    both into its bootloader; the dome was left lit, and the probe exited 0."""
+    board = board_for("nab-rti-v1")
+    board.boot_s = SLOW_BOOT_S
+    code, said = _probe(board, "nab-rti-v1")
+    assert code == 0, said
+    assert f"Lights: {SWITCHED_OFF}" in said, said
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_a_slow_nab_board_stopped_before_it_is_named_is_switched_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The same slow board, the stop landing as the probe begins to switch it off: the
+    teardown's own all-off (the port opened again, the board reset) waits for its banner too."""
+    real_found = probe_usecase._nab_found
+    calls: list[str | None] = []
+
+    def stopped_first(result: probe_usecase.ProbeResult, wait: float) -> Any:
+        calls.append(result.profile)
+        if len(calls) == 1:
+            raise EmergencyStop("Ctrl-C")
+        return real_found(result, wait)
+
+    monkeypatch.setattr(probe_usecase, "_nab_found", stopped_first)
+    board = board_for("nab-rti-v1")
+    board.boot_s = SLOW_BOOT_S
+    code, said = _probe(board, "nab-rti-v1")
+    assert code == 130 and len(calls) == 2, said
+    assert f"Probe stopped (Ctrl-C): {SWITCHED_OFF}" in said, said
+    assert board.lit_once_booted() == frozenset()
+
+
+def test_an_all_off_not_acknowledged_is_not_a_success() -> None:
+    """Both of the all-off's replies lost: the lights are not confirmed off, and the probe had
+    exited 0 as one that succeeded."""
+    board = board_for(
+        "nab-rti-v1",
+        faults=FaultPlan((Fault(1, FaultKind.DROP_REPLY), Fault(2, FaultKind.DROP_REPLY))),
+    )
+    code, said = _probe(board, "nab-rti-v1")
+    assert code == 1, said
+    assert "error: the Nab sketch did not acknowledge its all-off <0>" in said, said
+    assert "NOT acknowledged: check the dome" in said and "Traceback" not in said, said
+
+
 def test_a_stop_after_nichlocks_banner_at_115200_names_it_and_does_not_reset_it(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -118,3 +172,15 @@ def test_a_stop_after_nichlocks_banner_at_115200_names_it_and_does_not_reset_it(
     assert "Probe stopped (Ctrl-C): the firmware boots with every LED off" in said, said
     assert 'profile = "nichlock"' in said and "baudrate = 115200" in said, said
     assert _boots(board) == 2, board.events  # 9600, then 115200: not reset a third time
+
+
+def test_a_nab_board_first_heard_by_the_last_probe_is_switched_off() -> None:
+    """A board that boots in 3.9 s is heard by none of the probes before RTIPy's ``T,0,0,0``,
+    whose longer listen hears its banner: the probe said "No known dome firmware answered",
+    exit 1, the banner among the lines heard and the dome lit."""
+    board = board_for("nab-rti-v1")
+    board.boot_s = 3.9
+    code, said = _probe(board, "nab-rti-v1")
+    assert code == 0, said
+    assert "Found: nab-rti-v1" in said and f"Lights: {SWITCHED_OFF}" in said, said
+    assert board.lit_once_booted() == frozenset()

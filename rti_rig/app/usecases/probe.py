@@ -366,20 +366,31 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     :class:`ProbeStopped`: a stop mid all-off had escaped to the probe's teardown, which opened
     the port again (a reset: every LED lit once more) to send the all-off a second time. A
     port that fails after such a stop is said, with the lights, in :class:`ProbeStopped` (it had
-    ended as a probe that succeeded, exit 0, "Found: nab-rti-v1")."""
+    ended as a probe that succeeded, exit 0, "Found: nab-rti-v1").
+
+    The all-off is sent once the sketch's banner is over (its ready line, ``ready_pattern``),
+    listened for up to the boot time its profile allows (:func:`_nab_boot_s`): after a fixed
+    ``wait`` it had reached a board slower to boot (3.3 to 4 s) still in its bootloader, which
+    drops what it receives, and the dome was left lit."""
     result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
     t = SerialTransport(result.port, _NAB_BAUD)
     result.openings += 1
     t.open()
     opened = time.monotonic()
+    deadline = opened + _nab_boot_s(wait)
+    booted = bytearray()
     stop: EmergencyStop | None = None
     try:
         try:
-            _listen(t, wait)  # the board resets as the port opens: its bootloader, its banner
+            # the board resets as the port opens: its bootloader, then its banner
+            _listen(t, deadline - time.monotonic(), until=_NAB_READY, into=booted)
         except EmergencyStop as exc:
             # the teardown: the rest of the boot, so that the all-off reaches a booted board
             stop = exc
-            _listen(t, max(0.0, opened + wait - time.monotonic()))
+            if not _NAB_READY.search(booted.decode("latin-1")):
+                left = max(0.0, deadline - time.monotonic())
+                _listen(t, left, until=_NAB_READY, into=booted)
+        result.heard.append((f"the board's boot at {_NAB_BAUD} baud", booted.decode("latin-1")))
         try:
             _nab_off(result, t)
         except EmergencyStop as exc:
@@ -425,12 +436,25 @@ def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
         result.heard.append((what, off))
         if _NAB_OFF_SAYS.search(off):
             break
+    if _NAB_OFF_SAYS.search(off):
+        result.lights = "the sketch boots with every LED on; all-off sent and acknowledged"
+        if result.error and result.error.startswith(_NOT_ACKNOWLEDGED):
+            result.error = None  # a first all-off unanswered, this one acknowledged
+        return
     result.lights = (
-        "the sketch boots with every LED on; all-off sent and acknowledged"
-        if _NAB_OFF_SAYS.search(off)
-        else "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
+        "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
         "the dome"
     )
+    # a probe that leaves the lights unconfirmed is no success: it had exited 0 under
+    # "Found: nab-rti-v1", the dome lit
+    result.error = (
+        f"{_NOT_ACKNOWLEDGED} {command} (sent twice on {result.port}): the dome may be fully "
+        "lit; look at it, and switch it off at its power supply if it is"
+    )
+
+
+#: How the error of an all-off the Nab sketch did not acknowledge begins.
+_NOT_ACKNOWLEDGED = "the Nab sketch did not acknowledge its all-off"
 
 
 def _unanswered_lights(wait: float) -> str:
@@ -578,6 +602,12 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             result.profile, result.baudrate = "rtipy", 9600
             result.lights = "LED (0, 0) was asked for zero seconds: it stays dark"
             return result
+        if _nab_heard(result):
+            # a Nab board slower to boot than a probe's listen (up to the 4 s its profile
+            # allows) is first heard by a later probe's longer listen, T,0,0,0's: its banner
+            # had been shown among the lines heard under "No known dome firmware answered",
+            # the dome left lit
+            return _nab_found(result, wait)
         result.lights = _unanswered_lights(wait)
     except TransportError as exc:
         result.error = str(exc)
