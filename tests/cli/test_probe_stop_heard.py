@@ -5,8 +5,8 @@ heard was kept only once a listen returned, so a stop inside a listen (or in the
 it) lost a banner already received: the dome was left lit under "stopped before a firmware
 answered". A board booting in 3.3 to 4 s (its profile allows 4 s) was sent its all-off while
 still in its bootloader. Each test runs the command against the firmware's emulator on a
-pseudo-terminal; a stop is raised where a signal lands (a read, a closing), which no timing
-could aim a real signal at.
+pseudo-terminal; a stop is raised where a signal lands (a read, a closing, the gap between two
+ports), which no timing could aim a real signal at.
 """
 
 from __future__ import annotations
@@ -155,6 +155,33 @@ def test_an_all_off_not_acknowledged_is_not_a_success() -> None:
     assert "NOT acknowledged: check the dome" in said and "Traceback" not in said, said
 
 
+def test_a_stop_between_two_ports_reopens_at_9600_and_switches_the_nab_off(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C after the first port closed (its listen over before the slow board booted),
+    before the next opened: the opening had reset the board, which boots lit; the probe said
+    "look at the dome" and left it so."""
+    real_exchange = probe_usecase._exchange
+    stops: list[str] = []
+
+    def then_stopped(result: probe_usecase.ProbeResult, what: str, *args: Any) -> str:
+        text = real_exchange(result, what, *args)
+        if not stops:
+            stops.append(what)
+            raise EmergencyStop("Ctrl-C")
+        return text
+
+    monkeypatch.setattr(probe_usecase, "_exchange", then_stopped)
+    board = board_for("nab-rti-v1")
+    board.boot_s = SLOW_BOOT_S
+    code, said = _probe(board, "nab-rti-v1")
+    assert code == 130 and stops, said
+    assert f"Probe stopped (Ctrl-C): {SWITCHED_OFF}" in said, said
+    assert 'profile = "nab-rti-v1"' in said and "Traceback" not in said, said
+    assert _boots(board) == 2, board.events
+    assert board.lit_once_booted() == frozenset()
+
+
 def test_a_stop_after_nichlocks_banner_at_115200_names_it_and_does_not_reset_it(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -184,3 +211,29 @@ def test_a_nab_board_first_heard_by_the_last_probe_is_switched_off() -> None:
     assert code == 0, said
     assert "Found: nab-rti-v1" in said and f"Lights: {SWITCHED_OFF}" in said, said
     assert board.lit_once_booted() == frozenset()
+
+
+def test_a_stop_between_two_ports_after_nichlocks_banner_names_it_and_does_not_reset_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C as the listen at 115200 returns with nichlock's banner, before the probe
+    looked at it: the board answered, so the teardown names it rather than open the port
+    again at 9600 (a reset) to look for a Nab board."""
+    real_exchange = probe_usecase._exchange
+    stops: list[str] = []
+
+    def then_stopped(result: probe_usecase.ProbeResult, what: str, *args: Any) -> str:
+        text = real_exchange(result, what, *args)
+        if not stops and what == "listen at 115200 baud":
+            stops.append(what)
+            raise EmergencyStop("Ctrl-C")
+        return text
+
+    monkeypatch.setattr(probe_usecase, "_exchange", then_stopped)
+    board = board_for("nichlock")
+    code, said = _probe(board, "nichlock")
+    assert code == 130 and stops, said
+    assert "before a firmware answered" not in said, said
+    assert "Probe stopped (Ctrl-C): the firmware boots with every LED off" in said, said
+    assert 'profile = "nichlock"' in said and "baudrate = 115200" in said, said
+    assert _boots(board) == 2, board.events  # 9600, then 115200: not reset a third time

@@ -11,8 +11,11 @@ Ctrl-C or SIGTERM (raised as :class:`EmergencyStop` by the command's handler) st
 through a teardown, as it stops a check: opening the port, at whatever rate, resets a Nab
 board, which boots at 9600 with every LED on, so a stop on a port open at 9600 listens out the
 board's boot on that same port (reopening would reset it again) and sends the sketch's all-off
-if its banner comes; a stop on a port open at another rate, or inside any opening, opens the
-port again at 9600 and does the same; a Nab board identified is sent its all-off.
+if its banner comes; a stop on a port open at another rate, inside any opening, or between
+two ports, opens the port again at 9600 and does the same, unless what was heard shows another
+firmware (nichlock's banner), which is named instead; a Nab board identified is sent its
+all-off once its banner is over. What a listen heard is kept as it comes, so a stop loses none
+of it.
 :class:`ProbeStopped` then says what is known of the lights (it had said only "stopped
 (Ctrl-C)", a dome lit in full behind it).
 """
@@ -550,10 +553,33 @@ def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
         # as it returned: its lights stand ("stopped before a firmware answered … look at the
         # dome" had replaced a found nichlock board's "boots with every LED off")
         return
+    elif _heard_another_firmware(result):
+        # its text was heard but not yet looked at, the stop coming as the probe read it:
+        # named, its port not reopened (it answered; an opening would only reset it)
+        return
+    elif result.openings and SerialTransport(result.port, _NAB_BAUD).resets_on_open:
+        # a port opened, each opening a reset after which a Nab board boots lit at its own
+        # rate, and nothing concluded: opened again at that rate, as after a stop inside an
+        # opening (a stop between two ports had left such a board lit under "look at the dome")
+        _reopened_at_nab_rate(result, wait)
     elif result.openings:
         result.lights = STOPPED_UNANSWERED
     else:
         result.lights = "nothing was lit by the probe: it never opened the port"
+
+
+def _heard_another_firmware(result: ProbeResult) -> bool:
+    """Some probe's text in ``result.heard`` shows a firmware other than the Nab sketch
+    (:func:`_another_firmware_found`, at the rate that probe used), which is then named."""
+    for what, text in result.heard:
+        rate = _RATE_SAID.search(what)
+        if rate and _another_firmware_found(result, text, int(rate.group(1))):
+            return True
+    return False
+
+
+#: The rate in a probe's description (each says "at N baud", as :func:`_probe` writes them).
+_RATE_SAID = re.compile(r"\bat (\d+) baud\b")
 
 
 def _probe(result: ProbeResult, wait: float) -> ProbeResult:
