@@ -25,8 +25,9 @@ _LAYOUTS = {
     b"MM\x00+": (">", 16, 8, 20, 8),
 }
 
-#: the data types a TIFF entry may have (TIFF 6.0's 1-12, IFD 13, BigTIFF's 16-18)
-TIFF_TYPES = frozenset({*range(1, 14), 16, 17, 18})
+#: the data types a TIFF entry may have (TIFF 6.0's 1-12, IFD 13, BigTIFF's 16-18; 14 UNICODE
+#: and 15 COMPLEX, which tifffile's DATATYPE and LibRaw know and some writers' private tags use)
+TIFF_TYPES = frozenset({*range(1, 19)})
 
 #: more tags than any writer uses: tifffile refuses an IFD with more as "suspicious"
 MAX_TAGS = 4096
@@ -111,9 +112,10 @@ def ifd_garbage(path: Path) -> str | None:
     header names none (0) until the IFD is there, tifffile's slot is zeros (a count of 0), a
     share that sizes a file first reads zeros where it has not filled, and a copy cut short
     ends inside an IFD whose count and entries so far are the writer's own. So a non-zero
-    offset inside the header, a count over :data:`MAX_TAGS`, or an entry in the file with a
-    non-zero type no TIFF has is damage. (Whether the file's size is steady and its end
-    written is the caller's to add.)"""
+    offset inside the header, a count over :data:`MAX_TAGS`, or, in an IFD running past the
+    file's end, an entry in the file with a non-zero type no TIFF has is damage (a whole IFD
+    with an unknown type is left to the decode: TIFF 6.0 tells readers to skip such a field).
+    (Whether the file's size is steady and its end written is the caller's to add.)"""
     try:
         size = path.stat().st_size
         with path.open("rb") as f:
@@ -145,8 +147,15 @@ def ifd_garbage(path: Path) -> str | None:
                     f"its first IFD, at byte {offset}, gives a tag count of {count}, more than "
                     f"any writer writes ({MAX_TAGS}); a writer's IFD not written yet reads 0"
                 )
-            # the entries that are in the file (a copy cut short holds only the first ones)
-            entries = f.read(min(count, (size - offset - count_size) // entry_size) * entry_size)
+            in_file = (size - offset - count_size) // entry_size
+            if count <= in_file:
+                # a whole IFD: an entry of a type this reader does not know is the decode's to
+                # judge (TIFF 6.0 tells readers to skip such fields; tifffile does, and reads
+                # the image), never a reason to stop a good shot
+                return None
+            # the entries that are in the file of an IFD that runs past its end (a copy cut
+            # short holds only the first ones, each as its writer wrote it)
+            entries = f.read(in_file * entry_size)
     except OSError:
         return None
     for n in range(len(entries) // entry_size):

@@ -816,3 +816,43 @@ def test_the_compressions_advised_are_ones_the_reader_decodes(tmp_path, compress
     cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
     cam.connect()
     assert np.all(cam.capture(0.5).pixels == 30000)
+
+
+@pytest.mark.parametrize("kind", [14, 15, 40])
+def test_a_paused_tiff_with_a_private_tag_of_an_unlisted_type_is_waited_for(tmp_path, kind):
+    """A good TIFF carrying one private tag whose data type the reader does not list (14
+    UNICODE and 15 COMPLEX, which tifffile and LibRaw know; or a vendor's own), its writer
+    pausing half way: the shot was called damaged ("has data type 15, which no TIFF has") and
+    the session stopped. TIFF 6.0 tells readers to skip such a field, and tifffile reads the
+    image: it is waited for and decoded whole."""
+    whole = tmp_path / "whole.tif.tmp"
+    tifffile.imwrite(
+        whole,
+        np.full((64, 64, 3), 30000, np.uint16),
+        photometric="rgb",
+        extratags=[(65000, "H", 1, 7, True)],
+    )
+    data = bytearray(whole.read_bytes())
+    whole.unlink()
+    (ifd,) = struct.unpack_from("<I", data, 4)
+    (count,) = struct.unpack_from("<H", data, ifd)
+    entry = next(
+        ifd + 2 + 12 * n
+        for n in range(count)
+        if struct.unpack_from("<H", data, ifd + 2 + 12 * n)[0] == 65000
+    )
+    struct.pack_into("<H", data, entry + 2, kind)
+    data = bytes(data)
+    assert ifd + 2 + 12 * count < len(data) // 2  # the whole IFD is in the half written first
+    target = tmp_path / "IMG_0001.tif"
+    clock = ScriptedClock(
+        {
+            0.5: lambda: target.write_bytes(data[: len(data) // 2]),
+            3.0: lambda: target.write_bytes(data),
+        }
+    )
+    cam = watch(tmp_path, clock, patterns=("*.tif",), timeout_s=30.0, poll_interval_s=0.25)
+    cam.connect()
+    frame = cam.capture(0.5)
+    assert frame.pixels.shape[:2] == (64, 64)
+    assert clock.now() >= 3.0
