@@ -119,6 +119,11 @@ def stop_exit_code(why: str) -> int:
 #: Libraries whose log records are not for the user's terminal: a command says in words what
 #: they found (a damaged file is named by the image reader), so their records are dropped.
 QUIET_LIBRARY_LOGGERS = ("tifffile",)
+#: Dask's loggers that print a raw traceback of what ``fit --scheduler`` then says in words (a
+#: task or result that cannot be read here: "Failed to deserialize ... ModuleNotFoundError").
+#: Dask gives its ``distributed`` logger a stderr handler of its own, so a handler that drops
+#: their records is not enough: they are also kept from propagating to it.
+QUIET_DASK_LOGGERS = ("distributed.protocol.pickle", "distributed.protocol.core")
 
 
 def quiet_library_logs() -> None:
@@ -128,13 +133,16 @@ def quiet_library_logs() -> None:
     last-resort handler and is printed raw: a TIFF with damaged tags printed nine
     ``<TiffTag.fromfile> raised TiffFileError(...)`` lines per read, dozens for one ``fit``,
     around rti-rig's own sentences. A program that configures logging itself still receives
-    the records (they propagate as before)."""
+    the records (they propagate as before). :data:`QUIET_DASK_LOGGERS` propagate no further
+    (Dask's own handler on ``distributed`` printed them): only the command line calls this."""
     import logging
 
-    for name in QUIET_LIBRARY_LOGGERS:
+    for name in QUIET_LIBRARY_LOGGERS + QUIET_DASK_LOGGERS:
         logger = logging.getLogger(name)
         if not any(isinstance(h, logging.NullHandler) for h in logger.handlers):
             logger.addHandler(logging.NullHandler())
+    for name in QUIET_DASK_LOGGERS:
+        logging.getLogger(name).propagate = False
 
 
 def main() -> None:

@@ -284,3 +284,38 @@ def test_a_local_two_worker_cluster_gives_the_single_process_bytes(tmp_path: Pat
         assert f"s2: refitted ({changed}{Path(entries[0].name).stem}'s by " in said
         assert said.count("(finished earlier)") == 2, said
         assert sorted(p.name for p in (tmp_path / "batch").iterdir()) == ["s1", "s2", "s3"]
+
+
+def test_a_batch_session_whose_result_cannot_be_read_back_but_whose_fit_stands_is_not_failed(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """A result the client cannot read (a worker running other rti-rig code) raised here
+    although the session's fit ended on the worker, complete in --out: it had been said
+    "A: failed on the Dask cluster: ModuleNotFoundError …", and the rerun "skipped (finished
+    earlier)"."""
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import fit_dask
+
+    for name in ("A", "B"):
+        make_session(tmp_path / name, size=(24, 32))
+    real = fit_dask.fit_one
+
+    def fits_then_its_result_cannot_be_read(source, root, template, bands=None):  # type: ignore[no-untyped-def]
+        item = real(source, root, template)
+        if source.name == "B":
+            return item
+        raise ModuleNotFoundError("No module named 'rti_rig.app.usecases.fit_batch'")
+
+    monkeypatch.setattr(fit_dask, "fit_one", fits_then_its_result_cannot_be_read)
+    out = tmp_path / "FB"
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        args = ["fit", str(tmp_path / "A"), str(tmp_path / "B"), "--out", str(out), "--no-qa"]
+        r = runner.invoke(app, [*args, "--model", "ps", "--scheduler", cluster.scheduler_address])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert f"{tmp_path / 'A'}: finished on its worker; its report could not be read here" in said
+    assert f"its fit stands complete in {out.resolve() / 'A'}" in said, said
+    assert "failed" not in said and (out / "A" / "fit.json").exists()

@@ -17,7 +17,9 @@ Two ways to scale out, both with outputs identical to the single-process fit:
 ``scheduler`` is ``"threads"`` (local threads in this process, one per core, each computing a
 band's Dask graph: nothing to set up) or the address of a ``dask scheduler``
 (``tcp://host:8786``). Workers must see the session
-files at the same paths as this machine; every error says so.
+files at the same paths as this machine; every error says so. They must run the same rti-rig
+too: a cluster whose workers run other code is refused before any task is sent
+(:mod:`rti_rig.app.usecases.worker_code`).
 
 Whether a scheduler address can be used at all (parsed, looked up, TLS, a bounded first
 connection) is :mod:`rti_rig.app.usecases.scheduler_probe`'s. Dask is imported only in these
@@ -69,6 +71,7 @@ from rti_rig.app.usecases.scheduler_probe import (
     probe,
     unreachable_scheduler,
 )
+from rti_rig.app.usecases.worker_code import describe, local_identity, worker_identities
 from rti_rig.core.errors import RtiRigError
 from rti_rig.reconstruct.lazy_stack import ImageReadError, StackSource, lazy_stack
 from rti_rig.reconstruct.stack import ImageStack
@@ -203,9 +206,29 @@ def scheduler_client(address: str) -> Iterator[Any]:
                 f"{WORKERS_TIMEOUT_S:.0f} s: start some with `dask worker {address}`; "
                 f"{SHARED_PATHS}."
             ) from None
+        _refuse_other_code(client, address)
         yield client
     finally:
         _close_quietly(client)
+
+
+def _refuse_other_code(client: Any, address: str) -> None:
+    """Refuse a cluster whose workers run another rti-rig than this machine, before any task
+    is sent (:mod:`rti_rig.app.usecases.worker_code` says why)."""
+    workers = worker_identities(client)
+    mine = local_identity()
+    differ = {w: ident for w, ident in workers.items() if ident != mine}
+    if not differ:
+        return
+    named = "; ".join(f"{w} ({describe(ident)})" for w, ident in sorted(differ.items()))
+    raise SchedulerError(
+        f"{len(differ)} of the {len(workers)} workers of the Dask cluster at {address!r} run "
+        "other rti-rig code "
+        f"than this machine ({describe(local_identity())}): {named}. Their tasks and results "
+        "cannot be read from one side to the other, so nothing was sent: install this same "
+        "rti-rig on every worker (the same release, or the same checkout installed with "
+        "`pip install -e`), restart the workers, and run the same command"
+    )
 
 
 def _close_quietly(client: Any) -> None:
@@ -472,6 +495,24 @@ def _batch_results(
                 continue
             if scheduler_lost(client, exc):
                 raise _batch_lost(scheduler, sources, given, root) from None
-            detail = f" on the Dask cluster: {type(exc).__name__}: {exc}"
-            items.append(BatchItem(s, batch_out_dir(root, s), Outcome.FAILED, detail))
+            items.append(_task_failed(s, root, exc))
     return items
+
+
+def _task_failed(source: Path, root: Path, exc: BaseException) -> BatchItem:
+    """The item of a session whose task raised ``exc`` on its way back (e.g. a worker died
+    on it, or its result could not be read here).
+
+    Why: a result that cannot be read back (a worker running other rti-rig code) raises
+    although the session's fit ended on the worker and stands complete in ``--out``: it had
+    been said "failed", and the rerun skipped it as "finished earlier". What is known is said:
+    a fit that stands is finished, its report unread."""
+    out = batch_out_dir(root, source)
+    why = f"{type(exc).__name__}: {exc}"
+    if earlier_fit(out, source).stands:
+        detail = (
+            f" on its worker; its report could not be read here ({why}); its fit stands "
+            f"complete in {out}"
+        )
+        return BatchItem(source, out, Outcome.FINISHED, detail)
+    return BatchItem(source, out, Outcome.FAILED, f" on the Dask cluster: {why}")
