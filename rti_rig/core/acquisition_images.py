@@ -33,6 +33,20 @@ class AcquisitionImages:
     colour: bool
 
 
+class AcquisitionImagesError(ConfigError):
+    """What is wrong with an acquisition's images: every problem found (``problems``, each a
+    sentence naming the images and what to do), the first one as the message.
+
+    Why a kind of its own: ``check ACQ/dirs.lp`` checks exactly these, and says them as a
+    failed check (each one, RESULT: FAIL, exit 1), where ``run``, ``fit`` and ``bench`` refuse
+    to start (the first one, as before). The check had said the first one as a usage error
+    (exit 2), the others unsaid."""
+
+    def __init__(self, lp_path: Path | str, problems: Sequence[str]) -> None:
+        super().__init__(lp_path, None, problems[0])
+        self.problems = tuple(problems)
+
+
 def check_acquisition_images(
     lp_path: Path,
     entries: Sequence[LpEntry],
@@ -42,8 +56,9 @@ def check_acquisition_images(
     pixels: str = "a replay cannot give as a frame",
 ) -> AcquisitionImages:
     """The images ``entries`` (read from ``lp_path``) name, each found, whole, readable, and
-    all of one size and one kind (colour or grey); else a :class:`ConfigError` naming the
-    `.lp`, the images and what to do.
+    all of one size and one kind (colour or grey); else an :class:`AcquisitionImagesError`
+    naming the `.lp`, the images and what to do (every problem found, the first as its
+    message).
 
     From the files' headers where they say (decoding only those whose header does not, as a
     capture or a read would), so that a fault is said before minutes of work, not part-way.
@@ -85,13 +100,12 @@ def check_image_files(
     would say "index 0 out of range"); the size and kind then are 0 and colour when no header
     says them."""
     paths = dict(zip(names, files, strict=True))
+    problems: list[str] = []
     missing = [n for n in names if not paths[n].is_file()]
     if missing:
         more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
         shown = ", ".join(missing[:5]) + more
-        raise ConfigError(
-            lp_path,
-            None,
+        problems.append(
             f"{lead}{len(missing)} of {len(names)} image(s) missing in "
             f"{Path(lp_path).parent} ({shown})"
             + missing_images_advice(
@@ -100,9 +114,11 @@ def check_image_files(
                 Path(lp_path).parent,
                 use,
                 total=len(names),
-            ),
+            )
         )
-    why_cut = {n: image_truncation(paths[n]) for n in names}
+    gone = set(missing)
+    present = [n for n in names if n not in gone]
+    why_cut = {n: image_truncation(paths[n]) for n in present}
     damaged = [f"{name}: {why}" for name, why in why_cut.items() if why is not None]
     # OpenCV would decode a JPEG with its missing part grey, and say nothing
     if damaged and not headers_only:
@@ -111,21 +127,19 @@ def check_image_files(
             for name, why in why_cut.items()
             if why is not None
         )
-        raise ConfigError(
-            lp_path,
-            None,
+        problems.append(
             f"{len(damaged)} of {len(names)} image(s) beside it are damaged "
             f"{'JPEGs' if jpegs else 'images'} "
             f"({'; '.join(damaged[:5])}{' ...' if len(damaged) > 5 else ''}); copy them again "
-            "from the camera or card",
+            "from the camera or card"
         )
     layouts: dict[str, tuple[int, int, bool]] = {}
     unreadable: list[str] = []
     unsupported: list[str] = []
-    for n in names:
+    for n in present:
         path = paths[n]
         if why_cut[n] is not None:
-            continue  # (headers_only) said by the reader
+            continue  # said above (or, headers_only, by the reader)
         problem = tiff_sample_problem(path)  # a float TIFF has a header like any other
         if problem is not None:
             if not headers_only:
@@ -143,43 +157,39 @@ def check_image_files(
             layout = (int(img.shape[0]), int(img.shape[1]), img.ndim == 3)
         layouts[n] = layout
     if unreadable:
-        raise ConfigError(
-            lp_path,
-            None,
+        problems.append(
             f"{len(unreadable)} of {len(names)} image(s) beside it cannot be read "
             f"({'; '.join(unreadable[:5])}{' ...' if len(unreadable) > 5 else ''}); copy them "
-            "again from the camera or card, or list only the others",
+            "again from the camera or card, or list only the others"
         )
     if unsupported:
-        raise ConfigError(
-            lp_path,
-            None,
+        problems.append(
             f"{len(unsupported)} of {len(names)} image(s) beside it hold pixels {pixels} "
             f"({'; '.join(unsupported[:3])}"
-            f"{' ...' if len(unsupported) > 3 else ''}), or list only the others",
+            f"{' ...' if len(unsupported) > 3 else ''}), or list only the others"
         )
-    if not layouts:  # (headers_only) no header said a size
+    if not layouts:  # (headers_only) no header said a size, or no image could say one
+        if problems:
+            raise AcquisitionImagesError(lp_path, problems)
         return AcquisitionImages([paths[n] for n in names], 0, 0, True)
     first = next(iter(layouts))  # the first image listed, unless left to its reader
     height, width, colour = layouts[first]
     odd = [f"{n} is {w}x{h}" for n, (h, w, _) in layouts.items() if (h, w) != (height, width)]
     if odd:
-        raise ConfigError(
-            lp_path,
-            None,
+        problems.append(
             f"the images beside it differ in size: {first} is {width}x{height} but "
             f"{'; '.join(odd[:5])}{' ...' if len(odd) > 5 else ''}; an acquisition has one "
-            "image size (replace or resize those images, or list only the others)",
+            "image size (replace or resize those images, or list only the others)"
         )
     kind = "colour" if colour else "greyscale"
     other = [n for n, (_, _, c) in layouts.items() if c != colour]
     if other:
-        raise ConfigError(
-            lp_path,
-            None,
+        problems.append(
             f"the images beside it are not all {kind}: {first} is {kind} but "
             f"{', '.join(other[:5])}{' ...' if len(other) > 5 else ''} "
             f"{'is' if len(other) == 1 else 'are'} {'greyscale' if colour else 'colour'}; an "
-            "acquisition has one kind of image (convert those images, or list only the others)",
+            "acquisition has one kind of image (convert those images, or list only the others)"
         )
+    if problems:
+        raise AcquisitionImagesError(lp_path, problems)
     return AcquisitionImages([paths[n] for n in names], height, width, colour)

@@ -490,9 +490,10 @@ def test_check_of_a_recorded_acquisition_tests_no_lights_that_do_not_exist(
     first = next(iter(sorted(copy.glob("*.jpg"))))
     first.write_bytes(first.read_bytes()[:2000])  # cut off, as a card pulled too early
     r = runner.invoke(app, ["check", str(copy / "dirs.lp")])
-    assert r.exit_code == 2, r.output
+    assert r.exit_code == 1, r.output  # a failed check, not a usage error
     said = " ".join(r.output.split())
     assert "damaged JPEG" in said and first.name in said and "Traceback" not in r.output
+    assert said.endswith("RESULT: FAIL"), said
 
 
 def test_image_names_differing_only_in_case_are_named_with_their_file(tmp_path: Path) -> None:

@@ -364,15 +364,17 @@ def _four_images(acq: Path, seed: int, write) -> None:  # type: ignore[no-untype
 
 
 def _refused_by_check_and_run(tmp_path: Path, acq: Path, *fragments: str) -> None:
-    """`check` and `run` of ``acq/dirs.lp`` both refuse it (exit 2, every fragment said, no
-    PASS, no traceback), and no session folder is made."""
-    for args in (
-        ["check", str(acq / "dirs.lp")],
-        ["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")],
+    """`check` of ``acq/dirs.lp`` fails it (RESULT: FAIL, exit 1: its images are what it
+    checks) and `run` refuses it (exit 2), every fragment said, no PASS, no traceback, and no
+    session folder is made."""
+    for args, code in (
+        (["check", str(acq / "dirs.lp")], 1),
+        (["run", str(acq / "dirs.lp"), "--out", str(tmp_path / "s")], 2),
     ):
         r = runner.invoke(app, args)
         said = " ".join(r.output.split())
-        assert r.exit_code == 2, said
+        assert r.exit_code == code, said
+        assert said.endswith("RESULT: FAIL") == (code == 1), said
         for fragment in fragments:
             assert fragment in said, said
         assert "PASS" not in said and "Traceback" not in r.output

@@ -16,6 +16,7 @@ from typing import Any
 from rti_rig.app.compose import build_rig
 from rti_rig.app.config import load_rig_config
 from rti_rig.app.usecases.safe_state import lights_state
+from rti_rig.core.acquisition_images import AcquisitionImagesError
 from rti_rig.core.errors import DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry
 from rti_rig.runtime.arm_check import arm_self_test
@@ -52,7 +53,13 @@ def check_rig(req: CheckRequest) -> Any:
         raise RtiRigError(
             f"--intensity {req.intensity:g}: give the LED drive level as a fraction in (0, 1]"
         )
-    loaded = load_rig_config(req.rig_config)
+    try:
+        loaded = load_rig_config(req.rig_config)
+    except AcquisitionImagesError as exc:
+        if req.auto_exposure:  # refused on any replay: a usage error, said as before
+            raise
+        # what this check is for: the images of a recorded acquisition, each problem said
+        return FailedReplayCheck(Path(exc.path).name, exc.problems)
     if req.auto_exposure:
         # what run --auto-exposure refuses before the rig opens, refused here as there
         from rti_rig.app.flash_sync import refuse_options
@@ -313,4 +320,28 @@ class ReplayCheck:
             f"undamaged and readable, all {self.width}x{self.height} of one kind",
             *config_note_lines(self),
             "RESULT: PASS",
+        ]
+
+
+@dataclass(frozen=True)
+class FailedReplayCheck:
+    """``check`` of a recorded acquisition whose images fail what :class:`ReplayCheck` checks
+    (missing, damaged, unreadable, of another size or kind): each problem, then RESULT: FAIL.
+
+    Why: ``check --help`` names these as what it checks of an `.lp`, and a failed check ends
+    "RESULT: FAIL" with exit 1; an image deleted or resized had been said as a usage error
+    ("error: …", exit 2), as if the command had been mistyped."""
+
+    lp_name: str
+    problems: tuple[str, ...]
+
+    @property
+    def ok(self) -> bool:
+        return False
+
+    def lines(self) -> list[str]:
+        return [
+            "replay rig: a recorded acquisition, no device to light, move or open",
+            *(f"images of {self.lp_name}: FAILED: {p}" for p in self.problems),
+            "RESULT: FAIL",
         ]
