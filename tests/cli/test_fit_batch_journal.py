@@ -91,7 +91,10 @@ def test_an_image_edited_in_place_is_refitted_and_named(
 def test_a_lost_journal_is_said_and_the_images_judged_by_size_and_time(tmp_path: Path) -> None:
     s, t, fb = fitted(tmp_path)
     journal = s / "journal.jsonl"
-    shutil.move(journal, tmp_path / "journal.jsonl")
+    # moved aside, not into tmp_path: a folder holding a journal is a session folder, and the
+    # batch's --out (tmp_path/FB) would be inside it
+    (tmp_path / "aside").mkdir()
+    shutil.move(journal, tmp_path / "aside" / "journal.jsonl")
     r = batch(s, t, out=fb)
     assert r.exit_code == 0, r.output
     lost = f"its session's journal {journal} is missing since the earlier fit"

@@ -683,6 +683,23 @@ def _discard_outputs(out: Path, created: bool) -> None:
             path.unlink(missing_ok=True)
 
 
+def refuse_out_inside_a_session(out: Path) -> None:
+    """Refuse an ``--out`` inside a session folder (one holding rti-rig's manifest or
+    journal), in the words ``run`` refuses one.
+
+    Why: ``fit SESSION --out SESSION/fitout`` wrote the fit among the session's images and
+    exited 0, where ``run --out SESSION/sub`` refuses: a copy of the session then carries the
+    fit, and a fit of it or a ``--resume`` meets files that are not its capture's."""
+    from rti_rig.runtime.session import enclosing_session
+
+    outer = enclosing_session(out)
+    if outer is not None:
+        raise RtiRigError(
+            f"--out {out} is inside {outer}, a session folder: give an --out outside it, so "
+            "that each session stays a folder of its own"
+        )
+
+
 def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     """Fit, write every output into ``req.out_dir``, and judge the acquisition.
 
@@ -695,6 +712,7 @@ def run_fit(req: FitRequest, bands: BandRunner | None = None) -> FitResult:
     # a file given for --out, or a folder the user may not look into (Path.exists raises
     # PermissionError on Python 3.11: a traceback), refused by name before any image is read
     refuse_a_file_in_the_way(req.out_dir)
+    refuse_out_inside_a_session(req.out_dir)
     notes: list[str] = []
     inputs = acquisition_inputs(req.source)  # before reading: a later change is a change
     frames, lights, names, what = load_acquisition(req.source, notes)
