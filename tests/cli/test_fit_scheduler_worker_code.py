@@ -97,3 +97,39 @@ def test_dask_s_unreadable_result_traceback_stays_off_the_terminal(tmp_path: Pat
     )
     assert done.stdout.strip() == "raised", done.stderr
     assert "Traceback" not in done.stderr and "deserialize" not in done.stderr, done.stderr
+
+
+def test_a_worker_that_cannot_say_which_rti_rig_it_runs_is_not_called_another_version(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """A worker whose check fails there (the error returned in its place) is refused, nothing
+    sent, in words that do not claim a version it was not heard to run."""
+    from distributed import LocalCluster
+
+    from rti_rig.app.usecases import worker_code
+
+    real = worker_code._identity_function
+
+    def failing_on_workers():  # type: ignore[no-untyped-def]
+        here = real()
+
+        def rti_rig_identity(dask_worker=None):  # type: ignore[no-untyped-def]
+            if dask_worker is not None:  # run on a worker, not here
+                raise OSError("connection reset by peer")
+            return here()
+
+        return rti_rig_identity
+
+    monkeypatch.setattr(worker_code, "_identity_function", failing_on_workers)
+    session = make_session(tmp_path / "s", size=(24, 32))[0]
+    out = tmp_path / "o"
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        address = cluster.scheduler_address
+        r = runner.invoke(app, ["fit", str(session), "--out", str(out), "--scheduler", address])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert f"1 of the 1 workers of the Dask cluster at '{address}' could not be asked" in said
+    assert "OSError: connection reset by peer" in said and "other rti-rig code" not in said
+    assert "Traceback" not in r.output and not out.exists()

@@ -71,7 +71,12 @@ from rti_rig.app.usecases.scheduler_probe import (
     probe,
     unreachable_scheduler,
 )
-from rti_rig.app.usecases.worker_code import describe, local_identity, worker_identities
+from rti_rig.app.usecases.worker_code import (
+    UNKNOWN,
+    describe,
+    local_identity,
+    worker_identities,
+)
 from rti_rig.core.errors import RtiRigError
 from rti_rig.reconstruct.lazy_stack import ImageReadError, StackSource, lazy_stack
 from rti_rig.reconstruct.stack import ImageStack
@@ -217,18 +222,26 @@ def _refuse_other_code(client: Any, address: str) -> None:
     is sent (:mod:`rti_rig.app.usecases.worker_code` says why)."""
     workers = worker_identities(client)
     mine = local_identity()
-    differ = {w: ident for w, ident in workers.items() if ident != mine}
-    if not differ:
-        return
-    named = "; ".join(f"{w} ({describe(ident)})" for w, ident in sorted(differ.items()))
-    raise SchedulerError(
-        f"{len(differ)} of the {len(workers)} workers of the Dask cluster at {address!r} run "
-        "other rti-rig code "
-        f"than this machine ({describe(local_identity())}): {named}. Their tasks and results "
-        "cannot be read from one side to the other, so nothing was sent: install this same "
-        "rti-rig on every worker (the same release, or the same checkout installed with "
-        "`pip install -e`), restart the workers, and run the same command"
-    )
+    untold = {w: ident for w, ident in workers.items() if ident[0] == UNKNOWN}
+    differ = {w: ident for w, ident in workers.items() if ident != mine and w not in untold}
+    if differ:
+        named = "; ".join(f"{w} ({describe(ident)})" for w, ident in sorted(differ.items()))
+        raise SchedulerError(
+            f"{len(differ)} of the {len(workers)} workers of the Dask cluster at {address!r} "
+            f"run other rti-rig code than this machine ({describe(mine)}): {named}. Their "
+            "tasks and results cannot be read from one side to the other, so nothing was "
+            "sent: install this same rti-rig on every worker (the same release, or the same "
+            "checkout installed with `pip install -e`), restart the workers, and run the same "
+            "command"
+        )
+    if untold:
+        named = "; ".join(f"{w} ({why})" for w, (_, why) in sorted(untold.items()))
+        raise SchedulerError(
+            f"{len(untold)} of the {len(workers)} workers of the Dask cluster at {address!r} "
+            f"could not be asked which rti-rig they run: {named}. Nothing was sent: check "
+            "that they are running and reachable from this machine (restart them), and run "
+            f"the same command; they must run this same rti-rig ({describe(mine)})"
+        )
 
 
 def _close_quietly(client: Any) -> None:
