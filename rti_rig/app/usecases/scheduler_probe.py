@@ -12,11 +12,12 @@ runs the fit. Dask is imported only inside the functions (this module is importe
 from __future__ import annotations
 
 import asyncio
+import copy
 import socket
 import threading
 from collections.abc import Sequence
 from contextlib import suppress
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from rti_rig.core.errors import RtiRigError
@@ -326,14 +327,18 @@ class Reached:
     scheduler, which was there, told as "no Dask scheduler answered within 20 s" (23
     lookups, measured). For tcp:// and tls:// the address is the given one with its host
     replaced by the address that accepted the probe's connection, so no lookup is made after
-    the probe's; a tls:// connection still presents the host name given
-    (``server_hostname``: SNI, and the certificate's name where Dask checks it). ws:// and
-    wss:// keep the name (their URL, and the Host header a proxy routes by): Dask looks it up
-    again there, within its connect timeout."""
+    the probe's; a tls:// connection still presents the host name given (``server_hostname``:
+    sent as SNI only, for a proxy or server that picks its certificate by it; Dask never
+    checks the certificate's name, its ``Security`` sets ``check_hostname = False`` and
+    verifies only that the CA it is given signed the certificate). ws:// and wss:// keep the
+    name (their URL, and the Host header a proxy routes by): Dask looks it up again there,
+    within its connect timeout."""
 
     address: str
     #: the host name a tls:// connection to :attr:`address` presents; None: the name given
     server_hostname: str | None = None
+    #: Dask's ``Security`` the probe connected with (:func:`dask_security`); None: not built
+    base_security: Any = None
 
     def connection_args(self, args: dict[str, Any]) -> dict[str, Any]:
         """Dask's connection arguments ``args`` for a connection to :attr:`address`."""
@@ -342,21 +347,84 @@ class Reached:
         return {**args, "server_hostname": self.server_hostname}
 
     def security(self) -> Any:
-        """The ``security`` to build the ``Client`` with: None (Dask's configuration, as
-        without) unless a host name must be presented, then Dask's ``Security`` from its
-        configuration giving it too (Dask's own ``Worker`` sets the same key for its
-        scheduler's name)."""
-        if self.server_hostname is None:
-            return None
-        from distributed.security import Security
+        """The ``security`` to build the ``Client`` with: :attr:`base_security` (None: Dask's
+        own, its security loader or configuration, as without), and where a host name must be
+        presented a copy of it that gives the name too (Dask's own ``Worker`` sets the same
+        key for its scheduler's name).
 
+        Why a copy of the probe's: a ``Client`` given any ``security`` does not call Dask's
+        ``distributed.client.security-loader``; a ``Security()`` built here from Dask's
+        configuration alone lost the loader's settings for every tls:// address."""
+        base = self.base_security
+        if self.server_hostname is None:
+            return base
+        if base is None:
+            from distributed.security import Security
+
+            base = Security()
         name = self.server_hostname
 
-        class _Named(Security):  # type: ignore[misc]
+        class _Named(type(base)):  # type: ignore[misc]
+            __slots__ = ()  # the base's layout: a copy of it can take this class
+
             def get_connection_args(self, role: str) -> dict[str, Any]:
                 return {**super().get_connection_args(role), "server_hostname": name}
 
-        return _Named()
+        named = copy.copy(base)  # every setting of the base's, whatever its class adds
+        named.__class__ = _Named
+        return named
+
+
+#: Dask's configuration key naming a function that gives a client's ``Security``.
+SECURITY_LOADER = "distributed.client.security-loader"
+
+
+def dask_security(address: str) -> Any:
+    """The ``Security`` Dask's ``Client`` builds for ``address`` when given none: the one the
+    function configured as ``distributed.client.security-loader`` returns, called with the
+    address as given (a dict, True: a temporary one, None: from Dask's configuration), else
+    ``Security()``.
+
+    Why: the probe and the Client must connect with the settings Dask itself would use, and
+    the Client is now always given them (:meth:`Reached.security`), which stops Dask from
+    calling the loader. A loader that cannot be imported or fails is said in words, naming
+    the key, not a traceback."""
+    import dask.config
+    from distributed.security import Security
+    from distributed.utils import import_term
+
+    term = dask.config.get(SECURITY_LOADER, None)
+    if not term:
+        return Security()
+    fix = f"Check Dask's configuration key {SECURITY_LOADER} (= {term!r})"
+    try:
+        loader = import_term(term)
+    except Exception as exc:  # any failure to import it means the same: not usable
+        raise SchedulerError(
+            f"--scheduler {address!r}: Dask's security loader cannot be imported "
+            f"({type(exc).__name__}: {exc}). {fix}: it names a function as module.function, "
+            "in a module this Python can import."
+        ) from None
+    try:
+        security = loader({"address": address})
+        if security is None or security is False:
+            return Security()
+        if isinstance(security, dict):
+            return Security(**security)
+        if security is True:
+            return Security.temporary()
+    except Exception as exc:  # the loader's own code: whatever it raises is its failure
+        raise SchedulerError(
+            f"--scheduler {address!r}: Dask's security loader {term!r} failed "
+            f"({type(exc).__name__}: {exc}). {fix} and the function it names."
+        ) from None
+    if not isinstance(security, Security):
+        raise SchedulerError(
+            f"--scheduler {address!r}: Dask's security loader {term!r} returned "
+            f"{type(security).__name__}, not a distributed.Security, a dict of its settings, "
+            f"True or None. {fix} and the function it names."
+        )
+    return security
 
 
 #: Dask's configuration keys a tls:// client needs (its ``Security()`` reads them).
@@ -377,9 +445,9 @@ def _encrypted(scheme: str) -> bool:
     return getattr(get_backend(scheme).get_connector(), "encrypted", None) is not False
 
 
-def _tls_settings(address: str) -> dict[str, Any]:
-    """The connection arguments Dask's ``Client`` will use (``Security()`` from Dask's
-    configuration), refused in words when they cannot serve ``address``.
+def _tls_settings(address: str) -> tuple[Any, dict[str, Any]]:
+    """Dask's ``Security`` for ``address`` (:func:`dask_security`) and the connection
+    arguments the ``Client`` will use, refused in words when they cannot serve ``address``.
 
     Why: a tls:// address without TLS settings was told as "cannot reach the Dask scheduler
     (TypeError: TLS expects a `ssl_context` argument …)", with advice to start a scheduler,
@@ -392,7 +460,6 @@ def _tls_settings(address: str) -> dict[str, Any]:
 
     import dask.config
     from distributed.comm import parse_address
-    from distributed.security import Security
 
     how = (
         f"Dask reads them from its configuration: {', '.join(TLS_KEYS)} (the key may be in "
@@ -401,7 +468,7 @@ def _tls_settings(address: str) -> dict[str, Any]:
         "DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT and DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY"
     )
     try:
-        security = Security()
+        security = dask_security(address)
         args: dict[str, Any] = security.get_connection_args("client")
     except (OSError, ValueError) as exc:  # ssl.SSLError is an OSError
         given = {key: dask.config.get(key, None) for key in TLS_KEYS}
@@ -433,7 +500,7 @@ def _tls_settings(address: str) -> dict[str, Any]:
             "signed the scheduler's certificate and this client's certificate and key. "
             f"{how}. Or give the scheduler's tcp:// address if it has one."
         )
-    return args
+    return security, args
 
 
 def probe(address: str, timeout: float) -> Reached:
@@ -446,7 +513,7 @@ def probe(address: str, timeout: float) -> Reached:
     ever, and its Ctrl-C left a half-built Client waiting 40 s in ``__del__``. No Client is
     built before this answers. The host name is looked up first, with the whole ``timeout``
     (a slow resolver is not a missing name), and the connection has what is left."""
-    args = _tls_settings(address)
+    security, args = _tls_settings(address)
 
     async def bounded() -> Any:
         loop = asyncio.get_running_loop()
@@ -493,4 +560,4 @@ def probe(address: str, timeout: float) -> Reached:
             "address `dask scheduler` prints (the one its workers were started with), such as "
             "tcp://HOST:8786"
         )
-    return reached
+    return replace(reached, base_security=security)
