@@ -233,8 +233,9 @@ async def _connect(
     left to Dask, which says it in its own words. The plain connections go to the addresses
     looked up, not to the name: a slow resolver (a nameserver down, 5 s per lookup) had timed
     out this step's second lookup, and the port is called refused only where every address
-    refuses (localhost's ::1 may refuse where 127.0.0.1 listens). Dask's connect goes to the
-    first address that accepted, for tcp:// and tls:// (see :class:`Reached`)."""
+    refuses (localhost's ::1 may refuse where 127.0.0.1 listens); an address that cannot be
+    reached otherwise (no route, no answer) is passed over for the next. Dask's connect goes
+    to the first address that accepted, for tcp:// and tls:// (see :class:`Reached`)."""
     from distributed.comm import connect, parse_address
     from distributed.comm.addressing import unparse_host_port
 
@@ -249,24 +250,37 @@ async def _connect(
         elif scheme == "wss":  # Dask's wss:// gives tornado None for its default context
             tls = connection_args.get("ssl_context") or True
 
-        async def first_accepting() -> tuple[bool, str | None]:
-            """(every address refused, the first that accepted: None if none did)"""
-            for ip in ips:
+        async def first_accepting(limit: float) -> tuple[bool, str | None]:
+            """(every address refused, the first that accepted: None if none did), within
+            ``limit`` seconds in all, each address given an equal share of what is left.
+
+            Why: an address that fails otherwise than refused (no route to it, a firewall
+            that drops the connection) had ended the search, and the client fell back to the
+            name, which Dask looked up again (5–13 s with a slow resolver); one that never
+            answered had taken the whole limit from the addresses after it."""
+            loop = asyncio.get_running_loop()
+            deadline = loop.time() + limit
+            every_refused = True
+            for n, ip in enumerate(ips):
+                share = max(deadline - loop.time(), 0.0) / (len(ips) - n)
                 try:
-                    _, writer = await asyncio.open_connection(
-                        ip, port, ssl=tls, server_hostname=host if tls else None
+                    _, writer = await asyncio.wait_for(
+                        asyncio.open_connection(
+                            ip, port, ssl=tls, server_hostname=host if tls else None
+                        ),
+                        share,
                     )
+                except TimeoutError:
+                    every_refused = False
+                    continue
                 except (OSError, ValueError) as exc:
-                    if _refused(exc):
-                        continue
-                    return False, None
+                    every_refused = every_refused and _refused(exc)
+                    continue
                 writer.close()
                 return False, ip
-            return True, None
+            return every_refused, None
 
-        every_refused, accepted = False, None
-        with suppress(TimeoutError):
-            every_refused, accepted = await asyncio.wait_for(first_accepting(), timeout / 5)
+        every_refused, accepted = await first_accepting(timeout / 5)
         if every_refused:
             raise _Refused(location)
         if accepted is not None and scheme in ("tcp", "tls"):
