@@ -151,22 +151,32 @@ def _build_emulated_dome(loaded: LoadedRig, geometry: DomeGeometry, clock: Clock
 
 
 class _BoardLight:
-    """The light a real-firmware emulator really produces (one LED, or none/ambiguous)."""
+    """The light a real-firmware emulator really produces (one LED, or none/ambiguous).
 
-    def __init__(self, board, geometry: DomeGeometry, link) -> None:  # type: ignore[no-untyped-def]
+    The LED is lit at full light (no described firmware can dim one) times its own output
+    (``[emulator] led_power`` / ``led_power_spread``: these had been accepted for a firmware
+    dome and ignored, so an on/off dome's uneven LEDs could not be rehearsed)."""
+
+    def __init__(self, board, geometry: DomeGeometry, link, power) -> None:  # type: ignore[no-untyped-def]
         self._board, self._geometry, self._link = board, geometry, link
+        self._power = power  # each emulated LED's output relative to nominal
 
-    @property
-    def direction(self):  # type: ignore[no-untyped-def]
+    def _led(self) -> int | None:
         self._link.wait_delivered()  # what a UART would have delivered by now, whatever the load
         lit = self._board.lit
         if len(lit) != 1 or next(iter(lit)) >= self._geometry.count:
             return None  # dark, or several LEDs at once (a boot-lit dome): no single light
-        return self._geometry.directions[next(iter(lit))]
+        return next(iter(lit))
+
+    @property
+    def direction(self):  # type: ignore[no-untyped-def]
+        led = self._led()
+        return None if led is None else self._geometry.directions[led]
 
     @property
     def intensity(self) -> float:
-        return 0.0 if self.direction is None else 1.0
+        led = self._led()
+        return 0.0 if led is None else float(self._power[led])
 
 
 def _build_emulated_firmware_dome(
@@ -213,7 +223,8 @@ def _build_emulated_firmware_dome(
             directions=geometry.directions,
             name=f"dome on {link.port} (emulated {serial.profile})",
         )
-        camera = _simulated_camera(loaded, _BoardLight(board, geometry, link), clock)
+        power = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
+        camera = _simulated_camera(loaded, _BoardLight(board, geometry, link, power), clock)
     except BaseException:
         stack.close()
         raise
