@@ -311,25 +311,9 @@ class DomeSerialSettings(_Strict):
         """Why this link cannot dim an LED, naming the firmware or profile, or None where it can.
 
         The one answer to "can this dome be dimmed LED by LED" (``calibrate-lights``, an
-        ``intensity_correction`` at config load, the metering's "evened out"): this project's
-        ``default`` and ``binary`` protocols carry a PWM level in every light command, ``framed``
-        does unless ``send_level = false``, and no real firmware described here carries one
-        (:func:`~rti_rig.drivers.led_dome.dome_profiles.no_dimming`)."""
-        if self.profile in ("default", "binary"):
-            return None
-        if self.profile == "framed":
-            if (self.framed or FramedOptions()).send_level:
-                return None
-            return (
-                "the 'framed' profile with send_level = false cannot dim an LED: its light "
-                "frames carry no level, only full intensity"
-            )
-        if self.profile == "custom":
-            return (
-                "a 'custom' firmware described in [dome.serial.protocol] cannot be dimmed: a "
-                "description has no brightness placeholder, its light command switches an LED on"
-            )
-        return f"the {self.profile} firmware cannot dim an LED: {no_dimming(self.profile)}"
+        ``intensity_correction`` at config load, the metering's "evened out", the QA verdict of
+        a recorded session): see :func:`dimming_refusal_of`."""
+        return dimming_refusal_of(self.profile, (self.framed or FramedOptions()).send_level)
 
     @property
     def can_dim(self) -> bool:
@@ -349,3 +333,31 @@ class DomeSerialSettings(_Strict):
         if corr is not None and len(corr) != count:
             return f"intensity_correction has {len(corr)} factors for {count} LEDs"
         return None
+
+
+def dimming_refusal_of(profile: str, send_level: bool = True) -> str | None:
+    """Why a link of ``profile`` (``framed``: with ``send_level``) cannot dim an LED, naming the
+    firmware or profile, or None where it can.
+
+    A function of the two keys it depends on, so a session's recorded ``[dome.serial]`` table
+    is judged as its loaded settings are (the QA verdict had advised ``calibrate-lights`` for
+    every recorded serial dome, a command that refuses an on/off firmware). This project's
+    ``default`` and ``binary`` protocols carry a PWM level in every light command, ``framed``
+    does unless ``send_level = false``, and no real firmware described here carries one
+    (:func:`~rti_rig.drivers.led_dome.dome_profiles.no_dimming`). Raises ``KeyError`` for a
+    name that is no profile of this version (the loaded settings never hold one)."""
+    if profile in ("default", "binary"):
+        return None
+    if profile == "framed":
+        if send_level:
+            return None
+        return (
+            "the 'framed' profile with send_level = false cannot dim an LED: its light "
+            "frames carry no level, only full intensity"
+        )
+    if profile == "custom":
+        return (
+            "a 'custom' firmware described in [dome.serial.protocol] cannot be dimmed: a "
+            "description has no brightness placeholder, its light command switches an LED on"
+        )
+    return f"the {profile} firmware cannot dim an LED: {no_dimming(profile)}"
