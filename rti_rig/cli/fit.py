@@ -45,11 +45,11 @@ NORMALS_SHOWN = {
 
 def print_verdict(session: Path | None) -> None:
     """Last line of ``run``: the QA verdict (never fails the run: it is advice)."""
-    from rti_rig.app.usecases.fit import verdict_for_session
-
     if session is None:
         return
-    try:
+    try:  # the import too: a SIGTERM while it loads (slow on a busy machine) is the verdict's
+        from rti_rig.app.usecases.fit import verdict_for_session
+
         out.print(f"QA verdict: {escape(verdict_for_session(session))}")
     except (RtiRigError, ValueError) as exc:
         err.print(f"[yellow]QA verdict unavailable:[/] {escape(str(exc))}")
