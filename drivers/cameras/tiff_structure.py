@@ -16,6 +16,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO
 
 #: (byte order, the version word) -> (header size, IFD tag-count size, entry size, offset size)
 _LAYOUTS = {
@@ -57,6 +58,25 @@ class FirstIfd:
         return any(t != 0 and t not in TIFF_TYPES for t in self.types)
 
 
+def _first_ifd_named(f: BinaryIO) -> tuple[tuple[str, int, int, int, int], int] | None:
+    """The layout of the TIFF open as ``f`` (read from its start) and the offset its header
+    names for the first IFD; None when it does not begin with a TIFF signature or its header
+    is not all there. One reading of the header for :func:`first_ifd` and
+    :func:`ifd_garbage`, which judge what lies at that offset differently."""
+    head = f.read(16)
+    layout = _LAYOUTS.get(head[:4])
+    if layout is None:
+        return None
+    order, header = layout[0], layout[1]
+    if len(head) < header:
+        return None
+    if header == 8:
+        (offset,) = struct.unpack(f"{order}I", head[4:8])
+    else:
+        (offset,) = struct.unpack(f"{order}Q", head[8:16])
+    return layout, offset
+
+
 def first_ifd(path: Path) -> FirstIfd | None:
     """``path``'s first IFD when its header names one (a non-zero offset) lying wholly inside
     the file with a tag count between 1 and :data:`MAX_TAGS`; None otherwise.
@@ -68,17 +88,10 @@ def first_ifd(path: Path) -> FirstIfd | None:
     try:
         size = path.stat().st_size
         with path.open("rb") as f:
-            head = f.read(16)
-            layout = _LAYOUTS.get(head[:4])
-            if layout is None:
+            named = _first_ifd_named(f)
+            if named is None:
                 return None
-            order, header, count_size, entry_size, offset_size = layout
-            if len(head) < header:
-                return None
-            if header == 8:
-                (offset,) = struct.unpack(f"{order}I", head[4:8])
-            else:
-                (offset,) = struct.unpack(f"{order}Q", head[8:16])
+            (order, header, count_size, entry_size, offset_size), offset = named
             if offset < header or offset + count_size > size:
                 return None
             f.seek(offset)
@@ -119,17 +132,10 @@ def ifd_garbage(path: Path) -> str | None:
     try:
         size = path.stat().st_size
         with path.open("rb") as f:
-            head = f.read(16)
-            layout = _LAYOUTS.get(head[:4])
-            if layout is None:
+            named = _first_ifd_named(f)
+            if named is None:
                 return None
-            order, header, count_size, entry_size, _ = layout
-            if len(head) < header:
-                return None
-            if header == 8:
-                (offset,) = struct.unpack(f"{order}I", head[4:8])
-            else:
-                (offset,) = struct.unpack(f"{order}Q", head[8:16])
+            (order, header, count_size, entry_size, _), offset = named
             if 0 < offset < header:
                 return (
                     f"its header names its first IFD at byte {offset}, inside the "
