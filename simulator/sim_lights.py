@@ -154,3 +154,12 @@ class SimulatedArm:
     def park(self) -> None:
         self.lamp(False)
         self._move_joints(self._geometry.park_azimuth_deg, self._geometry.park_elevation_deg)
+
+    @property
+    def park_pose_deg(self) -> tuple[float, float]:
+        """(azimuth, elevation) of the park pose: what a read-back position is compared to."""
+        return (self._geometry.park_azimuth_deg, self._geometry.park_elevation_deg)
+
+    def reached_direction(self) -> NDArray[np.float64]:
+        """The lamp's direction from the joints' present angles (the simulation's read-back)."""
+        return self._direction()

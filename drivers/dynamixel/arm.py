@@ -630,6 +630,11 @@ class DynamixelArm:
         s = self.settings
         self._move_ticks(self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg), "park")
 
+    @property
+    def park_pose_deg(self) -> tuple[float, float]:
+        """(azimuth, elevation) of the park pose: what a read-back position is compared to."""
+        return (self.settings.park_azimuth_deg, self.settings.park_elevation_deg)
+
     def home(self) -> None:
         """Check the arm is inside its limits (absolute encoders: no search needed) and park."""
         self._require_connected("home")

@@ -1081,6 +1081,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
     True when it completed but its teardown failed (see :func:`_refuse_unsafe_end`)."""
     from rti_rig.runtime.controller import FinishReason
     from rti_rig.runtime.disowned import MARKER
+    from rti_rig.runtime.lighting import ArmLighting
     from rti_rig.runtime.session import LP_NAME
 
     rig, folder = opened.rig, opened.folder
@@ -1115,9 +1116,10 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         err.print(f"[yellow]note:[/] {escape(str(note))}")
     for failure in result.teardown_failures:
         err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
-    if result.finish_reason is not FinishReason.CANCELLED and getattr(
-        rig.loaded.config, "backend", None
-    ) in ("hardware", "emulated"):
+    if result.finish_reason is not FinishReason.CANCELLED and (
+        getattr(rig.loaded.config, "backend", None) in ("hardware", "emulated")
+        or isinstance(rig.lighting, ArmLighting)  # a simulated arm: where it was left
+    ):
         from rti_rig.app.usecases.safe_state import lights_state
 
         # a finished session on a rig with devices says what its teardown established, as a

@@ -499,6 +499,14 @@ def _refuse_other_layout(
     )
 
 
+def _arm_end(lighting: object) -> dict[str, Any]:
+    """The manifest's ``arm_end``: where an arm's teardown left it, as read back
+    (:class:`rti_rig.runtime.arm_end.ArmEnd`); nothing for a dome, or an arm not gone safe."""
+    end = getattr(lighting, "end", None)
+    to_dict = getattr(end, "to_dict", None)
+    return {} if to_dict is None else {"arm_end": to_dict()}
+
+
 def _teardown_failure(label: str, exc: Exception, earlier: list[str]) -> str:
     """``label: what failed``, or a pointer to the earlier failure it repeats word for word.
 
@@ -723,6 +731,7 @@ def run_session(
                         "steps_planned": total,
                         "steps_done_this_run": len(records),
                         **({"end_check": end_notes} if rig.end_check is not None else {}),
+                        **_arm_end(rig.lighting),
                     },
                     timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
                     source_result=concluded if reason is FinishReason.COMPLETED else None,

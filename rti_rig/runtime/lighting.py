@@ -18,6 +18,7 @@ from rti_rig.core.errors import DeviceError
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
+from rti_rig.runtime.arm_end import ArmEnd, left_end, park_end
 
 #: A dome step's direction must match its LED's calibrated direction this closely (degrees).
 LED_MATCH_TOLERANCE_DEG = 0.5
@@ -169,9 +170,12 @@ class ArmLighting:
         self.park_on_emergency = park_on_emergency
         #: the arm's own failure since the last connect (a move or the lamp): no park after it
         self.arm_failure: Exception | None = None
+        #: where the last :meth:`safe` left the arm, as read back (None: not gone safe yet)
+        self.end: ArmEnd | None = None
 
     def connect(self) -> None:
         self.arm_failure = None
+        self.end = None
         self.carrier.connect()
 
     def close(self) -> None:
@@ -207,10 +211,29 @@ class ArmLighting:
             raise
 
     def safe(self, emergency: bool = False) -> list[str]:
+        """Lamp off, stop, then park as the policy says; :attr:`end` records where the arm
+        was left, as read back (see :mod:`rti_rig.runtime.arm_end`)."""
         failures = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
         stop_failed = attempt_all([("stop", self.carrier.stop)])
         failures += stop_failed
         if not (self.park_on_emergency if emergency else self.park_after_session):
+            policy = (
+                "park_on_emergency_stop is off: an emergency stop leaves it where it stopped"
+                if emergency
+                else "park_after_session is off"
+            )
+            # a stop that did not hold may leave the arm moving: its position is not read as
+            # where it is left (a silent servo would also spend its timeouts on the read)
+            self.end = (
+                ArmEnd(
+                    "left",
+                    None,
+                    None,
+                    f"{policy}; the stop failed (above), so it may still be moving",
+                )
+                if stop_failed
+                else left_end(self.carrier, policy)
+            )
             return failures
         if self.arm_failure is not None or stop_failed:
             why = "own move failed" if self.arm_failure is not None else "stop failed"
@@ -221,6 +244,9 @@ class ArmLighting:
                 if stop_failed
                 else "it was left where it stopped"
             )
+            self.end = ArmEnd(
+                "park-unconfirmed", None, None, f"not attempted because the arm's {why} (above)"
+            )
             return [
                 *failures,
                 f"park: not attempted because the arm's {why}: parking is a move of both "
@@ -228,7 +254,9 @@ class ArmLighting:
                 f"{left}. Clear the fault (its error says how), then park it with "
                 "'rti-rig check'",
             ]
-        return failures + attempt_all([("park", self.carrier.park)])
+        parked = attempt_all([("park", self.carrier.park)])
+        self.end = park_end(self.carrier, parked[0] if parked else None)
+        return failures + parked
 
 
 def attempt_all(actions: list[tuple[str, object]]) -> list[str]:

@@ -266,7 +266,8 @@ def test_too_few_lights_to_fit_are_said_before_the_rig_moves(
         # a firmware that never confirms: the all-off was sent, and that is all that is known
         ("emulated_rti_dome.toml", "All-off sent; this firmware never acknowledges"),
         ("simulated_dome.toml", "Lights were switched off."),
-        ("virtual_arm.toml", "Lamp off and stop were requested."),
+        # a cancel parks (park_after_session), read back at the park pose
+        ("virtual_arm.toml", "Lamp off and stop were requested; the arm parked (read back at"),
     ],
 )
 def test_a_cancelled_session_says_what_is_known_of_the_lights(
@@ -425,7 +426,7 @@ def _finished_run(tmp_path: Path, config: str) -> str:
     [
         ("emulated_dome.toml", "All-off sent and acknowledged by the dome: lights are off."),
         ("emulated_elexol.toml", "this firmware never acknowledges"),
-        ("simulated_arm.toml", "Lamp off and stop were requested."),
+        ("simulated_arm.toml", "Lamp off and stop were requested; the arm parked (read back at"),
     ],
 )
 def test_a_finished_session_on_a_rig_with_devices_says_what_is_known_of_the_lights(

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from rti_rig.core.dome_link import OffOutcome
 from rti_rig.runtime.arm_check import not_connected_sentence
+from rti_rig.runtime.arm_end import ArmEnd
 from rti_rig.runtime.dome_policy import lights_state_sentence
 from rti_rig.runtime.lighting import DomeLighting
 
@@ -37,12 +38,18 @@ def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-
     if lamp == "software" and getattr(rig.loaded.config, "backend", None) == "hardware":
         # the lamp's own switch is outside the servo bus: its "off" is a flag in the driver,
         # and "lamp off ... requested" had told a user at a real arm that it was switched
-        return (
+        said = (
             'stop was requested; the lamp is not switched by rti-rig (lamp = "software" in '
             "[arm.dynamixel]: its switch is outside the servo bus), so switch it off yourself"
-            + after
         )
-    return "lamp off and stop were requested" + after
+    else:
+        said = "lamp off and stop were requested"
+    # where the arm was left, as read back at the teardown (it had gone unsaid: "lamp off and
+    # stop were requested" after a park, after no park, and after a park that failed alike)
+    end = getattr(lighting, "end", None)
+    if isinstance(end, ArmEnd):
+        said += f"; {end.sentence()}"
+    return said + after
 
 
 def safe_state_unsure(rig) -> bool:  # type: ignore[no-untyped-def]

@@ -1,0 +1,134 @@
+"""What ``run`` says, and the manifest records, of where an arm was left.
+
+Every arm session had ended with "lamp off and stop were requested" whether the arm had
+parked, had been left where it stopped (``park_after_session = false``, an emergency stop) or
+had failed to park; a completed run on the simulated arm said nothing at all; the manifest
+recorded none of it. Each case runs the CLI on a shipped arm config; a stop or a fault is
+raised at a known call, not by a timer.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, REPO
+
+#: runs rti-rig with, as the environment asks, a SIGTERM sent to itself as the arm is about
+#: to light the Nth image (``ARM_END_SIGTERM_AT``), or the park failing (``ARM_END_JAM``)
+HOOK = """
+import os, signal, sys
+from rti_rig.runtime.lighting import ArmLighting
+at = int(os.environ.get("ARM_END_SIGTERM_AT", "0"))
+real_set = ArmLighting.set
+calls = []
+def hooked_set(self, step):
+    calls.append(step)
+    if len(calls) == at:
+        os.kill(os.getpid(), signal.SIGTERM)
+    return real_set(self, step)
+ArmLighting.set = hooked_set
+if os.environ.get("ARM_END_JAM"):
+    real_safe = ArmLighting.safe
+    def jammed_safe(self, emergency=False):
+        def jam():
+            raise RuntimeError("jammed")
+        self.carrier.park = jam
+        return real_safe(self, emergency)
+    ArmLighting.safe = jammed_safe
+from rti_rig.cli import app
+sys.argv = ["rti-rig", *sys.argv[1:]]
+app()
+"""
+
+
+def _config(tmp_path: Path, shipped: str, arm_line: str = "") -> Path:
+    """The shipped config ``shipped``, with ``arm_line`` added under its ``[arm]``."""
+    text = (CONFIGS / shipped).read_text()
+    if arm_line:
+        assert "\n[arm]\n" in text
+        text = text.replace("\n[arm]\n", f"\n[arm]\n{arm_line}\n", 1)
+    cfg = tmp_path / shipped
+    cfg.write_text(text)
+    return cfg
+
+
+def _run(tmp_path: Path, cfg: Path, lights: int = 4, **env: str) -> tuple[int, str, Path]:
+    """``rti-rig run cfg`` (hooked as ``env`` asks): exit code, output folded, session."""
+    hook = tmp_path / "hook.py"
+    hook.write_text(HOOK)
+    out = tmp_path / "s"
+    argv = ["run", str(cfg), "--lights", str(lights), "--out", str(out), "--no-verdict"]
+    proc = subprocess.run(
+        [sys.executable, str(hook), *argv],
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300", **env},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    return proc.returncode, " ".join((proc.stdout + proc.stderr).split()), out
+
+
+def _arm_end(out: Path) -> dict:  # type: ignore[type-arg]
+    return json.loads((out / "manifest.json").read_text())["runner"]["arm_end"]
+
+
+@pytest.mark.parametrize(
+    ("shipped", "park_el"), [("simulated_arm.toml", 10.0), ("virtual_arm.toml", 45.0)]
+)
+def test_a_completed_run_says_the_arm_parked_where_read_back(
+    tmp_path: Path, shipped: str, park_el: float
+) -> None:
+    code, said, out = _run(tmp_path, _config(tmp_path, shipped))
+    assert code == 0, said
+    assert (
+        f"lamp off and stop were requested; the arm parked (read back at az 0.0°, "
+        f"el {park_el:.1f}°, within 1° of its park pose)." in said.lower()
+    ), said
+    end = _arm_end(out)
+    assert end["outcome"] == "parked" and end["elevation_deg"] == pytest.approx(park_el, abs=1)
+
+
+def test_a_run_with_park_off_says_where_the_arm_is_left(tmp_path: Path) -> None:
+    cfg = _config(tmp_path, "simulated_arm.toml", "park_after_session = false")
+    code, said, out = _run(tmp_path, cfg)
+    assert code == 0, said
+    end = _arm_end(out)
+    assert end["outcome"] == "left" and end["why"] == "park_after_session is off"
+    at = f"az {end['azimuth_deg']:.1f}°, el {end['elevation_deg']:.1f}°"
+    assert (
+        f"the arm was not parked and is left at {at} (read back; park_after_session is off)" in said
+    ), said
+    assert abs(end["elevation_deg"] - 10.0) > 1  # not at the park pose: it stayed put
+
+
+def test_a_sigterm_with_park_on_emergency_says_the_arm_parked(tmp_path: Path) -> None:
+    cfg = _config(tmp_path, "simulated_arm.toml", "park_on_emergency_stop = true")
+    code, said, out = _run(tmp_path, cfg, ARM_END_SIGTERM_AT="3")
+    assert code == 143, said
+    assert (
+        "Emergency stop (SIGTERM): lamp off and stop were requested; the arm parked "
+        "(read back at az 0.0°, el 10.0°" in said
+    ), said
+    assert _arm_end(out)["outcome"] == "parked"
+
+
+def test_a_sigterm_on_the_virtual_arm_says_it_is_left_where_it_stopped(tmp_path: Path) -> None:
+    code, said, out = _run(tmp_path, _config(tmp_path, "virtual_arm.toml"), ARM_END_SIGTERM_AT="3")
+    assert code == 143, said
+    end = _arm_end(out)
+    assert end["outcome"] == "left" and end["azimuth_deg"] is not None
+    assert "the arm was not parked and is left at az " in said, said
+    assert "park_on_emergency_stop is off" in said, said
+
+
+def test_a_park_that_fails_is_said_not_confirmed(tmp_path: Path) -> None:
+    code, said, out = _run(tmp_path, _config(tmp_path, "virtual_arm.toml"), ARM_END_JAM="1")
+    assert code == 1, said  # complete, but not brought to a known safe state
+    assert "the arm's park is NOT confirmed: the park failed (park: jammed); read back at" in said
+    end = _arm_end(out)
+    assert end["outcome"] == "park-unconfirmed" and "jammed" in end["why"]
