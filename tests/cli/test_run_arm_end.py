@@ -1,10 +1,10 @@
-"""What ``run`` says, and the manifest records, of where an arm was left.
+"""What ``run`` says, and the manifest records, of where an arm was left, and of its moves.
 
 Every arm session had ended with "lamp off and stop were requested" whether the arm had
 parked, had been left where it stopped (``park_after_session = false``, an emergency stop) or
 had failed to park; a completed run on the simulated arm said nothing at all; the manifest
-recorded none of it. Each case runs the CLI on a shipped arm config; a stop or a fault is
-raised at a known call, not by a timer.
+recorded none of it; and the time spent moving the arm was said nowhere. Each case runs the
+CLI on a shipped arm config; a stop or a fault is raised at a known call, not by a timer.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ def _arm_end(out: Path) -> dict:  # type: ignore[type-arg]
 @pytest.mark.parametrize(
     ("shipped", "park_el"), [("simulated_arm.toml", 10.0), ("virtual_arm.toml", 45.0)]
 )
-def test_a_completed_run_says_the_arm_parked_where_read_back(
+def test_a_completed_run_says_the_arm_parked_where_read_back_and_its_moving_time(
     tmp_path: Path, shipped: str, park_el: float
 ) -> None:
     code, said, out = _run(tmp_path, _config(tmp_path, shipped))
@@ -91,6 +91,11 @@ def test_a_completed_run_says_the_arm_parked_where_read_back(
     ), said
     end = _arm_end(out)
     assert end["outcome"] == "parked" and end["elevation_deg"] == pytest.approx(park_el, abs=1)
+    # the moves: each image's start to lamp-on, summed, said beside the session time
+    records = [json.loads(line) for line in (out / "journal.jsonl").read_text().splitlines()]
+    moving = sum(r["light_s"] for r in records if "light_s" in r)
+    assert moving > 0
+    assert f"of which moving the arm (and switching its lamp on) {moving:.1f} s" in said, said
 
 
 def test_a_run_with_park_off_says_where_the_arm_is_left(tmp_path: Path) -> None:
@@ -132,3 +137,10 @@ def test_a_park_that_fails_is_said_not_confirmed(tmp_path: Path) -> None:
     assert "the arm's park is NOT confirmed: the park failed (park: jammed); read back at" in said
     end = _arm_end(out)
     assert end["outcome"] == "park-unconfirmed" and "jammed" in end["why"]
+
+
+def test_a_dome_s_time_line_says_nothing_of_moving(tmp_path: Path) -> None:
+    """The moving time is an arm's: a dome's session time has no such part."""
+    code, said, _ = _run(tmp_path, _config(tmp_path, "simulated_dome.toml"))
+    assert code == 0, said
+    assert "Session time on the real rig" in said and "moving the arm" not in said, said
