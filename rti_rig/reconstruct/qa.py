@@ -14,7 +14,9 @@ Run before the object leaves the dome. The checks (all on linear images):
   - **gain** ``image / prediction``; its :data:`DIM_PERCENTILE` percentile below
     :data:`DIM_GAIN` means a misfired or dim light, below :data:`NO_LIGHT_GAIN` no light (a
     black frame); shadows lower the median, not the bright end; a dark image is not judged
-    where its light is at or below the object's mean surface (its relief's own shadows);
+    where its light is at or below the object's mean surface (its relief's own shadows), and
+    a grazing one (:data:`GRAZING_DEG`) only on what shadows there cannot do: a black frame,
+    the pixels the fit explains, its bright end against its neighbours';
   - **best direction**: the light direction that explains the image best (least squares of the
     image on ``rho n`` over its lit pixels). Far from the recorded direction means a wrong
     light (a swapped entry of the ``.lp``, a wrong LED); the report names the recorded light
@@ -139,6 +141,26 @@ MIN_DIRECTION_IMAGES = 5
 MAX_ROUNDS = 4
 #: An image below this gain at its bright end had no light at all (a black frame).
 NO_LIGHT_GAIN = 0.1
+#: A light within this many degrees above the object's mean surface (the crop's mean fitted
+#: normal) is grazing: the object's relief casts shadows the fit does not model over most of
+#: what it reaches, and how much it shadows changes steeply with elevation, so its image's
+#: median gain says nothing against its (higher) neighbours', and even its bright end can fall
+#: below :data:`DIM_GAIN` with the light right. The simulated arm's 200-light session, every
+#: light right, read median gains of 0-43 % of its neighbours' at 0.2-3.8° (fourteen images
+#: told "misfired or dim light"), and bright ends of 0.39-0.54 at 0.2-0.4°, 0.8-0.98 above;
+#: 0.53 of its neighbours' at 4.0°. There a light is judged only on what a faulty one changes
+#: and shadows do not: a black frame (:data:`NO_LIGHT_GAIN`), the pixels the fit explains
+#: (:func:`_reliable_gains`), and its bright end against its neighbours' bright ends
+#: (:data:`NEIGHBOUR_DIM_RATIO`); otherwise it is said unjudged, never a reshoot.
+GRAZING_DEG = 5.0
+#: ... the bright-end comparison is made only where the neighbours' bright ends (their median)
+#: reach this (the prediction holds for them), and only on a light at least
+#: :data:`GRAZING_DIM_MIN_DEG` above the surface: lower, its own bright end fails with the light
+#: right (the same session's 0.2-1.2° lights read 0.40-0.80, 0.40 of their neighbours' at
+#: 0.44°; 0.90-0.98 from 1.5° up), and a dim light cannot be told there; a black frame still
+#: can. Half power at 2.2° and 2.7° read 0.48 of neighbours at about 1.0.
+GRAZING_TRUSTED_BRIGHT_END = 0.85
+GRAZING_DIM_MIN_DEG = 1.5
 #: The percentile of an image's reduced pixels that is its brightest: the level a black
 #: acquisition's "misfired, no light" names. Whether it is black throughout is judged by
 #: :func:`~rti_rig.reconstruct.signal_check.every_image_black` (the rule ``fit --no-qa``
@@ -281,6 +303,11 @@ class ImageCheck:
     #: :meth:`QAReport.explain_bright_by_lights` takes that claim off by what it is, not by
     #: matching its words (a reworded message would have kept a claim the lights explain).
     bright_problem: str | None = None
+    #: True when its light is grazing (:data:`GRAZING_DEG`) and its image darker than the
+    #: median or absolute gain checks allow, but not dark enough for the evidence a grazing
+    #: light is judged on: too little lit to judge, so its brightness is not judged
+    #: (``gain_judged``) rather than called a misfire that a reshoot would repeat.
+    grazing_unjudged: bool = False
 
 
 #: The saturation check's advice (replaced where a session cannot follow it).
@@ -348,7 +375,8 @@ class QAReport:
                 continue
             unjudged = [c for c in self.images if not getattr(c, attr) and c.index not in flagged]
             below = [c.name for c in unjudged if attr == "gain_judged" and c.dark_below_surface]
-            skipped = [c.name for c in unjudged if c.name not in below]
+            grazing = [c.name for c in unjudged if attr == "gain_judged" and c.grazing_unjudged]
+            skipped = [c.name for c in unjudged if c.name not in below and c.name not in grazing]
             if skipped:
                 why = (
                     f"its light reaches less than {DRIFT_MIN_LIT:.0%} of the object"
@@ -361,6 +389,16 @@ class QAReport:
                     f"{label} not judged on {_names(below)} (dark, but its light is at or below "
                     "the object's mean surface, where the object's own relief can shadow all it "
                     "reaches: a misfire cannot be told from that; check the LED fired)"
+                )
+            if grazing:
+                out.append(
+                    f"{label} not judged on {_names(grazing)} (grazing light: too little lit "
+                    f"to judge; within {GRAZING_DEG:.0f}° of the object's mean surface its "
+                    "relief shadows most of what the light reaches, which a reshoot gives "
+                    f"again. A light that did not fire at all is still named, and from "
+                    f"{GRAZING_DIM_MIN_DEG:g}° up one whose brightest pixels read at most "
+                    f"{NEIGHBOUR_DIM_RATIO:.0%} of its neighbours'; a dim light lower cannot "
+                    "be told: check the LED fired)"
                 )
         glossy = [
             c.name
@@ -1447,6 +1485,7 @@ def assess(
                 misfit=float(ev.misfit[i]),
                 within_light_scatter=bool(within_scatter[i]),
                 dark_below_surface=bool(ev.dark_below_surface[i]),
+                grazing_unjudged=bool(ev.grazing_unjudged[i]),
                 bright_as_its_elevation=bool(
                     bright_as_mates[i] and _bright(float(ev.gain[i]), float(sat_frac[i]))
                 ),
@@ -1604,6 +1643,8 @@ class _Evidence:
     #: Of an image called wrong as one of a swapped pair (:func:`swapped_pairs`): how many times
     #: closer the other's recorded light renders it than its own; NaN otherwise.
     swap_ratio: NDArray = field(default_factory=lambda: np.zeros(0))
+    #: Dark images of a grazing light (:data:`GRAZING_DEG`) too little lit to judge.
+    grazing_unjudged: NDArray = field(default_factory=lambda: np.zeros(0, bool))
 
 
 def _evidence(
@@ -1695,6 +1736,21 @@ def _evidence(
     nb_ratio = neighbour_ratio(gain, lt)
     nb_dark = below & np.isfinite(nb_ratio) & (nb_ratio <= NEIGHBOUR_DIM_RATIO)
     gain[nb_dark] = lit_gain[nb_dark] = nb_ratio[nb_dark] = np.nan
+    # A grazing light (GRAZING_DEG) is judged on its bright end against its neighbours' bright
+    # ends, not on its median (shadows) nor its bright end alone (a 0.2° light's reads 0.4).
+    over = _elevation_over(lt, mean_n)
+    grazing = ~below & (over < GRAZING_DEG)
+    top_ratio = neighbour_ratio(lit_gain, lt)
+    grazing_dead = grazing & np.isfinite(lit_gain) & (lit_gain < NO_LIGHT_GAIN)
+    median_dark = np.isfinite(nb_ratio) & (nb_ratio <= NEIGHBOUR_DIM_RATIO)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mates_top = lit_gain / top_ratio  # the neighbours' median bright end
+    top_trusted = (
+        np.isfinite(mates_top)
+        & (mates_top >= GRAZING_TRUSTED_BRIGHT_END)
+        & (over >= GRAZING_DIM_MIN_DEG)
+    )
+    nb_ratio[grazing] = np.where(top_trusted, top_ratio, np.nan)[grazing]
     rel_gain, rel_top, rel_count = _reliable_gains(np.stack(images), crop_sat, ps, lt, dark)
     rel_gain[unjudged | nb_dark] = np.nan
     # The bright end of image / prediction is a misfire only where the pixels the fit
@@ -1714,10 +1770,13 @@ def _evidence(
         & np.isfinite(lit_gain)
     )
     dim = (
-        (np.isfinite(lit_gain) & (lit_gain < DIM_GAIN) & ~cleared)
+        (np.isfinite(lit_gain) & (lit_gain < DIM_GAIN) & ~cleared & (~grazing | grazing_dead))
         | rel_dim
         | (np.isfinite(nb_ratio) & (nb_ratio <= NEIGHBOUR_DIM_RATIO))
     )
+    # a grazing image the checks above would have called dim: too little lit to judge
+    grazing_unjudged = grazing & ~dim & ((lit_gain < DIM_GAIN) | median_dark)
+    gain[grazing_unjudged] = lit_gain[grazing_unjudged] = rel_gain[grazing_unjudged] = np.nan
     # directions: judged where measurable (the image close to some rendering of the fit),
     # against the session's own spread (systematic errors are shared, a wrong light stands out)
     best = _unit_rows(sols)
@@ -1915,6 +1974,7 @@ def _evidence(
         object_typical,
         rel_gain,
         swap_ratio,
+        grazing_unjudged,
     )
 
 
@@ -1964,6 +2024,16 @@ _GAIN_FIELDS = ("gain", "lit_gain", "reliable_gain", "neighbour_ratio")
 #: Images called dim judged again beside the others scaled back (:func:`_dim_rejudged`), the
 #: nearest to right first: each costs one robust fit of the crop.
 MAX_DIM_REJUDGED = 4
+
+
+def _elevation_over(lt: NDArray, mean_n: NDArray) -> NDArray:
+    """Each light's elevation above the object's mean surface (degrees): grazing is measured
+    from the surface the relief sits on, not the camera's axis (a tilted object's)."""
+    norm = float(np.linalg.norm(mean_n))
+    if norm == 0.0:
+        return np.full(len(lt), 90.0)
+    up = mean_n / norm
+    return np.degrees(np.arcsin(np.clip(lt @ up / np.linalg.norm(lt, axis=1), -1.0, 1.0)))
 
 
 def _dim_rejudged(
