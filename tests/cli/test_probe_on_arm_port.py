@@ -20,7 +20,7 @@ import pytest
 from typer.testing import CliRunner
 
 import rti_rig.app.usecases.probe as probe_usecase
-from rti_rig.app.usecases.probe import ProbeResult
+from rti_rig.app.usecases.probe import Heard, ProbeResult
 from rti_rig.cli import app
 from rti_rig.core.clock import VirtualClock
 from rti_rig.simulator.dynamixel_emulator import arm_settings_of, emulator_for_arm
@@ -30,7 +30,7 @@ DXL2_HEADER = b"\xff\xff\xfd\x00"
 
 
 def test_nothing_answered_says_an_arm_port_as_a_possibility_with_the_command_for_it() -> None:
-    result = ProbeResult("/dev/ttyUSB0", heard=[("listen at 9600 baud", "")])
+    result = ProbeResult("/dev/ttyUSB0", heard=[Heard("listen at 9600 baud", 9600, "")])
     said = " ".join(" ".join(result.lines()).split())
     assert "No known dome firmware answered" in said, said
     assert "If this is a servo arm's port (Dynamixel servos), silence is all probe" in said, said

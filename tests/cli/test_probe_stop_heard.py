@@ -237,3 +237,105 @@ def test_a_stop_between_two_ports_after_nichlocks_banner_names_it_and_does_not_r
     assert "Probe stopped (Ctrl-C): the firmware boots with every LED off" in said, said
     assert 'profile = "nichlock"' in said and "baudrate = 115200" in said, said
     assert _boots(board) == 2, board.events  # 9600, then 115200: not reset a third time
+
+
+# The teardown decides on typed data (each listen's rate in ``Heard.baud``, the lights in
+# ``ProbeResult.lights_state``), not on the words it prints: it had read the rate back out of
+# a listen's label ("at N baud") and cleared an error by how its words began.
+
+
+def test_a_listen_label_without_its_rate_still_names_nichlock_at_its_rate(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The stop between two ports after nichlock's banner at 115200, its listens labelled with
+    no "at N baud" in the words: the firmware is named at the rate its port was open at, and
+    the port is not opened again at 9600 (a reset)."""
+    monkeypatch.setattr(probe_usecase, "_LISTEN_SAID", "listening ({baud} bd)")
+    real_exchange = probe_usecase._exchange
+    stops: list[str] = []
+
+    def then_stopped(result: probe_usecase.ProbeResult, what: str, baud: int, *args: Any) -> str:
+        text = real_exchange(result, what, baud, *args)
+        if not stops and baud == 115200:
+            stops.append(what)
+            raise EmergencyStop("Ctrl-C")
+        return text
+
+    monkeypatch.setattr(probe_usecase, "_exchange", then_stopped)
+    board = board_for("nichlock")
+    code, said = _probe(board, "nichlock")
+    assert code == 130 and stops == ["listening (115200 bd)"], (stops, said)
+    assert "listening (115200 bd):" in said, said  # the reworded label is what is printed
+    assert "Probe stopped (Ctrl-C): the firmware boots with every LED off" in said, said
+    assert 'profile = "nichlock"' in said and "baudrate = 115200" in said, said
+    assert _boots(board) == 2, board.events  # 9600, then 115200: not reset a third time
+
+
+class _NabLine:
+    """A stand-in for the Nab board's open port: each write of the all-off is answered with
+    ``replies``' next (empty: the reply lost)."""
+
+    baudrate = 9600
+
+    def __init__(self, *replies: bytes) -> None:
+        self.replies = list(replies)
+        self.pending = b""
+
+    def write(self, data: bytes) -> None:
+        self.pending += self.replies.pop(0) if self.replies else b""
+
+    def read(self, timeout: float) -> bytes:
+        out, self.pending = self.pending, b""
+        return out
+
+
+#: The Nab sketch's answer to its all-off, as its emulator prints it.
+_OFF_REPLY = b"<UV Turned off.>\n<All lights turned off.>\n"
+
+
+def test_an_acknowledged_all_off_clears_the_unacknowledged_ones_error_whatever_its_words(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """An all-off sent twice unanswered, then (a stop's teardown) once more and acknowledged:
+    its error is cleared however its words are put (they had to begin with the words of
+    ``_NOT_ACKNOWLEDGED``); the labels of the all-offs reworded change only what is printed."""
+    monkeypatch.setattr(probe_usecase, "_ALL_OFF_SAID", "switching off ({command})")
+    monkeypatch.setattr(probe_usecase, "_ALL_OFF_AGAIN_SAID", "once more ({command})")
+    result = probe_usecase.ProbeResult("/dev/ttyACM9")
+    probe_usecase._nab_off(result, _NabLine())  # type: ignore[arg-type]
+    assert result.lights_state is probe_usecase.LightsState.OFF_NOT_ACKNOWLEDGED
+    assert result.error is not None
+    monkeypatch.setattr(probe_usecase, "_NOT_ACKNOWLEDGED", "reworded")
+    probe_usecase._nab_off(result, _NabLine(_OFF_REPLY))  # type: ignore[arg-type]
+    assert result.lights_state is probe_usecase.LightsState.OFF_ACKNOWLEDGED
+    assert result.error is None
+    assert [h.label for h in result.heard] == [
+        "switching off (<0>)",
+        "once more (<0>)",
+        "switching off (<0>)",
+    ]
+    assert all(h.baud == 9600 for h in result.heard)
+
+
+def test_a_stop_after_an_acknowledged_all_off_does_not_reopen_whatever_was_printed(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A stop with no port open after the Nab board acknowledged its all-off: the port is not
+    opened again (a reset, every LED lit once more) whatever the lines heard say, decided on
+    the lights' state (it had searched the transcript for the reply's words)."""
+
+    def reopened(result: probe_usecase.ProbeResult, wait: float) -> Any:
+        raise AssertionError("the port was opened again after an acknowledged all-off")
+
+    monkeypatch.setattr(probe_usecase, "_nab_found", reopened)
+    result = probe_usecase.ProbeResult(
+        "/dev/ttyACM9",
+        profile="nab-rti-v1",
+        baudrate=9600,
+        heard=[probe_usecase.Heard("reworded", 9600, "")],
+        openings=2,
+    )
+    probe_usecase._say_lights(result, probe_usecase.LightsState.OFF_ACKNOWLEDGED)
+    probe_usecase._stopped_between_ports(result, 0.1)
+    assert result.lights_state is probe_usecase.LightsState.OFF_ACKNOWLEDGED
+    assert result.lights == "the sketch boots with every LED on; all-off sent and acknowledged"

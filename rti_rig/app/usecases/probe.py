@@ -28,6 +28,7 @@ import re
 import stat
 import time
 from dataclasses import dataclass, field
+from enum import Enum, auto
 
 from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
 from rti_rig.drivers.led_dome.transport import SerialTransport, TransportError
@@ -41,15 +42,67 @@ class ProbeRequest:
     listen_s: float = 2.6
 
 
+@dataclass(frozen=True)
+class Heard:
+    """What one listen of the probe heard: ``label`` is only said (the line printed before the
+    text); what the probe decides is taken from ``baud`` and ``text``. A stop's teardown had read
+    the rate back out of the label ("at N baud"), so rewording a label changed which firmware
+    it named and whether it reset the board once more."""
+
+    #: What the listen was, as printed ("listen at 9600 baud", "all off <0>" …).
+    label: str
+    #: The rate the port was open at.
+    baud: int
+    #: All the port sent meanwhile.
+    text: str
+
+
+class LightsState(Enum):
+    """What the probe established of the lights, as it decides on it; the words said
+    (:attr:`ProbeResult.lights`) are built from it where it is set (:func:`_say_lights`). The
+    teardown had decided by searching its own transcript and error text for the words of an
+    acknowledgement: rewording a line changed what it did."""
+
+    #: A firmware found whose probes light nothing (the Elexol board's ``?``); the default.
+    NOTHING_LIT = auto()
+    #: Stopped before the port was ever opened.
+    NEVER_OPENED = auto()
+    #: The port could not be opened: nothing was sent.
+    PORT_UNUSABLE = auto()
+    #: The port failed after some probes, none of which lights an LED.
+    PORT_FAILED_AFTER_PROBES = auto()
+    #: The port failed during a stop's teardown: the dome's state is not known.
+    PORT_FAILED_IN_STOP = auto()
+    #: Stopped after an opening (a reset) before any firmware answered.
+    STOPPED_UNANSWERED = auto()
+    #: No firmware answered; a board slow to boot may light after the probe.
+    UNANSWERED = auto()
+    #: nichlock's firmware: it boots with every LED off.
+    BOOTS_DARK = auto()
+    #: minirti: the all-off mask was sent and acknowledged.
+    MASK_ACKNOWLEDGED = auto()
+    #: RTIPy: LED 0 was asked for zero seconds.
+    ZERO_SECONDS = auto()
+    #: The Nab sketch, lit at boot: its all-off was acknowledged.
+    OFF_ACKNOWLEDGED = auto()
+    #: The Nab sketch, lit at boot: its all-off was sent twice, not acknowledged.
+    OFF_NOT_ACKNOWLEDGED = auto()
+    #: The Nab sketch, lit at boot: its all-off could not be sent (the port failed).
+    OFF_NOT_SENT = auto()
+
+
 @dataclass
 class ProbeResult:
     port: str
     profile: str | None = None
     #: The baud rate the firmware answered at (with ``profile``).
     baudrate: int | None = None
-    #: What each probe heard (probe description → text), in the order tried.
-    heard: list[tuple[str, str]] = field(default_factory=list)
+    #: What each probe heard, in the order tried.
+    heard: list[Heard] = field(default_factory=list)
+    #: What is known of the lights, said (built from :attr:`lights_state`).
     lights: str = "nothing was lit by the probe"
+    #: What is known of the lights, decided on.
+    lights_state: LightsState = LightsState.NOTHING_LIT
     error: str | None = None
     #: What else the firmware showed that the user must act on before a check (or None).
     note: str | None = None
@@ -71,9 +124,9 @@ class ProbeResult:
     def heard_lines(self) -> list[str]:
         """What each probe heard, one line each (the end of a long text)."""
         out = []
-        for what, text in self.heard:
-            shown = text.strip().replace("\r", "")[-200:] or "(nothing)"
-            out.append(f"{what}: {shown!r}")
+        for heard in self.heard:
+            shown = heard.text.strip().replace("\r", "")[-200:] or "(nothing)"
+            out.append(f"{heard.label}: {shown!r}")
         return out
 
     def lines(self) -> list[str]:
@@ -204,17 +257,14 @@ def _exchange(
                 t.write(send)
                 _listen(t, listen_s, into=heard)
         text = heard.decode("latin-1")
-        result.heard.append((what, text))
+        result.heard.append(Heard(what, baud, text))
     except EmergencyStop as exc:
-        result.heard.append((f"{what} (stopped)", heard.decode("latin-1")))
+        result.heard.append(Heard(f"{what} (stopped)", baud, heard.decode("latin-1")))
         try:
             _stopped_on_open_port(result, t, baud, opened, wait_s, heard.decode("latin-1"))
         except TransportError as failed:
             result.error = str(failed)
-            result.lights = (
-                f"the port failed while the probe stopped ({failed}): the dome's state is not "
-                "known; look at it"
-            )
+            _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
         raise ProbeStopped(str(exc), result) from None
     except BaseException:
         t.close()
@@ -272,7 +322,7 @@ def _stopped_on_open_port(
             left = opened + _nab_boot_s(wait_s) - time.monotonic()
             _listen(t, max(0.0, left), until=_NAB_READY, into=boot)
         text = boot[len(heard) :].decode("latin-1")
-        result.heard.append(("listening out the board's boot", text))
+        result.heard.append(Heard("listening out the board's boot", baud, text))
         whole = boot.decode("latin-1")  # a banner cut in two by the stop is still one banner
         if _nab_heard(result) or any(says.search(whole) for says in _NAB_SAYS):
             result.profile, result.baudrate = _NAB_NAME, _NAB_BAUD
@@ -282,7 +332,7 @@ def _stopped_on_open_port(
         t.close()
         _reopened_at_nab_rate(result, wait_s)
         return
-    result.lights = STOPPED_UNANSWERED
+    _say_lights(result, LightsState.STOPPED_UNANSWERED)
 
 
 def _nab_boot_s(wait_s: float) -> float:
@@ -296,7 +346,7 @@ def _nab_boot_s(wait_s: float) -> float:
 def _nab_heard(result: ProbeResult) -> bool:
     """Some probe heard the Nab sketch (its banner, its answer to its all-on or to an unknown
     code): the board booted, and it boots with every LED on."""
-    return any(says.search(heard) for _, heard in result.heard for says in _NAB_SAYS)
+    return any(says.search(heard.text) for heard in result.heard for says in _NAB_SAYS)
 
 
 def _stopped_inside_opening(result: ProbeResult, cut: SerialTransport, wait_s: float) -> None:
@@ -309,7 +359,7 @@ def _stopped_inside_opening(result: ProbeResult, cut: SerialTransport, wait_s: f
     115200, 19200 or 2400 the dome was left lit under "look at the dome"). A further signal is
     not raised (the command's handler raises only the first)."""
     if not cut.resets_on_open:
-        result.lights = STOPPED_UNANSWERED
+        _say_lights(result, LightsState.STOPPED_UNANSWERED)
         return
     _reopened_at_nab_rate(result, wait_s)
 
@@ -326,10 +376,7 @@ def _reopened_at_nab_rate(result: ProbeResult, wait_s: float) -> None:
         _stopped_on_open_port(result, t, _NAB_BAUD, time.monotonic(), wait_s)
     except TransportError as failed:
         result.error = str(failed)
-        result.lights = (
-            f"the port failed while the probe stopped ({failed}): the dome's state is not "
-            "known; look at it"
-        )
+        _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
     finally:
         t.close()
 
@@ -393,7 +440,8 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
             if not _NAB_READY.search(booted.decode("latin-1")):
                 left = max(0.0, deadline - time.monotonic())
                 _listen(t, left, until=_NAB_READY, into=booted)
-        result.heard.append((f"the board's boot at {_NAB_BAUD} baud", booted.decode("latin-1")))
+        booted_text = booted.decode("latin-1")
+        result.heard.append(Heard(f"the board's boot at {_NAB_BAUD} baud", _NAB_BAUD, booted_text))
         try:
             _nab_off(result, t)
         except EmergencyStop as exc:
@@ -405,7 +453,7 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
         if stop is None:
             raise  # the probe's own handler says it (the dome may be lit; exit 1)
         result.error = str(exc)
-        result.lights = _nab_not_off(exc)
+        _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
         raise ProbeStopped(str(stop), result) from None
     finally:
         t.close()
@@ -433,21 +481,23 @@ def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
     here: the caller, which holds the open port, finishes the all-off on it."""
     off = ""
     command = _NAB_ALL_OFF.decode("ascii")
-    for what, listen_s in ((f"all off {command}", 0.6), (f"all off {command} again", 1.2)):
+    for what, listen_s in (
+        (_ALL_OFF_SAID.format(command=command), 0.6),
+        (_ALL_OFF_AGAIN_SAID.format(command=command), 1.2),
+    ):
         t.write(_NAB_ALL_OFF)
         off = _listen(t, listen_s, until=_NAB_OFF_SAYS).decode("latin-1")
-        result.heard.append((what, off))
+        result.heard.append(Heard(what, t.baudrate, off))
         if _NAB_OFF_SAYS.search(off):
             break
     if _NAB_OFF_SAYS.search(off):
-        result.lights = "the sketch boots with every LED on; all-off sent and acknowledged"
-        if result.error and result.error.startswith(_NOT_ACKNOWLEDGED):
-            result.error = None  # a first all-off unanswered, this one acknowledged
+        if result.lights_state is LightsState.OFF_NOT_ACKNOWLEDGED:
+            # a first all-off unanswered (its error said), this one acknowledged: decided on
+            # the state, not on how the error's words begin
+            result.error = None
+        _say_lights(result, LightsState.OFF_ACKNOWLEDGED)
         return
-    result.lights = (
-        "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
-        "the dome"
-    )
+    _say_lights(result, LightsState.OFF_NOT_ACKNOWLEDGED)
     # a probe that leaves the lights unconfirmed is no success: it had exited 0 under
     # "Found: nab-rti-v1", the dome lit
     result.error = (
@@ -456,8 +506,53 @@ def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
     )
 
 
-#: How the error of an all-off the Nab sketch did not acknowledge begins.
+#: How the error of an all-off the Nab sketch did not acknowledge begins (said only: whether
+#: a later all-off clears it is decided on :attr:`ProbeResult.lights_state`).
 _NOT_ACKNOWLEDGED = "the Nab sketch did not acknowledge its all-off"
+
+#: The labels of the Nab sketch's all-off and its resending, in the lines heard (said only).
+_ALL_OFF_SAID = "all off {command}"
+_ALL_OFF_AGAIN_SAID = "all off {command} again"
+
+#: The label of a probe that only listens at a rate, in the lines heard (said only: the
+#: teardown takes the rate from :attr:`Heard.baud`).
+_LISTEN_SAID = "listen at {baud} baud"
+
+
+def _stop_failed(failed: TransportError) -> str:
+    """The lights of a probe whose port failed during a stop's teardown."""
+    return (
+        f"the port failed while the probe stopped ({failed}): the dome's state is not "
+        "known; look at it"
+    )
+
+
+#: The words said of each state whose words take nothing from the case.
+_LIGHTS_SAID: dict[LightsState, str] = {
+    LightsState.NOTHING_LIT: "nothing was lit by the probe",
+    LightsState.NEVER_OPENED: "nothing was lit by the probe: it never opened the port",
+    LightsState.PORT_UNUSABLE: "the port could not be used; nothing was sent",
+    LightsState.STOPPED_UNANSWERED: STOPPED_UNANSWERED,
+    LightsState.BOOTS_DARK: "the firmware boots with every LED off; nothing that lights was sent",
+    LightsState.MASK_ACKNOWLEDGED: "the probe sent an all-off mask, acknowledged",
+    LightsState.ZERO_SECONDS: "LED (0, 0) was asked for zero seconds: it stays dark",
+    LightsState.OFF_ACKNOWLEDGED: (
+        "the sketch boots with every LED on; all-off sent and acknowledged"
+    ),
+    LightsState.OFF_NOT_ACKNOWLEDGED: (
+        "the sketch boots with every LED on; all-off sent twice but NOT acknowledged: check "
+        "the dome"
+    ),
+}
+
+
+def _say_lights(result: ProbeResult, state: LightsState, said: str | None = None) -> None:
+    """Set what is known of the lights: ``state``, decided on, and the words said of it
+    (``said``, for a state whose words take the case's details; else its words in
+    :data:`_LIGHTS_SAID`). Both are set together, so that no line says lights the state does
+    not hold."""
+    result.lights_state = state
+    result.lights = _LIGHTS_SAID[state] if said is None else said
 
 
 def _unanswered_lights(wait: float) -> str:
@@ -503,7 +598,7 @@ def _nichlock_found(result: ProbeResult, text: str, baud: int) -> bool:
     if not any(words in text for words in _NICHLOCK_SAYS):
         return False
     result.profile, result.baudrate = "nichlock", baud
-    result.lights = "the firmware boots with every LED off; nothing that lights was sent"
+    _say_lights(result, LightsState.BOOTS_DARK)
     if "Starting Calibration" in text and "For help, press 'h'" not in text:
         # beginDisplay holds the boot in calTouch while the touch screen is uncalibrated: a
         # check then meets the calibration, not the prompt (it says so too)
@@ -534,7 +629,7 @@ def probe(request: ProbeRequest, result: ProbeResult | None = None) -> ProbeResu
 
 def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
     """The teardown of a probe stopped with no port open (before the first, between two)."""
-    if any(_NAB_OFF_SAYS.search(text) for _, text in result.heard):
+    if result.lights_state is LightsState.OFF_ACKNOWLEDGED:
         # its all-off was acknowledged, the stop coming as the port closed after it: reopening
         # would reset the board, lit once more, to switch it off again (``lights`` says it)
         return
@@ -547,7 +642,7 @@ def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
             _nab_found(result, wait)
         except TransportError as exc:
             result.error = str(exc)
-            result.lights = _nab_not_off(exc)
+            _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
     elif result.profile is not None or result.error:
         # the probe had concluded (another firmware found, or the port failed), the stop coming
         # as it returned: its lights stand ("stopped before a firmware answered … look at the
@@ -563,41 +658,33 @@ def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
         # opening (a stop between two ports had left such a board lit under "look at the dome")
         _reopened_at_nab_rate(result, wait)
     elif result.openings:
-        result.lights = STOPPED_UNANSWERED
+        _say_lights(result, LightsState.STOPPED_UNANSWERED)
     else:
-        result.lights = "nothing was lit by the probe: it never opened the port"
+        _say_lights(result, LightsState.NEVER_OPENED)
 
 
 def _heard_another_firmware(result: ProbeResult) -> bool:
     """Some probe's text in ``result.heard`` shows a firmware other than the Nab sketch
     (:func:`_another_firmware_found`, at the rate that probe used), which is then named."""
-    for what, text in result.heard:
-        rate = _RATE_SAID.search(what)
-        if rate and _another_firmware_found(result, text, int(rate.group(1))):
-            return True
-    return False
-
-
-#: The rate in a probe's description (each says "at N baud", as :func:`_probe` writes them).
-_RATE_SAID = re.compile(r"\bat (\d+) baud\b")
+    return any(_another_firmware_found(result, heard.text, heard.baud) for heard in result.heard)
 
 
 def _probe(result: ProbeResult, wait: float) -> ProbeResult:
     """:func:`probe`'s sequence of probes."""
     try:
-        text = _exchange(result, "listen at 9600 baud", 9600, wait, b"", 0)
+        text = _exchange(result, _LISTEN_SAID.format(baud=9600), 9600, wait, b"", 0)
         if _NAB_BANNER.search(text) or _NAB_ALL_ON.search(text):
             return _nab_found(result, wait)
         if _nichlock_found(result, text, 9600):
             return result
-        text = _exchange(result, "listen at 115200 baud", 115200, wait, b"", 0)
+        text = _exchange(result, _LISTEN_SAID.format(baud=115200), 115200, wait, b"", 0)
         if _nichlock_found(result, text, 115200):
             return result
         # nichlock's settings menu (``a``, ``2``) stores 19200 or 2400 too, taken at its next
         # boot: listened for before anything is sent, since bytes at another rate reach such a
         # board as keys of its menus (a board set so had been "No known dome firmware")
         for rate in NICHLOCK_OTHER_RATES:
-            text = _exchange(result, f"listen at {rate} baud", rate, wait, b"", 0)
+            text = _exchange(result, _LISTEN_SAID.format(baud=rate), rate, wait, b"", 0)
             if _nichlock_found(result, text, rate):
                 return result
         text = _exchange(result, "'?' at 38400 baud", 38400, 0.2, b"?", 0.5)
@@ -621,12 +708,12 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             return result
         if text.endswith("\x01"):
             result.profile, result.baudrate = "minirti", 9600
-            result.lights = "the probe sent an all-off mask, acknowledged"
+            _say_lights(result, LightsState.MASK_ACKNOWLEDGED)
             return result
         text = _exchange(result, "'T,0,0,0' at 9600 baud", 9600, wait, b"T,0,0,0", 1.8)
         if "I received: T,0,0,0 the instructionByte was: T" in text:
             result.profile, result.baudrate = "rtipy", 9600
-            result.lights = "LED (0, 0) was asked for zero seconds: it stays dark"
+            _say_lights(result, LightsState.ZERO_SECONDS)
             return result
         if _nab_heard(result):
             # a Nab board slower to boot than a probe's listen (up to the 4 s its profile
@@ -634,23 +721,27 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             # had been shown among the lines heard under "No known dome firmware answered",
             # the dome left lit
             return _nab_found(result, wait)
-        result.lights = _unanswered_lights(wait)
+        _say_lights(result, LightsState.UNANSWERED, _unanswered_lights(wait))
     except TransportError as exc:
         result.error = str(exc)
         if result.profile == _NAB_NAME:
             # it answered, so it booted, and it boots with every LED on
-            result.lights = (
+            _say_lights(
+                result,
+                LightsState.OFF_NOT_SENT,
                 "the sketch boots with every LED on and the all-off could NOT be sent: the dome "
-                "may be fully lit; switch it off at its power supply"
+                "may be fully lit; switch it off at its power supply",
             )
         elif result.heard:
-            sent = ", ".join(what for what, _ in result.heard)
-            result.lights = (
+            sent = ", ".join(heard.label for heard in result.heard)
+            _say_lights(
+                result,
+                LightsState.PORT_FAILED_AFTER_PROBES,
                 f"the port failed after these probes ({sent}); none of them lights an LED on "
-                "the firmwares known, but the dome's state is not known"
+                "the firmwares known, but the dome's state is not known",
             )
         else:
-            result.lights = "the port could not be used; nothing was sent"
+            _say_lights(result, LightsState.PORT_UNUSABLE)
             result.not_serial = _not_a_serial_port(result.port, exc)
     return result
 
