@@ -72,7 +72,8 @@ from rti_rig.app.usecases.scheduler_probe import (
     unreachable_scheduler,
 )
 from rti_rig.app.usecases.worker_code import (
-    UNKNOWN,
+    Unasked,
+    WorkerCode,
     describe,
     local_identity,
     worker_identities,
@@ -222,8 +223,10 @@ def _refuse_other_code(client: Any, address: str) -> None:
     is sent (:mod:`rti_rig.app.usecases.worker_code` says why)."""
     workers = worker_identities(client)
     mine = local_identity()
-    untold = {w: ident for w, ident in workers.items() if ident[0] == UNKNOWN}
-    differ = {w: ident for w, ident in workers.items() if ident != mine and w not in untold}
+    untold = {w: ident for w, ident in workers.items() if isinstance(ident, Unasked)}
+    differ = {
+        w: ident for w, ident in workers.items() if isinstance(ident, WorkerCode) and ident != mine
+    }
     if differ:
         named = "; ".join(f"{w} ({describe(ident)})" for w, ident in sorted(differ.items()))
         raise SchedulerError(
@@ -235,7 +238,7 @@ def _refuse_other_code(client: Any, address: str) -> None:
             "command"
         )
     if untold:
-        named = "; ".join(f"{w} ({why})" for w, (_, why) in sorted(untold.items()))
+        named = "; ".join(f"{w} ({why.reason})" for w, why in sorted(untold.items()))
         raise SchedulerError(
             f"{len(untold)} of the {len(workers)} workers of the Dask cluster at {address!r} "
             f"could not be asked which rti-rig they run: {named}. Nothing was sent: check "

@@ -9,63 +9,143 @@ code is compared before any task is sent.
 
 The function run on the workers is built by :func:`_identity_function` as a nested function,
 which ``cloudpickle`` sends by value: a worker reads it with the standard library alone,
-whatever rti-rig it has (or none), and it imports that worker's own ``rti_rig``.
+whatever rti-rig it has (or none), and it imports that worker's own ``rti_rig``. It answers
+with a plain dict (a class of this module would need this module on the worker), turned into
+a :class:`WorkerCode` here.
+
+The fingerprint covers every package rti-rig installs, not only the ``rti_rig/`` folder:
+``rti_rig.drivers``, ``.planner``, ``.simulator`` and ``.rig_configs`` come from top-level
+folders of the checkout (pyproject's package-dir mapping), so in an editable install they are
+not under ``rti_rig/`` at all, and in a wheel they are. Each package's files are keyed by the
+package's dotted name and their path inside it, so the same code gives the same fingerprint
+wherever and however it is laid out.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
-#: What a worker whose identity could not be taken reports instead of a version.
-UNKNOWN = "?"
+#: The packages rti-rig installs whose folders are not inside ``rti_rig/`` in a checkout
+#: (pyproject's ``[tool.setuptools.package-dir]``; a test holds the two equal). An editable
+#: install's finder maps them, so they cannot be found by listing ``rti_rig``'s folder.
+MAPPED_PACKAGES: tuple[str, ...] = (
+    "rti_rig.drivers",
+    "rti_rig.planner",
+    "rti_rig.simulator",
+    "rti_rig.rig_configs",
+)
+
+#: The files a wheel ships (code and the rig configs' package data): stray files of a
+#: checkout (editor backups, caches) would otherwise tell an editable install from a wheel.
+FINGERPRINTED_SUFFIXES: tuple[str, ...] = (".py", ".toml", ".lp")
 
 
-def _identity_function() -> Callable[[], tuple[str, str]]:
-    """The function that reports ``(rti_rig.__version__, fingerprint of its source)`` of the
-    process it runs in. Nested, so that it is pickled by value (see the module's note); it
-    refers to no global of this module."""
+@dataclass(frozen=True)
+class WorkerCode:
+    """Which rti-rig a process runs: its ``__version__`` (``None`` when it declares none), the
+    fingerprint of its installed files, or the ``problem`` that kept rti-rig from importing
+    there (then neither of the others is known)."""
 
-    def rti_rig_identity() -> tuple[str, str]:
+    version: str | None
+    fingerprint: str | None
+    problem: str | None = None
+
+
+@dataclass(frozen=True)
+class Unasked:
+    """A worker whose check failed there (an error returned in its answer's place): which
+    rti-rig it runs is not known, so it is not called another one."""
+
+    reason: str
+
+
+def _identity_function(
+    mapped: tuple[str, ...] = MAPPED_PACKAGES, suffixes: tuple[str, ...] = FINGERPRINTED_SUFFIXES
+) -> Callable[[], dict[str, str | None]]:
+    """The function that reports, as a plain dict of :class:`WorkerCode`'s fields, the rti-rig
+    of the process it runs in. Nested, so that it is pickled by value (see the module's note);
+    it refers to no global of this module (``mapped`` and ``suffixes`` travel with it)."""
+
+    def rti_rig_identity() -> dict[str, str | None]:
         import hashlib
+        import importlib.util
         from pathlib import Path
 
         try:
             import rti_rig
         except Exception as exc:  # a worker without rti-rig says so
-            return ("not installed", f"{type(exc).__name__}: {exc}")
-        root = Path(rti_rig.__file__).resolve().parent
+            return {"version": None, "fingerprint": None, "problem": f"{type(exc).__name__}: {exc}"}
+        roots = ("rti_rig", *mapped)
+        folders: dict[str, Path | None] = {}
+        for name in roots:
+            spec = importlib.util.find_spec(name)
+            places = list(spec.submodule_search_locations or []) if spec else []
+            folders[name] = Path(places[0]).resolve() if places else None
+        # In a wheel the mapped packages sit inside rti_rig/: each is hashed under its own name.
+        nested = {folder for name, folder in folders.items() if name != "rti_rig" and folder}
         digest = hashlib.sha256()
-        for path in sorted(root.rglob("*.py")):
-            digest.update(path.relative_to(root).as_posix().encode() + b"\0")
-            digest.update(path.read_bytes() + b"\0")
-        return (str(getattr(rti_rig, "__version__", "?")), digest.hexdigest()[:12])
+        for name in roots:
+            folder = folders[name]
+            digest.update(f"package {name}\0".encode())
+            if folder is None:
+                digest.update(b"missing\0")
+                continue
+            files = []
+            for path in folder.rglob("*"):
+                if (
+                    path.is_file()
+                    and path.suffix in suffixes
+                    and "__pycache__" not in path.parts
+                    and not any(parent in nested for parent in path.parents if parent != folder)
+                ):
+                    files.append((path.relative_to(folder).as_posix(), path))
+            for relative, path in sorted(files):
+                digest.update(relative.encode() + b"\0")
+                digest.update(path.read_bytes() + b"\0")
+        version = getattr(rti_rig, "__version__", None)
+        return {
+            "version": None if version is None else str(version),
+            "fingerprint": digest.hexdigest()[:12],
+            "problem": None,
+        }
 
     return rti_rig_identity
 
 
+def _as_worker_code(answer: Mapping[str, Any]) -> WorkerCode:
+    """A worker's plain answer as the typed value (missing fields read as unknown)."""
+
+    def field(key: str) -> str | None:
+        value = answer.get(key)
+        return None if value is None else str(value)
+
+    return WorkerCode(field("version"), field("fingerprint"), field("problem"))
+
+
 @lru_cache(maxsize=1)
-def local_identity() -> tuple[str, str]:
-    """This process's ``(version, code fingerprint)``, computed once per process."""
-    return _identity_function()()
+def local_identity() -> WorkerCode:
+    """This process's rti-rig, computed once per process."""
+    return _as_worker_code(_identity_function()())
 
 
-def worker_identities(client: Any) -> dict[str, tuple[str, str]]:
-    """Each worker's ``(version, code fingerprint)``, computed on the worker itself."""
+def worker_identities(client: Any) -> dict[str, WorkerCode | Unasked]:
+    """Each worker's rti-rig, computed on the worker itself (or why it could not be)."""
     answers: Mapping[str, Any] = client.run(_identity_function(), on_error="return")
-    identities = {}
+    identities: dict[str, WorkerCode | Unasked] = {}
     for worker, answer in answers.items():
-        if isinstance(answer, tuple) and len(answer) == 2:
-            identities[worker] = (str(answer[0]), str(answer[1]))
+        if isinstance(answer, Mapping):
+            identities[worker] = _as_worker_code(answer)
         else:  # the function failed there: an exception returned in its place
-            identities[worker] = (UNKNOWN, f"{type(answer).__name__}: {answer}")
+            identities[worker] = Unasked(f"{type(answer).__name__}: {answer}")
     return identities
 
 
-def describe(identity: tuple[str, str]) -> str:
+def describe(code: WorkerCode) -> str:
     """``rti-rig 0.1.0, code 1a2b3c4d5e6f`` (or what kept it from being known)."""
-    version, code = identity
-    if version == "not installed":
-        return f"no rti-rig ({code})"
-    return f"rti-rig {version}, code {code}"
+    if code.problem is not None:
+        return f"no rti-rig ({code.problem})"
+    version = "(no version)" if code.version is None else code.version
+    return f"rti-rig {version}, code {code.fingerprint}"
