@@ -245,7 +245,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
 ) -> None:
     """The body of :func:`fit`, run under its stop handling (``written`` gets True once every
     output is written)."""
-    from rti_rig.app.usecases.fit import FitRequest, refuse_out_inside_a_session, run_fit
+    from rti_rig.app.usecases.fit import FitRequest, run_fit
     from rti_rig.app.usecases.fit_batch import Outcome, run_batch
     from rti_rig.reconstruct.registry import model_spec
 
@@ -276,9 +276,6 @@ def _fit_command(  # type: ignore[no-untyped-def]
             hsh_order=hsh_order,
         )
         if len(sources) > 1:
-            # the batch's root as given, refused whole (each session's fit would be refused
-            # by run_fit, naming its partial folder)
-            refuse_out_inside_a_session(out_dir)
             if scheduler is None:
                 items = run_batch(sources, out_dir, request)
             else:

@@ -30,3 +30,33 @@ def test_a_fit_or_a_batch_into_a_session_folder_is_refused_as_run_refuses_one(
         assert f"--out {session / 'fitout'} is inside {session}, a session folder" in said, said
         assert ADVICE in said and "Traceback" not in said
         assert not (session / "fitout").exists()
+
+
+def test_every_caller_of_a_batch_gets_the_refusal_before_anything_is_done(tmp_path: Path) -> None:
+    """The batch use cases refuse a root inside a session themselves (only the command line
+    had, so another caller made the batch folder inside the session and had each session's fit
+    refused there); with a scheduler, before the cluster is reached."""
+    import pytest
+
+    from rti_rig.app.usecases.fit import FitRequest
+    from rti_rig.app.usecases.fit_batch import run_batch
+    from rti_rig.app.usecases.fit_dask import run_batch_dask
+    from rti_rig.core.errors import RtiRigError
+
+    session = tmp_path / "demo"
+    r = runner.invoke(app, ["run", str(ACQ / "dirs.lp"), "--out", str(session), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    root = session / "fitout"
+    sources = [session, ACQ / "dirs.lp"]
+    template = FitRequest(session, root, model="ps", qa=False)
+    unreachable = "tcp://127.0.0.1:9"  # never contacted: the refusal comes first
+    for run in (
+        lambda: run_batch(sources, root, template),
+        lambda: run_batch_dask(sources, root, template),
+        lambda: run_batch_dask(sources, root, template, unreachable),
+    ):
+        with pytest.raises(RtiRigError, match="a session folder") as refused:
+            run()
+        assert f"--out {root} is inside {session}" in str(refused.value)
+        assert ADVICE in str(refused.value)
+        assert not root.exists()

@@ -21,6 +21,7 @@ from rti_rig.app.usecases.fit import (
     FitInputError,
     FitRequest,
     acquisition_inputs,
+    refuse_out_inside_a_session,
     run_fit,
 )
 from rti_rig.app.usecases.fit_inputs import (
@@ -102,7 +103,12 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
     removes and redoes. A session that fails is
     reported and the batch goes on. (:func:`rti_rig.app.usecases.fit_dask.run_batch_dask` runs
     the same :func:`fit_one` per session as parallel tasks on a Dask cluster.)
+
+    A ``root`` inside a session folder is refused first, as given, here rather than by each
+    caller (each session's fit would be refused by :func:`run_fit` too, but once per session,
+    naming its partial folder, after the batch folder was made inside the session).
     """
+    refuse_out_inside_a_session(root)
     plan_batch(sources, root)
     return [fit_one(source, root, template) for source in sources]
 

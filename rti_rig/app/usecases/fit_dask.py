@@ -46,6 +46,7 @@ from rti_rig.app.usecases.fit import (
     FitResult,
     acquisition_files,
     read_image,
+    refuse_out_inside_a_session,
     run_fit,
 )
 from rti_rig.app.usecases.fit_bands import (
@@ -444,7 +445,9 @@ def run_batch_dask(
 ) -> list[BatchItem]:
     """A resumable batch (see :func:`rti_rig.app.usecases.fit_batch.run_batch`) on Dask: with
     :data:`THREADS`, sessions one after another with their bands in threads; on a cluster,
-    every unfinished session a task of its own (run in parallel across the workers)."""
+    every unfinished session a task of its own (run in parallel across the workers). A
+    ``root`` inside a session folder is refused before the cluster is reached."""
+    refuse_out_inside_a_session(root)  # as given, as run_batch does
     if scheduler == THREADS:
         plan_batch(sources, root)
         return [fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources]
