@@ -1366,9 +1366,14 @@ def _known_pixels(path: Path) -> str | None:
     return known[1] if known is not None and known[0] == _identity(st) else None
 
 
-def _sha256(path: Path) -> str | None:
+def file_sha256(path: Path) -> str | None:
     """SHA-256 of the file at ``path`` (None if it is not a file), read in chunks; a file this
-    process wrote or hashed and that has not changed since is not read again."""
+    process wrote or hashed and that has not changed since is not read again.
+
+    The one checksum cache of a process: the session's integrity check and a batch's judgement
+    of an earlier fit (:func:`rti_rig.app.usecases.fit_batch.earlier_fit`) share it, keyed by
+    the resolved path and the file's :func:`_identity` (a batch had kept a second cache of its
+    own, keyed by path, size and mtime alone, and read files the session had just hashed)."""
     try:
         st = path.stat()
         key = str(path.resolve())
@@ -1377,14 +1382,11 @@ def _sha256(path: Path) -> str | None:
     known = _KNOWN_DIGESTS.get(key)
     if known is not None and known[0] == _identity(st):
         return known[1]
-    h = hashlib.sha256()
     try:
         with open(path, "rb") as fh:
-            for chunk in iter(lambda: fh.read(1 << 22), b""):
-                h.update(chunk)
+            digest = hashlib.file_digest(fh, "sha256").hexdigest()
     except (FileNotFoundError, IsADirectoryError):
         return None
-    digest = h.hexdigest()
     _know(key, _identity(st), digest)
     return digest
 
@@ -1399,7 +1401,7 @@ def _as_captured(root: Path, rec: dict[str, Any], name: str, digest: str | None)
     pixels = (rec.get("pixels_sha256") or {}).get(name)
     if pixels is not None and name == rec.get("linear_image") and _known_pixels(path) == pixels:
         return True  # this process read the very pixels captured (a fit, as it went through)
-    if _sha256(path) == digest:
+    if file_sha256(path) == digest:
         return True
     if pixels is None or name != rec.get("linear_image") or not path.is_file():
         return False
@@ -2708,7 +2710,7 @@ def checksum_session_files(
                 return
             if pixels.get(name) and (root / name).resolve() in skipped:
                 continue  # its pixel checksum is taken as the caller reads it
-            _sha256(root / name)
+            file_sha256(root / name)
 
 
 def tiff_check_note(root: Path) -> str:
@@ -3160,7 +3162,7 @@ def renamed_jpegs(
                 or not path.is_file()
             ):
                 continue
-            name = wanted.get(_sha256(path) or "")
+            name = wanted.get(file_sha256(path) or "")
             if name is not None and name not in found:
                 found[name] = rel
     return found

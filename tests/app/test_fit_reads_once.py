@@ -46,7 +46,7 @@ def fresh_copy(src: Path, dest: Path) -> Path:
 def read_whole(path: Path, monkeypatch: pytest.MonkeyPatch) -> list[str]:
     """Record the files the session's integrity check reads whole from now on."""
     read: list[str] = []
-    sha, pixels = session_module._sha256, session_module.tiff_pixels_sha256
+    sha, pixels = session_module.file_sha256, session_module.tiff_pixels_sha256
 
     def counted_sha(p: Path) -> str | None:
         read.append(Path(p).relative_to(path).as_posix())
@@ -56,7 +56,7 @@ def read_whole(path: Path, monkeypatch: pytest.MonkeyPatch) -> list[str]:
         read.append(Path(p).relative_to(path).as_posix())
         return pixels(p)
 
-    monkeypatch.setattr(session_module, "_sha256", counted_sha)
+    monkeypatch.setattr(session_module, "file_sha256", counted_sha)
     monkeypatch.setattr(session_module, "tiff_pixels_sha256", counted_pixels)
     return read
 

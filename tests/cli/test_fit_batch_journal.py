@@ -139,12 +139,13 @@ def counting_reads(monkeypatch: pytest.MonkeyPatch) -> list[Path]:
     import tifffile
 
     from rti_rig.app.usecases import fit_batch
+    from rti_rig.runtime import session as session_module
 
     read: list[Path] = []
     real_plan = fit_batch.plan_batch
 
     def plan(*args: Any, **kwargs: Any) -> Any:  # a batch begins
-        monkeypatch.setattr(fit_batch, "_HASHED", {})
+        monkeypatch.setattr(session_module, "_KNOWN_DIGESTS", {})
         return real_plan(*args, **kwargs)
 
     monkeypatch.setattr(fit_batch, "plan_batch", plan)

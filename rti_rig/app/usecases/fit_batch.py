@@ -34,7 +34,7 @@ from rti_rig.app.usecases.fit_inputs import (
 )
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import refuse_a_file_in_the_way
-from rti_rig.runtime.session import JOURNAL
+from rti_rig.runtime.session import JOURNAL, file_sha256
 
 
 class Outcome(Enum):
@@ -423,27 +423,16 @@ def _journal_gone(source: Path) -> str:
     return f"its session's journal {journal} {state} since the earlier fit"
 
 
-#: Files hashed by this process, by (path, size, mtime_ns): a batch judges each session twice
-#: (plan_batch, then fit_one), and an image whose size or time changed had been read twice.
-_HASHED: dict[tuple[str, int, int], str] = {}
-
-
 def _file_sha256(path: Path | None) -> str | None:
-    """The sha256 of the file at ``path``, read in chunks, or None when it cannot be read; a
-    file this process hashed is not read again while its size and time are unchanged."""
-    import hashlib
-
+    """The sha256 of the file at ``path`` (:func:`rti_rig.runtime.session.file_sha256`: one
+    cache per process, so a session judged twice, by plan_batch and by fit_one, is read once),
+    or None when it cannot be read."""
     if path is None:
         return None
     try:
-        st = path.stat()
-        key = (str(path), st.st_size, st.st_mtime_ns)
-        if key not in _HASHED:
-            with path.open("rb") as fh:
-                _HASHED[key] = hashlib.file_digest(fh, "sha256").hexdigest()
+        return file_sha256(path)
     except OSError:
         return None
-    return _HASHED[key]
 
 
 def fit_one(
