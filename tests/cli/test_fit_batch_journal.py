@@ -217,3 +217,36 @@ def test_a_session_copied_without_its_times_is_read_once(
     assert said(r).count("skipped (finished earlier)") == 2, r.output
     assert read == []
     assert [p.name for p in (fb / "S").iterdir() if p.name.startswith(".")] == []
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_judging_an_earlier_fit_writes_nothing_and_a_batch_keeps_its_update_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``earlier_fit`` is a question: it had rewritten fit.json itself, from whichever of a
+    batch's up to three askers of a session came first. The update it found is returned, and
+    the batch keeps it once."""
+    from rti_rig.app.usecases import fit_batch
+
+    s, t, fb = fitted(tmp_path)
+    for image in (s / "linear").glob("*.tif"):
+        later(image)  # new times, the same bytes: a hash confirms them
+    fit_json = fb / "S" / "fit.json"
+    before = fit_json.read_bytes()
+    earlier = fit_batch.earlier_fit(fb / "S", s)
+    assert earlier.stands and earlier.confirmed is not None
+    assert fit_json.read_bytes() == before  # asked, not written
+
+    kept: list[Path] = []
+    real = fit_batch._keep_record
+
+    def counted(path: Path, summary: Any, record: Any) -> None:
+        kept.append(path)
+        real(path, summary, record)
+
+    monkeypatch.setattr(fit_batch, "_keep_record", counted)
+    r = batch(s, t, out=fb)
+    assert r.exit_code == 0 and said(r).count("skipped (finished earlier)") == 2, r.output
+    assert kept == [fit_json]
+    assert fit_batch.earlier_fit(fb / "S", s).confirmed is None  # the record is up to date

@@ -11,7 +11,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 from typing import Any
@@ -161,7 +161,9 @@ def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
 
 def plan_batch(sources: list[Path], root: Path) -> list[Path]:
     """The sources of a batch still to fit (their output folder does not exist), after removing
-    the partial folders a killed run left for them. Refuses two sources with one output name."""
+    the partial folders a killed run left for them, and keeping each earlier fit's record a
+    hash brought up to date (:func:`keep_confirmed`). Refuses two sources with one output
+    name."""
     import shutil
 
     by_name: dict[str, list[Path]] = {}
@@ -207,7 +209,9 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
             # another batch's attempt, running now into the same --out, is left to it
             if partial not in keep and owner_gone(partial, mine_too=True):
                 shutil.rmtree(partial, ignore_errors=True)
-        if not earlier_fit(final, source).stands:
+        earlier = earlier_fit(final, source)
+        keep_confirmed(earlier)  # once, here: the later askers find the record up to date
+        if not earlier.stands:
             todo.append(source)
     return todo
 
@@ -299,6 +303,15 @@ FINISHED_EARLIER = " (finished earlier)"
 
 
 @dataclass(frozen=True)
+class RecordUpdate:
+    """A fit's ``fit.json`` (``summary``) with its inputs record to be replaced by ``record``."""
+
+    fit_json: Path
+    summary: dict[str, Any]
+    record: dict[str, Any]
+
+
+@dataclass(frozen=True)
 class EarlierFit:
     """What a batch finds of a session's earlier fit (:func:`earlier_fit`)."""
 
@@ -308,6 +321,9 @@ class EarlierFit:
     outgrown: str | None = None
     #: what a skip says after "skipped (finished earlier)"
     note: str = ""
+    #: the earlier fit's record brought up to date with the images a hash confirmed unchanged
+    #: (new sizes or times, e.g. a copy), for the caller to keep (:func:`keep_confirmed`)
+    confirmed: RecordUpdate | None = field(default=None, compare=False)
 
     @property
     def stands(self) -> bool:
@@ -323,7 +339,10 @@ class EarlierFit:
 def earlier_fit(final: Path, source: Path) -> EarlierFit:
     """Whether ``final`` holds an earlier fit of ``source``, and whether it stands: not when
     its session changed since that fit (its ``fit.json`` records what it was made from,
-    :func:`acquisition_inputs`; ``outgrown`` says how).
+    :func:`acquisition_inputs`; ``outgrown`` says how). It writes nothing: a record that
+    hashes confirmed is returned as ``confirmed`` for the caller to keep once
+    (:func:`keep_confirmed`; it had been written by whichever of the up to three askers of a
+    session came first).
 
     Why: only the folder's existence was checked, so a session fitted while interrupted and
     then continued with ``run --resume`` (or mended with ``--reshoot-lost``) kept its
@@ -369,16 +388,27 @@ def earlier_fit(final: Path, source: Path) -> EarlierFit:
         lambda name: _tiff_pixels(files.get(name)),
         confirmed,
     )
+    update = None
     if changed is None and confirmed:
-        _keep_record(final / "fit.json", summary, confirmed_update(record, confirmed))
+        update = RecordUpdate(final / "fit.json", summary, confirmed_update(record, confirmed))
     if lost:
         how = "judged by its images' sizes and modification times"
         if changed is None:
-            return EarlierFit(True, note=f"; {_journal_gone(source)}: {how}, which match the fit")
+            note = f"; {_journal_gone(source)}: {how}, which match the fit"
+            return EarlierFit(True, note=note, confirmed=update)
         return EarlierFit(True, f"{_journal_gone(source)}; {how}: {changed}")
     if changed is None:
-        return EarlierFit(found=True)
+        return EarlierFit(found=True, confirmed=update)
     return EarlierFit(True, f"its session changed since the earlier fit: {changed}")
+
+
+def keep_confirmed(earlier: EarlierFit) -> None:
+    """Keep the record :func:`earlier_fit` brought up to date, if any, in its ``fit.json``, so
+    that the next batch need not hash those images again (a session copied without its
+    times had been read in full on every batch)."""
+    if earlier.confirmed is not None:
+        update = earlier.confirmed
+        _keep_record(update.fit_json, update.summary, update.record)
 
 
 def _keep_record(path: Path, summary: dict[str, Any], record: dict[str, Any]) -> None:
