@@ -250,3 +250,26 @@ def test_judging_an_earlier_fit_writes_nothing_and_a_batch_keeps_its_update_once
     assert r.exit_code == 0 and said(r).count("skipped (finished earlier)") == 2, r.output
     assert kept == [fit_json]
     assert fit_batch.earlier_fit(fb / "S", s).confirmed is None  # the record is up to date
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_a_batch_judges_each_standing_earlier_fit_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """What plan_batch found of a session's earlier fit is handed to fit_one, which had judged
+    the session again (its record read, its images stat-ed or hashed) to skip it."""
+    from rti_rig.app.usecases import fit_batch
+
+    s, t, fb = fitted(tmp_path)
+    asked: list[Path] = []
+    real = fit_batch.earlier_fit
+
+    def counted(final: Path, source: Path) -> Any:
+        asked.append(source)
+        return real(final, source)
+
+    monkeypatch.setattr(fit_batch, "earlier_fit", counted)
+    r = batch(s, t, out=fb)
+    assert r.exit_code == 0 and said(r).count("skipped (finished earlier)") == 2, r.output
+    assert sorted(asked) == [s, t]

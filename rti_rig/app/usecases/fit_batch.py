@@ -109,8 +109,8 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
     naming its partial folder, after the batch folder was made inside the session).
     """
     refuse_out_inside_a_session(root)
-    plan_batch(sources, root)
-    return [fit_one(source, root, template) for source in sources]
+    plan = plan_batch(sources, root)
+    return [fit_one(source, root, template, earlier=plan[source]) for source in sources]
 
 
 def partial_folders(root: Path, name: str) -> list[Path]:
@@ -159,11 +159,15 @@ def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
     return False
 
 
-def plan_batch(sources: list[Path], root: Path) -> list[Path]:
-    """The sources of a batch still to fit (their output folder does not exist), after removing
-    the partial folders a killed run left for them, and keeping each earlier fit's record a
-    hash brought up to date (:func:`keep_confirmed`). Refuses two sources with one output
-    name."""
+def plan_batch(sources: list[Path], root: Path) -> dict[Path, EarlierFit]:
+    """What a batch finds of each source's earlier fit (:func:`earlier_fit`; the sources still
+    to fit are those whose fit does not stand), after removing the partial folders a killed
+    run left for them, and keeping each earlier fit's record a hash brought up to date
+    (:func:`keep_confirmed`). Refuses two sources with one output name.
+
+    Why the judgements and not only the sources to fit: :func:`fit_one` and the Dask batch's
+    report of a skipped session had judged each session again (reading its record and
+    stat-ing, or hashing, its images) to find what this had just found."""
     import shutil
 
     by_name: dict[str, list[Path]] = {}
@@ -193,7 +197,7 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
             f"--out {root}: cannot create the batch folder ({exc.strerror or exc}); choose a "
             "folder you can write to"
         ) from None
-    todo = []
+    plan: dict[Path, EarlierFit] = {}
     for source in sources:
         final = batch_out_dir(root, source)
         # a finished session's too: a Dask worker killed mid-session leaves its attempt's
@@ -209,11 +213,9 @@ def plan_batch(sources: list[Path], root: Path) -> list[Path]:
             # another batch's attempt, running now into the same --out, is left to it
             if partial not in keep and owner_gone(partial, mine_too=True):
                 shutil.rmtree(partial, ignore_errors=True)
-        earlier = earlier_fit(final, source)
-        keep_confirmed(earlier)  # once, here: the later askers find the record up to date
-        if not earlier.stands:
-            todo.append(source)
-    return todo
+        plan[source] = earlier_fit(final, source)
+        keep_confirmed(plan[source])  # once, here: a later asker finds the record up to date
+    return plan
 
 
 def earlier_backups(root: Path, name: str) -> list[Path]:
@@ -466,13 +468,22 @@ def _file_sha256(path: Path | None) -> str | None:
 
 
 def fit_one(
-    source: Path, root: Path, template: FitRequest, bands: BandRunner | None = None
+    source: Path,
+    root: Path,
+    template: FitRequest,
+    bands: BandRunner | None = None,
+    earlier: EarlierFit | None = None,
 ) -> BatchItem:
     """One session of a batch: fitted into a partial folder of its own (unique per attempt, so
     that a retried or orphaned attempt never writes into another's), renamed to
     :func:`batch_out_dir` when complete. If another attempt finished first, its folder stands
     and this one's is discarded. Runs in this process or as a task on a Dask worker; ``bands``
-    as for :func:`run_fit`."""
+    as for :func:`run_fit`.
+
+    ``earlier``: what :func:`plan_batch` found of the session's earlier fit. A fit it found
+    standing is skipped without judging it again; any other finding is judged again here, as
+    another batch into the same ``--out`` may have finished the session since (and a swap
+    finished here puts another fit in place)."""
     import os
     import shutil
     import uuid
@@ -481,7 +492,8 @@ def fit_one(
     final = batch_out_dir(root, source)
     swapped = finish_swap(root, final)
     said = (swapped,) if swapped else ()
-    earlier = earlier_fit(final, source)
+    if swapped or earlier is None or not earlier.stands:
+        earlier = earlier_fit(final, source)
     outgrown = earlier.outgrown
     if earlier.stands:
         return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail, notes=said)

@@ -58,6 +58,7 @@ from rti_rig.app.usecases.fit_bands import (
 )
 from rti_rig.app.usecases.fit_batch import (
     BatchItem,
+    EarlierFit,
     Outcome,
     batch_out_dir,
     earlier_fit,
@@ -449,8 +450,11 @@ def run_batch_dask(
     ``root`` inside a session folder is refused before the cluster is reached."""
     refuse_out_inside_a_session(root)  # as given, as run_batch does
     if scheduler == THREADS:
-        plan_batch(sources, root)
-        return [fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources]
+        plan = plan_batch(sources, root)
+        return [
+            fit_one(s, root, template, bands=dask_bands(None, THREADS, s), earlier=plan[s])
+            for s in sources
+        ]
     # Absolute, as workers do not share this process's working directory, but not resolved:
     # ``resolve()`` followed a symlinked session folder, so its output was named after the
     # link's target (OUT/s1 for sess/coin_day2 -> s1, OUT/coin_day2 without Dask, so a rerun
@@ -460,7 +464,7 @@ def run_batch_dask(
     sources = [a for a, _ in given]
     root = root.resolve()
     with scheduler_client(scheduler) as client:
-        todo = set(plan_batch(sources, root))  # refuses a source given twice, as without Dask
+        plan = plan_batch(sources, root)  # refuses a source given twice, as without Dask
         threads = blas_threads()
         # A source missing here too is the user's typo, not the workers' filesystem: it is
         # refused here in the words of the batch without Dask ("does not exist: give a session
@@ -468,10 +472,10 @@ def run_batch_dask(
         with _gathers_watched(client) as watch:
             futures = {
                 s: watch.track(client.submit(_fit_one_task, s, root, template, threads, pure=False))
-                for s in todo
-                if s.exists()
+                for s, earlier in plan.items()
+                if not earlier.stands and s.exists()
             }
-            items = _batch_results(client, scheduler, sources, given, root, template, todo, futures)
+            items = _batch_results(client, scheduler, sources, given, root, template, plan, futures)
         return [replace(item, source=g) for item, (_, g) in zip(items, given, strict=True)]
 
 
@@ -482,18 +486,19 @@ def _batch_results(
     given: list[tuple[Path, Path]],
     root: Path,
     template: FitRequest,
-    todo: set[Path],
+    plan: dict[Path, EarlierFit],
     futures: dict[Path, Any],
 ) -> list[BatchItem]:
-    """Each session's item of a batch on a cluster, in the order given, as its task ends."""
+    """Each session's item of a batch on a cluster, in the order given, as its task ends
+    (a skipped session's in the words of ``plan``, :func:`plan_batch`'s findings)."""
     items = []
     for s in sources:
-        if s in todo and s not in futures:
+        if not plan[s].stands and s not in futures:
             items.append(fit_one(s, root, template))  # fails at once, naming the path
             continue
         if s not in futures:
             out = batch_out_dir(root, s)
-            items.append(BatchItem(s, out, Outcome.SKIPPED, earlier_fit(out, s).skip_detail))
+            items.append(BatchItem(s, out, Outcome.SKIPPED, plan[s].skip_detail))
             continue
         try:
             items.append(futures[s].result())
