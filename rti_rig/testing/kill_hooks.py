@@ -157,14 +157,15 @@ def _hold_before_fit_json(k: int) -> None:
 
 def _die_in_refit_swap(k: int, die: Callable[[], None]) -> None:
     """Die right after the ``k``-th rename that sets a batch's earlier fit aside."""
-    from rti_rig.app.usecases import fit_batch
+    from rti_rig.app.usecases.fit_attempts import AttemptFolder, Kind
 
     real_rename = Path.rename
     renamed = [0]
 
     def rename(self: Path, target: Any) -> Path:
         result = real_rename(self, target)
-        if Path(target).name.endswith(fit_batch.EARLIER_SUFFIX):
+        attempt = AttemptFolder.parse(Path(target).name)
+        if attempt is not None and attempt.kind is Kind.EARLIER:
             if renamed[0] == k:
                 die()
             renamed[0] += 1

@@ -24,6 +24,7 @@ from rti_rig.app.usecases.fit import (
     refuse_out_inside_a_session,
     run_fit,
 )
+from rti_rig.app.usecases.fit_attempts import AttemptFolder, Kind
 from rti_rig.app.usecases.fit_inputs import (
     INPUTS_KEY,
     change_since,
@@ -115,24 +116,23 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
 
 def partial_folders(root: Path, name: str) -> list[Path]:
     """The partial folders of the session whose output is ``root/name`` (``.NAME.PID-ID.partial``,
-    or ``.NAME.partial`` of older runs). Matched exactly, not by a glob: ``.s1.*partial`` also
-    matched session ``s1.x``'s ``.s1.x.PID-ID.partial``, which a batch may be fitting."""
-    import re
+    or ``.NAME.partial`` of older runs; :class:`AttemptFolder`)."""
+    return _attempt_folders(root, name, Kind.PARTIAL)
 
-    pattern = re.compile(rf"\.{re.escape(name)}(\.[^.]*)?\.partial")
+
+def _attempt_folders(root: Path, name: str, kind: Kind) -> list[Path]:
+    """The folders of ``kind`` of the attempts at session output ``root/name``."""
     try:
-        return [p for p in root.iterdir() if pattern.fullmatch(p.name) and p.is_dir()]
-    except OSError:  # no root yet: nothing partial
+        listed = list(root.iterdir())
+    except OSError:  # no root yet: nothing there
         return []
-
-
-def _owner_pid(folder: Path) -> int | None:
-    """The PID an attempt's folder names (``.NAME.PID-ID.partial`` / ``.earlier``), or None
-    (``.NAME.partial`` of older runs names none)."""
-    import re
-
-    found = re.search(r"\.(\d+)-[^.]*\.(partial|earlier)$", folder.name)
-    return int(found.group(1)) if found else None
+    return [
+        p
+        for p in listed
+        if (found := AttemptFolder.parse(p.name, name)) is not None
+        and found.kind is kind
+        and p.is_dir()
+    ]
 
 
 def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
@@ -145,7 +145,8 @@ def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
     asked of this host (``os.kill(pid, 0)``): the batch is assumed to run where its
     ``--out`` was made; a Dask worker on another host sharing the folder is not seen, and
     its attempt's folder is kept (or, its PID reused here, left for a later run)."""
-    pid = _owner_pid(folder)
+    attempt = AttemptFolder.parse(folder.name)
+    pid = None if attempt is None else attempt.pid
     if pid is None:
         return True
     if pid == os.getpid():
@@ -222,13 +223,7 @@ def earlier_backups(root: Path, name: str) -> list[Path]:
     """The earlier fits of session output ``root/name`` that a refit set aside
     (``.NAME.ATTEMPT.earlier``), oldest first: a refit keeps the fit it replaces under this
     name until the new one is in place (:func:`fit_one`)."""
-    import re
-
-    pattern = re.compile(rf"\.{re.escape(name)}\.([^.]+)\{EARLIER_SUFFIX}")
-    try:
-        found = [p for p in root.iterdir() if pattern.fullmatch(p.name) and p.is_dir()]
-    except OSError:
-        return []
+    found = _attempt_folders(root, name, Kind.EARLIER)
 
     def when(p: Path) -> int:
         try:
@@ -239,13 +234,11 @@ def earlier_backups(root: Path, name: str) -> list[Path]:
     return sorted(found, key=when)
 
 
-#: The ending of the folder a refit keeps the earlier fit in while it swaps the new one in.
-EARLIER_SUFFIX = ".earlier"
-
-
 def _swap_partial(backup: Path) -> Path:
     """The partial folder of the attempt that set ``backup`` aside (the same ATTEMPT)."""
-    return backup.with_name(backup.name.removesuffix(EARLIER_SUFFIX) + ".partial")
+    attempt = AttemptFolder.parse(backup.name)
+    assert attempt is not None, backup  # listed by earlier_backups
+    return attempt.as_kind(Kind.PARTIAL).path(backup.parent)
 
 
 def finish_swap(root: Path, final: Path) -> str:
@@ -484,9 +477,7 @@ def fit_one(
     standing is skipped without judging it again; any other finding is judged again here, as
     another batch into the same ``--out`` may have finished the session since (and a swap
     finished here puts another fit in place)."""
-    import os
     import shutil
-    import uuid
     from dataclasses import replace
 
     final = batch_out_dir(root, source)
@@ -497,8 +488,8 @@ def fit_one(
     outgrown = earlier.outgrown
     if earlier.stands:
         return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail, notes=said)
-    attempt = f"{os.getpid()}-{uuid.uuid4().hex[:8]}"
-    partial = root / f".{final.name}.{attempt}.partial"
+    attempt = AttemptFolder.new(final.name)
+    partial = attempt.path(root)
     try:
         result = run_fit(replace(template, source=source, out_dir=partial), bands)
     except RtiRigError as exc:
@@ -513,7 +504,7 @@ def fit_one(
         # the earlier fit is set aside only now that its successor is complete, under a
         # backup's name: a batch killed between the renames is finished by the next run's
         # finish_swap (the new fit put in place), never left without a fit
-        set_aside = root / f".{final.name}.{attempt}{EARLIER_SUFFIX}"
+        set_aside = attempt.as_kind(Kind.EARLIER).path(root)
         try:
             final.rename(set_aside)
         except FileNotFoundError:  # another attempt replaced it meanwhile: rename as below
