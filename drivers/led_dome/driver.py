@@ -66,6 +66,7 @@ class LedDomeDriver(PortOpening):
         reply_timeout_s: float = 0.5,
         ready_timeout_s: float = 3.0,
         max_level: int = 255,
+        can_dim: bool | None = None,
     ) -> None:
         if reply_timeout_s <= 0:
             raise ValueError(f"reply_timeout_s must be > 0, got {reply_timeout_s}")
@@ -76,7 +77,12 @@ class LedDomeDriver(PortOpening):
         self.ready_timeout_s = ready_timeout_s
         self.max_level = max_level
         #: This project's protocols carry a PWM level, unless framed with send_level = false.
-        self.can_dim = codec.has_level
+        #: The factory passes the settings' answer (``DomeSerialSettings.can_dim``) so the link
+        #: and ``calibrate-lights`` / the config loader cannot disagree; a driver built by hand
+        #: asks its codec. A link said to dim whose codec sends no level would be a lie.
+        if can_dim and not codec.has_level:
+            raise ValueError(f"the {codec.profile} codec sends no level: the link cannot dim")
+        self.can_dim = codec.has_level if can_dim is None else can_dim
         self.has_watchdog = codec.has_watchdog
         self.echoes_light = codec.profile != "binary"
         #: Every light command is answered (an acknowledgement, or the LED's error).

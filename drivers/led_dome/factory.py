@@ -44,7 +44,11 @@ def protocol_for(settings: DomeSerialSettings) -> ProtocolSpec:
 def build_driver(
     settings: DomeSerialSettings, transport: Transport | None = None, *, name: str = "dome"
 ) -> LedDomeDriver | ScriptedDomeDriver:
-    """The driver for ``settings`` on ``transport`` (default: the serial port it names)."""
+    """The driver for ``settings`` on ``transport`` (default: the serial port it names).
+
+    The link's ``can_dim`` is the settings' (:meth:`DomeSerialSettings.can_dim`): the one answer
+    to "can this dome dim", which ``calibrate-lights`` and the config loader read too; the
+    drivers refuse a "yes" their bytes cannot carry."""
     port = transport or SerialTransport(settings.port, settings.baudrate)
     if settings.is_described:
         # reply_timeout_s is a floor under the profile's own timeouts (a slow USB bridge, or an
@@ -55,6 +59,7 @@ def build_driver(
             device=name,
             min_reply_timeout_s=settings.reply_timeout_s,
             led_count_source=settings.led_count_source(),
+            can_dim=settings.can_dim,
         )
     return LedDomeDriver(
         port,
@@ -63,4 +68,5 @@ def build_driver(
         reply_timeout_s=settings.reply_timeout_s,
         ready_timeout_s=settings.ready_timeout_s,
         max_level=settings.max_level,
+        can_dim=settings.can_dim,
     )

@@ -49,6 +49,7 @@ class ScriptedDomeDriver(PortOpening):
         device: str = "dome",
         min_reply_timeout_s: float = 0.0,
         led_count_source: str | None = None,
+        can_dim: bool = False,
     ) -> None:
         self.transport = transport
         self.spec = spec
@@ -64,7 +65,11 @@ class ScriptedDomeDriver(PortOpening):
         self.has_watchdog = False
         self.max_level = 1  # on/off only
         #: A protocol description has no brightness placeholder: its light command switches an
-        #: LED on (``dome_profiles.no_dimming`` says so of each built-in firmware).
+        #: LED on (``dome_profiles.no_dimming`` says so of each built-in firmware). The factory
+        #: passes the settings' answer (``DomeSerialSettings.can_dim``), the one source; the
+        #: driver's own bytes are on/off, so a "yes" is refused rather than believed.
+        if can_dim:
+            raise ValueError(f"the {spec.name} protocol description has no level: it cannot dim")
         self.can_dim = False
         pat = spec.light.reply.pattern or ""
         self.echoes_light = spec.light.reply.kind == "pattern" and (

@@ -23,6 +23,12 @@ from rti_rig.cli import app
 from rti_rig.core.clock import VirtualClock
 from rti_rig.core.errors import DeviceError
 from rti_rig.drivers.led_dome.dome_profiles import described_profiles, no_dimming
+from rti_rig.drivers.led_dome.driver import LedDomeDriver
+from rti_rig.drivers.led_dome.factory import build_driver, protocol_for
+from rti_rig.drivers.led_dome.profiles import make_codec
+from rti_rig.drivers.led_dome.scripted import ScriptedDomeDriver
+from rti_rig.drivers.led_dome.settings import DomeSerialSettings
+from rti_rig.drivers.led_dome.transport import SerialTransport
 
 runner = CliRunner()
 
@@ -69,8 +75,26 @@ def test_every_shipped_dome_declares_whether_it_dims_as_its_firmware_does(config
     settings = load_rig_config(config).config.dome.serial
     assert settings.can_dim is DIMS[settings.profile]
     assert (settings.dimming_refusal() is None) is settings.can_dim
+    assert build_driver(settings).can_dim is settings.can_dim
     link = build_dome(settings, VirtualClock()).link
     assert link.can_dim is settings.can_dim
+
+
+def test_the_factory_gives_the_link_the_settings_answer(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The settings are the one source: the link does not ask its codec a second time."""
+    settings = DomeSerialSettings(port="loop://")
+    assert build_driver(settings).can_dim is True
+    monkeypatch.setattr(DomeSerialSettings, "can_dim", property(lambda self: False))
+    assert build_driver(settings).can_dim is False
+
+
+def test_a_driver_refuses_to_say_it_dims_when_its_bytes_carry_no_level() -> None:
+    framed = DomeSerialSettings(port="loop://", profile="framed", framed={"send_level": False})
+    with pytest.raises(ValueError, match="cannot dim"):
+        LedDomeDriver(SerialTransport("loop://"), make_codec(framed), can_dim=True)
+    nab = DomeSerialSettings(port="loop://", profile="nab-rti-v1")
+    with pytest.raises(ValueError, match="cannot dim"):
+        ScriptedDomeDriver(SerialTransport("loop://"), protocol_for(nab), can_dim=True)
 
 
 def test_the_shipped_domes_hold_both_kinds() -> None:
