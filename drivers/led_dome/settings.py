@@ -335,6 +335,18 @@ class DomeSerialSettings(_Strict):
         return None
 
 
+#: What a light correction needs, said wherever one is refused for a link that cannot dim: the
+#: links :func:`dimming_refusal_of` lets through, worded once beside it (the config loader and
+#: ``calibrate-lights`` had each spelled the list, free to drift from this function).
+DIMMING_LINK = (
+    "a link whose light command carries a brightness (the 'default' or 'binary' profile, or "
+    "'framed' with send_level = true)"
+)
+
+#: Where a dome that cannot dim is evened out instead: its images, divided by the light gains.
+IMAGE_GAINS_REMEDY = "rti_rig.reconstruct.apply_light_gains"
+
+
 def dimming_refusal_of(profile: str, send_level: bool = True) -> str | None:
     """Why a link of ``profile`` (``framed``: with ``send_level``) cannot dim an LED, naming the
     firmware or profile, or None where it can.

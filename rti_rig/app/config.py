@@ -35,7 +35,12 @@ from rti_rig.core.rig_geometry import (
 from rti_rig.core.validation_text import error_text as _error_text
 from rti_rig.core.validation_text import key_of as _key_of
 from rti_rig.drivers.dynamixel.settings import ArmSettings
-from rti_rig.drivers.led_dome.settings import DomeSerialSettings, ProtocolKeyError
+from rti_rig.drivers.led_dome.settings import (
+    DIMMING_LINK,
+    IMAGE_GAINS_REMEDY,
+    DomeSerialSettings,
+    ProtocolKeyError,
+)
 
 
 class _Strict(BaseModel):
@@ -875,9 +880,8 @@ def _check_dome_can_dim(path: Path, data: dict[str, Any], serial: Any) -> None:
         path,
         key,
         f"{why}, so {what} would be ignored (every LED lit at full light). Remove the key; "
-        "a correction needs a link whose light command carries a brightness (the 'default' or "
-        "'binary' profile, or 'framed' with send_level = true). To even out this dome's images "
-        "instead, divide the light gains out of them (rti_rig.reconstruct.apply_light_gains)",
+        f"a correction needs {DIMMING_LINK}. To even out this dome's images instead, divide "
+        f"the light gains out of them ({IMAGE_GAINS_REMEDY})",
     )
 
 

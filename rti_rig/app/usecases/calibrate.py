@@ -25,6 +25,7 @@ from rti_rig.app.light_calibration import (
 from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.drivers.led_dome.settings import DIMMING_LINK, IMAGE_GAINS_REMEDY
 
 
 @dataclass(frozen=True)
@@ -78,9 +79,8 @@ def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
     if why is not None:
         raise RtiRigError(
             f"{req.rig_config}: {why}, so a light correction could not be applied to it. A "
-            "correction needs a link whose light command carries a brightness (the 'default' "
-            "or 'binary' profile, or 'framed' with send_level = true); on this dome, divide the "
-            "gains out of the images instead (rti_rig.reconstruct.apply_light_gains)"
+            f"correction needs {DIMMING_LINK}; on this dome, divide the gains out of the "
+            f"images instead ({IMAGE_GAINS_REMEDY})"
         )
 
 

@@ -22,7 +22,11 @@ from pathlib import Path
 from typing import Any
 
 from rti_rig.app.config import MEASURED_KEY
-from rti_rig.drivers.led_dome.settings import dimming_refusal_of
+from rti_rig.drivers.led_dome.settings import (
+    DomeSerialSettings,
+    FramedOptions,
+    dimming_refusal_of,
+)
 from rti_rig.reconstruct.qa import BRIGHTER, QAReport
 
 
@@ -43,16 +47,18 @@ def recorded_dimming_refusal(manifest: dict[str, Any]) -> str | None:
     Read from the recorded table as the loaded settings are read (the same
     :func:`dimming_refusal_of`), not by building the settings: an older session's table may
     hold keys this version refuses or files no longer there. The table is the config as
-    written, so a key it leaves out is the settings' default: ``profile`` ``"default"``,
-    ``[dome.serial.framed] send_level`` true. A profile name this version does not know (one
-    since renamed) is said as such and taken for one that cannot dim: this rti-rig cannot drive
-    it, so ``calibrate-lights`` could not load that config and is no command to advise."""
+    written, so a key it leaves out is the settings' default, read from their model
+    (``profile``, ``[dome.serial.framed] send_level``) rather than restated. A profile name
+    this version does not know (one since renamed) is said as such and taken for one that
+    cannot dim: this rti-rig cannot drive it, so ``calibrate-lights`` could not load that
+    config and is no command to advise."""
     serial = _dome_serial(manifest)
     if serial is None:
         return None
-    profile = str(serial.get("profile", "default"))
+    profile = str(serial.get("profile", DomeSerialSettings.model_fields["profile"].default))
     framed = serial.get("framed")
-    send_level = framed.get("send_level", True) if isinstance(framed, dict) else True
+    unsaid: bool = FramedOptions.model_fields["send_level"].default
+    send_level = framed.get("send_level", unsaid) if isinstance(framed, dict) else unsaid
     try:
         return dimming_refusal_of(profile, bool(send_level))
     except KeyError:
