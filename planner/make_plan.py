@@ -36,6 +36,7 @@ from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule
 from rti_rig.planner.builtin_methods import MANY_LIGHTS, MIN_LIGHTS_FOR_EXCHANGE
+from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.methods import MethodContext, PlanMethod, get_method
 from rti_rig.planner.objectives import (
     GLOSSY_SPECULAR,
@@ -201,6 +202,8 @@ class PlanRequest:
     depth_spec: DepthModelSpec | None = None
     arm_order: ArmOrder | None = None
     seed: int = 0
+    #: where ``preview_light`` came from: typed (given) or read from a record of the shot
+    preview_light_origin: LightOrigin = LightOrigin.GIVEN
 
     def check(self) -> PlanMethod:
         """Refuse what cannot be planned, before any work; returns the method to plan with."""
@@ -471,7 +474,13 @@ def _surface_for(
         )
     elif preview is not None:
         try:
-            surface = estimate_surface(preview, req.preview_light, req.depth_model, req.depth_spec)
+            surface = estimate_surface(
+                preview,
+                req.preview_light,
+                req.depth_model,
+                req.depth_spec,
+                light_origin=req.preview_light_origin,
+            )
         except ScheduleError as exc:
             if method.surface != "none":
                 raise
@@ -482,7 +491,7 @@ def _surface_for(
         report.rms_tilt_deg, report.p90_tilt_deg = tilt_stats(surface.normals)
     if surface is not None and preview is not None:
         _report_preview_facts(preview, surface, report)
-        if surface.light_source == "given":  # recorded or --preview-light: a known light
+        if surface.light_origin.known:  # recorded or --preview-light: a known light
             _note_preview_outside_band(surface, req, report)
     return surface
 
@@ -521,7 +530,7 @@ def _report_preview_facts(preview: NDArray, surface: SurfaceEstimate, report: Pl
             "level surface)"
         )
     report.preview_light_az_el_deg = (float(az), float(el))
-    report.preview_light_source = surface.light_source
+    report.preview_light_origin = surface.light_origin
     report.preview_light_why_zenith = surface.light_why_zenith
     report.planning_shape = tuple(surface.image.shape)
     report.relief_scale = surface.fit.scale * relief_trust(surface.fit)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.pixel_bins import GRAZING_DEG
 
 
@@ -23,6 +24,9 @@ class PlanReport:
     preview_shape: tuple[int, ...] | None = None
     planning_shape: tuple[int, ...] | None = None
     preview_light_az_el_deg: tuple[float, float] | None = None
+    #: where the preview's light came from (None: no preview was evaluated)
+    preview_light_origin: LightOrigin | None = None
+    #: the origin in words, for the reader (the app's sentence; without one, the origin's name)
     preview_light_source: str | None = None
     #: why the zenith was assumed for the preview's light, no direction being had from it
     preview_light_why_zenith: str | None = None
@@ -47,8 +51,18 @@ class PlanReport:
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
 
+    def light_said(self) -> str | None:
+        """The preview light's origin as the reader is told it."""
+        if self.preview_light_source is not None or self.preview_light_origin is None:
+            return self.preview_light_source
+        return self.preview_light_origin.value
+
     def to_dict(self) -> dict[str, Any]:
+        """The report as saved beside the schedule: the origin is kept as its words (the
+        string field readers of saved plans have), not as the enum."""
         d = asdict(self)
+        del d["preview_light_origin"]
+        d["preview_light_source"] = self.light_said()
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
 
     def lines(self) -> list[str]:
@@ -61,7 +75,7 @@ class PlanReport:
             )
         if self.preview_light_az_el_deg is not None:
             az, el = self.preview_light_az_el_deg
-            out.append(f"preview light az {az:.1f}°, el {el:.1f}° ({self.preview_light_source})")
+            out.append(f"preview light az {az:.1f}°, el {el:.1f}° ({self.light_said()})")
         if self.relief_source and self.shading_explained_r2 is None:
             out.append(f"relief: {self.relief_source}")
         elif self.relief_source:

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import ScheduleError
+from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.normals import (
     ReliefFit,
     fit_relief_scale,
@@ -65,7 +66,7 @@ class SurfaceEstimate:
 
     image: NDArray[np.float64]
     light: NDArray[np.float64]
-    light_source: str
+    light_origin: LightOrigin
     relief_px: NDArray[np.float64]
     normals: NDArray[np.float64]
     fit: ReliefFit
@@ -74,7 +75,8 @@ class SurfaceEstimate:
     #: normals of the fitted relief before the trust shrinkage (what the paper's k-means sees)
     fitted_normals: NDArray[np.float64] | None = None
     #: why the zenith was assumed, no light direction being had from the image
-    #: (:attr:`planner.topography.LightEstimate.why_zenith`); None: given or estimated
+    #: (:attr:`planner.topography.LightEstimate.why_zenith`); None unless ``light_origin`` is
+    #: :attr:`LightOrigin.ZENITH_ASSUMED`
     light_why_zenith: str | None = None
 
 
@@ -93,8 +95,12 @@ def estimate_surface(
     preview_light: tuple[float, float] | None = None,
     depth_model: Path | None = None,
     depth_spec: DepthModelSpec | None = None,
+    light_origin: LightOrigin = LightOrigin.GIVEN,
 ) -> SurfaceEstimate:
-    """Steps 1–4 of the pipeline (see module docstring)."""
+    """Steps 1–4 of the pipeline (see module docstring).
+
+    ``light_origin``: where ``preview_light`` came from (given or recorded), carried into the
+    estimate; without a ``preview_light`` the light is estimated and the origin says how."""
     image = planning_image(preview)
     peak = float(image.max()) if image.size else 0.0
     if not peak > 1e-6:
@@ -110,12 +116,12 @@ def estimate_surface(
         )
     why_zenith = None
     if preview_light is not None:
-        light, light_source, albedo = given_light(preview_light), "given", None
+        light, origin, albedo = given_light(preview_light), light_origin, None
     else:
         est = estimate_light(image)
-        light, light_source, albedo = est.direction, "estimated (Zheng-Chellappa)", None
+        light, origin, albedo = est.direction, LightOrigin.ESTIMATED, None
         if est.why_zenith is not None:
-            light_source, why_zenith = "assumed (zenith)", est.why_zenith
+            origin, why_zenith = LightOrigin.ZENITH_ASSUMED, est.why_zenith
     if depth_model is not None:
         raw = depth_from_onnx(preview, Path(depth_model), depth_spec, out_shape=image.shape)
         source = f"depth model {Path(depth_model).name}"
@@ -130,7 +136,7 @@ def estimate_surface(
     return SurfaceEstimate(
         image,
         light,
-        light_source,
+        origin,
         relief,
         normals_from_height(relief),
         fit,
@@ -161,13 +167,14 @@ def flat_surface() -> SurfaceEstimate:
     return SurfaceEstimate(
         np.full_like(relief, 0.5),
         np.array([0.0, 0.0, 1.0]),
-        "none (no preview)",
+        LightOrigin.ZENITH_ASSUMED,
         relief,
         normals,
         fit,
         "none (no preview: a level surface)",
         0,
         normals,
+        light_why_zenith="there is no preview",
     )
 
 

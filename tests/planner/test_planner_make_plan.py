@@ -12,6 +12,7 @@ from rti_rig.core.errors import ScheduleError
 from rti_rig.core.geometry import angle_between_deg, direction_from_az_el, fibonacci_cap
 from rti_rig.core.lp_format import read_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
+from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.make_plan import DEFAULT_OBJECTIVE, MANY_LIGHTS, make_plan, plan_with_report
 from rti_rig.planner.uniform import plan_uniform
 from rti_rig.simulator.sim_scene import lambert_radiance, relief_scene
@@ -230,7 +231,7 @@ def test_real_preview_on_the_real_dome() -> None:
 def test_report_is_serialisable_and_readable() -> None:
     sched, rep = plan_with_report(PREVIEW, DOME, 6, "optimal")
     assert rep.objective == DEFAULT_OBJECTIVE
-    assert rep.preview_light_source.startswith("estimated")
+    assert rep.preview_light_origin is LightOrigin.ESTIMATED
     d = sched.provenance["report"]
     assert d["method"] == "optimal" and isinstance(d["expected"], dict)
     text = "\n".join(rep.lines())

@@ -31,6 +31,7 @@ from rti_rig.core.geometry import direction_from_az_el
 from rti_rig.core.lp_format import LpEntry, image_file_name, read_lp, write_lp
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry, coincident_leds
 from rti_rig.core.schedule import LightSchedule
+from rti_rig.planner.light_origin import LightOrigin
 from rti_rig.planner.make_plan import (
     DEFAULT_OBJECTIVE,
     MIN_PLAN_LIGHTS,
@@ -195,6 +196,7 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
             method,
             objective,
             preview_light=az_el,
+            preview_light_origin=LightOrigin.GIVEN if light_note is None else LightOrigin.RECORDED,
             depth_model=req.depth_model,
             min_elevation_deg=req.min_elevation_deg,
             max_elevation_deg=req.max_elevation_deg,
@@ -206,14 +208,9 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     # every planner picks among the rig's lights in the band: where those cannot determine a
     # normal, any choice cannot (the plan had been written, "expected RMS normal error 90.00")
     _check_determined(req, schedule, notes)
-    if light_note and report.preview_light_source == "given":
-        report.preview_light_source = light_note
-    if image is not None and az_el is None and report.preview_light_az_el_deg is not None:
-        why_zenith = report.preview_light_why_zenith
-        report.preview_light_source = (
-            estimated_light_said(unrecorded)
-            if why_zenith is None
-            else zenith_assumed_said(unrecorded, why_zenith)
+    if report.preview_light_origin is not None:
+        report.preview_light_source = preview_light_said(
+            report.preview_light_origin, light_note, unrecorded, report.preview_light_why_zenith
         )
     if req.signal_noise and not report.signal_noise:
         # as --material's note says (planner.make_plan): an option given and silently unused
@@ -237,6 +234,23 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     if (outlook := fit_outlook(len(schedule))) is not None:
         notes.append(outlook)
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
+
+
+def preview_light_said(
+    origin: LightOrigin, recorded_by: str | None, unrecorded: str | None, why_zenith: str | None
+) -> str:
+    """The plan's preview light's origin in the words the plan prints and saves: the one place
+    it is worded (the planner gives the fact, :class:`LightOrigin`).
+
+    ``recorded_by``: which record gave the light; ``unrecorded``: why none did; ``why_zenith``:
+    why no direction could be estimated."""
+    if origin is LightOrigin.RECORDED:
+        return recorded_by or origin.value
+    if origin is LightOrigin.ESTIMATED:
+        return estimated_light_said(unrecorded)
+    if origin is LightOrigin.ZENITH_ASSUMED:
+        return zenith_assumed_said(unrecorded, why_zenith or "")
+    return "given"
 
 
 #: How far the light estimated from a preview was off the light that fired, where that was
