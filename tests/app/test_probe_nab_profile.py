@@ -7,33 +7,59 @@ probe, which would then identify, or switch off, a board by words the profile no
 
 from __future__ import annotations
 
-import inspect
-import re
+import importlib.util
+import sys
+from types import ModuleType
+
+import pytest
 
 from rti_rig.app.usecases import probe
 from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
 
 
-def _words(pattern: str) -> str:
-    """The literal text at the start of a profile's reply pattern (its regex escapes undone)."""
-    literal = re.match(r"(?:\\.|[^\\.^$*+?{}\[\]|()])+", pattern)
-    assert literal is not None, pattern
-    return re.sub(r"\\(.)", r"\1", literal.group(0))
+class _Board:
+    """A Nab board that answers what it is sent with ``reply``: the bytes the probe wrote."""
+
+    def __init__(self, reply: bytes) -> None:
+        self.written = bytearray()
+        self._reply = reply
+        self._pending = b""
+
+    def write(self, data: bytes) -> None:
+        self.written += data
+        self._pending = self._reply
+
+    def read(self, timeout_s: float) -> bytes:
+        out, self._pending = self._pending, b""
+        return out
 
 
-def test_the_probe_holds_no_copy_of_the_nab_profiles_words() -> None:
-    source = inspect.getsource(probe)
-    copies = [
-        _words(nab.ALL_OFF["reply"]["pattern"]),
-        _words(nab.ALL_ON_REPLY_PATTERN),
-        _words(nab.SPEC["reset_pattern"]),
-        _words(nab.SPEC["error_pattern"]),
-        f'b"{nab.ALL_OFF["send"]}"',
-        f"_NAB_BAUD = {nab.SPEC['baudrate']}",
-        f'"{nab.SPEC["name"]}", _NAB_BAUD',
-    ]
-    held = [words for words in copies if words in source]
-    assert not held, f"probe.py restates the Nab profile's {held}: read them from the profile"
+def _probe_loaded_now(monkeypatch: pytest.MonkeyPatch) -> ModuleType:
+    """A fresh copy of the probe module, its constants read from the profile as it is now
+    (the imported module read them once; reloading it would replace the classes other modules
+    hold)."""
+    spec = importlib.util.spec_from_file_location("_probe_copy", probe.__file__)
+    assert spec is not None and spec.loader is not None
+    copy = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, spec.name, copy)  # its dataclasses look themselves up
+    spec.loader.exec_module(copy)
+    return copy
+
+
+def test_a_change_to_the_profile_reaches_the_probe(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The probe switches a Nab board off, and names it, with what the profile says: a profile
+    whose all-off, answer, rate or name changed is followed (a copy in the probe would not)."""
+    changed = {"send": "<Z>", "reply": {"kind": "pattern", "pattern": r"<Dark now\.>"}}
+    monkeypatch.setattr(nab, "ALL_OFF", changed)
+    monkeypatch.setitem(nab.SPEC, "baudrate", 57600)
+    monkeypatch.setitem(nab.SPEC, "name", "nab-renamed")
+    copy = _probe_loaded_now(monkeypatch)
+    board = _Board(b"<Dark now.>\r\n")
+    result = copy.ProbeResult(port="loop://")
+    copy._nab_off(result, board)
+    assert bytes(board.written) == b"<Z>"
+    assert "acknowledged" in result.lights and "NOT" not in result.lights, result.lights
+    assert (copy._NAB_NAME, copy._NAB_BAUD) == ("nab-renamed", 57600)
 
 
 def test_the_probe_answers_to_what_the_profile_says() -> None:
