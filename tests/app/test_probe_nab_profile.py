@@ -20,7 +20,8 @@ from rti_rig.drivers.led_dome.dome_profiles import nab_rti_v1 as nab
 class _Board:
     """A Nab board that answers what it is sent with ``reply``: the bytes the probe wrote."""
 
-    def __init__(self, reply: bytes) -> None:
+    def __init__(self, reply: bytes, baudrate: int = 9600) -> None:
+        self.baudrate = baudrate  # the port's rate, which the probe records with what it heard
         self.written = bytearray()
         self._reply = reply
         self._pending = b""
@@ -54,12 +55,13 @@ def test_a_change_to_the_profile_reaches_the_probe(monkeypatch: pytest.MonkeyPat
     monkeypatch.setitem(nab.SPEC, "baudrate", 57600)
     monkeypatch.setitem(nab.SPEC, "name", "nab-renamed")
     copy = _probe_loaded_now(monkeypatch)
-    board = _Board(b"<Dark now.>\r\n")
+    board = _Board(b"<Dark now.>\r\n", baudrate=57600)
     result = copy.ProbeResult(port="loop://")
     copy._nab_off(result, board)
     assert bytes(board.written) == b"<Z>"
     assert "acknowledged" in result.lights and "NOT" not in result.lights, result.lights
     assert (copy._NAB_NAME, copy._NAB_BAUD) == ("nab-renamed", 57600)
+    assert [h.baud for h in result.heard] == [57600]
 
 
 def test_the_probe_answers_to_what_the_profile_says() -> None:
