@@ -343,6 +343,25 @@ class RigConfig(_Strict):
                 "[camera.device]); for the dry run, set port = 'emulated'"
             )
 
+    def _real_unevenness(self) -> str:
+        """What becomes of a real dome's uneven LEDs on this config's link, as the tail of the
+        ``[emulator] led_power`` refusal (empty where there is no serial link to speak of).
+
+        Why: the refusal had said the real driver applies the correction that evens them out,
+        untrue for an on/off firmware (nab-rti-v1 and the other described ones), which cannot
+        dim: its LEDs' unevenness stays in the images. Judged by the link's own
+        :meth:`~rti_rig.drivers.led_dome.settings.DomeSerialSettings.dimming_refusal`."""
+        serial = self.dome.serial if self.kind == "dome" and self.dome is not None else None
+        if serial is None:
+            return ""
+        why = serial.dimming_refusal()
+        if why is None:
+            return " (the real driver applies the intensity correction that evens them out)"
+        return (
+            f" (on this rig {why}, so its LEDs' unevenness stays in the images; divide the "
+            f"light gains out of them instead: {IMAGE_GAINS_REMEDY})"
+        )
+
     def _arm_faults_are_replies(self) -> None:
         """Refuse, naming the key, an arm's fault the emulated servos cannot rehearse.
 
@@ -442,8 +461,7 @@ class RigConfig(_Strict):
         ):
             raise ValueError(
                 "emulator.led_power / led_power_spread make an emulated dome's LEDs uneven: "
-                "they need kind = 'dome' and backend = 'emulated' (the real driver applies the "
-                "intensity correction that evens them out)"
+                f"they need kind = 'dome' and backend = 'emulated'{self._real_unevenness()}"
             )
         self._arm_faults_are_replies()
         if self.backend in ("simulated", "emulated"):
