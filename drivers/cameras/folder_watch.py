@@ -80,6 +80,7 @@ from rti_rig.drivers.cameras.image_io import (
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
     RawDecodeError,
+    RawFileMissingError,
     UnsupportedRawError,
     decode_raw,
     exposure_stats,
@@ -1031,6 +1032,8 @@ class FolderWatchCamera:
             except CaptureError as exc:
                 if held != path and _identity(path) is not None:
                     self._drop_copy(held)  # the folder's file stays; the copy is no use
+                if isinstance(exc, RawFileMissingError) and held != path:
+                    raise self._copy_gone(path, held) from exc
                 # the decoders' own refusals: LibRaw's, or a TIFF/PNG that would not read (not
                 # this camera's, of a whole file: 8-bit data, a wrong exposure)
                 if exc.device != DECODER and exc.command != "read":
@@ -1149,6 +1152,29 @@ class FolderWatchCamera:
                     "decode",
                 ) from failure
 
+    def _copy_gone(self, path: Path, held: Path) -> CaptureError:
+        """The stop for a copy :meth:`_hold` made that was gone when it was to be decoded,
+        naming the folder's file ``path`` and whether it is still left there.
+
+        Why: the decoder's "RAW file not found" names the file it looked for, the session's
+        hidden ``raw/.incoming`` copy, a file the user never saw, and said nothing of the
+        folder's own file, which may well be there (waiting for it to change would not help:
+        it is the copy that went)."""
+        folder = self.settings.folder
+        left = (
+            f"{path.name} is left in {folder}"
+            if _identity(path) is not None
+            else f"{path.name} is gone from {folder} too (moved or deleted by another program)"
+        )
+        return CaptureError(
+            self.name,
+            f"{path} was taken as this light's image and copied into the session "
+            f"({held.parent}), but that copy was removed or renamed before it could be "
+            "decoded: keep other programs out of the session's folder. "
+            f"{left}, and no image was recorded for this light",
+            "decode",
+        )
+
     def _hold(self, path: Path) -> Path:
         """Copy the file taken from the watched folder into the session (``output_dir``, its
         ``raw/.incoming``) and return the copy, which is decoded and kept; ``path`` itself
@@ -1190,7 +1216,10 @@ class FolderWatchCamera:
     def _decode(
         self, path: Path, exposure_s: float, started: float, watched: Path | None = None
     ) -> Frame:
-        """Decode ``path`` (the session's copy of ``watched``, the folder's file)."""
+        """Decode ``path`` (the session's copy of ``watched``, the folder's file).
+
+        Its refusals name ``watched`` (the file the user's program saved, left in the folder),
+        never the copy, whose name may differ (``IMG_0001_2.dng`` beside an earlier copy)."""
         s = self.settings
         watched = watched or path
         if is_raw_file(path):
@@ -1215,14 +1244,14 @@ class FolderWatchCamera:
                 )
                 raise CaptureError(
                     self.name,
-                    f"{path.name} is 8-bit (gamma-encoded), not linear data: {fix}",
+                    f"{watched.name} is 8-bit (gamma-encoded), not linear data: {fix}",
                     "decode",
                 )
             response = "linear" if s.eight_bit_response == "refuse" else s.eight_bit_response
             try:
                 pixels, white = to_linear_uint16(image, response, order="rgb")
             except ValueError as exc:
-                raise CaptureError(self.name, f"{path.name}: {exc}", "decode") from exc
+                raise CaptureError(self.name, f"{watched.name}: {exc}", "decode") from exc
             file_exposure, gain = None, s.gain
             metadata = {"source_file": str(path), "bit_depth": 8 * image.dtype.itemsize}
             metadata.update(exposure_stats(pixels, white, s.decode.underexposed_level))
@@ -1231,7 +1260,7 @@ class FolderWatchCamera:
             if rel > s.exposure_tolerance:
                 raise CaptureError(
                     self.name,
-                    f"{path.name} was exposed {file_exposure:g} s but {exposure_s:g} s was "
+                    f"{watched.name} was exposed {file_exposure:g} s but {exposure_s:g} s was "
                     "asked: set the camera to manual at the session exposure",
                     "check exposure",
                 )

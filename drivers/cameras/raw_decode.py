@@ -78,6 +78,15 @@ class UnsupportedRawError(RawDecodeError):
     ``stable_polls``."""
 
 
+class RawFileMissingError(RawDecodeError):
+    """The RAW file to decode is not there (``path``: the file looked for).
+
+    Why a class of its own: a caller that decodes a copy (a watched folder's file, copied into
+    the session first) words a missing copy itself, from this field: the folder's file may
+    well be there, and the sentence "RAW file not found: <the copy>" had named the session's
+    hidden ``raw/.incoming`` copy instead of the file the user's program saved."""
+
+
 _COLOR_NAMES = "RGBG"
 
 
@@ -101,7 +110,7 @@ def _source(source: Path | str | bytes) -> tuple[str, Any]:
         return "<bytes>", io.BytesIO(bytes(source))
     path = Path(source)
     if not path.is_file():
-        raise CaptureError(DECODER, f"RAW file not found: {path}", "decode")
+        raise RawFileMissingError(path, "RAW file not found (moved or deleted before it was read)")
     return str(path), str(path)
 
 
