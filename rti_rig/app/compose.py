@@ -25,7 +25,7 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
     window): see :func:`_build_emulated_firmware_dome`. Use the rig as a context manager (or
     call ``close``) to release emulators and ports afterwards.
     """
-    from rti_rig.app.disk_estimate import bytes_per_image
+    from rti_rig.app.disk_estimate import bytes_per_image, size_from_frame
 
     cfg = loaded.config
     if cfg.backend == "hardware":
@@ -35,6 +35,7 @@ def build_rig(loaded: LoadedRig, clock: Clock | None = None) -> Rig:
     else:
         rig = _build_simulated(loaded, clock)
     rig.bytes_per_image = bytes_per_image(loaded)  # what the controller's disk checks count
+    rig.size_from_frame = size_from_frame(loaded)  # the first real frame's size, counted
     return rig
 
 

@@ -8,6 +8,8 @@ controller gets the figure through :attr:`rti_rig.runtime.rig.Rig.bytes_per_imag
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from rti_rig.app.config import LoadedRig, camera_device_settings
 from rti_rig.runtime.session import estimated_bytes_per_image
 
@@ -18,16 +20,45 @@ def bytes_per_image(loaded: LoadedRig) -> int:
     RAW kept in the session's ``raw/`` (and the camera's JPEG with ``keep_jpeg``); any other
     camera, a full-size 16-bit RGB TIFF and its JPEG."""
     cam = loaded.config.camera
-    if cam.device is None or loaded.config.backend != "hardware":
-        return estimated_bytes_per_image(cam.width, cam.height)
+    return _bytes_for(loaded, cam.width, cam.height)
+
+
+def size_from_frame(loaded: LoadedRig) -> Callable[[int, int], tuple[int, int, int]]:
+    """A function of a delivered frame's width and height giving the ``[camera]`` width and
+    height it implies (a RAW camera decoded at ``"half"`` delivers half the sensor's) and the
+    bound on one image's files for that size, as :func:`bytes_per_image` counts them.
+
+    Why: ``[camera] width``/``height`` default to 512 x 512 and are never checked against a
+    real camera, so the disk check before a session counted a 24 MP camera's images as
+    0.26 MP; the controller compares the first real frame with them and checks the disk again
+    (:attr:`rti_rig.runtime.rig.Rig.size_from_frame`)."""
+    half = _decode_mode(loaded) == "half"
+
+    def implied(width: int, height: int) -> tuple[int, int, int]:
+        w, h = (2 * width, 2 * height) if half else (width, height)
+        return w, h, _bytes_for(loaded, w, h)
+
+    return implied
+
+
+def _decode_mode(loaded: LoadedRig) -> str | None:
+    """A hardware RAW camera's ``decode.mode``; None for a camera that delivers frames."""
+    if loaded.config.camera.device is None or loaded.config.backend != "hardware":
+        return None
+    decode = getattr(camera_device_settings(loaded), "decode", None)
+    return None if decode is None else str(decode.mode)
+
+
+def _bytes_for(loaded: LoadedRig, width: int, height: int) -> int:
+    """:func:`bytes_per_image` for a sensor of ``width`` x ``height``."""
+    mode = _decode_mode(loaded)
+    if mode is None:  # a camera that delivers frames, not RAW files (opencv), or a dry run
+        return estimated_bytes_per_image(width, height)
     settings = camera_device_settings(loaded)
-    decode = getattr(settings, "decode", None)
-    if decode is None:  # a camera that delivers frames, not RAW files (opencv)
-        return estimated_bytes_per_image(cam.width, cam.height)
     return estimated_bytes_per_image(
-        cam.width,
-        cam.height,
-        decode.mode,
+        width,
+        height,
+        mode,
         kept_raw=True,
         kept_jpeg=bool(getattr(settings, "keep_jpeg", False)),
     )

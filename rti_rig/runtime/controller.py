@@ -12,6 +12,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from enum import StrEnum
+from pathlib import Path
 from typing import Any, Protocol
 
 from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame, FramePacedCamera
@@ -499,6 +500,51 @@ def _refuse_other_layout(
     )
 
 
+#: How far (a fraction of the pixels) the camera's real frames may differ from ``[camera]``'s
+#: width x height before the config's size is said to be wrong and the disk checked again.
+SIZE_TOLERANCE = 0.05
+
+
+def _checked_real_size(
+    rig: Rig,
+    root: Path,
+    got: tuple[int, int, bool],
+    per_image: int,
+    left: int,
+    emit: Callable[[Event], None],
+) -> int:
+    """The bound on one image's files for the rest of the run, from the first real frame
+    (``got``: height, width, colour): where it is not the ``[camera]`` width x height (beyond
+    :data:`SIZE_TOLERANCE`), says once that the config's size is wrong, naming the keys, and
+    checks the disk again for the ``left`` images still to take at the real size (raising
+    :class:`~rti_rig.runtime.session.NoSpaceError`, with the images kept, if it cannot hold
+    them).
+
+    Why: ``[camera] width``/``height`` default to 512 x 512 and nothing compared them with a
+    real camera's frames, so the start-up check counted a 24 MP camera's images as 0.26 MP
+    and let a session start that the disk could not hold."""
+    if rig.size_from_frame is None:
+        return per_image
+    cam = rig.camera_config
+    width, height, real = rig.size_from_frame(got[1], got[0])
+    said = cam.width * cam.height
+    if abs(width * height - said) <= SIZE_TOLERANCE * said:
+        return per_image
+    emit(
+        DeviceSays(
+            rig.camera.name,
+            f"The camera delivers {got[1]} x {got[0]} px images, but camera.width x "
+            f"camera.height in {rig.loaded.path} say {cam.width} x {cam.height} px: set "
+            f"camera.width = {width} and camera.height = {height} there. The disk was "
+            f"checked for images of the config's size; the {left} image(s) left are checked "
+            "again at the real size",
+        )
+    )
+    if left:
+        check_free_space(root, left, real, holds_images=True)
+    return real
+
+
 def _arm_end(lighting: object) -> dict[str, Any]:
     """The manifest's ``arm_end``: where an arm's teardown left it, as read back
     (:class:`rti_rig.runtime.arm_end.ArmEnd`); nothing for a dome, or an arm not gone safe."""
@@ -568,6 +614,7 @@ def run_session(
     records: list[StepRecord] = []
     end_notes: list[str] = []
     layout = folder.image_layout()  # the session's image size, once it has an image
+    size_checked = False  # the first frame of this run compared with [camera]'s size
     reason = FinishReason.ERROR
     error: str | None = None
     teardown: list[str] = []
@@ -683,6 +730,10 @@ def run_session(
             if source is not None:
                 source.observe(i, frame, record)
             layout = layout or got
+            if not size_checked:  # once a run: its first frame is the camera's real size
+                size_checked = True
+                left = steps_to_hold(total, len(done) + len(records), sure)
+                per_image = _checked_real_size(rig, folder.root, got, per_image, left, emit)
         else:
             if source is not None:  # run to its maximum: never asked for the step past it
                 concluded = source.conclude()

@@ -85,6 +85,10 @@ class Rig:
     #: camera config (a RAW camera's decode mode and kept files); None: the controller's own
     #: full-size RGB bound. The start-up check before the rig opens counts the same.
     bytes_per_image: int | None = None
+    #: Given the first delivered frame's width and height: the ``[camera]`` width and height
+    #: it implies and the bound on one image's files at that size (the composition root's
+    #: :func:`rti_rig.app.disk_estimate.size_from_frame`); None: the config's size stands.
+    size_from_frame: Callable[[int, int], tuple[int, int, int]] | None = None
 
     def bind_session(self, root: Path) -> None:
         """Tell the devices which session folder this run writes (before ``connect``)."""

@@ -1,0 +1,81 @@
+"""A camera whose frames are not the ``[camera]`` width x height: the run says so once, naming
+the keys, and checks the disk again for the images left at the real size.
+
+Found by a review: ``[camera] width``/``height`` default to 512 x 512 and were never compared
+with a real camera's frames, so the disk check before a session counted a 24 MP camera's
+images as 0.26 MP and let a session start that the disk could not hold.
+
+The simulated camera renders the config's size, so the camera's real size is faked here at its
+capture (each frame upscaled 4 x 4, as a camera larger than its config delivers), and the disk's
+free space at ``shutil.disk_usage`` (room for the config's size, not the real one).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS, write_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.lp_format import read_lp
+from rti_rig.simulator.sim_camera import SimulatedCamera
+
+runner = CliRunner()
+LIGHTS = 8
+
+
+def _said(result) -> str:  # type: ignore[no-untyped-def]
+    return " ".join(result.output.split())
+
+
+@pytest.fixture
+def bigger_camera(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """The shipped simulated dome at 64 x 64 px, its camera delivering 256 x 256 px frames."""
+    text = (CONFIGS / "simulated_dome.toml").read_text(encoding="utf-8")
+    assert "width = 512\nheight = 512" in text
+    cfg = write_config(
+        tmp_path, text.replace("width = 512\nheight = 512", "width = 64\nheight = 64")
+    )
+    capture = SimulatedCamera.capture
+
+    def larger(self: SimulatedCamera, exposure_s: float):  # type: ignore[no-untyped-def]
+        frame = capture(self, exposure_s)
+        pixels = np.repeat(np.repeat(frame.pixels, 4, axis=0), 4, axis=1)
+        return dataclasses.replace(frame, pixels=pixels)
+
+    monkeypatch.setattr(SimulatedCamera, "capture", larger)
+    return cfg
+
+
+def test_a_disk_too_small_for_the_real_size_is_refused_after_the_first_image(
+    tmp_path: Path, bigger_camera: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    usage = shutil.disk_usage(tmp_path)
+    # 10 MB: room for 8 images of 64 x 64 px (and the 8 MB margin), not for 7 of 256 x 256
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=10_000_000))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
+    said = _said(r)
+    assert r.exit_code == 2, r.output
+    assert "The camera delivers 256 x 256 px images" in said, said
+    assert "camera.width = 256 and camera.height = 256" in said and "64 x 64 px" in said
+    assert "not enough free disk space for 7 image(s)" in said, said
+    assert "free at least" in said and f"--resume {out}" in said, said
+    assert "1 image(s) kept" in said, said
+    assert len(read_lp(out / "lights.lp")) == 1
+
+
+def test_the_wrong_size_is_said_once_and_a_disk_with_room_goes_on(
+    tmp_path: Path, bigger_camera: Path
+) -> None:
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
+    said = _said(r)
+    assert r.exit_code == 0, r.output
+    assert said.count("The camera delivers 256 x 256 px images") == 1, said
+    assert len(read_lp(out / "lights.lp")) == LIGHTS
