@@ -396,11 +396,17 @@ def enclosing_session(root: Path) -> Path | None:
     Why: a new session given an ``--out`` inside a finished one was written there, nested
     among its images; a copy, a fit or a ``--resume`` of the outer session then carries or
     stumbles over the inner one. The path is resolved first, so ``S/../T/new`` is not taken
-    for a folder inside ``S`` and a symbolic link into a session is.
+    for a folder inside ``S`` and a symbolic link into a session is. A folder that cannot be
+    looked into (PermissionError on Python 3.11) is passed over: the ``--out`` checks that
+    follow refuse it by name, where this had raised past them as a traceback.
     """
     resolved = Path(root).resolve()
     for ancestor in resolved.parents:
-        if is_session_folder(ancestor):
+        try:
+            inside = is_session_folder(ancestor)
+        except OSError:  # a folder the user may not look into: the write check says so
+            continue
+        if inside:
             if Path(root).is_absolute():
                 return ancestor
             try:
