@@ -64,6 +64,7 @@ from rti_rig.reconstruct.qa_drift import (
     Step,
     change_point,
     edge_shifts_trusted,
+    light_trend,
     measure_drift,
     move_back,
     step_candidates,
@@ -1137,7 +1138,10 @@ def assess(
     edge_moved = np.zeros(n, bool)
     captured = crop_arr  # before any image is moved back by its edges alone
     if edges_trusted:
-        edge_moved = np.isfinite(edge_dev[:, 0]) & (np.hypot(*edge_dev.T) > DRIFT_PX)
+        # only the part of an image's edge shift that does not follow its light is a move
+        # (shading edges lean towards the light: :func:`light_trend`)
+        off_trend = np.nan_to_num(edge_dev) - light_trend(edge_dev, lt)
+        edge_moved = np.isfinite(edge_dev[:, 0]) & (np.hypot(*off_trend.T) > DRIFT_PX)
         if edge_moved.any():
             step_fit = None  # crop_arr changes below
         crop_arr = crop_arr.copy()

@@ -1,0 +1,81 @@
+"""Uneven LEDs are not a move; a real shift of one image still is.
+
+Found on the emulated Nab dome's 48 px tablet with ``[emulator] led_power_spread = 0.2`` (real
+domes' LEDs are uneven) and nothing else changed: the verdict said image_001 "moved: shifted
+(+1.0, -0.6) px", and the simulator never moves the object. The tablet's shading edges lean
+towards each light (x shift against the light's x: correlation 0.94); with even LEDs their
+spread (0.37 px) left the edges untrusted, with these uneven ones it read 0.25 px, trusted, and
+the most grazing light's image, 1.2 px off along its light, was called moved on its edges'
+word alone. Now only the part of an edge shift that does not follow the light counts; a
+session with one image really shifted 1-2 px names that image, and only it (it had named
+image_001 beside it).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
+
+REPO = Path(__file__).resolve().parents[2]
+runner = CliRunner()
+
+
+def _sha(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture(scope="module")
+def uneven(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """A still session of the shipped emulated dome with uneven LEDs, and its run's output."""
+    folder = tmp_path_factory.mktemp("uneven")
+    config = folder / "rig.toml"
+    text = (REPO / "rig_configs" / "emulated_nab_rti_v1.toml").read_text()
+    config.write_text(text + "\n[emulator]\nled_power_spread = 0.2\n")
+    out = folder / "s"
+    r = runner.invoke(app, ["run", str(config), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    return out, " ".join(r.output.split())
+
+
+def _shifted_copy(session: Path, dst: Path, image: int, dx: int, dy: int) -> Path:
+    """``session`` with linear image ``image`` (1-based) shifted by ``(dx, dy)`` px (x right, y
+    down: the object nudged and put back), its checksum updated as the capture would have."""
+    shutil.copytree(session, dst)
+    f = dst / "linear" / f"image_{image:03d}.tif"
+    before = _sha(f)
+    img = np.roll(read_linear_tiff(f), (dy, dx), axis=(0, 1))
+    f.unlink()
+    write_linear_tiff(f, img)
+    for name in ("journal.jsonl", "manifest.json"):
+        p = dst / name
+        p.write_text(p.read_text().replace(before, _sha(f)))
+    return dst
+
+
+def test_uneven_leds_on_a_still_tablet_are_not_called_moved(uneven: tuple[Path, str]) -> None:
+    _, output = uneven
+    assert "QA verdict" in output, output
+    assert "moved" not in output, output
+
+
+@pytest.mark.parametrize(("image", "dx", "dy"), [(7, 2, 0), (7, 1, 1), (4, 0, 1)])
+def test_a_real_shift_of_one_image_under_uneven_leds_is_caught(
+    uneven: tuple[Path, str], tmp_path: Path, image: int, dx: int, dy: int
+) -> None:
+    session, _ = uneven
+    moved = _shifted_copy(session, tmp_path / "moved", image, dx, dy)
+    out = tmp_path / "f"
+    r = runner.invoke(app, ["fit", str(moved), "--out", str(out), "--no-ptm", "--no-hsh"])
+    assert r.exit_code == 0, r.output
+    qa = json.loads((out / "qa.json").read_text())
+    called = [c["name"] for c in qa["images"] if any("moved" in p for p in c["problems"])]
+    assert called == [f"image_{image:03d}"], qa["verdict"]
