@@ -22,6 +22,7 @@ from rti_rig.core.devices import LightCarrier
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.geometry import angle_between_deg, az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry
+from rti_rig.runtime.arm_end import PARK_TOLERANCE_DEG, ArmEnd, left_end, park_end
 from rti_rig.runtime.lighting import attempt_all
 
 #: Largest angle between the asked and the reached direction that passes (degrees).
@@ -61,6 +62,7 @@ class ArmSelfTestReport:
     checks: list[PoseCheck] = field(default_factory=list)
     #: how many poses the walk was to visit (:func:`self_test_poses`)
     planned: int = 0
+    #: the park was commanded and returned (not yet that it is where it was sent: see ``end``)
     parked: bool = False
     aborted: str | None = None
     teardown_failures: list[str] = field(default_factory=list)
@@ -77,6 +79,14 @@ class ArmSelfTestReport:
     #: what the carrier says of a park it does not hold (its torque released at the close),
     #: said with "parked"; None: nothing to add
     release_note: str | None = None
+    #: where the teardown left the arm, as read back after its stop (None: it never connected,
+    #: so nothing was moved); "parked" only of a park read back at the park pose
+    end: ArmEnd | None = None
+
+    @property
+    def park_confirmed(self) -> bool:
+        """The park returned and was read back at the park pose."""
+        return self.parked and self.end is not None and self.end.outcome == "parked"
 
     @property
     def ok(self) -> bool:
@@ -85,7 +95,7 @@ class ArmSelfTestReport:
             and not self.teardown_failures
             and bool(self.checks)
             and all(c.ok for c in self.checks)
-            and self.parked == self.park_wanted
+            and (self.park_confirmed if self.park_wanted else not self.parked)
         )
 
     def lines(self) -> list[str]:
@@ -122,26 +132,48 @@ class ArmSelfTestReport:
             # no stop or hold to speak of (it had said "stopped where it was" of an arm whose
             # port could not even be opened)
             out.append(f"ABORTED: {self.aborted} ({self.not_connected})")
-        elif self.aborted and not self.stopped:
-            # the stop failed (a servo that does not answer, one that shut down): "stopped
-            # where it was" had been said above the teardown's "it may still be moving"
-            out.append(
-                f"ABORTED: {self.aborted} (not parked; the stop did not hold every joint: "
-                "see the teardown below)"
-            )
         elif self.aborted:
+            # where it was left, and whether the stop held, is said once, on the park line
+            # below: it had been said here too ("not parked: the arm was stopped where it was",
+            # "not parked; the stop did not hold every joint"), then again as "NOT parked"
             out.append(
-                f"ABORTED: {self.aborted} (not parked: the arm was stopped where it was"
-                + ("; see the teardown below)" if self.teardown_failures else ")")
+                f"ABORTED: {self.aborted}"
+                + (" (see the teardown below)" if self.teardown_failures else "")
             )
         out.extend(f"teardown FAILED: {self._said_once(f)}" for f in self.teardown_failures)
-        if self.parked:
-            out.append("parked" + (f"; {self.release_note}" if self.release_note else ""))
-        else:
-            out.append("NOT parked" + ("" if self.park_wanted else " (park_after_session is off)"))
+        out.append(self._park_line())
         out.append(f"elapsed {self.elapsed_s:.1f} s on the rig's clock")
         out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
+
+    def _park_line(self) -> str:
+        """Where the arm was left, as read back after the teardown's stop: "parked" only of a
+        park read back within :data:`PARK_TOLERANCE_DEG` of the park pose.
+
+        Why: the check said "parked" of any park that returned, without reading where the arm
+        was, and of a check stopped early (an error, Ctrl-C) said "NOT parked" and nothing of
+        where the arm had been left, which ``run`` says (``runner.arm_end``)."""
+        end = self.end
+        policy = "" if self.park_wanted else " (park_after_session is off)"
+        if end is None:  # never connected: nothing moved (ABORTED says why)
+            return "NOT parked" + policy
+        at = (
+            f"az {end.azimuth_deg:.1f}°, el {end.elevation_deg:.1f}°"
+            if end.azimuth_deg is not None and end.elevation_deg is not None
+            else None
+        )
+        if self.park_confirmed:
+            return (
+                f"parked (read back at {at}, within {PARK_TOLERANCE_DEG:g}° of its park pose)"
+                + (f"; {self.release_note}" if self.release_note else "")
+            )
+        head = "park NOT confirmed" if self.parked else "NOT parked"
+        why = self._said_once(end.why) if end.why else ""
+        if not self.park_wanted:  # "NOT parked (park_after_session is off…)", as before
+            said = f"{head} ({why})" if why else head + policy
+        else:
+            said = f"{head}: {why}" if why else head
+        return said + (f"; left at {at} (read back)" if at else "")
 
     def _said_once(self, text: str) -> str:
         """``text`` with the aborting error's explanation, said in full under ABORTED,
@@ -246,7 +278,7 @@ def arm_self_test(
             carrier.lamp(False)
         if park:
             carrier.park()
-            report.parked = True
+            report.parked = True  # returned: whether it is at the park pose is read below
     except Exception as exc:  # a self-test reports what went wrong; teardown follows
         # a device error names its device and command; anything else by its kind (the class
         # name of our own errors had been printed to the user: "CommunicationError: arm …")
@@ -260,19 +292,48 @@ def arm_self_test(
         exc.self_test_report = report  # type: ignore[attr-defined]
         raise
     finally:
-        failures = attempt_all(
-            [
-                ("lamp off", lambda: carrier.lamp(False)),
-                ("stop", carrier.stop),
-                ("close", carrier.close),
-            ]
-        )
+        failures = attempt_all([("lamp off", lambda: carrier.lamp(False)), ("stop", carrier.stop)])
         report.stopped = not any(f.startswith("stop: ") for f in failures)
+        # read back before the close releases the port (and, by its torque policy, the joints)
+        report.end = _check_end(carrier, report, connected)
+        failures += attempt_all([("close", carrier.close)])
         note = getattr(carrier, "torque_release_note", None)
         report.release_note = note() if callable(note) else None
         report.teardown_failures = _point_back(failures)
         report.elapsed_s = clock.now() - started
     return report
+
+
+def _check_end(carrier: LightCarrier, report: ArmSelfTestReport, connected: bool) -> ArmEnd | None:
+    """Where the self-test's teardown left the arm, read back after its stop (None: it never
+    connected). The same record ``run`` keeps (:mod:`rti_rig.runtime.arm_end`): "parked" only
+    of a park that returned and read back at the park pose; a stop that did not hold every
+    joint leaves an arm that may still be moving, whose position is not read as where it is
+    left (the same rule as :meth:`rti_rig.runtime.lighting.ArmLighting.safe`)."""
+    if not connected:
+        return None
+    if report.parked:
+        return park_end(carrier, None)
+    stopped_by_user = (report.aborted or "").startswith("stopped (")
+    if not report.park_wanted:
+        why = "park_after_session is off"
+    elif stopped_by_user:
+        why = f"the check was {report.aborted}, and a stopped check does not park"
+    else:  # the ABORTED line says what ended it: parking a faulty arm is a move not made
+        why = "not attempted after the error above"
+    # no park by policy or by the user's stop: "left"; one the arm's error kept from being
+    # attempted: not confirmed (as ``run`` records them)
+    outcome = "left" if not report.park_wanted or stopped_by_user else "park-unconfirmed"
+    if not report.stopped:
+        return ArmEnd(
+            outcome,
+            None,
+            None,
+            f"{why}; the stop did not hold every joint (see the teardown above): its "
+            "position is not read as where it is left",
+        )
+    end = left_end(carrier, why)
+    return ArmEnd(outcome, end.azimuth_deg, end.elevation_deg, end.why)
 
 
 def _point_back(failures: list[str]) -> list[str]:

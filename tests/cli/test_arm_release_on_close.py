@@ -41,8 +41,8 @@ def test_a_released_park_above_the_lower_limit_is_said_not_to_be_held(
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert (
-        'parked; torque then released (torque_policy = "release_on_close", read back off on '
-        "each servo)" in said
+        "parked (read back at az 0.0°, el 10.0°, within 1° of its park pose); torque then "
+        'released (torque_policy = "release_on_close", read back off on each servo)' in said
     ), said
     assert "may lower the elevation joint from its park pose (10°), past its lower limit" in said
     assert 'set torque_policy = "hold"' in said

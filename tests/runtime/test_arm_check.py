@@ -34,6 +34,7 @@ class FakeCarrier:
         self.fail_on_move = fail_on_move
         self.refuse = refuse
         self.moves = 0
+        self.at = direction_from_az_el(*self.park_pose_deg)
 
     def connect(self) -> None:
         self.log.append("connect")
@@ -44,13 +45,21 @@ class FakeCarrier:
     def unreachable_reason(self, direction: np.ndarray) -> str | None:
         return "the fake refuses everything" if self.refuse else None
 
+    #: (azimuth, elevation) it parks at: ARM's park pose
+    park_pose_deg = (0.0, 45.0)
+
     def move_to(self, direction: np.ndarray) -> np.ndarray:
         self.moves += 1
         if self.fail_on_move == self.moves:
             raise DeviceError(self.name, "servo 2 reports an overload error")
         self.log.append("move")
         az, el = az_el_from_direction(np.asarray(direction))
-        return direction_from_az_el(float(az), float(el) - self.aim_error_deg)
+        self.at = direction_from_az_el(float(az), float(el) - self.aim_error_deg)
+        return self.at
+
+    def reached_direction(self) -> np.ndarray:
+        """Where it is (read back): its last move's or its park's direction."""
+        return self.at
 
     def lamp(self, on: bool) -> None:
         self.log.append(f"lamp {'on' if on else 'off'}")
@@ -60,6 +69,7 @@ class FakeCarrier:
 
     def park(self) -> None:
         self.log.append("park")
+        self.at = direction_from_az_el(*self.park_pose_deg)
 
 
 class RenamedCarrier(FakeCarrier):
@@ -114,7 +124,13 @@ def test_a_device_error_aborts_without_parking_but_makes_the_arm_safe() -> None:
     assert "park" not in carrier.log
     assert carrier.log[-3:] == ["lamp off", "stop", "close"]
     assert len(report.checks) == 3 and not report.checks[-1].ok
-    assert "not parked" in "\n".join(report.lines())
+    # where it was left, read back after the stop: the pose it reached before the failed one
+    assert report.end is not None and report.end.outcome == "park-unconfirmed"
+    az, el = az_el_from_direction(carrier.at)
+    assert report.end.elevation_deg == pytest.approx(float(el))
+    text = "\n".join(report.lines())
+    assert f"NOT parked: not attempted after the error above; left at az {float(az):.1f}°" in text
+    assert "parked (read back" not in text
 
 
 def test_the_heading_says_how_far_an_aborted_walk_got() -> None:
@@ -154,7 +170,9 @@ def test_park_after_session_off_is_respected() -> None:
     report = arm_self_test(carrier, ARM, VirtualClock(), park=False)
     assert report.ok
     assert "park" not in carrier.log
-    assert "NOT parked (park_after_session is off)" in report.lines()
+    assert report.end is not None and report.end.outcome == "left"
+    (line,) = [x for x in report.lines() if "parked" in x]
+    assert line.startswith("NOT parked (park_after_session is off); left at az "), line
 
 
 def test_the_real_driver_is_not_parked_after_an_error(tmp_path: Path) -> None:
@@ -207,7 +225,14 @@ def test_check_command_on_the_shipped_arm_configs(config: str, tmp_path: Path) -
     r = runner.invoke(app, ["check", str(path)])
     assert r.exit_code == 0, r.output
     assert "RESULT: PASS" in r.output
-    assert "8 poses" in r.output and "\nparked\n" in r.output and "NOT parked" not in r.output
+    # parked as read back at the park pose (the check had said "parked" of any park that
+    # returned, without reading where the arm was)
+    park_el = 45.0 if config == "virtual_arm.toml" else 10.0
+    assert "8 poses" in r.output and "NOT parked" not in r.output
+    assert (
+        f"\nparked (read back at az 0.0°, el {park_el:.1f}°, within 1° of its park pose)\n"
+        in r.output
+    ), r.output
     assert r.output.count(" ok\n") == 8
     # the heading names the arm once ("arm arm: 8 poses" on the Dynamixel configs, whose
     # driver's arm is named "arm"; "arm simulated arm" on the virtual one)

@@ -92,7 +92,10 @@ def check_rig(req: CheckRequest) -> Any:
             # the self-test's own teardown (all-off; lamp off, stop) has run on the way out
             report = getattr(exc, "self_test_report", None)
             failures = tuple(str(f) for f in getattr(report, "teardown_failures", None) or ())
-            raise CheckStopped(str(exc), lights_state(rig, bool(failures)), failures) from None
+            # where the self-test's teardown left the arm, as read back (a stopped check
+            # had said "lamp off and stop were requested" and nothing of the arm)
+            lights = lights_state(rig, bool(failures), end=getattr(report, "end", None))
+            raise CheckStopped(str(exc), lights, failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
 
 

@@ -15,9 +15,13 @@ from rti_rig.runtime.dome_policy import lights_state_sentence
 from rti_rig.runtime.lighting import DomeLighting
 
 
-def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-untyped-def]
+def lights_state(  # type: ignore[no-untyped-def]
+    rig, teardown_failed: bool = False, *, end: ArmEnd | None = None
+) -> str:
     """One sentence on the lights of ``rig`` after its teardown (``teardown_failed``: the
-    teardown's failures were printed just before, and the sentence points at them)."""
+    teardown's failures were printed just before, and the sentence points at them; ``end``:
+    where a teardown other than the session's left an arm, as read back — a stopped check's
+    self-test, whose record the rig's lighting does not hold)."""
     lighting = rig.lighting
     if getattr(rig.loaded.config, "backend", None) == "replay":
         return "a replayed acquisition has no lights to switch off"
@@ -46,7 +50,8 @@ def lights_state(rig, teardown_failed: bool = False) -> str:  # type: ignore[no-
         said = "lamp off and stop were requested"
     # where the arm was left, as read back at the teardown (it had gone unsaid: "lamp off and
     # stop were requested" after a park, after no park, and after a park that failed alike)
-    end = getattr(lighting, "end", None)
+    if end is None:
+        end = getattr(lighting, "end", None)
     if isinstance(end, ArmEnd):
         said += f"; {end.sentence()}"
     return said + after

@@ -1,0 +1,145 @@
+"""What ``rti-rig check`` says of where it left an arm, as read back after its stop.
+
+A check stopped part-way (SIGTERM, Ctrl-C) had said "lamp off and stop were requested" and
+nothing of the arm, though ``run`` says where it left it (``runner.arm_end``); a completed
+check had said "parked" of any park that returned, without reading where the arm was; and a
+check aborted by a servo fault said "not parked" twice. Each case runs the CLI on a shipped arm
+config; a stop is a real signal through the check's handler, raised at a known call.
+"""
+
+from __future__ import annotations
+
+import re
+import signal
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import CONFIGS, inprocess_arm_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.geometry import angle_between_deg, direction_from_az_el
+
+AT = re.compile(r"left at az (-?[\d.]+)°, el (-?[\d.]+)°")
+
+
+def _built_rigs(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
+    """The rigs ``rti-rig check`` builds from here on (build_rig wrapped where it is used)."""
+    import rti_rig.app.compose as compose
+    import rti_rig.app.usecases.check as check_usecase
+
+    rigs: list[Any] = []
+    real_build = compose.build_rig
+
+    def build(*args: Any, **kwargs: Any) -> Any:
+        rigs.append(real_build(*args, **kwargs))
+        return rigs[-1]
+
+    monkeypatch.setattr(compose, "build_rig", build)
+    monkeypatch.setattr(check_usecase, "build_rig", build)
+    return rigs
+
+
+def _truth(rig: Any) -> np.ndarray:
+    """Where the lamp really is: the emulated servos' present positions, or the simulation's."""
+    emulator = getattr(rig, "emulator", None)
+    if emulator is None:
+        return np.asarray(rig.lighting.carrier.reached_direction())
+    from rti_rig.simulator.dynamixel_emulator import lamp_direction
+
+    return np.asarray(lamp_direction(emulator, rig.loaded.config.arm.dynamixel))
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+@pytest.mark.parametrize("config", ["virtual_arm.toml", "simulated_arm.toml (inprocess)"])
+def test_a_check_stopped_by_sigterm_says_where_the_arm_is_left(
+    config: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = inprocess_arm_config(tmp_path) if "inprocess" in config else CONFIGS / config
+    rigs = _built_rigs(monkeypatch)
+    moves: list[int] = []
+
+    def sigterm_at_third_move(carrier: Any) -> None:
+        real_move = carrier.move_to
+
+        def move_to(direction: np.ndarray) -> np.ndarray:
+            moves.append(1)
+            if len(moves) == 3:  # the user's SIGTERM, through the check's own handler
+                signal.raise_signal(signal.SIGTERM)
+            return real_move(direction)
+
+        carrier.move_to = move_to
+
+    import rti_rig.app.usecases.check as check_usecase
+
+    real_self_test = check_usecase.arm_self_test
+
+    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
+        sigterm_at_third_move(carrier)
+        return real_self_test(carrier, *args, **kwargs)
+
+    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+    r = CliRunner().invoke(app, ["check", str(path)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 143, said
+    assert "Traceback" not in said
+    assert (
+        "Check stopped (SIGTERM): lamp off and stop were requested; the arm was not parked and "
+        "is left at az " in said
+    ), said
+    assert "(read back; the check was stopped (SIGTERM), and a stopped check does not park)" in said
+    found = AT.search(said)
+    assert found, said
+    said_dir = direction_from_az_el(float(found[1]), float(found[2]))
+    (rig,) = rigs
+    # what was said is where the arm really is (to the sentence's 0.1°), not its park pose
+    assert float(angle_between_deg(said_dir, _truth(rig))) < 0.2, said
+    park = direction_from_az_el(*rig.lighting.carrier.park_pose_deg)
+    assert float(angle_between_deg(said_dir, park)) > 5.0
+
+
+def test_a_park_that_returns_off_its_pose_is_not_said_parked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The emulated arm's park returns without moving (as a goal the servos ignored would): the
+    check had said "parked" and PASS of an arm it had left at its last pose."""
+    rigs = _built_rigs(monkeypatch)
+    import rti_rig.app.usecases.check as check_usecase
+
+    real_self_test = check_usecase.arm_self_test
+
+    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
+        carrier.park = lambda: None
+        return real_self_test(carrier, *args, **kwargs)
+
+    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+    r = CliRunner().invoke(app, ["check", str(inprocess_arm_config(tmp_path))], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "park NOT confirmed: read back " in said and "from the park pose (az 0°, el 10°)" in said
+    assert not re.search(r"(^| )parked", said), said
+    found = AT.search(said)
+    assert found, said
+    said_dir = direction_from_az_el(float(found[1]), float(found[2]))
+    assert float(angle_between_deg(said_dir, _truth(rigs[0]))) < 0.2, said
+
+
+def test_a_check_aborted_by_an_overload_says_not_parked_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Servo 2 overloads (its torque off, so the stop cannot hold it): the abort line had said
+    "not parked; the stop did not hold every joint" and the park line "NOT parked" again."""
+    fault = '\n[[emulator.faults]]\nat_command = 60\nkind = "overload"\nservo_id = 2\n'
+    cfg = inprocess_arm_config(tmp_path, fault)
+    r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert said.lower().count("not parked") == 1, said
+    assert said.count("the stop did not hold every joint") == 1, said
+    assert (
+        "NOT parked: not attempted after the error above; the stop did not hold every joint "
+        "(see the teardown above): its position is not read as where it is left" in said
+    ), said
