@@ -772,16 +772,29 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     return f"No image was completed, but {out_dir} holds files of the camera. {resume_hint}"
 
 
-def _print_teardown_failures(folder) -> bool:  # type: ignore[no-untyped-def]
+def _print_teardown_failures(  # type: ignore[no-untyped-def]
+    folder, said_below: BaseException | None = None
+) -> bool:
     """What could not be made safe when a session stopped early (the controller records it in
-    the manifest; the lights' state line that follows refers to it); True if any."""
-    return _print_failures((folder.manifest.get("runner") or {}).get("teardown_failures"))
+    the manifest; the lights' state line that follows refers to it); True if any.
+    ``said_below``: the session's error, printed in full after these lines."""
+    failures = (folder.manifest.get("runner") or {}).get("teardown_failures")
+    return _print_failures(failures, said_below)
 
 
-def _print_failures(failures) -> bool:  # type: ignore[no-untyped-def]
-    """Each teardown failure on its own line; True if there was any."""
+def _print_failures(  # type: ignore[no-untyped-def]
+    failures, said_below: BaseException | None = None
+) -> bool:
+    """Each teardown failure on its own line; True if there was any. The explanation of
+    ``said_below`` (the error printed after them) is pointed to, not repeated: an arm's servo
+    fault met again by the teardown's stop had its paragraph of what to do printed twice, in
+    the stop's failure and in the error (the manifest keeps both in full)."""
+    from rti_rig.runtime.arm_check import said_once
+
+    detail = getattr(said_below, "message", None)
     for failure in failures or ():
-        err.print(f"[red]teardown problem:[/] {escape(str(failure))}")
+        said = said_once(str(failure), detail, "as in the error below")
+        err.print(f"[red]teardown problem:[/] {escape(said)}")
     return bool(failures)
 
 
@@ -1056,7 +1069,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
-        state = lights_state(rig, _print_teardown_failures(folder))
+        state = lights_state(rig, _print_teardown_failures(folder, said_below=exc))
         err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
         raise fail(_write_failed_said(exc, opened)) from None
     except Exception as exc:

@@ -178,11 +178,17 @@ class ArmSelfTestReport:
     def _said_once(self, text: str) -> str:
         """``text`` with the aborting error's explanation, said in full under ABORTED,
         shortened to its first clause (the fault itself) and a pointer back."""
-        detail = self.aborted_detail
-        if not detail or len(detail) < 60 or detail not in text:
-            return text
-        head = detail.split(";", 1)[0]
-        return text.replace(detail, f"{head} (as under ABORTED above)")
+        return said_once(text, self.aborted_detail, "as under ABORTED above")
+
+
+def said_once(text: str, detail: str | None, pointer: str) -> str:
+    """``text`` with ``detail`` (an error's explanation, said in full elsewhere) shortened to
+    its first clause (the fault itself) and ``(pointer)``: a servo fault's paragraph of what to
+    do is said once, not again by every teardown step that met the same fault."""
+    if not detail or len(detail) < 60 or detail not in text:
+        return text
+    head = detail.split(";", 1)[0]
+    return text.replace(detail, f"{head} ({pointer})")
 
 
 def not_connected_sentence(carrier: object, connected: bool | None = None) -> str | None:

@@ -154,8 +154,8 @@ class ArmLighting:
     overload — "the arm is blocked" —, a move timeout, a servo that stopped answering), or whose
     stop did not hold every joint, is not parked: the park is a move sent to both joints, and
     it had driven the healthy joint round while the faulty one hung limp (the self-test,
-    :mod:`rti_rig.runtime.arm_check`, already kept this rule). The teardown says why it was
-    not parked.
+    :mod:`rti_rig.runtime.arm_check`, already kept this rule). :attr:`end` says why it was not
+    parked (a park not attempted by this rule is no teardown failure: nothing failed).
     """
 
     def __init__(
@@ -244,16 +244,17 @@ class ArmLighting:
                 if stop_failed
                 else "it was left where it stopped"
             )
+            # said once, as where the arm was left: it had also been listed as a teardown
+            # failure ("park: not attempted because …"), and the arm's sentence repeated it
             self.end = ArmEnd(
-                "park-unconfirmed", None, None, f"not attempted because the arm's {why} (above)"
+                "park-unconfirmed",
+                None,
+                None,
+                f"not attempted because the arm's {why}: parking is a move of both joints, and "
+                f"a faulty or blocked arm must not be driven near the object; {left}. Clear the "
+                "fault (its error says how), then park it with 'rti-rig check'",
             )
-            return [
-                *failures,
-                f"park: not attempted because the arm's {why}: parking is a move of both "
-                f"joints, and a faulty or blocked arm must not be driven near the object; "
-                f"{left}. Clear the fault (its error says how), then park it with "
-                "'rti-rig check'",
-            ]
+            return failures
         parked = attempt_all([("park", self.carrier.park)])
         self.end = park_end(self.carrier, parked[0] if parked else None)
         return failures + parked

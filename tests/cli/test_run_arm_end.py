@@ -139,6 +139,27 @@ def test_a_park_that_fails_is_said_not_confirmed(tmp_path: Path) -> None:
     assert end["outcome"] == "park-unconfirmed" and "jammed" in end["why"]
 
 
+def test_a_fault_that_blocks_the_park_is_said_once(tmp_path: Path) -> None:
+    """Servo 2 overloads mid-run (its torque off): the park is not attempted. Why had been
+    said twice (a "park: not attempted because …" teardown problem, then the arm's sentence
+    "park is NOT confirmed: not attempted because …"), and the fault's paragraph of what to do
+    twice too (in the teardown's stop, then in the error)."""
+    cfg = _config(tmp_path, "simulated_arm.toml")
+    with cfg.open("a") as f:
+        f.write('\n[[emulator.faults]]\nat_command = 200\nkind = "overload"\nservo_id = 2\n')
+    code, said, out = _run(tmp_path, cfg, lights=6)
+    assert code == 2, said
+    assert "Traceback" not in said
+    assert said.count("not attempted because the arm's own move failed") == 1, said
+    assert (
+        "the arm's park is NOT confirmed: not attempted because the arm's own move failed: "
+        "parking is a move of both joints" in said
+    ), said
+    assert said.count("clear the obstruction") == 1, said  # in the error, said last
+    assert said.rindex("clear the obstruction") > said.index("(as in the error below)"), said
+    assert _arm_end(out)["outcome"] == "park-unconfirmed"
+
+
 def test_a_dome_s_time_line_says_nothing_of_moving(tmp_path: Path) -> None:
     """The moving time is an arm's: a dome's session time has no such part."""
     code, said, _ = _run(tmp_path, _config(tmp_path, "simulated_dome.toml"))
