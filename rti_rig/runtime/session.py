@@ -1000,6 +1000,10 @@ class SessionFolder:
             lp_error = exc
         run = self.manifest["runs"][-1]
         run.update({"finished_at": _now_iso(), "finish_reason": runner["finish_reason"], **timing})
+        if "arm_end" in runner:
+            # each run's own record of where it left the arm: ``runner`` is the last run's
+            # alone (a resume resets it), so a resumed session had kept only the last park
+            run["arm_end"] = runner["arm_end"]
         runs = self.manifest["runs"]
         self.manifest.update(
             {

@@ -131,6 +131,30 @@ def test_a_sigterm_on_the_virtual_arm_says_it_is_left_where_it_stopped(tmp_path:
     assert "park_on_emergency_stop is off" in said, said
 
 
+def test_each_run_of_a_resumed_session_keeps_where_it_left_the_arm(tmp_path: Path) -> None:
+    """The manifest's ``runner`` is the last run's alone (a resume resets it), so a session
+    stopped with the arm left mid-band and then resumed to its park had kept only "parked":
+    each run's record now stays with it, under ``runs[i].arm_end``."""
+    cfg = _config(tmp_path, "virtual_arm.toml")
+    code, said, out = _run(tmp_path, cfg, ARM_END_SIGTERM_AT="3")
+    assert code == 143, said
+    hook = tmp_path / "hook.py"
+    proc = subprocess.run(
+        [sys.executable, str(hook), "run", "--resume", str(out), "--no-verdict"],
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 0, said
+    runs = json.loads((out / "manifest.json").read_text())["runs"]
+    assert [r["finish_reason"] for r in runs] == ["emergency-stop", "completed"]
+    assert runs[0]["arm_end"]["outcome"] == "left" and runs[0]["arm_end"]["azimuth_deg"] is not None
+    assert runs[1]["arm_end"]["outcome"] == "parked"
+    assert _arm_end(out) == runs[1]["arm_end"]
+
+
 def test_a_park_that_fails_is_said_not_confirmed(tmp_path: Path) -> None:
     code, said, out = _run(tmp_path, _config(tmp_path, "virtual_arm.toml"), ARM_END_JAM="1")
     assert code == 1, said  # complete, but not brought to a known safe state
