@@ -75,7 +75,9 @@ class ArmEnd:
             why = f"; {self.why}" if self.why else ""
             if at:
                 return f"the arm was not parked and is left at {at} (read back{why})"
-            return f"the arm was not parked and is left where it stopped ({self.why})"
+            # no position: the why says whether it was not read or may still be moving ("left
+            # where it stopped" had been said beside "the stop failed, so it may still be moving")
+            return f"the arm was not parked ({self.why})"
         where = f"; read back at {at}" if at else ""
         return f"the arm's park is NOT confirmed: {self.why}{where}"
 

@@ -101,6 +101,45 @@ def test_a_check_stopped_by_sigterm_says_where_the_arm_is_left(
     assert float(angle_between_deg(said_dir, park)) > 5.0
 
 
+def test_a_stopped_check_whose_stop_failed_is_not_said_left_where_it_stopped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """SIGTERM as the azimuth servo stops answering: the teardown's stop cannot hold that
+    joint, which may still be moving to its last goal. The arm's sentence had said "left where
+    it stopped" beside "the stop did not hold every joint"."""
+    rigs = _built_rigs(monkeypatch)
+    import rti_rig.app.usecases.check as check_usecase
+
+    real_self_test = check_usecase.arm_self_test
+    moves: list[int] = []
+
+    def self_test(carrier: Any, *args: Any, **kwargs: Any) -> Any:
+        real_move = carrier.move_to
+
+        def move_to(direction: np.ndarray) -> np.ndarray:
+            moves.append(1)
+            if len(moves) == 3:
+                rigs[0].emulator.silent_ids.add(1)
+                signal.raise_signal(signal.SIGTERM)
+            return real_move(direction)
+
+        carrier.move_to = move_to
+        return real_self_test(carrier, *args, **kwargs)
+
+    monkeypatch.setattr(check_usecase, "arm_self_test", self_test)
+    r = CliRunner().invoke(app, ["check", str(inprocess_arm_config(tmp_path))], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert r.exit_code == 143, said
+    assert "teardown problem: stop:" in said, said
+    assert (
+        "Check stopped (SIGTERM): lamp off and stop were requested; the arm was not parked (the "
+        "check was stopped (SIGTERM), and a stopped check does not park; the stop did not hold "
+        "every joint (see the teardown above): its position is not read as where it is left)"
+        in said
+    ), said
+    assert "left where it stopped" not in said and "left at az" not in said, said
+
+
 def test_a_park_that_returns_off_its_pose_is_not_said_parked(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
