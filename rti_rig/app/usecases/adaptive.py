@@ -746,6 +746,49 @@ def images_sure(header: dict[str, Any]) -> int:
     return min(total, least)
 
 
+def images_before_rig(  # type: ignore[no-untyped-def]
+    loaded,
+    offered: int | None,
+    lights: int | None,
+    until_error_deg: float | None,
+    min_lights: int | None,
+    band: tuple[float, float] = _FULL_BAND,
+) -> tuple[int, int]:
+    """The images a new adaptive session is sure to take and the most it may take, from its
+    request and rig config alone, as :func:`images_sure` counts them once the rig is built:
+    its ``--lights`` (checked against what the rig offers) or its cap, the config's
+    ``default_lights`` or every light offered; with --until-error and no --lights, its
+    starting lights (or --min-lights if larger). ``offered``: a dome's lights in the band
+    (None on an arm, whose lights in reach are counted here before its lighting rules, which
+    need the rig, drop any: the figure is then at most the session's).
+
+    Why: the disk check of an adaptive session had waited for the rig (the dome's port
+    opened, the fit warmed up, ~13 s on emulated_dome) when a planned run's refusal comes
+    before it; what the session needs is known from its request."""
+    if offered is None:  # an arm: its lights in reach, before its lighting rules
+        from rti_rig.app.config import rig_geometry
+        from rti_rig.planner.uniform import arm_below
+
+        geometry = rig_geometry(loaded)
+        assert isinstance(geometry, ArmGeometry)
+        within = len(candidates_for(arm_below(geometry, band[1]), band[0]).directions)
+        cap = min(ARM_MAX_LIGHTS, within)
+    else:
+        within = cap = offered
+    default = None if lights is not None else default_max_lights(loaded, until_error_deg)
+    if default is not None:
+        cap = min(cap, default)
+    most = min(lights, within) if lights is not None else cap
+    header = {
+        "max_lights": most,
+        "until_error_deg": until_error_deg,
+        "min_lights": min_lights,
+        "start_lights": min(START_LIGHTS, most),
+        "design_lights": most if lights is not None else None,
+    }
+    return images_sure(header), most
+
+
 def default_max_lights(loaded, until_error_deg: float | None) -> int | None:  # type: ignore[no-untyped-def]
     """The maximum of an adaptive session given neither ``--lights`` nor ``--until-error``:
     the rig config's ``default_lights``, as ``--lights`` documents its default and a planned
@@ -1267,9 +1310,14 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     objective: str = "normals",
     min_lights: int | None = None,
     band: tuple[float, float] = _FULL_BAND,
+    check_room: Callable[[int, int], None] | None = None,
 ):
     """Check the request and the folder, open the rig, plan the start, make the folder
     (``band``: the elevations every light is chosen between, :func:`adaptive_plan`).
+
+    ``check_room``: called with the images the session is sure to take and its most
+    (:func:`images_before_rig`) once the request and the folder pass, before the rig is built;
+    it raises to refuse the session (the disk cannot hold them).
 
     Returns (rig, starting schedule, folder, step source); the rig is closed if anything after
     opening it fails.
@@ -1300,6 +1348,8 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
         if min_lights is not None:
             _check_min_within(min_lights, offered, band)
     SessionFolder.check_new(out_dir)
+    if check_room is not None:  # the disk, before the rig is built (as a planned run's)
+        check_room(*images_before_rig(loaded, offered, lights, until_error_deg, min_lights, band))
     warm_up_fit()  # the robust kernel loaded (or compiled) now, not after the fourth light
     rig = build_rig(loaded)
     try:

@@ -971,6 +971,24 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
     if req.lights is not None:
         check_light_count(req.lights)
     identity = rig_identity(loaded)
+
+    def check_room(sure: int, most: int) -> None:
+        """The images it is sure to take, as the controller counts them; the rest, image by
+        image. Asked before the rig is built, as a planned run's (it had come after)."""
+        try:
+            check_disk_holds(loaded, req.out_dir, sure)
+        except NoSpaceError as exc:
+            if sure >= most:
+                raise
+            raise NoSpaceError(
+                f"{exc} (the {exc.steps} are the lights it is sure to take; it may take up "
+                f"to {most}, each checked for room as it comes)",
+                exc.where,
+                exc.steps,
+                exc.need,
+                exc.free,
+            ) from None
+
     rig, schedule, folder, source = open_adaptive_session(
         loaded,
         req.out_dir,
@@ -979,25 +997,9 @@ def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ig
         req.objective or "normals",
         req.min_lights,
         (req.min_elevation_deg, req.max_elevation_deg),
+        check_room=check_room,
     )
     folder.rig_identity = identity
-    try:  # the images it is sure to take, as the controller counts them; the rest, image by image
-        check_disk_holds(loaded, req.out_dir, source.sure_total)
-    except NoSpaceError as exc:
-        rig.close()
-        if source.sure_total >= source.total:
-            raise
-        raise NoSpaceError(
-            f"{exc} (the {exc.steps} are the lights it is sure to take; it may take up to "
-            f"{source.total}, each checked for room as it comes)",
-            exc.where,
-            exc.steps,
-            exc.need,
-            exc.free,
-        ) from None
-    except BaseException:
-        rig.close()
-        raise
     return OpenedSession(rig, schedule, folder, Path(req.out_dir), source=source)
 
 
