@@ -12,7 +12,6 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from enum import StrEnum
-from pathlib import Path
 from typing import Any, Protocol
 
 from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame, FramePacedCamera
@@ -22,12 +21,14 @@ from rti_rig.core.schedule import LightSchedule, LightStep
 from rti_rig.runtime.deferred_signals import signals_deferred
 from rti_rig.runtime.rig import Rig
 from rti_rig.runtime.session import (
+    FRAME_SIZE_KEY,
     NoSpaceError,
     SessionFolder,
     SessionWriteError,
     StepRecord,
     check_free_space,
     estimated_bytes_per_image,
+    recorded_frame_size,
     steps_to_hold,
 )
 
@@ -507,7 +508,7 @@ SIZE_TOLERANCE = 0.05
 
 def _checked_real_size(
     rig: Rig,
-    root: Path,
+    folder: SessionFolder,
     got: tuple[int, int, bool],
     per_image: int,
     left: int,
@@ -515,14 +516,18 @@ def _checked_real_size(
 ) -> int:
     """The bound on one image's files for the rest of the run, from the first real frame
     (``got``: height, width, colour): where it is not the ``[camera]`` width x height (beyond
-    :data:`SIZE_TOLERANCE`), says once that the config's size is wrong, naming the keys, and
-    checks the disk again for the ``left`` images still to take at the real size (raising
+    :data:`SIZE_TOLERANCE`), says once a session that the config's size is wrong, naming the
+    keys, records the real size in the manifest (``rig.frame_size``), and checks the disk
+    again for the ``left`` images still to take at the real size (raising
     :class:`~rti_rig.runtime.session.NoSpaceError`, with the images kept, if it cannot hold
     them).
 
     Why: ``[camera] width``/``height`` default to 512 x 512 and nothing compared them with a
     real camera's frames, so the start-up check counted a 24 MP camera's images as 0.26 MP
-    and let a session start that the disk could not hold."""
+    and let a session start that the disk could not hold. Said once a session: each resume
+    had said it again, as if newly found, and told the user to set the keys, which a resume
+    then refused (the session's recorded camera size changed); a resume counts the disk at
+    the recorded real size from its start."""
     if rig.size_from_frame is None:
         return per_image
     cam = rig.camera_config
@@ -530,18 +535,24 @@ def _checked_real_size(
     said = cam.width * cam.height
     if abs(width * height - said) <= SIZE_TOLERANCE * said:
         return per_image
-    emit(
-        DeviceSays(
-            rig.camera.name,
-            f"The camera delivers {got[1]} x {got[0]} px images, but camera.width x "
-            f"camera.height in {rig.loaded.path} say {cam.width} x {cam.height} px: set "
-            f"camera.width = {width} and camera.height = {height} there. The disk was "
-            f"checked for images of the config's size; the {left} image(s) left are checked "
-            "again at the real size",
+    if recorded_frame_size(folder.manifest, cam.width, cam.height) != (got[1], got[0]):
+        emit(
+            DeviceSays(
+                rig.camera.name,
+                f"The camera delivers {got[1]} x {got[0]} px images, but camera.width x "
+                f"camera.height in {rig.loaded.path} say {cam.width} x {cam.height} px: for "
+                f"new sessions, set camera.width = {width} and camera.height = {height} there "
+                "(a --resume of this one needs the config's size as it began: the real one "
+                "is recorded in its manifest). The disk was checked for images of the "
+                f"config's size; the {left} image(s) left are checked again at the real size",
+            )
         )
-    )
+        folder.manifest.setdefault("rig", {})[FRAME_SIZE_KEY] = {
+            "frames": [got[1], got[0]],
+            "config": [cam.width, cam.height],
+        }
     if left:
-        check_free_space(root, left, real, holds_images=True)
+        check_free_space(folder.root, left, real, holds_images=True)
     return real
 
 
@@ -592,6 +603,9 @@ def run_session(
     todo = [i for i in range(total) if i not in done]
     cam = rig.camera_config
     per_image = rig.bytes_per_image or estimated_bytes_per_image(cam.width, cam.height)
+    seen = recorded_frame_size(folder.manifest, cam.width, cam.height)
+    if seen is not None and rig.size_from_frame is not None:  # a resume: its camera's real size
+        per_image = rig.size_from_frame(*seen)[2]
     sure = total if source is None else getattr(source, "sure_total", total)
     check_free_space(
         folder.root, steps_to_hold(total, len(done), sure), per_image, holds_images=bool(done)
@@ -733,7 +747,7 @@ def run_session(
             if not size_checked:  # once a run: its first frame is the camera's real size
                 size_checked = True
                 left = steps_to_hold(total, len(done) + len(records), sure)
-                per_image = _checked_real_size(rig, folder.root, got, per_image, left, emit)
+                per_image = _checked_real_size(rig, folder, got, per_image, left, emit)
         else:
             if source is not None:  # run to its maximum: never asked for the step past it
                 concluded = source.conclude()

@@ -280,6 +280,29 @@ def estimated_bytes_per_image(
     return total
 
 
+#: The manifest's record (under ``rig``) of a session whose camera delivered frames of another
+#: size than its ``[camera]`` width x height: ``{"frames": [w, h], "config": [w, h]}``.
+FRAME_SIZE_KEY = "frame_size"
+
+
+def recorded_frame_size(
+    manifest: dict[str, Any], width: int, height: int
+) -> tuple[int, int] | None:
+    """The frame size (width, height) the session's camera was seen to deliver, where its
+    manifest records one that differed from a ``[camera]`` of ``width`` x ``height`` (the
+    config as it still is); None otherwise.
+
+    Why: a resume counted the disk at the config's size again (a 24 MP camera's images as
+    0.26 MP) and said the config's size was wrong again, as if newly found."""
+    seen = (manifest.get("rig") or {}).get(FRAME_SIZE_KEY)
+    if not isinstance(seen, dict) or list(seen.get("config") or []) != [width, height]:
+        return None
+    frames = seen.get("frames")
+    if not (isinstance(frames, list) and len(frames) == 2):
+        return None
+    return int(frames[0]), int(frames[1])
+
+
 class NoSpaceError(SessionError):
     """The disk cannot hold the next image(s): checked before the rig starts and before each
     image, so the session stops cleanly rather than on a write that fails half-way.

@@ -79,3 +79,47 @@ def test_the_wrong_size_is_said_once_and_a_disk_with_room_goes_on(
     assert r.exit_code == 0, r.output
     assert said.count("The camera delivers 256 x 256 px images") == 1, said
     assert len(read_lp(out / "lights.lp")) == LIGHTS
+
+
+def test_a_resume_counts_the_disk_at_the_real_size_and_does_not_say_it_again(
+    tmp_path: Path, bigger_camera: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The session stopped by the disk after its first image is resumed: the resume had
+    counted the disk at the config's 64 x 64 again (let through, it took one more image before
+    the same refusal) and, once room was made, said the config's size was wrong again as if
+    newly found, telling the user to set the keys, which the resume then refuses."""
+    import json
+
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=10_000_000))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2 and len(read_lp(out / "lights.lp")) == 1, r.output
+    seen = json.loads((out / "manifest.json").read_text())["rig"]["frame_size"]
+    assert seen == {"frames": [256, 256], "config": [64, 64]}
+    # 10 MB hold the 7 left at 64 x 64, not at the 256 x 256 the camera delivers
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    said = _said(r)
+    assert r.exit_code == 2, said
+    assert "not enough free disk space to go on with" in said, said
+    assert "the 7 image(s) still to shoot" in said and "capturing" not in said, said
+    assert len(read_lp(out / "lights.lp")) == 1
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    said = _said(r)
+    assert r.exit_code == 0, said
+    assert "The camera delivers" not in said, said
+    assert len(read_lp(out / "lights.lp")) == LIGHTS
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["rig"]["frame_size"] == seen
+
+
+def test_the_note_says_the_keys_are_for_new_sessions(tmp_path: Path, bigger_camera: Path) -> None:
+    """Setting them mid-session gets its resume refused (the session's recorded camera size
+    changes): the note had said to set them, with no word of that."""
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
+    said = _said(r)
+    assert r.exit_code == 0, said
+    assert "for new sessions, set camera.width = 256 and camera.height = 256 there" in said
+    assert "a --resume of this one needs the config's size as it began" in said, said

@@ -688,15 +688,20 @@ def _timed_limit(rig: Rig):  # type: ignore[no-untyped-def]
     return timed_exposure_limit(rig.loaded) if isinstance(rig.loaded, LoadedRig) else None
 
 
-def check_disk_holds(loaded, root: Path, steps: int) -> None:  # type: ignore[no-untyped-def]
-    """Refuse a session whose images the disk under ``root`` cannot hold, before the rig opens.
+def check_disk_holds(  # type: ignore[no-untyped-def]
+    loaded, root: Path, steps: int, frames: tuple[int, int] | None = None
+) -> None:
+    """Refuse a session whose images the disk under ``root`` cannot hold, before the rig opens
+    (``frames``: the frame size its camera was seen to deliver, counted instead of the
+    config's, :func:`~rti_rig.runtime.session.recorded_frame_size`).
 
     Why: the controller checks this too, but only as the capture begins: a full disk had been
     refused after the rig opened and below a drawn "capturing 0/48" progress bar, as if the
     capture had started. The controller's own check stays (the disk may fill meanwhile)."""
-    from rti_rig.app.disk_estimate import bytes_per_image
+    from rti_rig.app.disk_estimate import bytes_per_image, size_from_frame
 
-    check_free_space(root, steps, bytes_per_image(loaded))
+    per = bytes_per_image(loaded) if frames is None else size_from_frame(loaded)(*frames)[2]
+    check_free_space(root, steps, per)
 
 
 def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  # type: ignore[no-untyped-def]
@@ -706,7 +711,7 @@ def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  
     is refused ("drop --out"); nor did it say that the images taken are kept or how to go on,
     which the same disk refusal had said when it came after the rig opened. The caller adds
     the command to continue with (it knows the options the resume was given)."""
-    from rti_rig.runtime.session import LP_NAME, steps_to_hold
+    from rti_rig.runtime.session import LP_NAME, recorded_frame_size, steps_to_hold
 
     done, total = len(folder.done), folder.total_steps
     header = folder.manifest.get("adaptive")
@@ -716,8 +721,10 @@ def _check_disk_holds_rest(loaded, folder: SessionFolder, root: Path) -> None:  
         sure = images_sure(header)
     else:
         sure = total
-    try:
-        check_disk_holds(loaded, root, steps_to_hold(total, done, sure))
+    cam = loaded.config.camera
+    frames = recorded_frame_size(folder.manifest, cam.width, cam.height)
+    try:  # at the size its camera was seen to deliver, where the config's was wrong
+        check_disk_holds(loaded, root, steps_to_hold(total, done, sure), frames)
     except NoSpaceError as exc:
         if done:
             listed = f", listed in {LP_NAME}" if folder.lp_listing()[0] else ""
