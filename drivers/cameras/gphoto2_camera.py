@@ -30,7 +30,7 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.drivers.cameras.folder_watch import is_raw_file
-from rti_rig.drivers.cameras.raw_decode import RawDecodeError, decode_raw
+from rti_rig.drivers.cameras.raw_decode import RawDecodeError, RawFileMissingError, decode_raw
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
 #: libgphoto2's name for an object of a capture kept in the camera's RAM when the body gives
@@ -588,6 +588,8 @@ class Gphoto2Camera:
         raw_path = saved[raw_files[0][1]]
         try:
             decoded = decode_raw(raw_path, s.decode, timestamp_s=t_capture)
+        except RawFileMissingError as exc:
+            raise self._download_gone(raw_path, raw_files[0]) from exc
         except CaptureError as exc:
             raise self._undecoded(raw_path, raw_files[0][1], exc) from exc
         jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
@@ -639,6 +641,32 @@ class Gphoto2Camera:
             white_level=decoded.white_level,
             timestamp_s=t_capture,
             metadata=metadata,
+        )
+
+    def _download_gone(self, raw_path: Path, camera_file: tuple[str, str]) -> CaptureError:
+        """The error for a RAW downloaded and then gone before it was decoded: the file the
+        camera reported, the folder it was downloaded into and looked for in, where the
+        camera's copy is, and what to do.
+
+        Why: it said "the camera's file IMG_0002.CR2 would not decode; it is kept at
+        raw/.incoming/cap0002_IMG_0002.CR2 … RAW file not found (moved or deleted before it
+        was read)": a file said kept that was gone, no word of the camera's folder or of
+        what took it."""
+        folder, name = camera_file
+        on_camera = f"{folder.rstrip('/')}/{name}"
+        if self.settings.delete_from_camera:
+            copy = "the camera's copy was deleted after the download, so this shot is lost"
+        else:
+            copy = f"the camera's copy is left on the camera at {on_camera}"
+        where = raw_path.parent
+        return CaptureError(
+            self.name,
+            f"the camera reported {on_camera} and it was downloaded into {where} as "
+            f"{raw_path.name}, but it was gone from there before it could be decoded (moved or "
+            "deleted by another program: a sync, backup or antivirus tool, or a clean-up of "
+            f"that folder); {copy}. Keep other programs out of {where} (exclude it "
+            "from them), then run again (a resumed session shoots this image again)",
+            "decode",
         )
 
     def _undecoded(self, raw_path: Path, camera_name: str, exc: CaptureError) -> CaptureError:

@@ -936,3 +936,51 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
     assert [kept["camera_file"] for kept in strays.values()] == ["_DSC0002.DNG"], strays
     assert "shot before this run connected" in said, said
     assert ("only to within 10 min" in said) is restarted, said
+
+
+@pytest.mark.parametrize("delete", [True, False])
+def test_a_download_gone_before_its_decode_names_the_camera_s_file_the_folder_and_what_to_do(
+    body, tmp_path, monkeypatch, delete
+):
+    """Another program (a sync, backup or antivirus tool) takes the second shot's RAW out of
+    the session's download folder as soon as it is written. The run had said "the camera's
+    file IMG_0002.CR2 would not decode; it is kept at …/cap0002_IMG_0002.CR2 … RAW file not
+    found (moved or deleted before it was read)": a file said kept that was gone, with no word
+    of the camera's folder, of what took it or of what to do."""
+    import os
+
+    text = DSLR_CONFIG.read_text()
+    if not delete:
+        text = text.replace(
+            'image_format = "RAW"', 'image_format = "RAW"\ndelete_from_camera = false'
+        )
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "dslr.toml"
+    config.write_text(text)
+    gp = sys.modules["gphoto2"]
+    save = gp.CameraFile.save
+    written: list[str] = []
+
+    def saved_then_taken(self, target: str) -> None:  # the other program, as the file lands
+        save(self, target)
+        written.append(target)
+        if len(written) == 2:
+            os.unlink(target)
+
+    monkeypatch.setattr(gp.CameraFile, "save", saved_then_taken)
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "3")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, result.output
+    incoming = out / "raw" / ".incoming"
+    assert "RAW file not found" not in said and "would not decode" not in said, said
+    assert f"downloaded into {incoming} as cap0002_IMG_0002.CR2" in said, said
+    assert "/IMG_0002.CR2 and it was downloaded" in said, said
+    assert "moved or deleted by another program" in said, said
+    assert f"Keep other programs out of {incoming}" in said, said
+    assert "a resumed session shoots this image again" in said, said
+    lost = "so this shot is lost" in said
+    assert lost == delete, said
+    assert [e["index"] for e in journal(out)] == [0]
