@@ -58,9 +58,11 @@ def test_the_bound_holds_what_each_mode_writes_and_not_twice_that(
 ) -> None:
     kept, camera_jpeg = _written(tmp_path, mode)
     bound = estimated_bytes_per_image(W, H, mode, kept_raw=True)
-    assert kept <= bound <= 1.3 * kept, (mode, kept, bound)
+    # within half as much again: the JPEG's allowance is the worst JPEG's (a noisy object's,
+    # tests/app/test_jpeg_allowance.py), this smooth scene's is a tenth of it
+    assert kept <= bound <= 1.5 * kept, (mode, kept, bound)
     with_jpeg = estimated_bytes_per_image(W, H, mode, kept_raw=True, kept_jpeg=True)
-    # the JPEGs' bound is generous (half a byte a sample): only that it is counted, in full
+    # the JPEGs' bound is the worst JPEG's (a byte a sample): only that it is counted, in full
     assert kept + camera_jpeg <= with_jpeg and with_jpeg - bound >= 3 * W * H // 2, with_jpeg
 
 
