@@ -525,9 +525,9 @@ def _checked_real_size(
     Why: ``[camera] width``/``height`` default to 512 x 512 and nothing compared them with a
     real camera's frames, so the start-up check counted a 24 MP camera's images as 0.26 MP
     and let a session start that the disk could not hold. Said once a session: each resume
-    had said it again, as if newly found, and told the user to set the keys, which a resume
-    then refused (the session's recorded camera size changed); a resume counts the disk at
-    the recorded real size from its start."""
+    had said it again, as if newly found; a resume counts the disk at the recorded real size
+    from its start, and takes the config corrected to it (the recorded size is the session's
+    own: :func:`rti_rig.app.usecases.session.check_resume_rig`)."""
     if rig.size_from_frame is None:
         return per_image
     cam = rig.camera_config
@@ -540,11 +540,11 @@ def _checked_real_size(
             DeviceSays(
                 rig.camera.name,
                 f"The camera delivers {got[1]} x {got[0]} px images, but camera.width x "
-                f"camera.height in {rig.loaded.path} say {cam.width} x {cam.height} px: for "
-                f"new sessions, set camera.width = {width} and camera.height = {height} there "
-                "(a --resume of this one needs the config's size as it began: the real one "
-                "is recorded in its manifest). The disk was checked for images of the "
-                f"config's size; the {left} image(s) left are checked again at the real size",
+                f"camera.height in {rig.loaded.path} say {cam.width} x {cam.height} px: set "
+                f"camera.width = {width} and camera.height = {height} there (the real size "
+                "is recorded in the session's manifest: a --resume takes either). The disk "
+                f"was checked for images of the config's size; the {left} image(s) left are "
+                "checked again at the real size",
             )
         )
         folder.manifest.setdefault("rig", {})[FRAME_SIZE_KEY] = {

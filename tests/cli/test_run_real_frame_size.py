@@ -114,12 +114,37 @@ def test_a_resume_counts_the_disk_at_the_real_size_and_does_not_say_it_again(
     assert manifest["rig"]["frame_size"] == seen
 
 
-def test_the_note_says_the_keys_are_for_new_sessions(tmp_path: Path, bigger_camera: Path) -> None:
-    """Setting them mid-session gets its resume refused (the session's recorded camera size
-    changes): the note had said to set them, with no word of that."""
+def test_a_session_resumed_with_the_keys_set_as_told_goes_on(
+    tmp_path: Path, bigger_camera: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Stopped by the disk after the note, the keys set as it says, then resumed: the resume
+    had been refused as another picture ("camera size: 64×64 → 256×256"), though the camera's
+    images were 256 x 256 all along. A camera's size is its own, whatever the config says: the
+    fake camera here delivers 256 x 256 px frames at either setting."""
+    import json
+
+    capture = SimulatedCamera.capture
+
+    def its_own_size(self: SimulatedCamera, exposure_s: float):  # type: ignore[no-untyped-def]
+        frame = capture(self, exposure_s)  # the fixture's: 4 x the config's size
+        step = frame.pixels.shape[0] // 256
+        return dataclasses.replace(frame, pixels=frame.pixels[::step, ::step])
+
+    monkeypatch.setattr(SimulatedCamera, "capture", its_own_size)
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=10_000_000))
     out = tmp_path / "s"
     r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
     said = _said(r)
+    assert r.exit_code == 2 and "set camera.width = 256 and camera.height = 256 there" in said
+    text = bigger_camera.read_text(encoding="utf-8")
+    bigger_camera.write_text(text.replace("width = 64\nheight = 64", "width = 256\nheight = 256"))
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    said = _said(r)
     assert r.exit_code == 0, said
-    assert "for new sessions, set camera.width = 256 and camera.height = 256 there" in said
-    assert "a --resume of this one needs the config's size as it began" in said, said
+    assert "The camera delivers" not in said, said
+    assert len(read_lp(out / "lights.lp")) == LIGHTS
+    rig = json.loads((out / "manifest.json").read_text())["rig"]
+    assert rig["identity"]["camera_size"] == "64×64"  # as the session began, beside the real
+    assert rig["frame_size"] == {"frames": [256, 256], "config": [64, 64]}

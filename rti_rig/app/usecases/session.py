@@ -1058,6 +1058,33 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
     return opened
 
 
+def _real_size_as_recorded(  # type: ignore[no-untyped-def]
+    manifest: dict[str, Any], recorded: dict[str, Any] | None, identity: dict[str, Any], loaded
+) -> dict[str, Any]:
+    """``identity`` with the session's recorded camera size where the config now says the
+    size its camera was seen to deliver (``rig.frame_size``, recorded by the run that found
+    the config's size wrong): the same images, the config corrected as that run advised.
+
+    Why: the run says to set camera.width and camera.height, and a resume with them set was
+    refused as another picture ("camera size: 64×64 → 256×256"), though the camera's images
+    were that size all along."""
+    from rti_rig.app.disk_estimate import size_from_frame
+    from rti_rig.runtime.session import FRAME_SIZE_KEY
+
+    seen = (manifest.get("rig") or {}).get(FRAME_SIZE_KEY)
+    if not recorded or not isinstance(seen, dict) or "camera_size" not in recorded:
+        return identity
+    config, frames = seen.get("config"), seen.get("frames")
+    if not (isinstance(config, list) and isinstance(frames, list) and len(frames) == 2):
+        return identity
+    if recorded["camera_size"] != "×".join(str(v) for v in config):
+        return identity
+    width, height, _ = size_from_frame(loaded)(int(frames[0]), int(frames[1]))
+    if identity.get("camera_size") != f"{width}×{height}":
+        return identity
+    return {**identity, "camera_size": recorded["camera_size"]}
+
+
 def check_resume_rig(  # type: ignore[no-untyped-def]
     manifest: dict[str, Any],
     loaded,
@@ -1077,8 +1104,8 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
         same_rig,
     )
 
-    identity = rig_identity(loaded)
     recorded = (manifest.get("rig") or {}).get("identity")
+    identity = _real_size_as_recorded(manifest, recorded, rig_identity(loaded), loaded)
     if recorded is None:  # a session from before identities were recorded
         if loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
             on_note(
