@@ -1013,10 +1013,11 @@ class FolderWatchCamera:
         IFDs name written, the last ones not zeros) whose data will not decode, or one read as
         no pixels whose first IFD is all written (:func:`first_ifd`) and names no data, data
         inside the file or garbage, or one whose first IFD holds what no writer on its way
-        leaves (:func:`ifd_garbage`: a tag count over 4096, an entry of no TIFF type, an
-        offset inside the header): each is said at once, naming the file. A TIFF whose IFD
-        is not there yet (libtiff writes it last, tifffile zeroed until its data is out) is
-        waited for. Messages are worded here from the decoders' fields.
+        leaves (:func:`ifd_garbage`: a tag count over 4096, a count of 0 before written
+        bytes, an entry of no TIFF type, an offset inside the header): each is said at once,
+        naming the file. A TIFF whose IFD is not there yet (libtiff writes it last, tifffile
+        zeroed until its data is out) is waited for. Messages are
+        worded here from the decoders' fields.
 
         Why: a steady size only means the writer paused (a network share, a Wi-Fi upload, a
         program writing in chunks). Half a file had stopped the session at once, a shot lost

@@ -125,17 +125,20 @@ def ifd_garbage(path: Path) -> str | None:
     header names none (0) until the IFD is there, tifffile's slot is zeros (a count of 0), a
     share that sizes a file first reads zeros where it has not filled, and a copy cut short
     ends inside an IFD whose count and entries so far are the writer's own. So a non-zero
-    offset inside the header, a count over :data:`MAX_TAGS`, or, in an IFD running past the
-    file's end, an entry in the file with a non-zero type no TIFF has is damage (a whole IFD
-    with an unknown type is left to the decode: TIFF 6.0 tells readers to skip such a field).
-    (Whether the file's size is steady and its end written is the caller's to add.)"""
+    offset inside the header, a count over :data:`MAX_TAGS`, a count of 0 (TIFF 6.0: every
+    IFD has at least one entry) followed by bytes that are not zeros (an offset landing in
+    pixel data: a writer's slot not written yet is zeros throughout), or, in an IFD running
+    past the file's end, an entry in the file with a non-zero type no TIFF has is damage (a
+    whole IFD with an unknown type is left to the decode: TIFF 6.0 tells readers to skip
+    such a field). (Whether the file's size is steady and its end written is the caller's
+    to add.)"""
     try:
         size = path.stat().st_size
         with path.open("rb") as f:
             named = _first_ifd_named(f)
             if named is None:
                 return None
-            (order, header, count_size, entry_size, _), offset = named
+            (order, header, count_size, entry_size, offset_size), offset = named
             if 0 < offset < header:
                 return (
                     f"its header names its first IFD at byte {offset}, inside the "
@@ -148,6 +151,20 @@ def ifd_garbage(path: Path) -> str | None:
             if len(raw) < count_size:
                 return None
             (count,) = struct.unpack(f"{order}{'H' if count_size == 2 else 'Q'}", raw)
+            if count == 0:
+                # TIFF 6.0 (p. 14): "each IFD must have at least one entry", and libtiff
+                # refuses a count of 0; a writer's IFD not written yet is zeros throughout
+                # (tifffile's reserved slot, a share's unfilled bytes), so a 0 count is a
+                # slot to wait for only while the first entry and next-IFD offset after it
+                # read as zeros too. Written bytes there (pixel data under a header that
+                # names the wrong offset) will not turn into an IFD.
+                if any(f.read(entry_size + offset_size)):
+                    return (
+                        f"its first IFD, at byte {offset}, gives a tag count of 0, which no "
+                        "finished IFD has, while the bytes after it are written, where an IFD "
+                        "not written yet reads as zeros"
+                    )
+                return None
             if count > MAX_TAGS:
                 return (
                     f"its first IFD, at byte {offset}, gives a tag count of {count}, more than "

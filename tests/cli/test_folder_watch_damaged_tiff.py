@@ -193,30 +193,38 @@ def test_run_waits_for_a_libtiff_tiff_whose_copy_paused_and_records_it_whole(
     assert lit_at_end == []
 
 
-def _garbage_ifd_tiff(scratch: Path) -> bytes:
-    """A whole 16-bit TIFF whose first IFD's tag count is garbage (bytes XORed, as a copy
-    gone wrong leaves them): its header names the IFD at a byte inside the file."""
-    tifffile.imwrite(scratch, np.full((64, 64, 3), 30000, np.uint16), photometric="rgb")
+def _garbage_ifd_tiff(scratch: Path, kind: str) -> bytes:
+    """A whole 16-bit TIFF whose first IFD is garbage of ``kind``: its tag count's bytes
+    XORed, as a copy gone wrong leaves them ("xored"), or its header's offset moved onto a
+    black pixel's zero red inside the pixel data, lit pixels after it ("zero in the data")."""
+    pixels = np.full((64, 64, 3), 30000, np.uint16)
+    pixels[20, 20, 0] = 0
+    tifffile.imwrite(scratch, pixels, photometric="rgb")
     data = scratch.read_bytes()
     scratch.unlink()
     ifd = int.from_bytes(data[4:8], "little")
     assert 8 <= ifd < len(data)
+    if kind == "zero in the data":
+        at = data.index(bytes(2) + (30000).to_bytes(2, "little") * 2, ifd + 64)
+        return data[:4] + at.to_bytes(4, "little") + data[8:]
     return data[:ifd] + bytes(b ^ 0x5A for b in data[ifd : ifd + 2]) + data[ifd + 2 :]
 
 
+@pytest.mark.parametrize("kind", ["xored", "zero in the data"])
 def test_run_names_a_tiff_whose_first_ifd_is_garbage_at_once(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str
 ) -> None:
     """A whole TIFF, its size steady, whose header names a first IFD inside the file that
-    holds a tag count no writer writes (tifffile: "suspicious number of tags"): ``rti-rig
-    run`` had waited ``timeout_s`` (its capture-time read, then its decode), then advised
-    raising stable_polls. A writer on its way leaves that slot zeros (tifffile) or names no
-    IFD yet (libtiff): the file is named at once as damaged, with what to do."""
+    holds a tag count no writer writes (tifffile: "suspicious number of tags"), or a count of
+    0 (no finished IFD has one) with written bytes after it: ``rti-rig run`` had waited
+    ``timeout_s`` (its capture-time read, then its decode), then advised raising
+    stable_polls. A writer on its way leaves that slot zeros throughout (tifffile) or names
+    no IFD yet (libtiff): the file is named at once as damaged, with what to do."""
     tether = tmp_path / "tether"
     tether.mkdir()
     out = tmp_path / "s"
     cfg = _config(tmp_path, tether)
-    data = _garbage_ifd_tiff(tmp_path / "scratch.tif")
+    data = _garbage_ifd_tiff(tmp_path / "scratch.tif", kind)
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
         camera = Tether(firmware, tether, data)
         camera.start()

@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import pytest
 import tifffile
+from PIL import Image
 from scripted_clock import ScriptedClock
 
 from rti_rig.core.clock import SystemClock, VirtualClock
@@ -465,12 +466,13 @@ def test_a_file_named_tif_that_is_no_tiff_is_said_at_once_naming_it(tmp_path):
     assert (tmp_path / "IMG_0001.tif").exists()  # left where the program saved it
 
 
-def _tiff_bytes(tmp_path, compression=None) -> tuple[bytes, int, int]:
-    """A whole 16-bit RGB TIFF's bytes, and its first strip's offset and byte count."""
+def _tiff_bytes(tmp_path, compression=None, pixels=None) -> tuple[bytes, int, int]:
+    """A whole 16-bit RGB TIFF's bytes (of ``pixels``, all 30000 unless given), and its first
+    strip's offset and byte count."""
     whole = tmp_path / "whole.tif.tmp"
-    tifffile.imwrite(
-        whole, np.full((64, 64, 3), 30000, np.uint16), photometric="rgb", compression=compression
-    )
+    if pixels is None:
+        pixels = np.full((64, 64, 3), 30000, np.uint16)
+    tifffile.imwrite(whole, pixels, photometric="rgb", compression=compression)
     with tifffile.TiffFile(whole) as tif:
         offset, count = tif.pages[0].dataoffsets[0], tif.pages[0].databytecounts[0]
     data = whole.read_bytes()
@@ -562,11 +564,20 @@ def _garbage_first_ifd(data: bytes, kind: str) -> bytes:
     if kind == "entry type":  # a plausible count whose IFD would run past the end
         count = struct.pack("<H", (len(data) - ifd) // 12 + 5)
         return data[:ifd] + count + data[ifd + 2 : ifd + 4] + b"\x5a\x5a" + data[ifd + 6 :]
+    if kind == "zero count in the data":  # the header names a 0 0 pair inside the pixels
+        at = next(
+            n
+            for n in range(ifd + 64, len(data) - 16, 2)
+            if data[n : n + 2] == bytes(2) and all(data[n + 2 : n + 18])
+        )
+        return data[:4] + struct.pack("<I", at) + data[8:]
     assert kind == "inside the header"
     return data[:4] + struct.pack("<I", 2) + data[8:]
 
 
-@pytest.mark.parametrize("kind", ["tag count", "entry type", "inside the header"])
+@pytest.mark.parametrize(
+    "kind", ["tag count", "entry type", "inside the header", "zero count in the data"]
+)
 @pytest.mark.parametrize("trigger", [False, True])
 def test_a_tiff_whose_first_ifd_is_garbage_is_said_at_once_naming_it(tmp_path, kind, trigger):
     """A whole TIFF, its size steady, whose header names a first IFD inside the file holding
@@ -576,6 +587,8 @@ def test_a_tiff_whose_first_ifd_is_garbage_is_said_at_once_naming_it(tmp_path, k
     capture-time read and again in its decode), then advice to raise stable_polls. It is
     named at once as damaged, with where it is left and what to do."""
     data, _, _ = _tiff_bytes(tmp_path, compression="zlib")
+    if kind == "zero count in the data":  # pixels holding a 0 0 pair (a black pixel's red)
+        data, _, _ = _tiff_bytes(tmp_path, pixels=_PIXELS_WITH_BLACK)
     damaged = _garbage_first_ifd(data, kind)
     target = tmp_path / "IMG_0001.tif"
     clock = ScriptedClock({0.5: lambda: target.write_bytes(damaged)})
@@ -594,6 +607,7 @@ def test_a_tiff_whose_first_ifd_is_garbage_is_said_at_once_naming_it(tmp_path, k
         "tag count": "gives a tag count of",
         "entry type": "has data type 23130, which no TIFF has",
         "inside the header": "at byte 2, inside the 8-byte header",
+        "zero count in the data": "gives a tag count of 0, which no finished IFD has",
     }[kind]
     assert "IMG_0001.tif is a damaged TIFF" in said and why in said, said
     assert f"left in {tmp_path}" in said and "waiting will not help" in said, said
@@ -609,11 +623,24 @@ def test_no_state_a_writer_leaves_a_tiff_in_reads_as_a_garbage_ifd(tmp_path):
     from rti_rig.drivers.cameras.tiff_structure import ifd_garbage
 
     states = []
-    for kind in ("plain", "zlib", "tiled", "BigTIFF", "multi-page"):
+    for kind in ("plain", "zlib", "tiled", "BigTIFF", "multi-page", "black", "black BigTIFF"):
         part, whole = _tifffile_order(kind)
         states += part + [whole[:n] for n in range(0, len(whole), 7)]
     whole = _libtiff_whole()
     states += [whole[:n] for n in range(0, len(whole), 7)]
+    # Pillow's order (header, IFD, then its strips), of a shot with black pixels: each state
+    # as written and cut anywhere, and each cut of a whole file filled in place by a share
+    for compression in (None, "tiff_lzw", "tiff_adobe_deflate"):
+        log = _WriteLog()
+        Image.fromarray(_PIXELS_WITH_BLACK[..., 0]).save(
+            log, format="TIFF", compression=compression
+        )
+        whole = log.getvalue()
+        states += _as_written(log.writes) + [whole[:n] for n in range(0, len(whole), 7)]
+    # tifffile's and libtiff's, of a shot with black pixels, filled in place by a share (its
+    # full size set first, zeros where it has not filled)
+    for whole in (_tifffile_order("plain")[1], _tifffile_order("black")[1], _libtiff_whole()):
+        states += [whole[:n] + bytes(len(whole) - n) for n in range(0, len(whole), 97)]
     target = tmp_path / "IMG_0001.tif"
     for n, state in enumerate(states):
         target.write_bytes(state)
@@ -661,6 +688,9 @@ def _as_written(writes: list[tuple[int, bytes]]) -> list[bytes]:
 
 
 _PIXELS = np.full((64, 64, 3), 30000, np.uint16)
+#: a shot with one black pixel, whose red (two zero bytes) is followed by lit pixels
+_PIXELS_WITH_BLACK = _PIXELS.copy()
+_PIXELS_WITH_BLACK[20, 20, 0] = 0
 
 
 def _tifffile_order(kind: str) -> tuple[list[bytes], bytes]:
@@ -677,8 +707,11 @@ def _tifffile_order(kind: str) -> tuple[list[bytes], bytes]:
             "zlib": {"compression": "zlib"},
             "tiled": {"tile": (32, 32)},
             "BigTIFF": {"bigtiff": True},
+            "black": {},
+            "black BigTIFF": {"bigtiff": True},
         }[kind]
-        tifffile.imwrite(log, _PIXELS, photometric="rgb", **options)
+        pixels = _PIXELS_WITH_BLACK if kind.startswith("black") else _PIXELS
+        tifffile.imwrite(log, pixels, photometric="rgb", **options)
     whole = log.getvalue()
     states = _as_written(log.writes)
     assert states[-1] == whole
