@@ -84,6 +84,7 @@ from rti_rig.drivers.cameras.raw_decode import (
     UnsupportedRawError,
     decode_raw,
     exposure_stats,
+    libraw_printed,
 )
 from rti_rig.drivers.cameras.settings import FolderWatchSettings
 from rti_rig.drivers.cameras.tiff_structure import (
@@ -292,7 +293,9 @@ def _read_capture_time(path: Path) -> tuple[bool, float | None]:
     try:
         import rawpy
 
-        with rawpy.imread(str(path)) as raw:
+        # LibRaw prints its own line about a file cut short, naming it: kept off the
+        # terminal (the file's decode says what is wrong with it, naming the folder's file)
+        with libraw_printed(str(path), []), rawpy.imread(str(path)) as raw:
             stamp = raw.other.timestamp
     except Exception as exc:  # no evidence yet, or none: the file's own decode says why
         unsupported = type(exc).__name__ == "LibRawFileUnsupportedError"

@@ -15,6 +15,12 @@ maximum), nothing is rotated.
 from __future__ import annotations
 
 import io
+import os
+import sys
+import tempfile
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +40,8 @@ class RawDecodeError(CaptureError):
     """A RAW file that would not decode, with what is known as fields: ``path`` (the file
     read, None for bytes), ``problem`` (what is wrong with it and what to do: the sentence
     after the file's name), ``libraw_error`` (LibRaw's error kind, "LibRawIOError"; None when
-    the refusal is ours) and ``libraw_said`` (LibRaw's own words, as text).
+    the refusal is ours), ``libraw_said`` (LibRaw's own words, as text) and
+    ``libraw_printed`` (the lines LibRaw printed about the file, its name taken off).
 
     Why fields: a caller that names another file than the one read (a watched folder's file,
     of which the session's copy was decoded; a camera's file, downloaded under another name)
@@ -48,11 +55,13 @@ class RawDecodeError(CaptureError):
         *,
         libraw_error: str | None = None,
         libraw_said: str | None = None,
+        libraw_printed: tuple[str, ...] = (),
     ) -> None:
         self.path = path
         self.problem = problem
         self.libraw_error = libraw_error
         self.libraw_said = libraw_said
+        self.libraw_printed = libraw_printed
         super().__init__(DECODER, self.about("<bytes>" if path is None else path), "decode")
 
     def about(self, file: Path | str) -> str:
@@ -67,6 +76,66 @@ def libraw_words(exc: BaseException) -> str:
     if isinstance(said, bytes | bytearray):
         said = bytes(said).decode("utf-8", "replace")
     return str(said) or type(exc).__name__
+
+
+#: the name LibRaw gives a file it reads from memory in the lines it prints
+LIBRAW_BUFFER_NAME = "unknown file"
+
+#: one capture of fd 2 at a time: fd 2 is the process's, and two decoding threads each
+#: saving and restoring it would leave the second's sink in place for good
+_FD2 = threading.Lock()
+
+
+@contextmanager
+def libraw_printed(name: str, into: list[str]) -> Iterator[None]:
+    """Hold what C code writes to fd 2 while LibRaw reads ``name`` (the path given to it, or
+    :data:`LIBRAW_BUFFER_NAME`); on exit, put LibRaw's lines about it into ``into`` without
+    their "``name``: " prefix ("Unexpected end of file"), and write any other line back to
+    fd 2, so another thread's output is held back for the decode, never lost.
+
+    Why: LibRaw's data-error handler prints its own line straight to the C stderr, naming the
+    file it read: a watched folder's session copy (``raw/.incoming/...``), a file the user
+    never saw, appeared on the terminal beside rti-rig's own refusal. A redirect of Python's
+    ``sys.stderr`` does not catch a C ``fprintf``; fd 2 itself is swapped (``os.dup2``) and
+    always restored. Where fd 2 cannot be swapped (none open), LibRaw runs as it is."""
+    with suppress(AttributeError, OSError, ValueError):
+        sys.stderr.flush()  # Python's own buffered lines go out first, not into the sink
+    with _FD2:
+        try:
+            saved = os.dup(2)
+        except OSError:
+            yield
+            return
+        try:
+            with tempfile.TemporaryFile() as sink:
+                os.dup2(sink.fileno(), 2)
+                try:
+                    yield
+                finally:
+                    with suppress(AttributeError, OSError, ValueError):
+                        sys.stderr.flush()
+                    os.dup2(saved, 2)
+                    sink.seek(0)
+                    text = sink.read().decode("utf-8", "replace")
+                    prefix, other = f"{name}: ", []
+                    for line in text.splitlines(keepends=True):
+                        if line.startswith(prefix) and line[len(prefix) :].strip():
+                            into.append(line[len(prefix) :].strip())
+                        else:
+                            other.append(line)
+                    if other:
+                        os.write(2, "".join(other).encode("utf-8", "replace"))
+        finally:
+            os.close(saved)
+
+
+def _reported(printed: list[str]) -> str:
+    """LibRaw's printed lines as a clause of a refusal ("it reports: unexpected end of
+    file"), or "" when it printed none."""
+    if not printed:
+        return ""
+    words = "; ".join(dict.fromkeys(printed))  # each line once, in LibRaw's order
+    return f": LibRaw reports {words[:1].lower()}{words[1:]}"
 
 
 class UnsupportedRawError(RawDecodeError):
@@ -403,8 +472,12 @@ def decode_raw(
     settings = settings or RawDecodeSettings()
     name, handle = _source(source)
     read = None if name == "<bytes>" else Path(name)
+    printed: list[str] = []  # LibRaw's own lines, kept off the terminal (libraw_printed)
     try:
-        with rawpy.imread(handle) as raw:
+        with (
+            libraw_printed(LIBRAW_BUFFER_NAME if read is None else name, printed),
+            rawpy.imread(handle) as raw,
+        ):
             raw_vis = np.array(raw.raw_image_visible)  # uint16 copy out of LibRaw memory
             colors = np.array(raw.raw_colors_visible)
             black_pc = np.asarray(raw.black_level_per_channel, dtype=np.int64)
@@ -430,21 +503,24 @@ def decode_raw(
         raise UnsupportedRawError(
             read,
             f"LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy "
-            f"{rawpy.__version__}) does not read this file's format ({said}): a camera newer "
+            f"{rawpy.__version__}) does not read this file's format ({said}){_reported(printed)}"
+            ": a camera newer "
             "than this LibRaw, or a file that is no RAW. Update rawpy (pip install -U rawpy), "
             "or shoot a format it reads (DNG where the camera offers it, or convert the files "
             "with a DNG converter and watch a folder of DNGs)",
             libraw_error=type(exc).__name__,
             libraw_said=said,
+            libraw_printed=tuple(printed),
         ) from exc
     except rawpy.LibRawError as exc:
         said = libraw_words(exc)
         raise RawDecodeError(
             read,
-            f"LibRaw cannot decode this file ({type(exc).__name__}: {said}); "
-            "is it a complete RAW/DNG download?",
+            f"LibRaw cannot decode this file ({type(exc).__name__}: {said})"
+            f"{_reported(printed)}; is it a complete RAW/DNG download?",
             libraw_error=type(exc).__name__,
             libraw_said=said,
+            libraw_printed=tuple(printed),
         ) from exc
     if raw_vis.ndim != 2:
         raise RawDecodeError(read, "not a single-plane CFA RAW")
@@ -525,6 +601,14 @@ def decode_raw(
             "sensor orientation, as the camera's RAW data and JPEG previews are stored, so "
             "these images are not turned upright; the .lp light directions are in the same "
             "(sensor) frame, so fitting is unaffected (docs/cameras.md)"
+        )
+    if printed:
+        # LibRaw went on past a data error it printed (kept off the terminal): the image is
+        # recorded, and what LibRaw said of it is kept with it rather than lost
+        decode["libraw_reported"] = list(dict.fromkeys(printed))
+        notices.append(
+            f"LibRaw reported {'; '.join(decode['libraw_reported'])} while decoding this "
+            "file, and decoded it anyway: check the image for damage"
         )
     metadata: dict[str, Any] = {
         "source_file": source_file,

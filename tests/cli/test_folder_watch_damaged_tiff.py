@@ -249,13 +249,15 @@ def test_run_names_a_tiff_whose_first_ifd_is_garbage_at_once(
 
 
 def test_run_names_a_raw_cut_short_with_libraws_words_as_text(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
 ) -> None:
     """Half a DNG saved into the shipped folder-watch dome's folder, the rest never coming:
     ``rti-rig run`` names the folder's file (not the session's copy it decoded) and LibRaw's
     error with its words as text. The sentence had been LibRaw's refusal of the copy with the
     copy's path replaced inside it, LibRaw's words shown as a Python bytes literal
-    ("(LibRawIOError: b'Input/output error')")."""
+    ("(LibRawIOError: b'Input/output error')"). LibRaw's own line, printed by its C code on
+    fd 2 ("<s>/raw/.incoming/IMG_0001.dng: Unexpected end of file", once for each read), had
+    reached the terminal naming the session's hidden copy: its words are in the refusal."""
     from rti_rig.drivers.cameras.dng_writer import linear_to_mosaic, write_dng
 
     tether = tmp_path / "tether"
@@ -292,5 +294,8 @@ def test_run_names_a_raw_cut_short_with_libraws_words_as_text(
     assert "(LibRawIOError: Input/output error)" in said, said
     assert "b'" not in said and ".incoming" not in said, said
     assert "IMG_0001.dng did not change within 1.5 s" in said, said
+    assert "Input/output error): LibRaw reports unexpected end of file; is it a " in said, said
+    terminal = capfd.readouterr().err  # what C code wrote to fd 2, past the runner's capture
+    assert ".incoming" not in terminal and "Unexpected end of file" not in terminal, terminal
     assert (tether / "IMG_0001.dng").read_bytes() == data  # left as the program saved it
     assert lit_at_end == []  # the dome was switched off

@@ -12,9 +12,11 @@ from hypothesis import strategies as st
 from rti_rig.core.errors import CaptureError
 from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic, write_dng
 from rti_rig.drivers.cameras.raw_decode import (
+    RawDecodeError,
     average_frames,
     decode_raw,
     exposure_stats,
+    libraw_printed,
     subtract_dark,
 )
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
@@ -210,6 +212,76 @@ def test_unreadable_and_missing_files_name_the_file(tmp_path):
         decode_raw(bad, MOSAIC)
     with pytest.raises(CaptureError, match="not found"):
         decode_raw(tmp_path / "missing.dng", MOSAIC)
+
+
+@pytest.mark.parametrize("source", ["file", "bytes"])
+def test_libraws_own_line_about_a_cut_file_is_kept_off_the_terminal_and_said_in_the_refusal(
+    tmp_path, capfd, source
+):
+    """LibRaw prints "<the file it read>: Unexpected end of file" straight to the C stderr
+    (fd 2) for a RAW cut short: a watched folder's session copy (``raw/.incoming/...``)
+    reached the terminal beside rti-rig's own refusal. It is held off fd 2 and its words
+    carried into the refusal, which names the file only through its fields."""
+    whole = tmp_path / "whole.dng"
+    mosaic = linear_to_mosaic(np.full((32, 32), 0.3), "RGGB", 256, 4095)
+    write_dng(whole, mosaic, black_level=256, white_level=4095)
+    cut = tmp_path / "cut.dng"
+    cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])
+    capfd.readouterr()
+    with pytest.raises(RawDecodeError) as info:
+        decode_raw(cut if source == "file" else cut.read_bytes(), MOSAIC)
+    err = capfd.readouterr().err
+    assert "Unexpected end of file" not in err and "cut.dng" not in err, err
+    assert info.value.libraw_printed == ("Unexpected end of file",)
+    assert "LibRaw reports unexpected end of file; is it a complete" in info.value.problem
+
+
+def test_libraws_line_about_a_file_it_decodes_anyway_is_kept_with_the_image(
+    tmp_path, capfd, monkeypatch
+):
+    """LibRaw's data-error handler prints "<file>: data corrupted at <offset>" and goes on
+    decoding (its default callback): the line is kept with the image (a notice, the decode
+    record) rather than on the terminal, where it had named the file LibRaw read."""
+    import os
+
+    import rawpy
+
+    real = rawpy.imread
+    path = write_dng(
+        tmp_path / "IMG_0001.dng",
+        linear_to_mosaic(np.full((32, 32), 0.3), "RGGB", 256, 4095),
+        black_level=256,
+        white_level=4095,
+    )
+
+    def corrupt_noted(source, *args, **kwargs):  # LibRaw's callback, as its C code prints it
+        os.write(2, f"{source}: data corrupted at 4096\n".encode())
+        return real(source, *args, **kwargs)
+
+    monkeypatch.setattr(rawpy, "imread", corrupt_noted)
+    capfd.readouterr()
+    frame = decode_raw(path, MOSAIC)
+    assert capfd.readouterr().err == ""
+    assert frame.metadata["decode"]["libraw_reported"] == ["data corrupted at 4096"]
+    assert any(
+        "LibRaw reported data corrupted at 4096 while decoding this file" in n
+        for n in frame.metadata["notices"]
+    )
+
+
+def test_lines_not_libraws_written_to_fd_2_meanwhile_are_written_back(capfd):
+    """fd 2 is the process's: another thread's line written while LibRaw reads is held back
+    for the read, never lost; fd 2 is the terminal's again afterwards."""
+    import os
+
+    printed: list[str] = []
+    capfd.readouterr()
+    with libraw_printed("/s/raw/.incoming/IMG_1.dng", printed):
+        os.write(2, b"/s/raw/.incoming/IMG_1.dng: data corrupted at 1024\n")
+        os.write(2, b"another thread's warning\n")
+    os.write(2, b"after\n")
+    assert printed == ["data corrupted at 1024"]
+    assert capfd.readouterr().err == "another thread's warning\nafter\n"
 
 
 def test_dng_writer_validates_its_input():
