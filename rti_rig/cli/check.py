@@ -164,13 +164,14 @@ def probe(
         _probe_stopped(str(exc), result)
     for line in result.heard_lines():
         out.print(line, highlight=False, markup=False)
-    if result.error:
+    if result.error is not None:
         # on stderr, unwrapped, as every other command says an error (it had gone to stdout,
         # wrapped mid-message when piped)
-        err.print(f"[bold red]error:[/] {escape(result.error)}", highlight=False, soft_wrap=True)
+        said = escape(str(result.error))
+        err.print(f"[bold red]error:[/] {said}", highlight=False, soft_wrap=True)
     for line in result.conclusion_lines():
         out.print(line, highlight=False, markup=False)
-    if result.profile is None or result.error:
+    if result.profile is None or result.error is not None:
         # a port that failed after the firmware was found (a Nab board whose all-off could
         # not be sent, possibly fully lit) had exited 0, as a probe that succeeded
         raise typer.Exit(code=1)

@@ -108,3 +108,66 @@ def test_a_device_that_is_no_terminal_is_named_whatever_pyserial_words_its_failu
     assert r.exit_code == 1, text
     assert f"{device} is a device but not a terminal: it is not a serial port" in text, text
     assert "plugged in" not in text and "Traceback" not in text, text
+
+
+class _UnpluggedAfterOpening:
+    """A pty standing for a USB serial adapter pulled out just after the port is opened: its
+    other end is closed once pyserial's opening returns, so the first read meets the system's
+    EIO, as an unplugged adapter's does."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch) -> None:
+        import os
+        import pty
+
+        import serial
+
+        self.master, slave = pty.openpty()
+        self.port = os.ttyname(slave)
+        os.close(slave)
+        self.open = True
+        real = serial.serial_for_url
+
+        def opens_then_unplugged(url: str, **kwargs: object) -> object:
+            opened = real(url, **kwargs)
+            self.unplug()
+            return opened
+
+        monkeypatch.setattr(serial, "serial_for_url", opens_then_unplugged)
+
+    def unplug(self) -> None:
+        import os
+
+        if self.open:
+            os.close(self.master)
+            self.open = False
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux")
+def test_a_port_that_opens_then_fails_is_not_said_to_have_failed_to_open(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A serial port that opens and then fails on its first read (a USB adapter pulled out
+    just after, another program taking the port): the conclusion had said "The port could
+    not be opened", under an error line saying the read failed, and had looked up what the
+    path is from the read's failure. It is decided now on the typed error's kind."""
+    adapter = _UnpluggedAfterOpening(monkeypatch)
+    try:
+        r = runner.invoke(app, ["probe", adapter.port])
+    finally:
+        adapter.unplug()
+    text = said(r)
+    assert r.exit_code == 1, text
+    assert f"error: read from {adapter.port} failed" in text, text
+    assert "The port opened but failed before any firmware answered" in text, text
+    assert "could not be opened" not in text and "not a serial port" not in text, text
+    assert "Traceback" not in text, text
+
+    from rti_rig.app.usecases.probe import ProbeFailure, ProbeRequest, probe
+
+    adapter = _UnpluggedAfterOpening(monkeypatch)
+    try:
+        result = probe(ProbeRequest(adapter.port, listen_s=0.3))
+    finally:
+        adapter.unplug()
+    assert result.error is not None and result.error.failure is ProbeFailure.PORT_FAILED
+    assert result.lights == "the port could not be used; nothing was sent"

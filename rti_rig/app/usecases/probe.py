@@ -91,6 +91,37 @@ class LightsState(Enum):
     OFF_NOT_SENT = auto()
 
 
+class ProbeFailure(Enum):
+    """What went wrong with a probe, as a caller decides on it (:attr:`ProbeError.failure`):
+    the conclusion said, and whether a later acknowledged all-off clears it. They had been
+    decided on a free-form error string being set at all, so a port that opened and then
+    failed before anything was heard was told "The port could not be opened"."""
+
+    #: The probe's port could not be opened: nothing was sent on it.
+    PORT_NOT_OPENED = auto()
+    #: The port failed once open (a read, a write), or in a stop's teardown.
+    PORT_FAILED = auto()
+    #: The Nab sketch did not acknowledge its all-off, sent twice: the dome may be lit.
+    OFF_NOT_ACKNOWLEDGED = auto()
+
+
+@dataclass(frozen=True)
+class ProbeError:
+    """A probe's error: ``failure``, decided on, and ``said``, the words printed (``str()``
+    gives them, as the free-form string it replaces did)."""
+
+    failure: ProbeFailure
+    said: str
+
+    def __str__(self) -> str:
+        return self.said
+
+
+class _PortNotOpened(TransportError):
+    """The opening of the probe's port failed (raised from :func:`_exchange`, the transport's
+    own error carried: its words and ``errno``), told from a port that failed once open."""
+
+
 @dataclass
 class ProbeResult:
     port: str
@@ -103,7 +134,8 @@ class ProbeResult:
     lights: str = "nothing was lit by the probe"
     #: What is known of the lights, decided on.
     lights_state: LightsState = LightsState.NOTHING_LIT
-    error: str | None = None
+    #: What went wrong, typed (None: nothing); printed as its words on stderr.
+    error: ProbeError | None = None
     #: What else the firmware showed that the user must act on before a check (or None).
     note: str | None = None
     #: How many times a port opening was attempted (each resets a board like an Arduino).
@@ -139,7 +171,9 @@ class ProbeResult:
         """What the probe concludes: the advice, the firmware and its config lines, the
         lights."""
         out: list[str] = []
-        if self.error and not self.heard and self.not_serial:
+        failure = None if self.error is None else self.error.failure
+        not_opened = failure is ProbeFailure.PORT_NOT_OPENED and not self.heard
+        if not_opened and self.not_serial:
             # a file, a folder or /dev/null: "check the dome is plugged in" sent a user to the
             # hardware when the path given was the mistake
             out.append(
@@ -148,7 +182,16 @@ class ProbeResult:
                 "Give the dome's serial port (ls /dev/ttyACM* /dev/ttyUSB* /dev/serial/by-id/; "
                 "on Windows COM3 ...)."
             )
-        elif self.error and not self.heard:
+        elif failure is ProbeFailure.PORT_FAILED and not self.heard:
+            # it opened, then failed before its first listen was over (a USB adapter pulled
+            # out, another program taking the port): "could not be opened" contradicted the
+            # error above it
+            out.append(
+                "The port opened but failed before any firmware answered, so no firmware was "
+                "identified. Check that the dome's cable is plugged in and that no other "
+                "program uses the port, then probe again."
+            )
+        elif not_opened:
             # the port never opened: nothing was asked, so nothing can be concluded about a
             # firmware (it had gone on to advise setting a profile for a port that is not there)
             out.append(
@@ -237,6 +280,8 @@ def _exchange(
     result.openings += 1
     try:
         t.open()
+    except TransportError as exc:
+        raise _PortNotOpened(str(exc), errno=exc.errno) from exc
     except EmergencyStop as exc:
         # inside pyserial's open, which closes the port as the stop goes through: the opening
         # may have reset the board all the same (the Nab sketch then boots with every LED on)
@@ -263,7 +308,7 @@ def _exchange(
         try:
             _stopped_on_open_port(result, t, baud, opened, wait_s, heard.decode("latin-1"))
         except TransportError as failed:
-            result.error = str(failed)
+            result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
             _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
         raise ProbeStopped(str(exc), result) from None
     except BaseException:
@@ -375,7 +420,7 @@ def _reopened_at_nab_rate(result: ProbeResult, wait_s: float) -> None:
         t.open()
         _stopped_on_open_port(result, t, _NAB_BAUD, time.monotonic(), wait_s)
     except TransportError as failed:
-        result.error = str(failed)
+        result.error = ProbeError(ProbeFailure.PORT_FAILED, str(failed))
         _say_lights(result, LightsState.PORT_FAILED_IN_STOP, _stop_failed(failed))
     finally:
         t.close()
@@ -452,7 +497,7 @@ def _nab_found(result: ProbeResult, wait: float) -> ProbeResult:
     except TransportError as exc:
         if stop is None:
             raise  # the probe's own handler says it (the dome may be lit; exit 1)
-        result.error = str(exc)
+        result.error = ProbeError(ProbeFailure.PORT_FAILED, str(exc))
         _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
         raise ProbeStopped(str(stop), result) from None
     finally:
@@ -491,23 +536,24 @@ def _nab_off(result: ProbeResult, t: SerialTransport) -> None:
         if _NAB_OFF_SAYS.search(off):
             break
     if _NAB_OFF_SAYS.search(off):
-        if result.lights_state is LightsState.OFF_NOT_ACKNOWLEDGED:
+        if result.error is not None and result.error.failure is ProbeFailure.OFF_NOT_ACKNOWLEDGED:
             # a first all-off unanswered (its error said), this one acknowledged: decided on
-            # the state, not on how the error's words begin
+            # the error's kind, not on how its words begin
             result.error = None
         _say_lights(result, LightsState.OFF_ACKNOWLEDGED)
         return
     _say_lights(result, LightsState.OFF_NOT_ACKNOWLEDGED)
     # a probe that leaves the lights unconfirmed is no success: it had exited 0 under
     # "Found: nab-rti-v1", the dome lit
-    result.error = (
+    result.error = ProbeError(
+        ProbeFailure.OFF_NOT_ACKNOWLEDGED,
         f"{_NOT_ACKNOWLEDGED} {command} (sent twice on {result.port}): the dome may be fully "
-        "lit; look at it, and switch it off at its power supply if it is"
+        "lit; look at it, and switch it off at its power supply if it is",
     )
 
 
 #: How the error of an all-off the Nab sketch did not acknowledge begins (said only: whether
-#: a later all-off clears it is decided on :attr:`ProbeResult.lights_state`).
+#: a later all-off clears it is decided on :attr:`ProbeError.failure`).
 _NOT_ACKNOWLEDGED = "the Nab sketch did not acknowledge its all-off"
 
 #: The labels of the Nab sketch's all-off and its resending, in the lines heard (said only).
@@ -641,9 +687,9 @@ def _stopped_between_ports(result: ProbeResult, wait: float) -> None:
         try:
             _nab_found(result, wait)
         except TransportError as exc:
-            result.error = str(exc)
+            result.error = ProbeError(ProbeFailure.PORT_FAILED, str(exc))
             _say_lights(result, LightsState.OFF_NOT_SENT, _nab_not_off(exc))
-    elif result.profile is not None or result.error:
+    elif result.profile is not None or result.error is not None:
         # the probe had concluded (another firmware found, or the port failed), the stop coming
         # as it returned: its lights stand ("stopped before a firmware answered … look at the
         # dome" had replaced a found nichlock board's "boots with every LED off")
@@ -723,7 +769,10 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             return _nab_found(result, wait)
         _say_lights(result, LightsState.UNANSWERED, _unanswered_lights(wait))
     except TransportError as exc:
-        result.error = str(exc)
+        opening = isinstance(exc, _PortNotOpened)
+        result.error = ProbeError(
+            ProbeFailure.PORT_NOT_OPENED if opening else ProbeFailure.PORT_FAILED, str(exc)
+        )
         if result.profile == _NAB_NAME:
             # it answered, so it booted, and it boots with every LED on
             _say_lights(
@@ -742,7 +791,8 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
             )
         else:
             _say_lights(result, LightsState.PORT_UNUSABLE)
-            result.not_serial = _not_a_serial_port(result.port, exc)
+            # what the path is, from its opening's failure (a read's failure says nothing of it)
+            result.not_serial = _not_a_serial_port(result.port, exc) if opening else None
     return result
 
 
