@@ -257,8 +257,8 @@ def test_judging_an_earlier_fit_writes_nothing_and_a_batch_keeps_its_update_once
 def test_a_batch_judges_each_standing_earlier_fit_once(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """What plan_batch found of a session's earlier fit is handed to fit_one, which had judged
-    the session again (its record read, its images stat-ed or hashed) to skip it."""
+    """A session is judged once, at its turn (fit_one): plan_batch had judged it too when the
+    batch began (its record read, its images stat-ed or hashed), and fit_one again."""
     from rti_rig.app.usecases import fit_batch
 
     s, t, fb = fitted(tmp_path)

@@ -110,8 +110,8 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
     naming its partial folder, after the batch folder was made inside the session).
     """
     refuse_out_inside_a_session(root)
-    plan = plan_batch(sources, root)
-    return [fit_one(source, root, template, earlier=plan[source]) for source in sources]
+    plan_batch(sources, root, judge=False)  # each session is judged at its turn
+    return [fit_one(source, root, template) for source in sources]
 
 
 def partial_folders(root: Path, name: str) -> list[Path]:
@@ -160,15 +160,17 @@ def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
     return False
 
 
-def plan_batch(sources: list[Path], root: Path) -> dict[Path, EarlierFit]:
+def plan_batch(sources: list[Path], root: Path, *, judge: bool = True) -> dict[Path, EarlierFit]:
     """What a batch finds of each source's earlier fit (:func:`earlier_fit`; the sources still
     to fit are those whose fit does not stand), after removing the partial folders a killed
     run left for them, and keeping each earlier fit's record a hash brought up to date
     (:func:`keep_confirmed`). Refuses two sources with one output name.
 
-    Why the judgements and not only the sources to fit: :func:`fit_one` and the Dask batch's
-    report of a skipped session had judged each session again (reading its record and
-    stat-ing, or hashing, its images) to find what this had just found."""
+    ``judge`` False: the folders only, no judgement (an empty plan), for a batch that fits its
+    sessions one after another: :func:`fit_one` judges each at its turn, which a judgement
+    made here when the batch began cannot replace (a session may change meanwhile), and
+    judging here as well had read each session's record and stat-ed its images twice. A
+    cluster batch judges here to know which sessions to send at once."""
     import shutil
 
     by_name: dict[str, list[Path]] = {}
@@ -214,8 +216,9 @@ def plan_batch(sources: list[Path], root: Path) -> dict[Path, EarlierFit]:
             # another batch's attempt, running now into the same --out, is left to it
             if partial not in keep and owner_gone(partial, mine_too=True):
                 shutil.rmtree(partial, ignore_errors=True)
-        plan[source] = earlier_fit(final, source)
-        keep_confirmed(plan[source])  # once, here: a later asker finds the record up to date
+        if judge:
+            plan[source] = earlier_fit(final, source)
+            keep_confirmed(plan[source])  # once, here: a later asker finds the record up to date
     return plan
 
 
@@ -394,7 +397,24 @@ def earlier_fit(final: Path, source: Path) -> EarlierFit:
         return EarlierFit(True, f"{_journal_gone(source)}; {how}: {changed}")
     if changed is None:
         return EarlierFit(found=True, confirmed=update)
-    return EarlierFit(True, f"its session changed since the earlier fit: {changed}")
+    return EarlierFit(True, CHANGED_SINCE + changed)
+
+
+#: How :func:`earlier_fit` begins the words on a session whose images or lights changed since.
+CHANGED_SINCE = "its session changed since the earlier fit: "
+
+
+def changed_while_fitted(fit: Path, source: Path) -> str | None:
+    """How ``source`` no longer matches the fit just written to ``fit`` (its record was taken
+    before the images were read), or None when it still does.
+
+    Why: a batch judged each session once; a session whose capture was resumed, or whose image
+    was replaced, while its own fit ran got a fit of the session as it was before, reported
+    "done" as if it matched the session's images now."""
+    outgrown = earlier_fit(fit, source).outgrown
+    if outgrown is None:
+        return None
+    return outgrown.removeprefix(CHANGED_SINCE)
 
 
 def keep_confirmed(earlier: EarlierFit) -> None:
@@ -450,8 +470,8 @@ def _journal_gone(source: Path) -> str:
 
 def _file_sha256(path: Path | None) -> str | None:
     """The sha256 of the file at ``path`` (:func:`rti_rig.runtime.session.file_sha256`: one
-    cache per process, so a session judged twice, by plan_batch and by fit_one, is read once),
-    or None when it cannot be read."""
+    cache per process, so a session judged twice, by a cluster batch's plan and at its turn, is
+    read once), or None when it cannot be read."""
     if path is None:
         return None
     try:
@@ -465,7 +485,6 @@ def fit_one(
     root: Path,
     template: FitRequest,
     bands: BandRunner | None = None,
-    earlier: EarlierFit | None = None,
 ) -> BatchItem:
     """One session of a batch: fitted into a partial folder of its own (unique per attempt, so
     that a retried or orphaned attempt never writes into another's), renamed to
@@ -473,18 +492,21 @@ def fit_one(
     and this one's is discarded. Runs in this process or as a task on a Dask worker; ``bands``
     as for :func:`run_fit`.
 
-    ``earlier``: what :func:`plan_batch` found of the session's earlier fit. A fit it found
-    standing is skipped without judging it again; any other finding is judged again here, as
-    another batch into the same ``--out`` may have finished the session since (and a swap
-    finished here puts another fit in place)."""
+    The earlier fit is judged here, at the session's turn, not taken from what
+    :func:`plan_batch` found when the batch began: the session may have changed since (a capture
+    resumed, an image replaced while other sessions were fitted: it had been reported "skipped
+    (finished earlier)", its fit of fewer images kept), and another batch into the same
+    ``--out`` may have finished it (a swap finished here puts another fit in place). Its
+    images are stat-ed again; only one whose size or time changed is hashed. A session that
+    changed while its own fit ran is said so (:func:`changed_while_fitted`)."""
     import shutil
     from dataclasses import replace
 
     final = batch_out_dir(root, source)
     swapped = finish_swap(root, final)
     said = (swapped,) if swapped else ()
-    if swapped or earlier is None or not earlier.stands:
-        earlier = earlier_fit(final, source)
+    earlier = earlier_fit(final, source)
+    keep_confirmed(earlier)
     outgrown = earlier.outgrown
     if earlier.stands:
         return BatchItem(source, final, Outcome.SKIPPED, earlier.skip_detail, notes=said)
@@ -500,6 +522,7 @@ def fit_one(
             return BatchItem(source, final, Outcome.DONE, DONE_ELSEWHERE, notes=said)
         kept = f" (the earlier fit in {final} is kept)" if outgrown and final.exists() else ""
         return BatchItem(source, final, Outcome.FAILED, f": {exc}{kept}", notes=said)
+    moved_on = changed_while_fitted(partial, source)
     if outgrown is not None and final.exists():
         # the earlier fit is set aside only now that its successor is complete, under a
         # backup's name: a batch killed between the renames is finished by the next run's
@@ -532,11 +555,20 @@ def fit_one(
     for stale in partial_folders(root, final.name):
         if owner_gone(stale):
             shutil.rmtree(stale, ignore_errors=True)
+    detail = "" if outgrown is None else f" ({outgrown})"
+    if moved_on is not None:
+        # the fit is of the session as it was read, and its record says so: the next batch
+        # refits it; said on the session's line, as "done" alone claims it matches
+        detail += (
+            f"; but its session changed while it was being fitted ({moved_on}): this fit is "
+            "of the session as it was read; run the same command again once the session is "
+            "no longer being changed to refit it"
+        )
     return BatchItem(
         source,
         final,
         Outcome.DONE if outgrown is None else Outcome.REFITTED,
-        "" if outgrown is None else f" ({outgrown})",
+        detail,
         result.qa.verdict if result.qa is not None else None,
         (*said, *result.notes),
         tuple(result.warnings),

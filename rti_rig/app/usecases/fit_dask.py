@@ -450,11 +450,8 @@ def run_batch_dask(
     ``root`` inside a session folder is refused before the cluster is reached."""
     refuse_out_inside_a_session(root)  # as given, as run_batch does
     if scheduler == THREADS:
-        plan = plan_batch(sources, root)
-        return [
-            fit_one(s, root, template, bands=dask_bands(None, THREADS, s), earlier=plan[s])
-            for s in sources
-        ]
+        plan_batch(sources, root, judge=False)  # each session is judged at its turn
+        return [fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources]
     # Absolute, as workers do not share this process's working directory, but not resolved:
     # ``resolve()`` followed a symlinked session folder, so its output was named after the
     # link's target (OUT/s1 for sess/coin_day2 -> s1, OUT/coin_day2 without Dask, so a rerun
@@ -470,12 +467,17 @@ def run_batch_dask(
         # refused here in the words of the batch without Dask ("does not exist: give a session
         # folder or an .lp file"); it had been sent and blamed on the workers' shared paths.
         with _gathers_watched(client) as watch:
+
+            def submit(s: Path) -> Any:
+                task = client.submit(_fit_one_task, s, root, template, threads, pure=False)
+                return watch.track(task)
+
             futures = {
-                s: watch.track(client.submit(_fit_one_task, s, root, template, threads, pure=False))
-                for s, earlier in plan.items()
-                if not earlier.stands and s.exists()
+                s: submit(s) for s, earlier in plan.items() if not earlier.stands and s.exists()
             }
-            items = _batch_results(client, scheduler, sources, given, root, template, plan, futures)
+            items = _batch_results(
+                client, scheduler, sources, given, root, template, plan, futures, submit
+            )
         return [replace(item, source=g) for item, (_, g) in zip(items, given, strict=True)]
 
 
@@ -488,9 +490,14 @@ def _batch_results(
     template: FitRequest,
     plan: dict[Path, EarlierFit],
     futures: dict[Path, Any],
+    submit: Callable[[Path], Any],
 ) -> list[BatchItem]:
-    """Each session's item of a batch on a cluster, in the order given, as its task ends
-    (a skipped session's in the words of ``plan``, :func:`plan_batch`'s findings)."""
+    """Each session's item of a batch on a cluster, in the order given, as its task ends.
+
+    A session :func:`plan_batch` found standing is judged again at its turn (as
+    :func:`fit_one` does without Dask): one whose capture was resumed, or an image replaced,
+    while the batch ran had been reported "skipped (finished earlier)", its out-of-date fit
+    kept. It is then sent (``submit``) and waited for."""
     items = []
     for s in sources:
         if not plan[s].stands and s not in futures:
@@ -498,8 +505,14 @@ def _batch_results(
             continue
         if s not in futures:
             out = batch_out_dir(root, s)
-            items.append(BatchItem(s, out, Outcome.SKIPPED, plan[s].skip_detail))
-            continue
+            now = earlier_fit(out, s)
+            if now.stands:
+                items.append(BatchItem(s, out, Outcome.SKIPPED, now.skip_detail))
+                continue
+            if not s.exists():  # gone meanwhile: fails at once, naming the path
+                items.append(fit_one(s, root, template))
+                continue
+            futures[s] = submit(s)
         try:
             items.append(futures[s].result())
         except Exception as exc:  # e.g. KilledWorker: this session failed, the batch goes on
