@@ -19,7 +19,8 @@ band's Dask graph: nothing to set up) or the address of a ``dask scheduler``
 (``tcp://host:8786``). Workers must see the session
 files at the same paths as this machine; every error says so. They must run the same rti-rig
 too: a cluster whose workers run other code is refused before any task is sent
-(:mod:`rti_rig.app.usecases.worker_code`).
+(:mod:`rti_rig.app.usecases.worker_code`), and tasks go only to the workers so checked
+(:class:`Cluster`).
 
 Whether a scheduler address can be used at all (parsed, looked up, TLS, a bounded first
 connection) is :mod:`rti_rig.app.usecases.scheduler_probe`'s. Dask is imported only in these
@@ -36,7 +37,7 @@ import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -97,6 +98,11 @@ SCHEDULER_LOST = "scheduler-connection-lost"
 #: The reason given to the future of a band (or a batch's session) whose result could not be
 #: fetched from the worker that holds it, cancelled by :class:`_GatherWatch`.
 GATHER_FAILED = "rti-rig-result-unreachable"
+#: The reason given to the futures still to compute when every worker whose rti-rig was checked
+#: has left the cluster (:class:`_CheckedWatch`): the tasks may run on no other worker.
+CHECKED_GONE = "rti-rig-checked-workers-gone"
+#: Seconds between looks, while tasks are out, at whether a checked worker is left.
+CHECKED_POLL_S = 5.0
 #: Failed fetches of one result before the fit stops. Dask retries a failed fetch at once and
 #: for ever, logging "Couldn't gather N keys, rescheduling" each time (hundreds a second with
 #: a worker that answers the scheduler but not a fetch): one or two are a worker lost and its
@@ -187,11 +193,97 @@ def _unreachable(address: str, what: str, kept: str) -> str:
     )
 
 
+@dataclass(frozen=True)
+class Cluster:
+    """A client of the Dask scheduler at ``address`` and the ``workers`` whose rti-rig was
+    checked (:func:`_refuse_other_code`) before any task was sent.
+
+    Why the workers: the check asks the workers there when the fit begins; one that joins
+    later (a worker restarted with another rti-rig, a colleague's added to the cluster) was
+    given tasks unchecked, which it cannot read or answers with its own code's fit. Every
+    task is restricted to the checked workers (:meth:`restrictions`), Dask's own
+    ``workers=`` / ``allow_other_workers=False``: a late worker is given none."""
+
+    client: Any
+    address: str
+    workers: frozenset[str]
+
+    def restrictions(self) -> dict[str, Any]:
+        """The keywords of ``Client.submit`` / ``Client.compute`` that keep a task to the
+        checked workers."""
+        return {"workers": sorted(self.workers), "allow_other_workers": False}
+
+
+def checked_gone(cluster: Cluster, kept: str) -> str:
+    """What is said when every checked worker has left (their tasks wait for no one)."""
+    return (
+        f"the {len(cluster.workers)} worker(s) of the Dask cluster at {cluster.address!r} whose "
+        "rti-rig was checked when the fit began have all left it; workers that joined since "
+        "were not checked and are given no task of this fit, so it cannot go on: "
+        f"{kept}; run the same command again once the workers are back (each is checked then)"
+    )
+
+
+class _CheckedWatch:
+    """Cancels the tracked futures, with the reason :data:`CHECKED_GONE`, once none of the
+    checked workers is left: a task restricted to them (:meth:`Cluster.restrictions`) would
+    otherwise wait, and the fit with it, for ever. Looks every :data:`CHECKED_POLL_S`
+    seconds in a thread of its own, stopped at the end of the block."""
+
+    def __init__(self, cluster: Cluster, watch: _GatherWatch) -> None:
+        self.cluster = cluster
+        self.watch = watch
+        self.stop = threading.Event()
+        self.gone = False
+        self.thread = threading.Thread(target=self._run, name="rti-rig-checked", daemon=True)
+
+    def _present(self) -> set[str]:
+        try:
+            return set(self.cluster.client.scheduler_info()["workers"])
+        except Exception:  # the scheduler lost: said by the waiting code, in its words
+            return set(self.cluster.workers)
+
+    def _run(self) -> None:
+        cancelled: set[Any] = set()
+        while not self.stop.wait(CHECKED_POLL_S):
+            if not self.gone and not self._present() & self.cluster.workers:
+                self.gone = True
+            if self.gone:  # and again at each look: a task sent meanwhile waits too
+                waiting = [
+                    f
+                    for key, f in list(self.watch.futures.items())
+                    if key not in cancelled and f.status == "pending"
+                ]
+                cancelled.update(f.key for f in waiting)
+                if waiting:
+                    self._cancel(waiting)
+
+    def _cancel(self, futures: list[Any]) -> None:
+        """Cancel ``futures`` with :data:`CHECKED_GONE`, on the client's loop (no waiting)."""
+        client = self.cluster.client
+        client.loop.add_callback(
+            lambda: client.cancel(futures, asynchronous=True, reason=CHECKED_GONE)
+        )
+
+
 @contextmanager
-def scheduler_client(address: str) -> Iterator[Any]:
-    """A ``distributed.Client`` connected to ``address`` (closed afterwards), or None for
-    :data:`THREADS`. Refuses clearly when the scheduler does not answer within
-    :data:`CONNECT_TIMEOUT_S` or has no workers within :data:`WORKERS_TIMEOUT_S`."""
+def _checked_watched(cluster: Cluster, watch: _GatherWatch) -> Iterator[_CheckedWatch]:
+    """:class:`_CheckedWatch` over ``watch``'s futures for the length of the block."""
+    checked = _CheckedWatch(cluster, watch)
+    checked.thread.start()
+    try:
+        yield checked
+    finally:
+        checked.stop.set()
+        checked.thread.join(timeout=CONNECT_TIMEOUT_S)  # a look may await the scheduler
+
+
+@contextmanager
+def scheduler_client(address: str) -> Iterator[Cluster | None]:
+    """A ``distributed.Client`` connected to ``address`` (closed afterwards) with the workers
+    it checked (:class:`Cluster`), or None for :data:`THREADS`. Refuses clearly when the
+    scheduler does not answer within :data:`CONNECT_TIMEOUT_S` or has no workers within
+    :data:`WORKERS_TIMEOUT_S`."""
     if address == THREADS:
         yield None
         return
@@ -214,15 +306,14 @@ def scheduler_client(address: str) -> Iterator[Any]:
                 f"{WORKERS_TIMEOUT_S:.0f} s: start some with `dask worker {address}`; "
                 f"{SHARED_PATHS}."
             ) from None
-        _refuse_other_code(client, address)
-        yield client
+        yield Cluster(client, address, _refuse_other_code(client, address))
     finally:
         _close_quietly(client)
 
 
-def _refuse_other_code(client: Any, address: str) -> None:
+def _refuse_other_code(client: Any, address: str) -> frozenset[str]:
     """Refuse a cluster whose workers run another rti-rig than this machine, before any task
-    is sent (:mod:`rti_rig.app.usecases.worker_code` says why)."""
+    is sent (:mod:`rti_rig.app.usecases.worker_code` says why); the workers checked."""
     workers = worker_identities(client)
     mine = local_identity()
     untold = {w: ident for w, ident in workers.items() if isinstance(ident, Unasked)}
@@ -247,6 +338,7 @@ def _refuse_other_code(client: Any, address: str) -> None:
             "that they are running and reachable from this machine (restart them), and run "
             f"the same command; they must run this same rti-rig ({describe(mine)})"
         )
+    return frozenset(workers)
 
 
 def _close_quietly(client: Any) -> None:
@@ -272,10 +364,10 @@ def scheduler_lost(client: Any, exc: BaseException) -> bool:
     return str(getattr(client, "status", "running")) in ("connecting", "closing", "closed")
 
 
-def dask_bands(client: Any, address: str, source: Path) -> BandRunner:
+def dask_bands(cluster: Cluster | None, source: Path) -> BandRunner:
     """A band runner for :func:`rti_rig.app.usecases.fit.run_fit`: the bands of ``source`` as
     chunks of a lazily read ``dask.array``, each fitted by :func:`fit_band` — in threads here
-    (``client`` None) or on the cluster behind ``client``."""
+    (``cluster`` None) or on the checked workers of ``cluster``."""
 
     def run(
         stack: ImageStack, plan: BandPlan, tiles: list[slice]
@@ -287,13 +379,13 @@ def dask_bands(client: Any, address: str, source: Path) -> BandRunner:
         blocks = array.to_delayed().ravel()  # one per band, in row order
         if len(blocks) != len(tiles):
             raise AssertionError(f"{len(blocks)} chunks for {len(tiles)} bands")
-        if client is None:
+        if cluster is None:
             tasks = [dask.delayed(fit_band, pure=True)(b, plan) for b in blocks]
             yield from _in_threads(tasks, tiles)
         else:
             threads = blas_threads()
             tasks = [dask.delayed(fit_band_recording, pure=True)(b, plan, threads) for b in blocks]
-            yield from _on_cluster(client, address, tasks, tiles)
+            yield from _on_cluster(cluster, tasks, tiles)
 
     return run
 
@@ -328,10 +420,13 @@ def _in_threads(tasks: list[Any], tiles: list[slice]) -> Iterator[tuple[slice, B
 
 
 def _on_cluster(
-    client: Any, address: str, tasks: list[Any], tiles: list[slice]
+    cluster: Cluster, tasks: list[Any], tiles: list[slice]
 ) -> Iterator[tuple[slice, BandFit]]:
-    """Band fits computed on the cluster, a bounded number in flight, yielded as they finish."""
+    """Band fits computed on the cluster's checked workers, a bounded number in flight,
+    yielded as they finish."""
     from distributed import as_completed
+
+    client, address = cluster.client, cluster.address
 
     threads = max(1, sum(client.nthreads().values()))
     window = BANDS_IN_FLIGHT_PER_THREAD * threads
@@ -342,11 +437,11 @@ def _on_cluster(
         i = next(pending, None)
         if i is None:
             return None
-        future = watch.track(client.compute(tasks[i]))
+        future = watch.track(client.compute(tasks[i], **cluster.restrictions()))
         outstanding[future.key] = (future, i)
         return future
 
-    with _gathers_watched(client) as watch:
+    with _gathers_watched(client) as watch, _checked_watched(cluster, watch):
         first = [f for f in (submit_next(watch) for _ in range(window)) if f is not None]
         running = as_completed(first, loop=client.loop)
         try:
@@ -361,7 +456,7 @@ def _on_cluster(
                 except RtiRigError:
                     raise  # a named error of the fit itself, raised on the worker
                 except Exception as exc:  # e.g. KilledWorker: a worker died on this band
-                    raise _band_failed(client, address, exc) from None
+                    raise _band_failed(cluster, exc) from None
                 yield tiles[outstanding.pop(future.key)[1]], fitted
                 future.release()
                 following = submit_next(watch)
@@ -373,9 +468,12 @@ def _on_cluster(
                 client.cancel([f for f, _ in outstanding.values()])
 
 
-def _band_failed(client: Any, address: str, exc: BaseException) -> SchedulerError:
-    """The error of a band whose future failed (a lost scheduler, or a result that could not
-    be fetched, said as such)."""
+def _band_failed(cluster: Cluster, exc: BaseException) -> SchedulerError:
+    """The error of a band whose future failed (a lost scheduler, a result that could not
+    be fetched, or no checked worker left, said as such)."""
+    client, address = cluster.client, cluster.address
+    if getattr(exc, "reason", None) == CHECKED_GONE:
+        return SchedulerError(checked_gone(cluster, "nothing of this fit was kept in --out"))
     if getattr(exc, "reason", None) == GATHER_FAILED:
         kept = "nothing of this fit was kept in --out"
         return SchedulerError(_unreachable(address, "a band of the fit", kept))
@@ -395,8 +493,8 @@ def _band_failed(client: Any, address: str, exc: BaseException) -> SchedulerErro
 def run_fit_dask(req: FitRequest, scheduler: str = THREADS) -> FitResult:
     """:func:`run_fit` with its bands computed by Dask (``scheduler``: :data:`THREADS` or a
     scheduler address)."""
-    with scheduler_client(scheduler) as client:
-        return run_fit(req, bands=dask_bands(client, scheduler, req.source))
+    with scheduler_client(scheduler) as cluster:
+        return run_fit(req, bands=dask_bands(cluster, req.source))
 
 
 _SESSION_LOCK = threading.Lock()
@@ -420,19 +518,33 @@ def _fit_one_task(source: Path, root: Path, template: FitRequest, threads: int |
         return fit_one(source, root, template)
 
 
-def _batch_lost(
-    scheduler: str, sources: list[Path], given: list[tuple[Path, Path]], root: Path
-) -> SchedulerError:
-    """The error of a batch whose scheduler went away: which sessions are finished in
-    ``root`` (a session can finish on its worker while the client waits for another's result,
-    so it is told by its folder, not by its future, which Dask cancels with the rest)."""
+def _finished_kept(sources: list[Path], given: list[tuple[Path, Path]], root: Path) -> str:
+    """Which sessions of a stopped batch are finished in ``root`` (a session can finish on its
+    worker while the client waits for another's result, so it is told by its folder, not by
+    its future, which is cancelled with the rest)."""
     finished = [g for s, g in given if batch_out_dir(root, s).exists()]
-    kept = (
+    return (
         f"{len(finished)} of {len(sources)} sessions are finished in {root} "
         f"({', '.join(map(str, finished))}) and are kept"
         if finished
         else f"no session is finished in {root} yet"
     )
+
+
+def _batch_checked_gone(
+    cluster: Cluster, sources: list[Path], given: list[tuple[Path, Path]], root: Path
+) -> str:
+    """What a batch says when every checked worker has left (:func:`checked_gone`)."""
+    kept = _finished_kept(sources, given, root)
+    return checked_gone(cluster, f"{kept}, the rest are skipped or redone by that run")
+
+
+def _batch_lost(
+    scheduler: str, sources: list[Path], given: list[tuple[Path, Path]], root: Path
+) -> SchedulerError:
+    """The error of a batch whose scheduler went away: which sessions are finished in
+    ``root`` (:func:`_finished_kept`)."""
+    kept = _finished_kept(sources, given, root)
     return SchedulerError(
         f"lost the Dask scheduler at {scheduler!r} during the batch (it stopped or the network "
         f"to it failed): {kept}. Start the scheduler again (`dask scheduler`, workers with "
@@ -451,7 +563,7 @@ def run_batch_dask(
     refuse_out_inside_a_session(root)  # as given, as run_batch does
     if scheduler == THREADS:
         plan_batch(sources, root, judge=False)  # each session is judged at its turn
-        return [fit_one(s, root, template, bands=dask_bands(None, THREADS, s)) for s in sources]
+        return [fit_one(s, root, template, bands=dask_bands(None, s)) for s in sources]
     # Absolute, as workers do not share this process's working directory, but not resolved:
     # ``resolve()`` followed a symlinked session folder, so its output was named after the
     # link's target (OUT/s1 for sess/coin_day2 -> s1, OUT/coin_day2 without Dask, so a rerun
@@ -460,30 +572,33 @@ def run_batch_dask(
     given = list(zip([Path(os.path.abspath(s)) for s in sources], sources, strict=True))
     sources = [a for a, _ in given]
     root = root.resolve()
-    with scheduler_client(scheduler) as client:
+    with scheduler_client(scheduler) as cluster:
+        assert cluster is not None  # an address, not THREADS
+        client = cluster.client
         plan = plan_batch(sources, root)  # refuses a source given twice, as without Dask
         threads = blas_threads()
         # A source missing here too is the user's typo, not the workers' filesystem: it is
         # refused here in the words of the batch without Dask ("does not exist: give a session
         # folder or an .lp file"); it had been sent and blamed on the workers' shared paths.
-        with _gathers_watched(client) as watch:
+        with _gathers_watched(client) as watch, _checked_watched(cluster, watch) as checked:
 
             def submit(s: Path) -> Any:
-                task = client.submit(_fit_one_task, s, root, template, threads, pure=False)
+                if checked.gone:  # its task would wait for no one
+                    raise SchedulerError(_batch_checked_gone(cluster, sources, given, root))
+                task = client.submit(
+                    _fit_one_task, s, root, template, threads, pure=False, **cluster.restrictions()
+                )
                 return watch.track(task)
 
             futures = {
                 s: submit(s) for s, earlier in plan.items() if not earlier.stands and s.exists()
             }
-            items = _batch_results(
-                client, scheduler, sources, given, root, template, plan, futures, submit
-            )
+            items = _batch_results(cluster, sources, given, root, template, plan, futures, submit)
         return [replace(item, source=g) for item, (_, g) in zip(items, given, strict=True)]
 
 
 def _batch_results(
-    client: Any,
-    scheduler: str,
+    cluster: Cluster,
     sources: list[Path],
     given: list[tuple[Path, Path]],
     root: Path,
@@ -498,6 +613,7 @@ def _batch_results(
     :func:`fit_one` does without Dask): one whose capture was resumed, or an image replaced,
     while the batch ran had been reported "skipped (finished earlier)", its out-of-date fit
     kept. It is then sent (``submit``) and waited for."""
+    client, scheduler = cluster.client, cluster.address
     items = []
     for s in sources:
         if not plan[s].stands and s not in futures:
@@ -530,6 +646,8 @@ def _batch_results(
                     detail = f": {_unreachable(scheduler, 'the session', kept)}"
                 items.append(BatchItem(s, out, outcome, detail))
                 continue
+            if getattr(exc, "reason", None) == CHECKED_GONE:
+                raise SchedulerError(_batch_checked_gone(cluster, sources, given, root)) from None
             if scheduler_lost(client, exc):
                 raise _batch_lost(scheduler, sources, given, root) from None
             items.append(_task_failed(s, root, exc))
