@@ -66,12 +66,25 @@ def _normalise(gains: NDArray[np.float64], estimated: NDArray[np.bool_]) -> NDAr
     return out
 
 
-def _check_dead(gains: NDArray[np.float64], estimated: NDArray[np.bool_]) -> None:
-    for k in np.flatnonzero(estimated & (gains < MIN_GAIN)):
-        raise ReconstructionError(
-            f"light {k} gives {gains[k]:.3f} of the median light's signal: a dead LED or a "
+class DeadLightError(ReconstructionError):
+    """A light gives almost nothing (:data:`MIN_GAIN`): a dead LED or a black frame.
+
+    ``light`` is its index in the images given (not an LED number) and ``gain`` its measured
+    gain. Why a class of its own: the caller knows which LED and which session image that index
+    is, and what can be done about it, where this module knows only the position in a stack."""
+
+    def __init__(self, light: int, gain: float) -> None:
+        super().__init__(
+            f"light {light} gives {gain:.3f} of the median light's signal: a dead LED or a "
             "black frame, not something to calibrate; check that light and drop its image"
         )
+        self.light = light
+        self.gain = gain
+
+
+def _check_dead(gains: NDArray[np.float64], estimated: NDArray[np.bool_]) -> None:
+    for k in np.flatnonzero(estimated & (gains < MIN_GAIN)):
+        raise DeadLightError(int(k), float(gains[k]))
 
 
 def _target_channel(

@@ -9,6 +9,8 @@ input and the output are checked, and a card session's own calibration file is n
 
 from __future__ import annotations
 
+import shlex
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +28,7 @@ from rti_rig.app.output_files import check_output_file, rig_inputs
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.drivers.led_dome.settings import DIMMING_LINK, IMAGE_GAINS_REMEDY
+from rti_rig.reconstruct.light_gains import DeadLightError
 
 
 @dataclass(frozen=True)
@@ -84,6 +87,31 @@ def _check_dome_can_dim(req: CalibrateRequest, loaded: LoadedRig) -> None:
         )
 
 
+def _dead_led_advice(
+    req: CalibrateRequest, card: CardSession, names: Sequence[str], exc: DeadLightError
+) -> str:
+    """A dark card image named as the LED and session image it is, with what can be done.
+
+    Why: the refusal said "light 20 gives 0.000 of the median light's signal ...; check that
+    light and drop its image": "light 20" is the 21st image of the session (image_021, the one
+    the QA verdict calls misfired), not an LED number, and a card session with an image
+    removed is refused as not as captured. A card shot under every other LED (a ``--plan`` of
+    the session's own lights.lp without that line) is what calibrates the rest."""
+    led = int(card.leds[exc.light])
+    image = card.image_of.get(led, f"image {exc.light + 1}")
+    name = names[led] if 0 <= led < len(names) else f"LED {led}"
+    session = shlex.quote(str(req.card_session))
+    return (
+        f"{req.card_session}: LED {led} ({name}, session image {image}) gave {exc.gain:.3f} "
+        "of the median LED's light: a dead LED (or a black frame), which no correction can "
+        "even out. Check that LED and its wiring, then shoot the card again; to calibrate "
+        f"the other LEDs meanwhile, shoot the card under all but it: copy {session}/lights.lp "
+        f"without the line of {image} (the count on its first line one less) as PLAN.lp, "
+        f"run rti-rig run {shlex.quote(str(req.rig_config))} --plan PLAN.lp --out NEW_CARD "
+        "and calibrate NEW_CARD"
+    )
+
+
 def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     """Check, measure, and write the calibration file; returns what was measured."""
     loaded = load_rig_config(req.rig_config)
@@ -109,12 +137,15 @@ def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
             "object's relief, not the LEDs. Shoot a level matte white card under every LED; "
             "if this is one (a card large for its dome), give --not-flat-ok"
         )
-    cal = calibrate_dome(
-        card,
-        geometry.count,
-        card_normal=req.card_normal,
-        min_elevation_deg=req.min_elevation_deg,
-    )
+    try:
+        cal = calibrate_dome(
+            card,
+            geometry.count,
+            card_normal=req.card_normal,
+            min_elevation_deg=req.min_elevation_deg,
+        )
+    except DeadLightError as exc:
+        raise RtiRigError(_dead_led_advice(req, card, geometry.names, exc)) from None
     text = calibration_toml(cal, loaded.config.name, req.card_session.resolve(), geometry.names)
     try:
         target.write_text(text, encoding="utf-8")

@@ -1,0 +1,58 @@
+"""`calibrate-lights` on a card shot with a dead LED names that LED and its session image, and
+the way out it gives works through the CLI.
+
+Why: it refused with "light 20 gives 0.000 of the median light's signal: ...; check that light
+and drop its image". "light 20" was the 21st image of the session (image_021, the one the QA
+verdict calls misfired), not LED 20's .lp name, and a card session with an image removed is
+refused as "not as captured": the advice led nowhere. A card shot under every other LED (a
+--plan of the session's lights.lp without that line) calibrates the rest.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from card_support import card_rig
+from conftest import said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+DEAD = 20  # LED index: led_20.jpg in example_dome_48.lp, the session's image_021
+
+
+def test_a_dead_led_is_named_and_the_advice_calibrates_the_others(tmp_path: Path) -> None:
+    cfg = card_rig(tmp_path)
+    # a board that does not sense LED current: the dead LED "fires" and leaves a black frame
+    with cfg.open("a", encoding="utf-8") as f:
+        f.write(f"dead_leds = [{DEAD}]\nreports_dead_leds = false\n")
+    card = tmp_path / "card"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(card)])
+    assert (card / "image_048.jpg").exists(), r.output
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
+
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"LED {DEAD} (led_{DEAD}.jpg, session image image_{DEAD + 1:03d}.jpg)" in text, text
+    assert "drop its image" not in text and "Traceback" not in r.output
+    assert "--plan PLAN.lp" in text, text
+    assert not (card / "light_calibration.toml").exists()
+
+    # the advice, followed as written: the session's lights.lp without that image's line
+    lines = (card / "lights.lp").read_text().splitlines()
+    kept = [ln for ln in lines[1:] if not ln.startswith(f"image_{DEAD + 1:03d}.jpg ")]
+    assert len(kept) == len(lines) - 2
+    plan = tmp_path / "PLAN.lp"
+    plan.write_text("\n".join([str(len(kept)), *kept]) + "\n")
+    again = tmp_path / "NEW_CARD"
+    r = runner.invoke(app, ["run", str(cfg), "--plan", str(plan), "--out", str(again)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["calibrate-lights", str(again), "--rig", str(cfg)])
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    assert "47 of 48 LEDs measured" in text, text
+    assert f"led_{DEAD}.jpg" in text  # named as not measured
+    assert (again / "light_calibration.toml").exists()
