@@ -7,6 +7,7 @@ from pathlib import Path
 
 from rti_rig.app.config import LoadedRig
 from rti_rig.core.errors import RtiRigError
+from rti_rig.core.lp_format import image_paths, read_lp
 from rti_rig.core.out_folders import ensure_file_writable
 from rti_rig.runtime.session import LP_NAME, MANIFEST
 
@@ -17,13 +18,17 @@ def rig_inputs(rig: Path, loaded: LoadedRig) -> dict[str, Path | None]:
     (``intensity_correction_file``) and its LED map (``led_map_file``). Why: an ``--out
     --force`` onto one of them had replaced it with the command's output (a light
     calibration's TOML over the LED ``.lp``, a plan over the intensity correction), after
-    which every command on that rig was refused at load."""
+    which every command on that rig was refused at load. A replay rig (a recorded
+    acquisition's ``.lp``) reads its recorded images too: ``plan --rig ACQ/dirs.lp --out
+    ACQ/image_011.jpg --force`` had written the plan over a recorded image."""
     inputs: dict[str, Path | None] = {"RIG": rig}
     dome = loaded.config.dome
     if dome is None:
         return inputs
     if dome.lp_file:
         inputs["rig's LED calibration (lp_file)"] = loaded.folder / dome.lp_file
+        if loaded.config.backend == "replay":
+            inputs.update(recorded_images(loaded.folder / dome.lp_file))
     serial = (loaded.raw.get("dome") or {}).get("serial") or {}
     name = serial.get("intensity_correction_file")
     if isinstance(name, str) and name:  # relative to the config's real folder, as it is read
@@ -33,6 +38,20 @@ def rig_inputs(rig: Path, loaded: LoadedRig) -> dict[str, Path | None]:
     if dome.serial is not None and dome.serial.led_map_file:
         inputs["rig's LED map (led_map_file)"] = Path(dome.serial.led_map_file)
     return inputs
+
+
+def recorded_images(lp_file: Path) -> dict[str, Path | None]:
+    """The images a recorded acquisition's ``.lp`` names, where a replay reads them, as inputs
+    for :func:`check_output_file`; none if the ``.lp`` cannot be read (the command that reads
+    it as its rig says why, in its own words)."""
+    try:
+        entries = read_lp(lp_file, upper_hemisphere=True)
+        paths = image_paths(lp_file, entries)
+    except (OSError, RtiRigError):
+        return {}
+    return {
+        f"recorded image {e.name} of the rig's .lp": p for e, p in zip(entries, paths, strict=True)
+    }
 
 
 def check_output_file(

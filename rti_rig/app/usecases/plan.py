@@ -23,7 +23,7 @@ from rti_rig.app.normals_determined import (
     refuse_undetermined,
     undetermined_normals,
 )
-from rti_rig.app.output_files import check_output_file, rig_inputs
+from rti_rig.app.output_files import check_output_file, recorded_images, rig_inputs
 from rti_rig.app.preview_source import resolve_preview
 from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook
 from rti_rig.core.errors import RtiRigError
@@ -123,7 +123,8 @@ def _signal_noise(req: PlanLightsRequest, loaded: LoadedRig | None, objective: s
 
 def _check_outputs(req: PlanLightsRequest, loaded: LoadedRig | None) -> None:
     # the rig's own files (its LED .lp, intensity correction, LED map) are inputs too
-    rig_files = {} if loaded is None else rig_inputs(req.rig, loaded)
+    # a bare .lp's images (a recorded acquisition) too: a plan had been written over one
+    rig_files = recorded_images(req.rig) if loaded is None else rig_inputs(req.rig, loaded)
     rig_files.pop("RIG", None)  # named "rig file" here
     inputs: dict[str, Path | None] = {
         "preview": req.preview,
