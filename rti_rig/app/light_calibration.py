@@ -101,6 +101,20 @@ class LightCalibration:
         return float(-math.log2(self.evened_light))
 
 
+#: How a run records an error about one LED (``DomeLedError``) as its finish ``error``.
+LED_ERROR = "DomeLedError: "
+
+
+class CardStoppedAtLedError(SessionError):
+    """The card session stopped at an error about one LED (a dead one, say), which a resume or
+    a new card session meets again: the caller adds how to shoot the card without it. ``led``
+    is the LED of the first step not captured (the one it stopped at), None if not known."""
+
+    def __init__(self, message: str, led: int | None) -> None:
+        super().__init__(message)
+        self.led = led
+
+
 def _serial_table(manifest: dict[str, Any]) -> dict[str, Any]:
     config = (manifest.get("rig") or {}).get("config") or {}
     return (config.get("dome") or {}).get("serial") or {}
@@ -152,7 +166,20 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
     if finish != "completed" or len(steps) != len(planned):
         # counted from the journal: the manifest lists a run's steps only once it finishes, so
         # a killed card session had been said to hold "0 of 48 images" with 20 on disk
-        taken = len({r["index"] for r in scan_journal(root, image_names(len(planned))).records})
+        done = {r["index"] for r in scan_journal(root, image_names(len(planned))).records}
+        taken = len(done)
+        error = str((manifest.get("runner") or {}).get("error") or "")
+        if finish == "error" and error.startswith(LED_ERROR):
+            # a resume lights the same LED first, and a new card session lights it too: "continue
+            # it with --resume, or shoot the card again" led back to the same stop
+            stopped = next((k for k in range(len(planned)) if k not in done), None)
+            led = None if stopped is None else planned[stopped].get("led")
+            raise CardStoppedAtLedError(
+                f"{root}: the card session stopped at an LED after {max(taken, len(steps))} of "
+                f"{len(planned)} images ({error.removeprefix(LED_ERROR)}); a resume, or the card "
+                "shot again, lights that LED again",
+                led if isinstance(led, int) and not isinstance(led, bool) else None,
+            )
         raise SessionError(
             f"{root}: the card session did not finish ({finish or 'no finish recorded'}, "
             f"{max(taken, len(steps))} of {len(planned)} images): continue it with rti-rig run "

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from card_support import card_rig
-from conftest import said
+from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -56,3 +56,39 @@ def test_a_dead_led_is_named_and_the_advice_calibrates_the_others(tmp_path: Path
     assert "47 of 48 LEDs measured" in text, text
     assert f"led_{DEAD}.jpg" in text  # named as not measured
     assert (again / "light_calibration.toml").exists()
+
+
+def test_a_card_session_stopped_at_a_dead_led_says_how_to_shoot_the_others(
+    tmp_path: Path,
+) -> None:
+    """A board that senses LED current refuses the dead LED and the card session stops there.
+    calibrate-lights had said "continue it with rti-rig run --resume CARD, or shoot the card
+    again": both light that LED again and stop on it again."""
+    cfg = card_rig(tmp_path)
+    with cfg.open("a", encoding="utf-8") as f:
+        f.write(f"dead_leds = [{DEAD}]\n")
+    card = tmp_path / "card"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(card)])
+    assert r.exit_code != 0 and (card / f"image_{DEAD:03d}.jpg").exists(), r.output
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
+
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert "continue it with rti-rig run --resume" not in text, text
+    assert f"stopped at an LED after {DEAD} of 48 images" in text, text
+    assert f"without the line of LED {DEAD} (led_{DEAD}.jpg)" in text, text
+    assert "--plan PLAN.lp --out NEW_CARD" in text and "Traceback" not in r.output
+
+    # the advice, followed as written: the rig's LED .lp without that LED's line
+    lines = (CONFIGS / "example_dome_48.lp").read_text().splitlines()
+    kept = [ln for ln in lines[1:] if not ln.startswith(f"led_{DEAD}.jpg ")]
+    assert "the rig's LED .lp" in text and len(kept) == 47
+    plan = tmp_path / "PLAN.lp"
+    plan.write_text("\n".join([str(len(kept)), *kept]) + "\n")
+    again = tmp_path / "NEW_CARD"
+    r = runner.invoke(app, ["run", str(cfg), "--plan", str(plan), "--out", str(again)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["calibrate-lights", str(again), "--rig", str(cfg)])
+    assert r.exit_code == 0, r.output
+    assert "47 of 48 LEDs measured" in said(r)

@@ -18,6 +18,7 @@ from rti_rig.app.config import LoadedRig, load_rig_config, rig_geometry
 from rti_rig.app.light_calibration import (
     MAX_CARD_SPREAD_DEG,
     CardSession,
+    CardStoppedAtLedError,
     LightCalibration,
     calibrate_dome,
     calibration_toml,
@@ -112,12 +113,38 @@ def _dead_led_advice(
     )
 
 
+def _without_led(req: CalibrateRequest, loaded: LoadedRig, which: str) -> str:
+    """How to calibrate the other LEDs while ``which`` LED waits for repair: a card session of
+    a plan that leaves it out (an LED not in a card session is assumed at the median)."""
+    dome = loaded.config.dome
+    lp = (
+        f"{loaded.folder / dome.lp_file} (the rig's LED .lp)"
+        if dome is not None and dome.lp_file
+        else "a list of every LED's direction (x y z, as rti-rig plan writes them)"
+    )
+    return (
+        f"Repair {which} or its wiring and shoot the card again; to calibrate the other LEDs "
+        f"meanwhile, copy {lp} without the line of {which} (the count on its first line one "
+        f"less) as PLAN.lp, run rti-rig run {shlex.quote(str(req.rig_config))} --plan PLAN.lp "
+        "--out NEW_CARD and calibrate NEW_CARD"
+    )
+
+
 def calibrate_lights(req: CalibrateRequest) -> CalibrationWritten:
     """Check, measure, and write the calibration file; returns what was measured."""
     loaded = load_rig_config(req.rig_config)
     _check_dome_can_dim(req, loaded)
     geometry = rig_geometry(loaded)
-    card = read_card_session(req.card_session, rig_name=loaded.config.name)
+    try:
+        card = read_card_session(req.card_session, rig_name=loaded.config.name)
+    except CardStoppedAtLedError as exc:
+        names = rig_geometry(loaded).names
+        which = (
+            f"LED {exc.led} ({names[exc.led]})"
+            if exc.led is not None and 0 <= exc.led < len(names)
+            else "that LED"
+        )
+        raise RtiRigError(f"{exc}. {_without_led(req, loaded, which)}") from None
     target = req.target
     if req.out_file is None and target.exists():
         raise RtiRigError(
