@@ -115,9 +115,11 @@ def _reboot_faulted(rig_config: Path) -> None:
     left."""
     from rti_rig.app.usecases.check import reboot_faulted
 
-    out.print(f"Looking for faulted servos on {escape(str(rig_config))}'s arm (nothing moves)…")
+    def looking() -> None:
+        out.print(f"Looking for faulted servos on {escape(str(rig_config))}'s arm (nothing moves)…")
+
     try:
-        report = reboot_faulted(rig_config)
+        report = reboot_faulted(rig_config, on_start=looking)
     except RtiRigError as exc:
         raise fail(exc) from None
     for line in report.lines():

@@ -40,6 +40,7 @@ def test_reboot_faulted_clears_the_faulted_servo_only_and_moves_nothing(
     said = " ".join(r.output.split())
     assert r.exit_code == 0, said
     assert "Traceback" not in said
+    assert said.startswith(f"Looking for faulted servos on {cfg}'s arm (nothing moves)"), said
     assert "servo 1 (azimuth): no hardware fault (Hardware Error Status 0x00): not rebooted" in (
         said
     )
@@ -61,15 +62,21 @@ def test_reboot_faulted_clears_the_faulted_servo_only_and_moves_nothing(
     assert writes == []
 
 
-def test_reboot_faulted_is_refused_on_a_rig_without_dynamixel_servos() -> None:
-    r = runner.invoke(
-        app,
-        ["check", str(CONFIGS / "emulated_nab_rti_v1.toml"), "--reboot-faulted"],
-        terminal_width=400,
-    )
+@pytest.mark.parametrize(
+    "rig",
+    [
+        CONFIGS / "emulated_nab_rti_v1.toml",
+        Path(__file__).resolve().parents[1] / "data" / "neuralrti_replay" / "dirs.lp",
+    ],
+)
+def test_reboot_faulted_is_refused_on_a_rig_without_dynamixel_servos(rig: Path) -> None:
+    r = runner.invoke(app, ["check", str(rig), "--reboot-faulted"], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said
     assert "--reboot-faulted reboots a Dynamixel arm's faulted servos" in said
+    # a dome or a recorded acquisition was said to have an arm ("Looking for faulted servos
+    # on dirs.lp's arm") before the refusal
+    assert "Looking for faulted servos" not in said, said
 
 
 def test_a_faulted_servo_whose_torque_is_on_is_left_alone_and_the_user_told_what_to_do(

@@ -9,6 +9,7 @@ happens.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -123,16 +124,22 @@ class RebootReport:
         return out
 
 
-def reboot_faulted(rig_config: Path) -> RebootReport:
+def reboot_faulted(rig_config: Path, on_start: Callable[[], None] | None = None) -> RebootReport:
     """Reboot the arm's servos whose Hardware Error Status is set (torque off), and read their
     status back: nothing moves, and no torque is switched on (see
-    ``DynamixelArm.reboot_faulted``). Refused on a rig that has no Dynamixel arm."""
+    ``DynamixelArm.reboot_faulted``). Refused on a rig that has no Dynamixel arm.
+
+    ``on_start`` is called once the config is known to have one, before its port is opened.
+    Why: the command said "Looking for faulted servos on ACQ/dirs.lp's arm" of a dome or a
+    replay rig before refusing it as having no arm."""
     loaded = load_rig_config(rig_config)
     if loaded.config.arm is None or loaded.config.backend not in ("emulated", "hardware"):
         raise RtiRigError(
             f"{rig_config}: --reboot-faulted reboots a Dynamixel arm's faulted servos; this rig "
             "config has none (a dome, a simulated or a replay rig)"
         )
+    if on_start is not None:
+        on_start()
     with build_rig(loaded) as rig:
         carrier = getattr(rig.lighting, "carrier", None)
         reboot = getattr(carrier, "reboot_faulted", None)
