@@ -456,6 +456,9 @@ class FolderWatchCamera:
         self._seen_inodes: set[tuple[int, int]] = set()
         #: names of used files that reappeared as another file (reported at a timeout)
         self._reused_names: set[str] = set()
+        #: names of seen files written again in place (the same inode, new size or time): a
+        #: tethering program saving every shot over one name (reported at a timeout)
+        self._rewritten_names: set[str] = set()
         #: stems of the files taken: a later file with one is the same shot's other file
         self._taken_stems: set[str] = set()
         #: every file name in the folder at connect (a timeout names the new ones that no
@@ -487,6 +490,7 @@ class FolderWatchCamera:
         self._seen_ids = {i for i in map(_identity, present) if i is not None}
         self._seen_inodes = {i[:2] for i in self._seen_ids}
         self._reused_names = set()
+        self._rewritten_names = set()
         self._taken_stems = set()
         self._anchor = None
         self._orphan = None
@@ -595,6 +599,8 @@ class FolderWatchCamera:
             if p.name in seen:
                 if ident[:2] not in self._seen_inodes:  # another file
                     self._reused_names.add(p.name)
+                elif ident not in self._seen_ids:  # the same file, written again in place
+                    self._rewritten_names.add(p.name)
                 continue
             if ident in self._seen_ids:  # a file already seen, renamed
                 continue
@@ -642,8 +648,19 @@ class FolderWatchCamera:
                         "(an earlier shot had it): have the tethering program give every shot "
                         "its own file name"
                     )
+                if self._rewritten_names:
+                    # saved over in place: the camera was firing and saving there, but the
+                    # timeout had asked whether it was (gphoto2 --force-overwrite, a program
+                    # set to one file name for every shot)
+                    names = ", ".join(sorted(self._rewritten_names))
+                    reused += (
+                        f"; {names} was written again after the session had seen it (saved "
+                        "over under the same name, or still being written when the session "
+                        "began), but a name is used once: have the tethering program give "
+                        "every shot its own file name instead of saving over one"
+                    )
                 unmatched = self._unmatched_said()
-                ask = "" if unmatched else ": is the camera firing and saving there?"
+                ask = "" if unmatched or reused else ": is the camera firing and saving there?"
                 if not s.folder.is_dir():
                     # a network share that dropped, a card reader unplugged: the question
                     # about the camera had sent the user to check a camera that was firing
