@@ -1350,6 +1350,8 @@ def export_lp(
         )
     if done.raw_lost:
         err.print(f"[yellow]note:[/] {escape(done.raw_lost)}", soft_wrap=True)
+    if done.mosaic:
+        err.print(f"[yellow]note:[/] {escape(done.mosaic)}", soft_wrap=True)
     if done.relisted:
         err.print(f"[yellow]note:[/] {escape(done.relisted)}", soft_wrap=True)
     if done.unchecked:

@@ -65,6 +65,9 @@ class ExportedLp:
     #: What was done to the session's own lights.lp, one image short of what it holds (a run
     #: stopped between a step's record file and its journal line), or why it could not be.
     relisted: str = ""
+    #: What to say of listed images that are CFA mosaics (``decode.mode = "mosaic"``), "" if
+    #: none: the .lp is written, but a viewer or fitter given it fits a checkerboard.
+    mosaic: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -103,6 +106,7 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         renamed=renamed_note(renamed),
         relisted=relisted or "",
         raw_lost=_raw_lost(root, {Path(e.name).stem for e in entries}, scan, adaptive),
+        mosaic=_mosaic_said({Path(e.name).stem for e in entries}, scan),
         # the images left out named with what gets them back, as the verdict does (the note
         # named them alone)
         left_out_advice=(
@@ -129,4 +133,26 @@ def _raw_lost(root: Path, listed: set[str], scan: JournalScan, adaptive: bool) -
         f"{', '.join(n for n, _ in lost[:8])} is lost (the developed "
         f"{'image is' if len(lost) == 1 else 'images are'} as captured, and listed); "
         + lost_image_advice(root, adaptive, scan)
+    )
+
+
+def _mosaic_said(listed: set[str], scan: JournalScan) -> str:
+    """What to say of the images ``listed`` that the journal records as CFA mosaics, "" if
+    none. Why: ``rti-rig fit`` refuses a mosaic, but export-lp wrote its .lp for other tools
+    without a word, and relight or RTIBuilder given it fit grey checkerboards (one colour per
+    pixel) as if they were pictures."""
+    records = [r for r in scan.records if Path(str(r.get("image", ""))).stem in listed]
+    mosaics = sum(
+        isinstance(r.get("decode"), dict) and r["decode"].get("mode") == "mosaic" for r in records
+    )
+    if not mosaics:
+        return ""
+    return (
+        f"{mosaics} of the {len(listed)} images listed are CFA mosaics (the session was shot "
+        'with decode.mode = "mosaic"): one colour per pixel, not pictures (their JPEGs are '
+        "grey checkerboards): relight or RTIBuilder given this .lp would fit the checkerboard "
+        "(rti-rig fit refuses it); decode the camera's RAW files kept in the session's raw/ "
+        "folder to linear RGB (demosaiced) TIFFs with your RAW converter and list those "
+        "instead, and set "
+        'decode.mode = "demosaic" or "half" in the rig config for the next session'
     )
