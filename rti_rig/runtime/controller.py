@@ -490,13 +490,15 @@ def _refuse_other_layout(
         f"not image {index + 1} of the session: {said(got, 'x')}, the session's are "
         f"{said(layout, 'x')}"
     )
-    kept = folder.set_aside(index, frame, why)
+    tiff, *originals = folder.set_aside(index, frame, why)
+    camera_files = f", the camera's own file(s) as {', '.join(originals)}" if originals else ""
     raise CaptureError(
         rig.camera.name,
         f"image {index + 1} came back {said(got)}, but this session's images are "
         f"{said(layout)}: the camera's image size or format changed during the session (a "
         "setting changed on the camera, another camera's file in a watched folder). It is not "
-        f"part of the session (kept as {kept}); set the camera back, then continue the session",
+        f"part of the session (kept as {tiff}{camera_files}); set the camera back, then "
+        "continue the session",
         "capture",
     )
 

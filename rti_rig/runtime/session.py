@@ -696,17 +696,37 @@ class SessionFolder:
                 return None
         return None
 
-    def set_aside(self, index: int, frame: Frame, why: str) -> str:
+    def set_aside(self, index: int, frame: Frame, why: str) -> list[str]:
         """Keep ``frame``, which cannot be one of the session's images, as a linear TIFF under
-        ``recovered/`` (never listed, never deleted); its path relative to the folder."""
-        rel = f"recovered/{_new_stamp(self.root)}/{LINEAR_DIR}/{self.names[index]}.tif"
+        ``recovered/`` (never listed, never deleted), and beside it, under ``raw/``, the
+        camera's own files of it that the session holds (a DSLR download staged in
+        ``raw/.incoming``); their paths relative to the folder, the TIFF's first.
+
+        Why: only the TIFF was named; the RAW, the capture itself and perhaps its only copy
+        (a body shooting to its RAM keeps none), stayed in the hidden ``raw/.incoming`` under a
+        staging name until a resume moved it to another ``recovered/`` folder, unsaid."""
+        stamp = _new_stamp(self.root)
+        rel = f"recovered/{stamp}/{LINEAR_DIR}/{self.names[index]}.tif"
         dest = self.root / rel
         try:
             dest.parent.mkdir(parents=True, exist_ok=True)
             write_linear_tiff(dest, frame.pixels, description=why)
         except OSError as exc:
             raise SessionWriteError(dest, exc) from None
-        return rel
+        kept = [rel]
+        root = self.root.resolve()
+        for item in frame.metadata.get("originals") or []:
+            src = Path(item["path"])
+            if not src.is_file() or not src.resolve().is_relative_to(root):
+                continue  # a watched folder's own file: another program's, left where it is
+            raw_rel = f"recovered/{stamp}/{RAW_DIR}/{src.name}"
+            try:
+                (self.root / raw_rel).parent.mkdir(parents=True, exist_ok=True)
+                os.replace(src, self.root / raw_rel)
+            except OSError as exc:
+                raise SessionWriteError(self.root / raw_rel, exc) from None
+            kept.append(raw_rel)
+        return kept
 
     def _make_folder(self) -> None:
         try:

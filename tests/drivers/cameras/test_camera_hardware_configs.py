@@ -984,3 +984,34 @@ def test_a_download_gone_before_its_decode_names_the_camera_s_file_the_folder_an
     lost = "so this shot is lost" in said
     assert lost == delete, said
     assert [e["index"] for e in journal(out)] == [0]
+
+
+def test_a_dslr_frame_of_another_size_is_set_aside_with_its_raw_and_both_are_named(
+    dome, monkeypatch, tmp_path
+):
+    """The body's image size changed at the third shot (S-RAW chosen on the camera): the frame
+    is refused, and its RAW, the capture itself (a body shooting to its RAM keeps no copy),
+    is kept beside the refused frame and named; it had stayed in the hidden raw/.incoming
+    under a staging name, unsaid, until a resume moved it to another recovered/ folder."""
+    base = render_for(dome)
+    made: list[bytes] = []
+
+    def render(b: Body) -> bytes:
+        if b.shots < 2:
+            return base(b)
+        rgb = np.full((2 * H, W, 3), 0.3)
+        made.append(dng(mosaic_from_rgb(rgb, "RGGB", BLACK, WHITE), "RGGB", BLACK, WHITE))
+        return made[-1]
+
+    monkeypatch.setitem(sys.modules, "gphoto2", make_module(Body(render=render)))
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert "image 3 came back" in said and "Traceback" not in said, said
+    (stamp,) = (out / "recovered").iterdir()
+    (raw,) = (stamp / "raw").glob("*IMG_0003.CR2")
+    assert raw.read_bytes() == made[0]
+    assert (stamp / "linear" / "image_003.tif").is_file()
+    assert raw.relative_to(out).as_posix() in said, said
+    assert not any((out / "raw" / ".incoming").iterdir())
