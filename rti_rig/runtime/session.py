@@ -394,11 +394,15 @@ _FOLDER_METADATA = {".DS_Store", "Thumbs.db", "desktop.ini", ".directory"}
 
 
 def holds_no_image(root: Path) -> bool:
-    """True if ``root`` holds nothing but an image-less session's own files."""
+    """True if ``root`` holds nothing but an image-less session's own files.
+
+    Its own folders, empty, are no image: ``raw/.incoming`` is made for a DSLR's first
+    download, and a download that failed leaves it empty (a stop there had said "holds files of
+    the camera" of a folder holding none, and a new run in it was refused)."""
     for path in root.rglob("*"):
         rel = path.relative_to(root)
         if path.is_dir():
-            if rel.as_posix() != LINEAR_DIR:
+            if rel.as_posix() not in (LINEAR_DIR, RAW_DIR, RAW_INCOMING):
                 return False
             continue
         name = rel.as_posix()

@@ -1015,3 +1015,20 @@ def test_a_dslr_frame_of_another_size_is_set_aside_with_its_raw_and_both_are_nam
     assert (stamp / "linear" / "image_003.tif").is_file()
     assert raw.relative_to(out).as_posix() in said, said
     assert not any((out / "raw" / ".incoming").iterdir())
+
+
+def test_a_first_download_that_fails_leaves_a_folder_said_and_used_as_image_less(body, tmp_path):
+    """The first shot's download fails (libgphoto2 -1): nothing is in the session but its own
+    empty raw/.incoming. The stop had said "No image was completed, but S holds files of the
+    camera" of a folder holding none, and a new run there was refused as "not empty"."""
+    body.failures = {"file_get": [-1]}
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert not [p for p in out.rglob("*") if p.is_file() and p.parent.name != out.name]
+    assert "holds files of the camera" not in said, said
+    assert "holds no image and may be used again" in said, said
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    assert result.exit_code == 0, result.output
+    check_images(out)
