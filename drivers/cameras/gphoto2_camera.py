@@ -400,6 +400,24 @@ class Gphoto2Camera:
                 "read shutter speeds",
             )
         self._shutters = sorted(shutters)
+        self._check_shutter_latches(str(widget.get_value()))
+
+    def _check_shutter_latches(self, current: str) -> None:
+        """Set another offered shutter speed, read it back, and put the camera's own back.
+
+        Why: a body whose mode dial is not on M (Av, P) accepts a shutter speed and keeps its
+        own. ISO and the others were verified at connect, but the shutter only at the first
+        shot: ``rti-rig check`` passed such a camera, and ``run`` lit the first LED before
+        stopping on it. Found here, it is refused before anything is lit."""
+        s = self.settings
+        probe = next((label for _, label in self._shutters if label != current), None)
+        if probe is None:
+            return  # one speed offered: nothing to tell apart
+        self._set_config_values({s.shutter_config: (probe, "shutter_config")})
+        self._shutter_label = probe
+        if any(label == current for _, label in self._shutters):
+            self._set_config_values({s.shutter_config: (current, "shutter_config")})
+            self._shutter_label = current
 
     def available_exposures_s(self) -> list[float]:
         """Shutter speeds the camera offers, in seconds (for ``exposure.choose_exposure``)."""

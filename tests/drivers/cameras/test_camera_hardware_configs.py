@@ -1032,3 +1032,31 @@ def test_a_first_download_that_fails_leaves_a_folder_said_and_used_as_image_less
     result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
     assert result.exit_code == 0, result.output
     check_images(out)
+
+
+def test_a_dslr_not_in_manual_mode_is_refused_before_any_led_lights(body, dome, tmp_path):
+    """The mode dial is on Av: the body accepts a shutter speed and keeps its own. ISO and the
+    format were verified at connect, the shutter only at the first shot: `check` passed the
+    camera and `run` lit LED 0 before stopping on it."""
+    body.read_only = {"shutterspeed"}
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert "put the camera in manual (M) mode" in said and "shutterspeed" in said, said
+    assert not [e for e in dome.history if e.what == "lit"], "an LED was lit"
+    assert body.shots == 0 and not out.exists()
+    result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert "put the camera in manual (M) mode" in said, said
+    assert body.config["shutterspeed"] == "1/60"  # the camera's own, untouched
+
+
+def test_check_leaves_a_manual_bodys_shutter_as_it_found_it(body, tmp_path):
+    """The shutter is tried at connect (another speed, read back) and put back: `check` does
+    not change the camera's own setting."""
+    result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
+    assert result.exit_code == 0, result.output
+    assert body.config["shutterspeed"] == "1/60"
+    assert body.calls.count("set_config") >= 3  # format and target, the try, the one put back
