@@ -400,9 +400,9 @@ class Gphoto2Camera:
                 "read shutter speeds",
             )
         self._shutters = sorted(shutters)
-        self._check_shutter_latches(str(widget.get_value()))
+        self._check_shutter_latches(str(widget.get_value()), self._choices(widget))
 
-    def _check_shutter_latches(self, current: str) -> None:
+    def _check_shutter_latches(self, current: str, offered: list[str]) -> None:
         """Set another offered shutter speed, read it back, and put the camera's own back.
 
         Why: a body whose mode dial is not on M (Av, P) accepts a shutter speed and keeps its
@@ -415,7 +415,7 @@ class Gphoto2Camera:
             return  # one speed offered: nothing to tell apart
         self._set_config_values({s.shutter_config: (probe, "shutter_config")})
         self._shutter_label = probe
-        if any(label == current for _, label in self._shutters):
+        if current in offered:  # "bulb" too: the camera's own, whatever it was
             self._set_config_values({s.shutter_config: (current, "shutter_config")})
             self._shutter_label = current
 

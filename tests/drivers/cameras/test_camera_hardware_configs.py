@@ -1053,10 +1053,12 @@ def test_a_dslr_not_in_manual_mode_is_refused_before_any_led_lights(body, dome, 
     assert body.config["shutterspeed"] == "1/60"  # the camera's own, untouched
 
 
-def test_check_leaves_a_manual_bodys_shutter_as_it_found_it(body, tmp_path):
+@pytest.mark.parametrize("own", ["1/60", "bulb"])
+def test_check_leaves_a_manual_bodys_shutter_as_it_found_it(body, tmp_path, own):
     """The shutter is tried at connect (another speed, read back) and put back: `check` does
-    not change the camera's own setting."""
+    not change the camera's own setting, a timed speed or bulb."""
+    body.config["shutterspeed"] = own
     result = CliRunner().invoke(app, ["check", str(DSLR_CONFIG)])
     assert result.exit_code == 0, result.output
-    assert body.config["shutterspeed"] == "1/60"
+    assert body.config["shutterspeed"] == own
     assert body.calls.count("set_config") >= 3  # format and target, the try, the one put back
