@@ -130,8 +130,8 @@ def test_a_worker_of_other_code_joining_after_the_check_fits_no_session(
                 app, [*args, "--model", "ps", "--scheduler", cluster.scheduler_address]
             )
     finally:
-        for worker in workers:
-            worker.terminate()
+        for worker in workers:  # a throwaway: killed, since a SIGTERM'd dask worker may
+            worker.kill()  # spend minutes closing gracefully towards a scheduler now gone
             worker.wait(timeout=120)
     assert len(workers) == 1
     said = " ".join(r.output.split())
