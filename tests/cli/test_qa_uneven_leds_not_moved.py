@@ -9,6 +9,13 @@ the most grazing light's image, 1.2 px off along its light, was called moved on 
 word alone. Now only the part of an edge shift that does not follow the light counts; a
 session with one image really shifted 1-2 px names that image, and only it (it had named
 image_001 beside it).
+
+A 2 px shift of an image whose LED is about 20 % off power had still been missed: with the
+moved image among them the edges spread 0.41 px about their median, untrusted, and against a
+fit of 12 lights that had taken the image in it read 0.8 px (seed 0's image_008, LED at 0.84;
+12 of 16 such shifts over seeds 0-3 called good). The edges' noise is now their spread about
+the light's trend (0.1-0.2 px there), and those shifts are named; still sessions over several
+seeds stay unmoved.
 """
 
 from __future__ import annotations
@@ -33,17 +40,24 @@ def _sha(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-@pytest.fixture(scope="module")
-def uneven(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    """A still session of the shipped emulated dome with uneven LEDs, and its run's output."""
-    folder = tmp_path_factory.mktemp("uneven")
+def _uneven_session(folder: Path, seed: int) -> tuple[Path, str]:
+    """A still session of the shipped emulated dome with uneven LEDs drawn from ``seed``, and
+    its run's output."""
     config = folder / "rig.toml"
     text = (REPO / "rig_configs" / "emulated_nab_rti_v1.toml").read_text()
+    assert "\nseed = 0\n" in text
+    text = text.replace("\nseed = 0\n", f"\nseed = {seed}\n")
     config.write_text(text + "\n[emulator]\nled_power_spread = 0.2\n")
     out = folder / "s"
     r = runner.invoke(app, ["run", str(config), "--out", str(out)])
     assert r.exit_code == 0, r.output
     return out, " ".join(r.output.split())
+
+
+@pytest.fixture(scope="module")
+def uneven(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """A still session of the shipped emulated dome with uneven LEDs, and its run's output."""
+    return _uneven_session(tmp_path_factory.mktemp("uneven"), 0)
 
 
 def _shifted_copy(session: Path, dst: Path, image: int, dx: int, dy: int) -> Path:
@@ -67,7 +81,17 @@ def test_uneven_leds_on_a_still_tablet_are_not_called_moved(uneven: tuple[Path, 
     assert "moved" not in output, output
 
 
-@pytest.mark.parametrize(("image", "dx", "dy"), [(7, 2, 0), (7, 1, 1), (4, 0, 1)])
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_still_sessions_of_other_uneven_leds_are_not_called_moved(
+    tmp_path: Path, seed: int
+) -> None:
+    _, output = _uneven_session(tmp_path, seed)
+    assert "QA verdict" in output, output
+    assert "moved" not in output, output
+
+
+# image_008's LED gives 0.84 of nominal (seed 0): its (2, 0) px shift had been called good
+@pytest.mark.parametrize(("image", "dx", "dy"), [(7, 2, 0), (7, 1, 1), (4, 0, 1), (8, 2, 0)])
 def test_a_real_shift_of_one_image_under_uneven_leds_is_caught(
     uneven: tuple[Path, str], tmp_path: Path, image: int, dx: int, dy: int
 ) -> None:
