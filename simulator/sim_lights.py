@@ -7,6 +7,7 @@ actually did, not from what the schedule asked for.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,7 +15,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.arm_motion import joint_move_time_s
 from rti_rig.core.clock import Clock
-from rti_rig.core.errors import DeviceError
+from rti_rig.core.errors import DeviceError, MoveCancelled
 from rti_rig.core.geometry import az_el_from_direction, direction_from_az_el
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 
@@ -151,8 +152,12 @@ class SimulatedArm:
     def stop(self) -> None:
         """Motion is modelled as complete when ``move_to`` returns, so stopping is immediate."""
 
-    def park(self) -> None:
+    def park(self, cancelled: Callable[[], bool] | None = None) -> None:
+        """Lamp off, then the park move. Motion is modelled as one step, so ``cancelled`` (a
+        stop asked for during the teardown) is asked once, before it: the arm stays put."""
         self.lamp(False)
+        if cancelled is not None and cancelled():
+            raise MoveCancelled(self.name, "cancelled before it moved; left where it was", "park")
         self._move_joints(self._geometry.park_azimuth_deg, self._geometry.park_elevation_deg)
 
     @property

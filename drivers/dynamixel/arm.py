@@ -18,6 +18,7 @@ limits only.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rti_rig.core.clock import Clock
+from rti_rig.core.errors import MoveCancelled
 from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 from rti_rig.drivers.dynamixel.bus import DxlBus
@@ -626,9 +628,18 @@ class DynamixelArm:
             raise UnreachableError(self.name, np.round(d, 6).tolist(), reason or "unknown")
         return self._move_ticks(self.kin.ticks_of_pose(*pose), f"move_to {np.round(d, 4)}")
 
-    def park(self) -> None:
+    def park(self, cancelled: Callable[[], bool] | None = None) -> None:
+        """Move to the park pose and wait until in position.
+
+        ``cancelled`` is asked before each poll of the wait (every ``poll_interval_s`` plus one
+        bus round trip): once it says True the park is given up and the arm held where it
+        stands (:meth:`stop`: goal = present position, torque stays on; a torque-off would
+        drop the lamp onto the object), then :class:`MoveCancelled` is raised. Why: the
+        teardown's park holds Ctrl-C and SIGTERM (a stop must not cut the lamp-off), and a
+        user's stop during a park sat out the whole move, up to ``move_timeout_s``."""
         s = self.settings
-        self._move_ticks(self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg), "park")
+        goal = self.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
+        self._move_ticks(goal, "park", cancelled)
 
     @property
     def park_pose_deg(self) -> tuple[float, float]:
@@ -931,15 +942,24 @@ class DynamixelArm:
         self._goal = goal
         self._reached = None  # until this goal is reached
 
-    def _move_ticks(self, goal: tuple[int, int], command: str) -> NDArray[np.float64]:
+    def _move_ticks(
+        self, goal: tuple[int, int], command: str, cancelled: Callable[[], bool] | None = None
+    ) -> NDArray[np.float64]:
         self._require_connected(command)
         self._send_goal(goal, command)
-        return self._wait_in_position(goal, command)
+        return self._wait_in_position(goal, command, cancelled)
 
-    def _wait_in_position(self, goal: tuple[int, int], command: str) -> NDArray[np.float64]:
+    def _wait_in_position(
+        self, goal: tuple[int, int], command: str, cancelled: Callable[[], bool] | None = None
+    ) -> NDArray[np.float64]:
         s = self.settings
         start = self.clock.now()
         while True:
+            if cancelled is not None and cancelled():
+                self.stop()  # the hold; a stop that fails raises its own error, said as is
+                raise MoveCancelled(
+                    self.name, "cancelled part-way; held where it stopped (torque on)", command
+                )
             present, moving = [], False
             for joint in s.joints:
                 data, error = self._bus.read_block(

@@ -192,7 +192,8 @@ def run(
 
     Ctrl-C once stops after the current image (before it, its light left off, while a busy
     camera is awaited in the dark); Ctrl-C twice or SIGTERM stops at once (lights off, arm
-    stopped, and parked if the config says park_on_emergency_stop = true). A stop while the
+    stopped, and parked if the config says park_on_emergency_stop = true); during an arm's
+    final park, a Ctrl-C or SIGTERM stops the arm where it is, held (torque on). A stop while the
     dome connects first switches the dome off, once its board has booted (a few seconds; a
     further Ctrl-C waits for it): opening its port may have reset a board that boots lit.
     SIGUSR1 pauses or resumes between images. An interrupted session can be continued with
@@ -982,6 +983,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if cancel.cancelled:
             raise EmergencyStop("second Ctrl-C")
         cancel.cancel()
+        if _park_stopped_by(opened.rig) is not None:  # delivered after the teardown it stopped:
+            return  # no image is left to stop after; the arm's line and the summary say it
         err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")
 
     def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]
@@ -1179,7 +1182,25 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         raise typer.Exit(code=130)
     from rti_rig.app.usecases.safe_state import safe_state_unsure
 
-    return bool(result.teardown_failures) or safe_state_unsure(rig)
+    unsafe = bool(result.teardown_failures) or safe_state_unsure(rig)
+    if _park_stopped_by(rig) == signal.SIGINT:
+        # a Ctrl-C that stopped the final park: an interrupted run's exit, as a late SIGTERM's
+        _refuse_unsafe_end(unsafe, exit_code=None)
+        err.print(
+            "[yellow]Stopped (Ctrl-C) during the arm's park, once the session had ended: it is "
+            "complete; its QA verdict was not computed:[/] rti-rig fit "
+            f"{escape(_arg(opened.out_dir))} --out FOLDER gives it",
+            soft_wrap=True,
+        )
+        raise typer.Exit(code=130)
+    return unsafe
+
+
+def _park_stopped_by(rig) -> int | None:  # type: ignore[no-untyped-def]
+    """The signal (SIGINT, SIGTERM) that stopped the arm's final park, None if none did (or
+    the rig has no arm): a stop during the teardown's park holds the arm where it stands
+    (:meth:`rti_rig.runtime.lighting.ArmLighting.safe`)."""
+    return getattr(rig.lighting, "stopped_by", None)
 
 
 @app.command()

@@ -17,6 +17,7 @@ Devices open their transport in ``connect()`` (never in ``__init__``) and releas
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
@@ -102,7 +103,10 @@ class LightCarrier(Protocol):
 
     def stop(self) -> None: ...
 
-    def park(self) -> None: ...
+    def park(self, cancelled: Callable[[], bool] | None = None) -> None:
+        """Move to the park pose; once ``cancelled()`` says True, hold where it stands and
+        raise :class:`~rti_rig.core.errors.MoveCancelled` (a stop during the teardown)."""
+        ...
 
 
 @runtime_checkable

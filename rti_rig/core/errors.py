@@ -55,6 +55,13 @@ class DeviceError(RtiRigError):
         super().__init__(f"{device}{cmd}: {message}")
 
 
+class MoveCancelled(DeviceError):
+    """A move (the teardown's park) was cancelled by its caller part-way, and the arm stopped
+    by a hold where it stood (torque on): raised only once that hold was written to every
+    joint, so whoever catches it may say the arm is held there (a stop that did not hold
+    every joint raises its own error instead)."""
+
+
 class CaptureError(DeviceError):
     """The camera did not deliver a usable frame."""
 

@@ -19,9 +19,14 @@ from typing import Any
 
 
 @contextlib.contextmanager
-def signals_deferred() -> Iterator[None]:
+def signals_deferred(on_held: Callable[[int], None] | None = None) -> Iterator[None]:
     """Hold SIGINT/SIGTERM while devices are put in their safe state, or while a captured
     image is committed (its files and journal line).
+
+    ``on_held`` (called with the signal's number, in the main thread, as each is held) lets
+    the block cut short a long wait of its own that a stop must not sit through (the arm's
+    final park, which lasts up to ``move_timeout_s``): it should only record the request (set
+    a flag), never raise; the signal is still delivered once the block is done.
 
     An emergency-stop handler raising in the middle of teardown could leave a light on, and in
     the middle of a commit an image that ``lights.lp`` does not list; the signals are delivered
@@ -38,6 +43,8 @@ def signals_deferred() -> Iterator[None]:
 
     def hold(signum: int, frame: Any) -> None:
         pending.append((signum, frame))
+        if on_held is not None:
+            on_held(signum)
 
     installed: dict[int, Any] = {}
     for sig in (signal.SIGINT, signal.SIGTERM):

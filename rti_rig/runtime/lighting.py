@@ -8,17 +8,19 @@ arm reached, which is what the session's `.lp` records.
 
 from __future__ import annotations
 
+import signal
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
 from rti_rig.core.devices import DiscreteLightSource, LightCarrier
-from rti_rig.core.errors import DeviceError
+from rti_rig.core.errors import DeviceError, MoveCancelled
 from rti_rig.core.geometry import angle_between_deg
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.core.schedule import LightStep
 from rti_rig.runtime.arm_end import ArmEnd, left_end, park_end
+from rti_rig.runtime.deferred_signals import signals_deferred
 
 #: A dome step's direction must match its LED's calibrated direction this closely (degrees).
 LED_MATCH_TOLERANCE_DEG = 0.5
@@ -172,6 +174,8 @@ class ArmLighting:
         self.arm_failure: Exception | None = None
         #: where the last :meth:`safe` left the arm, as read back (None: not gone safe yet)
         self.end: ArmEnd | None = None
+        #: the signal (SIGINT, SIGTERM) that stopped the last :meth:`safe`'s park, if one did
+        self.stopped_by: int | None = None
 
     def connect(self) -> None:
         self.arm_failure = None
@@ -212,7 +216,26 @@ class ArmLighting:
 
     def safe(self, emergency: bool = False) -> list[str]:
         """Lamp off, stop, then park as the policy says; :attr:`end` records where the arm
-        was left, as read back (see :mod:`rti_rig.runtime.arm_end`)."""
+        was left, as read back (see :mod:`rti_rig.runtime.arm_end`).
+
+        Ctrl-C and SIGTERM are held here (as by the caller's own hold, which delivers them
+        once the teardown is done), but one that comes before or during the park stops it:
+        the arm is held where it stands, torque on (:attr:`stopped_by` names the signal).
+        Why: the park is a move of up to ``move_timeout_s``, and a user's stop sat it out."""
+        self.stopped_by = None
+
+        def stop_asked(signum: int) -> None:
+            if self.stopped_by is None:
+                self.stopped_by = signum
+
+        with signals_deferred(on_held=stop_asked):
+            return self._safe(emergency)
+
+    def _stopped_why(self) -> str:
+        who = "Ctrl-C" if self.stopped_by == signal.SIGINT else "SIGTERM"
+        return f"the park was stopped by {who}: held where it stopped, torque on"
+
+    def _safe(self, emergency: bool) -> list[str]:
         failures = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
         stop_failed = attempt_all([("stop", self.carrier.stop)])
         failures += stop_failed
@@ -255,9 +278,20 @@ class ArmLighting:
                 "fault (its error says how), then park it with 'rti-rig check'",
             )
             return failures
-        parked = attempt_all([("park", self.carrier.park)])
-        self.end = park_end(self.carrier, parked[0] if parked else None)
-        return failures + parked
+        if self.stopped_by is not None:  # a stop came as the lamp went off: no park begun
+            self.end = left_end(self.carrier, self._stopped_why())
+            return failures
+        try:
+            self.carrier.park(cancelled=lambda: self.stopped_by is not None)
+        except MoveCancelled:  # held where it stood, every joint (the driver's stop)
+            self.end = left_end(self.carrier, self._stopped_why())
+            return failures
+        except Exception as exc:  # teardown must go on whatever the arm does
+            parked = [f"park: {exc}"]
+            self.end = park_end(self.carrier, parked[0])
+            return failures + parked
+        self.end = park_end(self.carrier, None)
+        return failures
 
 
 def attempt_all(actions: list[tuple[str, object]]) -> list[str]:

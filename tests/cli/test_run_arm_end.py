@@ -35,7 +35,7 @@ ArmLighting.set = hooked_set
 if os.environ.get("ARM_END_JAM"):
     real_safe = ArmLighting.safe
     def jammed_safe(self, emergency=False):
-        def jam():
+        def jam(cancelled=None):
             raise RuntimeError("jammed")
         self.carrier.park = jam
         return real_safe(self, emergency)

@@ -1,0 +1,155 @@
+"""A Ctrl-C or SIGTERM during an arm session's final park stops the arm where it is, held.
+
+The teardown holds Ctrl-C and SIGTERM (a stop must not cut the lamp-off), and the park ran
+inside that hold: a user's stop during it was sat out until the arm had parked (up to
+``move_timeout_s``, 20 s on the shipped config), and the run then said "parked". Each case
+runs ``rti-rig run`` on the shipped emulated arm in a subprocess sent a real signal once the
+emulated elevation servo reports it is moving to the park pose; the rig runs on the wall
+clock (a dry run's virtual clock would finish the park before any signal could come) with
+the elevation joint slowed (1 rpm: the park takes seconds) so that the signal comes mid-park.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, REPO
+
+#: runs rti-rig on the wall clock; says "PARK MOVING" once the emulated elevation servo moves
+#: to the park pose, and "PARK ENDED <monotonic s>" when the driver's park returns or raises
+HOOK = """
+import sys, threading, time
+import rti_rig.app.compose as compose
+from rti_rig.core.clock import SystemClock
+from rti_rig.drivers.dynamixel.arm import DynamixelArm
+rigs = []
+real_build = compose.build_rig
+def build_rig(loaded, clock=None):
+    rigs.append(real_build(loaded, clock or SystemClock()))
+    return rigs[-1]
+compose.build_rig = build_rig
+real_park = DynamixelArm.park
+def park(self, *args, **kwargs):
+    servo = rigs[-1].emulator.servos[2]
+    def watch():
+        deadline = time.monotonic() + 120
+        while not servo.is_moving() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        print("PARK MOVING", file=sys.stderr, flush=True)
+    threading.Thread(target=watch, daemon=True).start()
+    try:
+        return real_park(self, *args, **kwargs)
+    finally:
+        print(f"PARK ENDED {time.monotonic()}", file=sys.stderr, flush=True)
+DynamixelArm.park = park
+from rti_rig.cli import app
+sys.argv = ["rti-rig", *sys.argv[1:]]
+app()
+"""
+
+
+def _slow_config(tmp_path: Path) -> Path:
+    """The shipped emulated arm, its elevation joint at 1 rpm (6°/s) and the timeout raised
+    to match (the config check refuses a timeout shorter than the longest move)."""
+    text = (CONFIGS / "simulated_arm.toml").read_text()
+    head, sep, elevation = text.partition("[arm.dynamixel.elevation]")
+    assert sep and "profile_velocity_rpm = 20.0" in elevation
+    elevation = elevation.replace("profile_velocity_rpm = 20.0", "profile_velocity_rpm = 1.0", 1)
+    assert "move_timeout_s = 20.0" in head
+    head = head.replace("move_timeout_s = 20.0", "move_timeout_s = 40.0", 1)
+    cfg = tmp_path / "slow_arm.toml"
+    cfg.write_text(head + sep + elevation)
+    return cfg
+
+
+def _run_signalled(tmp_path: Path, *signals: int) -> tuple[int, str, Path, float]:
+    """``rti-rig run`` sent ``signals[0]`` once the park moves, the rest once the park
+    has ended: exit code, output folded,
+    session, and seconds from the first signal to the park's end (the child's monotonic
+    clock is the system's, as this one's)."""
+    hook = tmp_path / "hook.py"
+    hook.write_text(HOOK)
+    out = tmp_path / "s"
+    argv = ["run", str(_slow_config(tmp_path)), "--lights", "2", "--out", str(out)]
+    proc = subprocess.Popen(
+        [sys.executable, str(hook), *argv, "--no-verdict"],
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    lines: list[str] = []
+    sent_at = None
+    try:
+        assert proc.stdout is not None
+        for line in proc.stdout:  # until the park moves (or the run ends without one)
+            lines.append(line)
+            if line.startswith("PARK MOVING"):
+                sent_at = time.monotonic()
+                proc.send_signal(signals[0])
+            elif line.startswith("PARK ENDED"):
+                # any further signal once the first has been acted on (two sent at once are
+                # one: a process sees a pending signal once)
+                for sig in signals[1:]:
+                    proc.send_signal(sig)
+                break
+        lines.append(proc.stdout.read())
+        code = proc.wait(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    said = "".join(lines)
+    assert sent_at is not None, said
+    ended = [float(x.split()[2]) for x in said.splitlines() if x.startswith("PARK ENDED")]
+    assert ended, said
+    return code, " ".join(said.split()), out, ended[0] - sent_at
+
+
+def _arm_end(out: Path) -> dict:  # type: ignore[type-arg]
+    return json.loads((out / "manifest.json").read_text())["runner"]["arm_end"]
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+@pytest.mark.parametrize(
+    ("signals", "code", "who"),
+    [
+        ((signal.SIGINT,), 130, "Ctrl-C"),
+        ((signal.SIGINT, signal.SIGINT), 130, "Ctrl-C"),
+        ((signal.SIGTERM,), 143, "SIGTERM"),
+    ],
+    ids=["ctrl-c", "ctrl-c-twice", "sigterm"],
+)
+def test_a_stop_during_the_final_park_holds_the_arm_where_it_is(
+    tmp_path: Path, signals: tuple[int, ...], code: int, who: str
+) -> None:
+    got, said, out, took = _run_signalled(tmp_path, *signals)
+    print(f"park ended {took:.3f} s after the signal")
+    assert got == code, said
+    assert "Traceback" not in said, said
+    end = _arm_end(out)
+    # held part-way: read back, away from the park pose (el 10°), not "parked"
+    assert end["outcome"] == "left", said
+    assert end["elevation_deg"] is not None and end["elevation_deg"] > 12.0, end
+    assert end["why"] == f"the park was stopped by {who}: held where it stopped, torque on"
+    at = f"az {end['azimuth_deg']:.1f}°, el {end['elevation_deg']:.1f}°"
+    assert f"the arm was not parked and is left at {at} (read back; the park was stopped" in said
+    assert "parked (read back" not in said and "Stopping after this image" not in said, said
+    # nothing captured is lost: both images kept and listed
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["steps_done_this_run"] == 2, said
+    assert len((out / "lights.lp").read_text().split("\n")[1:]) >= 2
+    stopped = "Stopped (Ctrl-C) during the arm's park, once the session had ended" in said
+    if signals == (signal.SIGINT,):
+        assert stopped, said
+    elif signals == (signal.SIGTERM,):  # the run's emergency stop, said as ever
+        assert "Emergency stop (SIGTERM)" in said, said
+    else:  # the second Ctrl-C met the end of the teardown (a stop) or the summary (ignored)
+        assert stopped or "Emergency stop (second Ctrl-C)" in said, said
