@@ -23,12 +23,16 @@ import pytest
 from conftest import CONFIGS, REPO
 
 #: runs rti-rig on the wall clock; says "PARK MOVING" once the emulated elevation servo moves
-#: to the park pose, and "PARK ENDED <monotonic s>" when the driver's park returns or raises
+#: to the park pose, "PARK ENDED <monotonic s>" when the driver's park returns or raises, and
+#: after the teardown "SERVOS {...}": the emulated servos' Torque Enable and Goal Position, and
+#: the park's goal
 HOOK = """
-import sys, threading, time
+import json, sys, threading, time
 import rti_rig.app.compose as compose
 from rti_rig.core.clock import SystemClock
+from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel.arm import DynamixelArm
+from rti_rig.runtime.lighting import ArmLighting
 rigs = []
 real_build = compose.build_rig
 def build_rig(loaded, clock=None):
@@ -48,6 +52,23 @@ def park(self, *args, **kwargs):
         return real_park(self, *args, **kwargs)
     finally:
         print(f"PARK ENDED {time.monotonic()}", file=sys.stderr, flush=True)
+real_safe = ArmLighting.safe
+def safe(self, *args, **kwargs):
+    # after the teardown's read-back, a request answered on the same link: any goal written
+    # before it has reached the emulated servos (a Sync Write is not answered)
+    try:
+        return real_safe(self, *args, **kwargs)
+    finally:
+        s = self.carrier.settings
+        park_goal = self.carrier.kin.ticks_of_pose(s.park_azimuth_deg, s.park_elevation_deg)
+        servos = [rigs[-1].emulator.servos[j.servo_id] for j in s.joints]
+        state = {
+            "torque": [x.get(ct.TORQUE_ENABLE) for x in servos],
+            "goal": [x.get(ct.GOAL_POSITION) for x in servos],
+            "park": list(park_goal),
+        }
+        print("SERVOS " + json.dumps(state), file=sys.stderr, flush=True)
+ArmLighting.safe = safe
 DynamixelArm.park = park
 from rti_rig.cli import app
 sys.argv = ["rti-rig", *sys.argv[1:]]
@@ -69,11 +90,11 @@ def _slow_config(tmp_path: Path) -> Path:
     return cfg
 
 
-def _run_signalled(tmp_path: Path, *signals: int) -> tuple[int, str, Path, float]:
+def _run_signalled(tmp_path: Path, *signals: int) -> tuple[int, str, Path, float, dict]:  # type: ignore[type-arg]
     """``rti-rig run`` sent ``signals[0]`` once the park moves, the rest once the park
     has ended: exit code, output folded,
-    session, and seconds from the first signal to the park's end (the child's monotonic
-    clock is the system's, as this one's)."""
+    session, seconds from the first signal to the park's end (the child's monotonic clock
+    is the system's, as this one's), and the emulated servos' state as the park ended."""
     hook = tmp_path / "hook.py"
     hook.write_text(HOOK)
     out = tmp_path / "s"
@@ -110,7 +131,9 @@ def _run_signalled(tmp_path: Path, *signals: int) -> tuple[int, str, Path, float
     assert sent_at is not None, said
     ended = [float(x.split()[2]) for x in said.splitlines() if x.startswith("PARK ENDED")]
     assert ended, said
-    return code, " ".join(said.split()), out, ended[0] - sent_at
+    servos = [json.loads(x[len("SERVOS ") :]) for x in said.splitlines() if x.startswith("SERVOS")]
+    assert servos, said
+    return code, " ".join(said.split()), out, ended[0] - sent_at, servos[0]
 
 
 def _arm_end(out: Path) -> dict:  # type: ignore[type-arg]
@@ -130,10 +153,13 @@ def _arm_end(out: Path) -> dict:  # type: ignore[type-arg]
 def test_a_stop_during_the_final_park_holds_the_arm_where_it_is(
     tmp_path: Path, signals: tuple[int, ...], code: int, who: str
 ) -> None:
-    got, said, out, took = _run_signalled(tmp_path, *signals)
+    got, said, out, took, servos = _run_signalled(tmp_path, *signals)
     print(f"park ended {took:.3f} s after the signal")
     assert got == code, said
     assert "Traceback" not in said, said
+    # held, not let go: torque on at both servos, the elevation's goal rewritten off the park
+    assert servos["torque"] == [1, 1], servos
+    assert abs(servos["goal"][1] - servos["park"][1]) > 20, servos
     end = _arm_end(out)
     # held part-way: read back, away from the park pose (el 10°), not "parked"
     assert end["outcome"] == "left", said
