@@ -674,6 +674,11 @@ class Gphoto2Camera:
         on_camera = f"{folder.rstrip('/')}/{name}"
         if self.settings.delete_from_camera:
             copy = "the camera's copy was deleted after the download, so this shot is lost"
+        elif self.settings.capture_target == "Internal RAM":
+            copy = (
+                'the camera shot it to its RAM (capture_target = "Internal RAM"), which keeps '
+                "no copy once it is downloaded, so this shot is lost"
+            )
         else:
             copy = f"the camera's copy is left on the camera at {on_camera}"
         where = raw_path.parent
@@ -686,6 +691,19 @@ class Gphoto2Camera:
             "from them), then run again (a resumed session shoots this image again)",
             "decode",
         )
+
+    def _copy_said(self) -> str:
+        """The camera's copy of a downloaded shot, as an error says it.
+
+        Why: ``delete_from_camera = false`` leaves a copy on the card only: a capture to the
+        camera's RAM (the shipped DSLR example's ``capture_target``) keeps none once it is
+        downloaded, and had been said "the camera's copy kept" (and, of a download gone before
+        its decode, "left on the camera at /IMG_0002.CR2")."""
+        if self.settings.delete_from_camera:
+            return "deleted"
+        if self.settings.capture_target == "Internal RAM":
+            return 'not kept (a capture to its RAM, capture_target = "Internal RAM")'
+        return "kept"
 
     def _undecoded(self, raw_path: Path, camera_name: str, exc: CaptureError) -> CaptureError:
         """The error for a downloaded RAW that would not decode: the camera's file and where
@@ -700,7 +718,7 @@ class Gphoto2Camera:
         return CaptureError(
             self.name,
             f"the camera's file {camera_name} would not decode; it is kept at {where}, the "
-            f"camera's copy {'deleted' if self.settings.delete_from_camera else 'kept'}. "
+            f"camera's copy {self._copy_said()}. "
             + (exc.problem if isinstance(exc, RawDecodeError) else exc.message),
             "decode",
         )

@@ -568,22 +568,36 @@ def test_a_shots_own_jpeg_written_late_is_no_stray_after_a_busy_answer(body, tmp
     assert not (out / "strays").exists()
 
 
-def test_a_raw_libraw_cannot_read_names_the_file_what_to_do_and_keeps_it(body, tmp_path):
+@pytest.mark.parametrize("delete", [True, False])
+def test_a_raw_libraw_cannot_read_names_the_file_what_to_do_and_keeps_it(body, tmp_path, delete):
     """A body newer than the bundled LibRaw: its second RAW is a format LibRaw does not know.
     The run had stopped with "…/raw/.incoming/cap0002_IMG_0002.RAF: LibRaw cannot decode this
     file …; is it a complete RAW/DNG download?": no word of a format too new, of what to do,
-    or that the camera's copy was already deleted and this is the only one."""
+    or that the camera's copy was already deleted and this is the only one. With
+    delete_from_camera = false the shipped config's capture to the camera's RAM keeps no copy
+    either: it had been said "the camera's copy kept"."""
     good = body.render
     unknown = b"FUJIFILMCCD-RAW 0201" + bytes(4000)
     body.render = lambda b: unknown if b.shots >= 1 else good(b)
     body.raw_suffix = ".RAF"
+    text = DSLR_CONFIG.read_text().replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    if not delete:
+        text = text.replace(
+            'image_format = "RAW"', 'image_format = "RAW"\ndelete_from_camera = false'
+        )
+    config = tmp_path / "dslr.toml"
+    config.write_text(text)
     out = tmp_path / "s"
-    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "3")
+    result = run(str(config), "--out", str(out), "--lights", "3")
     said = " ".join(result.output.split())
     assert result.exit_code == 2, result.output
     assert "the camera's file IMG_0002.RAF would not decode" in said
     assert "does not read this file's format" in said and "pip install -U rawpy" in said
-    assert "the camera's copy deleted" in said and "recovered/" in said
+    copy = "deleted" if delete else 'not kept (a capture to its RAM, capture_target = "Internal'
+    assert f"the camera's copy {copy}" in said and "recovered/" in said, said
+    assert "copy kept" not in said, said
     kept = out / "raw" / ".incoming" / "cap0002_IMG_0002.RAF"
     assert f"kept at {kept}" in said and kept.read_bytes() == unknown
     assert [e["index"] for e in journal(out)] == [0]
@@ -938,9 +952,12 @@ def test_folder_watch_resume_sets_aside_a_file_shot_before_it(tmp_path, monkeypa
     assert ("only to within 10 min" in said) is restarted, said
 
 
-@pytest.mark.parametrize("delete", [True, False])
+@pytest.mark.parametrize(
+    ("delete", "target"),
+    [(True, "Internal RAM"), (False, "Internal RAM"), (False, "Memory card")],
+)
 def test_a_download_gone_before_its_decode_names_the_camera_s_file_the_folder_and_what_to_do(
-    body, tmp_path, monkeypatch, delete
+    body, tmp_path, monkeypatch, delete, target
 ):
     """Another program (a sync, backup or antivirus tool) takes the second shot's RAW out of
     the session's download folder as soon as it is written. The run had said "the camera's
@@ -957,6 +974,8 @@ def test_a_download_gone_before_its_decode_names_the_camera_s_file_the_folder_an
     text = text.replace(
         'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
     )
+    assert 'capture_target = "Internal RAM"' in text
+    text = text.replace('capture_target = "Internal RAM"', f'capture_target = "{target}"')
     config = tmp_path / "dslr.toml"
     config.write_text(text)
     gp = sys.modules["gphoto2"]
@@ -981,8 +1000,12 @@ def test_a_download_gone_before_its_decode_names_the_camera_s_file_the_folder_an
     assert "moved or deleted by another program" in said, said
     assert f"Keep other programs out of {incoming}" in said, said
     assert "a resumed session shoots this image again" in said, said
-    lost = "so this shot is lost" in said
-    assert lost == delete, said
+    # a capture to the camera's RAM is not kept there once downloaded, deleted or not: it
+    # had been said "left on the camera at /IMG_0002.CR2" with delete_from_camera = false
+    kept_on_card = not delete and target == "Memory card"
+    assert ("so this shot is lost" in said) != kept_on_card, said
+    assert ("the camera's copy is left on the camera at" in said) == kept_on_card, said
+    assert ("it to its RAM" in said) == (not delete and target == "Internal RAM"), said
     assert [e["index"] for e in journal(out)] == [0]
 
 
