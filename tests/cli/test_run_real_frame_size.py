@@ -148,3 +148,51 @@ def test_a_session_resumed_with_the_keys_set_as_told_goes_on(
     rig = json.loads((out / "manifest.json").read_text())["rig"]
     assert rig["identity"]["camera_size"] == "64×64"  # as the session began, beside the real
     assert rig["frame_size"] == {"frames": [256, 256], "config": [64, 64]}
+
+
+@pytest.mark.parametrize(("keys", "goes_on"), [(256, True), (128, False)])
+def test_a_session_from_before_the_record_resumed_with_the_keys_set_as_told_goes_on(
+    tmp_path: Path,
+    bigger_camera: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    keys: int,
+    goes_on: bool,
+) -> None:
+    """A session begun before the manifest recorded ``rig.frame_size`` (its run said the same
+    "set camera.width = 256 and camera.height = 256 there"), resumed with the keys set as
+    told: it had been refused as another picture ("camera size: 64×64 → 256×256"; "images
+    shot now would not match the ones already taken"), its images 256 x 256 all along. Its
+    first image's size stands for the record; keys set to another size are still refused."""
+    import json
+
+    capture = SimulatedCamera.capture
+
+    def its_own_size(self: SimulatedCamera, exposure_s: float):  # type: ignore[no-untyped-def]
+        frame = capture(self, exposure_s)  # the fixture's: 4 x the config's size
+        step = frame.pixels.shape[0] // 256
+        return dataclasses.replace(frame, pixels=frame.pixels[::step, ::step])
+
+    monkeypatch.setattr(SimulatedCamera, "capture", its_own_size)
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=10_000_000))
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
+    assert r.exit_code == 2 and "set camera.width = 256 and camera.height = 256" in _said(r)
+    manifest = json.loads((out / "manifest.json").read_text())
+    del manifest["rig"]["frame_size"]  # as a manifest written before the record
+    (out / "manifest.json").write_text(json.dumps(manifest, indent=2))
+    text = bigger_camera.read_text(encoding="utf-8")
+    bigger_camera.write_text(
+        text.replace("width = 64\nheight = 64", f"width = {keys}\nheight = {keys}")
+    )
+    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage)
+    r = runner.invoke(app, ["run", "--resume", str(out)])
+    said = _said(r)
+    if not goes_on:
+        assert r.exit_code != 0 and f"camera size: 64×64 → {keys}×{keys}" in said, said
+        assert len(read_lp(out / "lights.lp")) == 1
+        return
+    assert r.exit_code == 0, said
+    assert len(read_lp(out / "lights.lp")) == LIGHTS
+    rig = json.loads((out / "manifest.json").read_text())["rig"]
+    assert rig["identity"]["camera_size"] == "64×64"  # as the session began

@@ -1059,22 +1059,34 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
 
 
 def _real_size_as_recorded(  # type: ignore[no-untyped-def]
-    manifest: dict[str, Any], recorded: dict[str, Any] | None, identity: dict[str, Any], loaded
+    manifest: dict[str, Any],
+    recorded: dict[str, Any] | None,
+    identity: dict[str, Any],
+    loaded,
+    root: Path | None = None,
 ) -> dict[str, Any]:
     """``identity`` with the session's recorded camera size where the config now says the
     size its camera was seen to deliver (``rig.frame_size``, recorded by the run that found
-    the config's size wrong): the same images, the config corrected as that run advised.
+    the config's size wrong; for a session begun before that record, the size of its first
+    image in ``root``): the same images, the config corrected as that run advised.
 
     Why: the run says to set camera.width and camera.height, and a resume with them set was
     refused as another picture ("camera size: 64×64 → 256×256"), though the camera's images
-    were that size all along."""
+    were that size all along. A session whose manifest predates ``rig.frame_size`` had been
+    told the same by its run, and was still refused."""
     from rti_rig.app.disk_estimate import size_from_frame
     from rti_rig.runtime.session import FRAME_SIZE_KEY
 
     seen = (manifest.get("rig") or {}).get(FRAME_SIZE_KEY)
-    if not recorded or not isinstance(seen, dict) or "camera_size" not in recorded:
+    if not recorded or recorded.get("camera_size") in (None, identity.get("camera_size")):
         return identity
-    config, frames = seen.get("config"), seen.get("frames")
+    if seen is None and root is not None:  # a session from before the record: its images
+        frames: Any = _first_image_size(root)
+        config: Any = [int(v) for v in str(recorded["camera_size"]).split("×") if v.isdigit()]
+    elif isinstance(seen, dict):
+        config, frames = seen.get("config"), seen.get("frames")
+    else:
+        return identity
     if not (isinstance(config, list) and isinstance(frames, list) and len(frames) == 2):
         return identity
     if recorded["camera_size"] != "×".join(str(v) for v in config):
@@ -1083,6 +1095,21 @@ def _real_size_as_recorded(  # type: ignore[no-untyped-def]
     if identity.get("camera_size") != f"{width}×{height}":
         return identity
     return {**identity, "camera_size": recorded["camera_size"]}
+
+
+def _first_image_size(root: Path) -> list[int] | None:
+    """[width, height] of the session's first journaled linear TIFF, from its header; None
+    when it has none or the header cannot be read (the resume then checks as before)."""
+    from rti_rig.core.image_files import header_layout
+    from rti_rig.runtime.session import scan_journal
+
+    try:
+        records = scan_journal(root).records
+        name = records[0].get("linear_image") if records else None
+        layout = header_layout(root / str(name)) if name else None
+    except (OSError, RtiRigError):  # a journal the reopen will judge: checked as before
+        return None
+    return None if layout is None else [layout[1], layout[0]]
 
 
 def check_resume_rig(  # type: ignore[no-untyped-def]
@@ -1105,7 +1132,10 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
     )
 
     recorded = (manifest.get("rig") or {}).get("identity")
-    identity = _real_size_as_recorded(manifest, recorded, rig_identity(loaded), loaded)
+    root = Path(session_dir)
+    identity = _real_size_as_recorded(
+        manifest, recorded, rig_identity(loaded), loaded, root if root.is_dir() else None
+    )
     if recorded is None:  # a session from before identities were recorded
         if loaded.sha256 != (manifest.get("rig") or {}).get("config_sha256"):
             on_note(
