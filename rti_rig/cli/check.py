@@ -56,8 +56,13 @@ def check(
         ),
     ],
     intensity: Annotated[
-        float, typer.Option("--intensity", help="LED drive level for the walk, in (0, 1].")
-    ] = 0.2,
+        float | None,
+        typer.Option(
+            "--intensity",
+            help="LED drive level for a dome's walk, in (0, 1] (default 0.2). Refused on a "
+            "replay rig, which has no LEDs to dim.",
+        ),
+    ] = None,
     reboot_faulted: Annotated[
         bool,
         typer.Option(

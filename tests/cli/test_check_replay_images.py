@@ -42,3 +42,15 @@ def test_input_that_is_not_an_acquisition_stays_a_usage_error(tmp_path: Path) ->
         said = " ".join(r.output.split())
         assert r.exit_code == 2, said
         assert "RESULT" not in said and "Traceback" not in said
+
+
+def test_intensity_on_a_replay_is_refused_by_name() -> None:
+    """A replay's "LEDs" are recorded images: ``--intensity`` had passed without a word, as if
+    the level had been used. It is refused as ``--auto-exposure`` is (exit 2, drop it)."""
+    r = runner.invoke(app, ["check", str(ACQ / "dirs.lp"), "--intensity", "0.5"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert "--intensity 0.5 cannot be used on a replayed acquisition" in said, said
+    assert "drop --intensity" in said and "RESULT" not in said and "Traceback" not in said
+    r = runner.invoke(app, ["check", str(ACQ / "dirs.lp")])
+    assert r.exit_code == 0 and "RESULT: PASS" in r.output, r.output

@@ -41,18 +41,23 @@ class CheckStopped(Exception):
 @dataclass(frozen=True)
 class CheckRequest:
     rig_config: Path
-    #: LED drive level for a dome's walk, in (0, 1].
-    intensity: float = 0.2
+    #: LED drive level for a dome's walk, in (0, 1]; None: not given (:data:`DEFAULT_INTENSITY`)
+    intensity: float | None = None
     #: check the rig for ``run --auto-exposure``: ``[camera] exposure_s`` is then only the
     #: metering's start, judged as the metering takes it (see :func:`_exposure_problem`)
     auto_exposure: bool = False
 
 
+#: the LED drive level of a dome's walk when ``--intensity`` is not given
+DEFAULT_INTENSITY = 0.2
+
+
 def check_rig(req: CheckRequest) -> Any:
     """The self-test report (``.lines()``, ``.ok``) of the rig ``req.rig_config`` describes."""
-    if not 0.0 < req.intensity <= 1.0:
+    intensity = DEFAULT_INTENSITY if req.intensity is None else req.intensity
+    if not 0.0 < intensity <= 1.0:
         raise RtiRigError(
-            f"--intensity {req.intensity:g}: give the LED drive level as a fraction in (0, 1]"
+            f"--intensity {intensity:g}: give the LED drive level as a fraction in (0, 1]"
         )
     try:
         loaded = load_rig_config(req.rig_config)
@@ -61,6 +66,8 @@ def check_rig(req: CheckRequest) -> Any:
             raise
         # what this check is for: the images of a recorded acquisition, each problem said
         return FailedReplayCheck(Path(exc.path).name, exc.problems)
+    if req.intensity is not None:
+        _refuse_undimmable(loaded, req.intensity)
     if req.auto_exposure:
         # what run --auto-exposure refuses before the rig opens, refused here as there
         from rti_rig.app.flash_sync import refuse_options
@@ -77,7 +84,7 @@ def check_rig(req: CheckRequest) -> Any:
     with build_rig(loaded) as rig:
         try:
             if isinstance(rig.lighting, DomeLighting):
-                lights = self_test(rig.lighting.source, rig.clock, intensity=req.intensity)
+                lights = self_test(rig.lighting.source, rig.clock, intensity=intensity)
                 camera = camera_line(rig, auto_exposure=req.auto_exposure)
                 return WithCamera(lights, camera, config_note_lines(loaded))
             if isinstance(rig.lighting, ArmLighting) and isinstance(rig.geometry, ArmGeometry):
@@ -98,6 +105,24 @@ def check_rig(req: CheckRequest) -> Any:
             lights = lights_state(rig, bool(failures), end=getattr(report, "end", None))
             raise CheckStopped(str(exc), lights, failures) from None
         raise RtiRigError(f"{req.rig_config}: no self-test for this kind of lighting")
+
+
+def _refuse_undimmable(loaded: Any, intensity: float) -> None:
+    """``--intensity`` given for a replayed acquisition is refused, as ``--auto-exposure`` is
+    (:func:`~rti_rig.app.usecases.session.refuse_unmeterable_rig`): a usage error that names
+    the option and says to drop it.
+
+    Why: ``check ACQ/dirs.lp --intensity 0.5`` passed without a word, as if the level had been
+    used; a replay's "LEDs" are its recorded images, with nothing to dim."""
+    if loaded.config.backend == "replay":
+        from rti_rig.core.errors import ConfigError
+
+        raise ConfigError(
+            loaded.path,
+            None,
+            f"--intensity {intensity:g} cannot be used on a replayed acquisition: it has no "
+            "LEDs to dim (its images were recorded at the light they had); drop --intensity",
+        )
 
 
 @dataclass(frozen=True)
