@@ -52,7 +52,8 @@ def check(
         Path,
         typer.Argument(
             help="Rig config TOML to check, or a recorded acquisition's .lp (its images are "
-            "checked: present, undamaged, readable, of one size and kind)."
+            "checked: present, undamaged, readable, of one size and kind; a session another "
+            "rti-rig run is still capturing is refused until that run ends)."
         ),
     ],
     intensity: Annotated[

@@ -1,4 +1,5 @@
-"""``fit``, ``export-lp`` and ``plan`` of a session another rti-rig process is still capturing.
+"""``fit``, ``export-lp``, ``plan`` and ``check`` of a session another rti-rig process is
+still capturing.
 
 The fit read the session's lights.lp and its images at different moments while they grew:
 "error: 40 image names for 33 light directions", or a verdict of part of the session that
@@ -59,6 +60,11 @@ def test_a_session_being_captured_is_not_fitted_or_exported(tmp_path: Path) -> N
         assert r.exit_code == 2 and "being captured" in said(r), r.output
         # it had read "export its .lp it once that run has ended"
         assert "export its .lp once that run has ended" in said(r), r.output
+        # check of its lights.lp as a replay had passed the images present so far
+        r = runner.invoke(app, ["check", str(s / "lights.lp")])
+        assert r.exit_code == 2 and "being captured" in said(r), r.output
+        assert "check its images once that run has ended" in said(r), r.output
+        assert "RESULT" not in said(r), r.output
     finally:
         assert holder.stdin is not None
         holder.stdin.close()
@@ -67,6 +73,8 @@ def test_a_session_being_captured_is_not_fitted_or_exported(tmp_path: Path) -> N
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["export-lp", str(s), "--out", str(tmp_path / "x.lp")])
     assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["check", str(s / "lights.lp")])
+    assert r.exit_code == 0 and "RESULT: PASS" in r.output, r.output
 
 
 def test_a_session_being_captured_is_not_planned_from(tmp_path: Path) -> None:

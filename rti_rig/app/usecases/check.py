@@ -24,6 +24,7 @@ from rti_rig.runtime.arm_check import arm_self_test
 from rti_rig.runtime.controller import EmergencyStop
 from rti_rig.runtime.dome_policy import self_test
 from rti_rig.runtime.lighting import ArmLighting, DomeLighting
+from rti_rig.runtime.session import refuse_if_in_use
 
 
 class CheckStopped(Exception):
@@ -59,6 +60,11 @@ def check_rig(req: CheckRequest) -> Any:
         raise RtiRigError(
             f"--intensity {intensity:g}: give the LED drive level as a fraction in (0, 1]"
         )
+    if req.rig_config.suffix.lower() == ".lp":
+        # a session's lights.lp as a replay: refused while a run still captures into it, as
+        # export-lp, fit and plan refuse it (its images and lights.lp change as it goes, and
+        # the check had passed the images present so far)
+        refuse_if_in_use(req.rig_config.parent, "check its images")
     try:
         loaded = load_rig_config(req.rig_config)
     except AcquisitionImagesError as exc:
