@@ -674,6 +674,18 @@ def _cannot_resume(rig) -> str | None:  # type: ignore[no-untyped-def]
     return None if why is None else f"It cannot be resumed: {why}."
 
 
+def _dead_led_hint(opened, exc: BaseException) -> str | None:  # type: ignore[no-untyped-def]
+    """How to go on from a stop at an LED the board refused as dead (None: another error).
+    A resume lights that LED first and stops there again, so "Continue with: rti-rig run
+    --resume" had followed the driver's own "its resume stops there again"."""
+    from rti_rig.app.dead_led import dead_led_advice, dead_led_of
+
+    led = dead_led_of(exc)
+    if led is None or _cannot_resume(opened.rig):
+        return None
+    return dead_led_advice(opened.rig.loaded, opened.schedule, opened.out_dir, led)
+
+
 def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore[no-untyped-def]
     """A file the capture could not write, said as the run's last line with what happened to
     the images and the next command; any other error as it is.
@@ -1073,7 +1085,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         from rti_rig.app.usecases.safe_state import lights_state
 
         state = lights_state(rig, _print_teardown_failures(folder, said_below=exc))
-        err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
+        hint = _dead_led_hint(opened, exc) or resume_hint
+        err.print(f"{_sentence(state)}. {_after_stop(opened, hint)}", markup=False)
         raise fail(_write_failed_said(exc, opened)) from None
     except Exception as exc:
         # a fault no driver named (an OSError, a library's own exception): the controller has

@@ -1,0 +1,69 @@
+"""What a session stopped at a dead LED is told to do next (``rti-rig run``).
+
+Why: a board that senses LED current refuses a dead LED (firmware error "LED fault"), and the
+run ended "Continue with: rti-rig run --resume S" right after the driver said that a resume
+stops there again: the resume lights that LED first. The advice here is one that works: repair
+it and resume, or shoot the other lights with a plan that leaves it out (as
+``calibrate-lights`` advises of a card session stopped the same way).
+"""
+
+from __future__ import annotations
+
+import shlex
+from pathlib import Path
+from typing import Any
+
+from rti_rig.core.dome_link import DomeLedError, DomeLinkError, LinkFault
+from rti_rig.core.errors import RtiRigError
+from rti_rig.drivers.led_dome.messages import ERR_LED_FAULT
+
+
+def dead_led_of(exc: BaseException) -> int | None:
+    """The LED a board refused as faulty (no current drawn: dead, or its wiring cut), None for
+    any other error. Decided by the firmware's error code, not by the message's words: a
+    thermal cut-out is refused too, but a resume after the LED cooled goes on."""
+    if not isinstance(exc, DomeLedError):
+        return None
+    cause = exc.__cause__
+    if (
+        isinstance(cause, DomeLinkError)
+        and cause.fault is LinkFault.REJECTED
+        and cause.code == ERR_LED_FAULT
+    ):
+        return exc.led
+    return None
+
+
+def dead_led_advice(loaded: Any, schedule: Any, out_dir: Path, led: int) -> str:
+    """How to go on from a session stopped at dead LED ``led``: repair it, then resume; or
+    shoot the others meanwhile with a plan without it (the rig's LED ``.lp`` without its line
+    when the session planned every LED, else a plan without its direction)."""
+    dome = loaded.config.dome
+    cfg = shlex.quote(str(loaded.path))
+    names = _led_names(loaded)
+    which = f"LED {led} ({names[led]})" if 0 <= led < len(names) else f"LED {led}"
+    leds = {s.led for s in schedule.steps}
+    if dome is not None and dome.lp_file and leds == set(range(len(names))):
+        plan = (
+            f"copy {loaded.folder / dome.lp_file} (the rig's LED .lp) without the line of "
+            f"{which}, the count on its first line one less, as PLAN.lp"
+        )
+    else:
+        step = next((s for s in schedule.steps if s.led == led), None)
+        where = "" if step is None else " ({:.4f} {:.4f} {:.4f})".format(*step.direction)
+        plan = f"write the lights to shoot without the direction of {which}{where} as PLAN.lp"
+    return (
+        f"A resume lights {which} first and stops there again. To shoot the other lights now, "
+        f"{plan} and run rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR; once that LED or its "
+        f"wiring is repaired, continue with: rti-rig run --resume {shlex.quote(str(out_dir))}"
+    )
+
+
+def _led_names(loaded: Any) -> tuple[str, ...]:
+    """The dome's LED names (``.lp`` labels), empty where they cannot be read."""
+    from rti_rig.app.config import dome_led_directions
+
+    try:
+        return tuple(dome_led_directions(loaded)[1])
+    except RtiRigError:  # advice only: an LED said by its number alone
+        return ()

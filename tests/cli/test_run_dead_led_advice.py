@@ -1,0 +1,53 @@
+"""A session stopped at a dead LED (the board senses LED current and refuses it) is told what
+works: a plan without that LED, or a resume once it is repaired.
+
+Why: ``run`` ended "Continue with: rti-rig run --resume S" right after the driver said that a
+resume stops there again (it lights that LED first); following it stopped at the same LED.
+The advice is followed here as written, through the CLI.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+DEAD = 2
+
+
+def test_a_stop_at_a_dead_led_advises_a_plan_without_it_that_works(tmp_path: Path) -> None:
+    shutil.copy(CONFIGS / "example_dome_48.lp", tmp_path)
+    cfg = tmp_path / "dome.toml"
+    cfg.write_text(
+        (CONFIGS / "emulated_dome.toml").read_text() + f"\n[emulator]\ndead_leds = [{DEAD}]\n"
+    )
+    s = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(s), "--no-verdict"])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert f"LED {DEAD} refused" in text and "LED fault" in text, text
+    assert "Continue with: rti-rig run --resume" not in text, text
+    assert f"A resume lights LED {DEAD} (led_0{DEAD}.jpg) first and stops there again" in text
+    assert f"continue with: rti-rig run --resume {s}" in text, text  # once repaired
+
+    # the advice, followed as written: the rig's LED .lp it names, without that LED's line
+    named = re.search(r"copy (\S+) \(the rig's LED \.lp\) without the line of LED", text)
+    assert named is not None, text
+    lines = Path(named.group(1)).read_text().splitlines()
+    kept = [ln for ln in lines[1:] if not ln.startswith(f"led_0{DEAD}.jpg ")]
+    assert len(kept) == len(lines) - 2
+    plan = tmp_path / "PLAN.lp"
+    plan.write_text("\n".join([str(len(kept)), *kept]) + "\n")
+    assert f"rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR" in text, text
+    r = runner.invoke(
+        app, ["run", str(cfg), "--plan", str(plan), "--out", str(tmp_path / "new"), "--no-verdict"]
+    )
+    assert r.exit_code == 0, r.output
+    assert "47 image(s) in the session" in said(r), r.output
