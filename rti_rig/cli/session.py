@@ -755,6 +755,15 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     folder, out_dir = opened.folder, opened.out_dir
     if folder.images_kept:
         whole, listed = folder.lp_listing()
+        if whole and folder.images_kept >= opened.total_steps:
+            # every image was in when the stop came (a SIGTERM or a park stopped in the
+            # teardown): "Continue with: rti-rig run --resume" had been said of a complete
+            # session, which has nothing left to resume
+            return (
+                f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: the "
+                "session is complete, nothing is left to resume. Next: rti-rig fit "
+                f"{_arg(out_dir)} --out FOLDER"
+            )
         if whole:
             return (
                 f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}. "

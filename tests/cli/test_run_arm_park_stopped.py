@@ -177,5 +177,9 @@ def test_a_stop_during_the_final_park_holds_the_arm_where_it_is(
         assert stopped, said
     elif signals == (signal.SIGTERM,):  # the run's emergency stop, said as ever
         assert "Emergency stop (SIGTERM)" in said, said
+        # of a session whose images are all in: complete, fit next (it had said "Continue
+        # with: rti-rig run --resume", with nothing left to resume)
+        assert "the session is complete" in said and f"rti-rig fit {out}" in said, said
+        assert "--resume" not in said, said
     else:  # the second Ctrl-C met the end of the teardown (a stop) or the summary (ignored)
         assert stopped or "Emergency stop (second Ctrl-C)" in said, said
