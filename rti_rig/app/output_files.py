@@ -104,3 +104,21 @@ def _own_lp(out_file: Path, session: Path) -> bool:
         and out_file.name != LP_NAME
         and out_file.resolve().parent == session
     )
+
+
+def lp_name_note(out_file: Path, *, run_reads_it: bool = False) -> str | None:
+    """What to say of an ``.lp`` written under another name (``--out plan.txt``), None when it
+    is named ``.lp``.
+
+    Why: ``plan`` and ``export-lp`` wrote the format to any name without a word, and the tools
+    that read it find it by its suffix: relight and RTIBuilder look for an ``.lp``, and
+    ``rti-rig fit`` refuses any other file ("give a session folder or an .lp file").
+    ``run_reads_it``: a plan, which ``run --plan`` reads whatever its name."""
+    if out_file.suffix.lower() == ".lp":
+        return None
+    run = "rti-rig run --plan reads it as it is, but " if run_reads_it else ""
+    named = out_file.with_suffix(".lp")
+    return (
+        f"{out_file} holds light positions in the .lp format but is not named .lp: {run}relight, "
+        f"RTIBuilder and rti-rig fit find an .lp by its name; name it {named} to use it there"
+    )

@@ -118,9 +118,14 @@ def plan(
             "flat glossy object does not show its gloss; docs/research/planner.md).",
         ),
     ] = "auto",
-    out_file: Annotated[Path, typer.Option("--out", help="Plan file to write (.lp).")] = Path(
-        "plan.lp"
-    ),
+    out_file: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            help="Plan file to write (.lp; another name is written too, with a note: relight, "
+            "RTIBuilder and rti-rig fit find an .lp by its name).",
+        ),
+    ] = Path("plan.lp"),
     figure: Annotated[
         Path | None,
         typer.Option(

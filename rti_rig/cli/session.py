@@ -1365,7 +1365,14 @@ def _metered_apart(opened) -> tuple[float, float] | None:  # type: ignore[no-unt
 @app.command("export-lp")
 def export_lp(
     session_dir: Annotated[Path, typer.Argument(help="A session folder written by 'rti-rig run'.")],
-    out_file: Annotated[Path, typer.Option("--out", help="The .lp file to write.")],
+    out_file: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            help="The .lp file to write (another name is written too, with a note: relight, "
+            "RTIBuilder and rti-rig fit find an .lp by its name).",
+        ),
+    ],
     linear: Annotated[
         bool,
         typer.Option("--linear", help="Name the 16-bit linear TIFFs instead of the JPEGs."),
@@ -1397,6 +1404,8 @@ def export_lp(
         err.print(f"[yellow]note:[/] {escape(done.mosaic)}", soft_wrap=True)
     if done.relisted:
         err.print(f"[yellow]note:[/] {escape(done.relisted)}", soft_wrap=True)
+    if done.misnamed:
+        err.print(f"[yellow]note:[/] {escape(done.misnamed)}", soft_wrap=True)
     if done.unchecked:
         err.print(
             f"[yellow]note:[/] left out, not verifiable as captured "

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from rti_rig.app.output_files import check_output_file
+from rti_rig.app.output_files import check_output_file, lp_name_note
 from rti_rig.core.lp_format import LpEntry, write_lp
 from rti_rig.runtime.disowned import refuse_if_disowned
 from rti_rig.runtime.session import (
@@ -68,6 +68,8 @@ class ExportedLp:
     #: What to say of listed images that are CFA mosaics (``decode.mode = "mosaic"``), "" if
     #: none: the .lp is written, but a viewer or fitter given it fits a checkerboard.
     mosaic: str = ""
+    #: What to say of a file written under a name that is not ``.lp`` ("" if it is one).
+    misnamed: str = ""
 
 
 def export_lp(req: ExportLpRequest) -> ExportedLp:
@@ -112,6 +114,7 @@ def export_lp(req: ExportLpRequest) -> ExportedLp:
         left_out_advice=(
             lost_image_advice(root, adaptive, scan) if len(left_out) > len(renamed) else ""
         ),
+        misnamed=lp_name_note(Path(req.out_file)) or "",
     )
 
 

@@ -23,7 +23,12 @@ from rti_rig.app.normals_determined import (
     refuse_undetermined,
     undetermined_normals,
 )
-from rti_rig.app.output_files import check_output_file, recorded_images, rig_inputs
+from rti_rig.app.output_files import (
+    check_output_file,
+    lp_name_note,
+    recorded_images,
+    rig_inputs,
+)
 from rti_rig.app.preview_source import resolve_preview
 from rti_rig.app.usecases.fit_outlook import fit_needs, fit_outlook
 from rti_rig.core.errors import RtiRigError
@@ -234,6 +239,8 @@ def plan_lights(req: PlanLightsRequest) -> PlannedLights:
     # what the session it plans gives `rti-rig fit` (run says it again before it shoots)
     if (outlook := fit_outlook(len(schedule))) is not None:
         notes.append(outlook)
+    if (misnamed := lp_name_note(Path(req.out_file), run_reads_it=True)) is not None:
+        notes.append(misnamed)
     return PlannedLights(schedule, report, geometry, req.out_file, method, objective, tuple(notes))
 
 
