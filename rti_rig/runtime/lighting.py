@@ -176,6 +176,8 @@ class ArmLighting:
         self.end: ArmEnd | None = None
         #: the signal (SIGINT, SIGTERM) that stopped the last :meth:`safe`'s park, if one did
         self.stopped_by: int | None = None
+        #: the first signal held by the running :meth:`safe`, whether or not a park was due
+        self._stop_asked: int | None = None
 
     def connect(self) -> None:
         self.arm_failure = None
@@ -221,12 +223,16 @@ class ArmLighting:
         Ctrl-C and SIGTERM are held here (as by the caller's own hold, which delivers them
         once the teardown is done), but one that comes before or during the park stops it:
         the arm is held where it stands, torque on (:attr:`stopped_by` names the signal).
-        Why: the park is a move of up to ``move_timeout_s``, and a user's stop sat it out."""
+        Why: the park is a move of up to ``move_timeout_s``, and a user's stop sat it out.
+        :attr:`stopped_by` is set only of a park the signal stopped or kept from starting: one
+        held during a teardown with no park due, or after the park had ended, stopped none,
+        and the run had then said "Stopped during the arm's park" of an arm left or parked."""
         self.stopped_by = None
+        self._stop_asked = None
 
         def stop_asked(signum: int) -> None:
-            if self.stopped_by is None:
-                self.stopped_by = signum
+            if self._stop_asked is None:
+                self._stop_asked = signum
 
         with signals_deferred(on_held=stop_asked):
             return self._safe(emergency)
@@ -278,12 +284,14 @@ class ArmLighting:
                 "fault (its error says how), then park it with 'rti-rig check'",
             )
             return failures
-        if self.stopped_by is not None:  # a stop came as the lamp went off: no park begun
+        if self._stop_asked is not None:  # a stop came as the lamp went off: no park begun
+            self.stopped_by = self._stop_asked
             self.end = left_end(self.carrier, self._stopped_why())
             return failures
         try:
-            self.carrier.park(cancelled=lambda: self.stopped_by is not None)
+            self.carrier.park(cancelled=lambda: self._stop_asked is not None)
         except MoveCancelled:  # held where it stood, every joint (the driver's stop)
+            self.stopped_by = self._stop_asked
             self.end = left_end(self.carrier, self._stopped_why())
             return failures
         except Exception as exc:  # teardown must go on whatever the arm does

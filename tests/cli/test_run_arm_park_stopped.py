@@ -183,3 +183,68 @@ def test_a_stop_during_the_final_park_holds_the_arm_where_it_is(
         assert "--resume" not in said, said
     else:  # the second Ctrl-C met the end of the teardown (a stop) or the summary (ignored)
         assert stopped or "Emergency stop (second Ctrl-C)" in said, said
+
+
+#: a dry run of the simulated arm whose Ctrl-C comes in the teardown but stops no park: raised
+#: by the arm's own stop (no park due: park_after_session is off) or once its park has returned
+LATE_HOOK = """
+import os, signal, sys
+from rti_rig.runtime.lighting import ArmLighting
+from rti_rig.simulator.sim_lights import SimulatedArm
+when = os.environ["CTRL_C_AT"]
+tearing = []
+real_safe = ArmLighting.safe
+def safe(self, *args, **kwargs):
+    tearing.append(1)
+    return real_safe(self, *args, **kwargs)
+ArmLighting.safe = safe
+real_stop, real_park = SimulatedArm.stop, SimulatedArm.park
+def stop(self):
+    real_stop(self)
+    if tearing and when == "stop":
+        signal.raise_signal(signal.SIGINT)
+def park(self, *args, **kwargs):
+    real_park(self, *args, **kwargs)
+    if when == "parked":
+        signal.raise_signal(signal.SIGINT)
+SimulatedArm.stop, SimulatedArm.park = stop, park
+from rti_rig.cli import app
+sys.argv = ["rti-rig", *sys.argv[1:]]
+app()
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+@pytest.mark.parametrize(
+    ("when", "outcome"), [("stop", "left"), ("parked", "parked")], ids=["no-park-due", "parked"]
+)
+def test_a_ctrl_c_in_a_teardown_that_stops_no_park_is_not_said_to_have(
+    tmp_path: Path, when: str, outcome: str
+) -> None:
+    """A Ctrl-C held by the teardown when no park was due (park_after_session = false), or
+    after the park had ended, stopped no park: the run had said "Stopped (Ctrl-C) during the
+    arm's park" of an arm it had just said was left by policy, or parked."""
+    text = (CONFIGS / "virtual_arm.toml").read_text()
+    if when == "stop":
+        assert "\ndefault_lights = 24\n" in text
+        text = text.replace(
+            "\ndefault_lights = 24\n", "\ndefault_lights = 24\npark_after_session = false\n", 1
+        )
+    cfg = tmp_path / "arm.toml"
+    cfg.write_text(text)
+    hook = tmp_path / "hook.py"
+    hook.write_text(LATE_HOOK)
+    out = tmp_path / "s"
+    argv = ["run", str(cfg), "--lights", "2", "--out", str(out), "--no-verdict"]
+    done = subprocess.run(
+        [sys.executable, str(hook), *argv],
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300", "CTRL_C_AT": when},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    said = " ".join((done.stdout + done.stderr).split())
+    assert "Traceback" not in said, said
+    assert _arm_end(out)["outcome"] == outcome, said
+    assert "during the arm's park" not in said, said
+    assert done.returncode == 0, said
