@@ -16,6 +16,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -108,6 +109,10 @@ def _run_signalled(tmp_path: Path, *signals: int) -> tuple[int, str, Path, float
     )
     lines: list[str] = []
     sent_at = None
+    # the reads below block until the child writes or exits: one that never exits (a stop
+    # that hangs) is killed, and the test fails on what it said, rather than hanging for ever
+    watchdog = threading.Timer(300, proc.kill)
+    watchdog.start()
     try:
         assert proc.stdout is not None
         for line in proc.stdout:  # until the park moves (or the run ends without one)
@@ -124,6 +129,7 @@ def _run_signalled(tmp_path: Path, *signals: int) -> tuple[int, str, Path, float
         lines.append(proc.stdout.read())
         code = proc.wait(timeout=300)
     finally:
+        watchdog.cancel()
         if proc.poll() is None:
             proc.kill()
             proc.wait()
