@@ -310,6 +310,14 @@ def run(
                 soft_wrap=True,
             )
             raise typer.Exit(code=143)
+        # the verdict is not computed: the stop asked for no more
+        _exit_if_park_stopped(
+            opened,
+            unsafe,
+            "the session",
+            "; its QA verdict was not computed:",
+            f" rti-rig fit {escape(_arg(opened.out_dir))} --out FOLDER gives it",
+        )
         if not no_verdict:
             from rti_rig.cli.fit import print_verdict
 
@@ -1204,18 +1212,7 @@ def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ign
         raise typer.Exit(code=130)
     from rti_rig.app.usecases.safe_state import safe_state_unsure
 
-    unsafe = bool(result.teardown_failures) or safe_state_unsure(rig)
-    if _park_stopped_by(rig) == signal.SIGINT:
-        # a Ctrl-C that stopped the final park: an interrupted run's exit, as a late SIGTERM's
-        _refuse_unsafe_end(unsafe, exit_code=None)
-        err.print(
-            "[yellow]Stopped (Ctrl-C) during the arm's park, once the session had ended: it is "
-            "complete; its QA verdict was not computed:[/] rti-rig fit "
-            f"{escape(_arg(opened.out_dir))} --out FOLDER gives it",
-            soft_wrap=True,
-        )
-        raise typer.Exit(code=130)
-    return unsafe
+    return bool(result.teardown_failures) or safe_state_unsure(rig)
 
 
 def _park_stopped_by(rig) -> int | None:  # type: ignore[no-untyped-def]
@@ -1223,6 +1220,25 @@ def _park_stopped_by(rig) -> int | None:  # type: ignore[no-untyped-def]
     the rig has no arm): a stop during the teardown's park holds the arm where it stands
     (:meth:`rti_rig.runtime.lighting.ArmLighting.safe`)."""
     return getattr(rig.lighting, "stopped_by", None)
+
+
+def _exit_if_park_stopped(  # type: ignore[no-untyped-def]
+    opened, unsafe: bool, what: str, head: str, tail: str
+) -> None:
+    """Exit 130 once the summary is out if a Ctrl-C stopped the arm's final park (an
+    interrupted command's exit, as a late SIGTERM's), saying ``what`` is complete, ``head``
+    (highlighted) and ``tail`` what to do. Said by each command after its own summary, not
+    in :func:`_summarise`: a preview's had told the user of a QA verdict and ``rti-rig fit``,
+    and lost its plan hint."""
+    if _park_stopped_by(opened.rig) != signal.SIGINT:
+        return
+    _refuse_unsafe_end(unsafe, exit_code=None)
+    err.print(
+        f"[yellow]Stopped (Ctrl-C) during the arm's park, once {what} had ended: it is "
+        f"complete{head}[/]{tail}",
+        soft_wrap=True,
+    )
+    raise typer.Exit(code=130)
 
 
 @app.command()
@@ -1345,6 +1361,13 @@ def preview(
                 soft_wrap=True,
             )
             raise typer.Exit(code=143)
+        _exit_if_park_stopped(
+            opened,
+            unsafe,
+            "the preview",
+            f" in {escape(_arg(out_dir))}",
+            " (plan from it as above)",
+        )
         _refuse_unsafe_end(unsafe)
 
 

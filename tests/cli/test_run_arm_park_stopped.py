@@ -238,19 +238,44 @@ def test_a_ctrl_c_in_a_teardown_that_stops_no_park_is_not_said_to_have(
         )
     cfg = tmp_path / "arm.toml"
     cfg.write_text(text)
+    out = tmp_path / "s"
+    code, said = _run_late(tmp_path, when, "run", str(cfg), "--lights", "2", "--out", str(out))
+    assert "Traceback" not in said, said
+    assert _arm_end(out)["outcome"] == outcome, said
+    assert "during the arm's park" not in said, said
+    assert code == 0, said
+
+
+def _run_late(tmp_path: Path, when: str, *argv: str) -> tuple[int, str]:
+    """``rti-rig ARGV`` under :data:`LATE_HOOK` (its Ctrl-C raised ``when``): exit code and
+    output folded."""
     hook = tmp_path / "hook.py"
     hook.write_text(LATE_HOOK)
-    out = tmp_path / "s"
-    argv = ["run", str(cfg), "--lights", "2", "--out", str(out), "--no-verdict"]
     done = subprocess.run(
-        [sys.executable, str(hook), *argv],
+        [sys.executable, str(hook), *argv, *(["--no-verdict"] if argv[0] == "run" else [])],
         env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300", "CTRL_C_AT": when},
         capture_output=True,
         text=True,
         timeout=300,
     )
-    said = " ".join((done.stdout + done.stderr).split())
+    return done.returncode, " ".join((done.stdout + done.stderr).split())
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_ctrl_c_that_stops_a_preview_s_park_keeps_its_plan_hint(tmp_path: Path) -> None:
+    """``rti-rig preview`` on an arm, a Ctrl-C as its teardown stops the arm (its park then not
+    begun): it had ended as a run does, "its QA verdict was not computed: rti-rig fit … gives
+    it" (a preview has none), and without its "Plan from it" line."""
+    out = tmp_path / "p"
+    code, said = _run_late(
+        tmp_path, "stop", "preview", str(CONFIGS / "virtual_arm.toml"), "--out", str(out)
+    )
+    assert code == 130, said
     assert "Traceback" not in said, said
-    assert _arm_end(out)["outcome"] == outcome, said
-    assert "during the arm's park" not in said, said
-    assert done.returncode == 0, said
+    assert "read back; the park was stopped by Ctrl-C: held where it stopped" in said, said
+    assert f"Plan from it: rti-rig plan {out} --rig " in said, said
+    assert "verdict" not in said and "rti-rig fit" not in said, said
+    assert (
+        f"Stopped (Ctrl-C) during the arm's park, once the preview had ended: it is complete "
+        f"in {out} (plan from it as above)" in said
+    ), said
