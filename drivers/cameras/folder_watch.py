@@ -1144,6 +1144,25 @@ class FolderWatchCamera:
                         SAVE_AGAIN,
                     ) from exc
                 if (
+                    isinstance(exc, ImageReadError)
+                    and exc.contradicts
+                    and steady
+                    and tried is not None
+                    and (extent is None or extent[1] <= tried[2])
+                    # not a file a share sized first and is still filling (its end zeros)
+                    and _tiff_end_written(path, 0, tried[2])
+                ):
+                    # its own tags contradict each other (an RGB TIFF whose SamplesPerPixel
+                    # is lost): it had been read as a one-channel image of the same size and
+                    # gone into the session as if it were the picture the camera took
+                    raise self._damaged(
+                        message,
+                        path,
+                        f"is a damaged TIFF (its size steady over {s.stable_polls} polls, "
+                        "its end written, but its tags contradict each other)",
+                        SAVE_AGAIN,
+                    ) from exc
+                if (
                     extent is not None
                     and tried is not None
                     and steady

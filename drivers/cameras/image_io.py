@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import struct
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import cv2
 import numpy as np
@@ -86,8 +86,10 @@ class ImageReadError(CaptureError):
     """An image file that would not read, with what is known as fields: ``path`` (the file
     read), ``reason`` (the reader's own words), ``is_tiff``, ``no_pixels`` (it read, as an
     image of no pixels: a TIFF whose IFD is not written yet or is damaged, which tifffile
-    reads past, logging; only its bytes tell which) and ``compression`` (the name of a TIFF
-    compression the reader does not decode, None otherwise).
+    reads past, logging; only its bytes tell which), ``compression`` (the name of a TIFF
+    compression the reader does not decode, None otherwise) and ``contradicts`` (its own tags
+    contradict each other: :func:`tiff_contradiction`; a damaged file, unless its bytes are
+    not all written yet).
 
     Why fields: a caller that words the failure its own way (a watched folder naming the
     folder's file, not the session's copy it read, and whether waiting can help) had cut this
@@ -102,12 +104,14 @@ class ImageReadError(CaptureError):
         is_tiff: bool,
         no_pixels: bool = False,
         compression: str | None = None,
+        contradicts: bool = False,
     ) -> None:
         self.path = path
         self.reason = reason
         self.is_tiff = is_tiff
         self.no_pixels = no_pixels
         self.compression = compression
+        self.contradicts = contradicts
         advice = (
             f": {SAVE_READABLE}" if compression else f": {COMPLETE_TIFF_ADVICE}" if is_tiff else ""
         )
@@ -132,6 +136,47 @@ def _cut_within_header(path: Path) -> str | None:
     return f"it ends within its {need}-byte header: {len(head)} bytes written"
 
 
+#: PhotometricInterpretation codes whose pixels are colour, and how many samples each takes
+#: (TIFF 6.0: RGB 2, YCbCr 6, CIELab 8; ICCLab 9 and ITULab 10 of the TIFF/IT and Adobe notes)
+COLOUR_SAMPLES = {
+    2: ("RGB", 3),
+    6: ("YCbCr", 3),
+    8: ("CIELab", 3),
+    9: ("ICCLab", 3),
+    10: ("ITULab", 3),
+}
+
+
+def tiff_contradiction(page: Any) -> str | None:
+    """Why ``page`` (a tifffile page) contradicts itself, as a phrase ("its
+    PhotometricInterpretation says RGB …"), or None when its tags agree.
+
+    Why: a TIFF whose SamplesPerPixel tag is lost (one tag number damaged) is read by tifffile
+    with TIFF's default of one sample, silently: an RGB picture came into a session as a
+    single-channel image of the same size, the colour the file itself declares gone. Its
+    PhotometricInterpretation and its BitsPerSample (one value per sample) still tell."""
+    tags = page.tags
+    photometric = tags.get("PhotometricInterpretation")
+    samples_tag = tags.get("SamplesPerPixel")
+    samples = int(samples_tag.value) if samples_tag is not None else 1
+    said = f"is {samples}" if samples_tag is not None else "tag is missing, so TIFF's default, 1,"
+    if photometric is not None:
+        colour = COLOUR_SAMPLES.get(int(photometric.value))
+        if colour is not None and samples < colour[1]:
+            return (
+                f"its PhotometricInterpretation says {colour[0]}, which takes {colour[1]} "
+                f"samples per pixel, but its SamplesPerPixel {said} applies: read as it stands "
+                "it would be a one-channel image, not the colour picture it says it is"
+            )
+    bits = tags.get("BitsPerSample")
+    if bits is not None and bits.count > 1 and bits.count != samples:
+        return (
+            f"its BitsPerSample gives {bits.count} values (one per sample) but its "
+            f"SamplesPerPixel {said}{' applies' if samples_tag is None else ''}"
+        )
+    return None
+
+
 def read_image_file(path: Path, device: str) -> NDArray:
     """Read a non-RAW image file with its bit depth kept, colour in **RGB** order whatever the
     format (OpenCV decodes PNG/JPEG as BGR, tifffile TIFF as RGB: one order for callers).
@@ -146,7 +191,9 @@ def read_image_file(path: Path, device: str) -> NDArray:
             # tifffile unpacks a header cut short as itself: a struct.error had escaped
             raise ImageReadError(device, path, cut, is_tiff=True)
         try:
-            image = tifffile.imread(path)
+            with tifffile.TiffFile(path) as tif:
+                image = tif.asarray()
+                contradiction = tiff_contradiction(tif.pages[0]) if len(tif.pages) else None
         except (ValueError, OSError, RuntimeError, struct.error) as exc:
             # a TIFF cut short or not a TIFF at all (tifffile raises ValueError, TiffFileError
             # among them), or compressed data that will not decompress (imagecodecs' errors
@@ -160,6 +207,8 @@ def read_image_file(path: Path, device: str) -> NDArray:
             raise ImageReadError(device, path, str(exc), is_tiff=True) from exc
         if image.size == 0:  # a damaged IFD tifffile reads past, logging, as no pixels
             raise ImageReadError(device, path, "it holds no pixels", is_tiff=True, no_pixels=True)
+        if contradiction is not None:  # never taken as the other image it reads as
+            raise ImageReadError(device, path, contradiction, is_tiff=True, contradicts=True)
         return image
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
