@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.dng_tags import dng_refusal
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
 DECODER = "raw-decode"
@@ -498,16 +499,26 @@ def decode_raw(
     except rawpy.LibRawFileUnsupportedError as exc:
         # a body newer than the bundled LibRaw (a new Canon CR3 or Fujifilm RAF, say) gives
         # this, a truncated download a data or I/O error: "is it a complete download?" had
-        # sent the owner of a new camera looking for a cable fault
+        # sent the owner of a new camera looking for a cable fault. LibRaw says the same of a
+        # DNG whose tags are damaged, for which "Update rawpy" had been the advice: a DNG's
+        # own tags tell which where they can (dng_tags), and both are said where they cannot
         said = libraw_words(exc)
+        libraw = f"LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy {rawpy.__version__})"
+        dng = None if read is None else dng_refusal(read)
+        problem = (
+            f"{libraw} refuses it as of a format it does not read ({said}){_reported(printed)}"
+            f", but it names itself a DNG, and {dng}"
+            if dng is not None
+            else f"{libraw} does not read this file's format ({said}){_reported(printed)}: "
+            "a camera newer than this LibRaw, or a file that is no RAW or is damaged. "
+            "Update rawpy (pip install -U rawpy), or shoot a format it reads (DNG where the "
+            "camera offers it, or convert the files with a DNG converter and watch a "
+            "folder of DNGs); if no other program opens the file either, it is damaged: "
+            "copy it again from the camera's card"
+        )
         raise UnsupportedRawError(
             read,
-            f"LibRaw {'.'.join(map(str, rawpy.libraw_version))} (rawpy "
-            f"{rawpy.__version__}) does not read this file's format ({said}){_reported(printed)}"
-            ": a camera newer "
-            "than this LibRaw, or a file that is no RAW. Update rawpy (pip install -U rawpy), "
-            "or shoot a format it reads (DNG where the camera offers it, or convert the files "
-            "with a DNG converter and watch a folder of DNGs)",
+            problem,
             libraw_error=type(exc).__name__,
             libraw_said=said,
             libraw_printed=tuple(printed),

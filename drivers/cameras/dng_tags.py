@@ -1,0 +1,175 @@
+"""What a file LibRaw refused as "unsupported" says of itself, read from its own TIFF tags.
+
+Why: LibRaw gives one error, LIBRAW_FILE_UNSUPPORTED ("Unsupported file format or not RAW
+file"), both for a format it does not know (a body newer than it, a DNG compressed as JPEG XL
+by a rawpy built without it) and for a DNG whose tags are damaged (its ImageWidth's tag number
+lost, its PhotometricInterpretation garbage): its identify step finds no image it can read in
+either. A damaged DNG had been refused with "a camera newer than this LibRaw … Update rawpy",
+advice that cannot help. A DNG's own tags tell the two apart where they can: the main image's
+IFD (NewSubFileType 0, in IFD 0 or one of its SubIFDs) must give a size, a sample depth, a
+photometric kind a raw image has, its data's place inside the file, and a compression the DNG
+specification names. Where all of that holds, nothing here can tell, and :func:`dng_refusal`
+says both possibilities.
+
+Sources: TIFF 6.0 (header, IFD entries, tags 254-279, 322-325) and the DNG Specification
+1.7.1.0 (DNGVersion 50706, DNGBackwardVersion 50707, SubIFDs 330, PhotometricInterpretation
+32803 CFA / 34892 LinearRaw, compressions 1, 7, 8, 34892, 52546).
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass, field
+from pathlib import Path
+
+#: DNG compressions (DNG 1.7.1 §"Compression"): none, lossless JPEG, Deflate, lossy JPEG,
+#: JPEG XL (new in DNG 1.7)
+DNG_COMPRESSIONS = {1: "uncompressed", 7: "lossless JPEG", 8: "Deflate", 34892: "lossy JPEG"}
+JPEG_XL = 52546
+#: photometric kinds of a DNG's raw image: BlackIsZero (a monochrome sensor), CFA, LinearRaw
+RAW_PHOTOMETRIC = {1, 32803, 34892}
+#: the DNG version LibRaw 0.22 was written for (DNG 1.7: JPEG XL only when built with it)
+LIBRAW_DNG = (1, 7)
+_TYPES = {1: ("B", 1), 3: ("H", 2), 4: ("I", 4), 13: ("I", 4)}  # BYTE, SHORT, LONG, IFD
+
+
+@dataclass
+class DngTags:
+    """The tags of ``path`` that matter to whether LibRaw could read it."""
+
+    version: tuple[int, ...] | None = None
+    backward: tuple[int, ...] | None = None
+    #: what is wrong with its main image's IFD, as phrases ("it gives no ImageWidth")
+    damage: list[str] = field(default_factory=list)
+    compression: int | None = None
+
+
+def _ifd(data: bytes, order: str, offset: int) -> tuple[dict[int, tuple[int, ...]], int] | None:
+    """IFD at ``offset``: {tag: values} of the integer tags, and the next IFD's offset."""
+    if offset < 8 or offset + 2 > len(data):
+        return None
+    (count,) = struct.unpack_from(order + "H", data, offset)
+    end = offset + 2 + 12 * count
+    if not 1 <= count <= 4096 or end + 4 > len(data):
+        return None
+    tags: dict[int, tuple[int, ...]] = {}
+    for n in range(count):
+        tag, typ, many = struct.unpack_from(order + "HHI", data, offset + 2 + 12 * n)
+        if typ not in _TYPES or many > 1 << 16:
+            tags.setdefault(tag, ())
+            continue
+        code, size = _TYPES[typ]
+        at = offset + 2 + 12 * n + 8
+        if size * many > 4:
+            (at,) = struct.unpack_from(order + "I", data, at)
+        if at + size * many > len(data):
+            tags[tag] = ()
+            continue
+        tags[tag] = struct.unpack_from(f"{order}{many}{code}", data, at)
+    (after,) = struct.unpack_from(order + "I", data, end)
+    return tags, after
+
+
+def _main_image(
+    data: bytes, order: str, first: dict[int, tuple[int, ...]]
+) -> dict[int, tuple[int, ...]] | None:
+    """The IFD of the full-resolution raw image: the first of IFD 0 and its SubIFDs whose
+    NewSubFileType is 0 (TIFF's default when the tag is absent)."""
+    candidates = [first]
+    for offset in first.get(330, ()):
+        sub = _ifd(data, order, offset)
+        if sub is not None:
+            candidates.append(sub[0])
+    for tags in candidates:
+        if tags.get(254, (0,))[:1] == (0,):
+            return tags
+    return None
+
+
+def read_dng_tags(path: Path) -> DngTags | None:
+    """``path``'s DNG tags, or None when it is no classic TIFF naming a DNGVersion in IFD 0
+    (another RAW format, or not a TIFF at all), or cannot be read."""
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return None
+    if data[:4] not in (b"II*\x00", b"MM\x00*"):
+        return None
+    order = "<" if data[:2] == b"II" else ">"
+    first = _ifd(data, order, struct.unpack_from(order + "I", data, 4)[0])
+    if first is None or len(first[0].get(50706, ())) != 4:
+        return None
+    ifd0 = first[0]
+    found = DngTags(version=ifd0[50706], backward=ifd0.get(50707) or None)
+    main = _main_image(data, order, ifd0)
+    if main is None:
+        found.damage.append("none of its IFDs is marked as the main image (NewSubFileType 0)")
+        return found
+    for tag, name in ((256, "ImageWidth"), (257, "ImageLength")):
+        if not main.get(tag) or main[tag][0] == 0:
+            found.damage.append(f"its main image gives no {name}")
+    bits = main.get(258)
+    if not bits or not all(1 <= b <= 32 for b in bits):
+        found.damage.append(
+            f"its main image's BitsPerSample is {list(bits) if bits else 'missing'}"
+        )
+    photometric = main.get(262)
+    if not photometric or photometric[0] not in RAW_PHOTOMETRIC:
+        said = photometric[0] if photometric else "missing"
+        found.damage.append(f"its main image's PhotometricInterpretation is {said}")
+    offsets, counts = main.get(273) or main.get(324), main.get(279) or main.get(325)
+    if not offsets or not counts or len(offsets) != len(counts):
+        found.damage.append("its main image names no data (strip or tile offsets and counts)")
+    elif any(o + c > len(data) for o, c in zip(offsets, counts, strict=True)):
+        found.damage.append("its main image's data runs past the end of the file")
+    compression = main.get(259)
+    found.compression = compression[0] if compression else None
+    if compression is None:
+        found.damage.append("its main image gives no Compression")
+    return found
+
+
+def _version(v: tuple[int, ...] | None) -> str:
+    return ".".join(map(str, v)) if v else "?"
+
+
+def dng_refusal(path: Path) -> str | None:
+    """What to tell of a DNG LibRaw refused as unsupported, as the sentence after LibRaw's
+    words: damaged, newer than LibRaw (or compressed in a way this build does not decode), or
+    either; None when ``path`` does not say it is a DNG (the caller words other formats)."""
+    tags = read_dng_tags(path)
+    if tags is None:
+        return None
+    if tags.damage:
+        return (
+            f"it is damaged ({'; '.join(tags.damage)}): its own tags are broken, so "
+            "updating rawpy will not help. Copy the shot again from the camera's card, or "
+            "save it again from the program that made it"
+        )
+    if tags.compression == JPEG_XL:
+        return (
+            "it is compressed as JPEG XL (DNG 1.7), which this LibRaw build does not "
+            "decode. Update rawpy (pip install -U rawpy) to one built with JPEG XL, or save "
+            "DNGs with lossless JPEG compression (the converter's or camera's compatibility "
+            "setting)"
+        )
+    needs = tags.backward or tags.version
+    if needs is not None and needs[:2] > LIBRAW_DNG:
+        return (
+            f"it asks for a reader of DNG {_version(needs)} (its DNGVersion "
+            f"{_version(tags.version)}), newer than the DNG {_version(LIBRAW_DNG)} this LibRaw "
+            "was written for. Update rawpy (pip install -U rawpy), or save the DNGs for an "
+            "older DNG version (the converter's compatibility setting)"
+        )
+    compression = (
+        ""
+        if tags.compression in DNG_COMPRESSIONS
+        else f"; its compression code {tags.compression} is none the DNG specification names"
+    )
+    return (
+        f"its main image's tags look whole (DNGVersion {_version(tags.version)}{compression}), "
+        "so it is either newer than this LibRaw reads or damaged in a way its tags do not "
+        "show. Open it in another program (Adobe DNG Converter, darktable): if it opens, "
+        "update rawpy (pip install -U rawpy); if it does not, copy the shot again from the "
+        "camera's card"
+    )

@@ -1,0 +1,122 @@
+"""A whole DNG that LibRaw refuses as "Unsupported file format or not RAW file", saved into the
+watched folder of the shipped folder-watch dome (its framed board emulated on a pty, the camera
+and its tethering program a thread that saves the file at the first shutter pulse): ``rti-rig
+run`` says what the file's own tags show.
+
+LibRaw gives that one error (LIBRAW_FILE_UNSUPPORTED) both for a DNG whose tags are damaged and
+for one it cannot read because it is newer than LibRaw: every such file had been refused with
+"a camera newer than this LibRaw … Update rawpy", advice that cannot mend a damaged file. The
+DNGs here come from the tests' own DNG writer (written from the TIFF and DNG specifications),
+each with one thing changed.
+"""
+
+from __future__ import annotations
+
+import struct
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CONFIGS, shipped_dome_on_pty
+from dng_spec_writer import dng
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+SHIPPED = CONFIGS / "example_dome_48_folder_watch.toml"
+
+
+def _entry(data: bytearray, tag: int) -> int:
+    """The byte offset of ``tag``'s entry in the (little-endian, IFD at 8) DNG's IFD 0."""
+    for n in range(struct.unpack_from("<H", data, 8)[0]):
+        at = 10 + 12 * n
+        if struct.unpack_from("<H", data, at)[0] == tag:
+            return at
+    raise AssertionError(f"no tag {tag}")
+
+
+def _changed(how: str) -> bytes:
+    data = bytearray(dng(np.full((32, 48), 20000, np.uint16)))
+    if how == "width tag lost":  # ImageWidth's tag number damaged: its value is still there
+        struct.pack_into("<H", data, _entry(data, 256), 250)
+    elif how == "jpeg xl":  # a DNG 1.7 compression this LibRaw build does not decode
+        struct.pack_into("<H", data, _entry(data, 259) + 8, 52546)
+    else:  # a compression code no DNG specification names: cannot be told from here
+        assert how == "unknown compression"
+        struct.pack_into("<H", data, _entry(data, 259) + 8, 99)
+    return bytes(data)
+
+
+class Tether(threading.Thread):
+    """The camera and its tethering program: the board's first shutter pulse becomes
+    ``IMG_0001.dng`` in the folder, whole."""
+
+    def __init__(self, firmware, folder: Path, data: bytes) -> None:  # type: ignore[no-untyped-def]
+        super().__init__(daemon=True)
+        self.firmware, self.folder, self.data = firmware, folder, data
+        self.stop = threading.Event()
+
+    def run(self) -> None:
+        while not self.stop.is_set():
+            if any(e.what == "shutter" for e in list(self.firmware.history)):
+                (self.folder / "IMG_0001.dng").write_bytes(self.data)
+                return
+            self.stop.wait(0.02)
+
+
+@pytest.mark.parametrize("how", ["width tag lost", "jpeg xl", "unknown compression"])
+def test_run_says_what_a_refused_dngs_own_tags_show(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, how: str
+) -> None:
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    out = tmp_path / "s"
+    text = SHIPPED.read_text(encoding="utf-8")
+    for old, new in [
+        ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
+        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
+    ]:
+        assert old in text, old
+        text = text.replace(old, new)
+    cfg = tmp_path / "example_dome_48_folder_watch.toml"
+    cfg.write_text(text, encoding="utf-8")
+    data = _changed(how)
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, data)
+        camera.start()
+        try:
+            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            r = CliRunner().invoke(app, args, terminal_width=400)
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+        lit_at_end = firmware.lit_indices()
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said, said
+    assert f"{tether / 'IMG_0001.dng'}: LibRaw " in said, said
+    assert "Unsupported file format or not RAW file" in said, said  # LibRaw's own words
+    assert "it names itself a DNG" in said, said
+    assert "a camera newer than this LibRaw" not in said, said
+    assert "waiting will not help" in said and f"left in {tether}" in said, said
+    if how == "width tag lost":
+        assert "it is damaged (its main image gives no ImageWidth)" in said, said
+        assert "updating rawpy will not help" in said, said
+        assert "pip install -U rawpy" not in said, said
+    elif how == "jpeg xl":
+        assert "compressed as JPEG XL" in said and "pip install -U rawpy" in said, said
+        assert "damaged" not in said, said
+    else:
+        assert "compression code 99" in said, said
+        assert "either newer than this LibRaw reads or damaged" in said, said
+        assert "if it opens, update rawpy" in said and "copy the shot again" in said, said
+    assert not list((out / "linear").glob("image_*.tif")), said
+    assert (tether / "IMG_0001.dng").read_bytes() == data  # left as the program saved it
+    assert lit_at_end == []  # the dome was switched off
