@@ -30,6 +30,9 @@ JPEG_XL = 52546
 RAW_PHOTOMETRIC = {1, 32803, 34892}
 #: the DNG version LibRaw 0.22 was written for (DNG 1.7: JPEG XL only when built with it)
 LIBRAW_DNG = (1, 7)
+#: what lays a CFA mosaic out (TIFF/EP): without them LibRaw fills the pattern from memory
+#: it never set, a different one at each read
+CFA_TAGS = {33421: "CFARepeatPatternDim", 33422: "CFAPattern"}
 _TYPES = {1: ("B", 1), 3: ("H", 2), 4: ("I", 4), 13: ("I", 4)}  # BYTE, SHORT, LONG, IFD
 
 
@@ -41,6 +44,8 @@ class DngTags:
     backward: tuple[int, ...] | None = None
     #: what is wrong with its main image's IFD, as phrases ("it gives no ImageWidth")
     damage: list[str] = field(default_factory=list)
+    #: why its CFA cannot be laid out (a CFA image without CFAPattern), or None
+    cfa_lost: str | None = None
     compression: int | None = None
 
 
@@ -122,6 +127,11 @@ def read_dng_tags(path: Path) -> DngTags | None:
         found.damage.append("its main image names no data (strip or tile offsets and counts)")
     elif any(o + c > len(data) for o, c in zip(offsets, counts, strict=True)):
         found.damage.append("its main image's data runs past the end of the file")
+    if photometric and photometric[0] == 32803:
+        lost = [name for tag, name in CFA_TAGS.items() if not main.get(tag)]
+        if lost:
+            found.cfa_lost = f"its main image, a CFA mosaic, gives no {' or '.join(lost)}"
+            found.damage.append(found.cfa_lost)
     compression = main.get(259)
     found.compression = compression[0] if compression else None
     if compression is None:
@@ -173,3 +183,13 @@ def dng_refusal(path: Path) -> str | None:
         "update rawpy (pip install -U rawpy); if it does not, copy the shot again from the "
         "camera's card"
     )
+
+
+def cfa_lost(path: Path) -> str | None:
+    """Why ``path``, a DNG, has no CFA layout LibRaw can have read (as a phrase), or None.
+
+    Why: LibRaw decodes a CFA DNG whose CFAPattern is lost without a word, its pattern taken
+    from memory it never set: one read made a picture of red photosites only, the next a
+    run-stopping IndexError. Only the file's tags can say the pattern LibRaw used is none."""
+    tags = read_dng_tags(path)
+    return None if tags is None else tags.cfa_lost

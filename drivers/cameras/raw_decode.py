@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
-from rti_rig.drivers.cameras.dng_tags import dng_refusal
+from rti_rig.drivers.cameras.dng_tags import cfa_lost, dng_refusal
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
 DECODER = "raw-decode"
@@ -148,6 +148,13 @@ class UnsupportedRawError(RawDecodeError):
     ``stable_polls``."""
 
 
+class DamagedRawError(RawDecodeError):
+    """A whole RAW file whose own tags show it damaged (a CFA DNG without its CFAPattern).
+
+    Why a class of its own: like :class:`UnsupportedRawError`, waiting will not mend it; a
+    watched folder says so at once instead of waiting ``timeout_s`` for it to change."""
+
+
 class RawFileMissingError(RawDecodeError):
     """The RAW file to decode is not there (``path``: the file looked for).
 
@@ -210,7 +217,10 @@ def _iso_from_tiff(source: Path | str | bytes) -> float:
 
 
 def _pattern_name(raw: rawpy.RawPy) -> str:
-    pattern = np.asarray(raw.raw_pattern)
+    try:
+        pattern = np.asarray(raw.raw_pattern)
+    except NotImplementedError:  # rawpy's word for a filter code it cannot lay out
+        return "unknown"
     desc = raw.color_desc.decode("ascii", "replace") if raw.color_desc else _COLOR_NAMES
     if pattern.shape != (2, 2):
         return f"{pattern.shape[0]}x{pattern.shape[1]}"
@@ -474,6 +484,14 @@ def decode_raw(
     name, handle = _source(source)
     read = None if name == "<bytes>" else Path(name)
     printed: list[str] = []  # LibRaw's own lines, kept off the terminal (libraw_printed)
+    lost = None if read is None else cfa_lost(read)
+    if lost is not None:  # before LibRaw: what it makes of such a file differs at each read
+        raise DamagedRawError(
+            read,
+            f"it names itself a DNG, but {lost}: LibRaw would read it all the same, with a "
+            "pattern of its own guessing, and not the picture taken. The file is damaged: copy "
+            "the shot again from the camera's card",
+        )
     try:
         with (
             libraw_printed(LIBRAW_BUFFER_NAME if read is None else name, printed),
@@ -523,6 +541,13 @@ def decode_raw(
             libraw_said=said,
             libraw_printed=tuple(printed),
         ) from exc
+    except NotImplementedError as exc:  # rawpy: a CFA layout it cannot lay out
+        raise DamagedRawError(
+            read,
+            f"rawpy cannot lay out its colour filter array ({exc}): its CFA tags are damaged, "
+            "or it is a sensor layout this rawpy does not know. Copy the shot again from the "
+            "camera's card; if another program opens it, update rawpy (pip install -U rawpy)",
+        ) from exc
     except rawpy.LibRawError as exc:
         said = libraw_words(exc)
         raise RawDecodeError(
@@ -539,6 +564,9 @@ def decode_raw(
         raise RawDecodeError(
             read, f"white level {white} is not above the black levels {black_pc.tolist()}"
         )
+    cfa = _cfa_refusal(colors, desc, settings.mode)
+    if cfa is not None:
+        raise RawDecodeError(read, cfa)
     # Uniform black (the usual case) stays scalar: uint16 arithmetic, no index arrays.
     uniform = bool(np.all(black_pc == black_pc[0]))
     black: int | NDArray[np.int64] = int(black_pc[0]) if uniform else black_pc[colors]
@@ -648,6 +676,36 @@ def decode_raw(
     if dark is not None:
         frame = subtract_dark(frame, dark, settings.underexposed_level)
     return frame
+
+
+def _cfa_refusal(colors: NDArray[np.integer], desc: str, mode: str) -> str | None:
+    """Why the photosite colours LibRaw gives (``colors``, indices into ``desc``) cannot make
+    the image ``mode`` asks for, or None when they can.
+
+    Why: a DNG whose CFAPattern tag is lost or damaged still decodes: LibRaw fills the
+    pattern from what it has (every photosite red, or colour codes past its four), and the
+    file had gone into the session as a picture of one colour, or stopped the run with an
+    IndexError from the colour step. A colour image needs red, green and blue photosites."""
+    codes = np.unique(colors)
+    if codes.size and int(codes.max()) >= 4:
+        return (
+            f"LibRaw gives its photosites colour codes up to {int(codes.max())}, beyond the "
+            "four a colour filter array has: its CFA tags (CFAPattern, CFARepeatPatternDim) "
+            "are damaged or lost. Copy the shot again from the camera's card"
+        )
+    if mode == "mosaic":
+        return None
+    found = {_rgb_channel(desc, int(c)) for c in codes}
+    if found == {0, 1, 2}:
+        return None
+    named = "".join("RGB"[c] for c in sorted(found)) or "none"
+    return (
+        f"its colour filter array as LibRaw reads it has photosites of {named} only, so no "
+        "colour picture can be made of it: its CFA tags (CFAPattern, CFARepeatPatternDim) "
+        "are damaged or lost (copy the shot again from the camera's card), or its sensor "
+        'has no colour filter (a monochrome camera: set [camera.device.decode] mode = "mosaic", '
+        "which keeps its values as they are)"
+    )
 
 
 def _rgb_channel(desc: str, index: int) -> int:

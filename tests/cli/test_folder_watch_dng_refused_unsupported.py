@@ -1,13 +1,15 @@
-"""A whole DNG that LibRaw refuses as "Unsupported file format or not RAW file", saved into the
-watched folder of the shipped folder-watch dome (its framed board emulated on a pty, the camera
-and its tethering program a thread that saves the file at the first shutter pulse): ``rti-rig
-run`` says what the file's own tags show.
+"""A whole DNG that LibRaw refuses as "Unsupported file format or not RAW file" (or would
+read, its CFAPattern lost, with a pattern of its own guessing), saved into the watched folder
+of the shipped folder-watch dome (its framed board emulated on a pty, the camera and its
+tethering program a thread that saves the file at the first shutter pulse): ``rti-rig run``
+says what the file's own tags show.
 
 LibRaw gives that one error (LIBRAW_FILE_UNSUPPORTED) both for a DNG whose tags are damaged and
 for one it cannot read because it is newer than LibRaw: every such file had been refused with
-"a camera newer than this LibRaw … Update rawpy", advice that cannot mend a damaged file. The
-DNGs here come from the tests' own DNG writer (written from the TIFF and DNG specifications),
-each with one thing changed.
+"a camera newer than this LibRaw … Update rawpy", advice that cannot mend a damaged file. A
+DNG without CFAPattern had gone into the session as a picture of LibRaw's guessing (all red
+photosites at one read, an IndexError at another). The DNGs here come from the tests' own DNG
+writer (written from the TIFF and DNG specifications), each with one thing changed.
 """
 
 from __future__ import annotations
@@ -46,6 +48,8 @@ def _changed(how: str) -> bytes:
     data = bytearray(dng(np.full((32, 48), 20000, np.uint16)))
     if how == "width tag lost":  # ImageWidth's tag number damaged: its value is still there
         struct.pack_into("<H", data, _entry(data, 256), 250)
+    elif how == "cfa pattern lost":  # decodes, with a pattern LibRaw guesses anew each read
+        struct.pack_into("<H", data, _entry(data, 33422), 33000)
     elif how == "jpeg xl":  # a DNG 1.7 compression this LibRaw build does not decode
         struct.pack_into("<H", data, _entry(data, 259) + 8, 52546)
     else:  # a compression code no DNG specification names: cannot be told from here
@@ -71,7 +75,9 @@ class Tether(threading.Thread):
             self.stop.wait(0.02)
 
 
-@pytest.mark.parametrize("how", ["width tag lost", "jpeg xl", "unknown compression"])
+@pytest.mark.parametrize(
+    "how", ["width tag lost", "cfa pattern lost", "jpeg xl", "unknown compression"]
+)
 def test_run_says_what_a_refused_dngs_own_tags_show(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, how: str
 ) -> None:
@@ -101,15 +107,21 @@ def test_run_says_what_a_refused_dngs_own_tags_show(
     said = " ".join(r.output.split())
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
-    assert f"{tether / 'IMG_0001.dng'}: LibRaw " in said, said
-    assert "Unsupported file format or not RAW file" in said, said  # LibRaw's own words
+    assert f"{tether / 'IMG_0001.dng'}: " in said, said  # the folder's file, not the copy
+    assert ".incoming" not in said, said
     assert "it names itself a DNG" in said, said
+    if how != "cfa pattern lost":  # LibRaw's own words: it refused the file
+        assert "Unsupported file format or not RAW file" in said, said
     assert "a camera newer than this LibRaw" not in said, said
     assert "waiting will not help" in said and f"left in {tether}" in said, said
     if how == "width tag lost":
         assert "it is damaged (its main image gives no ImageWidth)" in said, said
         assert "updating rawpy will not help" in said, said
         assert "pip install -U rawpy" not in said, said
+    elif how == "cfa pattern lost":
+        assert "its main image, a CFA mosaic, gives no CFAPattern" in said, said
+        assert "The file is damaged: copy the shot again" in said, said
+        assert "did not change within" not in said, said  # not waited for
     elif how == "jpeg xl":
         assert "compressed as JPEG XL" in said and "pip install -U rawpy" in said, said
         assert "damaged" not in said, said
