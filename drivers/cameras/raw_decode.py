@@ -109,13 +109,19 @@ def libraw_printed(name: str, into: list[str]) -> Iterator[None]:
             return
         try:
             with tempfile.TemporaryFile() as sink:
-                os.dup2(sink.fileno(), 2)
+                # the swap inside the try, and the restore in a finally of its own: a signal
+                # (Ctrl-C, SIGTERM raised as an exception) landing just after the swap, or in
+                # the flush before the restore, had left fd 2 on the sink for good, every later
+                # line (the run's own error, its teardown) written to a deleted file
                 try:
+                    os.dup2(sink.fileno(), 2)
                     yield
                 finally:
-                    with suppress(AttributeError, OSError, ValueError):
-                        sys.stderr.flush()
-                    os.dup2(saved, 2)
+                    try:
+                        with suppress(AttributeError, OSError, ValueError):
+                            sys.stderr.flush()
+                    finally:
+                        os.dup2(saved, 2)
                     sink.seek(0)
                     text = sink.read().decode("utf-8", "replace")
                     prefix, other = f"{name}: ", []

@@ -284,6 +284,47 @@ def test_lines_not_libraws_written_to_fd_2_meanwhile_are_written_back(capfd):
     assert capfd.readouterr().err == "another thread's warning\nafter\n"
 
 
+def test_a_signal_landing_as_fd_2_is_given_back_still_gives_it_back(capfd, monkeypatch):
+    """A Ctrl-C (the signal's handler raising) landing in the flush made just before fd 2 is
+    given back had skipped the restore: fd 2 stayed on the deleted sink for good, and every
+    later line (the run's error, its teardown) was lost. The signal goes through; fd 2 is the
+    terminal's again."""
+    import os
+    import signal
+    import sys
+
+    class StderrWhereTheSignalLands:
+        """``sys.stderr``: its second flush, the one before the restore, takes a SIGINT."""
+
+        def __init__(self) -> None:
+            self.flushes = 0
+
+        def write(self, text: str) -> int:
+            return len(text)
+
+        def flush(self) -> None:
+            self.flushes += 1
+            if self.flushes == 2:
+                signal.raise_signal(signal.SIGINT)
+
+    def interrupted(signum, frame):  # Python's own Ctrl-C, whatever the runner installed
+        raise KeyboardInterrupt
+
+    before = os.fstat(2)
+    previous = signal.signal(signal.SIGINT, interrupted)
+    try:
+        monkeypatch.setattr(sys, "stderr", StderrWhereTheSignalLands())
+        with pytest.raises(KeyboardInterrupt), libraw_printed("/s/IMG_1.dng", []):
+            os.write(2, b"/s/IMG_1.dng: Unexpected end of file\n")
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    after = os.fstat(2)
+    assert (after.st_dev, after.st_ino) == (before.st_dev, before.st_ino)
+    capfd.readouterr()
+    os.write(2, b"after\n")
+    assert capfd.readouterr().err == "after\n"
+
+
 def test_dng_writer_validates_its_input():
     with pytest.raises(ValueError, match="at least 22"):
         dng_bytes(np.zeros((20, 20), np.uint16))
