@@ -160,9 +160,16 @@ def test_a_port_that_opens_then_fails_is_not_said_to_have_failed_to_open(
     assert f"error: read from {adapter.port} failed" in text, text
     assert "The port opened but failed before any firmware answered" in text, text
     assert "could not be opened" not in text and "not a serial port" not in text, text
+    # the opening reset the board all the same (the Nab sketch boots with every LED on): the
+    # lights had been "the port could not be used; nothing was sent"
+    assert (
+        "Lights: the port failed once open, before a firmware answered: nothing that lights "
+        "an LED was sent, but opening the port resets a board like an Arduino"
+    ) in text, text
+    assert "nothing was sent" not in text, text
     assert "Traceback" not in text, text
 
-    from rti_rig.app.usecases.probe import ProbeFailure, ProbeRequest, probe
+    from rti_rig.app.usecases.probe import LightsState, ProbeFailure, ProbeRequest, probe
 
     adapter = _UnpluggedAfterOpening(monkeypatch)
     try:
@@ -170,4 +177,5 @@ def test_a_port_that_opens_then_fails_is_not_said_to_have_failed_to_open(
     finally:
         adapter.unplug()
     assert result.error is not None and result.error.failure is ProbeFailure.PORT_FAILED
-    assert result.lights == "the port could not be used; nothing was sent"
+    assert result.lights_state is LightsState.PORT_FAILED_UNANSWERED
+    assert "look at the dome" in result.lights

@@ -69,6 +69,8 @@ class LightsState(Enum):
     NEVER_OPENED = auto()
     #: The port could not be opened: nothing was sent.
     PORT_UNUSABLE = auto()
+    #: The port opened (a reset) and failed before any firmware answered.
+    PORT_FAILED_UNANSWERED = auto()
     #: The port failed after some probes, none of which lights an LED.
     PORT_FAILED_AFTER_PROBES = auto()
     #: The port failed during a stop's teardown: the dome's state is not known.
@@ -578,6 +580,11 @@ _LIGHTS_SAID: dict[LightsState, str] = {
     LightsState.NOTHING_LIT: "nothing was lit by the probe",
     LightsState.NEVER_OPENED: "nothing was lit by the probe: it never opened the port",
     LightsState.PORT_UNUSABLE: "the port could not be used; nothing was sent",
+    LightsState.PORT_FAILED_UNANSWERED: (
+        "the port failed once open, before a firmware answered: nothing that lights an LED "
+        "was sent, but opening the port resets a board like an Arduino, which then lights "
+        "whatever its firmware lights at boot (the Nab sketch: every LED): look at the dome"
+    ),
     LightsState.STOPPED_UNANSWERED: STOPPED_UNANSWERED,
     LightsState.BOOTS_DARK: "the firmware boots with every LED off; nothing that lights was sent",
     LightsState.MASK_ACKNOWLEDGED: "the probe sent an all-off mask, acknowledged",
@@ -790,7 +797,12 @@ def _probe(result: ProbeResult, wait: float) -> ProbeResult:
                 "the firmwares known, but the dome's state is not known",
             )
         else:
-            _say_lights(result, LightsState.PORT_UNUSABLE)
+            # a port that opened had reset the board all the same: "nothing was sent" of it
+            # had read as nothing lit, of a Nab sketch that boots with every LED on
+            _say_lights(
+                result,
+                LightsState.PORT_UNUSABLE if opening else LightsState.PORT_FAILED_UNANSWERED,
+            )
             # what the path is, from its opening's failure (a read's failure says nothing of it)
             result.not_serial = _not_a_serial_port(result.port, exc) if opening else None
     return result
