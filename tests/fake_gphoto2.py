@@ -74,6 +74,9 @@ class Body:
             "shutterspeed": SHUTTERS,
         }
     )
+    #: what a format gives, as (RAW, JPEG), for a name that does not say it ("Unknown value
+    #: 0007", libgphoto2's name for a code its table lacks); others by the name (RAW, JPEG)
+    format_gives: dict[str, tuple[bool, bool]] = field(default_factory=dict)
     #: what autodetect finds, when not just this body: [] for none, or several bodies
     detected: list[tuple[str, str]] | None = None
     #: settings the body accepts but does not change (e.g. the mode dial is not on M)
@@ -251,9 +254,10 @@ def make_module(body: Body) -> types.ModuleType:
         store = body.store()
         fmt = body.config["imageformat"]
         files = []
-        if "RAW" in fmt:
+        raw, jpeg = body.format_gives.get(fmt, ("RAW" in fmt, "JPEG" in fmt))
+        if raw:
             files.append(stem + body.raw_suffix)
-        if "JPEG" in fmt:
+        if jpeg:
             files.append(stem + ".JPG")
         if body.clock is not None:  # the shutter is open for its time, then the file named
             body.clock.sleep(shutter_s(body.config["shutterspeed"]))

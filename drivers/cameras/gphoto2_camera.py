@@ -30,6 +30,7 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
 from rti_rig.drivers.cameras.folder_watch import is_raw_file
+from rti_rig.drivers.cameras.gphoto2_formats import gives_raw, raw_choices
 from rti_rig.drivers.cameras.raw_decode import RawDecodeError, RawFileMissingError, decode_raw
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
 
@@ -180,6 +181,10 @@ class Gphoto2Camera:
         self._left_on_card = 0
         self.retries_used = 0
         self.camera_model: str | None = None
+        #: the image-format choices the camera offered at connect (for the first-shot refusal)
+        self._format_choices: list[str] = []
+        #: what connect could not establish of the image format (said by ``rti-rig check``)
+        self._format_note: str | None = None
 
     # -- error handling --------------------------------------------------------------------
     def _call(
@@ -280,6 +285,11 @@ class Gphoto2Camera:
         except BaseException:
             self.close()
             raise
+
+    def connect_notes(self) -> tuple[str, ...]:
+        """What connect could not establish and the first shot will (``rti-rig check`` says
+        it): an image format whose name does not tell whether it gives a RAW file."""
+        return (self._format_note,) if self._format_note else ()
 
     def close(self) -> None:
         """End the camera session and remove the private staging folder. Safe twice and after
@@ -386,6 +396,7 @@ class Gphoto2Camera:
             wanted[s.aperture_config] = (s.aperture, "aperture")
         self._set_config_values(wanted)
         config = self._call("get_config", self._cam.get_config, DeviceError)
+        self._check_image_format(config)
         widget = self._widget(config, s.shutter_config, "shutter_config")
         shutters = []
         for label in self._choices(widget):
@@ -401,6 +412,63 @@ class Gphoto2Camera:
             )
         self._shutters = sorted(shutters)
         self._check_shutter_latches(str(widget.get_value()), self._choices(widget))
+
+    def _check_image_format(self, config: Any) -> None:
+        """Refuse, before anything is lit, an image format libgphoto2 names as giving no RAW.
+
+        Why: every decode mode (``[camera.device.decode] mode``: mosaic, half, demosaic) reads
+        the shot's RAW, and ``collect`` refuses a shot without one; a JPEG-only
+        ``image_format`` ("Large Fine JPEG") had passed ``rti-rig check`` and was refused at
+        the first shot, its LED lit. The value judged is the one in effect: ``image_format``
+        (set and read back above), or the camera's own when it is left (``""``). A name that
+        cannot be judged (:func:`gives_raw` None) is noted for the check, and the first shot
+        still refuses a shot without a RAW."""
+        s = self.settings
+        self._format_note, self._format_choices = None, []
+        key = f"image_format_config = '{s.image_format_config}'"
+        try:
+            widget = config.get_child_by_name(s.image_format_config)
+        except self._gp.GPhoto2Error:
+            widget = None
+        if widget is None:  # image_format left, and the camera has no such setting
+            self._format_note = (
+                f"image format not checked: the camera has no setting '{s.image_format_config}' "
+                f"({key} in [camera.device]); the first shot is refused if it gives no RAW "
+                "file (every decode mode reads the RAW)"
+            )
+            return
+        value = str(widget.get_value())
+        self._format_choices = self._choices(widget)
+        raws = raw_choices(self._format_choices)
+        judged = gives_raw(value)
+        said = (
+            f"image_format = '{value}' in [camera.device]"
+            if s.image_format is not None
+            else f"the camera's own {s.image_format_config} '{value}' (image_format is left "
+            "as the camera has it in [camera.device])"
+        )
+        if judged is None:
+            self._format_note = (
+                f"{said}: libgphoto2's name does not tell whether it gives a RAW file, so it is "
+                f"not checked here; the first shot is refused if it gives none (decode mode "
+                f"'{s.decode.mode}' reads the RAW)"
+                + (f"; the choices known to give RAW: {raws}" if raws else "")
+            )
+            return
+        if judged:
+            return
+        fix = (
+            f"set image_format to one the camera offers that gives a RAW: {raws}"
+            if raws
+            else "the camera offers no choice known to give a RAW "
+            f"({self._format_choices}): set image_format to its RAW value"
+        )
+        raise DeviceError(
+            self.name,
+            f"{said} gives JPEG only, and decode mode '{s.decode.mode}' (every mode) reads the "
+            f"shot's RAW: {fix}",
+            f"check {s.image_format_config}",
+        )
 
     def _check_shutter_latches(self, current: str, offered: list[str]) -> None:
         """Set another offered shutter speed, read it back, and put the camera's own back.
@@ -557,10 +625,12 @@ class Gphoto2Camera:
         raw_files = [f for f in files if is_raw_file(Path(f[1]))]
         if not raw_files:
             self._delete(files)
+            raws = raw_choices(self._format_choices)
+            offered = f": it offers {raws}" if raws else ""
             raise CaptureError(
                 self.name,
-                f"camera delivered {[n for _, n in files]} but no RAW file: set image_format to "
-                "the camera's RAW (or RAW+JPEG) value",
+                f"camera delivered {[n for _, n in files]} but no RAW file: set image_format in "
+                f"[camera.device] to the camera's RAW (or RAW+JPEG) value{offered}",
                 "capture",
             )
         staging = self._staging_dir()

@@ -213,21 +213,29 @@ def camera_line(  # type: ignore[no-untyped-def]
     off; on a camera-triggered dome a shot would step it: ``why_no_image``): the line to print
     and whether it connected. A check had passed a rig whose camera then failed the session's
     first capture (gphoto2 not installed, no camera found). ``auto_exposure``: the exposure is
-    judged as ``run --auto-exposure`` takes it (:func:`_exposure_problem`)."""
+    judged as ``run --auto-exposure`` takes it (:func:`_exposure_problem`).
+
+    What the camera could not establish at connect (``connect_notes``: a gphoto2 image format
+    whose name does not tell whether it gives a RAW) is said after the line: left unsaid, a
+    check passed what the first shot might refuse."""
     try:
         rig.camera.connect()
         problem = _exposure_problem(rig, auto_exposure)
+        notes = getattr(rig.camera, "connect_notes", None)
+        said = tuple(notes()) if callable(notes) else ()
     except RtiRigError as exc:
         return f"camera: FAILED to connect: {exc}", False
     finally:
         rig.camera.close()
     why = f": {why_no_image}" if why_no_image else ""
+    unsure = "".join(f"; note: {n}" for n in said)
     if problem is not None:
         return (
-            f"camera: {rig.camera.name} connected (no image taken{why}), but FAILED: {problem}",
+            f"camera: {rig.camera.name} connected (no image taken{why}), but FAILED: "
+            f"{problem}{unsure}",
             False,
         )
-    return f"camera: {rig.camera.name} connected (no image taken{why})", True
+    return f"camera: {rig.camera.name} connected (no image taken{why}){unsure}", True
 
 
 def _exposure_problem(rig, auto_exposure: bool = False) -> str | None:  # type: ignore[no-untyped-def]

@@ -120,7 +120,15 @@ def test_file_announced_twice_is_downloaded_once(tmp_path):
 
 
 def test_jpeg_only_camera_is_an_error_naming_the_setting(tmp_path):
+    """A format libgphoto2 names JPEG-only is refused at connect, before any shot; one whose
+    name cannot be judged is refused at the shot that gives no RAW."""
     body = dslr()
+    with pytest.raises(DeviceError, match=r"gives JPEG only.*\['RAW', 'RAW \+ Large Fine JPEG'\]"):
+        camera(body, tmp_path, image_format=None).connect()
+    assert body.shots == 0
+    body.config["imageformat"] = "Unknown value 0007"
+    body.choices["imageformat"].append("Unknown value 0007")
+    body.format_gives = {"Unknown value 0007": (False, True)}
     with (
         camera(body, tmp_path, image_format=None) as cam,
         pytest.raises(CaptureError, match="no RAW file"),

@@ -1085,3 +1085,89 @@ def test_check_leaves_a_manual_bodys_shutter_as_it_found_it(body, tmp_path, own)
     assert result.exit_code == 0, result.output
     assert body.config["shutterspeed"] == own
     assert body.calls.count("set_config") >= 3  # format and target, the try, the one put back
+
+
+def dslr_config(tmp_path: Path, *replace: tuple[str, str]) -> Path:
+    """A copy of the shipped DSLR config beside its .lp, with ``replace`` (old, new) applied."""
+    text = DSLR_CONFIG.read_text()
+    for old, new in replace:
+        assert old in text, old
+        text = text.replace(old, new)
+    cfg = tmp_path / DSLR_CONFIG.name
+    cfg.write_text(text)
+    (tmp_path / "example_dome_48.lp").write_text((CONFIGS / "example_dome_48.lp").read_text())
+    return cfg
+
+
+#: (the camera's setting name, its choices, the JPEG-only value asked, the RAW choices) as
+#: libgphoto2 names them (camlibs/ptp2/config.c): a Canon EOS, a Nikon, a Sony
+JPEG_ONLY = [
+    ("imageformat", ["Large Fine JPEG", "RAW", "RAW + Large Fine JPEG", "mRAW"], "Large Fine JPEG"),
+    ("imagequality", ["JPEG Basic", "JPEG Fine", "NEF (Raw)", "NEF+Fine"], "JPEG Fine"),
+    ("imagequality", ["Standard", "Fine", "Extra Fine", "RAW", "RAW+JPEG"], "Extra Fine"),
+]
+
+
+@pytest.mark.parametrize(("setting", "choices", "value"), JPEG_ONLY)
+def test_a_jpeg_only_image_format_is_refused_at_connect_before_any_led_lights(
+    body, dome, tmp_path, setting, choices, value
+):
+    """`check` had passed image_format = "Large Fine JPEG", and `run` refused it only at the
+    first shot, after LED 0 was lit: the choice is judged by libgphoto2's name at connect."""
+    body.config[setting] = choices[0]
+    body.choices[setting] = choices
+    if setting != "imageformat":
+        del body.config["imageformat"], body.choices["imageformat"]
+    cfg = dslr_config(
+        tmp_path,
+        ('image_format = "RAW"', f'image_format = "{value}"\nimage_format_config = "{setting}"'),
+    )
+    raws = [c for c in choices if "RAW" in c.upper() or "NEF" in c]
+    out = tmp_path / "s"
+    result = run(str(cfg), "--out", str(out), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert f"image_format = '{value}' in [camera.device] gives JPEG only" in said, said
+    assert f"gives a RAW: {raws}" in said, said
+    assert "Traceback" not in said
+    assert not [e for e in dome.history if e.what == "lit"], "an LED was lit"
+    assert body.shots == 0 and not out.exists()
+    result = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 1 and "RESULT: FAIL" in said, said
+    assert f"image_format = '{value}' in [camera.device] gives JPEG only" in said, said
+
+
+def test_a_camera_s_own_jpeg_format_is_refused_when_image_format_is_left(body, dome, tmp_path):
+    """image_format = "" leaves the camera's own format: a JPEG-only one is refused too."""
+    cfg = dslr_config(tmp_path, ('image_format = "RAW"', 'image_format = ""'))
+    result = run(str(cfg), "--out", str(tmp_path / "s"), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert "the camera's own imageformat 'Large Fine JPEG'" in said, said
+    assert "gives JPEG only" in said and "['RAW', 'RAW + Large Fine JPEG']" in said, said
+    assert not [e for e in dome.history if e.what == "lit"], "an LED was lit"
+    body.config["imageformat"] = "RAW"  # the owner sets it on the body: the session runs
+    result = run(str(cfg), "--out", str(tmp_path / "s"), "--lights", "4")
+    assert result.exit_code == 0, result.output
+    check_images(tmp_path / "s")
+
+
+def test_an_image_format_whose_name_cannot_be_judged_is_said_at_check(body, dome, tmp_path):
+    """libgphoto2 names a code its table lacks "Unknown value 0007": whether it gives a RAW
+    is not known before a shot. `check` says so (never guessed), and the first shot still
+    refuses it when it gives none, naming the choices known to give RAW."""
+    unknown = "Unknown value 0007"
+    body.choices["imageformat"] = ["Large Fine JPEG", unknown, "RAW"]
+    body.format_gives = {unknown: (False, True)}
+    cfg = dslr_config(tmp_path, ('image_format = "RAW"', f'image_format = "{unknown}"'))
+    result = CliRunner().invoke(app, ["check", str(cfg)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 0 and "RESULT: PASS" in said, said
+    assert f"note: image_format = '{unknown}' in [camera.device]: libgphoto2's name" in said
+    assert "does not tell whether it gives a RAW file" in said, said
+    result = run(str(cfg), "--out", str(tmp_path / "s"), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert "but no RAW file" in said and "RAW+JPEG) value: it offers ['RAW']" in said, said
+    assert body.shots == 1
