@@ -639,9 +639,15 @@ class Gphoto2Camera:
             if not is_raw_file(Path(name)) and not s.keep_jpeg:
                 continue
             target = _unused(staging, f"cap{self._count:04d}_{name}")
-            camera_file = self._call(
-                "download", lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL)
-            )
+            try:
+                camera_file = self._call(
+                    "download",
+                    lambda f=folder, n=name: cam.file_get(f, n, gp.GP_FILE_TYPE_NORMAL),
+                )
+            except CameraGoneError:
+                raise  # said already: images taken are kept, resume continues
+            except CaptureError as exc:
+                raise self._download_failed(exc, folder, name) from exc
             camera_file.save(str(target))
             saved[name] = target
         # pictures the body took behind a busy answer: downloaded too (nothing captured is
@@ -729,6 +735,32 @@ class Gphoto2Camera:
             white_level=decoded.white_level,
             timestamp_s=t_capture,
             metadata=metadata,
+        )
+
+    def _download_failed(self, exc: CaptureError, folder: str, name: str) -> CaptureError:
+        """The error for a shot's file that would not download: where the shot is now, and
+        that a resume shoots it again.
+
+        Why: a failed download (libgphoto2 -1) said only "gphoto2 error -1 …: see `gphoto2
+        --debug` output". Shot into the camera's RAM (``capture_target = "Internal RAM"``) the
+        picture exists nowhere else, and the body drops it at the next capture or at the
+        session's end: it is lost, which the user was not told. On a card its copy stays
+        there (it is deleted only once downloaded). Either way the step is not recorded, so
+        ``rti-rig run --resume SESSION`` shoots it again under its own light."""
+        on_camera = f"{folder.rstrip('/')}/{name}"
+        if self.settings.capture_target == "Internal RAM":
+            where = (
+                f"the shot was taken into the camera's RAM (capture_target = 'Internal RAM'), "
+                f"so it is lost: {on_camera} existed only there"
+            )
+        else:
+            where = f"the shot's copy stays on the camera's card at {on_camera}"
+        return CaptureError(
+            self.name,
+            f"{exc.message}; downloading {on_camera} failed, {where}. Its step is not "
+            "recorded: 'rti-rig run --resume SESSION' shoots it again (check the USB cable "
+            "and that no other program holds the camera first)",
+            "download",
         )
 
     def _download_gone(self, raw_path: Path, camera_file: tuple[str, str]) -> CaptureError:

@@ -1171,3 +1171,32 @@ def test_an_image_format_whose_name_cannot_be_judged_is_said_at_check(body, dome
     assert result.exit_code == 2, said
     assert "but no RAW file" in said and "RAW+JPEG) value: it offers ['RAW']" in said, said
     assert body.shots == 1
+
+
+def test_a_download_failed_from_the_camera_s_ram_says_the_shot_is_lost_and_resume_reshoots(
+    body, tmp_path
+):
+    """The second shot's download fails (libgphoto2 -1) while the body shoots to its RAM: the
+    message had said only "gphoto2 error -1 … see `gphoto2 --debug` output", not that the
+    shot was lost, nor that a resume shoots it again (which it does)."""
+    render = body.render
+
+    def fail_second_download(b: Body) -> bytes:
+        if b.shots == 1:  # the second shot: its download fails once
+            b.failures["file_get"] = [-1]
+        return render(b)
+
+    body.render = fail_second_download
+    out = tmp_path / "s"
+    result = run(str(DSLR_CONFIG), "--out", str(out), "--lights", "4")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert "gphoto2 error -1" in said, said
+    assert "taken into the camera's RAM (capture_target = 'Internal RAM'), so it is lost" in said
+    assert "'rti-rig run --resume SESSION' shoots it again" in said, said
+    assert [e["index"] for e in journal(out)] == [0]
+    result = run("--resume", str(out))
+    assert result.exit_code == 0, result.output
+    check_images(out)
+    assert [e["index"] for e in journal(out)] == [0, 1, 2, 3]
+    assert body.shots == 5  # the lost shot taken again, no other
