@@ -115,6 +115,18 @@ class CardStoppedAtLedError(SessionError):
         self.led = led
 
 
+def _refused(error: str, led: int | None) -> bool:
+    """Whether a run's recorded LED error is the board refusing that LED (a dead one, sensed by
+    its current), which a resume meets again.
+
+    Why: the other errors about one LED pass: a board that rebooted while the LED was lit (its
+    power supply or USB cable) or an LED left on past ``max_on_s`` stop the run too, which says
+    to resume, and a card session stopped by them had been told to repair the LED and shoot the
+    card without it. The dome driver words a refusal "LED <n> refused: <the firmware's
+    reason>"."""
+    return led is not None and f"LED {led} refused: " in error
+
+
 def _serial_table(manifest: dict[str, Any]) -> dict[str, Any]:
     config = (manifest.get("rig") or {}).get("config") or {}
     return (config.get("dome") or {}).get("serial") or {}
@@ -169,16 +181,18 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         done = {r["index"] for r in scan_journal(root, image_names(len(planned))).records}
         taken = len(done)
         error = str((manifest.get("runner") or {}).get("error") or "")
-        if finish == "error" and error.startswith(LED_ERROR):
+        stopped = next((k for k in range(len(planned)) if k not in done), None)
+        led = None if stopped is None else planned[stopped].get("led")
+        if not isinstance(led, int) or isinstance(led, bool):
+            led = None
+        if finish == "error" and error.startswith(LED_ERROR) and _refused(error, led):
             # a resume lights the same LED first, and a new card session lights it too: "continue
             # it with --resume, or shoot the card again" led back to the same stop
-            stopped = next((k for k in range(len(planned)) if k not in done), None)
-            led = None if stopped is None else planned[stopped].get("led")
             raise CardStoppedAtLedError(
                 f"{root}: the card session stopped at an LED after {max(taken, len(steps))} of "
                 f"{len(planned)} images ({error.removeprefix(LED_ERROR)}); a resume, or the card "
                 "shot again, lights that LED again",
-                led if isinstance(led, int) and not isinstance(led, bool) else None,
+                led,
             )
         raise SessionError(
             f"{root}: the card session did not finish ({finish or 'no finish recorded'}, "

@@ -92,3 +92,37 @@ def test_a_card_session_stopped_at_a_dead_led_says_how_to_shoot_the_others(
     r = runner.invoke(app, ["calibrate-lights", str(again), "--rig", str(cfg)])
     assert r.exit_code == 0, r.output
     assert "47 of 48 LEDs measured" in said(r)
+
+
+def test_a_card_session_stopped_by_a_board_reboot_under_an_led_is_resumed(
+    tmp_path: Path,
+) -> None:
+    """A board that rebooted while an LED was lit (its power supply, its USB cable) stops the
+    run with an error about that LED too, and the run says to resume. calibrate-lights had
+    told the user to repair that LED and shoot the card without it: only a refused LED (one the
+    board senses dead) stops a resume again."""
+    cfg = card_rig(tmp_path)
+    with cfg.open("a", encoding="utf-8") as f:  # the board reboots after acknowledging a light
+        f.write('\n[[emulator.faults]]\nat_command = 40\nkind = "reset_after_reply"\n')
+    card = tmp_path / "card"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(card)])
+    assert r.exit_code != 0 and "rebooted while LED" in said(r), r.output
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
+
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"continue it with rti-rig run --resume {card}" in text, text
+    assert "Repair LED" not in text and "PLAN.lp" not in text, text
+    assert "Traceback" not in r.output
+
+    # the advice, followed: each resume's emulator reboots at its 40th command again, and
+    # each gets further (18 more images) until the card session is whole
+    for _ in range(3):
+        r = runner.invoke(app, ["run", "--resume", str(card)])
+        if r.exit_code == 0:
+            break
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
+    assert r.exit_code == 0, r.output
+    assert "48 of 48 LEDs measured" in said(r)
