@@ -1163,16 +1163,19 @@ def assess(
     trend_trusted = still_spread_px(edge_dev - trend) <= TRUSTED_SPREAD_PX
     edge_moved = np.zeros(n, bool)
     captured = crop_arr  # before any image is moved back by its edges alone
+    # the move is the shift off the trend, and so is what is said and moved back: the trend's
+    # part is where a still image's edges read under that light (image_004 of the uneven-LED
+    # tablet, moved (0, 1) px, was said "shifted (+0.5, -1.2)", its light's lean included)
+    off_trend = np.nan_to_num(edge_dev) - trend
     if edges_trusted or trend_trusted:
-        off_trend = np.nan_to_num(edge_dev) - trend
         edge_moved = np.isfinite(edge_dev[:, 0]) & (np.hypot(*off_trend.T) > move_px)
         if edge_moved.any():
             step_fit = None  # crop_arr changes below
         crop_arr = crop_arr.copy()
         for i in np.flatnonzero(edge_moved):
-            crop_arr[i] = move_back(crop_arr[i], float(edge_dev[i, 0]), float(edge_dev[i, 1]))
+            crop_arr[i] = move_back(crop_arr[i], float(off_trend[i, 0]), float(off_trend[i, 1]))
     # the shift each image was moved back by (image axes); a step's images are moved, all
-    moved_by = np.where(edge_moved[:, None], np.nan_to_num(edge_dev), 0.0)
+    moved_by = np.where(edge_moved[:, None], off_trend, 0.0)
     moved_by[step_moved] += step_shift
     edge_only = edge_moved & ~step_moved  # moved on the edges' word alone
     edge_moved = edge_moved | step_moved

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -103,3 +104,10 @@ def test_a_real_shift_of_one_image_under_uneven_leds_is_caught(
     qa = json.loads((out / "qa.json").read_text())
     called = [c["name"] for c in qa["images"] if any("moved" in p for p in c["problems"])]
     assert called == [f"image_{image:03d}"], qa["verdict"]
+    # and by how much it moved, not that plus where its light leans a still image's edges
+    # (image_004, moved (0, 1) px, had been said "shifted (+0.5, -1.2)")
+    said = next(p for p in qa["images"][image - 1]["problems"] if "moved" in p)
+    found = re.search(r"shifted \(([-+][0-9.]+), ([-+][0-9.]+)\) px", said)
+    assert found is not None, said
+    stated = np.array([float(found[1]), float(found[2])])
+    assert np.hypot(*(stated - (dx, -dy))) <= 0.35, said  # x right, y up
