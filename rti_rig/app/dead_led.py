@@ -18,20 +18,35 @@ from rti_rig.core.errors import RtiRigError
 from rti_rig.drivers.led_dome.messages import ERR_LED_FAULT
 
 
+def is_dead_led(fault: str | None, code: int | None) -> bool:
+    """Whether a link error beneath an LED's error is the board refusing that LED as faulty (no
+    current drawn: dead, or its wiring cut). Decided by the firmware's error code, not by the
+    message's words: a thermal cut-out is refused too, but a resume after the LED cooled goes
+    on; a board that rebooted under the LED goes on after a resume as well."""
+    return fault == LinkFault.REJECTED and code == ERR_LED_FAULT
+
+
 def dead_led_of(exc: BaseException) -> int | None:
-    """The LED a board refused as faulty (no current drawn: dead, or its wiring cut), None for
-    any other error. Decided by the firmware's error code, not by the message's words: a
-    thermal cut-out is refused too, but a resume after the LED cooled goes on."""
+    """The LED a board refused as faulty (:func:`is_dead_led`), None for any other error."""
     if not isinstance(exc, DomeLedError):
         return None
     cause = exc.__cause__
-    if (
-        isinstance(cause, DomeLinkError)
-        and cause.fault is LinkFault.REJECTED
-        and cause.code == ERR_LED_FAULT
-    ):
+    if isinstance(cause, DomeLinkError) and is_dead_led(cause.fault, cause.code):
         return exc.led
     return None
+
+
+def dead_led_recorded(runner: dict[str, Any]) -> int | None:
+    """The dead LED a finished run's manifest ``runner`` records (``led_error``, written by the
+    controller from the error's types), None for any other finish; None too for a manifest
+    written before ``led_error`` was recorded."""
+    record = runner.get("led_error")
+    if not isinstance(record, dict):
+        return None
+    led = record.get("led")
+    if not isinstance(led, int) or isinstance(led, bool):
+        return None
+    return led if is_dead_led(record.get("fault"), record.get("code")) else None
 
 
 def dead_led_advice(loaded: Any, schedule: Any, out_dir: Path, led: int) -> str:

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.app.config import CALIBRATION_FORMAT as FORMAT
+from rti_rig.app.dead_led import dead_led_recorded
 from rti_rig.core.errors import SessionError
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.planner.topography import downsample
@@ -115,9 +116,18 @@ class CardStoppedAtLedError(SessionError):
         self.led = led
 
 
+def _stopped_dead(runner: dict[str, Any], error: str, led: int | None) -> bool:
+    """Whether a card session stopped at dead LED ``led``: from the run's typed record
+    (``runner.led_error``, :func:`dead_led_recorded`), the same fact ``run`` advises from;
+    a manifest written before that record is judged by :func:`_refused`."""
+    if "led_error" in runner:
+        return led is not None and dead_led_recorded(runner) == led
+    return _refused(error, led)
+
+
 def _refused(error: str, led: int | None) -> bool:
     """Whether a run's recorded LED error is the board refusing that LED (a dead one, sensed by
-    its current), which a resume meets again.
+    its current), which a resume meets again: for manifests without ``runner.led_error``.
 
     Why: the other errors about one LED pass: a board that rebooted while the LED was lit (its
     power supply or USB cable) or an LED left on past ``max_on_s`` stop the run too, which says
@@ -180,12 +190,13 @@ def _read_card_session(root: Path, manifest: dict[str, Any], rig_name: str | Non
         # a killed card session had been said to hold "0 of 48 images" with 20 on disk
         done = {r["index"] for r in scan_journal(root, image_names(len(planned))).records}
         taken = len(done)
-        error = str((manifest.get("runner") or {}).get("error") or "")
+        runner = manifest.get("runner") or {}
+        error = str(runner.get("error") or "")
         stopped = next((k for k in range(len(planned)) if k not in done), None)
         led = None if stopped is None else planned[stopped].get("led")
         if not isinstance(led, int) or isinstance(led, bool):
             led = None
-        if finish == "error" and error.startswith(LED_ERROR) and _refused(error, led):
+        if finish == "error" and error.startswith(LED_ERROR) and _stopped_dead(runner, error, led):
             # a resume lights the same LED first, and a new card session lights it too: "continue
             # it with --resume, or shoot the card again" led back to the same stop
             raise CardStoppedAtLedError(

@@ -15,6 +15,7 @@ from enum import StrEnum
 from typing import Any, Protocol
 
 from rti_rig.core.devices import BusyAwareCamera, ExposingCamera, Frame, FramePacedCamera
+from rti_rig.core.dome_link import DomeLedError, DomeLinkError
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError, ScheduleError
 from rti_rig.core.lp_format import MAX_LIGHTS
 from rti_rig.core.schedule import LightSchedule, LightStep
@@ -558,6 +559,25 @@ def _checked_real_size(
     return real
 
 
+def led_error_record(exc: BaseException) -> dict[str, Any] | None:
+    """An error about one LED as data for the manifest's ``runner.led_error``: the LED, and the
+    link's fault and firmware code beneath it (``None`` for any other error).
+
+    Why: what a stopped session is told to do next depends on *why* the LED stopped it (a dead
+    LED meets a resume again, a board reboot or a cooled LED does not), and a later command
+    (``calibrate-lights`` on a card session) must decide it from the record, not by reading
+    the error's words."""
+    if not isinstance(exc, DomeLedError):
+        return None
+    cause = exc.__cause__
+    link = cause if isinstance(cause, DomeLinkError) else None
+    return {
+        "led": exc.led,
+        "fault": None if link is None else str(link.fault),
+        "code": None if link is None else link.code,
+    }
+
+
 def _arm_end(lighting: object) -> dict[str, Any]:
     """The manifest's ``arm_end``: where an arm's teardown left it, as read back
     (:class:`rti_rig.runtime.arm_end.ArmEnd`); nothing for a dome, or an arm not gone safe."""
@@ -633,6 +653,7 @@ def run_session(
     size_checked = False  # the first frame of this run compared with [camera]'s size
     reason = FinishReason.ERROR
     error: str | None = None
+    led_error: dict[str, Any] | None = None
     teardown: list[str] = []
     #: the source's conclusion (``StepSource.conclude``), once it has one
     concluded: dict[str, Any] | None = None
@@ -773,6 +794,7 @@ def run_session(
         raise
     except Exception as exc:
         reason, error = FinishReason.ERROR, f"{type(exc).__name__}: {exc}"
+        led_error = led_error_record(exc)
         raise
     finally:
         with signals_deferred():
@@ -799,6 +821,7 @@ def run_session(
                         "steps_done_this_run": len(records),
                         **({"end_check": end_notes} if rig.end_check is not None else {}),
                         **_arm_end(rig.lighting),
+                        **({"led_error": led_error} if led_error is not None else {}),
                     },
                     timing={"rig_time_s": rig_time, "wall_time_s": wall_time},
                     source_result=concluded if reason is FinishReason.COMPLETED else None,

@@ -10,6 +10,7 @@ refused as "not as captured": the advice led nowhere. A card shot under every ot
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from card_support import card_rig
@@ -17,6 +18,7 @@ from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
+from rti_rig.drivers.led_dome.messages import ERR_LED_FAULT, ERR_THERMAL
 
 runner = CliRunner()
 
@@ -70,6 +72,12 @@ def test_a_card_session_stopped_at_a_dead_led_says_how_to_shoot_the_others(
     card = tmp_path / "card"
     r = runner.invoke(app, ["run", str(cfg), "--out", str(card)])
     assert r.exit_code != 0 and (card / f"image_{DEAD:03d}.jpg").exists(), r.output
+    manifest = json.loads((card / "manifest.json").read_text(encoding="utf-8"))
+    assert manifest["runner"]["led_error"] == {
+        "led": DEAD,
+        "fault": "rejected",
+        "code": ERR_LED_FAULT,
+    }
 
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
 
@@ -126,3 +134,30 @@ def test_a_card_session_stopped_by_a_board_reboot_under_an_led_is_resumed(
     r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
     assert r.exit_code == 0, r.output
     assert "48 of 48 LEDs measured" in said(r)
+
+
+def test_a_card_session_an_led_s_thermal_refusal_stopped_is_resumed(tmp_path: Path) -> None:
+    """A board refusing an LED for its temperature (firmware code ERR_THERMAL) stops the run
+    with "LED <n> refused: …" too, and the run says to resume once it cooled (``dead_led_of``
+    decides by the code). calibrate-lights decided by the words "LED <n> refused" and told
+    the user to repair the LED: it now reads the run's typed ``runner.led_error``, the fact
+    the run advised from. The emulated boards have no thermal sensor, so the dead-LED stop's
+    record is given the thermal code the firmware would have sent."""
+    cfg = card_rig(tmp_path)
+    with cfg.open("a", encoding="utf-8") as f:
+        f.write(f"dead_leds = [{DEAD}]\n")
+    card = tmp_path / "card"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(card)])
+    assert r.exit_code != 0, r.output
+    path = card / "manifest.json"
+    manifest = json.loads(path.read_text(encoding="utf-8"))
+    assert f"LED {DEAD} refused: " in manifest["runner"]["error"]
+    manifest["runner"]["led_error"]["code"] = ERR_THERMAL
+    path.write_text(json.dumps(manifest), encoding="utf-8")
+
+    r = runner.invoke(app, ["calibrate-lights", str(card), "--rig", str(cfg)])
+
+    assert r.exit_code == 2, r.output
+    text = said(r)
+    assert f"continue it with rti-rig run --resume {card}" in text, text
+    assert "PLAN.lp" not in text and "Traceback" not in r.output, text
