@@ -65,6 +65,9 @@ class ArmSelfTestReport:
     #: the park was commanded and returned (not yet that it is where it was sent: see ``end``)
     parked: bool = False
     aborted: str | None = None
+    #: the walk was ended by a stop (Ctrl-C, SIGTERM), not by an error: a stopped check does
+    #: not park, by the user's choice (decided on here, not on how ``aborted`` begins)
+    stopped_by_user: bool = False
     teardown_failures: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
     #: what may be said of an arm whose connect failed (:func:`not_connected_sentence`)
@@ -295,6 +298,7 @@ def arm_self_test(
         report.aborted_detail = getattr(exc, "message", None)
     except BaseException as exc:  # a stop (signal): goes on up, with what the teardown found
         report.aborted = f"stopped ({exc})"
+        report.stopped_by_user = True
         exc.self_test_report = report  # type: ignore[attr-defined]
         raise
     finally:
@@ -320,7 +324,7 @@ def _check_end(carrier: LightCarrier, report: ArmSelfTestReport, connected: bool
         return None
     if report.parked:
         return park_end(carrier, None)
-    stopped_by_user = (report.aborted or "").startswith("stopped (")
+    stopped_by_user = report.stopped_by_user
     if not report.park_wanted:
         why = "park_after_session is off"
     elif stopped_by_user:
