@@ -22,9 +22,12 @@ import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
-#: DNG compressions (DNG 1.7.1 §"Compression"): none, lossless JPEG, Deflate, lossy JPEG,
-#: JPEG XL (new in DNG 1.7)
+from rti_rig.drivers.cameras.tiff_structure import MAX_TAGS, header_size
+
+#: DNG compressions (DNG 1.7.1 §"Compression") LibRaw 0.22 decodes in any build: none,
+#: lossless JPEG, Deflate, lossy JPEG
 DNG_COMPRESSIONS = {1: "uncompressed", 7: "lossless JPEG", 8: "Deflate", 34892: "lossy JPEG"}
+#: JPEG XL (new in DNG 1.7): named apart, as LibRaw decodes it only when built with it
 JPEG_XL = 52546
 #: photometric kinds of a DNG's raw image: BlackIsZero (a monochrome sensor), CFA, LinearRaw
 RAW_PHOTOMETRIC = {1, 32803, 34892}
@@ -34,6 +37,9 @@ LIBRAW_DNG = (1, 7)
 #: it never set, a different one at each read
 CFA_TAGS = {33421: "CFARepeatPatternDim", 33422: "CFAPattern"}
 _TYPES = {1: ("B", 1), 3: ("H", 2), 4: ("I", 4), 13: ("I", 4)}  # BYTE, SHORT, LONG, IFD
+#: values read of one integer tag at most (the most, StripOffsets of a strip per row, has a
+#: sensor's rows); a larger count is damage, read as a tag given no value
+_MAX_VALUES = 1 << 16
 
 
 @dataclass
@@ -55,12 +61,12 @@ def _ifd(data: bytes, order: str, offset: int) -> tuple[dict[int, tuple[int, ...
         return None
     (count,) = struct.unpack_from(order + "H", data, offset)
     end = offset + 2 + 12 * count
-    if not 1 <= count <= 4096 or end + 4 > len(data):
+    if not 1 <= count <= MAX_TAGS or end + 4 > len(data):
         return None
     tags: dict[int, tuple[int, ...]] = {}
     for n in range(count):
         tag, typ, many = struct.unpack_from(order + "HHI", data, offset + 2 + 12 * n)
-        if typ not in _TYPES or many > 1 << 16:
+        if typ not in _TYPES or many > _MAX_VALUES:
             tags.setdefault(tag, ())
             continue
         code, size = _TYPES[typ]
@@ -98,7 +104,7 @@ def read_dng_tags(path: Path) -> DngTags | None:
         data = path.read_bytes()
     except OSError:
         return None
-    if data[:4] not in (b"II*\x00", b"MM\x00*"):
+    if header_size(data) != 8:  # not a TIFF, or a BigTIFF, which this does not read
         return None
     order = "<" if data[:2] == b"II" else ">"
     first = _ifd(data, order, struct.unpack_from(order + "I", data, 4)[0])
