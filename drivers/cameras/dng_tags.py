@@ -104,7 +104,7 @@ def read_dng_tags(path: Path) -> DngTags | None:
         data = path.read_bytes()
     except OSError:
         return None
-    if header_size(data) != 8:  # not a TIFF, or a BigTIFF, which this does not read
+    if header_size(data) != 8 or len(data) < 8:  # not a TIFF, a BigTIFF, or a header cut
         return None
     order = "<" if data[:2] == b"II" else ">"
     first = _ifd(data, order, struct.unpack_from(order + "I", data, 4)[0])

@@ -214,6 +214,16 @@ def test_unreadable_and_missing_files_name_the_file(tmp_path):
         decode_raw(tmp_path / "missing.dng", MOSAIC)
 
 
+@pytest.mark.parametrize("head", [b"II*\x00\x08\x00", b"MM\x00*\x00"])
+def test_a_file_cut_inside_its_tiff_header_is_refused_naming_it(tmp_path, head):
+    """LibRaw calls it unsupported, and the DNG tag reader asked of it had raised
+    struct.error (a traceback, not a refusal naming the file)."""
+    cut = tmp_path / "cut.dng"
+    cut.write_bytes(head)
+    with pytest.raises(CaptureError, match=r"cut\.dng"):
+        decode_raw(cut, MOSAIC)
+
+
 @pytest.mark.parametrize("source", ["file", "bytes"])
 def test_libraws_own_line_about_a_cut_file_is_kept_off_the_terminal_and_said_in_the_refusal(
     tmp_path, capfd, source
