@@ -142,13 +142,13 @@ def counting_reads(monkeypatch: pytest.MonkeyPatch) -> list[Path]:
     from rti_rig.runtime import session as session_module
 
     read: list[Path] = []
-    real_plan = fit_batch.plan_batch
+    real_prepare = fit_batch.prepare_batch
 
-    def plan(*args: Any, **kwargs: Any) -> Any:  # a batch begins
+    def prepare(*args: Any, **kwargs: Any) -> Any:  # a batch begins
         monkeypatch.setattr(session_module, "_KNOWN_DIGESTS", {})
-        return real_plan(*args, **kwargs)
+        return real_prepare(*args, **kwargs)
 
-    monkeypatch.setattr(fit_batch, "plan_batch", plan)
+    monkeypatch.setattr(fit_batch, "prepare_batch", prepare)
     real_digest, real_imread = hashlib.file_digest, tifffile.imread
 
     def counted(fh: Any, digest: Any) -> Any:
@@ -257,7 +257,7 @@ def test_judging_an_earlier_fit_writes_nothing_and_a_batch_keeps_its_update_once
 def test_a_batch_judges_each_standing_earlier_fit_once(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """A session is judged once, at its turn (fit_one): plan_batch had judged it too when the
+    """A session is judged once, at its turn (fit_one): the batch had judged it too when it
     batch began (its record read, its images stat-ed or hashed), and fit_one again."""
     from rti_rig.app.usecases import fit_batch
 

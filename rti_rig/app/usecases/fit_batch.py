@@ -110,7 +110,7 @@ def run_batch(sources: list[Path], root: Path, template: FitRequest) -> list[Bat
     naming its partial folder, after the batch folder was made inside the session).
     """
     refuse_out_inside_a_session(root)
-    plan_batch(sources, root, judge=False)  # each session is judged at its turn
+    prepare_batch(sources, root)  # each session is judged at its turn (fit_one)
     return [fit_one(source, root, template) for source in sources]
 
 
@@ -160,17 +160,29 @@ def owner_gone(folder: Path, *, mine_too: bool = False) -> bool:
     return False
 
 
-def plan_batch(sources: list[Path], root: Path, *, judge: bool = True) -> dict[Path, EarlierFit]:
+def plan_batch(sources: list[Path], root: Path) -> dict[Path, EarlierFit]:
     """What a batch finds of each source's earlier fit (:func:`earlier_fit`; the sources still
-    to fit are those whose fit does not stand), after removing the partial folders a killed
-    run left for them, and keeping each earlier fit's record a hash brought up to date
-    (:func:`keep_confirmed`). Refuses two sources with one output name.
+    to fit are those whose fit does not stand), once :func:`prepare_batch` has made its
+    folders ready, keeping each earlier fit's record a hash brought up to date
+    (:func:`keep_confirmed`).
 
-    ``judge`` False: the folders only, no judgement (an empty plan), for a batch that fits its
-    sessions one after another: :func:`fit_one` judges each at its turn, which a judgement
-    made here when the batch began cannot replace (a session may change meanwhile), and
-    judging here as well had read each session's record and stat-ed its images twice. A
-    cluster batch judges here to know which sessions to send at once."""
+    Why apart from :func:`prepare_batch`: only a cluster batch judges here, to know which
+    sessions to send at once. A batch that fits its sessions one after another leaves each to
+    :func:`fit_one`'s judgement at its turn, which one made when the batch began cannot
+    replace (a session may change meanwhile); judging here as well had read each session's
+    record and stat-ed its images twice."""
+    prepare_batch(sources, root)
+    plan: dict[Path, EarlierFit] = {}
+    for source in sources:
+        plan[source] = earlier_fit(batch_out_dir(root, source), source)
+        keep_confirmed(plan[source])  # once, here: a later asker finds the record up to date
+    return plan
+
+
+def prepare_batch(sources: list[Path], root: Path) -> None:
+    """Make ``root`` ready for a batch of ``sources``: two sources with one output name are
+    refused, the folder is made, and the partial folders (and outgrown earlier fits) killed
+    runs left for these sources are removed; another batch's running attempts are left."""
     import shutil
 
     by_name: dict[str, list[Path]] = {}
@@ -200,7 +212,6 @@ def plan_batch(sources: list[Path], root: Path, *, judge: bool = True) -> dict[P
             f"--out {root}: cannot create the batch folder ({exc.strerror or exc}); choose a "
             "folder you can write to"
         ) from None
-    plan: dict[Path, EarlierFit] = {}
     for source in sources:
         final = batch_out_dir(root, source)
         # a finished session's too: a Dask worker killed mid-session leaves its attempt's
@@ -216,10 +227,6 @@ def plan_batch(sources: list[Path], root: Path, *, judge: bool = True) -> dict[P
             # another batch's attempt, running now into the same --out, is left to it
             if partial not in keep and owner_gone(partial, mine_too=True):
                 shutil.rmtree(partial, ignore_errors=True)
-        if judge:
-            plan[source] = earlier_fit(final, source)
-            keep_confirmed(plan[source])  # once, here: a later asker finds the record up to date
-    return plan
 
 
 def earlier_backups(root: Path, name: str) -> list[Path]:

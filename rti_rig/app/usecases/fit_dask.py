@@ -65,6 +65,7 @@ from rti_rig.app.usecases.fit_batch import (
     earlier_fit,
     fit_one,
     plan_batch,
+    prepare_batch,
 )
 from rti_rig.app.usecases.scheduler_probe import (
     SHARED_PATHS,
@@ -562,7 +563,7 @@ def run_batch_dask(
     ``root`` inside a session folder is refused before the cluster is reached."""
     refuse_out_inside_a_session(root)  # as given, as run_batch does
     if scheduler == THREADS:
-        plan_batch(sources, root, judge=False)  # each session is judged at its turn
+        prepare_batch(sources, root)  # each session is judged at its turn (fit_one)
         return [fit_one(s, root, template, bands=dask_bands(None, s)) for s in sources]
     # Absolute, as workers do not share this process's working directory, but not resolved:
     # ``resolve()`` followed a symlinked session folder, so its output was named after the
