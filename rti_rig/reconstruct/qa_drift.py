@@ -441,7 +441,8 @@ def still_spread_px(dev: NDArray[np.float64]) -> float:
     ok = np.isfinite(dev[:, 0])
     dist = np.hypot(dev[ok, 0], dev[ok, 1])
     still = dist[dist <= 1.0]
-    if ok.sum() < 5 or still.size < max(STILL_MIN_IMAGES, (ok.sum() + 1) // 2):
+    # the still images are measured ones, so this floor covers the five measured it also had
+    if still.size < max(STILL_MIN_IMAGES, (ok.sum() + 1) // 2):
         return float("inf")
     return 1.4826 * float(np.median(still))
 
