@@ -7,6 +7,7 @@ import json
 import re
 import signal
 import socket
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -47,6 +48,51 @@ def shipped_dome_on_pty(monkeypatch: pytest.MonkeyPatch, config: Path) -> Iterat
 
         monkeypatch.setattr(serial, "serial_for_url", redirect)
         yield firmware
+
+
+def folder_watch_config(
+    tmp_path: Path, tether: Path, *, timeout_s: float | None = None, tiffs: bool = False
+) -> Path:
+    """The shipped folder-watch dome config watching ``tether``, its LED .lp named where it
+    ships; ``timeout_s`` replaces its wait for a file, ``tiffs`` watches for ``*.tif`` only.
+    (One rewrite for the folder-watch CLI tests, which had each kept, or imported from another
+    test module, a copy.)"""
+    text = (CONFIGS / "example_dome_48_folder_watch.toml").read_text(encoding="utf-8")
+    changes = [
+        ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
+        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
+    ]
+    if timeout_s is not None:
+        changes.append(("timeout_s = 15.0", f"timeout_s = {timeout_s}"))
+    for old, new in changes:
+        assert old in text, old
+        text = text.replace(old, new)
+    if tiffs:
+        start = text.index("patterns = [")
+        text = text.replace(text[start : text.index("]\n", start) + 1], 'patterns = ["*.tif"]')
+    cfg = tmp_path / "example_dome_48_folder_watch.toml"
+    cfg.write_text(text, encoding="utf-8")
+    return cfg
+
+
+class Tether(threading.Thread):
+    """A camera and its tethering program on an emulated board: the board's n-th shutter
+    pulse becomes ``files[n - 1]`` (a name and its bytes) in ``folder``, written whole."""
+
+    def __init__(self, firmware: Any, folder: Path, files: list[tuple[str, bytes]]) -> None:
+        super().__init__(daemon=True)
+        self.firmware, self.folder, self.files = firmware, folder, files
+        self.stop = threading.Event()
+
+    def run(self) -> None:
+        saved = 0
+        while not self.stop.is_set() and saved < len(self.files):
+            pulses = sum(e.what == "shutter" for e in list(self.firmware.history))
+            if pulses > saved:
+                name, data = self.files[saved]
+                (self.folder / name).write_bytes(data)
+                saved += 1
+            self.stop.wait(0.02)
 
 
 #: The handlers a test must leave as it found them: a command run in the pytest process

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import CONFIGS, shipped_dome_on_pty
+from conftest import Tether, folder_watch_config, shipped_dome_on_pty
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -27,7 +27,6 @@ pytestmark = [
     pytest.mark.pty,
 ]
 
-SHIPPED = CONFIGS / "example_dome_48_folder_watch.toml"
 #: long enough that a decode that waits for the file to change is told from one that does not
 #: by what the run says (the waiting one says "did not change within 20 s")
 TIMEOUT_S = 20.0
@@ -51,40 +50,7 @@ def _damaged_tiff(scratch: Path) -> bytes:
 
 def _config(tmp_path: Path, tether: Path) -> Path:
     """The shipped config with its folder set to ``tether``, watched for TIFFs."""
-    text = SHIPPED.read_text(encoding="utf-8")
-    for old, new in [
-        ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
-        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
-        ("timeout_s = 15.0", f"timeout_s = {TIMEOUT_S}"),
-    ]:
-        assert old in text, old
-        text = text.replace(old, new)
-    text = text.replace(
-        text[text.index("patterns = [") : text.index("]\n", text.index("patterns = [")) + 1],
-        'patterns = ["*.tif"]',
-    )
-    cfg = tmp_path / "example_dome_48_folder_watch.toml"
-    cfg.write_text(text, encoding="utf-8")
-    return cfg
-
-
-class Tether(threading.Thread):
-    """The camera and its tethering program: the board's first shutter pulse becomes
-    ``name`` (``IMG_0001.tif``) in the folder, whole but damaged."""
-
-    def __init__(  # type: ignore[no-untyped-def]
-        self, firmware, folder: Path, data: bytes, name: str = "IMG_0001.tif"
-    ) -> None:
-        super().__init__(daemon=True)
-        self.firmware, self.folder, self.data, self.name = firmware, folder, data, name
-        self.stop = threading.Event()
-
-    def run(self) -> None:
-        while not self.stop.is_set():
-            if any(e.what == "shutter" for e in list(self.firmware.history)):
-                (self.folder / self.name).write_bytes(self.data)
-                return
-            self.stop.wait(0.02)
+    return folder_watch_config(tmp_path, tether, timeout_s=TIMEOUT_S, tiffs=True)
 
 
 def test_run_names_a_damaged_tiff_at_once_with_what_to_do(
@@ -96,7 +62,7 @@ def test_run_names_a_damaged_tiff_at_once_with_what_to_do(
     cfg = _config(tmp_path, tether)
     data = _damaged_tiff(tmp_path / "scratch.tif")
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, data)
+        camera = Tether(firmware, tether, [("IMG_0001.tif", data)])
         camera.start()
         try:
             args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
@@ -226,7 +192,7 @@ def test_run_names_a_tiff_whose_first_ifd_is_garbage_at_once(
     cfg = _config(tmp_path, tether)
     data = _garbage_ifd_tiff(tmp_path / "scratch.tif", kind)
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, data)
+        camera = Tether(firmware, tether, [("IMG_0001.tif", data)])
         camera.start()
         try:
             args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
@@ -263,22 +229,14 @@ def test_run_names_a_raw_cut_short_with_libraws_words_as_text(
     tether = tmp_path / "tether"
     tether.mkdir()
     out = tmp_path / "s"
-    text = SHIPPED.read_text(encoding="utf-8")
-    for old, new in [
-        ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
-        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
-        ("timeout_s = 15.0", "timeout_s = 1.5"),  # the cut file waited for, then refused
-    ]:
-        assert old in text, old
-        text = text.replace(old, new)
-    cfg = tmp_path / "example_dome_48_folder_watch.toml"
-    cfg.write_text(text, encoding="utf-8")
+    # the cut file waited for, then refused
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=1.5)
     whole = tmp_path / "whole.dng"
     mosaic = linear_to_mosaic(np.full((32, 32), 0.3), "RGGB", 256, 4095)
     write_dng(whole, mosaic, black_level=256, white_level=4095, exposure_s=0.5, iso=100)
     data = whole.read_bytes()[: whole.stat().st_size // 2]
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, data, "IMG_0001.dng")
+        camera = Tether(firmware, tether, [("IMG_0001.dng", data)])
         camera.start()
         try:
             args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]

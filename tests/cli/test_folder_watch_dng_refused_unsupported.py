@@ -16,12 +16,11 @@ from __future__ import annotations
 
 import struct
 import sys
-import threading
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, shipped_dome_on_pty
+from conftest import Tether, folder_watch_config, shipped_dome_on_pty
 from dng_spec_writer import dng
 from typer.testing import CliRunner
 
@@ -31,8 +30,6 @@ pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
     pytest.mark.pty,
 ]
-
-SHIPPED = CONFIGS / "example_dome_48_folder_watch.toml"
 
 
 def _entry(data: bytearray, tag: int) -> int:
@@ -58,23 +55,6 @@ def _changed(how: str) -> bytes:
     return bytes(data)
 
 
-class Tether(threading.Thread):
-    """The camera and its tethering program: the board's first shutter pulse becomes
-    ``IMG_0001.dng`` in the folder, whole."""
-
-    def __init__(self, firmware, folder: Path, data: bytes) -> None:  # type: ignore[no-untyped-def]
-        super().__init__(daemon=True)
-        self.firmware, self.folder, self.data = firmware, folder, data
-        self.stop = threading.Event()
-
-    def run(self) -> None:
-        while not self.stop.is_set():
-            if any(e.what == "shutter" for e in list(self.firmware.history)):
-                (self.folder / "IMG_0001.dng").write_bytes(self.data)
-                return
-            self.stop.wait(0.02)
-
-
 @pytest.mark.parametrize(
     "how", ["width tag lost", "cfa pattern lost", "jpeg xl", "unknown compression"]
 )
@@ -84,18 +64,10 @@ def test_run_says_what_a_refused_dngs_own_tags_show(
     tether = tmp_path / "tether"
     tether.mkdir()
     out = tmp_path / "s"
-    text = SHIPPED.read_text(encoding="utf-8")
-    for old, new in [
-        ('lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS / "example_dome_48.lp"}"'),
-        ('folder = "~/Pictures/rti-tether"', f'folder = "{tether}"'),
-    ]:
-        assert old in text, old
-        text = text.replace(old, new)
-    cfg = tmp_path / "example_dome_48_folder_watch.toml"
-    cfg.write_text(text, encoding="utf-8")
+    cfg = folder_watch_config(tmp_path, tether)
     data = _changed(how)
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, data)
+        camera = Tether(firmware, tether, [("IMG_0001.dng", data)])
         camera.start()
         try:
             args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]

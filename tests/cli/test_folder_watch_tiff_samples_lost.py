@@ -15,14 +15,12 @@ from __future__ import annotations
 
 import struct
 import sys
-import threading
 from pathlib import Path
 
 import numpy as np
 import pytest
 import tifffile
-from conftest import shipped_dome_on_pty
-from test_folder_watch_damaged_tiff import _config
+from conftest import Tether, folder_watch_config, shipped_dome_on_pty
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -56,32 +54,13 @@ def _samples_lost(data: bytes) -> bytes:
     raise AssertionError("no SamplesPerPixel entry")
 
 
-class Tether(threading.Thread):
-    """The camera and its tethering program: the board's n-th shutter pulse becomes
-    ``IMG_000n.tif`` in the folder, with ``files[n - 1]``'s bytes."""
-
-    def __init__(self, firmware, folder: Path, files: list[bytes]) -> None:  # type: ignore[no-untyped-def]
-        super().__init__(daemon=True)
-        self.firmware, self.folder, self.files = firmware, folder, files
-        self.stop = threading.Event()
-
-    def run(self) -> None:
-        saved = 0
-        while not self.stop.is_set() and saved < len(self.files):
-            pulses = sum(e.what == "shutter" for e in list(self.firmware.history))
-            if pulses > saved:
-                (self.folder / f"IMG_{saved + 1:04d}.tif").write_bytes(self.files[saved])
-                saved += 1
-            self.stop.wait(0.02)
-
-
 def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, files: list[bytes]):  # type: ignore[no-untyped-def]
     tether = tmp_path / "tether"
     tether.mkdir()
-    cfg = _config(tmp_path, tether)
+    cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
     out = tmp_path / "s"
     with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, files)
+        camera = Tether(firmware, tether, [(f"IMG_{n:04d}.tif", f) for n, f in enumerate(files, 1)])
         camera.start()
         try:
             args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
