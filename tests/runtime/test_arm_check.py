@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -67,7 +68,8 @@ class FakeCarrier:
     def stop(self) -> None:
         self.log.append("stop")
 
-    def park(self) -> None:
+    def park(self, cancelled: Callable[[], bool] | None = None) -> None:
+        """As the LightCarrier protocol's (``cancelled``: the final park's stop, not asked)."""
         self.log.append("park")
         self.at = direction_from_az_el(*self.park_pose_deg)
 
