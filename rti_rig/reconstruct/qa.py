@@ -69,6 +69,7 @@ from rti_rig.reconstruct.qa_drift import (
     measure_drift,
     move_back,
     step_candidates,
+    step_follows_elevation,
     still_spread_px,
 )
 from rti_rig.reconstruct.qa_exposure import (
@@ -354,6 +355,9 @@ class QAReport:
     drift_note: str = ""
     #: The smallest shift judged, where it is larger than DRIFT_PX, and why; empty otherwise.
     shift_note: str = ""
+    #: A step in capture order the edges alone found and the lights' elevation explains as
+    #: well, so not claimed as a move (:func:`_confirmed_step`); empty otherwise.
+    step_note: str = ""
     #: Images whose files could not be checked against their capture checksums, and why (set
     #: by the application for a session folder); empty when every image was checkable.
     integrity_note: str = ""
@@ -390,6 +394,8 @@ class QAReport:
             out.append(self.drift_note)
         if self.shift_note:
             out.append(self.shift_note)
+        if self.step_note:
+            out.append(self.step_note)
         for label, attr in (("shift", "drift_judged"), ("brightness", "gain_judged")):
             if attr == "drift_judged" and self.drift_note:
                 continue
@@ -779,7 +785,11 @@ STEP_FIT_NO_EVIDENCE = 0.1
 
 
 def _confirmed_step(
-    crop_arr: NDArray, lt: NDArray, lit: NDArray[np.bool_], saturation: float | None
+    crop_arr: NDArray,
+    lt: NDArray,
+    lit: NDArray[np.bool_],
+    saturation: float | None,
+    refused: list[Step] | None = None,
 ) -> tuple[Step, NDArray, Any] | None:
     """A move part-way through the session (the first of
     :func:`~rti_rig.reconstruct.qa_drift.step_candidates` the fit confirms), with the images
@@ -793,8 +803,13 @@ def _confirmed_step(
     than as captured. Measured on the emulated sessions: 0.50-0.61 for moves of 1.4-3 px from
     image 4 or 7 of 12 and 25 of 48; 1.01-1.26 for the tablet's two still sessions. Where the
     fit explains those images poorly (:data:`STEP_FIT_NO_EVIDENCE`: gloss, an object the
-    Lambertian fit cannot render) it confirms nothing, and the edges' step is taken as found:
-    on the emulated coin and industrial part no still session yields an edges' step."""
+    Lambertian fit cannot render) it confirms nothing, and the edges' step is taken as found,
+    unless the lights' elevation explains it as well
+    (:func:`~rti_rig.reconstruct.qa_drift.step_follows_elevation`): on a fibonacci dome the
+    capture order is the order of rising elevation, and a still brushed-steel part's shadow
+    edges split low lights from high ones by up to 5 px (emulated Nab dome, uneven LEDs, seeds
+    2 and 8: "moved part-way through", reshoot the whole session). Such steps are appended to
+    ``refused`` for the verdict to say, not claimed."""
     n = len(crop_arr)
     # The fit-confirmed candidate that, undone, explains its images best: the first one the
     # fit confirms can be a blend. The still tablet of 12 lights moved (2, 0) px from image 7
@@ -826,7 +841,11 @@ def _confirmed_step(
             if best is None or undone / as_is < best[0]:
                 best = (undone / as_is, step)
         elif min(as_is, undone) > STEP_FIT_NO_EVIDENCE:
-            unjudged.append(step)
+            if step_follows_elevation(crop_arr, lit, step, lt):
+                if refused is not None:
+                    refused.append(step)
+            else:
+                unjudged.append(step)
     if best is None and unjudged:
         step = _most_agreeing(unjudged, n)
         moved = _moved_from(crop_arr, step)
@@ -844,6 +863,21 @@ def _confirmed_step(
     except ReconstructionError:
         return None
     return _placed_by_fit(crop_arr, lt, step, moved, fit_undone, saturation)
+
+
+def _elevation_step_note(refused: list[Step], names: Sequence[str]) -> str:
+    """The verdict's words for edges' steps the lights' elevation explains as well as a move
+    (:func:`_confirmed_step`): said, so that a real move there is not passed over in silence,
+    but not claimed, and no image is named for a reshoot on it."""
+    if not refused:
+        return ""
+    s = refused[0]
+    return (
+        f"a step in the edges from {names[s.first]} on ({s.shift[0]:+.1f}, {-s.shift[1]:+.1f}) "
+        "px could not be told from the light's elevation (the lights rise in capture order, "
+        "and the edges move with them within the images of the higher lights): not claimed "
+        "as a move"
+    )
 
 
 def _most_agreeing(unjudged: list[Step], n: int) -> Step:
@@ -1143,7 +1177,8 @@ def assess(
     # A move part-way through (a step in capture order) blends every reference below: found
     # first, from the two sides' own edges, and confirmed by the fit; its images are moved
     # back before anything else is measured, and the images from it on are the ones moved.
-    found = _confirmed_step(crop_arr, lt, lit_images, sat_level)
+    refused_steps: list[Step] = []
+    found = _confirmed_step(crop_arr, lt, lit_images, sat_level, refused_steps)
     step: Step | None = None
     step_fit: Any = None  # the fit of crop_arr as it now is (the step undone)
     step_moved = np.zeros(n, bool)
@@ -1571,6 +1606,7 @@ def assess(
         direction_note=ev.direction_note,
         drift_note=drift_note,
         shift_note=shift_note,
+        step_note=_elevation_step_note(refused_steps, names) if step is None else "",
         light_scatter=light_scatter,
         crop=(rs.start, cs.start, rs.stop - rs.start, cs.stop - cs.start),
     )
