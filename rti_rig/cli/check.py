@@ -60,8 +60,10 @@ def check(
         float | None,
         typer.Option(
             "--intensity",
-            help="LED drive level for a dome's walk, in (0, 1] (default 0.2). Refused on a "
-            "replay rig, which has no LEDs to dim.",
+            help="LED drive level for a dome's walk, in (0, 1] (default 0.2). Refused where "
+            "nothing can be lit at a chosen level: a replay rig, an arm (its lamp is only "
+            "switched on and off), a camera-triggered dome (rti-rig lights none of its LEDs) "
+            "and a dome whose firmware cannot dim an LED.",
         ),
     ] = None,
     reboot_faulted: Annotated[

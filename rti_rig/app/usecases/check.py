@@ -114,21 +114,57 @@ def check_rig(req: CheckRequest) -> Any:
 
 
 def _refuse_undimmable(loaded: Any, intensity: float) -> None:
-    """``--intensity`` given for a replayed acquisition is refused, as ``--auto-exposure`` is
+    """``--intensity`` given for a rig whose check cannot light anything at that level is
+    refused, as ``--auto-exposure`` is
     (:func:`~rti_rig.app.usecases.session.refuse_unmeterable_rig`): a usage error that names
-    the option and says to drop it.
+    the option, says why, and says to drop it.
 
     Why: ``check ACQ/dirs.lp --intensity 0.5`` passed without a word, as if the level had been
-    used; a replay's "LEDs" are its recorded images, with nothing to dim."""
-    if loaded.config.backend == "replay":
-        from rti_rig.core.errors import ConfigError
+    used; so did an arm (its lamp is switched on or off, never dimmed), a camera-triggered
+    dome (rti-rig lights none of its LEDs) and an on/off serial firmware (its LEDs were lit
+    fully on): a PASS that implied a walk at the level asked for."""
+    from rti_rig.core.errors import ConfigError
 
-        raise ConfigError(
-            loaded.path,
-            None,
-            f"--intensity {intensity:g} cannot be used on a replayed acquisition: it has no "
-            "LEDs to dim (its images were recorded at the light they had); drop --intensity",
+    why = _undimmable_reason(loaded)
+    if why is None:
+        return
+    raise ConfigError(
+        loaded.path,
+        None,
+        f"--intensity {intensity:g} cannot be used on {why}; drop --intensity",
+    )
+
+
+def _undimmable_reason(loaded: Any) -> str | None:
+    """What about this rig leaves the check no LED to light at a chosen level, or None."""
+    config = loaded.config
+    if config.backend == "replay":
+        return (
+            "a replayed acquisition: it has no LEDs to dim (its images were recorded at the "
+            "light they had)"
         )
+    if config.arm is not None:
+        return (
+            "an arm: its lamp is only switched on and off (its brightness is the lamp's own), "
+            "so the check's lamp flashes cannot be dimmed"
+        )
+    dome = config.dome
+    if dome is None:
+        return None
+    if dome.flash_sync is not None:
+        return (
+            f"a camera-triggered dome ({dome.flash_sync.firmware}): its firmware lights its "
+            "LEDs with the camera's flash pulse, and rti-rig lights none of them, so no LED "
+            "can be checked at any level"
+        )
+    serial = getattr(dome, "serial", None)
+    refusal = None if serial is None else serial.dimming_refusal()
+    if refusal is not None:
+        return (
+            f"this dome: {refusal}, so the check would light each LED fully on, not at the "
+            "level asked for"
+        )
+    return None
 
 
 @dataclass(frozen=True)

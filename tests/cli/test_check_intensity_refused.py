@@ -1,0 +1,45 @@
+"""`rti-rig check CFG --intensity L` is refused, by name and with the reason, on a rig whose
+check cannot light anything at a chosen level; it is used on a dome that can dim.
+
+Found by a review: on an arm (lamp only on/off), a camera-triggered dome (rti-rig lights none
+of its LEDs) and an on/off firmware (each LED lit fully on) the option was silently ignored and
+the check ended "RESULT: PASS", as if the walk had been made at the level asked for."""
+
+from __future__ import annotations
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def said(output: str) -> str:
+    return " ".join(output.split())
+
+
+@pytest.mark.parametrize(
+    ("config", "why"),
+    [
+        ("simulated_arm.toml", "an arm: its lamp is only switched on and off"),
+        ("virtual_arm.toml", "an arm: its lamp is only switched on and off"),
+        ("emulated_cceh_rti.toml", "a camera-triggered dome (cceh-rti)"),
+        ("emulated_nab_rti_v1.toml", "the nab-rti-v1 firmware cannot dim an LED"),
+    ],
+)
+def test_intensity_is_refused_where_nothing_is_lit_at_that_level(config: str, why: str) -> None:
+    r = runner.invoke(app, ["check", str(CONFIGS / config), "--intensity", "0.5"])
+    text = said(r.output)
+    assert r.exit_code == 2, text
+    assert f"{config}: --intensity 0.5 cannot be used on" in text, text
+    assert why in text and "drop --intensity" in text, text
+    assert "RESULT" not in text and "Traceback" not in text, text
+
+
+def test_intensity_is_used_on_a_dome_that_dims() -> None:
+    r = runner.invoke(app, ["check", str(CONFIGS / "simulated_dome.toml"), "--intensity", "0.5"])
+    text = said(r.output)
+    assert r.exit_code == 0, text
+    assert text.endswith("RESULT: PASS") and "--intensity" not in text, text
