@@ -763,10 +763,11 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     folder, out_dir = opened.folder, opened.out_dir
     if folder.images_kept:
         whole, listed = folder.lp_listing()
-        if whole and folder.images_kept >= opened.total_steps:
+        if whole and (folder.images_kept >= opened.total_steps or _run_completed(folder)):
             # every image was in when the stop came (a SIGTERM or a park stopped in the
-            # teardown): "Continue with: rti-rig run --resume" had been said of a complete
-            # session, which has nothing left to resume
+            # teardown; an adaptive session's last image, short of its maximum): "Continue
+            # with: rti-rig run --resume" had been said of a complete session, which has
+            # nothing left to resume
             return (
                 f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: the "
                 "session is complete, nothing is left to resume. Next: rti-rig fit "
@@ -800,6 +801,18 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         return f"Nothing was captured: {out_dir} holds no image and may be used again."
     # e.g. a camera's file downloaded for a step that then failed: kept, never deleted
     return f"No image was completed, but {out_dir} holds files of the camera. {resume_hint}"
+
+
+def _run_completed(folder) -> bool:  # type: ignore[no-untyped-def]
+    """Whether this run's own entry in the manifest (its last, written by the teardown's
+    ``finish``) says the session completed: the capture's end was reached before the stop.
+
+    Why: an adaptive session that stopped itself short of its maximum (its estimate met
+    --until-error) and was then stopped during its teardown (a second Ctrl-C) was told to
+    "Continue with: rti-rig run --resume", its images counted against the maximum; the
+    manifest, written before the stop acts, is what says the capture was over."""
+    runs = (folder.manifest or {}).get("runs") or []
+    return bool(runs) and runs[-1].get("finish_reason") == "completed"
 
 
 def _print_teardown_failures(  # type: ignore[no-untyped-def]
@@ -1014,6 +1027,11 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         cancel.cancel()
         if _park_stopped_by(opened.rig) is not None:  # delivered after the teardown it stopped:
             return  # no image is left to stop after; the arm's line and the summary say it
+        if opened.folder.images_kept >= opened.total_steps:
+            # after the last image (the teardown, the records' last writes): "Stopping after
+            # this image" read as if one were still to come, and asked for a second Ctrl-C
+            err.print("[yellow]Every image is in: finishing the session (lights off, records)…[/]")
+            return
         err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")
 
     def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]

@@ -1,0 +1,96 @@
+"""A Ctrl-C once every image is in (during the teardown, as the records are finished) says the
+truth of what the session holds: complete, fit next; never the resume.
+
+Found by a review: the first Ctrl-C there said "Stopping after this image (Ctrl-C again to stop
+at once)" as if an image were still to come, and an adaptive session that had stopped itself
+short of its maximum (its estimate met --until-error), stopped by a second Ctrl-C in its
+teardown, was told "Continue with: rti-rig run --resume" (its images were counted against the
+maximum, not the manifest's "completed"). A stop with images missing still says the resume.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, REPO
+
+#: ``rti-rig run`` in a process of its own that sends itself SIGINT ``TIMES`` times when the
+#: session's records are finished (the teardown: after the capture's end, or its stop), or
+#: once image ``AT`` (0-based) is committed when ``AT`` >= 0: a condition, never a delay
+SCRIPT = """
+import os, signal, sys
+from rti_rig.runtime.session import SessionFolder
+AT, TIMES = int(sys.argv.pop(1)), int(sys.argv.pop(1))
+def interrupt():
+    for _ in range(TIMES):
+        os.kill(os.getpid(), signal.SIGINT)
+if AT < 0:
+    real_finish = SessionFolder.finish
+    def finish(self, *a, **k):
+        interrupt()
+        return real_finish(self, *a, **k)
+    SessionFolder.finish = finish
+else:
+    real_write = SessionFolder.write_step
+    def write_step(self, i, *a, **k):
+        record = real_write(self, i, *a, **k)
+        if i == AT:
+            interrupt()
+        return record
+    SessionFolder.write_step = write_step
+from rti_rig.cli import app
+app(sys.argv[1:], prog_name="rti-rig")
+"""
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
+
+
+def _run(tmp_path: Path, at: int, times: int, *options: str) -> tuple[int, str, Path]:
+    out = tmp_path / "s"
+    args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), *options]
+    proc = subprocess.run(
+        [sys.executable, "-c", SCRIPT, str(at), str(times), *args, "--no-verdict"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+    )
+    return proc.returncode, " ".join((proc.stdout + proc.stderr).split()), out
+
+
+def test_a_ctrl_c_after_the_last_image_says_it_is_in_and_completes(tmp_path: Path) -> None:
+    code, said, out = _run(tmp_path, 5, 1, "--lights", "6")
+    assert code == 0, said
+    assert "Every image is in: finishing the session" in said, said
+    assert "Stopping after this image" not in said and "--resume" not in said, said
+    assert "6 image(s) in the session; lights.lp lists the lights that fired." in said, said
+    assert len((out / "lights.lp").read_text().splitlines()) == 7  # its count and 6 lights
+
+
+def test_two_ctrl_c_in_a_completed_adaptive_sessions_teardown_say_complete(
+    tmp_path: Path,
+) -> None:
+    code, said, out = _run(tmp_path, -1, 2, "--until-error", "30", "--lights", "20")
+    manifest = json.loads((out / "manifest.json").read_text())
+    kept = manifest["runner"]["steps_done"]
+    # the session stopped itself short of its maximum, and its manifest says it completed
+    assert manifest["runs"][-1]["finish_reason"] == "completed" and 0 < kept < 20, manifest
+    assert code == 130, said
+    assert "Emergency stop (second Ctrl-C)" in said and "Traceback" not in said, said
+    assert "--resume" not in said, said
+    assert f"{kept} image(s) kept in {out}, listed in lights.lp: the session is complete" in said
+    assert f"Next: rti-rig fit {out} --out FOLDER" in said, said
+
+
+def test_two_ctrl_c_with_images_missing_still_say_the_resume(tmp_path: Path) -> None:
+    code, said, out = _run(tmp_path, 2, 2, "--lights", "6")
+    assert code == 130, said
+    assert "Stopping after this image" in said, said
+    kept = f"3 image(s) kept in {out}, listed in lights.lp. Continue with: rti-rig run --resume"
+    assert kept in said, said
+    assert "session is complete" not in said, said
