@@ -199,7 +199,13 @@ def fit(
         ),
     ] = None,
 ) -> None:
-    """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict."""
+    """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict.
+
+    Exit codes: 0 every fit is written (a batch: each session done, refitted, skipped as
+    finished earlier, or finished on a Dask worker); 1 a batch's fits are all in place but
+    a session changed while it was fitted, so its fit is of the session as it was read (run
+    the same command again to refit it); 2 an error (a batch: a session failed, the others
+    fitted); 130 / 143 stopped by Ctrl-C / SIGTERM."""
     from rti_rig.app.usecases.fit_memory import use_one_heap
 
     # One malloc heap for this process, before any decode or reader thread starts: it is
@@ -294,6 +300,17 @@ def _fit_command(  # type: ignore[no-untyped-def]
                     err.print(line, highlight=False, soft_wrap=True)
             if any(i.outcome is Outcome.FAILED for i in items):
                 raise typer.Exit(code=2)
+            stale = [i for i in items if i.stale]
+            if stale:
+                # each fit is in place, but not of the session there now: a script chaining
+                # batches had exit 0 and only the session's line to tell it
+                err.print(
+                    f"[yellow]{len(stale)} of {len(items)} fit(s) are of their session as it "
+                    "was read, not as it is now (it changed while it was fitted):[/] run the "
+                    "same command again once the session is no longer being changed (exit 1)",
+                    soft_wrap=True,
+                )
+                raise typer.Exit(code=1)
             return
         if scheduler is None:
             result = run_fit(request)

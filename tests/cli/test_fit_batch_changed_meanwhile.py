@@ -109,7 +109,7 @@ def test_an_image_replaced_while_its_fit_runs_is_said_and_refitted_next(
     on_fit(monkeypatch, "S", replace, after=True)
     r = batch(s, t, out=fb)
     text = said(r)
-    assert r.exit_code == 0, r.output
+    assert r.exit_code == 1, r.output  # its fit is in place, but not of the session now
     assert (
         f"{s}: refitted (its session changed since the earlier fit: 5 → 8 images); but its "
         "session changed while it was being fitted (1 of 8 images changed on disk since their "
@@ -123,6 +123,40 @@ def test_an_image_replaced_while_its_fit_runs_is_said_and_refitted_next(
     assert "while it was being fitted" not in text, r.output
     r = batch(s, t, out=fb)
     assert said(r).count("skipped (finished earlier)") == 2, r.output
+
+
+@pytest.mark.e2e
+@pytest.mark.slow
+def test_a_session_resumed_while_its_own_fit_runs_exits_1_until_refitted(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The batch's exit code says a fit is stale (its session changed under it): 1, between
+    0 (every fit matches its session) and 2 (a session failed). It had exited 0, a script
+    chaining batches told only by the words on the session's line."""
+    import shutil
+
+    s, t, fb = sessions(tmp_path)
+    shutil.rmtree(fb / "S")  # S is fitted again, and its capture resumed as it is
+
+    def resume() -> None:
+        r = runner.invoke(app, ["run", "--resume", str(s)])
+        assert r.exit_code == 0, r.output
+
+    on_fit(monkeypatch, "S", resume, after=True)
+    r = batch(s, t, out=fb)
+    text = said(r)
+    assert r.exit_code == 1, r.output
+    assert f"{s}: done; but its session changed while it was being fitted (5 → 8 images)" in text
+    assert f"{t}: skipped (finished earlier)" in text, r.output
+    assert "1 of 2 fit(s) are of their session as it was read" in text, r.output
+    assert "run the same command again" in text and "Traceback" not in text, r.output
+    assert read(fb / "S").startswith("5 images")
+    monkeypatch.undo()
+    r = batch(s, t, out=fb)  # run again, as said: refitted from the session there now
+    text = said(r)
+    assert r.exit_code == 0, r.output
+    assert f"{s}: refitted (its session changed since the earlier fit: 5 → 8 images)" in text
+    assert read(fb / "S").startswith("8 images")
 
 
 @pytest.mark.e2e

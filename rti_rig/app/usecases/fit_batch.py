@@ -65,6 +65,16 @@ class BatchItem:
     #: "fit.ptm not written" for a 5-light session was said by fit S, not by fit S1 S2)
     notes: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+    #: how the session changed while its own fit ran (:func:`changed_while_fitted`), or None:
+    #: its fit is of the session as it was read, and the batch's exit code says so
+    changed_meanwhile: str | None = None
+
+    @property
+    def stale(self) -> bool:
+        """The fit in place is of its session as it was read, not as it is now (it changed
+        while it was fitted): the next batch refits it. Why a flag and not only words: a
+        script running batches had only "done; but …" to find, the exit code being 0."""
+        return self.changed_meanwhile is not None
 
     @property
     def status(self) -> str:
@@ -579,4 +589,5 @@ def fit_one(
         result.qa.verdict if result.qa is not None else None,
         (*said, *result.notes),
         tuple(result.warnings),
+        moved_on,
     )
