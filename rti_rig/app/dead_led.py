@@ -4,7 +4,9 @@ Why: a board that senses LED current refuses a dead LED (firmware error "LED fau
 run ended "Continue with: rti-rig run --resume S" right after the driver said that a resume
 stops there again: the resume lights that LED first. The advice here is one that works: repair
 it and resume, or shoot the other lights with a plan that leaves it out (as
-``calibrate-lights`` advises of a card session stopped the same way).
+``calibrate-lights`` advises of a card session stopped the same way): the rig's LED ``.lp``
+without its line, or for a session of some LEDs a plan written beside it
+(:func:`write_plan_without`), since the user has no file of the lights ``--lights N`` chose.
 """
 
 from __future__ import annotations
@@ -64,14 +66,55 @@ def dead_led_advice(loaded: Any, schedule: Any, out_dir: Path, led: int) -> str:
             f"{which}, the count on its first line one less, as PLAN.lp"
         )
     else:
+        written = write_plan_without(schedule, out_dir, led)
+        if written is not None:
+            # the session's own lights (a --plan's, or those --lights N chose), which the
+            # user had no file of: coordinates to find and delete by hand were no command
+            return (
+                f"A resume lights {which} first and stops there again. The session's "
+                f"{len(schedule.steps) - 1} other lights, in its order, were written beside it "
+                f"as {written.name}; to shoot them now: rti-rig run {cfg} --plan "
+                f"{shlex.quote(str(written))} --out NEW_DIR. Once that LED or its wiring is "
+                f"repaired, continue with: rti-rig run --resume {shlex.quote(str(out_dir))}"
+            )
         step = next((s for s in schedule.steps if s.led == led), None)
-        where = "" if step is None else " ({:.4f} {:.4f} {:.4f})".format(*step.direction)
+        where = "" if step is None else " ({:.6f} {:.6f} {:.6f})".format(*step.direction)
         plan = f"write the lights to shoot without the direction of {which}{where} as PLAN.lp"
     return (
         f"A resume lights {which} first and stops there again. To shoot the other lights now, "
         f"{plan} and run rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR; once that LED or its "
         f"wiring is repaired, continue with: rti-rig run --resume {shlex.quote(str(out_dir))}"
     )
+
+
+def write_plan_without(schedule: Any, out_dir: Path, led: int) -> Path | None:
+    """Write the session's lights without LED ``led``, in its order, as a new ``.lp`` beside
+    ``out_dir`` (``<name>-without-led-<led>.lp``, never over an existing file); its path, or
+    None when it cannot be written (no other light, a folder one cannot write to).
+
+    Beside the session, not in it: a second ``.lp`` in the session folder would be offered to
+    relight and RTIBuilder beside its ``lights.lp``, naming images it does not hold."""
+    from rti_rig.core.lp_format import LpEntry, format_lp
+
+    kept = [s for s in schedule.steps if s.led != led]
+    if not kept:
+        return None
+    text = format_lp(
+        [LpEntry(f"image_{i:03d}.jpg", s.direction) for i, s in enumerate(kept, start=1)]
+    )
+    base = Path(out_dir).absolute()
+    for n in range(1, 100):
+        suffix = "" if n == 1 else f"-{n}"
+        path = base.parent / f"{base.name}-without-led-{led}{suffix}.lp"
+        try:
+            with open(path, "x", encoding="ascii", newline="\n") as fh:  # never over a file
+                fh.write(text)
+        except FileExistsError:
+            continue
+        except OSError:
+            return None
+        return path
+    return None
 
 
 def _led_names(loaded: Any) -> tuple[str, ...]:

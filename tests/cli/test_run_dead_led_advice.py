@@ -8,10 +8,12 @@ The advice is followed here as written, through the CLI.
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 from pathlib import Path
 
+import pytest
 from conftest import CONFIGS, said
 from typer.testing import CliRunner
 
@@ -51,3 +53,53 @@ def test_a_stop_at_a_dead_led_advises_a_plan_without_it_that_works(tmp_path: Pat
     )
     assert r.exit_code == 0, r.output
     assert "47 image(s) in the session" in said(r), r.output
+
+
+def _dead_dome(tmp_path: Path) -> Path:
+    shutil.copy(CONFIGS / "example_dome_48.lp", tmp_path)
+    cfg = tmp_path / "dome.toml"
+    cfg.write_text(
+        (CONFIGS / "emulated_dome.toml").read_text() + f"\n[emulator]\ndead_leds = [{DEAD}]\n"
+    )
+    return cfg
+
+
+@pytest.mark.parametrize("partial", ["--lights", "--plan"])
+def test_a_partial_plan_stopped_at_a_dead_led_is_given_a_plan_that_runs(
+    tmp_path: Path, partial: str
+) -> None:
+    """A run of some of the LEDs (``--lights N``, ``--plan P``) had been told "write the lights
+    to shoot without the direction of LED 2 (0.4918 0.8546 0.1666) as PLAN.lp": coordinates,
+    rounded, of lights the user had no file of (--lights chose them). The plan is written for
+    them, beside the session (never in it), and the command said runs it."""
+    cfg = _dead_dome(tmp_path)
+    chosen = ["--lights", "24"]
+    if partial == "--plan":
+        plan = tmp_path / "mine.lp"
+        r = runner.invoke(app, ["plan", "--rig", str(cfg), "--lights", "24", "--out", str(plan)])
+        assert r.exit_code == 0, r.output
+        chosen = ["--plan", str(plan)]
+    s = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(s), *chosen, "--no-verdict"])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert f"LED {DEAD} refused" in text and "Continue with: rti-rig run --resume" not in text
+    assert f"continue with: rti-rig run --resume {s}" in text, text  # once repaired
+    written = tmp_path / f"s-without-led-{DEAD}.lp"
+    command = f"rti-rig run {cfg} --plan {written} --out NEW_DIR."
+    assert (
+        f"The session's 23 other lights, in its order, were written beside it as {written.name}"
+        in text
+    )
+    assert command in text, text
+    assert [p.name for p in s.glob("*.lp")] == ["lights.lp"]  # nothing added in the session
+
+    # the command, run as said: the other 23 lights, LED 2 not among them
+    new = tmp_path / "new"
+    argv = command.removeprefix("rti-rig ").removesuffix(".").replace("NEW_DIR", str(new))
+    r = runner.invoke(app, [*argv.split(), "--no-verdict"])
+    assert r.exit_code == 0, r.output
+    assert "23 image(s) in the session" in said(r), r.output
+    fired = json.loads((new / "manifest.json").read_text())["steps"]
+    planned = json.loads((s / "manifest.json").read_text())["schedule"]["steps"]
+    assert [st["led"] for st in fired] == [st["led"] for st in planned if st["led"] != DEAD]
