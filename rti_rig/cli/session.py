@@ -811,6 +811,8 @@ def _run_completed(folder) -> bool:  # type: ignore[no-untyped-def]
     --until-error) and was then stopped during its teardown (a second Ctrl-C) was told to
     "Continue with: rti-rig run --resume", its images counted against the maximum; the
     manifest, written before the stop acts, is what says the capture was over."""
+    if not folder.begun:  # the manifest's last run is an earlier one (a --reshoot-lost's)
+        return False
     runs = (folder.manifest or {}).get("runs") or []
     return bool(runs) and runs[-1].get("finish_reason") == "completed"
 
