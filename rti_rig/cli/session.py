@@ -761,6 +761,12 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     from rti_rig.runtime.session import LP_NAME, holds_no_image
 
     folder, out_dir = opened.folder, opened.out_dir
+    if opened.resumed and not folder.begun and not _cannot_resume(opened.rig):
+        runs = (folder.manifest or {}).get("runs") or []
+        if runs and runs[-1].get("finish_reason") == "completed":
+            # a --reshoot-lost stopped before it wrote anything: the session is still the
+            # completed one, which a plain --resume refuses
+            resume_hint = f"Continue with: rti-rig run --resume {_arg(out_dir)} --reshoot-lost"
     if folder.images_kept:
         whole, listed = folder.lp_listing()
         if whole and (folder.images_kept >= opened.total_steps or _run_completed(folder)):

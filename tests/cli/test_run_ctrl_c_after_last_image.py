@@ -20,8 +20,9 @@ import pytest
 from conftest import CONFIGS, REPO
 
 #: ``rti-rig run`` in a process of its own that sends itself SIGINT ``TIMES`` times when the
-#: session's records are finished (the teardown: after the capture's end, or its stop), or
-#: once image ``AT`` (0-based) is committed when ``AT`` >= 0: a condition, never a delay
+#: session's records are finished (the teardown: after the capture's end, or its stop) when
+#: ``AT`` is -1, as the run is about to write its first file when -2, or once image ``AT``
+#: (0-based) is committed when ``AT`` >= 0: a condition, never a delay
 SCRIPT = """
 import os, signal, sys
 from rti_rig.runtime.session import SessionFolder
@@ -29,7 +30,13 @@ AT, TIMES = int(sys.argv.pop(1)), int(sys.argv.pop(1))
 def interrupt():
     for _ in range(TIMES):
         os.kill(os.getpid(), signal.SIGINT)
-if AT < 0:
+if AT == -2:
+    real_begin = SessionFolder.begin
+    def begin(self, *a, **k):
+        interrupt()
+        return real_begin(self, *a, **k)
+    SessionFolder.begin = begin
+elif AT < 0:
     real_finish = SessionFolder.finish
     def finish(self, *a, **k):
         interrupt()
@@ -52,7 +59,8 @@ pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="signals tested 
 
 def _run(tmp_path: Path, at: int, times: int, *options: str) -> tuple[int, str, Path]:
     out = tmp_path / "s"
-    args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), *options]
+    new = [] if "--resume" in options else [str(CONFIGS / "simulated_dome.toml"), "--out", str(out)]
+    args = ["run", *new, *options]
     proc = subprocess.run(
         [sys.executable, "-c", SCRIPT, str(at), str(times), *args, "--no-verdict"],
         capture_output=True,
@@ -94,3 +102,18 @@ def test_two_ctrl_c_with_images_missing_still_say_the_resume(tmp_path: Path) -> 
     kept = f"3 image(s) kept in {out}, listed in lights.lp. Continue with: rti-rig run --resume"
     assert kept in said, said
     assert "session is complete" not in said, said
+
+
+def test_a_reshoot_stopped_before_it_wrote_anything_is_not_said_complete(tmp_path: Path) -> None:
+    """A completed session reopened with --reshoot-lost, stopped (two Ctrl-C) before its first
+    write: the manifest's last run is still the earlier, completed one, and was read as this
+    run's ("the session is complete, nothing is left to resume", an image still missing)."""
+    code, said, out = _run(tmp_path, 99, 0, "--lights", "6")
+    assert code == 0, said
+    (out / "image_003.jpg").unlink()
+    (out / "linear" / "image_003.tif").unlink()
+    code, said, _ = _run(tmp_path, -2, 2, "--resume", str(out), "--reshoot-lost")
+    assert code == 130, said
+    assert "session is complete" not in said and "Traceback" not in said, said
+    assert f"5 image(s) kept in {out}" in said, said
+    assert f"Continue with: rti-rig run --resume {out} --reshoot-lost" in said, said
