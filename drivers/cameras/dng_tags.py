@@ -11,6 +11,11 @@ photometric kind a raw image has, its data's place inside the file, and a compre
 specification names. Where all of that holds, nothing here can tell, and :func:`dng_refusal`
 says both possibilities.
 
+Asked of every decode (:func:`cfa_lost`), it reads only the header, the IFDs and the values of
+the tags above, by seeking to them (:mod:`~rti_rig.drivers.cameras.tiff_ifd`, the TIFF reader
+the folder watch's checks use too): it had read the whole file, 48 MB of a 24-MP DNG, per
+image.
+
 Sources: TIFF 6.0 (header, IFD entries, tags 254-279, 322-325) and the DNG Specification
 1.7.1.0 (DNGVersion 50706, DNGBackwardVersion 50707, SubIFDs 330, PhotometricInterpretation
 32803 CFA / 34892 LinearRaw, compressions 1, 7, 8, 34892, 52546).
@@ -18,11 +23,19 @@ Sources: TIFF 6.0 (header, IFD entries, tags 254-279, 322-325) and the DNG Speci
 
 from __future__ import annotations
 
-import struct
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import BinaryIO
 
-from rti_rig.drivers.cameras.tiff_structure import MAX_TAGS, header_size
+from rti_rig.drivers.cameras.tiff_ifd import (
+    MAX_TAGS,
+    Layout,
+    read_count,
+    read_entries,
+    read_header,
+    read_values,
+)
 
 #: DNG compressions (DNG 1.7.1 §"Compression") LibRaw 0.22 decodes in any build: none,
 #: lossless JPEG, Deflate, lossy JPEG
@@ -36,10 +49,14 @@ LIBRAW_DNG = (1, 7)
 #: what lays a CFA mosaic out (TIFF/EP): without them LibRaw fills the pattern from memory
 #: it never set, a different one at each read
 CFA_TAGS = {33421: "CFARepeatPatternDim", 33422: "CFAPattern"}
-_TYPES = {1: ("B", 1), 3: ("H", 2), 4: ("I", 4), 13: ("I", 4)}  # BYTE, SHORT, LONG, IFD
 #: values read of one integer tag at most (the most, StripOffsets of a strip per row, has a
 #: sensor's rows); a larger count is damage, read as a tag given no value
 _MAX_VALUES = 1 << 16
+#: the tags whose values are read (any other's, a DNGPrivateData or XMP of hundreds of KB
+#: among them, are never read): NewSubFileType, ImageWidth, ImageLength, BitsPerSample,
+#: Compression, PhotometricInterpretation, StripOffsets, StripByteCounts, TileOffsets,
+#: TileByteCounts, SubIFDs, the CFA tags, DNGVersion, DNGBackwardVersion
+_READ = frozenset({254, 256, 257, 258, 259, 262, 273, 279, 324, 325, 330, *CFA_TAGS, 50706, 50707})
 
 
 @dataclass
@@ -55,42 +72,41 @@ class DngTags:
     compression: int | None = None
 
 
-def _ifd(data: bytes, order: str, offset: int) -> tuple[dict[int, tuple[int, ...]], int] | None:
-    """IFD at ``offset``: {tag: values} of the integer tags, and the next IFD's offset."""
-    if offset < 8 or offset + 2 > len(data):
+def _ifd(f: BinaryIO, layout: Layout, offset: int, size: int) -> dict[int, tuple[int, ...]] | None:
+    """{tag: values} of the integer tags of :data:`_READ` in the IFD at ``offset``, all of it
+    in the ``size`` bytes of ``f``; None where there is no such IFD. A tag whose values lie
+    past the end reads as given none (``()``); one of another type or an absurd count too,
+    unless an entry before it of the same tag gave values."""
+    if offset < layout.header:
         return None
-    (count,) = struct.unpack_from(order + "H", data, offset)
-    end = offset + 2 + 12 * count
-    if not 1 <= count <= MAX_TAGS or end + 4 > len(data):
+    count = read_count(f, layout, offset)
+    if count is None or not 1 <= count <= MAX_TAGS or layout.ifd_end(offset, count) > size:
+        return None
+    entries = read_entries(f, layout, offset, count)
+    if len(entries) < count:  # the file shrank while read (rewritten in place)
         return None
     tags: dict[int, tuple[int, ...]] = {}
-    for n in range(count):
-        tag, typ, many = struct.unpack_from(order + "HHI", data, offset + 2 + 12 * n)
-        if typ not in _TYPES or many > _MAX_VALUES:
-            tags.setdefault(tag, ())
+    for entry in entries:
+        if entry.tag not in _READ:
             continue
-        code, size = _TYPES[typ]
-        at = offset + 2 + 12 * n + 8
-        if size * many > 4:
-            (at,) = struct.unpack_from(order + "I", data, at)
-        if at + size * many > len(data):
-            tags[tag] = ()
-            continue
-        tags[tag] = struct.unpack_from(f"{order}{many}{code}", data, at)
-    (after,) = struct.unpack_from(order + "I", data, end)
-    return tags, after
+        values = read_values(f, layout, entry, size, _MAX_VALUES)
+        if values is None:
+            tags.setdefault(entry.tag, ())
+        else:
+            tags[entry.tag] = values
+    return tags
 
 
 def _main_image(
-    data: bytes, order: str, first: dict[int, tuple[int, ...]]
+    f: BinaryIO, layout: Layout, size: int, first: dict[int, tuple[int, ...]]
 ) -> dict[int, tuple[int, ...]] | None:
     """The IFD of the full-resolution raw image: the first of IFD 0 and its SubIFDs whose
     NewSubFileType is 0 (TIFF's default when the tag is absent)."""
     candidates = [first]
     for offset in first.get(330, ()):
-        sub = _ifd(data, order, offset)
+        sub = _ifd(f, layout, offset, size)
         if sub is not None:
-            candidates.append(sub[0])
+            candidates.append(sub)
     for tags in candidates:
         if tags.get(254, (0,))[:1] == (0,):
             return tags
@@ -99,20 +115,27 @@ def _main_image(
 
 def read_dng_tags(path: Path) -> DngTags | None:
     """``path``'s DNG tags, or None when it is no classic TIFF naming a DNGVersion in IFD 0
-    (another RAW format, or not a TIFF at all), or cannot be read."""
+    (another RAW format, a BigTIFF, or not a TIFF at all), or cannot be read.
+
+    Only the header, the IFDs and the values of :data:`_READ` are read (a few hundred bytes
+    of a DNG of tens of MB: this is asked of every decode), each where it lies."""
     try:
-        data = path.read_bytes()
+        with path.open("rb") as f:
+            return _read_dng_tags(f, os.fstat(f.fileno()).st_size)
     except OSError:
         return None
-    if header_size(data) != 8 or len(data) < 8:  # not a TIFF, a BigTIFF, or a header cut
+
+
+def _read_dng_tags(f: BinaryIO, size: int) -> DngTags | None:
+    named = read_header(f)
+    if named is None or named[0].header != 8:  # not a TIFF, a BigTIFF, or a header cut
         return None
-    order = "<" if data[:2] == b"II" else ">"
-    first = _ifd(data, order, struct.unpack_from(order + "I", data, 4)[0])
-    if first is None or len(first[0].get(50706, ())) != 4:
+    layout, offset = named
+    ifd0 = _ifd(f, layout, offset, size)
+    if ifd0 is None or len(ifd0.get(50706, ())) != 4:
         return None
-    ifd0 = first[0]
     found = DngTags(version=ifd0[50706], backward=ifd0.get(50707) or None)
-    main = _main_image(data, order, ifd0)
+    main = _main_image(f, layout, size, ifd0)
     if main is None:
         found.damage.append("none of its IFDs is marked as the main image (NewSubFileType 0)")
         return found
@@ -131,7 +154,7 @@ def read_dng_tags(path: Path) -> DngTags | None:
     offsets, counts = main.get(273) or main.get(324), main.get(279) or main.get(325)
     if not offsets or not counts or len(offsets) != len(counts):
         found.damage.append("its main image names no data (strip or tile offsets and counts)")
-    elif any(o + c > len(data) for o, c in zip(offsets, counts, strict=True)):
+    elif any(o + c > size for o, c in zip(offsets, counts, strict=True)):
         found.damage.append("its main image's data runs past the end of the file")
     if photometric and photometric[0] == 32803:
         lost = [name for tag, name in CFA_TAGS.items() if not main.get(tag)]

@@ -13,32 +13,20 @@ the file, with a tag count no writer in the middle of its work leaves.
 
 from __future__ import annotations
 
-import struct
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO
 
-#: (byte order, the version word) -> (header size, IFD tag-count size, entry size, offset size)
-_LAYOUTS = {
-    b"II*\x00": ("<", 8, 2, 12, 4),
-    b"MM\x00*": (">", 8, 2, 12, 4),
-    b"II+\x00": ("<", 16, 8, 20, 8),
-    b"MM\x00+": (">", 16, 8, 20, 8),
-}
+from rti_rig.drivers.cameras.tiff_ifd import (
+    MAX_TAGS,
+    TIFF_TYPES,
+    header_size,
+    read_count,
+    read_entries,
+    read_header,
+)
 
-#: the data types a TIFF entry may have (TIFF 6.0's 1-12, IFD 13, BigTIFF's 16-18; 14 UNICODE
-#: and 15 COMPLEX, which tifffile's DATATYPE and LibRaw know and some writers' private tags use)
-TIFF_TYPES = frozenset({*range(1, 19)})
-
-#: more tags than any writer uses: tifffile refuses an IFD with more as "suspicious"
-MAX_TAGS = 4096
-
-
-def header_size(head: bytes) -> int | None:
-    """The size of the header a file beginning with ``head`` has (8 bytes, 16 for BigTIFF);
-    None when ``head`` does not begin with a TIFF signature."""
-    layout = _LAYOUTS.get(bytes(head[:4]))
-    return None if layout is None else layout[1]
+#: re-exported: what a TIFF's bytes are is read in one place (:mod:`.tiff_ifd`)
+__all__ = ["MAX_TAGS", "TIFF_TYPES", "FirstIfd", "first_ifd", "header_size", "ifd_garbage"]
 
 
 @dataclass(frozen=True)
@@ -58,25 +46,6 @@ class FirstIfd:
         return any(t != 0 and t not in TIFF_TYPES for t in self.types)
 
 
-def _first_ifd_named(f: BinaryIO) -> tuple[tuple[str, int, int, int, int], int] | None:
-    """The layout of the TIFF open as ``f`` (read from its start) and the offset its header
-    names for the first IFD; None when it does not begin with a TIFF signature or its header
-    is not all there. One reading of the header for :func:`first_ifd` and
-    :func:`ifd_garbage`, which judge what lies at that offset differently."""
-    head = f.read(16)
-    layout = _LAYOUTS.get(head[:4])
-    if layout is None:
-        return None
-    order, header = layout[0], layout[1]
-    if len(head) < header:
-        return None
-    if header == 8:
-        (offset,) = struct.unpack(f"{order}I", head[4:8])
-    else:
-        (offset,) = struct.unpack(f"{order}Q", head[8:16])
-    return layout, offset
-
-
 def first_ifd(path: Path) -> FirstIfd | None:
     """``path``'s first IFD when its header names one (a non-zero offset) lying wholly inside
     the file with a tag count between 1 and :data:`MAX_TAGS`; None otherwise.
@@ -88,29 +57,24 @@ def first_ifd(path: Path) -> FirstIfd | None:
     try:
         size = path.stat().st_size
         with path.open("rb") as f:
-            named = _first_ifd_named(f)
+            named = read_header(f)
             if named is None:
                 return None
-            (order, header, count_size, entry_size, offset_size), offset = named
-            if offset < header or offset + count_size > size:
+            layout, offset = named
+            if offset < layout.header or offset + layout.count_size > size:
                 return None
-            f.seek(offset)
-            raw = f.read(count_size)
-            if len(raw) < count_size:
+            count = read_count(f, layout, offset)
+            if count is None:
                 return None
-            (count,) = struct.unpack(f"{order}{'H' if count_size == 2 else 'Q'}", raw)
-            end = offset + count_size + count * entry_size + offset_size
+            end = layout.ifd_end(offset, count)
             if not 1 <= count <= MAX_TAGS or end > size:
                 return None
-            entries = f.read(count * entry_size)
+            entries = read_entries(f, layout, offset, count)
     except OSError:
         return None
-    if len(entries) < count * entry_size:
+    if len(entries) < count:
         return None
-    types = tuple(
-        struct.unpack_from(f"{order}H", entries, n * entry_size + 2)[0] for n in range(count)
-    )
-    return FirstIfd(offset, end, types)
+    return FirstIfd(offset, end, tuple(e.type for e in entries))
 
 
 def ifd_garbage(path: Path) -> str | None:
@@ -135,10 +99,11 @@ def ifd_garbage(path: Path) -> str | None:
     try:
         size = path.stat().st_size
         with path.open("rb") as f:
-            named = _first_ifd_named(f)
+            named = read_header(f)
             if named is None:
                 return None
-            (order, header, count_size, entry_size, offset_size), offset = named
+            layout, offset = named
+            header, count_size = layout.header, layout.count_size
             if 0 < offset < header:
                 return (
                     f"its header names its first IFD at byte {offset}, inside the "
@@ -146,11 +111,9 @@ def ifd_garbage(path: Path) -> str | None:
                 )
             if offset == 0 or offset + count_size > size:
                 return None  # none named yet (libtiff), or past the end (a copy cut short)
-            f.seek(offset)
-            raw = f.read(count_size)
-            if len(raw) < count_size:
+            count = read_count(f, layout, offset)
+            if count is None:
                 return None
-            (count,) = struct.unpack(f"{order}{'H' if count_size == 2 else 'Q'}", raw)
             if count == 0:
                 # TIFF 6.0 (p. 14): "each IFD must have at least one entry", and libtiff
                 # refuses a count of 0; a writer's IFD not written yet is zeros throughout
@@ -158,7 +121,7 @@ def ifd_garbage(path: Path) -> str | None:
                 # slot to wait for only while the first entry and next-IFD offset after it
                 # read as zeros too. Written bytes there (pixel data under a header that
                 # names the wrong offset) will not turn into an IFD.
-                if any(f.read(entry_size + offset_size)):
+                if any(f.read(layout.entry_size + layout.offset_size)):
                     return (
                         f"its first IFD, at byte {offset}, gives a tag count of 0, which no "
                         "finished IFD has, while the bytes after it are written, where an IFD "
@@ -170,7 +133,7 @@ def ifd_garbage(path: Path) -> str | None:
                     f"its first IFD, at byte {offset}, gives a tag count of {count}, more than "
                     f"any writer writes ({MAX_TAGS}); a writer's IFD not written yet reads 0"
                 )
-            in_file = (size - offset - count_size) // entry_size
+            in_file = (size - offset - count_size) // layout.entry_size
             if count <= in_file:
                 # a whole IFD: an entry of a type this reader does not know is the decode's to
                 # judge (TIFF 6.0 tells readers to skip such fields; tifffile does, and reads
@@ -178,15 +141,14 @@ def ifd_garbage(path: Path) -> str | None:
                 return None
             # the entries that are in the file of an IFD that runs past its end (a copy cut
             # short holds only the first ones, each as its writer wrote it)
-            entries = f.read(in_file * entry_size)
+            entries = read_entries(f, layout, offset, in_file)
     except OSError:
         return None
-    for n in range(len(entries) // entry_size):
-        (kind,) = struct.unpack_from(f"{order}H", entries, n * entry_size + 2)
-        if kind != 0 and kind not in TIFF_TYPES:
+    for n, entry in enumerate(entries):
+        if entry.type != 0 and entry.type not in TIFF_TYPES:
             return (
-                f"entry {n + 1} of its first IFD, at byte {offset}, has data type {kind}, "
-                "which no TIFF has"
+                f"entry {n + 1} of its first IFD, at byte {offset}, has data type "
+                f"{entry.type}, which no TIFF has"
             )
     return None
 

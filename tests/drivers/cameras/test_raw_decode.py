@@ -467,3 +467,68 @@ def test_file_colour_matrix_takes_a_camera_back_to_srgb():
     assert f.metadata["decode"]["color_space"].startswith("linear sRGB")
     cam = decode_raw(data, RawDecodeSettings(output_color="raw"))
     np.testing.assert_allclose(cam.pixels[16, 24] / 65535, a @ srgb, rtol=1e-3)
+
+
+def test_a_decode_reads_only_the_dngs_structure_of_its_own_accord(tmp_path, monkeypatch):
+    """Whether a DNG's CFAPattern is lost is asked of every decode, and its tags had been read
+    from the whole file read into memory (48 MB of a 24-MP DNG, per image): of a 12 MB DNG, at
+    most one read buffer's worth is read through Python (LibRaw reads the file itself, in C),
+    and the tags read are the file's, as a damaged copy of it shows."""
+    from pathlib import Path
+
+    from rti_rig.drivers.cameras.dng_tags import dng_refusal, read_dng_tags
+
+    mosaic = linear_to_mosaic(np.full((2000, 3000), 0.3), "RGGB", BLACK, WHITE)
+    path = write_dng(tmp_path / "big.dng", mosaic, black_level=BLACK, white_level=WHITE)
+    size = path.stat().st_size
+    assert size > 10_000_000
+    read = [0]
+    real_open = Path.open
+
+    class Counted(io.RawIOBase):
+        def __init__(self, raw):
+            self.raw = raw
+
+        def readable(self):
+            return True
+
+        def seekable(self):
+            return True
+
+        def seek(self, *args):
+            return self.raw.seek(*args)
+
+        def readinto(self, b):
+            n = self.raw.readinto(b)
+            read[0] += n or 0
+            return n
+
+        def fileno(self):
+            return self.raw.fileno()
+
+        def close(self):
+            self.raw.close()
+            super().close()
+
+    def counted(self, mode="r", *args, **kwargs):
+        if "b" in mode and not set("wax+") & set(mode):
+            return io.BufferedReader(Counted(real_open(self, mode, buffering=0)))
+        return real_open(self, mode, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "open", counted)
+    frame = decode_raw(path, MOSAIC)
+    assert frame.pixels.shape == mosaic.shape
+    assert read[0] <= 16384, read[0]
+    assert read_dng_tags(path).damage == []
+    # its StripByteCounts said to run a byte past the file's end: read where the tag lies
+    data = bytearray(path.read_bytes())
+    monkeypatch.setattr(Path, "open", real_open)
+    for n in range(int.from_bytes(data[8:10], "little")):
+        at = 10 + 12 * n
+        if int.from_bytes(data[at : at + 2], "little") == 279:
+            data[at + 8 : at + 12] = (size + 1).to_bytes(4, "little")
+    path.write_bytes(bytes(data))
+    read[0] = 0
+    monkeypatch.setattr(Path, "open", counted)
+    assert "its main image's data runs past the end of the file" in dng_refusal(path)
+    assert read[0] <= 16384, read[0]
