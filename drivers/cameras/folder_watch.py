@@ -80,6 +80,7 @@ from rti_rig.drivers.cameras.image_io import (
 from rti_rig.drivers.cameras.raw_decode import (
     DECODER,
     DamagedRawError,
+    MonochromeRawError,
     RawDecodeError,
     RawFileMissingError,
     UnsupportedRawError,
@@ -1069,7 +1070,9 @@ class FolderWatchCamera:
                     message = exc.about(path)
                 else:
                     message = exc.message
-                if isinstance(exc, UnsupportedRawError | DamagedRawError) and _has_header(path):
+                if isinstance(
+                    exc, UnsupportedRawError | DamagedRawError | MonochromeRawError
+                ) and _has_header(path):
                     raise CaptureError(
                         self.name,
                         f"{message}. The file is whole (its size steady over "

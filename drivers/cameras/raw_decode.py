@@ -161,6 +161,16 @@ class DamagedRawError(RawDecodeError):
     watched folder says so at once instead of waiting ``timeout_s`` for it to change."""
 
 
+class MonochromeRawError(RawDecodeError):
+    """A whole RAW file of a sensor without a colour filter (a monochrome camera), which no
+    decode mode here turns into the session's images.
+
+    Why a class of its own: like :class:`UnsupportedRawError`, waiting will not change it; a
+    watched folder says so at once. Such a file (a LinearRaw DNG of one sample, as monochrome
+    bodies write) had been refused as a damaged CFA ("copy the shot again from the camera's
+    card"), advice no copy can follow, and the setting to change went unsaid."""
+
+
 class RawFileMissingError(RawDecodeError):
     """The RAW file to decode is not there (``path``: the file looked for).
 
@@ -520,6 +530,7 @@ def decode_raw(
                 else [int(v) for v in per_channel_white]
             )
             other = raw.other
+            colours_sensed = int(raw.num_colors)
     except rawpy.LibRawFileUnsupportedError as exc:
         # a body newer than the bundled LibRaw (a new Canon CR3 or Fujifilm RAF, say) gives
         # this, a truncated download a data or I/O error: "is it a complete download?" had
@@ -566,6 +577,8 @@ def decode_raw(
         ) from exc
     if raw_vis.ndim != 2:
         raise RawDecodeError(read, "not a single-plane CFA RAW")
+    if colours_sensed == 1:  # LibRaw: one colour, no CFA (its colour codes then mean nothing)
+        raise MonochromeRawError(read, _monochrome_refusal(settings.mode))
     if white <= int(black_pc.max()):
         raise RawDecodeError(
             read, f"white level {white} is not above the black levels {black_pc.tolist()}"
@@ -682,6 +695,30 @@ def decode_raw(
     if dark is not None:
         frame = subtract_dark(frame, dark, settings.underexposed_level)
     return frame
+
+
+def _monochrome_refusal(mode: str) -> str:
+    """What to say of a monochrome sensor's RAW decoded in ``mode``, naming what to change.
+
+    Why refused in every mode: ``"demosaic"`` and ``"half"`` make colour images of a colour
+    filter's photosites, and a session's images are of one kind (colour or grey) fixed by its
+    first; ``"mosaic"`` labels its images CFA mosaics, which ``rti-rig fit`` refuses and
+    export-lp warns of, though a monochrome sensor's are grey pictures. A grey TIFF is what
+    the session takes as a grey picture."""
+    kind = (
+        "a grey picture, while this camera is set to make colour images "
+        f'([camera.device.decode] mode = "{mode}"), and a session\'s images are all of one '
+        "kind"
+        if mode != "mosaic"
+        else 'a grey picture, which mode = "mosaic" would label a colour-filter mosaic (one '
+        "colour per pixel, refused by rti-rig fit)"
+    )
+    return (
+        "it is a monochrome sensor's file (LibRaw reads one colour and no colour filter array): "
+        f"{kind}. No RAW decode mode here takes it: save the shots as 16-bit grey TIFFs (the "
+        'camera\'s program or a RAW converter) and watch those (patterns = ["*.tif"] in '
+        "[camera.device]), which make a grey session, or shoot with a colour camera"
+    )
 
 
 def _cfa_refusal(colors: NDArray[np.integer], desc: str, mode: str) -> str | None:

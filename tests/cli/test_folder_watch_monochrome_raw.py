@@ -1,0 +1,84 @@
+"""A monochrome camera's DNG (LinearRaw, one sample: no colour filter) saved into the watched
+folder of the shipped folder-watch dome, which is set to make colour images (its
+``[camera.device.decode] mode = "demosaic"``): ``rti-rig run`` refuses it at once, as a grey
+picture where the camera is set for colour, naming the setting and what to do instead.
+
+LibRaw reads such a file as one colour with colour codes that mean nothing (6): it had been
+refused as a colour filter array whose "CFA tags are damaged or lost", with advice to copy the
+shot again from the card, which no copy can follow. The DNG comes from the tests' own writer
+(written from the TIFF and DNG specifications): PhotometricInterpretation 34892 (LinearRaw),
+SamplesPerPixel 1, no CFA tags.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import Tether, folder_watch_config, shipped_dome_on_pty
+from dng_spec_writer import ASCII, BYTE, LONG, SHORT, tiff_bytes
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+pytestmark = [
+    pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
+    pytest.mark.pty,
+]
+
+
+def _monochrome_dng(height: int = 32, width: int = 48) -> bytes:
+    """An uncompressed 16-bit monochrome DNG: a LinearRaw image of one sample per pixel."""
+    entries = {
+        254: (LONG, [0]),
+        256: (LONG, [width]),
+        257: (LONG, [height]),
+        258: (SHORT, [16]),
+        259: (SHORT, [1]),
+        262: (SHORT, [34892]),  # LinearRaw
+        271: (ASCII, ["SpecWriter"]),
+        272: (ASCII, ["monochrome test camera"]),
+        277: (SHORT, [1]),
+        278: (LONG, [height]),
+        284: (SHORT, [1]),
+        50706: (BYTE, [1, 4, 0, 0]),
+        50708: (ASCII, ["monochrome test camera"]),
+        50717: (LONG, [65535]),
+    }
+    return tiff_bytes(entries, np.full((height, width), 20000, "<u2").tobytes())
+
+
+def test_run_refuses_a_monochrome_cameras_dng_where_the_camera_is_set_for_colour(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    tether = tmp_path / "tether"
+    tether.mkdir()
+    out = tmp_path / "s"
+    cfg = folder_watch_config(tmp_path, tether)
+    assert 'mode = "demosaic"' in cfg.read_text(encoding="utf-8")  # a colour camera
+    data = _monochrome_dng()
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        camera = Tether(firmware, tether, [("IMG_0001.dng", data)])
+        camera.start()
+        try:
+            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            r = CliRunner().invoke(app, args, terminal_width=400)
+        finally:
+            camera.stop.set()
+            camera.join(5.0)
+        lit_at_end = firmware.lit_indices()
+    said = " ".join(r.output.split())
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said, said
+    assert f"{tether / 'IMG_0001.dng'}: " in said and ".incoming" not in said, said
+    assert "it is a monochrome sensor's file" in said, said
+    assert '[camera.device.decode] mode = "demosaic"' in said, said
+    assert 'patterns = ["*.tif"] in [camera.device]' in said, said
+    assert "damaged" not in said and "copy the shot again" not in said.lower(), said
+    assert "waiting will not help" in said and f"left in {tether}" in said, said
+    assert "did not change within" not in said, said  # not waited for
+    assert not list((out / "linear").glob("image_*.tif")), said
+    assert (tether / "IMG_0001.dng").read_bytes() == data  # left as the program saved it
+    assert lit_at_end == []  # the dome was switched off
