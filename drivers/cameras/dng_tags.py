@@ -11,7 +11,7 @@ photometric kind a raw image has, its data's place inside the file, and a compre
 specification names. Where all of that holds, nothing here can tell, and :func:`dng_refusal`
 says both possibilities.
 
-Asked of every decode (:func:`cfa_lost`), it reads only the header, the IFDs and the values of
+Asked of every decode (:func:`read_blind`), it reads only the header, the IFDs and the values of
 the tags above, by seeking to them (:mod:`~rti_rig.drivers.cameras.tiff_ifd`, the TIFF reader
 the folder watch's checks use too): it had read the whole file, 48 MB of a 24-MP DNG, per
 image.
@@ -69,6 +69,9 @@ class DngTags:
     damage: list[str] = field(default_factory=list)
     #: why its CFA cannot be laid out (a CFA image without CFAPattern), or None
     cfa_lost: str | None = None
+    #: why its picture's place in the file is not known (no StripOffsets or TileOffsets
+    #: entry at all), or None
+    data_lost: str | None = None
     compression: int | None = None
 
 
@@ -151,6 +154,8 @@ def _read_dng_tags(f: BinaryIO, size: int) -> DngTags | None:
     if not photometric or photometric[0] not in RAW_PHOTOMETRIC:
         said = photometric[0] if photometric else "missing"
         found.damage.append(f"its main image's PhotometricInterpretation is {said}")
+    if 273 not in main and 324 not in main:  # absent, not unreadable (a copy still coming)
+        found.data_lost = "its main image gives no StripOffsets or TileOffsets"
     offsets, counts = main.get(273) or main.get(324), main.get(279) or main.get(325)
     if not offsets or not counts or len(offsets) != len(counts):
         found.damage.append("its main image names no data (strip or tile offsets and counts)")
@@ -214,11 +219,30 @@ def dng_refusal(path: Path) -> str | None:
     )
 
 
-def cfa_lost(path: Path) -> str | None:
-    """Why ``path``, a DNG, has no CFA layout LibRaw can have read (as a phrase), or None.
+def read_blind(path: Path) -> str | None:
+    """Why LibRaw, which decodes ``path`` (a DNG) without a word, cannot have read the
+    picture taken from it (the sentence's clause after "it names itself a DNG, but"); None
+    when nothing its tags say shows that, or it is no DNG.
 
-    Why: LibRaw decodes a CFA DNG whose CFAPattern is lost without a word, its pattern taken
-    from memory it never set: one read made a picture of red photosites only, the next a
-    run-stopping IndexError. Only the file's tags can say the pattern LibRaw used is none."""
+    Why: LibRaw decodes a CFA DNG whose CFAPattern is lost with a pattern taken from memory
+    it never set (one read made a picture of red photosites only, the next a run-stopping
+    IndexError), and one whose StripOffsets entry is lost with its pixels read from bytes
+    that are not the picture's (measured, LibRaw 0.22.2: values 0 to 65535 of a picture of
+    1017 to 59970, with no error and nothing printed). Only the file's tags can say so. A
+    lost StripByteCounts alone is not said: LibRaw reads an uncompressed strip without it,
+    the picture as taken."""
     tags = read_dng_tags(path)
-    return None if tags is None else tags.cfa_lost
+    if tags is None:
+        return None
+    if tags.cfa_lost is not None:
+        return (
+            f"{tags.cfa_lost}: LibRaw would read it all the same, with a pattern of its own "
+            "guessing, and not the picture taken"
+        )
+    if tags.data_lost is not None:
+        return (
+            f"{tags.data_lost} (where its picture lies in the file): LibRaw would read it all "
+            "the same, its pixels from bytes that are not the picture's, and not the picture "
+            "taken"
+        )
+    return None

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError
-from rti_rig.drivers.cameras.dng_tags import cfa_lost, dng_refusal
+from rti_rig.drivers.cameras.dng_tags import dng_refusal, read_blind
 from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
 DECODER = "raw-decode"
@@ -500,13 +500,12 @@ def decode_raw(
     name, handle = _source(source)
     read = None if name == "<bytes>" else Path(name)
     printed: list[str] = []  # LibRaw's own lines, kept off the terminal (libraw_printed)
-    lost = None if read is None else cfa_lost(read)
-    if lost is not None:  # before LibRaw: what it makes of such a file differs at each read
+    blind = None if read is None else read_blind(read)
+    if blind is not None:  # before LibRaw, which decodes such a file without a word
         raise DamagedRawError(
             read,
-            f"it names itself a DNG, but {lost}: LibRaw would read it all the same, with a "
-            "pattern of its own guessing, and not the picture taken. The file is damaged: copy "
-            "the shot again from the camera's card",
+            f"it names itself a DNG, but {blind}. The file is damaged: copy the shot again "
+            "from the camera's card",
         )
     try:
         with (

@@ -1,5 +1,6 @@
 """A whole DNG that LibRaw refuses as "Unsupported file format or not RAW file" (or would
-read, its CFAPattern lost, with a pattern of its own guessing), saved into the watched folder
+read, its CFAPattern lost, with a pattern of its own guessing, or its StripOffsets lost, with
+pixels read from bytes that are not the picture's), saved into the watched folder
 of the shipped folder-watch dome (its framed board emulated on a pty, the camera and its
 tethering program a thread that saves the file at the first shutter pulse): ``rti-rig run``
 says what the file's own tags show.
@@ -8,7 +9,8 @@ LibRaw gives that one error (LIBRAW_FILE_UNSUPPORTED) both for a DNG whose tags 
 for one it cannot read because it is newer than LibRaw: every such file had been refused with
 "a camera newer than this LibRaw … Update rawpy", advice that cannot mend a damaged file. A
 DNG without CFAPattern had gone into the session as a picture of LibRaw's guessing (all red
-photosites at one read, an IndexError at another). The DNGs here come from the tests' own DNG
+photosites at one read, an IndexError at another), and one without StripOffsets as a picture of
+bytes that are not its own, without a word. The DNGs here come from the tests' own DNG
 writer (written from the TIFF and DNG specifications), each with one thing changed.
 """
 
@@ -47,6 +49,8 @@ def _changed(how: str) -> bytes:
         struct.pack_into("<H", data, _entry(data, 256), 250)
     elif how == "cfa pattern lost":  # decodes, with a pattern LibRaw guesses anew each read
         struct.pack_into("<H", data, _entry(data, 33422), 33000)
+    elif how == "strip offsets lost":  # decodes, its pixels read from where LibRaw guesses
+        struct.pack_into("<H", data, _entry(data, 273), 250)
     elif how == "jpeg xl":  # a DNG 1.7 compression this LibRaw build does not decode
         struct.pack_into("<H", data, _entry(data, 259) + 8, 52546)
     else:  # a compression code no DNG specification names: cannot be told from here
@@ -56,7 +60,8 @@ def _changed(how: str) -> bytes:
 
 
 @pytest.mark.parametrize(
-    "how", ["width tag lost", "cfa pattern lost", "jpeg xl", "unknown compression"]
+    "how",
+    ["width tag lost", "cfa pattern lost", "strip offsets lost", "jpeg xl", "unknown compression"],
 )
 def test_run_says_what_a_refused_dngs_own_tags_show(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, how: str
@@ -82,7 +87,7 @@ def test_run_says_what_a_refused_dngs_own_tags_show(
     assert f"{tether / 'IMG_0001.dng'}: " in said, said  # the folder's file, not the copy
     assert ".incoming" not in said, said
     assert "it names itself a DNG" in said, said
-    if how != "cfa pattern lost":  # LibRaw's own words: it refused the file
+    if how not in ("cfa pattern lost", "strip offsets lost"):  # LibRaw's words: it refused
         assert "Unsupported file format or not RAW file" in said, said
     assert "a camera newer than this LibRaw" not in said, said
     assert "waiting will not help" in said and f"left in {tether}" in said, said
@@ -92,6 +97,10 @@ def test_run_says_what_a_refused_dngs_own_tags_show(
         assert "pip install -U rawpy" not in said, said
     elif how == "cfa pattern lost":
         assert "its main image, a CFA mosaic, gives no CFAPattern" in said, said
+        assert "The file is damaged: copy the shot again" in said, said
+        assert "did not change within" not in said, said  # not waited for
+    elif how == "strip offsets lost":
+        assert "its main image gives no StripOffsets or TileOffsets" in said, said
         assert "The file is damaged: copy the shot again" in said, said
         assert "did not change within" not in said, said  # not waited for
     elif how == "jpeg xl":

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from rti_rig.core.errors import CaptureError
 from rti_rig.drivers.cameras.dng_writer import dng_bytes, linear_to_mosaic, write_dng
 from rti_rig.drivers.cameras.raw_decode import (
+    DamagedRawError,
     RawDecodeError,
     average_frames,
     decode_raw,
@@ -532,3 +533,37 @@ def test_a_decode_reads_only_the_dngs_structure_of_its_own_accord(tmp_path, monk
     monkeypatch.setattr(Path, "open", counted)
     assert "its main image's data runs past the end of the file" in dng_refusal(path)
     assert read[0] <= 16384, read[0]
+
+
+def _tag_renumbered(data: bytes, tag: int) -> bytes:
+    """``data`` (a little-endian DNG, IFD 0 at 8) with ``tag``'s number damaged (to 250)."""
+    out = bytearray(data)
+    for n in range(int.from_bytes(out[8:10], "little")):
+        at = 10 + 12 * n
+        if int.from_bytes(out[at : at + 2], "little") == tag:
+            out[at : at + 2] = (250).to_bytes(2, "little")
+            return bytes(out)
+    raise AssertionError(f"no tag {tag}")
+
+
+def test_a_dng_whose_strip_offsets_are_lost_is_refused_before_libraw_reads_it(tmp_path):
+    """LibRaw decodes a DNG whose StripOffsets entry is lost without an error or a line
+    printed, its pixels read from bytes that are not the picture's (shown here of LibRaw
+    itself): it had gone into the session as that picture. It is refused, by name, before
+    LibRaw reads it; a lost StripByteCounts alone, which LibRaw does without for an
+    uncompressed strip, still decodes as the picture taken."""
+    import rawpy
+
+    mosaic = random_mosaic(3)
+    whole = dng_bytes(mosaic, black_level=BLACK, white_level=WHITE)
+    lost = tmp_path / "offsets_lost.dng"
+    lost.write_bytes(_tag_renumbered(whole, 273))
+    with rawpy.imread(str(lost)) as raw:  # what LibRaw makes of it: not the picture
+        assert not np.array_equal(np.array(raw.raw_image_visible), mosaic)
+    with pytest.raises(DamagedRawError) as info:
+        decode_raw(lost, MOSAIC)
+    assert "gives no StripOffsets or TileOffsets" in info.value.problem
+    counts_lost = tmp_path / "counts_lost.dng"
+    counts_lost.write_bytes(_tag_renumbered(whole, 279))
+    frame = decode_raw(counts_lost, MOSAIC)
+    np.testing.assert_array_equal(frame.pixels, mosaic.astype(np.int64) - BLACK)
