@@ -12,9 +12,10 @@ got, so a file cut or shrinking meanwhile reads as "not there", never as an exce
 tifffile (a dependency) was measured on the files the tests pin and not used: it raises
 ``struct.error`` on a header cut short (not its own error), reads an IFD with a tag count of 0
 as an image of no pixels, refuses an IFD running past the file's end without saying what of it
-is there (what tells a copy cut short from garbage), and logs a warning (to the terminal,
-logging unset) for each damaged tag it skips. The judging stays with the callers, which are
-tolerant in different ways; this module only reads.
+is there (what tells a copy cut short from garbage), and logs a warning for each damaged tag
+it skips (the command line has to silence them). It reads lazily too, so it would have cost
+no fewer bytes. The judging stays with the callers, which are tolerant in different ways; this
+module only reads.
 
 Source: TIFF 6.0 (header, IFD, entry layout, types 1-12), BigTIFF (version 43, 8-byte counts
 and offsets, 20-byte entries, types 16-18).
