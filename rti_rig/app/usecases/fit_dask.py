@@ -19,8 +19,8 @@ band's Dask graph: nothing to set up) or the address of a ``dask scheduler``
 (``tcp://host:8786``). Workers must see the session
 files at the same paths as this machine; every error says so. They must run the same rti-rig
 too: a cluster whose workers run other code is refused before any task is sent
-(:mod:`rti_rig.app.usecases.worker_code`), and tasks go only to the workers so checked
-(:class:`Cluster`).
+(:mod:`rti_rig.app.usecases.worker_code`), and tasks go only to worker processes checked to run
+this code, those that join or restart later included (:class:`Cluster`).
 
 Whether a scheduler address can be used at all (parsed, looked up, TLS, a bounded first
 connection) is :mod:`rti_rig.app.usecases.scheduler_probe`'s. Dask is imported only in these
@@ -34,9 +34,10 @@ import os
 import socket
 import threading
 import time
+import uuid
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -80,6 +81,8 @@ from rti_rig.app.usecases.worker_code import (
     WorkerCode,
     describe,
     local_identity,
+    tag_for,
+    tagging_plugin,
     worker_identities,
 )
 from rti_rig.core.errors import RtiRigError
@@ -99,11 +102,15 @@ SCHEDULER_LOST = "scheduler-connection-lost"
 #: The reason given to the future of a band (or a batch's session) whose result could not be
 #: fetched from the worker that holds it, cancelled by :class:`_GatherWatch`.
 GATHER_FAILED = "rti-rig-result-unreachable"
-#: The reason given to the futures still to compute when every worker whose rti-rig was checked
-#: has left the cluster (:class:`_CheckedWatch`): the tasks may run on no other worker.
+#: The reason given to the futures still to compute when no worker checked to run this rti-rig
+#: has been in the cluster for :data:`CHECKED_GRACE_S` (:class:`_CheckedWatch`): the tasks may
+#: run on no other worker.
 CHECKED_GONE = "rti-rig-checked-workers-gone"
-#: Seconds between looks, while tasks are out, at whether a checked worker is left.
+#: Seconds between looks, while tasks are out, at whether a checked worker is there.
 CHECKED_POLL_S = 5.0
+#: Seconds without any checked worker before the fit stops: a worker restarted by its nanny
+#: (a memory kill) is away for the seconds its restart takes, then checked again as it joins.
+CHECKED_GRACE_S = 60.0
 #: Failed fetches of one result before the fit stops. Dask retries a failed fetch at once and
 #: for ever, logging "Couldn't gather N keys, rescheduling" each time (hundreds a second with
 #: a worker that answers the scheduler but not a fetch): one or two are a worker lost and its
@@ -196,59 +203,95 @@ def _unreachable(address: str, what: str, kept: str) -> str:
 
 @dataclass(frozen=True)
 class Cluster:
-    """A client of the Dask scheduler at ``address`` and the ``workers`` whose rti-rig was
-    checked (:func:`_refuse_other_code`) before any task was sent.
+    """A client of the Dask scheduler at ``address``, the ``workers`` whose rti-rig was
+    checked (:func:`_refuse_other_code`) before any task was sent, and the resource ``tag``
+    that every worker process checked to run this rti-rig holds
+    (:func:`rti_rig.app.usecases.worker_code.tagging_plugin`).
 
-    Why the workers: the check asks the workers there when the fit begins; one that joins
-    later (a worker restarted with another rti-rig, a colleague's added to the cluster) was
-    given tasks unchecked, which it cannot read or answers with its own code's fit. Every
-    task is restricted to the checked workers (:meth:`restrictions`), Dask's own
-    ``workers=`` / ``allow_other_workers=False``: a late worker is given none."""
+    Why a resource, not the addresses: a worker that joins later (restarted with another
+    rti-rig, a colleague's added) had been given tasks unchecked. Tasks were then kept to the
+    checked addresses, but an address is not a worker: one restarted by its nanny comes back
+    on another (the fit stopped, the same code there), one restarted on a fixed port with
+    other code has the same (it was given tasks). The tag is given by the worker process
+    itself, once its own code is found to be this one, as it joins; every task needs it
+    (:meth:`restrictions`)."""
 
     client: Any
     address: str
     workers: frozenset[str]
+    tag: str
 
     def restrictions(self) -> dict[str, Any]:
         """The keywords of ``Client.submit`` / ``Client.compute`` that keep a task to the
-        checked workers."""
-        return {"workers": sorted(self.workers), "allow_other_workers": False}
+        workers checked to run this rti-rig."""
+        return {"resources": {self.tag: 1}}
+
+
+def workers_by_tag(cluster: Cluster) -> tuple[set[str], set[str]]:
+    """The workers of the cluster now that hold :attr:`Cluster.tag` (checked to run this
+    rti-rig) and those that do not (another rti-rig, or none)."""
+    workers = cluster.client.scheduler_info(n_workers=-1)["workers"]
+    tagged = {w for w, info in workers.items() if cluster.tag in (info.get("resources") or {})}
+    return tagged, set(workers) - tagged
 
 
 def checked_gone(cluster: Cluster, kept: str) -> str:
-    """What is said when every checked worker has left (their tasks wait for no one)."""
+    """What is said when no worker checked to run this rti-rig has been in the cluster for
+    :data:`CHECKED_GRACE_S` (the tasks wait for no one), naming the workers there, refused."""
+    try:
+        others = workers_by_tag(cluster)[1]
+    except Exception:  # the scheduler lost meanwhile: who is there is not known
+        others = set()
+    there = (
+        "the workers there now were refused, their rti-rig being another or none: "
+        + ", ".join(sorted(others))
+        if others
+        else "no worker is there now"
+    )
     return (
         f"the {len(cluster.workers)} worker(s) of the Dask cluster at {cluster.address!r} whose "
-        "rti-rig was checked when the fit began have all left it; workers that joined since "
-        "were not checked and are given no task of this fit, so it cannot go on: "
-        f"{kept}; run the same command again once the workers are back (each is checked then)"
+        "rti-rig was checked when the fit began have all left it, and no worker running this "
+        f"rti-rig ({describe(local_identity())}) joined in the {CHECKED_GRACE_S:.0f} s after; "
+        f"{there}. A worker is checked as it joins and given tasks only if it runs this same "
+        f"rti-rig, so the fit cannot go on: {kept}; run the same command again once workers "
+        "running this rti-rig are back"
     )
 
 
 class _CheckedWatch:
-    """Cancels the tracked futures, with the reason :data:`CHECKED_GONE`, once none of the
-    checked workers is left: a task restricted to them (:meth:`Cluster.restrictions`) would
-    otherwise wait, and the fit with it, for ever. Looks every :data:`CHECKED_POLL_S`
-    seconds in a thread of its own, stopped at the end of the block."""
+    """Cancels the tracked futures, with the reason :data:`CHECKED_GONE`, once no worker
+    checked to run this rti-rig (holding :attr:`Cluster.tag`) has been in the cluster for
+    :data:`CHECKED_GRACE_S`: a task that needs one (:meth:`Cluster.restrictions`) would
+    otherwise wait, and the fit with it, for ever. Looks every :data:`CHECKED_POLL_S` seconds
+    in a thread of its own, stopped at the end of the block."""
 
-    def __init__(self, cluster: Cluster, watch: _GatherWatch) -> None:
+    def __init__(
+        self, cluster: Cluster, watch: _GatherWatch, clock: Callable[[], float] = time.monotonic
+    ) -> None:
         self.cluster = cluster
         self.watch = watch
+        self.clock = clock
         self.stop = threading.Event()
         self.gone = False
         self.thread = threading.Thread(target=self._run, name="rti-rig-checked", daemon=True)
 
-    def _present(self) -> set[str]:
+    def _tagged_present(self) -> bool:
         try:
-            return set(self.cluster.client.scheduler_info()["workers"])
+            return bool(workers_by_tag(self.cluster)[0])
         except Exception:  # the scheduler lost: said by the waiting code, in its words
-            return set(self.cluster.workers)
+            return True
 
     def _run(self) -> None:
         cancelled: set[Any] = set()
+        absent_since: float | None = None
         while not self.stop.wait(CHECKED_POLL_S):
-            if not self.gone and not self._present() & self.cluster.workers:
-                self.gone = True
+            if not self.gone:
+                if self._tagged_present():
+                    absent_since = None
+                else:
+                    now = self.clock()
+                    absent_since = now if absent_since is None else absent_since
+                    self.gone = now - absent_since >= CHECKED_GRACE_S
             if self.gone:  # and again at each look: a task sent meanwhile waits too
                 waiting = [
                     f
@@ -307,7 +350,20 @@ def scheduler_client(address: str) -> Iterator[Cluster | None]:
                 f"{WORKERS_TIMEOUT_S:.0f} s: start some with `dask worker {address}`; "
                 f"{SHARED_PATHS}."
             ) from None
-        yield Cluster(client, address, _refuse_other_code(client, address))
+        checked = _refuse_other_code(client, address)
+        mine = local_identity()
+        plugin_name = f"rti-rig-code-check-{uuid.uuid4().hex}"  # this fit's, removed after it
+        try:
+            # A worker lost during the registration fails it (Dask's CommClosedError), but the
+            # scheduler keeps the plugin before telling the workers, so every worker that joins
+            # is still checked; one lost now is not tagged, given no task. A scheduler lost is
+            # said by the waiting code, and no tagged worker by _CheckedWatch, in their words.
+            with suppress(Exception):
+                client.register_plugin(tagging_plugin(mine), name=plugin_name)
+            yield Cluster(client, address, checked, tag_for(mine))
+        finally:
+            with suppress(Exception):  # the scheduler lost: it took the plugin with it
+                client.unregister_worker_plugin(plugin_name)
     finally:
         _close_quietly(client)
 

@@ -149,3 +149,68 @@ def describe(code: WorkerCode) -> str:
         return f"no rti-rig ({code.problem})"
     version = "(no version)" if code.version is None else code.version
     return f"rti-rig {version}, code {code.fingerprint}"
+
+
+#: The Dask resource a worker holds once its own rti-rig was found to be this code
+#: (:func:`tagging_plugin`), followed by the code's fingerprint; every task of a fit needs one
+#: unit of it. The amount held is large so that it limits nothing but who may run the task.
+TAG_PREFIX = "rti-rig-code-"
+TAG_AMOUNT = 1_000_000.0
+
+
+def tag_for(code: WorkerCode) -> str:
+    """The resource name of ``code`` (its fingerprint): tasks asking for it run only on a
+    worker process whose own rti-rig was checked to be this code."""
+    return f"{TAG_PREFIX}{code.fingerprint}"
+
+
+def tagging_plugin(code: WorkerCode) -> Any:
+    """A Dask ``WorkerPlugin`` that, on every worker it is set up on — those there when it is
+    registered and every one that joins or restarts later, before that worker takes any task —
+    computes that worker's own rti-rig and, only if it is ``code``, gives the worker the
+    resource :func:`tag_for` names.
+
+    Why: tasks had been kept to the checked workers by address. A worker restarted by its
+    nanny (after a memory kill) comes back on another address, and the fit stopped although
+    the same code was there; a worker restarted on the same fixed port with other code was
+    taken for the checked one and fitted with that code. The resource belongs to the worker
+    process that was checked, wherever it listens. The class is made here, nested, so that
+    ``cloudpickle`` sends it by value (as :func:`_identity_function`): a worker with another
+    rti-rig, or none, still reads it, and is simply not tagged.
+
+    Why the pause: Dask reconsiders a task no worker may run (``no-worker``) when a worker
+    joins or resumes, not when one gains a resource; the tagged worker pauses and resumes so
+    that tasks waiting for a tagged worker are given to it."""
+    from distributed import WorkerPlugin
+
+    expected = {"version": code.version, "fingerprint": code.fingerprint, "problem": None}
+    resource = tag_for(code)
+    identity = _identity_function()
+
+    class RtiRigCodeTag(WorkerPlugin):  # type: ignore[misc]  # untyped base
+        """Tags a worker running this rti-rig (see :func:`tagging_plugin`)."""
+
+        def __init__(self) -> None:
+            self.identity = identity
+            self.expected = expected
+            self.resource = resource
+            self.amount = TAG_AMOUNT
+
+        async def setup(self, worker: Any) -> None:
+            """Never raises: a worker whose check fails is left untagged, given no task (an
+            error here had failed the registration, and with it the fit, for every worker)."""
+            from distributed.core import Status
+
+            try:
+                if worker.state.total_resources.get(self.resource) == self.amount:
+                    return  # tagged already (by another fit of this code)
+                if self.identity() != self.expected:
+                    return  # other code (or none): never tagged, given no task of this fit
+                await worker.set_resources(**{self.resource: self.amount})
+                if worker.status == Status.running:
+                    worker.status = Status.paused
+                    worker.status = Status.running
+            except Exception:  # e.g. its scheduler lost meanwhile: untagged
+                return
+
+    return RtiRigCodeTag()
