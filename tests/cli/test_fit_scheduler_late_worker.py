@@ -316,5 +316,7 @@ def test_a_worker_restarted_by_its_nanny_on_a_new_address_goes_on_fitting(
     assert len(first) == 1 and first[0] not in now, (first, now)  # it did restart elsewhere
     assert r.exit_code == 0, said
     assert said.count(": done") == 2 and "failed" not in said, said
+    (now_there,) = now
+    assert said.count(f"note: ran on the Dask worker at {now_there} (host ") == 2, said
     for n in names:
         assert (out / n / "fit.json").exists(), n

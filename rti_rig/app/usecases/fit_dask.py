@@ -572,7 +572,24 @@ def _fit_one_task(source: Path, root: Path, template: FitRequest, threads: int |
             f": {source} does not exist on worker host {socket.gethostname()}: {SHARED_PATHS}",
         )
     with _SESSION_LOCK, threadpool_limits(limits=threads, user_api="blas"):
-        return fit_one(source, root, template)
+        item = fit_one(source, root, template)
+    return replace(item, notes=(*item.notes, _ran_on()))
+
+
+def _ran_on() -> str:
+    """The note saying which worker ran a batch's session (run there). Why: tasks go to any
+    worker checked to run this rti-rig, those that join or restart later too, so the user is
+    told which one fitted each session."""
+    from distributed import get_worker
+
+    try:
+        address = get_worker().address
+    except ValueError:  # not in a worker (a test calling the task here)
+        address = "(not a worker)"
+    return (
+        f"ran on the Dask worker at {address} (host {socket.gethostname()}), checked to run "
+        f"this rti-rig ({describe(local_identity())})"
+    )
 
 
 def _finished_kept(sources: list[Path], given: list[tuple[Path, Path]], root: Path) -> str:
