@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from rti_rig.cli.app import app, err, fail, out
+from rti_rig.cli.app import app, err, fail, out, print_notes
 from rti_rig.core.errors import RtiRigError
 from rti_rig.core.out_folders import ensure_writable_folder, refuse_a_file_in_the_way
 
@@ -175,9 +175,11 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
         # empty --out folder behind
         try:
             from_lp = _acquisition_lp(from_lp)
-            check_acquisition(from_lp)
+            notes: list[str] = []
+            check_acquisition(from_lp, notes)
         except RtiRigError as exc:
             raise fail(exc) from None
+        print_notes(notes)
     if out_dir is not None:  # before minutes of computing, not after
         try:
             _check_out_folder(out_dir, force)

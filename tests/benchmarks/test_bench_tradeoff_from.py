@@ -478,3 +478,29 @@ def test_the_write_probe_leaves_a_users_files_in_out_alone(
     assert r.exit_code == 0 and "stand-in summary" in r.output, r.output
     assert seen == [sorted(mine)]  # the probe was there and gone before the trade-off ran
     assert {p.name: p.read_text() for p in out.iterdir()} == mine
+
+
+def test_what_the_tolerant_reader_did_to_the_lp_is_said_as_run_and_fit_say_it(
+    tmp_path: Path,
+) -> None:
+    """A count line that disagrees with the lines listed, and a light a hair below the horizon
+    (clamped to it), are kept and *said* by run, check, plan and fit, naming the file and the
+    line; `bench tradeoff --from` measured such a file in silence, the clamped light's
+    direction changed without a word."""
+    lp = _acquisition(tmp_path / "acq")
+    lines = lp.read_text().splitlines()
+    name, x, y, _z = lines[3].split()
+    flat = float(np.hypot(float(x), float(y)))  # its azimuth kept, at the horizon's noise
+    lines[0] = "11"  # 12 lights listed
+    lines[3] = f"{name} {float(x) / flat:.6f} {float(y) / flat:.6f} -0.002"
+    lp.write_text("\n".join(lines) + "\n")
+    r = CliRunner().invoke(app, ["bench", "tradeoff", "--from", str(lp)])
+    text = " ".join(r.output.split())
+    assert r.exit_code == 0, text
+    assert f"note: {lp}, line 1: count line says 11 lights but the file lists 12" in text, text
+    assert f"note: {lp}, line 4: light z = -0.0020 is a hair below the object plane" in text
+    assert "clamped to z = 0" in text
+    # the same words as fit of the same .lp (one reader, one wording)
+    fitted = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"])
+    assert fitted.exit_code == 0, fitted.output
+    assert f"{lp}, line 4: light z = -0.0020" in " ".join(fitted.output.split())
