@@ -97,7 +97,7 @@ def _too_few_lights(lp: Path, count: int) -> str | None:
     )
 
 
-def check_acquisition(lp: Path, notes: list[str] | None = None) -> None:
+def check_acquisition(lp: Path, notes: list[str] | None = None) -> list[Path]:
     """Refuse ``lp`` by name, as :func:`load_acquisition_colour` and
     :func:`run_tradeoff_from` would, without reading the pixels: for the command to say it
     before it creates its ``--out`` folder (an acquisition of too few lights had been refused
@@ -105,15 +105,18 @@ def check_acquisition(lp: Path, notes: list[str] | None = None) -> None:
 
     What the tolerant reader kept of a flawed file (a count line that disagrees, a light a hair
     below the horizon clamped to it) is appended to ``notes`` for the command to say, as
-    ``run``, ``check``, ``plan`` and ``fit`` say it: such a file had been measured in silence."""
+    ``run``, ``check``, ``plan`` and ``fit`` say it: such a file had been measured in silence.
+
+    Returns the image files, for the command to keep ``--out`` out of their folders."""
     from rti_rig.core.errors import RtiRigError
     from rti_rig.core.lp_format import read_lp
 
     entries = read_lp(lp, upper_hemisphere=True, notes=notes)
-    _image_files(lp, entries)
+    files = _image_files(lp, entries)
     too_few = _too_few_lights(lp, len(entries))
     if too_few is not None:
         raise RtiRigError(too_few)
+    return files
 
 
 def _image_files(lp: Path, entries: list[Any]) -> list[Path]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated
 
@@ -67,7 +68,9 @@ def bench_tradeoff(
     force: Annotated[
         bool,
         typer.Option(
-            "--force", help="Write into an --out folder that is not empty (replacing results)."
+            "--force",
+            help="Write into an --out folder that is not empty (replacing results); never "
+            "into a session's folder or the --from acquisition's own.",
         ),
     ] = False,
 ) -> None:
@@ -130,12 +133,16 @@ def _acquisition_lp(given: Path) -> Path:
     )
 
 
-def _check_out_folder(out_dir: Path, force: bool) -> None:
+def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = ()) -> None:
     """Refuse, before minutes of computing, a folder whose files the results would replace.
 
     A session folder (or one inside it) is refused even with ``--force``: nothing captured is
-    ever overwritten; any other folder that is not empty needs ``--force`` (a user's own
-    summary.md had been replaced without a word)."""
+    ever overwritten; so is a folder of the ``--from`` acquisition (``acquisition``: its .lp
+    and image files), where ``--force`` had put results.csv, summary.md and four PNG plots
+    among the recorded images (RTIBuilder imports a jpeg-exports folder's images whole). A
+    new folder inside it is written as ``run`` and ``fit`` write one. Any other folder that
+    is not empty needs ``--force`` (a user's own summary.md had been replaced without a
+    word)."""
     from rti_rig.runtime.session import MANIFEST
 
     # first, as it says a file given for a folder, or a folder the user may not look into
@@ -148,6 +155,12 @@ def _check_out_folder(out_dir: Path, force: bool) -> None:
                 f"--out {out_dir} is inside the session in {folder}; a session's folder is "
                 "never written into: choose another folder"
             )
+    if out_dir.resolve() in {p.resolve().parent for p in acquisition}:
+        raise RtiRigError(
+            f"--out {out_dir} holds the acquisition --from reads (its .lp or images): its "
+            "folder is never written into, even with --force; choose another folder (a new "
+            "one inside it will do)"
+        )
     if out_dir.is_dir() and any(out_dir.iterdir()) and not force:
         raise RtiRigError(
             f"--out {out_dir} is not empty: its results.csv, summary.md and plots would be "
@@ -170,19 +183,20 @@ def _tradeoff(out_dir: Path | None, quick: bool, from_lp: Path | None, force: bo
                 "your acquisition): drop --quick"
             )
         )
+    acquisition: list[Path] = []  # the --from .lp and its images: never written among
     if from_lp is not None:
         # its images before the --out folder is made: a refused acquisition had left an
         # empty --out folder behind
         try:
             from_lp = _acquisition_lp(from_lp)
             notes: list[str] = []
-            check_acquisition(from_lp, notes)
+            acquisition = [from_lp, *check_acquisition(from_lp, notes)]
         except RtiRigError as exc:
             raise fail(exc) from None
         print_notes(notes)
     if out_dir is not None:  # before minutes of computing, not after
         try:
-            _check_out_folder(out_dir, force)
+            _check_out_folder(out_dir, force, acquisition)
         except RtiRigError as exc:
             raise fail(exc) from None
     if from_lp is not None:

@@ -504,3 +504,38 @@ def test_what_the_tolerant_reader_did_to_the_lp_is_said_as_run_and_fit_say_it(
     fitted = CliRunner().invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"])
     assert fitted.exit_code == 0, fitted.output
     assert f"{lp}, line 4: light z = -0.0020" in " ".join(fitted.output.split())
+
+
+@pytest.mark.parametrize("where", ["lp", "images"])
+def test_the_acquisitions_own_folder_is_refused_as_out_even_with_force(
+    tmp_path: Path, where: str
+) -> None:
+    """`--out` the folder of the `--from` acquisition (its .lp's, or its images', as in
+    RTIBuilder's assembly-files/ and jpeg-exports/) with `--force` had written results.csv,
+    summary.md and four PNG plots among the recorded images (which RTIBuilder imports by
+    folder), as a session's folder is never written into: refused, nothing written."""
+    lp = _acquisition(tmp_path / "acq")
+    if where == "images":  # RTIBuilder's layout: absolute names, images in ../jpeg-exports
+        images = tmp_path / "acq" / "jpeg-exports"
+        images.mkdir()
+        lines = lp.read_text().splitlines()
+        for i, line in enumerate(lines[1:], start=1):
+            name, rest = line.split(maxsplit=1)
+            (lp.parent / name).rename(images / name)
+            lines[i] = f"H:\\RTI\\proj\\jpeg-exports\\{name} {rest}"
+        (tmp_path / "acq" / "assembly-files").mkdir()
+        lp.unlink()
+        lp = tmp_path / "acq" / "assembly-files" / "dirs.lp"
+        lp.write_text("\n".join(lines) + "\n")
+        out = images
+    else:
+        out = lp.parent
+    before = sorted(p.name for p in out.iterdir())
+    r = CliRunner().invoke(
+        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out), "--force"]
+    )
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert f"error: --out {out} holds the acquisition --from reads" in text, text
+    assert "even with --force" in text and "choose another folder" in text
+    assert sorted(p.name for p in out.iterdir()) == before
