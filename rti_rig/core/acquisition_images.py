@@ -17,6 +17,7 @@ from rti_rig.core.errors import ConfigError, SessionError
 from rti_rig.core.image_files import (
     header_layout,
     image_truncation,
+    is_camera_raw,
     read_image_any,
     tiff_sample_problem,
 )
@@ -117,6 +118,20 @@ def check_image_files(
             )
         )
     gone = set(missing)
+    # a camera's RAW files, from their names (no read decodes them): a DNG is a TIFF to the
+    # header reader, so they had passed as "undamaged and readable" and stopped the replay at
+    # its first capture, the fit at its first read, behind an OpenCV warning line
+    raw = [n for n in names if n not in gone and is_camera_raw(paths[n])]
+    if raw:
+        more = f" and {len(raw) - 5} more" if len(raw) > 5 else ""
+        problems.append(
+            f"{len(raw)} of {len(names)} image(s) beside it are camera RAW files "
+            f"({', '.join(raw[:5])}{more}), which rti-rig does not read as an acquisition's "
+            "images: develop them to 16-bit linear TIFFs (dcraw -4 -T, or RawTherapee or "
+            "darktable with a linear output profile) and list those in the .lp, or list the "
+            "camera's JPEGs"
+        )
+        gone.update(raw)
     present = [n for n in names if n not in gone]
     why_cut = {n: image_truncation(paths[n]) for n in present}
     damaged = [f"{name}: {why}" for name, why in why_cut.items() if why is not None]

@@ -26,6 +26,21 @@ JPEG_MAGIC = b"\xff\xd8"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 #: a TIFF's first bytes, little- and big-endian, then a BigTIFF's (tifffile reads both)
 TIFF_MAGIC = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
+#: Camera RAW file endings (the camera drivers' ``folder_watch.RAW_SUFFIXES``, which the core
+#: may not import; a test keeps the two alike). :func:`read_image_any` does not decode them:
+#: most are TIFF inside, so the header reader gives them a size (a DNG's, or the thumbnail
+#: that opens a NEF), and OpenCV then fails on the CFA data or reads that thumbnail.
+CAMERA_RAW_SUFFIXES = frozenset(
+    {
+        ".dng", ".cr2", ".cr3", ".crw", ".nef", ".nrw", ".arw", ".srf", ".sr2", ".orf",
+        ".rw2", ".raf", ".pef", ".srw", ".3fr", ".iiq", ".erf", ".kdc", ".mos", ".x3f",
+    }
+)  # fmt: skip
+
+
+def is_camera_raw(path: Path) -> bool:
+    """Whether ``path`` is named as a camera RAW file (see :data:`CAMERA_RAW_SUFFIXES`)."""
+    return Path(path).suffix.lower() in CAMERA_RAW_SUFFIXES
 
 
 def looks_like_image(raw: bytes) -> bool:

@@ -494,3 +494,40 @@ def test_a_resume_on_an_acquisition_whose_images_changed_is_refused(tmp_path: Pa
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert len(read_lp(out / "lights.lp")) == 8
+
+
+def test_an_acquisition_of_camera_raw_files_is_refused_by_check_run_and_fit_before_any_work(
+    tmp_path: Path,
+) -> None:
+    """An `.lp` listing the camera's RAW files (DNG here, written by the spec-based test
+    writer from the real acquisition's pixels) had passed `check` ("undamaged and readable": a
+    DNG is a TIFF to the header reader), then stopped `run` at its first capture (and `fit` at
+    its first read) behind an OpenCV warning line, "not an image OpenCV decodes". All three
+    now say up front that they are RAW files and what to give instead."""
+    from tests.dng_spec_writer import dng, mosaic_from_rgb
+
+    acq = tmp_path / "acq"
+    acq.mkdir()
+    lines = (ACQ / "dirs.lp").read_text().splitlines()
+    out_lines = [lines[0]]
+    for line in lines[1:]:
+        name, rest = line.split(maxsplit=1)
+        rgb = read_jpeg_rgb(ACQ / name).astype(np.float64) / 255.0
+        even = rgb[: rgb.shape[0] // 2 * 2, : rgb.shape[1] // 2 * 2]
+        stem = Path(name).stem
+        (acq / f"{stem}.dng").write_bytes(dng(mosaic_from_rgb(even, "RGGB", (0, 0, 0, 0), 65535)))
+        out_lines.append(f"{stem}.dng {rest}")
+    lp = acq / "dirs.lp"
+    lp.write_text("\n".join(out_lines) + "\n")
+    said = "18 of 18 image(s) beside it are camera RAW files (image01.dng, image05.dng"
+    checked = runner.invoke(app, ["check", str(lp)])
+    text = " ".join(checked.output.split())
+    assert checked.exit_code == 1 and "RESULT: FAIL" in text, text
+    assert said in text and "16-bit linear TIFF" in text, text
+    ran = runner.invoke(app, ["run", str(lp), "--out", str(tmp_path / "s"), "--lights", "6"])
+    ran_text = " ".join(ran.output.split())
+    assert ran.exit_code == 2 and said in ran_text, ran_text
+    assert "OpenCV" not in ran_text and not (tmp_path / "s").exists()
+    fitted = runner.invoke(app, ["fit", str(lp), "--out", str(tmp_path / "f"), "--no-qa"])
+    fit_text = " ".join(fitted.output.split())
+    assert fitted.exit_code == 2 and said in fit_text and "OpenCV" not in fit_text, fit_text
