@@ -156,11 +156,16 @@ class _BoardLight:
 
     The LED is lit at full light (no described firmware can dim one) times its own output
     (``[emulator] led_power`` / ``led_power_spread``: these had been accepted for a firmware
-    dome and ignored, so an on/off dome's uneven LEDs could not be rehearsed)."""
+    dome and ignored, so an on/off dome's uneven LEDs could not be rehearsed). An LED of
+    ``[emulator] dead_leds`` gives no light (it had been accepted and ignored here too, so a
+    dead LED could not be rehearsed on these domes); the board answers as for a working LED,
+    as these emulators model no current sensing (``reports_dead_leds`` concerns the project's
+    own protocols)."""
 
-    def __init__(self, board, geometry: DomeGeometry, link, power) -> None:  # type: ignore[no-untyped-def]
+    def __init__(self, board, geometry: DomeGeometry, link, power, dead=frozenset()) -> None:  # type: ignore[no-untyped-def]
         self._board, self._geometry, self._link = board, geometry, link
         self._power = power  # each emulated LED's output relative to nominal
+        self._dead = frozenset(dead)  # LEDs that give no light when switched on
 
     def _led(self) -> int | None:
         self._link.wait_delivered()  # what a UART would have delivered by now, whatever the load
@@ -177,7 +182,7 @@ class _BoardLight:
     @property
     def intensity(self) -> float:
         led = self._led()
-        return 0.0 if led is None else float(self._power[led])
+        return 0.0 if led is None or led in self._dead else float(self._power[led])
 
 
 def _build_emulated_firmware_dome(
@@ -225,7 +230,8 @@ def _build_emulated_firmware_dome(
             name=f"dome on {link.port} (emulated {serial.profile})",
         )
         power = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
-        camera = _simulated_camera(loaded, _BoardLight(board, geometry, link, power), clock)
+        light = _BoardLight(board, geometry, link, power, cfg.emulator.dead_leds)
+        camera = _simulated_camera(loaded, light, clock)
     except BaseException:
         stack.close()
         raise
