@@ -78,6 +78,7 @@ from rti_rig.reconstruct.qa_exposure import (
     exposure_off,
     exposure_ratios,
 )
+from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
 from rti_rig.reconstruct.signal_check import SAMPLE_PIXELS, every_image_black, sample_grid
 from rti_rig.reconstruct.stack import channel_mean, validate_lights
 
@@ -305,6 +306,15 @@ class ImageCheck:
     #: normal) and its image was dark where the fit said it would be lit: the object's own
     #: relief can shadow all it reaches, so its brightness is not judged (``gain_judged``).
     dark_below_surface: bool = False
+    #: True when its light lies above the fitted mean surface by less than the fit can place
+    #: that surface under the session's uneven lights (:attr:`QAReport.surface_margin_deg`)
+    #: and its image was dark: the light may lie below the real surface, so its brightness is
+    #: not judged (``gain_judged``).
+    dark_near_surface: bool = False
+    #: True when its light reaches no pixel of the object at n . l > 0.2 (a flat plate's
+    #: lights below 11.5°) and its image is no black frame, or could not be told from one:
+    #: its brightness is not judged (``gain_judged``).
+    faint_light: bool = False
     #: True when its image is brighter than predicted, as the images lit from its elevation are
     #: (:data:`BRIGHT_MATE_DEG`): the object's gloss there, not called a fault.
     bright_as_its_elevation: bool = False
@@ -382,6 +392,13 @@ class QAReport:
     #: The full-resolution window the per-image evidence comes from: (top, left, height,
     #: width) in pixels (:func:`_choose_crop`).
     crop: tuple[int, int, int, int] = (0, 0, 0, 0)
+    #: How far above the fitted mean surface (degrees) a dark image's light must lie to be
+    #: judged: the fit's uncertainty there under the session's light scatter
+    #: (:func:`~rti_rig.reconstruct.qa_surface.surface_margin_deg`); 0 with even lights.
+    surface_margin_deg: float = 0.0
+    #: From how many degrees above the object's mean surface a light that reaches it only at
+    #: n . l < 0.2 has its black frame told (:func:`qa_surface.faint_black_frame`).
+    faint_floor_deg: float = 0.0
 
     @property
     def caveats(self) -> list[str]:
@@ -402,7 +419,17 @@ class QAReport:
             unjudged = [c for c in self.images if not getattr(c, attr) and c.index not in flagged]
             below = [c.name for c in unjudged if attr == "gain_judged" and c.dark_below_surface]
             grazing = [c.name for c in unjudged if attr == "gain_judged" and c.grazing_unjudged]
-            skipped = [c.name for c in unjudged if c.name not in below and c.name not in grazing]
+            unsure = [c.name for c in unjudged if attr == "gain_judged" and c.dark_near_surface]
+            faint = [c.name for c in unjudged if attr == "gain_judged" and c.faint_light]
+            skipped = [c.name for c in unjudged if c.name not in below + grazing + unsure + faint]
+            if faint:
+                out.append(
+                    f"{label} not judged on {_names(faint)} (its light reaches the object too "
+                    "obliquely to judge how bright it is: nowhere at n · l above 0.2; a light "
+                    "that did not fire at all is still named from "
+                    f"{self.faint_floor_deg:.1f}° above the object's mean surface up, and "
+                    "could not be told on this object below that: check those LEDs fired)"
+                )
             if skipped:
                 why = (
                     f"its light reaches less than {DRIFT_MIN_LIT:.0%} of the object"
@@ -415,6 +442,17 @@ class QAReport:
                     f"{label} not judged on {_names(below)} (dark, but its light is at or below "
                     "the object's mean surface, where the object's own relief can shadow all it "
                     "reaches: a misfire cannot be told from that; check the LED fired)"
+                )
+            if unsure:
+                scatter = (
+                    f" ({self.light_scatter:.0%} RMS)" if np.isfinite(self.light_scatter) else ""
+                )
+                out.append(
+                    f"{label} not judged on {_names(unsure)} (dark, but its light lies less "
+                    f"than {self.surface_margin_deg:.0f}° above the object's mean surface as "
+                    f"fitted, and this session's uneven lights{scatter} "
+                    "let the fit place that surface no closer: the light may be below the "
+                    "real surface, so a misfire cannot be told from that; check the LED fired)"
                 )
             if grazing:
                 out.append(
@@ -541,6 +579,8 @@ class QAReport:
             "drift_note": self.drift_note,
             "caveats": self.caveats,
             "light_scatter": self.light_scatter,
+            "surface_margin_deg": self.surface_margin_deg,
+            "faint_floor_deg": self.faint_floor_deg,
             "light_note": self.light_note,
             "crop": list(self.crop),
             "thresholds": self.thresholds,
@@ -1551,6 +1591,8 @@ def assess(
                 misfit=float(ev.misfit[i]),
                 within_light_scatter=bool(within_scatter[i]),
                 dark_below_surface=bool(ev.dark_below_surface[i]),
+                dark_near_surface=bool(ev.dark_near_surface[i]),
+                faint_light=bool(ev.faint[i]),
                 grazing_unjudged=bool(ev.grazing_unjudged[i]),
                 bright_as_its_elevation=bool(
                     bright_as_mates[i] and _bright(float(ev.gain[i]), float(sat_frac[i]))
@@ -1608,6 +1650,8 @@ def assess(
         shift_note=shift_note,
         step_note=_elevation_step_note(refused_steps, names) if step is None else "",
         light_scatter=light_scatter,
+        surface_margin_deg=ev.surface_margin_deg,
+        faint_floor_deg=ev.faint_floor_deg,
         crop=(rs.start, cs.start, rs.stop - rs.start, cs.stop - cs.start),
     )
 
@@ -1712,6 +1756,15 @@ class _Evidence:
     swap_ratio: NDArray = field(default_factory=lambda: np.zeros(0))
     #: Dark images of a grazing light (:data:`GRAZING_DEG`) too little lit to judge.
     grazing_unjudged: NDArray = field(default_factory=lambda: np.zeros(0, bool))
+    #: Dark images whose light lies above the fitted mean surface by less than the fit's
+    #: uncertainty there (:func:`~rti_rig.reconstruct.qa_surface.surface_margin_deg`).
+    dark_near_surface: NDArray = field(default_factory=lambda: np.zeros(0, bool))
+    #: That uncertainty's margin, degrees (0 where the lights' scatter was not measured).
+    surface_margin_deg: float = 0.0
+    #: Images whose light reaches no pixel at n . l > 0.2, not named a black frame.
+    faint: NDArray = field(default_factory=lambda: np.zeros(0, bool))
+    #: From how many degrees above the mean surface a faint light's black frame is told.
+    faint_floor_deg: float = GRAZING_DIM_MIN_DEG
 
 
 def _evidence(
@@ -1798,15 +1851,38 @@ def _evidence(
     # a misfire (a bright one is still evidence it fired): its brightness is not judged.
     mean_n = ps.normals[valid].astype(np.float64).mean(axis=0) if valid.any() else np.zeros(3)
     below = (lt @ mean_n) <= 0.0 if np.any(mean_n) else np.zeros(n, bool)
+    over = _elevation_over(lt, mean_n)
+    # Uneven lights tilt the fitted surface (qa_surface): a dark image whose light lies
+    # within the fit's uncertainty of that surface may be of a light below the real one.
+    margin = surface_margin_deg(lt, mean_n, _light_scatter(gain, misfit)[0])
+    near_surface = ~below & (over < margin) & np.isfinite(lit_gain) & (lit_gain < DIM_GAIN)
+    # A light reaching the object only at n . l < 0.2 (no gain above): a black frame is
+    # still told where the prediction stands above the dark level, on a surface placed
+    # surely below the light (a flat plate's lights under 11.5°).
+    faint = ~below & ~np.isfinite(gain)  # no pixel its light reaches at n . l > 0.2
+    faint_floor = max(margin, GRAZING_DIM_MIN_DEG)
+    faint_judged = faint & (over >= faint_floor)
+    for i in np.flatnonzero(faint_judged):
+        shade = ps.normals @ lt[i].astype(np.float32)
+        med, top = faint_black_frame(
+            images[i],
+            rho * np.maximum(shade, 0.0),
+            valid & (shade > 0.0) & ~crop_sat[i],
+            dark,
+            max(10, int(DRIFT_MIN_LIT * valid.sum())),
+            DIM_PERCENTILE,
+        )
+        if top < NO_LIGHT_GAIN:  # a black frame: no light reached the object
+            gain[i], lit_gain[i] = med, top
+    faint &= ~np.isfinite(gain)  # ... and not named a black frame
     unjudged = below & np.isfinite(lit_gain) & (lit_gain < DIM_GAIN)
-    gain[unjudged] = lit_gain[unjudged] = np.nan
+    gain[unjudged | near_surface] = lit_gain[unjudged | near_surface] = np.nan
     nb_ratio = neighbour_ratio(gain, lt)
     nb_dark = below & np.isfinite(nb_ratio) & (nb_ratio <= NEIGHBOUR_DIM_RATIO)
     gain[nb_dark] = lit_gain[nb_dark] = nb_ratio[nb_dark] = np.nan
     # A grazing light (GRAZING_DEG) is judged on its bright end against its neighbours' bright
     # ends, not on its median (shadows) nor its bright end alone (a 0.2° light's reads 0.4).
-    over = _elevation_over(lt, mean_n)
-    grazing = ~below & (over < GRAZING_DEG)
+    grazing = ~below & ~near_surface & (over < GRAZING_DEG)
     top_ratio = neighbour_ratio(lit_gain, lt)
     grazing_dead = grazing & np.isfinite(lit_gain) & (lit_gain < NO_LIGHT_GAIN)
     median_dark = np.isfinite(nb_ratio) & (nb_ratio <= NEIGHBOUR_DIM_RATIO)
@@ -1819,7 +1895,7 @@ def _evidence(
     )
     nb_ratio[grazing] = np.where(top_trusted, top_ratio, np.nan)[grazing]
     rel_gain, rel_top, rel_count = _reliable_gains(np.stack(images), crop_sat, ps, lt, dark)
-    rel_gain[unjudged | nb_dark] = np.nan
+    rel_gain[unjudged | nb_dark | near_surface] = np.nan
     # The bright end of image / prediction is a misfire only where the pixels the fit
     # explains agree (_reliable_gains): on a glossy coin the Lambertian prediction misjudges a
     # grazing light's image as a whole (the shipped dome's 1024 px coin, 12 lights, every light
@@ -2045,6 +2121,10 @@ def _evidence(
         rel_gain,
         swap_ratio,
         grazing_unjudged,
+        near_surface,
+        margin,
+        faint,
+        faint_floor,
     )
 
 
@@ -2088,7 +2168,7 @@ def _reliable_gains(
 
 
 #: Gain fields of :class:`_Evidence` that :func:`_dim_rejudged` takes from an image's re-judgement.
-_GAIN_FIELDS = ("gain", "lit_gain", "reliable_gain", "neighbour_ratio")
+_GAIN_FIELDS = ("gain", "lit_gain", "reliable_gain", "neighbour_ratio", "dark_near_surface")
 
 
 #: Images called dim judged again beside the others scaled back (:func:`_dim_rejudged`), the
