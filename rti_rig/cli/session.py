@@ -193,9 +193,11 @@ def run(
     Ctrl-C once stops after the current image (before it, its light left off, while a busy
     camera is awaited in the dark); Ctrl-C twice or SIGTERM stops at once (lights off, arm
     stopped, and parked if the config says park_on_emergency_stop = true); during an arm's
-    final park, a Ctrl-C or SIGTERM stops the arm where it is, held (torque on). A stop while the
-    dome connects first switches the dome off, once its board has booted (a few seconds; a
-    further Ctrl-C waits for it): opening its port may have reset a board that boots lit.
+    final park, a Ctrl-C or SIGTERM stops the arm where it is, held (torque on; with
+    torque_policy = "release_on_close" the close then releases an arm it finds at its park
+    pose, and the run says so, as after a park). A stop while the dome connects first
+    switches the dome off, once its board has booted (a few seconds; a further Ctrl-C waits
+    for it): opening its port may have reset a board that boots lit.
     SIGUSR1 pauses or resumes between images. An interrupted session can be continued with
     --resume.
     """

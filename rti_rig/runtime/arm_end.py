@@ -33,12 +33,17 @@ class ArmEnd:
     by policy: the arm stays where it stopped) or ``"park-unconfirmed"`` (a park wanted but not
     attempted, failed, or not read back at the park pose); ``azimuth_deg``/``elevation_deg``:
     the position read back (None when it could not be read); ``why``: what kept the park from
-    being confirmed, or why the position is unknown."""
+    being confirmed, or why the position is unknown; ``torque``: what the carrier's close did
+    to the joints' torque when it released them (``torque_policy = "release_on_close"``, see
+    :meth:`rti_rig.drivers.dynamixel.arm.DynamixelArm.torque_release_note`), None when it
+    released nothing. Why: the close comes after the teardown's read-back, and ``run`` had
+    said "held where it stopped, torque on" of an arm its close then let go limp."""
 
     outcome: Outcome
     azimuth_deg: float | None = None
     elevation_deg: float | None = None
     why: str | None = None
+    torque: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -50,12 +55,13 @@ class ArmEnd:
         if outcome not in ("parked", "left", "park-unconfirmed"):
             raise ValueError(f"not an arm end outcome: {outcome!r}")
         az, el = data.get("azimuth_deg"), data.get("elevation_deg")
-        why = data.get("why")
+        why, torque = data.get("why"), data.get("torque")
         return cls(
             outcome,  # type: ignore[arg-type]
             None if az is None else float(az),
             None if el is None else float(el),
             None if why is None else str(why),
+            None if torque is None else str(torque),
         )
 
     def _at(self) -> str:
@@ -64,7 +70,12 @@ class ArmEnd:
         return f"az {self.azimuth_deg:.1f}°, el {self.elevation_deg:.1f}°"
 
     def sentence(self) -> str:
-        """What the user is told of the arm (no capital, no full stop)."""
+        """What the user is told of the arm (no capital, no full stop), with what the close
+        did to its torque, if it released it."""
+        said = self._where()
+        return f"{said}; {self.torque}" if self.torque else said
+
+    def _where(self) -> str:
         at = self._at()
         if self.outcome == "parked":
             return (

@@ -9,7 +9,7 @@ arm reached, which is what the session's `.lp` records.
 from __future__ import annotations
 
 import signal
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -185,7 +185,28 @@ class ArmLighting:
         self.carrier.connect()
 
     def close(self) -> None:
-        self.carrier.close()
+        """Close the carrier, then record in :attr:`end` what the close did to its torque.
+
+        Why: a carrier with ``torque_policy = "release_on_close"`` switches its torque off at
+        the close when it finds the arm at its park pose, after :meth:`safe` has read the arm
+        back; ``run`` then said "parked" with no word of the release, and "held where it
+        stopped, torque on" of a park a Ctrl-C stopped near the park pose, an arm whose
+        close had just let it go limp. Recorded even when the close raised (its error is the
+        caller's to say): a release sent before the failure still happened."""
+        try:
+            self.carrier.close()
+        finally:
+            self._record_release()
+
+    def _record_release(self) -> None:
+        note = getattr(self.carrier, "torque_release_note", None)
+        said = note() if callable(note) else None
+        if not said or self.end is None:
+            return
+        why = self.end.why
+        if self.stopped_by is not None:  # "torque on" no longer true: the close released it
+            why = self._stopped_why(released=True)
+        self.end = replace(self.end, why=why, torque=str(said))
 
     def problem(self, step: LightStep) -> str | None:
         return self.carrier.unreachable_reason(np.asarray(step.direction))
@@ -237,8 +258,15 @@ class ArmLighting:
         with signals_deferred(on_held=stop_asked):
             return self._safe(emergency)
 
-    def _stopped_why(self) -> str:
+    def _stopped_why(self, released: bool = False) -> str:
+        """Why the arm is where the stop left it; ``released``: the close then found it at the
+        park pose and released its torque (said after this, from the carrier's own note)."""
         who = "Ctrl-C" if self.stopped_by == signal.SIGINT else "SIGTERM"
+        if released:
+            return (
+                f"the park was stopped by {who}: held where it stopped, close enough to the park "
+                "pose for the close to release it"
+            )
         return f"the park was stopped by {who}: held where it stopped, torque on"
 
     def _safe(self, emergency: bool) -> list[str]:

@@ -1,0 +1,107 @@
+"""``rti-rig run`` on an arm whose ``torque_policy = "release_on_close"`` says what the close did
+to its torque.
+
+The close comes after the teardown's read-back: it releases the torque when it finds the arm
+at its park pose (within a few ticks). ``run`` said "the arm parked" with no word of the
+release (``check`` said it), and of a final park a Ctrl-C stopped with the arm already at the
+park pose, "held where it stopped, torque on", of an arm the close then let go limp. Run
+in-process on the shipped emulated arm (its servos emulated in-process: real Protocol 2.0
+packets); the servos' Torque Enable is read from the emulator afterwards, the truth."""
+
+from __future__ import annotations
+
+import json
+import signal
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import emulators_built_by_check, inprocess_arm_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.geometry import direction_from_az_el
+from rti_rig.drivers.dynamixel import control_table as ct
+from rti_rig.drivers.dynamixel.arm import DynamixelArm
+from rti_rig.runtime.lighting import ArmLighting
+
+RELEASE = ('torque_policy = "hold"', 'torque_policy = "release_on_close"')
+RELEASED = 'torque then released (torque_policy = "release_on_close", read back off on each servo)'
+
+
+def _config(tmp_path: Path) -> Path:
+    cfg = inprocess_arm_config(tmp_path)
+    text = cfg.read_text()
+    assert RELEASE[0] in text and "park_azimuth_deg = 0.0" in text
+    assert "park_elevation_deg = 10.0" in text
+    cfg.write_text(text.replace(*RELEASE))
+    return cfg
+
+
+def _run(tmp_path: Path, *argv: str) -> tuple[int, str, dict]:  # type: ignore[type-arg]
+    out = tmp_path / "s"
+    r = CliRunner().invoke(
+        app,
+        ["run", str(_config(tmp_path)), *argv, "--out", str(out), "--no-verdict"],
+        terminal_width=400,
+    )
+    said = " ".join(r.output.split())
+    assert "Traceback" not in said, said
+    end = json.loads((out / "manifest.json").read_text())["runner"]["arm_end"]
+    return r.exit_code, said, end
+
+
+def test_a_park_released_at_the_close_is_said_by_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    emulators = emulators_built_by_check(monkeypatch)
+    code, said, end = _run(tmp_path, "--lights", "2")
+    assert code == 0, said
+    assert (
+        f"the arm parked (read back at az 0.0°, el 10.0°, within 1° of its park pose); {RELEASED}"
+        in said
+    ), said
+    assert "hold no pose" in said and 'set torque_policy = "hold"' in said, said
+    assert end["outcome"] == "parked" and end["torque"].startswith(RELEASED[:22]), end
+    (emu,) = emulators  # the truth: released
+    assert all(s.get(ct.TORQUE_ENABLE) == 0 for s in emu.servos.values())
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_stopped_park_released_at_the_close_is_not_said_to_hold(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The one light is at the park pose (az 0°, el 10°): a Ctrl-C as the teardown stops the
+    arm stops its park before it starts, with the arm already parked, and the close releases
+    it. The run had said "held where it stopped, torque on"."""
+    emulators = emulators_built_by_check(monkeypatch)
+    plan = tmp_path / "park.lp"
+    x, y, z = (float(v) for v in direction_from_az_el(0.0, 10.0))
+    plan.write_text(f"1\nimage_001.jpg {x:.8f} {y:.8f} {z:.8f}\n")
+    tearing: list[str] = []
+    real_safe, real_stop = ArmLighting.safe, DynamixelArm.stop
+
+    def safe(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        tearing.append("safe")
+        return real_safe(self, *args, **kwargs)
+
+    def stop(self):  # type: ignore[no-untyped-def]
+        real_stop(self)
+        if tearing == ["safe"]:  # the teardown's stop, once (the close stops again)
+            tearing.append("ctrl-c")
+            signal.raise_signal(signal.SIGINT)
+
+    monkeypatch.setattr(ArmLighting, "safe", safe)
+    monkeypatch.setattr(DynamixelArm, "stop", stop)
+    code, said, end = _run(tmp_path, "--plan", str(plan))
+    assert tearing == ["safe", "ctrl-c"], said
+    assert code == 130, said
+    assert "torque on" not in said, said
+    assert (
+        "the park was stopped by Ctrl-C: held where it stopped, close enough to the park pose "
+        f"for the close to release it); {RELEASED}" in said
+    ), said
+    assert end["outcome"] == "left" and "torque on" not in end["why"], end
+    assert end["torque"].startswith(RELEASED[:22]), end
+    (emu,) = emulators  # the truth: released
+    assert all(s.get(ct.TORQUE_ENABLE) == 0 for s in emu.servos.values())
