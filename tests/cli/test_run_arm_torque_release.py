@@ -105,3 +105,17 @@ def test_a_stopped_park_released_at_the_close_is_not_said_to_hold(
     assert end["torque"].startswith(RELEASED[:22]), end
     (emu,) = emulators  # the truth: released
     assert all(s.get(ct.TORQUE_ENABLE) == 0 for s in emu.servos.values())
+
+
+def test_a_preview_s_released_park_is_said(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``preview`` closes the arm as ``run`` does: its release is said the same way."""
+    emulators = emulators_built_by_check(monkeypatch)
+    out = tmp_path / "p"
+    r = CliRunner().invoke(
+        app, ["preview", str(_config(tmp_path)), "--out", str(out)], terminal_width=400
+    )
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0, said
+    assert f"within 1° of its park pose); {RELEASED}" in said, said
+    (emu,) = emulators
+    assert all(s.get(ct.TORQUE_ENABLE) == 0 for s in emu.servos.values())
