@@ -1037,6 +1037,12 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         cancel.cancel()
         if _park_stopped_by(opened.rig) is not None:  # delivered after the teardown it stopped:
             return  # no image is left to stop after; the arm's line and the summary say it
+        if cancel.over:  # held by the teardown (no park due, or after it) and delivered now
+            err.print(
+                "[yellow]Ctrl-C after the capture had ended: no image was left to stop after, "
+                "and the rig's teardown has run (what it did is said below).[/]"
+            )
+            return
         if opened.folder.images_kept >= opened.total_steps:
             # after the last image (the teardown, the records' last writes): "Stopping after
             # this image" read as if one were still to come, and asked for a second Ctrl-C

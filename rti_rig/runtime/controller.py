@@ -70,6 +70,21 @@ class CancelToken:
     def __init__(self) -> None:
         self._cancelled = False
         self._paused = False
+        self._capture_over = False
+
+    def capture_over(self) -> None:
+        """Set by the controller as it leaves its capture loop for the teardown (whatever
+        ended it): a Ctrl-C from now on has no image left to stop after.
+
+        Why: the teardown holds Ctrl-C and delivers it once done, and the CLI then said
+        "Stopping after this image" of a session whose images were all in and whose arm was
+        already left or parked."""
+        self._capture_over = True
+
+    @property
+    def over(self) -> bool:
+        """Whether the capture has ended (see :meth:`capture_over`)."""
+        return self._capture_over
 
     def cancel(self) -> None:
         self._cancelled = True
@@ -797,6 +812,7 @@ def run_session(
         led_error = led_error_record(exc)
         raise
     finally:
+        cancel.capture_over()
         with signals_deferred():
             teardown += rig.lighting.safe(emergency=reason is FinishReason.EMERGENCY_STOP)
             for label, close in (

@@ -1,0 +1,44 @@
+"""A Ctrl-C held by a dome session's teardown (its all-off) is not answered "Stopping after
+this image": the capture is over, and there is no image left to stop after.
+
+The controller holds Ctrl-C while the rig goes safe and delivers it once that is done; the
+run's handler then said "Stopping after this image (Ctrl-C again to stop at once)…" after
+the last image (the arm's case: tests/cli/test_run_arm_park_stopped.py)."""
+
+from __future__ import annotations
+
+import signal
+import sys
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.runtime.lighting import DomeLighting
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_ctrl_c_during_a_dome_s_teardown_is_not_said_to_stop_after_an_image(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    raised: list[int] = []
+    real_safe = DomeLighting.safe
+
+    def safe(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        raised.append(signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)  # held by the teardown, delivered once it is done
+        return real_safe(self, *args, **kwargs)
+
+    monkeypatch.setattr(DomeLighting, "safe", safe)
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
+    said = " ".join(r.output.split())
+    assert raised == [signal.SIGINT], said
+    assert "Traceback" not in said, said
+    assert "Stopping after this image" not in said, said
+    assert "Ctrl-C after the capture had ended: no image was left to stop after" in said, said
+    assert "6 image(s) in the session" in said, said
+    assert r.exit_code == 0, said
