@@ -12,7 +12,7 @@ object is what the abort protects against; the same rule as an emergency stop).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -165,10 +165,14 @@ class ArmSelfTestReport:
             if end.azimuth_deg is not None and end.elevation_deg is not None
             else None
         )
+        # what the close then did to the torque, wherever the arm was left: a close releases
+        # an arm it finds at its park pose also when the park was not confirmed (off by
+        # policy, stopped, failed), and that release had gone unsaid
+        released = f"; {self.release_note}" if self.release_note else ""
         if self.park_confirmed:
             return (
                 f"parked (read back at {at}, within {PARK_TOLERANCE_DEG:g}° of its park pose)"
-                + (f"; {self.release_note}" if self.release_note else "")
+                + released
             )
         head = "park NOT confirmed" if self.parked else "NOT parked"
         why = self._said_once(end.why) if end.why else ""
@@ -176,7 +180,7 @@ class ArmSelfTestReport:
             said = f"{head} ({why})" if why else head + policy
         else:
             said = f"{head}: {why}" if why else head
-        return said + (f"; left at {at} (read back)" if at else "")
+        return said + (f"; left at {at} (read back)" if at else "") + released
 
     def _said_once(self, text: str) -> str:
         """``text`` with the aborting error's explanation, said in full under ABORTED,
@@ -309,6 +313,11 @@ def arm_self_test(
         failures += attempt_all([("close", carrier.close)])
         note = getattr(carrier, "torque_release_note", None)
         report.release_note = note() if callable(note) else None
+        if report.end is not None and report.release_note:
+            # the end a stopped check is said by (``end.sentence()``) carries the release too:
+            # a check stopped with the arm at its park pose was said "not parked and left at
+            # az 0.0°, el 10.0°" with no word of the torque its close had just switched off
+            report.end = replace(report.end, torque=report.release_note)
         report.teardown_failures = _point_back(failures)
         report.elapsed_s = clock.now() - started
     return report
