@@ -1074,6 +1074,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         previous[signal.SIGTERM] = signal.getsignal(signal.SIGTERM)
         previous.update(handover.originals)  # not the hand-over's holds
     started = False  # whether the capture (which tears the rig down itself) has begun
+    over = False  # whether it returned (its summary follows)
     rig, folder, out_dir = opened.rig, opened.folder, opened.out_dir
     dry = " (dry run)" if opened.dry_run else ""
     adaptive = " at most, adaptive" if opened.source is not None else ""
@@ -1120,6 +1121,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
 
             started = True
             result = run_opened_session(opened, cancel, on_event)
+            over = True
     except EmergencyStop as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
@@ -1149,24 +1151,36 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
         raise _unexpected(exc, f"{out_dir}/manifest.json") from None
     finally:
-        put_back(previous)
-    # the session is over (stopped or done): a late Ctrl-C must not cut the summary
-    with _ctrl_c_ignored():
+        if over and settable and previous.get(signal.SIGINT) is not None:
+            # the session is over (stopped or done): a late Ctrl-C must not cut the summary.
+            # Ignored before the handlers are put back, not after: in between, the handler
+            # from before (Python's KeyboardInterrupt) was in place, and a Ctrl-C there
+            # escaped ``run`` with the summary unsaid
+            put_back({signal.SIGINT: signal.SIG_IGN})
+            put_back({sig: h for sig, h in previous.items() if sig != signal.SIGINT})
+        else:
+            put_back(previous)
+    with _ctrl_c_ignored(previous.get(signal.SIGINT) if over else None):
         return _summarise(opened, result, resume_hint, dry)
 
 
 @contextmanager
-def _ctrl_c_ignored() -> Iterator[None]:
-    """SIGINT ignored for the block, the handler before put back however it ends (a return,
-    an error, a ``typer.Exit``).
+def _ctrl_c_ignored(then: Any = None) -> Iterator[None]:
+    """SIGINT ignored for the block, the handler before (or ``then``, the one to end with
+    when the caller has already set the ignore in its place) put back however it ends (a
+    return, an error, a ``typer.Exit``).
 
     Why: the summary of a session that is over must not be cut by a late Ctrl-C (a second one
     meant as "stop at once"), but the ignore had been set and left to the caller to undo:
     ``run`` called in-process (CliRunner, or anyone calling the app from Python) was one
     restore away from leaving its caller deaf to Ctrl-C, and every process it started after
     would inherit the ignored signal."""
-    with signal_handlers({signal.SIGINT: signal.SIG_IGN}):
-        yield
+    try:
+        with signal_handlers({signal.SIGINT: signal.SIG_IGN}):
+            yield
+    finally:
+        if then is not None:
+            put_back({signal.SIGINT: then})
 
 
 def _summarise(opened, result, resume_hint: str, dry: str) -> bool:  # type: ignore[no-untyped-def]
