@@ -684,6 +684,23 @@ def _cannot_resume(rig) -> str | None:  # type: ignore[no-untyped-def]
     return None if why is None else f"It cannot be resumed: {why}."
 
 
+def _end_unrecorded(manifest: dict) -> str | None:  # type: ignore[type-arg]
+    """What a session whose images are all in has not recorded of its end (None: its run
+    recorded it completed): "its end" or, of an adaptive one, "its end and its adaptive
+    outcome (why it stopped, its error estimate)".
+
+    Why: a SIGTERM once the last image was in (in the teardown, or an arm's final park) was
+    told "the session is complete, nothing is left to resume", while its manifest recorded an
+    emergency stop: `rti-rig fit` then called it "not finished … continue it with rti-rig run
+    --resume", and an adaptive session's outcome was recorded only by that resume."""
+    if (manifest.get("runner") or {}).get("finish_reason") == "completed":
+        return None
+    adaptive = manifest.get("adaptive")
+    if isinstance(adaptive, dict) and not adaptive.get("result"):
+        return "its end and its adaptive outcome (why it stopped, its error estimate)"
+    return "its end"
+
+
 def _dead_led_hint(opened, exc: BaseException) -> str | None:  # type: ignore[no-untyped-def]
     """How to go on from a stop at an LED the board refused as dead (None: another error).
     A resume lights that LED first and stops there again, so "Continue with: rti-rig run
@@ -776,6 +793,15 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
             # teardown; an adaptive session's last image, short of its maximum): "Continue
             # with: rti-rig run --resume" had been said of a complete session, which has
             # nothing left to resume
+            unrecorded = _end_unrecorded(folder.manifest)
+            if unrecorded and not _cannot_resume(opened.rig):
+                return (
+                    f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: "
+                    f"every image is in, but the stop came before the run recorded {unrecorded}"
+                    f", so `rti-rig fit` calls it not finished. `rti-rig run --resume "
+                    f"{_arg(out_dir)}` records it complete without shooting anything again; "
+                    f"`rti-rig fit {_arg(out_dir)} --out FOLDER` fits the images as they are"
+                )
             return (
                 f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: the "
                 "session is complete, nothing is left to resume. Next: rti-rig fit "

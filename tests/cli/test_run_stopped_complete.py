@@ -1,12 +1,16 @@
 """A run stopped once every image is in (a SIGTERM held while the last image was committed,
-or during an arm's final park) says the session is complete and that fit is next.
+or during an arm's final park) says every image is in, that fit works on them, and that the
+resume records the session's end without shooting anything again.
 
-Why: it said "Continue with: rti-rig run --resume S" of a complete session, which has nothing
-left to resume. A stop with images missing still says the resume.
+Why: it said "Continue with: rti-rig run --resume S" as if images were missing; then "the
+session is complete, nothing is left to resume", while its manifest recorded an emergency stop
+(and, of an adaptive session, no outcome): `rti-rig fit` called it "not finished … continue it
+with rti-rig run --resume". A stop with images missing still says the resume.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -32,11 +36,11 @@ app(sys.argv[1:], prog_name="rti-rig")
 """
 
 
-def _run_sigterm_at(tmp_path: Path, at: int) -> tuple[int, str, Path]:
+def _run_sigterm_at(tmp_path: Path, at: int, *extra: str) -> tuple[int, str, Path]:
     out = tmp_path / "s"
     args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "6"]
     proc = subprocess.run(
-        [sys.executable, "-c", SCRIPT, str(at), *args, "--no-verdict"],
+        [sys.executable, "-c", SCRIPT, str(at), *args, *extra, "--no-verdict"],
         capture_output=True,
         text=True,
         timeout=300,
@@ -46,14 +50,56 @@ def _run_sigterm_at(tmp_path: Path, at: int) -> tuple[int, str, Path]:
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
-def test_a_sigterm_as_the_last_image_is_committed_says_complete_and_fit(tmp_path: Path) -> None:
+def test_a_sigterm_as_the_last_image_is_committed_says_all_in_fit_and_resume(
+    tmp_path: Path,
+) -> None:
     code, said, out = _run_sigterm_at(tmp_path, 5)
     assert code == 143, said
     assert "Emergency stop (SIGTERM)" in said and "Traceback" not in said, said
-    assert "--resume" not in said, said
-    assert f"6 image(s) kept in {out}, listed in lights.lp: the session is complete" in said
-    assert f"Next: rti-rig fit {out} --out FOLDER" in said, said
+    assert f"6 image(s) kept in {out}, listed in lights.lp: every image is in" in said, said
+    assert "before the run recorded its end," in said, said
+    assert "nothing is left to resume" not in said, said
+    assert f"rti-rig run --resume {out}` records it complete without shooting" in said, said
+    assert f"rti-rig fit {out} --out FOLDER" in said, said
     assert len((out / "lights.lp").read_text().splitlines()) == 7  # its count and 6 lights
+
+
+def _cli(*args: str) -> tuple[int, str]:
+    proc = subprocess.run(
+        [sys.executable, "-m", "rti_rig", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+    )
+    return proc.returncode, " ".join((proc.stdout + proc.stderr).split())
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
+def test_an_adaptive_session_stopped_with_every_image_in_is_completed_by_its_resume(
+    tmp_path: Path,
+) -> None:
+    """Its outcome (why it stopped, its estimate) is not recorded until the resume the stop
+    names, which shoots nothing and records it."""
+    code, said, out = _run_sigterm_at(tmp_path, 5, "--adaptive")
+    assert code == 143 and "Traceback" not in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] != "completed", said
+    assert "result" not in manifest["adaptive"], said
+    assert "before the run recorded its end and its adaptive outcome" in said, said
+    assert f"rti-rig run --resume {out}` records it complete" in said, said
+    lp = (out / "lights.lp").read_text()
+    images = {p.name: p.read_bytes() for p in out.glob("image_*.jpg")}
+    assert len(images) == 6, said
+    code, said = _cli("run", "--resume", str(out), "--no-verdict")
+    assert code == 0 and "Traceback" not in said, said
+    assert "0 of 6 lights left" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] == "completed", said
+    assert manifest["adaptive"]["result"]["lights_used"] == 6, said
+    # nothing shot again, nothing lost or overwritten
+    assert {p.name: p.read_bytes() for p in out.glob("image_*.jpg")} == images
+    assert (out / "lights.lp").read_text() == lp
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
