@@ -790,9 +790,9 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         whole, listed = folder.lp_listing()
         if whole and (folder.images_kept >= opened.total_steps or _run_completed(folder)):
             # every image was in when the stop came (a SIGTERM or a park stopped in the
-            # teardown; an adaptive session's last image, short of its maximum): "Continue
-            # with: rti-rig run --resume" had been said of a complete session, which has
-            # nothing left to resume
+            # teardown; an adaptive session its stopping rule ended short of its maximum):
+            # "Continue with: rti-rig run --resume" had been said of a complete session, which
+            # has nothing left to resume (the resume refused it as "already completed")
             unrecorded = _end_unrecorded(folder.manifest)
             if unrecorded and not _cannot_resume(opened.rig):
                 return (
@@ -801,6 +801,13 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
                     f", so `rti-rig fit` calls it not finished. `rti-rig run --resume "
                     f"{_arg(out_dir)}` records it complete without shooting anything again; "
                     f"`rti-rig fit {_arg(out_dir)} --out FOLDER` fits the images as they are"
+                )
+            if folder.images_kept < opened.total_steps:
+                return (
+                    f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: the "
+                    f"session is complete (its stopping rule ended it at {folder.images_kept} "
+                    f"of at most {opened.total_steps} lights), nothing is left to resume. Next: "
+                    f"rti-rig fit {_arg(out_dir)} --out FOLDER"
                 )
             return (
                 f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: the "

@@ -109,3 +109,48 @@ def test_a_sigterm_with_images_missing_still_says_the_resume(tmp_path: Path) -> 
     kept = f"3 image(s) kept in {out}, listed in lights.lp. Continue with: rti-rig run --resume"
     assert kept in said, said
     assert "session is complete" not in said, said
+
+
+#: as SCRIPT, but the SIGTERM comes as the session records its end (in the teardown, where
+#: it is held until the teardown is done): after an adaptive stopping rule ended it
+FINISH_SCRIPT = """
+import os, signal, sys
+from rti_rig.runtime.session import SessionFolder
+real = SessionFolder.finish
+def finish(self, *a, **k):
+    real(self, *a, **k)
+    os.kill(os.getpid(), signal.SIGTERM)
+SessionFolder.finish = finish
+from rti_rig.cli import app
+app(sys.argv[1:], prog_name="rti-rig")
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
+def test_a_sigterm_after_an_until_error_stop_says_complete_not_resume(tmp_path: Path) -> None:
+    """Its stopping rule ended it short of its maximum and the run recorded it complete: the
+    stop had said "Continue with: rti-rig run --resume S", which the resume refused as
+    "already completed"."""
+    out = tmp_path / "s"
+    args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out)]
+    proc = subprocess.run(
+        [sys.executable, "-c", FINISH_SCRIPT, *args, "--until-error", "3", "--no-verdict"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 143 and "Emergency stop (SIGTERM)" in said, said
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["runner"]["finish_reason"] == "completed", said
+    kept = len(list(out.glob("image_*.jpg")))
+    total = manifest["runner"]["steps_planned"]
+    assert kept < total, said  # stopped by its rule, short of its maximum
+    assert "Continue with" not in said, said
+    assert f"the session is complete (its stopping rule ended it at {kept} of at most {total}" in (
+        said
+    )
+    assert f"Next: rti-rig fit {out} --out FOLDER" in said, said
+    code, again = _cli("run", "--resume", str(out))
+    assert code != 0 and "already completed" in again, again  # what the advice would have met
