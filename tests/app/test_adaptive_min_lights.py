@@ -45,6 +45,22 @@ def test_a_loose_target_stops_at_the_start_and_says_no_rti_file_follows(
     assert "To get fit.ptm and fit.rti, start a session with --min-lights 6" in text
 
 
+@pytest.mark.parametrize("minimum", ["3", "4"])
+def test_a_minimum_below_an_rti_file_s_lights_still_says_no_rti_file_follows(
+    never_reached: tuple[Path, Path], tmp_path: Path, minimum: str
+) -> None:
+    """A minimum asked for had silenced the note: --min-lights 3 or 4 (the start is 4) stopped
+    at 4 lights with nothing said of the fit.ptm and fit.rti that would not follow."""
+    cfg, _ = never_reached
+    out = tmp_path / "s"
+    r = _run(cfg, out, "--until-error", LOOSE, "--min-lights", minimum)
+    assert r.exit_code == 0, r.output
+    assert manifest(out)["adaptive"]["result"]["lights_used"] == 4
+    text = said(r)
+    assert "without fit.ptm and fit.rti" in text, text
+    assert "To get fit.ptm and fit.rti, start a session with --min-lights 6" in text, text
+
+
 def test_the_advice_stays_within_the_session_s_maximum(
     never_reached: tuple[Path, Path], tmp_path: Path
 ) -> None:

@@ -1156,11 +1156,13 @@ RTI_FILE_LIGHTS = (
 def few_lights_note(result: dict[str, Any]) -> str | None:
     """What a session whose --until-error target was reached before it had the lights of an
     RTI file gives and does not give, and how to ask for more (None: nothing to say — no
-    target, not reached, a minimum asked for, or lights enough). The target is a normal
-    error; a user who came for a PTM or an .rti learns it here, not when `fit` skips them.
-    The advice never exceeds the session's maximum (``--lights`` or the rig's lights)."""
+    target, not reached, or lights enough). The target is a normal error; a user who came for
+    a PTM or an .rti learns it here, not when `fit` skips them. The advice never exceeds the
+    session's maximum (``--lights`` or the rig's lights). A minimum asked for is no reason to
+    be silent: one below an RTI file's lights (``--min-lights 4``, below the 4 starting lights
+    that a loose target stops at) had silenced the note of a session with no RTI file."""
     used = int(result.get("lights_used") or 0)
-    if not result.get("target_claimed") or result.get("min_lights") is not None:
+    if not result.get("target_claimed"):
         return None
     short = [(name, what, n) for name, what, n in RTI_FILE_LIGHTS if used < n]
     if not short:
