@@ -63,7 +63,7 @@ def check(
             help="LED drive level for a dome's walk, in (0, 1] (default 0.2). Refused where "
             "nothing can be lit at a chosen level: a replay rig, an arm (its lamp is only "
             "switched on and off), a camera-triggered dome (rti-rig lights none of its LEDs) "
-            "and a dome whose firmware cannot dim an LED.",
+            "and, below 1, a dome whose firmware cannot dim an LED (it lights each fully on).",
         ),
     ] = None,
     reboot_faulted: Annotated[

@@ -43,3 +43,18 @@ def test_intensity_is_used_on_a_dome_that_dims() -> None:
     text = said(r.output)
     assert r.exit_code == 0, text
     assert text.endswith("RESULT: PASS") and "--intensity" not in text, text
+
+
+@pytest.mark.parametrize("config", ["emulated_nab_rti_v1.toml", "emulated_minirti.toml"])
+def test_full_intensity_is_used_on_an_on_off_firmware(config: str) -> None:
+    """``--intensity 1`` asks for each LED fully on, which is what an on/off firmware lights:
+    it had been refused as "the check would light each LED fully on, not at the level asked
+    for" (found by a review). A level below 1 is still refused, naming the way that works."""
+    r = runner.invoke(app, ["check", str(CONFIGS / config), "--intensity", "1"])
+    text = said(r.output)
+    assert r.exit_code == 0, text
+    assert text.endswith("RESULT: PASS") and "--intensity" not in text, text
+    r = runner.invoke(app, ["check", str(CONFIGS / config), "--intensity", "0.99"])
+    text = said(r.output)
+    assert r.exit_code == 2, text
+    assert "not at the level asked for (--intensity 1 is that full drive)" in text, text

@@ -122,10 +122,12 @@ def _refuse_undimmable(loaded: Any, intensity: float) -> None:
     Why: ``check ACQ/dirs.lp --intensity 0.5`` passed without a word, as if the level had been
     used; so did an arm (its lamp is switched on or off, never dimmed), a camera-triggered
     dome (rti-rig lights none of its LEDs) and an on/off serial firmware (its LEDs were lit
-    fully on): a PASS that implied a walk at the level asked for."""
+    fully on): a PASS that implied a walk at the level asked for. An on/off firmware's
+    ``--intensity 1`` is the full drive it lights each LED at, so it is used, not refused (it
+    had been refused as "not at the level asked for", which it is)."""
     from rti_rig.core.errors import ConfigError
 
-    why = _undimmable_reason(loaded)
+    why = _undimmable_reason(loaded, intensity)
     if why is None:
         return
     raise ConfigError(
@@ -135,8 +137,8 @@ def _refuse_undimmable(loaded: Any, intensity: float) -> None:
     )
 
 
-def _undimmable_reason(loaded: Any) -> str | None:
-    """What about this rig leaves the check no LED to light at a chosen level, or None."""
+def _undimmable_reason(loaded: Any, intensity: float) -> str | None:
+    """What about this rig leaves the check no LED to light at level ``intensity``, or None."""
     config = loaded.config
     if config.backend == "replay":
         return (
@@ -159,10 +161,10 @@ def _undimmable_reason(loaded: Any) -> str | None:
         )
     serial = getattr(dome, "serial", None)
     refusal = None if serial is None else serial.dimming_refusal()
-    if refusal is not None:
+    if refusal is not None and intensity < 1.0:  # fully on is the level 1 asks for
         return (
             f"this dome: {refusal}, so the check would light each LED fully on, not at the "
-            "level asked for"
+            "level asked for (--intensity 1 is that full drive)"
         )
     return None
 
