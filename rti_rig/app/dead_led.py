@@ -51,20 +51,46 @@ def dead_led_recorded(runner: dict[str, Any]) -> int | None:
     return led if is_dead_led(record.get("fault"), record.get("code")) else None
 
 
-def dead_led_advice(loaded: Any, schedule: Any, out_dir: Path, led: int) -> str:
+def dead_led_advice(
+    loaded: Any, schedule: Any, out_dir: Path, led: int, adaptive: bool = False
+) -> str:
     """How to go on from a session stopped at dead LED ``led``: repair it, then resume; or
     shoot the others meanwhile with a plan without it (the rig's LED ``.lp`` without its line
-    when the session planned every LED, else a plan without its direction)."""
+    when the session planned every LED, else a plan without its direction).
+
+    An ``adaptive`` session's ``schedule`` is only its first design, the rest chosen as it
+    goes: no plan of its other lights exists. Its first design, minus nothing (the dead LED
+    is one it chose later), had been written as "the session's N other lights" (N one short),
+    a plan of a few lights offered in the session's place."""
     dome = loaded.config.dome
     cfg = shlex.quote(str(loaded.path))
     names = _led_names(loaded)
     which = f"LED {led} ({names[led]})" if 0 <= led < len(names) else f"LED {led}"
     leds = {s.led for s in schedule.steps}
-    if dome is not None and dome.lp_file and leds == set(range(len(names))):
-        plan = (
-            f"copy {loaded.folder / dome.lp_file} (the rig's LED .lp) without the line of "
-            f"{which}, the count on its first line one less, as PLAN.lp"
+    resume = (
+        f"once that LED or its wiring is repaired, continue with: rti-rig run --resume "
+        f"{shlex.quote(str(out_dir))}"
+    )
+    rig_lp = (
+        f"copy {loaded.folder / dome.lp_file} (the rig's LED .lp) without the line of "
+        f"{which}, the count on its first line one less, as PLAN.lp"
+        if dome is not None and dome.lp_file
+        else None
+    )
+    if adaptive:
+        meanwhile = (
+            ""
+            if rig_lp is None
+            else f" To shoot every other LED now instead (not adaptively), {rig_lp} and run "
+            f"rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR."
         )
+        return (
+            f"A resume lights {which} first and stops there again. An adaptive session "
+            f"chooses its lights as it goes, so no plan of its other lights exists."
+            f"{meanwhile} {resume[0].upper()}{resume[1:]}"
+        )
+    if rig_lp is not None and leds == set(range(len(names))):
+        plan = rig_lp
     else:
         written = write_plan_without(schedule, out_dir, led)
         if written is not None:
@@ -72,18 +98,16 @@ def dead_led_advice(loaded: Any, schedule: Any, out_dir: Path, led: int) -> str:
             # user had no file of: coordinates to find and delete by hand were no command
             return (
                 f"A resume lights {which} first and stops there again. The session's "
-                f"{len(schedule.steps) - 1} other lights, in its order, were written beside it "
+                f"{len(leds - {led})} other lights, in its order, were written beside it "
                 f"as {written.name}; to shoot them now: rti-rig run {cfg} --plan "
-                f"{shlex.quote(str(written))} --out NEW_DIR. Once that LED or its wiring is "
-                f"repaired, continue with: rti-rig run --resume {shlex.quote(str(out_dir))}"
+                f"{shlex.quote(str(written))} --out NEW_DIR. {resume[0].upper()}{resume[1:]}"
             )
         step = next((s for s in schedule.steps if s.led == led), None)
         where = "" if step is None else " ({:.6f} {:.6f} {:.6f})".format(*step.direction)
         plan = f"write the lights to shoot without the direction of {which}{where} as PLAN.lp"
     return (
         f"A resume lights {which} first and stops there again. To shoot the other lights now, "
-        f"{plan} and run rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR; once that LED or its "
-        f"wiring is repaired, continue with: rti-rig run --resume {shlex.quote(str(out_dir))}"
+        f"{plan} and run rti-rig run {cfg} --plan PLAN.lp --out NEW_DIR; {resume}"
     )
 
 

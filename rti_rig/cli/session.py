@@ -710,7 +710,8 @@ def _dead_led_hint(opened, exc: BaseException) -> str | None:  # type: ignore[no
     led = dead_led_of(exc)
     if led is None or _cannot_resume(opened.rig):
         return None
-    return dead_led_advice(opened.rig.loaded, opened.schedule, opened.out_dir, led)
+    adaptive = opened.source is not None  # its schedule is only its first design
+    return dead_led_advice(opened.rig.loaded, opened.schedule, opened.out_dir, led, adaptive)
 
 
 def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore[no-untyped-def]

@@ -103,3 +103,41 @@ def test_a_partial_plan_stopped_at_a_dead_led_is_given_a_plan_that_runs(
     fired = json.loads((new / "manifest.json").read_text())["steps"]
     planned = json.loads((s / "manifest.json").read_text())["schedule"]["steps"]
     assert [st["led"] for st in fired] == [st["led"] for st in planned if st["led"] != DEAD]
+
+
+def test_an_adaptive_session_stopped_at_a_dead_led_it_chose_is_given_no_plan_of_its_design(
+    tmp_path: Path,
+) -> None:
+    """An adaptive session's schedule is only its first design; the LED it stopped at is one it
+    chose later. Its first design had been written as "the session's 3 other lights" (it held
+    4, the dead LED not among them), a plan of a few lights offered in the session's place
+    (found by a review). It is told that no plan of its other lights exists, the rig's LED .lp
+    without that LED (every other LED), and the resume once the LED is repaired."""
+    shutil.copy(CONFIGS / "example_dome_48.lp", tmp_path)
+    clean = tmp_path / "clean.toml"
+    clean.write_text((CONFIGS / "emulated_dome.toml").read_text())
+    first = tmp_path / "first"
+    adaptive = ["--adaptive", "--lights", "12", "--no-verdict"]
+    r = runner.invoke(app, ["run", str(clean), "--out", str(first), *adaptive])
+    assert r.exit_code == 0, r.output
+    design = {
+        st["led"] for st in json.loads((first / "manifest.json").read_text())["schedule"]["steps"]
+    }
+    fired = [json.loads(line)["led"] for line in (first / "journal.jsonl").read_text().splitlines()]
+    dead = next(led for led in fired if led not in design)  # one it chose as it went
+
+    cfg = tmp_path / "dome.toml"
+    cfg.write_text(clean.read_text() + f"\n[emulator]\ndead_leds = [{dead}]\n")
+    s = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(s), *adaptive])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert f"LED {dead} refused" in text and "Continue with: rti-rig run --resume" not in text
+    assert "no plan of its other lights exists" in text, text
+    assert (
+        f"copy {tmp_path / 'example_dome_48.lp'} (the rig's LED .lp) without the line of LED {dead}"
+        in text
+    )
+    assert f"continue with: rti-rig run --resume {s}" in text, text  # once repaired
+    assert "were written beside it" not in text, text
+    assert not list(tmp_path.glob("s-without-led-*.lp")), text
