@@ -239,15 +239,16 @@ def checked_gone(cluster: Cluster, kept: str) -> str:
     """What is said when no worker checked to run this rti-rig has been in the cluster for
     :data:`CHECKED_GRACE_S` (the tasks wait for no one), naming the workers there, refused."""
     try:
-        others = workers_by_tag(cluster)[1]
+        others: set[str] | None = workers_by_tag(cluster)[1]
     except Exception:  # the scheduler lost meanwhile: who is there is not known
-        others = set()
-    there = (
-        "the workers there now were refused, their rti-rig being another or none: "
-        + ", ".join(sorted(others))
-        if others
-        else "no worker is there now"
-    )
+        others = None
+    if others is None:  # not "no worker is there now": the scheduler did not say
+        there = "which workers are there now is not known (the scheduler did not answer)"
+    elif others:
+        there = "the workers there now were refused, their rti-rig being another or none: "
+        there += ", ".join(sorted(others))
+    else:
+        there = "no worker is there now"
     return (
         f"the {len(cluster.workers)} worker(s) of the Dask cluster at {cluster.address!r} whose "
         "rti-rig was checked when the fit began have all left it, and no worker running this "
