@@ -727,7 +727,10 @@ def _cfa_refusal(colors: NDArray[np.integer], desc: str, mode: str) -> str | Non
     Why: a DNG whose CFAPattern tag is lost or damaged still decodes: LibRaw fills the
     pattern from what it has (every photosite red, or colour codes past its four), and the
     file had gone into the session as a picture of one colour, or stopped the run with an
-    IndexError from the colour step. A colour image needs red, green and blue photosites."""
+    IndexError from the colour step. A colour image needs red, green and blue photosites.
+    A sensor without a colour filter is sent to grey TIFFs, as ``_monochrome_refusal`` does,
+    not to ``mode = "mosaic"``: that labels its images CFA mosaics, which ``rti-rig fit``
+    refuses, so the session could never be fitted."""
     codes = np.unique(colors)
     if codes.size and int(codes.max()) >= 4:
         return (
@@ -745,8 +748,11 @@ def _cfa_refusal(colors: NDArray[np.integer], desc: str, mode: str) -> str | Non
         f"its colour filter array as LibRaw reads it has photosites of {named} only, so no "
         "colour picture can be made of it: its CFA tags (CFAPattern, CFARepeatPatternDim) "
         "are damaged or lost (copy the shot again from the camera's card), or its sensor "
-        'has no colour filter (a monochrome camera: set [camera.device.decode] mode = "mosaic", '
-        "which keeps its values as they are)"
+        "has no colour filter (a monochrome camera, whose shots no RAW decode mode here takes: "
+        'mode = "mosaic" would label them colour-filter mosaics, which rti-rig fit refuses). '
+        "For a monochrome camera, save the shots as 16-bit grey TIFFs (the camera's program "
+        'or a RAW converter) and watch those (patterns = ["*.tif"] in [camera.device]), '
+        "which make a grey session"
     )
 
 
