@@ -338,16 +338,48 @@ def _is_number(token: str) -> bool:
 def _refuse_extra_columns(tokens: list[str], line: str, source: str, lineno: int) -> None:
     """Refuse a line whose image name is followed by a number before the vector: a fourth
     column (an intensity, a weight), not a name with spaces. It had been read as the name
-    ``image01.jpg 0.2051`` and reported as a missing image."""
+    ``image01.jpg 0.2051`` and reported as a missing image.
+
+    Why the hint says what the line has: it had asked "an extra column after the name?" of
+    ``a.jpg 0.6 0 0.8 1.0`` too, whose extra number is the last; which one is extra is named
+    only where exactly one run of three is a unit vector (the light's direction)."""
     if len(tokens) < 5 or not tokens[0].lower().endswith(_IMAGE_ENDINGS):
         return
     if any(_is_number(t) for t in tokens[1:-3]):
         raise LpFormatError(
             source,
             lineno,
-            f"expected 'name x y z', found {len(tokens)} fields: {line.strip()!r} (an extra "
-            "column after the name? an .lp line is the image name and the light's x y z only)",
+            f"expected 'name x y z', found {len(tokens)} fields: {line.strip()!r} "
+            f"({_extra_columns_hint(tokens[1:])}; an .lp line is the image name and the "
+            "light's x y z only)",
         )
+
+
+def _extra_columns_hint(after: list[str]) -> str:
+    """What the fields after an image name are, and which are extra where the line shows it
+    (exactly one run of three numbers is a unit vector)."""
+    if not all(_is_number(t) for t in after):
+        return f"{len(after)} fields after the name where an .lp line has 3 numbers"
+    said = f"{len(after)} numbers after the name where an .lp line has 3"
+    units = [
+        i
+        for i in range(len(after) - 2)
+        if abs(math.sqrt(sum(float(t) ** 2 for t in after[i : i + 3])) - 1.0) <= UNIT_TOLERANCE
+    ]
+    if len(units) != 1:
+        return said
+    i = units[0]
+    before, vector, later = after[:i], after[i : i + 3], after[i + 3 :]
+    where = " and ".join(
+        part
+        for part in (
+            f"before it {' '.join(before)}" if before else "",
+            f"after it {' '.join(later)}" if later else "",
+        )
+        if part
+    )
+    extra = "is an extra column" if len(before) + len(later) == 1 else "are extra columns"
+    return f"{said}: {' '.join(vector)} is a unit vector, and {where} {extra}"
 
 
 def _refuse_non_lp_text(content: list[tuple[int, str]], source: str) -> None:

@@ -103,7 +103,7 @@ def test_tolerant_reading() -> None:
         ("0\n", 1, "must be positive"),
         # a column after the name (an intensity) is no name with a space in it
         ("1\na_1.jpg 0.6 0 0.8 1.0\n", 2, "found 5 fields"),
-        ("1\na_1.JPG 1.0 0.6 0 0.8\n", 2, "an extra column after the name?"),
+        ("1\na_1.JPG 1.0 0.6 0 0.8\n", 2, "before it 1.0 is an extra column"),
     ],
 )
 def test_malformed_files_name_line_and_reason(text: str, line: int, fragment: str) -> None:
@@ -385,7 +385,7 @@ def test_ptmfitter_image_endings_tell_an_extra_column() -> None:
     """HP's PTMfitter reads .tga and .ppm images: a number after such a name is a stray column,
     refused as one (it had been read as the name ``xx-001.tga 1.0``)."""
     for name in ("xx-001.tga", "xx-001.PPM"):
-        with pytest.raises(LpFormatError, match="an extra column after the name"):
+        with pytest.raises(LpFormatError, match=r"before it 1\.0 is an extra column"):
             parse_lp(f"1\n{name} 1.0 0.6 0 0.8\n", "ptm.lp")
 
 
