@@ -202,10 +202,10 @@ def fit(
     """Fit a session: normal map, albedo, .ptm, .rti, relight .dome and a QA verdict.
 
     Exit codes: 0 every fit is written (a batch: each session done, refitted, skipped as
-    finished earlier, or finished on a Dask worker); 1 a batch's fits are all in place but
-    a session changed while it was fitted, so its fit is of the session as it was read (run
-    the same command again to refit it); 2 an error (a batch: a session failed, the others
-    fitted); 130 / 143 stopped by Ctrl-C / SIGTERM."""
+    finished earlier, or finished on a Dask worker); 1 every fit is in place but a session
+    changed while it was fitted, so its fit is of the session as it was read (a batch: run
+    the same command again to refit it; one session: fit it again into a new --out); 2 an
+    error (a batch: a session failed, the others fitted); 130 / 143 stopped by Ctrl-C / SIGTERM."""
     from rti_rig.app.usecases.fit_memory import use_one_heap
 
     # One malloc heap for this process, before any decode or reader thread starts: it is
@@ -252,7 +252,7 @@ def _fit_command(  # type: ignore[no-untyped-def]
     """The body of :func:`fit`, run under its stop handling (``written`` gets True once every
     output is written)."""
     from rti_rig.app.usecases.fit import FitRequest, run_fit
-    from rti_rig.app.usecases.fit_batch import Outcome, run_batch
+    from rti_rig.app.usecases.fit_batch import Outcome, changed_while_fitted, run_batch
     from rti_rig.reconstruct.registry import model_spec
 
     try:
@@ -319,6 +319,10 @@ def _fit_command(  # type: ignore[no-untyped-def]
 
             result = run_fit_dask(request, scheduler)
         written.append(True)
+        # as a batch does for each session: the fit's record was taken before its images
+        # were read, so a resume (or a replaced image) while it ran is seen here; a single
+        # fit had exited 0 with a fit of fewer images than its session now holds
+        moved_on = changed_while_fitted(out_dir, request.source)
     except RtiRigError as exc:
         raise fail(exc) from None
     print_notes(result.notes)
@@ -334,3 +338,12 @@ def _fit_command(  # type: ignore[no-untyped-def]
     )
     if result.qa is not None:
         out.print(f"QA verdict: {escape(result.qa.verdict)}")
+    if moved_on is not None:
+        err.print(
+            f"[yellow]warning:[/] {escape(str(request.source))} changed while it was being "
+            f"fitted ({escape(moved_on)}): the fit in {escape(str(out_dir))} is of the session "
+            "as it was read, not as it is now; once the session is no longer being changed, "
+            "fit it again into a new --out (exit 1)",
+            soft_wrap=True,
+        )
+        raise typer.Exit(code=1)
