@@ -3,9 +3,16 @@
 A session shot half on one rig and half on another is not one session: a dome finished by an
 arm, 512² images next to 256² ones, or a different exposure make the images disagree with each
 other and with the `.lp`. The identity lists what changes the images — the rig's kind and
-backend, where its lights can be, the LEDs' intensity correction, the camera's size, exposure,
-gain and RAW decoding, and (for a dry run) the simulated scene — and nothing that does not (a
-serial port's name, timing, parking policy), so a rig moved to another USB port resumes.
+backend, where its lights can be, the LEDs' intensity correction, a dome's firmware profile,
+the camera's size, exposure, gain and RAW decoding, and (for a dry run) the simulated scene —
+and nothing that does not (a serial port's name, timing, parking policy), so a rig moved to
+another USB port resumes.
+
+The firmware profile names the dome's controller board: another board drives its LEDs with
+another command set, timing and possibly numbering (a stepping nichlock board counts LEDs in
+its wiring's order, a minirti board addresses a 64-bit mask), so the same LED index may not
+be the same light. A resume on another profile had gone on without a word. A session recorded
+before the profile was part of the identity has no ``dome_firmware`` key and is not asked.
 
 A dome's light positions are compared as positions, not as a digest: a re-measured dome
 whose ``.lp`` differs from the session's by rounding (written again with four decimals or
@@ -35,6 +42,7 @@ LABELS = {
     "lights": "lights",
     "light_positions": "light positions",
     "intensity_correction": "LED intensity correction",
+    "dome_firmware": "dome firmware profile",
     "arm_reach": "arm reach",
     "camera_size": "camera size",
     "exposure_s": "exposure (s)",
@@ -90,6 +98,7 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
         serial = cfg.dome.serial if cfg.dome else None
         corr = getattr(serial, "intensity_correction", None)
         ident["intensity_correction"] = None if corr is None else _digest(list(corr))
+        ident["dome_firmware"] = getattr(serial, "profile", None)
     else:
         ident["lights"] = "one lamp on an arm"
         ident["arm_reach"] = {
@@ -140,10 +149,17 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
         old, new = before.get(key), now.get(key)
         if old == new:
             continue
-        if other_kind and key in ("light_positions", "intensity_correction", "arm_reach"):
+        if other_kind and key in (
+            "light_positions",
+            "intensity_correction",
+            "dome_firmware",
+            "arm_reach",
+        ):
             continue  # a dome and an arm differ in these by nature: the kind says it all
         if key == "recorded_images" and old is None:
             continue  # a session begun before the images were part of the identity
+        if key == "dome_firmware" and key not in before:
+            continue  # a session begun before the firmware profile was part of the identity
         if key == "light_directions":
             continue  # said under "light positions"
         if key == "light_positions":
@@ -160,6 +176,11 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
             out.append(
                 f"{label}: "
                 + ", ".join(f"{k} {_show(old.get(k))} → {_show(new.get(k))}" for k in changed)
+            )
+        elif key == "dome_firmware":
+            out.append(
+                f"{label}: {_show(old)} → {_show(new)} (another controller board: its LEDs "
+                "are driven, timed and possibly numbered otherwise)"
             )
         else:
             out.append(f"{label}: {_show(old)} → {_show(new)}")

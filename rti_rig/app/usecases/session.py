@@ -1191,7 +1191,7 @@ def check_resume_rig(  # type: ignore[no-untyped-def]
                 or _back_to_own_config(config_path, manifest, session_dir)
             )
             + ", or, if the change is deliberate (a repaired LED, recalibrated light "
-            "positions), add --accept-rig-change to record it"
+            "positions, a new controller board), add --accept-rig-change to record it"
         )
     if diffs:
         # recorded in the manifest when the session goes on: a resume refused after this (a

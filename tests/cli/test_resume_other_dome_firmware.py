@@ -1,0 +1,85 @@
+"""A session shot on one dome firmware profile is not resumed on another without a word.
+
+``rig_configs/emulated_nichlock.toml`` and ``rig_configs/emulated_minirti.toml`` describe the
+same LED positions and camera on two controller boards: a stepping nichlock board, which
+counts its LEDs in its wiring's order, and a minirti board, which addresses a 64-bit mask
+(/work/shared/reference/dome-firmwares.md). Another board drives its LEDs with another command
+set, timing and possibly numbering, so the same LED index may not be the same light: a resume
+on the other config had gone on without complaint. It is refused naming both profiles and
+``--accept-rig-change``, which records a deliberate change; a session recorded before the
+profile was part of the rig's identity resumes as it did.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, journal, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+NICHLOCK = CONFIGS / "emulated_nichlock.toml"
+MINIRTI = CONFIGS / "emulated_minirti.toml"
+
+
+def _cut(out: Path) -> None:
+    """A 6-light session on the nichlock dome, cancelled after three images as Ctrl-C does."""
+    from rti_rig.app.usecases.session import (
+        NewSessionRequest,
+        open_new_session,
+        run_opened_session,
+    )
+    from rti_rig.runtime.controller import CancelToken, StepCompleted
+
+    cancel = CancelToken()
+
+    def on_event(event) -> None:  # type: ignore[no-untyped-def]
+        if isinstance(event, StepCompleted) and event.index == 2:
+            cancel.cancel()
+
+    run_opened_session(open_new_session(NewSessionRequest(NICHLOCK, out, 6)), cancel, on_event)
+    assert len(journal(out)) == 3
+
+
+def _resume(out: Path, config: Path, *extra: str):  # type: ignore[no-untyped-def]
+    args = ["run", str(config), "--resume", str(out), "--no-verdict", *extra]
+    return runner.invoke(app, args, terminal_width=400)
+
+
+@pytest.mark.e2e
+def test_a_resume_on_another_firmware_profile_is_refused_naming_both(tmp_path: Path) -> None:
+    out = tmp_path / "S"
+    _cut(out)
+    r = _resume(out, MINIRTI)
+    text = said(r)
+    assert r.exit_code == 2, r.output
+    assert "Traceback" not in text, r.output
+    assert f"{MINIRTI} does not describe the rig this session began on" in text, r.output
+    assert "dome firmware profile: nichlock → minirti (another controller board" in text, text
+    assert "add --accept-rig-change to record it" in text, r.output
+    assert len(journal(out)) == 3  # nothing captured
+    r = _resume(out, MINIRTI, "--accept-rig-change")  # a deliberate change: recorded
+    text = said(r)
+    assert r.exit_code == 0, r.output
+    assert "rig change accepted" in text and "nichlock → minirti" in text, r.output
+    assert len(journal(out)) == 6
+
+
+@pytest.mark.e2e
+def test_a_session_recorded_before_the_profile_was_in_the_identity_resumes(
+    tmp_path: Path,
+) -> None:
+    out = tmp_path / "S"
+    _cut(out)
+    manifest = out / "manifest.json"
+    data = json.loads(manifest.read_text(encoding="utf-8"))
+    assert data["rig"]["identity"].pop("dome_firmware") == "nichlock"
+    manifest.write_text(json.dumps(data, indent=1), encoding="utf-8")
+    r = _resume(out, NICHLOCK)
+    assert r.exit_code == 0, r.output
+    assert "dome firmware" not in said(r), r.output
+    assert len(journal(out)) == 6
