@@ -79,8 +79,12 @@ def _ifd(f: BinaryIO, layout: Layout, offset: int, size: int) -> dict[int, tuple
     """{tag: values} of the integer tags of :data:`_READ` in the IFD at ``offset``, all of it
     in the ``size`` bytes of ``f``; None where there is no such IFD. A tag whose values lie
     past the end reads as given none (``()``); one of another type or an absurd count too,
-    unless an entry before it of the same tag gave values."""
-    if offset < layout.header:
+    unless an entry before it of the same tag gave values.
+
+    An offset past the end is "no such IFD" before anything is read: a SubIFDs entry of an
+    8-byte type (LONG8, IFD8) in a damaged file can name one past 2**63, which ``seek``
+    refuses with a ValueError, not an OSError (it had ended the decode with that error)."""
+    if offset < layout.header or offset + layout.count_size > size:
         return None
     count = read_count(f, layout, offset)
     if count is None or not 1 <= count <= MAX_TAGS or layout.ifd_end(offset, count) > size:

@@ -567,3 +567,27 @@ def test_a_dng_whose_strip_offsets_are_lost_is_refused_before_libraw_reads_it(tm
     counts_lost.write_bytes(_tag_renumbered(whole, 279))
     frame = decode_raw(counts_lost, MOSAIC)
     np.testing.assert_array_equal(frame.pixels, mosaic.astype(np.int64) - BLACK)
+
+
+def test_a_dng_whose_sub_ifds_name_an_offset_past_any_file_still_decodes(tmp_path):
+    """A damaged SubIFDs entry of an 8-byte type (LONG8, which no classic TIFF has) naming an
+    IFD at 0xFFFF_FFFF_FFFF_FFFF: the whole-file reader this one replaced skipped it, while the
+    seeking one passed the offset to ``seek``, whose ValueError (not an OSError) ended the
+    decode. It is no IFD, and the picture, whose own IFD is whole, decodes as taken."""
+    import struct
+
+    mosaic = random_mosaic(4)
+    data = bytearray(dng_bytes(mosaic, black_level=BLACK, white_level=WHITE))
+    end = len(data)
+    data += b"\xff" * 8
+    for n in range(int.from_bytes(data[8:10], "little")):
+        at = 10 + 12 * n
+        if int.from_bytes(data[at : at + 2], "little") == 305:  # Software: not needed
+            struct.pack_into("<HHII", data, at, 330, 16, 1, end)
+            break
+    else:
+        raise AssertionError("no Software tag")
+    path = tmp_path / "sub_ifds_garbage.dng"
+    path.write_bytes(bytes(data))
+    frame = decode_raw(path, MOSAIC)
+    np.testing.assert_array_equal(frame.pixels, mosaic.astype(np.int64) - BLACK)
