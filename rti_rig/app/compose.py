@@ -473,12 +473,22 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
     p = Path(path)
     if not is_raw_file(p) or not p.is_file():
         return read_preview(p)  # which also refuses a folder or a missing file, by name
-    from rti_rig.drivers.cameras.raw_decode import decode_raw
+    from rti_rig.drivers.cameras.raw_decode import MonochromeRawError, decode_raw
     from rti_rig.drivers.cameras.settings import RawDecodeSettings
 
     try:
         settings = RawDecodeSettings(mode="half", white_balance="unity", output_color="raw")
         return decode_raw(p, settings).pixels
+    except MonochromeRawError as exc:
+        # its own words are for a camera's [camera.device.decode] mode and a watched folder,
+        # neither of which plan has (it had named a mode = "half" no config set); a grey
+        # picture is a preview the planner reads, as a 16-bit TIFF
+        raise ScheduleError(
+            f"RAW preview {p}: it is a monochrome sensor's file (LibRaw reads one colour and "
+            "no colour filter array), which the RAW decode does not read. Give a 16-bit "
+            "linear grey TIFF of it (a RAW converter's linear output), or the camera's JPEG, "
+            "as the preview"
+        ) from exc
     except CaptureError as exc:  # its message names the file and LibRaw's reason
         raise ScheduleError(
             f"RAW preview {exc.message} Otherwise give the camera's JPEG or a 16-bit linear "

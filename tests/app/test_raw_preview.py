@@ -113,3 +113,47 @@ def test_a_raw_preview_keeps_its_colour_channels_in_rgb_order(tmp_path: Path) ->
     )
     np.testing.assert_allclose(left, (0.8, 0.1, 0.05), atol=0.01)
     np.testing.assert_allclose(right, (0.05, 0.1, 0.8), atol=0.01)
+
+
+def test_plan_refuses_a_monochrome_raw_preview_in_a_previews_words(tmp_path: Path) -> None:
+    """A monochrome sensor's DNG (LinearRaw, one sample) as plan's preview is refused, as the
+    decode refuses it, but in words for a preview: the decode's own named a camera's
+    ``[camera.device.decode] mode = "half"`` (plan's setting, in no config) and a watched
+    folder's patterns, which plan has neither of. The grey 16-bit TIFF it advises plans."""
+    from tests.dng_spec_writer import ASCII, BYTE, LONG, SHORT, tiff_bytes
+
+    linear = shaded_relief(256)
+    grey = np.round(linear * 65535).astype("<u2")
+    entries = {
+        254: (LONG, [0]),
+        256: (LONG, [grey.shape[1]]),
+        257: (LONG, [grey.shape[0]]),
+        258: (SHORT, [16]),
+        259: (SHORT, [1]),
+        262: (SHORT, [34892]),  # LinearRaw
+        271: (ASCII, ["SpecWriter"]),
+        272: (ASCII, ["monochrome test camera"]),
+        277: (SHORT, [1]),
+        278: (LONG, [grey.shape[0]]),
+        284: (SHORT, [1]),
+        50706: (BYTE, [1, 4, 0, 0]),
+        50708: (ASCII, ["monochrome test camera"]),
+        50717: (LONG, [65535]),
+    }
+    mono = tmp_path / "mono.dng"
+    mono.write_bytes(tiff_bytes(entries, grey.tobytes()))
+    rig = REPO / "rig_configs" / "simulated_dome.toml"
+    args = ["--rig", str(rig), "--lights", "9", "--preview-light", "45,50"]
+    plan = tmp_path / "plan_mono.lp"
+    r = CliRunner().invoke(app, ["plan", str(mono), *args, "--out", str(plan)])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 2, said
+    assert f"RAW preview {mono}: it is a monochrome sensor's file" in said, said
+    assert "16-bit linear grey TIFF" in said, said
+    assert "[camera.device.decode]" not in said and "patterns" not in said, said
+    assert not plan.exists()
+    tif = tmp_path / "mono.tif"
+    tifffile.imwrite(tif, grey)
+    r = CliRunner().invoke(app, ["plan", str(tif), *args, "--out", str(plan)])
+    assert r.exit_code == 0, r.output
+    assert len(read_lp(plan)) == 9
