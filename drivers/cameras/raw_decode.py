@@ -703,7 +703,9 @@ def _monochrome_refusal(mode: str) -> str:
     filter's photosites, and a session's images are of one kind (colour or grey) fixed by its
     first; ``"mosaic"`` labels its images CFA mosaics, which ``rti-rig fit`` refuses and
     export-lp warns of, though a monochrome sensor's are grey pictures. A grey TIFF is what
-    the session takes as a grey picture."""
+    the session takes as a grey picture, and only a folder-watch camera reads TIFFs: the
+    advice names that driver, as a gphoto2 camera's config has no ``patterns`` key (it had
+    told a gphoto2 rig to set one in its ``[camera.device]``, which its config refuses)."""
     kind = (
         "a grey picture, while this camera is set to make colour images "
         f'([camera.device.decode] mode = "{mode}"), and a session\'s images are all of one '
@@ -715,8 +717,9 @@ def _monochrome_refusal(mode: str) -> str:
     return (
         "it is a monochrome sensor's file (LibRaw reads one colour and no colour filter array): "
         f"{kind}. No RAW decode mode here takes it: save the shots as 16-bit grey TIFFs (the "
-        'camera\'s program or a RAW converter) and watch those (patterns = ["*.tif"] in '
-        "[camera.device]), which make a grey session, or shoot with a colour camera"
+        "camera's program or a RAW converter) and watch those with a folder-watch camera "
+        '(patterns = ["*.tif"] in its [camera.device]), which make a grey session, or shoot '
+        "with a colour camera"
     )
 
 

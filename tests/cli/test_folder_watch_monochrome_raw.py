@@ -75,7 +75,7 @@ def test_run_refuses_a_monochrome_cameras_dng_where_the_camera_is_set_for_colour
     assert f"{tether / 'IMG_0001.dng'}: " in said and ".incoming" not in said, said
     assert "it is a monochrome sensor's file" in said, said
     assert '[camera.device.decode] mode = "demosaic"' in said, said
-    assert 'patterns = ["*.tif"] in [camera.device]' in said, said
+    assert 'with a folder-watch camera (patterns = ["*.tif"] in its [camera.device])' in said
     assert "damaged" not in said and "copy the shot again" not in said.lower(), said
     assert "waiting will not help" in said and f"left in {tether}" in said, said
     assert "did not change within" not in said, said  # not waited for

@@ -1200,3 +1200,46 @@ def test_a_download_failed_from_the_camera_s_ram_says_the_shot_is_lost_and_resum
     check_images(out)
     assert [e["index"] for e in journal(out)] == [0, 1, 2, 3]
     assert body.shots == 5  # the lost shot taken again, no other
+
+
+def test_a_monochrome_bodys_raw_is_refused_with_advice_a_gphoto2_rig_can_follow(body, tmp_path):
+    """A monochrome body's DNG (LinearRaw, one sample: no colour filter) over gphoto2: the
+    decode refuses it, and its advice had been to set ``patterns = ["*.tif"]`` in the rig's
+    ``[camera.device]``, a key a gphoto2 camera's config refuses. It names the folder-watch
+    camera that reads TIFFs, and the file is kept."""
+    from dng_spec_writer import ASCII, BYTE, LONG, SHORT, tiff_bytes
+
+    entries = {
+        254: (LONG, [0]),
+        256: (LONG, [48]),
+        257: (LONG, [32]),
+        258: (SHORT, [16]),
+        259: (SHORT, [1]),
+        262: (SHORT, [34892]),  # LinearRaw
+        271: (ASCII, ["SpecWriter"]),
+        272: (ASCII, ["monochrome test camera"]),
+        277: (SHORT, [1]),
+        278: (LONG, [32]),
+        284: (SHORT, [1]),
+        50706: (BYTE, [1, 4, 0, 0]),
+        50708: (ASCII, ["monochrome test camera"]),
+        50717: (LONG, [65535]),
+    }
+    mono = tiff_bytes(entries, np.full((32, 48), 20000, "<u2").tobytes())
+    body.render = lambda b: mono
+    body.raw_suffix = ".DNG"
+    text = DSLR_CONFIG.read_text().replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    config = tmp_path / "dslr.toml"
+    config.write_text(text)
+    out = tmp_path / "s"
+    result = run(str(config), "--out", str(out), "--lights", "3")
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert "Traceback" not in said, said
+    assert "the camera's file IMG_0001.DNG would not decode" in said, said
+    assert "it is a monochrome sensor's file" in said, said
+    assert 'with a folder-watch camera (patterns = ["*.tif"] in its [camera.device])' in said
+    kept = out / "raw" / ".incoming" / "cap0001_IMG_0001.DNG"
+    assert f"kept at {kept}" in said and kept.read_bytes() == mono, said
