@@ -155,7 +155,10 @@ def _check_out_folder(out_dir: Path, force: bool, acquisition: Sequence[Path] = 
                 f"--out {out_dir} is inside the session in {folder}; a session's folder is "
                 "never written into: choose another folder"
             )
-    if out_dir.resolve() in {p.resolve().parent for p in acquisition}:
+    # the folder an image is listed in, and the one its file is in when it is a link (images
+    # linked into a project's jpeg-exports/ from a card's copy resolve to the card's folder)
+    held = {p.parent.resolve() for p in acquisition} | {p.resolve().parent for p in acquisition}
+    if out_dir.resolve() in held:
         raise RtiRigError(
             f"--out {out_dir} holds the acquisition --from reads (its .lp or images): its "
             "folder is never written into, even with --force; choose another folder (a new "

@@ -539,3 +539,32 @@ def test_the_acquisitions_own_folder_is_refused_as_out_even_with_force(
     assert f"error: --out {out} holds the acquisition --from reads" in text, text
     assert "even with --force" in text and "choose another folder" in text
     assert sorted(p.name for p in out.iterdir()) == before
+
+
+def test_a_folder_of_links_to_the_acquisitions_images_is_refused_as_out_even_with_force(
+    tmp_path: Path,
+) -> None:
+    """Images linked into a project's jpeg-exports/ from where the shots lie (a card's copy),
+    the `.lp` in assembly-files/: the refusal compared `--out` with the folders the links
+    resolve to only, so `--out` jpeg-exports/ with `--force` wrote results.csv, summary.md and
+    the plots among the linked images (which RTIBuilder imports by folder)."""
+    shots = _acquisition(tmp_path / "card").parent
+    project = tmp_path / "project"
+    (project / "jpeg-exports").mkdir(parents=True)
+    (project / "assembly-files").mkdir()
+    lines = (shots / "dirs.lp").read_text().splitlines()
+    for i, line in enumerate(lines[1:], start=1):
+        name, rest = line.split(maxsplit=1)
+        (project / "jpeg-exports" / name).symlink_to(shots / name)
+        lines[i] = f"H:\\RTI\\project\\jpeg-exports\\{name} {rest}"  # RTIBuilder's
+    lp = project / "assembly-files" / "dirs.lp"
+    lp.write_text("\n".join(lines) + "\n")
+    out = project / "jpeg-exports"
+    before = sorted(p.name for p in out.iterdir())
+    r = CliRunner().invoke(
+        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out), "--force"]
+    )
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert f"error: --out {out} holds the acquisition --from reads" in text, text
+    assert sorted(p.name for p in out.iterdir()) == before
