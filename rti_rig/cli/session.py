@@ -1072,14 +1072,17 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if _park_stopped_by(opened.rig) is not None:  # delivered after the teardown it stopped:
             return  # no image is left to stop after; the arm's line and the summary say it
         if cancel.over:  # held by the teardown (no park due, or after it) and delivered now
+            # not "no image was left to stop after": after a capture an error or a SIGTERM
+            # ended part-way, that read as if every image were in, above a resume hint
             err.print(
-                "[yellow]Ctrl-C after the capture had ended: no image was left to stop after, "
+                "[yellow]Ctrl-C after the capture had ended: there was nothing left to stop, "
                 "and the rig's teardown has run (what it did is said below).[/]"
             )
             return
         if opened.folder.images_kept >= opened.total_steps:
-            # after the last image (the teardown, the records' last writes): "Stopping after
-            # this image" read as if one were still to come, and asked for a second Ctrl-C
+            # the last image is committed, the capture not yet over (its last writes, an end
+            # check): "Stopping after this image" read as if one were still to come, and asked
+            # for a second Ctrl-C (a Ctrl-C in the teardown is the branch above)
             err.print("[yellow]Every image is in: finishing the session (lights off, records)…[/]")
             return
         err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")

@@ -246,7 +246,7 @@ def test_a_ctrl_c_in_a_teardown_that_stops_no_park_is_not_said_to_have(
     # the images were all in: there was no image to stop after (it had said "Stopping after
     # this image (Ctrl-C again to stop at once)")
     assert "Stopping after this image" not in said, said
-    assert "Ctrl-C after the capture had ended: no image was left to stop after" in said, said
+    assert "Ctrl-C after the capture had ended: there was nothing left to stop" in said, said
     assert code == 0, said
 
 
