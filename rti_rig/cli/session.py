@@ -794,6 +794,13 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
             # teardown; an adaptive session its stopping rule ended short of its maximum):
             # "Continue with: rti-rig run --resume" had been said of a complete session, which
             # has nothing left to resume (the resume refused it as "already completed")
+            disowned = _labels_disowned(out_dir)
+            if disowned is not None:
+                return (
+                    f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}, their "
+                    f"labels NOT verified: {disowned} says why (fit and export-lp refuse this "
+                    f"session). {resume_hint}"
+                )
             unrecorded = _end_unrecorded(folder.manifest)
             if unrecorded and not _cannot_resume(opened.rig):
                 return (
@@ -843,6 +850,18 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         return f"Nothing was captured: {out_dir} holds no image and may be used again."
     # e.g. a camera's file downloaded for a step that then failed: kept, never deleted
     return f"No image was completed, but {out_dir} holds files of the camera. {resume_hint}"
+
+
+def _labels_disowned(out_dir: Path) -> Path | None:
+    """The marker that disowns the session's labels (None: there is none).
+
+    Why: a camera-triggered dome's run stopped once its last image was in, before its
+    end-of-run proof frame, was told "the session is complete, nothing is left to resume.
+    Next: rti-rig fit", and fit then refused it as labelled with unverified lights."""
+    from rti_rig.runtime.disowned import MARKER
+
+    marker = Path(out_dir) / MARKER
+    return marker if marker.is_file() else None
 
 
 def _run_completed(folder) -> bool:  # type: ignore[no-untyped-def]

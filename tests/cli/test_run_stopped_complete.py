@@ -154,3 +154,30 @@ def test_a_sigterm_after_an_until_error_stop_says_complete_not_resume(tmp_path: 
     assert f"Next: rti-rig fit {out} --out FOLDER" in said, said
     code, again = _cli("run", "--resume", str(out))
     assert code != 0 and "already completed" in again, again  # what the advice would have met
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
+def test_a_camera_triggered_run_stopped_before_its_proof_is_not_said_complete(
+    tmp_path: Path,
+) -> None:
+    """Every image of the shipped cceh/rti dome is in, but the SIGTERM stops the run before its
+    end-of-run proof frame, which alone verifies the labels: it had said "the session is
+    complete, nothing is left to resume. Next: rti-rig fit", and fit refused the session."""
+    out = tmp_path / "s"
+    args = ["run", str(CONFIGS / "emulated_cceh_rti.toml"), "--out", str(out), "--no-verdict"]
+    proc = subprocess.run(
+        [sys.executable, "-c", SCRIPT, "59", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
+    )
+    said = " ".join((proc.stdout + proc.stderr).split())
+    assert proc.returncode == 143 and "Emergency stop (SIGTERM)" in said, said
+    assert len(list(out.glob("image_*.jpg"))) == 60, said  # every image is in
+    assert "session is complete" not in said and "Next: rti-rig fit" not in said, said
+    marker = out / "LABELS_NOT_VERIFIED.txt"
+    assert f"listed in lights.lp, their labels NOT verified: {marker} says why" in said, said
+    assert "A camera-triggered dome cannot resume a session" in said, said
+    code, fitted = _cli("fit", str(out), "--out", str(tmp_path / "fit"))  # what fit says of it
+    assert code != 0 and "it is not used" in fitted, fitted
