@@ -802,13 +802,19 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
                     f"session). {resume_hint}"
                 )
             unrecorded = _end_unrecorded(folder.manifest)
-            if unrecorded and not _cannot_resume(opened.rig):
-                return (
+            if unrecorded:
+                head = (
                     f"{folder.images_kept} image(s) kept in {out_dir}, listed in {LP_NAME}: "
                     f"every image is in, but the stop came before the run recorded {unrecorded}"
-                    f", so `rti-rig fit` calls it not finished. `rti-rig run --resume "
-                    f"{_arg(out_dir)}` records it complete without shooting anything again; "
-                    f"`rti-rig fit {_arg(out_dir)} --out FOLDER` fits the images as they are"
+                    ", so `rti-rig fit` calls it not finished"
+                )
+                fit_it = f"`rti-rig fit {_arg(out_dir)} --out FOLDER` fits the images as they are"
+                cannot = _cannot_resume(opened.rig)
+                if cannot:  # an image sequence: it had been said complete, fit contradicting
+                    return f"{head}; {fit_it}. {cannot}"
+                return (
+                    f"{head}. `rti-rig run --resume {_arg(out_dir)}` records it complete without "
+                    f"shooting anything again; {fit_it}"
                 )
             if folder.images_kept < opened.total_steps:
                 return (

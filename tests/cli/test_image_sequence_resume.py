@@ -80,3 +80,40 @@ def test_a_session_shot_from_an_image_sequence_is_not_resumed(dome, tmp_path: Pa
     assert "Traceback" not in r.output
     after = sorted((p.relative_to(out), p.read_bytes()) for p in out.rglob("*") if p.is_file())
     assert after == before  # refused before the folder was touched
+
+
+def test_a_stop_once_every_image_is_in_says_what_fit_will_say(
+    dome, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A SIGTERM as the last image is committed (held by the commit, acted on after it): every
+    image is in, but the run has not recorded its end, and it cannot be resumed to record it.
+    It had said "the session is complete, nothing is left to resume", and fit then called the
+    session "not finished"."""
+    import signal
+
+    from rti_rig.runtime.session import SessionFolder
+
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i in range(4):
+        cv2.imwrite(str(frames / f"f_{i:03d}.png"), np.full((24, 32, 3), 40 + 30 * i, np.uint8))
+    real_write = SessionFolder.write_step
+
+    def write_step(self, i, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if i == 3:  # the last image: the commit holds the signal until it is written
+            signal.raise_signal(signal.SIGTERM)
+        return real_write(self, i, *args, **kwargs)
+
+    monkeypatch.setattr(SessionFolder, "write_step", write_step)
+    out = tmp_path / "s"
+    argv = ["run", str(_config(tmp_path, frames)), "--out", str(out), "--lights", "4"]
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 143 and "Emergency stop (SIGTERM)" in said, said
+    assert len(list(out.glob("image_*.jpg"))) == 4 and "Traceback" not in said, said
+    assert "session is complete" not in said and "--resume" not in said, said
+    assert "every image is in, but the stop came before the run recorded its end" in said, said
+    fit_it = f"rti-rig fit {out} --out FOLDER` fits the images as they are."
+    assert f"{fit_it} It cannot be resumed: its camera is an image sequence" in said, said
+    r = runner.invoke(app, ["fit", str(out), "--out", str(tmp_path / "fit")])
+    assert "the session is not finished" in " ".join(r.output.split()), r.output
