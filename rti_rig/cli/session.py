@@ -781,12 +781,8 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
     from rti_rig.runtime.session import LP_NAME, holds_no_image
 
     folder, out_dir = opened.folder, opened.out_dir
-    if opened.resumed and not folder.begun and not _cannot_resume(opened.rig):
-        runs = (folder.manifest or {}).get("runs") or []
-        if runs and runs[-1].get("finish_reason") == "completed":
-            # a --reshoot-lost stopped before it wrote anything: the session is still the
-            # completed one, which a plain --resume refuses
-            resume_hint = f"Continue with: rti-rig run --resume {_arg(out_dir)} --reshoot-lost"
+    if _reshoot_not_begun(opened):
+        resume_hint = f"Continue with: {_resume_before_begin(opened)}"
     if folder.images_kept:
         whole, listed = folder.lp_listing()
         if whole and (folder.images_kept >= opened.total_steps or _run_completed(folder)):
@@ -856,6 +852,27 @@ def _after_stop(opened, resume_hint: str) -> str:  # type: ignore[no-untyped-def
         return f"Nothing was captured: {out_dir} holds no image and may be used again."
     # e.g. a camera's file downloaded for a step that then failed: kept, never deleted
     return f"No image was completed, but {out_dir} holds files of the camera. {resume_hint}"
+
+
+def _reshoot_not_begun(opened) -> bool:  # type: ignore[no-untyped-def]
+    """Whether ``opened`` is a resume of a completed session (a --reshoot-lost) stopped before
+    it wrote anything: the session is still the completed one, which a plain --resume
+    refuses."""
+    folder = opened.folder
+    if not opened.resumed or folder.begun or _cannot_resume(opened.rig):
+        return False
+    runs = (folder.manifest or {}).get("runs") or []
+    return bool(runs) and runs[-1].get("finish_reason") == "completed"
+
+
+def _resume_before_begin(opened) -> str:  # type: ignore[no-untyped-def]
+    """The resume command for a resume stopped before it wrote anything: with --reshoot-lost
+    when the session is a completed one (:func:`_reshoot_not_begun`).
+
+    Why: a --reshoot-lost stopped as the capture took over from the opening was told a plain
+    ``rti-rig run --resume S``, which refuses a completed session."""
+    tail = " --reshoot-lost" if _reshoot_not_begun(opened) else ""
+    return f"rti-rig run --resume {_arg(opened.out_dir)}{tail}"
 
 
 def _labels_disowned(out_dir: Path) -> Path | None:
@@ -1007,7 +1024,7 @@ def _stopped_before_capture(opened, why: str) -> typer.Exit:  # type: ignore[no-
     if opened.resumed:
         said = (
             f"Stopped ({why}) before the session went on: no new image was captured; continue "
-            f"it with rti-rig run --resume {_arg(opened.out_dir)}"
+            f"it with {_resume_before_begin(opened)}"
         )
     else:
         said = f"Stopped ({why}) before the first image: nothing was captured"

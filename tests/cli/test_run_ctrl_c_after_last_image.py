@@ -117,3 +117,36 @@ def test_a_reshoot_stopped_before_it_wrote_anything_is_not_said_complete(tmp_pat
     assert "session is complete" not in said and "Traceback" not in said, said
     assert f"5 image(s) kept in {out}" in said, said
     assert f"Continue with: rti-rig run --resume {out} --reshoot-lost" in said, said
+
+
+def test_a_reshoot_stopped_as_the_capture_takes_over_is_told_to_reshoot(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same stop, held by the hand-over from the opening to the capture (a SIGTERM raised
+    as the hand-over starts holding): it had been told "continue it with rti-rig run --resume
+    S", which refuses a completed session, --reshoot-lost dropped."""
+    import signal
+
+    from typer.testing import CliRunner
+
+    import rti_rig.cli.session as cli_session
+    from rti_rig.cli import app
+
+    code, said, out = _run(tmp_path, 99, 0, "--lights", "6")
+    assert code == 0, said
+    (out / "image_003.jpg").unlink()
+    (out / "linear" / "image_003.tif").unlink()
+    real_hold, held = cli_session.HandOver.hold, []
+
+    def hold(self):  # type: ignore[no-untyped-def]
+        real_hold(self)
+        held.append(signal.SIGTERM)
+        signal.raise_signal(signal.SIGTERM)  # recorded by the hand-over, answered by the capture
+
+    monkeypatch.setattr(cli_session.HandOver, "hold", hold)
+    argv = ["run", "--resume", str(out), "--reshoot-lost", "--no-verdict"]
+    r = CliRunner().invoke(app, argv, terminal_width=400)
+    said = " ".join(r.output.split())
+    assert held and r.exit_code == 143 and "Traceback" not in said, said
+    assert "Stopped (SIGTERM) before the session went on" in said, said
+    assert f"continue it with rti-rig run --resume {out} --reshoot-lost" in said, said
