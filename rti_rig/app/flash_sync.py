@@ -284,7 +284,9 @@ def keep_unlabelled(
 
 def emulated_flash_sync_camera(loaded, geometry: DomeGeometry, clock: Clock):  # type: ignore[no-untyped-def]
     """The cceh/rti emulator fired by a simulated camera's sync contact; returns the camera
-    (its ``dome`` is the emulator)."""
+    (its ``dome`` is the emulator). An LED of ``[emulator] dead_leds`` gives no light when the
+    firmware fires it (accepted and ignored here, the one emulated dome left so, a dead LED
+    could not be rehearsed on a camera-triggered dome)."""
     from rti_rig.app.compose import SIMULATED_SCENE_EXPOSURE_S, scene_renderer
     from rti_rig.simulator.domes.cceh_rti import CcehRtiFirmware
     from rti_rig.simulator.flash_sync_camera import FlashSyncCamera, SyncFault
@@ -292,13 +294,14 @@ def emulated_flash_sync_camera(loaded, geometry: DomeGeometry, clock: Clock):  #
     cfg = loaded.config
     render = scene_renderer(loaded)
     powers = cfg.emulator.led_powers(geometry.count, cfg.scene.seed)
+    dead = frozenset(cfg.emulator.dead_leds)
     return FlashSyncCamera(
         render,
         CcehRtiFirmware(start=clock.now()),
         geometry.directions,
         clock,
         faults=tuple(SyncFault(f.at_image, f.kind) for f in cfg.emulator.sync_faults),
-        power=lambda led: float(powers[led]),
+        power=lambda led: 0.0 if led in dead else float(powers[led]),
         reference_exposure_s=SIMULATED_SCENE_EXPOSURE_S,
         readout_s=cfg.timing.readout_s,
         transfer_s=cfg.timing.transfer_s,

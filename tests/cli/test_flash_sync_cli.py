@@ -338,3 +338,20 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
         text = " ".join(result.output.split())
         assert "this session already completed all 60 steps; nothing to resume" in text
         assert "cannot be used" not in text
+
+
+def test_a_dead_led_gives_a_dark_image_that_is_caught(tmp_path: Path, rigs) -> None:  # type: ignore[no-untyped-def]
+    """``[emulator] dead_leds`` had been accepted and ignored on the camera-triggered dome: the
+    run went through all 60 LEDs with the dead one lit. The firmware fires it (the dome steps);
+    it gives no light, and the slip guard catches the dark image there."""
+    config = tmp_path / "rig.toml"
+    config.write_text(SHIPPED.read_text(encoding="utf-8") + "\n[emulator]\ndead_leds = [5]\n")
+    out = tmp_path / "s"
+    result = runner.invoke(app, ["run", str(config), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert "image 6 was not lit by LED 6" in text and "dark" in text, text
+    rig = rigs[-1]
+    assert truth(rig)[5] == 5  # the firmware did fire LED 6: it is the LED that gave no light
+    assert lp_matches_truth(out, rig) == 5
+    assert (out / "unlabelled" / "image_006.tif").is_file()
