@@ -904,10 +904,11 @@ def _run_completed(folder) -> bool:  # type: ignore[no-untyped-def]
 def _print_teardown_failures(  # type: ignore[no-untyped-def]
     folder, said_below: BaseException | None = None
 ) -> bool:
-    """What could not be made safe when a session stopped early (the controller records it in
-    the manifest; the lights' state line that follows refers to it); True if any.
+    """What could not be made safe when this run stopped early (the controller hands it to the
+    folder's ``finish``, not the manifest's, which a resume that never connected leaves with
+    the previous run's; the lights' state line that follows refers to it); True if any.
     ``said_below``: the session's error, printed in full after these lines."""
-    failures = (folder.manifest.get("runner") or {}).get("teardown_failures")
+    failures = (getattr(folder, "run_end", None) or {}).get("teardown_failures")
     return _print_failures(failures, said_below)
 
 

@@ -178,11 +178,18 @@ class ArmLighting:
         self.stopped_by: int | None = None
         #: the first signal held by the running :meth:`safe`, whether or not a park was due
         self._stop_asked: int | None = None
+        #: the last :meth:`connect` raised (the arm was never reached): no park, no end
+        self.connect_failed = False
 
     def connect(self) -> None:
         self.arm_failure = None
         self.end = None
-        self.carrier.connect()
+        self.connect_failed = False
+        try:
+            self.carrier.connect()
+        except BaseException:
+            self.connect_failed = True
+            raise
 
     def close(self) -> None:
         """Close the carrier, then record in :attr:`end` what the close did to its torque.
@@ -273,6 +280,14 @@ class ArmLighting:
         failures = attempt_all([("lamp off", lambda: self.carrier.lamp(False))])
         stop_failed = attempt_all([("stop", self.carrier.stop)])
         failures += stop_failed
+        if self.connect_failed:
+            # a connect that failed (a servo reporting an overload as the port opened): no
+            # park, and no end to record, as nothing was read back; what may be said of the
+            # servos is the carrier's (``not_connected_sentence``). A park had been asked of it,
+            # refused by its driver and reported as a teardown problem ("park: not connected;
+            # call connect() first") of a move that must not be tried
+            self.end = None
+            return failures
         if not (self.park_on_emergency if emergency else self.park_after_session):
             policy = (
                 "park_on_emergency_stop is off: an emergency stop leaves it where it stopped"

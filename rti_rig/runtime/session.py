@@ -583,6 +583,13 @@ class SessionFolder:
         #: was shot from and what was assumed about it, not only the terminal that ran it
         self.input_notes: list[str] = []
         self.begun = False
+        #: this run's end as the controller handed it to :meth:`finish` (its ``runner``
+        #: record: finish reason, teardown failures, arm end), None before; kept also for a
+        #: run that never began. Why: a resume whose rig did not connect writes no manifest,
+        #: whose ``runner`` then still holds the previous run's end, and ``run`` had printed
+        #: that run's teardown problems ("stop incomplete: servo 1 held where it is") as this
+        #: run's, beside "Nothing was commanded: the arm could not be connected"
+        self.run_end: dict[str, Any] | None = None
         #: every committed step (earlier runs' verified ones and this run's), by index
         self.committed: dict[int, StepRecord] = {}
 
@@ -1016,8 +1023,11 @@ class SessionFolder:
         (with ``source_result``, an adaptive session's outcome, under ``adaptive.result``: in
         the one write that says the session completed, so that no stop can fall between them).
 
-        Does nothing for a session that never began (nothing was created on disk).
+        Writes nothing for a session that never began (nothing was created on disk), but keeps
+        ``runner`` as :attr:`run_end` whatever happens (the very dict: a failure the caller
+        appends to it after a failed write is this run's too).
         """
+        self.run_end = runner
         try:
             self._finish(records, runner, timing, source_result)
         finally:
