@@ -127,12 +127,15 @@ class DynamixelArm:
         port: Any,
         clock: Clock,
         packet_handler: Any | None = None,
+        *,
+        config_path: str | None = None,
     ) -> None:
         self.settings = settings
         self.name = settings.name
         self.clock = clock
         self.kin = ArmKinematics(settings)
-        self._bus = DxlBus(port, settings.name, packet_handler)
+        # the rig config's path: a servo fault's advice names it in the command to paste
+        self._bus = DxlBus(port, settings.name, packet_handler, config=config_path)
         self._connected = False
         #: whether a connect ever completed (what a stop may say of an arm it never reached)
         self.ever_connected = False

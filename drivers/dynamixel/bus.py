@@ -108,9 +108,18 @@ class _ReleasingHandler:
 class DxlBus:
     """Checked Protocol 2.0 commands over an SDK port (a ``PortHandler`` or a stand-in)."""
 
-    def __init__(self, port: Any, device: str, packet_handler: Any | None = None) -> None:
+    def __init__(
+        self,
+        port: Any,
+        device: str,
+        packet_handler: Any | None = None,
+        *,
+        config: str | None = None,
+    ) -> None:
         self.port = port
         self.device = device
+        #: the rig config the arm was opened from (named in a hardware fault's advice)
+        self.config = config
         self.ph = _ReleasingHandler(packet_handler or sdk.PacketHandler(2.0), port, device)
         #: the line speed the port was opened at (named when a servo does not answer)
         self.baudrate: int | None = None
@@ -241,7 +250,9 @@ class DxlBus:
                 )
             except DynamixelError:
                 voltage = None
-        return HardwareFaultError(self.device, dxl_id, status, command, torque_on, voltage)
+        return HardwareFaultError(
+            self.device, dxl_id, status, command, torque_on, voltage, config=self.config
+        )
 
     #: Results that mean the status packet was lost or damaged (not that the servo refused).
     RETRYABLE = (sdk.COMM_RX_TIMEOUT, sdk.COMM_RX_CORRUPT)

@@ -8,6 +8,7 @@ MODEL_NAMES; factory values are not (per model, cited: rti_rig.simulator.dynamix
 
 from __future__ import annotations
 
+import shlex
 from dataclasses import dataclass
 from enum import IntEnum
 
@@ -138,7 +139,7 @@ class HardwareFault(IntEnum):
 
 
 #: What to do about each fault; :class:`~rti_rig.drivers.dynamixel.faults.HardwareFaultError`
-#: follows it with :data:`REBOOT_HOW`.
+#: follows it with :func:`reboot_how`.
 FAULT_ADVICE = {
     HardwareFault.INPUT_VOLTAGE: "check the power supply voltage against the servo's limits",
     HardwareFault.OVERHEATING: "let the servo cool down and reduce its load or duty cycle",
@@ -146,16 +147,25 @@ FAULT_ADVICE = {
     HardwareFault.ELECTRICAL_SHOCK: "check wiring and power",
     HardwareFault.OVERLOAD: "the arm is blocked or overloaded; clear the obstruction",
 }
-#: How a user restarts a servo to clear its fault — rti-rig has no reboot command, and
-#: refuses to connect to a servo reporting one: the e-manual's H/W REBOOT (power off and on)
-#: or S/W REBOOT (the Reboot instruction, e.g. from Dynamixel Wizard 2.0; ROBOTIS-GIT/emanual
-#: _includes/en/dxl/x/shutdown.md @ 048ec0de). The advice had said "then reboot" for some
-#: faults and nothing for others: an overheated servo, told only to cool down, was refused
-#: again once cool, its fault still latched.
-REBOOT_HOW = (
-    "then run rti-rig check RIG.toml --reboot-faulted (it reboots the faulted servos whose "
-    "torque is off, and nothing moves), or switch the servos' power off and on, to clear it"
-)
+
+
+def reboot_how(config: str | None = None) -> str:
+    """The advice's last clause: how to clear a latched fault, ``config`` (the rig config's
+    path, shell-quoted) named in the command when known, so that it can be pasted; the
+    placeholder ``RIG.toml`` only for a bus opened without a rig config (the manual tools).
+
+    The two ways are the e-manual's S/W REBOOT (the Reboot instruction, which ``check
+    --reboot-faulted`` sends) and H/W REBOOT (power off and on; ROBOTIS-GIT/emanual
+    _includes/en/dxl/x/shutdown.md @ 048ec0de). Why: the advice had said "then reboot" for
+    some faults and nothing for others (an overheated servo, told only to cool down, was
+    refused again once cool, its fault still latched); and "then run rti-rig check RIG.toml
+    --reboot-faulted" was said by ``run`` and ``check`` of a config they had just opened,
+    which the user had to put in by hand."""
+    rig = shlex.quote(config) if config else "RIG.toml"
+    return (
+        f"then run rti-rig check {rig} --reboot-faulted (it reboots the faulted servos whose "
+        "torque is off, and nothing moves), or switch the servos' power off and on, to clear it"
+    )
 
 
 def decode_hardware_error(status: int) -> list[HardwareFault]:

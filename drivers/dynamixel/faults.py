@@ -40,7 +40,8 @@ class HardwareFaultError(DynamixelError):
     ``torque_on`` is Torque Enable as read after the fault (``None``: it could not be read),
     so the message never claims a limp joint that is still driven, or a held one that is limp.
     ``voltage`` is (Present Input Voltage, Min, Max Voltage Limit) in 0.1 V as read for an
-    input-voltage error (``None``: not read)."""
+    input-voltage error (``None``: not read). ``config``: the rig config's path, named in the
+    ``--reboot-faulted`` command the message gives (:func:`~control_table.reboot_how`)."""
 
     def __init__(
         self,
@@ -50,6 +51,8 @@ class HardwareFaultError(DynamixelError):
         command: str | None,
         torque_on: bool | None = None,
         voltage: tuple[int, int, int] | None = None,
+        *,
+        config: str | None = None,
     ) -> None:
         self.status = status
         self.torque_on = torque_on
@@ -69,7 +72,7 @@ class HardwareFaultError(DynamixelError):
         super().__init__(
             device,
             f"hardware fault {names} (Hardware Error Status 0x{status:02X}); {advice}; "
-            f"{ct.REBOOT_HOW}. " + torque_statement(torque_on),
+            f"{ct.reboot_how(config)}. " + torque_statement(torque_on),
             command,
             servo_id,
         )

@@ -286,7 +286,7 @@ def _build_emulated_arm(loaded: LoadedRig, geometry: ArmGeometry, clock: Clock) 
     for f in loaded.config.emulator.faults:
         emulator.add_fault(f.at_command, f.kind, f.servo_id)
     try:
-        arm = DynamixelArm(settings, port, clock)
+        arm = DynamixelArm(settings, port, clock, config_path=loaded.path)
         camera = _simulated_camera(loaded, _ArmLamp(arm, emulator, settings), clock)
     except BaseException:
         stack.close()
@@ -339,7 +339,9 @@ def _build_hardware(loaded: LoadedRig, clock: Clock) -> Rig:
         # the port in the name, as a hardware dome's: "arm during 'ping': servo 3: no servo
         # with id 3 answers at 57600 baud" had named no port, on a bench with two adapters
         named = settings.model_copy(update={"name": f"{settings.name} on {settings.port}"})
-        arm = DynamixelArm(named, dynamixel_sdk.PortHandler(settings.port), clock)
+        arm = DynamixelArm(
+            named, dynamixel_sdk.PortHandler(settings.port), clock, config_path=loaded.path
+        )
         camera = build_camera(camera_settings, clock=clock)
         rig = Rig(loaded, geometry, _arm_lighting(loaded, arm), camera, clock)
     rig.session_hooks.append(_session_hook(camera))

@@ -10,6 +10,7 @@ rehearsed (an ``overload`` fault was refused at load).
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 
 import pytest
@@ -37,7 +38,8 @@ def test_check_on_a_servo_that_overloads_stops_names_it_and_leaves_it_unparked(
     assert r.exit_code == 1, said
     assert "Traceback" not in said
     assert "servo 2: hardware fault overload (Hardware Error Status 0x20)" in said, said
-    assert "run rti-rig check RIG.toml --reboot-faulted" in said
+    # the command names the config checked (it had said "RIG.toml", a placeholder)
+    assert f"run rti-rig check {shlex.quote(str(tmp_path / 'arm.toml'))} --reboot-faulted" in said
     assert "NOT parked" in said and "RESULT: FAIL" in said
     # the fault's paragraph is said once (it was printed three times: the pose's row, ABORTED
     # and the teardown's stop), and the teardown still says what it met
