@@ -41,6 +41,9 @@ FIRMWARES: dict[str, dict[str, Any]] = {
     "cceh-rti": {"led_count": 60, "timeout_s": 4.0},
 }
 UNLABELLED_DIR = "unlabelled"
+#: The frame after a dark image names the LED it was lit by when that LED's residual is below
+#: this fraction of the other candidate's (else the two are not told apart, and both are said).
+DECIDE_RATIO = 0.8
 
 
 class FlashSyncSettings(BaseModel):
@@ -128,6 +131,9 @@ class SlipGuard:
         self.settings = settings
         self.checker = SequenceChecker(geometry.directions, settings.check_after_images)
         self.verdicts: list[Any] = []
+        #: Shoots one more frame (set by :func:`build_flash_sync_rig`): after a dark image it
+        #: tells a missed pulse (the dome did not step) from a dead LED (it stepped on).
+        self.shoot: Callable[[], Frame] | None = None
 
     def __call__(self, index: int, frame: Frame, actual: ActualLight, root: Path) -> None:
         if not self.verdicts and not (Path(root) / DISOWN_MARKER).exists():
@@ -145,6 +151,8 @@ class SlipGuard:
             "The dome's count no longer matches the session: long-press its start button to "
             "rewind it, then start a new session"
         )
+        if verdict.dark:
+            raise LightSlipError(self._after_dark(index, verdict, kept, Path(root), rewind))
         last = self.settings.firmware_led_count - 1
         if verdict.fitted and verdict.best_position == index - 1 and index == last:
             # the firmware re-lights its last LED once its order is exhausted: it got there early
@@ -178,6 +186,87 @@ class SlipGuard:
             f"image {index + 1} was not lit by LED {index + 1} of the dome's order — {what}: "
             f"{verdict.reason}. The image is kept, unlabelled, as {kept}; lights.lp lists "
             f"{before} only. {rewind}"
+        )
+
+    def _after_dark(self, index: int, verdict: Any, kept: str, root: Path, rewind: str) -> str:
+        """What a dark image was, from one more frame (:meth:`SequenceChecker.judge_after_dark`).
+
+        A missed pulse and a dead LED both give a dark image, but a missed pulse leaves the
+        dome one LED behind (the next frame is lit by the LED this image was due) while a dead
+        LED was fired and the dome stepped on (the next frame is lit by the next LED, as the
+        order says). Blaming the flash signal for a dead LED sent the user after a good cable
+        and told them the dome's count was lost when it was not.
+        """
+        k, n = index + 1, self.geometry.count
+        head = f"image {k} was not lit by LED {k} of the dome's order — {verdict.reason}"
+        listed = f"images 1–{index}" if index > 1 else ("image 1" if index == 1 else "no image")
+        either = (
+            f"either the flash pulse did not reach the dome (a missed step: it did not step, "
+            f"and its count no longer matches the session) or LED {k} is dead (the dome "
+            "stepped on)"
+        )
+        rewind_either = (
+            "Either way the session stops here: long-press the dome's start button to rewind "
+            "it, then start a new session"
+        )
+        if self.shoot is None:
+            return (
+                f"{head}: {either}. The image is kept, unlabelled, as {kept}; lights.lp lists "
+                f"{listed} only. {rewind_either}"
+            )
+        frame = self.shoot()
+        ratio, residuals = self.checker.judge_after_dark(index, frame.pixels, frame.white_level)
+        record = {
+            "after_dark_image": k,
+            "brightness_ratio": ratio,
+            "residuals": None if residuals is None else {str(p): r for p, r in residuals.items()},
+        }
+        check = _keep(root, index + 1, frame, record, stem="check")
+        shot = f"the frame shot after it to tell, kept unlabelled as {check},"
+        end = self.settings.firmware_led_count == n and index == n - 1
+        due, nxt = (residuals or {}).get(index), (residuals or {}).get(index + 1)
+        dead = missed = False
+        if residuals is None and ratio < 1.0 and (end or ratio < 0.5):
+            # dark again: the firmware re-lights its last (dead) LED; else no LED lit it either
+            if end:
+                dead, why = True, f"{shot} is dark too: the firmware re-lit its last LED, {k}"
+            else:
+                why = f"{shot} is dark too"
+        elif due is not None and nxt is not None:
+            vs = f"relative residual {min(due, nxt):.3f} against {max(due, nxt):.3f}"
+            if nxt < DECIDE_RATIO * due:
+                dead, why = True, f"{shot} was lit by LED {k + 1}, as the order says ({vs})"
+            elif due < DECIDE_RATIO * nxt:
+                missed = True
+                why = f"{shot} was lit by LED {k}, the one image {k} was due ({vs})"
+            else:
+                why = f"{shot} fits LEDs {k} and {k + 1} alike ({vs})"
+        elif due is not None and end:
+            missed, why = True, f"{shot} was lit by LED {k}, the one image {k} was due"
+        else:
+            why = f"{shot} could not be judged (too few images before it to fit)"
+        if dead:
+            return (
+                f"image {k} is dark: LED {k} did not light (dead LED?); the dome stepped on: "
+                f"{why}. Image {k}: {verdict.reason}; it is kept, unlabelled, as {kept}. The "
+                f"session's other images are good as far as the per-image check can tell: "
+                f"lights.lp lists {listed}, each matched to its LED (the run stopped before its "
+                f"end-of-run proof, so {DISOWN_MARKER} stays in the session). Repair or replace "
+                f"LED {k} (look at it during a flash), then long-press the dome's start button "
+                "to rewind it and shoot the session again; the dome's count matched the session, "
+                "the run stopped only for the dark image"
+            )
+        if missed:
+            return (
+                f"{head}: missed step — the flash pulse did not reach the dome, which therefore "
+                f"did not step: {why}. Check the camera's PC-sync cable and flash-contact "
+                f"setting. The image is kept, unlabelled, as {kept}; lights.lp lists {listed} "
+                f"only. {rewind}"
+            )
+        return (
+            f"{head}: {either}; {why}. The image is kept, unlabelled, as {kept}; lights.lp "
+            f"lists {listed} only. Look at LED {k} during a flash and check the camera's "
+            f"PC-sync cable. {rewind_either}"
         )
 
     def end_of_run(self, shoot: Callable[[], Frame], root: Path) -> list[str]:
@@ -331,6 +420,13 @@ def build_flash_sync_rig(loaded, geometry: DomeGeometry, clock: Clock, camera=No
         capture_check=guard,
         end_check=guard.end_of_run,
     )
+
+    def shoot() -> Frame:
+        from rti_rig.runtime.controller import shoot_lit
+
+        return shoot_lit(rig, rig.camera_config.exposure_s)
+
+    guard.shoot = shoot
     if emulated:
         rig.emulator = camera.dome  # type: ignore[attr-defined]  # the truth, for tests
     return rig

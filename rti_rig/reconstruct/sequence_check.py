@@ -11,9 +11,11 @@ Evidence, cheapest first, on the grey image reduced to at most :data:`SIDE` pixe
 
 1. **dark**: the image's 99th percentile below :data:`DARK_RATIO` of the brightest image
    accepted so far (below :data:`DARK_FIRST` of full scale for the first image): no LED lit
-   the exposure — the pulse never reached the dome. Grazing light on a flat, dark or metallic
-   object can be 10 × dimmer than the brightest image; a missed pulse leaves only the
-   ambient light inside the dome, far below that;
+   the exposure — the pulse never reached the dome, or the LED it fired is dead. Grazing light
+   on a flat, dark or metallic object can be 10 × dimmer than the brightest image; a missed
+   pulse or a dead LED leaves only the ambient light inside the dome, far below that. Which of
+   the two it was, only the next frame says (:meth:`SequenceChecker.judge_after_dark`): after
+   a missed pulse it is lit by the LED the dark image was due, after a dead LED by the next;
 2. **which neighbour in the order explains it** (from :data:`MIN_FIT_IMAGES` accepted images
    on): the qa.py machinery — robust Lambertian photometric stereo
    (:func:`~rti_rig.reconstruct.photometric_stereo.fit_photometric_stereo`) on the images
@@ -81,7 +83,8 @@ OK, MISSED, DOUBLE = "ok", "missed-step", "double-step"
 class SequenceVerdict:
     """The check of image ``index`` (0-based), expected lit by position ``index`` of the order.
 
-    ``kind`` is ``ok``, ``missed-step`` (dark, or lit by the previous LED: the dome is behind)
+    ``kind`` is ``ok``, ``missed-step`` (lit by the previous LED: the dome is behind; or dark,
+    with ``dark`` set: a missed pulse or a dead LED, which only the next frame tells apart)
     or ``double-step`` (lit by the next LED: the dome is ahead). ``residuals`` are the relative
     residuals per order position tried; ``fitted`` says whether the neighbour test ran.
     """
@@ -95,6 +98,9 @@ class SequenceVerdict:
     brightness_ratio: float = float("nan")
     #: For a slip found by the blind-spot test: the image (0-based) it started at.
     since: int | None = None
+    #: No LED lit the image. A missed pulse and a dead LED both give one; only the next frame
+    #: tells them apart (:meth:`SequenceChecker.judge_after_dark`).
+    dark: bool = False
 
     @property
     def slip(self) -> bool:
@@ -110,6 +116,7 @@ class SequenceVerdict:
             "residuals": {str(k): v for k, v in self.residuals.items()},
             "brightness_ratio": self.brightness_ratio,
             "since": self.since,
+            "dark": self.dark,
         }
 
 
@@ -154,11 +161,11 @@ class SequenceChecker:
                 MISSED,
                 f"dark: its brightest pixels reach {ratio:.0%} of "
                 + ("the brightest image's" if self._peaks else "full scale")
-                + ": no LED lit the exposure (the flash pulse did not reach the dome, which "
-                "therefore did not step)",
+                + ": no LED lit the exposure",
                 None,
                 False,
                 brightness_ratio=ratio,
+                dark=True,
             )
         verdict = self._neighbour_test(index, img, ratio)
         if verdict.slip:
@@ -171,33 +178,61 @@ class SequenceChecker:
             self._peaks.append(peak)
         return verdict
 
+    def judge_after_dark(
+        self, index: int, pixels: ArrayLike, white_level: float
+    ) -> tuple[float, dict[int, float] | None]:
+        """The frame shot after dark image ``index``: its brightness ratio, and its relative
+        residuals under order positions ``index`` and ``index + 1`` (None without a fit).
+
+        Why: a missed pulse leaves the dome one LED behind, so that frame is lit by LED
+        ``index`` (the one the dark image was due); a dead LED was fired and the dome stepped
+        on, so it is lit by LED ``index + 1``, as the order says. The frame joins nothing.
+        """
+        img = reduce_image(pixels, white_level)
+        ref = max(self._peaks) if self._peaks else 1.0
+        peak = float(np.percentile(img, 99.0))
+        ratio = peak / ref if ref > 0 else float("inf")
+        if ratio < (DARK_RATIO if self._peaks else DARK_FIRST):
+            return ratio, None
+        positions = [p for p in (index, index + 1) if 0 <= p < len(self.order)]
+        return ratio, self._residuals(img, positions)
+
+    def _residuals(self, img: NDArray[np.float32], positions: list[int]) -> dict[int, float] | None:
+        """Relative residual of ``img`` under each order position (a free gain each), from the
+        robust fit of the accepted images; None while no fit can be made."""
+        if len(self._images) < self.min_fit_images:
+            return None
+        try:
+            ps = fit_photometric_stereo(
+                np.stack(self._images), np.stack(self._lights), robust=True, saturation=1.0
+            )
+        except ReconstructionError:
+            return None  # the lights so far cannot determine a normal
+        rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
+        use = ps.valid & (img < 1.0)
+        if use.sum() < 10:
+            return None
+        y = img[use].astype(np.float64)
+        n = ps.normals[use].astype(np.float64)
+        r = rho[use].astype(np.float64)
+        residuals: dict[int, float] = {}
+        for pos in positions:
+            pred = r * np.maximum(n @ self.order[pos], 0.0)
+            denom = float(pred @ pred)
+            gain = float(pred @ y) / denom if denom > 0 else 0.0
+            residuals[pos] = float(np.linalg.norm(y - gain * pred) / max(np.linalg.norm(y), 1e-12))
+        return residuals
+
     def _neighbour_test(
         self, index: int, img: NDArray[np.float32], ratio: float
     ) -> SequenceVerdict:
         none = SequenceVerdict(index, OK, "no fit yet", None, False, brightness_ratio=ratio)
         if len(self._images) < self.min_fit_images or index >= len(self.order):
             return none
-        try:
-            ps = fit_photometric_stereo(
-                np.stack(self._images), np.stack(self._lights), robust=True, saturation=1.0
-            )
-        except ReconstructionError:
-            return none  # the lights so far cannot determine a normal
-        rho = ps.albedo if ps.albedo.ndim == 2 else ps.albedo.mean(axis=-1)
-        use = ps.valid & (img < 1.0)
-        if use.sum() < 10:
+        positions = [p for p in (index - 1, index, index + 1) if 0 <= p < len(self.order)]
+        residuals = self._residuals(img, positions)
+        if residuals is None:
             return none
-        y = img[use].astype(np.float64)
-        n = ps.normals[use].astype(np.float64)
-        r = rho[use].astype(np.float64)
-        residuals: dict[int, float] = {}
-        for pos in (index - 1, index, index + 1):
-            if not 0 <= pos < len(self.order):
-                continue
-            pred = r * np.maximum(n @ self.order[pos], 0.0)
-            denom = float(pred @ pred)
-            gain = float(pred @ y) / denom if denom > 0 else 0.0
-            residuals[pos] = float(np.linalg.norm(y - gain * pred) / max(np.linalg.norm(y), 1e-12))
         expected = residuals[index]
         best = min(residuals, key=lambda p: residuals[p])
         if best == index or expected <= MIN_RESIDUAL or residuals[best] > SLIP_RATIO * expected:

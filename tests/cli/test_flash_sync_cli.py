@@ -340,18 +340,53 @@ def test_resuming_a_finished_session_says_it_is_complete(tmp_path: Path) -> None
         assert "cannot be used" not in text
 
 
-def test_a_dead_led_gives_a_dark_image_that_is_caught(tmp_path: Path, rigs) -> None:  # type: ignore[no-untyped-def]
+def test_a_dead_led_is_named_as_such_and_the_dome_said_to_have_stepped_on(  # type: ignore[no-untyped-def]
+    tmp_path: Path, rigs
+) -> None:
     """``[emulator] dead_leds`` had been accepted and ignored on the camera-triggered dome: the
     run went through all 60 LEDs with the dead one lit. The firmware fires it (the dome steps);
-    it gives no light, and the slip guard catches the dark image there."""
+    it gives no light. The guard then blamed a missed flash pulse and said the dome's count was
+    lost, both untrue: the frame shot after the dark image is lit by the next LED, as the order
+    says, so the dome stepped on and only the LED stayed dark."""
     config = tmp_path / "rig.toml"
     config.write_text(SHIPPED.read_text(encoding="utf-8") + "\n[emulator]\ndead_leds = [5]\n")
     out = tmp_path / "s"
     result = runner.invoke(app, ["run", str(config), "--out", str(out)])
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
-    assert "image 6 was not lit by LED 6" in text and "dark" in text, text
+    assert "image 6 is dark: LED 6 did not light (dead LED?); the dome stepped on" in text, text
+    assert "was lit by LED 7, as the order says" in text
+    assert "Repair or replace LED 6" in text and "other images are good" in text
+    assert "missed step" not in text and "did not reach the dome" not in text
+    assert "no longer matches" not in text
     rig = rigs[-1]
     assert truth(rig)[5] == 5  # the firmware did fire LED 6: it is the LED that gave no light
+    assert truth(rig)[6] == 6  # …and stepped on: the frame after it is LED 7
     assert lp_matches_truth(out, rig) == 5
     assert (out / "unlabelled" / "image_006.tif").is_file()
+    # the frame that told them apart is kept, never labelled
+    assert (out / "unlabelled" / "check_007.tif").is_file()
+    assert len(list(out.glob("image_*.jpg"))) == 5
+
+
+def test_a_missed_pulse_is_told_from_a_dead_led_by_the_frame_after_it(  # type: ignore[no-untyped-def]
+    tmp_path: Path, rigs
+) -> None:
+    """A missed pulse gives a dark image too; the frame after it is lit by the LED the dark
+    image was due (the dome did not step), which is what the missed-step verdict says."""
+    out = tmp_path / "s"
+    result = runner.invoke(
+        app, ["run", str(with_fault(tmp_path, 21, "missed_pulse")), "--out", str(out)]
+    )
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert "image 21 was not lit by LED 21" in text and "missed step" in text, text
+    assert "the flash pulse did not reach the dome, which therefore did not step" in text
+    assert "was lit by LED 21, the one image 21 was due" in text
+    assert "The dome's count no longer matches the session" in text
+    assert "dead LED" not in text and "stepped on" not in text
+    rig = rigs[-1]
+    assert truth(rig)[20] is None and truth(rig)[21] == 20  # dark, then the LED it was due
+    assert lp_matches_truth(out, rig) == 20
+    assert (out / "unlabelled" / "image_021.tif").is_file()
+    assert (out / "unlabelled" / "check_022.tif").is_file()
