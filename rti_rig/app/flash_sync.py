@@ -28,7 +28,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from rti_rig.core.clock import Clock
 from rti_rig.core.devices import Frame
-from rti_rig.core.errors import ConfigError, RtiRigError
+from rti_rig.core.errors import ConfigError, DeviceError, RtiRigError
 from rti_rig.core.rig_geometry import DomeGeometry
 from rti_rig.runtime.disowned import MARKER as DISOWN_MARKER
 from rti_rig.runtime.disowned import disown
@@ -214,7 +214,15 @@ class SlipGuard:
                 f"{head}: {either}. The image is kept, unlabelled, as {kept}; lights.lp lists "
                 f"{listed} only. {rewind_either}"
             )
-        frame = self.shoot()
+        try:
+            frame = self.shoot()
+        except DeviceError as exc:  # the dark image's own message is what matters: say both
+            return (
+                f"{head}: {either}; the frame that would tell them apart could not be shot "
+                f"({exc}). The image is kept, unlabelled, as {kept}; lights.lp lists {listed} "
+                f"only. Look at LED {k} during a flash and check the camera's PC-sync cable. "
+                f"{rewind_either}"
+            )
         ratio, residuals = self.checker.judge_after_dark(index, frame.pixels, frame.white_level)
         record = {
             "after_dark_image": k,
@@ -484,7 +492,8 @@ def check_lines(loaded, geometry: DomeGeometry) -> list[str]:  # type: ignore[no
         "  before a run: long-press the dome's start button (rewinds it to its first LED) and "
         "leave its camera-trigger cable unplugged, so that only rti-rig fires the camera",
         "  each image is checked against its LED before it is labelled (a missed or double "
-        f"step stops the run; the neighbour test starts after {fs.check_after_images} images)",
+        "step, or a dark image, stops the run; after a dark image one more frame tells a missed "
+        f"step from a dead LED; the neighbour test starts after {fs.check_after_images} images)",
         (
             "  after the last image one more flash is shot, the proof frame (kept in "
             "unlabelled/, never labelled): the firmware must re-light its last LED, which proves "

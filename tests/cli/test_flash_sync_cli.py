@@ -390,3 +390,34 @@ def test_a_missed_pulse_is_told_from_a_dead_led_by_the_frame_after_it(  # type: 
     assert lp_matches_truth(out, rig) == 20
     assert (out / "unlabelled" / "image_021.tif").is_file()
     assert (out / "unlabelled" / "check_022.tif").is_file()
+
+
+def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignore[no-untyped-def]
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The frame shot after a dark image to tell a dead LED from a missed pulse can fail (a
+    camera error): the dark image's verdict is still said, naming both causes."""
+    from rti_rig.core.errors import CaptureError
+
+    real = flash_sync.build_flash_sync_rig
+
+    def failing_check_frame(*args, **kwargs):  # type: ignore[no-untyped-def]
+        rig = real(*args, **kwargs)
+
+        def shoot():  # type: ignore[no-untyped-def]
+            raise CaptureError("camera", "the USB link dropped")
+
+        rig.capture_check.shoot = shoot
+        return rig
+
+    monkeypatch.setattr(flash_sync, "build_flash_sync_rig", failing_check_frame)
+    config = tmp_path / "rig.toml"
+    config.write_text(SHIPPED.read_text(encoding="utf-8") + "\n[emulator]\ndead_leds = [5]\n")
+    out = tmp_path / "s"
+    result = runner.invoke(app, ["run", str(config), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert "image 6 was not lit by LED 6" in text and "or LED 6 is dead" in text, text
+    assert "could not be shot (camera: the USB link dropped)" in text
+    assert "Traceback" not in result.output
+    assert (out / "unlabelled" / "image_006.tif").is_file()
