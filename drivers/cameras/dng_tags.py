@@ -23,6 +23,7 @@ Sources: TIFF 6.0 (header, IFD entries, tags 254-279, 322-325) and the DNG Speci
 
 from __future__ import annotations
 
+import hashlib
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -175,6 +176,68 @@ def _read_dng_tags(f: BinaryIO, size: int) -> DngTags | None:
     if compression is None:
         found.damage.append("its main image gives no Compression")
     return found
+
+
+@dataclass(frozen=True)
+class IfdState:
+    """What a DNG's structure holds at one read: a checksum of its header and the bytes of
+    IFD 0 and its SubIFDs, and whether any of them is still unwritten (zeros)."""
+
+    digest: bytes
+    #: an IFD its header or IFD 0 names reads as zeros (a count of 0, or an entry slot all
+    #: zeros: no TIFF entry has type 0), as in a file a network share sized first
+    unwritten: bool
+
+
+def ifd_state(path: Path) -> IfdState | None:
+    """:class:`IfdState` of ``path``, a classic TIFF (a DNG); None when it is none, or cannot
+    be read.
+
+    Why: a copy over a network share (SMB, some NAS clients) may set a file's final size first
+    and fill its bytes afterwards, not always in order, so a DNG can be whole-sized with
+    zeros where its IFD's CFAPattern or StripOffsets entry will be: the refusal of such a
+    file (:func:`read_blind`) is only true once the bytes have stopped changing, which this
+    checksum tells cheaply (a few hundred bytes read, never the picture)."""
+    try:
+        with path.open("rb") as f:
+            return _ifd_state(f, os.fstat(f.fileno()).st_size)
+    except OSError:
+        return None
+
+
+def _ifd_state(f: BinaryIO, size: int) -> IfdState | None:
+    named = read_header(f)
+    if named is None or named[0].header != 8:
+        return None
+    layout, first = named
+    f.seek(0)
+    digest = hashlib.blake2b(f.read(layout.header), digest_size=16)
+    unwritten = False
+    offsets, done = [first], set()
+    while offsets:
+        offset = offsets.pop(0)
+        if offset in done or len(done) > 16:
+            continue
+        done.add(offset)
+        digest.update(offset.to_bytes(8, "little"))
+        if offset < layout.header or offset + layout.count_size > size:
+            unwritten = True  # a SubIFDs value not written yet, or garbage
+            continue
+        count = read_count(f, layout, offset)
+        if not count or count > MAX_TAGS:
+            unwritten = unwritten or count == 0
+            continue
+        f.seek(offset)
+        digest.update(f.read(layout.ifd_end(offset, count) - offset))
+        for entry in read_entries(f, layout, offset, count):
+            if entry.tag == 0 and entry.type == 0 and not any(entry.field) and not entry.count:
+                unwritten = True  # an entry slot still zeros
+            elif entry.tag == 330 and offset == first:
+                offsets.extend(read_values(f, layout, entry, size, MAX_TAGS) or ())
+            elif entry.tag in _READ:  # the values read_blind judges, where they lie apart
+                values = read_values(f, layout, entry, size, _MAX_VALUES)
+                digest.update(repr(values).encode())
+    return IfdState(digest.digest(), unwritten)
 
 
 def _version(v: tuple[int, ...] | None) -> str:

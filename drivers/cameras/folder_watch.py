@@ -72,6 +72,7 @@ from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
 from rti_rig.core.image_files import TIFF_MAGIC, tiff_extent
+from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
 from rti_rig.drivers.cameras.image_io import (
     ImageReadError,
     read_image_file,
@@ -843,6 +844,28 @@ class FolderWatchCamera:
                 return True
         return False
 
+    def _ifd_settled(
+        self, path: Path, deadline: float
+    ) -> tuple[tuple[int, int, int, int], IfdState] | None:
+        """``path``'s identity and IFD state once both have stayed the same for
+        ``stable_polls`` polls, or None if they have not by ``deadline`` (or it is gone).
+
+        Why: a steady size says nothing of a file a network share sized first and is filling
+        (its IFD's entries zeros, then written): a DNG's structure read then was refused as
+        damaged, a good shot lost. Its bytes, not its size, must stop changing first."""
+        s = self.settings
+        last, stable = None, 0
+        while True:
+            ident, state = _identity(path), ifd_state(path)
+            now = None if ident is None or state is None else (ident, state)
+            stable = stable + 1 if now is not None and now == last else 1
+            last = now
+            if now is not None and stable >= s.stable_polls:
+                return now
+            if self._clock.now() >= deadline:
+                return None
+            self._clock.sleep(s.poll_interval_s)
+
     def _whole_capture_time(self, path: Path) -> float | None:
         """The capture time of ``path`` once LibRaw can open it: a file still being written
         (a network share, a Wi-Fi upload pausing) is given ``timeout_s`` to change and settle,
@@ -1038,8 +1061,11 @@ class FolderWatchCamera:
         leaves (:func:`ifd_garbage`: a tag count over 4096, a count of 0 before written
         bytes, an entry of no TIFF type, an offset inside the header): each is said at once,
         naming the file. A TIFF whose IFD is not there yet (libtiff writes it last, tifffile
-        zeroed until its data is out) is waited for. Messages are
-        worded here from the decoders' fields.
+        zeroed until its data is out) is waited for. A RAW refused by its TIFF structure
+        (a DNG's CFAPattern or StripOffsets missing) is judged only once its size and IFDs
+        are unchanged over ``stable_polls`` polls (read again if they changed), and waited
+        for while its IFDs hold zeros (:func:`ifd_state`: a share that set its size first).
+        Messages are worded here from the decoders' fields.
 
         Why: a steady size only means the writer paused (a network share, a Wi-Fi upload, a
         program writing in chunks). Half a file had stopped the session at once, a shot lost
@@ -1070,13 +1096,44 @@ class FolderWatchCamera:
                     message = exc.about(path)
                 else:
                     message = exc.message
-                if isinstance(
+                whole = None  # what the RAW's structure says of the file being whole
+                if (
+                    isinstance(exc, UnsupportedRawError | DamagedRawError)
+                    and (seen := ifd_state(path)) is not None
+                ):
+                    # its structure judged: only once its bytes have stopped arriving
+                    settled = self._ifd_settled(path, deadline)
+                    if settled is None:
+                        raise CaptureError(
+                            self.name,
+                            f"{message}; {path.name} was still being written "
+                            f"{s.timeout_s:g} s after that (its IFD or size still changing: "
+                            "if the program or share saving it is that slow, raise "
+                            "timeout_s)",
+                            "decode",
+                        ) from exc
+                    if settled != (tried, seen):
+                        continue  # more of it came since it was read: read it again
+                    if seen.unwritten:
+                        # zeros where its IFD's entries belong: a share that set the size
+                        # first and has not filled it yet, not (yet) known to be damaged
+                        message += (
+                            ": parts of its IFD are still zeros (a copy over a network share "
+                            "that sets a file's size first, not yet filled?)"
+                        )
+                    whole = (
+                        None
+                        if seen.unwritten
+                        else f"its size and IFDs steady over {s.stable_polls} polls"
+                    )
+                elif _has_header(path):
+                    whole = f"its size steady over {s.stable_polls} polls, its header written"
+                if whole and isinstance(
                     exc, UnsupportedRawError | DamagedRawError | MonochromeRawError
-                ) and _has_header(path):
+                ):
                     raise CaptureError(
                         self.name,
-                        f"{message}. The file is whole (its size steady over "
-                        f"{s.stable_polls} polls, its header written), so waiting will not "
+                        f"{message}. The file is whole ({whole}), so waiting will not "
                         f"help; it is left in {s.folder}, and no image was recorded for this "
                         "light",
                         "decode",
