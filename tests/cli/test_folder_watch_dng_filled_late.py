@@ -160,3 +160,36 @@ def test_run_refuses_a_dng_whose_ifd_stays_unwritten_naming_it(
 
 def tether_file(tmp_path: Path) -> Path:
     return tmp_path / "tether" / "IMG_0001.dng"
+
+
+def test_run_refuses_a_dng_whose_ifd_never_settles_within_timeout_naming_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A file whose IFD is rewritten between every two polls (a program saving it over and
+    over) is never judged whole, and is refused within ``timeout_s``, naming it."""
+    from rti_rig.drivers.cameras import folder_watch
+
+    real = folder_watch.ifd_state
+    tick = [0]
+
+    def rewritten_between_polls(path: Path) -> object:
+        state = real(path)
+        if path.parent.name == "tether":  # the folder's file, rewritten after each look
+            with path.open("r+b") as f:
+                f.seek(_entry(path.read_bytes(), 274) + 8)  # Orientation's value, in place
+                tick[0] += 1
+                f.write(struct.pack("<H", 1 + 2 * (tick[0] % 2)))
+        return state
+
+    monkeypatch.setattr(folder_watch, "ifd_state", rewritten_between_polls)
+    r, said, _, out, _, lit_at_end = _run(
+        tmp_path, monkeypatch, (33421, 33422), timeout_s=5.0, never_filled=True
+    )
+    assert tick[0] >= 2  # looked at more than once
+    assert r.exit_code != 0, said
+    assert "Traceback" not in said, said
+    assert f"{tether_file(tmp_path)}: " in said, said
+    assert "IMG_0001.dng was still being written 5 s after that" in said, said
+    assert "waiting will not help" not in said, said  # never judged whole
+    assert not list((out / "linear").glob("image_*.tif")), said
+    assert lit_at_end == []
