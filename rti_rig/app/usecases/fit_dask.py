@@ -266,12 +266,9 @@ class _CheckedWatch:
     otherwise wait, and the fit with it, for ever. Looks every :data:`CHECKED_POLL_S` seconds
     in a thread of its own, stopped at the end of the block."""
 
-    def __init__(
-        self, cluster: Cluster, watch: _GatherWatch, clock: Callable[[], float] = time.monotonic
-    ) -> None:
+    def __init__(self, cluster: Cluster, watch: _GatherWatch) -> None:
         self.cluster = cluster
         self.watch = watch
-        self.clock = clock
         self.stop = threading.Event()
         self.gone = False
         self.thread = threading.Thread(target=self._run, name="rti-rig-checked", daemon=True)
@@ -290,7 +287,7 @@ class _CheckedWatch:
                 if self._tagged_present():
                     absent_since = None
                 else:
-                    now = self.clock()
+                    now = time.monotonic()
                     absent_since = now if absent_since is None else absent_since
                     self.gone = now - absent_since >= CHECKED_GRACE_S
             if self.gone:  # and again at each look: a task sent meanwhile waits too
