@@ -29,7 +29,7 @@ from typing import Any, TypeVar
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CameraBusyError, CaptureError, DeviceError
-from rti_rig.drivers.cameras.folder_watch import is_raw_file
+from rti_rig.core.image_files import is_camera_raw
 from rti_rig.drivers.cameras.gphoto2_formats import gives_raw, raw_choices
 from rti_rig.drivers.cameras.raw_decode import RawDecodeError, RawFileMissingError, decode_raw
 from rti_rig.drivers.cameras.settings import Gphoto2CameraSettings
@@ -622,7 +622,7 @@ class Gphoto2Camera:
         strays.extend(self._unannounced(str(path.folder), files + late + strays, strays))
         self._delete(late)  # a previous shot's file announced late: never this shot's
         self._count += 1
-        raw_files = [f for f in files if is_raw_file(Path(f[1]))]
+        raw_files = [f for f in files if is_camera_raw(Path(f[1]))]
         if not raw_files:
             self._delete(files)
             raws = raw_choices(self._format_choices)
@@ -636,7 +636,7 @@ class Gphoto2Camera:
         staging = self._staging_dir()
         saved: dict[str, Path] = {}
         for folder, name in files:
-            if not is_raw_file(Path(name)) and not s.keep_jpeg:
+            if not is_camera_raw(Path(name)) and not s.keep_jpeg:
                 continue
             target = _unused(staging, f"cap{self._count:04d}_{name}")
             try:
@@ -686,7 +686,7 @@ class Gphoto2Camera:
             raise self._download_gone(raw_path, raw_files[0]) from exc
         except CaptureError as exc:
             raise self._undecoded(raw_path, raw_files[0][1], exc) from exc
-        jpeg = [str(p) for n, p in saved.items() if not is_raw_file(Path(n))]
+        jpeg = [str(p) for n, p in saved.items() if not is_camera_raw(Path(n))]
         iso = _number(s.iso) or decoded.gain
         metadata = dict(decoded.metadata)
         camera_path = {n: f"{f.rstrip('/')}/{n}" for f, n in files}
@@ -899,7 +899,9 @@ class Gphoto2Camera:
                 elif (
                     (by_stem and name.stem != stem)
                     or name.stem in {Path(n).stem for _, n in strays}
-                    or (is_raw_file(name) and any(is_raw_file(Path(n)) for _, n in files + more))
+                    or (
+                        is_camera_raw(name) and any(is_camera_raw(Path(n)) for _, n in files + more)
+                    )
                 ):
                     strays.append(item)
                 else:
@@ -908,8 +910,8 @@ class Gphoto2Camera:
             quiet_s += took
             if quiet_s >= wait_ms / 1000:
                 names = [Path(n) for _, n in files + more]
-                have_raw = any(is_raw_file(n) for n in names)
-                have_jpeg = any(not is_raw_file(n) for n in names)
+                have_raw = any(is_camera_raw(n) for n in names)
+                have_jpeg = any(not is_camera_raw(n) for n in names)
                 if have_raw and (have_jpeg or not self.settings.keep_jpeg):
                     break
         self._earlier_stems.update(Path(n).stem for _, n in files + more + strays)
@@ -1091,14 +1093,14 @@ def _last_picture(
     was kept as the image (and the stray's JPEG as a second JPEG of the step), the shot's own
     RAW set aside as the stray."""
     numbers = [_ram_number(n) for _, n in files]
-    raws = [f for f in files if is_raw_file(Path(f[1]))]
+    raws = [f for f in files if is_camera_raw(Path(f[1]))]
     if len(raws) < 2 or None in numbers or len(set(numbers)) != len(numbers):
         return None
     raw = max(raws, key=lambda f: _ram_number(f[1]) or 0)
     n = _ram_number(raw[1]) or 0
-    jpeg_number = n - 1 if not is_raw_file(Path(returned[1])) else n + 1
+    jpeg_number = n - 1 if not is_camera_raw(Path(returned[1])) else n + 1
     own = [raw] + [
-        f for f in files if not is_raw_file(Path(f[1])) and _ram_number(f[1]) == jpeg_number
+        f for f in files if not is_camera_raw(Path(f[1])) and _ram_number(f[1]) == jpeg_number
     ]
     return own, [f for f in files if f not in own]
 

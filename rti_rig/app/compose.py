@@ -469,11 +469,11 @@ def read_preview_image(path: Path):  # type: ignore[no-untyped-def]
     :func:`rti_rig.planner.topography.read_preview`.
     """
     from rti_rig.core.errors import CaptureError, ScheduleError
-    from rti_rig.drivers.cameras.folder_watch import is_raw_file
+    from rti_rig.core.image_files import is_camera_raw
     from rti_rig.planner.topography import read_preview
 
     p = Path(path)
-    if not is_raw_file(p) or not p.is_file():
+    if not is_camera_raw(p) or not p.is_file():
         return read_preview(p)  # which also refuses a folder or a missing file, by name
     from rti_rig.drivers.cameras.raw_decode import MonochromeRawError, decode_raw
     from rti_rig.drivers.cameras.settings import RawDecodeSettings
