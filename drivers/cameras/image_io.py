@@ -17,10 +17,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rti_rig.core.errors import CaptureError
+from rti_rig.drivers.cameras.tiff_ifd import header_size
 from rti_rig.drivers.cameras.tiff_structure import (
     COMPLETE_TIFF_ADVICE,
     SAVE_READABLE,
-    header_size,
     unread_compression,
 )
 

@@ -16,17 +16,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+# what a TIFF's bytes are is read in one place (:mod:`.tiff_ifd`); this module judges them
 from rti_rig.drivers.cameras.tiff_ifd import (
     MAX_TAGS,
     TIFF_TYPES,
-    header_size,
     read_count,
     read_entries,
     read_header,
 )
-
-#: re-exported: what a TIFF's bytes are is read in one place (:mod:`.tiff_ifd`)
-__all__ = ["MAX_TAGS", "TIFF_TYPES", "FirstIfd", "first_ifd", "header_size", "ifd_garbage"]
 
 
 @dataclass(frozen=True)
