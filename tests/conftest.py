@@ -159,6 +159,16 @@ def inprocess_arm_config(tmp_path: Path, extra: str = "") -> Path:
     return cfg
 
 
+def servo_fault(at_command: int, servo_id: int, kind: str = "overload") -> str:
+    """An ``[[emulator.faults]]`` table of the emulated arm (to append to its config, e.g. as
+    :func:`inprocess_arm_config`'s ``extra``): servo ``servo_id`` reports ``kind`` from the
+    ``at_command``-th packet on. One spelling of the table for the arm fault tests."""
+    return (
+        f'\n[[emulator.faults]]\nat_command = {at_command}\nkind = "{kind}"\n'
+        f"servo_id = {servo_id}\n"
+    )
+
+
 def emulators_built_by_check(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
     """The emulators of the rigs ``rti-rig check`` builds from here on (``build_rig`` wrapped
     where compose and the check use case import it): what a test reads the servos' state

@@ -12,7 +12,7 @@ import shlex
 from pathlib import Path
 
 import pytest
-from conftest import emulators_built_by_check, inprocess_arm_config
+from conftest import emulators_built_by_check, inprocess_arm_config, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -21,7 +21,7 @@ from rti_rig.drivers.dynamixel import control_table as ct
 runner = CliRunner()
 
 # servo 2 already overloaded as rti-rig opens the port (its torque off by its own Shutdown)
-FAULT = '\n[[emulator.faults]]\nat_command = 1\nkind = "overload"\nservo_id = 2\n'
+FAULT = servo_fault(1, 2)
 
 
 def _advised(said: str) -> list[str]:

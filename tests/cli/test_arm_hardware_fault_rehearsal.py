@@ -14,7 +14,7 @@ import shlex
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, emulators_built_by_check, inprocess_arm_config
+from conftest import CONFIGS, emulators_built_by_check, inprocess_arm_config, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -22,7 +22,7 @@ from rti_rig.drivers.dynamixel import control_table as ct
 
 runner = CliRunner()
 
-FAULT = '\n[[emulator.faults]]\nat_command = 60\nkind = "overload"\nservo_id = 2\n'
+FAULT = servo_fault(60, 2)
 
 
 def _config(tmp_path: Path, extra: str = FAULT) -> Path:

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, emulators_built_by_check, inprocess_arm_config
+from conftest import CONFIGS, emulators_built_by_check, inprocess_arm_config, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -24,7 +24,7 @@ runner = CliRunner()
 
 # the elevation servo overloads as the first instruction packet arrives (the arm already
 # faulted when rti-rig opens the port, as after a session that stopped on it)
-FAULT = '\n[[emulator.faults]]\nat_command = 1\nkind = "overload"\nservo_id = 2\n'
+FAULT = servo_fault(1, 2)
 
 
 def _config(tmp_path: Path) -> Path:

@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import emulators_built_by_check, inprocess_arm_config
+from conftest import emulators_built_by_check, inprocess_arm_config, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -22,10 +22,6 @@ from rti_rig.drivers.dynamixel import control_table as ct
 from rti_rig.drivers.dynamixel import protocol2 as p2
 
 runner = CliRunner()
-
-
-def _fault(at: int, servo_id: int) -> str:
-    return f'\n[[emulator.faults]]\nat_command = {at}\nkind = "overload"\nservo_id = {servo_id}\n'
 
 
 def test_a_resume_whose_arm_overloads_at_connect_claims_no_stop_of_it(
@@ -36,7 +32,7 @@ def test_a_resume_whose_arm_overloads_at_connect_claims_no_stop_of_it(
     first = tmp_path / "first"
     first.mkdir()
     out = tmp_path / "s"
-    cfg = inprocess_arm_config(first, _fault(200, 2))
+    cfg = inprocess_arm_config(first, servo_fault(200, 2))
     r = runner.invoke(
         app, ["run", str(cfg), "--out", str(out), "--lights", "6"], terminal_width=400
     )
@@ -49,7 +45,7 @@ def test_a_resume_whose_arm_overloads_at_connect_claims_no_stop_of_it(
     emulators = emulators_built_by_check(monkeypatch)
     again = tmp_path / "again"
     again.mkdir()
-    cfg = inprocess_arm_config(again, _fault(1, 1))
+    cfg = inprocess_arm_config(again, servo_fault(1, 1))
     r = runner.invoke(app, ["run", str(cfg), "--resume", str(out)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 2, said

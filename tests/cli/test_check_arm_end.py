@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import CONFIGS, inprocess_arm_config
+from conftest import CONFIGS, inprocess_arm_config, servo_fault
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -171,8 +171,7 @@ def test_a_check_aborted_by_an_overload_says_not_parked_once(
 ) -> None:
     """Servo 2 overloads (its torque off, so the stop cannot hold it): the abort line had said
     "not parked; the stop did not hold every joint" and the park line "NOT parked" again."""
-    fault = '\n[[emulator.faults]]\nat_command = 60\nkind = "overload"\nservo_id = 2\n'
-    cfg = inprocess_arm_config(tmp_path, fault)
+    cfg = inprocess_arm_config(tmp_path, servo_fault(60, 2))
     r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())
     assert r.exit_code == 1 and "RESULT: FAIL" in said, said

@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CONFIGS, REPO
+from conftest import CONFIGS, REPO, servo_fault
 
 #: runs rti-rig with, as the environment asks, a SIGTERM sent to itself as the arm is about
 #: to light the Nth image (``ARM_END_SIGTERM_AT``), or the park failing (``ARM_END_JAM``)
@@ -170,7 +170,7 @@ def test_a_fault_that_blocks_the_park_is_said_once(tmp_path: Path) -> None:
     twice too (in the teardown's stop, then in the error)."""
     cfg = _config(tmp_path, "simulated_arm.toml")
     with cfg.open("a") as f:
-        f.write('\n[[emulator.faults]]\nat_command = 200\nkind = "overload"\nservo_id = 2\n')
+        f.write(servo_fault(200, 2))
     code, said, out = _run(tmp_path, cfg, lights=6)
     assert code == 2, said
     assert "Traceback" not in said
