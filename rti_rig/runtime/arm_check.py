@@ -79,11 +79,10 @@ class ArmSelfTestReport:
     #: said in full once, under ABORTED: the failed pose's row and a teardown that met the
     #: same fault point back to it (one overload's paragraph had been printed three times)
     aborted_detail: str | None = None
-    #: what the carrier says of a park it does not hold (its torque released at the close),
-    #: said with "parked"; None: nothing to add
-    release_note: str | None = None
     #: where the teardown left the arm, as read back after its stop (None: it never connected,
-    #: so nothing was moved); "parked" only of a park read back at the park pose
+    #: so nothing was moved); "parked" only of a park read back at the park pose. Its
+    #: ``torque`` is what the close then did to the joints' torque (released, by its policy),
+    #: the one record of it that the park line and a stopped check's end sentence both say
     end: ArmEnd | None = None
 
     @property
@@ -168,7 +167,7 @@ class ArmSelfTestReport:
         # what the close then did to the torque, wherever the arm was left: a close releases
         # an arm it finds at its park pose also when the park was not confirmed (off by
         # policy, stopped, failed), and that release had gone unsaid
-        released = f"; {self.release_note}" if self.release_note else ""
+        released = f"; {end.torque}" if end.torque else ""
         if self.park_confirmed:
             return (
                 f"parked (read back at {at}, within {PARK_TOLERANCE_DEG:g}° of its park pose)"
@@ -312,12 +311,12 @@ def arm_self_test(
         report.end = _check_end(carrier, report, connected)
         failures += attempt_all([("close", carrier.close)])
         note = getattr(carrier, "torque_release_note", None)
-        report.release_note = note() if callable(note) else None
-        if report.end is not None and report.release_note:
+        released = note() if callable(note) else None
+        if report.end is not None and released:
             # the end a stopped check is said by (``end.sentence()``) carries the release too:
             # a check stopped with the arm at its park pose was said "not parked and left at
             # az 0.0°, el 10.0°" with no word of the torque its close had just switched off
-            report.end = replace(report.end, torque=report.release_note)
+            report.end = replace(report.end, torque=released)
         report.teardown_failures = _point_back(failures)
         report.elapsed_s = clock.now() - started
     return report
