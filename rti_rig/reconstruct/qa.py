@@ -64,7 +64,9 @@ from rti_rig.reconstruct.qa_drift import (
     TRUSTED_SPREAD_PX,
     Step,
     change_point,
+    edge_agreement,
     edge_shifts_trusted,
+    edges_place,
     light_trend,
     measure_drift,
     move_back,
@@ -1244,6 +1246,12 @@ def assess(
     off_trend = np.nan_to_num(edge_dev) - trend
     if edges_trusted or trend_trusted:
         edge_moved = np.isfinite(edge_dev[:, 0]) & (np.hypot(*off_trend.T) > move_px)
+        if edge_moved.any():
+            # ... where the edges are the object's: not a featureless plate's noise, nor an
+            # image almost all in shadow, whose shadow's edge moves with its light
+            # (qa_drift.edges_place)
+            still = np.isfinite(edge_dev[:, 0]) & (np.hypot(*off_trend.T) <= 1.0)
+            edge_moved &= edges_place(edge_agreement(crop_arr, edge_shift), still)
         if edge_moved.any():
             step_fit = None  # crop_arr changes below
         crop_arr = crop_arr.copy()
