@@ -71,7 +71,7 @@ import numpy as np
 from rti_rig.core.clock import Clock, SystemClock
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import CaptureError, DeviceError
-from rti_rig.core.image_files import TIFF_MAGIC, tiff_extent
+from rti_rig.core.image_files import CAMERA_RAW_SUFFIXES, TIFF_MAGIC, is_camera_raw, tiff_extent
 from rti_rig.drivers.cameras.dng_tags import IfdState, ifd_state
 from rti_rig.drivers.cameras.image_io import (
     ImageReadError,
@@ -98,28 +98,8 @@ from rti_rig.drivers.cameras.tiff_structure import (
     ifd_garbage,
 )
 
-RAW_SUFFIXES = {
-    ".dng",
-    ".cr2",
-    ".cr3",
-    ".crw",
-    ".nef",
-    ".nrw",
-    ".arw",
-    ".srf",
-    ".sr2",
-    ".orf",
-    ".rw2",
-    ".raf",
-    ".pef",
-    ".srw",
-    ".3fr",
-    ".iiq",
-    ".erf",
-    ".kdc",
-    ".mos",
-    ".x3f",
-}
+#: the core's one list of camera RAW endings (the replay check refuses the same files)
+RAW_SUFFIXES = CAMERA_RAW_SUFFIXES
 
 #: A capture time's resolution: EXIF DateTimeOriginal is whole seconds, and LibRaw's timestamp
 #: (rawpy's ``other.timestamp``) keeps no SubSecTimeOriginal; a difference of two such times is
@@ -260,7 +240,7 @@ class TriggerUnconfirmed(Exception):
 
 def is_raw_file(path: Path) -> bool:
     """True for file names LibRaw should decode (by suffix)."""
-    return path.suffix.lower() in RAW_SUFFIXES
+    return is_camera_raw(path)
 
 
 def _identity(path: Path) -> tuple[int, int, int, int] | None:

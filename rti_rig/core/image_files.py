@@ -28,8 +28,8 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 TIFF_MAGIC = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
 #: Camera RAW file endings, the one list for the core and the drivers: the gphoto2 camera and
 #: the planner's RAW preview use :func:`is_camera_raw` (the core may not import a driver, a
-#: driver may import the core). ``folder_watch.RAW_SUFFIXES`` is still a copy, kept alike by a
-#: test. :func:`read_image_any` does not decode them:
+#: driver may import the core; ``folder_watch.RAW_SUFFIXES`` is this list).
+#: :func:`read_image_any` does not decode them:
 #: most are TIFF inside, so the header reader gives them a size (a DNG's, or the thumbnail
 #: that opens a NEF), and OpenCV then fails on the CFA data or reads that thumbnail.
 CAMERA_RAW_SUFFIXES = frozenset(

@@ -19,13 +19,3 @@ def test_a_missing_image_is_named_without_an_opencv_warning(
         read_image_any(missing)
     captured = capfd.readouterr()
     assert "WARN" not in captured.err + captured.out
-
-
-def test_the_cores_camera_raw_endings_are_the_camera_drivers() -> None:
-    """The acquisition check refuses RAW files by the core's list of endings (the core may not
-    import the drivers): one ending known to the drivers and not to the core would pass the
-    check as "readable" and stop a replay at its capture."""
-    from rti_rig.core.image_files import CAMERA_RAW_SUFFIXES
-    from rti_rig.drivers.cameras.folder_watch import RAW_SUFFIXES
-
-    assert set(RAW_SUFFIXES) == set(CAMERA_RAW_SUFFIXES)
