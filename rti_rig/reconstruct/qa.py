@@ -451,7 +451,7 @@ class QAReport:
                 )
                 out.append(
                     f"{label} not judged on {_names(unsure)} (dark, but its light lies less "
-                    f"than {self.surface_margin_deg:.0f}° above the object's mean surface as "
+                    f"than {_degrees(self.surface_margin_deg)} above the object's mean surface as "
                     f"fitted, and this session's uneven lights{scatter} "
                     "let the fit place that surface no closer: the light may be below the "
                     "real surface, so a misfire cannot be told from that; check the LED fired)"
@@ -2403,3 +2403,8 @@ def _expected_error_deg(
     tr = np.einsum("pij,pjk,pki->p", p, inv, p)
     theta = (sigma / rr[ok]) * np.sqrt(np.maximum(tr, 0.0))
     return float(np.degrees(np.median(theta)))
+
+
+def _degrees(angle: float) -> str:
+    """An angle in words: whole degrees, or tenths below 1° (a margin of 0.3° read "0°")."""
+    return f"{angle:.0f}°" if angle >= 1 else f"{angle:.1f}°"

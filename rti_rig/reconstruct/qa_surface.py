@@ -26,7 +26,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 #: A dark image is judged only on a light more than this many standard deviations of the
-#: fitted mean surface's normal above that surface (:func:`surface_margin_deg`).
+#: fitted mean surface's normal above that surface (:func:`surface_margin_deg`). Two, for a
+#: one-sided tail of about 2.3 %: calling the dark image of a working LED below the real surface
+#: a misfire tells a user to repair it, while a wider margin leaves more dead low LEDs unjudged.
+#: The deviation is measured from the scatter left after the fit, which the fit has partly
+#: absorbed: on strongly uneven domes the margin is smaller than the real tilt
+#: (docs/reconstruction.md, the margin's measured cost).
 SURFACE_MARGIN_SD = 2.0
 #: Below this many lights above the mean surface the fit's surface has no spread to measure.
 SURFACE_MIN_LIGHTS = 3
