@@ -10,7 +10,7 @@ import shlex
 import signal
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -736,7 +736,7 @@ def _write_failed_said(exc: RtiRigError, opened) -> RtiRigError:  # type: ignore
         what = f"{kept} image(s) are kept"
     return RtiRigError(
         f"{exc}: the session stopped there; {what}; {_disk_fix(exc.errno_name)}, then continue "
-        f"with rti-rig run --resume {_arg(opened.out_dir)}"
+        f"with {_continue_command(opened)}"
     )
 
 
@@ -866,13 +866,36 @@ def _reshoot_not_begun(opened) -> bool:  # type: ignore[no-untyped-def]
 
 
 def _resume_before_begin(opened) -> str:  # type: ignore[no-untyped-def]
-    """The resume command for a resume stopped before it wrote anything: with --reshoot-lost
-    when the session is a completed one (:func:`_reshoot_not_begun`).
+    """The resume command for a resume stopped before it wrote anything: the one the user
+    gave (:func:`_resume_command`), or with --reshoot-lost when the session is a completed
+    one (:func:`_reshoot_not_begun`).
 
     Why: a --reshoot-lost stopped as the capture took over from the opening was told a plain
-    ``rti-rig run --resume S``, which refuses a completed session."""
+    ``rti-rig run --resume S``, which refuses a completed session; then ``--resume S
+    --reshoot-lost``, without the rig config, --accept-rig-change or --rebuild-journal given
+    with it, each of which the resume needs again."""
+    if opened.request is not None:
+        return _resume_command(opened.request)
     tail = " --reshoot-lost" if _reshoot_not_begun(opened) else ""
     return f"rti-rig run --resume {_arg(opened.out_dir)}{tail}"
+
+
+def _continue_command(opened) -> str:  # type: ignore[no-untyped-def]
+    """The command to continue ``opened`` with after a stop or failure: a resume's own request
+    (its rig config and flags) while this run has written nothing, else its rig config,
+    --accept-rig-change and --objective (--reshoot-lost and --rebuild-journal did their work
+    once this run began writing); ``--resume DIR`` alone for a new session, whose manifest
+    names its config.
+
+    Why: a resume given a rig config (``rti-rig run RIG.toml --resume S``) that failed (an arm
+    that did not connect) was told "Continue with: rti-rig run --resume S", without it: the
+    manifest's config, not the one the user chose, or a refusal if that one had moved."""
+    req = opened.request
+    if req is None:
+        return f"rti-rig run --resume {_arg(opened.out_dir)}"
+    if not opened.folder.begun:
+        return _resume_command(req)
+    return _resume_command(replace(req, reshoot_lost=False, rebuild_journal=False))
 
 
 def _labels_disowned(out_dir: Path) -> Path | None:
@@ -1164,7 +1187,10 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     noun = "light" if todo == 1 else "lights"
     count = f"{todo} {noun}" if todo == total else f"{todo} of {total} {noun} left"
     out.print(f"Rig [bold]{escape(rig.name)}[/]{dry}: {count}{adaptive} → {escape(str(out_dir))}")
-    resume_hint = _cannot_resume(rig) or f"Continue with: rti-rig run --resume {_arg(out_dir)}"
+
+    def resume_hint() -> str:  # said once the run stopped: what it wrote decides the command
+        return _cannot_resume(rig) or f"Continue with: {_continue_command(opened)}"
+
     try:
         if settable:
             signal.signal(signal.SIGTERM, on_sigterm)
@@ -1212,13 +1238,13 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         err.print(
             f"[red]Emergency stop ({escape(str(exc))}):[/] {escape(lights_state(rig, failed))}."
         )
-        err.print(_after_stop(opened, resume_hint), markup=False, soft_wrap=True)
+        err.print(_after_stop(opened, resume_hint()), markup=False, soft_wrap=True)
         raise typer.Exit(code=stop_exit_code(str(exc))) from None
     except RtiRigError as exc:
         from rti_rig.app.usecases.safe_state import lights_state
 
         state = lights_state(rig, _print_teardown_failures(folder, said_below=exc))
-        hint = _dead_led_hint(opened, exc) or resume_hint
+        hint = _dead_led_hint(opened, exc) or resume_hint()
         err.print(f"{_sentence(state)}. {_after_stop(opened, hint)}", markup=False)
         raise fail(_write_failed_said(exc, opened)) from None
     except Exception as exc:
@@ -1228,7 +1254,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         from rti_rig.app.usecases.safe_state import lights_state
 
         state = lights_state(rig, _print_teardown_failures(folder))
-        err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint)}", markup=False)
+        err.print(f"{_sentence(state)}. {_after_stop(opened, resume_hint())}", markup=False)
         raise _unexpected(exc, f"{out_dir}/manifest.json") from None
     finally:
         if over and settable and previous.get(signal.SIGINT) is not None:
@@ -1241,7 +1267,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         else:
             put_back(previous)
     with _ctrl_c_ignored(previous.get(signal.SIGINT) if over else None):
-        return _summarise(opened, result, resume_hint, dry)
+        return _summarise(opened, result, resume_hint(), dry)
 
 
 @contextmanager

@@ -55,7 +55,9 @@ def test_a_resume_whose_arm_overloads_at_connect_claims_no_stop_of_it(
     # no teardown problem of this run (none failed), none of the run before, no park of it
     assert "teardown problem" not in said, said
     assert "held where it is" not in said and "park" not in said, said
-    assert f"Continue with: rti-rig run --resume {out}" in said, said
+    # the config the user gave is in the command to continue with (it had been left out: the
+    # resume would take the manifest's config, not the one chosen)
+    assert f"Continue with: rti-rig run {cfg} --resume {out}" in said, said
     assert (out / "manifest.json").read_bytes() == manifest  # nothing of the session changed
     # the truth: nothing was written to a servo, and servo 1 is limp by its own shutdown
     (emu,) = emulators

@@ -150,3 +150,21 @@ def test_a_reshoot_stopped_as_the_capture_takes_over_is_told_to_reshoot(
     assert held and r.exit_code == 143 and "Traceback" not in said, said
     assert "Stopped (SIGTERM) before the session went on" in said, said
     assert f"continue it with rti-rig run --resume {out} --reshoot-lost" in said, said
+
+
+def test_a_reshoot_stopped_before_it_wrote_anything_is_told_the_flags_it_was_given(
+    tmp_path: Path,
+) -> None:
+    """The same stop of a reshoot given its rig config and --accept-rig-change: it had been
+    told ``--resume S --reshoot-lost``, the config and the acceptance dropped (a resume
+    without them takes the manifest's config, or refuses the rig change again)."""
+    code, said, out = _run(tmp_path, 99, 0, "--lights", "6")
+    assert code == 0, said
+    (out / "image_003.jpg").unlink()
+    (out / "linear" / "image_003.tif").unlink()
+    cfg = str(CONFIGS / "simulated_dome.toml")
+    flags = ("--resume", str(out), "--accept-rig-change", "--reshoot-lost")
+    code, said, _ = _run(tmp_path, -2, 2, cfg, *flags)
+    assert code == 130 and "Traceback" not in said, said
+    given = f"rti-rig run {cfg} --resume {out} --accept-rig-change --reshoot-lost"
+    assert f"Continue with: {given}" in said, said

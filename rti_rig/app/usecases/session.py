@@ -152,6 +152,9 @@ class OpenedSession:
     #: whether a card camera lists its card before the first shot (a capture session, `run`;
     #: not the one-image session of `preview`, which had waited minutes on a full card)
     list_card: bool = True
+    #: the request a resumed session was opened by (None: a new session): what the user gave
+    #: (a rig config, --accept-rig-change …), which the command to continue with must repeat
+    request: ResumeRequest | None = None
 
     @property
     def dry_run(self) -> bool:
@@ -1449,7 +1452,9 @@ def _opened_resume(req, loaded, folder, identity, diffs, on_note):  # type: igno
         except BaseException:
             rig.close()
             raise
-    return OpenedSession(rig, schedule, folder, Path(req.session_dir), resumed=True, source=source)
+    return OpenedSession(
+        rig, schedule, folder, Path(req.session_dir), resumed=True, source=source, request=req
+    )
 
 
 def open_preview_session(req: PreviewRequest, on_note: NoteSink = _ignore) -> OpenedSession:
