@@ -689,10 +689,12 @@ def _end_unrecorded(manifest: dict) -> str | None:  # type: ignore[type-arg]
     recorded it completed): "its end" or, of an adaptive one, "its end and its adaptive
     outcome (why it stopped, its error estimate)".
 
-    Why: a SIGTERM once the last image was in (in the teardown, or an arm's final park) was
-    told "the session is complete, nothing is left to resume", while its manifest recorded an
-    emergency stop: `rti-rig fit` then called it "not finished … continue it with rti-rig run
-    --resume", and an adaptive session's outcome was recorded only by that resume."""
+    Why: a stop as the last image was committed (its journal line written, the run's end not
+    yet recorded) was told "the session is complete, nothing is left to resume", while its
+    manifest recorded an emergency stop (a stop later, in the teardown or an arm's final park,
+    records "completed" and is not this case): `rti-rig fit` then called it "not finished …
+    continue it with rti-rig run --resume", and an adaptive session's outcome was recorded only
+    by that resume."""
     if (manifest.get("runner") or {}).get("finish_reason") == "completed":
         return None
     adaptive = manifest.get("adaptive")
