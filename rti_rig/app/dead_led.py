@@ -92,13 +92,15 @@ def dead_led_advice(
     if rig_lp is not None and leds == set(range(len(names))):
         plan = rig_lp
     else:
-        written = write_plan_without(schedule, out_dir, led)
-        if written is not None:
+        plan_file = write_plan_without(schedule, out_dir, led)
+        if plan_file is not None:
             # the session's own lights (a --plan's, or those --lights N chose), which the
             # user had no file of: coordinates to find and delete by hand were no command
+            written, reused = plan_file
+            how = "are already" if reused else "were written"
             return (
                 f"A resume lights {which} first and stops there again. The session's "
-                f"{len(leds - {led})} other lights, in its order, were written beside it "
+                f"{len(leds - {led})} other lights, in its order, {how} beside it "
                 f"as {written.name}; to shoot them now: rti-rig run {cfg} --plan "
                 f"{shlex.quote(str(written))} --out NEW_DIR. {resume[0].upper()}{resume[1:]}"
             )
@@ -111,13 +113,17 @@ def dead_led_advice(
     )
 
 
-def write_plan_without(schedule: Any, out_dir: Path, led: int) -> Path | None:
+def write_plan_without(schedule: Any, out_dir: Path, led: int) -> tuple[Path, bool] | None:
     """Write the session's lights without LED ``led``, in its order, as a new ``.lp`` beside
-    ``out_dir`` (``<name>-without-led-<led>.lp``, never over an existing file); its path, or
-    None when it cannot be written (no other light, a folder one cannot write to).
+    ``out_dir`` (``<name>-without-led-<led>.lp``, never over an existing file); its path and
+    whether it was there already with this very content (reused, not written again), or None
+    when it cannot be written (no other light, a folder one cannot write to).
 
     Beside the session, not in it: a second ``.lp`` in the session folder would be offered to
-    relight and RTIBuilder beside its ``lights.lp``, naming images it does not hold."""
+    relight and RTIBuilder beside its ``lights.lp``, naming images it does not hold. An
+    identical file is reused: each resume stopped at the same LED had written another copy
+    (``-2.lp``, ``-3.lp``); a file that differs (another plan, edited by the user) is kept and
+    the next free name taken."""
     from rti_rig.core.lp_format import LpEntry, format_lp
 
     kept = [s for s in schedule.steps if s.led != led]
@@ -134,11 +140,21 @@ def write_plan_without(schedule: Any, out_dir: Path, led: int) -> Path | None:
             with open(path, "x", encoding="ascii", newline="\n") as fh:  # never over a file
                 fh.write(text)
         except FileExistsError:
+            if _holds(path, text):
+                return path, True
             continue
         except OSError:
             return None
-        return path
+        return path, False
     return None
+
+
+def _holds(path: Path, text: str) -> bool:
+    """Whether the file at ``path`` holds exactly ``text`` (False if it cannot be read)."""
+    try:
+        return path.read_bytes() == text.encode("ascii")
+    except (OSError, UnicodeEncodeError):
+        return False
 
 
 def _led_names(loaded: Any) -> tuple[str, ...]:

@@ -141,3 +141,32 @@ def test_an_adaptive_session_stopped_at_a_dead_led_it_chose_is_given_no_plan_of_
     assert f"continue with: rti-rig run --resume {s}" in text, text  # once repaired
     assert "were written beside it" not in text, text
     assert not list(tmp_path.glob("s-without-led-*.lp")), text
+
+
+def test_a_resume_stopped_at_the_same_dead_led_reuses_the_plan_it_wrote(tmp_path: Path) -> None:
+    """Each resume stopped at the same LED had written another identical plan (``-2.lp``,
+    ``-3.lp``) beside the session. The identical file is reused and said to be there; a file
+    that differs (edited by the user) is never overwritten: the next name is written."""
+    cfg = _dead_dome(tmp_path)
+    s = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(cfg), "--out", str(s), "--lights", "24", "--no-verdict"])
+    assert r.exit_code == 2, said(r)
+    first = tmp_path / f"s-without-led-{DEAD}.lp"
+    assert f"were written beside it as {first.name}" in said(r), said(r)
+    content = first.read_bytes()
+
+    r = runner.invoke(app, ["run", "--resume", str(s), "--no-verdict"])
+    text = said(r)
+    assert r.exit_code == 2 and f"LED {DEAD} refused" in text, text
+    assert f"other lights, in its order, are already beside it as {first.name}" in text, text
+    assert f"--plan {first} --out NEW_DIR" in text, text
+    assert sorted(p.name for p in tmp_path.glob("s-without-led-*.lp")) == [first.name]
+    assert first.read_bytes() == content
+
+    edited = content + b"# the user's note\n"
+    first.write_bytes(edited)
+    r = runner.invoke(app, ["run", "--resume", str(s), "--no-verdict"])
+    text = said(r)
+    second = tmp_path / f"s-without-led-{DEAD}-2.lp"
+    assert r.exit_code == 2 and f"were written beside it as {second.name}" in text, text
+    assert first.read_bytes() == edited and second.read_bytes() == content
