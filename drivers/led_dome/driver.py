@@ -87,6 +87,8 @@ class LedDomeDriver(PortOpening):
         self.echoes_light = codec.profile != "binary"
         #: Every light command is answered (an acknowledgement, or the LED's error).
         self.light_confirmed = True
+        #: A dead LED is refused (error 4, LED fault: the board senses its current).
+        self.senses_led_current = True
         self._rx = bytearray()
         self._seq = 0
         self._open = False

@@ -83,6 +83,9 @@ class ScriptedDomeDriver(PortOpening):
         #: A light command is answered: else the self-test can only send it (whether the LED
         #: lit is seen only on the dome).
         self.light_confirmed = spec.light.reply.kind != "none"
+        #: No described firmware senses LED current: its reply says the command was taken,
+        #: never that the LED lit (a dead one is acknowledged all the same).
+        self.senses_led_current = False
         #: What an all-off establishes on this firmware.
         self.off_outcome = (
             OffOutcome.SELF_TIMED

@@ -850,6 +850,16 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
                 "emulator.led_power",
                 f"{len(power)} values for {len(dirs)} LEDs: give one per LED, in LED order",
             )
+        # an LED index the dome has not had been ignored without a word: the rehearsal then
+        # had no dead LED at all, and its check and fit "found" none
+        outside = sorted({i for i in config.emulator.dead_leds if not 0 <= i < len(dirs)})
+        if outside:
+            raise ConfigError(
+                path,
+                "emulator.dead_leds",
+                f"{', '.join(map(str, outside))} not among this dome's {len(dirs)} LEDs: give "
+                f"LED indices from 0 to {len(dirs) - 1}",
+            )
     if config.camera.device is not None and config.backend != "hardware":
         # a dry run renders its images (the camera a simulated, emulated or replayed rig has):
         # a real camera's table would be ignored without a word

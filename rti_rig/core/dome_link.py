@@ -141,6 +141,10 @@ class DomeLink(Protocol):
     #: only a person watching the dome knows whether the LED lit. Declared, not looked up
     #: with a default: a link lacking it had had its steps reported "passed".
     light_confirmed: bool
+    #: The firmware senses LED current and refuses a dead LED (the project's protocol: error
+    #: 4, "LED fault"): else an acknowledged light command says only that the board took it,
+    #: and a dead LED is dark with no word (the self-test must not call its step "passed").
+    senses_led_current: bool
 
     # The stop hooks below are what the policy asks after a stop, a failed connect or a lost
     # reply. They are declared, not looked up with defaults: a link type that lacked one had

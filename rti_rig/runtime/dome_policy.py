@@ -1385,6 +1385,9 @@ class SelfTestReport:
     #: Whether the firmware answers a light command: if not, a step "passes" when it was sent
     #: without error, and only a person watching the dome knows whether the LED lit.
     light_confirmed: bool = True
+    #: Whether the firmware senses LED current (refuses a dead LED): if not, an acknowledged
+    #: step says only that the board took the command, not that the LED lit.
+    senses_current: bool = True
     #: How far the connect got (:attr:`DomePolicy.reached`); None: not a dome policy.
     reached: str | None = None
     #: The built-in firmware whose boot banner the board printed when it is not the profile's
@@ -1465,10 +1468,16 @@ class SelfTestReport:
             out = [f"{self.name}: {' '.join(fw.split())}, {count}"]
             passed = sum(c.ok for c in self.checks)
             out.append(
-                f"LEDs stepped: {len(self.checks)}, "
-                + (f"passed: {passed}" if self.light_confirmed else f"sent without error: {passed}")
+                f"LEDs stepped: {len(self.checks)}, {self._passed_as()}: {passed}"
                 + f", failed: {len(self.failed)} in {self.elapsed_s:.2f} s"
             )
+            if self.light_confirmed and not self.senses_current and passed:
+                out.append(
+                    "  whether each LED lights cannot be sensed by this firmware (it measures "
+                    "no LED current, so a dead LED is acknowledged too): look at the dome "
+                    "during the check, or run a short session and `rti-rig fit S --out FOLDER "
+                    "--no-ptm --no-hsh --no-normals`, whose QA names a dark image"
+                )
         out += [f"  LED {c.index}: {c.message}" for c in self.failed]
         if self.light_latency_s and self.foreign_firmware is None:
             lat = np.asarray(self.light_latency_s) * 1000
@@ -1499,9 +1508,23 @@ class SelfTestReport:
                 "RESULT: SENT, NOT VERIFIED (this firmware answers no light command: watch the "
                 "dome during the check; each LED should light in turn)"
             )
+        elif self.ok and not self.senses_current:
+            # PASS of what was established: the board and its replies, not the LEDs' light
+            out.append("RESULT: PASS (each LED acknowledged by the board, none seen lit)")
         else:
             out.append("RESULT: " + ("PASS" if self.ok else "FAIL"))
         return out
+
+    def _passed_as(self) -> str:
+        """What a step that ended without error established, as the walk's count names it:
+        "passed" only where the firmware would have refused a dead LED.
+
+        Why: a board that senses no current (the Nab sketch and every described firmware)
+        acknowledges a dead LED as it does a good one, and "passed: 12 … PASS" had claimed
+        12 LEDs that lit, of a dome with a dead one."""
+        if not self.light_confirmed:
+            return "sent without error"
+        return "passed" if self.senses_current else "acknowledged by the board"
 
 
 def _recovered_board_faults(recovered: list[str]) -> list[str]:
@@ -1578,6 +1601,7 @@ def self_test(
     link = source.link if isinstance(source, DomePolicy) else None
     # a source with no link (no firmware to answer) is reported as before: its steps passed
     report.light_confirmed = True if link is None else link.light_confirmed
+    report.senses_current = True if link is None else link.senses_led_current
     if isinstance(source, DomePolicy):
         source.lights_images = False  # an LED lost to a reboot spoils no image here
     try:

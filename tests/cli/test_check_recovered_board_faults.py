@@ -64,7 +64,7 @@ def test_a_banner_later_than_the_boot_wait_is_not_called_a_reboot(tmp_path: Path
         cfg = emulated_dome_as_hardware(tmp_path, "emulated_nab_rti_v1.toml", link.port)
         r = CliRunner().invoke(app, ["check", str(cfg)], terminal_width=400)
     said = " ".join(r.output.split())
-    assert "LEDs stepped: 12, passed: 12" in said, said
+    assert "LEDs stepped: 12, acknowledged by the board: 12" in said, said
     assert "rebooted during the check" not in said, said
     # CliRunner mixes stderr into output: the report's own line is what is looked for
     assert "slow boot: the board printed its boot banner only" in said, said

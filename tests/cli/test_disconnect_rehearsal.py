@@ -67,6 +67,6 @@ def test_the_documented_disconnect_rehearsal_recovers(tmp_path: Path) -> None:
     assert r.exit_code == 0, said
     assert "did not come back" not in said
     assert "1 reconnects" in said, said
-    assert "LEDs stepped: 12, passed: 12, failed: 0" in said, said
+    assert "LEDs stepped: 12, acknowledged by the board: 12, failed: 0" in said, said
     assert "all-off sent and acknowledged by the dome: lights are off" in said, said
     assert "RESULT: PASS" in said, said

@@ -884,6 +884,7 @@ class _TimedLink:
     firmware_name = None
     boots_lit_firmware = None
     light_confirmed = True
+    senses_led_current = True
 
     @property
     def clock(self):

@@ -849,7 +849,7 @@ def test_check_fails_a_dome_whose_camera_does_not_connect(tmp_path: Path) -> Non
         r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
     text = said(r)
     assert r.exit_code == 1, text
-    assert "passed: 12, failed: 0" in text  # the lights were fine
+    assert "acknowledged by the board: 12, failed: 0" in text  # the lights were fine
     assert "camera: FAILED to connect" in text and str(tmp_path / "v9") in text
     assert r.output.rstrip().splitlines()[-1] == "RESULT: FAIL"
 

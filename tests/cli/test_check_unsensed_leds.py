@@ -1,0 +1,54 @@
+"""``rti-rig check`` of a dome whose firmware senses no LED current says what it established.
+
+The Nab sketch (and every described firmware) acknowledges a light command whether the LED
+lit or not. Its check had said "passed: 12 … RESULT: PASS" of a dome with a dead LED: only
+the board's acknowledgement was established. The emulated board here has LED 3 dead
+(``[emulator] dead_leds``): it acknowledges it as the real board would, and gives no light.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+
+
+def _nab(tmp_path: Path, dead: str) -> Path:
+    cfg = tmp_path / "nab.toml"
+    cfg.write_text(
+        (CONFIGS / "emulated_nab_rti_v1.toml").read_text() + f"\n[emulator]\ndead_leds = {dead}\n"
+    )
+    return cfg
+
+
+@pytest.mark.pty
+def test_a_check_of_a_board_that_senses_no_current_claims_no_led_lit(tmp_path: Path) -> None:
+    r = runner.invoke(app, ["check", str(_nab(tmp_path, "[3]"))], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 0 and "Traceback" not in text, text
+    assert "LEDs stepped: 12, acknowledged by the board: 12, failed: 0" in text, text
+    assert "passed: 12" not in text, text
+    assert "whether each LED lights cannot be sensed by this firmware" in text, text
+    assert "rti-rig fit S --out FOLDER --no-ptm --no-hsh --no-normals" in text, text
+    assert r.output.rstrip().splitlines()[-1] == (
+        "RESULT: PASS (each LED acknowledged by the board, none seen lit)"
+    )
+
+
+@pytest.mark.parametrize("dead", ["[12]", "[-1, 3]"])
+def test_a_dead_led_the_dome_has_not_is_refused_by_name(tmp_path: Path, dead: str) -> None:
+    """An index outside the dome's LEDs had been ignored without a word: the rehearsal had no
+    dead LED at all."""
+    cfg = _nab(tmp_path, dead)
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    assert f"{cfg}: key 'emulator.dead_leds'" in text, text
+    assert "not among this dome's 12 LEDs: give LED indices from 0 to 11" in text, text
+    assert "LEDs stepped" not in text, text  # refused before the port opened
