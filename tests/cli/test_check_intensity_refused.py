@@ -53,7 +53,9 @@ def test_full_intensity_is_used_on_an_on_off_firmware(config: str) -> None:
     r = runner.invoke(app, ["check", str(CONFIGS / config), "--intensity", "1"])
     text = said(r.output)
     assert r.exit_code == 0, text
-    assert text.endswith("RESULT: PASS") and "--intensity" not in text, text
+    # these firmwares sense no LED current: the pass says what it established
+    assert text.endswith("RESULT: PASS (each LED acknowledged by the board, none seen lit)"), text
+    assert "--intensity" not in text, text
     r = runner.invoke(app, ["check", str(CONFIGS / config), "--intensity", "0.99"])
     text = said(r.output)
     assert r.exit_code == 2, text
