@@ -863,8 +863,7 @@ def _reshoot_not_begun(opened) -> bool:  # type: ignore[no-untyped-def]
     folder = opened.folder
     if not opened.resumed or folder.begun or _cannot_resume(opened.rig):
         return False
-    runs = (folder.manifest or {}).get("runs") or []
-    return bool(runs) and runs[-1].get("finish_reason") == "completed"
+    return _last_run_completed(folder)
 
 
 def _resume_before_begin(opened) -> str:  # type: ignore[no-untyped-def]
@@ -922,6 +921,12 @@ def _run_completed(folder) -> bool:  # type: ignore[no-untyped-def]
     manifest, written before the stop acts, is what says the capture was over."""
     if not folder.begun:  # the manifest's last run is an earlier one (a --reshoot-lost's)
         return False
+    return _last_run_completed(folder)
+
+
+def _last_run_completed(folder) -> bool:  # type: ignore[no-untyped-def]
+    """Whether the manifest's last run entry says the session completed: this run's once it
+    began (:func:`_run_completed`), an earlier run's before (:func:`_reshoot_not_begun`)."""
     runs = (folder.manifest or {}).get("runs") or []
     return bool(runs) and runs[-1].get("finish_reason") == "completed"
 
@@ -933,7 +938,7 @@ def _print_teardown_failures(  # type: ignore[no-untyped-def]
     folder's ``finish``, not the manifest's, which a resume that never connected leaves with
     the previous run's; the lights' state line that follows refers to it); True if any.
     ``said_below``: the session's error, printed in full after these lines."""
-    failures = (getattr(folder, "run_end", None) or {}).get("teardown_failures")
+    failures = (folder.run_end or {}).get("teardown_failures")
     return _print_failures(failures, said_below)
 
 
