@@ -159,6 +159,36 @@ def inprocess_arm_config(tmp_path: Path, extra: str = "") -> Path:
     return cfg
 
 
+def shipped_variant(
+    folder: Path, shipped: str, edits: tuple[tuple[str, str], ...], emulator: str = ""
+) -> Path:
+    """``rig_configs/<shipped>`` written to ``folder/rig.toml`` with each ``(old, new)`` edit
+    made and ``emulator`` as its ``[emulator]`` block (none if empty). Each ``old`` must be in
+    the shipped text: a shipped config that changed fails here, by name, not as a session that
+    quietly ran on another scene or seed."""
+    text = (CONFIGS / shipped).read_text(encoding="utf-8")
+    for old, new in edits:
+        assert old in text, f"{shipped}: {old!r}"
+        text = text.replace(old, new)
+    config = folder / "rig.toml"
+    config.write_text(text + (f"\n[emulator]\n{emulator}" if emulator else ""), encoding="utf-8")
+    return config
+
+
+def qa_of(session: Path, out: Path) -> tuple[str, dict]:  # type: ignore[type-arg]
+    """The QA verdict of ``rti-rig fit session --out out`` with no fit but the QA's: its words
+    (one line) and its ``qa.json``."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    r = CliRunner().invoke(
+        app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh", "--no-normals"]
+    )
+    assert r.exit_code == 0, r.output
+    return " ".join(r.output.split()), json.loads((out / "qa.json").read_text())
+
+
 def servo_fault(at_command: int, servo_id: int, kind: str = "overload") -> str:
     """An ``[[emulator.faults]]`` table of the emulated arm (to append to its config, e.g. as
     :func:`inprocess_arm_config`'s ``extra``): servo ``servo_id`` reports ``kind`` from the

@@ -12,10 +12,9 @@ plane is still named (measured over seeds 0-9 in docs/reconstruction.md).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from conftest import CONFIGS
+from conftest import qa_of, shipped_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -25,31 +24,16 @@ runner = CliRunner()
 
 def _tilted_session(folder: Path, emulator: str) -> Path:
     """A session of the shipped emulated minirti dome on the tilted relief, seed 5."""
-    text = (CONFIGS / "emulated_minirti.toml").read_text()
-    for old, new in (
-        ('\nname = "tablet"\n', '\nname = "tilted"\n'),
-        ("\nseed = 0\n", "\nseed = 5\n"),
-    ):
-        assert old in text, old
-        text = text.replace(old, new)
-    config = folder / "rig.toml"
-    config.write_text(text + "\n[emulator]\n" + emulator)
+    edits = (('\nname = "tablet"\n', '\nname = "tilted"\n'), ("\nseed = 0\n", "\nseed = 5\n"))
+    config = shipped_variant(folder, "emulated_minirti.toml", edits, emulator)
     out = folder / "s"
     r = runner.invoke(app, ["run", str(config), "--out", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     return out
 
 
-def _fit(session: Path, out: Path) -> tuple[str, dict]:
-    r = runner.invoke(
-        app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh", "--no-normals"]
-    )
-    assert r.exit_code == 0, r.output
-    return " ".join(r.output.split()), json.loads((out / "qa.json").read_text())
-
-
 def test_a_dark_light_below_the_real_plane_is_not_a_misfire(tmp_path: Path) -> None:
-    said, qa = _fit(_tilted_session(tmp_path, "led_power_spread = 0.2\n"), tmp_path / "f")
+    said, qa = qa_of(_tilted_session(tmp_path, "led_power_spread = 0.2\n"), tmp_path / "f")
     assert "QA verdict" in said, said
     image_006 = qa["images"][5]
     assert image_006["name"] == "image_006"
@@ -62,7 +46,7 @@ def test_a_dark_light_below_the_real_plane_is_not_a_misfire(tmp_path: Path) -> N
 def test_a_dead_led_above_the_plane_is_still_named(tmp_path: Path) -> None:
     # LED 4 (image_005) lies 27° above the real plane; its LED gives no light
     session = _tilted_session(tmp_path, "led_power_spread = 0.2\ndead_leds = [4]\n")
-    _, qa = _fit(session, tmp_path / "f")
+    _, qa = qa_of(session, tmp_path / "f")
     misfired = {c["name"]: c["problems"] for c in qa["images"] if "misfired" in str(c["problems"])}
     assert set(misfired) == {"image_005"}, qa["verdict"]
     assert misfired["image_005"][0].startswith("misfired, no light"), misfired

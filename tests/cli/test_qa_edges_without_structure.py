@@ -13,12 +13,11 @@ with one image really moved 2 px is still named (docs/reconstruction.md gives th
 
 from __future__ import annotations
 
-import json
 import shutil
 from pathlib import Path
 
 import numpy as np
-from conftest import CONFIGS
+from conftest import qa_of, shipped_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -28,17 +27,13 @@ runner = CliRunner()
 
 def _session(folder: Path, shipped: str, scene: str, seed: int, emulator: str = "") -> Path:
     """A still 24-light session of a shipped emulated dome on ``scene``."""
-    text = (CONFIGS / shipped).read_text()
-    for old, new in (
+    edits = (
         ("\ncount = 12\n", "\ncount = 24\n"),
         ("\nled_count = 12 ", "\nled_count = 24 "),
         ('\nname = "tablet"\n', f'\nname = "{scene}"\n'),
         ("\nseed = 0\n", f"\nseed = {seed}\n"),
-    ):
-        assert old in text, old
-        text = text.replace(old, new)
-    config = folder / "rig.toml"
-    config.write_text(text + (f"\n[emulator]\n{emulator}" if emulator else ""))
+    )
+    config = shipped_variant(folder, shipped, edits, emulator)
     out = folder / "s"
     r = runner.invoke(
         app, ["run", str(config), "--out", str(out), "--lights", "24", "--no-verdict"]
@@ -62,12 +57,8 @@ def _one_image_moved(session: Path, dst: Path, name: str, dx: int) -> Path:
 
 def _moved(session: Path, out: Path) -> list[str]:
     """The images the verdict of ``rti-rig fit`` calls moved."""
-    r = runner.invoke(
-        app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh", "--no-normals"]
-    )
-    assert r.exit_code == 0, r.output
-    assert "QA verdict" in " ".join(r.output.split()), r.output
-    qa = json.loads((out / "qa.json").read_text())
+    said, qa = qa_of(session, out)
+    assert "QA verdict" in said, said
     return [c["name"] for c in qa["images"] if any("moved" in p for p in c["problems"])]
 
 

@@ -12,10 +12,9 @@ elevation from which a black frame is told.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from conftest import CONFIGS
+from conftest import qa_of, shipped_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
@@ -25,40 +24,28 @@ runner = CliRunner()
 
 def _flat_session(folder: Path, emulator: str) -> Path:
     """24 lights of the shipped emulated Nab dome, from 3.2° up, over the flat plate."""
-    text = (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
-    for old, new in (
+    edits = (
         ('\nname = "tablet"\n', '\nname = "flat"\n'),
         ("\ncount = 12\n", "\ncount = 24\n"),
         ("\nled_count = 12 ", "\nled_count = 24 "),
         ("\nmin_elevation_deg = 15.0\n", "\nmin_elevation_deg = 2.0\n"),
-    ):
-        assert old in text, old
-        text = text.replace(old, new)
-    config = folder / "rig.toml"
-    config.write_text(text + "\n[emulator]\n" + emulator)
+    )
+    config = shipped_variant(folder, "emulated_nab_rti_v1.toml", edits, emulator)
     out = folder / "s"
     r = runner.invoke(app, ["run", str(config), "--out", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     return out
 
 
-def _fit(session: Path, out: Path) -> tuple[str, dict]:
-    r = runner.invoke(
-        app, ["fit", str(session), "--out", str(out), "--no-ptm", "--no-hsh", "--no-normals"]
-    )
-    assert r.exit_code == 0, r.output
-    return " ".join(r.output.split()), json.loads((out / "qa.json").read_text())
-
-
 def test_a_dead_oblique_led_on_a_flat_plate_is_a_misfire(tmp_path: Path) -> None:
-    _, qa = _fit(_flat_session(tmp_path, "dead_leds = [0]\n"), tmp_path / "f")
+    _, qa = qa_of(_flat_session(tmp_path, "dead_leds = [0]\n"), tmp_path / "f")
     problems = {c["name"]: c["problems"] for c in qa["images"] if c["problems"]}
     assert set(problems) == {"image_001"}, qa["verdict"]
     assert problems["image_001"][0].startswith("misfired, no light"), problems
 
 
 def test_lit_oblique_lights_on_a_flat_plate_are_said_not_judged(tmp_path: Path) -> None:
-    said, qa = _fit(_flat_session(tmp_path, "dead_leds = []\n"), tmp_path / "f")
+    said, qa = qa_of(_flat_session(tmp_path, "dead_leds = []\n"), tmp_path / "f")
     assert qa["good"], qa["verdict"]
     assert "misfired" not in said, said
     faint = [c["name"] for c in qa["images"] if c["faint_light"]]

@@ -20,28 +20,24 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import shipped_variant
 from typer.testing import CliRunner
 
 from rti_rig.cli import app
 from rti_rig.core.image_files import read_linear_tiff, write_linear_tiff
 
-REPO = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 
 
 def _coin_config(folder: Path, seed: int, side: int = 48) -> Path:
     """The shipped emulated Nab dome on the glossy coin, uneven LEDs drawn from ``seed``."""
-    text = (REPO / "rig_configs" / "emulated_nab_rti_v1.toml").read_text()
-    for old, new in (
+    edits = (
         ('\nname = "tablet"\n', '\nname = "coin"\n'),
         ("\nseed = 0\n", f"\nseed = {seed}\n"),
         ("\nwidth = 48\n", f"\nwidth = {side}\n"),
         ("\nheight = 48\n", f"\nheight = {side}\n"),
-    ):
-        assert old in text, old
-        text = text.replace(old, new)
-    config = folder / "rig.toml"
-    config.write_text(text + "\n[emulator]\nled_power_spread = 0.2\n")
+    )
+    config = shipped_variant(folder, "emulated_nab_rti_v1.toml", edits, "led_power_spread = 0.2\n")
     return config
 
 
