@@ -67,10 +67,11 @@ def dead_led_advice(
     names = _led_names(loaded)
     which = f"LED {led} ({names[led]})" if 0 <= led < len(names) else f"LED {led}"
     leds = {s.led for s in schedule.steps}
-    resume = (
-        f"once that LED or its wiring is repaired, continue with: rti-rig run --resume "
+    repaired = (
+        f"that LED or its wiring is repaired, continue with: rti-rig run --resume "
         f"{shlex.quote(str(out_dir))}"
     )
+    resume, resume_sentence = f"once {repaired}", f"Once {repaired}"
     rig_lp = (
         f"copy {loaded.folder / dome.lp_file} (the rig's LED .lp) without the line of "
         f"{which}, the count on its first line one less, as PLAN.lp"
@@ -87,7 +88,7 @@ def dead_led_advice(
         return (
             f"A resume lights {which} first and stops there again. An adaptive session "
             f"chooses its lights as it goes, so no plan of its other lights exists."
-            f"{meanwhile} {resume[0].upper()}{resume[1:]}"
+            f"{meanwhile} {resume_sentence}"
         )
     if rig_lp is not None and leds == set(range(len(names))):
         plan = rig_lp
@@ -102,7 +103,7 @@ def dead_led_advice(
                 f"A resume lights {which} first and stops there again. The session's "
                 f"{len(leds - {led})} other lights, in its order, {how} beside it "
                 f"as {written.name}; to shoot them now: rti-rig run {cfg} --plan "
-                f"{shlex.quote(str(written))} --out NEW_DIR. {resume[0].upper()}{resume[1:]}"
+                f"{shlex.quote(str(written))} --out NEW_DIR. {resume_sentence}"
             )
         step = next((s for s in schedule.steps if s.led == led), None)
         where = "" if step is None else " ({:.6f} {:.6f} {:.6f})".format(*step.direction)
