@@ -8,9 +8,9 @@ import re
 import signal
 import socket
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pytest
@@ -93,6 +93,45 @@ class Tether(threading.Thread):
                 (self.folder / name).write_bytes(data)
                 saved += 1
             self.stop.wait(0.02)
+
+
+class TetheredRun(NamedTuple):
+    """What a tethered ``rti-rig run`` left for a test to assert on: the CLI result, its
+    output unwrapped (one line), and the LEDs the board had lit once the command ended."""
+
+    result: Any
+    said: str
+    lit_at_end: list[int]
+
+
+def tethered_run(
+    monkeypatch: pytest.MonkeyPatch,
+    cfg: Path,
+    tether: Path,
+    files: list[tuple[str, bytes]],
+    out: Path,
+    camera: Callable[[Any], Any] | None = None,
+) -> TetheredRun:
+    """``rti-rig run cfg --out out --lights 2 --no-verdict`` on the shipped dome emulated on a
+    pty (:func:`shipped_dome_on_pty`), a :class:`Tether` saving ``files`` into ``tether`` (or
+    the thread ``camera(firmware)`` builds: one with a ``stop`` event), stopped whatever the
+    command did. One spelling of the folder-watch CLI tests' set-up, which had each written
+    it out."""
+    from typer.testing import CliRunner
+
+    from rti_rig.cli import app
+
+    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
+        thread = camera(firmware) if camera is not None else Tether(firmware, tether, files)
+        thread.start()
+        try:
+            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            r = CliRunner().invoke(app, args, terminal_width=400)
+        finally:
+            thread.stop.set()
+            thread.join(5.0)
+        lit_at_end = firmware.lit_indices()
+    return TetheredRun(r, " ".join(r.output.split()), lit_at_end)
 
 
 #: The handlers a test must leave as it found them: a command run in the pytest process

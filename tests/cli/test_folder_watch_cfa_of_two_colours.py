@@ -18,10 +18,7 @@ from pathlib import Path
 import dng_spec_writer
 import numpy as np
 import pytest
-from conftest import Tether, folder_watch_config, shipped_dome_on_pty
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
+from conftest import folder_watch_config, tethered_run
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -39,16 +36,7 @@ def test_run_refuses_a_cfa_of_two_colours_with_advice_that_leads_to_a_fittable_s
     assert 'mode = "demosaic"' in cfg.read_text(encoding="utf-8")  # a colour camera
     monkeypatch.setitem(dng_spec_writer.PATTERNS, "RGRG", (0, 1, 0, 1))
     data = dng_spec_writer.dng(np.full((32, 48), 20000, np.uint16), pattern="RGRG")
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, [("IMG_0001.dng", data)])
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-    said = " ".join(r.output.split())
+    r, said, _lit_at_end = tethered_run(monkeypatch, cfg, tether, [("IMG_0001.dng", data)], out)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert f"{tether / 'IMG_0001.dng'}: " in said, said

@@ -17,10 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import Tether, folder_watch_config, shipped_dome_on_pty
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
+from conftest import folder_watch_config, tethered_run
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -61,17 +58,7 @@ def test_run_names_a_damaged_tiff_at_once_with_what_to_do(
     out = tmp_path / "s"
     cfg = _config(tmp_path, tether)
     data = _damaged_tiff(tmp_path / "scratch.tif")
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, [("IMG_0001.tif", data)])
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit_at_end = firmware.lit_indices()
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, [("IMG_0001.tif", data)], out)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert "IMG_0001.tif is a damaged TIFF" in said and "waiting will not help" in said, said
@@ -140,17 +127,14 @@ def test_run_waits_for_a_libtiff_tiff_whose_copy_paused_and_records_it_whole(
         return real(self, *args)
 
     monkeypatch.setattr(folder_watch.FolderWatchCamera, "_changed_and_settled", waits)
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = PausedCopy(firmware, tether, encoded.tobytes(), tried)
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit_at_end = firmware.lit_indices()
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = tethered_run(
+        monkeypatch,
+        cfg,
+        tether,
+        [],
+        out,
+        camera=lambda firmware: PausedCopy(firmware, tether, encoded.tobytes(), tried),
+    )
     assert "damaged" not in said and "Traceback" not in said, said
     assert tried.is_set(), said  # the half file was read and waited for
     assert r.exit_code == 0, said
@@ -191,17 +175,7 @@ def test_run_names_a_tiff_whose_first_ifd_is_garbage_at_once(
     out = tmp_path / "s"
     cfg = _config(tmp_path, tether)
     data = _garbage_ifd_tiff(tmp_path / "scratch.tif", kind)
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, [("IMG_0001.tif", data)])
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit_at_end = firmware.lit_indices()
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, [("IMG_0001.tif", data)], out)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert "IMG_0001.tif is a damaged TIFF" in said and "waiting will not help" in said, said
@@ -235,17 +209,7 @@ def test_run_names_a_raw_cut_short_with_libraws_words_as_text(
     mosaic = linear_to_mosaic(np.full((32, 32), 0.3), "RGGB", 256, 4095)
     write_dng(whole, mosaic, black_level=256, white_level=4095, exposure_s=0.5, iso=100)
     data = whole.read_bytes()[: whole.stat().st_size // 2]
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, [("IMG_0001.dng", data)])
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit_at_end = firmware.lit_indices()
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, [("IMG_0001.dng", data)], out)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert f"{tether / 'IMG_0001.dng'}: LibRaw cannot decode this file (LibRawIOError: " in said

@@ -22,11 +22,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Tether, folder_watch_config, shipped_dome_on_pty
+from conftest import folder_watch_config, tethered_run
 from dng_spec_writer import dng
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -71,17 +68,7 @@ def test_run_says_what_a_refused_dngs_own_tags_show(
     out = tmp_path / "s"
     cfg = folder_watch_config(tmp_path, tether)
     data = _changed(how)
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, [("IMG_0001.dng", data)])
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit_at_end = firmware.lit_indices()
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, [("IMG_0001.dng", data)], out)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert f"{tether / 'IMG_0001.dng'}: " in said, said  # the folder's file, not the copy

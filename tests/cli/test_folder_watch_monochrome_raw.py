@@ -17,11 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Tether, folder_watch_config, shipped_dome_on_pty
+from conftest import folder_watch_config, tethered_run
 from dng_spec_writer import ASCII, BYTE, LONG, SHORT, tiff_bytes
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -59,17 +56,7 @@ def test_run_refuses_a_monochrome_cameras_dng_where_the_camera_is_set_for_colour
     cfg = folder_watch_config(tmp_path, tether)
     assert 'mode = "demosaic"' in cfg.read_text(encoding="utf-8")  # a colour camera
     data = _monochrome_dng()
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, [("IMG_0001.dng", data)])
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit_at_end = firmware.lit_indices()
-    said = " ".join(r.output.split())
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, [("IMG_0001.dng", data)], out)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said
     assert f"{tether / 'IMG_0001.dng'}: " in said and ".incoming" not in said, said

@@ -20,10 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tifffile
-from conftest import Tether, folder_watch_config, shipped_dome_on_pty
-from typer.testing import CliRunner
-
-from rti_rig.cli import app
+from conftest import folder_watch_config, tethered_run
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
@@ -59,17 +56,9 @@ def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, files: list[bytes]):  
     tether.mkdir()
     cfg = folder_watch_config(tmp_path, tether, timeout_s=20.0, tiffs=True)
     out = tmp_path / "s"
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        camera = Tether(firmware, tether, [(f"IMG_{n:04d}.tif", f) for n, f in enumerate(files, 1)])
-        camera.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            camera.stop.set()
-            camera.join(5.0)
-        lit_at_end = firmware.lit_indices()
-    return r, " ".join(r.output.split()), tether, out, lit_at_end
+    named = [(f"IMG_{n:04d}.tif", f) for n, f in enumerate(files, 1)]
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, named, out)
+    return r, said, tether, out, lit_at_end
 
 
 def test_run_refuses_an_rgb_tiff_whose_samples_per_pixel_is_lost(
