@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import shutil
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -114,15 +115,13 @@ def test_a_resume_counts_the_disk_at_the_real_size_and_does_not_say_it_again(
     assert manifest["rig"]["frame_size"] == seen
 
 
-def test_a_session_resumed_with_the_keys_set_as_told_goes_on(
+def _stopped_by_the_disk_at_its_own_size(
     tmp_path: Path, bigger_camera: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """Stopped by the disk after the note, the keys set as it says, then resumed: the resume
-    had been refused as another picture ("camera size: 64×64 → 256×256"), though the camera's
-    images were 256 x 256 all along. A camera's size is its own, whatever the config says: the
-    fake camera here delivers 256 x 256 px frames at either setting."""
-    import json
-
+) -> tuple[Path, Any]:
+    """A session of ``bigger_camera`` stopped by a 10 MB disk after its first image, its
+    camera delivering 256 x 256 px frames whatever the config's keys say (a camera's size is
+    its own); returns its folder and the disk's real usage (to make room with). The run told
+    the user to set the keys: what the resume tests then do."""
     capture = SimulatedCamera.capture
 
     def its_own_size(self: SimulatedCamera, exposure_s: float):  # type: ignore[no-untyped-def]
@@ -137,6 +136,19 @@ def test_a_session_resumed_with_the_keys_set_as_told_goes_on(
     r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
     said = _said(r)
     assert r.exit_code == 2 and "set camera.width = 256 and camera.height = 256 there" in said
+    return out, usage
+
+
+def test_a_session_resumed_with_the_keys_set_as_told_goes_on(
+    tmp_path: Path, bigger_camera: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Stopped by the disk after the note, the keys set as it says, then resumed: the resume
+    had been refused as another picture ("camera size: 64×64 → 256×256"), though the camera's
+    images were 256 x 256 all along. A camera's size is its own, whatever the config says: the
+    fake camera here delivers 256 x 256 px frames at either setting."""
+    import json
+
+    out, usage = _stopped_by_the_disk_at_its_own_size(tmp_path, bigger_camera, monkeypatch)
     text = bigger_camera.read_text(encoding="utf-8")
     bigger_camera.write_text(text.replace("width = 64\nheight = 64", "width = 256\nheight = 256"))
     monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage)
@@ -165,19 +177,7 @@ def test_a_session_from_before_the_record_resumed_with_the_keys_set_as_told_goes
     first image's size stands for the record; keys set to another size are still refused."""
     import json
 
-    capture = SimulatedCamera.capture
-
-    def its_own_size(self: SimulatedCamera, exposure_s: float):  # type: ignore[no-untyped-def]
-        frame = capture(self, exposure_s)  # the fixture's: 4 x the config's size
-        step = frame.pixels.shape[0] // 256
-        return dataclasses.replace(frame, pixels=frame.pixels[::step, ::step])
-
-    monkeypatch.setattr(SimulatedCamera, "capture", its_own_size)
-    usage = shutil.disk_usage(tmp_path)
-    monkeypatch.setattr(shutil, "disk_usage", lambda _p: usage._replace(free=10_000_000))
-    out = tmp_path / "s"
-    r = runner.invoke(app, ["run", str(bigger_camera), "--out", str(out), "--lights", str(LIGHTS)])
-    assert r.exit_code == 2 and "set camera.width = 256 and camera.height = 256" in _said(r)
+    out, usage = _stopped_by_the_disk_at_its_own_size(tmp_path, bigger_camera, monkeypatch)
     manifest = json.loads((out / "manifest.json").read_text())
     del manifest["rig"]["frame_size"]  # as a manifest written before the record
     (out / "manifest.json").write_text(json.dumps(manifest, indent=2))
