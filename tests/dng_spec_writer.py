@@ -157,6 +157,31 @@ def dng(
     return tiff_bytes(entries, data, big_endian)
 
 
+def monochrome_dng(grey: np.ndarray) -> bytes:
+    """An uncompressed 16-bit monochrome DNG of ``grey`` (raw codes, H×W): a LinearRaw image
+    (PhotometricInterpretation 34892) of one sample per pixel and no CFA tags, as a camera
+    without a colour filter writes. (One spelling for the tests of its refusal, which had each
+    written the entries out.)"""
+    h, w = grey.shape
+    entries: dict[int, tuple[int, list]] = {  # type: ignore[type-arg]
+        254: (LONG, [0]),
+        256: (LONG, [w]),
+        257: (LONG, [h]),
+        258: (SHORT, [16]),
+        259: (SHORT, [1]),
+        262: (SHORT, [34892]),  # LinearRaw
+        271: (ASCII, ["SpecWriter"]),
+        272: (ASCII, ["monochrome test camera"]),
+        277: (SHORT, [1]),
+        278: (LONG, [h]),
+        284: (SHORT, [1]),
+        50706: (BYTE, [1, 4, 0, 0]),
+        50708: (ASCII, ["monochrome test camera"]),
+        50717: (LONG, [65535]),
+    }
+    return tiff_bytes(entries, np.ascontiguousarray(grey, dtype="<u2").tobytes())
+
+
 def srgb8(linear: np.ndarray) -> np.ndarray:
     """The sRGB 8-bit code of linear values (IEC 61966-2-1 transfer curve)."""
     x = np.clip(np.asarray(linear, dtype=np.float64), 0.0, 1.0)

@@ -120,28 +120,12 @@ def test_plan_refuses_a_monochrome_raw_preview_in_a_previews_words(tmp_path: Pat
     decode refuses it, but in words for a preview: the decode's own named a camera's
     ``[camera.device.decode] mode = "half"`` (plan's setting, in no config) and a watched
     folder's patterns, which plan has neither of. The grey 16-bit TIFF it advises plans."""
-    from tests.dng_spec_writer import ASCII, BYTE, LONG, SHORT, tiff_bytes
+    from tests.dng_spec_writer import monochrome_dng
 
     linear = shaded_relief(256)
     grey = np.round(linear * 65535).astype("<u2")
-    entries = {
-        254: (LONG, [0]),
-        256: (LONG, [grey.shape[1]]),
-        257: (LONG, [grey.shape[0]]),
-        258: (SHORT, [16]),
-        259: (SHORT, [1]),
-        262: (SHORT, [34892]),  # LinearRaw
-        271: (ASCII, ["SpecWriter"]),
-        272: (ASCII, ["monochrome test camera"]),
-        277: (SHORT, [1]),
-        278: (LONG, [grey.shape[0]]),
-        284: (SHORT, [1]),
-        50706: (BYTE, [1, 4, 0, 0]),
-        50708: (ASCII, ["monochrome test camera"]),
-        50717: (LONG, [65535]),
-    }
     mono = tmp_path / "mono.dng"
-    mono.write_bytes(tiff_bytes(entries, grey.tobytes()))
+    mono.write_bytes(monochrome_dng(grey))
     rig = REPO / "rig_configs" / "simulated_dome.toml"
     args = ["--rig", str(rig), "--lights", "9", "--preview-light", "45,50"]
     plan = tmp_path / "plan_mono.lp"

@@ -18,33 +18,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import folder_watch_config, tethered_run
-from dng_spec_writer import ASCII, BYTE, LONG, SHORT, tiff_bytes
+from dng_spec_writer import monochrome_dng
 
 pytestmark = [
     pytest.mark.skipif(sys.platform != "linux", reason="pty semantics tested on Linux"),
     pytest.mark.pty,
 ]
-
-
-def _monochrome_dng(height: int = 32, width: int = 48) -> bytes:
-    """An uncompressed 16-bit monochrome DNG: a LinearRaw image of one sample per pixel."""
-    entries = {
-        254: (LONG, [0]),
-        256: (LONG, [width]),
-        257: (LONG, [height]),
-        258: (SHORT, [16]),
-        259: (SHORT, [1]),
-        262: (SHORT, [34892]),  # LinearRaw
-        271: (ASCII, ["SpecWriter"]),
-        272: (ASCII, ["monochrome test camera"]),
-        277: (SHORT, [1]),
-        278: (LONG, [height]),
-        284: (SHORT, [1]),
-        50706: (BYTE, [1, 4, 0, 0]),
-        50708: (ASCII, ["monochrome test camera"]),
-        50717: (LONG, [65535]),
-    }
-    return tiff_bytes(entries, np.full((height, width), 20000, "<u2").tobytes())
 
 
 def test_run_refuses_a_monochrome_cameras_dng_where_the_camera_is_set_for_colour(
@@ -55,7 +34,7 @@ def test_run_refuses_a_monochrome_cameras_dng_where_the_camera_is_set_for_colour
     out = tmp_path / "s"
     cfg = folder_watch_config(tmp_path, tether)
     assert 'mode = "demosaic"' in cfg.read_text(encoding="utf-8")  # a colour camera
-    data = _monochrome_dng()
+    data = monochrome_dng(np.full((32, 48), 20000, np.uint16))
     r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, [("IMG_0001.dng", data)], out)
     assert r.exit_code != 0, said
     assert "Traceback" not in said, said

@@ -1207,25 +1207,9 @@ def test_a_monochrome_bodys_raw_is_refused_with_advice_a_gphoto2_rig_can_follow(
     decode refuses it, and its advice had been to set ``patterns = ["*.tif"]`` in the rig's
     ``[camera.device]``, a key a gphoto2 camera's config refuses. It names the folder-watch
     camera that reads TIFFs, and the file is kept."""
-    from dng_spec_writer import ASCII, BYTE, LONG, SHORT, tiff_bytes
+    from dng_spec_writer import monochrome_dng
 
-    entries = {
-        254: (LONG, [0]),
-        256: (LONG, [48]),
-        257: (LONG, [32]),
-        258: (SHORT, [16]),
-        259: (SHORT, [1]),
-        262: (SHORT, [34892]),  # LinearRaw
-        271: (ASCII, ["SpecWriter"]),
-        272: (ASCII, ["monochrome test camera"]),
-        277: (SHORT, [1]),
-        278: (LONG, [32]),
-        284: (SHORT, [1]),
-        50706: (BYTE, [1, 4, 0, 0]),
-        50708: (ASCII, ["monochrome test camera"]),
-        50717: (LONG, [65535]),
-    }
-    mono = tiff_bytes(entries, np.full((32, 48), 20000, "<u2").tobytes())
+    mono = monochrome_dng(np.full((32, 48), 20000, np.uint16))
     body.render = lambda b: mono
     body.raw_suffix = ".DNG"
     text = DSLR_CONFIG.read_text().replace(
