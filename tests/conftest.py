@@ -111,11 +111,12 @@ def tethered_run(
     files: list[tuple[str, bytes]],
     out: Path,
     camera: Callable[[Any], Any] | None = None,
+    lights: int = 2,
 ) -> TetheredRun:
-    """``rti-rig run cfg --out out --lights 2 --no-verdict`` on the shipped dome emulated on a
-    pty (:func:`shipped_dome_on_pty`), a :class:`Tether` saving ``files`` into ``tether`` (or
-    the thread ``camera(firmware)`` builds: one with a ``stop`` event), stopped whatever the
-    command did. One spelling of the folder-watch CLI tests' set-up, which had each written
+    """``rti-rig run cfg --out out --lights <lights> --no-verdict`` on the shipped dome emulated
+    on a pty (:func:`shipped_dome_on_pty`), a :class:`Tether` saving ``files`` into ``tether``
+    (or the thread ``camera(firmware)`` builds: one with a ``stop`` event), stopped whatever
+    the command did. One spelling of the folder-watch CLI tests' set-up, which had each written
     it out."""
     from typer.testing import CliRunner
 
@@ -125,7 +126,7 @@ def tethered_run(
         thread = camera(firmware) if camera is not None else Tether(firmware, tether, files)
         thread.start()
         try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "2", "--no-verdict"]
+            args = ["run", str(cfg), "--out", str(out), "--lights", str(lights), "--no-verdict"]
             r = CliRunner().invoke(app, args, terminal_width=400)
         finally:
             thread.stop.set()

@@ -22,11 +22,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import folder_watch_config, shipped_dome_on_pty
+from conftest import folder_watch_config, tethered_run
 from dng_spec_writer import dng
-from typer.testing import CliRunner
 
-from rti_rig.cli import app
 from rti_rig.drivers.cameras import raw_decode
 
 pytestmark = [
@@ -111,18 +109,15 @@ def _run(
         return said
 
     monkeypatch.setattr(raw_decode, "read_blind", spy)
-    with shipped_dome_on_pty(monkeypatch, cfg) as firmware:
-        share = SizeFirstShare(firmware, tether / "IMG_0001.dng", data, late, looked, never)
-        share.start()
-        try:
-            args = ["run", str(cfg), "--out", str(out), "--lights", "1", "--no-verdict"]
-            r = CliRunner().invoke(app, args, terminal_width=400)
-        finally:
-            share.stop.set()
-            share.join(5.0)
-        lit_at_end = firmware.lit_indices()
+    shares: list[SizeFirstShare] = []
+
+    def share_on(firmware: object) -> SizeFirstShare:
+        shares.append(SizeFirstShare(firmware, tether / "IMG_0001.dng", data, late, looked, never))
+        return shares[-1]
+
+    r, said, lit_at_end = tethered_run(monkeypatch, cfg, tether, [], out, share_on, lights=1)
     assert looked.is_set()  # the file was read while its entries were zeros
-    return r, " ".join(r.output.split()), data, out, share, lit_at_end
+    return r, said, data, out, shares[0], lit_at_end
 
 
 @pytest.mark.parametrize(
