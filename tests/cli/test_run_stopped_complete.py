@@ -36,17 +36,23 @@ app(sys.argv[1:], prog_name="rti-rig")
 """
 
 
-def _run_sigterm_at(tmp_path: Path, at: int, *extra: str) -> tuple[int, str, Path]:
-    out = tmp_path / "s"
-    args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "6"]
+def _python(*argv: str) -> tuple[int, str]:
+    """``python argv…`` in a process of its own (a signal it sends itself stops it alone), on
+    this checkout, 300 columns wide: its exit code and its output unwrapped (one line)."""
     proc = subprocess.run(
-        [sys.executable, "-c", SCRIPT, str(at), *args, *extra, "--no-verdict"],
+        [sys.executable, *argv],
         capture_output=True,
         text=True,
         timeout=300,
         env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
     )
-    return proc.returncode, " ".join((proc.stdout + proc.stderr).split()), out
+    return proc.returncode, " ".join((proc.stdout + proc.stderr).split())
+
+
+def _run_sigterm_at(tmp_path: Path, at: int, *extra: str) -> tuple[int, str, Path]:
+    out = tmp_path / "s"
+    args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out), "--lights", "6"]
+    return (*_python("-c", SCRIPT, str(at), *args, *extra, "--no-verdict"), out)
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
@@ -65,14 +71,7 @@ def test_a_sigterm_as_the_last_image_is_committed_says_all_in_fit_and_resume(
 
 
 def _cli(*args: str) -> tuple[int, str]:
-    proc = subprocess.run(
-        [sys.executable, "-m", "rti_rig", *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
-    )
-    return proc.returncode, " ".join((proc.stdout + proc.stderr).split())
+    return _python("-m", "rti_rig", *args)
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="signals tested on POSIX")
@@ -133,15 +132,8 @@ def test_a_sigterm_after_an_until_error_stop_says_complete_not_resume(tmp_path: 
     "already completed"."""
     out = tmp_path / "s"
     args = ["run", str(CONFIGS / "simulated_dome.toml"), "--out", str(out)]
-    proc = subprocess.run(
-        [sys.executable, "-c", FINISH_SCRIPT, *args, "--until-error", "3", "--no-verdict"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
-    )
-    said = " ".join((proc.stdout + proc.stderr).split())
-    assert proc.returncode == 143 and "Emergency stop (SIGTERM)" in said, said
+    code, said = _python("-c", FINISH_SCRIPT, *args, "--until-error", "3", "--no-verdict")
+    assert code == 143 and "Emergency stop (SIGTERM)" in said, said
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["runner"]["finish_reason"] == "completed", said
     kept = len(list(out.glob("image_*.jpg")))
@@ -165,15 +157,8 @@ def test_a_camera_triggered_run_stopped_before_its_proof_is_not_said_complete(
     complete, nothing is left to resume. Next: rti-rig fit", and fit refused the session."""
     out = tmp_path / "s"
     args = ["run", str(CONFIGS / "emulated_cceh_rti.toml"), "--out", str(out), "--no-verdict"]
-    proc = subprocess.run(
-        [sys.executable, "-c", SCRIPT, "59", *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "300"},
-    )
-    said = " ".join((proc.stdout + proc.stderr).split())
-    assert proc.returncode == 143 and "Emergency stop (SIGTERM)" in said, said
+    code, said = _python("-c", SCRIPT, "59", *args)
+    assert code == 143 and "Emergency stop (SIGTERM)" in said, said
     assert len(list(out.glob("image_*.jpg"))) == 60, said  # every image is in
     assert "session is complete" not in said and "Next: rti-rig fit" not in said, said
     marker = out / "LABELS_NOT_VERIFIED.txt"
