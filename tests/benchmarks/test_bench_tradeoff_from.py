@@ -506,6 +506,20 @@ def test_what_the_tolerant_reader_did_to_the_lp_is_said_as_run_and_fit_say_it(
     assert f"{lp}, line 4: light z = -0.0020" in " ".join(fitted.output.split())
 
 
+def _refused_as_out(lp: Path, out: Path) -> str:
+    """``bench tradeoff --from lp --out out --force``, checked refused as an ``--out`` that
+    holds the acquisition, nothing in ``out`` added or removed: its words (one line)."""
+    before = sorted(p.name for p in out.iterdir())
+    r = CliRunner().invoke(
+        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out), "--force"]
+    )
+    text = " ".join(r.output.split())
+    assert r.exit_code == 2, text
+    assert f"error: --out {out} holds the acquisition --from reads" in text, text
+    assert sorted(p.name for p in out.iterdir()) == before
+    return text
+
+
 @pytest.mark.parametrize("where", ["lp", "images"])
 def test_the_acquisitions_own_folder_is_refused_as_out_even_with_force(
     tmp_path: Path, where: str
@@ -530,15 +544,8 @@ def test_the_acquisitions_own_folder_is_refused_as_out_even_with_force(
         out = images
     else:
         out = lp.parent
-    before = sorted(p.name for p in out.iterdir())
-    r = CliRunner().invoke(
-        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out), "--force"]
-    )
-    text = " ".join(r.output.split())
-    assert r.exit_code == 2, text
-    assert f"error: --out {out} holds the acquisition --from reads" in text, text
+    text = _refused_as_out(lp, out)
     assert "even with --force" in text and "choose another folder" in text
-    assert sorted(p.name for p in out.iterdir()) == before
 
 
 def test_a_folder_of_links_to_the_acquisitions_images_is_refused_as_out_even_with_force(
@@ -560,11 +567,4 @@ def test_a_folder_of_links_to_the_acquisitions_images_is_refused_as_out_even_wit
     lp = project / "assembly-files" / "dirs.lp"
     lp.write_text("\n".join(lines) + "\n")
     out = project / "jpeg-exports"
-    before = sorted(p.name for p in out.iterdir())
-    r = CliRunner().invoke(
-        app, ["bench", "tradeoff", "--from", str(lp), "--out", str(out), "--force"]
-    )
-    text = " ".join(r.output.split())
-    assert r.exit_code == 2, text
-    assert f"error: --out {out} holds the acquisition --from reads" in text, text
-    assert sorted(p.name for p in out.iterdir()) == before
+    _refused_as_out(lp, out)
