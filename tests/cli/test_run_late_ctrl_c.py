@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 from conftest import CONFIGS
-from typer.testing import CliRunner
+from typer.testing import CliRunner, Result
 
 import rti_rig.runtime.controller as controller
 from rti_rig.cli import app
@@ -21,10 +21,9 @@ from rti_rig.core.errors import CaptureError
 from rti_rig.runtime.lighting import DomeLighting
 
 
-@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
-def test_a_ctrl_c_during_a_dome_s_teardown_is_not_said_to_stop_after_an_image(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def _ctrl_c_in_the_teardown(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """A Ctrl-C (SIGINT) raised as the dome's teardown makes the rig safe, where the
+    controller holds it until the teardown is done: the list records each one raised."""
     raised: list[int] = []
     real_safe = DomeLighting.safe
 
@@ -34,10 +33,24 @@ def test_a_ctrl_c_during_a_dome_s_teardown_is_not_said_to_stop_after_an_image(
         return real_safe(self, *args, **kwargs)
 
     monkeypatch.setattr(DomeLighting, "safe", safe)
+    return raised
+
+
+def _run_six_lights(tmp_path: Path) -> tuple[Result, str, Path]:
+    """``rti-rig run`` of the shipped simulated dome, 6 lights, no verdict: the result, its
+    words (one line) and the session folder."""
     out = tmp_path / "s"
     argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "6", "--out", str(out)]
     r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
-    said = " ".join(r.output.split())
+    return r, " ".join(r.output.split()), out
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+def test_a_ctrl_c_during_a_dome_s_teardown_is_not_said_to_stop_after_an_image(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    raised = _ctrl_c_in_the_teardown(monkeypatch)
+    r, said, _out = _run_six_lights(tmp_path)
     assert raised == [signal.SIGINT], said
     assert "Traceback" not in said, said
     assert "Stopping after this image" not in said, said
@@ -61,20 +74,9 @@ def test_a_ctrl_c_in_the_teardown_of_a_failed_capture_does_not_say_every_image_i
             raise CaptureError("camera", "no frame came (the cable was pulled)")
         return real_shoot(*args, **kwargs)
 
-    raised: list[int] = []
-    real_safe = DomeLighting.safe
-
-    def safe(self, *args, **kwargs):  # type: ignore[no-untyped-def]
-        raised.append(signal.SIGINT)
-        signal.raise_signal(signal.SIGINT)  # held by the teardown, delivered once it is done
-        return real_safe(self, *args, **kwargs)
-
     monkeypatch.setattr(controller, "shoot_step", shoot_step)
-    monkeypatch.setattr(DomeLighting, "safe", safe)
-    out = tmp_path / "s"
-    argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "6", "--out", str(out)]
-    r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
-    said = " ".join(r.output.split())
+    raised = _ctrl_c_in_the_teardown(monkeypatch)
+    r, said, out = _run_six_lights(tmp_path)
     assert raised == [signal.SIGINT] and len(shots) == 3, said
     assert "Traceback" not in said, said
     assert "no image was left" not in said, said
