@@ -47,6 +47,18 @@ def with_fault(tmp_path: Path, at_image: int, kind: str) -> Path:
     return path
 
 
+def _run_with_led_6_dead(tmp_path: Path) -> tuple[Path, str]:
+    """``rti-rig run`` of the shipped dome with ``[emulator] dead_leds = [5]`` (LED 6 fires,
+    gives no light), checked stopped with exit code 2: the session folder and the run's words
+    (one line)."""
+    config = tmp_path / "rig.toml"
+    config.write_text(SHIPPED.read_text(encoding="utf-8") + "\n[emulator]\ndead_leds = [5]\n")
+    out = tmp_path / "s"
+    result = runner.invoke(app, ["run", str(config), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    return out, " ".join(result.output.split())
+
+
 def truth(rig) -> list[int | None]:  # type: ignore[no-untyped-def]
     """The LED that lit most of each exposure, from the emulator's record."""
     leds: list[int | None] = []
@@ -348,12 +360,7 @@ def test_a_dead_led_is_named_as_such_and_the_dome_said_to_have_stepped_on(  # ty
     it gives no light. The guard then blamed a missed flash pulse and said the dome's count was
     lost, both untrue: the frame shot after the dark image is lit by the next LED, as the order
     says, so the dome stepped on and only the LED stayed dark."""
-    config = tmp_path / "rig.toml"
-    config.write_text(SHIPPED.read_text(encoding="utf-8") + "\n[emulator]\ndead_leds = [5]\n")
-    out = tmp_path / "s"
-    result = runner.invoke(app, ["run", str(config), "--out", str(out)])
-    assert result.exit_code == 2, result.output
-    text = " ".join(result.output.split())
+    out, text = _run_with_led_6_dead(tmp_path)
     assert "image 6 is dark: LED 6 did not light (dead LED?); the dome stepped on" in text, text
     assert "was lit by LED 7, as the order says" in text
     assert "Repair or replace LED 6" in text and "other images are good" in text
@@ -411,13 +418,8 @@ def test_a_check_frame_the_camera_fails_leaves_both_causes_named(  # type: ignor
         return rig
 
     monkeypatch.setattr(flash_sync, "build_flash_sync_rig", failing_check_frame)
-    config = tmp_path / "rig.toml"
-    config.write_text(SHIPPED.read_text(encoding="utf-8") + "\n[emulator]\ndead_leds = [5]\n")
-    out = tmp_path / "s"
-    result = runner.invoke(app, ["run", str(config), "--out", str(out)])
-    assert result.exit_code == 2, result.output
-    text = " ".join(result.output.split())
+    out, text = _run_with_led_6_dead(tmp_path)
     assert "image 6 was not lit by LED 6" in text and "or LED 6 is dead" in text, text
     assert "could not be shot (camera: the USB link dropped)" in text
-    assert "Traceback" not in result.output
+    assert "Traceback" not in text
     assert (out / "unlabelled" / "image_006.tif").is_file()
