@@ -112,6 +112,30 @@ def mosaic_from_rgb(
     return out
 
 
+def _one_sample_image(
+    shape: tuple[int, ...], photometric: int, model: str
+) -> dict[int, tuple[int, list]]:  # type: ignore[type-arg]
+    """The entries every DNG here has: an uncompressed 16-bit main image (NewSubFileType 0) of
+    ``shape`` (H, W), one sample per pixel in one strip, chunky, of PhotometricInterpretation
+    ``photometric``, DNGVersion 1.4 and ``model`` as Model and UniqueCameraModel."""
+    h, w = shape
+    return {
+        254: (LONG, [0]),
+        256: (LONG, [w]),
+        257: (LONG, [h]),
+        258: (SHORT, [16]),
+        259: (SHORT, [1]),
+        262: (SHORT, [photometric]),
+        271: (ASCII, ["SpecWriter"]),
+        272: (ASCII, [model]),
+        277: (SHORT, [1]),
+        278: (LONG, [h]),
+        284: (SHORT, [1]),
+        50706: (BYTE, [1, 4, 0, 0]),
+        50708: (ASCII, [model]),
+    }
+
+
 def dng(
     mosaic: np.ndarray,
     pattern: str = "RGGB",
@@ -124,24 +148,11 @@ def dng(
     color_matrix: np.ndarray | None = None,
 ) -> bytes:
     """An uncompressed 16-bit CFA DNG of ``mosaic`` (raw codes, black included)."""
-    h, w = mosaic.shape
-    entries: dict[int, tuple[int, list]] = {  # type: ignore[type-arg]
-        254: (LONG, [0]),
-        256: (LONG, [w]),
-        257: (LONG, [h]),
-        258: (SHORT, [16]),
-        259: (SHORT, [1]),
-        262: (SHORT, [32803]),
-        271: (ASCII, ["SpecWriter"]),
-        272: (ASCII, [model]),
+    entries = _one_sample_image(mosaic.shape, 32803, model)  # CFA
+    entries |= {
         274: (SHORT, [orientation]),
-        277: (SHORT, [1]),
-        278: (LONG, [h]),
-        284: (SHORT, [1]),
         33421: (SHORT, [2, 2]),
         33422: (BYTE, list(PATTERNS[pattern])),
-        50706: (BYTE, [1, 4, 0, 0]),
-        50708: (ASCII, [model]),
         50710: (BYTE, [0, 1, 2]),
         50711: (SHORT, [1]),
         50713: (SHORT, [2, 2]),
@@ -162,23 +173,8 @@ def monochrome_dng(grey: np.ndarray) -> bytes:
     (PhotometricInterpretation 34892) of one sample per pixel and no CFA tags, as a camera
     without a colour filter writes. (One spelling for the tests of its refusal, which had each
     written the entries out.)"""
-    h, w = grey.shape
-    entries: dict[int, tuple[int, list]] = {  # type: ignore[type-arg]
-        254: (LONG, [0]),
-        256: (LONG, [w]),
-        257: (LONG, [h]),
-        258: (SHORT, [16]),
-        259: (SHORT, [1]),
-        262: (SHORT, [34892]),  # LinearRaw
-        271: (ASCII, ["SpecWriter"]),
-        272: (ASCII, ["monochrome test camera"]),
-        277: (SHORT, [1]),
-        278: (LONG, [h]),
-        284: (SHORT, [1]),
-        50706: (BYTE, [1, 4, 0, 0]),
-        50708: (ASCII, ["monochrome test camera"]),
-        50717: (LONG, [65535]),
-    }
+    entries = _one_sample_image(grey.shape, 34892, "monochrome test camera")  # LinearRaw
+    entries[50717] = (LONG, [65535])
     return tiff_bytes(entries, np.ascontiguousarray(grey, dtype="<u2").tobytes())
 
 
