@@ -267,9 +267,9 @@ def image_truncation(path: Path) -> str | None:
                 return "it ends before its IEND chunk (cut short)"
             return None
     if head[:4] in TIFF_MAGIC:
-        # its first page only: the image read (None, too, where tifffile cannot parse it:
-        # the decoder names the problem later)
-        extent = tiff_extent(p, pages=1)
+        # the image read (:func:`tiff_main_image`), not every page (None, too, where tifffile
+        # cannot parse it: the decoder names the problem later)
+        extent = tiff_extent(p, main_image=True)
         size = p.stat().st_size
         if extent is not None and extent[1] > size:
             return f"its image data runs {extent[1] - size} bytes past its end (cut short)"
@@ -277,9 +277,49 @@ def image_truncation(path: Path) -> str | None:
     return jpeg_truncation(p)
 
 
-def tiff_extent(path: Path, pages: int | None = None) -> tuple[int, int] | None:
+def tiff_main_image(tif: Any) -> Any:
+    """The full-resolution image of an open :class:`tifffile.TiffFile`, as a page series
+    (``.keyframe`` its first page, ``.asarray()`` its pixels, ``.pages`` its pages).
+
+    Why not the first page: some cameras and RTIBuilder exports put a small thumbnail in IFD0
+    and the full image in a later IFD or in a SubIFD (as DNG does); reading IFD0 had replayed
+    and checked an acquisition at thumbnail size (16x12 for a 64x48 image) without a word.
+    Images marked reduced-resolution (NewSubfileType bit 0) or as a mask (bit 2) are
+    thumbnails and previews; of the others, the largest is the image. Two different images of
+    that size (neither a thumbnail of the other) are refused: which one was meant is not known.
+    """
+    candidates = [level for series in tif.series for level in series.levels]
+    if not candidates:
+        raise ValueError("it holds no image")
+
+    def flags(series: Any) -> int:
+        return int(getattr(series.keyframe, "subfiletype", 0) or 0)
+
+    def area(series: Any) -> int:
+        return int(series.keyframe.imagelength) * int(series.keyframe.imagewidth)
+
+    full = [s for s in candidates if not flags(s) & 0b101] or candidates
+    best = max(full, key=area)
+    rivals = [s for s in full if s is not best and area(s) == area(best)]
+    if rivals:
+        sizes = ", ".join(
+            f"{int(s.keyframe.imagewidth)}x{int(s.keyframe.imagelength)} {s.dtype}"
+            for s in (best, *rivals)
+        )
+        raise ValueError(
+            f"it holds {1 + len(rivals)} full-size images ({sizes}) and which one is the "
+            "photograph is not known; save it again as a TIFF of one image"
+        )
+    return best
+
+
+def tiff_extent(
+    path: Path, pages: int | None = None, main_image: bool = False
+) -> tuple[int, int] | None:
     """Where the TIFF ``path``'s own structure names last lies: (start, end) of the strip,
-    tile or IFD that ends furthest into the file, over its first ``pages`` pages (None: all);
+    tile or IFD that ends furthest into the file, over its first ``pages`` pages (None: all),
+    or with ``main_image`` over the pages of the image a reader takes (:func:`tiff_main_image`:
+    not a thumbnail before it, nor a SubIFD it would skip);
     None when tifffile cannot parse its IFDs at all, or one names no data (not all written
     yet, or damaged: not known which).
 
@@ -292,7 +332,8 @@ def tiff_extent(path: Path, pages: int | None = None) -> tuple[int, int] | None:
     try:
         with tifffile.TiffFile(path) as tif:
             last = (0, 0)
-            for page in itertools.islice(tif.pages, pages):
+            read = tiff_main_image(tif).pages if main_image else tif.pages
+            for page in itertools.islice(read, pages):
                 ifd = int(getattr(page, "offset", 0))
                 data = [
                     (int(o), int(o) + int(n))
@@ -311,10 +352,10 @@ def tiff_extent(path: Path, pages: int | None = None) -> tuple[int, int] | None:
 
 
 def header_layout(path: Path) -> tuple[int, int, bool] | None:
-    """(height, width, colour) from the file's header alone (JPEG frame header, PNG IHDR, TIFF
-    first page), without decoding the pixels; ``colour`` as :func:`read_image_any` would
-    return it (3 channels, not grey). None when the header does not say (another format, or a
-    damaged or empty file: the decoder will say why)."""
+    """(height, width, colour) from the file's header alone (JPEG frame header, PNG IHDR, the
+    TIFF full-resolution image's IFD), without decoding the pixels; ``colour`` as
+    :func:`read_image_any` would return it (3 channels, not grey). None when the header does
+    not say (another format, or a damaged or empty file: the decoder will say why)."""
     p = Path(path)
     with open(p, "rb") as fh:
         head = fh.read(64 * 1024)
@@ -327,7 +368,7 @@ def header_layout(path: Path) -> tuple[int, int, bool] | None:
 
         try:
             with tifffile.TiffFile(p) as tif:
-                page = tif.pages[0]
+                page = tiff_main_image(tif).keyframe  # not a thumbnail in IFD0
                 return int(page.imagelength), int(page.imagewidth), page.samplesperpixel >= 3
         except Exception:  # tifffile raises many kinds; the decoder names the problem later
             return None
@@ -420,8 +461,9 @@ def tiff_sample_problem(path: Path) -> str | None:
 
     try:
         with tifffile.TiffFile(p) as tif:
-            dtype = tif.pages[0].dtype
-            shape = tuple(int(n) for n in tif.series[0].shape)
+            image = tiff_main_image(tif)
+            dtype = image.keyframe.dtype
+            shape = tuple(int(n) for n in image.shape)
     except Exception:  # tifffile raises many kinds; the decoder names the problem later
         return None
     if dtype is None or (np.dtype(dtype) in (np.uint8, np.uint16) and len(shape) in (2, 3)):
@@ -431,14 +473,16 @@ def tiff_sample_problem(path: Path) -> str | None:
 
 def read_image_any(path: Path) -> NDArray[np.uint8] | NDArray[np.uint16]:
     """A recorded image as stored: 8-bit (JPEG, 8-bit PNG/TIFF) or 16-bit (TIFF, PNG), RGB
-    order, shape (H, W) or (H, W, 3); refused with the file's name if it cannot be read."""
+    order, shape (H, W) or (H, W, 3) (a TIFF's full-resolution image, :func:`tiff_main_image`);
+    refused with the file's name if it cannot be read."""
     p = Path(path)
     if p.suffix.lower() in (".tif", ".tiff"):
         import tifffile
 
         try:
             with tifffile.TiffFile(p) as tif:
-                img = tiff_samples_last(tif.asarray(), tiff_is_planar(tif.pages[0]))
+                image = tiff_main_image(tif)  # not a thumbnail in IFD0
+                img = tiff_samples_last(image.asarray(), tiff_is_planar(image.keyframe))
         except Exception as exc:  # tifffile raises many kinds; the user needs the file's name
             raise SessionError(f"cannot read image {p}: {exc}") from None
         if img.dtype not in (np.uint8, np.uint16) or img.ndim not in (2, 3):

@@ -27,6 +27,7 @@ from rti_rig.core.image_files import (
     colour_or_grey,
     pixels_hasher,
     tiff_is_planar,
+    tiff_main_image,
     tiff_samples_last,
 )
 
@@ -35,7 +36,9 @@ _STRIPPED = {1: "none", 8: "zlib", 32946: "zlib"}
 
 
 class TiffRows:
-    """Read-only, array-like view of the first page of a TIFF; ``obj[a:b]`` decodes rows a..b."""
+    """Read-only, array-like view of a TIFF's full-resolution image (its first page, unless a
+    thumbnail comes first: :func:`~rti_rig.core.image_files.tiff_main_image`); ``obj[a:b]``
+    decodes rows a..b."""
 
     def __init__(self, path: Path | str) -> None:
         self.path = Path(path)
@@ -61,7 +64,7 @@ class TiffRows:
 
     def _read_header(self) -> None:
         with tifffile.TiffFile(self.path) as tf:
-            page = tf.pages[0]
+            page = tiff_main_image(tf).keyframe  # not a thumbnail in IFD0 (as the replay)
             stored = tuple(int(x) for x in page.shape)
             self._planar = tiff_is_planar(page) and len(stored) == 3
             if self._planar:  # separate planes: (samples, H, W) as stored
@@ -156,7 +159,9 @@ class TiffRows:
         if not self._lean or not isinstance(key, slice):
             if self._full is None:
                 try:
-                    full = tiff_samples_last(tifffile.imread(self.path), self._planar)
+                    with tifffile.TiffFile(self.path) as tf:
+                        pixels = tiff_main_image(tf).asarray()
+                    full = tiff_samples_last(pixels, self._planar)
                     self._full = np.ascontiguousarray(colour_or_grey(full))
                 except MemoryError:
                     raise
