@@ -130,29 +130,95 @@ def image_path(lp_dir: Path, name: str) -> Path:
     A relative name is read relative to the `.lp`'s folder (``\\`` as a folder separator, as
     Windows tools write it). An absolute name — what RTIBuilder writes, the project's path on
     the machine that built it (``H:\\RTI_Data\\proj\\jpeg-exports\\proj_01.jpg``) — is looked
-    for by its file name beside the `.lp`, then in a ``jpeg-exports`` folder beside it or beside
-    its folder (RTIBuilder keeps the `.lp` in ``assembly-files/``); never at the path itself,
+    for by its trailing path components under the `.lp`'s folder, longest first
+    (``C:\\captures\\sub\\IMG.JPG`` in ``captures/sub/IMG.JPG``, then ``sub/IMG.JPG``, then
+    ``IMG.JPG`` beside the `.lp`), then in a ``jpeg-exports`` folder beside it or beside its
+    folder (RTIBuilder keeps the `.lp` in ``assembly-files/``); never at the path itself,
     which is another machine's (and would let an `.lp` read any file, where a relative name
-    that climbs out with ``..`` is refused). The first that exists is returned; none
-    existing, the file beside the `.lp` (for the caller's "missing" message)."""
+    that climbs out with ``..`` is refused; a ``..`` in the name ends the components tried).
+    The first that exists is returned; none existing, the file beside the `.lp` (for the
+    caller's "missing" message). Why the folders: an acquisition copied with its subfolders
+    (``sub/IMG.JPG``) had been looked for only as ``IMG.JPG`` and said to be missing."""
     lp_dir = Path(lp_dir)
     if not is_absolute_name(name):
         literal = lp_dir / name
         portable = lp_dir / PureWindowsPath(name).as_posix() if "\\" in name else literal
         return literal if literal.exists() and not portable.exists() else portable
-    base = image_file_name(name)
-    candidates = [
-        lp_dir / base,
-        lp_dir / "jpeg-exports" / base,
-        lp_dir.parent / "jpeg-exports" / base,
-    ]
-    return next((c for c in candidates if c.is_file()), candidates[0])
+    candidates = _absolute_name_candidates(lp_dir, name)
+    return next((c for c in candidates if c.is_file()), lp_dir / image_file_name(name))
+
+
+def _trailing_parts(name: str) -> list[str]:
+    """The plain folder and file names at the end of an absolute image name, outermost first,
+    stopping at its root or at a ``.``/``..`` (never followed out of the `.lp`'s folder)."""
+    pure = PureWindowsPath(name) if "\\" in name else PurePosixPath(name)
+    parts: list[str] = []
+    for part in reversed(pure.parts[1:] if pure.anchor else pure.parts):
+        if part in ("", ".", "..") or "/" in part or "\\" in part:
+            break
+        parts.insert(0, part)
+    return parts
+
+
+def _absolute_name_candidates(lp_dir: Path, name: str) -> list[Path]:
+    """Where :func:`image_path` looks for an absolute name, in order (no duplicates)."""
+    parts = _trailing_parts(name) or [image_file_name(name)]
+    base = parts[-1]
+    tails = [lp_dir.joinpath(*parts[k:]) for k in range(len(parts))]
+    found: list[Path] = []
+    for c in [*tails, lp_dir / "jpeg-exports" / base, lp_dir.parent / "jpeg-exports" / base]:
+        if c not in found:
+            found.append(c)
+    return found
+
+
+def image_name_ambiguity(lp_dir: Path, name: str) -> str | None:
+    """Why an absolute image name cannot be read without a guess, or None: two of the files
+    its trailing components name under the `.lp`'s folder exist and differ
+    (``C:\\captures\\sub\\IMG.JPG`` with both ``sub/IMG.JPG`` and ``IMG.JPG`` beside the `.lp`,
+    not copies of one image). The longest is the likelier, but reading it where the other was
+    meant would put one light's photograph under another's: the user says which."""
+    if not is_absolute_name(name):
+        return None
+    lp_dir = Path(lp_dir)
+    parts = _trailing_parts(name)
+    existing = [lp_dir.joinpath(*parts[k:]) for k in range(len(parts))]
+    existing = [c for c in existing if c.is_file()]
+    if len(existing) < 2:
+        return None
+    chosen, others = existing[0], existing[1:]
+    differ = [c for c in others if not _same_bytes(chosen, c)]
+    if not differ:
+        return None
+    listed = ", ".join(str(c.relative_to(lp_dir)) for c in (chosen, *differ))
+    return (
+        f"'{name}' could be {listed} under the .lp's folder, which are different files: "
+        "move away the ones that are not this light's image, or write the name relative to "
+        "the .lp's folder (e.g. " + chosen.relative_to(lp_dir).as_posix() + ")"
+    )
+
+
+def _same_bytes(a: Path, b: Path) -> bool:
+    """Whether two files hold the same bytes (a copy of one image is no ambiguity)."""
+    import filecmp
+
+    try:
+        return filecmp.cmp(a, b, shallow=False)
+    except OSError:
+        return False
 
 
 def image_paths(lp_path: Path, entries: Sequence[LpEntry]) -> list[Path]:
     """:func:`image_path` of every entry of the `.lp` at ``lp_path``; two lines that come to
-    one file (absolute names in two folders with one file name) are refused, naming them."""
-    paths = [image_path(Path(lp_path).parent, e.name) for e in entries]
+    one file (absolute names in two folders with one file name) are refused, naming them, and
+    so is a name that could be either of two different files
+    (:func:`image_name_ambiguity`)."""
+    lp_dir = Path(lp_path).parent
+    for e in entries:
+        why = image_name_ambiguity(lp_dir, e.name)
+        if why is not None:
+            raise LpFormatError(lp_path, None, why)
+    paths = [image_path(lp_dir, e.name) for e in entries]
     first: dict[Path, str] = {}
     for e, p in zip(entries, paths, strict=True):
         if p in first:
@@ -228,7 +294,8 @@ def missing_images_advice(
     absolute = [n for n in names if is_absolute_name(n)]
     where = (
         "an absolute name (a path on the machine that wrote the .lp) is looked for by its "
-        "file name beside the .lp and in a jpeg-exports folder beside it or beside its folder"
+        "trailing folders and file name under the .lp's folder (sub/IMG.JPG, then IMG.JPG), "
+        "then in a jpeg-exports folder beside it or beside its folder"
     )
     there = [n for n in absolute if _is_file_at(n)]
     if there:

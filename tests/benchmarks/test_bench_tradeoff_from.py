@@ -304,8 +304,9 @@ def test_absolute_names_whose_files_are_there_are_said_so_by_bench_run_and_fit(
     lp.write_text("\n".join([lines[0], *(f"{src.parent}/{line}" for line in lines[1:])]) + "\n")
     said = (
         "all of them exist at the path the .lp names, but an .lp's images are read beside it: "
-        "an absolute name (a path on the machine that wrote the .lp) is looked for by its file "
-        f"name beside the .lp and in a jpeg-exports folder beside it or beside its folder; copy "
+        "an absolute name (a path on the machine that wrote the .lp) is looked for by its "
+        "trailing folders and file name under the .lp's folder (sub/IMG.JPG, then IMG.JPG), "
+        "then in a jpeg-exports folder beside it or beside its folder; copy "
         f"them into {elsewhere}, or write an .lp whose names are relative to its folder"
     )
     commands = {
@@ -343,8 +344,9 @@ def test_absolute_names_at_no_such_path_are_told_to_copy_them_beside_the_lp(
     lp = elsewhere / "abs.lp"
     lp.write_text("\n".join([lines[0], *(f"/nonexist/x/{line}" for line in lines[1:])]) + "\n")
     looked_for = (
-        "an absolute name (a path on the machine that wrote the .lp) is looked for by its file "
-        "name beside the .lp and in a jpeg-exports folder beside it or beside its folder"
+        "an absolute name (a path on the machine that wrote the .lp) is looked for by its "
+        "trailing folders and file name under the .lp's folder (sub/IMG.JPG, then IMG.JPG), "
+        "then in a jpeg-exports folder beside it or beside its folder"
     )
     commands = {
         "fit": ["fit", str(lp), "--out", str(tmp_path / "f")],

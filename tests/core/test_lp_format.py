@@ -498,3 +498,16 @@ def test_missing_absolute_and_relative_names_are_told_where_each_goes(tmp_path: 
     ), said
     said = missing_images_advice(names, paths, tmp_path, "fit", total=2)
     assert "remove their lines" not in said, said
+
+
+def test_an_absolute_names_folders_never_lead_out_of_the_lp_folder(tmp_path: Path) -> None:
+    """The trailing components of an absolute name are tried under the .lp's folder; a ``..``
+    among them ends the folders tried (a file above the .lp's folder is never read)."""
+    lp_dir = tmp_path / "acq"
+    (lp_dir / "sub").mkdir(parents=True)
+    (tmp_path / "secret.jpg").write_bytes(b"outside")
+    (lp_dir / "sub" / "a.jpg").write_bytes(b"a")
+    assert image_path(lp_dir, "C:\\captures\\sub\\a.jpg") == lp_dir / "sub" / "a.jpg"
+    assert image_path(lp_dir, "/mnt/c/captures/sub/a.jpg") == lp_dir / "sub" / "a.jpg"
+    assert image_path(lp_dir, "C:\\x\\..\\..\\secret.jpg") == lp_dir / "secret.jpg"
+    assert image_path(lp_dir, "C:\\x\\..\\sub\\a.jpg") == lp_dir / "sub" / "a.jpg"
