@@ -67,6 +67,7 @@ class LedDomeDriver(PortOpening):
         ready_timeout_s: float = 3.0,
         max_level: int = 255,
         can_dim: bool | None = None,
+        senses_led_current: bool = True,
     ) -> None:
         if reply_timeout_s <= 0:
             raise ValueError(f"reply_timeout_s must be > 0, got {reply_timeout_s}")
@@ -87,8 +88,10 @@ class LedDomeDriver(PortOpening):
         self.echoes_light = codec.profile != "binary"
         #: Every light command is answered (an acknowledgement, or the LED's error).
         self.light_confirmed = True
-        #: A dead LED is refused (error 4, LED fault: the board senses its current).
-        self.senses_led_current = True
+        #: A dead LED is refused (error 4, LED fault: the board senses its current), unless
+        #: the config says the board measures no current (``senses_led_current = false``):
+        #: the protocol cannot tell, and a check had then called a dead LED "passed".
+        self.senses_led_current = senses_led_current
         self._rx = bytearray()
         self._seq = 0
         self._open = False

@@ -69,4 +69,5 @@ def build_driver(
         ready_timeout_s=settings.ready_timeout_s,
         max_level=settings.max_level,
         can_dim=settings.can_dim,
+        senses_led_current=settings.senses_led_current,
     )

@@ -179,6 +179,15 @@ class DomeSerialSettings(_Strict):
         False, description="after lighting, ask the firmware which LED is lit (binary: no echo)"
     )
     expected_led_count: int | None = Field(None, ge=1, le=1000)
+    #: Whether the board's firmware measures LED current and answers error 4 (LED fault) for a
+    #: dead LED, as this project's protocols define. The protocol cannot tell: a board built
+    #: without current sensing acknowledges a dead LED like a good one. ``false`` makes
+    #: ``rti-rig check`` say what it established ("acknowledged by the board … none seen lit")
+    #: instead of "passed". This project's own profiles only (a described firmware senses none).
+    senses_led_current: bool = Field(
+        True,
+        description="the firmware answers error 4 for a dead LED (false: it measures no current)",
+    )
     thermal: ThermalSettings = ThermalSettings()
     intensity_correction: list[float] | None = Field(
         None, description="per-LED factor (0, 1] applied to the requested intensity"
@@ -248,6 +257,12 @@ class DomeSerialSettings(_Strict):
                 f"[dome.serial.protocol] and led_map_file describe a firmware's protocol; the "
                 f"'{self.profile}' profile is this project's own: remove them or choose a "
                 "firmware profile (or 'custom')"
+            )
+        if described and "senses_led_current" in self.model_fields_set:
+            raise ValueError(
+                f"senses_led_current is for this project's own protocols; the '{self.profile}' "
+                "firmware answers no LED fault (its check says each LED 'acknowledged by the "
+                "board'): remove the key"
             )
         if self.profile == "custom" and self.protocol is None:
             raise ValueError(

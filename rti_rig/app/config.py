@@ -860,6 +860,23 @@ def _checked(loaded: LoadedRig, path: Path, data: dict[str, Any]) -> LoadedRig:
                 f"{', '.join(map(str, outside))} not among this dome's {len(dirs)} LEDs: give "
                 f"LED indices from 0 to {len(dirs) - 1}",
             )
+        if (
+            config.backend == "emulated"
+            and serial is not None
+            and not serial.is_described
+            and serial.senses_led_current
+            and not config.emulator.reports_dead_leds
+        ):
+            # the emulated board measures no LED current but the config says the board does:
+            # its check had called a dead LED "passed" (the protocol cannot tell the two)
+            raise ConfigError(
+                path,
+                "emulator.reports_dead_leds",
+                "false rehearses a board that measures no LED current, but "
+                "dome.serial.senses_led_current is true (the default), so a check would call "
+                "a dead LED 'passed': set senses_led_current = false under [dome.serial], as "
+                "for the real board without current sensing",
+            )
     if config.camera.device is not None and config.backend != "hardware":
         # a dry run renders its images (the camera a simulated, emulated or replayed rig has):
         # a real camera's table would be ignored without a word

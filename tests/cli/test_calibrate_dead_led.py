@@ -26,8 +26,8 @@ DEAD = 20  # LED index: led_20.jpg in example_dome_48.lp, the session's image_02
 
 
 def test_a_dead_led_is_named_and_the_advice_calibrates_the_others(tmp_path: Path) -> None:
-    cfg = card_rig(tmp_path)
     # a board that does not sense LED current: the dead LED "fires" and leaves a black frame
+    cfg = card_rig(tmp_path, serial_extra="senses_led_current = false\n")
     with cfg.open("a", encoding="utf-8") as f:
         f.write(f"dead_leds = [{DEAD}]\nreports_dead_leds = false\n")
     card = tmp_path / "card"

@@ -52,3 +52,53 @@ def test_a_dead_led_the_dome_has_not_is_refused_by_name(tmp_path: Path, dead: st
     assert f"{cfg}: key 'emulator.dead_leds'" in text, text
     assert "not among this dome's 12 LEDs: give LED indices from 0 to 11" in text, text
     assert "LEDs stepped" not in text, text  # refused before the port opened
+
+
+def _own_firmware_dome(tmp_path: Path, serial_extra: str) -> Path:
+    """The shipped emulated dome (this project's `default` protocol) whose board measures no
+    LED current and has LED 3 dead: it acknowledges LED 3 and gives no light."""
+    text = (CONFIGS / "emulated_dome.toml").read_text()
+    text = text.replace(
+        'lp_file = "example_dome_48.lp"', f'lp_file = "{CONFIGS}/example_dome_48.lp"'
+    )
+    text = text.replace('profile = "default"\n', f'profile = "default"\n{serial_extra}')
+    cfg = tmp_path / "own.toml"
+    cfg.write_text(text + "\n[emulator]\ndead_leds = [3]\nreports_dead_leds = false\n")
+    return cfg
+
+
+@pytest.mark.pty
+def test_an_own_firmware_board_without_current_sensing_is_checked_for_what_it_established(
+    tmp_path: Path,
+) -> None:
+    """Its check had said "passed: 48 … RESULT: PASS" with LED 3 dead. The protocol cannot
+    tell whether the board senses current: the config says so (``senses_led_current``), and
+    a rehearsal of such a board that does not say it is refused by key before the port opens."""
+    cfg = _own_firmware_dome(tmp_path, "")
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    assert f"{cfg}: key 'emulator.reports_dead_leds'" in text, text
+    assert "set senses_led_current = false under [dome.serial]" in text, text
+    assert "LEDs stepped" not in text and "passed:" not in text, text
+
+    cfg = _own_firmware_dome(tmp_path, "senses_led_current = false\n")
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 0 and "Traceback" not in text, text
+    assert "LEDs stepped: 48, acknowledged by the board: 48, failed: 0" in text, text
+    assert "passed: 48" not in text, text
+    assert r.output.rstrip().splitlines()[-1] == (
+        "RESULT: PASS (each LED acknowledged by the board, none seen lit)"
+    )
+
+
+def test_senses_led_current_on_a_described_firmware_is_refused_by_key(tmp_path: Path) -> None:
+    cfg = tmp_path / "nab.toml"
+    text = (CONFIGS / "emulated_nab_rti_v1.toml").read_text()
+    assert "[dome.serial]\n" in text
+    cfg.write_text(text.replace("[dome.serial]\n", "[dome.serial]\nsenses_led_current = true\n"))
+    r = runner.invoke(app, ["check", str(cfg)], terminal_width=400)
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, text
+    assert "senses_led_current is for this project's own protocols" in text, text
