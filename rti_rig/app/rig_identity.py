@@ -13,6 +13,9 @@ another command set, timing and possibly numbering (a stepping nichlock board co
 its wiring's order, a minirti board addresses a 64-bit mask), so the same LED index may not
 be the same light. A resume on another profile had gone on without a word. A session recorded
 before the profile was part of the identity has no ``dome_firmware`` key and is not asked.
+Where the config describes the protocol (``custom``, or a protocol table or LED map over a
+built-in), a digest of its commands and LED addressing is the ``dome_protocol`` key: the name
+"custom" alone said nothing of which board it was.
 
 A dome's light positions are compared as positions, not as a digest: a re-measured dome
 whose ``.lp`` differs from the session's by rounding (written again with four decimals or
@@ -43,6 +46,7 @@ LABELS = {
     "light_positions": "light positions",
     "intensity_correction": "LED intensity correction",
     "dome_firmware": "dome firmware profile",
+    "dome_protocol": "dome protocol described in the config",
     "arm_reach": "arm reach",
     "camera_size": "camera size",
     "exposure_s": "exposure (s)",
@@ -99,6 +103,7 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
         corr = getattr(serial, "intensity_correction", None)
         ident["intensity_correction"] = None if corr is None else _digest(list(corr))
         ident["dome_firmware"] = getattr(serial, "profile", None)
+        ident["dome_protocol"] = _dome_protocol_digest(serial)
     else:
         ident["lights"] = "one lamp on an arm"
         ident["arm_reach"] = {
@@ -117,6 +122,43 @@ def rig_identity(loaded: LoadedRig) -> dict[str, Any]:
         assert isinstance(geometry, DomeGeometry)
         ident["recorded_images"] = _recorded_images_digest(loaded, geometry)
     return ident
+
+
+#: The parts of a described protocol that say which LED a command lights and how it is
+#: addressed: its commands' bytes, its LED numbering and count, and its map. Timeouts,
+#: delays, the baud rate and the reply patterns are left out (they change how the board is
+#: talked to, not which light an LED index is), as a port's name and timing are.
+_ADDRESSING_KEYS = (
+    "name", "led_count", "encoding", "index_base", "columns", "mask_bit_order", "mask_bytes",
+    "stepping", "led_map",
+)  # fmt: skip
+_COMMAND_KEYS = ("handshake", "init", "light", "all_off", "shutter")
+
+
+def _dome_protocol_digest(serial: Any) -> str | None:
+    """A digest of what defines the dome's protocol where the config describes it
+    (``profile = "custom"``, or a ``[dome.serial.protocol]`` table or LED map laid over a
+    built-in firmware), None for a protocol fixed by its profile's name.
+
+    Why: two different custom protocols are both called "custom", so the profile's name
+    alone had passed a board with another command set or LED numbering as the same rig, and
+    its LED indices as the same lights. A session recorded before has no ``dome_protocol``
+    key and is not asked (:func:`identity_differences`)."""
+    if serial is None or not getattr(serial, "is_described", False):
+        return None
+    if serial.profile != "custom" and serial.protocol is None and serial.led_map_file is None:
+        return None
+    from rti_rig.drivers.led_dome.factory import protocol_for
+
+    spec = protocol_for(serial).model_dump(mode="json")
+    defining: dict[str, Any] = {k: spec.get(k) for k in _ADDRESSING_KEYS}
+    for key in _COMMAND_KEYS:
+        command = spec.get(key)
+        if isinstance(command, list):
+            defining[key] = [c.get("send") for c in command]
+        else:
+            defining[key] = None if command is None else command.get("send")
+    return _digest(defining)
 
 
 def _recorded_images_digest(loaded: LoadedRig, geometry: DomeGeometry) -> str:
@@ -153,13 +195,16 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
             "light_positions",
             "intensity_correction",
             "dome_firmware",
+            "dome_protocol",
             "arm_reach",
         ):
             continue  # a dome and an arm differ in these by nature: the kind says it all
         if key == "recorded_images" and old is None:
             continue  # a session begun before the images were part of the identity
-        if key == "dome_firmware" and key not in before:
-            continue  # a session begun before the firmware profile was part of the identity
+        if key in ("dome_firmware", "dome_protocol") and key not in before:
+            continue  # a session begun before the firmware profile (protocol) was part of it
+        if key == "dome_protocol" and before.get("dome_firmware") != now.get("dome_firmware"):
+            continue  # another profile: "dome firmware profile" says it
         if key == "light_directions":
             continue  # said under "light positions"
         if key == "light_positions":
@@ -176,6 +221,14 @@ def identity_differences(before: dict[str, Any], now: dict[str, Any]) -> list[st
             out.append(
                 f"{label}: "
                 + ", ".join(f"{k} {_show(old.get(k))} → {_show(new.get(k))}" for k in changed)
+            )
+        elif key == "dome_protocol":
+            out.append(
+                f"{label}: changed (its commands or LED numbering differ under the same "
+                f"profile name '{now.get('dome_firmware') or before.get('dome_firmware')}': the "
+                "same LED index may be another light)"
+                if old and new
+                else f"{label}: {_show(old)} → {_show(new)}"
             )
         elif key == "dome_firmware":
             out.append(

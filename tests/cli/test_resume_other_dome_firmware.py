@@ -83,3 +83,39 @@ def test_a_session_recorded_before_the_profile_was_in_the_identity_resumes(
     assert r.exit_code == 0, r.output
     assert "dome firmware" not in said(r), r.output
     assert len(journal(out)) == 6
+
+
+def _nichlock_variant(tmp_path: Path, protocol_extra: str) -> Path:
+    """The shipped nichlock config with more keys in its [dome.serial.protocol] table."""
+    text = NICHLOCK.read_text()
+    assert "[dome.serial.protocol]\n" in text
+    cfg = tmp_path / "nichlock_variant.toml"
+    cfg.write_text(
+        text.replace("[dome.serial.protocol]\n", f"[dome.serial.protocol]\n{protocol_extra}")
+    )
+    return cfg
+
+
+@pytest.mark.e2e
+def test_a_resume_whose_config_describes_another_protocol_under_one_name_is_refused(
+    tmp_path: Path,
+) -> None:
+    """The profile's name alone had been the identity: a config describing other LED numbering
+    (here from 1) under the same name resumed as the same rig, so index k lit another LED. A
+    session recorded before the protocol was part of the identity resumes as it did."""
+    out = tmp_path / "S"
+    _cut(out)
+    r = _resume(out, _nichlock_variant(tmp_path, "index_base = 1\n"))
+    text = said(r)
+    assert r.exit_code == 2 and "Traceback" not in text, r.output
+    assert "dome protocol described in the config: changed" in text, text
+    assert "profile name 'nichlock'" in text and "add --accept-rig-change" in text, text
+    assert len(journal(out)) == 3  # nothing captured
+
+    manifest = out / "manifest.json"
+    data = json.loads(manifest.read_text(encoding="utf-8"))
+    assert data["rig"]["identity"].pop("dome_protocol")
+    manifest.write_text(json.dumps(data, indent=1), encoding="utf-8")
+    r = _resume(out, NICHLOCK)
+    assert r.exit_code == 0 and "dome protocol" not in said(r), r.output
+    assert len(journal(out)) == 6

@@ -1,0 +1,79 @@
+"""Two rig configs with ``profile = "custom"`` describing different protocols are different
+rigs to a resume: the identity holds what defines the protocol (its commands and LED
+addressing), not the name "custom" alone, which had passed one board for another. What does
+not change which light an LED index is (a reply timeout, the port) keeps the rig the same."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rti_rig.app.config import load_rig_config
+from rti_rig.app.rig_identity import identity_differences, rig_identity
+
+CUSTOM = """
+name = "my-dome"
+kind = "dome"
+backend = "hardware"
+
+[dome]
+layout = "fibonacci"
+count = 12
+min_elevation_deg = 15.0
+
+[dome.serial]
+port = "{port}"
+profile = "custom"
+baudrate = 9600
+
+[dome.serial.protocol]
+name = "my-dome"
+led_count = 12
+index_base = {base}
+
+[dome.serial.protocol.light]
+send = "{light}"
+reply = {{ kind = "line", timeout_s = {timeout} }}
+
+[dome.serial.protocol.all_off]
+send = "X\\n"
+reply = {{ kind = "line" }}
+
+[camera]
+width = 64
+height = 48
+exposure_s = 0.05
+
+[camera.device]
+kind = "folder_watch"
+folder = "{folder}"
+"""
+
+
+def _identity(tmp_path: Path, name: str, **keys: object) -> dict[str, object]:
+    values = {"port": "/dev/ttyUSB0", "base": 0, "light": "L{index}\\n", "timeout": 1.0}
+    values["folder"] = str(tmp_path / "shots")
+    values.update(keys)
+    path = tmp_path / f"{name}.toml"
+    path.write_text(CUSTOM.format(**values))
+    return rig_identity(load_rig_config(path))
+
+
+def test_two_custom_protocols_are_two_rigs(tmp_path: Path) -> None:
+    first = _identity(tmp_path, "a")
+    for name, change in (("b", {"light": "ON {index}\\n"}), ("c", {"base": 1})):
+        said = identity_differences(first, _identity(tmp_path, name, **change))
+        assert len(said) == 1, said
+        assert said[0].startswith("dome protocol described in the config: changed"), said
+        assert "profile name 'custom'" in said[0], said
+
+
+def test_what_does_not_address_the_leds_keeps_the_custom_rig(tmp_path: Path) -> None:
+    first = _identity(tmp_path, "a")
+    again = _identity(tmp_path, "b", port="/dev/ttyUSB1", timeout=2.5)
+    assert identity_differences(first, again) == []
+
+
+def test_a_custom_session_recorded_before_the_protocol_digest_resumes(tmp_path: Path) -> None:
+    before = _identity(tmp_path, "a")
+    assert before.pop("dome_protocol")
+    assert identity_differences(before, _identity(tmp_path, "b", light="ON {index}\\n")) == []
