@@ -23,6 +23,13 @@ Modelled on the published behaviour, not on our driver:
 
 Each row's value is ``scale`` × the light integrated over that row's own exposure, so a frame
 exposed partly under another light (or partly dark) shows it row by row.
+
+The pixel format (``pixel_format``: ``"Y16 "``, ``"GREY"`` or ``"YUYV"``, the only one the
+camera offers: another ``CAP_PROP_FOURCC`` is not taken) comes back as OpenCV's
+``retrieveFrame`` / ``convertToRgb`` in ``cap_v4l.cpp`` gives it: with ``CAP_PROP_CONVERT_RGB``
+on (OpenCV's default) every format is converted to 8-bit BGR — Y16 by ``convertTo(CV_8U, 1/256)``,
+GREY by ``COLOR_GRAY2BGR``, YUYV by ``COLOR_YUV2BGR_YUYV``; with it off, the buffer as the
+camera sent it: Y16 as CV_16UC1, GREY as CV_8UC1, YUYV as CV_8UC2 (Y, then U or V).
 """
 
 from __future__ import annotations
@@ -83,8 +90,10 @@ class BufferedUvcStream:
         exposure_units: float = 100.0,
         frame_rates: tuple[float, ...] | None = None,
         start_latency_s: float = 0.0,
+        pixel_format: str = "Y16 ",
     ) -> None:
         self.light = light
+        self.pixel_format = pixel_format
         #: the first frame's readout begins this long after STREAMON (OpenCV #25688: "the
         #: first grab on a camera video stream is consistently several hundreds of ms long")
         self.start_latency_s = start_latency_s
@@ -107,7 +116,7 @@ class BufferedUvcStream:
         #: (time set, exposure units): the exposure control's history
         self.exposures: list[tuple[float, float]] = [(-math.inf, exposure_units)]
         self.props = {
-            cv2.CAP_PROP_FOURCC: float(cv2.VideoWriter_fourcc(*"Y16 ")),
+            cv2.CAP_PROP_FOURCC: float(cv2.VideoWriter_fourcc(*pixel_format)),
             cv2.CAP_PROP_CONVERT_RGB: 1.0,
             cv2.CAP_PROP_AUTO_EXPOSURE: 3.0,
             cv2.CAP_PROP_EXPOSURE: exposure_units,
@@ -201,7 +210,7 @@ class BufferedUvcStream:
                 return True
             self.exposures.append((self.clock.now(), float(value)))
         if prop == cv2.CAP_PROP_FOURCC and value != self.props[prop]:
-            return True  # Y16 only
+            return True  # its one pixel format only (set returns True, the format stays)
         if prop in self.props:
             self.props[prop] = float(value)
             return True
@@ -227,7 +236,26 @@ class BufferedUvcStream:
         assert self.held is not None and self.held.frame is not None
         k = self.held.frame
         self.delivered.append((k, self._row_windows(k)))
-        return True, self._pixels(k)
+        return True, self._retrieve(self._pixels(k))
+
+    def _retrieve(self, light16: np.ndarray) -> np.ndarray:
+        """The frame as OpenCV hands it over for the camera's pixel format (module docstring):
+        the sensor's 16-bit light values, 8-bit (their high byte) for GREY and YUYV."""
+        convert = self.props[cv2.CAP_PROP_CONVERT_RGB] != 0
+        if self.pixel_format == "Y16 ":
+            if not convert:
+                return light16
+            # convertTo(CV_8U, 1.0 / 256): rounded to the nearest, then GRAY2BGR
+            high = np.clip(np.rint(light16 / 256.0), 0, 255).astype(np.uint8)
+            return cv2.cvtColor(high, cv2.COLOR_GRAY2BGR)
+        luma = (light16 >> 8).astype(np.uint8)
+        if self.pixel_format == "GREY":
+            return cv2.cvtColor(luma, cv2.COLOR_GRAY2BGR) if convert else luma
+        assert self.pixel_format == "YUYV", self.pixel_format
+        packed = np.empty((*luma.shape, 2), np.uint8)  # Y0 U Y1 V: grey light, no chroma
+        packed[..., 0] = luma
+        packed[..., 1] = 128
+        return cv2.cvtColor(packed, cv2.COLOR_YUV2BGR_YUYV) if convert else packed
 
     def release(self) -> None:
         """STREAMOFF and the buffers freed (OpenCV's release: VIDIOC_STREAMOFF, then

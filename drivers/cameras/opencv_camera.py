@@ -32,6 +32,12 @@ from rti_rig.drivers.cameras.raw_decode import exposure_stats
 from rti_rig.drivers.cameras.settings import OpenCvCameraSettings
 
 RAW_GREY_FOURCCS = {"Y16 ", "Y10 ", "Y12 "}
+#: Grey formats OpenCV hands over as they are (one channel) only with ``CAP_PROP_CONVERT_RGB``
+#: off: with it on (its default) ``convertToRgb`` in cap_v4l.cpp makes every frame 8-bit BGR
+#: (a Y16 frame by ``convertTo(CV_8U, 1/256)``, GREY by ``COLOR_GRAY2BGR``), so a grey camera's
+#: session had been written as three equal colour channels (an 8-bit GREY one) or lost its
+#: 16 bits (a Y16 one).
+GREY_FOURCCS = RAW_GREY_FOURCCS | {"GREY"}
 #: Buffers OpenCV's V4L2 backend queues unless CAP_PROP_BUFFERSIZE changes it
 #: (DEFAULT_V4L_BUFFERS in modules/videoio/src/cap_v4l.cpp).
 OPENCV_V4L_DEFAULT_BUFFERS = 4
@@ -174,7 +180,7 @@ class OpenCvCamera:
                     "set fourcc",
                 )
             info["fourcc"] = got
-            if got in RAW_GREY_FOURCCS:
+            if got in GREY_FOURCCS:
                 self._set_verified(cap, cv2.CAP_PROP_CONVERT_RGB, 0, "convert_rgb")
         if s.fps is not None:
             # before the buffers: OpenCV restarts the stream for a new frame interval

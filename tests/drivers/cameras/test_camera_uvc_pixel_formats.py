@@ -1,0 +1,69 @@
+"""`rti-rig run` with a UVC camera, through the real stack from the rig config (the dome's
+firmware emulated on a pty, the camera a stream that converts frames as OpenCV's V4L2 backend
+does: tests/fake_uvc.py): a grey camera's frames are written as grey, a 16-bit one's at its
+16 bits, never as 8-bit sRGB colour. The fake stream had ignored ``CAP_PROP_CONVERT_RGB``, so
+a driver that left OpenCV converting a Y16 stream to 8-bit BGR would have passed unseen."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import tifffile
+from conftest import shipped_dome_on_pty
+from fake_uvc import BufferedUvcStream, LightHistory
+from test_camera_uvc_stream import _uvc_dome_config
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+from rti_rig.core.clock import SystemClock
+
+
+def _run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, pixel_format: str, device: str):
+    """Two lights shot with a UVC camera offering only ``pixel_format``; ``device`` is added
+    to its [camera.device] table. The session's linear TIFFs, and the output."""
+    cfg = _uvc_dome_config(tmp_path, max_on_s=1.5)
+    text = cfg.read_text().replace('kind = "opencv"\n', f'kind = "opencv"\n{device}')
+    cfg.write_text(text)
+    stream = BufferedUvcStream(
+        LightHistory(SystemClock()),  # type: ignore[arg-type]  # the session's own clock
+        fps=20.0,
+        scale=6e5,  # 0.05 s under light 1: 30000 of 65535, well inside the range
+        pixel_format=pixel_format,
+    )
+    out = tmp_path / "s"
+    monkeypatch.setattr(cv2, "VideoCapture", lambda device, api: stream)
+    with shipped_dome_on_pty(monkeypatch, cfg):
+        stream.light.set(1.0)  # constant: the frames need a value to carry, not a light
+        r = CliRunner().invoke(app, ["run", str(cfg), "--out", str(out), "--lights", "2"])
+    said = " ".join(r.output.split())
+    assert r.exit_code == 0 and "Traceback" not in said, said
+    frames = [tifffile.imread(p) for p in sorted((out / "linear").glob("*.tif"))]
+    assert len(frames) == 2, said
+    return frames, stream
+
+
+@pytest.mark.pty
+def test_a_y16_camera_is_written_as_16_bit_grey(tmp_path, monkeypatch) -> None:
+    frames, stream = _run(tmp_path, monkeypatch, "Y16 ", 'fourcc = "Y16 "\n')
+    assert stream.props[cv2.CAP_PROP_CONVERT_RGB] == 0  # OpenCV told to hand over Y16 as is
+    for pixels in frames:
+        assert pixels.dtype == np.uint16 and pixels.ndim == 2, pixels.shape  # grey
+        # the camera's 16 bits, not its high byte scaled back up (8-bit data read as sRGB)
+        assert np.any(pixels % 256 != 0), pixels
+
+
+@pytest.mark.pty
+def test_a_grey_8_bit_camera_is_written_as_grey(tmp_path, monkeypatch) -> None:
+    frames, _ = _run(tmp_path, monkeypatch, "GREY", 'fourcc = "GREY"\nresponse = "srgb"\n')
+    for pixels in frames:
+        assert pixels.ndim == 2, pixels.shape  # one channel, as the camera sent it
+
+
+@pytest.mark.pty
+def test_a_yuyv_camera_is_written_as_colour_from_srgb(tmp_path, monkeypatch) -> None:
+    frames, _ = _run(tmp_path, monkeypatch, "YUYV", 'fourcc = "YUYV"\nresponse = "srgb"\n')
+    for pixels in frames:
+        assert pixels.ndim == 3 and pixels.shape[2] == 3, pixels.shape
