@@ -1137,9 +1137,24 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
     )
 
     cancel = CancelToken()
+    #: the capture has returned or raised, or will never begin: from then on a stop has
+    #: nothing left to stop at once, and a signal handler that raised would do so in this
+    #: function's except or finally clauses, where nothing catches it (see ``on_sigint``)
+    ended = False
+    late_said = False
 
     def on_sigint(signum, frame):  # type: ignore[no-untyped-def]
+        nonlocal ended, late_said
+        if ended:
+            # a second Ctrl-C meant as "stop at once", landing as the session's end is
+            # reported (its except or finally clauses, before the ignore is set) had raised
+            # EmergencyStop where nothing caught it: a traceback, the summary and resume unsaid
+            if not late_said:
+                late_said = True
+                err.print(f"[yellow]{_LATE_CTRL_C if started else _CLOSING_CTRL_C}[/]")
+            return
         if cancel.cancelled:
+            ended = not started  # stopped before the capture began: it never will
             raise EmergencyStop("second Ctrl-C")
         cancel.cancel()
         if _park_stopped_by(opened.rig) is not None:  # delivered after the teardown it stopped:
@@ -1147,10 +1162,8 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if cancel.over:  # held by the teardown (no park due, or after it) and delivered now
             # not "no image was left to stop after": after a capture an error or a SIGTERM
             # ended part-way, that read as if every image were in, above a resume hint
-            err.print(
-                "[yellow]Ctrl-C after the capture had ended: there was nothing left to stop, "
-                "and the rig's teardown has run (what it did is said below).[/]"
-            )
+            late_said = True
+            err.print(f"[yellow]{_LATE_CTRL_C}[/]")
             return
         if opened.folder.images_kept >= opened.total_steps:
             # the last image is committed, the capture not yet over (its last writes, an end
@@ -1161,6 +1174,9 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         err.print("[yellow]Stopping after this image (Ctrl-C again to stop at once)…[/]")
 
     def on_sigterm(signum, frame):  # type: ignore[no-untyped-def]
+        if ended:  # as for Ctrl-C: nothing left to stop; the handler from before answers it
+            _as_before(previous.get(signal.SIGTERM), signum, frame)
+            return
         raise EmergencyStop("SIGTERM")
 
     def on_sigusr1(signum, frame):  # type: ignore[no-untyped-def]
@@ -1202,6 +1218,7 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
         if settable:
             signal.signal(signal.SIGTERM, on_sigterm)
         if handover.held:  # a SIGTERM or Ctrl-C while the capture took over from the opening
+            ended = True  # the capture will not begin: a Ctrl-C as the rig closes stops nothing
             raise EmergencyStop(handover.why())
         with Progress(
             TextColumn("[progress.description]{task.description}"),
@@ -1232,8 +1249,17 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
                 elif isinstance(event, DeviceSays):
                     err.print(event.text, markup=False)
 
+            def capture():  # type: ignore[no-untyped-def]
+                # ``ended`` is set in here: a stop raised before it is raised inside the try
+                # below, whose except clauses say it; once set, none is raised
+                nonlocal ended
+                try:
+                    return run_opened_session(opened, cancel, on_event)
+                finally:
+                    ended = True
+
             started = True
-            result = run_opened_session(opened, cancel, on_event)
+            result = capture()
             over = True
     except EmergencyStop as exc:
         from rti_rig.app.usecases.safe_state import lights_state
@@ -1275,6 +1301,31 @@ def _run_and_report(opened, handover: HandOver) -> bool:  # type: ignore[no-unty
             put_back(previous)
     with _ctrl_c_ignored(previous.get(signal.SIGINT) if over else None):
         return _summarise(opened, result, resume_hint(), dry)
+
+
+#: What a Ctrl-C once the capture has ended (returned, raised or been stopped) is told.
+_LATE_CTRL_C = (
+    "Ctrl-C after the capture had ended: there was nothing left to stop, and the rig's "
+    "teardown has run (what it did is said below)."
+)
+#: What a Ctrl-C is told while a session stopped before its capture began closes its rig.
+_CLOSING_CTRL_C = (
+    "Ctrl-C while the session stopped before its first image: the rig is being closed (said below)."
+)
+
+
+def _as_before(handler: Any, signum: int, frame: Any) -> None:
+    """Answer ``signum`` as ``handler`` (what was in place before the capture's) would have:
+    call it, ignore the signal, or take the default action (for SIGTERM, the process ends).
+
+    Why: the capture's SIGTERM handler raises an emergency stop, which once the capture has
+    ended would be raised where nothing catches it (a traceback); the run's own late handler
+    (:func:`_late_term_held`) is what answers a SIGTERM after the capture."""
+    if callable(handler):
+        handler(signum, frame)
+    elif handler != signal.SIG_IGN:  # the default action (or one set outside Python)
+        signal.signal(signum, signal.SIG_DFL)
+        signal.raise_signal(signum)
 
 
 @contextmanager

@@ -1,0 +1,120 @@
+"""A stop (a second Ctrl-C, a SIGTERM) landing as ``run`` reports a capture that has ended —
+in its except clauses or its ``finally``, before Ctrl-C is ignored — neither escapes as a
+traceback nor cuts what the run says of the images, the lights and how to go on.
+
+The capture's handlers stayed in place there: a second Ctrl-C (or a SIGTERM) raised
+EmergencyStop where nothing caught it, and ``rti-rig`` printed Python's traceback instead of
+the summary or the error's resume hint. The signals are raised at exactly those points by the
+function the run calls there (no sleep)."""
+
+from __future__ import annotations
+
+import signal
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import CONFIGS
+from typer.testing import CliRunner
+
+import rti_rig.cli.session as cli_session
+import rti_rig.runtime.controller as controller
+from rti_rig.cli import app
+from rti_rig.core.errors import CaptureError
+
+pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="signals tested on Linux")
+
+
+def _first_ctrl_c_at_image(monkeypatch: pytest.MonkeyPatch, image: int) -> None:
+    """A Ctrl-C as image ``image`` (1-based) is shot: the run stops after it."""
+    real_shoot, shots = controller.shoot_step, []
+
+    def shoot_step(*args: Any, **kwargs: Any) -> Any:
+        shots.append(1)
+        if len(shots) == image:
+            signal.raise_signal(signal.SIGINT)
+        return real_shoot(*args, **kwargs)
+
+    monkeypatch.setattr(controller, "shoot_step", shoot_step)
+
+
+def _signal_as_ctrl_c_is_ignored(monkeypatch: pytest.MonkeyPatch, signum: int) -> list[int]:
+    """``signum`` raised in ``_run_and_report``'s ``finally``, as it sets Ctrl-C ignored
+    (before the ignore is in place): the window."""
+    real_put_back, raised = cli_session.put_back, []
+
+    def put_back(previous: Any) -> None:
+        if not raised and previous.get(signal.SIGINT) is signal.SIG_IGN:
+            raised.append(signum)
+            signal.raise_signal(signum)
+        real_put_back(previous)
+
+    monkeypatch.setattr(cli_session, "put_back", put_back)
+    return raised
+
+
+def _run(tmp_path: Path) -> tuple[Any, str, Path]:
+    out = tmp_path / "s"
+    argv = ["run", str(CONFIGS / "simulated_dome.toml"), "--lights", "6", "--out", str(out)]
+    r = CliRunner().invoke(app, [*argv, "--no-verdict"], terminal_width=400)
+    return r, " ".join(r.output.split()), out
+
+
+def test_a_second_ctrl_c_in_the_finally_does_not_cut_the_summary(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _first_ctrl_c_at_image(monkeypatch, 2)
+    raised = _signal_as_ctrl_c_is_ignored(monkeypatch, signal.SIGINT)
+    r, said, out = _run(tmp_path)
+    assert raised == [signal.SIGINT], said
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "Ctrl-C after the capture had ended: there was nothing left to stop" in said, said
+    assert "2 image(s) in the session" in said, said
+    assert "Lights were switched off" in said, said
+    assert f"Continue with: rti-rig run --resume {out}" in said, said
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_sigterm_in_the_finally_is_said_after_the_summary(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    raised = _signal_as_ctrl_c_is_ignored(monkeypatch, signal.SIGTERM)
+    r, said, _ = _run(tmp_path)
+    assert raised == [signal.SIGTERM], said
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "6 image(s) in the session" in said, said
+    assert "Stopped (SIGTERM) once the session had ended: it is complete" in said, said
+    assert r.exit_code == 143, said
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+
+
+def test_two_ctrl_c_as_a_failed_capture_is_reported_leave_the_error_and_resume_said(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The camera fails at image 3 of 6; two Ctrl-C land as the run reports it (in its
+    except clause): the second had raised EmergencyStop out of it."""
+    real_shoot, shots = controller.shoot_step, []
+
+    def shoot_step(*args: Any, **kwargs: Any) -> Any:
+        shots.append(1)
+        if len(shots) == 3:
+            raise CaptureError("camera", "no frame came (the cable was pulled)")
+        return real_shoot(*args, **kwargs)
+
+    real_failures = cli_session._print_teardown_failures
+
+    def print_teardown_failures(*args: Any, **kwargs: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)
+        return real_failures(*args, **kwargs)
+
+    monkeypatch.setattr(controller, "shoot_step", shoot_step)
+    monkeypatch.setattr(cli_session, "_print_teardown_failures", print_teardown_failures)
+    r, said, out = _run(tmp_path)
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert said.count("Ctrl-C after the capture had ended") == 1, said
+    assert f"2 image(s) kept in {out}" in said, said
+    assert f"Continue with: rti-rig run --resume {out}" in said, said
+    assert "error: camera: no frame came" in said, said
+    assert r.exit_code == 2, said
