@@ -157,7 +157,9 @@ def run(
             "--min-lights",
             help="With --until-error: shoot at least this many lights before the stop may "
             "claim the target (a PTM needs 6, an HSH fit.rti 5; without it a session "
-            "that reaches its target early has a normal map and no RTI).",
+            "that reaches its target early has a normal map and no RTI). The stop is first "
+            "judged after the 4 starting lights, so a minimum holds it from 5 (4 or less is "
+            "said to hold nothing).",
         ),
     ] = None,
     objective: Annotated[

@@ -190,3 +190,39 @@ def test_a_session_begun_before_the_minimum_existed_resumes_without_one(
     r = runner.invoke(app, ["run", "--resume", str(out), "--no-verdict"])
     assert r.exit_code == 0, r.output
     assert [s["led"] for s in journal(out)] == [s["led"] for s in journal(ref)]
+
+
+@pytest.mark.parametrize("minimum", ["3", "4"])
+def test_a_minimum_at_or_below_the_start_is_said_to_hold_nothing_before_anything_lights(
+    never_reached: tuple[Path, Path], tmp_path: Path, minimum: str
+) -> None:
+    """--min-lights 3 or 4 was accepted and held nothing (the stop is first judged after the
+    4 starting lights), with no word of it: the note says so before the first image, with the
+    smallest minimum that holds the stop; --help says the same."""
+    from rti_rig.planner.adaptive import START_LIGHTS
+
+    cfg, _ = never_reached
+    out = tmp_path / "s"
+    r = _run(cfg, out, "--until-error", LOOSE, "--min-lights", minimum)
+    assert r.exit_code == 0, r.output
+    text = said(r)
+    note = (
+        f"--min-lights {minimum} holds nothing: an adaptive session shoots its {START_LIGHTS} "
+        f"starting lights before its stop is first judged, so it never stops below "
+        f"{START_LIGHTS}; the smallest --min-lights that holds its stop is {START_LIGHTS + 1}"
+    )
+    assert note in text, text
+    assert text.index(note) < text.index("Rig ")  # before the capture's first line
+    boxed = runner.invoke(app, ["run", "--help"]).output  # rich's box drawn round the help
+    helped = " ".join(boxed.replace("│", " ").split())
+    assert f"first judged after the {START_LIGHTS} starting lights" in helped, helped
+    assert f"holds it from {START_LIGHTS + 1}" in helped, helped
+
+
+def test_a_minimum_above_the_start_gives_no_such_note(
+    never_reached: tuple[Path, Path], tmp_path: Path
+) -> None:
+    cfg, _ = never_reached
+    r = _run(cfg, tmp_path / "s", "--until-error", LOOSE, "--min-lights", "5")
+    assert r.exit_code == 0, r.output
+    assert "holds nothing" not in said(r)

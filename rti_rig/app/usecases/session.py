@@ -957,6 +957,31 @@ def _metering_options(req: NewSessionRequest, loaded) -> str:  # type: ignore[no
     return band_run_options(lights, lo, hi)
 
 
+def _minimum_below_start(min_lights: int | None, source) -> Note | None:  # type: ignore[no-untyped-def]
+    """What a ``--min-lights`` at or below the starting lights means: nothing, said before
+    anything lights, with the smallest minimum that binds.
+
+    Why: the stop is first judged once the starting lights are in, so ``--min-lights 3`` (or
+    4, the start) was accepted and silently held nothing; a user who asked for a floor was
+    not told the session's own start already was one, nor what value would change anything."""
+    start = len(source.plan.start)
+    if min_lights is None or min_lights > start:
+        return None
+    most = source.plan.max_lights
+    binds = (
+        f"the smallest --min-lights that holds its stop is {start + 1} (a PTM needs 6 lights, "
+        "an HSH fit.rti 5)"
+        if start < most
+        else f"this session's maximum is {most} lights: it shoots them all"
+    )
+    return Note(
+        f"--min-lights {min_lights} holds nothing: an adaptive session shoots its {start} "
+        f"starting lights before its stop is first judged, so it never stops below {start}; "
+        f"{binds}",
+        "warning",
+    )
+
+
 def _open_adaptive(req: NewSessionRequest, loaded) -> OpenedSession:  # type: ignore[no-untyped-def]
     """A new adaptive session: the starting layout, the step source and the folder."""
     from rti_rig.app.rig_identity import rig_identity
@@ -1045,6 +1070,8 @@ def open_new_session(req: NewSessionRequest, on_note: NoteSink = _ignore) -> Ope
         fixed = req.lights if req.until_error_deg is None else None
         if fixed is not None and (few := too_few_to_fit(fixed)) is not None:
             on_note(few)
+        if (idle := _minimum_below_start(req.min_lights, opened.source)) is not None:
+            on_note(idle)
         return opened
     plan_notes: list[Note] = []
 
