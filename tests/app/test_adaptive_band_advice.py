@@ -25,7 +25,7 @@ def test_the_advised_planned_run_keeps_to_the_band(tmp_path: Path) -> None:
     assert r.exit_code == 2, r.output
     text = said(r)
     assert "none left to choose" in text
-    advised = text.split("Shoot them all with a planned run: ", 1)[1].split(" (or widen")[0]
+    advised = text.split("shoot its 4 with a planned run: ", 1)[1]
     assert advised == f"rti-rig run {cfg} --out DIR --lights 4 --min-elevation-deg 45"
     argv = shlex.split(advised)[1:]
     argv[argv.index("DIR")] = str(tmp_path / "planned")

@@ -43,7 +43,7 @@ from rti_rig.core import fit_minimums
 from rti_rig.core.arm_motion import move_time_s
 from rti_rig.core.devices import Frame
 from rti_rig.core.errors import RtiRigError
-from rti_rig.core.geometry import angle_between_deg
+from rti_rig.core.geometry import angle_between_deg, az_el_from_direction
 from rti_rig.core.image_files import read_linear_tiff
 from rti_rig.core.rig_geometry import ArmGeometry, DomeGeometry
 from rti_rig.core.schedule import LightSchedule, LightStep
@@ -1282,26 +1282,105 @@ def _refuse_nothing_to_choose(  # type: ignore[no-untyped-def]
     lights: int | None,
     until_error_deg: float | None,
     band: tuple[float, float] = _FULL_BAND,
+    min_lights: int | None = None,
 ) -> None:
     """Refuse ``--adaptive`` (or ``--lights N`` with it) on a rig offering no more lights than
     the starting layout: there is nothing left to choose. ``--lights 4`` was refused with "give
     at least 5" and ``--lights 5`` with "give at most 4", sending the user round in a circle,
     while ``--adaptive`` alone ran the lights as a planned run would, labelled adaptive.
-    ``--until-error`` alone is kept: its estimate still says whether these lights reach the
-    target."""
-    if offered > START_LIGHTS or (lights is None and until_error_deg is not None):
+    ``--until-error`` alone is kept where its estimate can say whether these lights reach the
+    target (3 lights or more: photometric stereo's); with fewer it could judge nothing (a
+    1-light session ran, "the target is not claimed").
+
+    The advice is a band that holds the session (:func:`_band_holding`), as a command with
+    the user's own options, and the planned run of the band's lights as the other way: the
+    planned run alone had been advised, ``--lights 1`` on the Nab dome below 20°, a session
+    no fit can use."""
+    if offered > START_LIGHTS:
         return
-    widen = " (or widen --min/--max-elevation-deg)" if tuple(band) != _FULL_BAND else ""
+    if lights is None and until_error_deg is not None and offered >= fit_minimums.NORMAL_MIN_LIGHTS:
+        return
+    from rti_rig.app.config import rig_geometry
+
     noun = "light" if offered == 1 else "lights"
-    # the band's lights (the bare `rti-rig run RIG --out DIR` fires every LED, those the band
-    # keeps out above a gilded object's ceiling too)
-    in_band = "" if tuple(band) == _FULL_BAND else " " + band_run_options(offered, *band)
-    raise RtiRigError(
-        f"this rig offers {offered} {noun}{_band_words(band)}, and an adaptive session starts "
-        f"from {START_LIGHTS} and chooses the next ones: there is none left to choose. Shoot "
-        f"them all with a planned run: rti-rig run {shlex.quote(str(loaded.path))} --out DIR"
-        f"{in_band}{widen}"
+    need = max(START_LIGHTS + 1, lights or 0, min_lights or 0)
+    _, el = az_el_from_direction(rig_geometry(loaded).directions)
+    config = shlex.quote(str(loaded.path))
+    session = (
+        f"an adaptive session needs at least {need}"
+        if need == START_LIGHTS + 1
+        else f"this adaptive session (--{'lights' if need == lights else 'min-lights'} {need}) "
+        f"needs {need}"
     )
+    words = [
+        f"this rig offers {offered} {noun}{_band_words(band)} (its {len(el)} LEDs are at "
+        f"{el.min():.1f}°–{el.max():.1f}° elevation), and {session}: it starts from "
+        f"{START_LIGHTS} and chooses the next ones: there is none left to choose here"
+    ]
+    wider = _band_holding(el, need, band)
+    if wider is not None:
+        asked = (
+            f"--until-error {until_error_deg:g}" if until_error_deg is not None else "--adaptive"
+        )
+        if lights is not None:
+            asked += f" --lights {lights}"
+        if min_lights is not None:
+            asked += f" --min-lights {min_lights}"
+        words.append(
+            f"Widen the band to hold {need}: rti-rig run {config} --out DIR {asked}"
+            f"{_band_options(wider)} ({_held(el, wider)} lights"
+            f"{_band_words(wider) or ' at every elevation'})"
+        )
+    if offered:
+        # the band's lights (the bare `rti-rig run RIG --out DIR` fires every LED, those the
+        # band keeps out above a gilded object's ceiling too)
+        in_band = "" if tuple(band) == _FULL_BAND else " " + band_run_options(offered, *band)
+        caveat = (
+            f" (a test shot only: normals need {fit_minimums.NORMAL_MIN_LIGHTS} lights)"
+            if offered < fit_minimums.NORMAL_MIN_LIGHTS
+            else ""
+        )
+        them = "it" if offered == 1 else f"its {offered}"
+        shoot = (
+            f"shoot {them} with a planned run"
+            if wider is not None
+            else "Shoot them all with a planned run"
+        )
+        words.append(f"{shoot}: rti-rig run {config} --out DIR{in_band}{caveat}")
+    raise RtiRigError(". ".join(words[:2]) + "".join(f"; or {w}" for w in words[2:]))
+
+
+def _band_options(band: tuple[float, float]) -> str:
+    """`` --min-elevation-deg A --max-elevation-deg B`` for those of ``band`` not at their
+    defaults (nothing for every elevation)."""
+    lo, hi = band
+    return (f" --min-elevation-deg {lo:g}" if lo != 0.0 else "") + (
+        f" --max-elevation-deg {hi:g}" if hi != 90.0 else ""
+    )
+
+
+def _held(el: NDArray[np.float64], band: tuple[float, float]) -> int:
+    """How many of the elevations ``el`` (°) ``band`` holds, as :func:`candidates_for` counts."""
+    return int(((el >= band[0] - 1e-9) & (el <= band[1] + 1e-9)).sum())
+
+
+def _band_holding(
+    el: NDArray[np.float64], need: int, band: tuple[float, float]
+) -> tuple[float, float] | None:
+    """The band nearest ``band`` (whole degrees) that holds ``need`` of the LEDs at elevations
+    ``el``: its ceiling raised (the floor kept), else its floor lowered (the ceiling kept), else
+    every elevation; None when the dome has fewer than ``need`` LEDs."""
+    lo, hi = band
+    above = np.sort(el[el >= lo - 1e-9])
+    if hi < 90.0 and len(above) >= need:
+        ceiling = min(90.0, float(np.ceil(above[need - 1] - 1e-9)))
+        return lo, ceiling
+    below = np.sort(el[el <= hi + 1e-9])[::-1]
+    if lo > 0.0 and len(below) >= need:
+        return float(np.floor(below[need - 1] + 1e-9)), hi
+    if len(el) >= need:
+        return _FULL_BAND
+    return None
 
 
 def open_adaptive_session(  # type: ignore[no-untyped-def]
@@ -1336,7 +1415,7 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     offered: int | None = None
     if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
         offered = len(candidates_for(geometry, band[0], max_elevation_deg=band[1]).directions)
-        _refuse_nothing_to_choose(loaded, offered, lights, until_error_deg, band)
+        _refuse_nothing_to_choose(loaded, offered, lights, until_error_deg, band, min_lights)
     if lights is not None and lights < START_LIGHTS + 1:
         asked = "--until-error … " if until_error_deg is not None else "--adaptive "
         raise RtiRigError(

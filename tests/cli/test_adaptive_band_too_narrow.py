@@ -1,0 +1,97 @@
+"""`run --adaptive` (or `--until-error`) in a band too narrow for an adaptive session, on the
+shipped Nab dome (12 LEDs, 16.8°–75.7°): the refusal says how many LEDs the band holds, what
+the session needs, and a command that works — the band widened to hold it, with the user's
+own options — as well as the planned run of the band's lights.
+
+Below 20° the Nab dome holds one LED, and the only advice had been a planned run of
+``--lights 1``: a single image, no normals, no fit. ``--until-error`` alone there ran that one
+light and said "the target is not claimed" (nothing can be estimated from one image). The
+advised commands are run here, as a user would paste them."""
+
+from __future__ import annotations
+
+import math
+import shlex
+from pathlib import Path
+
+import pytest
+from conftest import CONFIGS, journal, said
+from typer.testing import CliRunner
+
+from rti_rig.cli import app
+
+runner = CliRunner()
+NAB = CONFIGS / "emulated_nab_rti_v1.toml"
+
+
+def _advised(text: str, lead: str, tmp_path: Path, name: str) -> list[str]:
+    """The command after ``lead`` in ``text`` (up to its parenthesis), DIR made a folder."""
+    command = text.split(lead, 1)[1].split(" (", 1)[0]
+    argv = shlex.split(command)
+    assert argv[:2] == ["rti-rig", "run"], command
+    argv[argv.index("DIR")] = str(tmp_path / name)
+    return argv[1:]
+
+
+def _elevations(session: Path) -> list[float]:
+    return [math.degrees(math.asin(s["actual_direction"][2])) for s in journal(session)]
+
+
+@pytest.mark.parametrize(
+    ("asked", "kept"),
+    [(["--adaptive"], "--adaptive"), (["--until-error", "30"], "--until-error 30")],
+)
+def test_a_band_of_one_nab_led_is_refused_with_a_band_that_holds_the_session(
+    tmp_path: Path, asked: list[str], kept: str
+) -> None:
+    out = tmp_path / "s"
+    argv = ["run", str(NAB), "--out", str(out), *asked, "--max-elevation-deg", "20"]
+    r = runner.invoke(app, argv)
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert not out.exists()
+    assert "this rig offers 1 light between 0° and 20° elevation" in text, text
+    assert "its 12 LEDs are at 16.8°–75.7° elevation" in text, text
+    assert "an adaptive session needs at least 5: it starts from 4" in text, text
+    assert f"--out DIR {kept} --max-elevation-deg 33 (5 lights between 0° and 33°" in text, text
+    # the widened band's command works, and keeps to its band
+    argv = _advised(text, "Widen the band to hold 5: ", tmp_path, "wide")
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    lit = _elevations(tmp_path / "wide")
+    assert len(lit) >= 4 and max(lit) <= 33, lit
+    # the planned run of the band's one light is said for what it is
+    assert "(a test shot only: normals need 3 lights)" in text, text
+    argv = _advised(text, "or shoot it with a planned run: ", tmp_path, "planned")
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    assert len(_elevations(tmp_path / "planned")) == 1
+
+
+def test_the_widened_band_holds_the_lights_asked_for(tmp_path: Path) -> None:
+    """--lights 9: the band advised holds 9, and the command keeps --lights 9."""
+    out = tmp_path / "s"
+    args = ["--adaptive", "--lights", "9", "--max-elevation-deg", "20"]
+    r = runner.invoke(app, ["run", str(NAB), "--out", str(out), *args])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "this adaptive session (--lights 9) needs 9" in text, text
+    argv = _advised(text, "Widen the band to hold 9: ", tmp_path, "wide")
+    assert "--lights" in argv and argv[argv.index("--lights") + 1] == "9", argv
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    assert len(_elevations(tmp_path / "wide")) == 9
+
+
+def test_a_floor_too_high_is_lowered(tmp_path: Path) -> None:
+    out = tmp_path / "s"
+    args = ["--adaptive", "--min-elevation-deg", "60"]
+    r = runner.invoke(app, ["run", str(NAB), "--out", str(out), *args])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "this rig offers 2 lights between 60° and 90° elevation" in text, text
+    argv = _advised(text, "Widen the band to hold 5: ", tmp_path, "wide")
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    low = float(argv[argv.index("--min-elevation-deg") + 1])
+    assert min(_elevations(tmp_path / "wide")) >= low - 1e-6
