@@ -95,3 +95,23 @@ def test_a_floor_too_high_is_lowered(tmp_path: Path) -> None:
     assert r.exit_code == 0, said(r)
     low = float(argv[argv.index("--min-elevation-deg") + 1])
     assert min(_elevations(tmp_path / "wide")) >= low - 1e-6
+
+
+def test_a_band_with_no_led_is_refused_with_one_that_holds_the_session(tmp_path: Path) -> None:
+    """Above 80° on the simulated dome (its highest ring is at 70°): the refusal had been
+    "widen --min-elevation-deg / --max-elevation-deg", with no value that would do."""
+    out = tmp_path / "s"
+    dome = CONFIGS / "simulated_dome.toml"
+    r = runner.invoke(
+        app, ["run", str(dome), "--out", str(out), "--adaptive", "--min-elevation-deg", "80"]
+    )
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "this rig offers 0 lights between 80° and 90° elevation" in text, text
+    assert "planned run" not in text, text  # no light of the band to shoot
+    argv = _advised(text, "Widen the band to hold 5: ", tmp_path, "wide")
+    r = runner.invoke(app, [*argv, "--no-verdict"])
+    assert r.exit_code == 0, said(r)
+    low = float(argv[argv.index("--min-elevation-deg") + 1])
+    assert len(_elevations(tmp_path / "wide")) >= 5
+    assert min(_elevations(tmp_path / "wide")) >= low - 1e-6

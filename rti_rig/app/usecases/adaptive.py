@@ -1414,7 +1414,10 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     geometry = rig_geometry(loaded)
     offered: int | None = None
     if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
-        offered = len(candidates_for(geometry, band[0], max_elevation_deg=band[1]).directions)
+        # counted as candidates_for counts, but a band holding none is refused with a band
+        # that holds the session (it had been "widen --min-elevation-deg /
+        # --max-elevation-deg", with no value that would do)
+        offered = _held(az_el_from_direction(geometry.directions)[1], band)
         _refuse_nothing_to_choose(loaded, offered, lights, until_error_deg, band, min_lights)
     if lights is not None and lights < START_LIGHTS + 1:
         asked = "--until-error … " if until_error_deg is not None else "--adaptive "
