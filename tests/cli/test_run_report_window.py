@@ -118,3 +118,31 @@ def test_two_ctrl_c_as_a_failed_capture_is_reported_leave_the_error_and_resume_s
     assert f"Continue with: rti-rig run --resume {out}" in said, said
     assert "error: camera: no frame came" in said, said
     assert r.exit_code == 2, said
+
+
+def test_two_ctrl_c_as_a_session_stopped_before_its_capture_closes_are_answered(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C at the hand-over stops the session before its first image; two more as its
+    rig is closed had been told "Stopping after this image", then raised EmergencyStop out
+    of the except clause that closes it."""
+    real_execute, real_stopped = cli_session._execute, cli_session._stopped_before_capture
+
+    def execute(*args: Any, **kwargs: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)  # held by the hand-over: the capture never begins
+        return real_execute(*args, **kwargs)
+
+    def stopped_before_capture(*args: Any, **kwargs: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)
+        return real_stopped(*args, **kwargs)
+
+    monkeypatch.setattr(cli_session, "_execute", execute)
+    monkeypatch.setattr(cli_session, "_stopped_before_capture", stopped_before_capture)
+    r, said, out = _run(tmp_path)
+    assert not (out / "lights.lp").exists(), said  # nothing was captured
+    assert r.exception is None or isinstance(r.exception, SystemExit), repr(r.exception)
+    assert "Stopping after this image" not in said, said
+    assert said.count("Ctrl-C while the session stopped before its first image") == 1, said
+    assert "Stopped (Ctrl-C) before the first image: nothing was captured" in said, said
+    assert r.exit_code == 130, said
