@@ -115,3 +115,40 @@ def test_a_band_with_no_led_is_refused_with_one_that_holds_the_session(tmp_path:
     low = float(argv[argv.index("--min-elevation-deg") + 1])
     assert len(_elevations(tmp_path / "wide")) >= 5
     assert min(_elevations(tmp_path / "wide")) >= low - 1e-6
+
+
+@pytest.mark.parametrize("option", ["--lights", "--min-lights"])
+def test_more_lights_than_the_band_holds_are_refused_with_a_band_that_holds_them(
+    tmp_path: Path, option: str
+) -> None:
+    """`--lights 14` (or `--until-error … --min-lights 14`) below 10° on the simulated dome,
+    whose 10° ring holds 12: "give at most 12 (or widen --min/--max-elevation-deg)" gave no
+    value; the band that holds 14 is named, and the session runs in it."""
+    dome = CONFIGS / "simulated_dome.toml"
+    asked = ["--adaptive", "--lights", "14"] if option == "--lights" else []
+    if option == "--min-lights":
+        asked = ["--until-error", "30", "--min-lights", "14"]
+    band = ["--max-elevation-deg", "10"]
+    out = tmp_path / "s"
+    r = runner.invoke(app, ["run", str(dome), "--out", str(out), *asked, *band])
+    text = said(r)
+    assert r.exit_code == 2, text
+    assert "this rig offers 12 lights between 0° and 10° elevation" in text, text
+    ceiling = text.split("(or widen the band to hold 14: --max-elevation-deg ", 1)[1]
+    ceiling = ceiling.split(")", 1)[0]
+    r = runner.invoke(
+        app,
+        [
+            "run",
+            str(dome),
+            "--out",
+            str(tmp_path / "wide"),
+            *asked,
+            "--max-elevation-deg",
+            ceiling,
+            "--no-verdict",
+        ],
+    )
+    assert r.exit_code == 0, said(r)
+    lit = _elevations(tmp_path / "wide")
+    assert len(lit) == 14 and max(lit) <= float(ceiling) + 1e-6, lit

@@ -1247,13 +1247,33 @@ def check_min_lights(
 
 
 def _check_min_within(
-    min_lights: int, offered: int, band: tuple[float, float] = _FULL_BAND
+    min_lights: int,
+    offered: int,
+    band: tuple[float, float] = _FULL_BAND,
+    el: NDArray[np.float64] | None = None,
 ) -> None:
+    """``--min-lights M`` above what the rig offers (in the band) is refused; ``el``: a dome's
+    LED elevations (°), for the band that would hold M (:func:`_widen_to_hold`)."""
     if min_lights > offered:
         raise RtiRigError(
             f"--min-lights {min_lights}: this rig offers {offered} lights{_band_words(band)} "
             f"an adaptive session can use; give at most {offered}"
+            f"{_widen_to_hold(min_lights, band, el)}"
         )
+
+
+def _widen_to_hold(need: int, band: tuple[float, float], el: NDArray[np.float64] | None) -> str:
+    """`` (or widen the band to hold N: --max-elevation-deg C)`` for a band asked for, where a
+    dome's elevations ``el`` say which would (a generic "widen" where they do not: an arm);
+    nothing over every elevation. Why: "widen --min/--max-elevation-deg" gave no value."""
+    if tuple(band) == _FULL_BAND:
+        return ""
+    if el is None:
+        return " (or widen --min/--max-elevation-deg)"
+    wider = _band_holding(el, need, band)
+    if wider is None:  # the dome has fewer LEDs in all: no band holds them
+        return ""
+    return f" (or widen the band to hold {need}:{_band_options(wider)})"
 
 
 def _band_words(band: tuple[float, float]) -> str:
@@ -1264,15 +1284,18 @@ def _band_words(band: tuple[float, float]) -> str:
 
 
 def _check_lights_within(
-    lights: int | None, offered: int, band: tuple[float, float] = _FULL_BAND
+    lights: int | None,
+    offered: int,
+    band: tuple[float, float] = _FULL_BAND,
+    el: NDArray[np.float64] | None = None,
 ) -> None:
     """``--lights N`` above what the rig offers is refused, as a planned session's is (it was
-    capped without a word: 100 asked of a 48-LED dome ran 48)."""
+    capped without a word: 100 asked of a 48-LED dome ran 48); ``el`` as
+    :func:`_check_min_within`'s."""
     if lights is not None and lights > offered:
-        widen = " (or widen --min/--max-elevation-deg)" if tuple(band) != _FULL_BAND else ""
         raise RtiRigError(
             f"--lights {lights}: this rig offers {offered} lights{_band_words(band)} an "
-            f"adaptive session can use; give at most {offered}{widen}"
+            f"adaptive session can use; give at most {offered}{_widen_to_hold(lights, band, el)}"
         )
 
 
@@ -1413,11 +1436,13 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
 
     geometry = rig_geometry(loaded)
     offered: int | None = None
+    elevations: NDArray[np.float64] | None = None  # a dome's LEDs' (°)
     if isinstance(geometry, DomeGeometry):  # a dome's lights are known from its config: before
         # counted as candidates_for counts, but a band holding none is refused with a band
         # that holds the session (it had been "widen --min-elevation-deg /
         # --max-elevation-deg", with no value that would do)
-        offered = _held(az_el_from_direction(geometry.directions)[1], band)
+        elevations = az_el_from_direction(geometry.directions)[1]
+        offered = _held(elevations, band)
         _refuse_nothing_to_choose(loaded, offered, lights, until_error_deg, band, min_lights)
     if lights is not None and lights < START_LIGHTS + 1:
         asked = "--until-error … " if until_error_deg is not None else "--adaptive "
@@ -1428,9 +1453,9 @@ def open_adaptive_session(  # type: ignore[no-untyped-def]
     check_objective(objective, lights, until_error_deg)
     check_min_lights(min_lights, lights, until_error_deg)
     if offered is not None:
-        _check_lights_within(lights, offered, band)
+        _check_lights_within(lights, offered, band, elevations)
         if min_lights is not None:
-            _check_min_within(min_lights, offered, band)
+            _check_min_within(min_lights, offered, band, elevations)
     SessionFolder.check_new(out_dir)
     if check_room is not None:  # the disk, before the rig is built (as a planned run's)
         check_room(*images_before_rig(loaded, offered, lights, until_error_deg, min_lights, band))
