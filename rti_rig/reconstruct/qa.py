@@ -77,8 +77,11 @@ from rti_rig.reconstruct.qa_drift import (
 from rti_rig.reconstruct.qa_exposure import (
     EXPOSURE_MATE_DEG,
     EXPOSURE_OFF,
+    EXPOSURE_SCATTER_Z,
+    exposure_limit,
     exposure_off,
     exposure_ratios,
+    exposure_scatter,
 )
 from rti_rig.reconstruct.qa_surface import faint_black_frame, surface_margin_deg
 from rti_rig.reconstruct.signal_check import SAMPLE_PIXELS, every_image_black, sample_grid
@@ -329,8 +332,12 @@ class ImageCheck:
     #: (:func:`~rti_rig.reconstruct.qa_exposure.exposure_ratios`); NaN where the session does
     #: not show that azimuth leaves the level alone there (too few such images, mates that
     #: disagree, no other elevation's pair to prove it), and for a clipped image.
-    #: :data:`EXPOSURE_OFF` either way names it.
+    #: ``exposure_limit`` either way names it.
     exposure_ratio: float = float("nan")
+    #: The factor either way from which ``exposure_ratio`` names the image: :data:`EXPOSURE_OFF`,
+    #: wider where the session's light scatter spreads correct images' ratios further
+    #: (:func:`~rti_rig.reconstruct.qa_exposure.exposure_limit`).
+    exposure_limit: float = EXPOSURE_OFF
     #: Which of ``problems`` says the image is brighter than predicted (the bright-image
     #: check's or the exposure check's), None when none does. Kept apart so that
     #: :meth:`QAReport.explain_bright_by_lights` takes that claim off by what it is, not by
@@ -1482,8 +1489,11 @@ def assess(
     # (a clipped image's level is a lower bound and its highlight may cover much of the
     # frame (the real neuralrti_replay's image09, 21 %): no mate, and never judged)
     wrong_judged = ev.wrong & ev.direction_judged
-    exposure, mates = exposure_ratios(level, lt, ~ev.dim & ~wrong_judged & ~clipped)
+    exposure_usable = ~ev.dim & ~wrong_judged & ~clipped
+    exposure, mates = exposure_ratios(level, lt, exposure_usable)
     exposure[clipped] = np.nan
+    # an uneven dome's LEDs scatter a correct image's level against its mates' (qa_exposure)
+    limit = np.array([exposure_limit(s) for s in exposure_scatter(level, lt, exposure_usable)])
     checks: list[ImageCheck] = []
     for i in range(n):
         problems = []
@@ -1537,7 +1547,7 @@ def assess(
             bright_claim = f"{ev.gain[i]:.1f}× {BRIGHTER}"
             problems.append(bright_claim)
         if (
-            exposure_off(exposure[i])
+            exposure_off(exposure[i], float(limit[i]))
             and not all_black
             and not ev.dim[i]
             and not wrong_i
@@ -1607,6 +1617,7 @@ def assess(
                 ),
                 reliable_gain=float(ev.reliable_gain[i]),
                 exposure_ratio=float(exposure[i]),
+                exposure_limit=float(limit[i]),
                 bright_problem=bright_claim,
             )
         )
@@ -1639,6 +1650,7 @@ def assess(
         "neighbour_span_deg": NEIGHBOUR_SPAN_DEG,
         "min_coverage": MIN_COVERAGE,
         "exposure_off": EXPOSURE_OFF,
+        "exposure_scatter_z": EXPOSURE_SCATTER_Z,
         "exposure_mate_deg": EXPOSURE_MATE_DEG,
     }
     return QAReport(

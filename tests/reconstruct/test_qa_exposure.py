@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from rti_rig.reconstruct.qa_exposure import exposure_off, exposure_ratios
+from rti_rig.reconstruct.qa_exposure import (
+    EXPOSURE_OFF,
+    exposure_limit,
+    exposure_off,
+    exposure_ratios,
+    exposure_scatter,
+)
 
 
 def _lights(elevations_deg: list[float], azimuths_deg: list[float] | None = None) -> np.ndarray:
@@ -95,3 +101,25 @@ def test_another_rings_pair_from_its_side_and_a_mates_lets_a_ring_of_3_be_judged
     level = np.array([0.2, 0.2, 0.2, 0.1, 0.3, 0.3]) * lt[:, 2]  # the 55° 22.5° image halved
     ratio, _ = exposure_ratios(level, lt, np.ones(6, bool))
     assert abs(ratio[3] - 1 / 3) < 1e-9 and exposure_off(ratio[3])
+
+
+def test_the_limit_widens_by_the_scatter_the_other_images_show() -> None:
+    # 24 lights, one per elevation 3 to 60°: a level object (level = lz) under LEDs ±20 %
+    el = list(np.linspace(3.0, 60.0, 24))
+    lt = _lights(el)
+    power = np.exp(0.2 * np.random.default_rng(7).standard_normal(24))
+    level = lt[:, 2] * power
+    usable = np.ones(24, bool)
+    scatter = exposure_scatter(level, lt, usable)
+    assert 0.1 < float(np.nanmedian(scatter)) < 0.35
+    limit = exposure_limit(float(scatter[12]))
+    assert limit > 1.75  # a correct LED 0.6 of its mates' (1.7x) is within it
+    # the scatter is of the other images: image 12's own fault does not widen it
+    dim = level.copy()
+    dim[12] *= 0.05
+    assert abs(exposure_scatter(dim, lt, usable)[12] - scatter[12]) < 0.08
+    # even LEDs: no scatter, the limit stays 1.5x; too few images: not measured
+    assert exposure_limit(float(exposure_scatter(lt[:, 2], lt, usable)[12])) == EXPOSURE_OFF
+    assert np.isnan(exposure_scatter(level[:6], lt[:6], usable[:6])).all()
+    assert exposure_limit(float("nan")) == EXPOSURE_OFF
+    assert exposure_off(0.3, limit) and not exposure_off(0.6, limit)
